@@ -1,0 +1,82 @@
+# pound — nonsmooth dynamics of pounding structures.
+#
+#   make demo     install missing packages (as root), build, run the main job
+#   make test     install missing packages (as root), build, run the tests
+#   make asan     the tests under AddressSanitizer + UndefinedBehaviorSanitizer
+#   make bench    performance figures (pound bench)
+#   make all      library and binary only (build/libpound.a, build/pound)
+#
+# Layers: cli -> problems -> engine -> lcp; HDF5 is used by cli/ only.
+
+CC      ?= cc
+OPT     ?= -O2
+CFLAGS  ?= $(OPT) -g
+WARN     = -std=c11 -Wall -Wextra -Wshadow -Wpedantic -Werror
+DEFS     = -D_POSIX_C_SOURCE=200809L
+BUILD   ?= build
+
+# Dependencies through pkg-config (Debian's SuiteSparse 5 ships no .pc file;
+# its headers live in the documented suitesparse/ subfolder of the include path).
+PKGS         = gsl hdf5
+PKG_CFLAGS  := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
+PKG_LIBS    := $(shell pkg-config --libs $(PKGS) 2>/dev/null)
+SS_CFLAGS   := $(shell pkg-config --cflags cholmod 2>/dev/null || echo -I/usr/include/suitesparse)
+SS_LIBS     := $(shell pkg-config --libs cholmod cxsparse 2>/dev/null || echo -lcholmod -lcxsparse)
+
+INC      = -Ilcp -Iengine -Iproblems -Icli
+ALL_CFLAGS = $(WARN) $(DEFS) $(CFLAGS) $(INC) $(PKG_CFLAGS) $(SS_CFLAGS) $(XCFLAGS)
+LIBS     = $(PKG_LIBS) $(SS_LIBS) -lm
+
+LIB_SRC  = $(wildcard lcp/*.c) $(wildcard engine/*.c) $(wildcard problems/*.c)
+CLI_SRC  = $(wildcard cli/*.c)
+TEST_SRC = $(wildcard tests/*.c)
+LIB_OBJ  = $(LIB_SRC:%.c=$(BUILD)/%.o)
+CLI_OBJ  = $(CLI_SRC:%.c=$(BUILD)/%.o)
+TEST_OBJ = $(TEST_SRC:%.c=$(BUILD)/%.o)
+HDRS     = $(wildcard */*.h)
+
+.PHONY: all deps demo test check asan bench clean acceptance
+
+all: $(BUILD)/pound $(BUILD)/pound_tests
+
+$(BUILD)/%.o: %.c $(HDRS)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -c $< -o $@
+
+$(BUILD)/libpound.a: $(LIB_OBJ)
+	ar rcs $@ $^
+
+$(BUILD)/pound: $(CLI_OBJ) $(BUILD)/libpound.a
+	$(CC) $(CFLAGS) $(XCFLAGS) -o $@ $(CLI_OBJ) $(BUILD)/libpound.a $(LIBS)
+
+$(BUILD)/pound_tests: $(TEST_OBJ) $(BUILD)/libpound.a
+	$(CC) $(CFLAGS) $(XCFLAGS) -o $@ $(TEST_OBJ) $(BUILD)/libpound.a $(LIBS)
+
+deps:
+	@sh scripts/deps.sh
+
+# The main job: the paper's Fig. 9 case, normal and reverse pulse.
+demo: deps
+	@$(MAKE) --no-print-directory all
+	$(BUILD)/pound simulate --pulse sine --dir normal  --Tp 0.3 --T0 3 --ap 4 --gap 0.004 --eps 0.6
+	$(BUILD)/pound simulate --pulse sine --dir reverse --Tp 0.3 --T0 3 --ap 4 --gap 0.004 --eps 0.6
+
+test: deps
+	@$(MAKE) --no-print-directory check
+
+check: all
+	$(BUILD)/pound_tests --pound $(BUILD)/pound
+
+asan: deps
+	@$(MAKE) --no-print-directory BUILD=build-asan OPT=-O1 \
+	  XCFLAGS="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer" check
+
+bench: deps
+	@$(MAKE) --no-print-directory all
+	$(BUILD)/pound bench
+
+acceptance: all
+	@for s in ../shared/acceptance/*.sh; do echo "== $$s"; $$s $(BUILD)/pound || exit 1; done
+
+clean:
+	rm -rf build build-asan

@@ -1,0 +1,47 @@
+/* args.c — parsing flag values with errors that name the flag. */
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+
+#include "pd_cli.h"
+
+int pd_cli_usage_error(const char *fmt, ...)
+{
+    va_list ap;
+    fputs("pound: ", stderr);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fputc('\n', stderr);
+    return 2;
+}
+
+int pd_cli_double(const char *flag, const char *text, double *out)
+{
+    char *end = NULL;
+    if (!text)
+        return pd_cli_usage_error("%s needs a value", flag);
+    errno = 0;
+    double x = strtod(text, &end);
+    if (end == text || *end != '\0' || errno == ERANGE)
+        return pd_cli_usage_error("%s: '%s' is not a number", flag, text);
+    if (!isfinite(x))
+        return pd_cli_usage_error("%s: '%s' is not a finite number", flag, text);
+    *out = x;
+    return 0;
+}
+
+int pd_cli_int(const char *flag, const char *text, int *out)
+{
+    char *end = NULL;
+    if (!text)
+        return pd_cli_usage_error("%s needs a value", flag);
+    errno = 0;
+    long x = strtol(text, &end, 10);
+    if (end == text || *end != '\0' || errno == ERANGE || x < INT_MIN || x > INT_MAX)
+        return pd_cli_usage_error("%s: '%s' is not an integer", flag, text);
+    *out = (int)x;
+    return 0;
+}

@@ -1,0 +1,46 @@
+/* cmd_bench.c — `pound bench [--lcp] [--engine] [--json] [--shared DIR]`. */
+#include <string.h>
+
+#include "pd_cli.h"
+
+int pd_cmd_bench(int argc, char **argv)
+{
+    int json = 0, want_lcp = 0, want_engine = 0;
+    const char *shared = "../shared";
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--json"))
+            json = 1;
+        else if (!strcmp(argv[i], "--lcp"))
+            want_lcp = 1;
+        else if (!strcmp(argv[i], "--engine"))
+            want_engine = 1;
+        else if (!strcmp(argv[i], "--shared") && i + 1 < argc)
+            shared = argv[++i];
+        else if (!strcmp(argv[i], "--help")) {
+            puts("usage: pound bench [--lcp] [--engine] [--json] [--shared DIR]\n"
+                 "  no selection runs every benchmark; --shared points at the shared data\n"
+                 "  folder holding lcp/siconos (default ../shared)");
+            return 0;
+        } else
+            return pd_cli_usage_error("bench: unknown flag '%s'", argv[i]);
+    }
+    if (!want_lcp && !want_engine)
+        want_lcp = want_engine = 1;
+
+    pd_json js, *jp = NULL;
+    if (json) {
+        pd_json_init(&js, stdout);
+        pd_json_begin_object(&js, NULL);
+        jp = &js;
+    }
+    int rc = 0;
+    if (want_lcp)
+        rc |= pd_bench_lcp(jp, shared);
+    if (want_engine)
+        rc |= pd_bench_engine(jp);
+    if (json) {
+        pd_json_end_object(&js);
+        pd_json_finish(&js);
+    }
+    return rc ? 1 : 0;
+}

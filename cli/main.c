@@ -1,0 +1,30 @@
+/* main.c — `pound`: dispatch to a subcommand. */
+#include <string.h>
+
+#include "pd_cli.h"
+
+static const char usage[] =
+    "usage: pound <command> [options]\n"
+    "\n"
+    "commands:\n"
+    "  simulate   one run of the pounding oscillator (Moreau-Jean)\n"
+    "  lcp FILE   solve one linear complementarity problem (Lemke)\n"
+    "  bench      performance figures (--lcp, --engine)\n"
+    "\n"
+    "`pound <command> --help` lists a command's options; docs/ has the details.\n";
+
+int main(int argc, char **argv)
+{
+    if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
+        fputs(usage, argc < 2 ? stderr : stdout);
+        return argc < 2 ? 2 : 0;
+    }
+    const char *cmd = argv[1];
+    if (!strcmp(cmd, "lcp"))
+        return pd_cmd_lcp(argc - 1, argv + 1);
+    if (!strcmp(cmd, "simulate"))
+        return pd_cmd_simulate(argc - 1, argv + 1);
+    if (!strcmp(cmd, "bench"))
+        return pd_cmd_bench(argc - 1, argv + 1);
+    return pd_cli_usage_error("unknown command '%s' (try `pound --help`)", cmd);
+}

@@ -1,0 +1,80 @@
+/* pd_lcp.h — linear complementarity problems.
+ *
+ *   find z >= 0 such that w = M z + q >= 0 and z'w = 0,   M dense n x n.
+ *
+ * Matrices are dense, COLUMN-MAJOR, leading dimension n: M[i + j*n] = M_ij.
+ * Lemke's complementary pivoting method with a covering vector d (default all
+ * ones) and a lexicographic minimum-ratio rule; a workspace sized for a
+ * maximum n is allocated once and reused, so a solve never allocates. */
+#ifndef PD_LCP_H
+#define PD_LCP_H
+
+#include <stdio.h>
+
+#include "pd_status.h"
+
+/* Outcome of a solve.  The solver returns PD_OK for PD_LCP_SOLVED and the
+ * negative status PD_ENOSOLUTION / PD_EMAXPIVOTS / PD_ENUMERICAL otherwise. */
+typedef enum {
+    PD_LCP_SOLVED = 0,      /* verified solution */
+    PD_LCP_NO_SOLUTION = 1, /* ray termination */
+    PD_LCP_MAX_PIVOTS = 2,  /* pivot cap reached */
+    PD_LCP_NUMERICAL = 3    /* pivot too small, or the answer failed verification */
+} pd_lcp_outcome;
+
+/* Name of an outcome as printed by `pound lcp`: "solved", "no_solution",
+ * "max_pivots", "numerical". */
+const char *pd_lcp_outcome_name(pd_lcp_outcome outcome);
+
+/* Options; zero-initialise for the defaults. */
+typedef struct pd_lcp_opts {
+    const double *cover; /* covering vector d > 0 (n entries), NULL = all ones */
+    int max_pivots;      /* pivot cap, <= 0 = default (documented in docs/lcp.md) */
+    double tol;          /* relative tolerance for ties and tiny pivots, <= 0 = default */
+} pd_lcp_opts;
+
+/* What a solve reports. */
+typedef struct pd_lcp_info {
+    pd_lcp_outcome outcome;
+    int pivots;             /* pivots performed, counting the one that brings z0 in */
+    double complementarity; /* max_i |z_i w_i| */
+    double infeasibility;   /* max_i max(-z_i, -w_i, 0) */
+    double scale;           /* data scale the two figures above are relative to */
+} pd_lcp_info;
+
+typedef struct pd_lcp_work pd_lcp_work;
+
+/* Workspace for problems of size up to nmax; NULL when out of memory. */
+pd_lcp_work *pd_lcp_alloc(int nmax);
+void pd_lcp_free(pd_lcp_work *work);
+int pd_lcp_nmax(const pd_lcp_work *work);
+
+/* Solve the LCP (M, q) of size n <= nmax by Lemke's method.  z and w receive
+ * n entries each.  Returns PD_OK only for a verified solution.  Never
+ * allocates. info may be NULL. */
+int pd_lcp_lemke(pd_lcp_work *work, int n, const double *M, const double *q,
+                 const pd_lcp_opts *opts, double *z, double *w, pd_lcp_info *info);
+
+/* Brute-force enumeration of the 2^n complementary bases, n <= 12: the test
+ * oracle.  Returns PD_OK with a solution (the first found, in order of
+ * increasing support) or PD_ENOSOLUTION if none exists. */
+int pd_lcp_enumerate(int n, const double *M, const double *q, double *z, double *w);
+
+/* Residuals of a candidate z: fills w = M z + q and returns, through the
+ * pointers, max|z_i w_i|, the largest sign violation, and the data scale
+ * max(1, max|q|, max|M| * max(1, max|z|)). */
+void pd_lcp_residual(int n, const double *M, const double *q, const double *z,
+                     double *w, double *complementarity, double *infeasibility,
+                     double *scale);
+
+/* File formats: plain (SPEC §3, row-major, '#' comments) and Siconos
+ * (column-major).  PD_LCP_FORMAT_AUTO detects which. */
+typedef enum { PD_LCP_FORMAT_AUTO, PD_LCP_FORMAT_PLAIN, PD_LCP_FORMAT_SICONOS } pd_lcp_format;
+
+/* Read an LCP from a file; on success *M (column-major n x n) and *q are
+ * malloc'd and owned by the caller.  A malformed file returns PD_EPARSE with
+ * a message naming the line. */
+int pd_lcp_read(const char *path, pd_lcp_format format, int *n, double **M, double **q,
+                pd_err *err);
+
+#endif

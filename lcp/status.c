@@ -1,0 +1,59 @@
+/* status.c — status codes, error messages and clocks. */
+#include "pd_status.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <time.h>
+
+const char *pd_strerror(int status)
+{
+    switch (status) {
+    case PD_OK: return "ok";
+    case PD_ENOMEM: return "out of memory";
+    case PD_EINVAL: return "invalid argument";
+    case PD_ENOSOLUTION: return "no solution (ray termination)";
+    case PD_EMAXPIVOTS: return "pivot limit reached";
+    case PD_ENUMERICAL: return "numerical failure";
+    case PD_ENONFINITE: return "non-finite value";
+    case PD_EIO: return "input/output error";
+    case PD_EPARSE: return "malformed input";
+    case PD_ESINGULAR: return "singular matrix";
+    case PD_EBUDGET: return "budget exhausted";
+    case PD_ESTOPPED: return "stopped by observer";
+    default: return "unknown status";
+    }
+}
+
+int pd_err_set(pd_err *err, int status, const char *fmt, ...)
+{
+    if (err) {
+        va_list ap;
+        err->status = status;
+        va_start(ap, fmt);
+        vsnprintf(err->msg, sizeof err->msg, fmt, ap);
+        va_end(ap);
+    }
+    return status;
+}
+
+void pd_err_clear(pd_err *err)
+{
+    if (err) {
+        err->status = PD_OK;
+        err->msg[0] = '\0';
+    }
+}
+
+double pd_wall_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+double pd_cpu_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}

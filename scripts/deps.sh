@@ -1,0 +1,21 @@
+#!/bin/sh
+# deps.sh — make sure the Debian packages pound needs are installed.
+# As root, installs what is missing; otherwise prints the one apt-get line
+# needed and fails.  Usage: scripts/deps.sh [--ci]   (--ci adds CI-only tools)
+set -u
+pkgs="gcc make pkg-config libgsl-dev libsuitesparse-dev libhdf5-dev hdf5-tools gnuplot-nox"
+[ "${1:-}" = "--ci" ] && pkgs="$pkgs python3"
+missing=""
+for p in $pkgs; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+[ -z "$missing" ] && exit 0
+if [ "$(id -u)" = 0 ]; then
+    echo "deps: installing$missing" >&2
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -qq >&2 && apt-get install -y -qq --no-install-recommends $missing >&2 && exit 0
+    echo "deps: apt-get failed" >&2
+    exit 1
+fi
+echo "deps: missing packages; run:  sudo apt-get install -y$missing" >&2
+exit 1

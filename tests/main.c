@@ -1,0 +1,81 @@
+/* main.c — test runner: runs every suite, ends with "N passed, N failed". 
+ *
+ * usage: pound_tests [--pound PATH] [--shared DIR] [FILTER] */
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "pd_test.h"
+
+void pd_test_run(pd_test_ctx *ctx, const char *name, void (*fn)(pd_test_ctx *))
+{
+    if (ctx->filter && !strstr(name, ctx->filter))
+        return;
+    ctx->case_failures = 0;
+    ctx->case_skipped = 0;
+    ctx->case_name = name;
+    fn(ctx);
+    if (ctx->case_failures) {
+        ctx->failed++;
+        printf("FAIL  %s\n", name);
+    } else if (ctx->case_skipped) {
+        ctx->skipped++;
+    } else {
+        ctx->passed++;
+        printf("ok    %s\n", name);
+    }
+    fflush(stdout);
+}
+
+int pd_test_check(pd_test_ctx *ctx, int ok, const char *file, int line, const char *fmt, ...)
+{
+    if (!ok) {
+        va_list ap;
+        printf("  %s:%d: %s: ", file, line, ctx->case_name);
+        va_start(ap, fmt);
+        vprintf(fmt, ap);
+        va_end(ap);
+        printf("\n");
+        ctx->case_failures++;
+    }
+    return ok;
+}
+
+void pd_test_skip(pd_test_ctx *ctx, const char *why)
+{
+    printf("skip  %s: skipped (%s)\n", ctx->case_name, why);
+    ctx->case_skipped = 1;
+}
+
+static int is_dir(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+int main(int argc, char **argv)
+{
+    pd_test_ctx ctx;
+    memset(&ctx, 0, sizeof ctx);
+    ctx.pound = "build/pound";
+    ctx.shared = getenv("POUND_SHARED") ? getenv("POUND_SHARED") : "../shared";
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--pound") && i + 1 < argc)
+            ctx.pound = argv[++i];
+        else if (!strcmp(argv[i], "--shared") && i + 1 < argc)
+            ctx.shared = argv[++i];
+        else
+            ctx.filter = argv[i];
+    }
+    if (!is_dir(ctx.shared))
+        ctx.shared = NULL;
+
+    suite_lcp(&ctx);
+    suite_engine(&ctx);
+    suite_oscillator(&ctx);
+    suite_cli(&ctx);
+
+    printf("%d passed, %d failed, %d skipped\n", ctx.passed, ctx.failed, ctx.skipped);
+    return ctx.failed ? 1 : 0;
+}
