@@ -41,16 +41,20 @@ all: $(BUILD)/pound $(BUILD)/pound_tests
 
 $(BUILD)/%.o: %.c $(HDRS)
 	@mkdir -p $(dir $@)
-	$(CC) $(ALL_CFLAGS) -c $< -o $@
+	@echo "  CC    $<"
+	@$(CC) $(ALL_CFLAGS) -c $< -o $@
 
 $(BUILD)/libpound.a: $(LIB_OBJ)
-	ar rcs $@ $^
+	@echo "  AR    $@"
+	@rm -f $@ && ar rcs $@ $^
 
 $(BUILD)/pound: $(CLI_OBJ) $(BUILD)/libpound.a
-	$(CC) $(CFLAGS) $(XCFLAGS) -o $@ $(CLI_OBJ) $(BUILD)/libpound.a $(LIBS)
+	@echo "  LD    $@"
+	@$(CC) $(CFLAGS) $(XCFLAGS) -o $@ $(CLI_OBJ) $(BUILD)/libpound.a $(XOBJ) $(LIBS)
 
 $(BUILD)/pound_tests: $(TEST_OBJ) $(BUILD)/libpound.a
-	$(CC) $(CFLAGS) $(XCFLAGS) -o $@ $(TEST_OBJ) $(BUILD)/libpound.a $(LIBS)
+	@echo "  LD    $@"
+	@$(CC) $(CFLAGS) $(XCFLAGS) -o $@ $(TEST_OBJ) $(BUILD)/libpound.a $(XOBJ) $(LIBS)
 
 deps:
 	@sh scripts/deps.sh

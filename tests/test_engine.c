@@ -1,6 +1,329 @@
+/* test_engine.c — the Moreau–Jean engine against closed forms and invariants. */
+#include <malloc.h>
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "pd_engine.h"
 #include "pd_test.h"
+
+/* A seeded generator (splitmix64) for reproducible random data. */
+static double uniform(uint64_t *s)
+{
+    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    return (double)(z >> 11) * 0x1.0p-53;
+}
+
+/* pd_sdof_advance satisfies the ODE (central differences), composes over
+ * sub-intervals, and matches the textbook free vibration. */
+static void test_engine_sdof_closed_form(pd_test_ctx *ctx)
+{
+    const pd_sdof cases[] = {{2.0, 0.05}, {7.5, 0.0}, {1.3, 0.4}, {3.0, 0.0}};
+    for (size_t c = 0; c < 4; c++) {
+        const pd_sdof *o = &cases[c];
+        double A = 1.7, w = c == 3 ? 3.0 : 2.9, phi = 0.4; /* case 3: undamped resonance */
+        double t = 1.234, d = 1e-4, u[3], v[3];
+        for (int k = 0; k < 3; k++)
+            pd_sdof_advance(o, A, w, phi, 0.2, 0.3, -0.8, t + (k - 1) * d, &u[k], &v[k]);
+        double acc = (u[0] - 2 * u[1] + u[2]) / (d * d);
+        double res = acc + 2 * o->xi * o->w0 * v[1] + o->w0 * o->w0 * u[1] - A * sin(w * t + phi);
+        CHECK(ctx, fabs(res) < 1e-5 * (1 + o->w0 * o->w0), "case %zu: ODE residual %g", c, res);
+        CHECK_NEAR(ctx, (u[2] - u[0]) / (2 * d), v[1], 1e-6);
+        /* composition: 0.2 -> 0.9 -> t equals 0.2 -> t */
+        double um, vm, u2, v2;
+        pd_sdof_advance(o, A, w, phi, 0.2, 0.3, -0.8, 0.9, &um, &vm);
+        pd_sdof_advance(o, A, w, phi, 0.9, um, vm, t, &u2, &v2);
+        CHECK_NEAR(ctx, u2, u[1], 1e-12);
+        CHECK_NEAR(ctx, v2, v[1], 1e-11);
+        /* initial conditions */
+        pd_sdof_advance(o, A, w, phi, 0.2, 0.3, -0.8, 0.2, &um, &vm);
+        CHECK_NEAR(ctx, um, 0.3, 1e-14);
+        CHECK_NEAR(ctx, vm, -0.8, 1e-14);
+    }
+    /* free vibration: u = e^{-a t}(u0 cos wd t + (v0 + a u0)/wd sin wd t) */
+    pd_sdof o = {2.0, 0.1};
+    double a = 0.2, wd = 2.0 * sqrt(0.99), t = 3.7, u, v;
+    pd_sdof_advance(&o, 0.0, 1.0, 0.0, 0.0, 0.5, 0.25, t, &u, &v);
+    CHECK_NEAR(ctx, u, exp(-a * t) * (0.5 * cos(wd * t) + (0.25 + a * 0.5) / wd * sin(wd * t)),
+               1e-14);
+}
+
+/* The closed-form scalar LCP gives Lemke's impulse to 1e-15 relative. */
+static void test_engine_scalar_lcp_matches_lemke(pd_test_ctx *ctx)
+{
+    uint64_t seed = 42;
+    pd_lcp_work *work = pd_lcp_alloc(1);
+    double worst = 0.0;
+    int mismatched_sign = 0;
+    for (int k = 0; k < 2000; k++) {
+        double D = 1e-3 + 10.0 * uniform(&seed), b = 4.0 * uniform(&seed) - 2.0;
+        double z, w;
+        int st = pd_lcp_lemke(work, 1, &D, &b, NULL, &z, &w, NULL);
+        double P = pd_contact_impulse_1(D, b);
+        if (st != PD_OK || (P > 0) != (z > 0))
+            mismatched_sign++;
+        if (P > 0)
+            worst = fmax(worst, fabs(P - z) / P);
+    }
+    CHECK(ctx, mismatched_sign == 0, "%d scalar LCPs disagree with Lemke on the status", mismatched_sign);
+    CHECK(ctx, worst <= 1e-15, "closed form vs Lemke: worst relative difference %.3g", worst);
+    pd_lcp_free(work);
+}
+
+/* Two equal free masses, 1 strikes 2 at speed V: after the step that closes
+ * the gap, v1 = (1-e)V/2, v2 = (1+e)V/2 (momentum kept, Newton's law). */
+static void test_engine_two_mass_impact(pd_test_ctx *ctx)
+{
+    const double es[] = {1.0, 0.5, 0.0};
+    for (int c = 0; c < 3; c++) {
+        double M[4] = {1, 0, 0, 1}, W[2] = {-1, 1}, g0 = 0.01, e = es[c];
+        pd_model md = {2, 1, pd_matrix_dense(2, 2, M), {PD_MATRIX_ZERO, 2, 2, NULL},
+                       {PD_MATRIX_ZERO, 2, 2, NULL}, pd_matrix_dense(2, 1, W), &g0, &e,
+                       NULL, NULL, NULL, 0};
+        pd_mj_opts o = pd_mj_default_opts();
+        o.h = 1e-3;
+        pd_err err;
+        pd_mj *mj = pd_mj_alloc(&md, &o, &err);
+        if (!CHECK(ctx, mj != NULL, "alloc: %s", err.msg))
+            return;
+        double v0[2] = {2.0, 0.0};
+        pd_mj_reset(mj, 0.0, NULL, v0, &err);
+        CHECK(ctx, pd_mj_run(mj, 20, NULL, NULL, &err) == PD_OK, "run: %s", err.msg);
+        const pd_state *st = pd_mj_state(mj);
+        CHECK_NEAR(ctx, st->v[0], (1 - e) * 1.0, 1e-14);
+        CHECK_NEAR(ctx, st->v[1], (1 + e) * 1.0, 1e-14);
+        CHECK_NEAR(ctx, st->v[0] + st->v[1], 2.0, 1e-14);
+        CHECK(ctx, !strcmp(pd_mj_kernel_name(mj), "general"), "2 dofs run the general kernel");
+        pd_mj_free(mj);
+    }
+}
+
+/* A chain of 3 masses between two walls (4 contacts), springs between
+ * neighbours: gaps stay above -C h with C fixed, impulses are complementary,
+ * and with theta = 1/2, e = 1, no damping, energy is conserved exactly. */
+static void test_engine_chain_energy(pd_test_ctx *ctx)
+{
+    enum { N = 3, C = 4 };
+    double M[N * N] = {0}, K[N * N] = {0}, W[N * C] = {0}, g0[C], e[C];
+    for (int i = 0; i < N; i++) {
+        M[i + N * i] = 1.0 + 0.5 * i;
+        K[i + N * i] = 40.0;
+    }
+    K[0 + N * 1] = K[1 + N * 0] = -10.0;
+    K[1 + N * 2] = K[2 + N * 1] = -10.0;
+    /* contact 0: left wall and mass 0; 1, 2: between masses; 3: mass 2 and right wall */
+    W[0 + N * 0] = 1.0;
+    W[0 + N * 1] = -1.0, W[1 + N * 1] = 1.0;
+    W[1 + N * 2] = -1.0, W[2 + N * 2] = 1.0;
+    W[2 + N * 3] = -1.0;
+    for (int a = 0; a < C; a++) {
+        g0[a] = 0.02;
+        e[a] = 1.0;
+    }
+    pd_model md = {N, C, pd_matrix_dense(N, N, M), {PD_MATRIX_ZERO, N, N, NULL},
+                   pd_matrix_dense(N, N, K), pd_matrix_dense(N, C, W), g0, e, NULL, NULL, NULL, 0};
+    double v0[N] = {1.0, -0.5, 0.7};
+    for (int pass = 0; pass < 2; pass++) {
+        double h = pass ? 5e-4 : 1e-3, vmax = 0;
+        pd_mj_opts o = pd_mj_default_opts();
+        o.h = h;
+        pd_err err;
+        pd_mj *mj = pd_mj_alloc(&md, &o, &err);
+        if (!CHECK(ctx, mj != NULL, "alloc: %s", err.msg))
+            return;
+        pd_mj_reset(mj, 0.0, NULL, v0, &err);
+        const pd_state *st = pd_mj_state(mj);
+        double E0 = 0, Emax_dev = 0, gmin = 0, worst_compl = 0, vprev[N];
+        memcpy(vprev, v0, sizeof vprev);
+        long impacts = 0;
+        for (int i = 0; i < N; i++)
+            E0 += 0.5 * M[i + N * i] * v0[i] * v0[i];
+        for (long k = 0; k < (long)(5.0 / h); k++) {
+            if (pd_mj_step(mj, &err)) {
+                CHECK(ctx, 0, "step: %s", err.msg);
+                break;
+            }
+            double E = 0;
+            for (int i = 0; i < N; i++) {
+                double Kq = 0;
+                for (int j = 0; j < N; j++)
+                    Kq += K[i + N * j] * st->q[j];
+                E += 0.5 * M[i + N * i] * st->v[i] * st->v[i] + 0.5 * st->q[i] * Kq;
+                vmax = fmax(vmax, fabs(st->v[i]));
+            }
+            Emax_dev = fmax(Emax_dev, fabs(E - E0) / E0);
+            for (int a = 0; a < C; a++) {
+                gmin = fmin(gmin, st->g[a]);
+                impacts += st->P[a] > 0;
+                CHECK(ctx, st->P[a] >= 0.0, "negative impulse %g", st->P[a]);
+                /* the step's LCP: w = U_k+1 + e U_k >= 0 and P w = 0 */
+                if (st->active[a]) {
+                    double U1 = 0, U0 = 0;
+                    for (int i = 0; i < N; i++) {
+                        U1 += W[i + N * a] * st->v[i];
+                        U0 += W[i + N * a] * vprev[i];
+                    }
+                    double w = U1 + e[a] * U0;
+                    worst_compl = fmax(worst_compl, fmax(-w, st->P[a] * fabs(w)));
+                }
+            }
+            memcpy(vprev, st->v, sizeof vprev);
+        }
+        CHECK(ctx, impacts > 10, "the chain must pound (%ld impacts)", impacts);
+        CHECK(ctx, Emax_dev < 1e-10, "h = %g: energy drift %.3g with e = 1, theta = 1/2", h,
+              Emax_dev);
+        CHECK(ctx, -gmin <= h * 2 * vmax, "h = %g: penetration %.3g > 2 h vmax = %.3g", h, -gmin,
+              2 * h * vmax);
+        CHECK(ctx, worst_compl <= 1e-12, "step LCPs violated by %.3g", worst_compl);
+        pd_mj_free(mj);
+    }
+}
+
+/* theta < 1/2 is refused unless asked for; asked for, it blows up at a large
+ * step while theta = 1/2 and 1 stay bounded (unconditional stability). */
+static void test_engine_theta_stability(pd_test_ctx *ctx)
+{
+    double M = 1, K = 1, zero = 0;
+    pd_model md = {1, 0, pd_matrix_dense(1, 1, &M), pd_matrix_dense(1, 1, &zero),
+                   pd_matrix_dense(1, 1, &K), {PD_MATRIX_ZERO, 1, 0, NULL}, NULL, NULL, NULL,
+                   NULL, NULL, 0};
+    pd_mj_opts o = pd_mj_default_opts();
+    pd_err err;
+    o.h = 1.0; /* w0 h = 1 */
+    o.theta = 0.3;
+    CHECK(ctx, pd_mj_alloc(&md, &o, &err) == NULL && err.status == PD_EINVAL &&
+                   strstr(err.msg, "theta"),
+          "theta = 0.3 must be refused naming theta: %s", err.msg);
+    const double thetas[] = {0.0, 0.3, 0.5, 1.0};
+    for (int c = 0; c < 4; c++) {
+        o.theta = thetas[c];
+        o.allow_unstable = 1;
+        /* amplification |R|^2 = (1 + (1-theta)^2 (w0 h)^2) / (1 + theta^2 (w0 h)^2):
+         * above 1 for every h when theta < 1/2; 200 steps at w0 h = 2.5 */
+        o.h = 2.5;
+        pd_mj *mj = pd_mj_alloc(&md, &o, &err);
+        if (!CHECK(ctx, mj != NULL, "alloc theta %g: %s", o.theta, err.msg))
+            continue;
+        double q0 = 1.0;
+        pd_mj_reset(mj, 0.0, &q0, NULL, &err);
+        int rc = pd_mj_run(mj, 200, NULL, NULL, &err);
+        const pd_state *st = pd_mj_state(mj);
+        double amp = sqrt(st->q[0] * st->q[0] + st->v[0] * st->v[0]);
+        if (thetas[c] < 0.5)
+            CHECK(ctx, rc == PD_ENONFINITE || amp > 1e6,
+                  "theta %g at w0 h = 2.5 must grow without bound (amp %g)", thetas[c], amp);
+        else
+            CHECK(ctx, rc == PD_OK && amp <= 1.0 + 1e-12 && amp > 0.0,
+                  "theta %g must stay bounded (amp %g)", thetas[c], amp);
+        pd_mj_free(mj);
+    }
+}
+
+/* A non-finite force stops the run with PD_ENONFINITE naming the time. */
+static void nan_after_one(double t, int side, double *F, void *ctx)
+{
+    (void)side;
+    (void)ctx;
+    F[0] = t > 1.0 ? NAN : 1.0;
+}
+
+static void test_engine_failure_is_reported(pd_test_ctx *ctx)
+{
+    double M = 1, K = 4;
+    pd_model md = {1, 0, pd_matrix_dense(1, 1, &M), {PD_MATRIX_ZERO, 1, 1, NULL},
+                   pd_matrix_dense(1, 1, &K), {PD_MATRIX_ZERO, 1, 0, NULL}, NULL, NULL,
+                   nan_after_one, NULL, NULL, 0};
+    pd_mj_opts o = pd_mj_default_opts();
+    o.h = 0.1;
+    for (int kernel = 0; kernel < 2; kernel++) {
+        o.kernel = kernel ? PD_KERNEL_GENERAL : PD_KERNEL_AUTO;
+        pd_err err;
+        pd_mj *mj = pd_mj_alloc(&md, &o, &err);
+        int rc = pd_mj_run(mj, 100, NULL, NULL, &err);
+        CHECK(ctx, rc == PD_ENONFINITE, "status %d, expected PD_ENONFINITE", rc);
+        CHECK(ctx, strstr(err.msg, "t = 1.1") != NULL, "message must name t = 1.1: %s", err.msg);
+        CHECK(ctx, pd_mj_state(mj)->step == 11, "stopped at step %ld", pd_mj_state(mj)->step);
+        pd_mj_free(mj);
+    }
+}
+
+/* Model checks name the faulty field. */
+static void test_engine_model_check(pd_test_ctx *ctx)
+{
+    double M = 1, K = 1, W = -1, g = -0.1, e = 0.5, Knan = NAN;
+    pd_model md = {1, 1, pd_matrix_dense(1, 1, &M), {PD_MATRIX_ZERO, 1, 1, NULL},
+                   pd_matrix_dense(1, 1, &K), pd_matrix_dense(1, 1, &W), &g, &e, NULL, NULL,
+                   NULL, 0};
+    pd_err err;
+    CHECK(ctx, pd_model_check(&md, &err) == PD_EINVAL && strstr(err.msg, "gap"), "%s", err.msg);
+    g = 0.1;
+    e = 1.5;
+    CHECK(ctx, pd_model_check(&md, &err) == PD_EINVAL && strstr(err.msg, "restitution"), "%s",
+          err.msg);
+    e = 0.5;
+    md.K = pd_matrix_dense(1, 1, &Knan);
+    CHECK(ctx, pd_model_check(&md, &err) == PD_EINVAL && strstr(err.msg, "K"), "%s", err.msg);
+    md.K = pd_matrix_dense(1, 1, &K);
+    CHECK(ctx, pd_model_check(&md, &err) == PD_OK, "valid model refused: %s", err.msg);
+    pd_mj_opts o = pd_mj_default_opts();
+    o.h = -1;
+    CHECK(ctx, pd_mj_alloc(&md, &o, &err) == NULL && strstr(err.msg, "dt"), "%s", err.msg);
+}
+
+/* Steps do not allocate: the heap in use is the same before and after a
+ * run of many impacting steps (glibc's mallinfo2; skipped where the
+ * allocator does not report, e.g. under AddressSanitizer). */
+static void osc_force(double t, int side, double *F, void *ctx)
+{
+    (void)side;
+    (void)ctx;
+    F[0] = 3.0 * sin(t);
+    F[1] = -2.0 * cos(t);
+}
+
+static void test_engine_no_allocation_in_steps(pd_test_ctx *ctx)
+{
+    double M[4] = {1, 0, 0, 2}, K[4] = {4, -1, -1, 3}, C[4] = {0.1, 0, 0, 0.1};
+    double W[4] = {-1, 0, 1, -1}, g0[2] = {0.05, 0.02}, e[2] = {0.7, 0.3};
+    pd_model md = {2, 2, pd_matrix_dense(2, 2, M), pd_matrix_dense(2, 2, C),
+                   pd_matrix_dense(2, 2, K), pd_matrix_dense(2, 2, W), g0, e, osc_force, NULL,
+                   NULL, 0};
+    pd_mj_opts o = pd_mj_default_opts();
+    o.h = 1e-3;
+    pd_err err;
+    pd_mj *mj = pd_mj_alloc(&md, &o, &err);
+    if (!CHECK(ctx, mj != NULL, "alloc: %s", err.msg))
+        return;
+    struct mallinfo2 before = mallinfo2();
+    if (before.uordblks == 0 && before.arena == 0) {
+        pd_test_skip(ctx, "allocator reports no heap statistics");
+        pd_mj_free(mj);
+        return;
+    }
+    long pivots = 0, contact_steps = 0;
+    for (int k = 0; k < 20000 && !pd_mj_step(mj, &err); k++) {
+        pivots += pd_mj_state(mj)->lcp_pivots;
+        contact_steps += pd_mj_state(mj)->nactive > 0;
+    }
+    struct mallinfo2 after = mallinfo2();
+    CHECK(ctx, contact_steps > 100 && pivots > 0, "the run must solve LCPs (%ld contact steps)",
+          contact_steps);
+    CHECK(ctx, after.uordblks == before.uordblks, "heap in use changed by %ld bytes during steps",
+          (long)after.uordblks - (long)before.uordblks);
+    pd_mj_free(mj);
+}
 
 void suite_engine(pd_test_ctx *ctx)
 {
-    (void)ctx;
+    PD_RUN(ctx, test_engine_sdof_closed_form);
+    PD_RUN(ctx, test_engine_scalar_lcp_matches_lemke);
+    PD_RUN(ctx, test_engine_two_mass_impact);
+    PD_RUN(ctx, test_engine_chain_energy);
+    PD_RUN(ctx, test_engine_theta_stability);
+    PD_RUN(ctx, test_engine_failure_is_reported);
+    PD_RUN(ctx, test_engine_model_check);
+    PD_RUN(ctx, test_engine_no_allocation_in_steps);
 }

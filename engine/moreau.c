@@ -1,0 +1,407 @@
+/* moreau.c — Moreau–Jean theta time-stepping (SPEC §2).
+ *
+ *   What  = M + h theta C + h^2 theta^2 K                       (factored once)
+ *   vfree = v_k + What^-1 h [F_theta - C v_k - K (q_k + h theta v_k)]
+ *   I     = { a : g_a(q_k) + h gamma U_a(v_k) <= 0 },  U = W^T v
+ *   LCP:  w = D P + W_I^T vfree + e U_k,  D = W_I^T What^-1 W_I,  0 <= w ⊥ P >= 0
+ *   v_k+1 = vfree + What^-1 W_I P,   q_k+1 = q_k + h [theta v_k+1 + (1-theta) v_k]
+ *
+ * Two kernels share these equations: a scalar one for n = 1, m <= 1 (one
+ * oscillator, one wall: plain doubles, closed-form scalar LCP) and a general
+ * one (factorisation table, Delassus blocks, Lemke). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pd_engine.h"
+#include "pd_factor.h"
+
+struct pd_mj {
+    const pd_model *model;
+    pd_mj_opts opts;
+    int scalar;           /* 1: scalar kernel */
+    long step0;           /* steps before the last reset (unused: 0) */
+    double t0;            /* time of the last reset */
+    int next_break;       /* index of the first model breakpoint after t */
+    pd_factor *factor;    /* What, What^-1 W and the Delassus matrix */
+    pd_lcp_work *lcp;     /* Lemke workspace for m contacts */
+    double *F0, *F1;      /* n: force at t_k and t_k+1 */
+    double *work_n;       /* n: right-hand side, then velocity increment */
+    double *qtheta;       /* n: q_k + h theta v_k */
+    double *U0;           /* m: W^T v_k */
+    double *D_active;     /* m x m: Delassus block of the active set */
+    double *b_active;     /* m: LCP vector of the active set */
+    double *P_active;     /* m: impulses of the active set */
+    double *w_active;     /* m: post-impact relative velocities of the active set */
+    int *idx_active;      /* m: indices of the active contacts */
+    /* scalar kernel constants */
+    double s_what, s_w, s_c, s_k, s_winv, s_del;
+    pd_state st;
+};
+
+pd_mj_opts pd_mj_default_opts(void)
+{
+    pd_mj_opts o = {0.0, 0.5, 0.5, 0, PD_KERNEL_AUTO};
+    return o;
+}
+
+/* Closed-form scalar LCP  w = D P + b >= 0, P >= 0, wP = 0  (D > 0). */
+double pd_contact_impulse_1(double D, double b)
+{
+    return b < 0.0 ? -b / D : 0.0;
+}
+
+void pd_mj_free(pd_mj *mj)
+{
+    if (!mj)
+        return;
+    pd_factor_free(mj->factor);
+    pd_lcp_free(mj->lcp);
+    free(mj->F0);
+    free(mj->F1);
+    free(mj->work_n);
+    free(mj->qtheta);
+    free(mj->U0);
+    free(mj->D_active);
+    free(mj->b_active);
+    free(mj->P_active);
+    free(mj->w_active);
+    free(mj->idx_active);
+    free(mj->st.q);
+    free(mj->st.v);
+    free(mj->st.P);
+    free(mj->st.g);
+    free(mj->st.active);
+    free(mj);
+}
+
+/* Options in range: h > 0 finite, theta in [1/2, 1] unless allowed. */
+static int check_opts(pd_mj_opts *o, pd_err *err)
+{
+    if (!(o->h > 0.0) || !isfinite(o->h))
+        return pd_err_set(err, PD_EINVAL, "dt must be a finite number > 0 (got %g)", o->h);
+    if (o->theta == 0.0 && !o->allow_unstable)
+        o->theta = 0.5;
+    if (o->gamma < 0.0)
+        o->gamma = 0.5;
+    if (!isfinite(o->theta) || o->theta < 0.0 || o->theta > 2.0)
+        return pd_err_set(err, PD_EINVAL, "theta must be in [0, 2] (got %g)", o->theta);
+    if ((o->theta < 0.5 || o->theta > 1.0) && !o->allow_unstable)
+        return pd_err_set(err, PD_EINVAL,
+                          "theta = %g is outside [1/2, 1], where the scheme is not unconditionally "
+                          "stable (pass --allow-unstable to run it anyway)",
+                          o->theta);
+    if (!(o->gamma <= 1.0) || !isfinite(o->gamma))
+        return pd_err_set(err, PD_EINVAL, "gamma must be in [0, 1] (got %g)", o->gamma);
+    return PD_OK;
+}
+
+/* Every array, sized once for (n, m). */
+static int alloc_arrays(pd_mj *mj, int n, int m)
+{
+    size_t mm = m > 0 ? (size_t)m : 1;
+    mj->F0 = calloc((size_t)n, sizeof(double));
+    mj->F1 = calloc((size_t)n, sizeof(double));
+    mj->work_n = calloc((size_t)n, sizeof(double));
+    mj->qtheta = calloc((size_t)n, sizeof(double));
+    mj->U0 = calloc(mm, sizeof(double));
+    mj->D_active = calloc(mm * mm, sizeof(double));
+    mj->b_active = calloc(mm, sizeof(double));
+    mj->P_active = calloc(mm, sizeof(double));
+    mj->w_active = calloc(mm, sizeof(double));
+    mj->idx_active = calloc(mm, sizeof(int));
+    mj->st.q = calloc((size_t)n, sizeof(double));
+    mj->st.v = calloc((size_t)n, sizeof(double));
+    mj->st.P = calloc(mm, sizeof(double));
+    mj->st.g = calloc(mm, sizeof(double));
+    mj->st.active = calloc(mm, 1);
+    return mj->F0 && mj->F1 && mj->work_n && mj->qtheta && mj->U0 && mj->D_active &&
+                   mj->b_active && mj->P_active && mj->w_active && mj->idx_active && mj->st.q &&
+                   mj->st.v && mj->st.P && mj->st.g && mj->st.active
+               ? PD_OK
+               : PD_ENOMEM;
+}
+
+/* Constants of the scalar kernel from the factored 1 x 1 system. */
+static void scalar_setup(pd_mj *mj)
+{
+    const pd_model *md = mj->model;
+    double h = mj->opts.h, th = mj->opts.theta;
+    double M = pd_matrix_get(&md->M, 0, 0), C = pd_matrix_get(&md->C, 0, 0);
+    double K = pd_matrix_get(&md->K, 0, 0);
+    mj->s_c = C;
+    mj->s_k = K;
+    mj->s_what = M + h * th * C + h * h * th * th * K;
+    mj->s_w = md->m ? pd_matrix_get(&md->W, 0, 0) : 0.0;
+    mj->s_winv = mj->s_w / mj->s_what;
+    mj->s_del = mj->s_w * mj->s_winv;
+}
+
+pd_mj *pd_mj_alloc(const pd_model *model, const pd_mj_opts *opts, pd_err *err)
+{
+    pd_mj *mj = NULL;
+    pd_mj_opts o = opts ? *opts : pd_mj_default_opts();
+    int st;
+    pd_err_clear(err);
+    if ((st = pd_model_check(model, err)) || (st = check_opts(&o, err)))
+        return NULL;
+    mj = calloc(1, sizeof *mj);
+    if (!mj || alloc_arrays(mj, model->n, model->m)) {
+        pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for n = %d, m = %d", model->n,
+                   model->m);
+        goto fail;
+    }
+    mj->model = model;
+    mj->opts = o;
+    mj->scalar = o.kernel == PD_KERNEL_AUTO && model->n == 1 && model->m <= 1;
+    mj->factor = pd_factor_alloc(model, o.h, o.theta, err);
+    if (!mj->factor)
+        goto fail;
+    if (mj->scalar)
+        scalar_setup(mj);
+    if (model->m > 0 && !(mj->lcp = pd_lcp_alloc(model->m))) {
+        pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for the LCP workspace");
+        goto fail;
+    }
+    if (pd_mj_reset(mj, 0.0, NULL, NULL, err))
+        goto fail;
+    return mj;
+fail:
+    pd_mj_free(mj);
+    return NULL;
+}
+
+/* g = g0 + W^T q. */
+static void gaps(const pd_model *md, const double *q, double *g)
+{
+    for (int a = 0; a < md->m; a++) {
+        double s = md->g0[a];
+        for (int i = 0; i < md->n; i++)
+            s += pd_matrix_get(&md->W, i, a) * q[i];
+        g[a] = s;
+    }
+}
+
+int pd_mj_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_err *err)
+{
+    const pd_model *md = mj->model;
+    int n = md->n;
+    for (int i = 0; i < n; i++) {
+        mj->st.q[i] = q0 ? q0[i] : 0.0;
+        mj->st.v[i] = v0 ? v0[i] : 0.0;
+        if (!isfinite(mj->st.q[i]) || !isfinite(mj->st.v[i]))
+            return pd_err_set(err, PD_EINVAL, "initial state: dof %d is not finite", i);
+    }
+    mj->t0 = t0;
+    mj->st.t = t0;
+    mj->st.step = 0;
+    mj->st.nactive = 0;
+    mj->st.lcp_pivots = 0;
+    for (int a = 0; a < md->m; a++) {
+        mj->st.P[a] = 0.0;
+        mj->st.active[a] = 0;
+    }
+    gaps(md, mj->st.q, mj->st.g);
+    mj->next_break = 0;
+    while (mj->next_break < md->nbreaks && md->breaks[mj->next_break] < t0 - 1e-9 * mj->opts.h)
+        mj->next_break++;
+    if (md->force)
+        md->force(t0, +1, mj->F0, md->force_ctx);
+    else
+        memset(mj->F0, 0, (size_t)n * sizeof(double));
+    return PD_OK;
+}
+
+/* F_k for the next step: F(t_k+1 -) unless t_k+1 is a breakpoint, where the
+ * next step starts from the right limit F(t_k+1 +). */
+static void advance_force(pd_mj *mj, double t1)
+{
+    const pd_model *md = mj->model;
+    double tol = 1e-9 * mj->opts.h;
+    while (mj->next_break < md->nbreaks && md->breaks[mj->next_break] < t1 - tol)
+        mj->next_break++;
+    if (mj->next_break < md->nbreaks && md->breaks[mj->next_break] <= t1 + tol) {
+        md->force(t1, +1, mj->F0, md->force_ctx);
+        mj->next_break++;
+    } else
+        memcpy(mj->F0, mj->F1, (size_t)md->n * sizeof(double));
+}
+
+/* Non-finite state: fail naming time and degree of freedom. */
+static int check_finite(const pd_mj *mj, pd_err *err)
+{
+    for (int i = 0; i < mj->model->n; i++)
+        if (!isfinite(mj->st.q[i]) || !isfinite(mj->st.v[i]))
+            return pd_err_set(err, PD_ENONFINITE,
+                              "Moreau-Jean: non-finite state at t = %.9g (step %ld, dof %d)",
+                              mj->st.t, mj->st.step, i);
+    return PD_OK;
+}
+
+/* One step of the scalar kernel (n = 1, m <= 1). */
+static int step_scalar(pd_mj *mj, pd_err *err)
+{
+    const pd_model *md = mj->model;
+    pd_state *st = &mj->st;
+    double h = mj->opts.h, th = mj->opts.theta;
+    double t1 = mj->t0 + (double)(st->step + 1) * h;
+    double F1 = 0.0;
+    if (md->force)
+        md->force(t1, -1, &F1, md->force_ctx);
+    double q = st->q[0], v = st->v[0];
+    /* free velocity */
+    double Fth = th * F1 + (1.0 - th) * mj->F0[0];
+    double rhs = h * (Fth - mj->s_c * v - mj->s_k * (q + h * th * v));
+    double vnew = v + rhs / mj->s_what;
+    double P = 0.0;
+    int active = 0;
+    /* contact: predicted gap, then the scalar LCP */
+    if (md->m) {
+        double U0 = mj->s_w * v;
+        if (st->g[0] + h * mj->opts.gamma * U0 <= 0.0) {
+            active = 1;
+            P = pd_contact_impulse_1(mj->s_del, mj->s_w * vnew + md->e[0] * U0);
+            vnew += mj->s_winv * P;
+        }
+        st->P[0] = P;
+        st->active[0] = (unsigned char)active;
+    }
+    q += h * (th * vnew + (1.0 - th) * v);
+    st->q[0] = q;
+    st->v[0] = vnew;
+    if (md->m)
+        st->g[0] = md->g0[0] + mj->s_w * q;
+    st->nactive = active;
+    st->lcp_pivots = 0;
+    mj->F0[0] = F1;
+    if (mj->next_break < md->nbreaks) {
+        mj->F1[0] = F1;
+        advance_force(mj, t1);
+    }
+    st->t = t1;
+    st->step++;
+    if (!isfinite(q) || !isfinite(vnew))
+        return check_finite(mj, err);
+    return PD_OK;
+}
+
+/* Active set {a : g_a + h gamma U_a <= 0}; returns its size. */
+static int predict_active(pd_mj *mj)
+{
+    const pd_model *md = mj->model;
+    double hg = mj->opts.h * mj->opts.gamma;
+    int nI = 0;
+    pd_matrix_gemv_t(&md->W, mj->st.v, mj->U0);
+    for (int a = 0; a < md->m; a++) {
+        mj->st.active[a] = 0;
+        mj->st.P[a] = 0.0;
+        if (mj->st.g[a] + hg * mj->U0[a] <= 0.0) {
+            mj->st.active[a] = 1;
+            mj->idx_active[nI++] = a;
+        }
+    }
+    return nI;
+}
+
+/* Impulses of the active contacts: Lemke on (D_II, W_I^T vfree + e U). */
+static int solve_contacts(pd_mj *mj, int nI, const double *vfree, pd_err *err)
+{
+    const pd_model *md = mj->model;
+    pd_lcp_info info;
+    pd_factor_delassus(mj->factor, mj->idx_active, nI, mj->D_active);
+    for (int r = 0; r < nI; r++) {
+        int a = mj->idx_active[r];
+        double s = md->e[a] * mj->U0[a];
+        for (int i = 0; i < md->n; i++)
+            s += pd_matrix_get(&md->W, i, a) * vfree[i];
+        mj->b_active[r] = s;
+    }
+    int st = pd_lcp_lemke(mj->lcp, nI, mj->D_active, mj->b_active, NULL, mj->P_active,
+                          mj->w_active, &info);
+    mj->st.lcp_pivots = info.pivots;
+    if (st)
+        return pd_err_set(err, st,
+                          "Moreau-Jean: LCP over %d active contact(s) (first: contact %d) not "
+                          "solved at t = %.9g: %s",
+                          nI, mj->idx_active[0], mj->st.t + mj->opts.h,
+                          pd_lcp_outcome_name(info.outcome));
+    for (int r = 0; r < nI; r++)
+        mj->st.P[mj->idx_active[r]] = mj->P_active[r];
+    return PD_OK;
+}
+
+/* One step of the general kernel. */
+static int step_general(pd_mj *mj, pd_err *err)
+{
+    const pd_model *md = mj->model;
+    pd_state *st = &mj->st;
+    int n = md->n, nI = 0, rc;
+    double h = mj->opts.h, th = mj->opts.theta;
+    double t1 = mj->t0 + (double)(st->step + 1) * h;
+    double *x = mj->work_n;
+    /* right-hand side h [F_theta - C v - K (q + h theta v)] */
+    if (md->force)
+        md->force(t1, -1, mj->F1, md->force_ctx);
+    for (int i = 0; i < n; i++) {
+        x[i] = th * mj->F1[i] + (1.0 - th) * mj->F0[i];
+        mj->qtheta[i] = st->q[i] + h * th * st->v[i];
+    }
+    pd_matrix_gemv(&md->C, -1.0, st->v, 1.0, x);
+    pd_matrix_gemv(&md->K, -1.0, mj->qtheta, 1.0, x);
+    for (int i = 0; i < n; i++)
+        x[i] *= h;
+    /* vfree - v_k = What^-1 rhs */
+    pd_factor_solve(mj->factor, x);
+    if (md->m)
+        nI = predict_active(mj);
+    st->lcp_pivots = 0;
+    /* q gets the (1 - theta) v_k part before v is overwritten */
+    for (int i = 0; i < n; i++) {
+        st->q[i] += h * (1.0 - th) * st->v[i];
+        st->v[i] += x[i];
+    }
+    if (nI > 0) {
+        if ((rc = solve_contacts(mj, nI, st->v, err)))
+            return rc;
+        pd_factor_add_impulse(mj->factor, mj->idx_active, nI, mj->P_active, st->v);
+    }
+    for (int i = 0; i < n; i++)
+        st->q[i] += h * th * st->v[i];
+    if (md->force)
+        advance_force(mj, t1);
+    st->nactive = nI;
+    st->t = t1;
+    st->step++;
+    if (md->m)
+        gaps(md, st->q, st->g);
+    return check_finite(mj, err);
+}
+
+int pd_mj_step(pd_mj *mj, pd_err *err)
+{
+    return mj->scalar ? step_scalar(mj, err) : step_general(mj, err);
+}
+
+int pd_mj_run(pd_mj *mj, long nsteps, pd_observer observer, void *ctx, pd_err *err)
+{
+    int rc;
+    if (observer && observer(&mj->st, ctx) > 0)
+        return PD_OK;
+    for (long k = 0; k < nsteps; k++) {
+        if ((rc = pd_mj_step(mj, err)))
+            return rc;
+        if (observer && observer(&mj->st, ctx) > 0)
+            break;
+    }
+    return PD_OK;
+}
+
+const pd_state *pd_mj_state(const pd_mj *mj)
+{
+    return &mj->st;
+}
+
+const char *pd_mj_kernel_name(const pd_mj *mj)
+{
+    return mj->scalar ? "scalar" : "general";
+}

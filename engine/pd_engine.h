@@ -1,0 +1,158 @@
+/* pd_engine.h — time integration of linear mechanical systems with
+ * frictionless unilateral contacts (SPEC §2):
+ *
+ *     M q'' + C q' + K q = F(t) + W lambda,
+ *     g = g0 + W^T q >= 0,  lambda >= 0,  g ⊥ lambda,
+ *     Newton impact law  U+ = -e U-  (U = W^T v) for each closing contact.
+ *
+ * A model (pd_model) is const during a run; an integrator object (pd_mj for
+ * Moreau–Jean) owns every workspace, allocated once by its _alloc, and the
+ * mutable state (pd_state) that it advances.  Steps never allocate.
+ *
+ * Dense blocks are column-major.  The matrices are reached through pd_matrix
+ * (y = A x) and the iteration matrix through a factorisation table
+ * (pd_factor_type), the seam where sparse storage plugs in. */
+#ifndef PD_ENGINE_H
+#define PD_ENGINE_H
+
+#include "pd_lcp.h"
+#include "pd_status.h"
+
+/* ---- matrices --------------------------------------------------------- */
+
+typedef enum {
+    PD_MATRIX_ZERO = 0, /* all zeros (values unused) */
+    PD_MATRIX_DENSE = 1 /* column-major values, leading dimension rows */
+} pd_matrix_kind;
+
+/* A rows x cols matrix the engine only reads. */
+typedef struct pd_matrix {
+    pd_matrix_kind kind;
+    int rows, cols;
+    const double *values;
+} pd_matrix;
+
+/* A dense matrix view. */
+pd_matrix pd_matrix_dense(int rows, int cols, const double *values);
+
+/* y = alpha A x + beta y. */
+void pd_matrix_gemv(const pd_matrix *A, double alpha, const double *x, double beta, double *y);
+
+/* y = A^T x (y has cols entries). */
+void pd_matrix_gemv_t(const pd_matrix *A, const double *x, double *y);
+
+/* Entry (i, j). */
+double pd_matrix_get(const pd_matrix *A, int i, int j);
+
+/* ---- dense LU --------------------------------------------------------- */
+
+/* In-place LU with partial pivoting of the n x n column-major A (P A = L U);
+ * PD_ESINGULAR when a pivot is zero or below 1e-14 times the column scale. */
+int pd_dense_lu(int n, double *A, int *perm);
+
+/* Solve (P^-1 L U) x = b in place, from the output of pd_dense_lu. */
+void pd_dense_lu_solve(int n, const double *LU, const int *perm, double *b);
+
+/* ---- the model -------------------------------------------------------- */
+
+/* Effective force F(t) (n entries) written to F; ctx is the model's.
+ * side = -1 asks for the left limit F(t-), +1 for the right limit F(t+);
+ * they differ only at the model's breakpoints. */
+typedef void (*pd_force_fn)(double t, int side, double *F, void *ctx);
+
+typedef struct pd_model {
+    int n;              /* degrees of freedom */
+    int m;              /* contacts (0 = none) */
+    pd_matrix M, C, K;  /* n x n */
+    pd_matrix W;        /* n x m: contact directions, g = g0 + W^T q */
+    const double *g0;   /* m initial gaps */
+    const double *e;    /* m Newton restitution coefficients in [0, 1] */
+    pd_force_fn force;  /* F(t); NULL = no external force */
+    void *force_ctx;
+    const double *breaks; /* increasing times where F may jump (NULL if none) */
+    int nbreaks;
+} pd_model;
+
+/* Check sizes, finiteness, gaps and restitution; message names the field. */
+int pd_model_check(const pd_model *model, pd_err *err);
+
+/* ---- state and observers ---------------------------------------------- */
+
+typedef struct pd_state {
+    long step;             /* steps taken since reset */
+    double t;              /* time */
+    double *q, *v;         /* n displacements and velocities */
+    double *P;             /* m contact impulses over the last step */
+    double *g;             /* m gaps g0 + W^T q at t */
+    unsigned char *active; /* m flags: contact was in the last step's LCP */
+    int nactive;           /* number of active contacts in the last step */
+    int lcp_pivots;        /* pivots of the last step's LCP (0 if none solved) */
+} pd_state;
+
+/* Called with the state after reset and after every step: return 0 to go
+ * on, a positive value to stop the run early (not an error). */
+typedef int (*pd_observer)(const pd_state *state, void *ctx);
+
+/* ---- Moreau–Jean theta scheme (SPEC §2) ------------------------------- */
+
+typedef enum {
+    PD_KERNEL_AUTO = 0,    /* scalar kernel when n = 1 and m <= 1, else general */
+    PD_KERNEL_GENERAL = 1  /* the general kernel always (tests compare them) */
+} pd_kernel;
+
+typedef struct pd_mj_opts {
+    double h;           /* step size > 0 */
+    double theta;       /* in [1/2, 1] (0 = default 1/2) */
+    double gamma;       /* active-set look-ahead in [0, 1] (negative = default 1/2) */
+    int allow_unstable; /* accept theta outside [1/2, 1] (stability studies) */
+    pd_kernel kernel;
+} pd_mj_opts;
+
+/* Defaults: theta = 1/2, gamma = 1/2, h unset. */
+pd_mj_opts pd_mj_default_opts(void);
+
+typedef struct pd_mj pd_mj;
+
+/* Allocate every workspace, form What = M + h theta C + h^2 theta^2 K and
+ * factor it once, precompute the Delassus data; the state is at rest at
+ * t = 0.  The model must outlive the object.  NULL on failure (err says why). */
+pd_mj *pd_mj_alloc(const pd_model *model, const pd_mj_opts *opts, pd_err *err);
+void pd_mj_free(pd_mj *mj);
+
+/* Set t, q, v (NULL = zeros) and clear impulses; recomputes gaps. */
+int pd_mj_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_err *err);
+
+/* Advance one step of size h.  Fails, naming the time and the contact, when
+ * the LCP is not solved or the state is not finite. */
+int pd_mj_step(pd_mj *mj, pd_err *err);
+
+/* Take nsteps steps, calling observer (may be NULL) after reset state and
+ * after each step; stops early when the observer asks. */
+int pd_mj_run(pd_mj *mj, long nsteps, pd_observer observer, void *ctx, pd_err *err);
+
+const pd_state *pd_mj_state(const pd_mj *mj);
+
+/* Which kernel the object runs: "scalar" or "general". */
+const char *pd_mj_kernel_name(const pd_mj *mj);
+
+/* Closed-form scalar LCP: the P >= 0 with D P + b >= 0, P (D P + b) = 0,
+ * for D > 0 (the one-contact kernel uses it instead of Lemke). */
+double pd_contact_impulse_1(double D, double b);
+
+/* Number of steps to cover [0, tend] with step h (tend/h rounded when
+ * within 1e-9 of an integer, else rounded up). */
+long pd_steps_for(double tend, double h);
+
+/* ---- closed forms for one linear oscillator --------------------------- */
+
+/* u'' + 2 xi w0 u' + w0^2 u = A sin(w t + phi),  0 <= xi < 1, w0 > 0.
+ * Advance the exact solution from (u0, v0) at t0 to t1 (A = 0: free
+ * vibration); resonance with xi = 0 is handled. */
+typedef struct pd_sdof {
+    double w0, xi;
+} pd_sdof;
+
+void pd_sdof_advance(const pd_sdof *osc, double A, double w, double phi, double t0, double u0,
+                     double v0, double t1, double *u1, double *v1);
+
+#endif

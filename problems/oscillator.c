@@ -1,0 +1,310 @@
+/* oscillator.c — the pounding oscillator as an engine scene (SPEC §1).
+ *
+ * Dimensionless form (tau = wp t, x = u / Le, Le = ap / wp^2):
+ *   x'' + 2 xi Pi2 x' + Pi2^2 x = s phi(tau) - lambda,   gap Pi3 - x >= 0,
+ * phi = sin or cos on [0, 2 pi] (zero after), sin for all tau (harmonic).
+ * So n = m = 1, M = 1, C = 2 xi Pi2, K = Pi2^2, W = -1, g0 = Pi3. */
+#include <math.h>
+#include <string.h>
+
+#include "pd_oscillator.h"
+
+#define PD_TWO_PI 6.283185307179586476925286766559
+
+const char *pd_pulse_name(pd_pulse pulse)
+{
+    switch (pulse) {
+    case PD_PULSE_SINE: return "sine";
+    case PD_PULSE_COSINE: return "cosine";
+    case PD_PULSE_HARMONIC: return "harmonic";
+    }
+    return "?";
+}
+
+int pd_pulse_parse(const char *name, pd_pulse *pulse)
+{
+    static const pd_pulse all[] = {PD_PULSE_SINE, PD_PULSE_COSINE, PD_PULSE_HARMONIC};
+    for (int i = 0; i < 3; i++)
+        if (name && !strcmp(name, pd_pulse_name(all[i]))) {
+            *pulse = all[i];
+            return PD_OK;
+        }
+    return PD_EINVAL;
+}
+
+const char *pd_dir_name(int dir)
+{
+    return dir > 0 ? "normal" : "reverse";
+}
+
+int pd_dir_parse(const char *name, int *dir)
+{
+    if (name && !strcmp(name, "normal"))
+        *dir = 1;
+    else if (name && !strcmp(name, "reverse"))
+        *dir = -1;
+    else
+        return PD_EINVAL;
+    return PD_OK;
+}
+
+double pd_osc_wp(const pd_osc *c) { return PD_TWO_PI / c->Tp; }
+double pd_osc_T0(const pd_osc *c) { return c->Tp / c->Pi2; }
+double pd_osc_Le(const pd_osc *c) { return c->ap / (pd_osc_wp(c) * pd_osc_wp(c)); }
+double pd_osc_gap(const pd_osc *c) { return c->Pi3 * pd_osc_Le(c); }
+
+/* s phi(tau): the dimensionless effective acceleration; side -1 / +1 picks
+ * the left / right limit at the pulse end tau = 2 pi (recognised to a
+ * relative 1e-12, so that tau = k h lands on the same side at every scale). */
+static double pulse_shape(pd_pulse pulse, int dir, double tau, int side)
+{
+    double end = PD_TWO_PI * (1.0 + (side < 0 ? 1e-12 : -1e-12));
+    if (pulse != PD_PULSE_HARMONIC && (side < 0 ? tau > end : tau >= end))
+        return 0.0;
+    return dir * (pulse == PD_PULSE_COSINE ? cos(tau) : sin(tau));
+}
+
+double pd_osc_excitation(const pd_osc *c, double t)
+{
+    return c->ap * pulse_shape(c->pulse, c->dir, pd_osc_wp(c) * t, -1);
+}
+
+/* A finite value in [lo, hi] (hi_open: hi excluded). */
+static int in_range(double x, double lo, double hi, int hi_open)
+{
+    return isfinite(x) && x >= lo && (hi_open ? x < hi : x <= hi);
+}
+
+int pd_osc_check(const pd_osc *c, pd_err *err)
+{
+    if (c->pulse != PD_PULSE_SINE && c->pulse != PD_PULSE_COSINE && c->pulse != PD_PULSE_HARMONIC)
+        return pd_err_set(err, PD_EINVAL, "pulse must be sine, cosine or harmonic");
+    if (c->dir != 1 && c->dir != -1)
+        return pd_err_set(err, PD_EINVAL, "dir must be normal (+1) or reverse (-1)");
+    if (!(c->ap > 0.0) || !isfinite(c->ap))
+        return pd_err_set(err, PD_EINVAL, "ap (pulse amplitude) must be > 0 (got %g)", c->ap);
+    if (!(c->Tp > 0.0) || !isfinite(c->Tp))
+        return pd_err_set(err, PD_EINVAL, "Tp (pulse period) must be > 0 (got %g)", c->Tp);
+    if (!(c->Pi2 > 0.0) || !isfinite(c->Pi2) || !isfinite(pd_osc_T0(c)))
+        return pd_err_set(err, PD_EINVAL, "T0 / Pi2 must be finite and > 0 (Pi2 = %g)", c->Pi2);
+    if (!in_range(c->Pi3, 0.0, HUGE_VAL, 1))
+        return pd_err_set(err, PD_EINVAL, "gap must be >= 0 (Pi3 = %g)", c->Pi3);
+    if (!in_range(c->eps, 0.0, 1.0, 0))
+        return pd_err_set(err, PD_EINVAL, "eps (restitution) must be in [0, 1] (got %g)", c->eps);
+    if (!in_range(c->xi, 0.0, 1.0, 1))
+        return pd_err_set(err, PD_EINVAL, "xi (damping ratio) must be in [0, 1) (got %g)", c->xi);
+    return PD_OK;
+}
+
+pd_osc_opts pd_osc_default_opts(void)
+{
+    pd_osc_opts o;
+    memset(&o, 0, sizeof o);
+    o.theta = 0.5;
+    o.gamma = 0.5;
+    return o;
+}
+
+double pd_osc_default_dt(const pd_osc *c)
+{
+    return fmin(c->Tp, pd_osc_T0(c)) / 2000.0;
+}
+
+/* Measuring window of the harmonic steady state: max(16 Tp, 3 T0). */
+static double harmonic_window(const pd_osc *c)
+{
+    return fmax(16.0 * c->Tp, 3.0 * pd_osc_T0(c));
+}
+
+/* Harmonic transient: until exp(-xi w0 t) < 1e-3 (at least 20 Tp), or
+ * 20 Tp + 20 T0 without damping (impacts then dissipate when eps < 1). */
+double pd_osc_default_tend(const pd_osc *c)
+{
+    double T0 = pd_osc_T0(c);
+    if (c->pulse != PD_PULSE_HARMONIC)
+        return c->Tp + 2.0 * T0;
+    double w0 = PD_TWO_PI / T0;
+    double transient = c->xi > 0.0 ? fmax(20.0 * c->Tp, log(1e3) / (c->xi * w0))
+                                   : 20.0 * c->Tp + 20.0 * T0;
+    return transient + harmonic_window(c);
+}
+
+double pd_osc_measure_start(const pd_osc *c, double tend)
+{
+    if (c->pulse != PD_PULSE_HARMONIC)
+        return 0.0;
+    return fmax(0.0, tend - harmonic_window(c));
+}
+
+/* ---- the scene -------------------------------------------------------- */
+
+typedef struct scene {
+    pd_pulse pulse;
+    int dir;
+} scene;
+
+static void scene_force(double tau, int side, double *F, void *ctx)
+{
+    const scene *sc = ctx;
+    F[0] = pulse_shape(sc->pulse, sc->dir, tau, side);
+}
+
+/* Measurements in dimensionless units, updated by the observer. */
+typedef struct tracker {
+    const pd_osc *c;
+    double h;             /* dimensionless step */
+    double tau_measure;   /* window start (dimensionless) */
+    double Le, vscale, wp;
+    double xmax, xtoward, xaway;
+    long impacts, contact_steps;
+    double first_tau, first_v, vimp_max;
+    double closing_tau, closing_v; /* last gap closing seen */
+    double prev_x, prev_v, prev2_v, prev_P, min_gap;
+    pd_osc_sampler sampler;
+    void *sampler_ctx;
+} tracker;
+
+/* Time s in [0, h] after the step start at which the gap g0 > 0 closes
+ * under x(s) = v s + a s^2 / 2 (velocity v, acceleration a of the step). */
+static double closing_time(double g0, double v, double a, double h)
+{
+    double s = h;
+    if (g0 <= 0.0)
+        return 0.0;
+    if (fabs(a) * h < 1e-12 * fabs(v) || a == 0.0)
+        s = v > 0.0 ? g0 / v : h;
+    else {
+        double disc = v * v + 2.0 * a * g0; /* a s^2/2 + v s - g0 = 0 */
+        if (disc >= 0.0)
+            s = (v > 0.0) ? 2.0 * g0 / (v + sqrt(disc)) : (-v + sqrt(disc)) / a;
+    }
+    return fmin(fmax(s, 0.0), h);
+}
+
+/* Per step: extremes, impacts (impulse after a step without) with their
+ * instant and approach speed estimated inside the step, samples. */
+static int observe(const pd_state *st, void *ctx)
+{
+    tracker *tr = ctx;
+    double x = st->q[0], v = st->v[0], P = st->P[0];
+    double gap = tr->c->Pi3 - x;
+    if (st->t >= tr->tau_measure - 0.5 * tr->h) {
+        tr->xmax = fmax(tr->xmax, fabs(x));
+        tr->xtoward = fmax(tr->xtoward, x);
+        tr->xaway = fmax(tr->xaway, -x);
+    }
+    /* the gap closes in this step (or an impulse stops it closing): instant
+     * and speed from the step start and the step's free acceleration */
+    double g_prev = tr->c->Pi3 - tr->prev_x;
+    if (st->step > 0 && g_prev > 0.0 && (gap <= 0.0 || P > 0.0)) {
+        double acc = P == 0.0 ? (v - tr->prev_v) / tr->h
+                              : (st->step > 1 ? (tr->prev_v - tr->prev2_v) / tr->h : 0.0);
+        double s = closing_time(g_prev, tr->prev_v, acc, tr->h);
+        tr->closing_tau = st->t - tr->h + s;
+        tr->closing_v = tr->prev_v + acc * s;
+    }
+    if (P > 0.0) {
+        tr->contact_steps++;
+        if (tr->prev_P == 0.0) {
+            tr->impacts++;
+            tr->vimp_max = fmax(tr->vimp_max, tr->closing_v);
+            if (tr->impacts == 1) {
+                tr->first_tau = tr->closing_tau;
+                tr->first_v = tr->closing_v;
+            }
+        }
+    }
+    tr->min_gap = fmin(tr->min_gap, gap);
+    tr->prev2_v = tr->prev_v;
+    tr->prev_x = x;
+    tr->prev_v = v;
+    tr->prev_P = P;
+    if (tr->sampler) {
+        pd_osc_sample smp = {st->step, st->t / tr->wp, x * tr->Le, v * tr->vscale,
+                             P * tr->vscale, gap * tr->Le};
+        return tr->sampler(&smp, tr->sampler_ctx);
+    }
+    return 0;
+}
+
+int pd_osc_simulate(const pd_osc *c, const pd_osc_opts *opts, pd_osc_sampler sampler,
+                    void *ctx, pd_osc_result *res, pd_err *err)
+{
+    pd_osc_opts o = opts ? *opts : pd_osc_default_opts();
+    int rc;
+    pd_err_clear(err);
+    if ((rc = pd_osc_check(c, err)))
+        return rc;
+    if (o.dt == 0.0)
+        o.dt = pd_osc_default_dt(c);
+    if (o.tend == 0.0)
+        o.tend = pd_osc_default_tend(c);
+    if (!(o.dt > 0.0) || !isfinite(o.dt))
+        return pd_err_set(err, PD_EINVAL, "dt must be a finite number > 0 (got %g)", o.dt);
+    if (!(o.tend > 0.0) || !isfinite(o.tend))
+        return pd_err_set(err, PD_EINVAL, "tend must be a finite number > 0 (got %g)", o.tend);
+    if (o.tend / o.dt > 4e9)
+        return pd_err_set(err, PD_EINVAL, "tend / dt = %g steps is too many", o.tend / o.dt);
+
+    /* model in Pi units; the step is 2 pi (dt / Tp) so equal dt/Tp gives equal h */
+    scene sc = {c->pulse, c->dir};
+    double pulse_end = PD_TWO_PI; /* the only breakpoint of a pulse */
+    double M = 1.0, C = 2.0 * c->xi * c->Pi2, K = c->Pi2 * c->Pi2, W = -1.0;
+    double g0 = c->Pi3, e = c->eps;
+    pd_model model = {1, o.no_wall ? 0 : 1, pd_matrix_dense(1, 1, &M), pd_matrix_dense(1, 1, &C),
+                      pd_matrix_dense(1, 1, &K), pd_matrix_dense(1, 1, &W), &g0, &e,
+                      scene_force, &sc, &pulse_end, c->pulse == PD_PULSE_HARMONIC ? 0 : 1};
+    pd_mj_opts mo = pd_mj_default_opts();
+    mo.h = PD_TWO_PI * (o.dt / c->Tp);
+    mo.theta = o.theta;
+    mo.gamma = o.gamma;
+    mo.allow_unstable = o.allow_unstable;
+    mo.kernel = o.kernel;
+    long nsteps = pd_steps_for(o.tend, o.dt);
+
+    double cpu0 = pd_cpu_seconds();
+    pd_mj *mj = pd_mj_alloc(&model, &mo, err);
+    if (!mj)
+        return err ? err->status : PD_EINVAL;
+    double wp = pd_osc_wp(c);
+    tracker tr = {c, mo.h, wp * pd_osc_measure_start(c, o.tend), pd_osc_Le(c),
+                  pd_osc_Le(c) * wp, wp, 0.0, 0.0, 0.0, 0, 0, NAN, NAN, 0.0, 0.0, 0.0,
+                  0.0, 0.0, 0.0, 0.0, c->Pi3, sampler, ctx};
+    rc = pd_mj_run(mj, nsteps, observe, &tr, err);
+    const pd_state *st = pd_mj_state(mj);
+
+    /* results in metres and seconds */
+    memset(res, 0, sizeof *res);
+    res->umax = tr.xmax * tr.Le;
+    res->u_toward = tr.xtoward * tr.Le;
+    res->u_away = tr.xaway * tr.Le;
+    res->impacts = tr.impacts;
+    res->first_impact = tr.first_tau / wp;
+    res->first_impact_velocity = tr.first_v * tr.vscale;
+    res->max_impact_velocity = tr.vimp_max * tr.vscale;
+    res->contact_time = (double)tr.contact_steps * o.dt;
+    res->min_gap = tr.min_gap * tr.Le;
+    res->steps = st->step;
+    res->dt = o.dt;
+    res->tend = o.tend;
+    res->theta = mo.theta == 0.0 ? 0.5 : mo.theta;
+    res->gamma = mo.gamma < 0.0 ? 0.5 : mo.gamma;
+    res->kernel = pd_mj_kernel_name(mj);
+    pd_mj_free(mj);
+    res->cpu_s = pd_cpu_seconds() - cpu0;
+    return rc;
+}
+
+void pd_osc_free_exact(const pd_osc *c, double t, double *u, double *v)
+{
+    pd_sdof osc = {PD_TWO_PI / pd_osc_T0(c), c->xi};
+    double wp = pd_osc_wp(c), A = c->dir * c->ap;
+    double phi = c->pulse == PD_PULSE_COSINE ? PD_TWO_PI / 4.0 : 0.0; /* cos = sin(+pi/2) */
+    if (c->pulse == PD_PULSE_HARMONIC || t <= c->Tp) {
+        pd_sdof_advance(&osc, A, wp, phi, 0.0, 0.0, 0.0, t, u, v);
+        return;
+    }
+    double uT, vT;
+    pd_sdof_advance(&osc, A, wp, phi, 0.0, 0.0, 0.0, c->Tp, &uT, &vT);
+    pd_sdof_advance(&osc, 0.0, wp, 0.0, c->Tp, uT, vT, t, u, v);
+}
