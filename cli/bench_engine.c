@@ -1,7 +1,143 @@
+/* bench_engine.c — `pound bench --engine`: Moreau–Jean steps per second on
+ * the one-wall oscillator (no history), in free flight, in persistent
+ * contact (an LCP every step) and with many impacts; scalar and general
+ * kernels; the median of three timed runs each. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
 #include "pd_cli.h"
+#include "pd_oscillator.h"
+
+/* A scene of its own for persistent contact: x'' + k x = 1 pressing the
+ * oscillator on a wall at x = 0 (gap 0, e = 0): active, LCP every step. */
+static void push_force(double t, int side, double *F, void *ctx)
+{
+    (void)t;
+    (void)side;
+    (void)ctx;
+    F[0] = 1.0;
+}
+
+typedef struct bench_case {
+    const char *name;
+    const char *what;
+    double steps_per_s;
+    double lcp_fraction; /* steps with an active contact */
+    long steps;
+} bench_case;
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Median rate of pd_osc_simulate over three runs. */
+static int time_oscillator(const pd_osc *c, const pd_osc_opts *o, bench_case *bc)
+{
+    double rate[3];
+    pd_osc_result r;
+    pd_err err;
+    for (int k = 0; k < 3; k++) {
+        if (pd_osc_simulate(c, o, NULL, NULL, &r, &err))
+            return 1;
+        rate[k] = (double)r.steps / fmax(r.cpu_s, 1e-9);
+    }
+    qsort(rate, 3, sizeof rate[0], cmp_double);
+    bc->steps_per_s = rate[1];
+    bc->steps = r.steps;
+    bc->lcp_fraction = r.contact_time / r.tend;
+    return 0;
+}
+
+/* Median rate of the bare engine (no observer) on the pressing scene. */
+static int time_pressing(pd_kernel kernel, long nsteps, bench_case *bc)
+{
+    double M = 1, K = 0.01, W = -1, g0 = 0, e = 0, rate[3];
+    pd_model md = {1, 1, pd_matrix_dense(1, 1, &M), {PD_MATRIX_ZERO, 1, 1, NULL},
+                   pd_matrix_dense(1, 1, &K), pd_matrix_dense(1, 1, &W), &g0, &e, push_force,
+                   NULL, NULL, 0};
+    pd_mj_opts o = pd_mj_default_opts();
+    pd_err err;
+    o.h = 1e-3;
+    o.kernel = kernel;
+    pd_mj *mj = pd_mj_alloc(&md, &o, &err);
+    if (!mj)
+        return 1;
+    long active = 0;
+    for (int k = 0; k < 3; k++) {
+        pd_mj_reset(mj, 0.0, NULL, NULL, &err);
+        double t0 = pd_cpu_seconds();
+        active = 0;
+        for (long s = 0; s < nsteps; s++) {
+            if (pd_mj_step(mj, &err)) {
+                pd_mj_free(mj);
+                return 1;
+            }
+            active += pd_mj_state(mj)->nactive;
+        }
+        rate[k] = (double)nsteps / fmax(pd_cpu_seconds() - t0, 1e-9);
+    }
+    pd_mj_free(mj);
+    qsort(rate, 3, sizeof rate[0], cmp_double);
+    bc->steps_per_s = rate[1];
+    bc->steps = nsteps;
+    bc->lcp_fraction = (double)active / (double)nsteps;
+    return 0;
+}
 
 int pd_bench_engine(pd_json *js)
 {
-    (void)js;
-    return 0;
+    bench_case cases[6];
+    int n = 0, rc = 0;
+    pd_osc_opts o = pd_osc_default_opts();
+    /* free flight: harmonic excitation, the wall out of reach */
+    pd_osc free_c = {PD_PULSE_HARMONIC, 1, 1.0, 1.0, 0.5, 1e9, 0.5, 0.05};
+    o.dt = 1e-4;
+    o.tend = 1000.0;
+    cases[n] = (bench_case){"free_flight", "harmonic, no contact, oscillator observer", 0, 0, 0};
+    rc |= time_oscillator(&free_c, &o, &cases[n++]);
+    /* many impacts: harmonic, small gap, eps = 0.8 */
+    pd_osc imp_c = {PD_PULSE_HARMONIC, 1, 1.0, 1.0, 0.5, 0.01, 0.8, 0.05};
+    cases[n] = (bench_case){"many_impacts", "harmonic, Pi3 = 0.01, eps = 0.8", 0, 0, 0};
+    rc |= time_oscillator(&imp_c, &o, &cases[n++]);
+    /* persistent contact: a normal sine pulse, eps = 0, long resting phases */
+    pd_osc rest_c = {PD_PULSE_HARMONIC, 1, 1.0, 1.0, 0.3, 0.0, 0.0, 0.05};
+    cases[n] = (bench_case){"contact_phases", "harmonic, Pi3 = 0, eps = 0 (rests half the time)",
+                            0, 0, 0};
+    rc |= time_oscillator(&rest_c, &o, &cases[n++]);
+    cases[n] = (bench_case){"persistent_scalar", "pressed on the wall, LCP every step, scalar kernel",
+                            0, 0, 0};
+    rc |= time_pressing(PD_KERNEL_AUTO, 10000000, &cases[n++]);
+    cases[n] = (bench_case){"persistent_general",
+                            "pressed on the wall, LCP every step, general kernel (Lemke)", 0, 0, 0};
+    rc |= time_pressing(PD_KERNEL_GENERAL, 2000000, &cases[n++]);
+
+    if (js) {
+        pd_json_begin_object(js, "engine");
+        pd_json_num(js, "target_free_steps_per_s", 20e6);
+        pd_json_num(js, "target_lcp_steps_per_s", 5e6);
+        pd_json_begin_array(js, "cases");
+        for (int k = 0; k < n; k++) {
+            pd_json_begin_object(js, NULL);
+            pd_json_str(js, "name", cases[k].name);
+            pd_json_str(js, "what", cases[k].what);
+            pd_json_num(js, "steps_per_s", cases[k].steps_per_s);
+            pd_json_num(js, "ns_per_step", 1e9 / cases[k].steps_per_s);
+            pd_json_num(js, "active_fraction", cases[k].lcp_fraction);
+            pd_json_int(js, "steps", cases[k].steps);
+            pd_json_end_object(js);
+        }
+        pd_json_end_array(js);
+        pd_json_end_object(js);
+    } else {
+        printf("Moreau-Jean engine, one-wall oscillator (median of 3 runs, one core)\n");
+        printf("  %-20s %14s %10s %8s  %s\n", "case", "steps/s", "ns/step", "active", "what");
+        for (int k = 0; k < n; k++)
+            printf("  %-20s %14.4g %10.2f %7.1f%%  %s\n", cases[k].name, cases[k].steps_per_s,
+                   1e9 / cases[k].steps_per_s, 100 * cases[k].lcp_fraction, cases[k].what);
+        printf("  targets: 20e6 steps/s in free flight, 5e6 steps/s with an LCP every step\n");
+    }
+    return rc ? 1 : 0;
 }
