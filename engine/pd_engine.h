@@ -143,6 +143,43 @@ double pd_contact_impulse_1(double D, double b);
  * within 1e-9 of an integer, else rounded up). */
 long pd_steps_for(double tend, double h);
 
+/* ---- penalty baseline (engine/penalty.c) -------------------------------- */
+
+/* What practitioners use today: a contact element per contact, active while
+ * the gap is negative (penetration d = -g > 0), integrated with GSL's
+ * adaptive odeiv2 steppers.
+ *   Kelvin-Voigt (Anagnostopoulos):  lambda = kc d + c d'        (c from e)
+ *   Hertz-damp (Muthukumar–DesRoches): lambda = kc d^1.5 + c d^1.5 d'
+ * Damping constants follow from the restitution e of each contact and, for
+ * Hertz-damp, from the approach speed at the start of each contact; see
+ * docs/methods.md. */
+typedef enum { PD_PENALTY_KELVIN = 0, PD_PENALTY_HERTZDAMP = 1 } pd_penalty_law;
+
+typedef struct pd_penalty_opts {
+    pd_penalty_law law;
+    double kc;           /* contact stiffness (force per unit penetration[^1.5]) > 0 */
+    double rtol, atol;   /* adaptive tolerances (0 = defaults 1e-10, 1e-12) */
+    const char *stepper; /* GSL stepper: "rk8pd" (default), "rkf45", "rk4imp", "msbdf" */
+    double h_out;        /* > 0: the observer is called every h_out (and at t1) */
+    long max_steps;      /* budget of accepted steps (0 = 10^8) */
+} pd_penalty_opts;
+
+typedef struct pd_penalty_result {
+    long steps;    /* accepted steps */
+    long rhs;      /* right-hand-side evaluations */
+    double min_gap;
+    double max_penetration_velocity;
+} pd_penalty_result;
+
+/* Integrate the model from (t0, q0, v0) to t1 (NULL = zeros).  The observer
+ * gets a pd_state at t0, at every multiple of h_out and at t1; in it P holds
+ * the contact forces lambda at that instant (not impulses).  Extremes that
+ * fall between outputs are the caller's to track through an observer with
+ * h_out = 0: then it is called after every accepted step. */
+int pd_penalty_run(const pd_model *model, double t0, const double *q0, const double *v0,
+                   double t1, const pd_penalty_opts *opts, pd_observer observer, void *ctx,
+                   pd_penalty_result *res, pd_err *err);
+
 /* ---- closed forms for one linear oscillator --------------------------- */
 
 /* u'' + 2 xi w0 u' + w0^2 u = A sin(w t + phi),  0 <= xi < 1, w0 > 0.

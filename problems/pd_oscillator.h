@@ -102,6 +102,27 @@ typedef struct pd_osc_result {
 int pd_osc_simulate(const pd_osc *c, const pd_osc_opts *opts, pd_osc_sampler sampler,
                     void *ctx, pd_osc_result *res, pd_err *err);
 
+/* ---- other methods on the same case ------------------------------------ */
+
+/* Penalty baseline (problems/osc_penalty.c): the same case with a contact
+ * element (see pd_penalty_run).  kc_mult > 0 sets the stiffness as a
+ * multiple of w0^2 (Hertz: the force at a penetration of Le equals
+ * kc_mult w0^2 Le); kc_abs > 0 instead gives it in N/m per kg (N/m^1.5 per
+ * kg for Hertz).
+ * Steps, extremes and impacts are measured on the accepted steps; the
+ * sampler (if any) is called every opts->dt.  res->steps counts accepted
+ * steps, res->kernel names the stepper. */
+typedef struct pd_osc_penalty_opts {
+    pd_penalty_law law;
+    double kc_mult;      /* stiffness as a multiple of w0^2 (default 1e4) */
+    double kc_abs;       /* or absolute, N/m per kg (overrides kc_mult when > 0) */
+    double rtol, atol;   /* 0 = defaults */
+    const char *stepper; /* NULL = "rk8pd" */
+} pd_osc_penalty_opts;
+
+int pd_osc_penalty(const pd_osc *c, const pd_osc_opts *opts, const pd_osc_penalty_opts *popts,
+                   pd_osc_sampler sampler, void *ctx, pd_osc_result *res, pd_err *err);
+
 /* Exact response without the wall from rest (closed form), at t [s]. */
 void pd_osc_free_exact(const pd_osc *c, double t, double *u, double *v);
 
