@@ -182,14 +182,72 @@ int pd_penalty_run(const pd_model *model, double t0, const double *q0, const dou
 
 /* ---- closed forms for one linear oscillator --------------------------- */
 
-/* u'' + 2 xi w0 u' + w0^2 u = A sin(w t + phi),  0 <= xi < 1, w0 > 0.
+/* u'' + 2 xi w0 u' + w0^2 u = A sin(w t + phi),  0 <= xi < 1, w0 >= 0.
  * Advance the exact solution from (u0, v0) at t0 to t1 (A = 0: free
- * vibration); resonance with xi = 0 is handled. */
+ * vibration); resonance with xi = 0 is handled; w0 = 0 is a free mass
+ * (then xi is ignored; w = 0 is the constant force A sin(phi)). */
 typedef struct pd_sdof {
     double w0, xi;
 } pd_sdof;
 
 void pd_sdof_advance(const pd_sdof *osc, double A, double w, double phi, double t0, double u0,
                      double v0, double t1, double *u1, double *v1);
+
+/* The same, returning the displacement increment du = u(t1) - u0 computed
+ * without cancellation (full relative precision for short intervals). */
+void pd_sdof_increment(const pd_sdof *osc, double A, double w, double phi, double t0, double u0,
+                       double v0, double t1, double *du, double *v1);
+
+/* ---- event-driven reference: one oscillator, one wall (event_sdof.c) --
+
+ *   x'' + 2 xi w0 x' + w0^2 x = F(t) - lambda,  g = delta - x >= 0,
+ * F piecewise sinusoidal.  Exact closed-form flight between events; gap
+ * closings (and grazing) located by bracketing on a scan grid plus
+ * bisection to machine precision; Newton impacts; persistent contact while
+ * lambda = F - w0^2 delta >= 0 (the acceleration-level LCP of one contact);
+ * accumulations of impacts jumped with the bouncing-ball tail
+ * t_inf = t_i + 2 v+ / (a (1 - e)).  Extremes are the exact continuous ones. */
+
+/* F(t) = A sin(w t + phi) from t_start until the next piece's t_start. */
+typedef struct pd_sine_piece {
+    double t_start, A, w, phi;
+} pd_sine_piece;
+
+typedef struct pd_ed_sdof {
+    pd_sdof osc;
+    int wall;       /* 0: no wall (the free twin) */
+    double delta;   /* wall at x = delta >= 0 */
+    double e;       /* Newton restitution in [0, 1] */
+    int npieces;    /* >= 1; pieces[0].t_start is the start time */
+    const pd_sine_piece *pieces;
+} pd_ed_sdof;
+
+typedef struct pd_ed_opts {
+    double t_end;
+    double t_measure;     /* extremes count from here on */
+    double h_out;         /* > 0: sampler at t_start + k h_out */
+    int no_accumulation;  /* 1: never jump an accumulation (shows the stall) */
+    long max_events;      /* 0 = 10^7 */
+    long max_burst;       /* impacts in one accumulation before giving up, 0 = 10^4 */
+    double length_scale;  /* an accumulation is jumped once its bounce height
+                             v+^2 / (2 a) is below 1e-13 * length_scale (0 = 1) */
+    int scan_divisions;   /* bracketing grid: shortest period / this (0 = 64) */
+} pd_ed_opts;
+
+typedef struct pd_ed_result {
+    double xmax, xtoward, xaway;  /* max |x|, max x, max -x over the window */
+    long impacts, accumulations, detachments, events;
+    double first_impact, first_impact_velocity, max_impact_velocity; /* NAN: none */
+    double contact_time;          /* time spent resting on the wall */
+    double t_reached;             /* where the run stopped (t_end unless it failed) */
+} pd_ed_result;
+
+/* Called on the output grid with the exact state; return > 0 to stop. */
+typedef int (*pd_ed_sampler)(double t, double x, double v, int in_contact, void *ctx);
+
+/* Run from (x0, v0) at pieces[0].t_start to opts->t_end.  PD_EBUDGET when an
+ * event budget is exhausted (message names the time and the count). */
+int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opts *opts,
+                   pd_ed_sampler sampler, void *ctx, pd_ed_result *res, pd_err *err);
 
 #endif

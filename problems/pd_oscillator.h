@@ -56,6 +56,7 @@ typedef struct pd_osc_opts {
     int allow_unstable; /* accept theta outside [1/2, 1] */
     int no_wall;        /* run the no-wall twin instead */
     pd_kernel kernel;
+    int no_accumulation; /* event-driven: do not jump accumulations of impacts */
 } pd_osc_opts;
 
 pd_osc_opts pd_osc_default_opts(void);
@@ -92,7 +93,8 @@ typedef struct pd_osc_result {
     double max_impact_velocity;   /* largest approach speed of any impact [m/s] */
     double contact_time;  /* time spent with a nonzero impulse [s] */
     double min_gap;       /* smallest gap seen [m] (negative: penetration) */
-    long steps;
+    long accumulations;   /* event-driven: accumulations jumped to rest */
+    long steps;           /* steps (Moreau–Jean, penalty) or events (event-driven) */
     double dt, tend, theta, gamma;
     double cpu_s;
     const char *kernel;   /* "scalar" or "general" */
@@ -103,6 +105,13 @@ int pd_osc_simulate(const pd_osc *c, const pd_osc_opts *opts, pd_osc_sampler sam
                     void *ctx, pd_osc_result *res, pd_err *err);
 
 /* ---- other methods on the same case ------------------------------------ */
+
+/* Event-driven reference (pd_ed_sdof_run): exact between events, so its
+ * umax is the continuous maximum to rounding.  opts->dt is only the
+ * sampling interval of sampler; theta/gamma/kernel are ignored; res->steps
+ * counts events, res->min_gap is 0, res->kernel is "event". */
+int pd_osc_reference(const pd_osc *c, const pd_osc_opts *opts, pd_osc_sampler sampler, void *ctx,
+                     pd_osc_result *res, pd_err *err);
 
 /* Penalty baseline (problems/osc_penalty.c): the same case with a contact
  * element (see pd_penalty_run).  kc_mult > 0 sets the stiffness as a

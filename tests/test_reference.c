@@ -1,0 +1,300 @@
+/* test_reference.c — the event-driven reference: closed forms, accumulation,
+ * energy balance, self-consistency, and Moreau–Jean converging to it. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pd_oscillator.h"
+#include "pd_test.h"
+
+#define TWO_PI 6.283185307179586476925286766559
+
+/* Without the wall the reference is the closed form, and its umax is the
+ * continuous maximum: above every sample of a fine grid, and within the
+ * grid's O(h^2) of the best one. */
+typedef struct grid_max {
+    const pd_osc *c;
+    double worst, umax_grid;
+} grid_max;
+
+static int compare_free(const pd_osc_sample *s, void *ctx)
+{
+    grid_max *g = ctx;
+    double u, v;
+    pd_osc_free_exact(g->c, s->t, &u, &v);
+    g->worst = fmax(g->worst, fabs(s->u - u) + fabs(s->v - v) / pd_osc_wp(g->c));
+    g->umax_grid = fmax(g->umax_grid, fabs(u));
+    return 0;
+}
+
+static void test_ref_no_wall_is_closed_form(pd_test_ctx *ctx)
+{
+    const pd_pulse pulses[] = {PD_PULSE_SINE, PD_PULSE_COSINE, PD_PULSE_HARMONIC};
+    for (int p = 0; p < 3; p++) {
+        pd_osc c = {pulses[p], -1, 3.0, 0.7, 0.8, 0.0, 0.5, 0.05};
+        pd_osc_opts o = pd_osc_default_opts();
+        pd_osc_result r;
+        pd_err e;
+        grid_max g = {&c, 0, 0};
+        o.no_wall = 1;
+        o.dt = c.Tp / 20000;
+        if (pulses[p] == PD_PULSE_HARMONIC)
+            o.tend = 10 * c.Tp;
+        CHECK(ctx, pd_osc_reference(&c, &o, compare_free, &g, &r, &e) == PD_OK, "%s", e.msg);
+        double scale = pd_osc_Le(&c);
+        CHECK(ctx, g.worst <= 1e-13 * scale, "%s: samples differ from the closed form by %.3g",
+              pd_pulse_name(pulses[p]), g.worst);
+        CHECK(ctx, r.umax >= g.umax_grid * (1 - 1e-15) && r.umax - g.umax_grid <= 1e-7 * r.umax,
+              "%s: umax %.15g vs grid max %.15g", pd_pulse_name(pulses[p]), r.umax, g.umax_grid);
+        CHECK(ctx, r.impacts == 0 && r.steps < 10, "no events beyond breakpoints (%ld)", r.steps);
+    }
+}
+
+/* Bouncing ball (w0 = 0, constant force a toward the wall from rest at a
+ * distance delta): t1 = sqrt(2 delta / a), v1 = a t1, and the impacts
+ * accumulate at t_inf = t1 + 2 e v1 / (a (1 - e)); then it rests. */
+static void test_ref_bouncing_ball_accumulation(pd_test_ctx *ctx)
+{
+    const double es[] = {0.3, 0.5, 0.8, 0.9};
+    for (int k = 0; k < 4; k++) {
+        double a = 2.0, delta = 0.5, e = es[k];
+        pd_sine_piece piece = {0.0, a, 0.0, TWO_PI / 4}; /* a sin(pi/2) = a */
+        pd_ed_sdof prob = {{0.0, 0.0}, 1, delta, e, 1, &piece};
+        double t1 = sqrt(2 * delta / a), v1 = a * t1, t_inf = t1 + 2 * e * v1 / (a * (1 - e));
+        pd_ed_opts o;
+        memset(&o, 0, sizeof o);
+        o.t_end = 2 * t_inf + 1.0;
+        o.max_burst = 500;
+        pd_ed_result r;
+        pd_err err;
+        CHECK(ctx, pd_ed_sdof_run(&prob, 0.0, 0.0, &o, NULL, NULL, &r, &err) == PD_OK, "%s",
+              err.msg);
+        CHECK_NEAR(ctx, r.first_impact, t1, 1e-14);
+        CHECK_NEAR(ctx, r.first_impact_velocity, v1, 1e-14);
+        CHECK_NEAR(ctx, o.t_end - r.contact_time, t_inf, 1e-12 * t_inf);
+        CHECK(ctx, r.accumulations == 1, "e %g: accumulations %ld", e, r.accumulations);
+        /* bounce heights fall as e^2n: the jump comes after about
+         * log(1e-13 / h1) / log(e^2) impacts, h1 = (e v1)^2 / (2 a) */
+        double h1 = (e * v1) * (e * v1) / (2 * a), n_expected = log(1e-13 / h1) / log(e * e);
+        CHECK(ctx, fabs((double)r.impacts - n_expected) <= 2.0, "e %g: %ld impacts, expected %.1f",
+              e, r.impacts, n_expected);
+        CHECK_NEAR(ctx, r.xtoward, delta, 0.0);
+    }
+}
+
+/* Without the accumulation jump the same ball exhausts its impact budget
+ * with a clear status, and does not hang. */
+static void test_ref_accumulation_off_stalls(pd_test_ctx *ctx)
+{
+    double a = 2.0, delta = 0.5, e = 0.8;
+    pd_sine_piece piece = {0.0, a, 0.0, TWO_PI / 4};
+    pd_ed_sdof prob = {{0.0, 0.0}, 1, delta, e, 1, &piece};
+    double t1 = sqrt(2 * delta / a), t_inf = t1 + 2 * e * a * t1 / (a * (1 - e));
+    pd_ed_opts o;
+    memset(&o, 0, sizeof o);
+    o.t_end = 2 * t_inf;
+    o.max_burst = 500;
+    o.no_accumulation = 1;
+    pd_ed_result r;
+    pd_err err;
+    int rc = pd_ed_sdof_run(&prob, 0.0, 0.0, &o, NULL, NULL, &r, &err);
+    CHECK(ctx, rc == PD_EBUDGET, "status %d, expected PD_EBUDGET", rc);
+    CHECK(ctx, strstr(err.msg, "accumulation") && strstr(err.msg, "t = "), "message: %s", err.msg);
+    CHECK(ctx, fabs(r.t_reached - t_inf) <= 1e-9 * t_inf,
+          "stalled at %.15g, the accumulation point is t_inf = %.15g", r.t_reached, t_inf);
+    CHECK(ctx, r.impacts == 501, "impacts %ld (budget 500)", r.impacts);
+}
+
+/* Unforced, undamped oscillator launched at V toward a wall at delta:
+ * t1 = asin(w0 delta / V) / w0, v1 = V cos(w0 t1); each impact keeps
+ * the energy times e^2 in its kinetic part; e = 1 keeps E exactly. */
+typedef struct energy_obs {
+    double w0, E0, worst;
+} energy_obs;
+
+static int track_energy(double t, double x, double v, int in_contact, void *ctx)
+{
+    energy_obs *eo = ctx;
+    (void)t;
+    (void)in_contact;
+    double E = 0.5 * v * v + 0.5 * eo->w0 * eo->w0 * x * x;
+    eo->worst = fmax(eo->worst, fabs(E - eo->E0) / eo->E0);
+    return 0;
+}
+
+static void test_ref_impact_closed_form(pd_test_ctx *ctx)
+{
+    double w0 = 2.0, V = 1.0, delta = 0.3;
+    pd_sine_piece piece = {0.0, 0.0, 0.0, 0.0};
+    pd_ed_sdof prob = {{w0, 0.0}, 1, delta, 1.0, 1, &piece};
+    pd_ed_opts o;
+    memset(&o, 0, sizeof o);
+    o.t_end = 50.0;
+    o.h_out = 1e-3;
+    energy_obs eo = {w0, 0.5 * V * V, 0};
+    pd_ed_result r;
+    pd_err err;
+    CHECK(ctx, pd_ed_sdof_run(&prob, 0.0, V, &o, track_energy, &eo, &r, &err) == PD_OK, "%s",
+          err.msg);
+    double t1 = asin(w0 * delta / V) / w0;
+    CHECK_NEAR(ctx, r.first_impact, t1, 1e-14);
+    CHECK_NEAR(ctx, r.first_impact_velocity, V * cos(w0 * t1), 1e-14);
+    CHECK(ctx, eo.worst <= 1e-13, "e = 1: energy drift %.3g over %ld impacts", eo.worst, r.impacts);
+    /* period with the wall: 2 pi/w0 less the clipped arc 2 (pi/2 - w0 t1)/w0 */
+    double period = (TWO_PI - 2 * (TWO_PI / 4 - w0 * t1)) / w0;
+    CHECK(ctx, labs(r.impacts - (long)floor((50.0 - t1) / period) - 1) <= 1,
+          "impacts %ld, expected %ld", r.impacts, (long)floor((50.0 - t1) / period) + 1);
+    CHECK_NEAR(ctx, r.xaway, V / w0, 1e-14);
+}
+
+/* Work-energy balance with forcing, damping and impacts:
+ * E(t) - E(0) = int F v - int 2 xi w0 v^2 - sum (1 - e^2) v_imp^2 / 2,
+ * integrals by the trapezoid rule on a fine grid (error O(h^2)). */
+typedef struct work_obs {
+    const pd_osc *c;
+    double prev_t, prev_v, prev_p, prev_d, work, damp, w0;
+    double x_last, v_last;
+    long n;
+} work_obs;
+
+static int track_work(const pd_osc_sample *s, void *ctx)
+{
+    work_obs *wo = ctx;
+    double f = pd_osc_excitation(wo->c, s->t), p = f * s->v;
+    double d = 2 * wo->c->xi * wo->w0 * s->v * s->v;
+    if (wo->n++ > 0) {
+        wo->work += 0.5 * (s->t - wo->prev_t) * (p + wo->prev_p);
+        wo->damp += 0.5 * (s->t - wo->prev_t) * (d + wo->prev_d);
+    }
+    wo->prev_t = s->t;
+    wo->prev_p = p;
+    wo->prev_d = d;
+    wo->x_last = s->u;
+    wo->v_last = s->v;
+    return 0;
+}
+
+static void test_ref_energy_balance(pd_test_ctx *ctx)
+{
+    const double es[] = {1.0, 0.6};
+    for (int k = 0; k < 2; k++) {
+        pd_osc c = {PD_PULSE_SINE, 1, 2.0, 0.5, 0.8, 0.2, es[k], 0.05};
+        pd_osc_opts o = pd_osc_default_opts();
+        pd_osc_result r;
+        pd_err e;
+        double w0 = TWO_PI / pd_osc_T0(&c);
+        work_obs wo = {&c, 0, 0, 0, 0, 0, 0, w0, 0, 0, 0};
+        o.dt = c.Tp / 200000;
+        o.tend = c.Tp; /* during the pulse: the force does work */
+        CHECK(ctx, pd_osc_reference(&c, &o, track_work, &wo, &r, &e) == PD_OK, "%s", e.msg);
+        double E = 0.5 * wo.v_last * wo.v_last + 0.5 * w0 * w0 * wo.x_last * wo.x_last;
+        double loss = E - (wo.work - wo.damp);
+        /* the trapezoid rule meets each impact's jump of f v: O(h) per impact */
+        if (es[k] == 1.0)
+            CHECK(ctx, fabs(loss) <= 1e-5 * wo.work, "e = 1: balance off by %.3g (work %.3g)",
+                  loss, wo.work);
+        else /* the impact losses are what the balance misses */
+            CHECK(ctx, loss < -1e-3 * wo.work && r.impacts > 0,
+                  "e = 0.6: impacts must dissipate (%.3g, %ld impacts)", loss, r.impacts);
+    }
+}
+
+/* Self-consistency over the grid of issue 4: a bracketing grid 8 times
+ * finer gives the same umax to 1e-11 (the root finding is to rounding). */
+static void test_ref_self_consistent_on_grid(pd_test_ctx *ctx)
+{
+    const double Pi2s[] = {0.05, 0.2, 0.7, 1.16, 3.0, 10.0}, Pi3s[] = {0.001, 0.05, 1.0, 10.0};
+    const double epss[] = {0.0, 0.5, 0.9, 1.0};
+    double worst = 0;
+    int points = 0, pounding = 0, failures = 0;
+    for (int p = 0; p < 2; p++)
+        for (int dir = -1; dir <= 1; dir += 2)
+            for (int i = 0; i < 6; i++)
+                for (int j = 0; j < 4; j++)
+                    for (int k = 0; k < 4; k++) {
+                        pd_osc c = {p ? PD_PULSE_COSINE : PD_PULSE_SINE, dir, 1.0, 1.0, Pi2s[i],
+                                    Pi3s[j], epss[k], 0.05};
+                        pd_osc_result r;
+                        pd_err e;
+                        pd_ed_result fine;
+                        if (pd_osc_reference(&c, NULL, NULL, NULL, &r, &e)) {
+                            failures++;
+                            continue;
+                        }
+                        /* the same problem, bracketing grid 8x finer */
+                        double phi = p ? TWO_PI / 4 : 0.0;
+                        pd_sine_piece pc[2] = {{0, (double)dir, 1, phi}, {TWO_PI, 0, 0, 0}};
+                        pd_ed_sdof prob = {{Pi2s[i], 0.05}, 1, Pi3s[j], epss[k], 2, pc};
+                        pd_ed_opts o;
+                        memset(&o, 0, sizeof o);
+                        o.t_end = TWO_PI * pd_osc_default_tend(&c) / c.Tp;
+                        o.scan_divisions = 512;
+                        if (pd_ed_sdof_run(&prob, 0, 0, &o, NULL, NULL, &fine, &e)) {
+                            failures++;
+                            continue;
+                        }
+                        double Pi1 = r.umax / pd_osc_Le(&c);
+                        worst = fmax(worst, fabs(fine.xmax - Pi1) / Pi1);
+                        points++;
+                        pounding += r.impacts > 0;
+                    }
+    CHECK(ctx, failures == 0, "%d grid points failed", failures);
+    CHECK(ctx, worst <= 1e-11, "umax differs by %.3g relative between scan grids", worst);
+    CHECK(ctx, pounding > points / 3, "the grid must pound (%d of %d)", pounding, points);
+}
+
+/* Moreau–Jean converges to the reference at order about 1 on the history
+ * (max over the step grid of |u - u_ref| / umax_ref). */
+typedef struct hist {
+    double *u;
+    long n, cap;
+} hist;
+
+static int record_u(const pd_osc_sample *s, void *ctx)
+{
+    hist *h = ctx;
+    if (h->n < h->cap)
+        h->u[h->n++] = s->u;
+    return 0;
+}
+
+static void test_ref_moreau_order_one(pd_test_ctx *ctx)
+{
+    const pd_osc cases[] = {{PD_PULSE_SINE, 1, 1.0, 1.0, 0.5, 0.05, 0.6, 0.05},
+                            {PD_PULSE_COSINE, -1, 1.0, 1.0, 1.16, 0.05, 0.2, 0.05}};
+    for (int c = 0; c < 2; c++) {
+        double err[4];
+        for (int k = 0; k < 4; k++) {
+            pd_osc_opts o = pd_osc_default_opts();
+            pd_osc_result rm, rr;
+            pd_err e;
+            o.dt = cases[c].Tp / (2000.0 * (1 << k));
+            long cap = pd_steps_for(pd_osc_default_tend(&cases[c]), o.dt) + 2;
+            hist hm = {malloc(cap * sizeof(double)), 0, cap}, hr = {malloc(cap * sizeof(double)), 0, cap};
+            CHECK(ctx, pd_osc_simulate(&cases[c], &o, record_u, &hm, &rm, &e) == PD_OK, "%s", e.msg);
+            CHECK(ctx, pd_osc_reference(&cases[c], &o, record_u, &hr, &rr, &e) == PD_OK, "%s", e.msg);
+            CHECK(ctx, labs(hm.n - hr.n) <= 1, "grids %ld vs %ld", hm.n, hr.n);
+            double w = 0;
+            for (long i = 0; i < hm.n && i < hr.n; i++)
+                w = fmax(w, fabs(hm.u[i] - hr.u[i]));
+            err[k] = w / rr.umax;
+            free(hm.u);
+            free(hr.u);
+        }
+        double slope = log2(err[0] / err[3]) / 3;
+        CHECK(ctx, slope > 0.7 && slope < 1.6, "case %d: history error slope %.3f (%.3g -> %.3g)",
+              c, slope, err[0], err[3]);
+        CHECK(ctx, err[3] < 1e-2, "case %d: finest history error %.3g", c, err[3]);
+    }
+}
+
+void suite_reference(pd_test_ctx *ctx)
+{
+    PD_RUN(ctx, test_ref_no_wall_is_closed_form);
+    PD_RUN(ctx, test_ref_bouncing_ball_accumulation);
+    PD_RUN(ctx, test_ref_accumulation_off_stalls);
+    PD_RUN(ctx, test_ref_impact_closed_form);
+    PD_RUN(ctx, test_ref_energy_balance);
+    PD_RUN(ctx, test_ref_self_consistent_on_grid);
+    PD_RUN(ctx, test_ref_moreau_order_one);
+}
