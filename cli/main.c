@@ -7,7 +7,9 @@ static const char usage[] =
     "usage: pound <command> [options]\n"
     "\n"
     "commands:\n"
-    "  simulate   one run of the pounding oscillator (Moreau-Jean)\n"
+    "  simulate   one run of the pounding oscillator (Moreau-Jean, event-driven, penalty)\n"
+    "  compare    Moreau-Jean (and penalty) against the event-driven reference\n"
+    "  converge   errors and cost as dt shrinks; work-precision charts\n"
     "  lcp FILE   solve one linear complementarity problem (Lemke)\n"
     "  bench      performance figures (--lcp, --engine)\n"
     "\n"
@@ -24,6 +26,10 @@ int main(int argc, char **argv)
         return pd_cmd_lcp(argc - 1, argv + 1);
     if (!strcmp(cmd, "simulate"))
         return pd_cmd_simulate(argc - 1, argv + 1);
+    if (!strcmp(cmd, "compare"))
+        return pd_cmd_compare(argc - 1, argv + 1);
+    if (!strcmp(cmd, "converge"))
+        return pd_cmd_converge(argc - 1, argv + 1);
     if (!strcmp(cmd, "bench"))
         return pd_cmd_bench(argc - 1, argv + 1);
     return pd_cli_usage_error("unknown command '%s' (try `pound --help`)", cmd);

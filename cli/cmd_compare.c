@@ -1,0 +1,133 @@
+/* cmd_compare.c — `pound compare`: Moreau–Jean (and optionally penalty)
+ * against the event-driven reference on one case. */
+#include <math.h>
+#include <string.h>
+
+#include "pd_measure.h"
+
+static const char compare_usage[] =
+    "usage: pound compare [model flags] [--dt H] [--theta T] [--methods moreau[,penalty]] [--json]\n"
+    "  errors against the event-driven reference on the step grid t_k = k dt:\n"
+    "  err_umax_rel = |umax - umax_ref| / umax_ref,\n"
+    "  err_hist_linf = max_k |u(t_k) - u_ref(t_k)| / umax_ref\n";
+
+/* "moreau,penalty" -> flags; 0 or 2. */
+static int parse_methods(const char *list, int *want)
+{
+    char buf[128];
+    if (!list || strlen(list) >= sizeof buf)
+        return pd_cli_usage_error("--methods needs a list such as moreau,penalty");
+    strcpy(buf, list);
+    want[0] = want[1] = want[2] = 0;
+    for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+        pd_method m;
+        if (pd_method_parse(tok, &m) || m == PD_METHOD_EVENT)
+            return pd_cli_usage_error("--methods: '%s' is not one of moreau, penalty", tok);
+        want[m] = 1;
+    }
+    return 0;
+}
+
+int pd_cmd_compare(int argc, char **argv)
+{
+    pd_cli_case k;
+    int json = 0, want[3] = {1, 0, 0}, rc, status = 0;
+    pd_cli_case_init(&k);
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+            fputs(compare_usage, stdout);
+            fputs(pd_cli_case_help, stdout);
+            return 0;
+        }
+        if ((rc = pd_cli_case_flag(&k, argc, argv, &i)) == 2)
+            return 2;
+        if (rc == 1)
+            continue;
+        if (!strcmp(argv[i], "--json"))
+            json = 1;
+        else if (!strcmp(argv[i], "--methods")) {
+            if (parse_methods(i + 1 < argc ? argv[i + 1] : NULL, want))
+                return 2;
+            i++;
+        } else
+            return pd_cli_usage_error("compare: unknown flag '%s' (see pound compare --help)",
+                                      argv[i]);
+    }
+    if ((rc = pd_cli_case_finish(&k)))
+        return rc;
+
+    pd_trace ref = {0}, work = {0};
+    pd_osc_result rr;
+    pd_measured mres[3];
+    pd_err err;
+    if (pd_trace_alloc(&ref, &k.opts) || pd_trace_alloc(&work, &k.opts)) {
+        fprintf(stderr, "pound: compare: out of memory for the histories\n");
+        status = 1;
+        goto done;
+    }
+    if ((rc = pd_measure_reference(&k, &k.opts, &ref, &rr, &err))) {
+        fprintf(stderr, "pound: compare: reference: %s\n", err.msg);
+        status = rc == PD_EINVAL ? 2 : 1;
+        goto done;
+    }
+    for (int m = 0; m < 3; m++)
+        if (want[m] && (rc = pd_measure_run(&k, (pd_method)m, &k.opts, &ref, rr.umax, &work,
+                                            &mres[m], &err))) {
+            fprintf(stderr, "pound: compare: %s: %s\n", pd_method_name((pd_method)m), err.msg);
+            status = 1;
+            goto done;
+        }
+    int first = want[0] ? 0 : 2;
+    if (json) {
+        pd_json js;
+        pd_json_init(&js, stdout);
+        pd_json_begin_object(&js, NULL);
+        pd_json_str(&js, "method", pd_method_name((pd_method)first));
+        pd_json_num(&js, "err_umax_rel", mres[first].err_umax_rel);
+        pd_json_num(&js, "err_hist_linf", mres[first].err_hist_linf);
+        pd_json_int(&js, "impacts", mres[first].r.impacts);
+        pd_json_int(&js, "impacts_ref", rr.impacts);
+        pd_json_num(&js, "cpu_s", mres[first].r.cpu_s);
+        pd_json_num(&js, "cpu_s_ref", rr.cpu_s);
+        pd_json_num(&js, "umax", mres[first].r.umax);
+        pd_json_num(&js, "umax_ref", rr.umax);
+        pd_json_int(&js, "events_ref", rr.steps);
+        pd_json_int(&js, "accumulations_ref", rr.accumulations);
+        pd_json_num(&js, "dt", k.opts.dt);
+        pd_json_num(&js, "Pi2", k.c.Pi2);
+        pd_json_num(&js, "Pi3", k.c.Pi3);
+        pd_json_num(&js, "eps", k.c.eps);
+        pd_json_begin_array(&js, "methods");
+        for (int m = 0; m < 3; m++)
+            if (want[m]) {
+                pd_json_begin_object(&js, NULL);
+                pd_json_str(&js, "method", pd_method_name((pd_method)m));
+                pd_json_num(&js, "err_umax_rel", mres[m].err_umax_rel);
+                pd_json_num(&js, "err_hist_linf", mres[m].err_hist_linf);
+                pd_json_int(&js, "impacts", mres[m].r.impacts);
+                pd_json_int(&js, "steps", mres[m].r.steps);
+                pd_json_num(&js, "cpu_s", mres[m].r.cpu_s);
+                pd_json_end_object(&js);
+            }
+        pd_json_end_array(&js);
+        pd_json_end_object(&js);
+        pd_json_finish(&js);
+    } else {
+        printf("%s %s pulse, Pi2 = %.6g, Pi3 = %.6g, eps = %g, xi = %g, dt = %.4g s\n",
+               pd_dir_name(k.c.dir), pd_pulse_name(k.c.pulse), k.c.Pi2, k.c.Pi3, k.c.eps, k.c.xi,
+               k.opts.dt);
+        printf("  %-10s %14s %12s %12s %8s %10s\n", "method", "umax [m]", "err_umax", "err_hist",
+               "impacts", "cpu [s]");
+        printf("  %-10s %14.9g %12s %12s %8ld %10.3g\n", "event", rr.umax, "(ref)", "(ref)",
+               rr.impacts, rr.cpu_s);
+        for (int m = 0; m < 3; m++)
+            if (want[m])
+                printf("  %-10s %14.9g %12.3g %12.3g %8ld %10.3g\n", pd_method_name((pd_method)m),
+                       mres[m].r.umax, mres[m].err_umax_rel, mres[m].err_hist_linf,
+                       mres[m].r.impacts, mres[m].r.cpu_s);
+    }
+done:
+    pd_trace_free(&ref);
+    pd_trace_free(&work);
+    return status;
+}

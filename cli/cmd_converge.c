@@ -1,0 +1,372 @@
+/* cmd_converge.c — `pound converge`: errors against the event-driven
+ * reference and cost as dt shrinks (Moreau–Jean, one curve per theta) or as
+ * the contact stiffness grows (penalty); the observed order between rows;
+ * the work-precision chart. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pd_measure.h"
+#include "pd_output.h"
+#include "pd_plot.h"
+
+static const char converge_usage[] =
+    "usage: pound converge [model flags] --dt MAX:MIN:N [--methods moreau,penalty]\n"
+    "                      [--theta LIST] [--kcs LIST] [--plot FILE.png] [-o FILE] [--json]\n"
+    "  --dt MAX:MIN:N  N step sizes, log-spaced from MAX down to MIN (Moreau-Jean rows)\n"
+    "  --theta LIST    one Moreau-Jean curve per theta (default 0.5)\n"
+    "  --kcs LIST      penalty rows: stiffness multiples of w0^2 (default 1e2,1e3,1e4,1e5,1e6),\n"
+    "                  measured on the finest dt grid\n"
+    "  --plot F.png    error vs dt in F.png, error vs CPU time (work-precision) in F-work.png\n"
+    "  -o FILE         the table as CSV or HDF5\n"
+    "  order = log(err_prev / err) / log(dt_prev / dt) on err_hist_linf\n";
+
+enum { MAX_LIST = 32, MAX_ROWS = 1024 };
+
+typedef struct row {
+    pd_method method;
+    double theta, dt, kc, err_umax, err_hist, cpu_s, order;
+    long impacts, steps;
+} row;
+
+typedef struct conv_args {
+    pd_cli_case k;
+    double dt_max, dt_min;
+    int ndt, ntheta, nkc, want_moreau, want_penalty, json, have_dt_range;
+    double thetas[MAX_LIST], kcs[MAX_LIST];
+    const char *plot, *out;
+} conv_args;
+
+/* "a,b,c" -> up to MAX_LIST finite numbers; 0 or 2. */
+static int parse_list(const char *flag, const char *text, double *x, int *n)
+{
+    char buf[512];
+    *n = 0;
+    if (!text || strlen(text) >= sizeof buf)
+        return pd_cli_usage_error("%s needs a comma-separated list of numbers", flag);
+    strcpy(buf, text);
+    for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+        if (*n >= MAX_LIST)
+            return pd_cli_usage_error("%s: at most %d values", flag, MAX_LIST);
+        if (pd_cli_double(flag, tok, &x[*n]))
+            return 2;
+        (*n)++;
+    }
+    return *n ? 0 : pd_cli_usage_error("%s: empty list", flag);
+}
+
+/* "MAX:MIN:N" with MAX >= MIN > 0, N >= 2 (N = 1: MAX only). */
+static int parse_range(conv_args *a, const char *text)
+{
+    char buf[256], *p1, *p2;
+    if (!text || strlen(text) >= sizeof buf)
+        return pd_cli_usage_error("--dt needs MAX:MIN:N");
+    strcpy(buf, text);
+    p1 = strchr(buf, ':');
+    p2 = p1 ? strchr(p1 + 1, ':') : NULL;
+    if (!p1 || !p2)
+        return pd_cli_usage_error("--dt: '%s' is not MAX:MIN:N", text);
+    *p1 = *p2 = '\0';
+    if (pd_cli_double("--dt", buf, &a->dt_max) || pd_cli_double("--dt", p1 + 1, &a->dt_min) ||
+        pd_cli_int("--dt", p2 + 1, &a->ndt))
+        return 2;
+    if (!(a->dt_min > 0.0) || a->dt_max < a->dt_min || a->ndt < 1 || a->ndt > 64)
+        return pd_cli_usage_error("--dt: need MAX >= MIN > 0 and 1 <= N <= 64 (got %s)", text);
+    a->have_dt_range = 1;
+    return 0;
+}
+
+static int parse_args(conv_args *a, int argc, char **argv)
+{
+    int rc, nm;
+    double dummy[MAX_LIST];
+    memset(a, 0, sizeof *a);
+    pd_cli_case_init(&a->k);
+    a->want_moreau = 1;
+    for (int i = 1; i < argc; i++) {
+        const char *f = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(f, "--dt")) { /* a range here, not a single step */
+            if ((rc = parse_range(a, val)))
+                return rc;
+            i++;
+            continue;
+        }
+        if (!strcmp(f, "--theta")) {
+            if ((rc = parse_list(f, val, a->thetas, &a->ntheta)))
+                return rc;
+            i++;
+            continue;
+        }
+        if ((rc = pd_cli_case_flag(&a->k, argc, argv, &i)) == 2)
+            return 2;
+        if (rc == 1)
+            continue;
+        if (!strcmp(f, "--json"))
+            a->json = 1;
+        else if (!strcmp(f, "--kcs")) {
+            if ((rc = parse_list(f, val, a->kcs, &a->nkc)))
+                return rc;
+            i++;
+        } else if (!strcmp(f, "--methods")) {
+            char buf[128];
+            if (!val || strlen(val) >= sizeof buf)
+                return pd_cli_usage_error("--methods needs a list such as moreau,penalty");
+            strcpy(buf, val);
+            a->want_moreau = a->want_penalty = 0;
+            for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+                if (!strcmp(tok, "moreau"))
+                    a->want_moreau = 1;
+                else if (!strcmp(tok, "penalty"))
+                    a->want_penalty = 1;
+                else
+                    return pd_cli_usage_error("--methods: '%s' is not one of moreau, penalty", tok);
+            }
+            i++;
+        } else if (!strcmp(f, "--plot")) {
+            if (!val)
+                return pd_cli_usage_error("--plot needs a file name");
+            a->plot = val;
+            i++;
+        } else if (!strcmp(f, "-o")) {
+            if (!val)
+                return pd_cli_usage_error("-o needs a file name");
+            a->out = val;
+            i++;
+        } else
+            return pd_cli_usage_error("converge: unknown flag '%s' (see pound converge --help)", f);
+    }
+    (void)dummy;
+    (void)nm;
+    if (!a->have_dt_range)
+        return pd_cli_usage_error("converge: --dt MAX:MIN:N is required");
+    if (!a->ntheta) {
+        a->thetas[0] = 0.5;
+        a->ntheta = 1;
+    }
+    for (int t = 0; t < a->ntheta; t++)
+        if (!(a->thetas[t] >= 0.5 && a->thetas[t] <= 1.0) && !a->k.opts.allow_unstable)
+            return pd_cli_usage_error("--theta: %g is outside [1/2, 1] (add --allow-unstable)",
+                                      a->thetas[t]);
+    if (!a->nkc) {
+        const double def[] = {1e2, 1e3, 1e4, 1e5, 1e6};
+        memcpy(a->kcs, def, sizeof def);
+        a->nkc = 5;
+    }
+    for (int k = 0; k < a->nkc; k++)
+        if (!(a->kcs[k] > 0.0))
+            return pd_cli_usage_error("--kcs: stiffness multiples must be > 0 (got %g)", a->kcs[k]);
+    if (a->plot && (strlen(a->plot) < 5 || strcmp(a->plot + strlen(a->plot) - 4, ".png")))
+        return pd_cli_usage_error("--plot: '%s' must end in .png", a->plot);
+    pd_err err;
+    if (a->out && pd_output_check_path(a->out, &err))
+        return pd_cli_usage_error("%s", err.msg);
+    a->k.have_dt = 1;
+    a->k.opts.dt = a->dt_max;
+    return pd_cli_case_finish(&a->k);
+}
+
+/* The i-th of n log-spaced steps from dt_max down to dt_min. */
+static double dt_at(const conv_args *a, int i)
+{
+    if (a->ndt == 1)
+        return a->dt_max;
+    return a->dt_max * pow(a->dt_min / a->dt_max, (double)i / (a->ndt - 1));
+}
+
+/* Rows: for each dt the reference on that grid, then Moreau–Jean per theta;
+ * penalty per stiffness on the finest grid. */
+static int compute_rows(conv_args *a, row *rows, int *nrows, double *ref_cpu, pd_err *err)
+{
+    pd_trace ref = {0}, work = {0};
+    pd_osc_opts o = a->k.opts;
+    pd_osc_result rr;
+    int rc = PD_OK, n = 0;
+    o.dt = a->dt_min;
+    if (pd_trace_alloc(&ref, &o) || pd_trace_alloc(&work, &o)) {
+        rc = pd_err_set(err, PD_ENOMEM, "out of memory for %ld grid points", ref.cap);
+        goto done;
+    }
+    *ref_cpu = 0.0;
+    for (int i = 0; i < a->ndt && a->want_moreau; i++) {
+        o.dt = dt_at(a, i);
+        if ((rc = pd_measure_reference(&a->k, &o, &ref, &rr, err)))
+            goto done;
+        *ref_cpu = fmax(*ref_cpu, rr.cpu_s);
+        for (int t = 0; t < a->ntheta; t++) {
+            pd_measured m;
+            o.theta = a->thetas[t];
+            if ((rc = pd_measure_run(&a->k, PD_METHOD_MOREAU, &o, &ref, rr.umax, &work, &m, err)))
+                goto done;
+            rows[n++] = (row){PD_METHOD_MOREAU, o.theta, o.dt, NAN, m.err_umax_rel,
+                              m.err_hist_linf, m.r.cpu_s, NAN, m.r.impacts, m.r.steps};
+        }
+    }
+    if (a->want_penalty) {
+        pd_cli_case kp = a->k;
+        o.dt = a->dt_min;
+        if ((rc = pd_measure_reference(&a->k, &o, &ref, &rr, err)))
+            goto done;
+        *ref_cpu = fmax(*ref_cpu, rr.cpu_s);
+        for (int k = 0; k < a->nkc; k++) {
+            pd_measured m;
+            kp.pen.kc_mult = a->kcs[k];
+            kp.pen.kc_abs = 0.0;
+            if ((rc = pd_measure_run(&kp, PD_METHOD_PENALTY, &o, &ref, rr.umax, &work, &m, err)))
+                goto done;
+            rows[n++] = (row){PD_METHOD_PENALTY, NAN, o.dt, a->kcs[k], m.err_umax_rel,
+                              m.err_hist_linf, m.r.cpu_s, NAN, m.r.impacts, m.r.steps};
+        }
+    }
+    /* observed order between successive Moreau–Jean rows of one theta */
+    for (int r = 0; r < n; r++)
+        for (int q = r - 1; q >= 0; q--)
+            if (rows[q].method == PD_METHOD_MOREAU && rows[r].method == PD_METHOD_MOREAU &&
+                rows[q].theta == rows[r].theta) {
+                rows[r].order = log(rows[q].err_hist / rows[r].err_hist) /
+                                log(rows[q].dt / rows[r].dt);
+                break;
+            }
+done:
+    *nrows = n;
+    pd_trace_free(&ref);
+    pd_trace_free(&work);
+    return rc;
+}
+
+static void print_rows(const conv_args *a, const row *rows, int n, double ref_cpu)
+{
+    if (a->json) {
+        pd_json js;
+        pd_json_init(&js, stdout);
+        pd_json_begin_object(&js, NULL);
+        pd_json_begin_array(&js, "rows");
+        for (int r = 0; r < n; r++) {
+            pd_json_begin_object(&js, NULL);
+            pd_json_str(&js, "method", pd_method_name(rows[r].method));
+            pd_json_num(&js, "theta", rows[r].theta);
+            pd_json_num(&js, "dt", rows[r].dt);
+            pd_json_num(&js, "kc", rows[r].kc);
+            pd_json_num(&js, "err_umax_rel", rows[r].err_umax);
+            pd_json_num(&js, "err_hist_linf", rows[r].err_hist);
+            pd_json_num(&js, "cpu_s", rows[r].cpu_s);
+            pd_json_num(&js, "order", rows[r].order);
+            pd_json_int(&js, "impacts", rows[r].impacts);
+            pd_json_int(&js, "steps", rows[r].steps);
+            pd_json_end_object(&js);
+        }
+        pd_json_end_array(&js);
+        pd_json_num(&js, "cpu_s_ref", ref_cpu);
+        pd_json_end_object(&js);
+        pd_json_finish(&js);
+        return;
+    }
+    printf("%s %s pulse, Pi2 = %.6g, Pi3 = %.6g, eps = %g, xi = %g; reference cost %.3g s\n",
+           pd_dir_name(a->k.c.dir), pd_pulse_name(a->k.c.pulse), a->k.c.Pi2, a->k.c.Pi3,
+           a->k.c.eps, a->k.c.xi, ref_cpu);
+    printf("  %-8s %6s %11s %8s %11s %11s %10s %7s %8s\n", "method", "theta", "dt [s]", "kc",
+           "err_umax", "err_hist", "cpu [s]", "order", "impacts");
+    for (int r = 0; r < n; r++)
+        printf("  %-8s %6.3g %11.4g %8.3g %11.3g %11.3g %10.3g %7.3f %8ld\n",
+               pd_method_name(rows[r].method), rows[r].theta, rows[r].dt, rows[r].kc,
+               rows[r].err_umax, rows[r].err_hist, rows[r].cpu_s, rows[r].order, rows[r].impacts);
+}
+
+/* err_hist against dt (Moreau–Jean curves) and against CPU time (all). */
+static int plot_rows(const conv_args *a, const row *rows, int n, double ref_cpu, pd_err *err)
+{
+    static double xs[2][MAX_LIST + 1][MAX_ROWS], ys[2][MAX_LIST + 1][MAX_ROWS];
+    pd_curve by_dt[MAX_LIST], by_cpu[MAX_LIST + 1];
+    char labels[MAX_LIST + 1][64], work_png[4096];
+    int ncurve = 0;
+    for (int t = 0; t < a->ntheta && a->want_moreau; t++, ncurve++) {
+        int m = 0;
+        for (int r = 0; r < n; r++)
+            if (rows[r].method == PD_METHOD_MOREAU && rows[r].theta == a->thetas[t]) {
+                xs[0][ncurve][m] = rows[r].dt;
+                ys[0][ncurve][m] = rows[r].err_hist;
+                xs[1][ncurve][m] = rows[r].cpu_s;
+                ys[1][ncurve][m] = rows[r].err_hist;
+                m++;
+            }
+        snprintf(labels[ncurve], sizeof labels[0], "Moreau-Jean theta = %g", a->thetas[t]);
+        by_dt[ncurve] = (pd_curve){labels[ncurve], m, xs[0][ncurve], ys[0][ncurve]};
+        by_cpu[ncurve] = (pd_curve){labels[ncurve], m, xs[1][ncurve], ys[1][ncurve]};
+    }
+    int npen = 0;
+    if (a->want_penalty) {
+        for (int r = 0; r < n; r++)
+            if (rows[r].method == PD_METHOD_PENALTY) {
+                xs[1][ncurve][npen] = rows[r].cpu_s;
+                ys[1][ncurve][npen] = rows[r].err_hist;
+                npen++;
+            }
+        snprintf(labels[ncurve], sizeof labels[0], "penalty (kc = %g..%g w0^2)", a->kcs[0],
+                 a->kcs[a->nkc - 1]);
+        by_cpu[ncurve] = (pd_curve){labels[ncurve], npen, xs[1][ncurve], ys[1][ncurve]};
+    }
+    char title[256];
+    snprintf(title, sizeof title, "%s %s pulse, Pi2 = %.3g, Pi3 = %.3g, eps = %g",
+             pd_dir_name(a->k.c.dir), pd_pulse_name(a->k.c.pulse), a->k.c.Pi2, a->k.c.Pi3,
+             a->k.c.eps);
+    pd_chart c1 = {title, "dt [s]", "max |u - u_{ref}| / u_{max,ref}", 1, 1, ncurve, by_dt, NAN,
+                   NULL, 1.0};
+    pd_chart c2 = {title, "CPU time per run [s]", "max |u - u_{ref}| / u_{max,ref}", 1, 1,
+                   ncurve + (npen > 0), by_cpu, ref_cpu, "event-driven reference", 0.0};
+    size_t len = strlen(a->plot);
+    snprintf(work_png, sizeof work_png, "%.*s-work.png", (int)(len - 4), a->plot);
+    int rc = ncurve ? pd_plot(a->plot, &c1, err) : PD_OK;
+    return rc ? rc : pd_plot(work_png, &c2, err);
+}
+
+/* The table as CSV or HDF5 columns (method 0 = moreau, 2 = penalty). */
+static int write_rows(const conv_args *a, const row *rows, int n, pd_err *err)
+{
+    static double col[9][MAX_ROWS];
+    for (int r = 0; r < n; r++) {
+        double v[9] = {(double)rows[r].method, rows[r].theta, rows[r].dt, rows[r].kc,
+                       rows[r].err_umax, rows[r].err_hist, rows[r].cpu_s, rows[r].order,
+                       (double)rows[r].impacts};
+        for (int c = 0; c < 9; c++)
+            col[c][r] = v[c];
+    }
+    pd_column cols[9] = {{"method", "0 = moreau, 2 = penalty", col[0]}, {"theta", "1", col[1]},
+                         {"dt", "s", col[2]}, {"kc", "w0^2", col[3]}, {"err_umax_rel", "1", col[4]},
+                         {"err_hist_linf", "1", col[5]}, {"cpu_s", "s", col[6]},
+                         {"order", "1", col[7]}, {"impacts", "1", col[8]}};
+    pd_attr attrs[] = {{"pulse", NULL, 1, 0, pd_pulse_name(a->k.c.pulse)},
+                       {"dir", NULL, 1, 0, pd_dir_name(a->k.c.dir)},
+                       {"Pi2", "1", 0, a->k.c.Pi2, NULL}, {"Pi3", "1", 0, a->k.c.Pi3, NULL},
+                       {"eps", "1", 0, a->k.c.eps, NULL}, {"xi", "1", 0, a->k.c.xi, NULL},
+                       {"ap", "m/s^2", 0, a->k.c.ap, NULL}, {"Tp", "s", 0, a->k.c.Tp, NULL}};
+    pd_table t = {n, 9, cols, (int)(sizeof attrs / sizeof attrs[0]), attrs};
+    return pd_output_write(a->out, &t, err);
+}
+
+int pd_cmd_converge(int argc, char **argv)
+{
+    static conv_args a;
+    static row rows[MAX_ROWS];
+    int n = 0, rc;
+    double ref_cpu = 0.0;
+    pd_err err;
+    for (int i = 1; i < argc; i++)
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+            fputs(converge_usage, stdout);
+            fputs(pd_cli_case_help, stdout);
+            return 0;
+        }
+    if ((rc = parse_args(&a, argc, argv)))
+        return rc;
+    if (a.ndt * a.ntheta + a.nkc > MAX_ROWS)
+        return pd_cli_usage_error("converge: too many rows (at most %d)", MAX_ROWS);
+    if ((rc = compute_rows(&a, rows, &n, &ref_cpu, &err))) {
+        fprintf(stderr, "pound: converge: %s\n", err.msg);
+        return rc == PD_EINVAL ? 2 : 1;
+    }
+    if ((a.plot && plot_rows(&a, rows, n, ref_cpu, &err)) || (a.out && write_rows(&a, rows, n, &err))) {
+        fprintf(stderr, "pound: converge: %s\n", err.msg);
+        return 1;
+    }
+    print_rows(&a, rows, n, ref_cpu);
+    return 0;
+}

@@ -1,0 +1,65 @@
+/* measure.c — a method's errors against the event-driven reference on the
+ * same output grid:  err_umax_rel = |umax - umax_ref| / umax_ref,
+ * err_hist_linf = max_k |u(t_k) - u_ref(t_k)| / umax_ref. */
+#include <math.h>
+#include <stdlib.h>
+
+#include "pd_measure.h"
+
+/* Sampler filling a preallocated array of u. */
+static int record_u(const pd_osc_sample *s, void *ctx)
+{
+    pd_trace *tr = ctx;
+    if (tr->n < tr->cap)
+        tr->u[tr->n++] = s->u;
+    return 0;
+}
+
+int pd_trace_alloc(pd_trace *tr, const pd_osc_opts *o)
+{
+    tr->n = 0;
+    tr->cap = pd_steps_for(o->tend, o->dt) + 2;
+    tr->u = malloc((size_t)tr->cap * sizeof(double));
+    return tr->u ? 0 : -1;
+}
+
+void pd_trace_free(pd_trace *tr)
+{
+    free(tr->u);
+    tr->u = NULL;
+}
+
+int pd_measure_run(const pd_cli_case *k, pd_method method, const pd_osc_opts *o,
+                   const pd_trace *ref, double umax_ref, pd_trace *work, pd_measured *out,
+                   pd_err *err)
+{
+    int rc;
+    work->n = 0;
+    if ((rc = pd_cli_run(k, method, o, record_u, work, &out->r, err)))
+        return rc;
+    long n = work->n < ref->n ? work->n : ref->n;
+    double worst = 0.0;
+    for (long i = 0; i < n; i++)
+        worst = fmax(worst, fabs(work->u[i] - ref->u[i]));
+    out->err_umax_rel = fabs(out->r.umax - umax_ref) / umax_ref;
+    out->err_hist_linf = worst / umax_ref;
+    out->grid_points = n;
+    return PD_OK;
+}
+
+int pd_measure_reference(const pd_cli_case *k, const pd_osc_opts *o, pd_trace *ref,
+                         pd_osc_result *res, pd_err *err)
+{
+    int rc;
+    pd_osc_result timed;
+    ref->n = 0;
+    if ((rc = pd_osc_reference(&k->c, o, record_u, ref, res, err)))
+        return rc;
+    /* its cost without the sampling */
+    if ((rc = pd_osc_reference(&k->c, o, NULL, NULL, &timed, err)))
+        return rc;
+    res->cpu_s = timed.cpu_s;
+    if (!(res->umax > 0.0))
+        return pd_err_set(err, PD_EINVAL, "the reference response is zero: no error to measure");
+    return PD_OK;
+}

@@ -1,0 +1,27 @@
+/* pd_plot.h — (cli) log-log line charts drawn by gnuplot into PNG files. */
+#ifndef PD_PLOT_H
+#define PD_PLOT_H
+
+#include "pd_status.h"
+
+typedef struct pd_curve {
+    const char *label;
+    int n;
+    const double *x, *y;
+} pd_curve;
+
+typedef struct pd_chart {
+    const char *title, *xlabel, *ylabel;
+    int logx, logy;
+    int ncurves;
+    const pd_curve *curves;
+    double vline;             /* NAN: none; else a vertical marker at x = vline */
+    const char *vline_label;
+    double slope_ref;         /* 0: none; else a dashed guide of this log-log slope */
+} pd_chart;
+
+/* Draw the chart into png (written to a temporary name, renamed on
+ * success).  PD_EIO when gnuplot is missing or fails. */
+int pd_plot(const char *png, const pd_chart *chart, pd_err *err);
+
+#endif
