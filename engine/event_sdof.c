@@ -244,7 +244,7 @@ static int settle(ed_run *ed, int j, double t, double vp, double tb, double *t_r
         return 0;
     double height = vp * vp / (2.0 * a), scale = ed->o->length_scale > 0 ? ed->o->length_scale : 1;
     double tail = 2.0 * fabs(vp) / (a * (1.0 - e));
-    if (height > 1e-13 * scale || t + tail >= tb || !(wall_accel(ed, j, t + tail, 0.0) > 0.0) ||
+    if (height > 1e-10 * scale || t + tail >= tb || !(wall_accel(ed, j, t + tail, 0.0) > 0.0) ||
         !(wall_accel(ed, j, t + 0.5 * tail, 0.0) > 0.0))
         return 0;
     *t_rest = t + tail; /* bouncing-ball limit: sum of the geometric flight times */
@@ -266,7 +266,7 @@ int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opt
     double t = prob->pieces[0].t_start, x = x0, v = v0;
     ed = (ed_run){prob, opts, res, sampler, ctx, scan_step(prob, opts->t_end - t, opts->scan_divisions), 0, 0,
                   opts->max_events > 0 ? opts->max_events : 10000000L,
-                  opts->max_burst > 0 ? opts->max_burst : 10000L, t, 0};
+                  opts->max_burst > 0 ? opts->max_burst : 100000L, t, 0};
     note(&ed, t, x);
     if (prob->wall && x >= prob->delta && v >= 0.0) { /* starting on the wall */
         x = prob->delta;

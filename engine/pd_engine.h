@@ -162,20 +162,30 @@ typedef struct pd_penalty_opts {
     const char *stepper; /* GSL stepper: "rk8pd" (default), "rkf45", "rk4imp", "msbdf" */
     double h_out;        /* > 0: the observer is called every h_out (and at t1) */
     long max_steps;      /* budget of accepted steps (0 = 10^8) */
+    pd_observer on_step; /* optional: called at t0 and after every accepted step
+                            whatever h_out (measurements next to the outputs) */
+    void *on_step_ctx;
 } pd_penalty_opts;
 
 typedef struct pd_penalty_result {
     long steps;    /* accepted steps */
-    long rhs;      /* right-hand-side evaluations */
+    long rhs;      /* right-hand-side evaluations (probes included) */
     double min_gap;
-    double max_penetration_velocity;
+    double max_penetration_velocity; /* largest -W_a^T v while contact a is engaged */
+    long switches;       /* contact elements engaged or released (located crossings) */
+    const char *stepper; /* canonical GSL stepper name (static string) */
 } pd_penalty_result;
 
 /* Integrate the model from (t0, q0, v0) to t1 (NULL = zeros).  The observer
- * gets a pd_state at t0, at every multiple of h_out and at t1; in it P holds
- * the contact forces lambda at that instant (not impulses).  Extremes that
- * fall between outputs are the caller's to track through an observer with
- * h_out = 0: then it is called after every accepted step. */
+ * gets a pd_state at t0, at every t0 + k h_out and at t1; in it P holds the
+ * contact forces lambda at that instant (not impulses) and active the
+ * engaged elements.  Output states are integrated (to the tolerances) from
+ * the last accepted step, so h_out never changes the trajectory.  Extremes
+ * that fall between outputs are the caller's to track through on_step, or
+ * an observer with h_out = 0: then it is called after every accepted step.
+ * Steps end exactly at every breakpoint and at every located gap crossing
+ * (the state there is reported with the element already switched).
+ * Turns GSL's aborting error handler off for the whole process. */
 int pd_penalty_run(const pd_model *model, double t0, const double *q0, const double *v0,
                    double t1, const pd_penalty_opts *opts, pd_observer observer, void *ctx,
                    pd_penalty_result *res, pd_err *err);
@@ -228,9 +238,10 @@ typedef struct pd_ed_opts {
     double h_out;         /* > 0: sampler at t_start + k h_out */
     int no_accumulation;  /* 1: never jump an accumulation (shows the stall) */
     long max_events;      /* 0 = 10^7 */
-    long max_burst;       /* impacts in one accumulation before giving up, 0 = 10^4 */
+    long max_burst;       /* impacts in one accumulation before giving up, 0 = 10^5 */
     double length_scale;  /* an accumulation is jumped once its bounce height
-                             v+^2 / (2 a) is below 1e-13 * length_scale (0 = 1) */
+                             v+^2 / (2 a) is below 1e-10 * length_scale (0 = 1):
+                             the motion left out stays that close to the wall */
     int scan_divisions;   /* bracketing grid: shortest period / this (0 = 64) */
 } pd_ed_opts;
 

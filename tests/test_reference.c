@@ -55,8 +55,8 @@ static void test_ref_no_wall_is_closed_form(pd_test_ctx *ctx)
  * accumulate at t_inf = t1 + 2 e v1 / (a (1 - e)); then it rests. */
 static void test_ref_bouncing_ball_accumulation(pd_test_ctx *ctx)
 {
-    const double es[] = {0.3, 0.5, 0.8, 0.9};
-    for (int k = 0; k < 4; k++) {
+    const double es[] = {0.3, 0.5, 0.8, 0.9, 0.995}; /* 0.995: chattering, ~2300 impacts */
+    for (int k = 0; k < 5; k++) {
         double a = 2.0, delta = 0.5, e = es[k];
         pd_sine_piece piece = {0.0, a, 0.0, TWO_PI / 4}; /* a sin(pi/2) = a */
         pd_ed_sdof prob = {{0.0, 0.0}, 1, delta, e, 1, &piece};
@@ -64,18 +64,19 @@ static void test_ref_bouncing_ball_accumulation(pd_test_ctx *ctx)
         pd_ed_opts o;
         memset(&o, 0, sizeof o);
         o.t_end = 2 * t_inf + 1.0;
-        o.max_burst = 500;
+        o.max_burst = 5000;
         pd_ed_result r;
         pd_err err;
         CHECK(ctx, pd_ed_sdof_run(&prob, 0.0, 0.0, &o, NULL, NULL, &r, &err) == PD_OK, "%s",
               err.msg);
         CHECK_NEAR(ctx, r.first_impact, t1, 1e-14);
         CHECK_NEAR(ctx, r.first_impact_velocity, v1, 1e-14);
-        CHECK_NEAR(ctx, o.t_end - r.contact_time, t_inf, 1e-12 * t_inf);
+        /* t_inf moves by 2 e dv / (a (1 - e)) for a speed error dv: conditioning 1/(1-e) */
+        CHECK_NEAR(ctx, o.t_end - r.contact_time, t_inf, 1e-12 * t_inf / (1 - e));
         CHECK(ctx, r.accumulations == 1, "e %g: accumulations %ld", e, r.accumulations);
         /* bounce heights fall as e^2n: the jump comes after about
-         * log(1e-13 / h1) / log(e^2) impacts, h1 = (e v1)^2 / (2 a) */
-        double h1 = (e * v1) * (e * v1) / (2 * a), n_expected = log(1e-13 / h1) / log(e * e);
+         * log(1e-10 / h1) / log(e^2) impacts, h1 = (e v1)^2 / (2 a) */
+        double h1 = (e * v1) * (e * v1) / (2 * a), n_expected = log(1e-10 / h1) / log(e * e);
         CHECK(ctx, fabs((double)r.impacts - n_expected) <= 2.0, "e %g: %ld impacts, expected %.1f",
               e, r.impacts, n_expected);
         CHECK_NEAR(ctx, r.xtoward, delta, 0.0);
