@@ -4,6 +4,7 @@
 #   make test     install missing packages (as root), build, run the tests
 #   make asan     the tests under AddressSanitizer + UndefinedBehaviorSanitizer
 #   make bench    performance figures (pound bench)
+#   make figures  docs/figures/*.png (convergence, stability, energy)
 #   make all      library and binary only (build/libpound.a, build/pound)
 #
 # Layers: cli -> problems -> engine -> lcp; HDF5 is used by cli/ only.
@@ -35,7 +36,7 @@ CLI_OBJ  = $(CLI_SRC:%.c=$(BUILD)/%.o)
 TEST_OBJ = $(TEST_SRC:%.c=$(BUILD)/%.o)
 HDRS     = $(wildcard */*.h)
 
-.PHONY: all deps demo test check asan bench clean acceptance
+.PHONY: all deps demo test check asan bench clean acceptance figures
 
 all: $(BUILD)/pound $(BUILD)/pound_tests
 
@@ -78,6 +79,10 @@ asan: deps
 bench: deps
 	@$(MAKE) --no-print-directory all
 	$(BUILD)/pound bench
+
+figures: deps
+	@$(MAKE) --no-print-directory all
+	sh scripts/figures.sh $(BUILD)/pound
 
 acceptance: all
 	@for s in ../shared/acceptance/*.sh; do echo "== $$s"; $$s $(BUILD)/pound || exit 1; done

@@ -222,6 +222,40 @@ static void test_engine_theta_stability(pd_test_ctx *ctx)
     }
 }
 
+/* With damping xi, theta < 1/2 is stable up to about w0 h = 2 xi / (1 - 2 theta)
+ * (growth (1 - 2 theta) w0^2 h / 2 per unit time against the decay xi w0):
+ * bounded at 0.7 times that step, growing at 1.4 times it. */
+static void test_engine_theta_damped_boundary(pd_test_ctx *ctx)
+{
+    const double thetas[] = {0.3, 0.4, 0.45}, xi = 0.05, w0 = 1.0;
+    double M = 1, K = w0 * w0, C = 2 * xi * w0;
+    pd_model md = {1, 0, pd_matrix_dense(1, 1, &M), pd_matrix_dense(1, 1, &C),
+                   pd_matrix_dense(1, 1, &K), {PD_MATRIX_ZERO, 1, 0, NULL}, NULL, NULL, NULL,
+                   NULL, NULL, 0};
+    for (int c = 0; c < 3; c++)
+        for (int side = 0; side < 2; side++) {
+            double boundary = 2 * xi / (1 - 2 * thetas[c]) / w0;
+            pd_mj_opts o = pd_mj_default_opts();
+            pd_err err;
+            o.theta = thetas[c];
+            o.allow_unstable = 1;
+            o.h = boundary * (side ? 1.4 : 0.7);
+            pd_mj *mj = pd_mj_alloc(&md, &o, &err);
+            double q0 = 1.0;
+            pd_mj_reset(mj, 0.0, &q0, NULL, &err);
+            int rc = pd_mj_run(mj, (long)(400.0 / o.h), NULL, NULL, &err);
+            const pd_state *st = pd_mj_state(mj);
+            double amp = sqrt(st->q[0] * st->q[0] + st->v[0] * st->v[0] / (w0 * w0));
+            if (side)
+                CHECK(ctx, rc != PD_OK || amp > 10.0, "theta %g at 1.4x the boundary: amp %g",
+                      thetas[c], amp);
+            else
+                CHECK(ctx, rc == PD_OK && amp < 1.0, "theta %g at 0.7x the boundary: amp %g",
+                      thetas[c], amp);
+            pd_mj_free(mj);
+        }
+}
+
 /* A non-finite force stops the run with PD_ENONFINITE naming the time. */
 static void nan_after_one(double t, int side, double *F, void *ctx)
 {
@@ -323,6 +357,7 @@ void suite_engine(pd_test_ctx *ctx)
     PD_RUN(ctx, test_engine_two_mass_impact);
     PD_RUN(ctx, test_engine_chain_energy);
     PD_RUN(ctx, test_engine_theta_stability);
+    PD_RUN(ctx, test_engine_theta_damped_boundary);
     PD_RUN(ctx, test_engine_failure_is_reported);
     PD_RUN(ctx, test_engine_model_check);
     PD_RUN(ctx, test_engine_no_allocation_in_steps);

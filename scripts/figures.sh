@@ -1,0 +1,65 @@
+#!/bin/sh
+# figures.sh — regenerate docs/figures/*.png with the pound CLI and gnuplot.
+# Usage: scripts/figures.sh [path/to/pound]   (run from the project root)
+set -eu
+pound=${1:-build/pound}
+out=docs/figures
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+mkdir -p "$out"
+
+# 1. Convergence and work-precision: Moreau-Jean (theta 1/2 and 1) and the
+#    penalty baseline against the event-driven reference, two cases.
+"$pound" converge --pulse sine --dir normal --Pi2 0.5 --Pi3 0.05 --eps 0.6 \
+    --dt 0.004:0.0000625:7 --theta 0.5,1 --methods moreau,penalty \
+    --kcs 1e2,1e3,1e4,1e5,1e6,1e7 --plot "$out/converge-sine-normal.png" \
+    -o "$tmp/c1.csv" > "$out/converge-sine-normal.txt"
+"$pound" converge --pulse cosine --dir reverse --Pi2 1.16 --Pi3 0.05 --eps 0.2 \
+    --dt 0.004:0.0000625:7 --theta 0.5,1 --methods moreau,penalty \
+    --kcs 1e2,1e3,1e4,1e5,1e6,1e7 --plot "$out/converge-cosine-reverse.png" \
+    -o "$tmp/c2.csv" > "$out/converge-cosine-reverse.txt"
+
+# 2. Where theta < 1/2 fails: amplitude after 200 s of a damped oscillator
+#    (xi = 0.05, T0 = 1 s) against w0 h; a blown-up run is drawn at 1e30.
+for th in 0.3 0.4 0.45 0.5; do
+    for wh in 0.05 0.1 0.15 0.2 0.25 0.3 0.4 0.5 0.6 0.8 1.0 1.2 1.5 2.0 3.0; do
+        dt=$(awk "BEGIN{printf \"%.12g\", $wh / 6.283185307179586}")
+        u=$("$pound" simulate --no-wall --pulse sine --Tp 1 --T0 1 --xi 0.05 --theta "$th" \
+              --allow-unstable --dt "$dt" --tend 200 --json 2>/dev/null |
+            sed -n 's/.*"umax":\([^,]*\),.*/\1/p')
+        [ -n "$u" ] || u=1e30
+        awk "BEGIN{u=$u; if (u > 1e30) u = 1e30; print $wh, u}"
+    done > "$tmp/stab-$th.dat"
+done
+gnuplot <<GP
+set terminal pngcairo size 900,600 enhanced font 'sans,11'
+set output '$out/stability-theta.png'
+set logscale xy; set grid; set key top left
+set title 'Moreau-Jean below theta = 1/2: max |u| over 200 s (xi = 0.05, no wall)'
+set xlabel 'w_0 h'; set ylabel 'max |u| [m]'
+set arrow from 0.25,graph 0 to 0.25,graph 1 nohead dt 3
+set arrow from 0.5,graph 0 to 0.5,graph 1 nohead dt 3
+set arrow from 1.0,graph 0 to 1.0,graph 1 nohead dt 3
+set label 'predicted limits 2 xi/(1-2 theta)' at 0.27,1e25
+plot '$tmp/stab-0.3.dat' w lp lw 2 t 'theta = 0.3', '$tmp/stab-0.4.dat' w lp lw 2 t 'theta = 0.4', \
+     '$tmp/stab-0.45.dat' w lp lw 2 t 'theta = 0.45', '$tmp/stab-0.5.dat' w lp lw 2 t 'theta = 0.5'
+GP
+
+# 3. eps = 1, theta = 1/2, no damping, 200 periods after a pulse: the energy
+#    v^2/2 + w0^2 u^2/2 (w0 = 2 pi) stays put through hundreds of impacts.
+"$pound" simulate --pulse sine --dir normal --Tp 1 --T0 1 --xi 0 --eps 1 --Pi3 0.05 \
+    --dt 0.0005 --tend 200 --every 20 -o "$tmp/e1.csv" > /dev/null
+"$pound" simulate --pulse sine --dir normal --Tp 1 --T0 1 --xi 0 --eps 0.8 --Pi3 0.05 \
+    --dt 0.0005 --tend 200 --every 20 -o "$tmp/e08.csv" > /dev/null
+for f in e1 e08; do
+    grep -v '^#' "$tmp/$f.csv" | awk -F, 'NR > 1 && $1 > 1 {w = 6.283185307179586; print $1, 0.5*$3*$3 + 0.5*w*w*$2*$2}' > "$tmp/$f.dat"
+done
+gnuplot <<GP
+set terminal pngcairo size 900,500 enhanced font 'sans,11'
+set output '$out/energy-eps1.png'
+set grid; set key bottom left; set logscale y
+set title 'Energy after the pulse, theta = 1/2, xi = 0 (Moreau-Jean, dt = Tp/2000)'
+set xlabel 't [s]'; set ylabel 'v^2/2 + w_0^2 u^2/2 [m^2/s^2]'
+plot '$tmp/e1.dat' w l lw 2 t 'eps = 1 (kept)', '$tmp/e08.dat' w l lw 2 t 'eps = 0.8 (falls at each impact)'
+GP
+echo "figures written to $out/"
