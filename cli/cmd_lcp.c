@@ -1,8 +1,225 @@
+/* cmd_lcp.c — `pound lcp FILE`: solve one LCP by Lemke's method.
+ *
+ * Exit status 0 when solved, 1 for any other outcome of the solve (the result
+ * is still printed), 2 for bad input (flag, unreadable or malformed file). */
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
 #include "pd_cli.h"
+#include "pd_lcp.h"
+
+static const char lcp_usage[] =
+    "usage: pound lcp FILE [--format plain|siconos|auto] [--json] [--cover D]\n"
+    "                      [--max-pivots K] [--tol T]\n"
+    "\n"
+    "Solve the LCP  z >= 0, w = M z + q >= 0, z'w = 0  read from FILE by Lemke's method.\n"
+    "  --format F      plain (n, M row by row, q; '#' comments), siconos (column-major,\n"
+    "                  Siconos header), or auto (default: detects the Siconos header)\n"
+    "  --json          print one JSON object: status, n, z, w, pivots, complementarity,\n"
+    "                  infeasibility, scale, cpu_s\n"
+    "  --cover D       covering vector: one positive value for every entry, or n\n"
+    "                  comma-separated positive values (default all ones)\n"
+    "  --max-pivots K  pivot cap (default max(10000, 100 n))\n"
+    "  --tol T         relative tolerance for ties and tiny pivots (default 1e-12)\n"
+    "status: solved, no_solution (ray termination), max_pivots, numerical.\n"
+    "exit status: 0 solved, 1 another status, 2 bad input.\n";
+
+/* What the command line asks for. */
+typedef struct lcp_args {
+    const char *path;
+    pd_lcp_format format;
+    int json;
+    const char *cover_text;
+    int max_pivots;
+    double tol;
+} lcp_args;
+
+/* --format value. */
+static int parse_format(const char *text, pd_lcp_format *format)
+{
+    if (!text)
+        return pd_cli_usage_error("lcp: --format needs a value (plain, siconos or auto)");
+    if (!strcmp(text, "plain"))
+        *format = PD_LCP_FORMAT_PLAIN;
+    else if (!strcmp(text, "siconos"))
+        *format = PD_LCP_FORMAT_SICONOS;
+    else if (!strcmp(text, "auto"))
+        *format = PD_LCP_FORMAT_AUTO;
+    else
+        return pd_cli_usage_error("lcp: --format: '%s' is not plain, siconos or auto", text);
+    return 0;
+}
+
+/* One flag with its value at argv[*i + 1]; 0, 2 on error. */
+static int parse_valued_flag(int argc, char **argv, int *i, lcp_args *a)
+{
+    const char *flag = argv[*i], *value = *i + 1 < argc ? argv[*i + 1] : NULL;
+    int rc;
+    if (!strcmp(flag, "--format"))
+        rc = parse_format(value, &a->format);
+    else if (!strcmp(flag, "--cover")) {
+        a->cover_text = value;
+        rc = value ? 0 : pd_cli_usage_error("lcp: --cover needs a value");
+    } else if (!strcmp(flag, "--max-pivots")) {
+        rc = pd_cli_int("--max-pivots", value, &a->max_pivots);
+        if (rc == 0 && a->max_pivots <= 0)
+            rc = pd_cli_usage_error("--max-pivots: must be a positive integer, got %s", value);
+    } else if (!strcmp(flag, "--tol")) {
+        rc = pd_cli_double("--tol", value, &a->tol);
+        if (rc == 0 && !(a->tol > 0.0 && a->tol < 1e-3))
+            rc = pd_cli_usage_error("--tol: must lie in (0, 1e-3), got %s", value);
+    } else
+        return pd_cli_usage_error("lcp: unknown flag '%s' (try `pound lcp --help`)", flag);
+    *i += 1;
+    return rc;
+}
+
+/* argv into a; 0, 2 on error, -1 when --help was printed. */
+static int parse_args(int argc, char **argv, lcp_args *a)
+{
+    memset(a, 0, sizeof *a);
+    a->format = PD_LCP_FORMAT_AUTO;
+    for (int i = 1; i < argc; i++) {
+        const char *arg = argv[i];
+        int rc = 0;
+        if (!strcmp(arg, "--help") || !strcmp(arg, "-h")) {
+            fputs(lcp_usage, stdout);
+            return -1;
+        } else if (!strcmp(arg, "--json")) {
+            a->json = 1;
+        } else if (arg[0] == '-' && arg[1] != '\0') {
+            rc = parse_valued_flag(argc, argv, &i, a);
+        } else if (a->path) {
+            rc = pd_cli_usage_error("lcp: more than one FILE ('%s' and '%s')", a->path, arg);
+        } else {
+            a->path = arg;
+        }
+        if (rc)
+            return rc;
+    }
+    if (!a->path)
+        return pd_cli_usage_error("lcp: no FILE given (usage: pound lcp FILE [--json] ...)");
+    return 0;
+}
+
+/* --cover: one value for all entries or n comma-separated values, all > 0. */
+static int parse_cover(const char *text, int n, double *cover)
+{
+    int count = 0;
+    const char *p = text;
+    for (;;) {
+        char *stop = NULL;
+        errno = 0;
+        double v = strtod(p, &stop);
+        if (stop == p || (*stop != ',' && *stop != '\0') || errno == ERANGE || !isfinite(v))
+            return pd_cli_usage_error("--cover: '%s' is not a list of numbers", text);
+        if (!(v > 0.0))
+            return pd_cli_usage_error("--cover: entries must be positive, got %g", v);
+        if (count == n)
+            return pd_cli_usage_error("--cover: more than n = %d values", n);
+        cover[count++] = v;
+        if (*stop == '\0')
+            break;
+        p = stop + 1;
+    }
+    if (count == 1)
+        for (int i = 1; i < n; i++)
+            cover[i] = cover[0];
+    else if (count != n)
+        return pd_cli_usage_error("--cover: expected 1 or n = %d values, got %d", n, count);
+    return 0;
+}
+
+/* A vector on one line. */
+static void print_vector(const char *name, int n, const double *x)
+{
+    printf("%-16s", name);
+    for (int i = 0; i < n; i++)
+        printf(" %.12g", x[i]);
+    putchar('\n');
+}
+
+/* Human-readable result. */
+static void print_text(int n, const double *z, const double *w, const pd_lcp_info *info,
+                       double cpu_s)
+{
+    printf("%-16s %s\n", "status", pd_lcp_outcome_name(info->outcome));
+    printf("%-16s %d\n", "n", n);
+    printf("%-16s %d\n", "pivots", info->pivots);
+    printf("%-16s %.3g\n", "complementarity", info->complementarity);
+    printf("%-16s %.3g\n", "infeasibility", info->infeasibility);
+    printf("%-16s %.3g\n", "scale", info->scale);
+    printf("%-16s %.3g\n", "cpu_s", cpu_s);
+    print_vector("z", n, z);
+    print_vector("w", n, w);
+}
+
+/* One JSON object. */
+static void print_json(int n, const double *z, const double *w, const pd_lcp_info *info,
+                       double cpu_s)
+{
+    pd_json js;
+    pd_json_init(&js, stdout);
+    pd_json_begin_object(&js, NULL);
+    pd_json_str(&js, "status", pd_lcp_outcome_name(info->outcome));
+    pd_json_int(&js, "n", n);
+    pd_json_nums(&js, "z", n, z);
+    pd_json_nums(&js, "w", n, w);
+    pd_json_int(&js, "pivots", info->pivots);
+    pd_json_num(&js, "complementarity", info->complementarity);
+    pd_json_num(&js, "infeasibility", info->infeasibility);
+    pd_json_num(&js, "scale", info->scale);
+    pd_json_num(&js, "cpu_s", cpu_s);
+    pd_json_end_object(&js);
+    pd_json_finish(&js);
+}
+
+/* Solve (M, q) and print; the exit status. */
+static int solve_and_print(const lcp_args *a, int n, const double *M, const double *q,
+                           const double *cover, double *z, double *w)
+{
+    pd_lcp_work *work = pd_lcp_alloc(n);
+    if (!work) {
+        fprintf(stderr, "pound: lcp: out of memory for n = %d\n", n);
+        return 1;
+    }
+    pd_lcp_opts opts = {.cover = cover, .max_pivots = a->max_pivots, .tol = a->tol};
+    pd_lcp_info info;
+    double t0 = pd_cpu_seconds();
+    int st = pd_lcp_lemke(work, n, M, q, &opts, z, w, &info);
+    double cpu_s = pd_cpu_seconds() - t0;
+    pd_lcp_free(work);
+    if (st == PD_EINVAL)
+        return pd_cli_usage_error("lcp: %s: the data are not finite numbers", a->path);
+    if (a->json)
+        print_json(n, z, w, &info, cpu_s);
+    else
+        print_text(n, z, w, &info, cpu_s);
+    return st == PD_OK ? 0 : 1;
+}
 
 int pd_cmd_lcp(int argc, char **argv)
 {
-    (void)argc;
-    (void)argv;
-    return pd_cli_usage_error("lcp: not built yet");
+    lcp_args a;
+    int rc = parse_args(argc, argv, &a);
+    if (rc)
+        return rc < 0 ? 0 : rc;
+    int n = 0;
+    double *M = NULL, *q = NULL, *buf = NULL;
+    pd_err err;
+    if (pd_lcp_read(a.path, a.format, &n, &M, &q, &err) != PD_OK)
+        return pd_cli_usage_error("lcp: %s", err.msg);
+    buf = malloc(3 * (size_t)n * sizeof(double));
+    if (!buf) {
+        fprintf(stderr, "pound: lcp: out of memory for n = %d\n", n);
+        rc = 1;
+    } else if (!a.cover_text || (rc = parse_cover(a.cover_text, n, buf + 2 * n)) == 0) {
+        rc = solve_and_print(&a, n, M, q, a.cover_text ? buf + 2 * n : NULL, buf, buf + n);
+    }
+    free(buf);
+    free(M);
+    free(q);
+    return rc;
 }

@@ -1,6 +1,1052 @@
+/* test_lcp.c — Lemke's method, the enumeration oracle, residuals and readers. */
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "pd_lcp.h"
 #include "pd_test.h"
+
+#define VERIFY_TOL 1e-10 /* a solved answer: residuals <= this * scale */
+
+/* ---- helpers --------------------------------------------------------------------- */
+
+/* splitmix64: the next 64 random bits of the stream *state. */
+static uint64_t rng_next(uint64_t *state)
+{
+    uint64_t x = (*state += 0x9E3779B97F4A7C15ull);
+    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+    return x ^ (x >> 31);
+}
+
+/* Uniform in [-1, 1). */
+static double rng_pm1(uint64_t *state)
+{
+    return 2.0 * ((double)(rng_next(state) >> 11) * 0x1.0p-53) - 1.0;
+}
+
+/* A problem with its own storage (column-major M). */
+typedef struct lcp_case {
+    int n;
+    double *M, *q, *z, *w;
+} lcp_case;
+
+/* Zeroed storage for size n; NULL members if out of memory (checked by callers). */
+static lcp_case case_new(int n)
+{
+    lcp_case c = {n, calloc((size_t)n * n, sizeof(double)), calloc((size_t)n, sizeof(double)),
+                  calloc((size_t)n, sizeof(double)), calloc((size_t)n, sizeof(double))};
+    return c;
+}
+
+static void case_free(lcp_case *c)
+{
+    free(c->M);
+    free(c->q);
+    free(c->z);
+    free(c->w);
+}
+
+static int case_ok(const lcp_case *c)
+{
+    return c->M && c->q && c->z && c->w;
+}
+
+/* M = 1 on the diagonal, 2 above it (upper) or below it (lower). */
+static void murty_matrix(lcp_case *c, int upper)
+{
+    int n = c->n;
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++)
+            c->M[i + j * n] = i == j ? 1.0 : ((upper ? i < j : i > j) ? 2.0 : 0.0);
+}
+
+/* Murty's exponential example: upper M, q_i = -sum_{j=i..n} 2^j (1-based). */
+static void murty_exponential(lcp_case *c)
+{
+    murty_matrix(c, 1);
+    double tail = 0.0;
+    for (int i = c->n - 1; i >= 0; i--) {
+        tail += ldexp(1.0, i + 1);
+        c->q[i] = -tail;
+    }
+}
+
+/* Fathi 1979: M = L L^T, L unit lower triangular with 2 below the diagonal; q = -e. */
+static void fathi_problem(lcp_case *c)
+{
+    int n = c->n;
+    for (int j = 0; j < n; j++) {
+        for (int i = 0; i < n; i++) {
+            int lo = i < j ? i : j; /* sum_k L_ik L_jk over k <= min(i, j) */
+            c->M[i + j * n] = 4.0 * lo + (i == j ? 1.0 : 2.0);
+        }
+        c->q[j] = -1.0;
+    }
+}
+
+/* M = B B^T / r + shift I with B n x r uniform in [-1, 1). */
+static void random_gram(lcp_case *c, int r, double shift, uint64_t *rng)
+{
+    int n = c->n;
+    double *B = malloc((size_t)n * r * sizeof(double));
+    if (!B)
+        return;
+    for (int k = 0; k < n * r; k++)
+        B[k] = rng_pm1(rng);
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i <= j; i++) {
+            double s = 0.0;
+            for (int k = 0; k < r; k++)
+                s += B[i + k * n] * B[j + k * n];
+            c->M[i + j * n] = c->M[j + i * n] = s / r + (i == j ? shift : 0.0);
+        }
+    free(B);
+}
+
+/* SPD: M = B B^T / r + 0.1 I. */
+static void random_spd(lcp_case *c, int r, uint64_t *rng)
+{
+    random_gram(c, r, 0.1, rng);
+}
+
+/* Nonsymmetric P-matrix, row-diagonally dominant with a positive diagonal. */
+static void random_diag_dominant(lcp_case *c, uint64_t *rng)
+{
+    int n = c->n;
+    for (int i = 0; i < n; i++) {
+        double off = 0.0;
+        for (int j = 0; j < n; j++) {
+            if (j == i)
+                continue;
+            c->M[i + j * n] = rng_pm1(rng);
+            off += fabs(c->M[i + j * n]);
+        }
+        c->M[i + i * n] = off + 0.1 + 0.5 * (1.0 + rng_pm1(rng));
+    }
+}
+
+/* Nonsymmetric positive definite: M = I + (S - S^T) + B B^T / r. */
+static void random_pd_skew(lcp_case *c, int r, uint64_t *rng)
+{
+    int n = c->n;
+    random_spd(c, r, rng);
+    for (int j = 0; j < n; j++) {
+        c->M[j + j * n] += 0.9;
+        for (int i = 0; i < j; i++) {
+            double s = rng_pm1(rng);
+            c->M[i + j * n] += s;
+            c->M[j + i * n] -= s;
+        }
+    }
+}
+
+/* q uniform in [-1, 1). */
+static void random_q(lcp_case *c, uint64_t *rng)
+{
+    for (int i = 0; i < c->n; i++)
+        c->q[i] = rng_pm1(rng);
+}
+
+/* Lemke with a fresh workspace; info out. */
+static int solve(lcp_case *c, const pd_lcp_opts *opts, pd_lcp_info *info)
+{
+    pd_lcp_work *work = pd_lcp_alloc(c->n);
+    if (!work)
+        return PD_ENOMEM;
+    int st = pd_lcp_lemke(work, c->n, c->M, c->q, opts, c->z, c->w, info);
+    pd_lcp_free(work);
+    return st;
+}
+
+/* Independent check of a solved answer: residuals within VERIFY_TOL * scale. */
+static void check_verified(pd_test_ctx *ctx, const lcp_case *c, const char *what)
+{
+    double *w = malloc((size_t)c->n * sizeof(double));
+    double comp = NAN, infeas = NAN, scale = NAN;
+    if (w)
+        pd_lcp_residual(c->n, c->M, c->q, c->z, w, &comp, &infeas, &scale);
+    CHECK(ctx, comp <= VERIFY_TOL * scale, "%s: complementarity %.3g > %.0e * scale %.3g", what,
+          comp, VERIFY_TOL, scale);
+    CHECK(ctx, infeas <= VERIFY_TOL * scale, "%s: infeasibility %.3g > %.0e * scale %.3g", what,
+          infeas, VERIFY_TOL, scale);
+    free(w);
+}
+
+/* max_i |a_i - b_i|. */
+static double max_diff(int n, const double *a, const double *b)
+{
+    double d = 0.0;
+    for (int i = 0; i < n; i++)
+        d = fmax(d, fabs(a[i] - b[i]));
+    return d;
+}
+
+/* Lemke solves (verified) and matches the enumeration's solution (unique). */
+static void check_against_enumeration(pd_test_ctx *ctx, lcp_case *c, const char *what)
+{
+    pd_lcp_info info;
+    int st = solve(c, NULL, &info);
+    CHECK(ctx, st == PD_OK, "%s: Lemke status %d (%s)", what, st, pd_lcp_outcome_name(info.outcome));
+    check_verified(ctx, c, what);
+    double z_enum[12], w_enum[12];
+    int se = pd_lcp_enumerate(c->n, c->M, c->q, z_enum, w_enum);
+    CHECK(ctx, se == PD_OK, "%s: enumeration status %d", what, se);
+    double zmax = fmax(1.0, fabs(z_enum[0]));
+    for (int i = 1; i < c->n; i++)
+        zmax = fmax(zmax, fabs(z_enum[i]));
+    double d = max_diff(c->n, c->z, z_enum);
+    CHECK(ctx, d <= 1e-10 * zmax, "%s: |z_lemke - z_enum| = %.3g", what, d);
+}
+
+/* Write text to a new temporary file; 0 on success (path filled). */
+static int write_temp(char path[64], const char *text)
+{
+    strcpy(path, "/tmp/pound_lcp_XXXXXX");
+    int fd = mkstemp(path);
+    if (fd < 0)
+        return -1;
+    size_t len = strlen(text);
+    ssize_t wrote = write(fd, text, len);
+    close(fd);
+    return wrote == (ssize_t)len ? 0 : -1;
+}
+
+/* Read text (written to a temp file) in the given format. */
+static int read_text(const char *text, pd_lcp_format format, int *n, double **M, double **q,
+                     pd_err *err)
+{
+    char path[64];
+    if (write_temp(path, text) != 0)
+        return pd_err_set(err, PD_EIO, "cannot write a temporary file");
+    int st = pd_lcp_read(path, format, n, M, q, err);
+    remove(path);
+    return st;
+}
+
+/* ---- Siconos test set --------------------------------------------------------------- */
+
+static const char *const siconos_files[] = {
+    "CPS_1", "CPS_2", "CPS_3", "CPS_4", "CPS_4bis", "CPS_5", "Pang_isolated_sol",
+    "Pang_isolated_sol_perturbed", "deudeu", "enum_fails", "exp_murty", "exp_murty2",
+    "inf_sol_perturbed", "mmc", "ortiz", "tobenna", "trivial"};
+
+/* README: only these two end on a ray. */
+static int siconos_expects_ray(const char *name)
+{
+    return !strcmp(name, "CPS_3") || !strcmp(name, "Pang_isolated_sol_perturbed");
+}
+
+/* Read <shared>/data/lcp/siconos/lcp_NAME.dat. */
+static int read_siconos(pd_test_ctx *ctx, const char *name, lcp_case *c)
+{
+    char path[1024];
+    pd_err err;
+    snprintf(path, sizeof path, "%s/data/lcp/siconos/lcp_%s.dat", ctx->shared, name);
+    memset(c, 0, sizeof *c);
+    int st = pd_lcp_read(path, PD_LCP_FORMAT_SICONOS, &c->n, &c->M, &c->q, &err);
+    CHECK(ctx, st == PD_OK, "read %s: %s", name, err.msg);
+    if (st != PD_OK)
+        return -1;
+    c->z = calloc((size_t)c->n, sizeof(double));
+    c->w = calloc((size_t)c->n, sizeof(double));
+    return case_ok(c) ? 0 : -1;
+}
+
+static void test_lcp_siconos_outcomes(pd_test_ctx *ctx)
+{
+    if (!ctx->shared) {
+        pd_test_skip(ctx, "no shared folder with data/lcp/siconos");
+        return;
+    }
+    for (size_t k = 0; k < sizeof siconos_files / sizeof siconos_files[0]; k++) {
+        lcp_case c;
+        if (read_siconos(ctx, siconos_files[k], &c) != 0) {
+            case_free(&c);
+            continue;
+        }
+        pd_lcp_info info;
+        int st = solve(&c, NULL, &info);
+        if (siconos_expects_ray(siconos_files[k])) {
+            CHECK(ctx, st == PD_ENOSOLUTION && info.outcome == PD_LCP_NO_SOLUTION,
+                  "%s: status %d (%s), expected no_solution", siconos_files[k], st,
+                  pd_lcp_outcome_name(info.outcome));
+        } else {
+            CHECK(ctx, st == PD_OK && info.outcome == PD_LCP_SOLVED, "%s: status %d (%s)",
+                  siconos_files[k], st, pd_lcp_outcome_name(info.outcome));
+            check_verified(ctx, &c, siconos_files[k]);
+        }
+        case_free(&c);
+    }
+}
+
+static void test_lcp_siconos_murty2_pivots(pd_test_ctx *ctx)
+{
+    if (!ctx->shared) {
+        pd_test_skip(ctx, "no shared folder with data/lcp/siconos");
+        return;
+    }
+    lcp_case c;
+    if (read_siconos(ctx, "exp_murty2", &c) == 0) {
+        pd_lcp_info info;
+        CHECK(ctx, solve(&c, NULL, &info) == PD_OK, "exp_murty2 solved");
+        CHECK(ctx, info.pivots == 64, "exp_murty2: %d pivots, expected 2^6 = 64", info.pivots);
+        CHECK_NEAR(ctx, c.z[5], 64.0, 0.0);
+        /* the file holds the n = 6 member of the generated family */
+        lcp_case g = case_new(6);
+        if (case_ok(&g)) {
+            murty_exponential(&g);
+            CHECK(ctx, max_diff(36, g.M, c.M) == 0.0 && max_diff(6, g.q, c.q) == 0.0,
+                  "exp_murty2 equals the generated Murty family member n = 6");
+        }
+        case_free(&g);
+    }
+    case_free(&c);
+}
+
+/* ---- classics defined by formulas ----------------------------------------------------- */
+
+static void test_lcp_murty_exponential_pivots(pd_test_ctx *ctx)
+{
+    for (int n = 6; n <= 12; n++) {
+        lcp_case c = case_new(n);
+        if (!case_ok(&c)) {
+            CHECK(ctx, 0, "out of memory");
+            case_free(&c);
+            return;
+        }
+        murty_exponential(&c);
+        pd_lcp_opts opts = {.max_pivots = 1 << 14};
+        pd_lcp_info info;
+        int st = solve(&c, &opts, &info);
+        CHECK(ctx, st == PD_OK, "n = %d: status %d", n, st);
+        CHECK(ctx, info.pivots == 1 << n, "n = %d: %d pivots, expected 2^n = %d", n, info.pivots,
+              1 << n);
+        /* unique solution z = 2^n e_n, w_i = 2^i (1-based i < n) */
+        for (int i = 0; i < n - 1; i++) {
+            CHECK_NEAR(ctx, c.z[i], 0.0, 0.0);
+            CHECK_NEAR(ctx, c.w[i], ldexp(1.0, i + 1), 1e-12 * ldexp(1.0, n));
+        }
+        CHECK_NEAR(ctx, c.z[n - 1], ldexp(1.0, n), 1e-12 * ldexp(1.0, n));
+        case_free(&c);
+    }
+}
+
+/* Murty's 1978 test problem, q = -e: M lower (1 diagonal, 2 below; solution e_1)
+ * or upper (the Siconos exp_murty orientation; solution e_n).  With the
+ * lexicographic rule the tie of the first step is resolved towards the last
+ * row, which makes the lower orientation the exponential instance (2^n
+ * pivots) and the upper one a two-pivot solve. */
+static void check_murty_1978(pd_test_ctx *ctx, int n, int upper)
+{
+    lcp_case c = case_new(n);
+    if (!case_ok(&c)) {
+        CHECK(ctx, 0, "out of memory");
+        case_free(&c);
+        return;
+    }
+    murty_matrix(&c, upper);
+    for (int i = 0; i < n; i++)
+        c.q[i] = -1.0;
+    pd_lcp_info info;
+    CHECK(ctx, solve(&c, NULL, &info) == PD_OK, "Murty %s n = %d solved", upper ? "upper" : "lower", n);
+    int want = upper ? 2 : 1 << n;
+    CHECK(ctx, info.pivots == want, "Murty %s n = %d: %d pivots, expected %d",
+          upper ? "upper" : "lower", n, info.pivots, want);
+    int one = upper ? n - 1 : 0;
+    for (int i = 0; i < n; i++)
+        CHECK_NEAR(ctx, c.z[i], i == one ? 1.0 : 0.0, 1e-14);
+    if (n <= 10)
+        check_against_enumeration(ctx, &c, upper ? "Murty upper" : "Murty lower");
+    case_free(&c);
+}
+
+static void test_lcp_murty_1978(pd_test_ctx *ctx)
+{
+    int lower[] = {1, 2, 5, 10, 12}, upper[] = {1, 2, 5, 10, 40, 200};
+    for (size_t k = 0; k < sizeof lower / sizeof lower[0]; k++)
+        check_murty_1978(ctx, lower[k], 0);
+    for (size_t k = 0; k < sizeof upper / sizeof upper[0]; k++)
+        check_murty_1978(ctx, upper[k], 1);
+}
+
+static void test_lcp_fathi_1979(pd_test_ctx *ctx)
+{
+    int sizes[] = {1, 3, 8, 10, 32, 100};
+    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
+        int n = sizes[k];
+        lcp_case c = case_new(n);
+        if (!case_ok(&c)) {
+            CHECK(ctx, 0, "out of memory");
+            case_free(&c);
+            return;
+        }
+        fathi_problem(&c);
+        pd_lcp_info info;
+        CHECK(ctx, solve(&c, NULL, &info) == PD_OK, "Fathi n = %d solved", n);
+        for (int i = 0; i < n; i++)   /* known solution z = e_1 */
+            CHECK_NEAR(ctx, c.z[i], i == 0 ? 1.0 : 0.0, 1e-12);
+        if (n <= 10)
+            check_against_enumeration(ctx, &c, "Fathi");
+        case_free(&c);
+    }
+}
+
+static void test_lcp_q_nonnegative(pd_test_ctx *ctx)
+{
+    lcp_case c = case_new(4);
+    if (!case_ok(&c)) {
+        CHECK(ctx, 0, "out of memory");
+        case_free(&c);
+        return;
+    }
+    double q[4] = {0.0, 3.0, -0.0, 1e-300};
+    memcpy(c.q, q, sizeof q);
+    for (int k = 0; k < 16; k++)
+        c.M[k] = k % 3 - 1.0; /* arbitrary, even indefinite */
+    pd_lcp_info info;
+    CHECK(ctx, solve(&c, NULL, &info) == PD_OK, "q >= 0 solved");
+    CHECK(ctx, info.pivots == 0, "q >= 0: %d pivots, expected 0", info.pivots);
+    for (int i = 0; i < 4; i++) {
+        CHECK_NEAR(ctx, c.z[i], 0.0, 0.0);
+        CHECK_NEAR(ctx, c.w[i], q[i], 0.0);
+    }
+    CHECK_NEAR(ctx, info.complementarity, 0.0, 0.0);
+    case_free(&c);
+}
+
+/* One 1 x 1 problem: the expected status and z. */
+static void check_scalar(pd_test_ctx *ctx, double m, double q, int want_status, double want_z)
+{
+    pd_lcp_work *work = pd_lcp_alloc(1);
+    double z = -7.0, w = -7.0;
+    pd_lcp_info info;
+    int st = pd_lcp_lemke(work, 1, &m, &q, NULL, &z, &w, &info);
+    CHECK(ctx, st == want_status, "m = %g, q = %g: status %d, expected %d", m, q, st, want_status);
+    CHECK(ctx, z >= 0.0, "m = %g, q = %g: z = %g is negative", m, q, z);
+    if (want_status == PD_OK) {
+        CHECK_NEAR(ctx, z, want_z, 1e-15 * fmax(1.0, want_z));
+        CHECK_NEAR(ctx, w, m * z + q, 1e-15 * fmax(1.0, fabs(q)));
+    }
+    CHECK(ctx, info.pivots == (q < 0.0 ? (want_status == PD_OK ? 2 : 1) : 0),
+          "m = %g, q = %g: %d pivots", m, q, info.pivots);
+    pd_lcp_free(work);
+}
+
+static void test_lcp_scalar_signs(pd_test_ctx *ctx)
+{
+    check_scalar(ctx, 2.0, -3.0, PD_OK, 1.5);
+    check_scalar(ctx, 2.0, 3.0, PD_OK, 0.0);
+    check_scalar(ctx, 2.0, 0.0, PD_OK, 0.0);
+    check_scalar(ctx, 0.0, 1.0, PD_OK, 0.0);
+    check_scalar(ctx, 0.0, 0.0, PD_OK, 0.0);
+    check_scalar(ctx, -2.0, 3.0, PD_OK, 0.0);
+    check_scalar(ctx, 1e-8, -1e8, PD_OK, 1e16);
+    check_scalar(ctx, 0.0, -1.0, PD_ENOSOLUTION, 0.0);
+    check_scalar(ctx, -2.0, -3.0, PD_ENOSOLUTION, 0.0);
+}
+
+/* ---- random problems -------------------------------------------------------------- */
+
+/* n x n random P-matrix problems of one kind against the enumeration. */
+static void random_small_vs_enumeration(pd_test_ctx *ctx, int kind, const char *what)
+{
+    uint64_t rng = 0x5eed0000u + (uint64_t)kind;
+    for (int n = 1; n <= 10; n++) {
+        for (int rep = 0; rep < 20; rep++) {
+            lcp_case c = case_new(n);
+            if (!case_ok(&c)) {
+                CHECK(ctx, 0, "out of memory");
+                case_free(&c);
+                return;
+            }
+            if (kind == 0)
+                random_spd(&c, n + 2, &rng);
+            else if (kind == 1)
+                random_diag_dominant(&c, &rng);
+            else
+                random_pd_skew(&c, 2, &rng);
+            random_q(&c, &rng);
+            check_against_enumeration(ctx, &c, what);
+            case_free(&c);
+        }
+    }
+}
+
+/* Large random problems of one kind: solved and verified. */
+static void random_large_verified(pd_test_ctx *ctx, int kind, const int *sizes, int count)
+{
+    uint64_t rng = 0xb16b00b5u + (uint64_t)kind;
+    for (int k = 0; k < count; k++) {
+        lcp_case c = case_new(sizes[k]);
+        if (!case_ok(&c)) {
+            CHECK(ctx, 0, "out of memory");
+            case_free(&c);
+            return;
+        }
+        if (kind == 0)
+            random_spd(&c, 32, &rng);
+        else if (kind == 1)
+            random_diag_dominant(&c, &rng);
+        else
+            random_pd_skew(&c, 16, &rng);
+        random_q(&c, &rng);
+        pd_lcp_info info;
+        int st = solve(&c, NULL, &info);
+        CHECK(ctx, st == PD_OK, "kind %d, n = %d: status %d (%s)", kind, sizes[k], st,
+              pd_lcp_outcome_name(info.outcome));
+        CHECK(ctx, info.pivots >= 1 && info.pivots <= 4 * sizes[k], "n = %d: %d pivots",
+              sizes[k], info.pivots);
+        check_verified(ctx, &c, "large random");
+        case_free(&c);
+    }
+}
+
+static void test_lcp_random_spd_vs_enumeration(pd_test_ctx *ctx)
+{
+    random_small_vs_enumeration(ctx, 0, "random SPD");
+}
+
+static void test_lcp_random_diag_dominant_vs_enumeration(pd_test_ctx *ctx)
+{
+    random_small_vs_enumeration(ctx, 1, "random diagonally dominant");
+}
+
+static void test_lcp_random_pd_skew_vs_enumeration(pd_test_ctx *ctx)
+{
+    random_small_vs_enumeration(ctx, 2, "random I + skew + SPD");
+}
+
+static void test_lcp_random_large_spd(pd_test_ctx *ctx)
+{
+    int sizes[] = {50, 200, 500};
+    random_large_verified(ctx, 0, sizes, 3);
+}
+
+static void test_lcp_random_large_nonsymmetric(pd_test_ctx *ctx)
+{
+    int sizes[] = {100, 500};
+    random_large_verified(ctx, 1, sizes, 2);
+    random_large_verified(ctx, 2, sizes, 2);
+}
+
+/* Random PSD (rank-deficient, copositive-plus) problems: Lemke solves exactly when
+ * the enumeration finds a solution, and ray-terminates otherwise. */
+static void test_lcp_random_psd_solvable_iff_enumeration(pd_test_ctx *ctx)
+{
+    uint64_t rng = 0xfeedu;
+    int solved = 0, rays = 0;
+    for (int rep = 0; rep < 400; rep++) {
+        int n = 2 + rep % 7;
+        lcp_case c = case_new(n);
+        if (!case_ok(&c)) {
+            CHECK(ctx, 0, "out of memory");
+            case_free(&c);
+            return;
+        }
+        random_gram(&c, 1 + rep % 2, 0.0, &rng); /* positive semidefinite, singular */
+        random_q(&c, &rng);
+        double ze[12], we[12];
+        int se = pd_lcp_enumerate(n, c.M, c.q, ze, we);
+        pd_lcp_info info;
+        int st = solve(&c, NULL, &info);
+        CHECK(ctx, (st == PD_OK) == (se == PD_OK) && (st == PD_OK || st == PD_ENOSOLUTION),
+              "rep %d (n = %d): Lemke %d, enumeration %d", rep, n, st, se);
+        if (st == PD_OK)
+            check_verified(ctx, &c, "random PSD");
+        solved += st == PD_OK;
+        rays += st == PD_ENOSOLUTION;
+        case_free(&c);
+    }
+    CHECK(ctx, solved > 40 && rays > 40, "both outcomes exercised: %d solved, %d rays", solved,
+          rays);
+}
+
+/* ---- degeneracy, rays, caps ------------------------------------------------------- */
+
+static void test_lcp_degenerate_cyclic(pd_test_ctx *ctx)
+{
+    /* M = [1 2 0; 0 1 2; 2 0 1], q = -e: every ratio test ties; z = e/3 */
+    lcp_case c = case_new(3);
+    if (!case_ok(&c)) {
+        CHECK(ctx, 0, "out of memory");
+        case_free(&c);
+        return;
+    }
+    double M[9] = {1, 0, 2, 2, 1, 0, 0, 2, 1};
+    memcpy(c.M, M, sizeof M);
+    for (int i = 0; i < 3; i++)
+        c.q[i] = -1.0;
+    pd_lcp_info info;
+    CHECK(ctx, solve(&c, NULL, &info) == PD_OK, "cyclic 3 x 3 solved");
+    for (int i = 0; i < 3; i++)
+        CHECK_NEAR(ctx, c.z[i], 1.0 / 3.0, 1e-15);
+    CHECK(ctx, info.pivots <= 10, "cyclic: %d pivots", info.pivots);
+    check_against_enumeration(ctx, &c, "cyclic");
+    case_free(&c);
+}
+
+static void test_lcp_degenerate_repeated_q(pd_test_ctx *ctx)
+{
+    uint64_t rng = 0xdec0de;
+    int sizes[] = {2, 4, 7, 10, 60};
+    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
+        int n = sizes[k];
+        for (int kind = 0; kind < 3; kind++) {
+            lcp_case c = case_new(n);
+            if (!case_ok(&c)) {
+                CHECK(ctx, 0, "out of memory");
+                case_free(&c);
+                return;
+            }
+            if (kind == 0)
+                random_spd(&c, n + 1, &rng);
+            else if (kind == 1)
+                random_diag_dominant(&c, &rng);
+            else
+                for (int i = 0; i < n; i++)
+                    c.M[i + i * n] = 1.0; /* identity: every row ties */
+            for (int i = 0; i < n; i++) /* repeated equal negatives and zeros */
+                c.q[i] = i % 3 == 2 ? 0.0 : -1.0;
+            pd_lcp_info info;
+            int st = solve(&c, NULL, &info);
+            CHECK(ctx, st == PD_OK, "n = %d kind %d: status %d", n, kind, st);
+            check_verified(ctx, &c, "repeated q");
+            if (n <= 10)
+                check_against_enumeration(ctx, &c, "repeated q");
+            case_free(&c);
+        }
+    }
+}
+
+static void test_lcp_ray_copositive_plus(pd_test_ctx *ctx)
+{
+    /* M skew (copositive-plus), w1 = z2 - 1, w2 = -z1 - 1 < 0: infeasible */
+    double M[4] = {0.0, -1.0, 1.0, 0.0}, q[2] = {-1.0, -1.0}, z[2], w[2];
+    pd_lcp_work *work = pd_lcp_alloc(2);
+    pd_lcp_info info;
+    int st = pd_lcp_lemke(work, 2, M, q, NULL, z, w, &info);
+    CHECK(ctx, st == PD_ENOSOLUTION, "skew: status %d, expected PD_ENOSOLUTION", st);
+    CHECK(ctx, info.outcome == PD_LCP_NO_SOLUTION, "skew: outcome %s",
+          pd_lcp_outcome_name(info.outcome));
+    CHECK(ctx, pd_lcp_enumerate(2, M, q, z, w) == PD_ENOSOLUTION, "enumeration agrees");
+    /* M = 0 (copositive-plus) with a negative q */
+    double Z[9] = {0}, q3[3] = {1.0, -2.0, 0.5}, z3[3], w3[3];
+    st = pd_lcp_lemke(work, 2, Z, q3, NULL, z3, w3, &info); /* n = 2 of a bigger array */
+    CHECK(ctx, st == PD_ENOSOLUTION, "M = 0: status %d", st);
+    CHECK(ctx, z3[0] >= 0.0 && z3[1] >= 0.0, "M = 0: z stays >= 0");
+    pd_lcp_free(work);
+}
+
+static void test_lcp_small_pivot_is_not_a_ray(pd_test_ctx *ctx)
+{
+    /* M = [1 -1; -1 1 + 1e-12] (SPD: a P-matrix, so never a ray), q = (0.5, -1):
+     * the last entering column has an entry ~1e-12 of its largest, below the
+     * pivot tolerance but far above roundoff; unique solution z2 = 0.5 / 1e-12 */
+    double M[4] = {1.0, -1.0, -1.0, 1.0 + 1e-12}, q[2] = {0.5, -1.0}, z[2], w[2];
+    pd_lcp_work *work = pd_lcp_alloc(2);
+    pd_lcp_info info;
+    int st = pd_lcp_lemke(work, 2, M, q, NULL, z, w, &info);
+    CHECK(ctx, st == PD_OK, "status %d (%s), expected solved", st, pd_lcp_outcome_name(info.outcome));
+    double z2 = 0.5 / (M[3] - 1.0); /* exact for this double data */
+    CHECK_NEAR(ctx, z[1], z2, 1e-6 * z2);
+    CHECK_NEAR(ctx, z[0], z2 - 0.5, 1e-6 * z2);
+    pd_lcp_free(work);
+}
+
+static void test_lcp_numerical_outcome(pd_test_ctx *ctx)
+{
+    /* M = [1.1 -1.3; -1.3 1.3^2/1.1 + 1e-11] (SPD, cond ~ 1e11), q = (0.3, -1): the
+     * unique solution has |z| ~ 1e11, and |w| ~ eps |M| |z| in doubles makes
+     * |z w| / scale ~ 1e-5 > 1e-10: not verifiable, so numerical (never solved),
+     * with the best answer still returned */
+    double m22 = 1.3 * 1.3 / 1.1 + 1e-11;
+    double M[4] = {1.1, -1.3, -1.3, m22}, q[2] = {0.3, -1.0}, z[2], w[2];
+    pd_lcp_work *work = pd_lcp_alloc(2);
+    pd_lcp_info info;
+    int st = pd_lcp_lemke(work, 2, M, q, NULL, z, w, &info);
+    CHECK(ctx, st == PD_ENUMERICAL, "status %d, expected PD_ENUMERICAL", st);
+    CHECK(ctx, info.outcome == PD_LCP_NUMERICAL, "outcome %s", pd_lcp_outcome_name(info.outcome));
+    CHECK(ctx, info.complementarity > 1e-10 * info.scale, "reported figures: comp %.3g, scale %.3g",
+          info.complementarity, info.scale);
+    long double det = (long double)M[0] * M[3] - (long double)M[1] * M[2]; /* z = -M^-1 q */
+    long double z1 = -((long double)M[3] * q[0] - (long double)M[2] * q[1]) / det;
+    long double z2 = -(-(long double)M[1] * q[0] + (long double)M[0] * q[1]) / det;
+    CHECK(ctx, fabsl(z[0] - z1) <= 1e-3L * z1 && fabsl(z[1] - z2) <= 1e-3L * z2,
+          "best answer returned: z = (%.6g, %.6g) vs (%.6Lg, %.6Lg)", z[0], z[1], z1, z2);
+    pd_lcp_free(work);
+}
+
+static void test_lcp_max_pivots(pd_test_ctx *ctx)
+{
+    lcp_case c = case_new(12);
+    if (!case_ok(&c)) {
+        CHECK(ctx, 0, "out of memory");
+        case_free(&c);
+        return;
+    }
+    murty_exponential(&c);
+    pd_lcp_opts opts = {.max_pivots = 100};
+    pd_lcp_info info;
+    int st = solve(&c, &opts, &info);
+    CHECK(ctx, st == PD_EMAXPIVOTS, "status %d, expected PD_EMAXPIVOTS", st);
+    CHECK(ctx, info.outcome == PD_LCP_MAX_PIVOTS, "outcome %s", pd_lcp_outcome_name(info.outcome));
+    CHECK(ctx, info.pivots == 100, "%d pivots at a cap of 100", info.pivots);
+    CHECK(ctx, PD_EMAXPIVOTS != PD_ENOSOLUTION, "cap and ray have distinct codes");
+    /* the cap is exact: 2^6 pivots are enough for n = 6, 2^6 - 1 are not */
+    lcp_case s = case_new(6);
+    if (case_ok(&s)) {
+        murty_exponential(&s);
+        opts.max_pivots = 64;
+        CHECK(ctx, solve(&s, &opts, &info) == PD_OK, "cap 64 suffices for n = 6");
+        opts.max_pivots = 63;
+        CHECK(ctx, solve(&s, &opts, &info) == PD_EMAXPIVOTS, "cap 63 does not");
+        /* the default cap (max(10000, 100 n)) lets n = 12 finish */
+        CHECK(ctx, solve(&c, NULL, &info) == PD_OK && info.pivots == 4096,
+              "default cap: %d pivots", info.pivots);
+    }
+    case_free(&s);
+    case_free(&c);
+}
+
+static void test_lcp_cover_vector(pd_test_ctx *ctx)
+{
+    uint64_t rng = 0xc0e7;
+    for (int rep = 0; rep < 20; rep++) {
+        int n = 1 + rep % 10;
+        lcp_case c = case_new(n);
+        double d[10];
+        if (!case_ok(&c)) {
+            CHECK(ctx, 0, "out of memory");
+            case_free(&c);
+            return;
+        }
+        random_diag_dominant(&c, &rng);
+        random_q(&c, &rng);
+        for (int i = 0; i < n; i++)
+            d[i] = 0.5 + 1.5 * (1.0 + rng_pm1(&rng));
+        pd_lcp_opts opts = {.cover = d};
+        pd_lcp_info info;
+        CHECK(ctx, solve(&c, &opts, &info) == PD_OK, "cover: solved");
+        check_verified(ctx, &c, "cover");
+        double ze[10], we[10];
+        pd_lcp_enumerate(n, c.M, c.q, ze, we);
+        CHECK(ctx, max_diff(n, ze, c.z) <= 1e-10, "cover: same unique solution");
+        case_free(&c);
+    }
+}
+
+/* ---- workspace, arguments ----------------------------------------------------------- */
+
+static void test_lcp_workspace_reuse(pd_test_ctx *ctx)
+{
+    int sizes[] = {40, 3, 17, 1, 40, 25};
+    uint64_t rng = 0x7e57;
+    pd_lcp_work *shared = pd_lcp_alloc(40);
+    CHECK(ctx, shared && pd_lcp_nmax(shared) == 40, "nmax = 40");
+    for (size_t k = 0; shared && k < sizeof sizes / sizeof sizes[0]; k++) {
+        int n = sizes[k];
+        lcp_case c = case_new(n);
+        double *z2 = calloc((size_t)n, sizeof(double)), *w2 = calloc((size_t)n, sizeof(double));
+        if (case_ok(&c) && z2 && w2) {
+            random_pd_skew(&c, 4, &rng);
+            random_q(&c, &rng);
+            pd_lcp_info a, b;
+            int sa = pd_lcp_lemke(shared, n, c.M, c.q, NULL, z2, w2, &a);
+            int sb = solve(&c, NULL, &b);
+            CHECK(ctx, sa == PD_OK && sb == PD_OK, "n = %d: %d, %d", n, sa, sb);
+            CHECK(ctx, a.pivots == b.pivots, "n = %d: pivots %d vs %d", n, a.pivots, b.pivots);
+            CHECK(ctx, max_diff(n, z2, c.z) == 0.0, "n = %d: shared workspace gives the same z", n);
+        } else {
+            CHECK(ctx, 0, "out of memory");
+        }
+        free(z2);
+        free(w2);
+        case_free(&c);
+    }
+    pd_lcp_free(shared);
+}
+
+static void test_lcp_invalid_arguments(pd_test_ctx *ctx)
+{
+    double M[9] = {2, 0, 0, 0, 2, 0, 0, 0, 2}, q[3] = {-1, -1, -1}, z[3], w[3];
+    pd_lcp_work *work = pd_lcp_alloc(2);
+    pd_lcp_info info;
+    CHECK(ctx, pd_lcp_alloc(0) == NULL && pd_lcp_alloc(-3) == NULL, "alloc(n <= 0) is NULL");
+    CHECK(ctx, pd_lcp_nmax(work) == 2 && pd_lcp_nmax(NULL) == 0, "nmax");
+    CHECK(ctx, pd_lcp_lemke(work, 3, M, q, NULL, z, w, &info) == PD_EINVAL, "n > nmax");
+    CHECK(ctx, pd_lcp_lemke(work, 0, M, q, NULL, z, w, &info) == PD_EINVAL, "n = 0");
+    CHECK(ctx, pd_lcp_lemke(NULL, 1, M, q, NULL, z, w, &info) == PD_EINVAL, "NULL workspace");
+    CHECK(ctx, pd_lcp_lemke(work, 1, M, NULL, NULL, z, w, NULL) == PD_EINVAL, "NULL q");
+    double bad_cover[2] = {1.0, 0.0};
+    pd_lcp_opts opts = {.cover = bad_cover};
+    CHECK(ctx, pd_lcp_lemke(work, 2, M, q, &opts, z, w, &info) == PD_EINVAL, "cover with a 0");
+    opts = (pd_lcp_opts){.tol = 2.0};
+    CHECK(ctx, pd_lcp_lemke(work, 2, M, q, &opts, z, w, &info) == PD_EINVAL, "tol >= 1");
+    double Mnan[4] = {1.0, NAN, 0.0, 1.0}, qinf[2] = {-1.0, -INFINITY};
+    CHECK(ctx, pd_lcp_lemke(work, 2, Mnan, q, NULL, z, w, &info) == PD_EINVAL, "NaN in M");
+    CHECK(ctx, pd_lcp_lemke(work, 2, M, qinf, NULL, z, w, &info) == PD_EINVAL, "inf in q");
+    CHECK(ctx, pd_lcp_enumerate(13, M, q, z, w) == PD_EINVAL, "enumerate n = 13");
+    pd_lcp_free(work);
+    pd_lcp_free(NULL);
+}
+
+static void test_lcp_outcome_names(pd_test_ctx *ctx)
+{
+    CHECK(ctx, !strcmp(pd_lcp_outcome_name(PD_LCP_SOLVED), "solved"), "solved");
+    CHECK(ctx, !strcmp(pd_lcp_outcome_name(PD_LCP_NO_SOLUTION), "no_solution"), "no_solution");
+    CHECK(ctx, !strcmp(pd_lcp_outcome_name(PD_LCP_MAX_PIVOTS), "max_pivots"), "max_pivots");
+    CHECK(ctx, !strcmp(pd_lcp_outcome_name(PD_LCP_NUMERICAL), "numerical"), "numerical");
+}
+
+static void test_lcp_residual_figures(pd_test_ctx *ctx)
+{
+    /* M = [2 -1; 0 3] (column-major {2, 0, -1, 3}), q = (1, -4), z = (0.5, 1) */
+    double M[4] = {2, 0, -1, 3}, q[2] = {1, -4}, z[2] = {0.5, 1}, w[2];
+    double comp, infeas, scale;
+    pd_lcp_residual(2, M, q, z, w, &comp, &infeas, &scale);
+    CHECK_NEAR(ctx, w[0], 1.0, 0.0);   /* 2 * 0.5 - 1 + 1 */
+    CHECK_NEAR(ctx, w[1], -1.0, 0.0);  /* 3 - 4 */
+    CHECK_NEAR(ctx, comp, 1.0, 0.0);   /* max(0.5 * 1, 1 * 1) */
+    CHECK_NEAR(ctx, infeas, 1.0, 0.0); /* -w2 */
+    CHECK_NEAR(ctx, scale, 4.0, 0.0);  /* max(1, 4, 3 * 1) */
+}
+
+static void test_lcp_enumerate_oracle(pd_test_ctx *ctx)
+{
+    /* deudeu: M = [2 1; 1 2], q = (-5, -6): z = (4/3, 7/3) */
+    double M[4] = {2, 1, 1, 2}, q[2] = {-5, -6}, z[2], w[2];
+    CHECK(ctx, pd_lcp_enumerate(2, M, q, z, w) == PD_OK, "deudeu solved");
+    CHECK_NEAR(ctx, z[0], 4.0 / 3.0, 1e-15);
+    CHECK_NEAR(ctx, z[1], 7.0 / 3.0, 1e-15);
+    /* M = [1 -1; -1 1] (CPS_5), q = (1, -1): smallest support first, z = (0, 1) */
+    double M5[4] = {1, -1, -1, 1}, q5[2] = {1, -1};
+    CHECK(ctx, pd_lcp_enumerate(2, M5, q5, z, w) == PD_OK, "CPS_5 solved");
+    CHECK_NEAR(ctx, z[0], 0.0, 0.0);
+    CHECK_NEAR(ctx, z[1], 1.0, 1e-15);
+}
+
+/* ---- readers ------------------------------------------------------------------------- */
+
+static void test_lcp_read_plain(pd_test_ctx *ctx)
+{
+    const char *text = "# a 2 x 2 LCP\r\n"
+                       "2   # size\r\n"
+                       "\r\n"
+                       "1 2\t# row 1\r\n"
+                       "3 4e0\r\n"
+                       "-5 6.5#q\r\n";
+    int n = 0;
+    double *M = NULL, *q = NULL;
+    pd_err err;
+    int st = read_text(text, PD_LCP_FORMAT_PLAIN, &n, &M, &q, &err);
+    CHECK(ctx, st == PD_OK, "plain: %s", err.msg);
+    if (st == PD_OK) {
+        CHECK(ctx, n == 2, "n = %d", n);
+        CHECK_NEAR(ctx, M[0], 1.0, 0.0); /* row by row in the file, column-major in memory */
+        CHECK_NEAR(ctx, M[1], 3.0, 0.0);
+        CHECK_NEAR(ctx, M[2], 2.0, 0.0);
+        CHECK_NEAR(ctx, M[3], 4.0, 0.0);
+        CHECK_NEAR(ctx, q[0], -5.0, 0.0);
+        CHECK_NEAR(ctx, q[1], 6.5, 0.0);
+    }
+    free(M);
+    free(q);
+    /* auto-detection keeps it plain */
+    st = read_text(text, PD_LCP_FORMAT_AUTO, &n, &M, &q, &err);
+    CHECK(ctx, st == PD_OK && n == 2 && M[2] == 2.0, "auto: plain (%s)", err.msg);
+    free(M);
+    free(q);
+}
+
+static void test_lcp_read_siconos(pd_test_ctx *ctx)
+{
+    const char *text = "2\r\n0\r\n2\r\n2\r\n2\t2\r\n"
+                       "1 3\r\n" /* column 1 */
+                       "2 4\r\n" /* column 2 */
+                       "-5 6.5\r\n"
+                       "\r\nExample 4.4.16 CPS 2009: 12 words of free text, 3.5 numbers\r\n";
+    for (int fmt = 0; fmt < 2; fmt++) {
+        int n = 0;
+        double *M = NULL, *q = NULL;
+        pd_err err;
+        int st = read_text(text, fmt ? PD_LCP_FORMAT_SICONOS : PD_LCP_FORMAT_AUTO, &n, &M, &q, &err);
+        CHECK(ctx, st == PD_OK, "siconos (%s): %s", fmt ? "explicit" : "auto", err.msg);
+        if (st == PD_OK) {
+            CHECK(ctx, n == 2, "n = %d", n);
+            CHECK_NEAR(ctx, M[0], 1.0, 0.0);
+            CHECK_NEAR(ctx, M[1], 3.0, 0.0);
+            CHECK_NEAR(ctx, M[2], 2.0, 0.0);
+            CHECK_NEAR(ctx, M[3], 4.0, 0.0);
+            CHECK_NEAR(ctx, q[1], 6.5, 0.0);
+        }
+        free(M);
+        free(q);
+    }
+    /* n = 1, no newline at the end */
+    int n = 0;
+    double *M = NULL, *q = NULL;
+    pd_err err;
+    int st = read_text("1\n0\n1\n1\n1 1\n2\n-3", PD_LCP_FORMAT_AUTO, &n, &M, &q, &err);
+    CHECK(ctx, st == PD_OK && n == 1 && M[0] == 2.0 && q[0] == -3.0, "siconos n = 1: %s", err.msg);
+    free(M);
+    free(q);
+}
+
+/* A malformed text: PD_EPARSE and a message that holds `needle`. */
+static void check_malformed(pd_test_ctx *ctx, const char *text, pd_lcp_format format,
+                            const char *needle)
+{
+    int n = 5;
+    double *M = NULL, *q = NULL;
+    pd_err err;
+    int st = read_text(text, format, &n, &M, &q, &err);
+    CHECK(ctx, st == PD_EPARSE, "status %d for %.30s...", st, text);
+    CHECK(ctx, strstr(err.msg, needle) != NULL, "message '%s' lacks '%s'", err.msg, needle);
+    CHECK(ctx, M == NULL && q == NULL && n == 0, "nothing returned on error");
+}
+
+static void test_lcp_read_malformed(pd_test_ctx *ctx)
+{
+    check_malformed(ctx, "2\n1 2\n3 x\n-1 -1\n", PD_LCP_FORMAT_PLAIN, "line 3: matrix entry: 'x'");
+    check_malformed(ctx, "2\n1 2\n3 4\n-1\n", PD_LCP_FORMAT_PLAIN, "line 4: too few values");
+    check_malformed(ctx, "# size\n0\n", PD_LCP_FORMAT_PLAIN, "line 2: the size n must be");
+    check_malformed(ctx, "-3\n", PD_LCP_FORMAT_AUTO, "line 1: the size n must be");
+    check_malformed(ctx, "2.5\n1\n", PD_LCP_FORMAT_PLAIN, "line 1");
+    check_malformed(ctx, "1\n\n\nnan\n-1\n", PD_LCP_FORMAT_PLAIN, "line 4: matrix entry: 'nan' is not a finite");
+    check_malformed(ctx, "1\n2\ninf\n", PD_LCP_FORMAT_PLAIN, "line 3: entry of q");
+    check_malformed(ctx, "1\n2\n-1\n7\n", PD_LCP_FORMAT_PLAIN, "line 4: unexpected value '7'");
+    check_malformed(ctx, "", PD_LCP_FORMAT_AUTO, "line 1: empty file");
+    check_malformed(ctx, "# nothing\n\n", PD_LCP_FORMAT_PLAIN, "line 2: empty file");
+    check_malformed(ctx, "2\n1\n2\n2\n2 2\n1 0 0 1 -1 -1\n", PD_LCP_FORMAT_SICONOS,
+                    "line 2: storage '1' is not supported");
+    check_malformed(ctx, "2\n0\n2\n3\n2 3\n1 0 0 1 -1 -1\n", PD_LCP_FORMAT_SICONOS,
+                    "line 4: matrix dimension '3'");
+    check_malformed(ctx, "2\n0\n2\n2\n2 2\n1 0 0 1\n-1\n", PD_LCP_FORMAT_SICONOS,
+                    "line 7: too few values");
+    check_malformed(ctx, "3\n0\n3\n3\n3 3\n1 0 0\n0 1 0\n0 0 1e999\n-1 -1 -1\n",
+                    PD_LCP_FORMAT_AUTO, "line 8: matrix entry: '1e999' is not a finite");
+    int n = 0;
+    double *M = NULL, *q = NULL;
+    pd_err err;
+    CHECK(ctx, pd_lcp_read("/nonexistent/pound.lcp", PD_LCP_FORMAT_AUTO, &n, &M, &q, &err) == PD_EIO,
+          "missing file: PD_EIO");
+    CHECK(ctx, strstr(err.msg, "/nonexistent/pound.lcp") != NULL, "message names the file: %s",
+          err.msg);
+}
+
+static void test_lcp_example_file(pd_test_ctx *ctx)
+{
+    int n = 0;
+    double *M = NULL, *q = NULL;
+    pd_err err;
+    if (access("examples/murty1978.lcp", R_OK) != 0) {
+        pd_test_skip(ctx, "examples/murty1978.lcp not found (run from the project root)");
+        return;
+    }
+    int st = pd_lcp_read("examples/murty1978.lcp", PD_LCP_FORMAT_AUTO, &n, &M, &q, &err);
+    CHECK(ctx, st == PD_OK && n == 4, "example: %s", err.msg);
+    if (st == PD_OK && n == 4) {
+        lcp_case c = {n, M, q, calloc(4, sizeof(double)), calloc(4, sizeof(double))};
+        pd_lcp_info info;
+        CHECK(ctx, case_ok(&c) && solve(&c, NULL, &info) == PD_OK, "example solved");
+        for (int i = 0; case_ok(&c) && i < n; i++)
+            CHECK_NEAR(ctx, c.z[i], i == 0 ? 1.0 : 0.0, 1e-15);
+        free(c.z);
+        free(c.w);
+    }
+    free(M);
+    free(q);
+}
+
+/* ---- the command line ----------------------------------------------------------------- */
+
+/* Run a shell command; its exit status, its stdout in out. */
+static int run_capture(const char *cmd, char *out, size_t size)
+{
+    FILE *p = popen(cmd, "r");
+    if (!p)
+        return -1;
+    size_t len = fread(out, 1, size - 1, p);
+    out[len] = '\0';
+    int status = pclose(p);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+static void test_lcp_cli(pd_test_ctx *ctx)
+{
+    if (access(ctx->pound, X_OK) != 0) {
+        pd_test_skip(ctx, "no pound binary");
+        return;
+    }
+    char solvable[64], ray[64], bad[64], cmd[512], out[4096];
+    if (write_temp(solvable, "2\n2 1\n1 2\n-5 -6\n") || write_temp(ray, "1\n-1\n-2\n") ||
+        write_temp(bad, "2\n1 2\n3 oops\n-1 -1\n")) {
+        CHECK(ctx, 0, "temporary files");
+        return;
+    }
+    snprintf(cmd, sizeof cmd, "%s lcp --json %s", ctx->pound, solvable);
+    CHECK(ctx, run_capture(cmd, out, sizeof out) == 0, "solved: exit 0");
+    CHECK(ctx, strstr(out, "\"status\":\"solved\"") && strstr(out, "\"z\":[1.3333333333333333,"),
+          "solved JSON: %s", out);
+    CHECK(ctx, strstr(out, "\"pivots\":3") && strstr(out, "\"cpu_s\":") &&
+                   strstr(out, "\"complementarity\":") && strstr(out, "\"w\":["),
+          "JSON keys: %s", out);
+    snprintf(cmd, sizeof cmd, "%s lcp %s --json", ctx->pound, ray);
+    CHECK(ctx, run_capture(cmd, out, sizeof out) == 1, "ray: exit 1");
+    CHECK(ctx, strstr(out, "\"status\":\"no_solution\"") != NULL, "ray JSON: %s", out);
+    snprintf(cmd, sizeof cmd, "%s lcp %s --json 2>&1", ctx->pound, bad);
+    CHECK(ctx, run_capture(cmd, out, sizeof out) == 2, "malformed: exit 2");
+    int lines = 0;
+    for (const char *c = out; *c; c++)
+        lines += *c == '\n';
+    CHECK(ctx, strstr(out, "line 3") && strstr(out, bad) && lines == 1,
+          "one line naming file and line: %s", out);
+    snprintf(cmd, sizeof cmd, "%s lcp %s --max-pivots 1 --json", ctx->pound, solvable);
+    CHECK(ctx, run_capture(cmd, out, sizeof out) == 1 && strstr(out, "\"status\":\"max_pivots\""),
+          "cap: %s", out);
+    snprintf(cmd, sizeof cmd, "%s lcp %s --frobnicate 2>/dev/null", ctx->pound, solvable);
+    CHECK(ctx, run_capture(cmd, out, sizeof out) == 2, "bad flag: exit 2");
+    snprintf(cmd, sizeof cmd, "%s lcp %s --cover 1,2 --format plain", ctx->pound, solvable);
+    CHECK(ctx, run_capture(cmd, out, sizeof out) == 0 && strstr(out, "solved"), "cover: %s", out);
+    remove(solvable);
+    remove(ray);
+    remove(bad);
+}
 
 void suite_lcp(pd_test_ctx *ctx)
 {
-    (void)ctx;
+    PD_RUN(ctx, test_lcp_siconos_outcomes);
+    PD_RUN(ctx, test_lcp_siconos_murty2_pivots);
+    PD_RUN(ctx, test_lcp_murty_exponential_pivots);
+    PD_RUN(ctx, test_lcp_murty_1978);
+    PD_RUN(ctx, test_lcp_fathi_1979);
+    PD_RUN(ctx, test_lcp_q_nonnegative);
+    PD_RUN(ctx, test_lcp_scalar_signs);
+    PD_RUN(ctx, test_lcp_random_spd_vs_enumeration);
+    PD_RUN(ctx, test_lcp_random_diag_dominant_vs_enumeration);
+    PD_RUN(ctx, test_lcp_random_pd_skew_vs_enumeration);
+    PD_RUN(ctx, test_lcp_random_large_spd);
+    PD_RUN(ctx, test_lcp_random_large_nonsymmetric);
+    PD_RUN(ctx, test_lcp_random_psd_solvable_iff_enumeration);
+    PD_RUN(ctx, test_lcp_degenerate_cyclic);
+    PD_RUN(ctx, test_lcp_degenerate_repeated_q);
+    PD_RUN(ctx, test_lcp_ray_copositive_plus);
+    PD_RUN(ctx, test_lcp_small_pivot_is_not_a_ray);
+    PD_RUN(ctx, test_lcp_numerical_outcome);
+    PD_RUN(ctx, test_lcp_max_pivots);
+    PD_RUN(ctx, test_lcp_cover_vector);
+    PD_RUN(ctx, test_lcp_workspace_reuse);
+    PD_RUN(ctx, test_lcp_invalid_arguments);
+    PD_RUN(ctx, test_lcp_outcome_names);
+    PD_RUN(ctx, test_lcp_residual_figures);
+    PD_RUN(ctx, test_lcp_enumerate_oracle);
+    PD_RUN(ctx, test_lcp_read_plain);
+    PD_RUN(ctx, test_lcp_read_siconos);
+    PD_RUN(ctx, test_lcp_read_malformed);
+    PD_RUN(ctx, test_lcp_example_file);
+    PD_RUN(ctx, test_lcp_cli);
 }
