@@ -40,6 +40,7 @@ static int slurp(lcp_text *t, pd_err *err)
         return pd_err_set(err, PD_EIO, "%s: cannot open: %s", t->path, strerror(errno));
     size_t cap = 4096;
     int status = PD_OK;
+    errno = 0;
     t->buf = malloc(cap);
     t->len = 0;
     while (t->buf) {
@@ -55,7 +56,7 @@ static int slurp(lcp_text *t, pd_err *err)
     if (!t->buf)
         status = pd_err_set(err, PD_ENOMEM, "%s: out of memory reading the file", t->path);
     else if (ferror(f))
-        status = pd_err_set(err, PD_EIO, "%s: read error", t->path);
+        status = pd_err_set(err, PD_EIO, "%s: cannot read: %s", t->path, strerror(errno));
     else
         t->buf[t->len] = '\0';
     fclose(f);
@@ -102,7 +103,8 @@ static int tokenize(lcp_text *t, pd_err *err)
             in_comment = 1;
             *p++ = '\0';
         } else if (c == '\0') {
-            return pd_err_set(err, PD_EPARSE, "%s: line %d: NUL byte in a text file", t->path, line);
+            return pd_err_set(err, PD_EPARSE, "%s: line %d: NUL byte in a text file", t->path,
+                              line);
         } else {
             if (push_token(t, p, line) != 0)
                 return pd_err_set(err, PD_ENOMEM, "%s: out of memory", t->path);
@@ -149,8 +151,9 @@ static int token_size(const lcp_text *t, size_t k, const char *what, int *n, pd_
     long v = 0;
     const lcp_token *tk = &t->tok[k];
     if (!token_integer(tk, &v) || v <= 0)
-        return pd_err_set(err, PD_EPARSE, "%s: line %d: the %s must be a positive integer, got '%.40s'",
-                          t->path, tk->line, what, tk->text);
+        return pd_err_set(err, PD_EPARSE,
+                          "%s: line %d: the %s must be a positive integer, got '%.40s'", t->path,
+                          tk->line, what, tk->text);
     if (v > READ_NMAX)
         return pd_err_set(err, PD_EPARSE, "%s: line %d: the %s %ld is too large (at most %d)",
                           t->path, tk->line, what, v, READ_NMAX);
@@ -184,7 +187,8 @@ static int alloc_problem(const lcp_text *t, int n, double **M, double **q, pd_er
 }
 
 /* n*n entries of M from token `first` on; row_major selects the layout. */
-static int read_matrix(const lcp_text *t, size_t first, int n, int row_major, double *M, pd_err *err)
+static int read_matrix(const lcp_text *t, size_t first, int n, int row_major, double *M,
+                       pd_err *err)
 {
     size_t nn = (size_t)n * (size_t)n;
     for (size_t k = 0; k < nn; k++) {

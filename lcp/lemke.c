@@ -255,10 +255,9 @@ static int lex_filter_column(const lemke_state *st, int c, int nties)
     }
     double eq = st->tol * pd_lcp_max_abs(n, bc) / colmin;
     int kept = 0;
-    for (int k = 0; k < nties; k++) {
-        ties[kept] = ties[k];
-        kept += value[k] <= vmin + eq;
-    }
+    for (int k = 0; k < nties; k++)
+        if (value[k] <= vmin + eq)
+            ties[kept++] = ties[k];
     return kept;
 }
 
@@ -267,10 +266,9 @@ static int lex_filter_column(const lemke_state *st, int c, int nties)
 static int lex_drop_row(int *ties, int nties, int s)
 {
     int kept = 0;
-    for (int k = 0; k < nties; k++) { /* branch-free compaction */
-        ties[kept] = ties[k];
-        kept += ties[k] != s;
-    }
+    for (int k = 0; k < nties; k++)
+        if (ties[k] != s)
+            ties[kept++] = ties[k];
     return kept;
 }
 
@@ -315,10 +313,9 @@ static int blocking_row(const lemke_state *st, double ptol)
         return -1;
     double slack = st->tol * xscale;
     int nties = 0, z0row = ws->row_of[2 * n];
-    for (int i = 0; i < n; i++) { /* branch-free collection of the tied rows */
-        ws->ties[nties] = i;
-        nties += (col[i] > ptol) & (max2(xb[i], 0.0) - theta * col[i] <= slack);
-    }
+    for (int i = 0; i < n; i++)
+        if (col[i] > ptol && max2(xb[i], 0.0) - theta * col[i] <= slack)
+            ws->ties[nties++] = i;
     if (nties <= 1)
         return argmin;
     for (int k = 0; k < nties; k++)
@@ -588,8 +585,8 @@ static int set_options(lemke_state *st, const pd_lcp_opts *opts, int *cap)
     if (isnan(tol) || tol >= 1.0)
         return -1;
     st->tol = tol > 0.0 ? tol : LEMKE_TOL_DEFAULT;
-    int by_size = st->n > (LEMKE_CAP_MIN / LEMKE_CAP_PER_N) ? LEMKE_CAP_PER_N * st->n : LEMKE_CAP_MIN;
-    *cap = max_pivots > 0 ? max_pivots : by_size;
+    int by_size = LEMKE_CAP_PER_N * st->n; /* n <= 46340: no overflow */
+    *cap = max_pivots > 0 ? max_pivots : (by_size > LEMKE_CAP_MIN ? by_size : LEMKE_CAP_MIN);
     return set_cover(st, cover);
 }
 
