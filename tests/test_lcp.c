@@ -624,6 +624,45 @@ static void test_lcp_degenerate_repeated_q(pd_test_ctx *ctx)
     }
 }
 
+/* Integer data, heavy degeneracy: M = I + G G^T with G in {-2..1}^(n x 3) (a
+ * P-matrix), q in {-2..2} (many zeros and repeats): every ratio test is full of
+ * exact ties.  Solved, verified, equal to the enumeration for n <= 10. */
+static void test_lcp_degenerate_integer_random(pd_test_ctx *ctx)
+{
+    uint64_t rng = 0x1e9;
+    int sizes[] = {3, 5, 8, 10, 40, 150};
+    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
+        for (int rep = 0; rep < (sizes[k] <= 10 ? 40 : 4); rep++) {
+            int n = sizes[k];
+            lcp_case c = case_new(n);
+            int G[150 * 3];
+            if (!case_ok(&c)) {
+                CHECK(ctx, 0, "out of memory");
+                case_free(&c);
+                return;
+            }
+            for (int e = 0; e < 3 * n; e++)
+                G[e] = (int)(rng_next(&rng) % 4) - 2;
+            for (int j = 0; j < n; j++) {
+                for (int i = 0; i < n; i++) {
+                    int dot = G[3 * i] * G[3 * j] + G[3 * i + 1] * G[3 * j + 1] +
+                              G[3 * i + 2] * G[3 * j + 2];
+                    c.M[i + j * n] = dot + (i == j);
+                }
+                c.q[j] = (double)((int)(rng_next(&rng) % 5) - 2);
+            }
+            pd_lcp_info info;
+            int st = solve(&c, NULL, &info);
+            CHECK(ctx, st == PD_OK, "n = %d rep %d: status %d (%s)", n, rep, st,
+                  pd_lcp_outcome_name(info.outcome));
+            check_verified(ctx, &c, "integer degenerate");
+            if (n <= 10)
+                check_against_enumeration(ctx, &c, "integer degenerate");
+            case_free(&c);
+        }
+    }
+}
+
 static void test_lcp_ray_copositive_plus(pd_test_ctx *ctx)
 {
     /* M skew (copositive-plus), w1 = z2 - 1, w2 = -z1 - 1 < 0: infeasible */
@@ -1039,6 +1078,7 @@ void suite_lcp(pd_test_ctx *ctx)
     PD_RUN(ctx, test_lcp_random_psd_solvable_iff_enumeration);
     PD_RUN(ctx, test_lcp_degenerate_cyclic);
     PD_RUN(ctx, test_lcp_degenerate_repeated_q);
+    PD_RUN(ctx, test_lcp_degenerate_integer_random);
     PD_RUN(ctx, test_lcp_ray_copositive_plus);
     PD_RUN(ctx, test_lcp_small_pivot_is_not_a_ray);
     PD_RUN(ctx, test_lcp_numerical_outcome);
