@@ -80,11 +80,4 @@ void pd_json_finish(pd_json *js); /* newline after the top-level value */
 int pd_bench_lcp(pd_json *js, const char *shared_dir);
 int pd_bench_engine(pd_json *js);
 
-
-/* Benchmarks, one per module.  With js NULL they print a readable table on
- * stdout; otherwise they add one member ("lcp", "engine") to the JSON object
- * that js has open.  Return 0, or 1 when a benchmark run failed. */
-int pd_bench_lcp(pd_json *js, const char *shared_dir);
-int pd_bench_engine(pd_json *js);
-
 #endif
