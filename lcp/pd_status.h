@@ -41,7 +41,7 @@ int pd_err_set(pd_err *err, int status, const char *fmt, ...)
 /* Clear err to PD_OK with an empty message. */
 void pd_err_clear(pd_err *err);
 
-/* Monotonic wall-clock and per-process CPU time in seconds. */
+/* Monotonic wall-clock time, and the calling thread's CPU time, in seconds. */
 double pd_wall_seconds(void);
 double pd_cpu_seconds(void);
 
