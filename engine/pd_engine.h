@@ -143,6 +143,35 @@ double pd_contact_impulse_1(double D, double b);
  * within 1e-9 of an integer, else rounded up). */
 long pd_steps_for(double tend, double h);
 
+/* ---- event-driven reference for the general system (engine/event.c) --- *
+ * Smooth motion between events integrated by GSL (rk8pd, tight tolerances)
+ * with the persistent contacts held by the acceleration-level LCP
+ * (paper Eqs. 2, 7); every gap closing located by root finding; impacts of
+ * all contacts at zero gap in one velocity-level LCP with Newton's law
+ * (Eqs. 3, 4, 8, 9); detachment when a contact force reaches zero; force
+ * breakpoints as events; accumulations of impacts jumped to persistent
+ * contact (criterion in docs/methods.md). */
+typedef struct pd_edg_opts {
+    double rtol, atol;      /* GSL tolerances (0 = 1e-12, 1e-14) */
+    double h_out;           /* > 0: observer every h_out (and at t1); 0: every event/step */
+    int no_accumulation;    /* 1: never jump an accumulation */
+    long max_events;        /* 0 = 10^6 */
+    long max_burst;         /* impacts of one accumulation before giving up (0 = 10^5) */
+} pd_edg_opts;
+
+typedef struct pd_edg_result {
+    long impacts, accumulations, detachments, events, steps;
+    double first_impact;    /* NAN when none */
+    double contact_time;    /* summed over contacts: time spent in persistent contact */
+} pd_edg_result;
+
+/* Run the model from (t0, q0, v0) (NULL = zeros) to t1.  The observer gets
+ * pd_state: P holds the impulses of an impact at that instant (zero
+ * otherwise), active flags the contacts in persistent contact. */
+int pd_edg_run(const pd_model *model, double t0, const double *q0, const double *v0, double t1,
+               const pd_edg_opts *opts, pd_observer observer, void *ctx, pd_edg_result *res,
+               pd_err *err);
+
 /* ---- penalty baseline (engine/penalty.c) -------------------------------- */
 
 /* What practitioners use today: a contact element per contact, active while
