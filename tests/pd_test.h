@@ -39,6 +39,7 @@ void pd_test_skip(pd_test_ctx *ctx, const char *why);
 void suite_lcp(pd_test_ctx *ctx);
 void suite_engine(pd_test_ctx *ctx);
 void suite_oscillator(pd_test_ctx *ctx);
+void suite_penalty(pd_test_ctx *ctx);
 void suite_reference(pd_test_ctx *ctx);
 void suite_cli(pd_test_ctx *ctx);
 

@@ -1,0 +1,876 @@
+/* penalty.c — the penalty baseline: a contact element per contact,
+ * integrated with GSL's adaptive odeiv2 steppers (SPEC §2, issue 4).
+ *
+ *   M q'' + C q' + K q = F(t) + W lambda,   y = (q, v),  y' = (v, M^-1 r)
+ *   engaged element a:  d = -g_a = -(g0_a + W_a^T q),  d' = -W_a^T v
+ *     Kelvin-Voigt:  lambda_a = kc d + c_a d',
+ *                    c_a = 2 zeta sqrt(kc m_a),  zeta = -ln e / sqrt(pi^2 + ln^2 e),
+ *                    m_a = 1 / (W_a^T M^-1 W_a)                  (not clipped)
+ *     Hertz-damp:    lambda_a = kc d^1.5 + c_a d^1.5 d',
+ *                    c_a = 3 kc (1 - e^2) / (4 v_a),  v_a = d' when a engaged
+ *
+ * The right-hand side is frozen to the engaged set (each element keeps its
+ * law on both sides of g = 0), so it is smooth within a step.  After every
+ * accepted step the gaps are checked; a crossing (a sign change of the gap,
+ * or a dip of its cubic Hermite interpolant) is located by Newton's method
+ * on the gap with bracketing, each trial state integrated from the step's
+ * start by a second "probe" integrator, and the step is cut there: the
+ * element switches at the crossing and the stepper restarts.  The
+ * integration also stops and restarts at every force breakpoint, the force
+ * taken from the right limit at a segment's start and the left limit at its
+ * end.  Output states (h_out) come from the probe integrator too, so they
+ * do not perturb the trajectory.  See docs/penalty.md. */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_odeiv2.h>
+
+#include "pd_engine.h"
+
+#define PEN_PI 3.14159265358979323846
+
+/* A GSL stepper the baseline offers. */
+typedef struct pen_stepper {
+    const char *name;
+    const gsl_odeiv2_step_type *const *type;
+    const gsl_odeiv2_step_type *const *probe; /* one-step type for probes */
+    int implicit;                             /* needs the Jacobian */
+} pen_stepper;
+
+static const pen_stepper pen_steppers[] = {
+    {"rk8pd", &gsl_odeiv2_step_rk8pd, &gsl_odeiv2_step_rk8pd, 0},
+    {"rkf45", &gsl_odeiv2_step_rkf45, &gsl_odeiv2_step_rkf45, 0},
+    {"rk4imp", &gsl_odeiv2_step_rk4imp, &gsl_odeiv2_step_rk4imp, 1},
+    {"msbdf", &gsl_odeiv2_step_msbdf, &gsl_odeiv2_step_rk4imp, 1},
+};
+
+/* One run: the model, the engaged set, GSL objects and workspaces. */
+typedef struct pen {
+    const pd_model *md;
+    pd_penalty_opts o;
+    const pen_stepper *stp;
+    int n, m;
+    size_t dim;            /* 2 n */
+    double *LU;            /* n x n: M factored */
+    int *perm;
+    double *cd;            /* m: damping constants c_a */
+    double vfloor;         /* smallest approach speed used by Hertz-damp */
+    double vseen;          /* largest approach speed at an engagement so far */
+    unsigned char *mode;   /* m: 1 = element engaged (the RHS is frozen to it) */
+    double seg_lo, seg_hi; /* the current force segment */
+    double *F, *lam, *col; /* n, m, n work */
+    double *Aq, *Av;       /* n x n: Jacobian blocks before M^-1 */
+    double *y, *ya, *yt, *yo; /* dim: state, step start, trial, output */
+    double *ys;            /* dim: state before a GSL step (retries) */
+    double *ga, *Ua;       /* m: gaps and W^T v at the step start */
+    gsl_odeiv2_system sys;
+    gsl_odeiv2_driver *main_drv, *probe_drv;
+    pd_observer observer;
+    void *obs_ctx;
+    double t_out0;         /* t0 (outputs at t0 + k h_out) */
+    long next_out;         /* k of the next output */
+    int stopped;           /* an observer asked to stop */
+    pd_state st;
+    pd_penalty_result res;
+} pen;
+
+/* ---- options and setup ------------------------------------------------ */
+
+/* The stepper table entry called name (NULL = rk8pd), or NULL. */
+static const pen_stepper *find_stepper(const char *name)
+{
+    if (!name)
+        return &pen_steppers[0];
+    for (size_t i = 0; i < sizeof pen_steppers / sizeof pen_steppers[0]; i++)
+        if (!strcmp(name, pen_steppers[i].name))
+            return &pen_steppers[i];
+    return NULL;
+}
+
+/* Options in range; zero tolerances and budget take their defaults. */
+static int check_opts(pen *p, double t0, double t1, pd_err *err)
+{
+    pd_penalty_opts *o = &p->o;
+    if (o->law != PD_PENALTY_KELVIN && o->law != PD_PENALTY_HERTZDAMP)
+        return pd_err_set(err, PD_EINVAL, "penalty: law must be Kelvin-Voigt or Hertz-damp");
+    if (!(o->kc > 0.0) || !isfinite(o->kc))
+        return pd_err_set(err, PD_EINVAL,
+                          "penalty: kc (contact stiffness) must be a finite number > 0 (got %g)",
+                          o->kc);
+    if (!(o->rtol >= 0.0) || !isfinite(o->rtol) || !(o->atol >= 0.0) || !isfinite(o->atol))
+        return pd_err_set(err, PD_EINVAL, "penalty: rtol and atol must be >= 0 (got %g, %g)",
+                          o->rtol, o->atol);
+    if (!(p->stp = find_stepper(o->stepper)))
+        return pd_err_set(err, PD_EINVAL,
+                          "penalty: stepper \"%s\" is unknown (rk8pd, rkf45, rk4imp, msbdf)",
+                          o->stepper);
+    if (!(o->h_out >= 0.0) || !isfinite(o->h_out))
+        return pd_err_set(err, PD_EINVAL, "penalty: h_out must be >= 0 (got %g)", o->h_out);
+    if (o->max_steps < 0)
+        return pd_err_set(err, PD_EINVAL, "penalty: max_steps must be >= 0");
+    if (!isfinite(t0) || !isfinite(t1) || t1 < t0)
+        return pd_err_set(err, PD_EINVAL, "penalty: need finite t0 <= t1 (got %g, %g)", t0, t1);
+    o->rtol = o->rtol > 0.0 ? o->rtol : 1e-10;
+    o->atol = o->atol > 0.0 ? o->atol : 1e-12;
+    o->max_steps = o->max_steps > 0 ? o->max_steps : 100000000L;
+    return PD_OK;
+}
+
+/* Anagnostopoulos: zeta = -ln e / sqrt(pi^2 + ln^2 e); zeta(0) = 1 (the limit). */
+static double kv_zeta(double e)
+{
+    if (e <= 0.0)
+        return 1.0;
+    double l = log(e);
+    return -l / sqrt(PEN_PI * PEN_PI + l * l);
+}
+
+/* Free what the run took (safe on a partly set up run). */
+static void pen_free(pen *p)
+{
+    if (p->main_drv)
+        gsl_odeiv2_driver_free(p->main_drv);
+    if (p->probe_drv)
+        gsl_odeiv2_driver_free(p->probe_drv);
+    free(p->LU);
+    free(p->perm);
+    free(p->cd);
+    free(p->mode);
+    free(p->F);
+    free(p->lam);
+    free(p->col);
+    free(p->Aq);
+    free(p->Av);
+    free(p->y);
+    free(p->ya);
+    free(p->yt);
+    free(p->yo);
+    free(p->ys);
+    free(p->ga);
+    free(p->Ua);
+    free(p->st.q);
+    free(p->st.v);
+    free(p->st.P);
+    free(p->st.g);
+    free(p->st.active);
+}
+
+/* Every array, sized once for (n, m). */
+static int alloc_arrays(pen *p)
+{
+    size_t n = (size_t)p->n, m = p->m > 0 ? (size_t)p->m : 1, d = p->dim;
+    p->LU = malloc(n * n * sizeof(double));
+    p->perm = malloc(n * sizeof(int));
+    p->cd = calloc(m, sizeof(double));
+    p->mode = calloc(m, 1);
+    p->F = calloc(n, sizeof(double));
+    p->lam = calloc(m, sizeof(double));
+    p->col = calloc(n, sizeof(double));
+    p->Aq = calloc(n * n, sizeof(double));
+    p->Av = calloc(n * n, sizeof(double));
+    p->y = calloc(d, sizeof(double));
+    p->ya = calloc(d, sizeof(double));
+    p->yt = calloc(d, sizeof(double));
+    p->yo = calloc(d, sizeof(double));
+    p->ys = calloc(d, sizeof(double));
+    p->ga = calloc(m, sizeof(double));
+    p->Ua = calloc(m, sizeof(double));
+    p->st.q = calloc(n, sizeof(double));
+    p->st.v = calloc(n, sizeof(double));
+    p->st.P = calloc(m, sizeof(double));
+    p->st.g = calloc(m, sizeof(double));
+    p->st.active = calloc(m, 1);
+    return p->LU && p->perm && p->cd && p->mode && p->F && p->lam && p->col && p->Aq && p->Av &&
+                   p->y && p->ya && p->yt && p->yo && p->ys && p->ga && p->Ua && p->st.q && p->st.v &&
+                   p->st.P && p->st.g && p->st.active
+               ? PD_OK
+               : PD_ENOMEM;
+}
+
+/* Factor M once; KV damping c_a = 2 zeta_a sqrt(kc m_a), m_a = 1 / (W_a^T M^-1 W_a). */
+static int setup_mass(pen *p, pd_err *err)
+{
+    const pd_model *md = p->md;
+    int n = p->n;
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++)
+            p->LU[i + (size_t)j * n] = pd_matrix_get(&md->M, i, j);
+    if (pd_dense_lu(n, p->LU, p->perm))
+        return pd_err_set(err, PD_ESINGULAR, "penalty: the mass matrix M is singular");
+    for (int a = 0; a < p->m; a++) {
+        double s = 0.0;
+        for (int i = 0; i < n; i++)
+            p->col[i] = pd_matrix_get(&md->W, i, a);
+        pd_dense_lu_solve(n, p->LU, p->perm, p->col);
+        for (int i = 0; i < n; i++)
+            s += pd_matrix_get(&md->W, i, a) * p->col[i];
+        if (!(s > 0.0) || !isfinite(s))
+            return pd_err_set(err, PD_EINVAL,
+                              "penalty: contact %d has no effective mass (W_a^T M^-1 W_a = %g)",
+                              a, s);
+        if (p->o.law == PD_PENALTY_KELVIN)
+            p->cd[a] = 2.0 * kv_zeta(md->e[a]) * sqrt(p->o.kc / s);
+    }
+    return PD_OK;
+}
+
+/* ---- the right-hand side ---------------------------------------------- */
+
+/* g_a = g0_a + W_a^T q. */
+static double gap_of(const pen *p, int a, const double *q)
+{
+    double s = p->md->g0[a];
+    for (int i = 0; i < p->n; i++)
+        s += pd_matrix_get(&p->md->W, i, a) * q[i];
+    return s;
+}
+
+/* U_a = W_a^T v (the gap rate). */
+static double rate_of(const pen *p, int a, const double *v)
+{
+    double s = 0.0;
+    for (int i = 0; i < p->n; i++)
+        s += pd_matrix_get(&p->md->W, i, a) * v[i];
+    return s;
+}
+
+/* Element force: KV kc d + c d'; Hertz-damp d^1.5 (kc + c d'), zero for d <= 0. */
+static double element_force(const pen *p, int a, double d, double dd)
+{
+    if (p->o.law == PD_PENALTY_KELVIN)
+        return p->o.kc * d + p->cd[a] * dd;
+    if (d <= 0.0)
+        return 0.0;
+    return d * sqrt(d) * (p->o.kc + p->cd[a] * dd);
+}
+
+/* lambda of every contact at (q, v) under the engaged set (0 if released). */
+static void contact_forces(const pen *p, const double *q, const double *v, double *lam)
+{
+    for (int a = 0; a < p->m; a++)
+        lam[a] = p->mode[a] ? element_force(p, a, -gap_of(p, a, q), -rate_of(p, a, v)) : 0.0;
+}
+
+/* F(t): right limit in the first half of the segment, left limit in the second. */
+static void force_at(const pen *p, double t, double *F)
+{
+    if (p->md->force)
+        p->md->force(t, t < 0.5 * (p->seg_lo + p->seg_hi) ? +1 : -1, F, p->md->force_ctx);
+    else
+        memset(F, 0, (size_t)p->n * sizeof(double));
+}
+
+/* y' = (v, M^-1 [F - C v - K q + W lambda]). */
+static int rhs(double t, const double y[], double dydt[], void *params)
+{
+    pen *p = params;
+    const pd_model *md = p->md;
+    int n = p->n;
+    const double *q = y, *v = y + n;
+    double *r = dydt + n;
+    p->res.rhs++;
+    force_at(p, t, r);
+    pd_matrix_gemv(&md->C, -1.0, v, 1.0, r);
+    pd_matrix_gemv(&md->K, -1.0, q, 1.0, r);
+    if (p->m > 0) {
+        contact_forces(p, q, v, p->lam);
+        pd_matrix_gemv(&md->W, 1.0, p->lam, 1.0, r);
+    }
+    pd_dense_lu_solve(n, p->LU, p->perm, r);
+    memmove(dydt, v, (size_t)n * sizeof(double));
+    for (size_t i = 0; i < p->dim; i++)
+        if (!isfinite(dydt[i]))
+            return GSL_ERANGE; /* an overflowing trial step: retried smaller */
+    return GSL_SUCCESS;
+}
+
+/* d lambda / d d and d lambda / d d' of an engaged element. */
+static void element_slopes(const pen *p, int a, double d, double dd, double *kd, double *cdd)
+{
+    if (p->o.law == PD_PENALTY_KELVIN) {
+        *kd = p->o.kc;
+        *cdd = p->cd[a];
+        return;
+    }
+    double sd = d > 0.0 ? sqrt(d) : 0.0;
+    *kd = 1.5 * sd * (p->o.kc + p->cd[a] * dd);
+    *cdd = p->cd[a] * d * sd;
+}
+
+/* Aq = -K - sum_a kd_a W_a W_a^T,  Av = -C - sum_a cdd_a W_a W_a^T. */
+static void stiffness_blocks(pen *p, const double *q, const double *v)
+{
+    const pd_model *md = p->md;
+    int n = p->n;
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            p->Aq[i + (size_t)j * n] = -pd_matrix_get(&md->K, i, j);
+            p->Av[i + (size_t)j * n] = -pd_matrix_get(&md->C, i, j);
+        }
+    for (int a = 0; a < p->m; a++) {
+        double kd, cdd;
+        if (!p->mode[a])
+            continue;
+        element_slopes(p, a, -gap_of(p, a, q), -rate_of(p, a, v), &kd, &cdd);
+        for (int j = 0; j < n; j++)
+            for (int i = 0; i < n; i++) {
+                double ww = pd_matrix_get(&md->W, i, a) * pd_matrix_get(&md->W, j, a);
+                p->Aq[i + (size_t)j * n] -= kd * ww;
+                p->Av[i + (size_t)j * n] -= cdd * ww;
+            }
+    }
+}
+
+/* dF/dt at t by a central difference of step dt kept inside the segment. */
+static void force_rate(pen *p, double t, double *dF)
+{
+    double dt = 1e-6 * fmax(1.0, fabs(t));
+    double tc = fmin(fmax(t, p->seg_lo + dt), p->seg_hi - dt);
+    if (!(p->seg_hi - p->seg_lo > 2.0 * dt)) {
+        memset(dF, 0, (size_t)p->n * sizeof(double));
+        return;
+    }
+    force_at(p, tc + dt, dF);
+    force_at(p, tc - dt, p->col);
+    for (int i = 0; i < p->n; i++)
+        dF[i] = (dF[i] - p->col[i]) / (2.0 * dt);
+}
+
+/* df/dy = [0 I; M^-1 Aq  M^-1 Av];  df/dt = (0, M^-1 dF/dt). */
+static int jacobian(double t, const double y[], double *dfdy, double dfdt[], void *params)
+{
+    pen *p = params;
+    int n = p->n;
+    size_t dim = p->dim;
+    memset(dfdy, 0, dim * dim * sizeof(double));
+    for (int i = 0; i < n; i++)
+        dfdy[(size_t)i * dim + (size_t)(n + i)] = 1.0;
+    stiffness_blocks(p, y, y + n);
+    for (int blk = 0; blk < 2; blk++)
+        for (int j = 0; j < n; j++) {
+            const double *A = blk ? p->Av : p->Aq;
+            memcpy(p->col, A + (size_t)j * n, (size_t)n * sizeof(double));
+            pd_dense_lu_solve(n, p->LU, p->perm, p->col);
+            for (int i = 0; i < n; i++)
+                dfdy[(size_t)(n + i) * dim + (size_t)(blk * n + j)] = p->col[i];
+        }
+    force_rate(p, t, dfdt + n);
+    for (int i = 0; i < n; i++)
+        dfdt[i] = 0.0;
+    pd_dense_lu_solve(n, p->LU, p->perm, dfdt + n);
+    return GSL_SUCCESS;
+}
+
+/* Main and probe integrators (step, control, evolve), allocated once. */
+static int alloc_drivers(pen *p, double span, pd_err *err)
+{
+    double h0 = span > 0.0 ? 1e-3 * span : 1.0;
+    p->sys.function = rhs;
+    p->sys.jacobian = jacobian;
+    p->sys.dimension = p->dim;
+    p->sys.params = p;
+    p->main_drv = gsl_odeiv2_driver_alloc_y_new(&p->sys, *p->stp->type, h0, p->o.atol, p->o.rtol);
+    p->probe_drv =
+        gsl_odeiv2_driver_alloc_y_new(&p->sys, *p->stp->probe, h0, p->o.atol, p->o.rtol);
+    if (!p->main_drv || !p->probe_drv)
+        return pd_err_set(err, PD_ENOMEM, "penalty: out of memory for the GSL %s integrator",
+                          p->stp->name);
+    return PD_OK;
+}
+
+/* Map a GSL failure at time t to a pd status with a message. */
+static int gsl_failure(const pen *p, int status, double t, pd_err *err)
+{
+    if (status == GSL_ERANGE)
+        return pd_err_set(err, PD_ENONFINITE,
+                          "penalty: non-finite state or force at t = %.9g (step size %s cannot "
+                          "resolve the contact)",
+                          t, p->stp->name);
+    if (status == GSL_ENOMEM)
+        return pd_err_set(err, PD_ENOMEM, "penalty: GSL ran out of memory at t = %.9g", t);
+    return pd_err_set(err, PD_ENUMERICAL, "penalty: GSL stepper %s failed at t = %.9g: %s",
+                      p->stp->name, t, gsl_strerror(status));
+}
+
+/* One GSL evolve step from (*t, y) toward tb.  A trial that overflows (the
+ * RHS reports it, or a non-finite state slips through the error control) is
+ * undone and retried with h / 10, up to 30 times. */
+static int evolve_once(pen *p, gsl_odeiv2_driver *d, double *t, double tb, double *h, double *y,
+                       pd_err *err)
+{
+    double t_in = *t;
+    memcpy(p->ys, y, p->dim * sizeof(double));
+    for (int tries = 0; tries < 30; tries++) {
+        int s = gsl_odeiv2_evolve_apply(d->e, d->c, d->s, &p->sys, t, tb, h, y);
+        int finite = 1;
+        for (size_t i = 0; i < p->dim && !s; i++)
+            finite = finite && isfinite(y[i]);
+        if (!s && finite)
+            return PD_OK;
+        if (s && s != GSL_ERANGE)
+            return gsl_failure(p, s, t_in, err);
+        memcpy(y, p->ys, p->dim * sizeof(double));
+        *t = t_in;
+        *h *= 0.1;
+        gsl_odeiv2_evolve_reset(d->e);
+        gsl_odeiv2_step_reset(d->s);
+    }
+    return gsl_failure(p, GSL_ERANGE, t_in, err);
+}
+
+/* ---- probes: controlled integration from the step start --------------- */
+
+/* yb = y(tb) from (ta, ya) with the probe integrator (same engaged set). */
+static int probe(pen *p, double ta, const double *ya, double tb, double *yb, pd_err *err)
+{
+    gsl_odeiv2_driver *d = p->probe_drv;
+    double t = ta, h = tb - ta;
+    memcpy(yb, ya, p->dim * sizeof(double));
+    gsl_odeiv2_evolve_reset(d->e);
+    gsl_odeiv2_step_reset(d->s);
+    int rc = PD_OK;
+    while (t < tb && !rc)
+        rc = evolve_once(p, d, &t, tb, &h, yb, err);
+    return rc;
+}
+
+/* ---- observers ---------------------------------------------------------- */
+
+/* The pd_state at (t, y) under the engaged set. */
+static void fill_state(pen *p, double t, const double *y)
+{
+    int n = p->n;
+    memcpy(p->st.q, y, (size_t)n * sizeof(double));
+    memcpy(p->st.v, y + n, (size_t)n * sizeof(double));
+    contact_forces(p, y, y + n, p->st.P);
+    p->st.nactive = 0;
+    for (int a = 0; a < p->m; a++) {
+        p->st.g[a] = gap_of(p, a, y);
+        p->st.active[a] = p->mode[a];
+        p->st.nactive += p->mode[a];
+    }
+    p->st.t = t;
+    p->st.step = p->res.steps;
+    p->st.lcp_pivots = 0;
+}
+
+/* Call fn (if any) on the current pd_state; remember a stop request. */
+static void notify(pen *p, pd_observer fn, void *ctx)
+{
+    if (fn && !p->stopped && fn(&p->st, ctx) > 0)
+        p->stopped = 1;
+}
+
+/* Time of output k. */
+static double out_time(const pen *p, long k)
+{
+    return p->t_out0 + (double)k * p->o.h_out;
+}
+
+/* Outputs t_k in (ta, tb), integrated from the step start (ta, ya). */
+static int outputs_inside(pen *p, double ta, double tb, pd_err *err)
+{
+    double tprev = ta, tol = 1e-12 * fmax(1.0, fabs(tb));
+    int rc;
+    if (!p->observer || !(p->o.h_out > 0.0))
+        return PD_OK;
+    memcpy(p->yo, p->ya, p->dim * sizeof(double));
+    while (!p->stopped && out_time(p, p->next_out) < tb - tol) {
+        double tk = out_time(p, p->next_out++);
+        if (tk <= tprev)
+            continue;
+        memcpy(p->yt, p->yo, p->dim * sizeof(double));
+        if ((rc = probe(p, tprev, p->yt, tk, p->yo, err)))
+            return rc;
+        tprev = tk;
+        fill_state(p, tk, p->yo);
+        notify(p, p->observer, p->obs_ctx);
+    }
+    return PD_OK;
+}
+
+/* An output that falls on tb (within rounding) gets the end state. */
+static void output_at_end(pen *p, double tb)
+{
+    double tol = 1e-12 * fmax(1.0, fabs(tb));
+    if (!p->observer || !(p->o.h_out > 0.0))
+        return;
+    while (!p->stopped && out_time(p, p->next_out) <= tb + tol) {
+        fill_state(p, out_time(p, p->next_out++), p->y);
+        notify(p, p->observer, p->obs_ctx);
+    }
+}
+
+/* ---- crossings ---------------------------------------------------------- */
+
+/* Cubic Hermite on [0, h] through (f0, d0) and (f1, d1), at s. */
+static double hermite(double f0, double d0, double f1, double d1, double h, double s)
+{
+    double x = s / h, x2 = x * x, x3 = x2 * x;
+    return (2 * x3 - 3 * x2 + 1) * f0 + (x3 - 2 * x2 + x) * h * d0 + (-2 * x3 + 3 * x2) * f1 +
+           (x3 - x2) * h * d1;
+}
+
+/* Interior critical points of that cubic (its derivative is a quadratic);
+ * returns how many lie in (0, h). */
+static int hermite_critical(double f0, double d0, double f1, double d1, double h, double s[2])
+{
+    /* H'(x)/h in x = s/h: A x^2 + B x + C */
+    double D = (f1 - f0) / h;
+    double A = 3.0 * (d0 + d1 - 2.0 * D), B = 2.0 * (3.0 * D - 2.0 * d0 - d1), C = d0;
+    double r[2];
+    int nr = 0, k = 0;
+    if (fabs(A) <= 1e-14 * (fabs(B) + fabs(C))) {
+        if (B != 0.0)
+            r[nr++] = -C / B;
+    } else {
+        double disc = B * B - 4.0 * A * C;
+        if (disc >= 0.0) {
+            double sq = sqrt(disc), qq = -0.5 * (B + (B >= 0.0 ? sq : -sq));
+            if (qq != 0.0) {
+                r[nr++] = qq / A;
+                r[nr++] = C / qq;
+            }
+        }
+    }
+    for (int i = 0; i < nr; i++)
+        if (r[i] > 0.0 && r[i] < 1.0)
+            s[k++] = r[i] * h;
+    return k;
+}
+
+/* phi = sigma g with sigma = +1 released, -1 engaged: a crossing makes phi < 0. */
+static double phi_sign(const pen *p, int a)
+{
+    return p->mode[a] ? -1.0 : 1.0;
+}
+
+/* Smallest s in (0, h] where the cubic of phi (ends a: start, b: end) may turn
+ * negative: h if phi_b < 0, the dip's bottom if the cubic dips below zero,
+ * else 0 (no crossing). */
+static double crossing_bound(double fa, double da, double fb, double db, double h)
+{
+    double s[2];
+    if (fb < 0.0)
+        return h;
+    if (!(fa > 0.0 && da < 0.0 && db > 0.0))
+        return 0.0;
+    int k = hermite_critical(fa, da, fb, db, h, s);
+    for (int i = 0; i < k; i++)
+        if (hermite(fa, da, fb, db, h, s[i]) < 0.0)
+            return s[i];
+    return 0.0;
+}
+
+/* phi_a and its rate at ta + s (probe state left in p->yt). */
+static int phi_at(pen *p, int a, double ta, double s, double *f, double *df, pd_err *err)
+{
+    int rc = probe(p, ta, p->ya, ta + s, p->yt, err);
+    double sg = phi_sign(p, a);
+    *f = sg * gap_of(p, a, p->yt);
+    *df = sg * rate_of(p, a, p->yt + p->n);
+    return rc;
+}
+
+/* Root of phi_a in (0, hi] with phi_a(hi) < 0 by safeguarded Newton from the
+ * cubic's estimate; *s gets the crossing, p->yt the state there (the last
+ * trial is the answer). */
+static int locate_root(pen *p, int a, double ta, double hi, const double cub[4], double h,
+                       double *s, pd_err *err)
+{
+    double lo = 0.0, x = hi, f, df;
+    int rc;
+    for (int it = 0; it < 60; it++) { /* the cubic's root in [lo, hi] by bisection */
+        double mid = 0.5 * (lo + x);
+        if (hermite(cub[0], cub[1], cub[2], cub[3], h, mid) < 0.0)
+            x = mid;
+        else
+            lo = mid;
+    }
+    lo = 0.0;
+    for (int it = 0;; it++) {
+        if ((rc = phi_at(p, a, ta, x, &f, &df, err)))
+            return rc;
+        *(f < 0.0 ? &hi : &lo) = x;
+        double tol = 4.0 * DBL_EPSILON * (fabs(ta) + hi);
+        double nx = df != 0.0 ? x - f / df : 0.5 * (lo + hi);
+        if (f == 0.0 || fabs(nx - x) <= tol || hi - lo <= tol || it == 100)
+            break;
+        x = nx > lo && nx < hi ? nx : 0.5 * (lo + hi);
+    }
+    *s = x;
+    return PD_OK;
+}
+
+/* Engage or release element a at the current state p->y; Hertz-damp takes
+ * c_a = 3 kc (1 - e^2) / (4 v_a) from the approach speed v_a = -W_a^T v. */
+static void switch_element(pen *p, int a)
+{
+    p->mode[a] = (unsigned char)!p->mode[a];
+    p->res.switches++;
+    if (p->mode[a] && p->o.law == PD_PENALTY_HERTZDAMP) {
+        double e = p->md->e[a], vimp = -rate_of(p, a, p->y + p->n);
+        p->vseen = fmax(p->vseen, vimp);
+        p->cd[a] = 0.75 * p->o.kc * (1.0 - e * e) / fmax(vimp, fmax(p->vfloor, 1e-3 * p->vseen));
+    }
+}
+
+/* After a step (ta, ya) -> (*t, p->y): find the earliest crossing; if any,
+ * cut the step there (p->y, *t) and return its contact in *which (else -1). */
+static int earliest_crossing(pen *p, double ta, double *t, int *which, pd_err *err)
+{
+    double h = *t - ta, best = h;
+    const double *vb = p->y + p->n;
+    int rc;
+    *which = -1;
+    for (int a = 0; a < p->m; a++) {
+        double sg = phi_sign(p, a), s;
+        double cub[4] = {sg * p->ga[a], sg * p->Ua[a], sg * gap_of(p, a, p->y),
+                         sg * rate_of(p, a, vb)};
+        double bound = crossing_bound(cub[0], cub[1], cub[2], cub[3], h);
+        if (!(bound > 0.0))
+            continue;
+        if (bound < h) { /* a dip: is the true phi negative at its bottom? */
+            double f, df;
+            if ((rc = phi_at(p, a, ta, bound, &f, &df, err)))
+                return rc;
+            if (f >= 0.0)
+                continue;
+        }
+        if ((rc = locate_root(p, a, ta, bound, cub, h, &s, err)))
+            return rc;
+        if (s <= best) {
+            best = s;
+            *which = a;
+            memcpy(p->yo, p->yt, p->dim * sizeof(double));
+        }
+    }
+    if (*which >= 0) {
+        memcpy(p->y, p->yo, p->dim * sizeof(double));
+        *t = ta + best;
+    }
+    return PD_OK;
+}
+
+/* Switch the crossing contact, and any other already across at this state. */
+static void apply_switches(pen *p, int which)
+{
+    for (int a = 0; a < p->m; a++) {
+        double phi = phi_sign(p, a) * gap_of(p, a, p->y);
+        if (a == which || phi < 0.0)
+            switch_element(p, a);
+    }
+}
+
+/* Quintic Hermite on [0, h] through (f, f', f'') at both ends, at s
+ * (value and, in *df, slope): f = sum_k c_k r^k with r = s / h. */
+static double quintic(const double e0[3], const double e1[3], double h, double s, double *df)
+{
+    double c[6] = {e0[0], h * e0[1], 0.5 * h * h * e0[2], 0, 0, 0};
+    double P = e1[0] - (c[0] + c[1] + c[2]), V = h * e1[1] - (c[1] + 2.0 * c[2]);
+    double A = h * h * e1[2] - 2.0 * c[2], r = s / h, f = 0.0, d = 0.0;
+    c[3] = 10.0 * P - 4.0 * V + 0.5 * A;
+    c[4] = -15.0 * P + 7.0 * V - A;
+    c[5] = 6.0 * P - 3.0 * V + 0.5 * A;
+    for (int k = 5; k >= 0; k--) {
+        f = f * r + c[k];
+        d = k > 0 ? d * r + k * c[k] : d;
+    }
+    *df = d / h;
+    return f;
+}
+
+/* Smallest value of that quintic over (0, h): sign changes of its slope on a
+ * grid of 16, refined by bisection. */
+static double quintic_min(const double e0[3], const double e1[3], double h)
+{
+    double best = fmin(e0[0], e1[0]), s0 = 0.0, d0 = e0[1], d1, d;
+    for (int k = 1; k <= 16; k++) {
+        double s1 = h * k / 16.0;
+        quintic(e0, e1, h, s1, &d1);
+        if (d0 < 0.0 && d1 >= 0.0) {
+            double lo = s0, hi = s1;
+            for (int it = 0; it < 60; it++) {
+                double mid = 0.5 * (lo + hi);
+                quintic(e0, e1, h, mid, &d);
+                *(d < 0.0 ? &lo : &hi) = mid;
+            }
+            best = fmin(best, quintic(e0, e1, h, 0.5 * (lo + hi), &d));
+        }
+        s0 = s1;
+        d0 = d1;
+    }
+    return best;
+}
+
+/* Smallest gap a over the step (ta, ya) -> (ta + h, p->y): the cubic of
+ * (g, U) tells whether it dips inside; then the quintic with g'' = W^T a
+ * (two RHS evaluations under the step's engaged set) gives its bottom. */
+static double step_min_gap(pen *p, int a, double ta, double h)
+{
+    double g1 = gap_of(p, a, p->y), U1 = rate_of(p, a, p->y + p->n), s[2];
+    double gmin = fmin(p->ga[a], g1), cub = gmin;
+    int k = h > 0.0 ? hermite_critical(p->ga[a], p->Ua[a], g1, U1, h, s) : 0;
+    for (int i = 0; i < k; i++)
+        cub = fmin(cub, hermite(p->ga[a], p->Ua[a], g1, U1, h, s[i]));
+    if (!(cub < gmin) || rhs(ta, p->ya, p->yt, p) || rhs(ta + h, p->y, p->yo, p))
+        return cub;
+    double e0[3] = {p->ga[a], p->Ua[a], rate_of(p, a, p->yt + p->n)};
+    double e1[3] = {g1, U1, rate_of(p, a, p->yo + p->n)};
+    return quintic_min(e0, e1, h);
+}
+
+/* min gap over the step and the largest engaged penetration rate at its end. */
+static void track_extremes(pen *p, double ta, double h)
+{
+    for (int a = 0; a < p->m; a++) {
+        p->res.min_gap = fmin(p->res.min_gap, step_min_gap(p, a, ta, h));
+        if (p->mode[a])
+            p->res.max_penetration_velocity =
+                fmax(p->res.max_penetration_velocity, -rate_of(p, a, p->y + p->n));
+    }
+}
+
+/* ---- the run ------------------------------------------------------------ */
+
+/* Remember the step start: state, gaps, gap rates. */
+static void mark_start(pen *p)
+{
+    memcpy(p->ya, p->y, p->dim * sizeof(double));
+    for (int a = 0; a < p->m; a++) {
+        p->ga[a] = gap_of(p, a, p->y);
+        p->Ua[a] = rate_of(p, a, p->y + p->n);
+    }
+}
+
+/* One accepted step from *t toward tb, cut at the earliest crossing. */
+static int one_step(pen *p, double *t, double tb, double *h, pd_err *err)
+{
+    gsl_odeiv2_driver *d = p->main_drv;
+    double ta = *t;
+    int which, rc;
+    if (p->res.steps >= p->o.max_steps)
+        return pd_err_set(err, PD_EBUDGET,
+                          "penalty: budget of %ld accepted steps exhausted at t = %.9g",
+                          p->o.max_steps, ta);
+    mark_start(p);
+    if ((rc = evolve_once(p, d, t, tb, h, p->y, err)))
+        return rc;
+    p->res.steps++;
+    if ((rc = earliest_crossing(p, ta, t, &which, err)) ||
+        (rc = outputs_inside(p, ta, *t, err)))
+        return rc;
+    track_extremes(p, ta, *t - ta);
+    if (which >= 0) {
+        apply_switches(p, which);
+        track_extremes(p, *t, 0.0);
+        gsl_odeiv2_evolve_reset(d->e);
+        gsl_odeiv2_step_reset(d->s);
+    }
+    output_at_end(p, *t);
+    fill_state(p, *t, p->y);
+    notify(p, p->o.on_step, p->o.on_step_ctx);
+    if (p->o.h_out == 0.0)
+        notify(p, p->observer, p->obs_ctx);
+    return PD_OK;
+}
+
+/* Integrate [*t, tb] within one force segment. */
+static int run_segment(pen *p, double *t, double tb, double *h, pd_err *err)
+{
+    gsl_odeiv2_driver *d = p->main_drv;
+    int rc;
+    p->seg_lo = *t;
+    p->seg_hi = tb;
+    gsl_odeiv2_evolve_reset(d->e);
+    gsl_odeiv2_step_reset(d->s);
+    *h = fmin(*h, tb - *t);
+    while (*t < tb && !p->stopped)
+        if ((rc = one_step(p, t, tb, h, err)))
+            return rc;
+    return PD_OK;
+}
+
+/* Segments between the model's breakpoints inside (t0, t1). */
+static int run_segments(pen *p, double t0, double t1, pd_err *err)
+{
+    const pd_model *md = p->md;
+    double t = t0, h = 1e-3 * (t1 - t0), tol = 1e-12 * fmax(1.0, fmax(fabs(t0), fabs(t1)));
+    int k = 0, rc;
+    while (k < md->nbreaks && md->breaks[k] <= t0 + tol)
+        k++;
+    while (t < t1 && !p->stopped) {
+        double tb = t1;
+        if (k < md->nbreaks && md->breaks[k] < t1 - tol)
+            tb = md->breaks[k++];
+        if ((rc = run_segment(p, &t, tb, &h, err)))
+            return rc;
+    }
+    if (p->observer && p->o.h_out > 0.0 && !p->stopped &&
+        out_time(p, p->next_out - 1) < t1 - tol) {
+        fill_state(p, t1, p->y);
+        notify(p, p->observer, p->obs_ctx);
+    }
+    return PD_OK;
+}
+
+/* Initial state, engaged set from the initial gaps, first observer calls. */
+static int start(pen *p, double t0, const double *q0, const double *v0, pd_err *err)
+{
+    int n = p->n;
+    for (int i = 0; i < n; i++) {
+        p->y[i] = q0 ? q0[i] : 0.0;
+        p->y[n + i] = v0 ? v0[i] : 0.0;
+        if (!isfinite(p->y[i]) || !isfinite(p->y[n + i]))
+            return pd_err_set(err, PD_EINVAL, "penalty: initial state: dof %d is not finite", i);
+    }
+    p->vfloor = 1e3 * p->o.atol;
+    p->res.min_gap = HUGE_VAL;
+    for (int a = 0; a < p->m; a++) {
+        p->res.min_gap = fmin(p->res.min_gap, gap_of(p, a, p->y));
+        if (gap_of(p, a, p->y) < 0.0)
+            switch_element(p, a);
+    }
+    p->res.switches = 0;
+    p->t_out0 = t0;
+    p->next_out = 1;
+    fill_state(p, t0, p->y);
+    notify(p, p->o.on_step, p->o.on_step_ctx);
+    notify(p, p->observer, p->obs_ctx);
+    return PD_OK;
+}
+
+int pd_penalty_run(const pd_model *model, double t0, const double *q0, const double *v0,
+                   double t1, const pd_penalty_opts *opts, pd_observer observer, void *ctx,
+                   pd_penalty_result *res, pd_err *err)
+{
+    pen p;
+    int rc;
+    memset(&p, 0, sizeof p);
+    pd_err_clear(err);
+    gsl_set_error_handler_off(); /* process-wide: GSL reports, never aborts */
+    p.md = model;
+    p.observer = observer;
+    p.obs_ctx = ctx;
+    if (opts)
+        p.o = *opts;
+    if (!(rc = pd_model_check(model, err)) && !(rc = check_opts(&p, t0, t1, err))) {
+        p.n = model->n;
+        p.m = model->m;
+        p.dim = 2 * (size_t)model->n;
+        p.res.stepper = p.stp->name;
+        if (alloc_arrays(&p))
+            rc = pd_err_set(err, PD_ENOMEM, "penalty: out of memory for n = %d, m = %d", p.n,
+                            p.m);
+        if (!rc && !(rc = setup_mass(&p, err)) && !(rc = alloc_drivers(&p, t1 - t0, err)) &&
+            !(rc = start(&p, t0, q0, v0, err)))
+            rc = run_segments(&p, t0, t1, err);
+    }
+    if (res)
+        *res = p.res;
+    pen_free(&p);
+    return rc;
+}

@@ -1,0 +1,351 @@
+/* osc_penalty.c — the pounding oscillator (SPEC §1) run with the penalty
+ * baseline (engine/penalty.c), in the Pi units of oscillator.c:
+ *
+ *   tau = wp t, x = u / Le:  x'' + 2 xi Pi2 x' + Pi2^2 x = s phi(tau) - lambda,
+ *   gap Pi3 - x;  so M = 1, C = 2 xi Pi2, K = Pi2^2, W = -1, g0 = Pi3.
+ *
+ * Stiffness in Pi units (lambda / ap against d / Le):
+ *   Kelvin-Voigt  kc = kc_mult Pi2^2   or  kc_abs / wp^2
+ *   Hertz-damp    kc = kc_mult Pi2^2   or  kc_abs sqrt(Le) / wp^2
+ * Extremes are measured on every accepted step, refined inside the step by
+ * the quintic Hermite interpolant of (x, x', x''); impacts are the located
+ * gap closings; samples come every dt from the engine's outputs. */
+#include <math.h>
+#include <string.h>
+
+#include "pd_oscillator.h"
+
+#define PD_TWO_PI 6.283185307179586476925286766559
+
+/* The excitation of the scene. */
+typedef struct pen_scene {
+    pd_pulse pulse;
+    int dir;
+} pen_scene;
+
+/* s phi(tau) with oscillator.c's convention at the pulse end tau = 2 pi:
+ * side -1 the left limit, +1 the right limit (relative tolerance 1e-12). */
+static double pulse_value(const pen_scene *sc, double tau, int side)
+{
+    double end = PD_TWO_PI * (1.0 + (side < 0 ? 1e-12 : -1e-12));
+    if (sc->pulse != PD_PULSE_HARMONIC && (side < 0 ? tau > end : tau >= end))
+        return 0.0;
+    return sc->dir * (sc->pulse == PD_PULSE_COSINE ? cos(tau) : sin(tau));
+}
+
+/* F = s phi(tau): the model's force callback. */
+static void scene_force(double tau, int side, double *F, void *ctx)
+{
+    F[0] = pulse_value(ctx, tau, side);
+}
+
+/* d/dtau of s phi(tau), same sides. */
+static double pulse_rate(const pen_scene *sc, double tau, int side)
+{
+    double end = PD_TWO_PI * (1.0 + (side < 0 ? 1e-12 : -1e-12));
+    if (sc->pulse != PD_PULSE_HARMONIC && (side < 0 ? tau > end : tau >= end))
+        return 0.0;
+    return sc->dir * (sc->pulse == PD_PULSE_COSINE ? -sin(tau) : cos(tau));
+}
+
+/* Measurements in Pi units, updated after every accepted step. */
+typedef struct pen_track {
+    pen_scene sc;
+    pd_penalty_law law;
+    int m;                        /* 0: no wall */
+    double C, K, Pi3, tau_measure;
+    double xmax, xtoward, xaway, xpeak;
+    long impacts;
+    double first_tau, first_v, vimp_max, contact_tau;
+    int have_prev, pactive;
+    double pt, px, pv, pP;        /* previous accepted state and its force */
+    double imp_t, imp_lam, imp;   /* integral of lambda since the last sample */
+    double Le, vscale, wp;
+    pd_osc_sampler sampler;
+    void *sampler_ctx;
+} pen_track;
+
+/* A step of the interpolant: x(s) = sum_k c_k (s/h)^k on [0, h]. */
+typedef struct pen_poly {
+    double c[8], h;
+} pen_poly;
+
+/* The derivatives of x at a step end: x, x', x'', x'''. */
+typedef struct pen_jet {
+    double x, v, a, j;
+} pen_jet;
+
+/* Hermite interpolant through the jets at both ends, matching derivatives
+ * up to order (degree - 1) / 2: degree 3 (x, x'), 5 (+ x'') or 7 (+ x''').
+ * With r = s/h, the low coefficients are the start's Taylor terms and the
+ * high ones solve the end conditions (P, V, A, J: what the low ones miss). */
+static pen_poly hermite_step(double h, const pen_jet *s, const pen_jet *e, int degree)
+{
+    pen_poly p = {{s->x, h * s->v, 0, 0, 0, 0, 0, 0}, h};
+    double h2 = h * h;
+    if (degree == 3) {
+        p.c[2] = 3.0 * (e->x - s->x) - 2.0 * h * s->v - h * e->v;
+        p.c[3] = 2.0 * (s->x - e->x) + h * s->v + h * e->v;
+        return p;
+    }
+    p.c[2] = 0.5 * h2 * s->a;
+    if (degree == 5) {
+        double P = e->x - (p.c[0] + p.c[1] + p.c[2]), V = h * e->v - (p.c[1] + 2.0 * p.c[2]);
+        double A = h2 * e->a - 2.0 * p.c[2];
+        p.c[3] = 10.0 * P - 4.0 * V + 0.5 * A;
+        p.c[4] = -15.0 * P + 7.0 * V - A;
+        p.c[5] = 6.0 * P - 3.0 * V + 0.5 * A;
+        return p;
+    }
+    p.c[3] = h2 * h * s->j / 6.0;
+    double P = e->x - (p.c[0] + p.c[1] + p.c[2] + p.c[3]);
+    double V = h * e->v - (p.c[1] + 2.0 * p.c[2] + 3.0 * p.c[3]);
+    double A = h2 * e->a - (2.0 * p.c[2] + 6.0 * p.c[3]), J = h2 * h * e->j - 6.0 * p.c[3];
+    p.c[4] = 35.0 * P - 15.0 * V + 2.5 * A - J / 6.0;
+    p.c[5] = -84.0 * P + 39.0 * V - 7.0 * A + 0.5 * J;
+    p.c[6] = 70.0 * P - 34.0 * V + 6.5 * A - 0.5 * J;
+    p.c[7] = -20.0 * P + 10.0 * V - 2.0 * A + J / 6.0;
+    return p;
+}
+
+/* x(s) by Horner. */
+static double poly_x(const pen_poly *p, double s)
+{
+    double r = s / p->h, y = 0.0;
+    for (int k = 7; k >= 0; k--)
+        y = y * r + p->c[k];
+    return y;
+}
+
+/* x'(s) = (1/h) sum_k k c_k (s/h)^(k-1). */
+static double poly_v(const pen_poly *p, double s)
+{
+    double r = s / p->h, y = 0.0;
+    for (int k = 7; k >= 1; k--)
+        y = y * r + k * p->c[k];
+    return y / p->h;
+}
+
+/* Extremes of x at time tau: |x|, x, -x in the window; x everywhere. */
+static void record_x(pen_track *tr, double tau, double x)
+{
+    if (tau >= tr->tau_measure * (1.0 - 1e-12)) {
+        tr->xmax = fmax(tr->xmax, fabs(x));
+        tr->xtoward = fmax(tr->xtoward, x);
+        tr->xaway = fmax(tr->xaway, -x);
+    }
+    tr->xpeak = fmax(tr->xpeak, x);
+}
+
+/* Turning points x' = 0 inside the step: sign changes of x' on a grid of 16,
+ * each refined by bisection. */
+static void interior_extremes(pen_track *tr, const pen_poly *p, double t0)
+{
+    enum { GRID = 16 };
+    double s0 = 0.0, v0 = poly_v(p, 0.0);
+    for (int k = 1; k <= GRID; k++) {
+        double s1 = p->h * k / GRID, v1 = poly_v(p, s1);
+        if ((v0 < 0.0) != (v1 < 0.0) && v0 != 0.0 && v1 != 0.0) {
+            double lo = s0, hi = s1;
+            for (int it = 0; it < 60; it++) {
+                double mid = 0.5 * (lo + hi);
+                if ((poly_v(p, mid) < 0.0) == (v0 < 0.0))
+                    lo = mid;
+                else
+                    hi = mid;
+            }
+            record_x(tr, t0 + 0.5 * (lo + hi), poly_x(p, 0.5 * (lo + hi)));
+        }
+        s0 = s1;
+        v0 = v1;
+    }
+}
+
+/* Trapezoid of lambda from the last point to (tau, lam). */
+static void add_impulse(pen_track *tr, double tau, double lam)
+{
+    tr->imp += 0.5 * (tr->imp_lam + lam) * (tau - tr->imp_t);
+    tr->imp_t = tau;
+}
+
+/* x, x', x'' and (free flight) x''' = f' - C x'' - K x' at tau, side of f. */
+static pen_jet jet_at(const pen_track *tr, double tau, double x, double v, double lam, int side)
+{
+    pen_jet q = {x, v, 0.0, 0.0};
+    q.a = pulse_value(&tr->sc, tau, side) - tr->C * v - tr->K * x - lam;
+    q.j = pulse_rate(&tr->sc, tau, side) - tr->C * q.a - tr->K * v;
+    return q;
+}
+
+/* The step from the previous state to (tau, x, v): its turning points, its
+ * contact time and impulse.  A free step gets the degree-7 interpolant (the
+ * jerk is known there); an engaged one degree 5, with the force at its end
+ * from the law it ran with: lambda when still engaged, 0 when released by
+ * Hertz-damp (d = 0); a Kelvin-Voigt release leaves it unknown here, so
+ * that step gets the cubic. */
+static void close_step(pen_track *tr, double tau, double x, double v, double lam, int active)
+{
+    double h = tau - tr->pt, lam_end = 0.0;
+    int degree = tr->pactive ? 5 : 7;
+    if (tr->pactive && active)
+        lam_end = lam;
+    else if (tr->pactive && tr->law == PD_PENALTY_KELVIN)
+        degree = 3;
+    pen_jet s = jet_at(tr, tr->pt, tr->px, tr->pv, tr->pactive ? tr->pP : 0.0, +1);
+    pen_jet e = jet_at(tr, tau, x, v, lam_end, -1);
+    pen_poly p = hermite_step(h, &s, &e, degree);
+    interior_extremes(tr, &p, tr->pt);
+    if (tr->pactive)
+        tr->contact_tau += h;
+    add_impulse(tr, tau, lam_end);
+}
+
+/* on_step: per accepted step (and at tau = 0). */
+static int track_step(const pd_state *st, void *ctx)
+{
+    pen_track *tr = ctx;
+    double tau = st->t, x = st->q[0], v = st->v[0];
+    double lam = tr->m ? st->P[0] : 0.0;
+    int active = tr->m ? st->active[0] : 0;
+    if (tr->have_prev && tau > tr->pt)
+        close_step(tr, tau, x, v, lam, active);
+    record_x(tr, tau, x);
+    if (active && !tr->pactive) { /* an element engaged at a located closing */
+        tr->impacts++;
+        tr->vimp_max = fmax(tr->vimp_max, v);
+        if (tr->impacts == 1) {
+            tr->first_tau = tau;
+            tr->first_v = v;
+        }
+    }
+    tr->have_prev = 1;
+    tr->pt = tau;
+    tr->px = x;
+    tr->pv = v;
+    tr->pP = lam;
+    tr->pactive = active;
+    tr->imp_lam = lam;
+    return 0;
+}
+
+/* observer: a sample every dt, in metres, seconds and m/s. */
+static int emit_sample(const pd_state *st, void *ctx)
+{
+    pen_track *tr = ctx;
+    double x = st->q[0], lam = tr->m ? st->P[0] : 0.0;
+    add_impulse(tr, st->t, lam);
+    pd_osc_sample s = {st->step, st->t / tr->wp, x * tr->Le, st->v[0] * tr->vscale,
+                       tr->imp * tr->vscale, (tr->Pi3 - x) * tr->Le};
+    tr->imp = 0.0;
+    tr->imp_lam = lam;
+    return tr->sampler(&s, tr->sampler_ctx);
+}
+
+/* Contact stiffness in Pi units (see the file comment). */
+static int pi_stiffness(const pd_osc *c, const pd_osc_penalty_opts *po, double *kc, pd_err *err)
+{
+    double wp = pd_osc_wp(c);
+    if (!(po->kc_abs >= 0.0) || !isfinite(po->kc_abs))
+        return pd_err_set(err, PD_EINVAL, "kc_abs (contact stiffness) must be >= 0 (got %g)",
+                          po->kc_abs);
+    if (!(po->kc_mult >= 0.0) || !isfinite(po->kc_mult))
+        return pd_err_set(err, PD_EINVAL,
+                          "kc (contact stiffness multiple of w0^2) must be > 0 (got %g)",
+                          po->kc_mult);
+    if (po->kc_abs > 0.0)
+        *kc = po->law == PD_PENALTY_HERTZDAMP ? po->kc_abs * sqrt(pd_osc_Le(c)) / (wp * wp)
+                                              : po->kc_abs / (wp * wp);
+    else
+        *kc = (po->kc_mult > 0.0 ? po->kc_mult : 1e4) * c->Pi2 * c->Pi2;
+    return PD_OK;
+}
+
+/* dt and tend defaults and ranges, as pd_osc_simulate takes them. */
+static int run_times(const pd_osc *c, pd_osc_opts *o, pd_err *err)
+{
+    if (o->dt == 0.0)
+        o->dt = pd_osc_default_dt(c);
+    if (o->tend == 0.0)
+        o->tend = pd_osc_default_tend(c);
+    if (!(o->dt > 0.0) || !isfinite(o->dt))
+        return pd_err_set(err, PD_EINVAL, "dt must be a finite number > 0 (got %g)", o->dt);
+    if (!(o->tend > 0.0) || !isfinite(o->tend))
+        return pd_err_set(err, PD_EINVAL, "tend must be a finite number > 0 (got %g)", o->tend);
+    if (o->tend / o->dt > 4e9)
+        return pd_err_set(err, PD_EINVAL, "tend / dt = %g samples is too many", o->tend / o->dt);
+    return PD_OK;
+}
+
+/* Results back in metres and seconds. */
+static void fill_result(const pen_track *tr, const pd_osc_opts *o,
+                        const pd_penalty_result *pr, pd_osc_result *res)
+{
+    memset(res, 0, sizeof *res);
+    res->umax = tr->xmax * tr->Le;
+    res->u_toward = tr->xtoward * tr->Le;
+    res->u_away = tr->xaway * tr->Le;
+    res->impacts = tr->impacts;
+    res->first_impact = tr->first_tau / tr->wp;
+    res->first_impact_velocity = tr->first_v * tr->vscale;
+    res->max_impact_velocity = tr->vimp_max * tr->vscale;
+    res->contact_time = tr->contact_tau / tr->wp;
+    res->min_gap = (tr->Pi3 - tr->xpeak) * tr->Le;
+    res->steps = pr->steps;
+    res->dt = o->dt;
+    res->tend = o->tend;
+    res->theta = NAN;
+    res->gamma = NAN;
+    res->kernel = pr->stepper ? pr->stepper : "penalty";
+}
+
+int pd_osc_penalty(const pd_osc *c, const pd_osc_opts *opts, const pd_osc_penalty_opts *popts,
+                   pd_osc_sampler sampler, void *ctx, pd_osc_result *res, pd_err *err)
+{
+    pd_osc_opts o = opts ? *opts : pd_osc_default_opts();
+    pd_osc_penalty_opts po = {PD_PENALTY_KELVIN, 1e4, 0.0, 0.0, 0.0, NULL};
+    pd_penalty_result pr;
+    double kc = 0.0;
+    int rc;
+    pd_err_clear(err);
+    if (popts)
+        po = *popts;
+    if ((rc = pd_osc_check(c, err)) || (rc = run_times(c, &o, err)) ||
+        (rc = pi_stiffness(c, &po, &kc, err)))
+        return rc;
+
+    /* the scene in Pi units; outputs on the grid tau_k = k 2 pi dt / Tp */
+    pen_scene sc = {c->pulse, c->dir};
+    double M = 1.0, C = 2.0 * c->xi * c->Pi2, K = c->Pi2 * c->Pi2, W = -1.0;
+    double g0 = c->Pi3, e = c->eps, wp = pd_osc_wp(c);
+    double h_out = PD_TWO_PI * (o.dt / c->Tp);
+    double tau_end = (double)pd_steps_for(o.tend, o.dt) * h_out;
+    double tau_measure = wp * pd_osc_measure_start(c, o.tend);
+    double brk = c->pulse == PD_PULSE_HARMONIC ? tau_measure : PD_TWO_PI;
+    pd_model model = {1, o.no_wall ? 0 : 1, pd_matrix_dense(1, 1, &M), pd_matrix_dense(1, 1, &C),
+                      pd_matrix_dense(1, 1, &K), pd_matrix_dense(1, 1, &W), &g0, &e,
+                      scene_force, &sc, &brk, brk > 0.0 ? 1 : 0};
+    pen_track tr;
+    memset(&tr, 0, sizeof tr);
+    tr.sc = sc;
+    tr.law = po.law;
+    tr.m = model.m;
+    tr.C = C;
+    tr.K = K;
+    tr.Pi3 = c->Pi3;
+    tr.tau_measure = tau_measure;
+    tr.first_tau = tr.first_v = NAN;
+    tr.Le = pd_osc_Le(c);
+    tr.wp = wp;
+    tr.vscale = tr.Le * wp;
+    tr.sampler = sampler;
+    tr.sampler_ctx = ctx;
+    pd_penalty_opts eo = {po.law, kc, po.rtol, po.atol, po.stepper, sampler ? h_out : 0.0,
+                          0, track_step, &tr};
+
+    double cpu0 = pd_cpu_seconds();
+    rc = pd_penalty_run(&model, 0.0, NULL, NULL, tau_end, &eo, sampler ? emit_sample : NULL,
+                        &tr, &pr, err);
+    fill_result(&tr, &o, &pr, res);
+    res->cpu_s = pd_cpu_seconds() - cpu0;
+    return rc;
+}
