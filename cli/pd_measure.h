@@ -26,7 +26,8 @@ int pd_measure_reference(const pd_cli_case *k, const pd_osc_opts *o, pd_trace *r
                          pd_osc_result *res, pd_err *err);
 
 /* Run a method on the same grid (work sized by pd_trace_alloc for o) and
- * measure its errors against ref. */
+ * measure its errors against ref; out->r.cpu_s is the cost of a second run
+ * without sampling. */
 int pd_measure_run(const pd_cli_case *k, pd_method method, const pd_osc_opts *o,
                    const pd_trace *ref, double umax_ref, pd_trace *work, pd_measured *out,
                    pd_err *err);
