@@ -63,3 +63,24 @@ set xlabel 't [s]'; set ylabel 'v^2/2 + w_0^2 u^2/2 [m^2/s^2]'
 plot '$tmp/e1.dat' w l lw 2 t 'eps = 1 (kept)', '$tmp/e08.dat' w l lw 2 t 'eps = 0.8 (falls at each impact)'
 GP
 echo "figures written to $out/"
+
+# 4. Moreau-Jean (dt = min(Tp, T0)/2000) against the reference over the grid
+#    of issue 4: error quantiles and the worst points (docs/methods.md).
+for pulse in sine cosine; do for dir in normal reverse; do
+  for Pi2 in 0.05 0.2 0.7 1.16 3 10; do for Pi3 in 0.001 0.05 1 10; do for eps in 0 0.5 0.9 1; do
+    "$pound" compare --pulse $pulse --dir $dir --Tp 1 --Pi2 $Pi2 --Pi3 $Pi3 --eps $eps --json |
+      sed -e 's/.*"err_umax_rel":\([^,]*\),"err_hist_linf":\([^,]*\),"impacts":\([^,]*\),"impacts_ref":\([^,]*\),"cpu_s":\([^,]*\),"cpu_s_ref":\([^,]*\),.*/\1 \2 \3 \4 \5 \6/' |
+      awk -v c="$pulse $dir Pi2=$Pi2 Pi3=$Pi3 eps=$eps" '{print $0, c}'
+  done; done; done
+done; done > "$tmp/grid.dat"
+{
+  echo "Moreau-Jean (theta 1/2, dt = min(Tp,T0)/2000) vs the event-driven reference, $(wc -l < "$tmp/grid.dat") points"
+  for col in 1 2 5 6; do
+    name=$(echo "err_umax err_hist - - cpu_s_moreau cpu_s_ref" | cut -d' ' -f$col)
+    sort -g -k$col,$col "$tmp/grid.dat" | awk -v c=$col -v n="$name" '{v[NR]=$c} END {printf "%-14s median %.3g  p90 %.3g  max %.3g\n", n, v[int((NR+1)/2)], v[int(0.9*NR)], v[NR]}'
+  done
+  echo "pounding points: $(awk '$4 > 0' "$tmp/grid.dat" | wc -l)"
+  echo "worst umax:  $(sort -g -k1,1 "$tmp/grid.dat" | tail -1)"
+  echo "worst hist:  $(sort -g -k2,2 "$tmp/grid.dat" | tail -1)"
+} > "$out/grid-moreau.txt"
+cat "$out/grid-moreau.txt"
