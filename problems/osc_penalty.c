@@ -19,18 +19,15 @@
 
 /* The excitation of the scene. */
 typedef struct pen_scene {
+    const pd_osc *c;
     pd_pulse pulse;
     int dir;
 } pen_scene;
 
-/* s phi(tau) with oscillator.c's convention at the pulse end tau = 2 pi:
- * side -1 the left limit, +1 the right limit (relative tolerance 1e-12). */
+/* s phi(tau), with oscillator.c's one-sided limits at the pulse end. */
 static double pulse_value(const pen_scene *sc, double tau, int side)
 {
-    double end = PD_TWO_PI * (1.0 + (side < 0 ? 1e-12 : -1e-12));
-    if (sc->pulse != PD_PULSE_HARMONIC && (side < 0 ? tau > end : tau >= end))
-        return 0.0;
-    return sc->dir * (sc->pulse == PD_PULSE_COSINE ? cos(tau) : sin(tau));
+    return pd_osc_shape(sc->c, tau, side);
 }
 
 /* F = s phi(tau): the model's force callback. */
@@ -260,22 +257,6 @@ static int pi_stiffness(const pd_osc *c, const pd_osc_penalty_opts *po, double *
     return PD_OK;
 }
 
-/* dt and tend defaults and ranges, as pd_osc_simulate takes them. */
-static int run_times(const pd_osc *c, pd_osc_opts *o, pd_err *err)
-{
-    if (o->dt == 0.0)
-        o->dt = pd_osc_default_dt(c);
-    if (o->tend == 0.0)
-        o->tend = pd_osc_default_tend(c);
-    if (!(o->dt > 0.0) || !isfinite(o->dt))
-        return pd_err_set(err, PD_EINVAL, "dt must be a finite number > 0 (got %g)", o->dt);
-    if (!(o->tend > 0.0) || !isfinite(o->tend))
-        return pd_err_set(err, PD_EINVAL, "tend must be a finite number > 0 (got %g)", o->tend);
-    if (o->tend / o->dt > 4e9)
-        return pd_err_set(err, PD_EINVAL, "tend / dt = %g samples is too many", o->tend / o->dt);
-    return PD_OK;
-}
-
 /* Results back in metres and seconds. */
 static void fill_result(const pen_track *tr, const pd_osc_opts *o,
                         const pd_penalty_result *pr, pd_osc_result *res)
@@ -301,7 +282,7 @@ static void fill_result(const pen_track *tr, const pd_osc_opts *o,
 int pd_osc_penalty(const pd_osc *c, const pd_osc_opts *opts, const pd_osc_penalty_opts *popts,
                    pd_osc_sampler sampler, void *ctx, pd_osc_result *res, pd_err *err)
 {
-    pd_osc_opts o = opts ? *opts : pd_osc_default_opts();
+    pd_osc_opts o;
     pd_osc_penalty_opts po = {PD_PENALTY_KELVIN, 1e4, 0.0, 0.0, 0.0, NULL};
     pd_penalty_result pr;
     double kc = 0.0;
@@ -309,12 +290,12 @@ int pd_osc_penalty(const pd_osc *c, const pd_osc_opts *opts, const pd_osc_penalt
     pd_err_clear(err);
     if (popts)
         po = *popts;
-    if ((rc = pd_osc_check(c, err)) || (rc = run_times(c, &o, err)) ||
+    if ((rc = pd_osc_resolve_opts(c, opts, &o, err)) ||
         (rc = pi_stiffness(c, &po, &kc, err)))
         return rc;
 
     /* the scene in Pi units; outputs on the grid tau_k = k 2 pi dt / Tp */
-    pen_scene sc = {c->pulse, c->dir};
+    pen_scene sc = {c, c->pulse, c->dir};
     double M = 1.0, C = 2.0 * c->xi * c->Pi2, K = c->Pi2 * c->Pi2, W = -1.0;
     double g0 = c->Pi3, e = c->eps, wp = pd_osc_wp(c);
     double h_out = PD_TWO_PI * (o.dt / c->Tp);

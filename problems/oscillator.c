@@ -69,6 +69,11 @@ double pd_osc_excitation(const pd_osc *c, double t)
     return c->ap * pulse_shape(c->pulse, c->dir, pd_osc_wp(c) * t, -1);
 }
 
+double pd_osc_shape(const pd_osc *c, double tau, int side)
+{
+    return pulse_shape(c->pulse, c->dir, tau, side);
+}
+
 /* A finite value in [lo, hi] (hi_open: hi excluded). */
 static int in_range(double x, double lo, double hi, int hi_open)
 {
@@ -103,6 +108,25 @@ pd_osc_opts pd_osc_default_opts(void)
     o.theta = 0.5;
     o.gamma = 0.5;
     return o;
+}
+
+int pd_osc_resolve_opts(const pd_osc *c, const pd_osc_opts *in, pd_osc_opts *out, pd_err *err)
+{
+    int rc;
+    *out = in ? *in : pd_osc_default_opts();
+    if ((rc = pd_osc_check(c, err)))
+        return rc;
+    if (out->dt == 0.0)
+        out->dt = pd_osc_default_dt(c);
+    if (out->tend == 0.0)
+        out->tend = pd_osc_default_tend(c);
+    if (!(out->dt > 0.0) || !isfinite(out->dt))
+        return pd_err_set(err, PD_EINVAL, "dt must be a finite number > 0 (got %g)", out->dt);
+    if (!(out->tend > 0.0) || !isfinite(out->tend))
+        return pd_err_set(err, PD_EINVAL, "tend must be a finite number > 0 (got %g)", out->tend);
+    if (out->tend / out->dt > 4e9)
+        return pd_err_set(err, PD_EINVAL, "tend / dt = %g steps is too many", out->tend / out->dt);
+    return PD_OK;
 }
 
 double pd_osc_default_dt(const pd_osc *c)
@@ -230,21 +254,11 @@ static int observe(const pd_state *st, void *ctx)
 int pd_osc_simulate(const pd_osc *c, const pd_osc_opts *opts, pd_osc_sampler sampler,
                     void *ctx, pd_osc_result *res, pd_err *err)
 {
-    pd_osc_opts o = opts ? *opts : pd_osc_default_opts();
+    pd_osc_opts o;
     int rc;
     pd_err_clear(err);
-    if ((rc = pd_osc_check(c, err)))
+    if ((rc = pd_osc_resolve_opts(c, opts, &o, err)))
         return rc;
-    if (o.dt == 0.0)
-        o.dt = pd_osc_default_dt(c);
-    if (o.tend == 0.0)
-        o.tend = pd_osc_default_tend(c);
-    if (!(o.dt > 0.0) || !isfinite(o.dt))
-        return pd_err_set(err, PD_EINVAL, "dt must be a finite number > 0 (got %g)", o.dt);
-    if (!(o.tend > 0.0) || !isfinite(o.tend))
-        return pd_err_set(err, PD_EINVAL, "tend must be a finite number > 0 (got %g)", o.tend);
-    if (o.tend / o.dt > 4e9)
-        return pd_err_set(err, PD_EINVAL, "tend / dt = %g steps is too many", o.tend / o.dt);
 
     /* model in Pi units; the step is 2 pi (dt / Tp) so equal dt/Tp gives equal h */
     scene sc = {c->pulse, c->dir};
@@ -315,18 +329,12 @@ static int ref_sample(double tau, double x, double v, int in_contact, void *ctx)
 int pd_osc_reference(const pd_osc *c, const pd_osc_opts *opts, pd_osc_sampler sampler, void *ctx,
                      pd_osc_result *res, pd_err *err)
 {
-    pd_osc_opts o = opts ? *opts : pd_osc_default_opts();
+    pd_osc_opts o;
     pd_ed_result er;
     int rc;
     pd_err_clear(err);
-    if ((rc = pd_osc_check(c, err)))
+    if ((rc = pd_osc_resolve_opts(c, opts, &o, err)))
         return rc;
-    if (o.dt == 0.0)
-        o.dt = pd_osc_default_dt(c);
-    if (o.tend == 0.0)
-        o.tend = pd_osc_default_tend(c);
-    if (!(o.dt > 0.0) || !(o.tend > 0.0) || !isfinite(o.tend))
-        return pd_err_set(err, PD_EINVAL, "dt and tend must be finite numbers > 0");
     /* forcing pieces in Pi units: s sin(tau + phi) on [0, 2 pi], then zero */
     double phi = c->pulse == PD_PULSE_COSINE ? PD_TWO_PI / 4.0 : 0.0;
     pd_sine_piece pieces[2] = {{0.0, (double)c->dir, 1.0, phi}, {PD_TWO_PI, 0.0, 0.0, 0.0}};
@@ -371,4 +379,27 @@ void pd_osc_free_exact(const pd_osc *c, double t, double *u, double *v)
     double uT, vT;
     pd_sdof_advance(&osc, A, wp, phi, 0.0, 0.0, 0.0, c->Tp, &uT, &vT);
     pd_sdof_advance(&osc, 0.0, wp, 0.0, c->Tp, uT, vT, t, u, v);
+}
+
+int pd_osc_free_first_contact(const pd_osc *c, double tmax, double *t, double *v)
+{
+    double delta = pd_osc_gap(c), step = c->Tp / 1000.0, lo = 0.0, hi = -1.0, u;
+    for (double s = step; s <= tmax + 0.5 * step; s += step) {
+        pd_osc_free_exact(c, s, &u, v);
+        if (u >= delta) {
+            hi = s;
+            break;
+        }
+        lo = s;
+    }
+    if (hi < 0.0)
+        return PD_EINVAL;
+    for (int it = 0; it < 200 && hi - lo > 1e-16 * hi; it++) {
+        double mid = 0.5 * (lo + hi);
+        pd_osc_free_exact(c, mid, &u, v);
+        *(u < delta ? &lo : &hi) = mid;
+    }
+    *t = 0.5 * (lo + hi);
+    pd_osc_free_exact(c, *t, &u, v);
+    return PD_OK;
 }

@@ -44,6 +44,10 @@ double pd_osc_Le(const pd_osc *c);  /* ap / wp^2 [m] */
 /* Effective acceleration f(t) [m/s^2] of the case at time t [s]. */
 double pd_osc_excitation(const pd_osc *c, double t);
 
+/* The same in Pi units, f / ap at tau = wp t; side -1 / +1 picks the left /
+ * right limit at the pulse end tau = 2 pi. */
+double pd_osc_shape(const pd_osc *c, double tau, int side);
+
 /* Check every field; the message names the field ("eps", "gap", ...). */
 int pd_osc_check(const pd_osc *c, pd_err *err);
 
@@ -60,6 +64,9 @@ typedef struct pd_osc_opts {
 } pd_osc_opts;
 
 pd_osc_opts pd_osc_default_opts(void);
+
+/* Check the case and complete opts: dt and tend defaults, their ranges. */
+int pd_osc_resolve_opts(const pd_osc *c, const pd_osc_opts *in, pd_osc_opts *out, pd_err *err);
 double pd_osc_default_dt(const pd_osc *c);
 /* Pulses: Tp + 2 T0.  Harmonic: a transient phase (pd_osc_measure_start)
  * followed by a measuring window of max(16 Tp, 3 T0). */
@@ -134,5 +141,10 @@ int pd_osc_penalty(const pd_osc *c, const pd_osc_opts *opts, const pd_osc_penalt
 
 /* Exact response without the wall from rest (closed form), at t [s]. */
 void pd_osc_free_exact(const pd_osc *c, double t, double *u, double *v);
+
+/* First time t <= tmax at which that free response reaches the gap, found
+ * on a grid of Tp/1000 and bisected to rounding, with the speed there:
+ * PD_OK, or PD_EINVAL when it does not reach the gap by tmax. */
+int pd_osc_free_first_contact(const pd_osc *c, double tmax, double *t, double *v);
 
 #endif

@@ -221,23 +221,9 @@ static void test_osc_energy_across_impacts(pd_test_ctx *ctx)
 static void test_osc_first_impact(pd_test_ctx *ctx)
 {
     pd_osc c = {PD_PULSE_SINE, 1, 2.0, 0.5, 0.8, 0.3, 0.5, 0.05};
-    double delta = pd_osc_gap(&c), lo = 0, hi = c.Tp, u, v;
-    /* the exact free flight first reaches delta between 0 and Tp here */
-    for (double t = 0; t < 2 * c.Tp; t += c.Tp / 1000) {
-        pd_osc_free_exact(&c, t, &u, &v);
-        if (u >= delta) {
-            hi = t;
-            break;
-        }
-        lo = t;
-    }
-    for (int it = 0; it < 200; it++) {
-        double mid = 0.5 * (lo + hi);
-        pd_osc_free_exact(&c, mid, &u, &v);
-        *(u < delta ? &lo : &hi) = mid;
-    }
-    double t_star = 0.5 * (lo + hi), v_star;
-    pd_osc_free_exact(&c, t_star, &u, &v_star);
+    double t_star, v_star;
+    CHECK(ctx, pd_osc_free_first_contact(&c, 2 * c.Tp, &t_star, &v_star) == PD_OK,
+          "the free response must reach the gap");
     double et[3], ev[3];
     for (int k = 0; k < 3; k++) {
         pd_osc_opts o = pd_osc_default_opts();
