@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "pd_cli.h"
 
@@ -16,6 +17,18 @@ int pd_cli_usage_error(const char *fmt, ...)
     va_end(ap);
     fputc('\n', stderr);
     return 2;
+}
+
+int pd_cli_help(int argc, char **argv, const char *usage, int with_case)
+{
+    for (int i = 1; i < argc; i++)
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+            fputs(usage, stdout);
+            if (with_case)
+                fputs(pd_cli_case_help, stdout);
+            return 1;
+        }
+    return 0;
 }
 
 int pd_cli_double(const char *flag, const char *text, double *out)

@@ -33,12 +33,9 @@ int pd_cmd_compare(int argc, char **argv)
     pd_cli_case k;
     int json = 0, want[3] = {1, 0, 0}, rc, status = 0;
     pd_cli_case_init(&k);
+    if (pd_cli_help(argc, argv, compare_usage, 1))
+        return 0;
     for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
-            fputs(compare_usage, stdout);
-            fputs(pd_cli_case_help, stdout);
-            return 0;
-        }
         if ((rc = pd_cli_case_flag(&k, argc, argv, &i)) == 2)
             return 2;
         if (rc == 1)

@@ -349,12 +349,8 @@ int pd_cmd_converge(int argc, char **argv)
     int n = 0, rc;
     double ref_cpu = 0.0;
     pd_err err;
-    for (int i = 1; i < argc; i++)
-        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
-            fputs(converge_usage, stdout);
-            fputs(pd_cli_case_help, stdout);
-            return 0;
-        }
+    if (pd_cli_help(argc, argv, converge_usage, 1))
+        return 0;
     if ((rc = parse_args(&a, argc, argv)))
         return rc;
     if (a.ndt * a.ntheta + a.nkc > MAX_ROWS)

@@ -221,12 +221,8 @@ int pd_cmd_simulate(int argc, char **argv)
     history hist;
     pd_err err;
     int rc, status = 0;
-    for (int i = 1; i < argc; i++)
-        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
-            fputs(simulate_usage, stdout);
-            fputs(pd_cli_case_help, stdout);
-            return 0;
-        }
+    if (pd_cli_help(argc, argv, simulate_usage, 1))
+        return 0;
     if ((rc = parse_args(&a, argc, argv)))
         return rc;
     memset(&hist, 0, sizeof hist);

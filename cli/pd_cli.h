@@ -49,6 +49,10 @@ int pd_cli_run(const pd_cli_case *a, pd_method method, const pd_osc_opts *opts,
 int pd_cli_usage_error(const char *fmt, ...)
     __attribute__((format(printf, 1, 2)));
 
+/* When argv holds --help or -h: print usage (and the case flags' help when
+ * with_case) on stdout and return 1; else 0. */
+int pd_cli_help(int argc, char **argv, const char *usage, int with_case);
+
 /* Parse a finite double / an int from a flag's value; on failure print an
  * error naming the flag and return 2, else 0. */
 int pd_cli_double(const char *flag, const char *text, double *out);
