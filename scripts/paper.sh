@@ -1,0 +1,177 @@
+#!/bin/sh
+# paper.sh — the source paper's figures (Dimitrakopoulos, Makris & Kappos
+# 2010), regenerated with pound into docs/figures/paper-*.png, plus the
+# numbers docs/paper.md quotes (docs/figures/paper-*.txt).
+# Usage: scripts/paper.sh [path/to/pound]   (run from the project root)
+set -eu
+pound=${1:-build/pound}
+out=docs/figures
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+mkdir -p "$out"
+term="set terminal pngcairo size 1100,800 enhanced font 'sans,10'"
+
+# A history as "t u v" rows (CSV of pound simulate, comments dropped).
+hist() { # file args...
+    f=$1; shift
+    "$pound" simulate "$@" -o "$tmp/h.csv" > /dev/null
+    grep -v '^#' "$tmp/h.csv" | awk -F, 'NR > 1 {print $1, $2, $3}' > "$f"
+}
+
+# Rows of a spectrum CSV matching pulse, dir and a numeric column test.
+rows() { # csv pulse dir awk-condition columns...
+    csv=$1 p=$2 d=$3 cond=$4
+    grep -v '^#' "$csv" | awk -F, -v p="$p" -v d="$d" "NR > 1 && \$1 == p && \$2 == d && ($cond) {print \$10, \$12, \$15, \$16, \$11, \$13}"
+}
+
+# ---- Fig. 3: two oscillators, one dimensionless history ----------------
+# T0 = 0.5 s and 1.5 s, xi = 5 %, one-cosine pulses with Pi2 = 0.6, Pi3 = 0.2.
+hist "$tmp/f3a" --pulse cosine --ap 3 --Tp 0.3 --T0 0.5 --Pi3 0.2 --eps 0.7 --dt 0.00015
+hist "$tmp/f3b" --pulse cosine --ap 5 --Tp 0.9 --T0 1.5 --Pi3 0.2 --eps 0.7 --dt 0.00045
+gnuplot <<GP
+$term
+set output '$out/paper-fig3.png'
+set multiplot layout 2,2 title 'Fig. 3: T_0 = 0.5 s (a_p = 3 m/s^2, T_p = 0.3 s) and T_0 = 1.5 s (a_p = 5 m/s^2, T_p = 0.9 s), {/Symbol P}_2 = 0.6, {/Symbol P}_3 = 0.2, eps = 0.7'
+set grid
+set xlabel 't [s]'; set ylabel 'u [cm]'
+plot '$tmp/f3a' u 1:(100*\$2) w l lw 2 t 'T_0 = 0.5 s', '$tmp/f3b' u 1:(100*\$2) w l lw 2 t 'T_0 = 1.5 s'
+set ylabel 'du/dt [m/s]'
+plot '$tmp/f3a' u 1:3 w l lw 2 t 'T_0 = 0.5 s', '$tmp/f3b' u 1:3 w l lw 2 t 'T_0 = 1.5 s'
+set xlabel 't / T_p'; set ylabel 'u {/Symbol w}_p^2 / a_p'
+wa = 2*pi/0.3; wb = 2*pi/0.9
+plot '$tmp/f3a' u (\$1/0.3):(\$2*wa*wa/3) w l lw 4 t 'T_0 = 0.5 s', '$tmp/f3b' u (\$1/0.9):(\$2*wb*wb/5) w l lw 2 dt 2 t 'T_0 = 1.5 s'
+set ylabel '(du/dt) {/Symbol w}_p / a_p'
+plot '$tmp/f3a' u (\$1/0.3):(\$3*wa/3) w l lw 4 t 'T_0 = 0.5 s', '$tmp/f3b' u (\$1/0.9):(\$3*wb/5) w l lw 2 dt 2 t 'T_0 = 1.5 s'
+unset multiplot
+GP
+
+# ---- Fig. 4: dimensional spectra collapse in Pi terms -------------------
+"$pound" spectrum --pulse cosine --dir normal --Tp 0.5 --ap 1,3,9 --Pi3 0.05,0.5 \
+    --Pi2 0.05:5:100 --eps 0.5 --method event -o "$tmp/f4.csv" --plot "$tmp/f4.png" > "$out/paper-fig4.txt"
+cp "$tmp/f4-dim.png" "$out/paper-fig4-dimensional.png"
+cp "$tmp/f4.png" "$out/paper-fig4-collapse.png"
+
+# ---- Figs. 5, 6: sine and cosine spectra, normal and reverse, several Pi3,
+#      with the traditional gamma-vs-chi view -------------------------------
+for pulse in sine cosine; do
+    n=5; [ $pulse = cosine ] && n=6
+    "$pound" spectrum --pulse $pulse --dir normal,reverse --Pi3 0.01,0.1,0.5,1,2 --eps 0.5 \
+        --Pi2 0.05:5:120 --method event -o "$tmp/f$n.csv" > "$out/paper-fig$n.txt"
+    for d in normal reverse; do for P in 0.01 0.1 0.5 1 2; do
+        rows "$tmp/f$n.csv" $pulse $d "\$6 == $P" > "$tmp/f$n-$d-$P"
+    done; done
+    gnuplot <<GP
+$term
+set output '$out/paper-fig$n.png'
+set multiplot layout 2,2 title 'Fig. $n: one-$pulse pulse, eps = 0.5, xi = 0.05 (event-driven reference)'
+set grid; set logscale xy; set key bottom left
+set xlabel '{/Symbol P}_2 = T_p / T_0'; set ylabel '{/Symbol P}_1 = u_{max} {/Symbol w}_p^2 / a_p'
+do for [d in 'normal reverse'] {
+  set title d
+  plot for [P in '0.01 0.1 0.5 1 2'] '$tmp/f$n-'.d.'-'.P u 1:2 w l lw 2 t '{/Symbol P}_3 = '.P
+}
+unset logscale y; set key top right
+set xlabel '{/Symbol c} = gap / u_{max,free}'; set ylabel '{/Symbol g} = u_{max} / u_{max,free}'
+do for [d in 'normal reverse'] {
+  set title d.' (traditional view)'
+  plot for [P in '0.01 0.1 0.5 1 2'] '$tmp/f$n-'.d.'-'.P u 4:3 w p pt 7 ps 0.5 t '{/Symbol P}_3 = '.P
+}
+unset multiplot
+GP
+done
+
+# ---- Fig. 8: time histories in the three spectral regions ---------------
+for P2 in 0.2 1 3; do
+    hist "$tmp/f8-$P2" --pulse sine --dir normal --Tp 1 --Pi2 $P2 --Pi3 0.05 --eps 0.5 --method event --dt 0.001
+    hist "$tmp/f8f-$P2" --pulse sine --dir normal --Tp 1 --Pi2 $P2 --Pi3 0.05 --eps 0.5 --method event --dt 0.001 --no-wall
+done
+gnuplot <<GP
+$term
+set output '$out/paper-fig8.png'
+set multiplot layout 3,1 title 'Fig. 8: normal sine pulse (a_p = 1 m/s^2, T_p = 1 s), {/Symbol P}_3 = 0.05, eps = 0.5'
+set grid; set ylabel 'u / L_e'; set xlabel 't / T_p'
+L = 1/(2*pi)**2
+do for [P in '0.2 1 3'] {
+  set title '{/Symbol P}_2 = '.P
+  plot '$tmp/f8-'.P u 1:(\$2/L) w l lw 2 t 'with the wall', '$tmp/f8f-'.P u 1:(\$2/L) w l lw 1 dt 2 t 'without', 0.05 w l lc rgb 'black' t 'wall'
+}
+unset multiplot
+GP
+
+# ---- Fig. 9: T0 = 3 s, Tp = 0.3 s, gap 4 mm, normal vs reverse ----------
+for d in normal reverse; do
+    hist "$tmp/f9-$d" --pulse sine --dir $d --Tp 0.3 --T0 3 --ap 4 --gap 0.004 --eps 0.6 --method event --dt 0.001
+    "$pound" simulate --pulse sine --dir $d --Tp 0.3 --T0 3 --ap 4 --gap 0.004 --eps 0.6 --method event > "$tmp/f9-$d.txt"
+done
+cat "$tmp/f9-normal.txt" "$tmp/f9-reverse.txt" > "$out/paper-fig9.txt"
+gnuplot <<GP
+$term
+set output '$out/paper-fig9.png'
+set multiplot layout 2,1 title 'Fig. 9: T_0 = 3 s, one-sine pulse T_p = 0.3 s, a_p = 4 m/s^2, gap 4 mm, eps = 0.6'
+set grid; set xlabel 't [s]'; set ylabel 'u [cm]'
+set title 'normal'; plot '$tmp/f9-normal' u 1:(100*\$2) w l lw 2 t '', 0.4 w l lc rgb 'black' t 'wall'
+set title 'reverse'; plot '$tmp/f9-reverse' u 1:(100*\$2) w l lw 2 t '', 0.4 w l lc rgb 'black' t 'wall'
+unset multiplot
+GP
+
+# ---- Fig. 10: eps across [0, 1] ------------------------------------------
+"$pound" spectrum --pulse sine,cosine --dir normal,reverse --Pi3 0.05 --eps 0,0.25,0.5,0.75,1 \
+    --Pi2 0.05:5:120 --method event -o "$tmp/f10.csv" > "$out/paper-fig10.txt"
+for p in sine cosine; do for d in normal reverse; do for e in 0 0.25 0.5 0.75 1; do
+    rows "$tmp/f10.csv" $p $d "\$8 == $e" > "$tmp/f10-$p-$d-$e"
+done; done; done
+gnuplot <<GP
+$term
+set output '$out/paper-fig10.png'
+set multiplot layout 2,2 title 'Fig. 10: {/Symbol P}_3 = 0.05, xi = 0.05, eps from 0 to 1'
+set grid; set logscale xy; set key bottom left
+set xlabel '{/Symbol P}_2'; set ylabel '{/Symbol P}_1'
+do for [p in 'sine cosine'] { do for [d in 'normal reverse'] {
+  set title p.', '.d
+  plot for [e in '0 0.25 0.5 0.75 1'] '$tmp/f10-'.p.'-'.d.'-'.e u 1:2 w l lw 2 t 'eps = '.e
+} }
+unset multiplot
+GP
+
+# ---- Fig. 11: Pi2 = 1.16, one-cosine reverse, eps = 0.2 vs 1.0 -----------
+for P3 in 0.3 0.05; do for e in 0.2 1; do
+    hist "$tmp/f11-$P3-$e" --pulse cosine --dir reverse --Tp 1 --Pi2 1.16 --Pi3 $P3 --eps $e --method event --dt 0.001
+done; done
+gnuplot <<GP
+$term
+set output '$out/paper-fig11.png'
+set multiplot layout 2,2 title 'Fig. 11: {/Symbol P}_2 = 1.16, one-cosine reverse pulse (T_p = 1 s): eps = 0.2 against eps = 1'
+set grid; set xlabel 't / T_p'
+L = 1/(2*pi)**2; V = 1/(2*pi)
+do for [P in '0.3 0.05'] {
+  set title '{/Symbol P}_3 = '.P; set ylabel 'u / L_e'
+  plot '$tmp/f11-'.P.'-0.2' u 1:(\$2/L) w l lw 2 t 'eps = 0.2', '$tmp/f11-'.P.'-1' u 1:(\$2/L) w l lw 2 t 'eps = 1', P+0 w l lc rgb 'black' t 'wall'
+}
+do for [P in '0.3 0.05'] {
+  set title '{/Symbol P}_3 = '.P; set ylabel '(du/dt) / (a_p / {/Symbol w}_p)'
+  plot '$tmp/f11-'.P.'-0.2' u 1:(\$3/V) w l lw 2 t 'eps = 0.2', '$tmp/f11-'.P.'-1' u 1:(\$3/V) w l lw 2 t 'eps = 1'
+}
+unset multiplot
+GP
+
+# ---- Fig. 12: harmonic steady state, Pi3 = 0.001, subharmonic peaks -------
+"$pound" spectrum --pulse harmonic --dir normal --Pi3 0.001 --eps 0.3,0.6,0.9 \
+    --Pi2 0.1:1.25:200 --method event -o "$tmp/f12.csv" > "$out/paper-fig12.txt"
+for e in 0.3 0.6 0.9; do rows "$tmp/f12.csv" harmonic normal "\$8 == $e" > "$tmp/f12-$e"; done
+gnuplot <<GP
+$term
+set output '$out/paper-fig12.png'
+set title 'Fig. 12: harmonic excitation, steady state, {/Symbol P}_3 = 0.001, xi = 0.05'
+set grid; set logscale y; set key top left
+set xlabel '1/{/Symbol P}_2 = T_0 / T_p'; set ylabel '{/Symbol P}_1 (steady state)'
+set xtics 1
+plot for [e in '0.3 0.6 0.9'] '$tmp/f12-'.e u (1/\$1):2 w l lw 2 t 'eps = '.e
+GP
+# the largest Pi1 within 0.7 of 1/Pi2 = 2, 4, 6, 8 (the subharmonic peaks)
+for e in 0.3 0.6 0.9; do
+    awk -v e=$e '{x[NR] = 1/$1; y[NR] = $2} END {printf "eps %s: peaks of Pi1 near 1/Pi2 = 2,4,6,8 at", e;
+        for (k = 2; k <= 8; k += 2) {b = 0; for (i = 1; i <= NR; i++) if (x[i] > k - 0.7 && x[i] < k + 0.7 && y[i] > b) {b = y[i]; bx = x[i]}
+            printf " %.2f (Pi1 %.3g)", bx, b} print ""}' "$tmp/f12-$e"
+done >> "$out/paper-fig12.txt"
+
+echo "paper figures written to $out/paper-*.png"
