@@ -6,6 +6,9 @@
 #   make bench    performance figures (pound bench)
 #   make figures  docs/figures/*.png (convergence, stability, energy)
 #   make all      library and binary only (build/libpound.a, build/pound)
+#   make MPI=1    the MPI build (OpenMPI's mpicc, -DPD_MPI) in build-mpi/:
+#                 mpirun -np K build-mpi/pound spectrum ...
+#   make OPENMP=  without OpenMP (spectrum then runs one thread)
 #
 # Layers: cli -> problems -> engine -> lcp; HDF5 is used by cli/ only.
 
@@ -14,6 +17,18 @@ OPT     ?= -O2
 CFLAGS  ?= $(OPT) -g
 WARN     = -std=c11 -Wall -Wextra -Wshadow -Wpedantic -Werror
 DEFS     = -D_POSIX_C_SOURCE=200809L
+OPENMP  ?= -fopenmp
+
+# The MPI build: a separate binary, so that the plain build never runs as
+# several copies that would each write the whole sweep.
+ifeq ($(MPI),1)
+ifeq ($(shell command -v mpicc 2>/dev/null),)
+$(error MPI=1 needs OpenMPI's mpicc: apt-get install libopenmpi-dev openmpi-bin)
+endif
+CC       = mpicc
+BUILD   ?= build-mpi
+DEFS    += -DPD_MPI
+endif
 BUILD   ?= build
 
 # Dependencies through pkg-config (Debian's SuiteSparse 5 ships no .pc file;
@@ -25,7 +40,7 @@ SS_CFLAGS   := $(shell pkg-config --cflags cholmod 2>/dev/null || echo -I/usr/in
 SS_LIBS     := $(shell pkg-config --libs cholmod cxsparse 2>/dev/null || echo -lcholmod -lcxsparse)
 
 INC      = -Ilcp -Iengine -Iproblems -Icli
-ALL_CFLAGS = $(WARN) $(DEFS) $(CFLAGS) $(INC) $(PKG_CFLAGS) $(SS_CFLAGS) $(XCFLAGS)
+ALL_CFLAGS = $(WARN) $(DEFS) $(CFLAGS) $(OPENMP) $(INC) $(PKG_CFLAGS) $(SS_CFLAGS) $(XCFLAGS)
 LIBS     = $(PKG_LIBS) $(SS_LIBS) -lm
 
 LIB_SRC  = $(wildcard lcp/*.c) $(wildcard engine/*.c) $(wildcard problems/*.c)
@@ -36,7 +51,7 @@ CLI_OBJ  = $(CLI_SRC:%.c=$(BUILD)/%.o)
 TEST_OBJ = $(TEST_SRC:%.c=$(BUILD)/%.o)
 HDRS     = $(wildcard */*.h)
 
-.PHONY: all deps demo test check asan bench clean acceptance figures
+.PHONY: all deps demo test check asan bench clean acceptance figures paper
 
 all: $(BUILD)/pound $(BUILD)/pound_tests
 
@@ -51,11 +66,11 @@ $(BUILD)/libpound.a: $(LIB_OBJ)
 
 $(BUILD)/pound: $(CLI_OBJ) $(BUILD)/libpound.a
 	@echo "  LD    $@"
-	@$(CC) $(CFLAGS) $(XCFLAGS) -o $@ $(CLI_OBJ) $(BUILD)/libpound.a $(XOBJ) $(LIBS)
+	@$(CC) $(CFLAGS) $(OPENMP) $(XCFLAGS) -o $@ $(CLI_OBJ) $(BUILD)/libpound.a $(XOBJ) $(LIBS)
 
 $(BUILD)/pound_tests: $(TEST_OBJ) $(BUILD)/libpound.a
 	@echo "  LD    $@"
-	@$(CC) $(CFLAGS) $(XCFLAGS) -o $@ $(TEST_OBJ) $(BUILD)/libpound.a $(XOBJ) $(LIBS)
+	@$(CC) $(CFLAGS) $(OPENMP) $(XCFLAGS) -o $@ $(TEST_OBJ) $(BUILD)/libpound.a $(XOBJ) $(LIBS)
 
 deps:
 	@sh scripts/deps.sh
@@ -83,9 +98,14 @@ bench: deps
 figures: deps
 	@$(MAKE) --no-print-directory all
 	sh scripts/figures.sh $(BUILD)/pound
+	sh scripts/paper.sh $(BUILD)/pound
+
+paper: deps
+	@$(MAKE) --no-print-directory all
+	sh scripts/paper.sh $(BUILD)/pound
 
 acceptance: all
 	@for s in ../shared/acceptance/*.sh; do echo "== $$s"; $$s $(BUILD)/pound || exit 1; done
 
 clean:
-	rm -rf build build-asan
+	rm -rf build build-asan build-mpi

@@ -2,6 +2,7 @@
 #include <string.h>
 
 #include "pd_cli.h"
+#include "pd_spectrum.h"
 
 static const char usage[] =
     "usage: pound <command> [options]\n"
@@ -10,8 +11,9 @@ static const char usage[] =
     "  simulate   one run of the pounding oscillator (Moreau-Jean, event-driven, penalty)\n"
     "  compare    Moreau-Jean (and penalty) against the event-driven reference\n"
     "  converge   errors and cost as dt shrinks; work-precision charts\n"
+    "  spectrum   response spectra Pi1(Pi2) over lists of Pi3, eps, xi, pulses (OpenMP, MPI)\n"
     "  lcp FILE   solve one linear complementarity problem (Lemke)\n"
-    "  bench      performance figures (--lcp, --engine)\n"
+    "  bench      performance figures (--lcp, --engine, --spectrum)\n"
     "\n"
     "`pound <command> --help` lists a command's options; docs/ has the details.\n";
 
@@ -30,6 +32,8 @@ int main(int argc, char **argv)
         return pd_cmd_compare(argc - 1, argv + 1);
     if (!strcmp(cmd, "converge"))
         return pd_cmd_converge(argc - 1, argv + 1);
+    if (!strcmp(cmd, "spectrum"))
+        return pd_cmd_spectrum(argc - 1, argv + 1);
     if (!strcmp(cmd, "bench"))
         return pd_cmd_bench(argc - 1, argv + 1);
     return pd_cli_usage_error("unknown command '%s' (try `pound --help`)", cmd);

@@ -1,10 +1,12 @@
 #!/bin/sh
 # deps.sh — make sure the Debian packages pound needs are installed.
 # As root, installs what is missing; otherwise prints the one apt-get line
-# needed and fails.  Usage: scripts/deps.sh [--ci]   (--ci adds CI-only tools)
+# needed and fails.  Usage: scripts/deps.sh [--ci]   (--ci adds CI-only tools:
+# python3, and OpenMPI for the MPI build `make MPI=1`, which the quick start
+# does not need)
 set -u
 pkgs="gcc make pkg-config libgsl-dev libsuitesparse-dev libhdf5-dev hdf5-tools gnuplot-nox"
-[ "${1:-}" = "--ci" ] && pkgs="$pkgs python3"
+[ "${1:-}" = "--ci" ] && pkgs="$pkgs python3 libopenmpi-dev openmpi-bin"
 missing=""
 for p in $pkgs; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

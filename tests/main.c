@@ -78,6 +78,7 @@ int main(int argc, char **argv)
     suite_reference(&ctx);
     suite_paper(&ctx);
     suite_cli(&ctx);
+    suite_spectrum(&ctx);
 
     printf("%d passed, %d failed, %d skipped\n", ctx.passed, ctx.failed, ctx.skipped);
     return ctx.failed ? 1 : 0;

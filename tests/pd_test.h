@@ -43,5 +43,6 @@ void suite_penalty(pd_test_ctx *ctx);
 void suite_reference(pd_test_ctx *ctx);
 void suite_paper(pd_test_ctx *ctx);
 void suite_cli(pd_test_ctx *ctx);
+void suite_spectrum(pd_test_ctx *ctx);
 
 #endif

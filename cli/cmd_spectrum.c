@@ -1,0 +1,358 @@
+/* cmd_spectrum.c — `pound spectrum`: pounding response spectra, Pi1 (and
+ * gamma, chi) against Pi2 over lists of the other parameters, computed in
+ * parallel (OpenMP threads; MPI ranks in the MPI build), journaled so that
+ * an interrupted sweep resumes (--resume). */
+#include <fcntl.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "pd_output.h"
+#include "pd_spectrum.h"
+
+static const char spectrum_usage[] =
+    "usage: pound spectrum --Pi2 MIN:MAX:N [--linear] [model flags without --T0/--Pi2]\n"
+    "                      [--Pi3 LIST | --gap LIST] [--eps LIST] [--xi LIST] [--pulse LIST]\n"
+    "                      [--dir LIST] [--ap LIST] [--method moreau|event|penalty]\n"
+    "                      [--dt H | --dt-per-Tp N] [-o FILE.h5|FILE.csv] [--plot FILE.png]\n"
+    "                      [--json] [--resume] [--threads K]\n"
+    "  --Pi2 MIN:MAX:N  N values of Pi2 = Tp/T0, log-spaced (--linear: equal steps)\n"
+    "  LIST             comma-separated values; the sweep is every combination\n"
+    "                   (one curve per pulse, dir, ap, xi, Pi3 or gap, eps)\n"
+    "  --ap LIST        the dimensional view: umax [m] against T0 [s] per amplitude, at the\n"
+    "                   same Pi3 (or the same gap in metres with --gap); --Tp T sets Tp\n"
+    "  --dt-per-Tp N    dt = Tp/N for every point [default: dt = min(Tp, T0)/2000]\n"
+    "  -o FILE          HDF5 (one group per curve) or CSV (one row per point); while it runs,\n"
+    "                   FILE.partial journals the finished points\n"
+    "  --resume         continue an interrupted sweep from FILE.partial (same flags)\n"
+    "  --plot F.png     Pi1 vs Pi2 in F.png, gamma vs Pi2 in F-gamma.png (and with --ap,\n"
+    "                   umax [cm] vs T0 in F-dim.png)\n"
+    "  --threads K      OpenMP threads [OMP_NUM_THREADS or all cores]\n"
+    "  --json           {\"points\": [...], \"cpu_s\": ..., \"wall_s\": ...} on stdout\n"
+    "MPI: make MPI=1, then mpirun -np K build-mpi/pound spectrum ... (rank 0 writes)\n";
+
+/* Everything the command line sets. */
+typedef struct spec_args {
+    pd_spectrum s;
+    const char *out, *plot;
+    int json, resume, threads, have_pi2, have_pi3, have_gap;
+    long stop_after;
+} spec_args;
+
+/* The next comma-separated token of *p into tok: 0, or -1 when empty or
+ * too long. */
+static int next_token(const char **p, char *tok, size_t cap)
+{
+    size_t len = strcspn(*p, ",");
+    if (len == 0 || len >= cap)
+        return -1;
+    memcpy(tok, *p, len);
+    tok[len] = '\0';
+    *p += len + ((*p)[len] == ',');
+    return 0;
+}
+
+/* "a,b,c" -> up to PD_SPEC_MAX_LIST finite numbers: 0 or 2. */
+static int parse_nums(const char *flag, const char *text, double *x, int *n)
+{
+    char tok[64];
+    const char *p = text;
+    *n = 0;
+    if (!text || !*text)
+        return pd_cli_usage_error("%s needs a comma-separated list of numbers", flag);
+    while (*p) {
+        if (next_token(&p, tok, sizeof tok))
+            return pd_cli_usage_error("%s: '%s' is not a list of numbers", flag, text);
+        if (*n >= PD_SPEC_MAX_LIST)
+            return pd_cli_usage_error("%s: at most %d values", flag, PD_SPEC_MAX_LIST);
+        if (pd_cli_double(flag, tok, &x[(*n)++]))
+            return 2;
+    }
+    return text[strlen(text) - 1] == ',' ? pd_cli_usage_error("%s: '%s' ends in a comma", flag, text)
+                                         : 0;
+}
+
+/* "sine,cosine" -> pulses, or "normal,reverse" -> directivities: 0 or 2. */
+static int parse_names(const char *flag, const char *text, int is_pulse, int *out, int *n,
+                       int cap)
+{
+    char tok[32];
+    const char *p = text;
+    *n = 0;
+    if (!text || !*text || text[strlen(text) - 1] == ',')
+        return pd_cli_usage_error("%s needs a comma-separated list of names", flag);
+    while (*p) {
+        pd_pulse pulse;
+        int bad = next_token(&p, tok, sizeof tok) || *n >= cap;
+        if (!bad && is_pulse && !(bad = pd_pulse_parse(tok, &pulse) != 0))
+            out[*n] = (int)pulse;
+        else if (!bad && !is_pulse)
+            bad = pd_dir_parse(tok, &out[*n]) != 0;
+        if (bad)
+            return pd_cli_usage_error("%s: '%s' is not a list of %s", flag, text,
+                                      is_pulse ? "sine, cosine, harmonic" : "normal, reverse");
+        (*n)++;
+    }
+    return 0;
+}
+
+/* "MIN:MAX:N": 0 < MIN < MAX with N >= 2, or MIN = MAX with N = 1. */
+static int parse_pi2(spec_args *a, const char *text)
+{
+    char buf[256], *p1, *p2;
+    pd_spectrum *s = &a->s;
+    if (!text || strlen(text) >= sizeof buf || !(p1 = strchr(strcpy(buf, text), ':')) ||
+        !(p2 = strchr(p1 + 1, ':')))
+        return pd_cli_usage_error("--Pi2: spectrum sweeps Pi2: give MIN:MAX:N (got '%s'; "
+                                  "`pound simulate --Pi2 X` runs one value)",
+                                  text ? text : "");
+    *p1 = *p2 = '\0';
+    if (pd_cli_double("--Pi2", buf, &s->pi2_min) || pd_cli_double("--Pi2", p1 + 1, &s->pi2_max) ||
+        pd_cli_int("--Pi2", p2 + 1, &s->npi2))
+        return 2;
+    if (!(s->pi2_min > 0.0) || s->npi2 < 1 || s->npi2 > 1000000 ||
+        (s->npi2 == 1 ? s->pi2_max != s->pi2_min : !(s->pi2_max > s->pi2_min)))
+        return pd_cli_usage_error("--Pi2: need 0 < MIN < MAX and 2 <= N <= 1e6, or MIN = MAX "
+                                  "with N = 1 (got %s)",
+                                  text);
+    a->have_pi2 = 1;
+    return 0;
+}
+
+/* A list flag of the sweep: 1 consumed, 0 not one, 2 error. */
+static int list_flag(spec_args *a, const char *f, const char *val)
+{
+    pd_spectrum *s = &a->s;
+    int names[3], rc;
+    if (!strcmp(f, "--Pi3") || !strcmp(f, "--gap")) {
+        a->have_pi3 |= !strcmp(f, "--Pi3");
+        a->have_gap |= !strcmp(f, "--gap");
+        s->size_is_gap = !strcmp(f, "--gap");
+        rc = parse_nums(f, val, s->size, &s->nsize);
+    } else if (!strcmp(f, "--eps"))
+        rc = parse_nums(f, val, s->eps, &s->neps);
+    else if (!strcmp(f, "--xi"))
+        rc = parse_nums(f, val, s->xi, &s->nxi);
+    else if (!strcmp(f, "--ap")) {
+        s->dimensional = 1;
+        rc = parse_nums(f, val, s->ap, &s->nap);
+    } else if (!strcmp(f, "--pulse")) {
+        if (!(rc = parse_names(f, val, 1, names, &s->npulse, 3)))
+            for (int i = 0; i < s->npulse; i++)
+                s->pulse[i] = (pd_pulse)names[i];
+    } else if (!strcmp(f, "--dir"))
+        rc = parse_names(f, val, 0, s->dir, &s->ndir, 2);
+    else
+        return 0;
+    return rc ? 2 : 1;
+}
+
+/* The command's own flags: 1 consumed (*i advanced past a value), 0 not
+ * one, 2 error. */
+static int own_flag(spec_args *a, int argc, char **argv, int *i)
+{
+    const char *f = argv[*i], *val = *i + 1 < argc ? argv[*i + 1] : NULL;
+    int n, rc;
+    if (!strcmp(f, "--json") || !strcmp(f, "--resume") || !strcmp(f, "--linear")) {
+        a->json |= !strcmp(f, "--json");
+        a->resume |= !strcmp(f, "--resume");
+        a->s.linear |= !strcmp(f, "--linear");
+        return 1;
+    }
+    if (!strcmp(f, "--T0"))
+        return pd_cli_usage_error("--T0: spectrum sweeps Pi2 = Tp/T0: give --Pi2 MIN:MAX:N");
+    if (!strcmp(f, "--no-wall"))
+        return pd_cli_usage_error("--no-wall: spectrum runs the no-wall twin of every point "
+                                  "itself (umax_free)");
+    if (!strcmp(f, "--Pi2"))
+        rc = parse_pi2(a, val);
+    else if (!strcmp(f, "-o") || !strcmp(f, "--plot")) {
+        if (!val)
+            return pd_cli_usage_error("%s needs a file name", f);
+        *(!strcmp(f, "-o") ? &a->out : &a->plot) = val;
+        rc = 0;
+    } else if (!strcmp(f, "--dt-per-Tp")) {
+        if (!(rc = pd_cli_double(f, val, &a->s.dt_per_Tp)) && !(a->s.dt_per_Tp > 0.0))
+            rc = pd_cli_usage_error("--dt-per-Tp: must be > 0 (got %g)", a->s.dt_per_Tp);
+    } else if (!strcmp(f, "--threads")) {
+        if (!(rc = pd_cli_int(f, val, &a->threads)) && (a->threads < 1 || a->threads > 4096))
+            rc = pd_cli_usage_error("--threads: must be in [1, 4096] (got %d)", a->threads);
+    } else if (!strcmp(f, "--stop-after")) { /* test hook: die after K finished runs */
+        if (!(rc = pd_cli_int(f, val, &n)) && n < 1)
+            rc = pd_cli_usage_error("--stop-after: must be >= 1 (got %d)", n);
+        a->stop_after = n;
+    } else if ((rc = list_flag(a, f, val)) != 1)
+        return rc;
+    else
+        rc = 0;
+    (*i)++;
+    return rc ? 2 : 1;
+}
+
+/* Cross-flag rules once every flag is read: 0 or 2. */
+static int check_args(spec_args *a)
+{
+    pd_spectrum *s = &a->s;
+    pd_err err;
+    if (!a->have_pi2)
+        return pd_cli_usage_error("spectrum: --Pi2 MIN:MAX:N is required");
+    if (a->have_pi3 && a->have_gap)
+        return pd_cli_usage_error("--gap and --Pi3 are alternatives: give one");
+    if (s->dt_per_Tp > 0.0 && s->base.have_dt)
+        return pd_cli_usage_error("--dt and --dt-per-Tp are alternatives: give one");
+    if (a->resume && !a->out)
+        return pd_cli_usage_error("--resume needs -o FILE (the sweep's journal is FILE.partial)");
+    if (a->stop_after && !a->out)
+        return pd_cli_usage_error("--stop-after needs -o FILE");
+    if (a->plot && (strlen(a->plot) < 5 || strcmp(a->plot + strlen(a->plot) - 4, ".png")))
+        return pd_cli_usage_error("--plot: '%s' must end in .png", a->plot);
+    if (a->out && pd_output_check_path(a->out, &err))
+        return pd_cli_usage_error("%s", err.msg);
+    if (pd_spec_tasks(s) > PD_SPEC_MAX_TASKS)
+        return pd_cli_usage_error("--Pi2: %ld runs in this sweep, at most %ld", pd_spec_tasks(s),
+                                  PD_SPEC_MAX_TASKS);
+    return pd_spec_validate(s);
+}
+
+/* Every flag, then the cross-flag rules and every point checked: 0 or 2. */
+static int parse_args(spec_args *a, int argc, char **argv)
+{
+    int rc;
+    memset(a, 0, sizeof *a);
+    pd_spec_init(&a->s);
+    for (int i = 1; i < argc; i++) {
+        if ((rc = own_flag(a, argc, argv, &i)) == 1)
+            continue;
+        if (rc == 2 || (rc = pd_cli_case_flag(&a->s.base, argc, argv, &i)) == 2)
+            return 2;
+        if (rc == 0)
+            return pd_cli_usage_error("spectrum: unknown flag '%s' (see pound spectrum --help)",
+                                      argv[i]);
+    }
+    return check_args(a);
+}
+
+/* Parse on every rank; only rank 0 prints the error (same argv, same
+ * verdict everywhere). */
+static int parse_on_rank(spec_args *a, int argc, char **argv, int rank)
+{
+    int saved = -1, rc;
+    if (rank > 0) {
+        fflush(stderr);
+        saved = dup(2);
+        int nul = open("/dev/null", O_WRONLY);
+        if (nul >= 0) {
+            dup2(nul, 2);
+            close(nul);
+        }
+    }
+    rc = parse_args(a, argc, argv);
+    if (saved >= 0) {
+        fflush(stderr);
+        dup2(saved, 2);
+        close(saved);
+    }
+    return rc;
+}
+
+/* Rank 0: the journal (read back with --resume): 0, 1 or 2. */
+static int open_journal(const spec_args *a, pd_spec_journal *j, pd_spec_result *res,
+                        long *loaded)
+{
+    pd_err err;
+    char *key = pd_spec_key(&a->s);
+    int rc = key ? pd_spec_journal_open(j, a->out, key, pd_spec_tasks(&a->s), a->resume, res,
+                                        loaded, &err)
+                 : pd_err_set(&err, PD_ENOMEM, "out of memory");
+    free(key);
+    if (rc)
+        fprintf(stderr, "pound: %s\n", err.msg);
+    return rc == 0 ? 0 : rc == PD_EINVAL ? 2 : 1;
+}
+
+/* Rank 0: rows, the file (then the journal goes), charts, the summary. */
+static int write_results(const spec_args *a, const pd_spec_result *res, pd_spec_journal *j,
+                         const pd_spec_totals *t)
+{
+    pd_err err;
+    int rc = 0;
+    pd_spec_row *rows = malloc((size_t)pd_spec_points(&a->s) * sizeof *rows);
+    if (!rows) {
+        fprintf(stderr, "pound: spectrum: out of memory for the rows\n");
+        return 1;
+    }
+    pd_spec_rows(&a->s, res, rows);
+    if (a->out && (rc = pd_spec_write(a->out, &a->s, rows, &err)) == 0)
+        pd_spec_journal_close(j, 1); /* the file is in place: the journal has served */
+    if (!rc && a->plot)
+        rc = pd_spec_plot(a->plot, &a->s, rows, &err);
+    if (rc)
+        fprintf(stderr, "pound: spectrum: %s\n", err.msg);
+    else if (a->json)
+        pd_spec_print_json(&a->s, rows, t);
+    else
+        pd_spec_print_text(&a->s, rows, t);
+    rc = rc ? 1 : 0;
+    free(rows);
+    return rc;
+}
+
+/* Compute and (rank 0) write; the exit status, the same on every rank. */
+static int sweep(spec_args *a, int rank, int size, double wall0)
+{
+    pd_spec_journal j = {-1, "", 0.0, 0};
+    pd_spec_exec ex = {a->threads, rank == 0 && isatty(2), a->stop_after, NULL, rank, size};
+    pd_spec_totals t = {0.0, 0.0, 0.0, pd_spec_tasks(&a->s), 0, pd_spec_threads(a->threads), size};
+    pd_spec_result *res = calloc((size_t)t.runs, sizeof *res);
+    pd_err err;
+    int status = res ? 0 : 1;
+    if (rank == 0 && !status && a->out)
+        status = open_journal(a, &j, res, &t.resumed);
+    pd_spec_mpi_agree(&status);
+    if (!status && pd_spec_mpi_bcast_done(res, t.runs))
+        status = 1;
+    if (!status) {
+        ex.journal = a->out ? &j : NULL;
+        int rc = pd_spec_compute(&a->s, &ex, res, &err);
+        if (rc && rank == 0)
+            fprintf(stderr, "pound: spectrum: %s\n", err.msg);
+        status = rc == 0 ? 0 : rc == PD_EINVAL ? 2 : 1;
+    }
+    pd_spec_mpi_agree(&status);
+    for (long k = 0; k < t.runs && res; k++) {
+        t.cpu_s += res[k].cpu_s;
+        t.steps += (double)res[k].steps;
+    }
+    t.wall_s = pd_wall_seconds() - wall0;
+    if (rank == 0 && !status)
+        status = write_results(a, res, &j, &t);
+    pd_spec_journal_close(&j, 0);
+    pd_spec_mpi_agree(&status);
+    free(res);
+    return status;
+}
+
+int pd_cmd_spectrum(int argc, char **argv)
+{
+    spec_args *a;
+    int rank = 0, size = 1, threaded = 1, rc;
+    for (int i = 1; i < argc; i++)
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+            fputs(spectrum_usage, stdout);
+            fputs(pd_cli_case_help, stdout);
+            return 0;
+        }
+    if ((rc = pd_spec_mpi_init(&rank, &size, &threaded)))
+        return rc;
+    double wall0 = pd_wall_seconds();
+    if (!(a = malloc(sizeof *a)))
+        rc = 1;
+    else if (!(rc = parse_on_rank(a, argc, argv, rank))) {
+        if (!threaded)
+            a->threads = 1; /* MPI without thread support: one thread per rank */
+        rc = sweep(a, rank, size, wall0);
+    }
+    free(a);
+    pd_spec_mpi_finalize();
+    return rc;
+}

@@ -1,0 +1,201 @@
+/* pd_spectrum.h — (cli) pounding response spectra: a Pi2 grid crossed with
+ * lists of pulse, directivity, amplitude, damping, gap and restitution.
+ *
+ * Tasks.  A sweep is a list of independent, deterministic runs ("tasks"):
+ * first the no-wall twins, one per (pulse, dir, ap, xi, Pi2) — they do not
+ * depend on the gap or on eps — then the runs with the wall, one per point.
+ * Task results go into a preallocated array indexed by task, so the order in
+ * which threads or MPI ranks finish never changes a number: any split of the
+ * tasks gives output bit-identical to the serial run.
+ *
+ * Curves and points.  A curve is one (pulse, dir, ap, xi, Pi3 or gap, eps);
+ * curve indices run with eps fastest, then the gap, xi, ap, dir, pulse.
+ * Point p = curve * npi2 + j is the curve's j-th Pi2 value. */
+#ifndef PD_SPECTRUM_H
+#define PD_SPECTRUM_H
+
+#include "pd_cli.h"
+
+enum { PD_SPEC_MAX_LIST = 64 };
+
+/* `pound spectrum` (cmd_spectrum.c): the exit status. */
+int pd_cmd_spectrum(int argc, char **argv);
+
+/* Most tasks a sweep may have (memory for results and journal). */
+#define PD_SPEC_MAX_TASKS 2000000L
+
+/* The sweep as the command line defines it. */
+typedef struct pd_spectrum {
+    pd_cli_case base; /* Tp, scheme, method and penalty flags (lists override) */
+    double pi2_min, pi2_max;
+    int npi2, linear; /* linear: equal steps; else log-spaced */
+    int npulse, ndir, nap, nxi, nsize, neps;
+    pd_pulse pulse[3];
+    int dir[2];
+    double ap[PD_SPEC_MAX_LIST], xi[PD_SPEC_MAX_LIST];
+    double size[PD_SPEC_MAX_LIST], eps[PD_SPEC_MAX_LIST];
+    int size_is_gap; /* size[] holds gaps in metres (--gap), else Pi3 values */
+    int dimensional; /* --ap given: add the dimensional view (umax vs T0) */
+    double dt_per_Tp; /* > 0: dt = Tp / dt_per_Tp for every point */
+} pd_spectrum;
+
+/* Where a task sits in the sweep. */
+typedef struct pd_spec_coords {
+    int twin; /* 1: the no-wall twin of a (pulse, dir, ap, xi, Pi2) */
+    int pulse, dir, ap, xi, size, eps, j;
+    long curve; /* -1 for a twin */
+} pd_spec_coords;
+
+/* What one task measured (in metres and seconds). */
+typedef struct pd_spec_result {
+    double umax, u_toward, u_away, contact_time, first_impact, cpu_s;
+    long impacts, steps;
+    int status; /* 0 ok, else the run's PD_E* status */
+    int done;   /* 1 once computed (or read back from the journal) */
+} pd_spec_result;
+
+/* One point of the spectrum, ready for output. */
+typedef struct pd_spec_row {
+    pd_osc c;
+    long curve;
+    double T0, gap, dt, tend;
+    double umax, Pi1, umax_free, gamma, chi, u_toward, u_away, contact_time, first_impact;
+    double cpu_s;
+    long impacts, steps;
+} pd_spec_row;
+
+/* ---- the sweep (spectrum_sweep.c) ---------------------------------------- */
+
+/* Defaults: one sine pulse, normal, ap = 1, Tp = 1, xi = 0.05, Pi3 = 0.05,
+ * eps = 0.5; no Pi2 grid yet (npi2 = 0). */
+void pd_spec_init(pd_spectrum *s);
+long pd_spec_curves(const pd_spectrum *s);
+long pd_spec_points(const pd_spectrum *s);
+long pd_spec_twins(const pd_spectrum *s);
+long pd_spec_tasks(const pd_spectrum *s);
+/* The j-th Pi2 of the grid (end points exact). */
+double pd_spec_pi2(const pd_spectrum *s, int j);
+void pd_spec_coords_of(const pd_spectrum *s, long task, pd_spec_coords *co);
+/* The twin task of a point task. */
+long pd_spec_twin_of(const pd_spectrum *s, long task);
+/* The case of a task, finished as `pound simulate` would finish it: 0, or
+ * 2 after printing an error naming the flag (never after pd_spec_validate). */
+int pd_spec_case(const pd_spectrum *s, long task, pd_cli_case *k);
+/* Check every point's case (errors name the flag): 0 or 2. */
+int pd_spec_validate(const pd_spectrum *s);
+/* Expected cost of a task: its number of steps. */
+double pd_spec_cost(const pd_spectrum *s, long task);
+/* A canonical text of every parameter that shapes the results (the
+ * journal header); malloc'd, NULL when out of memory. */
+char *pd_spec_key(const pd_spectrum *s);
+/* Points from task results (twins give umax_free, gamma, chi). */
+void pd_spec_rows(const pd_spectrum *s, const pd_spec_result *res, pd_spec_row *rows);
+/* A short label of a curve naming the parameters that vary. */
+void pd_spec_curve_label(const pd_spectrum *s, long curve, char *buf, size_t cap);
+
+/* ---- the journal of finished tasks (spectrum_journal.c) ------------------ */
+
+typedef struct pd_spec_journal {
+    int fd;
+    char path[4096];
+    double last_sync;
+    int failed; /* an append failed: warned once, the sweep goes on */
+} pd_spec_journal;
+
+/* Open OUT.partial: with resume, read back the finished tasks (res[t].done)
+ * whose header matches key, dropping a torn last line; without resume,
+ * create it (an existing one is an error: PD_EINVAL, as is a header that
+ * does not match or a journal locked by a running sweep). */
+int pd_spec_journal_open(pd_spec_journal *j, const char *out, const char *key, long ntasks,
+                         int resume, pd_spec_result *res, long *loaded, pd_err *err);
+/* Append one finished task as one checksummed line (written at once,
+ * fdatasync'd at most once a second): 0 or -1. */
+int pd_spec_journal_append(pd_spec_journal *j, long task, const pd_spec_result *r);
+/* Close; remove the file when remove is set. */
+void pd_spec_journal_close(pd_spec_journal *j, int remove);
+
+/* ---- MPI (spectrum_mpi.c; stubs without -DPD_MPI) ------------------------ */
+
+/* Start MPI (the MPI build) or refuse to run as one of several copies
+ * under mpirun (the plain build): 0, or 2 after printing why. */
+int pd_spec_mpi_init(int *rank, int *size, int *threaded);
+void pd_spec_mpi_finalize(void);
+/* End every rank at once (a rank that cannot go on would leave the others
+ * waiting); no-op in the plain build. */
+void pd_spec_mpi_abort(int status);
+/* The largest status of any rank, on every rank. */
+void pd_spec_mpi_agree(int *status);
+/* Rank 0's done flags on every rank. */
+int pd_spec_mpi_bcast_done(pd_spec_result *res, long ntasks);
+/* Dynamic distribution: rank 0 holds the queue of tasks (in decreasing
+ * cost) and computes from it too; a worker asks for a chunk of tasks before
+ * it runs dry and reports finished tasks in batches (messages under 4 kB,
+ * sent eagerly). */
+enum { PD_SPEC_BATCH = 40, PD_SPEC_CHUNK = 64 };
+
+/* A worker's message to rank 0: finished tasks, a request for `want` more
+ * tasks (0: none), and whether it is the worker's last message. */
+typedef struct pd_spec_report {
+    int n, want, last;
+    long task[PD_SPEC_BATCH];
+    pd_spec_result r[PD_SPEC_BATCH];
+} pd_spec_report;
+
+/* Rank 0's answer to a request: tasks to compute (n = 0: none are left). */
+typedef struct pd_spec_grant {
+    int n;
+    long task[PD_SPEC_CHUNK];
+} pd_spec_grant;
+
+void pd_spec_mpi_report(const pd_spec_report *m);
+/* Rank 0: a worker's report, if any (block: wait for one): 1 and its
+ * sender in *from, else 0. */
+int pd_spec_mpi_poll_report(int block, pd_spec_report *m, int *from);
+void pd_spec_mpi_grant(int to, const pd_spec_grant *g);
+/* A worker: rank 0's answer, if any (block: wait for it): 1 or 0. */
+int pd_spec_mpi_poll_grant(int block, pd_spec_grant *g);
+
+/* ---- computing (spectrum_run.c) ------------------------------------------ */
+
+/* How to compute. */
+typedef struct pd_spec_exec {
+    int threads;              /* OpenMP threads per rank; 0 = the OpenMP default */
+    int progress;             /* a progress bar on stderr (rank 0) */
+    long stop_after;          /* test hook: exit(130) after this many tasks; 0 = never */
+    pd_spec_journal *journal; /* rank 0's journal, or NULL */
+    int rank, size;           /* MPI; size 1: this process computes every task */
+} pd_spec_exec;
+
+/* The threads a rank uses for `requested` (0: the OpenMP default; 1
+ * without OpenMP). */
+int pd_spec_threads(int requested);
+
+/* Compute every task not yet done.  On rank 0 all results are in res at
+ * the end; the status of the lowest failed task (0 if none) is returned
+ * there, with its message in err. */
+int pd_spec_compute(const pd_spectrum *s, const pd_spec_exec *ex, pd_spec_result *res,
+                    pd_err *err);
+
+/* ---- output (spectrum_out.c) --------------------------------------------- */
+
+/* HDF5 (one group per curve) or CSV (one row per point) by extension,
+ * through a temporary file renamed on success. */
+int pd_spec_write(const char *path, const pd_spectrum *s, const pd_spec_row *rows,
+                  pd_err *err);
+/* PNG.png: Pi1 vs Pi2 (log-log); PNG-gamma.png: gamma vs Pi2; with the
+ * dimensional view PNG-dim.png: umax [cm] vs T0 [s]. */
+int pd_spec_plot(const char *png, const pd_spectrum *s, const pd_spec_row *rows, pd_err *err);
+/* Totals printed beside the points. */
+typedef struct pd_spec_totals {
+    double cpu_s, wall_s, steps; /* steps: of every run, twins included */
+    long runs, resumed;
+    int threads, ranks;
+} pd_spec_totals;
+void pd_spec_print_json(const pd_spectrum *s, const pd_spec_row *rows, const pd_spec_totals *t);
+void pd_spec_print_text(const pd_spectrum *s, const pd_spec_row *rows, const pd_spec_totals *t);
+
+/* `pound bench --spectrum` (bench_spectrum.c): the paper-scale sweep serial
+ * and on 2 OpenMP threads; like pd_bench_engine (js NULL: a table). */
+int pd_bench_spectrum(pd_json *js);
+
+#endif

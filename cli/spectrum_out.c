@@ -1,0 +1,413 @@
+/* spectrum_out.c — a computed spectrum as HDF5 (one group per curve), CSV
+ * (long format, one row per point), gnuplot charts, JSON and text.  Files
+ * are written to a temporary name and renamed on success, and hold no
+ * timings or dates, so equal sweeps give byte-identical files. */
+#include <hdf5.h>
+#include <math.h>
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "pd_plot.h"
+#include "pd_spectrum.h"
+
+/* A per-point column of the output. */
+typedef struct col_def {
+    const char *name, *units;
+    size_t off;
+    int is_long;
+} col_def;
+
+#define DCOL(name, units, field) {name, units, offsetof(pd_spec_row, field), 0}
+#define LCOL(name, field) {name, "1", offsetof(pd_spec_row, field), 1}
+static const col_def point_cols[] = {
+    DCOL("Pi2", "1", c.Pi2),         DCOL("T0", "s", T0),
+    DCOL("Pi1", "1", Pi1),           DCOL("umax", "m", umax),
+    DCOL("umax_free", "m", umax_free), DCOL("gamma", "1", gamma),
+    DCOL("chi", "1", chi),           DCOL("u_toward", "m", u_toward),
+    DCOL("u_away", "m", u_away),     LCOL("impacts", impacts),
+    DCOL("contact_time", "s", contact_time), DCOL("first_impact", "s", first_impact),
+    LCOL("steps", steps),            DCOL("dt", "s", dt),
+    DCOL("tend", "s", tend)};
+enum { NCOLS = sizeof point_cols / sizeof point_cols[0] };
+
+/* The value of column d in row r. */
+static double col_value(const pd_spec_row *r, const col_def *d)
+{
+    const char *p = (const char *)r + d->off;
+    if (d->is_long) {
+        long v;
+        memcpy(&v, p, sizeof v);
+        return (double)v;
+    }
+    double x;
+    memcpy(&x, p, sizeof x);
+    return x;
+}
+
+/* Does path end with suffix? */
+static int ends_with(const char *path, const char *suffix)
+{
+    size_t n = strlen(path), k = strlen(suffix);
+    return n > k && !strcmp(path + n - k, suffix);
+}
+
+/* How dt was chosen, in words. */
+static void dt_rule(const pd_spectrum *s, char *buf, size_t cap)
+{
+    if (s->dt_per_Tp > 0.0)
+        snprintf(buf, cap, "Tp/%.17g", s->dt_per_Tp);
+    else if (s->base.have_dt)
+        snprintf(buf, cap, "%.17g s", s->base.opts.dt);
+    else
+        snprintf(buf, cap, "min(Tp,T0)/2000");
+}
+
+/* ---- HDF5 --------------------------------------------------------------- */
+
+/* An object-creation property list without modification times. */
+static hid_t untimed(hid_t cls)
+{
+    hid_t p = H5Pcreate(cls);
+    if (p >= 0 && H5Pset_obj_track_times(p, 0) < 0) {
+        H5Pclose(p);
+        return -1;
+    }
+    return p;
+}
+
+/* A scalar attribute: text when text is non-NULL, else the number x. */
+static int h5_attr(hid_t obj, const char *name, const char *text, double x)
+{
+    hid_t space = H5Screate(H5S_SCALAR), type = -1, attr = -1;
+    herr_t st = -1;
+    if (space < 0)
+        return -1;
+    if (text) {
+        type = H5Tcopy(H5T_C_S1);
+        if (type >= 0 && H5Tset_size(type, strlen(text) + 1) >= 0 &&
+            (attr = H5Acreate2(obj, name, type, space, H5P_DEFAULT, H5P_DEFAULT)) >= 0)
+            st = H5Awrite(attr, type, text);
+    } else if ((attr = H5Acreate2(obj, name, H5T_NATIVE_DOUBLE, space, H5P_DEFAULT,
+                                  H5P_DEFAULT)) >= 0)
+        st = H5Awrite(attr, H5T_NATIVE_DOUBLE, &x);
+    if (attr >= 0)
+        H5Aclose(attr);
+    if (type >= 0)
+        H5Tclose(type);
+    H5Sclose(space);
+    return st < 0 ? -1 : 0;
+}
+
+/* A number attribute with its "<name>_units" companion. */
+static int h5_num(hid_t obj, const char *name, double x, const char *units)
+{
+    char uname[96];
+    if (h5_attr(obj, name, NULL, x))
+        return -1;
+    snprintf(uname, sizeof uname, "%s_units", name);
+    return units ? h5_attr(obj, uname, units, 0.0) : 0;
+}
+
+/* A 1-D double dataset with a "units" attribute. */
+static int h5_dataset(hid_t grp, hid_t dcpl, const char *name, const char *units,
+                      const double *x, long n)
+{
+    hsize_t dims[1] = {(hsize_t)n};
+    hid_t space = H5Screate_simple(1, dims, NULL), ds = -1;
+    int rc = -1;
+    if (space < 0)
+        return -1;
+    ds = H5Dcreate2(grp, name, H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+    if (ds >= 0 && H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, x) >= 0)
+        rc = h5_attr(ds, "units", units, 0.0);
+    if (ds >= 0)
+        H5Dclose(ds);
+    H5Sclose(space);
+    return rc;
+}
+
+/* The curve's parameters as attributes of its group. */
+static int h5_curve_attrs(hid_t g, const pd_spectrum *s, const pd_spec_row *r, long curve)
+{
+    char label[256];
+    pd_spec_curve_label(s, curve, label, sizeof label);
+    return h5_attr(g, "label", label, 0) || h5_attr(g, "pulse", pd_pulse_name(r->c.pulse), 0) ||
+           h5_attr(g, "dir", pd_dir_name(r->c.dir), 0) ||
+           h5_attr(g, "method", pd_method_name(s->base.method), 0) ||
+           h5_num(g, "ap", r->c.ap, "m/s^2") || h5_num(g, "Tp", r->c.Tp, "s") ||
+           h5_num(g, "Pi3", r->c.Pi3, "1") || h5_num(g, "gap", r->gap, "m") ||
+           h5_num(g, "eps", r->c.eps, "1") || h5_num(g, "xi", r->c.xi, "1");
+}
+
+/* Group curve_NNNN: attributes and one dataset per column. */
+static int h5_curve(hid_t file, hid_t gcpl, hid_t dcpl, const pd_spectrum *s,
+                    const pd_spec_row *rows, long curve, double *buf)
+{
+    char name[32];
+    const pd_spec_row *r = rows + curve * s->npi2;
+    snprintf(name, sizeof name, "curve_%04ld", curve);
+    hid_t g = H5Gcreate2(file, name, H5P_DEFAULT, gcpl, H5P_DEFAULT);
+    int rc = g < 0 ? -1 : h5_curve_attrs(g, s, r, curve);
+    for (int k = 0; k < NCOLS && !rc; k++) {
+        for (int j = 0; j < s->npi2; j++)
+            buf[j] = col_value(&r[j], &point_cols[k]);
+        rc = h5_dataset(g, dcpl, point_cols[k].name, point_cols[k].units, buf, s->npi2);
+    }
+    if (g >= 0 && H5Gclose(g) < 0)
+        rc = -1;
+    return rc;
+}
+
+/* The sweep's common parameters as root attributes. */
+static int h5_root_attrs(hid_t file, const pd_spectrum *s)
+{
+    char rule[64];
+    dt_rule(s, rule, sizeof rule);
+    return h5_attr(file, "command", "pound spectrum", 0) ||
+           h5_attr(file, "method", pd_method_name(s->base.method), 0) ||
+           h5_attr(file, "Pi2_spacing", s->linear ? "linear" : "log", 0) ||
+           h5_num(file, "Pi2_min", s->pi2_min, "1") || h5_num(file, "Pi2_max", s->pi2_max, "1") ||
+           h5_num(file, "Pi2_n", s->npi2, NULL) || h5_num(file, "Tp", s->base.c.Tp, "s") ||
+           h5_attr(file, "dt", rule, 0) || h5_num(file, "theta", s->base.opts.theta, "1") ||
+           h5_num(file, "curves", (double)pd_spec_curves(s), NULL) ||
+           h5_num(file, "points", (double)pd_spec_points(s), NULL);
+}
+
+/* The whole spectrum into an HDF5 file: 0 or -1. */
+static int write_hdf5(const char *path, const pd_spectrum *s, const pd_spec_row *rows)
+{
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL); /* no HDF5 diagnostics on stderr */
+    hid_t fcpl = untimed(H5P_FILE_CREATE), gcpl = untimed(H5P_GROUP_CREATE);
+    hid_t dcpl = untimed(H5P_DATASET_CREATE), file = -1;
+    double *buf = malloc((size_t)s->npi2 * sizeof *buf);
+    int rc = -1;
+    if (fcpl >= 0 && gcpl >= 0 && dcpl >= 0 && buf &&
+        (file = H5Fcreate(path, H5F_ACC_TRUNC, fcpl, H5P_DEFAULT)) >= 0) {
+        rc = h5_root_attrs(file, s);
+        for (long c = 0; c < pd_spec_curves(s) && !rc; c++)
+            rc = h5_curve(file, gcpl, dcpl, s, rows, c, buf);
+        if (H5Fclose(file) < 0)
+            rc = -1;
+    }
+    free(buf);
+    if (fcpl >= 0)
+        H5Pclose(fcpl);
+    if (gcpl >= 0)
+        H5Pclose(gcpl);
+    if (dcpl >= 0)
+        H5Pclose(dcpl);
+    return rc;
+}
+
+/* ---- CSV ---------------------------------------------------------------- */
+
+/* "# name = value" lines, the header row, one row per point. */
+static int write_csv(const char *path, const pd_spectrum *s, const pd_spec_row *rows)
+{
+    char rule[64];
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return -1;
+    dt_rule(s, rule, sizeof rule);
+    fprintf(f, "# pound spectrum\n# method = %s\n# Pi2 = %.17g:%.17g:%d %s\n# dt = %s\n",
+            pd_method_name(s->base.method), s->pi2_min, s->pi2_max, s->npi2,
+            s->linear ? "linear" : "log", rule);
+    fprintf(f, "# theta = %.17g\n# units: ap m/s^2, Tp T0 contact_time first_impact dt tend s, "
+               "gap umax umax_free u_toward u_away m\n",
+            s->base.opts.theta);
+    fputs("pulse,dir,method,ap,Tp,Pi3,gap,eps,xi", f);
+    for (int k = 0; k < NCOLS; k++)
+        fprintf(f, ",%s", point_cols[k].name);
+    fputc('\n', f);
+    for (long p = 0; p < pd_spec_points(s); p++) {
+        const pd_spec_row *r = &rows[p];
+        fprintf(f, "%s,%s,%s,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", pd_pulse_name(r->c.pulse),
+                pd_dir_name(r->c.dir), pd_method_name(s->base.method), r->c.ap, r->c.Tp,
+                r->c.Pi3, r->gap, r->c.eps, r->c.xi);
+        for (int k = 0; k < NCOLS; k++)
+            fprintf(f, ",%.17g", col_value(r, &point_cols[k]));
+        fputc('\n', f);
+    }
+    int bad = ferror(f);
+    return (fclose(f) != 0 || bad) ? -1 : 0;
+}
+
+int pd_spec_write(const char *path, const pd_spectrum *s, const pd_spec_row *rows, pd_err *err)
+{
+    char tmp[4200];
+    int h5 = ends_with(path, ".h5") || ends_with(path, ".hdf5");
+    if (!h5 && !ends_with(path, ".csv"))
+        return pd_err_set(err, PD_EINVAL, "-o %s: the file name must end in .h5, .hdf5 or .csv",
+                          path);
+    if (snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid()) >= (int)sizeof tmp)
+        return pd_err_set(err, PD_EINVAL, "-o %s: path too long", path);
+    int rc = h5 ? write_hdf5(tmp, s, rows) : write_csv(tmp, s, rows);
+    if (rc || rename(tmp, path) != 0) {
+        unlink(tmp);
+        return pd_err_set(err, PD_EIO, "-o %s: cannot write the file", path);
+    }
+    return PD_OK;
+}
+
+/* ---- charts ------------------------------------------------------------- */
+
+/* The parameters every curve shares, for a chart title. */
+static void common_title(const pd_spectrum *s, char *buf, size_t cap)
+{
+    size_t n = (size_t)snprintf(buf, cap, "spectra (%s", pd_method_name(s->base.method));
+#define ADD(...) (n += (size_t)snprintf(buf + n, n < cap ? cap - n : 0, __VA_ARGS__))
+    if (s->npulse == 1)
+        ADD(", %s", pd_pulse_name(s->pulse[0]));
+    if (s->ndir == 1)
+        ADD(" %s", pd_dir_name(s->dir[0]));
+    if (s->nsize == 1)
+        ADD(", %s = %g", s->size_is_gap ? "gap" : "Pi3", s->size[0]);
+    if (s->neps == 1)
+        ADD(", eps = %g", s->eps[0]);
+    if (s->nxi == 1)
+        ADD(", xi = %g", s->xi[0]);
+    ADD(")");
+#undef ADD
+}
+
+/* One chart, one curve per spectrum curve; y = f(row) scaled; x = T0 or Pi2. */
+static int chart(const char *png, const pd_spectrum *s, const pd_spec_row *rows, int use_T0,
+                 size_t yoff, double yscale, const char *ylabel, int logy, pd_err *err)
+{
+    long nc = pd_spec_curves(s), np = pd_spec_points(s);
+    double *x = malloc((size_t)np * sizeof *x), *y = malloc((size_t)np * sizeof *y);
+    pd_curve *cv = malloc((size_t)nc * sizeof *cv);
+    char *labels = malloc((size_t)nc * 128), title[256];
+    int rc;
+    if (!x || !y || !cv || !labels) {
+        rc = pd_err_set(err, PD_ENOMEM, "--plot: out of memory");
+        goto done;
+    }
+    for (long p = 0; p < np; p++) {
+        x[p] = use_T0 ? rows[p].T0 : rows[p].c.Pi2;
+        memcpy(&y[p], (const char *)&rows[p] + yoff, sizeof y[p]);
+        y[p] *= yscale;
+    }
+    for (long c = 0; c < nc; c++) {
+        pd_spec_curve_label(s, c, labels + 128 * c, 128);
+        cv[c] = (pd_curve){labels + 128 * c, s->npi2, x + c * s->npi2, y + c * s->npi2};
+    }
+    common_title(s, title, sizeof title);
+    pd_chart ch = {title, use_T0 ? "T_0 [s]" : "Pi_2 = T_p / T_0", ylabel, 1, logy, (int)nc, cv,
+                   NAN, NULL, 0.0};
+    rc = pd_plot(png, &ch, err);
+done:
+    free(x);
+    free(y);
+    free(cv);
+    free(labels);
+    return rc;
+}
+
+int pd_spec_plot(const char *png, const pd_spectrum *s, const pd_spec_row *rows, pd_err *err)
+{
+    char other[4200];
+    size_t len = strlen(png);
+    int rc = chart(png, s, rows, 0, offsetof(pd_spec_row, Pi1), 1.0,
+                   "Pi_1 = u_{max} w_p^2 / a_p", 1, err);
+    snprintf(other, sizeof other, "%.*s-gamma.png", (int)(len - 4), png);
+    if (!rc)
+        rc = chart(other, s, rows, 0, offsetof(pd_spec_row, gamma), 1.0,
+                   "gamma = u_{max} / u_{max,free}", 0, err);
+    snprintf(other, sizeof other, "%.*s-dim.png", (int)(len - 4), png);
+    if (!rc && s->dimensional)
+        rc = chart(other, s, rows, 1, offsetof(pd_spec_row, umax), 100.0, "u_{max} [cm]", 1, err);
+    return rc;
+}
+
+/* ---- JSON and text ------------------------------------------------------ */
+
+/* One point as a JSON object (the SPEC keys first). */
+static void json_point(pd_json *js, const pd_spectrum *s, const pd_spec_row *r)
+{
+    pd_json_begin_object(js, NULL);
+    pd_json_str(js, "pulse", pd_pulse_name(r->c.pulse));
+    pd_json_str(js, "dir", pd_dir_name(r->c.dir));
+    pd_json_num(js, "Pi2", r->c.Pi2);
+    pd_json_num(js, "Pi3", r->c.Pi3);
+    pd_json_num(js, "eps", r->c.eps);
+    pd_json_num(js, "xi", r->c.xi);
+    pd_json_num(js, "Pi1", r->Pi1);
+    pd_json_num(js, "umax_free", r->umax_free);
+    pd_json_num(js, "gamma", r->gamma);
+    pd_json_num(js, "chi", r->chi);
+    pd_json_int(js, "impacts", r->impacts);
+    pd_json_str(js, "method", pd_method_name(s->base.method));
+    pd_json_int(js, "curve", r->curve);
+    pd_json_num(js, "umax", r->umax);
+    pd_json_num(js, "u_toward", r->u_toward);
+    pd_json_num(js, "u_away", r->u_away);
+    pd_json_num(js, "contact_time", r->contact_time);
+    pd_json_num(js, "first_impact", r->first_impact);
+    pd_json_num(js, "ap", r->c.ap);
+    pd_json_num(js, "Tp", r->c.Tp);
+    pd_json_num(js, "T0", r->T0);
+    pd_json_num(js, "gap", r->gap);
+    pd_json_num(js, "dt", r->dt);
+    pd_json_num(js, "tend", r->tend);
+    pd_json_int(js, "steps", r->steps);
+    pd_json_num(js, "cpu_s", r->cpu_s);
+    pd_json_end_object(js);
+}
+
+void pd_spec_print_json(const pd_spectrum *s, const pd_spec_row *rows, const pd_spec_totals *t)
+{
+    pd_json js;
+    pd_json_init(&js, stdout);
+    pd_json_begin_object(&js, NULL);
+    pd_json_begin_array(&js, "points");
+    for (long p = 0; p < pd_spec_points(s); p++)
+        json_point(&js, s, &rows[p]);
+    pd_json_end_array(&js);
+    pd_json_int(&js, "curves", pd_spec_curves(s));
+    pd_json_int(&js, "runs", t->runs);
+    pd_json_int(&js, "twins", pd_spec_twins(s));
+    pd_json_int(&js, "resumed", t->resumed);
+    pd_json_num(&js, "steps", t->steps);
+    pd_json_int(&js, "threads", t->threads);
+    pd_json_int(&js, "ranks", t->ranks);
+    pd_json_num(&js, "cpu_s", t->cpu_s);
+    pd_json_num(&js, "wall_s", t->wall_s);
+    pd_json_end_object(&js);
+    pd_json_finish(&js);
+}
+
+/* One curve in a line: its peak Pi1, the range of gamma, impacts. */
+static void text_curve(const pd_spectrum *s, const pd_spec_row *r, long curve)
+{
+    char label[128];
+    int jmax = 0, hit = 0;
+    double gmin = HUGE_VAL, gmax = -HUGE_VAL;
+    for (int j = 0; j < s->npi2; j++) {
+        jmax = r[j].Pi1 > r[jmax].Pi1 ? j : jmax;
+        gmin = fmin(gmin, r[j].gamma);
+        gmax = fmax(gmax, r[j].gamma);
+        hit += r[j].impacts > 0;
+    }
+    pd_spec_curve_label(s, curve, label, sizeof label);
+    printf("  %-36s %10.4g %10.4g %9.4g %9.4g %7d/%d\n", label, r[jmax].Pi1, r[jmax].c.Pi2, gmin,
+           gmax, hit, s->npi2);
+}
+
+void pd_spec_print_text(const pd_spectrum *s, const pd_spec_row *rows, const pd_spec_totals *t)
+{
+    char rule[64];
+    dt_rule(s, rule, sizeof rule);
+    printf("pounding spectra: %ld curves x %d Pi2 in [%g, %g] (%s), %s, dt = %s\n",
+           pd_spec_curves(s), s->npi2, s->pi2_min, s->pi2_max, s->linear ? "linear" : "log",
+           pd_method_name(s->base.method), rule);
+    printf("  %-36s %10s %10s %9s %9s %9s\n", "curve", "max Pi1", "at Pi2", "min gamma",
+           "max gamma", "impacting");
+    for (long c = 0; c < pd_spec_curves(s); c++)
+        text_curve(s, rows + c * s->npi2, c);
+    printf("  %ld runs (%ld no-wall twins shared across gaps and eps, %ld resumed), "
+           "cpu %.3g s, wall %.3g s, %d thread(s) x %d rank(s)\n",
+           t->runs, pd_spec_twins(s), t->resumed, t->cpu_s, t->wall_s, t->threads, t->ranks);
+}

@@ -1,0 +1,275 @@
+/* spectrum_sweep.c — a spectrum sweep as a list of tasks: the Pi2 grid,
+ * where each task sits, its case (finished exactly as `pound simulate`
+ * finishes one), its cost, the canonical key, and the output rows. */
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pd_spectrum.h"
+
+void pd_spec_init(pd_spectrum *s)
+{
+    memset(s, 0, sizeof *s);
+    pd_cli_case_init(&s->base);
+    s->npulse = s->ndir = s->nap = s->nxi = s->nsize = s->neps = 1;
+    s->pulse[0] = PD_PULSE_SINE;
+    s->dir[0] = 1;
+    s->ap[0] = s->base.c.ap;
+    s->xi[0] = s->base.c.xi;
+    s->size[0] = s->base.c.Pi3;
+    s->eps[0] = s->base.c.eps;
+}
+
+long pd_spec_curves(const pd_spectrum *s)
+{
+    return (long)s->npulse * s->ndir * s->nap * s->nxi * s->nsize * s->neps;
+}
+
+long pd_spec_points(const pd_spectrum *s) { return pd_spec_curves(s) * s->npi2; }
+
+long pd_spec_twins(const pd_spectrum *s)
+{
+    return (long)s->npulse * s->ndir * s->nap * s->nxi * s->npi2;
+}
+
+long pd_spec_tasks(const pd_spectrum *s) { return pd_spec_twins(s) + pd_spec_points(s); }
+
+double pd_spec_pi2(const pd_spectrum *s, int j)
+{
+    if (s->npi2 < 2 || j <= 0)
+        return s->pi2_min;
+    if (j >= s->npi2 - 1)
+        return s->pi2_max;
+    double t = (double)j / (s->npi2 - 1);
+    if (s->linear)
+        return s->pi2_min + (s->pi2_max - s->pi2_min) * t;
+    return s->pi2_min * pow(s->pi2_max / s->pi2_min, t);
+}
+
+/* Split a (pulse, dir, ap, xi) group index into its digits, xi fastest. */
+static void group_digits(const pd_spectrum *s, long g, pd_spec_coords *co)
+{
+    co->xi = (int)(g % s->nxi);
+    g /= s->nxi;
+    co->ap = (int)(g % s->nap);
+    g /= s->nap;
+    co->dir = (int)(g % s->ndir);
+    co->pulse = (int)(g / s->ndir);
+}
+
+void pd_spec_coords_of(const pd_spectrum *s, long task, pd_spec_coords *co)
+{
+    long ntw = pd_spec_twins(s);
+    memset(co, 0, sizeof *co);
+    if (task < ntw) {
+        co->twin = 1;
+        co->curve = -1;
+        co->j = (int)(task % s->npi2);
+        group_digits(s, task / s->npi2, co);
+        return;
+    }
+    long p = task - ntw, c = p / s->npi2;
+    co->curve = c;
+    co->j = (int)(p % s->npi2);
+    co->eps = (int)(c % s->neps);
+    c /= s->neps;
+    co->size = (int)(c % s->nsize);
+    group_digits(s, c / s->nsize, co);
+}
+
+long pd_spec_twin_of(const pd_spectrum *s, long task)
+{
+    long p = task - pd_spec_twins(s);
+    long group = (p / s->npi2) / ((long)s->nsize * s->neps);
+    return group * s->npi2 + p % s->npi2;
+}
+
+int pd_spec_case(const pd_spectrum *s, long task, pd_cli_case *k)
+{
+    pd_spec_coords co;
+    pd_spec_coords_of(s, task, &co);
+    *k = s->base;
+    k->c.pulse = s->pulse[co.pulse];
+    k->c.dir = s->dir[co.dir];
+    k->c.ap = s->ap[co.ap];
+    k->c.xi = s->xi[co.xi];
+    k->c.eps = s->eps[co.eps];
+    k->c.Pi2 = pd_spec_pi2(s, co.j);
+    k->have_Pi2 = 1;
+    k->have_T0 = 0;
+    k->have_gap = s->size_is_gap;
+    k->have_Pi3 = !s->size_is_gap;
+    if (s->size_is_gap)
+        k->gap = s->size[co.size];
+    else
+        k->c.Pi3 = s->size[co.size];
+    if (s->dt_per_Tp > 0.0) {
+        k->opts.dt = k->c.Tp / s->dt_per_Tp;
+        k->have_dt = 1;
+    }
+    k->opts.no_wall = co.twin;
+    return pd_cli_case_finish(k);
+}
+
+int pd_spec_validate(const pd_spectrum *s)
+{
+    pd_cli_case k;
+    long ntw = pd_spec_twins(s), n = pd_spec_tasks(s);
+    for (long t = ntw; t < n; t++)
+        if (pd_spec_case(s, t, &k))
+            return 2;
+    return 0;
+}
+
+double pd_spec_cost(const pd_spectrum *s, long task)
+{
+    pd_cli_case k;
+    if (pd_spec_case(s, task, &k))
+        return 1.0;
+    return (double)pd_steps_for(k.opts.tend, k.opts.dt);
+}
+
+/* ---- the canonical key -------------------------------------------------- */
+
+/* A growing text buffer. */
+typedef struct textbuf {
+    char *p;
+    size_t n, cap;
+    int oom;
+} textbuf;
+
+/* Append printf-style text. */
+static void tb_add(textbuf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void tb_add(textbuf *b, const char *fmt, ...)
+{
+    va_list ap;
+    if (b->oom)
+        return;
+    for (;;) {
+        va_start(ap, fmt);
+        int len = vsnprintf(b->p + b->n, b->cap - b->n, fmt, ap);
+        va_end(ap);
+        if (len < 0) {
+            b->oom = 1;
+            return;
+        }
+        if ((size_t)len < b->cap - b->n) {
+            b->n += (size_t)len;
+            return;
+        }
+        size_t cap = 2 * b->cap + (size_t)len + 64;
+        char *q = realloc(b->p, cap);
+        if (!q) {
+            b->oom = 1;
+            return;
+        }
+        b->p = q;
+        b->cap = cap;
+    }
+}
+
+/* " name=x1,x2,..." with every value in hexadecimal floating point. */
+static void tb_list(textbuf *b, const char *name, const double *x, int n)
+{
+    tb_add(b, " %s=", name);
+    for (int i = 0; i < n; i++)
+        tb_add(b, "%s%a", i ? "," : "", x[i]);
+}
+
+char *pd_spec_key(const pd_spectrum *s)
+{
+    const pd_cli_case *k = &s->base;
+    textbuf b = {malloc(256), 0, 256, 0};
+    if (!b.p)
+        return NULL;
+    b.p[0] = '\0';
+    tb_add(&b, "v=1 method=%s pulse=", pd_method_name(k->method));
+    for (int i = 0; i < s->npulse; i++)
+        tb_add(&b, "%s%s", i ? "," : "", pd_pulse_name(s->pulse[i]));
+    tb_add(&b, " dir=");
+    for (int i = 0; i < s->ndir; i++)
+        tb_add(&b, "%s%s", i ? "," : "", pd_dir_name(s->dir[i]));
+    tb_list(&b, "ap", s->ap, s->nap);
+    tb_add(&b, " Tp=%a", k->c.Tp);
+    tb_list(&b, "xi", s->xi, s->nxi);
+    tb_list(&b, s->size_is_gap ? "gap" : "Pi3", s->size, s->nsize);
+    tb_list(&b, "eps", s->eps, s->neps);
+    tb_add(&b, " Pi2=%a:%a:%d spacing=%s", s->pi2_min, s->pi2_max, s->npi2,
+           s->linear ? "linear" : "log");
+    tb_add(&b, " dt=%a dt_per_Tp=%a theta=%a gamma=%a tend=%a", k->have_dt ? k->opts.dt : 0.0,
+           s->dt_per_Tp, k->opts.theta, k->opts.gamma, k->have_tend ? k->opts.tend : 0.0);
+    tb_add(&b, " unstable=%d accumulation=%d kernel=%d", k->opts.allow_unstable,
+           !k->opts.no_accumulation, (int)k->opts.kernel);
+    tb_add(&b, " contact=%d kc=%a kc_abs=%a rtol=%a atol=%a stepper=%s", (int)k->pen.law,
+           k->pen.kc_mult, k->pen.kc_abs, k->pen.rtol, k->pen.atol,
+           k->pen.stepper ? k->pen.stepper : "default");
+    tb_add(&b, " tasks=%ld", pd_spec_tasks(s));
+    if (b.oom) {
+        free(b.p);
+        return NULL;
+    }
+    return b.p;
+}
+
+/* ---- rows --------------------------------------------------------------- */
+
+/* One point from its run and its twin, as `pound simulate` computes them. */
+static void fill_row(const pd_cli_case *k, long curve, const pd_spec_result *r,
+                     const pd_spec_result *f, pd_spec_row *row)
+{
+    memset(row, 0, sizeof *row);
+    row->c = k->c;
+    row->curve = curve;
+    row->T0 = pd_osc_T0(&k->c);
+    row->gap = pd_osc_gap(&k->c);
+    row->dt = k->opts.dt;
+    row->tend = k->opts.tend;
+    row->umax = r->umax;
+    row->Pi1 = r->umax / pd_osc_Le(&k->c);
+    row->umax_free = f->umax;
+    row->gamma = f->umax > 0.0 ? r->umax / f->umax : NAN;
+    row->chi = f->umax > 0.0 ? pd_osc_gap(&k->c) / f->umax : NAN;
+    row->u_toward = r->u_toward;
+    row->u_away = r->u_away;
+    row->contact_time = r->contact_time;
+    row->first_impact = r->first_impact;
+    row->cpu_s = r->cpu_s;
+    row->impacts = r->impacts;
+    row->steps = r->steps;
+}
+
+void pd_spec_rows(const pd_spectrum *s, const pd_spec_result *res, pd_spec_row *rows)
+{
+    long ntw = pd_spec_twins(s), np = pd_spec_points(s);
+    pd_cli_case k;
+    for (long p = 0; p < np; p++) {
+        long t = ntw + p;
+        pd_spec_case(s, t, &k);
+        fill_row(&k, p / s->npi2, &res[t], &res[pd_spec_twin_of(s, t)], &rows[p]);
+    }
+}
+
+void pd_spec_curve_label(const pd_spectrum *s, long curve, char *buf, size_t cap)
+{
+    pd_spec_coords co;
+    size_t n = 0;
+    pd_spec_coords_of(s, pd_spec_twins(s) + curve * s->npi2, &co);
+    buf[0] = '\0';
+#define ADD(...) (n += (size_t)snprintf(buf + n, n < cap ? cap - n : 0, __VA_ARGS__))
+    if (s->npulse > 1)
+        ADD("%s ", pd_pulse_name(s->pulse[co.pulse]));
+    if (s->ndir > 1)
+        ADD("%s ", pd_dir_name(s->dir[co.dir]));
+    if (s->nap > 1 || s->dimensional)
+        ADD("ap=%g ", s->ap[co.ap]);
+    if (s->nxi > 1)
+        ADD("xi=%g ", s->xi[co.xi]);
+    if (s->nsize > 1 || n == 0)
+        ADD("%s=%g ", s->size_is_gap ? "gap" : "Pi3", s->size[co.size]);
+    if (s->neps > 1)
+        ADD("eps=%g ", s->eps[co.eps]);
+#undef ADD
+    if (n > 0 && n <= cap)
+        buf[n - 1] = '\0';
+}
