@@ -70,7 +70,8 @@ $(BUILD)/pound: $(CLI_OBJ) $(BUILD)/libpound.a
 
 $(BUILD)/pound_tests: $(TEST_OBJ) $(BUILD)/libpound.a
 	@echo "  LD    $@"
-	@$(CC) $(CFLAGS) $(OPENMP) $(XCFLAGS) -o $@ $(TEST_OBJ) $(BUILD)/libpound.a $(XOBJ) $(LIBS)
+	@$(CC) $(CFLAGS) $(OPENMP) $(XCFLAGS) -o $@ $(TEST_OBJ) $(BUILD)/libpound.a $(XOBJ) $(LIBS) \
+	    -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc
 
 deps:
 	@sh scripts/deps.sh

@@ -1,0 +1,157 @@
+/* test_alloc.c — every allocation of the library's constructors fails in
+ * turn (CSparse style): each failure must come back as PD_ENOMEM / NULL,
+ * never as a crash, and free what was taken (LeakSanitizer checks that in
+ * `make asan`).
+ *
+ * The test binary is linked with -Wl,--wrap=malloc,--wrap=calloc,
+ * --wrap=realloc: the library's calls come here first.  The countdown is
+ * test-harness state, not library state. */
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "pd_oscillator.h"
+#include "pd_test.h"
+
+void *__real_malloc(size_t n);
+void *__real_calloc(size_t k, size_t n);
+void *__real_realloc(void *p, size_t n);
+
+static long alloc_countdown = -1; /* < 0: never fail; 0: fail this one */
+static long alloc_seen = 0;
+
+/* Decide whether this allocation fails. */
+static int alloc_should_fail(void)
+{
+    alloc_seen++;
+    if (alloc_countdown < 0)
+        return 0;
+    return alloc_countdown-- == 0;
+}
+
+void *__wrap_malloc(size_t n)
+{
+    return alloc_should_fail() ? NULL : __real_malloc(n);
+}
+
+void *__wrap_calloc(size_t k, size_t n)
+{
+    return alloc_should_fail() ? NULL : __real_calloc(k, n);
+}
+
+void *__wrap_realloc(void *p, size_t n)
+{
+    return alloc_should_fail() ? NULL : __real_realloc(p, n);
+}
+
+/* A constructor under test: returns a status. */
+typedef int (*alloc_case)(void);
+
+/* Fail allocation k = 0, 1, 2, ... until the call succeeds; every failed
+ * call must report PD_ENOMEM.  Returns the number of allocations tried. */
+static long fail_each(pd_test_ctx *ctx, const char *name, alloc_case fn)
+{
+    long k = 0;
+    for (; k < 10000; k++) {
+        alloc_countdown = k;
+        alloc_seen = 0;
+        int st = fn();
+        long seen = alloc_seen;
+        alloc_countdown = -1;
+        if (seen <= k) { /* fewer allocations than k: it ran clean */
+            CHECK(ctx, st == PD_OK, "%s: clean run returned %d", name, st);
+            break;
+        }
+        CHECK(ctx, st == PD_ENOMEM, "%s: allocation %ld failed, status %d (want PD_ENOMEM)", name,
+              k, st);
+    }
+    CHECK(ctx, k > 0, "%s: no allocation seen", name);
+    return k;
+}
+
+static int case_lcp(void)
+{
+    pd_lcp_work *w = pd_lcp_alloc(50);
+    if (!w)
+        return PD_ENOMEM;
+    double M[4] = {2, -1, -1, 2}, q[2] = {-1, 1}, z[2], wv[2];
+    int st = pd_lcp_lemke(w, 2, M, q, NULL, z, wv, NULL);
+    pd_lcp_free(w);
+    return st;
+}
+
+static int case_moreau_general(void)
+{
+    double M[4] = {1, 0, 0, 2}, K[4] = {4, -1, -1, 3}, W[4] = {-1, 0, 1, -1};
+    double g0[2] = {0.05, 0.02}, e[2] = {0.7, 0.3};
+    pd_model md = {2, 2, pd_matrix_dense(2, 2, M), {PD_MATRIX_ZERO, 2, 2, NULL},
+                   pd_matrix_dense(2, 2, K), pd_matrix_dense(2, 2, W), g0, e, NULL, NULL, NULL, 0};
+    pd_mj_opts o = pd_mj_default_opts();
+    pd_err err;
+    double v0[2] = {1.0, -1.0};
+    o.h = 1e-3;
+    pd_mj *mj = pd_mj_alloc(&md, &o, &err);
+    if (!mj)
+        return err.status;
+    int st = pd_mj_reset(mj, 0.0, NULL, v0, &err);
+    if (!st)
+        st = pd_mj_run(mj, 200, NULL, NULL, &err);
+    pd_mj_free(mj);
+    return st;
+}
+
+static int case_oscillator(void)
+{
+    pd_osc c = {PD_PULSE_SINE, 1, 1.0, 1.0, 0.5, 0.05, 0.5, 0.05};
+    pd_osc_opts o = pd_osc_default_opts();
+    pd_osc_result r;
+    pd_err err;
+    o.dt = 0.01;
+    return pd_osc_simulate(&c, &o, NULL, NULL, &r, &err);
+}
+
+static int case_penalty(void)
+{
+    pd_osc c = {PD_PULSE_SINE, 1, 1.0, 1.0, 0.5, 0.05, 0.5, 0.05};
+    pd_osc_opts o = pd_osc_default_opts();
+    pd_osc_result r;
+    pd_err err;
+    o.dt = 0.01;
+    return pd_osc_penalty(&c, &o, NULL, NULL, NULL, &r, &err);
+}
+
+static int case_lcp_read(void)
+{
+    char path[] = "/tmp/pd_alloc_lcpXXXXXX";
+    int fd = mkstemp(path);
+    if (fd < 0)
+        return PD_EIO;
+    const char text[] = "2\n2 -1\n-1 2\n-1 1\n";
+    int ok = write(fd, text, sizeof text - 1) == (ssize_t)(sizeof text - 1);
+    close(fd);
+    int n;
+    double *M = NULL, *q = NULL;
+    pd_err err;
+    int st = ok ? pd_lcp_read(path, PD_LCP_FORMAT_PLAIN, &n, &M, &q, &err) : PD_EIO;
+    free(M);
+    free(q);
+    unlink(path);
+    return st;
+}
+
+static void test_alloc_every_failure_reported(pd_test_ctx *ctx)
+{
+    long n[5];
+    n[0] = fail_each(ctx, "pd_lcp_alloc", case_lcp);
+    n[1] = fail_each(ctx, "pd_mj_alloc (general)", case_moreau_general);
+    n[2] = fail_each(ctx, "pd_osc_simulate", case_oscillator);
+    n[3] = fail_each(ctx, "pd_osc_penalty", case_penalty);
+    n[4] = fail_each(ctx, "pd_lcp_read", case_lcp_read);
+    CHECK(ctx, n[1] >= 10, "the general kernel takes many allocations (%ld)", n[1]);
+}
+
+void suite_alloc(pd_test_ctx *ctx)
+{
+    PD_RUN(ctx, test_alloc_every_failure_reported);
+}
