@@ -157,6 +157,8 @@ typedef struct pd_edg_opts {
     int no_accumulation;    /* 1: never jump an accumulation */
     long max_events;        /* 0 = 10^6 */
     long max_burst;         /* impacts of one accumulation before giving up (0 = 10^5) */
+    double length_scale;    /* accumulation jumped once the bounce height is below
+                               1e-10 * length_scale (0 = 1), as in pd_ed_opts */
 } pd_edg_opts;
 
 typedef struct pd_edg_result {

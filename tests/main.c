@@ -76,6 +76,7 @@ int main(int argc, char **argv)
     suite_oscillator(&ctx);
     suite_penalty(&ctx);
     suite_reference(&ctx);
+    suite_event(&ctx);
     suite_paper(&ctx);
     suite_cli(&ctx);
     suite_spectrum(&ctx);

@@ -1,0 +1,1262 @@
+/* event.c — event-driven reference for the general system (SPEC §2):
+ *
+ *   M q'' + C q' + K q = F(t) + W lambda,   g = g0 + W^T q >= 0 ⊥ lambda >= 0.
+ *
+ * Smooth motion: y = (d, v, z) by GSL rk8pd under step control, q = qref + d
+ * with qref re-based at every event (small d keeps gaps near an impact to
+ * full relative precision), z' = lambda (the contact impulses, so that the
+ * control also resolves the contact forces).  The persistent contacts A are
+ * held by their acceleration LCP; while every lambda_a > 0 its solution is
+ * the linear system
+ *     D_AA lambda_A = -W_A^T M^-1 (F - C v - K q),   D = W^T M^-1 W,
+ * factored once per set.  After each accepted step q and v are projected
+ * M-orthogonally back onto g_A = 0, U_A = W_A^T v = 0.
+ *
+ * Events, located on the re-integrated motion (one rk8pd step from the start
+ * of the accepted step, never perturbing it):
+ *   gap closing   a free gap sampled on the quintic Hermite of the step goes
+ *                 below its rounding level (interior minima included: grazing);
+ *   detachment    a held contact force lambda_a turns negative;
+ *   breakpoint    the integrator stops at each model break and restarts from F(t+);
+ *   t1.
+ * At an event: one velocity LCP (Newton's law) over every contact at zero
+ * gap, then one acceleration LCP over those at zero gap and zero rate
+ * decides A (lambda > 0).  Accumulations of impacts are jumped to persistent
+ * contact (docs/event.md). */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_odeiv2.h>
+
+#include "pd_engine.h"
+
+#define EDG_GAP_SAMPLES 16  /* gap samples per accepted step */
+#define EDG_FORCE_SAMPLES 8 /* contact-force samples per step */
+#define EDG_ZERO 1e-12      /* relative size of a "zero" gap or rate */
+#define EDG_NEAR 1e-6       /* relative interpolant minimum checked on the true motion */
+#define EDG_BOUNCE 1e-10    /* relative bounce height that ends an accumulation */
+#define EDG_STUCK 100       /* events at one instant before giving up */
+
+enum { EV_NONE = 0, EV_GAP = 1, EV_FORCE = 2 };
+
+typedef struct edg {
+    const pd_model *md;
+    pd_edg_opts o;
+    pd_edg_result *res;
+    pd_observer obs;
+    void *obs_ctx;
+    int n, m, dim;        /* dim = 2 n + m */
+    double t0, t1, t;     /* run interval, current time */
+    double seg_a, seg_b;  /* current smooth segment (between breakpoints) */
+    double ta, tb, h;     /* accepted step [ta, tb], next step size */
+    int next_break, stopped, lcp_pivots;
+    long next_out;        /* index k of the next output time t0 + k h_out */
+    double last_event;    /* time of the last event */
+    long same_instant;    /* consecutive events within rounding of it */
+    double last_emit;
+    /* constant data */
+    double *Wd;           /* n x m dense copy of W */
+    double *Mlu;          /* n x n LU of M */
+    int *Mperm;
+    double *MinvW;        /* n x m: M^-1 W */
+    double *D;            /* m x m: W^T M^-1 W */
+    /* persistent contacts */
+    unsigned char *inA;
+    int *idxA, *posA, nA;
+    double *Dlu;          /* nA x nA LU of D_AA */
+    int *Dperm;
+    double *lam;          /* nA: contact forces of the last acceleration */
+    double *tmpA;         /* nA: projection work */
+    /* states: q = qref + d */
+    double *qref, *Kqref; /* n: reference displacement and K qref */
+    double *gref, *gscale; /* m: gap at qref, and its rounding scale */
+    double *y, *ya, *fa, *fb, *yp, *yev, *yerr, *acc, *qs, *vs;
+    double *ga, *Ua, *Ga, *gb, *Ub, *Gb; /* m: gap, rate, acceleration at ta and tb */
+    /* contacts at an event */
+    double *g, *U, *Um, *vsc, *vpre, *tolg, *tolU, *P, *tail, *Uprev, *rest_from;
+    long *burst;
+    unsigned char *hit, *flag;
+    int *idx;
+    double *Dsub, *bsub, *zsub, *wsub;
+    pd_lcp_work *lcp;
+    /* GSL */
+    gsl_odeiv2_system sys;
+    gsl_odeiv2_step *step, *probe;
+    gsl_odeiv2_control *ctl;
+    gsl_odeiv2_evolve *evo;
+    pd_state st;
+    char *block;
+} edg;
+
+/* ---- workspace ---------------------------------------------------------- */
+
+/* Lay every array out in one block (base NULL: only count the bytes). */
+static size_t layout(edg *w, char *base)
+{
+    size_t off = 0, n = (size_t)w->n, m = w->m > 0 ? (size_t)w->m : 1, d = (size_t)w->dim;
+#define TAKE(ptr, count, type)                                                                \
+    do {                                                                                      \
+        off = (off + 15u) & ~(size_t)15u;                                                     \
+        if (base)                                                                             \
+            (ptr) = (type *)(void *)(base + off);                                             \
+        off += (size_t)(count) * sizeof(type);                                                \
+    } while (0)
+    TAKE(w->Wd, n * m, double);
+    TAKE(w->Mlu, n * n, double);
+    TAKE(w->Mperm, n, int);
+    TAKE(w->MinvW, n * m, double);
+    TAKE(w->D, m * m, double);
+    TAKE(w->inA, m, unsigned char);
+    TAKE(w->idxA, m, int);
+    TAKE(w->posA, m, int);
+    TAKE(w->Dlu, m * m, double);
+    TAKE(w->Dperm, m, int);
+    TAKE(w->lam, m, double);
+    TAKE(w->tmpA, m, double);
+    TAKE(w->qref, n, double);
+    TAKE(w->Kqref, n, double);
+    TAKE(w->gref, m, double);
+    TAKE(w->gscale, m, double);
+    TAKE(w->y, d, double);
+    TAKE(w->ya, d, double);
+    TAKE(w->fa, d, double);
+    TAKE(w->fb, d, double);
+    TAKE(w->yp, d, double);
+    TAKE(w->yev, d, double);
+    TAKE(w->yerr, d, double);
+    TAKE(w->acc, n, double);
+    TAKE(w->qs, n, double);
+    TAKE(w->vs, n, double);
+    TAKE(w->ga, m, double);
+    TAKE(w->Ua, m, double);
+    TAKE(w->Ga, m, double);
+    TAKE(w->gb, m, double);
+    TAKE(w->Ub, m, double);
+    TAKE(w->Gb, m, double);
+    TAKE(w->g, m, double);
+    TAKE(w->U, m, double);
+    TAKE(w->Um, m, double);
+    TAKE(w->vsc, m, double);
+    TAKE(w->vpre, m, double);
+    TAKE(w->tolg, m, double);
+    TAKE(w->tolU, m, double);
+    TAKE(w->P, m, double);
+    TAKE(w->tail, m, double);
+    TAKE(w->Uprev, m, double);
+    TAKE(w->rest_from, m, double);
+    TAKE(w->burst, m, long);
+    TAKE(w->hit, m, unsigned char);
+    TAKE(w->flag, m, unsigned char);
+    TAKE(w->idx, m, int);
+    TAKE(w->Dsub, m * m, double);
+    TAKE(w->bsub, m, double);
+    TAKE(w->zsub, m, double);
+    TAKE(w->wsub, m, double);
+    TAKE(w->st.q, n, double);
+    TAKE(w->st.v, n, double);
+    TAKE(w->st.P, m, double);
+    TAKE(w->st.g, m, double);
+    TAKE(w->st.active, m, unsigned char);
+#undef TAKE
+    return off;
+}
+
+/* Release what edg_alloc took (NULL members are skipped). */
+static void edg_free(edg *w)
+{
+    if (w->evo)
+        gsl_odeiv2_evolve_free(w->evo);
+    if (w->ctl)
+        gsl_odeiv2_control_free(w->ctl);
+    if (w->probe)
+        gsl_odeiv2_step_free(w->probe);
+    if (w->step)
+        gsl_odeiv2_step_free(w->step);
+    pd_lcp_free(w->lcp);
+    free(w->block);
+}
+
+static int ode_rhs(double t, const double y[], double dydt[], void *params);
+
+/* Every array, the LCP workspace and the GSL objects, once per run. */
+static int edg_alloc(edg *w, pd_err *err)
+{
+    size_t bytes = layout(w, NULL);
+    w->block = calloc(1, bytes);
+    if (w->block)
+        layout(w, w->block);
+    w->step = gsl_odeiv2_step_alloc(gsl_odeiv2_step_rk8pd, (size_t)w->dim);
+    w->probe = gsl_odeiv2_step_alloc(gsl_odeiv2_step_rk8pd, (size_t)w->dim);
+    w->ctl = gsl_odeiv2_control_y_new(w->o.atol, w->o.rtol);
+    w->evo = gsl_odeiv2_evolve_alloc((size_t)w->dim);
+    w->lcp = pd_lcp_alloc(w->m > 0 ? w->m : 1);
+    if (!w->block || !w->step || !w->probe || !w->ctl || !w->evo || !w->lcp)
+        return pd_err_set(err, PD_ENOMEM, "event-driven: out of memory for n = %d, m = %d", w->n,
+                          w->m);
+    w->sys = (gsl_odeiv2_system){ode_rhs, NULL, (size_t)w->dim, w};
+    return PD_OK;
+}
+
+/* ---- checks ----------------------------------------------------------- */
+
+/* Options in range, zeros replaced by the defaults. */
+static int check_opts(pd_edg_opts *o, pd_err *err)
+{
+    if (!(o->rtol >= 0.0 && o->atol >= 0.0 && isfinite(o->rtol) && isfinite(o->atol)))
+        return pd_err_set(err, PD_EINVAL, "event-driven: rtol and atol must be finite and >= 0");
+    if (!(o->h_out >= 0.0) || !isfinite(o->h_out))
+        return pd_err_set(err, PD_EINVAL, "event-driven: h_out must be finite and >= 0 (got %g)",
+                          o->h_out);
+    if (!(o->length_scale >= 0.0) || !isfinite(o->length_scale))
+        return pd_err_set(err, PD_EINVAL, "event-driven: length_scale must be finite and >= 0");
+    if (o->max_events < 0 || o->max_burst < 0)
+        return pd_err_set(err, PD_EINVAL, "event-driven: budgets must be >= 0");
+    o->rtol = o->rtol > 0.0 ? o->rtol : 1e-12;
+    o->atol = o->atol > 0.0 ? o->atol : 1e-14;
+    o->max_events = o->max_events > 0 ? o->max_events : 1000000L;
+    o->max_burst = o->max_burst > 0 ? o->max_burst : 100000L;
+    o->length_scale = o->length_scale > 0.0 ? o->length_scale : 1.0;
+    return PD_OK;
+}
+
+/* Model, interval and initial state; the message names what is wrong. */
+static int check_inputs(const pd_model *md, double t0, const double *q0, const double *v0,
+                        double t1, pd_err *err)
+{
+    int rc = pd_model_check(md, err);
+    if (rc)
+        return rc;
+    if (!isfinite(t0) || !isfinite(t1) || !(t1 > t0))
+        return pd_err_set(err, PD_EINVAL, "event-driven: t1 = %g must be finite and after t0 = %g",
+                          t1, t0);
+    for (int i = 0; i < md->n; i++)
+        if ((q0 && !isfinite(q0[i])) || (v0 && !isfinite(v0[i])))
+            return pd_err_set(err, PD_EINVAL, "event-driven: initial state of dof %d is not finite",
+                              i);
+    return PD_OK;
+}
+
+/* ---- linear algebra ----------------------------------------------------- */
+
+/* x^T y over n entries. */
+static double dot(const double *x, const double *y, int n)
+{
+    double s = 0.0;
+    for (int i = 0; i < n; i++)
+        s += x[i] * y[i];
+    return s;
+}
+
+/* y += s x over n entries. */
+static void axpy(double s, const double *x, double *y, int n)
+{
+    if (s != 0.0)
+        for (int i = 0; i < n; i++)
+            y[i] += s * x[i];
+}
+
+/* LU of M, then M^-1 W and D = W^T M^-1 W. */
+static int factor_mass(edg *w, pd_err *err)
+{
+    int n = w->n, m = w->m;
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++)
+            w->Mlu[i + (size_t)j * n] = pd_matrix_get(&w->md->M, i, j);
+    if (pd_dense_lu(n, w->Mlu, w->Mperm))
+        return pd_err_set(err, PD_ESINGULAR, "event-driven: the mass matrix M is singular");
+    for (int a = 0; a < m; a++) {
+        double *col = w->MinvW + (size_t)a * n;
+        for (int i = 0; i < n; i++)
+            w->Wd[i + (size_t)a * n] = col[i] = pd_matrix_get(&w->md->W, i, a);
+        pd_dense_lu_solve(n, w->Mlu, w->Mperm, col);
+    }
+    for (int b = 0; b < m; b++)
+        for (int a = 0; a < m; a++)
+            w->D[a + (size_t)b * m] = dot(w->Wd + (size_t)a * n, w->MinvW + (size_t)b * n, n);
+    return PD_OK;
+}
+
+/* Dsub = D[idx, idx] for k contacts. */
+static void delassus(const edg *w, const int *idx, int k, double *Dsub)
+{
+    for (int s = 0; s < k; s++)
+        for (int r = 0; r < k; r++)
+            Dsub[r + (size_t)s * k] = w->D[idx[r] + (size_t)idx[s] * w->m];
+}
+
+/* Index list of A from the flags inA, and the LU of D_AA. */
+static int factor_set(edg *w, double t, pd_err *err)
+{
+    w->nA = 0;
+    for (int a = 0; a < w->m; a++) {
+        w->posA[a] = -1;
+        if (w->inA[a]) {
+            w->posA[a] = w->nA;
+            w->idxA[w->nA++] = a;
+        }
+    }
+    delassus(w, w->idxA, w->nA, w->Dlu);
+    if (w->nA && pd_dense_lu(w->nA, w->Dlu, w->Dperm))
+        return pd_err_set(err, PD_ESINGULAR,
+                          "event-driven: the %d contacts in persistent contact at t = %.9g (first: "
+                          "contact %d) are redundant (D_AA singular)",
+                          w->nA, t, w->idxA[0]);
+    return PD_OK;
+}
+
+/* x -= M^-1 W_A D_AA^-1 r_A, r_a = W_a^T x + shift_a (shift NULL = 0):
+ * the M-orthogonal projection onto W_A^T x + shift_A = 0. */
+static void project_on_A(edg *w, double *x, const double *shift)
+{
+    int n = w->n;
+    if (!w->nA)
+        return;
+    for (int r = 0; r < w->nA; r++) {
+        int a = w->idxA[r];
+        w->tmpA[r] = dot(w->Wd + (size_t)a * n, x, n) + (shift ? shift[a] : 0.0);
+    }
+    pd_dense_lu_solve(w->nA, w->Dlu, w->Dperm, w->tmpA);
+    for (int r = 0; r < w->nA; r++)
+        axpy(-w->tmpA[r], w->MinvW + (size_t)w->idxA[r] * n, x, w->n);
+}
+
+/* Hold A exactly: g_A(q) = 0 and U_A(v) = 0. */
+static void project(edg *w, double *y)
+{
+    if (!w->nA)
+        return;
+    project_on_A(w, y, w->gref);
+    project_on_A(w, y + w->n, NULL);
+}
+
+/* ---- the smooth motion -------------------------------------------------- */
+
+/* F(t), the limit from inside the current segment [seg_a, seg_b]. */
+static void force_at(const edg *w, double t, double *out)
+{
+    const pd_model *md = w->md;
+    if (!md->force) {
+        memset(out, 0, (size_t)w->n * sizeof(double));
+        return;
+    }
+    double tc = fmin(fmax(t, w->seg_a), w->seg_b);
+    md->force(tc, tc - w->seg_a <= w->seg_b - tc ? +1 : -1, out, md->force_ctx);
+}
+
+/* acc = M^-1 (F - C v - K q + W_A lambda_A), q = qref + d, with
+ * D_AA lambda_A = -W_A^T M^-1 (F - C v - K q)  (lambda_A left in w->lam). */
+static void accel(edg *w, double t, const double *d, const double *v, double *acc)
+{
+    int n = w->n;
+    force_at(w, t, acc);
+    pd_matrix_gemv(&w->md->C, -1.0, v, 1.0, acc);
+    pd_matrix_gemv(&w->md->K, -1.0, d, 1.0, acc);
+    for (int i = 0; i < n; i++)
+        acc[i] -= w->Kqref[i];
+    pd_dense_lu_solve(n, w->Mlu, w->Mperm, acc);
+    if (!w->nA)
+        return;
+    for (int r = 0; r < w->nA; r++)
+        w->lam[r] = -dot(w->Wd + (size_t)w->idxA[r] * n, acc, n);
+    pd_dense_lu_solve(w->nA, w->Dlu, w->Dperm, w->lam);
+    for (int r = 0; r < w->nA; r++)
+        axpy(w->lam[r], w->MinvW + (size_t)w->idxA[r] * n, acc, n);
+}
+
+/* y' = (v, q'', lambda) for GSL. */
+static int ode_rhs(double t, const double y[], double dydt[], void *params)
+{
+    edg *w = params;
+    int n = w->n;
+    memcpy(dydt, y + n, (size_t)n * sizeof(double));
+    accel(w, t, y, y + n, dydt + n);
+    for (int a = 0; a < w->m; a++)
+        dydt[2 * n + a] = w->posA[a] >= 0 ? w->lam[w->posA[a]] : 0.0;
+    for (int i = n; i < 2 * n; i++)
+        if (!isfinite(dydt[i]))
+            return GSL_EBADFUNC;
+    return GSL_SUCCESS;
+}
+
+/* yp = y(t), ta <= t <= tb: one rk8pd step of t - ta from (ta, ya). */
+static int probe(edg *w, double t, pd_err *err)
+{
+    memcpy(w->yp, w->ya, (size_t)w->dim * sizeof(double));
+    if (t == w->ta)
+        return PD_OK;
+    int s = gsl_odeiv2_step_apply(w->probe, w->ta, t - w->ta, w->yp, w->yerr, w->fa, NULL, &w->sys);
+    if (s != GSL_SUCCESS)
+        return pd_err_set(err, PD_ENUMERICAL, "event-driven: re-integration to t = %.9g failed: %s",
+                          t, gsl_strerror(s));
+    return PD_OK;
+}
+
+/* Gap of contact a at q = qref + d: gref_a + W_a^T d. */
+static double gap_of(const edg *w, int a, const double *d)
+{
+    return w->gref[a] + dot(w->Wd + (size_t)a * w->n, d, w->n);
+}
+
+/* Rounding level of a gap computed from the state y = (d, v) over a step
+ * of length h: 4 eps (gscale_a + |gref_a| + sum_i |W_ia| (|d_i| + h |v_i|)). */
+static double gap_noise(const edg *w, int a, const double *y, double h)
+{
+    const double *col = w->Wd + (size_t)a * w->n;
+    double s = w->gscale[a] + fabs(w->gref[a]);
+    for (int i = 0; i < w->n; i++)
+        s += fabs(col[i]) * (fabs(y[i]) + h * fabs(y[w->n + i]));
+    return 4.0 * DBL_EPSILON * s;
+}
+
+/* K qref, gref = g0 + W^T qref and its scale |g0| + sum_i |W_ia qref_i|. */
+static void set_reference(edg *w)
+{
+    int n = w->n;
+    pd_matrix_gemv(&w->md->K, 1.0, w->qref, 0.0, w->Kqref);
+    for (int a = 0; a < w->m; a++) {
+        const double *col = w->Wd + (size_t)a * n;
+        double s = fabs(w->md->g0[a]);
+        for (int i = 0; i < n; i++)
+            s += fabs(col[i] * w->qref[i]);
+        w->gref[a] = w->md->g0[a] + dot(col, w->qref, n);
+        w->gscale[a] = s;
+    }
+}
+
+/* New reference at an event: qref += d, d = 0. */
+static void rebase(edg *w)
+{
+    for (int i = 0; i < w->n; i++) {
+        w->qref[i] += w->y[i];
+        w->y[i] = 0.0;
+    }
+    set_reference(w);
+}
+
+/* Gap, rate and acceleration of every contact at both ends of the step. */
+static void step_ends(edg *w)
+{
+    int n = w->n;
+    for (int a = 0; a < w->m; a++) {
+        const double *col = w->Wd + (size_t)a * n;
+        w->ga[a] = gap_of(w, a, w->ya);
+        w->Ua[a] = dot(col, w->ya + n, n);
+        w->Ga[a] = dot(col, w->fa + n, n);
+        w->gb[a] = gap_of(w, a, w->y);
+        w->Ub[a] = dot(col, w->y + n, n);
+        w->Gb[a] = dot(col, w->fb + n, n);
+    }
+}
+
+/* One accepted GSL step from t toward the segment end; fa, fb the rates at
+ * both ends. */
+static int step_once(edg *w, pd_err *err)
+{
+    w->ta = w->t;
+    memcpy(w->ya, w->y, (size_t)w->dim * sizeof(double));
+    int s = ode_rhs(w->ta, w->ya, w->fa, w);
+    double h_try = w->h;
+    /* GSL keeps the end rate of the last step as the next start rate: y, t or
+     * the rates may have changed since (projection, event, breakpoint). */
+    gsl_odeiv2_evolve_reset(w->evo);
+    if (s == GSL_SUCCESS)
+        s = gsl_odeiv2_evolve_apply(w->evo, w->ctl, w->step, &w->sys, &w->t, w->seg_b, &w->h, w->y);
+    if (s == GSL_SUCCESS)
+        s = ode_rhs(w->t, w->y, w->fb, w);
+    if (s != GSL_SUCCESS)
+        return pd_err_set(err, PD_ENONFINITE, "event-driven: integration failed at t = %.9g: %s",
+                          w->ta, gsl_strerror(s));
+    if (w->t == w->seg_b && w->h < h_try) /* a step cut at the segment end says nothing */
+        w->h = h_try;
+    w->tb = w->t;
+    w->res->steps++;
+    step_ends(w);
+    return PD_OK;
+}
+
+/* ---- event location ----------------------------------------------------- */
+
+/* Quintic Hermite at s in [0, 1] of the step of length h from
+ * (f, f', f'') = p0 at 0 and p1 at 1: value *f and time rate *fd. */
+static void quintic(const double p0[3], const double p1[3], double h, double s, double *f,
+                    double *fd)
+{
+    double s2 = s * s, s3 = s2 * s, s4 = s3 * s, s5 = s4 * s;
+    double H1 = s - 6 * s3 + 8 * s4 - 3 * s5, H2 = 0.5 * (s2 - 3 * s3 + 3 * s4 - s5);
+    double H3 = 10 * s3 - 15 * s4 + 6 * s5, H4 = -4 * s3 + 7 * s4 - 3 * s5;
+    double H5 = 0.5 * (s3 - 2 * s4 + s5);
+    double D1 = 1 - 18 * s2 + 32 * s3 - 15 * s4, D2 = 0.5 * (2 * s - 9 * s2 + 12 * s3 - 5 * s4);
+    double D3 = 30 * s2 - 60 * s3 + 30 * s4, D4 = -12 * s2 + 28 * s3 - 15 * s4;
+    double D5 = 0.5 * (3 * s2 - 8 * s3 + 5 * s4);
+    *f = p0[0] + (p1[0] - p0[0]) * H3 + h * (p0[1] * H1 + p1[1] * H4) +
+         h * h * (p0[2] * H2 + p1[2] * H5);
+    *fd = (p1[0] - p0[0]) * D3 / h + p0[1] * D1 + p1[1] * D4 + h * (p0[2] * D2 + p1[2] * D5);
+}
+
+/* The interpolated state (qs, vs) at fraction s of the step. */
+static void interp_state(edg *w, double s)
+{
+    int n = w->n;
+    double h = w->tb - w->ta;
+    for (int i = 0; i < n; i++) {
+        double p0[3] = {w->ya[i], w->ya[n + i], w->fa[n + i]};
+        double p1[3] = {w->y[i], w->y[n + i], w->fb[n + i]};
+        quintic(p0, p1, h, s, &w->qs[i], &w->vs[i]);
+    }
+}
+
+/* Minimum of the interpolant between s0 (rate < 0) and s1 (rate > 0):
+ * bisection on the rate. */
+static double min_between(const double p0[3], const double p1[3], double h, double s0, double s1)
+{
+    for (int it = 0; it < 60; it++) {
+        double sm = 0.5 * (s0 + s1), f, fd;
+        quintic(p0, p1, h, sm, &f, &fd);
+        if (fd < 0.0)
+            s0 = sm;
+        else
+            s1 = sm;
+    }
+    return 0.5 * (s0 + s1);
+}
+
+/* Gap of contact a near a shallow interpolant minimum at tm, on the true
+ * motion: two Newton steps t -= U / G toward the true minimum; found when it
+ * lies below -thr (a grazing impact), with the bracket [ta, t]. */
+static int graze_check(edg *w, int a, double tm, double thr, double *lo, double *hi, int *found,
+                       pd_err *err)
+{
+    int n = w->n, rc = PD_OK;
+    const double *col = w->Wd + (size_t)a * n;
+    for (int it = 0; it < 3 && !rc; it++) {
+        if ((rc = probe(w, tm, err)))
+            break;
+        if (gap_of(w, a, w->yp) < -thr) {
+            *lo = w->ta;
+            *hi = tm;
+            *found = 1;
+            break;
+        }
+        accel(w, tm, w->yp, w->yp + n, w->acc);
+        double U = dot(col, w->yp + n, n), G = dot(col, w->acc, n);
+        if (it == 2 || !(G > 0.0))
+            break;
+        tm = fmin(tm - U / G, w->tb);
+        if (!(tm > w->ta))
+            break;
+    }
+    return rc;
+}
+
+/* Earliest closing of free contact a in the step on the quintic interpolant
+ * of its gap: the first sample below -thr or an interior minimum below it
+ * (grazing); a shallow interior minimum is checked on the true motion.
+ * found = 1 with the bracket [lo, hi] (gap >= 0 at lo on the interpolant). */
+static int scan_gap(edg *w, int a, double *lo, double *hi, int *found, pd_err *err)
+{
+    double h = w->tb - w->ta, thr = gap_noise(w, a, w->ya, h);
+    double p0[3] = {w->ga[a], w->Ua[a], w->Ga[a]}, p1[3] = {w->gb[a], w->Ub[a], w->Gb[a]};
+    double slo = 0.0, sprev = 0.0, dprev = p0[1], gmin = HUGE_VAL, smin = 0.0;
+    *found = 0;
+    for (int k = 1; k <= EDG_GAP_SAMPLES; k++) {
+        double s = (double)k / EDG_GAP_SAMPLES, f, fd;
+        quintic(p0, p1, h, s, &f, &fd);
+        if (dprev < 0.0 && fd > 0.0) { /* interior minimum in (sprev, s) */
+            double sm = min_between(p0, p1, h, sprev, s), fm, fdm;
+            quintic(p0, p1, h, sm, &fm, &fdm);
+            if (fm < -thr) {
+                *lo = w->ta + slo * h;
+                *hi = w->ta + sm * h;
+                *found = 1;
+                return PD_OK;
+            }
+            if (fm < gmin) {
+                gmin = fm;
+                smin = sm;
+            }
+        }
+        if (f < -thr) {
+            *lo = w->ta + slo * h;
+            *hi = k == EDG_GAP_SAMPLES ? w->tb : w->ta + s * h;
+            *found = 1;
+            return PD_OK;
+        }
+        if (f >= 0.0)
+            slo = s;
+        sprev = s;
+        dprev = fd;
+    }
+    double near = EDG_NEAR * (fabs(p0[0]) + fabs(p1[0]) + h * (fabs(p0[1]) + fabs(p1[1])) +
+                              h * h * (fabs(p0[2]) + fabs(p1[2])));
+    if (gmin < near)
+        return graze_check(w, a, w->ta + smin * h, thr, lo, hi, found, err);
+    return PD_OK;
+}
+
+/* Earliest sample of the step where a held contact force is negative:
+ * found = 1 with the contact *c and the bracket [lo, hi]. */
+static void scan_force(edg *w, double *lo, double *hi, int *c, int *found)
+{
+    double h = w->tb - w->ta, sprev = 0.0;
+    *found = 0;
+    for (int k = 1; k <= EDG_FORCE_SAMPLES; k++) {
+        double s = (double)k / EDG_FORCE_SAMPLES;
+        double t = k == EDG_FORCE_SAMPLES ? w->tb : w->ta + s * h;
+        interp_state(w, s);
+        accel(w, t, w->qs, w->vs, w->acc);
+        for (int r = 0; r < w->nA; r++)
+            if (w->lam[r] < 0.0) {
+                *c = w->idxA[r];
+                *lo = w->ta + sprev * h;
+                *hi = t;
+                *found = 1;
+                return;
+            }
+        sprev = s;
+    }
+}
+
+/* The earliest candidate event of the accepted step (kind EV_NONE: none). */
+static int scan(edg *w, int *kind, int *c, double *lo, double *hi, pd_err *err)
+{
+    int rc = PD_OK, found;
+    double l, u;
+    *kind = EV_NONE;
+    for (int a = 0; a < w->m && !rc; a++) {
+        if (w->inA[a])
+            continue;
+        rc = scan_gap(w, a, &l, &u, &found, err);
+        if (!rc && found && (*kind == EV_NONE || u < *hi)) {
+            *kind = EV_GAP;
+            *c = a;
+            *lo = l;
+            *hi = u;
+        }
+    }
+    if (rc || !w->nA)
+        return rc;
+    int cf;
+    scan_force(w, &l, &u, &cf, &found);
+    if (found && (*kind == EV_NONE || u < *hi)) {
+        *kind = EV_FORCE;
+        *c = cf;
+        *lo = l;
+        *hi = u;
+    }
+    return PD_OK;
+}
+
+/* Event function on the true motion at t (state left in yp): the gap of c
+ * (EV_GAP) or its held contact force (EV_FORCE). */
+static int value(edg *w, int kind, int c, double t, double *f, pd_err *err)
+{
+    int rc = probe(w, t, err);
+    if (rc)
+        return rc;
+    if (kind == EV_GAP) {
+        *f = gap_of(w, c, w->yp);
+    } else {
+        accel(w, t, w->yp, w->yp + w->n, w->acc);
+        *f = w->lam[w->posA[c]];
+    }
+    return PD_OK;
+}
+
+/* Illinois regula falsi on f(lo) >= 0 > f(hi) to adjacent doubles, bisecting
+ * when the bracket fails to halve in three iterations; *t_ev = hi side
+ * (f <= 0 there), its state in yp. */
+static int illinois(edg *w, int kind, int c, double lo, double flo, double hi, double fhi,
+                    double *t_ev, pd_err *err)
+{
+    int side = 0, rc = PD_OK;
+    double wref = hi - lo, last = NAN;
+    for (int it = 0; it < 200 && !rc; it++) {
+        if (!(hi - lo > 4.0 * DBL_EPSILON * fmax(fabs(lo), fabs(hi))))
+            break;
+        double tc = (flo * hi - fhi * lo) / (flo - fhi), f;
+        if (it % 3 == 0 && it > 0) {
+            if (hi - lo > 0.5 * wref)
+                tc = 0.5 * (lo + hi);
+            wref = hi - lo;
+        }
+        if (!(tc > lo && tc < hi))
+            tc = 0.5 * (lo + hi);
+        if (tc <= lo || tc >= hi)
+            break;
+        if ((rc = value(w, kind, c, tc, &f, err)))
+            break;
+        last = tc;
+        if (f < 0.0) {
+            hi = tc;
+            fhi = f;
+            if (side == -1)
+                flo *= 0.5;
+            side = -1;
+        } else {
+            lo = tc;
+            flo = f;
+            if (side == 1)
+                fhi *= 0.5;
+            side = 1;
+        }
+    }
+    *t_ev = hi;
+    if (!rc && last != hi)
+        rc = probe(w, hi, err);
+    return rc;
+}
+
+/* A contact that crossed before t (state in yp): a free gap below its zero
+ * tolerance, or a held force below zero.  Returns 1 with its kind and index. */
+static int earlier_event(edg *w, double t, int c, int *kind, int *a_out)
+{
+    int n = w->n;
+    for (int a = 0; a < w->m; a++) {
+        if (w->inA[a] || a == c)
+            continue;
+        double g = gap_of(w, a, w->yp), U = dot(w->Wd + (size_t)a * n, w->yp + n, n);
+        double tol = EDG_ZERO * gap_noise(w, a, w->yp, 0.0) / (4.0 * DBL_EPSILON) +
+                     64.0 * DBL_EPSILON * fabs(t) * fabs(U);
+        if (g < -tol) {
+            *kind = EV_GAP;
+            *a_out = a;
+            return 1;
+        }
+    }
+    if (!w->nA)
+        return 0;
+    accel(w, t, w->yp, w->yp + n, w->acc);
+    for (int r = 0; r < w->nA; r++)
+        if (w->lam[r] < 0.0 && w->idxA[r] != c) {
+            *kind = EV_FORCE;
+            *a_out = w->idxA[r];
+            return 1;
+        }
+    return 0;
+}
+
+/* Locate the candidate (kind, c) bracketed by [lo, hi] on the true motion.
+ * On return w->yev holds the state at *t_ev; *kind = EV_NONE when the true
+ * motion has no event at hi (then the step is cut there). */
+static int locate(edg *w, int *kind, int *c, double lo, double hi, double *t_ev, pd_err *err)
+{
+    int rc = PD_OK;
+    if (!(hi > w->ta)) { /* a dip at the very start is rounding: no event */
+        *kind = EV_NONE;
+        memcpy(w->yev, w->y, (size_t)w->dim * sizeof(double));
+        *t_ev = w->tb;
+        return PD_OK;
+    }
+    for (int round = 0; round <= w->m + 1 && !rc; round++) {
+        double fhi, flo, thr = *kind == EV_GAP ? gap_noise(w, *c, w->ya, w->tb - w->ta) : 0.0;
+        if ((rc = value(w, *kind, *c, hi, &fhi, err)))
+            break;
+        if (!(fhi < -thr)) { /* the interpolant was wrong: no event, cut the step at hi */
+            if (round == 0)
+                *kind = EV_NONE;
+            *t_ev = hi;
+            break;
+        }
+        flo = 0.0;
+        if (lo > w->ta && (rc = value(w, *kind, *c, lo, &flo, err)))
+            break;
+        if (lo <= w->ta || flo < 0.0) {
+            lo = w->ta;
+            flo = 0.0;
+        }
+        if ((rc = illinois(w, *kind, *c, lo, flo, hi, fhi, t_ev, err)))
+            break;
+        if (!earlier_event(w, *t_ev, *c, kind, c))
+            break;
+        lo = w->ta;
+        hi = *t_ev;
+    }
+    memcpy(w->yev, w->yp, (size_t)w->dim * sizeof(double));
+    return rc;
+}
+
+/* ---- observer ----------------------------------------------------------- */
+
+/* Report state y at t (with the event's impulses when with_P). */
+static void emit(edg *w, double t, const double *y, int with_P)
+{
+    pd_state *st = &w->st;
+    if (!w->obs || w->stopped)
+        return;
+    st->step = w->res->steps;
+    st->t = t;
+    for (int i = 0; i < w->n; i++)
+        st->q[i] = w->qref[i] + y[i];
+    memcpy(st->v, y + w->n, (size_t)w->n * sizeof(double));
+    for (int a = 0; a < w->m; a++) {
+        st->g[a] = gap_of(w, a, y);
+        st->P[a] = with_P ? w->P[a] : 0.0;
+        st->active[a] = w->inA[a];
+    }
+    st->nactive = w->nA;
+    st->lcp_pivots = with_P ? w->lcp_pivots : 0;
+    w->last_emit = t;
+    if (w->obs(st, w->obs_ctx) > 0)
+        w->stopped = 1;
+}
+
+/* Output times t0 + k h_out in (ta, t_end], re-integrated from the step
+ * start (the accepted path is untouched). */
+static int emit_grid(edg *w, double t_end, pd_err *err)
+{
+    int rc = PD_OK;
+    if (!(w->o.h_out > 0.0) || !w->obs)
+        return PD_OK;
+    for (;;) {
+        double tk = w->t0 + (double)w->next_out * w->o.h_out;
+        if (tk > t_end || tk > w->t1 || w->stopped)
+            break;
+        if ((rc = probe(w, fmax(tk, w->ta), err)))
+            break;
+        project(w, w->yp);
+        emit(w, tk, w->yp, 0);
+        w->next_out++;
+    }
+    return rc;
+}
+
+/* ---- contacts at an event ---------------------------------------------- */
+
+/* Gaps, rates and their zero tolerances for every contact at t: a gap is
+ * zero below 1e-12 of its rounding scale (plus 64 ulp of t at its rate), a
+ * rate below 1e-12 of sum_i |W_ia v_i| plus vpre (the velocity scale before
+ * an impact and that of its LCP). */
+static void measure(edg *w, double t)
+{
+    int n = w->n;
+    const double *d = w->y, *v = w->y + n;
+    for (int a = 0; a < w->m; a++) {
+        const double *col = w->Wd + (size_t)a * n;
+        double vs = 0.0;
+        for (int i = 0; i < n; i++)
+            vs += fabs(col[i] * v[i]);
+        w->g[a] = gap_of(w, a, d);
+        w->U[a] = dot(col, v, n);
+        w->vsc[a] = vs;
+        w->tolg[a] = EDG_ZERO * gap_noise(w, a, w->y, 0.0) / (4.0 * DBL_EPSILON) +
+                     64.0 * DBL_EPSILON * fabs(t) * fabs(w->U[a]);
+        w->tolU[a] = EDG_ZERO * (vs + w->vpre[a]);
+    }
+}
+
+/* Count an event; PD_EBUDGET past the budget, or after EDG_STUCK events
+ * at one instant (within 64 ulp): the run would make no progress. */
+static int count_event(edg *w, double t, const char *what, int c, pd_err *err)
+{
+    w->same_instant = t - w->last_event <= 64.0 * DBL_EPSILON * fabs(t) ? w->same_instant + 1 : 0;
+    w->last_event = t;
+    if (w->same_instant > EDG_STUCK)
+        return pd_err_set(err, PD_EBUDGET,
+                          "event-driven: no progress at t = %.9g: %ld events at one instant "
+                          "(last: %s of contact %d)",
+                          t, w->same_instant, what, c);
+    if (++w->res->events > w->o.max_events)
+        return pd_err_set(err, PD_EBUDGET,
+                          "event-driven: %ld events by t = %.9g (budget exhausted; last: %s of "
+                          "contact %d)",
+                          w->res->events - 1, t, what, c);
+    return PD_OK;
+}
+
+/* The rates after an impact carry the rounding of its LCP: vpre_a +=
+ * max|b| + max|D_II| max P (velocity scale of the LCP data). */
+static void lcp_rounding(edg *w, int nI)
+{
+    double bmax = 0.0, Dmax = 0.0, Pmax = 0.0;
+    for (int r = 0; r < nI; r++) {
+        bmax = fmax(bmax, fabs(w->bsub[r]));
+        Pmax = fmax(Pmax, w->zsub[r]);
+    }
+    for (int k = 0; k < nI * nI; k++)
+        Dmax = fmax(Dmax, fabs(w->Dsub[k]));
+    for (int a = 0; a < w->m; a++)
+        w->vpre[a] += bmax + Dmax * Pmax;
+}
+
+/* Newton's law over the nI contacts idx at zero gap, one LCP:
+ *   U+ = U- + D_II P,  0 <= U+ + e min(U-, 0) ⊥ P >= 0,  v += M^-1 W_I P. */
+static int impact(edg *w, double t, int nI, pd_err *err)
+{
+    pd_lcp_info info;
+    delassus(w, w->idx, nI, w->Dsub);
+    for (int r = 0; r < nI; r++) {
+        int a = w->idx[r];
+        w->bsub[r] = w->U[a] + w->md->e[a] * fmin(w->U[a], 0.0);
+    }
+    int rc = pd_lcp_lemke(w->lcp, nI, w->Dsub, w->bsub, NULL, w->zsub, w->wsub, &info);
+    w->lcp_pivots = info.pivots;
+    if (rc)
+        return pd_err_set(err, rc,
+                          "event-driven: impact LCP over %d contact(s) (first: contact %d) not "
+                          "solved at t = %.9g: %s",
+                          nI, w->idx[0], t, pd_lcp_outcome_name(info.outcome));
+    for (int r = 0; r < nI; r++) {
+        w->P[w->idx[r]] = w->zsub[r];
+        axpy(w->zsub[r], w->MinvW + (size_t)w->idx[r] * w->n, w->y + w->n, w->n);
+    }
+    lcp_rounding(w, nI);
+    return PD_OK;
+}
+
+/* Impact statistics of the closing contacts, and the burst budget: a burst
+ * is a run of impacts of one contact with shrinking speeds. */
+static int count_impacts(edg *w, double t, int nI, pd_err *err)
+{
+    for (int r = 0; r < nI; r++) {
+        int a = w->idx[r];
+        double speed = -w->Um[a];
+        if (!(w->Um[a] < -w->tolU[a]))
+            continue;
+        w->hit[a] = 1;
+        w->res->impacts++;
+        if (isnan(w->res->first_impact))
+            w->res->first_impact = t;
+        w->burst[a] = speed < w->Uprev[a] * (1.0 - 1e-12) ? w->burst[a] + 1 : 1;
+        w->Uprev[a] = speed;
+        if (w->burst[a] > w->o.max_burst)
+            return pd_err_set(err, PD_EBUDGET,
+                              "event-driven: accumulation of impacts of contact %d at t = %.9g: "
+                              "%ld impacts without reaching persistent contact%s",
+                              a, t, w->burst[a] - 1,
+                              w->o.no_accumulation ? " (accumulation handling is off)" : "");
+    }
+    return PD_OK;
+}
+
+/* Bookkeeping of contacts entering (rest starts) and leaving A (detachment,
+ * contact time), then the new flags. */
+static void commit(edg *w, double t)
+{
+    for (int a = 0; a < w->m; a++) {
+        if (w->inA[a] && !w->flag[a]) {
+            w->res->detachments++;
+            w->res->contact_time += fmax(0.0, t - w->rest_from[a]);
+            w->burst[a] = 0;
+            w->Uprev[a] = 0.0;
+        } else if (!w->inA[a] && w->flag[a]) {
+            w->rest_from[a] = t;
+            w->burst[a] = 0;
+            w->Uprev[a] = 0.0;
+        }
+        w->inA[a] = w->flag[a];
+    }
+}
+
+/* Rates of the nJ contacts idx set exactly to zero (M-orthogonal projection)
+ * when D_JJ is regular; they are zero to EDG_ZERO already. */
+static void zero_rates(edg *w, int nJ)
+{
+    int n = w->n;
+    delassus(w, w->idx, nJ, w->Dsub);
+    if (!nJ || pd_dense_lu(nJ, w->Dsub, w->Dperm))
+        return;
+    for (int r = 0; r < nJ; r++)
+        w->bsub[r] = dot(w->Wd + (size_t)w->idx[r] * n, w->y + n, n);
+    pd_dense_lu_solve(nJ, w->Dsub, w->Dperm, w->bsub);
+    for (int r = 0; r < nJ; r++)
+        axpy(-w->bsub[r], w->MinvW + (size_t)w->idx[r] * n, w->y + n, n);
+}
+
+/* Acceleration LCP over the nJ contacts idx at zero gap and rate:
+ *   g''_J = D_JJ lambda + W_J^T M^-1 (F(t+) - C v - K q) >= 0 ⊥ lambda >= 0,
+ * A = { lambda > 0 }; then A is factored and held. */
+static int decide(edg *w, double t, int nJ, pd_err *err)
+{
+    pd_lcp_info info;
+    int n = w->n, rc;
+    zero_rates(w, nJ);
+    memset(w->flag, 0, (size_t)w->m);
+    w->nA = 0;
+    if (nJ) {
+        accel(w, t, w->y, w->y + n, w->acc);
+        delassus(w, w->idx, nJ, w->Dsub);
+        for (int r = 0; r < nJ; r++)
+            w->bsub[r] = dot(w->Wd + (size_t)w->idx[r] * n, w->acc, n);
+        rc = pd_lcp_lemke(w->lcp, nJ, w->Dsub, w->bsub, NULL, w->zsub, w->wsub, &info);
+        if (rc)
+            return pd_err_set(err, rc,
+                              "event-driven: contact-force LCP over %d contact(s) (first: contact "
+                              "%d) not solved at t = %.9g: %s",
+                              nJ, w->idx[0], t, pd_lcp_outcome_name(info.outcome));
+        for (int r = 0; r < nJ; r++)
+            w->flag[w->idx[r]] = w->zsub[r] > 0.0;
+    }
+    commit(w, t);
+    if ((rc = factor_set(w, t, err)))
+        return rc;
+    project(w, w->y);
+    return PD_OK;
+}
+
+/* The contacts at zero gap and zero rate (except drop) into idx; count. */
+static int zero_set(edg *w, double t, int drop)
+{
+    int nJ = 0;
+    measure(w, t);
+    for (int a = 0; a < w->m; a++)
+        if (a != drop && (w->g[a] <= w->tolg[a] || w->inA[a]) && fabs(w->U[a]) <= w->tolU[a])
+            w->idx[nJ++] = a;
+    return nJ;
+}
+
+/* Accumulation test for contact a bouncing off at U+ > 0 after an impact at t:
+ * closing acceleration acl = -W_a^T q'' > 0, bounce height U+^2 / (2 acl)
+ * below 1e-10 L, tail 2 U+ / (acl (1 - e)) inside the segment, and a held
+ * contact force positive half-way through and at the end of the tail (frozen
+ * state).  On success v has U_a = 0 and tail[a] is set. */
+static int try_jump(edg *w, double t, int a, int *jumped, pd_err *err)
+{
+    int n = w->n, rc, ok = 1;
+    double e = w->md->e[a], Up = w->U[a];
+    *jumped = 0;
+    if (!(e < 1.0) || !(Up > w->tolU[a]))
+        return PD_OK;
+    accel(w, t, w->y, w->y + n, w->acc);
+    double acl = -dot(w->Wd + (size_t)a * n, w->acc, n);
+    if (!(acl > 0.0) || Up * Up / (2.0 * acl) > EDG_BOUNCE * w->o.length_scale)
+        return PD_OK;
+    double tail = 2.0 * Up / (acl * (1.0 - e));
+    if (!(t + tail < w->seg_b))
+        return PD_OK;
+    w->inA[a] = 1; /* held tentatively, on a copy of the state */
+    if (factor_set(w, t, NULL) == PD_OK) {
+        memcpy(w->yp, w->y, (size_t)w->dim * sizeof(double));
+        project_on_A(w, w->yp + n, NULL);
+        for (int k = 1; k <= 2 && ok; k++) {
+            accel(w, t + 0.5 * k * tail, w->yp, w->yp + n, w->acc);
+            ok = w->lam[w->posA[a]] > 0.0;
+        }
+    } else {
+        ok = 0;
+    }
+    w->inA[a] = 0;
+    if ((rc = factor_set(w, t, err)))
+        return rc;
+    if (ok) {
+        memcpy(w->y + n, w->yp + n, (size_t)n * sizeof(double));
+        w->tail[a] = tail;
+        *jumped = 1;
+    }
+    return PD_OK;
+}
+
+/* Accumulations among the contacts that just bounced: jump them to
+ * persistent contact and decide A again. */
+static int jump_accumulations(edg *w, double t, int drop, pd_err *err)
+{
+    int rc = PD_OK, any = 0, jumped;
+    if (w->o.no_accumulation)
+        return PD_OK;
+    memset(w->flag, 0, (size_t)w->m);
+    for (int a = 0; a < w->m && !rc; a++) {
+        if (!w->hit[a] || w->inA[a])
+            continue;
+        measure(w, t);
+        if (!(rc = try_jump(w, t, a, &jumped, err)) && jumped) {
+            w->flag[a] = 2;
+            any = 1;
+        }
+    }
+    if (rc || !any)
+        return rc;
+    for (int a = 0; a < w->m; a++)
+        w->hit[a] = w->flag[a] == 2;
+    if ((rc = decide(w, t, zero_set(w, t, drop), err)))
+        return rc;
+    for (int a = 0; a < w->m; a++)
+        if (w->hit[a] && w->inA[a]) {
+            w->res->accumulations++;
+            w->rest_from[a] = t + w->tail[a];
+            w->burst[a] = 0;
+        }
+    return PD_OK;
+}
+
+/* The nI contacts idx at zero gap put exactly on it: qref projected
+ * M-orthogonally onto g_I = 0 (when D_II is regular), then gref_I = 0. */
+static void snap(edg *w, int nI)
+{
+    int n = w->n;
+    delassus(w, w->idx, nI, w->Dsub);
+    if (!nI || pd_dense_lu(nI, w->Dsub, w->Dperm))
+        return;
+    for (int r = 0; r < nI; r++)
+        w->bsub[r] = w->gref[w->idx[r]];
+    pd_dense_lu_solve(nI, w->Dsub, w->Dperm, w->bsub);
+    for (int r = 0; r < nI; r++)
+        axpy(-w->bsub[r], w->MinvW + (size_t)w->idx[r] * n, w->qref, n);
+    set_reference(w);
+    for (int r = 0; r < nI; r++)
+        w->gref[w->idx[r]] = w->gscale[w->idx[r]] = 0.0;
+}
+
+/* All contacts at an event at t: the reference re-based, impacts of those at
+ * zero gap (forced: the located one), then the new set A (drop: a detaching
+ * contact, kept out). */
+static int resolve(edg *w, double t, int forced, int drop, pd_err *err)
+{
+    int nI = 0, closing = 0, rc;
+    rebase(w);
+    memset(w->vpre, 0, (size_t)w->m * sizeof(double));
+    measure(w, t);
+    memcpy(w->vpre, w->vsc, (size_t)w->m * sizeof(double));
+    for (int a = 0; a < w->m; a++) {
+        w->P[a] = 0.0;
+        w->hit[a] = 0;
+        if (w->g[a] <= w->tolg[a] || a == forced || w->inA[a]) {
+            w->idx[nI++] = a;
+            closing |= w->U[a] < -w->tolU[a];
+        }
+    }
+    snap(w, nI);
+    w->lcp_pivots = 0;
+    if (closing) {
+        memcpy(w->Um, w->U, (size_t)w->m * sizeof(double));
+        if ((rc = impact(w, t, nI, err)) || (rc = count_impacts(w, t, nI, err)))
+            return rc;
+    }
+    if ((rc = decide(w, t, zero_set(w, t, drop), err)))
+        return rc;
+    return closing ? jump_accumulations(w, t, drop, err) : PD_OK;
+}
+
+/* ---- the run -------------------------------------------------------------- */
+
+/* The smooth segment from t: up to the next breakpoint after t, or t1. */
+static void next_segment(edg *w)
+{
+    const pd_model *md = w->md;
+    while (w->next_break < md->nbreaks && md->breaks[w->next_break] <= w->t)
+        w->next_break++;
+    w->seg_a = w->t;
+    w->seg_b = w->next_break < md->nbreaks ? fmin(md->breaks[w->next_break], w->t1) : w->t1;
+}
+
+/* A breakpoint reached: F(t+) from now on, persistent contacts re-decided. */
+static int on_break(edg *w, pd_err *err)
+{
+    int rc = count_event(w, w->t, "breakpoint", -1, err);
+    next_segment(w);
+    if (!rc)
+        rc = resolve(w, w->t, -1, -1, err);
+    if (!rc)
+        emit(w, w->t, w->y, 1);
+    return rc;
+}
+
+/* An impact (EV_GAP) or a detachment (EV_FORCE) of contact c at t. */
+static int on_event(edg *w, int kind, int c, pd_err *err)
+{
+    int rc = count_event(w, w->t, kind == EV_GAP ? "impact" : "detachment", c, err);
+    if (!rc)
+        rc = resolve(w, w->t, kind == EV_GAP ? c : -1, kind == EV_FORCE ? c : -1, err);
+    if (rc)
+        return rc;
+    emit(w, w->t, w->y, 1);
+    return PD_OK;
+}
+
+/* One accepted step, cut at its first event, which is then resolved. */
+static int advance(edg *w, pd_err *err)
+{
+    int kind, c = -1, rc;
+    double lo = 0.0, hi = 0.0, t_end;
+    if ((rc = step_once(w, err)) || (rc = scan(w, &kind, &c, &lo, &hi, err)))
+        return rc;
+    t_end = w->tb;
+    if (kind != EV_NONE && (rc = locate(w, &kind, &c, lo, hi, &t_end, err)))
+        return rc;
+    if ((rc = emit_grid(w, t_end, err)))
+        return rc;
+    if (t_end < w->tb) {
+        memcpy(w->y, w->yev, (size_t)w->dim * sizeof(double));
+        w->t = t_end;
+    }
+    if (kind != EV_NONE)
+        rc = on_event(w, kind, c, err);
+    else {
+        project(w, w->y);
+        if (!(w->o.h_out > 0.0))
+            emit(w, w->t, w->y, 0);
+    }
+    if (!rc && w->t >= w->seg_b && w->t < w->t1)
+        rc = on_break(w, err);
+    return rc;
+}
+
+/* Initial state, contacts at t0 resolved, the first report. */
+static int start(edg *w, const double *q0, const double *v0, pd_err *err)
+{
+    int n = w->n, rc;
+    for (int i = 0; i < n; i++) {
+        w->qref[i] = q0 ? q0[i] : 0.0;
+        w->y[n + i] = v0 ? v0[i] : 0.0;
+    }
+    set_reference(w);
+    w->t = w->t0;
+    next_segment(w);
+    measure(w, w->t0);
+    for (int a = 0; a < w->m; a++)
+        if (w->g[a] < -w->tolg[a])
+            return pd_err_set(err, PD_EINVAL,
+                              "event-driven: initial gap of contact %d is %g < 0 (q0 penetrates)",
+                              a, w->g[a]);
+    w->h = 1e-4 * (w->t1 - w->t0);
+    if ((rc = resolve(w, w->t0, -1, -1, err)))
+        return rc;
+    emit(w, w->t0, w->y, 1);
+    w->next_out = 1;
+    return PD_OK;
+}
+
+/* The run: checks, one allocation, the initial contacts, then accepted
+ * steps and events up to t1; one exit path frees the workspace. */
+int pd_edg_run(const pd_model *model, double t0, const double *q0, const double *v0, double t1,
+               const pd_edg_opts *opts, pd_observer observer, void *ctx, pd_edg_result *res,
+               pd_err *err)
+{
+    edg w;
+    pd_edg_result local;
+    int rc;
+    pd_err_clear(err);
+    memset(&w, 0, sizeof w);
+    w.res = res ? res : &local;
+    memset(w.res, 0, sizeof *w.res);
+    w.res->first_impact = NAN;
+    if (opts)
+        w.o = *opts;
+    if ((rc = check_opts(&w.o, err)) || (rc = check_inputs(model, t0, q0, v0, t1, err)))
+        return rc;
+    gsl_set_error_handler_off(); /* process-wide: GSL reports, never aborts */
+    w.md = model;
+    w.n = model->n;
+    w.m = model->m;
+    w.dim = 2 * w.n + w.m;
+    w.t0 = t0;
+    w.t1 = t1;
+    w.obs = observer;
+    w.obs_ctx = ctx;
+    w.last_emit = NAN;
+    w.last_event = -HUGE_VAL;
+    if (!(rc = edg_alloc(&w, err)) && !(rc = factor_mass(&w, err)))
+        rc = start(&w, q0, v0, err);
+    while (!rc && !w.stopped && w.t < t1)
+        rc = advance(&w, err);
+    if (!rc) {
+        for (int a = 0; a < w.m; a++)
+            if (w.inA[a])
+                w.res->contact_time += fmax(0.0, w.t - w.rest_from[a]);
+        if (w.last_emit != w.t)
+            emit(&w, w.t, w.y, 0);
+    }
+    edg_free(&w);
+    return rc;
+}
