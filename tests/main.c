@@ -78,6 +78,7 @@ int main(int argc, char **argv)
     suite_reference(&ctx);
     suite_event(&ctx);
     suite_paper(&ctx);
+    suite_alloc(&ctx);
     suite_cli(&ctx);
     suite_spectrum(&ctx);
 

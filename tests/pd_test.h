@@ -43,6 +43,7 @@ void suite_penalty(pd_test_ctx *ctx);
 void suite_reference(pd_test_ctx *ctx);
 void suite_event(pd_test_ctx *ctx);
 void suite_paper(pd_test_ctx *ctx);
+void suite_alloc(pd_test_ctx *ctx);
 void suite_cli(pd_test_ctx *ctx);
 void suite_spectrum(pd_test_ctx *ctx);
 
