@@ -195,16 +195,19 @@ static double wall_accel(const ed_run *ed, int j, double t, double v)
            osc->w0 * osc->w0 * ed->p->delta;
 }
 
-/* Scan step: the shortest period present over divisions (default 64), at
- * most span/4 over divisions. */
+/* Scan step: the shortest period present over divisions (default 64),
+ * independent of the run's length so that results do not move with t_end;
+ * span/4 over divisions only when no period exists (free mass, constant force). */
 static double scan_step(const pd_ed_sdof *p, double span, int divisions)
 {
-    double T = span / 4.0;
+    double T = HUGE_VAL;
     if (p->osc.w0 > 0.0)
-        T = fmin(T, TWO_PI / p->osc.w0);
+        T = TWO_PI / p->osc.w0;
     for (int j = 0; j < p->npieces; j++)
         if (p->pieces[j].A != 0.0 && p->pieces[j].w > 0.0)
             T = fmin(T, TWO_PI / p->pieces[j].w);
+    if (!isfinite(T))
+        T = span / 4.0;
     return T / (divisions > 0 ? divisions : 64);
 }
 
