@@ -5,6 +5,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "pd_h5.h"
 #include "pd_output.h"
 
 /* Does path end with suffix? */
@@ -23,21 +24,21 @@ int pd_output_check_path(const char *path, pd_err *err)
     return pd_err_set(err, PD_EINVAL, "-o %s: the file name must end in .h5, .hdf5 or .csv", path);
 }
 
-/* A double or string attribute on an HDF5 object. */
-static int h5_attr(hid_t obj, const char *name, const pd_attr *a, const char *text_value)
+/* A scalar attribute: text when text is non-NULL, else the number x. */
+int pd_h5_attr(hid_t obj, const char *name, const char *text, double x)
 {
     hid_t space = H5Screate(H5S_SCALAR), type = -1, attr = -1;
     herr_t st = -1;
     if (space < 0)
         return -1;
-    if (text_value) {
+    if (text) {
         type = H5Tcopy(H5T_C_S1);
-        if (type >= 0 && H5Tset_size(type, strlen(text_value) + 1) >= 0 &&
+        if (type >= 0 && H5Tset_size(type, strlen(text) + 1) >= 0 &&
             (attr = H5Acreate2(obj, name, type, space, H5P_DEFAULT, H5P_DEFAULT)) >= 0)
-            st = H5Awrite(attr, type, text_value);
+            st = H5Awrite(attr, type, text);
     } else if ((attr = H5Acreate2(obj, name, H5T_NATIVE_DOUBLE, space, H5P_DEFAULT,
                                   H5P_DEFAULT)) >= 0)
-        st = H5Awrite(attr, H5T_NATIVE_DOUBLE, &a->num);
+        st = H5Awrite(attr, H5T_NATIVE_DOUBLE, &x);
     if (attr >= 0)
         H5Aclose(attr);
     if (type >= 0)
@@ -50,11 +51,11 @@ static int h5_attr(hid_t obj, const char *name, const pd_attr *a, const char *te
 static int h5_attr_with_units(hid_t obj, const pd_attr *a)
 {
     char uname[128];
-    if (h5_attr(obj, a->name, a, a->is_text ? a->text : NULL))
+    if (pd_h5_attr(obj, a->name, a->is_text ? a->text : NULL, a->num))
         return -1;
     if (a->units && a->units[0]) {
         snprintf(uname, sizeof uname, "%s_units", a->name);
-        return h5_attr(obj, uname, a, a->units);
+        return pd_h5_attr(obj, uname, a->units, 0.0);
     }
     return 0;
 }
@@ -71,8 +72,7 @@ static int h5_column(hid_t file, const pd_column *c, long rows)
                     H5P_DEFAULT);
     if (ds >= 0 && (rows == 0 || H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT,
                                           c->values) >= 0)) {
-        pd_attr u = {"units", NULL, 1, 0.0, c->units ? c->units : ""};
-        rc = h5_attr(ds, "units", &u, u.text);
+        rc = pd_h5_attr(ds, "units", c->units ? c->units : "", 0.0);
     }
     if (ds >= 0)
         H5Dclose(ds);

@@ -9,6 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "pd_h5.h"
 #include "pd_plot.h"
 #include "pd_spectrum.h"
 
@@ -77,37 +78,15 @@ static hid_t untimed(hid_t cls)
     return p;
 }
 
-/* A scalar attribute: text when text is non-NULL, else the number x. */
-static int h5_attr(hid_t obj, const char *name, const char *text, double x)
-{
-    hid_t space = H5Screate(H5S_SCALAR), type = -1, attr = -1;
-    herr_t st = -1;
-    if (space < 0)
-        return -1;
-    if (text) {
-        type = H5Tcopy(H5T_C_S1);
-        if (type >= 0 && H5Tset_size(type, strlen(text) + 1) >= 0 &&
-            (attr = H5Acreate2(obj, name, type, space, H5P_DEFAULT, H5P_DEFAULT)) >= 0)
-            st = H5Awrite(attr, type, text);
-    } else if ((attr = H5Acreate2(obj, name, H5T_NATIVE_DOUBLE, space, H5P_DEFAULT,
-                                  H5P_DEFAULT)) >= 0)
-        st = H5Awrite(attr, H5T_NATIVE_DOUBLE, &x);
-    if (attr >= 0)
-        H5Aclose(attr);
-    if (type >= 0)
-        H5Tclose(type);
-    H5Sclose(space);
-    return st < 0 ? -1 : 0;
-}
 
 /* A number attribute with its "<name>_units" companion. */
 static int h5_num(hid_t obj, const char *name, double x, const char *units)
 {
     char uname[96];
-    if (h5_attr(obj, name, NULL, x))
+    if (pd_h5_attr(obj, name, NULL, x))
         return -1;
     snprintf(uname, sizeof uname, "%s_units", name);
-    return units ? h5_attr(obj, uname, units, 0.0) : 0;
+    return units ? pd_h5_attr(obj, uname, units, 0.0) : 0;
 }
 
 /* A 1-D double dataset with a "units" attribute. */
@@ -121,7 +100,7 @@ static int h5_dataset(hid_t grp, hid_t dcpl, const char *name, const char *units
         return -1;
     ds = H5Dcreate2(grp, name, H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
     if (ds >= 0 && H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, x) >= 0)
-        rc = h5_attr(ds, "units", units, 0.0);
+        rc = pd_h5_attr(ds, "units", units, 0.0);
     if (ds >= 0)
         H5Dclose(ds);
     H5Sclose(space);
@@ -133,9 +112,9 @@ static int h5_curve_attrs(hid_t g, const pd_spectrum *s, const pd_spec_row *r, l
 {
     char label[256];
     pd_spec_curve_label(s, curve, label, sizeof label);
-    return h5_attr(g, "label", label, 0) || h5_attr(g, "pulse", pd_pulse_name(r->c.pulse), 0) ||
-           h5_attr(g, "dir", pd_dir_name(r->c.dir), 0) ||
-           h5_attr(g, "method", pd_method_name(s->base.method), 0) ||
+    return pd_h5_attr(g, "label", label, 0) || pd_h5_attr(g, "pulse", pd_pulse_name(r->c.pulse), 0) ||
+           pd_h5_attr(g, "dir", pd_dir_name(r->c.dir), 0) ||
+           pd_h5_attr(g, "method", pd_method_name(s->base.method), 0) ||
            h5_num(g, "ap", r->c.ap, "m/s^2") || h5_num(g, "Tp", r->c.Tp, "s") ||
            h5_num(g, "Pi3", r->c.Pi3, "1") || h5_num(g, "gap", r->gap, "m") ||
            h5_num(g, "eps", r->c.eps, "1") || h5_num(g, "xi", r->c.xi, "1");
@@ -165,12 +144,12 @@ static int h5_root_attrs(hid_t file, const pd_spectrum *s)
 {
     char rule[64];
     dt_rule(s, rule, sizeof rule);
-    return h5_attr(file, "command", "pound spectrum", 0) ||
-           h5_attr(file, "method", pd_method_name(s->base.method), 0) ||
-           h5_attr(file, "Pi2_spacing", s->linear ? "linear" : "log", 0) ||
+    return pd_h5_attr(file, "command", "pound spectrum", 0) ||
+           pd_h5_attr(file, "method", pd_method_name(s->base.method), 0) ||
+           pd_h5_attr(file, "Pi2_spacing", s->linear ? "linear" : "log", 0) ||
            h5_num(file, "Pi2_min", s->pi2_min, "1") || h5_num(file, "Pi2_max", s->pi2_max, "1") ||
            h5_num(file, "Pi2_n", s->npi2, NULL) || h5_num(file, "Tp", s->base.c.Tp, "s") ||
-           h5_attr(file, "dt", rule, 0) || h5_num(file, "theta", s->base.opts.theta, "1") ||
+           pd_h5_attr(file, "dt", rule, 0) || h5_num(file, "theta", s->base.opts.theta, "1") ||
            h5_num(file, "curves", (double)pd_spec_curves(s), NULL) ||
            h5_num(file, "points", (double)pd_spec_points(s), NULL);
 }

@@ -35,6 +35,30 @@ void pd_test_skip(pd_test_ctx *ctx, const char *why);
                       fabs(pd_a_ - pd_b_), pd_t_);                                          \
     } while (0)
 
+/* ---- helpers for the CLI suites (test_util.c) ---------------------------- */
+
+#include <hdf5.h>
+
+/* What one run printed and returned (out and err malloc'd). */
+typedef struct proc_out {
+    int status;
+    char *out, *err;
+} proc_out;
+
+char *pd_test_slurp(const char *path);               /* whole file, malloc'd */
+void pd_test_proc_free(proc_out *r);
+/* Run argv with env ("NAME=value" or NULL) added; capture stdout, stderr. */
+int pd_test_spawn(const char *const *argv, const char *env, proc_out *r);
+/* Run ctx->pound with args (NULL-terminated). */
+int pd_test_pound(const pd_test_ctx *ctx, const char *const *args, proc_out *r);
+int pd_test_have_pound(pd_test_ctx *ctx);           /* else skips the case */
+double pd_test_json_num(const char *json, const char *key, int k); /* k-th "key": */
+void pd_test_json_str(const char *json, const char *key, int k, char *buf, size_t cap);
+int pd_test_dir_entries(const char *dir);            /* besides . and .. */
+void pd_test_rm_dir(const char *dir);
+int pd_test_same_file(const char *a, const char *b);
+double pd_test_h5_num(hid_t obj, const char *name); /* NAN when missing */
+
 /* Suites, one per test file. */
 void suite_lcp(pd_test_ctx *ctx);
 void suite_engine(pd_test_ctx *ctx);

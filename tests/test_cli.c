@@ -9,84 +9,6 @@
 
 #include "pd_test.h"
 
-/* What one run of pound printed and returned. */
-typedef struct run_out {
-    int status;
-    char out[16384], err[4096];
-} run_out;
-
-/* Read a whole (small) file into buf. */
-static void slurp(const char *path, char *buf, size_t cap)
-{
-    FILE *f = fopen(path, "r");
-    size_t n = f ? fread(buf, 1, cap - 1, f) : 0;
-    buf[n] = '\0';
-    if (f)
-        fclose(f);
-}
-
-/* Run pound with args (NULL-terminated), capturing stdout and stderr. */
-static int run_pound(const pd_test_ctx *ctx, const char *const *args, run_out *r)
-{
-    char out_path[] = "/tmp/pd_cli_outXXXXXX", err_path[] = "/tmp/pd_cli_errXXXXXX";
-    int fo = mkstemp(out_path), fe = mkstemp(err_path);
-    const char *argv[64];
-    int n = 0;
-    argv[n++] = ctx->pound;
-    for (; args[n - 1] && n < 63; n++)
-        argv[n] = args[n - 1];
-    argv[n] = NULL;
-    fflush(stdout);
-    pid_t pid = fork();
-    if (pid == 0) {
-        dup2(fo, 1);
-        dup2(fe, 2);
-        execv(ctx->pound, (char *const *)argv);
-        _exit(127);
-    }
-    int st = 0;
-    waitpid(pid, &st, 0);
-    close(fo);
-    close(fe);
-    slurp(out_path, r->out, sizeof r->out);
-    slurp(err_path, r->err, sizeof r->err);
-    unlink(out_path);
-    unlink(err_path);
-    r->status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-    return r->status;
-}
-
-/* Number of entries in a directory besides . and .. */
-static int dir_entries(const char *dir)
-{
-    DIR *d = opendir(dir);
-    int n = 0;
-    for (struct dirent *e; d && (e = readdir(d));)
-        n += strcmp(e->d_name, ".") && strcmp(e->d_name, "..");
-    if (d)
-        closedir(d);
-    return n;
-}
-
-/* The number after "key": in a JSON text (NAN when absent or null). */
-static double json_number(const char *json, const char *key)
-{
-    char pat[64];
-    snprintf(pat, sizeof pat, "\"%s\":", key);
-    const char *p = strstr(json, pat);
-    if (!p || !strncmp(p + strlen(pat), "null", 4))
-        return NAN;
-    return strtod(p + strlen(pat), NULL);
-}
-
-static int have_pound(pd_test_ctx *ctx)
-{
-    if (access(ctx->pound, X_OK) == 0)
-        return 1;
-    pd_test_skip(ctx, "no pound binary (pass --pound PATH)");
-    return 0;
-}
-
 /* Every bad-input class: exit 2, one stderr line naming the flag, no file. */
 static void test_cli_bad_input(pd_test_ctx *ctx)
 {
@@ -99,7 +21,7 @@ static void test_cli_bad_input(pd_test_ctx *ctx)
         {"--Pi3", "-1", "Pi3"},        {"--every", "0", "every"},     {"--bogus", "1", "bogus"},
         {"--method", "magic", "method"}, {"--tend", "-2", "tend"},    {"--gamma", "2", "gamma"},
         {"-o", "run.txt", "run.txt"},  {"--Pi2", "1", "Pi2"} /* with --T0: both given */};
-    if (!have_pound(ctx))
+    if (!pd_test_have_pound(ctx))
         return;
     char dir[] = "/tmp/pd_cli_dirXXXXXX";
     if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
@@ -127,8 +49,8 @@ static void test_cli_bad_input(pd_test_ctx *ctx)
             args[14] = cases[k].value;
             args[15] = NULL;
         }
-        run_out r;
-        run_pound(ctx, args, &r);
+        proc_out r;
+        pd_test_pound(ctx, args, &r);
         char *nl = strchr(r.err, '\n');
         CHECK(ctx, r.status == 2, "%s %s: exit %d, expected 2 (stderr: %s)", cases[k].flag,
               cases[k].value, r.status, r.err);
@@ -138,28 +60,18 @@ static void test_cli_bad_input(pd_test_ctx *ctx)
               cases[k].value, r.err);
         CHECK(ctx, r.out[0] == '\0', "%s %s: nothing on stdout: %s", cases[k].flag,
               cases[k].value, r.out);
-        CHECK(ctx, dir_entries(dir) == 0, "%s %s: a file was left behind", cases[k].flag,
+        CHECK(ctx, pd_test_dir_entries(dir) == 0, "%s %s: a file was left behind", cases[k].flag,
               cases[k].value);
+        pd_test_proc_free(&r);
     }
     rmdir(dir);
 }
 
 /* -o run.h5: datasets t, u, v, impulse, gap with units, inputs and summary
  * as attributes, read back with the HDF5 library; the JSON agrees. */
-static double h5_attr_double(hid_t f, const char *name)
-{
-    double x = NAN;
-    hid_t a = H5Aopen(f, name, H5P_DEFAULT);
-    if (a >= 0) {
-        H5Aread(a, H5T_NATIVE_DOUBLE, &x);
-        H5Aclose(a);
-    }
-    return x;
-}
-
 static void test_cli_hdf5_output(pd_test_ctx *ctx)
 {
-    if (!have_pound(ctx))
+    if (!pd_test_have_pound(ctx))
         return;
     char dir[] = "/tmp/pd_cli_h5XXXXXX", path[512];
     if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
@@ -168,9 +80,9 @@ static void test_cli_hdf5_output(pd_test_ctx *ctx)
     const char *args[] = {"simulate", "--pulse", "cosine", "--dir", "normal", "--ap", "2",
                           "--Tp", "0.5", "--T0", "0.6", "--gap", "0.002", "--eps", "0.7",
                           "--dt", "1e-3", "--every", "3", "-o", path, "--json", NULL};
-    run_out r;
-    CHECK(ctx, run_pound(ctx, args, &r) == 0, "exit %d: %s", r.status, r.err);
-    double steps = json_number(r.out, "steps"), umax = json_number(r.out, "umax");
+    proc_out r;
+    CHECK(ctx, pd_test_pound(ctx, args, &r) == 0, "exit %d: %s", r.status, r.err);
+    double steps = pd_test_json_num(r.out, "steps", 0), umax = pd_test_json_num(r.out, "umax", 0);
     CHECK(ctx, steps == 1700, "steps %g (tend = Tp + 2 T0 = 1.7 s at dt 1e-3)", steps);
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
     hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
@@ -198,13 +110,14 @@ static void test_cli_hdf5_output(pd_test_ctx *ctx)
         H5Sclose(sp);
         H5Dclose(ds);
     }
-    CHECK_NEAR(ctx, h5_attr_double(f, "umax"), umax, 0.0);
-    CHECK_NEAR(ctx, h5_attr_double(f, "eps"), 0.7, 0.0);
-    CHECK_NEAR(ctx, h5_attr_double(f, "Tp"), 0.5, 0.0);
+    CHECK_NEAR(ctx, pd_test_h5_num(f, "umax"), umax, 0.0);
+    CHECK_NEAR(ctx, pd_test_h5_num(f, "eps"), 0.7, 0.0);
+    CHECK_NEAR(ctx, pd_test_h5_num(f, "Tp"), 0.5, 0.0);
     CHECK(ctx, H5Aexists(f, "umax_units") > 0 && H5Aexists(f, "pulse") > 0,
           "summary attributes with units");
     H5Fclose(f);
 done:
+    pd_test_proc_free(&r);
     unlink(path);
     rmdir(dir);
 }
@@ -213,23 +126,24 @@ done:
  * Pi1 = umax wp^2 / ap. */
 static void test_cli_csv_and_json(pd_test_ctx *ctx)
 {
-    if (!have_pound(ctx))
+    if (!pd_test_have_pound(ctx))
         return;
-    static char text[1 << 17];
     char dir[] = "/tmp/pd_cli_csvXXXXXX", path[512];
     if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
         return;
     snprintf(path, sizeof path, "%s/run.csv", dir);
     const char *args[] = {"simulate", "--pulse", "sine", "--ap", "1", "--Tp", "1", "--T0", "1",
                           "--gap", "10", "--dt", "0.01", "-o", path, "--json", NULL};
-    run_out r;
-    CHECK(ctx, run_pound(ctx, args, &r) == 0, "exit %d: %s", r.status, r.err);
+    proc_out r;
+    CHECK(ctx, pd_test_pound(ctx, args, &r) == 0, "exit %d: %s", r.status, r.err);
     CHECK(ctx, strstr(r.out, "\"first_impact\":null") != NULL, "no impact: first_impact null");
-    CHECK(ctx, json_number(r.out, "impacts") == 0, "impacts must be 0");
-    double wp = 6.283185307179586, Pi1 = json_number(r.out, "Pi1"), umax = json_number(r.out, "umax");
+    CHECK(ctx, pd_test_json_num(r.out, "impacts", 0) == 0, "impacts must be 0");
+    double wp = 6.283185307179586, Pi1 = pd_test_json_num(r.out, "Pi1", 0), umax = pd_test_json_num(r.out, "umax", 0);
     CHECK_NEAR(ctx, Pi1, umax * wp * wp, 1e-12 * Pi1);
-    CHECK_NEAR(ctx, json_number(r.out, "gamma"), 1.0, 1e-15); /* no contact: same as free */
-    slurp(path, text, sizeof text);
+    CHECK_NEAR(ctx, pd_test_json_num(r.out, "gamma", 0), 1.0, 1e-15); /* no contact: same as free */
+    char *text = pd_test_slurp(path);
+    if (!CHECK(ctx, text != NULL, "cannot read %s", path))
+        goto done;
     CHECK(ctx, strstr(text, "\nt,u,v,impulse,gap\n") != NULL, "CSV header row");
     CHECK(ctx, strstr(text, "# umax = ") != NULL && strstr(text, "[m]") != NULL,
           "CSV carries the summary with units");
@@ -237,6 +151,9 @@ static void test_cli_csv_and_json(pd_test_ctx *ctx)
     for (char *p = strstr(text, "\nt,u,v"); p && *(++p);)
         rows += *p == '\n';
     CHECK(ctx, rows == 301, "CSV rows %d, expected 301 (t = 0 and 300 steps)", rows);
+    free(text);
+done:
+    pd_test_proc_free(&r);
     unlink(path);
     rmdir(dir);
 }
@@ -245,7 +162,7 @@ static void test_cli_csv_and_json(pd_test_ctx *ctx)
  * time, and leaves no file. */
 static void test_cli_failed_run_leaves_no_file(pd_test_ctx *ctx)
 {
-    if (!have_pound(ctx))
+    if (!pd_test_have_pound(ctx))
         return;
     char dir[] = "/tmp/pd_cli_failXXXXXX", path[512];
     if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
@@ -253,11 +170,12 @@ static void test_cli_failed_run_leaves_no_file(pd_test_ctx *ctx)
     snprintf(path, sizeof path, "%s/run.h5", dir);
     const char *args[] = {"simulate", "--Tp", "1", "--T0", "1", "--Pi3", "1e6", "--theta", "0",
                           "--allow-unstable", "--dt", "0.5", "--tend", "2000", "-o", path, NULL};
-    run_out r;
-    run_pound(ctx, args, &r);
+    proc_out r;
+    pd_test_pound(ctx, args, &r);
     CHECK(ctx, r.status == 1, "exit %d, expected 1 (%s)", r.status, r.err);
     CHECK(ctx, strstr(r.err, "non-finite") && strstr(r.err, "t = "), "message: %s", r.err);
-    CHECK(ctx, dir_entries(dir) == 0, "a file was left behind");
+    CHECK(ctx, pd_test_dir_entries(dir) == 0, "a file was left behind");
+    pd_test_proc_free(&r);
     rmdir(dir);
 }
 

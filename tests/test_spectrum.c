@@ -1,179 +1,12 @@
 /* test_spectrum.c — `pound spectrum`: agreement with `pound simulate`,
  * bit-identical output across thread counts, MPI ranks and resumed runs,
  * bad input, HDF5/CSV read back, the Pi2 grid, the dimensional view. */
-#include <dirent.h>
 #include <hdf5.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include "pd_test.h"
-
-/* What one run printed and returned (out and err malloc'd). */
-typedef struct proc_out {
-    int status;
-    char *out, *err;
-} proc_out;
-
-/* Read a whole file into a malloc'd NUL-terminated buffer. */
-static char *slurp(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    size_t n = 0, cap = 4096;
-    char *buf = malloc(cap);
-    while (f && buf) {
-        if (n + 1 >= cap) {
-            char *b = realloc(buf, cap *= 2);
-            if (!b)
-                break;
-            buf = b;
-        }
-        size_t r = fread(buf + n, 1, cap - n - 1, f);
-        if (r == 0)
-            break;
-        n += r;
-    }
-    if (buf)
-        buf[n] = '\0';
-    if (f)
-        fclose(f);
-    return buf;
-}
-
-/* Release what spawn captured. */
-static void proc_free(proc_out *r)
-{
-    free(r->out);
-    free(r->err);
-    r->out = r->err = NULL;
-}
-
-/* Run argv (argv[0] a path or a name on PATH) with env ("NAME=value" or
- * NULL) added, capturing stdout and stderr; returns the exit status. */
-static int spawn(const char *const *argv, const char *env, proc_out *r)
-{
-    char out_path[] = "/tmp/pd_spec_outXXXXXX", err_path[] = "/tmp/pd_spec_errXXXXXX";
-    int fo = mkstemp(out_path), fe = mkstemp(err_path), st = 0;
-    fflush(stdout);
-    pid_t pid = fork();
-    if (pid == 0) {
-        dup2(fo, 1);
-        dup2(fe, 2);
-        if (env) {
-            char kv[256];
-            snprintf(kv, sizeof kv, "%s", env);
-            char *eq = strchr(kv, '=');
-            if (eq) {
-                *eq = '\0';
-                setenv(kv, eq + 1, 1);
-            }
-        }
-        execvp(argv[0], (char *const *)argv);
-        _exit(127);
-    }
-    waitpid(pid, &st, 0);
-    close(fo);
-    close(fe);
-    r->out = slurp(out_path);
-    r->err = slurp(err_path);
-    unlink(out_path);
-    unlink(err_path);
-    r->status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-    return r->status;
-}
-
-/* Run `pound spectrum` (or another subcommand) with args, NULL-terminated. */
-static int pound(const pd_test_ctx *ctx, const char *const *args, proc_out *r)
-{
-    const char *argv[80];
-    int n = 0;
-    argv[n++] = ctx->pound;
-    for (; args[n - 1] && n < 79; n++)
-        argv[n] = args[n - 1];
-    argv[n] = NULL;
-    return spawn(argv, NULL, r);
-}
-
-/* Is the binary under test there?  Skips the case otherwise. */
-static int have_pound(pd_test_ctx *ctx)
-{
-    if (access(ctx->pound, X_OK) == 0)
-        return 1;
-    pd_test_skip(ctx, "no pound binary (pass --pound PATH)");
-    return 0;
-}
-
-/* The number after the k-th "key": (NAN when absent or null). */
-static double json_num(const char *json, const char *key, int k)
-{
-    char pat[64];
-    const char *p = json;
-    snprintf(pat, sizeof pat, "\"%s\":", key);
-    for (int i = 0; p && i <= k; i++)
-        if ((p = strstr(p, pat)))
-            p += strlen(pat);
-    if (!p || !strncmp(p, "null", 4))
-        return NAN;
-    return strtod(p, NULL);
-}
-
-/* The string after the k-th "key": into buf ("" when absent). */
-static void json_str(const char *json, const char *key, int k, char *buf, size_t cap)
-{
-    char pat[64];
-    const char *p = json;
-    snprintf(pat, sizeof pat, "\"%s\":\"", key);
-    for (int i = 0; p && i <= k; i++)
-        if ((p = strstr(p, pat)))
-            p += strlen(pat);
-    size_t n = p ? strcspn(p, "\"") : 0;
-    n = n < cap ? n : cap - 1;
-    memcpy(buf, p ? p : "", n);
-    buf[n] = '\0';
-}
-
-/* Number of entries in a directory besides . and .. */
-static int dir_entries(const char *dir)
-{
-    DIR *d = opendir(dir);
-    int n = 0;
-    for (struct dirent *e; d && (e = readdir(d));)
-        n += strcmp(e->d_name, ".") && strcmp(e->d_name, "..");
-    if (d)
-        closedir(d);
-    return n;
-}
-
-/* Remove a scratch directory and its files. */
-static void rm_dir(const char *dir)
-{
-    DIR *d = opendir(dir);
-    char path[1024];
-    for (struct dirent *e; d && (e = readdir(d));)
-        if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) {
-            snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
-            unlink(path);
-        }
-    if (d)
-        closedir(d);
-    rmdir(dir);
-}
-
-/* Are two files byte-identical (and both present)? */
-static int same_file(const char *a, const char *b)
-{
-    FILE *f = fopen(a, "rb"), *g = fopen(b, "rb");
-    int same = f && g, x = 0, y = 0;
-    while (same && (x = fgetc(f)) == (y = fgetc(g)) && x != EOF)
-        ;
-    same = same && x == y;
-    if (f)
-        fclose(f);
-    if (g)
-        fclose(g);
-    return same;
-}
 
 /* |a - b| <= tol max(|a|, |b|), NaN equal to NaN. */
 static int rel_close(double a, double b, double tol)
@@ -193,14 +26,14 @@ static void test_spectrum_matches_simulate(pd_test_ctx *ctx)
     static const char *const methods[] = {"moreau", "event"};
     static const char *const keys[] = {"pulse", "dir", "Pi2", "Pi3", "eps", "xi", "Pi1",
                                        "umax_free", "gamma", "chi", "impacts", "method"};
-    if (!have_pound(ctx))
+    if (!pd_test_have_pound(ctx))
         return;
     for (int m = 0; m < 2; m++) {
         const char *args[] = {"spectrum", "--pulse", "sine,cosine", "--dir", "normal,reverse",
                               "--Pi2", "0.2:3:3", "--Pi3", "0.05", "--eps", "0.6", "--method",
                               methods[m], "--json", NULL};
         proc_out sp;
-        pound(ctx, args, &sp);
+        pd_test_pound(ctx, args, &sp);
         CHECK(ctx, sp.status == 0, "%s: exit %d: %s", methods[m], sp.status, sp.err);
         CHECK(ctx, sp.err[0] == '\0', "%s: stderr not quiet: %s", methods[m], sp.err);
         for (size_t k = 0; k < sizeof keys / sizeof keys[0]; k++) {
@@ -208,28 +41,28 @@ static void test_spectrum_matches_simulate(pd_test_ctx *ctx)
             snprintf(pat, sizeof pat, "\"%s\":", keys[k]);
             CHECK(ctx, strstr(sp.out, pat) != NULL, "point key %s missing", keys[k]);
         }
-        CHECK(ctx, isfinite(json_num(sp.out, "cpu_s", 12)) && isfinite(json_num(sp.out, "wall_s", 0)),
+        CHECK(ctx, isfinite(pd_test_json_num(sp.out, "cpu_s", 12)) && isfinite(pd_test_json_num(sp.out, "wall_s", 0)),
               "totals cpu_s, wall_s missing");
         for (int p = 0; p < 12; p++) {
             char pulse[16], dir[16], pi2[40];
-            json_str(sp.out, "pulse", p, pulse, sizeof pulse);
-            json_str(sp.out, "dir", p, dir, sizeof dir);
-            snprintf(pi2, sizeof pi2, "%.17g", json_num(sp.out, "Pi2", p));
+            pd_test_json_str(sp.out, "pulse", p, pulse, sizeof pulse);
+            pd_test_json_str(sp.out, "dir", p, dir, sizeof dir);
+            snprintf(pi2, sizeof pi2, "%.17g", pd_test_json_num(sp.out, "Pi2", p));
             const char *sargs[] = {"simulate", "--pulse", pulse, "--dir", dir, "--Pi2", pi2,
                                    "--Pi3", "0.05", "--eps", "0.6", "--method", methods[m],
                                    "--json", NULL};
             proc_out sim;
-            pound(ctx, sargs, &sim);
+            pd_test_pound(ctx, sargs, &sim);
             static const char *const cmp[] = {"Pi1", "gamma", "chi", "umax_free", "impacts"};
             for (int c = 0; c < 5; c++) {
-                double a = json_num(sp.out, cmp[c], p), b = json_num(sim.out, cmp[c], 0);
+                double a = pd_test_json_num(sp.out, cmp[c], p), b = pd_test_json_num(sim.out, cmp[c], 0);
                 CHECK(ctx, rel_close(a, b, 1e-12) && isfinite(a),
                       "%s %s %s Pi2 = %s: %s spectrum %.17g vs simulate %.17g", methods[m],
                       pulse, dir, pi2, cmp[c], a, b);
             }
-            proc_free(&sim);
+            pd_test_proc_free(&sim);
         }
-        proc_free(&sp);
+        pd_test_proc_free(&sp);
     }
 }
 
@@ -243,7 +76,7 @@ static void test_spectrum_matches_simulate(pd_test_ctx *ctx)
 static void test_spectrum_threads_bit_identical(pd_test_ctx *ctx)
 {
     static const char *const ext[] = {"h5", "csv"};
-    if (!have_pound(ctx))
+    if (!pd_test_have_pound(ctx))
         return;
     char dir[] = "/tmp/pd_spec_thrXXXXXX", f1[512], f2[512];
     if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
@@ -254,15 +87,15 @@ static void test_spectrum_threads_bit_identical(pd_test_ctx *ctx)
         snprintf(f2, sizeof f2, "%s/t2.%s", dir, ext[e]);
         const char *a1[] = {"spectrum", SWEEP, "--threads", "1", "-o", f1, NULL};
         const char *a2[] = {"spectrum", SWEEP, "--threads", "2", "-o", f2, NULL};
-        pound(ctx, a1, &r1);
-        pound(ctx, a2, &r2);
+        pd_test_pound(ctx, a1, &r1);
+        pd_test_pound(ctx, a2, &r2);
         CHECK(ctx, r1.status == 0 && r2.status == 0, "exit %d / %d: %s %s", r1.status, r2.status,
               r1.err, r2.err);
-        CHECK(ctx, same_file(f1, f2), "%s: 1 and 2 threads differ", ext[e]);
-        proc_free(&r1);
-        proc_free(&r2);
+        CHECK(ctx, pd_test_same_file(f1, f2), "%s: 1 and 2 threads differ", ext[e]);
+        pd_test_proc_free(&r1);
+        pd_test_proc_free(&r2);
     }
-    rm_dir(dir);
+    pd_test_rm_dir(dir);
 }
 
 /* A sweep killed mid-way (the --stop-after hook, twice) and resumed gives
@@ -271,7 +104,7 @@ static void test_spectrum_threads_bit_identical(pd_test_ctx *ctx)
  * refused naming the flag; the journal is gone at the end. */
 static void test_spectrum_resume(pd_test_ctx *ctx)
 {
-    if (!have_pound(ctx))
+    if (!pd_test_have_pound(ctx))
         return;
     char dir[] = "/tmp/pd_spec_resXXXXXX", full[512], part[512], journal[600];
     if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
@@ -281,45 +114,45 @@ static void test_spectrum_resume(pd_test_ctx *ctx)
     snprintf(journal, sizeof journal, "%s.partial", part);
     proc_out r;
     const char *a_full[] = {"spectrum", SWEEP, "-o", full, NULL};
-    pound(ctx, a_full, &r);
+    pd_test_pound(ctx, a_full, &r);
     CHECK(ctx, r.status == 0, "uninterrupted: exit %d: %s", r.status, r.err);
-    proc_free(&r);
+    pd_test_proc_free(&r);
     const char *a_stop[] = {"spectrum", SWEEP, "-o", part, "--threads", "2", "--stop-after",
                             "20", NULL};
-    pound(ctx, a_stop, &r);
+    pd_test_pound(ctx, a_stop, &r);
     CHECK(ctx, r.status == 130, "killed run: exit %d, expected 130", r.status);
     CHECK(ctx, access(part, F_OK) != 0 && access(journal, F_OK) == 0,
           "after the kill: no final file, a journal");
-    proc_free(&r);
+    pd_test_proc_free(&r);
     FILE *j = fopen(journal, "a");
     if (j) { /* a torn last line, as a kill during a write would leave */
         fputs("T 3 0x1.8p-3 0x1", j);
         fclose(j);
     }
     const char *a_fresh[] = {"spectrum", SWEEP, "-o", part, NULL};
-    pound(ctx, a_fresh, &r);
+    pd_test_pound(ctx, a_fresh, &r);
     CHECK(ctx, r.status == 2 && strstr(r.err, "--resume"),
           "a fresh run over a journal: exit %d (%s)", r.status, r.err);
-    proc_free(&r);
+    pd_test_proc_free(&r);
     const char *a_other[] = {"spectrum", SWEEP, "--xi", "0.02", "-o", part, "--resume", NULL};
-    pound(ctx, a_other, &r);
+    pd_test_pound(ctx, a_other, &r);
     CHECK(ctx, r.status == 2 && strstr(r.err, "--xi"),
           "resume with another xi: exit %d (%s)", r.status, r.err);
-    proc_free(&r);
+    pd_test_proc_free(&r);
     const char *a_stop2[] = {"spectrum", SWEEP, "-o", part, "--resume", "--stop-after", "15",
                              NULL};
-    pound(ctx, a_stop2, &r);
+    pd_test_pound(ctx, a_stop2, &r);
     CHECK(ctx, r.status == 130, "second kill: exit %d", r.status);
-    proc_free(&r);
+    pd_test_proc_free(&r);
     const char *a_res[] = {"spectrum", SWEEP, "-o", part, "--resume", "--json", NULL};
-    pound(ctx, a_res, &r);
+    pd_test_pound(ctx, a_res, &r);
     CHECK(ctx, r.status == 0, "resume: exit %d: %s", r.status, r.err);
-    CHECK(ctx, json_num(r.out, "resumed", 0) == 35, "resumed %g runs, expected 35",
-          json_num(r.out, "resumed", 0));
-    CHECK(ctx, same_file(full, part), "resumed file differs from the uninterrupted one");
+    CHECK(ctx, pd_test_json_num(r.out, "resumed", 0) == 35, "resumed %g runs, expected 35",
+          pd_test_json_num(r.out, "resumed", 0));
+    CHECK(ctx, pd_test_same_file(full, part), "resumed file differs from the uninterrupted one");
     CHECK(ctx, access(journal, F_OK) != 0, "journal left behind");
-    proc_free(&r);
-    rm_dir(dir);
+    pd_test_proc_free(&r);
+    pd_test_rm_dir(dir);
 }
 
 /* ---- bad input ----------------------------------------------------------- */
@@ -348,7 +181,7 @@ static void test_spectrum_bad_input(pd_test_ctx *ctx)
         {{"--Pi3", "0.1", "--gap", "0.01"}, "--gap", 0, 0},
         {{"--dt", "0.001", "--dt-per-Tp", "100"}, "--dt-per-Tp", 0, 0},
         {{"--resume"}, "--resume", 1, 0},        {{"--eps", "0.5"}, "--Pi2", 0, 1}};
-    if (!have_pound(ctx))
+    if (!pd_test_have_pound(ctx))
         return;
     char dir[] = "/tmp/pd_spec_badXXXXXX", out[512], png[512];
     if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
@@ -373,7 +206,7 @@ static void test_spectrum_bad_input(pd_test_ctx *ctx)
             args[n++] = cases[k].a[i];
         args[n] = NULL;
         proc_out r;
-        pound(ctx, args, &r);
+        pd_test_pound(ctx, args, &r);
         char *nl = strchr(r.err, '\n');
         CHECK(ctx, r.status == 2, "%s %s: exit %d, expected 2 (%s)", cases[k].a[0],
               cases[k].a[1] ? cases[k].a[1] : "", r.status, r.err);
@@ -381,17 +214,17 @@ static void test_spectrum_bad_input(pd_test_ctx *ctx)
               cases[k].a[0], cases[k].named, r.err);
         CHECK(ctx, nl && nl[1] == '\0', "%s: stderr must be one line: %s", cases[k].a[0], r.err);
         CHECK(ctx, r.out[0] == '\0', "%s: nothing on stdout: %s", cases[k].a[0], r.out);
-        CHECK(ctx, dir_entries(dir) == 0, "%s: a file was left behind", cases[k].a[0]);
-        proc_free(&r);
+        CHECK(ctx, pd_test_dir_entries(dir) == 0, "%s: a file was left behind", cases[k].a[0]);
+        pd_test_proc_free(&r);
     }
-    rm_dir(dir);
+    pd_test_rm_dir(dir);
 }
 
 /* The plain build (the one under test) started as one of several copies,
  * as mpirun would start it, refuses instead of writing the sweep twice. */
 static void test_spectrum_refuses_copies_without_mpi(pd_test_ctx *ctx)
 {
-    if (!have_pound(ctx))
+    if (!pd_test_have_pound(ctx))
         return;
     char dir[] = "/tmp/pd_spec_cpyXXXXXX", out[512];
     if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
@@ -399,26 +232,14 @@ static void test_spectrum_refuses_copies_without_mpi(pd_test_ctx *ctx)
     snprintf(out, sizeof out, "%s/s.h5", dir);
     const char *argv[] = {ctx->pound, "spectrum", "--Pi2", "0.5:2:3", "-o", out, NULL};
     proc_out r;
-    spawn(argv, "OMPI_COMM_WORLD_SIZE=2", &r);
+    pd_test_spawn(argv, "OMPI_COMM_WORLD_SIZE=2", &r);
     CHECK(ctx, r.status == 2 && strstr(r.err, "MPI=1"), "exit %d: %s", r.status, r.err);
-    CHECK(ctx, dir_entries(dir) == 0, "a file was written");
-    proc_free(&r);
-    rm_dir(dir);
+    CHECK(ctx, pd_test_dir_entries(dir) == 0, "a file was written");
+    pd_test_proc_free(&r);
+    pd_test_rm_dir(dir);
 }
 
 /* ---- files read back ----------------------------------------------------- */
-
-/* A double attribute (NAN when missing). */
-static double h5_num_attr(hid_t obj, const char *name)
-{
-    double x = NAN;
-    hid_t a = H5Aopen(obj, name, H5P_DEFAULT);
-    if (a >= 0) {
-        H5Aread(a, H5T_NATIVE_DOUBLE, &x);
-        H5Aclose(a);
-    }
-    return x;
-}
 
 /* A string attribute into buf ("" when missing). */
 static void h5_str_attr(hid_t obj, const char *name, char *buf, size_t cap)
@@ -460,18 +281,18 @@ static void check_group(pd_test_ctx *ctx, hid_t f, int c, const char *json)
     if (!CHECK(ctx, g >= 0, "group %s missing", name))
         return;
     h5_str_attr(g, "pulse", pulse, sizeof pulse);
-    json_str(json, "pulse", 5 * c, jpulse, sizeof jpulse);
+    pd_test_json_str(json, "pulse", 5 * c, jpulse, sizeof jpulse);
     CHECK(ctx, !strcmp(pulse, jpulse), "%s: pulse '%s' vs '%s'", name, pulse, jpulse);
-    CHECK(ctx, h5_num_attr(g, "Pi3") == json_num(json, "Pi3", 5 * c) &&
-                   h5_num_attr(g, "eps") == 0.4 && h5_num_attr(g, "xi") == 0.05,
-          "%s: attributes Pi3 %g eps %g xi %g", name, h5_num_attr(g, "Pi3"),
-          h5_num_attr(g, "eps"), h5_num_attr(g, "xi"));
+    CHECK(ctx, pd_test_h5_num(g, "Pi3") == pd_test_json_num(json, "Pi3", 5 * c) &&
+                   pd_test_h5_num(g, "eps") == 0.4 && pd_test_h5_num(g, "xi") == 0.05,
+          "%s: attributes Pi3 %g eps %g xi %g", name, pd_test_h5_num(g, "Pi3"),
+          pd_test_h5_num(g, "eps"), pd_test_h5_num(g, "xi"));
     for (int k = 0; k < 6; k++) {
         if (!CHECK(ctx, h5_read(g, cols[k], x, 5) == 0, "%s/%s unreadable", name, cols[k]))
             continue;
         for (int j = 0; j < 5; j++)
-            CHECK(ctx, x[j] == json_num(json, cols[k], 5 * c + j), "%s/%s[%d] = %.17g vs %.17g",
-                  name, cols[k], j, x[j], json_num(json, cols[k], 5 * c + j));
+            CHECK(ctx, x[j] == pd_test_json_num(json, cols[k], 5 * c + j), "%s/%s[%d] = %.17g vs %.17g",
+                  name, cols[k], j, x[j], pd_test_json_num(json, cols[k], 5 * c + j));
     }
     H5Gclose(g);
 }
@@ -480,7 +301,7 @@ static void check_group(pd_test_ctx *ctx, hid_t f, int c, const char *json)
  * to the JSON ones. */
 static void check_csv(pd_test_ctx *ctx, const char *path, const char *json)
 {
-    char *text = slurp(path), *line = text, *save = NULL;
+    char *text = pd_test_slurp(path), *line = text, *save = NULL;
     int rows = 0, col_pi1 = -1, col_gamma = -1;
     for (line = strtok_r(text, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
         if (line[0] == '#')
@@ -499,7 +320,7 @@ static void check_csv(pd_test_ctx *ctx, const char *path, const char *json)
             pi1 = c == col_pi1 ? strtod(tok, NULL) : pi1;
             gamma = c == col_gamma ? strtod(tok, NULL) : gamma;
         }
-        CHECK(ctx, pi1 == json_num(json, "Pi1", rows) && gamma == json_num(json, "gamma", rows),
+        CHECK(ctx, pi1 == pd_test_json_num(json, "Pi1", rows) && gamma == pd_test_json_num(json, "gamma", rows),
               "CSV row %d: Pi1 %.17g gamma %.17g differ from the JSON", rows, pi1, gamma);
         rows++;
     }
@@ -513,7 +334,7 @@ static void check_csv(pd_test_ctx *ctx, const char *path, const char *json)
  * per point; both equal the JSON to the bit. */
 static void test_spectrum_hdf5_csv_read_back(pd_test_ctx *ctx)
 {
-    if (!have_pound(ctx))
+    if (!pd_test_have_pound(ctx))
         return;
     char dir[] = "/tmp/pd_spec_rbXXXXXX", h5[512], csv[512];
     if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
@@ -525,23 +346,23 @@ static void test_spectrum_hdf5_csv_read_back(pd_test_ctx *ctx)
     const char *a2[] = {"spectrum", "--pulse", "sine,cosine", "--Pi3", "0.01,0.1", "--eps", "0.4",
                         "--Pi2", "0.3:3:5", "-o", csv, NULL};
     proc_out r, r2;
-    pound(ctx, a1, &r);
-    pound(ctx, a2, &r2);
+    pd_test_pound(ctx, a1, &r);
+    pd_test_pound(ctx, a2, &r2);
     CHECK(ctx, r.status == 0 && r2.status == 0, "exit %d / %d: %s", r.status, r2.status, r.err);
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
     hid_t f = H5Fopen(h5, H5F_ACC_RDONLY, H5P_DEFAULT);
     if (CHECK(ctx, f >= 0, "cannot open %s", h5)) {
-        CHECK(ctx, h5_num_attr(f, "curves") == 4 && h5_num_attr(f, "points") == 20,
-              "root attributes curves %g points %g", h5_num_attr(f, "curves"),
-              h5_num_attr(f, "points"));
+        CHECK(ctx, pd_test_h5_num(f, "curves") == 4 && pd_test_h5_num(f, "points") == 20,
+              "root attributes curves %g points %g", pd_test_h5_num(f, "curves"),
+              pd_test_h5_num(f, "points"));
         for (int c = 0; c < 4; c++)
             check_group(ctx, f, c, r.out);
         H5Fclose(f);
     }
     check_csv(ctx, csv, r.out);
-    proc_free(&r);
-    proc_free(&r2);
-    rm_dir(dir);
+    pd_test_proc_free(&r);
+    pd_test_proc_free(&r2);
+    pd_test_rm_dir(dir);
 }
 
 /* ---- the grid, the twins, the dimensional view --------------------------- */
@@ -549,23 +370,23 @@ static void test_spectrum_hdf5_csv_read_back(pd_test_ctx *ctx)
 /* --linear gives equal steps, the default equal ratios; end points exact. */
 static void test_spectrum_linear_vs_log(pd_test_ctx *ctx)
 {
-    if (!have_pound(ctx))
+    if (!pd_test_have_pound(ctx))
         return;
     for (int lin = 0; lin < 2; lin++) {
         const char *args[] = {"spectrum", "--Pi2", "0.5:2.5:5", "--json",
                               lin ? "--linear" : NULL, NULL};
         proc_out r;
-        pound(ctx, args, &r);
+        pd_test_pound(ctx, args, &r);
         CHECK(ctx, r.status == 0, "exit %d: %s", r.status, r.err);
         for (int j = 0; j < 5; j++) {
-            double x = json_num(r.out, "Pi2", j);
+            double x = pd_test_json_num(r.out, "Pi2", j);
             double want = lin ? 0.5 + 0.5 * j : 0.5 * pow(5.0, j / 4.0);
             CHECK(ctx, rel_close(x, want, 1e-15), "%s Pi2[%d] = %.17g, expected %.17g",
                   lin ? "linear" : "log", j, x, want);
         }
-        CHECK(ctx, json_num(r.out, "Pi2", 0) == 0.5 && json_num(r.out, "Pi2", 4) == 2.5,
+        CHECK(ctx, pd_test_json_num(r.out, "Pi2", 0) == 0.5 && pd_test_json_num(r.out, "Pi2", 4) == 2.5,
               "end points not exact");
-        proc_free(&r);
+        pd_test_proc_free(&r);
     }
 }
 
@@ -573,21 +394,21 @@ static void test_spectrum_linear_vs_log(pd_test_ctx *ctx)
  * gaps and restitutions: 4 twins for 16 points, equal umax_free. */
 static void test_spectrum_twins_shared(pd_test_ctx *ctx)
 {
-    if (!have_pound(ctx))
+    if (!pd_test_have_pound(ctx))
         return;
     const char *args[] = {"spectrum", "--Pi3", "0.01,0.1", "--eps", "0.2,0.9", "--Pi2",
                           "0.3:3:4", "--json", NULL};
     proc_out r;
-    pound(ctx, args, &r);
+    pd_test_pound(ctx, args, &r);
     CHECK(ctx, r.status == 0, "exit %d: %s", r.status, r.err);
-    CHECK(ctx, json_num(r.out, "runs", 0) == 20 && json_num(r.out, "twins", 0) == 4,
-          "runs %g twins %g, expected 20 and 4", json_num(r.out, "runs", 0),
-          json_num(r.out, "twins", 0));
+    CHECK(ctx, pd_test_json_num(r.out, "runs", 0) == 20 && pd_test_json_num(r.out, "twins", 0) == 4,
+          "runs %g twins %g, expected 20 and 4", pd_test_json_num(r.out, "runs", 0),
+          pd_test_json_num(r.out, "twins", 0));
     for (int c = 1; c < 4; c++)
         for (int j = 0; j < 4; j++)
-            CHECK(ctx, json_num(r.out, "umax_free", 4 * c + j) == json_num(r.out, "umax_free", j),
+            CHECK(ctx, pd_test_json_num(r.out, "umax_free", 4 * c + j) == pd_test_json_num(r.out, "umax_free", j),
                   "curve %d Pi2 #%d: umax_free differs", c, j);
-    proc_free(&r);
+    pd_test_proc_free(&r);
 }
 
 /* The dimensional view: amplitudes 1, 2.5, 7 m/s^2 at the same Pi3 give
@@ -596,36 +417,36 @@ static void test_spectrum_twins_shared(pd_test_ctx *ctx)
 static void test_spectrum_dimensional_self_similar(pd_test_ctx *ctx)
 {
     static const double ap[] = {1.0, 2.5, 7.0};
-    if (!have_pound(ctx))
+    if (!pd_test_have_pound(ctx))
         return;
     const char *args[] = {"spectrum", "--ap", "1,2.5,7", "--Tp", "0.4", "--Pi3", "0.05",
                           "--pulse", "cosine", "--dir", "reverse", "--Pi2", "0.3:3:6", "--json",
                           NULL};
     proc_out r;
-    pound(ctx, args, &r);
+    pd_test_pound(ctx, args, &r);
     CHECK(ctx, r.status == 0, "exit %d: %s", r.status, r.err);
     for (int c = 1; c < 3; c++)
         for (int j = 0; j < 6; j++) {
             int p = 6 * c + j;
-            CHECK(ctx, rel_close(json_num(r.out, "Pi1", p), json_num(r.out, "Pi1", j), 1e-12),
-                  "ap %g Pi2 #%d: Pi1 %.17g vs %.17g", ap[c], j, json_num(r.out, "Pi1", p),
-                  json_num(r.out, "Pi1", j));
-            CHECK(ctx, rel_close(json_num(r.out, "umax", p) / ap[c], json_num(r.out, "umax", j),
+            CHECK(ctx, rel_close(pd_test_json_num(r.out, "Pi1", p), pd_test_json_num(r.out, "Pi1", j), 1e-12),
+                  "ap %g Pi2 #%d: Pi1 %.17g vs %.17g", ap[c], j, pd_test_json_num(r.out, "Pi1", p),
+                  pd_test_json_num(r.out, "Pi1", j));
+            CHECK(ctx, rel_close(pd_test_json_num(r.out, "umax", p) / ap[c], pd_test_json_num(r.out, "umax", j),
                                  1e-12),
                   "ap %g: umax not proportional to ap", ap[c]);
-            CHECK(ctx, rel_close(json_num(r.out, "T0", p), 0.4 / json_num(r.out, "Pi2", p), 1e-15),
+            CHECK(ctx, rel_close(pd_test_json_num(r.out, "T0", p), 0.4 / pd_test_json_num(r.out, "Pi2", p), 1e-15),
                   "T0 != Tp / Pi2");
         }
-    proc_free(&r);
+    pd_test_proc_free(&r);
     const char *gargs[] = {"spectrum", "--ap", "1,2", "--Tp", "0.4", "--gap", "0.002", "--Pi2",
                            "0.5:1:2", "--json", NULL};
-    pound(ctx, gargs, &r);
+    pd_test_pound(ctx, gargs, &r);
     CHECK(ctx, r.status == 0, "--gap: exit %d: %s", r.status, r.err);
     double wp = 6.283185307179586 / 0.4;
     for (int c = 0; c < 2; c++)
-        CHECK(ctx, rel_close(json_num(r.out, "Pi3", 2 * c), 0.002 * wp * wp / (c + 1.0), 1e-12),
-              "--gap: curve %d Pi3 %.17g", c, json_num(r.out, "Pi3", 2 * c));
-    proc_free(&r);
+        CHECK(ctx, rel_close(pd_test_json_num(r.out, "Pi3", 2 * c), 0.002 * wp * wp / (c + 1.0), 1e-12),
+              "--gap: curve %d Pi3 %.17g", c, pd_test_json_num(r.out, "Pi3", 2 * c));
+    pd_test_proc_free(&r);
 }
 
 /* --plot F.png draws F.png, F-gamma.png and, with --ap, F-dim.png. */
@@ -634,14 +455,14 @@ static void test_spectrum_plot(pd_test_ctx *ctx)
     static const char *const suffix[] = {".png", "-gamma.png", "-dim.png"};
     const char *gp[] = {"gnuplot", "--version", NULL};
     proc_out g;
-    if (!have_pound(ctx))
+    if (!pd_test_have_pound(ctx))
         return;
-    if (spawn(gp, NULL, &g) != 0) {
-        proc_free(&g);
+    if (pd_test_spawn(gp, NULL, &g) != 0) {
+        pd_test_proc_free(&g);
         pd_test_skip(ctx, "gnuplot not installed");
         return;
     }
-    proc_free(&g);
+    pd_test_proc_free(&g);
     char dir[] = "/tmp/pd_spec_pltXXXXXX", png[512], path[600];
     if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
         return;
@@ -649,18 +470,18 @@ static void test_spectrum_plot(pd_test_ctx *ctx)
     const char *args[] = {"spectrum", "--ap", "1,2", "--Pi3", "0.01,0.1", "--Pi2", "0.2:5:8",
                           "--plot", png, NULL};
     proc_out r;
-    pound(ctx, args, &r);
+    pd_test_pound(ctx, args, &r);
     CHECK(ctx, r.status == 0, "exit %d: %s", r.status, r.err);
     for (int k = 0; k < 3; k++) {
         snprintf(path, sizeof path, "%s/s%s", dir, suffix[k]);
-        char *bytes = slurp(path);
+        char *bytes = pd_test_slurp(path);
         CHECK(ctx, bytes && !strncmp(bytes + 1, "PNG", 3), "%s missing or not a PNG", path);
         free(bytes);
     }
-    CHECK(ctx, dir_entries(dir) == 3, "%d files in the folder, expected the 3 charts",
-          dir_entries(dir));
-    proc_free(&r);
-    rm_dir(dir);
+    CHECK(ctx, pd_test_dir_entries(dir) == 3, "%d files in the folder, expected the 3 charts",
+          pd_test_dir_entries(dir));
+    pd_test_proc_free(&r);
+    pd_test_rm_dir(dir);
 }
 
 /* ---- MPI ------------------------------------------------------------------ */
@@ -672,40 +493,40 @@ static void test_spectrum_mpi_matches_serial(pd_test_ctx *ctx)
     const char *mpi = getenv("POUND_MPI") ? getenv("POUND_MPI") : "build-mpi/pound";
     const char *probe[] = {"mpirun", "--version", NULL};
     proc_out r;
-    if (!have_pound(ctx))
+    if (!pd_test_have_pound(ctx))
         return;
     if (access(mpi, X_OK) != 0) {
         pd_test_skip(ctx, "no MPI build (make MPI=1)");
         return;
     }
-    if (spawn(probe, NULL, &r) != 0) {
-        proc_free(&r);
+    if (pd_test_spawn(probe, NULL, &r) != 0) {
+        pd_test_proc_free(&r);
         pd_test_skip(ctx, "no mpirun");
         return;
     }
-    proc_free(&r);
+    pd_test_proc_free(&r);
     char dir[] = "/tmp/pd_spec_mpiXXXXXX", ser[512], par[512];
     if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
         return;
     snprintf(ser, sizeof ser, "%s/serial.h5", dir);
     snprintf(par, sizeof par, "%s/mpi.h5", dir);
     const char *a_ser[] = {"spectrum", SWEEP, "--threads", "1", "-o", ser, NULL};
-    pound(ctx, a_ser, &r);
+    pd_test_pound(ctx, a_ser, &r);
     CHECK(ctx, r.status == 0, "serial: exit %d: %s", r.status, r.err);
-    proc_free(&r);
+    pd_test_proc_free(&r);
     for (int th = 1; th <= 2; th++) {
         const char *a_mpi[] = {"mpirun", "-np", "2", "--allow-run-as-root", "--oversubscribe",
                                mpi, "spectrum", SWEEP, "--threads", th == 1 ? "1" : "2", "-o",
                                par, "--json", NULL};
         unlink(par);
-        spawn(a_mpi, NULL, &r);
+        pd_test_spawn(a_mpi, NULL, &r);
         CHECK(ctx, r.status == 0, "mpirun: exit %d: %s", r.status, r.err);
-        CHECK(ctx, json_num(r.out, "ranks", 0) == 2, "ranks %g in the JSON, expected 2",
-              json_num(r.out, "ranks", 0));
-        CHECK(ctx, same_file(ser, par), "MPI (2 ranks x %d threads) file differs from serial", th);
-        proc_free(&r);
+        CHECK(ctx, pd_test_json_num(r.out, "ranks", 0) == 2, "ranks %g in the JSON, expected 2",
+              pd_test_json_num(r.out, "ranks", 0));
+        CHECK(ctx, pd_test_same_file(ser, par), "MPI (2 ranks x %d threads) file differs from serial", th);
+        pd_test_proc_free(&r);
     }
-    rm_dir(dir);
+    pd_test_rm_dir(dir);
 }
 
 void suite_spectrum(pd_test_ctx *ctx)

@@ -1,0 +1,182 @@
+/* test_util.c — helpers the CLI suites share: running pound and capturing
+ * its output, reading JSON members, scratch folders, HDF5 attributes. */
+#include <dirent.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "pd_test.h"
+
+
+/* Read a whole file into a malloc'd NUL-terminated buffer. */
+char *pd_test_slurp(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    size_t n = 0, cap = 4096;
+    char *buf = malloc(cap);
+    while (f && buf) {
+        if (n + 1 >= cap) {
+            char *b = realloc(buf, cap *= 2);
+            if (!b)
+                break;
+            buf = b;
+        }
+        size_t r = fread(buf + n, 1, cap - n - 1, f);
+        if (r == 0)
+            break;
+        n += r;
+    }
+    if (buf)
+        buf[n] = '\0';
+    if (f)
+        fclose(f);
+    return buf;
+}
+
+/* Release what spawn captured. */
+void pd_test_proc_free(proc_out *r)
+{
+    free(r->out);
+    free(r->err);
+    r->out = r->err = NULL;
+}
+
+/* Run argv (argv[0] a path or a name on PATH) with env ("NAME=value" or
+ * NULL) added, capturing stdout and stderr; returns the exit status. */
+int pd_test_spawn(const char *const *argv, const char *env, proc_out *r)
+{
+    char out_path[] = "/tmp/pd_spec_outXXXXXX", err_path[] = "/tmp/pd_spec_errXXXXXX";
+    int fo = mkstemp(out_path), fe = mkstemp(err_path), st = 0;
+    fflush(stdout);
+    pid_t pid = fork();
+    if (pid == 0) {
+        dup2(fo, 1);
+        dup2(fe, 2);
+        if (env) {
+            char kv[256];
+            snprintf(kv, sizeof kv, "%s", env);
+            char *eq = strchr(kv, '=');
+            if (eq) {
+                *eq = '\0';
+                setenv(kv, eq + 1, 1);
+            }
+        }
+        execvp(argv[0], (char *const *)argv);
+        _exit(127);
+    }
+    waitpid(pid, &st, 0);
+    close(fo);
+    close(fe);
+    r->out = pd_test_slurp(out_path);
+    r->err = pd_test_slurp(err_path);
+    unlink(out_path);
+    unlink(err_path);
+    r->status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    return r->status;
+}
+
+/* Run `pound spectrum` (or another subcommand) with args, NULL-terminated. */
+int pd_test_pound(const pd_test_ctx *ctx, const char *const *args, proc_out *r)
+{
+    const char *argv[80];
+    int n = 0;
+    argv[n++] = ctx->pound;
+    for (; args[n - 1] && n < 79; n++)
+        argv[n] = args[n - 1];
+    argv[n] = NULL;
+    return pd_test_spawn(argv, NULL, r);
+}
+
+/* Is the binary under test there?  Skips the case otherwise. */
+int pd_test_have_pound(pd_test_ctx *ctx)
+{
+    if (access(ctx->pound, X_OK) == 0)
+        return 1;
+    pd_test_skip(ctx, "no pound binary (pass --pound PATH)");
+    return 0;
+}
+
+/* The number after the k-th "key": (NAN when absent or null). */
+double pd_test_json_num(const char *json, const char *key, int k)
+{
+    char pat[64];
+    const char *p = json;
+    snprintf(pat, sizeof pat, "\"%s\":", key);
+    for (int i = 0; p && i <= k; i++)
+        if ((p = strstr(p, pat)))
+            p += strlen(pat);
+    if (!p || !strncmp(p, "null", 4))
+        return NAN;
+    return strtod(p, NULL);
+}
+
+/* The string after the k-th "key": into buf ("" when absent). */
+void pd_test_json_str(const char *json, const char *key, int k, char *buf, size_t cap)
+{
+    char pat[64];
+    const char *p = json;
+    snprintf(pat, sizeof pat, "\"%s\":\"", key);
+    for (int i = 0; p && i <= k; i++)
+        if ((p = strstr(p, pat)))
+            p += strlen(pat);
+    size_t n = p ? strcspn(p, "\"") : 0;
+    n = n < cap ? n : cap - 1;
+    memcpy(buf, p ? p : "", n);
+    buf[n] = '\0';
+}
+
+/* Number of entries in a directory besides . and .. */
+int pd_test_dir_entries(const char *dir)
+{
+    DIR *d = opendir(dir);
+    int n = 0;
+    for (struct dirent *e; d && (e = readdir(d));)
+        n += strcmp(e->d_name, ".") && strcmp(e->d_name, "..");
+    if (d)
+        closedir(d);
+    return n;
+}
+
+/* Remove a scratch directory and its files. */
+void pd_test_rm_dir(const char *dir)
+{
+    DIR *d = opendir(dir);
+    char path[1024];
+    for (struct dirent *e; d && (e = readdir(d));)
+        if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) {
+            snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+            unlink(path);
+        }
+    if (d)
+        closedir(d);
+    rmdir(dir);
+}
+
+/* Are two files byte-identical (and both present)? */
+int pd_test_same_file(const char *a, const char *b)
+{
+    FILE *f = fopen(a, "rb"), *g = fopen(b, "rb");
+    int same = f && g, x = 0, y = 0;
+    while (same && (x = fgetc(f)) == (y = fgetc(g)) && x != EOF)
+        ;
+    same = same && x == y;
+    if (f)
+        fclose(f);
+    if (g)
+        fclose(g);
+    return same;
+}
+
+/* A double attribute (NAN when missing). */
+double pd_test_h5_num(hid_t obj, const char *name)
+{
+    double x = NAN;
+    hid_t a = H5Aopen(obj, name, H5P_DEFAULT);
+    if (a >= 0) {
+        H5Aread(a, H5T_NATIVE_DOUBLE, &x);
+        H5Aclose(a);
+    }
+    return x;
+}
+
