@@ -78,8 +78,7 @@ static int parse_range(conv_args *a, const char *text)
 
 static int parse_args(conv_args *a, int argc, char **argv)
 {
-    int rc, nm;
-    double dummy[MAX_LIST];
+    int rc;
     memset(a, 0, sizeof *a);
     pd_cli_case_init(&a->k);
     a->want_moreau = 1;
@@ -135,8 +134,6 @@ static int parse_args(conv_args *a, int argc, char **argv)
         } else
             return pd_cli_usage_error("converge: unknown flag '%s' (see pound converge --help)", f);
     }
-    (void)dummy;
-    (void)nm;
     if (!a->have_dt_range)
         return pd_cli_usage_error("converge: --dt MAX:MIN:N is required");
     if (!a->ntheta) {

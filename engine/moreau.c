@@ -20,7 +20,6 @@ struct pd_mj {
     const pd_model *model;
     pd_mj_opts opts;
     int scalar;           /* 1: scalar kernel */
-    long step0;           /* steps before the last reset (unused: 0) */
     double t0;            /* time of the last reset */
     int next_break;       /* index of the first model breakpoint after t */
     pd_factor *factor;    /* What, What^-1 W and the Delassus matrix */
@@ -174,12 +173,9 @@ fail:
 /* g = g0 + W^T q. */
 static void gaps(const pd_model *md, const double *q, double *g)
 {
-    for (int a = 0; a < md->m; a++) {
-        double s = md->g0[a];
-        for (int i = 0; i < md->n; i++)
-            s += pd_matrix_get(&md->W, i, a) * q[i];
-        g[a] = s;
-    }
+    pd_matrix_gemv_t(&md->W, q, g);
+    for (int a = 0; a < md->m; a++)
+        g[a] += md->g0[a];
 }
 
 int pd_mj_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_err *err)

@@ -1,10 +1,7 @@
 /* test_cli.c — the pound command line: bad input, output files, JSON. */
-#include <dirent.h>
-#include <fcntl.h>
 #include <hdf5.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include "pd_test.h"
