@@ -33,17 +33,17 @@ BUILD   ?= build
 
 # Dependencies through pkg-config (Debian's SuiteSparse 5 ships no .pc file;
 # its headers live in the documented suitesparse/ subfolder of the include path).
-PKGS         = gsl hdf5
+PKGS         = gsl hdf5 jansson
 PKG_CFLAGS  := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS    := $(shell pkg-config --libs $(PKGS) 2>/dev/null)
 SS_CFLAGS   := $(shell pkg-config --cflags cholmod 2>/dev/null || echo -I/usr/include/suitesparse)
 SS_LIBS     := $(shell pkg-config --libs cholmod cxsparse 2>/dev/null || echo -lcholmod -lcxsparse)
 
-INC      = -Ilcp -Iengine -Iproblems -Icli
+INC      = -Icore -Ilcp -Iengine -Iproblems -Icli
 ALL_CFLAGS = $(WARN) $(DEFS) $(CFLAGS) $(OPENMP) $(INC) $(PKG_CFLAGS) $(SS_CFLAGS) $(XCFLAGS)
 LIBS     = $(PKG_LIBS) $(SS_LIBS) -lm
 
-LIB_SRC  = $(wildcard lcp/*.c) $(wildcard engine/*.c) $(wildcard problems/*.c)
+LIB_SRC  = $(wildcard core/*.c) $(wildcard lcp/*.c) $(wildcard engine/*.c) $(wildcard problems/*.c)
 CLI_SRC  = $(wildcard cli/*.c)
 TEST_SRC = $(wildcard tests/*.c)
 LIB_OBJ  = $(LIB_SRC:%.c=$(BUILD)/%.o)

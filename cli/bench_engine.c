@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "pd_cli.h"
-#include "pd_oscillator.h"
+#include "pd_problems.h"
 
 /* A scene of its own for persistent contact: x'' + k x = 1 pressing the
  * oscillator on a wall at x = 0 (gap 0, e = 0): active, LCP every step. */
@@ -34,7 +34,7 @@ static int cmp_double(const void *a, const void *b)
 }
 
 /* Median rate of pd_osc_simulate over three runs. */
-static int time_oscillator(const pd_osc *c, const pd_osc_opts *o, bench_case *bc)
+static int time_oscillator(const pd_osc *c, const pd_run_opts *o, bench_case *bc)
 {
     double rate[3];
     pd_osc_result r;
@@ -55,9 +55,15 @@ static int time_oscillator(const pd_osc *c, const pd_osc_opts *o, bench_case *bc
 static int time_pressing(pd_kernel kernel, long nsteps, bench_case *bc)
 {
     double M = 1, K = 0.01, W = -1, g0 = 0, e = 0, rate[3];
-    pd_model md = {1, 1, pd_matrix_dense(1, 1, &M), {PD_MATRIX_ZERO, 1, 1, NULL},
-                   pd_matrix_dense(1, 1, &K), pd_matrix_dense(1, 1, &W), &g0, &e, push_force,
-                   NULL, NULL, 0};
+    pd_model md = {.n = 1,
+                   .m = 1,
+                   .M = pd_matrix_dense(1, 1, &M),
+                   .C = pd_matrix_zero(1, 1),
+                   .K = pd_matrix_dense(1, 1, &K),
+                   .W = pd_matrix_dense(1, 1, &W),
+                   .g0 = &g0,
+                   .e = &e,
+                   .force = push_force};
     pd_mj_opts o = pd_mj_default_opts();
     pd_err err;
     o.h = 1e-3;
@@ -91,19 +97,22 @@ int pd_bench_engine(pd_json *js)
 {
     bench_case cases[6];
     int n = 0, rc = 0;
-    pd_osc_opts o = pd_osc_default_opts();
+    pd_run_opts o = pd_run_default_opts();
     /* free flight: harmonic excitation, the wall out of reach */
-    pd_osc free_c = {PD_PULSE_HARMONIC, 1, 1.0, 1.0, 0.5, 1e9, 0.5, 0.05};
+    pd_osc free_c = {.pulse = PD_PULSE_HARMONIC, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5,
+                     .Pi3 = 1e9, .eps = 0.5, .xi = 0.05};
     o.dt = 1e-4;
     o.tend = 1000.0;
     cases[n] = (bench_case){"free_flight", "harmonic, no contact, oscillator observer", 0, 0, 0};
     rc |= time_oscillator(&free_c, &o, &cases[n++]);
     /* many impacts: harmonic, small gap, eps = 0.8 */
-    pd_osc imp_c = {PD_PULSE_HARMONIC, 1, 1.0, 1.0, 0.5, 0.01, 0.8, 0.05};
+    pd_osc imp_c = {.pulse = PD_PULSE_HARMONIC, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5,
+                    .Pi3 = 0.01, .eps = 0.8, .xi = 0.05};
     cases[n] = (bench_case){"many_impacts", "harmonic, Pi3 = 0.01, eps = 0.8", 0, 0, 0};
     rc |= time_oscillator(&imp_c, &o, &cases[n++]);
     /* persistent contact: a normal sine pulse, eps = 0, long resting phases */
-    pd_osc rest_c = {PD_PULSE_HARMONIC, 1, 1.0, 1.0, 0.3, 0.0, 0.0, 0.05};
+    pd_osc rest_c = {.pulse = PD_PULSE_HARMONIC, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.3,
+                     .Pi3 = 0.0, .eps = 0.0, .xi = 0.05};
     cases[n] = (bench_case){"contact_phases", "harmonic, Pi3 = 0, eps = 0 (rests half the time)",
                             0, 0, 0};
     rc |= time_oscillator(&rest_c, &o, &cases[n++]);

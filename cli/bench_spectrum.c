@@ -112,7 +112,7 @@ int pd_bench_spectrum(pd_json *js)
     f.points = pd_spec_points(&s);
     pd_spec_result *r1 = malloc((size_t)f.runs * sizeof *r1);
     pd_spec_result *r2 = malloc((size_t)f.runs * sizeof *r2);
-    int rc = !r1 || !r2 || pd_spec_validate(&s) || timed(&s, 1, r1, &f.serial_s) ||
+    int rc = !r1 || !r2 || pd_spec_validate(&s, NULL) || timed(&s, 1, r1, &f.serial_s) ||
              timed(&s, 2, r2, &f.omp2_s);
     if (!rc) {
         for (long t = 0; t < f.runs; t++)

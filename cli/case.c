@@ -1,5 +1,5 @@
-/* case.c — the model, scheme and method flags that simulate, compare and
- * converge share, with errors that name the flag. */
+/* case.c — the model, scheme, method and scene flags that simulate,
+ * compare, converge and spectrum share, with errors that name the flag. */
 #include <math.h>
 #include <string.h>
 
@@ -12,66 +12,72 @@ const char pd_cli_case_help[] =
     "  --T0 T   oscillator period, s  or  --Pi2 X = Tp/T0 [1]\n"
     "  --gap D  initial gap, m        or  --Pi3 X = gap wp^2/ap [0.05]\n"
     "  --eps E  restitution in [0,1] [0.5]    --xi Z   damping ratio in [0,1) [0.05]\n"
+    "scenes (rows of structures, docs/scenes.md):\n"
+    "  --scene F.json   run the scene of file F (its excitation replaces the model flags)\n"
+    "  --chain N        a row of N SDOFs between two walls built from the model flags: unit\n"
+    "                   masses, periods alternating T0 and R T0 (--chain-ratio R [1.5]),\n"
+    "                   every gap --gap/--Pi3, every restitution --eps\n"
     "scheme:\n"
     "  --method moreau|event|penalty [moreau]\n"
     "  --dt H [min(Tp,T0)/2000]   --theta T [0.5]   --gamma G [0.5]   --tend T [Tp+2 T0;\n"
     "         harmonic: transient + window, see docs/scheme.md]\n"
     "  --allow-unstable  accept theta outside [1/2, 1]\n"
     "  --no-accumulation  event-driven: do not jump accumulations of impacts\n"
+    "  --kernel auto|general [auto]  general: no fast path (scalar kernel, exact reference)\n"
+    "  --factor auto|scalar|dense|cholmod [auto]  storage of the iteration matrix\n"
+    "  --lcp-solver auto|lemke [auto]  the contact LCP solver\n"
     "penalty (--method penalty):\n"
-    "  --contact kelvin|hertz [kelvin]   --kc X stiffness as a multiple of w0^2 [1e4]\n"
-    "  --kc-abs K  stiffness in N/m per kg (N/m^1.5 per kg for hertz)\n"
+    "  --contact kelvin|hertz [kelvin]   --kc X stiffness as a multiple of w0^2 (scenes: of\n"
+    "         the largest storey stiffness) [1e4]\n"
+    "  --kc-abs K  stiffness in N/m per kg (scenes: N/m; N/m^1.5 for hertz)\n"
     "  --rtol R [1e-10]  --atol A [1e-12]  --stepper rk8pd|rkf45|rk4imp|msbdf [rk8pd]\n";
-
-const char *pd_method_name(pd_method m)
-{
-    return m == PD_METHOD_EVENT ? "event" : m == PD_METHOD_PENALTY ? "penalty" : "moreau";
-}
-
-int pd_method_parse(const char *name, pd_method *m)
-{
-    if (name && !strcmp(name, "moreau"))
-        *m = PD_METHOD_MOREAU;
-    else if (name && !strcmp(name, "event"))
-        *m = PD_METHOD_EVENT;
-    else if (name && !strcmp(name, "penalty"))
-        *m = PD_METHOD_PENALTY;
-    else
-        return -1;
-    return 0;
-}
 
 void pd_cli_case_init(pd_cli_case *a)
 {
     memset(a, 0, sizeof *a);
-    a->c = (pd_osc){PD_PULSE_SINE, 1, 1.0, 1.0, 1.0, 0.05, 0.5, 0.05};
-    a->opts = pd_osc_default_opts();
-    a->method = PD_METHOD_MOREAU;
-    a->pen.law = PD_PENALTY_KELVIN;
-    a->pen.kc_mult = 1e4;
+    a->c = pd_osc_default();
+    a->opts = pd_run_default_opts();
+    a->chain_ratio = 1.5;
 }
 
-/* A numeric flag and where it goes. */
+/* A numeric flag and where it goes; model flags describe the oscillator. */
 typedef struct num_flag {
     const char *flag;
     double *dst;
     int *given;
+    int model;
 } num_flag;
+
+/* A flag naming one of a set: its parser's verdict, or an error listing the set. */
+static int named(const char *flag, const char *val, int bad, const char *set)
+{
+    if (bad)
+        return pd_cli_usage_error("%s: '%s' is not one of %s", flag, val ? val : "", set);
+    return 1;
+}
 
 int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
 {
     const char *f = argv[*i], *val = *i + 1 < argc ? argv[*i + 1] : NULL;
     double x;
     int rc;
-    num_flag nums[] = {
-        {"--ap", &a->c.ap, NULL},          {"--Tp", &a->c.Tp, NULL},
-        {"--T0", &a->T0, &a->have_T0},     {"--Pi2", &a->c.Pi2, &a->have_Pi2},
-        {"--gap", &a->gap, &a->have_gap},  {"--Pi3", &a->c.Pi3, &a->have_Pi3},
-        {"--eps", &a->c.eps, NULL},        {"--xi", &a->c.xi, NULL},
-        {"--dt", &a->opts.dt, &a->have_dt}, {"--theta", &a->opts.theta, NULL},
-        {"--gamma", &a->opts.gamma, NULL}, {"--tend", &a->opts.tend, &a->have_tend},
-        {"--kc", &a->pen.kc_mult, NULL},   {"--kc-abs", &a->pen.kc_abs, NULL},
-        {"--rtol", &a->pen.rtol, NULL},    {"--atol", &a->pen.atol, NULL}};
+    num_flag nums[] = {{"--ap", &a->c.ap, NULL, 1},
+                       {"--Tp", &a->c.Tp, NULL, 1},
+                       {"--T0", &a->T0, &a->have_T0, 1},
+                       {"--Pi2", &a->c.Pi2, &a->have_Pi2, 1},
+                       {"--gap", &a->gap, &a->have_gap, 1},
+                       {"--Pi3", &a->c.Pi3, &a->have_Pi3, 1},
+                       {"--eps", &a->c.eps, NULL, 1},
+                       {"--xi", &a->c.xi, NULL, 1},
+                       {"--dt", &a->opts.dt, &a->have_dt, 0},
+                       {"--theta", &a->opts.theta, NULL, 0},
+                       {"--gamma", &a->opts.gamma, NULL, 0},
+                       {"--tend", &a->opts.tend, &a->have_tend, 0},
+                       {"--kc", &a->opts.pen.kc_mult, NULL, 0},
+                       {"--kc-abs", &a->opts.pen.kc_abs, NULL, 0},
+                       {"--rtol", &a->opts.pen.rtol, NULL, 0},
+                       {"--atol", &a->opts.pen.atol, NULL, 0},
+                       {"--chain-ratio", &a->chain_ratio, NULL, 1}};
     for (size_t n = 0; n < sizeof nums / sizeof nums[0]; n++)
         if (!strcmp(f, nums[n].flag)) {
             if ((rc = pd_cli_double(f, val, &x)))
@@ -79,55 +85,96 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
             *nums[n].dst = x;
             if (nums[n].given)
                 *nums[n].given = 1;
+            if (nums[n].model && !a->model_flag)
+                a->model_flag = nums[n].flag;
             (*i)++;
             return 1;
         }
-    if (!strcmp(f, "--allow-unstable"))
-        a->opts.allow_unstable = 1;
-    else if (!strcmp(f, "--no-wall"))
-        a->opts.no_wall = 1;
-    else if (!strcmp(f, "--no-accumulation"))
-        a->opts.no_accumulation = 1;
-    else if (!strcmp(f, "--pulse")) {
-        if (pd_pulse_parse(val, &a->c.pulse))
-            return pd_cli_usage_error("--pulse: '%s' is not one of sine, cosine, harmonic",
-                                      val ? val : "");
-        (*i)++;
-    } else if (!strcmp(f, "--dir")) {
-        if (pd_dir_parse(val, &a->c.dir))
-            return pd_cli_usage_error("--dir: '%s' is not one of normal, reverse", val ? val : "");
-        (*i)++;
-    } else if (!strcmp(f, "--method")) {
-        if (pd_method_parse(val, &a->method))
-            return pd_cli_usage_error("--method: '%s' is not one of moreau, event, penalty",
-                                      val ? val : "");
-        (*i)++;
-    } else if (!strcmp(f, "--contact")) {
-        if (!val || (strcmp(val, "kelvin") && strcmp(val, "hertz")))
-            return pd_cli_usage_error("--contact: '%s' is not one of kelvin, hertz", val ? val : "");
-        a->pen.law = strcmp(val, "hertz") ? PD_PENALTY_KELVIN : PD_PENALTY_HERTZDAMP;
-        (*i)++;
+    if (!strcmp(f, "--allow-unstable") || !strcmp(f, "--no-wall") ||
+        !strcmp(f, "--no-accumulation")) {
+        a->opts.allow_unstable |= !strcmp(f, "--allow-unstable");
+        a->opts.no_wall |= !strcmp(f, "--no-wall");
+        a->opts.no_accumulation |= !strcmp(f, "--no-accumulation");
+        return 1;
+    }
+    if (!strcmp(f, "--pulse"))
+        rc = named(f, val, pd_pulse_parse(val, &a->c.pulse) != PD_OK, "sine, cosine, harmonic");
+    else if (!strcmp(f, "--dir"))
+        rc = named(f, val, pd_dir_parse(val, &a->c.dir) != PD_OK, "normal, reverse");
+    else if (!strcmp(f, "--method"))
+        rc = named(f, val, pd_method_parse(val, &a->opts.method) != PD_OK,
+                   "moreau, event, penalty");
+    else if (!strcmp(f, "--contact")) {
+        rc = named(f, val, !val || (strcmp(val, "kelvin") && strcmp(val, "hertz")), "kelvin, hertz");
+        if (rc == 1)
+            a->opts.pen.law = strcmp(val, "hertz") ? PD_PENALTY_KELVIN : PD_PENALTY_HERTZDAMP;
     } else if (!strcmp(f, "--stepper")) {
         static const char *const steppers[] = {"rk8pd", "rkf45", "rk4imp", "msbdf"};
         int ok = 0;
         for (int k = 0; k < 4 && val; k++)
-            ok |= !strcmp(val, steppers[k]);
-        if (!ok)
-            return pd_cli_usage_error("--stepper: '%s' is not one of rk8pd, rkf45, rk4imp, msbdf",
-                                      val ? val : "");
-        a->pen.stepper = val;
-        (*i)++;
+            if (!strcmp(val, steppers[k])) {
+                ok = 1;
+                a->opts.pen.stepper = steppers[k];
+            }
+        rc = named(f, val, !ok, "rk8pd, rkf45, rk4imp, msbdf");
     } else if (!strcmp(f, "--kernel")) {
-        if (!val || (strcmp(val, "auto") && strcmp(val, "general")))
-            return pd_cli_usage_error("--kernel: '%s' is not one of auto, general", val ? val : "");
-        a->opts.kernel = strcmp(val, "general") ? PD_KERNEL_AUTO : PD_KERNEL_GENERAL;
-        (*i)++;
+        rc = named(f, val, !val || (strcmp(val, "auto") && strcmp(val, "general")), "auto, general");
+        if (rc == 1)
+            a->opts.kernel = strcmp(val, "general") ? PD_KERNEL_AUTO : PD_KERNEL_GENERAL;
+    } else if (!strcmp(f, "--factor"))
+        rc = named(f, val, pd_factor_kind_parse(val, &a->opts.factor) != PD_OK,
+                   "auto, scalar, dense, cholmod");
+    else if (!strcmp(f, "--lcp-solver"))
+        rc = named(f, val, pd_lcp_method_parse(val, &a->opts.lcp_solver) != PD_OK,
+                   pd_lcp_method_list());
+    else if (!strcmp(f, "--scene")) {
+        if (!val)
+            return pd_cli_usage_error("--scene needs a file name");
+        a->scene_path = val;
+        rc = 1;
+    } else if (!strcmp(f, "--chain")) {
+        if ((rc = pd_cli_int(f, val, &a->chain)))
+            return rc;
+        if (a->chain < 1 || a->chain > 10000000)
+            return pd_cli_usage_error("--chain: N must be in [1, 1e7] (got %d)", a->chain);
+        rc = 1;
     } else
         return 0;
-    return 1;
+    if (rc == 1)
+        (*i)++;
+    if (rc == 1 && (!strcmp(f, "--pulse") || !strcmp(f, "--dir")) && !a->model_flag)
+        a->model_flag = f;
+    return rc;
 }
 
 /* Ranges, each error naming the flag the user gave. */
+static int check_scheme(const pd_cli_case *a)
+{
+    const pd_run_opts *o = &a->opts;
+    if (a->have_dt && !(o->dt > 0.0))
+        return pd_cli_usage_error("--dt: the step must be > 0 (got %g)", o->dt);
+    if (a->have_tend && !(o->tend > 0.0))
+        return pd_cli_usage_error("--tend: must be > 0 (got %g)", o->tend);
+    if (!(o->gamma >= 0.0 && o->gamma <= 1.0))
+        return pd_cli_usage_error("--gamma: must be in [0, 1] (got %g)", o->gamma);
+    if (!o->allow_unstable && !(o->theta >= 0.5 && o->theta <= 1.0))
+        return pd_cli_usage_error("--theta: %g is outside [1/2, 1], where Moreau-Jean is not "
+                                  "unconditionally stable (add --allow-unstable to run it)",
+                                  o->theta);
+    if (!(o->theta >= 0.0 && o->theta <= 2.0))
+        return pd_cli_usage_error("--theta: must be in [0, 2] (got %g)", o->theta);
+    if (!(o->pen.kc_mult > 0.0))
+        return pd_cli_usage_error("--kc: the contact stiffness multiple must be > 0 (got %g)",
+                                  o->pen.kc_mult);
+    if (o->pen.kc_abs < 0.0)
+        return pd_cli_usage_error("--kc-abs: the contact stiffness must be >= 0 (got %g)",
+                                  o->pen.kc_abs);
+    if (!(o->pen.rtol > 0.0) || !(o->pen.atol > 0.0))
+        return pd_cli_usage_error("--rtol/--atol: tolerances must be > 0");
+    return 0;
+}
+
+/* The oscillator's ranges, each error naming the flag. */
 static int check_case(const pd_cli_case *a)
 {
     pd_err err;
@@ -151,22 +198,8 @@ static int check_case(const pd_cli_case *a)
         return pd_cli_usage_error("--eps: restitution must be in [0, 1] (got %g)", a->c.eps);
     if (!(a->c.xi >= 0.0 && a->c.xi < 1.0))
         return pd_cli_usage_error("--xi: damping ratio must be in [0, 1) (got %g)", a->c.xi);
-    if (a->have_dt && !(a->opts.dt > 0.0))
-        return pd_cli_usage_error("--dt: the step must be > 0 (got %g)", a->opts.dt);
-    if (a->have_tend && !(a->opts.tend > 0.0))
-        return pd_cli_usage_error("--tend: must be > 0 (got %g)", a->opts.tend);
-    if (!(a->opts.gamma >= 0.0 && a->opts.gamma <= 1.0))
-        return pd_cli_usage_error("--gamma: must be in [0, 1] (got %g)", a->opts.gamma);
-    if (!a->opts.allow_unstable && !(a->opts.theta >= 0.5 && a->opts.theta <= 1.0))
-        return pd_cli_usage_error("--theta: %g is outside [1/2, 1], where Moreau-Jean is not "
-                                  "unconditionally stable (add --allow-unstable to run it)",
-                                  a->opts.theta);
-    if (!(a->opts.theta >= 0.0 && a->opts.theta <= 2.0))
-        return pd_cli_usage_error("--theta: must be in [0, 2] (got %g)", a->opts.theta);
-    if (!(a->pen.kc_mult > 0.0) || a->pen.kc_abs < 0.0)
-        return pd_cli_usage_error("--kc: the contact stiffness must be > 0");
-    if (a->pen.rtol < 0.0 || a->pen.atol < 0.0)
-        return pd_cli_usage_error("--rtol/--atol: tolerances must be >= 0");
+    if (a->chain && !(a->chain_ratio > 0.0))
+        return pd_cli_usage_error("--chain-ratio: must be > 0 (got %g)", a->chain_ratio);
     if (pd_osc_check(&a->c, &err))
         return pd_cli_usage_error("%s", err.msg);
     return 0;
@@ -175,28 +208,62 @@ static int check_case(const pd_cli_case *a)
 int pd_cli_case_finish(pd_cli_case *a)
 {
     int rc;
-    if (a->have_T0)
-        a->c.Pi2 = a->T0 > 0.0 ? a->c.Tp / a->T0 : -1.0;
+    pd_err err;
+    if (a->scene_path && a->chain)
+        return pd_cli_usage_error("--scene and --chain are alternatives: give one");
+    if (a->scene_path && a->model_flag)
+        return pd_cli_usage_error("%s: the scene file gives the structures and the excitation "
+                                  "(model flags go with --chain or the oscillator)",
+                                  a->model_flag);
+    if ((rc = check_scheme(a)))
+        return rc;
+    if (a->scene_path)
+        return 0;
+    if (a->have_T0 && a->T0 > 0.0)
+        pd_osc_set_T0(&a->c, a->T0);
     if (a->have_gap && a->c.ap > 0.0 && a->c.Tp > 0.0)
-        a->c.Pi3 = a->gap / pd_osc_Le(&a->c);
+        pd_osc_set_gap(&a->c, a->gap);
     if ((rc = check_case(a)))
         return rc;
-    if (!a->have_dt)
-        a->opts.dt = pd_osc_default_dt(&a->c);
-    if (!a->have_tend)
-        a->opts.tend = pd_osc_default_tend(&a->c);
+    if (a->chain)
+        return 0; /* the chain's dt and tend come from its periods */
+    if (pd_osc_resolve_opts(&a->c, &a->opts, &a->opts, &err))
+        return pd_cli_usage_error("%s", err.msg);
     if (a->opts.tend / a->opts.dt > 2e9)
         return pd_cli_usage_error("--dt: %g s over %g s is more than 2e9 steps", a->opts.dt,
                                   a->opts.tend);
     return 0;
 }
 
-int pd_cli_run(const pd_cli_case *a, pd_method method, const pd_osc_opts *opts,
-               pd_osc_sampler sampler, void *ctx, pd_osc_result *res, pd_err *err)
+int pd_cli_is_scene(const pd_cli_case *a)
 {
-    switch (method) {
-    case PD_METHOD_EVENT: return pd_osc_reference(&a->c, opts, sampler, ctx, res, err);
-    case PD_METHOD_PENALTY: return pd_osc_penalty(&a->c, opts, &a->pen, sampler, ctx, res, err);
-    default: return pd_osc_simulate(&a->c, opts, sampler, ctx, res, err);
+    return a->scene_path != NULL || a->chain > 0;
+}
+
+int pd_cli_scene(const pd_cli_case *a, pd_scene **sc)
+{
+    pd_err err;
+    int rc;
+    *sc = NULL;
+    if (a->scene_path)
+        rc = pd_scene_load(a->scene_path, sc, &err);
+    else {
+        pd_scene_excitation x = {.pulse = a->c.pulse, .dir = a->c.dir, .ap = a->c.ap,
+                                 .Tp = a->c.Tp};
+        rc = pd_scene_chain(a->chain, &x, pd_osc_T0(&a->c), a->chain_ratio, a->c.xi,
+                            pd_osc_gap(&a->c), a->c.eps, sc, &err);
     }
+    if (rc == PD_ENOMEM) {
+        fprintf(stderr, "pound: %s\n", err.msg);
+        return 1;
+    }
+    if (rc)
+        return pd_cli_usage_error("%s", err.msg);
+    pd_run_opts o;
+    if (pd_scene_resolve_opts(*sc, &a->opts, &o, &err)) {
+        pd_scene_free(*sc);
+        *sc = NULL;
+        return pd_cli_usage_error("%s", err.msg);
+    }
+    return 0;
 }

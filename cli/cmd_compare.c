@@ -3,7 +3,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "pd_measure.h"
+#include "pd_cli.h"
 
 static const char compare_usage[] =
     "usage: pound compare [model flags] [--dt H] [--theta T] [--methods moreau[,penalty]] [--json]\n"
@@ -62,18 +62,20 @@ int pd_cmd_compare(int argc, char **argv)
         status = 1;
         goto done;
     }
-    if ((rc = pd_measure_reference(&k, &k.opts, &ref, &rr, &err))) {
+    if ((rc = pd_measure_reference(&k.c, &k.opts, &ref, &rr, &err))) {
         fprintf(stderr, "pound: compare: reference: %s\n", err.msg);
         status = rc == PD_EINVAL ? 2 : 1;
         goto done;
     }
-    for (int m = 0; m < 3; m++)
-        if (want[m] && (rc = pd_measure_run(&k, (pd_method)m, &k.opts, &ref, rr.umax, &work,
-                                            &mres[m], &err))) {
+    for (int m = 0; m < 3; m++) {
+        pd_run_opts om = k.opts;
+        om.method = (pd_method)m;
+        if (want[m] && (rc = pd_measure_run(&k.c, &om, &ref, rr.umax, &work, &mres[m], &err))) {
             fprintf(stderr, "pound: compare: %s: %s\n", pd_method_name((pd_method)m), err.msg);
             status = 1;
             goto done;
         }
+    }
     int first = want[0] ? 0 : 2;
     if (json) {
         pd_json js;

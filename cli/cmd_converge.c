@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "pd_measure.h"
+#include "pd_cli.h"
 #include "pd_output.h"
 #include "pd_plot.h"
 
@@ -175,7 +175,7 @@ static double dt_at(const conv_args *a, int i)
 static int compute_rows(conv_args *a, row *rows, int *nrows, double *ref_cpu, pd_err *err)
 {
     pd_trace ref = {0}, work = {0};
-    pd_osc_opts o = a->k.opts;
+    pd_run_opts o = a->k.opts;
     pd_osc_result rr;
     int rc = PD_OK, n = 0;
     o.dt = a->dt_min;
@@ -186,29 +186,30 @@ static int compute_rows(conv_args *a, row *rows, int *nrows, double *ref_cpu, pd
     *ref_cpu = 0.0;
     for (int i = 0; i < a->ndt && a->want_moreau; i++) {
         o.dt = dt_at(a, i);
-        if ((rc = pd_measure_reference(&a->k, &o, &ref, &rr, err)))
+        if ((rc = pd_measure_reference(&a->k.c, &o, &ref, &rr, err)))
             goto done;
         *ref_cpu = fmax(*ref_cpu, rr.cpu_s);
         for (int t = 0; t < a->ntheta; t++) {
             pd_measured m;
             o.theta = a->thetas[t];
-            if ((rc = pd_measure_run(&a->k, PD_METHOD_MOREAU, &o, &ref, rr.umax, &work, &m, err)))
+            o.method = PD_METHOD_MOREAU;
+            if ((rc = pd_measure_run(&a->k.c, &o, &ref, rr.umax, &work, &m, err)))
                 goto done;
             rows[n++] = (row){PD_METHOD_MOREAU, o.theta, o.dt, NAN, m.err_umax_rel,
                               m.err_hist_linf, m.r.cpu_s, NAN, m.r.impacts, m.r.steps};
         }
     }
     if (a->want_penalty) {
-        pd_cli_case kp = a->k;
         o.dt = a->dt_min;
-        if ((rc = pd_measure_reference(&a->k, &o, &ref, &rr, err)))
+        if ((rc = pd_measure_reference(&a->k.c, &o, &ref, &rr, err)))
             goto done;
         *ref_cpu = fmax(*ref_cpu, rr.cpu_s);
         for (int k = 0; k < a->nkc; k++) {
             pd_measured m;
-            kp.pen.kc_mult = a->kcs[k];
-            kp.pen.kc_abs = 0.0;
-            if ((rc = pd_measure_run(&kp, PD_METHOD_PENALTY, &o, &ref, rr.umax, &work, &m, err)))
+            o.method = PD_METHOD_PENALTY;
+            o.pen.kc_mult = a->kcs[k];
+            o.pen.kc_abs = 0.0;
+            if ((rc = pd_measure_run(&a->k.c, &o, &ref, rr.umax, &work, &m, err)))
                 goto done;
             rows[n++] = (row){PD_METHOD_PENALTY, NAN, o.dt, a->kcs[k], m.err_umax_rel,
                               m.err_hist_linf, m.r.cpu_s, NAN, m.r.impacts, m.r.steps};
@@ -286,8 +287,10 @@ static int plot_rows(const conv_args *a, const row *rows, int n, double ref_cpu,
                 m++;
             }
         snprintf(labels[ncurve], sizeof labels[0], "Moreau-Jean theta = %g", a->thetas[t]);
-        by_dt[ncurve] = (pd_curve){labels[ncurve], m, xs[0][ncurve], ys[0][ncurve]};
-        by_cpu[ncurve] = (pd_curve){labels[ncurve], m, xs[1][ncurve], ys[1][ncurve]};
+        by_dt[ncurve] = (pd_curve){.label = labels[ncurve], .n = m, .x = xs[0][ncurve],
+                                   .y = ys[0][ncurve]};
+        by_cpu[ncurve] = (pd_curve){.label = labels[ncurve], .n = m, .x = xs[1][ncurve],
+                                    .y = ys[1][ncurve]};
     }
     int npen = 0;
     if (a->want_penalty) {
@@ -299,16 +302,31 @@ static int plot_rows(const conv_args *a, const row *rows, int n, double ref_cpu,
             }
         snprintf(labels[ncurve], sizeof labels[0], "penalty (kc = %g..%g w0^2)", a->kcs[0],
                  a->kcs[a->nkc - 1]);
-        by_cpu[ncurve] = (pd_curve){labels[ncurve], npen, xs[1][ncurve], ys[1][ncurve]};
+        by_cpu[ncurve] = (pd_curve){.label = labels[ncurve], .n = npen, .x = xs[1][ncurve],
+                                    .y = ys[1][ncurve]};
     }
     char title[256];
     snprintf(title, sizeof title, "%s %s pulse, Pi2 = %.3g, Pi3 = %.3g, eps = %g",
              pd_dir_name(a->k.c.dir), pd_pulse_name(a->k.c.pulse), a->k.c.Pi2, a->k.c.Pi3,
              a->k.c.eps);
-    pd_chart c1 = {title, "dt [s]", "max |u - u_{ref}| / u_{max,ref}", 1, 1, ncurve, by_dt, NAN,
-                   NULL, 1.0};
-    pd_chart c2 = {title, "CPU time per run [s]", "max |u - u_{ref}| / u_{max,ref}", 1, 1,
-                   ncurve + (npen > 0), by_cpu, ref_cpu, "event-driven reference", 0.0};
+    pd_chart c1 = {.title = title,
+                   .xlabel = "dt [s]",
+                   .ylabel = "max |u - u_{ref}| / u_{max,ref}",
+                   .logx = 1,
+                   .logy = 1,
+                   .ncurves = ncurve,
+                   .curves = by_dt,
+                   .vline = NAN,
+                   .slope_ref = 1.0};
+    pd_chart c2 = {.title = title,
+                   .xlabel = "CPU time per run [s]",
+                   .ylabel = "max |u - u_{ref}| / u_{max,ref}",
+                   .logx = 1,
+                   .logy = 1,
+                   .ncurves = ncurve + (npen > 0),
+                   .curves = by_cpu,
+                   .vline = ref_cpu,
+                   .vline_label = "event-driven reference"};
     size_t len = strlen(a->plot);
     snprintf(work_png, sizeof work_png, "%.*s-work.png", (int)(len - 4), a->plot);
     int rc = ncurve ? pd_plot(a->plot, &c1, err) : PD_OK;

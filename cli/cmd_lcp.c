@@ -185,7 +185,11 @@ static int solve_and_print(const lcp_args *a, int n, const double *M, const doub
         fprintf(stderr, "pound: lcp: out of memory for n = %d\n", n);
         return 1;
     }
-    pd_lcp_opts opts = {.cover = cover, .max_pivots = a->max_pivots, .tol = a->tol};
+    pd_lcp_opts opts = pd_lcp_default_opts();
+    opts.cover = cover;
+    opts.max_pivots = a->max_pivots;
+    if (a->tol > 0.0)
+        opts.tol = a->tol;
     pd_lcp_info info;
     double t0 = pd_cpu_seconds();
     int st = pd_lcp_lemke(work, n, M, q, &opts, z, w, &info);

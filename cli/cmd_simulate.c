@@ -1,33 +1,51 @@
-/* cmd_simulate.c — `pound simulate`: one run of the pounding oscillator. */
+/* cmd_simulate.c — `pound simulate`: one run of the pounding oscillator or
+ * of a scene (a row of structures), with its contact-free twin, printed and
+ * optionally written and drawn. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "pd_cli.h"
-#include "pd_oscillator.h"
 #include "pd_output.h"
+#include "pd_scene_out.h"
 
 static const char simulate_usage[] =
-    "usage: pound simulate [model flags] [--method moreau|event|penalty] [--dt H] [--theta T]\n"
-    "                      [--tend T] [-o FILE.h5|FILE.csv] [--every K] [--json]\n"
-    "  -o FILE  history t,u,v,impulse,gap (HDF5 or CSV by extension), --every K decimates\n"
-    "  --json   one JSON object on stdout\n";
+    "usage: pound simulate [model flags | --scene F.json | --chain N] [--method moreau|event|penalty]\n"
+    "                      [--dt H] [--theta T] [--tend T] [-o FILE.h5|FILE.csv] [--every K]\n"
+    "                      [--plot FILE.png] [--json]\n"
+    "  -o FILE     the histories (HDF5 or CSV by extension), every input and result as\n"
+    "              attributes with units; --every K keeps every K-th step\n"
+    "              oscillator: t, u, v, impulse, gap; scene: t, x and v per structure and\n"
+    "              storey, gap and impulse per contact (docs/scenes.md)\n"
+    "  --plot F    the displacement histories with the impacts marked\n"
+    "  --json      one JSON object on stdout\n";
 
 /* Everything the command line sets. */
 typedef struct sim_args {
     pd_cli_case k;
-    const char *out;
+    const char *out, *plot;
     long every;
     int json;
+    char command[1024];
 } sim_args;
+
+/* The command line, for the files' provenance. */
+static void join_command(char *buf, size_t cap, int argc, char **argv)
+{
+    size_t n = (size_t)snprintf(buf, cap, "pound");
+    for (int i = 0; i < argc && n < cap; i++)
+        n += (size_t)snprintf(buf + n, cap - n, " %s", argv[i]);
+}
 
 /* Case flags, then the command's own; 0 or 2. */
 static int parse_args(sim_args *a, int argc, char **argv)
 {
     int rc, n;
+    pd_err err;
     memset(a, 0, sizeof *a);
     pd_cli_case_init(&a->k);
     a->every = 1;
+    join_command(a->command, sizeof a->command, argc, argv);
     for (int i = 1; i < argc; i++) {
         const char *f = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
         if ((rc = pd_cli_case_flag(&a->k, argc, argv, &i)) == 2)
@@ -36,10 +54,10 @@ static int parse_args(sim_args *a, int argc, char **argv)
             continue;
         if (!strcmp(f, "--json"))
             a->json = 1;
-        else if (!strcmp(f, "-o")) {
+        else if (!strcmp(f, "-o") || !strcmp(f, "--plot")) {
             if (!val)
-                return pd_cli_usage_error("-o needs a file name");
-            a->out = val;
+                return pd_cli_usage_error("%s needs a file name", f);
+            *(!strcmp(f, "-o") ? &a->out : &a->plot) = val;
             i++;
         } else if (!strcmp(f, "--every")) {
             if ((rc = pd_cli_int(f, val, &n)))
@@ -51,22 +69,31 @@ static int parse_args(sim_args *a, int argc, char **argv)
         } else
             return pd_cli_usage_error("simulate: unknown flag '%s' (see pound simulate --help)", f);
     }
-    pd_err err;
     if (a->out && pd_output_check_path(a->out, &err))
         return pd_cli_usage_error("%s", err.msg);
+    if (a->plot && (strlen(a->plot) < 5 || strcmp(a->plot + strlen(a->plot) - 4, ".png")))
+        return pd_cli_usage_error("--plot: '%s' must end in .png", a->plot);
     return pd_cli_case_finish(&a->k);
 }
+
+/* ==== the oscillator ======================================================== */
 
 /* The recorded history, allocated once before the run. */
 typedef struct history {
     long every, cap, rows;
     double *t, *u, *v, *impulse, *gap;
+    pd_scene_plot *plot; /* --plot: the same samples as a one-structure scene */
 } history;
 
 static int record(const pd_osc_sample *s, void *ctx)
 {
     history *h = ctx;
-    if (s->step % h->every || h->rows >= h->cap)
+    if (h->plot) {
+        pd_scene_sample ss = {.step = s->step, .t = s->t, .x = &s->u, .v = &s->v,
+                              .gap = &s->gap, .impulse = &s->impulse};
+        pd_scene_plot_sample(&ss, h->plot);
+    }
+    if (!h->t || s->step % h->every || h->rows >= h->cap)
         return 0;
     h->t[h->rows] = s->t;
     h->u[h->rows] = s->u;
@@ -88,7 +115,6 @@ static void history_free(history *h)
 
 static int history_alloc(history *h, long nsteps, long every)
 {
-    memset(h, 0, sizeof *h);
     h->every = every;
     h->cap = nsteps / every + 1;
     h->t = malloc((size_t)h->cap * sizeof(double));
@@ -99,19 +125,13 @@ static int history_alloc(history *h, long nsteps, long every)
     return h->t && h->u && h->v && h->impulse && h->gap ? 0 : -1;
 }
 
-/* Summary figures of a run and its no-wall twin. */
-typedef struct summary {
-    pd_osc_result r, free;
-    double Pi1, gamma, chi, cpu_s;
-} summary;
-
-static void print_json(const sim_args *a, const summary *s)
+static void print_json(const sim_args *a, const pd_osc_summary *s)
 {
     pd_json js;
     const pd_osc *c = &a->k.c;
     pd_json_init(&js, stdout);
     pd_json_begin_object(&js, NULL);
-    pd_json_str(&js, "method", pd_method_name(a->k.method));
+    pd_json_str(&js, "method", pd_method_name(a->k.opts.method));
     pd_json_num(&js, "umax", s->r.umax);
     pd_json_num(&js, "Pi1", s->Pi1);
     pd_json_num(&js, "u_toward", s->r.u_toward);
@@ -121,6 +141,7 @@ static void print_json(const sim_args *a, const summary *s)
     pd_json_num(&js, "first_impact", s->r.first_impact); /* NaN -> null */
     pd_json_num(&js, "first_impact_velocity", s->r.first_impact_velocity);
     pd_json_num(&js, "max_impact_velocity", s->r.max_impact_velocity);
+    pd_json_num(&js, "max_impulse", s->r.max_impulse);
     pd_json_num(&js, "contact_time", s->r.contact_time);
     pd_json_num(&js, "min_gap", s->r.min_gap);
     pd_json_num(&js, "umax_free", s->free.umax);
@@ -147,20 +168,20 @@ static void print_json(const sim_args *a, const summary *s)
     pd_json_finish(&js);
 }
 
-static void print_text(const sim_args *a, const summary *s)
+static void print_text(const sim_args *a, const pd_osc_summary *s)
 {
     const pd_osc *c = &a->k.c;
     printf("pounding oscillator, %s %s pulse: ap = %g m/s^2, Tp = %g s, T0 = %g s, "
            "gap = %g m, eps = %g, xi = %g\n",
            pd_dir_name(c->dir), pd_pulse_name(c->pulse), c->ap, c->Tp, pd_osc_T0(c),
            pd_osc_gap(c), c->eps, c->xi);
-    if (a->k.method == PD_METHOD_MOREAU)
+    if (a->k.opts.method == PD_METHOD_MOREAU)
         printf("  Pi2 = %.6g  Pi3 = %.6g   Moreau-Jean theta = %g, dt = %.6g s, %ld steps to %g s\n",
                c->Pi2, c->Pi3, s->r.theta, s->r.dt, s->r.steps, s->r.tend);
     else
         printf("  Pi2 = %.6g  Pi3 = %.6g   %s (%s), %ld %s to %g s\n", c->Pi2, c->Pi3,
-               a->k.method == PD_METHOD_EVENT ? "event-driven reference" : "penalty",
-               s->r.kernel, s->r.steps, a->k.method == PD_METHOD_EVENT ? "events" : "steps",
+               a->k.opts.method == PD_METHOD_EVENT ? "event-driven reference" : "penalty",
+               s->r.kernel, s->r.steps, a->k.opts.method == PD_METHOD_EVENT ? "events" : "steps",
                s->r.tend);
     printf("  umax      = %.6g m   (Pi1 = %.6g)\n", s->r.umax, s->Pi1);
     printf("  toward    = %.6g m,  away = %.6g m\n", s->r.u_toward, s->r.u_away);
@@ -175,7 +196,8 @@ static void print_text(const sim_args *a, const summary *s)
 }
 
 /* Write the history and every input and summary figure. */
-static int write_output(const sim_args *a, const summary *s, const history *h, pd_err *err)
+static int write_output(const sim_args *a, const pd_osc_summary *s, const history *h,
+                        pd_err *err)
 {
     const pd_osc *c = &a->k.c;
     pd_column cols[] = {{"t", "s", h->t},
@@ -183,78 +205,288 @@ static int write_output(const sim_args *a, const summary *s, const history *h, p
                         {"v", "m/s", h->v},
                         {"impulse", "m/s", h->impulse},
                         {"gap", "m", h->gap}};
-    pd_attr attrs[] = {
-        {"method", NULL, 1, 0, pd_method_name(a->k.method)},
-        {"pulse", NULL, 1, 0, pd_pulse_name(c->pulse)},
-        {"dir", NULL, 1, 0, pd_dir_name(c->dir)},
-        {"ap", "m/s^2", 0, c->ap, NULL},
-        {"Tp", "s", 0, c->Tp, NULL},
-        {"T0", "s", 0, pd_osc_T0(c), NULL},
-        {"gap", "m", 0, pd_osc_gap(c), NULL},
-        {"eps", "1", 0, c->eps, NULL},
-        {"xi", "1", 0, c->xi, NULL},
-        {"Pi2", "1", 0, c->Pi2, NULL},
-        {"Pi3", "1", 0, c->Pi3, NULL},
-        {"dt", "s", 0, s->r.dt, NULL},
-        {"theta", "1", 0, s->r.theta, NULL},
-        {"tend", "s", 0, s->r.tend, NULL},
-        {"every", "steps", 0, (double)a->every, NULL},
-        {"umax", "m", 0, s->r.umax, NULL},
-        {"Pi1", "1", 0, s->Pi1, NULL},
-        {"u_toward", "m", 0, s->r.u_toward, NULL},
-        {"u_away", "m", 0, s->r.u_away, NULL},
-        {"impacts", "1", 0, (double)s->r.impacts, NULL},
-        {"first_impact", "s", 0, s->r.first_impact, NULL},
-        {"contact_time", "s", 0, s->r.contact_time, NULL},
-        {"umax_free", "m", 0, s->free.umax, NULL},
-        {"gamma", "1", 0, s->gamma, NULL},
-        {"steps", "1", 0, (double)s->r.steps, NULL},
-        {"cpu_s", "s", 0, s->cpu_s, NULL}};
+#define NUM(n, u, x) {.name = n, .units = u, .num = (x)}
+#define TXT(n, x) {.name = n, .is_text = 1, .text = (x)}
+    pd_attr attrs[] = {TXT("command", a->command),
+                       TXT("method", pd_method_name(a->k.opts.method)),
+                       TXT("pulse", pd_pulse_name(c->pulse)),
+                       TXT("dir", pd_dir_name(c->dir)),
+                       NUM("ap", "m/s^2", c->ap),
+                       NUM("Tp", "s", c->Tp),
+                       NUM("T0", "s", pd_osc_T0(c)),
+                       NUM("gap", "m", pd_osc_gap(c)),
+                       NUM("eps", "1", c->eps),
+                       NUM("xi", "1", c->xi),
+                       NUM("Pi2", "1", c->Pi2),
+                       NUM("Pi3", "1", c->Pi3),
+                       NUM("dt", "s", s->r.dt),
+                       NUM("theta", "1", s->r.theta),
+                       NUM("tend", "s", s->r.tend),
+                       NUM("every", "steps", (double)a->every),
+                       NUM("umax", "m", s->r.umax),
+                       NUM("Pi1", "1", s->Pi1),
+                       NUM("u_toward", "m", s->r.u_toward),
+                       NUM("u_away", "m", s->r.u_away),
+                       NUM("impacts", "1", (double)s->r.impacts),
+                       NUM("first_impact", "s", s->r.first_impact),
+                       NUM("max_impulse", "m/s", s->r.max_impulse),
+                       NUM("contact_time", "s", s->r.contact_time),
+                       NUM("umax_free", "m", s->free.umax),
+                       NUM("gamma", "1", s->gamma),
+                       NUM("steps", "1", (double)s->r.steps),
+                       NUM("cpu_s", "s", s->cpu_s)};
+#undef NUM
+#undef TXT
     pd_table t = {h->rows, 5, cols, (int)(sizeof attrs / sizeof attrs[0]), attrs};
     return pd_output_write(a->out, &t, err);
+}
+
+/* The oscillator as a one-structure scene, for the chart. */
+static pd_scene *oscillator_scene(const pd_osc *c)
+{
+    pd_scene_excitation x = {.pulse = c->pulse, .dir = c->dir, .ap = c->ap, .Tp = c->Tp};
+    pd_scene *sc = pd_scene_new(&x);
+    if (!sc || pd_scene_add_sdof(sc, "oscillator", pd_osc_T0(c), c->xi, 1.0, NULL) ||
+        pd_scene_add_contact(sc, 0, 1, PD_WALL, 0, pd_osc_gap(c), c->eps, 0, NULL) ||
+        pd_scene_finish(sc, NULL)) {
+        pd_scene_free(sc);
+        return NULL;
+    }
+    return sc;
+}
+
+static int simulate_oscillator(sim_args *a)
+{
+    pd_osc_summary s;
+    history hist;
+    pd_scene *psc = NULL;
+    pd_err err;
+    int rc, status = 0;
+    long nsteps = pd_steps_for(a->k.opts.tend, a->k.opts.dt);
+    memset(&hist, 0, sizeof hist);
+    if ((a->out && history_alloc(&hist, nsteps, a->every)) ||
+        (a->plot && (!(psc = oscillator_scene(&a->k.c)) ||
+                     pd_scene_plot_open(&hist.plot, psc, nsteps, &err)))) {
+        fprintf(stderr, "pound: simulate: out of memory for the history (use --every)\n");
+        status = 1;
+        goto done;
+    }
+    if ((rc = pd_osc_summarize(&a->k.c, &a->k.opts, a->out || a->plot ? record : NULL, &hist, &s,
+                               &err))) {
+        fprintf(stderr, "pound: simulate: %s\n", err.msg);
+        status = rc == PD_EINVAL ? 2 : 1;
+        goto done;
+    }
+    if ((a->out && write_output(a, &s, &hist, &err)) ||
+        (a->plot && pd_scene_plot_draw(hist.plot, a->plot, "pounding oscillator", &err))) {
+        fprintf(stderr, "pound: simulate: %s\n", err.msg);
+        status = 1;
+        goto done;
+    }
+    if (a->json)
+        print_json(a, &s);
+    else
+        print_text(a, &s);
+done:
+    pd_scene_plot_free(hist.plot);
+    pd_scene_free(psc);
+    history_free(&hist);
+    return status;
+}
+
+/* ==== scenes ================================================================ */
+
+/* The writer and the chart both take the samples. */
+typedef struct fanout {
+    pd_scene_writer *w;
+    pd_scene_plot *p;
+} fanout;
+
+static int fan_sample(const pd_scene_sample *s, void *ctx)
+{
+    fanout *f = ctx;
+    if (f->p)
+        pd_scene_plot_sample(s, f->p);
+    return f->w ? pd_scene_writer_sample(s, f->w) : 0;
+}
+
+/* Name of a contact's side. */
+static const char *side_name(const pd_scene *sc, int s)
+{
+    return s == PD_WALL ? "wall" : sc->st[s].name;
+}
+
+static void scene_json(const pd_scene *sc, const pd_scene_summary *s)
+{
+    pd_json js;
+    const pd_scene_result *r = &s->r;
+    pd_json_init(&js, stdout);
+    pd_json_begin_object(&js, NULL);
+    pd_json_str(&js, "method", r->method);
+    pd_json_int(&js, "steps", r->steps);
+    pd_json_num(&js, "cpu_s", s->cpu_s);
+    pd_json_num(&js, "cpu_s_run", r->cpu_s);
+    pd_json_str(&js, "kernel", r->kernel);
+    pd_json_str(&js, "factor", r->factor);
+    pd_json_str(&js, "lcp_solver", r->lcp_solver);
+    pd_json_int(&js, "lcp_solves", r->lcp_solves);
+    pd_json_num(&js, "dt", r->dt);
+    pd_json_num(&js, "theta", r->theta);
+    pd_json_num(&js, "tend", r->tend);
+    pd_json_int(&js, "dofs", sc->n);
+    pd_json_str(&js, "pulse", pd_pulse_name(sc->exc.pulse));
+    pd_json_str(&js, "dir", sc->exc.dir > 0 ? "+x" : "-x");
+    pd_json_num(&js, "ap", sc->exc.ap);
+    pd_json_num(&js, "Tp", sc->exc.Tp);
+    pd_json_num(&js, "Le", pd_scene_Le(sc));
+    pd_json_begin_array(&js, "structures");
+    for (int k = 0; k < sc->nstruct; k++) {
+        const pd_structure *st = &sc->st[k];
+        int o = st->dof, n = st->storeys;
+        pd_json_begin_object(&js, NULL);
+        pd_json_str(&js, "name", st->name);
+        pd_json_int(&js, "storeys", n);
+        pd_json_num(&js, "T0", st->T0);
+        pd_json_num(&js, "Pi2", s->Pi2[k]);
+        pd_json_nums(&js, "umax", n, r->umax + o);
+        pd_json_nums(&js, "u_pos", n, r->u_pos + o);
+        pd_json_nums(&js, "u_neg", n, r->u_neg + o);
+        pd_json_nums(&js, "drift", n, r->drift + o);
+        pd_json_nums(&js, "Pi1", n, s->Pi1 + o);
+        pd_json_nums(&js, "umax_free", n, s->free.umax + o);
+        pd_json_nums(&js, "gamma", n, s->gamma + o);
+        pd_json_end_object(&js);
+    }
+    pd_json_end_array(&js);
+    pd_json_begin_array(&js, "contacts");
+    for (int c = 0; c < sc->ncontact; c++) {
+        const pd_contact *ct = &sc->ct[c];
+        pd_json_begin_object(&js, NULL);
+        pd_json_str(&js, "a", side_name(sc, ct->a));
+        pd_json_str(&js, "b", side_name(sc, ct->b));
+        pd_json_int(&js, "level", ct->a == PD_WALL ? ct->level_b : ct->level_a);
+        pd_json_int(&js, "level_b", ct->level_b);
+        pd_json_num(&js, "gap", ct->gap);
+        pd_json_num(&js, "eps", ct->eps);
+        pd_json_num(&js, "Pi3", s->Pi3[c]);
+        pd_json_int(&js, "impacts", r->impacts[c]);
+        pd_json_num(&js, "first_impact", r->first_impact[c]);
+        pd_json_num(&js, "max_impulse", r->max_impulse[c]);
+        pd_json_num(&js, "contact_time", r->contact_time[c]);
+        pd_json_num(&js, "approach", r->approach[c]);
+        pd_json_num(&js, "chi", s->chi[c]);
+        pd_json_end_object(&js);
+    }
+    pd_json_end_array(&js);
+    pd_json_end_object(&js);
+    pd_json_finish(&js);
+}
+
+enum { TEXT_MAX_STRUCTURES = 40, TEXT_MAX_CONTACTS = 60 };
+
+static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_summary *s)
+{
+    const pd_scene_result *r = &s->r;
+    printf("scene %s: %d structure%s, %d dof%s, %d contact%s; %s pulse along %s, ap = %g m/s^2, "
+           "Tp = %g s\n",
+           a->k.scene_path ? a->k.scene_path : "(chain)", sc->nstruct, sc->nstruct > 1 ? "s" : "",
+           sc->n, sc->n > 1 ? "s" : "", sc->ncontact, sc->ncontact == 1 ? "" : "s",
+           pd_pulse_name(sc->exc.pulse), sc->exc.dir > 0 ? "+x" : "-x", sc->exc.ap, sc->exc.Tp);
+    if (a->k.opts.method == PD_METHOD_MOREAU)
+        printf("  Moreau-Jean theta = %g, dt = %.6g s, %ld steps to %g s (kernel %s, factor %s, "
+               "LCP %s, %ld LCPs)\n",
+               r->theta, r->dt, r->steps, r->tend, r->kernel, r->factor, r->lcp_solver,
+               r->lcp_solves);
+    else
+        printf("  %s (%s), %ld %s to %g s\n",
+               a->k.opts.method == PD_METHOD_EVENT ? "event-driven reference" : "penalty",
+               r->kernel, r->steps, a->k.opts.method == PD_METHOD_EVENT ? "events" : "steps",
+               r->tend);
+    printf("  %-12s %7s %9s %12s %12s %10s %8s\n", "structure", "storey", "T0 [s]", "umax [m]",
+           "drift [m]", "Pi1", "gamma");
+    for (int k = 0; k < sc->nstruct && k < TEXT_MAX_STRUCTURES; k++) {
+        const pd_structure *st = &sc->st[k];
+        for (int i = 0; i < st->storeys; i++) {
+            int d = st->dof + i;
+            char T0[16] = "";
+            if (i == 0)
+                snprintf(T0, sizeof T0, "%.4g", st->T0);
+            printf("  %-12s %7d %9s %12.6g %12.6g %10.5g %8.4g\n", i ? "" : st->name, i + 1, T0,
+                   r->umax[d], r->drift[d], s->Pi1[d], s->gamma[d]);
+        }
+    }
+    if (sc->nstruct > TEXT_MAX_STRUCTURES)
+        printf("  ... %d more structures (--json or -o for all)\n",
+               sc->nstruct - TEXT_MAX_STRUCTURES);
+    if (sc->ncontact)
+        printf("  %-22s %6s %10s %8s %12s %14s %10s\n", "contact", "level", "gap [m]", "impacts",
+               "first [s]", "max imp. [N s]", "chi");
+    for (int c = 0; c < sc->ncontact && c < TEXT_MAX_CONTACTS; c++) {
+        const pd_contact *ct = &sc->ct[c];
+        char pair[2 * PD_NAME_MAX + 8];
+        snprintf(pair, sizeof pair, "%s-%s", side_name(sc, ct->a), side_name(sc, ct->b));
+        printf("  %-22s %6d %10.4g %8ld %12.6g %14.6g %10.4g\n", pair,
+               ct->a == PD_WALL ? ct->level_b : ct->level_a, ct->gap, r->impacts[c],
+               r->first_impact[c], r->max_impulse[c], s->chi[c]);
+    }
+    if (sc->ncontact > TEXT_MAX_CONTACTS)
+        printf("  ... %d more contacts (--json or -o for all)\n", sc->ncontact - TEXT_MAX_CONTACTS);
+    printf("  cpu       = %.3g s (the run and its contact-free twin)\n", s->cpu_s);
+}
+
+static int simulate_scene(sim_args *a)
+{
+    pd_scene *sc = NULL;
+    pd_scene_summary s;
+    pd_run_opts o;
+    fanout fo = {0};
+    pd_err err;
+    char name[64];
+    int rc, status;
+    memset(&s, 0, sizeof s);
+    if ((status = pd_cli_scene(&a->k, &sc)))
+        return status;
+    pd_scene_resolve_opts(sc, &a->k.opts, &o, &err);
+    long expected = pd_steps_for(o.tend, o.dt); /* samples: every step or every dt */
+    if ((a->out && pd_scene_writer_open(&fo.w, a->out, sc, a->every, &err)) ||
+        (a->plot && pd_scene_plot_open(&fo.p, sc, expected, &err))) {
+        fprintf(stderr, "pound: simulate: %s\n", err.msg);
+        status = err.status == PD_EINVAL ? 2 : 1;
+        goto done;
+    }
+    if ((rc = pd_scene_summarize(sc, &o, fo.w || fo.p ? fan_sample : NULL, &fo, &s, &err))) {
+        fprintf(stderr, "pound: simulate: %s\n", err.msg);
+        status = rc == PD_EINVAL ? 2 : 1;
+        goto done;
+    }
+    snprintf(name, sizeof name, "chain of %d", a->k.chain);
+    pd_scene_run_info ri = {.sum = &s, .command = a->command,
+                            .scene_name = a->k.scene_path ? a->k.scene_path : name};
+    if ((fo.w && pd_scene_writer_finish(fo.w, &ri, &err)) ||
+        (fo.p && pd_scene_plot_draw(fo.p, a->plot, ri.scene_name, &err))) {
+        fprintf(stderr, "pound: simulate: %s\n", err.msg);
+        status = 1;
+        goto done;
+    }
+    if (a->json)
+        scene_json(sc, &s);
+    else
+        scene_text(a, sc, &s);
+done:
+    pd_scene_writer_free(fo.w);
+    pd_scene_plot_free(fo.p);
+    pd_scene_summary_free(&s);
+    pd_scene_free(sc);
+    return status;
 }
 
 int pd_cmd_simulate(int argc, char **argv)
 {
     sim_args a;
-    summary s;
-    history hist;
-    pd_err err;
-    int rc, status = 0;
+    int rc;
     if (pd_cli_help(argc, argv, simulate_usage, 1))
         return 0;
     if ((rc = parse_args(&a, argc, argv)))
         return rc;
-    memset(&hist, 0, sizeof hist);
-    if (a.out && history_alloc(&hist, pd_steps_for(a.k.opts.tend, a.k.opts.dt), a.every)) {
-        history_free(&hist);
-        fprintf(stderr, "pound: simulate: out of memory for the history (use --every)\n");
-        return 1;
-    }
-    memset(&s, 0, sizeof s);
-    double cpu0 = pd_cpu_seconds();
-    pd_osc_opts free_opts = a.k.opts;
-    free_opts.no_wall = 1;
-    if ((rc = pd_cli_run(&a.k, a.k.method, &a.k.opts, a.out ? record : NULL, &hist, &s.r, &err)) ||
-        (rc = pd_cli_run(&a.k, a.k.method, &free_opts, NULL, NULL, &s.free, &err))) {
-        fprintf(stderr, "pound: simulate: %s\n", err.msg);
-        status = rc == PD_EINVAL ? 2 : 1;
-        goto done;
-    }
-    s.cpu_s = pd_cpu_seconds() - cpu0;
-    s.Pi1 = s.r.umax / pd_osc_Le(&a.k.c);
-    s.gamma = s.free.umax > 0.0 ? s.r.umax / s.free.umax : NAN;
-    s.chi = s.free.umax > 0.0 ? pd_osc_gap(&a.k.c) / s.free.umax : NAN;
-    if (a.out && write_output(&a, &s, &hist, &err)) {
-        fprintf(stderr, "pound: simulate: %s\n", err.msg);
-        status = 1;
-        goto done;
-    }
-    if (a.json)
-        print_json(&a, &s);
-    else
-        print_text(&a, &s);
-done:
-    history_free(&hist);
-    return status;
+    return pd_cli_is_scene(&a.k) ? simulate_scene(&a) : simulate_oscillator(&a);
 }

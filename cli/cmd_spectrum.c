@@ -34,6 +34,7 @@ static const char spectrum_usage[] =
 /* Everything the command line sets. */
 typedef struct spec_args {
     pd_spectrum s;
+    pd_cli_case k; /* the model, scheme and method flags */
     const char *out, *plot;
     int json, resume, threads, have_pi2, have_pi3, have_gap;
     long stop_after;
@@ -198,7 +199,7 @@ static int check_args(spec_args *a)
         return pd_cli_usage_error("spectrum: --Pi2 MIN:MAX:N is required");
     if (a->have_pi3 && a->have_gap)
         return pd_cli_usage_error("--gap and --Pi3 are alternatives: give one");
-    if (s->dt_per_Tp > 0.0 && s->base.have_dt)
+    if (s->dt_per_Tp > 0.0 && a->k.have_dt)
         return pd_cli_usage_error("--dt and --dt-per-Tp are alternatives: give one");
     if (a->resume && !a->out)
         return pd_cli_usage_error("--resume needs -o FILE (the sweep's journal is FILE.partial)");
@@ -211,7 +212,28 @@ static int check_args(spec_args *a)
     if (pd_spec_tasks(s) > PD_SPEC_MAX_TASKS)
         return pd_cli_usage_error("--Pi2: %ld runs in this sweep, at most %ld", pd_spec_tasks(s),
                                   PD_SPEC_MAX_TASKS);
-    return pd_spec_validate(s);
+    for (int i = 0; i < s->neps; i++)
+        if (!(s->eps[i] >= 0.0 && s->eps[i] <= 1.0))
+            return pd_cli_usage_error("--eps: restitution must be in [0, 1] (got %g)", s->eps[i]);
+    for (int i = 0; i < s->nxi; i++)
+        if (!(s->xi[i] >= 0.0 && s->xi[i] < 1.0))
+            return pd_cli_usage_error("--xi: damping ratio must be in [0, 1) (got %g)", s->xi[i]);
+    for (int i = 0; i < s->nap; i++)
+        if (!(s->ap[i] > 0.0))
+            return pd_cli_usage_error("--ap: pulse amplitude must be > 0 (got %g)", s->ap[i]);
+    for (int i = 0; i < s->nsize; i++)
+        if (!(s->size[i] >= 0.0))
+            return pd_cli_usage_error("%s: must be >= 0 (got %g)",
+                                      s->size_is_gap ? "--gap" : "--Pi3", s->size[i]);
+    pd_cli_case checked = a->k; /* the flags' ranges, errors naming them */
+    int rc = pd_cli_case_finish(&checked);
+    if (rc)
+        return rc;
+    s->base = a->k.c;
+    s->opts = a->k.opts; /* dt and tend stay 0 (per point) unless given */
+    if (pd_spec_validate(s, &err))
+        return pd_cli_usage_error("%s", err.msg);
+    return 0;
 }
 
 /* Every flag, then the cross-flag rules and every point checked: 0 or 2. */
@@ -220,10 +242,11 @@ static int parse_args(spec_args *a, int argc, char **argv)
     int rc;
     memset(a, 0, sizeof *a);
     pd_spec_init(&a->s);
+    pd_cli_case_init(&a->k);
     for (int i = 1; i < argc; i++) {
         if ((rc = own_flag(a, argc, argv, &i)) == 1)
             continue;
-        if (rc == 2 || (rc = pd_cli_case_flag(&a->s.base, argc, argv, &i)) == 2)
+        if (rc == 2 || (rc = pd_cli_case_flag(&a->k, argc, argv, &i)) == 2)
             return 2;
         if (rc == 0)
             return pd_cli_usage_error("spectrum: unknown flag '%s' (see pound spectrum --help)",

@@ -24,29 +24,6 @@ int pd_output_check_path(const char *path, pd_err *err)
     return pd_err_set(err, PD_EINVAL, "-o %s: the file name must end in .h5, .hdf5 or .csv", path);
 }
 
-/* A scalar attribute: text when text is non-NULL, else the number x. */
-int pd_h5_attr(hid_t obj, const char *name, const char *text, double x)
-{
-    hid_t space = H5Screate(H5S_SCALAR), type = -1, attr = -1;
-    herr_t st = -1;
-    if (space < 0)
-        return -1;
-    if (text) {
-        type = H5Tcopy(H5T_C_S1);
-        if (type >= 0 && H5Tset_size(type, strlen(text) + 1) >= 0 &&
-            (attr = H5Acreate2(obj, name, type, space, H5P_DEFAULT, H5P_DEFAULT)) >= 0)
-            st = H5Awrite(attr, type, text);
-    } else if ((attr = H5Acreate2(obj, name, H5T_NATIVE_DOUBLE, space, H5P_DEFAULT,
-                                  H5P_DEFAULT)) >= 0)
-        st = H5Awrite(attr, H5T_NATIVE_DOUBLE, &x);
-    if (attr >= 0)
-        H5Aclose(attr);
-    if (type >= 0)
-        H5Tclose(type);
-    H5Sclose(space);
-    return st < 0 ? -1 : 0;
-}
-
 /* Attribute name plus its "<name>_units" companion. */
 static int h5_attr_with_units(hid_t obj, const pd_attr *a)
 {

@@ -5,7 +5,7 @@
 
 #include <stdio.h>
 
-#include "pd_oscillator.h"
+#include "pd_problems.h"
 
 /* Subcommands: each returns the process exit status (0 ok, 1 run failure,
  * 2 bad input). */
@@ -14,22 +14,20 @@ int pd_cmd_simulate(int argc, char **argv);
 int pd_cmd_bench(int argc, char **argv);
 int pd_cmd_compare(int argc, char **argv);
 int pd_cmd_converge(int argc, char **argv);
+int pd_cmd_spectrum(int argc, char **argv);
 
 /* ---- the shared case flags (case.c) ------------------------------------ */
 
-typedef enum { PD_METHOD_MOREAU = 0, PD_METHOD_EVENT = 1, PD_METHOD_PENALTY = 2 } pd_method;
-
-const char *pd_method_name(pd_method m);
-int pd_method_parse(const char *name, pd_method *m); /* 0 or -1 */
-
-/* Everything the model, scheme and method flags set. */
+/* What the model, scheme, method and scene flags set, with what was given. */
 typedef struct pd_cli_case {
     pd_osc c;
-    pd_osc_opts opts;
-    pd_osc_penalty_opts pen;
-    pd_method method;
+    pd_run_opts opts;
     double T0, gap; /* dimensional forms when given */
     int have_T0, have_Pi2, have_gap, have_Pi3, have_dt, have_tend;
+    const char *model_flag; /* the first model flag given (refused with --scene) */
+    const char *scene_path; /* --scene F */
+    int chain;              /* --chain N (0: none) */
+    double chain_ratio;     /* --chain-ratio R */
 } pd_cli_case;
 
 extern const char pd_cli_case_help[];
@@ -38,12 +36,14 @@ void pd_cli_case_init(pd_cli_case *a);
 /* Consume the flag at argv[*i] (and its value): 1 if it was a case flag,
  * 0 if not (the caller handles it), 2 after printing an error. */
 int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i);
-/* Derive T0/gap forms, check ranges, fill dt and tend defaults: 0 or 2. */
+/* Derive T0/gap forms, check ranges; the oscillator gets its dt and tend
+ * defaults (a scene gets them from pd_scene_resolve_opts): 0 or 2. */
 int pd_cli_case_finish(pd_cli_case *a);
-/* Run the case with a method. */
-int pd_cli_run(const pd_cli_case *a, pd_method method, const pd_osc_opts *opts,
-               pd_osc_sampler sampler, void *ctx, pd_osc_result *res, pd_err *err);
-
+/* 1 when --scene or --chain was given. */
+int pd_cli_is_scene(const pd_cli_case *a);
+/* The scene of --scene or --chain, its options checked: 0, or 2 (1 when
+ * out of memory) after printing why. */
+int pd_cli_scene(const pd_cli_case *a, pd_scene **sc);
 
 /* Print "pound: <message>" on stderr and return 2 (bad input). */
 int pd_cli_usage_error(const char *fmt, ...)

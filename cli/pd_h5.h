@@ -8,4 +8,13 @@
  * double x.  0 on success, -1 on an HDF5 failure. */
 int pd_h5_attr(hid_t obj, const char *name, const char *text, double x);
 
+/* A number attribute with its "<name>_units" companion (units NULL: none). */
+int pd_h5_num(hid_t obj, const char *name, double x, const char *units);
+
+/* A 1-D double array attribute with its units companion. */
+int pd_h5_nums(hid_t obj, const char *name, int n, const double *x, const char *units);
+
+/* An object-creation property list of class cls that records no times. */
+hid_t pd_h5_untimed(hid_t cls);
+
 #endif

@@ -4,7 +4,7 @@
 #ifndef PD_OUTPUT_H
 #define PD_OUTPUT_H
 
-#include "pd_status.h"
+#include "pd_core.h"
 
 typedef struct pd_attr {
     const char *name;

@@ -1,13 +1,17 @@
-/* pd_plot.h — (cli) log-log line charts drawn by gnuplot into PNG files. */
+/* pd_plot.h — (cli) line charts (log or linear axes) drawn by gnuplot into
+ * PNG files. */
 #ifndef PD_PLOT_H
 #define PD_PLOT_H
 
-#include "pd_status.h"
+#include "pd_core.h"
+
+typedef enum { PD_CURVE_LINESPOINTS = 0, PD_CURVE_LINES = 1, PD_CURVE_POINTS = 2 } pd_curve_style;
 
 typedef struct pd_curve {
     const char *label;
     int n;
     const double *x, *y;
+    pd_curve_style style;
 } pd_curve;
 
 typedef struct pd_chart {

@@ -1,97 +1,13 @@
-/* pd_spectrum.h — (cli) pounding response spectra: a Pi2 grid crossed with
- * lists of pulse, directivity, amplitude, damping, gap and restitution.
- *
- * Tasks.  A sweep is a list of independent, deterministic runs ("tasks"):
- * first the no-wall twins, one per (pulse, dir, ap, xi, Pi2) — they do not
- * depend on the gap or on eps — then the runs with the wall, one per point.
- * Task results go into a preallocated array indexed by task, so the order in
- * which threads or MPI ranks finish never changes a number: any split of the
- * tasks gives output bit-identical to the serial run.
- *
- * Curves and points.  A curve is one (pulse, dir, ap, xi, Pi3 or gap, eps);
- * curve indices run with eps fastest, then the gap, xi, ap, dir, pulse.
- * Point p = curve * npi2 + j is the curve's j-th Pi2 value. */
+/* pd_spectrum.h — (cli) computing a spectrum sweep (pd_problems.h defines
+ * the sweep and its tasks): the journal that makes it resumable, MPI ranks
+ * and OpenMP threads taking tasks dynamically, and the output files. */
 #ifndef PD_SPECTRUM_H
 #define PD_SPECTRUM_H
 
 #include "pd_cli.h"
 
-enum { PD_SPEC_MAX_LIST = 64 };
-
 /* `pound spectrum` (cmd_spectrum.c): the exit status. */
 int pd_cmd_spectrum(int argc, char **argv);
-
-/* Most tasks a sweep may have (memory for results and journal). */
-#define PD_SPEC_MAX_TASKS 2000000L
-
-/* The sweep as the command line defines it. */
-typedef struct pd_spectrum {
-    pd_cli_case base; /* Tp, scheme, method and penalty flags (lists override) */
-    double pi2_min, pi2_max;
-    int npi2, linear; /* linear: equal steps; else log-spaced */
-    int npulse, ndir, nap, nxi, nsize, neps;
-    pd_pulse pulse[3];
-    int dir[2];
-    double ap[PD_SPEC_MAX_LIST], xi[PD_SPEC_MAX_LIST];
-    double size[PD_SPEC_MAX_LIST], eps[PD_SPEC_MAX_LIST];
-    int size_is_gap; /* size[] holds gaps in metres (--gap), else Pi3 values */
-    int dimensional; /* --ap given: add the dimensional view (umax vs T0) */
-    double dt_per_Tp; /* > 0: dt = Tp / dt_per_Tp for every point */
-} pd_spectrum;
-
-/* Where a task sits in the sweep. */
-typedef struct pd_spec_coords {
-    int twin; /* 1: the no-wall twin of a (pulse, dir, ap, xi, Pi2) */
-    int pulse, dir, ap, xi, size, eps, j;
-    long curve; /* -1 for a twin */
-} pd_spec_coords;
-
-/* What one task measured (in metres and seconds). */
-typedef struct pd_spec_result {
-    double umax, u_toward, u_away, contact_time, first_impact, cpu_s;
-    long impacts, steps;
-    int status; /* 0 ok, else the run's PD_E* status */
-    int done;   /* 1 once computed (or read back from the journal) */
-} pd_spec_result;
-
-/* One point of the spectrum, ready for output. */
-typedef struct pd_spec_row {
-    pd_osc c;
-    long curve;
-    double T0, gap, dt, tend;
-    double umax, Pi1, umax_free, gamma, chi, u_toward, u_away, contact_time, first_impact;
-    double cpu_s;
-    long impacts, steps;
-} pd_spec_row;
-
-/* ---- the sweep (spectrum_sweep.c) ---------------------------------------- */
-
-/* Defaults: one sine pulse, normal, ap = 1, Tp = 1, xi = 0.05, Pi3 = 0.05,
- * eps = 0.5; no Pi2 grid yet (npi2 = 0). */
-void pd_spec_init(pd_spectrum *s);
-long pd_spec_curves(const pd_spectrum *s);
-long pd_spec_points(const pd_spectrum *s);
-long pd_spec_twins(const pd_spectrum *s);
-long pd_spec_tasks(const pd_spectrum *s);
-/* The j-th Pi2 of the grid (end points exact). */
-double pd_spec_pi2(const pd_spectrum *s, int j);
-void pd_spec_coords_of(const pd_spectrum *s, long task, pd_spec_coords *co);
-/* The twin task of a point task. */
-long pd_spec_twin_of(const pd_spectrum *s, long task);
-/* The case of a task, finished as `pound simulate` would finish it: 0, or
- * 2 after printing an error naming the flag (never after pd_spec_validate). */
-int pd_spec_case(const pd_spectrum *s, long task, pd_cli_case *k);
-/* Check every point's case (errors name the flag): 0 or 2. */
-int pd_spec_validate(const pd_spectrum *s);
-/* Expected cost of a task: its number of steps. */
-double pd_spec_cost(const pd_spectrum *s, long task);
-/* A canonical text of every parameter that shapes the results (the
- * journal header); malloc'd, NULL when out of memory. */
-char *pd_spec_key(const pd_spectrum *s);
-/* Points from task results (twins give umax_free, gamma, chi). */
-void pd_spec_rows(const pd_spectrum *s, const pd_spec_result *res, pd_spec_row *rows);
-/* A short label of a curve naming the parameters that vary. */
-void pd_spec_curve_label(const pd_spectrum *s, long curve, char *buf, size_t cap);
 
 /* ---- the journal of finished tasks (spectrum_journal.c) ------------------ */
 

@@ -67,7 +67,10 @@ static int run_gnuplot(const char *data, const char *png_tmp, const pd_chart *c)
     }
     fputs("plot ", g);
     for (int k = 0; k < c->ncurves; k++) {
-        fprintf(g, "%s'%s' index %d with linespoints lw 2 title ", k ? ", " : "", data, k);
+        static const char *const styles[] = {"linespoints lw 2", "lines lw 1.5",
+                                             "points pt 7 ps 0.8"};
+        fprintf(g, "%s'%s' index %d with %s title ", k ? ", " : "", data, k,
+                styles[c->curves[k].style]);
         quoted(g, c->curves[k].label);
     }
     slope_guide(g, c);

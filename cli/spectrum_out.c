@@ -59,35 +59,13 @@ static void dt_rule(const pd_spectrum *s, char *buf, size_t cap)
 {
     if (s->dt_per_Tp > 0.0)
         snprintf(buf, cap, "Tp/%.17g", s->dt_per_Tp);
-    else if (s->base.have_dt)
-        snprintf(buf, cap, "%.17g s", s->base.opts.dt);
+    else if ((s->opts.dt > 0.0))
+        snprintf(buf, cap, "%.17g s", s->opts.dt);
     else
         snprintf(buf, cap, "min(Tp,T0)/2000");
 }
 
 /* ---- HDF5 --------------------------------------------------------------- */
-
-/* An object-creation property list without modification times. */
-static hid_t untimed(hid_t cls)
-{
-    hid_t p = H5Pcreate(cls);
-    if (p >= 0 && H5Pset_obj_track_times(p, 0) < 0) {
-        H5Pclose(p);
-        return -1;
-    }
-    return p;
-}
-
-
-/* A number attribute with its "<name>_units" companion. */
-static int h5_num(hid_t obj, const char *name, double x, const char *units)
-{
-    char uname[96];
-    if (pd_h5_attr(obj, name, NULL, x))
-        return -1;
-    snprintf(uname, sizeof uname, "%s_units", name);
-    return units ? pd_h5_attr(obj, uname, units, 0.0) : 0;
-}
 
 /* A 1-D double dataset with a "units" attribute. */
 static int h5_dataset(hid_t grp, hid_t dcpl, const char *name, const char *units,
@@ -114,10 +92,10 @@ static int h5_curve_attrs(hid_t g, const pd_spectrum *s, const pd_spec_row *r, l
     pd_spec_curve_label(s, curve, label, sizeof label);
     return pd_h5_attr(g, "label", label, 0) || pd_h5_attr(g, "pulse", pd_pulse_name(r->c.pulse), 0) ||
            pd_h5_attr(g, "dir", pd_dir_name(r->c.dir), 0) ||
-           pd_h5_attr(g, "method", pd_method_name(s->base.method), 0) ||
-           h5_num(g, "ap", r->c.ap, "m/s^2") || h5_num(g, "Tp", r->c.Tp, "s") ||
-           h5_num(g, "Pi3", r->c.Pi3, "1") || h5_num(g, "gap", r->gap, "m") ||
-           h5_num(g, "eps", r->c.eps, "1") || h5_num(g, "xi", r->c.xi, "1");
+           pd_h5_attr(g, "method", pd_method_name(s->opts.method), 0) ||
+           pd_h5_num(g, "ap", r->c.ap, "m/s^2") || pd_h5_num(g, "Tp", r->c.Tp, "s") ||
+           pd_h5_num(g, "Pi3", r->c.Pi3, "1") || pd_h5_num(g, "gap", r->gap, "m") ||
+           pd_h5_num(g, "eps", r->c.eps, "1") || pd_h5_num(g, "xi", r->c.xi, "1");
 }
 
 /* Group curve_NNNN: attributes and one dataset per column. */
@@ -145,21 +123,21 @@ static int h5_root_attrs(hid_t file, const pd_spectrum *s)
     char rule[64];
     dt_rule(s, rule, sizeof rule);
     return pd_h5_attr(file, "command", "pound spectrum", 0) ||
-           pd_h5_attr(file, "method", pd_method_name(s->base.method), 0) ||
+           pd_h5_attr(file, "method", pd_method_name(s->opts.method), 0) ||
            pd_h5_attr(file, "Pi2_spacing", s->linear ? "linear" : "log", 0) ||
-           h5_num(file, "Pi2_min", s->pi2_min, "1") || h5_num(file, "Pi2_max", s->pi2_max, "1") ||
-           h5_num(file, "Pi2_n", s->npi2, NULL) || h5_num(file, "Tp", s->base.c.Tp, "s") ||
-           pd_h5_attr(file, "dt", rule, 0) || h5_num(file, "theta", s->base.opts.theta, "1") ||
-           h5_num(file, "curves", (double)pd_spec_curves(s), NULL) ||
-           h5_num(file, "points", (double)pd_spec_points(s), NULL);
+           pd_h5_num(file, "Pi2_min", s->pi2_min, "1") || pd_h5_num(file, "Pi2_max", s->pi2_max, "1") ||
+           pd_h5_num(file, "Pi2_n", s->npi2, NULL) || pd_h5_num(file, "Tp", s->base.Tp, "s") ||
+           pd_h5_attr(file, "dt", rule, 0) || pd_h5_num(file, "theta", s->opts.theta, "1") ||
+           pd_h5_num(file, "curves", (double)pd_spec_curves(s), NULL) ||
+           pd_h5_num(file, "points", (double)pd_spec_points(s), NULL);
 }
 
 /* The whole spectrum into an HDF5 file: 0 or -1. */
 static int write_hdf5(const char *path, const pd_spectrum *s, const pd_spec_row *rows)
 {
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL); /* no HDF5 diagnostics on stderr */
-    hid_t fcpl = untimed(H5P_FILE_CREATE), gcpl = untimed(H5P_GROUP_CREATE);
-    hid_t dcpl = untimed(H5P_DATASET_CREATE), file = -1;
+    hid_t fcpl = pd_h5_untimed(H5P_FILE_CREATE), gcpl = pd_h5_untimed(H5P_GROUP_CREATE);
+    hid_t dcpl = pd_h5_untimed(H5P_DATASET_CREATE), file = -1;
     double *buf = malloc((size_t)s->npi2 * sizeof *buf);
     int rc = -1;
     if (fcpl >= 0 && gcpl >= 0 && dcpl >= 0 && buf &&
@@ -191,11 +169,11 @@ static int write_csv(const char *path, const pd_spectrum *s, const pd_spec_row *
         return -1;
     dt_rule(s, rule, sizeof rule);
     fprintf(f, "# pound spectrum\n# method = %s\n# Pi2 = %.17g:%.17g:%d %s\n# dt = %s\n",
-            pd_method_name(s->base.method), s->pi2_min, s->pi2_max, s->npi2,
+            pd_method_name(s->opts.method), s->pi2_min, s->pi2_max, s->npi2,
             s->linear ? "linear" : "log", rule);
     fprintf(f, "# theta = %.17g\n# units: ap m/s^2, Tp T0 contact_time first_impact dt tend s, "
                "gap umax umax_free u_toward u_away m\n",
-            s->base.opts.theta);
+            s->opts.theta);
     fputs("pulse,dir,method,ap,Tp,Pi3,gap,eps,xi", f);
     for (int k = 0; k < NCOLS; k++)
         fprintf(f, ",%s", point_cols[k].name);
@@ -203,7 +181,7 @@ static int write_csv(const char *path, const pd_spectrum *s, const pd_spec_row *
     for (long p = 0; p < pd_spec_points(s); p++) {
         const pd_spec_row *r = &rows[p];
         fprintf(f, "%s,%s,%s,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", pd_pulse_name(r->c.pulse),
-                pd_dir_name(r->c.dir), pd_method_name(s->base.method), r->c.ap, r->c.Tp,
+                pd_dir_name(r->c.dir), pd_method_name(s->opts.method), r->c.ap, r->c.Tp,
                 r->c.Pi3, r->gap, r->c.eps, r->c.xi);
         for (int k = 0; k < NCOLS; k++)
             fprintf(f, ",%.17g", col_value(r, &point_cols[k]));
@@ -235,7 +213,7 @@ int pd_spec_write(const char *path, const pd_spectrum *s, const pd_spec_row *row
 /* The parameters every curve shares, for a chart title. */
 static void common_title(const pd_spectrum *s, char *buf, size_t cap)
 {
-    size_t n = (size_t)snprintf(buf, cap, "spectra (%s", pd_method_name(s->base.method));
+    size_t n = (size_t)snprintf(buf, cap, "spectra (%s", pd_method_name(s->opts.method));
 #define ADD(...) (n += (size_t)snprintf(buf + n, n < cap ? cap - n : 0, __VA_ARGS__))
     if (s->npulse == 1)
         ADD(", %s", pd_pulse_name(s->pulse[0]));
@@ -271,11 +249,18 @@ static int chart(const char *png, const pd_spectrum *s, const pd_spec_row *rows,
     }
     for (long c = 0; c < nc; c++) {
         pd_spec_curve_label(s, c, labels + 128 * c, 128);
-        cv[c] = (pd_curve){labels + 128 * c, s->npi2, x + c * s->npi2, y + c * s->npi2};
+        cv[c] = (pd_curve){.label = labels + 128 * c, .n = s->npi2, .x = x + c * s->npi2,
+                           .y = y + c * s->npi2};
     }
     common_title(s, title, sizeof title);
-    pd_chart ch = {title, use_T0 ? "T_0 [s]" : "Pi_2 = T_p / T_0", ylabel, 1, logy, (int)nc, cv,
-                   NAN, NULL, 0.0};
+    pd_chart ch = {.title = title,
+                   .xlabel = use_T0 ? "T_0 [s]" : "Pi_2 = T_p / T_0",
+                   .ylabel = ylabel,
+                   .logx = 1,
+                   .logy = logy,
+                   .ncurves = (int)nc,
+                   .curves = cv,
+                   .vline = NAN};
     rc = pd_plot(png, &ch, err);
 done:
     free(x);
@@ -318,7 +303,7 @@ static void json_point(pd_json *js, const pd_spectrum *s, const pd_spec_row *r)
     pd_json_num(js, "gamma", r->gamma);
     pd_json_num(js, "chi", r->chi);
     pd_json_int(js, "impacts", r->impacts);
-    pd_json_str(js, "method", pd_method_name(s->base.method));
+    pd_json_str(js, "method", pd_method_name(s->opts.method));
     pd_json_int(js, "curve", r->curve);
     pd_json_num(js, "umax", r->umax);
     pd_json_num(js, "u_toward", r->u_toward);
@@ -381,7 +366,7 @@ void pd_spec_print_text(const pd_spectrum *s, const pd_spec_row *rows, const pd_
     dt_rule(s, rule, sizeof rule);
     printf("pounding spectra: %ld curves x %d Pi2 in [%g, %g] (%s), %s, dt = %s\n",
            pd_spec_curves(s), s->npi2, s->pi2_min, s->pi2_max, s->linear ? "linear" : "log",
-           pd_method_name(s->base.method), rule);
+           pd_method_name(s->opts.method), rule);
     printf("  %-36s %10s %10s %9s %9s %9s\n", "curve", "max Pi1", "at Pi2", "min gamma",
            "max gamma", "impacting");
     for (long c = 0; c < pd_spec_curves(s); c++)

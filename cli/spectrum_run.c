@@ -60,37 +60,6 @@ static int by_cost(const void *a, const void *b)
     return (x->task > y->task) - (x->task < y->task);
 }
 
-/* One task: its case, the chosen method, the figures kept; a failure's
- * message names the point. */
-static void run_task(const pd_spectrum *s, long t, pd_spec_result *r, pd_err *err)
-{
-    pd_cli_case k;
-    pd_osc_result o;
-    memset(r, 0, sizeof *r);
-    pd_err_clear(err);
-    if (pd_spec_case(s, t, &k)) {
-        r->status = pd_err_set(err, PD_EINVAL, "invalid case (task %ld)", t);
-        return;
-    }
-    if ((r->status = pd_cli_run(&k, k.method, &k.opts, NULL, NULL, &o, err))) {
-        char m[sizeof err->msg];
-        snprintf(m, sizeof m, "%s", err->msg);
-        pd_err_set(err, r->status, "%s %s pulse, Pi2 = %.6g, Pi3 = %.6g, eps = %g%s: %s",
-                   pd_dir_name(k.c.dir), pd_pulse_name(k.c.pulse), k.c.Pi2, k.c.Pi3, k.c.eps,
-                   k.opts.no_wall ? " (no wall)" : "", m);
-        return;
-    }
-    r->umax = o.umax;
-    r->u_toward = o.u_toward;
-    r->u_away = o.u_away;
-    r->contact_time = o.contact_time;
-    r->first_impact = o.first_impact;
-    r->cpu_s = o.cpu_s;
-    r->impacts = o.impacts;
-    r->steps = o.steps;
-    r->done = 1;
-}
-
 /* Redraw the progress bar (at most ten times a second, once the sweep
  * looks longer than a second); final: erase it. */
 static void progress(run_ctx *c, int final)
@@ -229,7 +198,7 @@ static void failure_message(run_ctx *c, pd_err *err)
 {
     pd_spec_result r;
     if (!c->msg[0])
-        run_task(c->s, c->first_bad, &r, err);
+        pd_spec_run_task(c->s, c->first_bad, &r, err);
     else
         pd_err_set(err, c->res[c->first_bad].status, "%s", c->msg);
     err->status = c->res[c->first_bad].status;
@@ -287,7 +256,7 @@ static void compute_here(run_ctx *c)
         t = next_task(c);
         if (t < 0)
             break;
-        run_task(c->s, t, &r, &e);
+        pd_spec_run_task(c->s, t, &r, &e);
         PD_OMP("omp critical(pd_spectrum)")
         finished(c, t, &r, e.msg);
     }
@@ -318,7 +287,7 @@ int pd_spec_compute(const pd_spectrum *s, const pd_spec_exec *ex, pd_spec_result
     }
     /* GSL's error handler is process-wide: the penalty runs turn it off
      * (the same store from every thread); do it once before the threads. */
-    if (s->base.method == PD_METHOD_PENALTY)
+    if (s->opts.method == PD_METHOD_PENALTY)
         gsl_set_error_handler_off();
     compute_here(c);
     if (ex->rank != 0)

@@ -32,6 +32,7 @@
 #include <gsl/gsl_odeiv2.h>
 
 #include "pd_engine.h"
+#include "pd_factor.h"
 
 #define EDG_GAP_SAMPLES 16  /* gap samples per accepted step */
 #define EDG_FORCE_SAMPLES 8 /* contact-force samples per step */
@@ -39,6 +40,8 @@
 #define EDG_NEAR 1e-6       /* relative interpolant minimum checked on the true motion */
 #define EDG_BOUNCE 1e-10    /* relative bounce height that ends an accumulation */
 #define EDG_STUCK 100       /* events at one instant before giving up */
+#define EDG_SET_MAX 512     /* most contacts at zero gap at one instant (dense blocks) */
+#define EDG_SINGULAR 1e-14  /* relative pivot floor of a contact set's D block */
 
 enum { EV_NONE = 0, EV_GAP = 1, EV_FORCE = 2 };
 
@@ -57,16 +60,14 @@ typedef struct edg {
     double last_event;    /* time of the last event */
     long same_instant;    /* consecutive events within rounding of it */
     double last_emit;
-    /* constant data */
-    double *Wd;           /* n x m dense copy of W */
-    double *Mlu;          /* n x n LU of M */
-    int *Mperm;
-    double *MinvW;        /* n x m: M^-1 W */
-    double *D;            /* m x m: W^T M^-1 W */
+    /* constant data: M factored, M^-1 W and D = W^T M^-1 W (pd_factor.h) */
+    pd_factor *fac;
+    const pd_matrix *W;
+    int kmax;             /* most contacts in one set (dense blocks kmax x kmax) */
     /* persistent contacts */
     unsigned char *inA;
     int *idxA, *posA, nA;
-    double *Dlu;          /* nA x nA LU of D_AA */
+    double *Dlu;          /* nA x nA LU of D_AA (kmax^2) */
     int *Dperm;
     double *lam;          /* nA: contact forces of the last acceleration */
     double *tmpA;         /* nA: projection work */
@@ -81,7 +82,7 @@ typedef struct edg {
     unsigned char *hit, *flag;
     int *idx;
     double *Dsub, *bsub, *zsub, *wsub;
-    pd_lcp_work *lcp;
+    pd_lcp_solver *lcp;
     /* GSL */
     gsl_odeiv2_system sys;
     gsl_odeiv2_step *step, *probe;
@@ -97,6 +98,7 @@ typedef struct edg {
 static size_t layout(edg *w, char *base)
 {
     size_t off = 0, n = (size_t)w->n, m = w->m > 0 ? (size_t)w->m : 1, d = (size_t)w->dim;
+    size_t k = (size_t)w->kmax;
 #define TAKE(ptr, count, type)                                                                \
     do {                                                                                      \
         off = (off + 15u) & ~(size_t)15u;                                                     \
@@ -104,15 +106,10 @@ static size_t layout(edg *w, char *base)
             (ptr) = (type *)(void *)(base + off);                                             \
         off += (size_t)(count) * sizeof(type);                                                \
     } while (0)
-    TAKE(w->Wd, n * m, double);
-    TAKE(w->Mlu, n * n, double);
-    TAKE(w->Mperm, n, int);
-    TAKE(w->MinvW, n * m, double);
-    TAKE(w->D, m * m, double);
     TAKE(w->inA, m, unsigned char);
     TAKE(w->idxA, m, int);
     TAKE(w->posA, m, int);
-    TAKE(w->Dlu, m * m, double);
+    TAKE(w->Dlu, k * k, double);
     TAKE(w->Dperm, m, int);
     TAKE(w->lam, m, double);
     TAKE(w->tmpA, m, double);
@@ -151,11 +148,12 @@ static size_t layout(edg *w, char *base)
     TAKE(w->hit, m, unsigned char);
     TAKE(w->flag, m, unsigned char);
     TAKE(w->idx, m, int);
-    TAKE(w->Dsub, m * m, double);
+    TAKE(w->Dsub, k * k, double);
     TAKE(w->bsub, m, double);
     TAKE(w->zsub, m, double);
     TAKE(w->wsub, m, double);
     TAKE(w->st.q, n, double);
+    TAKE(w->st.acc, n, double);
     TAKE(w->st.v, n, double);
     TAKE(w->st.P, m, double);
     TAKE(w->st.g, m, double);
@@ -175,7 +173,8 @@ static void edg_free(edg *w)
         gsl_odeiv2_step_free(w->probe);
     if (w->step)
         gsl_odeiv2_step_free(w->step);
-    pd_lcp_free(w->lcp);
+    pd_lcp_solver_free(w->lcp);
+    pd_factor_free(w->fac);
     free(w->block);
 }
 
@@ -192,7 +191,7 @@ static int edg_alloc(edg *w, pd_err *err)
     w->probe = gsl_odeiv2_step_alloc(gsl_odeiv2_step_rk8pd, (size_t)w->dim);
     w->ctl = gsl_odeiv2_control_y_new(w->o.atol, w->o.rtol);
     w->evo = gsl_odeiv2_evolve_alloc((size_t)w->dim);
-    w->lcp = pd_lcp_alloc(w->m > 0 ? w->m : 1);
+    w->lcp = pd_lcp_solver_alloc(w->o.lcp_solver, w->kmax, 0, err);
     if (!w->block || !w->step || !w->probe || !w->ctl || !w->evo || !w->lcp)
         return pd_err_set(err, PD_ENOMEM, "event-driven: out of memory for n = %d, m = %d", w->n,
                           w->m);
@@ -202,24 +201,34 @@ static int edg_alloc(edg *w, pd_err *err)
 
 /* ---- checks ----------------------------------------------------------- */
 
-/* Options in range, zeros replaced by the defaults. */
-static int check_opts(pd_edg_opts *o, pd_err *err)
+/* Options in range. */
+static int check_opts(const pd_edg_opts *o, pd_err *err)
 {
-    if (!(o->rtol >= 0.0 && o->atol >= 0.0 && isfinite(o->rtol) && isfinite(o->atol)))
-        return pd_err_set(err, PD_EINVAL, "event-driven: rtol and atol must be finite and >= 0");
+    if (!(o->rtol > 0.0 && o->atol > 0.0 && isfinite(o->rtol) && isfinite(o->atol)))
+        return pd_err_set(err, PD_EINVAL, "event-driven: rtol and atol must be finite and > 0");
     if (!(o->h_out >= 0.0) || !isfinite(o->h_out))
         return pd_err_set(err, PD_EINVAL, "event-driven: h_out must be finite and >= 0 (got %g)",
                           o->h_out);
-    if (!(o->length_scale >= 0.0) || !isfinite(o->length_scale))
-        return pd_err_set(err, PD_EINVAL, "event-driven: length_scale must be finite and >= 0");
-    if (o->max_events < 0 || o->max_burst < 0)
-        return pd_err_set(err, PD_EINVAL, "event-driven: budgets must be >= 0");
-    o->rtol = o->rtol > 0.0 ? o->rtol : 1e-12;
-    o->atol = o->atol > 0.0 ? o->atol : 1e-14;
-    o->max_events = o->max_events > 0 ? o->max_events : 1000000L;
-    o->max_burst = o->max_burst > 0 ? o->max_burst : 100000L;
-    o->length_scale = o->length_scale > 0.0 ? o->length_scale : 1.0;
+    if (!(o->length_scale > 0.0) || !isfinite(o->length_scale))
+        return pd_err_set(err, PD_EINVAL, "event-driven: length_scale must be finite and > 0");
+    if (o->max_events < 1 || o->max_burst < 1)
+        return pd_err_set(err, PD_EINVAL, "event-driven: budgets must be >= 1");
     return PD_OK;
+}
+
+pd_edg_opts pd_edg_default_opts(void)
+{
+    return (pd_edg_opts){.rtol = 1e-12,
+                         .atol = 1e-14,
+                         .h_out = 0.0,
+                         .no_accumulation = 0,
+                         .max_events = 1000000L,
+                         .max_burst = 100000L,
+                         .length_scale = 1.0,
+                         .on_step = NULL,
+                         .on_step_ctx = NULL,
+                         .factor = PD_FACTOR_AUTO,
+                         .lcp_solver = PD_LCP_AUTO};
 }
 
 /* Model, interval and initial state; the message names what is wrong. */
@@ -241,50 +250,43 @@ static int check_inputs(const pd_model *md, double t0, const double *q0, const d
 
 /* ---- linear algebra ----------------------------------------------------- */
 
-/* x^T y over n entries. */
-static double dot(const double *x, const double *y, int n)
+/* W_a^T x. */
+static double wdot(const edg *w, int a, const double *x)
 {
-    double s = 0.0;
-    for (int i = 0; i < n; i++)
-        s += x[i] * y[i];
-    return s;
+    return pd_matrix_col_dot(w->W, a, x);
 }
 
-/* y += s x over n entries. */
-static void axpy(double s, const double *x, double *y, int n)
+/* x += s M^-1 W_a. */
+static void add_minv_w(const edg *w, int a, double s, double *x)
 {
-    if (s != 0.0)
-        for (int i = 0; i < n; i++)
-            y[i] += s * x[i];
+    pd_factor_add_impulse(w->fac, &a, 1, &s, x);
 }
 
-/* LU of M, then M^-1 W and D = W^T M^-1 W. */
+/* M factored once (What with h = 0): M^-1 W and D = W^T M^-1 W with it. */
 static int factor_mass(edg *w, pd_err *err)
 {
-    int n = w->n, m = w->m;
-    for (int j = 0; j < n; j++)
-        for (int i = 0; i < n; i++)
-            w->Mlu[i + (size_t)j * n] = pd_matrix_get(&w->md->M, i, j);
-    if (pd_dense_lu(n, w->Mlu, w->Mperm))
-        return pd_err_set(err, PD_ESINGULAR, "event-driven: the mass matrix M is singular");
-    for (int a = 0; a < m; a++) {
-        double *col = w->MinvW + (size_t)a * n;
-        for (int i = 0; i < n; i++)
-            w->Wd[i + (size_t)a * n] = col[i] = pd_matrix_get(&w->md->W, i, a);
-        pd_dense_lu_solve(n, w->Mlu, w->Mperm, col);
-    }
-    for (int b = 0; b < m; b++)
-        for (int a = 0; a < m; a++)
-            w->D[a + (size_t)b * m] = dot(w->Wd + (size_t)a * n, w->MinvW + (size_t)b * n, n);
+    w->fac = pd_factor_alloc(w->md, 0.0, 1.0, w->o.factor, err);
+    if (!w->fac)
+        return err && err->status == PD_ESINGULAR
+                   ? pd_err_set(err, PD_ESINGULAR, "event-driven: the mass matrix M is singular")
+                   : (err ? err->status : PD_ENOMEM);
     return PD_OK;
 }
 
-/* Dsub = D[idx, idx] for k contacts. */
+/* Dsub = D[idx, idx] for k <= kmax contacts. */
 static void delassus(const edg *w, const int *idx, int k, double *Dsub)
 {
-    for (int s = 0; s < k; s++)
-        for (int r = 0; r < k; r++)
-            Dsub[r + (size_t)s * k] = w->D[idx[r] + (size_t)idx[s] * w->m];
+    pd_factor_delassus_dense(w->fac, idx, k, Dsub);
+}
+
+/* k contacts at once must fit the dense blocks. */
+static int set_fits(const edg *w, int k, double t, pd_err *err)
+{
+    if (k <= w->kmax)
+        return PD_OK;
+    return pd_err_set(err, PD_EBUDGET,
+                      "event-driven: %d contacts at zero gap at once at t = %.9g (at most %d)", k,
+                      t, w->kmax);
 }
 
 /* Index list of A from the flags inA, and the LU of D_AA. */
@@ -298,8 +300,10 @@ static int factor_set(edg *w, double t, pd_err *err)
             w->idxA[w->nA++] = a;
         }
     }
+    if (set_fits(w, w->nA, t, err))
+        return PD_EBUDGET;
     delassus(w, w->idxA, w->nA, w->Dlu);
-    if (w->nA && pd_dense_lu(w->nA, w->Dlu, w->Dperm))
+    if (w->nA && pd_dense_lu(w->nA, w->Dlu, w->nA, w->Dperm, EDG_SINGULAR))
         return pd_err_set(err, PD_ESINGULAR,
                           "event-driven: the %d contacts in persistent contact at t = %.9g (first: "
                           "contact %d) are redundant (D_AA singular)",
@@ -311,16 +315,15 @@ static int factor_set(edg *w, double t, pd_err *err)
  * the M-orthogonal projection onto W_A^T x + shift_A = 0. */
 static void project_on_A(edg *w, double *x, const double *shift)
 {
-    int n = w->n;
     if (!w->nA)
         return;
     for (int r = 0; r < w->nA; r++) {
         int a = w->idxA[r];
-        w->tmpA[r] = dot(w->Wd + (size_t)a * n, x, n) + (shift ? shift[a] : 0.0);
+        w->tmpA[r] = wdot(w, a, x) + (shift ? shift[a] : 0.0);
     }
-    pd_dense_lu_solve(w->nA, w->Dlu, w->Dperm, w->tmpA);
+    pd_dense_lu_solve(w->nA, w->Dlu, w->nA, w->Dperm, w->tmpA);
     for (int r = 0; r < w->nA; r++)
-        axpy(-w->tmpA[r], w->MinvW + (size_t)w->idxA[r] * n, x, w->n);
+        add_minv_w(w, w->idxA[r], -w->tmpA[r], x);
 }
 
 /* Hold A exactly: g_A(q) = 0 and U_A(v) = 0. */
@@ -356,14 +359,14 @@ static void accel(edg *w, double t, const double *d, const double *v, double *ac
     pd_matrix_gemv(&w->md->K, -1.0, d, 1.0, acc);
     for (int i = 0; i < n; i++)
         acc[i] -= w->Kqref[i];
-    pd_dense_lu_solve(n, w->Mlu, w->Mperm, acc);
+    pd_factor_solve(w->fac, acc);
     if (!w->nA)
         return;
     for (int r = 0; r < w->nA; r++)
-        w->lam[r] = -dot(w->Wd + (size_t)w->idxA[r] * n, acc, n);
-    pd_dense_lu_solve(w->nA, w->Dlu, w->Dperm, w->lam);
+        w->lam[r] = -wdot(w, w->idxA[r], acc);
+    pd_dense_lu_solve(w->nA, w->Dlu, w->nA, w->Dperm, w->lam);
     for (int r = 0; r < w->nA; r++)
-        axpy(w->lam[r], w->MinvW + (size_t)w->idxA[r] * n, acc, n);
+        add_minv_w(w, w->idxA[r], w->lam[r], acc);
 }
 
 /* y' = (v, q'', lambda) for GSL. */
@@ -397,32 +400,25 @@ static int probe(edg *w, double t, pd_err *err)
 /* Gap of contact a at q = qref + d: gref_a + W_a^T d. */
 static double gap_of(const edg *w, int a, const double *d)
 {
-    return w->gref[a] + dot(w->Wd + (size_t)a * w->n, d, w->n);
+    return w->gref[a] + wdot(w, a, d);
 }
 
 /* Rounding level of a gap computed from the state y = (d, v) over a step
  * of length h: 4 eps (gscale_a + |gref_a| + sum_i |W_ia| (|d_i| + h |v_i|)). */
 static double gap_noise(const edg *w, int a, const double *y, double h)
 {
-    const double *col = w->Wd + (size_t)a * w->n;
-    double s = w->gscale[a] + fabs(w->gref[a]);
-    for (int i = 0; i < w->n; i++)
-        s += fabs(col[i]) * (fabs(y[i]) + h * fabs(y[w->n + i]));
+    double s = w->gscale[a] + fabs(w->gref[a]) + pd_matrix_col_absdot(w->W, a, y) +
+               h * pd_matrix_col_absdot(w->W, a, y + w->n);
     return 4.0 * DBL_EPSILON * s;
 }
 
 /* K qref, gref = g0 + W^T qref and its scale |g0| + sum_i |W_ia qref_i|. */
 static void set_reference(edg *w)
 {
-    int n = w->n;
     pd_matrix_gemv(&w->md->K, 1.0, w->qref, 0.0, w->Kqref);
     for (int a = 0; a < w->m; a++) {
-        const double *col = w->Wd + (size_t)a * n;
-        double s = fabs(w->md->g0[a]);
-        for (int i = 0; i < n; i++)
-            s += fabs(col[i] * w->qref[i]);
-        w->gref[a] = w->md->g0[a] + dot(col, w->qref, n);
-        w->gscale[a] = s;
+        w->gref[a] = w->md->g0[a] + wdot(w, a, w->qref);
+        w->gscale[a] = fabs(w->md->g0[a]) + pd_matrix_col_absdot(w->W, a, w->qref);
     }
 }
 
@@ -441,13 +437,12 @@ static void step_ends(edg *w)
 {
     int n = w->n;
     for (int a = 0; a < w->m; a++) {
-        const double *col = w->Wd + (size_t)a * n;
         w->ga[a] = gap_of(w, a, w->ya);
-        w->Ua[a] = dot(col, w->ya + n, n);
-        w->Ga[a] = dot(col, w->fa + n, n);
+        w->Ua[a] = wdot(w, a, w->ya + n);
+        w->Ga[a] = wdot(w, a, w->fa + n);
         w->gb[a] = gap_of(w, a, w->y);
-        w->Ub[a] = dot(col, w->y + n, n);
-        w->Gb[a] = dot(col, w->fb + n, n);
+        w->Ub[a] = wdot(w, a, w->y + n);
+        w->Gb[a] = wdot(w, a, w->fb + n);
     }
 }
 
@@ -479,23 +474,6 @@ static int step_once(edg *w, pd_err *err)
 
 /* ---- event location ----------------------------------------------------- */
 
-/* Quintic Hermite at s in [0, 1] of the step of length h from
- * (f, f', f'') = p0 at 0 and p1 at 1: value *f and time rate *fd. */
-static void quintic(const double p0[3], const double p1[3], double h, double s, double *f,
-                    double *fd)
-{
-    double s2 = s * s, s3 = s2 * s, s4 = s3 * s, s5 = s4 * s;
-    double H1 = s - 6 * s3 + 8 * s4 - 3 * s5, H2 = 0.5 * (s2 - 3 * s3 + 3 * s4 - s5);
-    double H3 = 10 * s3 - 15 * s4 + 6 * s5, H4 = -4 * s3 + 7 * s4 - 3 * s5;
-    double H5 = 0.5 * (s3 - 2 * s4 + s5);
-    double D1 = 1 - 18 * s2 + 32 * s3 - 15 * s4, D2 = 0.5 * (2 * s - 9 * s2 + 12 * s3 - 5 * s4);
-    double D3 = 30 * s2 - 60 * s3 + 30 * s4, D4 = -12 * s2 + 28 * s3 - 15 * s4;
-    double D5 = 0.5 * (3 * s2 - 8 * s3 + 5 * s4);
-    *f = p0[0] + (p1[0] - p0[0]) * H3 + h * (p0[1] * H1 + p1[1] * H4) +
-         h * h * (p0[2] * H2 + p1[2] * H5);
-    *fd = (p1[0] - p0[0]) * D3 / h + p0[1] * D1 + p1[1] * D4 + h * (p0[2] * D2 + p1[2] * D5);
-}
-
 /* The interpolated state (qs, vs) at fraction s of the step. */
 static void interp_state(edg *w, double s)
 {
@@ -504,7 +482,7 @@ static void interp_state(edg *w, double s)
     for (int i = 0; i < n; i++) {
         double p0[3] = {w->ya[i], w->ya[n + i], w->fa[n + i]};
         double p1[3] = {w->y[i], w->y[n + i], w->fb[n + i]};
-        quintic(p0, p1, h, s, &w->qs[i], &w->vs[i]);
+        pd_hermite5(p0, p1, h, s, &w->qs[i], &w->vs[i]);
     }
 }
 
@@ -514,7 +492,7 @@ static double min_between(const double p0[3], const double p1[3], double h, doub
 {
     for (int it = 0; it < 60; it++) {
         double sm = 0.5 * (s0 + s1), f, fd;
-        quintic(p0, p1, h, sm, &f, &fd);
+        pd_hermite5(p0, p1, h, sm, &f, &fd);
         if (fd < 0.0)
             s0 = sm;
         else
@@ -530,7 +508,6 @@ static int graze_check(edg *w, int a, double tm, double thr, double *lo, double 
                        pd_err *err)
 {
     int n = w->n, rc = PD_OK;
-    const double *col = w->Wd + (size_t)a * n;
     for (int it = 0; it < 3 && !rc; it++) {
         if ((rc = probe(w, tm, err)))
             break;
@@ -541,7 +518,7 @@ static int graze_check(edg *w, int a, double tm, double thr, double *lo, double 
             break;
         }
         accel(w, tm, w->yp, w->yp + n, w->acc);
-        double U = dot(col, w->yp + n, n), G = dot(col, w->acc, n);
+        double U = wdot(w, a, w->yp + n), G = wdot(w, a, w->acc);
         if (it == 2 || !(G > 0.0))
             break;
         tm = fmin(tm - U / G, w->tb);
@@ -563,10 +540,10 @@ static int scan_gap(edg *w, int a, double *lo, double *hi, int *found, pd_err *e
     *found = 0;
     for (int k = 1; k <= EDG_GAP_SAMPLES; k++) {
         double s = (double)k / EDG_GAP_SAMPLES, f, fd;
-        quintic(p0, p1, h, s, &f, &fd);
+        pd_hermite5(p0, p1, h, s, &f, &fd);
         if (dprev < 0.0 && fd > 0.0) { /* interior minimum in (sprev, s) */
             double sm = min_between(p0, p1, h, sprev, s), fm, fdm;
-            quintic(p0, p1, h, sm, &fm, &fdm);
+            pd_hermite5(p0, p1, h, sm, &fm, &fdm);
             if (fm < -thr) {
                 *lo = w->ta + slo * h;
                 *hi = w->ta + sm * h;
@@ -717,7 +694,7 @@ static int earlier_event(edg *w, double t, int c, int *kind, int *a_out)
     for (int a = 0; a < w->m; a++) {
         if (w->inA[a] || a == c)
             continue;
-        double g = gap_of(w, a, w->yp), U = dot(w->Wd + (size_t)a * n, w->yp + n, n);
+        double g = gap_of(w, a, w->yp), U = wdot(w, a, w->yp + n);
         double tol = EDG_ZERO * gap_noise(w, a, w->yp, 0.0) / (4.0 * DBL_EPSILON) +
                      64.0 * DBL_EPSILON * fabs(t) * fabs(U);
         if (g < -tol) {
@@ -781,11 +758,9 @@ static int locate(edg *w, int *kind, int *c, double lo, double hi, double *t_ev,
 /* ---- observer ----------------------------------------------------------- */
 
 /* Report state y at t (with the event's impulses when with_P). */
-static void emit(edg *w, double t, const double *y, int with_P)
+static void fill_state(edg *w, double t, const double *y, int with_P)
 {
     pd_state *st = &w->st;
-    if (!w->obs || w->stopped)
-        return;
     st->step = w->res->steps;
     st->t = t;
     for (int i = 0; i < w->n; i++)
@@ -798,8 +773,30 @@ static void emit(edg *w, double t, const double *y, int with_P)
     }
     st->nactive = w->nA;
     st->lcp_pivots = with_P ? w->lcp_pivots : 0;
+    st->lcp_solver = with_P && w->lcp_pivots ? "lemke" : NULL;
+}
+
+enum { TO_OBSERVER = 1, TO_ON_STEP = 2 };
+
+/* Report state y at t (with the event's impulses when with_P) to the
+ * observer and/or on_step (with the accelerations). */
+static void emit(edg *w, double t, const double *y, int with_P, int to)
+{
+    if (w->stopped)
+        return;
+    if ((to & TO_ON_STEP) && w->o.on_step) {
+        fill_state(w, t, y, with_P);
+        accel(w, t, y, y + w->n, w->st.acc);
+        w->st.has_acc = 1;
+        if (w->o.on_step(&w->st, w->o.on_step_ctx) > 0)
+            w->stopped = 1;
+    }
+    if (!(to & TO_OBSERVER) || !w->obs || w->stopped)
+        return;
+    fill_state(w, t, y, with_P);
+    w->st.has_acc = 0;
     w->last_emit = t;
-    if (w->obs(st, w->obs_ctx) > 0)
+    if (w->obs(&w->st, w->obs_ctx) > 0)
         w->stopped = 1;
 }
 
@@ -817,7 +814,7 @@ static int emit_grid(edg *w, double t_end, pd_err *err)
         if ((rc = probe(w, fmax(tk, w->ta), err)))
             break;
         project(w, w->yp);
-        emit(w, tk, w->yp, 0);
+        emit(w, tk, w->yp, 0, TO_OBSERVER);
         w->next_out++;
     }
     return rc;
@@ -834,12 +831,9 @@ static void measure(edg *w, double t)
     int n = w->n;
     const double *d = w->y, *v = w->y + n;
     for (int a = 0; a < w->m; a++) {
-        const double *col = w->Wd + (size_t)a * n;
-        double vs = 0.0;
-        for (int i = 0; i < n; i++)
-            vs += fabs(col[i] * v[i]);
+        double vs = pd_matrix_col_absdot(w->W, a, v);
         w->g[a] = gap_of(w, a, d);
-        w->U[a] = dot(col, v, n);
+        w->U[a] = wdot(w, a, v);
         w->vsc[a] = vs;
         w->tolg[a] = EDG_ZERO * gap_noise(w, a, w->y, 0.0) / (4.0 * DBL_EPSILON) +
                      64.0 * DBL_EPSILON * fabs(t) * fabs(w->U[a]);
@@ -886,12 +880,15 @@ static void lcp_rounding(edg *w, int nI)
 static int impact(edg *w, double t, int nI, pd_err *err)
 {
     pd_lcp_info info;
+    pd_matrix D = pd_matrix_dense(nI, nI, w->Dsub);
+    if (set_fits(w, nI, t, err))
+        return PD_EBUDGET;
     delassus(w, w->idx, nI, w->Dsub);
     for (int r = 0; r < nI; r++) {
         int a = w->idx[r];
         w->bsub[r] = w->U[a] + w->md->e[a] * fmin(w->U[a], 0.0);
     }
-    int rc = pd_lcp_lemke(w->lcp, nI, w->Dsub, w->bsub, NULL, w->zsub, w->wsub, &info);
+    int rc = pd_lcp_solve(w->lcp, &D, w->bsub, NULL, w->zsub, w->wsub, &info);
     w->lcp_pivots = info.pivots;
     if (rc)
         return pd_err_set(err, rc,
@@ -900,7 +897,7 @@ static int impact(edg *w, double t, int nI, pd_err *err)
                           nI, w->idx[0], t, pd_lcp_outcome_name(info.outcome));
     for (int r = 0; r < nI; r++) {
         w->P[w->idx[r]] = w->zsub[r];
-        axpy(w->zsub[r], w->MinvW + (size_t)w->idx[r] * w->n, w->y + w->n, w->n);
+        add_minv_w(w, w->idx[r], w->zsub[r], w->y + w->n);
     }
     lcp_rounding(w, nI);
     return PD_OK;
@@ -955,14 +952,16 @@ static void commit(edg *w, double t)
 static void zero_rates(edg *w, int nJ)
 {
     int n = w->n;
+    if (!nJ)
+        return;
     delassus(w, w->idx, nJ, w->Dsub);
-    if (!nJ || pd_dense_lu(nJ, w->Dsub, w->Dperm))
+    if (pd_dense_lu(nJ, w->Dsub, nJ, w->Dperm, EDG_SINGULAR))
         return;
     for (int r = 0; r < nJ; r++)
-        w->bsub[r] = dot(w->Wd + (size_t)w->idx[r] * n, w->y + n, n);
-    pd_dense_lu_solve(nJ, w->Dsub, w->Dperm, w->bsub);
+        w->bsub[r] = wdot(w, w->idx[r], w->y + n);
+    pd_dense_lu_solve(nJ, w->Dsub, nJ, w->Dperm, w->bsub);
     for (int r = 0; r < nJ; r++)
-        axpy(-w->bsub[r], w->MinvW + (size_t)w->idx[r] * n, w->y + n, n);
+        add_minv_w(w, w->idx[r], -w->bsub[r], w->y + n);
 }
 
 /* Acceleration LCP over the nJ contacts idx at zero gap and rate:
@@ -972,15 +971,18 @@ static int decide(edg *w, double t, int nJ, pd_err *err)
 {
     pd_lcp_info info;
     int n = w->n, rc;
+    if ((rc = set_fits(w, nJ, t, err)))
+        return rc;
     zero_rates(w, nJ);
     memset(w->flag, 0, (size_t)w->m);
     w->nA = 0;
     if (nJ) {
+        pd_matrix D = pd_matrix_dense(nJ, nJ, w->Dsub);
         accel(w, t, w->y, w->y + n, w->acc);
         delassus(w, w->idx, nJ, w->Dsub);
         for (int r = 0; r < nJ; r++)
-            w->bsub[r] = dot(w->Wd + (size_t)w->idx[r] * n, w->acc, n);
-        rc = pd_lcp_lemke(w->lcp, nJ, w->Dsub, w->bsub, NULL, w->zsub, w->wsub, &info);
+            w->bsub[r] = wdot(w, w->idx[r], w->acc);
+        rc = pd_lcp_solve(w->lcp, &D, w->bsub, NULL, w->zsub, w->wsub, &info);
         if (rc)
             return pd_err_set(err, rc,
                               "event-driven: contact-force LCP over %d contact(s) (first: contact "
@@ -1020,7 +1022,7 @@ static int try_jump(edg *w, double t, int a, int *jumped, pd_err *err)
     if (!(e < 1.0) || !(Up > w->tolU[a]))
         return PD_OK;
     accel(w, t, w->y, w->y + n, w->acc);
-    double acl = -dot(w->Wd + (size_t)a * n, w->acc, n);
+    double acl = -wdot(w, a, w->acc);
     if (!(acl > 0.0) || Up * Up / (2.0 * acl) > EDG_BOUNCE * w->o.length_scale)
         return PD_OK;
     double tail = 2.0 * Up / (acl * (1.0 - e));
@@ -1084,15 +1086,16 @@ static int jump_accumulations(edg *w, double t, int drop, pd_err *err)
  * M-orthogonally onto g_I = 0 (when D_II is regular), then gref_I = 0. */
 static void snap(edg *w, int nI)
 {
-    int n = w->n;
+    if (!nI)
+        return;
     delassus(w, w->idx, nI, w->Dsub);
-    if (!nI || pd_dense_lu(nI, w->Dsub, w->Dperm))
+    if (pd_dense_lu(nI, w->Dsub, nI, w->Dperm, EDG_SINGULAR))
         return;
     for (int r = 0; r < nI; r++)
         w->bsub[r] = w->gref[w->idx[r]];
-    pd_dense_lu_solve(nI, w->Dsub, w->Dperm, w->bsub);
+    pd_dense_lu_solve(nI, w->Dsub, nI, w->Dperm, w->bsub);
     for (int r = 0; r < nI; r++)
-        axpy(-w->bsub[r], w->MinvW + (size_t)w->idx[r] * n, w->qref, n);
+        add_minv_w(w, w->idx[r], -w->bsub[r], w->qref);
     set_reference(w);
     for (int r = 0; r < nI; r++)
         w->gref[w->idx[r]] = w->gscale[w->idx[r]] = 0.0;
@@ -1116,6 +1119,8 @@ static int resolve(edg *w, double t, int forced, int drop, pd_err *err)
             closing |= w->U[a] < -w->tolU[a];
         }
     }
+    if ((rc = set_fits(w, nI, t, err)))
+        return rc;
     snap(w, nI);
     w->lcp_pivots = 0;
     if (closing) {
@@ -1148,7 +1153,7 @@ static int on_break(edg *w, pd_err *err)
     if (!rc)
         rc = resolve(w, w->t, -1, -1, err);
     if (!rc)
-        emit(w, w->t, w->y, 1);
+        emit(w, w->t, w->y, 1, TO_OBSERVER | TO_ON_STEP);
     return rc;
 }
 
@@ -1160,7 +1165,7 @@ static int on_event(edg *w, int kind, int c, pd_err *err)
         rc = resolve(w, w->t, kind == EV_GAP ? c : -1, kind == EV_FORCE ? c : -1, err);
     if (rc)
         return rc;
-    emit(w, w->t, w->y, 1);
+    emit(w, w->t, w->y, 1, TO_OBSERVER | TO_ON_STEP);
     return PD_OK;
 }
 
@@ -1180,12 +1185,12 @@ static int advance(edg *w, pd_err *err)
         memcpy(w->y, w->yev, (size_t)w->dim * sizeof(double));
         w->t = t_end;
     }
-    if (kind != EV_NONE)
+    if (kind != EV_NONE) {
+        emit(w, w->t, w->y, 0, TO_ON_STEP); /* the smooth motion up to the event */
         rc = on_event(w, kind, c, err);
-    else {
+    } else {
         project(w, w->y);
-        if (!(w->o.h_out > 0.0))
-            emit(w, w->t, w->y, 0);
+        emit(w, w->t, w->y, 0, TO_ON_STEP | (w->o.h_out > 0.0 ? 0 : TO_OBSERVER));
     }
     if (!rc && w->t >= w->seg_b && w->t < w->t1)
         rc = on_break(w, err);
@@ -1212,7 +1217,7 @@ static int start(edg *w, const double *q0, const double *v0, pd_err *err)
     w->h = 1e-4 * (w->t1 - w->t0);
     if ((rc = resolve(w, w->t0, -1, -1, err)))
         return rc;
-    emit(w, w->t0, w->y, 1);
+    emit(w, w->t0, w->y, 1, TO_OBSERVER | TO_ON_STEP);
     w->next_out = 1;
     return PD_OK;
 }
@@ -1231,8 +1236,7 @@ int pd_edg_run(const pd_model *model, double t0, const double *q0, const double 
     w.res = res ? res : &local;
     memset(w.res, 0, sizeof *w.res);
     w.res->first_impact = NAN;
-    if (opts)
-        w.o = *opts;
+    w.o = opts ? *opts : pd_edg_default_opts();
     if ((rc = check_opts(&w.o, err)) || (rc = check_inputs(model, t0, q0, v0, t1, err)))
         return rc;
     gsl_set_error_handler_off(); /* process-wide: GSL reports, never aborts */
@@ -1240,6 +1244,8 @@ int pd_edg_run(const pd_model *model, double t0, const double *q0, const double 
     w.n = model->n;
     w.m = model->m;
     w.dim = 2 * w.n + w.m;
+    w.W = &model->W;
+    w.kmax = w.m < EDG_SET_MAX ? (w.m > 0 ? w.m : 1) : EDG_SET_MAX;
     w.t0 = t0;
     w.t1 = t1;
     w.obs = observer;
@@ -1255,7 +1261,7 @@ int pd_edg_run(const pd_model *model, double t0, const double *q0, const double 
             if (w.inA[a])
                 w.res->contact_time += fmax(0.0, w.t - w.rest_from[a]);
         if (w.last_emit != w.t)
-            emit(&w, w.t, w.y, 0);
+            emit(&w, w.t, w.y, 0, TO_OBSERVER);
     }
     edg_free(&w);
     return rc;

@@ -8,9 +8,9 @@
 #include <math.h>
 #include <string.h>
 
+#include "pd_core.h"
 #include "pd_engine.h"
 
-#define TWO_PI 6.283185307179586476925286766559
 
 typedef struct ed_run {
     const pd_ed_sdof *p;
@@ -202,13 +202,13 @@ static double scan_step(const pd_ed_sdof *p, double span, int divisions)
 {
     double T = HUGE_VAL;
     if (p->osc.w0 > 0.0)
-        T = TWO_PI / p->osc.w0;
+        T = PD_TWO_PI / p->osc.w0;
     for (int j = 0; j < p->npieces; j++)
         if (p->pieces[j].A != 0.0 && p->pieces[j].w > 0.0)
-            T = fmin(T, TWO_PI / p->pieces[j].w);
+            T = fmin(T, PD_TWO_PI / p->pieces[j].w);
     if (!isfinite(T))
         T = span / 4.0;
-    return T / (divisions > 0 ? divisions : 64);
+    return T / divisions;
 }
 
 /* Count an event; PD_EBUDGET past the budget. */
@@ -231,7 +231,24 @@ static int check_problem(const pd_ed_sdof *p, const pd_ed_opts *o, pd_err *err)
         return pd_err_set(err, PD_EINVAL, "event-driven: need gap >= 0 and e in [0, 1]");
     if (!(o->t_end > p->pieces[0].t_start) || !isfinite(o->t_end))
         return pd_err_set(err, PD_EINVAL, "event-driven: t_end must follow the start time");
+    if (o->max_events < 1 || o->max_burst < 1 || o->scan_divisions < 1 ||
+        !(o->length_scale > 0.0) || !isfinite(o->length_scale))
+        return pd_err_set(err, PD_EINVAL,
+                          "event-driven: budgets and scan divisions must be >= 1 and the length "
+                          "scale > 0");
     return PD_OK;
+}
+
+pd_ed_opts pd_ed_default_opts(void)
+{
+    return (pd_ed_opts){.t_end = 0.0,
+                        .t_measure = 0.0,
+                        .h_out = 0.0,
+                        .no_accumulation = 0,
+                        .max_events = 10000000L,
+                        .max_burst = 100000L,
+                        .length_scale = 1.0,
+                        .scan_divisions = 64};
 }
 
 /* After an impact at t with post-impact speed vp (<= 0): 1 when the
@@ -245,7 +262,7 @@ static int settle(ed_run *ed, int j, double t, double vp, double tb, double *t_r
         return a > 0.0;
     if (ed->o->no_accumulation || e >= 1.0 || !(a > 0.0))
         return 0;
-    double height = vp * vp / (2.0 * a), scale = ed->o->length_scale > 0 ? ed->o->length_scale : 1;
+    double height = vp * vp / (2.0 * a), scale = ed->o->length_scale;
     double tail = 2.0 * fabs(vp) / (a * (1.0 - e));
     if (height > 1e-10 * scale || t + tail >= tb || !(wall_accel(ed, j, t + tail, 0.0) > 0.0) ||
         !(wall_accel(ed, j, t + 0.5 * tail, 0.0) > 0.0))
@@ -267,9 +284,15 @@ int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opt
     if ((rc = check_problem(prob, opts, err)))
         return rc;
     double t = prob->pieces[0].t_start, x = x0, v = v0;
-    ed = (ed_run){prob, opts, res, sampler, ctx, scan_step(prob, opts->t_end - t, opts->scan_divisions), 0, 0,
-                  opts->max_events > 0 ? opts->max_events : 10000000L,
-                  opts->max_burst > 0 ? opts->max_burst : 100000L, t, 0};
+    ed = (ed_run){.p = prob,
+                  .o = opts,
+                  .r = res,
+                  .sampler = sampler,
+                  .ctx = ctx,
+                  .scan = scan_step(prob, opts->t_end - t, opts->scan_divisions),
+                  .max_events = opts->max_events,
+                  .max_burst = opts->max_burst,
+                  .t_first = t};
     note(&ed, t, x);
     if (prob->wall && x >= prob->delta && v >= 0.0) { /* starting on the wall */
         x = prob->delta;

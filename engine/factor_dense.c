@@ -1,23 +1,19 @@
-/* factor_dense.c — dense LU of the iteration matrix and the Delassus data. */
+/* factor_dense.c — the scalar and dense storage kinds: What as a number or
+ * a dense LU, What^-1 W (n x m) and D = W^T What^-1 W (m x m) kept whole. */
 #include <stdlib.h>
 #include <string.h>
 
 #include "pd_factor.h"
 
-typedef struct dense_data {
-    double *lu;    /* n x n LU factors of What */
-    int *perm;     /* n row interchanges */
-    double *winv;  /* n x m: What^-1 W */
-    double *del;   /* m x m: W^T What^-1 W */
-} dense_data;
+#define DENSE_SINGULAR_TOL 1e-14 /* relative pivot floor of What's LU */
 
-/* A += s B for n x n views (zero kind adds nothing). */
-static void add_scaled(const pd_matrix *B, double s, double *A, int n)
-{
-    for (int j = 0; j < n; j++)
-        for (int i = 0; i < n; i++)
-            A[i + (size_t)j * n] += s * pd_matrix_get(B, i, j);
-}
+typedef struct dense_data {
+    double what;  /* scalar kind: the 1 x 1 What */
+    double *lu;   /* dense kind: n x n LU factors of What */
+    int *perm;    /* dense kind: n row interchanges */
+    double *winv; /* n x m: What^-1 W */
+    double *del;  /* m x m: W^T What^-1 W */
+} dense_data;
 
 static void dense_release(pd_factor *f)
 {
@@ -32,56 +28,100 @@ static void dense_release(pd_factor *f)
     f->data = NULL;
 }
 
-/* What = M + h theta C + (h theta)^2 K, LU, then What^-1 W and W^T What^-1 W. */
-static int dense_setup(pd_factor *f, pd_err *err)
+/* What = M + ht C + ht^2 K into the n x n column-major A. */
+static void form_what(const pd_model *md, double ht, double *A)
+{
+    int n = md->n;
+    pd_matrix_to_dense(&md->M, A);
+    for (int j = 0; j < n; j++) {
+        double *col = A + (size_t)j * n;
+        pd_matrix_col_axpy(&md->C, j, ht, col);
+        pd_matrix_col_axpy(&md->K, j, ht * ht, col);
+    }
+}
+
+/* The arrays both kinds keep: What^-1 W and D. */
+static int alloc_contact_data(dense_data *d, int n, int m)
+{
+    size_t mm = m > 0 ? (size_t)m : 1;
+    d->winv = calloc((size_t)n * mm, sizeof(double));
+    d->del = calloc(mm * mm, sizeof(double));
+    return d->winv && d->del ? PD_OK : PD_ENOMEM;
+}
+
+/* del = W^T winv once winv = What^-1 W. */
+static void form_delassus(const pd_factor *f, dense_data *d)
 {
     const pd_model *md = f->model;
     int n = md->n, m = md->m;
+    for (int b = 0; b < m; b++)
+        for (int a = 0; a < m; a++)
+            d->del[a + (size_t)b * m] = pd_matrix_col_dot(&md->W, a, d->winv + (size_t)b * n);
+}
+
+/* winv = What^-1 W column by column through the kind's solve. */
+static void form_winv(const pd_factor *f, dense_data *d)
+{
+    const pd_model *md = f->model;
+    for (int a = 0; a < md->m; a++) {
+        double *col = d->winv + (size_t)a * md->n;
+        pd_matrix_col_axpy(&md->W, a, 1.0, col);
+        f->type->solve(f, col);
+    }
+}
+
+/* The scalar kind: What = M + ht C + ht^2 K as one number. */
+static int scalar_setup(pd_factor *f, pd_err *err)
+{
+    const pd_model *md = f->model;
     double ht = f->h * f->theta;
     dense_data *d = calloc(1, sizeof *d);
     f->data = d;
-    if (!d || !(d->lu = calloc((size_t)n * n, sizeof(double))) ||
-        !(d->perm = calloc((size_t)n, sizeof(int))) ||
-        !(d->winv = calloc((size_t)n * (m ? m : 1), sizeof(double))) ||
-        !(d->del = calloc((size_t)(m ? m : 1) * (m ? m : 1), sizeof(double))))
-        return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for the iteration matrix");
-    add_scaled(&md->M, 1.0, d->lu, n);
-    add_scaled(&md->C, ht, d->lu, n);
-    add_scaled(&md->K, ht * ht, d->lu, n);
-    if (pd_dense_lu(n, d->lu, d->perm))
+    if (!d || alloc_contact_data(d, 1, md->m))
+        return pd_err_set(err, PD_ENOMEM, "factor: out of memory for m = %d contacts", md->m);
+    d->what = pd_matrix_get(&md->M, 0, 0) + ht * pd_matrix_get(&md->C, 0, 0) +
+              ht * ht * pd_matrix_get(&md->K, 0, 0);
+    if (!(d->what > 0.0))
         return pd_err_set(err, PD_ESINGULAR,
-                          "Moreau-Jean: the iteration matrix M + h theta C + h^2 theta^2 K is "
-                          "singular");
-    for (int a = 0; a < m; a++) {
-        double *col = d->winv + (size_t)a * n;
-        for (int i = 0; i < n; i++)
-            col[i] = pd_matrix_get(&md->W, i, a);
-        pd_dense_lu_solve(n, d->lu, d->perm, col);
-    }
-    for (int b = 0; b < m; b++)
-        for (int a = 0; a < m; a++) {
-            double s = 0.0;
-            for (int i = 0; i < n; i++)
-                s += pd_matrix_get(&md->W, i, a) * d->winv[i + (size_t)b * n];
-            d->del[a + (size_t)b * m] = s;
-        }
+                          "the iteration matrix M + h theta C + h^2 theta^2 K = %g is not positive",
+                          d->what);
+    form_winv(f, d);
+    form_delassus(f, d);
+    f->delassus_nnz = (long)md->m * md->m;
+    return PD_OK;
+}
+
+static void scalar_solve(const pd_factor *f, double *x)
+{
+    const dense_data *d = f->data;
+    x[0] /= d->what;
+}
+
+/* The dense kind: LU with partial pivoting of What. */
+static int dense_setup(pd_factor *f, pd_err *err)
+{
+    const pd_model *md = f->model;
+    int n = md->n;
+    dense_data *d = calloc(1, sizeof *d);
+    f->data = d;
+    if (!d || !(d->lu = calloc((size_t)n * n, sizeof(double))) ||
+        !(d->perm = calloc((size_t)n, sizeof(int))) || alloc_contact_data(d, n, md->m))
+        return pd_err_set(err, PD_ENOMEM, "factor: out of memory for a dense %d x %d matrix", n,
+                          n);
+    form_what(md, f->h * f->theta, d->lu);
+    if (pd_dense_lu(n, d->lu, n, d->perm, DENSE_SINGULAR_TOL))
+        return pd_err_set(err, PD_ESINGULAR,
+                          "the iteration matrix M + h theta C + h^2 theta^2 K is singular");
+    form_winv(f, d);
+    form_delassus(f, d);
+    f->delassus_nnz = (long)md->m * md->m;
     return PD_OK;
 }
 
 static void dense_solve(const pd_factor *f, double *x)
 {
     const dense_data *d = f->data;
-    pd_dense_lu_solve(f->model->n, d->lu, d->perm, x);
-}
-
-/* D_rs = del[idx_r, idx_s]. */
-static void dense_delassus(const pd_factor *f, const int *idx, int nI, double *D)
-{
-    const dense_data *d = f->data;
-    int m = f->model->m;
-    for (int s = 0; s < nI; s++)
-        for (int r = 0; r < nI; r++)
-            D[r + (size_t)s * nI] = d->del[idx[r] + (size_t)idx[s] * m];
+    pd_dense_lu_solve(f->model->n, d->lu, f->model->n, d->perm, x);
 }
 
 /* v += sum_r What^-1 W[:, idx_r] P_r. */
@@ -98,31 +138,37 @@ static void dense_add_impulse(const pd_factor *f, const int *idx, int nI, const 
     }
 }
 
-const pd_factor_type pd_factor_dense_type = {"dense-lu", dense_setup, dense_solve,
-                                             dense_delassus, dense_add_impulse, dense_release};
-
-pd_factor *pd_factor_alloc(const pd_model *model, double h, double theta, pd_err *err)
+static void dense_delassus(const pd_factor *f, const int *idx, int nI, double *D)
 {
-    pd_factor *f = calloc(1, sizeof *f);
-    if (!f) {
-        pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory");
-        return NULL;
-    }
-    f->type = &pd_factor_dense_type;
-    f->model = model;
-    f->h = h;
-    f->theta = theta;
-    if (f->type->setup(f, err)) {
-        pd_factor_free(f);
-        return NULL;
-    }
-    return f;
+    const dense_data *d = f->data;
+    pd_factor_gather_dense(d->del, f->model->m, idx, nI, D);
 }
 
-void pd_factor_free(pd_factor *f)
+static int dense_delassus_csc(const pd_factor *f, const int *idx, int nI, int *colptr,
+                              int *rowind, double *values)
 {
-    if (!f)
-        return;
-    f->type->release(f);
-    free(f);
+    const dense_data *d = f->data;
+    return pd_factor_gather_dense_csc(d->del, f->model->m, idx, nI, colptr, rowind, values);
 }
+
+const pd_factor_type pd_factor_scalar_type = {
+    .name = "scalar",
+    .kind = PD_FACTOR_SCALAR,
+    .setup = scalar_setup,
+    .solve = scalar_solve,
+    .add_impulse = dense_add_impulse,
+    .delassus_dense = dense_delassus,
+    .delassus_csc = dense_delassus_csc,
+    .release = dense_release,
+};
+
+const pd_factor_type pd_factor_dense_type = {
+    .name = "dense",
+    .kind = PD_FACTOR_DENSE,
+    .setup = dense_setup,
+    .solve = dense_solve,
+    .add_impulse = dense_add_impulse,
+    .delassus_dense = dense_delassus,
+    .delassus_csc = dense_delassus_csc,
+    .release = dense_release,
+};

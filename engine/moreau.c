@@ -8,13 +8,18 @@
  *
  * Two kernels share these equations: a scalar one for n = 1, m <= 1 (one
  * oscillator, one wall: plain doubles, closed-form scalar LCP) and a general
- * one (factorisation table, Delassus blocks, Lemke). */
+ * one (the factorisation seam of pd_factor.h, Delassus blocks dense or in
+ * compressed columns as the factor kind keeps them, the LCP solver table). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "pd_engine.h"
 #include "pd_factor.h"
+
+/* Most active contacts one LCP takes on the sparse path with a dense solver
+ * (its workspace grows as the square of this). */
+#define PD_MJ_SPARSE_LCP_MAX 1024
 
 struct pd_mj {
     const pd_model *model;
@@ -23,12 +28,15 @@ struct pd_mj {
     double t0;            /* time of the last reset */
     int next_break;       /* index of the first model breakpoint after t */
     pd_factor *factor;    /* What, What^-1 W and the Delassus matrix */
-    pd_lcp_work *lcp;     /* Lemke workspace for m contacts */
+    pd_lcp_solver *lcp;   /* the contact LCP solver, sized for lcp_nmax contacts */
+    int lcp_nmax;         /* most active contacts one LCP may have */
+    int sparse;           /* 1: Delassus blocks in compressed columns */
     double *F0, *F1;      /* n: force at t_k and t_k+1 */
     double *work_n;       /* n: right-hand side, then velocity increment */
     double *qtheta;       /* n: q_k + h theta v_k */
     double *U0;           /* m: W^T v_k */
-    double *D_active;     /* m x m: Delassus block of the active set */
+    double *D_active;     /* Delassus block: lcp_nmax^2 (dense) or delassus_nnz (sparse) */
+    int *D_colptr, *D_rowind; /* sparse: its compressed columns */
     double *b_active;     /* m: LCP vector of the active set */
     double *P_active;     /* m: impulses of the active set */
     double *w_active;     /* m: post-impact relative velocities of the active set */
@@ -40,8 +48,13 @@ struct pd_mj {
 
 pd_mj_opts pd_mj_default_opts(void)
 {
-    pd_mj_opts o = {0.0, 0.5, 0.5, 0, PD_KERNEL_AUTO};
-    return o;
+    return (pd_mj_opts){.h = 0.0,
+                        .theta = 0.5,
+                        .gamma = 0.5,
+                        .allow_unstable = 0,
+                        .kernel = PD_KERNEL_AUTO,
+                        .factor = PD_FACTOR_AUTO,
+                        .lcp_solver = PD_LCP_AUTO};
 }
 
 /* Closed-form scalar LCP  w = D P + b >= 0, P >= 0, wP = 0  (D > 0). */
@@ -55,13 +68,15 @@ void pd_mj_free(pd_mj *mj)
     if (!mj)
         return;
     pd_factor_free(mj->factor);
-    pd_lcp_free(mj->lcp);
+    pd_lcp_solver_free(mj->lcp);
     free(mj->F0);
     free(mj->F1);
     free(mj->work_n);
     free(mj->qtheta);
     free(mj->U0);
     free(mj->D_active);
+    free(mj->D_colptr);
+    free(mj->D_rowind);
     free(mj->b_active);
     free(mj->P_active);
     free(mj->w_active);
@@ -75,14 +90,10 @@ void pd_mj_free(pd_mj *mj)
 }
 
 /* Options in range: h > 0 finite, theta in [1/2, 1] unless allowed. */
-static int check_opts(pd_mj_opts *o, pd_err *err)
+static int check_opts(const pd_mj_opts *o, pd_err *err)
 {
     if (!(o->h > 0.0) || !isfinite(o->h))
         return pd_err_set(err, PD_EINVAL, "dt must be a finite number > 0 (got %g)", o->h);
-    if (o->theta == 0.0 && !o->allow_unstable)
-        o->theta = 0.5;
-    if (o->gamma < 0.0)
-        o->gamma = 0.5;
     if (!isfinite(o->theta) || o->theta < 0.0 || o->theta > 2.0)
         return pd_err_set(err, PD_EINVAL, "theta must be in [0, 2] (got %g)", o->theta);
     if ((o->theta < 0.5 || o->theta > 1.0) && !o->allow_unstable)
@@ -90,7 +101,7 @@ static int check_opts(pd_mj_opts *o, pd_err *err)
                           "theta = %g is outside [1/2, 1], where the scheme is not unconditionally "
                           "stable (pass --allow-unstable to run it anyway)",
                           o->theta);
-    if (!(o->gamma <= 1.0) || !isfinite(o->gamma))
+    if (!(o->gamma >= 0.0 && o->gamma <= 1.0))
         return pd_err_set(err, PD_EINVAL, "gamma must be in [0, 1] (got %g)", o->gamma);
     return PD_OK;
 }
@@ -104,7 +115,6 @@ static int alloc_arrays(pd_mj *mj, int n, int m)
     mj->work_n = calloc((size_t)n, sizeof(double));
     mj->qtheta = calloc((size_t)n, sizeof(double));
     mj->U0 = calloc(mm, sizeof(double));
-    mj->D_active = calloc(mm * mm, sizeof(double));
     mj->b_active = calloc(mm, sizeof(double));
     mj->P_active = calloc(mm, sizeof(double));
     mj->w_active = calloc(mm, sizeof(double));
@@ -114,8 +124,7 @@ static int alloc_arrays(pd_mj *mj, int n, int m)
     mj->st.P = calloc(mm, sizeof(double));
     mj->st.g = calloc(mm, sizeof(double));
     mj->st.active = calloc(mm, 1);
-    return mj->F0 && mj->F1 && mj->work_n && mj->qtheta && mj->U0 && mj->D_active &&
-                   mj->b_active && mj->P_active && mj->w_active && mj->idx_active && mj->st.q &&
+    return mj->F0 && mj->F1 && mj->work_n && mj->qtheta && mj->U0 && mj->b_active && mj->P_active && mj->w_active && mj->idx_active && mj->st.q &&
                    mj->st.v && mj->st.P && mj->st.g && mj->st.active
                ? PD_OK
                : PD_ENOMEM;
@@ -136,6 +145,31 @@ static void scalar_setup(pd_mj *mj)
     mj->s_del = mj->s_w * mj->s_winv;
 }
 
+/* The LCP solver and the Delassus block: dense lcp_nmax^2 when the factor
+ * keeps D dense, compressed columns bounded by the entries of D otherwise
+ * (then one LCP takes at most PD_MJ_SPARSE_LCP_MAX contacts for a dense
+ * solver). */
+static int contact_workspace(pd_mj *mj, pd_err *err)
+{
+    int m = mj->model->m;
+    long nnz = mj->factor->delassus_nnz;
+    mj->sparse = mj->factor->type->kind == PD_FACTOR_CHOLMOD;
+    mj->lcp_nmax = mj->sparse && m > PD_MJ_SPARSE_LCP_MAX ? PD_MJ_SPARSE_LCP_MAX : m;
+    if (!(mj->lcp = pd_lcp_solver_alloc(mj->opts.lcp_solver, mj->lcp_nmax, mj->sparse ? nnz : 0,
+                                        err)))
+        return err ? err->status : PD_ENOMEM;
+    if (mj->sparse) {
+        mj->D_active = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof(double));
+        mj->D_colptr = malloc(((size_t)m + 1) * sizeof(int));
+        mj->D_rowind = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof(int));
+    } else {
+        mj->D_active = malloc((size_t)m * (size_t)m * sizeof(double));
+    }
+    if (!mj->D_active || (mj->sparse && (!mj->D_colptr || !mj->D_rowind)))
+        return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for the Delassus block");
+    return PD_OK;
+}
+
 pd_mj *pd_mj_alloc(const pd_model *model, const pd_mj_opts *opts, pd_err *err)
 {
     pd_mj *mj = NULL;
@@ -153,15 +187,13 @@ pd_mj *pd_mj_alloc(const pd_model *model, const pd_mj_opts *opts, pd_err *err)
     mj->model = model;
     mj->opts = o;
     mj->scalar = o.kernel == PD_KERNEL_AUTO && model->n == 1 && model->m <= 1;
-    mj->factor = pd_factor_alloc(model, o.h, o.theta, err);
+    mj->factor = pd_factor_alloc(model, o.h, o.theta, o.factor, err);
     if (!mj->factor)
         goto fail;
     if (mj->scalar)
         scalar_setup(mj);
-    if (model->m > 0 && !(mj->lcp = pd_lcp_alloc(model->m))) {
-        pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for the LCP workspace");
+    else if (model->m > 0 && contact_workspace(mj, err))
         goto fail;
-    }
     if (pd_mj_reset(mj, 0.0, NULL, NULL, err))
         goto fail;
     return mj;
@@ -193,6 +225,7 @@ int pd_mj_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_err
     mj->st.step = 0;
     mj->st.nactive = 0;
     mj->st.lcp_pivots = 0;
+    mj->st.lcp_solver = NULL;
     for (int a = 0; a < md->m; a++) {
         mj->st.P[a] = 0.0;
         mj->st.active[a] = 0;
@@ -269,6 +302,7 @@ static int step_scalar(pd_mj *mj, pd_err *err)
         st->g[0] = md->g0[0] + mj->s_w * q;
     st->nactive = active;
     st->lcp_pivots = 0;
+    st->lcp_solver = active ? "closed-form" : NULL;
     mj->F0[0] = F1;
     if (mj->next_break < md->nbreaks) {
         mj->F1[0] = F1;
@@ -299,22 +333,33 @@ static int predict_active(pd_mj *mj)
     return nI;
 }
 
-/* Impulses of the active contacts: Lemke on (D_II, W_I^T vfree + e U). */
+/* Impulses of the active contacts: the LCP (D_II, W_I^T vfree + e U). */
 static int solve_contacts(pd_mj *mj, int nI, const double *vfree, pd_err *err)
 {
     const pd_model *md = mj->model;
     pd_lcp_info info;
-    pd_factor_delassus(mj->factor, mj->idx_active, nI, mj->D_active);
+    pd_matrix D;
+    if (nI > mj->lcp_nmax)
+        return pd_err_set(err, PD_EBUDGET,
+                          "Moreau-Jean: %d active contacts at t = %.9g exceed the %d the %s LCP "
+                          "solver is sized for",
+                          nI, mj->st.t + mj->opts.h, mj->lcp_nmax,
+                          pd_lcp_method_name(mj->opts.lcp_solver));
+    if (mj->sparse) {
+        pd_factor_delassus_csc(mj->factor, mj->idx_active, nI, mj->D_colptr, mj->D_rowind,
+                               mj->D_active);
+        D = pd_matrix_csc(nI, nI, mj->D_colptr, mj->D_rowind, mj->D_active);
+    } else {
+        pd_factor_delassus_dense(mj->factor, mj->idx_active, nI, mj->D_active);
+        D = pd_matrix_dense(nI, nI, mj->D_active);
+    }
     for (int r = 0; r < nI; r++) {
         int a = mj->idx_active[r];
-        double s = md->e[a] * mj->U0[a];
-        for (int i = 0; i < md->n; i++)
-            s += pd_matrix_get(&md->W, i, a) * vfree[i];
-        mj->b_active[r] = s;
+        mj->b_active[r] = pd_matrix_col_dot(&md->W, a, vfree) + md->e[a] * mj->U0[a];
     }
-    int st = pd_lcp_lemke(mj->lcp, nI, mj->D_active, mj->b_active, NULL, mj->P_active,
-                          mj->w_active, &info);
+    int st = pd_lcp_solve(mj->lcp, &D, mj->b_active, NULL, mj->P_active, mj->w_active, &info);
     mj->st.lcp_pivots = info.pivots;
+    mj->st.lcp_solver = info.solver;
     if (st)
         return pd_err_set(err, st,
                           "Moreau-Jean: LCP over %d active contact(s) (first: contact %d) not "
@@ -351,6 +396,7 @@ static int step_general(pd_mj *mj, pd_err *err)
     if (md->m)
         nI = predict_active(mj);
     st->lcp_pivots = 0;
+    st->lcp_solver = NULL;
     /* q gets the (1 - theta) v_k part before v is overwritten */
     for (int i = 0; i < n; i++) {
         st->q[i] += h * (1.0 - th) * st->v[i];
@@ -400,4 +446,9 @@ const pd_state *pd_mj_state(const pd_mj *mj)
 const char *pd_mj_kernel_name(const pd_mj *mj)
 {
     return mj->scalar ? "scalar" : "general";
+}
+
+const char *pd_mj_factor_name(const pd_mj *mj)
+{
+    return mj->factor->type->name;
 }

@@ -9,49 +9,37 @@
  * Moreau–Jean) owns every workspace, allocated once by its _alloc, and the
  * mutable state (pd_state) that it advances.  Steps never allocate.
  *
- * Dense blocks are column-major.  The matrices are reached through pd_matrix
- * (y = A x) and the iteration matrix through a factorisation table
- * (pd_factor_type), the seam where sparse storage plugs in. */
+ * The matrices are pd_matrix views (zero, dense column-major, or CSC); the
+ * iteration matrix is reached through a factorisation table (engine/factor.c)
+ * whose kind is chosen from the model, and the contact LCPs through the
+ * solver table of lcp/.  Options structs come from their _default_opts()
+ * function; their fields hold values, never "use the default" markers. */
 #ifndef PD_ENGINE_H
 #define PD_ENGINE_H
 
 #include "pd_lcp.h"
-#include "pd_status.h"
+#include "pd_core.h"
 
-/* ---- matrices --------------------------------------------------------- */
-
+/* ---- factorisation kinds --------------------------------------------- *
+ * How the iteration matrix What = M + h theta C + h^2 theta^2 K (M alone
+ * for the event-driven and penalty methods) is stored and factored: a
+ * number (one degree of freedom), a dense LU with W^T What^-1 W kept whole,
+ * or CHOLMOD's sparse Cholesky (What symmetric positive definite) with
+ * What^-1 W and W^T What^-1 W kept sparse -- no dense n x n or m x m matrix. */
 typedef enum {
-    PD_MATRIX_ZERO = 0, /* all zeros (values unused) */
-    PD_MATRIX_DENSE = 1 /* column-major values, leading dimension rows */
-} pd_matrix_kind;
+    PD_FACTOR_AUTO = 0,   /* scalar for n = 1; dense for n <= PD_FACTOR_DENSE_MAX or
+                             dense input; CHOLMOD otherwise */
+    PD_FACTOR_SCALAR = 1,
+    PD_FACTOR_DENSE = 2,
+    PD_FACTOR_CHOLMOD = 3
+} pd_factor_kind;
 
-/* A rows x cols matrix the engine only reads. */
-typedef struct pd_matrix {
-    pd_matrix_kind kind;
-    int rows, cols;
-    const double *values;
-} pd_matrix;
+/* The largest n the automatic choice factors densely (docs/scenes.md). */
+#define PD_FACTOR_DENSE_MAX 24
 
-/* A dense matrix view. */
-pd_matrix pd_matrix_dense(int rows, int cols, const double *values);
-
-/* y = alpha A x + beta y. */
-void pd_matrix_gemv(const pd_matrix *A, double alpha, const double *x, double beta, double *y);
-
-/* y = A^T x (y has cols entries). */
-void pd_matrix_gemv_t(const pd_matrix *A, const double *x, double *y);
-
-/* Entry (i, j). */
-double pd_matrix_get(const pd_matrix *A, int i, int j);
-
-/* ---- dense LU --------------------------------------------------------- */
-
-/* In-place LU with partial pivoting of the n x n column-major A (P A = L U);
- * PD_ESINGULAR when a pivot is zero or below 1e-14 times the column scale. */
-int pd_dense_lu(int n, double *A, int *perm);
-
-/* Solve (P^-1 L U) x = b in place, from the output of pd_dense_lu. */
-void pd_dense_lu_solve(int n, const double *LU, const int *perm, double *b);
+/* "auto", "scalar", "dense", "cholmod"; parse: PD_OK or PD_EINVAL. */
+const char *pd_factor_kind_name(pd_factor_kind kind);
+int pd_factor_kind_parse(const char *name, pd_factor_kind *kind);
 
 /* ---- the model -------------------------------------------------------- */
 
@@ -76,6 +64,10 @@ typedef struct pd_model {
 /* Check sizes, finiteness, gaps and restitution; message names the field. */
 int pd_model_check(const pd_model *model, pd_err *err);
 
+/* The kind the automatic choice gives this model (never PD_FACTOR_AUTO):
+ * requested itself unless it is PD_FACTOR_AUTO. */
+pd_factor_kind pd_factor_choose(const pd_model *model, pd_factor_kind requested);
+
 /* ---- state and observers ---------------------------------------------- */
 
 typedef struct pd_state {
@@ -86,7 +78,12 @@ typedef struct pd_state {
     double *g;             /* m gaps g0 + W^T q at t */
     unsigned char *active; /* m flags: contact was in the last step's LCP */
     int nactive;           /* number of active contacts in the last step */
-    int lcp_pivots;        /* pivots of the last step's LCP (0 if none solved) */
+    int lcp_pivots;        /* pivots (or iterations) of the last step's LCP (0: none) */
+    const char *lcp_solver; /* solver of the last step's LCP ("closed-form" for the
+                               scalar kernel, NULL when none was solved) */
+    double *acc;           /* n accelerations q'' at t, valid when has_acc (the
+                              on_step reports of the event-driven and penalty methods) */
+    int has_acc;
 } pd_state;
 
 /* Called with the state after reset and after every step: return 0 to go
@@ -102,13 +99,16 @@ typedef enum {
 
 typedef struct pd_mj_opts {
     double h;           /* step size > 0 */
-    double theta;       /* in [1/2, 1] (0 = default 1/2) */
-    double gamma;       /* active-set look-ahead in [0, 1] (negative = default 1/2) */
-    int allow_unstable; /* accept theta outside [1/2, 1] (stability studies) */
+    double theta;       /* in [1/2, 1] */
+    double gamma;       /* active-set look-ahead in [0, 1] */
+    int allow_unstable; /* accept theta in [0, 2] outside [1/2, 1] (stability studies) */
     pd_kernel kernel;
+    pd_factor_kind factor;     /* storage of What */
+    pd_lcp_method lcp_solver;  /* the contact LCP solver */
 } pd_mj_opts;
 
-/* Defaults: theta = 1/2, gamma = 1/2, h unset. */
+/* Defaults: h = 0 (must be set), theta = 1/2, gamma = 1/2, automatic kernel,
+ * factor and LCP solver. */
 pd_mj_opts pd_mj_default_opts(void);
 
 typedef struct pd_mj pd_mj;
@@ -132,8 +132,10 @@ int pd_mj_run(pd_mj *mj, long nsteps, pd_observer observer, void *ctx, pd_err *e
 
 const pd_state *pd_mj_state(const pd_mj *mj);
 
-/* Which kernel the object runs: "scalar" or "general". */
+/* Which kernel the object runs: "scalar" or "general"; which factor kind
+ * ("scalar", "dense", "cholmod"). */
 const char *pd_mj_kernel_name(const pd_mj *mj);
+const char *pd_mj_factor_name(const pd_mj *mj);
 
 /* Closed-form scalar LCP: the P >= 0 with D P + b >= 0, P (D P + b) = 0,
  * for D > 0 (the one-contact kernel uses it instead of Lemke). */
@@ -152,14 +154,24 @@ long pd_steps_for(double tend, double h);
  * breakpoints as events; accumulations of impacts jumped to persistent
  * contact (criterion in docs/methods.md). */
 typedef struct pd_edg_opts {
-    double rtol, atol;      /* GSL tolerances (0 = 1e-12, 1e-14) */
+    double rtol, atol;      /* GSL tolerances > 0 */
     double h_out;           /* > 0: observer every h_out (and at t1); 0: every event/step */
     int no_accumulation;    /* 1: never jump an accumulation */
-    long max_events;        /* 0 = 10^6 */
-    long max_burst;         /* impacts of one accumulation before giving up (0 = 10^5) */
+    long max_events;        /* event budget >= 1 */
+    long max_burst;         /* impacts of one accumulation before giving up, >= 1 */
     double length_scale;    /* accumulation jumped once the bounce height is below
-                               1e-10 * length_scale (0 = 1), as in pd_ed_opts */
+                               1e-10 * length_scale (> 0), as in pd_ed_opts */
+    pd_observer on_step;    /* optional: the state with its accelerations at t0, at the
+                               end of every accepted step, just before every event and
+                               just after it (same t), whatever h_out */
+    void *on_step_ctx;
+    pd_factor_kind factor;  /* storage of M */
+    pd_lcp_method lcp_solver; /* the impact and contact-force LCPs */
 } pd_edg_opts;
+
+/* rtol 1e-12, atol 1e-14, h_out 0, accumulations jumped, 10^6 events,
+ * bursts of 10^5, length scale 1, automatic factor and solver. */
+pd_edg_opts pd_edg_default_opts(void);
 
 typedef struct pd_edg_result {
     long impacts, accumulations, detachments, events, steps;
@@ -189,14 +201,19 @@ typedef enum { PD_PENALTY_KELVIN = 0, PD_PENALTY_HERTZDAMP = 1 } pd_penalty_law;
 typedef struct pd_penalty_opts {
     pd_penalty_law law;
     double kc;           /* contact stiffness (force per unit penetration[^1.5]) > 0 */
-    double rtol, atol;   /* adaptive tolerances (0 = defaults 1e-10, 1e-12) */
-    const char *stepper; /* GSL stepper: "rk8pd" (default), "rkf45", "rk4imp", "msbdf" */
+    double rtol, atol;   /* adaptive tolerances > 0 */
+    const char *stepper; /* GSL stepper: "rk8pd", "rkf45", "rk4imp", "msbdf" */
     double h_out;        /* > 0: the observer is called every h_out (and at t1) */
-    long max_steps;      /* budget of accepted steps (0 = 10^8) */
+    long max_steps;      /* budget of accepted steps >= 1 */
     pd_observer on_step; /* optional: called at t0 and after every accepted step
                             whatever h_out (measurements next to the outputs) */
     void *on_step_ctx;
+    pd_factor_kind factor; /* storage of M */
 } pd_penalty_opts;
+
+/* Kelvin-Voigt, kc = 0 (must be set), rtol 1e-10, atol 1e-12, rk8pd,
+ * h_out 0, 10^8 steps, no on_step, automatic factor. */
+pd_penalty_opts pd_penalty_default_opts(void);
 
 typedef struct pd_penalty_result {
     long steps;    /* accepted steps */
@@ -268,13 +285,17 @@ typedef struct pd_ed_opts {
     double t_measure;     /* extremes count from here on */
     double h_out;         /* > 0: sampler at t_start + k h_out */
     int no_accumulation;  /* 1: never jump an accumulation (shows the stall) */
-    long max_events;      /* 0 = 10^7 */
-    long max_burst;       /* impacts in one accumulation before giving up, 0 = 10^5 */
+    long max_events;      /* event budget >= 1 */
+    long max_burst;       /* impacts in one accumulation before giving up, >= 1 */
     double length_scale;  /* an accumulation is jumped once its bounce height
-                             v+^2 / (2 a) is below 1e-10 * length_scale (0 = 1):
+                             v+^2 / (2 a) is below 1e-10 * length_scale (> 0):
                              the motion left out stays that close to the wall */
-    int scan_divisions;   /* bracketing grid: shortest period / this (0 = 64) */
+    int scan_divisions;   /* bracketing grid: shortest period / this, >= 1 */
 } pd_ed_opts;
+
+/* t_end 0 (must be set), t_measure 0, h_out 0, accumulations jumped, 10^7
+ * events, bursts of 10^5, length scale 1, 64 scan divisions. */
+pd_ed_opts pd_ed_default_opts(void);
 
 typedef struct pd_ed_result {
     double xmax, xtoward, xaway;  /* max |x|, max x, max -x over the window */

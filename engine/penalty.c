@@ -28,9 +28,9 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_odeiv2.h>
 
+#include "pd_core.h"
 #include "pd_engine.h"
-
-#define PEN_PI 3.14159265358979323846
+#include "pd_factor.h"
 
 /* A GSL stepper the baseline offers. */
 typedef struct pen_stepper {
@@ -54,18 +54,18 @@ typedef struct pen {
     const pen_stepper *stp;
     int n, m;
     size_t dim;            /* 2 n */
-    double *LU;            /* n x n: M factored */
-    int *perm;
+    pd_factor *fac;        /* M factored (What with h = 0) */
     double *cd;            /* m: damping constants c_a */
     double vfloor;         /* smallest approach speed used by Hertz-damp */
     double vseen;          /* largest approach speed at an engagement so far */
     unsigned char *mode;   /* m: 1 = element engaged (the RHS is frozen to it) */
     double seg_lo, seg_hi; /* the current force segment */
     double *F, *lam, *col; /* n, m, n work */
-    double *Aq, *Av;       /* n x n: Jacobian blocks before M^-1 */
+    double *Aq, *Av;       /* n x n: Jacobian blocks before M^-1 (implicit steppers only) */
     double *y, *ya, *yt, *yo; /* dim: state, step start, trial, output */
     double *ys;            /* dim: state before a GSL step (retries) */
     double *ga, *Ua;       /* m: gaps and W^T v at the step start */
+    double *acc_work;      /* dim: y' for the accelerations of an on_step report */
     gsl_odeiv2_system sys;
     gsl_odeiv2_driver *main_drv, *probe_drv;
     pd_observer observer;
@@ -100,8 +100,8 @@ static int check_opts(pen *p, double t0, double t1, pd_err *err)
         return pd_err_set(err, PD_EINVAL,
                           "penalty: kc (contact stiffness) must be a finite number > 0 (got %g)",
                           o->kc);
-    if (!(o->rtol >= 0.0) || !isfinite(o->rtol) || !(o->atol >= 0.0) || !isfinite(o->atol))
-        return pd_err_set(err, PD_EINVAL, "penalty: rtol and atol must be >= 0 (got %g, %g)",
+    if (!(o->rtol > 0.0) || !isfinite(o->rtol) || !(o->atol > 0.0) || !isfinite(o->atol))
+        return pd_err_set(err, PD_EINVAL, "penalty: rtol and atol must be > 0 (got %g, %g)",
                           o->rtol, o->atol);
     if (!(p->stp = find_stepper(o->stepper)))
         return pd_err_set(err, PD_EINVAL,
@@ -109,14 +109,25 @@ static int check_opts(pen *p, double t0, double t1, pd_err *err)
                           o->stepper);
     if (!(o->h_out >= 0.0) || !isfinite(o->h_out))
         return pd_err_set(err, PD_EINVAL, "penalty: h_out must be >= 0 (got %g)", o->h_out);
-    if (o->max_steps < 0)
-        return pd_err_set(err, PD_EINVAL, "penalty: max_steps must be >= 0");
+    if (o->max_steps < 1)
+        return pd_err_set(err, PD_EINVAL, "penalty: max_steps must be >= 1");
     if (!isfinite(t0) || !isfinite(t1) || t1 < t0)
         return pd_err_set(err, PD_EINVAL, "penalty: need finite t0 <= t1 (got %g, %g)", t0, t1);
-    o->rtol = o->rtol > 0.0 ? o->rtol : 1e-10;
-    o->atol = o->atol > 0.0 ? o->atol : 1e-12;
-    o->max_steps = o->max_steps > 0 ? o->max_steps : 100000000L;
     return PD_OK;
+}
+
+pd_penalty_opts pd_penalty_default_opts(void)
+{
+    return (pd_penalty_opts){.law = PD_PENALTY_KELVIN,
+                             .kc = 0.0,
+                             .rtol = 1e-10,
+                             .atol = 1e-12,
+                             .stepper = "rk8pd",
+                             .h_out = 0.0,
+                             .max_steps = 100000000L,
+                             .on_step = NULL,
+                             .on_step_ctx = NULL,
+                             .factor = PD_FACTOR_AUTO};
 }
 
 /* Anagnostopoulos: zeta = -ln e / sqrt(pi^2 + ln^2 e); zeta(0) = 1 (the limit). */
@@ -125,7 +136,7 @@ static double kv_zeta(double e)
     if (e <= 0.0)
         return 1.0;
     double l = log(e);
-    return -l / sqrt(PEN_PI * PEN_PI + l * l);
+    return -l / sqrt(PD_PI * PD_PI + l * l);
 }
 
 /* Free what the run took (safe on a partly set up run). */
@@ -135,8 +146,7 @@ static void pen_free(pen *p)
         gsl_odeiv2_driver_free(p->main_drv);
     if (p->probe_drv)
         gsl_odeiv2_driver_free(p->probe_drv);
-    free(p->LU);
-    free(p->perm);
+    pd_factor_free(p->fac);
     free(p->cd);
     free(p->mode);
     free(p->F);
@@ -152,6 +162,8 @@ static void pen_free(pen *p)
     free(p->ga);
     free(p->Ua);
     free(p->st.q);
+    free(p->st.acc);
+    free(p->acc_work);
     free(p->st.v);
     free(p->st.P);
     free(p->st.g);
@@ -162,15 +174,14 @@ static void pen_free(pen *p)
 static int alloc_arrays(pen *p)
 {
     size_t n = (size_t)p->n, m = p->m > 0 ? (size_t)p->m : 1, d = p->dim;
-    p->LU = malloc(n * n * sizeof(double));
-    p->perm = malloc(n * sizeof(int));
+    size_t nn = p->stp->implicit ? n * n : 1;
     p->cd = calloc(m, sizeof(double));
     p->mode = calloc(m, 1);
     p->F = calloc(n, sizeof(double));
     p->lam = calloc(m, sizeof(double));
     p->col = calloc(n, sizeof(double));
-    p->Aq = calloc(n * n, sizeof(double));
-    p->Av = calloc(n * n, sizeof(double));
+    p->Aq = calloc(nn, sizeof(double));
+    p->Av = calloc(nn, sizeof(double));
     p->y = calloc(d, sizeof(double));
     p->ya = calloc(d, sizeof(double));
     p->yt = calloc(d, sizeof(double));
@@ -179,12 +190,14 @@ static int alloc_arrays(pen *p)
     p->ga = calloc(m, sizeof(double));
     p->Ua = calloc(m, sizeof(double));
     p->st.q = calloc(n, sizeof(double));
+    p->st.acc = calloc(n, sizeof(double));
+    p->acc_work = calloc(d, sizeof(double));
     p->st.v = calloc(n, sizeof(double));
     p->st.P = calloc(m, sizeof(double));
     p->st.g = calloc(m, sizeof(double));
     p->st.active = calloc(m, 1);
-    return p->LU && p->perm && p->cd && p->mode && p->F && p->lam && p->col && p->Aq && p->Av &&
-                   p->y && p->ya && p->yt && p->yo && p->ys && p->ga && p->Ua && p->st.q && p->st.v &&
+    return p->cd && p->mode && p->F && p->lam && p->col && p->Aq && p->Av &&
+                   p->y && p->ya && p->yt && p->yo && p->ys && p->ga && p->Ua && p->st.q && p->st.acc && p->acc_work && p->st.v &&
                    p->st.P && p->st.g && p->st.active
                ? PD_OK
                : PD_ENOMEM;
@@ -194,19 +207,13 @@ static int alloc_arrays(pen *p)
 static int setup_mass(pen *p, pd_err *err)
 {
     const pd_model *md = p->md;
-    int n = p->n;
-    for (int j = 0; j < n; j++)
-        for (int i = 0; i < n; i++)
-            p->LU[i + (size_t)j * n] = pd_matrix_get(&md->M, i, j);
-    if (pd_dense_lu(n, p->LU, p->perm))
-        return pd_err_set(err, PD_ESINGULAR, "penalty: the mass matrix M is singular");
+    if (!(p->fac = pd_factor_alloc(md, 0.0, 1.0, p->o.factor, err)))
+        return err && err->status == PD_ESINGULAR
+                   ? pd_err_set(err, PD_ESINGULAR, "penalty: the mass matrix M is singular")
+                   : (err ? err->status : PD_ENOMEM);
     for (int a = 0; a < p->m; a++) {
-        double s = 0.0;
-        for (int i = 0; i < n; i++)
-            p->col[i] = pd_matrix_get(&md->W, i, a);
-        pd_dense_lu_solve(n, p->LU, p->perm, p->col);
-        for (int i = 0; i < n; i++)
-            s += pd_matrix_get(&md->W, i, a) * p->col[i];
+        double s;
+        pd_factor_delassus_dense(p->fac, &a, 1, &s);
         if (!(s > 0.0) || !isfinite(s))
             return pd_err_set(err, PD_EINVAL,
                               "penalty: contact %d has no effective mass (W_a^T M^-1 W_a = %g)",
@@ -222,19 +229,13 @@ static int setup_mass(pen *p, pd_err *err)
 /* g_a = g0_a + W_a^T q. */
 static double gap_of(const pen *p, int a, const double *q)
 {
-    double s = p->md->g0[a];
-    for (int i = 0; i < p->n; i++)
-        s += pd_matrix_get(&p->md->W, i, a) * q[i];
-    return s;
+    return p->md->g0[a] + pd_matrix_col_dot(&p->md->W, a, q);
 }
 
 /* U_a = W_a^T v (the gap rate). */
 static double rate_of(const pen *p, int a, const double *v)
 {
-    double s = 0.0;
-    for (int i = 0; i < p->n; i++)
-        s += pd_matrix_get(&p->md->W, i, a) * v[i];
-    return s;
+    return pd_matrix_col_dot(&p->md->W, a, v);
 }
 
 /* Element force: KV kc d + c d'; Hertz-damp d^1.5 (kc + c d'), zero for d <= 0. */
@@ -263,15 +264,13 @@ static void force_at(const pen *p, double t, double *F)
         memset(F, 0, (size_t)p->n * sizeof(double));
 }
 
-/* y' = (v, M^-1 [F - C v - K q + W lambda]). */
-static int rhs(double t, const double y[], double dydt[], void *params)
+/* y' = (v, M^-1 [F - C v - K q + W lambda]), uncounted. */
+static int rhs_value(pen *p, double t, const double y[], double dydt[])
 {
-    pen *p = params;
     const pd_model *md = p->md;
     int n = p->n;
     const double *q = y, *v = y + n;
     double *r = dydt + n;
-    p->res.rhs++;
     force_at(p, t, r);
     pd_matrix_gemv(&md->C, -1.0, v, 1.0, r);
     pd_matrix_gemv(&md->K, -1.0, q, 1.0, r);
@@ -279,12 +278,20 @@ static int rhs(double t, const double y[], double dydt[], void *params)
         contact_forces(p, q, v, p->lam);
         pd_matrix_gemv(&md->W, 1.0, p->lam, 1.0, r);
     }
-    pd_dense_lu_solve(n, p->LU, p->perm, r);
+    pd_factor_solve(p->fac, r);
     memmove(dydt, v, (size_t)n * sizeof(double));
     for (size_t i = 0; i < p->dim; i++)
         if (!isfinite(dydt[i]))
             return GSL_ERANGE; /* an overflowing trial step: retried smaller */
     return GSL_SUCCESS;
+}
+
+/* The right-hand side GSL calls (counted). */
+static int rhs(double t, const double y[], double dydt[], void *params)
+{
+    pen *p = params;
+    p->res.rhs++;
+    return rhs_value(p, t, y, dydt);
 }
 
 /* d lambda / d d and d lambda / d d' of an engaged element. */
@@ -305,21 +312,23 @@ static void stiffness_blocks(pen *p, const double *q, const double *v)
 {
     const pd_model *md = p->md;
     int n = p->n;
-    for (int j = 0; j < n; j++)
-        for (int i = 0; i < n; i++) {
-            p->Aq[i + (size_t)j * n] = -pd_matrix_get(&md->K, i, j);
-            p->Av[i + (size_t)j * n] = -pd_matrix_get(&md->C, i, j);
-        }
+    pd_matrix_to_dense(&md->K, p->Aq);
+    pd_matrix_to_dense(&md->C, p->Av);
+    for (size_t k = 0; k < (size_t)n * n; k++) {
+        p->Aq[k] = -p->Aq[k];
+        p->Av[k] = -p->Av[k];
+    }
     for (int a = 0; a < p->m; a++) {
         double kd, cdd;
         if (!p->mode[a])
             continue;
         element_slopes(p, a, -gap_of(p, a, q), -rate_of(p, a, v), &kd, &cdd);
+        memset(p->col, 0, (size_t)n * sizeof(double));
+        pd_matrix_col_axpy(&md->W, a, 1.0, p->col); /* W_a, dense */
         for (int j = 0; j < n; j++)
-            for (int i = 0; i < n; i++) {
-                double ww = pd_matrix_get(&md->W, i, a) * pd_matrix_get(&md->W, j, a);
-                p->Aq[i + (size_t)j * n] -= kd * ww;
-                p->Av[i + (size_t)j * n] -= cdd * ww;
+            if (p->col[j] != 0.0) {
+                pd_matrix_col_axpy(&md->W, a, -kd * p->col[j], p->Aq + (size_t)j * n);
+                pd_matrix_col_axpy(&md->W, a, -cdd * p->col[j], p->Av + (size_t)j * n);
             }
     }
 }
@@ -353,14 +362,14 @@ static int jacobian(double t, const double y[], double *dfdy, double dfdt[], voi
         for (int j = 0; j < n; j++) {
             const double *A = blk ? p->Av : p->Aq;
             memcpy(p->col, A + (size_t)j * n, (size_t)n * sizeof(double));
-            pd_dense_lu_solve(n, p->LU, p->perm, p->col);
+            pd_factor_solve(p->fac, p->col);
             for (int i = 0; i < n; i++)
                 dfdy[(size_t)(n + i) * dim + (size_t)(blk * n + j)] = p->col[i];
         }
     force_rate(p, t, dfdt + n);
     for (int i = 0; i < n; i++)
         dfdt[i] = 0.0;
-    pd_dense_lu_solve(n, p->LU, p->perm, dfdt + n);
+    pd_factor_solve(p->fac, dfdt + n);
     return GSL_SUCCESS;
 }
 
@@ -455,6 +464,7 @@ static void fill_state(pen *p, double t, const double *y)
     p->st.t = t;
     p->st.step = p->res.steps;
     p->st.lcp_pivots = 0;
+    p->st.has_acc = 0;
 }
 
 /* Call fn (if any) on the current pd_state; remember a stop request. */
@@ -462,6 +472,18 @@ static void notify(pen *p, pd_observer fn, void *ctx)
 {
     if (fn && !p->stopped && fn(&p->st, ctx) > 0)
         p->stopped = 1;
+}
+
+/* on_step: the state at t (end of a step, or t0) with its accelerations. */
+static void notify_step(pen *p, double t)
+{
+    if (!p->o.on_step || p->stopped)
+        return;
+    fill_state(p, t, p->y);
+    p->st.has_acc = rhs_value(p, t, p->y, p->acc_work) == GSL_SUCCESS;
+    if (p->st.has_acc)
+        memcpy(p->st.acc, p->acc_work + p->n, (size_t)p->n * sizeof(double));
+    notify(p, p->o.on_step, p->o.on_step_ctx);
 }
 
 /* Time of output k. */
@@ -665,21 +687,11 @@ static void apply_switches(pen *p, int which)
     }
 }
 
-/* Quintic Hermite on [0, h] through (f, f', f'') at both ends, at s
- * (value and, in *df, slope): f = sum_k c_k r^k with r = s / h. */
+/* The quintic Hermite of (f, f', f'') on [0, h] at time s: value, and slope in *df. */
 static double quintic(const double e0[3], const double e1[3], double h, double s, double *df)
 {
-    double c[6] = {e0[0], h * e0[1], 0.5 * h * h * e0[2], 0, 0, 0};
-    double P = e1[0] - (c[0] + c[1] + c[2]), V = h * e1[1] - (c[1] + 2.0 * c[2]);
-    double A = h * h * e1[2] - 2.0 * c[2], r = s / h, f = 0.0, d = 0.0;
-    c[3] = 10.0 * P - 4.0 * V + 0.5 * A;
-    c[4] = -15.0 * P + 7.0 * V - A;
-    c[5] = 6.0 * P - 3.0 * V + 0.5 * A;
-    for (int k = 5; k >= 0; k--) {
-        f = f * r + c[k];
-        d = k > 0 ? d * r + k * c[k] : d;
-    }
-    *df = d / h;
+    double f;
+    pd_hermite5(e0, e1, h, s / h, &f, df);
     return f;
 }
 
@@ -771,8 +783,8 @@ static int one_step(pen *p, double *t, double tb, double *h, pd_err *err)
         gsl_odeiv2_step_reset(d->s);
     }
     output_at_end(p, *t);
+    notify_step(p, *t);
     fill_state(p, *t, p->y);
-    notify(p, p->o.on_step, p->o.on_step_ctx);
     if (p->o.h_out == 0.0)
         notify(p, p->observer, p->obs_ctx);
     return PD_OK;
@@ -837,8 +849,8 @@ static int start(pen *p, double t0, const double *q0, const double *v0, pd_err *
     p->res.switches = 0;
     p->t_out0 = t0;
     p->next_out = 1;
+    notify_step(p, t0);
     fill_state(p, t0, p->y);
-    notify(p, p->o.on_step, p->o.on_step_ctx);
     notify(p, p->observer, p->obs_ctx);
     return PD_OK;
 }
@@ -855,8 +867,7 @@ int pd_penalty_run(const pd_model *model, double t0, const double *q0, const dou
     p.md = model;
     p.observer = observer;
     p.obs_ctx = ctx;
-    if (opts)
-        p.o = *opts;
+    p.o = opts ? *opts : pd_penalty_default_opts();
     if (!(rc = pd_model_check(model, err)) && !(rc = check_opts(&p, t0, t1, err))) {
         p.n = model->n;
         p.m = model->m;

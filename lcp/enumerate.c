@@ -35,8 +35,10 @@ static int support_solution(int n, const double *M, const double *q, unsigned ma
             A[r + c * k] = M[idx[r] + idx[c] * n];
         b[c] = -q[idx[c]];
     }
-    if (k > 0 && pd_lcp_gauss_solve(k, A, k, b, perm, ENUM_SINGULAR_TOL) != 0)
+    if (k > 0 && pd_dense_lu(k, A, k, perm, ENUM_SINGULAR_TOL) != PD_OK)
         return -1;
+    if (k > 0)
+        pd_dense_lu_solve(k, A, k, perm, b);
     memset(z, 0, (size_t)n * sizeof(double));
     for (int c = 0; c < k; c++)
         z[idx[c]] = b[c] < 0.0 && b[c] > -ENUM_TOL ? 0.0 : b[c];

@@ -3,12 +3,6 @@
 #ifndef PD_LCP_INTERNAL_H
 #define PD_LCP_INTERNAL_H
 
-/* Solve A x = b in place by Gaussian elimination with partial pivoting:
- * A is k x k column-major with leading dimension lda and is overwritten by
- * its LU factors, b by x; perm holds k ints of scratch.  Returns 0, or -1
- * when a pivot is below rel_tol * max|A| (numerically singular). */
-int pd_lcp_gauss_solve(int k, double *A, int lda, double *b, int *perm, double rel_tol);
-
 /* Largest |x_i| of a vector. */
 double pd_lcp_max_abs(int n, const double *x);
 

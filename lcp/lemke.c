@@ -443,8 +443,9 @@ static int polish(const lemke_state *st, double *z)
             A[a + (size_t)b * k] = mcol[ws->ties[a]];
         rhs[b] = -st->q[ws->ties[b]];
     }
-    if (pd_lcp_gauss_solve(k, A, k, rhs, ws->perm, LEMKE_SINGULAR_TOL) != 0)
+    if (pd_dense_lu(k, A, k, ws->perm, LEMKE_SINGULAR_TOL) != PD_OK)
         return -1;
+    pd_dense_lu_solve(k, A, k, ws->perm, rhs);
     memset(z, 0, (size_t)n * sizeof(double));
     for (int a = 0; a < k; a++)
         z[ws->ties[a]] = rhs[a];
@@ -579,15 +580,18 @@ static int outcome_status(pd_lcp_outcome outcome)
 /* Options into the state; -1 if one is out of range. */
 static int set_options(lemke_state *st, const pd_lcp_opts *opts, int *cap)
 {
-    const double *cover = opts ? opts->cover : NULL;
-    double tol = opts ? opts->tol : 0.0;
-    int max_pivots = opts ? opts->max_pivots : 0;
-    if (isnan(tol) || tol >= 1.0)
+    pd_lcp_opts o = opts ? *opts : pd_lcp_default_opts();
+    if (!(o.tol > 0.0 && o.tol < 1.0) || o.max_pivots < 0)
         return -1;
-    st->tol = tol > 0.0 ? tol : LEMKE_TOL_DEFAULT;
+    st->tol = o.tol;
     int by_size = LEMKE_CAP_PER_N * st->n; /* n <= 46340: no overflow */
-    *cap = max_pivots > 0 ? max_pivots : (by_size > LEMKE_CAP_MIN ? by_size : LEMKE_CAP_MIN);
-    return set_cover(st, cover);
+    *cap = o.max_pivots > 0 ? o.max_pivots : (by_size > LEMKE_CAP_MIN ? by_size : LEMKE_CAP_MIN);
+    return set_cover(st, o.cover);
+}
+
+pd_lcp_opts pd_lcp_default_opts(void)
+{
+    return (pd_lcp_opts){.cover = NULL, .max_pivots = 0, .tol = LEMKE_TOL_DEFAULT};
 }
 
 /* Lemke's method on (M, q): check the input, z = 0 if q >= 0, else pivot from

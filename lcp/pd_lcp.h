@@ -11,7 +11,7 @@
 
 #include <stdio.h>
 
-#include "pd_status.h"
+#include "pd_core.h"
 
 /* Outcome of a solve.  The solver returns PD_OK for PD_LCP_SOLVED and the
  * negative status PD_ENOSOLUTION / PD_EMAXPIVOTS / PD_ENUMERICAL otherwise. */
@@ -26,12 +26,17 @@ typedef enum {
  * "max_pivots", "numerical". */
 const char *pd_lcp_outcome_name(pd_lcp_outcome outcome);
 
-/* Options; zero-initialise for the defaults. */
+/* Options: start from pd_lcp_default_opts() (a NULL opts pointer means the
+ * defaults).  Fields hold values, never "use the default" markers; a 0 pivot
+ * or iteration budget is derived from n (documented in docs/lcp.md). */
 typedef struct pd_lcp_opts {
-    const double *cover; /* covering vector d > 0 (n entries), NULL = all ones */
-    int max_pivots;      /* pivot cap, <= 0 = default (documented in docs/lcp.md) */
-    double tol;          /* relative tolerance for ties and tiny pivots, <= 0 = default */
+    const double *cover; /* Lemke's covering vector d > 0 (n entries), NULL = all ones */
+    int max_pivots;      /* Lemke's pivot cap; 0 = max(10000, 100 n) */
+    double tol;          /* relative tolerance for ties and tiny pivots, in (0, 1) */
 } pd_lcp_opts;
+
+/* cover NULL, max_pivots 0 (from n), tol 1e-12. */
+pd_lcp_opts pd_lcp_default_opts(void);
 
 /* What a solve reports. */
 typedef struct pd_lcp_info {
@@ -40,6 +45,7 @@ typedef struct pd_lcp_info {
     double complementarity; /* max_i |z_i w_i| */
     double infeasibility;   /* max_i max(-z_i, -w_i, 0) */
     double scale;           /* data scale the two figures above are relative to */
+    const char *solver;     /* the solver that produced the answer (pd_lcp_solve) */
 } pd_lcp_info;
 
 typedef struct pd_lcp_work pd_lcp_work;
@@ -66,6 +72,36 @@ int pd_lcp_enumerate(int n, const double *M, const double *q, double *z, double 
 void pd_lcp_residual(int n, const double *M, const double *q, const double *z,
                      double *w, double *complementarity, double *infeasibility,
                      double *scale);
+
+/* ---- the solver table ------------------------------------------------------ *
+ * One entry point for every solver: a solver object sized once (no
+ * allocation in a solve) takes the matrix as a pd_matrix view, dense or
+ * compressed-sparse-column; a solver that works on dense data copies a sparse
+ * matrix into its own buffer.  info->solver names who answered. */
+typedef enum {
+    PD_LCP_AUTO = 0, /* the best solver for the problem's structure */
+    PD_LCP_LEMKE = 1 /* Lemke's method (dense), always available */
+} pd_lcp_method;
+
+typedef struct pd_lcp_solver pd_lcp_solver;
+
+/* "auto", "lemke"; parse: PD_OK or PD_EINVAL. */
+const char *pd_lcp_method_name(pd_lcp_method method);
+int pd_lcp_method_parse(const char *name, pd_lcp_method *method);
+/* The names the parser takes, comma-separated (for messages). */
+const char *pd_lcp_method_list(void);
+
+/* A solver for problems of up to nmax unknowns whose sparse matrices store
+ * up to nnzmax entries (0: the caller passes dense matrices only).  NULL on
+ * failure, with the reason in err. */
+pd_lcp_solver *pd_lcp_solver_alloc(pd_lcp_method method, int nmax, long nnzmax, pd_err *err);
+void pd_lcp_solver_free(pd_lcp_solver *s);
+int pd_lcp_solver_nmax(const pd_lcp_solver *s);
+
+/* Solve (M, q), M square (dense or CSC) with n <= nmax; the status of
+ * pd_lcp_lemke (PD_OK only for a verified solution). */
+int pd_lcp_solve(pd_lcp_solver *s, const pd_matrix *M, const double *q, const pd_lcp_opts *opts,
+                 double *z, double *w, pd_lcp_info *info);
 
 /* File formats: plain (SPEC §3, row-major, '#' comments) and Siconos
  * (column-major).  PD_LCP_FORMAT_AUTO detects which. */

@@ -1,4 +1,4 @@
-/* residual.c — residuals of an LCP candidate and a small dense solver. */
+/* residual.c — residuals of an LCP candidate. */
 #include <math.h>
 
 #include "lcp_internal.h"
@@ -78,77 +78,4 @@ void pd_lcp_residual(int n, const double *M, const double *q, const double *z,
 {
     double mmax = pd_lcp_max_abs(n * n, M);
     pd_lcp_residual_mmax(n, M, q, z, mmax, w, complementarity, infeasibility, scale);
-}
-
-/* Row of the largest |A_ik| for i >= k (partial pivoting). */
-static int pivot_row(int k, int col, const double *A, int lda)
-{
-    int best = col;
-    double big = fabs(A[col + (size_t)col * lda]);
-    for (int i = col + 1; i < k; i++) {
-        double a = fabs(A[i + (size_t)col * lda]);
-        if (a > big) {
-            big = a;
-            best = i;
-        }
-    }
-    return best;
-}
-
-/* Swap rows r and s of A (all k columns) and of b. */
-static void swap_rows(int k, double *A, int lda, double *b, int r, int s)
-{
-    if (r == s)
-        return;
-    for (int j = 0; j < k; j++) {
-        double t = A[r + (size_t)j * lda];
-        A[r + (size_t)j * lda] = A[s + (size_t)j * lda];
-        A[s + (size_t)j * lda] = t;
-    }
-    double t = b[r];
-    b[r] = b[s];
-    b[s] = t;
-}
-
-/* Back substitution U x = y, U upper triangle of A. */
-static void back_substitute(int k, const double *A, int lda, double *b)
-{
-    for (int j = k - 1; j >= 0; j--) {
-        b[j] /= A[j + (size_t)j * lda];
-        const double *aj = A + (size_t)j * lda;
-        for (int i = 0; i < j; i++)
-            b[i] -= aj[i] * b[j];
-    }
-}
-
-/* PA = LU by right-looking elimination, applied to b as it goes, then U x = L^-1 P b. */
-int pd_lcp_gauss_solve(int k, double *A, int lda, double *b, int *perm, double rel_tol)
-{
-    double amax = 0.0;
-    for (int j = 0; j < k; j++)
-        amax = fmax(amax, pd_lcp_max_abs(k, A + (size_t)j * lda));
-    double tiny = rel_tol * amax;
-    for (int c = 0; c < k; c++) {
-        int r = pivot_row(k, c, A, lda);
-        perm[c] = r;
-        swap_rows(k, A, lda, b, c, r);
-        double piv = A[c + (size_t)c * lda];
-        if (!(fabs(piv) > tiny))
-            return -1;
-        double *ac = A + (size_t)c * lda;
-        for (int i = c + 1; i < k; i++)
-            ac[i] /= piv;
-        for (int j = c + 1; j < k; j++) {
-            double *aj = A + (size_t)j * lda;
-            double f = aj[c];
-            if (f == 0.0)
-                continue;
-            for (int i = c + 1; i < k; i++)
-                aj[i] -= ac[i] * f;
-        }
-        for (int i = c + 1; i < k; i++)
-            b[i] -= ac[i] * b[c];
-    }
-    back_substitute(k, A, lda, b);
-    return 0;
 }

@@ -13,41 +13,18 @@
 #include <math.h>
 #include <string.h>
 
-#include "pd_oscillator.h"
-
-#define PD_TWO_PI 6.283185307179586476925286766559
-
-/* The excitation of the scene. */
-typedef struct pen_scene {
-    const pd_osc *c;
-    pd_pulse pulse;
-    int dir;
-} pen_scene;
-
-/* s phi(tau), with oscillator.c's one-sided limits at the pulse end. */
-static double pulse_value(const pen_scene *sc, double tau, int side)
-{
-    return pd_osc_shape(sc->c, tau, side);
-}
+#include "pd_problems.h"
 
 /* F = s phi(tau): the model's force callback. */
 static void scene_force(double tau, int side, double *F, void *ctx)
 {
-    F[0] = pulse_value(ctx, tau, side);
-}
-
-/* d/dtau of s phi(tau), same sides. */
-static double pulse_rate(const pen_scene *sc, double tau, int side)
-{
-    double end = PD_TWO_PI * (1.0 + (side < 0 ? 1e-12 : -1e-12));
-    if (sc->pulse != PD_PULSE_HARMONIC && (side < 0 ? tau > end : tau >= end))
-        return 0.0;
-    return sc->dir * (sc->pulse == PD_PULSE_COSINE ? -sin(tau) : cos(tau));
+    const pd_osc *c = ctx;
+    F[0] = pd_pulse_shape(c->pulse, c->dir, tau, side);
 }
 
 /* Measurements in Pi units, updated after every accepted step. */
 typedef struct pen_track {
-    pen_scene sc;
+    const pd_osc *c;
     pd_penalty_law law;
     int m;                        /* 0: no wall */
     double C, K, Pi3, tau_measure;
@@ -57,6 +34,7 @@ typedef struct pen_track {
     int have_prev, pactive;
     double pt, px, pv, pP;        /* previous accepted state and its force */
     double imp_t, imp_lam, imp;   /* integral of lambda since the last sample */
+    double episode, episode_max;  /* integral of lambda over the current contact, its max */
     double Le, vscale, wp;
     pd_osc_sampler sampler;
     void *sampler_ctx;
@@ -161,7 +139,10 @@ static void interior_extremes(pen_track *tr, const pen_poly *p, double t0)
 /* Trapezoid of lambda from the last point to (tau, lam). */
 static void add_impulse(pen_track *tr, double tau, double lam)
 {
-    tr->imp += 0.5 * (tr->imp_lam + lam) * (tau - tr->imp_t);
+    double di = 0.5 * (tr->imp_lam + lam) * (tau - tr->imp_t);
+    tr->imp += di;
+    tr->episode += di;
+    tr->episode_max = fmax(tr->episode_max, tr->episode);
     tr->imp_t = tau;
 }
 
@@ -169,8 +150,8 @@ static void add_impulse(pen_track *tr, double tau, double lam)
 static pen_jet jet_at(const pen_track *tr, double tau, double x, double v, double lam, int side)
 {
     pen_jet q = {x, v, 0.0, 0.0};
-    q.a = pulse_value(&tr->sc, tau, side) - tr->C * v - tr->K * x - lam;
-    q.j = pulse_rate(&tr->sc, tau, side) - tr->C * q.a - tr->K * v;
+    q.a = pd_pulse_shape(tr->c->pulse, tr->c->dir, tau, side) - tr->C * v - tr->K * x - lam;
+    q.j = pd_pulse_shape_rate(tr->c->pulse, tr->c->dir, tau, side) - tr->C * q.a - tr->K * v;
     return q;
 }
 
@@ -208,6 +189,7 @@ static int track_step(const pd_state *st, void *ctx)
         close_step(tr, tau, x, v, lam, active);
     record_x(tr, tau, x);
     if (active && !tr->pactive) { /* an element engaged at a located closing */
+        tr->episode = 0.0;
         tr->impacts++;
         tr->vimp_max = fmax(tr->vimp_max, v);
         if (tr->impacts == 1) {
@@ -231,34 +213,29 @@ static int emit_sample(const pd_state *st, void *ctx)
     pen_track *tr = ctx;
     double x = st->q[0], lam = tr->m ? st->P[0] : 0.0;
     add_impulse(tr, st->t, lam);
-    pd_osc_sample s = {st->step, st->t / tr->wp, x * tr->Le, st->v[0] * tr->vscale,
-                       tr->imp * tr->vscale, (tr->Pi3 - x) * tr->Le};
+    pd_osc_sample s = {.step = st->step,
+                       .t = st->t / tr->wp,
+                       .u = x * tr->Le,
+                       .v = st->v[0] * tr->vscale,
+                       .impulse = tr->imp * tr->vscale,
+                       .gap = (tr->Pi3 - x) * tr->Le};
     tr->imp = 0.0;
     tr->imp_lam = lam;
     return tr->sampler(&s, tr->sampler_ctx);
 }
 
 /* Contact stiffness in Pi units (see the file comment). */
-static int pi_stiffness(const pd_osc *c, const pd_osc_penalty_opts *po, double *kc, pd_err *err)
+static double pi_stiffness(const pd_osc *c, const pd_penalty_setup *po)
 {
     double wp = pd_osc_wp(c);
-    if (!(po->kc_abs >= 0.0) || !isfinite(po->kc_abs))
-        return pd_err_set(err, PD_EINVAL, "kc_abs (contact stiffness) must be >= 0 (got %g)",
-                          po->kc_abs);
-    if (!(po->kc_mult >= 0.0) || !isfinite(po->kc_mult))
-        return pd_err_set(err, PD_EINVAL,
-                          "kc (contact stiffness multiple of w0^2) must be > 0 (got %g)",
-                          po->kc_mult);
     if (po->kc_abs > 0.0)
-        *kc = po->law == PD_PENALTY_HERTZDAMP ? po->kc_abs * sqrt(pd_osc_Le(c)) / (wp * wp)
-                                              : po->kc_abs / (wp * wp);
-    else
-        *kc = (po->kc_mult > 0.0 ? po->kc_mult : 1e4) * c->Pi2 * c->Pi2;
-    return PD_OK;
+        return po->law == PD_PENALTY_HERTZDAMP ? po->kc_abs * sqrt(pd_osc_Le(c)) / (wp * wp)
+                                               : po->kc_abs / (wp * wp);
+    return po->kc_mult * c->Pi2 * c->Pi2;
 }
 
 /* Results back in metres and seconds. */
-static void fill_result(const pen_track *tr, const pd_osc_opts *o,
+static void fill_result(const pen_track *tr, const pd_run_opts *o,
                         const pd_penalty_result *pr, pd_osc_result *res)
 {
     memset(res, 0, sizeof *res);
@@ -269,6 +246,7 @@ static void fill_result(const pen_track *tr, const pd_osc_opts *o,
     res->first_impact = tr->first_tau / tr->wp;
     res->first_impact_velocity = tr->first_v * tr->vscale;
     res->max_impact_velocity = tr->vimp_max * tr->vscale;
+    res->max_impulse = tr->episode_max * tr->vscale;
     res->contact_time = tr->contact_tau / tr->wp;
     res->min_gap = (tr->Pi3 - tr->xpeak) * tr->Le;
     res->steps = pr->steps;
@@ -279,36 +257,39 @@ static void fill_result(const pen_track *tr, const pd_osc_opts *o,
     res->kernel = pr->stepper ? pr->stepper : "penalty";
 }
 
-int pd_osc_penalty(const pd_osc *c, const pd_osc_opts *opts, const pd_osc_penalty_opts *popts,
-                   pd_osc_sampler sampler, void *ctx, pd_osc_result *res, pd_err *err)
+int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
+                   pd_osc_result *res, pd_err *err)
 {
-    pd_osc_opts o;
-    pd_osc_penalty_opts po = {PD_PENALTY_KELVIN, 1e4, 0.0, 0.0, 0.0, NULL};
+    pd_run_opts o;
     pd_penalty_result pr;
-    double kc = 0.0;
     int rc;
     pd_err_clear(err);
-    if (popts)
-        po = *popts;
-    if ((rc = pd_osc_resolve_opts(c, opts, &o, err)) ||
-        (rc = pi_stiffness(c, &po, &kc, err)))
+    if ((rc = pd_osc_resolve_opts(c, opts, &o, err)))
         return rc;
 
     /* the scene in Pi units; outputs on the grid tau_k = k 2 pi dt / Tp */
-    pen_scene sc = {c, c->pulse, c->dir};
     double M = 1.0, C = 2.0 * c->xi * c->Pi2, K = c->Pi2 * c->Pi2, W = -1.0;
     double g0 = c->Pi3, e = c->eps, wp = pd_osc_wp(c);
     double h_out = PD_TWO_PI * (o.dt / c->Tp);
     double tau_end = (double)pd_steps_for(o.tend, o.dt) * h_out;
     double tau_measure = wp * pd_osc_measure_start(c, o.tend);
     double brk = c->pulse == PD_PULSE_HARMONIC ? tau_measure : PD_TWO_PI;
-    pd_model model = {1, o.no_wall ? 0 : 1, pd_matrix_dense(1, 1, &M), pd_matrix_dense(1, 1, &C),
-                      pd_matrix_dense(1, 1, &K), pd_matrix_dense(1, 1, &W), &g0, &e,
-                      scene_force, &sc, &brk, brk > 0.0 ? 1 : 0};
+    pd_model model = {.n = 1,
+                      .m = o.no_wall ? 0 : 1,
+                      .M = pd_matrix_dense(1, 1, &M),
+                      .C = pd_matrix_dense(1, 1, &C),
+                      .K = pd_matrix_dense(1, 1, &K),
+                      .W = pd_matrix_dense(1, 1, &W),
+                      .g0 = &g0,
+                      .e = &e,
+                      .force = scene_force,
+                      .force_ctx = (void *)c,
+                      .breaks = &brk,
+                      .nbreaks = brk > 0.0 ? 1 : 0};
     pen_track tr;
     memset(&tr, 0, sizeof tr);
-    tr.sc = sc;
-    tr.law = po.law;
+    tr.c = c;
+    tr.law = o.pen.law;
     tr.m = model.m;
     tr.C = C;
     tr.K = K;
@@ -320,8 +301,16 @@ int pd_osc_penalty(const pd_osc *c, const pd_osc_opts *opts, const pd_osc_penalt
     tr.vscale = tr.Le * wp;
     tr.sampler = sampler;
     tr.sampler_ctx = ctx;
-    pd_penalty_opts eo = {po.law, kc, po.rtol, po.atol, po.stepper, sampler ? h_out : 0.0,
-                          0, track_step, &tr};
+    pd_penalty_opts eo = pd_penalty_default_opts();
+    eo.law = o.pen.law;
+    eo.kc = pi_stiffness(c, &o.pen);
+    eo.rtol = o.pen.rtol;
+    eo.atol = o.pen.atol;
+    eo.stepper = o.pen.stepper;
+    eo.h_out = sampler ? h_out : 0.0;
+    eo.on_step = track_step;
+    eo.on_step_ctx = &tr;
+    eo.factor = o.factor;
 
     double cpu0 = pd_cpu_seconds();
     rc = pd_penalty_run(&model, 0.0, NULL, NULL, tau_end, &eo, sampler ? emit_sample : NULL,

@@ -7,71 +7,30 @@
 #include <math.h>
 #include <string.h>
 
-#include "pd_oscillator.h"
+#include "pd_problems.h"
 
-#define PD_TWO_PI 6.283185307179586476925286766559
-
-const char *pd_pulse_name(pd_pulse pulse)
+pd_osc pd_osc_default(void)
 {
-    switch (pulse) {
-    case PD_PULSE_SINE: return "sine";
-    case PD_PULSE_COSINE: return "cosine";
-    case PD_PULSE_HARMONIC: return "harmonic";
-    }
-    return "?";
-}
-
-int pd_pulse_parse(const char *name, pd_pulse *pulse)
-{
-    static const pd_pulse all[] = {PD_PULSE_SINE, PD_PULSE_COSINE, PD_PULSE_HARMONIC};
-    for (int i = 0; i < 3; i++)
-        if (name && !strcmp(name, pd_pulse_name(all[i]))) {
-            *pulse = all[i];
-            return PD_OK;
-        }
-    return PD_EINVAL;
-}
-
-const char *pd_dir_name(int dir)
-{
-    return dir > 0 ? "normal" : "reverse";
-}
-
-int pd_dir_parse(const char *name, int *dir)
-{
-    if (name && !strcmp(name, "normal"))
-        *dir = 1;
-    else if (name && !strcmp(name, "reverse"))
-        *dir = -1;
-    else
-        return PD_EINVAL;
-    return PD_OK;
+    return (pd_osc){.pulse = PD_PULSE_SINE,
+                    .dir = 1,
+                    .ap = 1.0,
+                    .Tp = 1.0,
+                    .Pi2 = 1.0,
+                    .Pi3 = 0.05,
+                    .eps = 0.5,
+                    .xi = 0.05};
 }
 
 double pd_osc_wp(const pd_osc *c) { return PD_TWO_PI / c->Tp; }
 double pd_osc_T0(const pd_osc *c) { return c->Tp / c->Pi2; }
 double pd_osc_Le(const pd_osc *c) { return c->ap / (pd_osc_wp(c) * pd_osc_wp(c)); }
 double pd_osc_gap(const pd_osc *c) { return c->Pi3 * pd_osc_Le(c); }
-
-/* s phi(tau): the dimensionless effective acceleration; side -1 / +1 picks
- * the left / right limit at the pulse end tau = 2 pi (recognised to a
- * relative 1e-12, so that tau = k h lands on the same side at every scale). */
-static double pulse_shape(pd_pulse pulse, int dir, double tau, int side)
-{
-    double end = PD_TWO_PI * (1.0 + (side < 0 ? 1e-12 : -1e-12));
-    if (pulse != PD_PULSE_HARMONIC && (side < 0 ? tau > end : tau >= end))
-        return 0.0;
-    return dir * (pulse == PD_PULSE_COSINE ? cos(tau) : sin(tau));
-}
+void pd_osc_set_T0(pd_osc *c, double T0) { c->Pi2 = c->Tp / T0; }
+void pd_osc_set_gap(pd_osc *c, double gap) { c->Pi3 = gap / pd_osc_Le(c); }
 
 double pd_osc_excitation(const pd_osc *c, double t)
 {
-    return c->ap * pulse_shape(c->pulse, c->dir, pd_osc_wp(c) * t, -1);
-}
-
-double pd_osc_shape(const pd_osc *c, double tau, int side)
-{
-    return pulse_shape(c->pulse, c->dir, tau, side);
+    return c->ap * pd_pulse_shape(c->pulse, c->dir, pd_osc_wp(c) * t, -1);
 }
 
 /* A finite value in [lo, hi] (hi_open: hi excluded). */
@@ -101,20 +60,11 @@ int pd_osc_check(const pd_osc *c, pd_err *err)
     return PD_OK;
 }
 
-pd_osc_opts pd_osc_default_opts(void)
-{
-    pd_osc_opts o;
-    memset(&o, 0, sizeof o);
-    o.theta = 0.5;
-    o.gamma = 0.5;
-    return o;
-}
-
-int pd_osc_resolve_opts(const pd_osc *c, const pd_osc_opts *in, pd_osc_opts *out, pd_err *err)
+int pd_osc_resolve_opts(const pd_osc *c, const pd_run_opts *in, pd_run_opts *out, pd_err *err)
 {
     int rc;
-    *out = in ? *in : pd_osc_default_opts();
-    if ((rc = pd_osc_check(c, err)))
+    *out = in ? *in : pd_run_default_opts();
+    if ((rc = pd_osc_check(c, err)) || (rc = pd_run_opts_check(out, err)))
         return rc;
     if (out->dt == 0.0)
         out->dt = pd_osc_default_dt(c);
@@ -162,15 +112,10 @@ double pd_osc_measure_start(const pd_osc *c, double tend)
 
 /* ---- the scene -------------------------------------------------------- */
 
-typedef struct scene {
-    pd_pulse pulse;
-    int dir;
-} scene;
-
 static void scene_force(double tau, int side, double *F, void *ctx)
 {
-    const scene *sc = ctx;
-    F[0] = pulse_shape(sc->pulse, sc->dir, tau, side);
+    const pd_osc *c = ctx;
+    F[0] = pd_pulse_shape(c->pulse, c->dir, tau, side);
 }
 
 /* Measurements in dimensionless units, updated by the observer. */
@@ -181,7 +126,7 @@ typedef struct tracker {
     double Le, vscale, wp;
     double xmax, xtoward, xaway;
     long impacts, contact_steps;
-    double first_tau, first_v, vimp_max;
+    double first_tau, first_v, vimp_max, Pmax;
     double closing_tau, closing_v; /* last gap closing seen */
     double prev_x, prev_v, prev2_v, prev_P, min_gap;
     pd_osc_sampler sampler;
@@ -229,6 +174,7 @@ static int observe(const pd_state *st, void *ctx)
     }
     if (P > 0.0) {
         tr->contact_steps++;
+        tr->Pmax = fmax(tr->Pmax, P);
         if (tr->prev_P == 0.0) {
             tr->impacts++;
             tr->vimp_max = fmax(tr->vimp_max, tr->closing_v);
@@ -244,46 +190,68 @@ static int observe(const pd_state *st, void *ctx)
     tr->prev_v = v;
     tr->prev_P = P;
     if (tr->sampler) {
-        pd_osc_sample smp = {st->step, st->t / tr->wp, x * tr->Le, v * tr->vscale,
-                             P * tr->vscale, gap * tr->Le};
+        pd_osc_sample smp = {.step = st->step,
+                             .t = st->t / tr->wp,
+                             .u = x * tr->Le,
+                             .v = v * tr->vscale,
+                             .impulse = P * tr->vscale,
+                             .gap = gap * tr->Le};
         return tr->sampler(&smp, tr->sampler_ctx);
     }
     return 0;
 }
 
-int pd_osc_simulate(const pd_osc *c, const pd_osc_opts *opts, pd_osc_sampler sampler,
+int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler,
                     void *ctx, pd_osc_result *res, pd_err *err)
 {
-    pd_osc_opts o;
+    pd_run_opts o;
     int rc;
     pd_err_clear(err);
     if ((rc = pd_osc_resolve_opts(c, opts, &o, err)))
         return rc;
 
     /* model in Pi units; the step is 2 pi (dt / Tp) so equal dt/Tp gives equal h */
-    scene sc = {c->pulse, c->dir};
     double pulse_end = PD_TWO_PI; /* the only breakpoint of a pulse */
     double M = 1.0, C = 2.0 * c->xi * c->Pi2, K = c->Pi2 * c->Pi2, W = -1.0;
     double g0 = c->Pi3, e = c->eps;
-    pd_model model = {1, o.no_wall ? 0 : 1, pd_matrix_dense(1, 1, &M), pd_matrix_dense(1, 1, &C),
-                      pd_matrix_dense(1, 1, &K), pd_matrix_dense(1, 1, &W), &g0, &e,
-                      scene_force, &sc, &pulse_end, c->pulse == PD_PULSE_HARMONIC ? 0 : 1};
+    pd_model model = {.n = 1,
+                      .m = o.no_wall ? 0 : 1,
+                      .M = pd_matrix_dense(1, 1, &M),
+                      .C = pd_matrix_dense(1, 1, &C),
+                      .K = pd_matrix_dense(1, 1, &K),
+                      .W = pd_matrix_dense(1, 1, &W),
+                      .g0 = &g0,
+                      .e = &e,
+                      .force = scene_force,
+                      .force_ctx = (void *)c,
+                      .breaks = &pulse_end,
+                      .nbreaks = c->pulse == PD_PULSE_HARMONIC ? 0 : 1};
     pd_mj_opts mo = pd_mj_default_opts();
     mo.h = PD_TWO_PI * (o.dt / c->Tp);
     mo.theta = o.theta;
     mo.gamma = o.gamma;
     mo.allow_unstable = o.allow_unstable;
     mo.kernel = o.kernel;
+    mo.factor = o.factor;
+    mo.lcp_solver = o.lcp_solver;
     long nsteps = pd_steps_for(o.tend, o.dt);
 
     double cpu0 = pd_cpu_seconds();
     pd_mj *mj = pd_mj_alloc(&model, &mo, err);
     if (!mj)
         return err ? err->status : PD_EINVAL;
-    double wp = pd_osc_wp(c);
-    tracker tr = {c, mo.h, wp * pd_osc_measure_start(c, o.tend), pd_osc_Le(c),
-                  pd_osc_Le(c) * wp, wp, 0.0, 0.0, 0.0, 0, 0, NAN, NAN, 0.0, 0.0, 0.0,
-                  0.0, 0.0, 0.0, 0.0, c->Pi3, sampler, ctx};
+    double wp = pd_osc_wp(c), Le = pd_osc_Le(c);
+    tracker tr = {.c = c,
+                  .h = mo.h,
+                  .tau_measure = wp * pd_osc_measure_start(c, o.tend),
+                  .Le = Le,
+                  .vscale = Le * wp,
+                  .wp = wp,
+                  .first_tau = NAN,
+                  .first_v = NAN,
+                  .min_gap = c->Pi3,
+                  .sampler = sampler,
+                  .sampler_ctx = ctx};
     rc = pd_mj_run(mj, nsteps, observe, &tr, err);
     const pd_state *st = pd_mj_state(mj);
 
@@ -296,13 +264,14 @@ int pd_osc_simulate(const pd_osc *c, const pd_osc_opts *opts, pd_osc_sampler sam
     res->first_impact = tr.first_tau / wp;
     res->first_impact_velocity = tr.first_v * tr.vscale;
     res->max_impact_velocity = tr.vimp_max * tr.vscale;
+    res->max_impulse = tr.Pmax * tr.vscale;
     res->contact_time = (double)tr.contact_steps * o.dt;
     res->min_gap = tr.min_gap * tr.Le;
     res->steps = st->step;
     res->dt = o.dt;
     res->tend = o.tend;
-    res->theta = mo.theta == 0.0 ? 0.5 : mo.theta;
-    res->gamma = mo.gamma < 0.0 ? 0.5 : mo.gamma;
+    res->theta = mo.theta;
+    res->gamma = mo.gamma;
     res->kernel = pd_mj_kernel_name(mj);
     pd_mj_free(mj);
     res->cpu_s = pd_cpu_seconds() - cpu0;
@@ -320,16 +289,20 @@ typedef struct ref_bridge {
 static int ref_sample(double tau, double x, double v, int in_contact, void *ctx)
 {
     ref_bridge *b = ctx;
-    pd_osc_sample s = {b->step++, tau / b->wp, x * b->Le, v * b->vscale, 0.0,
-                       (b->Pi3 - x) * b->Le};
+    pd_osc_sample s = {.step = b->step++,
+                       .t = tau / b->wp,
+                       .u = x * b->Le,
+                       .v = v * b->vscale,
+                       .impulse = 0.0,
+                       .gap = (b->Pi3 - x) * b->Le};
     (void)in_contact;
     return b->sampler(&s, b->ctx);
 }
 
-int pd_osc_reference(const pd_osc *c, const pd_osc_opts *opts, pd_osc_sampler sampler, void *ctx,
+int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
                      pd_osc_result *res, pd_err *err)
 {
-    pd_osc_opts o;
+    pd_run_opts o;
     pd_ed_result er;
     int rc;
     pd_err_clear(err);
@@ -337,13 +310,22 @@ int pd_osc_reference(const pd_osc *c, const pd_osc_opts *opts, pd_osc_sampler sa
         return rc;
     /* forcing pieces in Pi units: s sin(tau + phi) on [0, 2 pi], then zero */
     double phi = c->pulse == PD_PULSE_COSINE ? PD_TWO_PI / 4.0 : 0.0;
-    pd_sine_piece pieces[2] = {{0.0, (double)c->dir, 1.0, phi}, {PD_TWO_PI, 0.0, 0.0, 0.0}};
-    pd_ed_sdof prob = {{c->Pi2, c->xi}, !o.no_wall, c->Pi3, c->eps,
-                       c->pulse == PD_PULSE_HARMONIC ? 1 : 2, pieces};
+    pd_sine_piece pieces[2] = {{.t_start = 0.0, .A = (double)c->dir, .w = 1.0, .phi = phi},
+                               {.t_start = PD_TWO_PI, .A = 0.0, .w = 0.0, .phi = 0.0}};
+    pd_ed_sdof prob = {.osc = {.w0 = c->Pi2, .xi = c->xi},
+                       .wall = !o.no_wall,
+                       .delta = c->Pi3,
+                       .e = c->eps,
+                       .npieces = c->pulse == PD_PULSE_HARMONIC ? 1 : 2,
+                       .pieces = pieces};
     double wp = pd_osc_wp(c), Le = pd_osc_Le(c);
-    pd_ed_opts eo = {wp * o.tend, wp * pd_osc_measure_start(c, o.tend),
-                     sampler ? PD_TWO_PI * (o.dt / c->Tp) : 0.0, o.no_accumulation, 0, 0, 1.0, 0};
-    ref_bridge bridge = {wp, Le, Le * wp, c->Pi3, 0, sampler, ctx};
+    pd_ed_opts eo = pd_ed_default_opts();
+    eo.t_end = wp * o.tend;
+    eo.t_measure = wp * pd_osc_measure_start(c, o.tend);
+    eo.h_out = sampler ? PD_TWO_PI * (o.dt / c->Tp) : 0.0;
+    eo.no_accumulation = o.no_accumulation;
+    ref_bridge bridge = {.wp = wp, .Le = Le, .vscale = Le * wp, .Pi3 = c->Pi3, .step = 0,
+                         .sampler = sampler, .ctx = ctx};
     double cpu0 = pd_cpu_seconds();
     rc = pd_ed_sdof_run(&prob, 0.0, 0.0, &eo, sampler ? ref_sample : NULL, &bridge, &er, err);
     memset(res, 0, sizeof *res);
@@ -355,6 +337,7 @@ int pd_osc_reference(const pd_osc *c, const pd_osc_opts *opts, pd_osc_sampler sa
     res->first_impact = er.first_impact / wp;
     res->first_impact_velocity = er.first_impact_velocity * Le * wp;
     res->max_impact_velocity = er.max_impact_velocity * Le * wp;
+    res->max_impulse = (1.0 + c->eps) * res->max_impact_velocity;
     res->contact_time = er.contact_time / wp;
     res->min_gap = o.no_wall ? NAN : 0.0;
     res->steps = er.events;
@@ -369,7 +352,7 @@ int pd_osc_reference(const pd_osc *c, const pd_osc_opts *opts, pd_osc_sampler sa
 
 void pd_osc_free_exact(const pd_osc *c, double t, double *u, double *v)
 {
-    pd_sdof osc = {PD_TWO_PI / pd_osc_T0(c), c->xi};
+    pd_sdof osc = {.w0 = PD_TWO_PI / pd_osc_T0(c), .xi = c->xi};
     double wp = pd_osc_wp(c), A = c->dir * c->ap;
     double phi = c->pulse == PD_PULSE_COSINE ? PD_TWO_PI / 4.0 : 0.0; /* cos = sin(+pi/2) */
     if (c->pulse == PD_PULSE_HARMONIC || t <= c->Tp) {
@@ -401,5 +384,34 @@ int pd_osc_free_first_contact(const pd_osc *c, double tmax, double *t, double *v
     }
     *t = 0.5 * (lo + hi);
     pd_osc_free_exact(c, *t, &u, v);
+    return PD_OK;
+}
+
+int pd_osc_run(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
+               pd_osc_result *res, pd_err *err)
+{
+    switch (opts ? opts->method : PD_METHOD_MOREAU) {
+    case PD_METHOD_EVENT: return pd_osc_reference(c, opts, sampler, ctx, res, err);
+    case PD_METHOD_PENALTY: return pd_osc_penalty(c, opts, sampler, ctx, res, err);
+    default: return pd_osc_simulate(c, opts, sampler, ctx, res, err);
+    }
+}
+
+/* The run, its no-wall twin, Pi1 = umax / Le, gamma and chi. */
+int pd_osc_summarize(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
+                     pd_osc_summary *s, pd_err *err)
+{
+    pd_run_opts twin = opts ? *opts : pd_run_default_opts();
+    int rc;
+    memset(s, 0, sizeof *s);
+    double cpu0 = pd_cpu_seconds();
+    twin.no_wall = 1;
+    if ((rc = pd_osc_run(c, opts, sampler, ctx, &s->r, err)) ||
+        (rc = pd_osc_run(c, &twin, NULL, NULL, &s->free, err)))
+        return rc;
+    s->cpu_s = pd_cpu_seconds() - cpu0;
+    s->Pi1 = s->r.umax / pd_osc_Le(c);
+    s->gamma = s->free.umax > 0.0 ? s->r.umax / s->free.umax : NAN;
+    s->chi = s->free.umax > 0.0 ? pd_osc_gap(c) / s->free.umax : NAN;
     return PD_OK;
 }

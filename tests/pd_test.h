@@ -59,6 +59,12 @@ void pd_test_rm_dir(const char *dir);
 int pd_test_same_file(const char *a, const char *b);
 double pd_test_h5_num(hid_t obj, const char *name); /* NAN when missing */
 
+/* Run options base (NULL: the defaults) for the penalty method with the
+ * contact elements po, whose zero tolerances and NULL stepper take the
+ * defaults (a convenience of the tests). */
+#include "pd_problems.h"
+pd_run_opts pd_test_pen(const pd_run_opts *base, const pd_penalty_setup *po);
+
 /* Suites, one per test file. */
 void suite_lcp(pd_test_ctx *ctx);
 void suite_engine(pd_test_ctx *ctx);

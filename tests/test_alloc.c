@@ -11,7 +11,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "pd_oscillator.h"
+#include "pd_problems.h"
 #include "pd_test.h"
 
 void *__real_malloc(size_t n);
@@ -85,8 +85,7 @@ static int case_moreau_general(void)
 {
     double M[4] = {1, 0, 0, 2}, K[4] = {4, -1, -1, 3}, W[4] = {-1, 0, 1, -1};
     double g0[2] = {0.05, 0.02}, e[2] = {0.7, 0.3};
-    pd_model md = {2, 2, pd_matrix_dense(2, 2, M), {PD_MATRIX_ZERO, 2, 2, NULL},
-                   pd_matrix_dense(2, 2, K), pd_matrix_dense(2, 2, W), g0, e, NULL, NULL, NULL, 0};
+    pd_model md = {.n = 2, .m = 2, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_zero(2, 2), .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_dense(2, 2, W), .g0 = g0, .e = e};
     pd_mj_opts o = pd_mj_default_opts();
     pd_err err;
     double v0[2] = {1.0, -1.0};
@@ -104,7 +103,7 @@ static int case_moreau_general(void)
 static int case_oscillator(void)
 {
     pd_osc c = {PD_PULSE_SINE, 1, 1.0, 1.0, 0.5, 0.05, 0.5, 0.05};
-    pd_osc_opts o = pd_osc_default_opts();
+    pd_run_opts o = pd_run_default_opts();
     pd_osc_result r;
     pd_err err;
     o.dt = 0.01;
@@ -114,11 +113,11 @@ static int case_oscillator(void)
 static int case_penalty(void)
 {
     pd_osc c = {PD_PULSE_SINE, 1, 1.0, 1.0, 0.5, 0.05, 0.5, 0.05};
-    pd_osc_opts o = pd_osc_default_opts();
+    pd_run_opts o = pd_run_default_opts();
     pd_osc_result r;
     pd_err err;
     o.dt = 0.01;
-    return pd_osc_penalty(&c, &o, NULL, NULL, NULL, &r, &err);
+    return pd_osc_penalty(&c, &o, NULL, NULL, &r, &err);
 }
 
 static int case_lcp_read(void)

@@ -80,9 +80,7 @@ static void test_engine_two_mass_impact(pd_test_ctx *ctx)
     const double es[] = {1.0, 0.5, 0.0};
     for (int c = 0; c < 3; c++) {
         double M[4] = {1, 0, 0, 1}, W[2] = {-1, 1}, g0 = 0.01, e = es[c];
-        pd_model md = {2, 1, pd_matrix_dense(2, 2, M), {PD_MATRIX_ZERO, 2, 2, NULL},
-                       {PD_MATRIX_ZERO, 2, 2, NULL}, pd_matrix_dense(2, 1, W), &g0, &e,
-                       NULL, NULL, NULL, 0};
+        pd_model md = {.n = 2, .m = 1, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_zero(2, 2), .K = pd_matrix_zero(2, 2), .W = pd_matrix_dense(2, 1, W), .g0 = &g0, .e = &e};
         pd_mj_opts o = pd_mj_default_opts();
         o.h = 1e-3;
         pd_err err;
@@ -123,8 +121,7 @@ static void test_engine_chain_energy(pd_test_ctx *ctx)
         g0[a] = 0.02;
         e[a] = 1.0;
     }
-    pd_model md = {N, C, pd_matrix_dense(N, N, M), {PD_MATRIX_ZERO, N, N, NULL},
-                   pd_matrix_dense(N, N, K), pd_matrix_dense(N, C, W), g0, e, NULL, NULL, NULL, 0};
+    pd_model md = {.n = N, .m = C, .M = pd_matrix_dense(N, N, M), .C = pd_matrix_zero(N, N), .K = pd_matrix_dense(N, N, K), .W = pd_matrix_dense(N, C, W), .g0 = g0, .e = e};
     double v0[N] = {1.0, -0.5, 0.7};
     for (int pass = 0; pass < 2; pass++) {
         double h = pass ? 5e-4 : 1e-3, vmax = 0;
@@ -187,9 +184,7 @@ static void test_engine_chain_energy(pd_test_ctx *ctx)
 static void test_engine_theta_stability(pd_test_ctx *ctx)
 {
     double M = 1, K = 1, zero = 0;
-    pd_model md = {1, 0, pd_matrix_dense(1, 1, &M), pd_matrix_dense(1, 1, &zero),
-                   pd_matrix_dense(1, 1, &K), {PD_MATRIX_ZERO, 1, 0, NULL}, NULL, NULL, NULL,
-                   NULL, NULL, 0};
+    pd_model md = {.n = 1, .m = 0, .M = pd_matrix_dense(1, 1, &M), .C = pd_matrix_dense(1, 1, &zero), .K = pd_matrix_dense(1, 1, &K), .W = pd_matrix_zero(1, 0)};
     pd_mj_opts o = pd_mj_default_opts();
     pd_err err;
     o.h = 1.0; /* w0 h = 1 */
@@ -229,9 +224,7 @@ static void test_engine_theta_damped_boundary(pd_test_ctx *ctx)
 {
     const double thetas[] = {0.3, 0.4, 0.45}, xi = 0.05, w0 = 1.0;
     double M = 1, K = w0 * w0, C = 2 * xi * w0;
-    pd_model md = {1, 0, pd_matrix_dense(1, 1, &M), pd_matrix_dense(1, 1, &C),
-                   pd_matrix_dense(1, 1, &K), {PD_MATRIX_ZERO, 1, 0, NULL}, NULL, NULL, NULL,
-                   NULL, NULL, 0};
+    pd_model md = {.n = 1, .m = 0, .M = pd_matrix_dense(1, 1, &M), .C = pd_matrix_dense(1, 1, &C), .K = pd_matrix_dense(1, 1, &K), .W = pd_matrix_zero(1, 0)};
     for (int c = 0; c < 3; c++)
         for (int side = 0; side < 2; side++) {
             double boundary = 2 * xi / (1 - 2 * thetas[c]) / w0;
@@ -267,9 +260,7 @@ static void nan_after_one(double t, int side, double *F, void *ctx)
 static void test_engine_failure_is_reported(pd_test_ctx *ctx)
 {
     double M = 1, K = 4;
-    pd_model md = {1, 0, pd_matrix_dense(1, 1, &M), {PD_MATRIX_ZERO, 1, 1, NULL},
-                   pd_matrix_dense(1, 1, &K), {PD_MATRIX_ZERO, 1, 0, NULL}, NULL, NULL,
-                   nan_after_one, NULL, NULL, 0};
+    pd_model md = {.n = 1, .m = 0, .M = pd_matrix_dense(1, 1, &M), .C = pd_matrix_zero(1, 1), .K = pd_matrix_dense(1, 1, &K), .W = pd_matrix_zero(1, 0), .force = nan_after_one};
     pd_mj_opts o = pd_mj_default_opts();
     o.h = 0.1;
     for (int kernel = 0; kernel < 2; kernel++) {
@@ -288,9 +279,7 @@ static void test_engine_failure_is_reported(pd_test_ctx *ctx)
 static void test_engine_model_check(pd_test_ctx *ctx)
 {
     double M = 1, K = 1, W = -1, g = -0.1, e = 0.5, Knan = NAN;
-    pd_model md = {1, 1, pd_matrix_dense(1, 1, &M), {PD_MATRIX_ZERO, 1, 1, NULL},
-                   pd_matrix_dense(1, 1, &K), pd_matrix_dense(1, 1, &W), &g, &e, NULL, NULL,
-                   NULL, 0};
+    pd_model md = {.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, &M), .C = pd_matrix_zero(1, 1), .K = pd_matrix_dense(1, 1, &K), .W = pd_matrix_dense(1, 1, &W), .g0 = &g, .e = &e};
     pd_err err;
     CHECK(ctx, pd_model_check(&md, &err) == PD_EINVAL && strstr(err.msg, "gap"), "%s", err.msg);
     g = 0.1;
@@ -322,9 +311,7 @@ static void test_engine_no_allocation_in_steps(pd_test_ctx *ctx)
 {
     double M[4] = {1, 0, 0, 2}, K[4] = {4, -1, -1, 3}, C[4] = {0.1, 0, 0, 0.1};
     double W[4] = {-1, 0, 1, -1}, g0[2] = {0.05, 0.02}, e[2] = {0.7, 0.3};
-    pd_model md = {2, 2, pd_matrix_dense(2, 2, M), pd_matrix_dense(2, 2, C),
-                   pd_matrix_dense(2, 2, K), pd_matrix_dense(2, 2, W), g0, e, osc_force, NULL,
-                   NULL, 0};
+    pd_model md = {.n = 2, .m = 2, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_dense(2, 2, C), .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_dense(2, 2, W), .g0 = g0, .e = e, .force = osc_force};
     pd_mj_opts o = pd_mj_default_opts();
     o.h = 1e-3;
     pd_err err;

@@ -320,7 +320,8 @@ static void test_lcp_murty_exponential_pivots(pd_test_ctx *ctx)
             return;
         }
         murty_exponential(&c);
-        pd_lcp_opts opts = {.max_pivots = 1 << 14};
+        pd_lcp_opts opts = pd_lcp_default_opts();
+        opts.max_pivots = 1 << 14;
         pd_lcp_info info;
         int st = solve(&c, &opts, &info);
         CHECK(ctx, st == PD_OK, "n = %d: status %d", n, st);
@@ -731,7 +732,8 @@ static void test_lcp_max_pivots(pd_test_ctx *ctx)
         return;
     }
     murty_exponential(&c);
-    pd_lcp_opts opts = {.max_pivots = 100};
+    pd_lcp_opts opts = pd_lcp_default_opts();
+    opts.max_pivots = 100;
     pd_lcp_info info;
     int st = solve(&c, &opts, &info);
     CHECK(ctx, st == PD_EMAXPIVOTS, "status %d, expected PD_EMAXPIVOTS", st);
@@ -770,7 +772,8 @@ static void test_lcp_cover_vector(pd_test_ctx *ctx)
         random_q(&c, &rng);
         for (int i = 0; i < n; i++)
             d[i] = 0.5 + 1.5 * (1.0 + rng_pm1(&rng));
-        pd_lcp_opts opts = {.cover = d};
+        pd_lcp_opts opts = pd_lcp_default_opts();
+        opts.cover = d;
         pd_lcp_info info;
         CHECK(ctx, solve(&c, &opts, &info) == PD_OK, "cover: solved");
         check_verified(ctx, &c, "cover");
@@ -824,9 +827,11 @@ static void test_lcp_invalid_arguments(pd_test_ctx *ctx)
     CHECK(ctx, pd_lcp_lemke(NULL, 1, M, q, NULL, z, w, &info) == PD_EINVAL, "NULL workspace");
     CHECK(ctx, pd_lcp_lemke(work, 1, M, NULL, NULL, z, w, NULL) == PD_EINVAL, "NULL q");
     double bad_cover[2] = {1.0, 0.0};
-    pd_lcp_opts opts = {.cover = bad_cover};
+    pd_lcp_opts opts = pd_lcp_default_opts();
+    opts.cover = bad_cover;
     CHECK(ctx, pd_lcp_lemke(work, 2, M, q, &opts, z, w, &info) == PD_EINVAL, "cover with a 0");
-    opts = (pd_lcp_opts){.tol = 2.0};
+    opts = pd_lcp_default_opts();
+    opts.tol = 2.0;
     CHECK(ctx, pd_lcp_lemke(work, 2, M, q, &opts, z, w, &info) == PD_EINVAL, "tol >= 1");
     double Mnan[4] = {1.0, NAN, 0.0, 1.0}, qinf[2] = {-1.0, -INFINITY};
     CHECK(ctx, pd_lcp_lemke(work, 2, Mnan, q, NULL, z, w, &info) == PD_EINVAL, "NaN in M");

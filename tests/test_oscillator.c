@@ -3,7 +3,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "pd_oscillator.h"
+#include "pd_problems.h"
 #include "pd_test.h"
 
 #define TWO_PI 6.283185307179586476925286766559
@@ -35,7 +35,7 @@ static void test_osc_free_flight_order(pd_test_ctx *ctx)
             pd_osc c = {pulses[p], 1, 2.0, 0.5, 0.7, 0.0, 0.5, 0.05};
             double err[4];
             for (int k = 0; k < 4; k++) {
-                pd_osc_opts o = pd_osc_default_opts();
+                pd_run_opts o = pd_run_default_opts();
                 pd_osc_result r;
                 pd_err e;
                 free_err fe = {&c, 0, 0};
@@ -68,7 +68,7 @@ static void test_osc_self_similarity(pd_test_ctx *ctx)
             long impacts[3];
             for (int k = 0; k < 3; k++) {
                 pd_osc c = {pulses[p], dir, scales[k][0], scales[k][1], 0.7, 0.05, 0.6, 0.05};
-                pd_osc_opts o = pd_osc_default_opts();
+                pd_run_opts o = pd_run_default_opts();
                 pd_osc_result r;
                 pd_err e;
                 o.dt = c.Tp / 4000;
@@ -93,7 +93,7 @@ static void test_osc_penetration_is_order_dt(pd_test_ctx *ctx)
     pd_osc c = {PD_PULSE_COSINE, 1, 1.0, 1.0, 0.5, 0.02, 0.7, 0.05};
     double C = 0, vmax = 0;
     for (int k = 0; k < 4; k++) {
-        pd_osc_opts o = pd_osc_default_opts();
+        pd_run_opts o = pd_run_default_opts();
         pd_osc_result r;
         pd_err e;
         o.dt = c.Tp / (500.0 * (1 << k));
@@ -149,7 +149,7 @@ static int track_rest(const pd_osc_sample *s, void *ctx)
 static void test_osc_persistent_contact(pd_test_ctx *ctx)
 {
     pd_osc c = {PD_PULSE_SINE, 1, 3.0, 0.8, 0.3, 0.05, 0.0, 0.05};
-    pd_osc_opts o = pd_osc_default_opts();
+    pd_run_opts o = pd_run_default_opts();
     pd_osc_result r;
     pd_err e;
     o.dt = c.Tp / 4000;
@@ -197,7 +197,7 @@ static void test_osc_energy_across_impacts(pd_test_ctx *ctx)
     const double eps[] = {0.0, 0.3, 0.7, 1.0};
     for (int k = 0; k < 4; k++) {
         pd_osc c = {PD_PULSE_SINE, 1, 1.0, 1.0, 0.6, 0.02, eps[k], 0.0};
-        pd_osc_opts o = pd_osc_default_opts();
+        pd_run_opts o = pd_run_default_opts();
         pd_osc_result r;
         pd_err e;
         o.dt = c.Tp / 2000;
@@ -226,7 +226,7 @@ static void test_osc_first_impact(pd_test_ctx *ctx)
           "the free response must reach the gap");
     double et[3], ev[3];
     for (int k = 0; k < 3; k++) {
-        pd_osc_opts o = pd_osc_default_opts();
+        pd_run_opts o = pd_run_default_opts();
         pd_osc_result r;
         pd_err e;
         o.dt = c.Tp / (200.0 * (1 << k));
@@ -262,7 +262,7 @@ static void test_osc_scalar_vs_general_kernel(pd_test_ctx *ctx)
     enum { CAP = 8000 };
     static double ua[CAP], ub[CAP];
     pd_osc c = {PD_PULSE_COSINE, -1, 1.0, 1.0, 1.16, 0.02, 0.2, 0.05};
-    pd_osc_opts o = pd_osc_default_opts();
+    pd_run_opts o = pd_run_default_opts();
     pd_osc_result ra, rb;
     pd_err e;
     o.dt = c.Tp / 1000;

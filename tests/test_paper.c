@@ -5,14 +5,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "pd_oscillator.h"
+#include "pd_problems.h"
 #include "pd_test.h"
 
 /* Pi1 of a case by the exact reference (with or without the wall). */
 static double ref_Pi1(pd_pulse pulse, int dir, double Pi2, double Pi3, double eps, int no_wall)
 {
     pd_osc c = {pulse, dir, 1.0, 1.0, Pi2, Pi3, eps, 0.05};
-    pd_osc_opts o = pd_osc_default_opts();
+    pd_run_opts o = pd_run_default_opts();
     pd_osc_result r;
     pd_err e;
     o.no_wall = no_wall;
@@ -50,7 +50,7 @@ static void test_paper_fig3_one_dimensionless_history(pd_test_ctx *ctx)
     /* Pi2 = Tp / T0 = 0.6: Tp = 0.3 s for T0 = 0.5 s, 0.9 s for T0 = 1.5 s */
     pd_osc a = {PD_PULSE_COSINE, 1, 3.0, 0.3, 0.6, 0.2, 0.7, 0.05};
     pd_osc b = {PD_PULSE_COSINE, 1, 5.0, 0.9, 0.6, 0.2, 0.7, 0.05};
-    pd_osc_opts o = pd_osc_default_opts();
+    pd_run_opts o = pd_run_default_opts();
     pd_osc_result ra, rb;
     pd_err e;
     pi_hist ha = {pd_osc_Le(&a), pd_osc_wp(&a), xa, 0, CAP};

@@ -5,7 +5,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "pd_oscillator.h"
+#include "pd_problems.h"
 #include "pd_test.h"
 
 #define TWO_PI 6.283185307179586476925286766559
@@ -66,7 +66,7 @@ static void test_penalty_free_flight_exact(pd_test_ctx *ctx)
     for (int p = 0; p < 3; p++)
         for (int k = 0; k < 2; k++) {
             pd_osc c = {pulses[p], k ? -1 : 1, 2.0, 0.5, k ? 3.0 : 0.3, 0.0, 0.5, 0.05};
-            pd_osc_opts o = pd_osc_default_opts();
+            pd_run_opts o = pd_run_default_opts();
             pd_osc_result r, r2;
             pd_err e;
             o.no_wall = 1;
@@ -74,9 +74,9 @@ static void test_penalty_free_flight_exact(pd_test_ctx *ctx)
             if (pulses[p] == PD_PULSE_HARMONIC)
                 o.tend = 12 * c.Tp;
             free_track ft = {&c, o.dt, 0, 0, 0, 0};
-            CHECK(ctx, pd_osc_penalty(&c, &o, NULL, track_free, &ft, &r, &e) == PD_OK, "%s",
+            CHECK(ctx, pd_osc_penalty(&c, &o, track_free, &ft, &r, &e) == PD_OK, "%s",
                   e.msg);
-            CHECK(ctx, pd_osc_penalty(&c, &o, NULL, NULL, NULL, &r2, &e) == PD_OK, "%s", e.msg);
+            CHECK(ctx, pd_osc_penalty(&c, &o, NULL, NULL, &r2, &e) == PD_OK, "%s", e.msg);
             const char *name = pd_pulse_name(pulses[p]);
             CHECK(ctx, ft.worst <= 1e-8 * ft.umax, "%s Pi2 %g: history error %.3g (umax %.3g)",
                   name, c.Pi2, ft.worst, ft.umax);
@@ -144,15 +144,13 @@ static void test_penalty_breakpoint_not_crossed(pd_test_ctx *ctx)
 {
     double M = 1.0, C = 2 * 0.02 * 0.7, K = 0.7 * 0.7, brk = TWO_PI;
     cos_scene cs = {0, 0, 0, 0};
-    pd_model md = {1, 0, pd_matrix_dense(1, 1, &M), pd_matrix_dense(1, 1, &C),
-                   pd_matrix_dense(1, 1, &K), pd_matrix_dense(1, 0, NULL), NULL, NULL,
-                   cos_force, &cs, &brk, 1};
+    pd_model md = {.n = 1, .m = 0, .M = pd_matrix_dense(1, 1, &M), .C = pd_matrix_dense(1, 1, &C), .K = pd_matrix_dense(1, 1, &K), .W = pd_matrix_dense(1, 0, NULL), .force = cos_force, .force_ctx = &cs, .breaks = &brk, .nbreaks = 1};
     pd_sdof osc = {0.7, 0.02};
     hit_track ht = {0, 0, &osc};
     pd_penalty_opts o;
     pd_penalty_result res;
     pd_err e;
-    memset(&o, 0, sizeof o);
+    o = pd_penalty_default_opts();
     o.kc = 1.0;
     CHECK(ctx, pd_penalty_run(&md, 0.0, NULL, NULL, 5 * TWO_PI, &o, track_break, &ht, &res, &e) ==
                    PD_OK,
@@ -174,10 +172,10 @@ static void test_penalty_first_impact_exact(pd_test_ctx *ctx)
     CHECK(ctx, pd_osc_free_first_contact(&c, 2 * c.Tp, &t_star, &v_star) == PD_OK,
           "the free response must reach the gap");
     for (int law = 0; law < 2; law++) {
-        pd_osc_penalty_opts po = {(pd_penalty_law)law, 1e4, 0, 0, 0, NULL};
+        pd_penalty_setup po = {.law = (pd_penalty_law)law, .kc_mult = 1e4, .kc_abs = 0, .rtol = 0, .atol = 0, .stepper = NULL};
         pd_osc_result r;
         pd_err e;
-        CHECK(ctx, pd_osc_penalty(&c, NULL, &po, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg);
+        CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg);
         CHECK(ctx, fabs(r.first_impact - t_star) <= 1e-9 * c.Tp,
               "law %d: first impact %.15g s vs exact %.15g s", law, r.first_impact, t_star);
         CHECK(ctx, fabs(r.first_impact_velocity - v_star) <= 1e-8 * v_star,
@@ -215,11 +213,9 @@ static int free_mass_impact(pd_penalty_law law, double e, double kc, episode *ep
                             pd_penalty_result *res, pd_err *err)
 {
     double M = 1.0, Z = 0.0, W = -1.0, g0 = 0.01, v0 = 1.0;
-    pd_model md = {1, 1, pd_matrix_dense(1, 1, &M), pd_matrix_dense(1, 1, &Z),
-                   pd_matrix_dense(1, 1, &Z), pd_matrix_dense(1, 1, &W), &g0, &e,
-                   NULL, NULL, NULL, 0};
+    pd_model md = {.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, &M), .C = pd_matrix_dense(1, 1, &Z), .K = pd_matrix_dense(1, 1, &Z), .W = pd_matrix_dense(1, 1, &W), .g0 = &g0, .e = &e};
     pd_penalty_opts o;
-    memset(&o, 0, sizeof o);
+    o = pd_penalty_default_opts();
     memset(ep, 0, sizeof *ep);
     o.law = law;
     o.kc = kc;
@@ -291,7 +287,7 @@ static void test_penalty_hertz_restitution(pd_test_ctx *ctx)
 static void test_penalty_converges_as_kc_grows(pd_test_ctx *ctx)
 {
     pd_osc c = {PD_PULSE_SINE, 1, 1.0, 1.0, 0.5, 0.05, 0.6, 0.05};
-    pd_osc_opts o = pd_osc_default_opts();
+    pd_run_opts o = pd_run_default_opts();
     pd_osc_result ref;
     pd_err e;
     o.dt = c.Tp / 1e5;
@@ -300,9 +296,9 @@ static void test_penalty_converges_as_kc_grows(pd_test_ctx *ctx)
         double err[3];
         long steps[3], impacts[3];
         for (int k = 0; k < 3; k++) {
-            pd_osc_penalty_opts po = {(pd_penalty_law)law, pow(10.0, 2 + 2 * k), 0, 0, 0, NULL};
+            pd_penalty_setup po = {.law = (pd_penalty_law)law, .kc_mult = pow(10.0, 2 + 2 * k), .kc_abs = 0, .rtol = 0, .atol = 0, .stepper = NULL};
             pd_osc_result r;
-            CHECK(ctx, pd_osc_penalty(&c, NULL, &po, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg);
+            CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg);
             err[k] = fabs(r.umax - ref.umax) / ref.umax;
             steps[k] = r.steps;
             impacts[k] = r.impacts;
@@ -334,12 +330,12 @@ static void test_penalty_stiffness_cost(pd_test_ctx *ctx)
     double umax[2][2];
     for (int s = 0; s < 2; s++)
         for (int k = 0; k < 2; k++) {
-            pd_osc_opts o = pd_osc_default_opts();
-            pd_osc_penalty_opts po = {PD_PENALTY_KELVIN, k ? 1e7 : 1e4, 0, 0, 0, names[s]};
+            pd_run_opts o = pd_run_default_opts();
+            pd_penalty_setup po = {.law = PD_PENALTY_KELVIN, .kc_mult = k ? 1e7 : 1e4, .kc_abs = 0, .rtol = 0, .atol = 0, .stepper = names[s]};
             pd_osc_result r;
             pd_err e;
             o.tend = 4 * c.Tp;
-            CHECK(ctx, pd_osc_penalty(&c, &o, &po, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg);
+            CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(&o, &po)}, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg);
             CHECK(ctx, r.contact_time > 0.25 * o.tend, "%s: in contact %.3g of %.3g s", names[s],
                   r.contact_time, o.tend);
             steps[s][k] = r.steps;
@@ -368,12 +364,12 @@ static void test_penalty_penetration_scaling(pd_test_ctx *ctx)
     for (int law = 0; law < 2; law++) {
         double pen[2], pen_free[2];
         for (int k = 0; k < 2; k++) {
-            pd_osc_penalty_opts po = {(pd_penalty_law)law, k ? 1e6 : 1e4, 0, 0, 0, NULL};
+            pd_penalty_setup po = {.law = (pd_penalty_law)law, .kc_mult = k ? 1e6 : 1e4, .kc_abs = 0, .rtol = 0, .atol = 0, .stepper = NULL};
             pd_osc_result r;
             pd_penalty_result res;
             episode ep;
             pd_err e;
-            CHECK(ctx, pd_osc_penalty(&c, NULL, &po, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg);
+            CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg);
             pen[k] = -r.min_gap;
             CHECK(ctx, free_mass_impact((pd_penalty_law)law, 0.6, k ? 1e6 : 1e4, &ep, &res, &e) ==
                            PD_OK,
@@ -401,13 +397,13 @@ static void test_penalty_self_similar_and_kc_abs(pd_test_ctx *ctx)
         for (int k = 0; k < 3; k++) {
             pd_osc c = {PD_PULSE_COSINE, -1, scales[k][0], scales[k][1], 0.7, 0.05, 0.6, 0.05};
             double w0 = TWO_PI / pd_osc_T0(&c);
-            pd_osc_penalty_opts po = {(pd_penalty_law)law, 1e4, 0, 0, 0, NULL};
+            pd_penalty_setup po = {.law = (pd_penalty_law)law, .kc_mult = 1e4, .kc_abs = 0, .rtol = 0, .atol = 0, .stepper = NULL};
             pd_osc_result r;
             pd_err e;
-            CHECK(ctx, pd_osc_penalty(&c, NULL, &po, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg);
+            CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg);
             Pi1[k] = r.umax / pd_osc_Le(&c);
             po.kc_abs = law ? 1e4 * w0 * w0 / sqrt(pd_osc_Le(&c)) : 1e4 * w0 * w0;
-            CHECK(ctx, pd_osc_penalty(&c, NULL, &po, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg);
+            CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg);
             Pi1_abs[k] = r.umax / pd_osc_Le(&c);
             CHECK(ctx, r.impacts > 0, "impacts %ld", r.impacts);
         }
@@ -430,11 +426,10 @@ static void test_penalty_steppers_agree(pd_test_ctx *ctx)
         double umax0 = 0;
         long impacts0 = 0;
         for (int s = 0; s < 4; s++) {
-            pd_osc_penalty_opts po = {(pd_penalty_law)law, 1e4, 0, s >= 2 ? 1e-8 : 0,
-                                      s >= 2 ? 1e-10 : 0, names[s]};
+            pd_penalty_setup po = {.law = (pd_penalty_law)law, .kc_mult = 1e4, .kc_abs = 0, .rtol = s >= 2 ? 1e-8 : 0, .atol = s >= 2 ? 1e-10 : 0, .stepper = names[s]};
             pd_osc_result r;
             pd_err e;
-            CHECK(ctx, pd_osc_penalty(&c, NULL, &po, NULL, NULL, &r, &e) == PD_OK, "%s: %s",
+            CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) == PD_OK, "%s: %s",
                   names[s], e.msg);
             CHECK(ctx, !strcmp(r.kernel, names[s]), "kernel %s for %s", r.kernel, names[s]);
             if (s == 0) {
@@ -514,14 +509,12 @@ static void test_penalty_two_mass_chain(pd_test_ctx *ctx)
     double Z[4] = {0, 0, 0, 0}, W[4] = {1, 0, 0, -1}, g0[2] = {0.1, 0.1}, v0[2] = {-1.0, 0.7};
     for (int law = 0; law < 2; law++) {
         double e1[2] = {1.0, 1.0};
-        pd_model md = {2, 2, pd_matrix_dense(2, 2, M), pd_matrix_dense(2, 2, Z),
-                       pd_matrix_dense(2, 2, K), pd_matrix_dense(2, 2, W), g0, e1,
-                       NULL, NULL, NULL, 0};
+        pd_model md = {.n = 2, .m = 2, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_dense(2, 2, Z), .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_dense(2, 2, W), .g0 = g0, .e = e1};
         chain_track ct = {&md, (pd_penalty_law)law, 1e5, 0, 0, 0, 0, 0.01, 0};
         pd_penalty_opts o;
         pd_penalty_result res;
         pd_err e;
-        memset(&o, 0, sizeof o);
+        o = pd_penalty_default_opts();
         o.law = (pd_penalty_law)law;
         o.kc = ct.kc;
         o.h_out = ct.h_out;
@@ -543,18 +536,16 @@ static void test_penalty_two_mass_chain(pd_test_ctx *ctx)
     long sw[3];
     for (int s = 0; s < 3; s++) {
         double e5[2] = {0.5, 0.5};
-        pd_model md = {2, 2, pd_matrix_dense(2, 2, M), pd_matrix_dense(2, 2, C),
-                       pd_matrix_dense(2, 2, K), pd_matrix_dense(2, 2, W), g0, e5,
-                       NULL, NULL, NULL, 0};
+        pd_model md = {.n = 2, .m = 2, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_dense(2, 2, C), .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_dense(2, 2, W), .g0 = g0, .e = e5};
         pd_penalty_opts o;
         pd_penalty_result res;
         pd_err e;
-        memset(&o, 0, sizeof o);
+        o = pd_penalty_default_opts();
         o.law = PD_PENALTY_HERTZDAMP;
         o.kc = 1e4;
         o.stepper = names[s];
-        o.rtol = s ? 1e-9 : 0;
-        o.atol = s ? 1e-11 : 0;
+        o.rtol = s ? 1e-9 : 1e-10;
+        o.atol = s ? 1e-11 : 1e-12;
         CHECK(ctx, pd_penalty_run(&md, 0.0, NULL, v0, 8.0, &o, record_end, q_end[s], &res, &e) ==
                        PD_OK,
               "%s: %s", names[s], e.msg);
@@ -577,32 +568,30 @@ static void test_penalty_two_mass_chain(pd_test_ctx *ctx)
 static void test_penalty_bad_options(pd_test_ctx *ctx)
 {
     double M = 1.0, Z = 0.0, W = -1.0, g0 = 0.1, eps = 0.5;
-    pd_model md = {1, 1, pd_matrix_dense(1, 1, &M), pd_matrix_dense(1, 1, &Z),
-                   pd_matrix_dense(1, 1, &Z), pd_matrix_dense(1, 1, &W), &g0, &eps,
-                   NULL, NULL, NULL, 0};
+    pd_model md = {.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, &M), .C = pd_matrix_dense(1, 1, &Z), .K = pd_matrix_dense(1, 1, &Z), .W = pd_matrix_dense(1, 1, &W), .g0 = &g0, .e = &eps};
     const double bad_kc[] = {0.0, -1.0, NAN, INFINITY};
     pd_penalty_opts o;
     pd_penalty_result res;
     pd_err e;
     for (int k = 0; k < 4; k++) {
-        memset(&o, 0, sizeof o);
+        o = pd_penalty_default_opts();
         o.kc = bad_kc[k];
         CHECK(ctx, pd_penalty_run(&md, 0, NULL, NULL, 1, &o, NULL, NULL, &res, &e) == PD_EINVAL &&
                        strstr(e.msg, "kc"),
               "kc = %g: %s", bad_kc[k], e.msg);
     }
-    memset(&o, 0, sizeof o);
+    o = pd_penalty_default_opts();
     o.kc = 1.0;
     o.stepper = "rk99";
     CHECK(ctx, pd_penalty_run(&md, 0, NULL, NULL, 1, &o, NULL, NULL, &res, &e) == PD_EINVAL &&
                    strstr(e.msg, "stepper") && strstr(e.msg, "rk99"),
           "%s", e.msg);
-    o.stepper = NULL;
+    o.stepper = "rk8pd";
     o.rtol = -1e-6;
     CHECK(ctx, pd_penalty_run(&md, 0, NULL, NULL, 1, &o, NULL, NULL, &res, &e) == PD_EINVAL &&
                    strstr(e.msg, "rtol"),
           "%s", e.msg);
-    o.rtol = 0;
+    o.rtol = 1e-10;
     CHECK(ctx, pd_penalty_run(&md, 1, NULL, NULL, 0, &o, NULL, NULL, &res, &e) == PD_EINVAL &&
                    strstr(e.msg, "t0"),
           "%s", e.msg);
@@ -613,28 +602,28 @@ static void test_penalty_bad_options(pd_test_ctx *ctx)
 
     pd_osc c = {PD_PULSE_SINE, 1, 1.0, 1.0, 0.5, 0.05, 0.6, 0.05};
     pd_osc_result r;
-    pd_osc_penalty_opts po = {PD_PENALTY_KELVIN, -1.0, 0, 0, 0, NULL};
-    CHECK(ctx, pd_osc_penalty(&c, NULL, &po, NULL, NULL, &r, &e) == PD_EINVAL &&
+    pd_penalty_setup po = {.law = PD_PENALTY_KELVIN, .kc_mult = -1.0, .kc_abs = 0, .rtol = 0, .atol = 0, .stepper = NULL};
+    CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) == PD_EINVAL &&
                    strstr(e.msg, "kc"),
           "%s", e.msg);
     po.kc_mult = 1e4;
     po.kc_abs = -5;
-    CHECK(ctx, pd_osc_penalty(&c, NULL, &po, NULL, NULL, &r, &e) == PD_EINVAL &&
-                   strstr(e.msg, "kc_abs"),
+    CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) == PD_EINVAL &&
+                   strstr(e.msg, "kc-abs"),
           "%s", e.msg);
     po.kc_abs = 0;
     po.stepper = "euler";
-    CHECK(ctx, pd_osc_penalty(&c, NULL, &po, NULL, NULL, &r, &e) == PD_EINVAL &&
+    CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) == PD_EINVAL &&
                    strstr(e.msg, "stepper"),
           "%s", e.msg);
     po.stepper = NULL;
-    pd_osc_opts oo = pd_osc_default_opts();
+    pd_run_opts oo = pd_run_default_opts();
     oo.dt = -1;
-    CHECK(ctx, pd_osc_penalty(&c, &oo, &po, NULL, NULL, &r, &e) == PD_EINVAL &&
+    CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(&oo, &po)}, NULL, NULL, &r, &e) == PD_EINVAL &&
                    strstr(e.msg, "dt"),
           "%s", e.msg);
     c.eps = 2;
-    CHECK(ctx, pd_osc_penalty(&c, NULL, &po, NULL, NULL, &r, &e) == PD_EINVAL &&
+    CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) == PD_EINVAL &&
                    strstr(e.msg, "eps"),
           "%s", e.msg);
 }

@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "pd_oscillator.h"
+#include "pd_problems.h"
 #include "pd_test.h"
 
 #define TWO_PI 6.283185307179586476925286766559
@@ -32,7 +32,7 @@ static void test_ref_no_wall_is_closed_form(pd_test_ctx *ctx)
     const pd_pulse pulses[] = {PD_PULSE_SINE, PD_PULSE_COSINE, PD_PULSE_HARMONIC};
     for (int p = 0; p < 3; p++) {
         pd_osc c = {pulses[p], -1, 3.0, 0.7, 0.8, 0.0, 0.5, 0.05};
-        pd_osc_opts o = pd_osc_default_opts();
+        pd_run_opts o = pd_run_default_opts();
         pd_osc_result r;
         pd_err e;
         grid_max g = {&c, 0, 0};
@@ -62,7 +62,7 @@ static void test_ref_bouncing_ball_accumulation(pd_test_ctx *ctx)
         pd_ed_sdof prob = {{0.0, 0.0}, 1, delta, e, 1, &piece};
         double t1 = sqrt(2 * delta / a), v1 = a * t1, t_inf = t1 + 2 * e * v1 / (a * (1 - e));
         pd_ed_opts o;
-        memset(&o, 0, sizeof o);
+        o = pd_ed_default_opts();
         o.t_end = 2 * t_inf + 1.0;
         o.max_burst = 5000;
         pd_ed_result r;
@@ -92,7 +92,7 @@ static void test_ref_accumulation_off_stalls(pd_test_ctx *ctx)
     pd_ed_sdof prob = {{0.0, 0.0}, 1, delta, e, 1, &piece};
     double t1 = sqrt(2 * delta / a), t_inf = t1 + 2 * e * a * t1 / (a * (1 - e));
     pd_ed_opts o;
-    memset(&o, 0, sizeof o);
+    o = pd_ed_default_opts();
     o.t_end = 2 * t_inf;
     o.max_burst = 500;
     o.no_accumulation = 1;
@@ -129,7 +129,7 @@ static void test_ref_impact_closed_form(pd_test_ctx *ctx)
     pd_sine_piece piece = {0.0, 0.0, 0.0, 0.0};
     pd_ed_sdof prob = {{w0, 0.0}, 1, delta, 1.0, 1, &piece};
     pd_ed_opts o;
-    memset(&o, 0, sizeof o);
+    o = pd_ed_default_opts();
     o.t_end = 50.0;
     o.h_out = 1e-3;
     energy_obs eo = {w0, 0.5 * V * V, 0};
@@ -180,7 +180,7 @@ static void test_ref_energy_balance(pd_test_ctx *ctx)
     const double es[] = {1.0, 0.6};
     for (int k = 0; k < 2; k++) {
         pd_osc c = {PD_PULSE_SINE, 1, 2.0, 0.5, 0.8, 0.2, es[k], 0.05};
-        pd_osc_opts o = pd_osc_default_opts();
+        pd_run_opts o = pd_run_default_opts();
         pd_osc_result r;
         pd_err e;
         double w0 = TWO_PI / pd_osc_T0(&c);
@@ -227,7 +227,7 @@ static void test_ref_self_consistent_on_grid(pd_test_ctx *ctx)
                         pd_sine_piece pc[2] = {{0, (double)dir, 1, phi}, {TWO_PI, 0, 0, 0}};
                         pd_ed_sdof prob = {{Pi2s[i], 0.05}, 1, Pi3s[j], epss[k], 2, pc};
                         pd_ed_opts o;
-                        memset(&o, 0, sizeof o);
+                        o = pd_ed_default_opts();
                         o.t_end = TWO_PI * pd_osc_default_tend(&c) / c.Tp;
                         o.scan_divisions = 512;
                         if (pd_ed_sdof_run(&prob, 0, 0, &o, NULL, NULL, &fine, &e)) {
@@ -266,7 +266,7 @@ static void test_ref_moreau_order_one(pd_test_ctx *ctx)
     for (int c = 0; c < 2; c++) {
         double err[4];
         for (int k = 0; k < 4; k++) {
-            pd_osc_opts o = pd_osc_default_opts();
+            pd_run_opts o = pd_run_default_opts();
             pd_osc_result rm, rr;
             pd_err e;
             o.dt = cases[c].Tp / (2000.0 * (1 << k));
@@ -306,8 +306,8 @@ static void test_ref_stiff_penalty_limit(pd_test_ctx *ctx)
         CHECK(ctx, pd_osc_reference(&cases[c], NULL, NULL, NULL, &rr, &e) == PD_OK, "%s", e.msg);
         double err[3];
         for (int k = 0; k < 3; k++) {
-            pd_osc_penalty_opts po = {PD_PENALTY_KELVIN, pow(100.0, k + 2), 0, 0, 0, NULL};
-            CHECK(ctx, pd_osc_penalty(&cases[c], NULL, &po, NULL, NULL, &rp, &e) == PD_OK, "%s",
+            pd_penalty_setup po = {.law = PD_PENALTY_KELVIN, .kc_mult = pow(100.0, k + 2), .kc_abs = 0, .rtol = 0, .atol = 0, .stepper = NULL};
+            CHECK(ctx, pd_osc_penalty(&cases[c], (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &rp, &e) == PD_OK, "%s",
                   e.msg);
             err[k] = fabs(rp.umax - rr.umax) / rr.umax;
         }

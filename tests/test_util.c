@@ -180,3 +180,15 @@ double pd_test_h5_num(hid_t obj, const char *name)
     return x;
 }
 
+
+pd_run_opts pd_test_pen(const pd_run_opts *base, const pd_penalty_setup *po)
+{
+    pd_run_opts o = base ? *base : pd_run_default_opts();
+    pd_run_opts d = pd_run_default_opts();
+    o.method = PD_METHOD_PENALTY;
+    o.pen = *po;
+    o.pen.rtol = po->rtol != 0.0 ? po->rtol : d.pen.rtol;
+    o.pen.atol = po->atol != 0.0 ? po->atol : d.pen.atol;
+    o.pen.stepper = po->stepper ? po->stepper : d.pen.stepper;
+    return o;
+}

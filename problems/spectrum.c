@@ -1,24 +1,25 @@
-/* spectrum_sweep.c — a spectrum sweep as a list of tasks: the Pi2 grid,
- * where each task sits, its case (finished exactly as `pound simulate`
- * finishes one), its cost, the canonical key, and the output rows. */
+/* spectrum.c — a spectrum sweep as a list of tasks: the Pi2 grid, where
+ * each task sits, its case (resolved exactly as `pound simulate` resolves
+ * one), a task's run, its cost, the canonical key, and the output rows. */
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "pd_spectrum.h"
+#include "pd_problems.h"
 
 void pd_spec_init(pd_spectrum *s)
 {
     memset(s, 0, sizeof *s);
-    pd_cli_case_init(&s->base);
+    s->base = pd_osc_default();
+    s->opts = pd_run_default_opts();
     s->npulse = s->ndir = s->nap = s->nxi = s->nsize = s->neps = 1;
     s->pulse[0] = PD_PULSE_SINE;
     s->dir[0] = 1;
-    s->ap[0] = s->base.c.ap;
-    s->xi[0] = s->base.c.xi;
-    s->size[0] = s->base.c.Pi3;
-    s->eps[0] = s->base.c.eps;
+    s->ap[0] = s->base.ap;
+    s->xi[0] = s->base.xi;
+    s->size[0] = s->base.Pi3;
+    s->eps[0] = s->base.eps;
 }
 
 long pd_spec_curves(const pd_spectrum *s)
@@ -85,49 +86,82 @@ long pd_spec_twin_of(const pd_spectrum *s, long task)
     return group * s->npi2 + p % s->npi2;
 }
 
-int pd_spec_case(const pd_spectrum *s, long task, pd_cli_case *k)
+int pd_spec_case(const pd_spectrum *s, long task, pd_osc *c, pd_run_opts *o, pd_err *err)
 {
     pd_spec_coords co;
     pd_spec_coords_of(s, task, &co);
-    *k = s->base;
-    k->c.pulse = s->pulse[co.pulse];
-    k->c.dir = s->dir[co.dir];
-    k->c.ap = s->ap[co.ap];
-    k->c.xi = s->xi[co.xi];
-    k->c.eps = s->eps[co.eps];
-    k->c.Pi2 = pd_spec_pi2(s, co.j);
-    k->have_Pi2 = 1;
-    k->have_T0 = 0;
-    k->have_gap = s->size_is_gap;
-    k->have_Pi3 = !s->size_is_gap;
+    *c = s->base;
+    *o = s->opts;
+    c->pulse = s->pulse[co.pulse];
+    c->dir = s->dir[co.dir];
+    c->ap = s->ap[co.ap];
+    c->xi = s->xi[co.xi];
+    c->eps = s->eps[co.eps];
+    c->Pi2 = pd_spec_pi2(s, co.j);
     if (s->size_is_gap)
-        k->gap = s->size[co.size];
+        pd_osc_set_gap(c, s->size[co.size]);
     else
-        k->c.Pi3 = s->size[co.size];
-    if (s->dt_per_Tp > 0.0) {
-        k->opts.dt = k->c.Tp / s->dt_per_Tp;
-        k->have_dt = 1;
-    }
-    k->opts.no_wall = co.twin;
-    return pd_cli_case_finish(k);
+        c->Pi3 = s->size[co.size];
+    if (s->dt_per_Tp > 0.0)
+        o->dt = c->Tp / s->dt_per_Tp;
+    o->no_wall = co.twin;
+    int rc = pd_osc_resolve_opts(c, o, o, err);
+    if (!rc && o->tend / o->dt > 2e9)
+        rc = pd_err_set(err, PD_EINVAL, "dt: %g s over %g s is more than 2e9 steps", o->dt,
+                        o->tend);
+    return rc;
 }
 
-int pd_spec_validate(const pd_spectrum *s)
+int pd_spec_validate(const pd_spectrum *s, pd_err *err)
 {
-    pd_cli_case k;
+    pd_osc c;
+    pd_run_opts o;
     long ntw = pd_spec_twins(s), n = pd_spec_tasks(s);
     for (long t = ntw; t < n; t++)
-        if (pd_spec_case(s, t, &k))
-            return 2;
-    return 0;
+        if (pd_spec_case(s, t, &c, &o, err))
+            return PD_EINVAL;
+    return PD_OK;
 }
 
 double pd_spec_cost(const pd_spectrum *s, long task)
 {
-    pd_cli_case k;
-    if (pd_spec_case(s, task, &k))
+    pd_osc c;
+    pd_run_opts o;
+    if (pd_spec_case(s, task, &c, &o, NULL))
         return 1.0;
-    return (double)pd_steps_for(k.opts.tend, k.opts.dt);
+    return (double)pd_steps_for(o.tend, o.dt);
+}
+
+/* One task: its case, the chosen method, the figures kept; a failure's
+ * message names the point. */
+void pd_spec_run_task(const pd_spectrum *s, long t, pd_spec_result *r, pd_err *err)
+{
+    pd_osc c;
+    pd_run_opts o;
+    pd_osc_result res;
+    memset(r, 0, sizeof *r);
+    pd_err_clear(err);
+    if (pd_spec_case(s, t, &c, &o, err)) {
+        r->status = PD_EINVAL;
+        return;
+    }
+    if ((r->status = pd_osc_run(&c, &o, NULL, NULL, &res, err))) {
+        char m[sizeof err->msg];
+        snprintf(m, sizeof m, "%s", err->msg);
+        pd_err_set(err, r->status, "%s %s pulse, Pi2 = %.6g, Pi3 = %.6g, eps = %g%s: %s",
+                   pd_dir_name(c.dir), pd_pulse_name(c.pulse), c.Pi2, c.Pi3, c.eps,
+                   o.no_wall ? " (no wall)" : "", m);
+        return;
+    }
+    r->umax = res.umax;
+    r->u_toward = res.u_toward;
+    r->u_away = res.u_away;
+    r->contact_time = res.contact_time;
+    r->first_impact = res.first_impact;
+    r->cpu_s = res.cpu_s;
+    r->impacts = res.impacts;
+    r->steps = res.steps;
+    r->done = 1;
 }
 
 /* ---- the canonical key -------------------------------------------------- */
@@ -179,31 +213,30 @@ static void tb_list(textbuf *b, const char *name, const double *x, int n)
 
 char *pd_spec_key(const pd_spectrum *s)
 {
-    const pd_cli_case *k = &s->base;
+    const pd_run_opts *o = &s->opts;
     textbuf b = {malloc(256), 0, 256, 0};
     if (!b.p)
         return NULL;
     b.p[0] = '\0';
-    tb_add(&b, "v=1 method=%s pulse=", pd_method_name(k->method));
+    tb_add(&b, "v=1 method=%s pulse=", pd_method_name(o->method));
     for (int i = 0; i < s->npulse; i++)
         tb_add(&b, "%s%s", i ? "," : "", pd_pulse_name(s->pulse[i]));
     tb_add(&b, " dir=");
     for (int i = 0; i < s->ndir; i++)
         tb_add(&b, "%s%s", i ? "," : "", pd_dir_name(s->dir[i]));
     tb_list(&b, "ap", s->ap, s->nap);
-    tb_add(&b, " Tp=%a", k->c.Tp);
+    tb_add(&b, " Tp=%a", s->base.Tp);
     tb_list(&b, "xi", s->xi, s->nxi);
     tb_list(&b, s->size_is_gap ? "gap" : "Pi3", s->size, s->nsize);
     tb_list(&b, "eps", s->eps, s->neps);
     tb_add(&b, " Pi2=%a:%a:%d spacing=%s", s->pi2_min, s->pi2_max, s->npi2,
            s->linear ? "linear" : "log");
-    tb_add(&b, " dt=%a dt_per_Tp=%a theta=%a gamma=%a tend=%a", k->have_dt ? k->opts.dt : 0.0,
-           s->dt_per_Tp, k->opts.theta, k->opts.gamma, k->have_tend ? k->opts.tend : 0.0);
-    tb_add(&b, " unstable=%d accumulation=%d kernel=%d", k->opts.allow_unstable,
-           !k->opts.no_accumulation, (int)k->opts.kernel);
-    tb_add(&b, " contact=%d kc=%a kc_abs=%a rtol=%a atol=%a stepper=%s", (int)k->pen.law,
-           k->pen.kc_mult, k->pen.kc_abs, k->pen.rtol, k->pen.atol,
-           k->pen.stepper ? k->pen.stepper : "default");
+    tb_add(&b, " dt=%a dt_per_Tp=%a theta=%a gamma=%a tend=%a", o->dt, s->dt_per_Tp, o->theta,
+           o->gamma, o->tend);
+    tb_add(&b, " unstable=%d accumulation=%d kernel=%d factor=%d lcp=%d", o->allow_unstable,
+           !o->no_accumulation, (int)o->kernel, (int)o->factor, (int)o->lcp_solver);
+    tb_add(&b, " contact=%d kc=%a kc_abs=%a rtol=%a atol=%a stepper=%s", (int)o->pen.law,
+           o->pen.kc_mult, o->pen.kc_abs, o->pen.rtol, o->pen.atol, o->pen.stepper);
     tb_add(&b, " tasks=%ld", pd_spec_tasks(s));
     if (b.oom) {
         free(b.p);
@@ -215,21 +248,21 @@ char *pd_spec_key(const pd_spectrum *s)
 /* ---- rows --------------------------------------------------------------- */
 
 /* One point from its run and its twin, as `pound simulate` computes them. */
-static void fill_row(const pd_cli_case *k, long curve, const pd_spec_result *r,
+static void fill_row(const pd_osc *c, const pd_run_opts *o, long curve, const pd_spec_result *r,
                      const pd_spec_result *f, pd_spec_row *row)
 {
     memset(row, 0, sizeof *row);
-    row->c = k->c;
+    row->c = *c;
     row->curve = curve;
-    row->T0 = pd_osc_T0(&k->c);
-    row->gap = pd_osc_gap(&k->c);
-    row->dt = k->opts.dt;
-    row->tend = k->opts.tend;
+    row->T0 = pd_osc_T0(c);
+    row->gap = pd_osc_gap(c);
+    row->dt = o->dt;
+    row->tend = o->tend;
     row->umax = r->umax;
-    row->Pi1 = r->umax / pd_osc_Le(&k->c);
+    row->Pi1 = r->umax / pd_osc_Le(c);
     row->umax_free = f->umax;
     row->gamma = f->umax > 0.0 ? r->umax / f->umax : NAN;
-    row->chi = f->umax > 0.0 ? pd_osc_gap(&k->c) / f->umax : NAN;
+    row->chi = f->umax > 0.0 ? pd_osc_gap(c) / f->umax : NAN;
     row->u_toward = r->u_toward;
     row->u_away = r->u_away;
     row->contact_time = r->contact_time;
@@ -242,11 +275,12 @@ static void fill_row(const pd_cli_case *k, long curve, const pd_spec_result *r,
 void pd_spec_rows(const pd_spectrum *s, const pd_spec_result *res, pd_spec_row *rows)
 {
     long ntw = pd_spec_twins(s), np = pd_spec_points(s);
-    pd_cli_case k;
+    pd_osc c;
+    pd_run_opts o;
     for (long p = 0; p < np; p++) {
         long t = ntw + p;
-        pd_spec_case(s, t, &k);
-        fill_row(&k, p / s->npi2, &res[t], &res[pd_spec_twin_of(s, t)], &rows[p]);
+        pd_spec_case(s, t, &c, &o, NULL);
+        fill_row(&c, &o, p / s->npi2, &res[t], &res[pd_spec_twin_of(s, t)], &rows[p]);
     }
 }
 

@@ -1,5 +1,5 @@
 /* status.c — status codes, error messages and clocks. */
-#include "pd_status.h"
+#include "pd_core.h"
 
 #include <stdarg.h>
 #include <stdio.h>

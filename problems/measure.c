@@ -4,7 +4,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "pd_measure.h"
+#include "pd_problems.h"
 
 /* Sampler filling a preallocated array of u. */
 static int record_u(const pd_osc_sample *s, void *ctx)
@@ -15,12 +15,12 @@ static int record_u(const pd_osc_sample *s, void *ctx)
     return 0;
 }
 
-int pd_trace_alloc(pd_trace *tr, const pd_osc_opts *o)
+int pd_trace_alloc(pd_trace *tr, const pd_run_opts *o)
 {
     tr->n = 0;
     tr->cap = pd_steps_for(o->tend, o->dt) + 2;
     tr->u = malloc((size_t)tr->cap * sizeof(double));
-    return tr->u ? 0 : -1;
+    return tr->u ? PD_OK : PD_ENOMEM;
 }
 
 void pd_trace_free(pd_trace *tr)
@@ -29,13 +29,12 @@ void pd_trace_free(pd_trace *tr)
     tr->u = NULL;
 }
 
-int pd_measure_run(const pd_cli_case *k, pd_method method, const pd_osc_opts *o,
-                   const pd_trace *ref, double umax_ref, pd_trace *work, pd_measured *out,
-                   pd_err *err)
+int pd_measure_run(const pd_osc *c, const pd_run_opts *o, const pd_trace *ref, double umax_ref,
+                   pd_trace *work, pd_measured *out, pd_err *err)
 {
     int rc;
     work->n = 0;
-    if ((rc = pd_cli_run(k, method, o, record_u, work, &out->r, err)))
+    if ((rc = pd_osc_run(c, o, record_u, work, &out->r, err)))
         return rc;
     long n = work->n < ref->n ? work->n : ref->n;
     double worst = 0.0;
@@ -47,22 +46,22 @@ int pd_measure_run(const pd_cli_case *k, pd_method method, const pd_osc_opts *o,
     /* its cost without the sampling (the penalty method integrates to every
      * sample time; the work-precision chart compares bare runs) */
     pd_osc_result timed;
-    if ((rc = pd_cli_run(k, method, o, NULL, NULL, &timed, err)))
+    if ((rc = pd_osc_run(c, o, NULL, NULL, &timed, err)))
         return rc;
     out->r.cpu_s = timed.cpu_s;
     return PD_OK;
 }
 
-int pd_measure_reference(const pd_cli_case *k, const pd_osc_opts *o, pd_trace *ref,
+int pd_measure_reference(const pd_osc *c, const pd_run_opts *o, pd_trace *ref,
                          pd_osc_result *res, pd_err *err)
 {
     int rc;
     pd_osc_result timed;
     ref->n = 0;
-    if ((rc = pd_osc_reference(&k->c, o, record_u, ref, res, err)))
+    if ((rc = pd_osc_reference(c, o, record_u, ref, res, err)))
         return rc;
     /* its cost without the sampling */
-    if ((rc = pd_osc_reference(&k->c, o, NULL, NULL, &timed, err)))
+    if ((rc = pd_osc_reference(c, o, NULL, NULL, &timed, err)))
         return rc;
     res->cpu_s = timed.cpu_s;
     if (!(res->umax > 0.0))

@@ -1,0 +1,428 @@
+/* scene_out.c — (cli) a scene run's histories streamed to HDF5 or CSV while
+ * it runs, so memory stays bounded whatever the run length, with every
+ * input and result added at the end; written under a temporary name and
+ * renamed on success.  Also the decimated copy that --plot draws.
+ *
+ * HDF5:  /t [s]; /structures/NAME/{x, v} (rows x storeys, m and m/s) with
+ *        the structure and its results as attributes; /contacts/K/{gap,
+ *        impulse} (m, N s) with the contact and its results as attributes;
+ *        the run as attributes of the root.
+ * CSV:   '#' lines with the inputs, a header row, one row per sample
+ *        (t, NAME.x1.., NAME.v1.., cK.gap, cK.impulse), '#' lines with the
+ *        results at the end. */
+#include <hdf5.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "pd_h5.h"
+#include "pd_scene_out.h"
+
+#define OUT_BUFFER_DOUBLES (1L << 22) /* row buffer, doubles (32 MiB) */
+
+struct pd_scene_writer {
+    const pd_scene *sc;
+    char path[4096], tmp[4096];
+    int hdf5, failed;
+    long every, seen, rows;
+    double *imp;        /* m: impulses since the last recorded row */
+    /* rows waiting to be written: t, x (n), v (n), gap (m), impulse (m) per row */
+    long cap, nbuf;
+    double *buf, *col;  /* cap rows x width; col: one block of a structure */
+    int width;
+    hid_t file, ds_t;
+    hid_t *ds_x, *ds_v, *ds_g, *ds_p;
+    FILE *csv;
+};
+
+/* Does path end with suffix? */
+static int ends_with(const char *path, const char *suffix)
+{
+    size_t n = strlen(path), k = strlen(suffix);
+    return n > k && !strcmp(path + n - k, suffix);
+}
+
+/* An extendible chunked dataset of rows x cols (cols 0: 1-D) with units. */
+static hid_t h5_extendible(hid_t loc, const char *name, int cols, long chunk, const char *units)
+{
+    int rank = cols > 0 ? 2 : 1;
+    hsize_t dims[2] = {0, (hsize_t)cols}, maxd[2] = {H5S_UNLIMITED, (hsize_t)cols};
+    hsize_t ch[2] = {(hsize_t)chunk, (hsize_t)(cols > 0 ? cols : 1)};
+    hid_t space = H5Screate_simple(rank, dims, maxd), dcpl = pd_h5_untimed(H5P_DATASET_CREATE);
+    hid_t ds = -1;
+    if (space >= 0 && dcpl >= 0 && H5Pset_chunk(dcpl, rank, ch) >= 0)
+        ds = H5Dcreate2(loc, name, H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+    if (ds >= 0 && pd_h5_attr(ds, "units", units, 0.0)) {
+        H5Dclose(ds);
+        ds = -1;
+    }
+    if (dcpl >= 0)
+        H5Pclose(dcpl);
+    if (space >= 0)
+        H5Sclose(space);
+    return ds;
+}
+
+/* Append nrows x cols values (row-major) to an extendible dataset at row r0. */
+static int h5_append(hid_t ds, long r0, long nrows, int cols, const double *x)
+{
+    int rank = cols > 0 ? 2 : 1;
+    hsize_t size[2] = {(hsize_t)(r0 + nrows), (hsize_t)cols};
+    hsize_t start[2] = {(hsize_t)r0, 0}, count[2] = {(hsize_t)nrows, (hsize_t)cols};
+    if (H5Dset_extent(ds, size) < 0)
+        return -1;
+    hid_t fs = H5Dget_space(ds), ms = H5Screate_simple(rank, count, NULL);
+    int rc = fs < 0 || ms < 0 ||
+             H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL) < 0 ||
+             H5Dwrite(ds, H5T_NATIVE_DOUBLE, ms, fs, H5P_DEFAULT, x) < 0;
+    if (ms >= 0)
+        H5Sclose(ms);
+    if (fs >= 0)
+        H5Sclose(fs);
+    return rc ? -1 : 0;
+}
+
+/* The groups and extendible datasets of every structure and contact. */
+static int h5_open(pd_scene_writer *w)
+{
+    const pd_scene *sc = w->sc;
+    char name[96];
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL); /* the library must not print */
+    hid_t fcpl = H5Pcreate(H5P_FILE_CREATE);
+    w->file = H5Fcreate(w->tmp, H5F_ACC_TRUNC, fcpl, H5P_DEFAULT);
+    if (fcpl >= 0)
+        H5Pclose(fcpl);
+    if (w->file < 0)
+        return -1;
+    hid_t gs = H5Gcreate2(w->file, "structures", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    hid_t gc = H5Gcreate2(w->file, "contacts", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    int rc = gs < 0 || gc < 0 || (w->ds_t = h5_extendible(w->file, "t", 0, w->cap, "s")) < 0;
+    for (int s = 0; s < sc->nstruct && !rc; s++) {
+        hid_t g = H5Gcreate2(gs, sc->st[s].name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+        rc = g < 0 || (w->ds_x[s] = h5_extendible(g, "x", sc->st[s].storeys, w->cap, "m")) < 0 ||
+             (w->ds_v[s] = h5_extendible(g, "v", sc->st[s].storeys, w->cap, "m/s")) < 0;
+        if (g >= 0 && H5Gclose(g) < 0)
+            rc = 1;
+    }
+    for (int a = 0; a < sc->ncontact && !rc; a++) {
+        snprintf(name, sizeof name, "%d", a);
+        hid_t g = H5Gcreate2(gc, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+        rc = g < 0 || (w->ds_g[a] = h5_extendible(g, "gap", 0, w->cap, "m")) < 0 ||
+             (w->ds_p[a] = h5_extendible(g, "impulse", 0, w->cap, "N s")) < 0;
+        if (g >= 0 && H5Gclose(g) < 0)
+            rc = 1;
+    }
+    if (gs >= 0 && H5Gclose(gs) < 0)
+        rc = 1;
+    if (gc >= 0 && H5Gclose(gc) < 0)
+        rc = 1;
+    return rc ? -1 : 0;
+}
+
+/* The CSV header row. */
+static int csv_open(pd_scene_writer *w)
+{
+    const pd_scene *sc = w->sc;
+    if (!(w->csv = fopen(w->tmp, "w")))
+        return -1;
+    fprintf(w->csv, "# pound scene run: units s, m, m/s, N s\nt");
+    for (int s = 0; s < sc->nstruct; s++)
+        for (int k = 1; k <= sc->st[s].storeys; k++)
+            fprintf(w->csv, ",%s.x%d", sc->st[s].name, k);
+    for (int s = 0; s < sc->nstruct; s++)
+        for (int k = 1; k <= sc->st[s].storeys; k++)
+            fprintf(w->csv, ",%s.v%d", sc->st[s].name, k);
+    for (int a = 0; a < sc->ncontact; a++)
+        fprintf(w->csv, ",c%d.gap,c%d.impulse", a, a);
+    fputc('\n', w->csv);
+    return ferror(w->csv) ? -1 : 0;
+}
+
+void pd_scene_writer_free(pd_scene_writer *w)
+{
+    if (!w)
+        return;
+    if (w->csv)
+        fclose(w->csv);
+    hid_t *sets[] = {w->ds_x, w->ds_v, w->ds_g, w->ds_p};
+    int counts[] = {w->sc->nstruct, w->sc->nstruct, w->sc->ncontact, w->sc->ncontact};
+    for (int k = 0; k < 4; k++)
+        for (int i = 0; sets[k] && i < counts[k]; i++)
+            if (sets[k][i] > 0)
+                H5Dclose(sets[k][i]);
+    if (w->ds_t > 0)
+        H5Dclose(w->ds_t);
+    if (w->file > 0)
+        H5Fclose(w->file);
+    if (w->tmp[0])
+        unlink(w->tmp);
+    free(w->imp);
+    free(w->buf);
+    free(w->col);
+    free(w->ds_x);
+    free(w->ds_v);
+    free(w->ds_g);
+    free(w->ds_p);
+    free(w);
+}
+
+int pd_scene_writer_open(pd_scene_writer **out, const char *path, const pd_scene *sc, long every,
+                         pd_err *err)
+{
+    pd_scene_writer *w = calloc(1, sizeof *w);
+    int smax = 1, m = sc->ncontact > 0 ? sc->ncontact : 1;
+    *out = NULL;
+    if (!w)
+        return pd_err_set(err, PD_ENOMEM, "-o %s: out of memory", path);
+    w->sc = sc;
+    w->every = every;
+    w->hdf5 = ends_with(path, ".h5") || ends_with(path, ".hdf5");
+    w->width = 1 + 2 * sc->n + 2 * sc->ncontact;
+    w->cap = OUT_BUFFER_DOUBLES / w->width;
+    w->cap = w->cap < 16 ? 16 : w->cap > 4096 ? 4096 : w->cap;
+    for (int s = 0; s < sc->nstruct; s++)
+        smax = sc->st[s].storeys > smax ? sc->st[s].storeys : smax;
+    if (snprintf(w->path, sizeof w->path, "%s", path) >= (int)sizeof w->path ||
+        snprintf(w->tmp, sizeof w->tmp, "%s.tmp%ld", path, (long)getpid()) >= (int)sizeof w->tmp) {
+        w->tmp[0] = '\0';
+        pd_scene_writer_free(w);
+        return pd_err_set(err, PD_EINVAL, "-o %s: path too long", path);
+    }
+    w->imp = calloc((size_t)m, sizeof(double));
+    w->buf = malloc((size_t)w->cap * (size_t)w->width * sizeof(double));
+    w->col = malloc((size_t)w->cap * (size_t)smax * sizeof(double));
+    w->ds_x = calloc((size_t)sc->nstruct, sizeof(hid_t));
+    w->ds_v = calloc((size_t)sc->nstruct, sizeof(hid_t));
+    w->ds_g = calloc((size_t)m, sizeof(hid_t));
+    w->ds_p = calloc((size_t)m, sizeof(hid_t));
+    if (!w->imp || !w->buf || !w->col || !w->ds_x || !w->ds_v || !w->ds_g || !w->ds_p) {
+        w->tmp[0] = '\0';
+        pd_scene_writer_free(w);
+        return pd_err_set(err, PD_ENOMEM, "-o %s: out of memory for the row buffer", path);
+    }
+    if (w->hdf5 ? h5_open(w) : csv_open(w)) {
+        pd_scene_writer_free(w);
+        return pd_err_set(err, PD_EIO, "-o %s: cannot create the file", path);
+    }
+    *out = w;
+    return PD_OK;
+}
+
+/* Write the buffered rows. */
+static int flush_rows(pd_scene_writer *w)
+{
+    const pd_scene *sc = w->sc;
+    long nb = w->nbuf;
+    int n = sc->n, m = sc->ncontact, rc = 0;
+    if (nb == 0 || w->failed)
+        return w->failed ? -1 : 0;
+    if (!w->hdf5) {
+        for (long r = 0; r < nb; r++) {
+            const double *row = w->buf + (size_t)r * w->width;
+            for (int k = 0; k < w->width; k++)
+                fprintf(w->csv, "%.17g%c", row[k], k + 1 < w->width ? ',' : '\n');
+        }
+        rc = ferror(w->csv) ? -1 : 0;
+    } else {
+        for (long r = 0; r < nb; r++)
+            w->col[r] = w->buf[(size_t)r * w->width];
+        rc = h5_append(w->ds_t, w->rows - nb, nb, 0, w->col);
+        for (int s = 0; s < sc->nstruct && !rc; s++)
+            for (int part = 0; part < 2 && !rc; part++) {
+                int st = sc->st[s].storeys, off = 1 + part * n + sc->st[s].dof;
+                for (long r = 0; r < nb; r++)
+                    memcpy(w->col + (size_t)r * st, w->buf + (size_t)r * w->width + off,
+                           (size_t)st * sizeof(double));
+                rc = h5_append(part ? w->ds_v[s] : w->ds_x[s], w->rows - nb, nb, st, w->col);
+            }
+        for (int a = 0; a < m && !rc; a++)
+            for (int part = 0; part < 2 && !rc; part++) {
+                for (long r = 0; r < nb; r++)
+                    w->col[r] = w->buf[(size_t)r * w->width + 1 + 2 * n + part * m + a];
+                rc = h5_append(part ? w->ds_p[a] : w->ds_g[a], w->rows - nb, nb, 0, w->col);
+            }
+    }
+    w->nbuf = 0;
+    w->failed = rc != 0;
+    return rc;
+}
+
+int pd_scene_writer_sample(const pd_scene_sample *s, void *ctx)
+{
+    pd_scene_writer *w = ctx;
+    const pd_scene *sc = w->sc;
+    int n = sc->n, m = sc->ncontact;
+    for (int a = 0; a < m && s->impulse; a++)
+        w->imp[a] += s->impulse[a];
+    if (w->seen++ % w->every)
+        return 0;
+    double *row = w->buf + (size_t)w->nbuf * w->width;
+    row[0] = s->t;
+    memcpy(row + 1, s->x, (size_t)n * sizeof(double));
+    memcpy(row + 1 + n, s->v, (size_t)n * sizeof(double));
+    for (int a = 0; a < m; a++) {
+        row[1 + 2 * n + a] = s->gap ? s->gap[a] : 0.0;
+        row[1 + 2 * n + m + a] = w->imp[a];
+        w->imp[a] = 0.0;
+    }
+    w->nbuf++;
+    w->rows++;
+    if (w->nbuf == w->cap && flush_rows(w))
+        return 1; /* stop the run: the file cannot be written */
+    return 0;
+}
+
+/* ---- the results at the end ----------------------------------------------- */
+
+/* One attribute line of the CSV, or one attribute of obj. */
+static int put_num(pd_scene_writer *w, hid_t obj, const char *prefix, const char *name, double x,
+                   const char *units)
+{
+    if (w->hdf5)
+        return pd_h5_num(obj, name, x, units);
+    fprintf(w->csv, "# %s%s = %.17g%s%s%s\n", prefix, name, x, units ? " [" : "",
+            units ? units : "", units ? "]" : "");
+    return 0;
+}
+
+static int put_text(pd_scene_writer *w, hid_t obj, const char *prefix, const char *name,
+                    const char *text)
+{
+    if (w->hdf5)
+        return pd_h5_attr(obj, name, text, 0.0);
+    fprintf(w->csv, "# %s%s = %s\n", prefix, name, text);
+    return 0;
+}
+
+static int put_nums(pd_scene_writer *w, hid_t obj, const char *prefix, const char *name, int n,
+                    const double *x, const char *units)
+{
+    if (w->hdf5)
+        return pd_h5_nums(obj, name, n, x, units);
+    fprintf(w->csv, "# %s%s = [", prefix, name);
+    for (int i = 0; i < n; i++)
+        fprintf(w->csv, "%s%.17g", i ? ", " : "", x[i]);
+    fprintf(w->csv, "]%s%s%s\n", units ? " [" : "", units ? units : "", units ? "]" : "");
+    return 0;
+}
+
+/* The run's inputs and figures on the root. */
+static int put_run(pd_scene_writer *w, const pd_scene_run_info *ri)
+{
+    const pd_scene *sc = w->sc;
+    const pd_scene_result *r = &ri->sum->r;
+    hid_t f = w->hdf5 ? w->file : -1;
+    return put_text(w, f, "", "command", ri->command) ||
+           put_text(w, f, "", "scene", ri->scene_name) ||
+           put_text(w, f, "", "method", r->method) || put_text(w, f, "", "kernel", r->kernel) ||
+           put_text(w, f, "", "factor", r->factor) ||
+           put_text(w, f, "", "lcp_solver", r->lcp_solver) ||
+           put_text(w, f, "", "pulse", pd_pulse_name(sc->exc.pulse)) ||
+           put_text(w, f, "", "dir", sc->exc.dir > 0 ? "+x" : "-x") ||
+           put_num(w, f, "", "ap", sc->exc.ap, "m/s^2") ||
+           put_num(w, f, "", "Tp", sc->exc.Tp, "s") ||
+           put_num(w, f, "", "Le", pd_scene_Le(sc), "m") || put_num(w, f, "", "dt", r->dt, "s") ||
+           put_num(w, f, "", "theta", r->theta, "1") || put_num(w, f, "", "tend", r->tend, "s") ||
+           put_num(w, f, "", "every", (double)w->every, "steps") ||
+           put_num(w, f, "", "steps", (double)r->steps, "1") ||
+           put_num(w, f, "", "cpu_s", ri->sum->cpu_s, "s");
+}
+
+/* Structure s: its description and results (group /structures/NAME). */
+static int put_structure(pd_scene_writer *w, const pd_scene_summary *sum, int s)
+{
+    const pd_structure *st = &w->sc->st[s];
+    char prefix[PD_NAME_MAX + 2];
+    hid_t g = -1;
+    int rc, o = st->dof, k = st->storeys;
+    snprintf(prefix, sizeof prefix, "%s.", st->name);
+    if (w->hdf5) {
+        char path[PD_NAME_MAX + 16];
+        snprintf(path, sizeof path, "structures/%s", st->name);
+        if ((g = H5Gopen2(w->file, path, H5P_DEFAULT)) < 0)
+            return -1;
+    }
+    rc = put_num(w, g, prefix, "storeys", k, "1") || put_num(w, g, prefix, "T0", st->T0, "s") ||
+         put_num(w, g, prefix, "Pi2", sum->Pi2[s], "1") || put_num(w, g, prefix, "xi", st->xi, "1") ||
+         put_text(w, g, prefix, "damping",
+                  st->storeys == 1 ? "exact" : st->damping == PD_DAMPING_STIFFNESS ? "stiffness"
+                                                                                   : "rayleigh") ||
+         put_num(w, g, prefix, "alpha", st->alpha, "1/s") ||
+         put_num(w, g, prefix, "beta", st->beta, "s") ||
+         put_nums(w, g, prefix, "masses", k, st->mass, "kg") ||
+         put_nums(w, g, prefix, "stiffnesses", k, st->stiffness, "N/m") ||
+         put_nums(w, g, prefix, "umax", k, sum->r.umax + o, "m") ||
+         put_nums(w, g, prefix, "u_pos", k, sum->r.u_pos + o, "m") ||
+         put_nums(w, g, prefix, "u_neg", k, sum->r.u_neg + o, "m") ||
+         put_nums(w, g, prefix, "drift", k, sum->r.drift + o, "m") ||
+         put_nums(w, g, prefix, "Pi1", k, sum->Pi1 + o, "1") ||
+         put_nums(w, g, prefix, "umax_free", k, sum->free.umax + o, "m") ||
+         put_nums(w, g, prefix, "gamma", k, sum->gamma + o, "1");
+    if (g >= 0 && H5Gclose(g) < 0)
+        rc = -1;
+    return rc;
+}
+
+/* Contact a: its description and results (group /contacts/A). */
+static int put_contact(pd_scene_writer *w, const pd_scene_summary *sum, int a)
+{
+    const pd_scene *sc = w->sc;
+    const pd_contact *ct = &sc->ct[a];
+    char prefix[32];
+    hid_t g = -1;
+    int rc;
+    snprintf(prefix, sizeof prefix, "c%d.", a);
+    if (w->hdf5) {
+        char path[48];
+        snprintf(path, sizeof path, "contacts/%d", a);
+        if ((g = H5Gopen2(w->file, path, H5P_DEFAULT)) < 0)
+            return -1;
+    }
+    rc = put_text(w, g, prefix, "a", ct->a == PD_WALL ? "wall" : sc->st[ct->a].name) ||
+         put_text(w, g, prefix, "b", ct->b == PD_WALL ? "wall" : sc->st[ct->b].name) ||
+         put_num(w, g, prefix, "level_a", ct->level_a, "1") ||
+         put_num(w, g, prefix, "level_b", ct->level_b, "1") ||
+         put_num(w, g, prefix, "gap0", ct->gap, "m") || put_num(w, g, prefix, "eps", ct->eps, "1") ||
+         put_num(w, g, prefix, "Pi3", sum->Pi3[a], "1") ||
+         put_num(w, g, prefix, "chi", sum->chi[a], "1") ||
+         put_num(w, g, prefix, "impacts", (double)sum->r.impacts[a], "1") ||
+         put_num(w, g, prefix, "first_impact", sum->r.first_impact[a], "s") ||
+         put_num(w, g, prefix, "max_impulse", sum->r.max_impulse[a], "N s") ||
+         put_num(w, g, prefix, "contact_time", sum->r.contact_time[a], "s") ||
+         put_num(w, g, prefix, "approach", sum->r.approach[a], "m");
+    if (g >= 0 && H5Gclose(g) < 0)
+        rc = -1;
+    return rc;
+}
+
+int pd_scene_writer_finish(pd_scene_writer *w, const pd_scene_run_info *ri, pd_err *err)
+{
+    int rc = flush_rows(w) || put_run(w, ri);
+    for (int s = 0; s < w->sc->nstruct && !rc; s++)
+        rc = put_structure(w, ri->sum, s);
+    for (int a = 0; a < w->sc->ncontact && !rc; a++)
+        rc = put_contact(w, ri->sum, a);
+    if (w->hdf5) {
+        hid_t *sets[] = {w->ds_x, w->ds_v, w->ds_g, w->ds_p};
+        int counts[] = {w->sc->nstruct, w->sc->nstruct, w->sc->ncontact, w->sc->ncontact};
+        for (int k = 0; k < 4; k++)
+            for (int i = 0; i < counts[k]; i++) {
+                rc |= H5Dclose(sets[k][i]) < 0;
+                sets[k][i] = 0;
+            }
+        rc |= H5Dclose(w->ds_t) < 0;
+        w->ds_t = 0;
+        rc |= H5Fclose(w->file) < 0;
+        w->file = 0;
+    } else {
+        rc |= ferror(w->csv) != 0;
+        rc |= fclose(w->csv) != 0;
+        w->csv = NULL;
+    }
+    if (rc || rename(w->tmp, w->path) != 0)
+        return pd_err_set(err, PD_EIO, "-o %s: cannot write the file", w->path);
+    w->tmp[0] = '\0'; /* renamed: nothing to remove */
+    return PD_OK;
+}

@@ -1,0 +1,145 @@
+/* pd_core.h — what every pound module shares: status codes and error
+ * messages, clocks, constants, and the matrices every layer reads.
+ *
+ * Status.  Every library function that can fail returns an int status: 0
+ * (PD_OK) on success, a negative PD_E* code otherwise, and may fill a pd_err
+ * with a one-line message naming what went wrong.  The library never
+ * prints, exits or aborts; the caller decides what to show.
+ *
+ * Matrices.  Read-only views of zero, dense (column-major) or
+ * compressed-sparse-column storage, the few products the solvers need, an
+ * owned sparse matrix assembled from triplets, and a small dense LU.  A view
+ * never owns its arrays.  CSC: colptr has cols + 1 entries, the row indices
+ * of a column are strictly increasing, values[k] is the entry at
+ * (rowind[k], j) for colptr[j] <= k < colptr[j + 1]. */
+#ifndef PD_CORE_H
+#define PD_CORE_H
+
+#include <stddef.h>
+
+enum {
+    PD_OK = 0,
+    PD_ENOMEM = -1,      /* an allocation failed */
+    PD_EINVAL = -2,      /* an argument is out of range or inconsistent */
+    PD_ENOSOLUTION = -3, /* LCP: ray termination, the LCP may have no solution */
+    PD_EMAXPIVOTS = -4,  /* LCP: pivot cap reached */
+    PD_ENUMERICAL = -5,  /* pivot too small, lost precision, failed verification */
+    PD_ENONFINITE = -6,  /* a NaN or infinity appeared in the state */
+    PD_EIO = -7,         /* a file could not be opened, read or written */
+    PD_EPARSE = -8,      /* a file is malformed */
+    PD_ESINGULAR = -9,   /* a matrix to factor is singular */
+    PD_EBUDGET = -10,    /* an event or step budget was exhausted */
+    PD_ESTOPPED = -11    /* an observer asked the run to stop (not an error) */
+};
+
+/* A one-line error message; status mirrors the code returned. */
+typedef struct pd_err {
+    int status;
+    char msg[256];
+} pd_err;
+
+/* Short text for a status code ("out of memory", ...). */
+const char *pd_strerror(int status);
+
+/* Record status and a printf-style message in err (err may be NULL);
+ * returns status so callers can write `return pd_err_set(err, ...)`. */
+int pd_err_set(pd_err *err, int status, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/* Clear err to PD_OK with an empty message. */
+void pd_err_clear(pd_err *err);
+
+/* Monotonic wall-clock time, and the calling thread's CPU time, in seconds. */
+double pd_wall_seconds(void);
+double pd_cpu_seconds(void);
+
+/* ---- constants ------------------------------------------------------------- */
+
+#define PD_PI 3.14159265358979323846264338327950288
+#define PD_TWO_PI 6.28318530717958647692528676655900577
+
+/* Standard gravity [m/s^2], for records given in g. */
+#define PD_G_STANDARD 9.80665
+
+/* ---- interpolation --------------------------------------------------------- */
+
+/* The quintic Hermite interpolant on a step of length h through (f, f', f'')
+ * = p0 at its start and p1 at its end: value *f and time rate *fd at the
+ * fraction r in [0, 1] of the step. */
+void pd_hermite5(const double p0[3], const double p1[3], double h, double r, double *f,
+                 double *fd);
+
+/* ---- matrices -------------------------------------------------------------- */
+
+typedef enum {
+    PD_MATRIX_ZERO = 0,  /* all zeros (no arrays) */
+    PD_MATRIX_DENSE = 1, /* column-major values, leading dimension rows */
+    PD_MATRIX_CSC = 2    /* compressed sparse column */
+} pd_matrix_kind;
+
+/* A rows x cols matrix, read only. */
+typedef struct pd_matrix {
+    pd_matrix_kind kind;
+    int rows, cols;
+    const double *values;
+    const int *colptr, *rowind; /* CSC only */
+} pd_matrix;
+
+pd_matrix pd_matrix_zero(int rows, int cols);
+pd_matrix pd_matrix_dense(int rows, int cols, const double *values);
+pd_matrix pd_matrix_csc(int rows, int cols, const int *colptr, const int *rowind,
+                        const double *values);
+
+/* y = alpha A x + beta y (beta = 0 ignores y's old contents). */
+void pd_matrix_gemv(const pd_matrix *A, double alpha, const double *x, double beta, double *y);
+
+/* y = A^T x (y has cols entries). */
+void pd_matrix_gemv_t(const pd_matrix *A, const double *x, double *y);
+
+/* Entry (i, j). */
+double pd_matrix_get(const pd_matrix *A, int i, int j);
+
+/* A[:, j]^T x;  y += s A[:, j];  sum_i |A_ij| |x_i|. */
+double pd_matrix_col_dot(const pd_matrix *A, int j, const double *x);
+void pd_matrix_col_axpy(const pd_matrix *A, int j, double s, double *y);
+double pd_matrix_col_absdot(const pd_matrix *A, int j, const double *x);
+
+/* Entries stored (rows * cols for dense, 0 for zero). */
+long pd_matrix_nnz(const pd_matrix *A);
+
+/* out (rows x cols, column-major) = A. */
+void pd_matrix_to_dense(const pd_matrix *A, double *out);
+
+/* 1 when every stored off-diagonal entry is zero. */
+int pd_matrix_is_diagonal(const pd_matrix *A);
+
+/* Shape rows x cols, a known kind, a valid CSC structure and finite
+ * entries; the message names the matrix. */
+int pd_matrix_check(const pd_matrix *A, int rows, int cols, const char *name, pd_err *err);
+
+/* ---- an owned sparse matrix ---------------------------------------------- */
+
+typedef struct pd_sparse {
+    int rows, cols, nnz;
+    int *colptr, *rowind;
+    double *values;
+} pd_sparse;
+
+/* Assemble rows x cols from nt triplets (Ti[k], Tj[k], Tx[k]), summing
+ * duplicates and dropping nothing (explicit zeros stay).  PD_ENOMEM or
+ * PD_EINVAL (an index out of range); on failure sp is empty. */
+int pd_sparse_from_triplets(pd_sparse *sp, int rows, int cols, long nt, const int *Ti,
+                            const int *Tj, const double *Tx, pd_err *err);
+void pd_sparse_free(pd_sparse *sp);
+pd_matrix pd_sparse_view(const pd_sparse *sp);
+
+/* ---- dense LU -------------------------------------------------------------- */
+
+/* P A = L U in place for the n x n column-major A (leading dimension lda),
+ * partial pivoting; PD_ESINGULAR when a pivot is not above rel_tol max|A|. */
+int pd_dense_lu(int n, double *A, int lda, int *perm, double rel_tol);
+
+/* Solve A x = b in place from the output of pd_dense_lu. */
+void pd_dense_lu_solve(int n, const double *LU, int lda, const int *perm, double *b);
+
+#endif

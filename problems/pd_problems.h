@@ -1,0 +1,493 @@
+/* pd_problems.h — the scenes pound models and how they are run: the
+ * excitations, the one-wall pounding oscillator of SPEC §1 (the paper's
+ * problem, with its exact reference and fast kernels), rows of structures
+ * that pound each other and their abutments (SPEC §4), the run request and
+ * method dispatch (Moreau–Jean, event-driven, penalty), measurements (maxima
+ * per dof, impacts per contact, the Pi terms, gamma and chi), errors against
+ * a reference, and spectrum sweeps.
+ *
+ * Everything here is in metres, seconds and kilograms at the interface;
+ * inside, scenes are integrated in the paper's dimensionless variables
+ * (time tau = wp t, displacement u / Le, Le = ap / wp^2), so that runs with
+ * the same Pi terms are the same discrete computation.
+ *
+ * Options structs come from their _default_opts() function; their fields
+ * hold values, except dt and tend where 0 means "derived from the case". */
+#ifndef PD_PROBLEMS_H
+#define PD_PROBLEMS_H
+
+#include "pd_engine.h"
+
+/* ==== excitations ========================================================== */
+
+typedef enum { PD_PULSE_SINE = 0, PD_PULSE_COSINE = 1, PD_PULSE_HARMONIC = 2 } pd_pulse;
+
+/* "sine", "cosine", "harmonic"; "normal" (+1), "reverse" (-1).  The parsers
+ * return PD_OK, or PD_EINVAL for an unknown name. */
+const char *pd_pulse_name(pd_pulse pulse);
+int pd_pulse_parse(const char *name, pd_pulse *pulse);
+const char *pd_dir_name(int dir);
+int pd_dir_parse(const char *name, int *dir);
+
+/* The effective acceleration in units of ap at tau = wp t: s phi(tau), phi =
+ * sin or cos on [0, 2 pi] and zero after (sin for all tau: harmonic), and
+ * its tau-derivative.  side -1 / +1 picks the left / right limit at the
+ * pulse end tau = 2 pi (recognised to a relative 1e-12, so that tau = k h
+ * lands on the same side at every scale). */
+double pd_pulse_shape(pd_pulse pulse, int dir, double tau, int side);
+double pd_pulse_shape_rate(pd_pulse pulse, int dir, double tau, int side);
+
+/* ==== how a run is made ====================================================== */
+
+typedef enum { PD_METHOD_MOREAU = 0, PD_METHOD_EVENT = 1, PD_METHOD_PENALTY = 2 } pd_method;
+
+/* "moreau", "event", "penalty"; parse: PD_OK or PD_EINVAL. */
+const char *pd_method_name(pd_method method);
+int pd_method_parse(const char *name, pd_method *method);
+
+/* The penalty baseline's contact elements (see pd_penalty_run). */
+typedef struct pd_penalty_setup {
+    pd_penalty_law law;
+    double kc_mult;      /* stiffness as a multiple of the structure's: w0^2 per unit mass for
+                            the oscillator, the largest storey stiffness for a scene (> 0) */
+    double kc_abs;       /* > 0: the stiffness itself (oscillator: N/m per kg; scene: N/m;
+                            N/m^1.5 for Hertz), overriding kc_mult; 0: use kc_mult */
+    double rtol, atol;   /* GSL tolerances > 0 */
+    const char *stepper; /* "rk8pd", "rkf45", "rk4imp", "msbdf" */
+} pd_penalty_setup;
+
+/* The run request of every command and sweep. */
+typedef struct pd_run_opts {
+    pd_method method;
+    double dt;          /* step (Moreau–Jean) or output interval [s]; 0 = derived */
+    double tend;        /* end time [s]; 0 = derived */
+    double theta;       /* Moreau–Jean theta in [1/2, 1] */
+    double gamma;       /* active-set look-ahead in [0, 1] */
+    int allow_unstable; /* accept theta outside [1/2, 1] */
+    pd_kernel kernel;   /* PD_KERNEL_GENERAL: no fast path (scalar kernel, exact reference) */
+    pd_factor_kind factor;
+    pd_lcp_method lcp_solver;
+    int no_accumulation; /* event-driven: do not jump accumulations of impacts */
+    int no_wall;         /* without contacts: the oscillator's no-wall twin, a free scene */
+    pd_penalty_setup pen;
+} pd_run_opts;
+
+/* Moreau–Jean, dt and tend derived, theta = gamma = 1/2, automatic kernel,
+ * factor and LCP solver, accumulations jumped, Kelvin-Voigt with kc = 1e4
+ * w0^2, rtol 1e-10, atol 1e-12, rk8pd. */
+pd_run_opts pd_run_default_opts(void);
+
+/* Ranges of the scheme options, each message naming the option. */
+int pd_run_opts_check(const pd_run_opts *o, pd_err *err);
+
+/* ==== the pounding oscillator (SPEC §1) ===================================== *
+ *   u'' + 2 xi w0 u' + w0^2 u = f(t) - lambda,   g = delta - u >= 0,
+ *   f(t) = s ap phi(wp t),  s = +1 normal, -1 reverse.                        */
+
+typedef struct pd_osc {
+    pd_pulse pulse;
+    int dir;    /* +1 normal (wall driven toward the oscillator), -1 reverse */
+    double ap;  /* pulse acceleration amplitude [m/s^2] > 0 */
+    double Tp;  /* pulse period [s] > 0 */
+    double Pi2; /* w0 / wp = Tp / T0 > 0 */
+    double Pi3; /* delta wp^2 / ap >= 0 (the dimensionless gap) */
+    double eps; /* coefficient of restitution in [0, 1] */
+    double xi;  /* damping ratio in [0, 1) */
+} pd_osc;
+
+/* sine, normal, ap = 1, Tp = 1, Pi2 = 1, Pi3 = 0.05, eps = 0.5, xi = 0.05. */
+pd_osc pd_osc_default(void);
+
+/* Derived quantities. */
+double pd_osc_wp(const pd_osc *c);  /* 2 pi / Tp */
+double pd_osc_T0(const pd_osc *c);  /* Tp / Pi2 */
+double pd_osc_gap(const pd_osc *c); /* delta = Pi3 ap / wp^2 [m] */
+double pd_osc_Le(const pd_osc *c);  /* ap / wp^2 [m] */
+
+/* The dimensional forms: Pi2 = Tp / T0, Pi3 = gap / Le (ap, Tp set first). */
+void pd_osc_set_T0(pd_osc *c, double T0);
+void pd_osc_set_gap(pd_osc *c, double gap);
+
+/* Effective acceleration f(t) [m/s^2] at time t [s]. */
+double pd_osc_excitation(const pd_osc *c, double t);
+
+/* Check every field; the message names the field ("eps", "gap", ...). */
+int pd_osc_check(const pd_osc *c, pd_err *err);
+
+/* Check the case and the options and complete dt and tend. */
+int pd_osc_resolve_opts(const pd_osc *c, const pd_run_opts *in, pd_run_opts *out, pd_err *err);
+double pd_osc_default_dt(const pd_osc *c); /* min(Tp, T0) / 2000 */
+/* Pulses: Tp + 2 T0.  Harmonic: a transient phase followed by a measuring
+ * window of max(16 Tp, 3 T0) (docs/scheme.md). */
+double pd_osc_default_tend(const pd_osc *c);
+/* Start of the window over which umax is measured (0 for pulses). */
+double pd_osc_measure_start(const pd_osc *c, double tend);
+
+/* One recorded sample, in metres, seconds and m/s. */
+typedef struct pd_osc_sample {
+    long step;
+    double t, u, v;
+    double impulse; /* contact impulse per unit mass since the last sample [m/s] */
+    double gap;     /* delta - u [m] */
+} pd_osc_sample;
+
+/* Called at t = 0 and after every step (or output); return > 0 to stop. */
+typedef int (*pd_osc_sampler)(const pd_osc_sample *s, void *ctx);
+
+/* What a run measures. */
+typedef struct pd_osc_result {
+    double umax;          /* max |u| over the measuring window [m] */
+    double u_toward;      /* max u (toward the wall) [m] */
+    double u_away;        /* max -u (away from the wall) [m] */
+    long impacts;         /* contact episodes begun */
+    double first_impact;  /* time of the first impact [s], NAN when none */
+    double first_impact_velocity; /* u' at that instant [m/s], NAN when none */
+    double max_impact_velocity;   /* largest approach speed of any impact [m/s] */
+    double max_impulse;   /* largest impulse of one impact per unit mass [m/s] */
+    double contact_time;  /* time spent in contact [s] */
+    double min_gap;       /* smallest gap seen [m] (negative: penetration) */
+    long accumulations;   /* event-driven: accumulations jumped to rest */
+    long steps;           /* steps (Moreau–Jean, penalty) or events (event-driven) */
+    double dt, tend, theta, gamma;
+    double cpu_s;
+    const char *kernel;   /* "scalar", "general", "event", or the penalty stepper */
+} pd_osc_result;
+
+/* Run the case with the method of opts (sampler may be NULL). */
+int pd_osc_run(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
+               pd_osc_result *res, pd_err *err);
+
+/* The three methods (pd_osc_run dispatches to them):
+ * Moreau–Jean, its umax the maximum over the steps; */
+int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler,
+                    void *ctx, pd_osc_result *res, pd_err *err);
+/* the exact event-driven reference (pd_ed_sdof_run): dt is only the
+ * sampling interval, res->steps counts events, res->kernel is "event"; */
+int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
+                     pd_osc_result *res, pd_err *err);
+/* the penalty baseline with opts->pen (Hertz: the force at a penetration of
+ * Le equals kc_mult w0^2 Le); samples every dt; res->steps counts accepted
+ * steps, res->kernel names the stepper. */
+int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
+                   pd_osc_result *res, pd_err *err);
+
+/* A run and its no-wall twin, with the paper's figures. */
+typedef struct pd_osc_summary {
+    pd_osc_result r, free;
+    double Pi1;   /* umax wp^2 / ap */
+    double gamma; /* umax / umax_free (NAN when umax_free = 0) */
+    double chi;   /* gap / umax_free (NAN when umax_free = 0) */
+    double cpu_s; /* both runs */
+} pd_osc_summary;
+
+int pd_osc_summarize(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
+                     pd_osc_summary *s, pd_err *err);
+
+/* Exact response without the wall from rest (closed form), at t [s]. */
+void pd_osc_free_exact(const pd_osc *c, double t, double *u, double *v);
+
+/* First time t <= tmax at which that free response reaches the gap, found
+ * on a grid of Tp/1000 and bisected to rounding, with the speed there:
+ * PD_OK, or PD_EINVAL when it does not reach the gap by tmax. */
+int pd_osc_free_first_contact(const pd_osc *c, double tmax, double *t, double *v);
+
+/* ---- errors against the reference (compare, converge) ------------------- *
+ *   err_umax_rel  = |umax - umax_ref| / umax_ref,
+ *   err_hist_linf = max_k |u(t_k) - u_ref(t_k)| / umax_ref   on t_k = k dt. */
+
+/* u on the output grid, preallocated once per run. */
+typedef struct pd_trace {
+    double *u;
+    long n, cap;
+} pd_trace;
+
+typedef struct pd_measured {
+    pd_osc_result r;
+    double err_umax_rel, err_hist_linf;
+    long grid_points;
+} pd_measured;
+
+/* Room for the grid of o (tend / dt + 2 points): PD_OK or PD_ENOMEM. */
+int pd_trace_alloc(pd_trace *tr, const pd_run_opts *o);
+void pd_trace_free(pd_trace *tr);
+
+/* The reference on the grid of o; res->cpu_s is its cost without sampling. */
+int pd_measure_reference(const pd_osc *c, const pd_run_opts *o, pd_trace *ref,
+                         pd_osc_result *res, pd_err *err);
+
+/* The method of o on the same grid, its errors against ref; out->r.cpu_s is
+ * the cost of a second run without sampling. */
+int pd_measure_run(const pd_osc *c, const pd_run_opts *o, const pd_trace *ref, double umax_ref,
+                   pd_trace *work, pd_measured *out, pd_err *err);
+
+/* ==== scenes: rows of structures (SPEC §4) =================================== *
+ * Structures stand in a row along x (positive to the right) on a common
+ * ground moving with the excitation; displacements are relative to the
+ * ground.  A structure is an SDOF or a lumped-mass shear building (storey 1
+ * lowest); a contact joins a storey of structure a (left) to a storey of
+ * structure b (right), or a structure to a rigid wall at either end, with
+ * gap g = gap + x_b - x_a >= 0 and Newton restitution eps.                    */
+
+#define PD_WALL (-1)        /* the structure index of a rigid wall */
+#define PD_NAME_MAX 64      /* longest structure name + 1 */
+
+typedef enum {
+    PD_DAMPING_RAYLEIGH = 0, /* C = alpha M + beta K: xi at two modes */
+    PD_DAMPING_STIFFNESS = 1 /* C = beta K: xi at the first mode */
+} pd_damping;
+
+typedef struct pd_structure {
+    char name[PD_NAME_MAX];
+    int storeys;         /* 1 for an SDOF */
+    double *mass;        /* storeys entries [kg] */
+    double *stiffness;   /* storeys entries [N/m]: k_i joins storey i - 1 (ground for i = 1) to i */
+    double xi;           /* damping ratio in [0, 1) */
+    pd_damping damping;
+    int modes[2];        /* Rayleigh: the two modes (1-based) given xi; an SDOF uses mode 1 */
+    /* derived by pd_scene_finish */
+    double T0;           /* fundamental period [s] */
+    double period[2];    /* periods of the damping modes [s] */
+    double alpha, beta;  /* C = alpha M + beta K */
+    int dof;             /* first dof of the structure in the scene's model */
+} pd_structure;
+
+typedef struct pd_contact {
+    int a, b;            /* structure indices (file order), PD_WALL for a wall */
+    int level_a, level_b; /* storeys, 1-based (0 at a wall) */
+    double gap;          /* [m] >= 0 */
+    double eps;          /* Newton restitution in [0, 1] */
+    int entry;           /* the contacts[] entry of the scene file it came from */
+} pd_contact;
+
+/* The excitation of a scene: a pulse along +x (dir +1) or -x. */
+typedef struct pd_scene_excitation {
+    pd_pulse pulse;
+    int dir;             /* +1: first effective inertial force -m ug'' along +x */
+    double ap, Tp;       /* [m/s^2], [s] */
+} pd_scene_excitation;
+
+typedef struct pd_scene {
+    int nstruct, ncontact;
+    pd_structure *st;
+    pd_contact *ct;
+    pd_scene_excitation exc;
+    double tend;         /* [s]; 0 = derived */
+    int n;               /* degrees of freedom (after pd_scene_finish) */
+    int finished;
+    int cap_struct, cap_contact; /* allocated entries */
+} pd_scene;
+
+/* An empty scene excited by exc; NULL when out of memory. */
+pd_scene *pd_scene_new(const pd_scene_excitation *exc);
+void pd_scene_free(pd_scene *sc);
+
+/* Add structures and contacts (file order is row order, left to right).
+ * Each returns PD_OK or an error whose message starts with the field it
+ * concerns ("T0: must be > 0 (got -1)"). */
+int pd_scene_add_sdof(pd_scene *sc, const char *name, double T0, double xi, double mass,
+                      pd_err *err);
+int pd_scene_add_building(pd_scene *sc, const char *name, int storeys, const double *masses,
+                          const double *stiffnesses, double xi, pd_err *err);
+/* Uniform storeys of mass `mass` with the stiffness that gives the
+ * fundamental period T0. */
+int pd_scene_add_uniform(pd_scene *sc, const char *name, int storeys, double mass, double T0,
+                         double xi, pd_err *err);
+/* Damping of the last structure added: the model and (Rayleigh) its modes. */
+int pd_scene_set_damping(pd_scene *sc, pd_damping damping, int mode1, int mode2, pd_err *err);
+/* A contact; a or b PD_WALL for a wall (level 0 there). */
+int pd_scene_add_contact(pd_scene *sc, int a, int level_a, int b, int level_b, double gap,
+                         double eps, int entry, pd_err *err);
+/* The structure called name, or -1 (PD_WALL for "wall"); -2 when unknown. */
+int pd_scene_find(const pd_scene *sc, const char *name);
+
+/* Check the row (contacts left to right, levels that exist, a non-empty
+ * row), number the dofs, derive periods and damping.  PD_OK or PD_EINVAL. */
+int pd_scene_finish(pd_scene *sc, pd_err *err);
+
+/* Read a scene file (JSON, docs/scenes.md).  Errors: PD_EIO (unreadable),
+ * PD_EPARSE with "FILE:LINE:COL: field.path: what is wrong". */
+int pd_scene_load(const char *path, pd_scene **out, pd_err *err);
+
+/* A generated row of N SDOFs of unit mass between two walls, periods
+ * alternating T0 and ratio T0, every gap `gap` and restitution eps: the
+ * scale-study scene of `--chain N`. */
+int pd_scene_chain(int N, const pd_scene_excitation *exc, double T0, double ratio, double xi,
+                   double gap, double eps, pd_scene **out, pd_err *err);
+
+/* Reference scales: wp = 2 pi / Tp, Le = ap / wp^2. */
+double pd_scene_wp(const pd_scene *sc);
+double pd_scene_Le(const pd_scene *sc);
+/* min(Tp, shortest fundamental period) / 2000, and the tend of a pulse:
+ * Tp + 2 (longest fundamental period); harmonic: as for the oscillator with
+ * the longest period and the smallest damping. */
+double pd_scene_default_dt(const pd_scene *sc);
+double pd_scene_default_tend(const pd_scene *sc);
+double pd_scene_measure_start(const pd_scene *sc, double tend);
+/* Check the options and complete dt and tend. */
+int pd_scene_resolve_opts(const pd_scene *sc, const pd_run_opts *in, pd_run_opts *out,
+                          pd_err *err);
+/* 1 when the scene is the one-wall oscillator (one SDOF, at most one contact,
+ * with a wall): it then runs on the oscillator's fast paths, with *c the
+ * equivalent case (mirrored when the wall is on the left). */
+int pd_scene_as_oscillator(const pd_scene *sc, pd_osc *c, int *mirrored);
+
+/* The scene as an engine model in the reference units (tau = wp t, x =
+ * u / Le, masses in kg): M, C, K, W compressed-column, F = M 1 phi(tau). */
+typedef struct pd_scene_model {
+    pd_model model;
+    pd_sparse M, C, K, W;
+    double *g0, *e, *mass;
+    double breaks[1];
+    pd_pulse pulse;
+    int dir;
+} pd_scene_model;
+
+int pd_scene_model_build(const pd_scene *sc, int with_contacts, pd_scene_model *sm, pd_err *err);
+void pd_scene_model_free(pd_scene_model *sm);
+
+/* One sample of a scene run, in metres, seconds and newton-seconds. */
+typedef struct pd_scene_sample {
+    long step;
+    double t;
+    const double *x;       /* n displacements (structure s, storey k: st[s].dof + k - 1) */
+    const double *v;       /* n velocities [m/s] */
+    const double *gap;     /* m gaps [m] */
+    const double *impulse; /* m contact impulses since the last sample [N s] */
+} pd_scene_sample;
+
+typedef int (*pd_scene_sampler)(const pd_scene_sample *s, void *ctx);
+
+/* What a scene run measures.  Arrays are allocated by pd_scene_result_alloc. */
+typedef struct pd_scene_result {
+    int n, m;
+    double *umax;          /* n: max |x| per dof over the measuring window [m] */
+    double *u_pos, *u_neg; /* n: max x and max -x [m] */
+    double *drift;         /* n: max |x_k - x_k-1| per storey (x_0 = ground) [m] */
+    long *impacts;         /* m: contact episodes begun */
+    double *first_impact;  /* m: time of the first impact [s], NAN when none */
+    double *max_impulse;   /* m: largest impulse of one impact [N s] */
+    double *contact_time;  /* m: time in contact [s] */
+    double *approach;      /* m: max over t of -(g - gap), the closing [m] */
+    long steps;            /* steps, accepted steps or events */
+    long lcp_solves;       /* LCPs solved (Moreau–Jean general kernel) */
+    double dt, tend, theta, cpu_s;
+    const char *method, *kernel, *factor, *lcp_solver;
+} pd_scene_result;
+
+int pd_scene_result_alloc(const pd_scene *sc, pd_scene_result *r, pd_err *err);
+void pd_scene_result_free(pd_scene_result *r);
+
+/* Run the scene with the method of opts; sampler (may be NULL) gets the
+ * state every step (Moreau–Jean) or every dt (the others), and at t = 0. */
+int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler sampler,
+                 void *ctx, pd_scene_result *res, pd_err *err);
+
+/* A run and its contact-free twin with the Pi terms:
+ *   Pi1 = umax wp^2 / ap per dof,  Pi2 = Tp / T0 per structure,
+ *   Pi3 = gap wp^2 / ap per contact,
+ *   gamma = umax / umax_free per dof,  chi = gap / approach_free per contact. */
+typedef struct pd_scene_summary {
+    pd_scene_result r, free;
+    double *Pi1, *gamma;   /* n */
+    double *Pi2;           /* nstruct */
+    double *Pi3, *chi;     /* m */
+    double cpu_s;
+} pd_scene_summary;
+
+int pd_scene_summarize(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler sampler,
+                       void *ctx, pd_scene_summary *s, pd_err *err);
+void pd_scene_summary_free(pd_scene_summary *s);
+
+/* ==== spectrum sweeps ============================================================ *
+ * A Pi2 grid crossed with lists of pulse, directivity, amplitude, damping,
+ * gap and restitution.
+ *
+ * Tasks.  A sweep is a list of independent, deterministic runs ("tasks"):
+ * first the no-wall twins, one per (pulse, dir, ap, xi, Pi2) — they do not
+ * depend on the gap or on eps — then the runs with the wall, one per point.
+ * Task results go into a preallocated array indexed by task, so the order in
+ * which threads or processes finish never changes a number: any split of
+ * the tasks gives output bit-identical to the serial run.
+ *
+ * Curves and points.  A curve is one (pulse, dir, ap, xi, Pi3 or gap, eps);
+ * curve indices run with eps fastest, then the gap, xi, ap, dir, pulse.
+ * Point p = curve * npi2 + j is the curve's j-th Pi2 value. */
+
+enum { PD_SPEC_MAX_LIST = 64 };
+
+/* Most tasks a sweep may have (memory for results and journal). */
+#define PD_SPEC_MAX_TASKS 2000000L
+
+/* The sweep as the command line defines it. */
+typedef struct pd_spectrum {
+    pd_osc base;      /* Tp and the defaults (the lists override) */
+    pd_run_opts opts; /* scheme, method and penalty; dt, tend 0: per point */
+    double pi2_min, pi2_max;
+    int npi2, linear; /* linear: equal steps; else log-spaced */
+    int npulse, ndir, nap, nxi, nsize, neps;
+    pd_pulse pulse[3];
+    int dir[2];
+    double ap[PD_SPEC_MAX_LIST], xi[PD_SPEC_MAX_LIST];
+    double size[PD_SPEC_MAX_LIST], eps[PD_SPEC_MAX_LIST];
+    int size_is_gap; /* size[] holds gaps in metres (--gap), else Pi3 values */
+    int dimensional; /* --ap given: add the dimensional view (umax vs T0) */
+    double dt_per_Tp; /* > 0: dt = Tp / dt_per_Tp for every point */
+} pd_spectrum;
+
+/* Where a task sits in the sweep. */
+typedef struct pd_spec_coords {
+    int twin; /* 1: the no-wall twin of a (pulse, dir, ap, xi, Pi2) */
+    int pulse, dir, ap, xi, size, eps, j;
+    long curve; /* -1 for a twin */
+} pd_spec_coords;
+
+/* What one task measured (in metres and seconds). */
+typedef struct pd_spec_result {
+    double umax, u_toward, u_away, contact_time, first_impact, cpu_s;
+    long impacts, steps;
+    int status; /* 0 ok, else the run's PD_E* status */
+    int done;   /* 1 once computed (or read back from the journal) */
+} pd_spec_result;
+
+/* One point of the spectrum, ready for output. */
+typedef struct pd_spec_row {
+    pd_osc c;
+    long curve;
+    double T0, gap, dt, tend;
+    double umax, Pi1, umax_free, gamma, chi, u_toward, u_away, contact_time, first_impact;
+    double cpu_s;
+    long impacts, steps;
+} pd_spec_row;
+
+/* ---- the sweep (spectrum_sweep.c) ---------------------------------------- */
+
+/* Defaults: one sine pulse, normal, ap = 1, Tp = 1, xi = 0.05, Pi3 = 0.05,
+ * eps = 0.5; no Pi2 grid yet (npi2 = 0). */
+void pd_spec_init(pd_spectrum *s);
+long pd_spec_curves(const pd_spectrum *s);
+long pd_spec_points(const pd_spectrum *s);
+long pd_spec_twins(const pd_spectrum *s);
+long pd_spec_tasks(const pd_spectrum *s);
+/* The j-th Pi2 of the grid (end points exact). */
+double pd_spec_pi2(const pd_spectrum *s, int j);
+void pd_spec_coords_of(const pd_spectrum *s, long task, pd_spec_coords *co);
+/* The twin task of a point task. */
+long pd_spec_twin_of(const pd_spectrum *s, long task);
+/* The case and options of a task, resolved as `pound simulate` resolves
+ * them (dt, tend derived per point): PD_OK or PD_EINVAL naming the field. */
+int pd_spec_case(const pd_spectrum *s, long task, pd_osc *c, pd_run_opts *o, pd_err *err);
+/* Check every point's case: PD_OK or PD_EINVAL with the first bad one. */
+int pd_spec_validate(const pd_spectrum *s, pd_err *err);
+/* Run one task into r (r->status and err say why it failed). */
+void pd_spec_run_task(const pd_spectrum *s, long task, pd_spec_result *r, pd_err *err);
+/* Expected cost of a task: its number of steps. */
+double pd_spec_cost(const pd_spectrum *s, long task);
+/* A canonical text of every parameter that shapes the results (the
+ * journal header); malloc'd, NULL when out of memory. */
+char *pd_spec_key(const pd_spectrum *s);
+/* Points from task results (twins give umax_free, gamma, chi). */
+void pd_spec_rows(const pd_spectrum *s, const pd_spec_result *res, pd_spec_row *rows);
+/* A short label of a curve naming the parameters that vary. */
+void pd_spec_curve_label(const pd_spectrum *s, long curve, char *buf, size_t cap);
+
+#endif

@@ -1,0 +1,77 @@
+/* run.c — the run request shared by the oscillator, scenes and sweeps. */
+#include <math.h>
+#include <string.h>
+
+#include "pd_problems.h"
+
+const char *pd_method_name(pd_method method)
+{
+    return method == PD_METHOD_EVENT ? "event" : method == PD_METHOD_PENALTY ? "penalty" : "moreau";
+}
+
+int pd_method_parse(const char *name, pd_method *method)
+{
+    if (name && !strcmp(name, "moreau"))
+        *method = PD_METHOD_MOREAU;
+    else if (name && !strcmp(name, "event"))
+        *method = PD_METHOD_EVENT;
+    else if (name && !strcmp(name, "penalty"))
+        *method = PD_METHOD_PENALTY;
+    else
+        return PD_EINVAL;
+    return PD_OK;
+}
+
+pd_run_opts pd_run_default_opts(void)
+{
+    return (pd_run_opts){.method = PD_METHOD_MOREAU,
+                         .dt = 0.0,
+                         .tend = 0.0,
+                         .theta = 0.5,
+                         .gamma = 0.5,
+                         .allow_unstable = 0,
+                         .kernel = PD_KERNEL_AUTO,
+                         .factor = PD_FACTOR_AUTO,
+                         .lcp_solver = PD_LCP_AUTO,
+                         .no_accumulation = 0,
+                         .no_wall = 0,
+                         .pen = {.law = PD_PENALTY_KELVIN,
+                                 .kc_mult = 1e4,
+                                 .kc_abs = 0.0,
+                                 .rtol = 1e-10,
+                                 .atol = 1e-12,
+                                 .stepper = "rk8pd"}};
+}
+
+int pd_run_opts_check(const pd_run_opts *o, pd_err *err)
+{
+    if (o->method != PD_METHOD_MOREAU && o->method != PD_METHOD_EVENT &&
+        o->method != PD_METHOD_PENALTY)
+        return pd_err_set(err, PD_EINVAL, "method: unknown method %d", (int)o->method);
+    if (!(o->dt >= 0.0) || !isfinite(o->dt))
+        return pd_err_set(err, PD_EINVAL, "dt: must be a finite number > 0 (got %g)", o->dt);
+    if (!(o->tend >= 0.0) || !isfinite(o->tend))
+        return pd_err_set(err, PD_EINVAL, "tend: must be a finite number > 0 (got %g)", o->tend);
+    if (!(o->theta >= 0.0 && o->theta <= 2.0))
+        return pd_err_set(err, PD_EINVAL, "theta: must be in [0, 2] (got %g)", o->theta);
+    if (!o->allow_unstable && !(o->theta >= 0.5 && o->theta <= 1.0))
+        return pd_err_set(err, PD_EINVAL,
+                          "theta: %g is outside [1/2, 1], where Moreau-Jean is not "
+                          "unconditionally stable (allow_unstable runs it anyway)",
+                          o->theta);
+    if (!(o->gamma >= 0.0 && o->gamma <= 1.0))
+        return pd_err_set(err, PD_EINVAL, "gamma: must be in [0, 1] (got %g)", o->gamma);
+    const pd_penalty_setup *p = &o->pen;
+    if (p->law != PD_PENALTY_KELVIN && p->law != PD_PENALTY_HERTZDAMP)
+        return pd_err_set(err, PD_EINVAL, "contact: unknown contact law %d", (int)p->law);
+    if (!(p->kc_mult > 0.0) || !isfinite(p->kc_mult))
+        return pd_err_set(err, PD_EINVAL, "kc: the contact stiffness multiple must be > 0 (got %g)",
+                          p->kc_mult);
+    if (!(p->kc_abs >= 0.0) || !isfinite(p->kc_abs))
+        return pd_err_set(err, PD_EINVAL, "kc-abs: the contact stiffness must be >= 0 (got %g)",
+                          p->kc_abs);
+    if (!(p->rtol > 0.0 && p->atol > 0.0) || !isfinite(p->rtol) || !isfinite(p->atol))
+        return pd_err_set(err, PD_EINVAL, "rtol/atol: tolerances must be > 0 (got %g, %g)",
+                          p->rtol, p->atol);
+    return PD_OK;
+}

@@ -1,0 +1,619 @@
+/* scene.c — rows of structures (SPEC §4): building a scene, checking it,
+ * its periods and damping, and the engine model it gives.
+ *
+ * A shear building of s storeys: masses m_i, storey stiffnesses k_i (k_1
+ * joins storey 1 to the ground), K tridiagonal with K_ii = k_i + k_i+1,
+ * K_i,i+1 = -k_i+1.  Periods from the tridiagonal eigenproblem
+ * M^-1/2 K M^-1/2 by Sturm bisection.  Classical damping C = alpha M + beta K:
+ * Rayleigh through xi at modes i, j (alpha = 2 xi wi wj / (wi + wj),
+ * beta = 2 xi / (wi + wj)), or stiffness-proportional through xi at mode 1;
+ * an SDOF gets c = 2 xi w0 m exactly. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pd_problems.h"
+
+#define SCENE_MAX_STOREYS 100000
+
+pd_scene *pd_scene_new(const pd_scene_excitation *exc)
+{
+    pd_scene *sc = calloc(1, sizeof *sc);
+    if (sc && exc)
+        sc->exc = *exc;
+    return sc;
+}
+
+void pd_scene_free(pd_scene *sc)
+{
+    if (!sc)
+        return;
+    for (int s = 0; s < sc->nstruct; s++) {
+        free(sc->st[s].mass);
+        free(sc->st[s].stiffness);
+    }
+    free(sc->st);
+    free(sc->ct);
+    free(sc);
+}
+
+int pd_scene_find(const pd_scene *sc, const char *name)
+{
+    if (!strcmp(name, "wall"))
+        return PD_WALL;
+    for (int s = 0; s < sc->nstruct; s++)
+        if (!strcmp(sc->st[s].name, name))
+            return s;
+    return -2;
+}
+
+/* Room for one more structure (with its storey arrays) or contact. */
+static int grow(void **arr, int *cap, int need, size_t size)
+{
+    if (need <= *cap)
+        return PD_OK;
+    int ncap = *cap ? 2 * *cap : 8;
+    while (ncap < need)
+        ncap *= 2;
+    void *p = realloc(*arr, (size_t)ncap * size);
+    if (!p)
+        return PD_ENOMEM;
+    *arr = p;
+    *cap = ncap;
+    return PD_OK;
+}
+
+/* A new structure: name checked, storey arrays allocated. */
+static pd_structure *new_structure(pd_scene *sc, const char *name, int storeys, double xi,
+                                   pd_err *err)
+{
+    if (!name || !name[0] || strlen(name) >= PD_NAME_MAX) {
+        pd_err_set(err, PD_EINVAL, "name: must be 1 to %d characters", PD_NAME_MAX - 1);
+        return NULL;
+    }
+    for (const char *c = name; *c; c++)
+        if ((unsigned char)*c < 0x20 || *c == 0x7f || *c == '/') {
+            pd_err_set(err, PD_EINVAL, "name: may not contain '/' or control characters");
+            return NULL;
+        }
+    if (pd_scene_find(sc, name) != -2) {
+        pd_err_set(err, PD_EINVAL, "name: '%s' %s", name,
+                   strcmp(name, "wall") ? "is used twice" : "is reserved for the walls");
+        return NULL;
+    }
+    if (storeys < 1 || storeys > SCENE_MAX_STOREYS) {
+        pd_err_set(err, PD_EINVAL, "storeys: must be an integer in [1, %d] (got %d)",
+                   SCENE_MAX_STOREYS, storeys);
+        return NULL;
+    }
+    if (!(xi >= 0.0 && xi < 1.0)) {
+        pd_err_set(err, PD_EINVAL, "xi: the damping ratio must be in [0, 1) (got %g)", xi);
+        return NULL;
+    }
+    if (grow((void **)&sc->st, &sc->cap_struct, sc->nstruct + 1, sizeof *sc->st)) {
+        pd_err_set(err, PD_ENOMEM, "out of memory for structure '%s'", name);
+        return NULL;
+    }
+    pd_structure *st = &sc->st[sc->nstruct];
+    memset(st, 0, sizeof *st);
+    st->mass = malloc((size_t)storeys * sizeof(double));
+    st->stiffness = malloc((size_t)storeys * sizeof(double));
+    if (!st->mass || !st->stiffness) {
+        free(st->mass);
+        free(st->stiffness);
+        pd_err_set(err, PD_ENOMEM, "out of memory for structure '%s'", name);
+        return NULL;
+    }
+    snprintf(st->name, sizeof st->name, "%s", name);
+    st->storeys = storeys;
+    st->xi = xi;
+    st->damping = PD_DAMPING_RAYLEIGH;
+    st->modes[0] = 1;
+    st->modes[1] = 2;
+    sc->nstruct++;
+    sc->finished = 0;
+    return st;
+}
+
+/* A finite value > 0. */
+static int positive(double x)
+{
+    return x > 0.0 && isfinite(x);
+}
+
+int pd_scene_add_sdof(pd_scene *sc, const char *name, double T0, double xi, double mass,
+                      pd_err *err)
+{
+    if (!positive(T0))
+        return pd_err_set(err, PD_EINVAL, "T0: the period must be > 0 (got %g)", T0);
+    if (!positive(mass))
+        return pd_err_set(err, PD_EINVAL, "mass: must be > 0 (got %g)", mass);
+    pd_structure *st = new_structure(sc, name, 1, xi, err);
+    if (!st)
+        return err ? err->status : PD_EINVAL;
+    double w0 = PD_TWO_PI / T0;
+    st->mass[0] = mass;
+    st->stiffness[0] = mass * w0 * w0;
+    return PD_OK;
+}
+
+int pd_scene_add_building(pd_scene *sc, const char *name, int storeys, const double *masses,
+                          const double *stiffnesses, double xi, pd_err *err)
+{
+    for (int i = 0; i < storeys; i++) {
+        if (!positive(masses[i]))
+            return pd_err_set(err, PD_EINVAL, "masses: storey %d has mass %g, must be > 0", i + 1,
+                              masses[i]);
+        if (!positive(stiffnesses[i]))
+            return pd_err_set(err, PD_EINVAL,
+                              "stiffnesses: storey %d has stiffness %g, must be > 0", i + 1,
+                              stiffnesses[i]);
+    }
+    pd_structure *st = new_structure(sc, name, storeys, xi, err);
+    if (!st)
+        return err ? err->status : PD_EINVAL;
+    memcpy(st->mass, masses, (size_t)storeys * sizeof(double));
+    memcpy(st->stiffness, stiffnesses, (size_t)storeys * sizeof(double));
+    return PD_OK;
+}
+
+/* Uniform shear building: w1 = 2 sqrt(k/m) sin(pi / (2 (2 s + 1))). */
+int pd_scene_add_uniform(pd_scene *sc, const char *name, int storeys, double mass, double T0,
+                         double xi, pd_err *err)
+{
+    if (!positive(T0))
+        return pd_err_set(err, PD_EINVAL, "T0: the period must be > 0 (got %g)", T0);
+    if (!positive(mass))
+        return pd_err_set(err, PD_EINVAL, "mass: must be > 0 (got %g)", mass);
+    pd_structure *st = new_structure(sc, name, storeys, xi, err);
+    if (!st)
+        return err ? err->status : PD_EINVAL;
+    double w1 = PD_TWO_PI / T0, s = sin(PD_PI / (2.0 * (2.0 * storeys + 1.0)));
+    double k = mass * w1 * w1 / (4.0 * s * s);
+    for (int i = 0; i < storeys; i++) {
+        st->mass[i] = mass;
+        st->stiffness[i] = k;
+    }
+    return PD_OK;
+}
+
+int pd_scene_set_damping(pd_scene *sc, pd_damping damping, int mode1, int mode2, pd_err *err)
+{
+    if (sc->nstruct == 0)
+        return pd_err_set(err, PD_EINVAL, "damping: no structure to apply it to");
+    pd_structure *st = &sc->st[sc->nstruct - 1];
+    if (damping != PD_DAMPING_RAYLEIGH && damping != PD_DAMPING_STIFFNESS)
+        return pd_err_set(err, PD_EINVAL, "damping: unknown model %d", (int)damping);
+    if (damping == PD_DAMPING_RAYLEIGH && st->storeys > 1 &&
+        !(mode1 >= 1 && mode2 > mode1 && mode2 <= st->storeys))
+        return pd_err_set(err, PD_EINVAL,
+                          "rayleigh_modes: need two modes 1 <= i < j <= %d (got %d, %d)",
+                          st->storeys, mode1, mode2);
+    st->damping = damping;
+    st->modes[0] = mode1;
+    st->modes[1] = mode2;
+    sc->finished = 0;
+    return PD_OK;
+}
+
+int pd_scene_add_contact(pd_scene *sc, int a, int level_a, int b, int level_b, double gap,
+                         double eps, int entry, pd_err *err)
+{
+    if (!(gap >= 0.0) || !isfinite(gap))
+        return pd_err_set(err, PD_EINVAL, "gap: must be >= 0 (got %g)", gap);
+    if (!(eps >= 0.0 && eps <= 1.0))
+        return pd_err_set(err, PD_EINVAL, "eps: the restitution must be in [0, 1] (got %g)", eps);
+    if (a == PD_WALL && b == PD_WALL)
+        return pd_err_set(err, PD_EINVAL, "b: a contact joins a structure to a wall or to "
+                                          "another structure, not two walls");
+    if (a < PD_WALL || a >= sc->nstruct)
+        return pd_err_set(err, PD_EINVAL, "a: no structure %d", a);
+    if (b < PD_WALL || b >= sc->nstruct)
+        return pd_err_set(err, PD_EINVAL, "b: no structure %d", b);
+    if (a != PD_WALL && b != PD_WALL && !(a < b))
+        return pd_err_set(err, PD_EINVAL,
+                          "b: '%s' must stand to the right of '%s' (a is the left one, in file "
+                          "order)",
+                          sc->st[b].name, sc->st[a].name);
+    if (a != PD_WALL && !(level_a >= 1 && level_a <= sc->st[a].storeys))
+        return pd_err_set(err, PD_EINVAL, "levels: '%s' has no storey %d (it has %d)",
+                          sc->st[a].name, level_a, sc->st[a].storeys);
+    if (b != PD_WALL && !(level_b >= 1 && level_b <= sc->st[b].storeys))
+        return pd_err_set(err, PD_EINVAL, "levels: '%s' has no storey %d (it has %d)",
+                          sc->st[b].name, level_b, sc->st[b].storeys);
+    if (grow((void **)&sc->ct, &sc->cap_contact, sc->ncontact + 1, sizeof *sc->ct))
+        return pd_err_set(err, PD_ENOMEM, "out of memory for contact %d", sc->ncontact);
+    sc->ct[sc->ncontact++] = (pd_contact){.a = a,
+                                          .b = b,
+                                          .level_a = a == PD_WALL ? 0 : level_a,
+                                          .level_b = b == PD_WALL ? 0 : level_b,
+                                          .gap = gap,
+                                          .eps = eps,
+                                          .entry = entry};
+    sc->finished = 0;
+    return PD_OK;
+}
+
+/* Number of eigenvalues below x of the symmetric tridiagonal (d, e):
+ * negative pivots of the LDL^T of T - x I (Sturm count). */
+static int sturm_count(int s, const double *d, const double *e, double x)
+{
+    int count = 0;
+    double q = 1.0;
+    for (int i = 0; i < s; i++) {
+        double off = i > 0 ? e[i - 1] * e[i - 1] : 0.0;
+        q = d[i] - x - (i > 0 ? off / q : 0.0);
+        if (q == 0.0)
+            q = -1e-300; /* an exact zero pivot counts as negative */
+        count += q < 0.0;
+    }
+    return count;
+}
+
+/* The j-th smallest eigenvalue (1-based) of (d, e) by bisection on the
+ * Sturm count, in [0, Gershgorin bound]. */
+static double tridiag_eigenvalue(int s, const double *d, const double *e, int j)
+{
+    double lo = 0.0, hi = 0.0;
+    for (int i = 0; i < s; i++)
+        hi = fmax(hi, d[i] + (i > 0 ? fabs(e[i - 1]) : 0.0) + (i + 1 < s ? fabs(e[i]) : 0.0));
+    for (int it = 0; it < 200 && hi - lo > 4e-16 * hi; it++) {
+        double mid = 0.5 * (lo + hi);
+        if (sturm_count(s, d, e, mid) >= j)
+            hi = mid;
+        else
+            lo = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+/* Circular frequencies of modes j1 and j2 of a structure (w[1] = w[0] when
+ * there is one storey); PD_ENOMEM. */
+static int structure_frequencies(const pd_structure *st, int j1, int j2, double w[2])
+{
+    int s = st->storeys;
+    double *d = malloc((size_t)s * sizeof(double)), *e = malloc((size_t)s * sizeof(double));
+    if (!d || !e) {
+        free(d);
+        free(e);
+        return PD_ENOMEM;
+    }
+    for (int i = 0; i < s; i++) { /* M^-1/2 K M^-1/2 */
+        double kup = i + 1 < s ? st->stiffness[i + 1] : 0.0;
+        d[i] = (st->stiffness[i] + kup) / st->mass[i];
+        e[i] = i + 1 < s ? -kup / sqrt(st->mass[i] * st->mass[i + 1]) : 0.0;
+    }
+    w[0] = sqrt(tridiag_eigenvalue(s, d, e, j1));
+    w[1] = j2 <= s ? sqrt(tridiag_eigenvalue(s, d, e, j2)) : w[0];
+    free(d);
+    free(e);
+    return PD_OK;
+}
+
+/* Periods and C = alpha M + beta K of one structure. */
+static int structure_damping(pd_structure *st, pd_err *err)
+{
+    double w1[2], w[2];
+    int rc;
+    if ((rc = structure_frequencies(st, 1, 1, w1)))
+        return pd_err_set(err, rc, "out of memory for the modes of '%s'", st->name);
+    st->T0 = PD_TWO_PI / w1[0];
+    if (st->storeys == 1 || st->damping == PD_DAMPING_STIFFNESS) {
+        st->period[0] = st->period[1] = st->T0;
+        st->alpha = st->storeys == 1 ? 2.0 * st->xi * w1[0] : 0.0;
+        st->beta = st->storeys == 1 ? 0.0 : 2.0 * st->xi / w1[0];
+        return PD_OK;
+    }
+    if (!(st->modes[0] >= 1 && st->modes[1] > st->modes[0] && st->modes[1] <= st->storeys))
+        return pd_err_set(err, PD_EINVAL,
+                          "rayleigh_modes: '%s' needs two modes 1 <= i < j <= %d (got %d, %d)",
+                          st->name, st->storeys, st->modes[0], st->modes[1]);
+    if ((rc = structure_frequencies(st, st->modes[0], st->modes[1], w)))
+        return pd_err_set(err, rc, "out of memory for the modes of '%s'", st->name);
+    st->period[0] = PD_TWO_PI / w[0];
+    st->period[1] = PD_TWO_PI / w[1];
+    st->alpha = 2.0 * st->xi * w[0] * w[1] / (w[0] + w[1]);
+    st->beta = 2.0 * st->xi / (w[0] + w[1]);
+    return PD_OK;
+}
+
+/* The excitation in range; the message names the field. */
+static int check_excitation(const pd_scene_excitation *x, pd_err *err)
+{
+    if (x->pulse != PD_PULSE_SINE && x->pulse != PD_PULSE_COSINE && x->pulse != PD_PULSE_HARMONIC)
+        return pd_err_set(err, PD_EINVAL, "pulse: must be sine, cosine or harmonic");
+    if (x->dir != 1 && x->dir != -1)
+        return pd_err_set(err, PD_EINVAL, "dir: must be +x or -x");
+    if (!positive(x->ap))
+        return pd_err_set(err, PD_EINVAL, "ap: the pulse amplitude must be > 0 (got %g)", x->ap);
+    if (!positive(x->Tp))
+        return pd_err_set(err, PD_EINVAL, "Tp: the pulse period must be > 0 (got %g)", x->Tp);
+    return PD_OK;
+}
+
+int pd_scene_finish(pd_scene *sc, pd_err *err)
+{
+    int rc, dof = 0;
+    if (sc->nstruct == 0)
+        return pd_err_set(err, PD_EINVAL, "structures: the row is empty");
+    if ((rc = check_excitation(&sc->exc, err)))
+        return rc;
+    if (!(sc->tend >= 0.0) || !isfinite(sc->tend))
+        return pd_err_set(err, PD_EINVAL, "tend: must be > 0 (got %g)", sc->tend);
+    for (int s = 0; s < sc->nstruct; s++) {
+        sc->st[s].dof = dof;
+        if (dof > 2000000000 - sc->st[s].storeys)
+            return pd_err_set(err, PD_EINVAL, "structures: too many storeys in the row");
+        dof += sc->st[s].storeys;
+        if ((rc = structure_damping(&sc->st[s], err)))
+            return rc;
+    }
+    sc->n = dof;
+    sc->finished = 1;
+    return PD_OK;
+}
+
+double pd_scene_wp(const pd_scene *sc) { return PD_TWO_PI / sc->exc.Tp; }
+
+double pd_scene_Le(const pd_scene *sc)
+{
+    double wp = pd_scene_wp(sc);
+    return sc->exc.ap / (wp * wp);
+}
+
+/* Longest and shortest fundamental periods, smallest damping. */
+static void period_range(const pd_scene *sc, double *Tmin, double *Tmax, double *ximin)
+{
+    *Tmin = HUGE_VAL;
+    *Tmax = 0.0;
+    *ximin = 1.0;
+    for (int s = 0; s < sc->nstruct; s++) {
+        *Tmin = fmin(*Tmin, sc->st[s].T0);
+        *Tmax = fmax(*Tmax, sc->st[s].T0);
+        *ximin = fmin(*ximin, sc->st[s].xi);
+    }
+}
+
+double pd_scene_default_dt(const pd_scene *sc)
+{
+    double Tmin, Tmax, ximin;
+    period_range(sc, &Tmin, &Tmax, &ximin);
+    return fmin(sc->exc.Tp, Tmin) / 2000.0;
+}
+
+/* The oscillator's defaults with the longest period and the least damping. */
+static pd_osc envelope_case(const pd_scene *sc)
+{
+    double Tmin, Tmax, ximin;
+    period_range(sc, &Tmin, &Tmax, &ximin);
+    pd_osc c = pd_osc_default();
+    c.pulse = sc->exc.pulse;
+    c.Tp = sc->exc.Tp;
+    c.ap = sc->exc.ap;
+    c.Pi2 = sc->exc.Tp / Tmax;
+    c.xi = ximin;
+    return c;
+}
+
+double pd_scene_default_tend(const pd_scene *sc)
+{
+    pd_osc c = envelope_case(sc);
+    return pd_osc_default_tend(&c);
+}
+
+double pd_scene_measure_start(const pd_scene *sc, double tend)
+{
+    pd_osc c = envelope_case(sc);
+    return pd_osc_measure_start(&c, tend);
+}
+
+int pd_scene_resolve_opts(const pd_scene *sc, const pd_run_opts *in, pd_run_opts *out,
+                          pd_err *err)
+{
+    int rc;
+    *out = in ? *in : pd_run_default_opts();
+    if (!sc->finished)
+        return pd_err_set(err, PD_EINVAL, "scene: not finished (pd_scene_finish)");
+    if ((rc = pd_run_opts_check(out, err)))
+        return rc;
+    if (out->dt == 0.0)
+        out->dt = pd_scene_default_dt(sc);
+    if (out->tend == 0.0)
+        out->tend = sc->tend > 0.0 ? sc->tend : pd_scene_default_tend(sc);
+    if (out->tend / out->dt > 4e9)
+        return pd_err_set(err, PD_EINVAL, "dt: tend / dt = %g steps is too many",
+                          out->tend / out->dt);
+    return PD_OK;
+}
+
+int pd_scene_as_oscillator(const pd_scene *sc, pd_osc *c, int *mirrored)
+{
+    if (!sc->finished || sc->nstruct != 1 || sc->st[0].storeys != 1 || sc->ncontact > 1)
+        return 0;
+    const pd_contact *ct = sc->ncontact ? &sc->ct[0] : NULL;
+    if (ct && ct->a != PD_WALL && ct->b != PD_WALL)
+        return 0;
+    *mirrored = ct && ct->a == PD_WALL; /* the wall on the left: x = -u */
+    *c = (pd_osc){.pulse = sc->exc.pulse,
+                  .dir = *mirrored ? -sc->exc.dir : sc->exc.dir,
+                  .ap = sc->exc.ap,
+                  .Tp = sc->exc.Tp,
+                  .Pi2 = sc->exc.Tp / sc->st[0].T0,
+                  .Pi3 = 0.0,
+                  .eps = ct ? ct->eps : 0.0,
+                  .xi = sc->st[0].xi};
+    if (ct)
+        pd_osc_set_gap(c, ct->gap);
+    return 1;
+}
+
+/* ---- the engine model ------------------------------------------------------ */
+
+/* F_i = m_i s phi(tau): the effective inertial forces along x, in units of ap. */
+static void scene_force(double tau, int side, double *F, void *ctx)
+{
+    const pd_scene_model *sm = ctx;
+    double f = pd_pulse_shape(sm->pulse, sm->dir, tau, side);
+    for (int i = 0; i < sm->model.n; i++)
+        F[i] = sm->mass[i] * f;
+}
+
+void pd_scene_model_free(pd_scene_model *sm)
+{
+    pd_sparse_free(&sm->M);
+    pd_sparse_free(&sm->C);
+    pd_sparse_free(&sm->K);
+    pd_sparse_free(&sm->W);
+    free(sm->g0);
+    free(sm->e);
+    free(sm->mass);
+    memset(sm, 0, sizeof *sm);
+}
+
+/* Triplets of M, K, C (in reference units) and of W. */
+typedef struct triplets {
+    int *i, *j;
+    double *x;
+    long n;
+} triplets;
+
+static void tri_add(triplets *t, int i, int j, double x)
+{
+    t->i[t->n] = i;
+    t->j[t->n] = j;
+    t->x[t->n++] = x;
+}
+
+static int tri_alloc(triplets *t, long cap)
+{
+    t->n = 0;
+    t->i = malloc((size_t)(cap > 0 ? cap : 1) * sizeof(int));
+    t->j = malloc((size_t)(cap > 0 ? cap : 1) * sizeof(int));
+    t->x = malloc((size_t)(cap > 0 ? cap : 1) * sizeof(double));
+    return t->i && t->j && t->x ? PD_OK : PD_ENOMEM;
+}
+
+static void tri_free(triplets *t)
+{
+    free(t->i);
+    free(t->j);
+    free(t->x);
+}
+
+/* K / wp^2 (kscale) and C / wp = (alpha M + beta K) / wp of one structure. */
+static void structure_triplets(const pd_structure *st, double wp, triplets *K, triplets *C,
+                               triplets *M)
+{
+    int s = st->storeys, o = st->dof;
+    for (int i = 0; i < s; i++) {
+        double kup = i + 1 < s ? st->stiffness[i + 1] : 0.0, kii = st->stiffness[i] + kup;
+        tri_add(M, o + i, o + i, st->mass[i]);
+        tri_add(K, o + i, o + i, kii / (wp * wp));
+        tri_add(C, o + i, o + i, (st->alpha * st->mass[i] + st->beta * kii) / wp);
+        if (i + 1 < s) {
+            tri_add(K, o + i, o + i + 1, -kup / (wp * wp));
+            tri_add(K, o + i + 1, o + i, -kup / (wp * wp));
+            if (st->beta != 0.0) {
+                tri_add(C, o + i, o + i + 1, -st->beta * kup / wp);
+                tri_add(C, o + i + 1, o + i, -st->beta * kup / wp);
+            }
+        }
+    }
+}
+
+/* The dof of a contact's side, or -1 at a wall. */
+static int side_dof(const pd_scene *sc, int s, int level)
+{
+    return s == PD_WALL ? -1 : sc->st[s].dof + level - 1;
+}
+
+int pd_scene_model_build(const pd_scene *sc, int with_contacts, pd_scene_model *sm, pd_err *err)
+{
+    triplets M = {0}, K = {0}, C = {0}, W = {0};
+    int n = sc->n, m = with_contacts ? sc->ncontact : 0, rc = PD_OK;
+    double wp = pd_scene_wp(sc), Le = pd_scene_Le(sc);
+    memset(sm, 0, sizeof *sm);
+    if (!sc->finished)
+        return pd_err_set(err, PD_EINVAL, "scene: not finished (pd_scene_finish)");
+    sm->g0 = malloc((size_t)(m > 0 ? m : 1) * sizeof(double));
+    sm->e = malloc((size_t)(m > 0 ? m : 1) * sizeof(double));
+    sm->mass = malloc((size_t)n * sizeof(double));
+    if (!sm->g0 || !sm->e || !sm->mass || tri_alloc(&M, n) || tri_alloc(&K, 3L * n) ||
+        tri_alloc(&C, 3L * n) || tri_alloc(&W, 2L * m)) {
+        rc = pd_err_set(err, PD_ENOMEM, "out of memory for a model of %d dofs", n);
+        goto done;
+    }
+    for (int s = 0; s < sc->nstruct; s++) {
+        structure_triplets(&sc->st[s], wp, &K, &C, &M);
+        for (int i = 0; i < sc->st[s].storeys; i++)
+            sm->mass[sc->st[s].dof + i] = sc->st[s].mass[i];
+    }
+    for (int a = 0; a < m; a++) { /* g = gap + x_b - x_a */
+        const pd_contact *ct = &sc->ct[a];
+        int ia = side_dof(sc, ct->a, ct->level_a), ib = side_dof(sc, ct->b, ct->level_b);
+        if (ia >= 0)
+            tri_add(&W, ia, a, -1.0);
+        if (ib >= 0)
+            tri_add(&W, ib, a, 1.0);
+        sm->g0[a] = ct->gap / Le;
+        sm->e[a] = ct->eps;
+    }
+    if ((rc = pd_sparse_from_triplets(&sm->M, n, n, M.n, M.i, M.j, M.x, err)) ||
+        (rc = pd_sparse_from_triplets(&sm->K, n, n, K.n, K.i, K.j, K.x, err)) ||
+        (rc = pd_sparse_from_triplets(&sm->C, n, n, C.n, C.i, C.j, C.x, err)) ||
+        (rc = pd_sparse_from_triplets(&sm->W, n, m, W.n, W.i, W.j, W.x, err)))
+        goto done;
+    sm->pulse = sc->exc.pulse;
+    sm->dir = sc->exc.dir;
+    sm->breaks[0] = PD_TWO_PI; /* the pulse end */
+    sm->model = (pd_model){.n = n,
+                           .m = m,
+                           .M = pd_sparse_view(&sm->M),
+                           .C = pd_sparse_view(&sm->C),
+                           .K = pd_sparse_view(&sm->K),
+                           .W = m > 0 ? pd_sparse_view(&sm->W) : pd_matrix_zero(n, 0),
+                           .g0 = sm->g0,
+                           .e = sm->e,
+                           .force = scene_force,
+                           .force_ctx = sm,
+                           .breaks = sm->breaks,
+                           .nbreaks = sc->exc.pulse == PD_PULSE_HARMONIC ? 0 : 1};
+done:
+    tri_free(&M);
+    tri_free(&K);
+    tri_free(&C);
+    tri_free(&W);
+    if (rc)
+        pd_scene_model_free(sm);
+    return rc;
+}
+
+int pd_scene_chain(int N, const pd_scene_excitation *exc, double T0, double ratio, double xi,
+                   double gap, double eps, pd_scene **out, pd_err *err)
+{
+    pd_scene *sc;
+    char name[PD_NAME_MAX];
+    int rc = PD_OK;
+    *out = NULL;
+    if (N < 1 || N > 10000000)
+        return pd_err_set(err, PD_EINVAL, "chain: N must be in [1, 1e7] (got %d)", N);
+    if (!positive(ratio))
+        return pd_err_set(err, PD_EINVAL, "chain-ratio: must be > 0 (got %g)", ratio);
+    if (!(sc = pd_scene_new(exc)))
+        return pd_err_set(err, PD_ENOMEM, "out of memory for a chain of %d", N);
+    for (int i = 0; i < N && !rc; i++) {
+        snprintf(name, sizeof name, "S%d", i + 1);
+        rc = pd_scene_add_sdof(sc, name, i % 2 ? ratio * T0 : T0, xi, 1.0, err);
+    }
+    for (int i = 0; i <= N && !rc; i++)
+        rc = pd_scene_add_contact(sc, i == 0 ? PD_WALL : i - 1, i == 0 ? 0 : 1,
+                                  i == N ? PD_WALL : i, i == N ? 0 : 1, gap, eps, i, err);
+    if (!rc)
+        rc = pd_scene_finish(sc, err);
+    if (rc) {
+        pd_scene_free(sc);
+        return rc;
+    }
+    *out = sc;
+    return PD_OK;
+}

@@ -1,0 +1,641 @@
+/* scene_run.c — running a scene: the one-wall oscillator's fast paths, the
+ * general engines (Moreau–Jean, event-driven, penalty) on the scene's
+ * model, and what a run measures.
+ *
+ * Measurements, in the reference units of the model (x = u / Le, tau = wp t):
+ *   extremes   max |x|, max x, max -x per dof and max |x_k - x_k-1| per storey,
+ *              at every step (Moreau–Jean: the discrete maximum) or, for the
+ *              event-driven and penalty methods, also between their steps,
+ *              where the velocity changes sign, on the quintic Hermite of
+ *              (x, x', x'') at the step ends;
+ *   impacts    an impulse after none (Moreau–Jean: a step with P_a > 0 after a
+ *              step without; event-driven: an impulse at an event; penalty: an
+ *              element engaging);
+ *   impulse    of one impact: the step's P_a, the event's P_a, or the integral
+ *              of the element force over one engagement;
+ *   approach   max over t of x_a - x_b (how far the gap closes). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pd_problems.h"
+
+/* What a run tracks, in reference units. */
+typedef struct track {
+    const pd_scene *sc;
+    pd_method method;
+    int n, m;          /* dofs, contacts of the scene (the model may have none) */
+    int model_m;       /* contacts of the model */
+    double Le, wp, h, tau_measure;
+    int *below;        /* n: the dof of the storey below, -1 for storey 1 */
+    int *dof_a, *dof_b; /* m: the dofs a contact joins, -1 at a wall */
+    double *xmax, *xpos, *xneg, *drift; /* n */
+    long *impacts;     /* m */
+    double *first, *maxP, *ctime, *approach, *episode; /* m */
+    double *g_prev, *U_prev, *U_prev2;  /* m: Moreau–Jean first-impact estimate */
+    unsigned char *touching;            /* m: in an impact episode */
+    double *px, *pv, *pa, *plam;        /* the previous on_step report */
+    unsigned char *pactive;
+    double pt;
+    int have_prev;
+    long lcp_solves;
+    /* sampling */
+    pd_scene_sampler fn;
+    void *ctx;
+    double *sx, *sv, *sg, *sP, *imp; /* SI scratch; impulses since the last sample */
+    double imp_t;                     /* penalty: time the impulses were integrated to */
+    double *imp_lam;                  /* penalty: forces at imp_t */
+} track;
+
+/* ---- results ---------------------------------------------------------------- */
+
+int pd_scene_result_alloc(const pd_scene *sc, pd_scene_result *r, pd_err *err)
+{
+    size_t n = (size_t)sc->n, m = (size_t)(sc->ncontact > 0 ? sc->ncontact : 1);
+    memset(r, 0, sizeof *r);
+    r->n = sc->n;
+    r->m = sc->ncontact;
+    r->umax = calloc(n, sizeof(double));
+    r->u_pos = calloc(n, sizeof(double));
+    r->u_neg = calloc(n, sizeof(double));
+    r->drift = calloc(n, sizeof(double));
+    r->impacts = calloc(m, sizeof(long));
+    r->first_impact = calloc(m, sizeof(double));
+    r->max_impulse = calloc(m, sizeof(double));
+    r->contact_time = calloc(m, sizeof(double));
+    r->approach = calloc(m, sizeof(double));
+    if (!r->umax || !r->u_pos || !r->u_neg || !r->drift || !r->impacts || !r->first_impact ||
+        !r->max_impulse || !r->contact_time || !r->approach) {
+        pd_scene_result_free(r);
+        return pd_err_set(err, PD_ENOMEM, "out of memory for the results of %d dofs", sc->n);
+    }
+    return PD_OK;
+}
+
+void pd_scene_result_free(pd_scene_result *r)
+{
+    free(r->umax);
+    free(r->u_pos);
+    free(r->u_neg);
+    free(r->drift);
+    free(r->impacts);
+    free(r->first_impact);
+    free(r->max_impulse);
+    free(r->contact_time);
+    free(r->approach);
+    memset(r, 0, sizeof *r);
+}
+
+/* ---- the tracker ------------------------------------------------------------ */
+
+static void track_free(track *tr)
+{
+    void *arrays[] = {tr->below, tr->dof_a, tr->dof_b, tr->xmax, tr->xpos, tr->xneg,
+                      tr->drift, tr->impacts, tr->first, tr->maxP, tr->ctime, tr->approach,
+                      tr->episode, tr->g_prev, tr->U_prev, tr->U_prev2, tr->touching, tr->px,
+                      tr->pv, tr->pa, tr->plam, tr->pactive, tr->sx, tr->sv, tr->sg, tr->sP,
+                      tr->imp, tr->imp_lam};
+    for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
+        free(arrays[k]);
+}
+
+/* Every array once, the topology of the scene. */
+static int track_alloc(track *tr, const pd_scene *sc, pd_err *err)
+{
+    size_t n = (size_t)sc->n, m = (size_t)(sc->ncontact > 0 ? sc->ncontact : 1);
+    tr->sc = sc;
+    tr->n = sc->n;
+    tr->m = sc->ncontact;
+#define TA(p, cnt) ((p) = calloc((cnt), sizeof *(p)))
+    if (!TA(tr->below, n) || !TA(tr->dof_a, m) || !TA(tr->dof_b, m) || !TA(tr->xmax, n) ||
+        !TA(tr->xpos, n) || !TA(tr->xneg, n) || !TA(tr->drift, n) || !TA(tr->impacts, m) ||
+        !TA(tr->first, m) || !TA(tr->maxP, m) || !TA(tr->ctime, m) || !TA(tr->approach, m) ||
+        !TA(tr->episode, m) || !TA(tr->g_prev, m) || !TA(tr->U_prev, m) ||
+        !TA(tr->U_prev2, m) || !TA(tr->touching, m) || !TA(tr->px, n) || !TA(tr->pv, n) ||
+        !TA(tr->pa, n) || !TA(tr->plam, m) || !TA(tr->pactive, m) || !TA(tr->sx, n) ||
+        !TA(tr->sv, n) || !TA(tr->sg, m) || !TA(tr->sP, m) || !TA(tr->imp, m) ||
+        !TA(tr->imp_lam, m)) {
+#undef TA
+        track_free(tr);
+        return pd_err_set(err, PD_ENOMEM, "out of memory for tracking %d dofs", sc->n);
+    }
+    for (int s = 0; s < sc->nstruct; s++)
+        for (int k = 0; k < sc->st[s].storeys; k++)
+            tr->below[sc->st[s].dof + k] = k == 0 ? -1 : sc->st[s].dof + k - 1;
+    for (int a = 0; a < tr->m; a++) {
+        const pd_contact *ct = &sc->ct[a];
+        tr->dof_a[a] = ct->a == PD_WALL ? -1 : sc->st[ct->a].dof + ct->level_a - 1;
+        tr->dof_b[a] = ct->b == PD_WALL ? -1 : sc->st[ct->b].dof + ct->level_b - 1;
+        tr->first[a] = NAN;
+        tr->approach[a] = -HUGE_VAL;
+    }
+    return PD_OK;
+}
+
+/* Extremes of the displacement and of the storey drift at one point in time. */
+static void note_point(track *tr, double t, const double *x)
+{
+    if (t < tr->tau_measure - 0.5 * tr->h)
+        return;
+    for (int i = 0; i < tr->n; i++) {
+        double d = x[i] - (tr->below[i] >= 0 ? x[tr->below[i]] : 0.0);
+        tr->xmax[i] = fmax(tr->xmax[i], fabs(x[i]));
+        tr->xpos[i] = fmax(tr->xpos[i], x[i]);
+        tr->xneg[i] = fmax(tr->xneg[i], -x[i]);
+        tr->drift[i] = fmax(tr->drift[i], fabs(d));
+    }
+}
+
+/* How far each gap has closed: x_a - x_b (walls at 0). */
+static void note_approach(track *tr, const double *x)
+{
+    for (int a = 0; a < tr->m; a++) {
+        double xa = tr->dof_a[a] >= 0 ? x[tr->dof_a[a]] : 0.0;
+        double xb = tr->dof_b[a] >= 0 ? x[tr->dof_b[a]] : 0.0;
+        tr->approach[a] = fmax(tr->approach[a], xa - xb);
+    }
+}
+
+/* A turning point of f inside a step: the root of f' on the quintic Hermite
+ * of (f, f', f'') at both ends when f' changes sign; *f gets the value. */
+static int interior_turn(const double p0[3], const double p1[3], double h, double *f)
+{
+    double lo = 0.0, hi = 1.0, fd, s;
+    if (!(p0[1] * p1[1] < 0.0))
+        return 0;
+    for (int it = 0; it < 50; it++) {
+        s = 0.5 * (lo + hi);
+        pd_hermite5(p0, p1, h, s, f, &fd);
+        if ((fd < 0.0) == (p0[1] < 0.0))
+            lo = s;
+        else
+            hi = s;
+    }
+    pd_hermite5(p0, p1, h, 0.5 * (lo + hi), f, &fd);
+    return 1;
+}
+
+/* Extremes between the previous report and (t, x, v, a): turning points of
+ * every dof and every storey drift. */
+static void note_between(track *tr, double t, const double *x, const double *v,
+                         const double *acc)
+{
+    double h = t - tr->pt, f;
+    if (!(h > 0.0) || t < tr->tau_measure)
+        return;
+    for (int i = 0; i < tr->n; i++) {
+        double p0[3] = {tr->px[i], tr->pv[i], tr->pa[i]}, p1[3] = {x[i], v[i], acc[i]};
+        if (interior_turn(p0, p1, h, &f)) {
+            tr->xmax[i] = fmax(tr->xmax[i], fabs(f));
+            tr->xpos[i] = fmax(tr->xpos[i], f);
+            tr->xneg[i] = fmax(tr->xneg[i], -f);
+        }
+        int b = tr->below[i];
+        if (b < 0)
+            continue;
+        double d0[3] = {tr->px[i] - tr->px[b], tr->pv[i] - tr->pv[b], tr->pa[i] - tr->pa[b]};
+        double d1[3] = {x[i] - x[b], v[i] - v[b], acc[i] - acc[b]};
+        if (interior_turn(d0, d1, h, &f))
+            tr->drift[i] = fmax(tr->drift[i], fabs(f));
+    }
+}
+
+/* Remember a report as the start of the next interval. */
+static void keep_report(track *tr, const pd_state *st)
+{
+    memcpy(tr->px, st->q, (size_t)tr->n * sizeof(double));
+    memcpy(tr->pv, st->v, (size_t)tr->n * sizeof(double));
+    if (st->has_acc)
+        memcpy(tr->pa, st->acc, (size_t)tr->n * sizeof(double));
+    for (int a = 0; a < tr->model_m; a++) {
+        tr->pactive[a] = st->active[a];
+        tr->plam[a] = st->P[a];
+    }
+    tr->pt = st->t;
+    tr->have_prev = st->has_acc;
+}
+
+/* Time s in [0, h] after a step start at which a gap g0 > 0 closes under
+ * g(s) = g0 + U s + G s^2 / 2 (rate U, acceleration G of the step). */
+static double closing_time(double g0, double U, double G, double h)
+{
+    double s = h;
+    if (g0 <= 0.0)
+        return 0.0;
+    if (G == 0.0 || fabs(G) * h < 1e-12 * fabs(U))
+        s = U < 0.0 ? -g0 / U : h;
+    else {
+        double disc = U * U - 2.0 * G * g0;
+        if (disc >= 0.0)
+            s = U < 0.0 ? 2.0 * g0 / (-U + sqrt(disc)) : (-U - sqrt(disc)) / G;
+    }
+    return fmin(fmax(s, 0.0), h);
+}
+
+/* Sampler: the state in metres, seconds and newton-seconds. */
+static int sample(track *tr, const pd_state *st)
+{
+    double vs = tr->Le * tr->wp, Ps = tr->sc->exc.ap / tr->wp;
+    for (int i = 0; i < tr->n; i++) {
+        tr->sx[i] = st->q[i] * tr->Le;
+        tr->sv[i] = st->v[i] * vs;
+    }
+    for (int a = 0; a < tr->m; a++) {
+        double xa = tr->dof_a[a] >= 0 ? st->q[tr->dof_a[a]] : 0.0;
+        double xb = tr->dof_b[a] >= 0 ? st->q[tr->dof_b[a]] : 0.0;
+        tr->sg[a] = tr->sc->ct[a].gap + (xb - xa) * tr->Le;
+        tr->sP[a] = tr->imp[a] * Ps;
+        tr->imp[a] = 0.0;
+    }
+    pd_scene_sample s = {.step = st->step,
+                         .t = st->t / tr->wp,
+                         .x = tr->sx,
+                         .v = tr->sv,
+                         .gap = tr->sg,
+                         .impulse = tr->sP};
+    return tr->fn(&s, tr->ctx);
+}
+
+/* Gap rate of contact a: x_b' - x_a' (walls at rest). */
+static double gap_rate(const track *tr, int a, const double *v)
+{
+    return (tr->dof_b[a] >= 0 ? v[tr->dof_b[a]] : 0.0) - (tr->dof_a[a] >= 0 ? v[tr->dof_a[a]] : 0.0);
+}
+
+/* Moreau–Jean, every step: extremes at the step, impacts (an impulse after a
+ * step without) with the first one's instant estimated inside its step from
+ * the step start and the previous step's gap acceleration, the sample. */
+static int observe_moreau(const pd_state *st, void *ctx)
+{
+    track *tr = ctx;
+    note_point(tr, st->t, st->q);
+    note_approach(tr, st->q);
+    tr->lcp_solves += st->nactive > 0;
+    for (int a = 0; a < tr->model_m; a++) {
+        double P = st->P[a], U = gap_rate(tr, a, st->v);
+        if (P > 0.0) {
+            if (!tr->touching[a] && isnan(tr->first[a])) {
+                double G = st->step > 1 ? (tr->U_prev[a] - tr->U_prev2[a]) / tr->h : 0.0;
+                tr->first[a] =
+                    st->t - tr->h + closing_time(tr->g_prev[a], tr->U_prev[a], G, tr->h);
+            }
+            tr->impacts[a] += !tr->touching[a];
+            tr->ctime[a] += tr->h;
+            tr->maxP[a] = fmax(tr->maxP[a], P);
+        }
+        tr->touching[a] = P > 0.0;
+        tr->imp[a] += P;
+        tr->U_prev2[a] = tr->U_prev[a];
+        tr->U_prev[a] = U;
+        tr->g_prev[a] = st->g[a];
+    }
+    return tr->fn ? sample(tr, st) : 0;
+}
+
+/* Event-driven, on_step: extremes between reports, impulses at events,
+ * persistent-contact time. */
+static int step_event(const pd_state *st, void *ctx)
+{
+    track *tr = ctx;
+    if (tr->have_prev && st->has_acc)
+        note_between(tr, st->t, st->q, st->v, st->acc);
+    note_point(tr, st->t, st->q);
+    note_approach(tr, st->q);
+    for (int a = 0; a < tr->model_m; a++) {
+        double P = st->P[a];
+        if (tr->pactive[a] && tr->have_prev)
+            tr->ctime[a] += st->t - tr->pt;
+        if (P > 0.0) {
+            tr->impacts[a]++;
+            tr->maxP[a] = fmax(tr->maxP[a], P);
+            tr->imp[a] += P;
+            if (isnan(tr->first[a]))
+                tr->first[a] = st->t;
+        }
+    }
+    keep_report(tr, st);
+    return 0;
+}
+
+/* Penalty, on_step: extremes between reports, engagements, the element
+ * impulses by the trapezoid rule over the accepted steps. */
+static int step_penalty(const pd_state *st, void *ctx)
+{
+    track *tr = ctx;
+    if (tr->have_prev && st->has_acc)
+        note_between(tr, st->t, st->q, st->v, st->acc);
+    note_point(tr, st->t, st->q);
+    note_approach(tr, st->q);
+    for (int a = 0; a < tr->model_m; a++) {
+        double dt = tr->have_prev ? st->t - tr->pt : 0.0;
+        double di = 0.5 * (tr->plam[a] + (st->active[a] ? st->P[a] : 0.0)) * dt;
+        if (tr->pactive[a])
+            tr->ctime[a] += dt;
+        tr->episode[a] += tr->pactive[a] ? di : 0.0;
+        tr->maxP[a] = fmax(tr->maxP[a], tr->episode[a]);
+        if (st->active[a] && !tr->pactive[a]) {
+            tr->impacts[a]++;
+            tr->episode[a] = 0.0;
+            if (isnan(tr->first[a]))
+                tr->first[a] = st->t;
+        }
+    }
+    keep_report(tr, st);
+    return 0;
+}
+
+/* The output grid (event-driven, penalty): impulses since the last sample
+ * (event impulses summed by step_event; element forces integrated here). */
+static int observe_grid(const pd_state *st, void *ctx)
+{
+    track *tr = ctx;
+    if (tr->method == PD_METHOD_PENALTY)
+        for (int a = 0; a < tr->model_m; a++) {
+            double lam = st->active[a] ? st->P[a] : 0.0;
+            tr->imp[a] += 0.5 * (tr->imp_lam[a] + lam) * (st->t - tr->imp_t);
+            tr->imp_lam[a] = lam;
+        }
+    tr->imp_t = st->t;
+    return sample(tr, st);
+}
+
+/* Results in metres, seconds and newton-seconds. */
+static void fill_result(const track *tr, pd_scene_result *r)
+{
+    double Ps = tr->sc->exc.ap / tr->wp;
+    for (int i = 0; i < tr->n; i++) {
+        r->umax[i] = tr->xmax[i] * tr->Le;
+        r->u_pos[i] = tr->xpos[i] * tr->Le;
+        r->u_neg[i] = tr->xneg[i] * tr->Le;
+        r->drift[i] = tr->drift[i] * tr->Le;
+    }
+    for (int a = 0; a < tr->m; a++) {
+        r->impacts[a] = tr->impacts[a];
+        r->first_impact[a] = tr->first[a] / tr->wp;
+        r->max_impulse[a] = tr->maxP[a] * Ps;
+        r->contact_time[a] = tr->ctime[a] / tr->wp;
+        r->approach[a] = tr->approach[a] * tr->Le;
+    }
+    r->lcp_solves = tr->lcp_solves;
+}
+
+/* ---- the one-wall oscillator: its fast paths ------------------------------- */
+
+/* The oscillator's samples as scene samples (x = -u when mirrored). */
+typedef struct osc_bridge {
+    pd_scene_sampler fn;
+    void *ctx;
+    double sign, mass;
+    int m;
+} osc_bridge;
+
+static int osc_sample(const pd_osc_sample *s, void *ctx)
+{
+    osc_bridge *b = ctx;
+    double x = b->sign * s->u, v = b->sign * s->v, imp = s->impulse * b->mass;
+    pd_scene_sample ss = {.step = s->step,
+                          .t = s->t,
+                          .x = &x,
+                          .v = &v,
+                          .gap = b->m ? &s->gap : NULL,
+                          .impulse = b->m ? &imp : NULL};
+    return b->fn(&ss, b->ctx);
+}
+
+/* Run the one-wall scene as the oscillator c. */
+static int run_oscillator(const pd_scene *sc, const pd_osc *c, int mirrored,
+                          const pd_run_opts *o, pd_scene_sampler fn, void *ctx,
+                          pd_scene_result *res, pd_err *err)
+{
+    pd_run_opts oo = *o;
+    pd_osc_result r;
+    double mass = sc->st[0].mass[0];
+    int has_wall = sc->ncontact > 0 && !o->no_wall, rc;
+    osc_bridge b = {.fn = fn, .ctx = ctx, .sign = mirrored ? -1.0 : 1.0, .mass = mass,
+                    .m = sc->ncontact};
+    oo.no_wall = !has_wall;
+    oo.pen.kc_abs = o->pen.kc_abs / mass; /* N/m -> N/m per kg */
+    if ((rc = pd_osc_run(c, &oo, fn ? osc_sample : NULL, &b, &r, err)))
+        return rc;
+    res->umax[0] = res->drift[0] = r.umax;
+    res->u_pos[0] = mirrored ? r.u_away : r.u_toward;
+    res->u_neg[0] = mirrored ? r.u_toward : r.u_away;
+    if (sc->ncontact > 0) {
+        res->impacts[0] = r.impacts;
+        res->first_impact[0] = r.first_impact;
+        res->max_impulse[0] = r.max_impulse * mass;
+        res->contact_time[0] = r.contact_time;
+        res->approach[0] = r.u_toward;
+    }
+    res->steps = r.steps;
+    res->lcp_solves = 0;
+    res->kernel = r.kernel;
+    res->factor = o->method == PD_METHOD_MOREAU ? "scalar" : "none";
+    res->lcp_solver = o->method == PD_METHOD_MOREAU && has_wall ? "closed-form" : "none";
+    return PD_OK;
+}
+
+/* ---- the general engines -------------------------------------------------- */
+
+/* Moreau–Jean on the scene's model. */
+static int run_moreau(const pd_model *md, const pd_run_opts *o, long nsteps, track *tr,
+                      pd_scene_result *res, pd_err *err)
+{
+    pd_mj_opts mo = pd_mj_default_opts();
+    mo.h = tr->h;
+    mo.theta = o->theta;
+    mo.gamma = o->gamma;
+    mo.allow_unstable = o->allow_unstable;
+    mo.kernel = o->kernel;
+    mo.factor = o->factor;
+    mo.lcp_solver = o->lcp_solver;
+    pd_mj *mj = pd_mj_alloc(md, &mo, err);
+    if (!mj)
+        return err ? err->status : PD_ENOMEM;
+    int rc = pd_mj_run(mj, nsteps, observe_moreau, tr, err);
+    res->steps = pd_mj_state(mj)->step;
+    res->kernel = pd_mj_kernel_name(mj);
+    res->factor = pd_mj_factor_name(mj);
+    res->lcp_solver = pd_lcp_method_name(o->lcp_solver);
+    pd_mj_free(mj);
+    return rc;
+}
+
+/* The general event-driven reference on the scene's model. */
+static int run_event(const pd_model *md, const pd_run_opts *o, double tau_end, track *tr,
+                     pd_scene_result *res, pd_err *err)
+{
+    pd_edg_opts eo = pd_edg_default_opts();
+    pd_edg_result er;
+    eo.h_out = tr->fn ? tr->h : 0.0;
+    eo.no_accumulation = o->no_accumulation;
+    eo.on_step = step_event;
+    eo.on_step_ctx = tr;
+    eo.factor = o->factor;
+    eo.lcp_solver = o->lcp_solver;
+    int rc = pd_edg_run(md, 0.0, NULL, NULL, tau_end, &eo, tr->fn ? observe_grid : NULL, tr, &er,
+                        err);
+    res->steps = er.events;
+    res->kernel = "event";
+    res->factor = pd_factor_kind_name(pd_factor_choose(md, o->factor));
+    res->lcp_solver = pd_lcp_method_name(o->lcp_solver);
+    return rc;
+}
+
+/* Largest storey stiffness of the scene [N/m]. */
+static double stiffest(const pd_scene *sc)
+{
+    double k = 0.0;
+    for (int s = 0; s < sc->nstruct; s++)
+        for (int i = 0; i < sc->st[s].storeys; i++)
+            k = fmax(k, sc->st[s].stiffness[i]);
+    return k;
+}
+
+/* The penalty baseline on the scene's model: kc in reference units is
+ * kc_abs / wp^2 (Kelvin) or kc_abs sqrt(Le) / wp^2 (Hertz), or kc_mult times
+ * the largest storey stiffness / wp^2 for both laws. */
+static int run_penalty(const pd_model *md, const pd_run_opts *o, double tau_end, track *tr,
+                       pd_scene_result *res, pd_err *err)
+{
+    pd_penalty_opts po = pd_penalty_default_opts();
+    pd_penalty_result pr;
+    double wp2 = tr->wp * tr->wp;
+    po.law = o->pen.law;
+    if (o->pen.kc_abs > 0.0)
+        po.kc = o->pen.kc_abs * (o->pen.law == PD_PENALTY_HERTZDAMP ? sqrt(tr->Le) : 1.0) / wp2;
+    else
+        po.kc = o->pen.kc_mult * stiffest(tr->sc) / wp2;
+    po.rtol = o->pen.rtol;
+    po.atol = o->pen.atol;
+    po.stepper = o->pen.stepper;
+    po.h_out = tr->fn ? tr->h : 0.0;
+    po.on_step = step_penalty;
+    po.on_step_ctx = tr;
+    po.factor = o->factor;
+    int rc = pd_penalty_run(md, 0.0, NULL, NULL, tau_end, &po, tr->fn ? observe_grid : NULL, tr,
+                            &pr, err);
+    res->steps = pr.steps;
+    res->kernel = pr.stepper ? pr.stepper : "penalty";
+    res->factor = pd_factor_kind_name(pd_factor_choose(md, o->factor));
+    res->lcp_solver = "none";
+    return rc;
+}
+
+/* Build the model, track, run the method, convert. */
+static int run_general(const pd_scene *sc, const pd_run_opts *o, pd_scene_sampler fn,
+                       void *ctx, pd_scene_result *res, pd_err *err)
+{
+    pd_scene_model sm;
+    track tr;
+    int rc;
+    memset(&tr, 0, sizeof tr);
+    if ((rc = pd_scene_model_build(sc, !o->no_wall, &sm, err)))
+        return rc;
+    if ((rc = track_alloc(&tr, sc, err))) {
+        pd_scene_model_free(&sm);
+        return rc;
+    }
+    tr.method = o->method;
+    tr.model_m = sm.model.m;
+    tr.Le = pd_scene_Le(sc);
+    tr.wp = pd_scene_wp(sc);
+    tr.h = tr.wp * o->dt;
+    tr.tau_measure = tr.wp * pd_scene_measure_start(sc, o->tend);
+    tr.fn = fn;
+    tr.ctx = ctx;
+    long nsteps = pd_steps_for(o->tend, o->dt);
+    double tau_end = (double)nsteps * tr.h;
+    switch (o->method) {
+    case PD_METHOD_EVENT: rc = run_event(&sm.model, o, tau_end, &tr, res, err); break;
+    case PD_METHOD_PENALTY: rc = run_penalty(&sm.model, o, tau_end, &tr, res, err); break;
+    default: rc = run_moreau(&sm.model, o, nsteps, &tr, res, err); break;
+    }
+    fill_result(&tr, res);
+    track_free(&tr);
+    pd_scene_model_free(&sm);
+    return rc;
+}
+
+int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler sampler,
+                 void *ctx, pd_scene_result *res, pd_err *err)
+{
+    pd_run_opts o;
+    pd_osc c;
+    int mirrored, rc;
+    pd_err_clear(err);
+    if ((rc = pd_scene_resolve_opts(sc, opts, &o, err)))
+        return rc;
+    for (int i = 0; i < res->n; i++)
+        res->umax[i] = res->u_pos[i] = res->u_neg[i] = res->drift[i] = 0.0;
+    for (int a = 0; a < res->m; a++) {
+        res->impacts[a] = 0;
+        res->first_impact[a] = NAN;
+        res->max_impulse[a] = res->contact_time[a] = res->approach[a] = 0.0;
+    }
+    res->dt = o.dt;
+    res->tend = o.tend;
+    res->theta = o.method == PD_METHOD_MOREAU ? o.theta : NAN;
+    res->method = pd_method_name(o.method);
+    double cpu0 = pd_cpu_seconds();
+    if (o.kernel == PD_KERNEL_AUTO && pd_scene_as_oscillator(sc, &c, &mirrored))
+        rc = run_oscillator(sc, &c, mirrored, &o, sampler, ctx, res, err);
+    else
+        rc = run_general(sc, &o, sampler, ctx, res, err);
+    res->cpu_s = pd_cpu_seconds() - cpu0;
+    return rc;
+}
+
+/* ---- the run, its contact-free twin, and the Pi terms --------------------- */
+
+void pd_scene_summary_free(pd_scene_summary *s)
+{
+    pd_scene_result_free(&s->r);
+    pd_scene_result_free(&s->free);
+    free(s->Pi1);
+    free(s->gamma);
+    free(s->Pi2);
+    free(s->Pi3);
+    free(s->chi);
+    memset(s, 0, sizeof *s);
+}
+
+int pd_scene_summarize(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler sampler,
+                       void *ctx, pd_scene_summary *s, pd_err *err)
+{
+    pd_run_opts twin = opts ? *opts : pd_run_default_opts();
+    size_t n = (size_t)sc->n, m = (size_t)(sc->ncontact > 0 ? sc->ncontact : 1);
+    int rc;
+    memset(s, 0, sizeof *s);
+    twin.no_wall = 1;
+    s->Pi1 = malloc(n * sizeof(double));
+    s->gamma = malloc(n * sizeof(double));
+    s->Pi2 = malloc((size_t)sc->nstruct * sizeof(double));
+    s->Pi3 = malloc(m * sizeof(double));
+    s->chi = malloc(m * sizeof(double));
+    if (!s->Pi1 || !s->gamma || !s->Pi2 || !s->Pi3 || !s->chi) {
+        pd_scene_summary_free(s);
+        return pd_err_set(err, PD_ENOMEM, "out of memory for the summary of %d dofs", sc->n);
+    }
+    double cpu0 = pd_cpu_seconds();
+    if ((rc = pd_scene_result_alloc(sc, &s->r, err)) ||
+        (rc = pd_scene_result_alloc(sc, &s->free, err)) ||
+        (rc = pd_scene_run(sc, opts, sampler, ctx, &s->r, err)) ||
+        (rc = pd_scene_run(sc, &twin, NULL, NULL, &s->free, err))) {
+        pd_scene_summary_free(s);
+        return rc;
+    }
+    s->cpu_s = pd_cpu_seconds() - cpu0;
+    double Le = pd_scene_Le(sc);
+    for (int i = 0; i < sc->n; i++) {
+        s->Pi1[i] = s->r.umax[i] / Le;
+        s->gamma[i] = s->free.umax[i] > 0.0 ? s->r.umax[i] / s->free.umax[i] : NAN;
+    }
+    for (int k = 0; k < sc->nstruct; k++)
+        s->Pi2[k] = sc->exc.Tp / sc->st[k].T0;
+    for (int a = 0; a < sc->ncontact; a++) {
+        s->Pi3[a] = sc->ct[a].gap / Le;
+        s->chi[a] = s->free.approach[a] > 0.0 ? sc->ct[a].gap / s->free.approach[a] : NAN;
+    }
+    return PD_OK;
+}
