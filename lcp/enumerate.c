@@ -10,7 +10,7 @@
 #include "pd_lcp.h"
 
 #define ENUM_NMAX 12
-#define ENUM_TOL 1e-9           /* feasibility tolerance, relative to the scale */
+#define ENUM_TOL 1e-9           /* relative backward residual of an accepted support */
 #define ENUM_SINGULAR_TOL 1e-13 /* M_SS with a relative pivot below this is skipped */
 
 /* Number of set bits of mask. */
@@ -48,9 +48,9 @@ static int support_solution(int n, const double *M, const double *q, unsigned ma
 /* 1 if z (with w = M z + q) satisfies the LCP within ENUM_TOL * scale. */
 static int is_solution(int n, const double *M, const double *q, const double *z, double *w)
 {
-    double comp, infeas, scale;
-    pd_lcp_residual(n, M, q, z, w, &comp, &infeas, &scale);
-    return comp <= ENUM_TOL * scale && infeas <= ENUM_TOL * scale;
+    double comp, infeas, residual;
+    pd_lcp_residual(n, M, q, z, w, &comp, &infeas, &residual);
+    return residual <= ENUM_TOL;
 }
 
 int pd_lcp_enumerate(int n, const double *M, const double *q, double *z, double *w)
@@ -66,8 +66,8 @@ int pd_lcp_enumerate(int n, const double *M, const double *q, double *z, double 
                 return PD_OK;
         }
     }
-    double comp, infeas, scale;
+    double comp, infeas, residual;
     memset(z, 0, (size_t)n * sizeof(double));
-    pd_lcp_residual(n, M, q, z, w, &comp, &infeas, &scale);
+    pd_lcp_residual(n, M, q, z, w, &comp, &infeas, &residual);
     return PD_ENOSOLUTION;
 }

@@ -3,13 +3,14 @@
 #ifndef PD_LCP_INTERNAL_H
 #define PD_LCP_INTERNAL_H
 
+#include "pd_lcp.h"
+
 /* Largest |x_i| of a vector. */
 double pd_lcp_max_abs(int n, const double *x);
 
-/* w = M z + q (columns with z_j == 0 skipped) and the residual figures of
- * pd_lcp_residual, given max|M| already known. */
-void pd_lcp_residual_mmax(int n, const double *M, const double *q, const double *z,
-                          double mmax, double *w, double *complementarity,
-                          double *infeasibility, double *scale);
+/* w = M z + q and the residual figures into info (complementarity,
+ * infeasibility, residual, scale); rows: n doubles of scratch. */
+void pd_lcp_verify(const pd_matrix *M, const double *q, const double *z, double *w, double *rows,
+                   pd_lcp_info *info);
 
 #endif

@@ -18,7 +18,7 @@
 #include "pd_lcp.h"
 
 #define LEMKE_TOL_DEFAULT 1e-12   /* relative tolerance for ties and tiny pivots */
-#define LEMKE_VERIFY_TOL 1e-10    /* a solved answer has residuals <= this * scale */
+#define LEMKE_VERIFY_TOL PD_LCP_VERIFY_TOL /* relative backward residual of a solved answer */
 #define LEMKE_CAP_MIN 10000       /* default pivot cap: max(LEMKE_CAP_MIN, ... */
 #define LEMKE_CAP_PER_N 100       /* ... LEMKE_CAP_PER_N * n) */
 #define LEMKE_REFINE_EVERY 50     /* pivots between two refinements of x_B */
@@ -35,6 +35,7 @@ struct pd_lcp_work {
     double *col;     /* entering column B^-1 a */
     double *cover;   /* covering vector d of the current solve */
     double *scratch; /* refinement residual, polish right-hand side */
+    double *rows;    /* row sizes of the verification */
     int *basis;      /* variable basic in each row */
     int *row_of;     /* row of each variable (2 nmax + 1 of them), -1 if nonbasic */
     int *ties;       /* rows tied in the ratio test; support of the polish */
@@ -72,6 +73,7 @@ void pd_lcp_free(pd_lcp_work *work)
     free(work->col);
     free(work->cover);
     free(work->scratch);
+    free(work->rows);
     free(work->basis);
     free(work->row_of);
     free(work->ties);
@@ -94,12 +96,13 @@ pd_lcp_work *pd_lcp_alloc(int nmax)
     work->col = malloc(n * sizeof(double));
     work->cover = malloc(n * sizeof(double));
     work->scratch = malloc(n * sizeof(double));
+    work->rows = malloc(n * sizeof(double));
     work->basis = malloc(n * sizeof(int));
     work->row_of = malloc((2 * n + 1) * sizeof(int));
     work->ties = malloc(n * sizeof(int));
     work->perm = malloc(n * sizeof(int));
     if (!work->binv || !work->xb || !work->col || !work->cover || !work->scratch ||
-        !work->basis || !work->row_of || !work->ties || !work->perm) {
+        !work->rows || !work->basis || !work->row_of || !work->ties || !work->perm) {
         pd_lcp_free(work);
         return NULL;
     }
@@ -399,7 +402,7 @@ static void refine(const lemke_state *st)
  * become 0; the verification that follows judges the result. */
 static void clamp_roundoff(int n, double *z)
 {
-    double floor_ = -LEMKE_VERIFY_TOL * max2(1.0, pd_lcp_max_abs(n, z));
+    double floor_ = -LEMKE_VERIFY_TOL * pd_lcp_max_abs(n, z);
     for (int j = 0; j < n; j++)
         if (z[j] < 0.0 && z[j] >= floor_)
             z[j] = 0.0;
@@ -417,14 +420,13 @@ static void extract_z(const lemke_state *st, double *z)
     clamp_roundoff(n, z);
 }
 
-/* w = M z + q and the residual figures into info; 1 if both are within
- * LEMKE_VERIFY_TOL * scale. */
+/* w = M z + q and the residual figures into info; 1 if the relative
+ * backward residual is within LEMKE_VERIFY_TOL (pd_lcp_residual). */
 static int verify(const lemke_state *st, const double *z, double *w, pd_lcp_info *info)
 {
-    pd_lcp_residual_mmax(st->n, st->M, st->q, z, st->mmax, w, &info->complementarity,
-                         &info->infeasibility, &info->scale);
-    double limit = LEMKE_VERIFY_TOL * info->scale;
-    return info->complementarity <= limit && info->infeasibility <= limit;
+    pd_matrix M = pd_matrix_dense(st->n, st->n, st->M);
+    pd_lcp_verify(&M, st->q, z, w, st->ws->rows, info);
+    return info->residual <= LEMKE_VERIFY_TOL;
 }
 
 /* Recompute the final basic solution directly: M_SS z_S = -q_S on the support
@@ -486,12 +488,6 @@ static pd_lcp_outcome run_pivots(const lemke_state *st, int cap, int *pivots)
     }
 }
 
-/* Largest residual figure relative to the scale. */
-static double relative_violation(const pd_lcp_info *info)
-{
-    return max2(info->complementarity, info->infeasibility) / info->scale;
-}
-
 /* A claimed solution: x_B refined until it verifies (at most LEMKE_FINAL_REFINES
  * times), else recomputed from the support (polish); the better of the two is
  * returned, as solved if it verifies, as numerical otherwise. */
@@ -504,11 +500,11 @@ static pd_lcp_outcome finish_solved(const lemke_state *st, double *z, double *w,
         if (verify(st, z, w, info))
             return PD_LCP_SOLVED;
     }
-    double pivoting = relative_violation(info);
+    double pivoting = info->residual;
     if (polish(st, z) == 0) {
         if (verify(st, z, w, info))
             return PD_LCP_SOLVED;
-        if (relative_violation(info) < pivoting)
+        if (info->residual < pivoting)
             return PD_LCP_NUMERICAL;
     }
     extract_z(st, z); /* the pivoting answer was the better one */

@@ -9,6 +9,9 @@
 #ifndef PD_LCP_H
 #define PD_LCP_H
 
+/* A verified answer has a relative backward residual at most this. */
+#define PD_LCP_VERIFY_TOL 1e-10
+
 #include <stdio.h>
 
 #include "pd_core.h"
@@ -44,7 +47,9 @@ typedef struct pd_lcp_info {
     int pivots;             /* pivots performed, counting the one that brings z0 in */
     double complementarity; /* max_i |z_i w_i| */
     double infeasibility;   /* max_i max(-z_i, -w_i, 0) */
-    double scale;           /* data scale the two figures above are relative to */
+    double residual;        /* relative backward residual (pd_lcp_residual): a verified
+                               answer has residual <= 1e-10 */
+    double scale;           /* max_i r_i, r_i = |q_i| + sum_j |M_ij z_j| (the size of w) */
     const char *solver;     /* the solver that produced the answer (pd_lcp_solve) */
 } pd_lcp_info;
 
@@ -67,11 +72,15 @@ int pd_lcp_lemke(pd_lcp_work *work, int n, const double *M, const double *q,
 int pd_lcp_enumerate(int n, const double *M, const double *q, double *z, double *w);
 
 /* Residuals of a candidate z: fills w = M z + q and returns, through the
- * pointers, max|z_i w_i|, the largest sign violation, and the data scale
- * max(1, max|q|, max|M| * max(1, max|z|)). */
+ * pointers, max|z_i w_i|, the largest sign violation, and the relative
+ * backward residual
+ *     max_i max(-z_i / zs, -w_i / r_i, min(|w_i| / r_i, |z_i| / zs)),
+ * zs = max|z|, r_i = |q_i| + sum_j |M_ij| |z_j| the size of the terms that
+ * make w_i (0/0 = 0).  It is invariant under scaling (q, z) or (M, 1/z), and
+ * an answer is verified when it is at most 1e-10 (docs/lcp.md). */
 void pd_lcp_residual(int n, const double *M, const double *q, const double *z,
                      double *w, double *complementarity, double *infeasibility,
-                     double *scale);
+                     double *residual);
 
 /* ---- the solver table ------------------------------------------------------ *
  * One entry point for every solver: a solver object sized once (no

@@ -1,5 +1,6 @@
 /* residual.c — residuals of an LCP candidate. */
 #include <math.h>
+#include <stdlib.h>
 
 #include "lcp_internal.h"
 #include "pd_lcp.h"
@@ -25,57 +26,82 @@ double pd_lcp_max_abs(int n, const double *x)
     return m2 > m0 ? m2 : m0;
 }
 
-/* w = M z + q, column by column (column-major, zero z_j skipped). */
-static void lcp_affine(int n, const double *restrict M, const double *q, const double *z,
-                       double *restrict w)
+/* Ratio a / b with 0 / 0 = 0 (a term that is exactly zero is exact). */
+static double ratio(double a, double b)
 {
-    for (int i = 0; i < n; i++)
+    return a == 0.0 ? 0.0 : b > 0.0 ? a / b : HUGE_VAL;
+}
+
+/* w = M z + q and the row sizes r_i = |q_i| + sum_j |M_ij| |z_j|, column by
+ * column over the support of z. */
+static void affine_rows(const pd_matrix *M, const double *q, const double *z, double *w,
+                        double *r)
+{
+    int n = M->rows;
+    for (int i = 0; i < n; i++) {
         w[i] = q[i];
-    for (int j = 0; j < n; j++) {
+        r[i] = fabs(q[i]);
+    }
+    for (int j = 0; j < M->cols; j++) {
         double zj = z[j];
         if (zj == 0.0)
             continue;
-        const double *mj = M + (size_t)j * (size_t)n;
-        int i = 0;
-        for (; i + 4 <= n; i += 4) { /* unrolled so that -O2 vectorises it */
-            w[i] += mj[i] * zj;
-            w[i + 1] += mj[i + 1] * zj;
-            w[i + 2] += mj[i + 2] * zj;
-            w[i + 3] += mj[i + 3] * zj;
+        if (M->kind == PD_MATRIX_DENSE) {
+            const double *mj = M->values + (size_t)j * (size_t)n;
+            for (int i = 0; i < n; i++) {
+                w[i] += mj[i] * zj;
+                r[i] += fabs(mj[i] * zj);
+            }
+        } else if (M->kind == PD_MATRIX_CSC) {
+            for (int k = M->colptr[j]; k < M->colptr[j + 1]; k++) {
+                w[M->rowind[k]] += M->values[k] * zj;
+                r[M->rowind[k]] += fabs(M->values[k] * zj);
+            }
         }
-        for (; i < n; i++)
-            w[i] += mj[i] * zj;
     }
 }
 
-/* comp = max|z_i w_i|, infeas = max(-z_i, -w_i, 0), scale = max(1, |q|, |M| max(1, |z|)) */
-void pd_lcp_residual_mmax(int n, const double *M, const double *q, const double *z,
-                          double mmax, double *w, double *complementarity,
-                          double *infeasibility, double *scale)
+/* The residual figures of a candidate z, with the relative backward residual
+ *   max_i max(-z_i / zs, -w_i / r_i, min(|w_i| / r_i, |z_i| / zs)),
+ * zs = max|z|, r_i the size of the terms that make w_i: invariant under
+ * scaling q and z, or M and 1/z, and exact zeros count as exact. */
+void pd_lcp_verify(const pd_matrix *M, const double *q, const double *z, double *w, double *rows,
+                   pd_lcp_info *info)
 {
-    lcp_affine(n, M, q, z, w);
-    double comp = 0.0, infeas = 0.0;
+    int n = M->rows;
+    double zs = pd_lcp_max_abs(n, z), comp = 0.0, infeas = 0.0, rel = 0.0, scale = 0.0;
+    affine_rows(M, q, z, w, rows);
     for (int i = 0; i < n; i++) {
-        double c = fabs(z[i] * w[i]);
-        if (c > comp || isnan(c))
-            comp = c;
-        if (-z[i] > infeas || isnan(z[i]))
-            infeas = -z[i];
-        if (-w[i] > infeas || isnan(w[i]))
-            infeas = -w[i];
+        double c = fabs(z[i] * w[i]), zi = ratio(fabs(z[i]), zs), wi = ratio(fabs(w[i]), rows[i]);
+        comp = c > comp || isnan(c) ? c : comp;
+        infeas = -z[i] > infeas || isnan(z[i]) ? -z[i] : infeas;
+        infeas = -w[i] > infeas || isnan(w[i]) ? -w[i] : infeas;
+        double v = fmax(wi < zi ? wi : zi, fmax(z[i] < 0.0 ? zi : 0.0, w[i] < 0.0 ? wi : 0.0));
+        rel = v > rel || isnan(v) || isnan(z[i]) || isnan(w[i]) ? (isnan(v) ? NAN : v) : rel;
+        scale = fmax(scale, rows[i]);
+        if (isnan(rel))
+            break;
     }
-    double zmax = pd_lcp_max_abs(n, z);
-    double data = fmax(pd_lcp_max_abs(n, q), mmax * fmax(1.0, zmax));
-    *complementarity = comp;
-    *infeasibility = isnan(infeas) ? NAN : fmax(infeas, 0.0);
-    *scale = fmax(1.0, data);
+    info->complementarity = comp;
+    info->infeasibility = isnan(infeas) ? NAN : fmax(infeas, 0.0);
+    info->residual = rel;
+    info->scale = scale;
 }
 
-/* The public form: max|M| measured here. */
-void pd_lcp_residual(int n, const double *M, const double *q, const double *z,
-                     double *w, double *complementarity, double *infeasibility,
-                     double *scale)
+void pd_lcp_residual(int n, const double *M, const double *q, const double *z, double *w,
+                     double *complementarity, double *infeasibility, double *residual)
 {
-    double mmax = pd_lcp_max_abs(n * n, M);
-    pd_lcp_residual_mmax(n, M, q, z, mmax, w, complementarity, infeasibility, scale);
+    pd_matrix A = pd_matrix_dense(n, n, M);
+    pd_lcp_info info;
+    double rows[64], *r = n <= 64 ? rows : malloc((size_t)n * sizeof(double));
+    if (!r) {
+        *complementarity = *infeasibility = *residual = NAN;
+        return;
+    }
+    pd_lcp_verify(&A, q, z, w, r, &info);
+    *complementarity = info.complementarity;
+    *infeasibility = info.infeasibility;
+    *residual = info.residual;
+    if (r != rows)
+        free(r);
 }

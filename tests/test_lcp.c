@@ -162,17 +162,16 @@ static int solve(lcp_case *c, const pd_lcp_opts *opts, pd_lcp_info *info)
     return st;
 }
 
-/* Independent check of a solved answer: residuals within VERIFY_TOL * scale. */
+/* Independent check of a solved answer: relative backward residual within
+ * VERIFY_TOL. */
 static void check_verified(pd_test_ctx *ctx, const lcp_case *c, const char *what)
 {
     double *w = malloc((size_t)c->n * sizeof(double));
-    double comp = NAN, infeas = NAN, scale = NAN;
+    double comp = NAN, infeas = NAN, residual = NAN;
     if (w)
-        pd_lcp_residual(c->n, c->M, c->q, c->z, w, &comp, &infeas, &scale);
-    CHECK(ctx, comp <= VERIFY_TOL * scale, "%s: complementarity %.3g > %.0e * scale %.3g", what,
-          comp, VERIFY_TOL, scale);
-    CHECK(ctx, infeas <= VERIFY_TOL * scale, "%s: infeasibility %.3g > %.0e * scale %.3g", what,
-          infeas, VERIFY_TOL, scale);
+        pd_lcp_residual(c->n, c->M, c->q, c->z, w, &comp, &infeas, &residual);
+    CHECK(ctx, residual <= VERIFY_TOL, "%s: relative residual %.3g > %.0e (complementarity %.3g, "
+          "infeasibility %.3g)", what, residual, VERIFY_TOL, comp, infeas);
     free(w);
 }
 
@@ -703,23 +702,30 @@ static void test_lcp_small_pivot_is_not_a_ray(pd_test_ctx *ctx)
 static void test_lcp_numerical_outcome(pd_test_ctx *ctx)
 {
     /* M = [1.1 -1.3; -1.3 1.3^2/1.1 + 1e-11] (SPD, cond ~ 1e11), q = (0.3, -1): the
-     * unique solution has |z| ~ 1e11, and |w| ~ eps |M| |z| in doubles makes
-     * |z w| / scale ~ 1e-5 > 1e-10: not verifiable, so numerical (never solved),
-     * with the best answer still returned */
+     * unique solution has |z| ~ 1e11; |w| ~ eps |M| |z| in doubles is rounding
+     * of the terms that make w, so the answer is backward stable (solved, relative
+     * residual <= 1e-10) and its forward error is what the condition allows */
     double m22 = 1.3 * 1.3 / 1.1 + 1e-11;
     double M[4] = {1.1, -1.3, -1.3, m22}, q[2] = {0.3, -1.0}, z[2], w[2];
     pd_lcp_work *work = pd_lcp_alloc(2);
     pd_lcp_info info;
     int st = pd_lcp_lemke(work, 2, M, q, NULL, z, w, &info);
-    CHECK(ctx, st == PD_ENUMERICAL, "status %d, expected PD_ENUMERICAL", st);
-    CHECK(ctx, info.outcome == PD_LCP_NUMERICAL, "outcome %s", pd_lcp_outcome_name(info.outcome));
-    CHECK(ctx, info.complementarity > 1e-10 * info.scale, "reported figures: comp %.3g, scale %.3g",
-          info.complementarity, info.scale);
+    CHECK(ctx, st == PD_OK && info.residual <= 1e-10, "status %d, residual %.3g", st,
+          info.residual);
     long double det = (long double)M[0] * M[3] - (long double)M[1] * M[2]; /* z = -M^-1 q */
     long double z1 = -((long double)M[3] * q[0] - (long double)M[2] * q[1]) / det;
     long double z2 = -(-(long double)M[1] * q[0] + (long double)M[0] * q[1]) / det;
     CHECK(ctx, fabsl(z[0] - z1) <= 1e-3L * z1 && fabsl(z[1] - z2) <= 1e-3L * z2,
-          "best answer returned: z = (%.6g, %.6g) vs (%.6Lg, %.6Lg)", z[0], z[1], z1, z2);
+          "z = (%.6g, %.6g) vs (%.6Lg, %.6Lg)", z[0], z[1], z1, z2);
+    /* no solution with extreme scales (w2 = -1e13 z1 - z2 + 1 < 0 whenever
+     * w1 = 2 z1 + z2 - 2 >= 0): a scale that hides w2 = -1 behind 1e13 must not
+     * make it "solved" (the enumeration oracle agrees there is none) */
+    double M2[4] = {2, -1e13, 1, -1}, q2[2] = {-2, 1};
+    st = pd_lcp_lemke(work, 2, M2, q2, NULL, z, w, &info);
+    CHECK(ctx, st != PD_OK && info.outcome != PD_LCP_SOLVED,
+          "extreme scales: status %d (%s), z = (%g, %g), w = (%g, %g)", st,
+          pd_lcp_outcome_name(info.outcome), z[0], z[1], w[0], w[1]);
+    CHECK(ctx, pd_lcp_enumerate(2, M2, q2, z, w) == PD_ENOSOLUTION, "the oracle finds none");
     pd_lcp_free(work);
 }
 
@@ -851,15 +857,24 @@ static void test_lcp_outcome_names(pd_test_ctx *ctx)
 
 static void test_lcp_residual_figures(pd_test_ctx *ctx)
 {
-    /* M = [2 -1; 0 3] (column-major {2, 0, -1, 3}), q = (1, -4), z = (0.5, 1) */
+    /* M = [2 -1; 0 3] (column-major {2, 0, -1, 3}), q = (1, -4), z = (0.5, 1):
+     * w = (1, -1), row sizes r = (1 + 1 + 1, 4 + 0 + 3) = (3, 7), zs = 1 */
     double M[4] = {2, 0, -1, 3}, q[2] = {1, -4}, z[2] = {0.5, 1}, w[2];
-    double comp, infeas, scale;
-    pd_lcp_residual(2, M, q, z, w, &comp, &infeas, &scale);
+    double comp, infeas, residual;
+    pd_lcp_residual(2, M, q, z, w, &comp, &infeas, &residual);
     CHECK_NEAR(ctx, w[0], 1.0, 0.0);   /* 2 * 0.5 - 1 + 1 */
     CHECK_NEAR(ctx, w[1], -1.0, 0.0);  /* 3 - 4 */
     CHECK_NEAR(ctx, comp, 1.0, 0.0);   /* max(0.5 * 1, 1 * 1) */
     CHECK_NEAR(ctx, infeas, 1.0, 0.0); /* -w2 */
-    CHECK_NEAR(ctx, scale, 4.0, 0.0);  /* max(1, 4, 3 * 1) */
+    /* max(min(1/3, 0.5/1), min(1/7, 1), -w2/r2 = 1/7) = 1/3 */
+    CHECK_NEAR(ctx, residual, 1.0 / 3.0, 1e-16);
+    /* invariant: q and z scaled by 1e9, or M by 1e-7 with z by 1e7 */
+    double q9[2] = {1e9, -4e9}, z9[2] = {0.5e9, 1e9}, M7[4] = {2e-7, 0, -1e-7, 3e-7};
+    double z7[2] = {0.5e7, 1e7}, r9, r7;
+    pd_lcp_residual(2, M, q9, z9, w, &comp, &infeas, &r9);
+    pd_lcp_residual(2, M7, q, z7, w, &comp, &infeas, &r7);
+    CHECK(ctx, fabs(r9 - residual) <= 1e-15 && fabs(r7 - residual) <= 1e-15,
+          "scaled residuals %.17g, %.17g vs %.17g", r9, r7, residual);
 }
 
 static void test_lcp_enumerate_oracle(pd_test_ctx *ctx)
