@@ -185,12 +185,14 @@ static void note_between(track *tr, double t, const double *x, const double *v,
         return;
     for (int i = 0; i < tr->n; i++) {
         double p0[3] = {tr->px[i], tr->pv[i], tr->pa[i]}, p1[3] = {x[i], v[i], acc[i]};
+        int b = tr->below[i];
         if (interior_turn(p0, p1, h, &f)) {
             tr->xmax[i] = fmax(tr->xmax[i], fabs(f));
             tr->xpos[i] = fmax(tr->xpos[i], f);
             tr->xneg[i] = fmax(tr->xneg[i], -f);
+            if (b < 0) /* storey 1: the drift is the displacement */
+                tr->drift[i] = fmax(tr->drift[i], fabs(f));
         }
-        int b = tr->below[i];
         if (b < 0)
             continue;
         double d0[3] = {tr->px[i] - tr->px[b], tr->pv[i] - tr->pv[b], tr->pa[i] - tr->pa[b]};
