@@ -6,26 +6,131 @@
 #include "pd_cli.h"
 
 static const char compare_usage[] =
-    "usage: pound compare [model flags] [--dt H] [--theta T] [--methods moreau[,penalty]] [--json]\n"
+    "usage: pound compare [model flags | --scene F.json | --chain N] [--dt H] [--theta T]\n"
+    "                     [--methods moreau[,penalty]] [--json]\n"
     "  errors against the event-driven reference on the step grid t_k = k dt:\n"
     "  err_umax_rel = |umax - umax_ref| / umax_ref,\n"
-    "  err_hist_linf = max_k |u(t_k) - u_ref(t_k)| / umax_ref\n";
+    "  err_hist_linf = max_k |u(t_k) - u_ref(t_k)| / umax_ref\n"
+    "  scenes: per structure, over its storeys (scaled by its largest umax_ref); the\n"
+    "  figures without a structure are the worst structure's\n";
 
 /* "moreau,penalty" -> flags; 0 or 2. */
 static int parse_methods(const char *list, int *want)
 {
     char buf[128];
-    if (!list || strlen(list) >= sizeof buf)
+    int n = 0;
+    if (!list || !*list || strlen(list) >= sizeof buf || list[strlen(list) - 1] == ',' ||
+        list[0] == ',' || strstr(list, ",,"))
         return pd_cli_usage_error("--methods needs a list such as moreau,penalty");
     strcpy(buf, list);
     want[0] = want[1] = want[2] = 0;
-    for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+    for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ","), n++) {
         pd_method m;
         if (pd_method_parse(tok, &m) || m == PD_METHOD_EVENT)
             return pd_cli_usage_error("--methods: '%s' is not one of moreau, penalty", tok);
         want[m] = 1;
     }
-    return 0;
+    return n ? 0 : pd_cli_usage_error("--methods needs a list such as moreau,penalty");
+}
+
+/* Moreau–Jean (and penalty) against the reference on a scene. */
+static int compare_scene(const pd_cli_case *k, const int *want, int json)
+{
+    pd_scene *sc = NULL;
+    pd_scene_trace ref = {0};
+    pd_scene_result rr = {0}, mr[3];
+    pd_scene_errors me[3];
+    pd_err err;
+    int status, rc;
+    memset(mr, 0, sizeof mr);
+    memset(me, 0, sizeof me);
+    if ((status = pd_cli_scene(k, &sc)))
+        return status;
+    if ((rc = pd_scene_trace_alloc(&ref, sc, &k->opts, &err)) ||
+        (rc = pd_scene_result_alloc(sc, &rr, &err)) ||
+        (rc = pd_scene_measure_reference(sc, &k->opts, &ref, &rr, &err))) {
+        fprintf(stderr, "pound: compare: reference: %s\n", err.msg);
+        status = rc == PD_EINVAL ? 2 : 1;
+        goto done;
+    }
+    for (int m = 0; m < 3; m++) {
+        pd_run_opts om = k->opts;
+        om.method = (pd_method)m;
+        if (want[m] && ((rc = pd_scene_result_alloc(sc, &mr[m], &err)) ||
+                        (rc = pd_scene_errors_alloc(sc, &me[m], &err)) ||
+                        (rc = pd_scene_measure_run(sc, &om, &ref, &rr, &mr[m], &me[m], &err)))) {
+            fprintf(stderr, "pound: compare: %s: %s\n", pd_method_name((pd_method)m), err.msg);
+            status = 1;
+            goto done;
+        }
+    }
+    long impacts_ref = 0;
+    for (int a = 0; a < sc->ncontact; a++)
+        impacts_ref += rr.impacts[a];
+    int first = want[0] ? 0 : 2;
+    if (json) {
+        pd_json js;
+        pd_json_init(&js, stdout);
+        pd_json_begin_object(&js, NULL);
+        pd_json_str(&js, "method", pd_method_name((pd_method)first));
+        pd_json_num(&js, "err_umax_rel", me[first].err_umax_max);
+        pd_json_num(&js, "err_hist_linf", me[first].err_hist_max);
+        pd_json_int(&js, "impacts", me[first].impacts);
+        pd_json_int(&js, "impacts_ref", impacts_ref);
+        pd_json_num(&js, "cpu_s", me[first].cpu_s);
+        pd_json_num(&js, "cpu_s_ref", rr.cpu_s);
+        pd_json_int(&js, "events_ref", rr.steps);
+        pd_json_num(&js, "dt", mr[first].dt);
+        pd_json_begin_array(&js, "methods");
+        for (int m = 0; m < 3; m++)
+            if (want[m]) {
+                pd_json_begin_object(&js, NULL);
+                pd_json_str(&js, "method", pd_method_name((pd_method)m));
+                pd_json_num(&js, "err_umax_rel", me[m].err_umax_max);
+                pd_json_num(&js, "err_hist_linf", me[m].err_hist_max);
+                pd_json_int(&js, "impacts", me[m].impacts);
+                pd_json_int(&js, "steps", mr[m].steps);
+                pd_json_num(&js, "cpu_s", me[m].cpu_s);
+                pd_json_begin_array(&js, "structures");
+                for (int s = 0; s < sc->nstruct; s++) {
+                    pd_json_begin_object(&js, NULL);
+                    pd_json_str(&js, "name", sc->st[s].name);
+                    pd_json_num(&js, "err_umax_rel", me[m].err_umax[s]);
+                    pd_json_num(&js, "err_hist_linf", me[m].err_hist[s]);
+                    pd_json_end_object(&js);
+                }
+                pd_json_end_array(&js);
+                pd_json_end_object(&js);
+            }
+        pd_json_end_array(&js);
+        pd_json_end_object(&js);
+        pd_json_finish(&js);
+    } else {
+        printf("scene %s: %d structures, dt = %.4g s; reference: %ld events, %ld impacts, "
+               "%.3g s\n",
+               k->scene_path ? k->scene_path : "(chain)", sc->nstruct, mr[first].dt, rr.steps,
+               impacts_ref, rr.cpu_s);
+        printf("  %-10s %-14s %12s %12s %8s %10s\n", "method", "structure", "err_umax",
+               "err_hist", "impacts", "cpu [s]");
+        for (int m = 0; m < 3; m++)
+            if (want[m]) {
+                printf("  %-10s %-14s %12.3g %12.3g %8ld %10.3g\n", pd_method_name((pd_method)m),
+                       "(worst)", me[m].err_umax_max, me[m].err_hist_max, me[m].impacts,
+                       me[m].cpu_s);
+                for (int s = 0; s < sc->nstruct && s < 40; s++)
+                    printf("  %-10s %-14s %12.3g %12.3g\n", "", sc->st[s].name,
+                           me[m].err_umax[s], me[m].err_hist[s]);
+            }
+    }
+done:
+    for (int m = 0; m < 3; m++) {
+        pd_scene_result_free(&mr[m]);
+        pd_scene_errors_free(&me[m]);
+    }
+    pd_scene_result_free(&rr);
+    pd_scene_trace_free(&ref);
+    pd_scene_free(sc);
+    return status;
 }
 
 int pd_cmd_compare(int argc, char **argv)
@@ -52,6 +157,8 @@ int pd_cmd_compare(int argc, char **argv)
     }
     if ((rc = pd_cli_case_finish(&k)))
         return rc;
+    if (pd_cli_is_scene(&k))
+        return compare_scene(&k, want, json);
 
     pd_trace ref = {0}, work = {0};
     pd_osc_result rr;

@@ -11,7 +11,8 @@
 #include "pd_plot.h"
 
 static const char converge_usage[] =
-    "usage: pound converge [model flags] --dt MAX:MIN:N [--methods moreau,penalty]\n"
+    "usage: pound converge [model flags | --scene F.json | --chain N] --dt MAX:MIN:N\n"
+    "                      [--methods moreau,penalty]\n"
     "                      [--theta LIST] [--kcs LIST] [--plot FILE.png] [-o FILE] [--json]\n"
     "  --dt MAX:MIN:N  N step sizes, log-spaced from MAX down to MIN (Moreau-Jean rows)\n"
     "  --theta LIST    one Moreau-Jean curve per theta (default 0.5)\n"
@@ -19,7 +20,8 @@ static const char converge_usage[] =
     "                  measured on the finest dt grid\n"
     "  --plot F.png    error vs dt in F.png, error vs CPU time (work-precision) in F-work.png\n"
     "  -o FILE         the table as CSV or HDF5\n"
-    "  order = log(err_prev / err) / log(dt_prev / dt) on err_hist_linf\n";
+    "  order = log(err_prev / err) / log(dt_prev / dt) on err_hist_linf\n"
+    "  scenes: the errors of the worst structure (per structure in --json)\n";
 
 enum { MAX_LIST = 32, MAX_ROWS = 1024 };
 
@@ -27,6 +29,7 @@ typedef struct row {
     pd_method method;
     double theta, dt, kc, err_umax, err_hist, cpu_s, order;
     long impacts, steps;
+    const double *serr_umax, *serr_hist; /* scenes: per structure */
 } row;
 
 typedef struct conv_args {
@@ -170,49 +173,126 @@ static double dt_at(const conv_args *a, int i)
     return a->dt_max * pow(a->dt_min / a->dt_max, (double)i / (a->ndt - 1));
 }
 
+/* A reference and the runs measured against it: the oscillator's or a
+ * scene's. */
+typedef struct measurer {
+    const pd_cli_case *k;
+    pd_trace ref, work;      /* oscillator */
+    pd_osc_result rr;
+    pd_scene *sc;            /* scene */
+    pd_scene_trace sref;
+    pd_scene_result srr, sres;
+    pd_scene_errors se;
+    double *serr;            /* rows x nstruct x 2: the per-structure errors of every row */
+} measurer;
+
+static void measurer_free(measurer *M)
+{
+    pd_trace_free(&M->ref);
+    pd_trace_free(&M->work);
+    pd_scene_trace_free(&M->sref);
+    pd_scene_result_free(&M->srr);
+    pd_scene_result_free(&M->sres);
+    pd_scene_errors_free(&M->se);
+    pd_scene_free(M->sc);
+    free(M->serr);
+}
+
+/* Room for the finest grid o. */
+static int measurer_alloc(measurer *M, const pd_run_opts *o, int nrows, pd_err *err)
+{
+    int rc;
+    if (!M->sc) {
+        if (pd_trace_alloc(&M->ref, o) || pd_trace_alloc(&M->work, o))
+            return pd_err_set(err, PD_ENOMEM, "out of memory for %ld grid points", M->ref.cap);
+        return PD_OK;
+    }
+    if ((rc = pd_scene_trace_alloc(&M->sref, M->sc, o, err)) ||
+        (rc = pd_scene_result_alloc(M->sc, &M->srr, err)) ||
+        (rc = pd_scene_result_alloc(M->sc, &M->sres, err)) ||
+        (rc = pd_scene_errors_alloc(M->sc, &M->se, err)))
+        return rc;
+    M->serr = malloc((size_t)nrows * (size_t)M->sc->nstruct * 2 * sizeof(double));
+    return M->serr ? PD_OK : pd_err_set(err, PD_ENOMEM, "out of memory for the rows");
+}
+
+/* The reference on the grid of o; its cost in *cpu. */
+static int measure_reference(measurer *M, const pd_run_opts *o, double *cpu, pd_err *err)
+{
+    int rc = M->sc ? pd_scene_measure_reference(M->sc, o, &M->sref, &M->srr, err)
+                   : pd_measure_reference(&M->k->c, o, &M->ref, &M->rr, err);
+    *cpu = fmax(*cpu, M->sc ? M->srr.cpu_s : M->rr.cpu_s);
+    return rc;
+}
+
+/* Row r: the method of o measured against the reference. */
+static int measure_row(measurer *M, const pd_run_opts *o, int r, row *out, pd_err *err)
+{
+    int rc;
+    *out = (row){.method = o->method,
+                 .theta = o->method == PD_METHOD_MOREAU ? o->theta : NAN,
+                 .dt = o->dt,
+                 .kc = o->method == PD_METHOD_PENALTY ? o->pen.kc_mult : NAN,
+                 .order = NAN};
+    if (!M->sc) {
+        pd_measured m;
+        if ((rc = pd_measure_run(&M->k->c, o, &M->ref, M->rr.umax, &M->work, &m, err)))
+            return rc;
+        out->err_umax = m.err_umax_rel;
+        out->err_hist = m.err_hist_linf;
+        out->cpu_s = m.r.cpu_s;
+        out->impacts = m.r.impacts;
+        out->steps = m.r.steps;
+        return PD_OK;
+    }
+    if ((rc = pd_scene_measure_run(M->sc, o, &M->sref, &M->srr, &M->sres, &M->se, err)))
+        return rc;
+    int ns = M->sc->nstruct;
+    double *eu = M->serr + (size_t)r * ns * 2, *eh = eu + ns;
+    memcpy(eu, M->se.err_umax, (size_t)ns * sizeof(double));
+    memcpy(eh, M->se.err_hist, (size_t)ns * sizeof(double));
+    out->err_umax = M->se.err_umax_max;
+    out->err_hist = M->se.err_hist_max;
+    out->cpu_s = M->se.cpu_s;
+    out->impacts = M->se.impacts;
+    out->steps = M->sres.steps;
+    out->serr_umax = eu;
+    out->serr_hist = eh;
+    return PD_OK;
+}
+
 /* Rows: for each dt the reference on that grid, then Moreau–Jean per theta;
  * penalty per stiffness on the finest grid. */
-static int compute_rows(conv_args *a, row *rows, int *nrows, double *ref_cpu, pd_err *err)
+static int compute_rows(conv_args *a, measurer *M, row *rows, int *nrows, double *ref_cpu,
+                        pd_err *err)
 {
-    pd_trace ref = {0}, work = {0};
     pd_run_opts o = a->k.opts;
-    pd_osc_result rr;
-    int rc = PD_OK, n = 0;
+    int rc, n = 0;
     o.dt = a->dt_min;
-    if (pd_trace_alloc(&ref, &o) || pd_trace_alloc(&work, &o)) {
-        rc = pd_err_set(err, PD_ENOMEM, "out of memory for %ld grid points", ref.cap);
-        goto done;
-    }
     *ref_cpu = 0.0;
+    if ((rc = measurer_alloc(M, &o, a->ndt * a->ntheta + a->nkc, err)))
+        goto done;
     for (int i = 0; i < a->ndt && a->want_moreau; i++) {
         o.dt = dt_at(a, i);
-        if ((rc = pd_measure_reference(&a->k.c, &o, &ref, &rr, err)))
+        if ((rc = measure_reference(M, &o, ref_cpu, err)))
             goto done;
-        *ref_cpu = fmax(*ref_cpu, rr.cpu_s);
-        for (int t = 0; t < a->ntheta; t++) {
-            pd_measured m;
+        for (int t = 0; t < a->ntheta; t++, n++) {
             o.theta = a->thetas[t];
             o.method = PD_METHOD_MOREAU;
-            if ((rc = pd_measure_run(&a->k.c, &o, &ref, rr.umax, &work, &m, err)))
+            if ((rc = measure_row(M, &o, n, &rows[n], err)))
                 goto done;
-            rows[n++] = (row){PD_METHOD_MOREAU, o.theta, o.dt, NAN, m.err_umax_rel,
-                              m.err_hist_linf, m.r.cpu_s, NAN, m.r.impacts, m.r.steps};
         }
     }
     if (a->want_penalty) {
         o.dt = a->dt_min;
-        if ((rc = pd_measure_reference(&a->k.c, &o, &ref, &rr, err)))
+        if ((rc = measure_reference(M, &o, ref_cpu, err)))
             goto done;
-        *ref_cpu = fmax(*ref_cpu, rr.cpu_s);
-        for (int k = 0; k < a->nkc; k++) {
-            pd_measured m;
+        for (int k = 0; k < a->nkc; k++, n++) {
             o.method = PD_METHOD_PENALTY;
             o.pen.kc_mult = a->kcs[k];
             o.pen.kc_abs = 0.0;
-            if ((rc = pd_measure_run(&a->k.c, &o, &ref, rr.umax, &work, &m, err)))
+            if ((rc = measure_row(M, &o, n, &rows[n], err)))
                 goto done;
-            rows[n++] = (row){PD_METHOD_PENALTY, NAN, o.dt, a->kcs[k], m.err_umax_rel,
-                              m.err_hist_linf, m.r.cpu_s, NAN, m.r.impacts, m.r.steps};
         }
     }
     /* observed order between successive Moreau–Jean rows of one theta */
@@ -226,13 +306,25 @@ static int compute_rows(conv_args *a, row *rows, int *nrows, double *ref_cpu, pd
             }
 done:
     *nrows = n;
-    pd_trace_free(&ref);
-    pd_trace_free(&work);
     return rc;
 }
 
-static void print_rows(const conv_args *a, const row *rows, int n, double ref_cpu)
+/* The case in words, for titles. */
+static void case_title(const conv_args *a, const measurer *M, char *buf, size_t cap)
 {
+    if (M->sc)
+        snprintf(buf, cap, "scene %s (%d structures)", a->k.scene_path ? a->k.scene_path : "chain",
+                 M->sc->nstruct);
+    else
+        snprintf(buf, cap, "%s %s pulse, Pi2 = %.3g, Pi3 = %.3g, eps = %g", pd_dir_name(a->k.c.dir),
+                 pd_pulse_name(a->k.c.pulse), a->k.c.Pi2, a->k.c.Pi3, a->k.c.eps);
+}
+
+static void print_rows(const conv_args *a, const measurer *M, const row *rows, int n,
+                       double ref_cpu)
+{
+    char title[256];
+    case_title(a, M, title, sizeof title);
     if (a->json) {
         pd_json js;
         pd_json_init(&js, stdout);
@@ -250,6 +342,17 @@ static void print_rows(const conv_args *a, const row *rows, int n, double ref_cp
             pd_json_num(&js, "order", rows[r].order);
             pd_json_int(&js, "impacts", rows[r].impacts);
             pd_json_int(&js, "steps", rows[r].steps);
+            if (M->sc) {
+                pd_json_begin_array(&js, "structures");
+                for (int k = 0; k < M->sc->nstruct; k++) {
+                    pd_json_begin_object(&js, NULL);
+                    pd_json_str(&js, "name", M->sc->st[k].name);
+                    pd_json_num(&js, "err_umax_rel", rows[r].serr_umax[k]);
+                    pd_json_num(&js, "err_hist_linf", rows[r].serr_hist[k]);
+                    pd_json_end_object(&js);
+                }
+                pd_json_end_array(&js);
+            }
             pd_json_end_object(&js);
         }
         pd_json_end_array(&js);
@@ -258,9 +361,7 @@ static void print_rows(const conv_args *a, const row *rows, int n, double ref_cp
         pd_json_finish(&js);
         return;
     }
-    printf("%s %s pulse, Pi2 = %.6g, Pi3 = %.6g, eps = %g, xi = %g; reference cost %.3g s\n",
-           pd_dir_name(a->k.c.dir), pd_pulse_name(a->k.c.pulse), a->k.c.Pi2, a->k.c.Pi3,
-           a->k.c.eps, a->k.c.xi, ref_cpu);
+    printf("%s; reference cost %.3g s\n", title, ref_cpu);
     printf("  %-8s %6s %11s %8s %11s %11s %10s %7s %8s\n", "method", "theta", "dt [s]", "kc",
            "err_umax", "err_hist", "cpu [s]", "order", "impacts");
     for (int r = 0; r < n; r++)
@@ -270,7 +371,8 @@ static void print_rows(const conv_args *a, const row *rows, int n, double ref_cp
 }
 
 /* err_hist against dt (Moreau–Jean curves) and against CPU time (all). */
-static int plot_rows(const conv_args *a, const row *rows, int n, double ref_cpu, pd_err *err)
+static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int n,
+                     double ref_cpu, pd_err *err)
 {
     static double xs[2][MAX_LIST + 1][MAX_ROWS], ys[2][MAX_LIST + 1][MAX_ROWS];
     pd_curve by_dt[MAX_LIST], by_cpu[MAX_LIST + 1];
@@ -306,9 +408,7 @@ static int plot_rows(const conv_args *a, const row *rows, int n, double ref_cpu,
                                     .y = ys[1][ncurve]};
     }
     char title[256];
-    snprintf(title, sizeof title, "%s %s pulse, Pi2 = %.3g, Pi3 = %.3g, eps = %g",
-             pd_dir_name(a->k.c.dir), pd_pulse_name(a->k.c.pulse), a->k.c.Pi2, a->k.c.Pi3,
-             a->k.c.eps);
+    case_title(a, M, title, sizeof title);
     pd_chart c1 = {.title = title,
                    .xlabel = "dt [s]",
                    .ylabel = "max |u - u_{ref}| / u_{max,ref}",
@@ -361,7 +461,8 @@ int pd_cmd_converge(int argc, char **argv)
 {
     static conv_args a;
     static row rows[MAX_ROWS];
-    int n = 0, rc;
+    measurer M;
+    int n = 0, rc, status = 0;
     double ref_cpu = 0.0;
     pd_err err;
     if (pd_cli_help(argc, argv, converge_usage, 1))
@@ -370,14 +471,19 @@ int pd_cmd_converge(int argc, char **argv)
         return rc;
     if (a.ndt * a.ntheta + a.nkc > MAX_ROWS)
         return pd_cli_usage_error("converge: too many rows (at most %d)", MAX_ROWS);
-    if ((rc = compute_rows(&a, rows, &n, &ref_cpu, &err))) {
+    memset(&M, 0, sizeof M);
+    M.k = &a.k;
+    if (pd_cli_is_scene(&a.k) && (status = pd_cli_scene(&a.k, &M.sc)))
+        return status;
+    if ((rc = compute_rows(&a, &M, rows, &n, &ref_cpu, &err))) {
         fprintf(stderr, "pound: converge: %s\n", err.msg);
-        return rc == PD_EINVAL ? 2 : 1;
-    }
-    if ((a.plot && plot_rows(&a, rows, n, ref_cpu, &err)) || (a.out && write_rows(&a, rows, n, &err))) {
+        status = rc == PD_EINVAL ? 2 : 1;
+    } else if ((a.plot && plot_rows(&a, &M, rows, n, ref_cpu, &err)) ||
+               (a.out && write_rows(&a, rows, n, &err))) {
         fprintf(stderr, "pound: converge: %s\n", err.msg);
-        return 1;
-    }
-    print_rows(&a, rows, n, ref_cpu);
-    return 0;
+        status = 1;
+    } else
+        print_rows(&a, &M, rows, n, ref_cpu);
+    measurer_free(&M);
+    return status;
 }

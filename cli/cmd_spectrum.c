@@ -29,14 +29,23 @@ static const char spectrum_usage[] =
     "                   umax [cm] vs T0 in F-dim.png)\n"
     "  --threads K      OpenMP threads [OMP_NUM_THREADS or all cores]\n"
     "  --json           {\"points\": [...], \"cpu_s\": ..., \"wall_s\": ...} on stdout\n"
-    "MPI: make MPI=1, then mpirun -np K build-mpi/pound spectrum ... (rank 0 writes)\n";
+    "MPI: make MPI=1, then mpirun -np K build-mpi/pound spectrum ... (rank 0 writes)\n"
+    "scenes: pound spectrum --scene F.json --Pi2 MIN:MAX:N [--ref NAME] [--Pi3 LIST]\n"
+    "                       [--ref-contact K] [--eps LIST] [-o F] [--plot F.png] [--json]\n"
+    "  Pi2 = Tp / T0 of the reference structure NAME [the first] (the pulse period is swept,\n"
+    "  the other structures keep their period ratios); --Pi3 scales every gap so that\n"
+    "  contact K [0] has Pi3 = gap wp^2 / ap (the others keep their ratios to it); --eps\n"
+    "  sets every restitution; Pi1 and gamma per structure (its largest storey)\n";
 
 /* Everything the command line sets. */
 typedef struct spec_args {
     pd_spectrum s;
     pd_cli_case k; /* the model, scheme and method flags */
     const char *out, *plot;
-    int json, resume, threads, have_pi2, have_pi3, have_gap;
+    int json, resume, threads, have_pi2, have_pi3, have_gap, have_eps;
+    const char *scene_list;           /* a list flag a scene sweep refuses */
+    const char *ref_name;             /* --ref NAME (scene sweeps) */
+    int ref_contact, have_ref_contact; /* --ref-contact K */
     long stop_after;
 } spec_args;
 
@@ -130,8 +139,10 @@ static int list_flag(spec_args *a, const char *f, const char *val)
         a->have_gap |= !strcmp(f, "--gap");
         s->size_is_gap = !strcmp(f, "--gap");
         rc = parse_nums(f, val, s->size, &s->nsize);
-    } else if (!strcmp(f, "--eps"))
+    } else if (!strcmp(f, "--eps")) {
+        a->have_eps = 1;
         rc = parse_nums(f, val, s->eps, &s->neps);
+    }
     else if (!strcmp(f, "--xi"))
         rc = parse_nums(f, val, s->xi, &s->nxi);
     else if (!strcmp(f, "--ap")) {
@@ -145,6 +156,8 @@ static int list_flag(spec_args *a, const char *f, const char *val)
         rc = parse_names(f, val, 0, s->dir, &s->ndir, 2);
     else
         return 0;
+    if (strcmp(f, "--Pi3") && strcmp(f, "--eps") && !a->scene_list)
+        a->scene_list = f;
     return rc ? 2 : 1;
 }
 
@@ -175,6 +188,15 @@ static int own_flag(spec_args *a, int argc, char **argv, int *i)
     } else if (!strcmp(f, "--dt-per-Tp")) {
         if (!(rc = pd_cli_double(f, val, &a->s.dt_per_Tp)) && !(a->s.dt_per_Tp > 0.0))
             rc = pd_cli_usage_error("--dt-per-Tp: must be > 0 (got %g)", a->s.dt_per_Tp);
+    } else if (!strcmp(f, "--ref")) {
+        if (!val)
+            return pd_cli_usage_error("--ref needs a structure name");
+        a->ref_name = val;
+        rc = 0;
+    } else if (!strcmp(f, "--ref-contact")) {
+        if (!(rc = pd_cli_int(f, val, &a->ref_contact)) && a->ref_contact < 0)
+            rc = pd_cli_usage_error("--ref-contact: must be >= 0 (got %d)", a->ref_contact);
+        a->have_ref_contact = 1;
     } else if (!strcmp(f, "--threads")) {
         if (!(rc = pd_cli_int(f, val, &a->threads)) && (a->threads < 1 || a->threads > 4096))
             rc = pd_cli_usage_error("--threads: must be in [1, 4096] (got %d)", a->threads);
@@ -190,6 +212,27 @@ static int own_flag(spec_args *a, int argc, char **argv, int *i)
     return rc ? 2 : 1;
 }
 
+/* The rules of a scene sweep: 0 or 2. */
+static int check_scene_args(spec_args *a)
+{
+    pd_err err;
+    if (a->k.chain)
+        return pd_cli_usage_error("--chain: spectrum sweeps a scene file (--scene F.json)");
+    if (a->scene_list)
+        return pd_cli_usage_error("%s: the scene file gives the structures and the excitation "
+                                  "(a scene sweep takes --Pi2, --Pi3 and --eps lists)",
+                                  a->scene_list);
+    if (a->resume || a->stop_after || a->s.dt_per_Tp > 0.0)
+        return pd_cli_usage_error("%s: not available for scene sweeps",
+                                  a->resume ? "--resume" : a->stop_after ? "--stop-after"
+                                                                         : "--dt-per-Tp");
+    if (a->plot && (strlen(a->plot) < 5 || strcmp(a->plot + strlen(a->plot) - 4, ".png")))
+        return pd_cli_usage_error("--plot: '%s' must end in .png", a->plot);
+    if (a->out && pd_output_check_path(a->out, &err))
+        return pd_cli_usage_error("%s", err.msg);
+    return pd_cli_case_finish(&a->k);
+}
+
 /* Cross-flag rules once every flag is read: 0 or 2. */
 static int check_args(spec_args *a)
 {
@@ -197,6 +240,10 @@ static int check_args(spec_args *a)
     pd_err err;
     if (!a->have_pi2)
         return pd_cli_usage_error("spectrum: --Pi2 MIN:MAX:N is required");
+    if (a->k.scene_path || a->k.chain)
+        return check_scene_args(a);
+    if (a->ref_name || a->have_ref_contact)
+        return pd_cli_usage_error("%s: goes with --scene", a->ref_name ? "--ref" : "--ref-contact");
     if (a->have_pi3 && a->have_gap)
         return pd_cli_usage_error("--gap and --Pi3 are alternatives: give one");
     if (s->dt_per_Tp > 0.0 && a->k.have_dt)
@@ -373,7 +420,27 @@ int pd_cmd_spectrum(int argc, char **argv)
     else if (!(rc = parse_on_rank(a, argc, argv, rank))) {
         if (!threaded)
             a->threads = 1; /* MPI without thread support: one thread per rank */
-        rc = sweep(a, rank, size, wall0);
+        if (a->k.scene_path) {
+            pd_scene_sweep_args sa = {.k = &a->k,
+                                      .ref_name = a->ref_name,
+                                      .ref_contact = a->ref_contact,
+                                      .pi2_min = a->s.pi2_min,
+                                      .pi2_max = a->s.pi2_max,
+                                      .npi2 = a->s.npi2,
+                                      .linear = a->s.linear,
+                                      .npi3 = a->have_pi3 ? a->s.nsize : 0,
+                                      .pi3 = a->s.size,
+                                      .neps = a->have_eps ? a->s.neps : 0,
+                                      .eps = a->s.eps,
+                                      .out = a->out,
+                                      .plot = a->plot,
+                                      .json = a->json,
+                                      .threads = a->threads};
+            rc = size > 1 ? pd_cli_usage_error("spectrum --scene runs in one process (OpenMP "
+                                               "threads), not under mpirun")
+                          : pd_cmd_spectrum_scene(&sa, wall0);
+        } else
+            rc = sweep(a, rank, size, wall0);
     }
     free(a);
     pd_spec_mpi_finalize();

@@ -9,6 +9,21 @@
 /* `pound spectrum` (cmd_spectrum.c): the exit status. */
 int pd_cmd_spectrum(int argc, char **argv);
 
+/* `pound spectrum --scene` (spectrum_scene.c): the Pi spectra of a scene. */
+typedef struct pd_scene_sweep_args {
+    const pd_cli_case *k;
+    const char *ref_name;
+    int ref_contact;
+    double pi2_min, pi2_max;
+    int npi2, linear;
+    int npi3, neps;
+    const double *pi3, *eps;
+    const char *out, *plot;
+    int json, threads;
+} pd_scene_sweep_args;
+
+int pd_cmd_spectrum_scene(const pd_scene_sweep_args *a, double wall0);
+
 /* ---- the journal of finished tasks (spectrum_journal.c) ------------------ */
 
 typedef struct pd_spec_journal {

@@ -297,6 +297,8 @@ int pd_scene_set_damping(pd_scene *sc, pd_damping damping, int mode1, int mode2,
 /* A contact; a or b PD_WALL for a wall (level 0 there). */
 int pd_scene_add_contact(pd_scene *sc, int a, int level_a, int b, int level_b, double gap,
                          double eps, int entry, pd_err *err);
+/* A deep copy, not finished (NULL when out of memory). */
+pd_scene *pd_scene_copy(const pd_scene *sc);
 /* The structure called name, or -1 (PD_WALL for "wall"); -2 when unknown. */
 int pd_scene_find(const pd_scene *sc, const char *name);
 
@@ -398,6 +400,42 @@ int pd_scene_summarize(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sam
                        void *ctx, pd_scene_summary *s, pd_err *err);
 void pd_scene_summary_free(pd_scene_summary *s);
 
+/* ---- errors against the reference on a scene (compare, converge) -------- *
+ * Per structure, on the output grid t_k = k dt:
+ *   err_umax_rel  = max over storeys |umax - umax_ref| / max over storeys umax_ref,
+ *   err_hist_linf = max_k max over storeys |x(t_k) - x_ref(t_k)| / (the same). */
+
+/* The reference history: rows of n displacements. */
+typedef struct pd_scene_trace {
+    double *x;
+    long rows, cap;
+    int n;
+} pd_scene_trace;
+
+typedef struct pd_scene_errors {
+    double *err_umax, *err_hist;      /* nstruct */
+    double err_umax_max, err_hist_max; /* the worst structure */
+    long impacts;                     /* over every contact */
+    long grid_points;
+    double cpu_s;                     /* a second run without sampling */
+} pd_scene_errors;
+
+/* Room for the grid of o (PD_EINVAL when it would exceed 2 GB). */
+int pd_scene_trace_alloc(pd_scene_trace *tr, const pd_scene *sc, const pd_run_opts *o,
+                         pd_err *err);
+void pd_scene_trace_free(pd_scene_trace *tr);
+int pd_scene_errors_alloc(const pd_scene *sc, pd_scene_errors *e, pd_err *err);
+void pd_scene_errors_free(pd_scene_errors *e);
+
+/* The event-driven reference of o's scene on its grid (res allocated by
+ * pd_scene_result_alloc; res->cpu_s is its cost without sampling). */
+int pd_scene_measure_reference(const pd_scene *sc, const pd_run_opts *o, pd_scene_trace *ref,
+                               pd_scene_result *res, pd_err *err);
+/* The method of o on the same grid and its errors against ref. */
+int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scene_trace *ref,
+                         const pd_scene_result *ref_res, pd_scene_result *res,
+                         pd_scene_errors *e, pd_err *err);
+
 /* ==== spectrum sweeps ============================================================ *
  * A Pi2 grid crossed with lists of pulse, directivity, amplitude, damping,
  * gap and restitution.
@@ -468,6 +506,9 @@ long pd_spec_curves(const pd_spectrum *s);
 long pd_spec_points(const pd_spectrum *s);
 long pd_spec_twins(const pd_spectrum *s);
 long pd_spec_tasks(const pd_spectrum *s);
+/* The j-th of n values from lo to hi, equal steps (linear) or log-spaced,
+ * the end points exact. */
+double pd_grid_value(double lo, double hi, int n, int linear, int j);
 /* The j-th Pi2 of the grid (end points exact). */
 double pd_spec_pi2(const pd_spectrum *s, int j);
 void pd_spec_coords_of(const pd_spectrum *s, long task, pd_spec_coords *co);
@@ -489,5 +530,45 @@ char *pd_spec_key(const pd_spectrum *s);
 void pd_spec_rows(const pd_spectrum *s, const pd_spec_result *res, pd_spec_row *rows);
 /* A short label of a curve naming the parameters that vary. */
 void pd_spec_curve_label(const pd_spectrum *s, long curve, char *buf, size_t cap);
+
+/* ---- scene sweeps ------------------------------------------------------------ *
+ * The Pi presentation carried to N structures: the pulse period swept over
+ * Pi2 = Tp / T0 of a reference structure (the others keep their period
+ * ratios), every gap scaled so that the reference contact's Pi3 = gap wp^2 /
+ * ap takes each listed value (the others keep their ratios to it), every
+ * restitution set to each listed eps.  Tasks: first the contact-free twins,
+ * one per Pi2, then the points, Pi2 fastest, then Pi3, then eps. */
+typedef struct pd_scene_sweep {
+    const pd_scene *sc;
+    pd_run_opts opts;      /* dt 0: the scene's default at each point */
+    int ref;               /* reference structure */
+    int ref_contact;       /* reference contact (its gap must be > 0 with Pi3 values) */
+    double pi2_min, pi2_max;
+    int npi2, linear;
+    int npi3, neps;        /* 0: the scene's own gaps, restitutions */
+    const double *pi3, *eps;
+} pd_scene_sweep;
+
+/* Per task: what the table of a sweep needs. */
+typedef struct pd_scene_point {
+    double Pi2, Pi3, eps, Tp, Le; /* Pi3 of the reference contact */
+    long steps, impacts;
+    double cpu_s;
+    int status;
+} pd_scene_point;
+
+long pd_scene_sweep_twins(const pd_scene_sweep *w);
+long pd_scene_sweep_points(const pd_scene_sweep *w);
+/* Check the sweep (the reference contact, the lists): PD_OK or PD_EINVAL
+ * naming the field. */
+int pd_scene_sweep_check(const pd_scene_sweep *w, pd_err *err);
+/* The scene of a task (a finished copy, freed by the caller) and its point. */
+int pd_scene_sweep_scene(const pd_scene_sweep *w, long task, pd_scene **out, pd_scene_point *pt,
+                         pd_err *err);
+/* Run every task on `threads` OpenMP threads (0: the default): pts[task]
+ * and umax[task * nstruct + s] (the largest storey displacement of
+ * structure s [m]).  The status of the lowest failed task, its message. */
+int pd_scene_sweep_run(const pd_scene_sweep *w, int threads, pd_scene_point *pts, double *umax,
+                       pd_err *err);
 
 #endif

@@ -37,6 +37,37 @@ void pd_scene_free(pd_scene *sc)
     free(sc);
 }
 
+pd_scene *pd_scene_copy(const pd_scene *sc)
+{
+    pd_scene *c = pd_scene_new(&sc->exc);
+    int ok = c != NULL;
+    for (int s = 0; ok && s < sc->nstruct; s++) {
+        const pd_structure *st = &sc->st[s];
+        ok = pd_scene_add_building(c, st->name, st->storeys, st->mass, st->stiffness, st->xi,
+                                   NULL) == PD_OK;
+        if (ok)
+            c->st[s] = (pd_structure){.storeys = st->storeys,
+                                      .mass = c->st[s].mass,
+                                      .stiffness = c->st[s].stiffness,
+                                      .xi = st->xi,
+                                      .damping = st->damping,
+                                      .modes = {st->modes[0], st->modes[1]}};
+        if (ok)
+            memcpy(c->st[s].name, st->name, sizeof st->name);
+    }
+    for (int a = 0; ok && a < sc->ncontact; a++) {
+        const pd_contact *ct = &sc->ct[a];
+        ok = pd_scene_add_contact(c, ct->a, ct->level_a, ct->b, ct->level_b, ct->gap, ct->eps,
+                                  ct->entry, NULL) == PD_OK;
+    }
+    if (!ok) {
+        pd_scene_free(c);
+        return NULL;
+    }
+    c->tend = sc->tend;
+    return c;
+}
+
 int pd_scene_find(const pd_scene *sc, const char *name)
 {
     if (!strcmp(name, "wall"))

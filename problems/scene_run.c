@@ -478,7 +478,7 @@ static int run_event(const pd_model *md, const pd_run_opts *o, double tau_end, t
     int rc = pd_edg_run(md, 0.0, NULL, NULL, tau_end, &eo, tr->fn ? observe_grid : NULL, tr, &er,
                         err);
     res->steps = er.events;
-    res->kernel = "event";
+    res->kernel = "event-general";
     res->factor = pd_factor_kind_name(pd_factor_choose(md, o->factor));
     res->lcp_solver = pd_lcp_method_name(o->lcp_solver);
     return rc;

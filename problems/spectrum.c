@@ -36,16 +36,21 @@ long pd_spec_twins(const pd_spectrum *s)
 
 long pd_spec_tasks(const pd_spectrum *s) { return pd_spec_twins(s) + pd_spec_points(s); }
 
+double pd_grid_value(double lo, double hi, int n, int linear, int j)
+{
+    if (n < 2 || j <= 0)
+        return lo;
+    if (j >= n - 1)
+        return hi;
+    double t = (double)j / (n - 1);
+    if (linear)
+        return lo + (hi - lo) * t;
+    return lo * pow(hi / lo, t);
+}
+
 double pd_spec_pi2(const pd_spectrum *s, int j)
 {
-    if (s->npi2 < 2 || j <= 0)
-        return s->pi2_min;
-    if (j >= s->npi2 - 1)
-        return s->pi2_max;
-    double t = (double)j / (s->npi2 - 1);
-    if (s->linear)
-        return s->pi2_min + (s->pi2_max - s->pi2_min) * t;
-    return s->pi2_min * pow(s->pi2_max / s->pi2_min, t);
+    return pd_grid_value(s->pi2_min, s->pi2_max, s->npi2, s->linear, j);
 }
 
 /* Split a (pulse, dir, ap, xi) group index into its digits, xi fastest. */

@@ -81,6 +81,7 @@ int main(int argc, char **argv)
     suite_alloc(&ctx);
     suite_cli(&ctx);
     suite_spectrum(&ctx);
+    suite_scene(&ctx);
 
     printf("%d passed, %d failed, %d skipped\n", ctx.passed, ctx.failed, ctx.skipped);
     return ctx.failed ? 1 : 0;

@@ -1,0 +1,162 @@
+/* scene_measure.c — a method's errors against the event-driven reference
+ * on a scene, per structure, on the common output grid t_k = k dt:
+ *   err_umax_rel  = max over storeys |umax - umax_ref| / max over storeys umax_ref,
+ *   err_hist_linf = max_k max over storeys |x(t_k) - x_ref(t_k)| / (the same).
+ * The reference history is kept (rows x dofs); the method's run is compared
+ * sample by sample as it goes. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pd_problems.h"
+
+#define TRACE_MAX_BYTES (2.0 * 1024 * 1024 * 1024) /* largest reference history kept */
+
+int pd_scene_trace_alloc(pd_scene_trace *tr, const pd_scene *sc, const pd_run_opts *o,
+                         pd_err *err)
+{
+    pd_run_opts r;
+    int rc;
+    memset(tr, 0, sizeof *tr);
+    if ((rc = pd_scene_resolve_opts(sc, o, &r, err)))
+        return rc;
+    tr->n = sc->n;
+    tr->cap = pd_steps_for(r.tend, r.dt) + 2;
+    double bytes = (double)tr->cap * sc->n * sizeof(double);
+    if (bytes > TRACE_MAX_BYTES)
+        return pd_err_set(err, PD_EINVAL,
+                          "dt: the reference history would take %.1f GB (%ld points x %d dofs): "
+                          "use a larger dt or a smaller scene",
+                          bytes / 1e9, tr->cap, sc->n);
+    if (!(tr->x = malloc((size_t)tr->cap * (size_t)sc->n * sizeof(double))))
+        return pd_err_set(err, PD_ENOMEM, "out of memory for the reference history");
+    return PD_OK;
+}
+
+void pd_scene_trace_free(pd_scene_trace *tr)
+{
+    free(tr->x);
+    memset(tr, 0, sizeof *tr);
+}
+
+void pd_scene_errors_free(pd_scene_errors *e)
+{
+    free(e->err_umax);
+    free(e->err_hist);
+    memset(e, 0, sizeof *e);
+}
+
+int pd_scene_errors_alloc(const pd_scene *sc, pd_scene_errors *e, pd_err *err)
+{
+    memset(e, 0, sizeof *e);
+    e->err_umax = calloc((size_t)sc->nstruct, sizeof(double));
+    e->err_hist = calloc((size_t)sc->nstruct, sizeof(double));
+    if (!e->err_umax || !e->err_hist) {
+        pd_scene_errors_free(e);
+        return pd_err_set(err, PD_ENOMEM, "out of memory for the errors");
+    }
+    return PD_OK;
+}
+
+/* Sampler: the reference history, row by row. */
+static int keep_row(const pd_scene_sample *s, void *ctx)
+{
+    pd_scene_trace *tr = ctx;
+    if (tr->rows < tr->cap)
+        memcpy(tr->x + (size_t)tr->rows++ * tr->n, s->x, (size_t)tr->n * sizeof(double));
+    return 0;
+}
+
+/* The largest reference displacement of each structure. */
+static double structure_scale(const pd_scene *sc, const pd_scene_result *ref, int s)
+{
+    double m = 0.0;
+    for (int k = 0; k < sc->st[s].storeys; k++)
+        m = fmax(m, ref->umax[sc->st[s].dof + k]);
+    return m;
+}
+
+int pd_scene_measure_reference(const pd_scene *sc, const pd_run_opts *o, pd_scene_trace *ref,
+                               pd_scene_result *res, pd_err *err)
+{
+    pd_run_opts r = *o;
+    pd_scene_result timed;
+    int rc;
+    r.method = PD_METHOD_EVENT;
+    ref->rows = 0;
+    if ((rc = pd_scene_run(sc, &r, keep_row, ref, res, err)))
+        return rc;
+    if ((rc = pd_scene_result_alloc(sc, &timed, err)))
+        return rc;
+    rc = pd_scene_run(sc, &r, NULL, NULL, &timed, err); /* its cost without the sampling */
+    res->cpu_s = timed.cpu_s;
+    pd_scene_result_free(&timed);
+    for (int s = 0; s < sc->nstruct && !rc; s++)
+        if (!(structure_scale(sc, res, s) > 0.0))
+            rc = pd_err_set(err, PD_EINVAL,
+                            "the reference response of '%s' is zero: no error to measure",
+                            sc->st[s].name);
+    return rc;
+}
+
+/* The comparison as the method runs. */
+typedef struct compare_ctx {
+    const pd_scene *sc;
+    const pd_scene_trace *ref;
+    pd_scene_errors *e;
+    const double *scale; /* nstruct */
+    long row;
+} compare_ctx;
+
+static int compare_row(const pd_scene_sample *s, void *ctx)
+{
+    compare_ctx *c = ctx;
+    if (c->row >= c->ref->rows)
+        return 0;
+    const double *xr = c->ref->x + (size_t)c->row++ * c->ref->n;
+    for (int k = 0; k < c->sc->nstruct; k++) {
+        const pd_structure *st = &c->sc->st[k];
+        double worst = 0.0;
+        for (int i = st->dof; i < st->dof + st->storeys; i++)
+            worst = fmax(worst, fabs(s->x[i] - xr[i]));
+        c->e->err_hist[k] = fmax(c->e->err_hist[k], worst / c->scale[k]);
+    }
+    return 0;
+}
+
+int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scene_trace *ref,
+                         const pd_scene_result *ref_res, pd_scene_result *res,
+                         pd_scene_errors *e, pd_err *err)
+{
+    pd_scene_result timed;
+    double *scale = malloc((size_t)sc->nstruct * sizeof(double));
+    int rc;
+    if (!scale)
+        return pd_err_set(err, PD_ENOMEM, "out of memory");
+    for (int s = 0; s < sc->nstruct; s++) {
+        scale[s] = structure_scale(sc, ref_res, s);
+        e->err_hist[s] = e->err_umax[s] = 0.0;
+    }
+    compare_ctx c = {.sc = sc, .ref = ref, .e = e, .scale = scale, .row = 0};
+    if ((rc = pd_scene_run(sc, o, compare_row, &c, res, err)) ||
+        (rc = pd_scene_result_alloc(sc, &timed, err))) {
+        free(scale);
+        return rc;
+    }
+    rc = pd_scene_run(sc, o, NULL, NULL, &timed, err); /* its cost without the sampling */
+    e->cpu_s = timed.cpu_s;
+    pd_scene_result_free(&timed);
+    e->err_umax_max = e->err_hist_max = 0.0;
+    e->impacts = 0;
+    for (int s = 0; s < sc->nstruct; s++) {
+        for (int i = sc->st[s].dof; i < sc->st[s].dof + sc->st[s].storeys; i++)
+            e->err_umax[s] = fmax(e->err_umax[s], fabs(res->umax[i] - ref_res->umax[i]) / scale[s]);
+        e->err_umax_max = fmax(e->err_umax_max, e->err_umax[s]);
+        e->err_hist_max = fmax(e->err_hist_max, e->err_hist[s]);
+    }
+    for (int a = 0; a < sc->ncontact; a++)
+        e->impacts += res->impacts[a];
+    e->grid_points = c.row;
+    free(scale);
+    return rc;
+}
