@@ -29,7 +29,8 @@ enum {
     PD_EPARSE = -8,      /* a file is malformed */
     PD_ESINGULAR = -9,   /* a matrix to factor is singular */
     PD_EBUDGET = -10,    /* an event or step budget was exhausted */
-    PD_ESTOPPED = -11    /* an observer asked the run to stop (not an error) */
+    PD_ESTOPPED = -11,   /* an observer asked the run to stop (not an error) */
+    PD_EMAXITER = -12    /* an iterative solver's budget ran out */
 };
 
 /* A one-line error message; status mirrors the code returned. */

@@ -20,6 +20,7 @@ const char *pd_strerror(int status)
     case PD_ESINGULAR: return "singular matrix";
     case PD_EBUDGET: return "budget exhausted";
     case PD_ESTOPPED: return "stopped by observer";
+    case PD_EMAXITER: return "iteration limit reached";
     default: return "unknown status";
     }
 }

@@ -17,9 +17,6 @@
 #include "pd_engine.h"
 #include "pd_factor.h"
 
-/* Most active contacts one LCP takes on the sparse path with a dense solver
- * (its workspace grows as the square of this). */
-#define PD_MJ_SPARSE_LCP_MAX 1024
 
 struct pd_mj {
     const pd_model *model;
@@ -30,7 +27,10 @@ struct pd_mj {
     pd_factor *factor;    /* What, What^-1 W and the Delassus matrix */
     pd_lcp_solver *lcp;   /* the contact LCP solver, sized for lcp_nmax contacts */
     int lcp_nmax;         /* most active contacts one LCP may have */
+    unsigned char *guess; /* m: the warm start of the active set's LCP: 1 pushed in the
+                             previous step, 0 active without pushing, 2 newly active */
     int sparse;           /* 1: Delassus blocks in compressed columns */
+    int stop;             /* the LCP observer asked to stop */
     double *F0, *F1;      /* n: force at t_k and t_k+1 */
     double *work_n;       /* n: right-hand side, then velocity increment */
     double *qtheta;       /* n: q_k + h theta v_k */
@@ -54,7 +54,9 @@ pd_mj_opts pd_mj_default_opts(void)
                         .allow_unstable = 0,
                         .kernel = PD_KERNEL_AUTO,
                         .factor = PD_FACTOR_AUTO,
-                        .lcp_solver = PD_LCP_AUTO};
+                        .lcp_solver = PD_LCP_AUTO,
+                        .on_lcp = NULL,
+                        .on_lcp_ctx = NULL};
 }
 
 /* Closed-form scalar LCP  w = D P + b >= 0, P >= 0, wP = 0  (D > 0). */
@@ -81,6 +83,7 @@ void pd_mj_free(pd_mj *mj)
     free(mj->P_active);
     free(mj->w_active);
     free(mj->idx_active);
+    free(mj->guess);
     free(mj->st.q);
     free(mj->st.v);
     free(mj->st.P);
@@ -145,16 +148,16 @@ static void scalar_setup(pd_mj *mj)
     mj->s_del = mj->s_w * mj->s_winv;
 }
 
-/* The LCP solver and the Delassus block: dense lcp_nmax^2 when the factor
- * keeps D dense, compressed columns bounded by the entries of D otherwise
- * (then one LCP takes at most PD_MJ_SPARSE_LCP_MAX contacts for a dense
- * solver). */
+/* The LCP solver and the Delassus block: dense m^2 when the factor keeps D
+ * dense, compressed columns bounded by the entries of D otherwise. */
 static int contact_workspace(pd_mj *mj, pd_err *err)
 {
     int m = mj->model->m;
     long nnz = mj->factor->delassus_nnz;
     mj->sparse = mj->factor->type->kind == PD_FACTOR_CHOLMOD;
-    mj->lcp_nmax = mj->sparse && m > PD_MJ_SPARSE_LCP_MAX ? PD_MJ_SPARSE_LCP_MAX : m;
+    mj->lcp_nmax = m;
+    if (!(mj->guess = calloc((size_t)m, 1)))
+        return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for %d contacts", m);
     if (!(mj->lcp = pd_lcp_solver_alloc(mj->opts.lcp_solver, mj->lcp_nmax, mj->sparse ? nnz : 0,
                                         err)))
         return err ? err->status : PD_ENOMEM;
@@ -323,10 +326,13 @@ static int predict_active(pd_mj *mj)
     int nI = 0;
     pd_matrix_gemv_t(&md->W, mj->st.v, mj->U0);
     for (int a = 0; a < md->m; a++) {
+        unsigned char was = mj->st.active[a] ? mj->st.P[a] > 0.0 : 2;
         mj->st.active[a] = 0;
         mj->st.P[a] = 0.0;
         if (mj->st.g[a] + hg * mj->U0[a] <= 0.0) {
             mj->st.active[a] = 1;
+            if (mj->guess)
+                mj->guess[nI] = was;
             mj->idx_active[nI++] = a;
         }
     }
@@ -338,13 +344,14 @@ static int solve_contacts(pd_mj *mj, int nI, const double *vfree, pd_err *err)
 {
     const pd_model *md = mj->model;
     pd_lcp_info info;
+    pd_lcp_opts lo = pd_lcp_default_opts();
     pd_matrix D;
-    if (nI > mj->lcp_nmax)
+    lo.guess = mj->guess; /* warm start: the contacts that pushed in the last step */
+    if (mj->opts.lcp_solver == PD_LCP_LEMKE && nI > PD_LCP_LEMKE_NMAX)
         return pd_err_set(err, PD_EBUDGET,
-                          "Moreau-Jean: %d active contacts at t = %.9g exceed the %d the %s LCP "
-                          "solver is sized for",
-                          nI, mj->st.t + mj->opts.h, mj->lcp_nmax,
-                          pd_lcp_method_name(mj->opts.lcp_solver));
+                          "Moreau-Jean: %d active contacts at t = %.9g: the lemke LCP solver "
+                          "takes at most %d (use the structured one)",
+                          nI, mj->st.t + mj->opts.h, PD_LCP_LEMKE_NMAX);
     if (mj->sparse) {
         pd_factor_delassus_csc(mj->factor, mj->idx_active, nI, mj->D_colptr, mj->D_rowind,
                                mj->D_active);
@@ -357,9 +364,13 @@ static int solve_contacts(pd_mj *mj, int nI, const double *vfree, pd_err *err)
         int a = mj->idx_active[r];
         mj->b_active[r] = pd_matrix_col_dot(&md->W, a, vfree) + md->e[a] * mj->U0[a];
     }
-    int st = pd_lcp_solve(mj->lcp, &D, mj->b_active, NULL, mj->P_active, mj->w_active, &info);
-    mj->st.lcp_pivots = info.pivots;
+    int st = pd_lcp_solve(mj->lcp, &D, mj->b_active, &lo, mj->P_active, mj->w_active, &info);
+    mj->st.lcp_pivots = info.pivots + info.iterations;
     mj->st.lcp_solver = info.solver;
+    if (mj->opts.on_lcp && mj->opts.on_lcp(&D, mj->b_active, mj->P_active, mj->w_active, &info,
+                                           mj->idx_active, mj->st.t + mj->opts.h,
+                                           mj->opts.on_lcp_ctx) > 0)
+        mj->stop = 1;
     if (st)
         return pd_err_set(err, st,
                           "Moreau-Jean: LCP over %d active contact(s) (first: contact %d) not "
@@ -429,7 +440,8 @@ int pd_mj_run(pd_mj *mj, long nsteps, pd_observer observer, void *ctx, pd_err *e
     int rc;
     if (observer && observer(&mj->st, ctx) > 0)
         return PD_OK;
-    for (long k = 0; k < nsteps; k++) {
+    mj->stop = 0;
+    for (long k = 0; k < nsteps && !mj->stop; k++) {
         if ((rc = pd_mj_step(mj, err)))
             return rc;
         if (observer && observer(&mj->st, ctx) > 0)

@@ -97,6 +97,15 @@ typedef enum {
     PD_KERNEL_GENERAL = 1  /* the general kernel always (tests compare them) */
 } pd_kernel;
 
+/* Called after every contact LCP a step solves (solved or not): the
+ * Delassus block D (dense or compressed columns), the vector b, the
+ * impulses z, w = D z + b, what the solver reported, the active contacts
+ * idx (nI = D->rows of them) and the time at the end of the step.  Return
+ * > 0 to stop the run. */
+typedef int (*pd_lcp_observer)(const pd_matrix *D, const double *b, const double *z,
+                               const double *w, const pd_lcp_info *info, const int *idx,
+                               double t, void *ctx);
+
 typedef struct pd_mj_opts {
     double h;           /* step size > 0 */
     double theta;       /* in [1/2, 1] */
@@ -105,6 +114,8 @@ typedef struct pd_mj_opts {
     pd_kernel kernel;
     pd_factor_kind factor;     /* storage of What */
     pd_lcp_method lcp_solver;  /* the contact LCP solver */
+    pd_lcp_observer on_lcp;    /* optional: every LCP solved (dumps, solver studies) */
+    void *on_lcp_ctx;
 } pd_mj_opts;
 
 /* Defaults: h = 0 (must be set), theta = 1/2, gamma = 1/2, automatic kernel,

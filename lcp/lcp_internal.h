@@ -13,4 +13,20 @@ double pd_lcp_max_abs(int n, const double *x);
 void pd_lcp_verify(const pd_matrix *M, const double *q, const double *z, double *w, double *rows,
                    pd_lcp_info *info);
 
+/* The structured solver (bpp.c): block principal pivoting with an envelope
+ * Cholesky of M_FF in at most envmax entries; flag: n bytes of scratch. */
+typedef struct pd_bpp_work pd_bpp_work;
+pd_bpp_work *pd_bpp_alloc(int nmax, long envmax);
+void pd_bpp_free(pd_bpp_work *ws);
+int pd_bpp_nmax(const pd_bpp_work *ws);
+int pd_bpp_solve(pd_bpp_work *ws, const pd_matrix *M, const double *q, const pd_lcp_opts *o,
+                 double *z, double *w, unsigned char *flag, pd_lcp_info *info);
+
+/* Projected Gauss-Seidel (pgs.c). */
+typedef struct pd_pgs_work pd_pgs_work;
+pd_pgs_work *pd_pgs_alloc(int nmax);
+void pd_pgs_free(pd_pgs_work *ws);
+int pd_pgs_solve(pd_pgs_work *ws, const pd_matrix *M, const double *q, const pd_lcp_opts *o,
+                 double *z, double *w, pd_lcp_info *info);
+
 #endif

@@ -59,6 +59,7 @@ const char *pd_lcp_outcome_name(pd_lcp_outcome outcome)
     case PD_LCP_NO_SOLUTION: return "no_solution";
     case PD_LCP_MAX_PIVOTS: return "max_pivots";
     case PD_LCP_NUMERICAL: return "numerical";
+    case PD_LCP_MAX_ITERATIONS: return "max_iterations";
     default: return "unknown";
     }
 }
@@ -587,11 +588,43 @@ static int set_options(lemke_state *st, const pd_lcp_opts *opts, int *cap)
 
 pd_lcp_opts pd_lcp_default_opts(void)
 {
-    return (pd_lcp_opts){.cover = NULL, .max_pivots = 0, .tol = LEMKE_TOL_DEFAULT};
+    return (pd_lcp_opts){.cover = NULL,
+                         .max_pivots = 0,
+                         .tol = LEMKE_TOL_DEFAULT,
+                         .max_iterations = 0,
+                         .guess = NULL};
 }
 
-/* Lemke's method on (M, q): check the input, z = 0 if q >= 0, else pivot from
- * B = I and verify the answer.  Invalid input: PD_EINVAL, outcome numerical. */
+/* n <= 2: the supports {1}, {2}, {1, 2} by their closed forms (z_S =
+ * -M_SS^-1 q_S, Cramer's rule), the first that verifies; 0 if none does
+ * (Lemke's pivots then decide the outcome). */
+static int small_closed_form(const lemke_state *st, double *z, double *w, pd_lcp_info *info)
+{
+    const double *M = st->M, *q = st->q;
+    int n = st->n;
+    for (int s = 0; s < (n == 1 ? 1 : 3); s++) {
+        z[0] = z[n - 1] = 0.0;
+        if (s < 2) {
+            double d = M[s + (size_t)s * n];
+            if (d == 0.0)
+                continue;
+            z[s] = -q[s] / d;
+        } else {
+            double det = M[0] * M[3] - M[2] * M[1];
+            if (det == 0.0)
+                continue;
+            z[0] = (-q[0] * M[3] + q[1] * M[2]) / det;
+            z[1] = (-q[1] * M[0] + q[0] * M[1]) / det;
+        }
+        if (z[0] >= 0.0 && z[n - 1] >= 0.0 && verify(st, z, w, info))
+            return 1;
+    }
+    return 0;
+}
+
+/* Lemke's method on (M, q): check the input, z = 0 if q >= 0, the closed
+ * forms for n <= 2, else pivot from B = I and verify the answer.  Invalid
+ * input: PD_EINVAL, outcome numerical. */
 int pd_lcp_lemke(pd_lcp_work *work, int n, const double *M, const double *q,
                  const pd_lcp_opts *opts, double *z, double *w, pd_lcp_info *info)
 {
@@ -610,6 +643,10 @@ int pd_lcp_lemke(pd_lcp_work *work, int n, const double *M, const double *q,
         memset(z, 0, (size_t)n * sizeof(double));
         info->outcome = verify(&st, z, w, info) ? PD_LCP_SOLVED : PD_LCP_NUMERICAL;
         return outcome_status(info->outcome);
+    }
+    if (n <= 2 && small_closed_form(&st, z, w, info)) {
+        info->outcome = PD_LCP_SOLVED;
+        return PD_OK;
     }
     pd_lcp_outcome outcome = run_pivots(&st, cap, &info->pivots);
     if (outcome == PD_LCP_SOLVED) {

@@ -1,11 +1,20 @@
 /* pd_lcp.h — linear complementarity problems.
  *
- *   find z >= 0 such that w = M z + q >= 0 and z'w = 0,   M dense n x n.
+ *   find z >= 0 such that w = M z + q >= 0 and z'w = 0,   M n x n.
  *
- * Matrices are dense, COLUMN-MAJOR, leading dimension n: M[i + j*n] = M_ij.
- * Lemke's complementary pivoting method with a covering vector d (default all
- * ones) and a lexicographic minimum-ratio rule; a workspace sized for a
- * maximum n is allocated once and reused, so a solve never allocates. */
+ * Three solvers behind one table (pd_lcp_solve, docs/lcp.md):
+ *   lemke       Lemke's complementary pivoting with a covering vector and a
+ *               lexicographic ratio test, on dense column-major M (M[i + j n]);
+ *               the general solver, closed forms for n <= 2;
+ *   structured  block principal pivoting (Judice-Pires) for symmetric
+ *               positive definite M (the Delassus matrices of the engine),
+ *               envelope Cholesky of the principal blocks on compressed
+ *               columns, warm-started; hands over to Lemke when it cannot
+ *               finish in its bounded number of iterations;
+ *   pgs         projected Gauss-Seidel, the physics engines' baseline.
+ * Every answer is verified (the relative backward residual of
+ * pd_lcp_residual) before it is called solved.  Workspaces are sized once;
+ * a solve never allocates. */
 #ifndef PD_LCP_H
 #define PD_LCP_H
 
@@ -19,14 +28,15 @@
 /* Outcome of a solve.  The solver returns PD_OK for PD_LCP_SOLVED and the
  * negative status PD_ENOSOLUTION / PD_EMAXPIVOTS / PD_ENUMERICAL otherwise. */
 typedef enum {
-    PD_LCP_SOLVED = 0,      /* verified solution */
-    PD_LCP_NO_SOLUTION = 1, /* ray termination */
-    PD_LCP_MAX_PIVOTS = 2,  /* pivot cap reached */
-    PD_LCP_NUMERICAL = 3    /* pivot too small, or the answer failed verification */
+    PD_LCP_SOLVED = 0,        /* verified solution */
+    PD_LCP_NO_SOLUTION = 1,   /* ray termination */
+    PD_LCP_MAX_PIVOTS = 2,    /* pivot cap reached */
+    PD_LCP_NUMERICAL = 3,     /* pivot too small, or the answer failed verification */
+    PD_LCP_MAX_ITERATIONS = 4 /* an iterative solver's budget ran out, unverified */
 } pd_lcp_outcome;
 
 /* Name of an outcome as printed by `pound lcp`: "solved", "no_solution",
- * "max_pivots", "numerical". */
+ * "max_pivots", "numerical", "max_iterations". */
 const char *pd_lcp_outcome_name(pd_lcp_outcome outcome);
 
 /* Options: start from pd_lcp_default_opts() (a NULL opts pointer means the
@@ -36,15 +46,22 @@ typedef struct pd_lcp_opts {
     const double *cover; /* Lemke's covering vector d > 0 (n entries), NULL = all ones */
     int max_pivots;      /* Lemke's pivot cap; 0 = max(10000, 100 n) */
     double tol;          /* relative tolerance for ties and tiny pivots, in (0, 1) */
+    int max_iterations;  /* structured: block pivots, 0 = 3 n + 10; pgs: sweeps, 0 = 1000 n
+                            (at most 10^6) */
+    const unsigned char *guess; /* n flags, a warm start for the structured solver:
+                            1 z_i > 0 expected, 0 z_i = 0 expected, 2 no idea (the
+                            sign of q_i decides); NULL = 2 everywhere */
 } pd_lcp_opts;
 
-/* cover NULL, max_pivots 0 (from n), tol 1e-12. */
+/* cover NULL, max_pivots 0 (from n), tol 1e-12, max_iterations 0 (from n),
+ * guess NULL. */
 pd_lcp_opts pd_lcp_default_opts(void);
 
 /* What a solve reports. */
 typedef struct pd_lcp_info {
     pd_lcp_outcome outcome;
-    int pivots;             /* pivots performed, counting the one that brings z0 in */
+    int pivots;             /* Lemke: pivots performed, counting the one that brings z0 in */
+    int iterations;         /* structured: block pivots (principal solves); pgs: sweeps */
     double complementarity; /* max_i |z_i w_i| */
     double infeasibility;   /* max_i max(-z_i, -w_i, 0) */
     double residual;        /* relative backward residual (pd_lcp_residual): a verified
@@ -88,27 +105,36 @@ void pd_lcp_residual(int n, const double *M, const double *q, const double *z,
  * compressed-sparse-column; a solver that works on dense data copies a sparse
  * matrix into its own buffer.  info->solver names who answered. */
 typedef enum {
-    PD_LCP_AUTO = 0, /* the best solver for the problem's structure */
-    PD_LCP_LEMKE = 1 /* Lemke's method (dense), always available */
+    PD_LCP_AUTO = 0,       /* structured for sparse or symmetric M with n > 2, else Lemke */
+    PD_LCP_LEMKE = 1,      /* Lemke's method (dense), always available */
+    PD_LCP_STRUCTURED = 2, /* block principal pivoting for symmetric positive definite M */
+    PD_LCP_PGS = 3         /* projected Gauss-Seidel (positive diagonal) */
 } pd_lcp_method;
 
 typedef struct pd_lcp_solver pd_lcp_solver;
 
-/* "auto", "lemke"; parse: PD_OK or PD_EINVAL. */
+/* "auto", "lemke", "structured", "pgs"; parse: PD_OK or PD_EINVAL. */
 const char *pd_lcp_method_name(pd_lcp_method method);
 int pd_lcp_method_parse(const char *name, pd_lcp_method *method);
 /* The names the parser takes, comma-separated (for messages). */
 const char *pd_lcp_method_list(void);
 
 /* A solver for problems of up to nmax unknowns whose sparse matrices store
- * up to nnzmax entries (0: the caller passes dense matrices only).  NULL on
- * failure, with the reason in err. */
+ * up to nnzmax entries (0: the caller passes dense matrices only).  Lemke
+ * and the hand-over to it take a dense workspace of min(nmax,
+ * PD_LCP_LEMKE_NMAX)^2.  NULL on failure, with the reason in err. */
 pd_lcp_solver *pd_lcp_solver_alloc(pd_lcp_method method, int nmax, long nnzmax, pd_err *err);
 void pd_lcp_solver_free(pd_lcp_solver *s);
 int pd_lcp_solver_nmax(const pd_lcp_solver *s);
 
-/* Solve (M, q), M square (dense or CSC) with n <= nmax; the status of
- * pd_lcp_lemke (PD_OK only for a verified solution). */
+/* Most unknowns Lemke takes inside the solver table (its workspace grows as
+ * the square): larger problems go to the structured solver or PGS. */
+#define PD_LCP_LEMKE_NMAX 2048
+
+/* Solve (M, q), M square (dense or CSC) with n <= nmax: PD_OK only for a
+ * verified solution; PD_ENOSOLUTION, PD_EMAXPIVOTS, PD_EMAXITER,
+ * PD_ENUMERICAL otherwise (info->outcome), PD_EINVAL for bad input.
+ * info->solver names the solver that answered (auto, or a hand-over). */
 int pd_lcp_solve(pd_lcp_solver *s, const pd_matrix *M, const double *q, const pd_lcp_opts *opts,
                  double *z, double *w, pd_lcp_info *info);
 

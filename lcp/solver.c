@@ -1,28 +1,40 @@
-/* solver.c — the LCP solver table: one object, one solve call, whatever
- * the method and the matrix storage. */
+/* solver.c — the LCP solver table: one object sized once, one solve call,
+ * whatever the method and the matrix storage; every answer verified.
+ *
+ * auto: Lemke for n <= 2 (its closed forms) and for dense matrices; the
+ * structured solver for compressed-column ones (the engine's sparse
+ * Delassus blocks), handing over to Lemke when it cannot finish and the
+ * problem fits Lemke's workspace. */
 #include <stdlib.h>
 #include <string.h>
 
-#include "pd_lcp.h"
+#include "lcp_internal.h"
 
-/* One method of the table. */
+/* A method of the table. */
 typedef struct solver_type {
     pd_lcp_method method;
     const char *name;
+    int lemke, structured, pgs; /* the workspaces it needs */
 } solver_type;
 
 static const solver_type solver_types[] = {
-    {PD_LCP_AUTO, "auto"},
-    {PD_LCP_LEMKE, "lemke"},
+    {.method = PD_LCP_AUTO, .name = "auto", .lemke = 1, .structured = 1},
+    {.method = PD_LCP_LEMKE, .name = "lemke", .lemke = 1},
+    {.method = PD_LCP_STRUCTURED, .name = "structured", .lemke = 1, .structured = 1},
+    {.method = PD_LCP_PGS, .name = "pgs", .pgs = 1},
 };
 
 #define NTYPES (int)(sizeof solver_types / sizeof solver_types[0])
 
 struct pd_lcp_solver {
-    pd_lcp_method method;
+    const solver_type *type;
     int nmax;
-    pd_lcp_work *lemke; /* Lemke's workspace */
-    double *dense;      /* nmax x nmax: a sparse matrix copied for Lemke */
+    pd_lcp_work *lemke;       /* Lemke, for up to lemke_nmax unknowns */
+    int lemke_nmax;
+    double *dense;            /* lemke_nmax^2: a sparse matrix copied for Lemke */
+    pd_bpp_work *bpp;         /* the structured solver */
+    pd_pgs_work *pgs;
+    unsigned char *flag;      /* nmax: scratch of the structured solver */
 };
 
 const char *pd_lcp_method_name(pd_lcp_method method)
@@ -45,7 +57,7 @@ int pd_lcp_method_parse(const char *name, pd_lcp_method *method)
 
 const char *pd_lcp_method_list(void)
 {
-    return "auto, lemke";
+    return "auto, lemke, structured, pgs";
 }
 
 void pd_lcp_solver_free(pd_lcp_solver *s)
@@ -54,29 +66,47 @@ void pd_lcp_solver_free(pd_lcp_solver *s)
         return;
     pd_lcp_free(s->lemke);
     free(s->dense);
+    pd_bpp_free(s->bpp);
+    pd_pgs_free(s->pgs);
+    free(s->flag);
     free(s);
 }
 
 pd_lcp_solver *pd_lcp_solver_alloc(pd_lcp_method method, int nmax, long nnzmax, pd_err *err)
 {
+    const solver_type *type = NULL;
     pd_lcp_solver *s = NULL;
-    if (nmax < 1 || nnzmax < 0 || !strcmp(pd_lcp_method_name(method), "?")) {
+    for (int k = 0; k < NTYPES; k++)
+        if (solver_types[k].method == method)
+            type = &solver_types[k];
+    if (!type || nmax < 1 || nnzmax < 0) {
         pd_err_set(err, PD_EINVAL, "LCP solver: bad method %d or size %d", (int)method, nmax);
         return NULL;
     }
-    s = calloc(1, sizeof *s);
-    if (!s)
+    if (!(s = calloc(1, sizeof *s)))
         goto oom;
-    s->method = method;
+    s->type = type;
     s->nmax = nmax;
-    if (!(s->lemke = pd_lcp_alloc(nmax)))
-        goto oom;
-    if (nnzmax > 0 && !(s->dense = malloc((size_t)nmax * (size_t)nmax * sizeof(double))))
+    s->lemke_nmax = nmax < PD_LCP_LEMKE_NMAX ? nmax : PD_LCP_LEMKE_NMAX;
+    if (type->lemke) {
+        size_t ln = (size_t)s->lemke_nmax;
+        if (!(s->lemke = pd_lcp_alloc(s->lemke_nmax)) ||
+            (nnzmax > 0 && !(s->dense = malloc(ln * ln * sizeof(double)))))
+            goto oom;
+    }
+    if (type->structured) {
+        /* the envelope of a banded matrix holds about half its entries */
+        long env = nnzmax > 0 ? 2 * nnzmax + nmax : (long)nmax * (nmax + 1) / 2;
+        if (!(s->bpp = pd_bpp_alloc(nmax, env)) || !(s->flag = malloc((size_t)nmax)))
+            goto oom;
+    }
+    if (type->pgs && !(s->pgs = pd_pgs_alloc(nmax)))
         goto oom;
     return s;
 oom:
     pd_lcp_solver_free(s);
-    pd_err_set(err, PD_ENOMEM, "LCP solver: out of memory for %d unknowns", nmax);
+    pd_err_set(err, PD_ENOMEM, "LCP solver %s: out of memory for %d unknowns",
+               type ? type->name : "?", nmax);
     return NULL;
 }
 
@@ -85,34 +115,61 @@ int pd_lcp_solver_nmax(const pd_lcp_solver *s)
     return s ? s->nmax : 0;
 }
 
-/* Lemke on a dense view, or on a CSC matrix copied into the dense buffer. */
+/* Lemke on a dense view, or on a compressed-column matrix copied densely. */
 static int solve_lemke(pd_lcp_solver *s, const pd_matrix *M, const double *q,
                        const pd_lcp_opts *opts, double *z, double *w, pd_lcp_info *info)
 {
     const double *dense = M->values;
+    info->solver = "lemke";
+    if (M->rows > s->lemke_nmax)
+        return PD_EINVAL;
     if (M->kind != PD_MATRIX_DENSE) {
         if (!s->dense)
             return PD_EINVAL;
         pd_matrix_to_dense(M, s->dense);
         dense = s->dense;
     }
-    return pd_lcp_lemke(s->lemke, M->rows, dense, q, opts, z, w, info);
+    int rc = pd_lcp_lemke(s->lemke, M->rows, dense, q, opts, z, w, info);
+    info->solver = "lemke"; /* the solve clears info */
+    return rc;
+}
+
+/* The structured solver; Lemke takes over a problem it cannot finish when
+ * the problem fits Lemke's workspace. */
+static int solve_structured(pd_lcp_solver *s, const pd_matrix *M, const double *q,
+                            const pd_lcp_opts *opts, double *z, double *w, pd_lcp_info *info)
+{
+    info->solver = "structured";
+    int rc = pd_bpp_solve(s->bpp, M, q, opts, z, w, s->flag, info);
+    if (rc == PD_OK || M->rows > s->lemke_nmax || (M->kind == PD_MATRIX_CSC && !s->dense))
+        return rc;
+    int iterations = info->iterations;
+    rc = solve_lemke(s, M, q, opts, z, w, info);
+    info->iterations = iterations;
+    info->solver = "lemke (after structured)";
+    return rc;
 }
 
 int pd_lcp_solve(pd_lcp_solver *s, const pd_matrix *M, const double *q, const pd_lcp_opts *opts,
                  double *z, double *w, pd_lcp_info *info)
 {
     pd_lcp_info local;
-    int rc;
+    pd_lcp_opts o = opts ? *opts : pd_lcp_default_opts();
     if (!info)
         info = &local;
     memset(info, 0, sizeof *info);
     info->outcome = PD_LCP_NUMERICAL;
-    info->solver = "lemke";
-    if (!s || !M || M->rows != M->cols || M->rows < 1 || M->rows > s->nmax ||
+    info->solver = s ? s->type->name : "?";
+    if (!s || !M || !q || !z || !w || M->rows != M->cols || M->rows < 1 || M->rows > s->nmax ||
         (M->kind != PD_MATRIX_DENSE && M->kind != PD_MATRIX_CSC))
         return PD_EINVAL;
-    rc = solve_lemke(s, M, q, opts, z, w, info);
-    info->solver = "lemke";
-    return rc;
+    switch (s->type->method) {
+    case PD_LCP_LEMKE: return solve_lemke(s, M, q, &o, z, w, info);
+    case PD_LCP_STRUCTURED: return solve_structured(s, M, q, &o, z, w, info);
+    case PD_LCP_PGS: info->solver = "pgs"; return pd_pgs_solve(s->pgs, M, q, &o, z, w, info);
+    default:
+        if (M->rows <= 2 || (M->kind == PD_MATRIX_DENSE && M->rows <= s->lemke_nmax))
+            return solve_lemke(s, M, q, &o, z, w, info);
+        return solve_structured(s, M, q, &o, z, w, info);
+    }
 }

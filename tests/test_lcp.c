@@ -355,7 +355,7 @@ static void check_murty_1978(pd_test_ctx *ctx, int n, int upper)
     pd_lcp_info info;
     CHECK(ctx, solve(&c, NULL, &info) == PD_OK, "Murty %s n = %d solved",
           upper ? "upper" : "lower", n);
-    int want = upper ? 2 : 1 << n;
+    int want = n <= 2 ? 0 : upper ? 2 : 1 << n; /* n <= 2: the closed forms, no pivots */
     CHECK(ctx, info.pivots == want, "Murty %s n = %d: %d pivots, expected %d",
           upper ? "upper" : "lower", n, info.pivots, want);
     int one = upper ? n - 1 : 0;
@@ -433,7 +433,8 @@ static void check_scalar(pd_test_ctx *ctx, double m, double q, int want_status, 
         CHECK_NEAR(ctx, z, want_z, 1e-15 * fmax(1.0, want_z));
         CHECK_NEAR(ctx, w, m * z + q, 1e-15 * fmax(1.0, fabs(q)));
     }
-    CHECK(ctx, info.pivots == (q < 0.0 ? (want_status == PD_OK ? 2 : 1) : 0),
+    /* solved: the closed form (no pivot); a ray: Lemke's one pivot */
+    CHECK(ctx, info.pivots == (q < 0.0 && want_status != PD_OK ? 1 : 0),
           "m = %g, q = %g: %d pivots", m, q, info.pivots);
     pd_lcp_free(work);
 }
@@ -1046,9 +1047,10 @@ static void test_lcp_cli(pd_test_ctx *ctx)
         pd_test_skip(ctx, "no pound binary");
         return;
     }
-    char solvable[64], ray[64], bad[64], cmd[512], out[4096];
+    char solvable[64], three[64], ray[64], bad[64], cmd[512], out[4096];
     if (write_temp(solvable, "2\n2 1\n1 2\n-5 -6\n") || write_temp(ray, "1\n-1\n-2\n") ||
-        write_temp(bad, "2\n1 2\n3 oops\n-1 -1\n")) {
+        write_temp(bad, "2\n1 2\n3 oops\n-1 -1\n") ||
+        write_temp(three, "3\n2 1 0\n1 2 1\n0 1 2\n-5 -6 -4\n")) {
         CHECK(ctx, 0, "temporary files");
         return;
     }
@@ -1056,7 +1058,7 @@ static void test_lcp_cli(pd_test_ctx *ctx)
     CHECK(ctx, run_capture(cmd, out, sizeof out) == 0, "solved: exit 0");
     CHECK(ctx, strstr(out, "\"status\":\"solved\"") && strstr(out, "\"z\":[1.3333333333333333,"),
           "solved JSON: %s", out);
-    CHECK(ctx, strstr(out, "\"pivots\":3") && strstr(out, "\"cpu_s\":") &&
+    CHECK(ctx, strstr(out, "\"pivots\":0") && strstr(out, "\"cpu_s\":") &&
                    strstr(out, "\"complementarity\":") && strstr(out, "\"w\":["),
           "JSON keys: %s", out);
     snprintf(cmd, sizeof cmd, "%s lcp %s --json", ctx->pound, ray);
@@ -1069,7 +1071,7 @@ static void test_lcp_cli(pd_test_ctx *ctx)
         lines += *c == '\n';
     CHECK(ctx, strstr(out, "line 3") && strstr(out, bad) && lines == 1,
           "one line naming file and line: %s", out);
-    snprintf(cmd, sizeof cmd, "%s lcp %s --max-pivots 1 --json", ctx->pound, solvable);
+    snprintf(cmd, sizeof cmd, "%s lcp %s --max-pivots 1 --json", ctx->pound, three);
     CHECK(ctx, run_capture(cmd, out, sizeof out) == 1 && strstr(out, "\"status\":\"max_pivots\""),
           "cap: %s", out);
     snprintf(cmd, sizeof cmd, "%s lcp %s --frobnicate 2>/dev/null", ctx->pound, solvable);
@@ -1077,6 +1079,7 @@ static void test_lcp_cli(pd_test_ctx *ctx)
     snprintf(cmd, sizeof cmd, "%s lcp %s --cover 1,2 --format plain", ctx->pound, solvable);
     CHECK(ctx, run_capture(cmd, out, sizeof out) == 0 && strstr(out, "solved"), "cover: %s", out);
     remove(solvable);
+    remove(three);
     remove(ray);
     remove(bad);
 }
