@@ -9,9 +9,11 @@
 
 #include "pd_cli.h"
 #include "pd_lcp.h"
+#include "pd_lcp_dump.h"
 
 static const char lcp_usage[] =
     "usage: pound lcp FILE [--solver auto|lemke|structured|pgs] [--format plain|siconos|auto]\n"
+    "                      [--all | --index K]   (FILE.h5: an LCP dump)\n"
     "                      [--json] [--cover D] [--max-pivots K] [--max-iterations K] [--tol T]\n"
     "\n"
     "Solve the LCP  z >= 0, w = M z + q >= 0, z'w = 0  read from FILE.\n"
@@ -27,6 +29,8 @@ static const char lcp_usage[] =
     "                  comma-separated positive values (default all ones)\n"
     "  --max-pivots K  pivot cap (default max(10000, 100 n))\n"
     "  --tol T         relative tolerance for ties and tiny pivots (default 1e-12)\n"
+    "  FILE.h5         an LCP dump (`simulate --dump-lcp`): --all re-solves every LCP and\n"
+    "                  reports agreement with the dumped answers; --index K solves one\n"
     "status: solved, no_solution (ray termination), max_pivots, max_iterations, numerical;\n"
     "solved means verified: relative backward residual <= 1e-10.\n"
     "exit status: 0 solved, 1 another status, 2 bad input.\n";
@@ -36,7 +40,8 @@ typedef struct lcp_args {
     const char *path;
     pd_lcp_format format;
     pd_lcp_method solver;
-    int json;
+    int json, all;
+    long index; /* a dump's LCP, -1: none chosen */
     const char *cover_text;
     int max_pivots, max_iterations;
     double tol;
@@ -77,6 +82,12 @@ static int parse_valued_flag(int argc, char **argv, int *i, lcp_args *a)
                  ? pd_cli_usage_error("lcp: --solver: '%s' is not one of %s", value ? value : "",
                                       pd_lcp_method_list())
                  : 0;
+    } else if (!strcmp(flag, "--index")) {
+        int k = -1;
+        rc = pd_cli_int("--index", value, &k);
+        if (rc == 0 && k < 0)
+            rc = pd_cli_usage_error("--index: must be >= 0, got %s", value);
+        a->index = k;
     } else if (!strcmp(flag, "--max-iterations")) {
         rc = pd_cli_int("--max-iterations", value, &a->max_iterations);
         if (rc == 0 && a->max_iterations <= 0)
@@ -96,14 +107,16 @@ static int parse_args(int argc, char **argv, lcp_args *a)
 {
     memset(a, 0, sizeof *a);
     a->format = PD_LCP_FORMAT_AUTO;
+    a->index = -1;
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i];
         int rc = 0;
         if (!strcmp(arg, "--help") || !strcmp(arg, "-h")) {
             fputs(lcp_usage, stdout);
             return -1;
-        } else if (!strcmp(arg, "--json")) {
-            a->json = 1;
+        } else if (!strcmp(arg, "--json") || !strcmp(arg, "--all")) {
+            a->json |= !strcmp(arg, "--json");
+            a->all |= !strcmp(arg, "--all");
         } else if (arg[0] == '-' && arg[1] != '\0') {
             rc = parse_valued_flag(argc, argv, &i, a);
         } else if (a->path) {
@@ -228,12 +241,102 @@ static int solve_and_print(const lcp_args *a, int n, const double *M, const doub
     return st == PD_OK ? 0 : 1;
 }
 
+/* Does path end with suffix? */
+static int ends_with(const char *path, const char *suffix)
+{
+    size_t n = strlen(path), k = strlen(suffix);
+    return n > k && !strcmp(path + n - k, suffix);
+}
+
+/* Every LCP of a dump (or the one of --index) re-solved: the agreement with
+ * the dumped answers.  Exit 0 when every one is solved. */
+static int resolve_dump(const lcp_args *a)
+{
+    pd_lcp_set set;
+    pd_err err;
+    if (pd_lcp_set_read(a->path, &set, &err))
+        return pd_cli_usage_error("lcp: %s", err.msg);
+    if (!a->all && (a->index < 0 || a->index >= set.count)) {
+        pd_lcp_set_free(&set);
+        return pd_cli_usage_error("lcp: %s holds %ld LCPs: give --all or --index K (0 <= K < %ld)",
+                                  a->path, set.count, set.count);
+    }
+    long lo = a->all ? 0 : a->index, hi = a->all ? set.count : a->index + 1;
+    long solved = 0, agree = 0, iterations = 0, pivots = 0;
+    double worst = 0.0, worst_res = 0.0, cpu = 0.0;
+    int rc = 0, nmax = set.nmax > 0 ? set.nmax : 1;
+    pd_lcp_solver *solver = pd_lcp_solver_alloc(a->solver, nmax, set.nnzmax + 1, &err);
+    double *z = malloc((size_t)nmax * sizeof(double)), *w = malloc((size_t)nmax * sizeof(double));
+    pd_lcp_opts opts = pd_lcp_default_opts();
+    opts.max_pivots = a->max_pivots;
+    opts.max_iterations = a->max_iterations;
+    if (!solver || !z || !w) {
+        fprintf(stderr, "pound: lcp: %s\n", solver ? "out of memory" : err.msg);
+        rc = 1;
+    }
+    for (long k = lo; k < hi && !rc; k++) {
+        pd_matrix D = pd_lcp_set_matrix(&set, k);
+        const double *b = set.b + set.voff[k], *z0 = set.z + set.voff[k];
+        pd_lcp_info info;
+        double t0 = pd_cpu_seconds();
+        int st = pd_lcp_solve(solver, &D, b, &opts, z, w, &info);
+        cpu += pd_cpu_seconds() - t0;
+        double d = 0.0, s = 0.0;
+        for (int i = 0; i < set.n[k]; i++) {
+            d = fmax(d, fabs(z[i] - z0[i]));
+            s = fmax(s, fabs(z0[i]));
+        }
+        d = s > 0.0 ? d / s : d;
+        solved += st == PD_OK;
+        agree += st == PD_OK && d <= 1e-8;
+        worst = fmax(worst, d);
+        worst_res = fmax(worst_res, info.residual);
+        iterations += info.iterations;
+        pivots += info.pivots;
+    }
+    long count = hi - lo;
+    if (!rc && a->json) {
+        pd_json js;
+        pd_json_init(&js, stdout);
+        pd_json_begin_object(&js, NULL);
+        pd_json_str(&js, "dump", a->path);
+        pd_json_str(&js, "solver", pd_lcp_method_name(a->solver));
+        pd_json_int(&js, "count", count);
+        pd_json_int(&js, "solved", solved);
+        pd_json_int(&js, "agree", agree);
+        pd_json_num(&js, "worst_difference", worst);
+        pd_json_num(&js, "worst_residual", worst_res);
+        pd_json_int(&js, "pivots", pivots);
+        pd_json_int(&js, "iterations", iterations);
+        pd_json_num(&js, "cpu_s", cpu);
+        pd_json_int(&js, "nmax", set.nmax);
+        pd_json_end_object(&js);
+        pd_json_finish(&js);
+    } else if (!rc) {
+        printf("%s: %ld LCPs (n up to %d) re-solved by %s in %.3g s\n", a->path, count, set.nmax,
+               pd_lcp_method_name(a->solver), cpu);
+        printf("  solved %ld, agreeing with the dump (1e-8) %ld, worst difference %.3g, worst "
+               "residual %.3g\n",
+               solved, agree, worst, worst_res);
+        printf("  pivots %ld, iterations %ld\n", pivots, iterations);
+    }
+    pd_lcp_solver_free(solver);
+    free(z);
+    free(w);
+    pd_lcp_set_free(&set);
+    return rc ? rc : solved == count ? 0 : 1;
+}
+
 int pd_cmd_lcp(int argc, char **argv)
 {
     lcp_args a;
     int rc = parse_args(argc, argv, &a);
     if (rc)
         return rc < 0 ? 0 : rc;
+    if (ends_with(a.path, ".h5") || ends_with(a.path, ".hdf5"))
+        return resolve_dump(&a);
+    if (a.all || a.index >= 0)
+        return pd_cli_usage_error("lcp: --all and --index go with an LCP dump (FILE.h5)");
     int n = 0;
     double *M = NULL, *q = NULL, *buf = NULL;
     pd_err err;

@@ -6,24 +6,27 @@
 #include <string.h>
 
 #include "pd_cli.h"
+#include "pd_lcp_dump.h"
 #include "pd_output.h"
 #include "pd_scene_out.h"
 
 static const char simulate_usage[] =
     "usage: pound simulate [model flags | --scene F.json | --chain N] [--method moreau|event|penalty]\n"
     "                      [--dt H] [--theta T] [--tend T] [-o FILE.h5|FILE.csv] [--every K]\n"
-    "                      [--plot FILE.png] [--json]\n"
+    "                      [--plot FILE.png] [--dump-lcp F.h5] [--json]\n"
     "  -o FILE     the histories (HDF5 or CSV by extension), every input and result as\n"
     "              attributes with units; --every K keeps every K-th step\n"
     "              oscillator: t, u, v, impulse, gap; scene: t, x and v per structure and\n"
     "              storey, gap and impulse per contact (docs/scenes.md)\n"
     "  --plot F    the displacement histories with the impacts marked\n"
+    "  --dump-lcp F.h5  every contact LCP Moreau-Jean solves (D, b, z, solver, pivots or\n"
+    "              iterations), for `pound lcp F.h5 --all` (docs/lcp.md)\n"
     "  --json      one JSON object on stdout\n";
 
 /* Everything the command line sets. */
 typedef struct sim_args {
     pd_cli_case k;
-    const char *out, *plot;
+    const char *out, *plot, *dump;
     long every;
     int json;
     char command[1024];
@@ -54,10 +57,10 @@ static int parse_args(sim_args *a, int argc, char **argv)
             continue;
         if (!strcmp(f, "--json"))
             a->json = 1;
-        else if (!strcmp(f, "-o") || !strcmp(f, "--plot")) {
+        else if (!strcmp(f, "-o") || !strcmp(f, "--plot") || !strcmp(f, "--dump-lcp")) {
             if (!val)
                 return pd_cli_usage_error("%s needs a file name", f);
-            *(!strcmp(f, "-o") ? &a->out : &a->plot) = val;
+            *(!strcmp(f, "-o") ? &a->out : !strcmp(f, "--plot") ? &a->plot : &a->dump) = val;
             i++;
         } else if (!strcmp(f, "--every")) {
             if ((rc = pd_cli_int(f, val, &n)))
@@ -73,7 +76,38 @@ static int parse_args(sim_args *a, int argc, char **argv)
         return pd_cli_usage_error("%s", err.msg);
     if (a->plot && (strlen(a->plot) < 5 || strcmp(a->plot + strlen(a->plot) - 4, ".png")))
         return pd_cli_usage_error("--plot: '%s' must end in .png", a->plot);
+    if (a->dump && (strlen(a->dump) < 4 || strcmp(a->dump + strlen(a->dump) - 3, ".h5")))
+        return pd_cli_usage_error("--dump-lcp: '%s' must end in .h5", a->dump);
+    if (a->dump && a->k.opts.method != PD_METHOD_MOREAU)
+        return pd_cli_usage_error("--dump-lcp: the LCPs dumped are Moreau-Jean's (--method moreau)");
     return pd_cli_case_finish(&a->k);
+}
+
+/* --dump-lcp: open the dump and hook it on the run; 0 or 1. */
+static int dump_open(sim_args *a, pd_lcp_dump **d)
+{
+    pd_err err;
+    *d = NULL;
+    if (!a->dump)
+        return 0;
+    if (pd_lcp_dump_open(d, a->dump, &err)) {
+        fprintf(stderr, "pound: simulate: %s\n", err.msg);
+        return 1;
+    }
+    a->k.opts.on_lcp = pd_lcp_dump_add;
+    a->k.opts.on_lcp_ctx = *d;
+    return 0;
+}
+
+/* --dump-lcp: the dump into place; 0 or 1. */
+static int dump_finish(const sim_args *a, pd_lcp_dump *d)
+{
+    pd_err err;
+    if (d && pd_lcp_dump_finish(d, a->command, &err)) {
+        fprintf(stderr, "pound: simulate: %s\n", err.msg);
+        return 1;
+    }
+    return 0;
 }
 
 /* ==== the oscillator ======================================================== */
@@ -260,10 +294,13 @@ static int simulate_oscillator(sim_args *a)
     pd_osc_summary s;
     history hist;
     pd_scene *psc = NULL;
+    pd_lcp_dump *dump = NULL;
     pd_err err;
     int rc, status = 0;
     long nsteps = pd_steps_for(a->k.opts.tend, a->k.opts.dt);
     memset(&hist, 0, sizeof hist);
+    if ((status = dump_open(a, &dump)))
+        goto done;
     if ((a->out && history_alloc(&hist, nsteps, a->every)) ||
         (a->plot && (!(psc = oscillator_scene(&a->k.c)) ||
                      pd_scene_plot_open(&hist.plot, psc, nsteps, &err)))) {
@@ -283,11 +320,14 @@ static int simulate_oscillator(sim_args *a)
         status = 1;
         goto done;
     }
+    if ((status = dump_finish(a, dump)))
+        goto done;
     if (a->json)
         print_json(a, &s);
     else
         print_text(a, &s);
 done:
+    pd_lcp_dump_free(dump);
     pd_scene_plot_free(hist.plot);
     pd_scene_free(psc);
     history_free(&hist);
@@ -439,6 +479,7 @@ static int simulate_scene(sim_args *a)
     pd_scene *sc = NULL;
     pd_scene_summary s;
     pd_run_opts o;
+    pd_lcp_dump *dump = NULL;
     fanout fo = {0};
     pd_err err;
     char name[64];
@@ -446,6 +487,8 @@ static int simulate_scene(sim_args *a)
     memset(&s, 0, sizeof s);
     if ((status = pd_cli_scene(&a->k, &sc)))
         return status;
+    if ((status = dump_open(a, &dump)))
+        goto done;
     pd_scene_resolve_opts(sc, &a->k.opts, &o, &err);
     long expected = pd_steps_for(o.tend, o.dt); /* samples: every step or every dt */
     if ((a->out && pd_scene_writer_open(&fo.w, a->out, sc, a->every, &err)) ||
@@ -468,11 +511,14 @@ static int simulate_scene(sim_args *a)
         status = 1;
         goto done;
     }
+    if ((status = dump_finish(a, dump)))
+        goto done;
     if (a->json)
         scene_json(sc, &s);
     else
         scene_text(a, sc, &s);
 done:
+    pd_lcp_dump_free(dump);
     pd_scene_writer_free(fo.w);
     pd_scene_plot_free(fo.p);
     pd_scene_summary_free(&s);

@@ -69,3 +69,45 @@ hid_t pd_h5_untimed(hid_t cls)
     }
     return p;
 }
+
+/* An extendible chunked dataset of rows x cols (cols 0: 1-D) of type with units. */
+hid_t pd_h5_extendible(hid_t loc, const char *name, hid_t type, int cols, long chunk,
+                       const char *units)
+{
+    int rank = cols > 0 ? 2 : 1;
+    hsize_t dims[2] = {0, (hsize_t)cols}, maxd[2] = {H5S_UNLIMITED, (hsize_t)cols};
+    hsize_t ch[2] = {(hsize_t)chunk, (hsize_t)(cols > 0 ? cols : 1)};
+    hid_t space = H5Screate_simple(rank, dims, maxd), dcpl = pd_h5_untimed(H5P_DATASET_CREATE);
+    hid_t ds = -1;
+    if (space >= 0 && dcpl >= 0 && H5Pset_chunk(dcpl, rank, ch) >= 0)
+        ds = H5Dcreate2(loc, name, type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+    if (ds >= 0 && pd_h5_attr(ds, "units", units, 0.0)) {
+        H5Dclose(ds);
+        ds = -1;
+    }
+    if (dcpl >= 0)
+        H5Pclose(dcpl);
+    if (space >= 0)
+        H5Sclose(space);
+    return ds;
+}
+
+/* Append nrows x cols values (row-major) to an extendible dataset at row r0. */
+int pd_h5_append(hid_t ds, hid_t type, long r0, long nrows, int cols, const void *x)
+{
+    int rank = cols > 0 ? 2 : 1;
+    hsize_t size[2] = {(hsize_t)(r0 + nrows), (hsize_t)cols};
+    hsize_t start[2] = {(hsize_t)r0, 0}, count[2] = {(hsize_t)nrows, (hsize_t)cols};
+    if (H5Dset_extent(ds, size) < 0)
+        return -1;
+    hid_t fs = H5Dget_space(ds), ms = H5Screate_simple(rank, count, NULL);
+    int rc = fs < 0 || ms < 0 ||
+             H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL) < 0 ||
+             H5Dwrite(ds, type, ms, fs, H5P_DEFAULT, x) < 0;
+    if (ms >= 0)
+        H5Sclose(ms);
+    if (fs >= 0)
+        H5Sclose(fs);
+    return rc ? -1 : 0;
+}
+

@@ -17,4 +17,12 @@ int pd_h5_nums(hid_t obj, const char *name, int n, const double *x, const char *
 /* An object-creation property list of class cls that records no times. */
 hid_t pd_h5_untimed(hid_t cls);
 
+/* An extendible dataset of rows x cols values of type (cols 0: 1-D),
+ * chunked by `chunk` rows, with a "units" attribute; -1 on failure. */
+hid_t pd_h5_extendible(hid_t loc, const char *name, hid_t type, int cols, long chunk,
+                       const char *units);
+
+/* Append nrows x cols values (row-major) at row r0, extending the dataset. */
+int pd_h5_append(hid_t ds, hid_t type, long r0, long nrows, int cols, const void *x);
+
 #endif

@@ -44,46 +44,6 @@ static int ends_with(const char *path, const char *suffix)
     return n > k && !strcmp(path + n - k, suffix);
 }
 
-/* An extendible chunked dataset of rows x cols (cols 0: 1-D) with units. */
-static hid_t h5_extendible(hid_t loc, const char *name, int cols, long chunk, const char *units)
-{
-    int rank = cols > 0 ? 2 : 1;
-    hsize_t dims[2] = {0, (hsize_t)cols}, maxd[2] = {H5S_UNLIMITED, (hsize_t)cols};
-    hsize_t ch[2] = {(hsize_t)chunk, (hsize_t)(cols > 0 ? cols : 1)};
-    hid_t space = H5Screate_simple(rank, dims, maxd), dcpl = pd_h5_untimed(H5P_DATASET_CREATE);
-    hid_t ds = -1;
-    if (space >= 0 && dcpl >= 0 && H5Pset_chunk(dcpl, rank, ch) >= 0)
-        ds = H5Dcreate2(loc, name, H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
-    if (ds >= 0 && pd_h5_attr(ds, "units", units, 0.0)) {
-        H5Dclose(ds);
-        ds = -1;
-    }
-    if (dcpl >= 0)
-        H5Pclose(dcpl);
-    if (space >= 0)
-        H5Sclose(space);
-    return ds;
-}
-
-/* Append nrows x cols values (row-major) to an extendible dataset at row r0. */
-static int h5_append(hid_t ds, long r0, long nrows, int cols, const double *x)
-{
-    int rank = cols > 0 ? 2 : 1;
-    hsize_t size[2] = {(hsize_t)(r0 + nrows), (hsize_t)cols};
-    hsize_t start[2] = {(hsize_t)r0, 0}, count[2] = {(hsize_t)nrows, (hsize_t)cols};
-    if (H5Dset_extent(ds, size) < 0)
-        return -1;
-    hid_t fs = H5Dget_space(ds), ms = H5Screate_simple(rank, count, NULL);
-    int rc = fs < 0 || ms < 0 ||
-             H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL) < 0 ||
-             H5Dwrite(ds, H5T_NATIVE_DOUBLE, ms, fs, H5P_DEFAULT, x) < 0;
-    if (ms >= 0)
-        H5Sclose(ms);
-    if (fs >= 0)
-        H5Sclose(fs);
-    return rc ? -1 : 0;
-}
-
 /* The groups and extendible datasets of every structure and contact. */
 static int h5_open(pd_scene_writer *w)
 {
@@ -98,19 +58,19 @@ static int h5_open(pd_scene_writer *w)
         return -1;
     hid_t gs = H5Gcreate2(w->file, "structures", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     hid_t gc = H5Gcreate2(w->file, "contacts", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    int rc = gs < 0 || gc < 0 || (w->ds_t = h5_extendible(w->file, "t", 0, w->cap, "s")) < 0;
+    int rc = gs < 0 || gc < 0 || (w->ds_t = pd_h5_extendible(w->file, "t", H5T_NATIVE_DOUBLE, 0, w->cap, "s")) < 0;
     for (int s = 0; s < sc->nstruct && !rc; s++) {
         hid_t g = H5Gcreate2(gs, sc->st[s].name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-        rc = g < 0 || (w->ds_x[s] = h5_extendible(g, "x", sc->st[s].storeys, w->cap, "m")) < 0 ||
-             (w->ds_v[s] = h5_extendible(g, "v", sc->st[s].storeys, w->cap, "m/s")) < 0;
+        rc = g < 0 || (w->ds_x[s] = pd_h5_extendible(g, "x", H5T_NATIVE_DOUBLE, sc->st[s].storeys, w->cap, "m")) < 0 ||
+             (w->ds_v[s] = pd_h5_extendible(g, "v", H5T_NATIVE_DOUBLE, sc->st[s].storeys, w->cap, "m/s")) < 0;
         if (g >= 0 && H5Gclose(g) < 0)
             rc = 1;
     }
     for (int a = 0; a < sc->ncontact && !rc; a++) {
         snprintf(name, sizeof name, "%d", a);
         hid_t g = H5Gcreate2(gc, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-        rc = g < 0 || (w->ds_g[a] = h5_extendible(g, "gap", 0, w->cap, "m")) < 0 ||
-             (w->ds_p[a] = h5_extendible(g, "impulse", 0, w->cap, "N s")) < 0;
+        rc = g < 0 || (w->ds_g[a] = pd_h5_extendible(g, "gap", H5T_NATIVE_DOUBLE, 0, w->cap, "m")) < 0 ||
+             (w->ds_p[a] = pd_h5_extendible(g, "impulse", H5T_NATIVE_DOUBLE, 0, w->cap, "N s")) < 0;
         if (g >= 0 && H5Gclose(g) < 0)
             rc = 1;
     }
@@ -228,20 +188,20 @@ static int flush_rows(pd_scene_writer *w)
     } else {
         for (long r = 0; r < nb; r++)
             w->col[r] = w->buf[(size_t)r * w->width];
-        rc = h5_append(w->ds_t, w->rows - nb, nb, 0, w->col);
+        rc = pd_h5_append(w->ds_t, H5T_NATIVE_DOUBLE, w->rows - nb, nb, 0, w->col);
         for (int s = 0; s < sc->nstruct && !rc; s++)
             for (int part = 0; part < 2 && !rc; part++) {
                 int st = sc->st[s].storeys, off = 1 + part * n + sc->st[s].dof;
                 for (long r = 0; r < nb; r++)
                     memcpy(w->col + (size_t)r * st, w->buf + (size_t)r * w->width + off,
                            (size_t)st * sizeof(double));
-                rc = h5_append(part ? w->ds_v[s] : w->ds_x[s], w->rows - nb, nb, st, w->col);
+                rc = pd_h5_append(part ? w->ds_v[s] : w->ds_x[s], H5T_NATIVE_DOUBLE, w->rows - nb, nb, st, w->col);
             }
         for (int a = 0; a < m && !rc; a++)
             for (int part = 0; part < 2 && !rc; part++) {
                 for (long r = 0; r < nb; r++)
                     w->col[r] = w->buf[(size_t)r * w->width + 1 + 2 * n + part * m + a];
-                rc = h5_append(part ? w->ds_p[a] : w->ds_g[a], w->rows - nb, nb, 0, w->col);
+                rc = pd_h5_append(part ? w->ds_p[a] : w->ds_g[a], H5T_NATIVE_DOUBLE, w->rows - nb, nb, 0, w->col);
             }
     }
     w->nbuf = 0;

@@ -234,6 +234,8 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
     mo.kernel = o.kernel;
     mo.factor = o.factor;
     mo.lcp_solver = o.lcp_solver;
+    mo.on_lcp = o.on_lcp;
+    mo.on_lcp_ctx = o.on_lcp_ctx;
     long nsteps = pd_steps_for(o.tend, o.dt);
 
     double cpu0 = pd_cpu_seconds();

@@ -70,6 +70,8 @@ typedef struct pd_run_opts {
     int no_accumulation; /* event-driven: do not jump accumulations of impacts */
     int no_wall;         /* without contacts: the oscillator's no-wall twin, a free scene */
     pd_penalty_setup pen;
+    pd_lcp_observer on_lcp; /* Moreau–Jean's general kernel: every contact LCP solved */
+    void *on_lcp_ctx;
 } pd_run_opts;
 
 /* Moreau–Jean, dt and tend derived, theta = gamma = 1/2, automatic kernel,

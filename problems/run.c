@@ -40,7 +40,9 @@ pd_run_opts pd_run_default_opts(void)
                                  .kc_abs = 0.0,
                                  .rtol = 1e-10,
                                  .atol = 1e-12,
-                                 .stepper = "rk8pd"}};
+                                 .stepper = "rk8pd"},
+                         .on_lcp = NULL,
+                         .on_lcp_ctx = NULL};
 }
 
 int pd_run_opts_check(const pd_run_opts *o, pd_err *err)

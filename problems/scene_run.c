@@ -451,6 +451,8 @@ static int run_moreau(const pd_model *md, const pd_run_opts *o, long nsteps, tra
     mo.kernel = o->kernel;
     mo.factor = o->factor;
     mo.lcp_solver = o->lcp_solver;
+    mo.on_lcp = o->on_lcp;
+    mo.on_lcp_ctx = o->on_lcp_ctx;
     pd_mj *mj = pd_mj_alloc(md, &mo, err);
     if (!mj)
         return err ? err->status : PD_ENOMEM;

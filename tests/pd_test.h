@@ -77,5 +77,6 @@ void suite_alloc(pd_test_ctx *ctx);
 void suite_cli(pd_test_ctx *ctx);
 void suite_spectrum(pd_test_ctx *ctx);
 void suite_scene(pd_test_ctx *ctx);
+void suite_solvers(pd_test_ctx *ctx);
 
 #endif

@@ -1,0 +1,322 @@
+/* lcp_dump.c — (cli) every LCP a Moreau–Jean run solves, written to HDF5 as
+ * a corpus for solver studies (`simulate --dump-lcp F.h5`), and read back
+ * (`pound lcp F.h5 --all`).  docs/lcp.md describes the layout:
+ *
+ *   /n, /t, /solver, /outcome, /pivots, /iterations, /residual   one per LCP
+ *   /colptr (n_k + 1 per LCP), /rowind, /values                  D_k by columns
+ *   /b, /z, /contact                                             n_k per LCP
+ *
+ * Offsets follow from /n and each colptr's last entry.  Datasets are
+ * extendible and written in blocks as the run goes; the file is written
+ * under a temporary name and renamed when the run has finished. */
+#include <hdf5.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "pd_h5.h"
+#include "pd_lcp_dump.h"
+
+#define DUMP_BLOCK (1L << 16) /* entries buffered per dataset */
+
+/* The solvers a dump names, by code. */
+static const char *const dump_solvers[] = {"lemke", "structured", "pgs",
+                                           "lemke (after structured)", "closed-form"};
+#define NSOLVERS (int)(sizeof dump_solvers / sizeof dump_solvers[0])
+
+/* One extendible dataset with its block buffer. */
+typedef struct dump_set {
+    const char *name;
+    hid_t type;
+    size_t size; /* bytes per entry */
+    hid_t ds;
+    char *buf;
+    long nbuf, written;
+} dump_set;
+
+enum { S_N, S_T, S_SOLVER, S_OUTCOME, S_PIVOTS, S_ITER, S_RES, S_COLPTR, S_ROWIND, S_VALUES,
+       S_B, S_Z, S_CONTACT, NSETS };
+
+struct pd_lcp_dump {
+    char path[4096], tmp[4096];
+    hid_t file;
+    dump_set set[NSETS];
+    long count;
+    int failed;
+};
+
+static const struct {
+    const char *name;
+    int is_int;
+} set_defs[NSETS] = {{"n", 1},         {"t", 0},        {"solver", 1}, {"outcome", 1},
+                     {"pivots", 1},    {"iterations", 1}, {"residual", 0}, {"colptr", 1},
+                     {"rowind", 1},    {"values", 0},   {"b", 0},      {"z", 0},
+                     {"contact", 1}};
+
+void pd_lcp_dump_free(pd_lcp_dump *d)
+{
+    if (!d)
+        return;
+    for (int k = 0; k < NSETS; k++) {
+        if (d->set[k].ds > 0)
+            H5Dclose(d->set[k].ds);
+        free(d->set[k].buf);
+    }
+    if (d->file > 0)
+        H5Fclose(d->file);
+    if (d->tmp[0])
+        unlink(d->tmp);
+    free(d);
+}
+
+int pd_lcp_dump_open(pd_lcp_dump **out, const char *path, pd_err *err)
+{
+    pd_lcp_dump *d = calloc(1, sizeof *d);
+    *out = NULL;
+    if (!d)
+        return pd_err_set(err, PD_ENOMEM, "--dump-lcp: out of memory");
+    if (snprintf(d->path, sizeof d->path, "%s", path) >= (int)sizeof d->path ||
+        snprintf(d->tmp, sizeof d->tmp, "%s.tmp%ld", path, (long)getpid()) >= (int)sizeof d->tmp) {
+        free(d);
+        return pd_err_set(err, PD_EINVAL, "--dump-lcp %s: path too long", path);
+    }
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    d->file = H5Fcreate(d->tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    int rc = d->file < 0;
+    for (int k = 0; k < NSETS && !rc; k++) {
+        dump_set *s = &d->set[k];
+        s->name = set_defs[k].name;
+        s->type = set_defs[k].is_int ? H5T_NATIVE_INT : H5T_NATIVE_DOUBLE;
+        s->size = set_defs[k].is_int ? sizeof(int) : sizeof(double);
+        s->buf = malloc(DUMP_BLOCK * s->size);
+        rc = !s->buf || (s->ds = pd_h5_extendible(d->file, s->name, s->type, 0, 4096, "")) < 0;
+    }
+    rc = rc || pd_h5_attr(d->file, "format", "pound LCP dump 1", 0.0);
+    if (rc) {
+        pd_lcp_dump_free(d);
+        return pd_err_set(err, PD_EIO, "--dump-lcp %s: cannot create the file", path);
+    }
+    *out = d;
+    return PD_OK;
+}
+
+/* Write a set's buffer. */
+static int flush_set(dump_set *s)
+{
+    if (s->nbuf == 0)
+        return 0;
+    int rc = pd_h5_append(s->ds, s->type, s->written, s->nbuf, 0, s->buf);
+    s->written += s->nbuf;
+    s->nbuf = 0;
+    return rc;
+}
+
+/* Append count entries of a set (ints or doubles as the set holds). */
+static int push(dump_set *s, const void *x, long count)
+{
+    const char *p = x;
+    while (count > 0) {
+        long room = DUMP_BLOCK - s->nbuf, k = count < room ? count : room;
+        memcpy(s->buf + (size_t)s->nbuf * s->size, p, (size_t)k * s->size);
+        s->nbuf += k;
+        p += (size_t)k * s->size;
+        count -= k;
+        if (s->nbuf == DUMP_BLOCK && flush_set(s))
+            return -1;
+    }
+    return 0;
+}
+
+static int push_int(dump_set *s, int v) { return push(s, &v, 1); }
+static int push_num(dump_set *s, double v) { return push(s, &v, 1); }
+
+/* The code of a solver name. */
+static int solver_code(const char *name)
+{
+    for (int k = 0; name && k < NSOLVERS; k++)
+        if (!strcmp(name, dump_solvers[k]))
+            return k;
+    return -1;
+}
+
+int pd_lcp_dump_add(const pd_matrix *D, const double *b, const double *z, const double *w,
+                    const pd_lcp_info *info, const int *idx, double t, void *ctx)
+{
+    pd_lcp_dump *d = ctx;
+    int n = D->rows, nz = 0, rc = 0;
+    (void)w;
+    if (d->failed)
+        return 1;
+    dump_set *s = d->set;
+    rc |= push_int(&s[S_N], n) || push_num(&s[S_T], t) ||
+          push_int(&s[S_SOLVER], solver_code(info->solver)) ||
+          push_int(&s[S_OUTCOME], (int)info->outcome) || push_int(&s[S_PIVOTS], info->pivots) ||
+          push_int(&s[S_ITER], info->iterations) || push_num(&s[S_RES], info->residual);
+    for (int j = 0; j < n && !rc; j++) { /* D by columns, its nonzeros */
+        rc |= push_int(&s[S_COLPTR], nz);
+        if (D->kind == PD_MATRIX_CSC) {
+            for (int k = D->colptr[j]; k < D->colptr[j + 1] && !rc; k++, nz++)
+                rc |= push_int(&s[S_ROWIND], D->rowind[k]) || push_num(&s[S_VALUES], D->values[k]);
+            continue;
+        }
+        for (int i = 0; i < n && !rc; i++) {
+            double x = D->values[i + (size_t)j * n];
+            if (x != 0.0) {
+                rc |= push_int(&s[S_ROWIND], i) || push_num(&s[S_VALUES], x);
+                nz++;
+            }
+        }
+    }
+    rc |= push_int(&s[S_COLPTR], nz) || push(&s[S_B], b, n) || push(&s[S_Z], z, n) ||
+          push(&s[S_CONTACT], idx, n);
+    d->count++;
+    d->failed = rc != 0;
+    return d->failed;
+}
+
+int pd_lcp_dump_finish(pd_lcp_dump *d, const char *command, pd_err *err)
+{
+    int rc = d->failed;
+    char names[160] = "";
+    for (int k = 0; k < NSOLVERS; k++)
+        snprintf(names + strlen(names), sizeof names - strlen(names), "%s%d=%s", k ? ", " : "",
+                 k, dump_solvers[k]);
+    for (int k = 0; k < NSETS && !rc; k++)
+        rc = flush_set(&d->set[k]);
+    rc = rc || pd_h5_attr(d->file, "solver_codes", names, 0.0) ||
+         pd_h5_attr(d->file, "command", command, 0.0) ||
+         pd_h5_num(d->file, "count", (double)d->count, NULL);
+    for (int k = 0; k < NSETS; k++) {
+        rc |= H5Dclose(d->set[k].ds) < 0;
+        d->set[k].ds = 0;
+    }
+    rc |= H5Fclose(d->file) < 0;
+    d->file = 0;
+    if (rc || rename(d->tmp, d->path) != 0)
+        return pd_err_set(err, PD_EIO, "--dump-lcp %s: cannot write the file", d->path);
+    d->tmp[0] = '\0';
+    return PD_OK;
+}
+
+long pd_lcp_dump_count(const pd_lcp_dump *d)
+{
+    return d->count;
+}
+
+/* ---- reading ------------------------------------------------------------------ */
+
+void pd_lcp_set_free(pd_lcp_set *s)
+{
+    free(s->n);
+    free(s->t);
+    free(s->solver);
+    free(s->outcome);
+    free(s->iterations);
+    free(s->pivots);
+    free(s->colptr);
+    free(s->rowind);
+    free(s->values);
+    free(s->b);
+    free(s->z);
+    free(s->voff);
+    free(s->poff);
+    free(s->eoff);
+    memset(s, 0, sizeof *s);
+}
+
+/* A whole 1-D dataset into a malloc'd array; its length in *len. */
+static void *read_all(hid_t file, const char *name, hid_t type, size_t size, long *len)
+{
+    hid_t ds = H5Dopen2(file, name, H5P_DEFAULT);
+    void *buf = NULL;
+    *len = -1;
+    if (ds < 0)
+        return NULL;
+    hid_t sp = H5Dget_space(ds);
+    hsize_t dims[1] = {0};
+    if (sp >= 0 && H5Sget_simple_extent_ndims(sp) == 1 && H5Sget_simple_extent_dims(sp, dims, NULL) == 1) {
+        buf = malloc((size_t)(dims[0] > 0 ? dims[0] : 1) * size);
+        if (buf && (dims[0] == 0 || H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) >= 0))
+            *len = (long)dims[0];
+        else {
+            free(buf);
+            buf = NULL;
+        }
+    }
+    if (sp >= 0)
+        H5Sclose(sp);
+    H5Dclose(ds);
+    return buf;
+}
+
+int pd_lcp_set_read(const char *path, pd_lcp_set *s, pd_err *err)
+{
+    long len[11];
+    memset(s, 0, sizeof *s);
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (f < 0)
+        return pd_err_set(err, PD_EIO, "%s: cannot open as HDF5", path);
+    s->n = read_all(f, "n", H5T_NATIVE_INT, sizeof(int), &len[0]);
+    s->t = read_all(f, "t", H5T_NATIVE_DOUBLE, sizeof(double), &len[1]);
+    s->solver = read_all(f, "solver", H5T_NATIVE_INT, sizeof(int), &len[2]);
+    s->outcome = read_all(f, "outcome", H5T_NATIVE_INT, sizeof(int), &len[3]);
+    s->iterations = read_all(f, "iterations", H5T_NATIVE_INT, sizeof(int), &len[4]);
+    s->pivots = read_all(f, "pivots", H5T_NATIVE_INT, sizeof(int), &len[5]);
+    s->colptr = read_all(f, "colptr", H5T_NATIVE_INT, sizeof(int), &len[6]);
+    s->rowind = read_all(f, "rowind", H5T_NATIVE_INT, sizeof(int), &len[7]);
+    s->values = read_all(f, "values", H5T_NATIVE_DOUBLE, sizeof(double), &len[8]);
+    s->b = read_all(f, "b", H5T_NATIVE_DOUBLE, sizeof(double), &len[9]);
+    s->z = read_all(f, "z", H5T_NATIVE_DOUBLE, sizeof(double), &len[10]);
+    H5Fclose(f);
+    for (int k = 0; k < 11; k++)
+        if (len[k] < 0) {
+            pd_lcp_set_free(s);
+            return pd_err_set(err, PD_EPARSE, "%s: not a pound LCP dump (a dataset is missing)",
+                              path);
+        }
+    s->count = len[0];
+    s->voff = malloc((size_t)(s->count + 1) * sizeof(long));
+    s->poff = malloc((size_t)(s->count + 1) * sizeof(long));
+    s->eoff = malloc((size_t)(s->count + 1) * sizeof(long));
+    if (!s->voff || !s->poff || !s->eoff) {
+        pd_lcp_set_free(s);
+        return pd_err_set(err, PD_ENOMEM, "%s: out of memory", path);
+    }
+    s->voff[0] = s->poff[0] = s->eoff[0] = 0;
+    int bad = len[1] != s->count || len[2] != s->count || len[3] != s->count ||
+              len[4] != s->count || len[5] != s->count;
+    for (long k = 0; k < s->count && !bad; k++) {
+        int n = s->n[k];
+        bad = n < 1 || s->poff[k] + n + 1 > len[6];
+        if (bad)
+            break;
+        const int *cp = s->colptr + s->poff[k];
+        s->voff[k + 1] = s->voff[k] + n;
+        s->poff[k + 1] = s->poff[k] + n + 1;
+        s->eoff[k + 1] = s->eoff[k] + cp[n];
+        s->nmax = n > s->nmax ? n : s->nmax;
+        s->nnzmax = cp[n] > s->nnzmax ? cp[n] : s->nnzmax;
+        bad = cp[0] != 0 || s->eoff[k + 1] > len[7] || s->voff[k + 1] > len[9];
+        for (int j = 0; j < n && !bad; j++)
+            bad = cp[j + 1] < cp[j];
+        for (long e = s->eoff[k]; e < s->eoff[k + 1] && !bad; e++)
+            bad = s->rowind[e] < 0 || s->rowind[e] >= n;
+    }
+    if (bad || len[7] != len[8] || len[9] != len[10]) {
+        pd_lcp_set_free(s);
+        return pd_err_set(err, PD_EPARSE, "%s: the LCP dump is inconsistent", path);
+    }
+    return PD_OK;
+}
+
+pd_matrix pd_lcp_set_matrix(const pd_lcp_set *s, long k)
+{
+    return pd_matrix_csc(s->n[k], s->n[k], s->colptr + s->poff[k], s->rowind + s->eoff[k],
+                         s->values + s->eoff[k]);
+}
+
+const char *pd_lcp_set_solver_name(int code)
+{
+    return code >= 0 && code < NSOLVERS ? dump_solvers[code] : "?";
+}

@@ -1,0 +1,345 @@
+/* test_solvers.c — the LCP solver table: the structured solver and PGS
+ * against the enumeration oracle and Lemke, the closed forms of n <= 2,
+ * warm starts, degenerate Delassus matrices and non-convergence reported
+ * with their status, chains of 10^4 contacts, dumps re-solved by every
+ * solver, and the engine's answers independent of the solver. */
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "pd_problems.h"
+#include "pd_test.h"
+
+/* A deterministic uniform number in [-1, 1). */
+static double rnd(uint64_t *s)
+{
+    *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (double)(*s >> 11) / (double)(1ULL << 52) - 1.0;
+}
+
+/* M = A^T A + n I / 4 (SPD, column-major) and q, from a seed. */
+static void random_spd(int n, uint64_t seed, double *M, double *q)
+{
+    double A[144];
+    uint64_t s = seed;
+    for (int k = 0; k < n * n; k++)
+        A[k] = rnd(&s);
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            double x = i == j ? 0.25 * n : 0.0;
+            for (int k = 0; k < n; k++)
+                x += A[k + i * n] * A[k + j * n];
+            M[i + j * n] = x;
+        }
+    for (int i = 0; i < n; i++)
+        q[i] = 2.0 * rnd(&s);
+}
+
+/* Solve with a method; the status. */
+static int solve_with(pd_lcp_method m, const pd_matrix *M, const double *q,
+                      const pd_lcp_opts *o, double *z, double *w, pd_lcp_info *info)
+{
+    pd_err e;
+    long nnz = M->kind == PD_MATRIX_CSC ? M->colptr[M->cols] : 0;
+    pd_lcp_solver *s = pd_lcp_solver_alloc(m, M->rows, nnz, &e);
+    if (!s)
+        return PD_ENOMEM;
+    int rc = pd_lcp_solve(s, M, q, o, z, w, info);
+    pd_lcp_solver_free(s);
+    return rc;
+}
+
+/* Random SPD problems, n = 1..10: structured, PGS and auto give the
+ * oracle's unique solution (1e-9) and verify. */
+static void test_solvers_match_oracle(pd_test_ctx *ctx)
+{
+    const pd_lcp_method methods[] = {PD_LCP_STRUCTURED, PD_LCP_PGS, PD_LCP_AUTO, PD_LCP_LEMKE};
+    int cases = 0;
+    for (int n = 1; n <= 10; n++)
+        for (uint64_t seed = 1; seed <= 20; seed++) {
+            double M[100], q[10], zo[10], wo[10], z[10], w[10];
+            random_spd(n, seed * 977 + (uint64_t)n, M, q);
+            pd_matrix Mv = pd_matrix_dense(n, n, M);
+            if (!CHECK(ctx, pd_lcp_enumerate(n, M, q, zo, wo) == PD_OK, "oracle n %d", n))
+                continue;
+            cases++;
+            for (int k = 0; k < 4; k++) {
+                pd_lcp_info info;
+                int st = solve_with(methods[k], &Mv, q, NULL, z, w, &info);
+                double d = 0.0, s = 0.0;
+                for (int i = 0; i < n; i++) {
+                    d = fmax(d, fabs(z[i] - zo[i]));
+                    s = fmax(s, fabs(zo[i]));
+                }
+                CHECK(ctx, st == PD_OK && info.residual <= 1e-10 && d <= 1e-9 * fmax(s, 1e-300),
+                      "%s, n %d seed %llu: status %d (%s), residual %.3g, |z - z_oracle| %.3g",
+                      pd_lcp_method_name(methods[k]), n, (unsigned long long)seed, st,
+                      info.solver, info.residual, d);
+            }
+        }
+    CHECK(ctx, cases == 200, "%d cases", cases);
+}
+
+/* n <= 2: Lemke answers by the closed forms (no pivot) what its pivoting
+ * and the oracle answer, on P-matrices of both signs of the off-diagonal. */
+static void test_solvers_closed_forms(pd_test_ctx *ctx)
+{
+    uint64_t s = 42;
+    pd_lcp_work *work = pd_lcp_alloc(2);
+    for (int k = 0; k < 400 && work; k++) {
+        int n = 1 + k % 2;
+        double M[4] = {1.0 + fabs(rnd(&s)), rnd(&s), rnd(&s), 1.0 + fabs(rnd(&s))};
+        if (n == 1)
+            M[1] = M[2] = M[3] = 0.0;
+        double Md[4] = {M[0], M[1], M[2], M[3]}, q[2] = {rnd(&s), rnd(&s)}, z[2], w[2], zo[2],
+               wo[2];
+        if (n == 1)
+            Md[1] = M[3];
+        pd_lcp_info info;
+        int st = pd_lcp_lemke(work, n, n == 1 ? M : Md, q, NULL, z, w, &info);
+        int so = pd_lcp_enumerate(n, n == 1 ? M : Md, q, zo, wo);
+        if (so != PD_OK) /* M[1] M[2] >= M[0] M[3] can leave no solution */
+            continue;
+        CHECK(ctx, st == PD_OK && info.pivots == 0 && fabs(z[0] - zo[0]) <= 1e-14 * (1 + fabs(zo[0])) &&
+                       fabs(z[n - 1] - zo[n - 1]) <= 1e-14 * (1 + fabs(zo[n - 1])),
+              "n %d case %d: status %d, %d pivots, z (%g, %g) vs (%g, %g)", n, k, st, info.pivots,
+              z[0], z[n - 1], zo[0], zo[n - 1]);
+    }
+    pd_lcp_free(work);
+}
+
+/* A tridiagonal Stieltjes chain (2 on the diagonal, -1 beside it) in
+ * compressed columns with q in [-1, 1). */
+typedef struct chain {
+    int n;
+    int *colptr, *rowind;
+    double *values, *q, *z, *w;
+} chain;
+
+static int chain_make(chain *c, int n, uint64_t seed)
+{
+    c->n = n;
+    c->colptr = malloc((size_t)(n + 1) * sizeof(int));
+    c->rowind = malloc((size_t)(3 * n) * sizeof(int));
+    c->values = malloc((size_t)(3 * n) * sizeof(double));
+    c->q = malloc((size_t)n * sizeof(double));
+    c->z = malloc((size_t)n * sizeof(double));
+    c->w = malloc((size_t)n * sizeof(double));
+    if (!c->colptr || !c->rowind || !c->values || !c->q || !c->z || !c->w)
+        return -1;
+    int k = 0;
+    uint64_t s = seed;
+    for (int j = 0; j < n; j++) {
+        c->colptr[j] = k;
+        for (int i = j - 1; i <= j + 1; i++)
+            if (i >= 0 && i < n) {
+                c->rowind[k] = i;
+                c->values[k++] = i == j ? 2.0 : -1.0;
+            }
+        c->q[j] = rnd(&s);
+    }
+    c->colptr[n] = k;
+    return 0;
+}
+
+static void chain_free(chain *c)
+{
+    free(c->colptr);
+    free(c->rowind);
+    free(c->values);
+    free(c->q);
+    free(c->z);
+    free(c->w);
+}
+
+/* Chains of 500 (against Lemke) and 20000 contacts: the structured solver
+ * verifies, agrees with Lemke, and a correct warm start ends in one solve. */
+static void test_solvers_chains(pd_test_ctx *ctx)
+{
+    const int sizes[] = {500, 20000};
+    for (int k = 0; k < 2; k++) {
+        chain c;
+        if (!CHECK(ctx, chain_make(&c, sizes[k], 7u + (uint64_t)k) == 0, "memory")) {
+            chain_free(&c);
+            continue;
+        }
+        pd_matrix M = pd_matrix_csc(c.n, c.n, c.colptr, c.rowind, c.values);
+        pd_lcp_info info;
+        int st = solve_with(PD_LCP_STRUCTURED, &M, c.q, NULL, c.z, c.w, &info);
+        CHECK(ctx, st == PD_OK && info.residual <= 1e-10 && !strcmp(info.solver, "structured"),
+              "n %d: status %d by %s, residual %.3g, %d iterations", c.n, st, info.solver,
+              info.residual, info.iterations);
+        if (c.n <= 2048) {
+            double *zl = malloc((size_t)c.n * sizeof(double)), *wl = malloc((size_t)c.n * sizeof(double));
+            pd_lcp_info il;
+            int sl = zl && wl ? solve_with(PD_LCP_LEMKE, &M, c.q, NULL, zl, wl, &il) : PD_ENOMEM;
+            double d = 0.0, zs = 0.0;
+            for (int i = 0; zl && i < c.n; i++) {
+                d = fmax(d, fabs(zl[i] - c.z[i]));
+                zs = fmax(zs, fabs(c.z[i]));
+            }
+            CHECK(ctx, sl == PD_OK && d <= 1e-9 * zs,
+                  "n %d: Lemke status %d, |z - z_lemke| %.3g", c.n, sl, d);
+            free(zl);
+            free(wl);
+        }
+        /* warm start from the answer: one principal solve */
+        unsigned char *guess = malloc((size_t)c.n);
+        for (int i = 0; guess && i < c.n; i++)
+            guess[i] = c.z[i] > 0.0;
+        pd_lcp_opts o = pd_lcp_default_opts();
+        o.guess = guess;
+        st = solve_with(PD_LCP_STRUCTURED, &M, c.q, &o, c.z, c.w, &info);
+        CHECK(ctx, st == PD_OK && info.iterations == 1, "n %d warm: status %d, %d iterations",
+              c.n, st, info.iterations);
+        free(guess);
+        chain_free(&c);
+    }
+}
+
+/* Degenerate Delassus matrices: redundant contacts on one pair (D = [1 1;
+ * 1 1], W_I rank deficient) have many solutions, each solver returns a
+ * verified one; an infeasible singular problem (D = [1 -1; -1 1], q = (-1,
+ * -1): w1 + w2 = -2) is reported with a failure status by every solver,
+ * never as solved. */
+static void test_solvers_degenerate(pd_test_ctx *ctx)
+{
+    const pd_lcp_method methods[] = {PD_LCP_LEMKE, PD_LCP_STRUCTURED, PD_LCP_PGS, PD_LCP_AUTO};
+    double R[4] = {1, 1, 1, 1}, qr[2] = {-1, -2}, S[4] = {1, -1, -1, 1}, qs[2] = {-1, -1};
+    for (int k = 0; k < 4; k++) {
+        double z[2], w[2];
+        pd_lcp_info info;
+        pd_matrix Rm = pd_matrix_dense(2, 2, R), Sm = pd_matrix_dense(2, 2, S);
+        int st = solve_with(methods[k], &Rm, qr, NULL, z, w, &info);
+        CHECK(ctx, st == PD_OK && info.residual <= 1e-10 && fabs(z[0] + z[1] - 2.0) <= 1e-9,
+              "%s redundant: status %d, z (%g, %g)", pd_lcp_method_name(methods[k]), st, z[0],
+              z[1]);
+        st = solve_with(methods[k], &Sm, qs, NULL, z, w, &info);
+        CHECK(ctx, st != PD_OK && info.outcome != PD_LCP_SOLVED,
+              "%s infeasible: status %d, outcome %s", pd_lcp_method_name(methods[k]), st,
+              pd_lcp_outcome_name(info.outcome));
+    }
+    /* the same degenerate pair in a chain of three contacts, in compressed columns */
+    int cp[4] = {0, 2, 4, 6}, ri[6] = {0, 1, 0, 1, 1, 2};
+    double vx[6] = {2, 2, 2, 2, 2, 3}, q3[3] = {-1, -1, 0.5}, z[3], w[3];
+    pd_matrix C = pd_matrix_csc(3, 3, cp, ri, vx);
+    pd_lcp_info info;
+    int st = solve_with(PD_LCP_STRUCTURED, &C, q3, NULL, z, w, &info);
+    CHECK(ctx, st == PD_OK && info.residual <= 1e-10, "redundant pair in compressed columns: "
+          "status %d by %s, residual %.3g", st, info.solver, info.residual);
+}
+
+/* PGS reports what it did: a zero pivot is numerical; a budget too small
+ * for its linear convergence is max_iterations with the residual left. */
+static void test_solvers_pgs_honest(pd_test_ctx *ctx)
+{
+    double Z[4] = {0, 1, 1, 2}, q[2] = {-1, -1}, z[2], w[2];
+    pd_matrix Zm = pd_matrix_dense(2, 2, Z);
+    pd_lcp_info info;
+    int st = solve_with(PD_LCP_PGS, &Zm, q, NULL, z, w, &info);
+    CHECK(ctx, st == PD_ENUMERICAL && info.outcome == PD_LCP_NUMERICAL,
+          "zero diagonal: status %d (%s)", st, pd_lcp_outcome_name(info.outcome));
+    chain c;
+    if (chain_make(&c, 400, 3u) == 0) {
+        pd_matrix M = pd_matrix_csc(c.n, c.n, c.colptr, c.rowind, c.values);
+        pd_lcp_opts o = pd_lcp_default_opts();
+        o.max_iterations = 20;
+        st = solve_with(PD_LCP_PGS, &M, c.q, &o, c.z, c.w, &info);
+        CHECK(ctx, st == PD_EMAXITER && info.outcome == PD_LCP_MAX_ITERATIONS &&
+                       info.iterations == 20 && info.residual > 1e-10,
+              "budget 20: status %d (%s), %d sweeps, residual %.3g", st,
+              pd_lcp_outcome_name(info.outcome), info.iterations, info.residual);
+    }
+    chain_free(&c);
+}
+
+/* The engine's answer does not depend on the solver: a row of 40 SDOFs
+ * with Lemke, the structured solver and PGS (umax to 1e-8). */
+static void test_solvers_engine_independent(pd_test_ctx *ctx)
+{
+    pd_scene_excitation x = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 3.0, .Tp = 0.5};
+    pd_scene *sc = NULL;
+    pd_err e;
+    if (!CHECK(ctx, pd_scene_chain(40, &x, 1.0, 1.5, 0.05, 0.0005, 0.5, &sc, &e) == PD_OK, "%s",
+               e.msg))
+        return;
+    const pd_lcp_method methods[] = {PD_LCP_LEMKE, PD_LCP_STRUCTURED, PD_LCP_PGS};
+    pd_scene_result r[3];
+    memset(r, 0, sizeof r);
+    for (int k = 0; k < 3; k++) {
+        pd_run_opts o = pd_run_default_opts();
+        o.lcp_solver = methods[k];
+        o.factor = PD_FACTOR_CHOLMOD;
+        o.tend = 1.5;
+        CHECK(ctx, pd_scene_result_alloc(sc, &r[k], &e) == PD_OK &&
+                       pd_scene_run(sc, &o, NULL, NULL, &r[k], &e) == PD_OK,
+              "%s: %s", pd_lcp_method_name(methods[k]), e.msg);
+    }
+    long impacts = 0;
+    for (int a = 0; a < sc->ncontact; a++)
+        impacts += r[0].impacts[a];
+    for (int k = 1; k < 3; k++) {
+        double d = 0.0, s = 0.0;
+        for (int i = 0; i < sc->n; i++) {
+            d = fmax(d, fabs(r[k].umax[i] - r[0].umax[i]));
+            s = fmax(s, r[0].umax[i]);
+        }
+        CHECK(ctx, d <= 1e-8 * s && impacts > 100, "%s vs lemke: umax differ by %.3g (%ld impacts)",
+              pd_lcp_method_name(methods[k]), d / s, impacts);
+    }
+    for (int k = 0; k < 3; k++)
+        pd_scene_result_free(&r[k]);
+    pd_scene_free(sc);
+}
+
+/* A dump of a row's LCPs re-solved by every solver: every one solved and
+ * agreeing with the dump (PGS: solved or honestly out of sweeps). */
+static void test_solvers_dump_resolved(pd_test_ctx *ctx)
+{
+    if (!pd_test_have_pound(ctx))
+        return;
+    char dir[] = "/tmp/pd_dumpXXXXXX", dump[256];
+    if (!mkdtemp(dir))
+        return;
+    snprintf(dump, sizeof dump, "%s/lcps.h5", dir);
+    proc_out r;
+    const char *sim[] = {"simulate", "--chain", "30", "--pulse", "sine", "--Tp", "0.5", "--T0",
+                         "1", "--ap", "3", "--Pi3", "0.01", "--eps", "0.5", "--tend", "1",
+                         "--dump-lcp", dump, NULL};
+    pd_test_pound(ctx, sim, &r);
+    CHECK(ctx, r.status == 0, "simulate: %s", r.err);
+    pd_test_proc_free(&r);
+    const char *solvers[] = {"lemke", "structured", "auto", "pgs"};
+    for (int k = 0; k < 4; k++) {
+        const char *a[] = {"lcp", dump, "--all", "--solver", solvers[k], "--json", NULL};
+        pd_test_pound(ctx, a, &r);
+        double count = pd_test_json_num(r.out ? r.out : "", "count", 0);
+        double solved = pd_test_json_num(r.out ? r.out : "", "solved", 0);
+        double agree = pd_test_json_num(r.out ? r.out : "", "agree", 0);
+        double res = pd_test_json_num(r.out ? r.out : "", "worst_residual", 0);
+        if (k < 3)
+            CHECK(ctx, r.status == 0 && count > 100 && solved == count && agree == count,
+                  "%s: exit %d, %g of %g solved, %g agree", solvers[k], r.status, solved, count,
+                  agree);
+        else
+            CHECK(ctx, count > 100 && solved >= 0.9 * count &&
+                           (r.status == 0) == (solved == count),
+                  "pgs: exit %d, %g of %g solved (worst residual %.3g)", r.status, solved, count,
+                  res);
+        pd_test_proc_free(&r);
+    }
+    pd_test_rm_dir(dir);
+}
+
+void suite_solvers(pd_test_ctx *ctx)
+{
+    PD_RUN(ctx, test_solvers_match_oracle);
+    PD_RUN(ctx, test_solvers_closed_forms);
+    PD_RUN(ctx, test_solvers_chains);
+    PD_RUN(ctx, test_solvers_degenerate);
+    PD_RUN(ctx, test_solvers_pgs_honest);
+    PD_RUN(ctx, test_solvers_engine_independent);
+    PD_RUN(ctx, test_solvers_dump_resolved);
+}
