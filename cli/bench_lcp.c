@@ -1,12 +1,16 @@
-/* bench_lcp.c — `pound bench --lcp`: median time per Lemke solve.
- *
- * Problems: the Siconos test set (<shared>/data/lcp/siconos, skipped when
- * absent) and the Moreau–Jean Delassus LCPs of a chain of N unit masses
- * pounding each other (D tridiagonal, 2 on the diagonal, -1 beside it, q of
- * mixed signs from a fixed seed).  Each solve is repeated in batches of at
- * least BENCH_BATCH_S; the figure is the median over at least BENCH_MIN_RUNS
- * batches and BENCH_MIN_S seconds, divided by the batch size.  One thread. */
+/* bench_lcp.c — `pound bench --lcp`: the solvers of the table side by side
+ * on the Siconos test set (when ../shared/data/lcp/siconos is there) and on
+ * the Moreau–Jean Delassus LCPs of a chain of N unit masses pounding each
+ * other (D tridiagonal, 2 on the diagonal, -1 beside it, q uniform in
+ * [-1, 1) from a fixed seed; compressed columns for the structured solver
+ * and PGS, dense for Lemke up to N = 500).  Each solve is repeated in
+ * batches of at least BENCH_BATCH_S; the figure is the median over at least
+ * BENCH_MIN_RUNS batches and BENCH_MIN_S seconds (3 runs once a solve takes
+ * longer than BENCH_LONG_S), divided by the batch size.  Solves are cold
+ * (no warm start).  The growth exponent is the least-squares slope of log
+ * time against log N over N = 10^3 ... 10^5.  One thread. */
 #include <dirent.h>
+#include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,7 +22,9 @@
 #define BENCH_MAX_RUNS 501
 #define BENCH_MIN_S 0.1
 #define BENCH_BATCH_S 50e-6
+#define BENCH_LONG_S 0.05
 #define BENCH_MAX_FILES 256
+#define BENCH_PGS_SWEEPS 2000 /* PGS's budget on the chains: its residual is reported */
 #define CHAIN_SEED 20240611u
 
 /* Reference figures (µs) of a widely used lexicographic Lemke on this machine class. */
@@ -30,17 +36,19 @@ typedef struct bench_ref {
 static const bench_ref bench_refs[] = {
     {"mmc", 10.8}, {"tobenna", 137.0}, {"chain_100", 434.0}, {"chain_200", 3200.0}};
 
-/* One measured problem. */
+/* One measured problem and solver. */
 typedef struct bench_row {
     char name[64];
-    int n, pivots;
+    const char *solver;
+    int n, pivots, iterations;
     pd_lcp_outcome outcome;
+    double residual;
     double median_us, ref_us; /* ref_us < 0: none */
 } bench_row;
 
 /* The report: rows to print as a table or as JSON. */
 typedef struct bench_report {
-    bench_row rows[BENCH_MAX_FILES + 8];
+    bench_row rows[3 * BENCH_MAX_FILES + 64];
     int nrows;
     int failed;
     int siconos_found;
@@ -71,43 +79,56 @@ static double median(double *x, int n)
 }
 
 /* Seconds for `batch` solves of (M, q). */
-static double time_batch(pd_lcp_work *work, int n, const double *M, const double *q, double *z,
-                         double *w, int batch, pd_lcp_info *info)
+static double time_batch(pd_lcp_solver *sv, const pd_matrix *M, const double *q,
+                         const pd_lcp_opts *o, double *z, double *w, int batch, pd_lcp_info *info)
 {
     double t0 = pd_wall_seconds();
     for (int b = 0; b < batch; b++)
-        pd_lcp_lemke(work, n, M, q, NULL, z, w, info);
+        pd_lcp_solve(sv, M, q, o, z, w, info);
     return pd_wall_seconds() - t0;
 }
 
-/* Median µs per solve over repeated batches; the outcome into row. */
-static int measure(int n, const double *M, const double *q, bench_row *row)
+/* Median µs per solve with `method` over repeated batches; the outcome into
+ * row.  1 when the solver failed where it should not (Lemke or structured
+ * not solving a solvable problem is caught by the callers). */
+static int measure(pd_lcp_method method, const pd_matrix *M, const double *q, int max_iterations,
+                   bench_row *row)
 {
-    pd_lcp_work *work = pd_lcp_alloc(n);
+    int n = M->rows;
+    long nnz = M->kind == PD_MATRIX_CSC ? M->colptr[n] : 0;
+    pd_err err;
+    pd_lcp_solver *sv = pd_lcp_solver_alloc(method, n, nnz, &err);
     double *zw = malloc(2 * (size_t)n * sizeof(double));
     double runs[BENCH_MAX_RUNS];
-    int rc = 1;
-    if (work && zw) {
-        pd_lcp_info info;
-        double once = time_batch(work, n, M, q, zw, zw + n, 1, &info);
-        int batch = once >= BENCH_BATCH_S ? 1 : (int)(BENCH_BATCH_S / (once + 1e-9)) + 1;
-        double total = 0.0;
-        int nruns = 0;
-        while (nruns < BENCH_MAX_RUNS && (nruns < BENCH_MIN_RUNS || total < BENCH_MIN_S)) {
-            double t = time_batch(work, n, M, q, zw, zw + n, batch, &info);
-            total += t;
-            runs[nruns++] = 1e6 * t / batch;
-        }
-        row->n = n;
-        row->pivots = info.pivots;
-        row->outcome = info.outcome;
-        row->median_us = median(runs, nruns);
-        row->ref_us = reference_us(row->name);
-        rc = info.outcome == PD_LCP_NUMERICAL || info.outcome == PD_LCP_MAX_PIVOTS;
+    pd_lcp_opts o = pd_lcp_default_opts();
+    o.max_iterations = max_iterations;
+    if (!sv || !zw) {
+        pd_lcp_solver_free(sv);
+        free(zw);
+        return 1;
     }
+    pd_lcp_info info;
+    double once = time_batch(sv, M, q, &o, zw, zw + n, 1, &info);
+    int batch = once >= BENCH_BATCH_S ? 1 : (int)(BENCH_BATCH_S / (once + 1e-9)) + 1;
+    int min_runs = once > BENCH_LONG_S ? 3 : BENCH_MIN_RUNS;
+    double total = 0.0;
+    int nruns = 0;
+    while (nruns < BENCH_MAX_RUNS && (nruns < min_runs || (total < BENCH_MIN_S && once <= BENCH_LONG_S))) {
+        double t = time_batch(sv, M, q, &o, zw, zw + n, batch, &info);
+        total += t;
+        runs[nruns++] = 1e6 * t / batch;
+    }
+    row->n = n;
+    row->solver = info.solver;
+    row->pivots = info.pivots;
+    row->iterations = info.iterations;
+    row->outcome = info.outcome;
+    row->residual = info.residual;
+    row->median_us = median(runs, nruns);
+    row->ref_us = method == PD_LCP_LEMKE ? reference_us(row->name) : -1.0;
+    pd_lcp_solver_free(sv);
     free(zw);
-    pd_lcp_free(work);
-    return rc;
+    return 0;
 }
 
 /* splitmix64: the next 64 random bits of the stream *state. */
@@ -125,42 +146,99 @@ static double uniform_pm1(uint64_t *state)
     return 2.0 * ((double)(splitmix64(state) >> 11) * 0x1.0p-53) - 1.0;
 }
 
-/* D = tridiag(-1/m, 2/m, -1/m) with m = 1, q uniform in [-1, 1) from a fixed seed. */
-static void chain_problem(int N, double *D, double *q)
+/* A chain: D = tridiag(-1, 2, -1) in compressed columns (and dense for
+ * small N), q uniform in [-1, 1) from a fixed seed. */
+typedef struct chain {
+    int N;
+    int *colptr, *rowind;
+    double *values, *dense, *q;
+} chain;
+
+static void chain_free(chain *c)
+{
+    free(c->colptr);
+    free(c->rowind);
+    free(c->values);
+    free(c->dense);
+    free(c->q);
+}
+
+static int chain_make(chain *c, int N, int with_dense)
 {
     uint64_t state = CHAIN_SEED + (uint64_t)N;
-    memset(D, 0, (size_t)N * (size_t)N * sizeof(double));
-    for (int i = 0; i < N; i++) {
-        D[i + (size_t)i * N] = 2.0;
-        if (i + 1 < N) {
-            D[i + 1 + (size_t)i * N] = -1.0;
-            D[i + (size_t)(i + 1) * N] = -1.0;
+    memset(c, 0, sizeof *c);
+    c->N = N;
+    c->colptr = malloc(((size_t)N + 1) * sizeof(int));
+    c->rowind = malloc(3 * (size_t)N * sizeof(int));
+    c->values = malloc(3 * (size_t)N * sizeof(double));
+    c->q = malloc((size_t)N * sizeof(double));
+    c->dense = with_dense ? calloc((size_t)N * (size_t)N, sizeof(double)) : NULL;
+    if (!c->colptr || !c->rowind || !c->values || !c->q || (with_dense && !c->dense))
+        return -1;
+    int k = 0;
+    for (int j = 0; j < N; j++) {
+        c->colptr[j] = k;
+        for (int i = j - 1; i <= j + 1; i++)
+            if (i >= 0 && i < N) {
+                double x = i == j ? 2.0 : -1.0;
+                c->rowind[k] = i;
+                c->values[k++] = x;
+                if (c->dense)
+                    c->dense[i + (size_t)j * N] = x;
+            }
+        c->q[j] = uniform_pm1(&state);
+    }
+    c->colptr[N] = k;
+    return 0;
+}
+
+/* Lemke (dense, N <= 500), structured and PGS (compressed columns). */
+static void bench_chains(bench_report *rep)
+{
+    static const int sizes[] = {10, 100, 200, 500, 1000, 10000, 100000};
+    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
+        int N = sizes[k];
+        chain c;
+        if (chain_make(&c, N, N <= 500)) {
+            chain_free(&c);
+            rep->failed = 1;
+            continue;
         }
-        q[i] = uniform_pm1(&state);
+        pd_matrix dense = pd_matrix_dense(N, N, c.dense);
+        pd_matrix csc = pd_matrix_csc(N, N, c.colptr, c.rowind, c.values);
+        const pd_lcp_method methods[] = {PD_LCP_LEMKE, PD_LCP_STRUCTURED, PD_LCP_PGS};
+        for (int m = 0; m < 3; m++) {
+            if (m == 0 && N > 500)
+                continue;
+            bench_row *row = &rep->rows[rep->nrows++];
+            snprintf(row->name, sizeof row->name, "chain_%d", N);
+            rep->failed |= measure(methods[m], m ? &csc : &dense, c.q,
+                                   m == 2 ? BENCH_PGS_SWEEPS : 0, row);
+            rep->failed |= m < 2 && row->outcome != PD_LCP_SOLVED;
+        }
+        chain_free(&c);
     }
 }
 
-/* The chain problems N = 10, 50, 100, 200, 500. */
-static void bench_chains(bench_report *rep)
+/* Least-squares slope of log(us) against log(n) of a solver's chains with
+ * n in [lo, hi]; NAN with fewer than two. */
+static double growth(const bench_report *rep, const char *solver, int lo, int hi)
 {
-    static const int sizes[] = {10, 50, 100, 200, 500};
-    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
-        int N = sizes[k];
-        bench_row *row = &rep->rows[rep->nrows];
-        double *D = malloc((size_t)N * (size_t)N * sizeof(double));
-        double *q = malloc((size_t)N * sizeof(double));
-        snprintf(row->name, sizeof row->name, "chain_%d", N);
-        if (D && q) {
-            chain_problem(N, D, q);
-            int bad = measure(N, D, q, row);
-            rep->failed |= bad || row->outcome != PD_LCP_SOLVED;
-            rep->nrows++;
-        } else {
-            rep->failed = 1;
-        }
-        free(D);
-        free(q);
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    int k = 0;
+    for (int r = 0; r < rep->nrows; r++) {
+        const bench_row *row = &rep->rows[r];
+        if (strncmp(row->name, "chain_", 6) || row->n < lo || row->n > hi ||
+            strcmp(row->solver, solver))
+            continue;
+        double x = log((double)row->n), y = log(row->median_us);
+        sx += x;
+        sy += y;
+        sxx += x * x;
+        sxy += x * y;
+        k++;
     }
+    return k < 2 ? NAN : (k * sxy - sx * sy) / (k * sxx - sx * sx);
 }
 
 /* Ascending order of strings, for qsort. */
@@ -200,6 +278,7 @@ static void bench_siconos_file(bench_report *rep, const char *dir, const char *f
     char path[4096];
     bench_row *row = &rep->rows[rep->nrows];
     int n = 0;
+    memset(row, 0, sizeof *row);
     double *M = NULL, *q = NULL;
     pd_err err;
     problem_name(file, row->name, sizeof row->name);
@@ -213,8 +292,15 @@ static void bench_siconos_file(bench_report *rep, const char *dir, const char *f
         rep->failed = 1;
         return;
     }
-    rep->failed |= measure(n, M, q, row);
-    rep->nrows++;
+    pd_matrix Mv = pd_matrix_dense(n, n, M);
+    const pd_lcp_method methods[] = {PD_LCP_LEMKE, PD_LCP_STRUCTURED, PD_LCP_PGS};
+    for (int m = 0; m < 3; m++) {
+        bench_row *r = &rep->rows[rep->nrows++];
+        if (m)
+            *r = rep->rows[rep->nrows - 2];
+        rep->failed |= measure(methods[m], &Mv, q, 0, r);
+        rep->failed |= m == 0 && (r->outcome == PD_LCP_NUMERICAL || r->outcome == PD_LCP_MAX_PIVOTS);
+    }
     free(M);
     free(q);
 }
@@ -236,22 +322,27 @@ static void bench_siconos(bench_report *rep, const char *shared_dir, char *dir, 
 /* The table with reference figures and ratios. */
 static void print_table(const bench_report *rep)
 {
-    printf("LCP: Lemke (lexicographic, basis-inverse updates), median us per solve over >= %d "
-           "timed batches, one thread\n", BENCH_MIN_RUNS);
+    printf("LCP solvers, median us per cold solve over >= %d timed batches (3 for solves over "
+           "%g s), one thread\n", BENCH_MIN_RUNS, BENCH_LONG_S);
     if (!rep->siconos_found)
         printf("Siconos set: skipped (no .dat files in %s)\n", rep->siconos_dir);
-    printf("%-28s %5s %7s %-12s %12s %10s %7s\n", "problem", "n", "pivots", "status",
-           "median_us", "ref_us", "ratio");
+    printf("%-28s %6s %-26s %-14s %7s %6s %9s %12s %9s %7s\n", "problem", "n", "solver", "status",
+           "pivots", "iters", "residual", "median_us", "ref_us", "ratio");
     for (int k = 0; k < rep->nrows; k++) {
         const bench_row *r = &rep->rows[k];
-        printf("%-28s %5d %7d %-12s %12.3f", r->name, r->n, r->pivots,
-               pd_lcp_outcome_name(r->outcome), r->median_us);
+        printf("%-28s %6d %-26s %-14s %7d %6d %9.2g %12.3f", r->name, r->n, r->solver,
+               pd_lcp_outcome_name(r->outcome), r->pivots, r->iterations, r->residual,
+               r->median_us);
         if (r->ref_us > 0.0)
-            printf(" %10.1f %7.3f\n", r->ref_us, r->median_us / r->ref_us);
+            printf(" %9.1f %7.3f\n", r->ref_us, r->median_us / r->ref_us);
         else
-            printf(" %10s %7s\n", "-", "-");
+            printf(" %9s %7s\n", "-", "-");
     }
-    printf("ratio = ours / reference (below 1: faster)\n");
+    printf("ratio = ours / a widely used lexicographic Lemke measured on this machine class\n");
+    printf("growth exponent of the time on chains, N = 1e3 ... 1e5: structured %.3f, pgs (%d "
+           "sweeps) %.3f\n",
+           growth(rep, "structured", 1000, 100000), BENCH_PGS_SWEEPS,
+           growth(rep, "pgs", 1000, 100000));
 }
 
 /* The member "lcp": {...} of the open JSON object. */
@@ -267,8 +358,11 @@ static void print_json(pd_json *js, const bench_report *rep)
         pd_json_begin_object(js, NULL);
         pd_json_str(js, "name", r->name);
         pd_json_int(js, "n", r->n);
+        pd_json_str(js, "solver", r->solver);
         pd_json_int(js, "pivots", r->pivots);
+        pd_json_int(js, "iterations", r->iterations);
         pd_json_str(js, "status", pd_lcp_outcome_name(r->outcome));
+        pd_json_num(js, "residual", r->residual);
         pd_json_num(js, "median_us", r->median_us);
         if (r->ref_us > 0.0)
             pd_json_num(js, "ref_us", r->ref_us);
@@ -277,6 +371,8 @@ static void print_json(pd_json *js, const bench_report *rep)
         pd_json_end_object(js);
     }
     pd_json_end_array(js);
+    pd_json_num(js, "growth_structured", growth(rep, "structured", 1000, 100000));
+    pd_json_num(js, "growth_pgs", growth(rep, "pgs", 1000, 100000));
     pd_json_bool(js, "failed", rep->failed);
     pd_json_end_object(js);
 }

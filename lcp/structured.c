@@ -9,19 +9,22 @@
  *     started from the last time step's support it ends in one or two solves.
  *   interior point (Mehrotra predictor-corrector, infeasible start)  For a
  *     cold start, or when pivoting does not settle within BPP_WARM_ROUNDS:
- *     (M + W Z^-1) dz = ..., a fixed number of iterations whatever n, each
- *     one envelope factorisation.  It finds the support of an impact that
+ *     (M + W Z^-1) dz = ..., a number of iterations that grows slowly with
+ *     n, each one factorisation.  It finds the support of an impact that
  *     runs along a chain in one go, where pivoting would move it one index
- *     per solve.  Its point, if it verifies, is the answer; else its support
- *     (z_i > w_i) warm-starts the pivoting again.
+ *     per solve.  Once its support guess (z_i M_ii > w_i) holds still, the
+ *     pivoting finishes from it; if that fails, the point driven to the
+ *     end is the answer when it verifies.
  *
- * Both factor by an envelope (profile) Cholesky in the order of the
- * indices: row i of L is stored from its first nonzero column on, and
- * fill-in stays inside that envelope.  The Delassus matrices of a row of
- * structures are (block) banded in the contact order, so a factorisation
- * costs O(n b^2) for bandwidth b: linear in the length of the row.  Every
- * answer is verified (pd_lcp_verify); what does not verify is handed back
- * as numerical or max_iterations for Lemke to take over. */
+ * Both factor M_FF as L D L^T in the order of the indices.  Tridiagonal
+ * blocks (rows of SDOFs) use a twisted factorisation, eliminated from both
+ * ends at once; others an envelope (profile) storage, row i of L from its
+ * first nonzero column on, fill-in inside that envelope.  The Delassus
+ * matrices of a row of structures are (block) banded in the contact order,
+ * so a factorisation costs O(n b^2) for bandwidth b: linear in the length
+ * of the row.  Every answer is verified (pd_lcp_verify); what does not
+ * verify is handed back as numerical or max_iterations for Lemke to take
+ * over. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -37,6 +40,9 @@
                                before the support is handed to the pivoting */
 #define IPM_MU_FINAL 1e-17  /* the same when the point itself must be the answer
                                (a singular M_FF: redundant contacts) */
+#define IPM_STABLE 2        /* iterations the support guess must hold ... */
+#define IPM_CROSS_MU 1e-3   /* ... with mu below this * its start, to try the pivoting */
+#define IPM_CROSSINGS 3     /* such early tries at most */
 #define IPM_STEP 0.995      /* fraction of the step to the boundary */
 #define IPM_SHIFT 1e-8      /* regularisation of the least-squares start, times max M_ii */
 #define IPM_START 0.1       /* the start's distance from the boundary, times the scales */
@@ -50,9 +56,18 @@ struct pd_bpp_work {
     int *first;         /* n: first column of the envelope of local row i */
     long *rowptr;       /* n + 1: start of row i in env */
     double *env;        /* envmax: the envelope of L, row by row */
-    double *diag;       /* n: M_ii */
+    double *diag;       /* n: the diagonal shift of the interior point */
     double *rhs;        /* n: the local right-hand side, then z_F */
     double *rows;       /* n: row sizes of the verification */
+    double *dinv;       /* n: 1 / D_ii */
+    double *tmpl;       /* envmax: the envelope of the whole M (the interior point) */
+    double *mii;        /* n: M_ii */
+    double *rz;         /* n: 1 / z_i of the interior point */
+    unsigned char *sup; /* n: the interior point's support guess */
+    int crossed;        /* the interior point stopped early at a stable support */
+    int tridiagonal;    /* the loaded matrix is tridiagonal: ta, tb instead of env */
+    double *ta, *tb;    /* n: its diagonal A_ii and subdiagonal A_i,i-1 (tb_0 = 0) */
+    double *tl, *tu;    /* n: the twisted factor's multipliers (tri_factor) */
     double *iz, *iw, *dz, *dw, *az, *aw, *r; /* n each: the interior point's */
 };
 
@@ -69,6 +84,14 @@ void pd_bpp_free(pd_bpp_work *ws)
     free(ws->diag);
     free(ws->rhs);
     free(ws->rows);
+    free(ws->dinv);
+    free(ws->tmpl);
+    free(ws->mii);
+    free(ws->rz);
+    free(ws->sup);
+    double *tri[] = {ws->ta, ws->tb, ws->tl, ws->tu};
+    for (size_t k = 0; k < sizeof tri / sizeof tri[0]; k++)
+        free(tri[k]);
     double *ipm[] = {ws->iz, ws->iw, ws->dz, ws->dw, ws->az, ws->aw, ws->r};
     for (size_t k = 0; k < sizeof ipm / sizeof ipm[0]; k++)
         free(ipm[k]);
@@ -94,12 +117,19 @@ pd_bpp_work *pd_bpp_alloc(int nmax, long envmax)
     ws->diag = malloc(n * sizeof(double));
     ws->rhs = malloc(n * sizeof(double));
     ws->rows = malloc(n * sizeof(double));
-    double **ipm[] = {&ws->iz, &ws->iw, &ws->dz, &ws->dw, &ws->az, &ws->aw, &ws->r};
+    ws->dinv = malloc(n * sizeof(double));
+    ws->tmpl = malloc((size_t)envmax * sizeof(double));
+    ws->mii = malloc(n * sizeof(double));
+    ws->rz = malloc(n * sizeof(double));
+    ws->sup = malloc(n);
+    double **ipm[] = {&ws->iz, &ws->iw, &ws->dz, &ws->dw, &ws->az, &ws->aw, &ws->r,
+                      &ws->ta, &ws->tb, &ws->tl, &ws->tu};
     int ok = 1;
     for (size_t k = 0; k < sizeof ipm / sizeof ipm[0]; k++)
         ok &= (*ipm[k] = malloc(n * sizeof(double))) != NULL;
     if (!ok || !ws->inF || !ws->loc || !ws->glob || !ws->first || !ws->rowptr || !ws->env ||
-        !ws->diag || !ws->rhs || !ws->rows) {
+        !ws->diag || !ws->rhs || !ws->rows || !ws->dinv || !ws->tmpl ||
+        !ws->mii || !ws->rz || !ws->sup) {
         pd_bpp_free(ws);
         return NULL;
     }
@@ -131,12 +161,14 @@ int pd_bpp_nmax(const pd_bpp_work *ws)
         }                                                                                     \
     } while (0)
 
-/* The envelope of M_FF (k local rows) and its entries, plus shift_i on the
- * diagonal (shift NULL: none): row i of A holds columns first[i] .. i.  -1
- * when the envelope exceeds the workspace. */
-static int load_envelope(pd_bpp_work *ws, const pd_matrix *M, int k, const double *shift)
+/* M_FF (k local rows) into the workspace: when every row reaches back at
+ * most one column, as ta, tb (ws->tridiagonal); else as an envelope, row i
+ * holding columns first[i] .. i.  -1 when the envelope exceeds the
+ * workspace. */
+static int load_envelope(pd_bpp_work *ws, const pd_matrix *M, int k)
 {
     long off = 0;
+    int band = 0;
     for (int i = 0; i < k; i++) {
         int g = ws->glob[i], f = i;
         FOR_COLUMN(M, g, r, x, {
@@ -148,10 +180,24 @@ static int load_envelope(pd_bpp_work *ws, const pd_matrix *M, int k, const doubl
         ws->first[i] = f;
         ws->rowptr[i] = off;
         off += i - f + 1;
-        if (off > ws->envmax)
-            return -1;
+        band = band > i - f ? band : i - f;
     }
     ws->rowptr[k] = off;
+    if ((ws->tridiagonal = band <= 1)) {
+        for (int i = 0; i < k; i++) {
+            ws->tb[i] = 0.0;
+            FOR_COLUMN(M, ws->glob[i], r, x, {
+                int l = ws->loc[r];
+                if (l == i)
+                    ws->ta[i] = x;
+                else if (l >= 0 && l == i - 1)
+                    ws->tb[i] = x;
+            });
+        }
+        return 0;
+    }
+    if (off > ws->envmax)
+        return -1;
     memset(ws->env, 0, (size_t)off * sizeof(double));
     for (int i = 0; i < k; i++) {
         double *row = ws->env + ws->rowptr[i] - ws->first[i]; /* row[j] = A_ij */
@@ -160,52 +206,151 @@ static int load_envelope(pd_bpp_work *ws, const pd_matrix *M, int k, const doubl
             if (l >= 0 && l <= i)
                 row[l] = x;
         });
-        if (shift)
-            row[i] += shift[i];
     }
     return 0;
 }
 
-/* A = L L^T in place on the envelope; -1 when a pivot is not positive. */
-static int envelope_cholesky(pd_bpp_work *ws, int k)
+/* The twisted factorisation of a tridiagonal A + diag(shift) (shift NULL:
+ * none), A = N P N^T: rows above m = k/2 eliminated downwards (pivots d_i,
+ * multipliers l_i = A_i,i-1 / d_i-1 in tl), rows below upwards (pivots e_j,
+ * u_j = A_j+1,j / e_j+1 in tu), both into row m (pivot g).  The two
+ * continued fractions are independent, so they run side by side at half
+ * the latency of one.  1 / pivot in dinv; -1 when a pivot is not positive. */
+static int tri_factor(pd_bpp_work *ws, int k, const double *shift)
 {
+    const double *a = ws->ta, *b = ws->tb;
+    double *tl = ws->tl, *tu = ws->tu, *dinv = ws->dinv, rd = 0.0, re = 0.0;
+    int m = k / 2;
+#define TRI_A(i) (shift ? a[i] + shift[i] : a[i])
+    for (int s = 0; s < m; s++) {
+        int i = s, j = k - 1 - s;
+        double l = b[i] * rd, d = TRI_A(i) - l * b[i];
+        if (!(d > BPP_PIVOT_TOL * TRI_A(i)) || !(d > 0.0))
+            return -1;
+        tl[i] = l;
+        dinv[i] = rd = 1.0 / d;
+        if (j > m) {
+            double u = b[j + 1 < k ? j + 1 : 0] * re, e = TRI_A(j) - u * b[j + 1 < k ? j + 1 : 0];
+            if (!(e > BPP_PIVOT_TOL * TRI_A(j)) || !(e > 0.0))
+                return -1;
+            tu[j] = u;
+            dinv[j] = re = 1.0 / e;
+        }
+    }
+    double bm1 = m + 1 < k ? b[m + 1] : 0.0, l = b[m] * rd, u = bm1 * re;
+    double g = TRI_A(m) - l * b[m] - u * bm1;
+#undef TRI_A
+    if (!(g > BPP_PIVOT_TOL * (shift ? a[m] + shift[m] : a[m])) || !(g > 0.0))
+        return -1;
+    tl[m] = l;
+    tu[m] = u;
+    dinv[m] = 1.0 / g;
+    return 0;
+}
+
+/* x = (N P N^T)^-1 x in place, the two halves side by side. */
+static void tri_solve(const pd_bpp_work *ws, int k, double *x)
+{
+    const double *tl = ws->tl, *tu = ws->tu, *dinv = ws->dinv;
+    int m = k / 2;
+    double yt = 0.0, yb = 0.0; /* N y = x: down to m from both ends */
+    for (int s = 0; s < m; s++) {
+        int i = s, j = k - 1 - s;
+        x[i] = yt = x[i] - tl[i] * yt;
+        if (j > m)
+            x[j] = yb = x[j] - tu[j] * yb;
+    }
+    double xm = (x[m] - tl[m] * yt - tu[m] * yb) * dinv[m];
+    x[m] = xm;
+    double xt = xm, xb = xm; /* N^T x = P^-1 y: out from m to both ends */
+    for (int s = 1; s <= m; s++) {
+        int i = m - s, j = m + s;
+        x[i] = xt = x[i] * dinv[i] - tl[i + 1] * xt;
+        if (j < k)
+            x[j] = xb = x[j] * dinv[j] - tu[j - 1] * xb;
+    }
+}
+
+/* A = L D L^T in place on the envelope (L unit lower triangular, D_ii on
+ * the diagonal), 1 / D_ii in dinv; -1 when a pivot is not positive.  No
+ * square roots: the factorisation of a chain is a continued fraction whose
+ * speed is the latency of one division per row.  Row i first holds
+ * u_j = L_ij D_jj, then L_ij. */
+static int envelope_ldlt(pd_bpp_work *ws, int k)
+{
+    double *dinv = ws->dinv, last = 0.0; /* last: 1 / D of the row before */
     for (int i = 0; i < k; i++) {
         int fi = ws->first[i];
-        double *ri = ws->env + ws->rowptr[i] - fi;
-        for (int j = fi; j < i; j++) {
-            int fj = ws->first[j], lo = fi > fj ? fi : fj;
-            const double *rj = ws->env + ws->rowptr[j] - fj;
-            double s = ri[j];
-            for (int c = lo; c < j; c++)
-                s -= ri[c] * rj[c];
-            ri[j] = s / rj[j];
+        double *ri = ws->env + ws->rowptr[i] - fi, a = ri[i], d = a;
+        if (fi == i - 1) { /* one off-diagonal entry: a chain */
+            double u = ri[i - 1], l = u * last;
+            ri[i - 1] = l;
+            d -= u * l;
+        } else if (fi < i) {
+            for (int j = fi; j < i; j++) { /* u_j = A_ij - sum_c u_c L_jc */
+                int fj = ws->first[j], lo = fi > fj ? fi : fj;
+                const double *rj = ws->env + ws->rowptr[j] - fj;
+                double s = ri[j];
+                for (int c = lo; c < j; c++)
+                    s -= ri[c] * rj[c];
+                ri[j] = s;
+            }
+            for (int j = fi; j < i; j++) { /* L_ij = u_j / D_jj, D_ii -= u_j L_ij */
+                double u = ri[j];
+                ri[j] = u * dinv[j];
+                d -= u * ri[j];
+            }
         }
-        double d = ri[i];
-        for (int c = fi; c < i; c++)
-            d -= ri[c] * ri[c];
-        if (!(d > BPP_PIVOT_TOL * ri[i]) || !(d > 0.0))
+        if (!(d > BPP_PIVOT_TOL * a) || !(d > 0.0))
             return -1;
-        ri[i] = sqrt(d);
+        ri[i] = d;
+        dinv[i] = last = 1.0 / d;
     }
     return 0;
 }
 
-/* x = (L L^T)^-1 x in place. */
+/* x = (L D L^T)^-1 x in place.  Along a chain the value of the row before
+ * stays in a register (y, zi): the sweeps run at the latency of one
+ * multiply-add per row. */
 static void envelope_solve(const pd_bpp_work *ws, int k, double *x)
 {
+    const double *dinv = ws->dinv;
+    double y = 0.0;
     for (int i = 0; i < k; i++) { /* L y = x, row by row */
-        const double *ri = ws->env + ws->rowptr[i] - ws->first[i];
+        int fi = ws->first[i];
+        const double *ri = ws->env + ws->rowptr[i] - fi;
         double s = x[i];
-        for (int c = ws->first[i]; c < i; c++)
-            s -= ri[c] * x[c];
-        x[i] = s / ri[i];
+        if (fi == i - 1)
+            s -= ri[i - 1] * y;
+        else
+            for (int c = fi; c < i; c++)
+                s -= ri[c] * x[c];
+        x[i] = y = s;
     }
-    for (int i = k - 1; i >= 0; i--) { /* L^T z = y, column i of L^T is row i of L */
-        const double *ri = ws->env + ws->rowptr[i] - ws->first[i];
-        x[i] /= ri[i];
-        for (int c = ws->first[i]; c < i; c++)
-            x[c] -= ri[c] * x[i];
+    for (int i = 0; i < k; i++) /* D^-1 y */
+        x[i] *= dinv[i];
+    double zi = k > 0 ? x[k - 1] : 0.0; /* z_i, final */
+    for (int i = k - 1; i > 0; i--) { /* L^T z = D^-1 y: column i of L^T is row i of L */
+        int fi = ws->first[i];
+        const double *ri = ws->env + ws->rowptr[i] - fi;
+        if (fi == i - 1) {
+            zi = x[i - 1] - ri[i - 1] * zi;
+            x[i - 1] = zi;
+        } else {
+            for (int c = fi; c < i; c++)
+                x[c] -= ri[c] * zi;
+            zi = x[i - 1];
+        }
     }
+}
+
+/* x = A^-1 x with the factor in the workspace. */
+static void factor_solve(const pd_bpp_work *ws, int k, double *x)
+{
+    if (ws->tridiagonal)
+        tri_solve(ws, k, x);
+    else
+        envelope_solve(ws, k, x);
 }
 
 /* z on F from the principal system, w = M z + q with the row sizes; the
@@ -221,13 +366,13 @@ static int principal_solve(pd_bpp_work *ws, const pd_matrix *M, const double *q,
             ws->glob[k++] = i;
         }
     }
-    if (load_envelope(ws, M, k, NULL))
+    if (load_envelope(ws, M, k))
         return -1;
-    if (envelope_cholesky(ws, k))
+    if (ws->tridiagonal ? tri_factor(ws, k, NULL) : envelope_ldlt(ws, k))
         return -2;
     for (int l = 0; l < k; l++)
         ws->rhs[l] = -q[ws->glob[l]];
-    envelope_solve(ws, k, ws->rhs);
+    factor_solve(ws, k, ws->rhs);
     memset(z, 0, (size_t)n * sizeof(double));
     for (int l = 0; l < k; l++)
         z[ws->glob[l]] = ws->rhs[l];
@@ -303,18 +448,64 @@ static void matvec(const pd_matrix *M, const double *x, double *y)
             FOR_COLUMN(M, j, r, v, y[r] += v * x[j]);
 }
 
-/* The largest step in (0, 1] keeping z + a dz and w + a dw positive. */
+/* y = M x for the interior point, whose M is loaded whole (ipm_pattern):
+ * three diagonals when tridiagonal. */
+static void ipm_matvec(const pd_bpp_work *ws, const pd_matrix *M, const double *x, double *y)
+{
+    int n = M->rows;
+    if (!ws->tridiagonal) {
+        matvec(M, x, y);
+        return;
+    }
+    const double *a = ws->ta, *b = ws->tb;
+    y[0] = a[0] * x[0];
+    for (int i = 1; i < n; i++) {
+        y[i] = a[i] * x[i] + b[i] * x[i - 1];
+        y[i - 1] += b[i] * x[i];
+    }
+}
+
+/* dw = c - w - (w / z) dz, with c NULL: 0, then the largest step in
+ * (0, 1] keeping z + a dz and w + a dw positive. */
 static double step_to_boundary(int n, const double *z, const double *dz, const double *w,
-                               const double *dw)
+                               const double *ratio, const double *c, double *dw)
 {
     double a = 1.0;
-    for (int i = 0; i < n; i++) {
-        if (dz[i] < 0.0 && -z[i] / dz[i] < a)
+    for (int i = 0; i < n; i++) { /* z + a dz < 0 only when dz < 0 (z > 0) */
+        dw[i] = (c ? c[i] : 0.0) - w[i] - ratio[i] * dz[i];
+        if (z[i] + a * dz[i] < 0.0)
             a = -z[i] / dz[i];
-        if (dw[i] < 0.0 && -w[i] / dw[i] < a)
+        if (w[i] + a * dw[i] < 0.0)
             a = -w[i] / dw[i];
     }
     return a;
+}
+
+/* The whole M loaded once for the interior point, whose factorisations
+ * change only the diagonal: an envelope is kept in tmpl.  -1 when it is
+ * too large. */
+static int ipm_pattern(pd_bpp_work *ws, const pd_matrix *M)
+{
+    int n = M->rows;
+    for (int i = 0; i < n; i++)
+        ws->loc[i] = ws->glob[i] = i;
+    if (load_envelope(ws, M, n))
+        return -1;
+    if (!ws->tridiagonal)
+        memcpy(ws->tmpl, ws->env, (size_t)ws->rowptr[n] * sizeof(double));
+    return 0;
+}
+
+/* The factor of M + diag(shift) on the pattern of ipm_pattern; -1 when a
+ * pivot is not positive. */
+static int ipm_factor(pd_bpp_work *ws, int n, const double *shift)
+{
+    if (ws->tridiagonal)
+        return tri_factor(ws, n, shift);
+    memcpy(ws->env, ws->tmpl, (size_t)ws->rowptr[n] * sizeof(double));
+    for (int i = 0; i < n; i++)
+        ws->env[ws->rowptr[i] + i - ws->first[i]] += shift[i];
+    return envelope_ldlt(ws, n);
 }
 
 /* The start: the (regularised) least-squares solution of M z = -q moved
@@ -324,68 +515,90 @@ static int ipm_start(pd_bpp_work *ws, const pd_matrix *M, const double *q, doubl
     int n = M->rows;
     double *z = ws->iz, *w = ws->iw;
     for (int i = 0; i < n; i++) {
-        ws->loc[i] = ws->glob[i] = i;
         ws->diag[i] = IPM_SHIFT * ds;
         z[i] = -q[i];
     }
-    if (load_envelope(ws, M, n, ws->diag) || envelope_cholesky(ws, n))
+    if (ipm_factor(ws, n, ws->diag))
         return -1;
-    envelope_solve(ws, n, z);
+    factor_solve(ws, n, z);
     double zs = fmax(pd_lcp_max_abs(n, z), qs / ds);
     for (int i = 0; i < n; i++)
         z[i] = fmax(z[i], 0.0) + IPM_START * zs;
-    matvec(M, z, w);
+    ipm_matvec(ws, M, z, w);
     for (int i = 0; i < n; i++)
         w[i] = fmax(w[i] + q[i], 0.0) + IPM_START * qs;
     return 0;
+}
+
+/* The support guess of the interior point, z_i M_ii > w_i (in the units
+ * of w), into sup; the number of indices that changed sides. */
+static int ipm_support(pd_bpp_work *ws, int n)
+{
+    int changed = 0;
+    for (int i = 0; i < n; i++) {
+        unsigned char s = ws->iz[i] * ws->mii[i] > ws->iw[i];
+        changed += s != ws->sup[i];
+        ws->sup[i] = s;
+    }
+    return changed;
 }
 
 /* Mehrotra's predictor-corrector for the monotone LCP, infeasible start:
  *   (M + W Z^-1) dz = -(M z + q) + (sigma mu - dz_a dw_a) / z,
  *   dw = (sigma mu - dz_a dw_a) / z - w - (w / z) dz,
  * sigma = (mu_affine / mu)^3, until mu = z.w / n is small relative to the
- * scales.  The point in ws->iz, ws->iw; -1 when a factorisation fails, else
- * the iterations made. */
+ * scales -- or, with `cross`, until the support guess has held for
+ * IPM_STABLE iterations while mu fell by IPM_CROSS_MU (ws->crossed): the
+ * pivoting finishes from there in one solve, where the last iterations
+ * would only sharpen a point whose support is known.  The point in ws->iz,
+ * ws->iw; -1 when a factorisation fails, else the iterations made. */
 static int interior_point(pd_bpp_work *ws, const pd_matrix *M, const double *q, double qs,
-                          double ds, double tol, int from_start)
+                          double ds, double tol, int from_start, int cross)
 {
-    int n = M->rows, it;
+    int n = M->rows, it, stable = 0;
     double *z = ws->iz, *w = ws->iw, *dz = ws->dz, *dw = ws->dw, *az = ws->az, *aw = ws->aw;
-    if (from_start && ipm_start(ws, M, q, qs, ds))
+    double *rz = ws->rz, mu0 = -1.0;
+    if (ipm_pattern(ws, M) || (from_start && ipm_start(ws, M, q, qs, ds)))
         return -1;
-    for (int i = 0; i < n; i++)
-        ws->loc[i] = ws->glob[i] = i;
+    ws->crossed = 0;
+    ipm_support(ws, n);
     for (it = 0; it < IPM_MAX; it++) {
         double mu = 0.0, rmax = 0.0;
-        matvec(M, z, ws->r);
+        ipm_matvec(ws, M, z, ws->r);
         for (int i = 0; i < n; i++) {
             mu += z[i] * w[i] / n;
             ws->r[i] += q[i]; /* M z + q */
-            rmax = fmax(rmax, fabs(w[i] - ws->r[i]));
-            ws->diag[i] = w[i] / z[i];
+            double gap = fabs(w[i] - ws->r[i]);
+            rmax = gap > rmax ? gap : rmax;
+            rz[i] = 1.0 / z[i];
+            ws->diag[i] = w[i] * rz[i];
         }
         if (mu <= tol * qs * qs / ds && rmax <= tol * qs)
             break;
-        if (load_envelope(ws, M, n, ws->diag) || envelope_cholesky(ws, n))
+        mu0 = mu0 < 0.0 ? mu : mu0;
+        if (cross && it > 0) {
+            stable = ipm_support(ws, n) ? 0 : stable + 1;
+            if (stable >= IPM_STABLE && mu <= IPM_CROSS_MU * mu0) {
+                ws->crossed = 1;
+                break;
+            }
+        }
+        if (ipm_factor(ws, n, ws->diag))
             return -1;
         for (int i = 0; i < n; i++) /* predictor */
             az[i] = -ws->r[i];
-        envelope_solve(ws, n, az);
-        for (int i = 0; i < n; i++)
-            aw[i] = -w[i] - ws->diag[i] * az[i];
-        double a = step_to_boundary(n, z, az, w, aw), mua = 0.0;
+        factor_solve(ws, n, az);
+        double a = step_to_boundary(n, z, az, w, ws->diag, NULL, aw), mua = 0.0;
         for (int i = 0; i < n; i++)
             mua += (z[i] + a * az[i]) * (w[i] + a * aw[i]) / n;
         double sigma = pow(mua / mu, 3.0);
         for (int i = 0; i < n; i++) { /* corrector */
-            double c = (sigma * mu - az[i] * aw[i]) / z[i];
+            double c = (sigma * mu - az[i] * aw[i]) * rz[i];
             dz[i] = -ws->r[i] + c;
             ws->rows[i] = c;
         }
-        envelope_solve(ws, n, dz);
-        for (int i = 0; i < n; i++)
-            dw[i] = ws->rows[i] - w[i] - ws->diag[i] * dz[i];
-        a = IPM_STEP * step_to_boundary(n, z, dz, w, dw);
+        factor_solve(ws, n, dz);
+        a = IPM_STEP * step_to_boundary(n, z, dz, w, ws->diag, ws->rows, dw);
         for (int i = 0; i < n; i++) {
             z[i] += a * dz[i];
             w[i] += a * dw[i];
@@ -413,30 +626,40 @@ int pd_bpp_solve(pd_bpp_work *ws, const pd_matrix *M, const double *q, const pd_
     info->iterations = 0;
     info->outcome = PD_LCP_NUMERICAL;
     for (int i = 0; i < n; i++) {
-        ws->diag[i] = pd_matrix_get(M, i, i);
-        ds = fmax(ds, ws->diag[i]);
-        if (!(ws->diag[i] > 0.0))
+        ws->mii[i] = pd_matrix_get(M, i, i);
+        ds = fmax(ds, ws->mii[i]);
+        if (!(ws->mii[i] > 0.0))
             return PD_ENUMERICAL; /* not positive definite: not this solver's problem */
     }
     /* from the guess (a warm start), or from the signs of q */
     for (int i = 0; i < n; i++)
         ws->inF[i] = o->guess && o->guess[i] < 2 ? o->guess[i] : q[i] < 0.0;
-    rc = pivot_rounds(ws, M, q, maxit < BPP_WARM_ROUNDS ? maxit : BPP_WARM_ROUNDS, z, w, flag,
-                      &its);
+    int rounds = o->guess ? BPP_WARM_ROUNDS : 1; /* cold: one try from the signs of q */
+    rc = pivot_rounds(ws, M, q, maxit < rounds ? maxit : rounds, z, w, flag, &its);
     if (rc == 0 && accept(ws, M, q, z, w, info))
         goto solved;
-    /* the interior point: its support hands over to the pivoting; if that
-     * fails (a singular M_FF: redundant contacts), the point itself, driven
-     * further, is the answer when it verifies */
-    int ipm = qs > 0.0 ? interior_point(ws, M, q, qs, ds, IPM_MU_TOL, 1) : -1;
-    if (ipm >= 0) {
-        its += ipm;
-        for (int i = 0; i < n; i++) /* the support: z_i M_ii > w_i, in the units of w */
-            ws->inF[i] = ws->iz[i] * pd_matrix_get(M, i, i) > ws->iw[i];
-        rc = pivot_rounds(ws, M, q, maxit > its ? maxit - its : 1, z, w, flag, &its);
+    /* the interior point: its support, once stable, hands over to the
+     * pivoting (IPM_CROSSINGS tries, then to convergence); if that fails (a
+     * singular M_FF: redundant contacts), the point itself, driven further,
+     * is the answer when it verifies */
+    int ipm = -1;
+    for (int t = 0; qs > 0.0 && t <= IPM_CROSSINGS; t++) {
+        int more = interior_point(ws, M, q, qs, ds, IPM_MU_TOL, t == 0, t < IPM_CROSSINGS);
+        if ((ipm = more) < 0)
+            break;
+        its += more;
+        if (!ws->crossed)
+            ipm_support(ws, n);
+        memcpy(ws->inF, ws->sup, (size_t)n);
+        int left = maxit > its ? maxit - its : 1;
+        rc = pivot_rounds(ws, M, q, ws->crossed && left > 2 ? 2 : left, z, w, flag, &its);
         if (rc == 0 && accept(ws, M, q, z, w, info))
             goto solved;
-        int more = interior_point(ws, M, q, qs, ds, IPM_MU_FINAL, 0);
+        if (!ws->crossed)
+            break;
+    }
+    if (ipm >= 0) {
+        int more = interior_point(ws, M, q, qs, ds, IPM_MU_FINAL, 0, 0);
         its += more > 0 ? more : 0;
         memcpy(z, ws->iz, (size_t)n * sizeof(double));
         if (more >= 0 && accept(ws, M, q, z, w, info))

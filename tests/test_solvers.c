@@ -82,6 +82,68 @@ static void test_solvers_match_oracle(pd_test_ctx *ctx)
     CHECK(ctx, cases == 200, "%d cases", cases);
 }
 
+/* M = B^T B + I / 4 with B upper triangular of `band` + 1 diagonals (so M
+ * has bandwidth `band`, off-diagonal entries of both signs) in compressed
+ * columns, and q, from a seed. */
+static int banded_spd(int n, int band, uint64_t seed, int *colptr, int *rowind, double *values,
+                      double *dense, double *q)
+{
+    double B[100] = {0};
+    uint64_t s = seed;
+    for (int j = 0; j < n; j++)
+        for (int i = j - band > 0 ? j - band : 0; i <= j; i++)
+            B[i + j * n] = rnd(&s);
+    int k = 0;
+    for (int j = 0; j < n; j++) {
+        colptr[j] = k;
+        for (int i = 0; i < n; i++) {
+            double x = i == j ? 0.25 : 0.0;
+            for (int r = 0; r < n; r++)
+                x += B[r + i * n] * B[r + j * n];
+            dense[i + j * n] = abs(i - j) <= band ? x : 0.0;
+            if (abs(i - j) <= band) {
+                rowind[k] = i;
+                values[k++] = x;
+            }
+        }
+        q[j] = 2.0 * rnd(&s);
+    }
+    colptr[n] = k;
+    return k;
+}
+
+/* Banded SPD problems in compressed columns, n = 1..10, bandwidth 1
+ * (the twisted factorisation of tridiagonal blocks, odd and even sizes)
+ * and 2 (the envelope): the structured solver gives the oracle's solution,
+ * itself, not through Lemke. */
+static void test_solvers_banded_oracle(pd_test_ctx *ctx)
+{
+    int cases = 0;
+    for (int band = 1; band <= 2; band++)
+        for (int n = 1; n <= 10; n++)
+            for (uint64_t seed = 1; seed <= 20; seed++) {
+                int colptr[11], rowind[100];
+                double values[100], dense[100], q[10], zo[10], wo[10], z[10], w[10];
+                banded_spd(n, band, seed * 131 + (uint64_t)(n + 17 * band), colptr, rowind,
+                           values, dense, q);
+                pd_matrix M = pd_matrix_csc(n, n, colptr, rowind, values);
+                if (!CHECK(ctx, pd_lcp_enumerate(n, dense, q, zo, wo) == PD_OK, "oracle n %d", n))
+                    continue;
+                cases++;
+                pd_lcp_info info;
+                int st = solve_with(PD_LCP_STRUCTURED, &M, q, NULL, z, w, &info);
+                double d = 0.0, zs = 0.0;
+                for (int i = 0; i < n; i++) {
+                    d = fmax(d, fabs(z[i] - zo[i]));
+                    zs = fmax(zs, fabs(zo[i]));
+                }
+                CHECK(ctx, st == PD_OK && !strcmp(info.solver, "structured") && d <= 1e-9 * fmax(zs, 1e-300),
+                      "band %d, n %d seed %llu: status %d (%s), |z - z_oracle| %.3g", band, n,
+                      (unsigned long long)seed, st, info.solver, d);
+            }
+    CHECK(ctx, cases == 400, "%d cases", cases);
+}
+
 /* n <= 2: Lemke answers by the closed forms (no pivot) what its pivoting
  * and the oracle answer, on P-matrices of both signs of the off-diagonal. */
 static void test_solvers_closed_forms(pd_test_ctx *ctx)
@@ -336,6 +398,7 @@ static void test_solvers_dump_resolved(pd_test_ctx *ctx)
 void suite_solvers(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_solvers_match_oracle);
+    PD_RUN(ctx, test_solvers_banded_oracle);
     PD_RUN(ctx, test_solvers_closed_forms);
     PD_RUN(ctx, test_solvers_chains);
     PD_RUN(ctx, test_solvers_degenerate);
