@@ -62,7 +62,7 @@ $(BUILD)/%.o: %.c $(HDRS)
 
 $(BUILD)/libpound.a: $(LIB_OBJ)
 	@echo "  AR    $@"
-	@rm -f $@ && ar rcs $@ $^
+	@rm -f $@ && $(AR) rcs $@ $^
 
 $(BUILD)/pound: $(CLI_OBJ) $(BUILD)/libpound.a
 	@echo "  LD    $@"

@@ -2,8 +2,10 @@
  * on the Siconos test set (when ../shared/data/lcp/siconos is there) and on
  * the Moreau–Jean Delassus LCPs of a chain of N unit masses pounding each
  * other (D tridiagonal, 2 on the diagonal, -1 beside it, q uniform in
- * [-1, 1) from a fixed seed; compressed columns for the structured solver
- * and PGS, dense for Lemke up to N = 500).  Each solve is repeated in
+ * [-1, 1) from CHAIN_SEEDS fixed seeds -- the iterations of a cold solve
+ * vary with q, so a chain's figures are means over the seeds (PGS: the
+ * first seed only); compressed columns for the structured solver and PGS,
+ * dense for Lemke up to N = 500).  Each solve is repeated in
  * batches of at least BENCH_BATCH_S; the figure is the median over at least
  * BENCH_MIN_RUNS batches and BENCH_MIN_S seconds (3 runs once a solve takes
  * longer than BENCH_LONG_S), divided by the batch size.  Solves are cold
@@ -26,6 +28,7 @@
 #define BENCH_MAX_FILES 256
 #define BENCH_PGS_SWEEPS 2000 /* PGS's budget on the chains: its residual is reported */
 #define CHAIN_SEED 20240611u
+#define CHAIN_SEEDS 5
 
 /* Reference figures (µs) of a widely used lexicographic Lemke on this machine class. */
 typedef struct bench_ref {
@@ -163,9 +166,9 @@ static void chain_free(chain *c)
     free(c->q);
 }
 
-static int chain_make(chain *c, int N, int with_dense)
+static int chain_make(chain *c, int N, int with_dense, int seed)
 {
-    uint64_t state = CHAIN_SEED + (uint64_t)N;
+    uint64_t state = CHAIN_SEED + (uint64_t)N + 1000003u * (uint64_t)seed;
     memset(c, 0, sizeof *c);
     c->N = N;
     c->colptr = malloc(((size_t)N + 1) * sizeof(int));
@@ -192,32 +195,57 @@ static int chain_make(chain *c, int N, int with_dense)
     return 0;
 }
 
+/* The mean of a solver's figures over the seeds of a chain into row; 1 on
+ * a failure (Lemke or structured not solving is one). */
+static int measure_seeds(pd_lcp_method method, int N, int seeds, bench_row *row)
+{
+    int failed = 0;
+    double us = 0.0, iterations = 0.0, pivots = 0.0, residual = 0.0;
+    for (int s = 0; s < seeds; s++) {
+        chain c;
+        bench_row one = *row;
+        if (chain_make(&c, N, method == PD_LCP_LEMKE, s)) {
+            chain_free(&c);
+            return 1;
+        }
+        pd_matrix dense = pd_matrix_dense(N, N, c.dense);
+        pd_matrix csc = pd_matrix_csc(N, N, c.colptr, c.rowind, c.values);
+        failed |= measure(method, method == PD_LCP_LEMKE ? &dense : &csc, c.q,
+                          method == PD_LCP_PGS ? BENCH_PGS_SWEEPS : 0, &one);
+        failed |= method != PD_LCP_PGS && one.outcome != PD_LCP_SOLVED;
+        us += one.median_us / seeds;
+        iterations += (double)one.iterations / seeds;
+        pivots += (double)one.pivots / seeds;
+        residual = fmax(residual, one.residual);
+        if (s == 0 || one.outcome != PD_LCP_SOLVED)
+            row->outcome = one.outcome;
+        row->n = one.n;
+        row->solver = one.solver;
+        row->ref_us = one.ref_us;
+        chain_free(&c);
+    }
+    row->median_us = us;
+    row->iterations = (int)lround(iterations);
+    row->pivots = (int)lround(pivots);
+    row->residual = residual;
+    return failed;
+}
+
 /* Lemke (dense, N <= 500), structured and PGS (compressed columns). */
 static void bench_chains(bench_report *rep)
 {
     static const int sizes[] = {10, 100, 200, 500, 1000, 10000, 100000};
-    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
-        int N = sizes[k];
-        chain c;
-        if (chain_make(&c, N, N <= 500)) {
-            chain_free(&c);
-            rep->failed = 1;
-            continue;
-        }
-        pd_matrix dense = pd_matrix_dense(N, N, c.dense);
-        pd_matrix csc = pd_matrix_csc(N, N, c.colptr, c.rowind, c.values);
-        const pd_lcp_method methods[] = {PD_LCP_LEMKE, PD_LCP_STRUCTURED, PD_LCP_PGS};
+    const pd_lcp_method methods[] = {PD_LCP_LEMKE, PD_LCP_STRUCTURED, PD_LCP_PGS};
+    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++)
         for (int m = 0; m < 3; m++) {
-            if (m == 0 && N > 500)
+            int N = sizes[k];
+            if (methods[m] == PD_LCP_LEMKE && N > 500)
                 continue;
             bench_row *row = &rep->rows[rep->nrows++];
             snprintf(row->name, sizeof row->name, "chain_%d", N);
-            rep->failed |= measure(methods[m], m ? &csc : &dense, c.q,
-                                   m == 2 ? BENCH_PGS_SWEEPS : 0, row);
-            rep->failed |= m < 2 && row->outcome != PD_LCP_SOLVED;
+            rep->failed |= measure_seeds(methods[m], N,
+                                         methods[m] == PD_LCP_PGS ? 1 : CHAIN_SEEDS, row);
         }
-        chain_free(&c);
-    }
 }
 
 /* Least-squares slope of log(us) against log(n) of a solver's chains with
@@ -338,7 +366,8 @@ static void print_table(const bench_report *rep)
         else
             printf(" %9s %7s\n", "-", "-");
     }
-    printf("ratio = ours / a widely used lexicographic Lemke measured on this machine class\n");
+    printf("chains: means over %d right-hand sides q (pgs: one); ratio = ours / a widely used "
+           "lexicographic Lemke measured on this machine class\n", CHAIN_SEEDS);
     printf("growth exponent of the time on chains, N = 1e3 ... 1e5: structured %.3f, pgs (%d "
            "sweeps) %.3f\n",
            growth(rep, "structured", 1000, 100000), BENCH_PGS_SWEEPS,

@@ -83,5 +83,6 @@ void pd_json_finish(pd_json *js); /* newline after the top-level value */
  * that js has open.  Return 0, or 1 when a benchmark run failed. */
 int pd_bench_lcp(pd_json *js, const char *shared_dir);
 int pd_bench_engine(pd_json *js);
+int pd_bench_scene(pd_json *js);
 
 #endif

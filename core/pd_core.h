@@ -62,6 +62,13 @@ double pd_cpu_seconds(void);
 /* Standard gravity [m/s^2], for records given in g. */
 #define PD_G_STANDARD 9.80665
 
+/* The larger of two numbers known not to be NaN: inlined, where a call to
+ * fmax (which must treat NaN) would cost more than the comparison. */
+static inline double pd_max(double a, double b)
+{
+    return a > b ? a : b;
+}
+
 /* ---- interpolation --------------------------------------------------------- */
 
 /* The quintic Hermite interpolant on a step of length h through (f, f', f'')

@@ -352,18 +352,26 @@ static int solve_contacts(pd_mj *mj, int nI, const double *vfree, pd_err *err)
                           "Moreau-Jean: %d active contacts at t = %.9g: the lemke LCP solver "
                           "takes at most %d (use the structured one)",
                           nI, mj->st.t + mj->opts.h, PD_LCP_LEMKE_NMAX);
-    if (mj->sparse) {
+    if (mj->sparse)
         pd_factor_delassus_csc(mj->factor, mj->idx_active, nI, mj->D_colptr, mj->D_rowind,
                                mj->D_active);
-        D = pd_matrix_csc(nI, nI, mj->D_colptr, mj->D_rowind, mj->D_active);
-    } else {
+    else
         pd_factor_delassus_dense(mj->factor, mj->idx_active, nI, mj->D_active);
-        D = pd_matrix_dense(nI, nI, mj->D_active);
-    }
     for (int r = 0; r < nI; r++) {
         int a = mj->idx_active[r];
         mj->b_active[r] = pd_matrix_col_dot(&md->W, a, vfree) + md->e[a] * mj->U0[a];
     }
+    /* one contact, the solver left to choose, nobody watching: the closed
+     * form of the scalar kernel (D_11 > 0 as What is positive definite) */
+    if (nI == 1 && mj->opts.lcp_solver == PD_LCP_AUTO && !mj->opts.on_lcp &&
+        (!mj->sparse || mj->D_colptr[1] == 1) && mj->D_active[0] > 0.0) {
+        mj->st.P[mj->idx_active[0]] = mj->P_active[0] =
+            pd_contact_impulse_1(mj->D_active[0], mj->b_active[0]);
+        mj->st.lcp_solver = "closed-form";
+        return PD_OK;
+    }
+    D = mj->sparse ? pd_matrix_csc(nI, nI, mj->D_colptr, mj->D_rowind, mj->D_active)
+                   : pd_matrix_dense(nI, nI, mj->D_active);
     int st = pd_lcp_solve(mj->lcp, &D, mj->b_active, &lo, mj->P_active, mj->w_active, &info);
     mj->st.lcp_pivots = info.pivots + info.iterations;
     mj->st.lcp_solver = info.solver;

@@ -47,7 +47,7 @@ typedef struct lemke_state {
     int n;
     const double *M, *q, *d;
     double tol;        /* relative tolerance for ties and tiny pivots */
-    double qmax, mmax; /* max|q|, max|M| */
+    double qmax;       /* max|q| */
     pd_lcp_work *ws;
 } lemke_state;
 
@@ -123,11 +123,18 @@ static double max2(double a, double b)
 }
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-/* AVX2 and baseline builds of the O(n k) kernels, picked once at load time. */
-#define LEMKE_KERNEL __attribute__((target_clones("avx2", "default")))
+/* AVX2 and baseline builds of the pivoting loop (its O(n k) kernels inlined
+ * into it), picked once at load time: one indirect call per solve. */
+#define LEMKE_KERNEL                                                                      \
+    __attribute__((target_clones("avx2", "default"), optimize("no-tree-loop-distribute-patterns")))
+/* Short loops stay loops (a call to memset or memcpy costs more for small n). */
+#define LEMKE_LOOPS __attribute__((optimize("no-tree-loop-distribute-patterns")))
 #else
 #define LEMKE_KERNEL
+#define LEMKE_LOOPS
 #endif
+/* The work of a pivot, inlined into the pivoting loop (and so into each build of it). */
+#define LEMKE_INLINE static inline __attribute__((always_inline))
 
 /* y <- y - t x; unrolled by four so that -O2 vectorises it. */
 static inline __attribute__((always_inline)) void axpy_minus(int n, double t,
@@ -146,11 +153,11 @@ static inline __attribute__((always_inline)) void axpy_minus(int n, double t,
 }
 
 /* out = B^-1 v, taking B^-1[:,i] = e_row(w_i) for every basic w_i. */
-LEMKE_KERNEL
-static void binv_times(int n, const double *binv, const int *row_of, const double *v,
+LEMKE_INLINE void binv_times(int n, const double *binv, const int *row_of, const double *v,
                        double *restrict out)
 {
-    memset(out, 0, (size_t)n * sizeof(double));
+    for (int r = 0; r < n; r++)
+        out[r] = 0.0;
     for (int i = 0; i < n; i++) {
         double vi = v[i];
         if (vi == 0.0)
@@ -165,15 +172,14 @@ static void binv_times(int n, const double *binv, const int *row_of, const doubl
 
 /* B^-1 <- E B^-1 for the pivot (r, col): row r divided by col_r, col_i/col_r
  * times row r taken from every other row; columns with B^-1[r,c] = 0 stay. */
-LEMKE_KERNEL
-static void eta_update(int n, double *binv, const double *restrict col, int r)
+LEMKE_INLINE void eta_update(int n, double *binv, const double *restrict col, int r)
 {
-    double p = col[r];
+    double rp = 1.0 / col[r]; /* one division per pivot, not one per column */
     for (int c = 0; c < n; c++) {
         double *restrict bc = binv + (size_t)c * n;
         if (bc[r] == 0.0)
             continue;
-        double t = bc[r] / p;
+        double t = bc[r] * rp;
         axpy_minus(n, t, col, bc);
         bc[r] = t;
     }
@@ -228,18 +234,25 @@ static int first_leaving_row(const lemke_state *st)
     return best;
 }
 
-/* col = B^-1 a_e: column e of B^-1 for w_e, -B^-1 M[:,j] for z_j, -B^-1 d for z0. */
-static void entering_column(const lemke_state *st, int var)
+/* col = B^-1 a_e: column e of B^-1 for w_e, -B^-1 M[:,j] for z_j, -B^-1 d
+ * for z0; returns max|col| (NaN when an entry is NaN). */
+LEMKE_INLINE double entering_column(const lemke_state *st, int var)
 {
     int n = st->n;
     pd_lcp_work *ws = st->ws;
-    if (var < n) {
-        memcpy(ws->col, ws->binv + (size_t)var * n, (size_t)n * sizeof(double));
-        return;
+    double *col = ws->col, cmax = 0.0;
+    int nan = 0;
+    if (var < n)
+        for (int i = 0; i < n; i++)
+            col[i] = ws->binv[i + (size_t)var * n];
+    else
+        binv_times(n, ws->binv, ws->row_of, data_column(st, var), col);
+    for (int i = 0; i < n; i++) {
+        col[i] = var < n ? col[i] : -col[i];
+        cmax = max2(cmax, fabs(col[i]));
+        nan |= isnan(col[i]);
     }
-    binv_times(n, ws->binv, ws->row_of, data_column(st, var), ws->col);
-    for (int i = 0; i < n; i++)
-        ws->col[i] = -ws->col[i];
+    return nan ? NAN : cmax;
 }
 
 /* Keep the tied rows t with B^-1[t,c]/col_t within eq_c of the smallest, for a
@@ -298,7 +311,7 @@ static int lex_choice(const lemke_state *st, int nties)
 /* The blocking row among col_i > ptol: theta = min max(x_i, 0)/col_i; rows whose
  * x_i - theta col_i is within tol*xscale of zero tie; z0 leaves if it ties,
  * else the lexicographic rule decides.  -1 if no entry exceeds ptol. */
-static int blocking_row(const lemke_state *st, double ptol)
+LEMKE_INLINE int blocking_row(const lemke_state *st, double ptol)
 {
     int n = st->n;
     pd_lcp_work *ws = st->ws;
@@ -332,10 +345,9 @@ static int blocking_row(const lemke_state *st, double ptol)
  * but some exceed roundoff (8 n eps max|col|), those are used rather than
  * declaring a ray on a column that is merely small.  Returns the row,
  * RATIO_RAY (no positive entry above roundoff) or RATIO_NUMERICAL. */
-static int ratio_test(const lemke_state *st)
+LEMKE_INLINE int ratio_test(const lemke_state *st, double colmax)
 {
     int n = st->n;
-    double colmax = pd_lcp_max_abs(n, st->ws->col);
     if (!isfinite(colmax))
         return RATIO_NUMERICAL;
     int r = blocking_row(st, st->tol * colmax);
@@ -346,7 +358,7 @@ static int ratio_test(const lemke_state *st)
 
 /* Gauss–Jordan pivot on (r, col): x_B <- E x_B, B^-1 <- E B^-1 with the eta
  * matrix E.  Returns -1 (nothing changed) if the new basic value overflows. */
-static int pivot(const lemke_state *st, int r, int entering)
+LEMKE_INLINE int pivot(const lemke_state *st, int r, int entering)
 {
     int n = st->n;
     pd_lcp_work *ws = st->ws;
@@ -362,18 +374,19 @@ static int pivot(const lemke_state *st, int r, int entering)
     ws->row_of[entering] = r;
     if (entering < n) { /* B^-1 e_i = e_r exactly once w_i is basic in row r */
         double *be = ws->binv + (size_t)entering * n;
-        memset(be, 0, (size_t)n * sizeof(double));
-        be[r] = 1.0;
+        for (int i = 0; i < n; i++)
+            be[i] = i == r ? 1.0 : 0.0;
     }
     return 0;
 }
 
 /* res = q - B x_B with the explicit basis columns (e_i, -M[:,j], -d). */
-static void basis_residual(const lemke_state *st, double *res)
+LEMKE_INLINE void basis_residual(const lemke_state *st, double *res)
 {
     int n = st->n;
     const pd_lcp_work *ws = st->ws;
-    memcpy(res, st->q, (size_t)n * sizeof(double));
+    for (int i = 0; i < n; i++)
+        res[i] = st->q[i];
     for (int r = 0; r < n; r++) {
         int v = ws->basis[r];
         double x = ws->xb[r];
@@ -388,7 +401,7 @@ static void basis_residual(const lemke_state *st, double *res)
 }
 
 /* x_B <- x_B + B^-1 (q - B x_B): one step of iterative refinement. */
-static void refine(const lemke_state *st)
+LEMKE_INLINE void refine(const lemke_state *st)
 {
     int n = st->n;
     pd_lcp_work *ws = st->ws;
@@ -457,6 +470,7 @@ static int polish(const lemke_state *st, double *z)
 }
 
 /* The pivoting loop from B = I until z0 leaves, a ray, or the cap. */
+LEMKE_KERNEL
 static pd_lcp_outcome run_pivots(const lemke_state *st, int cap, int *pivots)
 {
     int n = st->n, z0 = 2 * n;
@@ -474,8 +488,7 @@ static pd_lcp_outcome run_pivots(const lemke_state *st, int cap, int *pivots)
             return PD_LCP_MAX_PIVOTS;
         if (*pivots % LEMKE_REFINE_EVERY == 0)
             refine(st);
-        entering_column(st, entering);
-        r = ratio_test(st);
+        r = ratio_test(st, entering_column(st, entering));
         if (r == RATIO_RAY)
             return PD_LCP_NO_SOLUTION;
         if (r == RATIO_NUMERICAL)
@@ -491,7 +504,10 @@ static pd_lcp_outcome run_pivots(const lemke_state *st, int cap, int *pivots)
 
 /* A claimed solution: x_B refined until it verifies (at most LEMKE_FINAL_REFINES
  * times), else recomputed from the support (polish); the better of the two is
- * returned, as solved if it verifies, as numerical otherwise. */
+ * returned, as solved if it verifies, as numerical otherwise.  The first
+ * refinement is never skipped: it buys forward accuracy on ill-conditioned
+ * bases that the backward residual alone would accept. */
+LEMKE_LOOPS
 static pd_lcp_outcome finish_solved(const lemke_state *st, double *z, double *w,
                                     pd_lcp_info *info)
 {
@@ -532,12 +548,12 @@ static double scan_max_abs(int count, const double *x, int *finite)
     return pd_lcp_max_abs(count, x);
 }
 
-/* max|q| and max|M|; 0 if every entry is finite. */
+/* max|q|; 0 if every entry of q and M is finite. */
 static int scan_data(lemke_state *st)
 {
     int finite = 1;
     st->qmax = scan_max_abs(st->n, st->q, &finite);
-    st->mmax = scan_max_abs(st->n * st->n, st->M, &finite);
+    scan_max_abs(st->n * st->n, st->M, &finite);
     return finite ? 0 : -1;
 }
 

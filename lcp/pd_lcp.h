@@ -121,8 +121,11 @@ const char *pd_lcp_method_list(void);
 
 /* A solver for problems of up to nmax unknowns whose sparse matrices store
  * up to nnzmax entries (0: the caller passes dense matrices only).  Lemke
- * and the hand-over to it take a dense workspace of min(nmax,
- * PD_LCP_LEMKE_NMAX)^2.  NULL on failure, with the reason in err. */
+ * takes a dense workspace of min(nmax, PD_LCP_LEMKE_NMAX)^2; the hand-over
+ * of the structured solver on sparse matrices (auto, structured with
+ * nnzmax > 0) one of min(nmax, PD_LCP_HANDOVER_NMAX)^2, so that a long row
+ * never pays the square of its length.  NULL on failure, with the reason
+ * in err. */
 pd_lcp_solver *pd_lcp_solver_alloc(pd_lcp_method method, int nmax, long nnzmax, pd_err *err);
 void pd_lcp_solver_free(pd_lcp_solver *s);
 int pd_lcp_solver_nmax(const pd_lcp_solver *s);
@@ -130,6 +133,8 @@ int pd_lcp_solver_nmax(const pd_lcp_solver *s);
 /* Most unknowns Lemke takes inside the solver table (its workspace grows as
  * the square): larger problems go to the structured solver or PGS. */
 #define PD_LCP_LEMKE_NMAX 2048
+/* Most unknowns the structured solver hands over to Lemke on sparse input. */
+#define PD_LCP_HANDOVER_NMAX 256
 
 /* Solve (M, q), M square (dense or CSC) with n <= nmax: PD_OK only for a
  * verified solution; PD_ENOSOLUTION, PD_EMAXPIVOTS, PD_EMAXITER,

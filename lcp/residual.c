@@ -68,23 +68,23 @@ static void affine_rows(const pd_matrix *M, const double *q, const double *z, do
 void pd_lcp_verify(const pd_matrix *M, const double *q, const double *z, double *w, double *rows,
                    pd_lcp_info *info)
 {
-    int n = M->rows;
+    int n = M->rows, nan = 0;
     double zs = pd_lcp_max_abs(n, z), comp = 0.0, infeas = 0.0, rel = 0.0, scale = 0.0;
     affine_rows(M, q, z, w, rows);
-    for (int i = 0; i < n; i++) {
-        double c = fabs(z[i] * w[i]), zi = ratio(fabs(z[i]), zs), wi = ratio(fabs(w[i]), rows[i]);
-        comp = c > comp || isnan(c) ? c : comp;
-        infeas = -z[i] > infeas || isnan(z[i]) ? -z[i] : infeas;
-        infeas = -w[i] > infeas || isnan(w[i]) ? -w[i] : infeas;
-        double v = fmax(wi < zi ? wi : zi, fmax(z[i] < 0.0 ? zi : 0.0, w[i] < 0.0 ? wi : 0.0));
-        rel = v > rel || isnan(v) || isnan(z[i]) || isnan(w[i]) ? (isnan(v) ? NAN : v) : rel;
-        scale = fmax(scale, rows[i]);
-        if (isnan(rel))
-            break;
+    for (int i = 0; i < n; i++) { /* NaN compares false: caught apart, once */
+        double za = fabs(z[i]), wa = fabs(w[i]), zi = ratio(za, zs), wi = ratio(wa, rows[i]);
+        double v = wi < zi ? wi : zi;
+        nan |= isnan(z[i]) || isnan(w[i]);
+        comp = pd_max(comp, za * wa);
+        infeas = pd_max(infeas, pd_max(-z[i], -w[i]));
+        v = z[i] < 0.0 ? pd_max(v, zi) : v;
+        v = w[i] < 0.0 ? pd_max(v, wi) : v;
+        rel = pd_max(rel, v);
+        scale = pd_max(scale, rows[i]);
     }
-    info->complementarity = comp;
-    info->infeasibility = isnan(infeas) ? NAN : fmax(infeas, 0.0);
-    info->residual = rel;
+    info->complementarity = nan ? NAN : comp;
+    info->infeasibility = nan ? NAN : infeas;
+    info->residual = nan ? NAN : rel;
     info->scale = scale;
 }
 

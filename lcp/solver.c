@@ -87,7 +87,8 @@ pd_lcp_solver *pd_lcp_solver_alloc(pd_lcp_method method, int nmax, long nnzmax, 
         goto oom;
     s->type = type;
     s->nmax = nmax;
-    s->lemke_nmax = nmax < PD_LCP_LEMKE_NMAX ? nmax : PD_LCP_LEMKE_NMAX;
+    int cap = method != PD_LCP_LEMKE && nnzmax > 0 ? PD_LCP_HANDOVER_NMAX : PD_LCP_LEMKE_NMAX;
+    s->lemke_nmax = nmax < cap ? nmax : cap;
     if (type->lemke) {
         size_t ln = (size_t)s->lemke_nmax;
         if (!(s->lemke = pd_lcp_alloc(s->lemke_nmax)) ||

@@ -277,6 +277,8 @@ typedef struct pd_scene {
     int n;               /* degrees of freedom (after pd_scene_finish) */
     int finished;
     int cap_struct, cap_contact; /* allocated entries */
+    int *names;          /* name_cap slots: structure index + 1 by name hash, 0 empty */
+    int name_cap;
 } pd_scene;
 
 /* An empty scene excited by exc; NULL when out of memory. */

@@ -34,6 +34,7 @@ void pd_scene_free(pd_scene *sc)
     }
     free(sc->st);
     free(sc->ct);
+    free(sc->names);
     free(sc);
 }
 
@@ -68,14 +69,51 @@ pd_scene *pd_scene_copy(const pd_scene *sc)
     return c;
 }
 
+/* FNV-1a hash of a name. */
+static unsigned name_hash(const char *name)
+{
+    unsigned h = 2166136261u;
+    for (const unsigned char *c = (const unsigned char *)name; *c; c++)
+        h = (h ^ *c) * 16777619u;
+    return h;
+}
+
+/* The slot of name in the table: its structure's, or the empty one it
+ * would take (the table is never full). */
+static int name_slot(const pd_scene *sc, const char *name)
+{
+    unsigned mask = (unsigned)sc->name_cap - 1u, k = name_hash(name) & mask;
+    while (sc->names[k] && strcmp(sc->st[sc->names[k] - 1].name, name))
+        k = (k + 1u) & mask;
+    return (int)k;
+}
+
+/* Room in the name table for one more structure, at most half full:
+ * rebuilt twice as large when needed.  PD_OK or PD_ENOMEM. */
+static int names_grow(pd_scene *sc)
+{
+    if (2 * (sc->nstruct + 1) <= sc->name_cap)
+        return PD_OK;
+    int cap = sc->name_cap ? 2 * sc->name_cap : 64, *old = sc->names;
+    if (!(sc->names = calloc((size_t)cap, sizeof(int)))) {
+        sc->names = old;
+        return PD_ENOMEM;
+    }
+    free(old);
+    sc->name_cap = cap;
+    for (int s = 0; s < sc->nstruct; s++)
+        sc->names[name_slot(sc, sc->st[s].name)] = s + 1;
+    return PD_OK;
+}
+
 int pd_scene_find(const pd_scene *sc, const char *name)
 {
     if (!strcmp(name, "wall"))
         return PD_WALL;
-    for (int s = 0; s < sc->nstruct; s++)
-        if (!strcmp(sc->st[s].name, name))
-            return s;
-    return -2;
+    if (sc->name_cap == 0)
+        return -2;
+    int k = sc->names[name_slot(sc, name)];
+    return k ? k - 1 : -2;
 }
 
 /* Room for one more structure (with its storey arrays) or contact. */
@@ -121,7 +159,8 @@ static pd_structure *new_structure(pd_scene *sc, const char *name, int storeys, 
         pd_err_set(err, PD_EINVAL, "xi: the damping ratio must be in [0, 1) (got %g)", xi);
         return NULL;
     }
-    if (grow((void **)&sc->st, &sc->cap_struct, sc->nstruct + 1, sizeof *sc->st)) {
+    if (grow((void **)&sc->st, &sc->cap_struct, sc->nstruct + 1, sizeof *sc->st) ||
+        names_grow(sc)) {
         pd_err_set(err, PD_ENOMEM, "out of memory for structure '%s'", name);
         return NULL;
     }
@@ -141,6 +180,7 @@ static pd_structure *new_structure(pd_scene *sc, const char *name, int storeys, 
     st->damping = PD_DAMPING_RAYLEIGH;
     st->modes[0] = 1;
     st->modes[1] = 2;
+    sc->names[name_slot(sc, st->name)] = sc->nstruct + 1;
     sc->nstruct++;
     sc->finished = 0;
     return st;

@@ -139,10 +139,10 @@ static void note_point(track *tr, double t, const double *x)
         return;
     for (int i = 0; i < tr->n; i++) {
         double d = x[i] - (tr->below[i] >= 0 ? x[tr->below[i]] : 0.0);
-        tr->xmax[i] = fmax(tr->xmax[i], fabs(x[i]));
-        tr->xpos[i] = fmax(tr->xpos[i], x[i]);
-        tr->xneg[i] = fmax(tr->xneg[i], -x[i]);
-        tr->drift[i] = fmax(tr->drift[i], fabs(d));
+        tr->xmax[i] = pd_max(tr->xmax[i], fabs(x[i]));
+        tr->xpos[i] = pd_max(tr->xpos[i], x[i]);
+        tr->xneg[i] = pd_max(tr->xneg[i], -x[i]);
+        tr->drift[i] = pd_max(tr->drift[i], fabs(d));
     }
 }
 
@@ -152,7 +152,7 @@ static void note_approach(track *tr, const double *x)
     for (int a = 0; a < tr->m; a++) {
         double xa = tr->dof_a[a] >= 0 ? x[tr->dof_a[a]] : 0.0;
         double xb = tr->dof_b[a] >= 0 ? x[tr->dof_b[a]] : 0.0;
-        tr->approach[a] = fmax(tr->approach[a], xa - xb);
+        tr->approach[a] = pd_max(tr->approach[a], xa - xb);
     }
 }
 
@@ -187,18 +187,18 @@ static void note_between(track *tr, double t, const double *x, const double *v,
         double p0[3] = {tr->px[i], tr->pv[i], tr->pa[i]}, p1[3] = {x[i], v[i], acc[i]};
         int b = tr->below[i];
         if (interior_turn(p0, p1, h, &f)) {
-            tr->xmax[i] = fmax(tr->xmax[i], fabs(f));
-            tr->xpos[i] = fmax(tr->xpos[i], f);
-            tr->xneg[i] = fmax(tr->xneg[i], -f);
+            tr->xmax[i] = pd_max(tr->xmax[i], fabs(f));
+            tr->xpos[i] = pd_max(tr->xpos[i], f);
+            tr->xneg[i] = pd_max(tr->xneg[i], -f);
             if (b < 0) /* storey 1: the drift is the displacement */
-                tr->drift[i] = fmax(tr->drift[i], fabs(f));
+                tr->drift[i] = pd_max(tr->drift[i], fabs(f));
         }
         if (b < 0)
             continue;
         double d0[3] = {tr->px[i] - tr->px[b], tr->pv[i] - tr->pv[b], tr->pa[i] - tr->pa[b]};
         double d1[3] = {x[i] - x[b], v[i] - v[b], acc[i] - acc[b]};
         if (interior_turn(d0, d1, h, &f))
-            tr->drift[i] = fmax(tr->drift[i], fabs(f));
+            tr->drift[i] = pd_max(tr->drift[i], fabs(f));
     }
 }
 
@@ -283,7 +283,7 @@ static int observe_moreau(const pd_state *st, void *ctx)
             }
             tr->impacts[a] += !tr->touching[a];
             tr->ctime[a] += tr->h;
-            tr->maxP[a] = fmax(tr->maxP[a], P);
+            tr->maxP[a] = pd_max(tr->maxP[a], P);
         }
         tr->touching[a] = P > 0.0;
         tr->imp[a] += P;
@@ -309,7 +309,7 @@ static int step_event(const pd_state *st, void *ctx)
             tr->ctime[a] += st->t - tr->pt;
         if (P > 0.0) {
             tr->impacts[a]++;
-            tr->maxP[a] = fmax(tr->maxP[a], P);
+            tr->maxP[a] = pd_max(tr->maxP[a], P);
             tr->imp[a] += P;
             if (isnan(tr->first[a]))
                 tr->first[a] = st->t;
@@ -334,7 +334,7 @@ static int step_penalty(const pd_state *st, void *ctx)
         if (tr->pactive[a])
             tr->ctime[a] += dt;
         tr->episode[a] += tr->pactive[a] ? di : 0.0;
-        tr->maxP[a] = fmax(tr->maxP[a], tr->episode[a]);
+        tr->maxP[a] = pd_max(tr->maxP[a], tr->episode[a]);
         if (st->active[a] && !tr->pactive[a]) {
             tr->impacts[a]++;
             tr->episode[a] = 0.0;

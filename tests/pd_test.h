@@ -23,6 +23,10 @@ int pd_test_check(pd_test_ctx *ctx, int ok, const char *file, int line, const ch
     __attribute__((format(printf, 5, 6)));
 void pd_test_skip(pd_test_ctx *ctx, const char *why);
 
+/* Calls to malloc, calloc and realloc from the library and the tests
+ * since the start (the test binary wraps them, test_alloc.c). */
+long pd_test_allocations(void);
+
 #define PD_RUN(ctx, fn) pd_test_run((ctx), #fn, fn)
 /* CHECK(ctx, cond, "fmt", ...) — the message says what was measured. */
 #define CHECK(ctx, cond, ...) pd_test_check((ctx), (cond) ? 1 : 0, __FILE__, __LINE__, __VA_ARGS__)

@@ -20,11 +20,18 @@ void *__real_realloc(void *p, size_t n);
 
 static long alloc_countdown = -1; /* < 0: never fail; 0: fail this one */
 static long alloc_seen = 0;
+static long alloc_total = 0;      /* every allocation call since the start */
+
+long pd_test_allocations(void)
+{
+    return alloc_total;
+}
 
 /* Decide whether this allocation fails. */
 static int alloc_should_fail(void)
 {
     alloc_seen++;
+    alloc_total++;
     if (alloc_countdown < 0)
         return 0;
     return alloc_countdown-- == 0;

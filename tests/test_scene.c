@@ -457,6 +457,95 @@ static void scratch(const char *dir, const char *name, const char *text, char *b
     }
 }
 
+/* Heap in use (glibc), small blocks and mapped ones. */
+static long heap_in_use(void)
+{
+    struct mallinfo2 mi = mallinfo2();
+    return (long)(mi.uordblks + mi.hblkhd);
+}
+
+/* A --chain N row stepped by Moreau–Jean: the heap its setup takes, the
+ * allocation calls and the heap change over ROW_STEPS steps after a
+ * warm-up, and the mean share of contacts in the LCP. */
+#define ROW_WARM 200
+#define ROW_STEPS 200
+typedef struct row_heap {
+    long setup_bytes, step_allocations, step_heap_change;
+    double active;
+} row_heap;
+
+static int row_heap_run(int N, row_heap *rh, pd_err *e)
+{
+    pd_scene_excitation x = {.pulse = PD_PULSE_HARMONIC, .dir = 1, .ap = 1.0, .Tp = 1.0};
+    double wp = 2.0 * PD_PI;
+    pd_scene *sc = NULL;
+    pd_scene_model sm;
+    pd_mj *mj = NULL;
+    int rc, built = 0;
+    long h0 = heap_in_use(), active = 0;
+    if ((rc = pd_scene_chain(N, &x, 1.0, 1.5, 0.05, 0.01 / (wp * wp), 0.0, &sc, e)) ||
+        (rc = pd_scene_model_build(sc, 1, &sm, e)))
+        goto done;
+    built = 1;
+    pd_mj_opts o = pd_mj_default_opts();
+    o.h = wp * 0.005;
+    if (!(mj = pd_mj_alloc(&sm.model, &o, e))) {
+        rc = e->status;
+        goto done;
+    }
+    if ((rc = pd_mj_reset(mj, 0.0, NULL, NULL, e)))
+        goto done;
+    for (int k = 0; k < ROW_WARM && !rc; k++)
+        rc = pd_mj_step(mj, e);
+    rh->setup_bytes = heap_in_use() - h0;
+    long a0 = pd_test_allocations(), h1 = heap_in_use();
+    for (int k = 0; k < ROW_STEPS && !rc; k++) {
+        rc = pd_mj_step(mj, e);
+        active += pd_mj_state(mj)->nactive;
+    }
+    rh->step_allocations = pd_test_allocations() - a0;
+    rh->step_heap_change = heap_in_use() - h1;
+    rh->active = (double)active / ((double)ROW_STEPS * (N + 1));
+done:
+    pd_mj_free(mj);
+    if (built)
+        pd_scene_model_free(&sm);
+    pd_scene_free(sc);
+    return rc;
+}
+
+/* Rows of 1,000 and 10,000 SDOFs with about half their contacts in the
+ * LCP: no allocation and no heap change in a step, and a setup heap linear
+ * in N: each dof more costs at most ROW_BYTES_PER_DOF (a dense n x n or
+ * m x m block would cost 8 N bytes per dof, 80 kB at N = 10^4), and ten
+ * times the row never takes more than ten times the bytes.  Skipped where
+ * the allocator reports no statistics (AddressSanitizer). */
+#define ROW_BYTES_PER_DOF 2048.0
+static void test_scene_row_memory_linear(pd_test_ctx *ctx)
+{
+    if (heap_in_use() == 0) {
+        pd_test_skip(ctx, "allocator reports no heap statistics");
+        return;
+    }
+    row_heap small, large;
+    pd_err e;
+    if (!CHECK(ctx, row_heap_run(1000, &small, &e) == PD_OK, "N = 1000: %s", e.msg) ||
+        !CHECK(ctx, row_heap_run(10000, &large, &e) == PD_OK, "N = 10000: %s", e.msg))
+        return;
+    const row_heap *rows[2] = {&small, &large};
+    for (int k = 0; k < 2; k++)
+        CHECK(ctx, rows[k]->step_allocations == 0 && rows[k]->step_heap_change == 0 &&
+                       rows[k]->active > 0.25 && rows[k]->active < 0.75,
+              "N = %d: %ld allocations and %ld bytes of heap change in %d steps, %.0f%% of the "
+              "contacts active", k ? 10000 : 1000, rows[k]->step_allocations,
+              rows[k]->step_heap_change, ROW_STEPS, 100 * rows[k]->active);
+    double per_dof = (double)(large.setup_bytes - small.setup_bytes) / 9000.0;
+    CHECK(ctx, per_dof > 0.0 && per_dof <= ROW_BYTES_PER_DOF &&
+                   large.setup_bytes <= 10 * small.setup_bytes,
+          "setup heap %ld bytes at N = 1000, %ld at N = 10000: %.0f bytes per added dof",
+          small.setup_bytes, large.setup_bytes, per_dof);
+}
+
 /* Every class of bad scene file: exit 2, one line naming FILE:LINE:COL and
  * the field, and no output file. */
 static void test_scene_cli_bad_files(pd_test_ctx *ctx)
@@ -635,6 +724,7 @@ void suite_scene(pd_test_ctx *ctx)
     PD_RUN(ctx, test_scene_energy_across_impacts);
     PD_RUN(ctx, test_scene_moreau_converges_to_reference);
     PD_RUN(ctx, test_scene_building_modes);
+    PD_RUN(ctx, test_scene_row_memory_linear);
     PD_RUN(ctx, test_scene_cli_bad_files);
     PD_RUN(ctx, test_scene_cli_outputs);
     PD_RUN(ctx, test_scene_cli_spectrum);

@@ -1,0 +1,197 @@
+/* bench_scene.c — `pound bench --scene`: the cost of a Moreau–Jean step on
+ * `--chain N` rows (N SDOFs of unit mass between two walls, periods
+ * alternating 1 s and 1.5 s, harmonic ground motion of period 1 s and
+ * amplitude 1 m/s^2, every gap Pi3 = 0.01, e = 0, xi = 0.05, dt = Tp / 200):
+ * neighbours out of phase keep about half the contacts in the LCP.  After
+ * SCENE_WARM_STEPS untimed steps (the contacts start), SCENE_DOF_STEPS / N
+ * steps (at least SCENE_MIN_STEPS) are timed: ns per DOF-step, the mean
+ * share of contacts in the LCP, and the growth exponent of the per-step
+ * time over N = 10^3 ... 10^5.  Beside them the one-wall scene against the
+ * oscillator it is (bench --engine's many_impacts case) in the same run:
+ * the scene layer must cost the one-wall oscillator nothing. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pd_cli.h"
+#include "pd_problems.h"
+
+#define SCENE_WARM_STEPS 200    /* one excitation period */
+#define SCENE_DOF_STEPS 5e6     /* DOF-steps timed per row */
+#define SCENE_MIN_STEPS 100
+#define SCENE_PI3 0.01
+#define SCENE_TARGET 5e6        /* DOF-steps per second at N = 10^4 */
+
+/* One row's figures. */
+typedef struct chain_case {
+    int N;
+    long steps;
+    double ns_per_dof_step, active_fraction, lcp_iterations;
+    const char *factor, *lcp_solver;
+} chain_case;
+
+/* Time a chain of N; 1 on failure (message on stderr). */
+static int time_chain(int N, chain_case *cc)
+{
+    pd_scene_excitation exc = {.pulse = PD_PULSE_HARMONIC, .dir = 1, .ap = 1.0, .Tp = 1.0};
+    double wp = 2.0 * PD_PI / exc.Tp, gap = SCENE_PI3 * exc.ap / (wp * wp);
+    pd_scene *sc = NULL;
+    pd_scene_model sm;
+    pd_mj *mj = NULL;
+    pd_err err;
+    int rc = 1, built = 0;
+    memset(cc, 0, sizeof *cc);
+    cc->N = N;
+    if (pd_scene_chain(N, &exc, 1.0, 1.5, 0.05, gap, 0.0, &sc, &err) ||
+        pd_scene_model_build(sc, 1, &sm, &err))
+        goto done;
+    built = 1;
+    pd_mj_opts mo = pd_mj_default_opts();
+    mo.h = wp * exc.Tp / 200.0;
+    if (!(mj = pd_mj_alloc(&sm.model, &mo, &err)) || pd_mj_reset(mj, 0.0, NULL, NULL, &err))
+        goto done;
+    for (int s = 0; s < SCENE_WARM_STEPS; s++)
+        if (pd_mj_step(mj, &err))
+            goto done;
+    long steps = (long)(SCENE_DOF_STEPS / N), active = 0, iterations = 0;
+    steps = steps > SCENE_MIN_STEPS ? steps : SCENE_MIN_STEPS;
+    double t0 = pd_cpu_seconds();
+    for (long s = 0; s < steps; s++) {
+        if (pd_mj_step(mj, &err))
+            goto done;
+        const pd_state *st = pd_mj_state(mj);
+        active += st->nactive;
+        iterations += st->lcp_pivots;
+    }
+    double cpu = pd_cpu_seconds() - t0;
+    cc->steps = steps;
+    cc->ns_per_dof_step = 1e9 * cpu / ((double)steps * (double)sm.model.n);
+    cc->active_fraction = (double)active / ((double)steps * (double)sm.model.m);
+    cc->lcp_iterations = (double)iterations / (double)steps;
+    cc->factor = pd_mj_factor_name(mj);
+    rc = 0;
+done:
+    if (rc)
+        fprintf(stderr, "pound: bench --scene: chain %d: %s\n", N, err.msg);
+    pd_mj_free(mj);
+    if (built)
+        pd_scene_model_free(&sm);
+    pd_scene_free(sc);
+    return rc;
+}
+
+/* Least-squares slope of log(time per step) against log N over [lo, hi]. */
+static double growth(const chain_case *cc, int count, int lo, int hi)
+{
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    int k = 0;
+    for (int i = 0; i < count; i++) {
+        if (cc[i].N < lo || cc[i].N > hi)
+            continue;
+        double x = log((double)cc[i].N), y = log(cc[i].ns_per_dof_step * cc[i].N);
+        sx += x;
+        sy += y;
+        sxx += x * x;
+        sxy += x * y;
+        k++;
+    }
+    return k < 2 ? NAN : (k * sxy - sx * sy) / (k * sxx - sx * sx);
+}
+
+/* Median of three steps-per-second figures of a run (the scene path when
+ * sc is given, else the oscillator's own). */
+static int one_wall_rate(const pd_scene *sc, const pd_osc *c, const pd_run_opts *o, double *rate)
+{
+    double r[3];
+    pd_err err;
+    for (int k = 0; k < 3; k++) {
+        if (sc) {
+            pd_scene_result res;
+            if (pd_scene_result_alloc(sc, &res, &err))
+                return 1;
+            int rc = pd_scene_run(sc, o, NULL, NULL, &res, &err);
+            r[k] = (double)res.steps / fmax(res.cpu_s, 1e-9);
+            pd_scene_result_free(&res);
+            if (rc)
+                return 1;
+        } else {
+            pd_osc_result res;
+            if (pd_osc_simulate(c, o, NULL, NULL, &res, &err))
+                return 1;
+            r[k] = (double)res.steps / fmax(res.cpu_s, 1e-9);
+        }
+    }
+    double lo = fmin(r[0], fmin(r[1], r[2])), hi = fmax(r[0], fmax(r[1], r[2]));
+    *rate = r[0] + r[1] + r[2] - lo - hi;
+    return 0;
+}
+
+/* The one-wall scene against the oscillator (harmonic, Pi2 = 0.5, Pi3 =
+ * 0.01, e = 0.8, dt = 1e-4 s over 1000 s). */
+static int one_wall(double *scene_rate, double *osc_rate)
+{
+    pd_osc c = {.pulse = PD_PULSE_HARMONIC, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5,
+                .Pi3 = 0.01, .eps = 0.8, .xi = 0.05};
+    pd_scene_excitation exc = {.pulse = c.pulse, .dir = c.dir, .ap = c.ap, .Tp = c.Tp};
+    double wp = 2.0 * PD_PI / c.Tp;
+    pd_run_opts o = pd_run_default_opts();
+    pd_err err;
+    o.dt = 1e-4;
+    o.tend = 1000.0;
+    pd_scene *sc = pd_scene_new(&exc);
+    int rc = !sc || pd_scene_add_sdof(sc, "oscillator", c.Tp / c.Pi2, c.xi, 1.0, &err) ||
+             pd_scene_add_contact(sc, 0, 1, PD_WALL, 0, c.Pi3 * c.ap / (wp * wp), c.eps, 0, &err) ||
+             pd_scene_finish(sc, &err) || one_wall_rate(sc, NULL, &o, scene_rate) ||
+             one_wall_rate(NULL, &c, &o, osc_rate);
+    pd_scene_free(sc);
+    return rc;
+}
+
+int pd_bench_scene(pd_json *js)
+{
+    static const int sizes[] = {10, 100, 1000, 10000, 100000};
+    enum { NSIZES = sizeof sizes / sizeof sizes[0] };
+    chain_case cc[NSIZES];
+    int rc = 0;
+    for (int k = 0; k < NSIZES; k++)
+        rc |= time_chain(sizes[k], &cc[k]);
+    double scene_rate = 0.0, osc_rate = 0.0;
+    rc |= one_wall(&scene_rate, &osc_rate);
+    double expo = growth(cc, NSIZES, 1000, 100000);
+    if (js) {
+        pd_json_begin_object(js, "scene");
+        pd_json_begin_array(js, "chains");
+        for (int k = 0; k < NSIZES; k++) {
+            pd_json_begin_object(js, NULL);
+            pd_json_int(js, "N", cc[k].N);
+            pd_json_int(js, "steps", cc[k].steps);
+            pd_json_num(js, "ns_per_dof_step", cc[k].ns_per_dof_step);
+            pd_json_num(js, "dof_steps_per_s", 1e9 / cc[k].ns_per_dof_step);
+            pd_json_num(js, "active_fraction", cc[k].active_fraction);
+            pd_json_num(js, "lcp_iterations_per_step", cc[k].lcp_iterations);
+            pd_json_str(js, "factor", cc[k].factor ? cc[k].factor : "?");
+            pd_json_end_object(js);
+        }
+        pd_json_end_array(js);
+        pd_json_num(js, "growth_exponent", expo);
+        pd_json_num(js, "target_dof_steps_per_s", SCENE_TARGET);
+        pd_json_num(js, "one_wall_scene_steps_per_s", scene_rate);
+        pd_json_num(js, "one_wall_oscillator_steps_per_s", osc_rate);
+        pd_json_num(js, "one_wall_ratio", scene_rate / osc_rate);
+        pd_json_end_object(js);
+    } else {
+        printf("Moreau-Jean on --chain N rows (harmonic, Pi3 = %g, e = 0, dt = Tp/200; one core)\n",
+               SCENE_PI3);
+        printf("  %8s %8s %12s %14s %8s %10s  %s\n", "N", "steps", "ns/DOF-step", "DOF-steps/s",
+               "active", "LCP its", "factor");
+        for (int k = 0; k < NSIZES; k++)
+            printf("  %8d %8ld %12.1f %14.4g %7.1f%% %10.1f  %s\n", cc[k].N, cc[k].steps,
+                   cc[k].ns_per_dof_step, 1e9 / cc[k].ns_per_dof_step, 100 * cc[k].active_fraction,
+                   cc[k].lcp_iterations, cc[k].factor ? cc[k].factor : "?");
+        printf("  growth exponent of the time per step, N = 1e3 ... 1e5: %.3f (goal <= 1.2); "
+               "goal %.0e DOF-steps/s at N = 1e4\n", expo, SCENE_TARGET);
+        printf("  one-wall scene %.4g steps/s, the oscillator %.4g steps/s: ratio %.3f\n",
+               scene_rate, osc_rate, scene_rate / osc_rate);
+    }
+    return rc ? 1 : 0;
+}
