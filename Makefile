@@ -3,7 +3,7 @@
 #   make demo     install missing packages (as root), build, run the main job
 #   make test     install missing packages (as root), build, run the tests
 #   make asan     the tests under AddressSanitizer + UndefinedBehaviorSanitizer
-#   make bench    performance figures (pound bench)
+#   make bench    performance figures (pound bench; pound against Siconos numerics)
 #   make figures  docs/figures/*.png (convergence, stability, energy)
 #   make all      library and binary only (build/libpound.a, build/pound)
 #   make MPI=1    the MPI build (OpenMPI's mpicc, -DPD_MPI) in build-mpi/:
@@ -92,9 +92,14 @@ asan: deps
 	@$(MAKE) --no-print-directory BUILD=build-asan OPT=-O1 \
 	  XCFLAGS="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer" check
 
+# pound's own figures, then pound paired against Siconos numerics (when it
+# can be installed or is there: bench/build.sh exits 3 without it).
 bench: deps
+	@sh scripts/deps.sh --bench || echo "bench: Siconos numerics not installed (the paired table is skipped)"
 	@$(MAKE) --no-print-directory all
 	$(BUILD)/pound bench
+	@st=0; sh bench/build.sh $(BUILD) || st=$$?; \
+	if [ $$st = 0 ]; then $(BUILD)/siconos_lcp --chains; elif [ $$st != 3 ]; then exit $$st; fi
 
 figures: deps
 	@$(MAKE) --no-print-directory all

@@ -30,15 +30,6 @@
 #define CHAIN_SEED 20240611u
 #define CHAIN_SEEDS 5
 
-/* Reference figures (µs) of a widely used lexicographic Lemke on this machine class. */
-typedef struct bench_ref {
-    const char *name;
-    double us;
-} bench_ref;
-
-static const bench_ref bench_refs[] = {
-    {"mmc", 10.8}, {"tobenna", 137.0}, {"chain_100", 434.0}, {"chain_200", 3200.0}};
-
 /* One measured problem and solver. */
 typedef struct bench_row {
     char name[64];
@@ -46,7 +37,7 @@ typedef struct bench_row {
     int n, pivots, iterations;
     pd_lcp_outcome outcome;
     double residual;
-    double median_us, ref_us; /* ref_us < 0: none */
+    double median_us;
 } bench_row;
 
 /* The report: rows to print as a table or as JSON. */
@@ -57,15 +48,6 @@ typedef struct bench_report {
     int siconos_found;
     const char *siconos_dir;
 } bench_report;
-
-/* Reference time of a problem, -1 if none. */
-static double reference_us(const char *name)
-{
-    for (size_t k = 0; k < sizeof bench_refs / sizeof bench_refs[0]; k++)
-        if (!strcmp(bench_refs[k].name, name))
-            return bench_refs[k].us;
-    return -1.0;
-}
 
 /* Ascending order of doubles, for qsort. */
 static int cmp_double(const void *a, const void *b)
@@ -128,7 +110,6 @@ static int measure(pd_lcp_method method, const pd_matrix *M, const double *q, in
     row->outcome = info.outcome;
     row->residual = info.residual;
     row->median_us = median(runs, nruns);
-    row->ref_us = method == PD_LCP_LEMKE ? reference_us(row->name) : -1.0;
     pd_lcp_solver_free(sv);
     free(zw);
     return 0;
@@ -221,7 +202,6 @@ static int measure_seeds(pd_lcp_method method, int N, int seeds, bench_row *row)
             row->outcome = one.outcome;
         row->n = one.n;
         row->solver = one.solver;
-        row->ref_us = one.ref_us;
         chain_free(&c);
     }
     row->median_us = us;
@@ -252,21 +232,14 @@ static void bench_chains(bench_report *rep)
  * n in [lo, hi]; NAN with fewer than two. */
 static double growth(const bench_report *rep, const char *solver, int lo, int hi)
 {
-    double sx = 0, sy = 0, sxx = 0, sxy = 0;
-    int k = 0;
+    pd_loglog_fit fit = {0};
     for (int r = 0; r < rep->nrows; r++) {
         const bench_row *row = &rep->rows[r];
-        if (strncmp(row->name, "chain_", 6) || row->n < lo || row->n > hi ||
-            strcmp(row->solver, solver))
-            continue;
-        double x = log((double)row->n), y = log(row->median_us);
-        sx += x;
-        sy += y;
-        sxx += x * x;
-        sxy += x * y;
-        k++;
+        if (!strncmp(row->name, "chain_", 6) && row->n >= lo && row->n <= hi &&
+            !strcmp(row->solver, solver))
+            pd_loglog_add(&fit, (double)row->n, row->median_us);
     }
-    return k < 2 ? NAN : (k * sxy - sx * sy) / (k * sxx - sx * sx);
+    return pd_loglog_slope(&fit);
 }
 
 /* Ascending order of strings, for qsort. */
@@ -347,27 +320,23 @@ static void bench_siconos(bench_report *rep, const char *shared_dir, char *dir, 
     }
 }
 
-/* The table with reference figures and ratios. */
+/* The table. */
 static void print_table(const bench_report *rep)
 {
     printf("LCP solvers, median us per cold solve over >= %d timed batches (3 for solves over "
            "%g s), one thread\n", BENCH_MIN_RUNS, BENCH_LONG_S);
     if (!rep->siconos_found)
         printf("Siconos set: skipped (no .dat files in %s)\n", rep->siconos_dir);
-    printf("%-28s %6s %-26s %-14s %7s %6s %9s %12s %9s %7s\n", "problem", "n", "solver", "status",
-           "pivots", "iters", "residual", "median_us", "ref_us", "ratio");
+    printf("%-28s %6s %-26s %-14s %7s %6s %9s %12s\n", "problem", "n", "solver", "status",
+           "pivots", "iters", "residual", "median_us");
     for (int k = 0; k < rep->nrows; k++) {
         const bench_row *r = &rep->rows[k];
-        printf("%-28s %6d %-26s %-14s %7d %6d %9.2g %12.3f", r->name, r->n, r->solver,
+        printf("%-28s %6d %-26s %-14s %7d %6d %9.2g %12.3f\n", r->name, r->n, r->solver,
                pd_lcp_outcome_name(r->outcome), r->pivots, r->iterations, r->residual,
                r->median_us);
-        if (r->ref_us > 0.0)
-            printf(" %9.1f %7.3f\n", r->ref_us, r->median_us / r->ref_us);
-        else
-            printf(" %9s %7s\n", "-", "-");
     }
-    printf("chains: means over %d right-hand sides q (pgs: one); ratio = ours / a widely used "
-           "lexicographic Lemke measured on this machine class\n", CHAIN_SEEDS);
+    printf("chains: means over %d right-hand sides q (pgs: one); against Siconos numerics, "
+           "paired in one run: make bench (bench/siconos_lcp)\n", CHAIN_SEEDS);
     printf("growth exponent of the time on chains, N = 1e3 ... 1e5: structured %.3f, pgs (%d "
            "sweeps) %.3f\n",
            growth(rep, "structured", 1000, 100000), BENCH_PGS_SWEEPS,
@@ -393,10 +362,6 @@ static void print_json(pd_json *js, const bench_report *rep)
         pd_json_str(js, "status", pd_lcp_outcome_name(r->outcome));
         pd_json_num(js, "residual", r->residual);
         pd_json_num(js, "median_us", r->median_us);
-        if (r->ref_us > 0.0)
-            pd_json_num(js, "ref_us", r->ref_us);
-        else
-            pd_json_null(js, "ref_us");
         pd_json_end_object(js);
     }
     pd_json_end_array(js);

@@ -83,19 +83,11 @@ done:
 /* Least-squares slope of log(time per step) against log N over [lo, hi]. */
 static double growth(const chain_case *cc, int count, int lo, int hi)
 {
-    double sx = 0, sy = 0, sxx = 0, sxy = 0;
-    int k = 0;
-    for (int i = 0; i < count; i++) {
-        if (cc[i].N < lo || cc[i].N > hi)
-            continue;
-        double x = log((double)cc[i].N), y = log(cc[i].ns_per_dof_step * cc[i].N);
-        sx += x;
-        sy += y;
-        sxx += x * x;
-        sxy += x * y;
-        k++;
-    }
-    return k < 2 ? NAN : (k * sxy - sx * sy) / (k * sxx - sx * sx);
+    pd_loglog_fit fit = {0};
+    for (int i = 0; i < count; i++)
+        if (cc[i].N >= lo && cc[i].N <= hi)
+            pd_loglog_add(&fit, (double)cc[i].N, cc[i].ns_per_dof_step * cc[i].N);
+    return pd_loglog_slope(&fit);
 }
 
 /* Median of three steps-per-second figures of a run (the scene path when

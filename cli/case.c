@@ -25,7 +25,7 @@ const char pd_cli_case_help[] =
     "  --no-accumulation  event-driven: do not jump accumulations of impacts\n"
     "  --kernel auto|general [auto]  general: no fast path (scalar kernel, exact reference)\n"
     "  --factor auto|scalar|dense|cholmod [auto]  storage of the iteration matrix\n"
-    "  --lcp-solver auto|lemke [auto]  the contact LCP solver\n"
+    "  --lcp-solver auto|lemke|structured|pgs [auto]  the contact LCP solver (docs/lcp.md)\n"
     "penalty (--method penalty):\n"
     "  --contact kelvin|hertz [kelvin]   --kc X stiffness as a multiple of w0^2 (scenes: of\n"
     "         the largest storey stiffness) [1e4]\n"

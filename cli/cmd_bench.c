@@ -1,8 +1,26 @@
 /* cmd_bench.c — `pound bench [--lcp] [--engine] [--scene] [--spectrum] [--json] [--shared DIR]`. */
+#include <math.h>
 #include <string.h>
 
 #include "pd_cli.h"
 #include "pd_spectrum.h"
+
+void pd_loglog_add(pd_loglog_fit *f, double x, double y)
+{
+    double lx = log(x), ly = log(y);
+    f->sx += lx;
+    f->sy += ly;
+    f->sxx += lx * lx;
+    f->sxy += lx * ly;
+    f->k++;
+}
+
+double pd_loglog_slope(const pd_loglog_fit *f)
+{
+    if (f->k < 2)
+        return NAN;
+    return (f->k * f->sxy - f->sx * f->sy) / (f->k * f->sxx - f->sx * f->sx);
+}
 
 int pd_cmd_bench(int argc, char **argv)
 {

@@ -232,8 +232,10 @@ static int solve_and_print(const lcp_args *a, int n, const double *M, const doub
     int st = pd_lcp_solve(solver, &Mv, q, &opts, z, w, &info);
     double cpu_s = pd_cpu_seconds() - t0;
     pd_lcp_solver_free(solver);
-    if (st == PD_EINVAL)
-        return pd_cli_usage_error("lcp: %s: the data are not finite numbers", a->path);
+    if (st == PD_EINVAL) /* the reader refuses non-finite data: the size is what is left */
+        return pd_cli_usage_error("lcp: %s: n = %d is more than the %s solver takes (Lemke: at "
+                                  "most %d unknowns)",
+                                  a->path, n, pd_lcp_method_name(a->solver), PD_LCP_LEMKE_NMAX);
     if (a->json)
         print_json(n, z, w, &info, cpu_s);
     else
@@ -257,9 +259,10 @@ static int resolve_dump(const lcp_args *a)
     if (pd_lcp_set_read(a->path, &set, &err))
         return pd_cli_usage_error("lcp: %s", err.msg);
     if (!a->all && (a->index < 0 || a->index >= set.count)) {
+        long count = set.count;
         pd_lcp_set_free(&set);
         return pd_cli_usage_error("lcp: %s holds %ld LCPs: give --all or --index K (0 <= K < %ld)",
-                                  a->path, set.count, set.count);
+                                  a->path, count, count);
     }
     long lo = a->all ? 0 : a->index, hi = a->all ? set.count : a->index + 1;
     long solved = 0, agree = 0, iterations = 0, pivots = 0;

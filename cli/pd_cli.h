@@ -85,4 +85,13 @@ int pd_bench_lcp(pd_json *js, const char *shared_dir);
 int pd_bench_engine(pd_json *js);
 int pd_bench_scene(pd_json *js);
 
+/* The least-squares slope of log y against log x over the points added
+ * (the growth exponents of the benchmarks); NAN with fewer than two. */
+typedef struct pd_loglog_fit {
+    double sx, sy, sxx, sxy;
+    int k;
+} pd_loglog_fit;
+void pd_loglog_add(pd_loglog_fit *f, double x, double y);
+double pd_loglog_slope(const pd_loglog_fit *f);
+
 #endif

@@ -63,7 +63,7 @@ static int run_gnuplot(const char *data, const char *png_tmp, const pd_chart *c)
                 c->vline, c->vline);
         fprintf(g, "set label ");
         quoted(g, c->vline_label ? c->vline_label : "");
-        fprintf(g, " at %.17g, graph 0.95 left offset 0.5,0\n", c->vline);
+        fprintf(g, " at %.17g, graph 0.05 right offset -0.5,0\n", c->vline);
     }
     fputs("plot ", g);
     for (int k = 0; k < c->ncurves; k++) {

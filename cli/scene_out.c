@@ -8,7 +8,7 @@
  *        impulse} (m, N s) with the contact and its results as attributes;
  *        the run as attributes of the root.
  * CSV:   '#' lines with the inputs, a header row, one row per sample
- *        (t, NAME.x1.., NAME.v1.., cK.gap, cK.impulse), '#' lines with the
+ *        (t, NAME.x1.., NAME.v1.., cK.gap.., cK.impulse..), '#' lines with the
  *        results at the end. */
 #include <hdf5.h>
 #include <math.h>
@@ -94,8 +94,10 @@ static int csv_open(pd_scene_writer *w)
     for (int s = 0; s < sc->nstruct; s++)
         for (int k = 1; k <= sc->st[s].storeys; k++)
             fprintf(w->csv, ",%s.v%d", sc->st[s].name, k);
+    for (int a = 0; a < sc->ncontact; a++) /* the rows hold every gap, then every impulse */
+        fprintf(w->csv, ",c%d.gap", a);
     for (int a = 0; a < sc->ncontact; a++)
-        fprintf(w->csv, ",c%d.gap,c%d.impulse", a, a);
+        fprintf(w->csv, ",c%d.impulse", a);
     fputc('\n', w->csv);
     return ferror(w->csv) ? -1 : 0;
 }

@@ -22,7 +22,7 @@
  * At an event: one velocity LCP (Newton's law) over every contact at zero
  * gap, then one acceleration LCP over those at zero gap and zero rate
  * decides A (lambda > 0).  Accumulations of impacts are jumped to persistent
- * contact (docs/event.md). */
+ * contact (docs/methods.md, "The event-driven reference for the general system"). */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -884,10 +884,17 @@ static int impact(edg *w, double t, int nI, pd_err *err)
     if (set_fits(w, nI, t, err))
         return PD_EBUDGET;
     delassus(w, w->idx, nI, w->Dsub);
+    double bmax = 0.0;
     for (int r = 0; r < nI; r++) {
         int a = w->idx[r];
-        w->bsub[r] = w->U[a] + w->md->e[a] * fmin(w->U[a], 0.0);
+        double U = fabs(w->U[a]) <= w->tolU[a] ? 0.0 : w->U[a];
+        w->bsub[r] = U + w->md->e[a] * fmin(U, 0.0);
+        bmax = fmax(bmax, fabs(w->bsub[r]));
     }
+    /* a rate at the rounding level of the impact (a contact resting in a row
+     * that another one strikes) is zero: the LCP must not chase its sign */
+    for (int r = 0; r < nI; r++)
+        w->bsub[r] = fabs(w->bsub[r]) <= EDG_ZERO * bmax ? 0.0 : w->bsub[r];
     int rc = pd_lcp_solve(w->lcp, &D, w->bsub, NULL, w->zsub, w->wsub, &info);
     w->lcp_pivots = info.pivots;
     if (rc)

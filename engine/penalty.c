@@ -19,7 +19,7 @@
  * integration also stops and restarts at every force breakpoint, the force
  * taken from the right limit at a segment's start and the left limit at its
  * end.  Output states (h_out) come from the probe integrator too, so they
- * do not perturb the trajectory.  See docs/penalty.md. */
+ * do not perturb the trajectory.  See docs/methods.md, "Penalty baseline". */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>

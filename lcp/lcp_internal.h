@@ -13,8 +13,9 @@ double pd_lcp_max_abs(int n, const double *x);
 void pd_lcp_verify(const pd_matrix *M, const double *q, const double *z, double *w, double *rows,
                    pd_lcp_info *info);
 
-/* The structured solver (bpp.c): block principal pivoting with an envelope
- * Cholesky of M_FF in at most envmax entries; flag: n bytes of scratch. */
+/* The structured solver (structured.c): block principal pivoting and an
+ * interior point on L D L^T factors of M_FF, an envelope of at most envmax
+ * entries; flag: n bytes of scratch. */
 typedef struct pd_bpp_work pd_bpp_work;
 pd_bpp_work *pd_bpp_alloc(int nmax, long envmax);
 void pd_bpp_free(pd_bpp_work *ws);

@@ -51,7 +51,7 @@ typedef struct lemke_state {
     pd_lcp_work *ws;
 } lemke_state;
 
-/* "solved", "no_solution", "max_pivots", "numerical". */
+/* "solved", "no_solution", "max_pivots", "numerical", "max_iterations". */
 const char *pd_lcp_outcome_name(pd_lcp_outcome outcome)
 {
     switch (outcome) {
@@ -412,7 +412,7 @@ LEMKE_INLINE void refine(const lemke_state *st)
         ws->xb[r] += dx[r];
 }
 
-/* Negative entries within roundoff of zero (>= -tol_verify max(1, max|z|))
+/* Negative entries within roundoff of zero (>= -tol_verify max|z|)
  * become 0; the verification that follows judges the result. */
 static void clamp_roundoff(int n, double *z)
 {

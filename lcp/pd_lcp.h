@@ -6,11 +6,13 @@
  *   lemke       Lemke's complementary pivoting with a covering vector and a
  *               lexicographic ratio test, on dense column-major M (M[i + j n]);
  *               the general solver, closed forms for n <= 2;
- *   structured  block principal pivoting (Judice-Pires) for symmetric
- *               positive definite M (the Delassus matrices of the engine),
- *               envelope Cholesky of the principal blocks on compressed
- *               columns, warm-started; hands over to Lemke when it cannot
- *               finish in its bounded number of iterations;
+ *   structured  for symmetric positive (semi)definite M (the Delassus
+ *               matrices of the engine): block principal pivoting
+ *               (Judice-Pires), warm-started, with a Mehrotra interior
+ *               point for cold starts and cascades, on L D L^T factors of
+ *               the principal blocks (twisted for tridiagonal ones, an
+ *               envelope otherwise) in compressed columns; bounded work,
+ *               then a hand-over to Lemke;
  *   pgs         projected Gauss-Seidel, the physics engines' baseline.
  * Every answer is verified (the relative backward residual of
  * pd_lcp_residual) before it is called solved.  Workspaces are sized once;
@@ -46,8 +48,9 @@ typedef struct pd_lcp_opts {
     const double *cover; /* Lemke's covering vector d > 0 (n entries), NULL = all ones */
     int max_pivots;      /* Lemke's pivot cap; 0 = max(10000, 100 n) */
     double tol;          /* relative tolerance for ties and tiny pivots, in (0, 1) */
-    int max_iterations;  /* structured: block pivots, 0 = 3 n + 10; pgs: sweeps, 0 = 1000 n
-                            (at most 10^6) */
+    int max_iterations;  /* structured: principal solves of the pivoting, 0 = 3 n + 10
+                            (its interior point is bounded apart, at 40 iterations
+                            a call); pgs: sweeps, 0 = 1000 n (at most 10^6) */
     const unsigned char *guess; /* n flags, a warm start for the structured solver:
                             1 z_i > 0 expected, 0 z_i = 0 expected, 2 no idea (the
                             sign of q_i decides); NULL = 2 everywhere */
@@ -61,7 +64,8 @@ pd_lcp_opts pd_lcp_default_opts(void);
 typedef struct pd_lcp_info {
     pd_lcp_outcome outcome;
     int pivots;             /* Lemke: pivots performed, counting the one that brings z0 in */
-    int iterations;         /* structured: block pivots (principal solves); pgs: sweeps */
+    int iterations;         /* structured: principal solves plus interior-point
+                               iterations; pgs: sweeps */
     double complementarity; /* max_i |z_i w_i| */
     double infeasibility;   /* max_i max(-z_i, -w_i, 0) */
     double residual;        /* relative backward residual (pd_lcp_residual): a verified
@@ -105,7 +109,8 @@ void pd_lcp_residual(int n, const double *M, const double *q, const double *z,
  * compressed-sparse-column; a solver that works on dense data copies a sparse
  * matrix into its own buffer.  info->solver names who answered. */
 typedef enum {
-    PD_LCP_AUTO = 0,       /* structured for sparse or symmetric M with n > 2, else Lemke */
+    PD_LCP_AUTO = 0,       /* Lemke for n <= 2 and dense M (n <= PD_LCP_LEMKE_NMAX),
+                              structured for compressed columns and larger dense M */
     PD_LCP_LEMKE = 1,      /* Lemke's method (dense), always available */
     PD_LCP_STRUCTURED = 2, /* block principal pivoting for symmetric positive definite M */
     PD_LCP_PGS = 3         /* projected Gauss-Seidel (positive diagonal) */

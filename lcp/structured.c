@@ -43,6 +43,8 @@
 #define IPM_STABLE 2        /* iterations the support guess must hold ... */
 #define IPM_CROSS_MU 1e-3   /* ... with mu below this * its start, to try the pivoting */
 #define IPM_CROSSINGS 3     /* such early tries at most */
+#define IPM_STALLED -2       /* interior_point: a factorisation failed on the way; the
+                               point reached is valid (z, w > 0) */
 #define IPM_STEP 0.995      /* fraction of the step to the boundary */
 #define IPM_SHIFT 1e-8      /* regularisation of the least-squares start, times max M_ii */
 #define IPM_START 0.1       /* the start's distance from the boundary, times the scales */
@@ -65,6 +67,7 @@ struct pd_bpp_work {
     double *rz;         /* n: 1 / z_i of the interior point */
     unsigned char *sup; /* n: the interior point's support guess */
     int crossed;        /* the interior point stopped early at a stable support */
+    double mu, rmax;    /* its last z.w / n and max |w - (M z + q)| */
     int tridiagonal;    /* the loaded matrix is tridiagonal: ta, tb instead of env */
     double *ta, *tb;    /* n: its diagonal A_ii and subdiagonal A_i,i-1 (tb_0 = 0) */
     double *tl, *tu;    /* n: the twisted factor's multipliers (tri_factor) */
@@ -221,6 +224,8 @@ static int tri_factor(pd_bpp_work *ws, int k, const double *shift)
     const double *a = ws->ta, *b = ws->tb;
     double *tl = ws->tl, *tu = ws->tu, *dinv = ws->dinv, rd = 0.0, re = 0.0;
     int m = k / 2;
+    if (k == 0) /* an empty support: nothing to factor */
+        return 0;
 #define TRI_A(i) (shift ? a[i] + shift[i] : a[i])
     for (int s = 0; s < m; s++) {
         int i = s, j = k - 1 - s;
@@ -253,6 +258,8 @@ static void tri_solve(const pd_bpp_work *ws, int k, double *x)
 {
     const double *tl = ws->tl, *tu = ws->tu, *dinv = ws->dinv;
     int m = k / 2;
+    if (k == 0)
+        return;
     double yt = 0.0, yb = 0.0; /* N y = x: down to m from both ends */
     for (int s = 0; s < m; s++) {
         int i = s, j = k - 1 - s;
@@ -573,6 +580,8 @@ static int interior_point(pd_bpp_work *ws, const pd_matrix *M, const double *q, 
             rz[i] = 1.0 / z[i];
             ws->diag[i] = w[i] * rz[i];
         }
+        ws->mu = mu;
+        ws->rmax = rmax;
         if (mu <= tol * qs * qs / ds && rmax <= tol * qs)
             break;
         mu0 = mu0 < 0.0 ? mu : mu0;
@@ -583,8 +592,8 @@ static int interior_point(pd_bpp_work *ws, const pd_matrix *M, const double *q, 
                 break;
             }
         }
-        if (ipm_factor(ws, n, ws->diag))
-            return -1;
+        if (ipm_factor(ws, n, ws->diag)) /* M_FF singular at this point: w / z -> 0 */
+            return IPM_STALLED;
         for (int i = 0; i < n; i++) /* predictor */
             az[i] = -ws->r[i];
         factor_solve(ws, n, az);
@@ -658,11 +667,20 @@ int pd_bpp_solve(pd_bpp_work *ws, const pd_matrix *M, const double *q, const pd_
         if (!ws->crossed)
             break;
     }
+    /* a singular M_FF stalls the factorisation as w / z -> 0 on the
+     * redundant contacts: the point reached then is the answer if it is
+     * feasible and complementary to the interior point's own tolerance (an
+     * infeasible problem stalls too, with z running away and w far from
+     * M z + q) and verifies */
     if (ipm >= 0) {
         int more = interior_point(ws, M, q, qs, ds, IPM_MU_FINAL, 0, 0);
         its += more > 0 ? more : 0;
+        ipm = more == IPM_STALLED ? IPM_STALLED : ipm;
+    }
+    int converged = ws->rmax <= IPM_MU_TOL * qs && ws->mu <= IPM_MU_TOL * qs * qs / ds;
+    if ((ipm >= 0 || ipm == IPM_STALLED) && converged) {
         memcpy(z, ws->iz, (size_t)n * sizeof(double));
-        if (more >= 0 && accept(ws, M, q, z, w, info))
+        if (accept(ws, M, q, z, w, info))
             goto solved;
     }
     info->iterations = its;

@@ -409,11 +409,13 @@ void pd_scene_summary_free(pd_scene_summary *s);
  *   err_umax_rel  = max over storeys |umax - umax_ref| / max over storeys umax_ref,
  *   err_hist_linf = max_k max over storeys |x(t_k) - x_ref(t_k)| / (the same). */
 
-/* The reference history: rows of n displacements. */
+/* The reference history: rows of n displacements at t = k dt.  A run on a
+ * grid whose step is a whole multiple of dt is compared on its own points. */
 typedef struct pd_scene_trace {
     double *x;
     long rows, cap;
     int n;
+    double dt;
 } pd_scene_trace;
 
 typedef struct pd_scene_errors {

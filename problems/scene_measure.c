@@ -58,10 +58,14 @@ int pd_scene_errors_alloc(const pd_scene *sc, pd_scene_errors *e, pd_err *err)
     return PD_OK;
 }
 
-/* Sampler: the reference history, row by row. */
+/* Sampler: the reference history on its grid t = k dt, row by row (the
+ * states the reference reports at its events, between grid points, are
+ * not rows). */
 static int keep_row(const pd_scene_sample *s, void *ctx)
 {
     pd_scene_trace *tr = ctx;
+    if (fabs(s->t - (double)tr->rows * tr->dt) > 1e-9 * tr->dt)
+        return 0;
     if (tr->rows < tr->cap)
         memcpy(tr->x + (size_t)tr->rows++ * tr->n, s->x, (size_t)tr->n * sizeof(double));
     return 0;
@@ -79,11 +83,14 @@ static double structure_scale(const pd_scene *sc, const pd_scene_result *ref, in
 int pd_scene_measure_reference(const pd_scene *sc, const pd_run_opts *o, pd_scene_trace *ref,
                                pd_scene_result *res, pd_err *err)
 {
-    pd_run_opts r = *o;
+    pd_run_opts r;
     pd_scene_result timed;
     int rc;
+    if ((rc = pd_scene_resolve_opts(sc, o, &r, err))) /* dt 0: the scene's default */
+        return rc;
     r.method = PD_METHOD_EVENT;
     ref->rows = 0;
+    ref->dt = r.dt;
     if ((rc = pd_scene_run(sc, &r, keep_row, ref, res, err)))
         return rc;
     if ((rc = pd_scene_result_alloc(sc, &timed, err)))
@@ -105,15 +112,17 @@ typedef struct compare_ctx {
     const pd_scene_trace *ref;
     pd_scene_errors *e;
     const double *scale; /* nstruct */
-    long row;
+    long stride, row; /* the run's step in reference rows; its next row */
 } compare_ctx;
 
 static int compare_row(const pd_scene_sample *s, void *ctx)
 {
     compare_ctx *c = ctx;
-    if (c->row >= c->ref->rows)
+    long at = c->row * c->stride;
+    if (at >= c->ref->rows)
         return 0;
-    const double *xr = c->ref->x + (size_t)c->row++ * c->ref->n;
+    const double *xr = c->ref->x + (size_t)at * c->ref->n;
+    c->row++;
     for (int k = 0; k < c->sc->nstruct; k++) {
         const pd_structure *st = &c->sc->st[k];
         double worst = 0.0;
@@ -129,15 +138,23 @@ int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scen
                          pd_scene_errors *e, pd_err *err)
 {
     pd_scene_result timed;
-    double *scale = malloc((size_t)sc->nstruct * sizeof(double));
+    pd_run_opts r;
     int rc;
+    if ((rc = pd_scene_resolve_opts(sc, o, &r, err)))
+        return rc;
+    double ratio = r.dt / ref->dt;
+    long stride = lround(ratio);
+    if (stride < 1 || fabs(ratio - (double)stride) > 1e-9 * ratio)
+        return pd_err_set(err, PD_EINVAL, "dt: %g is not a whole multiple of the reference's %g",
+                          r.dt, ref->dt);
+    double *scale = malloc((size_t)sc->nstruct * sizeof(double));
     if (!scale)
         return pd_err_set(err, PD_ENOMEM, "out of memory");
     for (int s = 0; s < sc->nstruct; s++) {
         scale[s] = structure_scale(sc, ref_res, s);
         e->err_hist[s] = e->err_umax[s] = 0.0;
     }
-    compare_ctx c = {.sc = sc, .ref = ref, .e = e, .scale = scale, .row = 0};
+    compare_ctx c = {.sc = sc, .ref = ref, .e = e, .scale = scale, .stride = stride, .row = 0};
     if ((rc = pd_scene_run(sc, o, compare_row, &c, res, err)) ||
         (rc = pd_scene_result_alloc(sc, &timed, err))) {
         free(scale);

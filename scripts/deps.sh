@@ -1,12 +1,14 @@
 #!/bin/sh
 # deps.sh — make sure the Debian packages pound needs are installed.
 # As root, installs what is missing; otherwise prints the one apt-get line
-# needed and fails.  Usage: scripts/deps.sh [--ci]   (--ci adds CI-only tools:
-# python3, and OpenMPI for the MPI build `make MPI=1`, which the quick start
-# does not need)
+# needed and fails.  Usage: scripts/deps.sh [--ci|--bench]   (--ci adds
+# CI-only tools: python3, OpenMPI for the MPI build `make MPI=1`, which the
+# quick start does not need, and Siconos numerics, which bench/siconos_lcp
+# is timed against; --bench adds Siconos numerics alone)
 set -u
-pkgs="gcc make pkg-config libgsl-dev libsuitesparse-dev libhdf5-dev hdf5-tools gnuplot-nox"
-[ "${1:-}" = "--ci" ] && pkgs="$pkgs python3 libopenmpi-dev openmpi-bin"
+pkgs="gcc make pkg-config libgsl-dev libsuitesparse-dev libhdf5-dev hdf5-tools libjansson-dev gnuplot-nox"
+[ "${1:-}" = "--ci" ] && pkgs="$pkgs python3 libopenmpi-dev openmpi-bin libsiconos-numerics-dev"
+[ "${1:-}" = "--bench" ] && pkgs="$pkgs libsiconos-numerics-dev"
 missing=""
 for p in $pkgs; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

@@ -83,6 +83,7 @@ int main(int argc, char **argv)
     suite_spectrum(&ctx);
     suite_scene(&ctx);
     suite_solvers(&ctx);
+    suite_impacts(&ctx);
 
     printf("%d passed, %d failed, %d skipped\n", ctx.passed, ctx.failed, ctx.skipped);
     return ctx.failed ? 1 : 0;

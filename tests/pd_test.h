@@ -82,5 +82,6 @@ void suite_cli(pd_test_ctx *ctx);
 void suite_spectrum(pd_test_ctx *ctx);
 void suite_scene(pd_test_ctx *ctx);
 void suite_solvers(pd_test_ctx *ctx);
+void suite_impacts(pd_test_ctx *ctx);
 
 #endif

@@ -685,18 +685,22 @@ static void test_lcp_ray_copositive_plus(pd_test_ctx *ctx)
 
 static void test_lcp_small_pivot_is_not_a_ray(pd_test_ctx *ctx)
 {
-    /* M = [1 -1; -1 1 + 1e-12] (SPD: a P-matrix, so never a ray), q = (0.5, -1):
-     * the last entering column has an entry ~1e-12 of its largest, below the
-     * pivot tolerance but far above roundoff; unique solution z2 = 0.5 / 1e-12 */
-    double M[4] = {1.0, -1.0, -1.0, 1.0 + 1e-12}, q[2] = {0.5, -1.0}, z[2], w[2];
-    pd_lcp_work *work = pd_lcp_alloc(2);
+    /* M = [1 -1; -1 1 + 1e-12] (SPD: a P-matrix, so never a ray) beside a
+     * third, uncoupled unknown (n = 3: pivoting, not the closed forms of
+     * n <= 2), q = (0.5, -1, -1): the last entering column has an entry ~1e-12
+     * of its largest, below the pivot tolerance but far above roundoff;
+     * unique solution z2 = 0.5 / 1e-12, z1 = z2 - 0.5, z3 = 1 */
+    double M[9] = {1.0, -1.0, 0.0, -1.0, 1.0 + 1e-12, 0.0, 0.0, 0.0, 1.0};
+    double q[3] = {0.5, -1.0, -1.0}, z[3], w[3];
+    pd_lcp_work *work = pd_lcp_alloc(3);
     pd_lcp_info info;
-    int st = pd_lcp_lemke(work, 2, M, q, NULL, z, w, &info);
-    CHECK(ctx, st == PD_OK, "status %d (%s), expected solved", st,
-          pd_lcp_outcome_name(info.outcome));
-    double z2 = 0.5 / (M[3] - 1.0); /* exact for this double data */
+    int st = pd_lcp_lemke(work, 3, M, q, NULL, z, w, &info);
+    CHECK(ctx, st == PD_OK && info.pivots >= 3, "status %d (%s), %d pivots, expected solved by "
+          "pivoting", st, pd_lcp_outcome_name(info.outcome), info.pivots);
+    double z2 = 0.5 / (M[4] - 1.0); /* exact for this double data */
     CHECK_NEAR(ctx, z[1], z2, 1e-6 * z2);
     CHECK_NEAR(ctx, z[0], z2 - 0.5, 1e-6 * z2);
+    CHECK_NEAR(ctx, z[2], 1.0, 1e-12);
     pd_lcp_free(work);
 }
 

@@ -255,7 +255,7 @@ static void test_penalty_kelvin_restitution(pd_test_ctx *ctx)
 /* Hertz-damp, c = 3 kc (1 - e^2) / (4 v_imp): the rebound ratio is a
  * function of e alone (scaling d by (v^2 / kc)^(2/5) removes kc and v) and
  * overshoots e at low e: measured 0.6723, 0.7252, 0.8471 for e = 0.2, 0.5,
- * 0.8 (docs/penalty.md); exact at e = 1. */
+ * 0.8 (docs/methods.md, "Penalty baseline"); exact at e = 1. */
 static void test_penalty_hertz_restitution(pd_test_ctx *ctx)
 {
     const double es[] = {0.2, 0.5, 0.8, 1.0}, achieved[] = {0.6723, 0.7252, 0.8471, 1.0};

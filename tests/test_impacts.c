@@ -1,0 +1,176 @@
+/* test_impacts.c — simultaneous impacts on chains (docs/methods.md, "Where
+ * methods fail on chains"): Newton's cradle of N equal free balls, e = 1,
+ * the first one thrown at the others.
+ *
+ * Touching balls (gaps exactly 0): every contact of the row is closed when
+ * the first ball arrives, so Moreau–Jean and the event-driven reference put
+ * them all in one LCP with Newton's law at each, U+ = -e U- = (v0, 0, ...,
+ * 0).  With momentum that gives the simultaneous-impact answer
+ *   v_1 = -(N - 2) v0 / N,  v_k = 2 v0 / N  (k >= 2),
+ * energy conserved -- not the cradle on the desk, which sends the last ball
+ * off alone.  Any positive gap between the balls makes the impacts
+ * sequential, and both methods give the physical answer (0, ..., 0, v0):
+ * Moreau–Jean predicts a contact from the velocities at the start of a
+ * step, so a chain reaction moves one ball per step whatever the gap is
+ * against v0 dt; the event-driven reference locates each impact.  The
+ * answer jumps at gap = 0: the impact law, not the integrator, decides.
+ * (The impulses of the reference's simultaneous impact: test_event.c.) */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pd_engine.h"
+#include "pd_test.h"
+
+#define CRADLE_MAX 8
+#define CRADLE_V0 1.0
+#define CRADLE_RUN 0.01 /* the first ball's flight to the others [s] */
+#define CRADLE_END 0.1  /* the end of a run: every impact is over (gaps <= 1e-2) */
+
+/* N balls of unit mass, free (K = C = 0), contact a between balls a and
+ * a + 1 (g = g0 + q_{a+1} - q_a); the first gap CRADLE_RUN, the others gap. */
+typedef struct cradle {
+    int N;
+    double M[CRADLE_MAX * CRADLE_MAX], W[CRADLE_MAX * CRADLE_MAX];
+    double g0[CRADLE_MAX], e[CRADLE_MAX], v0[CRADLE_MAX];
+    pd_model model;
+} cradle;
+
+static void cradle_make(cradle *c, int N, double gap)
+{
+    memset(c, 0, sizeof *c);
+    c->N = N;
+    for (int i = 0; i < N; i++)
+        c->M[i + i * N] = 1.0;
+    for (int a = 0; a < N - 1; a++) {
+        c->W[a + a * N] = -1.0;
+        c->W[a + 1 + a * N] = 1.0;
+        c->g0[a] = a == 0 ? CRADLE_RUN * CRADLE_V0 : gap;
+        c->e[a] = 1.0;
+    }
+    c->v0[0] = CRADLE_V0;
+    c->model = (pd_model){.n = N,
+                          .m = N - 1,
+                          .M = pd_matrix_dense(N, N, c->M),
+                          .C = pd_matrix_zero(N, N),
+                          .K = pd_matrix_zero(N, N),
+                          .W = pd_matrix_dense(N, N - 1, c->W),
+                          .g0 = c->g0,
+                          .e = c->e};
+}
+
+/* Final velocities of Moreau–Jean with step h, run well past the impacts. */
+static int cradle_moreau(const cradle *c, double h, double *v, pd_err *err)
+{
+    pd_mj_opts o = pd_mj_default_opts();
+    o.h = h;
+    pd_mj *mj = pd_mj_alloc(&c->model, &o, err);
+    if (!mj)
+        return err->status;
+    int rc = pd_mj_reset(mj, 0.0, NULL, c->v0, err);
+    long steps = (long)(CRADLE_END / h);
+    for (long k = 0; k < steps && !rc; k++)
+        rc = pd_mj_step(mj, err);
+    memcpy(v, pd_mj_state(mj)->v, (size_t)c->N * sizeof(double));
+    pd_mj_free(mj);
+    return rc;
+}
+
+/* The observer keeping the last state's velocities. */
+typedef struct last_v {
+    int n;
+    double v[CRADLE_MAX];
+} last_v;
+
+static int keep_v(const pd_state *st, void *ctx)
+{
+    last_v *lv = ctx;
+    memcpy(lv->v, st->v, (size_t)lv->n * sizeof(double));
+    return 0;
+}
+
+/* Final velocities and impacts of the event-driven reference. */
+static int cradle_event(const cradle *c, double *v, long *impacts, pd_err *err)
+{
+    pd_edg_opts o = pd_edg_default_opts();
+    pd_edg_result r;
+    last_v lv = {.n = c->N};
+    int rc = pd_edg_run(&c->model, 0.0, NULL, c->v0, CRADLE_END, &o, keep_v, &lv, &r, err);
+    memcpy(v, lv.v, (size_t)c->N * sizeof(double));
+    *impacts = r.impacts;
+    return rc;
+}
+
+/* max_i |v_i - want_i| and the kinetic energy over the initial one. */
+static double cradle_error(const double *v, const double *want, int N, double *energy)
+{
+    double d = 0.0, ke = 0.0;
+    for (int i = 0; i < N; i++) {
+        d = fmax(d, fabs(v[i] - want[i]));
+        ke += v[i] * v[i];
+    }
+    *energy = ke / (CRADLE_V0 * CRADLE_V0);
+    return d;
+}
+
+/* Touching balls, N = 3 and 5: both methods give the simultaneous-impact
+ * answer to 1e-12 at every step size, energy conserved. */
+static void test_impacts_cradle_touching(pd_test_ctx *ctx)
+{
+    const int sizes[] = {3, 5};
+    const double steps[] = {1e-3, 1e-4};
+    for (int k = 0; k < 2; k++) {
+        cradle c;
+        int N = sizes[k];
+        double want[CRADLE_MAX], v[CRADLE_MAX], energy;
+        long impacts;
+        pd_err err;
+        cradle_make(&c, N, 0.0);
+        for (int i = 0; i < N; i++)
+            want[i] = i == 0 ? -(N - 2.0) / N * CRADLE_V0 : 2.0 / N * CRADLE_V0;
+        for (int s = 0; s < 2; s++) {
+            int rc = cradle_moreau(&c, steps[s], v, &err);
+            double d = cradle_error(v, want, N, &energy);
+            CHECK(ctx, rc == PD_OK && d <= 1e-12 && fabs(energy - 1.0) <= 1e-12,
+                  "Moreau-Jean, N = %d, h = %g: |v - simultaneous| %.3g, energy ratio %.15g (%s)",
+                  N, steps[s], d, energy, rc ? err.msg : "ok");
+        }
+        int rc = cradle_event(&c, v, &impacts, &err);
+        double d = cradle_error(v, want, N, &energy);
+        CHECK(ctx, rc == PD_OK && d <= 1e-12 && impacts == 1 && fabs(energy - 1.0) <= 1e-12,
+              "event-driven, N = %d: |v - simultaneous| %.3g in %ld impacts, energy ratio %.15g",
+              N, d, impacts, energy);
+    }
+}
+
+/* Gaps of 1e-9 ... 1e-2 between the balls (from far below v0 dt to far
+ * above): both methods give the sequential answer (0, ..., 0, v0), the
+ * reference in N - 1 impacts. */
+static void test_impacts_cradle_gapped(pd_test_ctx *ctx)
+{
+    const double gaps[] = {1e-9, 1e-6, 5e-4, 1e-2};
+    for (int k = 0; k < 4; k++) {
+        cradle c;
+        int N = 5;
+        double want[CRADLE_MAX] = {0}, v[CRADLE_MAX], energy;
+        long impacts;
+        pd_err err;
+        cradle_make(&c, N, gaps[k]);
+        want[N - 1] = CRADLE_V0;
+        int rc = cradle_moreau(&c, 1e-3, v, &err);
+        double d = cradle_error(v, want, N, &energy);
+        CHECK(ctx, rc == PD_OK && d <= 1e-12,
+              "Moreau-Jean, gap %g, h = 1e-3: |v - sequential| %.3g (%s)", gaps[k], d,
+              rc ? err.msg : "ok");
+        rc = cradle_event(&c, v, &impacts, &err);
+        d = cradle_error(v, want, N, &energy);
+        CHECK(ctx, rc == PD_OK && d <= 1e-12 && impacts == N - 1,
+              "event-driven, gap %g: |v - sequential| %.3g in %ld impacts", gaps[k], d, impacts);
+    }
+}
+
+void suite_impacts(pd_test_ctx *ctx)
+{
+    PD_RUN(ctx, test_impacts_cradle_touching);
+    PD_RUN(ctx, test_impacts_cradle_gapped);
+}
