@@ -52,7 +52,7 @@ static int time_oscillator(const pd_osc *c, const pd_run_opts *o, bench_case *bc
 }
 
 /* Median rate of the bare engine (no observer) on the pressing scene. */
-static int time_pressing(pd_kernel kernel, long nsteps, bench_case *bc)
+static int time_pressing(pd_kernel kernel, pd_lcp_method solver, long nsteps, bench_case *bc)
 {
     double M = 1, K = 0.01, W = -1, g0 = 0, e = 0, rate[3];
     pd_model md = {.n = 1,
@@ -68,6 +68,7 @@ static int time_pressing(pd_kernel kernel, long nsteps, bench_case *bc)
     pd_err err;
     o.h = 1e-3;
     o.kernel = kernel;
+    o.lcp_solver = solver;
     pd_mj *mj = pd_mj_alloc(&md, &o, &err);
     if (!mj)
         return 1;
@@ -95,7 +96,7 @@ static int time_pressing(pd_kernel kernel, long nsteps, bench_case *bc)
 
 int pd_bench_engine(pd_json *js)
 {
-    bench_case cases[6];
+    bench_case cases[8];
     int n = 0, rc = 0;
     pd_run_opts o = pd_run_default_opts();
     /* free flight: harmonic excitation, the wall out of reach */
@@ -103,25 +104,26 @@ int pd_bench_engine(pd_json *js)
                      .Pi3 = 1e9, .eps = 0.5, .xi = 0.05};
     o.dt = 1e-4;
     o.tend = 1000.0;
-    cases[n] = (bench_case){"free_flight", "harmonic, no contact, oscillator observer", 0, 0, 0};
+    cases[n] = (bench_case){.name = "free_flight", .what = "harmonic, no contact, oscillator observer"};
     rc |= time_oscillator(&free_c, &o, &cases[n++]);
     /* many impacts: harmonic, small gap, eps = 0.8 */
     pd_osc imp_c = {.pulse = PD_PULSE_HARMONIC, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5,
                     .Pi3 = 0.01, .eps = 0.8, .xi = 0.05};
-    cases[n] = (bench_case){"many_impacts", "harmonic, Pi3 = 0.01, eps = 0.8", 0, 0, 0};
+    cases[n] = (bench_case){.name = "many_impacts", .what = "harmonic, Pi3 = 0.01, eps = 0.8"};
     rc |= time_oscillator(&imp_c, &o, &cases[n++]);
     /* persistent contact: a normal sine pulse, eps = 0, long resting phases */
     pd_osc rest_c = {.pulse = PD_PULSE_HARMONIC, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.3,
                      .Pi3 = 0.0, .eps = 0.0, .xi = 0.05};
-    cases[n] = (bench_case){"contact_phases", "harmonic, Pi3 = 0, eps = 0 (rests half the time)",
-                            0, 0, 0};
+    cases[n] = (bench_case){.name = "contact_phases", .what = "harmonic, Pi3 = 0, eps = 0 (rests half the time)"};
     rc |= time_oscillator(&rest_c, &o, &cases[n++]);
-    cases[n] = (bench_case){"persistent_scalar", "pressed on the wall, LCP every step, scalar kernel",
-                            0, 0, 0};
-    rc |= time_pressing(PD_KERNEL_AUTO, 10000000, &cases[n++]);
-    cases[n] = (bench_case){"persistent_general",
-                            "pressed on the wall, LCP every step, general kernel (Lemke)", 0, 0, 0};
-    rc |= time_pressing(PD_KERNEL_GENERAL, 2000000, &cases[n++]);
+    cases[n] = (bench_case){.name = "persistent_scalar", .what = "pressed on the wall, LCP every step, scalar kernel"};
+    rc |= time_pressing(PD_KERNEL_AUTO, PD_LCP_AUTO, 10000000, &cases[n++]);
+    cases[n] = (bench_case){.name = "persistent_general",
+                            .what = "the same, general kernel (one contact: the closed form)"};
+    rc |= time_pressing(PD_KERNEL_GENERAL, PD_LCP_AUTO, 4000000, &cases[n++]);
+    cases[n] = (bench_case){.name = "persistent_lemke",
+                            .what = "the same, general kernel, --lcp-solver lemke"};
+    rc |= time_pressing(PD_KERNEL_GENERAL, PD_LCP_LEMKE, 2000000, &cases[n++]);
 
     if (js) {
         pd_json_begin_object(js, "engine");

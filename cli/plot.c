@@ -59,6 +59,17 @@ static int run_gnuplot(const char *data, const char *png_tmp, const pd_chart *c)
     quoted(g, c->ylabel);
     fputc('\n', g);
     if (isfinite(c->vline)) {
+        double lo = c->vline, hi = c->vline; /* the marker inside the x range */
+        for (int k = 0; k < c->ncurves; k++)
+            for (int i = 0; i < c->curves[k].n; i++)
+                if (!c->logx || c->curves[k].x[i] > 0.0) {
+                    lo = fmin(lo, c->curves[k].x[i]);
+                    hi = fmax(hi, c->curves[k].x[i]);
+                }
+        if (c->logx)
+            fprintf(g, "set xrange [%.17g:%.17g]\n", lo / 2.0, hi * 2.0);
+        else
+            fprintf(g, "set xrange [%.17g:%.17g]\n", lo - 0.05 * (hi - lo), hi + 0.05 * (hi - lo));
         fprintf(g, "set arrow from %.17g, graph 0 to %.17g, graph 1 nohead dt 3 lc rgb 'black'\n",
                 c->vline, c->vline);
         fprintf(g, "set label ");
