@@ -111,7 +111,7 @@ paper: deps
 	sh scripts/paper.sh $(BUILD)/pound
 
 acceptance: all
-	@for s in ../shared/acceptance/*.sh; do echo "== $$s"; $$s $(BUILD)/pound || exit 1; done
+	@sh scripts/acceptance.sh $(BUILD)/pound
 
 clean:
 	rm -rf build build-asan build-mpi

@@ -36,7 +36,7 @@ static void paper_sweep(pd_spectrum *s)
 static int timed(const pd_spectrum *s, int threads, pd_spec_result *res, double *best)
 {
     long n = pd_spec_tasks(s);
-    pd_spec_exec ex = {threads, 0, 0, NULL, 0, 1};
+    pd_spec_exec ex = {.threads = threads, .rank = 0, .size = 1};
     pd_err err;
     *best = HUGE_VAL;
     for (int k = 0; k < 2; k++) {

@@ -1,6 +1,8 @@
 /* case.c — the model, scheme, method and scene flags that simulate,
  * compare, converge and spectrum share, with errors that name the flag. */
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "pd_cli.h"
@@ -12,6 +14,11 @@ const char pd_cli_case_help[] =
     "  --T0 T   oscillator period, s  or  --Pi2 X = Tp/T0 [1]\n"
     "  --gap D  initial gap, m        or  --Pi3 X = gap wp^2/ap [0.05]\n"
     "  --eps E  restitution in [0,1] [0.5]    --xi Z   damping ratio in [0,1) [0.05]\n"
+    "records (SPEC 5, docs/records.md):\n"
+    "  --record F    the ground acceleration of a record (PEER .AT2, COSMOS V2, or text\n"
+    "                't a'): replaces the pulse; ap and Tp come from its fitted pulse\n"
+    "  --scale S [1]  multiplies the record   --dir normal|reverse as for pulses\n"
+    "  --units g|m/s2|cm/s2 [g]  of a text record   --record-format auto|at2|v2|text [auto]\n"
     "scenes (rows of structures, docs/scenes.md):\n"
     "  --scene F.json   run the scene of file F (its excitation replaces the model flags)\n"
     "  --chain N        a row of N SDOFs between two walls built from the model flags: unit\n"
@@ -38,6 +45,38 @@ void pd_cli_case_init(pd_cli_case *a)
     a->c = pd_osc_default();
     a->opts = pd_run_default_opts();
     a->chain_ratio = 1.5;
+    a->scale = 1.0;
+}
+
+void pd_cli_case_free(pd_cli_case *a)
+{
+    if (a->record) {
+        pd_record_free(&a->record->rec);
+        free(a->record);
+        a->record = NULL;
+    }
+}
+
+int pd_cli_record_load(const char *path, pd_record_format format, pd_record_units units,
+                       pd_cli_record **out)
+{
+    pd_err err;
+    pd_cli_record *r = calloc(1, sizeof *r);
+    *out = NULL;
+    if (!r) {
+        fprintf(stderr, "pound: out of memory for the record %s\n", path);
+        return 1;
+    }
+    int rc = pd_record_read(path, format, units, &r->rec, &err);
+    if (!rc && (rc = pd_record_fit_pulse(&r->rec, &r->pulse, &err)))
+        pd_record_free(&r->rec);
+    if (rc) {
+        free(r);
+        return rc == PD_ENOMEM ? (fprintf(stderr, "pound: %s\n", err.msg), 1)
+                               : pd_cli_usage_error("%s", err.msg);
+    }
+    *out = r;
+    return 0;
 }
 
 /* A numeric flag and where it goes; model flags describe the oscillator. */
@@ -77,7 +116,8 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
                        {"--kc-abs", &a->opts.pen.kc_abs, NULL, 0},
                        {"--rtol", &a->opts.pen.rtol, NULL, 0},
                        {"--atol", &a->opts.pen.atol, NULL, 0},
-                       {"--chain-ratio", &a->chain_ratio, NULL, 1}};
+                       {"--chain-ratio", &a->chain_ratio, NULL, 1},
+                       {"--scale", &a->scale, &a->have_scale, 0}};
     for (size_t n = 0; n < sizeof nums / sizeof nums[0]; n++)
         if (!strcmp(f, nums[n].flag)) {
             if ((rc = pd_cli_double(f, val, &x)))
@@ -87,6 +127,8 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
                 *nums[n].given = 1;
             if (nums[n].model && !a->model_flag)
                 a->model_flag = nums[n].flag;
+            if (!strcmp(f, "--ap") || !strcmp(f, "--Tp"))
+                a->pulse_flag = nums[n].flag;
             (*i)++;
             return 1;
         }
@@ -127,7 +169,17 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
     else if (!strcmp(f, "--lcp-solver"))
         rc = named(f, val, pd_lcp_method_parse(val, &a->opts.lcp_solver) != PD_OK,
                    pd_lcp_method_list());
-    else if (!strcmp(f, "--scene")) {
+    else if (!strcmp(f, "--units"))
+        rc = named(f, val, pd_record_units_parse(val, &a->rec_units) != PD_OK, "g, m/s2, cm/s2");
+    else if (!strcmp(f, "--record-format"))
+        rc = named(f, val, pd_record_format_parse(val, &a->rec_format) != PD_OK,
+                   "auto, at2, v2, text");
+    else if (!strcmp(f, "--record")) {
+        if (!val)
+            return pd_cli_usage_error("--record needs a file name");
+        a->record_path = val;
+        rc = 1;
+    } else if (!strcmp(f, "--scene")) {
         if (!val)
             return pd_cli_usage_error("--scene needs a file name");
         a->scene_path = val;
@@ -144,6 +196,8 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
         (*i)++;
     if (rc == 1 && (!strcmp(f, "--pulse") || !strcmp(f, "--dir")) && !a->model_flag)
         a->model_flag = f;
+    if (rc == 1 && !strcmp(f, "--pulse"))
+        a->pulse_flag = f;
     return rc;
 }
 
@@ -205,7 +259,28 @@ static int check_case(const pd_cli_case *a)
     return 0;
 }
 
-int pd_cli_case_finish(pd_cli_case *a)
+/* --record: its flags checked, the record read and its pulse fitted, the
+ * oscillator excited by it: 0 or 2. */
+static int case_record(pd_cli_case *a)
+{
+    if (!a->record_path)
+        return a->have_scale ? pd_cli_usage_error("--scale: goes with --record") : 0;
+    if (a->chain)
+        return pd_cli_usage_error("--record: rows of structures take a record through a scene "
+                                  "file (docs/scenes.md)");
+    if (a->pulse_flag)
+        return pd_cli_usage_error("%s: the record replaces the pulse (its fitted pulse gives ap "
+                                  "and Tp; --scale scales it)", a->pulse_flag);
+    if (!(a->scale > 0.0) || !isfinite(a->scale))
+        return pd_cli_usage_error("--scale: must be > 0 (got %g)", a->scale);
+    int rc = a->record ? 0 : pd_cli_record_load(a->record_path, a->rec_format, a->rec_units,
+                                                &a->record);
+    if (!rc)
+        pd_osc_set_record(&a->c, &a->record->rec, &a->record->pulse, a->scale);
+    return rc;
+}
+
+static int case_finish(pd_cli_case *a)
 {
     int rc;
     pd_err err;
@@ -218,7 +293,11 @@ int pd_cli_case_finish(pd_cli_case *a)
     if ((rc = check_scheme(a)))
         return rc;
     if (a->scene_path)
-        return 0;
+        return a->record_path ? pd_cli_usage_error("--record: a scene names its record in its "
+                                                   "excitation (docs/scenes.md)")
+                              : 0;
+    if ((rc = case_record(a)))
+        return rc;
     if (a->have_T0 && a->T0 > 0.0)
         pd_osc_set_T0(&a->c, a->T0);
     if (a->have_gap && a->c.ap > 0.0 && a->c.Tp > 0.0)
@@ -233,6 +312,14 @@ int pd_cli_case_finish(pd_cli_case *a)
         return pd_cli_usage_error("--dt: %g s over %g s is more than 2e9 steps", a->opts.dt,
                                   a->opts.tend);
     return 0;
+}
+
+int pd_cli_case_finish(pd_cli_case *a)
+{
+    int rc = case_finish(a);
+    if (rc) /* bad input: nothing left behind */
+        pd_cli_case_free(a);
+    return rc;
 }
 
 int pd_cli_is_scene(const pd_cli_case *a)

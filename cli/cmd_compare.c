@@ -157,8 +157,11 @@ int pd_cmd_compare(int argc, char **argv)
     }
     if ((rc = pd_cli_case_finish(&k)))
         return rc;
-    if (pd_cli_is_scene(&k))
-        return compare_scene(&k, want, json);
+    if (pd_cli_is_scene(&k)) {
+        rc = compare_scene(&k, want, json);
+        pd_cli_case_free(&k);
+        return rc;
+    }
 
     pd_trace ref = {0}, work = {0};
     pd_osc_result rr;
@@ -220,7 +223,7 @@ int pd_cmd_compare(int argc, char **argv)
         pd_json_finish(&js);
     } else {
         printf("%s %s pulse, Pi2 = %.6g, Pi3 = %.6g, eps = %g, xi = %g, dt = %.4g s\n",
-               pd_dir_name(k.c.dir), pd_pulse_name(k.c.pulse), k.c.Pi2, k.c.Pi3, k.c.eps, k.c.xi,
+               pd_dir_name(k.c.dir), pd_osc_excitation_name(&k.c), k.c.Pi2, k.c.Pi3, k.c.eps, k.c.xi,
                k.opts.dt);
         printf("  %-10s %14s %12s %12s %8s %10s\n", "method", "umax [m]", "err_umax", "err_hist",
                "impacts", "cpu [s]");
@@ -233,6 +236,7 @@ int pd_cmd_compare(int argc, char **argv)
                        mres[m].r.impacts, mres[m].r.cpu_s);
     }
 done:
+    pd_cli_case_free(&k);
     pd_trace_free(&ref);
     pd_trace_free(&work);
     return status;

@@ -346,7 +346,7 @@ static void case_title(const conv_args *a, const measurer *M, char *buf, size_t 
                  M->sc->nstruct);
     else
         snprintf(buf, cap, "%s %s pulse, Pi2 = %.3g, Pi3 = %.3g, eps = %g", pd_dir_name(a->k.c.dir),
-                 pd_pulse_name(a->k.c.pulse), a->k.c.Pi2, a->k.c.Pi3, a->k.c.eps);
+                 pd_osc_excitation_name(&a->k.c), a->k.c.Pi2, a->k.c.Pi3, a->k.c.eps);
 }
 
 static void print_rows(const conv_args *a, const measurer *M, const row *rows, int n,
@@ -479,7 +479,7 @@ static int write_rows(const conv_args *a, const row *rows, int n, pd_err *err)
                          {"dt", "s", col[2]}, {"kc", "w0^2", col[3]}, {"err_umax_rel", "1", col[4]},
                          {"err_hist_linf", "1", col[5]}, {"cpu_s", "s", col[6]},
                          {"order", "1", col[7]}, {"impacts", "1", col[8]}};
-    pd_attr attrs[] = {{"pulse", NULL, 1, 0, pd_pulse_name(a->k.c.pulse)},
+    pd_attr attrs[] = {{"pulse", NULL, 1, 0, pd_osc_excitation_name(&a->k.c)},
                        {"dir", NULL, 1, 0, pd_dir_name(a->k.c.dir)},
                        {"Pi2", "1", 0, a->k.c.Pi2, NULL}, {"Pi3", "1", 0, a->k.c.Pi3, NULL},
                        {"eps", "1", 0, a->k.c.eps, NULL}, {"xi", "1", 0, a->k.c.xi, NULL},
@@ -500,8 +500,10 @@ int pd_cmd_converge(int argc, char **argv)
         return 0;
     if ((rc = parse_args(&a, argc, argv)))
         return rc;
-    if (a.ndt * a.ntheta + a.nkc > MAX_ROWS)
+    if (a.ndt * a.ntheta + a.nkc > MAX_ROWS) {
+        pd_cli_case_free(&a.k);
         return pd_cli_usage_error("converge: too many rows (at most %d)", MAX_ROWS);
+    }
     memset(&M, 0, sizeof M);
     M.k = &a.k;
     if (pd_cli_is_scene(&a.k) && (status = pd_cli_scene(&a.k, &M.sc)))
@@ -516,5 +518,6 @@ int pd_cmd_converge(int argc, char **argv)
     } else
         print_rows(&a, &M, rows, n, ref_cpu);
     measurer_free(&M);
+    pd_cli_case_free(&a.k);
     return status;
 }

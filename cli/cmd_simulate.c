@@ -191,8 +191,12 @@ static void print_json(const sim_args *a, const pd_osc_summary *s)
     pd_json_num(&js, "Tp", c->Tp);
     pd_json_num(&js, "T0", pd_osc_T0(c));
     pd_json_num(&js, "gap", pd_osc_gap(c));
-    pd_json_str(&js, "pulse", pd_pulse_name(c->pulse));
+    pd_json_str(&js, "pulse", pd_osc_excitation_name(c));
     pd_json_str(&js, "dir", pd_dir_name(c->dir));
+    if (c->record) {
+        pd_json_str(&js, "record", c->record->name);
+        pd_json_num(&js, "scale", c->scale);
+    }
     pd_json_num(&js, "dt", s->r.dt);
     pd_json_num(&js, "theta", s->r.theta);
     pd_json_num(&js, "gamma_active", s->r.gamma);
@@ -205,10 +209,16 @@ static void print_json(const sim_args *a, const pd_osc_summary *s)
 static void print_text(const sim_args *a, const pd_osc_summary *s)
 {
     const pd_osc *c = &a->k.c;
-    printf("pounding oscillator, %s %s pulse: ap = %g m/s^2, Tp = %g s, T0 = %g s, "
-           "gap = %g m, eps = %g, xi = %g\n",
-           pd_dir_name(c->dir), pd_pulse_name(c->pulse), c->ap, c->Tp, pd_osc_T0(c),
-           pd_osc_gap(c), c->eps, c->xi);
+    if (c->record)
+        printf("pounding oscillator, record %s (%s, scale %g; its fitted pulse: ap = %g m/s^2, "
+               "Tp = %g s), T0 = %g s, gap = %g m, eps = %g, xi = %g\n",
+               c->record->name, pd_dir_name(c->dir), c->scale, c->ap, c->Tp, pd_osc_T0(c),
+               pd_osc_gap(c), c->eps, c->xi);
+    else
+        printf("pounding oscillator, %s %s pulse: ap = %g m/s^2, Tp = %g s, T0 = %g s, "
+               "gap = %g m, eps = %g, xi = %g\n",
+               pd_dir_name(c->dir), pd_pulse_name(c->pulse), c->ap, c->Tp, pd_osc_T0(c),
+               pd_osc_gap(c), c->eps, c->xi);
     if (a->k.opts.method == PD_METHOD_MOREAU)
         printf("  Pi2 = %.6g  Pi3 = %.6g   Moreau-Jean theta = %g, dt = %.6g s, %ld steps to %g s\n",
                c->Pi2, c->Pi3, s->r.theta, s->r.dt, s->r.steps, s->r.tend);
@@ -243,7 +253,7 @@ static int write_output(const sim_args *a, const pd_osc_summary *s, const histor
 #define TXT(n, x) {.name = n, .is_text = 1, .text = (x)}
     pd_attr attrs[] = {TXT("command", a->command),
                        TXT("method", pd_method_name(a->k.opts.method)),
-                       TXT("pulse", pd_pulse_name(c->pulse)),
+                       TXT("pulse", pd_osc_excitation_name(c)),
                        TXT("dir", pd_dir_name(c->dir)),
                        NUM("ap", "m/s^2", c->ap),
                        NUM("Tp", "s", c->Tp),
@@ -374,8 +384,12 @@ static void scene_json(const pd_scene *sc, const pd_scene_summary *s)
     pd_json_num(&js, "theta", r->theta);
     pd_json_num(&js, "tend", r->tend);
     pd_json_int(&js, "dofs", sc->n);
-    pd_json_str(&js, "pulse", pd_pulse_name(sc->exc.pulse));
+    pd_json_str(&js, "pulse", sc->exc.record ? sc->exc.record->name : pd_pulse_name(sc->exc.pulse));
     pd_json_str(&js, "dir", sc->exc.dir > 0 ? "+x" : "-x");
+    if (sc->exc.record) {
+        pd_json_str(&js, "record", sc->exc.record->name);
+        pd_json_num(&js, "scale", sc->exc.scale);
+    }
     pd_json_num(&js, "ap", sc->exc.ap);
     pd_json_num(&js, "Tp", sc->exc.Tp);
     pd_json_num(&js, "Le", pd_scene_Le(sc));
@@ -427,11 +441,13 @@ enum { TEXT_MAX_STRUCTURES = 40, TEXT_MAX_CONTACTS = 60 };
 static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_summary *s)
 {
     const pd_scene_result *r = &s->r;
-    printf("scene %s: %d structure%s, %d dof%s, %d contact%s; %s pulse along %s, ap = %g m/s^2, "
-           "Tp = %g s\n",
+    printf("scene %s: %d structure%s, %d dof%s, %d contact%s; %s %s along %s, ap = %g m/s^2, "
+           "Tp = %g s%s\n",
            a->k.scene_path ? a->k.scene_path : "(chain)", sc->nstruct, sc->nstruct > 1 ? "s" : "",
            sc->n, sc->n > 1 ? "s" : "", sc->ncontact, sc->ncontact == 1 ? "" : "s",
-           pd_pulse_name(sc->exc.pulse), sc->exc.dir > 0 ? "+x" : "-x", sc->exc.ap, sc->exc.Tp);
+           sc->exc.record ? "record" : pd_pulse_name(sc->exc.pulse),
+           sc->exc.record ? sc->exc.record->name : "pulse", sc->exc.dir > 0 ? "+x" : "-x",
+           sc->exc.ap, sc->exc.Tp, sc->exc.record ? " (its fitted pulse)" : "");
     if (a->k.opts.method == PD_METHOD_MOREAU)
         printf("  Moreau-Jean theta = %g, dt = %.6g s, %ld steps to %g s (kernel %s, factor %s, "
                "LCP %s, %ld LCPs)\n",
@@ -534,5 +550,7 @@ int pd_cmd_simulate(int argc, char **argv)
         return 0;
     if ((rc = parse_args(&a, argc, argv)))
         return rc;
-    return pd_cli_is_scene(&a.k) ? simulate_scene(&a) : simulate_oscillator(&a);
+    rc = pd_cli_is_scene(&a.k) ? simulate_scene(&a) : simulate_oscillator(&a);
+    pd_cli_case_free(&a.k);
+    return rc;
 }

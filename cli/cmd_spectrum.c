@@ -276,7 +276,13 @@ static int check_args(spec_args *a)
     int rc = pd_cli_case_finish(&checked);
     if (rc)
         return rc;
+    a->k.record = checked.record; /* a record and its pulse: the sweep's */
     s->base = a->k.c;
+    if (a->k.record) { /* its pulse's amplitude (times --scale) unless --ap lists them */
+        pd_osc_set_record(&s->base, &a->k.record->rec, &a->k.record->pulse, a->k.scale);
+        if (!s->dimensional)
+            s->ap[0] = s->base.ap;
+    }
     s->opts = a->k.opts; /* dt and tend stay 0 (per point) unless given */
     if (pd_spec_validate(s, &err))
         return pd_cli_usage_error("%s", err.msg);
@@ -370,9 +376,15 @@ static int write_results(const spec_args *a, const pd_spec_result *res, pd_spec_
 /* Compute and (rank 0) write; the exit status, the same on every rank. */
 static int sweep(spec_args *a, int rank, int size, double wall0)
 {
-    pd_spec_journal j = {-1, "", 0.0, 0};
-    pd_spec_exec ex = {a->threads, rank == 0 && isatty(2), a->stop_after, NULL, rank, size};
-    pd_spec_totals t = {0.0, 0.0, 0.0, pd_spec_tasks(&a->s), 0, pd_spec_threads(a->threads), size};
+    pd_spec_journal j = {.fd = -1};
+    pd_spec_exec ex = {.threads = a->threads,
+                       .progress = rank == 0 && isatty(2),
+                       .stop_after = a->stop_after,
+                       .rank = rank,
+                       .size = size};
+    pd_spec_totals t = {.runs = pd_spec_tasks(&a->s),
+                        .threads = pd_spec_threads(a->threads),
+                        .ranks = size};
     pd_spec_result *res = calloc((size_t)t.runs, sizeof *res);
     pd_err err;
     int status = res ? 0 : 1;
@@ -442,6 +454,7 @@ int pd_cmd_spectrum(int argc, char **argv)
         } else
             rc = sweep(a, rank, size, wall0);
     }
+    pd_cli_case_free(&a->k);
     free(a);
     pd_spec_mpi_finalize();
     return rc;

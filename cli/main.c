@@ -8,12 +8,14 @@ static const char usage[] =
     "usage: pound <command> [options]\n"
     "\n"
     "commands:\n"
-    "  simulate   one run of the pounding oscillator (Moreau-Jean, event-driven, penalty)\n"
+    "  simulate   one run of the pounding oscillator or a scene (Moreau-Jean, event-driven,\n"
+    "             penalty), under a pulse or a record\n"
     "  compare    Moreau-Jean (and penalty) against the event-driven reference\n"
     "  converge   errors and cost as dt shrinks; work-precision charts\n"
     "  spectrum   response spectra Pi1(Pi2) over lists of Pi3, eps, xi, pulses (OpenMP, MPI)\n"
-    "  lcp FILE   solve one linear complementarity problem (Lemke)\n"
-    "  bench      performance figures (--lcp, --engine, --spectrum)\n"
+    "  record F   ground-motion measures and the fitted pulse of strong-motion records\n"
+    "  lcp FILE   solve one linear complementarity problem (Lemke, structured, PGS)\n"
+    "  bench      performance figures (--lcp, --engine, --scene, --spectrum)\n"
     "\n"
     "`pound <command> --help` lists a command's options; docs/ has the details.\n";
 
@@ -34,6 +36,8 @@ int main(int argc, char **argv)
         return pd_cmd_converge(argc - 1, argv + 1);
     if (!strcmp(cmd, "spectrum"))
         return pd_cmd_spectrum(argc - 1, argv + 1);
+    if (!strcmp(cmd, "record"))
+        return pd_cmd_record(argc - 1, argv + 1);
     if (!strcmp(cmd, "bench"))
         return pd_cmd_bench(argc - 1, argv + 1);
     return pd_cli_usage_error("unknown command '%s' (try `pound --help`)", cmd);

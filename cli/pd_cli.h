@@ -15,10 +15,17 @@ int pd_cmd_bench(int argc, char **argv);
 int pd_cmd_compare(int argc, char **argv);
 int pd_cmd_converge(int argc, char **argv);
 int pd_cmd_spectrum(int argc, char **argv);
+int pd_cmd_record(int argc, char **argv);
 
 /* ---- the shared case flags (case.c) ------------------------------------ */
 
 /* What the model, scheme, method and scene flags set, with what was given. */
+/* A record read by a case (--record) and its fitted pulse. */
+typedef struct pd_cli_record {
+    pd_record rec;
+    pd_record_pulse pulse;
+} pd_cli_record;
+
 typedef struct pd_cli_case {
     pd_osc c;
     pd_run_opts opts;
@@ -28,6 +35,13 @@ typedef struct pd_cli_case {
     const char *scene_path; /* --scene F */
     int chain;              /* --chain N (0: none) */
     double chain_ratio;     /* --chain-ratio R */
+    const char *record_path; /* --record F */
+    const char *pulse_flag; /* --pulse, --ap or --Tp when given (refused with --record) */
+    double scale;           /* --scale S */
+    int have_scale;
+    pd_record_format rec_format; /* --record-format */
+    pd_record_units rec_units;   /* --units (text records) */
+    pd_cli_record *record;  /* read by pd_cli_case_finish; released by pd_cli_case_free */
 } pd_cli_case;
 
 extern const char pd_cli_case_help[];
@@ -39,6 +53,13 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i);
 /* Derive T0/gap forms, check ranges; the oscillator gets its dt and tend
  * defaults (a scene gets them from pd_scene_resolve_opts): 0 or 2. */
 int pd_cli_case_finish(pd_cli_case *a);
+/* What pd_cli_case_finish took (the record). */
+void pd_cli_case_free(pd_cli_case *a);
+/* Read a record and fit its pulse: 0, or 2 after printing the file's error. */
+int pd_cli_record_load(const char *path, pd_record_format format, pd_record_units units,
+                       pd_cli_record **out);
+/* The paper's Fig. 2 for up to 6 records (plot_records.c). */
+int pd_plot_records(const char *png, const pd_cli_record *const *recs, int n, pd_err *err);
 /* 1 when --scene or --chain was given. */
 int pd_cli_is_scene(const pd_cli_case *a);
 /* The scene of --scene or --chain, its options checked: 0, or 2 (1 when
@@ -84,6 +105,7 @@ void pd_json_finish(pd_json *js); /* newline after the top-level value */
 int pd_bench_lcp(pd_json *js, const char *shared_dir);
 int pd_bench_engine(pd_json *js);
 int pd_bench_scene(pd_json *js);
+int pd_bench_records(pd_json *js, const char *shared_dir);
 
 /* The least-squares slope of log y against log x over the points added
  * (the growth exponents of the benchmarks); NAN with fewer than two. */

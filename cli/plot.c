@@ -40,11 +40,10 @@ static void slope_guide(FILE *g, const pd_chart *c)
             cv->x[0], c->slope_ref, c->slope_ref);
 }
 
-static int run_gnuplot(const char *data, const char *png_tmp, const pd_chart *c)
+/* The chart's gnuplot script, reading data, writing png_tmp. */
+static void chart_script(FILE *g, const char *data, const char *png_tmp, const void *ctx)
 {
-    FILE *g = popen("gnuplot 2>/dev/null", "w");
-    if (!g)
-        return -1;
+    const pd_chart *c = ctx;
     fprintf(g, "set terminal pngcairo size 900,650 enhanced font 'sans,11'\n");
     fprintf(g, "set output '%s'\nset grid\nset key outside right top\n", png_tmp);
     if (c->logx)
@@ -86,10 +85,23 @@ static int run_gnuplot(const char *data, const char *png_tmp, const pd_chart *c)
     }
     slope_guide(g, c);
     fputc('\n', g);
-    return pclose(g) == 0 ? 0 : -1;
+}
+
+/* The chart's data: one block per curve. */
+static int chart_data(FILE *f, const void *ctx)
+{
+    return write_data(f, ctx);
 }
 
 int pd_plot(const char *png, const pd_chart *chart, pd_err *err)
+{
+    return pd_plot_with(png, chart_data, chart_script, chart, err);
+}
+
+int pd_plot_with(const char *png, int (*data_fn)(FILE *f, const void *ctx),
+                 void (*script_fn)(FILE *g, const char *data, const char *png_tmp,
+                                   const void *ctx),
+                 const void *ctx, pd_err *err)
 {
     char data[] = "/tmp/pound_plotXXXXXX", tmp[4096];
     int fd = mkstemp(data), rc = -1;
@@ -99,12 +111,17 @@ int pd_plot(const char *png, const pd_chart *chart, pd_err *err)
             close(fd);
         return pd_err_set(err, PD_EIO, "--plot: cannot create a temporary data file");
     }
-    int bad = write_data(f, chart);
+    int bad = data_fn(f, ctx);
     if (fclose(f) != 0 || bad)
         goto done;
     if (snprintf(tmp, sizeof tmp, "%s.tmp%ld.png", png, (long)getpid()) >= (int)sizeof tmp)
         goto done;
-    rc = run_gnuplot(data, tmp, chart);
+    FILE *g = popen("gnuplot 2>/dev/null", "w");
+    rc = g ? 0 : -1;
+    if (g) {
+        script_fn(g, data, tmp, ctx);
+        rc = pclose(g) == 0 ? 0 : -1;
+    }
     if (rc == 0 && access(tmp, R_OK) == 0 && rename(tmp, png) == 0)
         rc = 0;
     else {

@@ -90,7 +90,7 @@ static int h5_curve_attrs(hid_t g, const pd_spectrum *s, const pd_spec_row *r, l
 {
     char label[256];
     pd_spec_curve_label(s, curve, label, sizeof label);
-    return pd_h5_attr(g, "label", label, 0) || pd_h5_attr(g, "pulse", pd_pulse_name(r->c.pulse), 0) ||
+    return pd_h5_attr(g, "label", label, 0) || pd_h5_attr(g, "pulse", pd_osc_excitation_name(&r->c), 0) ||
            pd_h5_attr(g, "dir", pd_dir_name(r->c.dir), 0) ||
            pd_h5_attr(g, "method", pd_method_name(s->opts.method), 0) ||
            pd_h5_num(g, "ap", r->c.ap, "m/s^2") || pd_h5_num(g, "Tp", r->c.Tp, "s") ||
@@ -180,7 +180,7 @@ static int write_csv(const char *path, const pd_spectrum *s, const pd_spec_row *
     fputc('\n', f);
     for (long p = 0; p < pd_spec_points(s); p++) {
         const pd_spec_row *r = &rows[p];
-        fprintf(f, "%s,%s,%s,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", pd_pulse_name(r->c.pulse),
+        fprintf(f, "%s,%s,%s,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", pd_osc_excitation_name(&r->c),
                 pd_dir_name(r->c.dir), pd_method_name(s->opts.method), r->c.ap, r->c.Tp,
                 r->c.Pi3, r->gap, r->c.eps, r->c.xi);
         for (int k = 0; k < NCOLS; k++)
@@ -216,7 +216,7 @@ static void common_title(const pd_spectrum *s, char *buf, size_t cap)
     size_t n = (size_t)snprintf(buf, cap, "spectra (%s", pd_method_name(s->opts.method));
 #define ADD(...) (n += (size_t)snprintf(buf + n, n < cap ? cap - n : 0, __VA_ARGS__))
     if (s->npulse == 1)
-        ADD(", %s", pd_pulse_name(s->pulse[0]));
+        ADD(", %s", s->base.record ? s->base.record->name : pd_pulse_name(s->pulse[0]));
     if (s->ndir == 1)
         ADD(" %s", pd_dir_name(s->dir[0]));
     if (s->nsize == 1)
@@ -292,7 +292,7 @@ int pd_spec_plot(const char *png, const pd_spectrum *s, const pd_spec_row *rows,
 static void json_point(pd_json *js, const pd_spectrum *s, const pd_spec_row *r)
 {
     pd_json_begin_object(js, NULL);
-    pd_json_str(js, "pulse", pd_pulse_name(r->c.pulse));
+    pd_json_str(js, "pulse", pd_osc_excitation_name(&r->c));
     pd_json_str(js, "dir", pd_dir_name(r->c.dir));
     pd_json_num(js, "Pi2", r->c.Pi2);
     pd_json_num(js, "Pi3", r->c.Pi3);

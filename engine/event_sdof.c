@@ -4,13 +4,41 @@
  * ends) and CONTACT (x = delta, v = 0 while lambda = F - w0^2 delta >= 0).
  * Events: impact (Newton), detachment (lambda crosses zero downwards),
  * piece boundary (the forcing changes), accumulation (a geometric tail of
- * impacts replaced by its limit). */
+ * impacts replaced by its limit).
+ *
+ * Flight is scanned on intervals of at most the scan step, never across a
+ * piece boundary (a piece shorter than the step is one interval).  On each
+ * interval the velocity is, up to O((w0 h)^2) relative, a quadratic: it has
+ * no zero, one (the ends differ in sign: one extremum, bisected), or two
+ * (the ends agree, the acceleration changes sign between them and the ends
+ * are within reach of zero: the acceleration's zero splits the interval).
+ * The gap's interior minima are thus all located; a maximum beyond the wall
+ * means the gap closed before it (grazing). */
 #include <math.h>
 #include <string.h>
 
 #include "pd_core.h"
 #include "pd_engine.h"
 
+/* The velocity may turn twice inside a scan interval only when it is
+ * within this many |acceleration| * h of zero at an end (2: twice what a
+ * monotone acceleration needs). */
+#define TURN_MARGIN 2.0
+/* Bisection stops at adjacent doubles (relative spacing 2^-52). */
+#define BISECT_REL 2e-16
+#define BISECT_MAX_IT 200
+/* Extrema and the split of a double turn are bisected to this fraction of
+ * the scan step only: x is flat there, x(tc) is off by acc w^2 / 2, about
+ * 1e-17 of the amplitude for w = 4e-8 T / 64 (w0 w ~ 4e-9). */
+#define EXTREMUM_WIDTH 4e-8
+/* A closed-form root is polished inside this many relative ulps. */
+#define ROOT_POLISH_ULPS 16.0
+/* Output times past t_end by this relative amount are still emitted. */
+#define OUT_END_REL 1e-15
+/* Scan intervals per flight at most (a bound on absurd spans only). */
+#define SCAN_MAX_INTERVALS 1e15
+/* Accumulation: bounce heights below this times length_scale are jumped. */
+#define ACC_HEIGHT 1e-10
 
 typedef struct ed_run {
     const pd_ed_sdof *p;
@@ -26,10 +54,52 @@ typedef struct ed_run {
     int stopped;      /* the sampler asked to stop */
 } ed_run;
 
-/* Forcing piece j: A sin(w t + phi). */
-static double piece_force(const pd_sine_piece *pc, double t)
+/* A flight's origin: the piece j and the state there. */
+typedef struct ed_origin {
+    int j;
+    double t, x, v;
+} ed_origin;
+
+/* A point of a flight: x, v, the distance past the wall x - delta (without
+ * cancellation) and the free acceleration. */
+typedef struct ed_point {
+    double t, x, v, past, acc;
+} ed_point;
+
+/* What a bisection brackets the sign change of. */
+typedef enum {
+    ED_GAP,        /* x - delta: gap closing */
+    ED_NEG_V,      /* -v: a maximum */
+    ED_NEG_LAMBDA, /* -lambda: detachment */
+    ED_V,          /* v: a minimum */
+    ED_ACC,        /* acceleration: v's minimum */
+    ED_NEG_ACC     /* -acceleration: v's maximum */
+} ed_kind;
+
+/* F(t) of piece j. */
+static double piece_force(const ed_run *ed, int j, double t)
 {
-    return pc->A == 0.0 ? 0.0 : pc->A * sin(pc->w * t + pc->phi);
+    return pd_sine_piece_force(&ed->p->pieces[j], t);
+}
+
+/* lambda = F - w0^2 delta: the wall's force on the resting oscillator. */
+static double lambda_at(const ed_run *ed, int j, double t)
+{
+    const pd_sdof *osc = &ed->p->osc;
+    return piece_force(ed, j, t) - osc->w0 * osc->w0 * ed->p->delta;
+}
+
+/* x'' = F - 2 xi w0 v - w0^2 x (free flight). */
+static double free_accel(const ed_run *ed, int j, double t, double x, double v)
+{
+    const pd_sdof *osc = &ed->p->osc;
+    return piece_force(ed, j, t) - 2.0 * osc->xi * osc->w0 * v - osc->w0 * osc->w0 * x;
+}
+
+/* Free acceleration toward the wall at x = delta with velocity v. */
+static double wall_accel(const ed_run *ed, int j, double t, double v)
+{
+    return free_accel(ed, j, t, ed->p->delta, v);
 }
 
 /* End of piece j (the next start, or +inf). */
@@ -38,35 +108,35 @@ static double piece_end(const pd_ed_sdof *p, int j)
     return j + 1 < p->npieces ? p->pieces[j + 1].t_start : HUGE_VAL;
 }
 
-/* Exact displacement increment dx = x(t) - xa and velocity at t from
- * (ta, xa, va) under piece j. */
-static void flow_inc(const ed_run *ed, int j, double ta, double xa, double va, double t,
-                     double *dx, double *v)
+/* Exact increment dx = x(t) - x_o and velocity at t from the origin. */
+static void flow_inc(const ed_run *ed, const ed_origin *o, double t, double *dx, double *v)
 {
-    const pd_sine_piece *pc = &ed->p->pieces[j];
-    if (t == ta) {
+    if (t == o->t) {
         *dx = 0.0;
-        *v = va;
+        *v = o->v;
         return;
     }
-    pd_sdof_increment(&ed->p->osc, pc->A, pc->w, pc->phi, ta, xa, va, t, dx, v);
+    pd_sdof_increment_piece(&ed->p->osc, &ed->p->pieces[o->j], o->t, o->x, o->v, t, dx, v);
 }
 
-/* Exact state at t from (ta, xa, va) under piece j. */
-static void flow(const ed_run *ed, int j, double ta, double xa, double va, double t, double *x,
-                 double *v)
-{
-    double dx;
-    flow_inc(ed, j, ta, xa, va, t, &dx, v);
-    *x = xa + dx;
-}
-
-/* Signed distance past the wall, x(t) - delta, without cancellation. */
-static double past_wall(const ed_run *ed, int j, double ta, double xa, double va, double t)
+/* The flight's point at t: past = (x_o - delta) + dx, and x clipped to the
+ * wall when only rounding puts it beyond (past <= 0). */
+static ed_point probe(const ed_run *ed, const ed_origin *o, double t)
 {
     double dx, v;
-    flow_inc(ed, j, ta, xa, va, t, &dx, &v);
-    return (xa - ed->p->delta) + dx;
+    flow_inc(ed, o, t, &dx, &v);
+    ed_point q = {.t = t, .x = o->x + dx, .v = v, .past = (o->x - ed->p->delta) + dx};
+    if (ed->p->wall && q.past <= 0.0 && q.x > ed->p->delta)
+        q.x = ed->p->delta;
+    return q;
+}
+
+/* probe plus the free acceleration (the scan grid's points). */
+static ed_point probe_acc(const ed_run *ed, const ed_origin *o, double t)
+{
+    ed_point q = probe(ed, o, t);
+    q.acc = free_accel(ed, o->j, t, q.x, q.v);
+    return q;
 }
 
 /* Extremes over the measuring window. */
@@ -79,18 +149,21 @@ static void note(ed_run *ed, double t, double x)
     ed->r->xaway = fmax(ed->r->xaway, -x);
 }
 
-/* Output times in (.., tb] of a free piece (or resting when in_contact). */
-static void emit(ed_run *ed, int j, double ta, double xa, double va, double tb, int in_contact)
+/* Output times in (.., tb] of a flight (or resting at x_o when in_contact). */
+static void emit(ed_run *ed, const ed_origin *o, double tb, int in_contact)
 {
     if (!ed->sampler || ed->o->h_out <= 0.0 || ed->stopped)
         return;
     for (;;) {
         double t = ed->t_first + (double)ed->next_out * ed->o->h_out;
-        if (t > tb || t > ed->o->t_end * (1 + 1e-15))
+        if (t > tb || t > ed->o->t_end * (1 + OUT_END_REL))
             return;
-        double x = xa, v = 0.0;
-        if (!in_contact)
-            flow(ed, j, ta, xa, va, t, &x, &v);
+        double x = o->x, v = 0.0;
+        if (!in_contact) {
+            ed_point q = probe(ed, o, t);
+            x = q.x;
+            v = q.v;
+        }
         ed->next_out++;
         if (ed->sampler(t, x, v, in_contact, ed->ctx) > 0) {
             ed->stopped = 1;
@@ -99,26 +172,30 @@ static void emit(ed_run *ed, int j, double ta, double xa, double va, double tb, 
     }
 }
 
-/* Bisection on the sign of f between lo (f <= 0) and hi (f > 0), to
- * adjacent doubles; returns hi.  kind 0: f = x - delta (gap closing),
- * 1: f = -v (a maximum), 2: f = -lambda (detachment), 3: f = v (a minimum). */
-static double bisect(const ed_run *ed, int j, double ta, double xa, double va, int kind, double lo,
-                     double hi)
+/* The bracketed function of kind at t. */
+static double bracket_value(const ed_run *ed, const ed_origin *o, ed_kind kind, double t)
 {
-    const pd_sdof *osc = &ed->p->osc;
-    for (int it = 0; it < 200 && hi - lo > 2e-16 * fmax(fabs(hi), 1e-300); it++) {
-        double mid = 0.5 * (lo + hi), x, v, f;
+    if (kind == ED_NEG_LAMBDA)
+        return -lambda_at(ed, o->j, t);
+    if (kind == ED_ACC || kind == ED_NEG_ACC) {
+        ed_point q = probe_acc(ed, o, t);
+        return kind == ED_ACC ? q.acc : -q.acc;
+    }
+    ed_point q = probe(ed, o, t);
+    return kind == ED_GAP ? q.past : kind == ED_NEG_V ? -q.v : q.v;
+}
+
+/* Bisection on the sign of f between lo (f <= 0) and hi (f > 0), to
+ * adjacent doubles (or to the width w > 0); returns hi. */
+static double bisect_to(const ed_run *ed, const ed_origin *o, ed_kind kind, double lo, double hi,
+                        double w)
+{
+    for (int it = 0; it < BISECT_MAX_IT && hi - lo > fmax(w, BISECT_REL * fmax(fabs(hi), 1e-300));
+         it++) {
+        double mid = 0.5 * (lo + hi);
         if (mid <= lo || mid >= hi)
             break;
-        if (kind == 2)
-            f = -(piece_force(&ed->p->pieces[j], mid) - osc->w0 * osc->w0 * ed->p->delta);
-        else if (kind == 0)
-            f = past_wall(ed, j, ta, xa, va, mid);
-        else {
-            flow(ed, j, ta, xa, va, mid, &x, &v);
-            f = kind == 1 ? -v : v;
-        }
-        if (f > 0.0)
+        if (bracket_value(ed, o, kind, mid) > 0.0)
             hi = mid;
         else
             lo = mid;
@@ -126,78 +203,169 @@ static double bisect(const ed_run *ed, int j, double ta, double xa, double va, i
     return hi;
 }
 
-/* Free flight from (ta, xa, va) under piece j up to tb.  Returns 1 with
- * *t_hit when the gap closes first (exactly x = delta), else 0 with the
- * state at tb.  Every velocity zero inside is an extremum (noted); a
- * maximum beyond the wall means the gap closed before it (grazing). */
-static int free_flight(ed_run *ed, int j, double ta, double xa, double va, double tb,
-                       double *t_hit, double *x_end, double *v_end)
+/* Event times (gap closing, detachment): to adjacent doubles. */
+static double bisect(const ed_run *ed, const ed_origin *o, ed_kind kind, double lo, double hi)
 {
-    double a = ta, x_a = xa, v_a = va;
-    const double delta = ed->p->delta;
-    while (a < tb) {
-        double b = fmin(a + ed->scan, tb), xb, vb, hit = -1.0;
-        flow(ed, j, ta, xa, va, b, &xb, &vb);
-        if (v_a != 0.0 && (v_a > 0.0) != (vb > 0.0)) { /* extremum inside (a, b] */
-            double tc = bisect(ed, j, ta, xa, va, v_a > 0.0 ? 1 : 3, a, b), xc, vc;
-            flow(ed, j, ta, xa, va, tc, &xc, &vc);
-            if (ed->p->wall && v_a > 0.0 && past_wall(ed, j, ta, xa, va, tc) > 0.0)
-                hit = bisect(ed, j, ta, xa, va, 0, a, tc);
-            else
-                note(ed, tc, xc);
+    return bisect_to(ed, o, kind, lo, hi, 0.0);
+}
+
+/* Velocity and acceleration zeros: to EXTREMUM_WIDTH of the scan step. */
+static double bisect_turn(const ed_run *ed, const ed_origin *o, ed_kind kind, double lo, double hi)
+{
+    return bisect_to(ed, o, kind, lo, hi, EXTREMUM_WIDTH * ed->scan);
+}
+
+/* Sign of x (0 at 0). */
+static int sgn(double x)
+{
+    return (x > 0.0) - (x < 0.0);
+}
+
+/* Direction of motion just after q: v's sign, or the acceleration's at v = 0. */
+static int dir_after(const ed_point *q)
+{
+    return q->v != 0.0 ? sgn(q->v) : sgn(q->acc);
+}
+
+/* One velocity zero at most in (a, b]: locate it (an extremum, noted, or
+ * beyond the wall: the gap closed before it), then the gap at b.  Returns
+ * the impact time or -1. */
+static double scan_simple(ed_run *ed, const ed_origin *o, const ed_point *a, const ed_point *b)
+{
+    int s = dir_after(a), wall = ed->p->wall;
+    double hit = -1.0;
+    if (s != 0 && sgn(b->v) != s) {
+        double tc = bisect_turn(ed, o, s > 0 ? ED_NEG_V : ED_V, a->t, b->t);
+        ed_point c = probe(ed, o, tc);
+        if (wall && s > 0 && c.past > 0.0)
+            hit = bisect(ed, o, ED_GAP, a->t, tc);
+        else
+            note(ed, tc, c.x);
+    }
+    if (hit < 0.0 && wall && b->past > 0.0)
+        hit = bisect(ed, o, ED_GAP, a->t, b->t);
+    return hit;
+}
+
+/* v has the sign s at both ends and may dip through zero between: the
+ * acceleration turns v back toward s inside and v is within reach of zero
+ * at an end.  With a monotone acceleration, |v(a) - v(t)| <= |acc(a)| h. */
+static int may_turn_twice(const ed_point *a, const ed_point *b, int s)
+{
+    double h = b->t - a->t;
+    if (!(s * a->acc < 0.0 && s * b->acc > 0.0))
+        return 0;
+    return fabs(a->v) <= TURN_MARGIN * fabs(a->acc) * h ||
+           fabs(b->v) <= TURN_MARGIN * fabs(b->acc) * h;
+}
+
+/* One scan interval (a, b]: a velocity dip through zero and back is split
+ * at the acceleration's zero into two intervals of one turn each. */
+static double scan_interval(ed_run *ed, const ed_origin *o, const ed_point *a, const ed_point *b)
+{
+    int s = dir_after(a);
+    if (s != 0 && sgn(b->v) == s && may_turn_twice(a, b, s)) {
+        double tm = bisect_turn(ed, o, s > 0 ? ED_ACC : ED_NEG_ACC, a->t, b->t);
+        ed_point m = probe_acc(ed, o, tm);
+        if (sgn(m.v) != s) {
+            double hit = scan_simple(ed, o, a, &m);
+            if (hit >= 0.0)
+                return hit;
+            note(ed, m.t, m.x);
+            return scan_simple(ed, o, &m, b);
         }
-        if (hit < 0.0 && ed->p->wall && past_wall(ed, j, ta, xa, va, b) > 0.0)
-            hit = bisect(ed, j, ta, xa, va, 0, a, b);
+    }
+    return scan_simple(ed, o, a, b);
+}
+
+/* Scan intervals for a flight span: equal ones of at most the scan step. */
+static long scan_count(const ed_run *ed, double span)
+{
+    return span > 0.0 ? (long)fmin(fmax(1.0, ceil(span / ed->scan)), SCAN_MAX_INTERVALS) : 0;
+}
+
+/* Free flight from the origin up to tb.  Returns 1 with *t_hit when the gap
+ * closes first (exactly x = delta), else 0 with the state at tb.  Every
+ * velocity zero inside is an extremum (noted). */
+static int free_flight(ed_run *ed, const ed_origin *o, double tb, double *t_hit, double *x_end,
+                       double *v_end)
+{
+    ed_point a = {.t = o->t, .x = o->x, .v = o->v, .past = o->x - ed->p->delta};
+    a.acc = free_accel(ed, o->j, o->t, o->x, o->v);
+    long n = scan_count(ed, tb - o->t);
+    for (long i = 1; i <= n; i++) {
+        double tbi = i == n ? tb : o->t + (tb - o->t) * ((double)i / (double)n);
+        ed_point b = probe_acc(ed, o, tbi);
+        double hit = scan_interval(ed, o, &a, &b);
         if (hit >= 0.0) {
-            emit(ed, j, ta, xa, va, hit, 0);
+            emit(ed, o, hit, 0);
             *t_hit = hit;
-            flow(ed, j, ta, xa, va, hit, x_end, v_end);
-            *x_end = delta;
-            note(ed, hit, delta);
+            *v_end = probe(ed, o, hit).v;
+            *x_end = ed->p->delta;
+            note(ed, hit, ed->p->delta);
             return 1;
         }
-        note(ed, b, xb);
-        emit(ed, j, ta, xa, va, b, 0);
+        note(ed, b.t, b.x);
+        emit(ed, o, b.t, 0);
         a = b;
-        x_a = xb;
-        v_a = vb;
     }
-    *x_end = x_a;
-    *v_end = v_a;
+    *x_end = a.x;
+    *v_end = a.v;
     return 0;
+}
+
+/* lambda is linear on a linear piece: its zero ta + lambda(ta) / -c1,
+ * polished by bisection to the first double where lambda < 0 (the whole
+ * [ta, tb] when rounding puts the root outside its small bracket). */
+static double detach_linear(const ed_run *ed, int j, double ta, double tb)
+{
+    double c1 = ed->p->pieces[j].c1, lam_a = lambda_at(ed, j, ta);
+    ed_origin o = {.j = j, .t = ta};
+    if (lam_a < 0.0)
+        return ta;
+    if (!(c1 < 0.0) || !(lambda_at(ed, j, tb) < 0.0))
+        return tb;
+    double tr = fmin(fmax(ta + lam_a / -c1, ta), tb);
+    double pad = ROOT_POLISH_ULPS * BISECT_REL * fmax(fabs(tr), 1e-300);
+    double lo = fmax(tr - pad, ta), hi = fmin(tr + pad, tb);
+    if (!(lambda_at(ed, j, lo) >= 0.0 && lambda_at(ed, j, hi) < 0.0)) {
+        lo = ta;
+        hi = tb;
+    }
+    return bisect(ed, &o, ED_NEG_LAMBDA, lo, hi);
+}
+
+/* lambda of a sinusoid: scanned for a negative value, then bisected. */
+static double detach_scan(const ed_run *ed, int j, double ta, double tb)
+{
+    ed_origin o = {.j = j, .t = ta};
+    long n = scan_count(ed, tb - ta);
+    for (long i = 1; i <= n; i++) {
+        double a = ta + (tb - ta) * ((double)(i - 1) / (double)n);
+        double b = i == n ? tb : ta + (tb - ta) * ((double)i / (double)n);
+        if (lambda_at(ed, j, b) < 0.0)
+            return bisect(ed, &o, ED_NEG_LAMBDA, a, b);
+    }
+    return tb;
 }
 
 /* Resting on the wall from ta under piece j: the time lambda turns negative
  * (detachment), or tb if it stays >= 0. */
 static double rest(ed_run *ed, int j, double ta, double tb)
 {
-    const pd_sdof *osc = &ed->p->osc;
-    double k_delta = osc->w0 * osc->w0 * ed->p->delta, a = ta, td = tb;
-    while (a < tb) {
-        double b = fmin(a + ed->scan, tb);
-        if (piece_force(&ed->p->pieces[j], b) - k_delta < 0.0) {
-            td = bisect(ed, j, ta, 0, 0, 2, a, b);
-            break;
-        }
-        a = b;
-    }
+    double td = ed->p->pieces[j].A == 0.0 ? detach_linear(ed, j, ta, tb)
+                                          : detach_scan(ed, j, ta, tb);
+    ed_origin o = {.j = j, .t = ta, .x = ed->p->delta, .v = 0.0};
     note(ed, ta, ed->p->delta);
-    emit(ed, j, ta, ed->p->delta, 0.0, td, 1);
+    emit(ed, &o, td, 1);
     ed->r->contact_time += td - ta;
     return td;
 }
 
-/* Free acceleration toward the wall at x = delta with velocity v. */
-static double wall_accel(const ed_run *ed, int j, double t, double v)
-{
-    const pd_sdof *osc = &ed->p->osc;
-    return piece_force(&ed->p->pieces[j], t) - 2.0 * osc->xi * osc->w0 * v -
-           osc->w0 * osc->w0 * ed->p->delta;
-}
-
 /* Scan step: the shortest period present over divisions (default 64),
  * independent of the run's length so that results do not move with t_end;
- * span/4 over divisions only when no period exists (free mass, constant force). */
+ * span/4 over divisions only when no period exists (free mass, linear
+ * forcing).  Pieces shorter than the step are scanned at their ends. */
 static double scan_step(const pd_ed_sdof *p, double span, int divisions)
 {
     double T = HUGE_VAL;
@@ -221,6 +389,24 @@ static int count_event(ed_run *ed, double t, pd_err *err)
     return PD_OK;
 }
 
+/* Piece starts finite and in order. */
+static int check_pieces(const pd_ed_sdof *p, pd_err *err)
+{
+    for (int j = 0; j < p->npieces; j++) {
+        const pd_sine_piece *pc = &p->pieces[j];
+        if (!isfinite(pc->t_start) || (j > 0 && pc->t_start < p->pieces[j - 1].t_start))
+            return pd_err_set(err, PD_EINVAL,
+                              "event-driven: forcing piece %d starts at %g, not finite and "
+                              "in order",
+                              j, pc->t_start);
+        if (!isfinite(pc->A) || !isfinite(pc->w) || !isfinite(pc->phi) || !isfinite(pc->c0) ||
+            !isfinite(pc->c1))
+            return pd_err_set(err, PD_EINVAL, "event-driven: forcing piece %d is not finite",
+                              j);
+    }
+    return PD_OK;
+}
+
 static int check_problem(const pd_ed_sdof *p, const pd_ed_opts *o, pd_err *err)
 {
     if (!p || p->npieces < 1 || !p->pieces)
@@ -236,7 +422,7 @@ static int check_problem(const pd_ed_sdof *p, const pd_ed_opts *o, pd_err *err)
         return pd_err_set(err, PD_EINVAL,
                           "event-driven: budgets and scan divisions must be >= 1 and the length "
                           "scale > 0");
-    return PD_OK;
+    return check_pieces(p, err);
 }
 
 pd_ed_opts pd_ed_default_opts(void)
@@ -253,7 +439,8 @@ pd_ed_opts pd_ed_default_opts(void)
 
 /* After an impact at t with post-impact speed vp (<= 0): 1 when the
  * oscillator should rest (lambda > 0 and either vp = 0 or an accumulation
- * is jumped to *t_rest), 0 to fly on. */
+ * is jumped to *t_rest), 0 to fly on.  On a linear piece the acceleration
+ * at the wall is linear, so its sign at both ends of the tail holds between. */
 static int settle(ed_run *ed, int j, double t, double vp, double tb, double *t_rest)
 {
     double a = wall_accel(ed, j, t, vp), e = ed->p->e;
@@ -264,12 +451,45 @@ static int settle(ed_run *ed, int j, double t, double vp, double tb, double *t_r
         return 0;
     double height = vp * vp / (2.0 * a), scale = ed->o->length_scale;
     double tail = 2.0 * fabs(vp) / (a * (1.0 - e));
-    if (height > 1e-10 * scale || t + tail >= tb || !(wall_accel(ed, j, t + tail, 0.0) > 0.0) ||
-        !(wall_accel(ed, j, t + 0.5 * tail, 0.0) > 0.0))
+    if (height > ACC_HEIGHT * scale || t + tail >= tb ||
+        !(wall_accel(ed, j, t + tail, 0.0) > 0.0) || !(wall_accel(ed, j, t + 0.5 * tail, 0.0) > 0.0))
         return 0;
     *t_rest = t + tail; /* bouncing-ball limit: sum of the geometric flight times */
     ed->r->accumulations++;
     return 1;
+}
+
+/* An impact at t_hit with speed vn: Newton's law, then rest (an
+ * accumulation jumped or e = 0) or flight.  PD_EBUDGET when the burst of
+ * impacts exceeds its budget. */
+static int impact(ed_run *ed, int j, double t_hit, double vn, double tb, double *t, double *v,
+                  int *resting, pd_err *err)
+{
+    pd_ed_result *res = ed->r;
+    double t_rest;
+    res->impacts++;
+    if (isnan(res->first_impact)) {
+        res->first_impact = t_hit;
+        res->first_impact_velocity = vn;
+    }
+    res->max_impact_velocity = fmax(res->max_impact_velocity, vn);
+    *t = t_hit;
+    if (++ed->burst > ed->max_burst)
+        return pd_err_set(err, PD_EBUDGET,
+                          "event-driven: accumulation of impacts at t = %.9g: %ld impacts "
+                          "without reaching persistent contact%s",
+                          t_hit, ed->burst - 1,
+                          ed->o->no_accumulation ? " (accumulation handling is off)" : "");
+    *v = -ed->p->e * vn;
+    if (settle(ed, j, t_hit, *v, tb, &t_rest)) {
+        ed_origin o = {.j = j, .t = t_hit, .x = ed->p->delta, .v = 0.0};
+        emit(ed, &o, t_rest, 1);
+        *t = t_rest;
+        *v = 0.0;
+        *resting = 1;
+        ed->burst = 0;
+    }
+    return PD_OK;
 }
 
 int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opts *opts,
@@ -299,7 +519,7 @@ int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opt
         resting = v == 0.0 && wall_accel(&ed, j, t, 0.0) > 0.0;
     }
     while (t < opts->t_end && !ed.stopped) {
-        double tb = fmin(piece_end(prob, j), opts->t_end), t_hit, xn, vn, t_rest;
+        double tb = fmin(piece_end(prob, j), opts->t_end), t_hit, xn, vn;
         if ((rc = count_event(&ed, t, err)))
             break;
         if (resting) {
@@ -312,35 +532,14 @@ int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opt
             t = td;
             x = prob->delta;
             v = 0.0;
-        } else if (free_flight(&ed, j, t, x, v, tb, &t_hit, &xn, &vn)) {
-            /* impact: Newton's law, then rest, jump an accumulation, or fly */
-            res->impacts++;
-            if (isnan(res->first_impact)) {
-                res->first_impact = t_hit;
-                res->first_impact_velocity = vn;
-            }
-            res->max_impact_velocity = fmax(res->max_impact_velocity, vn);
-            if (++ed.burst > ed.max_burst) {
-                rc = pd_err_set(err, PD_EBUDGET,
-                                "event-driven: accumulation of impacts at t = %.9g: %ld impacts "
-                                "without reaching persistent contact%s",
-                                t_hit, ed.burst - 1,
-                                opts->no_accumulation ? " (accumulation handling is off)" : "");
-                t = t_hit;
-                break;
-            }
-            t = t_hit;
-            x = prob->delta;
-            v = -prob->e * vn;
-            if (settle(&ed, j, t, v, tb, &t_rest)) {
-                emit(&ed, j, t, x, 0.0, t_rest, 1);
-                t = t_rest;
-                v = 0.0;
-                resting = 1;
-                ed.burst = 0;
-            }
-            continue;
         } else {
+            ed_origin o = {.j = j, .t = t, .x = x, .v = v};
+            if (free_flight(&ed, &o, tb, &t_hit, &xn, &vn)) {
+                x = prob->delta;
+                if ((rc = impact(&ed, j, t_hit, vn, tb, &t, &v, &resting, err)))
+                    break;
+                continue;
+            }
             t = tb;
             x = xn;
             v = vn;

@@ -251,43 +251,67 @@ int pd_penalty_run(const pd_model *model, double t0, const double *q0, const dou
 
 /* ---- closed forms for one linear oscillator --------------------------- */
 
-/* u'' + 2 xi w0 u' + w0^2 u = A sin(w t + phi),  0 <= xi < 1, w0 >= 0.
- * Advance the exact solution from (u0, v0) at t0 to t1 (A = 0: free
- * vibration); resonance with xi = 0 is handled; w0 = 0 is a free mass
- * (then xi is ignored; w = 0 is the constant force A sin(phi)). */
+/* u'' + 2 xi w0 u' + w0^2 u = F(t),  0 <= xi < 1, w0 >= 0 (w0 = 0: a free
+ * mass, xi ignored). */
 typedef struct pd_sdof {
     double w0, xi;
 } pd_sdof;
 
+/* One piece of forcing, from t_start until the next piece's t_start:
+ *   F(t) = A sin(w t + phi) + c0 + c1 (t - t_start).
+ * c0 = c1 = 0 (what designated or positional initialisers leave out) is the
+ * pure sinusoid; A = 0 with c0, c1 is one linear segment of a sampled record
+ * (w = 0 with A is the constant A sin(phi)). */
+typedef struct pd_sine_piece {
+    double t_start, A, w, phi;
+    double c0, c1;
+} pd_sine_piece;
+
+/* F(t) of one piece (t need not lie inside it). */
+double pd_sine_piece_force(const pd_sine_piece *pc, double t);
+
+/* Advance the exact solution under the piece pc from (u0, v0) at t0 to t1:
+ * the sinusoid's particular solution plus the damped free vibration
+ * (undamped resonance handled), and by linearity the response to the linear
+ * term from rest, u(h) = f0 G1(h) + c1 G2(h) with f0 = F_lin(t0) and G1, G2
+ * the first two integrals of the impulse response (Taylor series for
+ * w0 |t1 - t0| <= 1, closed forms beyond).  The increment form returns
+ * du = u(t1) - u0 computed without cancellation (full relative precision
+ * for short intervals). */
+void pd_sdof_increment_piece(const pd_sdof *osc, const pd_sine_piece *pc, double t0, double u0,
+                             double v0, double t1, double *du, double *v1);
+void pd_sdof_advance_piece(const pd_sdof *osc, const pd_sine_piece *pc, double t0, double u0,
+                           double v0, double t1, double *u1, double *v1);
+
+/* The sinusoid alone, F = A sin(w t + phi) (A = 0: free vibration; w = 0
+ * with w0 = 0: the constant force A sin(phi)): the piece {t0, A, w, phi}. */
 void pd_sdof_advance(const pd_sdof *osc, double A, double w, double phi, double t0, double u0,
                      double v0, double t1, double *u1, double *v1);
-
-/* The same, returning the displacement increment du = u(t1) - u0 computed
- * without cancellation (full relative precision for short intervals). */
 void pd_sdof_increment(const pd_sdof *osc, double A, double w, double phi, double t0, double u0,
                        double v0, double t1, double *du, double *v1);
 
 /* ---- event-driven reference: one oscillator, one wall (event_sdof.c) --
 
  *   x'' + 2 xi w0 x' + w0^2 x = F(t) - lambda,  g = delta - x >= 0,
- * F piecewise sinusoidal.  Exact closed-form flight between events; gap
- * closings (and grazing) located by bracketing on a scan grid plus
- * bisection to machine precision; Newton impacts; persistent contact while
- * lambda = F - w0^2 delta >= 0 (the acceleration-level LCP of one contact);
- * accumulations of impacts jumped with the bouncing-ball tail
- * t_inf = t_i + 2 v+ / (a (1 - e)).  Extremes are the exact continuous ones. */
-
-/* F(t) = A sin(w t + phi) from t_start until the next piece's t_start. */
-typedef struct pd_sine_piece {
-    double t_start, A, w, phi;
-} pd_sine_piece;
+ * F piecewise: sinusoids plus linear terms (pd_sine_piece; a strong-motion
+ * record is one linear piece per sample interval).  Exact closed-form
+ * flight between events; gap closings (and grazing) located by bracketing
+ * on a scan grid (the shortest period / scan_divisions, never wider than a
+ * piece) plus bisection to machine precision, a turn of the velocity and
+ * back inside one scan interval included; Newton impacts; persistent
+ * contact while lambda = F - w0^2 delta >= 0 (the acceleration-level LCP of
+ * one contact; on a linear piece its zero is closed-form); accumulations of
+ * impacts jumped with the bouncing-ball tail t_inf = t_i + 2 v+ / (a (1 - e)).
+ * Extremes are the exact continuous ones.  Each piece boundary is one cheap
+ * event (one closed-form evaluation per scan interval). */
 
 typedef struct pd_ed_sdof {
     pd_sdof osc;
     int wall;       /* 0: no wall (the free twin) */
     double delta;   /* wall at x = delta >= 0 */
     double e;       /* Newton restitution in [0, 1] */
-    int npieces;    /* >= 1; pieces[0].t_start is the start time */
+    int npieces;    /* >= 1; pieces[0].t_start is the start time, starts
+                       non-decreasing and finite (PD_EINVAL otherwise) */
     const pd_sine_piece *pieces;
 } pd_ed_sdof;
 

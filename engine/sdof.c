@@ -1,18 +1,81 @@
-/* sdof.c — exact motion of one damped linear oscillator under a sinusoid.
+/* sdof.c — exact motion of one damped linear oscillator under one forcing
+ * piece F(t) = A sin(w t + phi) + c0 + c1 (t - t_start).
  *
  * Everything is computed as increments from the start state, with expm1 and
  * half-angle forms, so that u(t1) - u0 keeps full relative precision for
- * short intervals: the event-driven reference finds gap closings with it. */
+ * short intervals: the event-driven reference finds gap closings with it.
+ *
+ * The linear part uses the impulse response g(s) = e^{-a s} sin(wd s) / wd
+ * (a = xi w0, wd = w0 sqrt(1 - xi^2)) and its integrals G1 = int_0^h g,
+ * G2 = int_0^h G1.  By Duhamel, from (u0, v0) under f0 + c1 s:
+ *   u(h) - u0 = v0 g + (f0 - w0^2 u0) G1 + c1 G2,
+ *   v(h) - v0 = (f0 - 2 a v0 - w0^2 u0) g + (c1 - w0^2 v0) G1,
+ * with g ~ h, G1 ~ h^2/2, G2 ~ h^3/6: each term is one of the increment's
+ * Taylor terms, so nothing cancels that the motion does not cancel itself. */
 #include <math.h>
 
 #include "pd_engine.h"
 
-/* sin(b) - sin(a) and cos(b) - cos(a) without cancellation. */
-static void sin_cos_diff(double a, double b, double *ds, double *dc)
+/* Below this w0 h the kernels are summed as Taylor series (the closed forms
+ * lose up to (w0 h)^-3 of their digits for small w0 h). */
+#define KERNEL_SERIES_MAX 1.0
+/* Series terms: |p_k| <= (w0 h)^k / k!, 1/18! < 1e-16. */
+#define KERNEL_MAX_TERMS 40
+/* A series stops once two consecutive terms are this small relative to g. */
+#define KERNEL_SERIES_TOL 1e-18
+
+/* The impulse response and its first two integrals at h. */
+typedef struct kernels {
+    double g, G1, G2;
+} kernels;
+
+/* sin(a + d) - sin(a) and cos(a + d) - cos(a) without cancellation (the
+ * phase step d passed as such: w (t1 - t0), not a difference of phases). */
+static void sin_cos_diff(double a, double d, double *ds, double *dc)
 {
-    double h = sin(0.5 * (b - a)), m = 0.5 * (a + b);
+    double h = sin(0.5 * d), m = a + 0.5 * d;
     *ds = 2.0 * cos(m) * h;
     *dc = -2.0 * sin(m) * h;
+}
+
+/* Taylor series: p_1 = h, p_{k+1} = -(2 a h p_k + (w0 h)^2 p_{k-1} / k) / (k + 1);
+ * g = sum p_k, G1 = h sum p_k / (k+1), G2 = h^2 sum p_k / ((k+1)(k+2)). */
+static kernels kernels_series(double w0, double a, double h)
+{
+    double z2 = (w0 * h) * (w0 * h), ah2 = 2.0 * a * h, prev = 0.0, cur = h;
+    double g = 0.0, s1 = 0.0, s2 = 0.0;
+    for (int k = 1; k <= KERNEL_MAX_TERMS; k++) {
+        double next = -(ah2 * cur + z2 * prev / k) / (k + 1);
+        g += cur;
+        s1 += cur / (k + 1);
+        s2 += cur / ((double)(k + 1) * (k + 2));
+        if (fabs(cur) + fabs(next) <= KERNEL_SERIES_TOL * fabs(g))
+            break;
+        prev = cur;
+        cur = next;
+    }
+    return (kernels){.g = g, .G1 = h * s1, .G2 = h * h * s2};
+}
+
+/* Closed forms: g = e^{-a h} sin(wd h) / wd, G1 = (1 - e^{-a h}(cos + a/wd sin)) / w0^2,
+ * G2 = (h - g - 2 a G1) / w0^2 (integrate g' = 1 - 2 a g - w0^2 G1 twice). */
+static kernels kernels_closed(double w0, double xi, double h)
+{
+    double a = xi * w0, wd = w0 * sqrt(1.0 - xi * xi), k = w0 * w0;
+    double em1 = expm1(-a * h), ex = 1.0 + em1, half = sin(0.5 * wd * h);
+    double cs_m1 = -2.0 * half * half, cs = cos(wd * h);
+    double g = ex * sin(wd * h) / wd;
+    double G1 = -(em1 * cs + cs_m1 + a * g) / k;
+    return (kernels){.g = g, .G1 = G1, .G2 = (h - g - 2.0 * a * G1) / k};
+}
+
+/* g, G1, G2 of the oscillator at h (w0 = 0: h, h^2/2, h^3/6). */
+static kernels kernels_at(const pd_sdof *osc, double h)
+{
+    double w0 = osc->w0, a = w0 > 0.0 ? osc->xi * w0 : 0.0;
+    if (fabs(w0 * h) <= KERNEL_SERIES_MAX)
+        return kernels_series(w0, a, h);
+    return kernels_closed(w0, osc->xi, h);
 }
 
 /* Free mass (w0 = 0): du = v0 s + the double integral of A sin(w t + phi). */
@@ -28,7 +91,7 @@ static void free_mass(double A, double w, double phi, double t0, double v0, doub
     }
     /* u_p = -A sin(th) / w^2, v_p = -A cos(th) / w, th = w t + phi */
     double ds, dc, th0 = w * t0 + phi;
-    sin_cos_diff(th0, w * t1 + phi, &ds, &dc);
+    sin_cos_diff(th0, w * s, &ds, &dc);
     double vp0 = -A * cos(th0) / w;
     *du = -A * ds / (w * w) + (v0 - vp0) * s;
     *v1 = v0 - A * dc / w;
@@ -42,12 +105,12 @@ static void particular(const pd_sdof *osc, double A, double w, double phi, doubl
                        double *up0, double *vp0, double *dup, double *dvp)
 {
     double w0 = osc->w0, re = w0 * w0 - w * w, im = 2.0 * osc->xi * w0 * w;
-    double den = re * re + im * im, th0 = w * t0 + phi, th1 = w * t1 + phi;
+    double den = re * re + im * im, th0 = w * t0 + phi;
     double s0 = sin(th0), c0 = cos(th0), ds, dc;
     *up0 = *vp0 = *dup = *dvp = 0.0;
     if (A == 0.0)
         return;
-    sin_cos_diff(th0, th1, &ds, &dc);
+    sin_cos_diff(th0, w * (t1 - t0), &ds, &dc);
     if (den <= 1e-28 * w0 * w0 * w0 * w0) { /* undamped resonance */
         double s1 = s0 + ds, c1 = c0 + dc;
         *up0 = -A * t0 * c0 / (2.0 * w);
@@ -62,8 +125,10 @@ static void particular(const pd_sdof *osc, double A, double w, double phi, doubl
     *dvp = A * w * (re * dc + im * ds) / den;
 }
 
-void pd_sdof_increment(const pd_sdof *osc, double A, double w, double phi, double t0, double u0,
-                       double v0, double t1, double *du, double *v1)
+/* Response to A sin(w t + phi) from (u0, v0): particular solution plus the
+ * damped homogeneous part e^{-a s}(c1 cos wd s + c2 sin wd s) minus its start c1. */
+static void sine_increment(const pd_sdof *osc, double A, double w, double phi, double t0,
+                           double u0, double v0, double t1, double *du, double *v1)
 {
     if (osc->w0 == 0.0) {
         free_mass(A, w, phi, t0, v0, t1, du, v1);
@@ -71,7 +136,6 @@ void pd_sdof_increment(const pd_sdof *osc, double A, double w, double phi, doubl
     }
     double up0, vp0, dup, dvp;
     particular(osc, A, w, phi, t0, t1, &up0, &vp0, &dup, &dvp);
-    /* homogeneous part e^{-a s}(c1 cos wd s + c2 sin wd s) minus its start c1 */
     double a = osc->xi * osc->w0, wd = osc->w0 * sqrt(1.0 - osc->xi * osc->xi);
     double c1 = u0 - up0, c2 = (v0 - vp0 + a * c1) / wd;
     double s = t1 - t0, em1 = expm1(-a * s), ex = 1.0 + em1;
@@ -80,6 +144,58 @@ void pd_sdof_increment(const pd_sdof *osc, double A, double w, double phi, doubl
     double dh = c1 * (em1 * cs + cs_m1) + c2 * ex * sn;
     *du = dup + dh;
     *v1 = vp0 + dvp + ex * ((c2 * wd - a * c1) * cs - (c1 * wd + a * c2) * sn);
+}
+
+/* Response to f0 + c1 s from (u0, v0) over h (Duhamel with g, G1, G2). */
+static void ramp_increment(const pd_sdof *osc, double f0, double c1, double u0, double v0,
+                           double h, double *du, double *v1)
+{
+    kernels k = kernels_at(osc, h);
+    double k0 = osc->w0 * osc->w0, a2 = osc->w0 > 0.0 ? 2.0 * osc->xi * osc->w0 : 0.0;
+    double rest = f0 - k0 * u0; /* the acceleration without damping */
+    *du = v0 * k.g + rest * k.G1 + c1 * k.G2;
+    *v1 = v0 + ((rest - a2 * v0) * k.g + (c1 - k0 * v0) * k.G1);
+}
+
+double pd_sine_piece_force(const pd_sine_piece *pc, double t)
+{
+    double lin = pc->c0 + pc->c1 * (t - pc->t_start);
+    return pc->A == 0.0 ? lin : pc->A * sin(pc->w * t + pc->phi) + lin;
+}
+
+void pd_sdof_increment_piece(const pd_sdof *osc, const pd_sine_piece *pc, double t0, double u0,
+                             double v0, double t1, double *du, double *v1)
+{
+    double f0 = pc->c0 + pc->c1 * (t0 - pc->t_start);
+    if (pc->A == 0.0) {
+        ramp_increment(osc, f0, pc->c1, u0, v0, t1 - t0, du, v1);
+        return;
+    }
+    sine_increment(osc, pc->A, pc->w, pc->phi, t0, u0, v0, t1, du, v1);
+    if (f0 == 0.0 && pc->c1 == 0.0)
+        return;
+    /* by linearity: the ramp's response from rest added to the sinusoid's */
+    double dul, vl;
+    ramp_increment(osc, f0, pc->c1, 0.0, 0.0, t1 - t0, &dul, &vl);
+    *du += dul;
+    *v1 += vl;
+}
+
+/* u(t1) = u0 + (u(t1) - u0). */
+void pd_sdof_advance_piece(const pd_sdof *osc, const pd_sine_piece *pc, double t0, double u0,
+                           double v0, double t1, double *u1, double *v1)
+{
+    double du;
+    pd_sdof_increment_piece(osc, pc, t0, u0, v0, t1, &du, v1);
+    *u1 = u0 + du;
+}
+
+/* The sinusoid alone: a piece without linear terms. */
+void pd_sdof_increment(const pd_sdof *osc, double A, double w, double phi, double t0, double u0,
+                       double v0, double t1, double *du, double *v1)
+{
+    pd_sine_piece pc = {.t_start = t0, .A = A, .w = w, .phi = phi};
+    pd_sdof_increment_piece(osc, &pc, t0, u0, v0, t1, du, v1);
 }
 
 /* u(t1) = u0 + (u(t1) - u0). */

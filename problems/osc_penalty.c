@@ -11,15 +11,15 @@
  * the quintic Hermite interpolant of (x, x', x''); impacts are the located
  * gap closings; samples come every dt from the engine's outputs. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "pd_problems.h"
 
-/* F = s phi(tau): the model's force callback. */
+/* F = s phi(tau) (or the record's): the model's force callback. */
 static void scene_force(double tau, int side, double *F, void *ctx)
 {
-    const pd_osc *c = ctx;
-    F[0] = pd_pulse_shape(c->pulse, c->dir, tau, side);
+    F[0] = pd_osc_shape(ctx, tau, side);
 }
 
 /* Measurements in Pi units, updated after every accepted step. */
@@ -150,8 +150,8 @@ static void add_impulse(pen_track *tr, double tau, double lam)
 static pen_jet jet_at(const pen_track *tr, double tau, double x, double v, double lam, int side)
 {
     pen_jet q = {x, v, 0.0, 0.0};
-    q.a = pd_pulse_shape(tr->c->pulse, tr->c->dir, tau, side) - tr->C * v - tr->K * x - lam;
-    q.j = pd_pulse_shape_rate(tr->c->pulse, tr->c->dir, tau, side) - tr->C * q.a - tr->K * v;
+    q.a = pd_osc_shape(tr->c, tau, side) - tr->C * v - tr->K * x - lam;
+    q.j = pd_osc_shape_rate(tr->c, tau, side) - tr->C * q.a - tr->K * v;
     return q;
 }
 
@@ -273,7 +273,17 @@ int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler samp
     double h_out = PD_TWO_PI * (o.dt / c->Tp);
     double tau_end = (double)pd_steps_for(o.tend, o.dt) * h_out;
     double tau_measure = wp * pd_osc_measure_start(c, o.tend);
-    double brk = c->pulse == PD_PULSE_HARMONIC ? tau_measure : PD_TWO_PI;
+    double brk = isfinite(pd_osc_shape_end(c)) ? pd_osc_shape_end(c) : tau_measure;
+    /* a record: every sample is a kink of the force, a breakpoint for the stepper */
+    double *brks = NULL;
+    if (c->record) {
+        long nb = c->record->npts;
+        if (!(brks = malloc((size_t)nb * sizeof(double))))
+            return pd_err_set(err, PD_ENOMEM, "out of memory for %ld breakpoints", nb);
+        for (long k = 0; k < nb; k++)
+            brks[k] = wp * (double)k * c->record->dt;
+        brks[nb - 1] = brk;
+    }
     pd_model model = {.n = 1,
                       .m = o.no_wall ? 0 : 1,
                       .M = pd_matrix_dense(1, 1, &M),
@@ -284,8 +294,8 @@ int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler samp
                       .e = &e,
                       .force = scene_force,
                       .force_ctx = (void *)c,
-                      .breaks = &brk,
-                      .nbreaks = brk > 0.0 ? 1 : 0};
+                      .breaks = brks ? brks + 1 : &brk,
+                      .nbreaks = brks ? (int)(c->record->npts - 1) : brk > 0.0 ? 1 : 0};
     pen_track tr;
     memset(&tr, 0, sizeof tr);
     tr.c = c;
@@ -315,6 +325,7 @@ int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler samp
     double cpu0 = pd_cpu_seconds();
     rc = pd_penalty_run(&model, 0.0, NULL, NULL, tau_end, &eo, sampler ? emit_sample : NULL,
                         &tr, &pr, err);
+    free(brks);
     fill_result(&tr, &o, &pr, res);
     res->cpu_s = pd_cpu_seconds() - cpu0;
     return rc;

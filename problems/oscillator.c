@@ -5,6 +5,7 @@
  * phi = sin or cos on [0, 2 pi] (zero after), sin for all tau (harmonic).
  * So n = m = 1, M = 1, C = 2 xi Pi2, K = Pi2^2, W = -1, g0 = Pi3. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "pd_problems.h"
@@ -30,7 +31,63 @@ void pd_osc_set_gap(pd_osc *c, double gap) { c->Pi3 = gap / pd_osc_Le(c); }
 
 double pd_osc_excitation(const pd_osc *c, double t)
 {
-    return c->ap * pd_pulse_shape(c->pulse, c->dir, pd_osc_wp(c) * t, -1);
+    return c->ap * pd_osc_shape(c, pd_osc_wp(c) * t, -1);
+}
+
+void pd_osc_set_record(pd_osc *c, const pd_record *rec, const pd_record_pulse *p, double scale)
+{
+    c->record = rec;
+    c->rec_ap = p->ap;
+    c->scale = scale;
+    c->Tp = p->Tp;
+    c->ap = scale * p->ap;
+}
+
+/* tau past the record's end on the requested side (to a relative 1e-12). */
+static int after_record(const pd_osc *c, double tau, int side)
+{
+    double end = pd_osc_shape_end(c) * (1.0 + (side < 0 ? 1e-12 : -1e-12));
+    return side < 0 ? tau > end : tau >= end;
+}
+
+/* -dir ug''(t) / rec_ap: the record's samples are joined linearly. */
+double pd_osc_shape(const pd_osc *c, double tau, int side)
+{
+    if (!c->record)
+        return pd_pulse_shape(c->pulse, c->dir, tau, side);
+    if (tau < 0.0 || after_record(c, tau, side))
+        return 0.0;
+    return -c->dir * pd_record_acc(c->record, fmin(tau / pd_osc_wp(c),
+                                                   pd_record_duration(c->record))) / c->rec_ap;
+}
+
+/* d/dtau of the shape: the slope of the record's piece at tau. */
+double pd_osc_shape_rate(const pd_osc *c, double tau, int side)
+{
+    if (!c->record)
+        return pd_pulse_shape_rate(c->pulse, c->dir, tau, side);
+    const pd_record *r = c->record;
+    if (tau < 0.0 || after_record(c, tau, side))
+        return 0.0;
+    double t = tau / pd_osc_wp(c);
+    long k = (long)floor(t / r->dt);
+    if (side < 0 && k > 0 && t <= (double)k * r->dt)
+        k--; /* the left limit at a sample: the piece before it */
+    k = k < 0 ? 0 : k >= r->npts - 1 ? r->npts - 2 : k;
+    double slope = (r->acc[k + 1] - r->acc[k]) / r->dt;
+    return -c->dir * slope / (c->rec_ap * pd_osc_wp(c));
+}
+
+double pd_osc_shape_end(const pd_osc *c)
+{
+    if (c->record)
+        return pd_osc_wp(c) * pd_record_duration(c->record);
+    return c->pulse == PD_PULSE_HARMONIC ? HUGE_VAL : PD_TWO_PI;
+}
+
+const char *pd_osc_excitation_name(const pd_osc *c)
+{
+    return c->record ? c->record->name : pd_pulse_name(c->pulse);
 }
 
 /* A finite value in [lo, hi] (hi_open: hi excluded). */
@@ -41,8 +98,13 @@ static int in_range(double x, double lo, double hi, int hi_open)
 
 int pd_osc_check(const pd_osc *c, pd_err *err)
 {
-    if (c->pulse != PD_PULSE_SINE && c->pulse != PD_PULSE_COSINE && c->pulse != PD_PULSE_HARMONIC)
+    if (!c->record && c->pulse != PD_PULSE_SINE && c->pulse != PD_PULSE_COSINE &&
+        c->pulse != PD_PULSE_HARMONIC)
         return pd_err_set(err, PD_EINVAL, "pulse must be sine, cosine or harmonic");
+    if (c->record && (!(c->rec_ap > 0.0) || !isfinite(c->rec_ap) || !(c->scale > 0.0) ||
+                      !isfinite(c->scale) || c->record->npts < 2 || !(c->record->dt > 0.0)))
+        return pd_err_set(err, PD_EINVAL, "record %s: scale (got %g) and the fitted pulse's ap "
+                          "(got %g) must be > 0", c->record->name, c->scale, c->rec_ap);
     if (c->dir != 1 && c->dir != -1)
         return pd_err_set(err, PD_EINVAL, "dir must be normal (+1) or reverse (-1)");
     if (!(c->ap > 0.0) || !isfinite(c->ap))
@@ -91,10 +153,13 @@ static double harmonic_window(const pd_osc *c)
 }
 
 /* Harmonic transient: until exp(-xi w0 t) < 1e-3 (at least 20 Tp), or
- * 20 Tp + 20 T0 without damping (impacts then dissipate when eps < 1). */
+ * 20 Tp + 20 T0 without damping (impacts then dissipate when eps < 1).
+ * Pulses: Tp + 2 T0; records: their duration + 2 T0. */
 double pd_osc_default_tend(const pd_osc *c)
 {
     double T0 = pd_osc_T0(c);
+    if (c->record)
+        return pd_record_duration(c->record) + 2.0 * T0;
     if (c->pulse != PD_PULSE_HARMONIC)
         return c->Tp + 2.0 * T0;
     double w0 = PD_TWO_PI / T0;
@@ -105,7 +170,7 @@ double pd_osc_default_tend(const pd_osc *c)
 
 double pd_osc_measure_start(const pd_osc *c, double tend)
 {
-    if (c->pulse != PD_PULSE_HARMONIC)
+    if (c->record || c->pulse != PD_PULSE_HARMONIC)
         return 0.0;
     return fmax(0.0, tend - harmonic_window(c));
 }
@@ -114,8 +179,7 @@ double pd_osc_measure_start(const pd_osc *c, double tend)
 
 static void scene_force(double tau, int side, double *F, void *ctx)
 {
-    const pd_osc *c = ctx;
-    F[0] = pd_pulse_shape(c->pulse, c->dir, tau, side);
+    F[0] = pd_osc_shape(ctx, tau, side);
 }
 
 /* Measurements in dimensionless units, updated by the observer. */
@@ -211,7 +275,7 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
         return rc;
 
     /* model in Pi units; the step is 2 pi (dt / Tp) so equal dt/Tp gives equal h */
-    double pulse_end = PD_TWO_PI; /* the only breakpoint of a pulse */
+    double pulse_end = pd_osc_shape_end(c); /* the only breakpoint: the pulse's or record's end */
     double M = 1.0, C = 2.0 * c->xi * c->Pi2, K = c->Pi2 * c->Pi2, W = -1.0;
     double g0 = c->Pi3, e = c->eps;
     pd_model model = {.n = 1,
@@ -225,7 +289,7 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
                       .force = scene_force,
                       .force_ctx = (void *)c,
                       .breaks = &pulse_end,
-                      .nbreaks = c->pulse == PD_PULSE_HARMONIC ? 0 : 1};
+                      .nbreaks = isfinite(pulse_end) ? 1 : 0};
     pd_mj_opts mo = pd_mj_default_opts();
     mo.h = PD_TWO_PI * (o.dt / c->Tp);
     mo.theta = o.theta;
@@ -301,6 +365,24 @@ static int ref_sample(double tau, double x, double v, int in_contact, void *ctx)
     return b->sampler(&s, b->ctx);
 }
 
+/* A record's forcing in Pi units, piece k = [tau_k, tau_k+1): F linear
+ * from F(tau_k) with the piece's slope; the last piece (after the record) is
+ * zero.  npts pieces, malloc'd; NULL when out of memory. */
+static pd_sine_piece *record_pieces(const pd_osc *c)
+{
+    const pd_record *r = c->record;
+    double wp = pd_osc_wp(c), g = -(double)c->dir / c->rec_ap;
+    pd_sine_piece *p = malloc((size_t)r->npts * sizeof *p);
+    if (!p)
+        return NULL;
+    for (long k = 0; k + 1 < r->npts; k++)
+        p[k] = (pd_sine_piece){.t_start = wp * (double)k * r->dt,
+                               .c0 = g * r->acc[k],
+                               .c1 = g * (r->acc[k + 1] - r->acc[k]) / (wp * r->dt)};
+    p[r->npts - 1] = (pd_sine_piece){.t_start = pd_osc_shape_end(c)};
+    return p;
+}
+
 int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
                      pd_osc_result *res, pd_err *err)
 {
@@ -310,15 +392,21 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     pd_err_clear(err);
     if ((rc = pd_osc_resolve_opts(c, opts, &o, err)))
         return rc;
-    /* forcing pieces in Pi units: s sin(tau + phi) on [0, 2 pi], then zero */
+    /* forcing pieces in Pi units: s sin(tau + phi) on [0, 2 pi], then zero;
+     * a record: its linear pieces, then zero */
     double phi = c->pulse == PD_PULSE_COSINE ? PD_TWO_PI / 4.0 : 0.0;
-    pd_sine_piece pieces[2] = {{.t_start = 0.0, .A = (double)c->dir, .w = 1.0, .phi = phi},
-                               {.t_start = PD_TWO_PI, .A = 0.0, .w = 0.0, .phi = 0.0}};
+    pd_sine_piece pulse[2] = {{.t_start = 0.0, .A = (double)c->dir, .w = 1.0, .phi = phi},
+                              {.t_start = PD_TWO_PI, .A = 0.0, .w = 0.0, .phi = 0.0}};
+    pd_sine_piece *pieces = c->record ? record_pieces(c) : pulse;
+    if (!pieces)
+        return pd_err_set(err, PD_ENOMEM, "out of memory for the pieces of record %s",
+                          c->record->name);
     pd_ed_sdof prob = {.osc = {.w0 = c->Pi2, .xi = c->xi},
                        .wall = !o.no_wall,
                        .delta = c->Pi3,
                        .e = c->eps,
-                       .npieces = c->pulse == PD_PULSE_HARMONIC ? 1 : 2,
+                       .npieces = c->record ? (int)c->record->npts
+                                            : c->pulse == PD_PULSE_HARMONIC ? 1 : 2,
                        .pieces = pieces};
     double wp = pd_osc_wp(c), Le = pd_osc_Le(c);
     pd_ed_opts eo = pd_ed_default_opts();
@@ -330,6 +418,8 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
                          .sampler = sampler, .ctx = ctx};
     double cpu0 = pd_cpu_seconds();
     rc = pd_ed_sdof_run(&prob, 0.0, 0.0, &eo, sampler ? ref_sample : NULL, &bridge, &er, err);
+    if (pieces != pulse)
+        free(pieces);
     memset(res, 0, sizeof *res);
     res->umax = er.xmax * Le;
     res->u_toward = er.xtoward * Le;
@@ -369,6 +459,8 @@ void pd_osc_free_exact(const pd_osc *c, double t, double *u, double *v)
 int pd_osc_free_first_contact(const pd_osc *c, double tmax, double *t, double *v)
 {
     double delta = pd_osc_gap(c), step = c->Tp / 1000.0, lo = 0.0, hi = -1.0, u;
+    if (c->record)
+        return PD_EINVAL;
     for (double s = step; s <= tmax + 0.5 * step; s += step) {
         pd_osc_free_exact(c, s, &u, v);
         if (u >= delta) {

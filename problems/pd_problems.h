@@ -37,6 +37,106 @@ int pd_dir_parse(const char *name, int *dir);
 double pd_pulse_shape(pd_pulse pulse, int dir, double tau, int side);
 double pd_pulse_shape_rate(pd_pulse pulse, int dir, double tau, int side);
 
+/* ==== strong-motion records (SPEC §5, docs/records.md) ====================== *
+ * A record is the ground acceleration ug''(t) sampled every dt, linear
+ * between samples and zero after the last.  Readers: PEER NGA .AT2 (both
+ * header spellings, CR CR LF line ends, numbers that touch), COSMOS/CDMG V2
+ * (the first channel's acceleration block, units and dt from its header)
+ * and two-column text "t a" ('#' comments; t uniform to 1 % of a step,
+ * shifted so that the first sample is at t = 0; units given).  Every
+ * reader error is PD_EPARSE with "FILE:LINE: what was expected"; an
+ * unreadable file PD_EIO.  At most 10^8 samples. */
+
+typedef enum {
+    PD_RECORD_AUTO = 0, /* by content (an AT2 or V2 header), else two-column text */
+    PD_RECORD_AT2 = 1,
+    PD_RECORD_V2 = 2,
+    PD_RECORD_TEXT = 3
+} pd_record_format;
+
+/* Units of a two-column text file's accelerations. */
+typedef enum { PD_UNITS_G = 0, PD_UNITS_M_S2 = 1, PD_UNITS_CM_S2 = 2 } pd_record_units;
+
+/* "auto", "at2", "v2", "text"; "g", "m/s2", "cm/s2"; parse: PD_OK or PD_EINVAL. */
+const char *pd_record_format_name(pd_record_format f);
+int pd_record_format_parse(const char *name, pd_record_format *f);
+const char *pd_record_units_name(pd_record_units u);
+int pd_record_units_parse(const char *name, pd_record_units *u);
+
+/* Standard gravity used to convert records given in g (PD_G_STANDARD). */
+typedef struct pd_record {
+    char name[256];  /* the file's name without its folders */
+    long npts;       /* samples >= 2 */
+    double dt;       /* sample step [s] > 0 */
+    double *acc;     /* npts ground accelerations [m/s^2] at t_k = k dt (malloc'd) */
+} pd_record;
+
+/* Read a record; units apply to text files only (AT2 is in g, V2 says).
+ * On error rec is left empty (acc NULL, npts 0). */
+int pd_record_read(const char *path, pd_record_format format, pd_record_units units,
+                   pd_record *rec, pd_err *err);
+void pd_record_free(pd_record *rec);
+/* The record's duration (npts - 1) dt [s]. */
+double pd_record_duration(const pd_record *rec);
+/* ug''(t) [m/s^2]: linear between samples, 0 before 0 and after the last
+ * (whose time is recognised to a relative 1e-12). */
+double pd_record_acc(const pd_record *rec, double t);
+
+/* Ground-motion measures.  Velocity and displacement are the exact
+ * integrals of the piecewise-linear acceleration from rest, with no
+ * baseline correction (docs/records.md: processed records are corrected
+ * by their agencies; the measures describe the motion the structures are
+ * driven by); peaks are exact, also inside a step.  Arias intensity
+ *   Ia = pi / (2 g) integral a^2 dt   (g = PD_G_STANDARD; the integral exact
+ * for the piecewise-linear a), significant durations T5-75 and T5-95 from
+ * the normalised Husid curve (times solved inside their step). */
+typedef struct pd_record_measures {
+    double pga, pgv, pgd;        /* max |a| [m/s^2], |v| [m/s], |d| [m] */
+    double t_pga, t_pgv, t_pgd;  /* their times [s] */
+    double arias;                /* [m/s] */
+    double t5_75, t5_95;         /* [s] */
+} pd_record_measures;
+
+int pd_record_measure(const pd_record *rec, pd_record_measures *m, pd_err *err);
+
+/* The record's ground velocity and displacement at the samples (n = npts
+ * each, caller's arrays), as the measures use them. */
+int pd_record_integrate(const pd_record *rec, double *vel, double *disp, pd_err *err);
+
+/* The Mavroeidis–Papageorgiou (2003) velocity pulse fitted to the record's
+ * velocity by GSL's nonlinear least squares:
+ *   v(t) = vp/2 [1 + cos(2 pi fp (t - t0) / gamma)] cos(2 pi fp (t - t0) + nu)
+ * for |t - t0| <= gamma / (2 fp), 0 elsewhere; Tp = 1 / fp; ap = the
+ * largest |v'| of the fitted pulse; wp = 2 pi / Tp; Le = ap / wp^2.  Also
+ * the paper's one-cycle acceleration pulse (Fig. 2): sine or cosine shape,
+ * amplitude ap, period Tp, starting at t_start, with the sign polarity, so
+ * that ug''(t) ~ ap pd_pulse_shape(shape, polarity, wp (t - t_start), 1)
+ * (the one closest in least squares to the record's acceleration).  The
+ * fit window is the PGV time -/+ 2 initial periods (twice the time between
+ * the velocity's zero crossings around the PGV); of twelve starts (nu in
+ * {0, +-pi/2, pi}, gamma in {1.5, 2, 3}; 1 < gamma < 4 enforced) the best
+ * r2 is kept.  PD_ENUMERICAL when no pulse is found (r2 <= 0, the pulse
+ * centred outside the record or longer than it), PD_EINVAL for a record
+ * of fewer than 2 samples. */
+typedef struct pd_record_pulse {
+    double vp, fp, nu, gamma, t0; /* the fitted parameters [m/s, Hz, rad, 1, s] */
+    double Tp, ap, wp, Le;        /* [s, m/s^2, rad/s, m] */
+    double r2;                    /* 1 - SSE / SST of the fit over its window */
+    long iterations;              /* of the solver */
+    pd_pulse shape;               /* PD_PULSE_SINE or PD_PULSE_COSINE */
+    int polarity;                 /* +1 or -1: the sign of that pulse in ug'' */
+    double t_start;               /* start of the one-cycle pulse [s] */
+} pd_record_pulse;
+
+int pd_record_fit_pulse(const pd_record *rec, pd_record_pulse *p, pd_err *err);
+
+/* The fitted pulse as a function of time (record_pulse.c): the
+ * Mavroeidis–Papageorgiou velocity v(t) and acceleration a(t) = v'(t), and
+ * the paper's one-cycle acceleration pulse of amplitude ap and period Tp
+ * from t_start, signed as the record's acceleration there. */
+void pd_record_pulse_eval(const pd_record_pulse *p, double t, double *acc, double *vel);
+double pd_record_one_cycle(const pd_record_pulse *p, double t);
+
 /* ==== how a run is made ====================================================== */
 
 typedef enum { PD_METHOD_MOREAU = 0, PD_METHOD_EVENT = 1, PD_METHOD_PENALTY = 2 } pd_method;
@@ -95,6 +195,11 @@ typedef struct pd_osc {
     double Pi3; /* delta wp^2 / ap >= 0 (the dimensionless gap) */
     double eps; /* coefficient of restitution in [0, 1] */
     double xi;  /* damping ratio in [0, 1) */
+    /* a record instead of the pulse (pd_osc_set_record; NULL: the pulse):
+     * f(t) = -dir scale ug''(t), ap = scale rec_ap and Tp from its fitted pulse */
+    const pd_record *record;
+    double rec_ap;      /* the fitted pulse's ap at scale 1 [m/s^2] */
+    double scale;       /* the record's scale S > 0 */
 } pd_osc;
 
 /* sine, normal, ap = 1, Tp = 1, Pi2 = 1, Pi3 = 0.05, eps = 0.5, xi = 0.05. */
@@ -112,6 +217,22 @@ void pd_osc_set_gap(pd_osc *c, double gap);
 
 /* Effective acceleration f(t) [m/s^2] at time t [s]. */
 double pd_osc_excitation(const pd_osc *c, double t);
+
+/* Excite c by a record scaled by S (SPEC §5): Tp and ap = S p->ap from its
+ * fitted pulse p, so that the Pi terms are the pulse's; dir keeps its
+ * meaning (normal: f = -S ug''). */
+void pd_osc_set_record(pd_osc *c, const pd_record *rec, const pd_record_pulse *p, double scale);
+
+/* The effective acceleration in units of ap at tau = wp t (the pulse's
+ * s phi(tau) or the record's -dir ug''(t) / rec_ap), with its tau-rate;
+ * side -1 / +1: left / right limit at a jump (the pulse's or the record's
+ * end).  The end of the excitation in tau (HUGE_VAL: harmonic). */
+double pd_osc_shape(const pd_osc *c, double tau, int side);
+double pd_osc_shape_rate(const pd_osc *c, double tau, int side);
+double pd_osc_shape_end(const pd_osc *c);
+
+/* The name of the excitation: the pulse's, or the record's file name. */
+const char *pd_osc_excitation_name(const pd_osc *c);
 
 /* Check every field; the message names the field ("eps", "gap", ...). */
 int pd_osc_check(const pd_osc *c, pd_err *err);
@@ -185,12 +306,14 @@ typedef struct pd_osc_summary {
 int pd_osc_summarize(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
                      pd_osc_summary *s, pd_err *err);
 
-/* Exact response without the wall from rest (closed form), at t [s]. */
+/* Exact response without the wall from rest (closed form), at t [s]; a
+ * pulse only (a record's free response is pd_osc_reference with no wall). */
 void pd_osc_free_exact(const pd_osc *c, double t, double *u, double *v);
 
 /* First time t <= tmax at which that free response reaches the gap, found
  * on a grid of Tp/1000 and bisected to rounding, with the speed there:
- * PD_OK, or PD_EINVAL when it does not reach the gap by tmax. */
+ * PD_OK, or PD_EINVAL when it does not reach the gap by tmax (or c is
+ * driven by a record). */
 int pd_osc_free_first_contact(const pd_osc *c, double tmax, double *t, double *v);
 
 /* ---- errors against the reference (compare, converge) ------------------- *
@@ -261,11 +384,14 @@ typedef struct pd_contact {
     int entry;           /* the contacts[] entry of the scene file it came from */
 } pd_contact;
 
-/* The excitation of a scene: a pulse along +x (dir +1) or -x. */
+/* The excitation of a scene: a pulse along +x (dir +1) or -x, or a record
+ * whose axis is +x (dir -1 flips it): effective forces -m dir S ug''(t). */
 typedef struct pd_scene_excitation {
     pd_pulse pulse;
     int dir;             /* +1: first effective inertial force -m ug'' along +x */
-    double ap, Tp;       /* [m/s^2], [s] */
+    double ap, Tp;       /* [m/s^2], [s]; a record: S times its fitted pulse's, and its */
+    const pd_record *record; /* NULL: the pulse */
+    double rec_ap, scale;    /* the record's fitted ap at scale 1, and S */
 } pd_scene_excitation;
 
 typedef struct pd_scene {
@@ -279,6 +405,7 @@ typedef struct pd_scene {
     int cap_struct, cap_contact; /* allocated entries */
     int *names;          /* name_cap slots: structure index + 1 by name hash, 0 empty */
     int name_cap;
+    pd_record *own_record; /* the record a scene file named (freed with the scene) */
 } pd_scene;
 
 /* An empty scene excited by exc; NULL when out of memory. */
@@ -301,7 +428,8 @@ int pd_scene_set_damping(pd_scene *sc, pd_damping damping, int mode1, int mode2,
 /* A contact; a or b PD_WALL for a wall (level 0 there). */
 int pd_scene_add_contact(pd_scene *sc, int a, int level_a, int b, int level_b, double gap,
                          double eps, int entry, pd_err *err);
-/* A deep copy, not finished (NULL when out of memory). */
+/* A deep copy, not finished (NULL when out of memory); a record it names
+ * is shared, not copied: the original must outlive the copy. */
 pd_scene *pd_scene_copy(const pd_scene *sc);
 /* The structure called name, or -1 (PD_WALL for "wall"); -2 when unknown. */
 int pd_scene_find(const pd_scene *sc, const char *name);
@@ -344,8 +472,7 @@ typedef struct pd_scene_model {
     pd_sparse M, C, K, W;
     double *g0, *e, *mass;
     double breaks[1];
-    pd_pulse pulse;
-    int dir;
+    pd_osc shape;         /* the excitation's shape in Pi units (pd_osc_shape) */
 } pd_scene_model;
 
 int pd_scene_model_build(const pd_scene *sc, int with_contacts, pd_scene_model *sm, pd_err *err);

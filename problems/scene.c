@@ -35,6 +35,10 @@ void pd_scene_free(pd_scene *sc)
     free(sc->st);
     free(sc->ct);
     free(sc->names);
+    if (sc->own_record) {
+        pd_record_free(sc->own_record);
+        free(sc->own_record);
+    }
     free(sc);
 }
 
@@ -461,6 +465,9 @@ static pd_osc envelope_case(const pd_scene *sc)
     c.pulse = sc->exc.pulse;
     c.Tp = sc->exc.Tp;
     c.ap = sc->exc.ap;
+    c.record = sc->exc.record;
+    c.rec_ap = sc->exc.rec_ap;
+    c.scale = sc->exc.scale;
     c.Pi2 = sc->exc.Tp / Tmax;
     c.xi = ximin;
     return c;
@@ -512,7 +519,10 @@ int pd_scene_as_oscillator(const pd_scene *sc, pd_osc *c, int *mirrored)
                   .Pi2 = sc->exc.Tp / sc->st[0].T0,
                   .Pi3 = 0.0,
                   .eps = ct ? ct->eps : 0.0,
-                  .xi = sc->st[0].xi};
+                  .xi = sc->st[0].xi,
+                  .record = sc->exc.record,
+                  .rec_ap = sc->exc.rec_ap,
+                  .scale = sc->exc.scale};
     if (ct)
         pd_osc_set_gap(c, ct->gap);
     return 1;
@@ -520,11 +530,12 @@ int pd_scene_as_oscillator(const pd_scene *sc, pd_osc *c, int *mirrored)
 
 /* ---- the engine model ------------------------------------------------------ */
 
-/* F_i = m_i s phi(tau): the effective inertial forces along x, in units of ap. */
+/* F_i = m_i s phi(tau) (or the record's): the effective inertial forces along
+ * x, in units of ap. */
 static void scene_force(double tau, int side, double *F, void *ctx)
 {
     const pd_scene_model *sm = ctx;
-    double f = pd_pulse_shape(sm->pulse, sm->dir, tau, side);
+    double f = pd_osc_shape(&sm->shape, tau, side);
     for (int i = 0; i < sm->model.n; i++)
         F[i] = sm->mass[i] * f;
 }
@@ -634,9 +645,14 @@ int pd_scene_model_build(const pd_scene *sc, int with_contacts, pd_scene_model *
         (rc = pd_sparse_from_triplets(&sm->C, n, n, C.n, C.i, C.j, C.x, err)) ||
         (rc = pd_sparse_from_triplets(&sm->W, n, m, W.n, W.i, W.j, W.x, err)))
         goto done;
-    sm->pulse = sc->exc.pulse;
-    sm->dir = sc->exc.dir;
-    sm->breaks[0] = PD_TWO_PI; /* the pulse end */
+    sm->shape = (pd_osc){.pulse = sc->exc.pulse,
+                         .dir = sc->exc.dir,
+                         .ap = sc->exc.ap,
+                         .Tp = sc->exc.Tp,
+                         .record = sc->exc.record,
+                         .rec_ap = sc->exc.rec_ap,
+                         .scale = sc->exc.scale};
+    sm->breaks[0] = pd_osc_shape_end(&sm->shape); /* the pulse's or the record's end */
     sm->model = (pd_model){.n = n,
                            .m = m,
                            .M = pd_sparse_view(&sm->M),
@@ -648,7 +664,7 @@ int pd_scene_model_build(const pd_scene *sc, int with_contacts, pd_scene_model *
                            .force = scene_force,
                            .force_ctx = sm,
                            .breaks = sm->breaks,
-                           .nbreaks = sc->exc.pulse == PD_PULSE_HARMONIC ? 0 : 1};
+                           .nbreaks = isfinite(sm->breaks[0]) ? 1 : 0};
 done:
     tri_free(&M);
     tri_free(&K);

@@ -285,9 +285,68 @@ static int get_numbers(loader *L, json_t *arr, const char *at, int integers, dou
 
 /* ---- the sections ------------------------------------------------------------ */
 
-static int read_excitation(loader *L, json_t *root, pd_scene_excitation *x)
+/* The record file of the excitation: a path relative to the scene file's
+ * folder (unless absolute) into buf. */
+static void record_path(const loader *L, const char *file, char *buf, size_t cap)
 {
-    static const char *const keys[] = {"pulse", "dir", "ap", "Tp", NULL};
+    const char *slash = strrchr(L->path, '/');
+    if (file[0] == '/' || !slash)
+        snprintf(buf, cap, "%s", file);
+    else
+        snprintf(buf, cap, "%.*s/%s", (int)(slash - L->path), L->path, file);
+}
+
+/* "record", "scale", "units", "format" of the excitation: the record read,
+ * its pulse fitted, into x and *rec (malloc'd, the scene's to free). */
+static int read_record(loader *L, json_t *ex, pd_scene_excitation *x, pd_record **rec)
+{
+    const char *file, *units = "g", *format = "auto";
+    char path[4096], name[64];
+    pd_record_units u;
+    pd_record_format f;
+    pd_record_pulse pulse;
+    pd_err e;
+    int rc;
+    x->scale = 1.0;
+    if ((rc = get_string(L, ex, "excitation", "record", &file)) ||
+        (rc = get_number(L, ex, "excitation", "scale", 0, 1.0, &x->scale)) ||
+        (json_object_get(ex, "units") && (rc = get_string(L, ex, "excitation", "units", &units))) ||
+        (json_object_get(ex, "format") && (rc = get_string(L, ex, "excitation", "format", &format))))
+        return rc;
+    if (!(x->scale > 0.0))
+        return fail(L, "excitation.scale", "must be > 0 (got %g)", x->scale);
+    if (pd_record_units_parse(units, &u))
+        return fail(L, "excitation.units", "'%s' is not one of g, m/s2, cm/s2",
+                    printable(units, name, sizeof name));
+    if (pd_record_format_parse(format, &f))
+        return fail(L, "excitation.format", "'%s' is not one of auto, at2, v2, text",
+                    printable(format, name, sizeof name));
+    for (const char *k = "pulse\0ap\0Tp\0"; *k; k += strlen(k) + 1)
+        if (json_object_get(ex, k))
+            return fail(L, "excitation", "'%s' goes with a pulse, not with a record (its fitted "
+                        "pulse gives ap and Tp; 'scale' scales it)", k);
+    record_path(L, file, path, sizeof path);
+    if (!(*rec = calloc(1, sizeof **rec)))
+        return pd_err_set(L->err, PD_ENOMEM, "%s: out of memory", L->path);
+    if ((rc = pd_record_read(path, f, u, *rec, &e)) ||
+        (rc = pd_record_fit_pulse(*rec, &pulse, &e))) {
+        pd_record_free(*rec);
+        free(*rec);
+        *rec = NULL;
+        return rc == PD_ENOMEM ? pd_err_set(L->err, rc, "%s", e.msg)
+                               : fail(L, "excitation.record", "%s", e.msg);
+    }
+    x->record = *rec;
+    x->rec_ap = pulse.ap;
+    x->ap = x->scale * pulse.ap;
+    x->Tp = pulse.Tp;
+    return PD_OK;
+}
+
+static int read_excitation(loader *L, json_t *root, pd_scene_excitation *x, pd_record **rec)
+{
+    static const char *const keys[] = {"pulse", "dir", "ap", "Tp", "record", "scale", "units",
+                                       "format", NULL};
     json_t *ex = json_object_get(root, "excitation");
     const char *pulse, *dir = "+x";
     char name[64];
@@ -296,17 +355,23 @@ static int read_excitation(loader *L, json_t *root, pd_scene_excitation *x)
         return fail(L, "", "missing field 'excitation'");
     if (!json_is_object(ex))
         return fail(L, "excitation", "expected an object");
-    if ((rc = only_keys(L, ex, "excitation", keys)) ||
-        (rc = get_string(L, ex, "excitation", "pulse", &pulse)))
+    if ((rc = only_keys(L, ex, "excitation", keys)))
         return rc;
-    if (pd_pulse_parse(pulse, &x->pulse))
-        return fail(L, "excitation.pulse", "'%s' is not one of sine, cosine, harmonic",
-                    printable(pulse, name, sizeof name));
     if (json_object_get(ex, "dir") && (rc = get_string(L, ex, "excitation", "dir", &dir)))
         return rc;
     if (strcmp(dir, "+x") && strcmp(dir, "-x"))
         return fail(L, "excitation.dir", "'%s' is not +x or -x", printable(dir, name, sizeof name));
     x->dir = strcmp(dir, "+x") ? -1 : 1;
+    if (json_object_get(ex, "record"))
+        return read_record(L, ex, x, rec);
+    for (const char *k = "scale\0units\0format\0"; *k; k += strlen(k) + 1)
+        if (json_object_get(ex, k))
+            return fail(L, "excitation", "'%s' goes with a record", k);
+    if ((rc = get_string(L, ex, "excitation", "pulse", &pulse)))
+        return rc;
+    if (pd_pulse_parse(pulse, &x->pulse))
+        return fail(L, "excitation.pulse", "'%s' is not one of sine, cosine, harmonic",
+                    printable(pulse, name, sizeof name));
     if ((rc = get_number(L, ex, "excitation", "ap", 1, 0.0, &x->ap)) ||
         (rc = get_number(L, ex, "excitation", "Tp", 1, 0.0, &x->Tp)))
         return rc;
@@ -512,21 +577,10 @@ static int read_contact(loader *L, pd_scene *sc, json_t *ct, int k)
     return rc;
 }
 
-static int read_scene(loader *L, json_t *root, pd_scene **out)
+/* The structure and contact arrays of the file: present and of the right type. */
+static int check_sections(loader *L, json_t *root)
 {
-    static const char *const keys[] = {"excitation", "structures", "contacts", "tend",
-                                       "description", NULL};
-    pd_scene_excitation x = {0};
-    pd_scene *sc = NULL;
-    json_t *sts, *cts;
-    int rc;
-    pd_err e;
-    if (!json_is_object(root))
-        return fail(L, "", "expected a JSON object with excitation, structures, contacts");
-    if ((rc = only_keys(L, root, "", keys)) || (rc = read_excitation(L, root, &x)))
-        return rc;
-    sts = json_object_get(root, "structures");
-    cts = json_object_get(root, "contacts");
+    json_t *sts = json_object_get(root, "structures"), *cts = json_object_get(root, "contacts");
     if (!sts)
         return fail(L, "", "missing field 'structures'");
     if (!json_is_array(sts) || json_array_size(sts) == 0)
@@ -535,8 +589,32 @@ static int read_scene(loader *L, json_t *root, pd_scene **out)
         return fail(L, "contacts", "expected an array");
     if (json_object_get(root, "description") && !json_is_string(json_object_get(root, "description")))
         return fail(L, "description", "expected a string");
-    if (!(sc = pd_scene_new(&x)))
+    return PD_OK;
+}
+
+static int read_scene(loader *L, json_t *root, pd_scene **out)
+{
+    static const char *const keys[] = {"excitation", "structures", "contacts", "tend",
+                                       "description", NULL};
+    pd_scene_excitation x = {0};
+    pd_record *rec = NULL;
+    pd_scene *sc = NULL;
+    int rc;
+    pd_err e;
+    if (!json_is_object(root))
+        return fail(L, "", "expected a JSON object with excitation, structures, contacts");
+    if ((rc = only_keys(L, root, "", keys)) || (rc = check_sections(L, root)) ||
+        (rc = read_excitation(L, root, &x, &rec)))
+        return rc;
+    if (!(sc = pd_scene_new(&x))) {
+        if (rec) {
+            pd_record_free(rec);
+            free(rec);
+        }
         return pd_err_set(L->err, PD_ENOMEM, "%s: out of memory", L->path);
+    }
+    sc->own_record = rec; /* freed with the scene from here on */
+    json_t *sts = json_object_get(root, "structures"), *cts = json_object_get(root, "contacts");
     if ((rc = get_number(L, root, "", "tend", 0, 0.0, &sc->tend)) == PD_OK && sc->tend < 0.0)
         rc = fail(L, "tend", "must be > 0 (got %g)", sc->tend);
     for (size_t k = 0; !rc && k < json_array_size(sts); k++)

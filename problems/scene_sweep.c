@@ -26,6 +26,9 @@ int pd_scene_sweep_check(const pd_scene_sweep *w, pd_err *err)
     const pd_scene *sc = w->sc;
     if (!sc || !sc->finished)
         return pd_err_set(err, PD_EINVAL, "scene: not finished");
+    if (sc->exc.record)
+        return pd_err_set(err, PD_EINVAL, "scene: the sweep varies the pulse period, which a "
+                          "record fixes (its fitted pulse's): sweep records with the oscillator");
     if (w->ref < 0 || w->ref >= sc->nstruct)
         return pd_err_set(err, PD_EINVAL, "ref: no structure %d", w->ref);
     if (!(w->pi2_min > 0.0) || w->npi2 < 1 || !(w->pi2_max >= w->pi2_min))

@@ -100,6 +100,8 @@ int pd_spec_case(const pd_spectrum *s, long task, pd_osc *c, pd_run_opts *o, pd_
     c->pulse = s->pulse[co.pulse];
     c->dir = s->dir[co.dir];
     c->ap = s->ap[co.ap];
+    if (c->record) /* the amplitudes of a record's sweep are its pulse's: scales */
+        c->scale = c->ap / c->rec_ap;
     c->xi = s->xi[co.xi];
     c->eps = s->eps[co.eps];
     c->Pi2 = pd_spec_pi2(s, co.j);
@@ -216,6 +218,15 @@ static void tb_list(textbuf *b, const char *name, const double *x, int n)
         tb_add(b, "%s%a", i ? "," : "", x[i]);
 }
 
+/* A checksum of a record's samples (a sum weighted by position). */
+static double record_checksum(const pd_record *r)
+{
+    double sum = 0.0;
+    for (long k = 0; k < r->npts; k++)
+        sum += r->acc[k] * (double)((k % 1000) + 1);
+    return sum;
+}
+
 char *pd_spec_key(const pd_spectrum *s)
 {
     const pd_run_opts *o = &s->opts;
@@ -225,12 +236,17 @@ char *pd_spec_key(const pd_spectrum *s)
     b.p[0] = '\0';
     tb_add(&b, "v=1 method=%s pulse=", pd_method_name(o->method));
     for (int i = 0; i < s->npulse; i++)
-        tb_add(&b, "%s%s", i ? "," : "", pd_pulse_name(s->pulse[i]));
+        tb_add(&b, "%s%s", i ? "," : "",
+               s->base.record ? s->base.record->name : pd_pulse_name(s->pulse[i]));
     tb_add(&b, " dir=");
     for (int i = 0; i < s->ndir; i++)
         tb_add(&b, "%s%s", i ? "," : "", pd_dir_name(s->dir[i]));
     tb_list(&b, "ap", s->ap, s->nap);
     tb_add(&b, " Tp=%a", s->base.Tp);
+    if (s->base.record) /* a record's sweep: its samples matter, summed into the key */
+        tb_add(&b, " record=%s npts=%ld rdt=%a rec_ap=%a sum=%a", s->base.record->name,
+               s->base.record->npts, s->base.record->dt, s->base.rec_ap,
+               record_checksum(s->base.record));
     tb_list(&b, "xi", s->xi, s->nxi);
     tb_list(&b, s->size_is_gap ? "gap" : "Pi3", s->size, s->nsize);
     tb_list(&b, "eps", s->eps, s->neps);

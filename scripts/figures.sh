@@ -35,6 +35,16 @@ for N in 2 10 100; do
         > "$out/rows-$N.txt"
 done
 
+# 1c. Work-precision under a real record (Rinaldi RRS228, when the shared
+#     records are there): Moreau-Jean and penalty against the exact reference
+#     on the record's linear pieces (docs/records.md).
+rec=../shared/data/records/NGA_no_1063_RRS228.AT2
+if [ -f "$rec" ]; then
+    "$pound" converge --record "$rec" --T0 0.8 --gap 0.01 --eps 0.6 \
+        --dt 0.004:0.0000625:7 --theta 0.5,1 --methods moreau,penalty \
+        --kcs 1e2,1e3,1e4,1e5,1e6 --plot "$out/converge-record.png" > "$out/converge-record.txt"
+fi
+
 # 2. Where theta < 1/2 fails: amplitude after 200 s of a damped oscillator
 #    (xi = 0.05, T0 = 1 s) against w0 h; a blown-up run is drawn at 1e30.
 for th in 0.3 0.4 0.45 0.5; do

@@ -174,4 +174,79 @@ for e in 0.3 0.6 0.9; do
             printf " %.2f (Pi1 %.3g)", bx, b} print ""}' "$tmp/f12-$e"
 done >> "$out/paper-fig12.txt"
 
+# ---- Records (issue 10): Fig. 2, Fig. 7 and the collapse of record spectra --
+# Skipped when the shared records are absent.
+recs=../shared/data/records
+if [ -d "$recs" ]; then
+    pulse_like="NGA_no_1063_RRS228.AT2 RSN181_IMPVALL.H_H-E06230.AT2 RSN77_SFERN_PUL164.AT2 RSN1120_KOBE_TAK090.AT2"
+    set --
+    for r in $pulse_like; do set -- "$@" "$recs/$r"; done
+    # Fig. 2: records with their fitted pulses
+    "$pound" record "$@" --plot "$out/paper-fig2.png" > "$out/paper-fig2.txt"
+    # every shared record's fitted 1/Le, for Fig. 7
+    all=$(ls "$recs"/*.AT2 "$recs"/*.at2 "$recs"/*.V2 2>/dev/null | sort)
+    "$pound" record $all > "$out/paper-records.txt"
+    "$pound" record $all --json | tr '{' '\n' | awk -F'"name":"' 'NF > 1 {split($2, a, "\""); n = a[1]}
+        /"Le":/ {sub(/.*"Le":/, ""); sub(/,.*/, ""); printf "%s %.6g\n", n, 1 / $0}' > "$tmp/le"
+    # Fig. 7: contours of Pi3 = gap / Le on the (1/Le, gap) plane, the records placed
+    gnuplot <<GP
+$term
+set output '$out/paper-fig7.png'
+set title 'Fig. 7: {/Symbol P}_3 = gap / L_e on the (1/L_e, gap) plane; records at their fitted 1/L_e'
+set xlabel '1/L_e = {/Symbol w}_p^2 / a_p [m^{-1}]'; set ylabel 'gap [m]'
+set xrange [0:12]; set yrange [0:0.1]; set grid; set key top right
+set samples 400
+set arrow from 1.2, graph 0 to 1.2, graph 1 nohead dt 2 lc rgb 'black'
+set label 'Tabas (paper)' at 1.25, 0.095 font ',9'
+set arrow from 5.3, graph 0 to 5.3, graph 1 nohead dt 2 lc rgb 'black'
+set label 'Parkfield C02 (paper)' at 5.35, 0.095 font ',9'
+plot for [p in '0.01 0.02 0.05 0.1 0.2 0.5'] p/x w l lw 2 t '{/Symbol P}_3 = '.p, \
+     '$tmp/le' u 2:(0.002):(strcol(1)) w labels rotate by 90 left font ',7' noenhanced \
+        offset 0,0.5 t '', '$tmp/le' u 2:(0.0015) w points pt 7 ps 0.8 lc rgb 'black' \
+        t 'shared records (fitted 1/L_e)'
+GP
+    # the spectra of every record and of the one-cycle pulses at Pi3 = 0.01, 0.05, 0.1
+    grid="--Pi2 0.1:5:60 --Pi3 0.01,0.05,0.1 --eps 0.5 --xi 0.05 --method event"
+    k=0
+    for r in $all; do
+        k=$((k + 1))
+        "$pound" spectrum --record "$r" $grid -o "$tmp/r$k.csv" > /dev/null
+        grep -v '^#' "$tmp/r$k.csv" | awk -F, 'NR > 1 {print $1, $6, $10, $12}' >> "$tmp/rall"
+    done
+    "$pound" spectrum --pulse sine,cosine $grid -o "$tmp/p.csv" > /dev/null
+    grep -v '^#' "$tmp/p.csv" | awk -F, 'NR > 1 {print $1, $6, $10, $12}' >> "$tmp/rall"
+    # collapse: across the pulse-like records, per Pi3 and band of Pi2, the spread
+    # (max - min) / median of Pi1, and where the one-cycle pulses lie in it
+    awk -v like="$pulse_like" 'BEGIN {n = split(like, L, " "); for (i = 1; i <= n; i++) pl[L[i]] = 1}
+        ($1 in pl) {k = $2 " " $3; v[k] = v[k] " " $4; pi3[$2] = 1}
+        $1 == "sine" || $1 == "cosine" {pul[$1 " " $2 " " $3] = $4}
+        END {
+            printf "collapse of Pi1(Pi2) across the pulse-like records (%s)\n", like
+            printf "%6s %12s %8s %14s %14s %18s\n", "Pi3", "Pi2 band", "points", "median spread", "worst spread", "sine/cosine inside"
+            for (p3 in pi3) for (b = 0; b < 3; b++) {
+                lo = b == 0 ? 0 : b == 1 ? 0.5 : 2; hi = b == 0 ? 0.5 : b == 1 ? 2 : 99
+                m = 0; inside = 0; tot = 0
+                for (k in v) { split(k, kk, " "); if (kk[1] != p3 || kk[2] + 0 < lo || kk[2] + 0 >= hi) continue
+                    c = split(substr(v[k], 2), x, " "); for (i = 1; i <= c; i++) for (j = i + 1; j <= c; j++) if (x[j] < x[i]) {t = x[i]; x[i] = x[j]; x[j] = t}
+                    med = c % 2 ? x[(c + 1) / 2] : 0.5 * (x[c / 2] + x[c / 2 + 1])
+                    s[++m] = (x[c] - x[1]) / med
+                    for (q = 0; q < 2; q++) {pp = pul[(q ? "cosine " : "sine ") k]; tot++; if (pp >= x[1] && pp <= x[c]) inside++}
+                }
+                for (i = 1; i <= m; i++) for (j = i + 1; j <= m; j++) if (s[j] < s[i]) {t = s[i]; s[i] = s[j]; s[j] = t}
+                if (m) printf "%6g %12s %8d %14.3f %14.3f %13d/%d\n", p3 + 0, lo "-" (hi == 99 ? "5" : hi), m, s[int((m + 1) / 2)], s[m], inside, tot
+            }
+        }' "$tmp/rall" > "$out/paper-records-collapse.txt"
+    for r in $pulse_like sine cosine; do awk -v r="$r" '$1 == r && $2 == 0.05 {print $3, $4}' "$tmp/rall" > "$tmp/c-$r"; done
+    gnuplot <<GP
+$term
+set output '$out/paper-records-collapse.png'
+set title 'Pi_1({/Symbol P}_2) at {/Symbol P}_3 = 0.05, eps = 0.5, xi = 0.05: pulse-like records and the one-cycle pulses'
+set xlabel '{/Symbol P}_2 = T_p / T_0'; set ylabel '{/Symbol P}_1 = u_{max} / L_e'
+set logscale x; set grid; set key top right
+plot for [r in '$pulse_like'] '$tmp/c-'.r w l lw 2 t r noenhanced, \
+     '$tmp/c-sine' w l lw 3 dt 2 lc rgb 'black' t 'one-sine pulse', \
+     '$tmp/c-cosine' w l lw 3 dt 3 lc rgb 'gray30' t 'one-cosine pulse'
+GP
+fi
+
 echo "paper figures written to $out/paper-*.png"

@@ -84,6 +84,9 @@ int main(int argc, char **argv)
     suite_scene(&ctx);
     suite_solvers(&ctx);
     suite_impacts(&ctx);
+    suite_record(&ctx);
+    suite_ed_linear(&ctx);
+    suite_records_run(&ctx);
 
     printf("%d passed, %d failed, %d skipped\n", ctx.passed, ctx.failed, ctx.skipped);
     return ctx.failed ? 1 : 0;

@@ -27,6 +27,11 @@ void pd_test_skip(pd_test_ctx *ctx, const char *why);
  * since the start (the test binary wraps them, test_alloc.c). */
 long pd_test_allocations(void);
 
+/* A uniform number in [0, 1) from a seeded stream (splitmix64): reproducible
+ * random data for the tests. */
+#include <stdint.h>
+double pd_test_uniform(uint64_t *state);
+
 #define PD_RUN(ctx, fn) pd_test_run((ctx), #fn, fn)
 /* CHECK(ctx, cond, "fmt", ...) — the message says what was measured. */
 #define CHECK(ctx, cond, ...) pd_test_check((ctx), (cond) ? 1 : 0, __FILE__, __LINE__, __VA_ARGS__)
@@ -83,5 +88,8 @@ void suite_spectrum(pd_test_ctx *ctx);
 void suite_scene(pd_test_ctx *ctx);
 void suite_solvers(pd_test_ctx *ctx);
 void suite_impacts(pd_test_ctx *ctx);
+void suite_record(pd_test_ctx *ctx);
+void suite_ed_linear(pd_test_ctx *ctx);
+void suite_records_run(pd_test_ctx *ctx);
 
 #endif

@@ -109,7 +109,7 @@ static int case_moreau_general(void)
 
 static int case_oscillator(void)
 {
-    pd_osc c = {PD_PULSE_SINE, 1, 1.0, 1.0, 0.5, 0.05, 0.5, 0.05};
+    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5, .Pi3 = 0.05, .eps = 0.5, .xi = 0.05};
     pd_run_opts o = pd_run_default_opts();
     pd_osc_result r;
     pd_err err;
@@ -119,7 +119,7 @@ static int case_oscillator(void)
 
 static int case_penalty(void)
 {
-    pd_osc c = {PD_PULSE_SINE, 1, 1.0, 1.0, 0.5, 0.05, 0.5, 0.05};
+    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5, .Pi3 = 0.05, .eps = 0.5, .xi = 0.05};
     pd_run_opts o = pd_run_default_opts();
     pd_osc_result r;
     pd_err err;

@@ -7,16 +7,6 @@
 #include "pd_engine.h"
 #include "pd_test.h"
 
-/* A seeded generator (splitmix64) for reproducible random data. */
-static double uniform(uint64_t *s)
-{
-    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    z ^= z >> 31;
-    return (double)(z >> 11) * 0x1.0p-53;
-}
-
 /* pd_sdof_advance satisfies the ODE (central differences), composes over
  * sub-intervals, and matches the textbook free vibration. */
 static void test_engine_sdof_closed_form(pd_test_ctx *ctx)
@@ -59,7 +49,7 @@ static void test_engine_scalar_lcp_matches_lemke(pd_test_ctx *ctx)
     double worst = 0.0;
     int mismatched_sign = 0;
     for (int k = 0; k < 2000; k++) {
-        double D = 1e-3 + 10.0 * uniform(&seed), b = 4.0 * uniform(&seed) - 2.0;
+        double D = 1e-3 + 10.0 * pd_test_uniform(&seed), b = 4.0 * pd_test_uniform(&seed) - 2.0;
         double z, w;
         int st = pd_lcp_lemke(work, 1, &D, &b, NULL, &z, &w, NULL);
         double P = pd_contact_impulse_1(D, b);

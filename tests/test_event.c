@@ -131,9 +131,11 @@ static double continuous_max(const osc_model *om, const trace *r, int *failures)
 /* The same case through the exact one-wall reference. */
 static int exact_run(const osc_case *c, double tend, pd_ed_result *er, pd_err *err)
 {
-    pd_sine_piece pc[2] = {{0.0, (double)c->dir, 1.0, c->cosine ? TWO_PI / 4 : 0.0},
-                           {TWO_PI, 0.0, 0.0, 0.0}};
-    pd_ed_sdof prob = {{c->Pi2, c->xi}, 1, c->Pi3, c->eps, 2, pc};
+    pd_sine_piece pc[2] = {{.t_start = 0.0, .A = (double)c->dir, .w = 1.0,
+                            .phi = c->cosine ? TWO_PI / 4 : 0.0},
+                           {.t_start = TWO_PI}};
+    pd_ed_sdof prob = {.osc = {.w0 = c->Pi2, .xi = c->xi}, .wall = 1, .delta = c->Pi3,
+                       .e = c->eps, .npieces = 2, .pieces = pc};
     pd_ed_opts o;
     o = pd_ed_default_opts();
     o.t_end = tend;
@@ -531,8 +533,9 @@ static void test_edg_zeno_accumulation(pd_test_ctx *ctx)
         ball_setup(&b, es[k]);
         double e = es[k], t1 = sqrt(2 * b.delta / b.a), v1 = b.a * t1;
         double t_inf = t1 + 2 * e * v1 / (b.a * (1 - e)), T = 2 * t_inf + 1.0;
-        pd_sine_piece piece = {0.0, b.a, 0.0, TWO_PI / 4};
-        pd_ed_sdof prob = {{0.0, 0.0}, 1, b.delta, e, 1, &piece};
+        pd_sine_piece piece = {.t_start = 0.0, .A = b.a, .w = 0.0, .phi = TWO_PI / 4};
+        pd_ed_sdof prob = {.osc = {.w0 = 0.0, .xi = 0.0}, .wall = 1, .delta = b.delta, .e = e,
+                           .npieces = 1, .pieces = &piece};
         pd_ed_opts eo;
         pd_ed_result er;
         pd_edg_result r;

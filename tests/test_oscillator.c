@@ -32,7 +32,7 @@ static void test_osc_free_flight_order(pd_test_ctx *ctx)
     const double thetas[] = {0.5, 1.0}, orders[] = {2.0, 1.0};
     for (int p = 0; p < 2; p++)
         for (int th = 0; th < 2; th++) {
-            pd_osc c = {pulses[p], 1, 2.0, 0.5, 0.7, 0.0, 0.5, 0.05};
+            pd_osc c = {.pulse = pulses[p], .dir = 1, .ap = 2.0, .Tp = 0.5, .Pi2 = 0.7, .Pi3 = 0.0, .eps = 0.5, .xi = 0.05};
             double err[4];
             for (int k = 0; k < 4; k++) {
                 pd_run_opts o = pd_run_default_opts();
@@ -67,7 +67,7 @@ static void test_osc_self_similarity(pd_test_ctx *ctx)
             double Pi1[3];
             long impacts[3];
             for (int k = 0; k < 3; k++) {
-                pd_osc c = {pulses[p], dir, scales[k][0], scales[k][1], 0.7, 0.05, 0.6, 0.05};
+                pd_osc c = {.pulse = pulses[p], .dir = dir, .ap = scales[k][0], .Tp = scales[k][1], .Pi2 = 0.7, .Pi3 = 0.05, .eps = 0.6, .xi = 0.05};
                 pd_run_opts o = pd_run_default_opts();
                 pd_osc_result r;
                 pd_err e;
@@ -90,7 +90,7 @@ static void test_osc_self_similarity(pd_test_ctx *ctx)
  * Measured C = max(-min g / dt) over dt = Tp/500 ... Tp/4000. */
 static void test_osc_penetration_is_order_dt(pd_test_ctx *ctx)
 {
-    pd_osc c = {PD_PULSE_COSINE, 1, 1.0, 1.0, 0.5, 0.02, 0.7, 0.05};
+    pd_osc c = {.pulse = PD_PULSE_COSINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5, .Pi3 = 0.02, .eps = 0.7, .xi = 0.05};
     double C = 0, vmax = 0;
     for (int k = 0; k < 4; k++) {
         pd_run_opts o = pd_run_default_opts();
@@ -148,7 +148,7 @@ static int track_rest(const pd_osc_sample *s, void *ctx)
 
 static void test_osc_persistent_contact(pd_test_ctx *ctx)
 {
-    pd_osc c = {PD_PULSE_SINE, 1, 3.0, 0.8, 0.3, 0.05, 0.0, 0.05};
+    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 3.0, .Tp = 0.8, .Pi2 = 0.3, .Pi3 = 0.05, .eps = 0.0, .xi = 0.05};
     pd_run_opts o = pd_run_default_opts();
     pd_osc_result r;
     pd_err e;
@@ -196,7 +196,7 @@ static void test_osc_energy_across_impacts(pd_test_ctx *ctx)
 {
     const double eps[] = {0.0, 0.3, 0.7, 1.0};
     for (int k = 0; k < 4; k++) {
-        pd_osc c = {PD_PULSE_SINE, 1, 1.0, 1.0, 0.6, 0.02, eps[k], 0.0};
+        pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.6, .Pi3 = 0.02, .eps = eps[k], .xi = 0.0};
         pd_run_opts o = pd_run_default_opts();
         pd_osc_result r;
         pd_err e;
@@ -220,7 +220,7 @@ static void test_osc_energy_across_impacts(pd_test_ctx *ctx)
  * error O(dt) and falling with dt. */
 static void test_osc_first_impact(pd_test_ctx *ctx)
 {
-    pd_osc c = {PD_PULSE_SINE, 1, 2.0, 0.5, 0.8, 0.3, 0.5, 0.05};
+    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 2.0, .Tp = 0.5, .Pi2 = 0.8, .Pi3 = 0.3, .eps = 0.5, .xi = 0.05};
     double t_star, v_star;
     CHECK(ctx, pd_osc_free_first_contact(&c, 2 * c.Tp, &t_star, &v_star) == PD_OK,
           "the free response must reach the gap");
@@ -261,7 +261,7 @@ static void test_osc_scalar_vs_general_kernel(pd_test_ctx *ctx)
 {
     enum { CAP = 8000 };
     static double ua[CAP], ub[CAP];
-    pd_osc c = {PD_PULSE_COSINE, -1, 1.0, 1.0, 1.16, 0.02, 0.2, 0.05};
+    pd_osc c = {.pulse = PD_PULSE_COSINE, .dir = -1, .ap = 1.0, .Tp = 1.0, .Pi2 = 1.16, .Pi3 = 0.02, .eps = 0.2, .xi = 0.05};
     pd_run_opts o = pd_run_default_opts();
     pd_osc_result ra, rb;
     pd_err e;
@@ -284,7 +284,7 @@ static void test_osc_scalar_vs_general_kernel(pd_test_ctx *ctx)
 /* Defaults a user expects: dt = min(Tp, T0)/2000, tend = Tp + 2 T0. */
 static void test_osc_defaults_and_checks(pd_test_ctx *ctx)
 {
-    pd_osc c = {PD_PULSE_SINE, 1, 1.0, 0.3, 0.1, 0.4, 0.6, 0.05};
+    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 0.3, .Pi2 = 0.1, .Pi3 = 0.4, .eps = 0.6, .xi = 0.05};
     pd_osc_result r;
     pd_err e;
     CHECK_NEAR(ctx, pd_osc_default_dt(&c), 0.3 / 2000, 1e-18);

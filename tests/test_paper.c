@@ -11,7 +11,7 @@
 /* Pi1 of a case by the exact reference (with or without the wall). */
 static double ref_Pi1(pd_pulse pulse, int dir, double Pi2, double Pi3, double eps, int no_wall)
 {
-    pd_osc c = {pulse, dir, 1.0, 1.0, Pi2, Pi3, eps, 0.05};
+    pd_osc c = {.pulse = pulse, .dir = dir, .ap = 1.0, .Tp = 1.0, .Pi2 = Pi2, .Pi3 = Pi3, .eps = eps, .xi = 0.05};
     pd_run_opts o = pd_run_default_opts();
     pd_osc_result r;
     pd_err e;
@@ -48,8 +48,8 @@ static void test_paper_fig3_one_dimensionless_history(pd_test_ctx *ctx)
     enum { CAP = 20000 };
     static double xa[CAP], xb[CAP];
     /* Pi2 = Tp / T0 = 0.6: Tp = 0.3 s for T0 = 0.5 s, 0.9 s for T0 = 1.5 s */
-    pd_osc a = {PD_PULSE_COSINE, 1, 3.0, 0.3, 0.6, 0.2, 0.7, 0.05};
-    pd_osc b = {PD_PULSE_COSINE, 1, 5.0, 0.9, 0.6, 0.2, 0.7, 0.05};
+    pd_osc a = {.pulse = PD_PULSE_COSINE, .dir = 1, .ap = 3.0, .Tp = 0.3, .Pi2 = 0.6, .Pi3 = 0.2, .eps = 0.7, .xi = 0.05};
+    pd_osc b = {.pulse = PD_PULSE_COSINE, .dir = 1, .ap = 5.0, .Tp = 0.9, .Pi2 = 0.6, .Pi3 = 0.2, .eps = 0.7, .xi = 0.05};
     pd_run_opts o = pd_run_default_opts();
     pd_osc_result ra, rb;
     pd_err e;

@@ -65,7 +65,7 @@ static void test_penalty_free_flight_exact(pd_test_ctx *ctx)
     const pd_pulse pulses[] = {PD_PULSE_SINE, PD_PULSE_COSINE, PD_PULSE_HARMONIC};
     for (int p = 0; p < 3; p++)
         for (int k = 0; k < 2; k++) {
-            pd_osc c = {pulses[p], k ? -1 : 1, 2.0, 0.5, k ? 3.0 : 0.3, 0.0, 0.5, 0.05};
+            pd_osc c = {.pulse = pulses[p], .dir = k ? -1 : 1, .ap = 2.0, .Tp = 0.5, .Pi2 = k ? 3.0 : 0.3, .Pi3 = 0.0, .eps = 0.5, .xi = 0.05};
             pd_run_opts o = pd_run_default_opts();
             pd_osc_result r, r2;
             pd_err e;
@@ -167,7 +167,7 @@ static void test_penalty_breakpoint_not_crossed(pd_test_ctx *ctx)
  * is root-found, so time and speed match the closed form. */
 static void test_penalty_first_impact_exact(pd_test_ctx *ctx)
 {
-    pd_osc c = {PD_PULSE_SINE, 1, 2.0, 0.5, 0.8, 0.3, 0.5, 0.05};
+    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 2.0, .Tp = 0.5, .Pi2 = 0.8, .Pi3 = 0.3, .eps = 0.5, .xi = 0.05};
     double t_star, v_star;
     CHECK(ctx, pd_osc_free_first_contact(&c, 2 * c.Tp, &t_star, &v_star) == PD_OK,
           "the free response must reach the gap");
@@ -286,7 +286,7 @@ static void test_penalty_hertz_restitution(pd_test_ctx *ctx)
  * accepted steps grow (stiffer contacts need shorter steps). */
 static void test_penalty_converges_as_kc_grows(pd_test_ctx *ctx)
 {
-    pd_osc c = {PD_PULSE_SINE, 1, 1.0, 1.0, 0.5, 0.05, 0.6, 0.05};
+    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5, .Pi3 = 0.05, .eps = 0.6, .xi = 0.05};
     pd_run_opts o = pd_run_default_opts();
     pd_osc_result ref;
     pd_err e;
@@ -324,7 +324,7 @@ static void test_penalty_converges_as_kc_grows(pd_test_ctx *ctx)
  * the same answer. */
 static void test_penalty_stiffness_cost(pd_test_ctx *ctx)
 {
-    pd_osc c = {PD_PULSE_HARMONIC, 1, 1.0, 1.0, 2.0, 0.1, 0.0, 0.02};
+    pd_osc c = {.pulse = PD_PULSE_HARMONIC, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 2.0, .Pi3 = 0.1, .eps = 0.0, .xi = 0.02};
     const char *names[] = {"rk8pd", "rk4imp"};
     long steps[2][2];
     double umax[2][2];
@@ -359,7 +359,7 @@ static void test_penalty_stiffness_cost(pd_test_ctx *ctx)
  * pounding case; exactly for the free mass). */
 static void test_penalty_penetration_scaling(pd_test_ctx *ctx)
 {
-    pd_osc c = {PD_PULSE_SINE, 1, 1.0, 1.0, 0.5, 0.05, 0.6, 0.05};
+    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5, .Pi3 = 0.05, .eps = 0.6, .xi = 0.05};
     const double expect[] = {10.0, pow(100.0, 0.4)};
     for (int law = 0; law < 2; law++) {
         double pen[2], pen_free[2];
@@ -395,7 +395,7 @@ static void test_penalty_self_similar_and_kc_abs(pd_test_ctx *ctx)
     for (int law = 0; law < 2; law++) {
         double Pi1[3], Pi1_abs[3];
         for (int k = 0; k < 3; k++) {
-            pd_osc c = {PD_PULSE_COSINE, -1, scales[k][0], scales[k][1], 0.7, 0.05, 0.6, 0.05};
+            pd_osc c = {.pulse = PD_PULSE_COSINE, .dir = -1, .ap = scales[k][0], .Tp = scales[k][1], .Pi2 = 0.7, .Pi3 = 0.05, .eps = 0.6, .xi = 0.05};
             double w0 = TWO_PI / pd_osc_T0(&c);
             pd_penalty_setup po = {.law = (pd_penalty_law)law, .kc_mult = 1e4, .kc_abs = 0, .rtol = 0, .atol = 0, .stepper = NULL};
             pd_osc_result r;
@@ -421,7 +421,7 @@ static void test_penalty_self_similar_and_kc_abs(pd_test_ctx *ctx)
 static void test_penalty_steppers_agree(pd_test_ctx *ctx)
 {
     const char *names[] = {"rk8pd", "rkf45", "rk4imp", "msbdf"};
-    pd_osc c = {PD_PULSE_SINE, 1, 1.0, 1.0, 0.5, 0.05, 0.6, 0.05};
+    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5, .Pi3 = 0.05, .eps = 0.6, .xi = 0.05};
     for (int law = 0; law < 2; law++) {
         double umax0 = 0;
         long impacts0 = 0;
@@ -600,7 +600,7 @@ static void test_penalty_bad_options(pd_test_ctx *ctx)
                    strstr(e.msg, "budget") && res.steps == 5,
           "%s (%ld steps)", e.msg, res.steps);
 
-    pd_osc c = {PD_PULSE_SINE, 1, 1.0, 1.0, 0.5, 0.05, 0.6, 0.05};
+    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5, .Pi3 = 0.05, .eps = 0.6, .xi = 0.05};
     pd_osc_result r;
     pd_penalty_setup po = {.law = PD_PENALTY_KELVIN, .kc_mult = -1.0, .kc_abs = 0, .rtol = 0, .atol = 0, .stepper = NULL};
     CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) == PD_EINVAL &&

@@ -31,7 +31,8 @@ static void test_ref_no_wall_is_closed_form(pd_test_ctx *ctx)
 {
     const pd_pulse pulses[] = {PD_PULSE_SINE, PD_PULSE_COSINE, PD_PULSE_HARMONIC};
     for (int p = 0; p < 3; p++) {
-        pd_osc c = {pulses[p], -1, 3.0, 0.7, 0.8, 0.0, 0.5, 0.05};
+        pd_osc c = {.pulse = pulses[p], .dir = -1, .ap = 3.0, .Tp = 0.7, .Pi2 = 0.8,
+                    .Pi3 = 0.0, .eps = 0.5, .xi = 0.05};
         pd_run_opts o = pd_run_default_opts();
         pd_osc_result r;
         pd_err e;
@@ -58,7 +59,7 @@ static void test_ref_bouncing_ball_accumulation(pd_test_ctx *ctx)
     const double es[] = {0.3, 0.5, 0.8, 0.9, 0.995}; /* 0.995: chattering, ~2300 impacts */
     for (int k = 0; k < 5; k++) {
         double a = 2.0, delta = 0.5, e = es[k];
-        pd_sine_piece piece = {0.0, a, 0.0, TWO_PI / 4}; /* a sin(pi/2) = a */
+        pd_sine_piece piece = {.t_start = 0.0, .A = a, .w = 0.0, .phi = TWO_PI / 4}; /* a */
         pd_ed_sdof prob = {{0.0, 0.0}, 1, delta, e, 1, &piece};
         double t1 = sqrt(2 * delta / a), v1 = a * t1, t_inf = t1 + 2 * e * v1 / (a * (1 - e));
         pd_ed_opts o;
@@ -88,7 +89,7 @@ static void test_ref_bouncing_ball_accumulation(pd_test_ctx *ctx)
 static void test_ref_accumulation_off_stalls(pd_test_ctx *ctx)
 {
     double a = 2.0, delta = 0.5, e = 0.8;
-    pd_sine_piece piece = {0.0, a, 0.0, TWO_PI / 4};
+    pd_sine_piece piece = {.t_start = 0.0, .A = a, .w = 0.0, .phi = TWO_PI / 4};
     pd_ed_sdof prob = {{0.0, 0.0}, 1, delta, e, 1, &piece};
     double t1 = sqrt(2 * delta / a), t_inf = t1 + 2 * e * a * t1 / (a * (1 - e));
     pd_ed_opts o;
@@ -126,7 +127,7 @@ static int track_energy(double t, double x, double v, int in_contact, void *ctx)
 static void test_ref_impact_closed_form(pd_test_ctx *ctx)
 {
     double w0 = 2.0, V = 1.0, delta = 0.3;
-    pd_sine_piece piece = {0.0, 0.0, 0.0, 0.0};
+    pd_sine_piece piece = {.t_start = 0.0};
     pd_ed_sdof prob = {{w0, 0.0}, 1, delta, 1.0, 1, &piece};
     pd_ed_opts o;
     o = pd_ed_default_opts();
@@ -179,7 +180,8 @@ static void test_ref_energy_balance(pd_test_ctx *ctx)
 {
     const double es[] = {1.0, 0.6};
     for (int k = 0; k < 2; k++) {
-        pd_osc c = {PD_PULSE_SINE, 1, 2.0, 0.5, 0.8, 0.2, es[k], 0.05};
+        pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 2.0, .Tp = 0.5, .Pi2 = 0.8,
+                    .Pi3 = 0.2, .eps = es[k], .xi = 0.05};
         pd_run_opts o = pd_run_default_opts();
         pd_osc_result r;
         pd_err e;
@@ -213,8 +215,9 @@ static void test_ref_self_consistent_on_grid(pd_test_ctx *ctx)
             for (int i = 0; i < 6; i++)
                 for (int j = 0; j < 4; j++)
                     for (int k = 0; k < 4; k++) {
-                        pd_osc c = {p ? PD_PULSE_COSINE : PD_PULSE_SINE, dir, 1.0, 1.0, Pi2s[i],
-                                    Pi3s[j], epss[k], 0.05};
+                        pd_osc c = {.pulse = p ? PD_PULSE_COSINE : PD_PULSE_SINE,
+                                    .dir = dir, .ap = 1.0, .Tp = 1.0, .Pi2 = Pi2s[i],
+                                    .Pi3 = Pi3s[j], .eps = epss[k], .xi = 0.05};
                         pd_osc_result r;
                         pd_err e;
                         pd_ed_result fine;
@@ -224,7 +227,8 @@ static void test_ref_self_consistent_on_grid(pd_test_ctx *ctx)
                         }
                         /* the same problem, bracketing grid 8x finer */
                         double phi = p ? TWO_PI / 4 : 0.0;
-                        pd_sine_piece pc[2] = {{0, (double)dir, 1, phi}, {TWO_PI, 0, 0, 0}};
+                        pd_sine_piece pc[2] = {{.t_start = 0, .A = (double)dir, .w = 1, .phi = phi},
+                                                {.t_start = TWO_PI}};
                         pd_ed_sdof prob = {{Pi2s[i], 0.05}, 1, Pi3s[j], epss[k], 2, pc};
                         pd_ed_opts o;
                         o = pd_ed_default_opts();
@@ -244,6 +248,35 @@ static void test_ref_self_consistent_on_grid(pd_test_ctx *ctx)
     CHECK(ctx, pounding > points / 3, "the grid must pound (%d of %d)", pounding, points);
 }
 
+/* A chattering burst (cosine pulse, Pi2 = 0.7, Pi3 = 0.001, eps = 0.9: 78
+ * shrinking bounces, then rest): each flight lasts down to 1e-5, where the
+ * sinusoid's phase step must be w (t1 - t0) itself, not a difference of
+ * phases (that cost 1e-11 of each tiny dx and moved the rest time by 2e-9
+ * between scan grids).  The contact time agrees to 1e-11 over grids 16..4096. */
+static void test_ref_chatter_contact_time_consistent(pd_test_ctx *ctx)
+{
+    const int divs[] = {16, 64, 65, 512, 4096};
+    pd_sine_piece pc[2] = {{.t_start = 0.0, .A = 1.0, .w = 1.0, .phi = TWO_PI / 4},
+                           {.t_start = TWO_PI}};
+    pd_ed_sdof prob = {.osc = {.w0 = 0.7, .xi = 0.05}, .wall = 1, .delta = 0.001, .e = 0.9,
+                       .npieces = 2, .pieces = pc};
+    double ct[5];
+    for (int k = 0; k < 5; k++) {
+        pd_ed_opts o = pd_ed_default_opts();
+        pd_ed_result r;
+        pd_err err;
+        o.t_end = 6 * TWO_PI;
+        o.scan_divisions = divs[k];
+        CHECK(ctx, pd_ed_sdof_run(&prob, 0.0, 0.0, &o, NULL, NULL, &r, &err) == PD_OK, "%s",
+              err.msg);
+        CHECK(ctx, r.accumulations == 1 && r.impacts > 60, "grid %d: %ld accumulations, %ld impacts",
+              divs[k], r.accumulations, r.impacts);
+        ct[k] = r.contact_time;
+        CHECK(ctx, fabs(ct[k] - ct[0]) <= 1e-11, "grid %d: contact time %.17g vs %.17g", divs[k],
+              ct[k], ct[0]);
+    }
+}
+
 /* Moreau–Jean converges to the reference at order about 1 on the history
  * (max over the step grid of |u - u_ref| / umax_ref). */
 typedef struct hist {
@@ -261,8 +294,11 @@ static int record_u(const pd_osc_sample *s, void *ctx)
 
 static void test_ref_moreau_order_one(pd_test_ctx *ctx)
 {
-    const pd_osc cases[] = {{PD_PULSE_SINE, 1, 1.0, 1.0, 0.5, 0.05, 0.6, 0.05},
-                            {PD_PULSE_COSINE, -1, 1.0, 1.0, 1.16, 0.05, 0.2, 0.05}};
+    const pd_osc cases[] = {
+        {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5, .Pi3 = 0.05,
+         .eps = 0.6, .xi = 0.05},
+        {.pulse = PD_PULSE_COSINE, .dir = -1, .ap = 1.0, .Tp = 1.0, .Pi2 = 1.16, .Pi3 = 0.05,
+         .eps = 0.2, .xi = 0.05}};
     for (int c = 0; c < 2; c++) {
         double err[4];
         for (int k = 0; k < 4; k++) {
@@ -298,8 +334,11 @@ static void test_ref_moreau_order_one(pd_test_ctx *ctx)
  * isolated-impact case at the 1/kc rate. */
 static void test_ref_stiff_penalty_limit(pd_test_ctx *ctx)
 {
-    const pd_osc cases[] = {{PD_PULSE_SINE, 1, 1.0, 1.0, 0.5, 0.05, 0.6, 0.05},
-                            {PD_PULSE_COSINE, -1, 1.0, 1.0, 1.16, 0.3, 0.2, 0.05}};
+    const pd_osc cases[] = {
+        {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5, .Pi3 = 0.05,
+         .eps = 0.6, .xi = 0.05},
+        {.pulse = PD_PULSE_COSINE, .dir = -1, .ap = 1.0, .Tp = 1.0, .Pi2 = 1.16, .Pi3 = 0.3,
+         .eps = 0.2, .xi = 0.05}};
     for (int c = 0; c < 2; c++) {
         pd_osc_result rr, rp;
         pd_err e;
@@ -328,6 +367,7 @@ void suite_reference(pd_test_ctx *ctx)
     PD_RUN(ctx, test_ref_impact_closed_form);
     PD_RUN(ctx, test_ref_energy_balance);
     PD_RUN(ctx, test_ref_self_consistent_on_grid);
+    PD_RUN(ctx, test_ref_chatter_contact_time_consistent);
     PD_RUN(ctx, test_ref_moreau_order_one);
     PD_RUN(ctx, test_ref_stiff_penalty_limit);
 }

@@ -1,6 +1,7 @@
 /* test_util.c — helpers the CLI suites share: running pound and capturing
  * its output, reading JSON members, scratch folders, HDF5 attributes. */
 #include <dirent.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
@@ -191,4 +192,13 @@ pd_run_opts pd_test_pen(const pd_run_opts *base, const pd_penalty_setup *po)
     o.pen.atol = po->atol != 0.0 ? po->atol : d.pen.atol;
     o.pen.stepper = po->stepper ? po->stepper : d.pen.stepper;
     return o;
+}
+
+double pd_test_uniform(uint64_t *s)
+{
+    uint64_t z = (*s += 0x9E3779B97F4A7C15ull); /* splitmix64 */
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    return (double)(z >> 11) * 0x1.0p-53;
 }
