@@ -5,6 +5,9 @@
 #   make asan     the tests under AddressSanitizer + UndefinedBehaviorSanitizer
 #   make bench    performance figures (pound bench; pound against Siconos numerics)
 #   make figures  docs/figures/*.png (convergence, stability, energy)
+#   make stress   the adversarial suite (stress/run.py): hostile flags and
+#                 files, full disks, signals, hangs, libFuzzer, TSan;
+#                 STRESS_ARGS="--report docs/reliability.md" rewrites its table
 #   make all      library and binary only (build/libpound.a, build/pound)
 #   make MPI=1    the MPI build (OpenMPI's mpicc, -DPD_MPI) in build-mpi/:
 #                 mpirun -np K build-mpi/pound spectrum ...
@@ -51,7 +54,7 @@ CLI_OBJ  = $(CLI_SRC:%.c=$(BUILD)/%.o)
 TEST_OBJ = $(TEST_SRC:%.c=$(BUILD)/%.o)
 HDRS     = $(wildcard */*.h)
 
-.PHONY: all deps demo test check asan bench clean acceptance figures paper
+.PHONY: all deps demo test check asan bench clean acceptance figures paper stress print-libs
 
 all: $(BUILD)/pound $(BUILD)/pound_tests
 
@@ -109,6 +112,17 @@ figures: deps
 paper: deps
 	@$(MAKE) --no-print-directory all
 	sh scripts/paper.sh $(BUILD)/pound
+
+# The adversarial suite: fuzzers and a TSan binary built with clang in
+# $(BUILD)/stress, then stress/run.py against $(BUILD)/pound (about 5 min).
+STRESS_ARGS ?=
+stress: deps
+	@sh scripts/deps.sh --stress
+	@$(MAKE) --no-print-directory all
+	sh scripts/stress.sh $(BUILD) $(STRESS_ARGS)
+
+print-libs:
+	@echo $(LIBS)
 
 acceptance: all
 	@sh scripts/acceptance.sh $(BUILD)/pound

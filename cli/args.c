@@ -10,12 +10,13 @@
 
 int pd_cli_usage_error(const char *fmt, ...)
 {
+    char msg[1024];
     va_list ap;
-    fputs("pound: ", stderr);
     va_start(ap, fmt);
-    vfprintf(stderr, fmt, ap);
+    vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
-    fputc('\n', stderr);
+    pd_err_sanitize(msg); /* flags and file text may hold control bytes */
+    fprintf(stderr, "pound: %s\n", msg);
     return 2;
 }
 
@@ -38,8 +39,11 @@ int pd_cli_double(const char *flag, const char *text, double *out)
         return pd_cli_usage_error("%s needs a value", flag);
     errno = 0;
     double x = strtod(text, &end);
-    if (end == text || *end != '\0' || errno == ERANGE)
+    if (end == text || *end != '\0')
         return pd_cli_usage_error("%s: '%s' is not a number", flag, text);
+    if (errno == ERANGE) /* beyond the doubles, or below their normal range */
+        return pd_cli_usage_error("%s: '%s' is out of range (a magnitude between 1e-307 and "
+                                  "1e308, or 0)", flag, text);
     if (!isfinite(x))
         return pd_cli_usage_error("%s: '%s' is not a finite number", flag, text);
     *out = x;

@@ -35,7 +35,8 @@ const char pd_cli_case_help[] =
     "  --lcp-solver auto|lemke|structured|pgs [auto]  the contact LCP solver (docs/lcp.md)\n"
     "penalty (--method penalty):\n"
     "  --contact kelvin|hertz [kelvin]   --kc X stiffness as a multiple of w0^2 (scenes: of\n"
-    "         the largest storey stiffness) [1e4]\n"
+    "         the largest storey stiffness) [max(1e4 w0^2, 1e3 wp^2 / Pi3^2): about 3 %\n"
+    "         of the gap's penetration; scenes 1e4]\n"
     "  --kc-abs K  stiffness in N/m per kg (scenes: N/m; N/m^1.5 for hertz)\n"
     "  --rtol R [1e-10]  --atol A [1e-12]  --stepper rk8pd|rkf45|rk4imp|msbdf [rk8pd]\n";
 
@@ -72,8 +73,12 @@ int pd_cli_record_load(const char *path, pd_record_format format, pd_record_unit
         pd_record_free(&r->rec);
     if (rc) {
         free(r);
-        return rc == PD_ENOMEM ? (fprintf(stderr, "pound: %s\n", err.msg), 1)
-                               : pd_cli_usage_error("%s", err.msg);
+        if (rc == PD_ENOMEM)
+            return fprintf(stderr, "pound: %s\n", err.msg), 1;
+        if (format != PD_RECORD_AUTO) /* the user chose how to read it: say so */
+            return pd_cli_usage_error("%s (read as --record-format %s)", err.msg,
+                                      pd_record_format_name(format));
+        return pd_cli_usage_error("%s", err.msg);
     }
     *out = r;
     return 0;
@@ -112,7 +117,7 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
                        {"--theta", &a->opts.theta, NULL, 0},
                        {"--gamma", &a->opts.gamma, NULL, 0},
                        {"--tend", &a->opts.tend, &a->have_tend, 0},
-                       {"--kc", &a->opts.pen.kc_mult, NULL, 0},
+                       {"--kc", &a->opts.pen.kc_mult, &a->have_kc, 0},
                        {"--kc-abs", &a->opts.pen.kc_abs, NULL, 0},
                        {"--rtol", &a->opts.pen.rtol, NULL, 0},
                        {"--atol", &a->opts.pen.atol, NULL, 0},
@@ -206,25 +211,89 @@ static int check_scheme(const pd_cli_case *a)
 {
     const pd_run_opts *o = &a->opts;
     if (a->have_dt && !(o->dt > 0.0))
-        return pd_cli_usage_error("--dt: the step must be > 0 (got %g)", o->dt);
+        return pd_cli_usage_error("--dt: the step must be > 0 (got %.10g)", o->dt);
     if (a->have_tend && !(o->tend > 0.0))
-        return pd_cli_usage_error("--tend: must be > 0 (got %g)", o->tend);
+        return pd_cli_usage_error("--tend: must be > 0 (got %.10g)", o->tend);
     if (!(o->gamma >= 0.0 && o->gamma <= 1.0))
-        return pd_cli_usage_error("--gamma: must be in [0, 1] (got %g)", o->gamma);
+        return pd_cli_usage_error("--gamma: must be in [0, 1] (got %.10g)", o->gamma);
     if (!o->allow_unstable && !(o->theta >= 0.5 && o->theta <= 1.0))
-        return pd_cli_usage_error("--theta: %g is outside [1/2, 1], where Moreau-Jean is not "
+        return pd_cli_usage_error("--theta: %.10g is outside [1/2, 1], where Moreau-Jean is not "
                                   "unconditionally stable (add --allow-unstable to run it)",
                                   o->theta);
     if (!(o->theta >= 0.0 && o->theta <= 2.0))
-        return pd_cli_usage_error("--theta: must be in [0, 2] (got %g)", o->theta);
-    if (!(o->pen.kc_mult > 0.0))
-        return pd_cli_usage_error("--kc: the contact stiffness multiple must be > 0 (got %g)",
+        return pd_cli_usage_error("--theta: must be in [0, 2] (got %.10g)", o->theta);
+    if (a->have_kc && !(o->pen.kc_mult > 0.0))
+        return pd_cli_usage_error("--kc: the contact stiffness multiple must be > 0 (got %.10g)",
                                   o->pen.kc_mult);
     if (o->pen.kc_abs < 0.0)
-        return pd_cli_usage_error("--kc-abs: the contact stiffness must be >= 0 (got %g)",
+        return pd_cli_usage_error("--kc-abs: the contact stiffness must be >= 0 (got %.10g)",
                                   o->pen.kc_abs);
-    if (!(o->pen.rtol > 0.0) || !(o->pen.atol > 0.0))
-        return pd_cli_usage_error("--rtol/--atol: tolerances must be > 0");
+    if (!(o->pen.rtol > 0.0 && o->pen.rtol < 1.0))
+        return pd_cli_usage_error("--rtol: the relative tolerance must be in (0, 1) (got %.10g)",
+                                  o->pen.rtol);
+    if (!(o->pen.atol > 0.0))
+        return pd_cli_usage_error("--atol: the absolute tolerance must be > 0 (got %.10g)",
+                                  o->pen.atol);
+    return 0;
+}
+
+/* The flag that set the oscillator's period: --T0, --Pi2, else --Tp. */
+static const char *period_flag(const pd_cli_case *a)
+{
+    return a->have_T0 ? "--T0" : a->have_Pi2 ? "--Pi2" : "--Tp";
+}
+
+/* Moreau-Jean steps beyond which a run is refused (the event-driven
+ * reference's budget is the library's, PD_OSC_MAX_SCAN). */
+#define CASE_MAX_STEPS 2e9
+#define CASE_MAX_RATIO 1e4 /* periods of a chain's neighbours, at most this far apart */
+
+/* The flag behind the step count tend / dt: the ones the user gave. */
+static const char *steps_flag(const pd_cli_case *a)
+{
+    const char *dt = a->dt_flag ? a->dt_flag : "--dt";
+    if (a->have_dt && a->have_tend)
+        return !strcmp(dt, "--dt") ? "--dt/--tend" : "--dt-per-Tp/--tend";
+    return a->have_tend ? "--tend" : a->have_dt ? dt : period_flag(a);
+}
+
+/* The flag behind Le = ap (Tp / 2 pi)^2: --scale of a record, else the
+ * pulse flag given last (--ap or --Tp). */
+static const char *ap_flag(const pd_cli_case *a)
+{
+    return a->record_path ? "--scale" : a->pulse_flag ? a->pulse_flag : "--ap";
+}
+
+int pd_cli_case_check_derived(const pd_cli_case *a)
+{
+    const pd_osc *c = &a->c;
+    double T0 = pd_osc_T0(c), wp = pd_osc_wp(c), Le = pd_osc_Le(c), gap = pd_osc_gap(c);
+    if (!isfinite(T0) || !(T0 > 0.0) || !isfinite(PD_TWO_PI / T0))
+        return pd_cli_usage_error("%s: the oscillator's period T0 = Tp / Pi2 = %.3g s is out of "
+                                  "range", period_flag(a), T0);
+    if (!isfinite(wp) || !(Le > 0.0) || !isfinite(Le))
+        return pd_cli_usage_error("%s: Le = ap (Tp / 2 pi)^2 = %.3g m is out of range",
+                                  ap_flag(a), Le);
+    if (!isfinite(gap) || !isfinite(c->Pi3))
+        return pd_cli_usage_error("%s: the gap is too large for ap and Tp (Pi3 = gap / Le "
+                                  "overflows)", a->have_gap ? "--gap" : "--Pi3");
+    double tend = a->have_tend ? a->opts.tend : pd_osc_default_tend(c);
+    double dt = a->have_dt ? a->opts.dt : pd_osc_default_dt(c);
+    if (!isfinite(tend))
+        return pd_cli_usage_error("%s: tend = Tp + 2 T0 overflows", period_flag(a));
+    if (a->have_dt && !(dt < tend))
+        return pd_cli_usage_error("%s: the step %.3g s is not shorter than the run (tend = "
+                                  "%.3g s)", a->dt_flag ? a->dt_flag : "--dt", dt, tend);
+    if (!(tend / dt <= CASE_MAX_STEPS))
+        return pd_cli_usage_error("%s: %.3g steps of %.3g s over %.3g s (at most %.0e)",
+                                  steps_flag(a), tend / dt, dt, tend, CASE_MAX_STEPS);
+    double scan = pd_osc_scan_points(c, tend);
+    if (a->opts.method == PD_METHOD_EVENT && !(scan <= PD_OSC_MAX_SCAN))
+        return pd_cli_usage_error("%s: the event-driven reference would scan %.3g points (64 per "
+                                  "period T0 = %.3g s over %.3g s; at most %.3g: "
+                                  "--method moreau runs it)",
+                                  a->have_tend ? "--tend" : period_flag(a), scan, T0, tend,
+                                  PD_OSC_MAX_SCAN);
     return 0;
 }
 
@@ -232,28 +301,35 @@ static int check_scheme(const pd_cli_case *a)
 static int check_case(const pd_cli_case *a)
 {
     pd_err err;
+    int rc;
     if (a->have_T0 && a->have_Pi2)
         return pd_cli_usage_error("--T0 and --Pi2 are alternatives: give one");
     if (a->have_gap && a->have_Pi3)
         return pd_cli_usage_error("--gap and --Pi3 are alternatives: give one");
     if (!(a->c.ap > 0.0))
-        return pd_cli_usage_error("--ap: pulse amplitude must be > 0 (got %g)", a->c.ap);
+        return pd_cli_usage_error("--ap: pulse amplitude must be > 0 (got %.10g)", a->c.ap);
     if (!(a->c.Tp > 0.0))
-        return pd_cli_usage_error("--Tp: pulse period must be > 0 (got %g)", a->c.Tp);
+        return pd_cli_usage_error("--Tp: pulse period must be > 0 (got %.10g)", a->c.Tp);
     if (a->have_T0 && !(a->T0 > 0.0))
-        return pd_cli_usage_error("--T0: oscillator period must be > 0 (got %g)", a->T0);
+        return pd_cli_usage_error("--T0: oscillator period must be > 0 (got %.10g)", a->T0);
     if (a->have_Pi2 && !(a->c.Pi2 > 0.0))
-        return pd_cli_usage_error("--Pi2: must be > 0 (got %g)", a->c.Pi2);
+        return pd_cli_usage_error("--Pi2: must be > 0 (got %.10g)", a->c.Pi2);
     if (a->have_gap && !(a->gap >= 0.0))
-        return pd_cli_usage_error("--gap: the gap must be >= 0 (got %g)", a->gap);
+        return pd_cli_usage_error("--gap: the gap must be >= 0 (got %.10g)", a->gap);
     if (a->have_Pi3 && !(a->c.Pi3 >= 0.0))
-        return pd_cli_usage_error("--Pi3: the dimensionless gap must be >= 0 (got %g)", a->c.Pi3);
+        return pd_cli_usage_error("--Pi3: the dimensionless gap must be >= 0 (got %.10g)", a->c.Pi3);
     if (!(a->c.eps >= 0.0 && a->c.eps <= 1.0))
-        return pd_cli_usage_error("--eps: restitution must be in [0, 1] (got %g)", a->c.eps);
+        return pd_cli_usage_error("--eps: restitution must be in [0, 1] (got %.10g)", a->c.eps);
     if (!(a->c.xi >= 0.0 && a->c.xi < 1.0))
-        return pd_cli_usage_error("--xi: damping ratio must be in [0, 1) (got %g)", a->c.xi);
+        return pd_cli_usage_error("--xi: damping ratio must be in [0, 1) (got %.10g)", a->c.xi);
     if (a->chain && !(a->chain_ratio > 0.0))
-        return pd_cli_usage_error("--chain-ratio: must be > 0 (got %g)", a->chain_ratio);
+        return pd_cli_usage_error("--chain-ratio: must be > 0 (got %.10g)", a->chain_ratio);
+    /* the shorter period sets the step, the longer the run: at most CASE_MAX_RATIO apart */
+    if (a->chain > 1 && !(a->chain_ratio <= CASE_MAX_RATIO && a->chain_ratio >= 1.0 / CASE_MAX_RATIO))
+        return pd_cli_usage_error("--chain-ratio: must be in [1e-4, 1e4] (got %.10g)",
+                                  a->chain_ratio);
+    if ((rc = pd_cli_case_check_derived(a)))
+        return rc;
     if (pd_osc_check(&a->c, &err))
         return pd_cli_usage_error("%s", err.msg);
     return 0;
@@ -272,7 +348,7 @@ static int case_record(pd_cli_case *a)
         return pd_cli_usage_error("%s: the record replaces the pulse (its fitted pulse gives ap "
                                   "and Tp; --scale scales it)", a->pulse_flag);
     if (!(a->scale > 0.0) || !isfinite(a->scale))
-        return pd_cli_usage_error("--scale: must be > 0 (got %g)", a->scale);
+        return pd_cli_usage_error("--scale: must be > 0 (got %.10g)", a->scale);
     int rc = a->record ? 0 : pd_cli_record_load(a->record_path, a->rec_format, a->rec_units,
                                                 &a->record);
     if (!rc)

@@ -43,22 +43,68 @@ typedef struct conv_args {
     const char *plot, *out;
 } conv_args;
 
+/* The next element of a comma-separated list at *p (cut at its comma, *p
+ * moved past it; NULL after the last).  Empty elements are kept: "a,,b"
+ * gives "a", "", "b". */
+static char *next_element(char **p)
+{
+    char *tok = *p, *comma = tok ? strchr(tok, ',') : NULL;
+    if (comma)
+        *comma = '\0';
+    *p = comma ? comma + 1 : NULL;
+    return tok;
+}
+
+/* An empty k-th element (from 1) of the list text given to flag: 2. */
+static int empty_element(const char *flag, const char *text, int k)
+{
+    return pd_cli_usage_error("%s: element %d of '%s' is empty", flag, k, text);
+}
+
 /* "a,b,c" -> up to MAX_LIST finite numbers; 0 or 2. */
 static int parse_list(const char *flag, const char *text, double *x, int *n)
 {
-    char buf[512];
+    char buf[512], *p = buf;
     *n = 0;
     if (!text || strlen(text) >= sizeof buf)
         return pd_cli_usage_error("%s needs a comma-separated list of numbers", flag);
+    if (!text[0])
+        return pd_cli_usage_error("%s: empty list", flag);
     strcpy(buf, text);
-    for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+    for (char *tok; (tok = next_element(&p));) {
         if (*n >= MAX_LIST)
             return pd_cli_usage_error("%s: at most %d values", flag, MAX_LIST);
+        if (!tok[0])
+            return empty_element(flag, text, *n + 1);
         if (pd_cli_double(flag, tok, &x[*n]))
             return 2;
         (*n)++;
     }
-    return *n ? 0 : pd_cli_usage_error("%s: empty list", flag);
+    return 0;
+}
+
+/* "moreau,penalty" (either or both) into a; 0 or 2. */
+static int parse_methods(conv_args *a, const char *text)
+{
+    char buf[128], *p = buf;
+    if (!text || strlen(text) >= sizeof buf)
+        return pd_cli_usage_error("--methods needs a list such as moreau,penalty");
+    if (!text[0])
+        return pd_cli_usage_error("--methods: give moreau, penalty or both (got '')");
+    strcpy(buf, text);
+    a->want_moreau = a->want_penalty = 0;
+    for (int k = 1; p; k++) {
+        char *tok = next_element(&p);
+        if (!tok[0])
+            return empty_element("--methods", text, k);
+        if (!strcmp(tok, "moreau"))
+            a->want_moreau = 1;
+        else if (!strcmp(tok, "penalty"))
+            a->want_penalty = 1;
+        else
+            return pd_cli_usage_error("--methods: '%s' is not one of moreau, penalty", tok);
+    }
+    return 0;
 }
 
 /* "MAX:MIN:N" with MAX >= MIN > 0, N >= 2 (N = 1: MAX only). */
@@ -80,6 +126,19 @@ static int parse_range(conv_args *a, const char *text)
         return pd_cli_usage_error("--dt: need MAX >= MIN > 0 and 1 <= N <= 64 (got %s)", text);
     a->have_dt_range = 1;
     return 0;
+}
+
+/* -o, --plot F.png and the F-work.png it implies name different files:
+ * PD_OK or PD_EINVAL. */
+static int check_outputs_distinct(const conv_args *a, pd_err *err)
+{
+    char work[4096] = "";
+    size_t len = a->plot ? strlen(a->plot) : 0;
+    if (a->plot && len < sizeof work - 16)
+        snprintf(work, sizeof work, "%.*s-work.png", (int)(len - 4), a->plot);
+    const char *flags[] = {"-o", "--plot", "--plot (work-precision chart)"};
+    const char *paths[] = {a->out, a->plot, work[0] ? work : NULL};
+    return pd_output_check_distinct(3, flags, paths, err);
 }
 
 static int parse_args(conv_args *a, int argc, char **argv)
@@ -118,19 +177,8 @@ static int parse_args(conv_args *a, int argc, char **argv)
                 return rc;
             i++;
         } else if (!strcmp(f, "--methods")) {
-            char buf[128];
-            if (!val || strlen(val) >= sizeof buf)
-                return pd_cli_usage_error("--methods needs a list such as moreau,penalty");
-            strcpy(buf, val);
-            a->want_moreau = a->want_penalty = 0;
-            for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
-                if (!strcmp(tok, "moreau"))
-                    a->want_moreau = 1;
-                else if (!strcmp(tok, "penalty"))
-                    a->want_penalty = 1;
-                else
-                    return pd_cli_usage_error("--methods: '%s' is not one of moreau, penalty", tok);
-            }
+            if ((rc = parse_methods(a, val)))
+                return rc;
             i++;
         } else if (!strcmp(f, "--plot")) {
             if (!val)
@@ -167,6 +215,8 @@ static int parse_args(conv_args *a, int argc, char **argv)
         return pd_cli_usage_error("--plot: '%s' must end in .png", a->plot);
     pd_err err;
     if (a->out && pd_output_check_path(a->out, &err))
+        return pd_cli_usage_error("%s", err.msg);
+    if (check_outputs_distinct(a, &err))
         return pd_cli_usage_error("%s", err.msg);
     a->k.have_dt = 1;
     a->k.opts.dt = a->dt_max;
@@ -464,10 +514,14 @@ static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int
     return rc ? rc : pd_plot(work_png, &c2, err);
 }
 
-/* The table as CSV or HDF5 columns (method 0 = moreau, 2 = penalty). */
+/* The table as CSV or HDF5 columns; the method is a coded column: its name
+ * in the CSV ("moreau", "penalty"), its pd_method code in the HDF5 file
+ * with a "codes" attribute naming them. */
 static int write_rows(const conv_args *a, const row *rows, int n, pd_err *err)
 {
     static double col[9][MAX_ROWS];
+    const char *methods[] = {pd_method_name(PD_METHOD_MOREAU), pd_method_name(PD_METHOD_EVENT),
+                             pd_method_name(PD_METHOD_PENALTY)}; /* by code, as in --json */
     for (int r = 0; r < n; r++) {
         double v[9] = {(double)rows[r].method, rows[r].theta, rows[r].dt, rows[r].kc,
                        rows[r].err_umax, rows[r].err_hist, rows[r].cpu_s, rows[r].order,
@@ -475,10 +529,16 @@ static int write_rows(const conv_args *a, const row *rows, int n, pd_err *err)
         for (int c = 0; c < 9; c++)
             col[c][r] = v[c];
     }
-    pd_column cols[9] = {{"method", "0 = moreau, 2 = penalty", col[0]}, {"theta", "1", col[1]},
-                         {"dt", "s", col[2]}, {"kc", "w0^2", col[3]}, {"err_umax_rel", "1", col[4]},
-                         {"err_hist_linf", "1", col[5]}, {"cpu_s", "s", col[6]},
-                         {"order", "1", col[7]}, {"impacts", "1", col[8]}};
+    pd_column cols[9] = {
+        {.name = "method", .values = col[0], .labels = methods, .nlabels = 3},
+        {.name = "theta", .units = "1", .values = col[1]},
+        {.name = "dt", .units = "s", .values = col[2]},
+        {.name = "kc", .units = "w0^2", .values = col[3]},
+        {.name = "err_umax_rel", .units = "1", .values = col[4]},
+        {.name = "err_hist_linf", .units = "1", .values = col[5]},
+        {.name = "cpu_s", .units = "s", .values = col[6]},
+        {.name = "order", .units = "1", .values = col[7]},
+        {.name = "impacts", .units = "1", .values = col[8]}};
     pd_attr attrs[] = {{"pulse", NULL, 1, 0, pd_osc_excitation_name(&a->k.c)},
                        {"dir", NULL, 1, 0, pd_dir_name(a->k.c.dir)},
                        {"Pi2", "1", 0, a->k.c.Pi2, NULL}, {"Pi3", "1", 0, a->k.c.Pi3, NULL},

@@ -129,6 +129,8 @@ static int parse_args(int argc, char **argv, lcp_args *a)
     }
     if (!a->path)
         return pd_cli_usage_error("lcp: no FILE given (usage: pound lcp FILE [--json] ...)");
+    if (a->all && a->index >= 0)
+        return pd_cli_usage_error("--all and --index are alternatives: give one");
     return 0;
 }
 

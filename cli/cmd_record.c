@@ -60,6 +60,8 @@ static int parse_args(record_args *a, int argc, char **argv)
             i++;
         } else if (f[0] == '-' && f[1] != '\0')
             return pd_cli_usage_error("record: unknown flag '%s' (see pound record --help)", f);
+        else if (!strcmp(f, "-"))
+            return pd_cli_usage_error("record: '-' (standard input) is not read: give a file name");
         else if (a->nfiles >= RECORD_MAX_FILES)
             return pd_cli_usage_error("record: at most %d files", RECORD_MAX_FILES);
         else

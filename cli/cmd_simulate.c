@@ -18,6 +18,12 @@ static const char simulate_usage[] =
     "              attributes with units; --every K keeps every K-th step\n"
     "              oscillator: t, u, v, impulse, gap; scene: t, x and v per structure and\n"
     "              storey, gap and impulse per contact (docs/scenes.md)\n"
+    "              The rows are streamed to FILE.tmpPID as the run goes (memory stays\n"
+    "              bounded), renamed to FILE when complete (its mode kept; a symlink's\n"
+    "              target replaced).  Before the run: FILE must be writable, an output\n"
+    "              estimated above 100 MB is announced on stderr (\"pound: writing about\n"
+    "              N MB to FILE\"), and one larger than the free space of FILE's file\n"
+    "              system is refused (exit 2; fewer rows with --every K)\n"
     "  --plot F    the displacement histories with the impacts marked\n"
     "  --dump-lcp F.h5  every contact LCP Moreau-Jean solves (D, b, z, solver, pivots or\n"
     "              iterations), for `pound lcp F.h5 --all` (docs/lcp.md)\n"
@@ -76,11 +82,39 @@ static int parse_args(sim_args *a, int argc, char **argv)
         return pd_cli_usage_error("%s", err.msg);
     if (a->plot && (strlen(a->plot) < 5 || strcmp(a->plot + strlen(a->plot) - 4, ".png")))
         return pd_cli_usage_error("--plot: '%s' must end in .png", a->plot);
+    if (a->plot && pd_output_check_writable("--plot", a->plot, &err))
+        return pd_cli_usage_error("%s", err.msg);
     if (a->dump && (strlen(a->dump) < 4 || strcmp(a->dump + strlen(a->dump) - 3, ".h5")))
         return pd_cli_usage_error("--dump-lcp: '%s' must end in .h5", a->dump);
+    if (a->dump && pd_output_check_writable("--dump-lcp", a->dump, &err))
+        return pd_cli_usage_error("%s", err.msg);
+    const char *flags[] = {"-o", "--plot", "--dump-lcp"}, *paths[] = {a->out, a->plot, a->dump};
+    if (pd_output_check_distinct(3, flags, paths, &err))
+        return pd_cli_usage_error("%s", err.msg);
     if (a->dump && a->k.opts.method != PD_METHOD_MOREAU)
         return pd_cli_usage_error("--dump-lcp: the LCPs dumped are Moreau-Jean's (--method moreau)");
     return pd_cli_case_finish(&a->k);
+}
+
+/* About how many bytes -o writes for rows of width values (CSV: %.17g
+ * text, some 23 bytes a value). */
+static double output_bytes(const char *path, long rows, int width)
+{
+    size_t n = strlen(path);
+    int csv = n > 4 && !strcmp(path + n - 4, ".csv");
+    return 8192.0 + (double)rows * width * (csv ? 23.0 : 8.0);
+}
+
+/* Before the run: refuse an output larger than the space free for it,
+ * announce a large one; 0 or 2. */
+static int check_output_size(const char *path, double bytes)
+{
+    pd_err err;
+    if (pd_output_check_room("-o", path, bytes, &err))
+        return pd_cli_usage_error("%s (--every K keeps every K-th step)", err.msg);
+    if (bytes >= PD_OUTPUT_NOTICE_MB * 1e6)
+        fprintf(stderr, "pound: writing about %.0f MB to %s\n", bytes / 1e6, path);
+    return 0;
 }
 
 /* --dump-lcp: open the dump and hook it on the run; 0 or 1. */
@@ -112,51 +146,37 @@ static int dump_finish(const sim_args *a, pd_lcp_dump *d)
 
 /* ==== the oscillator ======================================================== */
 
-/* The recorded history, allocated once before the run. */
-typedef struct history {
-    long every, cap, rows;
-    double *t, *u, *v, *impulse, *gap;
+/* Where the oscillator's samples go: the file (every every-th step, at most
+ * rows_max rows) and the chart. */
+typedef struct osc_out {
+    long every, rows, rows_max;
+    pd_table_writer *file;
     pd_scene_plot *plot; /* --plot: the same samples as a one-structure scene */
-} history;
+} osc_out;
 
+/* The oscillator's columns. */
+static const pd_column osc_cols[] = {{.name = "t", .units = "s"},
+                                     {.name = "u", .units = "m"},
+                                     {.name = "v", .units = "m/s"},
+                                     {.name = "impulse", .units = "m/s"},
+                                     {.name = "gap", .units = "m"}};
+enum { OSC_COLS = sizeof osc_cols / sizeof osc_cols[0] };
+
+/* A pd_osc_sampler: a row to the file, a point to the chart; a failed write
+ * stops the run. */
 static int record(const pd_osc_sample *s, void *ctx)
 {
-    history *h = ctx;
-    if (h->plot) {
+    osc_out *o = ctx;
+    if (o->plot) {
         pd_scene_sample ss = {.step = s->step, .t = s->t, .x = &s->u, .v = &s->v,
                               .gap = &s->gap, .impulse = &s->impulse};
-        pd_scene_plot_sample(&ss, h->plot);
+        pd_scene_plot_sample(&ss, o->plot);
     }
-    if (!h->t || s->step % h->every || h->rows >= h->cap)
+    if (!o->file || s->step % o->every || o->rows >= o->rows_max)
         return 0;
-    h->t[h->rows] = s->t;
-    h->u[h->rows] = s->u;
-    h->v[h->rows] = s->v;
-    h->impulse[h->rows] = s->impulse;
-    h->gap[h->rows] = s->gap;
-    h->rows++;
-    return 0;
-}
-
-static void history_free(history *h)
-{
-    free(h->t);
-    free(h->u);
-    free(h->v);
-    free(h->impulse);
-    free(h->gap);
-}
-
-static int history_alloc(history *h, long nsteps, long every)
-{
-    h->every = every;
-    h->cap = nsteps / every + 1;
-    h->t = malloc((size_t)h->cap * sizeof(double));
-    h->u = malloc((size_t)h->cap * sizeof(double));
-    h->v = malloc((size_t)h->cap * sizeof(double));
-    h->impulse = malloc((size_t)h->cap * sizeof(double));
-    h->gap = malloc((size_t)h->cap * sizeof(double));
-    return h->t && h->u && h->v && h->impulse && h->gap ? 0 : -1;
+    double row[OSC_COLS] = {s->t, s->u, s->v, s->impulse, s->gap};
+    o->rows++;
+    return pd_table_row(o->file, row) ? 1 : 0;
 }
 
 static void print_json(const sim_args *a, const pd_osc_summary *s)
@@ -239,16 +259,11 @@ static void print_text(const sim_args *a, const pd_osc_summary *s)
     printf("  cpu       = %.3g s\n", s->cpu_s);
 }
 
-/* Write the history and every input and summary figure. */
-static int write_output(const sim_args *a, const pd_osc_summary *s, const history *h,
-                        pd_err *err)
+/* Every input and summary figure after the histories; the file into place. */
+static int finish_output(const sim_args *a, const pd_osc_summary *s, pd_table_writer *w,
+                         pd_err *err)
 {
     const pd_osc *c = &a->k.c;
-    pd_column cols[] = {{"t", "s", h->t},
-                        {"u", "m", h->u},
-                        {"v", "m/s", h->v},
-                        {"impulse", "m/s", h->impulse},
-                        {"gap", "m", h->gap}};
 #define NUM(n, u, x) {.name = n, .units = u, .num = (x)}
 #define TXT(n, x) {.name = n, .is_text = 1, .text = (x)}
     pd_attr attrs[] = {TXT("command", a->command),
@@ -281,8 +296,7 @@ static int write_output(const sim_args *a, const pd_osc_summary *s, const histor
                        NUM("cpu_s", "s", s->cpu_s)};
 #undef NUM
 #undef TXT
-    pd_table t = {h->rows, 5, cols, (int)(sizeof attrs / sizeof attrs[0]), attrs};
-    return pd_output_write(a->out, &t, err);
+    return pd_table_finish(w, (int)(sizeof attrs / sizeof attrs[0]), attrs, err);
 }
 
 /* The oscillator as a one-structure scene, for the chart. */
@@ -299,33 +313,39 @@ static pd_scene *oscillator_scene(const pd_osc *c)
     return sc;
 }
 
+/* The oscillator's run, its file, chart, dump and summary: the exit status. */
 static int simulate_oscillator(sim_args *a)
 {
     pd_osc_summary s;
-    history hist;
     pd_scene *psc = NULL;
     pd_lcp_dump *dump = NULL;
     pd_err err;
     int rc, status = 0;
     long nsteps = pd_steps_for(a->k.opts.tend, a->k.opts.dt);
-    memset(&hist, 0, sizeof hist);
+    osc_out o = {.every = a->every, .rows_max = nsteps / a->every + 1};
+    if (a->out && (status = check_output_size(a->out, output_bytes(a->out, o.rows_max, OSC_COLS))))
+        goto done;
     if ((status = dump_open(a, &dump)))
         goto done;
-    if ((a->out && history_alloc(&hist, nsteps, a->every)) ||
-        (a->plot && (!(psc = oscillator_scene(&a->k.c)) ||
-                     pd_scene_plot_open(&hist.plot, psc, nsteps, &err)))) {
-        fprintf(stderr, "pound: simulate: out of memory for the history (use --every)\n");
+    if (a->out && (rc = pd_table_open(&o.file, a->out, OSC_COLS, osc_cols, o.rows_max, &err))) {
+        fprintf(stderr, "pound: simulate: %s\n", err.msg);
+        status = rc == PD_EINVAL ? 2 : 1;
+        goto done;
+    }
+    if (a->plot && (!(psc = oscillator_scene(&a->k.c)) ||
+                    pd_scene_plot_open(&o.plot, psc, nsteps, &err))) {
+        fprintf(stderr, "pound: simulate: out of memory for the chart\n");
         status = 1;
         goto done;
     }
-    if ((rc = pd_osc_summarize(&a->k.c, &a->k.opts, a->out || a->plot ? record : NULL, &hist, &s,
+    if ((rc = pd_osc_summarize(&a->k.c, &a->k.opts, a->out || a->plot ? record : NULL, &o, &s,
                                &err))) {
         fprintf(stderr, "pound: simulate: %s\n", err.msg);
         status = rc == PD_EINVAL ? 2 : 1;
         goto done;
     }
-    if ((a->out && write_output(a, &s, &hist, &err)) ||
-        (a->plot && pd_scene_plot_draw(hist.plot, a->plot, "pounding oscillator", &err))) {
+    if ((o.file && finish_output(a, &s, o.file, &err)) ||
+        (a->plot && pd_scene_plot_draw(o.plot, a->plot, "pounding oscillator", &err))) {
         fprintf(stderr, "pound: simulate: %s\n", err.msg);
         status = 1;
         goto done;
@@ -338,9 +358,9 @@ static int simulate_oscillator(sim_args *a)
         print_text(a, &s);
 done:
     pd_lcp_dump_free(dump);
-    pd_scene_plot_free(hist.plot);
+    pd_table_free(o.file);
+    pd_scene_plot_free(o.plot);
     pd_scene_free(psc);
-    history_free(&hist);
     return status;
 }
 
@@ -503,10 +523,16 @@ static int simulate_scene(sim_args *a)
     memset(&s, 0, sizeof s);
     if ((status = pd_cli_scene(&a->k, &sc)))
         return status;
-    if ((status = dump_open(a, &dump)))
-        goto done;
     pd_scene_resolve_opts(sc, &a->k.opts, &o, &err);
     long expected = pd_steps_for(o.tend, o.dt); /* samples: every step or every dt */
+    int width = 1 + 2 * sc->n + 2 * sc->ncontact;
+    if (a->out &&
+        (status = check_output_size(a->out, output_bytes(a->out, expected / a->every + 1, width))))
+        goto done;
+    if ((status = dump_open(a, &dump)))
+        goto done;
+    o.on_lcp = a->k.opts.on_lcp; /* the dump's hook, set after the options were resolved */
+    o.on_lcp_ctx = a->k.opts.on_lcp_ctx;
     if ((a->out && pd_scene_writer_open(&fo.w, a->out, sc, a->every, &err)) ||
         (a->plot && pd_scene_plot_open(&fo.p, sc, expected, &err))) {
         fprintf(stderr, "pound: simulate: %s\n", err.msg);

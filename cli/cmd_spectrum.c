@@ -44,6 +44,7 @@ typedef struct spec_args {
     const char *out, *plot;
     int json, resume, threads, have_pi2, have_pi3, have_gap, have_eps;
     const char *scene_list;           /* a list flag a scene sweep refuses */
+    const char *pulse_flag;           /* --pulse or --dir when given (refused with --record) */
     const char *ref_name;             /* --ref NAME (scene sweeps) */
     int ref_contact, have_ref_contact; /* --ref-contact K */
     long stop_after;
@@ -149,6 +150,7 @@ static int list_flag(spec_args *a, const char *f, const char *val)
         s->dimensional = 1;
         rc = parse_nums(f, val, s->ap, &s->nap);
     } else if (!strcmp(f, "--pulse")) {
+        a->pulse_flag = f;
         if (!(rc = parse_names(f, val, 1, names, &s->npulse, 3)))
             for (int i = 0; i < s->npulse; i++)
                 s->pulse[i] = (pd_pulse)names[i];
@@ -212,6 +214,21 @@ static int own_flag(spec_args *a, int argc, char **argv, int *i)
     return rc ? 2 : 1;
 }
 
+/* -o, --plot F.png and the charts it implies (F-gamma.png, F-dim.png) name
+ * different files: PD_OK or PD_EINVAL. */
+static int check_outputs_distinct(const spec_args *a, pd_err *err)
+{
+    char gamma[4096] = "", dim[4096] = "";
+    size_t len = a->plot ? strlen(a->plot) : 0;
+    if (a->plot && len >= 4 && len < sizeof gamma - 16) {
+        snprintf(gamma, sizeof gamma, "%.*s-gamma.png", (int)(len - 4), a->plot);
+        snprintf(dim, sizeof dim, "%.*s-dim.png", (int)(len - 4), a->plot);
+    }
+    const char *flags[] = {"-o", "--plot", "--plot (gamma chart)", "--plot (dimensional chart)"};
+    const char *paths[] = {a->out, a->plot, gamma[0] ? gamma : NULL, dim[0] ? dim : NULL};
+    return pd_output_check_distinct(4, flags, paths, err);
+}
+
 /* The rules of a scene sweep: 0 or 2. */
 static int check_scene_args(spec_args *a)
 {
@@ -230,7 +247,43 @@ static int check_scene_args(spec_args *a)
         return pd_cli_usage_error("--plot: '%s' must end in .png", a->plot);
     if (a->out && pd_output_check_path(a->out, &err))
         return pd_cli_usage_error("%s", err.msg);
+    if (check_outputs_distinct(a, &err))
+        return pd_cli_usage_error("%s", err.msg);
     return pd_cli_case_finish(&a->k);
+}
+
+/* The sweep's corners (smallest and largest Pi2, every size and amplitude)
+ * through the checks of one case, so that a value whose derived quantities
+ * overflow is refused naming its flag: 0 or 2. */
+static int check_corners(const spec_args *a)
+{
+    const pd_spectrum *s = &a->s;
+    double pi2[2] = {s->pi2_min, s->pi2_max};
+    for (int i = 0; i < 2; i++)
+        for (int j = 0; j < s->nsize; j++)
+            for (int k = 0; k < s->nap; k++) {
+                pd_cli_case p = a->k; /* a copy: owns nothing that is freed here */
+                p.c = s->base;
+                p.c.Pi2 = pi2[i];
+                p.have_Pi2 = 1;
+                if (s->dimensional)
+                    p.c.ap = s->ap[k];
+                p.have_gap = s->size_is_gap;
+                p.have_Pi3 = !s->size_is_gap;
+                if (s->size_is_gap)
+                    pd_osc_set_gap(&p.c, s->size[j]);
+                else
+                    p.c.Pi3 = s->size[j];
+                if (s->dt_per_Tp > 0.0) {
+                    p.opts.dt = p.c.Tp / s->dt_per_Tp;
+                    p.have_dt = 1;
+                    p.dt_flag = "--dt-per-Tp";
+                }
+                int rc = pd_cli_case_check_derived(&p);
+                if (rc)
+                    return rc;
+            }
+    return 0;
 }
 
 /* Cross-flag rules once every flag is read: 0 or 2. */
@@ -256,6 +309,8 @@ static int check_args(spec_args *a)
         return pd_cli_usage_error("--plot: '%s' must end in .png", a->plot);
     if (a->out && pd_output_check_path(a->out, &err))
         return pd_cli_usage_error("%s", err.msg);
+    if (check_outputs_distinct(a, &err))
+        return pd_cli_usage_error("%s", err.msg);
     if (pd_spec_tasks(s) > PD_SPEC_MAX_TASKS)
         return pd_cli_usage_error("--Pi2: %ld runs in this sweep, at most %ld", pd_spec_tasks(s),
                                   PD_SPEC_MAX_TASKS);
@@ -272,6 +327,9 @@ static int check_args(spec_args *a)
         if (!(s->size[i] >= 0.0))
             return pd_cli_usage_error("%s: must be >= 0 (got %g)",
                                       s->size_is_gap ? "--gap" : "--Pi3", s->size[i]);
+    if (a->k.record_path && a->pulse_flag)
+        return pd_cli_usage_error("%s: the record replaces the pulse (its fitted pulse gives Tp; "
+                                  "--scale scales it)", a->pulse_flag);
     pd_cli_case checked = a->k; /* the flags' ranges, errors naming them */
     int rc = pd_cli_case_finish(&checked);
     if (rc)
@@ -284,6 +342,8 @@ static int check_args(spec_args *a)
             s->ap[0] = s->base.ap;
     }
     s->opts = a->k.opts; /* dt and tend stay 0 (per point) unless given */
+    if ((rc = check_corners(a)))
+        return rc;
     if (pd_spec_validate(s, &err))
         return pd_cli_usage_error("%s", err.msg);
     return 0;

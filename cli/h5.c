@@ -1,8 +1,247 @@
-/* h5.c — (cli) the HDF5 helpers the output writers share. */
+/* h5.c — (cli) the HDF5 helpers the output writers share, and the "sink"
+ * file driver every output file is written through (pd_h5.h). */
+#include <errno.h>
+#include <fcntl.h>
+#include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "pd_h5.h"
+
+/* ---- the sink driver --------------------------------------------------------
+ * sec2's features (so the library lays the file out byte for byte as sec2
+ * would, without driver info in the superblock: any HDF5 reader opens it),
+ * pread/pwrite on one descriptor, and failures kept from the library: the
+ * first one's errno goes to the owner's cell, later writes are dropped. */
+
+/* What the file-access property list carries: the owner's failure cell. */
+typedef struct sink_info {
+    int *failure;
+} sink_info;
+
+/* An open file; pub first, so that an H5FD_t * is a sink_file *. */
+typedef struct sink_file {
+    H5FD_t pub;
+    int fd;
+    haddr_t eoa, eof;
+    dev_t dev;
+    ino_t ino;
+    int *failure;
+} sink_file;
+
+/* Remember the first failure (errno e); later ones add nothing. */
+static void sink_fail(sink_file *f, int e)
+{
+    if (!*f->failure)
+        *f->failure = e ? e : EIO;
+}
+
+/* Open or create name with the library's access flags. */
+static H5FD_t *sink_open(const char *name, unsigned flags, hid_t fapl, haddr_t maxaddr)
+{
+    const sink_info *info = H5Pget_driver_info(fapl);
+    int how = (flags & H5F_ACC_RDWR ? O_RDWR : O_RDONLY) | (flags & H5F_ACC_TRUNC ? O_TRUNC : 0) |
+              (flags & H5F_ACC_CREAT ? O_CREAT : 0) | (flags & H5F_ACC_EXCL ? O_EXCL : 0);
+    sink_file *f = info ? calloc(1, sizeof *f) : NULL;
+    struct stat st;
+    (void)maxaddr;
+    if (!f)
+        return NULL;
+    f->failure = info->failure;
+    f->fd = open(name, how, 0666);
+    if (f->fd < 0 || fstat(f->fd, &st) != 0) {
+        if (flags & H5F_ACC_CREAT) /* not the library's tentative open first */
+            sink_fail(f, errno);
+        if (f->fd >= 0)
+            close(f->fd);
+        free(f);
+        return NULL;
+    }
+    f->eof = (haddr_t)st.st_size;
+    f->dev = st.st_dev;
+    f->ino = st.st_ino;
+    return &f->pub;
+}
+
+/* Close the descriptor (a failure of close is a write failure). */
+static herr_t sink_close(H5FD_t *file)
+{
+    sink_file *f = (sink_file *)file;
+    if (close(f->fd) != 0)
+        sink_fail(f, errno);
+    free(f);
+    return 0;
+}
+
+/* Order files by device and inode (the library's "same file" test). */
+static int sink_cmp(const H5FD_t *a, const H5FD_t *b)
+{
+    const sink_file *x = (const sink_file *)a, *y = (const sink_file *)b;
+    if (x->dev != y->dev)
+        return x->dev < y->dev ? -1 : 1;
+    return (x->ino > y->ino) - (x->ino < y->ino);
+}
+
+/* sec2's features, so the same layout. */
+static herr_t sink_query(const H5FD_t *file, unsigned long *flags)
+{
+    (void)file;
+    *flags = H5FD_FEAT_AGGREGATE_METADATA | H5FD_FEAT_ACCUMULATE_METADATA |
+             H5FD_FEAT_DATA_SIEVE | H5FD_FEAT_AGGREGATE_SMALLDATA |
+             H5FD_FEAT_DEFAULT_VFD_COMPATIBLE;
+    return 0;
+}
+
+/* The end of the allocated address space. */
+static haddr_t sink_get_eoa(const H5FD_t *file, H5FD_mem_t type)
+{
+    (void)type;
+    return ((const sink_file *)file)->eoa;
+}
+
+static herr_t sink_set_eoa(H5FD_t *file, H5FD_mem_t type, haddr_t addr)
+{
+    (void)type;
+    ((sink_file *)file)->eoa = addr;
+    return 0;
+}
+
+/* The end of the file as written so far. */
+static haddr_t sink_get_eof(const H5FD_t *file, H5FD_mem_t type)
+{
+    (void)type;
+    return ((const sink_file *)file)->eof;
+}
+
+/* Read size bytes at addr; beyond the end of the file, zeros. */
+static herr_t sink_read(H5FD_t *file, H5FD_mem_t type, hid_t dxpl, haddr_t addr, size_t size,
+                        void *buf)
+{
+    sink_file *f = (sink_file *)file;
+    char *p = buf;
+    (void)type;
+    (void)dxpl;
+    while (size > 0) {
+        ssize_t n = pread(f->fd, p, size, (off_t)addr);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n < 0 && !*f->failure)
+            return -1;
+        if (n <= 0)
+            break;
+        p += n;
+        addr += (haddr_t)n;
+        size -= (size_t)n;
+    }
+    memset(p, 0, size);
+    return 0;
+}
+
+/* Write size bytes at addr, or drop them after a failure. */
+static herr_t sink_write(H5FD_t *file, H5FD_mem_t type, hid_t dxpl, haddr_t addr, size_t size,
+                         const void *buf)
+{
+    sink_file *f = (sink_file *)file;
+    const char *p = buf;
+    haddr_t end = addr + size;
+    (void)type;
+    (void)dxpl;
+    while (size > 0 && !*f->failure) {
+        ssize_t n = pwrite(f->fd, p, size, (off_t)addr);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n <= 0) {
+            sink_fail(f, n < 0 ? errno : ENOSPC);
+            break;
+        }
+        p += n;
+        addr += (haddr_t)n;
+        size -= (size_t)n;
+    }
+    f->eof = end > f->eof ? end : f->eof;
+    return 0;
+}
+
+/* Set the file's length to the allocated address space (unless failed). */
+static herr_t sink_truncate(H5FD_t *file, hid_t dxpl, hbool_t closing)
+{
+    sink_file *f = (sink_file *)file;
+    (void)dxpl;
+    (void)closing;
+    if (f->eoa != f->eof && !*f->failure && ftruncate(f->fd, (off_t)f->eoa) != 0)
+        sink_fail(f, errno);
+    f->eof = f->eoa;
+    return 0;
+}
+
+static const H5FD_class_t sink_class = {
+#ifdef H5FD_CLASS_VERSION /* HDF5 >= 1.14 numbers its driver classes */
+    .version = H5FD_CLASS_VERSION,
+    .value = 601,
+#endif
+    .name = "pound_sink",
+    .maxaddr = (haddr_t)INT64_MAX,
+    .fc_degree = H5F_CLOSE_WEAK,
+    .fapl_size = sizeof(sink_info),
+    .open = sink_open,
+    .close = sink_close,
+    .cmp = sink_cmp,
+    .query = sink_query,
+    .get_eoa = sink_get_eoa,
+    .set_eoa = sink_set_eoa,
+    .get_eof = sink_get_eof,
+    .read = sink_read,
+    .write = sink_write,
+    .truncate = sink_truncate,
+    .fl_map = H5FD_FLMAP_DICHOTOMY,
+};
+
+hid_t pd_h5_create(const char *path, hid_t fcpl, int *failure)
+{
+    sink_info info = {.failure = failure};
+    hid_t file = -1;
+    *failure = 0;
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL); /* the library must not print */
+    hid_t drv = H5FDregister(&sink_class), fapl = H5Pcreate(H5P_FILE_ACCESS);
+    if (drv >= 0 && fapl >= 0 && H5Pset_driver(fapl, drv, &info) >= 0)
+        file = H5Fcreate(path, H5F_ACC_TRUNC, fcpl, fapl);
+    if (fapl >= 0)
+        H5Pclose(fapl);
+    if (drv >= 0) /* the open file holds its own reference to the driver */
+        H5FDunregister(drv);
+    if (file >= 0 && *failure) /* the superblock could not be written */
+        pd_h5_close(&file, failure);
+    if (file < 0 && !*failure)
+        *failure = EIO;
+    return file;
+}
+
+int pd_h5_close(hid_t *file, const int *failure)
+{
+    int rc = 0;
+    if (*file >= 0 && H5Fclose(*file) < 0)
+        rc = EIO;
+    *file = -1;
+    return *failure ? *failure : rc;
+}
+
+int pd_h5_close_id(hid_t *id)
+{
+    herr_t st = 0;
+    if (*id >= 0) {
+        H5I_type_t t = H5Iget_type(*id);
+        st = t == H5I_DATASET ? H5Dclose(*id)
+             : t == H5I_GROUP ? H5Gclose(*id)
+             : t == H5I_GENPROP_LST ? H5Pclose(*id)
+             : t == H5I_DATASPACE ? H5Sclose(*id)
+                                  : -1;
+    }
+    *id = -1;
+    return st < 0 ? -1 : 0;
+}
 
 /* A scalar attribute: text when text is non-NULL, else the number x. */
 int pd_h5_attr(hid_t obj, const char *name, const char *text, double x)

@@ -8,14 +8,16 @@
  *
  * Offsets follow from /n and each colptr's last entry.  Datasets are
  * extendible and written in blocks as the run goes; the file is written
- * under a temporary name and renamed when the run has finished. */
+ * under a temporary name and renamed when the run has finished.  A failed
+ * write stops the run and is reported with the system's reason. */
+#include <errno.h>
 #include <hdf5.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "pd_h5.h"
 #include "pd_lcp_dump.h"
+#include "pd_output.h"
 
 #define DUMP_BLOCK (1L << 16) /* entries buffered per dataset */
 
@@ -38,11 +40,11 @@ enum { S_N, S_T, S_SOLVER, S_OUTCOME, S_PIVOTS, S_ITER, S_RES, S_COLPTR, S_ROWIN
        S_B, S_Z, S_CONTACT, NSETS };
 
 struct pd_lcp_dump {
-    char path[4096], tmp[4096];
+    pd_outfile out;
     hid_t file;
     dump_set set[NSETS];
     long count;
-    int failed;
+    int failed, failure; /* failure: errno of the first failed write, 0 if none */
 };
 
 static const struct {
@@ -58,43 +60,52 @@ void pd_lcp_dump_free(pd_lcp_dump *d)
     if (!d)
         return;
     for (int k = 0; k < NSETS; k++) {
-        if (d->set[k].ds > 0)
-            H5Dclose(d->set[k].ds);
+        pd_h5_close_id(&d->set[k].ds);
         free(d->set[k].buf);
     }
-    if (d->file > 0)
-        H5Fclose(d->file);
-    if (d->tmp[0])
-        unlink(d->tmp);
+    pd_h5_close(&d->file, &d->failure);
+    pd_outfile_abort(&d->out);
     free(d);
+}
+
+/* The file and its extendible datasets: 0 or an errno. */
+static int dump_create(pd_lcp_dump *d)
+{
+    if ((d->file = pd_h5_create(d->out.tmp, H5P_DEFAULT, &d->failure)) < 0)
+        return d->failure;
+    for (int k = 0; k < NSETS; k++) {
+        dump_set *s = &d->set[k];
+        if (!(s->buf = malloc(DUMP_BLOCK * s->size)))
+            return ENOMEM;
+        if ((s->ds = pd_h5_extendible(d->file, s->name, s->type, 0, 4096, "")) < 0)
+            return d->failure ? d->failure : EIO;
+    }
+    if (pd_h5_attr(d->file, "format", "pound LCP dump 1", 0.0))
+        return d->failure ? d->failure : EIO;
+    return d->failure;
 }
 
 int pd_lcp_dump_open(pd_lcp_dump **out, const char *path, pd_err *err)
 {
     pd_lcp_dump *d = calloc(1, sizeof *d);
+    int rc, e;
     *out = NULL;
     if (!d)
         return pd_err_set(err, PD_ENOMEM, "--dump-lcp: out of memory");
-    if (snprintf(d->path, sizeof d->path, "%s", path) >= (int)sizeof d->path ||
-        snprintf(d->tmp, sizeof d->tmp, "%s.tmp%ld", path, (long)getpid()) >= (int)sizeof d->tmp) {
-        free(d);
-        return pd_err_set(err, PD_EINVAL, "--dump-lcp %s: path too long", path);
-    }
-    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-    d->file = H5Fcreate(d->tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
-    int rc = d->file < 0;
-    for (int k = 0; k < NSETS && !rc; k++) {
+    d->file = -1;
+    d->out.slot = -1;
+    for (int k = 0; k < NSETS; k++) {
         dump_set *s = &d->set[k];
         s->name = set_defs[k].name;
         s->type = set_defs[k].is_int ? H5T_NATIVE_INT : H5T_NATIVE_DOUBLE;
         s->size = set_defs[k].is_int ? sizeof(int) : sizeof(double);
-        s->buf = malloc(DUMP_BLOCK * s->size);
-        rc = !s->buf || (s->ds = pd_h5_extendible(d->file, s->name, s->type, 0, 4096, "")) < 0;
+        s->ds = -1;
     }
-    rc = rc || pd_h5_attr(d->file, "format", "pound LCP dump 1", 0.0);
+    if (!(rc = pd_outfile_begin(&d->out, "--dump-lcp", path, err)) && (e = dump_create(d)))
+        rc = pd_outfile_error(&d->out, e, err);
     if (rc) {
         pd_lcp_dump_free(d);
-        return pd_err_set(err, PD_EIO, "--dump-lcp %s: cannot create the file", path);
+        return rc;
     }
     *out = d;
     return PD_OK;
@@ -170,13 +181,13 @@ int pd_lcp_dump_add(const pd_matrix *D, const double *b, const double *z, const 
     rc |= push_int(&s[S_COLPTR], nz) || push(&s[S_B], b, n) || push(&s[S_Z], z, n) ||
           push(&s[S_CONTACT], idx, n);
     d->count++;
-    d->failed = rc != 0;
+    d->failed = rc != 0 || d->failure != 0;
     return d->failed;
 }
 
 int pd_lcp_dump_finish(pd_lcp_dump *d, const char *command, pd_err *err)
 {
-    int rc = d->failed;
+    int rc = d->failed, e;
     char names[160] = "";
     for (int k = 0; k < NSOLVERS; k++)
         snprintf(names + strlen(names), sizeof names - strlen(names), "%s%d=%s", k ? ", " : "",
@@ -186,16 +197,14 @@ int pd_lcp_dump_finish(pd_lcp_dump *d, const char *command, pd_err *err)
     rc = rc || pd_h5_attr(d->file, "solver_codes", names, 0.0) ||
          pd_h5_attr(d->file, "command", command, 0.0) ||
          pd_h5_num(d->file, "count", (double)d->count, NULL);
-    for (int k = 0; k < NSETS; k++) {
-        rc |= H5Dclose(d->set[k].ds) < 0;
-        d->set[k].ds = 0;
+    for (int k = 0; k < NSETS; k++)
+        rc |= pd_h5_close_id(&d->set[k].ds);
+    e = pd_h5_close(&d->file, &d->failure);
+    if (e || rc) {
+        pd_outfile_abort(&d->out);
+        return pd_outfile_error(&d->out, e ? e : EIO, err);
     }
-    rc |= H5Fclose(d->file) < 0;
-    d->file = 0;
-    if (rc || rename(d->tmp, d->path) != 0)
-        return pd_err_set(err, PD_EIO, "--dump-lcp %s: cannot write the file", d->path);
-    d->tmp[0] = '\0';
-    return PD_OK;
+    return pd_outfile_commit(&d->out, err);
 }
 
 long pd_lcp_dump_count(const pd_lcp_dump *d)

@@ -1,7 +1,10 @@
-/* main.c — `pound`: dispatch to a subcommand. */
+/* main.c — `pound`: dispatch to a subcommand; temporary output files
+ * removed on SIGINT/SIGTERM; standard output checked at the end. */
+#include <errno.h>
 #include <string.h>
 
 #include "pd_cli.h"
+#include "pd_output.h"
 #include "pd_spectrum.h"
 
 static const char usage[] =
@@ -19,11 +22,15 @@ static const char usage[] =
     "\n"
     "`pound <command> --help` lists a command's options; docs/ has the details.\n";
 
-int main(int argc, char **argv)
+/* The subcommand argv[1] names: its exit status. */
+static int dispatch(int argc, char **argv)
 {
-    if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
-        fputs(usage, argc < 2 ? stderr : stdout);
-        return argc < 2 ? 2 : 0;
+    if (argc < 2) /* bad input: one line */
+        return pd_cli_usage_error("no command given: simulate, compare, converge, spectrum, lcp, "
+                                  "record or bench (`pound --help` for usage)");
+    if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
+        fputs(usage, stdout);
+        return 0;
     }
     const char *cmd = argv[1];
     if (!strcmp(cmd, "lcp"))
@@ -41,4 +48,24 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "bench"))
         return pd_cmd_bench(argc - 1, argv + 1);
     return pd_cli_usage_error("unknown command '%s' (try `pound --help`)", cmd);
+}
+
+/* Everything printed on standard output must have reached it: a write
+ * error (a full disk, /dev/full) is a failure, exit 1 with the system's
+ * reason, unless the command failed already.  When an earlier flush failed
+ * (json.c flushes), its errno is the one still set, as nothing since has
+ * failed. */
+static int finish_stdout(int status)
+{
+    int before = errno, flushed = fflush(stdout) == 0, e = flushed ? before : errno;
+    if (flushed && !ferror(stdout))
+        return status;
+    fprintf(stderr, "pound: standard output: %s\n", strerror(e ? e : EIO));
+    return status ? status : 1;
+}
+
+int main(int argc, char **argv)
+{
+    pd_output_signals();
+    return finish_stdout(dispatch(argc, argv));
 }

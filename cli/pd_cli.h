@@ -30,13 +30,14 @@ typedef struct pd_cli_case {
     pd_osc c;
     pd_run_opts opts;
     double T0, gap; /* dimensional forms when given */
-    int have_T0, have_Pi2, have_gap, have_Pi3, have_dt, have_tend;
+    int have_T0, have_Pi2, have_gap, have_Pi3, have_dt, have_tend, have_kc;
     const char *model_flag; /* the first model flag given (refused with --scene) */
     const char *scene_path; /* --scene F */
     int chain;              /* --chain N (0: none) */
     double chain_ratio;     /* --chain-ratio R */
     const char *record_path; /* --record F */
     const char *pulse_flag; /* --pulse, --ap or --Tp when given (refused with --record) */
+    const char *dt_flag;    /* the flag that set dt (--dt, or spectrum's --dt-per-Tp) */
     double scale;           /* --scale S */
     int have_scale;
     pd_record_format rec_format; /* --record-format */
@@ -47,6 +48,11 @@ typedef struct pd_cli_case {
 extern const char pd_cli_case_help[];
 
 void pd_cli_case_init(pd_cli_case *a);
+/* The quantities derived from a checked case (T0, Le, the gap, tend, the
+ * work of the run) finite and bounded: 0, or 2 with one line naming the
+ * flag that made them overflow (spectrum checks its sweep's corners). */
+int pd_cli_case_check_derived(const pd_cli_case *a);
+
 /* Consume the flag at argv[*i] (and its value): 1 if it was a case flag,
  * 0 if not (the caller handles it), 2 after printing an error. */
 int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i);

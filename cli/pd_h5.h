@@ -1,8 +1,28 @@
-/* pd_h5.h — (cli) the HDF5 helper the output writers share. */
+/* pd_h5.h — (cli) the HDF5 helpers the output writers share, and the file
+ * driver every output file is written through. */
 #ifndef PD_H5_H
 #define PD_H5_H
 
 #include <hdf5.h>
+
+/* Create path (truncating it) for writing through the "sink" driver: POSIX
+ * I/O like HDF5's sec2 driver (the same bytes), except that a failed write,
+ * truncate or close never reaches the library.  The first failure's errno
+ * goes to *failure (which must outlive the file) and every later write is
+ * dropped, so the library always closes the file cleanly (a flush failing
+ * inside H5Fclose otherwise leaves a half-closed file that crashes
+ * H5_term_library at exit); the caller reports the reason and removes the
+ * file.  fcpl: a file-creation property list or H5P_DEFAULT.  The file, or
+ * -1 with *failure set (nothing left open). */
+hid_t pd_h5_create(const char *path, hid_t fcpl, int *failure);
+
+/* Close *file (set to -1); 0, or the errno of the first failure of the file
+ * (EIO when the library itself failed). */
+int pd_h5_close(hid_t *file, const int *failure);
+
+/* Close a dataset, group or property list id when it is one (>= 0) and set
+ * it to -1; 0, or -1 when the library failed. */
+int pd_h5_close_id(hid_t *id);
 
 /* A scalar attribute on obj: a string when text is non-NULL, else the
  * double x.  0 on success, -1 on an HDF5 failure. */

@@ -1,10 +1,91 @@
-/* pd_output.h — (cli) tables of columns plus attributes, written to HDF5 or
- * CSV through a temporary file renamed on success, so a failed run leaves
- * no partial file behind. */
+/* pd_output.h — (cli) output files: every file pound writes goes to a
+ * temporary name beside it and is renamed into place once complete, so a
+ * failed, refused or interrupted run leaves no partial file behind; tables
+ * of columns plus attributes streamed to HDF5 or CSV; checks made before a
+ * run starts (the name, the folder writable, the room for the file). */
 #ifndef PD_OUTPUT_H
 #define PD_OUTPUT_H
 
+#include <stdio.h>
+#include <sys/types.h>
+
 #include "pd_core.h"
+
+enum {
+    PD_PATH_MAX = 4096,       /* the longest output path */
+    PD_OUTPUT_NOTICE_MB = 100 /* larger outputs are announced on stderr */
+};
+
+/* ---- checks before a run ------------------------------------------------ */
+
+/* PD_OK when path has a supported extension (.h5, .hdf5, .csv) and the
+ * file can be written (pd_output_check_writable); else PD_EINVAL with a
+ * message naming -o and the reason. */
+int pd_output_check_path(const char *path, pd_err *err);
+
+/* Can `flag path` be written?  Symlinks followed; a directory refused;
+ * a temporary file is created beside it and removed.  PD_OK, or PD_EINVAL
+ * with "FLAG PATH: <the system's reason>". */
+int pd_output_check_writable(const char *flag, const char *path, pd_err *err);
+
+/* Is there room for about `bytes` on path's file system?  PD_OK, or
+ * PD_EINVAL naming the sizes (the estimate is refused when it exceeds the
+ * space free there). */
+int pd_output_check_room(const char *flag, const char *path, double bytes, pd_err *err);
+
+/* Do the n outputs name n different files?  flags[k] and paths[k] as given
+ * (paths[k] NULL: that output is not written).  Two paths are the same file
+ * when, symlinks followed, their folders resolve to one folder and their
+ * names agree, or when they are one existing file (hard links too).  PD_OK,
+ * or PD_EINVAL with "FLAG1 PATH1 and FLAG2 PATH2 name the same file". */
+int pd_output_check_distinct(int n, const char *const *flags, const char *const *paths,
+                             pd_err *err);
+
+/* ---- interrupted runs --------------------------------------------------- */
+
+/* SIGINT, SIGTERM and SIGHUP (unless ignored) remove every temporary file
+ * still registered, then end the process by the signal's default action.
+ * Called once by main. */
+void pd_output_signals(void);
+
+/* ---- an output file replaced atomically --------------------------------- */
+
+typedef struct pd_outfile {
+    const char *flag, *given;    /* "-o" and the path as given, for messages */
+    char path[PD_PATH_MAX];      /* the file replaced (symlinks followed) */
+    char tmp[PD_PATH_MAX + 32];  /* path.tmpPID, renamed onto path */
+    int slot;                    /* its signal-cleanup slot (-1: none) */
+    int keep_mode;               /* path exists: its mode goes to the new file */
+    mode_t mode;
+} pd_outfile;
+
+/* Before writing o->tmp: follow symlinks, refuse a directory, note the mode
+ * of a file being replaced, remove stale path.tmp<PID> files of processes
+ * that are gone, register o->tmp for removal on a signal.  PD_OK or PD_EIO. */
+int pd_outfile_begin(pd_outfile *o, const char *flag, const char *given, pd_err *err);
+/* o->tmp is complete: give it the old mode, sync it, rename it onto
+ * o->path.  PD_OK, or PD_EIO with the reason (the temporary removed). */
+int pd_outfile_commit(pd_outfile *o, pd_err *err);
+/* Remove the temporary file (if any) and unregister it; idempotent. */
+void pd_outfile_abort(pd_outfile *o);
+/* "FLAG GIVEN: <strerror(e)>" into err as PD_EIO. */
+int pd_outfile_error(const pd_outfile *o, int e, pd_err *err);
+
+/* ---- text files whose every write is checked --------------------------- */
+
+typedef struct pd_csv {
+    FILE *f;
+    int failure; /* errno of the first failed write, 0 if none */
+} pd_csv;
+
+/* Open path for writing: 0, or the errno. */
+int pd_csv_open(pd_csv *c, const char *path);
+/* Formatted output; after a failure nothing more is written.  0 or -1. */
+int pd_csv_printf(pd_csv *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* Flush and close (c->f NULL after): 0, or the errno of the first failure. */
+int pd_csv_close(pd_csv *c);
+
+/* ---- tables ------------------------------------------------------------- */
 
 typedef struct pd_attr {
     const char *name;
@@ -17,7 +98,13 @@ typedef struct pd_attr {
 typedef struct pd_column {
     const char *name;
     const char *units;
-    const double *values;
+    const double *values; /* pd_output_write only */
+    /* A coded column (labels non-NULL): its values are codes 0..nlabels-1;
+     * the CSV writes labels[code] as text, the HDF5 file the code with a
+     * "codes" attribute naming them ("0 = moreau, 1 = event, ..."); a code
+     * outside the labels is written as a number. */
+    const char *const *labels;
+    int nlabels;
 } pd_column;
 
 typedef struct pd_table {
@@ -28,11 +115,25 @@ typedef struct pd_table {
     const pd_attr *attrs;
 } pd_table;
 
-/* Write the table to path: HDF5 when it ends in .h5/.hdf5, CSV when it
- * ends in .csv; anything else is PD_EINVAL. */
+/* Write the table to path: HDF5 when it ends in .h5/.hdf5 (one 1-D dataset
+ * per column with a "units" attribute, the attributes on the root), CSV
+ * when it ends in .csv ('#' lines with the attributes, a header row, the
+ * rows); anything else is PD_EINVAL. */
 int pd_output_write(const char *path, const pd_table *table, pd_err *err);
 
-/* PD_OK when path has a supported extension. */
-int pd_output_check_path(const char *path, pd_err *err);
+/* The same files streamed: rows are written in blocks as they come (memory
+ * stays bounded whatever their number), the attributes at the end. */
+typedef struct pd_table_writer pd_table_writer;
+
+/* Open path.tmpPID for ncols columns (names and units kept until finish);
+ * expected_rows sizes the HDF5 chunks.  PD_OK, PD_EINVAL or PD_EIO. */
+int pd_table_open(pd_table_writer **w, const char *path, int ncols, const pd_column *cols,
+                  long expected_rows, pd_err *err);
+/* One row of ncols values: 0, or -1 once a write has failed (stop). */
+int pd_table_row(pd_table_writer *w, const double *row);
+/* The rows buffered, the attributes; close, rename into place. */
+int pd_table_finish(pd_table_writer *w, int nattrs, const pd_attr *attrs, pd_err *err);
+/* Release; an unfinished file is removed. */
+void pd_table_free(pd_table_writer *w);
 
 #endif

@@ -26,16 +26,26 @@ typedef struct pd_chart {
     double slope_ref;         /* 0: none; else a dashed guide of this log-log slope */
 } pd_chart;
 
-/* Draw the chart into png (written to a temporary name, renamed on
- * success).  PD_EIO when gnuplot is missing or fails. */
+/* Draw the chart into png (gnuplot writes a private temporary file, which
+ * is then moved into place whole).  PD_EIO when gnuplot is missing or fails,
+ * or png cannot be written. */
 int pd_plot(const char *png, const pd_chart *chart, pd_err *err);
 
 /* Any figure: data_fn writes the data file (0 ok), script_fn the gnuplot
- * script that reads it and writes png_tmp; the PNG is renamed into place
- * when gnuplot succeeded.  PD_EIO otherwise. */
-int pd_plot_with(const char *png, int (*data_fn)(FILE *f, const void *ctx),
-                 void (*script_fn)(FILE *g, const char *data, const char *png_tmp,
-                                   const void *ctx),
+ * script that reads data and writes png_tmp.  Both paths are private
+ * temporary names; the user's png never reaches gnuplot.  The PNG is moved
+ * to png (renamed, or copied and renamed across file systems) when gnuplot
+ * succeeded and wrote a PNG; no temporary is left either way.  PD_EIO
+ * otherwise. */
+typedef int pd_plot_data_fn(FILE *f, const void *ctx);
+typedef void pd_plot_script_fn(FILE *g, const char *data, const char *png_tmp, const void *ctx);
+int pd_plot_with(const char *png, pd_plot_data_fn *data_fn, pd_plot_script_fn *script_fn,
                  const void *ctx, pd_err *err);
+
+/* Write s (NULL: "") into a gnuplot script as one double-quoted string
+ * literal that cannot end early or run anything: '"' and '\\' escaped,
+ * '`' and '@' as octal escapes, control bytes and bytes beyond ASCII as '?'.
+ * Every text and file name in a script goes through it. */
+void pd_plot_text(FILE *g, const char *s);
 
 #endif

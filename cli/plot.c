@@ -1,12 +1,29 @@
-/* plot.c — charts through gnuplot: data in a temporary file, a script on
- * gnuplot's standard input, the PNG renamed into place when it succeeded. */
+/* plot.c — charts through gnuplot.  The data, the script and the PNG live
+ * in a private temporary folder whose name has only safe characters;
+ * gnuplot runs the script without a shell, its output on /dev/null (so no
+ * image can ever reach our standard output); the PNG, checked by its
+ * signature, is then moved to the user's path whole.  No file name of the
+ * user's reaches gnuplot, and every text does as one string literal that
+ * cannot escape (pd_plot_text). */
+#include <errno.h>
+#include <fcntl.h>
 #include <math.h>
+#include <spawn.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "pd_plot.h"
+
+enum { PLOT_ROOT_MAX = 200, PLOT_PATH = PLOT_ROOT_MAX + 64, PLOT_COPY_BUF = 16384 };
+
+/* The private folder and the files in it. */
+typedef struct plot_work {
+    char dir[PLOT_PATH], data[PLOT_PATH + 16], script[PLOT_PATH + 16], png[PLOT_PATH + 16];
+} plot_work;
 
 /* One block per curve, blocks separated by two blank lines (gnuplot index). */
 static int write_data(FILE *f, const pd_chart *c)
@@ -21,12 +38,17 @@ static int write_data(FILE *f, const pd_chart *c)
     return ferror(f) ? -1 : 0;
 }
 
-/* Gnuplot text escaping for labels: quotes only. */
-static void quoted(FILE *g, const char *s)
+/* s as one gnuplot string literal that cannot escape (pd_plot.h). */
+void pd_plot_text(FILE *g, const char *s)
 {
     fputc('"', g);
-    for (; s && *s; s++)
-        fputc(*s == '"' ? '\'' : *s, g);
+    for (const unsigned char *c = (const unsigned char *)(s ? s : ""); *c; c++)
+        if (*c == '"' || *c == '\\')
+            fprintf(g, "\\%c", *c);
+        else if (*c == '`' || *c == '@') /* \140, \100: three digits never take a fourth */
+            fprintf(g, "\\%03o", (unsigned)*c);
+        else
+            fputc(*c >= 0x20 && *c < 0x7f ? *c : '?', g);
     fputc('"', g);
 }
 
@@ -45,17 +67,19 @@ static void chart_script(FILE *g, const char *data, const char *png_tmp, const v
 {
     const pd_chart *c = ctx;
     fprintf(g, "set terminal pngcairo size 900,650 enhanced font 'sans,11'\n");
-    fprintf(g, "set output '%s'\nset grid\nset key outside right top\n", png_tmp);
+    fputs("set output ", g);
+    pd_plot_text(g, png_tmp);
+    fputs("\nset grid\nset key outside right top\n", g);
     if (c->logx)
         fputs("set logscale x\nset format x '10^{%L}'\n", g);
     if (c->logy)
         fputs("set logscale y\nset format y '10^{%L}'\n", g);
     fputs("set title ", g);
-    quoted(g, c->title);
+    pd_plot_text(g, c->title);
     fputs("\nset xlabel ", g);
-    quoted(g, c->xlabel);
+    pd_plot_text(g, c->xlabel);
     fputs("\nset ylabel ", g);
-    quoted(g, c->ylabel);
+    pd_plot_text(g, c->ylabel);
     fputc('\n', g);
     if (isfinite(c->vline)) {
         double lo = c->vline, hi = c->vline; /* the marker inside the x range */
@@ -72,16 +96,17 @@ static void chart_script(FILE *g, const char *data, const char *png_tmp, const v
         fprintf(g, "set arrow from %.17g, graph 0 to %.17g, graph 1 nohead dt 3 lc rgb 'black'\n",
                 c->vline, c->vline);
         fprintf(g, "set label ");
-        quoted(g, c->vline_label ? c->vline_label : "");
+        pd_plot_text(g, c->vline_label ? c->vline_label : "");
         fprintf(g, " at %.17g, graph 0.05 right offset -0.5,0\n", c->vline);
     }
     fputs("plot ", g);
     for (int k = 0; k < c->ncurves; k++) {
         static const char *const styles[] = {"linespoints lw 2", "lines lw 1.5",
                                              "points pt 7 ps 0.8"};
-        fprintf(g, "%s'%s' index %d with %s title ", k ? ", " : "", data, k,
-                styles[c->curves[k].style]);
-        quoted(g, c->curves[k].label);
+        fputs(k ? ", " : "", g);
+        pd_plot_text(g, data);
+        fprintf(g, " index %d with %s title ", k, styles[c->curves[k].style]);
+        pd_plot_text(g, c->curves[k].label);
     }
     slope_guide(g, c);
     fputc('\n', g);
@@ -98,38 +123,187 @@ int pd_plot(const char *png, const pd_chart *chart, pd_err *err)
     return pd_plot_with(png, chart_data, chart_script, chart, err);
 }
 
-int pd_plot_with(const char *png, int (*data_fn)(FILE *f, const void *ctx),
-                 void (*script_fn)(FILE *g, const char *data, const char *png_tmp,
-                                   const void *ctx),
+/* Where the private folder goes: $TMPDIR when it is an absolute path of
+ * safe characters that fits, else /tmp. */
+static const char *tmp_root(void)
+{
+    static const char safe[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789/._-";
+    const char *t = getenv("TMPDIR");
+    size_t n = t ? strlen(t) : 0;
+    return t && t[0] == '/' && n <= PLOT_ROOT_MAX && strspn(t, safe) == n ? t : "/tmp";
+}
+
+/* Create the private folder (mode 0700) under root and name its files (0
+ * ok, errno set otherwise). */
+static int work_open(plot_work *w, const char *root)
+{
+    snprintf(w->dir, sizeof w->dir, "%s/pound_plotXXXXXX", root);
+    if (!mkdtemp(w->dir))
+        return -1;
+    snprintf(w->data, sizeof w->data, "%s/data", w->dir);
+    snprintf(w->script, sizeof w->script, "%s/plot.gp", w->dir);
+    snprintf(w->png, sizeof w->png, "%s/plot.png", w->dir);
+    return 0;
+}
+
+/* Remove the private folder and whatever is left in it. */
+static void work_close(const plot_work *w)
+{
+    unlink(w->data);
+    unlink(w->script);
+    unlink(w->png);
+    rmdir(w->dir);
+}
+
+/* The data file, written by data_fn (0 ok). */
+static int write_data_file(const plot_work *w, pd_plot_data_fn *data_fn, const void *ctx)
+{
+    FILE *f = fopen(w->data, "w");
+    if (!f)
+        return -1;
+    int bad = data_fn(f, ctx) || ferror(f);
+    return fclose(f) != 0 || bad ? -1 : 0;
+}
+
+/* The script file, written by script_fn (0 ok). */
+static int write_script_file(const plot_work *w, pd_plot_script_fn *script_fn, const void *ctx)
+{
+    FILE *g = fopen(w->script, "w");
+    if (!g)
+        return -1;
+    script_fn(g, w->data, w->png, ctx);
+    int bad = ferror(g);
+    return fclose(g) != 0 || bad ? -1 : 0;
+}
+
+/* Run gnuplot on the script file, without a shell, its standard streams on
+ * /dev/null; a script file makes any error end it with a failure.  0 when
+ * it succeeded, 1 when it failed, -1 when it could not be started. */
+static int run_gnuplot(const char *script)
+{
+    extern char **environ;
+    char prog[] = "gnuplot", *argv[] = {prog, (char *)script, NULL};
+    posix_spawn_file_actions_t fa;
+    pid_t pid;
+    int st = 0;
+    if (posix_spawn_file_actions_init(&fa))
+        return -1;
+    int bad = posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0) ||
+              posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0) ||
+              posix_spawn_file_actions_addopen(&fa, 2, "/dev/null", O_WRONLY, 0) ||
+              posix_spawnp(&pid, prog, &fa, NULL, argv, environ);
+    posix_spawn_file_actions_destroy(&fa);
+    if (bad)
+        return -1;
+    while (waitpid(pid, &st, 0) < 0)
+        if (errno != EINTR)
+            return 1;
+    if (WIFEXITED(st) && WEXITSTATUS(st) == 127)
+        return -1; /* the exec failed in the child */
+    return WIFEXITED(st) && WEXITSTATUS(st) == 0 ? 0 : 1;
+}
+
+/* Does path hold a PNG (its eight signature bytes)? */
+static int is_png(const char *path)
+{
+    static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    unsigned char head[8];
+    FILE *f = fopen(path, "rb");
+    size_t n = f ? fread(head, 1, sizeof head, f) : 0;
+    if (f)
+        fclose(f);
+    return n == sizeof head && !memcmp(head, sig, sizeof sig);
+}
+
+/* Copy all of file descriptor in to out (0 ok, -1 with errno). */
+static int copy_fd(int in, int out)
+{
+    char buf[PLOT_COPY_BUF];
+    for (;;) {
+        ssize_t n = read(in, buf, sizeof buf);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n <= 0)
+            return n < 0 ? -1 : 0;
+        for (ssize_t off = 0; off < n;) {
+            ssize_t put = write(out, buf + off, (size_t)(n - off));
+            if (put < 0 && errno == EINTR)
+                continue;
+            if (put <= 0)
+                return -1;
+            off += put;
+        }
+    }
+}
+
+/* Copy src to a new temporary beside dst (src's permissions), flush it to
+ * disk and rename it over dst: dst appears whole or not at all (0 ok; -1
+ * with errno, the temporary removed). */
+static int copy_into_place(const char *src, const char *dst)
+{
+    char tmp[4096];
+    struct stat st;
+    if (snprintf(tmp, sizeof tmp, "%s.XXXXXX", dst) >= (int)sizeof tmp) {
+        errno = ENAMETOOLONG;
+        return -1;
+    }
+    int in = open(src, O_RDONLY), out = in >= 0 ? mkstemp(tmp) : -1;
+    int bad = out < 0 || fstat(in, &st) || fchmod(out, st.st_mode & 0777) || copy_fd(in, out) ||
+              fsync(out);
+    int saved = errno;
+    if (out >= 0 && close(out) && !bad) {
+        bad = 1;
+        saved = errno;
+    }
+    if (in >= 0)
+        close(in);
+    if (!bad && rename(tmp, dst)) {
+        bad = 1;
+        saved = errno;
+    }
+    if (bad && out >= 0)
+        unlink(tmp);
+    errno = saved;
+    return bad ? -1 : 0;
+}
+
+/* Move src to dst: a rename on one file system, else copy_into_place (0
+ * ok; -1 with errno). */
+static int move_into_place(const char *src, const char *dst)
+{
+    if (rename(src, dst) == 0)
+        return 0;
+    return errno == EXDEV ? copy_into_place(src, dst) : -1;
+}
+
+/* The steps in the private folder w: data, script, gnuplot, the PNG
+ * checked and moved to png. */
+static int draw(const plot_work *w, const char *png, pd_plot_data_fn *data_fn,
+                pd_plot_script_fn *script_fn, const void *ctx, pd_err *err)
+{
+    if (write_data_file(w, data_fn, ctx) || write_script_file(w, script_fn, ctx))
+        return pd_err_set(err, PD_EIO, "--plot %s: cannot write the temporary files in %s", png,
+                          w->dir);
+    int g = run_gnuplot(w->script);
+    if (g < 0)
+        return pd_err_set(err, PD_EIO, "--plot %s: cannot run gnuplot (is gnuplot installed?)",
+                          png);
+    if (g > 0 || !is_png(w->png))
+        return pd_err_set(err, PD_EIO, "--plot %s: gnuplot failed", png);
+    if (move_into_place(w->png, png))
+        return pd_err_set(err, PD_EIO, "--plot %s: cannot write the file: %s", png,
+                          strerror(errno));
+    return PD_OK;
+}
+
+int pd_plot_with(const char *png, pd_plot_data_fn *data_fn, pd_plot_script_fn *script_fn,
                  const void *ctx, pd_err *err)
 {
-    char data[] = "/tmp/pound_plotXXXXXX", tmp[4096];
-    int fd = mkstemp(data), rc = -1;
-    FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
-    if (!f) {
-        if (fd >= 0)
-            close(fd);
-        return pd_err_set(err, PD_EIO, "--plot: cannot create a temporary data file");
-    }
-    int bad = data_fn(f, ctx);
-    if (fclose(f) != 0 || bad)
-        goto done;
-    if (snprintf(tmp, sizeof tmp, "%s.tmp%ld.png", png, (long)getpid()) >= (int)sizeof tmp)
-        goto done;
-    FILE *g = popen("gnuplot 2>/dev/null", "w");
-    rc = g ? 0 : -1;
-    if (g) {
-        script_fn(g, data, tmp, ctx);
-        rc = pclose(g) == 0 ? 0 : -1;
-    }
-    if (rc == 0 && access(tmp, R_OK) == 0 && rename(tmp, png) == 0)
-        rc = 0;
-    else {
-        rc = -1;
-        unlink(tmp);
-    }
-done:
-    unlink(data);
-    return rc ? pd_err_set(err, PD_EIO, "--plot %s: gnuplot failed (is gnuplot installed?)", png)
-              : PD_OK;
+    plot_work w;
+    if (work_open(&w, tmp_root()) && work_open(&w, "/tmp")) /* a stale $TMPDIR: /tmp */
+        return pd_err_set(err, PD_EIO, "--plot: cannot create a temporary folder in /tmp: %s",
+                          strerror(errno));
+    int rc = draw(&w, png, data_fn, script_fn, ctx, err);
+    work_close(&w);
+    return rc;
 }

@@ -48,6 +48,16 @@ static int records_data(FILE *f, const void *ctx)
     return ferror(f) ? -1 : 0;
 }
 
+/* The title over record r's column: its name (any bytes, through
+ * pd_plot_text), then its pulse on a second line. */
+static void record_title(FILE *g, const pd_cli_record *r)
+{
+    fputs("set title ", g);
+    pd_plot_text(g, r->rec.name);
+    fprintf(g, " . \"\\nTp = %.3g s, ap = %.3g m/s^2, 1/Le = %.3g m^{-1}\" noenhanced\n",
+            r->pulse.Tp, r->pulse.ap, 1.0 / r->pulse.Le);
+}
+
 /* Three rows (acceleration, velocity, displacement), a column per record. */
 static void records_script(FILE *g, const char *data, const char *png_tmp, const void *ctx)
 {
@@ -56,22 +66,22 @@ static void records_script(FILE *g, const char *data, const char *png_tmp, const
                                         "displacement [m]"};
     fprintf(g, "set terminal pngcairo size %d,900 enhanced font 'sans,10'\n",
             360 * fig->n + 120);
-    fprintf(g, "set output '%s'\nset multiplot layout 3,%d\nset grid\nset key top right "
-               "font ',8'\n", png_tmp, fig->n);
+    fputs("set output ", g);
+    pd_plot_text(g, png_tmp);
+    fprintf(g, "\nset multiplot layout 3,%d\nset grid\nset key top right font ',8'\n", fig->n);
     for (int row = 0; row < 3; row++)
         for (int k = 0; k < fig->n; k++) {
             const pd_cli_record *r = fig->recs[k];
             if (row == 0)
-                fprintf(g, "set title \"%s\\nTp = %.3g s, ap = %.3g m/s^2, 1/Le = %.3g m^{-1}\" "
-                           "noenhanced\n",
-                        r->rec.name, r->pulse.Tp, r->pulse.ap, 1.0 / r->pulse.Le);
+                record_title(g, r);
             else
                 fputs("unset title\n", g);
-            fprintf(g, "set ylabel '%s'\nset xlabel '%s'\n", k ? "" : rows[row],
+            fprintf(g, "set ylabel '%s'\nset xlabel '%s'\nplot ", k ? "" : rows[row],
                     row == 2 ? "t [s]" : "");
-            fprintf(g, "plot '%s' index %d using 1:%d with lines lc rgb 'gray40' title 'record', "
+            pd_plot_text(g, data);
+            fprintf(g, " index %d using 1:%d with lines lc rgb 'gray40' title 'record', "
                        "'' index %d using 1:%d with lines lw 2 lc rgb 'red' title 'fitted pulse'",
-                    data, k, 2 + row, k, 5 + row);
+                    k, 2 + row, k, 5 + row);
             if (row == 0)
                 fprintf(g, ", '' index %d using 1:8 with lines lw 1.5 dt 2 lc rgb 'blue' "
                            "title 'one-cycle %s pulse'",

@@ -9,23 +9,26 @@
  *        the run as attributes of the root.
  * CSV:   '#' lines with the inputs, a header row, one row per sample
  *        (t, NAME.x1.., NAME.v1.., cK.gap.., cK.impulse..), '#' lines with the
- *        results at the end. */
+ *        results at the end.
+ * Every write is checked; the first failure stops the run and is reported
+ * with the system's reason, and the temporary file is removed. */
+#include <errno.h>
 #include <hdf5.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "pd_h5.h"
+#include "pd_output.h"
 #include "pd_scene_out.h"
 
 #define OUT_BUFFER_DOUBLES (1L << 22) /* row buffer, doubles (32 MiB) */
 
 struct pd_scene_writer {
     const pd_scene *sc;
-    char path[4096], tmp[4096];
-    int hdf5, failed;
+    pd_outfile out;
+    int hdf5, failure; /* failure: errno of the first failed write, 0 if none */
     long every, seen, rows;
     double *imp;        /* m: impulses since the last recorded row */
     /* rows waiting to be written: t, x (n), v (n), gap (m), impulse (m) per row */
@@ -34,7 +37,7 @@ struct pd_scene_writer {
     int width;
     hid_t file, ds_t;
     hid_t *ds_x, *ds_v, *ds_g, *ds_p;
-    FILE *csv;
+    pd_csv csv;
 };
 
 /* Does path end with suffix? */
@@ -44,18 +47,14 @@ static int ends_with(const char *path, const char *suffix)
     return n > k && !strcmp(path + n - k, suffix);
 }
 
-/* The groups and extendible datasets of every structure and contact. */
+/* The groups and extendible datasets of every structure and contact: 0 or
+ * an errno. */
 static int h5_open(pd_scene_writer *w)
 {
     const pd_scene *sc = w->sc;
     char name[96];
-    H5Eset_auto2(H5E_DEFAULT, NULL, NULL); /* the library must not print */
-    hid_t fcpl = H5Pcreate(H5P_FILE_CREATE);
-    w->file = H5Fcreate(w->tmp, H5F_ACC_TRUNC, fcpl, H5P_DEFAULT);
-    if (fcpl >= 0)
-        H5Pclose(fcpl);
-    if (w->file < 0)
-        return -1;
+    if ((w->file = pd_h5_create(w->out.tmp, H5P_DEFAULT, &w->failure)) < 0)
+        return w->failure;
     hid_t gs = H5Gcreate2(w->file, "structures", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     hid_t gc = H5Gcreate2(w->file, "contacts", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     int rc = gs < 0 || gc < 0 || (w->ds_t = pd_h5_extendible(w->file, "t", H5T_NATIVE_DOUBLE, 0, w->cap, "s")) < 0;
@@ -78,48 +77,51 @@ static int h5_open(pd_scene_writer *w)
         rc = 1;
     if (gc >= 0 && H5Gclose(gc) < 0)
         rc = 1;
-    return rc ? -1 : 0;
+    return w->failure ? w->failure : rc ? EIO : 0;
 }
 
-/* The CSV header row. */
+/* The CSV header row: 0 or an errno. */
 static int csv_open(pd_scene_writer *w)
 {
     const pd_scene *sc = w->sc;
-    if (!(w->csv = fopen(w->tmp, "w")))
-        return -1;
-    fprintf(w->csv, "# pound scene run: units s, m, m/s, N s\nt");
+    if (pd_csv_open(&w->csv, w->out.tmp))
+        return w->csv.failure;
+    pd_csv_printf(&w->csv, "# pound scene run: units s, m, m/s, N s\nt");
     for (int s = 0; s < sc->nstruct; s++)
         for (int k = 1; k <= sc->st[s].storeys; k++)
-            fprintf(w->csv, ",%s.x%d", sc->st[s].name, k);
+            pd_csv_printf(&w->csv, ",%s.x%d", sc->st[s].name, k);
     for (int s = 0; s < sc->nstruct; s++)
         for (int k = 1; k <= sc->st[s].storeys; k++)
-            fprintf(w->csv, ",%s.v%d", sc->st[s].name, k);
+            pd_csv_printf(&w->csv, ",%s.v%d", sc->st[s].name, k);
     for (int a = 0; a < sc->ncontact; a++) /* the rows hold every gap, then every impulse */
-        fprintf(w->csv, ",c%d.gap", a);
+        pd_csv_printf(&w->csv, ",c%d.gap", a);
     for (int a = 0; a < sc->ncontact; a++)
-        fprintf(w->csv, ",c%d.impulse", a);
-    fputc('\n', w->csv);
-    return ferror(w->csv) ? -1 : 0;
+        pd_csv_printf(&w->csv, ",c%d.impulse", a);
+    pd_csv_printf(&w->csv, "\n");
+    return w->csv.failure;
+}
+
+/* Close every dataset id (those not open are -1): 0, or -1 when one failed. */
+static int close_datasets(pd_scene_writer *w)
+{
+    hid_t *sets[] = {w->ds_x, w->ds_v, w->ds_g, w->ds_p};
+    int counts[] = {w->sc->nstruct, w->sc->nstruct, w->sc->ncontact, w->sc->ncontact}, rc = 0;
+    for (int k = 0; k < 4; k++)
+        for (int i = 0; sets[k] && i < counts[k]; i++)
+            rc |= pd_h5_close_id(&sets[k][i]);
+    rc |= pd_h5_close_id(&w->ds_t);
+    return rc ? -1 : 0;
 }
 
 void pd_scene_writer_free(pd_scene_writer *w)
 {
     if (!w)
         return;
-    if (w->csv)
-        fclose(w->csv);
-    hid_t *sets[] = {w->ds_x, w->ds_v, w->ds_g, w->ds_p};
-    int counts[] = {w->sc->nstruct, w->sc->nstruct, w->sc->ncontact, w->sc->ncontact};
-    for (int k = 0; k < 4; k++)
-        for (int i = 0; sets[k] && i < counts[k]; i++)
-            if (sets[k][i] > 0)
-                H5Dclose(sets[k][i]);
-    if (w->ds_t > 0)
-        H5Dclose(w->ds_t);
-    if (w->file > 0)
-        H5Fclose(w->file);
-    if (w->tmp[0])
-        unlink(w->tmp);
+    if (w->csv.f)
+        pd_csv_close(&w->csv);
+    close_datasets(w);
+    pd_h5_close(&w->file, &w->failure);
+    pd_outfile_abort(&w->out);
     free(w->imp);
     free(w->buf);
     free(w->col);
@@ -130,43 +132,50 @@ void pd_scene_writer_free(pd_scene_writer *w)
     free(w);
 }
 
+/* Every dataset id not open (-1); 0, or -1 without the arrays. */
+static int ids_init(pd_scene_writer *w, int m)
+{
+    const pd_scene *sc = w->sc;
+    w->ds_x = malloc((size_t)sc->nstruct * sizeof(hid_t));
+    w->ds_v = malloc((size_t)sc->nstruct * sizeof(hid_t));
+    w->ds_g = malloc((size_t)m * sizeof(hid_t));
+    w->ds_p = malloc((size_t)m * sizeof(hid_t));
+    for (int s = 0; w->ds_x && w->ds_v && s < sc->nstruct; s++)
+        w->ds_x[s] = w->ds_v[s] = -1;
+    for (int a = 0; w->ds_g && w->ds_p && a < m; a++)
+        w->ds_g[a] = w->ds_p[a] = -1;
+    return w->ds_x && w->ds_v && w->ds_g && w->ds_p ? 0 : -1;
+}
+
 int pd_scene_writer_open(pd_scene_writer **out, const char *path, const pd_scene *sc, long every,
                          pd_err *err)
 {
     pd_scene_writer *w = calloc(1, sizeof *w);
-    int smax = 1, m = sc->ncontact > 0 ? sc->ncontact : 1;
+    int smax = 1, m = sc->ncontact > 0 ? sc->ncontact : 1, rc, e;
     *out = NULL;
     if (!w)
         return pd_err_set(err, PD_ENOMEM, "-o %s: out of memory", path);
     w->sc = sc;
     w->every = every;
+    w->file = w->ds_t = -1;
+    w->out.slot = -1;
     w->hdf5 = ends_with(path, ".h5") || ends_with(path, ".hdf5");
     w->width = 1 + 2 * sc->n + 2 * sc->ncontact;
     w->cap = OUT_BUFFER_DOUBLES / w->width;
     w->cap = w->cap < 16 ? 16 : w->cap > 4096 ? 4096 : w->cap;
     for (int s = 0; s < sc->nstruct; s++)
         smax = sc->st[s].storeys > smax ? sc->st[s].storeys : smax;
-    if (snprintf(w->path, sizeof w->path, "%s", path) >= (int)sizeof w->path ||
-        snprintf(w->tmp, sizeof w->tmp, "%s.tmp%ld", path, (long)getpid()) >= (int)sizeof w->tmp) {
-        w->tmp[0] = '\0';
-        pd_scene_writer_free(w);
-        return pd_err_set(err, PD_EINVAL, "-o %s: path too long", path);
-    }
     w->imp = calloc((size_t)m, sizeof(double));
     w->buf = malloc((size_t)w->cap * (size_t)w->width * sizeof(double));
     w->col = malloc((size_t)w->cap * (size_t)smax * sizeof(double));
-    w->ds_x = calloc((size_t)sc->nstruct, sizeof(hid_t));
-    w->ds_v = calloc((size_t)sc->nstruct, sizeof(hid_t));
-    w->ds_g = calloc((size_t)m, sizeof(hid_t));
-    w->ds_p = calloc((size_t)m, sizeof(hid_t));
-    if (!w->imp || !w->buf || !w->col || !w->ds_x || !w->ds_v || !w->ds_g || !w->ds_p) {
-        w->tmp[0] = '\0';
+    if (ids_init(w, m) || !w->imp || !w->buf || !w->col)
+        rc = pd_err_set(err, PD_ENOMEM, "-o %s: out of memory for the row buffer", path);
+    else if (!(rc = pd_outfile_begin(&w->out, "-o", path, err)) &&
+             (e = w->hdf5 ? h5_open(w) : csv_open(w)))
+        rc = pd_outfile_error(&w->out, e, err);
+    if (rc) {
         pd_scene_writer_free(w);
-        return pd_err_set(err, PD_ENOMEM, "-o %s: out of memory for the row buffer", path);
-    }
-    if (w->hdf5 ? h5_open(w) : csv_open(w)) {
-        pd_scene_writer_free(w);
-        return pd_err_set(err, PD_EIO, "-o %s: cannot create the file", path);
+        return rc;
     }
     *out = w;
     return PD_OK;
@@ -178,15 +187,15 @@ static int flush_rows(pd_scene_writer *w)
     const pd_scene *sc = w->sc;
     long nb = w->nbuf;
     int n = sc->n, m = sc->ncontact, rc = 0;
-    if (nb == 0 || w->failed)
-        return w->failed ? -1 : 0;
+    if (nb == 0 || w->failure)
+        return w->failure ? -1 : 0;
     if (!w->hdf5) {
         for (long r = 0; r < nb; r++) {
             const double *row = w->buf + (size_t)r * w->width;
             for (int k = 0; k < w->width; k++)
-                fprintf(w->csv, "%.17g%c", row[k], k + 1 < w->width ? ',' : '\n');
+                pd_csv_printf(&w->csv, "%.17g%c", row[k], k + 1 < w->width ? ',' : '\n');
         }
-        rc = ferror(w->csv) ? -1 : 0;
+        w->failure = w->csv.failure;
     } else {
         for (long r = 0; r < nb; r++)
             w->col[r] = w->buf[(size_t)r * w->width];
@@ -207,8 +216,9 @@ static int flush_rows(pd_scene_writer *w)
             }
     }
     w->nbuf = 0;
-    w->failed = rc != 0;
-    return rc;
+    if (rc && !w->failure)
+        w->failure = EIO;
+    return w->failure ? -1 : 0;
 }
 
 int pd_scene_writer_sample(const pd_scene_sample *s, void *ctx)
@@ -244,9 +254,8 @@ static int put_num(pd_scene_writer *w, hid_t obj, const char *prefix, const char
 {
     if (w->hdf5)
         return pd_h5_num(obj, name, x, units);
-    fprintf(w->csv, "# %s%s = %.17g%s%s%s\n", prefix, name, x, units ? " [" : "",
-            units ? units : "", units ? "]" : "");
-    return 0;
+    return pd_csv_printf(&w->csv, "# %s%s = %.17g%s%s%s\n", prefix, name, x, units ? " [" : "",
+                         units ? units : "", units ? "]" : "");
 }
 
 static int put_text(pd_scene_writer *w, hid_t obj, const char *prefix, const char *name,
@@ -254,8 +263,7 @@ static int put_text(pd_scene_writer *w, hid_t obj, const char *prefix, const cha
 {
     if (w->hdf5)
         return pd_h5_attr(obj, name, text, 0.0);
-    fprintf(w->csv, "# %s%s = %s\n", prefix, name, text);
-    return 0;
+    return pd_csv_printf(&w->csv, "# %s%s = %s\n", prefix, name, text);
 }
 
 static int put_nums(pd_scene_writer *w, hid_t obj, const char *prefix, const char *name, int n,
@@ -263,11 +271,11 @@ static int put_nums(pd_scene_writer *w, hid_t obj, const char *prefix, const cha
 {
     if (w->hdf5)
         return pd_h5_nums(obj, name, n, x, units);
-    fprintf(w->csv, "# %s%s = [", prefix, name);
+    pd_csv_printf(&w->csv, "# %s%s = [", prefix, name);
     for (int i = 0; i < n; i++)
-        fprintf(w->csv, "%s%.17g", i ? ", " : "", x[i]);
-    fprintf(w->csv, "]%s%s%s\n", units ? " [" : "", units ? units : "", units ? "]" : "");
-    return 0;
+        pd_csv_printf(&w->csv, "%s%.17g", i ? ", " : "", x[i]);
+    return pd_csv_printf(&w->csv, "]%s%s%s\n", units ? " [" : "", units ? units : "",
+                         units ? "]" : "");
 }
 
 /* The run's inputs and figures on the root. */
@@ -361,30 +369,19 @@ static int put_contact(pd_scene_writer *w, const pd_scene_summary *sum, int a)
 
 int pd_scene_writer_finish(pd_scene_writer *w, const pd_scene_run_info *ri, pd_err *err)
 {
-    int rc = flush_rows(w) || put_run(w, ri);
+    int rc = flush_rows(w) || put_run(w, ri), e;
     for (int s = 0; s < w->sc->nstruct && !rc; s++)
         rc = put_structure(w, ri->sum, s);
     for (int a = 0; a < w->sc->ncontact && !rc; a++)
         rc = put_contact(w, ri->sum, a);
     if (w->hdf5) {
-        hid_t *sets[] = {w->ds_x, w->ds_v, w->ds_g, w->ds_p};
-        int counts[] = {w->sc->nstruct, w->sc->nstruct, w->sc->ncontact, w->sc->ncontact};
-        for (int k = 0; k < 4; k++)
-            for (int i = 0; i < counts[k]; i++) {
-                rc |= H5Dclose(sets[k][i]) < 0;
-                sets[k][i] = 0;
-            }
-        rc |= H5Dclose(w->ds_t) < 0;
-        w->ds_t = 0;
-        rc |= H5Fclose(w->file) < 0;
-        w->file = 0;
-    } else {
-        rc |= ferror(w->csv) != 0;
-        rc |= fclose(w->csv) != 0;
-        w->csv = NULL;
+        rc |= close_datasets(w);
+        e = pd_h5_close(&w->file, &w->failure);
+    } else
+        e = pd_csv_close(&w->csv);
+    if (e || rc) {
+        pd_outfile_abort(&w->out);
+        return pd_outfile_error(&w->out, e ? e : w->failure, err);
     }
-    if (rc || rename(w->tmp, w->path) != 0)
-        return pd_err_set(err, PD_EIO, "-o %s: cannot write the file", w->path);
-    w->tmp[0] = '\0'; /* renamed: nothing to remove */
-    return PD_OK;
+    return pd_outfile_commit(&w->out, err);
 }

@@ -11,7 +11,10 @@
  * torn last line, which the checksum exposes and the reader drops.
  * fdatasync runs at most once a second (an OS crash loses at most that
  * much work; a killed process loses nothing written).  A POSIX record lock
- * keeps two sweeps from sharing one journal. */
+ * keeps two sweeps from sharing one journal.  A journal this run created is
+ * open write-only, one it resumed read-write: a sweep that ends as bad input
+ * removes the first kind only (spectrum_run.c).  A signal leaves the
+ * journal in place, so the sweep resumes. */
 #include <errno.h>
 #include <fcntl.h>
 #include <stdint.h>
@@ -116,10 +119,11 @@ static int create_journal(pd_spec_journal *j, const char *key, pd_err *err)
     if (lock_fd(j->fd) || write_all(j->fd, magic, strlen(magic)) ||
         write_all(j->fd, "key ", 4) || write_all(j->fd, key, strlen(key)) ||
         write_all(j->fd, "\n", 1) || fdatasync(j->fd)) {
+        int e = errno ? errno : EIO;
         close(j->fd);
         j->fd = -1;
         unlink(j->path);
-        return pd_err_set(err, PD_EIO, "-o: cannot write %s", j->path);
+        return pd_err_set(err, PD_EIO, "-o: cannot write %s: %s", j->path, strerror(e));
     }
     return PD_OK;
 }

@@ -1,15 +1,18 @@
 /* spectrum_out.c — a computed spectrum as HDF5 (one group per curve), CSV
  * (long format, one row per point), gnuplot charts, JSON and text.  Files
  * are written to a temporary name and renamed on success, and hold no
- * timings or dates, so equal sweeps give byte-identical files. */
+ * timings or dates, so equal sweeps give byte-identical files.  Every write
+ * is checked: a failure is reported with the system's reason and leaves no
+ * file (the journal stays, so the sweep can be resumed). */
+#include <errno.h>
 #include <hdf5.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "pd_h5.h"
+#include "pd_output.h"
 #include "pd_plot.h"
 #include "pd_spectrum.h"
 
@@ -79,9 +82,8 @@ static int h5_dataset(hid_t grp, hid_t dcpl, const char *name, const char *units
     ds = H5Dcreate2(grp, name, H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
     if (ds >= 0 && H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, x) >= 0)
         rc = pd_h5_attr(ds, "units", units, 0.0);
-    if (ds >= 0)
-        H5Dclose(ds);
-    H5Sclose(space);
+    if (pd_h5_close_id(&ds) || H5Sclose(space) < 0)
+        rc = -1;
     return rc;
 }
 
@@ -132,80 +134,75 @@ static int h5_root_attrs(hid_t file, const pd_spectrum *s)
            pd_h5_num(file, "points", (double)pd_spec_points(s), NULL);
 }
 
-/* The whole spectrum into an HDF5 file: 0 or -1. */
+/* The whole spectrum into an HDF5 file: 0 or an errno. */
 static int write_hdf5(const char *path, const pd_spectrum *s, const pd_spec_row *rows)
 {
-    H5Eset_auto2(H5E_DEFAULT, NULL, NULL); /* no HDF5 diagnostics on stderr */
     hid_t fcpl = pd_h5_untimed(H5P_FILE_CREATE), gcpl = pd_h5_untimed(H5P_GROUP_CREATE);
     hid_t dcpl = pd_h5_untimed(H5P_DATASET_CREATE), file = -1;
     double *buf = malloc((size_t)s->npi2 * sizeof *buf);
-    int rc = -1;
+    int rc = -1, failure = 0, e = ENOMEM;
     if (fcpl >= 0 && gcpl >= 0 && dcpl >= 0 && buf &&
-        (file = H5Fcreate(path, H5F_ACC_TRUNC, fcpl, H5P_DEFAULT)) >= 0) {
+        (file = pd_h5_create(path, fcpl, &failure)) >= 0) {
         rc = h5_root_attrs(file, s);
-        for (long c = 0; c < pd_spec_curves(s) && !rc; c++)
+        for (long c = 0; c < pd_spec_curves(s) && !rc && !failure; c++)
             rc = h5_curve(file, gcpl, dcpl, s, rows, c, buf);
-        if (H5Fclose(file) < 0)
-            rc = -1;
-    }
+        e = pd_h5_close(&file, &failure);
+    } else if (failure)
+        e = failure;
     free(buf);
-    if (fcpl >= 0)
-        H5Pclose(fcpl);
-    if (gcpl >= 0)
-        H5Pclose(gcpl);
-    if (dcpl >= 0)
-        H5Pclose(dcpl);
-    return rc;
+    pd_h5_close_id(&fcpl);
+    pd_h5_close_id(&gcpl);
+    pd_h5_close_id(&dcpl);
+    return e ? e : rc ? EIO : 0;
 }
 
 /* ---- CSV ---------------------------------------------------------------- */
 
-/* "# name = value" lines, the header row, one row per point. */
+/* "# name = value" lines, the header row, one row per point: 0 or an errno. */
 static int write_csv(const char *path, const pd_spectrum *s, const pd_spec_row *rows)
 {
     char rule[64];
-    FILE *f = fopen(path, "w");
-    if (!f)
-        return -1;
+    pd_csv f;
+    if (pd_csv_open(&f, path))
+        return f.failure;
     dt_rule(s, rule, sizeof rule);
-    fprintf(f, "# pound spectrum\n# method = %s\n# Pi2 = %.17g:%.17g:%d %s\n# dt = %s\n",
-            pd_method_name(s->opts.method), s->pi2_min, s->pi2_max, s->npi2,
-            s->linear ? "linear" : "log", rule);
-    fprintf(f, "# theta = %.17g\n# units: ap m/s^2, Tp T0 contact_time first_impact dt tend s, "
-               "gap umax umax_free u_toward u_away m\n",
-            s->opts.theta);
-    fputs("pulse,dir,method,ap,Tp,Pi3,gap,eps,xi", f);
+    pd_csv_printf(&f, "# pound spectrum\n# method = %s\n# Pi2 = %.17g:%.17g:%d %s\n# dt = %s\n",
+                  pd_method_name(s->opts.method), s->pi2_min, s->pi2_max, s->npi2,
+                  s->linear ? "linear" : "log", rule);
+    pd_csv_printf(&f, "# theta = %.17g\n# units: ap m/s^2, Tp T0 contact_time first_impact dt "
+                      "tend s, gap umax umax_free u_toward u_away m\n",
+                  s->opts.theta);
+    pd_csv_printf(&f, "pulse,dir,method,ap,Tp,Pi3,gap,eps,xi");
     for (int k = 0; k < NCOLS; k++)
-        fprintf(f, ",%s", point_cols[k].name);
-    fputc('\n', f);
-    for (long p = 0; p < pd_spec_points(s); p++) {
+        pd_csv_printf(&f, ",%s", point_cols[k].name);
+    pd_csv_printf(&f, "\n");
+    for (long p = 0; p < pd_spec_points(s) && !f.failure; p++) {
         const pd_spec_row *r = &rows[p];
-        fprintf(f, "%s,%s,%s,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", pd_osc_excitation_name(&r->c),
-                pd_dir_name(r->c.dir), pd_method_name(s->opts.method), r->c.ap, r->c.Tp,
-                r->c.Pi3, r->gap, r->c.eps, r->c.xi);
+        pd_csv_printf(&f, "%s,%s,%s,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
+                      pd_osc_excitation_name(&r->c), pd_dir_name(r->c.dir),
+                      pd_method_name(s->opts.method), r->c.ap, r->c.Tp, r->c.Pi3, r->gap,
+                      r->c.eps, r->c.xi);
         for (int k = 0; k < NCOLS; k++)
-            fprintf(f, ",%.17g", col_value(r, &point_cols[k]));
-        fputc('\n', f);
+            pd_csv_printf(&f, ",%.17g", col_value(r, &point_cols[k]));
+        pd_csv_printf(&f, "\n");
     }
-    int bad = ferror(f);
-    return (fclose(f) != 0 || bad) ? -1 : 0;
+    return pd_csv_close(&f);
 }
 
 int pd_spec_write(const char *path, const pd_spectrum *s, const pd_spec_row *rows, pd_err *err)
 {
-    char tmp[4200];
-    int h5 = ends_with(path, ".h5") || ends_with(path, ".hdf5");
+    pd_outfile o;
+    int h5 = ends_with(path, ".h5") || ends_with(path, ".hdf5"), rc, e;
     if (!h5 && !ends_with(path, ".csv"))
         return pd_err_set(err, PD_EINVAL, "-o %s: the file name must end in .h5, .hdf5 or .csv",
                           path);
-    if (snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid()) >= (int)sizeof tmp)
-        return pd_err_set(err, PD_EINVAL, "-o %s: path too long", path);
-    int rc = h5 ? write_hdf5(tmp, s, rows) : write_csv(tmp, s, rows);
-    if (rc || rename(tmp, path) != 0) {
-        unlink(tmp);
-        return pd_err_set(err, PD_EIO, "-o %s: cannot write the file", path);
+    if ((rc = pd_outfile_begin(&o, "-o", path, err)))
+        return rc;
+    if ((e = h5 ? write_hdf5(o.tmp, s, rows) : write_csv(o.tmp, s, rows))) {
+        pd_outfile_abort(&o);
+        return pd_outfile_error(&o, e, err);
     }
-    return PD_OK;
+    return pd_outfile_commit(&o, err);
 }
 
 /* ---- charts ------------------------------------------------------------- */

@@ -8,6 +8,7 @@
  * the costly tasks first, small ones at the end) before they run dry, while
  * rank 0 computes from it too.  Every task writes only its own slot of the
  * result array, so the numbers do not depend on who computed what. */
+#include <fcntl.h>
 #include <gsl/gsl_errno.h>
 #include <math.h>
 #include <stdlib.h>
@@ -262,6 +263,32 @@ static void compute_here(run_ctx *c)
     }
 }
 
+/* Every task's case resolves, the no-wall twins' too (pd_spec_validate
+ * checks the points only): PD_OK, or PD_EINVAL with the first bad task's
+ * message, before anything is computed. */
+static int validate_all(const run_ctx *c, pd_err *err)
+{
+    pd_osc oc;
+    pd_run_opts o;
+    for (long t = 0; t < c->ntasks; t++)
+        if (pd_spec_case(c->s, t, &oc, &o, err))
+            return PD_EINVAL;
+    return PD_OK;
+}
+
+/* Rank 0, a sweep ending as bad input (exit 2): a journal this run created
+ * holds nothing worth resuming (the same flags fail the same way), and left
+ * behind it would make the next run refuse to start ("an interrupted
+ * sweep"), so it goes.  The journal tells by its descriptor: one created by
+ * this run is open write-only, one resumed read-write (spectrum_journal.c);
+ * that one is kept. */
+static void drop_own_journal(const pd_spec_exec *ex)
+{
+    pd_spec_journal *j = ex->journal;
+    if (ex->rank == 0 && j && j->fd >= 0 && (fcntl(j->fd, F_GETFL) & O_ACCMODE) == O_WRONLY)
+        pd_spec_journal_close(j, 1);
+}
+
 int pd_spec_compute(const pd_spectrum *s, const pd_spec_exec *ex, pd_spec_result *res,
                     pd_err *err)
 {
@@ -277,6 +304,8 @@ int pd_spec_compute(const pd_spectrum *s, const pd_spec_exec *ex, pd_spec_result
     c->t0 = c->last_report = pd_wall_seconds();
     c->first_bad = -1;
     c->workers_left = ex->rank == 0 ? ex->size - 1 : 0;
+    if ((rc = validate_all(c, err)))
+        goto done;
     if (plan(c)) {
         rc = pd_err_set(err, PD_ENOMEM, "out of memory for %ld tasks", c->ntasks);
         if (ex->size > 1) { /* the other ranks would wait for this one */
@@ -302,6 +331,8 @@ int pd_spec_compute(const pd_spectrum *s, const pd_spec_exec *ex, pd_spec_result
         rc = pd_err_set(err, PD_EIO, "%ld of %ld runs were not reported",
                         c->ntasks - c->ndone, c->ntasks);
 done:
+    if (rc == PD_EINVAL)
+        drop_own_journal(ex);
     free(c->cost);
     free(c->order);
     free(c->queue);

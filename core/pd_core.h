@@ -16,6 +16,7 @@
 #define PD_CORE_H
 
 #include <stddef.h>
+#include <stdio.h>
 
 enum {
     PD_OK = 0,
@@ -46,6 +47,9 @@ const char *pd_strerror(int status);
  * returns status so callers can write `return pd_err_set(err, ...)`. */
 int pd_err_set(pd_err *err, int status, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
+
+/* Replace control bytes in msg by '?' (pd_err_set does it to every message). */
+void pd_err_sanitize(char *msg);
 
 /* Clear err to PD_OK with an empty message. */
 void pd_err_clear(pd_err *err);
@@ -149,5 +153,62 @@ int pd_dense_lu(int n, double *A, int lda, int *perm, double rel_tol);
 
 /* Solve A x = b in place from the output of pd_dense_lu. */
 void pd_dense_lu_solve(int n, const double *LU, int lda, const int *perm, double *b);
+
+/* ---- input text files in bounded memory --------------------------------
+ * The one reader under the LCP, scene and record readers.
+ *
+ * A file is read whole (pd_text_read_all) or a line at a time (pd_text_open,
+ * pd_text_line), and refused as soon as the offence is read:
+ *   - a NUL byte: binary data (/dev/zero, an image, a compressed file);
+ *   - more than max_bytes bytes: the reader's size cap (each reader names
+ *     its own, generous for real inputs), so that an endless stream costs
+ *     at most the cap;
+ *   - a line longer than PD_TEXT_LINE_MAX (line by line only).
+ * Each refusal is PD_EPARSE with one line naming the file and where, in the
+ * style of the reader's other messages (pd_text_at); a file that cannot be
+ * opened or read is PD_EIO with the system's reason, a failed allocation
+ * PD_ENOMEM. */
+
+/* Longest line of the line reader: 64 MiB.  Text inputs have lines of tens
+ * of characters (a record line of 8 numbers is about 120); a line this long
+ * is not text, and the cap bounds the line buffer. */
+#define PD_TEXT_LINE_MAX (64L << 20)
+
+/* How messages name a place in the file. */
+typedef enum {
+    PD_TEXT_AT_LINE = 0,     /* "FILE:LINE: " (records) */
+    PD_TEXT_AT_LINE_COL = 1, /* "FILE:LINE:COL: " (JSON scenes, as jansson's errors) */
+    PD_TEXT_AT_WORD = 2      /* "FILE: line LINE: " (LCP files) */
+} pd_text_at;
+
+/* A file read line by line. */
+typedef struct pd_text {
+    const char *path;
+    FILE *f;
+    long max_bytes;  /* the size cap */
+    pd_text_at at;
+    char *line;      /* the current line with its '\n' (if any), NUL-terminated */
+    size_t len, cap; /* its length and the buffer's size */
+    long lineno;     /* of the current line, 1-based; 0 before the first */
+    long bytes;      /* read so far */
+    pd_err *err;
+} pd_text;
+
+/* Open path for reading with a cap of max_bytes > 0 bytes. */
+int pd_text_open(pd_text *t, const char *path, long max_bytes, pd_text_at at, pd_err *err);
+
+/* The next line into t->line: 1, 0 at the end of the file, or an error. */
+int pd_text_line(pd_text *t);
+
+/* Back to the start of the file (PD_EIO if it cannot seek: a pipe). */
+int pd_text_rewind(pd_text *t);
+
+/* Close the file and free the line buffer (t may have failed to open). */
+void pd_text_close(pd_text *t);
+
+/* The whole file into *text (malloc'd, NUL-terminated, *len bytes before the
+ * NUL); on error *text is NULL. */
+int pd_text_read_all(const char *path, long max_bytes, pd_text_at at, char **text, size_t *len,
+                     pd_err *err);
 
 #endif

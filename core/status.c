@@ -25,6 +25,15 @@ const char *pd_strerror(int status)
     }
 }
 
+/* Control bytes (a newline, an escape sequence from a file) shown as '?':
+ * a message is one line of text whatever it quotes. */
+void pd_err_sanitize(char *msg)
+{
+    for (; *msg; msg++)
+        if ((unsigned char)*msg < 0x20 || *msg == 0x7f)
+            *msg = '?';
+}
+
 int pd_err_set(pd_err *err, int status, const char *fmt, ...)
 {
     if (err) {
@@ -33,6 +42,7 @@ int pd_err_set(pd_err *err, int status, const char *fmt, ...)
         va_start(ap, fmt);
         vsnprintf(err->msg, sizeof err->msg, fmt, ap);
         va_end(ap);
+        pd_err_sanitize(err->msg);
     }
     return status;
 }

@@ -48,6 +48,8 @@ static const pen_stepper pen_steppers[] = {
 };
 
 /* One run: the model, the engaged set, GSL objects and workspaces. */
+#define PEN_MAX_STALL 1000 /* steps in a row that may end where they began */
+
 typedef struct pen {
     const pd_model *md;
     pd_penalty_opts o;
@@ -73,6 +75,7 @@ typedef struct pen {
     double t_out0;         /* t0 (outputs at t0 + k h_out) */
     long next_out;         /* k of the next output */
     int stopped;           /* an observer asked to stop */
+    long stalled;          /* consecutive steps that did not advance t */
     pd_state st;
     pd_penalty_result res;
 } pen;
@@ -775,6 +778,11 @@ static int one_step(pen *p, double *t, double tb, double *h, pd_err *err)
     if ((rc = earliest_crossing(p, ta, t, &which, err)) ||
         (rc = outputs_inside(p, ta, *t, err)))
         return rc;
+    p->stalled = *t > ta ? 0 : p->stalled + 1;
+    if (p->stalled > PEN_MAX_STALL) /* switching back and forth at one instant */
+        return pd_err_set(err, PD_ENUMERICAL, "penalty: no progress at t = %.9g after %d steps "
+                          "(rtol = %g, atol = %g: tighter tolerances resolve the contact)",
+                          ta, PEN_MAX_STALL, p->o.rtol, p->o.atol);
     track_extremes(p, ta, *t - ta);
     if (which >= 0) {
         apply_switches(p, which);

@@ -4,8 +4,9 @@
  *          else; '#' starts a comment that runs to the end of the line.
  * siconos: n, 0 (dense storage), rows, cols, "rows cols" on one line, then
  *          M column by column, then q; any text after q is ignored.
- * The whole file is read, split into whitespace-separated tokens that remember
- * their line, and every error names the file and the line. */
+ * The whole file is read (bounded: pd_text_read_all), then walked token by token
+ * (whitespace-separated, each with its line) with no token array, so memory
+ * is the file and the problem; every error names the file and the line. */
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
@@ -14,53 +15,41 @@
 #include <string.h>
 
 #include "pd_lcp.h"
+#include "pd_core.h"
 
 #define READ_NMAX 46340 /* n*n must fit an int */
 
+/* Largest LCP file read: 512 MiB, a dense n = 4096 problem at 30
+ * characters an entry (Lemke takes n <= 2048; larger problems come as
+ * HDF5 dumps).  The cap bounds what an endless input (/dev/zero, a
+ * stream) costs before it is refused. */
+#define LCP_FILE_MAX (512L << 20)
+
+/* A token: text[0 .. len) inside the file buffer, on a 1-based line. */
 typedef struct lcp_token {
-    char *text; /* NUL-terminated, inside the file buffer */
-    int line;   /* 1-based */
+    const char *text;
+    size_t len;
+    int line;
 } lcp_token;
 
-/* A file split into tokens. */
+/* A place in the file: the next byte, its line, inside a comment or not. */
+typedef struct lcp_cursor {
+    const char *p;
+    int line, in_comment;
+} lcp_cursor;
+
+/* The file's text. */
 typedef struct lcp_text {
     const char *path;
-    char *buf;       /* file contents + NUL */
+    char *buf;       /* file contents + NUL (no NUL inside) */
     size_t len;
-    lcp_token *tok;
-    size_t ntok, cap;
     int last_line;   /* line of the end of the file */
 } lcp_text;
 
-/* Whole file into t->buf (NUL-terminated). */
+/* Whole file into t->buf (NUL-terminated, no NUL inside: pd_text_read_all). */
 static int slurp(lcp_text *t, pd_err *err)
 {
-    FILE *f = fopen(t->path, "rb");
-    if (!f)
-        return pd_err_set(err, PD_EIO, "%s: cannot open: %s", t->path, strerror(errno));
-    size_t cap = 4096;
-    int status = PD_OK;
-    errno = 0;
-    t->buf = malloc(cap);
-    t->len = 0;
-    while (t->buf) {
-        t->len += fread(t->buf + t->len, 1, cap - 1 - t->len, f);
-        if (t->len < cap - 1)
-            break;
-        char *grown = realloc(t->buf, 2 * cap);
-        if (!grown)
-            free(t->buf);
-        t->buf = grown;
-        cap *= 2;
-    }
-    if (!t->buf)
-        status = pd_err_set(err, PD_ENOMEM, "%s: out of memory reading the file", t->path);
-    else if (ferror(f))
-        status = pd_err_set(err, PD_EIO, "%s: cannot read: %s", t->path, strerror(errno));
-    else
-        t->buf[t->len] = '\0';
-    fclose(f);
-    return status;
+    return pd_text_read_all(t->path, LCP_FILE_MAX, PD_TEXT_AT_WORD, &t->buf, &t->len, err);
 }
 
 /* Whitespace inside a line (CR of CRLF included). */
@@ -69,103 +58,107 @@ static int is_blank(char c)
     return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
 }
 
-/* Append one token. */
-static int push_token(lcp_text *t, char *text, int line)
+/* The start of the file, and the line holding its last byte. */
+static lcp_cursor text_start(lcp_text *t)
 {
-    if (t->ntok == t->cap) {
-        size_t cap = t->cap ? 2 * t->cap : 256;
-        lcp_token *grown = realloc(t->tok, cap * sizeof *grown);
-        if (!grown)
-            return -1;
-        t->tok = grown;
-        t->cap = cap;
+    int lines = 1;
+    for (size_t k = 0; k < t->len; k++)
+        lines += t->buf[k] == '\n';
+    t->last_line = t->len > 0 && t->buf[t->len - 1] == '\n' ? lines - 1 : lines;
+    return (lcp_cursor){.p = t->buf, .line = 1};
+}
+
+/* The next token at c: 1, or 0 at the end of the file.  Tokens end at
+ * blanks, newlines and '#'. */
+static int next_token(const lcp_text *t, lcp_cursor *c, lcp_token *tk)
+{
+    const char *end = t->buf + t->len;
+    for (; c->p < end; c->p++) {
+        char ch = *c->p;
+        if (ch == '\n') {
+            c->line++;
+            c->in_comment = 0;
+        } else if (ch == '#') {
+            c->in_comment = 1;
+        } else if (!c->in_comment && !is_blank(ch)) {
+            const char *s = c->p;
+            while (c->p < end && *c->p != '\n' && *c->p != '#' && !is_blank(*c->p))
+                c->p++;
+            *tk = (lcp_token){.text = s, .len = (size_t)(c->p - s), .line = c->line};
+            return 1;
+        }
     }
-    t->tok[t->ntok].text = text;
-    t->tok[t->ntok].line = line;
-    t->ntok++;
     return 0;
 }
 
-/* Split the buffer in place: tokens end at blanks, newlines and '#'. */
-static int tokenize(lcp_text *t, pd_err *err)
+/* Up to `limit` tokens from c on: how many there are (c is a copy). */
+static size_t count_tokens(const lcp_text *t, lcp_cursor c, size_t limit)
 {
-    char *p = t->buf, *end = t->buf + t->len;
-    int line = 1, in_comment = 0, final_newline = t->len > 0 && end[-1] == '\n';
-    while (p < end) {
-        char c = *p;
-        if (c == '\n') {
-            line++;
-            in_comment = 0;
-            *p++ = '\0';
-        } else if (in_comment || is_blank(c)) {
-            *p++ = '\0';
-        } else if (c == '#') {
-            in_comment = 1;
-            *p++ = '\0';
-        } else if (c == '\0') {
-            return pd_err_set(err, PD_EPARSE, "%s: line %d: NUL byte in a text file", t->path,
-                              line);
-        } else {
-            if (push_token(t, p, line) != 0)
-                return pd_err_set(err, PD_ENOMEM, "%s: out of memory", t->path);
-            while (p < end && *p != '\n' && *p != '#' && !is_blank(*p) && *p != '\0')
-                p++;
-        }
-    }
-    t->last_line = final_newline ? line - 1 : line; /* the line holding the last byte */
-    return PD_OK;
+    lcp_token tk;
+    size_t k = 0;
+    while (k < limit && next_token(t, &c, &tk))
+        k++;
+    return k;
 }
 
-/* Token k as a finite double. */
-static int token_number(const lcp_text *t, size_t k, const char *what, double *x, pd_err *err)
+/* Length of a token as printed in messages (at most 40 characters). */
+static int shown(const lcp_token *tk)
 {
-    const lcp_token *tk = &t->tok[k];
-    char *stop = NULL;
-    errno = 0;
-    double v = strtod(tk->text, &stop);
-    if (stop == tk->text || *stop != '\0')
-        return pd_err_set(err, PD_EPARSE, "%s: line %d: %s: '%.40s' is not a number", t->path,
-                          tk->line, what, tk->text);
-    if (isnan(v) || isinf(v) || (errno == ERANGE && fabs(v) > 1.0))
-        return pd_err_set(err, PD_EPARSE, "%s: line %d: %s: '%.40s' is not a finite number",
-                          t->path, tk->line, what, tk->text);
-    *x = v;
-    return PD_OK;
+    return tk->len > 40 ? 40 : (int)tk->len;
 }
 
-/* Token k as a decimal integer (no sign check). */
+/* Token as a decimal integer (no sign check). */
 static int token_integer(const lcp_token *tk, long *v)
 {
     char *stop = NULL;
     errno = 0;
     *v = strtol(tk->text, &stop, 10);
-    return stop != tk->text && *stop == '\0' && errno == 0;
+    return stop != tk->text && stop == tk->text + tk->len && errno == 0;
 }
 
-/* Token k as a size 1 <= n <= READ_NMAX. */
-static int token_size(const lcp_text *t, size_t k, const char *what, int *n, pd_err *err)
+/* The next token as a finite double (the count was checked: it exists). */
+static int token_number(const lcp_text *t, lcp_cursor *c, const char *what, double *x,
+                        pd_err *err)
 {
-    if (k >= t->ntok)
+    lcp_token tk = {.text = t->buf + t->len, .line = t->last_line};
+    next_token(t, c, &tk);
+    char *stop = NULL;
+    errno = 0;
+    double v = strtod(tk.text, &stop);
+    if (stop == tk.text || stop != tk.text + tk.len)
+        return pd_err_set(err, PD_EPARSE, "%s: line %d: %s: '%.*s' is not a number", t->path,
+                          tk.line, what, shown(&tk), tk.text);
+    if (isnan(v) || isinf(v) || (errno == ERANGE && fabs(v) > 1.0))
+        return pd_err_set(err, PD_EPARSE, "%s: line %d: %s: '%.*s' is not a finite number",
+                          t->path, tk.line, what, shown(&tk), tk.text);
+    *x = v;
+    return PD_OK;
+}
+
+/* The next token as a size 1 <= n <= READ_NMAX. */
+static int token_size(const lcp_text *t, lcp_cursor *c, const char *what, int *n, pd_err *err)
+{
+    lcp_token tk;
+    if (!next_token(t, c, &tk))
         return pd_err_set(err, PD_EPARSE, "%s: line %d: file ends before the %s", t->path,
                           t->last_line, what);
     long v = 0;
-    const lcp_token *tk = &t->tok[k];
-    if (!token_integer(tk, &v) || v <= 0)
+    if (!token_integer(&tk, &v) || v <= 0)
         return pd_err_set(err, PD_EPARSE,
-                          "%s: line %d: the %s must be a positive integer, got '%.40s'", t->path,
-                          tk->line, what, tk->text);
+                          "%s: line %d: the %s must be a positive integer, got '%.*s'", t->path,
+                          tk.line, what, shown(&tk), tk.text);
     if (v > READ_NMAX)
         return pd_err_set(err, PD_EPARSE, "%s: line %d: the %s %ld is too large (at most %d)",
-                          t->path, tk->line, what, v, READ_NMAX);
+                          t->path, tk.line, what, v, READ_NMAX);
     *n = (int)v;
     return PD_OK;
 }
 
-/* Enough tokens from `first` on for n*n + n values? */
-static int check_count(const lcp_text *t, size_t first, int n, pd_err *err)
+/* Enough tokens from c on for n*n + n values? */
+static int check_count(const lcp_text *t, lcp_cursor c, int n, pd_err *err)
 {
     size_t need = (size_t)n * (size_t)n + (size_t)n;
-    size_t have = t->ntok > first ? t->ntok - first : 0;
+    size_t have = count_tokens(t, c, need);
     if (have >= need)
         return PD_OK;
     return pd_err_set(err, PD_EPARSE,
@@ -186,110 +179,125 @@ static int alloc_problem(const lcp_text *t, int n, double **M, double **q, pd_er
     return pd_err_set(err, PD_ENOMEM, "%s: out of memory for n = %d", t->path, n);
 }
 
-/* n*n entries of M from token `first` on; row_major selects the layout. */
-static int read_matrix(const lcp_text *t, size_t first, int n, int row_major, double *M,
+/* n*n entries of M from c on; row_major selects the layout. */
+static int read_matrix(const lcp_text *t, lcp_cursor *c, int n, int row_major, double *M,
                        pd_err *err)
 {
     size_t nn = (size_t)n * (size_t)n;
     for (size_t k = 0; k < nn; k++) {
         size_t i = k / (size_t)n, j = k % (size_t)n;
         size_t at = row_major ? i + j * (size_t)n : k;
-        int st = token_number(t, first + k, "matrix entry", &M[at], err);
+        int st = token_number(t, c, "matrix entry", &M[at], err);
         if (st != PD_OK)
             return st;
     }
     return PD_OK;
 }
 
-/* n entries of q from token `first` on. */
-static int read_vector(const lcp_text *t, size_t first, int n, double *q, pd_err *err)
+/* n entries of q from c on. */
+static int read_vector(const lcp_text *t, lcp_cursor *c, int n, double *q, pd_err *err)
 {
     for (int i = 0; i < n; i++) {
-        int st = token_number(t, first + (size_t)i, "entry of q", &q[i], err);
+        int st = token_number(t, c, "entry of q", &q[i], err);
         if (st != PD_OK)
             return st;
     }
     return PD_OK;
+}
+
+/* Nothing after the n*n + n values from c on (c is a copy; the count was
+ * checked). */
+static int check_nothing_after(const lcp_text *t, lcp_cursor c, int n, pd_err *err)
+{
+    size_t need = (size_t)n * (size_t)n + (size_t)n;
+    lcp_token tk;
+    for (size_t k = 0; k < need; k++)
+        next_token(t, &c, &tk);
+    if (!next_token(t, &c, &tk))
+        return PD_OK;
+    return pd_err_set(err, PD_EPARSE,
+                      "%s: line %d: unexpected value '%.*s' after q (n = %d needs exactly "
+                      "%zu numbers)", t->path, tk.line, shown(&tk), tk.text, n, need + 1);
 }
 
 /* plain: n, M row by row, q, and nothing more. */
-static int read_plain(const lcp_text *t, int *n, double **M, double **q, pd_err *err)
+static int read_plain(const lcp_text *t, lcp_cursor c, int *n, double **M, double **q,
+                      pd_err *err)
 {
-    if (t->ntok == 0)
+    if (count_tokens(t, c, 1) == 0)
         return pd_err_set(err, PD_EPARSE, "%s: line %d: empty file, expected the size n",
                           t->path, t->last_line);
-    int st = token_size(t, 0, "size n", n, err);
+    int st = token_size(t, &c, "size n", n, err);
     if (st == PD_OK)
-        st = check_count(t, 1, *n, err);
-    size_t used = 1 + (size_t)*n * (size_t)*n + (size_t)*n;
-    if (st == PD_OK && t->ntok > used)
-        st = pd_err_set(err, PD_EPARSE,
-                        "%s: line %d: unexpected value '%.40s' after q (n = %d needs exactly "
-                        "%zu numbers)", t->path, t->tok[used].line, t->tok[used].text, *n, used);
+        st = check_count(t, c, *n, err);
+    if (st == PD_OK)
+        st = check_nothing_after(t, c, *n, err);
     if (st == PD_OK)
         st = alloc_problem(t, *n, M, q, err);
     if (st == PD_OK)
-        st = read_matrix(t, 1, *n, 1, *M, err);
+        st = read_matrix(t, &c, *n, 1, *M, err);
     if (st == PD_OK)
-        st = read_vector(t, 1 + (size_t)*n * (size_t)*n, *n, *q, err);
+        st = read_vector(t, &c, *n, *q, err);
     return st;
 }
 
-/* Siconos header: storage 0 and rows = cols = n, twice. */
-static int check_siconos_header(const lcp_text *t, int n, pd_err *err)
+/* Siconos header after n: storage 0 and rows = cols = n, twice. */
+static int check_siconos_header(const lcp_text *t, lcp_cursor *c, int n, pd_err *err)
 {
+    lcp_token tk[5];
     long v = 0;
-    if (t->ntok < 6)
-        return pd_err_set(err, PD_EPARSE, "%s: line %d: file ends inside the Siconos header "
-                          "(n, storage, rows, cols, rows cols)", t->path, t->last_line);
-    if (!token_integer(&t->tok[1], &v) || v != 0)
-        return pd_err_set(err, PD_EPARSE, "%s: line %d: storage '%.40s' is not supported "
-                          "(only 0 = dense)", t->path, t->tok[1].line, t->tok[1].text);
-    for (size_t k = 2; k < 6; k++)
-        if (!token_integer(&t->tok[k], &v) || v != n)
-            return pd_err_set(err, PD_EPARSE, "%s: line %d: matrix dimension '%.40s' does not "
-                              "match n = %d", t->path, t->tok[k].line, t->tok[k].text, n);
+    for (int k = 0; k < 5; k++)
+        if (!next_token(t, c, &tk[k]))
+            return pd_err_set(err, PD_EPARSE, "%s: line %d: file ends inside the Siconos header "
+                              "(n, storage, rows, cols, rows cols)", t->path, t->last_line);
+    if (!token_integer(&tk[0], &v) || v != 0)
+        return pd_err_set(err, PD_EPARSE, "%s: line %d: storage '%.*s' is not supported "
+                          "(only 0 = dense)", t->path, tk[0].line, shown(&tk[0]), tk[0].text);
+    for (int k = 1; k < 5; k++)
+        if (!token_integer(&tk[k], &v) || v != n)
+            return pd_err_set(err, PD_EPARSE, "%s: line %d: matrix dimension '%.*s' does not "
+                              "match n = %d", t->path, tk[k].line, shown(&tk[k]), tk[k].text, n);
     return PD_OK;
 }
 
 /* siconos: header, M column by column, q; the rest is free text. */
-static int read_siconos(const lcp_text *t, int *n, double **M, double **q, pd_err *err)
+static int read_siconos(const lcp_text *t, lcp_cursor c, int *n, double **M, double **q,
+                        pd_err *err)
 {
-    if (t->ntok == 0)
+    if (count_tokens(t, c, 1) == 0)
         return pd_err_set(err, PD_EPARSE, "%s: line %d: empty file, expected the size n",
                           t->path, t->last_line);
-    int st = token_size(t, 0, "size n", n, err);
+    int st = token_size(t, &c, "size n", n, err);
     if (st == PD_OK)
-        st = check_siconos_header(t, *n, err);
+        st = check_siconos_header(t, &c, *n, err);
     if (st == PD_OK)
-        st = check_count(t, 6, *n, err);
+        st = check_count(t, c, *n, err);
     if (st == PD_OK)
         st = alloc_problem(t, *n, M, q, err);
     if (st == PD_OK)
-        st = read_matrix(t, 6, *n, 0, *M, err);
+        st = read_matrix(t, &c, *n, 0, *M, err);
     if (st == PD_OK)
-        st = read_vector(t, 6 + (size_t)*n * (size_t)*n, *n, *q, err);
+        st = read_vector(t, &c, *n, *q, err);
     return st;
 }
 
 /* Siconos header layout: n, storage, rows, cols on lines of their own, then
  * "rows cols" on one line, all integers, repeated dims equal, and a token
- * count that a plain file of that n cannot have. */
-static int looks_siconos(const lcp_text *t)
+ * count that a plain file of that n cannot have (c is a copy). */
+static int looks_siconos(const lcp_text *t, lcp_cursor c)
 {
+    lcp_token tk[6];
     long v[6];
-    if (t->ntok < 6)
-        return 0;
     for (int k = 0; k < 6; k++)
-        if (!token_integer(&t->tok[k], &v[k]))
+        if (!next_token(t, &c, &tk[k]) || !token_integer(&tk[k], &v[k]))
             return 0;
-    const lcp_token *tk = t->tok;
     int lines_ok = tk[0].line < tk[1].line && tk[1].line < tk[2].line &&
                    tk[2].line < tk[3].line && tk[3].line < tk[4].line && tk[4].line == tk[5].line;
     if (!lines_ok || v[0] <= 0 || v[0] > READ_NMAX || v[2] != v[4] || v[3] != v[5])
         return 0;
     size_t plain_count = 1 + (size_t)v[0] * (size_t)v[0] + (size_t)v[0];
-    return t->ntok != plain_count;
+    /* plain_count is 3 or >= 7; counting one past it decides */
+    return plain_count < 6 || 6 + count_tokens(t, c, plain_count - 5) != plain_count;
 }
 
 int pd_lcp_read(const char *path, pd_lcp_format format, int *n, double **M, double **q,
@@ -305,12 +313,11 @@ int pd_lcp_read(const char *path, pd_lcp_format format, int *n, double **M, doub
     *M = *q = NULL;
     lcp_text t = {.path = path};
     int st = slurp(&t, err);
-    if (st == PD_OK)
-        st = tokenize(&t, err);
     if (st == PD_OK) {
+        lcp_cursor c = text_start(&t);
         int siconos = format == PD_LCP_FORMAT_SICONOS ||
-                      (format == PD_LCP_FORMAT_AUTO && looks_siconos(&t));
-        st = siconos ? read_siconos(&t, n, M, q, err) : read_plain(&t, n, M, q, err);
+                      (format == PD_LCP_FORMAT_AUTO && looks_siconos(&t, c));
+        st = siconos ? read_siconos(&t, c, n, M, q, err) : read_plain(&t, c, n, M, q, err);
     }
     if (st != PD_OK) {
         free(*M);
@@ -318,7 +325,6 @@ int pd_lcp_read(const char *path, pd_lcp_format format, int *n, double **M, doub
         *M = *q = NULL;
         *n = 0;
     }
-    free(t.tok);
     free(t.buf);
     return st;
 }

@@ -5,7 +5,7 @@
  *   gap Pi3 - x;  so M = 1, C = 2 xi Pi2, K = Pi2^2, W = -1, g0 = Pi3.
  *
  * Stiffness in Pi units (lambda / ap against d / Le):
- *   Kelvin-Voigt  kc = kc_mult Pi2^2   or  kc_abs / wp^2
+ *   Kelvin-Voigt  kc = kc_mult Pi2^2   or  kc_abs / wp^2   (kc_mult 0: max(1e4 Pi2^2, 1e3 / Pi3^2))
  *   Hertz-damp    kc = kc_mult Pi2^2   or  kc_abs sqrt(Le) / wp^2
  * Extremes are measured on every accepted step, refined inside the step by
  * the quintic Hermite interpolant of (x, x', x''); impacts are the located
@@ -15,6 +15,10 @@
 #include <string.h>
 
 #include "pd_problems.h"
+
+#define OSC_PEN_KC_W0 1e4    /* the default contact stiffness: at least this * w0^2, ... */
+#define OSC_PEN_KC_GAP 1e3   /* ... and this * wp^2 / Pi3^2 (penetration ~ 3 % of the gap) */
+#define OSC_PEN_MIN_PI3 1e-3 /* the Pi3 of that rule at a zero gap */
 
 /* F = s phi(tau) (or the record's): the model's force callback. */
 static void scene_force(double tau, int side, double *F, void *ctx)
@@ -231,7 +235,13 @@ static double pi_stiffness(const pd_osc *c, const pd_penalty_setup *po)
     if (po->kc_abs > 0.0)
         return po->law == PD_PENALTY_HERTZDAMP ? po->kc_abs * sqrt(pd_osc_Le(c)) / (wp * wp)
                                                : po->kc_abs / (wp * wp);
-    return po->kc_mult * c->Pi2 * c->Pi2;
+    if (po->kc_mult > 0.0)
+        return po->kc_mult * c->Pi2 * c->Pi2;
+    /* the default resolves the gap: a pulse's velocity scale ap/wp enters the
+     * wall by about 3 % of the gap (1e3 wp^2 / Pi3^2), and never softer than
+     * 1e4 w0^2 (docs/methods.md: 200 random cases) */
+    double pi3 = fmax(c->Pi3, OSC_PEN_MIN_PI3);
+    return fmax(OSC_PEN_KC_W0 * c->Pi2 * c->Pi2, OSC_PEN_KC_GAP / (pi3 * pi3));
 }
 
 /* Results back in metres and seconds. */

@@ -10,6 +10,7 @@
 
 #include "pd_problems.h"
 
+
 pd_osc pd_osc_default(void)
 {
     return (pd_osc){.pulse = PD_PULSE_SINE,
@@ -383,6 +384,11 @@ static pd_sine_piece *record_pieces(const pd_osc *c)
     return p;
 }
 
+double pd_osc_scan_points(const pd_osc *c, double tend)
+{
+    return 64.0 * tend / fmin(c->Tp, pd_osc_T0(c));
+}
+
 int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
                      pd_osc_result *res, pd_err *err)
 {
@@ -392,6 +398,11 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     pd_err_clear(err);
     if ((rc = pd_osc_resolve_opts(c, opts, &o, err)))
         return rc;
+    double scan = pd_osc_scan_points(c, o.tend); /* its scan grid: the cost */
+    if (!(scan <= PD_OSC_MAX_SCAN))
+        return pd_err_set(err, PD_EINVAL, "Pi2: the event-driven reference would scan %.3g "
+                          "points over tend (T0 = %.3g s; at most %.0e)", scan, pd_osc_T0(c),
+                          PD_OSC_MAX_SCAN);
     /* forcing pieces in Pi units: s sin(tau + phi) on [0, 2 pi], then zero;
      * a record: its linear pieces, then zero */
     double phi = c->pulse == PD_PULSE_COSINE ? PD_TWO_PI / 4.0 : 0.0;

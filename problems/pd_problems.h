@@ -45,7 +45,18 @@ double pd_pulse_shape_rate(pd_pulse pulse, int dir, double tau, int side);
  * and two-column text "t a" ('#' comments; t uniform to 1 % of a step,
  * shifted so that the first sample is at t = 0; units given).  Every
  * reader error is PD_EPARSE with "FILE:LINE: what was expected"; an
- * unreadable file PD_EIO.  At most 10^8 samples. */
+ * unreadable file PD_EIO.  At most 10^8 samples, files of at most 1 GiB
+ * (binary data, a NUL byte, is refused where it is read). */
+
+/* The sampling intervals a record may have [s].  Strong-motion records are
+ * sampled every 0.005 to 0.02 s (1e-3 s at the most, 0.05 s for old
+ * digitisations); 1e-6 s (1 MHz) and 10 s bound them by far, and keep
+ * everything derived finite and exact: the duration (npts - 1) dt is at
+ * most 10^9 s, sample times k dt and indices t / dt stay far inside the
+ * doubles' exact integers.  A DT outside (1e308, 1e-300, a denormal) is a
+ * broken header, refused by the readers with its FILE:LINE. */
+#define PD_RECORD_DT_MIN 1e-6
+#define PD_RECORD_DT_MAX 10.0
 
 typedef enum {
     PD_RECORD_AUTO = 0, /* by content (an AT2 or V2 header), else two-column text */
@@ -279,6 +290,12 @@ typedef struct pd_osc_result {
 /* Run the case with the method of opts (sampler may be NULL). */
 int pd_osc_run(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
                pd_osc_result *res, pd_err *err);
+
+/* The event-driven reference's work: its scan points over tend (64 per
+ * shortest of Tp and T0), and the most a run may take (about 5 s here: a
+ * stiffer oscillator is quasi-static, and Moreau-Jean runs it). */
+#define PD_OSC_MAX_SCAN 2.5e7
+double pd_osc_scan_points(const pd_osc *c, double tend);
 
 /* The three methods (pd_osc_run dispatches to them):
  * Moreau–Jean, its umax the maximum over the steps; */

@@ -9,8 +9,9 @@
  * (the velocity and displacement blocks that follow are not read).
  * Text: lines "t a", '#' comments, t uniform (see text_uniform).
  *
- * Files are read line by line (getline), so lines of any length and
- * records of any size up to RECORD_NPTS_MAX samples are read.  CR (also
+ * Files are read line by line in bounded memory (pd_core.h): lines up to
+ * PD_TEXT_LINE_MAX, files up to RECORD_FILE_MAX bytes and records up to
+ * RECORD_NPTS_MAX samples; a NUL byte is refused where it is read.  CR (also
  * CR CR LF line ends), tabs, commas and the DOS end-of-file byte 0x1A are
  * blanks.  Numbers that touch ("1.234E-02-5.678E-03", "0.123-0.456") are
  * split where a sign follows a complete number; Fortran's D exponent is
@@ -21,10 +22,14 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/types.h>
 
 #include "pd_problems.h"
+#include "pd_core.h"
 
+/* Largest record file read: 1 GiB.  Strong-motion records are kilobytes to
+ * a few megabytes (10^5 samples of 15 characters); the cap bounds what an
+ * endless input (/dev/zero, a stream) can cost before it is refused. */
+#define RECORD_FILE_MAX (1L << 30)
 #define RECORD_NPTS_MAX 100000000L /* 10^8 samples: 800 MB of doubles */
 #define RECORD_AT2_HEAD 10         /* lines searched for the AT2 NPTS line */
 #define RECORD_V2_HEAD 200         /* lines searched for the V2 acceleration block */
@@ -34,9 +39,8 @@
 /* A file read line by line. */
 typedef struct rec_reader {
     const char *path;
-    FILE *f;
-    char *line;   /* the current line, NUL-terminated (getline's buffer) */
-    size_t cap;
+    pd_text t;
+    char *line;   /* the current line, NUL-terminated (t's buffer) */
     long lineno;  /* of the current line, 1-based; 0 before the first */
     pd_err *err;
 } rec_reader;
@@ -177,47 +181,34 @@ static const char *find_nocase(const char *hay, const char *needle)
 static int reader_open(rec_reader *r, const char *path, pd_err *err)
 {
     *r = (rec_reader){.path = path, .err = err};
-    r->f = fopen(path, "rb");
-    if (!r->f)
-        return pd_err_set(err, PD_EIO, "%s: cannot open: %s", path, strerror(errno));
-    return PD_OK;
+    return pd_text_open(&r->t, path, RECORD_FILE_MAX, PD_TEXT_AT_LINE, err);
 }
 
 /* Back to the start of the file. */
-static void reader_rewind(rec_reader *r)
+static int reader_rewind(rec_reader *r)
 {
-    rewind(r->f);
     r->lineno = 0;
+    r->line = NULL;
+    return pd_text_rewind(&r->t);
 }
 
 /* Close the file and free the line buffer. */
 static void reader_close(rec_reader *r)
 {
-    if (r->f)
-        fclose(r->f);
-    free(r->line);
-    r->f = NULL;
+    pd_text_close(&r->t);
     r->line = NULL;
 }
 
 /* The next line into r->line: 1, 0 at the end of the file, or an error
- * (a read error, a NUL byte). */
+ * (a read error, a NUL byte, a line or a file beyond its cap). */
 static int next_line(rec_reader *r)
 {
-    errno = 0;
-    ssize_t len = getline(&r->line, &r->cap, r->f);
-    if (len < 0) {
-        if (ferror(r->f))
-            return pd_err_set(r->err, errno == ENOMEM ? PD_ENOMEM : PD_EIO,
-                              "%s:%ld: cannot read: %s", r->path, r->lineno + 1,
-                              strerror(errno ? errno : EIO));
-        return 0;
+    int st = pd_text_line(&r->t);
+    if (st == 1) {
+        r->line = r->t.line;
+        r->lineno = r->t.lineno;
     }
-    r->lineno++;
-    if (memchr(r->line, '\0', (size_t)len))
-        return pd_err_set(r->err, PD_EPARSE, "%s:%ld: not a text file (a NUL byte)", r->path,
-                          r->lineno);
-    return 1;
+    return st;
 }
 
 /* The word (up to a blank) at p, for messages: at most 40 characters. */
@@ -391,6 +382,18 @@ static int at2_units(rec_reader *r)
                       r->lineno, word_len(p), p);
 }
 
+/* A sampling interval dt (named what, read on line) within
+ * [PD_RECORD_DT_MIN, PD_RECORD_DT_MAX]: with at most RECORD_NPTS_MAX
+ * samples the duration is then at most 10^9 s. */
+static int check_dt(rec_reader *r, long line, double dt, const char *what)
+{
+    if (!(dt >= PD_RECORD_DT_MIN && dt <= PD_RECORD_DT_MAX))
+        return pd_err_set(r->err, PD_EPARSE,
+                          "%s:%ld: %s = %g s: expected a sampling interval in [%g, %g] s", r->path,
+                          line, what, dt, PD_RECORD_DT_MIN, PD_RECORD_DT_MAX);
+    return PD_OK;
+}
+
 /* Check npts and dt from a header (AT2 or V2) at the current line. */
 static int check_npts_dt(rec_reader *r, long npts, double dt)
 {
@@ -405,7 +408,7 @@ static int check_npts_dt(rec_reader *r, long npts, double dt)
     if (!(dt > 0.0) || !isfinite(dt))
         return pd_err_set(r->err, PD_EPARSE, "%s:%ld: DT = %g: expected a positive time step",
                           r->path, r->lineno, dt);
-    return PD_OK;
+    return check_dt(r, r->lineno, dt, "DT");
 }
 
 /* Read the AT2 header up to its NPTS line. */
@@ -441,6 +444,17 @@ static int v2_block_end(const char *s)
     return find_nocase(s, "POINTS OF") || skip_blanks(s)[0] == '/';
 }
 
+/* A value x of the file, scale m/s^2 per unit, finite in m/s^2 too (1e308 g
+ * is not). */
+static int finite_si(rec_reader *r, double x, double scale)
+{
+    if (isfinite(scale * x))
+        return PD_OK;
+    return pd_err_set(r->err, PD_EPARSE,
+                      "%s:%ld: acceleration %g times %g m/s^2 per unit is not a finite number",
+                      r->path, r->lineno, x, scale);
+}
+
 /* npts numbers from the following lines, times scale, into b; v2 stops at
  * the end of a V2 block. */
 static int read_values(rec_reader *r, long npts, double scale, int v2, rec_buf *b)
@@ -453,10 +467,13 @@ static int read_values(rec_reader *r, long npts, double scale, int v2, rec_buf *
         last = r->lineno;
         const char *p = r->line;
         double x;
-        while (b->n < npts && (st = scan_number(r, &p, &x)) == 1)
+        while (b->n < npts && (st = scan_number(r, &p, &x)) == 1) {
+            if ((st = finite_si(r, x, scale)) != PD_OK)
+                return st;
             if (buf_push(b, scale * x, npts) != PD_OK)
                 return pd_err_set(r->err, PD_ENOMEM, "%s: out of memory for %ld samples",
                                   r->path, npts);
+        }
         if (st < 0)
             return st;
         if (b->n == npts && scan_number(r, &p, &x) != 0)
@@ -627,7 +644,7 @@ static int text_uniform(rec_reader *r, const rec_buf *t, const long *lines, doub
         if (fabs(t->v[k] - (t->v[0] + (double)k * h)) > RECORD_TEXT_TOL * h)
             return text_where(r, t, lines, h);
     *dt = h;
-    return PD_OK;
+    return check_dt(r, lines[n - 1], h, "the time step");
 }
 
 /* Append a line number. */
@@ -678,6 +695,14 @@ static int read_text(rec_reader *r, double scale, rec_buf *b, double *dt)
             break;
         if (st == 0)
             continue;
+        if (t.n > 0 && !(tk > t.v[t.n - 1])) { /* at once: not after 10^8 samples */
+            st = pd_err_set(r->err, PD_EPARSE,
+                            "%s:%ld: the time column must increase (t = %.9g after %.9g)",
+                            r->path, r->lineno, tk, t.v[t.n - 1]);
+            break;
+        }
+        if ((st = finite_si(r, ak, scale)) != PD_OK)
+            break;
         if (t.n >= RECORD_NPTS_MAX) {
             st = pd_err_set(r->err, PD_EPARSE, "%s:%ld: more samples than the %ld read",
                             r->path, r->lineno, RECORD_NPTS_MAX);
@@ -732,8 +757,7 @@ static int detect_format(rec_reader *r, pd_record_format *f)
     }
     if (r->lineno == 0 && st == 0)
         return pd_err_set(r->err, PD_EPARSE, "%s:1: empty file: expected a record", r->path);
-    reader_rewind(r);
-    return PD_OK;
+    return reader_rewind(r);
 }
 
 /* The file's name without its folders. */

@@ -54,11 +54,17 @@
 
 /* ---- integration ------------------------------------------------------------ */
 
-/* The record holds at least two samples and a positive step. */
+/* The record holds at least two samples and a step within the readers' bounds. */
 static int record_valid(const pd_record *rec, pd_err *err)
 {
     if (!rec || !rec->acc || rec->npts < 2 || !(rec->dt > 0.0) || !isfinite(rec->dt))
         return pd_err_set(err, PD_EINVAL, "record: expected at least 2 samples and dt > 0");
+    /* the readers' bounds: beyond them the duration and the sample times
+     * overflow or underflow, and indices t / dt are no longer integers */
+    if (!(rec->dt >= PD_RECORD_DT_MIN && rec->dt <= PD_RECORD_DT_MAX) ||
+        !isfinite(pd_record_duration(rec)))
+        return pd_err_set(err, PD_EINVAL, "%s: dt = %g s: expected a sampling interval in "
+                          "[%g, %g] s", rec->name, rec->dt, PD_RECORD_DT_MIN, PD_RECORD_DT_MAX);
     return PD_OK;
 }
 

@@ -36,7 +36,7 @@ pd_run_opts pd_run_default_opts(void)
                          .no_accumulation = 0,
                          .no_wall = 0,
                          .pen = {.law = PD_PENALTY_KELVIN,
-                                 .kc_mult = 1e4,
+                                 .kc_mult = 0.0, /* derived: pd_osc_penalty, scene runs */
                                  .kc_abs = 0.0,
                                  .rtol = 1e-10,
                                  .atol = 1e-12,
@@ -66,9 +66,9 @@ int pd_run_opts_check(const pd_run_opts *o, pd_err *err)
     const pd_penalty_setup *p = &o->pen;
     if (p->law != PD_PENALTY_KELVIN && p->law != PD_PENALTY_HERTZDAMP)
         return pd_err_set(err, PD_EINVAL, "contact: unknown contact law %d", (int)p->law);
-    if (!(p->kc_mult > 0.0) || !isfinite(p->kc_mult))
-        return pd_err_set(err, PD_EINVAL, "kc: the contact stiffness multiple must be > 0 (got %g)",
-                          p->kc_mult);
+    if (!(p->kc_mult >= 0.0) || !isfinite(p->kc_mult))
+        return pd_err_set(err, PD_EINVAL, "kc: the contact stiffness multiple must be > 0, or 0 "
+                          "for the derived default (got %g)", p->kc_mult);
     if (!(p->kc_abs >= 0.0) || !isfinite(p->kc_abs))
         return pd_err_set(err, PD_EINVAL, "kc-abs: the contact stiffness must be >= 0 (got %g)",
                           p->kc_abs);

@@ -196,6 +196,16 @@ static int positive(double x)
     return x > 0.0 && isfinite(x);
 }
 
+/* The stiffness k derived from T0 and mass: a normal double > 0 (a period
+ * of 1e-300 s makes m (2 pi / T0)^2 infinite, one of 1e300 s makes it 0). */
+static int derived_stiffness(double k, double T0, double mass, pd_err *err)
+{
+    if (isnormal(k) && k > 0.0)
+        return PD_OK;
+    return pd_err_set(err, PD_EINVAL, "T0: a period of %g s with a mass of %g kg gives a "
+                      "stiffness of %g N/m, not a usable number", T0, mass, k);
+}
+
 int pd_scene_add_sdof(pd_scene *sc, const char *name, double T0, double xi, double mass,
                       pd_err *err)
 {
@@ -203,12 +213,13 @@ int pd_scene_add_sdof(pd_scene *sc, const char *name, double T0, double xi, doub
         return pd_err_set(err, PD_EINVAL, "T0: the period must be > 0 (got %g)", T0);
     if (!positive(mass))
         return pd_err_set(err, PD_EINVAL, "mass: must be > 0 (got %g)", mass);
-    pd_structure *st = new_structure(sc, name, 1, xi, err);
+    double w0 = PD_TWO_PI / T0, k = mass * w0 * w0;
+    int rc = derived_stiffness(k, T0, mass, err);
+    pd_structure *st = rc ? NULL : new_structure(sc, name, 1, xi, err);
     if (!st)
-        return err ? err->status : PD_EINVAL;
-    double w0 = PD_TWO_PI / T0;
+        return rc ? rc : err ? err->status : PD_EINVAL;
     st->mass[0] = mass;
-    st->stiffness[0] = mass * w0 * w0;
+    st->stiffness[0] = k;
     return PD_OK;
 }
 
@@ -240,11 +251,12 @@ int pd_scene_add_uniform(pd_scene *sc, const char *name, int storeys, double mas
         return pd_err_set(err, PD_EINVAL, "T0: the period must be > 0 (got %g)", T0);
     if (!positive(mass))
         return pd_err_set(err, PD_EINVAL, "mass: must be > 0 (got %g)", mass);
-    pd_structure *st = new_structure(sc, name, storeys, xi, err);
-    if (!st)
-        return err ? err->status : PD_EINVAL;
     double w1 = PD_TWO_PI / T0, s = sin(PD_PI / (2.0 * (2.0 * storeys + 1.0)));
     double k = mass * w1 * w1 / (4.0 * s * s);
+    int rc = derived_stiffness(k, T0, mass, err);
+    pd_structure *st = rc ? NULL : new_structure(sc, name, storeys, xi, err);
+    if (!st)
+        return rc ? rc : err ? err->status : PD_EINVAL;
     for (int i = 0; i < storeys; i++) {
         st->mass[i] = mass;
         st->stiffness[i] = k;
@@ -422,6 +434,12 @@ int pd_scene_finish(pd_scene *sc, pd_err *err)
         dof += sc->st[s].storeys;
         if ((rc = structure_damping(&sc->st[s], err)))
             return rc;
+        const pd_structure *st = &sc->st[s];
+        if (!positive(st->T0) || !isfinite(st->alpha) || !isfinite(st->beta))
+            return pd_err_set(err, PD_EINVAL, "structures: '%s' has a fundamental period of %g s "
+                              "and damping coefficients %g, %g: not usable numbers (masses "
+                              "and stiffnesses out of proportion?)",
+                              st->name, st->T0, st->alpha, st->beta);
     }
     sc->n = dof;
     sc->finished = 1;

@@ -17,8 +17,31 @@
 #include <jansson.h>
 
 #include "pd_problems.h"
+#include "pd_core.h"
 
 #define SCENE_FILE_MAX (256L << 20) /* largest scene file read, bytes */
+
+/* The usable ranges of a scene's values.  Structures that pound have
+ * periods of 0.1 to 10 s, pulses 0.1 to 5 s, storeys 10^4 to 10^7 kg and
+ * 10^6 to 10^10 N/m, gaps of centimetres; the ranges are wider by decades,
+ * and narrow enough that what is derived from them stays far inside the
+ * doubles: w0 = 2 pi / T0, w0^2, the stiffness m w0^2 and the ratios
+ * k / m, C = alpha M + beta K, Le = ap / wp^2 and gap / Le.  The shortest
+ * period also sets the run's cost: the default step is min(Tp, T0) / 2000,
+ * so a period of 0.01 s makes it 5 us, 2 10^5 steps a second of motion (a
+ * 1 kg storey on 6e8 N/m, T0 = 0.6 ms, asked for 10^7 steps and a hang). */
+#define SCENE_PERIOD_MIN 1e-2  /* s: T0, a building's fundamental period, Tp */
+#define SCENE_PERIOD_MAX 1e3
+#define SCENE_MASS_MIN 1e-6    /* kg, of a storey */
+#define SCENE_MASS_MAX 1e12
+#define SCENE_STIFF_MIN 1e-11  /* N/m: m w0^2 over the mass and period ranges */
+#define SCENE_STIFF_MAX 1e18
+#define SCENE_AP_MIN 1e-6      /* m/s^2 (also a record's fitted ap times its scale) */
+#define SCENE_AP_MAX 1e4       /* about 1000 g */
+#define SCENE_SCALE_MIN 1e-6   /* a record's scale */
+#define SCENE_SCALE_MAX 1e6
+#define SCENE_GAP_MAX 1e3      /* m */
+#define SCENE_TEND_MAX 1e5     /* s, about a day of motion */
 
 /* The file being read. */
 typedef struct loader {
@@ -235,6 +258,18 @@ static int get_number(loader *L, json_t *obj, const char *path, const char *key,
     return PD_OK;
 }
 
+/* A value x > 0 (what, in unit) within the usable range [lo, hi] (the
+ * SCENE_* ranges); the message names the field at path. */
+static int in_range(loader *L, const char *path, const char *what, double x, double lo,
+                    double hi, const char *unit)
+{
+    const char *sp = unit[0] ? " " : "";
+    if (!(x > 0.0) || (x >= lo && x <= hi)) /* <= 0: the builder's message */
+        return PD_OK;
+    return fail(L, path, "%s %g%s%s is outside the usable range [%g, %g]%s%s", what, x, sp, unit,
+                lo, hi, sp, unit);
+}
+
 /* A string field (required). */
 static int get_string(loader *L, json_t *obj, const char *path, const char *key,
                       const char **out)
@@ -315,6 +350,9 @@ static int read_record(loader *L, json_t *ex, pd_scene_excitation *x, pd_record 
         return rc;
     if (!(x->scale > 0.0))
         return fail(L, "excitation.scale", "must be > 0 (got %g)", x->scale);
+    if ((rc = in_range(L, "excitation.scale", "the scale", x->scale, SCENE_SCALE_MIN,
+                       SCENE_SCALE_MAX, "")))
+        return rc;
     if (pd_record_units_parse(units, &u))
         return fail(L, "excitation.units", "'%s' is not one of g, m/s2, cm/s2",
                     printable(units, name, sizeof name));
@@ -340,7 +378,16 @@ static int read_record(loader *L, json_t *ex, pd_scene_excitation *x, pd_record 
     x->rec_ap = pulse.ap;
     x->ap = x->scale * pulse.ap;
     x->Tp = pulse.Tp;
-    return PD_OK;
+    if ((rc = in_range(L, "excitation.record", "the fitted pulse's period Tp =", x->Tp,
+                       SCENE_PERIOD_MIN, SCENE_PERIOD_MAX, "s")) ||
+        (rc = in_range(L, "excitation.scale", "the fitted pulse's amplitude scale * ap =", x->ap,
+                       SCENE_AP_MIN, SCENE_AP_MAX, "m/s^2"))) {
+        pd_record_free(*rec);
+        free(*rec);
+        *rec = NULL;
+        x->record = NULL;
+    }
+    return rc;
 }
 
 static int read_excitation(loader *L, json_t *root, pd_scene_excitation *x, pd_record **rec)
@@ -379,7 +426,11 @@ static int read_excitation(loader *L, json_t *root, pd_scene_excitation *x, pd_r
         return fail(L, "excitation.ap", "the pulse amplitude must be > 0 (got %g)", x->ap);
     if (!(x->Tp > 0.0))
         return fail(L, "excitation.Tp", "the pulse period must be > 0 (got %g)", x->Tp);
-    return PD_OK;
+    if ((rc = in_range(L, "excitation.ap", "the pulse amplitude", x->ap, SCENE_AP_MIN,
+                       SCENE_AP_MAX, "m/s^2")))
+        return rc;
+    return in_range(L, "excitation.Tp", "the pulse period", x->Tp, SCENE_PERIOD_MIN,
+                    SCENE_PERIOD_MAX, "s");
 }
 
 /* The damping fields of structure s at path. */
@@ -420,6 +471,22 @@ static int read_damping(loader *L, pd_scene *sc, json_t *st, const char *path)
     return PD_OK;
 }
 
+/* Every storey's mass and stiffness of a building at path in the usable ranges. */
+static int storeys_in_range(loader *L, const char *path, int n, const double *m,
+                            const double *k)
+{
+    char at[200];
+    int rc = PD_OK;
+    for (int i = 0; i < n && !rc; i++) {
+        snprintf(at, sizeof at, "%s.masses[%d]", path, i);
+        rc = in_range(L, at, "the mass", m[i], SCENE_MASS_MIN, SCENE_MASS_MAX, "kg");
+        snprintf(at, sizeof at, "%s.stiffnesses[%d]", path, i);
+        if (!rc)
+            rc = in_range(L, at, "the stiffness", k[i], SCENE_STIFF_MIN, SCENE_STIFF_MAX, "N/m");
+    }
+    return rc;
+}
+
 /* One structure: SDOF (T0), building (masses, stiffnesses) or uniform
  * (storeys, mass, T0). */
 static int read_structure(loader *L, pd_scene *sc, json_t *st, int k)
@@ -456,7 +523,8 @@ static int read_structure(loader *L, pd_scene *sc, json_t *st, int k)
         if (nm != nk)
             rc = fail(L, field(at, sizeof at, path, "stiffnesses"),
                       "%d stiffnesses for %d masses: give one per storey", nk, nm);
-        else if (pd_scene_add_building(sc, name, nm, m, kk, xi, &e))
+        else if (!(rc = storeys_in_range(L, path, nm, m, kk)) &&
+                 pd_scene_add_building(sc, name, nm, m, kk, xi, &e))
             rc = fail_builder(L, path, &e);
         free(m);
         free(kk);
@@ -465,7 +533,11 @@ static int read_structure(loader *L, pd_scene *sc, json_t *st, int k)
     if (json_object_get(st, "stiffnesses"))
         return fail(L, path, "missing field 'masses' (one per storey)");
     if ((rc = get_number(L, st, path, "T0", 1, 0.0, &T0)) ||
-        (rc = get_number(L, st, path, "mass", 0, 1.0, &mass)))
+        (rc = get_number(L, st, path, "mass", 0, 1.0, &mass)) ||
+        (rc = in_range(L, field(at, sizeof at, path, "T0"), "the period", T0, SCENE_PERIOD_MIN,
+                       SCENE_PERIOD_MAX, "s")) ||
+        (rc = in_range(L, field(at, sizeof at, path, "mass"), "the mass", mass, SCENE_MASS_MIN,
+                       SCENE_MASS_MAX, "kg")))
         return rc;
     if (storeys) {
         if (!json_is_integer(storeys) || json_integer_value(storeys) < 1 ||
@@ -568,8 +640,10 @@ static int read_contact(loader *L, pd_scene *sc, json_t *ct, int k)
         snprintf(el, sizeof el, "%s[%d]", at, i);
         if (!json_is_number(g) || !isfinite(json_number_value(g)))
             rc = fail(L, json_is_array(gap) ? el : at, "expected a finite number");
-        else if (pd_scene_add_contact(sc, a, a == PD_WALL ? 0 : la[i], b, b == PD_WALL ? 0 : lb[i],
-                                      json_number_value(g), eps, k, &e))
+        else if (!(rc = in_range(L, json_is_array(gap) ? el : at, "the gap",
+                                 json_number_value(g), 0.0, SCENE_GAP_MAX, "m")) &&
+                 pd_scene_add_contact(sc, a, a == PD_WALL ? 0 : la[i], b,
+                                      b == PD_WALL ? 0 : lb[i], json_number_value(g), eps, k, &e))
             rc = fail_builder(L, path, &e);
     }
     free(la);
@@ -590,6 +664,19 @@ static int check_sections(loader *L, json_t *root)
     if (json_object_get(root, "description") && !json_is_string(json_object_get(root, "description")))
         return fail(L, "description", "expected a string");
     return PD_OK;
+}
+
+/* The fundamental period of structure k, once the scene is finished, in
+ * the usable range: for a building given storey by storey it comes from
+ * masses and stiffnesses together (1 kg storeys on 6e8 N/m: 0.6 ms). */
+static int check_periods(loader *L, const pd_scene *sc, json_t *st, int k)
+{
+    char path[64];
+    if (!json_object_get(st, "masses")) /* T0 given, and checked */
+        return PD_OK;
+    snprintf(path, sizeof path, "structures[%d].stiffnesses", k);
+    return in_range(L, path, "with these masses, the fundamental period", sc->st[k].T0,
+                    SCENE_PERIOD_MIN, SCENE_PERIOD_MAX, "s");
 }
 
 static int read_scene(loader *L, json_t *root, pd_scene **out)
@@ -617,12 +704,17 @@ static int read_scene(loader *L, json_t *root, pd_scene **out)
     json_t *sts = json_object_get(root, "structures"), *cts = json_object_get(root, "contacts");
     if ((rc = get_number(L, root, "", "tend", 0, 0.0, &sc->tend)) == PD_OK && sc->tend < 0.0)
         rc = fail(L, "tend", "must be > 0 (got %g)", sc->tend);
+    if (!rc && sc->tend > SCENE_TEND_MAX)
+        rc = fail(L, "tend", "%g s is outside the usable range (0, %g] s (0: derived)", sc->tend,
+                  SCENE_TEND_MAX);
     for (size_t k = 0; !rc && k < json_array_size(sts); k++)
         rc = read_structure(L, sc, json_array_get(sts, k), (int)k);
     for (size_t k = 0; !rc && cts && k < json_array_size(cts); k++)
         rc = read_contact(L, sc, json_array_get(cts, k), (int)k);
     if (!rc && pd_scene_finish(sc, &e))
         rc = fail_builder(L, "", &e);
+    for (size_t k = 0; !rc && k < json_array_size(sts); k++)
+        rc = check_periods(L, sc, json_array_get(sts, k), (int)k);
     if (rc) {
         pd_scene_free(sc);
         return rc;
@@ -631,43 +723,12 @@ static int read_scene(loader *L, json_t *root, pd_scene **out)
     return PD_OK;
 }
 
-/* The whole file, NUL-terminated. */
+/* The whole file, NUL-terminated: no NUL byte inside, at most
+ * SCENE_FILE_MAX bytes (pd_core.h). */
 static int slurp(loader *L)
 {
-    FILE *f = fopen(L->path, "rb");
-    if (!f)
-        return pd_err_set(L->err, PD_EIO, "%s: cannot open: %s", L->path, strerror(errno));
-    size_t cap = 1 << 16, n = 0;
-    char *buf = malloc(cap);
-    while (buf) {
-        n += fread(buf + n, 1, cap - n - 1, f);
-        if (n < cap - 1 || ferror(f))
-            break;
-        if ((long)cap > SCENE_FILE_MAX) {
-            free(buf);
-            fclose(f);
-            return pd_err_set(L->err, PD_EPARSE, "%s: larger than %ld MiB", L->path,
-                              SCENE_FILE_MAX >> 20);
-        }
-        char *nb = realloc(buf, 2 * cap);
-        if (!nb) {
-            free(buf);
-            buf = NULL;
-            break;
-        }
-        buf = nb;
-        cap *= 2;
-    }
-    int bad = !buf || ferror(f);
-    fclose(f);
-    if (bad) {
-        free(buf);
-        return pd_err_set(L->err, buf ? PD_EIO : PD_ENOMEM, "%s: cannot read", L->path);
-    }
-    buf[n] = '\0';
-    L->text = buf;
-    L->len = n;
-    return PD_OK;
+    return pd_text_read_all(L->path, SCENE_FILE_MAX, PD_TEXT_AT_LINE_COL, &L->text, &L->len,
+                            L->err);
 }
 
 int pd_scene_load(const char *path, pd_scene **out, pd_err *err)
@@ -679,10 +740,6 @@ int pd_scene_load(const char *path, pd_scene **out, pd_err *err)
     pd_err_clear(err);
     if ((rc = slurp(&L)))
         return rc;
-    if (memchr(L.text, '\0', L.len)) {
-        free(L.text);
-        return pd_err_set(err, PD_EPARSE, "%s: not a text file (a NUL byte)", path);
-    }
     json_t *root = json_loadb(L.text, L.len, JSON_REJECT_DUPLICATES, &je);
     if (!root) {
         char text[160];

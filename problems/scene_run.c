@@ -20,6 +20,8 @@
 
 #include "pd_problems.h"
 
+#define SCENE_PEN_KC 1e4 /* the default contact stiffness: this * the stiffest storey's */
+
 /* What a run tracks, in reference units. */
 typedef struct track {
     const pd_scene *sc;
@@ -509,7 +511,7 @@ static int run_penalty(const pd_model *md, const pd_run_opts *o, double tau_end,
     if (o->pen.kc_abs > 0.0)
         po.kc = o->pen.kc_abs * (o->pen.law == PD_PENALTY_HERTZDAMP ? sqrt(tr->Le) : 1.0) / wp2;
     else
-        po.kc = o->pen.kc_mult * stiffest(tr->sc) / wp2;
+        po.kc = (o->pen.kc_mult > 0.0 ? o->pen.kc_mult : SCENE_PEN_KC) * stiffest(tr->sc) / wp2;
     po.rtol = o->pen.rtol;
     po.atol = o->pen.atol;
     po.stepper = o->pen.stepper;

@@ -134,8 +134,9 @@ int pd_scene_sweep_run(const pd_scene_sweep *w, int threads, pd_scene_point *pts
 #ifdef _OPENMP
     int nt = threads > 0 ? threads : omp_get_max_threads();
 #else
-    int nt = 1;
+    int nt = 1; /* the pragma below is ignored without OpenMP */
     (void)threads;
+    (void)nt;
 #endif
     /* one task at a time to each thread; each writes only its own slots */
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nt)

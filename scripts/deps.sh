@@ -4,10 +4,14 @@
 # needed and fails.  Usage: scripts/deps.sh [--ci|--bench]   (--ci adds
 # CI-only tools: python3, OpenMPI for the MPI build `make MPI=1`, which the
 # quick start does not need, and Siconos numerics, which bench/siconos_lcp
-# is timed against; --bench adds Siconos numerics alone)
+# is timed against, and the stress suite's clang, LLVM OpenMP and libFuzzer;
+# --bench adds Siconos numerics alone; --stress the stress suite's tools)
 set -u
 pkgs="gcc make pkg-config libgsl-dev libsuitesparse-dev libhdf5-dev hdf5-tools libjansson-dev gnuplot-nox"
 [ "${1:-}" = "--ci" ] && pkgs="$pkgs python3 libopenmpi-dev openmpi-bin libsiconos-numerics-dev"
+stress="python3 clang libomp-dev libclang-rt-dev util-linux"
+[ "${1:-}" = "--ci" ] && pkgs="$pkgs $stress"
+[ "${1:-}" = "--stress" ] && pkgs="$pkgs $stress"
 [ "${1:-}" = "--bench" ] && pkgs="$pkgs libsiconos-numerics-dev"
 missing=""
 for p in $pkgs; do

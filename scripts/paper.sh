@@ -124,7 +124,7 @@ gnuplot <<GP
 $term
 set output '$out/paper-fig10.png'
 set multiplot layout 2,2 title 'Fig. 10: {/Symbol P}_3 = 0.05, xi = 0.05, eps from 0 to 1'
-set grid; set logscale xy; set key bottom left
+set grid; set logscale x; set key top right  # linear Pi1: on log axes the eps curves overlapped
 set xlabel '{/Symbol P}_2'; set ylabel '{/Symbol P}_1'
 do for [p in 'sine cosine'] { do for [d in 'normal reverse'] {
   set title p.', '.d

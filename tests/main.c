@@ -87,6 +87,8 @@ int main(int argc, char **argv)
     suite_record(&ctx);
     suite_ed_linear(&ctx);
     suite_records_run(&ctx);
+    suite_plots(&ctx);
+    suite_outputs(&ctx);
 
     printf("%d passed, %d failed, %d skipped\n", ctx.passed, ctx.failed, ctx.skipped);
     return ctx.failed ? 1 : 0;

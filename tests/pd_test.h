@@ -91,5 +91,7 @@ void suite_impacts(pd_test_ctx *ctx);
 void suite_record(pd_test_ctx *ctx);
 void suite_ed_linear(pd_test_ctx *ctx);
 void suite_records_run(pd_test_ctx *ctx);
+void suite_plots(pd_test_ctx *ctx);
+void suite_outputs(pd_test_ctx *ctx);
 
 #endif

@@ -64,6 +64,57 @@ static void test_cli_bad_input(pd_test_ctx *ctx)
     rmdir(dir);
 }
 
+/* Issue 11's refusals: overflowing and denormal values name the flag the
+ * user typed (not a derived one), the event-driven reference refuses a
+ * period it would take forever to scan (it hung), an empty method list is
+ * refused (it exited 0), a theta just below 1/2 is quoted as given, and
+ * control bytes from the command line never reach the terminal. */
+static void test_cli_hardening(pd_test_ctx *ctx)
+{
+    static const struct {
+        const char *args[10];
+        const char *named;
+    } cases[] = {
+        {{"simulate", "--Tp", "1e308", NULL}, "--Tp"},
+        {{"simulate", "--T0", "1e308", NULL}, "--T0"},
+        {{"simulate", "--gap", "1e308", NULL}, "--gap"},
+        {{"simulate", "--Pi2", "1e308", NULL}, "--Pi2"},
+        {{"simulate", "--Pi2", "1e308", "--dt", "0.01", "--method", "event", NULL}, "--Pi2"},
+        {{"simulate", "--Pi2", "1e8", "--dt", "0.01", "--method", "event", NULL}, "--Pi2"},
+        {{"converge", "--dt", "1e-2:1e-3:2", "--Pi2", "1e308", NULL}, "--Pi2"},
+        {{"simulate", "--ap", "4.9e-324", NULL}, "out of range"},
+        {{"simulate", "--theta", "0.4999999", NULL}, "0.4999999"},
+        {{"converge", "--dt", "1e-2:1e-3:2", "--methods", "", NULL}, "--methods"},
+        {{"compare", "--methods", ",", NULL}, "--methods"},
+        {{"simulate", "--pulse", "a\033[31mred", NULL}, "a?[31mred"},
+        /* the flag the user typed, not the one whose derived value overflowed */
+        {{"simulate", "--tend", "1e308", NULL}, "--tend"},
+        {{"simulate", "--dt", "1e308", NULL}, "--dt"},
+        {{"simulate", "--chain", "3", "--chain-ratio", "1e308", NULL}, "--chain-ratio"},
+        {{"spectrum", "--Pi2", "1e-300:1e300:2", NULL}, "--Pi2"},
+        {{"spectrum", "--Pi2", "0.5:1:2", "--gap", "1e308", NULL}, "--gap"},
+        {{"spectrum", "--Pi2", "0.5:1:2", "--dt-per-Tp", "1e308", NULL}, "--dt-per-Tp"},
+        {{"spectrum", "--Pi2", "0.5:1:2", "--tend", "1e308", NULL}, "--tend"},
+        /* the penalty's tolerances: a relative one of 1 or more is refused */
+        {{"simulate", "--method", "penalty", "--rtol", "0x10", NULL}, "--rtol"},
+        /* conflicting flags, no command */
+        {{"lcp", "x.lcp", "--all", "--index", "0", NULL}, "--index"},
+        {{NULL}, "no command"}};
+    if (!pd_test_have_pound(ctx))
+        return;
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        proc_out r;
+        pd_test_pound(ctx, cases[k].args, &r);
+        char *nl = strchr(r.err, '\n');
+        CHECK(ctx, r.status == 2 && strstr(r.err, cases[k].named) && nl && nl[1] == '\0' &&
+                       !strchr(r.err, '\033'),
+              "case %zu (%s %s): exit %d, expected 2 and one line naming '%s': %s", k,
+              cases[k].args[0] ? cases[k].args[0] : "", cases[k].args[0] ? cases[k].args[1] : "",
+              r.status, cases[k].named, r.err);
+        pd_test_proc_free(&r);
+    }
+}
+
 /* -o run.h5: datasets t, u, v, impulse, gap with units, inputs and summary
  * as attributes, read back with the HDF5 library; the JSON agrees. */
 static void test_cli_hdf5_output(pd_test_ctx *ctx)
@@ -176,10 +227,50 @@ static void test_cli_failed_run_leaves_no_file(pd_test_ctx *ctx)
     rmdir(dir);
 }
 
+/* converge's lists refuse empty elements (they were skipped: exit 0):
+ * exit 2, one line naming the flag and the list with the empty element's
+ * place, nothing on stdout. */
+static void test_cli_converge_empty_list_elements(pd_test_ctx *ctx)
+{
+    static const struct {
+        const char *flag, *list, *named;
+    } cases[] = {{"--methods", "moreau,", "element 2 of 'moreau,' is empty"},
+                 {"--methods", ",moreau", "element 1 of ',moreau' is empty"},
+                 {"--methods", "moreau,,penalty", "element 2 of 'moreau,,penalty' is empty"},
+                 {"--theta", "0.5,", "element 2 of '0.5,' is empty"},
+                 {"--theta", ",0.5", "element 1 of ',0.5' is empty"},
+                 {"--theta", "0.5,,1", "element 2 of '0.5,,1' is empty"},
+                 {"--kcs", "1e2,", "element 2 of '1e2,' is empty"},
+                 {"--kcs", "1e2,,1e3", "element 2 of '1e2,,1e3' is empty"},
+                 {"--kcs", ",", "element 1 of ',' is empty"},
+                 {"--methods", "", "--methods"},
+                 {"--theta", "", "--theta: empty list"}};
+    if (!pd_test_have_pound(ctx))
+        return;
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        const char *args[] = {"converge", "--dt", "1e-2:1e-3:2", "--methods", "moreau,penalty",
+                              cases[k].flag, cases[k].list, NULL};
+        proc_out r;
+        pd_test_pound(ctx, args, &r);
+        char *nl = strchr(r.err, '\n');
+        CHECK(ctx, r.status == 2, "%s '%s': exit %d, expected 2 (%s)", cases[k].flag,
+              cases[k].list, r.status, r.err);
+        CHECK(ctx, strstr(r.err, cases[k].flag) && strstr(r.err, cases[k].named) && nl &&
+                       nl[1] == '\0',
+              "%s '%s': one line naming '%s': %s", cases[k].flag, cases[k].list,
+              cases[k].named, r.err);
+        CHECK(ctx, r.out[0] == '\0', "%s '%s': stdout '%s'", cases[k].flag, cases[k].list,
+              r.out);
+        pd_test_proc_free(&r);
+    }
+}
+
 void suite_cli(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_cli_bad_input);
+    PD_RUN(ctx, test_cli_hardening);
     PD_RUN(ctx, test_cli_hdf5_output);
     PD_RUN(ctx, test_cli_csv_and_json);
     PD_RUN(ctx, test_cli_failed_run_leaves_no_file);
+    PD_RUN(ctx, test_cli_converge_empty_list_elements);
 }

@@ -882,6 +882,69 @@ static void test_lcp_residual_figures(pd_test_ctx *ctx)
           "scaled residuals %.17g, %.17g vs %.17g", r9, r7, residual);
 }
 
+/* A candidate with an infinity or a NaN is no answer: its residual is NaN,
+ * above every tolerance (z = (0, inf, 0) on the extreme problem of
+ * test_solvers_nonfinite_never_solved had residual 0: inf / inf). */
+static void test_lcp_residual_nonfinite(pd_test_ctx *ctx)
+{
+    double M[9] = {4e-300, 1e-300, 0.0, 1e-300, 4e-300, 1e-300, 0.0, 1e-300, 4e-300};
+    double q[3] = {-1e300, -2e300, 3e300}, w[3], comp, infeas, residual;
+    double zs[3][3] = {{0.0, INFINITY, 0.0}, {0.0, NAN, 0.0}, {-INFINITY, 0.0, 0.0}};
+    for (int k = 0; k < 3; k++) {
+        pd_lcp_residual(3, M, q, zs[k], w, &comp, &infeas, &residual);
+        CHECK(ctx, isnan(residual) && !(residual <= VERIFY_TOL),
+              "z = (%g, %g, %g): residual %g must be NaN", zs[k][0], zs[k][1], zs[k][2],
+              residual);
+    }
+    /* a finite candidate keeps a finite residual */
+    double z0[3] = {0.0, 0.0, 0.0};
+    pd_lcp_residual(3, M, q, z0, w, &comp, &infeas, &residual);
+    CHECK(ctx, residual == 1.0, "z = 0: residual %g (w_1 = -1e300 < 0)", residual);
+}
+
+/* Binary input: /dev/zero refused at its first byte (it took 2 GB before),
+ * a NUL byte named by its line; the size n followed by a mere stream of
+ * tokens is refused by the count, naming the end of the file. */
+static void test_lcp_read_bounded(pd_test_ctx *ctx)
+{
+    int n = 5;
+    double *M = NULL, *q = NULL;
+    pd_err err;
+    int st = pd_lcp_read("/dev/zero", PD_LCP_FORMAT_AUTO, &n, &M, &q, &err);
+    CHECK(ctx, st == PD_EPARSE && strstr(err.msg, "/dev/zero: line 1: not a text file (a NUL") &&
+               n == 0 && !M && !q, "/dev/zero: %d %s", st, err.msg);
+    char path[64];
+    strcpy(path, "/tmp/pound_lcp_XXXXXX");
+    int fd = mkstemp(path);
+    static const char nul[] = "2\n1 0\n0 1\0\n-1 -1\n";
+    if (!CHECK(ctx, fd >= 0 && write(fd, nul, sizeof nul - 1) == (ssize_t)(sizeof nul - 1),
+               "temporary file"))
+        return;
+    close(fd);
+    st = pd_lcp_read(path, PD_LCP_FORMAT_AUTO, &n, &M, &q, &err);
+    CHECK(ctx, st == PD_EPARSE && strstr(err.msg, path) &&
+               strstr(err.msg, ": line 3: not a text file (a NUL byte)"), "NUL: %d %s", st,
+          err.msg);
+    remove(path);
+    /* n = 46340, then 10^5 ones on 1000 lines */
+    size_t cap = 10 + 200000 + 1000;
+    char *text = malloc(cap), *p = text;
+    if (!CHECK(ctx, text != NULL, "malloc"))
+        return;
+    p += sprintf(p, "46340\n");
+    for (int line = 0; line < 1000; line++) {
+        for (int k = 0; k < 100; k++)
+            p += sprintf(p, k ? " 1" : "1");
+        *p++ = '\n';
+    }
+    *p = '\0';
+    st = read_text(text, PD_LCP_FORMAT_AUTO, &n, &M, &q, &err);
+    CHECK(ctx, st == PD_EPARSE && strstr(err.msg, "line 1001: too few values: the file ends "
+                                                   "after 100000 of the 2147441940 numbers"),
+          "stream: %d %s", st, err.msg);
+    free(text);
+}
+
 static void test_lcp_enumerate_oracle(pd_test_ctx *ctx)
 {
     /* deudeu: M = [2 1; 1 2], q = (-5, -6): z = (4/3, 7/3) */
@@ -1115,6 +1178,8 @@ void suite_lcp(pd_test_ctx *ctx)
     PD_RUN(ctx, test_lcp_invalid_arguments);
     PD_RUN(ctx, test_lcp_outcome_names);
     PD_RUN(ctx, test_lcp_residual_figures);
+    PD_RUN(ctx, test_lcp_residual_nonfinite);
+    PD_RUN(ctx, test_lcp_read_bounded);
     PD_RUN(ctx, test_lcp_enumerate_oracle);
     PD_RUN(ctx, test_lcp_read_plain);
     PD_RUN(ctx, test_lcp_read_siconos);

@@ -628,8 +628,54 @@ static void test_penalty_bad_options(pd_test_ctx *ctx)
           "%s", e.msg);
 }
 
+/* The default stiffness resolves the gap (issue 11): on a flexible
+ * oscillator under a reverse cosine pulse (Pi2 = 0.07, Pi3 = 0.077), the
+ * former default 1e4 w0^2 penetrated the wall by 40 % of the gap and missed
+ * umax by 50 %; the derived default keeps the penetration under 3 % of the
+ * gap and umax within 2 % of the exact reference. */
+static void test_penalty_default_resolves_gap(pd_test_ctx *ctx)
+{
+    pd_osc c = {.pulse = PD_PULSE_COSINE, .dir = -1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.06999172416774613,
+                .Pi3 = 0.07733297836391044, .eps = 0.7785108586766508, .xi = 0.05395511737002854};
+    pd_run_opts o = pd_run_default_opts();
+    pd_osc_result ref, pen, old;
+    pd_err err;
+    int rc = pd_osc_reference(&c, &o, NULL, NULL, &ref, &err) ||
+             pd_osc_penalty(&c, &o, NULL, NULL, &pen, &err);
+    o.pen.kc_mult = 1e4;
+    rc = rc || pd_osc_penalty(&c, &o, NULL, NULL, &old, &err);
+    if (!CHECK(ctx, rc == 0, "%s", err.msg))
+        return;
+    double gap = pd_osc_gap(&c), e = fabs(pen.umax - ref.umax) / ref.umax;
+    double e_old = fabs(old.umax - ref.umax) / ref.umax;
+    CHECK(ctx, -pen.min_gap <= 0.03 * gap && e <= 0.02 && e_old > 0.3 && -old.min_gap > 0.3 * gap,
+          "default: penetration %.3g of the gap, umax error %.3g; 1e4 w0^2: %.3g gaps, %.3g",
+          -pen.min_gap / gap, e, -old.min_gap / gap, e_old);
+}
+
+/* Loose tolerances used to switch a contact on and off at one instant for
+ * ever (rtol = 0.5 ran for hours): the run now stops with PD_ENUMERICAL
+ * after PEN_MAX_STALL steps that end where they began, naming the
+ * tolerances, while rtol = 1e-3 on the same case still runs to the end. */
+static void test_penalty_stall_reported(pd_test_ctx *ctx)
+{
+    pd_osc c = pd_osc_default();
+    pd_run_opts o = pd_run_default_opts();
+    pd_osc_result res;
+    pd_err err;
+    o.pen.rtol = 0.5;
+    int rc = pd_osc_penalty(&c, &o, NULL, NULL, &res, &err);
+    CHECK(ctx, rc == PD_ENUMERICAL && strstr(err.msg, "no progress") && strstr(err.msg, "rtol"),
+          "rtol 0.5: status %d (%s), expected PD_ENUMERICAL naming the tolerances", rc, err.msg);
+    o.pen.rtol = 1e-3;
+    rc = pd_osc_penalty(&c, &o, NULL, NULL, &res, &err);
+    CHECK(ctx, rc == PD_OK && res.impacts > 0, "rtol 1e-3: status %d (%s)", rc, err.msg);
+}
+
 void suite_penalty(pd_test_ctx *ctx)
 {
+    PD_RUN(ctx, test_penalty_stall_reported);
+    PD_RUN(ctx, test_penalty_default_resolves_gap);
     PD_RUN(ctx, test_penalty_free_flight_exact);
     PD_RUN(ctx, test_penalty_breakpoint_not_crossed);
     PD_RUN(ctx, test_penalty_first_impact_exact);

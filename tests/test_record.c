@@ -12,10 +12,15 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include "pd_lcp.h"
 #include "pd_problems.h"
 #include "pd_test.h"
+#include "pd_core.h"
 
 /* ---- helpers ---------------------------------------------------------------- */
 
@@ -523,7 +528,32 @@ static const bad_case bad_cases[] = {
      PD_RECORD_AUTO, 4, "truncated"},
     {"units.V2", "CORRECTED ACCELEROGRAM\n    2 POINTS OF ACCEL DATA EQUALLY SPACED AT  .020 SEC."
                  "  (UNITS: FURLONGS)\n   1.0   2.0\n", PD_RECORD_AUTO, 2, "units"},
-    {"noblock.V2", "CORRECTED ACCELEROGRAM\nNOTHING\n", PD_RECORD_V2, 2, "no V2 acceleration"}};
+    {"noblock.V2", "CORRECTED ACCELEROGRAM\nNOTHING\n", PD_RECORD_V2, 2, "no V2 acceleration"},
+    /* header values that break the arithmetic (SIGSEGV at DT = 1e308 before):
+     * refused where they are read, with the value */
+    {"dtbig.AT2", AT2_HEAD "NPTS=  3, DT= 1e308 SEC\n 0.1 0.2 0.3\n", PD_RECORD_AUTO, 4,
+     "DT = 1e+308 s: expected a sampling interval in [1e-06, 10] s"},
+    {"dtdenormal.AT2", AT2_HEAD "NPTS=  3, DT= 4.9e-324 SEC\n 0.1 0.2 0.3\n", PD_RECORD_AUTO, 4,
+     "DT = 4.94066e-324 s"},
+    {"dttiny.AT2", AT2_HEAD "3   1e-300   NPTS, DT\n 0.1 0.2 0.3\n", PD_RECORD_AUTO, 4,
+     "DT = 1e-300 s"},
+    {"dtlong.AT2", AT2_HEAD "NPTS=  3, DT= 10.5 SEC\n 0.1 0.2 0.3\n", PD_RECORD_AUTO, 4,
+     "DT = 10.5 s"},
+    {"dtbig.V2", "CORRECTED ACCELEROGRAM\n    2 POINTS OF ACCEL DATA EQUALLY SPACED AT  1e308 "
+                 "SEC.  (UNITS: CM/SEC/SEC)\n   1.0   2.0\n", PD_RECORD_AUTO, 2,
+     "DT = 1e+308 s"},
+    {"dttiny.V2", "CORRECTED ACCELEROGRAM\nX\n    2 POINTS OF ACCEL DATA EQUALLY SPACED AT  "
+                  "1e-300 SEC.  (UNITS: G)\n   1.0   2.0\n", PD_RECORD_AUTO, 3, "DT = 1e-300 s"},
+    {"tinystep.txt", "# t a\n0 1\n1e-300 2\n2e-300 3\n", PD_RECORD_AUTO, 4,
+     "the time step = 1e-300 s"},
+    {"bigstep.txt", "0 1\n1e300 2\n2e300 3\n", PD_RECORD_AUTO, 3, "the time step = 1e+300 s"},
+    {"infstep.txt", "-1e308 1\n1e308 2\n", PD_RECORD_AUTO, 2, "the time step = inf s"},
+    {"repeatfast.txt", "0 1\n0.01 2\n0.01 3\n0.02 4\n0.03 5\n", PD_RECORD_TEXT, 3,
+     "must increase"},
+    {"accinf.txt", "0 1\n0.01 1e308\n0.02 0\n", PD_RECORD_AUTO, 2,
+     "acceleration 1e+308 times 9.80665 m/s^2 per unit is not a finite number"},
+    {"accinf.AT2", AT2_HEAD "NPTS=  3, DT= .0100 SEC\n 0.1 -1e308 0.3\n", PD_RECORD_AUTO, 5,
+     "not a finite number"}};
 
 /* Every malformed file: PD_EPARSE, one message naming FILE:LINE and what
  * was expected, and an empty record. */
@@ -809,6 +839,137 @@ static void test_record_fit_nothing(pd_test_ctx *ctx)
     pd_record_free(&r);
 }
 
+/* A record with dt = 1e308 built by hand (the readers refuse it): the
+ * measures and the fit refuse it too, where the fit's index arithmetic
+ * overflowed (SIGSEGV) before; dt = 10 s, the largest read, is measured. */
+static void test_record_fit_bad_dt(pd_test_ctx *ctx)
+{
+    pd_record r = make_record(400, 1e308);
+    pd_record_pulse p;
+    pd_record_measures m;
+    pd_err err = {0};
+    if (!CHECK(ctx, r.acc != NULL, "calloc"))
+        return;
+    for (long k = 0; k < r.npts; k++)
+        r.acc[k] = sin(PD_TWO_PI * (double)k / 80.0);
+    const double dts[] = {1e308, 4.9e-324, 1e-300, 10.5};
+    for (int i = 0; i < 4; i++) {
+        r.dt = dts[i];
+        int st = pd_record_fit_pulse(&r, &p, &err);
+        CHECK(ctx, st == PD_EINVAL && strstr(err.msg, "synthetic: dt = ") &&
+                   strstr(err.msg, "sampling interval"), "fit, dt = %g: %d %s", dts[i], st,
+              err.msg);
+        st = pd_record_measure(&r, &m, &err);
+        CHECK(ctx, st == PD_EINVAL, "measures, dt = %g: %d %s", dts[i], st, err.msg);
+    }
+    r.dt = PD_RECORD_DT_MAX;
+    int st = pd_record_measure(&r, &m, &err);
+    CHECK(ctx, st == PD_OK && m.pga == 1.0, "dt = 10 s: %d %s, pga %g", st, err.msg, m.pga);
+    pd_record_free(&r);
+}
+
+/* Run fn in a child under an address-space limit of `mb` MiB (none under
+ * AddressSanitizer, which reserves terabytes): its exit status, or -1. */
+static int limited_child(int (*fn)(void), long mb)
+{
+    pid_t pid = fork();
+    if (pid == 0) {
+#ifndef __SANITIZE_ADDRESS__
+        struct rlimit rl = {.rlim_cur = (rlim_t)mb << 20, .rlim_max = (rlim_t)mb << 20};
+        setrlimit(RLIMIT_AS, &rl);
+#else
+        (void)mb;
+#endif
+        _exit(fn());
+    }
+    int status = 0;
+    if (pid < 0 || waitpid(pid, &status, 0) != pid || !WIFEXITED(status))
+        return -1;
+    return WEXITSTATUS(status);
+}
+
+/* /dev/zero through every record reader: 0 when each refuses it as binary
+ * data at its first byte, 1 + the format otherwise (the memory ran out:
+ * PD_ENOMEM, or a failed read taken for the end of the file). */
+static int zero_records(void)
+{
+    const pd_record_format f[] = {PD_RECORD_AUTO, PD_RECORD_AT2, PD_RECORD_V2, PD_RECORD_TEXT};
+    for (int i = 0; i < 4; i++) {
+        pd_record r;
+        pd_err err;
+        if (pd_record_read("/dev/zero", f[i], PD_UNITS_G, &r, &err) != PD_EPARSE ||
+            !strstr(err.msg, "/dev/zero:1: not a text file (a NUL byte)"))
+            return 1 + i;
+    }
+    return 0;
+}
+
+/* Endless or binary input in bounded memory: /dev/zero is refused at its
+ * first byte ("/dev/zero:1: ... NUL"), also in a child limited to 256 MiB
+ * of address space (it took 2 GB before); a NUL byte names its line. */
+static void test_record_bounded_input(pd_test_ctx *ctx)
+{
+    pd_record r = {0};
+    pd_err err = {0};
+    int st = pd_record_read("/dev/zero", PD_RECORD_TEXT, PD_UNITS_G, &r, &err);
+    CHECK(ctx, st == PD_EPARSE && strstr(err.msg, "/dev/zero:1: ") && strstr(err.msg, "NUL") &&
+               r.acc == NULL, "/dev/zero: %d %s", st, err.msg);
+    int rc = limited_child(zero_records, 256);
+    CHECK(ctx, rc == 0, "/dev/zero under 256 MiB: child status %d (format %d ran out)", rc,
+          rc - 1);
+    char dir[] = "/tmp/pd_recordXXXXXX", path[512];
+    if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
+        return;
+    static const char at2[] = AT2_HEAD "NPTS=  4, DT= .0100 SEC\n 0.1 0.2\n 0.3\0 0.4\n";
+    st = read_body(dir, "nul.AT2", at2, sizeof at2 - 1, PD_RECORD_AUTO, PD_UNITS_G, &r, &err,
+                   path, sizeof path);
+    CHECK(ctx, st == PD_EPARSE && names_line(err.msg, path, 6) && strstr(err.msg, "NUL"),
+          "NUL on line 6: %d %s", st, err.msg);
+    pd_record_free(&r);
+    pd_test_rm_dir(dir);
+}
+
+/* The shared bounded reader (core/pd_core.h) under small caps: the file
+ * cap and a NUL byte named at their line (and column), in each style. */
+static void test_record_text_reader_caps(pd_test_ctx *ctx)
+{
+    char dir[] = "/tmp/pd_recordXXXXXX", path[512], want[600];
+    if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
+        return;
+    static const char body[] = "0 1\n0.01 2\n0.02 3\n0.03 4\n"; /* 4 lines, 25 bytes */
+    write_file(dir, "four.txt", body, sizeof body - 1, path, sizeof path);
+    char *text = NULL;
+    size_t len = 0;
+    pd_err err = {0};
+    int st = pd_text_read_all(path, 25, PD_TEXT_AT_WORD, &text, &len, &err);
+    CHECK(ctx, st == PD_OK && len == 25 && text && !strcmp(text, body), "25 bytes, cap 25: %d %s",
+          st, err.msg);
+    free(text);
+    st = pd_text_read_all(path, 20, PD_TEXT_AT_WORD, &text, &len, &err);
+    snprintf(want, sizeof want, "%s: line 4: the file is larger than 20 bytes", path);
+    CHECK(ctx, st == PD_EPARSE && text == NULL && strstr(err.msg, want), "cap 20: %d %s", st,
+          err.msg);
+    pd_text t;
+    int lines = 0;
+    st = pd_text_open(&t, path, 20, PD_TEXT_AT_LINE, &err);
+    if (st == PD_OK)
+        while ((st = pd_text_line(&t)) == 1)
+            lines++;
+    snprintf(want, sizeof want, "%s:4: the file is larger than 20 bytes", path);
+    CHECK(ctx, lines == 3 && st == PD_EPARSE && strstr(err.msg, want), "lines, cap 20: %d lines, "
+          "%d %s", lines, st, err.msg);
+    CHECK(ctx, pd_text_rewind(&t) == PD_OK && pd_text_line(&t) == 1 && t.lineno == 1 &&
+               !strcmp(t.line, "0 1\n"), "rewound: line %ld '%s'", t.lineno, t.line);
+    pd_text_close(&t);
+    static const char nul[] = "{\n  \"a\": 1,\n  \"b\0\": 2\n}\n";
+    write_file(dir, "nul.json", nul, sizeof nul - 1, path, sizeof path);
+    st = pd_text_read_all(path, 1L << 20, PD_TEXT_AT_LINE_COL, &text, &len, &err);
+    snprintf(want, sizeof want, "%s:3:5: not a text file (a NUL byte)", path);
+    CHECK(ctx, st == PD_EPARSE && text == NULL && strstr(err.msg, want), "NUL at 3:5: %d %s", st,
+          err.msg);
+    pd_test_rm_dir(dir);
+}
+
 void suite_record(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_record_read_shared);
@@ -831,4 +992,7 @@ void suite_record(pd_test_ctx *ctx)
     PD_RUN(ctx, test_record_fit_all);
     PD_RUN(ctx, test_record_fit_shape);
     PD_RUN(ctx, test_record_fit_nothing);
+    PD_RUN(ctx, test_record_fit_bad_dt);
+    PD_RUN(ctx, test_record_bounded_input);
+    PD_RUN(ctx, test_record_text_reader_caps);
 }

@@ -611,6 +611,144 @@ static void test_scene_cli_bad_files(pd_test_ctx *ctx)
     pd_test_rm_dir(dir);
 }
 
+/* A scene from the template below with one value replaced. */
+typedef struct range_case {
+    const char *ap, *Tp, *T0, *mass, *masses, *stiff, *gap, *tend;
+    int line;           /* the line the message names, 0: loads */
+    const char *needle; /* the text at the message's column on that line */
+    const char *says;   /* field and phrase of the message */
+} range_case;
+
+/* The scene of c (text) written to dir/range.json (path). */
+static void range_scene(const char *dir, const range_case *c, char *text, size_t cap,
+                        char *path, size_t pcap)
+{
+    snprintf(text, cap,
+             "{\n"
+             "\"excitation\": {\"pulse\": \"sine\", \"ap\": %s, \"Tp\": %s},\n"
+             "\"structures\": [\n"
+             "{\"name\": \"A\", \"T0\": %s, \"mass\": %s},\n"
+             "{\"name\": \"B\", \"masses\": %s, \"stiffnesses\": %s}\n"
+             "],\n"
+             "\"contacts\": [{\"a\": \"A\", \"b\": \"B\", \"gap\": %s, \"eps\": 0.5}],\n"
+             "\"tend\": %s\n"
+             "}\n",
+             c->ap ? c->ap : "4", c->Tp ? c->Tp : "0.3", c->T0 ? c->T0 : "0.5",
+             c->mass ? c->mass : "1e5", c->masses ? c->masses : "[2e5, 2e5]",
+             c->stiff ? c->stiff : "[3e8, 3e8]", c->gap ? c->gap : "0.02",
+             c->tend ? c->tend : "2");
+    scratch(dir, "range.json", text, path, pcap);
+}
+
+/* Values whose derived quantities leave the doubles (w0 = 2 pi / T0, m w0^2,
+ * k / m, Le = ap / wp^2, gap / Le, tend / dt) are refused by the reader
+ * naming FILE:LINE:COL and the field (they were refused later as
+ * "dt: tend / dt = inf steps is too many", "model: C has a non-finite
+ * entry", or accepted), and the 1 kg storeys on 6e8 N/m that hung a run
+ * for 10^7 steps are refused by their fundamental period; values at the
+ * ends of the ranges load. */
+static void test_scene_values_in_range(pd_test_ctx *ctx)
+{
+    char dir[] = "/tmp/pd_sceneXXXXXX";
+    if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
+        return;
+    static const range_case cases[] = {
+        {.ap = "4.9e-324", .line = 2, .needle = "4.9e-324", .says = "excitation.ap: the pulse "
+         "amplitude 4.94066e-324 m/s^2 is outside the usable range [1e-06, 10000] m/s^2"},
+        {.ap = "1e308", .line = 2, .needle = "1e308", .says = "excitation.ap:"},
+        {.Tp = "1e308", .line = 2, .needle = "1e308", .says = "excitation.Tp: the pulse period "
+         "1e+308 s is outside the usable range [0.01, 1000] s"},
+        {.Tp = "4.9e-324", .line = 2, .needle = "4.9e-324", .says = "excitation.Tp:"},
+        {.T0 = "4.9e-324", .line = 4, .needle = "4.9e-324", .says = "structures[0].T0: the period"},
+        {.T0 = "1e308", .line = 4, .needle = "1e308", .says = "structures[0].T0:"},
+        {.mass = "1e308", .line = 4, .needle = "1e308", .says = "structures[0].mass: the mass "
+         "1e+308 kg is outside"},
+        {.mass = "4.9e-324", .line = 4, .needle = "4.9e-324", .says = "structures[0].mass:"},
+        {.masses = "[2e5, 1e308]", .line = 5, .needle = "1e308", .says = "structures[1].masses[1]"},
+        {.stiff = "[1e308, 3e8]", .line = 5, .needle = "1e308",
+         .says = "structures[1].stiffnesses[0]: the stiffness 1e+308 N/m"},
+        {.stiff = "[3e8, 4.9e-324]", .line = 5, .needle = "4.9e-324",
+         .says = "structures[1].stiffnesses[1]"},
+        {.masses = "[1, 1]", .stiff = "[6e8, 5e8]", .line = 5, .needle = "[6e8",
+         .says = "structures[1].stiffnesses: with these masses, the fundamental period 0.000"},
+        {.gap = "1e308", .line = 7, .needle = "1e308", .says = "contacts[0].gap: the gap 1e+308 m"},
+        {.tend = "1e308", .line = 8, .needle = "1e308", .says = "tend: 1e+308 s is outside"},
+        {.T0 = "0.01", .Tp = "1000", .ap = "1e-6", .mass = "1e12", .gap = "1000", .tend = "1e5"},
+        {.T0 = "1000", .Tp = "0.01", .ap = "1e4", .mass = "1e-6", .gap = "0"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        const range_case *c = &cases[k];
+        char text[1024], path[256], want[600];
+        range_scene(dir, c, text, sizeof text, path, sizeof path);
+        pd_scene *sc = NULL;
+        pd_err e = {0};
+        int st = pd_scene_load(path, &sc, &e);
+        if (!c->line) {
+            CHECK(ctx, st == PD_OK && sc, "case %zu loads: %s", k, e.msg);
+            pd_scene_free(sc);
+            continue;
+        }
+        const char *line = text; /* the column: where needle stands on its line */
+        for (int l = 1; l < c->line; l++)
+            line = strchr(line, '\n') + 1;
+        const char *at = strstr(line, c->needle);
+        snprintf(want, sizeof want, "%s:%d:%d: %s", path, c->line, (int)(at - line) + 1, c->says);
+        CHECK(ctx, st == PD_EPARSE && !sc && strstr(e.msg, want) && !strchr(e.msg, '\n'),
+              "case %zu: %d '%s', expected '%s'", k, st, e.msg, want);
+    }
+    pd_test_rm_dir(dir);
+}
+
+/* The builder (no file): a period whose stiffness m (2 pi / T0)^2 is
+ * infinite or zero is refused naming T0, not carried into the model. */
+static void test_scene_builder_derived_finite(pd_test_ctx *ctx)
+{
+    pd_scene_excitation x = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 4.0, .Tp = 0.3};
+    const double T0s[] = {1e-300, 1e300, 4.9e-324};
+    for (int k = 0; k < 3; k++) {
+        pd_scene *sc = pd_scene_new(&x);
+        pd_err e = {0};
+        if (!CHECK(ctx, sc != NULL, "pd_scene_new"))
+            return;
+        int st = pd_scene_add_sdof(sc, "A", T0s[k], 0.05, 1.0, &e);
+        int st2 = pd_scene_add_uniform(sc, "B", 3, 1.0, T0s[k], 0.05, &e);
+        CHECK(ctx, st == PD_EINVAL && st2 == PD_EINVAL && !strncmp(e.msg, "T0: a period of", 15) &&
+                   sc->nstruct == 0, "T0 = %g: %d %d %s", T0s[k], st, st2, e.msg);
+        pd_scene_free(sc);
+    }
+}
+
+/* Binary input: /dev/zero as the scene or as its record, and a NUL byte,
+ * refused at the byte with its line and column (the scene reader read 256
+ * MiB of /dev/zero, the record reader 2 GB, before). */
+static void test_scene_binary_input(pd_test_ctx *ctx)
+{
+    pd_scene *sc = NULL;
+    pd_err e = {0};
+    int st = pd_scene_load("/dev/zero", &sc, &e);
+    CHECK(ctx, st == PD_EPARSE && strstr(e.msg, "/dev/zero:1:1: not a text file (a NUL byte)"),
+          "/dev/zero: %d %s", st, e.msg);
+    char dir[] = "/tmp/pd_sceneXXXXXX", path[256], want[400];
+    if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
+        return;
+    scratch(dir, "zero.json", "{\n\"excitation\": {\"record\": \"/dev/zero\"},\n"
+            "\"structures\": [{\"name\": \"A\", \"T0\": 0.5}]\n}\n", path, sizeof path);
+    st = pd_scene_load(path, &sc, &e);
+    snprintf(want, sizeof want, "%s:2:26: excitation.record: /dev/zero:1: not a text file", path);
+    CHECK(ctx, st == PD_EPARSE && strstr(e.msg, want), "record /dev/zero: %d %s", st, e.msg);
+    snprintf(path, sizeof path, "%s/nul.json", dir);
+    FILE *f = fopen(path, "wb");
+    static const char nul[] = "{\n\"tend\": 1,\n  \"x\0\": 2\n}\n";
+    if (CHECK(ctx, f != NULL, "write %s", path)) {
+        fwrite(nul, 1, sizeof nul - 1, f);
+        fclose(f);
+        st = pd_scene_load(path, &sc, &e);
+        snprintf(want, sizeof want, "%s:3:5: not a text file (a NUL byte)", path);
+        CHECK(ctx, st == PD_EPARSE && strstr(e.msg, want), "NUL: %d %s", st, e.msg);
+    }
+    pd_test_rm_dir(dir);
+}
+
 /* `simulate --scene -o F.h5` streams groups per structure and contact with
  * units; CSV has a row per step; --plot draws. */
 static void test_scene_cli_outputs(pd_test_ctx *ctx)
@@ -752,4 +890,7 @@ void suite_scene(pd_test_ctx *ctx)
     PD_RUN(ctx, test_scene_cli_bad_files);
     PD_RUN(ctx, test_scene_cli_outputs);
     PD_RUN(ctx, test_scene_cli_spectrum);
+    PD_RUN(ctx, test_scene_values_in_range);
+    PD_RUN(ctx, test_scene_builder_derived_finite);
+    PD_RUN(ctx, test_scene_binary_input);
 }

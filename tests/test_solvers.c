@@ -5,6 +5,7 @@
  * solver, and the engine's answers independent of the solver. */
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -423,6 +424,64 @@ static void test_solvers_dump_resolved(pd_test_ctx *ctx)
     pd_test_rm_dir(dir);
 }
 
+/* q huge and M tiny (stress corpus extreme-q-huge-M-tiny): M = 1e-300
+ * tridiag(1, 4, 1), q = (-1e300, -2e300, 3e300), whose solution z ~ 1e600
+ * has no double.  The structured solver reported it solved with z_2 = inf
+ * (inf / inf passed the residual as 0): no solver may call it solved, dense
+ * or sparse, and whatever is called solved anywhere must be finite. */
+static void test_solvers_nonfinite_never_solved(pd_test_ctx *ctx)
+{
+    double M[9] = {4e-300, 1e-300, 0.0, 1e-300, 4e-300, 1e-300, 0.0, 1e-300, 4e-300};
+    double q[3] = {-1e300, -2e300, 3e300}, z[3], w[3];
+    int colptr[4] = {0, 2, 5, 7}, rowind[7] = {0, 1, 0, 1, 2, 1, 2};
+    double vals[7] = {4e-300, 1e-300, 1e-300, 4e-300, 1e-300, 1e-300, 4e-300};
+    const pd_matrix views[2] = {pd_matrix_dense(3, 3, M), pd_matrix_csc(3, 3, colptr, rowind, vals)};
+    const pd_lcp_method methods[] = {PD_LCP_AUTO, PD_LCP_LEMKE, PD_LCP_STRUCTURED, PD_LCP_PGS};
+    for (int v = 0; v < 2; v++)
+        for (int k = 0; k < 4; k++) {
+            pd_lcp_info info;
+            int rc = solve_with(methods[k], &views[v], q, NULL, z, w, &info);
+            int finite = 1;
+            for (int i = 0; i < 3; i++)
+                finite &= isfinite(z[i]) && isfinite(w[i]);
+            CHECK(ctx, rc != PD_OK && info.outcome != PD_LCP_SOLVED,
+                  "%s (%s): status %d, outcome %s, z = (%g, %g, %g), residual %g",
+                  pd_lcp_method_name(methods[k]), v ? "csc" : "dense", rc,
+                  pd_lcp_outcome_name(info.outcome), z[0], z[1], z[2], info.residual);
+            CHECK(ctx, info.outcome != PD_LCP_SOLVED || finite, "%s: solved with a non-finite z",
+                  pd_lcp_method_name(methods[k]));
+        }
+}
+
+/* The same problem from a file through `pound lcp --solver structured`: a
+ * status other than solved on stdout, exit 1 (it was "solved", exit 0). */
+static void test_solvers_nonfinite_cli(pd_test_ctx *ctx)
+{
+    if (!pd_test_have_pound(ctx))
+        return;
+    char dir[] = "/tmp/pd_lcpXXXXXX", path[256];
+    if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
+        return;
+    snprintf(path, sizeof path, "%s/extreme.lcp", dir);
+    FILE *f = fopen(path, "w");
+    if (!CHECK(ctx, f != NULL, "write %s", path))
+        return;
+    fputs("3\n4e-300 1e-300 0.0\n1e-300 4e-300 1e-300\n0.0 1e-300 4e-300\n"
+          "-1e+300 -2e+300 3e+300\n", f);
+    fclose(f);
+    const char *solvers[] = {"structured", "auto", "lemke", "pgs"};
+    for (int k = 0; k < 4; k++) {
+        const char *a[] = {"lcp", path, "--json", "--solver", solvers[k], NULL};
+        proc_out r;
+        pd_test_pound(ctx, a, &r);
+        CHECK(ctx, r.status == 1 && r.out && strstr(r.out, "\"status\":\"") &&
+                   !strstr(r.out, "\"status\":\"solved\"") && !strstr(r.out, "null"),
+              "%s: exit %d: %s", solvers[k], r.status, r.out ? r.out : "");
+        pd_test_proc_free(&r);
+    }
+    pd_test_rm_dir(dir);
+}
+
 void suite_solvers(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_solvers_match_oracle);
@@ -433,4 +492,6 @@ void suite_solvers(pd_test_ctx *ctx)
     PD_RUN(ctx, test_solvers_pgs_honest);
     PD_RUN(ctx, test_solvers_engine_independent);
     PD_RUN(ctx, test_solvers_dump_resolved);
+    PD_RUN(ctx, test_solvers_nonfinite_never_solved);
+    PD_RUN(ctx, test_solvers_nonfinite_cli);
 }
