@@ -9,6 +9,13 @@
 #                 files, full disks, signals, hangs, libFuzzer, TSan;
 #                 STRESS_ARGS="--report docs/reliability.md" rewrites its table
 #   make all      library and binary only (build/libpound.a, build/pound)
+#   make install  PREFIX=/usr/local DESTDIR=: bin/pound, lib/libpound.so.0 and
+#                 libpound.a, include/pound/, lib/pkgconfig/pound.pc, the man
+#                 page and the bash completion (docs/api.md); make uninstall
+#   make install-check  the examples/api/ programs built against an installed
+#                 copy (scripts/api-check.sh; part of make check)
+#   make formats-check  every output file read back with h5py (docs/formats.md)
+#   make python-check   the Python package (python/) tested against the CLI
 #   make MPI=1    the MPI build (OpenMPI's mpicc, -DPD_MPI) in build-mpi/:
 #                 mpirun -np K build-mpi/pound spectrum ...
 #   make OPENMP=  without OpenMP (spectrum then runs one thread)
@@ -54,7 +61,35 @@ CLI_OBJ  = $(CLI_SRC:%.c=$(BUILD)/%.o)
 TEST_OBJ = $(TEST_SRC:%.c=$(BUILD)/%.o)
 HDRS     = $(wildcard */*.h)
 
-.PHONY: all deps demo test check asan bench clean acceptance figures paper stress print-libs
+# The installed library: libpound.so from -fPIC objects of their own
+# ($(BUILD)/pic/) compiled with hidden visibility, so that only the PD_API
+# declarations of the public headers are exported; the static library and
+# the binaries are built as before.  The library needs GSL, jansson,
+# CHOLMOD, CXSparse, libm and OpenMP; HDF5 is the command line's only.
+VERSION    := $(shell sed -n 's/^\#define PD_VERSION "\(.*\)"/\1/p' core/pd_core.h)
+SOMAJOR    := $(firstword $(subst ., ,$(VERSION)))
+SONAME      = libpound.so.$(SOMAJOR)
+SOREAL      = libpound.so.$(VERSION)
+PREFIX     ?= /usr/local
+DESTDIR    ?=
+bindir     ?= $(PREFIX)/bin
+libdir     ?= $(PREFIX)/lib
+includedir ?= $(PREFIX)/include
+mandir     ?= $(PREFIX)/share/man
+bashcompdir ?= $(PREFIX)/share/bash-completion/completions
+PUB_HDRS    = include/pound/pound.h core/pd_core.h lcp/pd_lcp.h engine/pd_engine.h \
+              problems/pd_problems.h
+PIC_OBJ     = $(LIB_SRC:%.c=$(BUILD)/pic/%.o)
+SS_PC      := $(shell pkg-config --exists cholmod cxsparse 2>/dev/null && echo cholmod cxsparse)
+SO_LIBS    := $(shell pkg-config --libs gsl jansson 2>/dev/null) $(SS_LIBS) -lm
+INSTALLED   = $(bindir)/pound $(libdir)/libpound.a $(libdir)/$(SOREAL) $(libdir)/$(SONAME) \
+              $(libdir)/libpound.so $(addprefix $(includedir)/pound/,$(notdir $(PUB_HDRS))) \
+              $(libdir)/pkgconfig/pound.pc $(mandir)/man1/pound.1 $(bashcompdir)/pound
+# make check ends with scripts/api-check.sh (not under the sanitizers)
+API_CHECK  ?= 1
+
+.PHONY: all deps demo test check asan bench clean acceptance figures paper stress print-libs \
+        shared install uninstall install-check formats-check python-check
 
 all: $(BUILD)/pound $(BUILD)/pound_tests
 
@@ -66,6 +101,23 @@ $(BUILD)/%.o: %.c $(HDRS)
 $(BUILD)/libpound.a: $(LIB_OBJ)
 	@echo "  AR    $@"
 	@rm -f $@ && $(AR) rcs $@ $^
+
+$(BUILD)/pic/%.o: %.c $(HDRS)
+	@mkdir -p $(dir $@)
+	@echo "  CC    $< (pic)"
+	@$(CC) $(ALL_CFLAGS) -fPIC -fvisibility=hidden -c $< -o $@
+
+# The version script keeps what the compiler exports whatever the
+# visibility (OpenMP's named critical sections) local: pd_* only.
+$(BUILD)/$(SOREAL): $(PIC_OBJ)
+	@echo "  LD    $@"
+	@printf '{\n  global: pd_*;\n  local: *;\n};\n' > $(BUILD)/pic/libpound.map
+	@$(CC) -shared -Wl,-soname,$(SONAME) -Wl,-z,defs -Wl,--as-needed \
+	    -Wl,--version-script,$(BUILD)/pic/libpound.map $(CFLAGS) $(OPENMP) $(XCFLAGS) \
+	    -o $@ $(PIC_OBJ) $(SO_LIBS)
+	@ln -sf $(SOREAL) $(BUILD)/$(SONAME) && ln -sf $(SONAME) $(BUILD)/libpound.so
+
+shared: $(BUILD)/$(SOREAL)
 
 $(BUILD)/pound: $(CLI_OBJ) $(BUILD)/libpound.a
 	@echo "  LD    $@"
@@ -90,9 +142,24 @@ test: deps
 
 check: all
 	$(BUILD)/pound_tests --pound $(BUILD)/pound
+	@$(if $(API_CHECK),$(MAKE) --no-print-directory install-check)
+	@$(if $(API_CHECK),$(MAKE) --no-print-directory formats-check)
+
+# Every output file read back with h5py against docs/formats.md (Debian's
+# python3-h5py; skipped without it: scripts/deps.sh --python installs it).
+formats-check: all
+	@if /usr/bin/python3 -c 'import h5py, numpy' 2>/dev/null; then \
+	  /usr/bin/python3 tests/formats_check.py $(BUILD)/pound; \
+	else echo "formats: skipped (python3-h5py not installed; scripts/deps.sh --python)"; fi
+
+# The Python package (python/): built against this tree, installed offline
+# into a temporary venv, tested with pytest (bit-identical to the CLI).
+python-check: deps
+	@sh scripts/deps.sh --python
+	PY_BUILD=$(BUILD) sh python/check.sh
 
 asan: deps
-	@$(MAKE) --no-print-directory BUILD=build-asan OPT=-O1 \
+	@$(MAKE) --no-print-directory BUILD=build-asan OPT=-O1 API_CHECK= \
 	  XCFLAGS="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer" check
 
 # pound's own figures, then pound paired against Siconos numerics (when it
@@ -120,6 +187,37 @@ stress: deps
 	@sh scripts/deps.sh --stress
 	@$(MAKE) --no-print-directory all
 	sh scripts/stress.sh $(BUILD) $(STRESS_ARGS)
+
+# Everything install puts, under DESTDIR (staging) and PREFIX; uninstall
+# removes exactly that (and include/pound/ when empty).
+install: $(BUILD)/pound $(BUILD)/libpound.a $(BUILD)/$(SOREAL)
+	install -d $(DESTDIR)$(bindir) $(DESTDIR)$(libdir)/pkgconfig $(DESTDIR)$(includedir)/pound \
+	    $(DESTDIR)$(mandir)/man1 $(DESTDIR)$(bashcompdir)
+	install -m 755 $(BUILD)/pound $(DESTDIR)$(bindir)/pound
+	install -m 644 $(BUILD)/libpound.a $(DESTDIR)$(libdir)/libpound.a
+	install -m 755 $(BUILD)/$(SOREAL) $(DESTDIR)$(libdir)/$(SOREAL)
+	ln -sf $(SOREAL) $(DESTDIR)$(libdir)/$(SONAME)
+	ln -sf $(SONAME) $(DESTDIR)$(libdir)/libpound.so
+	install -m 644 $(PUB_HDRS) $(DESTDIR)$(includedir)/pound/
+	printf '%s\n' 'prefix=$(PREFIX)' 'libdir=$(patsubst $(PREFIX)%,$${prefix}%,$(libdir))' \
+	    'includedir=$(patsubst $(PREFIX)%,$${prefix}%,$(includedir))' '' 'Name: pound' \
+	    'Description: nonsmooth dynamics of pounding structures (Moreau-Jean, event-driven, penalty; LCP solvers)' \
+	    'Version: $(VERSION)' 'Requires.private: $(strip gsl jansson $(SS_PC))' \
+	    'Cflags: -I$${includedir}' 'Libs: -L$${libdir} -lpound' \
+	    'Libs.private: $(if $(SS_PC),,-lcholmod -lcxsparse )-lm $(OPENMP)' \
+	    > $(DESTDIR)$(libdir)/pkgconfig/pound.pc
+	install -m 644 docs/pound.1 $(DESTDIR)$(mandir)/man1/pound.1
+	install -m 644 scripts/pound.bash-completion $(DESTDIR)$(bashcompdir)/pound
+	@if [ -z "$(DESTDIR)" ] && [ "$$(id -u)" = 0 ] && command -v ldconfig >/dev/null; then \
+	    ldconfig; fi
+
+uninstall:
+	rm -f $(addprefix $(DESTDIR),$(INSTALLED))
+	@rmdir $(DESTDIR)$(includedir)/pound 2>/dev/null || true
+
+# The examples/api/ programs against a staged install (scripts/api-check.sh).
+install-check: all $(BUILD)/$(SOREAL)
+	@MAKE='$(MAKE)' sh scripts/api-check.sh $(BUILD)
 
 print-libs:
 	@echo $(LIBS)

@@ -514,37 +514,60 @@ static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int
     return rc ? rc : pd_plot(work_png, &c2, err);
 }
 
-/* The table as CSV or HDF5 columns; the method is a coded column: its name
- * in the CSV ("moreau", "penalty"), its pd_method code in the HDF5 file
- * with a "codes" attribute naming them. */
-static int write_rows(const conv_args *a, const row *rows, int n, pd_err *err)
+/* The table as CSV or HDF5 columns (docs/formats.md, PD_FORMAT_CONVERGE);
+ * the method is a coded column: its name in the CSV ("moreau", "penalty"),
+ * its pd_method code in the HDF5 file with a "codes" attribute naming them.
+ * The case as attributes: the oscillator's, or the scene's excitation. */
+static int write_rows(const conv_args *a, const measurer *M, const row *rows, int n,
+                      double ref_cpu, pd_err *err)
 {
-    static double col[9][MAX_ROWS];
+    enum { NC = 10 };
+    static double col[NC][MAX_ROWS];
     const char *methods[] = {pd_method_name(PD_METHOD_MOREAU), pd_method_name(PD_METHOD_EVENT),
                              pd_method_name(PD_METHOD_PENALTY)}; /* by code, as in --json */
+    char chain[64];
     for (int r = 0; r < n; r++) {
-        double v[9] = {(double)rows[r].method, rows[r].theta, rows[r].dt, rows[r].kc,
-                       rows[r].err_umax, rows[r].err_hist, rows[r].cpu_s, rows[r].order,
-                       (double)rows[r].impacts};
-        for (int c = 0; c < 9; c++)
+        double v[NC] = {(double)rows[r].method, rows[r].theta, rows[r].dt, rows[r].kc,
+                        rows[r].err_umax, rows[r].err_hist, rows[r].cpu_s, rows[r].order,
+                        (double)rows[r].impacts, (double)rows[r].steps};
+        for (int c = 0; c < NC; c++)
             col[c][r] = v[c];
     }
-    pd_column cols[9] = {
-        {.name = "method", .values = col[0], .labels = methods, .nlabels = 3},
+    pd_column cols[NC] = {
+        {.name = "method", .units = "1", .values = col[0], .labels = methods, .nlabels = 3},
         {.name = "theta", .units = "1", .values = col[1]},
         {.name = "dt", .units = "s", .values = col[2]},
-        {.name = "kc", .units = "w0^2", .values = col[3]},
+        {.name = "kc", .units = "1", .values = col[3]}, /* a multiple of w0^2 */
         {.name = "err_umax_rel", .units = "1", .values = col[4]},
         {.name = "err_hist_linf", .units = "1", .values = col[5]},
         {.name = "cpu_s", .units = "s", .values = col[6]},
         {.name = "order", .units = "1", .values = col[7]},
-        {.name = "impacts", .units = "1", .values = col[8]}};
-    pd_attr attrs[] = {{"pulse", NULL, 1, 0, pd_osc_excitation_name(&a->k.c)},
-                       {"dir", NULL, 1, 0, pd_dir_name(a->k.c.dir)},
-                       {"Pi2", "1", 0, a->k.c.Pi2, NULL}, {"Pi3", "1", 0, a->k.c.Pi3, NULL},
-                       {"eps", "1", 0, a->k.c.eps, NULL}, {"xi", "1", 0, a->k.c.xi, NULL},
-                       {"ap", "m/s^2", 0, a->k.c.ap, NULL}, {"Tp", "s", 0, a->k.c.Tp, NULL}};
-    pd_table t = {n, 9, cols, (int)(sizeof attrs / sizeof attrs[0]), attrs};
+        {.name = "impacts", .units = "1", .values = col[8]},
+        {.name = "steps", .units = "1", .values = col[9]}};
+#define NUM(nm, u, x) {.name = nm, .units = u, .num = (x)}
+#define TXT(nm, x) {.name = nm, .is_text = 1, .text = (x)}
+    const pd_osc *c = &a->k.c;
+    pd_attr osc[] = {TXT("error", a->use_umax ? "umax" : "hist"),
+                     NUM("cpu_s_ref", "s", ref_cpu),
+                     TXT("pulse", pd_osc_excitation_name(c)),
+                     TXT("dir", pd_dir_name(c->dir)),
+                     NUM("Pi2", "1", c->Pi2), NUM("Pi3", "1", c->Pi3),
+                     NUM("eps", "1", c->eps), NUM("xi", "1", c->xi),
+                     NUM("ap", "m/s^2", c->ap), NUM("Tp", "s", c->Tp)};
+    const pd_scene_excitation *x = M->sc ? &M->sc->exc : NULL;
+    snprintf(chain, sizeof chain, "chain of %d", a->k.chain);
+    pd_attr scene[] = {TXT("error", a->use_umax ? "umax" : "hist"),
+                       NUM("cpu_s_ref", "s", ref_cpu),
+                       TXT("scene", a->k.scene_path ? a->k.scene_path : chain),
+                       NUM("structures", "1", M->sc ? M->sc->nstruct : 0),
+                       TXT("pulse", !x ? "" : x->record ? x->record->name : pd_pulse_name(x->pulse)),
+                       TXT("dir", x && x->dir < 0 ? "-x" : "+x"),
+                       NUM("ap", "m/s^2", x ? x->ap : 0.0), NUM("Tp", "s", x ? x->Tp : 0.0)};
+#undef NUM
+#undef TXT
+    pd_table t = {n, NC, cols, M->sc ? (int)(sizeof scene / sizeof scene[0])
+                                     : (int)(sizeof osc / sizeof osc[0]),
+                  M->sc ? scene : osc};
     return pd_output_write(a->out, &t, err);
 }
 
@@ -560,6 +583,7 @@ int pd_cmd_converge(int argc, char **argv)
         return 0;
     if ((rc = parse_args(&a, argc, argv)))
         return rc;
+    pd_provenance_set(argc, argv, PD_FORMAT_CONVERGE, 0);
     if (a.ndt * a.ntheta + a.nkc > MAX_ROWS) {
         pd_cli_case_free(&a.k);
         return pd_cli_usage_error("converge: too many rows (at most %d)", MAX_ROWS);
@@ -572,7 +596,7 @@ int pd_cmd_converge(int argc, char **argv)
         fprintf(stderr, "pound: converge: %s\n", err.msg);
         status = rc == PD_EINVAL ? 2 : 1;
     } else if ((a.plot && plot_rows(&a, &M, rows, n, ref_cpu, &err)) ||
-               (a.out && write_rows(&a, rows, n, &err))) {
+               (a.out && write_rows(&a, &M, rows, n, ref_cpu, &err))) {
         fprintf(stderr, "pound: converge: %s\n", err.msg);
         status = 1;
     } else

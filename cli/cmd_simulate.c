@@ -35,16 +35,7 @@ typedef struct sim_args {
     const char *out, *plot, *dump;
     long every;
     int json;
-    char command[1024];
 } sim_args;
-
-/* The command line, for the files' provenance. */
-static void join_command(char *buf, size_t cap, int argc, char **argv)
-{
-    size_t n = (size_t)snprintf(buf, cap, "pound");
-    for (int i = 0; i < argc && n < cap; i++)
-        n += (size_t)snprintf(buf + n, cap - n, " %s", argv[i]);
-}
 
 /* Case flags, then the command's own; 0 or 2. */
 static int parse_args(sim_args *a, int argc, char **argv)
@@ -54,7 +45,6 @@ static int parse_args(sim_args *a, int argc, char **argv)
     memset(a, 0, sizeof *a);
     pd_cli_case_init(&a->k);
     a->every = 1;
-    join_command(a->command, sizeof a->command, argc, argv);
     for (int i = 1; i < argc; i++) {
         const char *f = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
         if ((rc = pd_cli_case_flag(&a->k, argc, argv, &i)) == 2)
@@ -134,10 +124,10 @@ static int dump_open(sim_args *a, pd_lcp_dump **d)
 }
 
 /* --dump-lcp: the dump into place; 0 or 1. */
-static int dump_finish(const sim_args *a, pd_lcp_dump *d)
+static int dump_finish(pd_lcp_dump *d)
 {
     pd_err err;
-    if (d && pd_lcp_dump_finish(d, a->command, &err)) {
+    if (d && pd_lcp_dump_finish(d, &err)) {
         fprintf(stderr, "pound: simulate: %s\n", err.msg);
         return 1;
     }
@@ -266,10 +256,10 @@ static int finish_output(const sim_args *a, const pd_osc_summary *s, pd_table_wr
     const pd_osc *c = &a->k.c;
 #define NUM(n, u, x) {.name = n, .units = u, .num = (x)}
 #define TXT(n, x) {.name = n, .is_text = 1, .text = (x)}
-    pd_attr attrs[] = {TXT("command", a->command),
-                       TXT("method", pd_method_name(a->k.opts.method)),
+    pd_attr attrs[] = {TXT("method", pd_method_name(a->k.opts.method)),
                        TXT("pulse", pd_osc_excitation_name(c)),
                        TXT("dir", pd_dir_name(c->dir)),
+                       NUM("scale", "1", c->record ? c->scale : 1.0),
                        NUM("ap", "m/s^2", c->ap),
                        NUM("Tp", "s", c->Tp),
                        NUM("T0", "s", pd_osc_T0(c)),
@@ -281,7 +271,7 @@ static int finish_output(const sim_args *a, const pd_osc_summary *s, pd_table_wr
                        NUM("dt", "s", s->r.dt),
                        NUM("theta", "1", s->r.theta),
                        NUM("tend", "s", s->r.tend),
-                       NUM("every", "steps", (double)a->every),
+                       NUM("every", "1", (double)a->every),
                        NUM("umax", "m", s->r.umax),
                        NUM("Pi1", "1", s->Pi1),
                        NUM("u_toward", "m", s->r.u_toward),
@@ -350,7 +340,7 @@ static int simulate_oscillator(sim_args *a)
         status = 1;
         goto done;
     }
-    if ((status = dump_finish(a, dump)))
+    if ((status = dump_finish(dump)))
         goto done;
     if (a->json)
         print_json(a, &s);
@@ -545,7 +535,7 @@ static int simulate_scene(sim_args *a)
         goto done;
     }
     snprintf(name, sizeof name, "chain of %d", a->k.chain);
-    pd_scene_run_info ri = {.sum = &s, .command = a->command,
+    pd_scene_run_info ri = {.sum = &s,
                             .scene_name = a->k.scene_path ? a->k.scene_path : name};
     if ((fo.w && pd_scene_writer_finish(fo.w, &ri, &err)) ||
         (fo.p && pd_scene_plot_draw(fo.p, a->plot, ri.scene_name, &err))) {
@@ -553,7 +543,7 @@ static int simulate_scene(sim_args *a)
         status = 1;
         goto done;
     }
-    if ((status = dump_finish(a, dump)))
+    if ((status = dump_finish(dump)))
         goto done;
     if (a->json)
         scene_json(sc, &s);
@@ -576,6 +566,7 @@ int pd_cmd_simulate(int argc, char **argv)
         return 0;
     if ((rc = parse_args(&a, argc, argv)))
         return rc;
+    pd_provenance_set(argc, argv, pd_cli_is_scene(&a.k) ? PD_FORMAT_SCENE : PD_FORMAT_OSCILLATOR, 0);
     rc = pd_cli_is_scene(&a.k) ? simulate_scene(&a) : simulate_oscillator(&a);
     pd_cli_case_free(&a.k);
     return rc;

@@ -474,6 +474,35 @@ static int sweep(spec_args *a, int rank, int size, double wall0)
     return status;
 }
 
+/* The files' provenance (docs/formats.md): a spectrum file is reproducible
+ * (no `created`), and its command is the sweep without the flags that only
+ * choose where the results go and how they are computed (-o, --plot,
+ * --json, --threads, --resume, --stop-after), so that equal sweeps give
+ * byte-identical files.  0, or 1 when out of memory. */
+static int set_provenance(int argc, char **argv)
+{
+    static const char *const with_value[] = {"-o", "--plot", "--threads", "--stop-after"};
+    char **kept = malloc((size_t)(argc > 0 ? argc : 1) * sizeof *kept);
+    int n = 0;
+    if (!kept) {
+        fprintf(stderr, "pound: spectrum: out of memory\n");
+        return 1;
+    }
+    for (int i = 0; i < argc; i++) {
+        int skip = i > 0 && (!strcmp(argv[i], "--json") || !strcmp(argv[i], "--resume"));
+        for (size_t k = 0; i > 0 && k < sizeof with_value / sizeof *with_value && !skip; k++)
+            if (!strcmp(argv[i], with_value[k])) {
+                skip = 1;
+                i++; /* and its value */
+            }
+        if (!skip)
+            kept[n++] = argv[i];
+    }
+    pd_provenance_set(n, kept, PD_FORMAT_SPECTRUM_SCENE, 1);
+    free(kept);
+    return 0;
+}
+
 int pd_cmd_spectrum(int argc, char **argv)
 {
     spec_args *a;
@@ -489,7 +518,7 @@ int pd_cmd_spectrum(int argc, char **argv)
     double wall0 = pd_wall_seconds();
     if (!(a = malloc(sizeof *a)))
         rc = 1;
-    else if (!(rc = parse_on_rank(a, argc, argv, rank))) {
+    else if (!(rc = parse_on_rank(a, argc, argv, rank)) && !(rc = set_provenance(argc, argv))) {
         if (!threaded)
             a->threads = 1; /* MPI without thread support: one thread per rank */
         if (a->k.scene_path) {

@@ -297,6 +297,16 @@ int pd_h5_nums(hid_t obj, const char *name, int n, const double *x, const char *
     return units ? pd_h5_attr(obj, uname, units, 0.0) : 0;
 }
 
+int pd_provenance_h5(hid_t file, const pd_provenance *p)
+{
+    int rc = pd_h5_attr(file, "format", p->format, 0.0) ||
+             pd_h5_attr(file, "command", p->command, 0.0) ||
+             pd_h5_attr(file, "pound_version", p->pound_version, 0.0);
+    if (!rc && p->created[0])
+        rc = pd_h5_attr(file, "created", p->created, 0.0);
+    return rc ? -1 : 0;
+}
+
 /* An object-creation property list without modification times (so equal
  * runs give byte-identical files). */
 hid_t pd_h5_untimed(hid_t cls)

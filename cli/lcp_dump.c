@@ -1,15 +1,18 @@
 /* lcp_dump.c — (cli) every LCP a Moreau–Jean run solves, written to HDF5 as
  * a corpus for solver studies (`simulate --dump-lcp F.h5`), and read back
- * (`pound lcp F.h5 --all`).  docs/lcp.md describes the layout:
+ * (`pound lcp F.h5 --all`).  docs/formats.md and docs/lcp.md describe the
+ * layout:
  *
  *   /n, /t, /solver, /outcome, /pivots, /iterations, /residual   one per LCP
  *   /colptr (n_k + 1 per LCP), /rowind, /values                  D_k by columns
  *   /b, /z, /contact                                             n_k per LCP
  *
- * Offsets follow from /n and each colptr's last entry.  Datasets are
- * extendible and written in blocks as the run goes; the file is written
- * under a temporary name and renamed when the run has finished.  A failed
- * write stops the run and is reported with the system's reason. */
+ * each with its "units"; the provenance (format "pound LCP dump 1"),
+ * model, solver_codes and count as root attributes.  Offsets follow from
+ * /n and each colptr's last entry.  Datasets are extendible and written in
+ * blocks as the run goes; the file is written under a temporary name and
+ * renamed when the run has finished.  A failed write stops the run and is
+ * reported with the system's reason. */
 #include <errno.h>
 #include <hdf5.h>
 #include <stdlib.h>
@@ -47,13 +50,18 @@ struct pd_lcp_dump {
     int failed, failure; /* failure: errno of the first failed write, 0 if none */
 };
 
+/* The datasets and their units: a scene's (D = W^T M^-1 W in 1/kg, b a
+ * velocity, z an impulse), and the oscillator's, which runs in its Pi
+ * units (time wp t, lengths in Le, unit mass): all dimensionless. */
 static const struct {
     const char *name;
     int is_int;
-} set_defs[NSETS] = {{"n", 1},         {"t", 0},        {"solver", 1}, {"outcome", 1},
-                     {"pivots", 1},    {"iterations", 1}, {"residual", 0}, {"colptr", 1},
-                     {"rowind", 1},    {"values", 0},   {"b", 0},      {"z", 0},
-                     {"contact", 1}};
+    const char *units;
+} set_defs[NSETS] = {{"n", 1, "1"},         {"t", 0, "s"},          {"solver", 1, "1"},
+                     {"outcome", 1, "1"},   {"pivots", 1, "1"},     {"iterations", 1, "1"},
+                     {"residual", 0, "1"},  {"colptr", 1, "1"},     {"rowind", 1, "1"},
+                     {"values", 0, "1/kg"}, {"b", 0, "m/s"},        {"z", 0, "N s"},
+                     {"contact", 1, "1"}};
 
 void pd_lcp_dump_free(pd_lcp_dump *d)
 {
@@ -71,17 +79,22 @@ void pd_lcp_dump_free(pd_lcp_dump *d)
 /* The file and its extendible datasets: 0 or an errno. */
 static int dump_create(pd_lcp_dump *d)
 {
+    pd_provenance p;
+    int osc = pd_provenance_tables_are(PD_FORMAT_OSCILLATOR);
+    pd_provenance_now(&p, PD_FORMAT_LCP_DUMP);
     if ((d->file = pd_h5_create(d->out.tmp, H5P_DEFAULT, &d->failure)) < 0)
         return d->failure;
+    if (pd_provenance_h5(d->file, &p) ||
+        pd_h5_attr(d->file, "model", osc ? "oscillator" : "scene", 0.0))
+        return d->failure ? d->failure : EIO;
     for (int k = 0; k < NSETS; k++) {
         dump_set *s = &d->set[k];
         if (!(s->buf = malloc(DUMP_BLOCK * s->size)))
             return ENOMEM;
-        if ((s->ds = pd_h5_extendible(d->file, s->name, s->type, 0, 4096, "")) < 0)
+        if ((s->ds = pd_h5_extendible(d->file, s->name, s->type, 0, 4096,
+                                      osc ? "1" : set_defs[k].units)) < 0)
             return d->failure ? d->failure : EIO;
     }
-    if (pd_h5_attr(d->file, "format", "pound LCP dump 1", 0.0))
-        return d->failure ? d->failure : EIO;
     return d->failure;
 }
 
@@ -185,7 +198,7 @@ int pd_lcp_dump_add(const pd_matrix *D, const double *b, const double *z, const 
     return d->failed;
 }
 
-int pd_lcp_dump_finish(pd_lcp_dump *d, const char *command, pd_err *err)
+int pd_lcp_dump_finish(pd_lcp_dump *d, pd_err *err)
 {
     int rc = d->failed, e;
     char names[160] = "";
@@ -195,8 +208,7 @@ int pd_lcp_dump_finish(pd_lcp_dump *d, const char *command, pd_err *err)
     for (int k = 0; k < NSETS && !rc; k++)
         rc = flush_set(&d->set[k]);
     rc = rc || pd_h5_attr(d->file, "solver_codes", names, 0.0) ||
-         pd_h5_attr(d->file, "command", command, 0.0) ||
-         pd_h5_num(d->file, "count", (double)d->count, NULL);
+         pd_h5_num(d->file, "count", (double)d->count, "1");
     for (int k = 0; k < NSETS; k++)
         rc |= pd_h5_close_id(&d->set[k].ds);
     e = pd_h5_close(&d->file, &d->failure);

@@ -1,6 +1,11 @@
-/* main.c — `pound`: dispatch to a subcommand; temporary output files
- * removed on SIGINT/SIGTERM; standard output checked at the end. */
+/* main.c — `pound`: dispatch to a subcommand, `pound help COMMAND` and
+ * `pound --version`; temporary output files removed on SIGINT/SIGTERM;
+ * standard output checked at the end. */
+#include <cholmod.h>
 #include <errno.h>
+#include <gsl/gsl_version.h>
+#include <hdf5.h>
+#include <jansson.h>
 #include <string.h>
 
 #include "pd_cli.h"
@@ -19,8 +24,70 @@ static const char usage[] =
     "  record F   ground-motion measures and the fitted pulse of strong-motion records\n"
     "  lcp FILE   solve one linear complementarity problem (Lemke, structured, PGS)\n"
     "  bench      performance figures (--lcp, --engine, --scene, --spectrum)\n"
+    "  help CMD   the options of a command (as `pound CMD --help`)\n"
     "\n"
-    "`pound <command> --help` lists a command's options; docs/ has the details.\n";
+    "  --version  pound's version and the libraries it was built with\n"
+    "\n"
+    "`pound <command> --help` lists a command's options; man pound and docs/ have the details.\n";
+
+/* The commands and their entry points. */
+static const struct {
+    const char *name;
+    int (*run)(int argc, char **argv);
+} commands[] = {{"simulate", pd_cmd_simulate}, {"compare", pd_cmd_compare},
+                {"converge", pd_cmd_converge}, {"spectrum", pd_cmd_spectrum},
+                {"record", pd_cmd_record},     {"lcp", pd_cmd_lcp},
+                {"bench", pd_cmd_bench}};
+
+#define NCOMMANDS (int)(sizeof commands / sizeof commands[0])
+
+/* The command called name, or -1. */
+static int find_command(const char *name)
+{
+    for (int k = 0; k < NCOMMANDS; k++)
+        if (!strcmp(commands[k].name, name))
+            return k;
+    return -1;
+}
+
+/* `pound --version`: this program's version (and the library's, when a
+ * shared libpound of another version answers), then what it was built with. */
+static int version(void)
+{
+    printf("pound %s", PD_VERSION);
+    if (strcmp(pd_version(), PD_VERSION))
+        printf(" (libpound %s)", pd_version());
+    printf("\nbuilt with GSL %s, HDF5 %d.%d.%d, jansson %s, CHOLMOD %d.%d.%d", GSL_VERSION,
+           H5_VERS_MAJOR, H5_VERS_MINOR, H5_VERS_RELEASE, JANSSON_VERSION, CHOLMOD_MAIN_VERSION,
+           CHOLMOD_SUB_VERSION, CHOLMOD_SUBSUB_VERSION);
+#ifdef _OPENMP
+    printf(", OpenMP %d", _OPENMP);
+#endif
+#ifdef PD_MPI
+    printf(", MPI");
+#endif
+    printf("\n");
+    return 0;
+}
+
+/* `pound help [COMMAND]`: the command's --help (exit 0), the usage without
+ * one; an unknown command is bad input (exit 2). */
+static int help(int argc, char **argv)
+{
+    if (argc < 3) {
+        fputs(usage, stdout);
+        return 0;
+    }
+    if (argc > 3)
+        return pd_cli_usage_error("help: one command at a time (got '%s' after '%s')", argv[3],
+                                  argv[2]);
+    int k = find_command(argv[2]);
+    if (k < 0)
+        return pd_cli_usage_error("help: unknown command '%s' (simulate, compare, converge, "
+                                  "spectrum, record, lcp or bench)", argv[2]);
+    char flag[] = "--help", *av[] = {argv[2], flag, NULL};
+    return commands[k].run(2, av);
+}
 
 /* The subcommand argv[1] names: its exit status. */
 static int dispatch(int argc, char **argv)
@@ -32,21 +99,14 @@ static int dispatch(int argc, char **argv)
         fputs(usage, stdout);
         return 0;
     }
+    if (!strcmp(argv[1], "--version"))
+        return version();
     const char *cmd = argv[1];
-    if (!strcmp(cmd, "lcp"))
-        return pd_cmd_lcp(argc - 1, argv + 1);
-    if (!strcmp(cmd, "simulate"))
-        return pd_cmd_simulate(argc - 1, argv + 1);
-    if (!strcmp(cmd, "compare"))
-        return pd_cmd_compare(argc - 1, argv + 1);
-    if (!strcmp(cmd, "converge"))
-        return pd_cmd_converge(argc - 1, argv + 1);
-    if (!strcmp(cmd, "spectrum"))
-        return pd_cmd_spectrum(argc - 1, argv + 1);
-    if (!strcmp(cmd, "record"))
-        return pd_cmd_record(argc - 1, argv + 1);
-    if (!strcmp(cmd, "bench"))
-        return pd_cmd_bench(argc - 1, argv + 1);
+    if (!strcmp(cmd, "help"))
+        return help(argc, argv);
+    int k = find_command(cmd);
+    if (k >= 0)
+        return commands[k].run(argc - 1, argv + 1);
     return pd_cli_usage_error("unknown command '%s' (try `pound --help`)", cmd);
 }
 

@@ -12,6 +12,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "pd_h5.h"
@@ -359,6 +360,102 @@ int pd_csv_close(pd_csv *c)
     return c->failure;
 }
 
+/* ---- provenance ---------------------------------------------------------- */
+
+/* The second exception to "no globals": the command line of the process,
+ * set once by the command (pd_provenance_set) before any file is written,
+ * read by every writer. */
+static struct {
+    char command[PD_COMMAND_MAX];
+    const char *table_format;
+    int reproducible;
+} prov = {"pound", "pound table 1", 0};
+
+/* Copy len bytes of s to buf at n (as much as fits, NUL-terminated): the
+ * length the text would have, n + len. */
+static size_t put(char *buf, size_t cap, size_t n, const char *s, size_t len)
+{
+    if (n + 1 < cap) {
+        size_t k = len < cap - 1 - n ? len : cap - 1 - n;
+        memcpy(buf + n, s, k);
+        buf[n + k] = '\0';
+    }
+    return n + len;
+}
+
+/* Does Python's shlex.quote leave ch as it is? */
+static int shell_safe(unsigned char ch)
+{
+    return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') ||
+           (ch && strchr("_@%+=:,./-", ch));
+}
+
+/* arg at n, quoted for a POSIX shell as shlex.quote does: as it is when
+ * every byte is safe, else in single quotes (a quote as '"'"'). */
+static size_t put_quoted(char *buf, size_t cap, size_t n, const char *arg)
+{
+    int safe = arg[0] != '\0';
+    for (const char *p = arg; *p && safe; p++)
+        safe = shell_safe((unsigned char)*p);
+    if (safe)
+        return put(buf, cap, n, arg, strlen(arg));
+    n = put(buf, cap, n, "'", 1);
+    for (const char *p = arg; *p; p++)
+        n = *p == '\'' ? put(buf, cap, n, "'\"'\"'", 5) : put(buf, cap, n, p, 1);
+    return put(buf, cap, n, "'", 1);
+}
+
+void pd_provenance_set(int argc, char *const *argv, const char *table_format, int reproducible)
+{
+    size_t cap = sizeof prov.command, n = put(prov.command, cap, 0, "pound", 5);
+    for (int i = 0; i < argc; i++)
+        n = put_quoted(prov.command, cap, put(prov.command, cap, n, " ", 1), argv[i]);
+    if (n >= cap) /* cut: marked */
+        memcpy(prov.command + cap - 4, "...", 4);
+    prov.table_format = table_format ? table_format : "pound table 1";
+    prov.reproducible = reproducible;
+}
+
+void pd_provenance_now(pd_provenance *p, const char *format)
+{
+    time_t now = time(NULL);
+    struct tm tm;
+    p->format = format ? format : prov.table_format;
+    p->command = prov.command;
+    p->pound_version = pd_version();
+    p->created[0] = '\0';
+    if (!prov.reproducible && now != (time_t)-1 && gmtime_r(&now, &tm))
+        strftime(p->created, sizeof p->created, "%Y-%m-%dT%H:%M:%SZ", &tm);
+}
+
+int pd_provenance_tables_are(const char *format)
+{
+    return !strcmp(prov.table_format, format);
+}
+
+int pd_csv_comment(pd_csv *c, const char *name, const char *text)
+{
+    pd_csv_printf(c, "# %s = ", name);
+    for (const char *p = text ? text : ""; *p;) {
+        size_t k = 0;
+        while (p[k] && !((unsigned char)p[k] < 0x20 || p[k] == 0x7f))
+            k++;
+        pd_csv_printf(c, "%.*s%s", (int)k, p, p[k] ? "?" : "");
+        p += k + (p[k] != '\0');
+    }
+    return pd_csv_printf(c, "\n");
+}
+
+int pd_provenance_csv(pd_csv *c, const pd_provenance *p)
+{
+    pd_csv_comment(c, "format", p->format);
+    pd_csv_comment(c, "command", p->command);
+    pd_csv_comment(c, "pound_version", p->pound_version);
+    if (p->created[0])
+        pd_csv_comment(c, "created", p->created);
+    return c->failure ? -1 : 0;
+}
+
 /* ---- tables -------------------------------------------------------------- */
 
 #define TABLE_BLOCK_ROWS 4096L /* rows buffered, and the largest HDF5 chunk */
@@ -371,7 +468,14 @@ struct pd_table_writer {
     double *buf, *col; /* HDF5: TABLE_BLOCK_ROWS rows, and one column of them */
     hid_t file, *ds;
     pd_csv spill; /* CSV: the rows so far, in an unnamed file beside the output */
+    pd_provenance prov; /* taken when the file is begun */
 };
+
+/* A column's units: "1" when none are given. */
+static const char *column_units(const pd_column *c)
+{
+    return c->units && c->units[0] ? c->units : "1";
+}
 
 /* The label of a coded column's value, or NULL (not coded, or no label). */
 static const char *column_label(const pd_column *c, double v)
@@ -398,10 +502,12 @@ static int h5_table_open(pd_table_writer *w)
 {
     if ((w->file = pd_h5_create(w->out.tmp, H5P_DEFAULT, &w->failure)) < 0)
         return w->failure;
+    if (pd_provenance_h5(w->file, &w->prov))
+        return w->failure ? w->failure : EIO;
     for (int j = 0; j < w->ncols; j++) {
         const pd_column *c = &w->cols[j];
         w->ds[j] = pd_h5_extendible(w->file, c->name, H5T_NATIVE_DOUBLE, 0, w->chunk,
-                                    c->units ? c->units : "");
+                                    column_units(c));
         if (w->ds[j] < 0 || (c->labels && h5_codes_attr(w->ds[j], c)))
             return w->failure ? w->failure : EIO;
     }
@@ -457,6 +563,7 @@ int pd_table_open(pd_table_writer **out, const char *path, int ncols, const pd_c
                            .out = {.slot = -1}};
     w->chunk = expected_rows < 1 ? 1 : expected_rows < TABLE_BLOCK_ROWS ? expected_rows
                                                                         : TABLE_BLOCK_ROWS;
+    pd_provenance_now(&w->prov, NULL);
     w->buf = malloc((size_t)TABLE_BLOCK_ROWS * (size_t)ncols * sizeof(double));
     w->col = malloc((size_t)TABLE_BLOCK_ROWS * sizeof(double));
     w->ds = malloc((size_t)ncols * sizeof(hid_t));
@@ -549,8 +656,8 @@ static void csv_copy(pd_csv *c, FILE *from)
         c->failure = EIO;
 }
 
-/* CSV: "# name = value [units]" lines, the header row, the rows: 0 or an
- * errno. */
+/* CSV: the provenance, "# name = value [units]" lines, "# units = ..." (one
+ * per column), the header row, the rows: 0 or an errno. */
 static int csv_table_finish(pd_table_writer *w, int nattrs, const pd_attr *attrs)
 {
     pd_csv c = {0};
@@ -559,16 +666,22 @@ static int csv_table_finish(pd_table_writer *w, int nattrs, const pd_attr *attrs
         e = errno ? errno : EIO;
     if (e || (e = pd_csv_open(&c, w->out.tmp)))
         return e;
+    pd_provenance_csv(&c, &w->prov);
     for (int i = 0; i < nattrs; i++) {
         const pd_attr *a = &attrs[i];
-        if (a->is_text)
-            pd_csv_printf(&c, "# %s = %s", a->name, a->text);
-        else
-            pd_csv_printf(&c, "# %s = %.17g", a->name, a->num);
+        if (a->is_text) {
+            pd_csv_comment(&c, a->name, a->text);
+            continue;
+        }
+        pd_csv_printf(&c, "# %s = %.17g", a->name, a->num);
         if (a->units && a->units[0])
             pd_csv_printf(&c, " [%s]", a->units);
         pd_csv_printf(&c, "\n");
     }
+    pd_csv_printf(&c, "# units = ");
+    for (int j = 0; j < w->ncols; j++)
+        pd_csv_printf(&c, "%s%s", j ? "," : "", column_units(&w->cols[j]));
+    pd_csv_printf(&c, "\n");
     for (int j = 0; j < w->ncols; j++)
         pd_csv_printf(&c, "%s%s", j ? "," : "", w->cols[j].name);
     pd_csv_printf(&c, "\n");

@@ -5,6 +5,8 @@
 
 #include <hdf5.h>
 
+#include "pd_output.h"
+
 /* Create path (truncating it) for writing through the "sink" driver: POSIX
  * I/O like HDF5's sec2 driver (the same bytes), except that a failed write,
  * truncate or close never reaches the library.  The first failure's errno
@@ -33,6 +35,10 @@ int pd_h5_num(hid_t obj, const char *name, double x, const char *units);
 
 /* A 1-D double array attribute with its units companion. */
 int pd_h5_nums(hid_t obj, const char *name, int n, const double *x, const char *units);
+
+/* The provenance (pd_output.h) as root attributes of file: format, command,
+ * pound_version and, unless empty, created (strings).  0 or -1. */
+int pd_provenance_h5(hid_t file, const pd_provenance *p);
 
 /* An object-creation property list of class cls that records no times. */
 hid_t pd_h5_untimed(hid_t cls);

@@ -13,7 +13,7 @@ int pd_lcp_dump_open(pd_lcp_dump **d, const char *path, pd_err *err);
 int pd_lcp_dump_add(const pd_matrix *D, const double *b, const double *z, const double *w,
                     const pd_lcp_info *info, const int *idx, double t, void *ctx);
 /* Write what is buffered, close, rename into place. */
-int pd_lcp_dump_finish(pd_lcp_dump *d, const char *command, pd_err *err);
+int pd_lcp_dump_finish(pd_lcp_dump *d, pd_err *err);
 long pd_lcp_dump_count(const pd_lcp_dump *d);
 /* Release; an unfinished file is removed. */
 void pd_lcp_dump_free(pd_lcp_dump *d);

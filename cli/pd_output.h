@@ -85,6 +85,55 @@ int pd_csv_printf(pd_csv *c, const char *fmt, ...) __attribute__((format(printf,
 /* Flush and close (c->f NULL after): 0, or the errno of the first failure. */
 int pd_csv_close(pd_csv *c);
 
+/* ---- provenance (docs/formats.md) --------------------------------------- */
+
+/* What every file pound writes records about its making, before anything
+ * else: root attributes of an HDF5 file, the first '#' lines of a CSV file.
+ *   format         the layout's name and version, "pound simulate oscillator 1"
+ *   command        the command line: "pound", then the arguments, each quoted
+ *                  for a POSIX shell when it needs it (Python's shlex.quote
+ *                  rule, so shlex.split(command) gives the arguments back)
+ *   pound_version  pd_version()
+ *   created        the UTC time the file was begun, "2025-01-31T12:00:00Z";
+ *                  absent from reproducible files (spectra), which hold the
+ *                  same bytes whenever and however they are computed */
+enum { PD_COMMAND_MAX = 16384 };
+
+/* The formats (a layout's name and version). */
+#define PD_FORMAT_OSCILLATOR "pound simulate oscillator 1"
+#define PD_FORMAT_SCENE "pound simulate scene 1"
+#define PD_FORMAT_LCP_DUMP "pound LCP dump 1"
+#define PD_FORMAT_CONVERGE "pound converge 1"
+#define PD_FORMAT_SPECTRUM "pound spectrum 1"
+#define PD_FORMAT_SPECTRUM_SCENE "pound spectrum scene 1"
+
+typedef struct pd_provenance {
+    const char *format, *command, *pound_version;
+    char created[32]; /* "" in reproducible files */
+} pd_provenance;
+
+/* This process's command line (argv as a command receives it, argv[0] its
+ * name: "simulate"), the format of the tables it writes (pd_table_open,
+ * pd_output_write) and whether its files are reproducible.  Each command
+ * that writes files calls it once, before writing; until then the command
+ * is "pound" and the format "pound table 1".  A command line longer than
+ * PD_COMMAND_MAX is cut and ends in "...". */
+void pd_provenance_set(int argc, char *const *argv, const char *table_format, int reproducible);
+
+/* The provenance of a file of `format` (NULL: the tables' format) begun now. */
+void pd_provenance_now(pd_provenance *p, const char *format);
+
+/* Is `format` the format of this process's tables?  (An LCP dump of the
+ * oscillator is in its dimensionless units, a scene's in SI.) */
+int pd_provenance_tables_are(const char *format);
+
+/* p as '#' lines ("# format = ..."): 0 or -1. */
+int pd_provenance_csv(pd_csv *c, const pd_provenance *p);
+
+/* A "# name = text" line, control bytes in text written as '?' (a CSV
+ * comment is one line): 0 or -1. */
+int pd_csv_comment(pd_csv *c, const char *name, const char *text);
+
 /* ---- tables ------------------------------------------------------------- */
 
 typedef struct pd_attr {
@@ -97,7 +146,7 @@ typedef struct pd_attr {
 
 typedef struct pd_column {
     const char *name;
-    const char *units;
+    const char *units; /* NULL or "": "1" (dimensionless, or a code) */
     const double *values; /* pd_output_write only */
     /* A coded column (labels non-NULL): its values are codes 0..nlabels-1;
      * the CSV writes labels[code] as text, the HDF5 file the code with a
@@ -115,10 +164,11 @@ typedef struct pd_table {
     const pd_attr *attrs;
 } pd_table;
 
-/* Write the table to path: HDF5 when it ends in .h5/.hdf5 (one 1-D dataset
- * per column with a "units" attribute, the attributes on the root), CSV
- * when it ends in .csv ('#' lines with the attributes, a header row, the
- * rows); anything else is PD_EINVAL. */
+/* Write the table to path: HDF5 when it ends in .h5/.hdf5 (the provenance
+ * and the attributes on the root, one 1-D dataset per column with a "units"
+ * attribute), CSV when it ends in .csv ('#' lines with the provenance and
+ * the attributes, "# units = U1,U2,..." with one unit per column, the
+ * header row, the rows); anything else is PD_EINVAL. */
 int pd_output_write(const char *path, const pd_table *table, pd_err *err);
 
 /* The same files streamed: rows are written in blocks as they come (memory

@@ -9,7 +9,6 @@
 /* What the files record besides the histories. */
 typedef struct pd_scene_run_info {
     const pd_scene_summary *sum;
-    const char *command;    /* the command line, for provenance */
     const char *scene_name; /* the scene file, or "chain of N" */
 } pd_scene_run_info;
 

@@ -3,13 +3,15 @@
  * input and result added at the end; written under a temporary name and
  * renamed on success.  Also the decimated copy that --plot draws.
  *
- * HDF5:  /t [s]; /structures/NAME/{x, v} (rows x storeys, m and m/s) with
- *        the structure and its results as attributes; /contacts/K/{gap,
- *        impulse} (m, N s) with the contact and its results as attributes;
- *        the run as attributes of the root.
- * CSV:   '#' lines with the inputs, a header row, one row per sample
- *        (t, NAME.x1.., NAME.v1.., cK.gap.., cK.impulse..), '#' lines with the
- *        results at the end.
+ * HDF5:  the provenance (format "pound simulate scene 1") and the run as
+ *        attributes of the root; /t [s]; /structures/NAME/{x, v} (rows x
+ *        storeys, m and m/s) with the structure and its results as
+ *        attributes; /contacts/K/{gap, impulse} (m, N s) with the contact and
+ *        its results as attributes.
+ * CSV:   '#' lines with the provenance, "# units = ..." (one per column), a
+ *        header row, one row per sample (t, NAME.x1.., NAME.v1.., cK.gap..,
+ *        cK.impulse..), '#' lines with the run and its results at the end.
+ * docs/formats.md describes both.
  * Every write is checked; the first failure stops the run and is reported
  * with the system's reason, and the temporary file is removed. */
 #include <errno.h>
@@ -38,7 +40,9 @@ struct pd_scene_writer {
     hid_t file, ds_t;
     hid_t *ds_x, *ds_v, *ds_g, *ds_p;
     pd_csv csv;
+    pd_provenance prov;
 };
+
 
 /* Does path end with suffix? */
 static int ends_with(const char *path, const char *suffix)
@@ -55,6 +59,8 @@ static int h5_open(pd_scene_writer *w)
     char name[96];
     if ((w->file = pd_h5_create(w->out.tmp, H5P_DEFAULT, &w->failure)) < 0)
         return w->failure;
+    if (pd_provenance_h5(w->file, &w->prov))
+        return w->failure ? w->failure : EIO;
     hid_t gs = H5Gcreate2(w->file, "structures", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     hid_t gc = H5Gcreate2(w->file, "contacts", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     int rc = gs < 0 || gc < 0 || (w->ds_t = pd_h5_extendible(w->file, "t", H5T_NATIVE_DOUBLE, 0, w->cap, "s")) < 0;
@@ -80,13 +86,21 @@ static int h5_open(pd_scene_writer *w)
     return w->failure ? w->failure : rc ? EIO : 0;
 }
 
-/* The CSV header row: 0 or an errno. */
+/* The CSV's provenance, units and header rows: 0 or an errno. */
 static int csv_open(pd_scene_writer *w)
 {
     const pd_scene *sc = w->sc;
     if (pd_csv_open(&w->csv, w->out.tmp))
         return w->csv.failure;
-    pd_csv_printf(&w->csv, "# pound scene run: units s, m, m/s, N s\nt");
+    pd_provenance_csv(&w->csv, &w->prov);
+    pd_csv_printf(&w->csv, "# units = s");
+    for (int part = 0; part < 2; part++)
+        for (int k = 0; k < sc->n; k++)
+            pd_csv_printf(&w->csv, ",%s", part ? "m/s" : "m");
+    for (int part = 0; part < 2; part++)
+        for (int a = 0; a < sc->ncontact; a++)
+            pd_csv_printf(&w->csv, ",%s", part ? "N s" : "m");
+    pd_csv_printf(&w->csv, "\nt");
     for (int s = 0; s < sc->nstruct; s++)
         for (int k = 1; k <= sc->st[s].storeys; k++)
             pd_csv_printf(&w->csv, ",%s.x%d", sc->st[s].name, k);
@@ -160,6 +174,7 @@ int pd_scene_writer_open(pd_scene_writer **out, const char *path, const pd_scene
     w->file = w->ds_t = -1;
     w->out.slot = -1;
     w->hdf5 = ends_with(path, ".h5") || ends_with(path, ".hdf5");
+    pd_provenance_now(&w->prov, PD_FORMAT_SCENE);
     w->width = 1 + 2 * sc->n + 2 * sc->ncontact;
     w->cap = OUT_BUFFER_DOUBLES / w->width;
     w->cap = w->cap < 16 ? 16 : w->cap > 4096 ? 4096 : w->cap;
@@ -263,7 +278,9 @@ static int put_text(pd_scene_writer *w, hid_t obj, const char *prefix, const cha
 {
     if (w->hdf5)
         return pd_h5_attr(obj, name, text, 0.0);
-    return pd_csv_printf(&w->csv, "# %s%s = %s\n", prefix, name, text);
+    char full[PD_NAME_MAX + 48];
+    snprintf(full, sizeof full, "%s%s", prefix, name);
+    return pd_csv_comment(&w->csv, full, text);
 }
 
 static int put_nums(pd_scene_writer *w, hid_t obj, const char *prefix, const char *name, int n,
@@ -284,18 +301,19 @@ static int put_run(pd_scene_writer *w, const pd_scene_run_info *ri)
     const pd_scene *sc = w->sc;
     const pd_scene_result *r = &ri->sum->r;
     hid_t f = w->hdf5 ? w->file : -1;
-    return put_text(w, f, "", "command", ri->command) ||
-           put_text(w, f, "", "scene", ri->scene_name) ||
+    return put_text(w, f, "", "scene", ri->scene_name) ||
            put_text(w, f, "", "method", r->method) || put_text(w, f, "", "kernel", r->kernel) ||
            put_text(w, f, "", "factor", r->factor) ||
            put_text(w, f, "", "lcp_solver", r->lcp_solver) ||
-           put_text(w, f, "", "pulse", pd_pulse_name(sc->exc.pulse)) ||
+           put_text(w, f, "", "pulse",
+                    sc->exc.record ? sc->exc.record->name : pd_pulse_name(sc->exc.pulse)) ||
+           put_num(w, f, "", "scale", sc->exc.record ? sc->exc.scale : 1.0, "1") ||
            put_text(w, f, "", "dir", sc->exc.dir > 0 ? "+x" : "-x") ||
            put_num(w, f, "", "ap", sc->exc.ap, "m/s^2") ||
            put_num(w, f, "", "Tp", sc->exc.Tp, "s") ||
            put_num(w, f, "", "Le", pd_scene_Le(sc), "m") || put_num(w, f, "", "dt", r->dt, "s") ||
            put_num(w, f, "", "theta", r->theta, "1") || put_num(w, f, "", "tend", r->tend, "s") ||
-           put_num(w, f, "", "every", (double)w->every, "steps") ||
+           put_num(w, f, "", "every", (double)w->every, "1") ||
            put_num(w, f, "", "steps", (double)r->steps, "1") ||
            put_num(w, f, "", "cpu_s", ri->sum->cpu_s, "s");
 }

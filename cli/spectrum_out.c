@@ -1,7 +1,9 @@
 /* spectrum_out.c — a computed spectrum as HDF5 (one group per curve), CSV
  * (long format, one row per point), gnuplot charts, JSON and text.  Files
  * are written to a temporary name and renamed on success, and hold no
- * timings or dates, so equal sweeps give byte-identical files.  Every write
+ * timings or dates (their provenance has no `created`, and its command
+ * leaves out -o, --plot, --json, --threads, --resume and --stop-after), so
+ * equal sweeps give byte-identical files (docs/formats.md).  Every write
  * is checked: a failure is reported with the system's reason and leaves no
  * file (the journal stays, so the sweep can be resumed). */
 #include <errno.h>
@@ -119,19 +121,21 @@ static int h5_curve(hid_t file, hid_t gcpl, hid_t dcpl, const pd_spectrum *s,
     return rc;
 }
 
-/* The sweep's common parameters as root attributes. */
+/* The provenance and the sweep's common parameters as root attributes. */
 static int h5_root_attrs(hid_t file, const pd_spectrum *s)
 {
     char rule[64];
+    pd_provenance p;
+    pd_provenance_now(&p, PD_FORMAT_SPECTRUM);
     dt_rule(s, rule, sizeof rule);
-    return pd_h5_attr(file, "command", "pound spectrum", 0) ||
+    return pd_provenance_h5(file, &p) ||
            pd_h5_attr(file, "method", pd_method_name(s->opts.method), 0) ||
            pd_h5_attr(file, "Pi2_spacing", s->linear ? "linear" : "log", 0) ||
            pd_h5_num(file, "Pi2_min", s->pi2_min, "1") || pd_h5_num(file, "Pi2_max", s->pi2_max, "1") ||
-           pd_h5_num(file, "Pi2_n", s->npi2, NULL) || pd_h5_num(file, "Tp", s->base.Tp, "s") ||
+           pd_h5_num(file, "Pi2_n", s->npi2, "1") || pd_h5_num(file, "Tp", s->base.Tp, "s") ||
            pd_h5_attr(file, "dt", rule, 0) || pd_h5_num(file, "theta", s->opts.theta, "1") ||
-           pd_h5_num(file, "curves", (double)pd_spec_curves(s), NULL) ||
-           pd_h5_num(file, "points", (double)pd_spec_points(s), NULL);
+           pd_h5_num(file, "curves", (double)pd_spec_curves(s), "1") ||
+           pd_h5_num(file, "points", (double)pd_spec_points(s), "1");
 }
 
 /* The whole spectrum into an HDF5 file: 0 or an errno. */
@@ -158,21 +162,35 @@ static int write_hdf5(const char *path, const pd_spectrum *s, const pd_spec_row 
 
 /* ---- CSV ---------------------------------------------------------------- */
 
-/* "# name = value" lines, the header row, one row per point: 0 or an errno. */
+/* The curve columns of the CSV (before the point columns), and their units. */
+static const char *const csv_curve_cols[][2] = {
+    {"pulse", "1"}, {"dir", "1"}, {"method", "1"}, {"ap", "m/s^2"}, {"Tp", "s"},
+    {"Pi3", "1"},   {"gap", "m"}, {"eps", "1"},    {"xi", "1"}};
+enum { NCURVE_COLS = sizeof csv_curve_cols / sizeof csv_curve_cols[0] };
+
+/* The provenance and "# name = value" lines, "# units = ..." (one per
+ * column), the header row, one row per point: 0 or an errno. */
 static int write_csv(const char *path, const pd_spectrum *s, const pd_spec_row *rows)
 {
     char rule[64];
     pd_csv f;
+    pd_provenance prov;
     if (pd_csv_open(&f, path))
         return f.failure;
+    pd_provenance_now(&prov, PD_FORMAT_SPECTRUM);
+    pd_provenance_csv(&f, &prov);
     dt_rule(s, rule, sizeof rule);
-    pd_csv_printf(&f, "# pound spectrum\n# method = %s\n# Pi2 = %.17g:%.17g:%d %s\n# dt = %s\n",
+    pd_csv_printf(&f, "# method = %s\n# Pi2 = %.17g:%.17g:%d %s\n# dt = %s\n# theta = %.17g\n",
                   pd_method_name(s->opts.method), s->pi2_min, s->pi2_max, s->npi2,
-                  s->linear ? "linear" : "log", rule);
-    pd_csv_printf(&f, "# theta = %.17g\n# units: ap m/s^2, Tp T0 contact_time first_impact dt "
-                      "tend s, gap umax umax_free u_toward u_away m\n",
-                  s->opts.theta);
-    pd_csv_printf(&f, "pulse,dir,method,ap,Tp,Pi3,gap,eps,xi");
+                  s->linear ? "linear" : "log", rule, s->opts.theta);
+    pd_csv_printf(&f, "# units = ");
+    for (int k = 0; k < NCURVE_COLS; k++)
+        pd_csv_printf(&f, "%s%s", k ? "," : "", csv_curve_cols[k][1]);
+    for (int k = 0; k < NCOLS; k++)
+        pd_csv_printf(&f, ",%s", point_cols[k].units);
+    pd_csv_printf(&f, "\n");
+    for (int k = 0; k < NCURVE_COLS; k++)
+        pd_csv_printf(&f, "%s%s", k ? "," : "", csv_curve_cols[k][0]);
     for (int k = 0; k < NCOLS; k++)
         pd_csv_printf(&f, ",%s", point_cols[k].name);
     pd_csv_printf(&f, "\n");

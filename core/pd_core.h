@@ -18,6 +18,24 @@
 #include <stddef.h>
 #include <stdio.h>
 
+/* PD_API marks the public API: the only symbols libpound.so exports (it is
+ * built with -fvisibility=hidden; docs/api.md).  The static library and
+ * other compilers see it as nothing. */
+#if defined(__GNUC__) || defined(__clang__)
+#define PD_API __attribute__((visibility("default")))
+#else
+#define PD_API
+#endif
+
+/* The library's version: MAJOR changes break the public API (pound.h);
+ * MINOR adds to it; PATCH fixes.  pd_version() is the string of the
+ * library actually linked, PD_VERSION the one compiled against. */
+#define PD_VERSION_MAJOR 0
+#define PD_VERSION_MINOR 12
+#define PD_VERSION_PATCH 0
+#define PD_VERSION "0.12.0"
+PD_API const char *pd_version(void);
+
 enum {
     PD_OK = 0,
     PD_ENOMEM = -1,      /* an allocation failed */
@@ -41,22 +59,22 @@ typedef struct pd_err {
 } pd_err;
 
 /* Short text for a status code ("out of memory", ...). */
-const char *pd_strerror(int status);
+PD_API const char *pd_strerror(int status);
 
 /* Record status and a printf-style message in err (err may be NULL);
  * returns status so callers can write `return pd_err_set(err, ...)`. */
-int pd_err_set(pd_err *err, int status, const char *fmt, ...)
+PD_API int pd_err_set(pd_err *err, int status, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
 /* Replace control bytes in msg by '?' (pd_err_set does it to every message). */
-void pd_err_sanitize(char *msg);
+PD_API void pd_err_sanitize(char *msg);
 
 /* Clear err to PD_OK with an empty message. */
-void pd_err_clear(pd_err *err);
+PD_API void pd_err_clear(pd_err *err);
 
 /* Monotonic wall-clock time, and the calling thread's CPU time, in seconds. */
-double pd_wall_seconds(void);
-double pd_cpu_seconds(void);
+PD_API double pd_wall_seconds(void);
+PD_API double pd_cpu_seconds(void);
 
 /* ---- constants ------------------------------------------------------------- */
 
@@ -78,8 +96,8 @@ static inline double pd_max(double a, double b)
 /* The quintic Hermite interpolant on a step of length h through (f, f', f'')
  * = p0 at its start and p1 at its end: value *f and time rate *fd at the
  * fraction r in [0, 1] of the step. */
-void pd_hermite5(const double p0[3], const double p1[3], double h, double r, double *f,
-                 double *fd);
+PD_API void pd_hermite5(const double p0[3], const double p1[3], double h, double r, double *f,
+                        double *fd);
 
 /* ---- matrices -------------------------------------------------------------- */
 
@@ -97,37 +115,38 @@ typedef struct pd_matrix {
     const int *colptr, *rowind; /* CSC only */
 } pd_matrix;
 
-pd_matrix pd_matrix_zero(int rows, int cols);
-pd_matrix pd_matrix_dense(int rows, int cols, const double *values);
-pd_matrix pd_matrix_csc(int rows, int cols, const int *colptr, const int *rowind,
-                        const double *values);
+PD_API pd_matrix pd_matrix_zero(int rows, int cols);
+PD_API pd_matrix pd_matrix_dense(int rows, int cols, const double *values);
+PD_API pd_matrix pd_matrix_csc(int rows, int cols, const int *colptr, const int *rowind,
+                               const double *values);
 
 /* y = alpha A x + beta y (beta = 0 ignores y's old contents). */
-void pd_matrix_gemv(const pd_matrix *A, double alpha, const double *x, double beta, double *y);
+PD_API void pd_matrix_gemv(const pd_matrix *A, double alpha, const double *x, double beta,
+                           double *y);
 
 /* y = A^T x (y has cols entries). */
-void pd_matrix_gemv_t(const pd_matrix *A, const double *x, double *y);
+PD_API void pd_matrix_gemv_t(const pd_matrix *A, const double *x, double *y);
 
 /* Entry (i, j). */
-double pd_matrix_get(const pd_matrix *A, int i, int j);
+PD_API double pd_matrix_get(const pd_matrix *A, int i, int j);
 
 /* A[:, j]^T x;  y += s A[:, j];  sum_i |A_ij| |x_i|. */
-double pd_matrix_col_dot(const pd_matrix *A, int j, const double *x);
-void pd_matrix_col_axpy(const pd_matrix *A, int j, double s, double *y);
-double pd_matrix_col_absdot(const pd_matrix *A, int j, const double *x);
+PD_API double pd_matrix_col_dot(const pd_matrix *A, int j, const double *x);
+PD_API void pd_matrix_col_axpy(const pd_matrix *A, int j, double s, double *y);
+PD_API double pd_matrix_col_absdot(const pd_matrix *A, int j, const double *x);
 
 /* Entries stored (rows * cols for dense, 0 for zero). */
-long pd_matrix_nnz(const pd_matrix *A);
+PD_API long pd_matrix_nnz(const pd_matrix *A);
 
 /* out (rows x cols, column-major) = A. */
-void pd_matrix_to_dense(const pd_matrix *A, double *out);
+PD_API void pd_matrix_to_dense(const pd_matrix *A, double *out);
 
 /* 1 when every stored off-diagonal entry is zero. */
-int pd_matrix_is_diagonal(const pd_matrix *A);
+PD_API int pd_matrix_is_diagonal(const pd_matrix *A);
 
 /* Shape rows x cols, a known kind, a valid CSC structure and finite
  * entries; the message names the matrix. */
-int pd_matrix_check(const pd_matrix *A, int rows, int cols, const char *name, pd_err *err);
+PD_API int pd_matrix_check(const pd_matrix *A, int rows, int cols, const char *name, pd_err *err);
 
 /* ---- an owned sparse matrix ---------------------------------------------- */
 
@@ -140,19 +159,19 @@ typedef struct pd_sparse {
 /* Assemble rows x cols from nt triplets (Ti[k], Tj[k], Tx[k]), summing
  * duplicates and dropping nothing (explicit zeros stay).  PD_ENOMEM or
  * PD_EINVAL (an index out of range); on failure sp is empty. */
-int pd_sparse_from_triplets(pd_sparse *sp, int rows, int cols, long nt, const int *Ti,
-                            const int *Tj, const double *Tx, pd_err *err);
-void pd_sparse_free(pd_sparse *sp);
-pd_matrix pd_sparse_view(const pd_sparse *sp);
+PD_API int pd_sparse_from_triplets(pd_sparse *sp, int rows, int cols, long nt, const int *Ti,
+                                   const int *Tj, const double *Tx, pd_err *err);
+PD_API void pd_sparse_free(pd_sparse *sp);
+PD_API pd_matrix pd_sparse_view(const pd_sparse *sp);
 
 /* ---- dense LU -------------------------------------------------------------- */
 
 /* P A = L U in place for the n x n column-major A (leading dimension lda),
  * partial pivoting; PD_ESINGULAR when a pivot is not above rel_tol max|A|. */
-int pd_dense_lu(int n, double *A, int lda, int *perm, double rel_tol);
+PD_API int pd_dense_lu(int n, double *A, int lda, int *perm, double rel_tol);
 
 /* Solve A x = b in place from the output of pd_dense_lu. */
-void pd_dense_lu_solve(int n, const double *LU, int lda, const int *perm, double *b);
+PD_API void pd_dense_lu_solve(int n, const double *LU, int lda, const int *perm, double *b);
 
 /* ---- input text files in bounded memory --------------------------------
  * The one reader under the LCP, scene and record readers.
@@ -195,20 +214,20 @@ typedef struct pd_text {
 } pd_text;
 
 /* Open path for reading with a cap of max_bytes > 0 bytes. */
-int pd_text_open(pd_text *t, const char *path, long max_bytes, pd_text_at at, pd_err *err);
+PD_API int pd_text_open(pd_text *t, const char *path, long max_bytes, pd_text_at at, pd_err *err);
 
 /* The next line into t->line: 1, 0 at the end of the file, or an error. */
-int pd_text_line(pd_text *t);
+PD_API int pd_text_line(pd_text *t);
 
 /* Back to the start of the file (PD_EIO if it cannot seek: a pipe). */
-int pd_text_rewind(pd_text *t);
+PD_API int pd_text_rewind(pd_text *t);
 
 /* Close the file and free the line buffer (t may have failed to open). */
-void pd_text_close(pd_text *t);
+PD_API void pd_text_close(pd_text *t);
 
 /* The whole file into *text (malloc'd, NUL-terminated, *len bytes before the
  * NUL); on error *text is NULL. */
-int pd_text_read_all(const char *path, long max_bytes, pd_text_at at, char **text, size_t *len,
-                     pd_err *err);
+PD_API int pd_text_read_all(const char *path, long max_bytes, pd_text_at at, char **text,
+                            size_t *len, pd_err *err);
 
 #endif

@@ -69,3 +69,5 @@ double pd_cpu_seconds(void)
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
+
+const char *pd_version(void) { return PD_VERSION; }

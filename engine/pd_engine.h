@@ -38,8 +38,8 @@ typedef enum {
 #define PD_FACTOR_DENSE_MAX 24
 
 /* "auto", "scalar", "dense", "cholmod"; parse: PD_OK or PD_EINVAL. */
-const char *pd_factor_kind_name(pd_factor_kind kind);
-int pd_factor_kind_parse(const char *name, pd_factor_kind *kind);
+PD_API const char *pd_factor_kind_name(pd_factor_kind kind);
+PD_API int pd_factor_kind_parse(const char *name, pd_factor_kind *kind);
 
 /* ---- the model -------------------------------------------------------- */
 
@@ -62,11 +62,11 @@ typedef struct pd_model {
 } pd_model;
 
 /* Check sizes, finiteness, gaps and restitution; message names the field. */
-int pd_model_check(const pd_model *model, pd_err *err);
+PD_API int pd_model_check(const pd_model *model, pd_err *err);
 
 /* The kind the automatic choice gives this model (never PD_FACTOR_AUTO):
  * requested itself unless it is PD_FACTOR_AUTO. */
-pd_factor_kind pd_factor_choose(const pd_model *model, pd_factor_kind requested);
+PD_API pd_factor_kind pd_factor_choose(const pd_model *model, pd_factor_kind requested);
 
 /* ---- state and observers ---------------------------------------------- */
 
@@ -120,41 +120,41 @@ typedef struct pd_mj_opts {
 
 /* Defaults: h = 0 (must be set), theta = 1/2, gamma = 1/2, automatic kernel,
  * factor and LCP solver. */
-pd_mj_opts pd_mj_default_opts(void);
+PD_API pd_mj_opts pd_mj_default_opts(void);
 
 typedef struct pd_mj pd_mj;
 
 /* Allocate every workspace, form What = M + h theta C + h^2 theta^2 K and
  * factor it once, precompute the Delassus data; the state is at rest at
  * t = 0.  The model must outlive the object.  NULL on failure (err says why). */
-pd_mj *pd_mj_alloc(const pd_model *model, const pd_mj_opts *opts, pd_err *err);
-void pd_mj_free(pd_mj *mj);
+PD_API pd_mj *pd_mj_alloc(const pd_model *model, const pd_mj_opts *opts, pd_err *err);
+PD_API void pd_mj_free(pd_mj *mj);
 
 /* Set t, q, v (NULL = zeros) and clear impulses; recomputes gaps. */
-int pd_mj_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_err *err);
+PD_API int pd_mj_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_err *err);
 
 /* Advance one step of size h.  Fails, naming the time and the contact, when
  * the LCP is not solved or the state is not finite. */
-int pd_mj_step(pd_mj *mj, pd_err *err);
+PD_API int pd_mj_step(pd_mj *mj, pd_err *err);
 
 /* Take nsteps steps, calling observer (may be NULL) after reset state and
  * after each step; stops early when the observer asks. */
-int pd_mj_run(pd_mj *mj, long nsteps, pd_observer observer, void *ctx, pd_err *err);
+PD_API int pd_mj_run(pd_mj *mj, long nsteps, pd_observer observer, void *ctx, pd_err *err);
 
-const pd_state *pd_mj_state(const pd_mj *mj);
+PD_API const pd_state *pd_mj_state(const pd_mj *mj);
 
 /* Which kernel the object runs: "scalar" or "general"; which factor kind
  * ("scalar", "dense", "cholmod"). */
-const char *pd_mj_kernel_name(const pd_mj *mj);
-const char *pd_mj_factor_name(const pd_mj *mj);
+PD_API const char *pd_mj_kernel_name(const pd_mj *mj);
+PD_API const char *pd_mj_factor_name(const pd_mj *mj);
 
 /* Closed-form scalar LCP: the P >= 0 with D P + b >= 0, P (D P + b) = 0,
  * for D > 0 (the one-contact kernel uses it instead of Lemke). */
-double pd_contact_impulse_1(double D, double b);
+PD_API double pd_contact_impulse_1(double D, double b);
 
 /* Number of steps to cover [0, tend] with step h (tend/h rounded when
  * within 1e-9 of an integer, else rounded up). */
-long pd_steps_for(double tend, double h);
+PD_API long pd_steps_for(double tend, double h);
 
 /* ---- event-driven reference for the general system (engine/event.c) --- *
  * Smooth motion between events integrated by GSL (rk8pd, tight tolerances)
@@ -182,7 +182,7 @@ typedef struct pd_edg_opts {
 
 /* rtol 1e-12, atol 1e-14, h_out 0, accumulations jumped, 10^6 events,
  * bursts of 10^5, length scale 1, automatic factor and solver. */
-pd_edg_opts pd_edg_default_opts(void);
+PD_API pd_edg_opts pd_edg_default_opts(void);
 
 typedef struct pd_edg_result {
     long impacts, accumulations, detachments, events, steps;
@@ -193,9 +193,9 @@ typedef struct pd_edg_result {
 /* Run the model from (t0, q0, v0) (NULL = zeros) to t1.  The observer gets
  * pd_state: P holds the impulses of an impact at that instant (zero
  * otherwise), active flags the contacts in persistent contact. */
-int pd_edg_run(const pd_model *model, double t0, const double *q0, const double *v0, double t1,
-               const pd_edg_opts *opts, pd_observer observer, void *ctx, pd_edg_result *res,
-               pd_err *err);
+PD_API int pd_edg_run(const pd_model *model, double t0, const double *q0, const double *v0,
+                      double t1, const pd_edg_opts *opts, pd_observer observer, void *ctx,
+                      pd_edg_result *res, pd_err *err);
 
 /* ---- penalty baseline (engine/penalty.c) -------------------------------- */
 
@@ -224,7 +224,7 @@ typedef struct pd_penalty_opts {
 
 /* Kelvin-Voigt, kc = 0 (must be set), rtol 1e-10, atol 1e-12, rk8pd,
  * h_out 0, 10^8 steps, no on_step, automatic factor. */
-pd_penalty_opts pd_penalty_default_opts(void);
+PD_API pd_penalty_opts pd_penalty_default_opts(void);
 
 typedef struct pd_penalty_result {
     long steps;    /* accepted steps */
@@ -245,9 +245,9 @@ typedef struct pd_penalty_result {
  * Steps end exactly at every breakpoint and at every located gap crossing
  * (the state there is reported with the element already switched).
  * Turns GSL's aborting error handler off for the whole process. */
-int pd_penalty_run(const pd_model *model, double t0, const double *q0, const double *v0,
-                   double t1, const pd_penalty_opts *opts, pd_observer observer, void *ctx,
-                   pd_penalty_result *res, pd_err *err);
+PD_API int pd_penalty_run(const pd_model *model, double t0, const double *q0, const double *v0,
+                          double t1, const pd_penalty_opts *opts, pd_observer observer, void *ctx,
+                          pd_penalty_result *res, pd_err *err);
 
 /* ---- closed forms for one linear oscillator --------------------------- */
 
@@ -268,7 +268,7 @@ typedef struct pd_sine_piece {
 } pd_sine_piece;
 
 /* F(t) of one piece (t need not lie inside it). */
-double pd_sine_piece_force(const pd_sine_piece *pc, double t);
+PD_API double pd_sine_piece_force(const pd_sine_piece *pc, double t);
 
 /* Advance the exact solution under the piece pc from (u0, v0) at t0 to t1:
  * the sinusoid's particular solution plus the damped free vibration
@@ -278,17 +278,17 @@ double pd_sine_piece_force(const pd_sine_piece *pc, double t);
  * w0 |t1 - t0| <= 1, closed forms beyond).  The increment form returns
  * du = u(t1) - u0 computed without cancellation (full relative precision
  * for short intervals). */
-void pd_sdof_increment_piece(const pd_sdof *osc, const pd_sine_piece *pc, double t0, double u0,
-                             double v0, double t1, double *du, double *v1);
-void pd_sdof_advance_piece(const pd_sdof *osc, const pd_sine_piece *pc, double t0, double u0,
-                           double v0, double t1, double *u1, double *v1);
+PD_API void pd_sdof_increment_piece(const pd_sdof *osc, const pd_sine_piece *pc, double t0,
+                                    double u0, double v0, double t1, double *du, double *v1);
+PD_API void pd_sdof_advance_piece(const pd_sdof *osc, const pd_sine_piece *pc, double t0, double u0,
+                                  double v0, double t1, double *u1, double *v1);
 
 /* The sinusoid alone, F = A sin(w t + phi) (A = 0: free vibration; w = 0
  * with w0 = 0: the constant force A sin(phi)): the piece {t0, A, w, phi}. */
-void pd_sdof_advance(const pd_sdof *osc, double A, double w, double phi, double t0, double u0,
-                     double v0, double t1, double *u1, double *v1);
-void pd_sdof_increment(const pd_sdof *osc, double A, double w, double phi, double t0, double u0,
-                       double v0, double t1, double *du, double *v1);
+PD_API void pd_sdof_advance(const pd_sdof *osc, double A, double w, double phi, double t0,
+                            double u0, double v0, double t1, double *u1, double *v1);
+PD_API void pd_sdof_increment(const pd_sdof *osc, double A, double w, double phi, double t0,
+                              double u0, double v0, double t1, double *du, double *v1);
 
 /* ---- event-driven reference: one oscillator, one wall (event_sdof.c) --
 
@@ -330,7 +330,7 @@ typedef struct pd_ed_opts {
 
 /* t_end 0 (must be set), t_measure 0, h_out 0, accumulations jumped, 10^7
  * events, bursts of 10^5, length scale 1, 64 scan divisions. */
-pd_ed_opts pd_ed_default_opts(void);
+PD_API pd_ed_opts pd_ed_default_opts(void);
 
 typedef struct pd_ed_result {
     double xmax, xtoward, xaway;  /* max |x|, max x, max -x over the window */
@@ -345,7 +345,7 @@ typedef int (*pd_ed_sampler)(double t, double x, double v, int in_contact, void 
 
 /* Run from (x0, v0) at pieces[0].t_start to opts->t_end.  PD_EBUDGET when an
  * event budget is exhausted (message names the time and the count). */
-int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opts *opts,
-                   pd_ed_sampler sampler, void *ctx, pd_ed_result *res, pd_err *err);
+PD_API int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opts *opts,
+                          pd_ed_sampler sampler, void *ctx, pd_ed_result *res, pd_err *err);
 
 #endif

@@ -39,7 +39,7 @@ typedef enum {
 
 /* Name of an outcome as printed by `pound lcp`: "solved", "no_solution",
  * "max_pivots", "numerical", "max_iterations". */
-const char *pd_lcp_outcome_name(pd_lcp_outcome outcome);
+PD_API const char *pd_lcp_outcome_name(pd_lcp_outcome outcome);
 
 /* Options: start from pd_lcp_default_opts() (a NULL opts pointer means the
  * defaults).  Fields hold values, never "use the default" markers; a 0 pivot
@@ -58,7 +58,7 @@ typedef struct pd_lcp_opts {
 
 /* cover NULL, max_pivots 0 (from n), tol 1e-12, max_iterations 0 (from n),
  * guess NULL. */
-pd_lcp_opts pd_lcp_default_opts(void);
+PD_API pd_lcp_opts pd_lcp_default_opts(void);
 
 /* What a solve reports. */
 typedef struct pd_lcp_info {
@@ -77,20 +77,20 @@ typedef struct pd_lcp_info {
 typedef struct pd_lcp_work pd_lcp_work;
 
 /* Workspace for problems of size up to nmax; NULL when out of memory. */
-pd_lcp_work *pd_lcp_alloc(int nmax);
-void pd_lcp_free(pd_lcp_work *work);
-int pd_lcp_nmax(const pd_lcp_work *work);
+PD_API pd_lcp_work *pd_lcp_alloc(int nmax);
+PD_API void pd_lcp_free(pd_lcp_work *work);
+PD_API int pd_lcp_nmax(const pd_lcp_work *work);
 
 /* Solve the LCP (M, q) of size n <= nmax by Lemke's method.  z and w receive
  * n entries each.  Returns PD_OK only for a verified solution.  Never
  * allocates. info may be NULL. */
-int pd_lcp_lemke(pd_lcp_work *work, int n, const double *M, const double *q,
-                 const pd_lcp_opts *opts, double *z, double *w, pd_lcp_info *info);
+PD_API int pd_lcp_lemke(pd_lcp_work *work, int n, const double *M, const double *q,
+                        const pd_lcp_opts *opts, double *z, double *w, pd_lcp_info *info);
 
 /* Brute-force enumeration of the 2^n complementary bases, n <= 12: the test
  * oracle.  Returns PD_OK with a solution (the first found, in order of
  * increasing support) or PD_ENOSOLUTION if none exists. */
-int pd_lcp_enumerate(int n, const double *M, const double *q, double *z, double *w);
+PD_API int pd_lcp_enumerate(int n, const double *M, const double *q, double *z, double *w);
 
 /* Residuals of a candidate z: fills w = M z + q and returns, through the
  * pointers, max|z_i w_i|, the largest sign violation, and the relative
@@ -99,9 +99,9 @@ int pd_lcp_enumerate(int n, const double *M, const double *q, double *z, double 
  * zs = max|z|, r_i = |q_i| + sum_j |M_ij| |z_j| the size of the terms that
  * make w_i (0/0 = 0).  It is invariant under scaling (q, z) or (M, 1/z), and
  * an answer is verified when it is at most 1e-10 (docs/lcp.md). */
-void pd_lcp_residual(int n, const double *M, const double *q, const double *z,
-                     double *w, double *complementarity, double *infeasibility,
-                     double *residual);
+PD_API void pd_lcp_residual(int n, const double *M, const double *q, const double *z,
+                            double *w, double *complementarity, double *infeasibility,
+                            double *residual);
 
 /* ---- the solver table ------------------------------------------------------ *
  * One entry point for every solver: a solver object sized once (no
@@ -119,10 +119,10 @@ typedef enum {
 typedef struct pd_lcp_solver pd_lcp_solver;
 
 /* "auto", "lemke", "structured", "pgs"; parse: PD_OK or PD_EINVAL. */
-const char *pd_lcp_method_name(pd_lcp_method method);
-int pd_lcp_method_parse(const char *name, pd_lcp_method *method);
+PD_API const char *pd_lcp_method_name(pd_lcp_method method);
+PD_API int pd_lcp_method_parse(const char *name, pd_lcp_method *method);
 /* The names the parser takes, comma-separated (for messages). */
-const char *pd_lcp_method_list(void);
+PD_API const char *pd_lcp_method_list(void);
 
 /* A solver for problems of up to nmax unknowns whose sparse matrices store
  * up to nnzmax entries (0: the caller passes dense matrices only).  Lemke
@@ -131,9 +131,9 @@ const char *pd_lcp_method_list(void);
  * nnzmax > 0) one of min(nmax, PD_LCP_HANDOVER_NMAX)^2, so that a long row
  * never pays the square of its length.  NULL on failure, with the reason
  * in err. */
-pd_lcp_solver *pd_lcp_solver_alloc(pd_lcp_method method, int nmax, long nnzmax, pd_err *err);
-void pd_lcp_solver_free(pd_lcp_solver *s);
-int pd_lcp_solver_nmax(const pd_lcp_solver *s);
+PD_API pd_lcp_solver *pd_lcp_solver_alloc(pd_lcp_method method, int nmax, long nnzmax, pd_err *err);
+PD_API void pd_lcp_solver_free(pd_lcp_solver *s);
+PD_API int pd_lcp_solver_nmax(const pd_lcp_solver *s);
 
 /* Most unknowns Lemke takes inside the solver table (its workspace grows as
  * the square): larger problems go to the structured solver or PGS. */
@@ -145,8 +145,8 @@ int pd_lcp_solver_nmax(const pd_lcp_solver *s);
  * verified solution; PD_ENOSOLUTION, PD_EMAXPIVOTS, PD_EMAXITER,
  * PD_ENUMERICAL otherwise (info->outcome), PD_EINVAL for bad input.
  * info->solver names the solver that answered (auto, or a hand-over). */
-int pd_lcp_solve(pd_lcp_solver *s, const pd_matrix *M, const double *q, const pd_lcp_opts *opts,
-                 double *z, double *w, pd_lcp_info *info);
+PD_API int pd_lcp_solve(pd_lcp_solver *s, const pd_matrix *M, const double *q,
+                        const pd_lcp_opts *opts, double *z, double *w, pd_lcp_info *info);
 
 /* File formats: plain (SPEC §3, row-major, '#' comments) and Siconos
  * (column-major).  PD_LCP_FORMAT_AUTO detects which. */
@@ -155,7 +155,7 @@ typedef enum { PD_LCP_FORMAT_AUTO, PD_LCP_FORMAT_PLAIN, PD_LCP_FORMAT_SICONOS } 
 /* Read an LCP from a file; on success *M (column-major n x n) and *q are
  * malloc'd and owned by the caller.  A malformed file returns PD_EPARSE with
  * a message naming the line. */
-int pd_lcp_read(const char *path, pd_lcp_format format, int *n, double **M, double **q,
-                pd_err *err);
+PD_API int pd_lcp_read(const char *path, pd_lcp_format format, int *n, double **M, double **q,
+                       pd_err *err);
 
 #endif

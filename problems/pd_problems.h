@@ -24,18 +24,18 @@ typedef enum { PD_PULSE_SINE = 0, PD_PULSE_COSINE = 1, PD_PULSE_HARMONIC = 2 } p
 
 /* "sine", "cosine", "harmonic"; "normal" (+1), "reverse" (-1).  The parsers
  * return PD_OK, or PD_EINVAL for an unknown name. */
-const char *pd_pulse_name(pd_pulse pulse);
-int pd_pulse_parse(const char *name, pd_pulse *pulse);
-const char *pd_dir_name(int dir);
-int pd_dir_parse(const char *name, int *dir);
+PD_API const char *pd_pulse_name(pd_pulse pulse);
+PD_API int pd_pulse_parse(const char *name, pd_pulse *pulse);
+PD_API const char *pd_dir_name(int dir);
+PD_API int pd_dir_parse(const char *name, int *dir);
 
 /* The effective acceleration in units of ap at tau = wp t: s phi(tau), phi =
  * sin or cos on [0, 2 pi] and zero after (sin for all tau: harmonic), and
  * its tau-derivative.  side -1 / +1 picks the left / right limit at the
  * pulse end tau = 2 pi (recognised to a relative 1e-12, so that tau = k h
  * lands on the same side at every scale). */
-double pd_pulse_shape(pd_pulse pulse, int dir, double tau, int side);
-double pd_pulse_shape_rate(pd_pulse pulse, int dir, double tau, int side);
+PD_API double pd_pulse_shape(pd_pulse pulse, int dir, double tau, int side);
+PD_API double pd_pulse_shape_rate(pd_pulse pulse, int dir, double tau, int side);
 
 /* ==== strong-motion records (SPEC §5, docs/records.md) ====================== *
  * A record is the ground acceleration ug''(t) sampled every dt, linear
@@ -69,10 +69,10 @@ typedef enum {
 typedef enum { PD_UNITS_G = 0, PD_UNITS_M_S2 = 1, PD_UNITS_CM_S2 = 2 } pd_record_units;
 
 /* "auto", "at2", "v2", "text"; "g", "m/s2", "cm/s2"; parse: PD_OK or PD_EINVAL. */
-const char *pd_record_format_name(pd_record_format f);
-int pd_record_format_parse(const char *name, pd_record_format *f);
-const char *pd_record_units_name(pd_record_units u);
-int pd_record_units_parse(const char *name, pd_record_units *u);
+PD_API const char *pd_record_format_name(pd_record_format f);
+PD_API int pd_record_format_parse(const char *name, pd_record_format *f);
+PD_API const char *pd_record_units_name(pd_record_units u);
+PD_API int pd_record_units_parse(const char *name, pd_record_units *u);
 
 /* Standard gravity used to convert records given in g (PD_G_STANDARD). */
 typedef struct pd_record {
@@ -84,14 +84,14 @@ typedef struct pd_record {
 
 /* Read a record; units apply to text files only (AT2 is in g, V2 says).
  * On error rec is left empty (acc NULL, npts 0). */
-int pd_record_read(const char *path, pd_record_format format, pd_record_units units,
-                   pd_record *rec, pd_err *err);
-void pd_record_free(pd_record *rec);
+PD_API int pd_record_read(const char *path, pd_record_format format, pd_record_units units,
+                          pd_record *rec, pd_err *err);
+PD_API void pd_record_free(pd_record *rec);
 /* The record's duration (npts - 1) dt [s]. */
-double pd_record_duration(const pd_record *rec);
+PD_API double pd_record_duration(const pd_record *rec);
 /* ug''(t) [m/s^2]: linear between samples, 0 before 0 and after the last
  * (whose time is recognised to a relative 1e-12). */
-double pd_record_acc(const pd_record *rec, double t);
+PD_API double pd_record_acc(const pd_record *rec, double t);
 
 /* Ground-motion measures.  Velocity and displacement are the exact
  * integrals of the piecewise-linear acceleration from rest, with no
@@ -108,11 +108,11 @@ typedef struct pd_record_measures {
     double t5_75, t5_95;         /* [s] */
 } pd_record_measures;
 
-int pd_record_measure(const pd_record *rec, pd_record_measures *m, pd_err *err);
+PD_API int pd_record_measure(const pd_record *rec, pd_record_measures *m, pd_err *err);
 
 /* The record's ground velocity and displacement at the samples (n = npts
  * each, caller's arrays), as the measures use them. */
-int pd_record_integrate(const pd_record *rec, double *vel, double *disp, pd_err *err);
+PD_API int pd_record_integrate(const pd_record *rec, double *vel, double *disp, pd_err *err);
 
 /* The Mavroeidis–Papageorgiou (2003) velocity pulse fitted to the record's
  * velocity by GSL's nonlinear least squares:
@@ -139,22 +139,22 @@ typedef struct pd_record_pulse {
     double t_start;               /* start of the one-cycle pulse [s] */
 } pd_record_pulse;
 
-int pd_record_fit_pulse(const pd_record *rec, pd_record_pulse *p, pd_err *err);
+PD_API int pd_record_fit_pulse(const pd_record *rec, pd_record_pulse *p, pd_err *err);
 
 /* The fitted pulse as a function of time (record_pulse.c): the
  * Mavroeidis–Papageorgiou velocity v(t) and acceleration a(t) = v'(t), and
  * the paper's one-cycle acceleration pulse of amplitude ap and period Tp
  * from t_start, signed as the record's acceleration there. */
-void pd_record_pulse_eval(const pd_record_pulse *p, double t, double *acc, double *vel);
-double pd_record_one_cycle(const pd_record_pulse *p, double t);
+PD_API void pd_record_pulse_eval(const pd_record_pulse *p, double t, double *acc, double *vel);
+PD_API double pd_record_one_cycle(const pd_record_pulse *p, double t);
 
 /* ==== how a run is made ====================================================== */
 
 typedef enum { PD_METHOD_MOREAU = 0, PD_METHOD_EVENT = 1, PD_METHOD_PENALTY = 2 } pd_method;
 
 /* "moreau", "event", "penalty"; parse: PD_OK or PD_EINVAL. */
-const char *pd_method_name(pd_method method);
-int pd_method_parse(const char *name, pd_method *method);
+PD_API const char *pd_method_name(pd_method method);
+PD_API int pd_method_parse(const char *name, pd_method *method);
 
 /* The penalty baseline's contact elements (see pd_penalty_run). */
 typedef struct pd_penalty_setup {
@@ -186,12 +186,13 @@ typedef struct pd_run_opts {
 } pd_run_opts;
 
 /* Moreau–Jean, dt and tend derived, theta = gamma = 1/2, automatic kernel,
- * factor and LCP solver, accumulations jumped, Kelvin-Voigt with kc = 1e4
- * w0^2, rtol 1e-10, atol 1e-12, rk8pd. */
-pd_run_opts pd_run_default_opts(void);
+ * factor and LCP solver, accumulations jumped, Kelvin-Voigt with the
+ * derived stiffness (kc_mult = 0: the oscillator's resolves the gap,
+ * docs/methods.md; scenes 1e4 w0^2), rtol 1e-10, atol 1e-12, rk8pd. */
+PD_API pd_run_opts pd_run_default_opts(void);
 
 /* Ranges of the scheme options, each message naming the option. */
-int pd_run_opts_check(const pd_run_opts *o, pd_err *err);
+PD_API int pd_run_opts_check(const pd_run_opts *o, pd_err *err);
 
 /* ==== the pounding oscillator (SPEC §1) ===================================== *
  *   u'' + 2 xi w0 u' + w0^2 u = f(t) - lambda,   g = delta - u >= 0,
@@ -214,48 +215,50 @@ typedef struct pd_osc {
 } pd_osc;
 
 /* sine, normal, ap = 1, Tp = 1, Pi2 = 1, Pi3 = 0.05, eps = 0.5, xi = 0.05. */
-pd_osc pd_osc_default(void);
+PD_API pd_osc pd_osc_default(void);
 
 /* Derived quantities. */
-double pd_osc_wp(const pd_osc *c);  /* 2 pi / Tp */
-double pd_osc_T0(const pd_osc *c);  /* Tp / Pi2 */
-double pd_osc_gap(const pd_osc *c); /* delta = Pi3 ap / wp^2 [m] */
-double pd_osc_Le(const pd_osc *c);  /* ap / wp^2 [m] */
+PD_API double pd_osc_wp(const pd_osc *c);  /* 2 pi / Tp */
+PD_API double pd_osc_T0(const pd_osc *c);  /* Tp / Pi2 */
+PD_API double pd_osc_gap(const pd_osc *c); /* delta = Pi3 ap / wp^2 [m] */
+PD_API double pd_osc_Le(const pd_osc *c);  /* ap / wp^2 [m] */
 
 /* The dimensional forms: Pi2 = Tp / T0, Pi3 = gap / Le (ap, Tp set first). */
-void pd_osc_set_T0(pd_osc *c, double T0);
-void pd_osc_set_gap(pd_osc *c, double gap);
+PD_API void pd_osc_set_T0(pd_osc *c, double T0);
+PD_API void pd_osc_set_gap(pd_osc *c, double gap);
 
 /* Effective acceleration f(t) [m/s^2] at time t [s]. */
-double pd_osc_excitation(const pd_osc *c, double t);
+PD_API double pd_osc_excitation(const pd_osc *c, double t);
 
 /* Excite c by a record scaled by S (SPEC §5): Tp and ap = S p->ap from its
  * fitted pulse p, so that the Pi terms are the pulse's; dir keeps its
  * meaning (normal: f = -S ug''). */
-void pd_osc_set_record(pd_osc *c, const pd_record *rec, const pd_record_pulse *p, double scale);
+PD_API void pd_osc_set_record(pd_osc *c, const pd_record *rec, const pd_record_pulse *p,
+                              double scale);
 
 /* The effective acceleration in units of ap at tau = wp t (the pulse's
  * s phi(tau) or the record's -dir ug''(t) / rec_ap), with its tau-rate;
  * side -1 / +1: left / right limit at a jump (the pulse's or the record's
  * end).  The end of the excitation in tau (HUGE_VAL: harmonic). */
-double pd_osc_shape(const pd_osc *c, double tau, int side);
-double pd_osc_shape_rate(const pd_osc *c, double tau, int side);
-double pd_osc_shape_end(const pd_osc *c);
+PD_API double pd_osc_shape(const pd_osc *c, double tau, int side);
+PD_API double pd_osc_shape_rate(const pd_osc *c, double tau, int side);
+PD_API double pd_osc_shape_end(const pd_osc *c);
 
 /* The name of the excitation: the pulse's, or the record's file name. */
-const char *pd_osc_excitation_name(const pd_osc *c);
+PD_API const char *pd_osc_excitation_name(const pd_osc *c);
 
 /* Check every field; the message names the field ("eps", "gap", ...). */
-int pd_osc_check(const pd_osc *c, pd_err *err);
+PD_API int pd_osc_check(const pd_osc *c, pd_err *err);
 
 /* Check the case and the options and complete dt and tend. */
-int pd_osc_resolve_opts(const pd_osc *c, const pd_run_opts *in, pd_run_opts *out, pd_err *err);
-double pd_osc_default_dt(const pd_osc *c); /* min(Tp, T0) / 2000 */
+PD_API int pd_osc_resolve_opts(const pd_osc *c, const pd_run_opts *in, pd_run_opts *out,
+                               pd_err *err);
+PD_API double pd_osc_default_dt(const pd_osc *c); /* min(Tp, T0) / 2000 */
 /* Pulses: Tp + 2 T0.  Harmonic: a transient phase followed by a measuring
  * window of max(16 Tp, 3 T0) (docs/scheme.md). */
-double pd_osc_default_tend(const pd_osc *c);
+PD_API double pd_osc_default_tend(const pd_osc *c);
 /* Start of the window over which umax is measured (0 for pulses). */
-double pd_osc_measure_start(const pd_osc *c, double tend);
+PD_API double pd_osc_measure_start(const pd_osc *c, double tend);
 
 /* One recorded sample, in metres, seconds and m/s. */
 typedef struct pd_osc_sample {
@@ -288,28 +291,28 @@ typedef struct pd_osc_result {
 } pd_osc_result;
 
 /* Run the case with the method of opts (sampler may be NULL). */
-int pd_osc_run(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
-               pd_osc_result *res, pd_err *err);
+PD_API int pd_osc_run(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
+                      pd_osc_result *res, pd_err *err);
 
 /* The event-driven reference's work: its scan points over tend (64 per
  * shortest of Tp and T0), and the most a run may take (about 5 s here: a
  * stiffer oscillator is quasi-static, and Moreau-Jean runs it). */
 #define PD_OSC_MAX_SCAN 2.5e7
-double pd_osc_scan_points(const pd_osc *c, double tend);
+PD_API double pd_osc_scan_points(const pd_osc *c, double tend);
 
 /* The three methods (pd_osc_run dispatches to them):
  * Moreau–Jean, its umax the maximum over the steps; */
-int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler,
-                    void *ctx, pd_osc_result *res, pd_err *err);
+PD_API int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler,
+                           void *ctx, pd_osc_result *res, pd_err *err);
 /* the exact event-driven reference (pd_ed_sdof_run): dt is only the
  * sampling interval, res->steps counts events, res->kernel is "event"; */
-int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
-                     pd_osc_result *res, pd_err *err);
+PD_API int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler,
+                            void *ctx, pd_osc_result *res, pd_err *err);
 /* the penalty baseline with opts->pen (Hertz: the force at a penetration of
  * Le equals kc_mult w0^2 Le); samples every dt; res->steps counts accepted
  * steps, res->kernel names the stepper. */
-int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
-                   pd_osc_result *res, pd_err *err);
+PD_API int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler,
+                          void *ctx, pd_osc_result *res, pd_err *err);
 
 /* A run and its no-wall twin, with the paper's figures. */
 typedef struct pd_osc_summary {
@@ -320,18 +323,18 @@ typedef struct pd_osc_summary {
     double cpu_s; /* both runs */
 } pd_osc_summary;
 
-int pd_osc_summarize(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
-                     pd_osc_summary *s, pd_err *err);
+PD_API int pd_osc_summarize(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler,
+                            void *ctx, pd_osc_summary *s, pd_err *err);
 
 /* Exact response without the wall from rest (closed form), at t [s]; a
  * pulse only (a record's free response is pd_osc_reference with no wall). */
-void pd_osc_free_exact(const pd_osc *c, double t, double *u, double *v);
+PD_API void pd_osc_free_exact(const pd_osc *c, double t, double *u, double *v);
 
 /* First time t <= tmax at which that free response reaches the gap, found
  * on a grid of Tp/1000 and bisected to rounding, with the speed there:
  * PD_OK, or PD_EINVAL when it does not reach the gap by tmax (or c is
  * driven by a record). */
-int pd_osc_free_first_contact(const pd_osc *c, double tmax, double *t, double *v);
+PD_API int pd_osc_free_first_contact(const pd_osc *c, double tmax, double *t, double *v);
 
 /* ---- errors against the reference (compare, converge) ------------------- *
  *   err_umax_rel  = |umax - umax_ref| / umax_ref,
@@ -350,17 +353,17 @@ typedef struct pd_measured {
 } pd_measured;
 
 /* Room for the grid of o (tend / dt + 2 points): PD_OK or PD_ENOMEM. */
-int pd_trace_alloc(pd_trace *tr, const pd_run_opts *o);
-void pd_trace_free(pd_trace *tr);
+PD_API int pd_trace_alloc(pd_trace *tr, const pd_run_opts *o);
+PD_API void pd_trace_free(pd_trace *tr);
 
 /* The reference on the grid of o; res->cpu_s is its cost without sampling. */
-int pd_measure_reference(const pd_osc *c, const pd_run_opts *o, pd_trace *ref,
-                         pd_osc_result *res, pd_err *err);
+PD_API int pd_measure_reference(const pd_osc *c, const pd_run_opts *o, pd_trace *ref,
+                                pd_osc_result *res, pd_err *err);
 
 /* The method of o on the same grid, its errors against ref; out->r.cpu_s is
  * the cost of a second run without sampling. */
-int pd_measure_run(const pd_osc *c, const pd_run_opts *o, const pd_trace *ref, double umax_ref,
-                   pd_trace *work, pd_measured *out, pd_err *err);
+PD_API int pd_measure_run(const pd_osc *c, const pd_run_opts *o, const pd_trace *ref,
+                          double umax_ref, pd_trace *work, pd_measured *out, pd_err *err);
 
 /* ==== scenes: rows of structures (SPEC §4) =================================== *
  * Structures stand in a row along x (positive to the right) on a common
@@ -426,61 +429,62 @@ typedef struct pd_scene {
 } pd_scene;
 
 /* An empty scene excited by exc; NULL when out of memory. */
-pd_scene *pd_scene_new(const pd_scene_excitation *exc);
-void pd_scene_free(pd_scene *sc);
+PD_API pd_scene *pd_scene_new(const pd_scene_excitation *exc);
+PD_API void pd_scene_free(pd_scene *sc);
 
 /* Add structures and contacts (file order is row order, left to right).
  * Each returns PD_OK or an error whose message starts with the field it
  * concerns ("T0: must be > 0 (got -1)"). */
-int pd_scene_add_sdof(pd_scene *sc, const char *name, double T0, double xi, double mass,
-                      pd_err *err);
-int pd_scene_add_building(pd_scene *sc, const char *name, int storeys, const double *masses,
-                          const double *stiffnesses, double xi, pd_err *err);
+PD_API int pd_scene_add_sdof(pd_scene *sc, const char *name, double T0, double xi, double mass,
+                             pd_err *err);
+PD_API int pd_scene_add_building(pd_scene *sc, const char *name, int storeys, const double *masses,
+                                 const double *stiffnesses, double xi, pd_err *err);
 /* Uniform storeys of mass `mass` with the stiffness that gives the
  * fundamental period T0. */
-int pd_scene_add_uniform(pd_scene *sc, const char *name, int storeys, double mass, double T0,
-                         double xi, pd_err *err);
+PD_API int pd_scene_add_uniform(pd_scene *sc, const char *name, int storeys, double mass, double T0,
+                                double xi, pd_err *err);
 /* Damping of the last structure added: the model and (Rayleigh) its modes. */
-int pd_scene_set_damping(pd_scene *sc, pd_damping damping, int mode1, int mode2, pd_err *err);
+PD_API int pd_scene_set_damping(pd_scene *sc, pd_damping damping, int mode1, int mode2,
+                                pd_err *err);
 /* A contact; a or b PD_WALL for a wall (level 0 there). */
-int pd_scene_add_contact(pd_scene *sc, int a, int level_a, int b, int level_b, double gap,
-                         double eps, int entry, pd_err *err);
+PD_API int pd_scene_add_contact(pd_scene *sc, int a, int level_a, int b, int level_b, double gap,
+                                double eps, int entry, pd_err *err);
 /* A deep copy, not finished (NULL when out of memory); a record it names
  * is shared, not copied: the original must outlive the copy. */
-pd_scene *pd_scene_copy(const pd_scene *sc);
+PD_API pd_scene *pd_scene_copy(const pd_scene *sc);
 /* The structure called name, or -1 (PD_WALL for "wall"); -2 when unknown. */
-int pd_scene_find(const pd_scene *sc, const char *name);
+PD_API int pd_scene_find(const pd_scene *sc, const char *name);
 
 /* Check the row (contacts left to right, levels that exist, a non-empty
  * row), number the dofs, derive periods and damping.  PD_OK or PD_EINVAL. */
-int pd_scene_finish(pd_scene *sc, pd_err *err);
+PD_API int pd_scene_finish(pd_scene *sc, pd_err *err);
 
 /* Read a scene file (JSON, docs/scenes.md).  Errors: PD_EIO (unreadable),
  * PD_EPARSE with "FILE:LINE:COL: field.path: what is wrong". */
-int pd_scene_load(const char *path, pd_scene **out, pd_err *err);
+PD_API int pd_scene_load(const char *path, pd_scene **out, pd_err *err);
 
 /* A generated row of N SDOFs of unit mass between two walls, periods
  * alternating T0 and ratio T0, every gap `gap` and restitution eps: the
  * scale-study scene of `--chain N`. */
-int pd_scene_chain(int N, const pd_scene_excitation *exc, double T0, double ratio, double xi,
-                   double gap, double eps, pd_scene **out, pd_err *err);
+PD_API int pd_scene_chain(int N, const pd_scene_excitation *exc, double T0, double ratio, double xi,
+                          double gap, double eps, pd_scene **out, pd_err *err);
 
 /* Reference scales: wp = 2 pi / Tp, Le = ap / wp^2. */
-double pd_scene_wp(const pd_scene *sc);
-double pd_scene_Le(const pd_scene *sc);
+PD_API double pd_scene_wp(const pd_scene *sc);
+PD_API double pd_scene_Le(const pd_scene *sc);
 /* min(Tp, shortest fundamental period) / 2000, and the tend of a pulse:
  * Tp + 2 (longest fundamental period); harmonic: as for the oscillator with
  * the longest period and the smallest damping. */
-double pd_scene_default_dt(const pd_scene *sc);
-double pd_scene_default_tend(const pd_scene *sc);
-double pd_scene_measure_start(const pd_scene *sc, double tend);
+PD_API double pd_scene_default_dt(const pd_scene *sc);
+PD_API double pd_scene_default_tend(const pd_scene *sc);
+PD_API double pd_scene_measure_start(const pd_scene *sc, double tend);
 /* Check the options and complete dt and tend. */
-int pd_scene_resolve_opts(const pd_scene *sc, const pd_run_opts *in, pd_run_opts *out,
-                          pd_err *err);
+PD_API int pd_scene_resolve_opts(const pd_scene *sc, const pd_run_opts *in, pd_run_opts *out,
+                                 pd_err *err);
 /* 1 when the scene is the one-wall oscillator (one SDOF, at most one contact,
  * with a wall): it then runs on the oscillator's fast paths, with *c the
  * equivalent case (mirrored when the wall is on the left). */
-int pd_scene_as_oscillator(const pd_scene *sc, pd_osc *c, int *mirrored);
+PD_API int pd_scene_as_oscillator(const pd_scene *sc, pd_osc *c, int *mirrored);
 
 /* The scene as an engine model in the reference units (tau = wp t, x =
  * u / Le, masses in kg): M, C, K, W compressed-column, F = M 1 phi(tau). */
@@ -492,8 +496,9 @@ typedef struct pd_scene_model {
     pd_osc shape;         /* the excitation's shape in Pi units (pd_osc_shape) */
 } pd_scene_model;
 
-int pd_scene_model_build(const pd_scene *sc, int with_contacts, pd_scene_model *sm, pd_err *err);
-void pd_scene_model_free(pd_scene_model *sm);
+PD_API int pd_scene_model_build(const pd_scene *sc, int with_contacts, pd_scene_model *sm,
+                                pd_err *err);
+PD_API void pd_scene_model_free(pd_scene_model *sm);
 
 /* One sample of a scene run, in metres, seconds and newton-seconds. */
 typedef struct pd_scene_sample {
@@ -524,13 +529,13 @@ typedef struct pd_scene_result {
     const char *method, *kernel, *factor, *lcp_solver;
 } pd_scene_result;
 
-int pd_scene_result_alloc(const pd_scene *sc, pd_scene_result *r, pd_err *err);
-void pd_scene_result_free(pd_scene_result *r);
+PD_API int pd_scene_result_alloc(const pd_scene *sc, pd_scene_result *r, pd_err *err);
+PD_API void pd_scene_result_free(pd_scene_result *r);
 
 /* Run the scene with the method of opts; sampler (may be NULL) gets the
  * state every step (Moreau–Jean) or every dt (the others), and at t = 0. */
-int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler sampler,
-                 void *ctx, pd_scene_result *res, pd_err *err);
+PD_API int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler sampler,
+                        void *ctx, pd_scene_result *res, pd_err *err);
 
 /* A run and its contact-free twin with the Pi terms:
  *   Pi1 = umax wp^2 / ap per dof,  Pi2 = Tp / T0 per structure,
@@ -544,9 +549,9 @@ typedef struct pd_scene_summary {
     double cpu_s;
 } pd_scene_summary;
 
-int pd_scene_summarize(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler sampler,
-                       void *ctx, pd_scene_summary *s, pd_err *err);
-void pd_scene_summary_free(pd_scene_summary *s);
+PD_API int pd_scene_summarize(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler sampler,
+                              void *ctx, pd_scene_summary *s, pd_err *err);
+PD_API void pd_scene_summary_free(pd_scene_summary *s);
 
 /* ---- errors against the reference on a scene (compare, converge) -------- *
  * Per structure, on the output grid t_k = k dt:
@@ -571,20 +576,20 @@ typedef struct pd_scene_errors {
 } pd_scene_errors;
 
 /* Room for the grid of o (PD_EINVAL when it would exceed 2 GB). */
-int pd_scene_trace_alloc(pd_scene_trace *tr, const pd_scene *sc, const pd_run_opts *o,
-                         pd_err *err);
-void pd_scene_trace_free(pd_scene_trace *tr);
-int pd_scene_errors_alloc(const pd_scene *sc, pd_scene_errors *e, pd_err *err);
-void pd_scene_errors_free(pd_scene_errors *e);
+PD_API int pd_scene_trace_alloc(pd_scene_trace *tr, const pd_scene *sc, const pd_run_opts *o,
+                                pd_err *err);
+PD_API void pd_scene_trace_free(pd_scene_trace *tr);
+PD_API int pd_scene_errors_alloc(const pd_scene *sc, pd_scene_errors *e, pd_err *err);
+PD_API void pd_scene_errors_free(pd_scene_errors *e);
 
 /* The event-driven reference of o's scene on its grid (res allocated by
  * pd_scene_result_alloc; res->cpu_s is its cost without sampling). */
-int pd_scene_measure_reference(const pd_scene *sc, const pd_run_opts *o, pd_scene_trace *ref,
-                               pd_scene_result *res, pd_err *err);
+PD_API int pd_scene_measure_reference(const pd_scene *sc, const pd_run_opts *o, pd_scene_trace *ref,
+                                      pd_scene_result *res, pd_err *err);
 /* The method of o on the same grid and its errors against ref. */
-int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scene_trace *ref,
-                         const pd_scene_result *ref_res, pd_scene_result *res,
-                         pd_scene_errors *e, pd_err *err);
+PD_API int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scene_trace *ref,
+                                const pd_scene_result *ref_res, pd_scene_result *res,
+                                pd_scene_errors *e, pd_err *err);
 
 /* ==== spectrum sweeps ============================================================ *
  * A Pi2 grid crossed with lists of pulse, directivity, amplitude, damping,
@@ -651,35 +656,53 @@ typedef struct pd_spec_row {
 
 /* Defaults: one sine pulse, normal, ap = 1, Tp = 1, xi = 0.05, Pi3 = 0.05,
  * eps = 0.5; no Pi2 grid yet (npi2 = 0). */
-void pd_spec_init(pd_spectrum *s);
-long pd_spec_curves(const pd_spectrum *s);
-long pd_spec_points(const pd_spectrum *s);
-long pd_spec_twins(const pd_spectrum *s);
-long pd_spec_tasks(const pd_spectrum *s);
+PD_API void pd_spec_init(pd_spectrum *s);
+PD_API long pd_spec_curves(const pd_spectrum *s);
+PD_API long pd_spec_points(const pd_spectrum *s);
+PD_API long pd_spec_twins(const pd_spectrum *s);
+PD_API long pd_spec_tasks(const pd_spectrum *s);
 /* The j-th of n values from lo to hi, equal steps (linear) or log-spaced,
  * the end points exact. */
-double pd_grid_value(double lo, double hi, int n, int linear, int j);
+PD_API double pd_grid_value(double lo, double hi, int n, int linear, int j);
 /* The j-th Pi2 of the grid (end points exact). */
-double pd_spec_pi2(const pd_spectrum *s, int j);
-void pd_spec_coords_of(const pd_spectrum *s, long task, pd_spec_coords *co);
+PD_API double pd_spec_pi2(const pd_spectrum *s, int j);
+PD_API void pd_spec_coords_of(const pd_spectrum *s, long task, pd_spec_coords *co);
 /* The twin task of a point task. */
-long pd_spec_twin_of(const pd_spectrum *s, long task);
+PD_API long pd_spec_twin_of(const pd_spectrum *s, long task);
 /* The case and options of a task, resolved as `pound simulate` resolves
  * them (dt, tend derived per point): PD_OK or PD_EINVAL naming the field. */
-int pd_spec_case(const pd_spectrum *s, long task, pd_osc *c, pd_run_opts *o, pd_err *err);
+PD_API int pd_spec_case(const pd_spectrum *s, long task, pd_osc *c, pd_run_opts *o, pd_err *err);
 /* Check every point's case: PD_OK or PD_EINVAL with the first bad one. */
-int pd_spec_validate(const pd_spectrum *s, pd_err *err);
+PD_API int pd_spec_validate(const pd_spectrum *s, pd_err *err);
 /* Run one task into r (r->status and err say why it failed). */
-void pd_spec_run_task(const pd_spectrum *s, long task, pd_spec_result *r, pd_err *err);
+PD_API void pd_spec_run_task(const pd_spectrum *s, long task, pd_spec_result *r, pd_err *err);
 /* Expected cost of a task: its number of steps. */
-double pd_spec_cost(const pd_spectrum *s, long task);
+PD_API double pd_spec_cost(const pd_spectrum *s, long task);
 /* A canonical text of every parameter that shapes the results (the
  * journal header); malloc'd, NULL when out of memory. */
-char *pd_spec_key(const pd_spectrum *s);
+PD_API char *pd_spec_key(const pd_spectrum *s);
 /* Points from task results (twins give umax_free, gamma, chi). */
-void pd_spec_rows(const pd_spectrum *s, const pd_spec_result *res, pd_spec_row *rows);
+PD_API void pd_spec_rows(const pd_spectrum *s, const pd_spec_result *res, pd_spec_row *rows);
 /* A short label of a curve naming the parameters that vary. */
-void pd_spec_curve_label(const pd_spectrum *s, long curve, char *buf, size_t cap);
+PD_API void pd_spec_curve_label(const pd_spectrum *s, long curve, char *buf, size_t cap);
+
+/* Called by pd_spec_sweep for each point, in order (p = curve * npi2 + j):
+ * co its place in the lists (co->curve, co->j; co->twin = 0), row its
+ * numbers (row->c holds Pi2, Pi3, eps, xi, ap, pulse, dir; umax, Pi1,
+ * umax_free of the no-wall twin, gamma, chi, impacts, ...).  Both are valid
+ * during the call only.  Return 0 to go on, nonzero to stop the sweep. */
+typedef int (*pd_spec_point_fn)(const pd_spec_coords *co, const pd_spec_row *row, void *ctx);
+
+/* Run every task of the sweep in order on the calling thread (the no-wall
+ * twins first, then the points) and hand each point to fn as it completes:
+ * the numbers pd_spec_run_task and pd_spec_rows give (`pound spectrum`
+ * runs the same tasks on threads and ranks).  Every case is checked before
+ * anything runs: PD_EINVAL naming the first bad one (or a list or grid out
+ * of range).  A failed run stops the sweep with its status and a message
+ * naming the point; fn's nonzero return stops it with PD_ESTOPPED.  Memory:
+ * one result per twin.  Re-entrant: sweeps may run on several threads
+ * (docs/api.md: threads, and GSL's process-wide error handler). */
+PD_API int pd_spec_sweep(const pd_spectrum *s, pd_spec_point_fn fn, void *ctx, pd_err *err);
 
 /* ---- scene sweeps ------------------------------------------------------------ *
  * The Pi presentation carried to N structures: the pulse period swept over
@@ -707,18 +730,18 @@ typedef struct pd_scene_point {
     int status;
 } pd_scene_point;
 
-long pd_scene_sweep_twins(const pd_scene_sweep *w);
-long pd_scene_sweep_points(const pd_scene_sweep *w);
+PD_API long pd_scene_sweep_twins(const pd_scene_sweep *w);
+PD_API long pd_scene_sweep_points(const pd_scene_sweep *w);
 /* Check the sweep (the reference contact, the lists): PD_OK or PD_EINVAL
  * naming the field. */
-int pd_scene_sweep_check(const pd_scene_sweep *w, pd_err *err);
+PD_API int pd_scene_sweep_check(const pd_scene_sweep *w, pd_err *err);
 /* The scene of a task (a finished copy, freed by the caller) and its point. */
-int pd_scene_sweep_scene(const pd_scene_sweep *w, long task, pd_scene **out, pd_scene_point *pt,
-                         pd_err *err);
+PD_API int pd_scene_sweep_scene(const pd_scene_sweep *w, long task, pd_scene **out,
+                                pd_scene_point *pt, pd_err *err);
 /* Run every task on `threads` OpenMP threads (0: the default): pts[task]
  * and umax[task * nstruct + s] (the largest storey displacement of
  * structure s [m]).  The status of the lowest failed task, its message. */
-int pd_scene_sweep_run(const pd_scene_sweep *w, int threads, pd_scene_point *pts, double *umax,
-                       pd_err *err);
+PD_API int pd_scene_sweep_run(const pd_scene_sweep *w, int threads, pd_scene_point *pts,
+                              double *umax, pd_err *err);
 
 #endif

@@ -328,3 +328,61 @@ void pd_spec_curve_label(const pd_spectrum *s, long curve, char *buf, size_t cap
     if (n > 0 && n <= cap)
         buf[n - 1] = '\0';
 }
+
+/* ---- a serial sweep with a callback per point -------------------------- */
+
+/* The lists and the grid within their arrays' bounds: PD_OK or PD_EINVAL. */
+static int check_shape(const pd_spectrum *s, pd_err *err)
+{
+    const struct {
+        const char *name;
+        int n, max;
+    } lists[] = {{"pulse", s->npulse, 3},           {"dir", s->ndir, 2},
+                 {"ap", s->nap, PD_SPEC_MAX_LIST},  {"xi", s->nxi, PD_SPEC_MAX_LIST},
+                 {s->size_is_gap ? "gap" : "Pi3", s->nsize, PD_SPEC_MAX_LIST},
+                 {"eps", s->neps, PD_SPEC_MAX_LIST}, {"Pi2", s->npi2, 1 << 24}};
+    for (size_t k = 0; k < sizeof lists / sizeof lists[0]; k++)
+        if (lists[k].n < 1 || lists[k].n > lists[k].max)
+            return pd_err_set(err, PD_EINVAL, "%s: %d values (1 to %d)", lists[k].name,
+                              lists[k].n, lists[k].max);
+    if (pd_spec_tasks(s) > PD_SPEC_MAX_TASKS)
+        return pd_err_set(err, PD_EINVAL, "sweep: %ld runs (at most %ld)", pd_spec_tasks(s),
+                          PD_SPEC_MAX_TASKS);
+    return PD_OK;
+}
+
+int pd_spec_sweep(const pd_spectrum *s, pd_spec_point_fn fn, void *ctx, pd_err *err)
+{
+    pd_osc c;
+    pd_run_opts o;
+    pd_spec_result r;
+    pd_spec_coords co;
+    pd_spec_row row;
+    int rc = check_shape(s, err);
+    long ntw = pd_spec_twins(s), n = pd_spec_tasks(s);
+    for (long t = 0; !rc && t < n; t++) /* every case, the twins' too, before any run */
+        rc = pd_spec_case(s, t, &c, &o, err) ? PD_EINVAL : PD_OK;
+    if (rc)
+        return rc;
+    pd_spec_result *twin = malloc((size_t)ntw * sizeof *twin);
+    if (!twin)
+        return pd_err_set(err, PD_ENOMEM, "out of memory for %ld runs", ntw);
+    for (long t = 0; !rc && t < n; t++) {
+        pd_err e; /* err may be NULL, pd_spec_run_task's may not */
+        pd_spec_run_task(s, t, t < ntw ? &twin[t] : &r, &e);
+        if ((rc = (t < ntw ? twin[t] : r).status))
+            pd_err_set(err, rc, "%s", e.msg);
+        if (rc || t < ntw)
+            continue;
+        pd_spec_case(s, t, &c, &o, NULL);
+        pd_spec_coords_of(s, t, &co);
+        fill_row(&c, &o, co.curve, &r, &twin[pd_spec_twin_of(s, t)], &row);
+        if (fn && fn(&co, &row, ctx))
+            rc = pd_err_set(err, PD_ESTOPPED, "spectrum: stopped by the caller after point %ld",
+                            t - ntw);
+    }
+    free(twin);
+    if (!rc)
+        pd_err_clear(err);
+    return rc;
+}

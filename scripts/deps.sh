@@ -5,11 +5,16 @@
 # CI-only tools: python3, OpenMPI for the MPI build `make MPI=1`, which the
 # quick start does not need, and Siconos numerics, which bench/siconos_lcp
 # is timed against, and the stress suite's clang, LLVM OpenMP and libFuzzer;
-# --bench adds Siconos numerics alone; --stress the stress suite's tools)
+# --bench adds Siconos numerics alone; --stress the stress suite's tools;
+# --python the Python package's: NumPy, pytest, Matplotlib, h5py, pip)
 set -u
 pkgs="gcc make pkg-config libgsl-dev libsuitesparse-dev libhdf5-dev hdf5-tools libjansson-dev gnuplot-nox"
 [ "${1:-}" = "--ci" ] && pkgs="$pkgs python3 libopenmpi-dev openmpi-bin libsiconos-numerics-dev"
 stress="python3 clang libomp-dev libclang-rt-dev util-linux"
+# the Python package's tests and the files read back with h5py
+py="python3 python3-numpy python3-pytest python3-matplotlib python3-h5py python3-pip python3-setuptools"
+[ "${1:-}" = "--ci" ] && pkgs="$pkgs $py groff-base g++"
+[ "${1:-}" = "--python" ] && pkgs="$pkgs $py"
 [ "${1:-}" = "--ci" ] && pkgs="$pkgs $stress"
 [ "${1:-}" = "--stress" ] && pkgs="$pkgs $stress"
 [ "${1:-}" = "--bench" ] && pkgs="$pkgs libsiconos-numerics-dev"

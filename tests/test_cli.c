@@ -265,6 +265,61 @@ static void test_cli_converge_empty_list_elements(pd_test_ctx *ctx)
     }
 }
 
+/* `pound --version`: exit 0, "pound VERSION" first (the header's), the
+ * libraries it was built with, nothing on stderr; `pound --help` lists it
+ * and `help`. */
+static void test_cli_version(pd_test_ctx *ctx)
+{
+    const char *args[] = {"--version", NULL}, *hargs[] = {"--help", NULL};
+    char first[64];
+    proc_out r, h;
+    if (!pd_test_have_pound(ctx))
+        return;
+    pd_test_pound(ctx, args, &r);
+    snprintf(first, sizeof first, "pound %s\n", PD_VERSION);
+    CHECK(ctx, r.status == 0 && r.err[0] == '\0', "exit %d, stderr '%s'", r.status, r.err);
+    CHECK(ctx, !strncmp(r.out, first, strlen(first)), "first line '%s', expected '%s'", r.out,
+          first);
+    CHECK(ctx, strstr(r.out, "GSL ") && strstr(r.out, "HDF5 "), "no GSL/HDF5 versions: %s",
+          r.out);
+    pd_test_pound(ctx, hargs, &h);
+    CHECK(ctx, h.status == 0 && strstr(h.out, "--version") && strstr(h.out, "help"),
+          "--help: exit %d, lists --version and help: %s", h.status, h.out);
+    pd_test_proc_free(&r);
+    pd_test_proc_free(&h);
+}
+
+/* `pound help COMMAND` is `pound COMMAND --help` for every command (same
+ * output, exit 0); an unknown command: exit 2, one line naming it, nothing
+ * on stdout. */
+static void test_cli_help_command(pd_test_ctx *ctx)
+{
+    static const char *const cmds[] = {"simulate", "compare", "converge", "spectrum",
+                                       "record",   "lcp",     "bench"};
+    if (!pd_test_have_pound(ctx))
+        return;
+    for (size_t k = 0; k < sizeof cmds / sizeof cmds[0]; k++) {
+        const char *a[] = {"help", cmds[k], NULL}, *b[] = {cmds[k], "--help", NULL};
+        proc_out ra, rb;
+        pd_test_pound(ctx, a, &ra);
+        pd_test_pound(ctx, b, &rb);
+        CHECK(ctx, ra.status == 0 && rb.status == 0, "%s: exit %d and %d", cmds[k], ra.status,
+              rb.status);
+        CHECK(ctx, !strcmp(ra.out, rb.out) && !strncmp(ra.out, "usage: pound ", 13),
+              "help %s differs from %s --help", cmds[k], cmds[k]);
+        pd_test_proc_free(&ra);
+        pd_test_proc_free(&rb);
+    }
+    const char *bad[] = {"help", "bogus", NULL};
+    proc_out r;
+    pd_test_pound(ctx, bad, &r);
+    char *nl = strchr(r.err, '\n');
+    CHECK(ctx, r.status == 2, "help bogus: exit %d, expected 2", r.status);
+    CHECK(ctx, strstr(r.err, "'bogus'") && nl && nl[1] == '\0' && r.out[0] == '\0',
+          "help bogus: one line naming it: '%s', stdout '%s'", r.err, r.out);
+    pd_test_proc_free(&r);
+}
+
 void suite_cli(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_cli_bad_input);
@@ -273,4 +328,6 @@ void suite_cli(pd_test_ctx *ctx)
     PD_RUN(ctx, test_cli_csv_and_json);
     PD_RUN(ctx, test_cli_failed_run_leaves_no_file);
     PD_RUN(ctx, test_cli_converge_empty_list_elements);
+    PD_RUN(ctx, test_cli_version);
+    PD_RUN(ctx, test_cli_help_command);
 }

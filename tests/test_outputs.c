@@ -963,6 +963,95 @@ static void test_outputs_converge_method_text(pd_test_ctx *ctx)
     pd_test_rm_dir(dir);
 }
 
+/* ---- provenance (issue 12, docs/formats.md) -------------------------------- */
+
+/* Is s a UTC ISO 8601 time, YYYY-MM-DDTHH:MM:SSZ? */
+static int iso_utc(const char *s)
+{
+    static const char shape[] = "dddd-dd-ddTdd:dd:ddZ";
+    if (strlen(s) != sizeof shape - 1)
+        return 0;
+    for (size_t i = 0; i < sizeof shape - 1; i++)
+        if (shape[i] == 'd' ? !(s[i] >= '0' && s[i] <= '9') : s[i] != shape[i])
+            return 0;
+    return 1;
+}
+
+/* Every -o file records its provenance: simulate -o F.h5 (a name the shell
+ * must quote) has the root attributes format, command (the arguments,
+ * quoted as shlex.quote does), pound_version (pd_version()) and created
+ * (UTC ISO 8601), and every dataset a units attribute; the CSV starts with
+ * the same four '#' lines and has a "# units = " line, one unit per column;
+ * a spectrum file has no created and a command without -o and --threads
+ * (equal sweeps, equal bytes). */
+static void test_outputs_provenance(pd_test_ctx *ctx)
+{
+    static const char *const cols[] = {"t", "u", "v", "impulse", "gap"};
+    char dir[64], h5[128], csv[128], spec[128], want[512], buf[1024];
+    if (!pd_test_have_pound(ctx) || scratch(ctx, "prov", dir, sizeof dir))
+        return;
+    in(dir, "it's.h5", h5, sizeof h5);
+    in(dir, "run.csv", csv, sizeof csv);
+    in(dir, "s.h5", spec, sizeof spec);
+    for (int f = 0; f < 2; f++) {
+        proc_out r;
+        const char *args[] = {"simulate", "--tend", "0.5", "--every", "10", "-o", f ? csv : h5, NULL};
+        run(ctx, args, NULL, &r, NULL);
+        CHECK(ctx, r.status == 0, "simulate -o %s: exit %d: %s", f ? "csv" : "h5", r.status, r.err);
+        pd_test_proc_free(&r);
+    }
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    hid_t file = H5Fopen(h5, H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (CHECK(ctx, file >= 0, "cannot open %s", h5)) {
+        h5_text_attr(file, "format", buf, sizeof buf);
+        CHECK(ctx, !strcmp(buf, "pound simulate oscillator 1"), "format '%s'", buf);
+        snprintf(want, sizeof want, "pound simulate --tend 0.5 --every 10 -o '%s/it'\"'\"'s.h5'", dir);
+        h5_text_attr(file, "command", buf, sizeof buf);
+        CHECK(ctx, !strcmp(buf, want), "command '%s', expected '%s'", buf, want);
+        h5_text_attr(file, "pound_version", buf, sizeof buf);
+        CHECK(ctx, !strcmp(buf, pd_version()), "pound_version '%s', expected '%s'", buf, pd_version());
+        h5_text_attr(file, "created", buf, sizeof buf);
+        CHECK(ctx, iso_utc(buf), "created '%s' is not YYYY-MM-DDTHH:MM:SSZ", buf);
+        for (int j = 0; j < 5; j++) {
+            hid_t ds = H5Dopen2(file, cols[j], H5P_DEFAULT);
+            buf[0] = '\0';
+            if (ds >= 0)
+                h5_text_attr(ds, "units", buf, sizeof buf);
+            CHECK(ctx, ds >= 0 && buf[0], "dataset %s: no units", cols[j]);
+            if (ds >= 0)
+                H5Dclose(ds);
+        }
+        H5Fclose(file);
+    }
+    char *text = pd_test_slurp(csv);
+    snprintf(want, sizeof want,
+             "# format = pound simulate oscillator 1\n# command = pound simulate --tend 0.5 --every "
+             "10 -o %s\n# pound_version = %s\n# created = ",
+             csv, pd_version());
+    CHECK(ctx, text && !strncmp(text, want, strlen(want)) && iso_utc(strtok(text + strlen(want), "\n")),
+          "csv: the first lines are not the provenance: '%.200s'", text ? text : "(none)");
+    free(text);
+    text = pd_test_slurp(csv);
+    CHECK(ctx, text && strstr(text, "\n# units = s,m,m/s,m/s,m\nt,u,v,impulse,gap\n"),
+          "csv: no '# units = s,m,m/s,m/s,m' line before the header");
+    free(text);
+    proc_out r;
+    const char *a_spec[] = {"spectrum", "--Pi2", "0.5:1:2", "--threads", "1", "-o", spec, NULL};
+    run(ctx, a_spec, NULL, &r, NULL);
+    CHECK(ctx, r.status == 0, "spectrum -o: exit %d: %s", r.status, r.err);
+    pd_test_proc_free(&r);
+    file = H5Fopen(spec, H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (CHECK(ctx, file >= 0, "cannot open %s", spec)) {
+        h5_text_attr(file, "command", buf, sizeof buf);
+        CHECK(ctx, !strcmp(buf, "pound spectrum --Pi2 0.5:1:2"), "spectrum command '%s'", buf);
+        h5_text_attr(file, "format", buf, sizeof buf);
+        CHECK(ctx, !strcmp(buf, "pound spectrum 1"), "spectrum format '%s'", buf);
+        CHECK(ctx, H5Aexists(file, "created") == 0, "a spectrum file records created");
+        H5Fclose(file);
+    }
+    pd_test_rm_dir(dir);
+}
+
 void suite_outputs(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_outputs_full_disk_simulate);
@@ -982,4 +1071,5 @@ void suite_outputs(pd_test_ctx *ctx)
     PD_RUN(ctx, test_outputs_full_disk_dump_keeps_old);
     PD_RUN(ctx, test_outputs_same_file_refused);
     PD_RUN(ctx, test_outputs_converge_method_text);
+    PD_RUN(ctx, test_outputs_provenance);
 }

@@ -529,6 +529,95 @@ static void test_spectrum_mpi_matches_serial(pd_test_ctx *ctx)
     pd_test_rm_dir(dir);
 }
 
+/* ---- the library's sweep with a callback (pd_spec_sweep) ----------------- */
+
+/* What the callback saw. */
+typedef struct sweep_seen {
+    int calls, stop_at; /* stop_at > 0: ask to stop on that call */
+    pd_spec_coords co[64];
+    pd_spec_row row[64];
+} sweep_seen;
+
+static int sweep_point(const pd_spec_coords *co, const pd_spec_row *row, void *ctx)
+{
+    sweep_seen *seen = ctx;
+    if (seen->calls < 64) {
+        seen->co[seen->calls] = *co;
+        seen->row[seen->calls] = *row;
+    }
+    return ++seen->calls == seen->stop_at;
+}
+
+/* Equal, NaN equal to NaN. */
+static int same(double a, double b) { return a == b || (isnan(a) && isnan(b)); }
+
+/* 2 pulses x 2 eps x 4 Pi2 (8 twins, 16 points), event-driven and
+ * Moreau-Jean: the callback gets every point once, in order, with the
+ * coordinates of pd_spec_coords_of and the numbers of pd_spec_run_task +
+ * pd_spec_rows, bit for bit; a nonzero return stops it (PD_ESTOPPED) on
+ * that point; a bad sweep is refused before any run. */
+static void test_spectrum_sweep_callback(pd_test_ctx *ctx)
+{
+    for (int m = 0; m < 2; m++) {
+        pd_spectrum s;
+        pd_spec_init(&s);
+        s.opts.method = m ? PD_METHOD_MOREAU : PD_METHOD_EVENT;
+        s.dt_per_Tp = m ? 500 : 0;
+        s.pi2_min = 0.3, s.pi2_max = 3, s.npi2 = 4;
+        s.npulse = 2, s.pulse[1] = PD_PULSE_COSINE;
+        s.neps = 2, s.eps[0] = 0.5, s.eps[1] = 0.8;
+        long ntw = pd_spec_twins(&s), np = pd_spec_points(&s), nt = pd_spec_tasks(&s);
+        pd_spec_result res[32];
+        pd_spec_row rows[16];
+        pd_err err;
+        if (!CHECK(ctx, ntw == 8 && np == 16, "%ld twins, %ld points", ntw, np))
+            return;
+        for (long t = 0; t < nt; t++)
+            pd_spec_run_task(&s, t, &res[t], &err);
+        pd_spec_rows(&s, res, rows);
+        sweep_seen seen = {0};
+        int rc = pd_spec_sweep(&s, sweep_point, &seen, &err);
+        CHECK(ctx, rc == PD_OK && seen.calls == np, "method %d: rc %d (%s), %d calls", m, rc,
+              err.msg, seen.calls);
+        for (int p = 0; p < seen.calls && p < np; p++) {
+            pd_spec_coords co;
+            const pd_spec_row *a = &seen.row[p], *b = &rows[p];
+            pd_spec_coords_of(&s, ntw + p, &co);
+            CHECK(ctx, !memcmp(&co, &seen.co[p], sizeof co), "point %d: coordinates differ", p);
+            CHECK(ctx, a->c.Pi2 == b->c.Pi2 && a->c.Pi3 == b->c.Pi3 && a->c.eps == b->c.eps &&
+                           a->c.pulse == b->c.pulse && a->c.dir == b->c.dir &&
+                           a->curve == b->curve && a->c.Pi2 == pd_spec_pi2(&s, co.j),
+                  "point %d: case differs", p);
+            CHECK(ctx, a->umax == res[ntw + p].umax && a->umax > 0.0,
+                  "point %d: umax %.17g vs pd_spec_run_task %.17g", p, a->umax,
+                  res[ntw + p].umax);
+            CHECK(ctx, a->umax_free == res[pd_spec_twin_of(&s, ntw + p)].umax,
+                  "point %d: umax_free %.17g vs the twin's %.17g", p, a->umax_free,
+                  res[pd_spec_twin_of(&s, ntw + p)].umax);
+            CHECK(ctx, same(a->Pi1, b->Pi1) && same(a->gamma, b->gamma) && same(a->chi, b->chi) &&
+                           a->impacts == b->impacts && a->steps == b->steps && isfinite(a->gamma),
+                  "point %d: Pi1 %.17g/%.17g gamma %.17g/%.17g impacts %ld/%ld", p, a->Pi1,
+                  b->Pi1, a->gamma, b->gamma, a->impacts, b->impacts);
+        }
+        sweep_seen stop = {.stop_at = 3};
+        rc = pd_spec_sweep(&s, sweep_point, &stop, &err);
+        CHECK(ctx, rc == PD_ESTOPPED && err.status == PD_ESTOPPED && stop.calls == 3,
+              "stop: rc %d, %d calls (%s)", rc, stop.calls, err.msg);
+        CHECK(ctx, pd_spec_sweep(&s, NULL, NULL, NULL) == PD_OK, "no callback, no err");
+    }
+    pd_spectrum bad;
+    pd_err err;
+    sweep_seen seen = {0};
+    pd_spec_init(&bad);
+    int rc = pd_spec_sweep(&bad, sweep_point, &seen, &err);
+    CHECK(ctx, rc == PD_EINVAL && strstr(err.msg, "Pi2") && seen.calls == 0,
+          "no Pi2 grid: rc %d (%s), %d calls", rc, err.msg, seen.calls);
+    bad.pi2_min = 0.5, bad.pi2_max = 2, bad.npi2 = 3, bad.eps[0] = 1.5;
+    rc = pd_spec_sweep(&bad, sweep_point, &seen, &err);
+    CHECK(ctx, rc == PD_EINVAL && strstr(err.msg, "eps") && seen.calls == 0,
+          "eps 1.5: rc %d (%s), %d calls", rc, err.msg, seen.calls);
+}
+
 void suite_spectrum(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_spectrum_matches_simulate);
@@ -542,4 +631,5 @@ void suite_spectrum(pd_test_ctx *ctx)
     PD_RUN(ctx, test_spectrum_dimensional_self_similar);
     PD_RUN(ctx, test_spectrum_plot);
     PD_RUN(ctx, test_spectrum_mpi_matches_serial);
+    PD_RUN(ctx, test_spectrum_sweep_callback);
 }

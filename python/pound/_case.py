@@ -1,0 +1,269 @@
+"""The case of a run from keyword arguments, built as the command line builds
+it from its flags (cli/case.c): the same library calls in the same order, so
+that the numbers are the CLI's to the last bit."""
+import ctypes
+import math
+
+import numpy as np
+
+from . import _lib
+from ._lib import InputError, PdErr, PdRecord, PdRecordPulse, lib
+
+# Keyword arguments and the CLI flags they mirror (the names without "--",
+# "-" written "_").
+MODEL_KEYS = ("pulse", "dir", "ap", "Tp", "T0", "Pi2", "gap", "Pi3", "eps", "xi")
+RECORD_KEYS = ("record", "scale", "units", "record_format")
+SCHEME_KEYS = ("method", "dt", "tend", "theta", "gamma", "allow_unstable", "no_accumulation",
+               "no_wall", "kernel", "factor", "lcp_solver", "contact", "kc", "kc_abs", "rtol",
+               "atol", "stepper")
+CASE_KEYS = MODEL_KEYS + RECORD_KEYS + SCHEME_KEYS
+
+STEPPERS = {"rk8pd": b"rk8pd", "rkf45": b"rkf45", "rk4imp": b"rk4imp", "msbdf": b"msbdf"}
+CASE_MAX_STEPS = 2e9
+PD_OSC_MAX_SCAN = 2.5e7
+
+
+def fmt(x):
+    """%.10g, as the CLI's messages print numbers."""
+    return "%.10g" % x
+
+
+def parse_name(what, parser, value, choices):
+    """A name through the library's parser (bytes out of str)."""
+    out = ctypes.c_int()
+    if not isinstance(value, str) or parser(value.encode(), ctypes.byref(out)) != 0:
+        raise InputError("%s: '%s' is not one of %s" % (what, value, choices))
+    return out.value
+
+
+def parse_dir(value):
+    if value in (1, -1) and not isinstance(value, bool):
+        return value
+    return parse_name("dir", lib.pd_dir_parse, value, "normal, reverse")
+
+
+def number(what, value):
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise InputError("%s: '%s' is not a number" % (what, value)) from None
+    if not math.isfinite(x):
+        raise InputError("%s: '%s' is not a finite number" % (what, value))
+    return x
+
+
+class Record:
+    """A strong-motion record read and its pulse fitted by the library
+    (pd_record_read, pd_record_fit_pulse); owns the C arrays."""
+
+    def __init__(self, path, units="g", format="auto"):
+        fmt_code = parse_name("record_format", lib.pd_record_format_parse, format,
+                              "auto, at2, v2, text")
+        unit_code = parse_name("units", lib.pd_record_units_parse, units, "g, m/s2, cm/s2")
+        self.rec = PdRecord()
+        self.pulse = PdRecordPulse()
+        self._owned = False
+        err = PdErr()
+        st = lib.pd_record_read(str(path).encode(), fmt_code, unit_code, self.rec, err)
+        if st == 0:
+            self._owned = True
+            st = lib.pd_record_fit_pulse(self.rec, self.pulse, err)
+        if st != 0:
+            msg = err.text()
+            if fmt_code != 0 and st != _lib.PD_ENOMEM:  # the user chose how to read it: say so
+                msg = "%s (read as record_format %s)" % (msg, format)
+            self.close()
+            raise _lib.make_error(st, msg)
+
+    def close(self):
+        if self._owned:
+            lib.pd_record_free(self.rec)
+            self._owned = False
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown
+            pass
+
+    @property
+    def name(self):
+        return self.rec.name.decode("utf-8", "replace")
+
+    @property
+    def acc(self):
+        """The ground accelerations [m/s^2] (a copy)."""
+        return np.ctypeslib.as_array(self.rec.acc, (self.rec.npts,)).copy()
+
+
+def _check_scheme(o, have):
+    """cli/case.c check_scheme: the ranges of the scheme options, each error
+    naming the option."""
+    if have.get("dt") and not o.dt > 0.0:
+        raise InputError("dt: the step must be > 0 (got %s)" % fmt(o.dt))
+    if have.get("tend") and not o.tend > 0.0:
+        raise InputError("tend: must be > 0 (got %s)" % fmt(o.tend))
+    if not 0.0 <= o.gamma <= 1.0:
+        raise InputError("gamma: must be in [0, 1] (got %s)" % fmt(o.gamma))
+    if not o.allow_unstable and not 0.5 <= o.theta <= 1.0:
+        raise InputError("theta: %s is outside [1/2, 1], where Moreau-Jean is not "
+                         "unconditionally stable (allow_unstable=True runs it)" % fmt(o.theta))
+    if not 0.0 <= o.theta <= 2.0:
+        raise InputError("theta: must be in [0, 2] (got %s)" % fmt(o.theta))
+    if have.get("kc") and not o.pen.kc_mult > 0.0:
+        raise InputError("kc: the contact stiffness multiple must be > 0 (got %s)"
+                         % fmt(o.pen.kc_mult))
+    if o.pen.kc_abs < 0.0:
+        raise InputError("kc_abs: the contact stiffness must be >= 0 (got %s)"
+                         % fmt(o.pen.kc_abs))
+    if not 0.0 < o.pen.rtol < 1.0:
+        raise InputError("rtol: the relative tolerance must be in (0, 1) (got %s)"
+                         % fmt(o.pen.rtol))
+    if not o.pen.atol > 0.0:
+        raise InputError("atol: the absolute tolerance must be > 0 (got %s)" % fmt(o.pen.atol))
+
+
+def scheme_opts(kw):
+    """pd_run_opts from the scheme keywords (pd_run_default_opts() first):
+    (opts, which were given).  Unknown keys are the caller's."""
+    o = _lib.default_opts()
+    have = {}
+    for key in SCHEME_KEYS:
+        if key not in kw or kw[key] is None:
+            continue
+        v = kw[key]
+        have[key] = True
+        if key == "method":
+            o.method = parse_name("method", lib.pd_method_parse, v, "moreau, event, penalty")
+        elif key in ("dt", "tend", "theta", "gamma"):
+            setattr(o, key, number(key, v))
+        elif key in ("allow_unstable", "no_accumulation", "no_wall"):
+            setattr(o, key, 1 if v else 0)
+        elif key == "kernel":
+            if v not in ("auto", "general"):
+                raise InputError("kernel: '%s' is not one of auto, general" % (v,))
+            o.kernel = 1 if v == "general" else 0
+        elif key == "factor":
+            o.factor = parse_name("factor", lib.pd_factor_kind_parse, v,
+                                  "auto, scalar, dense, cholmod")
+        elif key == "lcp_solver":
+            o.lcp_solver = parse_name("lcp_solver", lib.pd_lcp_method_parse, v,
+                                      _lib.s(lib.pd_lcp_method_list()))
+        elif key == "contact":
+            if v not in ("kelvin", "hertz"):
+                raise InputError("contact: '%s' is not one of kelvin, hertz" % (v,))
+            o.pen.law = 1 if v == "hertz" else 0
+        elif key == "kc":
+            o.pen.kc_mult = number(key, v)
+        elif key == "kc_abs":
+            o.pen.kc_abs = number(key, v)
+        elif key in ("rtol", "atol"):
+            setattr(o.pen, key, number(key, v))
+        elif key == "stepper":
+            if v not in STEPPERS:
+                raise InputError("stepper: '%s' is not one of rk8pd, rkf45, rk4imp, msbdf" % (v,))
+            o.pen.stepper = STEPPERS[v]
+    _check_scheme(o, have)
+    return o, have
+
+
+class Case:
+    """The one-wall oscillator of a set of keywords: c (pd_osc) and opts
+    (pd_run_opts, resolved by resolve()), as `pound simulate` builds them."""
+
+    def __init__(self, kw, allowed=CASE_KEYS):
+        unknown = sorted(set(kw) - set(allowed))
+        if unknown:
+            raise TypeError("unexpected keyword argument%s %s (the case takes %s)"
+                            % ("s" if len(unknown) > 1 else "", ", ".join(unknown),
+                               ", ".join(allowed)))
+        kw = {k: v for k, v in kw.items() if v is not None}
+        self.kw = kw
+        self.record = None
+        c = _lib.default_osc()
+        self.opts, self.have = scheme_opts(kw)
+        if "pulse" in kw:
+            c.pulse = parse_name("pulse", lib.pd_pulse_parse, kw["pulse"],
+                                 "sine, cosine, harmonic")
+        if "dir" in kw:
+            c.dir = parse_dir(kw["dir"])
+        for key in ("ap", "Tp", "Pi2", "Pi3", "eps", "xi"):
+            if key in kw:
+                setattr(c, key, number(key, kw[key]))
+        self.T0 = number("T0", kw["T0"]) if "T0" in kw else None
+        self.gap = number("gap", kw["gap"]) if "gap" in kw else None
+        self.c = c
+        self.pulse_key = next((k for k in ("pulse", "ap", "Tp") if k in kw), None)
+
+    def finish_model(self):
+        """cli/case.c case_record, the T0 and gap forms and check_case."""
+        kw, c = self.kw, self.c
+        if "record" in kw:
+            if self.pulse_key:
+                raise InputError("%s: the record replaces the pulse (its fitted pulse gives ap "
+                                 "and Tp; scale scales it)" % self.pulse_key)
+            scale = number("scale", kw.get("scale", 1.0))
+            if not scale > 0.0:
+                raise InputError("scale: must be > 0 (got %s)" % fmt(scale))
+            rec = kw["record"]
+            if not isinstance(rec, Record):
+                rec = Record(rec, kw.get("units", "g"), kw.get("record_format", "auto"))
+            self.record = rec
+            lib.pd_osc_set_record(c, rec.rec, rec.pulse, scale)
+        elif "scale" in kw:
+            raise InputError("scale: goes with record")
+        if self.T0 is not None and "Pi2" in kw:
+            raise InputError("T0 and Pi2 are alternatives: give one")
+        if self.gap is not None and "Pi3" in kw:
+            raise InputError("gap and Pi3 are alternatives: give one")
+        if self.T0 is not None:
+            lib.pd_osc_set_T0(c, self.T0)
+        if self.gap is not None:
+            lib.pd_osc_set_gap(c, self.gap)
+        err = PdErr()
+        _lib.check(lib.pd_osc_check(c, err), err)
+        self.check_derived(self.opts, self.have)
+
+    def check_derived(self, o, have, dt_key="dt"):
+        """cli/case.c pd_cli_case_check_derived: the run's size bounded."""
+        c = self.c
+        T0, Le, gap = lib.pd_osc_T0(c), lib.pd_osc_Le(c), lib.pd_osc_gap(c)
+        if not (math.isfinite(T0) and T0 > 0.0 and math.isfinite(2 * math.pi / T0)):
+            raise InputError("T0: the oscillator's period T0 = Tp / Pi2 = %.3g s is out of range"
+                             % T0)
+        if not (Le > 0.0 and math.isfinite(Le)):
+            raise InputError("ap: Le = ap (Tp / 2 pi)^2 = %.3g m is out of range" % Le)
+        if not (math.isfinite(gap) and math.isfinite(c.Pi3)):
+            raise InputError("gap: the gap is too large for ap and Tp (Pi3 = gap / Le "
+                             "overflows)")
+        tend = o.tend if have.get("tend") else lib.pd_osc_default_tend(c)
+        dt = o.dt if have.get("dt") else lib.pd_osc_default_dt(c)
+        if not math.isfinite(tend):
+            raise InputError("T0: tend = Tp + 2 T0 overflows")
+        if have.get("dt") and not dt < tend:
+            raise InputError("%s: the step %.3g s is not shorter than the run (tend = %.3g s)"
+                             % (dt_key, dt, tend))
+        if not tend / dt <= CASE_MAX_STEPS:
+            raise InputError("dt: %.3g steps of %.3g s over %.3g s (at most %.0e)"
+                             % (tend / dt, dt, tend, CASE_MAX_STEPS))
+        scan = lib.pd_osc_scan_points(c, tend)
+        if o.method == 1 and not scan <= PD_OSC_MAX_SCAN:
+            raise InputError("T0: the event-driven reference would scan %.3g points (64 per "
+                             "period T0 = %.3g s over %.3g s; at most %.3g: method='moreau' "
+                             "runs it)" % (scan, T0, tend, PD_OSC_MAX_SCAN))
+
+    def resolve(self):
+        """Check the case and complete dt and tend (pd_osc_resolve_opts)."""
+        self.finish_model()
+        err = PdErr()
+        _lib.check(lib.pd_osc_resolve_opts(self.c, self.opts, self.opts, err), err)
+        if self.opts.tend / self.opts.dt > 2e9:
+            raise InputError("dt: %g s over %g s is more than 2e9 steps"
+                             % (self.opts.dt, self.opts.tend))
+        return self
+
+
+def copy_opts(o):
+    """A copy of a pd_run_opts (its stepper string is a static or a bytes
+    object kept alive by STEPPERS)."""
+    return _lib.PdRunOpts.from_buffer_copy(o)

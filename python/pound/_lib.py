@@ -1,0 +1,736 @@
+"""libpound through ctypes: finding the library, the mirrors of its public
+structs, the prototypes of the functions used, errors, and the layout check
+run at import.
+
+Only functions declared in the four public headers (core/pd_core.h,
+lcp/pd_lcp.h, engine/pd_engine.h, problems/pd_problems.h) are used: they are
+the ones libpound.so exports.
+"""
+import ctypes
+import math
+import os
+from ctypes import (CFUNCTYPE, POINTER, Structure, c_char, c_char_p, c_double, c_int, c_long,
+                    c_ubyte, c_void_p)
+
+# ---- errors --------------------------------------------------------------------------
+
+STATUS_NAMES = {
+    0: "PD_OK", -1: "PD_ENOMEM", -2: "PD_EINVAL", -3: "PD_ENOSOLUTION", -4: "PD_EMAXPIVOTS",
+    -5: "PD_ENUMERICAL", -6: "PD_ENONFINITE", -7: "PD_EIO", -8: "PD_EPARSE",
+    -9: "PD_ESINGULAR", -10: "PD_EBUDGET", -11: "PD_ESTOPPED", -12: "PD_EMAXITER",
+}
+PD_OK, PD_ENOMEM, PD_EINVAL, PD_EIO, PD_EPARSE = 0, -1, -2, -7, -8
+
+
+class PoundError(Exception):
+    """A libpound failure: `status` is the PD_E* code (negative int), `message`
+    the library's one-line message (str(e) is the message)."""
+
+    def __init__(self, message, status=PD_EINVAL):
+        Exception.__init__(self, message)
+        self.message = message
+        self.status = status
+
+    @property
+    def code(self):
+        """The status's name, e.g. 'PD_EINVAL'."""
+        return STATUS_NAMES.get(self.status, str(self.status))
+
+    def __str__(self):
+        return self.message
+
+
+class InputError(PoundError, ValueError):
+    """PD_EINVAL: an argument out of range or inconsistent (the CLI's exit 2)."""
+
+
+class ParseError(PoundError, ValueError):
+    """PD_EPARSE: a malformed input file (the message names the line)."""
+
+
+class FileError(PoundError, OSError):
+    """PD_EIO: a file could not be opened, read or written."""
+
+    def __init__(self, message, status=PD_EIO):
+        PoundError.__init__(self, message, status)
+
+    def __str__(self):
+        return self.message
+
+
+class NumericalError(PoundError, ArithmeticError):
+    """PD_ENUMERICAL, PD_ENONFINITE, PD_ESINGULAR."""
+
+
+class SolverError(PoundError):
+    """PD_ENOSOLUTION, PD_EMAXPIVOTS, PD_EMAXITER: an LCP solver gave up."""
+
+
+class BudgetError(PoundError):
+    """PD_EBUDGET: an event or step budget was exhausted."""
+
+
+class PoundMemoryError(PoundError, MemoryError):
+    """PD_ENOMEM."""
+
+
+class LayoutError(ImportError):
+    """The ctypes mirrors of the library's structs do not match the library."""
+
+
+_ERROR_CLASSES = {
+    -1: PoundMemoryError, -2: InputError, -3: SolverError, -4: SolverError, -5: NumericalError,
+    -6: NumericalError, -7: FileError, -8: ParseError, -9: NumericalError, -10: BudgetError,
+    -12: SolverError,
+}
+
+
+def make_error(status, message):
+    cls = _ERROR_CLASSES.get(status, PoundError)
+    return cls(message, status)
+
+
+# ---- the structs ------------------------------------------------------------------------
+
+class PdErr(Structure):
+    _fields_ = [("status", c_int), ("msg", c_char * 256)]
+
+    def text(self):
+        return self.msg.decode("utf-8", "replace")
+
+
+class PdMatrix(Structure):
+    _fields_ = [("kind", c_int), ("rows", c_int), ("cols", c_int),
+                ("values", POINTER(c_double)), ("colptr", POINTER(c_int)),
+                ("rowind", POINTER(c_int))]
+
+
+class PdLcpOpts(Structure):
+    _fields_ = [("cover", POINTER(c_double)), ("max_pivots", c_int), ("tol", c_double),
+                ("max_iterations", c_int), ("guess", POINTER(c_ubyte))]
+
+
+class PdLcpInfo(Structure):
+    _fields_ = [("outcome", c_int), ("pivots", c_int), ("iterations", c_int),
+                ("complementarity", c_double), ("infeasibility", c_double),
+                ("residual", c_double), ("scale", c_double), ("solver", c_char_p)]
+
+
+class PdPenaltySetup(Structure):
+    _fields_ = [("law", c_int), ("kc_mult", c_double), ("kc_abs", c_double),
+                ("rtol", c_double), ("atol", c_double), ("stepper", c_char_p)]
+
+
+class PdRunOpts(Structure):
+    _fields_ = [("method", c_int), ("dt", c_double), ("tend", c_double), ("theta", c_double),
+                ("gamma", c_double), ("allow_unstable", c_int), ("kernel", c_int),
+                ("factor", c_int), ("lcp_solver", c_int), ("no_accumulation", c_int),
+                ("no_wall", c_int), ("pen", PdPenaltySetup), ("on_lcp", c_void_p),
+                ("on_lcp_ctx", c_void_p)]
+
+
+class PdRecord(Structure):
+    _fields_ = [("name", c_char * 256), ("npts", c_long), ("dt", c_double),
+                ("acc", POINTER(c_double))]
+
+
+class PdRecordMeasures(Structure):
+    _fields_ = [(k, c_double) for k in
+                ("pga", "pgv", "pgd", "t_pga", "t_pgv", "t_pgd", "arias", "t5_75", "t5_95")]
+
+
+class PdRecordPulse(Structure):
+    _fields_ = ([(k, c_double) for k in ("vp", "fp", "nu", "gamma", "t0", "Tp", "ap", "wp",
+                                          "Le", "r2")]
+                + [("iterations", c_long), ("shape", c_int), ("polarity", c_int),
+                   ("t_start", c_double)])
+
+
+class PdOsc(Structure):
+    _fields_ = [("pulse", c_int), ("dir", c_int), ("ap", c_double), ("Tp", c_double),
+                ("Pi2", c_double), ("Pi3", c_double), ("eps", c_double), ("xi", c_double),
+                ("record", POINTER(PdRecord)), ("rec_ap", c_double), ("scale", c_double)]
+
+
+class PdOscSample(Structure):
+    _fields_ = [("step", c_long), ("t", c_double), ("u", c_double), ("v", c_double),
+                ("impulse", c_double), ("gap", c_double)]
+
+
+class PdOscResult(Structure):
+    _fields_ = [("umax", c_double), ("u_toward", c_double), ("u_away", c_double),
+                ("impacts", c_long), ("first_impact", c_double),
+                ("first_impact_velocity", c_double), ("max_impact_velocity", c_double),
+                ("max_impulse", c_double), ("contact_time", c_double), ("min_gap", c_double),
+                ("accumulations", c_long), ("steps", c_long), ("dt", c_double),
+                ("tend", c_double), ("theta", c_double), ("gamma", c_double),
+                ("cpu_s", c_double), ("kernel", c_char_p)]
+
+
+class PdOscSummary(Structure):
+    _fields_ = [("r", PdOscResult), ("free", PdOscResult), ("Pi1", c_double),
+                ("gamma", c_double), ("chi", c_double), ("cpu_s", c_double)]
+
+
+class PdTrace(Structure):
+    _fields_ = [("u", POINTER(c_double)), ("n", c_long), ("cap", c_long)]
+
+
+class PdMeasured(Structure):
+    _fields_ = [("r", PdOscResult), ("err_umax_rel", c_double), ("err_hist_linf", c_double),
+                ("grid_points", c_long)]
+
+
+PD_WALL = -1
+PD_NAME_MAX = 64
+
+
+class PdStructure(Structure):
+    _fields_ = [("name", c_char * PD_NAME_MAX), ("storeys", c_int),
+                ("mass", POINTER(c_double)), ("stiffness", POINTER(c_double)), ("xi", c_double),
+                ("damping", c_int), ("modes", c_int * 2), ("T0", c_double),
+                ("period", c_double * 2), ("alpha", c_double), ("beta", c_double),
+                ("dof", c_int)]
+
+
+class PdContact(Structure):
+    _fields_ = [("a", c_int), ("b", c_int), ("level_a", c_int), ("level_b", c_int),
+                ("gap", c_double), ("eps", c_double), ("entry", c_int)]
+
+
+class PdSceneExcitation(Structure):
+    _fields_ = [("pulse", c_int), ("dir", c_int), ("ap", c_double), ("Tp", c_double),
+                ("record", POINTER(PdRecord)), ("rec_ap", c_double), ("scale", c_double)]
+
+
+class PdScene(Structure):
+    _fields_ = [("nstruct", c_int), ("ncontact", c_int), ("st", POINTER(PdStructure)),
+                ("ct", POINTER(PdContact)), ("exc", PdSceneExcitation), ("tend", c_double),
+                ("n", c_int), ("finished", c_int), ("cap_struct", c_int),
+                ("cap_contact", c_int), ("names", POINTER(c_int)), ("name_cap", c_int),
+                ("own_record", POINTER(PdRecord))]
+
+
+class PdSceneSample(Structure):
+    _fields_ = [("step", c_long), ("t", c_double), ("x", POINTER(c_double)),
+                ("v", POINTER(c_double)), ("gap", POINTER(c_double)),
+                ("impulse", POINTER(c_double))]
+
+
+class PdSceneResult(Structure):
+    _fields_ = [("n", c_int), ("m", c_int),
+                ("umax", POINTER(c_double)), ("u_pos", POINTER(c_double)),
+                ("u_neg", POINTER(c_double)), ("drift", POINTER(c_double)),
+                ("impacts", POINTER(c_long)), ("first_impact", POINTER(c_double)),
+                ("max_impulse", POINTER(c_double)), ("contact_time", POINTER(c_double)),
+                ("approach", POINTER(c_double)), ("steps", c_long), ("lcp_solves", c_long),
+                ("dt", c_double), ("tend", c_double), ("theta", c_double), ("cpu_s", c_double),
+                ("method", c_char_p), ("kernel", c_char_p), ("factor", c_char_p),
+                ("lcp_solver", c_char_p)]
+
+
+class PdSceneSummary(Structure):
+    _fields_ = [("r", PdSceneResult), ("free", PdSceneResult),
+                ("Pi1", POINTER(c_double)), ("gamma", POINTER(c_double)),
+                ("Pi2", POINTER(c_double)), ("Pi3", POINTER(c_double)),
+                ("chi", POINTER(c_double)), ("cpu_s", c_double)]
+
+
+class PdSceneTrace(Structure):
+    _fields_ = [("x", POINTER(c_double)), ("rows", c_long), ("cap", c_long), ("n", c_int),
+                ("dt", c_double)]
+
+
+class PdSceneErrors(Structure):
+    _fields_ = [("err_umax", POINTER(c_double)), ("err_hist", POINTER(c_double)),
+                ("err_umax_max", c_double), ("err_hist_max", c_double), ("impacts", c_long),
+                ("grid_points", c_long), ("cpu_s", c_double)]
+
+
+PD_SPEC_MAX_LIST = 64
+
+
+class PdSpectrum(Structure):
+    _fields_ = [("base", PdOsc), ("opts", PdRunOpts), ("pi2_min", c_double),
+                ("pi2_max", c_double), ("npi2", c_int), ("linear", c_int),
+                ("npulse", c_int), ("ndir", c_int), ("nap", c_int), ("nxi", c_int),
+                ("nsize", c_int), ("neps", c_int), ("pulse", c_int * 3), ("dir", c_int * 2),
+                ("ap", c_double * PD_SPEC_MAX_LIST), ("xi", c_double * PD_SPEC_MAX_LIST),
+                ("size", c_double * PD_SPEC_MAX_LIST), ("eps", c_double * PD_SPEC_MAX_LIST),
+                ("size_is_gap", c_int), ("dimensional", c_int), ("dt_per_Tp", c_double)]
+
+
+class PdSpecCoords(Structure):
+    _fields_ = [("twin", c_int), ("pulse", c_int), ("dir", c_int), ("ap", c_int),
+                ("xi", c_int), ("size", c_int), ("eps", c_int), ("j", c_int),
+                ("curve", c_long)]
+
+
+class PdSpecResult(Structure):
+    _fields_ = [(k, c_double) for k in ("umax", "u_toward", "u_away", "contact_time",
+                                         "first_impact", "cpu_s")] + \
+               [("impacts", c_long), ("steps", c_long), ("status", c_int), ("done", c_int)]
+
+
+class PdSpecRow(Structure):
+    _fields_ = ([("c", PdOsc), ("curve", c_long)]
+                + [(k, c_double) for k in ("T0", "gap", "dt", "tend", "umax", "Pi1",
+                                           "umax_free", "gamma", "chi", "u_toward", "u_away",
+                                           "contact_time", "first_impact", "cpu_s")]
+                + [("impacts", c_long), ("steps", c_long)])
+
+
+# Samplers get the address of a pd_osc_sample / pd_scene_sample (read with
+# from_address, or copied whole with memmove).
+OscSampler = CFUNCTYPE(c_int, c_void_p, c_void_p)
+SceneSampler = CFUNCTYPE(c_int, c_void_p, c_void_p)
+
+
+def _padded(ctype):
+    """ctype followed by guard bytes: the return type of a function that
+    returns ctype by value (x86-64 and aarch64 return such structs through a
+    caller-provided buffer: a larger C struct cannot overrun this one)."""
+    return type("Padded" + ctype.__name__, (Structure,),
+                {"_fields_": [("v", ctype), ("guard", c_ubyte * 256)]})
+
+
+# ---- the functions ----------------------------------------------------------------------
+
+P = POINTER
+_PROTOTYPES = {
+    # core
+    "pd_strerror": (c_char_p, [c_int]),
+    "pd_err_clear": (None, [P(PdErr)]),
+    "pd_matrix_get": (c_double, [P(PdMatrix), c_int, c_int]),
+    "pd_matrix_nnz": (c_long, [P(PdMatrix)]),
+    # lcp
+    "pd_lcp_outcome_name": (c_char_p, [c_int]),
+    "pd_lcp_default_opts": (_padded(PdLcpOpts), []),
+    "pd_lcp_method_name": (c_char_p, [c_int]),
+    "pd_lcp_method_parse": (c_int, [c_char_p, P(c_int)]),
+    "pd_lcp_method_list": (c_char_p, []),
+    "pd_lcp_solver_alloc": (c_void_p, [c_int, c_int, c_long, P(PdErr)]),
+    "pd_lcp_solver_free": (None, [c_void_p]),
+    "pd_lcp_solve": (c_int, [c_void_p, P(PdMatrix), P(c_double), P(PdLcpOpts), P(c_double),
+                             P(c_double), P(PdLcpInfo)]),
+    "pd_lcp_read": (c_int, [c_char_p, c_int, P(c_int), P(P(c_double)), P(P(c_double)),
+                            P(PdErr)]),
+    "pd_lcp_enumerate": (c_int, [c_int, P(c_double), P(c_double), P(c_double), P(c_double)]),
+    "pd_lcp_residual": (None, [c_int, P(c_double), P(c_double), P(c_double), P(c_double),
+                               P(c_double), P(c_double), P(c_double)]),
+    # engine
+    "pd_factor_kind_parse": (c_int, [c_char_p, P(c_int)]),
+    "pd_steps_for": (c_long, [c_double, c_double]),
+    # problems: names
+    "pd_pulse_name": (c_char_p, [c_int]),
+    "pd_pulse_parse": (c_int, [c_char_p, P(c_int)]),
+    "pd_dir_name": (c_char_p, [c_int]),
+    "pd_dir_parse": (c_int, [c_char_p, P(c_int)]),
+    "pd_method_name": (c_char_p, [c_int]),
+    "pd_method_parse": (c_int, [c_char_p, P(c_int)]),
+    "pd_record_format_parse": (c_int, [c_char_p, P(c_int)]),
+    "pd_record_units_parse": (c_int, [c_char_p, P(c_int)]),
+    # records
+    "pd_record_read": (c_int, [c_char_p, c_int, c_int, P(PdRecord), P(PdErr)]),
+    "pd_record_free": (None, [P(PdRecord)]),
+    "pd_record_duration": (c_double, [P(PdRecord)]),
+    "pd_record_measure": (c_int, [P(PdRecord), P(PdRecordMeasures), P(PdErr)]),
+    "pd_record_integrate": (c_int, [P(PdRecord), P(c_double), P(c_double), P(PdErr)]),
+    "pd_record_fit_pulse": (c_int, [P(PdRecord), P(PdRecordPulse), P(PdErr)]),
+    "pd_record_pulse_eval": (None, [P(PdRecordPulse), c_double, P(c_double), P(c_double)]),
+    "pd_record_one_cycle": (c_double, [P(PdRecordPulse), c_double]),
+    # the run request
+    "pd_run_default_opts": (_padded(PdRunOpts), []),
+    "pd_run_opts_check": (c_int, [P(PdRunOpts), P(PdErr)]),
+    # the oscillator
+    "pd_osc_default": (_padded(PdOsc), []),
+    "pd_osc_wp": (c_double, [P(PdOsc)]),
+    "pd_osc_T0": (c_double, [P(PdOsc)]),
+    "pd_osc_gap": (c_double, [P(PdOsc)]),
+    "pd_osc_Le": (c_double, [P(PdOsc)]),
+    "pd_osc_set_T0": (None, [P(PdOsc), c_double]),
+    "pd_osc_set_gap": (None, [P(PdOsc), c_double]),
+    "pd_osc_set_record": (None, [P(PdOsc), P(PdRecord), P(PdRecordPulse), c_double]),
+    "pd_osc_excitation_name": (c_char_p, [P(PdOsc)]),
+    "pd_osc_check": (c_int, [P(PdOsc), P(PdErr)]),
+    "pd_osc_resolve_opts": (c_int, [P(PdOsc), P(PdRunOpts), P(PdRunOpts), P(PdErr)]),
+    "pd_osc_default_dt": (c_double, [P(PdOsc)]),
+    "pd_osc_default_tend": (c_double, [P(PdOsc)]),
+    "pd_osc_scan_points": (c_double, [P(PdOsc), c_double]),
+    "pd_osc_run": (c_int, [P(PdOsc), P(PdRunOpts), OscSampler, c_void_p, P(PdOscResult),
+                           P(PdErr)]),
+    "pd_osc_summarize": (c_int, [P(PdOsc), P(PdRunOpts), OscSampler, c_void_p,
+                                 P(PdOscSummary), P(PdErr)]),
+    "pd_osc_free_exact": (None, [P(PdOsc), c_double, P(c_double), P(c_double)]),
+    "pd_trace_alloc": (c_int, [P(PdTrace), P(PdRunOpts)]),
+    "pd_trace_free": (None, [P(PdTrace)]),
+    "pd_measure_reference": (c_int, [P(PdOsc), P(PdRunOpts), P(PdTrace), P(PdOscResult),
+                                     P(PdErr)]),
+    "pd_measure_run": (c_int, [P(PdOsc), P(PdRunOpts), P(PdTrace), c_double, P(PdTrace),
+                               P(PdMeasured), P(PdErr)]),
+    # scenes
+    "pd_scene_new": (P(PdScene), [P(PdSceneExcitation)]),
+    "pd_scene_free": (None, [P(PdScene)]),
+    "pd_scene_add_sdof": (c_int, [P(PdScene), c_char_p, c_double, c_double, c_double,
+                                  P(PdErr)]),
+    "pd_scene_add_contact": (c_int, [P(PdScene), c_int, c_int, c_int, c_int, c_double,
+                                     c_double, c_int, P(PdErr)]),
+    "pd_scene_find": (c_int, [P(PdScene), c_char_p]),
+    "pd_scene_finish": (c_int, [P(PdScene), P(PdErr)]),
+    "pd_scene_load": (c_int, [c_char_p, P(P(PdScene)), P(PdErr)]),
+    "pd_scene_chain": (c_int, [c_int, P(PdSceneExcitation), c_double, c_double, c_double,
+                               c_double, c_double, P(P(PdScene)), P(PdErr)]),
+    "pd_scene_wp": (c_double, [P(PdScene)]),
+    "pd_scene_Le": (c_double, [P(PdScene)]),
+    "pd_scene_resolve_opts": (c_int, [P(PdScene), P(PdRunOpts), P(PdRunOpts), P(PdErr)]),
+    "pd_scene_result_alloc": (c_int, [P(PdScene), P(PdSceneResult), P(PdErr)]),
+    "pd_scene_result_free": (None, [P(PdSceneResult)]),
+    "pd_scene_summarize": (c_int, [P(PdScene), P(PdRunOpts), SceneSampler, c_void_p,
+                                   P(PdSceneSummary), P(PdErr)]),
+    "pd_scene_summary_free": (None, [P(PdSceneSummary)]),
+    "pd_scene_trace_alloc": (c_int, [P(PdSceneTrace), P(PdScene), P(PdRunOpts), P(PdErr)]),
+    "pd_scene_trace_free": (None, [P(PdSceneTrace)]),
+    "pd_scene_errors_alloc": (c_int, [P(PdScene), P(PdSceneErrors), P(PdErr)]),
+    "pd_scene_errors_free": (None, [P(PdSceneErrors)]),
+    "pd_scene_measure_reference": (c_int, [P(PdScene), P(PdRunOpts), P(PdSceneTrace),
+                                           P(PdSceneResult), P(PdErr)]),
+    "pd_scene_measure_run": (c_int, [P(PdScene), P(PdRunOpts), P(PdSceneTrace),
+                                     P(PdSceneResult), P(PdSceneResult), P(PdSceneErrors),
+                                     P(PdErr)]),
+    # spectra
+    "pd_spec_init": (None, [P(PdSpectrum)]),
+    "pd_spec_curves": (c_long, [P(PdSpectrum)]),
+    "pd_spec_points": (c_long, [P(PdSpectrum)]),
+    "pd_spec_twins": (c_long, [P(PdSpectrum)]),
+    "pd_spec_tasks": (c_long, [P(PdSpectrum)]),
+    "pd_spec_pi2": (c_double, [P(PdSpectrum), c_int]),
+    "pd_spec_coords_of": (None, [P(PdSpectrum), c_long, P(PdSpecCoords)]),
+    "pd_spec_validate": (c_int, [P(PdSpectrum), P(PdErr)]),
+    "pd_spec_run_task": (None, [P(PdSpectrum), c_long, P(PdSpecResult), P(PdErr)]),
+    "pd_spec_cost": (c_double, [P(PdSpectrum), c_long]),
+    "pd_spec_rows": (None, [P(PdSpectrum), P(PdSpecResult), P(PdSpecRow)]),
+    "pd_spec_curve_label": (None, [P(PdSpectrum), c_long, c_char_p, ctypes.c_size_t]),
+}
+# Called by pd_spec_sweep with the addresses of a pd_spec_coords and a pd_spec_row.
+SpecPointFn = CFUNCTYPE(c_int, c_void_p, c_void_p, c_void_p)
+
+# present in newer libraries only
+_OPTIONAL = {
+    "pd_version": (c_char_p, []),
+    "pd_spec_sweep": (c_int, [P(PdSpectrum), SpecPointFn, c_void_p, P(PdErr)]),
+}
+
+_HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def _candidates():
+    """Where the library is looked for, in order: $POUND_LIBRARY (a path), the
+    installed libpound.so.0 (the loader's search path), the build tree."""
+    env = os.environ.get("POUND_LIBRARY")
+    if env:
+        return [env]
+    return ["libpound.so.0", os.path.normpath(os.path.join(_HERE, "..", "..", "build",
+                                                           "libpound.so"))]
+
+
+def _load():
+    errors = []
+    for name in _candidates():
+        try:
+            return ctypes.CDLL(name), name
+        except OSError as e:
+            errors.append("%s (%s)" % (name, e))
+    raise ImportError("pound: libpound not found; tried " + "; ".join(errors) +
+                      ". Set POUND_LIBRARY to the path of libpound.so, install it "
+                      "(make install), or build it (make)")
+
+
+def _bind(lib, path):
+    missing = []
+    for name, (res, args) in _PROTOTYPES.items():
+        try:
+            f = getattr(lib, name)
+        except AttributeError:
+            missing.append(name)
+            continue
+        f.restype, f.argtypes = res, args
+    if missing:
+        raise ImportError("pound: %s does not export %s (a libpound older than this package, "
+                          "or symbols hidden)" % (path, ", ".join(missing)))
+    for name, (res, args) in _OPTIONAL.items():
+        f = getattr(lib, name, None)
+        if f is not None:
+            f.restype, f.argtypes = res, args
+
+
+lib, library_path = _load()
+_bind(lib, library_path)
+
+
+def version():
+    """The version of the library loaded (pd_version()), or None when it has no
+    pd_version."""
+    f = getattr(lib, "pd_version", None)
+    return f().decode() if f is not None else None
+
+
+def s(b):
+    """A C string as str (None stays None)."""
+    return None if b is None else b.decode("utf-8", "replace")
+
+
+def check(status, err):
+    """Raise the PoundError of a failed call."""
+    if status != 0:
+        msg = err.text() if err is not None and err.msg else s(lib.pd_strerror(status))
+        raise make_error(status, msg)
+
+
+def default_opts():
+    return lib.pd_run_default_opts().v
+
+
+def default_osc():
+    return lib.pd_osc_default().v
+
+
+def default_lcp_opts():
+    return lib.pd_lcp_default_opts().v
+
+
+# ---- the layout check ---------------------------------------------------------------------
+
+def _fail(what, detail):
+    raise LayoutError("pound: the ctypes mirror of %s does not match %s (%s): this package "
+                      "and the library come from different versions of pound; reinstall the "
+                      "package from the library's source tree" % (what, library_path, detail))
+
+
+def _probe(ctype, call, what):
+    """Bytes a call writes into a ctype it clears with memset(p, 0, sizeof *p)
+    first: the C sizeof, compared with the mirror's.  The buffer is larger than
+    the mirror, filled with two patterns in turn: a byte the call writes equals
+    at most one of them."""
+    cap = ctypes.sizeof(ctype) + 1024
+    size = 0
+    for fill in (0xA5, 0x5A):
+        buf = (c_ubyte * cap)()
+        ctypes.memset(buf, fill, cap)
+        call(ctypes.cast(buf, POINTER(ctype)))
+        size = max(size, len(bytes(buf).rstrip(bytes([fill]))))
+    if size != ctypes.sizeof(ctype):
+        _fail(what, "C writes %d bytes, the mirror has %d" % (size, ctypes.sizeof(ctype)))
+
+
+def _fields(x):
+    """The values of a struct's fields, recursively (padding left out)."""
+    if isinstance(x, Structure):
+        return tuple(_fields(getattr(x, f[0])) for f in x._fields_)
+    if isinstance(x, ctypes.Array):
+        return tuple(_fields(v) for v in x)
+    if isinstance(x, ctypes._Pointer):
+        return ctypes.cast(x, c_void_p).value
+    return x
+
+
+def _expect(what, got, want):
+    same = (got == want) or (isinstance(want, float) and isinstance(got, float)
+                             and math.isnan(want) and math.isnan(got))
+    if not same:
+        _fail(what, "got %r where the library's defaults give %r" % (got, want))
+
+
+def _check_layout():
+    err = PdErr()
+    # pd_err: a message longer than its buffer fills it (PD_EIO, the path in it)
+    long_path = b"/nonexistent-pound-layout-probe/" + b"x" * 400
+
+    def read_lcp(e):
+        n, M, q = c_int(), POINTER(c_double)(), POINTER(c_double)()
+        lib.pd_lcp_read(long_path, 0, ctypes.byref(n), ctypes.byref(M), ctypes.byref(q), e)
+    _probe(PdErr, read_lcp, "pd_err")
+
+    # pd_spectrum (and inside it pd_osc, pd_run_opts): pd_spec_init clears it and sets
+    # the defaults of pd_osc_default() and pd_run_default_opts()
+    _probe(PdSpectrum, lib.pd_spec_init, "pd_spectrum")
+    sp = PdSpectrum()
+    lib.pd_spec_init(sp)
+    b, o = sp.base, sp.opts
+    for name, got, want in [
+            ("pd_osc.pulse", b.pulse, 0), ("pd_osc.dir", b.dir, 1), ("pd_osc.ap", b.ap, 1.0),
+            ("pd_osc.Tp", b.Tp, 1.0), ("pd_osc.Pi2", b.Pi2, 1.0), ("pd_osc.Pi3", b.Pi3, 0.05),
+            ("pd_osc.eps", b.eps, 0.5), ("pd_osc.xi", b.xi, 0.05),
+            ("pd_osc.record", bool(b.record), False),
+            ("pd_run_opts.method", o.method, 0), ("pd_run_opts.dt", o.dt, 0.0),
+            ("pd_run_opts.theta", o.theta, 0.5), ("pd_run_opts.gamma", o.gamma, 0.5),
+            ("pd_run_opts.pen.rtol", o.pen.rtol, 1e-10),
+            ("pd_run_opts.pen.atol", o.pen.atol, 1e-12),
+            ("pd_run_opts.pen.stepper", s(o.pen.stepper), "rk8pd"),
+            ("pd_run_opts.on_lcp", o.on_lcp, None),
+            ("pd_spectrum.npi2", sp.npi2, 0), ("pd_spectrum.npulse", sp.npulse, 1),
+            ("pd_spectrum.neps", sp.neps, 1), ("pd_spectrum.dir", sp.dir[0], 1),
+            ("pd_spectrum.ap", sp.ap[0], 1.0), ("pd_spectrum.xi", sp.xi[0], 0.05),
+            ("pd_spectrum.size", sp.size[0], 0.05), ("pd_spectrum.eps", sp.eps[0], 0.5),
+            ("pd_spectrum.dt_per_Tp", sp.dt_per_Tp, 0.0)]:
+        _expect(name, got, want)
+    # the by-value defaults agree with them
+    d = default_opts()
+    if _fields(d) != _fields(sp.opts) or _fields(default_osc()) != _fields(sp.base):
+        _fail("pd_run_opts/pd_osc", "pd_run_default_opts() or pd_osc_default() differ from "
+              "what pd_spec_init() sets")
+    lo = default_lcp_opts()
+    for name, got, want in [("pd_lcp_opts.cover", bool(lo.cover), False),
+                            ("pd_lcp_opts.max_pivots", lo.max_pivots, 0),
+                            ("pd_lcp_opts.tol", lo.tol, 1e-12),
+                            ("pd_lcp_opts.max_iterations", lo.max_iterations, 0),
+                            ("pd_lcp_opts.guess", bool(lo.guess), False)]:
+        _expect(name, got, want)
+
+    # pd_spec_coords
+    sp.npi2, sp.pi2_min, sp.pi2_max = 3, 0.5, 2.0
+    sp.neps, sp.eps[1] = 2, 0.7
+    sp.ndir, sp.dir[1] = 2, -1
+    _probe(PdSpecCoords, lambda p: lib.pd_spec_coords_of(sp, 6 + 2 * 3 + 3 + 2, p),
+           "pd_spec_coords")
+    co = PdSpecCoords()
+    lib.pd_spec_coords_of(sp, 6 + 2 * 3 + 3 + 2, co)  # twins 6; curve 3 = dir 1, eps 1; j 2
+    _expect("pd_spec_coords", (co.twin, co.dir, co.eps, co.j, co.curve), (0, 1, 1, 2, 3))
+    # pd_spec_result: a task whose case is refused
+    bad = PdSpectrum()
+    lib.pd_spec_init(bad)
+    bad.npi2, bad.pi2_min, bad.pi2_max, bad.ap[0] = 1, 1.0, 1.0, -1.0
+    _probe(PdSpecResult, lambda p: lib.pd_spec_run_task(bad, 0, p, err), "pd_spec_result")
+    r = PdSpecResult()
+    lib.pd_spec_run_task(bad, 0, r, err)
+    _expect("pd_spec_result.status", r.status, PD_EINVAL)
+    _expect("pd_err.msg", err.text().startswith("ap (pulse amplitude)"), True)
+    # pd_spec_row: rows of given task results
+    one = PdSpectrum()
+    lib.pd_spec_init(one)
+    one.npi2, one.pi2_min, one.pi2_max = 1, 2.0, 2.0
+    res = (PdSpecResult * 2)()
+    res[0].umax, res[1].umax, res[1].impacts = 4.0, 2.0, 7
+    _probe(PdSpecRow, lambda p: lib.pd_spec_rows(one, res, p), "pd_spec_row")
+    row = PdSpecRow()
+    lib.pd_spec_rows(one, res, row)
+    _expect("pd_spec_row", (row.c.Pi2, row.T0, row.umax, row.umax_free, row.gamma,
+                            row.impacts, row.curve), (2.0, 0.5, 2.0, 4.0, 0.5, 7, 0))
+
+    # pd_osc_summary / pd_osc_result / pd_osc_sample: a refused case, then ten steps
+    c = default_osc()
+    c.ap = -1.0
+    _probe(PdOscSummary, lambda p: lib.pd_osc_summarize(c, None, OscSampler(), None, p, err),
+           "pd_osc_summary")
+    c = default_osc()
+    o = default_opts()
+    o.dt, o.tend = 0.001, 0.01
+    seen = []
+
+    def sample(p, ctx):
+        x = PdOscSample.from_address(p)
+        seen.append((x.step, x.t, x.gap, x.u))
+        return 0
+    sm = PdOscSummary()
+    check(lib.pd_osc_summarize(c, o, OscSampler(sample), None, sm, err), err)
+    gap = lib.pd_osc_gap(c)
+    _expect("pd_osc_result", (sm.r.dt, sm.r.tend, sm.r.theta, sm.r.gamma, sm.r.steps,
+                              s(sm.r.kernel), sm.free.steps, sm.r.impacts),
+            (0.001, 0.01, 0.5, 0.5, 10, "scalar", 10, 0))
+    _expect("pd_osc_sample", (len(seen), seen[0][0], seen[-1][0],
+                              abs(seen[-1][1] - 0.01) < 1e-12,
+                              abs(seen[-1][2] - (gap - seen[-1][3])) < 1e-12),
+            (11, 0, 10, True, True))
+    tr = PdTrace()
+    lib.pd_trace_alloc(tr, o)
+    _expect("pd_trace", (tr.n, tr.cap), (0, 12))
+    lib.pd_trace_free(tr)
+
+    # pd_lcp_info: a solve without a solver is refused after the info is cleared
+    M = (c_double * 1)(2.0)
+    q = (c_double * 1)(-1.0)
+    z, w = (c_double * 1)(), (c_double * 1)()
+    mat = PdMatrix(kind=1, rows=1, cols=1, values=M)
+    _probe(PdLcpInfo, lambda p: lib.pd_lcp_solve(None, mat, q, None, z, w, p), "pd_lcp_info")
+    info = PdLcpInfo()
+    _expect("pd_lcp_solve", lib.pd_lcp_solve(None, mat, q, None, z, w, info), PD_EINVAL)
+    _expect("pd_lcp_info", (info.outcome, s(info.solver)), (3, "?"))
+    # pd_matrix: dense and compressed columns read back
+    vals = (c_double * 4)(1.0, 2.0, 3.0, 4.0)  # [[1, 3], [2, 4]] column-major
+    dense = PdMatrix(kind=1, rows=2, cols=2, values=vals)
+    colptr, rowind = (c_int * 3)(0, 1, 3), (c_int * 3)(1, 0, 1)
+    csc = PdMatrix(kind=2, rows=2, cols=2, values=vals, colptr=colptr, rowind=rowind)
+    _expect("pd_matrix", (lib.pd_matrix_get(dense, 0, 1), lib.pd_matrix_nnz(dense),
+                          lib.pd_matrix_get(csc, 1, 0), lib.pd_matrix_get(csc, 0, 1),
+                          lib.pd_matrix_get(csc, 0, 0), lib.pd_matrix_nnz(csc)),
+            (3.0, 4, 1.0, 2.0, 0.0, 3))
+
+    # records: read (refused: the record cleared), measured and fitted in memory
+    _probe(PdRecord, lambda p: lib.pd_record_read(long_path, 0, 0, p, err), "pd_record")
+    acc = (c_double * 3)(0.0, 1.0, 0.0)
+    rec = PdRecord(name=b"probe", npts=3, dt=0.01, acc=acc)
+    _probe(PdRecordMeasures, lambda p: lib.pd_record_measure(rec, p, err),
+           "pd_record_measures")
+    m = PdRecordMeasures()
+    check(lib.pd_record_measure(rec, m, err), err)
+    _expect("pd_record_measures", (m.pga, m.t_pga, abs(m.pgv - 0.01) < 1e-15,
+                                   abs(m.t_pgv - 0.02) < 1e-15), (1.0, 0.01, True, True))
+    _probe(PdRecordPulse, lambda p: lib.pd_record_fit_pulse(rec, p, err), "pd_record_pulse")
+
+    # scenes: two SDOFs, a contact between them and one with the right wall
+    exc = PdSceneExcitation(pulse=1, dir=1, ap=3.0, Tp=0.6)
+    sc = lib.pd_scene_new(exc)
+    if not sc:
+        raise MemoryError("pound: out of memory")
+    try:
+        for call in (lambda: lib.pd_scene_add_sdof(sc, b"stiff", 0.4, 0.05, 2e5, err),
+                     lambda: lib.pd_scene_add_sdof(sc, b"flexible", 1.2, 0.03, 1e5, err),
+                     lambda: lib.pd_scene_add_contact(sc, 0, 1, 1, 1, 0.02, 0.65, 0, err),
+                     lambda: lib.pd_scene_add_contact(sc, 1, 1, PD_WALL, 0, 0.03, 0.5, 1, err),
+                     lambda: lib.pd_scene_finish(sc, err)):
+            check(call(), err)
+        S = sc[0]
+        st, ct = S.st[1], S.ct[1]
+        _expect("pd_scene", (S.nstruct, S.ncontact, S.n, S.finished, S.exc.pulse, S.exc.ap,
+                             S.exc.Tp, bool(S.exc.record), lib.pd_scene_find(sc, b"flexible")),
+                (2, 2, 2, 1, 1, 3.0, 0.6, False, 1))
+        _expect("pd_structure", (st.name, st.storeys, st.mass[0], st.xi, st.dof,
+                                 abs(st.T0 - 1.2) < 1e-12, S.st[0].name),
+                (b"flexible", 1, 1e5, 0.03, 1, True, b"stiff"))
+        _expect("pd_contact", (ct.a, ct.b, ct.level_a, ct.level_b, ct.gap, ct.eps, ct.entry,
+                               S.ct[0].b), (1, PD_WALL, 1, 0, 0.03, 0.5, 1, 1))
+        _probe(PdSceneResult, lambda p: (lib.pd_scene_result_alloc(sc, p, err),
+                                         lib.pd_scene_result_free(p)), "pd_scene_result")
+        o = default_opts()
+        o.theta = 5.0  # refused after the summary is cleared
+        _probe(PdSceneSummary, lambda p: (lib.pd_scene_summarize(sc, o, SceneSampler(), None,
+                                                                 p, err),
+                                          lib.pd_scene_summary_free(p)), "pd_scene_summary")
+        o = default_opts()
+        o.dt, o.tend = 0.001, 0.003
+        _probe(PdSceneTrace, lambda p: (lib.pd_scene_trace_alloc(p, sc, o, err),
+                                        lib.pd_scene_trace_free(p)), "pd_scene_trace")
+        _probe(PdSceneErrors, lambda p: (lib.pd_scene_errors_alloc(sc, p, err),
+                                         lib.pd_scene_errors_free(p)), "pd_scene_errors")
+        seen = []
+
+        def scene_sample(p, ctx):
+            x = PdSceneSample.from_address(p)
+            seen.append((x.step, x.t, x.x[1], x.gap[1]))
+            return 0
+        ss = PdSceneSummary()
+        check(lib.pd_scene_summarize(sc, o, SceneSampler(scene_sample), None, ss, err), err)
+        try:
+            _expect("pd_scene_result", (ss.r.n, ss.r.m, ss.r.steps, ss.r.dt, ss.r.tend,
+                                        s(ss.r.method), ss.r.impacts[1], ss.Pi2[0]),
+                    (2, 2, 3, 0.001, 0.003, "moreau", 0, 0.6 / S.st[0].T0))
+            _expect("pd_scene_sample", (len(seen), seen[-1][0],
+                                        abs(seen[-1][1] - 0.003) < 1e-12,
+                                        abs(seen[-1][3] - (0.03 - seen[-1][2])) < 1e-12),
+                    (4, 3, True, True))
+        finally:
+            lib.pd_scene_summary_free(ss)
+    finally:
+        lib.pd_scene_free(sc)
+
+
+_check_layout()

@@ -1,0 +1,414 @@
+"""The one-wall oscillator: simulate, compare, converge (cli/cmd_simulate.c,
+cli/cmd_compare.c, cli/cmd_converge.c reproduced from library calls)."""
+import ctypes
+import math
+
+import numpy as np
+
+from . import _lib
+from ._case import Case, InputError, copy_opts, number
+from ._lib import PdErr, lib, s
+
+NAN = float("nan")
+
+
+class Result(dict):
+    """A dict whose keys are also attributes (r.umax is r['umax'])."""
+
+    def __getattr__(self, key):
+        try:
+            return self[key]
+        except KeyError:
+            raise AttributeError(key) from None
+
+    def __dir__(self):
+        return list(self.keys()) + list(dict.__dir__(self))
+
+
+class _History:
+    """Samples copied whole (memmove) into a growing NumPy record array."""
+
+    def __init__(self, dtype, cap, every):
+        self.dtype = np.dtype(dtype)
+        self.buf = np.zeros(max(int(cap), 16), dtype=self.dtype)
+        self.n = 0
+        self.every = int(every)
+        self.error = None
+
+    def grow(self):
+        new = np.zeros(2 * len(self.buf), dtype=self.dtype)
+        new[:self.n] = self.buf[:self.n]
+        self.buf = new
+
+    def rows(self):
+        return self.buf[:self.n]
+
+
+OSC_SAMPLE = [("step", "i8"), ("t", "f8"), ("u", "f8"), ("v", "f8"), ("impulse", "f8"),
+              ("gap", "f8")]
+
+
+def _osc_sampler(h):
+    size = ctypes.sizeof(_lib.PdOscSample)
+    memmove, c_long = ctypes.memmove, ctypes.c_long
+
+    def sample(p, ctx):
+        try:
+            if h.every > 1 and c_long.from_address(p).value % h.every:
+                return 0
+            if h.n == len(h.buf):
+                h.grow()
+            memmove(h.buf.ctypes.data + h.n * size, p, size)
+            h.n += 1
+            return 0
+        except BaseException as e:  # stop the run; raised once it returns
+            h.error = e
+            return 1
+    return _lib.OscSampler(sample)
+
+
+def osc_result_fields(r):
+    """A pd_osc_result as a dict."""
+    return {k: (s(getattr(r, k)) if k == "kernel" else getattr(r, k))
+            for k, _ in _lib.PdOscResult._fields_}
+
+
+def _case_json(case, out):
+    c = case.c
+    out["Pi2"] = c.Pi2
+    out["Pi3"] = c.Pi3
+    out["eps"] = c.eps
+    out["xi"] = c.xi
+    out["ap"] = c.ap
+    out["Tp"] = c.Tp
+    out["T0"] = lib.pd_osc_T0(c)
+    out["gap"] = lib.pd_osc_gap(c)
+    out["pulse"] = s(lib.pd_osc_excitation_name(c))
+    out["dir"] = s(lib.pd_dir_name(c.dir))
+    if c.record:
+        out["record"] = case.record.name
+        out["scale"] = c.scale
+
+
+def simulate(history=True, every=1, **case):
+    """One run of the pounding oscillator and its no-wall twin, as
+    `pound simulate [flags] --json`.
+
+    Keywords mirror the CLI's flags (defaults in brackets): pulse
+    'sine'|'cosine'|'harmonic' ['sine'], dir 'normal'|'reverse' (or +1/-1)
+    ['normal'], ap [1] m/s^2, Tp [1] s, T0 s or Pi2 [1], gap m or Pi3 [0.05],
+    eps [0.5], xi [0.05]; record (a file or a pound.Record), scale [1],
+    units ['g'], record_format ['auto']; method 'moreau'|'event'|'penalty'
+    ['moreau'], dt [min(Tp, T0)/2000], tend [Tp + 2 T0], theta [0.5],
+    gamma [0.5], allow_unstable, no_accumulation, no_wall, kernel
+    'auto'|'general', factor, lcp_solver, contact 'kelvin'|'hertz', kc,
+    kc_abs, rtol, atol, stepper.
+
+    Returns a Result with the keys of the CLI's JSON (umax, Pi1, gamma,
+    impacts, ...) and, with history, r.history: the arrays step, t, u, v,
+    impulse, gap of every every-th step (the CLI's -o file: t [s], u [m],
+    v [m/s], impulse per unit mass since the last sample [m/s], gap
+    delta - u [m]), with t, u, v, impulse also as r.t, r.u, r.v, r.impulse."""
+    k = Case(case).resolve()
+    o = k.opts
+    h = sampler = None
+    if history:
+        every = int(every)
+        if every < 1:
+            raise InputError("every: must be >= 1 (got %d)" % every)
+        h = _History(OSC_SAMPLE, lib.pd_steps_for(o.tend, o.dt) // every + 2, every)
+        sampler = _osc_sampler(h)
+    sm = _lib.PdOscSummary()
+    err = PdErr()
+    st = lib.pd_osc_summarize(k.c, o, sampler or _lib.OscSampler(), None, sm, err)
+    if h is not None and h.error is not None:
+        raise h.error
+    _lib.check(st, err)
+    r = sm.r
+    out = Result(method=s(lib.pd_method_name(o.method)), umax=r.umax, Pi1=sm.Pi1,
+                 u_toward=r.u_toward, u_away=r.u_away, impacts=r.impacts,
+                 accumulations=r.accumulations, first_impact=r.first_impact,
+                 first_impact_velocity=r.first_impact_velocity,
+                 max_impact_velocity=r.max_impact_velocity, max_impulse=r.max_impulse,
+                 contact_time=r.contact_time, min_gap=r.min_gap, umax_free=sm.free.umax,
+                 gamma=sm.gamma, chi=sm.chi, steps=r.steps, cpu_s=sm.cpu_s)
+    _case_json(k, out)
+    out.update(dt=r.dt, theta=r.theta, gamma_active=r.gamma, tend=r.tend, kernel=s(r.kernel))
+    if h is not None:
+        rows = h.rows()
+        hist = Result((name, np.ascontiguousarray(rows[name])) for name, _ in OSC_SAMPLE)
+        out["history"] = hist
+        for name in ("t", "u", "v", "impulse"):  # shortcuts (gap is the case's gap)
+            out[name] = hist[name]
+    return out
+
+
+# ---- compare ------------------------------------------------------------------------------
+
+def parse_methods(methods):
+    """('moreau', 'penalty') -> [want moreau, event, penalty]."""
+    if isinstance(methods, str):
+        methods = methods.split(",")
+    want = [0, 0, 0]
+    if not methods:
+        raise InputError("methods: give moreau, penalty or both")
+    for m in methods:
+        if m not in ("moreau", "penalty"):
+            raise InputError("methods: '%s' is not one of moreau, penalty" % (m,))
+        want[0 if m == "moreau" else 2] = 1
+    return want
+
+
+class _Traces:
+    """The reference's and a run's u on the output grid (pd_trace)."""
+
+    def __init__(self, o):
+        self.ref, self.work = _lib.PdTrace(), _lib.PdTrace()
+        if lib.pd_trace_alloc(self.ref, o) or lib.pd_trace_alloc(self.work, o):
+            self.close()
+            raise _lib.PoundMemoryError("out of memory for the histories", _lib.PD_ENOMEM)
+
+    def close(self):
+        lib.pd_trace_free(self.ref)
+        lib.pd_trace_free(self.work)
+
+
+def compare(methods=("moreau",), scene=None, **case):
+    """Errors against the event-driven reference, as `pound compare --json`:
+    err_umax_rel = |umax - umax_ref| / umax_ref and err_hist_linf =
+    max_k |u(t_k) - u_ref(t_k)| / umax_ref on t_k = k dt, for Moreau-Jean
+    and/or penalty (methods).  scene=path: the scene's (per structure)."""
+    want = parse_methods(methods)
+    if scene is not None:
+        from ._scene import compare_scene
+        return compare_scene(scene, want, case)
+    k = Case(case).resolve()
+    o, err = k.opts, PdErr()
+    tr = _Traces(o)
+    try:
+        rr = _lib.PdOscResult()
+        st = lib.pd_measure_reference(k.c, o, tr.ref, rr, err)
+        if st:
+            raise _lib.make_error(st, "reference: " + err.text())
+        res = [None] * 3
+        for m in range(3):
+            if not want[m]:
+                continue
+            om = copy_opts(o)
+            om.method = m
+            res[m] = _lib.PdMeasured()
+            st = lib.pd_measure_run(k.c, om, tr.ref, rr.umax, tr.work, res[m], err)
+            if st:
+                raise _lib.make_error(st, "%s: %s" % (s(lib.pd_method_name(m)), err.text()))
+    finally:
+        tr.close()
+    first = 0 if want[0] else 2
+    f = res[first]
+    out = Result(method=s(lib.pd_method_name(first)), err_umax_rel=f.err_umax_rel,
+                 err_hist_linf=f.err_hist_linf, impacts=f.r.impacts, impacts_ref=rr.impacts,
+                 cpu_s=f.r.cpu_s, cpu_s_ref=rr.cpu_s, umax=f.r.umax, umax_ref=rr.umax,
+                 events_ref=rr.steps, accumulations_ref=rr.accumulations, dt=o.dt,
+                 Pi2=k.c.Pi2, Pi3=k.c.Pi3, eps=k.c.eps)
+    out["methods"] = [Result(method=s(lib.pd_method_name(m)), err_umax_rel=res[m].err_umax_rel,
+                             err_hist_linf=res[m].err_hist_linf, impacts=res[m].r.impacts,
+                             steps=res[m].r.steps, cpu_s=res[m].r.cpu_s)
+                      for m in range(3) if want[m]]
+    return out
+
+
+# ---- converge -----------------------------------------------------------------------------
+
+def dt_range(dt_max, dt_min, n):
+    """The steps of the CLI's --dt MAX:MIN:N: n values log-spaced from dt_max
+    down to dt_min (cli/cmd_converge.c dt_at)."""
+    dt_max, dt_min, n = float(dt_max), float(dt_min), int(n)
+    if not (dt_min > 0.0) or dt_max < dt_min or n < 1 or n > 64:
+        raise InputError("dt: need MAX >= MIN > 0 and 1 <= N <= 64 (got %g:%g:%d)"
+                         % (dt_max, dt_min, n))
+    if n == 1:
+        return [dt_max]
+    return [dt_max * math.pow(dt_min / dt_max, i / (n - 1)) for i in range(n)]
+
+
+def _steps(dts):
+    """The rows' steps and the finest: a 'MAX:MIN:N' string or a (MAX, MIN, N)
+    tuple whose N is an int (the CLI's range, its finest step MIN), or a
+    sequence of steps (the finest their minimum)."""
+    if isinstance(dts, str):
+        parts = dts.split(":")
+        if len(parts) != 3:
+            raise InputError("dt: '%s' is not MAX:MIN:N" % dts)
+        try:
+            dts = (float(parts[0]), float(parts[1]), int(parts[2]))
+        except ValueError:
+            raise InputError("dt: '%s' is not MAX:MIN:N" % (dts,)) from None
+    if isinstance(dts, tuple) and len(dts) == 3 and isinstance(dts[2], (int, np.integer)) \
+            and not isinstance(dts[2], bool):
+        return dt_range(*dts), float(dts[1]), float(dts[0])
+    steps = [number("dt", x) for x in np.atleast_1d(dts).tolist()]
+    if not steps or len(steps) > 64 or not all(x > 0.0 for x in steps):
+        raise InputError("dt: give 1 to 64 steps > 0")
+    return steps, min(steps), steps[0]
+
+
+def _c_round(x):
+    """C's round() (halves away from zero) for x >= 0."""
+    f = math.floor(x)
+    return f + 1.0 if x - f >= 0.5 else f
+
+
+def converge(dts, theta=(0.5,), methods=("moreau",), kcs=None, error="hist", scene=None,
+             **case):
+    """Error and cost as dt shrinks, as `pound converge --dt ... --json`: one
+    row per (dt, theta) for Moreau-Jean, one per contact stiffness multiple
+    kc (kcs [1e2, 1e3, 1e4, 1e5, 1e6]) on the finest grid for penalty; order =
+    log(err_prev / err) / log(dt_prev / dt) between successive rows of one
+    theta, on err_hist_linf (error='hist') or err_umax_rel ('umax').
+
+    dts: 'MAX:MIN:N' or (MAX, MIN, N) with an int N (the CLI's --dt), or a
+    sequence of steps.  Returns {'rows': [...], 'cpu_s_ref': ...}."""
+    steps, dt_min, dt_first = _steps(dts)
+    thetas = [number("theta", t) for t in np.atleast_1d(theta).tolist()]
+    if not thetas or len(thetas) > 32:
+        raise InputError("theta: give 1 to 32 values")
+    if isinstance(methods, str):
+        methods = methods.split(",")
+    for m in methods:
+        if m not in ("moreau", "penalty"):
+            raise InputError("methods: '%s' is not one of moreau, penalty" % (m,))
+    want_moreau, want_penalty = "moreau" in methods, "penalty" in methods
+    kcs = [1e2, 1e3, 1e4, 1e5, 1e6] if kcs is None else \
+        [number("kcs", x) for x in np.atleast_1d(kcs).tolist()]
+    if any(not x > 0.0 for x in kcs):
+        raise InputError("kcs: stiffness multiples must be > 0")
+    if error not in ("hist", "umax"):
+        raise InputError("error: expected 'hist' or 'umax'")
+    if not case.get("allow_unstable"):
+        for t in thetas:
+            if not 0.5 <= t <= 1.0:
+                raise InputError("theta: %g is outside [1/2, 1] (allow_unstable=True)" % t)
+    case = dict(case, dt=dt_first)
+    if scene is not None:
+        from ._scene import SceneMeasurer
+        meas = SceneMeasurer(scene, case)
+    else:
+        meas = _OscMeasurer(Case(case).resolve())
+    try:
+        rows, ref_cpu = _rows(meas, steps, dt_min, thetas, want_moreau, want_penalty, kcs,
+                              error)
+    finally:
+        meas.close()
+    return Result(rows=rows, cpu_s_ref=ref_cpu)
+
+
+class _OscMeasurer:
+    sc = None
+
+    def __init__(self, case):
+        self.case = case
+        self.opts = case.opts
+        self.tr = None
+        self.rr = _lib.PdOscResult()
+
+    def alloc(self, o):
+        self.tr = _Traces(o)
+
+    def reference(self, o, err):
+        st = lib.pd_measure_reference(self.case.c, o, self.tr.ref, self.rr, err)
+        return st, self.rr.cpu_s
+
+    def row(self, o, err):
+        m = _lib.PdMeasured()
+        st = lib.pd_measure_run(self.case.c, o, self.tr.ref, self.rr.umax, self.tr.work, m, err)
+        return st, dict(err_umax=m.err_umax_rel, err_hist=m.err_hist_linf, cpu_s=m.r.cpu_s,
+                        impacts=m.r.impacts, steps=m.r.steps)
+
+    def close(self):
+        if self.tr is not None:
+            self.tr.close()
+
+
+def _rows(M, steps, dt_min, thetas, want_moreau, want_penalty, kcs, error):
+    """cli/cmd_converge.c compute_rows."""
+    o = copy_opts(M.opts)
+    err = PdErr()
+    o.dt = dt_min
+    ref_cpu = 0.0
+    M.alloc(o)
+    nested = all(abs(d / dt_min - _c_round(d / dt_min)) <= 1e-9 * (d / dt_min) for d in steps)
+    once = M.sc is not None and nested
+    rows = []
+
+    def reference():
+        nonlocal ref_cpu
+        st, cpu = M.reference(o, err)
+        ref_cpu = max(ref_cpu, cpu)  # fmax: the CLI keeps the largest
+        if st:
+            raise _lib.make_error(st, err.text())
+
+    def row():
+        r = Result(method=s(lib.pd_method_name(o.method)),
+                   theta=o.theta if o.method == 0 else NAN, dt=o.dt,
+                   kc=o.pen.kc_mult if o.method == 2 else NAN)
+        st, m = M.row(o, err)
+        if st:
+            raise _lib.make_error(st, err.text())
+        r.update(err_umax_rel=m["err_umax"], err_hist_linf=m["err_hist"], cpu_s=m["cpu_s"],
+                 order=NAN, impacts=m["impacts"], steps=m["steps"])
+        if "structures" in m:
+            r["structures"] = m["structures"]
+        rows.append(r)
+
+    if once:
+        reference()
+    for d in steps if want_moreau else ():
+        o.dt = d
+        if not once:
+            reference()
+        for t in thetas:
+            o.theta = t
+            o.method = 0
+            row()
+    if want_penalty:
+        o.dt = dt_min
+        if not once:
+            reference()
+        for kc in kcs:
+            o.method = 2
+            o.pen.kc_mult = kc
+            o.pen.kc_abs = 0.0
+            row()
+    key = "err_umax_rel" if error == "umax" else "err_hist_linf"
+    for i, r in enumerate(rows):
+        for q in range(i - 1, -1, -1):
+            p = rows[q]
+            if p["method"] == "moreau" and r["method"] == "moreau" and p["theta"] == r["theta"]:
+                r["order"] = _order(p[key], r[key], p["dt"], r["dt"])
+                break
+    # the CLI's column order
+    keys = ("method", "theta", "dt", "kc", "err_umax_rel", "err_hist_linf", "cpu_s", "order",
+            "impacts", "steps", "structures")
+    return [Result((k, r[k]) for k in keys if k in r) for r in rows], ref_cpu
+
+
+def _cdiv(a, b):
+    """a / b with IEEE results where Python raises."""
+    if b == 0.0:
+        if a == 0.0 or math.isnan(a):
+            return NAN
+        return math.copysign(math.inf, a) * math.copysign(1.0, b)
+    return a / b
+
+
+def _clog(x):
+    """C's log (math.log calls it) with IEEE results where Python raises."""
+    if x == 0.0:
+        return -math.inf
+    if math.isnan(x) or x < 0.0:
+        return NAN
+    return math.log(x)
+
+
+def _order(e0, e1, d0, d1):
+    """log(e0 / e1) / log(d0 / d1) as C computes it."""
+    return _cdiv(_clog(_cdiv(e0, e1)), _clog(_cdiv(d0, d1)))

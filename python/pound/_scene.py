@@ -1,0 +1,393 @@
+"""Scenes: rows of structures read from JSON files (docs/scenes.md) or
+generated (chain), run as `pound simulate --scene F --json` runs them."""
+import ctypes
+
+import numpy as np
+
+from . import _lib
+from ._case import SCHEME_KEYS, Case, InputError, copy_opts, number, scheme_opts
+from ._lib import PD_WALL, PdErr, lib, s
+from ._osc import Result, _History
+
+SCENE_OPTS = SCHEME_KEYS
+
+
+def _array(ptr, n, dtype=np.float64):
+    if n <= 0 or not ptr:
+        return np.zeros(0, dtype=dtype)
+    return np.ctypeslib.as_array(ptr, (n,)).astype(dtype, copy=True)
+
+
+class Scene:
+    """A finished scene (pd_scene) owned by Python: Scene(path) reads a scene
+    file, Scene.chain(N, ...) generates a row of N SDOFs between two walls.
+    structures, contacts and excitation describe it; simulate() runs it."""
+
+    def __init__(self, path=None, _ptr=None, _name=None):
+        self._p = None
+        if _ptr is not None:
+            self._p, self.path = _ptr, _name
+            return
+        p = ctypes.POINTER(_lib.PdScene)()
+        err = PdErr()
+        _lib.check(lib.pd_scene_load(str(path).encode(), ctypes.byref(p), err), err)
+        self._p, self.path = p, str(path)
+
+    @classmethod
+    def chain(cls, N, ratio=1.5, **model):
+        """`pound simulate --chain N`: N SDOFs of unit mass between two walls,
+        periods alternating T0 and ratio T0, every gap `gap` (or Pi3), every
+        restitution eps; the model keywords of simulate() (pulse, dir, ap, Tp,
+        T0 or Pi2, gap or Pi3, eps, xi)."""
+        N = int(N)
+        if not 1 <= N <= 10000000:
+            raise InputError("chain: N must be in [1, 1e7] (got %d)" % N)
+        ratio = number("chain_ratio", ratio)
+        if not ratio > 0.0:
+            raise InputError("chain_ratio: must be > 0 (got %.10g)" % ratio)
+        if N > 1 and not 1e-4 <= ratio <= 1e4:
+            raise InputError("chain_ratio: must be in [1e-4, 1e4] (got %.10g)" % ratio)
+        k = Case(model, allowed=("pulse", "dir", "ap", "Tp", "T0", "Pi2", "gap", "Pi3", "eps",
+                                 "xi"))
+        k.finish_model()
+        c = k.c
+        x = _lib.PdSceneExcitation(pulse=c.pulse, dir=c.dir, ap=c.ap, Tp=c.Tp)
+        p = ctypes.POINTER(_lib.PdScene)()
+        err = PdErr()
+        _lib.check(lib.pd_scene_chain(N, x, lib.pd_osc_T0(c), ratio, c.xi, lib.pd_osc_gap(c),
+                                      c.eps, ctypes.byref(p), err), err)
+        return cls(_ptr=p, _name="chain of %d" % N)
+
+    def close(self):
+        if self._p:
+            lib.pd_scene_free(self._p)
+            self._p = None
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown
+            pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    @property
+    def _sc(self):
+        if not self._p:
+            raise ValueError("the scene is closed")
+        return self._p[0]
+
+    @property
+    def n(self):
+        """Degrees of freedom."""
+        return self._sc.n
+
+    @property
+    def tend(self):
+        """The file's tend [s] (0: derived)."""
+        return self._sc.tend
+
+    @property
+    def Le(self):
+        return lib.pd_scene_Le(self._p)
+
+    @property
+    def wp(self):
+        return lib.pd_scene_wp(self._p)
+
+    def _side(self, k):
+        return "wall" if k == PD_WALL else s(self._sc.st[k].name)
+
+    @property
+    def structures(self):
+        sc = self._sc
+        out = []
+        for k in range(sc.nstruct):
+            st = sc.st[k]
+            out.append(Result(name=s(st.name), storeys=st.storeys, T0=st.T0, xi=st.xi,
+                              mass=_array(st.mass, st.storeys),
+                              stiffness=_array(st.stiffness, st.storeys), dof=st.dof,
+                              damping="exact" if st.storeys == 1 else
+                              "stiffness" if st.damping == 1 else "rayleigh",
+                              alpha=st.alpha, beta=st.beta))
+        return out
+
+    @property
+    def contacts(self):
+        sc = self._sc
+        out = []
+        for a in range(sc.ncontact):
+            ct = sc.ct[a]
+            out.append(Result(a=self._side(ct.a), b=self._side(ct.b), level_a=ct.level_a,
+                              level_b=ct.level_b, gap=ct.gap, eps=ct.eps))
+        return out
+
+    @property
+    def excitation(self):
+        x = self._sc.exc
+        out = Result(pulse=s(x.record[0].name) if x.record else s(lib.pd_pulse_name(x.pulse)),
+                     dir="+x" if x.dir > 0 else "-x", ap=x.ap, Tp=x.Tp)
+        if x.record:
+            out["record"] = s(x.record[0].name)
+            out["scale"] = x.scale
+        return out
+
+    def opts(self, kw):
+        """The run options of the scheme keywords, resolved for this scene."""
+        unknown = sorted(set(kw) - set(SCENE_OPTS))
+        if unknown:
+            raise TypeError("unexpected keyword argument(s) %s (a scene run takes %s)"
+                            % (", ".join(unknown), ", ".join(SCENE_OPTS)))
+        o, _ = scheme_opts({k: v for k, v in kw.items() if v is not None})
+        out, err = _lib.PdRunOpts(), PdErr()
+        _lib.check(lib.pd_scene_resolve_opts(self._p, o, out, err), err)
+        return o, out
+
+    def simulate(self, history=True, every=1, **opts):
+        """The run and its contact-free twin, as `pound simulate --scene F
+        --json`: per structure umax, u_pos, u_neg, drift, Pi1, umax_free, gamma
+        (one value per storey), per contact impacts, first_impact,
+        max_impulse, contact_time, approach, Pi3, chi; with history,
+        r.history: step, t (N), x and v (N x dofs) [m, m/s], gap [m] and
+        impulse [N s] (N x contacts), every every-th sample, the impulses
+        summed since the last one kept (the CLI's -o file; t, x, v also as
+        r.t, r.x, r.v)."""
+        _, o = self.opts(opts)
+        sc = self._sc
+        n, m = sc.n, sc.ncontact
+        h = sampler = None
+        if history:
+            every = int(every)
+            if every < 1:
+                raise InputError("every: must be >= 1 (got %d)" % every)
+            dtype = [("step", "i8"), ("t", "f8"), ("x", "f8", (n,)), ("v", "f8", (n,)),
+                     ("gap", "f8", (m,)), ("impulse", "f8", (m,))]
+            h = _History(dtype, lib.pd_steps_for(o.tend, o.dt) // every + 2, every)
+            sampler = _scene_sampler(h, n, m)
+        sm = _lib.PdSceneSummary()
+        err = PdErr()
+        try:
+            st = lib.pd_scene_summarize(self._p, o, sampler or _lib.SceneSampler(), None, sm,
+                                        err)
+            if h is not None and h.error is not None:
+                raise h.error
+            _lib.check(st, err)
+            out = self._summary(sm)
+        finally:
+            lib.pd_scene_summary_free(sm)
+        if h is not None:
+            rows = h.rows()
+            hist = Result((name, np.ascontiguousarray(rows[name]))
+                          for name in ("step", "t", "x", "v", "gap", "impulse"))
+            out["history"] = hist
+            for name in ("t", "x", "v"):  # shortcuts
+                out[name] = hist[name]
+        return out
+
+    def _summary(self, sm):
+        sc, r = self._sc, sm.r
+        out = Result(method=s(r.method), steps=r.steps, cpu_s=sm.cpu_s, cpu_s_run=r.cpu_s,
+                     kernel=s(r.kernel), factor=s(r.factor), lcp_solver=s(r.lcp_solver),
+                     lcp_solves=r.lcp_solves, dt=r.dt, theta=r.theta, tend=r.tend, dofs=sc.n)
+        x = self.excitation
+        out["pulse"], out["dir"] = x["pulse"], x["dir"]
+        if "record" in x:
+            out["record"], out["scale"] = x["record"], x["scale"]
+        out.update(ap=sc.exc.ap, Tp=sc.exc.Tp, Le=self.Le)
+        structs = []
+        for k in range(sc.nstruct):
+            st = sc.st[k]
+            o, ns = st.dof, st.storeys
+
+            def part(p, o=o, ns=ns):
+                return np.ctypeslib.as_array(p, (o + ns,))[o:].copy()
+            structs.append(Result(name=s(st.name), storeys=ns, T0=st.T0, Pi2=sm.Pi2[k],
+                                  umax=part(r.umax), u_pos=part(r.u_pos), u_neg=part(r.u_neg),
+                                  drift=part(r.drift), Pi1=part(sm.Pi1),
+                                  umax_free=part(sm.free.umax), gamma=part(sm.gamma)))
+        out["structures"] = structs
+        contacts = []
+        for a in range(sc.ncontact):
+            ct = sc.ct[a]
+            contacts.append(Result(a=self._side(ct.a), b=self._side(ct.b),
+                                   level=ct.level_b if ct.a == PD_WALL else ct.level_a,
+                                   level_b=ct.level_b, gap=ct.gap, eps=ct.eps, Pi3=sm.Pi3[a],
+                                   impacts=r.impacts[a], first_impact=r.first_impact[a],
+                                   max_impulse=r.max_impulse[a],
+                                   contact_time=r.contact_time[a], approach=r.approach[a],
+                                   chi=sm.chi[a]))
+        out["contacts"] = contacts
+        return out
+
+    def __repr__(self):
+        if not self._p:
+            return "<pound.Scene closed>"
+        sc = self._sc
+        return "<pound.Scene %s: %d structures, %d dofs, %d contacts>" % (
+            self.path, sc.nstruct, sc.n, sc.ncontact)
+
+
+def _scene_sampler(h, n, m):
+    """Copy t, x, v, gap, impulse of every every-th sample into the history,
+    as the CLI's scene writer keeps them (cli/scene_out.c): samples counted,
+    the impulses of the samples left out added to the next one kept."""
+    memmove = ctypes.memmove
+    PdSceneSample = _lib.PdSceneSample
+    item = h.dtype.itemsize
+    off = {k: h.dtype.fields[k][1] for k in ("step", "t", "x", "v", "gap", "impulse")}
+    nb, mb = 8 * n, 8 * m
+    acc = np.zeros(m)
+    state = {"seen": 0}
+    every = h.every
+
+    def sample(p, ctx):
+        try:
+            x = PdSceneSample.from_address(p)
+            if every > 1:
+                if m and x.impulse:
+                    acc.__iadd__(np.ctypeslib.as_array(x.impulse, (m,)))
+                seen = state["seen"]
+                state["seen"] = seen + 1
+                if seen % every:
+                    return 0
+            if h.n == len(h.buf):
+                h.grow()
+            base = h.buf.ctypes.data + h.n * item
+            memmove(base, p, 16)  # step, t
+            if nb:
+                memmove(base + off["x"], x.x, nb)
+                memmove(base + off["v"], x.v, nb)
+            if mb and x.gap:
+                memmove(base + off["gap"], x.gap, mb)
+            if mb and every > 1:
+                h.buf["impulse"][h.n] = acc
+                acc[:] = 0.0
+            elif mb and x.impulse:
+                memmove(base + off["impulse"], x.impulse, mb)
+            h.n += 1
+            return 0
+        except BaseException as e:
+            h.error = e
+            return 1
+    return _lib.SceneSampler(sample)
+
+
+def scene(path):
+    """Read a scene file (JSON, docs/scenes.md): a pound.Scene."""
+    return Scene(path)
+
+
+def simulate_scene(path, history=True, every=1, **opts):
+    """`pound simulate --scene path --json`: Scene(path).simulate(**opts)."""
+    sc = path if isinstance(path, Scene) else Scene(path)
+    try:
+        return sc.simulate(history=history, every=every, **opts)
+    finally:
+        if sc is not path:
+            sc.close()
+
+
+# ---- compare and converge on a scene -------------------------------------------------------
+
+class SceneMeasurer:
+    """The reference of a scene and the runs measured against it (the
+    scene half of cli/cmd_converge.c's measurer)."""
+
+    def __init__(self, scene, kw):
+        self.scene = scene if isinstance(scene, Scene) else Scene(scene)
+        self.own = self.scene is not scene
+        self.sc = self.scene._p
+        self.opts, _ = self.scene.opts(kw)  # checked and resolvable; kept unresolved
+        self.ref = _lib.PdSceneTrace()
+        self.rr = _lib.PdSceneResult()
+        self.res = _lib.PdSceneResult()
+        self.e = _lib.PdSceneErrors()
+        self.live = False
+
+    def alloc(self, o):
+        err = PdErr()
+        self.live = True
+        for call in (lambda: lib.pd_scene_trace_alloc(self.ref, self.sc, o, err),
+                     lambda: lib.pd_scene_result_alloc(self.sc, self.rr, err),
+                     lambda: lib.pd_scene_result_alloc(self.sc, self.res, err),
+                     lambda: lib.pd_scene_errors_alloc(self.sc, self.e, err)):
+            _lib.check(call(), err)
+
+    def reference(self, o, err):
+        st = lib.pd_scene_measure_reference(self.sc, o, self.ref, self.rr, err)
+        return st, self.rr.cpu_s
+
+    def row(self, o, err):
+        st = lib.pd_scene_measure_run(self.sc, o, self.ref, self.rr, self.res, self.e, err)
+        if st:
+            return st, None
+        e, sc = self.e, self.scene._sc
+        return st, dict(err_umax=e.err_umax_max, err_hist=e.err_hist_max, cpu_s=e.cpu_s,
+                        impacts=e.impacts, steps=self.res.steps,
+                        structures=[Result(name=s(sc.st[k].name), err_umax_rel=e.err_umax[k],
+                                           err_hist_linf=e.err_hist[k])
+                                    for k in range(sc.nstruct)])
+
+    def close(self):
+        if self.live:
+            lib.pd_scene_trace_free(self.ref)
+            lib.pd_scene_result_free(self.rr)
+            lib.pd_scene_result_free(self.res)
+            lib.pd_scene_errors_free(self.e)
+            self.live = False
+        if self.own:
+            self.scene.close()
+
+
+def compare_scene(scene, want, kw):
+    """cli/cmd_compare.c compare_scene."""
+    M = SceneMeasurer(scene, kw)
+    try:
+        err = PdErr()
+        o = M.opts
+        M.alloc(o)
+        st = lib.pd_scene_measure_reference(M.sc, o, M.ref, M.rr, err)
+        if st:
+            raise _lib.make_error(st, "reference: " + err.text())
+        sc = M.scene._sc
+        rows = {}
+        for m in range(3):
+            if not want[m]:
+                continue
+            om = copy_opts(o)
+            om.method = m
+            res, e = _lib.PdSceneResult(), _lib.PdSceneErrors()
+            try:
+                _lib.check(lib.pd_scene_result_alloc(M.sc, res, err), err)
+                _lib.check(lib.pd_scene_errors_alloc(M.sc, e, err), err)
+                st = lib.pd_scene_measure_run(M.sc, om, M.ref, M.rr, res, e, err)
+                if st:
+                    raise _lib.make_error(st, "%s: %s" % (s(lib.pd_method_name(m)), err.text()))
+                rows[m] = Result(method=s(lib.pd_method_name(m)), err_umax_rel=e.err_umax_max,
+                                 err_hist_linf=e.err_hist_max, impacts=e.impacts,
+                                 steps=res.steps, cpu_s=e.cpu_s,
+                                 structures=[Result(name=s(sc.st[k].name),
+                                                    err_umax_rel=e.err_umax[k],
+                                                    err_hist_linf=e.err_hist[k])
+                                             for k in range(sc.nstruct)])
+                rows[m]["dt"] = res.dt
+            finally:
+                lib.pd_scene_result_free(res)
+                lib.pd_scene_errors_free(e)
+        impacts_ref = sum(M.rr.impacts[a] for a in range(sc.ncontact))
+        first = 0 if want[0] else 2
+        f = rows[first]
+        out = Result(method=f["method"], err_umax_rel=f["err_umax_rel"],
+                     err_hist_linf=f["err_hist_linf"], impacts=f["impacts"],
+                     impacts_ref=impacts_ref, cpu_s=f["cpu_s"], cpu_s_ref=M.rr.cpu_s,
+                     events_ref=M.rr.steps, dt=f["dt"])
+        for r in rows.values():
+            del r["dt"]
+        out["methods"] = [rows[m] for m in range(3) if want[m]]
+        return out
+    finally:
+        M.close()

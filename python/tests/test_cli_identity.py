@@ -1,0 +1,173 @@
+"""The Python numbers are the CLI's to the last bit: every case is run both
+ways and compared with == (the CLI prints %.17g, so doubles round-trip)."""
+import numpy as np
+import pytest
+
+import pound
+from conftest import EXAMPLES, RECORDS, read_csv
+
+FIG9 = dict(pulse="sine", dir="normal", Tp=0.3, T0=3, ap=4, gap=0.004, eps=0.6)
+FIG9_ARGS = ["--pulse", "sine", "--dir", "normal", "--Tp", "0.3", "--T0", "3", "--ap", "4",
+             "--gap", "0.004", "--eps", "0.6"]
+CASE = dict(pulse="cosine", dir="reverse", Tp=0.5, Pi2=0.8, Pi3=0.1, eps=0.7, xi=0.02)
+CASE_ARGS = ["--pulse", "cosine", "--dir", "reverse", "--Tp", "0.5", "--Pi2", "0.8", "--Pi3",
+             "0.1", "--eps", "0.7", "--xi", "0.02"]
+SCENE = EXAMPLES / "scenes" / "two-sdof.json"
+LCP = EXAMPLES / "murty1978.lcp"
+
+
+@pytest.mark.parametrize("method", ["moreau", "event", "penalty"])
+def test_simulate(cli, same, method):
+    r = pound.simulate(method=method, history=False, **FIG9)
+    same(r, cli("simulate", *FIG9_ARGS, "--method", method))
+
+
+@pytest.mark.parametrize("method", ["moreau", "event", "penalty"])
+def test_simulate_history_is_the_cli_file(cli, same, method, tmp_path):
+    """With a history the run has a sampler, as the CLI's with -o: the same
+    figures and, column by column, the same file."""
+    out = tmp_path / "run.csv"
+    js = cli("simulate", *CASE_ARGS, "--method", method, "-o", out)
+    r = pound.simulate(method=method, **CASE)
+    same(r, js)
+    header, data = read_csv(out)
+    assert header == ["t", "u", "v", "impulse", "gap"]
+    for k, name in enumerate(header):
+        assert np.array_equal(r.history[name], data[:, k]), name
+
+
+def test_simulate_every(cli, same, tmp_path):
+    out = tmp_path / "run.csv"
+    js = cli("simulate", *CASE_ARGS, "--every", "7", "-o", out)
+    r = pound.simulate(every=7, **CASE)
+    same(r, js)
+    _, data = read_csv(out)
+    assert np.array_equal(r.u, data[:, 1]) and np.array_equal(r.t, data[:, 0])
+
+
+@pytest.mark.parametrize("extra,kw", [
+    (["--pulse", "harmonic", "--Pi2", "1.3", "--Pi3", "0.2", "--tend", "12"],
+     dict(pulse="harmonic", Pi2=1.3, Pi3=0.2, tend=12)),
+    (["--theta", "0.7", "--dt", "0.002", "--kernel", "general", "--gamma", "0.3"],
+     dict(theta=0.7, dt=0.002, kernel="general", gamma=0.3)),
+    (["--method", "penalty", "--contact", "hertz", "--kc", "1e5", "--stepper", "rkf45"],
+     dict(method="penalty", contact="hertz", kc=1e5, stepper="rkf45")),
+    (["--method", "event", "--eps", "0", "--no-accumulation", "--Pi3", "0"],
+     dict(method="event", eps=0, no_accumulation=True, Pi3=0)),
+    (["--no-wall"], dict(no_wall=True)),
+])
+def test_simulate_flags(cli, same, extra, kw):
+    same(pound.simulate(history=False, **kw), cli("simulate", *extra))
+
+
+def test_compare(cli, same):
+    same(pound.compare(**CASE), cli("compare", *CASE_ARGS))
+    same(pound.compare(methods=("moreau", "penalty"), dt=0.001, **CASE),
+         cli("compare", *CASE_ARGS, "--dt", "0.001", "--methods", "moreau,penalty"))
+
+
+def test_converge(cli, same):
+    js = cli("converge", *FIG9_ARGS, "--dt", "0.004:0.0005:4", "--theta", "0.5,0.75",
+             "--methods", "moreau,penalty", "--kcs", "1e3,1e5")
+    same(pound.converge("0.004:0.0005:4", theta=[0.5, 0.75], methods=("moreau", "penalty"),
+                        kcs=[1e3, 1e5], **FIG9), js)
+    same(pound.converge((0.004, 0.0005, 4), theta=[0.5, 0.75], methods="moreau,penalty",
+                        kcs=[1e3, 1e5], **FIG9), js)
+    same(pound.converge("0.01:0.00125:4", error="umax", **CASE),
+         cli("converge", *CASE_ARGS, "--dt", "0.01:0.00125:4", "--error", "umax"))
+
+
+def test_spectrum(cli, same):
+    r = pound.spectrum(Pi2=(0.1, 3, 9), Pi3=[0.05, 0.5], eps=[0.3, 0.8],
+                       pulse=["sine", "cosine"], dir=["normal", "reverse"], method="event")
+    js = cli("spectrum", "--Pi2", "0.1:3:9", "--Pi3", "0.05,0.5", "--eps", "0.3,0.8", "--pulse",
+             "sine,cosine", "--dir", "normal,reverse", "--method", "event")
+    same(r.points, js["points"])
+    assert r.runs == js["runs"] and r.twins == js["twins"]
+    assert r.Pi1.shape == (js["curves"], 9)
+    if hasattr(pound._lib.lib, "pd_spec_sweep"):  # the library's serial sweep, the same
+        seen = []
+        s = pound.spectrum(Pi2=(0.1, 3, 9), Pi3=[0.05, 0.5], eps=[0.3, 0.8],
+                           pulse=["sine", "cosine"], dir=["normal", "reverse"], method="event",
+                           threads=1, on_point=seen.append)
+        same(s.points, js["points"])
+        same(seen, js["points"])  # in order, as they complete
+
+
+def test_spectrum_moreau_dimensional_linear(cli, same):
+    r = pound.spectrum(Pi2="0.5:2:5", linear=True, ap=[1, 3], gap=[0.01], Tp=0.5, xi=[0, 0.05],
+                       dt_per_Tp=400)
+    js = cli("spectrum", "--Pi2", "0.5:2:5", "--linear", "--ap", "1,3", "--gap", "0.01",
+             "--Tp", "0.5", "--xi", "0,0.05", "--dt-per-Tp", "400")
+    same(r.points, js["points"])
+
+
+def test_lcp(cli, same):
+    M, q = pound.read_lcp(LCP)
+    same(pound.lcp(M, q), cli("lcp", LCP))
+    for solver in ("lemke", "structured", "pgs"):
+        same(pound.lcp(M, q, solver=solver), cli("lcp", LCP, "--solver", solver))
+
+
+@pytest.mark.parametrize("method", ["moreau", "event", "penalty"])
+def test_scene(cli, same, method):
+    same(pound.simulate_scene(SCENE, method=method, history=False),
+         cli("simulate", "--scene", SCENE, "--method", method))
+
+
+def test_scene_history_is_the_cli_file(cli, same, tmp_path):
+    out = tmp_path / "scene.csv"
+    js = cli("simulate", "--scene", SCENE, "-o", out, "--every", "3")
+    r = pound.simulate_scene(SCENE, every=3)
+    same(r, js)
+    header, data = read_csv(out)
+    assert header == ["t", "stiff.x1", "flexible.x1", "stiff.v1", "flexible.v1", "c0.gap",
+                      "c0.impulse"]
+    cols = np.column_stack([r.t, r.x, r.v, r.history.gap, r.history.impulse])
+    assert np.array_equal(cols, data)
+
+
+def test_scene_others(cli, same):
+    for name in ("three-buildings.json", "oscillator.json"):
+        f = EXAMPLES / "scenes" / name
+        same(pound.simulate_scene(f, history=False), cli("simulate", "--scene", f))
+    same(pound.Scene.chain(5, Pi3=0.02, eps=0.4, pulse="harmonic").simulate(
+        history=False, tend=3), cli("simulate", "--chain", "5", "--Pi3", "0.02", "--eps",
+                                    "0.4", "--pulse", "harmonic", "--tend", "3"))
+
+
+def test_scene_compare_converge(cli, same):
+    same(pound.compare(scene=SCENE, methods="moreau,penalty"),
+         cli("compare", "--scene", SCENE, "--methods", "moreau,penalty"))
+    same(pound.converge("0.0008:0.0002:3", scene=SCENE),
+         cli("converge", "--scene", SCENE, "--dt", "0.0008:0.0002:3"))
+
+
+RECORD = RECORDS / "NGA_no_1063_RRS228.AT2"
+
+
+@pytest.mark.skipif(not RECORD.exists(), reason="no records in %s" % RECORDS)
+def test_record(cli, same):
+    js = cli("record", RECORD)["records"][0]
+    same(pound.record(RECORD), js)
+    kw = dict(record=RECORD, T0=0.8, gap=0.01, eps=0.6)
+    args = ["--record", RECORD, "--T0", "0.8", "--gap", "0.01", "--eps", "0.6"]
+    same(pound.simulate(method="event", history=False, **kw),
+         cli("simulate", *args, "--method", "event"))
+    same(pound.simulate(history=False, scale=0.5, dir="reverse", **kw),
+         cli("simulate", *args, "--scale", "0.5", "--dir", "reverse"))
+    r = pound.spectrum(Pi2=(0.2, 2, 4), record=RECORD, Pi3=[0.05], method="event")
+    js = cli("spectrum", "--Pi2", "0.2:2:4", "--record", RECORD, "--Pi3", "0.05", "--method",
+             "event")
+    same(r.points, js["points"])
+
+
+@pytest.mark.skipif(not RECORDS.is_dir(), reason="no records in %s" % RECORDS)
+def test_every_record(cli, same):
+    files = sorted(p for p in RECORDS.iterdir()
+                   if p.suffix.lower() in (".at2", ".v2") and p.stat().st_size < 5e6)[:8]
+    if not files:
+        pytest.skip("no AT2 records")
+    js = cli("record", *files)["records"]
+    for f, j in zip(files, js):
+        same(pound.record(f), j)

@@ -1,0 +1,167 @@
+#!/bin/sh
+# api-check.sh — pound as an installed library (make install-check; make check).
+#
+#   sh scripts/api-check.sh [BUILD]      (BUILD: the build folder, default build)
+#
+# Installs into a staging folder (make install DESTDIR=$tmp PREFIX=/usr) and
+# checks what a user gets: the files, the soname and its links, the exports
+# of libpound.so (pd_* only, no HDF5 needed), the examples/api/ programs
+# compiled with the installed pound.pc against the installed headers and
+# shared library (and one linked statically with pkg-config --static), each
+# run for its own sanity check; the installed pound --version, man page and
+# bash completion; then make uninstall leaves nothing.  One summary line;
+# exit 1 on any failure, with what failed above it.
+set -u
+BUILD=${1:-build}
+MAKE=${MAKE:-make}
+CC=${CC:-cc}
+# make -n (the single-letter flags come first in MAKEFLAGS): run nothing
+first=${MAKEFLAGS:-}
+first=${first%% *}
+case $first in -* | '') ;; *n*)
+    echo "sh scripts/api-check.sh $BUILD"
+    exit 0 ;;
+esac
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/pound-api.XXXXXX") || exit 1
+trap 'rm -rf "$tmp"' EXIT INT TERM
+stage=$tmp/stage
+root=$stage/usr
+start=$(date +%s)
+checks=0
+failed=0
+
+# check NAME COMMAND...: run it quietly; on failure say so with its output.
+check() {
+    name=$1
+    shift
+    checks=$((checks + 1))
+    if "$@" >"$tmp/out" 2>&1; then
+        return 0
+    fi
+    failed=$((failed + 1))
+    echo "api-check: FAIL $name"
+    sed 's/^/    /' "$tmp/out" | head -20
+    return 1
+}
+
+# The library's version, from the header the install copied.
+version=$(sed -n 's/^#define PD_VERSION "\(.*\)"/\1/p' core/pd_core.h)
+
+# ---- install -----------------------------------------------------------
+if ! check "make install" $MAKE --no-print-directory BUILD="$BUILD" install \
+    DESTDIR="$stage" PREFIX=/usr; then
+    echo "api-check: 0 of 1 checks passed (make install failed)"
+    exit 1
+fi
+
+files="bin/pound lib/libpound.a lib/libpound.so.$version lib/libpound.so.0 lib/libpound.so
+include/pound/pound.h include/pound/pd_core.h include/pound/pd_lcp.h
+include/pound/pd_engine.h include/pound/pd_problems.h lib/pkgconfig/pound.pc
+share/man/man1/pound.1 share/bash-completion/completions/pound"
+
+# Every file there, the links pointing at the real library, nothing else.
+installed() {
+    for f in $files; do
+        [ -e "$root/$f" ] || { echo "missing $f"; return 1; }
+    done
+    [ "$(readlink "$root/lib/libpound.so.0")" = "libpound.so.$version" ] &&
+        [ "$(readlink "$root/lib/libpound.so")" = "libpound.so.0" ] ||
+        { echo "symlinks: $(ls -l "$root/lib")"; return 1; }
+    extra=$(cd "$root" && find . \( -type f -o -type l \) | sed 's|^\./||' | sort |
+        while read -r f; do case " $(echo $files) " in *" $f "*) ;; *) echo "$f" ;; esac; done)
+    [ -z "$extra" ] || { echo "not expected: $extra"; return 1; }
+}
+check "installed files" installed
+
+# The soname, the exports (pd_* functions only) and the libraries it needs.
+exports() {
+    so=$root/lib/libpound.so.$version
+    readelf -d "$so" | grep -q 'SONAME.*\[libpound\.so\.0\]' || { echo "soname"; return 1; }
+    nm -D --defined-only "$so" | awk '{print $NF}' >"$tmp/syms"
+    n=$(wc -l <"$tmp/syms")
+    bad=$(grep -v '^pd_' "$tmp/syms")
+    [ "$n" -gt 100 ] && [ -z "$bad" ] || { echo "$n exports; not pd_*: $bad"; return 1; }
+    ! readelf -d "$so" | grep -qi 'NEEDED.*hdf5' || { echo "libpound.so needs HDF5"; return 1; }
+    echo "$n" >"$tmp/nsyms"
+}
+check "exports of libpound.so" exports
+
+# ---- the examples against the installed library ------------------------
+PKG="pkg-config --define-variable=prefix=$root"
+cflags= libs= static=
+export PKG_CONFIG_PATH="$root/lib/pkgconfig"
+cflags=$($PKG --cflags pound 2>/dev/null) && libs=$($PKG --libs pound 2>/dev/null) &&
+    static=$($PKG --static --libs pound 2>/dev/null)
+check "pkg-config pound" test -n "$libs"
+case $cflags in *"$root/include"*) ;; *) check "pkg-config --cflags" false ;; esac
+
+# Build and run one example: shared, or static (libpound.a, the rest shared).
+example() {
+    ex=$1 how=$2 bin=$tmp/$1-$2
+    if [ "$how" = shared ]; then
+        $CC -std=c11 -Wall -Wextra -Wpedantic -Werror examples/api/$ex.c $cflags $libs -lm -o "$bin" ||
+            return 1
+        LD_LIBRARY_PATH=$root/lib ldd "$bin" | grep -q "libpound.so.0 => $root/lib/" ||
+            { LD_LIBRARY_PATH=$root/lib ldd "$bin"; return 1; }
+    else
+        $CC -std=c11 -Wall -Wextra -Wpedantic -Werror examples/api/$ex.c $cflags \
+            $(echo " $static " | sed 's/ -lpound / -Wl,-Bstatic -lpound -Wl,-Bdynamic /') \
+            -lm -o "$bin" || return 1
+        ! readelf -d "$bin" | grep -q 'NEEDED.*libpound' || { echo "linked to libpound.so"; return 1; }
+    fi
+    LD_LIBRARY_PATH=$root/lib "$bin"
+}
+nex=0
+for src in examples/api/*.c; do
+    ex=$(basename "$src" .c)
+    nex=$((nex + 1))
+    check "example $ex (shared)" example "$ex" shared
+done
+check "example spectrum (static)" example spectrum static
+[ "$nex" -ge 4 ] || check "at least 4 examples in examples/api/" false
+
+# A C++ user includes the umbrella header too.
+cxx() {
+    command -v c++ >/dev/null || return 0
+    printf '#include <pound/pound.h>\nint main() { return pd_version()[0] == PD_VERSION[0] ? 0 : 1; }\n' \
+        >"$tmp/cxx.cc"
+    c++ -Wall -Wextra -Werror "$tmp/cxx.cc" $cflags $libs -o "$tmp/cxx" &&
+        LD_LIBRARY_PATH=$root/lib "$tmp/cxx"
+}
+check "C++ includes pound.h" cxx
+
+# ---- the installed command, man page and completion --------------------
+check "pound --version" sh -c '"$1/bin/pound" --version | head -1 | grep -qx "pound $2"' - \
+    "$root" "$version"
+man_page() {
+    command -v groff >/dev/null || return 0
+    groff -man -Tutf8 -ww -z "$root/share/man/man1/pound.1" 2>&1 | { ! grep .; }
+}
+check "man page" man_page
+completion() {
+    command -v bash >/dev/null || return 0
+    bash -c '. "$1"; COMP_WORDS=(pound simulate --method ""); COMP_CWORD=3; _pound
+        [ "${COMPREPLY[*]}" = "moreau event penalty" ] || { echo "got: ${COMPREPLY[*]}"; exit 1; }
+        COMP_WORDS=(pound sp); COMP_CWORD=1; _pound; [ "${COMPREPLY[*]}" = spectrum ]' - \
+        "$root/share/bash-completion/completions/pound"
+}
+check "bash completion" completion
+
+# ---- uninstall -----------------------------------------------------------
+left() {
+    $MAKE --no-print-directory BUILD="$BUILD" uninstall DESTDIR="$stage" PREFIX=/usr || return 1
+    rest=$(find "$stage" \( -type f -o -type l \))
+    [ -z "$rest" ] || { echo "left behind: $rest"; return 1; }
+    [ ! -d "$root/include/pound" ] || { echo "include/pound/ left"; return 1; }
+}
+check "make uninstall leaves nothing" left
+
+secs=$(($(date +%s) - start))
+nsyms=$(cat "$tmp/nsyms" 2>/dev/null || echo "?")
+if [ "$failed" -eq 0 ]; then
+    echo "api-check: $checks checks passed: installed $version, $nex examples built against it" \
+        "(shared and static), $nsyms exports (pd_* only), uninstall clean (${secs} s)"
+    exit 0
+fi
+echo "api-check: $failed of $checks checks FAILED (${secs} s)"
+exit 1
