@@ -60,6 +60,7 @@ typedef struct ed_run {
 typedef struct ed_origin {
     int j;
     double t, x, v;
+    pd_sdof_flow flow; /* of a flight (pd_sdof_flow_init); unused at rest */
 } ed_origin;
 
 /* A point of a flight: x, v, the distance past the wall x - delta (without
@@ -111,14 +112,14 @@ static double piece_end(const pd_ed_sdof *p, int j)
 }
 
 /* Exact increment dx = x(t) - x_o and velocity at t from the origin. */
-static void flow_inc(const ed_run *ed, const ed_origin *o, double t, double *dx, double *v)
+static void flow_inc(const ed_origin *o, double t, double *dx, double *v)
 {
     if (t == o->t) {
         *dx = 0.0;
         *v = o->v;
         return;
     }
-    pd_sdof_increment_piece(&ed->p->osc, &ed->p->pieces[o->j], o->t, o->x, o->v, t, dx, v);
+    pd_sdof_flow_at(&o->flow, t, dx, v);
 }
 
 /* The flight's point at t: past = (x_o - delta) + dx, and x clipped to the
@@ -126,7 +127,7 @@ static void flow_inc(const ed_run *ed, const ed_origin *o, double t, double *dx,
 static ed_point probe(const ed_run *ed, const ed_origin *o, double t)
 {
     double dx, v;
-    flow_inc(ed, o, t, &dx, &v);
+    flow_inc(o, t, &dx, &v);
     ed_point q = {.t = t, .x = o->x + dx, .v = v, .past = (o->x - ed->p->delta) + dx};
     if (ed->p->wall && q.past <= 0.0 && q.x > ed->p->delta)
         q.x = ed->p->delta;
@@ -594,6 +595,7 @@ int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opt
             v = 0.0;
         } else {
             ed_origin o = {.j = j, .t = t, .x = x, .v = v};
+            pd_sdof_flow_init(&o.flow, &prob->osc, &prob->pieces[j], t, x, v);
             if (free_flight(&ed, &o, tb, &t_hit, &xn, &vn)) {
                 x = prob->delta;
                 if ((rc = impact(&ed, j, t_hit, vn, tb, &t, &v, &resting, err)))

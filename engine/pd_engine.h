@@ -283,6 +283,28 @@ PD_API void pd_sdof_increment_piece(const pd_sdof *osc, const pd_sine_piece *pc,
 PD_API void pd_sdof_advance_piece(const pd_sdof *osc, const pd_sine_piece *pc, double t0, double u0,
                                   double v0, double t1, double *u1, double *v1);
 
+/* A flight from (t0, u0, v0) under one piece with what does not depend on
+ * t1 computed once (the particular solution's phase at t0, the homogeneous
+ * constants), so that each later time costs two sincos and one expm1 (the
+ * half angles give sin, cos and cos - 1 alike).  Equal to
+ * pd_sdof_increment_piece to rounding; cases without that form (a free
+ * mass, undamped resonance) fall back to it. */
+typedef struct pd_sdof_flow {
+    pd_sdof osc;
+    pd_sine_piece pc;
+    double t0, u0, v0;
+    int fast;                /* 1: the cached form applies */
+    double a, wd, k0;        /* xi w0, the damped frequency, w0^2 */
+    double s0, c0;           /* sin, cos of the forcing phase at t0 */
+    double pre, pim;         /* A re / den, A im / den: the particular's amplitudes */
+    double vp0, c1, c2;      /* v_p(t0) and the homogeneous constants */
+    double f0, ur, vr;       /* the linear force at t0, its response's start state */
+} pd_sdof_flow;
+PD_API void pd_sdof_flow_init(pd_sdof_flow *f, const pd_sdof *osc, const pd_sine_piece *pc,
+                              double t0, double u0, double v0);
+/* du = u(t1) - u0 and v(t1) of the flight. */
+PD_API void pd_sdof_flow_at(const pd_sdof_flow *f, double t1, double *du, double *v1);
+
 /* The sinusoid alone, F = A sin(w t + phi) (A = 0: free vibration; w = 0
  * with w0 = 0: the constant force A sin(phi)): the piece {t0, A, w, phi}. */
 PD_API void pd_sdof_advance(const pd_sdof *osc, double A, double w, double phi, double t0,

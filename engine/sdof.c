@@ -18,7 +18,7 @@
 
 /* Below this w0 h the kernels are summed as Taylor series (the closed forms
  * lose up to (w0 h)^-3 of their digits for small w0 h). */
-#define KERNEL_SERIES_MAX 1.0
+#define KERNEL_SERIES_MAX 0.25
 /* Series terms: |p_k| <= (w0 h)^k / k!, 1/18! < 1e-16. */
 #define KERNEL_MAX_TERMS 40
 /* A series stops once two consecutive terms are this small relative to g. */
@@ -36,6 +36,13 @@ static void sin_cos_diff(double a, double d, double *ds, double *dc)
     double h = sin(0.5 * d), m = a + 0.5 * d;
     *ds = 2.0 * cos(m) * h;
     *dc = -2.0 * sin(m) * h;
+}
+
+/* sin(x / 2) and cos(x / 2). */
+static void sincos_half(double x, double *s, double *c)
+{
+    *s = sin(0.5 * x);
+    *c = cos(0.5 * x);
 }
 
 /* Taylor series: p_1 = h, p_{k+1} = -(2 a h p_k + (w0 h)^2 p_{k-1} / k) / (k + 1);
@@ -188,6 +195,75 @@ void pd_sdof_advance_piece(const pd_sdof *osc, const pd_sine_piece *pc, double t
     double du;
     pd_sdof_increment_piece(osc, pc, t0, u0, v0, t1, &du, v1);
     *u1 = u0 + du;
+}
+
+void pd_sdof_flow_init(pd_sdof_flow *f, const pd_sdof *osc, const pd_sine_piece *pc, double t0,
+                       double u0, double v0)
+{
+    const pd_sine_piece *p = pc;
+    double w0 = osc->w0, w = p->w, re = w0 * w0 - w * w, im = 2.0 * osc->xi * w0 * w;
+    double den = re * re + im * im;
+    *f = (pd_sdof_flow){.osc = *osc, .pc = *pc, .t0 = t0, .u0 = u0, .v0 = v0};
+    /* the general path keeps the free mass and undamped resonance */
+    f->fast = w0 > 0.0 && (p->A == 0.0 || den > 1e-28 * w0 * w0 * w0 * w0);
+    if (!f->fast)
+        return;
+    f->a = osc->xi * w0;
+    f->wd = w0 * sqrt(1.0 - osc->xi * osc->xi);
+    f->k0 = w0 * w0;
+    f->f0 = p->c0 + p->c1 * (t0 - p->t_start);
+    double up0 = 0.0;
+    if (p->A != 0.0) {
+        double th0 = w * t0 + p->phi;
+        f->s0 = sin(th0);
+        f->c0 = cos(th0);
+        f->pre = p->A * re / den;
+        f->pim = p->A * im / den;
+        up0 = f->pre * f->s0 - f->pim * f->c0;
+        f->vp0 = w * (f->pre * f->c0 + f->pim * f->s0);
+    }
+    f->c1 = u0 - up0;
+    f->c2 = (v0 - f->vp0 + f->a * f->c1) / f->wd;
+    /* the linear term by linearity from rest beside a sinusoid, else from (u0, v0) */
+    f->ur = p->A != 0.0 ? 0.0 : u0;
+    f->vr = p->A != 0.0 ? 0.0 : v0;
+}
+
+void pd_sdof_flow_at(const pd_sdof_flow *f, double t1, double *du, double *v1)
+{
+    if (!f->fast) {
+        pd_sdof_increment_piece(&f->osc, &f->pc, f->t0, f->u0, f->v0, t1, du, v1);
+        return;
+    }
+    const pd_sine_piece *p = &f->pc;
+    double s = t1 - f->t0, a = f->a, wd = f->wd, k0 = f->k0;
+    /* e^{-a s} - 1, sin wd s, cos wd s - 1 from the half angle */
+    double em1 = expm1(-a * s), ex = 1.0 + em1, hs, hc;
+    sincos_half(wd * s, &hs, &hc);
+    double sn = 2.0 * hs * hc, cs_m1 = -2.0 * hs * hs, cs = 1.0 + cs_m1;
+    *du = 0.0;
+    *v1 = 0.0;
+    if (p->A != 0.0) { /* particular increments by angle addition, then the homogeneous part */
+        double ps, pc2;
+        sincos_half(p->w * s, &ps, &pc2);
+        double sm = f->s0 * pc2 + f->c0 * ps, cm = f->c0 * pc2 - f->s0 * ps;
+        double ds = 2.0 * cm * ps, dc = -2.0 * sm * ps;
+        *du = f->pre * ds - f->pim * dc + f->c1 * (em1 * cs + cs_m1) + f->c2 * ex * sn;
+        *v1 = f->vp0 + p->w * (f->pre * dc + f->pim * ds) +
+              ex * ((f->c2 * wd - a * f->c1) * cs - (f->c1 * wd + a * f->c2) * sn);
+    }
+    if (p->A != 0.0 && f->f0 == 0.0 && p->c1 == 0.0)
+        return;
+    kernels k;
+    if (fabs(sqrt(k0) * s) <= KERNEL_SERIES_MAX)
+        k = kernels_series(sqrt(k0), a, s);
+    else {
+        double g = ex * sn / wd, G1 = -(em1 * cs + cs_m1 + a * g) / k0;
+        k = (kernels){.g = g, .G1 = G1, .G2 = (s - g - 2.0 * a * G1) / k0};
+    }
+    double rest = f->f0 - k0 * f->ur;
+    *du += f->vr * k.g + rest * k.G1 + p->c1 * k.G2;
+    *v1 += f->vr + ((rest - 2.0 * a * f->vr) * k.g + (p->c1 - k0 * f->vr) * k.G1);
 }
 
 /* The sinusoid alone: a piece without linear terms. */

@@ -65,8 +65,9 @@ static void affine_rows(const pd_matrix *M, const double *q, const double *z, do
  *   max_i max(-z_i / zs, -w_i / r_i, min(|w_i| / r_i, |z_i| / zs)),
  * zs = max|z|, r_i the size of the terms that make w_i: invariant under
  * scaling q and z, or M and 1/z, and exact zeros count as exact.  A z or w
- * with a NaN or an infinity is no answer: its figures are NaN, which no
- * tolerance accepts (inf / inf would otherwise pass as a ratio of 0). */
+ * with a NaN or an infinity, or whose terms overflow (r_i infinite: a
+ * diverged iteration), is no answer: its figures are NaN, which no
+ * tolerance accepts (x / inf would otherwise pass as a ratio of 0). */
 void pd_lcp_verify(const pd_matrix *M, const double *q, const double *z, double *w, double *rows,
                    pd_lcp_info *info)
 {
@@ -76,7 +77,7 @@ void pd_lcp_verify(const pd_matrix *M, const double *q, const double *z, double 
     for (int i = 0; i < n; i++) { /* NaN compares false: caught apart, once */
         double za = fabs(z[i]), wa = fabs(w[i]), zi = ratio(za, zs), wi = ratio(wa, rows[i]);
         double v = wi < zi ? wi : zi;
-        nan |= !isfinite(z[i]) || !isfinite(w[i]);
+        nan |= !isfinite(z[i]) || !isfinite(w[i]) || !isfinite(rows[i]);
         comp = pd_max(comp, za * wa);
         infeas = pd_max(infeas, pd_max(-z[i], -w[i]));
         v = z[i] < 0.0 ? pd_max(v, zi) : v;

@@ -1154,7 +1154,8 @@ def run_fuzz(runner, env, fuzz_time):
                     with open(os.path.join(seed_dir, "s%04d" % k), "wb") as f:
                         f.write(m.data)
                     k += 1
-        cmd = [os.path.join(fdir, t), "-max_total_time=%d" % fuzz_time, "-timeout=10",
+        # a fixed seed: a CI run repeats the local one as far as time allows
+        cmd = [os.path.join(fdir, t), "-seed=1", "-max_total_time=%d" % fuzz_time, "-timeout=10",
                "-rss_limit_mb=2048", "-max_len=16384", "-print_final_stats=1",
                "-artifact_prefix=" + art + "/", work, seed_dir]
         envv = dict(os.environ, ASAN_OPTIONS="detect_leaks=1:allocator_may_return_null=0",

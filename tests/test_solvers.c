@@ -453,6 +453,26 @@ static void test_solvers_nonfinite_never_solved(pd_test_ctx *ctx)
         }
 }
 
+/* A PGS iteration that diverges to 1e307 (found by the LCP fuzzer): M =
+ * [[2, -12], [-1.222, 2]] has no P-property, and the row sums of |M z|
+ * overflow, so r_i = inf made every ratio 0 and the answer passed as
+ * solved with w_1 = -1.2e308.  An answer whose terms overflow is
+ * unverifiable: never solved, whatever the solver. */
+static void test_solvers_overflowing_terms_never_solved(pd_test_ctx *ctx)
+{
+    double M[4] = {2.0, -1.222, -12.0, 2.0}, q[2] = {-5.0, -6.0}, z[2], w[2];
+    const pd_matrix A = pd_matrix_dense(2, 2, M);
+    const pd_lcp_method methods[] = {PD_LCP_AUTO, PD_LCP_LEMKE, PD_LCP_STRUCTURED, PD_LCP_PGS};
+    for (int k = 0; k < 4; k++) {
+        pd_lcp_info info;
+        int rc = solve_with(methods[k], &A, q, NULL, z, w, &info);
+        CHECK(ctx, rc != PD_OK && info.outcome != PD_LCP_SOLVED,
+              "%s: status %d, outcome %s, z = (%g, %g), w = (%g, %g)",
+              pd_lcp_method_name(methods[k]), rc, pd_lcp_outcome_name(info.outcome), z[0], z[1],
+              w[0], w[1]);
+    }
+}
+
 /* The same problem from a file through `pound lcp --solver structured`: a
  * status other than solved on stdout, exit 1 (it was "solved", exit 0). */
 static void test_solvers_nonfinite_cli(pd_test_ctx *ctx)
@@ -493,5 +513,6 @@ void suite_solvers(pd_test_ctx *ctx)
     PD_RUN(ctx, test_solvers_engine_independent);
     PD_RUN(ctx, test_solvers_dump_resolved);
     PD_RUN(ctx, test_solvers_nonfinite_never_solved);
+    PD_RUN(ctx, test_solvers_overflowing_terms_never_solved);
     PD_RUN(ctx, test_solvers_nonfinite_cli);
 }
