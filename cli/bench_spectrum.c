@@ -3,7 +3,9 @@
  * cosine pulses x normal, reverse (800 points, 3200 runs with the wall and
  * 800 no-wall twins), eps = 0.5, xi = 0.05, Moreau–Jean at dt = Tp/2000;
  * timed on one thread and on two OpenMP threads (best of two runs each),
- * with the two results compared bit for bit.  The MPI figure comes from
+ * with the two results compared bit for bit; then the same sweep by the
+ * exact event-driven reference on one thread: runs/s by method and the
+ * Moreau-Jean umax errors against it (median, worst).  The MPI figure comes from
  * scripts/bench_spectrum_mpi.sh (mpirun -np 2 build-mpi/pound spectrum). */
 #include <math.h>
 #include <stdlib.h>
@@ -63,10 +65,30 @@ static int same_results(const pd_spec_result *a, const pd_spec_result *b, long n
 
 /* The figures of the benchmark. */
 typedef struct bench_fig {
-    double serial_s, omp2_s, steps;
+    double serial_s, omp2_s, steps, event_s; /* event_s: the reference, one thread */
+    double err_median, err_worst;            /* Moreau-Jean umax against it, relative */
     long runs, points;
     int identical;
 } bench_fig;
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Median and worst |umax_mj - umax_ref| / umax_ref over the runs with the
+ * wall (the tasks after the twins); err holds n doubles of scratch. */
+static void umax_errors(const pd_spectrum *s, const pd_spec_result *mj, const pd_spec_result *ref,
+                        double *err, bench_fig *f)
+{
+    long first = pd_spec_twins(s), n = pd_spec_tasks(s) - first;
+    for (long t = 0; t < n; t++)
+        err[t] = fabs(mj[first + t].umax - ref[first + t].umax) / ref[first + t].umax;
+    qsort(err, (size_t)n, sizeof *err, cmp_double);
+    f->err_median = n ? err[n / 2] : 0.0;
+    f->err_worst = n ? err[n - 1] : 0.0;
+}
 
 /* A table on stdout (js NULL) or the "spectrum" member of js. */
 static void print_fig(pd_json *js, const bench_fig *f)
@@ -82,6 +104,11 @@ static void print_fig(pd_json *js, const bench_fig *f)
         printf("  %-22s %8.3f s  %10.4g steps/s  speedup %.2f, efficiency %.0f %%\n",
                "OpenMP 2 threads", f->omp2_s, f->steps / f->omp2_s, speedup, 100.0 * eff);
         printf("  results of 1 and 2 threads bit-identical: %s\n", f->identical ? "yes" : "NO");
+        printf("  %-22s %8.3f s  runs/s: event %.4g, Moreau-Jean %.4g (event %.2fx faster)\n",
+               "event-driven (1 thread)", f->event_s, (double)f->runs / f->event_s,
+               (double)f->runs / f->serial_s, f->serial_s / f->event_s);
+        printf("  Moreau-Jean umax against the exact reference: median %.2g, worst %.2g\n",
+               f->err_median, f->err_worst);
         printf("  targets: under 3 s on 2 cores, efficiency above 85 %%; MPI: "
                "scripts/bench_spectrum_mpi.sh\n");
         return;
@@ -97,6 +124,11 @@ static void print_fig(pd_json *js, const bench_fig *f)
     pd_json_num(js, "steps_per_s_serial", f->steps / f->serial_s);
     pd_json_num(js, "steps_per_s_omp2", f->steps / f->omp2_s);
     pd_json_bool(js, "identical", f->identical);
+    pd_json_num(js, "event_serial_s", f->event_s);
+    pd_json_num(js, "runs_per_s_event", (double)f->runs / f->event_s);
+    pd_json_num(js, "runs_per_s_moreau", (double)f->runs / f->serial_s);
+    pd_json_num(js, "moreau_umax_err_median", f->err_median);
+    pd_json_num(js, "moreau_umax_err_worst", f->err_worst);
     pd_json_num(js, "target_s", 3.0);
     pd_json_num(js, "target_efficiency", 0.85);
     pd_json_end_object(js);
@@ -112,15 +144,23 @@ int pd_bench_spectrum(pd_json *js)
     f.points = pd_spec_points(&s);
     pd_spec_result *r1 = malloc((size_t)f.runs * sizeof *r1);
     pd_spec_result *r2 = malloc((size_t)f.runs * sizeof *r2);
-    int rc = !r1 || !r2 || pd_spec_validate(&s, NULL) || timed(&s, 1, r1, &f.serial_s) ||
-             timed(&s, 2, r2, &f.omp2_s);
+    double *err = malloc((size_t)f.runs * sizeof *err);
+    pd_spectrum se = s; /* the same sweep, exact */
+    se.opts.method = PD_METHOD_EVENT;
+    int rc = !r1 || !r2 || !err || pd_spec_validate(&s, NULL) ||
+             timed(&s, 1, r1, &f.serial_s) || timed(&s, 2, r2, &f.omp2_s);
     if (!rc) {
         for (long t = 0; t < f.runs; t++)
             f.steps += (double)r1[t].steps;
         f.identical = same_results(r1, r2, f.runs);
+        rc = timed(&se, 1, r2, &f.event_s);
+    }
+    if (!rc) {
+        umax_errors(&s, r1, r2, err, &f);
         print_fig(js, &f);
     }
     free(r1);
     free(r2);
+    free(err);
     return rc || !f.identical ? 1 : 0;
 }

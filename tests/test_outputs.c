@@ -185,6 +185,27 @@ static const char two_sdof[] =
 
 /* ---- 1. full disks --------------------------------------------------------- */
 
+/* A run under a file-size limit failed as it must: exit 1 (not a signal),
+ * its one line (msg_ok), nothing left in dir. */
+static void expect_too_large(pd_test_ctx *ctx, const proc_out *r, const char *name, long limit,
+                             int msg_ok, const char *dir)
+{
+    CHECK(ctx, r->status == 1, "%s at %ld bytes: exit %d (128+11 is SIGSEGV): %s", name, limit,
+          r->status, r->err);
+    CHECK(ctx, msg_ok, "%s at %ld bytes: one line naming the file and the reason: %s", name, limit,
+          r->err);
+    CHECK(ctx, pd_test_dir_entries(dir) == 0, "%s at %ld bytes: %d files left", name, limit,
+          pd_test_dir_entries(dir));
+}
+
+/* The next case in an empty scratch folder. */
+static void next_case(proc_out *r, const char *dir)
+{
+    pd_test_proc_free(r);
+    pd_test_rm_dir(dir);
+    mkdir(dir, 0700);
+}
+
 /* Under a file-size limit (a full disk without root), simulate -o F.h5 /
  * F.csv and a scene with --dump-lcp, at limits that fail at the start,
  * during the run and in the last flush (the 1.65 MB HDF5 file at 1.6 MB):
@@ -215,16 +236,11 @@ static void test_outputs_full_disk_simulate(pd_test_ctx *ctx)
             break;
         run(ctx, is_scene ? sc : osc, &o, &r, NULL);
         unlink(scene);
-        CHECK(ctx, r.status == 1, "%s at %ld bytes: exit %d (128+11 is SIGSEGV): %s",
-              cases[k].name, cases[k].limit, r.status, r.err);
-        CHECK(ctx, strstr(r.err, "File too large") && strstr(r.err, out) && one_line(r.err),
-              "%s at %ld bytes: one line naming the file and the reason: %s", cases[k].name,
-              cases[k].limit, r.err);
-        CHECK(ctx, pd_test_dir_entries(dir) == 0, "%s at %ld bytes: %d files left",
-              cases[k].name, cases[k].limit, pd_test_dir_entries(dir));
-        pd_test_proc_free(&r);
-        pd_test_rm_dir(dir);
-        mkdir(dir, 0700);
+        expect_too_large(ctx, &r, cases[k].name, cases[k].limit,
+                         strstr(r.err, "File too large") && strstr(r.err, out) &&
+                             one_line(r.err),
+                         dir);
+        next_case(&r, dir);
     }
     pd_test_rm_dir(dir);
 }
@@ -505,9 +521,7 @@ static void test_outputs_signal_leaves_no_temp(pd_test_ctx *ctx)
               r.err);
         CHECK(ctx, pd_test_dir_entries(dir) == 0, "signal %d: %d files left", sigs[k],
               pd_test_dir_entries(dir));
-        pd_test_proc_free(&r);
-        pd_test_rm_dir(dir);
-        mkdir(dir, 0700);
+        next_case(&r, dir);
     }
     pd_test_rm_dir(dir);
 }
@@ -778,17 +792,10 @@ static void test_outputs_full_disk_converge(pd_test_ctx *ctx)
                            pd_test_dir_entries(dir) == 1,
                   "%s at %ld bytes: the whole file alone (%ld bytes)", cases[k].name,
                   cases[k].limit, (long)st.st_size);
-        } else {
-            CHECK(ctx, r.status == 1, "%s at %ld bytes: exit %d: %s", cases[k].name,
-                  cases[k].limit, r.status, r.err);
-            CHECK(ctx, too_large(r.err, "converge", "-o", out), "%s at %ld bytes: stderr '%s'",
-                  cases[k].name, cases[k].limit, r.err);
-            CHECK(ctx, pd_test_dir_entries(dir) == 0, "%s at %ld bytes: %d files left",
-                  cases[k].name, cases[k].limit, pd_test_dir_entries(dir));
-        }
-        pd_test_proc_free(&r);
-        pd_test_rm_dir(dir);
-        mkdir(dir, 0700);
+        } else
+            expect_too_large(ctx, &r, cases[k].name, cases[k].limit,
+                             too_large(r.err, "converge", "-o", out), dir);
+        next_case(&r, dir);
     }
     pd_test_rm_dir(dir);
 }
@@ -822,9 +829,7 @@ static void test_outputs_full_disk_dump_keeps_old(pd_test_ctx *ctx)
               pd_test_dir_entries(dir), had ? (text && !strcmp(text, old) ? "kept" : "changed")
                                             : "-");
         free(text);
-        pd_test_proc_free(&r);
-        pd_test_rm_dir(dir);
-        mkdir(dir, 0700);
+        next_case(&r, dir);
     }
     pd_test_rm_dir(dir);
 }
