@@ -43,6 +43,7 @@ struct pd_mj {
     int *idx_active;      /* m: indices of the active contacts */
     /* scalar kernel constants */
     double s_what, s_w, s_c, s_k, s_winv, s_del;
+    double s_whatinv, s_delinv; /* reciprocals: no division in a step */
     pd_state st;
 };
 
@@ -146,6 +147,8 @@ static void scalar_setup(pd_mj *mj)
     mj->s_w = md->m ? pd_matrix_get(&md->W, 0, 0) : 0.0;
     mj->s_winv = mj->s_w / mj->s_what;
     mj->s_del = mj->s_w * mj->s_winv;
+    mj->s_whatinv = 1.0 / mj->s_what;
+    mj->s_delinv = mj->s_del != 0.0 ? 1.0 / mj->s_del : 0.0;
 }
 
 /* The LCP solver and the Delassus block: dense m^2 when the factor keeps D
@@ -284,7 +287,7 @@ static int step_scalar(pd_mj *mj, pd_err *err)
     /* free velocity */
     double Fth = th * F1 + (1.0 - th) * mj->F0[0];
     double rhs = h * (Fth - mj->s_c * v - mj->s_k * (q + h * th * v));
-    double vnew = v + rhs / mj->s_what;
+    double vnew = v + rhs * mj->s_whatinv;
     double P = 0.0;
     int active = 0;
     /* contact: predicted gap, then the scalar LCP */
@@ -292,7 +295,8 @@ static int step_scalar(pd_mj *mj, pd_err *err)
         double U0 = mj->s_w * v;
         if (st->g[0] + h * mj->opts.gamma * U0 <= 0.0) {
             active = 1;
-            P = pd_contact_impulse_1(mj->s_del, mj->s_w * vnew + md->e[0] * U0);
+            double b = mj->s_w * vnew + md->e[0] * U0; /* the scalar LCP, closed form */
+            P = b < 0.0 ? -b * mj->s_delinv : 0.0;
             vnew += mj->s_winv * P;
         }
         st->P[0] = P;

@@ -223,9 +223,9 @@ static int observe(const pd_state *st, void *ctx)
     double x = st->q[0], v = st->v[0], P = st->P[0];
     double gap = tr->c->Pi3 - x;
     if (st->t >= tr->tau_measure - 0.5 * tr->h) {
-        tr->xmax = fmax(tr->xmax, fabs(x));
-        tr->xtoward = fmax(tr->xtoward, x);
-        tr->xaway = fmax(tr->xaway, -x);
+        tr->xmax = pd_max(tr->xmax, fabs(x)); /* inlined: fmax is a library call */
+        tr->xtoward = pd_max(tr->xtoward, x);
+        tr->xaway = pd_max(tr->xaway, -x);
     }
     /* the gap closes in this step (or an impulse stops it closing): instant
      * and speed from the step start and the step's free acceleration */
@@ -239,17 +239,17 @@ static int observe(const pd_state *st, void *ctx)
     }
     if (P > 0.0) {
         tr->contact_steps++;
-        tr->Pmax = fmax(tr->Pmax, P);
+        tr->Pmax = pd_max(tr->Pmax, P);
         if (tr->prev_P == 0.0) {
             tr->impacts++;
-            tr->vimp_max = fmax(tr->vimp_max, tr->closing_v);
+            tr->vimp_max = pd_max(tr->vimp_max, tr->closing_v);
             if (tr->impacts == 1) {
                 tr->first_tau = tr->closing_tau;
                 tr->first_v = tr->closing_v;
             }
         }
     }
-    tr->min_gap = fmin(tr->min_gap, gap);
+    tr->min_gap = tr->min_gap < gap ? tr->min_gap : gap;
     tr->prev2_v = tr->prev_v;
     tr->prev_x = x;
     tr->prev_v = v;
