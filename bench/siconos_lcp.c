@@ -5,8 +5,8 @@
  * The Siconos set is every lcp_*.dat of DIR (default
  * ../shared/data/lcp/siconos): n, 0 (dense), rows, cols, "rows cols", M
  * column by column, q, free text.  A chain of N masses has M = tridiag(-1,
- * 2, -1) and q uniform in [-1, 1) from splitmix64 seeded per (N, seed), as
- * in `pound bench --lcp`; a chain's figures are means over CHAIN_SEEDS
+ * 2, -1) and q from pd_lcp_chain_q (the draws of `pound bench --lcp`,
+ * so the two pair); a chain's figures are means over CHAIN_SEEDS
  * right-hand sides (PGS: the first).
  *
  * Pairing: the machine's speed drifts by tens of percent within seconds,
@@ -57,7 +57,6 @@
 #define LONG_S 0.05
 #define MAX_FILES 256
 #define MAX_ROWS (MAX_FILES + 16)
-#define CHAIN_SEED 20240611u
 #define CHAIN_SEEDS 5
 #define PGS_SEEDS 1       /* pound times PGS on the first seed only */
 #define PGS_SWEEPS 2000   /* PGS's budget on the chains, as pound's */
@@ -307,25 +306,9 @@ static void lcp_data_free(lcp_data *p)
     p->M = p->q = NULL;
 }
 
-/* splitmix64: the next 64 random bits of the stream *state. */
-static uint64_t splitmix64(uint64_t *state)
-{
-    uint64_t x = (*state += 0x9E3779B97F4A7C15ull);
-    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-    return x ^ (x >> 31);
-}
-
-/* Uniform in [-1, 1). */
-static double uniform_pm1(uint64_t *state)
-{
-    return 2.0 * ((double)(splitmix64(state) >> 11) * 0x1.0p-53) - 1.0;
-}
-
 /* The chain of N masses with right-hand side number `seed`; -1 when out of memory. */
 static int chain_make(lcp_data *p, int N, int seed)
 {
-    uint64_t state = CHAIN_SEED + (uint64_t)N + 1000003u * (uint64_t)seed;
     *p = (lcp_data){.n = N};
     snprintf(p->name, sizeof p->name, "chain_%d", N);
     p->M = calloc((size_t)N * (size_t)N, sizeof(double));
@@ -336,8 +319,8 @@ static int chain_make(lcp_data *p, int N, int seed)
         for (int i = j - 1; i <= j + 1; i++)
             if (i >= 0 && i < N)
                 p->M[i + (size_t)j * N] = i == j ? 2.0 : -1.0;
-        p->q[j] = uniform_pm1(&state);
     }
+    pd_lcp_chain_q(N, seed, p->q);
     return 0;
 }
 

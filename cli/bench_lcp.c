@@ -27,7 +27,6 @@
 #define BENCH_LONG_S 0.05
 #define BENCH_MAX_FILES 256
 #define BENCH_PGS_SWEEPS 2000 /* PGS's budget on the chains: its residual is reported */
-#define CHAIN_SEED 20240611u
 #define CHAIN_SEEDS 5
 
 /* One measured problem and solver. */
@@ -115,21 +114,6 @@ static int measure(pd_lcp_method method, const pd_matrix *M, const double *q, in
     return 0;
 }
 
-/* splitmix64: the next 64 random bits of the stream *state. */
-static uint64_t splitmix64(uint64_t *state)
-{
-    uint64_t x = (*state += 0x9E3779B97F4A7C15ull);
-    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-    return x ^ (x >> 31);
-}
-
-/* Uniform in [-1, 1). */
-static double uniform_pm1(uint64_t *state)
-{
-    return 2.0 * ((double)(splitmix64(state) >> 11) * 0x1.0p-53) - 1.0;
-}
-
 /* A chain: D = tridiag(-1, 2, -1) in compressed columns (and dense for
  * small N), q uniform in [-1, 1) from a fixed seed. */
 typedef struct chain {
@@ -149,7 +133,6 @@ static void chain_free(chain *c)
 
 static int chain_make(chain *c, int N, int with_dense, int seed)
 {
-    uint64_t state = CHAIN_SEED + (uint64_t)N + 1000003u * (uint64_t)seed;
     memset(c, 0, sizeof *c);
     c->N = N;
     c->colptr = malloc(((size_t)N + 1) * sizeof(int));
@@ -170,9 +153,9 @@ static int chain_make(chain *c, int N, int with_dense, int seed)
                 if (c->dense)
                     c->dense[i + (size_t)j * N] = x;
             }
-        c->q[j] = uniform_pm1(&state);
     }
     c->colptr[N] = k;
+    pd_lcp_chain_q(N, seed, c->q);
     return 0;
 }
 

@@ -107,8 +107,8 @@ static int check_output_size(const char *path, double bytes)
     return 0;
 }
 
-/* --dump-lcp: open the dump and hook it on the run; 0 or 1. */
-static int dump_open(sim_args *a, pd_lcp_dump **d)
+/* --dump-lcp: open the dump and hook it on the run's options; 0 or 1. */
+static int dump_open(const sim_args *a, pd_lcp_dump **d, pd_run_opts *run)
 {
     pd_err err;
     *d = NULL;
@@ -118,8 +118,8 @@ static int dump_open(sim_args *a, pd_lcp_dump **d)
         fprintf(stderr, "pound: simulate: %s\n", err.msg);
         return 1;
     }
-    a->k.opts.on_lcp = pd_lcp_dump_add;
-    a->k.opts.on_lcp_ctx = *d;
+    run->on_lcp = pd_lcp_dump_add;
+    run->on_lcp_ctx = *d;
     return 0;
 }
 
@@ -315,7 +315,7 @@ static int simulate_oscillator(sim_args *a)
     osc_out o = {.every = a->every, .rows_max = nsteps / a->every + 1};
     if (a->out && (status = check_output_size(a->out, output_bytes(a->out, o.rows_max, OSC_COLS))))
         goto done;
-    if ((status = dump_open(a, &dump)))
+    if ((status = dump_open(a, &dump, &a->k.opts)))
         goto done;
     if (a->out && (rc = pd_table_open(&o.file, a->out, OSC_COLS, osc_cols, o.rows_max, &err))) {
         fprintf(stderr, "pound: simulate: %s\n", err.msg);
@@ -519,10 +519,8 @@ static int simulate_scene(sim_args *a)
     if (a->out &&
         (status = check_output_size(a->out, output_bytes(a->out, expected / a->every + 1, width))))
         goto done;
-    if ((status = dump_open(a, &dump)))
+    if ((status = dump_open(a, &dump, &o)))
         goto done;
-    o.on_lcp = a->k.opts.on_lcp; /* the dump's hook, set after the options were resolved */
-    o.on_lcp_ctx = a->k.opts.on_lcp_ctx;
     if ((a->out && pd_scene_writer_open(&fo.w, a->out, sc, a->every, &err)) ||
         (a->plot && pd_scene_plot_open(&fo.p, sc, expected, &err))) {
         fprintf(stderr, "pound: simulate: %s\n", err.msg);

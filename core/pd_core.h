@@ -16,6 +16,7 @@
 #define PD_CORE_H
 
 #include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 
 /* PD_API marks the public API: the only symbols libpound.so exports (it is
@@ -90,6 +91,14 @@ static inline double pd_max(double a, double b)
 {
     return a > b ? a : b;
 }
+
+/* ---- reproducible random numbers ------------------------------------------ */
+
+/* splitmix64: the next 64 random bits of the stream *state (the same on
+ * every platform: tests and benchmarks draw their problems from it). */
+PD_API uint64_t pd_rand_next(uint64_t *state);
+/* Uniform in [-1, 1): the next 53 bits. */
+PD_API double pd_rand_pm1(uint64_t *state);
 
 /* ---- interpolation --------------------------------------------------------- */
 

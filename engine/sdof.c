@@ -255,8 +255,8 @@ void pd_sdof_flow_at(const pd_sdof_flow *f, double t1, double *du, double *v1)
     if (p->A != 0.0 && f->f0 == 0.0 && p->c1 == 0.0)
         return;
     kernels k;
-    if (fabs(sqrt(k0) * s) <= KERNEL_SERIES_MAX)
-        k = kernels_series(sqrt(k0), a, s);
+    if (fabs(f->osc.w0 * s) <= KERNEL_SERIES_MAX)
+        k = kernels_series(f->osc.w0, a, s);
     else {
         double g = ex * sn / wd, G1 = -(em1 * cs + cs_m1 + a * g) / k0;
         k = (kernels){.g = g, .G1 = G1, .G2 = (s - g - 2.0 * a * G1) / k0};

@@ -92,6 +92,12 @@ PD_API int pd_lcp_lemke(pd_lcp_work *work, int n, const double *M, const double 
  * increasing support) or PD_ENOSOLUTION if none exists. */
 PD_API int pd_lcp_enumerate(int n, const double *M, const double *q, double *z, double *w);
 
+/* The right-hand side of the benchmark chain of N contacts (D =
+ * tridiag(-1, 2, -1)), draw number seed: q uniform in [-1, 1).  `pound
+ * bench --lcp` and bench/siconos_lcp draw the same problems from it, so
+ * that their timings pair. */
+PD_API void pd_lcp_chain_q(int N, int seed, double *q);
+
 /* Residuals of a candidate z: fills w = M z + q and returns, through the
  * pointers, max|z_i w_i|, the largest sign violation, and the relative
  * backward residual

@@ -137,8 +137,9 @@ int pd_osc_resolve_opts(const pd_osc *c, const pd_run_opts *in, pd_run_opts *out
         return pd_err_set(err, PD_EINVAL, "dt must be a finite number > 0 (got %g)", out->dt);
     if (!(out->tend > 0.0) || !isfinite(out->tend))
         return pd_err_set(err, PD_EINVAL, "tend must be a finite number > 0 (got %g)", out->tend);
-    if (out->tend / out->dt > 4e9)
-        return pd_err_set(err, PD_EINVAL, "tend / dt = %g steps is too many", out->tend / out->dt);
+    if (!(out->tend / out->dt <= PD_MAX_STEPS))
+        return pd_err_set(err, PD_EINVAL, "dt: tend / dt = %g steps is too many (at most %.0e)",
+                          out->tend / out->dt, PD_MAX_STEPS);
     return PD_OK;
 }
 

@@ -167,6 +167,10 @@ typedef struct pd_penalty_setup {
     const char *stepper; /* "rk8pd", "rkf45", "rk4imp", "msbdf" */
 } pd_penalty_setup;
 
+/* The most time steps a run may take (tend / dt): beyond, the run is
+ * refused as bad input rather than left to run for hours. */
+#define PD_MAX_STEPS 2e9
+
 /* The run request of every command and sweep. */
 typedef struct pd_run_opts {
     pd_method method;

@@ -516,9 +516,9 @@ int pd_scene_resolve_opts(const pd_scene *sc, const pd_run_opts *in, pd_run_opts
         out->dt = pd_scene_default_dt(sc);
     if (out->tend == 0.0)
         out->tend = sc->tend > 0.0 ? sc->tend : pd_scene_default_tend(sc);
-    if (out->tend / out->dt > 4e9)
-        return pd_err_set(err, PD_EINVAL, "dt: tend / dt = %g steps is too many",
-                          out->tend / out->dt);
+    if (!(out->tend / out->dt <= PD_MAX_STEPS))
+        return pd_err_set(err, PD_EINVAL, "dt: tend / dt = %g steps is too many (at most %.0e)",
+                          out->tend / out->dt, PD_MAX_STEPS);
     return PD_OK;
 }
 

@@ -112,11 +112,7 @@ int pd_spec_case(const pd_spectrum *s, long task, pd_osc *c, pd_run_opts *o, pd_
     if (s->dt_per_Tp > 0.0)
         o->dt = c->Tp / s->dt_per_Tp;
     o->no_wall = co.twin;
-    int rc = pd_osc_resolve_opts(c, o, o, err);
-    if (!rc && o->tend / o->dt > 2e9)
-        rc = pd_err_set(err, PD_EINVAL, "dt: %g s over %g s is more than 2e9 steps", o->dt,
-                        o->tend);
-    return rc;
+    return pd_osc_resolve_opts(c, o, o, err);
 }
 
 int pd_spec_validate(const pd_spectrum *s, pd_err *err)
@@ -358,11 +354,9 @@ int pd_spec_sweep(const pd_spectrum *s, pd_spec_point_fn fn, void *ctx, pd_err *
     pd_spec_result r;
     pd_spec_coords co;
     pd_spec_row row;
-    int rc = check_shape(s, err);
     long ntw = pd_spec_twins(s), n = pd_spec_tasks(s);
-    for (long t = 0; !rc && t < n; t++) /* every case, the twins' too, before any run */
-        rc = pd_spec_case(s, t, &c, &o, err) ? PD_EINVAL : PD_OK;
-    if (rc)
+    int rc = check_shape(s, err); /* then every point checked before any run */
+    if (rc || (rc = pd_spec_validate(s, err)))
         return rc;
     pd_spec_result *twin = malloc((size_t)ntw * sizeof *twin);
     if (!twin)

@@ -13,21 +13,6 @@
 
 /* ---- helpers --------------------------------------------------------------------- */
 
-/* splitmix64: the next 64 random bits of the stream *state. */
-static uint64_t rng_next(uint64_t *state)
-{
-    uint64_t x = (*state += 0x9E3779B97F4A7C15ull);
-    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-    return x ^ (x >> 31);
-}
-
-/* Uniform in [-1, 1). */
-static double rng_pm1(uint64_t *state)
-{
-    return 2.0 * ((double)(rng_next(state) >> 11) * 0x1.0p-53) - 1.0;
-}
-
 /* A problem with its own storage (column-major M). */
 typedef struct lcp_case {
     int n;
@@ -96,7 +81,7 @@ static void random_gram(lcp_case *c, int r, double shift, uint64_t *rng)
     if (!B)
         return;
     for (int k = 0; k < n * r; k++)
-        B[k] = rng_pm1(rng);
+        B[k] = pd_rand_pm1(rng);
     for (int j = 0; j < n; j++)
         for (int i = 0; i <= j; i++) {
             double s = 0.0;
@@ -122,10 +107,10 @@ static void random_diag_dominant(lcp_case *c, uint64_t *rng)
         for (int j = 0; j < n; j++) {
             if (j == i)
                 continue;
-            c->M[i + j * n] = rng_pm1(rng);
+            c->M[i + j * n] = pd_rand_pm1(rng);
             off += fabs(c->M[i + j * n]);
         }
-        c->M[i + i * n] = off + 0.1 + 0.5 * (1.0 + rng_pm1(rng));
+        c->M[i + i * n] = off + 0.1 + 0.5 * (1.0 + pd_rand_pm1(rng));
     }
 }
 
@@ -137,7 +122,7 @@ static void random_pd_skew(lcp_case *c, int r, uint64_t *rng)
     for (int j = 0; j < n; j++) {
         c->M[j + j * n] += 0.9;
         for (int i = 0; i < j; i++) {
-            double s = rng_pm1(rng);
+            double s = pd_rand_pm1(rng);
             c->M[i + j * n] += s;
             c->M[j + i * n] -= s;
         }
@@ -148,7 +133,7 @@ static void random_pd_skew(lcp_case *c, int r, uint64_t *rng)
 static void random_q(lcp_case *c, uint64_t *rng)
 {
     for (int i = 0; i < c->n; i++)
-        c->q[i] = rng_pm1(rng);
+        c->q[i] = pd_rand_pm1(rng);
 }
 
 /* Lemke with a fresh workspace; info out. */
@@ -643,14 +628,14 @@ static void test_lcp_degenerate_integer_random(pd_test_ctx *ctx)
                 return;
             }
             for (int e = 0; e < 3 * n; e++)
-                G[e] = (int)(rng_next(&rng) % 4) - 2;
+                G[e] = (int)(pd_rand_next(&rng) % 4) - 2;
             for (int j = 0; j < n; j++) {
                 for (int i = 0; i < n; i++) {
                     int dot = G[3 * i] * G[3 * j] + G[3 * i + 1] * G[3 * j + 1] +
                               G[3 * i + 2] * G[3 * j + 2];
                     c.M[i + j * n] = dot + (i == j);
                 }
-                c.q[j] = (double)((int)(rng_next(&rng) % 5) - 2);
+                c.q[j] = (double)((int)(pd_rand_next(&rng) % 5) - 2);
             }
             pd_lcp_info info;
             int st = solve(&c, NULL, &info);
@@ -782,7 +767,7 @@ static void test_lcp_cover_vector(pd_test_ctx *ctx)
         random_diag_dominant(&c, &rng);
         random_q(&c, &rng);
         for (int i = 0; i < n; i++)
-            d[i] = 0.5 + 1.5 * (1.0 + rng_pm1(&rng));
+            d[i] = 0.5 + 1.5 * (1.0 + pd_rand_pm1(&rng));
         pd_lcp_opts opts = pd_lcp_default_opts();
         opts.cover = d;
         pd_lcp_info info;
