@@ -245,22 +245,30 @@ int pd_spec_threads(int requested)
 #endif
 }
 
-/* The threads of this rank take tasks until none is left. */
+/* A thread's source: the next task of the shared queue. */
+static long stream_next(void *ctx)
+{
+    run_ctx *c = ctx;
+    long t;
+    PD_OMP("omp critical(pd_spectrum)")
+    t = next_task(c);
+    return t;
+}
+
+/* A thread's sink: the finished task stored (rank 0) or reported. */
+static void stream_done(void *ctx, long t, const pd_spec_result *r, const pd_err *err)
+{
+    run_ctx *c = ctx;
+    PD_OMP("omp critical(pd_spectrum)")
+    finished(c, t, r, err->msg);
+}
+
+/* The threads of this rank take tasks until none is left, each thread a
+ * stream of them (the Moreau-Jean ones run many at a time). */
 static void compute_here(run_ctx *c)
 {
     PD_OMP("omp parallel num_threads(c->nthreads)")
-    for (;;) {
-        long t;
-        pd_spec_result r;
-        pd_err e;
-        PD_OMP("omp critical(pd_spectrum)")
-        t = next_task(c);
-        if (t < 0)
-            break;
-        pd_spec_run_task(c->s, t, &r, &e);
-        PD_OMP("omp critical(pd_spectrum)")
-        finished(c, t, &r, e.msg);
-    }
+    pd_spec_stream(c->s, stream_next, stream_done, c, NULL);
 }
 
 /* Every task's case resolves, the no-wall twins' too (pd_spec_validate

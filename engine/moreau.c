@@ -16,6 +16,7 @@
 
 #include "pd_engine.h"
 #include "pd_factor.h"
+#include "mj1.h"
 
 
 struct pd_mj {
@@ -41,9 +42,7 @@ struct pd_mj {
     double *P_active;     /* m: impulses of the active set */
     double *w_active;     /* m: post-impact relative velocities of the active set */
     int *idx_active;      /* m: indices of the active contacts */
-    /* scalar kernel constants */
-    double s_what, s_w, s_c, s_k, s_winv, s_del;
-    double s_whatinv, s_delinv; /* reciprocals: no division in a step */
+    mj1_coef s1;          /* scalar kernel constants (no division in a step) */
     pd_state st;
 };
 
@@ -94,7 +93,7 @@ void pd_mj_free(pd_mj *mj)
 }
 
 /* Options in range: h > 0 finite, theta in [1/2, 1] unless allowed. */
-static int check_opts(const pd_mj_opts *o, pd_err *err)
+int pd_mj_check_opts(const pd_mj_opts *o, pd_err *err)
 {
     if (!(o->h > 0.0) || !isfinite(o->h))
         return pd_err_set(err, PD_EINVAL, "dt must be a finite number > 0 (got %g)", o->h);
@@ -134,21 +133,14 @@ static int alloc_arrays(pd_mj *mj, int n, int m)
                : PD_ENOMEM;
 }
 
-/* Constants of the scalar kernel from the factored 1 x 1 system. */
+/* Constants of the scalar kernel (mj1.h). */
 static void scalar_setup(pd_mj *mj)
 {
     const pd_model *md = mj->model;
-    double h = mj->opts.h, th = mj->opts.theta;
-    double M = pd_matrix_get(&md->M, 0, 0), C = pd_matrix_get(&md->C, 0, 0);
-    double K = pd_matrix_get(&md->K, 0, 0);
-    mj->s_c = C;
-    mj->s_k = K;
-    mj->s_what = M + h * th * C + h * h * th * th * K;
-    mj->s_w = md->m ? pd_matrix_get(&md->W, 0, 0) : 0.0;
-    mj->s_winv = mj->s_w / mj->s_what;
-    mj->s_del = mj->s_w * mj->s_winv;
-    mj->s_whatinv = 1.0 / mj->s_what;
-    mj->s_delinv = mj->s_del != 0.0 ? 1.0 / mj->s_del : 0.0;
+    mj->s1 = mj1_coef_make(pd_matrix_get(&md->M, 0, 0), pd_matrix_get(&md->C, 0, 0),
+                           pd_matrix_get(&md->K, 0, 0), md->m > 0,
+                           md->m ? pd_matrix_get(&md->W, 0, 0) : 0.0, md->m ? md->g0[0] : 0.0,
+                           md->m ? md->e[0] : 0.0, mj->opts.h, mj->opts.theta);
 }
 
 /* The LCP solver and the Delassus block: dense m^2 when the factor keeps D
@@ -182,7 +174,7 @@ pd_mj *pd_mj_alloc(const pd_model *model, const pd_mj_opts *opts, pd_err *err)
     pd_mj_opts o = opts ? *opts : pd_mj_default_opts();
     int st;
     pd_err_clear(err);
-    if ((st = pd_model_check(model, err)) || (st = check_opts(&o, err)))
+    if ((st = pd_model_check(model, err)) || (st = pd_mj_check_opts(&o, err)))
         return NULL;
     mj = calloc(1, sizeof *mj);
     if (!mj || alloc_arrays(mj, model->n, model->m)) {
@@ -252,13 +244,9 @@ int pd_mj_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_err
 static void advance_force(pd_mj *mj, double t1)
 {
     const pd_model *md = mj->model;
-    double tol = 1e-9 * mj->opts.h;
-    while (mj->next_break < md->nbreaks && md->breaks[mj->next_break] < t1 - tol)
-        mj->next_break++;
-    if (mj->next_break < md->nbreaks && md->breaks[mj->next_break] <= t1 + tol) {
+    if (mj_break_at(md->breaks, md->nbreaks, &mj->next_break, t1, 1e-9 * mj->opts.h))
         md->force(t1, +1, mj->F0, md->force_ctx);
-        mj->next_break++;
-    } else
+    else
         memcpy(mj->F0, mj->F1, (size_t)md->n * sizeof(double));
 }
 
@@ -273,40 +261,24 @@ static int check_finite(const pd_mj *mj, pd_err *err)
     return PD_OK;
 }
 
-/* One step of the scalar kernel (n = 1, m <= 1). */
+/* One step of the scalar kernel (n = 1, m <= 1): mj1.h's. */
 static int step_scalar(pd_mj *mj, pd_err *err)
 {
     const pd_model *md = mj->model;
     pd_state *st = &mj->st;
-    double h = mj->opts.h, th = mj->opts.theta;
+    double h = mj->opts.h;
     double t1 = mj->t0 + (double)(st->step + 1) * h;
     double F1 = 0.0;
     if (md->force)
         md->force(t1, -1, &F1, md->force_ctx);
-    double q = st->q[0], v = st->v[0];
-    /* free velocity */
-    double Fth = th * F1 + (1.0 - th) * mj->F0[0];
-    double rhs = h * (Fth - mj->s_c * v - mj->s_k * (q + h * th * v));
-    double vnew = v + rhs * mj->s_whatinv;
-    double P = 0.0;
-    int active = 0;
-    /* contact: predicted gap, then the scalar LCP */
+    double g = st->g[0], P;
+    int active = mj1_step(h, mj->opts.theta, h * mj->opts.gamma, &mj->s1, mj->F0[0], F1,
+                          &st->q[0], &st->v[0], &g, &P);
     if (md->m) {
-        double U0 = mj->s_w * v;
-        if (st->g[0] + h * mj->opts.gamma * U0 <= 0.0) {
-            active = 1;
-            double b = mj->s_w * vnew + md->e[0] * U0; /* the scalar LCP, closed form */
-            P = b < 0.0 ? -b * mj->s_delinv : 0.0;
-            vnew += mj->s_winv * P;
-        }
         st->P[0] = P;
         st->active[0] = (unsigned char)active;
+        st->g[0] = g;
     }
-    q += h * (th * vnew + (1.0 - th) * v);
-    st->q[0] = q;
-    st->v[0] = vnew;
-    if (md->m)
-        st->g[0] = md->g0[0] + mj->s_w * q;
     st->nactive = active;
     st->lcp_pivots = 0;
     st->lcp_solver = active ? "closed-form" : NULL;
@@ -317,7 +289,7 @@ static int step_scalar(pd_mj *mj, pd_err *err)
     }
     st->t = t1;
     st->step++;
-    if (!isfinite(q) || !isfinite(vnew))
+    if (!isfinite(st->q[0]) || !isfinite(st->v[0]))
         return check_finite(mj, err);
     return PD_OK;
 }

@@ -156,6 +156,80 @@ PD_API double pd_contact_impulse_1(double D, double b);
  * within 1e-9 of an integer, else rounded up). */
 PD_API long pd_steps_for(double tend, double h);
 
+/* ---- Moreau–Jean for a batch of one-DOF systems (engine/mj_batch.c) ---- *
+ * PD_MJB_LANES independent systems  M q'' + C q' + K q = F(t) + W lambda,
+ * each with at most one contact (gap g0 + W q) and at most one force
+ * breakpoint, advanced together by the arithmetic of pd_mj's scalar kernel:
+ * lane l's numbers are the ones pd_mj gives for its system alone, bit for
+ * bit (tests/test_engine.c), at a fraction of the cost (the lanes fill the
+ * processor's vector units and overlap their dependency chains).  Lanes
+ * share theta and gamma; each has its own step h, its own clock, and can be
+ * restarted with another system while the others run, so that a queue of
+ * systems of different lengths keeps every lane busy.  One force call per
+ * step gives every lane its force.  The object holds every number (no
+ * allocation, no failure once set up). */
+#define PD_MJB_LANES 32
+
+typedef struct pd_mjb_lane {
+    double M, C, K;   /* M > 0 */
+    int wall;         /* 1: the contact exists */
+    double W, g0, e;  /* its direction (nonzero), initial gap >= 0, restitution in [0, 1] */
+    double h;         /* step > 0 */
+    double brk;       /* the force's breakpoint (INFINITY: none) */
+} pd_mjb_lane;
+
+/* F[l] = lane l's force at time t[l] (its left limit for side = -1, right
+ * limit for +1), for every lane l < PD_MJB_LANES. */
+typedef void (*pd_mjb_force)(const double *t, int side, double *F, void *ctx);
+
+typedef struct pd_mjb pd_mjb;
+typedef void (*pd_mjb_step_fn)(pd_mjb *b); /* private */
+
+/* Laid out in whole 64-byte lines: an object at a 64-byte boundary
+ * (aligned_alloc(64, ...); the compiler's own placement of a declared one
+ * is 16) has every lane array on cache-line boundaries, which the wide
+ * loads of the step run fastest on. */
+struct pd_mjb {
+    double theta, gamma;
+    pd_mjb_step_fn lanes_step;        /* private: the step for this processor */
+    pd_mjb_force force;
+    void *force_ctx;
+    long iter;                        /* batch steps taken */
+    long next_event;                  /* iter at which a lane meets its breakpoint */
+    long reserved;                    /* (the first line's last word) */
+    long brk_iter[PD_MJB_LANES];      /* iter at which lane l does (LONG_MAX: never) */
+    double t[PD_MJB_LANES];     /* lane clocks */
+    double steps[PD_MJB_LANES]; /* lane step counts (whole numbers) */
+    double q[PD_MJB_LANES];     /* displacements at t */
+    double v[PD_MJB_LANES];     /* velocities at t */
+    double g[PD_MJB_LANES];     /* gaps at t */
+    double P[PD_MJB_LANES];     /* impulses of the last step */
+    double F0[PD_MJB_LANES];    /* forces at t+ */
+    double F1[PD_MJB_LANES];    /* forces at the step's end (scratch) */
+    double finite[PD_MJB_LANES]; /* 0 while the lane stayed finite, NaN after */
+    double h[PD_MJB_LANES], brk[PD_MJB_LANES];
+    double coef[11 * PD_MJB_LANES]; /* private: the lanes' constants */
+};
+
+/* Set theta, gamma (opts as pd_mj's: theta, gamma, allow_unstable; h and
+ * the kernel, factor and LCP fields are not used) and the force (NULL:
+ * none); every lane idle (a unit mass at rest, no contact, h = 1). */
+PD_API int pd_mjb_init(pd_mjb *b, const pd_mj_opts *opts, pd_mjb_force force, void *force_ctx,
+                       pd_err *err);
+
+/* Start lane l afresh with the system ln, at rest at its time 0 (the
+ * force is asked for every lane's F(t+); only lane l's is kept). */
+PD_API int pd_mjb_set_lane(pd_mjb *b, int l, const pd_mjb_lane *ln, pd_err *err);
+
+/* Take nsteps steps of every lane, calling observer (may be NULL) after
+ * each; stops early when it returns > 0. */
+typedef int (*pd_mjb_observer)(const pd_mjb *b, void *ctx);
+PD_API void pd_mjb_run(pd_mjb *b, long nsteps, pd_mjb_observer observer, void *ctx);
+
+/* 1 when lane l's state stayed finite since it was set: otherwise its run
+ * is repeated alone by pd_mj to name the step where it failed. */
+PD_API int pd_mjb_finite(const pd_mjb *b, int l);
+
 /* ---- event-driven reference for the general system (engine/event.c) --- *
  * Smooth motion between events integrated by GSL (rk8pd, tight tolerances)
  * with the persistent contacts held by the acceleration-level LCP

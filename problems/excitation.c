@@ -41,11 +41,16 @@ int pd_dir_parse(const char *name, int *dir)
     return PD_OK;
 }
 
+double pd_shape_cut(double end, int side)
+{
+    return end * (1.0 + (side < 0 ? 1e-12 : -1e-12));
+}
+
 /* 1 when tau lies past the pulse end on the requested side. */
 static int after_pulse(pd_pulse pulse, double tau, int side)
 {
-    double end = PD_TWO_PI * (1.0 + (side < 0 ? 1e-12 : -1e-12));
-    return pulse != PD_PULSE_HARMONIC && (side < 0 ? tau > end : tau >= end);
+    double cut = pd_shape_cut(PD_TWO_PI, side);
+    return pulse != PD_PULSE_HARMONIC && (side < 0 ? tau > cut : tau >= cut);
 }
 
 /* s phi(tau). */

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "osc_track.h"
 #include "pd_problems.h"
 
 
@@ -47,8 +48,8 @@ void pd_osc_set_record(pd_osc *c, const pd_record *rec, const pd_record_pulse *p
 /* tau past the record's end on the requested side (to a relative 1e-12). */
 static int after_record(const pd_osc *c, double tau, int side)
 {
-    double end = pd_osc_shape_end(c) * (1.0 + (side < 0 ? 1e-12 : -1e-12));
-    return side < 0 ? tau > end : tau >= end;
+    double cut = pd_shape_cut(pd_osc_shape_end(c), side);
+    return side < 0 ? tau > cut : tau >= cut;
 }
 
 /* -dir ug''(t) / rec_ap: the record's samples are joined linearly. */
@@ -184,20 +185,23 @@ static void scene_force(double tau, int side, double *F, void *ctx)
     F[0] = pd_osc_shape(ctx, tau, side);
 }
 
-/* Measurements in dimensionless units, updated by the observer. */
+/* The observer's context: the measurements and the sampler. */
 typedef struct tracker {
-    const pd_osc *c;
-    double h;             /* dimensionless step */
-    double tau_measure;   /* window start (dimensionless) */
+    pd_osc_track m;
     double Le, vscale, wp;
-    double xmax, xtoward, xaway;
-    long impacts, contact_steps;
-    double first_tau, first_v, vimp_max, Pmax;
-    double closing_tau, closing_v; /* last gap closing seen */
-    double prev_x, prev_v, prev2_v, prev_P, min_gap;
     pd_osc_sampler sampler;
     void *sampler_ctx;
 } tracker;
+
+void pd_osc_track_init(pd_osc_track *tr, const pd_osc *c, double h, double tau_measure)
+{
+    *tr = (pd_osc_track){.h = h,
+                         .Pi3 = c->Pi3,
+                         .tau_measure = tau_measure,
+                         .first_tau = NAN,
+                         .first_v = NAN,
+                         .min_gap = c->Pi3};
+}
 
 /* Time s in [0, h] after the step start at which the gap g0 > 0 closes
  * under x(s) = v s + a s^2 / 2 (velocity v, acceleration a of the step). */
@@ -216,52 +220,60 @@ static double closing_time(double g0, double v, double a, double h)
     return fmin(fmax(s, 0.0), h);
 }
 
-/* Per step: extremes, impacts (impulse after a step without) with their
- * instant and approach speed estimated inside the step, samples. */
+void pd_osc_track_events(pd_osc_track *tr, long step, double t, double x, double v, double P)
+{
+    /* the gap closes in this step (or an impulse stops it closing): instant
+     * and speed from the step start and the step's free acceleration */
+    double gap = tr->Pi3 - x, g_prev = tr->Pi3 - tr->prev_x;
+    if (step > 0 && g_prev > 0.0 && (gap <= 0.0 || P > 0.0)) {
+        double acc = P == 0.0 ? (v - tr->prev_v) / tr->h
+                              : (step > 1 ? (tr->prev_v - tr->prev2_v) / tr->h : 0.0);
+        double s = closing_time(g_prev, tr->prev_v, acc, tr->h);
+        tr->closing_tau = t - tr->h + s;
+        tr->closing_v = tr->prev_v + acc * s;
+    }
+    if (P > 0.0 && tr->prev_P == 0.0) {
+        tr->impacts++;
+        tr->vimp_max = pd_max(tr->vimp_max, tr->closing_v);
+        if (tr->impacts == 1) {
+            tr->first_tau = tr->closing_tau;
+            tr->first_v = tr->closing_v;
+        }
+    }
+}
+
+void pd_osc_track_result(const pd_osc_track *tr, const pd_osc *c, double dt, long steps,
+                         pd_osc_result *res)
+{
+    double wp = pd_osc_wp(c), Le = pd_osc_Le(c), vscale = Le * wp;
+    memset(res, 0, sizeof *res);
+    res->umax = tr->xmax * Le;
+    res->u_toward = tr->xtoward * Le;
+    res->u_away = tr->xaway * Le;
+    res->impacts = tr->impacts;
+    res->first_impact = tr->first_tau / wp;
+    res->first_impact_velocity = tr->first_v * vscale;
+    res->max_impact_velocity = tr->vimp_max * vscale;
+    res->max_impulse = tr->Pmax * vscale;
+    res->contact_time = (double)tr->contact_steps * dt;
+    res->min_gap = tr->min_gap * Le;
+    res->steps = steps;
+    res->dt = dt;
+}
+
+/* Per step: the measurements, then the sample. */
 static int observe(const pd_state *st, void *ctx)
 {
     tracker *tr = ctx;
     double x = st->q[0], v = st->v[0], P = st->P[0];
-    double gap = tr->c->Pi3 - x;
-    if (st->t >= tr->tau_measure - 0.5 * tr->h) {
-        tr->xmax = pd_max(tr->xmax, fabs(x)); /* inlined: fmax is a library call */
-        tr->xtoward = pd_max(tr->xtoward, x);
-        tr->xaway = pd_max(tr->xaway, -x);
-    }
-    /* the gap closes in this step (or an impulse stops it closing): instant
-     * and speed from the step start and the step's free acceleration */
-    double g_prev = tr->c->Pi3 - tr->prev_x;
-    if (st->step > 0 && g_prev > 0.0 && (gap <= 0.0 || P > 0.0)) {
-        double acc = P == 0.0 ? (v - tr->prev_v) / tr->h
-                              : (st->step > 1 ? (tr->prev_v - tr->prev2_v) / tr->h : 0.0);
-        double s = closing_time(g_prev, tr->prev_v, acc, tr->h);
-        tr->closing_tau = st->t - tr->h + s;
-        tr->closing_v = tr->prev_v + acc * s;
-    }
-    if (P > 0.0) {
-        tr->contact_steps++;
-        tr->Pmax = pd_max(tr->Pmax, P);
-        if (tr->prev_P == 0.0) {
-            tr->impacts++;
-            tr->vimp_max = pd_max(tr->vimp_max, tr->closing_v);
-            if (tr->impacts == 1) {
-                tr->first_tau = tr->closing_tau;
-                tr->first_v = tr->closing_v;
-            }
-        }
-    }
-    tr->min_gap = tr->min_gap < gap ? tr->min_gap : gap;
-    tr->prev2_v = tr->prev_v;
-    tr->prev_x = x;
-    tr->prev_v = v;
-    tr->prev_P = P;
+    pd_osc_track_step(&tr->m, st->step, st->t, x, v, P);
     if (tr->sampler) {
         pd_osc_sample smp = {.step = st->step,
                              .t = st->t / tr->wp,
                              .u = x * tr->Le,
                              .v = v * tr->vscale,
                              .impulse = P * tr->vscale,
-                             .gap = gap * tr->Le};
+                             .gap = (tr->m.Pi3 - x) * tr->Le};
         return tr->sampler(&smp, tr->sampler_ctx);
     }
     return 0;
@@ -309,34 +321,10 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
     if (!mj)
         return err ? err->status : PD_EINVAL;
     double wp = pd_osc_wp(c), Le = pd_osc_Le(c);
-    tracker tr = {.c = c,
-                  .h = mo.h,
-                  .tau_measure = wp * pd_osc_measure_start(c, o.tend),
-                  .Le = Le,
-                  .vscale = Le * wp,
-                  .wp = wp,
-                  .first_tau = NAN,
-                  .first_v = NAN,
-                  .min_gap = c->Pi3,
-                  .sampler = sampler,
-                  .sampler_ctx = ctx};
+    tracker tr = {.Le = Le, .vscale = Le * wp, .wp = wp, .sampler = sampler, .sampler_ctx = ctx};
+    pd_osc_track_init(&tr.m, c, mo.h, wp * pd_osc_measure_start(c, o.tend));
     rc = pd_mj_run(mj, nsteps, observe, &tr, err);
-    const pd_state *st = pd_mj_state(mj);
-
-    /* results in metres and seconds */
-    memset(res, 0, sizeof *res);
-    res->umax = tr.xmax * tr.Le;
-    res->u_toward = tr.xtoward * tr.Le;
-    res->u_away = tr.xaway * tr.Le;
-    res->impacts = tr.impacts;
-    res->first_impact = tr.first_tau / wp;
-    res->first_impact_velocity = tr.first_v * tr.vscale;
-    res->max_impact_velocity = tr.vimp_max * tr.vscale;
-    res->max_impulse = tr.Pmax * tr.vscale;
-    res->contact_time = (double)tr.contact_steps * o.dt;
-    res->min_gap = tr.min_gap * tr.Le;
-    res->steps = st->step;
-    res->dt = o.dt;
+    pd_osc_track_result(&tr.m, c, o.dt, pd_mj_state(mj)->step, res);
     res->tend = o.tend;
     res->theta = mo.theta;
     res->gamma = mo.gamma;

@@ -247,6 +247,10 @@ PD_API void pd_osc_set_record(pd_osc *c, const pd_record *rec, const pd_record_p
 PD_API double pd_osc_shape(const pd_osc *c, double tau, int side);
 PD_API double pd_osc_shape_rate(const pd_osc *c, double tau, int side);
 PD_API double pd_osc_shape_end(const pd_osc *c);
+/* The excitation ends at `end` to a relative 1e-12: the shape's left limit
+ * (side -1) is 0 past end (1 + 1e-12), its right limit (+1) from end
+ * (1 - 1e-12) on. */
+PD_API double pd_shape_cut(double end, int side);
 
 /* The name of the excitation: the pulse's, or the record's file name. */
 PD_API const char *pd_osc_excitation_name(const pd_osc *c);
@@ -297,6 +301,31 @@ typedef struct pd_osc_result {
 /* Run the case with the method of opts (sampler may be NULL). */
 PD_API int pd_osc_run(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
                       pd_osc_result *res, pd_err *err);
+
+/* ---- many cases: a stream ---------------------------------------------- *
+ * pd_osc_run_stream runs every case a source gives and reports each as it
+ * ends.  The Moreau–Jean cases without a sampler or an LCP hook
+ * (pd_osc_batchable) run many at a time on the lanes of a pd_mjb
+ * (pd_engine.h), a lane taking the next case as soon as its run ends; each
+ * result equals pd_osc_run's for the case, bit for bit, but for cpu_s (the
+ * lanes share the batch's time) and kernel ("batched").  The other cases,
+ * and any case whose state stops being finite, run alone by pd_osc_run,
+ * which gives their failure its message.  One stream per thread. */
+
+/* Fill *c and *o with the next case, *id with the caller's name for it, and
+ * return 1; return 0 when no case is left. */
+typedef int (*pd_osc_stream_next)(void *ctx, pd_osc *c, pd_run_opts *o, long *id);
+/* Case id ended: its result when status is 0, else err's message. */
+typedef void (*pd_osc_stream_done)(void *ctx, long id, const pd_osc_result *res, int status,
+                                   const pd_err *err);
+
+/* 1 when (c, o) can run in a batch: Moreau-Jean, the automatic kernel, no
+ * LCP hook (a sampler is the caller's to avoid). */
+PD_API int pd_osc_batchable(const pd_osc *c, const pd_run_opts *o);
+/* Run the stream until the source is exhausted: every case is reported,
+ * failed or not (without memory for a batch, cases run alone); PD_OK. */
+PD_API int pd_osc_run_stream(pd_osc_stream_next next, pd_osc_stream_done done, void *ctx,
+                             pd_err *err);
 
 /* The event-driven reference's work: its scan points over tend (64 per
  * shortest of Tp and T0), and the most a run may take (about 5 s here: a
@@ -680,6 +709,16 @@ PD_API int pd_spec_case(const pd_spectrum *s, long task, pd_osc *c, pd_run_opts 
 PD_API int pd_spec_validate(const pd_spectrum *s, pd_err *err);
 /* Run one task into r (r->status and err say why it failed). */
 PD_API void pd_spec_run_task(const pd_spectrum *s, long task, pd_spec_result *r, pd_err *err);
+
+/* Tasks as a stream (pd_osc_run_stream): next returns the next task to run
+ * (-1: none left), done receives each task's result as pd_spec_run_task
+ * gives it (cpu_s aside) with its message when r->status != 0.  The
+ * Moreau-Jean tasks run many at a time.  One stream per thread. */
+typedef long (*pd_spec_task_next)(void *ctx);
+typedef void (*pd_spec_task_done)(void *ctx, long task, const pd_spec_result *r,
+                                  const pd_err *err);
+PD_API int pd_spec_stream(const pd_spectrum *s, pd_spec_task_next next, pd_spec_task_done done,
+                          void *ctx, pd_err *err);
 /* Expected cost of a task: its number of steps. */
 PD_API double pd_spec_cost(const pd_spectrum *s, long task);
 /* A canonical text of every parameter that shapes the results (the
@@ -697,15 +736,17 @@ PD_API void pd_spec_curve_label(const pd_spectrum *s, long curve, char *buf, siz
  * during the call only.  Return 0 to go on, nonzero to stop the sweep. */
 typedef int (*pd_spec_point_fn)(const pd_spec_coords *co, const pd_spec_row *row, void *ctx);
 
-/* Run every task of the sweep in order on the calling thread (the no-wall
- * twins first, then the points) and hand each point to fn as it completes:
+/* Run every task of the sweep on the calling thread (the no-wall twins
+ * first, then the points; Moreau-Jean's many at a time, pd_spec_stream)
+ * and hand each point to fn, in order, once it and its twin have ended:
  * the numbers pd_spec_run_task and pd_spec_rows give (`pound spectrum`
  * runs the same tasks on threads and ranks).  Every case is checked before
  * anything runs: PD_EINVAL naming the first bad one (or a list or grid out
  * of range).  A failed run stops the sweep with its status and a message
- * naming the point; fn's nonzero return stops it with PD_ESTOPPED.  Memory:
- * one result per twin.  Re-entrant: sweeps may run on several threads
- * (docs/api.md: threads, and GSL's process-wide error handler). */
+ * naming the point (the first failure in order, after every point before
+ * it); fn's nonzero return stops it with PD_ESTOPPED.  Memory: one result
+ * per task.  Re-entrant: sweeps may run on several threads (docs/api.md:
+ * threads, and GSL's process-wide error handler). */
 PD_API int pd_spec_sweep(const pd_spectrum *s, pd_spec_point_fn fn, void *ctx, pd_err *err);
 
 /* ---- scene sweeps ------------------------------------------------------------ *

@@ -135,6 +135,20 @@ double pd_spec_cost(const pd_spectrum *s, long task)
     return (double)pd_steps_for(o.tend, o.dt);
 }
 
+/* A run's figures as a task's result. */
+static void result_of(const pd_osc_result *res, pd_spec_result *r)
+{
+    r->umax = res->umax;
+    r->u_toward = res->u_toward;
+    r->u_away = res->u_away;
+    r->contact_time = res->contact_time;
+    r->first_impact = res->first_impact;
+    r->cpu_s = res->cpu_s;
+    r->impacts = res->impacts;
+    r->steps = res->steps;
+    r->done = 1;
+}
+
 /* One task: its case, the chosen method, the figures kept; a failure's
  * message names the point. */
 void pd_spec_run_task(const pd_spectrum *s, long t, pd_spec_result *r, pd_err *err)
@@ -156,15 +170,60 @@ void pd_spec_run_task(const pd_spectrum *s, long t, pd_spec_result *r, pd_err *e
                    o.no_wall ? " (no wall)" : "", m);
         return;
     }
-    r->umax = res.umax;
-    r->u_toward = res.u_toward;
-    r->u_away = res.u_away;
-    r->contact_time = res.contact_time;
-    r->first_impact = res.first_impact;
-    r->cpu_s = res.cpu_s;
-    r->impacts = res.impacts;
-    r->steps = res.steps;
-    r->done = 1;
+    result_of(&res, r);
+}
+
+/* ---- tasks as a stream of runs ------------------------------------------ */
+
+/* The stream's source and sink: the sweep's tasks, the caller's. */
+typedef struct task_stream {
+    const pd_spectrum *s;
+    pd_spec_task_next next;
+    pd_spec_task_done done;
+    void *ctx;
+} task_stream;
+
+static int stream_next(void *ctx, pd_osc *c, pd_run_opts *o, long *id)
+{
+    task_stream *ts = ctx;
+    for (;;) {
+        long t = ts->next(ts->ctx);
+        if (t < 0)
+            return 0;
+        if (!pd_spec_case(ts->s, t, c, o, NULL)) {
+            *id = t;
+            return 1;
+        }
+        /* a case that does not resolve: reported with its message */
+        pd_spec_result r;
+        pd_err e;
+        pd_spec_run_task(ts->s, t, &r, &e);
+        ts->done(ts->ctx, t, &r, &e);
+    }
+}
+
+static void stream_done(void *ctx, long id, const pd_osc_result *res, int status,
+                        const pd_err *err)
+{
+    task_stream *ts = ctx;
+    pd_spec_result r;
+    pd_err e;
+    (void)err;
+    if (status) /* the failure worded as a task's (the same run fails the same way) */
+        pd_spec_run_task(ts->s, id, &r, &e);
+    else {
+        memset(&r, 0, sizeof r);
+        pd_err_clear(&e);
+        result_of(res, &r);
+    }
+    ts->done(ts->ctx, id, &r, &e);
+}
+
+int pd_spec_stream(const pd_spectrum *s, pd_spec_task_next next, pd_spec_task_done done,
+                   void *ctx, pd_err *err)
+{
+    task_stream ts = {.s = s, .next = next, .done = done, .ctx = ctx};
+    return pd_osc_run_stream(stream_next, stream_done, &ts, err);
 }
 
 /* ---- the canonical key -------------------------------------------------- */
@@ -347,36 +406,79 @@ static int check_shape(const pd_spectrum *s, pd_err *err)
     return PD_OK;
 }
 
-int pd_spec_sweep(const pd_spectrum *s, pd_spec_point_fn fn, void *ctx, pd_err *err)
+/* The sweep's stream state: results arrive in any order (a batch ends its
+ * runs as they end), points go to the caller in task order. */
+typedef struct sweep_ctx {
+    const pd_spectrum *s;
+    pd_spec_point_fn fn;
+    void *ctx;
+    pd_spec_result *res; /* every task's, as it ends */
+    long first_bad;      /* the lowest failed task so far (-1: none) */
+    char bad_msg[sizeof(((pd_err *)0)->msg)]; /* its message */
+    long ntasks, ntw, next, emitted;
+    int rc;
+    pd_err *err;
+} sweep_ctx;
+
+static long sweep_next(void *ctx)
+{
+    sweep_ctx *w = ctx;
+    return !w->rc && w->next < w->ntasks ? w->next++ : -1;
+}
+
+/* Emit the points whose task and twin have ended, in order; stop at the
+ * first failure or when the caller asks. */
+static void sweep_emit(sweep_ctx *w)
 {
     pd_osc c;
     pd_run_opts o;
-    pd_spec_result r;
     pd_spec_coords co;
     pd_spec_row row;
-    long ntw = pd_spec_twins(s), n = pd_spec_tasks(s);
+    while (!w->rc && w->emitted < w->ntasks && w->res[w->emitted].done) {
+        long t = w->emitted;
+        const pd_spec_result *r = &w->res[t];
+        if (r->status) { /* the lowest failure: every task before it ended */
+            w->rc = pd_err_set(w->err, r->status, "%s", w->bad_msg);
+            return;
+        }
+        w->emitted++;
+        if (t < w->ntw)
+            continue;
+        pd_spec_case(w->s, t, &c, &o, NULL);
+        pd_spec_coords_of(w->s, t, &co);
+        fill_row(&c, &o, co.curve, r, &w->res[pd_spec_twin_of(w->s, t)], &row);
+        if (w->fn && w->fn(&co, &row, w->ctx))
+            w->rc = pd_err_set(w->err, PD_ESTOPPED,
+                               "spectrum: stopped by the caller after point %ld", t - w->ntw);
+    }
+}
+
+static void sweep_done(void *ctx, long t, const pd_spec_result *r, const pd_err *e)
+{
+    sweep_ctx *w = ctx;
+    w->res[t] = *r;
+    w->res[t].done = 1;
+    if (r->status && (w->first_bad < 0 || t < w->first_bad)) {
+        w->first_bad = t;
+        snprintf(w->bad_msg, sizeof w->bad_msg, "%s", e->msg);
+    }
+    sweep_emit(w);
+}
+
+int pd_spec_sweep(const pd_spectrum *s, pd_spec_point_fn fn, void *ctx, pd_err *err)
+{
+    long n = pd_spec_tasks(s);
     int rc = check_shape(s, err); /* then every point checked before any run */
     if (rc || (rc = pd_spec_validate(s, err)))
         return rc;
-    pd_spec_result *twin = malloc((size_t)ntw * sizeof *twin);
-    if (!twin)
-        return pd_err_set(err, PD_ENOMEM, "out of memory for %ld runs", ntw);
-    for (long t = 0; !rc && t < n; t++) {
-        pd_err e; /* err may be NULL, pd_spec_run_task's may not */
-        pd_spec_run_task(s, t, t < ntw ? &twin[t] : &r, &e);
-        if ((rc = (t < ntw ? twin[t] : r).status))
-            pd_err_set(err, rc, "%s", e.msg);
-        if (rc || t < ntw)
-            continue;
-        pd_spec_case(s, t, &c, &o, NULL);
-        pd_spec_coords_of(s, t, &co);
-        fill_row(&c, &o, co.curve, &r, &twin[pd_spec_twin_of(s, t)], &row);
-        if (fn && fn(&co, &row, ctx))
-            rc = pd_err_set(err, PD_ESTOPPED, "spectrum: stopped by the caller after point %ld",
-                            t - ntw);
-    }
-    free(twin);
-    if (!rc)
+    sweep_ctx w = {.s = s, .fn = fn, .ctx = ctx, .ntasks = n, .ntw = pd_spec_twins(s),
+                   .first_bad = -1, .err = err};
+    w.res = calloc((size_t)n, sizeof *w.res);
+    if (!w.res)
+        return pd_err_set(err, PD_ENOMEM, "out of memory for %ld runs", n);
+    pd_spec_stream(s, sweep_next, sweep_done, &w, NULL);
+    free(w.res);
+    if (!w.rc)
         pd_err_clear(err);
-    return rc;
+    return w.rc;
 }

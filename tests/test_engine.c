@@ -1,9 +1,11 @@
 /* test_engine.c — the Moreau–Jean engine against closed forms and invariants. */
 #include <malloc.h>
+#include <stdlib.h>
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
 
+#include "mj1.h"
 #include "pd_engine.h"
 #include "pd_test.h"
 
@@ -327,6 +329,219 @@ static void test_engine_no_allocation_in_steps(pd_test_ctx *ctx)
     pd_mj_free(mj);
 }
 
+/* ---- the batch (pd_mjb) against pd_mj, bit for bit ---------------------- */
+
+/* A lane's system for the comparison: random periods, damping, gaps,
+ * restitution, steps, force shapes (a sine pulse ending at brk, or none). */
+typedef struct batch_sys {
+    double M, C, K, W, g0, e, h, brk, amp, w;
+    int wall;
+} batch_sys;
+
+static batch_sys batch_sys_draw(uint64_t *rs)
+{
+    batch_sys b = {.M = 0.5 + pd_test_uniform(rs),
+                   .C = 0.3 * pd_test_uniform(rs),
+                   .K = 0.2 + 20.0 * pd_test_uniform(rs),
+                   .W = pd_test_uniform(rs) < 0.5 ? -1.0 : 1.7,
+                   .g0 = 0.02 * pd_test_uniform(rs),
+                   .e = pd_test_uniform(rs),
+                   .h = 1e-3 * (1.0 + 4.0 * pd_test_uniform(rs)),
+                   .amp = pd_test_uniform(rs) < 0.5 ? 1.0 : -1.0,
+                   .w = 2.0 + 5.0 * pd_test_uniform(rs),
+                   .wall = pd_test_uniform(rs) < 0.8};
+    b.brk = pd_test_uniform(rs) < 0.7 ? 0.3 + 0.5 * pd_test_uniform(rs) : INFINITY;
+    if (pd_test_uniform(rs) < 0.2) /* a breakpoint on a step: the right limit there */
+        b.brk = 97.0 * b.h;
+    return b;
+}
+
+/* amp sin(w t) until brk (its left limit at brk), 0 after. */
+static double batch_sys_force(const batch_sys *b, double t, int side)
+{
+    int after = side < 0 ? t > b->brk : t >= b->brk;
+    return after ? 0.0 : b->amp * sin(b->w * t);
+}
+
+static void mj_sys_force(double t, int side, double *F, void *ctx)
+{
+    F[0] = batch_sys_force(ctx, t, side);
+}
+
+typedef struct batch_src {
+    batch_sys sys[PD_MJB_LANES];
+} batch_src;
+
+static void mjb_sys_force(const double *t, int side, double *F, void *ctx)
+{
+    batch_src *bs = ctx;
+    for (int l = 0; l < PD_MJB_LANES; l++)
+        F[l] = batch_sys_force(&bs->sys[l], t[l], side);
+}
+
+/* One system alone by pd_mj's scalar kernel: its q, v, g and P after each
+ * of nsteps steps into out (4 per step). */
+static int mj_alone(const batch_sys *b, double theta, double gamma, long nsteps, double *out,
+                    pd_err *err)
+{
+    pd_model md = {.n = 1, .m = b->wall, .M = pd_matrix_dense(1, 1, (double *)&b->M),
+                   .C = pd_matrix_dense(1, 1, (double *)&b->C),
+                   .K = pd_matrix_dense(1, 1, (double *)&b->K),
+                   .W = pd_matrix_dense(1, 1, (double *)&b->W), .g0 = &b->g0, .e = &b->e,
+                   .force = mj_sys_force, .force_ctx = (void *)b, .breaks = &b->brk,
+                   .nbreaks = isfinite(b->brk) ? 1 : 0};
+    pd_mj_opts o = pd_mj_default_opts();
+    o.h = b->h;
+    o.theta = theta;
+    o.gamma = gamma;
+    pd_mj *mj = pd_mj_alloc(&md, &o, err);
+    if (!mj)
+        return -1;
+    for (long k = 0; k < nsteps; k++) {
+        if (pd_mj_step(mj, err)) {
+            pd_mj_free(mj);
+            return -1;
+        }
+        const pd_state *st = pd_mj_state(mj);
+        out[4 * k] = st->q[0];
+        out[4 * k + 1] = st->v[0];
+        out[4 * k + 2] = b->wall ? st->g[0] : 0.0;
+        out[4 * k + 3] = b->wall ? st->P[0] : 0.0;
+    }
+    pd_mj_free(mj);
+    return 0;
+}
+
+/* Every lane of the batch, with lanes restarted at different batch steps,
+ * gives the numbers of pd_mj for its system alone at every step, bit for
+ * bit, with each instruction set's step this processor has. */
+static void test_engine_batch_matches_scalar(pd_test_ctx *ctx)
+{
+    enum { NSTEP = 700, RESTART = 250 };
+    static const struct {
+        const char *name;
+        pd_mjb_step_fn fn;
+        int usable;
+    } variants[] = {
+        {"baseline", pd_mjb_lanes_step_base, 1},
+#if PD_MJB_X86_VARIANTS
+        {"x86-64-v3", pd_mjb_lanes_step_x86v3, -3},
+        {"x86-64-v4", pd_mjb_lanes_step_x86v4, -4},
+#endif
+    };
+    static double alone[PD_MJB_LANES][2][4 * NSTEP];
+    batch_src src;
+    uint64_t rs = 20261123;
+    const double theta = 0.55, gamma = 0.5;
+    pd_err err;
+    /* lanes 0..L-1 run system A from step 0; odd lanes switch to system B
+     * at batch step RESTART (its own clock from 0 again) */
+    batch_sys A[PD_MJB_LANES], B[PD_MJB_LANES];
+    for (int l = 0; l < PD_MJB_LANES; l++) {
+        A[l] = batch_sys_draw(&rs);
+        B[l] = batch_sys_draw(&rs);
+        if (mj_alone(&A[l], theta, gamma, NSTEP, alone[l][0], &err) ||
+            mj_alone(&B[l], theta, gamma, NSTEP, alone[l][1], &err)) {
+            CHECK(ctx, 0, "pd_mj: %s", err.msg);
+            return;
+        }
+    }
+    long compared = 0, contacts = 0, breaks = 0;
+    for (size_t vi = 0; vi < sizeof variants / sizeof variants[0]; vi++) {
+        int usable = variants[vi].usable;
+#if PD_MJB_X86_VARIANTS
+        if (usable == -3)
+            usable = __builtin_cpu_supports("x86-64-v3");
+        if (usable == -4)
+            usable = __builtin_cpu_supports("x86-64-v4");
+#endif
+        if (!usable)
+            continue;
+        pd_mjb *b = aligned_alloc(64, sizeof *b);
+        pd_mj_opts o = pd_mj_default_opts();
+        o.theta = theta;
+        o.gamma = gamma;
+        if (!CHECK(ctx, b && !pd_mjb_init(b, &o, mjb_sys_force, &src, &err), "init: %s",
+                   err.msg)) {
+            free(b);
+            return;
+        }
+        b->lanes_step = variants[vi].fn;
+        for (int l = 0; l < PD_MJB_LANES; l++) {
+            src.sys[l] = A[l];
+            pd_mjb_lane ln = {.M = A[l].M, .C = A[l].C, .K = A[l].K, .wall = A[l].wall,
+                              .W = A[l].W, .g0 = A[l].g0, .e = A[l].e, .h = A[l].h,
+                              .brk = A[l].brk};
+            CHECK(ctx, !pd_mjb_set_lane(b, l, &ln, &err), "lane %d: %s", l, err.msg);
+        }
+        long bad = 0;
+        for (long k = 0; k < NSTEP + RESTART; k++) {
+            if (k == RESTART)
+                for (int l = 1; l < PD_MJB_LANES; l += 2) {
+                    src.sys[l] = B[l];
+                    pd_mjb_lane ln = {.M = B[l].M, .C = B[l].C, .K = B[l].K,
+                                      .wall = B[l].wall, .W = B[l].W, .g0 = B[l].g0,
+                                      .e = B[l].e, .h = B[l].h, .brk = B[l].brk};
+                    pd_mjb_set_lane(b, l, &ln, &err);
+                }
+            pd_mjb_run(b, 1, NULL, NULL);
+            for (int l = 0; l < PD_MJB_LANES; l++) {
+                int restarted = l % 2 && k >= RESTART;
+                long s = restarted ? k - RESTART : k;
+                if (s >= NSTEP)
+                    continue;
+                const double *ref = &alone[l][restarted][4 * s];
+                double got[4] = {b->q[l], b->v[l], src.sys[l].wall ? b->g[l] : 0.0, b->P[l]};
+                bad += memcmp(got, ref, sizeof got) != 0;
+                contacts += got[3] > 0.0;
+                breaks += isfinite(src.sys[l].brk) &&
+                          fabs(b->t[l] - src.sys[l].brk) < 0.5 * src.sys[l].h;
+                compared++;
+            }
+        }
+        CHECK(ctx, bad == 0, "%s: %ld of the lanes' steps differ from pd_mj's",
+              variants[vi].name, bad);
+        for (int l = 0; l < PD_MJB_LANES; l++)
+            CHECK(ctx, pd_mjb_finite(b, l), "%s: lane %d flagged not finite", variants[vi].name,
+                  l);
+        free(b);
+    }
+    CHECK(ctx, compared > 0 && contacts > 100 && breaks > 10,
+          "the comparison must cover impacts and breakpoints (%ld steps, %ld impulses, %ld "
+          "breakpoints)", compared, contacts, breaks);
+}
+
+/* A lane that blows up is flagged, the others are not disturbed. */
+static void test_engine_batch_flags_nonfinite(pd_test_ctx *ctx)
+{
+    pd_mjb *b = aligned_alloc(64, sizeof *b);
+    pd_mj_opts o = pd_mj_default_opts();
+    pd_err err;
+    o.theta = 0.0; /* explicit, unstable for h w0 > 2 */
+    o.allow_unstable = 1;
+    if (!CHECK(ctx, b && !pd_mjb_init(b, &o, NULL, NULL, &err), "init: %s", err.msg)) {
+        free(b);
+        return;
+    }
+    pd_mjb_lane calm = {.M = 1.0, .K = 1.0, .h = 0.01, .brk = INFINITY};
+    pd_mjb_lane wild = {.M = 1.0, .K = 1e6, .h = 0.01, .brk = INFINITY};
+    for (int l = 0; l < PD_MJB_LANES; l++)
+        pd_mjb_set_lane(b, l, l == 3 ? &wild : &calm, &err);
+    b->q[3] = 1e-3; /* a disturbance that grows (the state is the caller's to set) */
+    pd_mjb_run(b, 2000, NULL, NULL);
+    for (int l = 0; l < PD_MJB_LANES; l++)
+        CHECK(ctx, pd_mjb_finite(b, l) == (l != 3), "lane %d: finite %d", l, pd_mjb_finite(b, l));
+    pd_mjb_lane bad = calm;
+    bad.h = -1.0;
+    CHECK(ctx, pd_mjb_set_lane(b, 0, &bad, &err) == PD_EINVAL && strstr(err.msg, "h > 0"),
+          "a negative step is refused: %s", err.msg);
+    o.theta = 0.3;
+    o.allow_unstable = 0;
+    CHECK(ctx, pd_mjb_init(b, &o, NULL, NULL, &err) == PD_EINVAL && strstr(err.msg, "theta"),
+          "theta outside [1/2, 1] is refused: %s", err.msg);
+    free(b);
+}
+
 void suite_engine(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_engine_sdof_closed_form);
@@ -338,4 +553,6 @@ void suite_engine(pd_test_ctx *ctx)
     PD_RUN(ctx, test_engine_failure_is_reported);
     PD_RUN(ctx, test_engine_model_check);
     PD_RUN(ctx, test_engine_no_allocation_in_steps);
+    PD_RUN(ctx, test_engine_batch_matches_scalar);
+    PD_RUN(ctx, test_engine_batch_flags_nonfinite);
 }

@@ -6,6 +6,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "pd_problems.h"
 #include "pd_test.h"
 
 /* |a - b| <= tol max(|a|, |b|), NaN equal to NaN. */
@@ -618,6 +619,124 @@ static void test_spectrum_sweep_callback(pd_test_ctx *ctx)
           "eps 1.5: rc %d (%s), %d calls", rc, err.msg, seen.calls);
 }
 
+/* ---- tasks as a stream: the batch against single runs -------------------- */
+
+/* What a stream returned. */
+typedef struct stream_seen {
+    long ntasks, next, calls, order_breaks;
+    pd_spec_result *r;
+    char (*msg)[256];
+} stream_seen;
+
+static long seen_next(void *ctx)
+{
+    stream_seen *w = ctx;
+    return w->next < w->ntasks ? w->next++ : -1;
+}
+
+static void seen_done(void *ctx, long t, const pd_spec_result *r, const pd_err *err)
+{
+    stream_seen *w = ctx;
+    w->order_breaks += t != w->calls;
+    w->calls++;
+    w->r[t] = *r;
+    snprintf(w->msg[t], sizeof w->msg[t], "%s", r->status ? err->msg : "");
+}
+
+/* Every task of varied sweeps streamed (Moreau-Jean's run many at a time on
+ * the batch's lanes, each lane refilled as its run ends) gives
+ * pd_spec_run_task's figures bit for bit: pulses and the harmonic
+ * excitation, the default step (one h per Pi2 above 1) and a common step,
+ * theta, gamma, damping, restitution 0 and 1, the no-wall twins, a record;
+ * the event-driven and penalty tasks too (run alone); a task that blows up
+ * fails with pd_spec_run_task's status and message. */
+static void test_spectrum_stream_matches_single(pd_test_ctx *ctx)
+{
+    pd_record rec;
+    memset(&rec, 0, sizeof rec);
+    snprintf(rec.name, sizeof rec.name, "two pulses");
+    rec.npts = 801, rec.dt = 0.005;
+    rec.acc = malloc((size_t)rec.npts * sizeof *rec.acc);
+    if (!CHECK(ctx, rec.acc != NULL, "out of memory"))
+        return;
+    for (long k = 0; k < rec.npts; k++) /* two sine cycles of 1 s and 0.5 s, then rest */
+        rec.acc[k] = k < 200 ? -2.0 * sin(PD_TWO_PI * k / 200.0)
+                   : k < 300 ? 1.5 * sin(PD_TWO_PI * (k - 200) / 100.0) : 0.0;
+    pd_record_pulse rp = {.ap = 2.0, .Tp = 1.0};
+    long compared = 0, batched_impacts = 0;
+    for (int v = 0; v < 6; v++) {
+        pd_spectrum s;
+        pd_spec_init(&s);
+        s.pi2_min = 0.1, s.pi2_max = 6, s.npi2 = 23;
+        s.npulse = 2, s.pulse[1] = PD_PULSE_COSINE;
+        s.ndir = 2, s.dir[1] = -1;
+        s.nsize = 2, s.size[0] = 0.01, s.size[1] = 0.3;
+        if (v == 1) { /* a common step, theta and gamma, damping and restitution lists */
+            s.dt_per_Tp = 700;
+            s.opts.theta = 0.8, s.opts.gamma = 0.2;
+            s.nxi = 2, s.xi[0] = 0.0, s.xi[1] = 0.2;
+            s.neps = 2, s.eps[0] = 0.0, s.eps[1] = 1.0;
+        }
+        if (v == 2) { /* the harmonic excitation: a long run, a late window */
+            s.npulse = 1, s.pulse[0] = PD_PULSE_HARMONIC;
+            s.pi2_min = 0.5, s.pi2_max = 4, s.npi2 = 9;
+        }
+        if (v == 3) { /* a record */
+            pd_osc_set_record(&s.base, &rec, &rp, 1.0);
+            s.npulse = 1, s.nap = 1, s.ap[0] = s.base.ap;
+        }
+        if (v == 4) /* the exact method: every task alone */
+            s.opts.method = PD_METHOD_EVENT, s.npi2 = 6;
+        if (v == 5) { /* an explicit scheme that blows up above some Pi2 */
+            s.opts.theta = 0.0, s.opts.allow_unstable = 1;
+            s.dt_per_Tp = 10, s.opts.tend = 30.0, s.npi2 = 12, s.pi2_max = 300;
+        }
+        long n = pd_spec_tasks(&s);
+        stream_seen w = {.ntasks = n};
+        w.r = calloc((size_t)n, sizeof *w.r);
+        w.msg = calloc((size_t)n, sizeof *w.msg);
+        if (!CHECK(ctx, w.r && w.msg, "out of memory")) {
+            free(w.r);
+            free(w.msg);
+            break;
+        }
+        pd_err err;
+        CHECK(ctx, pd_spec_stream(&s, seen_next, seen_done, &w, &err) == PD_OK, "stream: %s",
+              err.msg);
+        CHECK(ctx, w.calls == n, "sweep %d: %ld of %ld tasks reported", v, w.calls, n);
+        long failed = 0, differ = 0;
+        for (long t = 0; t < n; t++) {
+            pd_spec_result a = w.r[t], b;
+            pd_spec_run_task(&s, t, &b, &err);
+            failed += b.status != 0;
+            if (b.status || a.status) {
+                differ += a.status != b.status || strcmp(w.msg[t], err.msg) != 0;
+                continue;
+            }
+            differ += !(same(a.umax, b.umax) && same(a.u_toward, b.u_toward) &&
+                        same(a.u_away, b.u_away) && same(a.contact_time, b.contact_time) &&
+                        same(a.first_impact, b.first_impact) && a.impacts == b.impacts &&
+                        a.steps == b.steps && a.done && signbit(a.u_away) == signbit(b.u_away));
+            if (v < 4)
+                batched_impacts += a.impacts;
+            compared++;
+        }
+        CHECK(ctx, differ == 0, "sweep %d: %ld of %ld tasks differ from single runs", v, differ,
+              n);
+        if (v == 5)
+            CHECK(ctx, failed > 0 && failed < n, "sweep 5 must fail in part (%ld of %ld)",
+                  failed, n);
+        if (v < 4)
+            CHECK(ctx, w.order_breaks > 0, "sweep %d: runs of different lengths end out of "
+                  "order on the lanes (%ld)", v, w.order_breaks);
+        free(w.r);
+        free(w.msg);
+    }
+    CHECK(ctx, compared > 1000 && batched_impacts > 1000, "%ld tasks compared, %ld impacts",
+          compared, batched_impacts);
+    free(rec.acc);
+}
+
 void suite_spectrum(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_spectrum_matches_simulate);
@@ -632,4 +751,5 @@ void suite_spectrum(pd_test_ctx *ctx)
     PD_RUN(ctx, test_spectrum_plot);
     PD_RUN(ctx, test_spectrum_mpi_matches_serial);
     PD_RUN(ctx, test_spectrum_sweep_callback);
+    PD_RUN(ctx, test_spectrum_stream_matches_single);
 }

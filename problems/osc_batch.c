@@ -1,0 +1,326 @@
+/* osc_batch.c — the oscillator's runs from a stream of cases, the
+ * Moreau–Jean ones many at a time (pd_problems.h).
+ *
+ * The Moreau–Jean cases run on the lanes of a pd_mjb (engine/mj_batch.c):
+ * a lane takes the next case as soon as its run ends, so runs of different
+ * lengths keep every lane busy.  A case's figures are pd_osc_simulate's,
+ * bit for bit: the same step (engine/mj1.h), the same excitation values
+ * (pd_osc_shape, once per step for lanes at the same instant of the same
+ * excitation), the same measurements (osc_track.h: the common ones here on
+ * whole vectors of lanes, the rare ones -- a gap closing, an impact -- by
+ * the very function the single run calls). */
+#include <limits.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define OSC_BATCH_OBSERVE pd_osc_batch_observe_base
+#include "osc_batch_lanes.h"
+
+#include "osc_batch.h"
+
+/* Every lane's force at its own clock: the case's pd_osc_shape, computed
+ * once for neighbouring lanes at the same instant of the same excitation
+ * (scaled by dir: pd_osc_shape is odd in dir), 0 past the excitation.  The
+ * left limits ask only the lanes still inside their excitation (the list
+ * `live`, pruned as they leave it). */
+static void lanes_force(const double *t, int side, double *F, void *ctx)
+{
+    osc_batch *ob = ctx;
+    double base = 0.0;
+    int prev = -1; /* the last lane whose base was computed or reused */
+    const vd zero = {0.0};
+    for (int j = 0; j < NV; j++) /* whole vectors: the step reads them so */
+        memcpy(&F[j * VW], &zero, sizeof zero);
+    if (side > 0) { /* a lane's start or its excitation's end: every lane asked */
+        for (int l = 0; l < NL; l++)
+            if (ob->id[l] >= 0)
+                F[l] = pd_osc_shape(&ob->c[l], t[l], side);
+        return;
+    }
+    int n = 0;
+    for (int i = 0; i < ob->nlive; i++) {
+        int l = ob->live[i];
+        if (ob->mjb.iter >= ob->quiet_iter[l]) /* past its excitation from now on */
+            continue;
+        ob->live[n++] = l;
+        if (!(prev == l - 1 && ob->same_prev[l] && t[l] == t[prev]))
+            base = pd_osc_shape(&ob->unit[l], t[l], side);
+        F[l] = ob->dir[l] * base;
+        prev = l;
+    }
+    ob->nlive = n;
+}
+
+/* Cases a and b excite their oscillators by one shape. */
+static int same_shape(const pd_osc *a, const pd_osc *b)
+{
+    if (a->record || b->record)
+        return a->record == b->record && a->Tp == b->Tp && a->rec_ap == b->rec_ap;
+    return a->pulse == b->pulse;
+}
+
+/* Recompute lane l's and lane l + 1's neighbour flags. */
+static void neighbours(osc_batch *ob, int l)
+{
+    for (int k = l; k <= l + 1 && k < NL; k++)
+        ob->same_prev[k] = k > 0 && ob->id[k] >= 0 && ob->id[k - 1] >= 0 &&
+                           same_shape(&ob->unit[k], &ob->unit[k - 1]);
+}
+
+/* The first step count s >= 1 whose end s h lies past cut (the force's
+ * left limit is 0 from there on), 0 when none does. */
+static long cut_step(double cut, double h)
+{
+    if (!(cut < (double)LONG_MAX * h * 0.5))
+        return 0;
+    double est = floor(cut / h);
+    long s = est < 1.0 ? 1 : (long)est;
+    while (s > 1 && (double)(s - 1) * h > cut)
+        s--;
+    while (!((double)s * h > cut))
+        s++;
+    return s;
+}
+
+/* Lane l joins the lanes inside their excitation (kept in increasing
+ * order, so that neighbours meet). */
+static void live_insert(osc_batch *ob, int l)
+{
+    int i = ob->nlive;
+    while (i > 0 && ob->live[i - 1] > l) {
+        ob->live[i] = ob->live[i - 1];
+        i--;
+    }
+    ob->live[i] = l;
+    ob->nlive++;
+}
+
+/* Lane l leaves that list. */
+static void live_remove(osc_batch *ob, int l)
+{
+    int n = 0;
+    for (int i = 0; i < ob->nlive; i++)
+        if (ob->live[i] != l)
+            ob->live[n++] = ob->live[i];
+    ob->nlive = n;
+}
+
+/* Lane l starts case (c, o): its system, its excitation, and the
+ * measurements of its state at rest (as the single run's first
+ * observation). */
+static int lane_start(osc_batch *ob, int l, long id, const pd_osc *c, const pd_run_opts *o,
+                      pd_err *err)
+{
+    double h = PD_TWO_PI * (o->dt / c->Tp), end = pd_osc_shape_end(c);
+    pd_mjb_lane ln = {.M = 1.0,
+                      .C = 2.0 * c->xi * c->Pi2,
+                      .K = c->Pi2 * c->Pi2,
+                      .wall = !o->no_wall,
+                      .W = -1.0,
+                      .g0 = c->Pi3,
+                      .e = c->eps,
+                      .h = h,
+                      .brk = isfinite(end) ? end : INFINITY};
+    ob->id[l] = id;
+    ob->c[l] = *c;
+    ob->unit[l] = *c;
+    ob->unit[l].dir = 1;
+    ob->o[l] = *o;
+    ob->dir[l] = (double)c->dir;
+    ob->nsteps[l] = pd_steps_for(o->tend, o->dt);
+    long sc = cut_step(pd_shape_cut(end, -1), h), it = ob->mjb.iter;
+    ob->quiet_iter[l] = sc > 0 && sc - 1 <= LONG_MAX - it ? it + sc - 1 : LONG_MAX;
+    live_insert(ob, l);
+    ob->cpu[l] = 0.0;
+    neighbours(ob, l);
+    int rc = pd_mjb_set_lane(&ob->mjb, l, &ln, err);
+    if (rc)
+        return rc;
+    pd_osc_track *tr = &ob->rare[l];
+    pd_osc_track_init(tr, c, h, pd_osc_wp(c) * pd_osc_measure_start(c, o->tend));
+    pd_osc_track_step(tr, 0, 0.0, 0.0, 0.0, 0.0);
+    rare_store(ob, l);
+    ob->Pi3[l] = tr->Pi3;
+    ob->meas_from[l] = tr->tau_measure - 0.5 * tr->h;
+    return PD_OK;
+}
+
+/* Lane l without a case. */
+static void lane_idle(osc_batch *ob, int l)
+{
+    static const pd_mjb_lane idle = {.M = 1.0, .h = 1.0, .brk = INFINITY};
+    ob->id[l] = -1;
+    live_remove(ob, l);
+    neighbours(ob, l);
+    pd_mjb_set_lane(&ob->mjb, l, &idle, NULL);
+    ob->Pi3[l] = 1.0; /* a gap that never closes */
+    ob->meas_from[l] = HUGE_VAL;
+    ob->prev_x[l] = ob->prev_P[l] = 0.0;
+}
+
+/* The result of lane l's finished run, as pd_osc_simulate gives it. */
+static void lane_result(osc_batch *ob, int l, pd_osc_result *res)
+{
+    pd_osc_track *tr = &ob->rare[l];
+    const pd_run_opts *o = &ob->o[l];
+    rare_load(ob, l);
+    pd_osc_track_result(tr, &ob->c[l], o->dt, ob->nsteps[l], res);
+    res->tend = o->tend;
+    res->theta = o->theta;
+    res->gamma = o->gamma;
+    res->kernel = "batched";
+    res->cpu_s = ob->cpu[l];
+}
+
+int pd_osc_batchable(const pd_osc *c, const pd_run_opts *o)
+{
+    (void)c;
+    return o->method == PD_METHOD_MOREAU && o->kernel == PD_KERNEL_AUTO && !o->on_lcp;
+}
+
+/* The measurements for this processor (osc_batch_lanes.h, as for the
+ * engine's step). */
+static pd_mjb_observer observe_for_cpu(void)
+{
+#if PD_MJB_X86_VARIANTS
+    if (__builtin_cpu_supports("x86-64-v4"))
+        return pd_osc_batch_observe_x86v4;
+    if (__builtin_cpu_supports("x86-64-v3"))
+        return pd_osc_batch_observe_x86v3;
+#endif
+    return pd_osc_batch_observe_base;
+}
+
+/* The stream's state: the source, the batch (allocated on the first
+ * batchable case) and its options. */
+typedef struct stream {
+    pd_osc_stream_next next;
+    pd_osc_stream_done done;
+    void *ctx;
+    osc_batch *ob;
+    pd_run_opts batch_opts; /* theta, gamma, allow_unstable of the batch */
+    int exhausted;
+} stream;
+
+/* A case run alone, reported. */
+static void run_single(stream *s, long id, const pd_osc *c, const pd_run_opts *o)
+{
+    pd_osc_result res;
+    pd_err e;
+    int rc = pd_osc_run(c, o, NULL, NULL, &res, &e);
+    s->done(s->ctx, id, &res, rc, &e);
+}
+
+/* The batch joins runs of the same theta, gamma and stability choice. */
+static int fits_batch(const stream *s, const pd_run_opts *o)
+{
+    const pd_run_opts *b = &s->batch_opts;
+    return o->theta == b->theta && o->gamma == b->gamma && o->allow_unstable == b->allow_unstable;
+}
+
+/* The batch, allocated and set up for the options of its first case:
+ * PD_OK, or a status when out of memory or the options are refused. */
+static int batch_open(stream *s, const pd_run_opts *o, pd_err *err)
+{
+    pd_mj_opts mo = pd_mj_default_opts();
+    s->ob = aligned_alloc(64, (sizeof *s->ob + 63) / 64 * 64);
+    if (!s->ob)
+        return pd_err_set(err, PD_ENOMEM, "out of memory for a batch of %d runs", NL);
+    memset(s->ob, 0, sizeof *s->ob);
+    mo.theta = o->theta;
+    mo.gamma = o->gamma;
+    mo.allow_unstable = o->allow_unstable;
+    s->ob->observe = observe_for_cpu();
+    int rc = pd_mjb_init(&s->ob->mjb, &mo, lanes_force, s->ob, err);
+    if (rc) {
+        free(s->ob);
+        s->ob = NULL;
+        return rc;
+    }
+    s->batch_opts = *o;
+    for (int l = 0; l < NL; l++)
+        lane_idle(s->ob, l);
+    return PD_OK;
+}
+
+/* Lane l takes the next case the batch can run; the others run alone as
+ * they come.  Leaves it idle when the source is exhausted. */
+static void refill(stream *s, int l)
+{
+    pd_osc c;
+    pd_run_opts o;
+    long id;
+    pd_err e;
+    while (!s->exhausted) {
+        if (!s->next(s->ctx, &c, &o, &id)) {
+            s->exhausted = 1;
+            break;
+        }
+        pd_run_opts ro;
+        if (!pd_osc_batchable(&c, &o) || pd_osc_resolve_opts(&c, &o, &ro, NULL) ||
+            (!s->ob && batch_open(s, &ro, &e)) || !fits_batch(s, &ro) ||
+            lane_start(s->ob, l, id, &c, &ro, &e)) {
+            if (s->ob && s->ob->id[l] >= 0)
+                lane_idle(s->ob, l);
+            run_single(s, id, &c, &o);
+            continue;
+        }
+        s->ob->busy++;
+        return;
+    }
+    if (s->ob)
+        lane_idle(s->ob, l);
+}
+
+/* Lane l's run ended: reported (a run that stopped being finite is run
+ * again alone, which names the step), and the lane refilled. */
+static void finish(stream *s, int l)
+{
+    osc_batch *ob = s->ob;
+    long id = ob->id[l];
+    ob->busy--;
+    if (!pd_mjb_finite(&ob->mjb, l)) {
+        pd_osc c = ob->c[l];
+        pd_run_opts o = ob->o[l];
+        lane_idle(ob, l);
+        run_single(s, id, &c, &o);
+    } else {
+        pd_osc_result res;
+        pd_err e;
+        lane_result(ob, l, &res);
+        pd_err_clear(&e);
+        lane_idle(ob, l);
+        s->done(s->ctx, id, &res, PD_OK, &e);
+    }
+    refill(s, l);
+}
+
+int pd_osc_run_stream(pd_osc_stream_next next, pd_osc_stream_done done, void *ctx, pd_err *err)
+{
+    stream s = {.next = next, .done = done, .ctx = ctx};
+    pd_err_clear(err);
+    /* fill the lanes (the batch opens with its first case) */
+    for (int l = 0; l < NL && !s.exhausted; l++)
+        refill(&s, l);
+    while (s.ob && s.ob->busy > 0) {
+        osc_batch *ob = s.ob;
+        long k = -1; /* steps until the first lane ends */
+        for (int l = 0; l < NL; l++)
+            if (ob->id[l] >= 0) {
+                long left = ob->nsteps[l] - (long)ob->mjb.steps[l];
+                k = k < 0 || left < k ? left : k;
+            }
+        double cpu0 = pd_cpu_seconds();
+        pd_mjb_run(&ob->mjb, k, ob->observe, ob);
+        double share = (pd_cpu_seconds() - cpu0) / ob->busy;
+        for (int l = 0; l < NL; l++)
+            if (ob->id[l] >= 0)
+                ob->cpu[l] += share;
+        for (int l = 0; l < NL; l++)
+            if (ob->id[l] >= 0 && (long)ob->mjb.steps[l] >= ob->nsteps[l])
+                finish(&s, l);
+    }
+    free(s.ob);
+    return PD_OK;
+}

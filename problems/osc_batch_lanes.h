@@ -1,0 +1,76 @@
+/* osc_batch_lanes.h — the batch's measurements after each step, a text
+ * compiled once per instruction set under the name OSC_BATCH_OBSERVE:
+ * osc_batch.c (the baseline), osc_batch_x86v3.c (AVX2), osc_batch_x86v4.c
+ * (AVX-512).  Every variant computes pd_osc_track_common's numbers, lane
+ * for lane. */
+#include "osc_batch.h"
+
+/* One vector of lanes after a step: pd_osc_track_common's numbers lane for
+ * lane; pd_osc_track_events for the lanes that need it (rare: a gap
+ * closing, an impact begun); then pd_osc_track_shift's. */
+static inline void track_vector(osc_batch *ob, int l)
+{
+    const vd zero = {0.0}, one = zero + 1.0;
+    const vm sign = (vm)(-zero); /* -0.0: the sign bit */
+    vd x, v, P, t, Pi3, mf, xmax, xto, xaw, mg, Pmax, cont, px, pP, pv;
+#define LOAD(var, arr) memcpy(&var, &(arr)[l], sizeof var)
+#define STORE(arr, var) memcpy(&(arr)[l], &var, sizeof var)
+    LOAD(x, ob->mjb.q);
+    LOAD(v, ob->mjb.v);
+    LOAD(P, ob->mjb.P);
+    LOAD(t, ob->mjb.t);
+    LOAD(Pi3, ob->Pi3);
+    LOAD(mf, ob->meas_from);
+    LOAD(xmax, ob->xmax);
+    LOAD(xto, ob->xtoward);
+    LOAD(xaw, ob->xaway);
+    LOAD(mg, ob->min_gap);
+    LOAD(Pmax, ob->Pmax);
+    LOAD(cont, ob->contact);
+    LOAD(px, ob->prev_x);
+    LOAD(pP, ob->prev_P);
+    LOAD(pv, ob->prev_v);
+    vd gap = Pi3 - x, ax = (vd)((vm)x & ~sign), nx = -x;
+    vm meas = t >= mf, pos = P > zero;
+    xmax = SELECT(meas, SELECT(xmax > ax, xmax, ax), xmax);
+    xto = SELECT(meas, SELECT(xto > x, xto, x), xto);
+    xaw = SELECT(meas, SELECT(xaw > nx, xaw, nx), xaw);
+    cont = cont + (vd)(pos & (vm)one);
+    Pmax = SELECT(pos, SELECT(Pmax > P, Pmax, P), Pmax);
+    mg = SELECT(mg < gap, mg, gap);
+    vd gprev = Pi3 - px;
+    /* every lane has taken a step: step > 0 */
+    vm due = ((gprev > zero) & ((gap <= zero) | pos)) | (pos & (pP == zero));
+    STORE(ob->xmax, xmax);
+    STORE(ob->xtoward, xto);
+    STORE(ob->xaway, xaw);
+    STORE(ob->min_gap, mg);
+    STORE(ob->Pmax, Pmax);
+    STORE(ob->contact, cont);
+    long long hit = 0;
+    for (int i = 0; i < VW; i++)
+        hit |= due[i];
+    if (hit)
+        for (int i = 0; i < VW; i++)
+            if (due[i] && ob->id[l + i] >= 0) {
+                rare_load(ob, l + i);
+                pd_osc_track_events(&ob->rare[l + i], (long)ob->mjb.steps[l + i],
+                                    ob->mjb.t[l + i], x[i], v[i], P[i]);
+            }
+    STORE(ob->prev2_v, pv);
+    STORE(ob->prev_x, x);
+    STORE(ob->prev_v, v);
+    STORE(ob->prev_P, P);
+#undef LOAD
+#undef STORE
+}
+
+/* After every step, every vector of lanes. */
+int OSC_BATCH_OBSERVE(const pd_mjb *b, void *ctx)
+{
+    osc_batch *ob = ctx;
+    (void)b;
+    for (int j = 0; j < NV; j++)
+        track_vector(ob, j * VW);
+    return 0;
+}
