@@ -25,7 +25,9 @@ const char pd_cli_case_help[] =
     "                   masses, periods alternating T0 and R T0 (--chain-ratio R [1.5]),\n"
     "                   every gap --gap/--Pi3, every restitution --eps\n"
     "scheme:\n"
-    "  --method moreau|event|penalty [moreau]\n"
+    "  --method moreau|event|penalty|auto [auto: event for one oscillator when its scan fits,\n"
+    "           moreau for scenes; a flag only one method takes (--dt, --theta, --kc, ...)\n"
+    "           chooses that method]\n"
     "  --dt H [min(Tp,T0)/2000]   --theta T [0.5]   --gamma G [0.5]   --tend T [Tp+2 T0;\n"
     "         harmonic: transient + window, see docs/scheme.md]\n"
     "  --allow-unstable  accept theta outside [1/2, 1]\n"
@@ -123,6 +125,20 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
                        {"--atol", &a->opts.pen.atol, NULL, 0},
                        {"--chain-ratio", &a->chain_ratio, NULL, 1},
                        {"--scale", &a->scale, &a->have_scale, 0}};
+    /* flags that only one method takes choose it, unless --method says another */
+    static const struct {
+        const char *flag;
+        pd_method method;
+    } only[] = {{"--dt", PD_METHOD_MOREAU},        {"--theta", PD_METHOD_MOREAU},
+                {"--gamma", PD_METHOD_MOREAU},     {"--allow-unstable", PD_METHOD_MOREAU},
+                {"--kernel", PD_METHOD_MOREAU},    {"--factor", PD_METHOD_MOREAU},
+                {"--lcp-solver", PD_METHOD_MOREAU}, {"--no-accumulation", PD_METHOD_EVENT},
+                {"--kc", PD_METHOD_PENALTY},       {"--kc-abs", PD_METHOD_PENALTY},
+                {"--rtol", PD_METHOD_PENALTY},     {"--atol", PD_METHOD_PENALTY},
+                {"--contact", PD_METHOD_PENALTY},  {"--stepper", PD_METHOD_PENALTY}};
+    for (size_t n = 0; n < sizeof only / sizeof only[0]; n++)
+        if (!strcmp(f, only[n].flag))
+            pd_cli_case_implies(a, f, only[n].method);
     for (size_t n = 0; n < sizeof nums / sizeof nums[0]; n++)
         if (!strcmp(f, nums[n].flag)) {
             if ((rc = pd_cli_double(f, val, &x)))
@@ -148,9 +164,11 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
         rc = named(f, val, pd_pulse_parse(val, &a->c.pulse) != PD_OK, "sine, cosine, harmonic");
     else if (!strcmp(f, "--dir"))
         rc = named(f, val, pd_dir_parse(val, &a->c.dir) != PD_OK, "normal, reverse");
-    else if (!strcmp(f, "--method"))
+    else if (!strcmp(f, "--method")) {
         rc = named(f, val, pd_method_parse(val, &a->opts.method) != PD_OK,
-                   "moreau, event, penalty");
+                   "moreau, event, penalty, auto");
+        a->method_by = a->opts.method == PD_METHOD_AUTO ? NULL : f;
+    }
     else if (!strcmp(f, "--contact")) {
         rc = named(f, val, !val || (strcmp(val, "kelvin") && strcmp(val, "hertz")), "kelvin, hertz");
         if (rc == 1)
@@ -356,10 +374,53 @@ static int case_record(pd_cli_case *a)
     return rc;
 }
 
+void pd_cli_case_implies(pd_cli_case *a, const char *flag, pd_method method)
+{
+    if (!a->implies[method])
+        a->implies[method] = flag;
+}
+
+/* The method when --method was not given: the one that the flags given
+ * belong to (two methods' flags together need --method), else the
+ * default, left PD_METHOD_AUTO for the library to resolve; 0 or 2. */
+static int case_method(pd_cli_case *a)
+{
+    const char *by = NULL;
+    if (a->method_by || a->methods_listed)
+        return 0;
+    for (int m = 0; m < 3; m++) {
+        if (!a->implies[m])
+            continue;
+        if (by)
+            return pd_cli_usage_error("%s and %s belong to different methods (%s, %s): give "
+                                      "--method", by, a->implies[m],
+                                      pd_method_name(a->opts.method), pd_method_name((pd_method)m));
+        by = a->implies[m];
+        a->opts.method = (pd_method)m;
+    }
+    a->method_by = by;
+    return 0;
+}
+
+pd_method pd_cli_case_method(const pd_cli_case *a)
+{
+    if (a->opts.method == PD_METHOD_AUTO && pd_cli_is_scene(a))
+        return PD_METHOD_MOREAU; /* as pd_scene_resolve_opts */
+    return a->opts.method;
+}
+
+const char *pd_cli_method_by(const pd_cli_case *a)
+{
+    return a->method_by ? a->method_by : "default";
+}
+
 static int case_finish(pd_cli_case *a)
 {
     int rc;
     pd_err err;
+    if ((rc = case_method(a)))
+        return rc;
+    a->opts.method = pd_cli_case_method(a); /* the oscillator's resolves below */
     if (a->scene_path && a->chain)
         return pd_cli_usage_error("--scene and --chain are alternatives: give one");
     if (a->scene_path && a->model_flag)

@@ -138,6 +138,7 @@ int pd_cmd_compare(int argc, char **argv)
     pd_cli_case k;
     int json = 0, want[3] = {1, 0, 0}, rc, status = 0;
     pd_cli_case_init(&k);
+    k.methods_listed = 1;
     if (pd_cli_help(argc, argv, compare_usage, 1))
         return 0;
     for (int i = 1; i < argc; i++) {

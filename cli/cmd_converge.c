@@ -146,6 +146,7 @@ static int parse_args(conv_args *a, int argc, char **argv)
     int rc;
     memset(a, 0, sizeof *a);
     pd_cli_case_init(&a->k);
+    a->k.methods_listed = 1;
     a->want_moreau = 1;
     for (int i = 1; i < argc; i++) {
         const char *f = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;

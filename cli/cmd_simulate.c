@@ -11,7 +11,7 @@
 #include "pd_scene_out.h"
 
 static const char simulate_usage[] =
-    "usage: pound simulate [model flags | --scene F.json | --chain N] [--method moreau|event|penalty]\n"
+    "usage: pound simulate [model flags | --scene F.json | --chain N] [--method moreau|event|penalty|auto]\n"
     "                      [--dt H] [--theta T] [--tend T] [-o FILE.h5|FILE.csv] [--every K]\n"
     "                      [--plot FILE.png] [--dump-lcp F.h5] [--json]\n"
     "  -o FILE     the histories (HDF5 or CSV by extension), every input and result as\n"
@@ -57,6 +57,8 @@ static int parse_args(sim_args *a, int argc, char **argv)
             if (!val)
                 return pd_cli_usage_error("%s needs a file name", f);
             *(!strcmp(f, "-o") ? &a->out : !strcmp(f, "--plot") ? &a->plot : &a->dump) = val;
+            if (!strcmp(f, "--dump-lcp"))
+                pd_cli_case_implies(&a->k, f, PD_METHOD_MOREAU);
             i++;
         } else if (!strcmp(f, "--every")) {
             if ((rc = pd_cli_int(f, val, &n)))
@@ -81,9 +83,13 @@ static int parse_args(sim_args *a, int argc, char **argv)
     const char *flags[] = {"-o", "--plot", "--dump-lcp"}, *paths[] = {a->out, a->plot, a->dump};
     if (pd_output_check_distinct(3, flags, paths, &err))
         return pd_cli_usage_error("%s", err.msg);
-    if (a->dump && a->k.opts.method != PD_METHOD_MOREAU)
+    if ((rc = pd_cli_case_finish(&a->k)))
+        return rc;
+    if (a->dump && a->k.opts.method != PD_METHOD_MOREAU) {
+        pd_cli_case_free(&a->k);
         return pd_cli_usage_error("--dump-lcp: the LCPs dumped are Moreau-Jean's (--method moreau)");
-    return pd_cli_case_finish(&a->k);
+    }
+    return 0;
 }
 
 /* About how many bytes -o writes for rows of width values (CSV: %.17g
@@ -169,6 +175,22 @@ static int record(const pd_osc_sample *s, void *ctx)
     return pd_table_row(o->file, row) ? 1 : 0;
 }
 
+/* Which method ran, and why. */
+static void method_line(const pd_cli_case *k)
+{
+    const char *m = pd_method_name(k->opts.method);
+    if (k->method_by)
+        printf("  method    = %s (%s)\n", m, k->method_by);
+    else if (pd_cli_is_scene(k))
+        printf("  method    = %s (the default for scenes; --method event|penalty for the "
+               "others)\n", m);
+    else
+        printf("  method    = %s (the default for one oscillator: %s; --method moreau|event|"
+               "penalty chooses)\n", m,
+               k->opts.method == PD_METHOD_EVENT ? "exact and fastest"
+                                                 : "the exact reference's scan is over budget");
+}
+
 static void print_json(const sim_args *a, const pd_osc_summary *s)
 {
     pd_json js;
@@ -176,6 +198,7 @@ static void print_json(const sim_args *a, const pd_osc_summary *s)
     pd_json_init(&js, stdout);
     pd_json_begin_object(&js, NULL);
     pd_json_str(&js, "method", pd_method_name(a->k.opts.method));
+    pd_json_str(&js, "method_by", pd_cli_method_by(&a->k));
     pd_json_num(&js, "umax", s->r.umax);
     pd_json_num(&js, "Pi1", s->Pi1);
     pd_json_num(&js, "u_toward", s->r.u_toward);
@@ -237,6 +260,7 @@ static void print_text(const sim_args *a, const pd_osc_summary *s)
                a->k.opts.method == PD_METHOD_EVENT ? "event-driven reference" : "penalty",
                s->r.kernel, s->r.steps, a->k.opts.method == PD_METHOD_EVENT ? "events" : "steps",
                s->r.tend);
+    method_line(&a->k);
     printf("  umax      = %.6g m   (Pi1 = %.6g)\n", s->r.umax, s->Pi1);
     printf("  toward    = %.6g m,  away = %.6g m\n", s->r.u_toward, s->r.u_away);
     printf("  umax_free = %.6g m   gamma = umax/umax_free = %.4g,  chi = gap/umax_free = %.4g\n",
@@ -376,13 +400,14 @@ static const char *side_name(const pd_scene *sc, int s)
     return s == PD_WALL ? "wall" : sc->st[s].name;
 }
 
-static void scene_json(const pd_scene *sc, const pd_scene_summary *s)
+static void scene_json(const sim_args *a, const pd_scene *sc, const pd_scene_summary *s)
 {
     pd_json js;
     const pd_scene_result *r = &s->r;
     pd_json_init(&js, stdout);
     pd_json_begin_object(&js, NULL);
     pd_json_str(&js, "method", r->method);
+    pd_json_str(&js, "method_by", pd_cli_method_by(&a->k));
     pd_json_int(&js, "steps", r->steps);
     pd_json_num(&js, "cpu_s", s->cpu_s);
     pd_json_num(&js, "cpu_s_run", r->cpu_s);
@@ -468,6 +493,7 @@ static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_sum
                a->k.opts.method == PD_METHOD_EVENT ? "event-driven reference" : "penalty",
                r->kernel, r->steps, a->k.opts.method == PD_METHOD_EVENT ? "events" : "steps",
                r->tend);
+    method_line(&a->k);
     printf("  %-12s %7s %9s %12s %12s %10s %8s\n", "structure", "storey", "T0 [s]", "umax [m]",
            "drift [m]", "Pi1", "gamma");
     for (int k = 0; k < sc->nstruct && k < TEXT_MAX_STRUCTURES; k++) {
@@ -544,7 +570,7 @@ static int simulate_scene(sim_args *a)
     if ((status = dump_finish(dump)))
         goto done;
     if (a->json)
-        scene_json(sc, &s);
+        scene_json(a, sc, &s);
     else
         scene_text(a, sc, &s);
 done:

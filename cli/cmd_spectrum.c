@@ -13,7 +13,7 @@
 static const char spectrum_usage[] =
     "usage: pound spectrum --Pi2 MIN:MAX:N [--linear] [model flags without --T0/--Pi2]\n"
     "                      [--Pi3 LIST | --gap LIST] [--eps LIST] [--xi LIST] [--pulse LIST]\n"
-    "                      [--dir LIST] [--ap LIST] [--method moreau|event|penalty]\n"
+    "                      [--dir LIST] [--ap LIST] [--method moreau|event|penalty|auto]\n"
     "                      [--dt H | --dt-per-Tp N] [-o FILE.h5|FILE.csv] [--plot FILE.png]\n"
     "                      [--json] [--resume] [--threads K]\n"
     "  --Pi2 MIN:MAX:N  N values of Pi2 = Tp/T0, log-spaced (--linear: equal steps)\n"
@@ -188,6 +188,7 @@ static int own_flag(spec_args *a, int argc, char **argv, int *i)
         *(!strcmp(f, "-o") ? &a->out : &a->plot) = val;
         rc = 0;
     } else if (!strcmp(f, "--dt-per-Tp")) {
+        pd_cli_case_implies(&a->k, f, PD_METHOD_MOREAU);
         if (!(rc = pd_cli_double(f, val, &a->s.dt_per_Tp)) && !(a->s.dt_per_Tp > 0.0))
             rc = pd_cli_usage_error("--dt-per-Tp: must be > 0 (got %g)", a->s.dt_per_Tp);
     } else if (!strcmp(f, "--ref")) {
@@ -342,6 +343,11 @@ static int check_args(spec_args *a)
             s->ap[0] = s->base.ap;
     }
     s->opts = a->k.opts; /* dt and tend stay 0 (per point) unless given */
+    /* the method given or implied by the flags (as the checked case took
+     * it), else one for the whole sweep */
+    a->k.method_by = checked.method_by;
+    s->opts.method = checked.method_by ? checked.opts.method : PD_METHOD_AUTO;
+    pd_spec_resolve_method(s);
     if ((rc = check_corners(a)))
         return rc;
     if (pd_spec_validate(s, &err))
@@ -442,7 +448,8 @@ static int sweep(spec_args *a, int rank, int size, double wall0)
                        .stop_after = a->stop_after,
                        .rank = rank,
                        .size = size};
-    pd_spec_totals t = {.runs = pd_spec_tasks(&a->s),
+    pd_spec_totals t = {.method_by = pd_cli_method_by(&a->k),
+                        .runs = pd_spec_tasks(&a->s),
                         .threads = pd_spec_threads(a->threads),
                         .ranks = size};
     pd_spec_result *res = calloc((size_t)t.runs, sizeof *res);

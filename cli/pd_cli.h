@@ -43,6 +43,12 @@ typedef struct pd_cli_case {
     pd_record_format rec_format; /* --record-format */
     pd_record_units rec_units;   /* --units (text records) */
     pd_cli_record *record;  /* read by pd_cli_case_finish; released by pd_cli_case_free */
+    /* the method: --method's, else the one the flags given belong to (a
+     * flag of one method's only: --theta, --kc, ...), else the default;
+     * method_by names the flag that chose it (NULL: the default) */
+    const char *method_by;
+    const char *implies[4]; /* per pd_method: the first flag given that only it takes */
+    int methods_listed;     /* compare, converge: --methods chooses per run */
 } pd_cli_case;
 
 extern const char pd_cli_case_help[];
@@ -52,6 +58,15 @@ void pd_cli_case_init(pd_cli_case *a);
  * work of the run) finite and bounded: 0, or 2 with one line naming the
  * flag that made them overflow (spectrum checks its sweep's corners). */
 int pd_cli_case_check_derived(const pd_cli_case *a);
+
+/* Flag f is one method's only: the method, unless --method says another. */
+void pd_cli_case_implies(pd_cli_case *a, const char *flag, pd_method method);
+/* The method a run of the checked case takes (scenes: Moreau-Jean by
+ * default; the oscillator's is resolved by pd_cli_case_finish). */
+pd_method pd_cli_case_method(const pd_cli_case *a);
+/* How the method was chosen, for the output: "--method", the flag that
+ * implied it, or "default". */
+const char *pd_cli_method_by(const pd_cli_case *a);
 
 /* Consume the flag at argv[*i] (and its value): 1 if it was a case flag,
  * 0 if not (the caller handles it), 2 after printing an error. */

@@ -121,6 +121,7 @@ typedef struct pd_spec_totals {
     double cpu_s, wall_s, steps; /* steps: of every run, twins included */
     long runs, resumed;
     int threads, ranks;
+    const char *method_by; /* how the method was chosen: "default", or the flag */
 } pd_spec_totals;
 void pd_spec_print_json(const pd_spectrum *s, const pd_spec_row *rows, const pd_spec_totals *t);
 void pd_spec_print_text(const pd_spectrum *s, const pd_spec_row *rows, const pd_spec_totals *t);

@@ -345,6 +345,8 @@ void pd_spec_print_json(const pd_spectrum *s, const pd_spec_row *rows, const pd_
     for (long p = 0; p < pd_spec_points(s); p++)
         json_point(&js, s, &rows[p]);
     pd_json_end_array(&js);
+    pd_json_str(&js, "method", pd_method_name(s->opts.method));
+    pd_json_str(&js, "method_by", t->method_by);
     pd_json_int(&js, "curves", pd_spec_curves(s));
     pd_json_int(&js, "runs", t->runs);
     pd_json_int(&js, "twins", pd_spec_twins(s));
@@ -386,6 +388,13 @@ void pd_spec_print_text(const pd_spectrum *s, const pd_spec_row *rows, const pd_
            "max gamma", "impacting");
     for (long c = 0; c < pd_spec_curves(s); c++)
         text_curve(s, rows + c * s->npi2, c);
+    if (!strcmp(t->method_by, "default"))
+        printf("  method %s: the default for one oscillator (%s); --method moreau|event|penalty "
+               "chooses\n", pd_method_name(s->opts.method),
+               s->opts.method == PD_METHOD_EVENT ? "exact and fastest"
+                                                 : "the exact reference's scan is over budget");
+    else
+        printf("  method %s (%s)\n", pd_method_name(s->opts.method), t->method_by);
     printf("  %ld runs (%ld no-wall twins shared across gaps and eps, %ld resumed), "
            "cpu %.3g s, wall %.3g s, %d thread(s) x %d rank(s)\n",
            t->runs, pd_spec_twins(s), t->resumed, t->cpu_s, t->wall_s, t->threads, t->ranks);

@@ -141,7 +141,16 @@ int pd_osc_resolve_opts(const pd_osc *c, const pd_run_opts *in, pd_run_opts *out
     if (!(out->tend / out->dt <= PD_MAX_STEPS))
         return pd_err_set(err, PD_EINVAL, "dt: tend / dt = %g steps is too many (at most %.0e)",
                           out->tend / out->dt, PD_MAX_STEPS);
+    out->method = pd_osc_method(c, out);
     return PD_OK;
+}
+
+pd_method pd_osc_method(const pd_osc *c, const pd_run_opts *o)
+{
+    if (o->method != PD_METHOD_AUTO)
+        return o->method;
+    double tend = o->tend > 0.0 ? o->tend : pd_osc_default_tend(c);
+    return pd_osc_scan_points(c, tend) <= PD_OSC_MAX_SCAN ? PD_METHOD_EVENT : PD_METHOD_MOREAU;
 }
 
 double pd_osc_default_dt(const pd_osc *c)
@@ -484,10 +493,11 @@ int pd_osc_free_first_contact(const pd_osc *c, double tmax, double *t, double *v
 int pd_osc_run(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
                pd_osc_result *res, pd_err *err)
 {
-    switch (opts ? opts->method : PD_METHOD_MOREAU) {
-    case PD_METHOD_EVENT: return pd_osc_reference(c, opts, sampler, ctx, res, err);
-    case PD_METHOD_PENALTY: return pd_osc_penalty(c, opts, sampler, ctx, res, err);
-    default: return pd_osc_simulate(c, opts, sampler, ctx, res, err);
+    pd_run_opts o = opts ? *opts : pd_run_default_opts();
+    switch (pd_osc_method(c, &o)) {
+    case PD_METHOD_EVENT: return pd_osc_reference(c, &o, sampler, ctx, res, err);
+    case PD_METHOD_PENALTY: return pd_osc_penalty(c, &o, sampler, ctx, res, err);
+    default: return pd_osc_simulate(c, &o, sampler, ctx, res, err);
     }
 }
 

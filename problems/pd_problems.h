@@ -150,9 +150,19 @@ PD_API double pd_record_one_cycle(const pd_record_pulse *p, double t);
 
 /* ==== how a run is made ====================================================== */
 
-typedef enum { PD_METHOD_MOREAU = 0, PD_METHOD_EVENT = 1, PD_METHOD_PENALTY = 2 } pd_method;
+/* PD_METHOD_AUTO, the default, is the exact event-driven reference for
+ * the one-wall oscillator (pulses and records) when its scan fits its
+ * budget (PD_OSC_MAX_SCAN), Moreau-Jean otherwise and for scenes: the
+ * resolution of the options (pd_osc_resolve_opts, pd_scene_resolve_opts,
+ * pd_spec_resolve_method) makes it one of the three. */
+typedef enum {
+    PD_METHOD_MOREAU = 0,
+    PD_METHOD_EVENT = 1,
+    PD_METHOD_PENALTY = 2,
+    PD_METHOD_AUTO = 3
+} pd_method;
 
-/* "moreau", "event", "penalty"; parse: PD_OK or PD_EINVAL. */
+/* "moreau", "event", "penalty", "auto"; parse: PD_OK or PD_EINVAL. */
 PD_API const char *pd_method_name(pd_method method);
 PD_API int pd_method_parse(const char *name, pd_method *method);
 
@@ -189,7 +199,9 @@ typedef struct pd_run_opts {
     void *on_lcp_ctx;
 } pd_run_opts;
 
-/* Moreau–Jean, dt and tend derived, theta = gamma = 1/2, automatic kernel,
+/* The automatic method (PD_METHOD_AUTO: exact for one oscillator,
+ * Moreau-Jean for scenes), dt and tend derived, theta = gamma = 1/2 for
+ * Moreau-Jean with its automatic kernel,
  * factor and LCP solver, accumulations jumped, Kelvin-Voigt with the
  * derived stiffness (kc_mult = 0: the oscillator's resolves the gap,
  * docs/methods.md; scenes 1e4 w0^2), rtol 1e-10, atol 1e-12, rk8pd. */
@@ -298,7 +310,13 @@ typedef struct pd_osc_result {
     const char *kernel;   /* "scalar", "general", "event", or the penalty stepper */
 } pd_osc_result;
 
-/* Run the case with the method of opts (sampler may be NULL). */
+/* The method a run of (c, o) takes: o's, or for PD_METHOD_AUTO the exact
+ * event-driven reference when its scan of the run fits PD_OSC_MAX_SCAN,
+ * else Moreau-Jean. */
+PD_API pd_method pd_osc_method(const pd_osc *c, const pd_run_opts *o);
+
+/* Run the case with the method of opts (sampler may be NULL; opts NULL:
+ * the defaults). */
 PD_API int pd_osc_run(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
                       pd_osc_result *res, pd_err *err);
 
@@ -707,6 +725,10 @@ PD_API long pd_spec_twin_of(const pd_spectrum *s, long task);
 PD_API int pd_spec_case(const pd_spectrum *s, long task, pd_osc *c, pd_run_opts *o, pd_err *err);
 /* Check every point's case: PD_OK or PD_EINVAL with the first bad one. */
 PD_API int pd_spec_validate(const pd_spectrum *s, pd_err *err);
+/* One method for the whole sweep: PD_METHOD_AUTO becomes the exact
+ * event-driven reference when every run's scan fits its budget
+ * (pd_osc_method), else Moreau-Jean for every run. */
+PD_API void pd_spec_resolve_method(pd_spectrum *s);
 /* Run one task into r (r->status and err say why it failed). */
 PD_API void pd_spec_run_task(const pd_spectrum *s, long task, pd_spec_result *r, pd_err *err);
 

@@ -6,7 +6,10 @@
 
 const char *pd_method_name(pd_method method)
 {
-    return method == PD_METHOD_EVENT ? "event" : method == PD_METHOD_PENALTY ? "penalty" : "moreau";
+    return method == PD_METHOD_EVENT     ? "event"
+           : method == PD_METHOD_PENALTY ? "penalty"
+           : method == PD_METHOD_AUTO    ? "auto"
+                                         : "moreau";
 }
 
 int pd_method_parse(const char *name, pd_method *method)
@@ -17,6 +20,8 @@ int pd_method_parse(const char *name, pd_method *method)
         *method = PD_METHOD_EVENT;
     else if (name && !strcmp(name, "penalty"))
         *method = PD_METHOD_PENALTY;
+    else if (name && !strcmp(name, "auto"))
+        *method = PD_METHOD_AUTO;
     else
         return PD_EINVAL;
     return PD_OK;
@@ -24,7 +29,7 @@ int pd_method_parse(const char *name, pd_method *method)
 
 pd_run_opts pd_run_default_opts(void)
 {
-    return (pd_run_opts){.method = PD_METHOD_MOREAU,
+    return (pd_run_opts){.method = PD_METHOD_AUTO,
                          .dt = 0.0,
                          .tend = 0.0,
                          .theta = 0.5,
@@ -48,7 +53,7 @@ pd_run_opts pd_run_default_opts(void)
 int pd_run_opts_check(const pd_run_opts *o, pd_err *err)
 {
     if (o->method != PD_METHOD_MOREAU && o->method != PD_METHOD_EVENT &&
-        o->method != PD_METHOD_PENALTY)
+        o->method != PD_METHOD_PENALTY && o->method != PD_METHOD_AUTO)
         return pd_err_set(err, PD_EINVAL, "method: unknown method %d", (int)o->method);
     if (!(o->dt >= 0.0) || !isfinite(o->dt))
         return pd_err_set(err, PD_EINVAL, "dt: must be a finite number > 0 (got %g)", o->dt);

@@ -512,6 +512,8 @@ int pd_scene_resolve_opts(const pd_scene *sc, const pd_run_opts *in, pd_run_opts
         return pd_err_set(err, PD_EINVAL, "scene: not finished (pd_scene_finish)");
     if ((rc = pd_run_opts_check(out, err)))
         return rc;
+    if (out->method == PD_METHOD_AUTO) /* a scene's default: Moreau-Jean */
+        out->method = PD_METHOD_MOREAU;
     if (out->dt == 0.0)
         out->dt = pd_scene_default_dt(sc);
     if (out->tend == 0.0)

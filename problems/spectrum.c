@@ -126,6 +126,21 @@ int pd_spec_validate(const pd_spectrum *s, pd_err *err)
     return PD_OK;
 }
 
+void pd_spec_resolve_method(pd_spectrum *s)
+{
+    pd_osc c;
+    pd_run_opts o;
+    long n = pd_spec_tasks(s);
+    if (s->opts.method != PD_METHOD_AUTO)
+        return;
+    s->opts.method = PD_METHOD_EVENT;
+    for (long t = 0; t < n; t++)
+        if (!pd_spec_case(s, t, &c, &o, NULL) && o.method != PD_METHOD_EVENT) {
+            s->opts.method = PD_METHOD_MOREAU;
+            return;
+        }
+}
+
 double pd_spec_cost(const pd_spectrum *s, long task)
 {
     pd_osc c;
@@ -471,12 +486,14 @@ int pd_spec_sweep(const pd_spectrum *s, pd_spec_point_fn fn, void *ctx, pd_err *
     int rc = check_shape(s, err); /* then every point checked before any run */
     if (rc || (rc = pd_spec_validate(s, err)))
         return rc;
-    sweep_ctx w = {.s = s, .fn = fn, .ctx = ctx, .ntasks = n, .ntw = pd_spec_twins(s),
+    pd_spectrum one = *s; /* one method for every run */
+    pd_spec_resolve_method(&one);
+    sweep_ctx w = {.s = &one, .fn = fn, .ctx = ctx, .ntasks = n, .ntw = pd_spec_twins(s),
                    .first_bad = -1, .err = err};
     w.res = calloc((size_t)n, sizeof *w.res);
     if (!w.res)
         return pd_err_set(err, PD_ENOMEM, "out of memory for %ld runs", n);
-    pd_spec_stream(s, sweep_next, sweep_done, &w, NULL);
+    pd_spec_stream(&one, sweep_next, sweep_done, &w, NULL);
     free(w.res);
     if (!w.rc)
         pd_err_clear(err);

@@ -4,6 +4,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "pd_problems.h"
 #include "pd_test.h"
 
 /* Every bad-input class: exit 2, one stderr line naming the flag, no file. */
@@ -320,6 +321,82 @@ static void test_cli_help_command(pd_test_ctx *ctx)
     pd_test_proc_free(&r);
 }
 
+/* The default method: the exact event-driven reference for one oscillator
+ * (pulses and records), Moreau-Jean for scenes; a flag only one method
+ * takes chooses it; two methods' flags need --method; the output says
+ * which method ran and why.  The oscillator's default equals --method
+ * event to the bit, and pd_osc_method falls back to Moreau-Jean where the
+ * exact reference's scan would be over its budget. */
+static void test_cli_default_method(pd_test_ctx *ctx)
+{
+    static const struct {
+        const char *args[8];
+        const char *method, *by;
+    } cases[] = {
+        {{"simulate", "--json"}, "event", "default"},
+        {{"simulate", "--method", "auto", "--json"}, "event", "default"},
+        {{"simulate", "--method", "moreau", "--json"}, "moreau", "--method"},
+        {{"simulate", "--theta", "0.6", "--json"}, "moreau", "--theta"},
+        {{"simulate", "--dt", "1e-3", "--json"}, "moreau", "--dt"},
+        {{"simulate", "--kc", "1e5", "--json"}, "penalty", "--kc"},
+        {{"simulate", "--no-accumulation", "--json"}, "event", "--no-accumulation"},
+        {{"simulate", "--chain", "2", "--json"}, "moreau", "default"},
+        {{"spectrum", "--Pi2", "0.5:2:3", "--json"}, "event", "default"},
+        {{"spectrum", "--Pi2", "0.5:2:3", "--dt-per-Tp", "500", "--json"}, "moreau",
+         "--dt-per-Tp"},
+    };
+    if (!pd_test_have_pound(ctx))
+        return;
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        proc_out r;
+        char method[32] = "", by[32] = "";
+        pd_test_pound(ctx, cases[k].args, &r);
+        pd_test_json_str(r.out, "method", 0, method, sizeof method);
+        pd_test_json_str(r.out, "method_by", 0, by, sizeof by);
+        CHECK(ctx, r.status == 0 && !strcmp(method, cases[k].method) && !strcmp(by, cases[k].by),
+              "%s %s: exit %d, method %s (%s), expected %s (%s): %s", cases[k].args[0],
+              cases[k].args[1], r.status, method, by, cases[k].method, cases[k].by, r.err);
+        pd_test_proc_free(&r);
+    }
+    /* the default is --method event, bit for bit; the text names it */
+    const char *d[] = {"simulate", "--pulse", "cosine", "--Pi2", "2.5", "--json", NULL};
+    const char *e[] = {"simulate", "--pulse", "cosine", "--Pi2", "2.5", "--method", "event",
+                       "--json", NULL};
+    const char *t[] = {"simulate", NULL};
+    proc_out rd, re, rt;
+    pd_test_pound(ctx, d, &rd);
+    pd_test_pound(ctx, e, &re);
+    pd_test_pound(ctx, t, &rt);
+    CHECK(ctx, pd_test_json_num(rd.out, "umax", 0) == pd_test_json_num(re.out, "umax", 0) &&
+                   pd_test_json_num(rd.out, "umax", 0) > 0.0,
+          "default umax %.17g vs --method event %.17g", pd_test_json_num(rd.out, "umax", 0),
+          pd_test_json_num(re.out, "umax", 0));
+    CHECK(ctx, strstr(rt.out, "method    = event (the default for one oscillator"),
+          "the text output names the default: %s", rt.out);
+    pd_test_proc_free(&rd);
+    pd_test_proc_free(&re);
+    pd_test_proc_free(&rt);
+    /* two methods' flags: exit 2 naming both */
+    const char *both[] = {"simulate", "--theta", "0.6", "--kc", "1e5", NULL};
+    proc_out rb;
+    pd_test_pound(ctx, both, &rb);
+    CHECK(ctx, rb.status == 2 && strstr(rb.err, "--theta") && strstr(rb.err, "--kc") &&
+                   strstr(rb.err, "--method"),
+          "--theta with --kc: exit %d: %s", rb.status, rb.err);
+    pd_test_proc_free(&rb);
+    /* over the exact reference's budget, the default is Moreau-Jean */
+    pd_osc c = pd_osc_default();
+    pd_run_opts o = pd_run_default_opts();
+    c.Pi2 = 1e6;
+    CHECK(ctx, pd_osc_method(&c, &o) == PD_METHOD_MOREAU, "Pi2 = 1e6: %s",
+          pd_method_name(pd_osc_method(&c, &o)));
+    c.Pi2 = 3.0;
+    CHECK(ctx, pd_osc_method(&c, &o) == PD_METHOD_EVENT, "Pi2 = 3: %s",
+          pd_method_name(pd_osc_method(&c, &o)));
+    o.method = PD_METHOD_PENALTY;
+    CHECK(ctx, pd_osc_method(&c, &o) == PD_METHOD_PENALTY, "a method given is kept");
+}
+
 void suite_cli(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_cli_bad_input);
@@ -330,4 +407,5 @@ void suite_cli(pd_test_ctx *ctx)
     PD_RUN(ctx, test_cli_converge_empty_list_elements);
     PD_RUN(ctx, test_cli_version);
     PD_RUN(ctx, test_cli_help_command);
+    PD_RUN(ctx, test_cli_default_method);
 }

@@ -398,6 +398,7 @@ static void test_outputs_content_unchanged(pd_test_ctx *ctx)
     c.Pi3 = 0.4;
     c.eps = 0.6;
     pd_run_opts o = pd_run_default_opts();
+    o.method = PD_METHOD_MOREAU; /* as the command's --dt chooses */
     o.dt = 1e-4;
     o.tend = 2.0;
     samples sm = {.cap = 20000 / 3 + 1, .every = 3};

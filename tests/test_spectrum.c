@@ -667,6 +667,7 @@ static void test_spectrum_stream_matches_single(pd_test_ctx *ctx)
     for (int v = 0; v < 6; v++) {
         pd_spectrum s;
         pd_spec_init(&s);
+        s.opts.method = PD_METHOD_MOREAU;
         s.pi2_min = 0.1, s.pi2_max = 6, s.npi2 = 23;
         s.npulse = 2, s.pulse[1] = PD_PULSE_COSINE;
         s.ndir = 2, s.dir[1] = -1;

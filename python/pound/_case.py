@@ -17,6 +17,13 @@ SCHEME_KEYS = ("method", "dt", "tend", "theta", "gamma", "allow_unstable", "no_a
                "no_wall", "kernel", "factor", "lcp_solver", "contact", "kc", "kc_abs", "rtol",
                "atol", "stepper")
 CASE_KEYS = MODEL_KEYS + RECORD_KEYS + SCHEME_KEYS
+# cli/case.c: the keywords only one method takes choose it (moreau 0,
+# event 1, penalty 2) unless method says another; the flags only
+# (allow_unstable, no_accumulation) when true
+IMPLIES = {"dt": 0, "theta": 0, "gamma": 0, "allow_unstable": 0, "kernel": 0, "factor": 0,
+           "lcp_solver": 0, "dt_per_Tp": 0, "no_accumulation": 1, "kc": 2, "kc_abs": 2,
+           "rtol": 2, "atol": 2, "contact": 2, "stepper": 2}
+PD_METHOD_AUTO = 3
 
 STEPPERS = {"rk8pd": b"rk8pd", "rkf45": b"rkf45", "rk4imp": b"rk4imp", "msbdf": b"msbdf"}
 CASE_MAX_STEPS = 2e9
@@ -164,7 +171,35 @@ def scheme_opts(kw):
                 raise InputError("stepper: '%s' is not one of rk8pd, rkf45, rk4imp, msbdf" % (v,))
             o.pen.stepper = STEPPERS[v]
     _check_scheme(o, have)
+    have["method_by"] = _method_by(o, kw)
     return o, have
+
+
+def implied_method(kw, extra=()):
+    """cli/case.c case_method: (method, the keyword that chose it), or
+    (None, None) when no keyword only one method takes was given."""
+    first = {}
+    for key in list(kw) + list(extra):
+        if key in IMPLIES and kw.get(key) not in (None, False) and IMPLIES[key] not in first:
+            first[IMPLIES[key]] = key
+    chosen = sorted(first.items())
+    if len(chosen) > 1:
+        names = ("moreau", "event", "penalty")
+        raise InputError("%s and %s belong to different methods (%s, %s): give method"
+                         % (chosen[0][1], chosen[1][1], names[chosen[0][0]],
+                            names[chosen[1][0]]))
+    return chosen[0] if chosen else (None, None)
+
+
+def _method_by(o, kw):
+    """The method given, else the implied one set in o: what chose it."""
+    if "method" in kw and o.method != PD_METHOD_AUTO:
+        return "--method"
+    m, key = implied_method(kw)
+    if m is None:
+        return None
+    o.method = m
+    return "--" + key.replace("_", "-")
 
 
 class Case:

@@ -406,6 +406,7 @@ _PROTOTYPES = {
     "pd_spec_pi2": (c_double, [P(PdSpectrum), c_int]),
     "pd_spec_coords_of": (None, [P(PdSpectrum), c_long, P(PdSpecCoords)]),
     "pd_spec_validate": (c_int, [P(PdSpectrum), P(PdErr)]),
+    "pd_spec_resolve_method": (None, [P(PdSpectrum)]),
     "pd_spec_run_task": (None, [P(PdSpectrum), c_long, P(PdSpecResult), P(PdErr)]),
     "pd_spec_cost": (c_double, [P(PdSpectrum), c_long]),
     "pd_spec_rows": (None, [P(PdSpectrum), P(PdSpecResult), P(PdSpecRow)]),
@@ -561,7 +562,7 @@ def _check_layout():
             ("pd_osc.Tp", b.Tp, 1.0), ("pd_osc.Pi2", b.Pi2, 1.0), ("pd_osc.Pi3", b.Pi3, 0.05),
             ("pd_osc.eps", b.eps, 0.5), ("pd_osc.xi", b.xi, 0.05),
             ("pd_osc.record", bool(b.record), False),
-            ("pd_run_opts.method", o.method, 0), ("pd_run_opts.dt", o.dt, 0.0),
+            ("pd_run_opts.method", o.method, 3), ("pd_run_opts.dt", o.dt, 0.0),
             ("pd_run_opts.theta", o.theta, 0.5), ("pd_run_opts.gamma", o.gamma, 0.5),
             ("pd_run_opts.pen.rtol", o.pen.rtol, 1e-10),
             ("pd_run_opts.pen.atol", o.pen.atol, 1e-12),
@@ -623,7 +624,7 @@ def _check_layout():
            "pd_osc_summary")
     c = default_osc()
     o = default_opts()
-    o.dt, o.tend = 0.001, 0.01
+    o.method, o.dt, o.tend = 0, 0.001, 0.01  # Moreau-Jean
     seen = []
 
     def sample(p, ctx):

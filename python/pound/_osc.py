@@ -125,7 +125,8 @@ def simulate(history=True, every=1, **case):
         raise h.error
     _lib.check(st, err)
     r = sm.r
-    out = Result(method=s(lib.pd_method_name(o.method)), umax=r.umax, Pi1=sm.Pi1,
+    out = Result(method=s(lib.pd_method_name(o.method)),
+                 method_by=k.have["method_by"] or "default", umax=r.umax, Pi1=sm.Pi1,
                  u_toward=r.u_toward, u_away=r.u_away, impacts=r.impacts,
                  accumulations=r.accumulations, first_impact=r.first_impact,
                  first_impact_velocity=r.first_impact_velocity,

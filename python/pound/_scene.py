@@ -142,9 +142,10 @@ class Scene:
         if unknown:
             raise TypeError("unexpected keyword argument(s) %s (a scene run takes %s)"
                             % (", ".join(unknown), ", ".join(SCENE_OPTS)))
-        o, _ = scheme_opts({k: v for k, v in kw.items() if v is not None})
+        o, have = scheme_opts({k: v for k, v in kw.items() if v is not None})
         out, err = _lib.PdRunOpts(), PdErr()
         _lib.check(lib.pd_scene_resolve_opts(self._p, o, out, err), err)
+        self._method_by = have["method_by"] or "default"
         return o, out
 
     def simulate(self, history=True, every=1, **opts):
@@ -177,6 +178,7 @@ class Scene:
                 raise h.error
             _lib.check(st, err)
             out = self._summary(sm)
+            out["method_by"] = self._method_by
         finally:
             lib.pd_scene_summary_free(sm)
         if h is not None:

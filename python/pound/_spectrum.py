@@ -10,7 +10,8 @@ import threading
 import numpy as np
 
 from . import _lib
-from ._case import CASE_KEYS, Case, InputError, number, parse_dir, parse_name
+from ._case import (CASE_KEYS, PD_METHOD_AUTO, Case, InputError, implied_method, number,
+                    parse_dir, parse_name)
 from ._lib import PD_SPEC_MAX_LIST, PdErr, lib, s
 from ._osc import Result
 
@@ -124,6 +125,15 @@ def build(Pi2, linear=False, pulse=None, dir=None, ap=None, xi=None, Pi3=None, g
         if not sp.dimensional:
             sp.ap[0] = sp.base.ap
     sp.opts = k.opts  # dt and tend stay 0 (per point) unless given
+    # the method given or implied (dt_per_Tp too), else one for the sweep
+    m, key = implied_method(dict(case, dt_per_Tp=dt_per_Tp))
+    by = k.have["method_by"]
+    if by is None and m is not None:
+        sp.opts.method, by = m, "--" + key.replace("_", "-")
+    if by is None:
+        sp.opts.method = PD_METHOD_AUTO
+        lib.pd_spec_resolve_method(sp)
+    k.method_by = by or "default"
     err = PdErr()
     _lib.check(lib.pd_spec_validate(sp, err), err)
     return sp, k
@@ -274,6 +284,7 @@ def spectrum(Pi2, linear=False, pulse=None, dir=None, ap=None, xi=None, Pi3=None
             d["Pi3"] = p["Pi3"]
         d["label"] = label.value.decode()
         curves.append(d)
-    out.update(curves=curves, points=points, method=method, runs=lib.pd_spec_tasks(sp),
+    out.update(curves=curves, points=points, method=method, method_by=k.method_by,
+               runs=lib.pd_spec_tasks(sp),
                twins=lib.pd_spec_twins(sp))
     return out

@@ -40,12 +40,17 @@ def test_free_response_closed_form():
     assert r.impacts == 0
     assert abs(r.umax_free - exact) <= 1e-12 * exact
     assert r.umax == r.umax_free and r.gamma == 1.0
-    m = pound.simulate(pulse="sine", ap=2, Tp=0.5, T0=2.5, xi=0, Pi3=1e3, history=False)
+    m = pound.simulate(pulse="sine", ap=2, Tp=0.5, T0=2.5, xi=0, Pi3=1e3, history=False,
+                       method="moreau")
     assert abs(m.umax - exact) < 1e-5 * exact  # Moreau-Jean, dt = Tp / 2000
+    d = pound.simulate(pulse="sine", ap=2, Tp=0.5, T0=2.5, xi=0, Pi3=1e3, history=False)
+    assert d.method == "event" and d.method_by == "default"  # the default: exact
+    assert abs(d.umax - exact) < 1e-13 * exact
 
 
 def test_summary_figures():
-    r = pound.simulate(pulse="cosine", ap=3, Tp=0.6, Pi2=0.7, Pi3=0.2, eps=0.6)
+    r = pound.simulate(pulse="cosine", ap=3, Tp=0.6, Pi2=0.7, Pi3=0.2, eps=0.6, theta=0.5)
+    assert r.method == "moreau" and r.method_by == "--theta"  # as the CLI's --theta
     Le = r.ap / (2 * math.pi / r.Tp) ** 2
     assert r.gamma == r.umax / r.umax_free and r.chi == r.gap / r.umax_free
     assert abs(r.Pi1 - r.umax / Le) <= 1e-15 * r.Pi1
@@ -227,7 +232,8 @@ def test_scene_description_and_history():
 def test_scene_oscillator_is_the_oscillator():
     """examples/scenes/oscillator.json: the Fig. 9 case as a scene."""
     a = pound.simulate_scene(EXAMPLES / "scenes" / "oscillator.json", history=False)
-    b = pound.simulate(pulse="sine", Tp=0.3, T0=3, ap=4, gap=0.004, eps=0.6, history=False)
+    b = pound.simulate(pulse="sine", Tp=0.3, T0=3, ap=4, gap=0.004, eps=0.6, history=False,
+                       method="moreau")  # a scene's default
     assert abs(a.structures[0].umax[0] - b.umax) < 1e-12 * b.umax
     assert a.contacts[0].impacts == b.impacts
 
