@@ -46,7 +46,7 @@ unset multiplot
 GP
 
 # ---- Fig. 4: dimensional spectra collapse in Pi terms -------------------
-"$pound" spectrum --pulse cosine --dir normal --Tp 0.5 --ap 1,3,9 --Pi3 0.05,0.5 \
+"$pound" spectrum --method moreau --pulse cosine --dir normal --Tp 0.5 --ap 1,3,9 --Pi3 0.05,0.5 \
     --Pi2 0.05:5:100 --eps 0.5 --method event -o "$tmp/f4.csv" --plot "$tmp/f4.png" > "$out/paper-fig4.txt"
 cp "$tmp/f4-dim.png" "$out/paper-fig4-dimensional.png"
 cp "$tmp/f4.png" "$out/paper-fig4-collapse.png"
@@ -55,7 +55,7 @@ cp "$tmp/f4.png" "$out/paper-fig4-collapse.png"
 #      with the traditional gamma-vs-chi view -------------------------------
 for pulse in sine cosine; do
     n=5; [ $pulse = cosine ] && n=6
-    "$pound" spectrum --pulse $pulse --dir normal,reverse --Pi3 0.01,0.1,0.5,1,2 --eps 0.5 \
+    "$pound" spectrum --method moreau --pulse $pulse --dir normal,reverse --Pi3 0.01,0.1,0.5,1,2 --eps 0.5 \
         --Pi2 0.05:5:120 --method event -o "$tmp/f$n.csv" > "$out/paper-fig$n.txt"
     for d in normal reverse; do for P in 0.01 0.1 0.5 1 2; do
         rows "$tmp/f$n.csv" $pulse $d "\$6 == $P" > "$tmp/f$n-$d-$P"
@@ -115,7 +115,7 @@ unset multiplot
 GP
 
 # ---- Fig. 10: eps across [0, 1] ------------------------------------------
-"$pound" spectrum --pulse sine,cosine --dir normal,reverse --Pi3 0.05 --eps 0,0.25,0.5,0.75,1 \
+"$pound" spectrum --method moreau --pulse sine,cosine --dir normal,reverse --Pi3 0.05 --eps 0,0.25,0.5,0.75,1 \
     --Pi2 0.05:5:120 --method event -o "$tmp/f10.csv" > "$out/paper-fig10.txt"
 for p in sine cosine; do for d in normal reverse; do for e in 0 0.25 0.5 0.75 1; do
     rows "$tmp/f10.csv" $p $d "\$8 == $e" > "$tmp/f10-$p-$d-$e"
@@ -155,7 +155,7 @@ unset multiplot
 GP
 
 # ---- Fig. 12: harmonic steady state, Pi3 = 0.001, subharmonic peaks -------
-"$pound" spectrum --pulse harmonic --dir normal --Pi3 0.001 --eps 0.3,0.6,0.9 \
+"$pound" spectrum --method moreau --pulse harmonic --dir normal --Pi3 0.001 --eps 0.3,0.6,0.9 \
     --Pi2 0.1:1.25:200 --method event -o "$tmp/f12.csv" > "$out/paper-fig12.txt"
 for e in 0.3 0.6 0.9; do rows "$tmp/f12.csv" harmonic normal "\$8 == $e" > "$tmp/f12-$e"; done
 gnuplot <<GP
@@ -210,10 +210,10 @@ GP
     k=0
     for r in $all; do
         k=$((k + 1))
-        "$pound" spectrum --record "$r" $grid -o "$tmp/r$k.csv" > /dev/null
+        "$pound" spectrum --method moreau --record "$r" $grid -o "$tmp/r$k.csv" > /dev/null
         grep -v '^#' "$tmp/r$k.csv" | awk -F, 'NR > 1 {print $1, $6, $10, $12}' >> "$tmp/rall"
     done
-    "$pound" spectrum --pulse sine,cosine $grid -o "$tmp/p.csv" > /dev/null
+    "$pound" spectrum --method moreau --pulse sine,cosine $grid -o "$tmp/p.csv" > /dev/null
     grep -v '^#' "$tmp/p.csv" | awk -F, 'NR > 1 {print $1, $6, $10, $12}' >> "$tmp/rall"
     # collapse: across the pulse-like records, per Pi3 and band of Pi2, the spread
     # (max - min) / median of Pi1, and where the one-cycle pulses lie in it
