@@ -52,8 +52,31 @@ PKG_LIBS    := $(shell pkg-config --libs $(PKGS) 2>/dev/null)
 SS_CFLAGS   := $(shell pkg-config --cflags cholmod 2>/dev/null || echo -I/usr/include/suitesparse)
 SS_LIBS     := $(shell pkg-config --libs cholmod cxsparse 2>/dev/null || echo -lcholmod -lcxsparse)
 
+# Start-up (cli/lazy.c): the pound binary loads HDF5 and CHOLMOD when a run
+# first calls them, by the sonames of the libraries found here, instead of
+# linking them: a process that writes no HDF5 and factors nothing sparse
+# starts in a few ms, not 30.  LAZY=0 (or a library not found) links them.
+LAZY    ?= 1
+# the soname of -l$(2) in the -L folders of $(1), else where $(CC) finds it
+lib_soname = $(shell for d in $(patsubst -L%,%,$(filter -L%,$(1))) \
+    "$$(dirname "$$($(CC) -print-file-name=lib$(2).so)")"; do \
+    if [ -e "$$d/lib$(2).so" ]; then \
+    objdump -p "$$d/lib$(2).so" 2>/dev/null | awk '/SONAME/ {print $$2; exit}'; break; fi; done)
+H5_LIBS        := $(shell pkg-config --libs hdf5 2>/dev/null)
+ifeq ($(LAZY),1)
+H5_SONAME      := $(call lib_soname,$(H5_LIBS),$(patsubst -l%,%,$(firstword $(filter -l%,$(H5_LIBS)))))
+CHOLMOD_SONAME := $(call lib_soname,,cholmod)
+endif
+ifneq ($(and $(H5_SONAME),$(CHOLMOD_SONAME)),)
+LAZY_DEFS = -DPD_LAZY_HDF5='"$(H5_SONAME)"' -DPD_LAZY_CHOLMOD='"$(CHOLMOD_SONAME)"'
+CLI_LIBS  = $(shell pkg-config --libs gsl jansson 2>/dev/null) \
+            $(shell pkg-config --libs cxsparse 2>/dev/null || echo -lcxsparse) -ldl -lm
+else
+CLI_LIBS  = $(LIBS)
+endif
+
 INC      = -Icore -Ilcp -Iengine -Iproblems -Icli
-ALL_CFLAGS = $(WARN) $(DEFS) $(FPFLAGS) $(CFLAGS) $(OPENMP) $(INC) $(PKG_CFLAGS) $(SS_CFLAGS) $(XCFLAGS)
+ALL_CFLAGS = $(WARN) $(DEFS) $(LAZY_DEFS) $(FPFLAGS) $(CFLAGS) $(OPENMP) $(INC) $(PKG_CFLAGS) $(SS_CFLAGS) $(XCFLAGS)
 LIBS     = $(PKG_LIBS) $(SS_LIBS) -lm
 
 LIB_SRC  = $(wildcard core/*.c) $(wildcard lcp/*.c) $(wildcard engine/*.c) $(wildcard problems/*.c)
@@ -124,7 +147,7 @@ shared: $(BUILD)/$(SOREAL)
 
 $(BUILD)/pound: $(CLI_OBJ) $(BUILD)/libpound.a
 	@echo "  LD    $@"
-	@$(CC) $(CFLAGS) $(OPENMP) $(XCFLAGS) -o $@ $(CLI_OBJ) $(BUILD)/libpound.a $(XOBJ) $(LIBS)
+	@$(CC) $(CFLAGS) $(OPENMP) $(XCFLAGS) -o $@ $(CLI_OBJ) $(BUILD)/libpound.a $(XOBJ) $(CLI_LIBS)
 
 $(BUILD)/pound_tests: $(TEST_OBJ) $(BUILD)/libpound.a
 	@echo "  LD    $@"

@@ -311,7 +311,7 @@ def doc_units(ctx, fmt, name):
 def oscillator(ctx):
     fmt = "pound simulate oscillator 1"
     base = ["simulate", "--pulse", "sine", "--Tp", "0.3", "--T0", "3", "--ap", "4", "--gap", "0.004",
-            "--eps", "0.6", "--tend", "2"]
+            "--eps", "0.6", "--tend", "2", "--method", "moreau"]
     for every, out in ((1, "osc.h5"), (7, "osc run.csv")):
         args = base + ["--every", str(every), "-o", out, "--json"]
         j = json.loads(run(ctx.pound, args, ctx.tmp))
