@@ -1,7 +1,9 @@
 /* bench_engine.c — `pound bench --engine`: Moreau–Jean steps per second on
  * the one-wall oscillator (no history), in free flight, in persistent
- * contact (an LCP every step) and with many impacts; scalar and general
- * kernels; the median of three timed runs each. */
+ * contact (an LCP every step) and with many impacts; scalar, batched and
+ * general kernels; the median of three timed runs each, beside the bound
+ * the step's dependency chain sets (its operations in a row, each at the
+ * latency of one dependent multiply or add measured here). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -19,18 +21,96 @@ static void push_force(double t, int side, double *F, void *ctx)
     F[0] = 1.0;
 }
 
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
 typedef struct bench_case {
     const char *name;
     const char *what;
     double steps_per_s;
     double lcp_fraction; /* steps with an active contact */
     long steps;
+    double chain_ns;     /* the dependency chain's bound per step (NAN: not estimated) */
 } bench_case;
 
-static int cmp_double(const void *a, const void *b)
+/* The scalar kernel's loop-carried chain (engine/mj1.h), in dependent
+ * operations per step: q_k -> q_k + h theta v_k (add) -> K (mul) -> the
+ * force difference (sub) -> h (mul) -> 1/What (mul) -> + v_k (add) = v_k+1
+ * -> theta v (mul) -> + (1 - theta) v_k (add) -> h (mul) -> + q_k (add) =
+ * q_k+1: 10.  A step with an impulse adds the closed-form LCP on the way,
+ * W vfree + e U (mul, add), -b / D (mul), vfree + W^ P (mul, add): 15. */
+#define CHAIN_FREE 10
+#define CHAIN_CONTACT 15
+
+/* The latency of one dependent double multiply or add on this machine
+ * [ns]: a chain of them timed (the median of three). */
+static double fp_latency_ns(void)
 {
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
+    volatile double seed = 1.0000001, tiny = 1e-300;
+    double lat[3];
+    const long n = 20000000;
+    for (int k = 0; k < 3; k++) {
+        double x = seed, y = seed, z = tiny;
+        double t0 = pd_cpu_seconds();
+        for (long i = 0; i < n; i++) {
+            x = x * y; /* each waits for the one before */
+            x = x + z;
+        }
+        lat[k] = (pd_cpu_seconds() - t0) / (2.0 * (double)n) * 1e9;
+        seed = x > 0.0 ? seed : x; /* keep x alive */
+    }
+    qsort(lat, 3, sizeof lat[0], cmp_double);
+    return lat[1];
+}
+
+/* The batched kernel: 4 x PD_MJB_LANES copies of case c (their Pi2 spread
+ * by 1 %) streamed through pd_osc_run_stream; rate per oscillator-step. */
+typedef struct batch_src {
+    pd_osc c;
+    pd_run_opts o;
+    long next, n, steps;
+    double cpu;
+} batch_src;
+
+static int batch_next(void *ctx, pd_osc *c, pd_run_opts *o, long *id)
+{
+    batch_src *b = ctx;
+    if (b->next >= b->n)
+        return 0;
+    *c = b->c;
+    c->Pi2 *= 1.0 + 0.01 * (double)b->next / (double)b->n;
+    *o = b->o;
+    *id = b->next++;
+    return 1;
+}
+
+static void batch_done(void *ctx, long id, const pd_osc_result *res, int status, const pd_err *err)
+{
+    batch_src *b = ctx;
+    (void)id;
+    (void)err;
+    b->steps += status ? 0 : res->steps;
+}
+
+static int time_batched(const pd_osc *c, const pd_run_opts *o, bench_case *bc)
+{
+    double rate[3];
+    pd_err err;
+    for (int k = 0; k < 3; k++) {
+        batch_src b = {.c = *c, .o = *o, .n = 4 * PD_MJB_LANES};
+        b.o.method = PD_METHOD_MOREAU;
+        double t0 = pd_cpu_seconds();
+        pd_osc_run_stream(batch_next, batch_done, &b, &err);
+        rate[k] = (double)b.steps / fmax(pd_cpu_seconds() - t0, 1e-9);
+        bc->steps = b.steps;
+    }
+    qsort(rate, 3, sizeof rate[0], cmp_double);
+    bc->steps_per_s = rate[1];
+    bc->lcp_fraction = NAN;
+    return 0;
 }
 
 /* Median rate of pd_osc_simulate over three runs. */
@@ -96,7 +176,7 @@ static int time_pressing(pd_kernel kernel, pd_lcp_method solver, long nsteps, be
 
 int pd_bench_engine(pd_json *js)
 {
-    bench_case cases[8];
+    bench_case cases[10];
     int n = 0, rc = 0;
     pd_run_opts o = pd_run_default_opts();
     /* free flight: harmonic excitation, the wall out of reach */
@@ -124,11 +204,32 @@ int pd_bench_engine(pd_json *js)
     cases[n] = (bench_case){.name = "persistent_lemke",
                             .what = "the same, general kernel, --lcp-solver lemke"};
     rc |= time_pressing(PD_KERNEL_GENERAL, PD_LCP_LEMKE, 2000000, &cases[n++]);
+    /* the batched kernel on the free flight and the impacts (shorter runs) */
+    pd_run_opts ob = o;
+    ob.tend = 100.0;
+    cases[n] = (bench_case){.name = "batched_free_flight",
+                            .what = "free_flight, 128 oscillators on the batch's lanes"};
+    rc |= time_batched(&free_c, &ob, &cases[n++]);
+    cases[n] = (bench_case){.name = "batched_impacts",
+                            .what = "many_impacts, 128 oscillators on the batch's lanes"};
+    rc |= time_batched(&imp_c, &ob, &cases[n++]);
+    /* the chains' bounds: the scalar kernel's per step, the batch's per
+     * oscillator-step (its lanes' chains overlap) */
+    double lat = fp_latency_ns();
+    for (int k = 0; k < n; k++) {
+        const char *nm = cases[k].name;
+        int batched = !strncmp(nm, "batched", 7), general = strstr(nm, "general") ||
+                                                             strstr(nm, "lemke");
+        double ops = !strcmp(nm, "persistent_scalar") ? CHAIN_CONTACT : CHAIN_FREE;
+        cases[k].chain_ns = general ? NAN : ops * lat / (batched ? PD_MJB_LANES : 1);
+    }
 
     if (js) {
         pd_json_begin_object(js, "engine");
         pd_json_num(js, "target_free_steps_per_s", 20e6);
         pd_json_num(js, "target_lcp_steps_per_s", 5e6);
+        pd_json_num(js, "fp_latency_ns", lat);
+        pd_json_int(js, "batch_lanes", PD_MJB_LANES);
         pd_json_begin_array(js, "cases");
         for (int k = 0; k < n; k++) {
             pd_json_begin_object(js, NULL);
@@ -136,6 +237,7 @@ int pd_bench_engine(pd_json *js)
             pd_json_str(js, "what", cases[k].what);
             pd_json_num(js, "steps_per_s", cases[k].steps_per_s);
             pd_json_num(js, "ns_per_step", 1e9 / cases[k].steps_per_s);
+            pd_json_num(js, "chain_ns_per_step", cases[k].chain_ns);
             pd_json_num(js, "active_fraction", cases[k].lcp_fraction);
             pd_json_int(js, "steps", cases[k].steps);
             pd_json_end_object(js);
@@ -144,10 +246,20 @@ int pd_bench_engine(pd_json *js)
         pd_json_end_object(js);
     } else {
         printf("Moreau-Jean engine, one-wall oscillator (median of 3 runs, one core)\n");
-        printf("  %-20s %14s %10s %8s  %s\n", "case", "steps/s", "ns/step", "active", "what");
-        for (int k = 0; k < n; k++)
-            printf("  %-20s %14.4g %10.2f %7.1f%%  %s\n", cases[k].name, cases[k].steps_per_s,
-                   1e9 / cases[k].steps_per_s, 100 * cases[k].lcp_fraction, cases[k].what);
+        printf("  %-20s %14s %10s %10s %8s  %s\n", "case", "steps/s", "ns/step", "chain", "active",
+               "what");
+        for (int k = 0; k < n; k++) {
+            char chain[16] = "-", active[16] = "-";
+            if (isfinite(cases[k].chain_ns))
+                snprintf(chain, sizeof chain, "%.2f", cases[k].chain_ns);
+            if (isfinite(cases[k].lcp_fraction))
+                snprintf(active, sizeof active, "%.1f%%", 100 * cases[k].lcp_fraction);
+            printf("  %-20s %14.4g %10.2f %10s %8s  %s\n", cases[k].name, cases[k].steps_per_s,
+                   1e9 / cases[k].steps_per_s, chain, active, cases[k].what);
+        }
+        printf("  chain: the bound of the step's dependency chain (%d dependent operations, %d "
+               "with an impulse, at %.2f ns each, measured; batched: per oscillator, the %d "
+               "lanes' chains overlapping)\n", CHAIN_FREE, CHAIN_CONTACT, lat, PD_MJB_LANES);
         printf("  targets: 20e6 steps/s in free flight, 5e6 steps/s with an LCP every step\n");
     }
     return rc ? 1 : 0;

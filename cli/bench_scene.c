@@ -127,6 +127,7 @@ static int one_wall(double *scene_rate, double *osc_rate)
     pd_scene_excitation exc = {.pulse = c.pulse, .dir = c.dir, .ap = c.ap, .Tp = c.Tp};
     double wp = 2.0 * PD_PI / c.Tp;
     pd_run_opts o = pd_run_default_opts();
+    o.method = PD_METHOD_MOREAU; /* both by the scalar kernel */
     pd_err err;
     o.dt = 1e-4;
     o.tend = 1000.0;

@@ -32,6 +32,7 @@ static void paper_sweep(pd_spectrum *s)
     s->eps[0] = 0.5;
     s->xi[0] = 0.05;
     s->dt_per_Tp = 2000.0;
+    s->opts.method = PD_METHOD_MOREAU;
 }
 
 /* Best wall time of two computations of the sweep on `threads` threads. */

@@ -26,7 +26,7 @@ double pd_loglog_slope(const pd_loglog_fit *f)
 int pd_cmd_bench(int argc, char **argv)
 {
     int json = 0, want_lcp = 0, want_engine = 0, want_scene = 0, want_spectrum = 0;
-    int want_records = 0;
+    int want_records = 0, want_startup = 0;
     const char *shared = "../shared";
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--json"))
@@ -41,26 +41,32 @@ int pd_cmd_bench(int argc, char **argv)
             want_records = 1;
         else if (!strcmp(argv[i], "--spectrum"))
             want_spectrum = 1;
+        else if (!strcmp(argv[i], "--startup"))
+            want_startup = 1;
         else if (!strcmp(argv[i], "--shared") && i + 1 < argc)
             shared = argv[++i];
         else if (!strcmp(argv[i], "--help")) {
-            puts("usage: pound bench [--lcp] [--engine] [--scene] [--spectrum] [--records] [--json]\n"
+            puts("usage: pound bench [--lcp] [--engine] [--scene] [--spectrum] [--records]\n"
+                 "                   [--startup] [--json]\n"
                  "                   [--shared DIR]\n"
                  "  no selection runs every benchmark; --shared points at the shared data\n"
                  "  folder holding lcp/siconos (default ../shared)\n"
                  "  --lcp: the LCP solvers on the Siconos set and chains of 10 ... 10^5 contacts\n"
-                 "  --engine: Moreau-Jean steps/s on the one-wall oscillator\n"
+                 "  --engine: Moreau-Jean steps/s on the one-wall oscillator (scalar, batched and\n"
+                 "  general kernels) beside the bound of each step's dependency chain\n"
                  "  --scene: ns per DOF-step on --chain rows of 10 ... 10^5 SDOFs, the one-wall\n"
                  "  scene against the oscillator\n"
                  "  --spectrum: the paper-scale sweep, serial and on 2 OpenMP threads\n"
                  "  --records: every shared record x 200 Pi2 x 4 Pi3 x 3 eps, exact reference and\n"
-                 "  Moreau-Jean, on 2 OpenMP threads");
+                 "  Moreau-Jean, on 2 OpenMP threads\n"
+                 "  --startup: the time a pound process takes to start, against /bin/true");
             return 0;
         } else
             return pd_cli_usage_error("bench: unknown flag '%s'", argv[i]);
     }
-    if (!want_lcp && !want_engine && !want_scene && !want_spectrum && !want_records)
-        want_lcp = want_engine = want_scene = want_spectrum = want_records = 1;
+    if (!want_lcp && !want_engine && !want_scene && !want_spectrum && !want_records &&
+        !want_startup)
+        want_lcp = want_engine = want_scene = want_spectrum = want_records = want_startup = 1;
 
     pd_json js, *jp = NULL;
     if (json) {
@@ -79,6 +85,8 @@ int pd_cmd_bench(int argc, char **argv)
         rc |= pd_bench_spectrum(jp);
     if (want_records)
         rc |= pd_bench_records(jp, shared);
+    if (want_startup)
+        rc |= pd_bench_startup(jp);
     if (json) {
         pd_json_end_object(&js);
         pd_json_finish(&js);

@@ -127,6 +127,7 @@ int pd_bench_lcp(pd_json *js, const char *shared_dir);
 int pd_bench_engine(pd_json *js);
 int pd_bench_scene(pd_json *js);
 int pd_bench_records(pd_json *js, const char *shared_dir);
+int pd_bench_startup(pd_json *js);
 
 /* The least-squares slope of log y against log x over the points added
  * (the growth exponents of the benchmarks); NAN with fewer than two. */

@@ -6,8 +6,9 @@
  * piece boundary (the forcing changes), accumulation (a geometric tail of
  * impacts replaced by its limit).
  *
- * Flight is scanned on intervals of at most the scan step, never across a
- * piece boundary (a piece shorter than the step is one interval).  On each
+ * Flight is scanned on intervals of at most the scan step (the shortest
+ * period of the piece over 64), never across a piece boundary (a piece
+ * shorter than the step is one interval).  On each
  * interval the velocity is, up to O((w0 h)^2) relative, a quadratic: it has
  * no zero, one (the ends differ in sign: one extremum, bisected), or two
  * (the ends agree, the acceleration changes sign between them and the ends
@@ -423,18 +424,18 @@ static double rest(ed_run *ed, int j, double ta, double tb)
     return td;
 }
 
-/* Scan step: the shortest period present over divisions (default 64),
- * independent of the run's length so that results do not move with t_end;
- * span/4 over divisions only when no period exists (free mass, linear
- * forcing).  Pieces shorter than the step are scanned at their ends. */
-static double scan_step(const pd_ed_sdof *p, double span, int divisions)
+/* Scan step of piece j: the shortest period present in it (the
+ * oscillator's; the piece's sine) over divisions (default 64), so that the
+ * free vibration after a short pulse is scanned at its own period, not the
+ * pulse's; independent of the run's length so that results do not move
+ * with t_end; span/4 over divisions only when no period exists (free mass,
+ * linear forcing).  Pieces shorter than the step are scanned at their ends. */
+static double scan_step(const pd_ed_sdof *p, int j, double span, int divisions)
 {
-    double T = HUGE_VAL;
-    if (p->osc.w0 > 0.0)
-        T = PD_TWO_PI / p->osc.w0;
-    for (int j = 0; j < p->npieces; j++)
-        if (p->pieces[j].A != 0.0 && p->pieces[j].w > 0.0)
-            T = fmin(T, PD_TWO_PI / p->pieces[j].w);
+    const pd_sine_piece *pc = &p->pieces[j];
+    double T = p->osc.w0 > 0.0 ? PD_TWO_PI / p->osc.w0 : HUGE_VAL;
+    if (pc->A != 0.0 && pc->w > 0.0)
+        T = fmin(T, PD_TWO_PI / pc->w);
     if (!isfinite(T))
         T = span / 4.0;
     return T / divisions;
@@ -570,7 +571,7 @@ int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opt
                   .r = res,
                   .sampler = sampler,
                   .ctx = ctx,
-                  .scan = scan_step(prob, opts->t_end - t, opts->scan_divisions),
+                  .scan = scan_step(prob, 0, opts->t_end - t, opts->scan_divisions),
                   .max_events = opts->max_events,
                   .max_burst = opts->max_burst,
                   .t_first = t};
@@ -608,6 +609,8 @@ int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opt
         }
         if (t >= piece_end(prob, j) && j + 1 < prob->npieces) {
             j++; /* forcing breakpoint: re-decide rest or flight */
+            ed.scan = scan_step(prob, j, opts->t_end - prob->pieces[0].t_start,
+                                opts->scan_divisions);
             if (resting && !(wall_accel(&ed, j, t, 0.0) > 0.0)) {
                 resting = 0;
                 res->detachments++;
