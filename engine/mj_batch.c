@@ -113,7 +113,7 @@ int pd_mjb_set_lane(pd_mjb *b, int l, const pd_mjb_lane *ln, pd_err *err)
     b->h[l] = ln->h;
     b->brk[l] = ln->brk;
     b->t[l] = b->steps[l] = 0.0;
-    b->q[l] = b->v[l] = b->P[l] = b->finite[l] = 0.0;
+    b->q[l] = b->v[l] = b->P[l] = 0.0;
     b->g[l] = one.g0 + one.w * 0.0;
     long s = break_step(ln->brk, ln->h);
     b->brk_iter[l] = s > 0 && s <= LONG_MAX - b->iter ? b->iter + s : LONG_MAX;
@@ -182,7 +182,9 @@ void pd_mjb_run(pd_mjb *b, long nsteps, pd_mjb_observer observer, void *ctx)
     }
 }
 
+/* A state that stops being finite stays so: q and v feed every later q
+ * and v through sums and products, so the state now tells. */
 int pd_mjb_finite(const pd_mjb *b, int l)
 {
-    return l >= 0 && l < PD_MJB_LANES && b->finite[l] == 0.0;
+    return l >= 0 && l < PD_MJB_LANES && isfinite(b->q[l]) && isfinite(b->v[l]);
 }

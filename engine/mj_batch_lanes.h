@@ -25,22 +25,19 @@ void MJB_LANES_STEP(pd_mjb *b)
 {
     for (int j = 0; j < NVEC; j++) {
         int l = j * MJ1_WIDTH;
-        mj1_vec q, v, g, P, F0, F1, h, fin;
+        mj1_vec q, v, g, P, F0, F1, h;
         memcpy(&q, &b->q[l], sizeof q);
         memcpy(&v, &b->v[l], sizeof v);
         memcpy(&g, &b->g[l], sizeof g);
         memcpy(&F0, &b->F0[l], sizeof F0);
         memcpy(&F1, &b->F1[l], sizeof F1);
         memcpy(&h, &b->h[l], sizeof h);
-        memcpy(&fin, &b->finite[l], sizeof fin);
         mj1_stepv(b->theta, &h, mjb_coef(b, j), &F0, &F1, &q, &v, &g, &P);
-        fin += (q - q) + (v - v);
         memcpy(&b->q[l], &q, sizeof q);
         memcpy(&b->v[l], &v, sizeof v);
         memcpy(&b->g[l], &g, sizeof g);
         memcpy(&b->P[l], &P, sizeof P);
         memcpy(&b->F0[l], &F1, sizeof F1);
-        memcpy(&b->finite[l], &fin, sizeof fin);
     }
 }
 

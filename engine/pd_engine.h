@@ -206,7 +206,6 @@ struct pd_mjb {
     double P[PD_MJB_LANES];     /* impulses of the last step */
     double F0[PD_MJB_LANES];    /* forces at t+ */
     double F1[PD_MJB_LANES];    /* forces at the step's end (scratch) */
-    double finite[PD_MJB_LANES]; /* 0 while the lane stayed finite, NaN after */
     double h[PD_MJB_LANES], brk[PD_MJB_LANES];
     double coef[11 * PD_MJB_LANES]; /* private: the lanes' constants */
 };
@@ -226,8 +225,9 @@ PD_API int pd_mjb_set_lane(pd_mjb *b, int l, const pd_mjb_lane *ln, pd_err *err)
 typedef int (*pd_mjb_observer)(const pd_mjb *b, void *ctx);
 PD_API void pd_mjb_run(pd_mjb *b, long nsteps, pd_mjb_observer observer, void *ctx);
 
-/* 1 when lane l's state stayed finite since it was set: otherwise its run
- * is repeated alone by pd_mj to name the step where it failed. */
+/* 1 when lane l's state is finite (a state that stops being finite stays
+ * so): otherwise its run is repeated alone by pd_mj to name the step where
+ * it failed. */
 PD_API int pd_mjb_finite(const pd_mjb *b, int l);
 
 /* ---- event-driven reference for the general system (engine/event.c) --- *

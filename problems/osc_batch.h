@@ -38,7 +38,8 @@ typedef struct osc_batch {
     int live[NL], nlive; /* the lanes still inside their excitation, in order */
     /* the measurements: what every step updates, by vectors of lanes */
     double Pi3[NL] __attribute__((aligned(64))), meas_from[NL]; /* window start - h/2 */
-    double xmax[NL] __attribute__((aligned(64))), xtoward[NL], xaway[NL], min_gap[NL], Pmax[NL];
+    /* (umax, max |x|, is the larger of xtoward and xaway: not kept apart) */
+    double xtoward[NL] __attribute__((aligned(64))), xaway[NL], min_gap[NL], Pmax[NL];
     double contact[NL] __attribute__((aligned(64))); /* contact steps (whole numbers) */
     double prev_x[NL] __attribute__((aligned(64))), prev_v[NL], prev2_v[NL], prev_P[NL];
     /* ... and what the rare events update */
@@ -50,7 +51,8 @@ typedef struct osc_batch {
 static inline void rare_load(osc_batch *ob, int l)
 {
     pd_osc_track *tr = &ob->rare[l];
-    tr->xmax = ob->xmax[l];
+    tr->xmax = ob->xtoward[l] > ob->xaway[l] ? ob->xtoward[l] : ob->xaway[l];
+    tr->xmax = tr->xmax > 0.0 ? tr->xmax : 0.0; /* as the fold of |x| from 0 gives */
     tr->xtoward = ob->xtoward[l];
     tr->xaway = ob->xaway[l];
     tr->min_gap = ob->min_gap[l];
@@ -65,7 +67,6 @@ static inline void rare_load(osc_batch *ob, int l)
 static inline void rare_store(osc_batch *ob, int l)
 {
     const pd_osc_track *tr = &ob->rare[l];
-    ob->xmax[l] = tr->xmax;
     ob->xtoward[l] = tr->xtoward;
     ob->xaway[l] = tr->xaway;
     ob->min_gap[l] = tr->min_gap;

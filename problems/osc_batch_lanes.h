@@ -6,22 +6,20 @@
 #include "osc_batch.h"
 
 /* One vector of lanes after a step: pd_osc_track_common's numbers lane for
- * lane; pd_osc_track_events for the lanes that need it (rare: a gap
- * closing, an impact begun); then pd_osc_track_shift's. */
+ * lane (max |x| is the larger of the two one-sided maxima, formed at the
+ * end: osc_batch.h's rare_load); pd_osc_track_events for
+ * the lanes that need it (rare: a gap closing, an impact begun); then
+ * pd_osc_track_shift's. */
 static inline void track_vector(osc_batch *ob, int l)
 {
     const vd zero = {0.0}, one = zero + 1.0;
-    const vm sign = (vm)(-zero); /* -0.0: the sign bit */
-    vd x, v, P, t, Pi3, mf, xmax, xto, xaw, mg, Pmax, cont, px, pP, pv;
+    vd x, v, P, Pi3, xto, xaw, mg, Pmax, cont, px, pP, pv;
 #define LOAD(var, arr) memcpy(&var, &(arr)[l], sizeof var)
 #define STORE(arr, var) memcpy(&(arr)[l], &var, sizeof var)
     LOAD(x, ob->mjb.q);
     LOAD(v, ob->mjb.v);
     LOAD(P, ob->mjb.P);
-    LOAD(t, ob->mjb.t);
     LOAD(Pi3, ob->Pi3);
-    LOAD(mf, ob->meas_from);
-    LOAD(xmax, ob->xmax);
     LOAD(xto, ob->xtoward);
     LOAD(xaw, ob->xaway);
     LOAD(mg, ob->min_gap);
@@ -30,9 +28,11 @@ static inline void track_vector(osc_batch *ob, int l)
     LOAD(px, ob->prev_x);
     LOAD(pP, ob->prev_P);
     LOAD(pv, ob->prev_v);
-    vd gap = Pi3 - x, ax = (vd)((vm)x & ~sign), nx = -x;
-    vm meas = t >= mf, pos = P > zero;
-    xmax = SELECT(meas, SELECT(xmax > ax, xmax, ax), xmax);
+    vd gap = Pi3 - x, nx = -x;
+    vd t, mf;
+    LOAD(t, ob->mjb.t);
+    LOAD(mf, ob->meas_from);
+    vm pos = P > zero, meas = t >= mf;
     xto = SELECT(meas, SELECT(xto > x, xto, x), xto);
     xaw = SELECT(meas, SELECT(xaw > nx, xaw, nx), xaw);
     cont = cont + (vd)(pos & (vm)one);
@@ -41,7 +41,6 @@ static inline void track_vector(osc_batch *ob, int l)
     vd gprev = Pi3 - px;
     /* every lane has taken a step: step > 0 */
     vm due = ((gprev > zero) & ((gap <= zero) | pos)) | (pos & (pP == zero));
-    STORE(ob->xmax, xmax);
     STORE(ob->xtoward, xto);
     STORE(ob->xaway, xaw);
     STORE(ob->min_gap, mg);
