@@ -1005,7 +1005,8 @@ def cases_faults(env):
         (["simulate", "--chain", "200", "--tend", "1000", "--every", "1000", "-o", "x.h5"], "x.h5", False),
         (["simulate", "--chain", "200", "--tend", "1000", "--every", "1000", "-o", "x.csv"], "x.csv", False),
         (["simulate", "--chain", "100", "--tend", "2000", "--dump-lcp", "d.h5"], "d.h5", False),
-        (["spectrum", "--Pi2", "0.05:5:5000", "--Pi3", "0.01,0.1", "-o", "s.h5"], "s.h5", True),
+        (["spectrum", "--Pi2", "0.05:5:5000", "--Pi3", "0.01,0.1", "--dt-per-Tp", "20000", "-o",
+          "s.h5"], "s.h5", True),
     ]
     for sig in (signal.SIGTERM, signal.SIGINT):
         for argv, out, resumable in long_runs:
