@@ -21,6 +21,8 @@ static inline mj1_coefv *mjb_coef(pd_mjb *b, int j)
     return (mj1_coefv *)(void *)b->coef + j;
 }
 
+/* Every vector of lanes one step (mj1_stepv) with the forces F1 at the
+ * step's end, which become the next step's F0. */
 void MJB_LANES_STEP(pd_mjb *b)
 {
     for (int j = 0; j < NVEC; j++) {

@@ -98,8 +98,11 @@ def simulate(history=True, every=1, **case):
     'sine'|'cosine'|'harmonic' ['sine'], dir 'normal'|'reverse' (or +1/-1)
     ['normal'], ap [1] m/s^2, Tp [1] s, T0 s or Pi2 [1], gap m or Pi3 [0.05],
     eps [0.5], xi [0.05]; record (a file or a pound.Record), scale [1],
-    units ['g'], record_format ['auto']; method 'moreau'|'event'|'penalty'
-    ['moreau'], dt [min(Tp, T0)/2000], tend [Tp + 2 T0], theta [0.5],
+    units ['g'], record_format ['auto']; method 'auto'|'moreau'|'event'|
+    'penalty' ['auto': the exact event-driven reference, or Moreau-Jean
+    where its scan would be over budget; a keyword only one method takes,
+    dt, theta, kc, ..., chooses that method, as on the command line: r.method
+    and r.method_by say which and why], dt [min(Tp, T0)/2000], tend [Tp + 2 T0], theta [0.5],
     gamma [0.5], allow_unstable, no_accumulation, no_wall, kernel
     'auto'|'general', factor, lcp_solver, contact 'kelvin'|'hertz', kc,
     kc_abs, rtol, atol, stepper.
