@@ -11,6 +11,7 @@
 #ifndef PD_MJ1_H
 #define PD_MJ1_H
 
+#include "pd_cpu.h"
 #include "pd_engine.h"
 
 /* The constants of one system: its own and the reciprocals that keep
@@ -134,11 +135,6 @@ static inline void mj1_stepv(double th, const mj1_vec *hp, const mj1_coefv *s,
 
 /* The batch's step over every lane, per instruction set (mj_batch_lanes.h):
  * x86-64 variants with GCC; the baseline everywhere. */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(PD_NO_VARIANTS)
-#define PD_MJB_X86_VARIANTS 1
-#else
-#define PD_MJB_X86_VARIANTS 0
-#endif
 void pd_mjb_lanes_step_base(pd_mjb *b);
 void pd_mjb_lanes_step_x86v3(pd_mjb *b);
 void pd_mjb_lanes_step_x86v4(pd_mjb *b);

@@ -25,13 +25,13 @@ _Static_assert(offsetof(pd_mjb, brk_iter) % 64 == 0 && offsetof(pd_mjb, t) % 64 
  * (the same text compiled for each, mj_batch_lanes.h), else the baseline. */
 static pd_mjb_step_fn lanes_step_for_cpu(void)
 {
-#if PD_MJB_X86_VARIANTS
-    if (__builtin_cpu_supports("x86-64-v4"))
-        return pd_mjb_lanes_step_x86v4;
-    if (__builtin_cpu_supports("x86-64-v3"))
-        return pd_mjb_lanes_step_x86v3;
+    switch (pd_cpu_level()) {
+#if PD_X86_VARIANTS
+    case 4: return pd_mjb_lanes_step_x86v4;
+    case 3: return pd_mjb_lanes_step_x86v3;
 #endif
-    return pd_mjb_lanes_step_base;
+    default: return pd_mjb_lanes_step_base;
+    }
 }
 
 /* The idle lane: a unit mass at rest, no contact, no force breakpoint. */

@@ -2,7 +2,7 @@
  * mj_batch_lanes.h's text; mj_batch.c picks it when the processor has it. */
 #include "mj1.h"
 
-#if PD_MJB_X86_VARIANTS
+#if PD_X86_VARIANTS
 #pragma GCC target("arch=x86-64-v4")
 #define MJB_LANES_STEP pd_mjb_lanes_step_x86v4
 #include "mj_batch_lanes.h"

@@ -183,13 +183,13 @@ int pd_osc_batchable(const pd_osc *c, const pd_run_opts *o)
  * engine's step). */
 static pd_mjb_observer observe_for_cpu(void)
 {
-#if PD_MJB_X86_VARIANTS
-    if (__builtin_cpu_supports("x86-64-v4"))
-        return pd_osc_batch_observe_x86v4;
-    if (__builtin_cpu_supports("x86-64-v3"))
-        return pd_osc_batch_observe_x86v3;
+    switch (pd_cpu_level()) {
+#if PD_X86_VARIANTS
+    case 4: return pd_osc_batch_observe_x86v4;
+    case 3: return pd_osc_batch_observe_x86v3;
 #endif
-    return pd_osc_batch_observe_base;
+    default: return pd_osc_batch_observe_base;
+    }
 }
 
 /* The stream's state: the source, the batch (allocated on the first

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "osc_track.h"
+#include "pd_cpu.h"
 #include "pd_engine.h"
 #include "pd_problems.h"
 
@@ -78,13 +79,7 @@ static inline void rare_store(osc_batch *ob, int l)
     ob->prev_P[l] = tr->prev_P;
 }
 
-/* The measurements after a step, per instruction set (as the engine's
- * batch step: PD_MJB_X86_VARIANTS). */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(PD_NO_VARIANTS)
-#define PD_MJB_X86_VARIANTS 1
-#else
-#define PD_MJB_X86_VARIANTS 0
-#endif
+/* The measurements after a step, per instruction set (pd_cpu.h). */
 int pd_osc_batch_observe_base(const pd_mjb *b, void *ctx);
 int pd_osc_batch_observe_x86v3(const pd_mjb *b, void *ctx);
 int pd_osc_batch_observe_x86v4(const pd_mjb *b, void *ctx);

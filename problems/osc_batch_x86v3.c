@@ -3,7 +3,7 @@
  * processor has it. */
 #include "osc_batch.h"
 
-#if PD_MJB_X86_VARIANTS
+#if PD_X86_VARIANTS
 #pragma GCC target("arch=x86-64-v3")
 #define OSC_BATCH_OBSERVE pd_osc_batch_observe_x86v3
 #include "osc_batch_lanes.h"

@@ -384,7 +384,11 @@ static pd_sine_piece *record_pieces(const pd_osc *c)
 
 double pd_osc_scan_points(const pd_osc *c, double tend)
 {
-    return 64.0 * tend / fmin(c->Tp, pd_osc_T0(c));
+    double T0 = pd_osc_T0(c);
+    double sine = c->record                       ? 0.0 /* linear pieces: T0 alone */
+                  : c->pulse == PD_PULSE_HARMONIC ? tend
+                                                  : fmin(tend, c->Tp);
+    return 64.0 * (sine / fmin(c->Tp, T0) + (tend - sine) / T0);
 }
 
 int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,

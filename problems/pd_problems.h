@@ -346,7 +346,9 @@ PD_API int pd_osc_run_stream(pd_osc_stream_next next, pd_osc_stream_done done, v
                              pd_err *err);
 
 /* The event-driven reference's work: its scan points over tend (64 per
- * shortest of Tp and T0), and the most a run may take (about 5 s here: a
+ * shortest period of each forcing piece: of Tp and T0 during a pulse or
+ * a harmonic excitation, of T0 after a pulse and under a record's linear
+ * pieces), and the most a run may take (about 5 s here: a
  * stiffer oscillator is quasi-static, and Moreau-Jean runs it). */
 #define PD_OSC_MAX_SCAN 2.5e7
 PD_API double pd_osc_scan_points(const pd_osc *c, double tend);

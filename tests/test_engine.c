@@ -421,12 +421,12 @@ static void test_engine_batch_matches_scalar(pd_test_ctx *ctx)
     static const struct {
         const char *name;
         pd_mjb_step_fn fn;
-        int usable;
+        int level; /* pd_cpu_level() it needs */
     } variants[] = {
-        {"baseline", pd_mjb_lanes_step_base, 1},
-#if PD_MJB_X86_VARIANTS
-        {"x86-64-v3", pd_mjb_lanes_step_x86v3, -3},
-        {"x86-64-v4", pd_mjb_lanes_step_x86v4, -4},
+        {"baseline", pd_mjb_lanes_step_base, 0},
+#if PD_X86_VARIANTS
+        {"x86-64-v3", pd_mjb_lanes_step_x86v3, 3},
+        {"x86-64-v4", pd_mjb_lanes_step_x86v4, 4},
 #endif
     };
     static double alone[PD_MJB_LANES][2][4 * NSTEP];
@@ -448,14 +448,7 @@ static void test_engine_batch_matches_scalar(pd_test_ctx *ctx)
     }
     long compared = 0, contacts = 0, breaks = 0;
     for (size_t vi = 0; vi < sizeof variants / sizeof variants[0]; vi++) {
-        int usable = variants[vi].usable;
-#if PD_MJB_X86_VARIANTS
-        if (usable == -3)
-            usable = __builtin_cpu_supports("x86-64-v3");
-        if (usable == -4)
-            usable = __builtin_cpu_supports("x86-64-v4");
-#endif
-        if (!usable)
+        if (pd_cpu_level() < variants[vi].level)
             continue;
         pd_mjb *b = aligned_alloc(64, sizeof *b);
         pd_mj_opts o = pd_mj_default_opts();
