@@ -124,7 +124,8 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
                        {"--rtol", &a->opts.pen.rtol, NULL, 0},
                        {"--atol", &a->opts.pen.atol, NULL, 0},
                        {"--chain-ratio", &a->chain_ratio, NULL, 1},
-                       {"--scale", &a->scale, &a->have_scale, 0}};
+                       {"--scale", &a->scale, &a->have_scale, 0},
+                       {"--close-tol", &a->opts.close_tol, NULL, 0}};
     /* flags that only one method takes choose it, unless --method says another */
     static const struct {
         const char *flag;
@@ -133,6 +134,7 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
                 {"--gamma", PD_METHOD_MOREAU},     {"--allow-unstable", PD_METHOD_MOREAU},
                 {"--kernel", PD_METHOD_MOREAU},    {"--factor", PD_METHOD_MOREAU},
                 {"--lcp-solver", PD_METHOD_MOREAU}, {"--no-accumulation", PD_METHOD_EVENT},
+                {"--close-tol", PD_METHOD_EVENT},
                 {"--kc", PD_METHOD_PENALTY},       {"--kc-abs", PD_METHOD_PENALTY},
                 {"--rtol", PD_METHOD_PENALTY},     {"--atol", PD_METHOD_PENALTY},
                 {"--contact", PD_METHOD_PENALTY},  {"--stepper", PD_METHOD_PENALTY}};
@@ -166,7 +168,7 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
         rc = named(f, val, pd_dir_parse(val, &a->c.dir) != PD_OK, "normal, reverse");
     else if (!strcmp(f, "--method")) {
         rc = named(f, val, pd_method_parse(val, &a->opts.method) != PD_OK,
-                   "moreau, event, penalty, auto");
+                   "moreau, event, penalty, auto, event-general");
         a->method_by = a->opts.method == PD_METHOD_AUTO ? NULL : f;
     }
     else if (!strcmp(f, "--contact")) {

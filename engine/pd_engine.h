@@ -386,6 +386,110 @@ PD_API void pd_sdof_advance(const pd_sdof *osc, double A, double w, double phi, 
 PD_API void pd_sdof_increment(const pd_sdof *osc, double A, double w, double phi, double t0,
                               double u0, double v0, double t1, double *du, double *v1);
 
+/* ---- exact event-driven reference for rows (engine/event_row.c) -------- *
+ * For models whose structures are linear between events under a force
+ * F(t) = b f(t), f a sequence of pd_sine_piece (pulses, harmonics, the
+ * linear pieces of a record): each structure (block of dofs that M, C, K
+ * couple; M diagonal) or cluster of structures held by persistent contacts
+ * moves by an exact closed-form flight (an underdamped oscillator for SDOFs
+ * and rigid trees of them, complex modes otherwise), so the reference is
+ * exact to rounding.  Events are asynchronous: each contact's next closing
+ * is predicted from the flights of its two sides (a scan at 1/64 of the
+ * shortest period of the pair that cannot miss a grazing dip, roots to
+ * adjacent doubles), a priority queue orders them, and an event changes
+ * only the cluster it touches, so its cost does not grow with the row.
+ * At an impact the contacts closed within close_tol form one velocity LCP
+ * with Newton's law (paper Eqs. 3, 4, 8, 9), persistence is decided by the
+ * contact-force LCP (Eqs. 2, 7), detachment root-found on the closed-form
+ * contact forces, accumulations of impacts jumped to their limit
+ * (docs/methods.md). */
+typedef struct pd_piecewise_force {
+    const double *b;             /* n: F(t) = b f(t) */
+    const pd_sine_piece *pieces; /* f: piece k from pieces[k].t_start to the next start */
+    int npieces;                 /* >= 1 */
+} pd_piecewise_force;
+
+/* What an event did, for observers (momentum and energy tests). */
+typedef enum { PD_EDR_IMPACT = 0, PD_EDR_DETACH = 1, PD_EDR_PIECE = 2 } pd_edr_kind;
+
+typedef struct pd_edr_event {
+    double t;
+    pd_edr_kind kind;
+    int ncontacts;         /* the contacts taken as closed (impact) or re-decided */
+    const int *contacts;
+    const double *P;       /* their impulses (impact) */
+    const double *U_minus, *U_plus; /* their gap rates before and after */
+    int ndofs;             /* the dofs of the clusters involved */
+    const int *dofs;
+    const double *v_minus, *v_plus; /* their velocities before and after */
+    int accumulation;      /* an accumulation of impacts was jumped here */
+} pd_edr_event;
+
+typedef int (*pd_edr_event_fn)(const pd_edr_event *ev, void *ctx);
+
+typedef struct pd_edr_opts {
+    double close_tol;      /* at an impact, contacts with gap <= close_tol * length_scale
+                              are closed too (one LCP); >= 0 */
+    double length_scale;   /* > 0: the scene's length (1 in the reference units) */
+    double t_measure;      /* extremes count from here */
+    double h_out;          /* > 0: the observer every h_out from t0 (and at t1) */
+    const int *below;      /* NULL, or n: the dof whose displacement is subtracted for the
+                              drift of dof i (-1: the ground) */
+    int no_accumulation;   /* 1: never jump an accumulation */
+    int inactive;          /* 1: contacts are measured (gaps) but never act (free twins) */
+    long max_events;       /* impacts, detachments and piece changes >= 1 */
+    long max_burst;        /* impacts of one contact before it rests or leaves, >= 1 */
+    double max_evals;      /* flight evaluations (the cost) before PD_EBUDGET, >= 1 */
+    int scan_divisions;    /* scan step: shortest period / this, >= 1 */
+    pd_lcp_method lcp_solver;
+    pd_edr_event_fn on_event; /* optional: every impact, detachment, piece change */
+    void *on_event_ctx;
+} pd_edr_opts;
+
+/* close_tol 1e-12, length scale 1, t_measure 0, no output grid, drift of
+ * each dof against the ground, accumulations jumped, active contacts, 10^7
+ * events, bursts of 10^5, 4e9 evaluations, 64 scan divisions, automatic
+ * LCP solver. */
+PD_API pd_edr_opts pd_edr_default_opts(void);
+
+typedef struct pd_edr_result {
+    long events, impacts, simultaneous, tol_closed, accumulations, detachments;
+    long lcp_solves;
+    long modal_bases;      /* cluster configurations diagonalised */
+    double evals;          /* flight evaluations */
+    double first_impact;   /* NAN: none */
+    double t_reached;
+    double max_penetration; /* deepest gap below zero the measurement found (rounding) */
+    /* per dof (n), over [t_measure, t1]: */
+    const double *xpos, *xneg; /* max x, max -x */
+    const double *drift;       /* max |x_i - x_below(i)| */
+    /* per contact (m): */
+    const long *contact_impacts;
+    const double *first;        /* NAN: none */
+    const double *max_impulse;  /* largest impulse of one event */
+    const double *contact_time; /* time persistent */
+    const double *min_gap;      /* smallest gap (0 once closed) */
+} pd_edr_result;
+
+typedef struct pd_edr pd_edr;
+
+/* Check the model (M diagonal and positive, every contact joining at most
+ * two structures), find its structures and allocate every workspace.  The
+ * model and force must outlive the object.  NULL on failure (err says why). */
+PD_API pd_edr *pd_edr_alloc(const pd_model *model, const pd_piecewise_force *force,
+                            const pd_edr_opts *opts, pd_err *err);
+PD_API void pd_edr_free(pd_edr *r);
+
+/* Run from (t0, q0, v0) (NULL = zeros) to t1.  The observer gets pd_state
+ * at t0 and every h_out (P: the impulses since the previous call; active:
+ * the persistent contacts).  PD_EBUDGET when a budget runs out, with the
+ * time in the message. */
+PD_API int pd_edr_run(pd_edr *r, double t0, const double *q0, const double *v0, double t1,
+                      pd_observer observer, void *ctx, pd_err *err);
+
+/* The last run's results (valid until the next run or pd_edr_free). */
+PD_API const pd_edr_result *pd_edr_result_of(const pd_edr *r);
+
 /* ---- event-driven reference: one oscillator, one wall (event_sdof.c) --
 
  *   x'' + 2 xi w0 x' + w0^2 x = F(t) - lambda,  g = delta - x >= 0,

@@ -130,6 +130,9 @@ int pd_osc_resolve_opts(const pd_osc *c, const pd_run_opts *in, pd_run_opts *out
     *out = in ? *in : pd_run_default_opts();
     if ((rc = pd_osc_check(c, err)) || (rc = pd_run_opts_check(out, err)))
         return rc;
+    if (out->method == PD_METHOD_EVENT_GENERAL)
+        return pd_err_set(err, PD_EINVAL, "method: event-general is the general reference for "
+                          "scenes; the oscillator's exact reference is event");
     if (out->dt == 0.0)
         out->dt = pd_osc_default_dt(c);
     if (out->tend == 0.0)
@@ -364,22 +367,32 @@ static int ref_sample(double tau, double x, double v, int in_contact, void *ctx)
     return b->sampler(&s, b->ctx);
 }
 
-/* A record's forcing in Pi units, piece k = [tau_k, tau_k+1): F linear
- * from F(tau_k) with the piece's slope; the last piece (after the record) is
- * zero.  npts pieces, malloc'd; NULL when out of memory. */
-static pd_sine_piece *record_pieces(const pd_osc *c)
+int pd_osc_pieces(const pd_osc *c, pd_sine_piece **pieces, int *npieces, pd_err *err)
 {
     const pd_record *r = c->record;
-    double wp = pd_osc_wp(c), g = -(double)c->dir / c->rec_ap;
-    pd_sine_piece *p = malloc((size_t)r->npts * sizeof *p);
+    int n = r ? (int)r->npts : c->pulse == PD_PULSE_HARMONIC ? 1 : 2;
+    pd_sine_piece *p = malloc((size_t)n * sizeof *p);
+    *pieces = NULL;
+    *npieces = 0;
     if (!p)
-        return NULL;
-    for (long k = 0; k + 1 < r->npts; k++)
-        p[k] = (pd_sine_piece){.t_start = wp * (double)k * r->dt,
-                               .c0 = g * r->acc[k],
-                               .c1 = g * (r->acc[k + 1] - r->acc[k]) / (wp * r->dt)};
-    p[r->npts - 1] = (pd_sine_piece){.t_start = pd_osc_shape_end(c)};
-    return p;
+        return pd_err_set(err, PD_ENOMEM, "out of memory for the forcing pieces of %s",
+                          pd_osc_excitation_name(c));
+    if (r) { /* piece k = [tau_k, tau_k+1): linear from F(tau_k) with the piece's slope */
+        double wp = pd_osc_wp(c), g = -(double)c->dir / c->rec_ap;
+        for (long k = 0; k + 1 < r->npts; k++)
+            p[k] = (pd_sine_piece){.t_start = wp * (double)k * r->dt,
+                                   .c0 = g * r->acc[k],
+                                   .c1 = g * (r->acc[k + 1] - r->acc[k]) / (wp * r->dt)};
+        p[n - 1] = (pd_sine_piece){.t_start = pd_osc_shape_end(c)};
+    } else { /* s sin(tau + phi) (cos = sin(+pi/2)), then zero after 2 pi */
+        double phi = c->pulse == PD_PULSE_COSINE ? PD_TWO_PI / 4.0 : 0.0;
+        p[0] = (pd_sine_piece){.t_start = 0.0, .A = (double)c->dir, .w = 1.0, .phi = phi};
+        if (n > 1)
+            p[1] = (pd_sine_piece){.t_start = PD_TWO_PI};
+    }
+    *pieces = p;
+    *npieces = n;
+    return PD_OK;
 }
 
 double pd_osc_scan_points(const pd_osc *c, double tend)
@@ -405,21 +418,15 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
         return pd_err_set(err, PD_EINVAL, "Pi2: the event-driven reference would scan %.3g "
                           "points over tend (T0 = %.3g s; at most %.0e)", scan, pd_osc_T0(c),
                           PD_OSC_MAX_SCAN);
-    /* forcing pieces in Pi units: s sin(tau + phi) on [0, 2 pi], then zero;
-     * a record: its linear pieces, then zero */
-    double phi = c->pulse == PD_PULSE_COSINE ? PD_TWO_PI / 4.0 : 0.0;
-    pd_sine_piece pulse[2] = {{.t_start = 0.0, .A = (double)c->dir, .w = 1.0, .phi = phi},
-                              {.t_start = PD_TWO_PI, .A = 0.0, .w = 0.0, .phi = 0.0}};
-    pd_sine_piece *pieces = c->record ? record_pieces(c) : pulse;
-    if (!pieces)
-        return pd_err_set(err, PD_ENOMEM, "out of memory for the pieces of record %s",
-                          c->record->name);
+    pd_sine_piece *pieces;
+    int npieces;
+    if ((rc = pd_osc_pieces(c, &pieces, &npieces, err)))
+        return rc;
     pd_ed_sdof prob = {.osc = {.w0 = c->Pi2, .xi = c->xi},
                        .wall = !o.no_wall,
                        .delta = c->Pi3,
                        .e = c->eps,
-                       .npieces = c->record ? (int)c->record->npts
-                                            : c->pulse == PD_PULSE_HARMONIC ? 1 : 2,
+                       .npieces = npieces,
                        .pieces = pieces};
     double wp = pd_osc_wp(c), Le = pd_osc_Le(c);
     pd_ed_opts eo = pd_ed_default_opts();
@@ -431,8 +438,7 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
                          .sampler = sampler, .ctx = ctx};
     double cpu0 = pd_cpu_seconds();
     rc = pd_ed_sdof_run(&prob, 0.0, 0.0, &eo, sampler ? ref_sample : NULL, &bridge, &er, err);
-    if (pieces != pulse)
-        free(pieces);
+    free(pieces);
     memset(res, 0, sizeof *res);
     res->umax = er.xmax * Le;
     res->u_toward = er.xtoward * Le;

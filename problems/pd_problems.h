@@ -159,10 +159,12 @@ typedef enum {
     PD_METHOD_MOREAU = 0,
     PD_METHOD_EVENT = 1,
     PD_METHOD_PENALTY = 2,
-    PD_METHOD_AUTO = 3
+    PD_METHOD_AUTO = 3,
+    PD_METHOD_EVENT_GENERAL = 4 /* scenes: the GSL-based general reference (pd_edg_run) */
 } pd_method;
 
-/* "moreau", "event", "penalty", "auto"; parse: PD_OK or PD_EINVAL. */
+/* "moreau", "event", "penalty", "auto", "event-general"; parse: PD_OK or
+ * PD_EINVAL. */
 PD_API const char *pd_method_name(pd_method method);
 PD_API int pd_method_parse(const char *name, pd_method *method);
 
@@ -197,7 +199,13 @@ typedef struct pd_run_opts {
     pd_penalty_setup pen;
     pd_lcp_observer on_lcp; /* Moreau–Jean's general kernel: every contact LCP solved */
     void *on_lcp_ctx;
+    double close_tol;   /* event-driven rows: at an impact, contacts whose gap is within
+                           close_tol Le are closed too (simultaneous); >= 0 */
 } pd_run_opts;
+
+/* The default closing tolerance of the event-driven reference for rows:
+ * gaps within this many Le of zero at an impact take part in it. */
+#define PD_CLOSE_TOL 1e-12
 
 /* The automatic method (PD_METHOD_AUTO: exact for one oscillator,
  * Moreau-Jean for scenes), dt and tend derived, theta = gamma = 1/2 for
@@ -263,6 +271,11 @@ PD_API double pd_osc_shape_end(const pd_osc *c);
  * (side -1) is 0 past end (1 + 1e-12), its right limit (+1) from end
  * (1 - 1e-12) on. */
 PD_API double pd_shape_cut(double end, int side);
+
+/* The excitation as forcing pieces in Pi units (f = pd_osc_shape): a
+ * pulse's s sin(tau + phi) on [0, 2 pi] then zero (harmonic: one piece for
+ * all tau), a record's linear pieces then zero; *pieces malloc'd (free()). */
+PD_API int pd_osc_pieces(const pd_osc *c, pd_sine_piece **pieces, int *npieces, pd_err *err);
 
 /* The name of the excitation: the pulse's, or the record's file name. */
 PD_API const char *pd_osc_excitation_name(const pd_osc *c);
@@ -577,7 +590,13 @@ typedef struct pd_scene_result {
     double *contact_time;  /* m: time in contact [s] */
     double *approach;      /* m: max over t of -(g - gap), the closing [m] */
     long steps;            /* steps, accepted steps or events */
-    long lcp_solves;       /* LCPs solved (Moreau–Jean general kernel) */
+    long lcp_solves;       /* LCPs solved (Moreau–Jean general kernel, event-driven) */
+    /* the model decisions of the event-driven reference (0 for the other methods):
+     * impacts whose LCP took several contacts at zero gap, contacts taken as closed
+     * within the closing tolerance (gap in (0, close_tol Le]), accumulations of
+     * impacts jumped to their limit */
+    long simultaneous, tol_closed, accumulations;
+    double close_tol;      /* the closing tolerance used [in Le] (NAN: not event-driven) */
     double dt, tend, theta, cpu_s;
     const char *method, *kernel, *factor, *lcp_solver;
 } pd_scene_result;

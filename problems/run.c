@@ -6,10 +6,11 @@
 
 const char *pd_method_name(pd_method method)
 {
-    return method == PD_METHOD_EVENT     ? "event"
-           : method == PD_METHOD_PENALTY ? "penalty"
-           : method == PD_METHOD_AUTO    ? "auto"
-                                         : "moreau";
+    return method == PD_METHOD_EVENT           ? "event"
+           : method == PD_METHOD_PENALTY       ? "penalty"
+           : method == PD_METHOD_AUTO          ? "auto"
+           : method == PD_METHOD_EVENT_GENERAL ? "event-general"
+                                               : "moreau";
 }
 
 int pd_method_parse(const char *name, pd_method *method)
@@ -22,6 +23,8 @@ int pd_method_parse(const char *name, pd_method *method)
         *method = PD_METHOD_PENALTY;
     else if (name && !strcmp(name, "auto"))
         *method = PD_METHOD_AUTO;
+    else if (name && !strcmp(name, "event-general"))
+        *method = PD_METHOD_EVENT_GENERAL;
     else
         return PD_EINVAL;
     return PD_OK;
@@ -47,13 +50,15 @@ pd_run_opts pd_run_default_opts(void)
                                  .atol = 1e-12,
                                  .stepper = "rk8pd"},
                          .on_lcp = NULL,
-                         .on_lcp_ctx = NULL};
+                         .on_lcp_ctx = NULL,
+                         .close_tol = PD_CLOSE_TOL};
 }
 
 int pd_run_opts_check(const pd_run_opts *o, pd_err *err)
 {
     if (o->method != PD_METHOD_MOREAU && o->method != PD_METHOD_EVENT &&
-        o->method != PD_METHOD_PENALTY && o->method != PD_METHOD_AUTO)
+        o->method != PD_METHOD_PENALTY && o->method != PD_METHOD_AUTO &&
+        o->method != PD_METHOD_EVENT_GENERAL)
         return pd_err_set(err, PD_EINVAL, "method: unknown method %d", (int)o->method);
     if (!(o->dt >= 0.0) || !isfinite(o->dt))
         return pd_err_set(err, PD_EINVAL, "dt: must be a finite number > 0 (got %g)", o->dt);
@@ -68,6 +73,9 @@ int pd_run_opts_check(const pd_run_opts *o, pd_err *err)
                           o->theta);
     if (!(o->gamma >= 0.0 && o->gamma <= 1.0))
         return pd_err_set(err, PD_EINVAL, "gamma: must be in [0, 1] (got %g)", o->gamma);
+    if (!(o->close_tol >= 0.0 && o->close_tol <= 1.0))
+        return pd_err_set(err, PD_EINVAL, "close-tol: the closing tolerance must be in [0, 1] "
+                          "(in units of Le; got %g)", o->close_tol);
     const pd_penalty_setup *p = &o->pen;
     if (p->law != PD_PENALTY_KELVIN && p->law != PD_PENALTY_HERTZDAMP)
         return pd_err_set(err, PD_EINVAL, "contact: unknown contact law %d", (int)p->law);

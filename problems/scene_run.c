@@ -432,6 +432,7 @@ static int run_oscillator(const pd_scene *sc, const pd_osc *c, int mirrored,
         res->approach[0] = r.u_toward;
     }
     res->steps = r.steps;
+    res->accumulations = r.accumulations;
     res->lcp_solves = 0;
     res->kernel = r.kernel;
     res->factor = o->method == PD_METHOD_MOREAU ? "scalar" : "none";
@@ -467,9 +468,72 @@ static int run_moreau(const pd_model *md, const pd_run_opts *o, long nsteps, tra
     return rc;
 }
 
-/* The general event-driven reference on the scene's model. */
-static int run_event(const pd_model *md, const pd_run_opts *o, double tau_end, track *tr,
+/* The row reference's samples: impulses since the last sample come with
+ * the state. */
+static int observe_edr(const pd_state *st, void *ctx)
+{
+    track *tr = ctx;
+    for (int a = 0; a < tr->model_m; a++)
+        tr->imp[a] += st->P[a];
+    return sample(tr, st);
+}
+
+/* The exact event-driven reference for rows (pd_edr) on the scene's model:
+ * its exact extremes, impacts and gaps replace the tracker's. */
+static int run_event(const pd_scene_model *sm, const pd_run_opts *o, double tau_end, track *tr,
                      pd_scene_result *res, pd_err *err)
+{
+    pd_edr_opts eo = pd_edr_default_opts();
+    pd_sine_piece *pieces;
+    int npieces, rc;
+    if ((rc = pd_osc_pieces(&sm->shape, &pieces, &npieces, err)))
+        return rc;
+    pd_piecewise_force F = {.b = sm->mass, .pieces = pieces, .npieces = npieces};
+    eo.close_tol = o->close_tol;
+    eo.t_measure = tr->tau_measure;
+    eo.h_out = tr->fn ? tr->h : 0.0;
+    eo.below = tr->below;
+    eo.no_accumulation = o->no_accumulation;
+    eo.inactive = o->no_wall;
+    eo.lcp_solver = o->lcp_solver;
+    pd_edr *edr = pd_edr_alloc(&sm->model, &F, &eo, err);
+    if (!edr) {
+        free(pieces);
+        return err ? err->status : PD_ENOMEM;
+    }
+    rc = pd_edr_run(edr, 0.0, NULL, NULL, tau_end, tr->fn ? observe_edr : NULL, tr, err);
+    const pd_edr_result *er = pd_edr_result_of(edr);
+    for (int i = 0; i < tr->n; i++) {
+        tr->xpos[i] = er->xpos[i];
+        tr->xneg[i] = er->xneg[i];
+        tr->xmax[i] = pd_max(er->xpos[i], er->xneg[i]);
+        tr->drift[i] = er->drift[i];
+    }
+    for (int a = 0; a < tr->m; a++) {
+        tr->impacts[a] = er->contact_impacts[a];
+        tr->first[a] = er->first[a];
+        tr->maxP[a] = er->max_impulse[a];
+        tr->ctime[a] = er->contact_time[a];
+        tr->approach[a] = sm->g0[a] - er->min_gap[a];
+    }
+    tr->lcp_solves = er->lcp_solves;
+    res->steps = er->events;
+    res->simultaneous = er->simultaneous;
+    res->tol_closed = er->tol_closed;
+    res->accumulations = er->accumulations;
+    res->close_tol = o->close_tol;
+    res->kernel = "event-rows";
+    res->factor = "none";
+    res->lcp_solver = pd_lcp_method_name(o->lcp_solver);
+    pd_edr_free(edr);
+    free(pieces);
+    return rc;
+}
+
+/* The general event-driven reference (pd_edg_run, GSL between events) on
+ * the scene's model. */
+static int run_event_general(const pd_model *md, const pd_run_opts *o, double tau_end,
+                             track *tr, pd_scene_result *res, pd_err *err)
 {
     pd_edg_opts eo = pd_edg_default_opts();
     pd_edg_result er;
@@ -482,6 +546,7 @@ static int run_event(const pd_model *md, const pd_run_opts *o, double tau_end, t
     int rc = pd_edg_run(md, 0.0, NULL, NULL, tau_end, &eo, tr->fn ? observe_grid : NULL, tr, &er,
                         err);
     res->steps = er.events;
+    res->accumulations = er.accumulations;
     res->kernel = "event-general";
     res->factor = pd_factor_kind_name(pd_factor_choose(md, o->factor));
     res->lcp_solver = pd_lcp_method_name(o->lcp_solver);
@@ -536,7 +601,8 @@ static int run_general(const pd_scene *sc, const pd_run_opts *o, pd_scene_sample
     track tr;
     int rc;
     memset(&tr, 0, sizeof tr);
-    if ((rc = pd_scene_model_build(sc, !o->no_wall, &sm, err)))
+    /* the row reference measures the gaps of a free twin's contacts itself */
+    if ((rc = pd_scene_model_build(sc, !o->no_wall || o->method == PD_METHOD_EVENT, &sm, err)))
         return rc;
     if ((rc = track_alloc(&tr, sc, err))) {
         pd_scene_model_free(&sm);
@@ -553,7 +619,10 @@ static int run_general(const pd_scene *sc, const pd_run_opts *o, pd_scene_sample
     long nsteps = pd_steps_for(o->tend, o->dt);
     double tau_end = (double)nsteps * tr.h;
     switch (o->method) {
-    case PD_METHOD_EVENT: rc = run_event(&sm.model, o, tau_end, &tr, res, err); break;
+    case PD_METHOD_EVENT: rc = run_event(&sm, o, tau_end, &tr, res, err); break;
+    case PD_METHOD_EVENT_GENERAL:
+        rc = run_event_general(&sm.model, o, tau_end, &tr, res, err);
+        break;
     case PD_METHOD_PENALTY: rc = run_penalty(&sm.model, o, tau_end, &tr, res, err); break;
     default: rc = run_moreau(&sm.model, o, nsteps, &tr, res, err); break;
     }
@@ -583,8 +652,11 @@ int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler s
     res->tend = o.tend;
     res->theta = o.method == PD_METHOD_MOREAU ? o.theta : NAN;
     res->method = pd_method_name(o.method);
+    res->simultaneous = res->tol_closed = res->accumulations = 0;
+    res->close_tol = o.method == PD_METHOD_EVENT ? o.close_tol : NAN;
     double cpu0 = pd_cpu_seconds();
-    if (o.kernel == PD_KERNEL_AUTO && pd_scene_as_oscillator(sc, &c, &mirrored))
+    if (o.kernel == PD_KERNEL_AUTO && o.method != PD_METHOD_EVENT_GENERAL &&
+        pd_scene_as_oscillator(sc, &c, &mirrored))
         rc = run_oscillator(sc, &c, mirrored, &o, sampler, ctx, res, err);
     else
         rc = run_general(sc, &o, sampler, ctx, res, err);

@@ -1,0 +1,209 @@
+/* edr_scan.c — the scan of a closed-form scalar function f over one
+ * interval, as the one-wall reference scans its flight (event_sdof.c):
+ * with (f, f', f'') known at every t, f' is nearly quadratic over an
+ * interval of a 64th of the shortest period, so it changes sign at most
+ * twice.  One sign change: the turn is located (an extremum of f, noted;
+ * in hit mode a maximum above zero means f crossed zero before it: a
+ * grazing closing).  None at the ends but f'' changing sign with f' within
+ * reach of zero: f' may dip through zero and back; the zero of f'' splits
+ * the interval into two of one turn each.  A crossing counts once f
+ * reaches above thr (its rounding level), so that a gap at zero whose
+ * rate and acceleration are rounding noise (a contact just released) does
+ * not close again at every next double.  Roots of f are located to
+ * adjacent doubles by safeguarded Newton on f' (bisection finishes), turns
+ * to a width (f is flat there). */
+#include <math.h>
+
+#include "edr.h"
+
+/* f' may turn twice in an interval only within this many |f''| h of zero. */
+#define TURN_MARGIN 2.0
+/* Bisection stops at adjacent doubles. */
+#define BISECT_REL 2e-16
+#define BISECT_MAX_IT 200
+#define NEWTON_MAX_IT 30
+/* A turn is not located in hit mode when f stays below -this of the
+ * interval's scale. */
+#define HERMITE_MARGIN 1e-3
+
+edr_pt edr_scan_point(edr_scan *s, double t)
+{
+    double o[3];
+    s->fn(s->ctx, t, o);
+    s->evals++;
+    return (edr_pt){.t = t, .f = o[0], .df = o[1], .ddf = o[2]};
+}
+
+void edr_scan_note(edr_scan *s, double f)
+{
+    s->fmax = fmax(s->fmax, f);
+    s->fmin = fmin(s->fmin, f);
+}
+
+/* sign * out[k] at t. */
+static double value(edr_scan *s, int k, double sign, double t, double *slope)
+{
+    double o[3];
+    s->fn(s->ctx, t, o);
+    s->evals++;
+    if (slope)
+        *slope = k < 2 ? sign * o[k + 1] : 0.0;
+    return sign * o[k];
+}
+
+/* Bisection between lo (value <= 0) and hi (> 0) to the width w (0:
+ * adjacent doubles); returns hi. */
+static double bisect_to(edr_scan *s, int k, double sign, double lo, double hi, double w)
+{
+    for (int it = 0; it < BISECT_MAX_IT && hi - lo > fmax(w, BISECT_REL * fmax(fabs(hi), 1e-300));
+         it++) {
+        double mid = 0.5 * (lo + hi);
+        if (mid <= lo || mid >= hi)
+            break;
+        if (value(s, k, sign, mid, NULL) > 0.0)
+            hi = mid;
+        else
+            lo = mid;
+    }
+    return hi;
+}
+
+/* The sign change of sign * out[k] between lo and hi by safeguarded Newton
+ * on its closed-form slope (k < 2), from the guess t0 when it lies inside
+ * (else the middle), closing the bracket around the converged step and
+ * finishing by bisection: the same hi as bisection. */
+static double locate_from(edr_scan *s, int k, double sign, double lo, double hi, double w,
+                          double t0)
+{
+    if (k == 2)
+        return bisect_to(s, k, sign, lo, hi, w);
+    double t = t0 > lo && t0 < hi ? t0 : 0.5 * (lo + hi);
+    for (int it = 0; it < NEWTON_MAX_IT; it++) {
+        double tol = fmax(w, BISECT_REL * fmax(fabs(hi), 1e-300));
+        if (hi - lo <= tol)
+            return hi;
+        double df, f = value(s, k, sign, t, &df);
+        if (f > 0.0)
+            hi = t;
+        else
+            lo = t;
+        double tn = t - f / df;
+        if (!(tn > lo && tn < hi)) {
+            t = 0.5 * (lo + hi);
+            continue;
+        }
+        if (fabs(tn - t) > tol) {
+            t = tn;
+            continue;
+        }
+        double a = fmax(tn - tol, lo), b = fmin(tn + tol, hi);
+        if (a > lo && value(s, k, sign, a, NULL) <= 0.0)
+            lo = a;
+        if (b < hi && value(s, k, sign, b, NULL) > 0.0)
+            hi = b;
+        break;
+    }
+    return bisect_to(s, k, sign, lo, hi, w);
+}
+
+static double locate(edr_scan *s, int k, double sign, double lo, double hi, double w)
+{
+    return locate_from(s, k, sign, lo, hi, w, NAN);
+}
+
+double edr_taylor_root(const edr_pt *a)
+{
+    /* f + f' s + f'' s^2 / 2 = 0: the smallest s > 0 (NAN: none) */
+    double f = a->f, d = a->df, c = 0.5 * a->ddf;
+    if (c == 0.0)
+        return d != 0.0 && -f / d > 0.0 ? -f / d : NAN;
+    double disc = d * d - 4.0 * c * f;
+    if (disc < 0.0)
+        return NAN;
+    double q = -0.5 * (d + copysign(sqrt(disc), d)), r1 = q / c, r2 = q != 0.0 ? f / q : NAN;
+    double best = NAN;
+    if (r1 > 0.0)
+        best = r1;
+    if (r2 > 0.0 && !(r2 >= best))
+        best = r2;
+    return best;
+}
+
+double edr_bisect_sign(edr_fn fn, void *ctx, int k, double sign, double lo, double hi)
+{
+    edr_scan s = {.fn = fn, .ctx = ctx};
+    return bisect_to(&s, k, sign, lo, hi, 0.0);
+}
+
+static int sgn(double x) { return (x > 0.0) - (x < 0.0); }
+
+/* Direction of f just after p: f' 's sign, or f'' 's where f' = 0. */
+static int dir_after(const edr_pt *p) { return p->df != 0.0 ? sgn(p->df) : sgn(p->ddf); }
+
+/* In hit mode, a maximum of f inside (a, b) that stays far below zero
+ * need not be located.  With f' linear from p = f'(a) > 0 to q = f'(b) < 0
+ * the maximum is f(a) + p^2 h / (2 (p - q)); f' departs from the line by
+ * at most |f''(b) - f''(a)| h / 4, which adds h^2 / 4 of it.  Far below:
+ * under -HERMITE_MARGIN of the interval's scale. */
+static int surely_below(const edr_scan *s, const edr_pt *a, const edr_pt *b)
+{
+    double h = b->t - a->t, p = a->df, q = b->df;
+    if (!s->hit_mode || !(p > 0.0 && q < 0.0))
+        return 0;
+    double top = a->f + p * p * h / (2.0 * (p - q)) + 0.25 * fabs(b->ddf - a->ddf) * h * h;
+    double scale = fabs(a->f) + fabs(b->f) + h * (fabs(p) + fabs(q));
+    return top < -HERMITE_MARGIN * scale;
+}
+
+/* At most one turn of f in (a, b]: locate it (noted, or in hit mode a
+ * maximum above zero: the crossing before it), then f(b). */
+static int scan_simple(edr_scan *s, const edr_pt *a, const edr_pt *b, double *t_hit)
+{
+    int dir = dir_after(a);
+    if (dir != 0 && sgn(b->df) != dir && !surely_below(s, a, b)) {
+        double tc = locate(s, 1, dir > 0 ? -1.0 : 1.0, a->t, b->t, s->width);
+        edr_pt c = edr_scan_point(s, tc);
+        if (s->hit_mode && dir > 0 && c.f > s->thr) {
+            *t_hit = locate(s, 0, 1.0, a->t, tc, 0.0);
+            return 1;
+        }
+        edr_scan_note(s, c.f);
+    }
+    if (s->hit_mode && b->f > s->thr) {
+        *t_hit = locate_from(s, 0, 1.0, a->t, b->t, 0.0, a->t + edr_taylor_root(a));
+        return 1;
+    }
+    return 0;
+}
+
+/* f' has the sign dir at both ends and may dip through zero between. */
+static int may_turn_twice(const edr_pt *a, const edr_pt *b, int dir)
+{
+    double h = b->t - a->t;
+    if (!(dir * a->ddf < 0.0 && dir * b->ddf > 0.0))
+        return 0;
+    return fabs(a->df) <= TURN_MARGIN * fabs(a->ddf) * h ||
+           fabs(b->df) <= TURN_MARGIN * fabs(b->ddf) * h;
+}
+
+int edr_scan_interval(edr_scan *s, const edr_pt *a, const edr_pt *b, double *t_hit)
+{
+    int dir = dir_after(a);
+    if (dir != 0 && sgn(b->df) == dir && may_turn_twice(a, b, dir)) {
+        double tm = locate(s, 2, dir > 0 ? 1.0 : -1.0, a->t, b->t, s->width);
+        edr_pt mid = edr_scan_point(s, tm);
+        if (sgn(mid.df) != dir) {
+            if (scan_simple(s, a, &mid, t_hit))
+                return 1;
+            edr_scan_note(s, mid.f);
+            if (scan_simple(s, &mid, b, t_hit))
+                return 1;
+            edr_scan_note(s, b->f);
+            return 0;
+        }
+    }
+    if (scan_simple(s, a, b, t_hit))
+        return 1;
+    edr_scan_note(s, b->f);
+    return 0;
+}

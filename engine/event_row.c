@@ -1,0 +1,1802 @@
+/* event_row.c — the exact event-driven reference for rows (pd_edr).
+ *
+ * Asynchronous events, as event-driven molecular dynamics schedules them:
+ * every structure belongs to a cluster (edr_cluster.c) that moves by an
+ * exact flight from its origin; each open contact holds one prediction of
+ * its next closing (from the flights of its two sides), each cluster with
+ * persistent contacts one of its next detachment, and a priority queue
+ * orders them with the forcing's next piece and the output grid.  A
+ * prediction scans one window (EDR_WINDOW scan intervals) and, finding
+ * nothing, queues its own continuation, so that a prediction that an event
+ * will soon replace costs little.  An event re-origins the clusters it
+ * touches and predicts again only the contacts next to them.
+ *
+ * An impact at t (a contact's predicted closing):
+ *   1. the group: from the closing contact, every contact of the clusters
+ *      reached whose gap is <= close_tol L at t is closed, and its other
+ *      side joins (persistent contacts are closed by definition);
+ *   2. the extremes of the group's flights are measured up to t;
+ *   3. impact LCP over the closed contacts Z (Newton's law; persistent and
+ *      separating ones take part with e ignored):
+ *        U+ = U- + D P,  0 <= U+ + e min(U-, 0) _|_ P >= 0,  D = W_Z^T M^-1 W_Z;
+ *   4. the contacts left at zero rate decide persistence by the
+ *      contact-force LCP (g'' = D lambda + W^T M^-1 (b f - C v - K q));
+ *      a contact leaving with a bounce height U+^2 / (2 a) below 1e-10 L
+ *      under a closing acceleration a, whose bouncing-ball tail
+ *      2 U+ / (a (1 - e)) fits in the forcing piece, has its accumulation
+ *      jumped: it joins the held contacts (their velocities projected
+ *      M-orthogonally by the cluster's start) if the force LCP and the
+ *      force at the tail's middle and end keep it;
+ *   5. new clusters from the held contacts, new flights, predictions. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "edr.h"
+
+/* Bounce heights below this times the length scale are jumped (as the
+ * one-wall reference). */
+#define EDR_ACC_HEIGHT 1e-10
+/* A gap rate is zero below this times the velocity scale of the event. */
+#define EDR_RATE_TOL 1e-12
+/* Scan intervals a prediction covers before it queues its continuation. */
+#define EDR_WINDOW 64
+#define EDR_WINDOW0 4
+/* Stages of one impact (a closed contact closing again under the
+ * others' impulses) before the run is declared stuck. */
+#define EDR_STAGES 10000
+/* Events at one instant before the run is declared stuck. */
+#define EDR_SAME_INSTANT 1000
+/* Impact LCPs of up to this many contacts are assembled densely. */
+#define EDR_DENSE_MAX 48
+/* A closing must take the gap below -this times the size of its terms
+ * (g0 and the displacements it adds): its rounding level. */
+#define EDR_GAP_ROUND 1e-14
+
+pd_edr_opts pd_edr_default_opts(void)
+{
+    return (pd_edr_opts){.close_tol = 1e-12,
+                         .length_scale = 1.0,
+                         .t_measure = 0.0,
+                         .h_out = 0.0,
+                         .below = NULL,
+                         .no_accumulation = 0,
+                         .inactive = 0,
+                         .max_events = 10000000L,
+                         .max_burst = 100000L,
+                         .max_evals = 4e9,
+                         .scan_divisions = 64,
+                         .lcp_solver = PD_LCP_AUTO,
+                         .on_event = NULL,
+                         .on_event_ctx = NULL};
+}
+
+/* ---- the queue ----------------------------------------------------------------- */
+
+static int q_less(const edr_queue *q, int a, int b)
+{
+    return q->key[a] < q->key[b] || (q->key[a] == q->key[b] && a < b);
+}
+
+static void q_swap(edr_queue *q, int i, int j)
+{
+    int a = q->heap[i], b = q->heap[j];
+    q->heap[i] = b;
+    q->heap[j] = a;
+    q->pos[b] = i;
+    q->pos[a] = j;
+}
+
+static void q_up(edr_queue *q, int i)
+{
+    while (i > 0) {
+        int p = (i - 1) / 2;
+        if (!q_less(q, q->heap[i], q->heap[p]))
+            break;
+        q_swap(q, i, p);
+        i = p;
+    }
+}
+
+static void q_down(edr_queue *q, int i)
+{
+    for (;;) {
+        int l = 2 * i + 1, rr = l + 1, s = i;
+        if (l < q->n && q_less(q, q->heap[l], q->heap[s]))
+            s = l;
+        if (rr < q->n && q_less(q, q->heap[rr], q->heap[s]))
+            s = rr;
+        if (s == i)
+            return;
+        q_swap(q, i, s);
+        i = s;
+    }
+}
+
+/* Queue slot at time t (HUGE_VAL: out of the queue). */
+static void q_set(edr_queue *q, int slot, double t)
+{
+    int i = q->pos[slot];
+    if (!(t < HUGE_VAL)) {
+        if (i < 0)
+            return;
+        q->key[slot] = HUGE_VAL;
+        q_swap(q, i, --q->n);
+        q->pos[slot] = -1;
+        if (i < q->n) {
+            q_up(q, i);
+            q_down(q, i);
+        }
+        return;
+    }
+    q->key[slot] = t;
+    if (i < 0) {
+        i = q->n++;
+        q->heap[i] = slot;
+        q->pos[slot] = i;
+    }
+    q_up(q, i);
+    q_down(q, q->pos[slot]);
+}
+
+/* ---- helpers -------------------------------------------------------------------- */
+
+static int cl_of_dof(const pd_edr *r, int dof) { return r->blk_cl[r->dof_blk[dof]]; }
+
+/* x(t), v(t), a(t) of a dof. */
+static void dof_state(pd_edr *r, int dof, double t, double *x, double *v, double *a)
+{
+    double dx;
+    edr_dof_at(r, cl_of_dof(r, dof), dof, t, &dx, v, a);
+    *x = r->xo[dof] + dx;
+}
+
+/* The gap of contact a at t from the positions. */
+static double gap_now(pd_edr *r, int a, double t, double *U)
+{
+    const edr_contact *ct = &r->ct[a];
+    double g = ct->g0, u = 0.0;
+    for (int s = 0; s < 2; s++)
+        if (ct->dof[s] >= 0) {
+            double x, v, acc;
+            dof_state(r, ct->dof[s], t, &x, &v, &acc);
+            g += ct->w[s] * x;
+            u += ct->w[s] * v;
+        }
+    if (U)
+        *U = u;
+    return g;
+}
+
+/* ---- gap and force functions for the scanner ----------------------------------- */
+
+typedef struct gap_ctx {
+    pd_edr *r;
+    int a;
+    double gb;      /* the gap at tb */
+    double dxb[2];  /* the sides' increments at tb */
+    double thr;     /* the gap's rounding level */
+} gap_ctx;
+
+/* f = -g, f' = -U, f'' = -G: positive past the closing. */
+static void gap_fn(void *vctx, double t, double out[3])
+{
+    gap_ctx *g = vctx;
+    const edr_contact *ct = &g->r->ct[g->a];
+    double gap = g->gb, U = 0.0, G = 0.0;
+    for (int s = 0; s < 2; s++)
+        if (ct->dof[s] >= 0) {
+            double dx, v, acc;
+            edr_dof_at(g->r, cl_of_dof(g->r, ct->dof[s]), ct->dof[s], t, &dx, &v, &acc);
+            gap += ct->w[s] * (dx - g->dxb[s]);
+            U += ct->w[s] * v;
+            G += ct->w[s] * acc;
+        }
+    out[0] = -gap;
+    out[1] = -U;
+    out[2] = -G;
+}
+
+/* The gap's base for contact a: the latest origin of its sides, where its
+ * value is known exactly (0 after a closing) or taken from the positions. */
+static void gap_base(pd_edr *r, int a, gap_ctx *g)
+{
+    const edr_contact *ct = &r->ct[a];
+    double tb = -HUGE_VAL;
+    for (int s = 0; s < 2; s++)
+        if (ct->dof[s] >= 0)
+            tb = fmax(tb, r->cl[cl_of_dof(r, ct->dof[s])].t0);
+    g->r = r;
+    g->a = a;
+    double gap = ct->g0;
+    for (int s = 0; s < 2; s++) {
+        g->dxb[s] = 0.0;
+        if (ct->dof[s] >= 0) {
+            double v, acc;
+            edr_dof_at(r, cl_of_dof(r, ct->dof[s]), ct->dof[s], tb, &g->dxb[s], &v, &acc);
+            gap += ct->w[s] * (r->xo[ct->dof[s]] + g->dxb[s]);
+        }
+    }
+    g->gb = r->base_t[a] == tb ? r->base_g[a] : gap;
+    /* the rounding level of the gap: its terms' size */
+    double size = fabs(ct->g0);
+    for (int s = 0; s < 2; s++)
+        if (ct->dof[s] >= 0)
+            size += fabs(ct->w[s]) * (fabs(r->xo[ct->dof[s]]) + fabs(g->dxb[s]));
+    g->thr = EDR_GAP_ROUND * size;
+}
+
+/* Scan step of a contact: the finer of its sides'. */
+static double contact_step(const pd_edr *r, int a)
+{
+    const edr_contact *ct = &r->ct[a];
+    double h = HUGE_VAL;
+    for (int s = 0; s < 2; s++)
+        if (ct->dof[s] >= 0)
+            h = fmin(h, r->cl[r->blk_cl[r->dof_blk[ct->dof[s]]]].h);
+    return h;
+}
+
+/* ---- predictions ----------------------------------------------------------------- */
+
+/* End of what a prediction may cover: the piece's end and t1. */
+static double horizon(const pd_edr *r) { return fmin(edr_piece_end(r, r->piece), r->t1); }
+
+/* Contact a's next closing after ts, or the end of its scan window. */
+static void predict_contact(pd_edr *r, int a, double ts, int cont)
+{
+    int slot = a;
+    if (r->o.inactive || r->cstate[a] != EDR_OPEN) {
+        q_set(&r->q, slot, HUGE_VAL);
+        return;
+    }
+    const edr_contact *ct = &r->ct[a];
+    if (ct->dof[0] >= 0 && ct->dof[1] >= 0 && cl_of_dof(r, ct->dof[0]) == cl_of_dof(r, ct->dof[1]) &&
+        r->cl[cl_of_dof(r, ct->dof[0])].kind != EDR_MODAL) {
+        q_set(&r->q, slot, HUGE_VAL); /* both sides in one rigid tree: the gap is constant */
+        return;
+    }
+    gap_ctx g;
+    gap_base(r, a, &g);
+    edr_scan s = {.fn = gap_fn, .ctx = &g, .hit_mode = 1, .thr = g.thr, .fmax = -HUGE_VAL,
+                  .fmin = HUGE_VAL};
+    /* windows double from EDR_WINDOW0 intervals as the prediction continues */
+    int win = cont && r->win[slot] > 0 ? r->win[slot] : EDR_WINDOW0;
+    r->win[slot] = win < EDR_WINDOW ? 2 * win : EDR_WINDOW;
+    double h = contact_step(r, a), tend = horizon(r), tw = fmin(tend, ts + win * h);
+    s.width = 4e-8 * h;
+    edr_pt p = edr_scan_point(&s, ts);
+    if (p.f > 0.0) { /* past zero at the start: rounding of a gap that is 0 */
+        if (p.f > g.thr && p.df > 0.0) {
+            r->qkind[slot] = EDR_Q_HIT;
+            q_set(&r->q, slot, ts);
+            return;
+        }
+        g.gb += p.f;
+        p.f = 0.0;
+    }
+    /* a closing the Taylor quadratic puts early in the first interval: a first
+     * interval of twice that time brackets it closely */
+    double s0 = p.df > 0.0 ? edr_taylor_root(&p) : NAN, t0 = ts;
+    if (s0 < 0.25 * h && ts + 2.0 * s0 < tw) {
+        double hit;
+        edr_pt b = edr_scan_point(&s, ts + 2.0 * s0);
+        if (edr_scan_interval(&s, &p, &b, &hit)) {
+            r->qkind[slot] = EDR_Q_HIT;
+            q_set(&r->q, slot, hit);
+            return;
+        }
+        p = b;
+        t0 = b.t;
+    }
+    long n = (long)ceil((tw - t0) / h);
+    if (n < 1)
+        n = 1;
+    for (long i = 1; i <= n; i++) {
+        double tb = i == n ? tw : t0 + (double)i * h, hit;
+        if (!(tb > p.t))
+            break;
+        edr_pt b = edr_scan_point(&s, tb);
+        if (edr_scan_interval(&s, &p, &b, &hit)) {
+            r->qkind[slot] = EDR_Q_HIT;
+            q_set(&r->q, slot, hit);
+            return;
+        }
+        p = b;
+    }
+    r->qkind[slot] = EDR_Q_SCAN;
+    q_set(&r->q, slot, tw < tend ? tw : HUGE_VAL);
+}
+
+typedef struct force_ctx {
+    pd_edr *r;
+    int c, a;
+} force_ctx;
+
+static void force_fn(void *vctx, double t, double out[3])
+{
+    force_ctx *f = vctx;
+    out[0] = edr_force_at(f->r, f->c, f->a, t);
+    out[1] = out[2] = 0.0;
+}
+
+/* lambda linear in t on a linear piece (REST): its zero, polished to the
+ * first double where it is negative (the one-wall reference's rule). */
+static double detach_linear(pd_edr *r, int c, int a, double ta, double tb)
+{
+    force_ctx f = {.r = r, .c = c, .a = a};
+    double la = edr_force_at(r, c, a, ta), lb = edr_force_at(r, c, a, tb);
+    if (la < 0.0)
+        return ta;
+    if (!(lb < 0.0))
+        return HUGE_VAL;
+    double tr = fmin(fmax(ta + la * (tb - ta) / (la - lb), ta), tb);
+    double pad = 16.0 * 2e-16 * fmax(fabs(tr), 1e-300);
+    double lo = fmax(tr - pad, ta), hi = fmin(tr + pad, tb);
+    if (!(edr_force_at(r, c, a, lo) >= 0.0 && edr_force_at(r, c, a, hi) < 0.0)) {
+        lo = ta;
+        hi = tb;
+    }
+    return edr_bisect_sign(force_fn, &f, 0, -1.0, lo, hi);
+}
+
+/* Cluster c's next detachment (a persistent force turning negative) after
+ * ts, or the end of its scan window. */
+static void predict_detach(pd_edr *r, int c, double ts, int cont)
+{
+    edr_cluster *cl = &r->cl[c];
+    int slot = r->m + c;
+    if (r->o.inactive || cl->npers == 0) {
+        q_set(&r->q, slot, HUGE_VAL);
+        return;
+    }
+    double tend = horizon(r), best = HUGE_VAL;
+    int who = -1;
+    const pd_sine_piece *pc = &r->pieces[cl->piece];
+    if (cl->kind == EDR_REST && pc->A == 0.0) { /* linear forces: closed form */
+        for (int a = cl->pers_head; a >= 0; a = r->pers_next[a]) {
+            double td = detach_linear(r, c, a, ts, tend);
+            if (td < best) {
+                best = td;
+                who = a;
+            }
+        }
+        cl->det_contact = who;
+        r->qkind[slot] = EDR_Q_HIT;
+        q_set(&r->q, slot, best);
+        return;
+    }
+    int win = cont && r->win[slot] > 0 ? r->win[slot] : EDR_WINDOW0;
+    r->win[slot] = win < EDR_WINDOW ? 2 * win : EDR_WINDOW;
+    double h = cl->h, tw = fmin(tend, ts + win * h), ta = ts;
+    for (int a = cl->pers_head; a >= 0; a = r->pers_next[a])
+        if (edr_force_at(r, c, a, ts) < 0.0) {
+            cl->det_contact = a;
+            r->qkind[slot] = EDR_Q_HIT;
+            q_set(&r->q, slot, ts);
+            return;
+        }
+    long n = (long)ceil((tw - ts) / h);
+    if (n < 1)
+        n = 1;
+    for (long i = 1; i <= n && who < 0; i++) {
+        double tb = i == n ? tw : ts + (double)i * h;
+        if (!(tb > ta))
+            break;
+        for (int a = cl->pers_head; a >= 0; a = r->pers_next[a])
+            if (edr_force_at(r, c, a, tb) < 0.0) {
+                force_ctx f = {.r = r, .c = c, .a = a};
+                double td = edr_bisect_sign(force_fn, &f, 0, -1.0, ta, tb);
+                if (td < best) {
+                    best = td;
+                    who = a;
+                }
+            }
+        ta = tb;
+    }
+    if (who >= 0) {
+        cl->det_contact = who;
+        r->qkind[slot] = EDR_Q_HIT;
+        q_set(&r->q, slot, best);
+        return;
+    }
+    r->qkind[slot] = EDR_Q_SCAN;
+    q_set(&r->q, slot, tw < tend ? tw : HUGE_VAL);
+}
+
+/* ---- measurements ----------------------------------------------------------------- */
+
+typedef struct meas_ctx {
+    pd_edr *r;
+    int c, dof, below; /* below >= 0: the drift x_dof - x_below */
+} meas_ctx;
+
+static void meas_fn(void *vctx, double t, double out[3])
+{
+    meas_ctx *m = vctx;
+    double dx, v, a;
+    edr_dof_at(m->r, m->c, m->dof, t, &dx, &v, &a);
+    out[0] = m->r->xo[m->dof] + dx;
+    out[1] = v;
+    out[2] = a;
+    if (m->below >= 0) {
+        edr_dof_at(m->r, m->c, m->below, t, &dx, &v, &a);
+        out[0] -= m->r->xo[m->below] + dx;
+        out[1] -= v;
+        out[2] -= a;
+    }
+}
+
+/* Note f's extremes into the dof's results (x, or the drift). */
+static void note_meas(pd_edr *r, int dof, int drift, double fmax, double fmin)
+{
+    if (drift) {
+        r->drift[dof] = pd_max(r->drift[dof], pd_max(fmax, -fmin));
+        return;
+    }
+    r->xpos[dof] = pd_max(r->xpos[dof], fmax);
+    r->xneg[dof] = pd_max(r->xneg[dof], -fmin);
+}
+
+/* The below-dof of dof i for the drift, if it lies in the same cluster
+ * (storeys of one structure always do); -1 for the ground. */
+static int below_of(const pd_edr *r, int i)
+{
+    return r->o.below ? r->o.below[i] : -1;
+}
+
+/* Extremes of every dof (and drift) of cluster c over [meas_t, tb]. */
+static void measure_cluster(pd_edr *r, int c, double tb)
+{
+    edr_cluster *cl = &r->cl[c];
+    double ta = fmax(cl->meas_t, r->o.t_measure);
+    cl->meas_t = fmax(cl->meas_t, tb);
+    if (!(tb >= ta))
+        return;
+    int nf = 0;
+    meas_ctx *mc = r->mctx;
+    edr_scan *sc = r->mscan;
+    edr_pt *prev = r->mprev;
+    for (int b = cl->head; b >= 0; b = r->blk_next[b]) {
+        const edr_block *bk = &r->blk[b];
+        for (int k = 0; k < bk->n; k++) {
+            int i = r->blk_dofs[bk->first + k], bl = below_of(r, i);
+            mc[nf++] = (meas_ctx){.r = r, .c = c, .dof = i, .below = -1}; /* x */
+            mc[nf++] = (meas_ctx){.r = r, .c = c, .dof = i, .below = bl}; /* the drift */
+        }
+    }
+    for (int k = 0; k < nf; k++) {
+        sc[k] = (edr_scan){.fn = meas_fn, .ctx = &mc[k], .width = 4e-8 * cl->h, .hit_mode = 0,
+                           .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
+        prev[k] = edr_scan_point(&sc[k], ta);
+        edr_scan_note(&sc[k], prev[k].f);
+    }
+    if (cl->kind != EDR_REST && tb > ta) {
+        long n = (long)ceil((tb - ta) / cl->h);
+        if (n < 1)
+            n = 1;
+        for (long i = 1; i <= n; i++) {
+            double t = i == n ? tb : ta + (double)i * cl->h, hit;
+            if (!(t > prev[0].t))
+                break;
+            for (int k = 0; k < nf; k++) {
+                edr_pt p = edr_scan_point(&sc[k], t);
+                edr_scan_interval(&sc[k], &prev[k], &p, &hit);
+                prev[k] = p;
+            }
+        }
+    }
+    for (int k = 0; k < nf; k++)
+        note_meas(r, mc[k].dof, k & 1, sc[k].fmax, sc[k].fmin);
+}
+
+/* The smallest gap of contact a over [gmeas_t, tb] (contacts that never
+ * closed: once closed, the minimum is 0). */
+static void measure_contact(pd_edr *r, int a, double tb)
+{
+    double ta = r->gmeas_t[a];
+    r->gmeas_t[a] = fmax(ta, tb);
+    if (!(tb > ta) || (!(r->gmin[a] > 0.0) && !r->o.inactive) || r->cstate[a] != EDR_OPEN)
+        return;
+    gap_ctx g;
+    gap_base(r, a, &g);
+    edr_scan s = {.fn = gap_fn, .ctx = &g, .hit_mode = 0, .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
+    double h = contact_step(r, a);
+    s.width = 4e-8 * h;
+    edr_pt p = edr_scan_point(&s, ta);
+    edr_scan_note(&s, p.f);
+    long n = (long)ceil((tb - ta) / h);
+    for (long i = 1; i <= n; i++) {
+        double t = i == n ? tb : ta + (double)i * h, hit;
+        if (!(t > p.t))
+            break;
+        edr_pt b = edr_scan_point(&s, t);
+        edr_scan_interval(&s, &p, &b, &hit);
+        p = b;
+    }
+    double gmin = -s.fmax;
+    if (gmin < 0.0 && !r->o.inactive) {
+        r->res.max_penetration = fmax(r->res.max_penetration, -gmin);
+        gmin = 0.0;
+    }
+    r->gmin[a] = fmin(r->gmin[a], gmin);
+}
+
+/* ---- the group of an event ---------------------------------------------------------- */
+
+static void group_add_cluster(pd_edr *r, int c)
+{
+    if (r->cl_mark[c] == r->epoch)
+        return;
+    r->cl_mark[c] = r->epoch;
+    r->g_cl[r->ng++] = c;
+}
+
+static void group_add_contact(pd_edr *r, int a)
+{
+    r->ct_mark[a] = r->epoch;
+    r->g_ct[r->ngc++] = a;
+}
+
+/* The group at t: from the clusters already in it, every contact at zero
+ * gap (within the tolerance) and the cluster on its other side.  Seeds
+ * (contacts already in g_ct) count as closed. */
+static void group_grow(pd_edr *r, double t)
+{
+    double tol = r->o.close_tol * r->L;
+    for (int i = 0; i < r->ng; i++) {
+        const edr_cluster *cl = &r->cl[r->g_cl[i]];
+        for (int b = cl->head; b >= 0; b = r->blk_next[b]) {
+            const edr_block *bk = &r->blk[b];
+            for (int k = 0; k < bk->ncont; k++) {
+                int a = r->blk_cont[bk->cont0 + k];
+                if (r->ct_mark[a] == r->epoch || r->ct_mark2[a] == r->epoch)
+                    continue;
+                r->ct_mark2[a] = r->epoch;
+                if (r->cstate[a] != EDR_OPEN) {
+                    group_add_contact(r, a);
+                    continue;
+                }
+                if (r->o.inactive)
+                    continue;
+                double g = gap_now(r, a, t, NULL);
+                if (!(g <= tol))
+                    continue;
+                group_add_contact(r, a);
+                r->res.tol_closed += g > 0.0;
+                const edr_contact *ct = &r->ct[a];
+                for (int s = 0; s < 2; s++)
+                    if (ct->dof[s] >= 0)
+                        group_add_cluster(r, cl_of_dof(r, ct->dof[s]));
+            }
+        }
+    }
+}
+
+/* The state at t of every dof of the group (gx, gv), measured flights. */
+static void group_state(pd_edr *r, double t)
+{
+    r->ngd = 0;
+    for (int i = 0; i < r->ng; i++) {
+        int c = r->g_cl[i];
+        measure_cluster(r, c, t);
+        for (int b = r->cl[c].head; b >= 0; b = r->blk_next[b]) {
+            const edr_block *bk = &r->blk[b];
+            for (int k = 0; k < bk->n; k++) {
+                int dof = r->blk_dofs[bk->first + k];
+                double acc;
+                dof_state(r, dof, t, &r->gx[dof], &r->gv[dof], &acc);
+                r->g_dof[r->ngd++] = dof;
+            }
+            for (int k = 0; k < bk->ncont; k++) /* the gaps about to change flights */
+                measure_contact(r, r->blk_cont[bk->cont0 + k], t);
+        }
+    }
+}
+
+/* ---- the contact LCPs ----------------------------------------------------------------- */
+
+/* D = W_I^T M^-1 W_I over the contacts idx[0..k): dense (k <= EDR_DENSE_MAX) or CSC. */
+static pd_matrix delassus(pd_edr *r, const int *idx, int k)
+{
+    for (int j = 0; j < k; j++)
+        r->pos_in[idx[j]] = j;
+    if (k <= EDR_DENSE_MAX) {
+        double *D = r->Dd;
+        memset(D, 0, (size_t)k * k * sizeof(double));
+        for (int j = 0; j < k; j++) {
+            const edr_contact *cj = &r->ct[idx[j]];
+            for (int s = 0; s < 2; s++) {
+                int dof = cj->dof[s];
+                if (dof < 0)
+                    continue;
+                for (int e = r->dofc_ptr[dof]; e < r->dofc_ptr[dof + 1]; e++) {
+                    int a = r->dofc[e];
+                    if (r->ct_markD[a] != r->epochD)
+                        continue;
+                    const edr_contact *ca = &r->ct[a];
+                    double wa = ca->dof[0] == dof ? ca->w[0] : ca->w[1];
+                    D[r->pos_in[a] + (size_t)j * k] += wa * cj->w[s] * r->minv[dof];
+                }
+            }
+        }
+        return pd_matrix_dense(k, k, D);
+    }
+    int nz = 0;
+    for (int j = 0; j < k; j++) {
+        const edr_contact *cj = &r->ct[idx[j]];
+        r->Dcol[j] = nz;
+        int start = nz;
+        for (int s = 0; s < 2; s++) {
+            int dof = cj->dof[s];
+            if (dof < 0)
+                continue;
+            for (int e = r->dofc_ptr[dof]; e < r->dofc_ptr[dof + 1]; e++) {
+                int a = r->dofc[e];
+                if (r->ct_markD[a] != r->epochD)
+                    continue;
+                const edr_contact *ca = &r->ct[a];
+                double wa = ca->dof[0] == dof ? ca->w[0] : ca->w[1];
+                int row = r->pos_in[a], f = -1;
+                for (int p = start; p < nz && f < 0; p++)
+                    if (r->Drow[p] == row)
+                        f = p;
+                if (f < 0) {
+                    r->Drow[nz] = row;
+                    r->Dval[nz++] = 0.0;
+                    f = nz - 1;
+                }
+                r->Dval[f] += wa * cj->w[s] * r->minv[dof];
+            }
+        }
+        for (int p = start + 1; p < nz; p++) /* sort the column's rows */
+            for (int q = p; q > start && r->Drow[q - 1] > r->Drow[q]; q--) {
+                int ti = r->Drow[q];
+                double tv = r->Dval[q];
+                r->Drow[q] = r->Drow[q - 1];
+                r->Dval[q] = r->Dval[q - 1];
+                r->Drow[q - 1] = ti;
+                r->Dval[q - 1] = tv;
+            }
+    }
+    r->Dcol[k] = nz;
+    return pd_matrix_csc(k, k, r->Dcol, r->Drow, r->Dval);
+}
+
+/* Solve the LCP D z + q over idx[0..k) into z (w = D z + q). */
+static int solve_lcp(pd_edr *r, const int *idx, int k, const double *q, double *z, double *w,
+                     double t, pd_err *err)
+{
+    if (k == 0)
+        return PD_OK;
+    r->epochD++;
+    for (int j = 0; j < k; j++)
+        r->ct_markD[idx[j]] = r->epochD;
+    pd_matrix D = delassus(r, idx, k);
+    r->res.lcp_solves++;
+    if (k == 1) {
+        z[0] = pd_contact_impulse_1(D.values[0], q[0]);
+        w[0] = D.values[0] * z[0] + q[0];
+        return PD_OK;
+    }
+    pd_lcp_info info;
+    int rc = pd_lcp_solve(r->solver, &D, q, NULL, z, w, &info);
+    if (rc)
+        return pd_err_set(err, rc, "row reference: the contact LCP of %d contacts at t = %.9g "
+                          "was not solved (%s)", k, t, pd_lcp_outcome_name(info.outcome));
+    return PD_OK;
+}
+
+/* Free accelerations M^-1 (b f - C v - K x) of the group's dofs at t. */
+static void free_accelerations(pd_edr *r, double t)
+{
+    double f = edr_force(r, edr_piece_at(r, t), t);
+    for (int k = 0; k < r->ngd; k++) {
+        int i = r->g_dof[k], b = r->dof_blk[i];
+        const edr_block *bk = &r->blk[b];
+        if (bk->sdof) {
+            r->gacc[i] = (bk->b * f - bk->c * r->gv[i] - bk->k * r->gx[i]) * r->minv[i];
+            continue;
+        }
+        int li = r->dof_loc[i];
+        long off = r->blk_off[b];
+        double s = r->b[i] * f;
+        for (int j = 0; j < bk->n; j++) {
+            int gj = r->blk_dofs[bk->first + j];
+            s -= r->Cb[off + li + (long)j * bk->n] * r->gv[gj] + r->Kb[off + li + (long)j * bk->n] * r->gx[gj];
+        }
+        r->gacc[i] = s * r->minv[i];
+    }
+}
+
+/* W_a^T y over the group's state array y (walls at rest). */
+static double contact_dot(const pd_edr *r, int a, const double *y)
+{
+    const edr_contact *ct = &r->ct[a];
+    double s = 0.0;
+    for (int k = 0; k < 2; k++)
+        if (ct->dof[k] >= 0)
+            s += ct->w[k] * y[ct->dof[k]];
+    return s;
+}
+
+/* The contact-force LCP over J = idx[0..k): lambda (r->lam), and the gap
+ * accelerations of every closed contact of the group (r->wlcp, indexed as
+ * g_ct). */
+static int force_lcp(pd_edr *r, const int *idx, int k, double t, pd_err *err)
+{
+    double *q = r->qlcp, *lam = r->lam, *w = r->wtmp;
+    for (int j = 0; j < k; j++)
+        q[j] = contact_dot(r, idx[j], r->gacc);
+    int rc = solve_lcp(r, idx, k, q, lam, w, t, err);
+    if (rc)
+        return rc;
+    /* gap accelerations of all closed contacts: W^T (a_free + M^-1 W_J lambda) */
+    for (int k2 = 0; k2 < r->ngd; k2++)
+        r->gtmp[r->g_dof[k2]] = r->gacc[r->g_dof[k2]];
+    for (int j = 0; j < k; j++) {
+        const edr_contact *ct = &r->ct[idx[j]];
+        for (int s = 0; s < 2; s++)
+            if (ct->dof[s] >= 0)
+                r->gtmp[ct->dof[s]] += ct->w[s] * lam[j] * r->minv[ct->dof[s]];
+    }
+    for (int j = 0; j < r->ngc; j++)
+        r->wlcp[j] = contact_dot(r, r->g_ct[j], r->gtmp);
+    return PD_OK;
+}
+
+/* ---- clusters from the held contacts ----------------------------------------------------- */
+
+static int uf_find(int *p, int x)
+{
+    while (p[x] != x) {
+        p[x] = p[p[x]];
+        x = p[x];
+    }
+    return x;
+}
+
+/* Dissolve the group's clusters and make new ones from the contacts
+ * flagged held (r->held), every dof starting at (gx, gv) at t. */
+static int regroup(pd_edr *r, double t, pd_err *err)
+{
+    int *uf = r->uf, rc;
+    for (int i = 0; i < r->ng; i++) {
+        int c = r->g_cl[i];
+        for (int b = r->cl[c].head; b >= 0; b = r->blk_next[b])
+            uf[b] = b;
+    }
+    for (int j = 0; j < r->ngc; j++) {
+        int a = r->g_ct[j];
+        const edr_contact *ct = &r->ct[a];
+        int was = r->cstate[a] == EDR_PERSIST;
+        if (was && !r->held[j])
+            r->ctime[a] += t - r->since[a] > 0.0 ? t - r->since[a] : 0.0;
+        if (r->held[j] && !was)
+            r->since[a] = t + r->held_tail[j];
+        r->cstate[a] = r->held[j] ? EDR_PERSIST : EDR_OPEN;
+        r->pers_next[a] = -1;
+        r->base_t[a] = t;
+        r->base_g[a] = 0.0;
+        if (r->held[j] && ct->blk[0] >= 0 && ct->blk[1] >= 0) {
+            int x = uf_find(uf, ct->blk[0]), y = uf_find(uf, ct->blk[1]);
+            if (x != y)
+                uf[x] = y;
+        }
+    }
+    for (int k = 0; k < r->ngd; k++) {
+        int i = r->g_dof[k];
+        r->xo[i] = r->gx[i];
+        r->vo[i] = r->gv[i];
+    }
+    /* release the old clusters, collect the blocks */
+    int nblk = 0;
+    for (int i = 0; i < r->ng; i++) {
+        int c = r->g_cl[i];
+        for (int b = r->cl[c].head, nx; b >= 0; b = nx) {
+            nx = r->blk_next[b];
+            r->gblk[nblk++] = b;
+        }
+        r->cl[c].live = 0;
+        r->cl[c].head = -1;
+        r->free_cl[r->nfree++] = c;
+        q_set(&r->q, r->m + c, HUGE_VAL);
+    }
+    /* one cluster per root */
+    r->ng = 0;
+    for (int k = 0; k < nblk; k++) {
+        int b = r->gblk[k];
+        if (uf_find(uf, b) != b)
+            continue;
+        int c = r->free_cl[--r->nfree];
+        edr_cluster *cl = &r->cl[c];
+        cl->live = 1;
+        cl->head = -1;
+        cl->nblk = 0;
+        cl->pers_head = -1;
+        cl->npers = 0;
+        cl->meas_t = t;
+        r->newcl[b] = c;
+        r->g_cl[r->ng++] = c;
+    }
+    for (int k = 0; k < nblk; k++) {
+        int b = r->gblk[k], c = r->newcl[uf_find(uf, b)];
+        r->blk_cl[b] = c;
+        r->blk_next[b] = r->cl[c].head;
+        r->cl[c].head = b;
+        r->cl[c].nblk++;
+    }
+    for (int j = 0; j < r->ngc; j++) {
+        int a = r->g_ct[j];
+        if (!r->held[j])
+            continue;
+        const edr_contact *ct = &r->ct[a];
+        int c = r->blk_cl[ct->blk[0] >= 0 ? ct->blk[0] : ct->blk[1]];
+        r->pers_next[a] = r->cl[c].pers_head;
+        r->cl[c].pers_head = a;
+        r->cl[c].npers++;
+    }
+    for (int i = 0; i < r->ng; i++)
+        if ((rc = edr_cluster_start(r, r->g_cl[i], t, err)))
+            return rc;
+    return PD_OK;
+}
+
+/* Predictions of every contact next to the group and of its clusters. */
+static void repredict(pd_edr *r, double t)
+{
+    for (int i = 0; i < r->ng; i++) {
+        int c = r->g_cl[i];
+        for (int b = r->cl[c].head; b >= 0; b = r->blk_next[b]) {
+            const edr_block *bk = &r->blk[b];
+            for (int k = 0; k < bk->ncont; k++)
+                predict_contact(r, r->blk_cont[bk->cont0 + k], t, 0);
+        }
+        predict_detach(r, c, t, 0);
+    }
+}
+
+/* ---- events --------------------------------------------------------------------- */
+
+static int report(pd_edr *r, double t, pd_edr_kind kind, int acc)
+{
+    if (!r->o.on_event)
+        return 0;
+    for (int k = 0; k < r->ngd; k++)
+        r->ev_vplus[k] = r->gv[r->g_dof[k]];
+    pd_edr_event ev = {.t = t,
+                       .kind = kind,
+                       .ncontacts = r->ngc,
+                       .contacts = r->g_ct,
+                       .P = r->P,
+                       .U_minus = r->Uminus,
+                       .U_plus = r->Uplus,
+                       .ndofs = r->ngd,
+                       .dofs = r->g_dof,
+                       .v_minus = r->ev_vminus,
+                       .v_plus = r->ev_vplus,
+                       .accumulation = acc};
+    return r->o.on_event(&ev, r->o.on_event_ctx);
+}
+
+/* Count the event; PD_EBUDGET past the budget or when time stands still. */
+static int count_event(pd_edr *r, double t, pd_err *err)
+{
+    if (++r->res.events > r->o.max_events)
+        return pd_err_set(err, PD_EBUDGET, "row reference: %ld events by t = %.9g (budget "
+                          "exhausted)", r->res.events - 1, t);
+    if (t == r->last_t) {
+        if (++r->same_t > EDR_SAME_INSTANT)
+            return pd_err_set(err, PD_EBUDGET, "row reference: %d events at t = %.17g without "
+                              "progress", EDR_SAME_INSTANT, t);
+    } else {
+        r->last_t = t;
+        r->same_t = 0;
+    }
+    return PD_OK;
+}
+
+/* After the impact (or at a touch, a detachment, a piece change): which
+ * closed contacts hold, accumulations jumped.  idx0 lists the candidates
+ * (zero rate), k0 of them. */
+static int decide_persistence(pd_edr *r, double t, int *acc_jumped, pd_err *err)
+{
+    int rc, k0 = 0, *idx = r->lcp_idx;
+    double vs = 0.0;
+    *acc_jumped = 0;
+    for (int k = 0; k < r->ngd; k++)
+        vs = fmax(vs, fabs(r->gv[r->g_dof[k]]));
+    double tolU = EDR_RATE_TOL * fmax(vs, r->vscale);
+    for (int j = 0; j < r->ngc; j++) {
+        r->held[j] = 0;
+        r->held_tail[j] = 0.0;
+        if (fabs(r->Uplus[j]) <= tolU && !r->excluded[j])
+            idx[k0++] = r->g_ct[j], r->jpos[j] = k0 - 1;
+        else
+            r->jpos[j] = -1;
+    }
+    free_accelerations(r, t);
+    if ((rc = force_lcp(r, idx, k0, t, err)))
+        return rc;
+    for (int j = 0; j < r->ngc; j++)
+        if (r->jpos[j] >= 0)
+            r->held[j] = r->lam[r->jpos[j]] > 0.0;
+    if (r->o.no_accumulation)
+        return PD_OK;
+    /* accumulations: contacts bouncing off with a tiny height under a closing acceleration */
+    double tend = fmin(edr_piece_end(r, edr_piece_at(r, t)), r->t1);
+    int ns = 0, k1 = k0;
+    for (int j = 0; j < r->ngc; j++) {
+        int a = r->g_ct[j];
+        double U = r->Uplus[j], acl = -r->wlcp[j], e = r->ct[a].e;
+        if (r->jpos[j] >= 0 || r->excluded[j] || !(U > 0.0) || !(e < 1.0) || !(acl > 0.0))
+            continue;
+        double height = U * U / (2.0 * acl), tail = 2.0 * U / (acl * (1.0 - e));
+        if (height > EDR_ACC_HEIGHT * r->L || !(t + tail < tend))
+            continue;
+        r->held_tail[j] = tail;
+        r->jpos[j] = k1;
+        idx[k1++] = a;
+        ns++;
+    }
+    if (ns == 0)
+        return PD_OK;
+    if ((rc = force_lcp(r, idx, k1, t, err)))
+        return rc;
+    int ok = 1;
+    for (int j = 0; j < r->ngc && ok; j++)
+        if (r->held_tail[j] > 0.0)
+            ok = r->lam[r->jpos[j]] > 0.0;
+    if (ok) {
+        for (int j = 0; j < r->ngc; j++)
+            r->held[j] = r->jpos[j] >= 0 && r->lam[r->jpos[j]] > 0.0;
+        /* the force must hold through the tail: try the clusters */
+        *acc_jumped = 1;
+        return PD_OK;
+    }
+    for (int j = 0; j < r->ngc; j++) /* rejected: the force LCP of the resting ones */
+        if (r->held_tail[j] > 0.0) {
+            r->held_tail[j] = 0.0;
+            r->jpos[j] = -1;
+        }
+    if ((rc = force_lcp(r, idx, k0, t, err)))
+        return rc;
+    for (int j = 0; j < r->ngc; j++)
+        r->held[j] = r->jpos[j] >= 0 && r->lam[r->jpos[j]] > 0.0;
+    return PD_OK;
+}
+
+/* The jumped contacts' forces at the middle and end of their tails, on
+ * the new clusters: 1 when they hold. */
+static int tails_hold(pd_edr *r)
+{
+    for (int j = 0; j < r->ngc; j++) {
+        double tail = r->held_tail[j];
+        if (!(tail > 0.0) || !r->held[j])
+            continue;
+        int a = r->g_ct[j], c = r->blk_cl[r->ct[a].blk[0] >= 0 ? r->ct[a].blk[0] : r->ct[a].blk[1]];
+        if (r->cstate[a] != EDR_PERSIST)
+            continue;
+        double t0 = r->cl[c].t0;
+        if (!(edr_force_at(r, c, a, t0 + 0.5 * tail) > 0.0) || !(edr_force_at(r, c, a, t0 + tail) > 0.0))
+            return 0;
+    }
+    return 1;
+}
+
+/* The impact at t, in stages: each takes the closed contacts whose rate
+ * is not separating (U <= 0) into one LCP with Newton's law,
+ *   w = D P + U + e min(U, 0),  0 <= w _|_ P >= 0,
+ * so that every stage dissipates (the kinetic energy changes by
+ * 1/2 sum P (U+ + U-) <= 0); a closed contact that was separating takes no
+ * impulse, and if the others' impulses make it close it takes part in the
+ * next stage at the same instant (as Moreau-Jean's active set leaves a
+ * separating contact to the next step).  Stages end when no closed contact
+ * closes. */
+static int impact_stages(pd_edr *r, double t, double tolU, pd_err *err)
+{
+    int rc, *idx = r->lcp_idx, stage = 0;
+    double *q = r->qlcp, *z = r->lam;
+    for (;;) {
+        int k = 0, closing = 0;
+        for (int j = 0; j < r->ngc; j++) {
+            double U = contact_dot(r, r->g_ct[j], r->gv);
+            if (fabs(U) <= tolU)
+                U = 0.0;
+            if (U > 0.0) {
+                r->jpos[j] = -1;
+                continue;
+            }
+            closing += U < 0.0;
+            r->jpos[j] = k;
+            idx[k] = r->g_ct[j];
+            q[k++] = U + r->ct[r->g_ct[j]].e * fmin(U, 0.0);
+        }
+        if (!closing)
+            return PD_OK;
+        if (++stage > EDR_STAGES)
+            return pd_err_set(err, PD_EBUDGET, "row reference: the impact at t = %.17g did not "
+                              "end in %d stages", t, EDR_STAGES);
+        if ((rc = solve_lcp(r, idx, k, q, z, r->wtmp, t, err)))
+            return rc;
+        r->res.simultaneous += k > 1;
+        for (int j = 0; j < r->ngc; j++) {
+            if (r->jpos[j] < 0)
+                continue;
+            int a = r->g_ct[j];
+            double P = z[r->jpos[j]];
+            const edr_contact *ct = &r->ct[a];
+            for (int s = 0; s < 2; s++)
+                if (ct->dof[s] >= 0)
+                    r->gv[ct->dof[s]] += ct->w[s] * P * r->minv[ct->dof[s]];
+            r->P[j] += P;
+            r->imp_out[a] += P;
+            r->maxP[a] = pd_max(r->maxP[a], P);
+            if (!(q[r->jpos[j]] < 0.0))
+                continue;
+            r->impacts[a]++; /* a closing contact */
+            r->res.impacts++;
+            if (isnan(r->first[a]))
+                r->first[a] = t;
+            if (isnan(r->res.first_impact))
+                r->res.first_impact = t;
+            if (++r->burst[a] > r->o.max_burst)
+                return pd_err_set(err, PD_EBUDGET, "row reference: accumulation of impacts of "
+                                  "contact %d at t = %.9g: %ld impacts without reaching "
+                                  "persistent contact%s", a, t, r->burst[a] - 1,
+                                  r->o.no_accumulation ? " (accumulation handling is off)" : "");
+        }
+    }
+}
+
+/* Resolve the group at t: impact LCP if a contact closes, persistence,
+ * accumulations, new clusters, predictions. */
+static int resolve_group(pd_edr *r, double t, pd_err *err)
+{
+    int rc, acc = 0;
+    group_grow(r, t);
+    group_state(r, t);
+    double tol = r->o.close_tol * r->L, vs = 0.0;
+    for (int j = 0; j < r->ngc; j++) { /* closed walls exactly at their gap */
+        const edr_contact *ct = &r->ct[r->g_ct[j]];
+        r->excluded[j] = 0;
+        if ((ct->dof[0] < 0) != (ct->dof[1] < 0)) {
+            int s = ct->dof[0] >= 0 ? 0 : 1;
+            double x = -ct->g0 / ct->w[s];
+            if (fabs(ct->g0 + ct->w[s] * r->gx[ct->dof[s]]) <= tol + fabs(ct->g0) * 1e-15)
+                r->gx[ct->dof[s]] = x;
+        }
+    }
+    for (int k = 0; k < r->ngd; k++) {
+        vs = fmax(vs, fabs(r->gv[r->g_dof[k]]));
+        r->ev_vminus[k] = r->gv[r->g_dof[k]];
+    }
+    r->vscale = fmax(r->vscale, vs);
+    double tolU = EDR_RATE_TOL * fmax(vs, r->vscale);
+    for (int j = 0; j < r->ngc; j++) {
+        double U = contact_dot(r, r->g_ct[j], r->gv);
+        r->Uminus[j] = fabs(U) <= tolU ? 0.0 : U;
+        r->P[j] = 0.0;
+    }
+    if ((rc = impact_stages(r, t, tolU, err)))
+        return rc;
+    for (int j = 0; j < r->ngc; j++) {
+        double U = contact_dot(r, r->g_ct[j], r->gv);
+        r->Uplus[j] = fabs(U) <= tolU ? 0.0 : U;
+    }
+    if ((rc = decide_persistence(r, t, &acc, err)))
+        return rc;
+    if ((rc = regroup(r, t, err)))
+        return rc;
+    if (acc && !tails_hold(r)) { /* the tail would not hold: bounce on */
+        for (int j = 0; j < r->ngc; j++)
+            if (r->held_tail[j] > 0.0) {
+                r->held[j] = 0;
+                r->held_tail[j] = 0.0;
+            }
+        acc = 0;
+        if ((rc = regroup(r, t, err)))
+            return rc;
+    }
+    if (acc) {
+        r->res.accumulations++;
+        for (int j = 0; j < r->ngc; j++)
+            if (r->held[j] && r->held_tail[j] > 0.0)
+                r->burst[r->g_ct[j]] = 0;
+    }
+    for (int j = 0; j < r->ngc; j++)
+        if (r->held[j])
+            r->burst[r->g_ct[j]] = 0;
+    for (int k = 0; k < r->ngd; k++)
+        r->gv[r->g_dof[k]] = r->vo[r->g_dof[k]];
+    if (report(r, t, PD_EDR_IMPACT, acc) > 0)
+        r->stopped = 1;
+    repredict(r, t);
+    return PD_OK;
+}
+
+/* Start a group from the seed contact a (its gap closing at t). */
+static void group_begin(pd_edr *r)
+{
+    r->epoch++;
+    r->ng = 0;
+    r->ngc = 0;
+}
+
+static int on_impact(pd_edr *r, int a, double t, pd_err *err)
+{
+    int rc;
+    if ((rc = count_event(r, t, err)))
+        return rc;
+    group_begin(r);
+    group_add_contact(r, a);
+    const edr_contact *ct = &r->ct[a];
+    for (int s = 0; s < 2; s++)
+        if (ct->dof[s] >= 0)
+            group_add_cluster(r, cl_of_dof(r, ct->dof[s]));
+    return resolve_group(r, t, err);
+}
+
+/* A persistent force of cluster c reaches zero at t: the force LCP
+ * without that contact decides again. */
+static int on_detach(pd_edr *r, int c, double t, pd_err *err)
+{
+    int rc, acc, a = r->cl[c].det_contact;
+    if ((rc = count_event(r, t, err)))
+        return rc;
+    group_begin(r);
+    group_add_cluster(r, c);
+    for (int b = r->cl[c].head; b >= 0; b = r->blk_next[b]) {
+        const edr_block *bk = &r->blk[b];
+        for (int k = 0; k < bk->ncont; k++) {
+            int x = r->blk_cont[bk->cont0 + k];
+            if (r->cstate[x] != EDR_OPEN && r->ct_mark[x] != r->epoch)
+                group_add_contact(r, x);
+        }
+    }
+    group_state(r, t);
+    for (int k = 0; k < r->ngd; k++)
+        r->ev_vminus[k] = r->gv[r->g_dof[k]];
+    for (int j = 0; j < r->ngc; j++) {
+        r->Uminus[j] = r->Uplus[j] = 0.0;
+        r->P[j] = 0.0;
+    }
+    for (int j = 0; j < r->ngc; j++)
+        r->excluded[j] = r->g_ct[j] == a;
+    if ((rc = decide_persistence(r, t, &acc, err)))
+        return rc;
+    for (int j = 0; j < r->ngc; j++) {
+        r->excluded[j] = 0;
+        if (r->cstate[r->g_ct[j]] == EDR_PERSIST && !r->held[j]) {
+            r->res.detachments++;
+            r->burst[r->g_ct[j]] = 0;
+        }
+    }
+    if ((rc = regroup(r, t, err)))
+        return rc;
+    if (acc && !tails_hold(r)) {
+        for (int j = 0; j < r->ngc; j++)
+            if (r->held_tail[j] > 0.0)
+                r->held[j] = 0;
+        if ((rc = regroup(r, t, err)))
+            return rc;
+    }
+    if (report(r, t, PD_EDR_DETACH, 0) > 0)
+        r->stopped = 1;
+    repredict(r, t);
+    return PD_OK;
+}
+
+/* The forcing's next piece starts at t: every cluster re-origins on it;
+ * held contacts whose force would be negative decide again. */
+static int on_piece(pd_edr *r, double t, pd_err *err)
+{
+    int rc;
+    if ((rc = count_event(r, t, err)))
+        return rc;
+    r->piece = edr_piece_at(r, t);
+    int ncl = 0;
+    for (int c = 0; c < r->nb; c++)
+        if (r->cl[c].live)
+            r->plist[ncl++] = c;
+    for (int i = 0; i < ncl; i++) {
+        int c = r->plist[i];
+        if (!r->cl[c].live || r->cl[c].t0 == t) /* gone, or started at t on the new piece */
+            continue;
+        edr_cluster *cl = &r->cl[c];
+        group_begin(r);
+        group_add_cluster(r, c);
+        for (int b = cl->head; b >= 0; b = r->blk_next[b]) {
+            const edr_block *bk = &r->blk[b];
+            for (int k = 0; k < bk->ncont; k++) {
+                int x = r->blk_cont[bk->cont0 + k];
+                if (r->cstate[x] != EDR_OPEN && r->ct_mark[x] != r->epoch)
+                    group_add_contact(r, x);
+            }
+        }
+        group_state(r, t);
+        for (int k = 0; k < r->ngd; k++)
+            r->ev_vminus[k] = r->gv[r->g_dof[k]];
+        int negative = 0;
+        for (int j = 0; j < r->ngc; j++) {
+            r->Uminus[j] = r->Uplus[j] = r->P[j] = 0.0;
+            r->excluded[j] = 0;
+        }
+        if (r->ngc > 0) { /* the held forces under the new piece */
+            free_accelerations(r, t);
+            int k0 = 0;
+            for (int j = 0; j < r->ngc; j++)
+                r->lcp_idx[k0++] = r->g_ct[j];
+            if ((rc = force_lcp(r, r->lcp_idx, k0, t, err)))
+                return rc;
+            for (int j = 0; j < r->ngc; j++)
+                negative |= r->cstate[r->g_ct[j]] == EDR_PERSIST && !(r->lam[j] > 0.0);
+        }
+        if (negative) {
+            int acc;
+            if ((rc = decide_persistence(r, t, &acc, err)))
+                return rc;
+            for (int j = 0; j < r->ngc; j++)
+                if (r->cstate[r->g_ct[j]] == EDR_PERSIST && !r->held[j])
+                    r->res.detachments++;
+        } else
+            for (int j = 0; j < r->ngc; j++) {
+                r->held[j] = r->cstate[r->g_ct[j]] != EDR_OPEN;
+                r->held_tail[j] = 0.0;
+            }
+        if ((rc = regroup(r, t, err)))
+            return rc;
+    }
+    for (int i = 0; i < r->m; i++)
+        predict_contact(r, i, t, 0);
+    for (int c = 0; c < r->nb; c++)
+        if (r->cl[c].live)
+            predict_detach(r, c, t, 0);
+    double next = edr_piece_end(r, r->piece);
+    q_set(&r->q, r->slot_piece, next < r->t1 ? next : HUGE_VAL);
+    return PD_OK;
+}
+
+/* The observer's state at t. */
+static int emit(pd_edr *r, double t, pd_observer obs, void *ctx)
+{
+    for (int i = 0; i < r->n; i++) {
+        double a;
+        dof_state(r, i, t, &r->st.q[i], &r->st.v[i], &a);
+        r->st.acc[i] = a;
+    }
+    for (int a = 0; a < r->m; a++) {
+        r->st.g[a] = gap_now(r, a, t, NULL);
+        r->st.P[a] = r->imp_out[a];
+        r->imp_out[a] = 0.0;
+        r->st.active[a] = r->cstate[a] == EDR_PERSIST;
+    }
+    r->st.t = t;
+    r->st.has_acc = 1;
+    return obs(&r->st, ctx);
+}
+
+/* ---- allocation ---------------------------------------------------------------------------- */
+
+void pd_edr_free(pd_edr *r)
+{
+    if (!r)
+        return;
+    if (r->cl)
+        for (int c = 0; c < r->nb; c++)
+            edr_cluster_free(&r->cl[c]);
+    edr_basis_cache_free(r);
+    pd_lcp_solver_free(r->solver);
+    void *arrays[] = {r->b, r->pieces, r->blk, r->blk_dofs, r->dof_blk, r->dof_loc, r->Mb,
+                      r->Cb, r->Kb, r->blk_off, r->blk_cont, r->ct, r->minv, r->cl, r->blk_cl,
+                      r->blk_next, r->free_cl, r->s, r->d, r->xo, r->vo, r->cstate, r->pers_next,
+                      r->la, r->lb, r->lg, r->ld, r->base_t, r->base_g, r->qkind, r->win, r->gmeas_t,
+                      r->since, r->burst, r->xpos, r->xneg, r->drift, r->gmin, r->impacts,
+                      r->first, r->maxP, r->ctime, r->imp_out, r->q.heap, r->q.pos, r->q.key,
+                      r->g_cl, r->cl_mark, r->g_ct, r->ct_mark, r->ct_mark2, r->ct_markD,
+                      r->g_dof, r->gx, r->gv, r->gacc, r->gtmp, r->Uminus, r->Uplus, r->P,
+                      r->lam, r->wlcp, r->qlcp, r->wtmp, r->Dd, r->lcp_idx, r->jpos, r->held,
+                      r->held_tail, r->excluded, r->pos_in, r->Dval, r->Dcol, r->Drow,
+                      r->stack, r->pe, r->pdof, r->crow, r->crow_c, r->keybuf, r->uf, r->gblk,
+                      r->newcl, r->plist, r->dofc_ptr, r->dofc, r->loc, r->wk, r->mctx,
+                      r->mscan, r->mprev, r->ev_vminus, r->ev_vplus, r->st.q,
+                      r->st.v, r->st.P, r->st.g, r->st.active, r->st.acc};
+    for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
+        free(arrays[k]);
+    free(r);
+}
+
+/* Entries of column j of A: rows and values through the callback. */
+typedef void (*entry_fn)(void *ctx, int i, int j, double x);
+static void for_each_entry(const pd_matrix *A, entry_fn fn, void *ctx)
+{
+    if (A->kind == PD_MATRIX_DENSE) {
+        for (int j = 0; j < A->cols; j++)
+            for (int i = 0; i < A->rows; i++)
+                fn(ctx, i, j, A->values[i + (size_t)j * A->rows]);
+    } else if (A->kind == PD_MATRIX_CSC) {
+        for (int j = 0; j < A->cols; j++)
+            for (int p = A->colptr[j]; p < A->colptr[j + 1]; p++)
+                fn(ctx, A->rowind[p], j, A->values[p]);
+    }
+}
+
+static void join_entry(void *ctx, int i, int j, double x)
+{
+    int *uf = ctx;
+    if (x != 0.0 && i != j) {
+        int a = uf_find(uf, i), b = uf_find(uf, j);
+        if (a != b)
+            uf[a] = b;
+    }
+}
+
+typedef struct fill_ctx {
+    pd_edr *r;
+    double *dst;
+} fill_ctx;
+
+static void fill_entry(void *ctx, int i, int j, double x)
+{
+    fill_ctx *f = ctx;
+    pd_edr *r = f->r;
+    int b = r->dof_blk[i];
+    if (x == 0.0 || r->dof_blk[j] != b)
+        return;
+    f->dst[r->blk_off[b] + r->dof_loc[i] + (long)r->dof_loc[j] * r->blk[b].n] += x;
+}
+
+typedef struct wcol_ctx {
+    pd_edr *r;
+    int bad;
+} wcol_ctx;
+
+static void wcol_entry(void *ctx, int i, int j, double x)
+{
+    wcol_ctx *w = ctx;
+    edr_contact *ct = &w->r->ct[j];
+    if (x == 0.0)
+        return;
+    if (ct->dof[0] < 0) {
+        ct->dof[0] = i;
+        ct->w[0] = x;
+    } else if (ct->dof[1] < 0) {
+        ct->dof[1] = i;
+        ct->w[1] = x;
+    } else
+        w->bad = j + 1;
+}
+
+#define ALLOC(p, cnt) (((p) = calloc((size_t)((cnt) > 0 ? (cnt) : 1), sizeof *(p))) != NULL)
+
+static int check_opts(const pd_edr_opts *o, pd_err *err)
+{
+    if (!(o->close_tol >= 0.0) || !isfinite(o->close_tol))
+        return pd_err_set(err, PD_EINVAL, "close_tol: must be >= 0 (got %g)", o->close_tol);
+    if (!(o->length_scale > 0.0) || !isfinite(o->length_scale))
+        return pd_err_set(err, PD_EINVAL, "row reference: the length scale must be > 0");
+    if (o->max_events < 1 || o->max_burst < 1 || o->scan_divisions < 1 || !(o->max_evals >= 1.0))
+        return pd_err_set(err, PD_EINVAL, "row reference: budgets and scan divisions must be "
+                                          ">= 1");
+    if (!(o->h_out >= 0.0) || !isfinite(o->h_out) || !isfinite(o->t_measure))
+        return pd_err_set(err, PD_EINVAL, "row reference: h_out and t_measure must be finite");
+    return PD_OK;
+}
+
+pd_edr *pd_edr_alloc(const pd_model *md, const pd_piecewise_force *F, const pd_edr_opts *opts,
+                     pd_err *err)
+{
+    pd_edr *r = NULL;
+    pd_edr_opts o = opts ? *opts : pd_edr_default_opts();
+    int rc;
+    pd_err_clear(err);
+    if (!md || !F || !F->b || !F->pieces || F->npieces < 1) {
+        pd_err_set(err, PD_EINVAL, "row reference: a model and a piecewise force are needed");
+        return NULL;
+    }
+    if ((rc = pd_model_check(md, err)) || (rc = check_opts(&o, err)))
+        return NULL;
+    if (!pd_matrix_is_diagonal(&md->M)) {
+        pd_err_set(err, PD_EINVAL, "M: the row reference needs a diagonal (lumped) mass matrix");
+        return NULL;
+    }
+    for (int k = 0; k < F->npieces; k++) {
+        const pd_sine_piece *pc = &F->pieces[k];
+        if (!isfinite(pc->t_start) || (k > 0 && !(pc->t_start > F->pieces[k - 1].t_start)) ||
+            !isfinite(pc->A) || !isfinite(pc->w) || !isfinite(pc->phi) || !isfinite(pc->c0) ||
+            !isfinite(pc->c1)) {
+            pd_err_set(err, PD_EINVAL, "row reference: forcing piece %d is not finite or not in "
+                                       "order", k);
+            return NULL;
+        }
+    }
+    int n = md->n, m = md->m;
+    for (int i = 0; i < n; i++)
+        if (!isfinite(F->b[i])) {
+            pd_err_set(err, PD_EINVAL, "row reference: load coefficient %d is not finite", i);
+            return NULL;
+        }
+    if (!(r = calloc(1, sizeof *r))) {
+        pd_err_set(err, PD_ENOMEM, "out of memory for the row reference");
+        return NULL;
+    }
+    r->md = md;
+    r->o = o;
+    r->n = n;
+    r->m = m;
+    int *uf = NULL;
+    if (!ALLOC(r->b, n) || !ALLOC(r->pieces, F->npieces) || !ALLOC(r->dof_blk, n) ||
+        !ALLOC(r->dof_loc, n) || !ALLOC(r->blk_dofs, n) || !ALLOC(r->minv, n) || !ALLOC(uf, n) ||
+        !ALLOC(r->ct, m))
+        goto nomem;
+    memcpy(r->b, F->b, (size_t)n * sizeof(double));
+    memcpy(r->pieces, F->pieces, (size_t)F->npieces * sizeof(pd_sine_piece));
+    r->npieces = F->npieces;
+    for (int i = 0; i < n; i++) {
+        double mi = pd_matrix_get(&md->M, i, i);
+        if (!(mi > 0.0)) {
+            pd_err_set(err, PD_EINVAL, "M: mass %d must be > 0 (got %g)", i, mi);
+            goto fail;
+        }
+        r->minv[i] = 1.0 / mi;
+        uf[i] = i;
+    }
+    /* blocks: the components of C and K's couplings */
+    for_each_entry(&md->C, join_entry, uf);
+    for_each_entry(&md->K, join_entry, uf);
+    int nb = 0;
+    for (int i = 0; i < n; i++)
+        if (uf_find(uf, i) == i)
+            r->dof_blk[i] = nb++;
+    r->nb = nb;
+    if (!ALLOC(r->blk, nb) || !ALLOC(r->blk_off, nb + 1))
+        goto nomem;
+    for (int i = 0; i < n; i++) {
+        int b = r->dof_blk[uf_find(uf, i)];
+        r->dof_blk[i] = b;
+        r->dof_loc[i] = r->blk[b].n++;
+    }
+    long off = 0;
+    int at = 0;
+    for (int b = 0; b < nb; b++) {
+        r->blk[b].first = at;
+        at += r->blk[b].n;
+        r->blk_off[b] = off;
+        off += (long)r->blk[b].n * r->blk[b].n;
+        r->blk[b].sdof = r->blk[b].n == 1;
+    }
+    r->blk_off[nb] = off;
+    for (int i = 0; i < n; i++)
+        r->blk_dofs[r->blk[r->dof_blk[i]].first + r->dof_loc[i]] = i;
+    if (!ALLOC(r->Cb, off) || !ALLOC(r->Kb, off) || !ALLOC(r->Mb, off))
+        goto nomem;
+    fill_ctx fc = {.r = r, .dst = r->Cb};
+    for_each_entry(&md->C, fill_entry, &fc);
+    fc.dst = r->Kb;
+    for_each_entry(&md->K, fill_entry, &fc);
+    for (int b = 0; b < nb; b++) {
+        edr_block *bk = &r->blk[b];
+        if (bk->sdof) {
+            int i = r->blk_dofs[bk->first];
+            bk->m = 1.0 / r->minv[i];
+            bk->c = r->Cb[r->blk_off[b]];
+            bk->k = r->Kb[r->blk_off[b]];
+            bk->b = r->b[i];
+            if (bk->k < 0.0 || bk->c < 0.0) {
+                pd_err_set(err, PD_EINVAL, "K, C: dof %d has a negative stiffness or damping", i);
+                goto fail;
+            }
+        }
+    }
+    /* contacts: one or two dofs each, in different structures */
+    for (int a = 0; a < m; a++) {
+        r->ct[a] = (edr_contact){.dof = {-1, -1}, .blk = {-1, -1}, .g0 = md->g0[a], .e = md->e[a]};
+    }
+    wcol_ctx wc = {.r = r, .bad = 0};
+    for_each_entry(&md->W, wcol_entry, &wc);
+    for (int a = 0; a < m && !wc.bad; a++) {
+        edr_contact *ct = &r->ct[a];
+        if (ct->dof[0] < 0)
+            wc.bad = a + 1;
+        for (int s = 0; s < 2; s++)
+            ct->blk[s] = ct->dof[s] >= 0 ? r->dof_blk[ct->dof[s]] : -1;
+        if (ct->dof[1] >= 0 && ct->blk[0] == ct->blk[1])
+            wc.bad = a + 1;
+    }
+    if (wc.bad) {
+        pd_err_set(err, PD_EINVAL, "W: contact %d must join one dof of one structure to one of "
+                   "another, or to a wall (the row reference)", wc.bad - 1);
+        goto fail;
+    }
+    /* adjacency: contacts of each block and of each dof */
+    if (!ALLOC(r->blk_cont, 2 * m) || !ALLOC(r->dofc_ptr, n + 1) || !ALLOC(r->dofc, 2 * m))
+        goto nomem;
+    for (int a = 0; a < m; a++)
+        for (int s = 0; s < 2; s++)
+            if (r->ct[a].dof[s] >= 0) {
+                r->blk[r->ct[a].blk[s]].ncont++;
+                r->dofc_ptr[r->ct[a].dof[s] + 1]++;
+            }
+    for (int b = 0, c0 = 0; b < nb; b++) {
+        r->blk[b].cont0 = c0;
+        c0 += r->blk[b].ncont;
+        r->blk[b].ncont = 0;
+    }
+    for (int i = 0; i < n; i++)
+        r->dofc_ptr[i + 1] += r->dofc_ptr[i];
+    long dnnz = 0;
+    for (int a = 0; a < m; a++)
+        for (int s = 0; s < 2; s++) {
+            int dof = r->ct[a].dof[s];
+            if (dof < 0)
+                continue;
+            edr_block *bk = &r->blk[r->ct[a].blk[s]];
+            r->blk_cont[bk->cont0 + bk->ncont++] = a;
+        }
+    for (int i = 0; i < n; i++) /* uf now counts the contacts filled per dof */
+        uf[i] = 0;
+    for (int a = 0; a < m; a++)
+        for (int s = 0; s < 2; s++) {
+            int dof = r->ct[a].dof[s];
+            if (dof >= 0)
+                r->dofc[r->dofc_ptr[dof] + uf[dof]++] = a;
+        }
+    for (int i = 0; i < n; i++) {
+        long dg = r->dofc_ptr[i + 1] - r->dofc_ptr[i];
+        dnnz += dg * dg;
+    }
+    r->Dcap = dnnz + m;
+    int dm = m < EDR_DENSE_MAX ? m : EDR_DENSE_MAX;
+    int nf = 2 * n;
+    if (!ALLOC(r->cl, nb) || !ALLOC(r->blk_cl, nb) || !ALLOC(r->blk_next, nb) ||
+        !ALLOC(r->free_cl, nb) || !ALLOC(r->s, n) || !ALLOC(r->d, n) || !ALLOC(r->xo, n) ||
+        !ALLOC(r->vo, n) || !ALLOC(r->cstate, m) || !ALLOC(r->pers_next, m) || !ALLOC(r->la, m) ||
+        !ALLOC(r->lb, m) || !ALLOC(r->lg, m) || !ALLOC(r->ld, m) || !ALLOC(r->base_t, m) ||
+        !ALLOC(r->base_g, m) || !ALLOC(r->qkind, m + nb + 2) || !ALLOC(r->win, m + nb + 2) || !ALLOC(r->gmeas_t, m) ||
+        !ALLOC(r->since, m) || !ALLOC(r->burst, m) || !ALLOC(r->xpos, n) || !ALLOC(r->xneg, n) ||
+        !ALLOC(r->drift, n) || !ALLOC(r->gmin, m) || !ALLOC(r->impacts, m) || !ALLOC(r->first, m) ||
+        !ALLOC(r->maxP, m) || !ALLOC(r->ctime, m) || !ALLOC(r->imp_out, m) ||
+        !ALLOC(r->q.heap, m + nb + 2) || !ALLOC(r->q.pos, m + nb + 2) ||
+        !ALLOC(r->q.key, m + nb + 2) || !ALLOC(r->g_cl, nb) || !ALLOC(r->cl_mark, nb) ||
+        !ALLOC(r->g_ct, m) || !ALLOC(r->ct_mark, m) || !ALLOC(r->ct_mark2, m) ||
+        !ALLOC(r->ct_markD, m) || !ALLOC(r->g_dof, n) || !ALLOC(r->gx, n) || !ALLOC(r->gv, n) ||
+        !ALLOC(r->gacc, n) || !ALLOC(r->gtmp, n) || !ALLOC(r->Uminus, m) || !ALLOC(r->Uplus, m) ||
+        !ALLOC(r->P, m) || !ALLOC(r->lam, m) || !ALLOC(r->wlcp, m) || !ALLOC(r->qlcp, m) ||
+        !ALLOC(r->wtmp, m) || !ALLOC(r->Dd, (long)dm * dm) || !ALLOC(r->lcp_idx, m) ||
+        !ALLOC(r->jpos, m) || !ALLOC(r->held, m) || !ALLOC(r->held_tail, m) ||
+        !ALLOC(r->excluded, m) || !ALLOC(r->pos_in, m) || !ALLOC(r->Dval, r->Dcap) ||
+        !ALLOC(r->Dcol, m + 1) || !ALLOC(r->Drow, r->Dcap) || !ALLOC(r->stack, n) ||
+        !ALLOC(r->pe, n) || !ALLOC(r->pdof, n) || !ALLOC(r->crow, n) || !ALLOC(r->crow_c, m) ||
+        !ALLOC(r->keybuf, 2 * (nb + m + 1)) || !ALLOC(r->uf, nb) || !ALLOC(r->gblk, nb) ||
+        !ALLOC(r->newcl, nb) || !ALLOC(r->plist, nb) || !ALLOC(r->loc, n) || !ALLOC(r->wk, 8L * n) ||
+        !ALLOC(r->mctx, nf) || !ALLOC(r->mscan, nf) || !ALLOC(r->mprev, nf) ||
+        !ALLOC(r->ev_vminus, n) || !ALLOC(r->ev_vplus, n) ||
+        !ALLOC(r->st.q, n) || !ALLOC(r->st.v, n) || !ALLOC(r->st.P, m) || !ALLOC(r->st.g, m) ||
+        !ALLOC(r->st.active, m) || !ALLOC(r->st.acc, n))
+        goto nomem;
+    if (m > 1 && !(r->solver = pd_lcp_solver_alloc(o.lcp_solver, m, r->Dcap, err)))
+        goto fail;
+    free(uf);
+    r->slot_piece = m + nb;
+    r->slot_out = m + nb + 1;
+    return r;
+nomem:
+    pd_err_set(err, PD_ENOMEM, "out of memory for the row reference (%d dofs, %d contacts)", n, m);
+fail:
+    free(uf);
+    pd_edr_free(r);
+    return NULL;
+}
+
+/* ---- the run -------------------------------------------------------------------------------- */
+
+static void reset(pd_edr *r, double t0, const double *q0, const double *v0, double t1)
+{
+    int n = r->n, m = r->m;
+    memset(&r->res, 0, sizeof r->res);
+    r->res.first_impact = NAN;
+    r->t = t0;
+    r->t1 = t1;
+    r->L = r->o.length_scale;
+    r->piece = edr_piece_at(r, t0);
+    r->q.n = 0;
+    for (int k = 0; k < m + r->nb + 2; k++) {
+        r->q.pos[k] = -1;
+        r->q.key[k] = HUGE_VAL;
+    }
+    for (int i = 0; i < n; i++) {
+        r->xo[i] = q0 ? q0[i] : 0.0;
+        r->vo[i] = v0 ? v0[i] : 0.0;
+        r->xpos[i] = r->xneg[i] = r->drift[i] = -HUGE_VAL;
+        r->loc[i] = -1;
+    }
+    for (int a = 0; a < m; a++) {
+        r->cstate[a] = EDR_OPEN;
+        r->pers_next[a] = -1;
+        r->base_t[a] = -HUGE_VAL;
+        r->gmeas_t[a] = t0;
+        r->gmin[a] = HUGE_VAL;
+        r->impacts[a] = 0;
+        r->first[a] = NAN;
+        r->maxP[a] = r->ctime[a] = r->imp_out[a] = 0.0;
+        r->burst[a] = 0;
+        r->since[a] = t0;
+    }
+    r->nfree = 0;
+    for (int c = r->nb - 1; c >= 0; c--) {
+        r->cl[c].live = 0;
+        r->free_cl[r->nfree++] = c;
+    }
+    r->epoch = r->epochD = 0;
+    memset(r->cl_mark, 0, (size_t)r->nb * sizeof *r->cl_mark);
+    memset(r->ct_mark, 0, (size_t)(m > 0 ? m : 1) * sizeof *r->ct_mark);
+    memset(r->ct_mark2, 0, (size_t)(m > 0 ? m : 1) * sizeof *r->ct_mark2);
+    memset(r->ct_markD, 0, (size_t)(m > 0 ? m : 1) * sizeof *r->ct_markD);
+    r->last_t = NAN;
+    r->same_t = 0;
+    r->stopped = 0;
+    r->vscale = 0.0;
+    r->evals = 0;
+}
+
+/* Every structure alone at t0; contacts closed at t0 resolved. */
+static int start(pd_edr *r, double t0, pd_err *err)
+{
+    int rc;
+    for (int b = 0; b < r->nb; b++) {
+        int c = r->free_cl[--r->nfree];
+        edr_cluster *cl = &r->cl[c];
+        cl->live = 1;
+        cl->head = b;
+        cl->nblk = 1;
+        cl->pers_head = -1;
+        cl->npers = 0;
+        cl->meas_t = t0;
+        r->blk_cl[b] = c;
+        r->blk_next[b] = -1;
+        if ((rc = edr_cluster_start(r, c, t0, err)))
+            return rc;
+    }
+    double tol = r->o.close_tol * r->L;
+    for (int a = 0; a < r->m; a++) {
+        double g = gap_now(r, a, t0, NULL);
+        if (g < -tol && !r->o.inactive)
+            return pd_err_set(err, PD_EINVAL, "q0: contact %d starts with a negative gap (%g)",
+                              a, g);
+    }
+    if (!r->o.inactive)
+        for (int a = 0; a < r->m; a++) {
+            if (r->cstate[a] != EDR_OPEN || !(gap_now(r, a, t0, NULL) <= tol))
+                continue;
+            group_begin(r);
+            group_add_contact(r, a);
+            const edr_contact *ct = &r->ct[a];
+            for (int s = 0; s < 2; s++)
+                if (ct->dof[s] >= 0)
+                    group_add_cluster(r, cl_of_dof(r, ct->dof[s]));
+            if ((rc = resolve_group(r, t0, err)))
+                return rc;
+        }
+    for (int a = 0; a < r->m; a++)
+        predict_contact(r, a, t0, 0);
+    for (int c = 0; c < r->nb; c++)
+        if (r->cl[c].live)
+            predict_detach(r, c, t0, 0);
+    double next = edr_piece_end(r, r->piece);
+    q_set(&r->q, r->slot_piece, next < r->t1 ? next : HUGE_VAL);
+    return PD_OK;
+}
+
+/* Close the run at t: extremes and gaps to t, contact times. */
+static void finish(pd_edr *r, double t)
+{
+    for (int c = 0; c < r->nb; c++)
+        if (r->cl[c].live)
+            measure_cluster(r, c, t);
+    for (int a = 0; a < r->m; a++) {
+        measure_contact(r, a, t);
+        if (r->cstate[a] == EDR_PERSIST && t > r->since[a])
+            r->ctime[a] += t - r->since[a];
+        if (!(r->gmin[a] < HUGE_VAL))
+            r->gmin[a] = gap_now(r, a, t, NULL);
+    }
+    for (int i = 0; i < r->n; i++) {
+        r->xpos[i] = pd_max(r->xpos[i], -HUGE_VAL);
+        if (!(r->xpos[i] > -HUGE_VAL))
+            r->xpos[i] = r->xneg[i] = r->drift[i] = 0.0;
+    }
+    r->res.t_reached = t;
+    r->res.evals = (double)r->evals;
+}
+
+int pd_edr_run(pd_edr *r, double t0, const double *q0, const double *v0, double t1,
+               pd_observer obs, void *ctx, pd_err *err)
+{
+    int rc;
+    pd_err_clear(err);
+    if (!r)
+        return pd_err_set(err, PD_EINVAL, "row reference: no object");
+    if (!isfinite(t0) || !(t1 > t0) || !isfinite(t1))
+        return pd_err_set(err, PD_EINVAL, "row reference: need t0 < t1, both finite");
+    for (int i = 0; q0 && i < r->n; i++)
+        if (!isfinite(q0[i]) || (v0 && !isfinite(v0[i])))
+            return pd_err_set(err, PD_EINVAL, "row reference: the initial state is not finite");
+    reset(r, t0, q0, v0, t1);
+    if ((rc = start(r, t0, err)))
+        goto out;
+    r->t_out0 = t0;
+    r->next_out = 0;
+    if (obs) {
+        r->st.step = 0;
+        if (emit(r, t0, obs, ctx) > 0)
+            goto out;
+        r->next_out = 1;
+        if (r->o.h_out > 0.0)
+            q_set(&r->q, r->slot_out, fmin(t0 + r->o.h_out, t1));
+    }
+    double t = t0;
+    while (!r->stopped) {
+        int slot = r->q.n > 0 ? r->q.heap[0] : -1;
+        double te = slot >= 0 ? r->q.key[slot] : HUGE_VAL;
+        if (!(te <= t1))
+            break;
+        t = te;
+        if (r->evals > r->o.max_evals) {
+            rc = pd_err_set(err, PD_EBUDGET, "row reference: %.3g flight evaluations by t = %.9g "
+                            "(budget exhausted)", (double)r->evals, t);
+            break;
+        }
+        if (slot == r->slot_out) {
+            r->st.step = r->next_out;
+            if (emit(r, t, obs, ctx) > 0)
+                break;
+            r->next_out++;
+            double tn = r->t_out0 + (double)r->next_out * r->o.h_out;
+            if (tn > t1 && t < t1 * (1.0 - 1e-15))
+                tn = t1;
+            q_set(&r->q, r->slot_out, tn <= t1 * (1.0 + 1e-15) && tn > t ? tn : HUGE_VAL);
+            continue;
+        }
+        if (slot == r->slot_piece) {
+            rc = on_piece(r, t, err);
+        } else if (slot < r->m) {
+            if (r->qkind[slot] == EDR_Q_SCAN)
+                predict_contact(r, slot, t, 1);
+            else
+                rc = on_impact(r, slot, t, err);
+        } else {
+            int c = slot - r->m;
+            if (r->qkind[slot] == EDR_Q_SCAN)
+                predict_detach(r, c, t, 1);
+            else
+                rc = on_detach(r, c, t, err);
+        }
+        if (rc)
+            break;
+    }
+    if (!rc) {
+        t = r->stopped ? t : t1;
+        finish(r, t);
+    } else
+        finish(r, t);
+out:
+    r->res.t_reached = t1;
+    if (rc)
+        r->res.t_reached = r->t;
+    return rc;
+}
+
+const pd_edr_result *pd_edr_result_of(const pd_edr *r)
+{
+    pd_edr_result *res = (pd_edr_result *)&r->res;
+    res->xpos = r->xpos;
+    res->xneg = r->xneg;
+    res->drift = r->drift;
+    res->contact_impacts = r->impacts;
+    res->first = r->first;
+    res->max_impulse = r->maxP;
+    res->contact_time = r->ctime;
+    res->min_gap = r->gmin;
+    res->modal_bases = r->nbasis;
+    return res;
+}

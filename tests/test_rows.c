@@ -1,0 +1,678 @@
+/* test_rows.c — the exact event-driven reference for rows (pd_edr,
+ * engine/event_row.c) against closed forms, invariants and independent
+ * methods:
+ *   - one SDOF against a wall equals the exact one-wall reference to 1e-12
+ *     (umax, impacts, first impact, accumulations), pulses and a record;
+ *   - a partner a billion times heavier and very stiff behaves as a wall,
+ *     within its own motion;
+ *   - at every impact the impulses balance (momentum changes only through
+ *     walls) and the kinetic energy does not rise; with eps = 1 and no
+ *     damping the total energy after the pulse is constant to 1e-10 over
+ *     hundreds of impacts;
+ *   - a row read backwards under the mirrored excitation gives the mirrored
+ *     result; scaling ap and every gap together leaves every Pi1 unchanged;
+ *   - where impacts are isolated it agrees with the GSL-based general
+ *     reference (pd_edg_run) to 1e-9, SDOF rows and shear buildings;
+ *   - Moreau–Jean converges to it on rows of 2 and 10;
+ *   - the closing tolerance decides simultaneity, and the run reports it;
+ *   - an SDOF row's run allocates nothing. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pd_problems.h"
+#include "pd_test.h"
+
+/* Relative agreement with the one-wall reference and the general one. */
+#define ONE_WALL_TOL 1e-12
+#define GENERAL_TOL 1e-9
+
+/* A finished scene from structures and contacts added by the caller. */
+static pd_scene *new_scene(pd_pulse pulse, int dir, double ap, double Tp)
+{
+    pd_scene_excitation exc = {.pulse = pulse, .dir = dir, .ap = ap, .Tp = Tp};
+    return pd_scene_new(&exc);
+}
+
+/* Run sc with method m (kernel: general forces the row reference even on
+ * the one-wall scene) into a fresh result; PD_OK or the failure checked. */
+static int run_m(pd_test_ctx *ctx, const pd_scene *sc, const pd_run_opts *o, pd_scene_result *r)
+{
+    pd_err e;
+    int rc = pd_scene_result_alloc(sc, r, &e);
+    if (!rc)
+        rc = pd_scene_run(sc, o, NULL, NULL, r, &e);
+    CHECK(ctx, rc == PD_OK, "%s run: %s", pd_method_name(o->method), e.msg);
+    return rc;
+}
+
+static pd_run_opts event_opts(void)
+{
+    pd_run_opts o = pd_run_default_opts();
+    o.method = PD_METHOD_EVENT;
+    o.kernel = PD_KERNEL_GENERAL; /* no oscillator fast path */
+    return o;
+}
+
+/* ---- one SDOF against a wall ------------------------------------------------- */
+
+/* The one-wall scene, the wall on the right (side 1) or the left. */
+static pd_scene *one_wall(const pd_osc *c, int wall_right, pd_err *e)
+{
+    pd_scene_excitation exc = {.pulse = c->pulse, .dir = wall_right ? c->dir : -c->dir,
+                               .ap = c->ap, .Tp = c->Tp, .record = c->record,
+                               .rec_ap = c->rec_ap, .scale = c->scale};
+    pd_scene *sc = pd_scene_new(&exc);
+    double gap = pd_osc_gap(c);
+    if (!sc || pd_scene_add_sdof(sc, "A", pd_osc_T0(c), c->xi, 2.5, e) ||
+        (wall_right ? pd_scene_add_contact(sc, 0, 1, PD_WALL, 0, gap, c->eps, 0, e)
+                    : pd_scene_add_contact(sc, PD_WALL, 0, 0, 1, gap, c->eps, 0, e)) ||
+        pd_scene_finish(sc, e)) {
+        pd_scene_free(sc);
+        return NULL;
+    }
+    return sc;
+}
+
+/* The row reference on the one-wall scene against the exact one-wall
+ * reference over a grid: umax, impacts, accumulations and first impact to
+ * ONE_WALL_TOL, the wall on either side. */
+static int one_wall_case(pd_test_ctx *ctx, const pd_osc *c, int wall_right, int *accs)
+{
+    pd_err e;
+    pd_scene *sc = one_wall(c, wall_right, &e);
+    pd_scene_result r = {0}, ref = {0};
+    pd_run_opts o = event_opts(), f = pd_run_default_opts();
+    int ok = 0;
+    f.method = PD_METHOD_EVENT;
+    if (!CHECK(ctx, sc != NULL, "scene: %s", e.msg))
+        return 0;
+    if (!run_m(ctx, sc, &o, &r) && !run_m(ctx, sc, &f, &ref)) {
+        ok = CHECK(ctx, strcmp(r.kernel, "event-rows") == 0 && strcmp(ref.kernel, "event") == 0,
+                   "kernels %s / %s", r.kernel, ref.kernel);
+        ok &= CHECK(ctx, fabs(r.umax[0] - ref.umax[0]) <= ONE_WALL_TOL * ref.umax[0] &&
+                             r.impacts[0] == ref.impacts[0] &&
+                             r.accumulations == ref.accumulations,
+                    "%s %s Pi2 %g Pi3 %g eps %g wall %s: umax %.17g vs %.17g, impacts %ld vs "
+                    "%ld, accumulations %ld vs %ld",
+                    pd_osc_excitation_name(c), pd_dir_name(c->dir), c->Pi2, c->Pi3, c->eps,
+                    wall_right ? "right" : "left", r.umax[0], ref.umax[0], r.impacts[0],
+                    ref.impacts[0], r.accumulations, ref.accumulations);
+        double t1 = r.first_impact[0], t2 = ref.first_impact[0];
+        ok &= CHECK(ctx, (isnan(t1) && isnan(t2)) || fabs(t1 - t2) <= ONE_WALL_TOL * c->Tp,
+                    "first impact %.17g vs %.17g", t1, t2);
+        *accs += (int)ref.accumulations;
+    }
+    pd_scene_result_free(&r);
+    pd_scene_result_free(&ref);
+    pd_scene_free(sc);
+    return ok;
+}
+
+static void test_rows_one_wall_equals_exact(pd_test_ctx *ctx)
+{
+    const double pi2[] = {0.2, 1.16, 3.0}, pi3[] = {0.01, 0.1, 1.0};
+    const double eps[] = {0.0, 0.3, 0.5, 0.8, 1.0};
+    int cases = 0, passed = 0, accs = 0;
+    for (int p = 0; p < 2; p++)
+        for (int d = 0; d < 2; d++)
+            for (int i = 0; i < 3; i++)
+                for (int j = 0; j < 3; j++)
+                    for (int k = 0; k < 5; k++) {
+                        pd_osc c = {.pulse = p ? PD_PULSE_COSINE : PD_PULSE_SINE,
+                                    .dir = d ? -1 : 1, .ap = 3.0, .Tp = 0.5, .Pi2 = pi2[i],
+                                    .Pi3 = pi3[j], .eps = eps[k], .xi = 0.05};
+                        cases++;
+                        passed += one_wall_case(ctx, &c, (i + j + k) % 2, &accs);
+                    }
+    CHECK(ctx, passed == cases, "%d of %d cases agree", passed, cases);
+    CHECK(ctx, accs >= 10, "the grid meets accumulations (%d)", accs);
+}
+
+/* A record: a synthetic accelerogram (three sines, a decaying envelope)
+ * sampled every 0.01 s, linear between samples. */
+static void test_rows_one_wall_record(pd_test_ctx *ctx)
+{
+    enum { NPTS = 800 };
+    double acc[NPTS];
+    for (int k = 0; k < NPTS; k++) {
+        double t = 0.01 * k;
+        acc[k] = 3.0 * exp(-0.4 * t) * (sin(4.1 * t) + 0.6 * sin(9.7 * t + 1.0) + 0.3 * sin(23.0 * t));
+    }
+    pd_record rec = {.npts = NPTS, .dt = 0.01, .acc = acc};
+    strcpy(rec.name, "synthetic");
+    int cases = 0, passed = 0, accs = 0;
+    const double eps[] = {0.3, 0.6, 0.8};
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < 2; i++) {
+            pd_osc c = {.dir = i ? -1 : 1, .ap = 3.0, .Tp = 1.5, .record = &rec, .rec_ap = 3.0,
+                        .scale = 1.0, .Pi3 = 0.05, .eps = eps[k], .xi = 0.05};
+            pd_osc_set_T0(&c, i ? 0.6 : 1.1);
+            cases++;
+            passed += one_wall_case(ctx, &c, i, &accs);
+        }
+    CHECK(ctx, passed == cases, "%d of %d record cases agree", passed, cases);
+}
+
+/* ---- a heavy, stiff partner is a wall --------------------------------------- */
+
+/* A (unit mass) strikes B, 1e9 times heavier with a period 1e-3 of A's: B
+ * moves by its quasi-static response to the pulse and the impulses it
+ * takes (max|x_B|), so A's umax and impacts agree with A against a wall
+ * within that motion; accumulations included. */
+static void test_rows_heavy_partner_is_a_wall(pd_test_ctx *ctx)
+{
+    const double eps[] = {0.0, 0.5, 0.8};
+    for (int k = 0; k < 3; k++) {
+        pd_err e;
+        pd_scene *row = new_scene(PD_PULSE_COSINE, 1, 3.0, 0.5), *wall = new_scene(PD_PULSE_COSINE, 1, 3.0, 0.5);
+        int ok = row && wall && !pd_scene_add_sdof(row, "A", 3.0, 0.05, 1.0, &e) &&
+                 !pd_scene_add_sdof(row, "B", 1e-3, 0.05, 1e9, &e) &&
+                 !pd_scene_add_contact(row, 0, 1, 1, 1, 0.001, eps[k], 0, &e) &&
+                 !pd_scene_finish(row, &e) && !pd_scene_add_sdof(wall, "A", 3.0, 0.05, 1.0, &e) &&
+                 !pd_scene_add_contact(wall, 0, 1, PD_WALL, 0, 0.001, eps[k], 0, &e) &&
+                 !pd_scene_finish(wall, &e);
+        pd_scene_result r = {0}, w = {0};
+        pd_run_opts o = event_opts();
+        if (CHECK(ctx, ok, "scenes: %s", e.msg) && !run_m(ctx, row, &o, &r) &&
+            !run_m(ctx, wall, &o, &w)) {
+            /* B follows the pulse quasi-statically (its free vibration damped out
+             * long before the impacts): its velocity is about wp max|x_B|; an
+             * impact on a wall moving at v_B changes A's rebound by (1 + e) v_B,
+             * which moves A by at most that times the run's length */
+            double xb = r.umax[1], wp = pd_scene_wp(row), tend = pd_scene_default_tend(row);
+            double bound = 4.0 * xb + (1.0 + eps[k]) * wp * xb * tend + 1e-12 * w.umax[0];
+            CHECK(ctx, fabs(r.umax[0] - w.umax[0]) <= bound &&
+                           r.impacts[0] == w.impacts[0] && r.accumulations == w.accumulations,
+                  "eps %g: umax %.17g vs wall %.17g (partner moves %.3g: bound %.3g), impacts "
+                  "%ld vs %ld, accumulations %ld vs %ld",
+                  eps[k], r.umax[0], w.umax[0], xb, bound, r.impacts[0], w.impacts[0], r.accumulations,
+                  w.accumulations);
+            CHECK(ctx, xb < 1e-5 * w.umax[0], "the partner barely moves (%.3g)", xb);
+            if (k == 1)
+                CHECK(ctx, w.accumulations >= 1, "eps 0.5: an accumulation is met (%ld)",
+                      w.accumulations);
+        }
+        pd_scene_result_free(&r);
+        pd_scene_result_free(&w);
+        pd_scene_free(row);
+        pd_scene_free(wall);
+    }
+}
+
+/* ---- invariants on random rows ------------------------------------------------- */
+
+/* A random row of n SDOFs (periods 0.3-2 s, masses 0.5-5, gaps 1-20 mm,
+ * eps, damping xi), walls at the ends with probability 1/2 each. */
+static pd_scene *random_row(uint64_t *rng, int n, double eps_lo, double eps_hi, double xi,
+                            pd_pulse pulse, pd_err *e)
+{
+    pd_scene *sc = new_scene(pulse, pd_test_uniform(rng) < 0.5 ? 1 : -1, 2.0 + 4.0 * pd_test_uniform(rng),
+                             0.3 + 0.7 * pd_test_uniform(rng));
+    int wl = pd_test_uniform(rng) < 0.5, wr = pd_test_uniform(rng) < 0.5, rc = sc ? 0 : PD_ENOMEM;
+    char name[16];
+    for (int i = 0; i < n && !rc; i++) {
+        snprintf(name, sizeof name, "S%d", i + 1);
+        rc = pd_scene_add_sdof(sc, name, 0.3 + 1.7 * pd_test_uniform(rng), xi,
+                               0.5 + 4.5 * pd_test_uniform(rng), e);
+    }
+    for (int i = 0; i <= n && !rc; i++) {
+        if ((i == 0 && !wl) || (i == n && !wr))
+            continue;
+        double gap = 0.001 + 0.019 * pd_test_uniform(rng);
+        double eps = eps_lo + (eps_hi - eps_lo) * pd_test_uniform(rng);
+        rc = pd_scene_add_contact(sc, i == 0 ? PD_WALL : i - 1, i == 0 ? 0 : 1,
+                                  i == n ? PD_WALL : i, i == n ? 0 : 1, gap, eps, i, e);
+    }
+    if (!rc)
+        rc = pd_scene_finish(sc, e);
+    if (rc) {
+        pd_scene_free(sc);
+        return NULL;
+    }
+    return sc;
+}
+
+/* The engine model of a scene with its row reference, for event checks. */
+typedef struct row_run {
+    pd_scene_model sm;
+    pd_sine_piece *pieces;
+    int npieces;
+    pd_edr *edr;
+} row_run;
+
+static int row_open(pd_test_ctx *ctx, const pd_scene *sc, pd_edr_opts *eo, row_run *rr)
+{
+    pd_err e;
+    memset(rr, 0, sizeof *rr);
+    if (!CHECK(ctx, !pd_scene_model_build(sc, 1, &rr->sm, &e), "model: %s", e.msg))
+        return 0;
+    if (!CHECK(ctx, !pd_osc_pieces(&rr->sm.shape, &rr->pieces, &rr->npieces, &e), "%s", e.msg))
+        return 0;
+    pd_piecewise_force F = {.b = rr->sm.mass, .pieces = rr->pieces, .npieces = rr->npieces};
+    rr->edr = pd_edr_alloc(&rr->sm.model, &F, eo, &e);
+    return CHECK(ctx, rr->edr != NULL, "pd_edr_alloc: %s", e.msg);
+}
+
+static void row_close(row_run *rr)
+{
+    pd_edr_free(rr->edr);
+    free(rr->pieces);
+    pd_scene_model_free(&rr->sm);
+}
+
+/* Per impact: momentum of the group's dofs changes only by the walls'
+ * impulses (structure-structure impulses are equal and opposite; an
+ * accumulation's jump, whose tail impulses are not reported, aside), and
+ * the kinetic energy does not rise. */
+typedef struct impact_check {
+    const pd_edr *edr;
+    const pd_scene_model *sm;
+    double worst_momentum, worst_energy;
+    double pscale; /* largest momentum met in the run */
+    long impacts;
+} impact_check;
+
+static int check_impact(const pd_edr_event *ev, void *vctx)
+{
+    impact_check *ic = vctx;
+    const pd_model *md = &ic->sm->model;
+    if (ev->kind != PD_EDR_IMPACT)
+        return 0;
+    double dp = 0.0, scale = 0.0, ke0 = 0.0, ke1 = 0.0;
+    for (int k = 0; k < ev->ndofs; k++) {
+        double m = ic->sm->mass[ev->dofs[k]], a = ev->v_minus[k], b = ev->v_plus[k];
+        dp += m * (b - a);
+        scale += m * (fabs(a) + fabs(b));
+        ke0 += 0.5 * m * a * a;
+        ke1 += 0.5 * m * b * b;
+    }
+    for (int j = 0; j < ev->ncontacts; j++) { /* the walls' impulses */
+        int a = ev->contacts[j];
+        for (int p = md->W.colptr[a]; p < md->W.colptr[a + 1]; p++)
+            if (md->W.colptr[a + 1] - md->W.colptr[a] == 1)
+                dp -= md->W.values[p] * ev->P[j];
+    }
+    /* the momentum scale of the run: rates below 1e-12 of it are zero (held
+     * contacts project them away) */
+    ic->pscale = fmax(ic->pscale, scale);
+    if (!ev->accumulation) /* a jump's tail impulses are not reported */
+        ic->worst_momentum = fmax(ic->worst_momentum, fabs(dp) / ic->pscale);
+    ic->worst_energy = fmax(ic->worst_energy, (ke1 - ke0) / fmax(ke0, 1e-300));
+    ic->impacts++;
+    return 0;
+}
+
+static void test_rows_impulses_balance_energy_falls(pd_test_ctx *ctx)
+{
+    uint64_t rng = 0x5eed1234;
+    impact_check ic = {0};
+    for (int k = 0; k < 40; k++) {
+        pd_err e;
+        pd_scene *sc = random_row(&rng, 2 + k % 5, 0.0, 1.0, 0.05, k % 2 ? PD_PULSE_COSINE : PD_PULSE_SINE, &e);
+        if (!CHECK(ctx, sc != NULL, "row: %s", e.msg))
+            continue;
+        pd_edr_opts eo = pd_edr_default_opts();
+        row_run rr;
+        eo.on_event = check_impact;
+        eo.on_event_ctx = &ic;
+        ic.sm = &rr.sm;
+        ic.pscale = 0.0;
+        if (row_open(ctx, sc, &eo, &rr)) {
+            double t1 = pd_scene_wp(sc) * pd_scene_default_tend(sc);
+            CHECK(ctx, pd_edr_run(rr.edr, 0.0, NULL, NULL, t1, NULL, NULL, &e) == PD_OK, "row %d: %s", k, e.msg);
+        }
+        row_close(&rr);
+        pd_scene_free(sc);
+    }
+    CHECK(ctx, ic.impacts > 200, "impacts checked: %ld", ic.impacts);
+    CHECK(ctx, ic.worst_momentum <= 1e-11, "momentum balance at impacts: worst %.3g (rates below 1e-12 of the scale are zero)", ic.worst_momentum);
+    CHECK(ctx, ic.worst_energy <= 1e-13, "kinetic energy never rises at an impact: worst %.3g",
+          ic.worst_energy);
+}
+
+/* Total energy 1/2 v'Mv + 1/2 x'Kx on the output grid after the pulse. */
+typedef struct energy_watch {
+    const pd_scene_model *sm;
+    double t_from, E0, worst;
+    int have;
+} energy_watch;
+
+static int watch_energy(const pd_state *s, void *vctx)
+{
+    energy_watch *w = vctx;
+    const pd_model *md = &w->sm->model;
+    if (s->t < w->t_from)
+        return 0;
+    double E = 0.0;
+    for (int i = 0; i < md->n; i++)
+        E += 0.5 * w->sm->mass[i] * s->v[i] * s->v[i];
+    for (int j = 0; j < md->n; j++)
+        for (int p = md->K.colptr[j]; p < md->K.colptr[j + 1]; p++)
+            E += 0.5 * s->q[md->K.rowind[p]] * md->K.values[p] * s->q[j];
+    if (!w->have) {
+        w->E0 = E;
+        w->have = 1;
+    }
+    w->worst = fmax(w->worst, fabs(E - w->E0) / w->E0);
+    return 0;
+}
+
+static void test_rows_elastic_energy_constant(pd_test_ctx *ctx)
+{
+    uint64_t rng = 0xe1a571c;
+    pd_err e;
+    for (int k = 0; k < 3; k++) {
+        pd_scene *sc = random_row(&rng, 3 + k, 1.0, 1.0, 0.0, PD_PULSE_SINE, &e);
+        if (!CHECK(ctx, sc != NULL, "row: %s", e.msg))
+            continue;
+        pd_edr_opts eo = pd_edr_default_opts();
+        row_run rr;
+        energy_watch w = {.sm = &rr.sm, .t_from = PD_TWO_PI};
+        eo.h_out = 0.05;
+        if (row_open(ctx, sc, &eo, &rr)) {
+            double t1 = 60.0 * PD_TWO_PI; /* 60 pulse periods of free motion */
+            CHECK(ctx, pd_edr_run(rr.edr, 0.0, NULL, NULL, t1, watch_energy, &w, &e) == PD_OK,
+                  "%s", e.msg);
+            const pd_edr_result *res = pd_edr_result_of(rr.edr);
+            CHECK(ctx, res->impacts >= 100, "row %d: %ld impacts", k, res->impacts);
+            CHECK(ctx, w.have && w.worst <= 1e-10,
+                  "row %d: energy after the pulse constant to %.3g over %ld impacts", k, w.worst,
+                  res->impacts);
+        }
+        row_close(&rr);
+        pd_scene_free(sc);
+    }
+}
+
+/* ---- symmetries ---------------------------------------------------------------- */
+
+/* The row read backwards, the excitation mirrored: the mirrored result. */
+static void test_rows_mirrored(pd_test_ctx *ctx)
+{
+    uint64_t rng = 0x31a2b3c;
+    int bad = 0, n_cases = 0;
+    for (int k = 0; k < 20; k++) {
+        pd_err e;
+        pd_scene *sc = random_row(&rng, 2 + k % 4, 0.2, 0.9, 0.05, PD_PULSE_SINE, &e), *mir;
+        if (!CHECK(ctx, sc != NULL, "row: %s", e.msg))
+            continue;
+        pd_scene_excitation exc = sc->exc;
+        exc.dir = -exc.dir;
+        mir = pd_scene_new(&exc);
+        int n = sc->nstruct, rc = 0;
+        for (int s = n - 1; s >= 0 && !rc; s--)
+            rc = pd_scene_add_sdof(mir, sc->st[s].name, sc->st[s].T0, sc->st[s].xi,
+                                   sc->st[s].mass[0], &e);
+        for (int a = sc->ncontact - 1; a >= 0 && !rc; a--) {
+            const pd_contact *c = &sc->ct[a];
+            int na = c->b == PD_WALL ? PD_WALL : n - 1 - c->b, nb = c->a == PD_WALL ? PD_WALL : n - 1 - c->a;
+            rc = pd_scene_add_contact(mir, na, na == PD_WALL ? 0 : 1, nb, nb == PD_WALL ? 0 : 1,
+                                      c->gap, c->eps, a, &e);
+        }
+        pd_scene_result r = {0}, m = {0};
+        pd_run_opts o = event_opts();
+        if (CHECK(ctx, !rc && !pd_scene_finish(mir, &e), "mirror: %s", e.msg) &&
+            !run_m(ctx, sc, &o, &r) && !run_m(ctx, mir, &o, &m)) {
+            n_cases++;
+            for (int s = 0; s < n; s++)
+                bad += !CHECK(ctx, fabs(r.umax[s] - m.umax[n - 1 - s]) <= 1e-12 * r.umax[s] &&
+                                       fabs(r.u_pos[s] - m.u_neg[n - 1 - s]) <= 1e-12 * r.umax[s],
+                              "row %d S%d: umax %.17g vs mirrored %.17g", k, s + 1, r.umax[s],
+                              m.umax[n - 1 - s]);
+            for (int a = 0; a < sc->ncontact; a++)
+                bad += !CHECK(ctx, r.impacts[a] == m.impacts[sc->ncontact - 1 - a],
+                              "row %d contact %d: %ld impacts vs mirrored %ld", k, a, r.impacts[a],
+                              m.impacts[sc->ncontact - 1 - a]);
+        }
+        pd_scene_result_free(&r);
+        pd_scene_result_free(&m);
+        pd_scene_free(mir);
+        pd_scene_free(sc);
+    }
+    CHECK(ctx, n_cases == 20 && bad == 0, "%d rows mirrored, %d disagreements", n_cases, bad);
+}
+
+/* ap and every gap scaled together: Pi1 = umax / Le unchanged (the run is
+ * made in Pi units). */
+static void test_rows_scaling(pd_test_ctx *ctx)
+{
+    uint64_t rng = 0x5ca1e;
+    for (int k = 0; k < 6; k++) {
+        pd_err e;
+        pd_scene *sc = random_row(&rng, 3 + k % 3, 0.3, 0.8, 0.05, PD_PULSE_COSINE, &e);
+        if (!CHECK(ctx, sc != NULL, "row: %s", e.msg))
+            continue;
+        pd_scene_result r = {0}, s2 = {0};
+        pd_run_opts o = event_opts();
+        double Le = pd_scene_Le(sc), f = 7.3;
+        if (!run_m(ctx, sc, &o, &r)) {
+            sc->exc.ap *= f;
+            for (int a = 0; a < sc->ncontact; a++)
+                sc->ct[a].gap *= f;
+            if (!run_m(ctx, sc, &o, &s2)) {
+                double Le2 = pd_scene_Le(sc), worst = 0.0;
+                for (int i = 0; i < sc->n; i++)
+                    worst = fmax(worst, fabs(s2.umax[i] / Le2 - r.umax[i] / Le) / (r.umax[i] / Le));
+                CHECK(ctx, worst <= 1e-12, "row %d: Pi1 moves by %.3g", k, worst);
+            }
+        }
+        pd_scene_result_free(&r);
+        pd_scene_result_free(&s2);
+        pd_scene_free(sc);
+    }
+}
+
+/* ---- the general reference ------------------------------------------------------ */
+
+/* Rows where every impact is isolated (no simultaneous impact, no contact
+ * taken as closed within the tolerance, no accumulation): umax agrees
+ * with pd_edg_run (GSL rk8pd at rtol 1e-12) to GENERAL_TOL. */
+static int compare_general(pd_test_ctx *ctx, const pd_scene *sc, const char *what, double *worst)
+{
+    pd_scene_result r = {0}, g = {0};
+    pd_run_opts o = event_opts(), og = pd_run_default_opts();
+    int used = 0;
+    og.method = PD_METHOD_EVENT_GENERAL;
+    if (!run_m(ctx, sc, &o, &r) && !run_m(ctx, sc, &og, &g) && r.simultaneous == 0 &&
+        r.tol_closed == 0 && r.accumulations == 0 && g.accumulations == 0) {
+        double d = 0.0, s = 0.0;
+        for (int i = 0; i < sc->n; i++) {
+            d = fmax(d, fabs(r.umax[i] - g.umax[i]));
+            s = fmax(s, g.umax[i]);
+        }
+        *worst = fmax(*worst, d / s);
+        CHECK(ctx, d <= GENERAL_TOL * s, "%s: umax differs by %.3g of the largest", what, d / s);
+        for (int a = 0; a < sc->ncontact; a++)
+            CHECK(ctx, r.impacts[a] <= g.impacts[a], "%s contact %d: %ld impacts vs %ld", what, a,
+                  r.impacts[a], g.impacts[a]);
+        used = 1;
+    }
+    pd_scene_result_free(&r);
+    pd_scene_result_free(&g);
+    return used;
+}
+
+static void test_rows_match_general_sdof(pd_test_ctx *ctx)
+{
+    uint64_t rng = 0x9e4e7a1;
+    int used = 0;
+    double worst = 0.0;
+    for (int k = 0; k < 40; k++) {
+        pd_err e;
+        pd_scene *sc = random_row(&rng, 2 + k % 4, 0.5, 1.0, 0.05, k % 2 ? PD_PULSE_SINE : PD_PULSE_COSINE, &e);
+        if (!CHECK(ctx, sc != NULL, "row: %s", e.msg))
+            continue;
+        char what[32];
+        snprintf(what, sizeof what, "SDOF row %d", k);
+        used += compare_general(ctx, sc, what, &worst);
+        pd_scene_free(sc);
+    }
+    CHECK(ctx, used >= 15, "%d rows with isolated impacts compared (worst %.3g)", used, worst);
+}
+
+/* Shear buildings: modal clusters, multi-level contacts, a wall. */
+static void test_rows_match_general_buildings(pd_test_ctx *ctx)
+{
+    uint64_t rng = 0xb01d;
+    int used = 0;
+    double worst = 0.0;
+    for (int k = 0; k < 16; k++) {
+        pd_err e;
+        pd_scene *sc = new_scene(k % 2 ? PD_PULSE_SINE : PD_PULSE_COSINE, k % 4 < 2 ? 1 : -1, 3.0, 0.6);
+        int rc = 0, ns = 2 + k % 2;
+        int storeys[3];
+        char name[16];
+        for (int s = 0; s < ns && !rc; s++) {
+            double m[4], kk[4];
+            storeys[s] = 1 + (int)(4 * pd_test_uniform(&rng));
+            for (int i = 0; i < storeys[s]; i++) {
+                m[i] = 1e5 * (1.0 + pd_test_uniform(&rng));
+                kk[i] = 4e8 * (0.5 + pd_test_uniform(&rng));
+            }
+            snprintf(name, sizeof name, "B%d", s);
+            rc = pd_scene_add_building(sc, name, storeys[s], m, kk, 0.02 + 0.04 * pd_test_uniform(&rng), &e);
+        }
+        if (!rc && k % 3 == 0)
+            rc = pd_scene_add_contact(sc, PD_WALL, 0, 0, 1, 0.01, 0.7, 0, &e);
+        for (int s = 0; s + 1 < ns && !rc; s++) {
+            int lv = storeys[s] < storeys[s + 1] ? storeys[s] : storeys[s + 1];
+            for (int l = 1; l <= lv && !rc; l++)
+                rc = pd_scene_add_contact(sc, s, l, s + 1, l, 0.004 + 0.01 * pd_test_uniform(&rng),
+                                          0.5 + 0.5 * pd_test_uniform(&rng), s + 1, &e);
+        }
+        if (!rc)
+            rc = pd_scene_finish(sc, &e);
+        if (CHECK(ctx, !rc, "buildings: %s", e.msg)) {
+            char what[32];
+            snprintf(what, sizeof what, "building row %d", k);
+            used += compare_general(ctx, sc, what, &worst);
+        }
+        pd_scene_free(sc);
+    }
+    CHECK(ctx, used >= 5, "%d building rows with isolated impacts compared (worst %.3g)", used, worst);
+}
+
+/* ---- Moreau-Jean converges to it ----------------------------------------------- */
+
+/* The work-precision rows of 2 and 10 SDOFs of docs/methods.md (periods 1
+ * and 1.5 s, Pi3 = 0.05, e = 0.6, sine pulse Tp = 1 s, 4 s): Moreau-Jean's
+ * largest umax error falls with dt and ends below 1e-3 (rows whose peaks
+ * rest on the closing tolerance are the docs' subject, not this test's). */
+static void test_rows_moreau_converges(pd_test_ctx *ctx)
+{
+    const int sizes[] = {2, 10};
+    for (int k = 0; k < 2; k++) {
+        pd_scene_excitation exc = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0};
+        pd_scene *sc;
+        pd_err e;
+        double Le = 1.0 / (PD_TWO_PI * PD_TWO_PI);
+        if (!CHECK(ctx, !pd_scene_chain(sizes[k], &exc, 1.0, 1.5, 0.05, 0.05 * Le, 0.6, &sc, &e),
+                   "%s", e.msg))
+            continue;
+        sc->tend = 4.0;
+        pd_scene_result ref = {0};
+        pd_run_opts o = event_opts();
+        if (!run_m(ctx, sc, &o, &ref)) {
+            double err[3], dts[3] = {1e-3, 1e-4, 1e-5};
+            for (int j = 0; j < 3; j++) {
+                pd_scene_result r = {0};
+                pd_run_opts m = pd_run_default_opts();
+                m.method = PD_METHOD_MOREAU;
+                m.dt = dts[j];
+                err[j] = HUGE_VAL;
+                if (!run_m(ctx, sc, &m, &r)) {
+                    err[j] = 0.0;
+                    for (int i = 0; i < sc->n; i++)
+                        err[j] = fmax(err[j], fabs(r.umax[i] - ref.umax[i]) / ref.umax[i]);
+                }
+                pd_scene_result_free(&r);
+            }
+            int last = 2;
+            CHECK(ctx, err[last] < 1e-3 && err[last] < err[0],
+                  "row of %d: Moreau-Jean umax errors %.3g (dt 1e-3) ... %.3g (dt %g)", sizes[k],
+                  err[0], err[last], dts[last]);
+        }
+        pd_scene_result_free(&ref);
+        pd_scene_free(sc);
+    }
+}
+
+/* ---- the closing tolerance ------------------------------------------------------ */
+
+/* Three free unit masses: the first thrown at two at rest, gaps g.  Gaps
+ * within the tolerance make one simultaneous impact (the row leaves as one
+ * body: v = (-1/3, 2/3, 2/3) V for e = 1), larger ones the sequential
+ * cradle (0, 0, V); the run reports which. */
+static void test_rows_tolerance_decides(pd_test_ctx *ctx)
+{
+    const double gaps[] = {0.0, 1e-13, 1e-9};
+    for (int k = 0; k < 3; k++) {
+        double g0[2] = {0.1, gaps[k]}, e[2] = {1, 1}, b[3] = {0, 0, 0}, v0[3] = {1, 0, 0};
+        double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, wv[4] = {-1, 1, -1, 1};
+        int cp[3] = {0, 2, 4}, ri[4] = {0, 1, 1, 2};
+        pd_model md = {.n = 3, .m = 2, .M = pd_matrix_dense(3, 3, I3), .C = pd_matrix_zero(3, 3),
+                       .K = pd_matrix_zero(3, 3), .W = pd_matrix_csc(3, 2, cp, ri, wv), .g0 = g0,
+                       .e = e};
+        pd_sine_piece pc = {.t_start = 0.0};
+        pd_piecewise_force F = {.b = b, .pieces = &pc, .npieces = 1};
+        pd_edr_opts eo = pd_edr_default_opts();
+        eo.h_out = 1.0;
+        pd_err err;
+        pd_edr *r = pd_edr_alloc(&md, &F, &eo, &err);
+        if (!CHECK(ctx, r != NULL, "%s", err.msg))
+            continue;
+        CHECK(ctx, pd_edr_run(r, 0.0, NULL, v0, 1.0, NULL, NULL, &err) == PD_OK, "%s", err.msg);
+        const pd_edr_result *res = pd_edr_result_of(r);
+        if (k < 2) /* within 1e-12 Le: one simultaneous impact */
+            CHECK(ctx, res->impacts == 1 && res->simultaneous == 1 && res->tol_closed == (k == 1),
+                  "gap %g: impacts %ld, simultaneous %ld, closed within the tolerance %ld",
+                  gaps[k], res->impacts, res->simultaneous, res->tol_closed);
+        else
+            CHECK(ctx, res->impacts == 2 && res->simultaneous == 0,
+                  "gap %g: sequential, impacts %ld, simultaneous %ld", gaps[k], res->impacts,
+                  res->simultaneous);
+        pd_edr_free(r);
+    }
+}
+
+/* ---- no allocation in an SDOF row's run ---------------------------------------- */
+
+static void test_rows_run_allocates_nothing(pd_test_ctx *ctx)
+{
+    pd_scene_excitation exc = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0};
+    pd_scene *sc;
+    pd_err e;
+    if (!CHECK(ctx, !pd_scene_chain(30, &exc, 1.0, 1.5, 0.05, 0.05 / (PD_TWO_PI * PD_TWO_PI), 0.6,
+                                    &sc, &e),
+               "%s", e.msg))
+        return;
+    pd_edr_opts eo = pd_edr_default_opts();
+    row_run rr;
+    if (row_open(ctx, sc, &eo, &rr)) {
+        long a0 = pd_test_allocations();
+        int rc = pd_edr_run(rr.edr, 0.0, NULL, NULL, 4.0 * PD_TWO_PI, NULL, NULL, &e);
+        long used = pd_test_allocations() - a0;
+        const pd_edr_result *res = pd_edr_result_of(rr.edr);
+        CHECK(ctx, rc == PD_OK && res->impacts > 1000, "run: %s (%ld impacts)", e.msg, res->impacts);
+        CHECK(ctx, used == 0, "%ld allocations during a run of %ld events", used, res->events);
+    }
+    row_close(&rr);
+    pd_scene_free(sc);
+}
+
+void suite_rows(pd_test_ctx *ctx)
+{
+    PD_RUN(ctx, test_rows_one_wall_equals_exact);
+    PD_RUN(ctx, test_rows_one_wall_record);
+    PD_RUN(ctx, test_rows_heavy_partner_is_a_wall);
+    PD_RUN(ctx, test_rows_impulses_balance_energy_falls);
+    PD_RUN(ctx, test_rows_elastic_energy_constant);
+    PD_RUN(ctx, test_rows_mirrored);
+    PD_RUN(ctx, test_rows_scaling);
+    PD_RUN(ctx, test_rows_match_general_sdof);
+    PD_RUN(ctx, test_rows_match_general_buildings);
+    PD_RUN(ctx, test_rows_moreau_converges);
+    PD_RUN(ctx, test_rows_tolerance_decides);
+    PD_RUN(ctx, test_rows_run_allocates_nothing);
+}
