@@ -188,8 +188,9 @@ struct pd_edr {
     /* the run */
     double t, t1, L;
     int piece;                 /* the current piece */
-    double last_t;             /* time of the last event, and how many there */
-    int same_t, stopped;
+    double *slot_t;            /* per queue slot: time of its last event */
+    int *slot_same;            /* and how many it had there */
+    int stopped;
     double vscale;             /* largest velocity met at an event */
     long evals;
     /* the group of an event */
@@ -197,7 +198,7 @@ struct pd_edr {
     int *g_cl, ng;             /* its clusters */
     int *cl_mark;
     int *g_ct, ngc;            /* its closed contacts */
-    int *ct_mark, *ct_mark2, *ct_markD;
+    int *ct_mark, *ct_mark2, *ct_markD, *ct_markP, epochP;
     int *g_dof, ngd;           /* its dofs */
     double *gx, *gv, *gacc, *gtmp; /* n: state of the group's dofs (global index) */
     double *Uminus, *Uplus, *P;    /* per closed contact (g_ct order) */
@@ -206,14 +207,23 @@ struct pd_edr {
     unsigned char *held;
     double *held_tail;
     int *pos_in;
+    unsigned char *guess;      /* the LCP's warm start */
     double *Dd;                /* dense Delassus */
     double *Dval;              /* compressed Delassus */
     int *Dcol, *Drow;
     long Dcap;
-    pd_lcp_solver *solver;
+    pd_lcp_solver *solver;     /* dof-level LCPs */
+    pd_lcp_solver *dsolver;    /* the clusters' small dense LCPs */
+    int *epos;                 /* an event's contacts between clusters (g_ct indices) */
+    double *qtmp, *ztmp;       /* the clusters' LCP data */
     double *ev_vminus, *ev_vplus;
     /* scratch */
-    int *stack, *pe, *pdof;    /* trees */
+    int *stack, *pe, *pdof;    /* trees: scratch; per dof its parent edge and dof */
+    int *bfs_next;             /* per dof: the next in its tree's breadth-first order */
+    double *ceta, *cmu, *cvy;  /* per cluster slot: its coordinate's rate, mass, rate before */
+    double *ext;               /* per dof: impulse from the contacts between clusters */
+    long *nimp;                /* per closed contact of an event: its impacts */
+    int instant_acc;           /* the event's stages met an accumulation at one instant */
     int *keybuf;               /* configuration keys */
     int *uf, *gblk, *newcl, *plist;
     int *loc;                  /* n: local index */

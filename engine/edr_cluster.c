@@ -194,6 +194,8 @@ static int tree_start(pd_edr *r, edr_cluster *c, double t)
                           : r->blk_dofs[r->blk[c->head].first];
     int *ord = r->stack, *pe = r->pe, *pd = r->pdof;
     int nn = tree_order(r, c, root, wedge, ord, pe, pd);
+    for (int k = 0; k < nn; k++) /* the order kept for the impulses of held edges */
+        r->bfs_next[ord[k]] = k + 1 < nn ? ord[k + 1] : -1;
     double *Ms = r->wk, *Cs = Ms + r->n, *Ks = Cs + r->n, *KDs = Ks + r->n, *Bs = KDs + r->n;
     for (int k = 0; k < nn; k++) {
         int i = ord[k];
@@ -937,11 +939,12 @@ void edr_cluster_eval(pd_edr *r, int ci, double t)
             vy = c->vy0;
         } else
             pd_sdof_flow_at(&c->flow, t, &dy, &vy);
-        double f = pd_sine_piece_force(&c->pc, t), w0 = c->osc.w0;
+        double w0 = c->osc.w0;
+        c->f_tc = edr_force(r, c->piece, t);
+        double f = c->rho == 1.0 && c->kappa == 0.0 ? c->f_tc : pd_sine_piece_force(&c->pc, t);
         c->dy = dy;
         c->vy = vy;
         c->ay = f - 2.0 * c->osc.xi * w0 * vy - w0 * w0 * (c->y0 + dy);
-        c->f_tc = edr_force(r, c->piece, t);
         break;
     }
     case EDR_REST:

@@ -111,6 +111,75 @@ static double locate(edr_scan *s, int k, double sign, double lo, double hi, doub
     return locate_from(s, k, sign, lo, hi, w, NAN);
 }
 
+/* The first double where f > 0 between lo (f <= 0) and hi (f > 0), from
+ * the guess t0: Newton on the exact f and f' until the step is a few
+ * ulps, then the answer certified by its predecessor (f <= 0 there); a
+ * Newton step leaving the bracket, or a failed certificate, hands the
+ * bracket to locate_from. */
+static double crossing(edr_scan *s, double lo, double hi, double t0)
+{
+    double t = t0 > lo && t0 < hi ? t0 : 0.5 * (lo + hi);
+    for (int it = 0; it < NEWTON_MAX_IT; it++) {
+        double df, f = value(s, 0, 1.0, t, &df);
+        if (f > 0.0)
+            hi = t;
+        else
+            lo = t;
+        double tn = t - f / df;
+        if (!(df > 0.0) || !(tn >= lo && tn <= hi))
+            break; /* outside the bracket: bisection's safety */
+        if (fabs(tn - t) > 8.0 * BISECT_REL * fabs(tn)) {
+            if (!(tn > lo && tn < hi))
+                break;
+            t = tn;
+            continue;
+        }
+        /* tn within a few ulps: walk to the first double with f > 0 */
+        double c = f > 0.0 ? t : nextafter(t, HUGE_VAL);
+        for (int k = 0; k < 8; k++) {
+            if (!(c > lo && c < hi))
+                break;
+            if (value(s, 0, 1.0, c, NULL) > 0.0) {
+                hi = c;
+                double p = nextafter(c, -HUGE_VAL);
+                if (!(p > lo) || value(s, 0, 1.0, p, NULL) <= 0.0)
+                    return c;
+                hi = c = p;
+                c = nextafter(c, -HUGE_VAL);
+                continue;
+            }
+            lo = c;
+            c = nextafter(c, HUGE_VAL);
+            if (c >= hi)
+                return hi;
+        }
+        break;
+    }
+    return locate(s, 0, 1.0, lo, hi, 0.0);
+}
+
+/* The root of the cubic Hermite of (f, f') through a and b (f(a) <= 0 <
+ * f(b)): a guess to O(h^4). */
+static double hermite_root(const edr_pt *a, const edr_pt *b)
+{
+    double h = b->t - a->t, u = 0.5;
+    double p0 = a->f, p1 = b->f, m0 = a->df * h, m1 = b->df * h;
+    for (int it = 0; it < 8; it++) { /* Newton on the cubic in u in [0, 1] */
+        double u2 = u * u, u3 = u2 * u;
+        double f = (2 * u3 - 3 * u2 + 1) * p0 + (u3 - 2 * u2 + u) * m0 + (-2 * u3 + 3 * u2) * p1 +
+                   (u3 - u2) * m1;
+        double d = (6 * u2 - 6 * u) * p0 + (3 * u2 - 4 * u + 1) * m0 + (-6 * u2 + 6 * u) * p1 +
+                   (3 * u2 - 2 * u) * m1;
+        if (!(d > 0.0))
+            break;
+        double un = u - f / d;
+        if (!(un > 0.0 && un < 1.0))
+            break;
+        u = un;
+    }
+    return a->t + u * h;
+}
+
 double edr_taylor_root(const edr_pt *a)
 {
     /* f + f' s + f'' s^2 / 2 = 0: the smallest s > 0 (NAN: none) */
@@ -170,7 +239,7 @@ static int scan_simple(edr_scan *s, const edr_pt *a, const edr_pt *b, double *t_
         edr_scan_note(s, c.f);
     }
     if (s->hit_mode && b->f > s->thr) {
-        *t_hit = locate_from(s, 0, 1.0, a->t, b->t, 0.0, a->t + edr_taylor_root(a));
+        *t_hit = crossing(s, a->t, b->t, a->f <= 0.0 ? hermite_root(a, b) : a->t + edr_taylor_root(a));
         return 1;
     }
     return 0;

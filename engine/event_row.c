@@ -42,13 +42,16 @@
 /* Scan intervals a prediction covers before it queues its continuation. */
 #define EDR_WINDOW 64
 #define EDR_WINDOW0 4
+/* Closings of one contact at one instant before its impact is plastic
+ * (stage_e). */
+#define EDR_INSTANT_BOUNCES 2
 /* Stages of one impact (a closed contact closing again under the
  * others' impulses) before the run is declared stuck. */
 #define EDR_STAGES 10000
 /* Events at one instant before the run is declared stuck. */
 #define EDR_SAME_INSTANT 1000
 /* Impact LCPs of up to this many contacts are assembled densely. */
-#define EDR_DENSE_MAX 48
+#define EDR_DENSE_MAX 8
 /* A closing must take the gap below -this times the size of its terms
  * (g0 and the displacements it adds): its rounding level. */
 #define EDR_GAP_ROUND 1e-14
@@ -445,7 +448,51 @@ static int below_of(const pd_edr *r, int i)
     return r->o.below ? r->o.below[i] : -1;
 }
 
-/* Extremes of every dof (and drift) of cluster c over [meas_t, tb]. */
+/* The coordinate y of an SDOF tree (x_i = s_i y + d_i). */
+static void tree_y_fn(void *vctx, double t, double out[3])
+{
+    meas_ctx *m = vctx;
+    edr_cluster *cl = &m->r->cl[m->c];
+    edr_cluster_eval(m->r, m->c, t);
+    out[0] = cl->y0 + cl->dy;
+    out[1] = cl->vy;
+    out[2] = cl->ay;
+}
+
+/* Scan the functions mc[0..nf) of cluster c over [ta, tb] on its grid into
+ * sc (their extremes). */
+static void scan_functions(pd_edr *r, edr_cluster *cl, int nf, meas_ctx *mc, edr_fn fn,
+                           double ta, double tb)
+{
+    edr_scan *sc = r->mscan;
+    edr_pt *prev = r->mprev;
+    for (int k = 0; k < nf; k++) {
+        sc[k] = (edr_scan){.fn = fn, .ctx = &mc[k], .width = 4e-8 * cl->h, .hit_mode = 0,
+                           .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
+        prev[k] = edr_scan_point(&sc[k], ta);
+        edr_scan_note(&sc[k], prev[k].f);
+    }
+    if (cl->kind == EDR_REST || !(tb > ta))
+        return;
+    long n = (long)ceil((tb - ta) / cl->h);
+    if (n < 1)
+        n = 1;
+    for (long i = 1; i <= n; i++) {
+        double t = i == n ? tb : ta + (double)i * cl->h, hit;
+        if (!(t > prev[0].t))
+            break;
+        for (int k = 0; k < nf; k++) {
+            edr_pt p = edr_scan_point(&sc[k], t);
+            edr_scan_interval(&sc[k], &prev[k], &p, &hit);
+            prev[k] = p;
+        }
+    }
+}
+
+/* Extremes of every dof (and drift) of cluster c over [meas_t, tb]: an
+ * SDOF tree through its coordinate y (each x_i = s_i y + d_i takes its
+ * extremes with y's), a modal cluster dof by dof, the drift of a storey
+ * above the first as its own function. */
 static void measure_cluster(pd_edr *r, int c, double tb)
 {
     edr_cluster *cl = &r->cl[c];
@@ -453,41 +500,36 @@ static void measure_cluster(pd_edr *r, int c, double tb)
     cl->meas_t = fmax(cl->meas_t, tb);
     if (!(tb >= ta))
         return;
-    int nf = 0;
     meas_ctx *mc = r->mctx;
     edr_scan *sc = r->mscan;
-    edr_pt *prev = r->mprev;
+    if (cl->kind != EDR_MODAL) {
+        mc[0] = (meas_ctx){.r = r, .c = c, .dof = -1, .below = -1};
+        scan_functions(r, cl, 1, mc, tree_y_fn, ta, tb);
+        for (int b = cl->head; b >= 0; b = r->blk_next[b]) {
+            int i = r->blk_dofs[r->blk[b].first];
+            double si = r->s[i], hi = si * (si > 0.0 ? sc[0].fmax : sc[0].fmin) + r->d[i];
+            double lo = si * (si > 0.0 ? sc[0].fmin : sc[0].fmax) + r->d[i];
+            note_meas(r, i, 0, hi, lo);
+            note_meas(r, i, 1, hi, lo);
+        }
+        return;
+    }
+    int nf = 0;
     for (int b = cl->head; b >= 0; b = r->blk_next[b]) {
         const edr_block *bk = &r->blk[b];
         for (int k = 0; k < bk->n; k++) {
             int i = r->blk_dofs[bk->first + k], bl = below_of(r, i);
-            mc[nf++] = (meas_ctx){.r = r, .c = c, .dof = i, .below = -1}; /* x */
-            mc[nf++] = (meas_ctx){.r = r, .c = c, .dof = i, .below = bl}; /* the drift */
+            mc[nf++] = (meas_ctx){.r = r, .c = c, .dof = i, .below = -1};
+            if (bl >= 0)
+                mc[nf++] = (meas_ctx){.r = r, .c = c, .dof = i, .below = bl};
         }
     }
+    scan_functions(r, cl, nf, mc, meas_fn, ta, tb);
     for (int k = 0; k < nf; k++) {
-        sc[k] = (edr_scan){.fn = meas_fn, .ctx = &mc[k], .width = 4e-8 * cl->h, .hit_mode = 0,
-                           .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
-        prev[k] = edr_scan_point(&sc[k], ta);
-        edr_scan_note(&sc[k], prev[k].f);
+        note_meas(r, mc[k].dof, mc[k].below >= 0, sc[k].fmax, sc[k].fmin);
+        if (mc[k].below < 0 && below_of(r, mc[k].dof) < 0) /* storey 1: the drift is x */
+            note_meas(r, mc[k].dof, 1, sc[k].fmax, sc[k].fmin);
     }
-    if (cl->kind != EDR_REST && tb > ta) {
-        long n = (long)ceil((tb - ta) / cl->h);
-        if (n < 1)
-            n = 1;
-        for (long i = 1; i <= n; i++) {
-            double t = i == n ? tb : ta + (double)i * cl->h, hit;
-            if (!(t > prev[0].t))
-                break;
-            for (int k = 0; k < nf; k++) {
-                edr_pt p = edr_scan_point(&sc[k], t);
-                edr_scan_interval(&sc[k], &prev[k], &p, &hit);
-                prev[k] = p;
-            }
-        }
-    }
-    for (int k = 0; k < nf; k++)
-        note_meas(r, mc[k].dof, k & 1, sc[k].fmax, sc[k].fmin);
 }
 
 /* The smallest gap of contact a over [gmeas_t, tb] (contacts that never
@@ -679,8 +721,13 @@ static int solve_lcp(pd_edr *r, const int *idx, int k, const double *q, double *
         w[0] = D.values[0] * z[0] + q[0];
         return PD_OK;
     }
+    /* a warm start: every contact pushing (stages move a whole cluster,
+     * held forces keep it together), so that pivoting starts near the answer */
+    pd_lcp_opts lo = pd_lcp_default_opts();
+    memset(r->guess, 1, (size_t)k);
+    lo.guess = r->guess;
     pd_lcp_info info;
-    int rc = pd_lcp_solve(r->solver, &D, q, NULL, z, w, &info);
+    int rc = pd_lcp_solve(r->solver, &D, q, &lo, z, w, &info);
     if (rc)
         return pd_err_set(err, rc, "row reference: the contact LCP of %d contacts at t = %.9g "
                           "was not solved (%s)", k, t, pd_lcp_outcome_name(info.outcome));
@@ -723,9 +770,14 @@ static double contact_dot(const pd_edr *r, int a, const double *y)
 /* The contact-force LCP over J = idx[0..k): lambda (r->lam), and the gap
  * accelerations of every closed contact of the group (r->wlcp, indexed as
  * g_ct). */
+static int reduced_force(pd_edr *r, const int *idx, int k, double t, pd_err *err);
+
 static int force_lcp(pd_edr *r, const int *idx, int k, double t, pd_err *err)
 {
     double *q = r->qlcp, *lam = r->lam, *w = r->wtmp;
+    int rr = reduced_force(r, idx, k, t, err);
+    if (rr != 1)
+        return rr;
     for (int j = 0; j < k; j++)
         q[j] = contact_dot(r, idx[j], r->gacc);
     int rc = solve_lcp(r, idx, k, q, lam, w, t, err);
@@ -842,15 +894,22 @@ static int regroup(pd_edr *r, double t, pd_err *err)
     return PD_OK;
 }
 
-/* Predictions of every contact next to the group and of its clusters. */
+/* Predictions of every contact next to the group (once each) and of its
+ * clusters. */
 static void repredict(pd_edr *r, double t)
 {
+    r->epochP++;
     for (int i = 0; i < r->ng; i++) {
         int c = r->g_cl[i];
         for (int b = r->cl[c].head; b >= 0; b = r->blk_next[b]) {
             const edr_block *bk = &r->blk[b];
-            for (int k = 0; k < bk->ncont; k++)
-                predict_contact(r, r->blk_cont[bk->cont0 + k], t, 0);
+            for (int k = 0; k < bk->ncont; k++) {
+                int a = r->blk_cont[bk->cont0 + k];
+                if (r->ct_markP[a] == r->epochP)
+                    continue;
+                r->ct_markP[a] = r->epochP;
+                predict_contact(r, a, t, 0);
+            }
         }
         predict_detach(r, c, t, 0);
     }
@@ -879,19 +938,22 @@ static int report(pd_edr *r, double t, pd_edr_kind kind, int acc)
     return r->o.on_event(&ev, r->o.on_event_ctx);
 }
 
-/* Count the event; PD_EBUDGET past the budget or when time stands still. */
-static int count_event(pd_edr *r, double t, pd_err *err)
+/* Count the event of queue slot `slot`; PD_EBUDGET past the budget, or
+ * when one slot keeps firing at one instant (time stands still for it;
+ * independent events at one instant, identical structures struck
+ * together, are no stall). */
+static int count_event(pd_edr *r, int slot, double t, pd_err *err)
 {
     if (++r->res.events > r->o.max_events)
         return pd_err_set(err, PD_EBUDGET, "row reference: %ld events by t = %.9g (budget "
                           "exhausted)", r->res.events - 1, t);
-    if (t == r->last_t) {
-        if (++r->same_t > EDR_SAME_INSTANT)
+    if (r->slot_t[slot] == t) {
+        if (++r->slot_same[slot] > EDR_SAME_INSTANT)
             return pd_err_set(err, PD_EBUDGET, "row reference: %d events at t = %.17g without "
                               "progress", EDR_SAME_INSTANT, t);
     } else {
-        r->last_t = t;
-        r->same_t = 0;
+        r->slot_t[slot] = t;
+        r->slot_same[slot] = 0;
     }
     return PD_OK;
 }
@@ -984,6 +1046,47 @@ static int tails_hold(pd_edr *r)
     return 1;
 }
 
+/* The restitution of closed contact j (g_ct index) in the next stage of
+ * an impact: its own, until it has closed EDR_INSTANT_BOUNCES times at
+ * this instant; then 0.  A contact that keeps closing again at one
+ * instant (a row in an inelastic collapse, touching within the closing
+ * tolerance) is in an accumulation at that instant: its bounces shrink
+ * geometrically, stage after stage, toward zero relative velocity, which
+ * is where a plastic stage takes it at once (as the one-wall reference
+ * jumps a bouncing ball to rest).  Counted in r->instant_acc. */
+static double stage_e(pd_edr *r, int j)
+{
+    if (r->nimp[j] < EDR_INSTANT_BOUNCES || r->o.no_accumulation)
+        return r->ct[r->g_ct[j]].e;
+    r->instant_acc = 1;
+    return 0.0;
+}
+
+/* Commit an impact's totals: every closed contact's impulse (r->P) and
+ * impacts (r->nimp, stages where it was closing). */
+static int commit_impacts(pd_edr *r, double t, pd_err *err)
+{
+    for (int j = 0; j < r->ngc; j++) {
+        int a = r->g_ct[j];
+        r->imp_out[a] += r->P[j];
+        r->maxP[a] = pd_max(r->maxP[a], r->P[j]);
+        if (!r->nimp[j])
+            continue;
+        r->impacts[a] += r->nimp[j];
+        r->res.impacts += r->nimp[j];
+        if (isnan(r->first[a]))
+            r->first[a] = t;
+        if (isnan(r->res.first_impact))
+            r->res.first_impact = t;
+        if ((r->burst[a] += r->nimp[j]) > r->o.max_burst)
+            return pd_err_set(err, PD_EBUDGET, "row reference: accumulation of impacts of "
+                              "contact %d at t = %.9g: %ld impacts without reaching persistent "
+                              "contact%s", a, t, r->burst[a] - 1,
+                              r->o.no_accumulation ? " (accumulation handling is off)" : "");
+    }
+    return PD_OK;
+}
+
 /* The impact at t, in stages: each takes the closed contacts whose rate
  * is not separating (U <= 0) into one LCP with Newton's law,
  *   w = D P + U + e min(U, 0),  0 <= w _|_ P >= 0,
@@ -992,7 +1095,7 @@ static int tails_hold(pd_edr *r)
  * impulse, and if the others' impulses make it close it takes part in the
  * next stage at the same instant (as Moreau-Jean's active set leaves a
  * separating contact to the next step).  Stages end when no closed contact
- * closes. */
+ * closes.  Totals in r->P, r->nimp. */
 static int impact_stages(pd_edr *r, double t, double tolU, pd_err *err)
 {
     int rc, *idx = r->lcp_idx, stage = 0;
@@ -1010,7 +1113,7 @@ static int impact_stages(pd_edr *r, double t, double tolU, pd_err *err)
             closing += U < 0.0;
             r->jpos[j] = k;
             idx[k] = r->g_ct[j];
-            q[k++] = U + r->ct[r->g_ct[j]].e * fmin(U, 0.0);
+            q[k++] = U + stage_e(r, j) * fmin(U, 0.0);
         }
         if (!closing)
             return PD_OK;
@@ -1023,30 +1126,296 @@ static int impact_stages(pd_edr *r, double t, double tolU, pd_err *err)
         for (int j = 0; j < r->ngc; j++) {
             if (r->jpos[j] < 0)
                 continue;
-            int a = r->g_ct[j];
             double P = z[r->jpos[j]];
-            const edr_contact *ct = &r->ct[a];
+            const edr_contact *ct = &r->ct[r->g_ct[j]];
             for (int s = 0; s < 2; s++)
                 if (ct->dof[s] >= 0)
                     r->gv[ct->dof[s]] += ct->w[s] * P * r->minv[ct->dof[s]];
             r->P[j] += P;
-            r->imp_out[a] += P;
-            r->maxP[a] = pd_max(r->maxP[a], P);
-            if (!(q[r->jpos[j]] < 0.0))
-                continue;
-            r->impacts[a]++; /* a closing contact */
-            r->res.impacts++;
-            if (isnan(r->first[a]))
-                r->first[a] = t;
-            if (isnan(r->res.first_impact))
-                r->res.first_impact = t;
-            if (++r->burst[a] > r->o.max_burst)
-                return pd_err_set(err, PD_EBUDGET, "row reference: accumulation of impacts of "
-                                  "contact %d at t = %.9g: %ld impacts without reaching "
-                                  "persistent contact%s", a, t, r->burst[a] - 1,
-                                  r->o.no_accumulation ? " (accumulation handling is off)" : "");
+            r->nimp[j] += q[r->jpos[j]] < 0.0;
         }
     }
+}
+
+/* sigma of contact a's side s: the rate of its gap per unit rate of the
+ * side's cluster coordinate (w s_i for an SDOF tree, 0 held still). */
+static double side_sigma(const pd_edr *r, int a, int s)
+{
+    int dof = r->ct[a].dof[s];
+    if (dof < 0)
+        return 0.0;
+    const edr_cluster *cl = &r->cl[cl_of_dof(r, dof)];
+    return cl->kind == EDR_SDOF ? r->ct[a].w[s] * r->s[dof] : 0.0;
+}
+
+/* The same stages on the clusters' coordinates: held trees move rigidly,
+ * so only the closed contacts between clusters are unknowns (one or two,
+ * not the whole compressed row), U_a = sum sigma eta_c, an impulse P_a
+ * adds sigma P_a / mu_c to eta_c (mu_c = sum s^2 m).  The held edges'
+ * impulses follow from each tree's momentum balance, subtree by subtree;
+ * they must push (a held contact cannot pull): 1 when one would pull, or
+ * the group holds a modal cluster, or the stage is larger than the dense
+ * solver takes — then the dof-level stages run instead. */
+static int reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
+{
+    int rc, stage = 0, ne = 0, *idx = r->lcp_idx;
+    double *q = r->qlcp, *z = r->lam, *D = r->Dd;
+    for (int i = 0; i < r->ng; i++) {
+        edr_cluster *cl = &r->cl[r->g_cl[i]];
+        if (cl->kind == EDR_MODAL)
+            return 1;
+        edr_cluster_eval(r, r->g_cl[i], t); /* (the measurements moved the cache) */
+        r->ceta[r->g_cl[i]] = cl->kind == EDR_SDOF ? cl->vy : 0.0;
+        r->cvy[r->g_cl[i]] = r->ceta[r->g_cl[i]];
+        r->cmu[r->g_cl[i]] = cl->mass;
+    }
+    for (int j = 0; j < r->ngc; j++) /* the contacts between clusters */
+        if (r->cstate[r->g_ct[j]] == EDR_OPEN)
+            r->epos[ne++] = j;
+    for (;;) {
+        int k = 0, closing = 0;
+        for (int e = 0; e < ne; e++) {
+            int j = r->epos[e], a = r->g_ct[j];
+            double U = 0.0;
+            for (int s = 0; s < 2; s++)
+                if (r->ct[a].dof[s] >= 0)
+                    U += side_sigma(r, a, s) * r->ceta[cl_of_dof(r, r->ct[a].dof[s])];
+            if (fabs(U) <= tolU)
+                U = 0.0;
+            if (U > 0.0) {
+                r->jpos[j] = -1;
+                continue;
+            }
+            if (k >= EDR_DENSE_MAX)
+                return 1;
+            closing += U < 0.0;
+            r->jpos[j] = k;
+            idx[k] = j;
+            q[k++] = U + stage_e(r, j) * fmin(U, 0.0);
+        }
+        if (!closing)
+            break;
+        if (++stage > EDR_STAGES)
+            return pd_err_set(err, PD_EBUDGET, "row reference: the impact at t = %.17g did not "
+                              "end in %d stages", t, EDR_STAGES);
+        for (int x = 0; x < k; x++) /* D_xy = sum over shared clusters sigma sigma / mu */
+            for (int y = 0; y < k; y++) {
+                int a = r->g_ct[idx[x]], b = r->g_ct[idx[y]];
+                double dxy = 0.0;
+                for (int s = 0; s < 2; s++)
+                    for (int u = 0; u < 2; u++) {
+                        int da = r->ct[a].dof[s], db = r->ct[b].dof[u];
+                        if (da < 0 || db < 0 || cl_of_dof(r, da) != cl_of_dof(r, db))
+                            continue;
+                        double sa = side_sigma(r, a, s), sb = side_sigma(r, b, u);
+                        if (sa != 0.0 && sb != 0.0)
+                            dxy += sa * sb / r->cmu[cl_of_dof(r, da)];
+                    }
+                D[x + (size_t)y * k] = dxy;
+            }
+        if (k == 1) {
+            z[0] = pd_contact_impulse_1(D[0], q[0]);
+        } else {
+            pd_matrix Dm = pd_matrix_dense(k, k, D);
+            pd_lcp_info info;
+            r->res.lcp_solves++;
+            if ((rc = pd_lcp_solve(r->dsolver, &Dm, q, NULL, z, r->wtmp, &info)))
+                return pd_err_set(err, rc, "row reference: the impact LCP of %d contacts at t = "
+                                  "%.9g was not solved (%s)", k, t,
+                                  pd_lcp_outcome_name(info.outcome));
+        }
+        r->res.lcp_solves += k == 1;
+        r->res.simultaneous += k > 1;
+        for (int x = 0; x < k; x++) {
+            int j = idx[x], a = r->g_ct[j];
+            for (int s = 0; s < 2; s++)
+                if (r->ct[a].dof[s] >= 0) {
+                    int c = cl_of_dof(r, r->ct[a].dof[s]);
+                    if (r->cl[c].kind == EDR_SDOF)
+                        r->ceta[c] += side_sigma(r, a, s) * z[x] / r->cmu[c];
+                }
+            r->P[j] += z[x];
+            r->nimp[j] += q[x] < 0.0;
+        }
+    }
+    /* dof rates, the impulses on each dof from the contacts between clusters */
+    for (int k = 0; k < r->ngd; k++) {
+        int i = r->g_dof[k];
+        r->ext[i] = 0.0;
+    }
+    for (int e = 0; e < ne; e++) {
+        int j = r->epos[e], a = r->g_ct[j];
+        for (int s = 0; s < 2; s++)
+            if (r->ct[a].dof[s] >= 0)
+                r->ext[r->ct[a].dof[s]] += r->ct[a].w[s] * r->P[j];
+    }
+    /* held edges: P_e = sum over the child's subtree of s (m dv - ext) / (s_c w_c) */
+    for (int j = 0; j < r->ngc; j++)
+        r->jpos[j] = -1;
+    for (int j = 0; j < r->ngc; j++)
+        r->pos_in[r->g_ct[j]] = j;
+    for (int i = 0; i < r->ng; i++) {
+        int c = r->g_cl[i];
+        edr_cluster *cl = &r->cl[c];
+        if (cl->npers == 0)
+            continue;
+        int nn = 0;
+        for (int d = cl->root; d >= 0; d = r->bfs_next[d])
+            r->stack[nn++] = d;
+        double deta = r->ceta[c] - r->cvy[c];
+        for (int k = 0; k < nn; k++) {
+            int d = r->stack[k];
+            r->gtmp[d] = r->s[d] * (r->s[d] * deta / r->minv[d] - r->ext[d]);
+        }
+        for (int k = nn - 1; k >= 0; k--) { /* children before their parents */
+            int d = r->stack[k], e = r->pe[d];
+            if (r->pdof[d] >= 0)
+                r->gtmp[r->pdof[d]] += r->gtmp[d];
+            if (e < 0)
+                continue;
+            const edr_contact *ct = &r->ct[e];
+            double Pe = r->gtmp[d] / (r->s[d] * ct->w[ct->dof[0] == d ? 0 : 1]);
+            if (Pe < -EDR_RATE_TOL * (fabs(r->gtmp[d]) + fabs(r->ext[d])) - 1e-300)
+                return 1; /* a held contact would pull */
+            r->P[r->pos_in[e]] = fmax(Pe, 0.0);
+        }
+    }
+    for (int k = 0; k < r->ngd; k++) {
+        int i = r->g_dof[k], c = cl_of_dof(r, i);
+        r->gv[i] = r->cl[c].kind == EDR_SDOF ? r->s[i] * r->ceta[c] : 0.0;
+    }
+    return PD_OK;
+}
+
+/* The contact-force LCP of force_lcp on the clusters' coordinates: the
+ * held contacts of every tree hold (its coordinate's acceleration
+ * alpha_c = (sum s_i F_i + sum sigma lambda) / mu_c, F the free forces),
+ * the closed contacts between clusters are the unknowns (gap acceleration
+ * sum sigma alpha_c), and each held edge's force follows from its
+ * subtree's balance, m a = F + W lambda.  1 (the dof-level LCP decides)
+ * when a held edge would pull, the group holds a modal cluster, or the
+ * LCP is too large for the dense solver. */
+static int reduced_force(pd_edr *r, const int *idx, int k, double t, pd_err *err)
+{
+    int ku = 0, rc, *ux = r->epos;
+    double *q = r->qtmp, *z = r->ztmp, *D = r->Dd;
+    for (int i = 0; i < r->ng; i++) {
+        int c = r->g_cl[i];
+        edr_cluster *cl = &r->cl[c];
+        if (cl->kind == EDR_MODAL)
+            return 1;
+        double phi = 0.0;
+        for (int b = cl->head; b >= 0 && cl->kind == EDR_SDOF; b = r->blk_next[b]) {
+            int d = r->blk_dofs[r->blk[b].first];
+            phi += r->s[d] * r->gacc[d] / r->minv[d];
+        }
+        r->cmu[c] = cl->mass;
+        r->ceta[c] = cl->kind == EDR_SDOF ? phi / cl->mass : 0.0; /* alpha_c, free */
+    }
+    for (int x = 0; x < k; x++) { /* unknowns: open contacts between two clusters (or a wall) */
+        const edr_contact *ct = &r->ct[idx[x]];
+        int internal = ct->dof[0] >= 0 && ct->dof[1] >= 0 &&
+                       cl_of_dof(r, ct->dof[0]) == cl_of_dof(r, ct->dof[1]);
+        r->lam[x] = 0.0;
+        if (r->cstate[idx[x]] == EDR_OPEN && !internal) {
+            if (ku >= EDR_DENSE_MAX)
+                return 1;
+            ux[ku++] = x;
+        }
+    }
+    for (int x = 0; x < ku; x++) {
+        int a = idx[ux[x]];
+        q[x] = 0.0;
+        for (int s = 0; s < 2; s++)
+            if (r->ct[a].dof[s] >= 0)
+                q[x] += side_sigma(r, a, s) * r->ceta[cl_of_dof(r, r->ct[a].dof[s])];
+        for (int y = 0; y < ku; y++) {
+            int b = idx[ux[y]];
+            double dxy = 0.0;
+            for (int s = 0; s < 2; s++)
+                for (int u = 0; u < 2; u++) {
+                    int da = r->ct[a].dof[s], db = r->ct[b].dof[u];
+                    if (da >= 0 && db >= 0 && cl_of_dof(r, da) == cl_of_dof(r, db) &&
+                        r->cl[cl_of_dof(r, da)].kind == EDR_SDOF)
+                        dxy += side_sigma(r, a, s) * side_sigma(r, b, u) / r->cmu[cl_of_dof(r, da)];
+                }
+            D[x + (size_t)y * ku] = dxy;
+        }
+    }
+    if (ku == 1) {
+        z[0] = D[0] > 0.0 ? pd_contact_impulse_1(D[0], q[0]) : (q[0] >= 0.0 ? 0.0 : -1.0);
+        if (z[0] < 0.0)
+            return 1; /* held still on both sides and pressed: let the dofs decide */
+        r->res.lcp_solves++;
+    } else if (ku > 1) {
+        pd_matrix Dm = pd_matrix_dense(ku, ku, D);
+        pd_lcp_info info;
+        r->res.lcp_solves++;
+        if ((rc = pd_lcp_solve(r->dsolver, &Dm, q, NULL, z, r->wtmp, &info)))
+            return 1;
+    }
+    for (int x = 0; x < ku; x++) { /* alpha_c with the unknowns' forces */
+        int a = idx[ux[x]];
+        r->lam[ux[x]] = z[x];
+        for (int s = 0; s < 2; s++)
+            if (r->ct[a].dof[s] >= 0) {
+                int c = cl_of_dof(r, r->ct[a].dof[s]);
+                if (r->cl[c].kind == EDR_SDOF)
+                    r->ceta[c] += side_sigma(r, a, s) * z[x] / r->cmu[c];
+            }
+    }
+    /* held edges: lambda_e = sum over the subtree of s (m a - F - ext) / (s_c w_c) */
+    for (int k2 = 0; k2 < r->ngd; k2++)
+        r->ext[r->g_dof[k2]] = 0.0;
+    for (int x = 0; x < ku; x++) {
+        int a = idx[ux[x]];
+        for (int s = 0; s < 2; s++)
+            if (r->ct[a].dof[s] >= 0)
+                r->ext[r->ct[a].dof[s]] += r->ct[a].w[s] * z[x];
+    }
+    for (int x = 0; x < k; x++)
+        r->pos_in[idx[x]] = x;
+    for (int i = 0; i < r->ng; i++) {
+        int c = r->g_cl[i];
+        edr_cluster *cl = &r->cl[c];
+        if (cl->npers == 0)
+            continue;
+        int nn = 0;
+        for (int d = cl->root; d >= 0; d = r->bfs_next[d])
+            r->stack[nn++] = d;
+        for (int x = 0; x < nn; x++) {
+            int d = r->stack[x];
+            double m = 1.0 / r->minv[d], a = r->s[d] * r->ceta[c];
+            r->gtmp[d] = r->s[d] * (m * a - m * r->gacc[d] - r->ext[d]);
+            r->wk[d] = fabs(m * a) + fabs(m * r->gacc[d]) + fabs(r->ext[d]);
+        }
+        for (int x = nn - 1; x >= 0; x--) {
+            int d = r->stack[x], e = r->pe[d];
+            if (r->pdof[d] >= 0) {
+                r->gtmp[r->pdof[d]] += r->gtmp[d];
+                r->wk[r->pdof[d]] += r->wk[d];
+            }
+            if (e < 0)
+                continue;
+            const edr_contact *ct = &r->ct[e];
+            double le = r->gtmp[d] / (r->s[d] * ct->w[ct->dof[0] == d ? 0 : 1]);
+            if (le < -EDR_RATE_TOL * r->wk[d])
+                return 1; /* a held contact would pull: it leaves */
+            if (r->ct_mark[e] == r->epoch && r->pos_in[e] < k && idx[r->pos_in[e]] == e)
+                r->lam[r->pos_in[e]] = le;
+        }
+    }
+    for (int j = 0; j < r->ngc; j++) { /* gap accelerations of every closed contact */
+        int a = r->g_ct[j];
+        double w = 0.0;
+        for (int s = 0; s < 2; s++)
+            if (r->ct[a].dof[s] >= 0)
+                w += side_sigma(r, a, s) * r->ceta[cl_of_dof(r, r->ct[a].dof[s])];
+        r->wlcp[j] = w;
+    }
+    (void)t;
+    (void)err;
+    return PD_OK;
 }
 
 /* Resolve the group at t: impact LCP if a contact closes, persistence,
@@ -1078,7 +1447,22 @@ static int resolve_group(pd_edr *r, double t, pd_err *err)
         r->Uminus[j] = fabs(U) <= tolU ? 0.0 : U;
         r->P[j] = 0.0;
     }
-    if ((rc = impact_stages(r, t, tolU, err)))
+    for (int j = 0; j < r->ngc; j++)
+        r->nimp[j] = 0;
+    r->instant_acc = 0;
+    rc = reduced_stages(r, t, tolU, err);
+    if (rc == 1) { /* on the dofs: back to the rates before the impact */
+        for (int k = 0; k < r->ngd; k++)
+            r->gv[r->g_dof[k]] = r->ev_vminus[k];
+        for (int j = 0; j < r->ngc; j++) {
+            r->P[j] = 0.0;
+            r->nimp[j] = 0;
+        }
+        r->instant_acc = 0;
+        rc = impact_stages(r, t, tolU, err);
+    }
+    r->res.accumulations += r->instant_acc;
+    if (rc || (rc = commit_impacts(r, t, err)))
         return rc;
     for (int j = 0; j < r->ngc; j++) {
         double U = contact_dot(r, r->g_ct[j], r->gv);
@@ -1126,7 +1510,7 @@ static void group_begin(pd_edr *r)
 static int on_impact(pd_edr *r, int a, double t, pd_err *err)
 {
     int rc;
-    if ((rc = count_event(r, t, err)))
+    if ((rc = count_event(r, a, t, err)))
         return rc;
     group_begin(r);
     group_add_contact(r, a);
@@ -1142,7 +1526,7 @@ static int on_impact(pd_edr *r, int a, double t, pd_err *err)
 static int on_detach(pd_edr *r, int c, double t, pd_err *err)
 {
     int rc, acc, a = r->cl[c].det_contact;
-    if ((rc = count_event(r, t, err)))
+    if ((rc = count_event(r, r->m + c, t, err)))
         return rc;
     group_begin(r);
     group_add_cluster(r, c);
@@ -1192,7 +1576,7 @@ static int on_detach(pd_edr *r, int c, double t, pd_err *err)
 static int on_piece(pd_edr *r, double t, pd_err *err)
 {
     int rc;
-    if ((rc = count_event(r, t, err)))
+    if ((rc = count_event(r, r->slot_piece, t, err)))
         return rc;
     r->piece = edr_piece_at(r, t);
     int ncl = 0;
@@ -1287,17 +1671,18 @@ void pd_edr_free(pd_edr *r)
             edr_cluster_free(&r->cl[c]);
     edr_basis_cache_free(r);
     pd_lcp_solver_free(r->solver);
+    pd_lcp_solver_free(r->dsolver);
     void *arrays[] = {r->b, r->pieces, r->blk, r->blk_dofs, r->dof_blk, r->dof_loc, r->Mb,
                       r->Cb, r->Kb, r->blk_off, r->blk_cont, r->ct, r->minv, r->cl, r->blk_cl,
                       r->blk_next, r->free_cl, r->s, r->d, r->xo, r->vo, r->cstate, r->pers_next,
-                      r->la, r->lb, r->lg, r->ld, r->base_t, r->base_g, r->qkind, r->win, r->gmeas_t,
+                      r->la, r->lb, r->lg, r->ld, r->base_t, r->base_g, r->qkind, r->win, r->slot_t, r->slot_same, r->gmeas_t,
                       r->since, r->burst, r->xpos, r->xneg, r->drift, r->gmin, r->impacts,
                       r->first, r->maxP, r->ctime, r->imp_out, r->q.heap, r->q.pos, r->q.key,
-                      r->g_cl, r->cl_mark, r->g_ct, r->ct_mark, r->ct_mark2, r->ct_markD,
+                      r->g_cl, r->cl_mark, r->g_ct, r->ct_mark, r->ct_mark2, r->ct_markD, r->ct_markP,
                       r->g_dof, r->gx, r->gv, r->gacc, r->gtmp, r->Uminus, r->Uplus, r->P,
                       r->lam, r->wlcp, r->qlcp, r->wtmp, r->Dd, r->lcp_idx, r->jpos, r->held,
-                      r->held_tail, r->excluded, r->pos_in, r->Dval, r->Dcol, r->Drow,
-                      r->stack, r->pe, r->pdof, r->crow, r->crow_c, r->keybuf, r->uf, r->gblk,
+                      r->held_tail, r->excluded, r->guess, r->epos, r->qtmp, r->ztmp, r->pos_in, r->Dval, r->Dcol, r->Drow,
+                      r->stack, r->pe, r->pdof, r->bfs_next, r->ceta, r->cmu, r->cvy, r->ext, r->nimp, r->crow, r->crow_c, r->keybuf, r->uf, r->gblk,
                       r->newcl, r->plist, r->dofc_ptr, r->dofc, r->loc, r->wk, r->mctx,
                       r->mscan, r->mprev, r->ev_vminus, r->ev_vplus, r->st.q,
                       r->st.v, r->st.P, r->st.g, r->st.active, r->st.acc};
@@ -1552,21 +1937,23 @@ pd_edr *pd_edr_alloc(const pd_model *md, const pd_piecewise_force *F, const pd_e
         !ALLOC(r->free_cl, nb) || !ALLOC(r->s, n) || !ALLOC(r->d, n) || !ALLOC(r->xo, n) ||
         !ALLOC(r->vo, n) || !ALLOC(r->cstate, m) || !ALLOC(r->pers_next, m) || !ALLOC(r->la, m) ||
         !ALLOC(r->lb, m) || !ALLOC(r->lg, m) || !ALLOC(r->ld, m) || !ALLOC(r->base_t, m) ||
-        !ALLOC(r->base_g, m) || !ALLOC(r->qkind, m + nb + 2) || !ALLOC(r->win, m + nb + 2) || !ALLOC(r->gmeas_t, m) ||
+        !ALLOC(r->base_g, m) || !ALLOC(r->qkind, m + nb + 2) || !ALLOC(r->win, m + nb + 2) ||
+        !ALLOC(r->slot_t, m + nb + 2) || !ALLOC(r->slot_same, m + nb + 2) || !ALLOC(r->gmeas_t, m) ||
         !ALLOC(r->since, m) || !ALLOC(r->burst, m) || !ALLOC(r->xpos, n) || !ALLOC(r->xneg, n) ||
         !ALLOC(r->drift, n) || !ALLOC(r->gmin, m) || !ALLOC(r->impacts, m) || !ALLOC(r->first, m) ||
         !ALLOC(r->maxP, m) || !ALLOC(r->ctime, m) || !ALLOC(r->imp_out, m) ||
         !ALLOC(r->q.heap, m + nb + 2) || !ALLOC(r->q.pos, m + nb + 2) ||
         !ALLOC(r->q.key, m + nb + 2) || !ALLOC(r->g_cl, nb) || !ALLOC(r->cl_mark, nb) ||
         !ALLOC(r->g_ct, m) || !ALLOC(r->ct_mark, m) || !ALLOC(r->ct_mark2, m) ||
-        !ALLOC(r->ct_markD, m) || !ALLOC(r->g_dof, n) || !ALLOC(r->gx, n) || !ALLOC(r->gv, n) ||
+        !ALLOC(r->ct_markD, m) || !ALLOC(r->ct_markP, m) || !ALLOC(r->g_dof, n) || !ALLOC(r->gx, n) || !ALLOC(r->gv, n) ||
         !ALLOC(r->gacc, n) || !ALLOC(r->gtmp, n) || !ALLOC(r->Uminus, m) || !ALLOC(r->Uplus, m) ||
         !ALLOC(r->P, m) || !ALLOC(r->lam, m) || !ALLOC(r->wlcp, m) || !ALLOC(r->qlcp, m) ||
         !ALLOC(r->wtmp, m) || !ALLOC(r->Dd, (long)dm * dm) || !ALLOC(r->lcp_idx, m) ||
         !ALLOC(r->jpos, m) || !ALLOC(r->held, m) || !ALLOC(r->held_tail, m) ||
-        !ALLOC(r->excluded, m) || !ALLOC(r->pos_in, m) || !ALLOC(r->Dval, r->Dcap) ||
+        !ALLOC(r->excluded, m) || !ALLOC(r->guess, m) || !ALLOC(r->epos, m) || !ALLOC(r->qtmp, m) || !ALLOC(r->ztmp, m) || !ALLOC(r->pos_in, m) || !ALLOC(r->Dval, r->Dcap) ||
         !ALLOC(r->Dcol, m + 1) || !ALLOC(r->Drow, r->Dcap) || !ALLOC(r->stack, n) ||
-        !ALLOC(r->pe, n) || !ALLOC(r->pdof, n) || !ALLOC(r->crow, n) || !ALLOC(r->crow_c, m) ||
+        !ALLOC(r->pe, n) || !ALLOC(r->pdof, n) || !ALLOC(r->bfs_next, n) ||
+        !ALLOC(r->ceta, nb) || !ALLOC(r->cmu, nb) || !ALLOC(r->cvy, nb) || !ALLOC(r->ext, n) || !ALLOC(r->nimp, m) || !ALLOC(r->crow, n) || !ALLOC(r->crow_c, m) ||
         !ALLOC(r->keybuf, 2 * (nb + m + 1)) || !ALLOC(r->uf, nb) || !ALLOC(r->gblk, nb) ||
         !ALLOC(r->newcl, nb) || !ALLOC(r->plist, nb) || !ALLOC(r->loc, n) || !ALLOC(r->wk, 8L * n) ||
         !ALLOC(r->mctx, nf) || !ALLOC(r->mscan, nf) || !ALLOC(r->mprev, nf) ||
@@ -1574,7 +1961,8 @@ pd_edr *pd_edr_alloc(const pd_model *md, const pd_piecewise_force *F, const pd_e
         !ALLOC(r->st.q, n) || !ALLOC(r->st.v, n) || !ALLOC(r->st.P, m) || !ALLOC(r->st.g, m) ||
         !ALLOC(r->st.active, m) || !ALLOC(r->st.acc, n))
         goto nomem;
-    if (m > 1 && !(r->solver = pd_lcp_solver_alloc(o.lcp_solver, m, r->Dcap, err)))
+    if (m > 1 && (!(r->solver = pd_lcp_solver_alloc(o.lcp_solver, m, r->Dcap, err)) ||
+                  !(r->dsolver = pd_lcp_solver_alloc(PD_LCP_LEMKE, dm, 0, err))))
         goto fail;
     free(uf);
     r->slot_piece = m + nb;
@@ -1632,8 +2020,12 @@ static void reset(pd_edr *r, double t0, const double *q0, const double *v0, doub
     memset(r->ct_mark, 0, (size_t)(m > 0 ? m : 1) * sizeof *r->ct_mark);
     memset(r->ct_mark2, 0, (size_t)(m > 0 ? m : 1) * sizeof *r->ct_mark2);
     memset(r->ct_markD, 0, (size_t)(m > 0 ? m : 1) * sizeof *r->ct_markD);
-    r->last_t = NAN;
-    r->same_t = 0;
+    memset(r->ct_markP, 0, (size_t)(m > 0 ? m : 1) * sizeof *r->ct_markP);
+    r->epochP = 0;
+    for (int k = 0; k < m + r->nb + 2; k++) {
+        r->slot_t[k] = NAN;
+        r->slot_same[k] = 0;
+    }
     r->stopped = 0;
     r->vscale = 0.0;
     r->evals = 0;

@@ -368,6 +368,8 @@ typedef struct pd_sdof_flow {
     pd_sine_piece pc;
     double t0, u0, v0;
     int fast;                /* 1: the cached form applies */
+    int constf;              /* 1: no ramp (c1 = 0): the constant's particular solution
+                                folded into the sinusoid's, no series */
     double a, wd, k0;        /* xi w0, the damped frequency, w0^2 */
     double s0, c0;           /* sin, cos of the forcing phase at t0 */
     double pre, pim;         /* A re / den, A im / den: the particular's amplitudes */

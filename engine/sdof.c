@@ -222,6 +222,11 @@ void pd_sdof_flow_init(pd_sdof_flow *f, const pd_sdof *osc, const pd_sine_piece 
         up0 = f->pre * f->s0 - f->pim * f->c0;
         f->vp0 = w * (f->pre * f->c0 + f->pim * f->s0);
     }
+    /* no ramp: a constant force's particular solution is the constant f0 / w0^2,
+     * folded into the particular one (the motion is then homogeneous about it) */
+    f->constf = p->c1 == 0.0;
+    if (f->constf)
+        up0 += f->f0 / f->k0;
     f->c1 = u0 - up0;
     f->c2 = (v0 - f->vp0 + f->a * f->c1) / f->wd;
     /* the linear term by linearity from rest beside a sinusoid, else from (u0, v0) */
@@ -243,6 +248,11 @@ void pd_sdof_flow_at(const pd_sdof_flow *f, double t1, double *du, double *v1)
     double sn = 2.0 * hs * hc, cs_m1 = -2.0 * hs * hs, cs = 1.0 + cs_m1;
     *du = 0.0;
     *v1 = 0.0;
+    if (f->constf && p->A == 0.0) { /* e^{-a s}(c1 cos + c2 sin) about the equilibrium */
+        *du = f->c1 * (em1 * cs + cs_m1) + f->c2 * ex * sn;
+        *v1 = ex * ((f->c2 * wd - a * f->c1) * cs - (f->c1 * wd + a * f->c2) * sn);
+        return;
+    }
     if (p->A != 0.0) { /* particular increments by angle addition, then the homogeneous part */
         double ps, pc2;
         sincos_half(p->w * s, &ps, &pc2);
@@ -252,7 +262,7 @@ void pd_sdof_flow_at(const pd_sdof_flow *f, double t1, double *du, double *v1)
         *v1 = f->vp0 + p->w * (f->pre * dc + f->pim * ds) +
               ex * ((f->c2 * wd - a * f->c1) * cs - (f->c1 * wd + a * f->c2) * sn);
     }
-    if (p->A != 0.0 && f->f0 == 0.0 && p->c1 == 0.0)
+    if (f->constf) /* the constant is in the particular solution */
         return;
     kernels k;
     if (fabs(f->osc.w0 * s) <= KERNEL_SERIES_MAX)
