@@ -25,6 +25,9 @@ typedef double complex edr_cplx;
 
 enum { EDR_SDOF = 1, EDR_REST = 2, EDR_MODAL = 3 };
 
+/* Degree of a flight's Taylor series near its origin (edr_cluster.c). */
+#define EDR_TAYLOR_N 7
+
 /* ---- scanning a scalar function f (edr_scan.c) ------------------------- *
  * The one-wall reference's scan carried to any closed-form function with
  * its first two derivatives: on each scan interval f' is nearly quadratic,
@@ -114,6 +117,9 @@ typedef struct edr_cluster {
     pd_sine_piece pc;       /* the piece as the flow sees it */
     pd_sdof_flow flow;
     double y0, vy0;
+    double tay[EDR_TAYLOR_N + 3];  /* y^(k)(t0) / 1, k <= N + 2 (Taylor near the origin) */
+    double ftay[EDR_TAYLOR_N + 1]; /* the unscaled piece's f^(k)(t0) */
+    double s_taylor;               /* the series' reach in s = t - t0 */
     /* MODAL */
     edr_basis *basis;
     edr_cplx *eta0, *deta, *etad; /* nmodes each (capacity cap) */

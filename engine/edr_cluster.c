@@ -51,6 +51,9 @@
 /* Eigenvector bases worse conditioned than this are refused (a nearly
  * defective cluster: critically damped modes). */
 #define MODAL_COND_MAX 1e10
+/* The flight's Taylor series: degree, and its reach Omega s (remainder
+ * below (Omega s)^8 / 8! ~ 2.5e-21 of the motion's scale). */
+#define EDR_TAYLOR_REACH 0.01
 /* Buckets of the configuration cache. */
 #define BASIS_BUCKETS 1024
 
@@ -185,6 +188,39 @@ static int tree_order(pd_edr *r, edr_cluster *c, int root, int wedge, int *ord, 
     return nn;
 }
 
+/* The flight's Taylor coefficients at its origin, y_k = y^(k)(t0) for
+ * k <= EDR_TAYLOR_N + 2 by y'' = F - 2 xi w0 y' - w0^2 y differentiated
+ * (F the scaled piece), and the unscaled piece's f_k: near the origin
+ * (Omega s <= EDR_TAYLOR_REACH) the series is the flight to rounding. */
+static void taylor_init(pd_edr *r, edr_cluster *c, double t)
+{
+    const pd_sine_piece *p = &r->pieces[c->piece], *q = &c->pc;
+    double th = p->w * t + p->phi, sn = sin(th), cs = cos(th), w0 = c->osc.w0;
+    double cyc[4] = {sn, cs, -sn, -cs}, wk = 1.0, a2 = 2.0 * c->osc.xi * w0, k0 = w0 * w0;
+    double *y = c->tay, *f = c->ftay;
+    y[0] = c->y0;
+    y[1] = c->vy0;
+    for (int k = 0; k <= EDR_TAYLOR_N; k++) {
+        double Fk = 0.0, fk = 0.0;
+        if (p->A != 0.0) {
+            Fk = q->A * wk * cyc[k % 4];
+            fk = p->A * wk * cyc[k % 4];
+        }
+        if (k == 0) {
+            Fk += q->c0 + q->c1 * (t - q->t_start);
+            fk += p->c0 + p->c1 * (t - p->t_start);
+        } else if (k == 1) {
+            Fk += q->c1;
+            fk += p->c1;
+        }
+        f[k] = fk;
+        y[k + 2] = Fk - a2 * y[k + 1] - k0 * y[k];
+        wk *= p->w;
+    }
+    double Om = fmax(w0, p->A != 0.0 ? p->w : 0.0);
+    c->s_taylor = Om > 0.0 ? EDR_TAYLOR_REACH / Om : 0.0;
+}
+
 /* An SDOF tree: aggregates, edge forces, flight.  Returns 0, or 1 when the
  * tree is no underdamped oscillator (it then runs as a modal cluster). */
 static int tree_start(pd_edr *r, edr_cluster *c, double t)
@@ -278,8 +314,10 @@ static int tree_start(pd_edr *r, edr_cluster *c, double t)
         c->pc.c0 = p->c0 * c->rho + c->kappa;
         c->pc.c1 = p->c1 * c->rho;
     }
-    if (c->kind == EDR_SDOF)
+    if (c->kind == EDR_SDOF) {
         pd_sdof_flow_init(&c->flow, &c->osc, &c->pc, t, c->y0, c->vy0);
+        taylor_init(r, c, t);
+    }
     c->T_min = c->kind == EDR_SDOF && c->osc.w0 > 0.0 ? PD_TWO_PI / c->osc.w0 : HUGE_VAL;
     return 0;
 }
@@ -933,10 +971,25 @@ void edr_cluster_eval(pd_edr *r, int ci, double t)
     c->cached = 1;
     switch (c->kind) {
     case EDR_SDOF: {
-        double dy, vy;
-        if (t == c->t0) {
+        double dy, vy, s = t - c->t0;
+        if (s == 0.0) {
             dy = 0.0;
             vy = c->vy0;
+        } else if (fabs(s) <= c->s_taylor) { /* the series: y, y', y'', f by Horner */
+            const double *y = c->tay, *f = c->ftay;
+            double sy = 0.0, sv = 0.0, sa = 0.0, sf = 0.0;
+            for (int k = EDR_TAYLOR_N; k >= 0; k--) {
+                double ik = 1.0 / (k + 1);
+                sy = (sy + y[k + 1]) * s * ik;
+                sv = sv * s * ik + y[k + 1];
+                sa = sa * s * ik + y[k + 2];
+                sf = sf * s * ik + f[k];
+            }
+            c->dy = sy;
+            c->vy = sv;
+            c->ay = sa;
+            c->f_tc = sf;
+            break;
         } else
             pd_sdof_flow_at(&c->flow, t, &dy, &vy);
         double w0 = c->osc.w0;

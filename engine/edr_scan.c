@@ -25,6 +25,11 @@
 /* A turn is not located in hit mode when f stays below -this of the
  * interval's scale. */
 #define HERMITE_MARGIN 1e-3
+/* In hit mode a maximum is first located to this fraction of its interval. */
+#define COARSE_TURN 1e-4
+/* A double turn's split is located precisely only when f' at the
+ * interpolated extremum is within this of its ends' sizes. */
+#define SPLIT_MARGIN 0.05
 
 edr_pt edr_scan_point(edr_scan *s, double t)
 {
@@ -96,6 +101,8 @@ static double locate_from(edr_scan *s, int k, double sign, double lo, double hi,
             t = tn;
             continue;
         }
+        if (w > 0.0) /* a turn, wanted to a width: Newton is there */
+            return fmin(fmax(tn, lo), hi);
         double a = fmax(tn - tol, lo), b = fmin(tn + tol, hi);
         if (a > lo && value(s, k, sign, a, NULL) <= 0.0)
             lo = a;
@@ -111,11 +118,11 @@ static double locate(edr_scan *s, int k, double sign, double lo, double hi, doub
     return locate_from(s, k, sign, lo, hi, w, NAN);
 }
 
-/* The first double where f > 0 between lo (f <= 0) and hi (f > 0), from
- * the guess t0: Newton on the exact f and f' until the step is a few
- * ulps, then the answer certified by its predecessor (f <= 0 there); a
- * Newton step leaving the bracket, or a failed certificate, hands the
- * bracket to locate_from. */
+/* The first double where f > 0 between lo (f <= 0) and hi (f > 0), to
+ * the precision f itself has: Newton on the exact f and f' from the guess
+ * t0 until the step is a few ulps or within f's rounding level (thr /
+ * f'), then the first iterate or next doubles with f > 0.  A step leaving
+ * the bracket hands it to bisection. */
 static double crossing(edr_scan *s, double lo, double hi, double t0)
 {
     double t = t0 > lo && t0 < hi ? t0 : 0.5 * (lo + hi);
@@ -128,30 +135,20 @@ static double crossing(edr_scan *s, double lo, double hi, double t0)
         double tn = t - f / df;
         if (!(df > 0.0) || !(tn >= lo && tn <= hi))
             break; /* outside the bracket: bisection's safety */
-        if (fabs(tn - t) > 8.0 * BISECT_REL * fabs(tn)) {
+        if (fabs(tn - t) > fmax(8.0 * BISECT_REL * fabs(tn), 2.0 * s->thr / df)) {
             if (!(tn > lo && tn < hi))
                 break;
             t = tn;
             continue;
         }
-        /* tn within a few ulps: walk to the first double with f > 0 */
-        double c = f > 0.0 ? t : nextafter(t, HUGE_VAL);
-        for (int k = 0; k < 8; k++) {
-            if (!(c > lo && c < hi))
-                break;
-            if (value(s, 0, 1.0, c, NULL) > 0.0) {
-                hi = c;
-                double p = nextafter(c, -HUGE_VAL);
-                if (!(p > lo) || value(s, 0, 1.0, p, NULL) <= 0.0)
-                    return c;
-                hi = c = p;
-                c = nextafter(c, -HUGE_VAL);
-                continue;
-            }
+        if (f > 0.0) /* converged past the crossing */
+            return t;
+        for (double c = fmax(tn, nextafter(t, HUGE_VAL)); c < hi; c = nextafter(c, HUGE_VAL)) {
+            if (value(s, 0, 1.0, c, NULL) > 0.0)
+                return c;
             lo = c;
-            c = nextafter(c, HUGE_VAL);
-            if (c >= hi)
-                return hi;
+            if (++it >= NEWTON_MAX_IT)
+                break;
         }
         break;
     }
@@ -230,8 +227,26 @@ static int scan_simple(edr_scan *s, const edr_pt *a, const edr_pt *b, double *t_
 {
     int dir = dir_after(a);
     if (dir != 0 && sgn(b->df) != dir && !surely_below(s, a, b)) {
-        double tc = locate(s, 1, dir > 0 ? -1.0 : 1.0, a->t, b->t, s->width);
-        edr_pt c = edr_scan_point(s, tc);
+        double tc;
+        edr_pt c;
+        if (s->hit_mode && dir > 0) {
+            /* a maximum: located coarsely first; refined only when f could
+             * reach thr within the coarse location's uncertainty */
+            double w = fmax(s->width, COARSE_TURN * (b->t - a->t));
+            double t0 = a->t + (b->t - a->t) * (a->df / (a->df - b->df));
+            tc = locate_from(s, 1, -1.0, a->t, b->t, w, t0);
+            c = edr_scan_point(s, tc);
+            double top = c.f + fabs(c.df) * w + fabs(c.ddf) * w * w;
+            if (!(c.f > s->thr) && top > s->thr && w > s->width) {
+                tc = locate(s, 1, -1.0, fmax(a->t, tc - w), tc, s->width);
+                c = edr_scan_point(s, tc);
+            }
+        } else {
+            /* from the zero of f' interpolated linearly */
+            double t0 = a->t + (b->t - a->t) * (a->df / (a->df - b->df));
+            tc = locate_from(s, 1, dir > 0 ? -1.0 : 1.0, a->t, b->t, s->width, t0);
+            c = edr_scan_point(s, tc);
+        }
         if (s->hit_mode && dir > 0 && c.f > s->thr) {
             *t_hit = locate(s, 0, 1.0, a->t, tc, 0.0);
             return 1;
@@ -259,8 +274,17 @@ int edr_scan_interval(edr_scan *s, const edr_pt *a, const edr_pt *b, double *t_h
 {
     int dir = dir_after(a);
     if (dir != 0 && sgn(b->df) == dir && may_turn_twice(a, b, dir)) {
-        double tm = locate(s, 2, dir > 0 ? 1.0 : -1.0, a->t, b->t, s->width);
+        /* f'' is nearly linear over the interval: its interpolated zero is
+         * f' 's extremum to O(h^2); located precisely only when f' there is
+         * too close to zero to tell whether it dips through */
+        double tm = a->t + (b->t - a->t) * (a->ddf / (a->ddf - b->ddf));
+        if (!(tm > a->t && tm < b->t))
+            tm = 0.5 * (a->t + b->t);
         edr_pt mid = edr_scan_point(s, tm);
+        if (sgn(mid.df) == dir && fabs(mid.df) <= SPLIT_MARGIN * (fabs(a->df) + fabs(b->df))) {
+            tm = locate(s, 2, dir > 0 ? 1.0 : -1.0, a->t, b->t, s->width);
+            mid = edr_scan_point(s, tm);
+        }
         if (sgn(mid.df) != dir) {
             if (scan_simple(s, a, &mid, t_hit))
                 return 1;

@@ -50,6 +50,9 @@
 #define EDR_STAGES 10000
 /* Events at one instant before the run is declared stuck. */
 #define EDR_SAME_INSTANT 1000
+/* The clusters' LCPs (contacts between clusters: one or two, a row's
+ * cascade more) are dense up to this size, else the dofs' LCP decides. */
+#define EDR_REDUCED_MAX 64
 /* Impact LCPs of up to this many contacts are assembled densely. */
 #define EDR_DENSE_MAX 8
 /* A closing must take the gap below -this times the size of its terms
@@ -1062,6 +1065,15 @@ static double stage_e(pd_edr *r, int j)
     return 0.0;
 }
 
+/* The small dense LCP  w = D z + q >= 0 _|_ z >= 0  of the clusters (k <=
+ * EDR_REDUCED_MAX): closed forms for k <= 2 and Lemke beyond (a cluster
+ * pinned between two held still makes D singular: Lemke takes it). */
+static int small_lcp(pd_edr *r, int k, const double *D, const double *q, double *z, double *w)
+{
+    pd_matrix Dm = pd_matrix_dense(k, k, D);
+    return pd_lcp_solve(r->dsolver, &Dm, q, NULL, z, w, NULL);
+}
+
 /* Commit an impact's totals: every closed contact's impulse (r->P) and
  * impacts (r->nimp, stages where it was closing). */
 static int commit_impacts(pd_edr *r, double t, pd_err *err)
@@ -1148,6 +1160,13 @@ static double side_sigma(const pd_edr *r, int a, int s)
     return cl->kind == EDR_SDOF ? r->ct[a].w[s] * r->s[dof] : 0.0;
 }
 
+/* 1 when contact a has a side whose cluster moves (an impulse on it does
+ * something). */
+static int movable(const pd_edr *r, int a)
+{
+    return side_sigma(r, a, 0) != 0.0 || side_sigma(r, a, 1) != 0.0;
+}
+
 /* The same stages on the clusters' coordinates: held trees move rigidly,
  * so only the closed contacts between clusters are unknowns (one or two,
  * not the whole compressed row), U_a = sum sigma eta_c, an impulse P_a
@@ -1182,11 +1201,11 @@ static int reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
                     U += side_sigma(r, a, s) * r->ceta[cl_of_dof(r, r->ct[a].dof[s])];
             if (fabs(U) <= tolU)
                 U = 0.0;
-            if (U > 0.0) {
+            if (U > 0.0 || !movable(r, a)) { /* separating, or held still on both sides */
                 r->jpos[j] = -1;
                 continue;
             }
-            if (k >= EDR_DENSE_MAX)
+            if (k >= EDR_REDUCED_MAX)
                 return 1;
             closing += U < 0.0;
             r->jpos[j] = k;
@@ -1216,13 +1235,10 @@ static int reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
         if (k == 1) {
             z[0] = pd_contact_impulse_1(D[0], q[0]);
         } else {
-            pd_matrix Dm = pd_matrix_dense(k, k, D);
-            pd_lcp_info info;
             r->res.lcp_solves++;
-            if ((rc = pd_lcp_solve(r->dsolver, &Dm, q, NULL, z, r->wtmp, &info)))
+            if ((rc = small_lcp(r, k, D, q, z, r->ztmp)))
                 return pd_err_set(err, rc, "row reference: the impact LCP of %d contacts at t = "
-                                  "%.9g was not solved (%s)", k, t,
-                                  pd_lcp_outcome_name(info.outcome));
+                                  "%.9g was not solved", k, t);
         }
         r->res.lcp_solves += k == 1;
         r->res.simultaneous += k > 1;
@@ -1317,8 +1333,8 @@ static int reduced_force(pd_edr *r, const int *idx, int k, double t, pd_err *err
         int internal = ct->dof[0] >= 0 && ct->dof[1] >= 0 &&
                        cl_of_dof(r, ct->dof[0]) == cl_of_dof(r, ct->dof[1]);
         r->lam[x] = 0.0;
-        if (r->cstate[idx[x]] == EDR_OPEN && !internal) {
-            if (ku >= EDR_DENSE_MAX)
+        if (r->cstate[idx[x]] == EDR_OPEN && !internal && movable(r, idx[x])) {
+            if (ku >= EDR_REDUCED_MAX)
                 return 1;
             ux[ku++] = x;
         }
@@ -1348,10 +1364,8 @@ static int reduced_force(pd_edr *r, const int *idx, int k, double t, pd_err *err
             return 1; /* held still on both sides and pressed: let the dofs decide */
         r->res.lcp_solves++;
     } else if (ku > 1) {
-        pd_matrix Dm = pd_matrix_dense(ku, ku, D);
-        pd_lcp_info info;
         r->res.lcp_solves++;
-        if ((rc = pd_lcp_solve(r->dsolver, &Dm, q, NULL, z, r->wtmp, &info)))
+        if ((rc = small_lcp(r, ku, D, q, z, r->wtmp)))
             return 1;
     }
     for (int x = 0; x < ku; x++) { /* alpha_c with the unknowns' forces */
@@ -1931,7 +1945,7 @@ pd_edr *pd_edr_alloc(const pd_model *md, const pd_piecewise_force *F, const pd_e
         dnnz += dg * dg;
     }
     r->Dcap = dnnz + m;
-    int dm = m < EDR_DENSE_MAX ? m : EDR_DENSE_MAX;
+    int dm = m < EDR_REDUCED_MAX ? m : EDR_REDUCED_MAX;
     int nf = 2 * n;
     if (!ALLOC(r->cl, nb) || !ALLOC(r->blk_cl, nb) || !ALLOC(r->blk_next, nb) ||
         !ALLOC(r->free_cl, nb) || !ALLOC(r->s, n) || !ALLOC(r->d, n) || !ALLOC(r->xo, n) ||
