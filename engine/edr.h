@@ -120,6 +120,9 @@ typedef struct edr_cluster {
     double tay[EDR_TAYLOR_N + 3];  /* y^(k)(t0) / 1, k <= N + 2 (Taylor near the origin) */
     double ftay[EDR_TAYLOR_N + 1]; /* the unscaled piece's f^(k)(t0) */
     double s_taylor;               /* the series' reach in s = t - t0 */
+    int bnd;                       /* the bounds below hold (flight_bounds) */
+    double Y1, Y2, Y3;             /* |y'|, |y''|, |y'''| over the flight */
+    double F1, F2;                 /* |f'|, |f''| of the piece */
     /* MODAL */
     edr_basis *basis;
     edr_cplx *eta0, *deta, *etad; /* nmodes each (capacity cap) */

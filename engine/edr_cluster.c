@@ -221,6 +221,35 @@ static void taylor_init(pd_edr *r, edr_cluster *c, double t)
     c->s_taylor = Om > 0.0 ? EDR_TAYLOR_REACH / Om : 0.0;
 }
 
+/* Bounds on |y^(k)|, k = 1..3, over an SDOF tree's flight (until its
+ * piece ends), and on the piece's |f'|, |f''|: without a ramp the flight
+ * is a constant plus the sinusoid's particular solution (amplitude P) plus
+ * e^{-a s} (c1 cos + c2 sin) (amplitude R, each derivative a factor w0 at
+ * most), so |y^(k)| <= w^k P + w0^k R.  Held still (REST): zero.  Other
+ * flights (a ramp, a free mass, resonance, modal clusters) have none:
+ * their predictions scan. */
+static void flight_bounds(pd_edr *r, edr_cluster *c)
+{
+    const pd_sine_piece *p = &r->pieces[c->piece];
+    c->bnd = 0;
+    c->F1 = fabs(p->A) * p->w + fabs(p->c1);
+    c->F2 = fabs(p->A) * p->w * p->w;
+    if (c->kind == EDR_REST) {
+        c->bnd = 1;
+        c->Y1 = c->Y2 = c->Y3 = 0.0;
+        return;
+    }
+    const pd_sdof_flow *f = &c->flow;
+    if (c->kind != EDR_SDOF || !f->fast || !f->constf)
+        return;
+    double w = c->pc.A != 0.0 ? c->pc.w : 0.0, w0 = c->osc.w0;
+    double P = c->pc.A != 0.0 ? hypot(f->pre, f->pim) : 0.0, R = hypot(f->c1, f->c2);
+    c->Y1 = w * P + w0 * R;
+    c->Y2 = w * w * P + w0 * w0 * R;
+    c->Y3 = w * w * w * P + w0 * w0 * w0 * R;
+    c->bnd = 1;
+}
+
 /* An SDOF tree: aggregates, edge forces, flight.  Returns 0, or 1 when the
  * tree is no underdamped oscillator (it then runs as a modal cluster). */
 static int tree_start(pd_edr *r, edr_cluster *c, double t)
@@ -318,6 +347,7 @@ static int tree_start(pd_edr *r, edr_cluster *c, double t)
         pd_sdof_flow_init(&c->flow, &c->osc, &c->pc, t, c->y0, c->vy0);
         taylor_init(r, c, t);
     }
+    flight_bounds(r, c);
     c->T_min = c->kind == EDR_SDOF && c->osc.w0 > 0.0 ? PD_TWO_PI / c->osc.w0 : HUGE_VAL;
     return 0;
 }
@@ -869,6 +899,7 @@ static int modal_start(pd_edr *r, edr_cluster *c, double t, pd_err *err)
     }
     c->kind = EDR_MODAL;
     c->basis = B;
+    c->bnd = 0;
     int nc = B->nc, k = B->k;
     double *y = r->wk, *yd = y + nc;
     for (int i = 0; i < nc; i++)

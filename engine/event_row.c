@@ -42,6 +42,9 @@
 /* Scan intervals a prediction covers before it queues its continuation. */
 #define EDR_WINDOW 64
 #define EDR_WINDOW0 4
+/* A prediction whose safe time (flight bounds) exceeds this many scan
+ * steps waits for it instead of scanning. */
+#define EDR_SAFE_SCANS 2
 /* Closings of one contact at one instant before its impact is plastic
  * (stage_e). */
 #define EDR_INSTANT_BOUNCES 2
@@ -61,7 +64,7 @@
 
 pd_edr_opts pd_edr_default_opts(void)
 {
-    return (pd_edr_opts){.close_tol = 1e-12,
+    return (pd_edr_opts){.close_tol = EDR_ACC_HEIGHT,
                          .length_scale = 1.0,
                          .t_measure = 0.0,
                          .h_out = 0.0,
@@ -245,6 +248,34 @@ static double contact_step(const pd_edr *r, int a)
 
 /* ---- predictions ----------------------------------------------------------------- */
 
+/* The time a function with value g >= 0, rate U and |second derivative|
+ * <= G2 takes at least to reach zero: the positive root of
+ * g + U s - G2 s^2 / 2 (HUGE_VAL when it never does). */
+static double safe_time(double g, double U, double G2)
+{
+    if (!(g > 0.0))
+        return 0.0;
+    if (!(G2 > 0.0))
+        return U < 0.0 ? g / -U : HUGE_VAL;
+    return (U + sqrt(U * U + 2.0 * G2 * g)) / G2;
+}
+
+/* A bound on contact a's |g''| over its sides' flights, or -1 when a side
+ * has none. */
+static double gap_curvature(const pd_edr *r, int a)
+{
+    const edr_contact *ct = &r->ct[a];
+    double G2 = 0.0;
+    for (int s = 0; s < 2; s++)
+        if (ct->dof[s] >= 0) {
+            const edr_cluster *cl = &r->cl[cl_of_dof(r, ct->dof[s])];
+            if (!cl->bnd)
+                return -1.0;
+            G2 += fabs(ct->w[s] * r->s[ct->dof[s]]) * cl->Y2;
+        }
+    return G2;
+}
+
 /* End of what a prediction may cover: the piece's end and t1. */
 static double horizon(const pd_edr *r) { return fmin(edr_piece_end(r, r->piece), r->t1); }
 
@@ -294,6 +325,13 @@ static void predict_contact(pd_edr *r, int a, double ts, int cont)
         }
         p = b;
         t0 = b.t;
+    }
+    /* far from closing by the flights' bounds: no scan before the safe time */
+    double G2, sf = safe_time(-p.f, -p.df, G2 = gap_curvature(r, a));
+    if (G2 >= 0.0 && sf > EDR_SAFE_SCANS * h) {
+        r->qkind[slot] = EDR_Q_SCAN;
+        q_set(&r->q, slot, ts + sf < tend ? ts + sf : HUGE_VAL);
+        return;
     }
     long n = (long)ceil((tw - t0) / h);
     if (n < 1)
@@ -375,6 +413,22 @@ static void predict_detach(pd_edr *r, int c, double ts, int cont)
     int win = cont && r->win[slot] > 0 ? r->win[slot] : EDR_WINDOW0;
     r->win[slot] = win < EDR_WINDOW ? 2 * win : EDR_WINDOW;
     double h = cl->h, tw = fmin(tend, ts + win * h), ta = ts;
+    if (cl->bnd && (cl->kind == EDR_SDOF || cl->kind == EDR_REST)) {
+        /* lambda = la y + lb y' + lg f + ld: |lambda''| <= |la| Y2 + |lb| Y3 + |lg| F2 */
+        const pd_sine_piece *pc2 = &r->pieces[cl->piece];
+        double sf = HUGE_VAL, df = pc2->A * pc2->w * cos(pc2->w * ts + pc2->phi) + pc2->c1;
+        for (int a = cl->pers_head; a >= 0; a = r->pers_next[a]) {
+            double lam = edr_force_at(r, c, a, ts);
+            double dl = r->la[a] * cl->vy + r->lb[a] * cl->ay + r->lg[a] * df;
+            double L2 = fabs(r->la[a]) * cl->Y2 + fabs(r->lb[a]) * cl->Y3 + fabs(r->lg[a]) * cl->F2;
+            sf = fmin(sf, safe_time(lam, dl, L2));
+        }
+        if (sf > EDR_SAFE_SCANS * h) {
+            r->qkind[slot] = EDR_Q_SCAN;
+            q_set(&r->q, slot, ts + sf < tend ? ts + sf : HUGE_VAL);
+            return;
+        }
+    }
     for (int a = cl->pers_head; a >= 0; a = r->pers_next[a])
         if (edr_force_at(r, c, a, ts) < 0.0) {
             cl->det_contact = a;

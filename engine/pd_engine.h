@@ -448,7 +448,8 @@ typedef struct pd_edr_opts {
     void *on_event_ctx;
 } pd_edr_opts;
 
-/* close_tol 1e-12, length scale 1, t_measure 0, no output grid, drift of
+/* close_tol 1e-10 (the accumulation's bounce height: one "in contact"
+ * scale), length scale 1, t_measure 0, no output grid, drift of
  * each dof against the ground, accumulations jumped, active contacts, 10^7
  * events, bursts of 10^5, 4e9 evaluations, 64 scan divisions, automatic
  * LCP solver. */

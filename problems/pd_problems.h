@@ -203,9 +203,12 @@ typedef struct pd_run_opts {
                            close_tol Le are closed too (simultaneous); >= 0 */
 } pd_run_opts;
 
-/* The default closing tolerance of the event-driven reference for rows:
- * gaps within this many Le of zero at an impact take part in it. */
-#define PD_CLOSE_TOL 1e-12
+/* The default closing tolerance of the event-driven reference for rows
+ * [in Le]: gaps within it at an impact take part in it.  The same scale
+ * below which the reference already treats a contact as closed when it
+ * jumps an accumulation (bounce heights under 1e-10 Le): one "in contact"
+ * scale for both decisions (docs/methods.md measures what it moves). */
+#define PD_CLOSE_TOL 1e-10
 
 /* The automatic method (PD_METHOD_AUTO: exact for one oscillator,
  * Moreau-Jean for scenes), dt and tend derived, theta = gamma = 1/2 for
