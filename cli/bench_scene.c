@@ -8,7 +8,8 @@
  * share of contacts in the LCP, and the growth exponent of the per-step
  * time over N = 10^3 ... 10^5.  Beside them the one-wall scene against the
  * oscillator it is (bench --engine's many_impacts case) in the same run:
- * the scene layer must cost the one-wall oscillator nothing. */
+ * the scene layer must cost the one-wall oscillator nothing.  Then the
+ * exact event-driven reference on rows (below). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -140,6 +141,86 @@ static int one_wall(double *scene_rate, double *osc_rate)
     return rc;
 }
 
+/* ---- the exact event-driven reference on rows --------------------------- *
+ * The work-precision row of docs/methods.md at N = 10 ... 10^4 (--chain N:
+ * periods 1 s and 1.5 s, sine pulse Tp = 1 s, ap = 1 m/s^2, Pi3 = 0.05,
+ * e = 0.6, xi = 0.05, 4 s), one run each: CPU, events and the cost per
+ * event (goal: flat within 2x); the GSL-based general reference on the row
+ * of 10 in the same run (the ratio); the 200-point spectrum of a
+ * three-structure row (examples/scenes/three-sdof.json) by the reference. */
+enum { ROW_SIZES = 4 };
+
+typedef struct row_case {
+    int N;
+    long events, impacts;
+    double cpu_s, us_per_event;
+} row_case;
+
+/* The row of N under the event method m: PD_OK or the failure (stderr). */
+static int time_row(int N, pd_method m, row_case *rc_out)
+{
+    pd_scene_excitation exc = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0};
+    double wp = 2.0 * PD_PI / exc.Tp, gap = 0.05 * exc.ap / (wp * wp);
+    pd_scene *sc = NULL;
+    pd_scene_result r = {0};
+    pd_run_opts o = pd_run_default_opts();
+    pd_err err;
+    int rc;
+    memset(rc_out, 0, sizeof *rc_out);
+    rc_out->N = N;
+    o.method = m;
+    if ((rc = pd_scene_chain(N, &exc, 1.0, 1.5, 0.05, gap, 0.6, &sc, &err)) == PD_OK) {
+        sc->tend = 4.0;
+        if (!(rc = pd_scene_result_alloc(sc, &r, &err)))
+            rc = pd_scene_run(sc, &o, NULL, NULL, &r, &err);
+    }
+    if (rc)
+        fprintf(stderr, "pound: bench --scene: row of %d (%s): %s\n", N, pd_method_name(m),
+                err.msg);
+    else {
+        rc_out->events = r.steps;
+        rc_out->cpu_s = r.cpu_s;
+        for (int c = 0; c < sc->ncontact; c++)
+            rc_out->impacts += r.impacts[c];
+        rc_out->us_per_event = 1e6 * r.cpu_s / (double)(r.steps > 0 ? r.steps : 1);
+    }
+    pd_scene_result_free(&r);
+    pd_scene_free(sc);
+    return rc;
+}
+
+/* The three-structure row's 200-point spectrum (Pi2 0.1 ... 5 of S1) on one
+ * thread: its CPU time. */
+static int time_row_spectrum(double *cpu_s)
+{
+    pd_scene_excitation exc = {.pulse = PD_PULSE_SINE, .dir = -1, .ap = 4.0, .Tp = 0.5};
+    pd_scene *sc = pd_scene_new(&exc);
+    pd_err err;
+    int rc = !sc || pd_scene_add_sdof(sc, "S1", 0.234, 0.05, 3e5, &err) ||
+             pd_scene_add_sdof(sc, "S2", 1.1, 0.05, 2e5, &err) ||
+             pd_scene_add_sdof(sc, "S3", 0.6, 0.05, 2.5e5, &err) ||
+             pd_scene_add_contact(sc, PD_WALL, 0, 0, 1, 0.01, 0.08, 0, &err) ||
+             pd_scene_add_contact(sc, 0, 1, 1, 1, 0.02, 0.08, 1, &err) ||
+             pd_scene_add_contact(sc, 1, 1, 2, 1, 0.015, 0.71, 2, &err) || pd_scene_finish(sc, &err);
+    if (!rc) {
+        sc->tend = 3.0;
+        pd_scene_sweep w = {.sc = sc, .opts = pd_run_default_opts(), .ref = 0, .ref_contact = 0,
+                            .pi2_min = 0.1, .pi2_max = 5.0, .npi2 = 200};
+        w.opts.method = PD_METHOD_EVENT;
+        long n = pd_scene_sweep_twins(&w) + pd_scene_sweep_points(&w);
+        pd_scene_point *pts = calloc((size_t)n, sizeof *pts);
+        double *umax = calloc((size_t)n * 3, sizeof *umax), c0 = pd_cpu_seconds();
+        rc = !pts || !umax || pd_scene_sweep_run(&w, 1, pts, umax, &err);
+        *cpu_s = pd_cpu_seconds() - c0;
+        free(pts);
+        free(umax);
+    }
+    if (rc)
+        fprintf(stderr, "pound: bench --scene: the row's spectrum failed\n");
+    pd_scene_free(sc);
+    return rc;
+}
+
 int pd_bench_scene(pd_json *js)
 {
     static const int sizes[] = {10, 100, 1000, 10000, 100000};
@@ -151,6 +232,16 @@ int pd_bench_scene(pd_json *js)
     double scene_rate = 0.0, osc_rate = 0.0;
     rc |= one_wall(&scene_rate, &osc_rate);
     double expo = growth(cc, NSIZES, 1000, 100000);
+    static const int rsizes[ROW_SIZES] = {10, 100, 1000, 10000};
+    row_case rows[ROW_SIZES], general;
+    double lo = HUGE_VAL, hi = 0.0, spec_cpu = 0.0;
+    for (int k = 0; k < ROW_SIZES; k++) {
+        rc |= time_row(rsizes[k], PD_METHOD_EVENT, &rows[k]);
+        lo = fmin(lo, rows[k].us_per_event);
+        hi = fmax(hi, rows[k].us_per_event);
+    }
+    rc |= time_row(10, PD_METHOD_EVENT_GENERAL, &general);
+    rc |= time_row_spectrum(&spec_cpu);
     if (js) {
         pd_json_begin_object(js, "scene");
         pd_json_begin_array(js, "chains");
@@ -171,6 +262,21 @@ int pd_bench_scene(pd_json *js)
         pd_json_num(js, "one_wall_scene_steps_per_s", scene_rate);
         pd_json_num(js, "one_wall_oscillator_steps_per_s", osc_rate);
         pd_json_num(js, "one_wall_ratio", scene_rate / osc_rate);
+        pd_json_begin_array(js, "event_rows");
+        for (int k = 0; k < ROW_SIZES; k++) {
+            pd_json_begin_object(js, NULL);
+            pd_json_int(js, "N", rows[k].N);
+            pd_json_num(js, "cpu_s", rows[k].cpu_s);
+            pd_json_int(js, "events", rows[k].events);
+            pd_json_int(js, "impacts", rows[k].impacts);
+            pd_json_num(js, "us_per_event", rows[k].us_per_event);
+            pd_json_end_object(js);
+        }
+        pd_json_end_array(js);
+        pd_json_num(js, "event_rows_cost_spread", hi / lo);
+        pd_json_num(js, "event_general_row10_cpu_s", general.cpu_s);
+        pd_json_num(js, "event_general_row10_ratio", general.cpu_s / rows[0].cpu_s);
+        pd_json_num(js, "row_spectrum_200_cpu_s", spec_cpu);
         pd_json_end_object(js);
     } else {
         printf("Moreau-Jean on --chain N rows (harmonic, Pi3 = %g, e = 0, dt = Tp/200; one core)\n",
@@ -185,6 +291,18 @@ int pd_bench_scene(pd_json *js)
                "goal %.0e DOF-steps/s at N = 1e4\n", expo, SCENE_TARGET);
         printf("  one-wall scene %.4g steps/s, the oscillator %.4g steps/s: ratio %.3f\n",
                scene_rate, osc_rate, scene_rate / osc_rate);
+        printf("the exact event-driven reference on --chain N rows (sine Tp = 1 s, Pi3 = 0.05, "
+               "e = 0.6, 4 s; one core)\n");
+        printf("  %8s %10s %10s %10s %12s\n", "N", "cpu [s]", "events", "impacts", "us/event");
+        for (int k = 0; k < ROW_SIZES; k++)
+            printf("  %8d %10.4g %10ld %10ld %12.3g\n", rows[k].N, rows[k].cpu_s,
+                   rows[k].events, rows[k].impacts, rows[k].us_per_event);
+        printf("  cost per event from N = 10 to 1e4 within %.2fx (goal 2x); the row of 100 in "
+               "%.3g s (goal 0.2 s)\n", hi / lo, rows[1].cpu_s);
+        printf("  the GSL-based general reference (event-general) on the row of 10: %.3g s, "
+               "%.3gx the exact one\n", general.cpu_s, general.cpu_s / rows[0].cpu_s);
+        printf("  200-point spectrum of a three-structure row (event): %.3g s (goal 1 s)\n",
+               spec_cpu);
     }
     return rc ? 1 : 0;
 }

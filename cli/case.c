@@ -25,13 +25,16 @@ const char pd_cli_case_help[] =
     "                   masses, periods alternating T0 and R T0 (--chain-ratio R [1.5]),\n"
     "                   every gap --gap/--Pi3, every restitution --eps\n"
     "scheme:\n"
-    "  --method moreau|event|penalty|auto [auto: event for one oscillator when its scan fits,\n"
-    "           moreau for scenes; a flag only one method takes (--dt, --theta, --kc, ...)\n"
-    "           chooses that method]\n"
+    "  --method moreau|event|penalty|auto|event-general [auto: event for one oscillator when\n"
+    "           its scan fits, moreau for scenes; a flag only one method takes (--dt, --theta,\n"
+    "           --kc, ...) chooses that method; event-general: the GSL-based reference for\n"
+    "           scenes, event-rows' cross-check]\n"
     "  --dt H [min(Tp,T0)/2000]   --theta T [0.5]   --gamma G [0.5]   --tend T [Tp+2 T0;\n"
     "         harmonic: transient + window, see docs/scheme.md]\n"
     "  --allow-unstable  accept theta outside [1/2, 1]\n"
     "  --no-accumulation  event-driven: do not jump accumulations of impacts\n"
+    "  --close-tol X [1e-10]  event-driven rows: contacts within X Le of zero at an impact\n"
+    "           take part in it (simultaneous); counted in the output (docs/methods.md)\n"
     "  --kernel auto|general [auto]  general: no fast path (scalar kernel, exact reference)\n"
     "  --factor auto|scalar|dense|cholmod [auto]  storage of the iteration matrix\n"
     "  --lcp-solver auto|lemke|structured|pgs [auto]  the contact LCP solver (docs/lcp.md)\n"
@@ -254,6 +257,9 @@ static int check_scheme(const pd_cli_case *a)
     if (!(o->pen.atol > 0.0))
         return pd_cli_usage_error("--atol: the absolute tolerance must be > 0 (got %.10g)",
                                   o->pen.atol);
+    if (!(o->close_tol >= 0.0 && o->close_tol <= 1.0))
+        return pd_cli_usage_error("--close-tol: the closing tolerance must be in [0, 1] (in "
+                                  "units of Le; got %.10g)", o->close_tol);
     return 0;
 }
 

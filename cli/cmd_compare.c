@@ -26,7 +26,7 @@ static int parse_methods(const char *list, int *want)
     want[0] = want[1] = want[2] = 0;
     for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ","), n++) {
         pd_method m;
-        if (pd_method_parse(tok, &m) || m == PD_METHOD_EVENT)
+        if (pd_method_parse(tok, &m) || (m != PD_METHOD_MOREAU && m != PD_METHOD_PENALTY))
             return pd_cli_usage_error("--methods: '%s' is not one of moreau, penalty", tok);
         want[m] = 1;
     }

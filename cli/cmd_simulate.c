@@ -415,6 +415,15 @@ static void scene_json(const sim_args *a, const pd_scene *sc, const pd_scene_sum
     pd_json_str(&js, "factor", r->factor);
     pd_json_str(&js, "lcp_solver", r->lcp_solver);
     pd_json_int(&js, "lcp_solves", r->lcp_solves);
+    /* the event-driven reference's model decisions (0 for the other methods) */
+    long impacts = 0;
+    for (int c = 0; c < sc->ncontact; c++)
+        impacts += r->impacts[c];
+    pd_json_int(&js, "impacts", impacts);
+    pd_json_int(&js, "simultaneous", r->simultaneous);
+    pd_json_int(&js, "tol_closed", r->tol_closed);
+    pd_json_int(&js, "accumulations", r->accumulations);
+    pd_json_num(&js, "close_tol", r->close_tol);
     pd_json_num(&js, "dt", r->dt);
     pd_json_num(&js, "theta", r->theta);
     pd_json_num(&js, "tend", r->tend);
@@ -490,10 +499,18 @@ static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_sum
                r->lcp_solves);
     else
         printf("  %s (%s), %ld %s to %g s\n",
-               a->k.opts.method == PD_METHOD_EVENT ? "event-driven reference" : "penalty",
-               r->kernel, r->steps, a->k.opts.method == PD_METHOD_EVENT ? "events" : "steps",
+               a->k.opts.method == PD_METHOD_PENALTY ? "penalty" : "event-driven reference",
+               r->kernel, r->steps, a->k.opts.method == PD_METHOD_PENALTY ? "steps" : "events",
                r->tend);
     method_line(&a->k);
+    if (a->k.opts.method == PD_METHOD_EVENT) {
+        long impacts = 0;
+        for (int c = 0; c < sc->ncontact; c++)
+            impacts += r->impacts[c];
+        printf("  decisions = %ld impacts: %ld LCPs of several contacts (simultaneous), %ld "
+               "contacts closed within --close-tol %g Le, %ld accumulations jumped\n",
+               impacts, r->simultaneous, r->tol_closed, r->close_tol, r->accumulations);
+    }
     printf("  %-12s %7s %9s %12s %12s %10s %8s\n", "structure", "storey", "T0 [s]", "umax [m]",
            "drift [m]", "Pi1", "gamma");
     for (int k = 0; k < sc->nstruct && k < TEXT_MAX_STRUCTURES; k++) {

@@ -315,6 +315,10 @@ static int put_run(pd_scene_writer *w, const pd_scene_run_info *ri)
            put_num(w, f, "", "theta", r->theta, "1") || put_num(w, f, "", "tend", r->tend, "s") ||
            put_num(w, f, "", "every", (double)w->every, "1") ||
            put_num(w, f, "", "steps", (double)r->steps, "1") ||
+           put_num(w, f, "", "simultaneous", (double)r->simultaneous, "1") ||
+           put_num(w, f, "", "tol_closed", (double)r->tol_closed, "1") ||
+           put_num(w, f, "", "accumulations", (double)r->accumulations, "1") ||
+           put_num(w, f, "", "close_tol", r->close_tol, "Le") ||
            put_num(w, f, "", "cpu_s", ri->sum->cpu_s, "s");
 }
 

@@ -15,13 +15,14 @@ MODEL_KEYS = ("pulse", "dir", "ap", "Tp", "T0", "Pi2", "gap", "Pi3", "eps", "xi"
 RECORD_KEYS = ("record", "scale", "units", "record_format")
 SCHEME_KEYS = ("method", "dt", "tend", "theta", "gamma", "allow_unstable", "no_accumulation",
                "no_wall", "kernel", "factor", "lcp_solver", "contact", "kc", "kc_abs", "rtol",
-               "atol", "stepper")
+               "atol", "stepper", "close_tol")
 CASE_KEYS = MODEL_KEYS + RECORD_KEYS + SCHEME_KEYS
 # cli/case.c: the keywords only one method takes choose it (moreau 0,
 # event 1, penalty 2) unless method says another; the flags only
 # (allow_unstable, no_accumulation) when true
 IMPLIES = {"dt": 0, "theta": 0, "gamma": 0, "allow_unstable": 0, "kernel": 0, "factor": 0,
-           "lcp_solver": 0, "dt_per_Tp": 0, "no_accumulation": 1, "kc": 2, "kc_abs": 2,
+           "lcp_solver": 0, "dt_per_Tp": 0, "no_accumulation": 1, "close_tol": 1, "kc": 2,
+           "kc_abs": 2,
            "rtol": 2, "atol": 2, "contact": 2, "stepper": 2}
 PD_METHOD_AUTO = 3
 
@@ -128,6 +129,9 @@ def _check_scheme(o, have):
                          % fmt(o.pen.rtol))
     if not o.pen.atol > 0.0:
         raise InputError("atol: the absolute tolerance must be > 0 (got %s)" % fmt(o.pen.atol))
+    if not 0.0 <= o.close_tol <= 1.0:
+        raise InputError("close_tol: the closing tolerance must be in [0, 1] (in units of Le; "
+                         "got %s)" % fmt(o.close_tol))
 
 
 def scheme_opts(kw):
@@ -141,8 +145,9 @@ def scheme_opts(kw):
         v = kw[key]
         have[key] = True
         if key == "method":
-            o.method = parse_name("method", lib.pd_method_parse, v, "moreau, event, penalty")
-        elif key in ("dt", "tend", "theta", "gamma"):
+            o.method = parse_name("method", lib.pd_method_parse, v,
+                                  "moreau, event, penalty, auto, event-general")
+        elif key in ("dt", "tend", "theta", "gamma", "close_tol"):
             setattr(o, key, number(key, v))
         elif key in ("allow_unstable", "no_accumulation", "no_wall"):
             setattr(o, key, 1 if v else 0)

@@ -126,7 +126,7 @@ class PdRunOpts(Structure):
                 ("gamma", c_double), ("allow_unstable", c_int), ("kernel", c_int),
                 ("factor", c_int), ("lcp_solver", c_int), ("no_accumulation", c_int),
                 ("no_wall", c_int), ("pen", PdPenaltySetup), ("on_lcp", c_void_p),
-                ("on_lcp_ctx", c_void_p)]
+                ("on_lcp_ctx", c_void_p), ("close_tol", c_double)]
 
 
 class PdRecord(Structure):
@@ -224,7 +224,8 @@ class PdSceneResult(Structure):
                 ("impacts", POINTER(c_long)), ("first_impact", POINTER(c_double)),
                 ("max_impulse", POINTER(c_double)), ("contact_time", POINTER(c_double)),
                 ("approach", POINTER(c_double)), ("steps", c_long), ("lcp_solves", c_long),
-                ("dt", c_double), ("tend", c_double), ("theta", c_double), ("cpu_s", c_double),
+                ("simultaneous", c_long), ("tol_closed", c_long), ("accumulations", c_long),
+                ("close_tol", c_double), ("dt", c_double), ("tend", c_double), ("theta", c_double), ("cpu_s", c_double),
                 ("method", c_char_p), ("kernel", c_char_p), ("factor", c_char_p),
                 ("lcp_solver", c_char_p)]
 

@@ -194,7 +194,10 @@ class Scene:
         sc, r = self._sc, sm.r
         out = Result(method=s(r.method), steps=r.steps, cpu_s=sm.cpu_s, cpu_s_run=r.cpu_s,
                      kernel=s(r.kernel), factor=s(r.factor), lcp_solver=s(r.lcp_solver),
-                     lcp_solves=r.lcp_solves, dt=r.dt, theta=r.theta, tend=r.tend, dofs=sc.n)
+                     lcp_solves=r.lcp_solves, dt=r.dt, theta=r.theta, tend=r.tend, dofs=sc.n,
+                     impacts=sum(r.impacts[c] for c in range(sc.ncontact)),
+                     simultaneous=r.simultaneous, tol_closed=r.tol_closed,
+                     accumulations=r.accumulations, close_tol=r.close_tol)
         x = self.excitation
         out["pulse"], out["dir"] = x["pulse"], x["dir"]
         if "record" in x:
