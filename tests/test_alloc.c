@@ -146,14 +146,60 @@ static int case_lcp_read(void)
     return st;
 }
 
+/* The row reference on two shear buildings touching at two floors (modal
+ * clusters: their bases are allocated during the run) and an SDOF against
+ * a wall: the constructor and the run. */
+static int case_rows(void)
+{
+    pd_scene_excitation exc = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 4.0, .Tp = 0.5};
+    double m[2] = {2e5, 2e5}, k[2] = {3e8, 2e8};
+    pd_scene *sc = pd_scene_new(&exc);
+    pd_scene_model sm;
+    pd_sine_piece *pc = NULL;
+    int np = 0, built = 0, st;
+    pd_err err;
+    if (!sc)
+        return PD_ENOMEM;
+    st = pd_scene_add_building(sc, "A", 2, m, k, 0.05, &err);
+    if (!st)
+        st = pd_scene_add_building(sc, "B", 2, m, k, 0.05, &err);
+    if (!st)
+        st = pd_scene_add_sdof(sc, "C", 0.5, 0.05, 1e5, &err);
+    if (!st)
+        st = pd_scene_add_contact(sc, 0, 1, 1, 1, 0.002, 0.3, 0, &err);
+    if (!st)
+        st = pd_scene_add_contact(sc, 0, 2, 1, 2, 0.002, 0.3, 0, &err);
+    if (!st)
+        st = pd_scene_add_contact(sc, 2, 1, PD_WALL, 0, 0.001, 0.5, 1, &err);
+    if (!st)
+        st = pd_scene_finish(sc, &err);
+    if (!st && !(st = pd_scene_model_build(sc, 1, &sm, &err)))
+        built = 1;
+    if (!st)
+        st = pd_osc_pieces(&sm.shape, &pc, &np, &err);
+    if (!st) {
+        pd_piecewise_force F = {.b = sm.mass, .pieces = pc, .npieces = np};
+        pd_edr *r = pd_edr_alloc(&sm.model, &F, NULL, &err);
+        st = r ? pd_edr_run(r, 0.0, NULL, NULL, 2.0 * PD_TWO_PI, NULL, NULL, &err) : err.status;
+        pd_edr_free(r);
+    }
+    free(pc);
+    if (built)
+        pd_scene_model_free(&sm);
+    pd_scene_free(sc);
+    return st;
+}
+
 static void test_alloc_every_failure_reported(pd_test_ctx *ctx)
 {
-    long n[5];
+    long n[6];
     n[0] = fail_each(ctx, "pd_lcp_alloc", case_lcp);
     n[1] = fail_each(ctx, "pd_mj_alloc (general)", case_moreau_general);
     n[2] = fail_each(ctx, "pd_osc_simulate", case_oscillator);
     n[3] = fail_each(ctx, "pd_osc_penalty", case_penalty);
     n[4] = fail_each(ctx, "pd_lcp_read", case_lcp_read);
+    n[5] = fail_each(ctx, "pd_edr_alloc, pd_edr_run (modal clusters)", case_rows);
+    CHECK(ctx, n[5] >= 50, "the row reference takes many allocations (%ld)", n[5]);
     CHECK(ctx, n[1] >= 10, "the general kernel takes many allocations (%ld)", n[1]);
 }
 
