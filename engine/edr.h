@@ -86,6 +86,7 @@ typedef struct edr_basis {
     int *dofs;              /* nc global dofs */
     int *cons;              /* r independent persistent contacts */
     edr_cplx *lam, *beta, *kap; /* nmodes: eta' = lam eta + beta f + kap */
+    edr_cplx *ilam;         /* 1 / lam */
     double *wt;             /* nmodes: 2 for a conjugate pair, 1 for a real mode */
     edr_cplx *Px, *Pv;      /* nc x nmodes, row per dof: x = q* + sum wt Re(Px eta) */
     edr_cplx *Z;            /* nmodes x 2k: eta0 = Z (y0, y0') */
@@ -126,6 +127,9 @@ typedef struct edr_cluster {
     /* MODAL */
     edr_basis *basis;
     edr_cplx *eta0, *deta, *etad; /* nmodes each (capacity cap) */
+    edr_cplx *gq, *bc1;     /* the flight's beta f_lin(t0) + kap, beta c1 */
+    edr_cplx *ilp, *ilm;    /* 1 / (lam - i w), 1 / (lam + i w) */
+    edr_cplx ath0;          /* A / (2i) e^{i th(t0)} */
     int cap;
     /* the state at tc (cache) */
     double tc;

@@ -42,9 +42,6 @@
 
 #include "edr.h"
 
-/* phi functions by their Taylor series below this |z|. */
-#define PHI_SERIES 1.0
-#define PHI_TERMS 30
 /* A constraint direction within this (relative) of the span of the others
  * is dependent: the contact is LOCKED. */
 #define DEPENDENT_TOL 1e-10
@@ -90,35 +87,6 @@ static double piece_period(const pd_edr *r, int j)
 }
 
 /* ---- complex helpers ----------------------------------------------------------- */
-
-/* e^z - 1 without cancellation. */
-static edr_cplx expm1c(edr_cplx z)
-{
-    double x = creal(z), y = cimag(z), h = sin(0.5 * y);
-    return expm1(x) * cos(y) - 2.0 * h * h + I * (exp(x) * sin(y));
-}
-
-/* phi1(z) = (e^z - 1)/z and phi2(z) = (e^z - 1 - z)/z^2; em1 = e^z - 1 when known. */
-static void phi12(edr_cplx z, const edr_cplx *em1, edr_cplx *p1, edr_cplx *p2)
-{
-    if (cabs(z) < PHI_SERIES) {
-        edr_cplx t1 = 1.0, s1 = 0.0, s2 = 0.0, t2 = 0.5; /* z^k/(k+1)!, z^k/(k+2)! */
-        for (int k = 0; k < PHI_TERMS; k++) {
-            s1 += t1;
-            s2 += t2;
-            t1 *= z / (k + 2);
-            t2 *= z / (k + 3);
-        }
-        *p1 = s1;
-        if (p2)
-            *p2 = s2;
-        return;
-    }
-    edr_cplx e = em1 ? *em1 : expm1c(z);
-    *p1 = e / z;
-    if (p2)
-        *p2 = (*p1 - 1.0) / z;
-}
 
 /* ---- the SDOF tree -------------------------------------------------------------- */
 
@@ -361,6 +329,7 @@ static void basis_free(edr_basis *b)
     free(b->dofs);
     free(b->cons);
     free(b->lam);
+    free(b->ilam);
     free(b->beta);
     free(b->kap);
     free(b->wt);
@@ -397,7 +366,11 @@ void edr_cluster_free(edr_cluster *c)
     free(c->eta0);
     free(c->deta);
     free(c->etad);
-    c->eta0 = c->deta = c->etad = NULL;
+    free(c->gq);
+    free(c->bc1);
+    free(c->ilp);
+    free(c->ilm);
+    c->eta0 = c->deta = c->etad = c->gq = c->bc1 = c->ilp = c->ilm = NULL;
     c->cap = 0;
 }
 
@@ -722,6 +695,7 @@ static int basis_build(pd_edr *r, const int *key, int nk, edr_basis **out, int *
     B->nmodes = nm;
     size_t nmz = (size_t)(nm > 0 ? nm : 1);
     B->lam = malloc(nmz * sizeof(edr_cplx));
+    B->ilam = malloc(nmz * sizeof(edr_cplx));
     B->beta = malloc(nmz * sizeof(edr_cplx));
     B->kap = malloc(nmz * sizeof(edr_cplx));
     B->wt = malloc(nmz * sizeof(double));
@@ -729,7 +703,8 @@ static int basis_build(pd_edr *r, const int *key, int nk, edr_basis **out, int *
     B->Pv = malloc(nmz * (size_t)nc * sizeof(edr_cplx));
     B->Z = malloc(nmz * (size_t)(2 * (k > 0 ? k : 1)) * sizeof(edr_cplx));
     B->F = malloc(nmz * (size_t)(nr > 0 ? nr : 1) * sizeof(edr_cplx));
-    if (!B->lam || !B->beta || !B->kap || !B->wt || !B->Px || !B->Pv || !B->Z || !B->F) {
+    if (!B->lam || !B->ilam || !B->beta || !B->kap || !B->wt || !B->Px || !B->Pv || !B->Z ||
+        !B->F) {
         rc = pd_err_set(err, PD_ENOMEM, "out of memory for a cluster's modes");
         goto done;
     }
@@ -746,6 +721,7 @@ static int basis_build(pd_edr *r, const int *key, int nk, edr_basis **out, int *
             kp += zz * mrk[a];
         }
         B->lam[q] = lam;
+        B->ilam[q] = 1.0 / lam;
         B->beta[q] = bt;
         B->kap[q] = kp;
         B->wt[q] = GSL_IMAG(l) > 0.0 ? 2.0 : 1.0;
@@ -891,7 +867,11 @@ static int modal_start(pd_edr *r, edr_cluster *c, double t, pd_err *err)
         c->eta0 = malloc((size_t)cap * sizeof(edr_cplx));
         c->deta = malloc((size_t)cap * sizeof(edr_cplx));
         c->etad = malloc((size_t)cap * sizeof(edr_cplx));
-        if (!c->eta0 || !c->deta || !c->etad) {
+        c->gq = malloc((size_t)cap * sizeof(edr_cplx));
+        c->bc1 = malloc((size_t)cap * sizeof(edr_cplx));
+        c->ilp = malloc((size_t)cap * sizeof(edr_cplx));
+        c->ilm = malloc((size_t)cap * sizeof(edr_cplx));
+        if (!c->eta0 || !c->deta || !c->etad || !c->gq || !c->bc1 || !c->ilp || !c->ilm) {
             edr_cluster_free(c);
             return pd_err_set(err, PD_ENOMEM, "out of memory for a cluster's modes");
         }
@@ -930,8 +910,21 @@ static int modal_start(pd_edr *r, edr_cluster *c, double t, pd_err *err)
         r->xo[B->dofs[i]] = x;
         r->vo[B->dofs[i]] = v;
     }
+    /* the flight's constants: beta f_lin(t0) + kap, beta c1, A / (2i) e^{i th(t0)},
+     * 1 / (lam -+ i w) */
+    const pd_sine_piece *pc = &r->pieces[c->piece];
+    double fl0 = pc->c0 + pc->c1 * (t - pc->t_start), th = pc->w * t + pc->phi;
+    c->ath0 = pc->A != 0.0 ? pc->A / (2.0 * I) * (cos(th) + I * sin(th)) : 0.0;
+    for (int q = 0; q < B->nmodes; q++) {
+        c->gq[q] = B->beta[q] * fl0 + B->kap[q];
+        c->bc1[q] = B->beta[q] * pc->c1;
+        if (pc->A != 0.0) {
+            edr_cplx lp = B->lam[q] - I * pc->w, lm = B->lam[q] + I * pc->w;
+            c->ilp[q] = cabs(lp) > 0.0 ? 1.0 / lp : 0.0; /* (0: the series serves) */
+            c->ilm[q] = cabs(lm) > 0.0 ? 1.0 / lm : 0.0;
+        }
+    }
     c->T_min = B->T_min;
-    (void)t;
     return PD_OK;
 }
 
@@ -961,30 +954,76 @@ int edr_cluster_start(pd_edr *r, int ci, double t, pd_err *err)
 
 /* ---- evaluation -------------------------------------------------------------- */
 
-/* The modes at t: deta = eta(t) - eta0, etad = eta'(t). */
+/* Terms of the phi series for |z| (|Re| + |Im|) below 1: the first k with
+ * |z|^k / k! under 1e-17 of the sum's 1. */
+static int phi_terms(double az)
+{
+    return az < 1e-4 ? 5 : az < 1e-2 ? 8 : az < 0.1 ? 12 : az < 0.5 ? 17 : 21;
+}
+
+/* phi1(z) and phi2(z) by Horner on their series (|z| < 1). */
+static void phi12_series(edr_cplx z, int n, edr_cplx *p1, edr_cplx *p2)
+{
+    edr_cplx s1 = 1.0, s2 = 1.0;
+    for (int k = n; k >= 1; k--) { /* phi1 = sum z^k/(k+1)!, phi2 = sum z^k/(k+2)! */
+        s1 = 1.0 + s1 * z / (double)(k + 1);
+        s2 = 1.0 + s2 * z / (double)(k + 2);
+    }
+    *p1 = s1;
+    *p2 = 0.5 * s2;
+}
+
+/* e^z - 1 from expm1 of the real part and sin, cos of the imaginary one
+ * (cos - 1 without cancellation), and e^z. */
+static edr_cplx expm1_parts(double x, double y, edr_cplx *ez)
+{
+    double em = expm1(x), sy, cy;
+    sy = sin(y);
+    cy = cos(y);
+    double cm1 = cy > 0.0 ? -sy * sy / (1.0 + cy) : cy - 1.0, ex = 1.0 + em;
+    *ez = ex * cy + I * (ex * sy);
+    return em * cy + cm1 + I * (ex * sy);
+}
+
+/* The modes at t: deta = eta(t) - eta0, etad = eta'(t), by the flight's
+ * constants (modal_start): one expm1 and one sin, cos per mode; the phi
+ * functions by series below |z| = 1, else from e^z and the precomputed
+ * reciprocals of lam and lam -+ i w. */
 static void modal_eval(const pd_edr *r, edr_cluster *c, double t)
 {
     const edr_basis *B = c->basis;
     const pd_sine_piece *pc = &r->pieces[c->piece];
-    double s = t - c->t0, fl0 = pc->c0 + pc->c1 * (c->t0 - pc->t_start);
-    double ft = pd_sine_piece_force(pc, t);
-    edr_cplx ep = 0.0, em = 0.0, Ah = 0.0;
-    if (pc->A != 0.0) {
-        double th = pc->w * t + pc->phi;
-        ep = cos(th) + I * sin(th);
-        em = conj(ep);
-        Ah = pc->A / (2.0 * I);
+    double s = t - c->t0, ft = pd_sine_piece_force(pc, t), is = 1.0 / s;
+    edr_cplx ews = 1.0, Aep = 0.0, Aem = 0.0;
+    if (pc->A != 0.0) { /* e^{i w s}; beta A / (2i) e^{+-i th} s at t folded below */
+        double ws = pc->w * s;
+        ews = cos(ws) + I * sin(ws);
+        Aep = c->ath0 * ews * s;
+        Aem = -conj(c->ath0 * ews) * s; /* conj(1 / (2i)) = -1 / (2i) */
     }
     for (int q = 0; q < B->nmodes; q++) {
-        edr_cplx lam = B->lam[q], z = lam * s, em1 = expm1c(z), p1, p2;
-        phi12(z, &em1, &p1, &p2);
-        edr_cplx de = em1 * c->eta0[q] + s * p1 * (B->beta[q] * fl0 + B->kap[q]) +
-                      s * s * p2 * B->beta[q] * pc->c1;
+        edr_cplx lam = B->lam[q], z = lam * s, ez, p1, p2;
+        double x = creal(z), y = cimag(z);
+        edr_cplx em1 = expm1_parts(x, y, &ez);
+        if (fabs(x) + fabs(y) < 1.0)
+            phi12_series(z, phi_terms(fabs(x) + fabs(y)), &p1, &p2);
+        else {
+            p1 = em1 * B->ilam[q] * is;
+            p2 = (p1 - 1.0) * B->ilam[q] * is;
+        }
+        edr_cplx de = em1 * c->eta0[q] + s * p1 * c->gq[q] + s * s * p2 * c->bc1[q];
         if (pc->A != 0.0) {
-            edr_cplx zp = (lam - I * pc->w) * s, zm = (lam + I * pc->w) * s, u1, u2;
-            phi12(zp, NULL, &u1, NULL);
-            phi12(zm, NULL, &u2, NULL);
-            de += B->beta[q] * Ah * (ep * s * u1 - em * s * u2);
+            edr_cplx zp = (lam - I * pc->w) * s, zm = (lam + I * pc->w) * s, u1, u2, dummy;
+            double ap = fabs(creal(zp)) + fabs(cimag(zp)), am = fabs(creal(zm)) + fabs(cimag(zm));
+            if (ap < 1.0)
+                phi12_series(zp, phi_terms(ap), &u1, &dummy);
+            else
+                u1 = (ez * conj(ews) - 1.0) * c->ilp[q] * is;
+            if (am < 1.0)
+                phi12_series(zm, phi_terms(am), &u2, &dummy);
+            else
+                u2 = (ez * ews - 1.0) * c->ilm[q] * is;
+            de += B->beta[q] * (Aep * u1 - Aem * u2);
         }
         c->deta[q] = de;
         c->etad[q] = lam * (c->eta0[q] + de) + B->beta[q] * ft + B->kap[q];
