@@ -12,10 +12,12 @@
 
 static const char converge_usage[] =
     "usage: pound converge [model flags | --scene F.json | --chain N] --dt MAX:MIN:N\n"
-    "                      [--methods moreau,penalty]\n"
+    "                      [--methods moreau,penalty,event-general]\n"
     "                      [--theta LIST] [--kcs LIST] [--plot FILE.png] [-o FILE] [--json]\n"
     "  --dt MAX:MIN:N  N step sizes, log-spaced from MAX down to MIN (Moreau-Jean rows)\n"
     "  --theta LIST    one Moreau-Jean curve per theta (default 0.5)\n"
+    "  --methods LIST  the rows: moreau (per dt and theta), penalty (per stiffness),\n"
+    "                  event-general (scenes: the GSL-based general reference, one row)\n"
     "  --kcs LIST      penalty rows: stiffness multiples of w0^2 (default 1e2,1e3,1e4,1e5,1e6),\n"
     "                  measured on the finest dt grid\n"
     "  --plot F.png    error vs dt in F.png, error vs CPU time (work-precision) in F-work.png\n"
@@ -37,7 +39,7 @@ typedef struct row {
 typedef struct conv_args {
     pd_cli_case k;
     double dt_max, dt_min;
-    int ndt, ntheta, nkc, want_moreau, want_penalty, json, have_dt_range;
+    int ndt, ntheta, nkc, want_moreau, want_penalty, want_general, json, have_dt_range;
     int use_umax; /* --error umax: chart and order err_umax_rel */
     double thetas[MAX_LIST], kcs[MAX_LIST];
     const char *plot, *out;
@@ -83,16 +85,16 @@ static int parse_list(const char *flag, const char *text, double *x, int *n)
     return 0;
 }
 
-/* "moreau,penalty" (either or both) into a; 0 or 2. */
+/* "moreau,penalty,event-general" (any of them) into a; 0 or 2. */
 static int parse_methods(conv_args *a, const char *text)
 {
     char buf[128], *p = buf;
     if (!text || strlen(text) >= sizeof buf)
         return pd_cli_usage_error("--methods needs a list such as moreau,penalty");
     if (!text[0])
-        return pd_cli_usage_error("--methods: give moreau, penalty or both (got '')");
+        return pd_cli_usage_error("--methods: give moreau, penalty, event-general (got '')");
     strcpy(buf, text);
-    a->want_moreau = a->want_penalty = 0;
+    a->want_moreau = a->want_penalty = a->want_general = 0;
     for (int k = 1; p; k++) {
         char *tok = next_element(&p);
         if (!tok[0])
@@ -101,8 +103,11 @@ static int parse_methods(conv_args *a, const char *text)
             a->want_moreau = 1;
         else if (!strcmp(tok, "penalty"))
             a->want_penalty = 1;
+        else if (!strcmp(tok, "event-general"))
+            a->want_general = 1;
         else
-            return pd_cli_usage_error("--methods: '%s' is not one of moreau, penalty", tok);
+            return pd_cli_usage_error("--methods: '%s' is not one of moreau, penalty, event-general",
+                                      tok);
     }
     return 0;
 }
@@ -221,7 +226,12 @@ static int parse_args(conv_args *a, int argc, char **argv)
         return pd_cli_usage_error("%s", err.msg);
     a->k.have_dt = 1;
     a->k.opts.dt = a->dt_max;
-    return pd_cli_case_finish(&a->k);
+    if ((rc = pd_cli_case_finish(&a->k)))
+        return rc;
+    if (a->want_general && !pd_cli_is_scene(&a->k))
+        return pd_cli_usage_error("--methods: event-general is a reference for scenes (--scene, "
+                                  "--chain); the oscillator's reference is exact");
+    return 0;
 }
 
 /* The i-th of n log-spaced steps from dt_max down to dt_min. */
@@ -347,7 +357,7 @@ static int compute_rows(conv_args *a, measurer *M, row *rows, int *nrows, double
     int rc, n = 0;
     o.dt = a->dt_min;
     *ref_cpu = 0.0;
-    if ((rc = measurer_alloc(M, &o, a->ndt * a->ntheta + a->nkc, err)))
+    if ((rc = measurer_alloc(M, &o, a->ndt * a->ntheta + a->nkc + 1, err)))
         goto done;
     int once = M->sc && nested_grid(a);
     if (once && (rc = measure_reference(M, &o, ref_cpu, err)))
@@ -374,6 +384,15 @@ static int compute_rows(conv_args *a, measurer *M, row *rows, int *nrows, double
             if ((rc = measure_row(M, &o, n, &rows[n], err)))
                 goto done;
         }
+    }
+    if (a->want_general) { /* one more point: the GSL-based reference on the finest grid */
+        o.dt = a->dt_min;
+        o.method = PD_METHOD_EVENT_GENERAL;
+        if (!once && (rc = measure_reference(M, &o, ref_cpu, err)))
+            goto done;
+        if ((rc = measure_row(M, &o, n, &rows[n], err)))
+            goto done;
+        n++;
     }
     /* observed order between successive Moreau–Jean rows of one theta */
     for (int r = 0; r < n; r++)
@@ -442,10 +461,10 @@ static void print_rows(const conv_args *a, const measurer *M, const row *rows, i
         return;
     }
     printf("%s; reference cost %.3g s\n", title, ref_cpu);
-    printf("  %-8s %6s %11s %8s %11s %11s %10s %7s %8s\n", "method", "theta", "dt [s]", "kc",
+    printf("  %-13s %6s %11s %8s %11s %11s %10s %7s %8s\n", "method", "theta", "dt [s]", "kc",
            "err_umax", "err_hist", "cpu [s]", "order", "impacts");
     for (int r = 0; r < n; r++)
-        printf("  %-8s %6.3g %11.4g %8.3g %11.3g %11.3g %10.3g %7.3f %8ld\n",
+        printf("  %-13s %6.3g %11.4g %8.3g %11.3g %11.3g %10.3g %7.3f %8ld\n",
                pd_method_name(rows[r].method), rows[r].theta, rows[r].dt, rows[r].kc,
                rows[r].err_umax, rows[r].err_hist, rows[r].cpu_s, rows[r].order, rows[r].impacts);
 }
@@ -454,9 +473,9 @@ static void print_rows(const conv_args *a, const measurer *M, const row *rows, i
 static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int n,
                      double ref_cpu, pd_err *err)
 {
-    static double xs[2][MAX_LIST + 1][MAX_ROWS], ys[2][MAX_LIST + 1][MAX_ROWS];
-    pd_curve by_dt[MAX_LIST], by_cpu[MAX_LIST + 1];
-    char labels[MAX_LIST + 1][64], work_png[4096];
+    static double xs[2][MAX_LIST + 2][MAX_ROWS], ys[2][MAX_LIST + 2][MAX_ROWS];
+    pd_curve by_dt[MAX_LIST], by_cpu[MAX_LIST + 2];
+    char labels[MAX_LIST + 2][64], work_png[4096];
     int ncurve = 0;
     for (int t = 0; t < a->ntheta && a->want_moreau; t++, ncurve++) {
         int m = 0;
@@ -487,6 +506,17 @@ static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int
         by_cpu[ncurve] = (pd_curve){.label = labels[ncurve], .n = npen, .x = xs[1][ncurve],
                                     .y = ys[1][ncurve]};
     }
+    int ngen = 0;
+    for (int r = 0; r < n && a->want_general; r++)
+        if (rows[r].method == PD_METHOD_EVENT_GENERAL) {
+            int c = ncurve + (npen > 0);
+            xs[1][c][0] = rows[r].cpu_s;
+            ys[1][c][0] = row_error(a, &rows[r]);
+            snprintf(labels[c], sizeof labels[0], "general reference (event-general, GSL)");
+            by_cpu[c] = (pd_curve){.label = labels[c], .n = 1, .x = xs[1][c], .y = ys[1][c],
+                                   .style = PD_CURVE_MARKER};
+            ngen = 1;
+        }
     char title[256];
     const char *ylabel = a->use_umax ? "|u_{max} - u_{max,ref}| / u_{max,ref}"
                                      : "max |u - u_{ref}| / u_{max,ref}";
@@ -505,7 +535,7 @@ static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int
                    .ylabel = ylabel,
                    .logx = 1,
                    .logy = 1,
-                   .ncurves = ncurve + (npen > 0),
+                   .ncurves = ncurve + (npen > 0) + ngen,
                    .curves = by_cpu,
                    .vline = ref_cpu,
                    .vline_label = "event-driven reference"};
@@ -525,7 +555,8 @@ static int write_rows(const conv_args *a, const measurer *M, const row *rows, in
     enum { NC = 10 };
     static double col[NC][MAX_ROWS];
     const char *methods[] = {pd_method_name(PD_METHOD_MOREAU), pd_method_name(PD_METHOD_EVENT),
-                             pd_method_name(PD_METHOD_PENALTY)}; /* by code, as in --json */
+                             pd_method_name(PD_METHOD_PENALTY), pd_method_name(PD_METHOD_AUTO),
+                             pd_method_name(PD_METHOD_EVENT_GENERAL)}; /* by code, as in --json */
     char chain[64];
     for (int r = 0; r < n; r++) {
         double v[NC] = {(double)rows[r].method, rows[r].theta, rows[r].dt, rows[r].kc,
@@ -535,7 +566,7 @@ static int write_rows(const conv_args *a, const measurer *M, const row *rows, in
             col[c][r] = v[c];
     }
     pd_column cols[NC] = {
-        {.name = "method", .units = "1", .values = col[0], .labels = methods, .nlabels = 3},
+        {.name = "method", .units = "1", .values = col[0], .labels = methods, .nlabels = 5},
         {.name = "theta", .units = "1", .values = col[1]},
         {.name = "dt", .units = "s", .values = col[2]},
         {.name = "kc", .units = "1", .values = col[3]}, /* a multiple of w0^2 */
@@ -585,7 +616,7 @@ int pd_cmd_converge(int argc, char **argv)
     if ((rc = parse_args(&a, argc, argv)))
         return rc;
     pd_provenance_set(argc, argv, PD_FORMAT_CONVERGE, 0);
-    if (a.ndt * a.ntheta + a.nkc > MAX_ROWS) {
+    if (a.ndt * a.ntheta + a.nkc + 1 > MAX_ROWS) {
         pd_cli_case_free(&a.k);
         return pd_cli_usage_error("converge: too many rows (at most %d)", MAX_ROWS);
     }

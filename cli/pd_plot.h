@@ -7,7 +7,12 @@
 
 #include "pd_core.h"
 
-typedef enum { PD_CURVE_LINESPOINTS = 0, PD_CURVE_LINES = 1, PD_CURVE_POINTS = 2 } pd_curve_style;
+typedef enum {
+    PD_CURVE_LINESPOINTS = 0,
+    PD_CURVE_LINES = 1,
+    PD_CURVE_POINTS = 2, /* small dots: a scatter of many */
+    PD_CURVE_MARKER = 3  /* large diamonds: one or a few points to find at a glance */
+} pd_curve_style;
 
 typedef struct pd_curve {
     const char *label;

@@ -69,7 +69,7 @@ static void chart_script(FILE *g, const char *data, const char *png_tmp, const v
     fprintf(g, "set terminal pngcairo size 900,650 enhanced font 'sans,11'\n");
     fputs("set output ", g);
     pd_plot_text(g, png_tmp);
-    fputs("\nset grid\nset key outside right top\n", g);
+    fputs("\nset grid\nset key below\n", g);
     if (c->logx)
         fputs("set logscale x\nset format x '10^{%L}'\n", g);
     if (c->logy)
@@ -102,7 +102,7 @@ static void chart_script(FILE *g, const char *data, const char *png_tmp, const v
     fputs("plot ", g);
     for (int k = 0; k < c->ncurves; k++) {
         static const char *const styles[] = {"linespoints lw 2", "lines lw 1.5",
-                                             "points pt 7 ps 0.8"};
+                                             "points pt 7 ps 0.8", "points pt 13 ps 2.2"};
         fputs(k ? ", " : "", g);
         pd_plot_text(g, data);
         fprintf(g, " index %d with %s title ", k, styles[c->curves[k].style]);

@@ -16,9 +16,13 @@
  *      reached whose gap is <= close_tol L at t is closed, and its other
  *      side joins (persistent contacts are closed by definition);
  *   2. the extremes of the group's flights are measured up to t;
- *   3. impact LCP over the closed contacts Z (Newton's law; persistent and
- *      separating ones take part with e ignored):
- *        U+ = U- + D P,  0 <= U+ + e min(U-, 0) _|_ P >= 0,  D = W_Z^T M^-1 W_Z;
+ *   3. the impact in stages (impact_stages): each an LCP with Newton's law
+ *      over the closed contacts Z that are not separating,
+ *        U+ = U- + D P,  0 <= U+ + e min(U-, 0) _|_ P >= 0,  D = W_Z^T M^-1 W_Z,
+ *      until no closed contact closes; a contact closing a third time at
+ *      one instant is plastic (an accumulation at that instant).  On the
+ *      clusters' coordinates when it can (reduced_stages), on the dofs
+ *      otherwise;
  *   4. the contacts left at zero rate decide persistence by the
  *      contact-force LCP (g'' = D lambda + W^T M^-1 (b f - C v - K q));
  *      a contact leaving with a bounce height U+^2 / (2 a) below 1e-10 L

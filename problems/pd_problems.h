@@ -607,8 +607,11 @@ typedef struct pd_scene_result {
 PD_API int pd_scene_result_alloc(const pd_scene *sc, pd_scene_result *r, pd_err *err);
 PD_API void pd_scene_result_free(pd_scene_result *r);
 
-/* Run the scene with the method of opts; sampler (may be NULL) gets the
- * state every step (Moreau–Jean) or every dt (the others), and at t = 0. */
+/* Run the scene with the method of opts into res (from
+ * pd_scene_result_alloc for this scene: PD_EINVAL otherwise); sampler (may
+ * be NULL) gets the state every step (Moreau–Jean) or every dt (the others;
+ * event-general also at each of its events, between grid points), and at
+ * t = 0. */
 PD_API int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler sampler,
                         void *ctx, pd_scene_result *res, pd_err *err);
 

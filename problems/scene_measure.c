@@ -119,8 +119,8 @@ static int compare_row(const pd_scene_sample *s, void *ctx)
 {
     compare_ctx *c = ctx;
     long at = c->row * c->stride;
-    if (at >= c->ref->rows)
-        return 0;
+    if (at >= c->ref->rows || fabs(s->t - (double)at * c->ref->dt) > 1e-9 * c->ref->dt)
+        return 0; /* past the reference, or an event's state between grid points */
     const double *xr = c->ref->x + (size_t)at * c->ref->n;
     c->row++;
     for (int k = 0; k < c->sc->nstruct; k++) {

@@ -15,6 +15,7 @@
  *              of the element force over one engagement;
  *   approach   max over t of x_a - x_b (how far the gap closes). */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -502,6 +503,11 @@ static int run_event(const pd_scene_model *sm, const pd_run_opts *o, double tau_
         return err ? err->status : PD_ENOMEM;
     }
     rc = pd_edr_run(edr, 0.0, NULL, NULL, tau_end, tr->fn ? observe_edr : NULL, tr, err);
+    if (err && (rc == PD_ENUMERICAL || rc == PD_ESINGULAR)) { /* a cluster without modes */
+        char why[sizeof err->msg];
+        snprintf(why, sizeof why, "%s", err->msg);
+        pd_err_set(err, rc, "%s; --method event-general integrates such clusters numerically", why);
+    }
     const pd_edr_result *er = pd_edr_result_of(edr);
     for (int i = 0; i < tr->n; i++) {
         tr->xpos[i] = er->xpos[i];
@@ -639,6 +645,9 @@ int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler s
     pd_osc c;
     int mirrored, rc;
     pd_err_clear(err);
+    if (!res || res->n != sc->n || res->m != sc->ncontact || !res->umax)
+        return pd_err_set(err, PD_EINVAL, "the result is not allocated for this scene "
+                                          "(pd_scene_result_alloc)");
     if ((rc = pd_scene_resolve_opts(sc, opts, &o, err)))
         return rc;
     for (int i = 0; i < res->n; i++)

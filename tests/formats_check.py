@@ -418,7 +418,8 @@ def converge(ctx):
     cases = [("oscillator", ["converge", "--pulse", "sine", "--Tp", "0.3", "--T0", "3", "--ap", "4", "--gap",
                              "0.004", "--eps", "0.6", "--dt", "1e-3:2.5e-4:3", "--methods", "moreau,penalty",
                              "--kcs", "1e3,1e4"]),
-             ("scene", ["converge", "--scene", "two sdof's.json", "--tend", "2", "--dt", "1e-3:5e-4:2"])]
+             ("scene", ["converge", "--scene", "two sdof's.json", "--tend", "2", "--dt", "1e-3:5e-4:2",
+                        "--methods", "moreau,event-general"])]
     for kind, base in cases:
         for out in ("conv-%s.h5" % kind, "conv-%s.csv" % kind):
             args = base + ["-o", out, "--json"]
@@ -429,9 +430,10 @@ def converge(ctx):
                 for k in ("theta", "dt", "kc", "err_umax_rel", "err_hist_linf", "order", "impacts", "steps"):
                     ok = all(close(a, r[k]) for a, r in zip(f[k][:], j))
                     check(ok, f"{out}: {k} differs from --json rows")
-                codes = {0: "moreau", 1: "event", 2: "penalty"}
+                codes = {0: "moreau", 1: "event", 2: "penalty", 3: "auto", 4: "event-general"}
                 check([codes[int(m)] for m in f["method"][:]] == [r["method"] for r in j], f"{out}: method codes")
-                check(text(f["method"].attrs["codes"]) == "0 = moreau, 1 = event, 2 = penalty", f"{out}: codes")
+                check(text(f["method"].attrs["codes"]) ==
+                      "0 = moreau, 1 = event, 2 = penalty, 3 = auto, 4 = event-general", f"{out}: codes")
                 f.close()
             else:
                 cols = [(d["name"], d["units"]) for d in ctx.doc[fmt]["datasets"]]

@@ -149,18 +149,28 @@ def simulate(history=True, every=1, **case):
 
 # ---- compare ------------------------------------------------------------------------------
 
+_METHOD_CODE = {"moreau": 0, "penalty": 2, "event-general": 4}  # pd_method
+
+
 def parse_methods(methods):
-    """('moreau', 'penalty') -> [want moreau, event, penalty]."""
+    """('moreau', 'penalty', 'event-general') -> want[] by pd_method code."""
     if isinstance(methods, str):
         methods = methods.split(",")
-    want = [0, 0, 0]
+    want = [0] * 5
     if not methods:
-        raise InputError("methods: give moreau, penalty or both")
+        raise InputError("methods: give moreau, penalty, event-general")
     for m in methods:
-        if m not in ("moreau", "penalty"):
-            raise InputError("methods: '%s' is not one of moreau, penalty" % (m,))
-        want[0 if m == "moreau" else 2] = 1
+        if m not in _METHOD_CODE:
+            raise InputError("methods: '%s' is not one of moreau, penalty, event-general" % (m,))
+        want[_METHOD_CODE[m]] = 1
     return want
+
+
+def _scenes_only(want, scene):
+    """event-general measures scenes only (the CLI's message)."""
+    if want[4] and scene is None:
+        raise InputError("methods: event-general is a reference for scenes (--scene, --chain); "
+                         "the oscillator's reference is exact")
 
 
 class _Traces:
@@ -181,8 +191,10 @@ def compare(methods=("moreau",), scene=None, **case):
     """Errors against the event-driven reference, as `pound compare --json`:
     err_umax_rel = |umax - umax_ref| / umax_ref and err_hist_linf =
     max_k |u(t_k) - u_ref(t_k)| / umax_ref on t_k = k dt, for Moreau-Jean
-    and/or penalty (methods).  scene=path: the scene's (per structure)."""
+    and/or penalty (methods; scenes also 'event-general', the GSL-based
+    reference).  scene=path: the scene's (per structure)."""
     want = parse_methods(methods)
+    _scenes_only(want, scene)
     if scene is not None:
         from ._scene import compare_scene
         return compare_scene(scene, want, case)
@@ -265,7 +277,8 @@ def converge(dts, theta=(0.5,), methods=("moreau",), kcs=None, error="hist", sce
              **case):
     """Error and cost as dt shrinks, as `pound converge --dt ... --json`: one
     row per (dt, theta) for Moreau-Jean, one per contact stiffness multiple
-    kc (kcs [1e2, 1e3, 1e4, 1e5, 1e6]) on the finest grid for penalty; order =
+    kc (kcs [1e2, 1e3, 1e4, 1e5, 1e6]) on the finest grid for penalty, and
+    (scenes, 'event-general' in methods) one for the GSL-based reference; order =
     log(err_prev / err) / log(dt_prev / dt) between successive rows of one
     theta, on err_hist_linf (error='hist') or err_umax_rel ('umax').
 
@@ -275,12 +288,9 @@ def converge(dts, theta=(0.5,), methods=("moreau",), kcs=None, error="hist", sce
     thetas = [number("theta", t) for t in np.atleast_1d(theta).tolist()]
     if not thetas or len(thetas) > 32:
         raise InputError("theta: give 1 to 32 values")
-    if isinstance(methods, str):
-        methods = methods.split(",")
-    for m in methods:
-        if m not in ("moreau", "penalty"):
-            raise InputError("methods: '%s' is not one of moreau, penalty" % (m,))
-    want_moreau, want_penalty = "moreau" in methods, "penalty" in methods
+    want = parse_methods(methods)
+    _scenes_only(want, scene)
+    want_moreau, want_penalty, want_general = want[0], want[2], want[4]
     kcs = [1e2, 1e3, 1e4, 1e5, 1e6] if kcs is None else \
         [number("kcs", x) for x in np.atleast_1d(kcs).tolist()]
     if any(not x > 0.0 for x in kcs):
@@ -299,7 +309,7 @@ def converge(dts, theta=(0.5,), methods=("moreau",), kcs=None, error="hist", sce
         meas = _OscMeasurer(Case(case).resolve())
     try:
         rows, ref_cpu = _rows(meas, steps, dt_min, thetas, want_moreau, want_penalty, kcs,
-                              error)
+                              error, want_general)
     finally:
         meas.close()
     return Result(rows=rows, cpu_s_ref=ref_cpu)
@@ -332,7 +342,7 @@ class _OscMeasurer:
             self.tr.close()
 
 
-def _rows(M, steps, dt_min, thetas, want_moreau, want_penalty, kcs, error):
+def _rows(M, steps, dt_min, thetas, want_moreau, want_penalty, kcs, error, want_general=False):
     """cli/cmd_converge.c compute_rows."""
     o = copy_opts(M.opts)
     err = PdErr()
@@ -382,6 +392,12 @@ def _rows(M, steps, dt_min, thetas, want_moreau, want_penalty, kcs, error):
             o.pen.kc_mult = kc
             o.pen.kc_abs = 0.0
             row()
+    if want_general:  # one more point: the GSL-based reference on the finest grid
+        o.dt = dt_min
+        o.method = 4
+        if not once:
+            reference()
+        row()
     key = "err_umax_rel" if error == "umax" else "err_hist_linf"
     for i, r in enumerate(rows):
         for q in range(i - 1, -1, -1):

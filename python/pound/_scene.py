@@ -360,7 +360,7 @@ def compare_scene(scene, want, kw):
             raise _lib.make_error(st, "reference: " + err.text())
         sc = M.scene._sc
         rows = {}
-        for m in range(3):
+        for m in range(len(want)):
             if not want[m]:
                 continue
             om = copy_opts(o)
@@ -384,7 +384,7 @@ def compare_scene(scene, want, kw):
                 lib.pd_scene_result_free(res)
                 lib.pd_scene_errors_free(e)
         impacts_ref = sum(M.rr.impacts[a] for a in range(sc.ncontact))
-        first = 0 if want[0] else 2
+        first = want.index(1)
         f = rows[first]
         out = Result(method=f["method"], err_umax_rel=f["err_umax_rel"],
                      err_hist_linf=f["err_hist_linf"], impacts=f["impacts"],
@@ -392,7 +392,7 @@ def compare_scene(scene, want, kw):
                      events_ref=M.rr.steps, dt=f["dt"])
         for r in rows.values():
             del r["dt"]
-        out["methods"] = [rows[m] for m in range(3) if want[m]]
+        out["methods"] = [rows[m] for m in range(len(want)) if want[m]]
         return out
     finally:
         M.close()

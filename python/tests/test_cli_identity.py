@@ -141,6 +141,13 @@ def test_scene_compare_converge(cli, same):
          cli("compare", "--scene", SCENE, "--methods", "moreau,penalty"))
     same(pound.converge("0.0008:0.0002:3", scene=SCENE),
          cli("converge", "--scene", SCENE, "--dt", "0.0008:0.0002:3"))
+    # the GSL-based reference measured against the exact row reference
+    same(pound.compare(scene=SCENE, methods="moreau,event-general"),
+         cli("compare", "--scene", SCENE, "--methods", "moreau,event-general"))
+    same(pound.converge("0.0008:0.0004:2", scene=SCENE, methods="moreau,event-general",
+                        error="umax"),
+         cli("converge", "--scene", SCENE, "--dt", "0.0008:0.0004:2", "--methods",
+             "moreau,event-general", "--error", "umax"))
 
 
 RECORD = RECORDS / "NGA_no_1063_RRS228.AT2"

@@ -68,6 +68,14 @@ def test_scene_option_errors():
     assert str(e.value) == "gamma: must be in [0, 1] (got 2)"
     with pytest.raises(pound.InputError):
         pound.Scene.chain(0)
+    # the GSL-based reference is measured on scenes only, as the CLI says
+    with pytest.raises(pound.InputError) as e:
+        pound.compare(methods="moreau,event-general", pulse="sine")
+    assert "event-general is a reference for scenes" in str(e.value)
+    with pytest.raises(pound.InputError):
+        pound.converge("1e-3:5e-4:2", methods=["event-general"], pulse="sine")
+    with pytest.raises(pound.InputError):
+        pound.compare(methods="event", pulse="sine")
 
 
 def test_lcp_input_errors():
