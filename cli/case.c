@@ -469,6 +469,25 @@ int pd_cli_is_scene(const pd_cli_case *a)
     return a->scene_path != NULL || a->chain > 0;
 }
 
+void pd_cli_ref_decisions_json(pd_json *js, const pd_scene_result *ref)
+{
+    pd_json_int(js, "simultaneous_ref", ref->simultaneous);
+    pd_json_int(js, "tol_closed_ref", ref->tol_closed);
+    pd_json_int(js, "accumulations_ref", ref->accumulations);
+    pd_json_num(js, "close_tol", ref->close_tol);
+}
+
+void pd_cli_ref_decisions_text(FILE *f, const pd_scene_result *ref)
+{
+    if (isnan(ref->close_tol)) /* the one-wall fast path */
+        fprintf(f, "  reference decisions: %ld accumulations jumped (one contact)\n",
+                ref->accumulations);
+    else
+        fprintf(f, "  reference decisions: %ld LCPs of several contacts, %ld contacts closed "
+                   "within --close-tol %g Le, %ld accumulations jumped\n",
+                ref->simultaneous, ref->tol_closed, ref->close_tol, ref->accumulations);
+}
+
 int pd_cli_scene(const pd_cli_case *a, pd_scene **sc)
 {
     pd_err err;

@@ -87,6 +87,7 @@ static int compare_scene(const pd_cli_case *k, const int *want, int json)
         pd_json_num(&js, "cpu_s", me[first].cpu_s);
         pd_json_num(&js, "cpu_s_ref", rr.cpu_s);
         pd_json_int(&js, "events_ref", rr.steps);
+        pd_cli_ref_decisions_json(&js, &rr);
         pd_json_num(&js, "dt", mr[first].dt);
         pd_json_begin_array(&js, "methods");
         for (int m = 0; m < NMETHOD; m++)
@@ -117,6 +118,7 @@ static int compare_scene(const pd_cli_case *k, const int *want, int json)
                "%.3g s\n",
                k->scene_path ? k->scene_path : "(chain)", sc->nstruct, mr[first].dt, rr.steps,
                impacts_ref, rr.cpu_s);
+        pd_cli_ref_decisions_text(stdout, &rr);
         printf("  %-13s %-14s %12s %12s %8s %10s\n", "method", "structure", "err_umax",
                "err_hist", "impacts", "cpu [s]");
         for (int m = 0; m < NMETHOD; m++)

@@ -456,11 +456,20 @@ static void print_rows(const conv_args *a, const measurer *M, const row *rows, i
         }
         pd_json_end_array(&js);
         pd_json_num(&js, "cpu_s_ref", ref_cpu);
+        if (M->sc) {
+            long impacts = 0;
+            for (int c = 0; c < M->sc->ncontact; c++)
+                impacts += M->srr.impacts[c];
+            pd_json_int(&js, "impacts_ref", impacts);
+            pd_cli_ref_decisions_json(&js, &M->srr);
+        }
         pd_json_end_object(&js);
         pd_json_finish(&js);
         return;
     }
     printf("%s; reference cost %.3g s\n", title, ref_cpu);
+    if (M->sc)
+        pd_cli_ref_decisions_text(stdout, &M->srr);
     printf("  %-13s %6s %11s %8s %11s %11s %10s %7s %8s\n", "method", "theta", "dt [s]", "kc",
            "err_umax", "err_hist", "cpu [s]", "order", "impacts");
     for (int r = 0; r < n; r++)

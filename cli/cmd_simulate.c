@@ -507,9 +507,13 @@ static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_sum
         long impacts = 0;
         for (int c = 0; c < sc->ncontact; c++)
             impacts += r->impacts[c];
-        printf("  decisions = %ld impacts: %ld LCPs of several contacts (simultaneous), %ld "
-               "contacts closed within --close-tol %g Le, %ld accumulations jumped\n",
-               impacts, r->simultaneous, r->tol_closed, r->close_tol, r->accumulations);
+        if (isnan(r->close_tol)) /* the one-wall fast path */
+            printf("  decisions = %ld impacts, %ld accumulations jumped (one contact)\n", impacts,
+                   r->accumulations);
+        else
+            printf("  decisions = %ld impacts: %ld LCPs of several contacts (simultaneous), %ld "
+                   "contacts closed within --close-tol %g Le, %ld accumulations jumped\n",
+                   impacts, r->simultaneous, r->tol_closed, r->close_tol, r->accumulations);
     }
     printf("  %-12s %7s %9s %12s %12s %10s %8s\n", "structure", "storey", "T0 [s]", "umax [m]",
            "drift [m]", "Pi1", "gamma");

@@ -120,6 +120,12 @@ void pd_json_null(pd_json *js, const char *key);
 void pd_json_nums(pd_json *js, const char *key, int n, const double *x);
 void pd_json_finish(pd_json *js); /* newline after the top-level value */
 
+/* The decisions a scene's reference run rests on (docs/methods.md, "The
+ * closing tolerance"): JSON keys simultaneous_ref, tol_closed_ref,
+ * accumulations_ref, close_tol; or one line of text. */
+void pd_cli_ref_decisions_json(pd_json *js, const pd_scene_result *ref);
+void pd_cli_ref_decisions_text(FILE *f, const pd_scene_result *ref);
+
 /* Benchmarks, one per module.  With js NULL they print a readable table on
  * stdout; otherwise they add one member ("lcp", "engine") to the JSON object
  * that js has open.  Return 0, or 1 when a benchmark run failed. */

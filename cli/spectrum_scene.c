@@ -35,6 +35,12 @@ static void derive(sweep_out *o)
     }
 }
 
+/* The exact reference's closing tolerance [Le]; NaN for the other methods. */
+static double close_tol(const sweep_out *o)
+{
+    return o->w.opts.method == PD_METHOD_EVENT ? o->w.opts.close_tol : NAN;
+}
+
 /* The table: Pi2, Pi3, eps, Tp, impacts, then Pi1, gamma, umax per structure. */
 static int write_table(const pd_scene_sweep_args *a, const sweep_out *o, pd_err *err)
 {
@@ -78,6 +84,7 @@ static int write_table(const pd_scene_sweep_args *a, const sweep_out *o, pd_err 
                        {.name = "reference_T0", .units = "s", .num = o->sc->st[o->w.ref].T0},
                        {.name = "reference_contact", .units = "1", .num = o->w.ref_contact},
                        {.name = "method", .is_text = 1, .text = pd_method_name(o->w.opts.method)},
+                       {.name = "close_tol", .units = "Le", .num = close_tol(o)},
                        {.name = "ap", .units = "m/s^2", .num = o->sc->exc.ap}};
     pd_table t = {.rows = np, .ncols = ncols, .cols = cols,
                   .nattrs = (int)(sizeof attrs / sizeof attrs[0]), .attrs = attrs};
@@ -138,6 +145,7 @@ static void print_json(const sweep_out *o, double cpu, double wall)
     pd_json_begin_object(&js, NULL);
     pd_json_str(&js, "reference", o->sc->st[o->w.ref].name);
     pd_json_str(&js, "method", pd_method_name(o->w.opts.method));
+    pd_json_num(&js, "close_tol", close_tol(o));
     pd_json_begin_array(&js, "points");
     for (long p = 0; p < o->np; p++) {
         const pd_scene_point *pt = &o->pts[o->ntw + p];

@@ -6,9 +6,9 @@
  * its next closing (from the flights of its two sides), each cluster with
  * persistent contacts one of its next detachment, and a priority queue
  * orders them with the forcing's next piece and the output grid.  A
- * prediction scans one window (EDR_WINDOW scan intervals) and, finding
- * nothing, queues its own continuation, so that a prediction that an event
- * will soon replace costs little.  An event re-origins the clusters it
+ * prediction scans one window (EDR_WINDOW0 scan intervals, doubling up to
+ * EDR_WINDOW) and, finding nothing, queues its own continuation, so that a
+ * prediction that an event will soon replace costs little.  An event re-origins the clusters it
  * touches and predicts again only the contacts next to them.
  *
  * An impact at t (a contact's predicted closing):
@@ -70,6 +70,7 @@ pd_edr_opts pd_edr_default_opts(void)
 {
     return (pd_edr_opts){.close_tol = EDR_ACC_HEIGHT,
                          .length_scale = 1.0,
+                         .time_unit = 1.0,
                          .t_measure = 0.0,
                          .h_out = 0.0,
                          .below = NULL,
@@ -790,8 +791,8 @@ static int solve_lcp(pd_edr *r, const int *idx, int k, const double *q, double *
     pd_lcp_info info;
     int rc = pd_lcp_solve(r->solver, &D, q, &lo, z, w, &info);
     if (rc)
-        return pd_err_set(err, rc, "row reference: the contact LCP of %d contacts at t = %.9g "
-                          "was not solved (%s)", k, t, pd_lcp_outcome_name(info.outcome));
+        return pd_err_set(err, rc, "row reference: the contact LCP of %d contacts at t = %.9g s "
+                          "was not solved (%s)", k, t * r->o.time_unit, pd_lcp_outcome_name(info.outcome));
     return PD_OK;
 }
 
@@ -1006,12 +1007,12 @@ static int report(pd_edr *r, double t, pd_edr_kind kind, int acc)
 static int count_event(pd_edr *r, int slot, double t, pd_err *err)
 {
     if (++r->res.events > r->o.max_events)
-        return pd_err_set(err, PD_EBUDGET, "row reference: %ld events by t = %.9g (budget "
-                          "exhausted)", r->res.events - 1, t);
+        return pd_err_set(err, PD_EBUDGET, "row reference: %ld events by t = %.9g s (budget "
+                          "exhausted)", r->res.events - 1, t * r->o.time_unit);
     if (r->slot_t[slot] == t) {
         if (++r->slot_same[slot] > EDR_SAME_INSTANT)
-            return pd_err_set(err, PD_EBUDGET, "row reference: %d events at t = %.17g without "
-                              "progress", EDR_SAME_INSTANT, t);
+            return pd_err_set(err, PD_EBUDGET, "row reference: %d events at t = %.17g s without "
+                              "progress", EDR_SAME_INSTANT, t * r->o.time_unit);
     } else {
         r->slot_t[slot] = t;
         r->slot_same[slot] = 0;
@@ -1150,8 +1151,8 @@ static int commit_impacts(pd_edr *r, double t, pd_err *err)
             r->res.first_impact = t;
         if ((r->burst[a] += r->nimp[j]) > r->o.max_burst)
             return pd_err_set(err, PD_EBUDGET, "row reference: accumulation of impacts of "
-                              "contact %d at t = %.9g: %ld impacts without reaching persistent "
-                              "contact%s", a, t, r->burst[a] - 1,
+                              "contact %d at t = %.9g s: %ld impacts without reaching persistent "
+                              "contact%s", a, t * r->o.time_unit, r->burst[a] - 1,
                               r->o.no_accumulation ? " (accumulation handling is off)" : "");
     }
     return PD_OK;
@@ -1188,8 +1189,8 @@ static int impact_stages(pd_edr *r, double t, double tolU, pd_err *err)
         if (!closing)
             return PD_OK;
         if (++stage > EDR_STAGES)
-            return pd_err_set(err, PD_EBUDGET, "row reference: the impact at t = %.17g did not "
-                              "end in %d stages", t, EDR_STAGES);
+            return pd_err_set(err, PD_EBUDGET, "row reference: the impact at t = %.17g s did not "
+                              "end in %d stages", t * r->o.time_unit, EDR_STAGES);
         if ((rc = solve_lcp(r, idx, k, q, z, r->wtmp, t, err)))
             return rc;
         r->res.simultaneous += k > 1;
@@ -1273,8 +1274,8 @@ static int reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
         if (!closing)
             break;
         if (++stage > EDR_STAGES)
-            return pd_err_set(err, PD_EBUDGET, "row reference: the impact at t = %.17g did not "
-                              "end in %d stages", t, EDR_STAGES);
+            return pd_err_set(err, PD_EBUDGET, "row reference: the impact at t = %.17g s did not "
+                              "end in %d stages", t * r->o.time_unit, EDR_STAGES);
         for (int x = 0; x < k; x++) /* D_xy = sum over shared clusters sigma sigma / mu */
             for (int y = 0; y < k; y++) {
                 int a = r->g_ct[idx[x]], b = r->g_ct[idx[y]];
@@ -1296,7 +1297,7 @@ static int reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
             r->res.lcp_solves++;
             if ((rc = small_lcp(r, k, D, q, z, r->ztmp)))
                 return pd_err_set(err, rc, "row reference: the impact LCP of %d contacts at t = "
-                                  "%.9g was not solved", k, t);
+                                  "%.9g s was not solved", k, t * r->o.time_unit);
         }
         r->res.lcp_solves += k == 1;
         r->res.simultaneous += k > 1;
@@ -1830,8 +1831,10 @@ static int check_opts(const pd_edr_opts *o, pd_err *err)
 {
     if (!(o->close_tol >= 0.0) || !isfinite(o->close_tol))
         return pd_err_set(err, PD_EINVAL, "close_tol: must be >= 0 (got %g)", o->close_tol);
-    if (!(o->length_scale > 0.0) || !isfinite(o->length_scale))
-        return pd_err_set(err, PD_EINVAL, "row reference: the length scale must be > 0");
+    if (!(o->length_scale > 0.0) || !isfinite(o->length_scale) || !(o->time_unit > 0.0) ||
+        !isfinite(o->time_unit))
+        return pd_err_set(err, PD_EINVAL, "row reference: the length scale and time unit must "
+                                          "be > 0");
     if (o->max_events < 1 || o->max_burst < 1 || o->scan_divisions < 1 || !(o->max_evals >= 1.0))
         return pd_err_set(err, PD_EINVAL, "row reference: budgets and scan divisions must be "
                                           ">= 1");
@@ -2207,7 +2210,7 @@ int pd_edr_run(pd_edr *r, double t0, const double *q0, const double *v0, double 
         t = te;
         if (r->evals > r->o.max_evals) {
             rc = pd_err_set(err, PD_EBUDGET, "row reference: %.3g flight evaluations by t = %.9g "
-                            "(budget exhausted)", (double)r->evals, t);
+                            "s (budget exhausted)", (double)r->evals, t * r->o.time_unit);
             break;
         }
         if (slot == r->slot_out) {

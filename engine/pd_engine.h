@@ -400,8 +400,9 @@ PD_API void pd_sdof_increment(const pd_sdof *osc, double A, double w, double phi
  * shortest period of the pair that cannot miss a grazing dip, roots to
  * adjacent doubles), a priority queue orders them, and an event changes
  * only the cluster it touches, so its cost does not grow with the row.
- * At an impact the contacts closed within close_tol form one velocity LCP
- * with Newton's law (paper Eqs. 3, 4, 8, 9), persistence is decided by the
+ * At an impact the contacts closed within close_tol take impulses in
+ * stages, each an LCP with Newton's law over the closed contacts that are
+ * not separating (paper Eqs. 3, 4, 8, 9), persistence is decided by the
  * contact-force LCP (Eqs. 2, 7), detachment root-found on the closed-form
  * contact forces, accumulations of impacts jumped to their limit
  * (docs/methods.md). */
@@ -433,6 +434,8 @@ typedef struct pd_edr_opts {
     double close_tol;      /* at an impact, contacts with gap <= close_tol * length_scale
                               are closed too (one LCP); >= 0 */
     double length_scale;   /* > 0: the scene's length (1 in the reference units) */
+    double time_unit;      /* > 0: the model's unit of time in seconds (1 / wp for a
+                              scene), for the times the messages give */
     double t_measure;      /* extremes count from here */
     double h_out;          /* > 0: the observer every h_out from t0 (and at t1) */
     const int *below;      /* NULL, or n: the dof whose displacement is subtracted for the
@@ -443,13 +446,15 @@ typedef struct pd_edr_opts {
     long max_burst;        /* impacts of one contact before it rests or leaves, >= 1 */
     double max_evals;      /* flight evaluations (the cost) before PD_EBUDGET, >= 1 */
     int scan_divisions;    /* scan step: shortest period / this, >= 1 */
-    pd_lcp_method lcp_solver;
+    pd_lcp_method lcp_solver; /* the LCPs on the dofs (a modal cluster takes part, or more
+                                 than 64 contacts between clusters); the clusters' own
+                                 LCPs are Lemke's */
     pd_edr_event_fn on_event; /* optional: every impact, detachment, piece change */
     void *on_event_ctx;
 } pd_edr_opts;
 
 /* close_tol 1e-10 (the accumulation's bounce height: one "in contact"
- * scale), length scale 1, t_measure 0, no output grid, drift of
+ * scale), length scale 1, time unit 1 s, t_measure 0, no output grid, drift of
  * each dof against the ground, accumulations jumped, active contacts, 10^7
  * events, bursts of 10^5, 4e9 evaluations, 64 scan divisions, automatic
  * LCP solver. */

@@ -4,9 +4,10 @@
  *
  * Measurements, in the reference units of the model (x = u / Le, tau = wp t):
  *   extremes   max |x|, max x, max -x per dof and max |x_k - x_k-1| per storey,
- *              at every step (Moreau–Jean: the discrete maximum) or, for the
- *              event-driven and penalty methods, also between their steps,
- *              where the velocity changes sign, on the quintic Hermite of
+ *              at every step (Moreau–Jean: the discrete maximum); the exact
+ *              row reference's own (exact, at its flights' turns); for
+ *              event-general and penalty also between their steps, where
+ *              the velocity changes sign, on the quintic Hermite of
  *              (x, x', x'') at the step ends;
  *   impacts    an impulse after none (Moreau–Jean: a step with P_a > 0 after a
  *              step without; event-driven: an impulse at an event; penalty: an
@@ -434,6 +435,7 @@ static int run_oscillator(const pd_scene *sc, const pd_osc *c, int mirrored,
     }
     res->steps = r.steps;
     res->accumulations = r.accumulations;
+    res->close_tol = NAN; /* one contact: nothing is simultaneous */
     res->lcp_solves = 0;
     res->kernel = r.kernel;
     res->factor = o->method == PD_METHOD_MOREAU ? "scalar" : "none";
@@ -491,6 +493,7 @@ static int run_event(const pd_scene_model *sm, const pd_run_opts *o, double tau_
         return rc;
     pd_piecewise_force F = {.b = sm->mass, .pieces = pieces, .npieces = npieces};
     eo.close_tol = o->close_tol;
+    eo.time_unit = 1.0 / tr->wp;
     eo.t_measure = tr->tau_measure;
     eo.h_out = tr->fn ? tr->h : 0.0;
     eo.below = tr->below;

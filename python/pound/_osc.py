@@ -310,9 +310,12 @@ def converge(dts, theta=(0.5,), methods=("moreau",), kcs=None, error="hist", sce
     try:
         rows, ref_cpu = _rows(meas, steps, dt_min, thetas, want_moreau, want_penalty, kcs,
                               error, want_general)
+        out = Result(rows=rows, cpu_s_ref=ref_cpu)
+        if scene is not None:
+            out.update(meas.summary())
     finally:
         meas.close()
-    return Result(rows=rows, cpu_s_ref=ref_cpu)
+    return out
 
 
 class _OscMeasurer:

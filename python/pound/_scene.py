@@ -298,6 +298,12 @@ def simulate_scene(path, history=True, every=1, **opts):
 
 # ---- compare and converge on a scene -------------------------------------------------------
 
+def ref_decisions(rr):
+    """The decisions the reference run rr rests on, as the CLI's keys."""
+    return dict(simultaneous_ref=rr.simultaneous, tol_closed_ref=rr.tol_closed,
+                accumulations_ref=rr.accumulations, close_tol=rr.close_tol)
+
+
 class SceneMeasurer:
     """The reference of a scene and the runs measured against it (the
     scene half of cli/cmd_converge.c's measurer)."""
@@ -336,6 +342,12 @@ class SceneMeasurer:
                         structures=[Result(name=s(sc.st[k].name), err_umax_rel=e.err_umax[k],
                                            err_hist_linf=e.err_hist[k])
                                     for k in range(sc.nstruct)])
+
+    def summary(self):
+        """The reference's impacts and decisions (converge --json)."""
+        sc = self.scene._sc
+        return dict(impacts_ref=sum(self.rr.impacts[a] for a in range(sc.ncontact)),
+                    **ref_decisions(self.rr))
 
     def close(self):
         if self.live:
@@ -389,7 +401,7 @@ def compare_scene(scene, want, kw):
         out = Result(method=f["method"], err_umax_rel=f["err_umax_rel"],
                      err_hist_linf=f["err_hist_linf"], impacts=f["impacts"],
                      impacts_ref=impacts_ref, cpu_s=f["cpu_s"], cpu_s_ref=M.rr.cpu_s,
-                     events_ref=M.rr.steps, dt=f["dt"])
+                     events_ref=M.rr.steps, **ref_decisions(M.rr), dt=f["dt"])
         for r in rows.values():
             del r["dt"]
         out["methods"] = [rows[m] for m in range(len(want)) if want[m]]
