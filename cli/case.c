@@ -274,13 +274,25 @@ static const char *period_flag(const pd_cli_case *a)
  * checked first so that a refusal names the flag the user typed. */
 #define CASE_MAX_RATIO 1e4 /* periods of a chain's neighbours, at most this far apart */
 
-/* The flag behind the step count tend / dt: the ones the user gave. */
+/* The flag behind a derived period out of range (T0 = Tp / Pi2, Tp + 2 T0):
+ * of Tp and the period flag given (--T0 or --Pi2), the one whose value is
+ * further from 1 on a log scale (1 s, or Pi2 = 1). */
+static const char *extreme_period_flag(const pd_cli_case *a)
+{
+    double other = a->have_T0 ? a->T0 : a->have_Pi2 ? a->c.Pi2 : 1.0;
+    if (!a->have_T0 && !a->have_Pi2)
+        return "--Tp";
+    return fabs(log(a->c.Tp)) > fabs(log(other)) ? "--Tp" : period_flag(a);
+}
+
+/* The flag behind the step count tend / dt: the ones the user gave, else
+ * the period that drives both (tend = Tp + 2 T0, dt = min(Tp, T0) / 2000). */
 static const char *steps_flag(const pd_cli_case *a)
 {
     const char *dt = a->dt_flag ? a->dt_flag : "--dt";
     if (a->have_dt && a->have_tend)
         return !strcmp(dt, "--dt") ? "--dt/--tend" : "--dt-per-Tp/--tend";
-    return a->have_tend ? "--tend" : a->have_dt ? dt : period_flag(a);
+    return a->have_tend ? "--tend" : a->have_dt ? dt : extreme_period_flag(a);
 }
 
 /* The flag behind Le = ap (Tp / 2 pi)^2: --scale of a record, else the
@@ -294,9 +306,9 @@ int pd_cli_case_check_derived(const pd_cli_case *a)
 {
     const pd_osc *c = &a->c;
     double T0 = pd_osc_T0(c), wp = pd_osc_wp(c), Le = pd_osc_Le(c), gap = pd_osc_gap(c);
-    if (!isfinite(T0) || !(T0 > 0.0) || !isfinite(PD_TWO_PI / T0))
-        return pd_cli_usage_error("%s: the oscillator's period T0 = Tp / Pi2 = %.3g s is out of "
-                                  "range", period_flag(a), T0);
+    if (!isfinite(T0) || !(T0 > 0.0) || !isfinite(PD_TWO_PI / T0) || !isfinite(c->Pi2))
+        return pd_cli_usage_error("%s: the oscillator's period T0 = Tp / Pi2 = %.3g s / %.3g is "
+                                  "out of range", extreme_period_flag(a), c->Tp, c->Pi2);
     if (!isfinite(wp) || !(Le > 0.0) || !isfinite(Le))
         return pd_cli_usage_error("%s: Le = ap (Tp / 2 pi)^2 = %.3g m is out of range",
                                   ap_flag(a), Le);
@@ -306,7 +318,7 @@ int pd_cli_case_check_derived(const pd_cli_case *a)
     double tend = a->have_tend ? a->opts.tend : pd_osc_default_tend(c);
     double dt = a->have_dt ? a->opts.dt : pd_osc_default_dt(c);
     if (!isfinite(tend))
-        return pd_cli_usage_error("%s: tend = Tp + 2 T0 overflows", period_flag(a));
+        return pd_cli_usage_error("%s: tend = Tp + 2 T0 overflows", extreme_period_flag(a));
     if (a->have_dt && !(dt < tend))
         return pd_cli_usage_error("%s: the step %.3g s is not shorter than the run (tend = "
                                   "%.3g s)", a->dt_flag ? a->dt_flag : "--dt", dt, tend);

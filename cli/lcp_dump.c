@@ -25,8 +25,15 @@
 #define DUMP_BLOCK (1L << 16) /* entries buffered per dataset */
 
 /* The solvers a dump names, by code. */
-static const char *const dump_solvers[] = {"lemke", "structured", "pgs",
-                                           "lemke (after structured)", "closed-form"};
+static const char *const dump_solvers[] = {"lemke",
+                                           "structured",
+                                           "pgs",
+                                           "lemke (after structured)",
+                                           "closed-form",
+                                           "structured (after lemke)",
+                                           "pgs (after lemke, structured)",
+                                           "pgs (after structured, lemke)",
+                                           "pgs (after structured)"};
 #define NSOLVERS (int)(sizeof dump_solvers / sizeof dump_solvers[0])
 
 /* One extendible dataset with its block buffer. */

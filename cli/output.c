@@ -48,6 +48,12 @@ void pd_output_signals(void)
     for (size_t k = 0; k < sizeof sigs / sizeof sigs[0]; k++)
         if (sigaction(sigs[k], NULL, &old) == 0 && old.sa_handler != SIG_IGN)
             sigaction(sigs[k], &sa, NULL);
+    /* a write past the file-size limit (ulimit -f) fails with EFBIG, which
+     * the writers report and clean up after, instead of killing pound with
+     * its temporary left behind */
+    struct sigaction ign = {.sa_handler = SIG_IGN};
+    sigemptyset(&ign.sa_mask);
+    sigaction(SIGXFSZ, &ign, NULL);
 }
 
 /* Register path for removal on a signal: its slot, or -1 when none is free. */
@@ -178,7 +184,14 @@ static void remove_stale(const char *real)
 int pd_output_check_writable(const char *flag, const char *path, pd_err *err)
 {
     char real[PD_PATH_MAX];
+    struct stat st;
     int e = follow_links(path, real, sizeof real);
+    if (!e && stat(real, &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode))
+        return pd_err_set(err, PD_EINVAL, "%s %s: not a regular file (%s): only a regular file "
+                                          "is replaced",
+                          flag, path, S_ISFIFO(st.st_mode) ? "a FIFO"
+                                      : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device"
+                                      : S_ISSOCK(st.st_mode) ? "a socket" : "not a file");
     if (!e)
         e = probe(real);
     return e ? pd_err_set(err, PD_EINVAL, "%s %s: %s", flag, path, strerror(e)) : PD_OK;

@@ -1,8 +1,10 @@
 /* matrix.c — matrix views and their products. */
+#include <limits.h>
 #include <math.h>
 #include <string.h>
 
 #include "pd_core.h"
+#include "pd_null.h"
 
 pd_matrix pd_matrix_zero(int rows, int cols)
 {
@@ -26,7 +28,7 @@ pd_matrix pd_matrix_csc(int rows, int cols, const int *colptr, const int *rowind
 }
 
 /* y += s A[:, j]. */
-void pd_matrix_col_axpy(const pd_matrix *A, int j, double s, double *y)
+static void col_axpy(const pd_matrix *A, int j, double s, double *y)
 {
     if (s == 0.0)
         return;
@@ -40,8 +42,15 @@ void pd_matrix_col_axpy(const pd_matrix *A, int j, double s, double *y)
     }
 }
 
+void pd_matrix_col_axpy(const pd_matrix *A, int j, double s, double *y)
+{
+    if (!A || !y)
+        return;
+    col_axpy(A, j, s, y);
+}
+
 /* A[:, j]^T x. */
-double pd_matrix_col_dot(const pd_matrix *A, int j, const double *x)
+static double col_dot(const pd_matrix *A, int j, const double *x)
 {
     double s = 0.0;
     if (A->kind == PD_MATRIX_DENSE) {
@@ -55,9 +64,18 @@ double pd_matrix_col_dot(const pd_matrix *A, int j, const double *x)
     return s;
 }
 
+double pd_matrix_col_dot(const pd_matrix *A, int j, const double *x)
+{
+    if (!A || !x)
+        return NAN;
+    return col_dot(A, j, x);
+}
+
 /* sum_i |A_ij| |x_i|. */
 double pd_matrix_col_absdot(const pd_matrix *A, int j, const double *x)
 {
+    if (!A || !x)
+        return NAN;
     double s = 0.0;
     if (A->kind == PD_MATRIX_DENSE) {
         const double *col = A->values + (size_t)j * A->rows;
@@ -73,23 +91,29 @@ double pd_matrix_col_absdot(const pd_matrix *A, int j, const double *x)
 /* y = alpha A x + beta y, column by column. */
 void pd_matrix_gemv(const pd_matrix *A, double alpha, const double *x, double beta, double *y)
 {
+    if (!A || !x || !y)
+        return;
     for (int i = 0; i < A->rows; i++)
         y[i] = beta == 0.0 ? 0.0 : beta * y[i];
     if (A->kind == PD_MATRIX_ZERO || alpha == 0.0)
         return;
     for (int j = 0; j < A->cols; j++)
-        pd_matrix_col_axpy(A, j, alpha * x[j], y);
+        col_axpy(A, j, alpha * x[j], y);
 }
 
 /* y_j = A[:, j]^T x. */
 void pd_matrix_gemv_t(const pd_matrix *A, const double *x, double *y)
 {
+    if (!A || !x || !y)
+        return;
     for (int j = 0; j < A->cols; j++)
-        y[j] = pd_matrix_col_dot(A, j, x);
+        y[j] = col_dot(A, j, x);
 }
 
 double pd_matrix_get(const pd_matrix *A, int i, int j)
 {
+    if (!A)
+        return NAN;
     if (A->kind == PD_MATRIX_DENSE)
         return A->values[i + (size_t)j * A->rows];
     if (A->kind == PD_MATRIX_CSC) /* row indices increase: binary search */
@@ -107,6 +131,8 @@ double pd_matrix_get(const pd_matrix *A, int i, int j)
 
 long pd_matrix_nnz(const pd_matrix *A)
 {
+    if (!A)
+        return 0;
     if (A->kind == PD_MATRIX_DENSE)
         return (long)A->rows * A->cols;
     if (A->kind == PD_MATRIX_CSC)
@@ -116,13 +142,17 @@ long pd_matrix_nnz(const pd_matrix *A)
 
 void pd_matrix_to_dense(const pd_matrix *A, double *out)
 {
+    if (!A || !out)
+        return;
     memset(out, 0, (size_t)A->rows * (size_t)A->cols * sizeof(double));
     for (int j = 0; j < A->cols; j++)
-        pd_matrix_col_axpy(A, j, 1.0, out + (size_t)j * A->rows);
+        col_axpy(A, j, 1.0, out + (size_t)j * A->rows);
 }
 
 int pd_matrix_is_diagonal(const pd_matrix *A)
 {
+    if (!A)
+        return 0;
     if (A->kind == PD_MATRIX_DENSE) {
         for (int j = 0; j < A->cols; j++)
             for (int i = 0; i < A->rows; i++)
@@ -155,6 +185,8 @@ static int csc_valid(const pd_matrix *A)
 
 int pd_matrix_check(const pd_matrix *A, int rows, int cols, const char *name, pd_err *err)
 {
+    if (!A || !name)
+        return PD_NULL_ARG(err, !A ? "A" : "name");
     if (A->kind == PD_MATRIX_ZERO)
         return A->rows == rows && A->cols == cols
                    ? PD_OK
@@ -175,22 +207,48 @@ int pd_matrix_check(const pd_matrix *A, int rows, int cols, const char *name, pd
     return PD_OK;
 }
 
-/* P A = L U by right-looking elimination with partial pivoting. */
+/* P A = L U by right-looking elimination with scaled partial pivoting.
+ * Each row has a scale 2^e, e the binary exponent of its largest entry in
+ * A (so the scale is that entry to within a factor 2, and exact to divide
+ * by).  The pivot of column k is the entry largest relative to the scale
+ * of its row, and A is singular (PD_ESINGULAR) when that pivot is not above
+ * rel_tol times the scale of its own row -- not of the largest entry of
+ * A: the iteration matrix of two structures of 1e12 and 1e-6 kg is
+ * regular, and scaling rows by powers of two changes nothing.  A zero row
+ * or a non-finite entry is singular.  The exponents of the rows not yet
+ * pivoted live in perm[k..n-1] (no workspace): step k moves the pivot
+ * row's out before it writes perm[k]. */
 int pd_dense_lu(int n, double *A, int lda, int *perm, double rel_tol)
 {
-    double amax = 0.0;
+    if (!A || !perm)
+        return PD_EINVAL;
+    for (int i = 0; i < n; i++)
+        perm[i] = INT_MIN;
     for (int j = 0; j < n; j++)
-        for (int i = 0; i < n; i++)
-            amax = fmax(amax, fabs(A[i + (size_t)j * lda]));
-    double tiny = rel_tol * amax;
+        for (int i = 0; i < n; i++) {
+            double a = A[i + (size_t)j * lda];
+            if (!isfinite(a))
+                return PD_ESINGULAR;
+            if (a != 0.0 && ilogb(a) > perm[i])
+                perm[i] = ilogb(a);
+        }
+    for (int i = 0; i < n; i++)
+        if (perm[i] == INT_MIN)
+            return PD_ESINGULAR;
     for (int k = 0; k < n; k++) {
-        double *colk = A + (size_t)k * lda;
+        double *colk = A + (size_t)k * lda, best = -1.0;
         int p = k;
-        for (int i = k + 1; i < n; i++)
-            if (fabs(colk[i]) > fabs(colk[p]))
+        for (int i = k; i < n; i++) {
+            double scaled = scalbn(fabs(colk[i]), -perm[i]);
+            if (scaled > best) {
+                best = scaled;
                 p = i;
+            }
+        }
+        int e = perm[p];
+        perm[p] = perm[k];
         perm[k] = p;
-        if (!(fabs(colk[p]) > tiny) || !isfinite(colk[p]))
+        if (!(fabs(colk[p]) > scalbn(rel_tol, e)) || !isfinite(colk[p]))
             return PD_ESINGULAR;
         if (p != k)
             for (int j = 0; j < n; j++) {
@@ -213,6 +271,8 @@ int pd_dense_lu(int n, double *A, int lda, int *perm, double rel_tol)
 /* x = U^-1 L^-1 P b, in place. */
 void pd_dense_lu_solve(int n, const double *LU, int lda, const int *perm, double *b)
 {
+    if (!LU || !perm || !b)
+        return;
     for (int k = 0; k < n; k++) {
         int p = perm[k];
         if (p != k) {

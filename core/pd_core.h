@@ -62,8 +62,9 @@ typedef struct pd_err {
 /* Short text for a status code ("out of memory", ...). */
 PD_API const char *pd_strerror(int status);
 
-/* Record status and a printf-style message in err (err may be NULL);
- * returns status so callers can write `return pd_err_set(err, ...)`. */
+/* Record status and a printf-style message in err (err may be NULL; fmt
+ * NULL: the message is pd_strerror(status)); returns status so callers can
+ * write `return pd_err_set(err, ...)`. */
 PD_API int pd_err_set(pd_err *err, int status, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
@@ -104,7 +105,7 @@ PD_API double pd_rand_pm1(uint64_t *state);
 
 /* The quintic Hermite interpolant on a step of length h through (f, f', f'')
  * = p0 at its start and p1 at its end: value *f and time rate *fd at the
- * fraction r in [0, 1] of the step. */
+ * fraction r in [0, 1] of the step (fd may be NULL: the value alone). */
 PD_API void pd_hermite5(const double p0[3], const double p1[3], double h, double r, double *f,
                         double *fd);
 
@@ -166,8 +167,9 @@ typedef struct pd_sparse {
 } pd_sparse;
 
 /* Assemble rows x cols from nt triplets (Ti[k], Tj[k], Tx[k]), summing
- * duplicates and dropping nothing (explicit zeros stay).  PD_ENOMEM or
- * PD_EINVAL (an index out of range); on failure sp is empty. */
+ * duplicates and dropping nothing (explicit zeros stay; Ti, Tj, Tx may be
+ * NULL when nt = 0).  PD_ENOMEM or PD_EINVAL (an index out of range); on
+ * failure sp is empty. */
 PD_API int pd_sparse_from_triplets(pd_sparse *sp, int rows, int cols, long nt, const int *Ti,
                                    const int *Tj, const double *Tx, pd_err *err);
 PD_API void pd_sparse_free(pd_sparse *sp);
@@ -176,7 +178,9 @@ PD_API pd_matrix pd_sparse_view(const pd_sparse *sp);
 /* ---- dense LU -------------------------------------------------------------- */
 
 /* P A = L U in place for the n x n column-major A (leading dimension lda),
- * partial pivoting; PD_ESINGULAR when a pivot is not above rel_tol max|A|. */
+ * scaled partial pivoting (each row scaled by the power of two nearest its
+ * largest entry); PD_ESINGULAR when a pivot is not above rel_tol times its
+ * own row's scale, when a row is zero or an entry not finite. */
 PD_API int pd_dense_lu(int n, double *A, int lda, int *perm, double rel_tol);
 
 /* Solve A x = b in place from the output of pd_dense_lu. */

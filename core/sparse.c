@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "pd_core.h"
+#include "pd_null.h"
 
 void pd_sparse_free(pd_sparse *sp)
 {
@@ -16,6 +17,8 @@ void pd_sparse_free(pd_sparse *sp)
 
 pd_matrix pd_sparse_view(const pd_sparse *sp)
 {
+    if (!sp)
+        return pd_matrix_zero(0, 0);
     return pd_matrix_csc(sp->rows, sp->cols, sp->colptr, sp->rowind, sp->values);
 }
 
@@ -56,7 +59,11 @@ int pd_sparse_from_triplets(pd_sparse *sp, int rows, int cols, long nt, const in
                             const int *Tj, const double *Tx, pd_err *err)
 {
     int *next = NULL;
+    if (!sp)
+        return PD_NULL_ARG(err, "sp");
     memset(sp, 0, sizeof *sp);
+    if (nt > 0 && (!Ti || !Tj || !Tx))
+        return PD_NULL_ARG(err, !Ti ? "Ti" : !Tj ? "Tj" : "Tx");
     if (rows < 0 || cols < 0 || nt < 0 || nt > 2147483647L)
         return pd_err_set(err, PD_EINVAL, "sparse: bad size %d x %d with %ld entries", rows,
                           cols, nt);

@@ -29,6 +29,8 @@ const char *pd_strerror(int status)
  * a message is one line of text whatever it quotes. */
 void pd_err_sanitize(char *msg)
 {
+    if (!msg)
+        return;
     for (; *msg; msg++)
         if ((unsigned char)*msg < 0x20 || *msg == 0x7f)
             *msg = '?';
@@ -36,7 +38,10 @@ void pd_err_sanitize(char *msg)
 
 int pd_err_set(pd_err *err, int status, const char *fmt, ...)
 {
-    if (err) {
+    if (err && !fmt) {
+        err->status = status;
+        snprintf(err->msg, sizeof err->msg, "%s", pd_strerror(status));
+    } else if (err) {
         va_list ap;
         err->status = status;
         va_start(ap, fmt);

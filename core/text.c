@@ -2,10 +2,14 @@
  * file beyond its cap or a line beyond PD_TEXT_LINE_MAX is refused where it
  * is read, so /dev/zero or an endless stream costs at most the cap. */
 #include "pd_core.h"
+#include "pd_null.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #define TEXT_CHUNK (64L << 10) /* first buffer of a whole-file read */
 
@@ -58,15 +62,34 @@ static int fault_read(const char *path, pd_text_at at, long line, pd_err *err)
 
 int pd_text_open(pd_text *t, const char *path, long max_bytes, pd_text_at at, pd_err *err)
 {
+    if (!t)
+        return PD_NULL_ARG(err, "t");
     *t = (pd_text){.path = path, .max_bytes = max_bytes, .at = at, .err = err};
     if (!path || max_bytes < 1)
         return pd_err_set(err, PD_EINVAL, "pd_text_open: no file or a cap of %ld bytes",
                           max_bytes);
+    /* without blocking: opening a FIFO for reading waits for a writer */
     errno = 0;
-    t->f = fopen(path, "rb");
-    if (!t->f)
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0)
         return pd_err_set(err, PD_EIO, "%s: cannot open: %s", path,
                           strerror(errno ? errno : EIO));
+    struct stat st;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        const char *what = S_ISFIFO(st.st_mode)  ? "a FIFO"
+                           : S_ISDIR(st.st_mode) ? "a directory"
+                           : S_ISCHR(st.st_mode) ? "a device"
+                           : S_ISSOCK(st.st_mode) ? "a socket"
+                                                  : "not a file";
+        close(fd);
+        return pd_err_set(err, PD_EINVAL, "%s: not a regular file (%s)", path, what);
+    }
+    int flags = fcntl(fd, F_GETFL);
+    if (flags < 0 || fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0 || !(t->f = fdopen(fd, "rb"))) {
+        int e = errno ? errno : EIO;
+        close(fd);
+        return pd_err_set(err, PD_EIO, "%s: cannot open: %s", path, strerror(e));
+    }
     return PD_OK;
 }
 
@@ -92,6 +115,8 @@ int pd_text_line(pd_text *t)
     char loc[300];
     size_t n = 0;
     int c;
+    if (!t || !t->f)
+        return PD_EINVAL;
     long line = t->lineno + 1;
     errno = 0;
     while ((c = getc_unlocked(t->f)) != EOF) {
@@ -123,6 +148,8 @@ int pd_text_line(pd_text *t)
 
 int pd_text_rewind(pd_text *t)
 {
+    if (!t || !t->f)
+        return PD_EINVAL;
     errno = 0;
     if (fseek(t->f, 0L, SEEK_SET) != 0)
         return pd_err_set(t->err, PD_EIO, "%s: cannot go back to its start to read it again: %s",
@@ -136,6 +163,8 @@ int pd_text_rewind(pd_text *t)
 
 void pd_text_close(pd_text *t)
 {
+    if (!t)
+        return;
     if (t->f)
         fclose(t->f);
     free(t->line);
@@ -182,6 +211,8 @@ int pd_text_read_all(const char *path, long max_bytes, pd_text_at at, char **tex
     char *buf = NULL;
     size_t n = 0, cap = 0;
     long line, col;
+    if (!text || !len)
+        return PD_NULL_ARG(err, !text ? "text" : "len");
     *text = NULL;
     *len = 0;
     int st = pd_text_open(&t, path, max_bytes, at, err);

@@ -209,8 +209,10 @@ static int check_opts(const pd_edg_opts *o, pd_err *err)
     if (!(o->h_out >= 0.0) || !isfinite(o->h_out))
         return pd_err_set(err, PD_EINVAL, "event-driven: h_out must be finite and >= 0 (got %g)",
                           o->h_out);
-    if (!(o->length_scale > 0.0) || !isfinite(o->length_scale))
-        return pd_err_set(err, PD_EINVAL, "event-driven: length_scale must be finite and > 0");
+    if (!(o->length_scale > 0.0) || !isfinite(o->length_scale) || !(o->time_unit > 0.0) ||
+        !isfinite(o->time_unit))
+        return pd_err_set(err, PD_EINVAL, "event-driven: length_scale and time_unit must be "
+                                          "finite and > 0");
     if (o->max_events < 1 || o->max_burst < 1)
         return pd_err_set(err, PD_EINVAL, "event-driven: budgets must be >= 1");
     return PD_OK;
@@ -225,6 +227,7 @@ pd_edg_opts pd_edg_default_opts(void)
                          .max_events = 1000000L,
                          .max_burst = 100000L,
                          .length_scale = 1.0,
+                         .time_unit = 1.0,
                          .on_step = NULL,
                          .on_step_ctx = NULL,
                          .factor = PD_FACTOR_AUTO,
@@ -285,8 +288,8 @@ static int set_fits(const edg *w, int k, double t, pd_err *err)
     if (k <= w->kmax)
         return PD_OK;
     return pd_err_set(err, PD_EBUDGET,
-                      "event-driven: %d contacts at zero gap at once at t = %.9g (at most %d)", k,
-                      t, w->kmax);
+                      "event-driven: %d contacts at zero gap at once at t = %.9g s (at most %d)", k,
+                      t * w->o.time_unit, w->kmax);
 }
 
 /* Index list of A from the flags inA, and the LU of D_AA. */
@@ -305,9 +308,9 @@ static int factor_set(edg *w, double t, pd_err *err)
     delassus(w, w->idxA, w->nA, w->Dlu);
     if (w->nA && pd_dense_lu(w->nA, w->Dlu, w->nA, w->Dperm, EDG_SINGULAR))
         return pd_err_set(err, PD_ESINGULAR,
-                          "event-driven: the %d contacts in persistent contact at t = %.9g (first: "
+                          "event-driven: the %d contacts in persistent contact at t = %.9g s (first: "
                           "contact %d) are redundant (D_AA singular)",
-                          w->nA, t, w->idxA[0]);
+                          w->nA, t * w->o.time_unit, w->idxA[0]);
     return PD_OK;
 }
 
@@ -392,8 +395,8 @@ static int probe(edg *w, double t, pd_err *err)
         return PD_OK;
     int s = gsl_odeiv2_step_apply(w->probe, w->ta, t - w->ta, w->yp, w->yerr, w->fa, NULL, &w->sys);
     if (s != GSL_SUCCESS)
-        return pd_err_set(err, PD_ENUMERICAL, "event-driven: re-integration to t = %.9g failed: %s",
-                          t, gsl_strerror(s));
+        return pd_err_set(err, PD_ENUMERICAL, "event-driven: re-integration to t = %.9g s failed: %s",
+                          t * w->o.time_unit, gsl_strerror(s));
     return PD_OK;
 }
 
@@ -462,8 +465,8 @@ static int step_once(edg *w, pd_err *err)
     if (s == GSL_SUCCESS)
         s = ode_rhs(w->t, w->y, w->fb, w);
     if (s != GSL_SUCCESS)
-        return pd_err_set(err, PD_ENONFINITE, "event-driven: integration failed at t = %.9g: %s",
-                          w->ta, gsl_strerror(s));
+        return pd_err_set(err, PD_ENONFINITE, "event-driven: integration failed at t = %.9g s: %s",
+                          w->ta * w->o.time_unit, gsl_strerror(s));
     if (w->t == w->seg_b && w->h < h_try) /* a step cut at the segment end says nothing */
         w->h = h_try;
     w->tb = w->t;
@@ -849,14 +852,14 @@ static int count_event(edg *w, double t, const char *what, int c, pd_err *err)
     w->last_event = t;
     if (w->same_instant > EDG_STUCK)
         return pd_err_set(err, PD_EBUDGET,
-                          "event-driven: no progress at t = %.9g: %ld events at one instant "
+                          "event-driven: no progress at t = %.9g s: %ld events at one instant "
                           "(last: %s of contact %d)",
-                          t, w->same_instant, what, c);
+                          t * w->o.time_unit, w->same_instant, what, c);
     if (++w->res->events > w->o.max_events)
         return pd_err_set(err, PD_EBUDGET,
-                          "event-driven: %ld events by t = %.9g (budget exhausted; last: %s of "
+                          "event-driven: %ld events by t = %.9g s (budget exhausted; last: %s of "
                           "contact %d)",
-                          w->res->events - 1, t, what, c);
+                          w->res->events - 1, t * w->o.time_unit, what, c);
     return PD_OK;
 }
 
@@ -900,8 +903,8 @@ static int impact(edg *w, double t, int nI, pd_err *err)
     if (rc)
         return pd_err_set(err, rc,
                           "event-driven: impact LCP over %d contact(s) (first: contact %d) not "
-                          "solved at t = %.9g: %s",
-                          nI, w->idx[0], t, pd_lcp_outcome_name(info.outcome));
+                          "solved at t = %.9g s: %s",
+                          nI, w->idx[0], t * w->o.time_unit, pd_lcp_outcome_name(info.outcome));
     for (int r = 0; r < nI; r++) {
         w->P[w->idx[r]] = w->zsub[r];
         add_minv_w(w, w->idx[r], w->zsub[r], w->y + w->n);
@@ -927,9 +930,9 @@ static int count_impacts(edg *w, double t, int nI, pd_err *err)
         w->Uprev[a] = speed;
         if (w->burst[a] > w->o.max_burst)
             return pd_err_set(err, PD_EBUDGET,
-                              "event-driven: accumulation of impacts of contact %d at t = %.9g: "
+                              "event-driven: accumulation of impacts of contact %d at t = %.9g s: "
                               "%ld impacts without reaching persistent contact%s",
-                              a, t, w->burst[a] - 1,
+                              a, t * w->o.time_unit, w->burst[a] - 1,
                               w->o.no_accumulation ? " (accumulation handling is off)" : "");
     }
     return PD_OK;
@@ -993,8 +996,8 @@ static int decide(edg *w, double t, int nJ, pd_err *err)
         if (rc)
             return pd_err_set(err, rc,
                               "event-driven: contact-force LCP over %d contact(s) (first: contact "
-                              "%d) not solved at t = %.9g: %s",
-                              nJ, w->idx[0], t, pd_lcp_outcome_name(info.outcome));
+                              "%d) not solved at t = %.9g s: %s",
+                              nJ, w->idx[0], t * w->o.time_unit, pd_lcp_outcome_name(info.outcome));
         for (int r = 0; r < nJ; r++)
             w->flag[w->idx[r]] = w->zsub[r] > 0.0;
     }

@@ -37,6 +37,7 @@
 #include <string.h>
 
 #include "edr.h"
+#include "pd_null.h"
 
 /* Bounce heights below this times the length scale are jumped (as the
  * one-wall reference). */
@@ -1850,7 +1851,11 @@ pd_edr *pd_edr_alloc(const pd_model *md, const pd_piecewise_force *F, const pd_e
     pd_edr_opts o = opts ? *opts : pd_edr_default_opts();
     int rc;
     pd_err_clear(err);
-    if (!md || !F || !F->b || !F->pieces || F->npieces < 1) {
+    if (!md || !F) {
+        PD_NULL_ARG(err, !md ? "model" : "force");
+        return NULL;
+    }
+    if (!F->b || !F->pieces || F->npieces < 1) {
         pd_err_set(err, PD_EINVAL, "row reference: a model and a piecewise force are needed");
         return NULL;
     }
@@ -2182,7 +2187,7 @@ int pd_edr_run(pd_edr *r, double t0, const double *q0, const double *v0, double 
     int rc;
     pd_err_clear(err);
     if (!r)
-        return pd_err_set(err, PD_EINVAL, "row reference: no object");
+        return PD_NULL_ARG(err, "r");
     if (!isfinite(t0) || !(t1 > t0) || !isfinite(t1))
         return pd_err_set(err, PD_EINVAL, "row reference: need t0 < t1, both finite");
     for (int i = 0; q0 && i < r->n; i++)
@@ -2255,6 +2260,8 @@ out:
 
 const pd_edr_result *pd_edr_result_of(const pd_edr *r)
 {
+    if (!r)
+        return NULL;
     pd_edr_result *res = (pd_edr_result *)&r->res;
     res->xpos = r->xpos;
     res->xneg = r->xneg;

@@ -20,6 +20,7 @@
 
 #include "pd_core.h"
 #include "pd_engine.h"
+#include "pd_null.h"
 
 /* The velocity may turn twice inside a scan interval only when it is
  * within this many |acceleration| * h of zero at an end (2: twice what a
@@ -559,7 +560,12 @@ int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opt
 {
     ed_run ed;
     int rc, j = 0, resting = 0;
+    pd_ed_opts defaults = pd_ed_default_opts();
     pd_err_clear(err);
+    if (!prob || !res)
+        return PD_NULL_ARG(err, !prob ? "prob" : "res");
+    if (!opts)
+        opts = &defaults;
     memset(res, 0, sizeof *res);
     res->first_impact = res->first_impact_velocity = NAN;
     res->max_impact_velocity = 0.0;

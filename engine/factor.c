@@ -20,11 +20,13 @@ const char *pd_factor_kind_name(pd_factor_kind kind)
 
 int pd_factor_kind_parse(const char *name, pd_factor_kind *kind)
 {
-    if (name && !strcmp(name, "auto")) {
+    if (!name || !kind)
+        return PD_EINVAL;
+    if (!strcmp(name, "auto")) {
         *kind = PD_FACTOR_AUTO;
         return PD_OK;
     }
-    for (size_t k = 0; name && k < sizeof factor_types / sizeof factor_types[0]; k++)
+    for (size_t k = 0; k < sizeof factor_types / sizeof factor_types[0]; k++)
         if (!strcmp(name, factor_types[k]->name)) {
             *kind = factor_types[k]->kind;
             return PD_OK;
@@ -36,6 +38,8 @@ int pd_factor_kind_parse(const char *name, pd_factor_kind *kind)
  * dense for small or dense models, sparse Cholesky for the rest. */
 pd_factor_kind pd_factor_choose(const pd_model *model, pd_factor_kind requested)
 {
+    if (!model)
+        return PD_FACTOR_AUTO;
     if (requested != PD_FACTOR_AUTO)
         return requested;
     if (model->n == 1)

@@ -13,6 +13,7 @@
 
 #include "mj1.h"
 #include "pd_engine.h"
+#include "pd_null.h"
 
 #define MJB_LANES_STEP pd_mjb_lanes_step_base
 #include "mj_batch_lanes.h"
@@ -43,6 +44,8 @@ int pd_mjb_init(pd_mjb *b, const pd_mj_opts *opts, pd_mjb_force force, void *for
     pd_mj_opts o = opts ? *opts : pd_mj_default_opts();
     int rc;
     pd_err_clear(err);
+    if (!b)
+        return PD_NULL_ARG(err, "b");
     o.h = 1.0; /* the lanes have their own */
     if ((rc = pd_mj_check_opts(&o, err)))
         return rc;
@@ -105,6 +108,8 @@ static void next_event(pd_mjb *b)
 int pd_mjb_set_lane(pd_mjb *b, int l, const pd_mjb_lane *ln, pd_err *err)
 {
     int rc;
+    if (!b || !ln)
+        return PD_NULL_ARG(err, !b ? "b" : "ln");
     if ((rc = check_lane(ln, l, err)))
         return rc;
     mj1_coef one = mj1_coef_make(ln->M, ln->C, ln->K, ln->wall, ln->W, ln->g0, ln->e, ln->h,
@@ -167,6 +172,8 @@ static void breakpoints(pd_mjb *b)
 
 void pd_mjb_run(pd_mjb *b, long nsteps, pd_mjb_observer observer, void *ctx)
 {
+    if (!b)
+        return;
     for (long n = 0; n < nsteps; n++) {
         step_clocks(b);
         if (b->force)
@@ -186,5 +193,5 @@ void pd_mjb_run(pd_mjb *b, long nsteps, pd_mjb_observer observer, void *ctx)
  * and v through sums and products, so the state now tells. */
 int pd_mjb_finite(const pd_mjb *b, int l)
 {
-    return l >= 0 && l < PD_MJB_LANES && isfinite(b->q[l]) && isfinite(b->v[l]);
+    return b && l >= 0 && l < PD_MJB_LANES && isfinite(b->q[l]) && isfinite(b->v[l]);
 }

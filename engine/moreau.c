@@ -16,6 +16,7 @@
 
 #include "pd_engine.h"
 #include "pd_factor.h"
+#include "pd_null.h"
 #include "mj1.h"
 
 
@@ -210,6 +211,8 @@ static void gaps(const pd_model *md, const double *q, double *g)
 
 int pd_mj_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_err *err)
 {
+    if (!mj)
+        return PD_NULL_ARG(err, "mj");
     const pd_model *md = mj->model;
     int n = md->n;
     for (int i = 0; i < n; i++) {
@@ -414,19 +417,28 @@ static int step_general(pd_mj *mj, pd_err *err)
     return check_finite(mj, err);
 }
 
-int pd_mj_step(pd_mj *mj, pd_err *err)
+static int mj_step(pd_mj *mj, pd_err *err)
 {
     return mj->scalar ? step_scalar(mj, err) : step_general(mj, err);
+}
+
+int pd_mj_step(pd_mj *mj, pd_err *err)
+{
+    if (!mj)
+        return PD_NULL_ARG(err, "mj");
+    return mj_step(mj, err);
 }
 
 int pd_mj_run(pd_mj *mj, long nsteps, pd_observer observer, void *ctx, pd_err *err)
 {
     int rc;
+    if (!mj)
+        return PD_NULL_ARG(err, "mj");
     if (observer && observer(&mj->st, ctx) > 0)
         return PD_OK;
     mj->stop = 0;
     for (long k = 0; k < nsteps && !mj->stop; k++) {
-        if ((rc = pd_mj_step(mj, err)))
+        if ((rc = mj_step(mj, err)))
             return rc;
         if (observer && observer(&mj->st, ctx) > 0)
             break;
@@ -436,15 +448,19 @@ int pd_mj_run(pd_mj *mj, long nsteps, pd_observer observer, void *ctx, pd_err *e
 
 const pd_state *pd_mj_state(const pd_mj *mj)
 {
-    return &mj->st;
+    return mj ? &mj->st : NULL;
 }
 
 const char *pd_mj_kernel_name(const pd_mj *mj)
 {
+    if (!mj)
+        return "(none)";
     return mj->scalar ? "scalar" : "general";
 }
 
 const char *pd_mj_factor_name(const pd_mj *mj)
 {
+    if (!mj)
+        return "(none)";
     return mj->factor->type->name;
 }

@@ -65,7 +65,8 @@ typedef struct pd_model {
 PD_API int pd_model_check(const pd_model *model, pd_err *err);
 
 /* The kind the automatic choice gives this model (never PD_FACTOR_AUTO):
- * requested itself unless it is PD_FACTOR_AUTO. */
+ * requested itself unless it is PD_FACTOR_AUTO.  A NULL model gives
+ * PD_FACTOR_AUTO. */
 PD_API pd_factor_kind pd_factor_choose(const pd_model *model, pd_factor_kind requested);
 
 /* ---- state and observers ---------------------------------------------- */
@@ -211,8 +212,9 @@ struct pd_mjb {
 };
 
 /* Set theta, gamma (opts as pd_mj's: theta, gamma, allow_unstable; h and
- * the kernel, factor and LCP fields are not used) and the force (NULL:
- * none); every lane idle (a unit mass at rest, no contact, h = 1). */
+ * the kernel, factor and LCP fields are not used; opts NULL: the defaults)
+ * and the force (NULL: none); every lane idle (a unit mass at rest, no
+ * contact, h = 1). */
 PD_API int pd_mjb_init(pd_mjb *b, const pd_mj_opts *opts, pd_mjb_force force, void *force_ctx,
                        pd_err *err);
 
@@ -246,6 +248,7 @@ typedef struct pd_edg_opts {
     long max_burst;         /* impacts of one accumulation before giving up, >= 1 */
     double length_scale;    /* accumulation jumped once the bounce height is below
                                1e-10 * length_scale (> 0), as in pd_ed_opts */
+    double time_unit;       /* > 0: the model's unit of time in seconds, for messages */
     pd_observer on_step;    /* optional: the state with its accelerations at t0, at the
                                end of every accepted step, just before every event and
                                just after it (same t), whatever h_out */
@@ -264,9 +267,10 @@ typedef struct pd_edg_result {
     double contact_time;    /* summed over contacts: time spent in persistent contact */
 } pd_edg_result;
 
-/* Run the model from (t0, q0, v0) (NULL = zeros) to t1.  The observer gets
- * pd_state: P holds the impulses of an impact at that instant (zero
- * otherwise), active flags the contacts in persistent contact. */
+/* Run the model from (t0, q0, v0) (NULL = zeros) to t1 (opts NULL: the
+ * defaults).  The observer gets pd_state: P holds the impulses of an impact
+ * at that instant (zero otherwise), active flags the contacts in persistent
+ * contact. */
 PD_API int pd_edg_run(const pd_model *model, double t0, const double *q0, const double *v0,
                       double t1, const pd_edg_opts *opts, pd_observer observer, void *ctx,
                       pd_edg_result *res, pd_err *err);
@@ -290,6 +294,7 @@ typedef struct pd_penalty_opts {
     const char *stepper; /* GSL stepper: "rk8pd", "rkf45", "rk4imp", "msbdf" */
     double h_out;        /* > 0: the observer is called every h_out (and at t1) */
     long max_steps;      /* budget of accepted steps >= 1 */
+    double time_unit;    /* > 0: the model's unit of time in seconds, for messages */
     pd_observer on_step; /* optional: called at t0 and after every accepted step
                             whatever h_out (measurements next to the outputs) */
     void *on_step_ctx;
@@ -297,7 +302,9 @@ typedef struct pd_penalty_opts {
 } pd_penalty_opts;
 
 /* Kelvin-Voigt, kc = 0 (must be set), rtol 1e-10, atol 1e-12, rk8pd,
- * h_out 0, 10^8 steps, no on_step, automatic factor. */
+ * h_out 0, 10^8 steps, time unit 1 s, no on_step, automatic factor.  A run
+ * whose steps stop advancing (elements switching at one instant: 1000
+ * steps in a row advancing t by less than 1e-12 of it) ends PD_ENUMERICAL. */
 PD_API pd_penalty_opts pd_penalty_default_opts(void);
 
 typedef struct pd_penalty_result {
@@ -309,7 +316,8 @@ typedef struct pd_penalty_result {
     const char *stepper; /* canonical GSL stepper name (static string) */
 } pd_penalty_result;
 
-/* Integrate the model from (t0, q0, v0) to t1 (NULL = zeros).  The observer
+/* Integrate the model from (t0, q0, v0) to t1 (NULL = zeros; opts NULL: the
+ * defaults).  The observer
  * gets a pd_state at t0, at every t0 + k h_out and at t1; in it P holds the
  * contact forces lambda at that instant (not impulses) and active the
  * engaged elements.  Output states are integrated (to the tolerances) from
@@ -483,7 +491,8 @@ typedef struct pd_edr pd_edr;
 
 /* Check the model (M diagonal and positive, every contact joining at most
  * two structures), find its structures and allocate every workspace.  The
- * model and force must outlive the object.  NULL on failure (err says why). */
+ * model and force (both required) must outlive the object; opts NULL: the
+ * defaults.  NULL on failure (err says why). */
 PD_API pd_edr *pd_edr_alloc(const pd_model *model, const pd_piecewise_force *force,
                             const pd_edr_opts *opts, pd_err *err);
 PD_API void pd_edr_free(pd_edr *r);
@@ -551,8 +560,9 @@ typedef struct pd_ed_result {
 /* Called on the output grid with the exact state; return > 0 to stop. */
 typedef int (*pd_ed_sampler)(double t, double x, double v, int in_contact, void *ctx);
 
-/* Run from (x0, v0) at pieces[0].t_start to opts->t_end.  PD_EBUDGET when an
- * event budget is exhausted (message names the time and the count). */
+/* Run from (x0, v0) at pieces[0].t_start to opts->t_end (opts NULL: the
+ * defaults, t_end 0).  PD_EBUDGET when an event budget is exhausted (message
+ * names the time and the count). */
 PD_API int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opts *opts,
                           pd_ed_sampler sampler, void *ctx, pd_ed_result *res, pd_err *err);
 

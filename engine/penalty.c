@@ -48,7 +48,11 @@ static const pen_stepper pen_steppers[] = {
 };
 
 /* One run: the model, the engaged set, GSL objects and workspaces. */
-#define PEN_MAX_STALL 1000 /* steps in a row that may end where they began */
+#define PEN_MAX_STALL 1000 /* steps in a row that may end (nearly) where they began */
+/* A step advancing t by less than this (relative to max(|t|, 1)) does not
+ * count as progress: elements switching at one instant cut steps a few
+ * doubles long, which would otherwise crawl on for hours. */
+#define PEN_STALL_REL 1e-12
 
 typedef struct pen {
     const pd_model *md;
@@ -75,7 +79,7 @@ typedef struct pen {
     double t_out0;         /* t0 (outputs at t0 + k h_out) */
     long next_out;         /* k of the next output */
     int stopped;           /* an observer asked to stop */
-    long stalled;          /* consecutive steps that did not advance t */
+    long stalled;          /* consecutive steps that did not advance t (PEN_STALL_REL) */
     pd_state st;
     pd_penalty_result res;
 } pen;
@@ -114,6 +118,8 @@ static int check_opts(pen *p, double t0, double t1, pd_err *err)
         return pd_err_set(err, PD_EINVAL, "penalty: h_out must be >= 0 (got %g)", o->h_out);
     if (o->max_steps < 1)
         return pd_err_set(err, PD_EINVAL, "penalty: max_steps must be >= 1");
+    if (!(o->time_unit > 0.0) || !isfinite(o->time_unit))
+        return pd_err_set(err, PD_EINVAL, "penalty: time_unit must be > 0 (got %g)", o->time_unit);
     if (!isfinite(t0) || !isfinite(t1) || t1 < t0)
         return pd_err_set(err, PD_EINVAL, "penalty: need finite t0 <= t1 (got %g, %g)", t0, t1);
     return PD_OK;
@@ -128,6 +134,7 @@ pd_penalty_opts pd_penalty_default_opts(void)
                              .stepper = "rk8pd",
                              .h_out = 0.0,
                              .max_steps = 100000000L,
+                             .time_unit = 1.0,
                              .on_step = NULL,
                              .on_step_ctx = NULL,
                              .factor = PD_FACTOR_AUTO};
@@ -393,18 +400,22 @@ static int alloc_drivers(pen *p, double span, pd_err *err)
     return PD_OK;
 }
 
+/* Model time t in seconds, for messages. */
+static double seconds(const pen *p, double t) { return t * p->o.time_unit; }
+
 /* Map a GSL failure at time t to a pd status with a message. */
 static int gsl_failure(const pen *p, int status, double t, pd_err *err)
 {
     if (status == GSL_ERANGE)
         return pd_err_set(err, PD_ENONFINITE,
-                          "penalty: non-finite state or force at t = %.9g (step size %s cannot "
+                          "penalty: non-finite state or force at t = %.9g s (step size %s cannot "
                           "resolve the contact)",
-                          t, p->stp->name);
+                          seconds(p, t), p->stp->name);
     if (status == GSL_ENOMEM)
-        return pd_err_set(err, PD_ENOMEM, "penalty: GSL ran out of memory at t = %.9g", t);
-    return pd_err_set(err, PD_ENUMERICAL, "penalty: GSL stepper %s failed at t = %.9g: %s",
-                      p->stp->name, t, gsl_strerror(status));
+        return pd_err_set(err, PD_ENOMEM, "penalty: GSL ran out of memory at t = %.9g s",
+                          seconds(p, t));
+    return pd_err_set(err, PD_ENUMERICAL, "penalty: GSL stepper %s failed at t = %.9g s: %s",
+                      p->stp->name, seconds(p, t), gsl_strerror(status));
 }
 
 /* One GSL evolve step from (*t, y) toward tb.  A trial that overflows (the
@@ -769,8 +780,8 @@ static int one_step(pen *p, double *t, double tb, double *h, pd_err *err)
     int which, rc;
     if (p->res.steps >= p->o.max_steps)
         return pd_err_set(err, PD_EBUDGET,
-                          "penalty: budget of %ld accepted steps exhausted at t = %.9g",
-                          p->o.max_steps, ta);
+                          "penalty: budget of %ld accepted steps exhausted at t = %.9g s",
+                          p->o.max_steps, seconds(p, ta));
     mark_start(p);
     if ((rc = evolve_once(p, d, t, tb, h, p->y, err)))
         return rc;
@@ -778,11 +789,12 @@ static int one_step(pen *p, double *t, double tb, double *h, pd_err *err)
     if ((rc = earliest_crossing(p, ta, t, &which, err)) ||
         (rc = outputs_inside(p, ta, *t, err)))
         return rc;
-    p->stalled = *t > ta ? 0 : p->stalled + 1;
+    p->stalled = *t - ta > PEN_STALL_REL * fmax(fabs(ta), 1.0) ? 0 : p->stalled + 1;
     if (p->stalled > PEN_MAX_STALL) /* switching back and forth at one instant */
-        return pd_err_set(err, PD_ENUMERICAL, "penalty: no progress at t = %.9g after %d steps "
-                          "(rtol = %g, atol = %g: tighter tolerances resolve the contact)",
-                          ta, PEN_MAX_STALL, p->o.rtol, p->o.atol);
+        return pd_err_set(err, PD_ENUMERICAL, "penalty: no progress at t = %.9g s after %d steps "
+                          "(elements switching at one instant; rtol = %g, atol = %g: tighter "
+                          "tolerances or a softer contact may resolve it, Moreau-Jean runs it)",
+                          seconds(p, ta), PEN_MAX_STALL, p->o.rtol, p->o.atol);
     track_extremes(p, ta, *t - ta);
     if (which >= 0) {
         apply_switches(p, which);

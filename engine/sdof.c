@@ -166,6 +166,8 @@ static void ramp_increment(const pd_sdof *osc, double f0, double c1, double u0, 
 
 double pd_sine_piece_force(const pd_sine_piece *pc, double t)
 {
+    if (!pc)
+        return NAN;
     double lin = pc->c0 + pc->c1 * (t - pc->t_start);
     return pc->A == 0.0 ? lin : pc->A * sin(pc->w * t + pc->phi) + lin;
 }
@@ -173,6 +175,8 @@ double pd_sine_piece_force(const pd_sine_piece *pc, double t)
 void pd_sdof_increment_piece(const pd_sdof *osc, const pd_sine_piece *pc, double t0, double u0,
                              double v0, double t1, double *du, double *v1)
 {
+    if (!osc || !pc || !du || !v1)
+        return;
     double f0 = pc->c0 + pc->c1 * (t0 - pc->t_start);
     if (pc->A == 0.0) {
         ramp_increment(osc, f0, pc->c1, u0, v0, t1 - t0, du, v1);
@@ -192,6 +196,8 @@ void pd_sdof_increment_piece(const pd_sdof *osc, const pd_sine_piece *pc, double
 void pd_sdof_advance_piece(const pd_sdof *osc, const pd_sine_piece *pc, double t0, double u0,
                            double v0, double t1, double *u1, double *v1)
 {
+    if (!osc || !pc || !u1 || !v1)
+        return;
     double du;
     pd_sdof_increment_piece(osc, pc, t0, u0, v0, t1, &du, v1);
     *u1 = u0 + du;
@@ -200,6 +206,8 @@ void pd_sdof_advance_piece(const pd_sdof *osc, const pd_sine_piece *pc, double t
 void pd_sdof_flow_init(pd_sdof_flow *f, const pd_sdof *osc, const pd_sine_piece *pc, double t0,
                        double u0, double v0)
 {
+    if (!f || !osc || !pc)
+        return;
     const pd_sine_piece *p = pc;
     double w0 = osc->w0, w = p->w, re = w0 * w0 - w * w, im = 2.0 * osc->xi * w0 * w;
     double den = re * re + im * im;
@@ -236,6 +244,8 @@ void pd_sdof_flow_init(pd_sdof_flow *f, const pd_sdof *osc, const pd_sine_piece 
 
 void pd_sdof_flow_at(const pd_sdof_flow *f, double t1, double *du, double *v1)
 {
+    if (!f || !du || !v1)
+        return;
     if (!f->fast) {
         pd_sdof_increment_piece(&f->osc, &f->pc, f->t0, f->u0, f->v0, t1, du, v1);
         return;
@@ -280,6 +290,8 @@ void pd_sdof_flow_at(const pd_sdof_flow *f, double t1, double *du, double *v1)
 void pd_sdof_increment(const pd_sdof *osc, double A, double w, double phi, double t0, double u0,
                        double v0, double t1, double *du, double *v1)
 {
+    if (!osc || !du || !v1)
+        return;
     pd_sine_piece pc = {.t_start = t0, .A = A, .w = w, .phi = phi};
     pd_sdof_increment_piece(osc, &pc, t0, u0, v0, t1, du, v1);
 }
@@ -288,6 +300,8 @@ void pd_sdof_increment(const pd_sdof *osc, double A, double w, double phi, doubl
 void pd_sdof_advance(const pd_sdof *osc, double A, double w, double phi, double t0, double u0,
                      double v0, double t1, double *u1, double *v1)
 {
+    if (!osc || !u1 || !v1)
+        return;
     double du;
     pd_sdof_increment(osc, A, w, phi, t0, u0, v0, t1, &du, v1);
     *u1 = u0 + du;

@@ -25,6 +25,7 @@
 #define LEMKE_FINAL_REFINES 2     /* at most this many refinements of x_B at the end */
 #define LEMKE_NMAX_LIMIT 46340    /* n*n must fit an int */
 #define LEMKE_SINGULAR_TOL 1e-14  /* relative pivot floor of the final polish */
+#define LEMKE_REPAIR_ROUNDS 8     /* principal solves of the final repair at most */
 
 enum { RATIO_RAY = -1, RATIO_NUMERICAL = -2 };
 
@@ -32,14 +33,14 @@ struct pd_lcp_work {
     int nmax;
     double *binv;    /* B^-1, n x n column-major with leading dimension n */
     double *xb;      /* x_B: value of the variable basic in each row */
-    double *col;     /* entering column B^-1 a */
+    double *col;     /* entering column B^-1 a; the answer kept while repairing */
     double *cover;   /* covering vector d of the current solve */
     double *scratch; /* refinement residual, polish right-hand side */
     double *rows;    /* row sizes of the verification */
     int *basis;      /* variable basic in each row */
     int *row_of;     /* row of each variable (2 nmax + 1 of them), -1 if nonbasic */
-    int *ties;       /* rows tied in the ratio test; support of the polish */
-    int *perm;       /* row interchanges of the polish */
+    int *ties;       /* rows tied in the ratio test; support of the polish, the repair */
+    int *perm;       /* row interchanges of the polish, the repair */
 };
 
 /* Everything one solve reads: data, options, workspace. */
@@ -215,7 +216,13 @@ static void start_basis(const lemke_state *st)
 }
 
 /* z0 enters at t = max_i -q_i/d_i; among rows tied within tol the
- * lexicographic rule (B^-1 = I) picks the largest index. */
+ * lexicographic rule (B^-1 = I) picks the largest index.  A row ties when
+ * its -q_i/d_i is within tol t of t (t > 0: some q_i < 0), not within tol
+ * max|q|: z0 is then at least (1 - tol) t, so every w_i = q_i + d_i z0 left
+ * basic is >= -tol |q_i|, within the rounding of its own row.  At the scale
+ * of max|q| a row with q_i = 0 tied with one with q_i = -2e-16 (a zero
+ * relative velocity's rounding, the only term of its row) and left that
+ * w_i < 0 behind, a violation the verification counts in full (issue 19). */
 static int first_leaving_row(const lemke_state *st)
 {
     int n = st->n, best = 0;
@@ -227,9 +234,8 @@ static int first_leaving_row(const lemke_state *st)
             best = i;
         }
     }
-    double slack = st->tol * st->qmax;
     for (int i = n - 1; i > best; i--)
-        if (st->q[i] + st->d[i] * tmax <= slack)
+        if (-st->q[i] / st->d[i] >= tmax - st->tol * tmax)
             return i;
     return best;
 }
@@ -308,9 +314,33 @@ static int lex_choice(const lemke_state *st, int nties)
     return best;
 }
 
+/* The size of the terms that make x_B[i] = (B^-1 q)_i, sum_c |B^-1[i,c] q_c|
+ * (the unit column of a w_c basic in row i gives |q_c|): the scale of
+ * x_B[i]'s rounding. */
+static double row_scale(const lemke_state *st, int i)
+{
+    int n = st->n;
+    const pd_lcp_work *ws = st->ws;
+    double s = 0.0;
+    for (int c = 0; c < n; c++) {
+        int r = ws->row_of[c];
+        if (r < 0)
+            s += fabs(ws->binv[i + (size_t)c * n] * st->q[c]);
+        else if (r == i)
+            s += fabs(st->q[c]);
+    }
+    return s;
+}
+
 /* The blocking row among col_i > ptol: theta = min max(x_i, 0)/col_i; rows whose
- * x_i - theta col_i is within tol*xscale of zero tie; z0 leaves if it ties,
- * else the lexicographic rule decides.  -1 if no entry exceeds ptol. */
+ * x_i - theta col_i is zero to within their rounding tie -- within tol*xscale,
+ * and within tol times the terms it is made of (row_scale + theta col_i);
+ * z0 leaves if it ties, else the lexicographic rule decides.  -1 if no entry
+ * exceeds ptol.  The second bound keeps a row whose terms are all tiny (a
+ * q_i of rounding size next to q_j of order one) from tying at the scale
+ * of the others: z0 would leave with that row's x_i - theta_z0 col_i < 0
+ * left behind, all of its own size, a violation the verification counts in
+ * full (issue 19). */
 LEMKE_INLINE int blocking_row(const lemke_state *st, double ptol)
 {
     int n = st->n;
@@ -330,9 +360,13 @@ LEMKE_INLINE int blocking_row(const lemke_state *st, double ptol)
         return -1;
     double slack = st->tol * xscale;
     int nties = 0, z0row = ws->row_of[2 * n];
-    for (int i = 0; i < n; i++)
-        if (col[i] > ptol && max2(xb[i], 0.0) - theta * col[i] <= slack)
+    for (int i = 0; i < n; i++) {
+        double gap = max2(xb[i], 0.0) - theta * col[i];
+        if (col[i] > ptol &&
+            (gap <= 0.0 ||
+             (gap <= slack && gap <= st->tol * (row_scale(st, i) + theta * col[i]))))
             ws->ties[nties++] = i;
+    }
     if (nties <= 1)
         return argmin;
     for (int k = 0; k < nties; k++)
@@ -443,15 +477,13 @@ static int verify(const lemke_state *st, const double *z, double *w, pd_lcp_info
     return info->residual <= LEMKE_VERIFY_TOL;
 }
 
-/* Recompute the final basic solution directly: M_SS z_S = -q_S on the support
- * S of the final basis, by Gaussian elimination (overwrites B^-1). */
-static int polish(const lemke_state *st, double *z)
+/* z_S = -M_SS^-1 q_S on the support S of k indices in ws->ties, z = 0 off
+ * S, roundoff negatives cleared, by Gaussian elimination (overwrites B^-1);
+ * -1 if M_SS is singular. */
+static int support_solve(const lemke_state *st, int k, double *z)
 {
-    int n = st->n, k = 0;
+    int n = st->n;
     pd_lcp_work *ws = st->ws;
-    for (int j = 0; j < n; j++)
-        if (ws->row_of[n + j] >= 0)
-            ws->ties[k++] = j;
     double *A = ws->binv, *rhs = ws->scratch;
     for (int b = 0; b < k; b++) {
         const double *mcol = st->M + (size_t)ws->ties[b] * n;
@@ -466,6 +498,60 @@ static int polish(const lemke_state *st, double *z)
     for (int a = 0; a < k; a++)
         z[ws->ties[a]] = rhs[a];
     clamp_roundoff(n, z);
+    return 0;
+}
+
+/* Recompute the final basic solution directly: M_SS z_S = -q_S on the
+ * support S of the final basis. */
+static int polish(const lemke_state *st, double *z)
+{
+    int n = st->n, k = 0;
+    pd_lcp_work *ws = st->ws;
+    for (int j = 0; j < n; j++)
+        if (ws->row_of[n + j] >= 0)
+            ws->ties[k++] = j;
+    return support_solve(st, k, z);
+}
+
+/* The support of z changed where the answer fails its own rows (w and
+ * ws->rows from its verification): an index off the support whose w_i < 0
+ * beyond the verification's tolerance of its row enters, one on it with
+ * z_i < 0 beyond that of max|z| leaves, all at once (block principal
+ * pivoting).  The new support into ws->ties, its size returned; -1 when
+ * nothing is infeasible. */
+static int repair_support(const lemke_state *st, const double *z, const double *w)
+{
+    int n = st->n, k = 0, changed = 0;
+    pd_lcp_work *ws = st->ws;
+    double zs = pd_lcp_max_abs(n, z);
+    for (int j = 0; j < n; j++) {
+        int in = z[j] != 0.0;
+        int flip = in ? z[j] < -LEMKE_VERIFY_TOL * zs : w[j] < -LEMKE_VERIFY_TOL * ws->rows[j];
+        changed |= flip;
+        if (in != flip)
+            ws->ties[k++] = j;
+    }
+    return changed ? k : -1;
+}
+
+/* An answer that does not verify, repaired by at most LEMKE_REPAIR_ROUNDS
+ * rounds of principal pivoting from its support; 1 with z, w, info the
+ * verified answer, else 0 with z, w, info those of the last round.  Lemke's
+ * basic values x_B = B^-1 q carry the q_i that are below their rounding
+ * (q_i = -2e-17 where others are of order one: a relative velocity that is
+ * zero but for rounding) no further than that rounding, so an index whose
+ * w_i = q_i + ... is lost there can end off the support with w_i < 0 at
+ * the scale of its own row; one or two principal solves put it right
+ * (issue 19). */
+static int repair(const lemke_state *st, double *z, double *w, pd_lcp_info *info)
+{
+    for (int round = 0; round < LEMKE_REPAIR_ROUNDS; round++) {
+        int k = repair_support(st, z, w);
+        if (k < 0 || support_solve(st, k, z) != 0)
+            return 0;
+        if (verify(st, z, w, info))
+            return 1;
+    }
     return 0;
 }
 
@@ -503,10 +589,11 @@ static pd_lcp_outcome run_pivots(const lemke_state *st, int cap, int *pivots)
 }
 
 /* A claimed solution: x_B refined until it verifies (at most LEMKE_FINAL_REFINES
- * times), else recomputed from the support (polish); the better of the two is
- * returned, as solved if it verifies, as numerical otherwise.  The first
- * refinement is never skipped: it buys forward accuracy on ill-conditioned
- * bases that the backward residual alone would accept. */
+ * times), else recomputed from the support (polish), else the better of the
+ * two repaired (repair); solved if one verifies, else the better of the two
+ * is returned as numerical.  The first refinement is never skipped: it buys
+ * forward accuracy on ill-conditioned bases that the backward residual
+ * alone would accept. */
 LEMKE_LOOPS
 static pd_lcp_outcome finish_solved(const lemke_state *st, double *z, double *w,
                                     pd_lcp_info *info)
@@ -518,13 +605,21 @@ static pd_lcp_outcome finish_solved(const lemke_state *st, double *z, double *w,
             return PD_LCP_SOLVED;
     }
     double pivoting = info->residual;
-    if (polish(st, z) == 0) {
+    int polished = polish(st, z) == 0;
+    if (polished) {
         if (verify(st, z, w, info))
             return PD_LCP_SOLVED;
-        if (info->residual < pivoting)
-            return PD_LCP_NUMERICAL;
+        polished = info->residual < pivoting;
     }
-    extract_z(st, z); /* the pivoting answer was the better one */
+    if (!polished) { /* the pivoting answer is the better one */
+        extract_z(st, z);
+        verify(st, z, w, info);
+    }
+    double *best = st->ws->col; /* free once the pivots are over */
+    memcpy(best, z, (size_t)st->n * sizeof(double));
+    if (repair(st, z, w, info))
+        return PD_LCP_SOLVED;
+    memcpy(z, best, (size_t)st->n * sizeof(double));
     verify(st, z, w, info);
     return PD_LCP_NUMERICAL;
 }

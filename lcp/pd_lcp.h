@@ -104,7 +104,8 @@ PD_API void pd_lcp_chain_q(int N, int seed, double *q);
  *     max_i max(-z_i / zs, -w_i / r_i, min(|w_i| / r_i, |z_i| / zs)),
  * zs = max|z|, r_i = |q_i| + sum_j |M_ij| |z_j| the size of the terms that
  * make w_i (0/0 = 0).  It is invariant under scaling (q, z) or (M, 1/z), and
- * an answer is verified when it is at most 1e-10 (docs/lcp.md). */
+ * an answer is verified when it is at most 1e-10 (docs/lcp.md).
+ * complementarity, infeasibility and residual may each be NULL (not wanted). */
 PD_API void pd_lcp_residual(int n, const double *M, const double *q, const double *z,
                             double *w, double *complementarity, double *infeasibility,
                             double *residual);
@@ -150,7 +151,8 @@ PD_API int pd_lcp_solver_nmax(const pd_lcp_solver *s);
 /* Solve (M, q), M square (dense or CSC) with n <= nmax: PD_OK only for a
  * verified solution; PD_ENOSOLUTION, PD_EMAXPIVOTS, PD_EMAXITER,
  * PD_ENUMERICAL otherwise (info->outcome), PD_EINVAL for bad input.
- * info->solver names the solver that answered (auto, or a hand-over). */
+ * info->solver names the solver that answered (auto, or a hand-over).
+ * opts NULL: the defaults; info may be NULL. */
 PD_API int pd_lcp_solve(pd_lcp_solver *s, const pd_matrix *M, const double *q,
                         const pd_lcp_opts *opts, double *z, double *w, pd_lcp_info *info);
 

@@ -1,4 +1,5 @@
 /* residual.c — residuals of an LCP candidate. */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 
@@ -25,6 +26,13 @@ double pd_lcp_max_abs(int n, const double *x)
     m2 = m3 > m2 ? m3 : m2;
     return m2 > m0 ? m2 : m0;
 }
+
+/* A row whose terms add up to less than (n + 1) VERIFY_ROW_MIN is not
+ * judged: below it the products and sums round to the subnormal spacing
+ * (4.9e-324), an absolute error that 1e13 row sizes keep under 1e-13 of the
+ * row (the verification's tolerance is 1e-10).  A problem at that scale has
+ * no answer this solver can vouch for (stress: subnormal q). */
+#define VERIFY_ROW_MIN (1e13 * DBL_TRUE_MIN)
 
 /* Ratio a / b with 0 / 0 = 0 (a term that is exactly zero is exact). */
 static double ratio(double a, double b)
@@ -67,17 +75,20 @@ static void affine_rows(const pd_matrix *M, const double *q, const double *z, do
  * scaling q and z, or M and 1/z, and exact zeros count as exact.  A z or w
  * with a NaN or an infinity, or whose terms overflow (r_i infinite: a
  * diverged iteration), is no answer: its figures are NaN, which no
- * tolerance accepts (x / inf would otherwise pass as a ratio of 0). */
+ * tolerance accepts (x / inf would otherwise pass as a ratio of 0); so
+ * are they when a row is too small to be judged (VERIFY_ROW_MIN). */
 void pd_lcp_verify(const pd_matrix *M, const double *q, const double *z, double *w, double *rows,
                    pd_lcp_info *info)
 {
     int n = M->rows, nan = 0;
     double zs = pd_lcp_max_abs(n, z), comp = 0.0, infeas = 0.0, rel = 0.0, scale = 0.0;
+    double row_min = (n + 1.0) * VERIFY_ROW_MIN;
     affine_rows(M, q, z, w, rows);
     for (int i = 0; i < n; i++) { /* NaN compares false: caught apart, once */
         double za = fabs(z[i]), wa = fabs(w[i]), zi = ratio(za, zs), wi = ratio(wa, rows[i]);
         double v = wi < zi ? wi : zi;
         nan |= !isfinite(z[i]) || !isfinite(w[i]) || !isfinite(rows[i]);
+        nan |= rows[i] > 0.0 && rows[i] < row_min;
         comp = pd_max(comp, za * wa);
         infeas = pd_max(infeas, pd_max(-z[i], -w[i]));
         v = z[i] < 0.0 ? pd_max(v, zi) : v;
@@ -94,17 +105,19 @@ void pd_lcp_verify(const pd_matrix *M, const double *q, const double *z, double 
 void pd_lcp_residual(int n, const double *M, const double *q, const double *z, double *w,
                      double *complementarity, double *infeasibility, double *residual)
 {
-    pd_matrix A = pd_matrix_dense(n, n, M);
-    pd_lcp_info info;
-    double rows[64], *r = n <= 64 ? rows : malloc((size_t)n * sizeof(double));
-    if (!r) {
-        *complementarity = *infeasibility = *residual = NAN;
+    if (!M || !q || !z || !w)
         return;
-    }
-    pd_lcp_verify(&A, q, z, w, r, &info);
-    *complementarity = info.complementarity;
-    *infeasibility = info.infeasibility;
-    *residual = info.residual;
+    pd_matrix A = pd_matrix_dense(n, n, M);
+    pd_lcp_info info = {.complementarity = NAN, .infeasibility = NAN, .residual = NAN};
+    double rows[64], *r = n <= 64 ? rows : malloc((size_t)n * sizeof(double));
+    if (r)
+        pd_lcp_verify(&A, q, z, w, r, &info);
+    if (complementarity)
+        *complementarity = info.complementarity;
+    if (infeasibility)
+        *infeasibility = info.infeasibility;
+    if (residual)
+        *residual = info.residual;
     if (r != rows)
         free(r);
 }

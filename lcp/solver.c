@@ -4,11 +4,19 @@
  * auto: Lemke for n <= 2 (its closed forms) and for dense matrices; the
  * structured solver for compressed-column ones (the engine's sparse
  * Delassus blocks), handing over to Lemke when it cannot finish and the
- * problem fits Lemke's workspace. */
+ * problem fits Lemke's workspace.  Under auto a solver that ends as
+ * numerical (or the structured solver as max_iterations) hands the problem
+ * on: Lemke to the structured solver, and what neither finishes to PGS on
+ * a bounded budget; a ray of Lemke's (no solution), its pivot cap and bad
+ * input end the solve.  Every answer is verified, whoever gives it. */
 #include <stdlib.h>
 #include <string.h>
 
 #include "lcp_internal.h"
+
+#define HANDOVER_PGS_WORK 1e9 /* auto's last resort: PGS sweeps of at most this many
+                                 multiply-adds in all (about a second) */
+#define HANDOVER_PGS_MIN 64   /* ... but at least this many sweeps */
 
 /* A method of the table. */
 typedef struct solver_type {
@@ -18,7 +26,7 @@ typedef struct solver_type {
 } solver_type;
 
 static const solver_type solver_types[] = {
-    {.method = PD_LCP_AUTO, .name = "auto", .lemke = 1, .structured = 1},
+    {.method = PD_LCP_AUTO, .name = "auto", .lemke = 1, .structured = 1, .pgs = 1},
     {.method = PD_LCP_LEMKE, .name = "lemke", .lemke = 1},
     {.method = PD_LCP_STRUCTURED, .name = "structured", .lemke = 1, .structured = 1},
     {.method = PD_LCP_PGS, .name = "pgs", .pgs = 1},
@@ -47,7 +55,9 @@ const char *pd_lcp_method_name(pd_lcp_method method)
 
 int pd_lcp_method_parse(const char *name, pd_lcp_method *method)
 {
-    for (int k = 0; name && k < NTYPES; k++)
+    if (!name || !method)
+        return PD_EINVAL;
+    for (int k = 0; k < NTYPES; k++)
         if (!strcmp(name, solver_types[k].name)) {
             *method = solver_types[k].method;
             return PD_OK;
@@ -151,6 +161,63 @@ static int solve_structured(pd_lcp_solver *s, const pd_matrix *M, const double *
     return rc;
 }
 
+/* A failure another solver may overcome: lost precision, or the structured
+ * solver's iterations spent (max_iterations bounds PGS's sweeps as well).
+ * A ray of Lemke's proves a positive semidefinite problem infeasible, its
+ * pivot cap is the caller's, bad input stays bad. */
+static int hands_over(int rc)
+{
+    return rc == PD_ENUMERICAL || rc == PD_EMAXITER;
+}
+
+/* PGS as auto's last resort, its sweeps bounded by HANDOVER_PGS_WORK (and
+ * by the caller's max_iterations); info keeps the pivots and adds the
+ * iterations of the solvers before it. */
+static int solve_pgs_last(pd_lcp_solver *s, const pd_matrix *M, const double *q,
+                          const pd_lcp_opts *opts, double *z, double *w, pd_lcp_info *info,
+                          const char *name)
+{
+    pd_lcp_opts o = *opts;
+    int pivots = info->pivots, iterations = info->iterations;
+    long nnz = pd_matrix_nnz(M), n = M->rows;
+    long sweeps = (long)(HANDOVER_PGS_WORK / (double)(nnz > n ? nnz : n));
+    sweeps = sweeps > HANDOVER_PGS_MIN ? sweeps : HANDOVER_PGS_MIN;
+    if (o.max_iterations <= 0 || o.max_iterations > sweeps)
+        o.max_iterations = sweeps < 1000L * n ? (int)sweeps : 0; /* 0: PGS's own default */
+    int rc = pd_pgs_solve(s->pgs, M, q, &o, z, w, info);
+    info->pivots = pivots;
+    info->iterations += iterations;
+    info->solver = name;
+    return rc;
+}
+
+/* auto: Lemke first on small dense input, else the structured solver (with
+ * its hand-over to Lemke); a failure that hands_over goes on to the other
+ * one, then to PGS. */
+static int solve_auto(pd_lcp_solver *s, const pd_matrix *M, const double *q,
+                      const pd_lcp_opts *o, double *z, double *w, pd_lcp_info *info)
+{
+    int rc;
+    if (M->rows <= 2 || (M->kind == PD_MATRIX_DENSE && M->rows <= s->lemke_nmax)) {
+        rc = solve_lemke(s, M, q, o, z, w, info);
+        if (!hands_over(rc))
+            return rc;
+        int pivots = info->pivots;
+        rc = pd_bpp_solve(s->bpp, M, q, o, z, w, s->flag, info);
+        info->pivots = pivots;
+        info->solver = "structured (after lemke)";
+        if (!hands_over(rc))
+            return rc;
+        return solve_pgs_last(s, M, q, o, z, w, info, "pgs (after lemke, structured)");
+    }
+    rc = solve_structured(s, M, q, o, z, w, info);
+    if (!hands_over(rc))
+        return rc;
+    return solve_pgs_last(s, M, q, o, z, w, info,
+                          strcmp(info->solver, "structured") ? "pgs (after structured, lemke)"
+                                                             : "pgs (after structured)");
+}
+
 int pd_lcp_solve(pd_lcp_solver *s, const pd_matrix *M, const double *q, const pd_lcp_opts *opts,
                  double *z, double *w, pd_lcp_info *info)
 {
@@ -168,9 +235,6 @@ int pd_lcp_solve(pd_lcp_solver *s, const pd_matrix *M, const double *q, const pd
     case PD_LCP_LEMKE: return solve_lemke(s, M, q, &o, z, w, info);
     case PD_LCP_STRUCTURED: return solve_structured(s, M, q, &o, z, w, info);
     case PD_LCP_PGS: info->solver = "pgs"; return pd_pgs_solve(s->pgs, M, q, &o, z, w, info);
-    default:
-        if (M->rows <= 2 || (M->kind == PD_MATRIX_DENSE && M->rows <= s->lemke_nmax))
-            return solve_lemke(s, M, q, &o, z, w, info);
-        return solve_structured(s, M, q, &o, z, w, info);
+    default: return solve_auto(s, M, q, &o, z, w, info);
     }
 }

@@ -17,8 +17,10 @@ const char *pd_pulse_name(pd_pulse pulse)
 int pd_pulse_parse(const char *name, pd_pulse *pulse)
 {
     static const pd_pulse all[] = {PD_PULSE_SINE, PD_PULSE_COSINE, PD_PULSE_HARMONIC};
+    if (!name || !pulse)
+        return PD_EINVAL;
     for (int i = 0; i < 3; i++)
-        if (name && !strcmp(name, pd_pulse_name(all[i]))) {
+        if (!strcmp(name, pd_pulse_name(all[i]))) {
             *pulse = all[i];
             return PD_OK;
         }
@@ -32,9 +34,11 @@ const char *pd_dir_name(int dir)
 
 int pd_dir_parse(const char *name, int *dir)
 {
-    if (name && !strcmp(name, "normal"))
+    if (!name || !dir)
+        return PD_EINVAL;
+    if (!strcmp(name, "normal"))
         *dir = 1;
-    else if (name && !strcmp(name, "reverse"))
+    else if (!strcmp(name, "reverse"))
         *dir = -1;
     else
         return PD_EINVAL;

@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "pd_null.h"
 #include "pd_problems.h"
 
 /* Sampler filling a preallocated array of u. */
@@ -17,6 +18,10 @@ static int record_u(const pd_osc_sample *s, void *ctx)
 
 int pd_trace_alloc(pd_trace *tr, const pd_run_opts *o)
 {
+    if (!tr || !o)
+        return PD_EINVAL;
+    if (!(o->dt > 0.0) || !(o->tend >= 0.0) || !(o->tend / o->dt <= PD_MAX_STEPS))
+        return PD_EINVAL; /* no grid: dt and tend not resolved */
     tr->n = 0;
     tr->cap = pd_steps_for(o->tend, o->dt) + 2;
     tr->u = malloc((size_t)tr->cap * sizeof(double));
@@ -25,6 +30,8 @@ int pd_trace_alloc(pd_trace *tr, const pd_run_opts *o)
 
 void pd_trace_free(pd_trace *tr)
 {
+    if (!tr)
+        return;
     free(tr->u);
     tr->u = NULL;
 }
@@ -33,6 +40,8 @@ int pd_measure_run(const pd_osc *c, const pd_run_opts *o, const pd_trace *ref, d
                    pd_trace *work, pd_measured *out, pd_err *err)
 {
     int rc;
+    if (!c || !o || !ref || !work || !out)
+        return PD_NULL_ARG(err, !c ? "c" : !o ? "o" : !ref ? "ref" : !work ? "work" : "out");
     work->n = 0;
     if ((rc = pd_osc_run(c, o, record_u, work, &out->r, err)))
         return rc;
@@ -57,6 +66,8 @@ int pd_measure_reference(const pd_osc *c, const pd_run_opts *o, pd_trace *ref,
 {
     int rc;
     pd_osc_result timed;
+    if (!c || !o || !ref || !res)
+        return PD_NULL_ARG(err, !c ? "c" : !o ? "o" : !ref ? "ref" : "res");
     ref->n = 0;
     if ((rc = pd_osc_reference(c, o, record_u, ref, res, err)))
         return rc;

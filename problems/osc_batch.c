@@ -18,6 +18,7 @@
 #include "osc_batch_lanes.h"
 
 #include "osc_batch.h"
+#include "pd_null.h"
 
 /* Every lane's force at its own clock: the case's pd_osc_shape, computed
  * once for neighbouring lanes at the same instant of the same excitation
@@ -175,7 +176,8 @@ static void lane_result(osc_batch *ob, int l, pd_osc_result *res)
 
 int pd_osc_batchable(const pd_osc *c, const pd_run_opts *o)
 {
-    (void)c;
+    if (!c || !o)
+        return 0;
     return o->method == PD_METHOD_MOREAU && o->kernel == PD_KERNEL_AUTO && !o->on_lcp;
 }
 
@@ -298,6 +300,8 @@ static void finish(stream *s, int l)
 
 int pd_osc_run_stream(pd_osc_stream_next next, pd_osc_stream_done done, void *ctx, pd_err *err)
 {
+    if (!next || !done)
+        return PD_NULL_ARG(err, !next ? "next" : "done");
     stream s = {.next = next, .done = done, .ctx = ctx};
     pd_err_clear(err);
     /* fill the lanes (the batch opens with its first case) */

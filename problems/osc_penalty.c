@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pd_null.h"
 #include "pd_problems.h"
 
 #define OSC_PEN_KC_W0 1e4    /* the default contact stiffness: at least this * w0^2, ... */
@@ -273,6 +274,8 @@ int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler samp
     pd_run_opts o;
     pd_penalty_result pr;
     int rc;
+    if (!c || !res)
+        return PD_NULL_ARG(err, !c ? "c" : "res");
     pd_err_clear(err);
     if ((rc = pd_osc_resolve_opts(c, opts, &o, err)))
         return rc;
@@ -331,6 +334,7 @@ int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler samp
     eo.on_step = track_step;
     eo.on_step_ctx = &tr;
     eo.factor = o.factor;
+    eo.time_unit = 1.0 / wp; /* tau = wp t */
 
     double cpu0 = pd_cpu_seconds();
     rc = pd_penalty_run(&model, 0.0, NULL, NULL, tau_end, &eo, sampler ? emit_sample : NULL,

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "osc_track.h"
+#include "pd_null.h"
 #include "pd_problems.h"
 
 
@@ -24,20 +25,34 @@ pd_osc pd_osc_default(void)
                     .xi = 0.05};
 }
 
-double pd_osc_wp(const pd_osc *c) { return PD_TWO_PI / c->Tp; }
-double pd_osc_T0(const pd_osc *c) { return c->Tp / c->Pi2; }
-double pd_osc_Le(const pd_osc *c) { return c->ap / (pd_osc_wp(c) * pd_osc_wp(c)); }
-double pd_osc_gap(const pd_osc *c) { return c->Pi3 * pd_osc_Le(c); }
-void pd_osc_set_T0(pd_osc *c, double T0) { c->Pi2 = c->Tp / T0; }
-void pd_osc_set_gap(pd_osc *c, double gap) { c->Pi3 = gap / pd_osc_Le(c); }
+double pd_osc_wp(const pd_osc *c) { return c ? PD_TWO_PI / c->Tp : NAN; }
+double pd_osc_T0(const pd_osc *c) { return c ? c->Tp / c->Pi2 : NAN; }
+double pd_osc_Le(const pd_osc *c) { return c ? c->ap / (pd_osc_wp(c) * pd_osc_wp(c)) : NAN; }
+double pd_osc_gap(const pd_osc *c) { return c ? c->Pi3 * pd_osc_Le(c) : NAN; }
+
+void pd_osc_set_T0(pd_osc *c, double T0)
+{
+    if (c)
+        c->Pi2 = c->Tp / T0;
+}
+
+void pd_osc_set_gap(pd_osc *c, double gap)
+{
+    if (c)
+        c->Pi3 = gap / pd_osc_Le(c);
+}
 
 double pd_osc_excitation(const pd_osc *c, double t)
 {
+    if (!c)
+        return NAN;
     return c->ap * pd_osc_shape(c, pd_osc_wp(c) * t, -1);
 }
 
 void pd_osc_set_record(pd_osc *c, const pd_record *rec, const pd_record_pulse *p, double scale)
 {
+    if (!c || !rec || !p)
+        return;
     c->record = rec;
     c->rec_ap = p->ap;
     c->scale = scale;
@@ -55,6 +70,8 @@ static int after_record(const pd_osc *c, double tau, int side)
 /* -dir ug''(t) / rec_ap: the record's samples are joined linearly. */
 double pd_osc_shape(const pd_osc *c, double tau, int side)
 {
+    if (!c)
+        return NAN;
     if (!c->record)
         return pd_pulse_shape(c->pulse, c->dir, tau, side);
     if (tau < 0.0 || after_record(c, tau, side))
@@ -66,6 +83,8 @@ double pd_osc_shape(const pd_osc *c, double tau, int side)
 /* d/dtau of the shape: the slope of the record's piece at tau. */
 double pd_osc_shape_rate(const pd_osc *c, double tau, int side)
 {
+    if (!c)
+        return NAN;
     if (!c->record)
         return pd_pulse_shape_rate(c->pulse, c->dir, tau, side);
     const pd_record *r = c->record;
@@ -82,6 +101,8 @@ double pd_osc_shape_rate(const pd_osc *c, double tau, int side)
 
 double pd_osc_shape_end(const pd_osc *c)
 {
+    if (!c)
+        return NAN;
     if (c->record)
         return pd_osc_wp(c) * pd_record_duration(c->record);
     return c->pulse == PD_PULSE_HARMONIC ? HUGE_VAL : PD_TWO_PI;
@@ -89,6 +110,8 @@ double pd_osc_shape_end(const pd_osc *c)
 
 const char *pd_osc_excitation_name(const pd_osc *c)
 {
+    if (!c)
+        return "(none)";
     return c->record ? c->record->name : pd_pulse_name(c->pulse);
 }
 
@@ -100,6 +123,8 @@ static int in_range(double x, double lo, double hi, int hi_open)
 
 int pd_osc_check(const pd_osc *c, pd_err *err)
 {
+    if (!c)
+        return PD_NULL_ARG(err, "c");
     if (!c->record && c->pulse != PD_PULSE_SINE && c->pulse != PD_PULSE_COSINE &&
         c->pulse != PD_PULSE_HARMONIC)
         return pd_err_set(err, PD_EINVAL, "pulse must be sine, cosine or harmonic");
@@ -127,6 +152,8 @@ int pd_osc_check(const pd_osc *c, pd_err *err)
 int pd_osc_resolve_opts(const pd_osc *c, const pd_run_opts *in, pd_run_opts *out, pd_err *err)
 {
     int rc;
+    if (!c || !out)
+        return PD_NULL_ARG(err, !c ? "c" : "out");
     *out = in ? *in : pd_run_default_opts();
     if ((rc = pd_osc_check(c, err)) || (rc = pd_run_opts_check(out, err)))
         return rc;
@@ -150,6 +177,8 @@ int pd_osc_resolve_opts(const pd_osc *c, const pd_run_opts *in, pd_run_opts *out
 
 pd_method pd_osc_method(const pd_osc *c, const pd_run_opts *o)
 {
+    if (!c || !o)
+        return PD_METHOD_AUTO; /* nothing to resolve */
     if (o->method != PD_METHOD_AUTO)
         return o->method;
     double tend = o->tend > 0.0 ? o->tend : pd_osc_default_tend(c);
@@ -158,6 +187,8 @@ pd_method pd_osc_method(const pd_osc *c, const pd_run_opts *o)
 
 double pd_osc_default_dt(const pd_osc *c)
 {
+    if (!c)
+        return NAN;
     return fmin(c->Tp, pd_osc_T0(c)) / 2000.0;
 }
 
@@ -172,6 +203,8 @@ static double harmonic_window(const pd_osc *c)
  * Pulses: Tp + 2 T0; records: their duration + 2 T0. */
 double pd_osc_default_tend(const pd_osc *c)
 {
+    if (!c)
+        return NAN;
     double T0 = pd_osc_T0(c);
     if (c->record)
         return pd_record_duration(c->record) + 2.0 * T0;
@@ -185,6 +218,8 @@ double pd_osc_default_tend(const pd_osc *c)
 
 double pd_osc_measure_start(const pd_osc *c, double tend)
 {
+    if (!c)
+        return NAN;
     if (c->record || c->pulse != PD_PULSE_HARMONIC)
         return 0.0;
     return fmax(0.0, tend - harmonic_window(c));
@@ -296,6 +331,8 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
 {
     pd_run_opts o;
     int rc;
+    if (!c || !res)
+        return PD_NULL_ARG(err, !c ? "c" : "res");
     pd_err_clear(err);
     if ((rc = pd_osc_resolve_opts(c, opts, &o, err)))
         return rc;
@@ -369,6 +406,8 @@ static int ref_sample(double tau, double x, double v, int in_contact, void *ctx)
 
 int pd_osc_pieces(const pd_osc *c, pd_sine_piece **pieces, int *npieces, pd_err *err)
 {
+    if (!c || !pieces || !npieces)
+        return PD_NULL_ARG(err, !c ? "c" : !pieces ? "pieces" : "npieces");
     const pd_record *r = c->record;
     int n = r ? (int)r->npts : c->pulse == PD_PULSE_HARMONIC ? 1 : 2;
     pd_sine_piece *p = malloc((size_t)n * sizeof *p);
@@ -397,6 +436,8 @@ int pd_osc_pieces(const pd_osc *c, pd_sine_piece **pieces, int *npieces, pd_err 
 
 double pd_osc_scan_points(const pd_osc *c, double tend)
 {
+    if (!c)
+        return NAN;
     double T0 = pd_osc_T0(c);
     double sine = c->record                       ? 0.0 /* linear pieces: T0 alone */
                   : c->pulse == PD_PULSE_HARMONIC ? tend
@@ -410,6 +451,8 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     pd_run_opts o;
     pd_ed_result er;
     int rc;
+    if (!c || !res)
+        return PD_NULL_ARG(err, !c ? "c" : "res");
     pd_err_clear(err);
     if ((rc = pd_osc_resolve_opts(c, opts, &o, err)))
         return rc;
@@ -463,6 +506,8 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
 
 void pd_osc_free_exact(const pd_osc *c, double t, double *u, double *v)
 {
+    if (!c || !u || !v)
+        return;
     pd_sdof osc = {.w0 = PD_TWO_PI / pd_osc_T0(c), .xi = c->xi};
     double wp = pd_osc_wp(c), A = c->dir * c->ap;
     double phi = c->pulse == PD_PULSE_COSINE ? PD_TWO_PI / 4.0 : 0.0; /* cos = sin(+pi/2) */
@@ -477,8 +522,10 @@ void pd_osc_free_exact(const pd_osc *c, double t, double *u, double *v)
 
 int pd_osc_free_first_contact(const pd_osc *c, double tmax, double *t, double *v)
 {
+    if (!c || !t || !v)
+        return PD_EINVAL;
     double delta = pd_osc_gap(c), step = c->Tp / 1000.0, lo = 0.0, hi = -1.0, u;
-    if (c->record)
+    if (c->record || !(step > 0.0) || !isfinite(step)) /* a record, or no grid (Tp) */
         return PD_EINVAL;
     for (double s = step; s <= tmax + 0.5 * step; s += step) {
         pd_osc_free_exact(c, s, &u, v);
@@ -503,6 +550,8 @@ int pd_osc_free_first_contact(const pd_osc *c, double tmax, double *t, double *v
 int pd_osc_run(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
                pd_osc_result *res, pd_err *err)
 {
+    if (!c || !res)
+        return PD_NULL_ARG(err, !c ? "c" : "res");
     pd_run_opts o = opts ? *opts : pd_run_default_opts();
     switch (pd_osc_method(c, &o)) {
     case PD_METHOD_EVENT: return pd_osc_reference(c, &o, sampler, ctx, res, err);
@@ -515,6 +564,8 @@ int pd_osc_run(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler,
 int pd_osc_summarize(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
                      pd_osc_summary *s, pd_err *err)
 {
+    if (!c || !s)
+        return PD_NULL_ARG(err, !c ? "c" : "s");
     pd_run_opts twin = opts ? *opts : pd_run_default_opts();
     int rc;
     memset(s, 0, sizeof *s);

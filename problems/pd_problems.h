@@ -286,7 +286,8 @@ PD_API const char *pd_osc_excitation_name(const pd_osc *c);
 /* Check every field; the message names the field ("eps", "gap", ...). */
 PD_API int pd_osc_check(const pd_osc *c, pd_err *err);
 
-/* Check the case and the options and complete dt and tend. */
+/* Check the case and the options and complete dt and tend (in NULL: the
+ * defaults). */
 PD_API int pd_osc_resolve_opts(const pd_osc *c, const pd_run_opts *in, pd_run_opts *out,
                                pd_err *err);
 PD_API double pd_osc_default_dt(const pd_osc *c); /* min(Tp, T0) / 2000 */
@@ -369,7 +370,8 @@ PD_API int pd_osc_run_stream(pd_osc_stream_next next, pd_osc_stream_done done, v
 #define PD_OSC_MAX_SCAN 2.5e7
 PD_API double pd_osc_scan_points(const pd_osc *c, double tend);
 
-/* The three methods (pd_osc_run dispatches to them):
+/* The three methods (pd_osc_run dispatches to them; opts NULL: the
+ * defaults):
  * Moreau–Jean, its umax the maximum over the steps; */
 PD_API int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler,
                            void *ctx, pd_osc_result *res, pd_err *err);
@@ -392,6 +394,7 @@ typedef struct pd_osc_summary {
     double cpu_s; /* both runs */
 } pd_osc_summary;
 
+/* opts NULL: the defaults. */
 PD_API int pd_osc_summarize(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler,
                             void *ctx, pd_osc_summary *s, pd_err *err);
 
@@ -421,7 +424,8 @@ typedef struct pd_measured {
     long grid_points;
 } pd_measured;
 
-/* Room for the grid of o (tend / dt + 2 points): PD_OK or PD_ENOMEM. */
+/* Room for the grid of o (tend / dt + 2 points): PD_OK, PD_ENOMEM, or
+ * PD_EINVAL when o has no grid (dt, tend not resolved). */
 PD_API int pd_trace_alloc(pd_trace *tr, const pd_run_opts *o);
 PD_API void pd_trace_free(pd_trace *tr);
 
@@ -461,6 +465,7 @@ typedef struct pd_structure {
     /* derived by pd_scene_finish */
     double T0;           /* fundamental period [s] */
     double period[2];    /* periods of the damping modes [s] */
+    double Tmin;         /* shortest natural period (the highest mode) [s] */
     double alpha, beta;  /* C = alpha M + beta K */
     int dof;             /* first dof of the structure in the scene's model */
 } pd_structure;
@@ -497,7 +502,8 @@ typedef struct pd_scene {
     pd_record *own_record; /* the record a scene file named (freed with the scene) */
 } pd_scene;
 
-/* An empty scene excited by exc; NULL when out of memory. */
+/* An empty scene excited by exc (NULL: none yet, sc->exc to be set before
+ * pd_scene_finish); NULL when out of memory. */
 PD_API pd_scene *pd_scene_new(const pd_scene_excitation *exc);
 PD_API void pd_scene_free(pd_scene *sc);
 
@@ -521,7 +527,8 @@ PD_API int pd_scene_add_contact(pd_scene *sc, int a, int level_a, int b, int lev
 /* A deep copy, not finished (NULL when out of memory); a record it names
  * is shared, not copied: the original must outlive the copy. */
 PD_API pd_scene *pd_scene_copy(const pd_scene *sc);
-/* The structure called name, or -1 (PD_WALL for "wall"); -2 when unknown. */
+/* The structure called name, or -1 (PD_WALL for "wall"); -2 when unknown
+ * (or sc or name NULL). */
 PD_API int pd_scene_find(const pd_scene *sc, const char *name);
 
 /* Check the row (contacts left to right, levels that exist, a non-empty
@@ -547,12 +554,13 @@ PD_API double pd_scene_Le(const pd_scene *sc);
 PD_API double pd_scene_default_dt(const pd_scene *sc);
 PD_API double pd_scene_default_tend(const pd_scene *sc);
 PD_API double pd_scene_measure_start(const pd_scene *sc, double tend);
-/* Check the options and complete dt and tend. */
+/* Check the options (in NULL: pd_run_default_opts()) and complete dt and tend. */
 PD_API int pd_scene_resolve_opts(const pd_scene *sc, const pd_run_opts *in, pd_run_opts *out,
                                  pd_err *err);
 /* 1 when the scene is the one-wall oscillator (one SDOF, at most one contact,
  * with a wall): it then runs on the oscillator's fast paths, with *c the
- * equivalent case (mirrored when the wall is on the left). */
+ * equivalent case (mirrored when the wall is on the left); 0 otherwise, and
+ * when a pointer is NULL. */
 PD_API int pd_scene_as_oscillator(const pd_scene *sc, pd_osc *c, int *mirrored);
 
 /* The scene as an engine model in the reference units (tau = wp t, x =
@@ -604,10 +612,14 @@ typedef struct pd_scene_result {
     const char *method, *kernel, *factor, *lcp_solver;
 } pd_scene_result;
 
+/* Arrays for the finished scene sc (PD_EINVAL before pd_scene_finish). */
 PD_API int pd_scene_result_alloc(const pd_scene *sc, pd_scene_result *r, pd_err *err);
+/* 1 when r holds the arrays of sc's shape (as pd_scene_result_alloc made
+ * them); 0 otherwise, and when sc or r is NULL. */
+PD_API int pd_scene_result_fits(const pd_scene *sc, const pd_scene_result *r);
 PD_API void pd_scene_result_free(pd_scene_result *r);
 
-/* Run the scene with the method of opts into res (from
+/* Run the scene with the method of opts (NULL: pd_run_default_opts()) into res (from
  * pd_scene_result_alloc for this scene: PD_EINVAL otherwise); sampler (may
  * be NULL) gets the state every step (Moreau–Jean) or every dt (the others;
  * event-general also at each of its events, between grid points), and at
@@ -627,6 +639,7 @@ typedef struct pd_scene_summary {
     double cpu_s;
 } pd_scene_summary;
 
+/* opts NULL: pd_run_default_opts(). */
 PD_API int pd_scene_summarize(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler sampler,
                               void *ctx, pd_scene_summary *s, pd_err *err);
 PD_API void pd_scene_summary_free(pd_scene_summary *s);
@@ -651,9 +664,14 @@ typedef struct pd_scene_errors {
     long impacts;                     /* over every contact */
     long grid_points;
     double cpu_s;                     /* a second run without sampling */
+    int nstruct;                      /* the shape: set by pd_scene_errors_alloc */
 } pd_scene_errors;
 
-/* Room for the grid of o (PD_EINVAL when it would exceed 2 GB). */
+/* Room for the grid of o (NULL: pd_run_default_opts(); PD_EINVAL when it
+ * would exceed 2 GB).  The
+ * trace, the errors and the results carry the shape of the finished scene
+ * they were allocated for; a measurement with another shape is refused
+ * (PD_EINVAL), never written out of bounds. */
 PD_API int pd_scene_trace_alloc(pd_scene_trace *tr, const pd_scene *sc, const pd_run_opts *o,
                                 pd_err *err);
 PD_API void pd_scene_trace_free(pd_scene_trace *tr);

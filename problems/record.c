@@ -6,7 +6,10 @@
  * then NPTS accelerations in g, several to a line.
  * COSMOS/CDMG V2: the first channel's acceleration block, announced by
  *   " 3251 POINTS OF ACCEL DATA EQUALLY SPACED AT  .020 SEC.  (UNITS: CM/SEC/SEC)"
- * (the velocity and displacement blocks that follow are not read).
+ * (the velocity and displacement blocks that follow are not read), held to
+ * what its header declares (read_v2): the first channel's, within its
+ * boundaries; in the CDMG layout on line 46 after 25 text, 7 integer and 13
+ * real lines, its points and dt those of the integer and real headers.
  * Text: lines "t a", '#' comments, t uniform (see text_uniform).
  *
  * Files are read line by line in bounded memory (pd_core.h): lines up to
@@ -25,6 +28,7 @@
 
 #include "pd_problems.h"
 #include "pd_core.h"
+#include "pd_null.h"
 
 /* Largest record file read: 1 GiB.  Strong-motion records are kilobytes to
  * a few megabytes (10^5 samples of 15 characters); the cap bounds what an
@@ -35,6 +39,24 @@
 #define RECORD_V2_HEAD 200         /* lines searched for the V2 acceleration block */
 #define RECORD_TEXT_TOL 1e-2       /* text: largest deviation of t_k from t_0 + k dt, in dt */
 #define RECORD_WORD_MAX 64         /* longest number read */
+
+/* The CDMG V2 layout (CSMIP's Volume 2 files, the shared ce36456p_CE36456.V2):
+ * 25 text lines, 100 integers in 16I5, 100 reals in 8F10.3, then the
+ * acceleration block's header; the integers' 53rd value is its number of
+ * points, the reals' 61st its dt (0-based indices below). */
+#define RECORD_V2_TEXT_LINES 25
+#define RECORD_V2_INTS 100
+#define RECORD_V2_INT_COLS 16
+#define RECORD_V2_INT_WIDTH 5
+#define RECORD_V2_REALS 100
+#define RECORD_V2_REAL_COLS 8
+#define RECORD_V2_REAL_WIDTH 10
+#define RECORD_V2_INT_NPTS 52
+#define RECORD_V2_REAL_DT 60
+#define RECORD_V2_INT_LINES ((RECORD_V2_INTS + RECORD_V2_INT_COLS - 1) / RECORD_V2_INT_COLS)
+#define RECORD_V2_REAL_LINES ((RECORD_V2_REALS + RECORD_V2_REAL_COLS - 1) / RECORD_V2_REAL_COLS)
+#define RECORD_V2_HEAD_LINES (RECORD_V2_TEXT_LINES + RECORD_V2_INT_LINES + RECORD_V2_REAL_LINES)
+#define RECORD_V2_DT_TOL 5.000001e-4 /* dts agree to the 3 decimals V2 headers print */
 
 /* A file read line by line. */
 typedef struct rec_reader {
@@ -68,8 +90,10 @@ int pd_record_format_parse(const char *name, pd_record_format *f)
 {
     static const pd_record_format all[] = {PD_RECORD_AUTO, PD_RECORD_AT2, PD_RECORD_V2,
                                            PD_RECORD_TEXT};
+    if (!name || !f)
+        return PD_EINVAL;
     for (int i = 0; i < 4; i++)
-        if (name && !strcmp(name, pd_record_format_name(all[i]))) {
+        if (!strcmp(name, pd_record_format_name(all[i]))) {
             *f = all[i];
             return PD_OK;
         }
@@ -89,7 +113,7 @@ const char *pd_record_units_name(pd_record_units u)
 /* Also "m/s^2" and "cm/s^2". */
 int pd_record_units_parse(const char *name, pd_record_units *u)
 {
-    if (!name)
+    if (!name || !u)
         return PD_EINVAL;
     if (!strcmp(name, "g"))
         *u = PD_UNITS_G;
@@ -121,11 +145,15 @@ void pd_record_free(pd_record *rec)
 
 double pd_record_duration(const pd_record *rec)
 {
+    if (!rec)
+        return NAN;
     return rec->npts > 1 ? (double)(rec->npts - 1) * rec->dt : 0.0;
 }
 
 double pd_record_acc(const pd_record *rec, double t)
 {
+    if (!rec)
+        return NAN;
     if (!(t >= 0.0) || rec->npts < 1)
         return 0.0;
     double x = t / rec->dt;
@@ -559,26 +587,247 @@ static int v2_npts_dt(rec_reader *r, long *npts, double *dt)
     return check_npts_dt(r, *npts, *dt);
 }
 
-/* A COSMOS/CDMG V2 file: its first acceleration block. */
-static int read_v2(rec_reader *r, rec_buf *b, double *dt)
+/* What the lines before a V2 file's acceleration block declare. */
+typedef struct v2_head {
+    int cdmg;             /* the CDMG layout: line 1 "CORRECTED ACCELEROGRAM", line 2
+                           * "UNCORRECTED ACCELEROGRAM DATA" */
+    long npts, npts_line; /* the text's "N POINTS OF ... DATA" and its line (0: none) */
+    double dt;
+    long dt_line;         /* the text's "INTERVALS OF H SEC" and its line (0: none) */
+    double ints[RECORD_V2_INTS], reals[RECORD_V2_REALS]; /* CDMG: the numeric headers */
+} v2_head;
+
+#define RECORD_GOT_MAX 72 /* a line shown in a message: 60 characters, quoted */
+
+/* "a blank line" or the line s quoted (its first 60 characters), for messages. */
+static const char *v2_got(const char *s, char *buf, size_t cap)
 {
-    int st;
-    while ((st = next_line(r)) == 1)
-        if (find_nocase(r->line, "POINTS OF ACCEL DATA"))
-            break;
+    if (line_blank(s))
+        snprintf(buf, cap, "a blank line");
+    else
+        snprintf(buf, cap, "'%.*s'", shown_len(s), s);
+    return buf;
+}
+
+/* The line of value i (0-based) of a CDMG numeric header starting on line first. */
+static long v2_value_line(long first, int i, int cols)
+{
+    return first + i / cols;
+}
+
+/* The n fixed-width fields (width w) of a CDMG numeric header line s into
+ * x: integers, or numbers when !integer; a field of '*' (Fortran's
+ * overflow) is NaN.  PD_EPARSE when a field is not one, or the line holds
+ * more or fewer than n. */
+static int v2_fields(const char *s, int n, int w, int integer, double *x)
+{
+    size_t len = strlen(s), width = (size_t)w;
+    while (len > 0 && is_blank((unsigned char)s[len - 1]))
+        len--;
+    if (len > (size_t)n * width || len <= (size_t)(n - 1) * width || width >= RECORD_WORD_MAX)
+        return PD_EPARSE;
+    for (int i = 0; i < n; i++) {
+        char f[RECORD_WORD_MAX];
+        size_t at = (size_t)i * width, m = at + width <= len ? width : len - at;
+        memcpy(f, s + at, m);
+        f[m] = '\0';
+        char *p = f;
+        while (*p == ' ')
+            p++;
+        if (*p && strspn(p, "*") == strlen(p)) {
+            x[i] = NAN;
+            continue;
+        }
+        size_t k = number_len(p);
+        if (!k || *skip_blanks(p + k) || (integer && strcspn(p, ".eEdD") < k))
+            return PD_EPARSE;
+        for (size_t j = 0; j < k; j++)
+            if (p[j] == 'd' || p[j] == 'D')
+                p[j] = 'e';
+        x[i] = strtod(p, NULL);
+    }
+    return PD_OK;
+}
+
+/* The current line, of a CDMG numeric header (`what`: "integer" or
+ * "real") of count values from line first on, cols of width w to a line:
+ * its values into x. */
+static int v2_numeric_line(rec_reader *r, const char *what, long first, int count, int cols,
+                           int w, int integer, double *x)
+{
+    long row = r->lineno - first;
+    int at = (int)row * cols, n = count - at < cols ? count - at : cols;
+    char got[RECORD_GOT_MAX];
+    if (v2_fields(r->line, n, w, integer, x + at) == PD_OK)
+        return PD_OK;
+    return pd_err_set(r->err, PD_EPARSE,
+                      "%s:%ld: V2 %s header (lines %ld-%ld of the CDMG layout): expected %d %s "
+                      "in columns of %d, got %s", r->path, r->lineno, what, first,
+                      first + (count + cols - 1) / cols - 1, n,
+                      integer ? "integers" : "numbers", w, v2_got(r->line, got, sizeof got));
+}
+
+/* A line that starts a data block: "N POINTS OF X DATA ... SPACED AT H". */
+static int v2_data_header(const char *s)
+{
+    return find_nocase(s, "POINTS OF") && find_nocase(s, "SPACED AT");
+}
+
+/* Before the acceleration block: nothing of another block or channel (a
+ * lost or damaged acceleration header must not hand over what follows). */
+static int v2_boundary(rec_reader *r)
+{
+    static const char missing[] =
+        "before the first channel's acceleration block: its header 'N POINTS OF ACCEL DATA "
+        "EQUALLY SPACED AT H SEC' is missing or damaged";
+    const char *s = skip_blanks(r->line);
+    if (v2_data_header(s)) {
+        const char *kind = skip_blanks(find_nocase(s, "POINTS OF") + 9);
+        return pd_err_set(r->err, PD_EPARSE, "%s:%ld: a %.*s data block %s", r->path, r->lineno,
+                          word_len(kind), kind, missing);
+    }
+    if (s[0] == '/' && s[1] == '&')
+        return pd_err_set(r->err, PD_EPARSE, "%s:%ld: the end of a channel ('/&') %s", r->path,
+                          r->lineno, missing);
+    if (r->lineno > 1 && find_nocase(s, "CORRECTED ACCELEROGRAM") == s)
+        return pd_err_set(r->err, PD_EPARSE, "%s:%ld: a second channel's header %s", r->path,
+                          r->lineno, missing);
+    return PD_OK;
+}
+
+/* A text line's declarations: "N POINTS OF ... DATA" (CDMG's line 16) and
+ * "... INTERVALS OF H SEC." (its line 17); the first of each is kept. */
+static void v2_declared(rec_reader *r, v2_head *h)
+{
+    const char *s = skip_blanks(r->line), *at;
+    char *end = NULL;
+    if (!h->npts_line && find_nocase(s, "POINTS OF")) {
+        double n = strtod(s, &end);
+        if (end != s && parse_count(n, &h->npts) == PD_OK)
+            h->npts_line = r->lineno;
+    }
+    if (!h->dt_line && (at = find_nocase(s, "INTERVALS OF")) != NULL) {
+        h->dt = strtod(at + 12, &end);
+        if (end != at + 12)
+            h->dt_line = r->lineno;
+    }
+}
+
+/* The file ended (st 0) or failed (st < 0) before the acceleration block. */
+static int v2_header_end(rec_reader *r, const v2_head *h, int st)
+{
     if (st < 0)
         return st;
-    if (st == 0)
+    if (r->lineno == 0)
+        return pd_err_set(r->err, PD_EPARSE, "%s:1: empty file: expected a V2 header", r->path);
+    if (!h->cdmg)
         return pd_err_set(r->err, PD_EPARSE,
-                          r->lineno ? "%s:%ld: no V2 acceleration block ('N POINTS OF ACCEL "
-                                      "DATA EQUALLY SPACED AT H SEC')"
-                                    : "%s:%ld: empty file: expected a V2 header",
-                          r->path, r->lineno ? r->lineno : 1);
+                          "%s:%ld: no V2 acceleration block ('N POINTS OF ACCEL DATA EQUALLY "
+                          "SPACED AT H SEC')", r->path, r->lineno);
+    const char *where = "ends before the acceleration block header";
+    if (r->lineno < RECORD_V2_TEXT_LINES)
+        where = "ends in the V2 text header";
+    else if (r->lineno < RECORD_V2_TEXT_LINES + RECORD_V2_INT_LINES)
+        where = "ends in the V2 integer header";
+    else if (r->lineno < RECORD_V2_HEAD_LINES)
+        where = "ends in the V2 real header";
+    return pd_err_set(r->err, PD_EPARSE,
+                      "%s:%ld: the file %s (the CDMG layout: %d text, %d integer and %d real "
+                      "lines, the acceleration block header on line %d)", r->path, r->lineno,
+                      where, RECORD_V2_TEXT_LINES, RECORD_V2_INT_LINES, RECORD_V2_REAL_LINES,
+                      RECORD_V2_HEAD_LINES + 1);
+}
+
+/* Read a V2 header up to its first acceleration block's header (then the
+ * current line), holding it to its layout: the block within the first
+ * channel (v2_boundary); in the CDMG layout, 25 text lines, the integer
+ * and real headers in their columns and the block header right after them. */
+static int v2_header(rec_reader *r, v2_head *h)
+{
+    const long ints = RECORD_V2_TEXT_LINES + 1, reals = ints + RECORD_V2_INT_LINES;
+    const long block = RECORD_V2_HEAD_LINES + 1;
+    char got[RECORD_GOT_MAX];
+    int st, line1 = 0;
+    while ((st = next_line(r)) == 1) {
+        if (find_nocase(r->line, "POINTS OF ACCEL DATA")) {
+            if (h->cdmg && r->lineno != block)
+                return pd_err_set(r->err, PD_EPARSE,
+                                  "%s:%ld: the acceleration block header is on line %ld, but the "
+                                  "CDMG V2 header's %ld lines put it on line %ld (%d text, %d "
+                                  "integer, %d real: a header line lost or added?)", r->path,
+                                  r->lineno, r->lineno, block - 1, block, RECORD_V2_TEXT_LINES,
+                                  RECORD_V2_INT_LINES, RECORD_V2_REAL_LINES);
+            return PD_OK;
+        }
+        if ((st = v2_boundary(r)) != PD_OK)
+            return st;
+        if (r->lineno == 1)
+            line1 = find_nocase(r->line, "CORRECTED ACCELEROGRAM") != NULL;
+        if (r->lineno == 2)
+            h->cdmg = line1 && find_nocase(r->line, "UNCORRECTED ACCELEROGRAM DATA");
+        if (h->cdmg && r->lineno >= ints && r->lineno < reals)
+            st = v2_numeric_line(r, "integer", ints, RECORD_V2_INTS, RECORD_V2_INT_COLS,
+                                 RECORD_V2_INT_WIDTH, 1, h->ints);
+        else if (h->cdmg && r->lineno >= reals && r->lineno < block)
+            st = v2_numeric_line(r, "real", reals, RECORD_V2_REALS, RECORD_V2_REAL_COLS,
+                                 RECORD_V2_REAL_WIDTH, 0, h->reals);
+        else if (h->cdmg && r->lineno == block)
+            return pd_err_set(r->err, PD_EPARSE,
+                              "%s:%ld: expected the acceleration block header 'N POINTS OF "
+                              "ACCEL DATA EQUALLY SPACED AT H SEC' after the CDMG V2 header's "
+                              "%ld lines (%d text, %d integer, %d real), got %s", r->path,
+                              r->lineno, block - 1, RECORD_V2_TEXT_LINES, RECORD_V2_INT_LINES,
+                              RECORD_V2_REAL_LINES, v2_got(r->line, got, sizeof got));
+        else
+            v2_declared(r, h);
+        if (st != PD_OK)
+            return st;
+    }
+    return v2_header_end(r, h, st);
+}
+
+/* The acceleration block's npts and dt (its header the current line)
+ * against what the header declares. */
+static int v2_counts(rec_reader *r, const v2_head *h, long npts, double dt)
+{
+    static const char points[] = "%s:%ld: the acceleration block has %ld points, but the %s "
+                                 "header declares %.0f (line %ld)";
+    static const char spacing[] = "%s:%ld: the acceleration block is spaced at %g s, but the %s "
+                                  "header declares %g s (line %ld)";
+    const long ints = RECORD_V2_TEXT_LINES + 1, reals = ints + RECORD_V2_INT_LINES;
+    if (h->cdmg) {
+        double n = h->ints[RECORD_V2_INT_NPTS], h_dt = h->reals[RECORD_V2_REAL_DT];
+        if (n != (double)npts)
+            return pd_err_set(r->err, PD_EPARSE, points, r->path, r->lineno, npts, "integer", n,
+                              v2_value_line(ints, RECORD_V2_INT_NPTS, RECORD_V2_INT_COLS));
+        if (!(fabs(h_dt - dt) <= RECORD_V2_DT_TOL))
+            return pd_err_set(r->err, PD_EPARSE, spacing, r->path, r->lineno, dt, "real", h_dt,
+                              v2_value_line(reals, RECORD_V2_REAL_DT, RECORD_V2_REAL_COLS));
+    }
+    if (h->npts_line && h->npts != npts)
+        return pd_err_set(r->err, PD_EPARSE, points, r->path, r->lineno, npts, "text",
+                          (double)h->npts, h->npts_line);
+    if (h->dt_line && !(fabs(h->dt - dt) <= RECORD_V2_DT_TOL))
+        return pd_err_set(r->err, PD_EPARSE, spacing, r->path, r->lineno, dt, "text", h->dt,
+                          h->dt_line);
+    return PD_OK;
+}
+
+/* A COSMOS/CDMG V2 file: its first acceleration block, held to what its
+ * header declares (v2_header, v2_counts) and its values to the block's
+ * points (read_values: as many as declared before the next block). */
+static int read_v2(rec_reader *r, rec_buf *b, double *dt)
+{
+    v2_head h = {.cdmg = 0};
     long npts = 0;
     double scale = 0.01;
-    st = v2_npts_dt(r, &npts, dt);
+    int st = v2_header(r, &h);
+    if (st == PD_OK)
+        st = v2_npts_dt(r, &npts, dt);
     if (st == PD_OK)
         st = v2_units(r, &scale);
+    if (st == PD_OK)
+        st = v2_counts(r, &h, npts, *dt);
     if (st == PD_OK)
         st = read_values(r, npts, scale, 1, b);
     if (st == PD_OK)
@@ -771,7 +1020,7 @@ int pd_record_read(const char *path, pd_record_format format, pd_record_units un
                    pd_record *rec, pd_err *err)
 {
     if (!path || !rec)
-        return pd_err_set(err, PD_EINVAL, "pd_record_read: no file or no record");
+        return PD_NULL_ARG(err, !path ? "path" : "rec");
     *rec = (pd_record){.npts = 0};
     rec_reader r;
     rec_buf b = {0};

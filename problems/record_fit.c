@@ -40,6 +40,7 @@
 #include <gsl/gsl_multifit_nlinear.h>
 #include <gsl/gsl_vector.h>
 
+#include "pd_null.h"
 #include "pd_problems.h"
 
 #define FIT_MAXITER 400        /* trust-region iterations per start */
@@ -70,11 +71,11 @@ static int record_valid(const pd_record *rec, pd_err *err)
 
 int pd_record_integrate(const pd_record *rec, double *vel, double *disp, pd_err *err)
 {
+    if (!rec || !vel || !disp)
+        return PD_NULL_ARG(err, !rec ? "rec" : !vel ? "vel" : "disp");
     int st = record_valid(rec, err);
     if (st != PD_OK)
         return st;
-    if (!vel || !disp)
-        return pd_err_set(err, PD_EINVAL, "pd_record_integrate: no output arrays");
     const double *a = rec->acc, h = rec->dt;
     vel[0] = disp[0] = 0.0;
     for (long k = 0; k + 1 < rec->npts; k++) {
@@ -225,6 +226,8 @@ static int integrated(const pd_record *rec, double **v, double **d, pd_err *err)
 
 int pd_record_measure(const pd_record *rec, pd_record_measures *m, pd_err *err)
 {
+    if (!rec || !m)
+        return PD_NULL_ARG(err, !rec ? "rec" : "m");
     int st = record_valid(rec, err);
     if (st != PD_OK)
         return st;
@@ -555,9 +558,11 @@ static int fit_check(const pd_record *rec, const mp_pulse *p, double r2, pd_err 
 
 int pd_record_fit_pulse(const pd_record *rec, pd_record_pulse *out, pd_err *err)
 {
+    if (!rec || !out)
+        return PD_NULL_ARG(err, !rec ? "rec" : "out");
     int st = record_valid(rec, err);
-    if (st != PD_OK || !out)
-        return st != PD_OK ? st : pd_err_set(err, PD_EINVAL, "pd_record_fit_pulse: no output");
+    if (st != PD_OK)
+        return st;
     *out = (pd_record_pulse){.shape = PD_PULSE_SINE, .polarity = 1};
     double *v = NULL, *d = NULL;
     if (st == PD_OK)

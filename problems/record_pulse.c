@@ -9,6 +9,8 @@
  * |s| <= gamma / (2 fp); a = dv/dt. */
 void pd_record_pulse_eval(const pd_record_pulse *p, double t, double *acc, double *vel)
 {
+    if (!p || !acc || !vel)
+        return;
     double s = t - p->t0, w = PD_TWO_PI * p->fp;
     *acc = *vel = 0.0;
     if (!(p->fp > 0.0) || !(p->gamma > 0.0) || fabs(s) > p->gamma / (2.0 * p->fp))
@@ -23,6 +25,8 @@ void pd_record_pulse_eval(const pd_record_pulse *p, double t, double *acc, doubl
  * elsewhere: the ground acceleration the one-cycle pulse stands for. */
 double pd_record_one_cycle(const pd_record_pulse *p, double t)
 {
+    if (!p)
+        return NAN;
     double x = PD_TWO_PI * (t - p->t_start) / p->Tp;
     if (!(p->Tp > 0.0) || x < 0.0 || x > PD_TWO_PI)
         return 0.0;

@@ -2,6 +2,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "pd_null.h"
 #include "pd_problems.h"
 
 const char *pd_method_name(pd_method method)
@@ -15,15 +16,17 @@ const char *pd_method_name(pd_method method)
 
 int pd_method_parse(const char *name, pd_method *method)
 {
-    if (name && !strcmp(name, "moreau"))
+    if (!name || !method)
+        return PD_EINVAL;
+    if (!strcmp(name, "moreau"))
         *method = PD_METHOD_MOREAU;
-    else if (name && !strcmp(name, "event"))
+    else if (!strcmp(name, "event"))
         *method = PD_METHOD_EVENT;
-    else if (name && !strcmp(name, "penalty"))
+    else if (!strcmp(name, "penalty"))
         *method = PD_METHOD_PENALTY;
-    else if (name && !strcmp(name, "auto"))
+    else if (!strcmp(name, "auto"))
         *method = PD_METHOD_AUTO;
-    else if (name && !strcmp(name, "event-general"))
+    else if (!strcmp(name, "event-general"))
         *method = PD_METHOD_EVENT_GENERAL;
     else
         return PD_EINVAL;
@@ -56,6 +59,8 @@ pd_run_opts pd_run_default_opts(void)
 
 int pd_run_opts_check(const pd_run_opts *o, pd_err *err)
 {
+    if (!o)
+        return PD_NULL_ARG(err, "o");
     if (o->method != PD_METHOD_MOREAU && o->method != PD_METHOD_EVENT &&
         o->method != PD_METHOD_PENALTY && o->method != PD_METHOD_AUTO &&
         o->method != PD_METHOD_EVENT_GENERAL)

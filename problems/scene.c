@@ -13,6 +13,8 @@
 #include <string.h>
 
 #include "pd_problems.h"
+#include "pd_null.h"
+#include "scene_priv.h"
 
 #define SCENE_MAX_STOREYS 100000
 
@@ -44,6 +46,8 @@ void pd_scene_free(pd_scene *sc)
 
 pd_scene *pd_scene_copy(const pd_scene *sc)
 {
+    if (!sc)
+        return NULL;
     pd_scene *c = pd_scene_new(&sc->exc);
     int ok = c != NULL;
     for (int s = 0; ok && s < sc->nstruct; s++) {
@@ -112,6 +116,8 @@ static int names_grow(pd_scene *sc)
 
 int pd_scene_find(const pd_scene *sc, const char *name)
 {
+    if (!sc || !name)
+        return -2;
     if (!strcmp(name, "wall"))
         return PD_WALL;
     if (sc->name_cap == 0)
@@ -144,11 +150,23 @@ static pd_structure *new_structure(pd_scene *sc, const char *name, int storeys, 
         pd_err_set(err, PD_EINVAL, "name: must be 1 to %d characters", PD_NAME_MAX - 1);
         return NULL;
     }
+    /* names head CSV columns (NAME.x1), HDF5 groups (/structures/NAME) and
+     * JSON strings: nothing those read as syntax */
     for (const char *c = name; *c; c++)
-        if ((unsigned char)*c < 0x20 || *c == 0x7f || *c == '/') {
-            pd_err_set(err, PD_EINVAL, "name: may not contain '/' or control characters");
+        if ((unsigned char)*c < 0x20 || *c == 0x7f || strchr("/\\,\"'", *c)) {
+            pd_err_set(err, PD_EINVAL, "name: may not contain %s (it heads CSV columns and "
+                                       "HDF5 groups)",
+                       (unsigned char)*c < 0x20 || *c == 0x7f ? "control characters"
+                       : *c == ',' ? "','" : *c == '/' ? "'/'" : *c == '\\' ? "'\\'"
+                                                                              : "quotes");
             return NULL;
         }
+    if (!strcmp(name, ".") || !strcmp(name, "..") || name[0] == ' ' ||
+        name[strlen(name) - 1] == ' ') {
+        pd_err_set(err, PD_EINVAL, "name: '%s' is not a usable name (not '.' or '..', no space "
+                                   "at either end)", name);
+        return NULL;
+    }
     if (pd_scene_find(sc, name) != -2) {
         pd_err_set(err, PD_EINVAL, "name: '%s' %s", name,
                    strcmp(name, "wall") ? "is used twice" : "is reserved for the walls");
@@ -209,6 +227,8 @@ static int derived_stiffness(double k, double T0, double mass, pd_err *err)
 int pd_scene_add_sdof(pd_scene *sc, const char *name, double T0, double xi, double mass,
                       pd_err *err)
 {
+    if (!sc || !name)
+        return PD_NULL_ARG(err, !sc ? "sc" : "name");
     if (!positive(T0))
         return pd_err_set(err, PD_EINVAL, "T0: the period must be > 0 (got %g)", T0);
     if (!positive(mass))
@@ -226,7 +246,9 @@ int pd_scene_add_sdof(pd_scene *sc, const char *name, double T0, double xi, doub
 int pd_scene_add_building(pd_scene *sc, const char *name, int storeys, const double *masses,
                           const double *stiffnesses, double xi, pd_err *err)
 {
-    for (int i = 0; i < storeys; i++) {
+    if (!sc || !name || !masses || !stiffnesses)
+        return PD_NULL_ARG(err, !sc ? "sc" : !name ? "name" : !masses ? "masses" : "stiffnesses");
+    for (int i = 0; i < storeys && storeys <= SCENE_MAX_STOREYS; i++) {
         if (!positive(masses[i]))
             return pd_err_set(err, PD_EINVAL, "masses: storey %d has mass %g, must be > 0", i + 1,
                               masses[i]);
@@ -247,6 +269,8 @@ int pd_scene_add_building(pd_scene *sc, const char *name, int storeys, const dou
 int pd_scene_add_uniform(pd_scene *sc, const char *name, int storeys, double mass, double T0,
                          double xi, pd_err *err)
 {
+    if (!sc || !name)
+        return PD_NULL_ARG(err, !sc ? "sc" : "name");
     if (!positive(T0))
         return pd_err_set(err, PD_EINVAL, "T0: the period must be > 0 (got %g)", T0);
     if (!positive(mass))
@@ -266,6 +290,8 @@ int pd_scene_add_uniform(pd_scene *sc, const char *name, int storeys, double mas
 
 int pd_scene_set_damping(pd_scene *sc, pd_damping damping, int mode1, int mode2, pd_err *err)
 {
+    if (!sc)
+        return PD_NULL_ARG(err, "sc");
     if (sc->nstruct == 0)
         return pd_err_set(err, PD_EINVAL, "damping: no structure to apply it to");
     pd_structure *st = &sc->st[sc->nstruct - 1];
@@ -286,6 +312,8 @@ int pd_scene_set_damping(pd_scene *sc, pd_damping damping, int mode1, int mode2,
 int pd_scene_add_contact(pd_scene *sc, int a, int level_a, int b, int level_b, double gap,
                          double eps, int entry, pd_err *err)
 {
+    if (!sc)
+        return PD_NULL_ARG(err, "sc");
     if (!(gap >= 0.0) || !isfinite(gap))
         return pd_err_set(err, PD_EINVAL, "gap: must be >= 0 (got %g)", gap);
     if (!(eps >= 0.0 && eps <= 1.0))
@@ -382,9 +410,10 @@ static int structure_damping(pd_structure *st, pd_err *err)
 {
     double w1[2], w[2];
     int rc;
-    if ((rc = structure_frequencies(st, 1, 1, w1)))
+    if ((rc = structure_frequencies(st, 1, st->storeys, w1)))
         return pd_err_set(err, rc, "out of memory for the modes of '%s'", st->name);
     st->T0 = PD_TWO_PI / w1[0];
+    st->Tmin = PD_TWO_PI / w1[1];
     if (st->storeys == 1 || st->damping == PD_DAMPING_STIFFNESS) {
         st->period[0] = st->period[1] = st->T0;
         st->alpha = st->storeys == 1 ? 2.0 * st->xi * w1[0] : 0.0;
@@ -418,9 +447,91 @@ static int check_excitation(const pd_scene_excitation *x, pd_err *err)
     return PD_OK;
 }
 
+/* Entries of the contact matrices Moreau–Jean forms (What^-1 W, D =
+ * W^T What^-1 W) at most: a building's What^-1 is dense, so its c contacts
+ * fill c (c + storeys) of them; a row of 10^5 SDOFs needs 6 10^5, ten
+ * buildings of 1000 storeys touching at every floor 6 10^7. */
+#define SCENE_COUPLING_MAX 1e8
+
+/* A contact's floors as a sortable key, with its index. */
+typedef struct contact_key {
+    int a, la, b, lb, k;
+} contact_key;
+
+static int key_cmp(const void *x, const void *y)
+{
+    const contact_key *p = x, *q = y;
+    int d = p->a != q->a ? (p->a > q->a) - (p->a < q->a)
+            : p->la != q->la ? (p->la > q->la) - (p->la < q->la)
+            : p->b != q->b ? (p->b > q->b) - (p->b < q->b)
+                           : (p->lb > q->lb) - (p->lb < q->lb);
+    return d ? d : (p->k > q->k) - (p->k < q->k);
+}
+
+/* No two contacts join the same two floors (a redundant constraint: its
+ * LCP is singular); PD_EINVAL naming the second entry. */
+static int check_duplicates(const pd_scene *sc, pd_err *err)
+{
+    int m = sc->ncontact, rc = PD_OK;
+    if (m < 2)
+        return PD_OK;
+    contact_key *key = malloc((size_t)m * sizeof *key);
+    if (!key)
+        return pd_err_set(err, PD_ENOMEM, "out of memory for %d contacts", m);
+    for (int k = 0; k < m; k++)
+        key[k] = (contact_key){.a = sc->ct[k].a, .la = sc->ct[k].level_a, .b = sc->ct[k].b,
+                               .lb = sc->ct[k].level_b, .k = k};
+    qsort(key, (size_t)m, sizeof *key, key_cmp);
+    for (int k = 1; k < m && !rc; k++) {
+        const contact_key *p = &key[k - 1], *q = &key[k];
+        if (p->a == q->a && p->la == q->la && p->b == q->b && p->lb == q->lb) {
+            const pd_contact *c = &sc->ct[q->k];
+            rc = pd_err_set(err, PD_EINVAL, "contacts[%d]: '%s' storey %d and '%s' storey %d are "
+                            "joined twice (also by contacts[%d])",
+                            c->entry, c->a == PD_WALL ? "wall" : sc->st[c->a].name, c->level_a,
+                            c->b == PD_WALL ? "wall" : sc->st[c->b].name, c->level_b,
+                            sc->ct[p->k].entry);
+        }
+    }
+    free(key);
+    return rc;
+}
+
+/* The contact matrices' fill within SCENE_COUPLING_MAX, counted contact by
+ * contact; PD_EINVAL naming the entry that passes it. */
+static int check_coupling(const pd_scene *sc, pd_err *err)
+{
+    double fill = 0.0;
+    long *c = calloc((size_t)sc->nstruct, sizeof *c);
+    if (!c)
+        return pd_err_set(err, PD_ENOMEM, "out of memory for %d structures", sc->nstruct);
+    int rc = PD_OK;
+    for (int k = 0; k < sc->ncontact && !rc; k++) {
+        const int side[2] = {sc->ct[k].a, sc->ct[k].b};
+        for (int j = 0; j < 2; j++) {
+            int s = side[j];
+            if (s == PD_WALL)
+                continue;
+            fill += 2.0 * (double)c[s] + 1.0 + sc->st[s].storeys; /* (c+1)(c+1+n) - c(c+n) */
+            c[s]++;
+        }
+        if (!(fill <= SCENE_COUPLING_MAX))
+            rc = pd_err_set(err, PD_EINVAL, "contacts[%d]: the contacts up to here couple through "
+                            "their structures into contact matrices of %.3g entries (at most "
+                            "%.3g; %ld contacts on '%s')",
+                            sc->ct[k].entry, fill, SCENE_COUPLING_MAX,
+                            c[side[0] == PD_WALL ? side[1] : side[0]],
+                            sc->st[side[0] == PD_WALL ? side[1] : side[0]].name);
+    }
+    free(c);
+    return rc;
+}
+
 int pd_scene_finish(pd_scene *sc, pd_err *err)
 {
     int rc, dof = 0;
+    if (!sc)
+        return PD_NULL_ARG(err, "sc");
     if (sc->nstruct == 0)
         return pd_err_set(err, PD_EINVAL, "structures: the row is empty");
     if ((rc = check_excitation(&sc->exc, err)))
@@ -441,15 +552,19 @@ int pd_scene_finish(pd_scene *sc, pd_err *err)
                               "and stiffnesses out of proportion?)",
                               st->name, st->T0, st->alpha, st->beta);
     }
+    if ((rc = check_duplicates(sc, err)) || (rc = check_coupling(sc, err)))
+        return rc;
     sc->n = dof;
     sc->finished = 1;
     return PD_OK;
 }
 
-double pd_scene_wp(const pd_scene *sc) { return PD_TWO_PI / sc->exc.Tp; }
+double pd_scene_wp(const pd_scene *sc) { return sc ? PD_TWO_PI / sc->exc.Tp : NAN; }
 
 double pd_scene_Le(const pd_scene *sc)
 {
+    if (!sc)
+        return NAN;
     double wp = pd_scene_wp(sc);
     return sc->exc.ap / (wp * wp);
 }
@@ -469,6 +584,8 @@ static void period_range(const pd_scene *sc, double *Tmin, double *Tmax, double 
 
 double pd_scene_default_dt(const pd_scene *sc)
 {
+    if (!sc)
+        return NAN;
     double Tmin, Tmax, ximin;
     period_range(sc, &Tmin, &Tmax, &ximin);
     return fmin(sc->exc.Tp, Tmin) / 2000.0;
@@ -493,20 +610,89 @@ static pd_osc envelope_case(const pd_scene *sc)
 
 double pd_scene_default_tend(const pd_scene *sc)
 {
+    if (!sc)
+        return NAN;
     pd_osc c = envelope_case(sc);
     return pd_osc_default_tend(&c);
 }
 
 double pd_scene_measure_start(const pd_scene *sc, double tend)
 {
+    if (!sc)
+        return NAN;
     pd_osc c = envelope_case(sc);
     return pd_osc_measure_start(&c, tend);
+}
+
+/* Points per shortest period the methods that follow every mode take (the
+ * oscillator's scan), and at most this many of them over a run, per
+ * structure and contact element: about 10 s of the row reference (2 µs a
+ * point on a stiff building), 25 s of event-general. */
+#define SCENE_SCAN_DIV 64.0
+#define SCENE_MAX_POINTS 5e6
+/* The row reference evaluates a building's n storeys through its 2n modes
+ * at every point: at most this many points times n^2 (a uniform building
+ * of 50 storeys over 4.5 s: 2.3e7, 0.8 s; 100 storeys: 1.8e8, 17 s). */
+#define SCENE_MAX_MODAL_WORK 1e8
+
+/* The floor mass at storey level (1-based) of structure s; INFINITY at a wall. */
+static double floor_mass(const pd_scene *sc, int s, int level)
+{
+    return s == PD_WALL ? INFINITY : sc->st[s].mass[level - 1];
+}
+
+/* The work of the methods that resolve every mode (all but Moreau–Jean,
+ * whose implicit step is stable at any period) within their budget: a 64th
+ * of the shortest period of each structure (and, for Kelvin–Voigt
+ * elements, of each contact element on its two floors) over the run. */
+static int check_budget(const pd_scene *sc, const pd_run_opts *o, pd_err *err)
+{
+    if (o->method == PD_METHOD_MOREAU)
+        return PD_OK;
+    const char *m = pd_method_name(o->method);
+    for (int s = 0; s < sc->nstruct; s++) {
+        const pd_structure *st = &sc->st[s];
+        double pts = SCENE_SCAN_DIV * o->tend / st->Tmin;
+        if (!(pts <= SCENE_MAX_POINTS))
+            return pd_err_set(err, PD_EINVAL,
+                              "structures[%d] ('%s'): its highest mode has a period of %.3g s; "
+                              "--method %s would follow it at %.3g points over %.3g s (at most "
+                              "%.3g): --method moreau runs it",
+                              s, st->name, st->Tmin, m, pts, o->tend, SCENE_MAX_POINTS);
+        double work = pts * st->storeys * (double)st->storeys;
+        if (o->method == PD_METHOD_EVENT && st->storeys > 1 && !(work <= SCENE_MAX_MODAL_WORK))
+            return pd_err_set(err, PD_EINVAL,
+                              "structures[%d] ('%s'): --method event follows its %d storeys "
+                              "through their modes, %.3g points times %d^2 over %.3g s (at most "
+                              "%.3g): --method moreau runs it",
+                              s, st->name, st->storeys, pts, st->storeys, o->tend,
+                              SCENE_MAX_MODAL_WORK);
+    }
+    if (o->method != PD_METHOD_PENALTY || o->pen.law != PD_PENALTY_KELVIN)
+        return PD_OK;
+    double kc = pd_scene_penalty_kc(sc, o);
+    for (int a = 0; a < sc->ncontact; a++) {
+        const pd_contact *ct = &sc->ct[a];
+        double ma = floor_mass(sc, ct->a, ct->level_a), mb = floor_mass(sc, ct->b, ct->level_b);
+        double mred = isinf(ma) ? mb : isinf(mb) ? ma : ma * mb / (ma + mb);
+        double Tc = PD_TWO_PI * sqrt(mred / kc), pts = SCENE_SCAN_DIV * o->tend / Tc;
+        if (!(pts <= SCENE_MAX_POINTS))
+            return pd_err_set(err, PD_EINVAL,
+                              "contacts[%d]: its element (kc = %.3g N/m on %.3g kg) vibrates with "
+                              "a period of %.3g s; --method penalty would follow it at %.3g "
+                              "points over %.3g s (at most %.3g): a softer --kc, or --method "
+                              "moreau, runs it",
+                              ct->entry, kc, mred, Tc, pts, o->tend, SCENE_MAX_POINTS);
+    }
+    return PD_OK;
 }
 
 int pd_scene_resolve_opts(const pd_scene *sc, const pd_run_opts *in, pd_run_opts *out,
                           pd_err *err)
 {
     int rc;
+    if (!sc || !out)
+        return PD_NULL_ARG(err, !sc ? "sc" : "out");
     *out = in ? *in : pd_run_default_opts();
     if (!sc->finished)
         return pd_err_set(err, PD_EINVAL, "scene: not finished (pd_scene_finish)");
@@ -521,12 +707,12 @@ int pd_scene_resolve_opts(const pd_scene *sc, const pd_run_opts *in, pd_run_opts
     if (!(out->tend / out->dt <= PD_MAX_STEPS))
         return pd_err_set(err, PD_EINVAL, "dt: tend / dt = %g steps is too many (at most %.0e)",
                           out->tend / out->dt, PD_MAX_STEPS);
-    return PD_OK;
+    return check_budget(sc, out, err);
 }
 
 int pd_scene_as_oscillator(const pd_scene *sc, pd_osc *c, int *mirrored)
 {
-    if (!sc->finished || sc->nstruct != 1 || sc->st[0].storeys != 1 || sc->ncontact > 1)
+    if (!sc || !c || !mirrored || !sc->finished || sc->nstruct != 1 || sc->st[0].storeys != 1 || sc->ncontact > 1)
         return 0;
     const pd_contact *ct = sc->ncontact ? &sc->ct[0] : NULL;
     if (ct && ct->a != PD_WALL && ct->b != PD_WALL)
@@ -562,6 +748,8 @@ static void scene_force(double tau, int side, double *F, void *ctx)
 
 void pd_scene_model_free(pd_scene_model *sm)
 {
+    if (!sm)
+        return;
     pd_sparse_free(&sm->M);
     pd_sparse_free(&sm->C);
     pd_sparse_free(&sm->K);
@@ -632,6 +820,8 @@ static int side_dof(const pd_scene *sc, int s, int level)
 int pd_scene_model_build(const pd_scene *sc, int with_contacts, pd_scene_model *sm, pd_err *err)
 {
     triplets M = {0}, K = {0}, C = {0}, W = {0};
+    if (!sc || !sm)
+        return PD_NULL_ARG(err, !sc ? "sc" : "sm");
     int n = sc->n, m = with_contacts ? sc->ncontact : 0, rc = PD_OK;
     double wp = pd_scene_wp(sc), Le = pd_scene_Le(sc);
     memset(sm, 0, sizeof *sm);
@@ -701,6 +891,8 @@ int pd_scene_chain(int N, const pd_scene_excitation *exc, double T0, double rati
     pd_scene *sc;
     char name[PD_NAME_MAX];
     int rc = PD_OK;
+    if (!out)
+        return PD_NULL_ARG(err, "out");
     *out = NULL;
     if (N < 1 || N > 10000000)
         return pd_err_set(err, PD_EINVAL, "chain: N must be in [1, 1e7] (got %d)", N);

@@ -16,6 +16,7 @@
 
 #include <jansson.h>
 
+#include "pd_null.h"
 #include "pd_problems.h"
 #include "pd_core.h"
 
@@ -42,6 +43,7 @@
 #define SCENE_SCALE_MAX 1e6
 #define SCENE_GAP_MAX 1e3      /* m */
 #define SCENE_TEND_MAX 1e5     /* s, about a day of motion */
+#define SCENE_LEVELS_MAX 100000 /* entries of one levels or pairs list */
 
 /* The file being read. */
 typedef struct loader {
@@ -580,9 +582,11 @@ static int read_levels(loader *L, json_t *ct, const char *path, int **la, int **
         return fail(L, field(at, sizeof at, path, "pairs"), "give levels or pairs, not both");
     size_t n = list ? json_array_size(list) : 1;
     field(at, sizeof at, path, levels ? "levels" : "pairs");
-    if (list && (!json_is_array(list) || n == 0 || n > 100000))
+    if (list && (!json_is_array(list) || n == 0))
         return fail(L, at, levels ? "expected a non-empty array of storeys [i, ...]"
                                   : "expected a non-empty array of pairs [[level_a, level_b], ...]");
+    if (n > SCENE_LEVELS_MAX)
+        return fail(L, at, "%zu entries: at most %d", n, SCENE_LEVELS_MAX);
     *la = malloc(n * sizeof(int));
     *lb = malloc(n * sizeof(int));
     if (!*la || !*lb)
@@ -736,6 +740,8 @@ int pd_scene_load(const char *path, pd_scene **out, pd_err *err)
     loader L = {.path = path, .err = err};
     json_error_t je;
     int rc;
+    if (!path || !out)
+        return PD_NULL_ARG(err, !path ? "path" : "out");
     *out = NULL;
     pd_err_clear(err);
     if ((rc = slurp(&L)))

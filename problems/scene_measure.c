@@ -17,6 +17,8 @@ int pd_scene_trace_alloc(pd_scene_trace *tr, const pd_scene *sc, const pd_run_op
 {
     pd_run_opts r;
     int rc;
+    if (!tr)
+        return pd_err_set(err, PD_EINVAL, "trace: NULL");
     memset(tr, 0, sizeof *tr);
     if ((rc = pd_scene_resolve_opts(sc, o, &r, err)))
         return rc;
@@ -35,12 +37,16 @@ int pd_scene_trace_alloc(pd_scene_trace *tr, const pd_scene *sc, const pd_run_op
 
 void pd_scene_trace_free(pd_scene_trace *tr)
 {
+    if (!tr)
+        return;
     free(tr->x);
     memset(tr, 0, sizeof *tr);
 }
 
 void pd_scene_errors_free(pd_scene_errors *e)
 {
+    if (!e)
+        return;
     free(e->err_umax);
     free(e->err_hist);
     memset(e, 0, sizeof *e);
@@ -48,13 +54,28 @@ void pd_scene_errors_free(pd_scene_errors *e)
 
 int pd_scene_errors_alloc(const pd_scene *sc, pd_scene_errors *e, pd_err *err)
 {
+    if (!e)
+        return pd_err_set(err, PD_EINVAL, "errors: NULL");
     memset(e, 0, sizeof *e);
+    if (!sc || !sc->finished)
+        return pd_err_set(err, PD_EINVAL, "scene: %s", sc ? "not finished (pd_scene_finish)"
+                                                          : "NULL");
     e->err_umax = calloc((size_t)sc->nstruct, sizeof(double));
     e->err_hist = calloc((size_t)sc->nstruct, sizeof(double));
     if (!e->err_umax || !e->err_hist) {
         pd_scene_errors_free(e);
         return pd_err_set(err, PD_ENOMEM, "out of memory for the errors");
     }
+    e->nstruct = sc->nstruct;
+    return PD_OK;
+}
+
+/* PD_OK when the trace was allocated for sc's shape (and holds room). */
+static int trace_fits(const pd_scene *sc, const pd_scene_trace *tr, pd_err *err)
+{
+    if (!tr || !tr->x || tr->n != sc->n || tr->cap < 1 || tr->rows < 0 || tr->rows > tr->cap)
+        return pd_err_set(err, PD_EINVAL, "the reference trace is not allocated for this scene "
+                                          "(pd_scene_trace_alloc)");
     return PD_OK;
 }
 
@@ -86,8 +107,12 @@ int pd_scene_measure_reference(const pd_scene *sc, const pd_run_opts *o, pd_scen
     pd_run_opts r;
     pd_scene_result timed;
     int rc;
-    if ((rc = pd_scene_resolve_opts(sc, o, &r, err))) /* dt 0: the scene's default */
+    if ((rc = pd_scene_resolve_opts(sc, o, &r, err)) || /* dt 0: the scene's default */
+        (rc = trace_fits(sc, ref, err)))
         return rc;
+    if (!pd_scene_result_fits(sc, res))
+        return pd_err_set(err, PD_EINVAL, "the result is not allocated for this scene "
+                                          "(pd_scene_result_alloc)");
     r.method = PD_METHOD_EVENT;
     ref->rows = 0;
     ref->dt = r.dt;
@@ -140,8 +165,12 @@ int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scen
     pd_scene_result timed;
     pd_run_opts r;
     int rc;
-    if ((rc = pd_scene_resolve_opts(sc, o, &r, err)))
+    if ((rc = pd_scene_resolve_opts(sc, o, &r, err)) || (rc = trace_fits(sc, ref, err)))
         return rc;
+    if (!pd_scene_result_fits(sc, ref_res) || !pd_scene_result_fits(sc, res) || !e ||
+        e->nstruct != sc->nstruct || !e->err_umax || !e->err_hist)
+        return pd_err_set(err, PD_EINVAL, "the results or errors are not allocated for this "
+                                          "scene (pd_scene_result_alloc, pd_scene_errors_alloc)");
     double ratio = r.dt / ref->dt;
     long stride = lround(ratio);
     if (stride < 1 || fabs(ratio - (double)stride) > 1e-9 * ratio)

@@ -20,9 +20,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pd_null.h"
 #include "pd_problems.h"
+#include "scene_priv.h"
 
-#define SCENE_PEN_KC 1e4 /* the default contact stiffness: this * the stiffest storey's */
 
 /* What a run tracks, in reference units. */
 typedef struct track {
@@ -55,8 +56,13 @@ typedef struct track {
 
 int pd_scene_result_alloc(const pd_scene *sc, pd_scene_result *r, pd_err *err)
 {
-    size_t n = (size_t)sc->n, m = (size_t)(sc->ncontact > 0 ? sc->ncontact : 1);
+    if (!r)
+        return pd_err_set(err, PD_EINVAL, "result: NULL");
     memset(r, 0, sizeof *r);
+    if (!sc || !sc->finished)
+        return pd_err_set(err, PD_EINVAL, "scene: %s", sc ? "not finished (pd_scene_finish)"
+                                                          : "NULL");
+    size_t n = (size_t)sc->n, m = (size_t)(sc->ncontact > 0 ? sc->ncontact : 1);
     r->n = sc->n;
     r->m = sc->ncontact;
     r->umax = calloc(n, sizeof(double));
@@ -76,8 +82,17 @@ int pd_scene_result_alloc(const pd_scene *sc, pd_scene_result *r, pd_err *err)
     return PD_OK;
 }
 
+int pd_scene_result_fits(const pd_scene *sc, const pd_scene_result *r)
+{
+    return sc && r && r->n == sc->n && r->m == sc->ncontact && r->umax && r->u_pos && r->u_neg &&
+           r->drift && r->impacts && r->first_impact && r->max_impulse && r->contact_time &&
+           r->approach;
+}
+
 void pd_scene_result_free(pd_scene_result *r)
 {
+    if (!r)
+        return;
     free(r->umax);
     free(r->u_pos);
     free(r->u_neg);
@@ -549,6 +564,7 @@ static int run_event_general(const pd_model *md, const pd_run_opts *o, double ta
     eo.h_out = tr->fn ? tr->h : 0.0;
     eo.no_accumulation = o->no_accumulation;
     eo.on_step = step_event;
+    eo.time_unit = 1.0 / tr->wp;
     eo.on_step_ctx = tr;
     eo.factor = o->factor;
     eo.lcp_solver = o->lcp_solver;
@@ -563,13 +579,20 @@ static int run_event_general(const pd_model *md, const pd_run_opts *o, double ta
 }
 
 /* Largest storey stiffness of the scene [N/m]. */
-static double stiffest(const pd_scene *sc)
+double pd_scene_stiffest(const pd_scene *sc)
 {
     double k = 0.0;
     for (int s = 0; s < sc->nstruct; s++)
         for (int i = 0; i < sc->st[s].storeys; i++)
             k = fmax(k, sc->st[s].stiffness[i]);
     return k;
+}
+
+double pd_scene_penalty_kc(const pd_scene *sc, const pd_run_opts *o)
+{
+    if (o->pen.kc_abs > 0.0)
+        return o->pen.kc_abs;
+    return (o->pen.kc_mult > 0.0 ? o->pen.kc_mult : SCENE_PEN_KC) * pd_scene_stiffest(sc);
 }
 
 /* The penalty baseline on the scene's model: kc in reference units is
@@ -585,11 +608,12 @@ static int run_penalty(const pd_model *md, const pd_run_opts *o, double tau_end,
     if (o->pen.kc_abs > 0.0)
         po.kc = o->pen.kc_abs * (o->pen.law == PD_PENALTY_HERTZDAMP ? sqrt(tr->Le) : 1.0) / wp2;
     else
-        po.kc = (o->pen.kc_mult > 0.0 ? o->pen.kc_mult : SCENE_PEN_KC) * stiffest(tr->sc) / wp2;
+        po.kc = pd_scene_penalty_kc(tr->sc, o) / wp2;
     po.rtol = o->pen.rtol;
     po.atol = o->pen.atol;
     po.stepper = o->pen.stepper;
     po.h_out = tr->fn ? tr->h : 0.0;
+    po.time_unit = 1.0 / tr->wp;
     po.on_step = step_penalty;
     po.on_step_ctx = tr;
     po.factor = o->factor;
@@ -648,7 +672,11 @@ int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler s
     pd_osc c;
     int mirrored, rc;
     pd_err_clear(err);
-    if (!res || res->n != sc->n || res->m != sc->ncontact || !res->umax)
+    if (!sc || !res)
+        return PD_NULL_ARG(err, !sc ? "sc" : "res");
+    if (!sc->finished)
+        return pd_err_set(err, PD_EINVAL, "scene: not finished (pd_scene_finish)");
+    if (!pd_scene_result_fits(sc, res))
         return pd_err_set(err, PD_EINVAL, "the result is not allocated for this scene "
                                           "(pd_scene_result_alloc)");
     if ((rc = pd_scene_resolve_opts(sc, opts, &o, err)))
@@ -680,6 +708,8 @@ int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler s
 
 void pd_scene_summary_free(pd_scene_summary *s)
 {
+    if (!s)
+        return;
     pd_scene_result_free(&s->r);
     pd_scene_result_free(&s->free);
     free(s->Pi1);
@@ -694,6 +724,10 @@ int pd_scene_summarize(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sam
                        void *ctx, pd_scene_summary *s, pd_err *err)
 {
     pd_run_opts twin = opts ? *opts : pd_run_default_opts();
+    if (!sc || !s)
+        return PD_NULL_ARG(err, !sc ? "sc" : "s");
+    if (!sc->finished)
+        return pd_err_set(err, PD_EINVAL, "scene: not finished (pd_scene_finish)");
     size_t n = (size_t)sc->n, m = (size_t)(sc->ncontact > 0 ? sc->ncontact : 1);
     int rc;
     memset(s, 0, sizeof *s);

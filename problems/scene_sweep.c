@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pd_null.h"
 #include "pd_problems.h"
 
 #ifdef _OPENMP
@@ -13,16 +14,20 @@
 
 long pd_scene_sweep_twins(const pd_scene_sweep *w)
 {
-    return w->npi2;
+    return w ? w->npi2 : 0;
 }
 
 long pd_scene_sweep_points(const pd_scene_sweep *w)
 {
+    if (!w)
+        return 0;
     return (long)w->npi2 * (w->npi3 > 0 ? w->npi3 : 1) * (w->neps > 0 ? w->neps : 1);
 }
 
 int pd_scene_sweep_check(const pd_scene_sweep *w, pd_err *err)
 {
+    if (!w)
+        return PD_NULL_ARG(err, "w");
     const pd_scene *sc = w->sc;
     if (!sc || !sc->finished)
         return pd_err_set(err, PD_EINVAL, "scene: not finished");
@@ -43,6 +48,10 @@ int pd_scene_sweep_check(const pd_scene_sweep *w, pd_err *err)
                               "to a Pi3",
                               w->ref_contact);
     }
+    if ((w->npi3 > 0 && !w->pi3) || (w->neps > 0 && !w->eps))
+        return pd_err_set(err, PD_EINVAL, "%s: %d values but no list",
+                          w->npi3 > 0 && !w->pi3 ? "Pi3" : "eps",
+                          w->npi3 > 0 && !w->pi3 ? w->npi3 : w->neps);
     for (int i = 0; i < w->npi3; i++)
         if (!(w->pi3[i] >= 0.0) || !isfinite(w->pi3[i]))
             return pd_err_set(err, PD_EINVAL, "Pi3: must be >= 0 (got %g)", w->pi3[i]);
@@ -56,6 +65,15 @@ int pd_scene_sweep_check(const pd_scene_sweep *w, pd_err *err)
 int pd_scene_sweep_scene(const pd_scene_sweep *w, long task, pd_scene **out, pd_scene_point *pt,
                          pd_err *err)
 {
+    int rc;
+    if (!w || !out || !pt)
+        return PD_NULL_ARG(err, !w ? "w" : !out ? "out" : "pt");
+    *out = NULL;
+    if ((rc = pd_scene_sweep_check(w, err)))
+        return rc;
+    if (task < 0 || task >= pd_scene_sweep_twins(w) + pd_scene_sweep_points(w))
+        return pd_err_set(err, PD_EINVAL, "task: %ld is not one of the sweep's %ld", task,
+                          pd_scene_sweep_twins(w) + pd_scene_sweep_points(w));
     const pd_scene *sc = w->sc;
     long ntw = pd_scene_sweep_twins(w), p = task - ntw;
     int twin = task < ntw, j = (int)(twin ? task : p % w->npi2);
@@ -63,8 +81,6 @@ int pd_scene_sweep_scene(const pd_scene_sweep *w, long task, pd_scene **out, pd_
     int i3 = w->npi3 > 0 ? (int)(rest % w->npi3) : 0;
     int ie = w->npi3 > 0 ? (int)(rest / w->npi3) : (int)rest;
     pd_scene *c = pd_scene_copy(sc);
-    int rc;
-    *out = NULL;
     if (!c)
         return pd_err_set(err, PD_ENOMEM, "out of memory for a copy of the scene");
     memset(pt, 0, sizeof *pt);
@@ -87,8 +103,8 @@ int pd_scene_sweep_scene(const pd_scene_sweep *w, long task, pd_scene **out, pd_
     }
     pt->Tp = c->exc.Tp;
     pt->Le = Le;
-    pt->Pi3 = c->ncontact > 0 ? c->ct[w->ref_contact < c->ncontact ? w->ref_contact : 0].gap / Le
-                              : NAN;
+    int refc = w->ref_contact >= 0 && w->ref_contact < c->ncontact ? w->ref_contact : 0;
+    pt->Pi3 = c->ncontact > 0 ? c->ct[refc].gap / Le : NAN;
     pt->eps = c->ncontact > 0 ? c->ct[0].eps : NAN;
     *out = c;
     return PD_OK;
@@ -103,7 +119,7 @@ static int run_task(const pd_scene_sweep *w, long t, pd_scene_point *pt, double 
     pd_run_opts o = w->opts;
     int rc;
     if ((rc = pd_scene_sweep_scene(w, t, &c, pt, err)))
-        return rc;
+        return pt->status = rc; /* the run's own status: pd_scene_sweep_run returns it */
     o.no_wall = t < pd_scene_sweep_twins(w);
     if (!(rc = pd_scene_result_alloc(c, &r, err))) {
         rc = pd_scene_run(c, &o, NULL, NULL, &r, err);
@@ -127,10 +143,13 @@ static int run_task(const pd_scene_sweep *w, long t, pd_scene_point *pt, double 
 int pd_scene_sweep_run(const pd_scene_sweep *w, int threads, pd_scene_point *pts, double *umax,
                        pd_err *err)
 {
+    if (!w || !pts || !umax)
+        return PD_NULL_ARG(err, !w ? "w" : !pts ? "pts" : "umax");
     long n = pd_scene_sweep_twins(w) + pd_scene_sweep_points(w), first_bad = -1;
-    int ns = w->sc->nstruct, rc;
+    int rc;
     if ((rc = pd_scene_sweep_check(w, err)))
         return rc;
+    int ns = w->sc->nstruct;
 #ifdef _OPENMP
     int nt = threads > 0 ? threads : omp_get_max_threads();
 #else

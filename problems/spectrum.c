@@ -6,10 +6,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pd_null.h"
 #include "pd_problems.h"
+
+static int check_lists(const pd_spectrum *s, pd_err *err);
 
 void pd_spec_init(pd_spectrum *s)
 {
+    if (!s)
+        return;
     memset(s, 0, sizeof *s);
     s->base = pd_osc_default();
     s->opts = pd_run_default_opts();
@@ -24,17 +29,21 @@ void pd_spec_init(pd_spectrum *s)
 
 long pd_spec_curves(const pd_spectrum *s)
 {
+    if (!s)
+        return 0;
     return (long)s->npulse * s->ndir * s->nap * s->nxi * s->nsize * s->neps;
 }
 
-long pd_spec_points(const pd_spectrum *s) { return pd_spec_curves(s) * s->npi2; }
+long pd_spec_points(const pd_spectrum *s) { return s ? pd_spec_curves(s) * s->npi2 : 0; }
 
 long pd_spec_twins(const pd_spectrum *s)
 {
+    if (!s)
+        return 0;
     return (long)s->npulse * s->ndir * s->nap * s->nxi * s->npi2;
 }
 
-long pd_spec_tasks(const pd_spectrum *s) { return pd_spec_twins(s) + pd_spec_points(s); }
+long pd_spec_tasks(const pd_spectrum *s) { return s ? pd_spec_twins(s) + pd_spec_points(s) : 0; }
 
 double pd_grid_value(double lo, double hi, int n, int linear, int j)
 {
@@ -50,6 +59,8 @@ double pd_grid_value(double lo, double hi, int n, int linear, int j)
 
 double pd_spec_pi2(const pd_spectrum *s, int j)
 {
+    if (!s)
+        return NAN;
     return pd_grid_value(s->pi2_min, s->pi2_max, s->npi2, s->linear, j);
 }
 
@@ -66,8 +77,12 @@ static void group_digits(const pd_spectrum *s, long g, pd_spec_coords *co)
 
 void pd_spec_coords_of(const pd_spectrum *s, long task, pd_spec_coords *co)
 {
+    if (!s || !co)
+        return;
     long ntw = pd_spec_twins(s);
     memset(co, 0, sizeof *co);
+    if (check_lists(s, NULL))
+        return; /* an empty list or grid: nothing to split by */
     if (task < ntw) {
         co->twin = 1;
         co->curve = -1;
@@ -86,6 +101,8 @@ void pd_spec_coords_of(const pd_spectrum *s, long task, pd_spec_coords *co)
 
 long pd_spec_twin_of(const pd_spectrum *s, long task)
 {
+    if (!s || check_lists(s, NULL))
+        return -1;
     long p = task - pd_spec_twins(s);
     long group = (p / s->npi2) / ((long)s->nsize * s->neps);
     return group * s->npi2 + p % s->npi2;
@@ -94,6 +111,14 @@ long pd_spec_twin_of(const pd_spectrum *s, long task)
 int pd_spec_case(const pd_spectrum *s, long task, pd_osc *c, pd_run_opts *o, pd_err *err)
 {
     pd_spec_coords co;
+    int rc;
+    if (!s || !c || !o)
+        return PD_NULL_ARG(err, !s ? "s" : !c ? "c" : "o");
+    if ((rc = check_lists(s, err)))
+        return rc;
+    if (task < 0 || task >= pd_spec_tasks(s))
+        return pd_err_set(err, PD_EINVAL, "task: %ld is not one of the sweep's %ld", task,
+                          pd_spec_tasks(s));
     pd_spec_coords_of(s, task, &co);
     *c = s->base;
     *o = s->opts;
@@ -119,6 +144,11 @@ int pd_spec_validate(const pd_spectrum *s, pd_err *err)
 {
     pd_osc c;
     pd_run_opts o;
+    int rc;
+    if (!s)
+        return PD_NULL_ARG(err, "s");
+    if ((rc = check_lists(s, err)))
+        return rc;
     long ntw = pd_spec_twins(s), n = pd_spec_tasks(s);
     for (long t = ntw; t < n; t++)
         if (pd_spec_case(s, t, &c, &o, err))
@@ -130,6 +160,8 @@ void pd_spec_resolve_method(pd_spectrum *s)
 {
     pd_osc c;
     pd_run_opts o;
+    if (!s)
+        return;
     long n = pd_spec_tasks(s);
     if (s->opts.method != PD_METHOD_AUTO)
         return;
@@ -145,6 +177,8 @@ double pd_spec_cost(const pd_spectrum *s, long task)
 {
     pd_osc c;
     pd_run_opts o;
+    if (!s)
+        return NAN;
     if (pd_spec_case(s, task, &c, &o, NULL))
         return 1.0;
     return (double)pd_steps_for(o.tend, o.dt);
@@ -171,6 +205,12 @@ void pd_spec_run_task(const pd_spectrum *s, long t, pd_spec_result *r, pd_err *e
     pd_osc c;
     pd_run_opts o;
     pd_osc_result res;
+    if (!s || !r) {
+        if (r)
+            *r = (pd_spec_result){.status = PD_EINVAL};
+        PD_NULL_ARG(err, !s ? "s" : "r");
+        return;
+    }
     memset(r, 0, sizeof *r);
     pd_err_clear(err);
     if (pd_spec_case(s, t, &c, &o, err)) {
@@ -178,6 +218,8 @@ void pd_spec_run_task(const pd_spectrum *s, long t, pd_spec_result *r, pd_err *e
         return;
     }
     if ((r->status = pd_osc_run(&c, &o, NULL, NULL, &res, err))) {
+        if (!err)
+            return;
         char m[sizeof err->msg];
         snprintf(m, sizeof m, "%s", err->msg);
         pd_err_set(err, r->status, "%s %s pulse, Pi2 = %.6g, Pi3 = %.6g, eps = %g%s: %s",
@@ -237,6 +279,8 @@ static void stream_done(void *ctx, long id, const pd_osc_result *res, int status
 int pd_spec_stream(const pd_spectrum *s, pd_spec_task_next next, pd_spec_task_done done,
                    void *ctx, pd_err *err)
 {
+    if (!s || !next || !done)
+        return PD_NULL_ARG(err, !s ? "s" : !next ? "next" : "done");
     task_stream ts = {.s = s, .next = next, .done = done, .ctx = ctx};
     return pd_osc_run_stream(stream_next, stream_done, &ts, err);
 }
@@ -299,6 +343,8 @@ static double record_checksum(const pd_record *r)
 
 char *pd_spec_key(const pd_spectrum *s)
 {
+    if (!s)
+        return NULL;
     const pd_run_opts *o = &s->opts;
     textbuf b = {malloc(256), 0, 256, 0};
     if (!b.p)
@@ -327,7 +373,8 @@ char *pd_spec_key(const pd_spectrum *s)
     tb_add(&b, " unstable=%d accumulation=%d kernel=%d factor=%d lcp=%d", o->allow_unstable,
            !o->no_accumulation, (int)o->kernel, (int)o->factor, (int)o->lcp_solver);
     tb_add(&b, " contact=%d kc=%a kc_abs=%a rtol=%a atol=%a stepper=%s", (int)o->pen.law,
-           o->pen.kc_mult, o->pen.kc_abs, o->pen.rtol, o->pen.atol, o->pen.stepper);
+           o->pen.kc_mult, o->pen.kc_abs, o->pen.rtol, o->pen.atol,
+           o->pen.stepper ? o->pen.stepper : "(none)");
     tb_add(&b, " tasks=%ld", pd_spec_tasks(s));
     if (b.oom) {
         free(b.p);
@@ -365,6 +412,8 @@ static void fill_row(const pd_osc *c, const pd_run_opts *o, long curve, const pd
 
 void pd_spec_rows(const pd_spectrum *s, const pd_spec_result *res, pd_spec_row *rows)
 {
+    if (!s || !res || !rows || check_lists(s, NULL))
+        return;
     long ntw = pd_spec_twins(s), np = pd_spec_points(s);
     pd_osc c;
     pd_run_opts o;
@@ -379,8 +428,12 @@ void pd_spec_curve_label(const pd_spectrum *s, long curve, char *buf, size_t cap
 {
     pd_spec_coords co;
     size_t n = 0;
-    pd_spec_coords_of(s, pd_spec_twins(s) + curve * s->npi2, &co);
+    if (!s || !buf || cap == 0)
+        return;
     buf[0] = '\0';
+    if (check_lists(s, NULL) || curve < 0 || curve >= pd_spec_curves(s))
+        return; /* no such curve: an empty label */
+    pd_spec_coords_of(s, pd_spec_twins(s) + curve * s->npi2, &co);
 #define ADD(...) (n += (size_t)snprintf(buf + n, n < cap ? cap - n : 0, __VA_ARGS__))
     if (s->npulse > 1)
         ADD("%s ", pd_pulse_name(s->pulse[co.pulse]));
@@ -402,7 +455,7 @@ void pd_spec_curve_label(const pd_spectrum *s, long curve, char *buf, size_t cap
 /* ---- a serial sweep with a callback per point -------------------------- */
 
 /* The lists and the grid within their arrays' bounds: PD_OK or PD_EINVAL. */
-static int check_shape(const pd_spectrum *s, pd_err *err)
+static int check_lists(const pd_spectrum *s, pd_err *err)
 {
     const struct {
         const char *name;
@@ -415,6 +468,15 @@ static int check_shape(const pd_spectrum *s, pd_err *err)
         if (lists[k].n < 1 || lists[k].n > lists[k].max)
             return pd_err_set(err, PD_EINVAL, "%s: %d values (1 to %d)", lists[k].name,
                               lists[k].n, lists[k].max);
+    return PD_OK;
+}
+
+/* The lists and the grid, and at most PD_SPEC_MAX_TASKS tasks. */
+static int check_shape(const pd_spectrum *s, pd_err *err)
+{
+    int rc = check_lists(s, err);
+    if (rc)
+        return rc;
     if (pd_spec_tasks(s) > PD_SPEC_MAX_TASKS)
         return pd_err_set(err, PD_EINVAL, "sweep: %ld runs (at most %ld)", pd_spec_tasks(s),
                           PD_SPEC_MAX_TASKS);
@@ -482,6 +544,8 @@ static void sweep_done(void *ctx, long t, const pd_spec_result *r, const pd_err 
 
 int pd_spec_sweep(const pd_spectrum *s, pd_spec_point_fn fn, void *ctx, pd_err *err)
 {
+    if (!s)
+        return PD_NULL_ARG(err, "s");
     long n = pd_spec_tasks(s);
     int rc = check_shape(s, err); /* then every point checked before any run */
     if (rc || (rc = pd_spec_validate(s, err)))

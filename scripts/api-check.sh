@@ -86,6 +86,49 @@ exports() {
 }
 check "exports of libpound.so" exports
 
+# docs/api.md's lists: per installed header, the PD_API names and their
+# count in "- `pd_x.h` (N): ..."; the total "**N functions" equal to the
+# exports.  The README gives no count (it points at the list).
+documented() {
+    awk '/^## The public API and what libpound.so exports/ { f = 1; next } /^## / { f = 0 } f' \
+        docs/api.md >"$tmp/apidoc"
+    total=$(sed -n 's/.*\*\*\([0-9][0-9]*\) functions.*/\1/p' "$tmp/apidoc" | head -1)
+    [ "$total" = "$(wc -l <"$tmp/syms")" ] ||
+        { echo "docs/api.md says $total functions; libpound.so exports $(wc -l <"$tmp/syms")"; return 1; }
+    ok=0
+    for h in pd_core.h pd_lcp.h pd_engine.h pd_problems.h; do
+        # the header's bullet: from its line to the next bullet
+        awk -v h="$h" 'index($0, "- `" h "` (") == 1 { f = 1 } f && /^- `/ && index($0, h) == 0 { f = 0 } f' \
+            "$tmp/apidoc" >"$tmp/bullet"
+        said=$(sed -n 's/^- `[a-z_.]*` (\([0-9]*\)).*/\1/p' "$tmp/bullet")
+        grep -o '`pd_[A-Za-z0-9_]*`' "$tmp/bullet" | tr -d '`' | sort >"$tmp/listed"
+        { tr '\n' ' ' <"$root/include/pound/$h"; echo; } | sed 's/PD_API/\n&/g' |
+            sed -n 's/^PD_API[^(]*[ *]\(pd_[A-Za-z0-9_]*\) *(.*/\1/p' | sort >"$tmp/declared"
+        if ! cmp -s "$tmp/listed" "$tmp/declared"; then
+            echo "docs/api.md, $h: listed vs declared:"
+            diff "$tmp/listed" "$tmp/declared" | grep '^[<>]'
+            ok=1
+        fi
+        [ "$said" = "$(wc -l <"$tmp/declared")" ] ||
+            { echo "docs/api.md, $h: says ($said), declares $(wc -l <"$tmp/declared")"; ok=1; }
+    done
+    return $ok
+}
+check "docs/api.md lists the exports" documented
+
+# tests/test_api_null.c is generated from the installed headers: the
+# committed file must be what the generator makes of them (python3: CI).
+null_test() {
+    command -v python3 >/dev/null || { echo "skip: no python3" >&2; return 0; }
+    inc=$root/include/pound
+    python3 scripts/gen_api_null.py "$inc/pound.h" "$inc/pd_core.h" "$inc/pd_lcp.h" \
+        "$inc/pd_engine.h" "$inc/pd_problems.h" >"$tmp/test_api_null.c" || return 1
+    diff -u tests/test_api_null.c "$tmp/test_api_null.c" | head -20
+    cmp -s tests/test_api_null.c "$tmp/test_api_null.c" ||
+        { echo "tests/test_api_null.c is stale: python3 scripts/gen_api_null.py \$(PUB_HDRS) > tests/test_api_null.c"; return 1; }
+}
+check "tests/test_api_null.c from the installed headers" null_test
+
 # ---- the examples against the installed library ------------------------
 PKG="pkg-config --define-variable=prefix=$root"
 cflags= libs= static=

@@ -3,18 +3,22 @@ stress/gen_corpus.py (which writes stress/corpus/ and stress/cases/) and
 stress/run.py (which mutates ../shared data at run time: those files are
 external test data, not copied into the project).
 
-Each generator returns a list of Mutant(name, data, expect, where):
-  expect  the exit statuses allowed, as a string: "2" bad input, "01" a
-          well-formed problem (solved or not), "012" anything clean
+Each generator returns a list of Mutant(name, data, expect, where, field):
+  expect  the exit statuses allowed, as a string: "2" bad input, "0" a good
+          one, "01" a well-formed problem (solved or not), "012" anything
+          clean (scene mutants always state one status)
   where   what an exit-2 message must name: "line" FILE:LINE (the readers'
           FILE: line N / FILE:N / FILE:N:C forms), "file" the file's name
+  field   scene mutants: the field path the message names right after
+          FILE:LINE:COL ("structures[0].T0"; "missing:A|B" for "missing
+          field 'A'"), or None for a syntax error
 """
 import json
 import random
 import re
 from collections import namedtuple
 
-Mutant = namedtuple("Mutant", "name data expect where")
+Mutant = namedtuple("Mutant", "name data expect where field", defaults=(None,))
 
 
 def _tokens(text):
@@ -32,11 +36,11 @@ def _replace_token(text, k, new):
 
 
 def _adder(out, encoding):
-    """add(name, data, expect, where): one Mutant onto out (text encoded)."""
-    def add(name, data, expect="2", where="line"):
+    """add(name, data, expect, where, field): one Mutant onto out (text encoded)."""
+    def add(name, data, expect="2", where="line", field=None):
         if isinstance(data, str):
             data = data.encode(encoding)
-        out.append(Mutant(name, data, expect, where))
+        out.append(Mutant(name, data, expect, where, field))
     return add
 
 
@@ -177,6 +181,10 @@ def lcp_extremes():
     out.append(("denormal-M", [[4.9e-324 if i == j else 0.0 for j in range(3)]
                                for i in range(3)], [-1.0, 1.0, -1.0]))
     out.append(("cond-1e15", [[1.0, 1.0], [1.0, 1.0 + 1e-15]], [-1.0, -1.0 - 1e-15]))
+    # found by fuzz_lcp: q of subnormals, whose solution z_0 = 6e-327 underflows;
+    # z = (0, 5 ulp, 0) leaves w_0 = -2.5e-324 < 0 (a third of the row's scale)
+    out.append(("subnormal-q-underflow", [[400.0, 0.1, 0.0], [1.0, 4.0, 1.0], [0.0, 1.0, 4.0]],
+                [-5e-324, -1e-322, 1.5e-323]))
     out.append(("cond-1e300-2x2", [[1e300, 1.0], [1.0, 1e-300]], [-1.0, -1.0]))
     for n in (8, 12):
         out.append(("hilbert-%d" % n, [[1.0 / (i + j + 1) for j in range(n)] for i in range(n)],
@@ -207,20 +215,120 @@ def lcp_extremes():
     return out
 
 
+
+def _sic_num(x):
+    return ("  %.24e " if x >= 0 else " %.24e ") % float(x)
+
+
+def lcp_siconos_styled(M, q, trailer=None):
+    """A Siconos-format file in the style of the Siconos test set: each
+    printed line a column of M, numbers as "  %.24e" with a trailing blank,
+    and free text after q (a remark or reference, to be ignored)."""
+    n = len(q)
+    lines = [str(n), "0", str(n), str(n), "%d\t%d" % (n, n)]
+    for j in range(n):
+        lines.append("".join(_sic_num(M[i][j]) for i in range(n)))
+    lines.append("".join(_sic_num(x) for x in q))
+    text = "\n".join(lines) + "\n"
+    if trailer:
+        text += "\n" + trailer + "\n"
+    return text
+
+
+def siconos_set():
+    """Synthetic problems in the Siconos test set's file style, made here so
+    that the suite does not depend on ../shared (whose files are external
+    data, not copied): (name, M, q, trailer).  The classes of that set: a
+    degenerate problem with a continuum of solutions, one with no solution
+    (Lemke ends on a ray), a diagonal one, a dense SPD one of 26 unknowns, a
+    nonsymmetric one with zero diagonal entries, Murty's exponential one."""
+    r = random.Random(19)
+    out = [("sic-degenerate.dat", [[1.0, 1.0], [1.0, 1.0]], [-1.0, -1.0],
+            "stress: a continuum of solutions z_1 + z_2 = 1"),
+           ("sic-no-solution.dat", [[0.0, -1.0, -1.0], [1.0, 0.0, 0.0], [1.0, 0.0, 0.0]],
+            [-1e-4, 1.0, 1.0], "stress: w_1 = -z_2 - z_3 - 1e-4 < 0: no solution"),
+           ("sic-diagonal-9.dat", [[float(i + 1) if i == j else 0.0 for j in range(9)] for i in range(9)],
+            [-1.0] * 9, "stress: diag(1..9), z_i = 1/i\n" + "".join(
+                _sic_num(1.0 / (i + 1)) for i in range(9)))]
+    n = 26
+    A = [[r.uniform(-1, 1) * 1e5 for _ in range(n)] for _ in range(n)]
+    spd = [[sum(A[k][i] * A[k][j] for k in range(n)) / n + (1e5 if i == j else 0.0)
+            for j in range(n)] for i in range(n)]
+    out.append(("sic-spd-26.dat", spd, [r.uniform(-1e3, 1e3) for _ in range(n)],
+                "stress: a dense SPD matrix of 26 unknowns with entries near 1e5"))
+    n = 40
+    ns = [[0.0 if i == j else r.uniform(-1, 1) for j in range(n)] for i in range(n)]
+    for i in range(n):
+        for j in range(n):
+            if (i + j) % 3 == 0 and i != j:
+                ns[i][j] = abs(ns[i][j]) + abs(ns[j][i])
+    out.append(("sic-nonsym-zero-diag-40.dat", ns, [r.uniform(-1, 1) for _ in range(n)],
+                "stress: nonsymmetric, zero diagonal"))
+    n = 6
+    out.append(("sic-murty-6.dat", [[1.0 if i == j else (2.0 if j < i else 0.0) for j in range(n)]
+                                    for i in range(n)], [-1.0] * n,
+                "stress: Murty's exponential example, 2^6 pivots"))
+    out.append(("sic-p-matrix-4.dat", [[3.0, 1.0, 0.0, -1.0], [-1.0, 2.0, 1.0, 1.0],
+                                       [0.0, 1.0, 3.0, -1.0], [0.0, 0.0, 1.0, 2.0]],
+                [-2.0, 1.0, -1.0, 1.0], "stress: a nonsymmetric P-matrix"))
+    return out
+
+
+def v2_text(npts, dt, acc_cms2):
+    """A COSMOS/CDMG V2 file: a text header, the acceleration block (in
+    cm/s^2, 8 values of 10 characters to a line), then the velocity and
+    displacement blocks, which the reader does not read, and "/&"."""
+    head = ["CORRECTED ACCELEROGRAM   00000-STRESS-00000.01       CHAN  1:  90 DEG",
+            "SYNTHETIC STRONG-MOTION DATA               PROCESSED:  1/01/00, POUND STRESS SUITE",
+            "STRESS SYNTHETIC EARTHQUAKE",
+            "JAN 1, 2000 00:00 UTC",
+            "STATION NO. 00000   0.000N, 0.000W",
+            "INSTR PERIOD =  .0400 SEC,  DAMPING =  .600,  SENSITIVITY = 1.80 CM/G.",
+            "                        RECORD LENGTH = %7.3f SEC." % (npts * dt),
+            "  %d POINTS OF INSTRUMENT- AND BASELINE-CORRECTED ACCEL, VELOC AND DISPL DATA" % npts,
+            "AT EQUALLY-SPACED INTERVALS OF   %.3f  SEC." % dt,
+            "PEAK ACCELERATION =  %9.3f    CM/SEC/SEC" % max(acc_cms2, key=abs),
+            ""]
+    head += ["".join("%5d" % ((i * 7 + k) % 10) for k in range(16)) for i in range(4)]
+    head += ["".join("%10.3f" % (0.001 * (i + k)) for k in range(8)) for i in range(6)]
+
+    def block(what, units, vals):
+        lines = [" %d POINTS OF %s DATA EQUALLY SPACED AT %5.3f SEC.  (UNITS: %s)"
+                 % (len(vals), what, dt, units)]
+        for k in range(0, len(vals), 8):
+            lines.append("".join(("%10.3f" % v).replace("0.", ".", 1) if abs(v) < 1 else "%10.3f" % v
+                                 for v in vals[k:k + 8]))
+        return lines
+    vel, disp, v, x = [], [], 0.0, 0.0
+    for a in acc_cms2:
+        v += a * dt
+        x += v * dt
+        vel.append(v)
+        disp.append(x)
+    body = block("ACCEL", "CM/SEC/SEC", acc_cms2) + block("VELOC", "CM/SEC", vel) + \
+        block("DISPL", "CM", disp) + ["/&"]
+    return "\n".join(head + body) + "\n"
+
 # ---- scene files (docs/scenes.md) -------------------------------------------
 
-# field -> (kind, domain) for the fields the example scenes use
+# field -> (kind, domain, usable range) for the fields the example scenes use
+# (docs/scenes.md §3: "Values are also held to usable ranges"); a value in the
+# domain and in the usable range is accepted (exit 0), any other is refused
+# (exit 2) with the field named
 def _scene_domain(path):
     key = path[-1] if isinstance(path[-1], str) else path[-2]
     return {
-        "ap": ("num", lambda x: x > 0), "Tp": ("num", lambda x: x > 0),
-        "T0": ("num", lambda x: x > 0), "mass": ("num", lambda x: x > 0),
-        "masses": ("num", lambda x: x > 0), "stiffnesses": ("num", lambda x: x > 0),
-        "xi": ("num", lambda x: 0 <= x < 1), "eps": ("num", lambda x: 0 <= x <= 1),
-        "gap": ("num", lambda x: x >= 0), "tend": ("num", lambda x: x >= 0),
-        "scale": ("num", lambda x: x > 0),
-        "storeys": ("int", lambda x: 1 <= x <= 100000), "levels": ("int", lambda x: x >= 1),
-    }.get(key, ("other", None))
+        "ap": ("num", lambda x: x > 0, (1e-6, 1e4)), "Tp": ("num", lambda x: x > 0, (0.01, 1000)),
+        "T0": ("num", lambda x: x > 0, (0.01, 1000)), "mass": ("num", lambda x: x > 0, (1e-6, 1e12)),
+        "masses": ("num", lambda x: x > 0, (1e-6, 1e12)),
+        "stiffnesses": ("num", lambda x: x > 0, (1e-11, 1e18)),
+        "xi": ("num", lambda x: 0 <= x < 1, None), "eps": ("num", lambda x: 0 <= x <= 1, None),
+        "gap": ("num", lambda x: x >= 0, (0, 1000)),
+        # tend 0: derived from the excitation (docs/scenes.md: "(0, 100000] s (0: derived)")
+        "tend": ("num", lambda x: x >= 0, (0, 1e5)),
+        "scale": ("num", lambda x: x > 0, (1e-6, 1e6)),
+        "storeys": ("int", lambda x: 1 <= x <= 100000, None), "levels": ("int", lambda x: x >= 1, None),
+    }.get(key, ("other", None, None))
 
 
 def _leaves(v, path=()):
@@ -244,10 +352,12 @@ def _set(doc, path, val):
 MARK = "@@MUTANT@@"
 
 
-def _with_raw(doc, path, raw):
-    """doc serialised with the value at path replaced by raw JSON text."""
+def _with_raw(doc, path, raw, also=()):
+    """doc serialised with the value at path (and at the paths of also)
+    replaced by raw JSON text."""
     d = json.loads(json.dumps(doc))
-    _set(d, path, MARK)
+    for p in (path,) + tuple(also):
+        _set(d, p, MARK)
     return json.dumps(d, indent=1).replace('"%s"' % MARK, raw)
 
 
@@ -258,8 +368,15 @@ def _pathname(path):
     return s
 
 
+def _name_refs(doc, name):
+    """The paths of the contacts' sides that name structure `name`."""
+    return [("contacts", i, side) for i, c in enumerate(doc.get("contacts") or [])
+            for side in ("a", "b") if c.get(side) == name]
+
+
 def scene_mutants(text, limit_fields=None):
-    """Mutants of a scene file's text (a JSON object)."""
+    """Mutants of a scene file's text (a JSON object), each with one expected
+    exit status and, for a refused one, the field its message names."""
     doc = json.loads(text)
     out = []
 
@@ -273,17 +390,19 @@ def scene_mutants(text, limit_fields=None):
     add("whitespace", " \n\t\n")
     add("null", "null")
     add("array", "[]")
-    add("empty-object", "{}", "2")
+    add("empty-object", "{}", "2", field="missing:structures|excitation")
     add("number", "42")
     add("trailing-text", b.rstrip() + " trailing\n")
     add("two-objects", b.rstrip() + "\n" + b)
     add("binary-junk", junk(3, 600), "2", "file")
     add("nul-byte", b[:20] + "\0" + b[20:], "2", "file")
     add("latin1-byte", b.replace('"', '"\xe9', 1).encode("latin-1"), "2")
-    add("bom", "\ufeff" + b, "012")
+    # a UTF-8 byte-order mark: jansson refuses it at 1:1 (RFC 8259 lets a
+    # parser refuse it); refused, with the position
+    add("bom", "\ufeff" + b, "2")
     add("crlf", b.replace("\n", "\r\n"), "0")
     add("deep-nesting", '{"description": ' + "[" * 100000 + "]" * 100000 + "}", "2")
-    add("unknown-top-key", json.dumps(dict(doc, bogus=1), indent=1))
+    add("unknown-top-key", json.dumps(dict(doc, bogus=1), indent=1), field="bogus")
     add("dup-top-key", b.rstrip().rstrip("}") + ', "tend": 1}' if "tend" in doc
         else b.rstrip().rstrip("}") + ', "tend": 1, "tend": 2}')
     add("dup-excitation-key", json.dumps(doc, indent=1).replace(
@@ -293,15 +412,15 @@ def scene_mutants(text, limit_fields=None):
     for k in ("excitation", "structures"):
         d = dict(doc)
         d.pop(k, None)
-        add("missing-" + k, json.dumps(d, indent=1))
+        add("missing-" + k, json.dumps(d, indent=1), field="missing:" + k)
     d = json.loads(b)
     d["structures"] = []
-    add("no-structures", json.dumps(d, indent=1))
+    add("no-structures", json.dumps(d, indent=1), field="structures")
     # values at every numeric leaf
     for path, v in _leaves(doc):
         if limit_fields and _pathname(path) not in limit_fields:
             continue
-        kind, ok = _scene_domain(path)
+        kind, ok, usable = _scene_domain(path)
         if kind == "other" or isinstance(v, (str, bool)) or v is None:
             continue
         pn = _pathname(path)
@@ -312,13 +431,20 @@ def scene_mutants(text, limit_fields=None):
             if x is None:
                 exp = "2"
             elif kind == "int":
-                exp = "2" if x != int(x) or raw in ("1e308", "4.9e-324") or not ok(x) else "012"
+                exp = "2" if x != int(x) or raw in ("1e308", "4.9e-324") or not ok(x) else "0"
             else:
-                exp = "012" if ok(x) else "2"
+                exp = "0" if ok(x) and (usable is None or usable[0] <= x <= usable[1]) else "2"
             if raw == "2.5" and kind != "int":
                 continue
-            add("%s=%s" % (pn, raw), _with_raw(doc, path, raw), exp)
-    # strings: names and enumerations
+            # jansson's syntax errors (1e999, NaN, ...) name no field; an
+            # array's entry is named by the array ("structures[0].masses:
+            # storey 2 has mass -1") or by itself (".masses[1]")
+            syntax = raw in ("1e999", "-1e999", "NaN", "Infinity")
+            field = _pathname(path[:-1]) if isinstance(path[-1], int) else pn
+            add("%s=%s" % (pn, raw), _with_raw(doc, path, raw), exp,
+                field=None if syntax else field)
+    # strings: names and enumerations; a structure's new name is used by its
+    # contacts too, so that the name itself is what is judged
     for path, v in _leaves(doc):
         if not isinstance(v, str) or path[-1] == "description":
             continue
@@ -326,18 +452,21 @@ def scene_mutants(text, limit_fields=None):
         if limit_fields and pn not in limit_fields:
             continue
         is_name = path[-1] == "name"
+        refs = _name_refs(doc, v) if is_name else []
         for label, raw, exp in [("empty", '""', "2"), ("ctrl-u0001", '"A\\u0001"', "2"),
                                 ("ctrl-raw", '"A\x01"', "2"), ("nul-u0000", '"A\\u0000"', "2"),
                                 ("newline", '"A\\nB"', "2"), ("del", '"A\\u007f"', "2"),
                                 ("long", '"' + "x" * 10000 + '"', "2"),
                                 ("number", "1", "2"), ("null", "null", "2")]:
-            add("%s=%s" % (pn, label), _with_raw(doc, path, raw), exp)
+            # a raw control byte and \u0000 in a string are jansson's syntax errors
+            add("%s=%s" % (pn, label), _with_raw(doc, path, raw, refs), exp,
+                field=None if label in ("ctrl-raw", "nul-u0000") else pn)
         if is_name:
-            add(pn + "=wall", _with_raw(doc, path, '"wall"'))
-            add(pn + "=slash", _with_raw(doc, path, '"a/b"'))
-            add(pn + "=utf8", _with_raw(doc, path, '"\u00e9t\u00e9"'), "012")
-            add(pn + "=63-bytes", _with_raw(doc, path, '"' + "y" * 63 + '"'), "012")
-            add(pn + "=64-bytes", _with_raw(doc, path, '"' + "y" * 64 + '"'))
+            add(pn + "=wall", _with_raw(doc, path, '"wall"', refs), field=pn)
+            add(pn + "=slash", _with_raw(doc, path, '"a/b"', refs), field=pn)
+            add(pn + "=utf8", _with_raw(doc, path, '"\u00e9t\u00e9"', refs), "0")
+            add(pn + "=63-bytes", _with_raw(doc, path, '"' + "y" * 63 + '"', refs), "0")
+            add(pn + "=64-bytes", _with_raw(doc, path, '"' + "y" * 64 + '"', refs), field=pn)
     # contacts that name what is not there
     if doc.get("contacts"):
         for label, val, exp in [("unknown-a", "Z", "2"), ("wall-wall", "wall", "2")]:
@@ -345,28 +474,32 @@ def scene_mutants(text, limit_fields=None):
             d["contacts"][0]["a"] = val
             if label == "wall-wall":
                 d["contacts"][0]["b"] = "wall"
-            add("contacts[0]." + label, json.dumps(d, indent=1), exp)
-        for label, lv, exp in [("levels-empty", [], "2"), ("levels-zero", [0], "2"),
-                               ("levels-neg", [-1], "2"), ("levels-big", [1000000000], "2"),
-                               ("levels-float", [1.5], "2"), ("levels-200000", [1] * 200000, "2"),
-                               ("levels-dup", [1, 1], "012")]:
+            add("contacts[0]." + label, json.dumps(d, indent=1), exp,
+                field="contacts[0].a" if label == "unknown-a" else "contacts[0]")
+        # a repeated level would join one pair of floors twice: refused
+        # ("contacts[0]: ... are joined twice")
+        for label, lv, field in [("levels-empty", [], ".levels"), ("levels-zero", [0], ".levels"),
+                                 ("levels-neg", [-1], ".levels"), ("levels-big", [1000000000], ".levels"),
+                                 ("levels-float", [1.5], ".levels"),
+                                 ("levels-200000", [1] * 200000, ".levels"),
+                                 ("levels-dup", [1, 1], "")]:
             d = json.loads(b)
             d["contacts"][0]["levels"] = lv
-            add("contacts[0]." + label, json.dumps(d), exp)
+            add("contacts[0]." + label, json.dumps(d), "2", field="contacts[0]" + field)
     # huge arrays
     d = json.loads(b)
     d["structures"] = [{"name": "s%d" % i, "T0": 0.5 + (i % 3) * 0.1} for i in range(100001)]
     d["contacts"] = []
     d["tend"] = 1e-3
-    add("structures-100001", json.dumps(d), "012")
+    add("structures-100001", json.dumps(d), "0")
     d = json.loads(b)
     d["structures"] = [{"name": "tall", "masses": [1.0] * 200000, "stiffnesses": [1e6] * 200000}]
     d["contacts"] = []
     d["tend"] = 1e-4
-    add("masses-200000", json.dumps(d), "012")
+    add("masses-200000", json.dumps(d), "2", field="structures[0]")
     d = json.loads(b)
     d["structures"][0]["masses"] = [1.0] * 3
-    add("mixed-forms", json.dumps(d, indent=1))
+    add("mixed-forms", json.dumps(d, indent=1), field="structures[0]")
     # records named by the excitation (docs/records.md)
     for label, rec in [("dev-null", "/dev/null"), ("missing", "no-such-record.AT2"),
                        ("directory", "."), ("itself", "SELF"), ("dev-zero", "/dev/zero")]:
@@ -387,9 +520,12 @@ def at2_text(npts, dt, acc, header_style=1):
         lines.append("NPTS=%7d, DT=%9.4f SEC" % (npts, dt))
     else:
         lines.append("%d    %.4f    NPTS, DT" % (npts, dt))
+    # header_style 3: an older processing's file, numbers that touch
+    # ("1.234567E-02-5.678901E-03") and CR CR LF line ends
+    width = "%13.6E" if header_style == 3 else "%15.6E"
     for k in range(0, len(acc), 5):
-        lines.append("".join("%15.6E" % a for a in acc[k:k + 5]))
-    return "\n".join(lines) + "\n"
+        lines.append("".join(width % a for a in acc[k:k + 5]))
+    return ("\r\r\n" if header_style == 3 else "\n").join(lines) + ("\r\r\n" if header_style == 3 else "\n")
 
 
 def synthetic_acc(npts=400, dt=0.01, seed=11):

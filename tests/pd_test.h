@@ -65,6 +65,9 @@ double pd_test_json_num(const char *json, const char *key, int k); /* k-th "key"
 void pd_test_json_str(const char *json, const char *key, int k, char *buf, size_t cap);
 int pd_test_dir_entries(const char *dir);            /* besides . and .. */
 void pd_test_rm_dir(const char *dir);
+/* A sparse regular file of `bytes` zero bytes (no disk used) at a fresh
+ * /tmp name written into path: 0, or -1 (nothing left). */
+int pd_test_zero_file(char *path, size_t cap, long long bytes);
 int pd_test_same_file(const char *a, const char *b);
 double pd_test_h5_num(hid_t obj, const char *name); /* NAN when missing */
 
@@ -94,5 +97,6 @@ void suite_ed_linear(pd_test_ctx *ctx);
 void suite_records_run(pd_test_ctx *ctx);
 void suite_plots(pd_test_ctx *ctx);
 void suite_outputs(pd_test_ctx *ctx);
+void suite_api_null(pd_test_ctx *ctx);
 
 #endif

@@ -73,7 +73,7 @@ static void test_cli_bad_input(pd_test_ctx *ctx)
 static void test_cli_hardening(pd_test_ctx *ctx)
 {
     static const struct {
-        const char *args[10];
+        const char *args[12];
         const char *named;
     } cases[] = {
         {{"simulate", "--Tp", "1e308", NULL}, "--Tp"},
@@ -90,6 +90,14 @@ static void test_cli_hardening(pd_test_ctx *ctx)
         {{"simulate", "--pulse", "a\033[31mred", NULL}, "a?[31mred"},
         /* the flag the user typed, not the one whose derived value overflowed */
         {{"simulate", "--tend", "1e308", NULL}, "--tend"},
+        /* Pi2 = Tp / T0 overflows: the extreme value is Tp's, not T0's */
+        {{"simulate", "--pulse", "sine", "--ap", "4", "--Tp", "1e308", "--T0", "0.5", "--gap",
+          "0.004", NULL}, "--Tp:"},
+        /* too many steps because of Tp (stress: derived): --Tp, not --T0 */
+        {{"simulate", "--pulse", "sine", "--ap", "4", "--Tp", "1e30", "--T0", "0.5", "--gap",
+          "0.004", NULL}, "--Tp:"},
+        {{"compare", "--pulse", "sine", "--ap", "4", "--Tp", "1e-30", "--T0", "0.5", "--gap",
+          "0.004", NULL}, "--Tp:"},
         {{"simulate", "--dt", "1e308", NULL}, "--dt"},
         {{"simulate", "--chain", "3", "--chain-ratio", "1e308", NULL}, "--chain-ratio"},
         {{"spectrum", "--Pi2", "1e-300:1e300:2", NULL}, "--Pi2"},

@@ -7,6 +7,7 @@
 
 #include "mj1.h"
 #include "pd_engine.h"
+#include "pd_factor.h"
 #include "pd_test.h"
 
 /* pd_sdof_advance satisfies the ODE (central differences), composes over
@@ -535,6 +536,164 @@ static void test_engine_batch_flags_nonfinite(pd_test_ctx *ctx)
     free(b);
 }
 
+/* ---- the dense factor on badly scaled matrices (issue 19) ---------------- */
+
+#define SCALED_N 6
+#define SCALED_SOLVE_TOL 1e-12 /* relative error of a solve of a well-conditioned-
+                                  after-scaling system: about cond(B) n eps */
+
+/* A row-diagonally-dominant B: off-diagonal entries in [-0.1, 0.1), unit
+ * diagonal (cond(B) <= 1.5 / 0.5 = 3 in the infinity norm). */
+static void scaled_base(uint64_t *seed, double *B)
+{
+    for (int j = 0; j < SCALED_N; j++)
+        for (int i = 0; i < SCALED_N; i++)
+            B[i + j * SCALED_N] = i == j ? 1.0 : 0.2 * pd_test_uniform(seed) - 0.1;
+}
+
+/* x from the factors of A (n x n, in LU, perm) for b = A x: max_i |dx_i| w_i
+ * over max_i |x_i| w_i (w = NULL: ones). */
+static double scaled_solve_error(int n, const double *A, const double *LU, const int *perm,
+                                 const double *x, const double *w)
+{
+    double b[SCALED_N], num = 0.0, den = 0.0;
+    for (int i = 0; i < n; i++) {
+        b[i] = 0.0;
+        for (int j = 0; j < n; j++)
+            b[i] += A[i + j * n] * x[j];
+    }
+    pd_dense_lu_solve(n, LU, n, perm, b);
+    for (int i = 0; i < n; i++) {
+        num = fmax(num, fabs(b[i] - x[i]) * (w ? w[i] : 1.0));
+        den = fmax(den, fabs(x[i]) * (w ? w[i] : 1.0));
+    }
+    return num / den;
+}
+
+/* pd_dense_lu judges a pivot against the scale of its own row: matrices
+ * with entries from 1e-6 to 1e12 that are diagonally dominant once scaled
+ * factor and solve to 1e-12 (the global floor 1e-14 max|A| = 1e-2 refused
+ * every pivot of the small rows); singular ones are still refused. */
+static void test_engine_dense_lu_scaled(pd_test_ctx *ctx)
+{
+    const double s2[SCALED_N] = {1e12, 1e-6, 1e3, 1.0, 1e9, 1e-3}; /* the diagonal's scales */
+    uint64_t seed = 19;
+    double B[SCALED_N * SCALED_N], A[SCALED_N * SCALED_N], LU[SCALED_N * SCALED_N];
+    double x[SCALED_N], s[SCALED_N];
+    int perm[SCALED_N], n = SCALED_N;
+    for (int i = 0; i < n; i++)
+        s[i] = sqrt(s2[i]);
+    for (int trial = 0; trial < 20; trial++) {
+        scaled_base(&seed, B);
+        for (int i = 0; i < n; i++)
+            x[i] = 2.0 * pd_test_uniform(&seed) - 1.0;
+        /* rows scaled: A = diag(s2) B, entries 1e-7 .. 1e12; x itself to 1e-12 */
+        for (int j = 0; j < n; j++)
+            for (int i = 0; i < n; i++)
+                A[i + j * n] = s2[i] * B[i + j * n];
+        memcpy(LU, A, sizeof A);
+        int rc = pd_dense_lu(n, LU, n, perm, 1e-14);
+        double err = rc ? INFINITY : scaled_solve_error(n, A, LU, perm, x, NULL);
+        CHECK(ctx, rc == PD_OK && err <= SCALED_SOLVE_TOL,
+              "trial %d, rows scaled 1e-6 .. 1e12: status %d, relative error %.3g", trial, rc,
+              err);
+        /* symmetric scaling, as What = M + ... of a scene: A = S B S, the
+         * diagonal 1e-6 .. 1e12; the answer to 1e-12 in the scaled norm
+         * max |s_i dx_i| / max |s_i x_i| (x_i = y_i / s_i, y of order one) */
+        double y[SCALED_N];
+        for (int j = 0; j < n; j++) {
+            y[j] = x[j] / s[j];
+            for (int i = 0; i < n; i++)
+                A[i + j * n] = s[i] * B[i + j * n] * s[j];
+        }
+        memcpy(LU, A, sizeof A);
+        rc = pd_dense_lu(n, LU, n, perm, 1e-14);
+        err = rc ? INFINITY : scaled_solve_error(n, A, LU, perm, y, s);
+        CHECK(ctx, rc == PD_OK && err <= SCALED_SOLVE_TOL,
+              "trial %d, S B S with S^2 1e-6 .. 1e12: status %d, scaled relative error %.3g",
+              trial, rc, err);
+    }
+    /* singular: S G G^T S with G 6 x 5 (rank 5), a zero row, equal rows */
+    for (int trial = 0; trial < 20; trial++) {
+        double G[SCALED_N * (SCALED_N - 1)];
+        for (int k = 0; k < n * (n - 1); k++)
+            G[k] = 2.0 * pd_test_uniform(&seed) - 1.0;
+        for (int j = 0; j < n; j++)
+            for (int i = 0; i < n; i++) {
+                double g = 0.0;
+                for (int k = 0; k < n - 1; k++)
+                    g += G[i + k * n] * G[j + k * n];
+                A[i + j * n] = s[i] * g * s[j];
+            }
+        int rc = pd_dense_lu(n, A, n, perm, 1e-14);
+        CHECK(ctx, rc == PD_ESINGULAR, "trial %d: S G G^T S of rank 5 factored (status %d)",
+              trial, rc);
+    }
+    scaled_base(&seed, B);
+    memcpy(A, B, sizeof A);
+    for (int j = 0; j < n; j++)
+        A[3 + j * n] = 0.0;
+    CHECK(ctx, pd_dense_lu(n, A, n, perm, 1e-14) == PD_ESINGULAR, "a zero row factored");
+    double E[4] = {1e12, 1e12, 1e-6, 1e-6}; /* columns (1e12, 1e12), (1e-6, 1e-6) */
+    CHECK(ctx, pd_dense_lu(2, E, 2, perm, 1e-14) == PD_ESINGULAR, "equal rows factored");
+    double Z[4] = {0.0, 0.0, 0.0, 0.0};
+    CHECK(ctx, pd_dense_lu(2, Z, 2, perm, 1e-14) == PD_ESINGULAR, "the zero matrix factored");
+}
+
+/* The scene of issue 19 -- two oscillators of 1e12 kg (T0 = 0.4 s) and
+ * 1e-6 kg (T0 = 1.2 s), one contact between them -- factors densely
+ * (What = diag(1e12, 1e-6) (1 + ...), refused as singular before): What^-1
+ * and D = W^T What^-1 W to 1e-12 relative, and Moreau–Jean runs it.  A
+ * singular What (M of rank 1, K = C = 0) is still refused. */
+static void test_engine_dense_factor_scaled(pd_test_ctx *ctx)
+{
+    const double mass[2] = {1e12, 1e-6}, T0[2] = {0.4, 1.2}, xi = 0.05, h = 2e-4, theta = 0.5;
+    double M[4] = {0}, K[4] = {0}, C[4] = {0}, W[2] = {-1.0, 1.0}, g0 = 0.02, e = 0.5;
+    double what[2];
+    for (int i = 0; i < 2; i++) {
+        double w0 = 2.0 * PD_PI / T0[i];
+        M[i * 3] = mass[i];
+        K[i * 3] = mass[i] * w0 * w0;
+        C[i * 3] = 2.0 * xi * w0 * mass[i];
+        what[i] = M[i * 3] + h * theta * C[i * 3] + h * theta * h * theta * K[i * 3];
+    }
+    pd_model md = {.n = 2, .m = 1, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_dense(2, 2, C),
+                   .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_dense(2, 1, W), .g0 = &g0,
+                   .e = &e};
+    pd_err err;
+    pd_factor *f = pd_factor_alloc(&md, h, theta, PD_FACTOR_DENSE, &err);
+    CHECK(ctx, f != NULL, "the dense factor refused the scene: %s", f ? "" : err.msg);
+    if (f) {
+        double x[2] = {3.0, -2.0}, D, Dwant = 1.0 / what[0] + 1.0 / what[1];
+        int idx = 0;
+        pd_factor_solve(f, x);
+        for (int i = 0; i < 2; i++)
+            CHECK(ctx, fabs(x[i] * what[i] - (i ? -2.0 : 3.0)) <= 1e-12 * fabs(x[i] * what[i]),
+                  "What^-1 b, row %d: %.17g, want %.17g", i, x[i], (i ? -2.0 : 3.0) / what[i]);
+        pd_factor_delassus_dense(f, &idx, 1, &D);
+        CHECK(ctx, fabs(D - Dwant) <= 1e-12 * Dwant, "D = %.17g, want %.17g", D, Dwant);
+        pd_factor_free(f);
+    }
+    pd_mj_opts o = pd_mj_default_opts();
+    o.h = h;
+    pd_mj *mj = pd_mj_alloc(&md, &o, &err);
+    double v0[2] = {1.0, -1.0};
+    int rc = mj ? pd_mj_reset(mj, 0.0, NULL, v0, &err) : err.status;
+    if (!rc)
+        rc = pd_mj_run(mj, 1000, NULL, NULL, &err);
+    CHECK(ctx, rc == PD_OK && !strcmp(pd_mj_factor_name(mj), "dense"),
+          "Moreau-Jean on the scene: %s", rc ? err.msg : pd_mj_factor_name(mj));
+    pd_mj_free(mj);
+    double Ms[4] = {1e12, 1e12, 1e12, 1e12};
+    md.M = pd_matrix_dense(2, 2, Ms);
+    md.C = pd_matrix_zero(2, 2);
+    md.K = pd_matrix_zero(2, 2);
+    f = pd_factor_alloc(&md, h, theta, PD_FACTOR_DENSE, &err);
+    CHECK(ctx, f == NULL && err.status == PD_ESINGULAR && strstr(err.msg, "singular"),
+          "a singular What factored (%s)", f ? "no error" : err.msg);
+    pd_factor_free(f);
+}
+
 void suite_engine(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_engine_sdof_closed_form);
@@ -548,4 +707,6 @@ void suite_engine(pd_test_ctx *ctx)
     PD_RUN(ctx, test_engine_no_allocation_in_steps);
     PD_RUN(ctx, test_engine_batch_matches_scalar);
     PD_RUN(ctx, test_engine_batch_flags_nonfinite);
+    PD_RUN(ctx, test_engine_dense_lu_scaled);
+    PD_RUN(ctx, test_engine_dense_factor_scaled);
 }

@@ -887,17 +887,27 @@ static void test_lcp_residual_nonfinite(pd_test_ctx *ctx)
     CHECK(ctx, residual == 1.0, "z = 0: residual %g (w_1 = -1e300 < 0)", residual);
 }
 
-/* Binary input: /dev/zero refused at its first byte (it took 2 GB before),
- * a NUL byte named by its line; the size n followed by a mere stream of
- * tokens is refused by the count, naming the end of the file. */
+/* Binary input: 3 GB of zeros (a sparse file) refused at its first byte
+ * (/dev/zero took 2 GB before; it is not a regular file now, refused
+ * unread), a NUL byte named by its line; the size n followed by a mere
+ * stream of tokens is refused by the count, naming the end of the file. */
 static void test_lcp_read_bounded(pd_test_ctx *ctx)
 {
     int n = 5;
     double *M = NULL, *q = NULL;
     pd_err err;
+    char zero[64], want[128];
     int st = pd_lcp_read("/dev/zero", PD_LCP_FORMAT_AUTO, &n, &M, &q, &err);
-    CHECK(ctx, st == PD_EPARSE && strstr(err.msg, "/dev/zero: line 1: not a text file (a NUL") &&
-               n == 0 && !M && !q, "/dev/zero: %d %s", st, err.msg);
+    CHECK(ctx, st == PD_EINVAL && strstr(err.msg, "/dev/zero: not a regular file") && n == 0 &&
+               !M && !q, "/dev/zero: %d %s", st, err.msg);
+    if (CHECK(ctx, pd_test_zero_file(zero, sizeof zero, 3LL << 30) == 0, "a sparse file")) {
+        n = 5;
+        st = pd_lcp_read(zero, PD_LCP_FORMAT_AUTO, &n, &M, &q, &err);
+        snprintf(want, sizeof want, "%s: line 1: not a text file (a NUL", zero);
+        CHECK(ctx, st == PD_EPARSE && strstr(err.msg, want) && n == 0 && !M && !q,
+              "3 GB of zeros: %d %s", st, err.msg);
+        unlink(zero);
+    }
     char path[64];
     strcpy(path, "/tmp/pound_lcp_XXXXXX");
     int fd = mkstemp(path);

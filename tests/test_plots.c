@@ -213,28 +213,27 @@ static int write_text(const char *path, const char *text)
     return (f && fclose(f) == 0 && ok) ? 0 : -1;
 }
 
-/* A scene whose structure names end in a backslash, carry quotes, and spell
- * a gnuplot command (a '/' built from %c 47, as names may not hold '/'),
- * read from a file whose name (the chart's title) has quotes too. */
+/* A scene whose structure names carry what gnuplot reads as syntax and
+ * names may hold (backticks, @, $, %, ;, parentheses), read from a file
+ * whose name (the chart's title) has quotes, a backslash and a command;
+ * and the names that would break a writer or a script (a backslash at the
+ * end, quotes, commas) refused at load, naming the field. */
 static void test_plot_scene_names(pd_test_ctx *ctx)
 {
     plot_dir d;
-    char scene[256], png[256], inj[128], json[1024];
+    char scene[512], png[256], json[1024], bad[256];
     if (!have_tools(ctx) || dir_open(ctx, &d))
         return;
-    snprintf(inj, sizeof inj, ".system(sprintf('touch %%ctmp%%c%.16s%%cpwned',47,47,47)).",
-             d.dir + 5);
-    snprintf(json, sizeof json,
+    snprintf(json, sizeof json, "%s",
              "{\"excitation\": {\"pulse\": \"cosine\", \"dir\": \"+x\", \"ap\": 3.0, \"Tp\": 0.6},\n"
              " \"structures\": [\n"
-             "  {\"name\": \"x\\\\\", \"T0\": 0.4, \"xi\": 0.05, \"mass\": 2.0e5},\n"
-             "  {\"name\": \"%s\", \"T0\": 1.2, \"xi\": 0.05, \"mass\": 1.0e5},\n"
-             "  {\"name\": \"say \\\"hi\\\" it's `x` @y \\\\\", \"T0\": 0.8, \"xi\": 0.05,"
-             " \"mass\": 1.0e5}],\n"
-             " \"contacts\": [{\"a\": \"x\\\\\", \"b\": \"%s\", \"gap\": 0.02, \"eps\": 0.65}],\n"
-             " \"tend\": 2.0}\n",
-             inj, inj);
-    snprintf(scene, sizeof scene, "%s/sc\"e'ne\\.json", d.dir);
+             "  {\"name\": \"x`touch pwned`\", \"T0\": 0.4, \"xi\": 0.05, \"mass\": 2.0e5},\n"
+             "  {\"name\": \"@y $HOME %c;system(x)\", \"T0\": 1.2, \"xi\": 0.05, \"mass\": 1.0e5},\n"
+             "  {\"name\": \"say `x` @y\", \"T0\": 0.8, \"xi\": 0.05, \"mass\": 1.0e5}],\n"
+             " \"contacts\": [{\"a\": \"x`touch pwned`\", \"b\": \"@y $HOME %c;system(x)\","
+             " \"gap\": 0.02, \"eps\": 0.65}],\n"
+             " \"tend\": 2.0}\n");
+    snprintf(scene, sizeof scene, "%s/sc\"e'ne\\\"; system(\"touch pwned\") \".json", d.dir);
     snprintf(png, sizeof png, "%s/scene.png", d.dir);
     if (!CHECK(ctx, write_text(scene, json) == 0, "cannot write %s", scene)) {
         dir_close(&d);
@@ -245,6 +244,21 @@ static void test_plot_scene_names(pd_test_ctx *ctx)
     run_pound(ctx, &d, args, &r);
     check_plotted(ctx, &d, &r, png, 3);
     pd_test_proc_free(&r);
+    static const char *const refused[] = {"x\\\\", "say \\\"hi\\\"", "it's", "a,b"};
+    for (int k = 0; k < 4; k++) {
+        snprintf(json, sizeof json,
+                 "{\"excitation\": {\"pulse\": \"cosine\", \"ap\": 3.0, \"Tp\": 0.6},\n"
+                 " \"structures\": [{\"name\": \"%s\", \"T0\": 0.4}]}\n", refused[k]);
+        snprintf(bad, sizeof bad, "%s/bad.json", d.dir);
+        if (!CHECK(ctx, write_text(bad, json) == 0, "cannot write %s", bad))
+            break;
+        const char *bargs[] = {"simulate", "--scene", bad, "--plot", png, NULL};
+        run_pound(ctx, &d, bargs, &r);
+        CHECK(ctx, r.status == 2 && r.err && strstr(r.err, "structures[0].name: "),
+              "name %s: exit %d, %s", refused[k], r.status, r.err ? r.err : "");
+        pd_test_proc_free(&r);
+        unlink(bad);
+    }
     dir_close(&d);
 }
 

@@ -100,9 +100,29 @@ static void test_records_self_similar(pd_test_ctx *ctx)
     pd_record_free(&rec);
 }
 
+#define RINALDI_DTS 7          /* dt = 4e-3 s halved six times, to 6.25e-5 s */
+#define RINALDI_SLOPE 1.23     /* docs/records.md §5: the fitted slope in umax */
+#define RINALDI_SLOPE_TOL 0.05 /* room for rounding in another build */
+
+/* Least-squares slope of log e on log h over n points. */
+static double fitted_slope(const double *h, const double *e, int n)
+{
+    double mx = 0.0, my = 0.0, sxy = 0.0, sxx = 0.0;
+    for (int k = 0; k < n; k++) {
+        mx += log(h[k]) / n;
+        my += log(e[k]) / n;
+    }
+    for (int k = 0; k < n; k++) {
+        sxy += (log(h[k]) - mx) * (log(e[k]) - my);
+        sxx += (log(h[k]) - mx) * (log(h[k]) - mx);
+    }
+    return sxy / sxx;
+}
+
 /* The shared Rinaldi record: Moreau–Jean's umax converges to the exact
  * reference's as dt halves (order >= 0.8 over dt = 4e-3 ... 5e-4 s), to
- * 1e-3 at the finest. */
+ * 1e-3 at 5e-4 s; over 5e-4 ... 6.25e-5 s the fitted slope of log err_umax
+ * on log dt is 1.23 (docs/records.md §5: about 1.2, not 1.5). */
 static void test_records_moreau_converges(pd_test_ctx *ctx)
 {
     char path[4096];
@@ -133,9 +153,9 @@ static void test_records_moreau_converges(pd_test_ctx *ctx)
         pd_record_free(&rec);
         return;
     }
-    double e[4], dt = 4e-3;
-    for (int k = 0; k < 4; k++, dt /= 2.0) {
-        o.dt = dt;
+    double e[RINALDI_DTS], h[RINALDI_DTS], dt = 4e-3;
+    for (int k = 0; k < RINALDI_DTS; k++, dt /= 2.0) {
+        o.dt = h[k] = dt;
         int rc = pd_osc_simulate(&c, &o, NULL, NULL, &r, &err);
         e[k] = rc ? NAN : fabs(r.umax - ref.umax) / ref.umax;
     }
@@ -143,6 +163,10 @@ static void test_records_moreau_converges(pd_test_ctx *ctx)
     CHECK(ctx, ref.impacts > 5 && e[3] <= 1e-3 && order >= 0.8,
           "%ld impacts; umax errors %.3g %.3g %.3g %.3g: order %.2f", ref.impacts, e[0], e[1],
           e[2], e[3], order);
+    double slope = fitted_slope(h + 3, e + 3, RINALDI_DTS - 3);
+    CHECK(ctx, fabs(slope - RINALDI_SLOPE) <= RINALDI_SLOPE_TOL,
+          "fitted slope %.3g over dt = 5e-4 ... 6.25e-5 s (errors %.3g %.3g %.3g %.3g), "
+          "docs/records.md: %.2f", slope, e[3], e[4], e[5], e[6], RINALDI_SLOPE);
     pd_record_free(&rec);
 }
 

@@ -583,6 +583,12 @@ static void test_scene_cli_bad_files(pd_test_ctx *ctx)
          "structures[0].xii: unknown field"},
         {"order", "{\n" EXC ST1 "\"contacts\": [{\"a\": \"B\", \"b\": \"A\", \"gap\": 0.1, \"eps\": 0.5}]\n}\n",
          "contacts[0].b: 'A' must stand to the right of 'B'"},
+        {"comma", "{\n" EXC "\"structures\": [{\"name\": \"a,b\", \"T0\": 1}]\n}\n",
+         "structures[0].name: may not contain ','"},
+        {"dot", "{\n" EXC "\"structures\": [{\"name\": \".\", \"T0\": 1}]\n}\n",
+         "structures[0].name: '.' is not a usable name"},
+        {"twice", "{\n" EXC ST1 "\"contacts\": [{\"a\": \"A\", \"b\": \"B\", \"levels\": [1, 1], \"gap\": 0.1, \"eps\": 0.5}]\n}\n",
+         "contacts[0]: 'A' storey 1 and 'B' storey 1 are joined twice"},
     };
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
         char path[256], out[256], fname[64];
@@ -718,24 +724,191 @@ static void test_scene_builder_derived_finite(pd_test_ctx *ctx)
     }
 }
 
-/* Binary input: /dev/zero as the scene or as its record, and a NUL byte,
- * refused at the byte with its line and column (the scene reader read 256
- * MiB of /dev/zero, the record reader 2 GB, before). */
+/* A finished scene of n SDOFs in a row between two walls (pd_scene_chain). */
+static pd_scene *small_row(int n)
+{
+    pd_scene_excitation x = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 4.0, .Tp = 0.3};
+    pd_scene *sc = NULL;
+    pd_err e;
+    return pd_scene_chain(n, &x, 1.0, 1.5, 0.05, 0.01, 0.6, &sc, &e) ? NULL : sc;
+}
+
+/* Results carry their shape: one allocated before pd_scene_finish, or for
+ * a smaller scene, is refused by every run and measurement (PD_EINVAL),
+ * never written out of bounds (ASan saw pd_scene_run write past both). */
+static void test_scene_result_shape(pd_test_ctx *ctx)
+{
+    pd_scene_excitation x = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 4.0, .Tp = 0.3};
+    pd_scene *open = pd_scene_new(&x), *small = small_row(2), *big = small_row(5);
+    pd_scene_result r = {0}, rs = {0}, rb = {0}, rb2 = {0};
+    pd_scene_errors es = {0};
+    pd_scene_trace ts = {0}, tb = {0};
+    pd_err e = {0};
+    pd_run_opts o = pd_run_default_opts();
+    o.dt = 1e-3;
+    if (!CHECK(ctx, open && small && big, "scenes"))
+        goto done;
+    CHECK(ctx, !pd_scene_add_sdof(open, "A", 1.0, 0.05, 1.0, &e), "%s", e.msg);
+    CHECK(ctx, pd_scene_result_alloc(open, &r, &e) == PD_EINVAL && strstr(e.msg, "not finished"),
+          "a result for an unfinished scene: %s", e.msg);
+    CHECK(ctx, pd_scene_run(open, &o, NULL, NULL, &r, &e) == PD_EINVAL, "ran an unfinished scene");
+    if (!CHECK(ctx, !pd_scene_result_alloc(small, &rs, &e) && !pd_scene_result_alloc(big, &rb, &e) &&
+                        !pd_scene_result_alloc(big, &rb2, &e) &&
+                        !pd_scene_errors_alloc(small, &es, &e) &&
+                        !pd_scene_trace_alloc(&ts, small, &o, &e) &&
+                        !pd_scene_trace_alloc(&tb, big, &o, &e),
+               "%s", e.msg))
+        goto done;
+    CHECK(ctx, pd_scene_result_fits(big, &rb) && !pd_scene_result_fits(big, &rs) &&
+                   !pd_scene_result_fits(big, &r), "pd_scene_result_fits");
+    CHECK(ctx, pd_scene_run(big, &o, NULL, NULL, &rs, &e) == PD_EINVAL &&
+                   strstr(e.msg, "not allocated for this scene"),
+          "a smaller scene's result: %s", e.msg);
+    CHECK(ctx, pd_scene_measure_reference(big, &o, &ts, &rb, &e) == PD_EINVAL,
+          "a smaller scene's trace: %s", e.msg);
+    CHECK(ctx, pd_scene_measure_reference(big, &o, &tb, &rs, &e) == PD_EINVAL,
+          "a smaller scene's reference result: %s", e.msg);
+    if (CHECK(ctx, !pd_scene_measure_reference(big, &o, &tb, &rb, &e), "%s", e.msg))
+        CHECK(ctx, pd_scene_measure_run(big, &o, &tb, &rb, &rb2, &es, &e) == PD_EINVAL,
+              "a smaller scene's errors: %s", e.msg);
+done:
+    pd_scene_result_free(&r);
+    pd_scene_result_free(&rs);
+    pd_scene_result_free(&rb);
+    pd_scene_result_free(&rb2);
+    pd_scene_errors_free(&es);
+    pd_scene_trace_free(&ts);
+    pd_scene_trace_free(&tb);
+    pd_scene_free(open);
+    pd_scene_free(small);
+    pd_scene_free(big);
+}
+
+/* A building whose second mode is at 160 kHz (masses 1 and 1e-6 kg): the
+ * methods that follow every mode are refused up front, naming the
+ * structure and the method that runs it (they ran for minutes); Moreau–Jean
+ * runs it.  A row of 30 under penalty elements 1e8 times its storeys'
+ * stiffness, whose elements end switching at one instant, ends with "no
+ * progress" (it crawled on for 681 s of CPU). */
+static void test_scene_work_budgets(pd_test_ctx *ctx)
+{
+    pd_scene_excitation x = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 4.0, .Tp = 0.5};
+    pd_scene *sc = pd_scene_new(&x), *row = NULL;
+    const double m[2] = {1.0, 1e-6}, k[2] = {40.0, 1e6};
+    const pd_method refused[3] = {PD_METHOD_EVENT, PD_METHOD_EVENT_GENERAL, PD_METHOD_PENALTY};
+    pd_scene_result r = {0};
+    pd_err e = {0};
+    if (!CHECK(ctx, sc && !pd_scene_add_building(sc, "A", 2, m, k, 0.05, &e) &&
+                        !pd_scene_add_contact(sc, PD_WALL, 0, 0, 2, 0.01, 0.5, 0, &e) &&
+                        !pd_scene_finish(sc, &e) && !pd_scene_result_alloc(sc, &r, &e),
+               "%s", e.msg))
+        goto done;
+    /* the top storey on its spring: w^2 = k2 (1/m1 + 1/m2), to k1 / k2 = 4e-5 */
+    double Tmin = PD_TWO_PI / sqrt(k[1] * (1.0 / m[0] + 1.0 / m[1]));
+    CHECK(ctx, fabs(sc->st[0].Tmin - Tmin) < 1e-4 * Tmin, "highest period %.6g s, %.6g s expected",
+          sc->st[0].Tmin, Tmin);
+    for (int j = 0; j < 3; j++) {
+        pd_run_opts o = pd_run_default_opts();
+        o.method = refused[j];
+        int rc = pd_scene_run(sc, &o, NULL, NULL, &r, &e);
+        CHECK(ctx, rc == PD_EINVAL && strstr(e.msg, "structures[0] ('A')") &&
+                       strstr(e.msg, "--method moreau runs it"),
+              "%s: %d %s", pd_method_name(refused[j]), rc, e.msg);
+    }
+    pd_run_opts mj = pd_run_default_opts();
+    mj.method = PD_METHOD_MOREAU;
+    CHECK(ctx, pd_scene_run(sc, &mj, NULL, NULL, &r, &e) == PD_OK, "Moreau-Jean: %s", e.msg);
+    pd_scene_result_free(&r);
+    pd_scene_free(sc);
+    /* a building of 100 storeys: the row reference's modes cost n^2 a point */
+    pd_run_opts ev = pd_run_default_opts();
+    ev.method = PD_METHOD_EVENT;
+    int rc100 = -1;
+    if ((sc = pd_scene_new(&x)) && !pd_scene_add_uniform(sc, "B", 100, 1e5, 2.0, 0.05, &e) &&
+        !pd_scene_add_contact(sc, 0, 100, PD_WALL, 0, 0.01, 0.5, 0, &e) && !pd_scene_finish(sc, &e))
+        rc100 = pd_scene_resolve_opts(sc, &ev, &ev, &e);
+    CHECK(ctx, rc100 == PD_EINVAL && strstr(e.msg, "100 storeys") && strstr(e.msg, "moreau"),
+          "a building of 100 storeys under --method event: %d %s", rc100, e.msg);
+    pd_scene_excitation xc = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0};
+    if (!CHECK(ctx, !pd_scene_chain(30, &xc, 1.0, 1.5, 0.05, 0.05 / (PD_TWO_PI * PD_TWO_PI), 0.5,
+                                    &row, &e) && !pd_scene_result_alloc(row, &r, &e),
+               "%s", e.msg))
+        goto done;
+    pd_run_opts pen = pd_run_default_opts();
+    pen.method = PD_METHOD_PENALTY;
+    pen.pen.kc_mult = 1e8;
+    int rc = pd_scene_run(row, &pen, NULL, NULL, &r, &e);
+    CHECK(ctx, rc == PD_ENUMERICAL && strstr(e.msg, "no progress") && strstr(e.msg, " s after"),
+          "penalty kc 1e8 on a row of 30: %d %s", rc, e.msg);
+done:
+    pd_scene_result_free(&r);
+    pd_scene_free(sc);
+    pd_scene_free(row);
+}
+
+/* Contacts coupled through two buildings of 20,000 storeys touching at
+ * every floor: Moreau–Jean's contact matrices would hold 1.6e9 entries
+ * (the run took 14 GB); pd_scene_finish refuses them at once, naming the
+ * contacts[] entry. */
+static void test_scene_coupling_bounded(pd_test_ctx *ctx)
+{
+    pd_scene_excitation x = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 4.0, .Tp = 0.5};
+    pd_scene *sc = pd_scene_new(&x);
+    pd_err e = {0};
+    int rc = -1, n = 20000;
+    if (sc && !pd_scene_add_uniform(sc, "A", n, 1e5, 2.0, 0.05, &e) &&
+        !pd_scene_add_uniform(sc, "B", n, 1e5, 2.5, 0.05, &e)) {
+        rc = 0;
+        for (int l = 1; l <= n && !rc; l++)
+            rc = pd_scene_add_contact(sc, 0, l, 1, l, 0.01, 0.5, 7, &e);
+        if (!rc)
+            rc = pd_scene_finish(sc, &e);
+    }
+    CHECK(ctx, rc == PD_EINVAL && !strncmp(e.msg, "contacts[7]: ", 13) &&
+                   strstr(e.msg, "contact matrices") && !sc->finished,
+          "20,000 coupled floors: %d %s", rc, e.msg);
+    pd_scene_free(sc);
+}
+
+/* Binary input: 3 GB of zero bytes (a sparse file) as the scene or as its
+ * record, and a NUL byte, refused at the byte with its line and column (the
+ * scene reader read 256 MiB of /dev/zero, the record reader 2 GB, before);
+ * /dev/zero and a FIFO are not regular files, refused before a byte is
+ * read (a FIFO hung for ever). */
 static void test_scene_binary_input(pd_test_ctx *ctx)
 {
     pd_scene *sc = NULL;
     pd_err e = {0};
+    char zero[64], text[300];
     int st = pd_scene_load("/dev/zero", &sc, &e);
-    CHECK(ctx, st == PD_EPARSE && strstr(e.msg, "/dev/zero:1:1: not a text file (a NUL byte)"),
+    CHECK(ctx, st == PD_EINVAL && strstr(e.msg, "/dev/zero: not a regular file (a device)"),
           "/dev/zero: %d %s", st, e.msg);
-    char dir[] = "/tmp/pd_sceneXXXXXX", path[256], want[400];
-    if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
+    char dir[] = "/tmp/pd_sceneXXXXXX", path[256], want[400], fifo[64];
+    if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp") ||
+        !CHECK(ctx, pd_test_zero_file(zero, sizeof zero, 3LL << 30) == 0, "a sparse file"))
         return;
-    scratch(dir, "zero.json", "{\n\"excitation\": {\"record\": \"/dev/zero\"},\n"
-            "\"structures\": [{\"name\": \"A\", \"T0\": 0.5}]\n}\n", path, sizeof path);
+    st = pd_scene_load(zero, &sc, &e);
+    snprintf(want, sizeof want, "%s:1:1: not a text file (a NUL byte)", zero);
+    CHECK(ctx, st == PD_EPARSE && strstr(e.msg, want), "3 GB of zeros: %d %s", st, e.msg);
+    snprintf(fifo, sizeof fifo, "%s/fifo", dir);
+    if (CHECK(ctx, mkfifo(fifo, 0600) == 0, "mkfifo")) {
+        st = pd_scene_load(fifo, &sc, &e);
+        CHECK(ctx, st == PD_EINVAL && strstr(e.msg, "not a regular file (a FIFO)"),
+              "a FIFO: %d %s", st, e.msg);
+    }
+    snprintf(text, sizeof text, "{\n\"excitation\": {\"record\": \"%s\"},\n"
+             "\"structures\": [{\"name\": \"A\", \"T0\": 0.5}]\n}\n", zero);
+    scratch(dir, "zero.json", text, path, sizeof path);
     st = pd_scene_load(path, &sc, &e);
-    snprintf(want, sizeof want, "%s:2:26: excitation.record: /dev/zero:1: not a text file", path);
-    CHECK(ctx, st == PD_EPARSE && strstr(e.msg, want), "record /dev/zero: %d %s", st, e.msg);
+    snprintf(want, sizeof want, "%s:2:26: excitation.record: %s:1: not a text file", path, zero);
+    CHECK(ctx, st == PD_EPARSE && strstr(e.msg, want), "record of zeros: %d %s", st, e.msg);
+    snprintf(text, sizeof text, "{\n\"excitation\": {\"record\": \"%s\"},\n"
+             "\"structures\": [{\"name\": \"A\", \"T0\": 0.5}]\n}\n", fifo);
+    scratch(dir, "fifo.json", text, path, sizeof path);
+    st = pd_scene_load(path, &sc, &e);
+    CHECK(ctx, st != PD_OK && strstr(e.msg, "not a regular file (a FIFO)"), "record FIFO: %d %s",
+          st, e.msg);
+    unlink(zero);
     snprintf(path, sizeof path, "%s/nul.json", dir);
     FILE *f = fopen(path, "wb");
     static const char nul[] = "{\n\"tend\": 1,\n  \"x\0\": 2\n}\n";
@@ -895,4 +1068,7 @@ void suite_scene(pd_test_ctx *ctx)
     PD_RUN(ctx, test_scene_values_in_range);
     PD_RUN(ctx, test_scene_builder_derived_finite);
     PD_RUN(ctx, test_scene_binary_input);
+    PD_RUN(ctx, test_scene_result_shape);
+    PD_RUN(ctx, test_scene_work_budgets);
+    PD_RUN(ctx, test_scene_coupling_bounded);
 }

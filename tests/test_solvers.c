@@ -458,19 +458,46 @@ static void test_solvers_nonfinite_never_solved(pd_test_ctx *ctx)
  * overflow, so r_i = inf made every ratio 0 and the answer passed as
  * solved with w_1 = -1.2e308.  An answer whose terms overflow is
  * unverifiable: never solved, whatever the solver. */
-static void test_solvers_overflowing_terms_never_solved(pd_test_ctx *ctx)
+/* Every solver (auto, Lemke, structured, PGS) declines the problem: a
+ * status other than PD_OK and an outcome other than solved. */
+static void check_never_solved(pd_test_ctx *ctx, const pd_matrix *A, const double *q,
+                               const char *what)
 {
-    double M[4] = {2.0, -1.222, -12.0, 2.0}, q[2] = {-5.0, -6.0}, z[2], w[2];
-    const pd_matrix A = pd_matrix_dense(2, 2, M);
     const pd_lcp_method methods[] = {PD_LCP_AUTO, PD_LCP_LEMKE, PD_LCP_STRUCTURED, PD_LCP_PGS};
+    double z[8], w[8];
     for (int k = 0; k < 4; k++) {
         pd_lcp_info info;
-        int rc = solve_with(methods[k], &A, q, NULL, z, w, &info);
+        int rc = solve_with(methods[k], A, q, NULL, z, w, &info);
         CHECK(ctx, rc != PD_OK && info.outcome != PD_LCP_SOLVED,
-              "%s: status %d, outcome %s, z = (%g, %g), w = (%g, %g)",
-              pd_lcp_method_name(methods[k]), rc, pd_lcp_outcome_name(info.outcome), z[0], z[1],
-              w[0], w[1]);
+              "%s, %s: status %d, outcome %s, z0 = %g, w0 = %g", what,
+              pd_lcp_method_name(methods[k]), rc, pd_lcp_outcome_name(info.outcome), z[0], w[0]);
     }
+}
+
+static void test_solvers_overflowing_terms_never_solved(pd_test_ctx *ctx)
+{
+    double M[4] = {2.0, -1.222, -12.0, 2.0}, q[2] = {-5.0, -6.0};
+    const pd_matrix A = pd_matrix_dense(2, 2, M);
+    check_never_solved(ctx, &A, q, "overflowing terms");
+}
+
+/* A q of subnormal numbers (stress: extreme-subnormal-q-underflow): its
+ * answer rounds to the subnormal spacing, 33 % off in exact arithmetic, and
+ * was called solved by every solver.  Now none vouches for it; the same
+ * problem scaled by 2^1000 (exact) is solved, and its z scaled back is the
+ * answer the tiny one would have. */
+static void test_solvers_subnormal_never_solved(pd_test_ctx *ctx)
+{
+    double M[9] = {400.0, 1.0, 0.0, 0.1, 4.0, 1.0, 0.0, 1.0, 4.0};
+    double q[3] = {-5e-324, -1e-322, 1.5e-323}, big[3], z[3], w[3];
+    const pd_matrix A = pd_matrix_dense(3, 3, M);
+    check_never_solved(ctx, &A, q, "subnormal q");
+    for (int i = 0; i < 3; i++)
+        big[i] = ldexp(q[i], 1000);
+    pd_lcp_info info;
+    int rc = solve_with(PD_LCP_AUTO, &A, big, NULL, z, w, &info);
+    CHECK(ctx, rc == PD_OK && info.residual <= 1e-12, "scaled: status %d, residual %g", rc,
+          info.residual);
 }
 
 /* The same problem from a file through `pound lcp --solver structured`: a
@@ -502,6 +529,147 @@ static void test_solvers_nonfinite_cli(pd_test_ctx *ctx)
     pd_test_rm_dir(dir);
 }
 
+/* Issue 19: the LCP of the step after a cradle's impact (five balls, eps =
+ * 0.5): contacts 0, 1 and 3 active, the bodies behind the first moving
+ * together at zero gap, D positive definite, q_2 = -1.7e-16 the rounding
+ * of a zero relative velocity and the only term of its row.  Lemke ended
+ * it as numerical: its first pivot tied row 3 (q = 0) with row 2 at the
+ * scale of max|q| and left w_2 = q_2 < 0 behind, which the verification
+ * measures against that row's own terms.  Every solver, auto and Lemke
+ * alone, solve it: z_2 = -q_2 / 2. */
+static void test_solvers_cradle_after_impact(pd_test_ctx *ctx)
+{
+    const pd_lcp_method methods[] = {PD_LCP_AUTO, PD_LCP_LEMKE, PD_LCP_STRUCTURED, PD_LCP_PGS};
+    double D[9] = {2, -1, 0, -1, 2, 0, 0, 0, 2}, q[3] = {0.75, -1.6653345369377348e-16, 0.0};
+    pd_matrix Dm = pd_matrix_dense(3, 3, D);
+    for (int k = 0; k < 4; k++) {
+        double z[3], w[3];
+        pd_lcp_info info;
+        int st = solve_with(methods[k], &Dm, q, NULL, z, w, &info);
+        CHECK(ctx, st == PD_OK && info.residual <= 1e-10 && fabs(z[1] + q[1] / 2.0) <= 1e-30 &&
+                       z[0] == 0.0 && z[2] == 0.0,
+              "%s: status %d (%s) by %s, residual %.3g, z (%g, %g, %g)",
+              pd_lcp_method_name(methods[k]), st, pd_lcp_outcome_name(info.outcome),
+              info.solver, info.residual, z[0], z[1], z[2]);
+    }
+}
+
+/* Rows in persistent contact: chains of five and nine contacts (masses
+ * of order one), q with entries of rounding size (1e-17: relative
+ * velocities that are zero but for rounding) next to ones of order one.
+ * Lemke's basic values carry such a q_i no further than their rounding, so
+ * its last basis left w_i = q_i < 0 off the support, a violation at the
+ * scale of that row; its final repair (principal solves from that support)
+ * puts it right.  Every solver, and Lemke alone, agree with the oracle. */
+static void test_solvers_rounding_size_q(pd_test_ctx *ctx)
+{
+    static const double d5[5] = {1.7148812556851616, 2.302481199504391, 2.1074597900058123,
+                                 1.7676700091545996, 1.8918536715523984};
+    static const double o5[4] = {-1.1629686585902015, -1.1395125409141893, -0.967947249091623,
+                                 -0.79972276006297649};
+    static const double q5[5] = {0, -1.5736185683543978e-17, 1.5559924651822565e-17,
+                                 0.10829623838829594, -0.11178781438072138};
+    static const double d9[9] = {2.7827906822824353, 2.4548209892288089, 2.4392412496057956,
+                                 2.2553665127581271, 1.8683054462329767, 2.0522631389978248,
+                                 1.6462809857827096, 1.9589978697960273, 2.3622935591810865};
+    static const double o9[8] = {-1.410037783941168,   -1.0447832052876409, -1.3944580443181545,
+                                 -0.86090846843997249, -1.0073969777930041, -1.0448661612048209,
+                                 -0.60141482457788864, -1.3575830452181386};
+    static const double q9[9] = {-0.92206794791839819, -0.063183171803975036, 0, 0,
+                                 0.34313256311911433,  -8.1089502575916512e-18,
+                                 -3.6568136374579563e-17, 0, 0.13650529119144461};
+    const pd_lcp_method methods[] = {PD_LCP_LEMKE, PD_LCP_AUTO, PD_LCP_STRUCTURED, PD_LCP_PGS};
+    struct {
+        int n;
+        const double *d, *o, *q;
+    } cases[] = {{5, d5, o5, q5}, {9, d9, o9, q9}};
+    for (int c = 0; c < 2; c++) {
+        int n = cases[c].n;
+        double D[81] = {0}, zo[9], wo[9], z[9], w[9];
+        for (int i = 0; i < n; i++) {
+            D[i + i * n] = cases[c].d[i];
+            if (i + 1 < n)
+                D[i + 1 + i * n] = D[i + (i + 1) * n] = cases[c].o[i];
+        }
+        pd_matrix Dm = pd_matrix_dense(n, n, D);
+        CHECK(ctx, pd_lcp_enumerate(n, D, cases[c].q, zo, wo) == PD_OK, "n = %d: oracle", n);
+        double zs = 0.0;
+        for (int i = 0; i < n; i++)
+            zs = fmax(zs, fabs(zo[i]));
+        for (int k = 0; k < 4; k++) {
+            pd_lcp_info info;
+            int st = solve_with(methods[k], &Dm, cases[c].q, NULL, z, w, &info);
+            double d = 0.0;
+            for (int i = 0; i < n; i++)
+                d = fmax(d, fabs(z[i] - zo[i]));
+            CHECK(ctx, st == PD_OK && info.residual <= 1e-10 && d <= 1e-9 * zs,
+                  "n = %d, %s: status %d (%s) by %s, residual %.3g, |z - oracle| %.3g", n,
+                  pd_lcp_method_name(methods[k]), st, pd_lcp_outcome_name(info.outcome),
+                  info.solver, info.residual, d);
+        }
+    }
+}
+
+/* auto hands a problem its first solver ends as numerical to the next one,
+ * and the answer is verified.  The problems: Delassus matrices of free rows
+ * of four and five bodies whose masses span 1e-6 .. 1e12 kg (blocks of
+ * condition up to 1e12), q with entries of rounding size.  On the first
+ * Lemke ends numerical and the structured solver answers; on the second
+ * both end numerical and PGS answers.  A budget is the caller's: Lemke
+ * capped at one pivot ends as max_pivots under auto too (and a ray of
+ * Lemke's is final, test_solvers_degenerate). */
+static void test_solvers_auto_hands_over(pd_test_ctx *ctx)
+{
+    static const double D4[16] = {417386.51306114433, -417386.51306114433, 0, 0,
+                                  -417386.51306114433, 417386.51306179556,
+                                  -6.5121435460566592e-07, 0, 0, -6.5121435460566592e-07,
+                                  1.6457142655450299e-06, -9.9449991093936384e-07, 0, 0,
+                                  -9.9449991093936384e-07, 9.9456886771884702e-07};
+    static const double q4[4] = {-3.1180842755874724e-17, -0.97636601327127071,
+                                 4.119965808919095e-17, -0.19371545894983699};
+    static const double D5[25] = {
+        25842.610253135914, -1099.3041189440878, 0, 0, 0,
+        -1099.3041189440878, 1099.3041189440908, -3.0132670230515511e-12, 0, 0,
+        0, -3.0132670230515511e-12, 0.00026760355590129645, -0.00026760355288802941, 0,
+        0, 0, -0.00026760355288802941, 0.0045322791061028558, -0.0042646755532148263,
+        0, 0, 0, -0.0042646755532148263, 589938.42350120074};
+    static const double q5[5] = {4.8812983381857435e-17, 0, 0, 1.6896876525163484e-17,
+                                 -0.57626793738914239};
+    struct {
+        int n;
+        const double *D, *q;
+        const char *solver;
+    } cases[] = {{4, D4, q4, "structured (after lemke)"},
+                 {5, D5, q5, "pgs (after lemke, structured)"}};
+    for (int k = 0; k < 2; k++) {
+        double z[5], w[5];
+        pd_lcp_info info;
+        pd_matrix Dm = pd_matrix_dense(cases[k].n, cases[k].n, cases[k].D);
+        int st = solve_with(PD_LCP_LEMKE, &Dm, cases[k].q, NULL, z, w, &info);
+        CHECK(ctx, st == PD_ENUMERICAL, "n = %d: lemke alone: status %d (%s)", cases[k].n, st,
+              pd_lcp_outcome_name(info.outcome));
+        st = solve_with(PD_LCP_AUTO, &Dm, cases[k].q, NULL, z, w, &info);
+        double r = info.residual;
+        pd_lcp_residual(cases[k].n, cases[k].D, cases[k].q, z, w, &info.complementarity,
+                        &info.infeasibility, &info.residual);
+        CHECK(ctx, st == PD_OK && r <= 1e-10 && info.residual <= 1e-10 &&
+                       !strcmp(info.solver, cases[k].solver),
+              "n = %d: auto: status %d by %s, residual %.3g (%.3g), expected %s", cases[k].n,
+              st, info.solver, r, info.residual, cases[k].solver);
+    }
+    enum { N = 6 };
+    double M[N * N], q[N], z[N], w[N];
+    pd_lcp_info info;
+    pd_lcp_opts o = pd_lcp_default_opts();
+    o.max_pivots = 1;
+    random_spd(N, 19, M, q);
+    pd_matrix Mm = pd_matrix_dense(N, N, M);
+    int st = solve_with(PD_LCP_AUTO, &Mm, q, &o, z, w, &info);
+    CHECK(ctx, st == PD_EMAXPIVOTS && !strcmp(info.solver, "lemke") && info.pivots == 1,
+          "auto, lemke capped at one pivot: status %d by %s (%d pivots)", st, info.solver,
+          info.pivots);
+}
+
 void suite_solvers(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_solvers_match_oracle);
@@ -515,4 +683,8 @@ void suite_solvers(pd_test_ctx *ctx)
     PD_RUN(ctx, test_solvers_nonfinite_never_solved);
     PD_RUN(ctx, test_solvers_overflowing_terms_never_solved);
     PD_RUN(ctx, test_solvers_nonfinite_cli);
+    PD_RUN(ctx, test_solvers_cradle_after_impact);
+    PD_RUN(ctx, test_solvers_rounding_size_q);
+    PD_RUN(ctx, test_solvers_auto_hands_over);
+    PD_RUN(ctx, test_solvers_subnormal_never_solved);
 }

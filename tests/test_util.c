@@ -1,6 +1,7 @@
 /* test_util.c — helpers the CLI suites share: running pound and capturing
  * its output, reading JSON members, scratch folders, HDF5 attributes. */
 #include <dirent.h>
+#include <fcntl.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -201,4 +202,17 @@ double pd_test_uniform(uint64_t *s)
     z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
     z ^= z >> 31;
     return (double)(z >> 11) * 0x1.0p-53;
+}
+
+int pd_test_zero_file(char *path, size_t cap, long long bytes)
+{
+    snprintf(path, cap, "/tmp/pd_zeroXXXXXX");
+    int fd = mkstemp(path);
+    if (fd < 0)
+        return -1;
+    int rc = ftruncate(fd, (off_t)bytes);
+    close(fd);
+    if (rc)
+        unlink(path);
+    return rc;
 }

@@ -6,7 +6,8 @@ import math
 
 import numpy as np
 
-from . import _lib
+from . import _args, _lib
+from ._args import number
 from ._lib import InputError, PdErr, PdRecord, PdRecordPulse, lib
 
 # Keyword arguments and the CLI flags they mirror (the names without "--",
@@ -37,27 +38,20 @@ def fmt(x):
 
 
 def parse_name(what, parser, value, choices):
-    """A name through the library's parser (bytes out of str)."""
+    """A name through the library's parser (a str without NUL, as bytes)."""
     out = ctypes.c_int()
-    if not isinstance(value, str) or parser(value.encode(), ctypes.byref(out)) != 0:
-        raise InputError("%s: '%s' is not one of %s" % (what, value, choices))
+    if parser(_args.name(what, value, choices), ctypes.byref(out)) != 0:
+        raise InputError("%s: %s is not one of %s" % (what, _args.show(value), choices))
     return out.value
 
 
 def parse_dir(value):
-    if value in (1, -1) and not isinstance(value, bool):
-        return value
+    """'normal'/'reverse', or the number +1/-1 (not a bool)."""
+    if isinstance(value, (int, float, np.integer, np.floating)) and not _args.is_bool(value):
+        if value in (1, -1):
+            return int(value)
+        raise InputError("dir: %s is not one of normal, reverse (or 1, -1)" % _args.show(value))
     return parse_name("dir", lib.pd_dir_parse, value, "normal, reverse")
-
-
-def number(what, value):
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise InputError("%s: '%s' is not a number" % (what, value)) from None
-    if not math.isfinite(x):
-        raise InputError("%s: '%s' is not a finite number" % (what, value))
-    return x
 
 
 class Record:
@@ -65,14 +59,15 @@ class Record:
     (pd_record_read, pd_record_fit_pulse); owns the C arrays."""
 
     def __init__(self, path, units="g", format="auto"):
+        self._owned = False
+        cpath, self.path = _args.path("record", path)
         fmt_code = parse_name("record_format", lib.pd_record_format_parse, format,
                               "auto, at2, v2, text")
         unit_code = parse_name("units", lib.pd_record_units_parse, units, "g, m/s2, cm/s2")
         self.rec = PdRecord()
         self.pulse = PdRecordPulse()
-        self._owned = False
         err = PdErr()
-        st = lib.pd_record_read(str(path).encode(), fmt_code, unit_code, self.rec, err)
+        st = lib.pd_record_read(cpath, fmt_code, unit_code, self.rec, err)
         if st == 0:
             self._owned = True
             st = lib.pd_record_fit_pulse(self.rec, self.pulse, err)
@@ -150,11 +145,9 @@ def scheme_opts(kw):
         elif key in ("dt", "tend", "theta", "gamma", "close_tol"):
             setattr(o, key, number(key, v))
         elif key in ("allow_unstable", "no_accumulation", "no_wall"):
-            setattr(o, key, 1 if v else 0)
+            setattr(o, key, 1 if _args.flag(key, v) else 0)
         elif key == "kernel":
-            if v not in ("auto", "general"):
-                raise InputError("kernel: '%s' is not one of auto, general" % (v,))
-            o.kernel = 1 if v == "general" else 0
+            o.kernel = 1 if _args.choice(key, v, ("auto", "general")) == "general" else 0
         elif key == "factor":
             o.factor = parse_name("factor", lib.pd_factor_kind_parse, v,
                                   "auto, scalar, dense, cholmod")
@@ -162,9 +155,7 @@ def scheme_opts(kw):
             o.lcp_solver = parse_name("lcp_solver", lib.pd_lcp_method_parse, v,
                                       _lib.s(lib.pd_lcp_method_list()))
         elif key == "contact":
-            if v not in ("kelvin", "hertz"):
-                raise InputError("contact: '%s' is not one of kelvin, hertz" % (v,))
-            o.pen.law = 1 if v == "hertz" else 0
+            o.pen.law = 1 if _args.choice(key, v, ("kelvin", "hertz")) == "hertz" else 0
         elif key == "kc":
             o.pen.kc_mult = number(key, v)
         elif key == "kc_abs":
@@ -172,9 +163,7 @@ def scheme_opts(kw):
         elif key in ("rtol", "atol"):
             setattr(o.pen, key, number(key, v))
         elif key == "stepper":
-            if v not in STEPPERS:
-                raise InputError("stepper: '%s' is not one of rk8pd, rkf45, rk4imp, msbdf" % (v,))
-            o.pen.stepper = STEPPERS[v]
+            o.pen.stepper = STEPPERS[_args.choice(key, v, STEPPERS)]
     _check_scheme(o, have)
     have["method_by"] = _method_by(o, kw)
     return o, have

@@ -4,7 +4,7 @@ import time
 
 import numpy as np
 
-from . import _lib
+from . import _args, _lib
 from ._case import InputError, Record, parse_name
 from ._lib import PdErr, PdMatrix, lib, s
 from ._osc import Result
@@ -15,16 +15,17 @@ _libc.free.restype = None
 
 _FORMATS = {"auto": 0, "plain": 1, "siconos": 2}
 _DPTR = ctypes.POINTER(ctypes.c_double)
+PD_LCP_LEMKE_NMAX = 2048  # lcp/pd_lcp.h
 
 
 def read_lcp(path, format="auto"):
     """Read an LCP file (plain: n, M row by row, q; or Siconos): (M, q) as
     NumPy arrays (pd_lcp_read)."""
-    if format not in _FORMATS:
-        raise InputError("format: '%s' is not plain, siconos or auto" % (format,))
+    fmt_code = _FORMATS[_args.choice("format", format, _FORMATS)]
+    cpath, _ = _args.path("read_lcp", path)
     n, M, q = ctypes.c_int(), _DPTR(), _DPTR()
     err = PdErr()
-    _lib.check(lib.pd_lcp_read(str(path).encode(), _FORMATS[format], ctypes.byref(n),
+    _lib.check(lib.pd_lcp_read(cpath, fmt_code, ctypes.byref(n),
                                ctypes.byref(M), ctypes.byref(q), err), err)
     try:
         nn = n.value
@@ -46,7 +47,9 @@ def lcp(M, q, solver="auto", cover=None, max_pivots=0, max_iterations=0, tol=Non
 
     M: a square array (dense), or a SciPy sparse matrix (compressed columns);
     solver: 'auto', 'lemke', 'structured', 'pgs'; cover: Lemke's covering
-    vector (one value or n)."""
+    vector (one value or n); max_pivots, max_iterations: the budgets (0:
+    from n).  M, q and cover must be finite: the library refuses what is
+    not (PD_EINVAL without a message), so they are checked here first."""
     method = parse_name("solver", lib.pd_lcp_method_parse, solver,
                         s(lib.pd_lcp_method_list()))
     keep = []
@@ -54,18 +57,20 @@ def lcp(M, q, solver="auto", cover=None, max_pivots=0, max_iterations=0, tol=Non
         A = M.tocsc()
         A.sort_indices()
         n = A.shape[0]
-        if A.shape != (n, n):
+        if A.shape != (n, n) or n < 1:
             raise InputError("M: must be square (got %dx%d)" % A.shape)
-        vals = np.ascontiguousarray(A.data, dtype=np.float64)
+        vals = np.ascontiguousarray(_args.real_array("M", A.data, finite=False).reshape(-1))
         colptr = np.ascontiguousarray(A.indptr, dtype=np.int32)
         rowind = np.ascontiguousarray(A.indices, dtype=np.int32)
+        _args.nonfinite_at("M", vals, lambda k: (int(rowind[k]), int(
+            np.searchsorted(colptr, k, side="right") - 1)))
         keep += [vals, colptr, rowind]
         mat = PdMatrix(kind=2, rows=n, cols=n, values=vals.ctypes.data_as(_DPTR),
                        colptr=colptr.ctypes.data_as(ctypes.POINTER(ctypes.c_int)),
                        rowind=rowind.ctypes.data_as(ctypes.POINTER(ctypes.c_int)))
         nnz = len(vals) + 1
     else:
-        A = np.asarray(M, dtype=np.float64)
+        A = _args.real_array("M", M)
         if A.ndim != 2 or A.shape[0] != A.shape[1] or A.shape[0] < 1:
             raise InputError("M: must be a square matrix (got shape %s)" % (A.shape,))
         n = A.shape[0]
@@ -73,29 +78,33 @@ def lcp(M, q, solver="auto", cover=None, max_pivots=0, max_iterations=0, tol=Non
         keep.append(vals)
         mat = PdMatrix(kind=1, rows=n, cols=n, values=vals.ctypes.data_as(_DPTR))
         nnz = 0
-    qa = np.ascontiguousarray(q, dtype=np.float64).reshape(-1)
+    qa = np.ascontiguousarray(_args.real_array("q", q)).reshape(-1)
     if qa.shape != (n,):
         raise InputError("q: expected %d entries (got %d)" % (n, qa.size))
-    err = PdErr()
-    err_ = lib.pd_lcp_solver_alloc(method, n, nnz, err)
-    if not err_:
-        raise _lib.make_error(err.status or _lib.PD_ENOMEM, err.text())
-    solver_p = err_
+    # the options before the solver is allocated (nothing to free on a refusal)
     opts = _lib.default_lcp_opts()
     if cover is not None:
-        cv = np.atleast_1d(np.asarray(cover, dtype=np.float64))
+        cv = np.atleast_1d(_args.real_array("cover", cover)).reshape(-1)
         if cv.size == 1:
             cv = np.full(n, cv[0])
-        if cv.shape != (n,) or not np.all(cv > 0) or not np.all(np.isfinite(cv)):
+        if cv.shape != (n,) or not np.all(cv > 0):
             raise InputError("cover: expected 1 or n = %d positive values" % n)
         keep.append(cv)
         opts.cover = cv.ctypes.data_as(_DPTR)
-    opts.max_pivots = int(max_pivots)
-    opts.max_iterations = int(max_iterations)
+    for key, v in (("max_pivots", max_pivots), ("max_iterations", max_iterations)):
+        k = _args.integer(key, v)
+        if k < 0:
+            raise InputError("%s: must be >= 0 (got %d)" % (key, k))
+        setattr(opts, key, k)
     if tol is not None:
+        tol = _args.number("tol", tol)
         if not 0.0 < tol < 1e-3:
             raise InputError("tol: must lie in (0, 1e-3), got %g" % tol)
-        opts.tol = float(tol)
+        opts.tol = tol
+    err = PdErr()
+    solver_p = lib.pd_lcp_solver_alloc(method, n, nnz, err)
+    if not solver_p:
+        raise _lib.make_error(err.status or _lib.PD_ENOMEM, err.text())
     z, w = np.zeros(n), np.zeros(n)
     info = _lib.PdLcpInfo()
     try:
@@ -106,8 +115,15 @@ def lcp(M, q, solver="auto", cover=None, max_pivots=0, max_iterations=0, tol=Non
     finally:
         lib.pd_lcp_solver_free(solver_p)
     if st == _lib.PD_EINVAL:
-        raise InputError("lcp: n = %d is more than the %s solver takes (Lemke: at most 2048 "
-                         "unknowns)" % (n, solver))
+        # pd_lcp_solve refuses without a message; everything else it refuses was
+        # checked above (finite M, q and cover > 0, budgets >= 0, tol), so what is left
+        # is the size, as in the CLI (whose reader refuses non-finite data)
+        name = s(lib.pd_lcp_method_name(method))
+        if n > PD_LCP_LEMKE_NMAX:
+            raise InputError("lcp: n = %d is more than the %s solver takes (Lemke: at most "
+                             "%d unknowns)" % (n, name, PD_LCP_LEMKE_NMAX))
+        raise InputError("lcp: the %s solver refused the problem (PD_EINVAL, n = %d)"
+                         % (name, n))
     return Result(status=s(lib.pd_lcp_outcome_name(info.outcome)), solver=s(info.solver), n=n,
                   z=z, w=w, pivots=info.pivots, iterations=info.iterations,
                   residual=info.residual, complementarity=info.complementarity,

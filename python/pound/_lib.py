@@ -189,8 +189,8 @@ class PdStructure(Structure):
     _fields_ = [("name", c_char * PD_NAME_MAX), ("storeys", c_int),
                 ("mass", POINTER(c_double)), ("stiffness", POINTER(c_double)), ("xi", c_double),
                 ("damping", c_int), ("modes", c_int * 2), ("T0", c_double),
-                ("period", c_double * 2), ("alpha", c_double), ("beta", c_double),
-                ("dof", c_int)]
+                ("period", c_double * 2), ("Tmin", c_double), ("alpha", c_double),
+                ("beta", c_double), ("dof", c_int)]
 
 
 class PdContact(Structure):
@@ -245,7 +245,7 @@ class PdSceneTrace(Structure):
 class PdSceneErrors(Structure):
     _fields_ = [("err_umax", POINTER(c_double)), ("err_hist", POINTER(c_double)),
                 ("err_umax_max", c_double), ("err_hist_max", c_double), ("impacts", c_long),
-                ("grid_points", c_long), ("cpu_s", c_double)]
+                ("grid_points", c_long), ("cpu_s", c_double), ("nstruct", c_int)]
 
 
 PD_SPEC_MAX_LIST = 64

@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 
-from . import _lib
+from . import _args, _lib
 from ._case import Case, InputError, copy_opts, number
 from ._lib import PdErr, lib, s
 
@@ -67,6 +67,15 @@ def _osc_sampler(h):
     return _lib.OscSampler(sample)
 
 
+def history_args(history, every):
+    """The history switch and its stride, checked (every >= 1, an integer)."""
+    history = _args.flag("history", history)
+    every = _args.integer("every", every)
+    if every < 1:
+        raise InputError("every: must be >= 1 (got %d)" % every)
+    return history, every
+
+
 def osc_result_fields(r):
     """A pd_osc_result as a dict."""
     return {k: (s(getattr(r, k)) if k == "kernel" else getattr(r, k))
@@ -112,13 +121,11 @@ def simulate(history=True, every=1, **case):
     impulse, gap of every every-th step (the CLI's -o file: t [s], u [m],
     v [m/s], impulse per unit mass since the last sample [m/s], gap
     delta - u [m]), with t, u, v, impulse also as r.t, r.u, r.v, r.impulse."""
+    history, every = history_args(history, every)
     k = Case(case).resolve()
     o = k.opts
     h = sampler = None
     if history:
-        every = int(every)
-        if every < 1:
-            raise InputError("every: must be >= 1 (got %d)" % every)
         h = _History(OSC_SAMPLE, lib.pd_steps_for(o.tend, o.dt) // every + 2, every)
         sampler = _osc_sampler(h)
     sm = _lib.PdOscSummary()
@@ -157,12 +164,10 @@ def parse_methods(methods):
     if isinstance(methods, str):
         methods = methods.split(",")
     want = [0] * 5
-    if not methods:
+    if methods is None or (hasattr(methods, "__len__") and len(methods) == 0):
         raise InputError("methods: give moreau, penalty, event-general")
-    for m in methods:
-        if m not in _METHOD_CODE:
-            raise InputError("methods: '%s' is not one of moreau, penalty, event-general" % (m,))
-        want[_METHOD_CODE[m]] = 1
+    for m in _args.values("methods", methods):
+        want[_METHOD_CODE[_args.choice("methods", m, _METHOD_CODE)]] = 1
     return want
 
 
@@ -237,7 +242,8 @@ def compare(methods=("moreau",), scene=None, **case):
 def dt_range(dt_max, dt_min, n):
     """The steps of the CLI's --dt MAX:MIN:N: n values log-spaced from dt_max
     down to dt_min (cli/cmd_converge.c dt_at)."""
-    dt_max, dt_min, n = float(dt_max), float(dt_min), int(n)
+    dt_max, dt_min = number("dt", dt_max, "MAX ="), number("dt", dt_min, "MIN =")
+    n = _args.integer("dt", n, "N =")
     if not (dt_min > 0.0) or dt_max < dt_min or n < 1 or n > 64:
         raise InputError("dt: need MAX >= MIN > 0 and 1 <= N <= 64 (got %g:%g:%d)"
                          % (dt_max, dt_min, n))
@@ -261,8 +267,8 @@ def _steps(dts):
     if isinstance(dts, tuple) and len(dts) == 3 and isinstance(dts[2], (int, np.integer)) \
             and not isinstance(dts[2], bool):
         return dt_range(*dts), float(dts[1]), float(dts[0])
-    steps = [number("dt", x) for x in np.atleast_1d(dts).tolist()]
-    if not steps or len(steps) > 64 or not all(x > 0.0 for x in steps):
+    steps = [number("dt", x) for x in _args.values("dt", dts)]
+    if len(steps) > 64 or not all(x > 0.0 for x in steps):
         raise InputError("dt: give 1 to 64 steps > 0")
     return steps, min(steps), steps[0]
 
@@ -285,19 +291,18 @@ def converge(dts, theta=(0.5,), methods=("moreau",), kcs=None, error="hist", sce
     dts: 'MAX:MIN:N' or (MAX, MIN, N) with an int N (the CLI's --dt), or a
     sequence of steps.  Returns {'rows': [...], 'cpu_s_ref': ...}."""
     steps, dt_min, dt_first = _steps(dts)
-    thetas = [number("theta", t) for t in np.atleast_1d(theta).tolist()]
-    if not thetas or len(thetas) > 32:
+    thetas = [number("theta", t) for t in _args.values("theta", theta)]
+    if len(thetas) > 32:
         raise InputError("theta: give 1 to 32 values")
     want = parse_methods(methods)
     _scenes_only(want, scene)
     want_moreau, want_penalty, want_general = want[0], want[2], want[4]
     kcs = [1e2, 1e3, 1e4, 1e5, 1e6] if kcs is None else \
-        [number("kcs", x) for x in np.atleast_1d(kcs).tolist()]
+        [number("kcs", x) for x in _args.values("kcs", kcs)]
     if any(not x > 0.0 for x in kcs):
         raise InputError("kcs: stiffness multiples must be > 0")
-    if error not in ("hist", "umax"):
-        raise InputError("error: expected 'hist' or 'umax'")
-    if not case.get("allow_unstable"):
+    _args.choice("error", error, ("hist", "umax"))
+    if not _args.flag("allow_unstable", case.get("allow_unstable")):
         for t in thetas:
             if not 0.5 <= t <= 1.0:
                 raise InputError("theta: %g is outside [1/2, 1] (allow_unstable=True)" % t)

@@ -4,10 +4,10 @@ import ctypes
 
 import numpy as np
 
-from . import _lib
+from . import _args, _lib
 from ._case import SCHEME_KEYS, Case, InputError, copy_opts, number, scheme_opts
 from ._lib import PD_WALL, PdErr, lib, s
-from ._osc import Result, _History
+from ._osc import Result, _History, history_args
 
 SCENE_OPTS = SCHEME_KEYS
 
@@ -28,10 +28,11 @@ class Scene:
         if _ptr is not None:
             self._p, self.path = _ptr, _name
             return
+        cpath, text = _args.path("scene", path)
         p = ctypes.POINTER(_lib.PdScene)()
         err = PdErr()
-        _lib.check(lib.pd_scene_load(str(path).encode(), ctypes.byref(p), err), err)
-        self._p, self.path = p, str(path)
+        _lib.check(lib.pd_scene_load(cpath, ctypes.byref(p), err), err)
+        self._p, self.path = p, text
 
     @classmethod
     def chain(cls, N, ratio=1.5, **model):
@@ -39,7 +40,7 @@ class Scene:
         periods alternating T0 and ratio T0, every gap `gap` (or Pi3), every
         restitution eps; the model keywords of simulate() (pulse, dir, ap, Tp,
         T0 or Pi2, gap or Pi3, eps, xi)."""
-        N = int(N)
+        N = _args.integer("chain", N)
         if not 1 <= N <= 10000000:
             raise InputError("chain: N must be in [1, 1e7] (got %d)" % N)
         ratio = number("chain_ratio", ratio)
@@ -157,14 +158,12 @@ class Scene:
         impulse [N s] (N x contacts), every every-th sample, the impulses
         summed since the last one kept (the CLI's -o file; t, x, v also as
         r.t, r.x, r.v)."""
+        history, every = history_args(history, every)
         _, o = self.opts(opts)
         sc = self._sc
         n, m = sc.n, sc.ncontact
         h = sampler = None
         if history:
-            every = int(every)
-            if every < 1:
-                raise InputError("every: must be >= 1 (got %d)" % every)
             dtype = [("step", "i8"), ("t", "f8"), ("x", "f8", (n,)), ("v", "f8", (n,)),
                      ("gap", "f8", (m,)), ("impulse", "f8", (m,))]
             h = _History(dtype, lib.pd_steps_for(o.tend, o.dt) // every + 2, every)

@@ -9,7 +9,7 @@ import threading
 
 import numpy as np
 
-from . import _lib
+from . import _args, _lib
 from ._case import (CASE_KEYS, PD_METHOD_AUTO, Case, InputError, implied_method, number,
                     parse_dir, parse_name)
 from ._lib import PD_SPEC_MAX_LIST, PdErr, lib, s
@@ -29,12 +29,7 @@ ARRAY_KEYS = ("Pi1", "gamma", "chi", "umax", "umax_free", "u_toward", "u_away",
 
 
 def _list(what, v, cap):
-    vals = [v] if isinstance(v, (str, int, float)) else list(np.atleast_1d(v).tolist())
-    if not vals:
-        raise InputError("%s: empty list" % what)
-    if len(vals) > cap:
-        raise InputError("%s: at most %d values" % (what, cap))
-    return vals
+    return _args.values(what, v, cap)
 
 
 def _grid(Pi2):
@@ -45,9 +40,13 @@ def _grid(Pi2):
             raise InputError("Pi2: give MIN:MAX:N (got '%s')" % Pi2)
         Pi2 = parts
     try:
-        lo, hi, n = float(Pi2[0]), float(Pi2[1]), int(Pi2[2])
-    except (TypeError, ValueError, IndexError):
-        raise InputError("Pi2: give (MIN, MAX, N) (got %r)" % (Pi2,)) from None
+        parts = list(Pi2)
+    except TypeError:
+        parts = None
+    if parts is None or len(parts) != 3:
+        raise InputError("Pi2: give (MIN, MAX, N) (got %r)" % (Pi2,))
+    lo, hi = _args.number("Pi2", parts[0], "MIN ="), _args.number("Pi2", parts[1], "MAX =")
+    n = _args.integer("Pi2", parts[2], "N =")
     if not lo > 0.0 or n < 1 or n > 1000000 or (hi != lo if n == 1 else not hi > lo):
         raise InputError("Pi2: need 0 < MIN < MAX and 2 <= N <= 1e6, or MIN = MAX with N = 1 "
                          "(got %g:%g:%d)" % (lo, hi, n))
@@ -64,7 +63,7 @@ def build(Pi2, linear=False, pulse=None, dir=None, ap=None, xi=None, Pi3=None, g
     sp = _lib.PdSpectrum()
     lib.pd_spec_init(sp)
     sp.pi2_min, sp.pi2_max, sp.npi2 = _grid(Pi2)
-    sp.linear = 1 if linear else 0
+    sp.linear = 1 if _args.flag("linear", linear) else 0
     if Pi3 is not None and gap is not None:
         raise InputError("gap and Pi3 are alternatives: give one")
     if pulse is not None:
@@ -142,7 +141,7 @@ def build(Pi2, linear=False, pulse=None, dir=None, ap=None, xi=None, Pi3=None, g
 def _threads(threads):
     if threads is None:
         threads = int(os.environ.get("OMP_NUM_THREADS", "0") or 0) or os.cpu_count() or 1
-    threads = int(threads)
+    threads = _args.integer("threads", threads)
     if not 1 <= threads <= 4096:
         raise InputError("threads: must be in [1, 4096] (got %d)" % threads)
     return threads

@@ -1,0 +1,18 @@
+/* scene_priv.h — what the scene's modules share (problems-private): the
+ * penalty's default contact stiffness and the stiffest storey it scales,
+ * and the methods' work budget checked when a run is resolved. */
+#ifndef PD_SCENE_PRIV_H
+#define PD_SCENE_PRIV_H
+
+#include "pd_problems.h"
+
+#define SCENE_PEN_KC 1e4 /* the default contact stiffness: this * the stiffest storey's */
+
+/* The largest storey stiffness of the scene [N/m]. */
+double pd_scene_stiffest(const pd_scene *sc);
+
+/* The penalty's contact stiffness of o on sc [N/m] (Kelvin-Voigt: kc_abs,
+ * or kc_mult, default SCENE_PEN_KC, times the stiffest storey). */
+double pd_scene_penalty_kc(const pd_scene *sc, const pd_run_opts *o);
+
+#endif
