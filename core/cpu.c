@@ -1,13 +1,40 @@
 /* cpu.c — the instruction-set level of this processor (pd_cpu.h). */
+#include <stdlib.h>
+#include <string.h>
+
 #include "pd_cpu.h"
 
+/* The level POUND_ISA asks for: 0 (baseline), 3 (avx2), 4 (avx512), or -1
+ * when it is unset or names none of them. */
+static int requested_level(void)
+{
+    const char *isa = getenv("POUND_ISA");
+    if (!isa)
+        return -1;
+    if (!strcmp(isa, "baseline"))
+        return 0;
+    if (!strcmp(isa, "avx2"))
+        return 3;
+    if (!strcmp(isa, "avx512"))
+        return 4;
+    return -1;
+}
+
+/* The processor's level, capped by POUND_ISA (benchmarks and tests run each
+ * variant the processor has; a level above the processor's is ignored). */
 int pd_cpu_level(void)
 {
+    int level = 0, want = requested_level();
 #if PD_X86_VARIANTS
     if (__builtin_cpu_supports("x86-64-v4"))
-        return 4;
-    if (__builtin_cpu_supports("x86-64-v3"))
-        return 3;
+        level = 4;
+    else if (__builtin_cpu_supports("x86-64-v3"))
+        level = 3;
 #endif
-    return 0;
+    return want >= 0 && want < level ? want : level;
+}
+
+const char *pd_cpu_level_name(int level)
+{
+    return level == 4 ? "avx512 (x86-64-v4)" : level == 3 ? "avx2 (x86-64-v3)" : "baseline";
 }

@@ -12,7 +12,11 @@
 #endif
 
 /* 4: x86-64-v4 (AVX-512), 3: x86-64-v3 (AVX2), 0: the baseline (and
- * every processor when the variants are not built). */
+ * every processor when the variants are not built); the environment's
+ * POUND_ISA = baseline, avx2 or avx512 caps it (benchmarks and tests run
+ * each variant this way). */
 int pd_cpu_level(void);
+/* "avx512 (x86-64-v4)", "avx2 (x86-64-v3)", "baseline". */
+const char *pd_cpu_level_name(int level);
 
 #endif

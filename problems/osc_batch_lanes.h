@@ -5,6 +5,22 @@
  * for lane. */
 #include "osc_batch.h"
 
+/* The processor's own vector, as in engine/mj_batch_lanes.h: 8 lanes under
+ * AVX-512, 4 under AVX2, 2 on the baseline (8-lane vectors on AVX2 went
+ * through the stack). */
+#if defined(__AVX512F__)
+#define LW 8
+#elif defined(__AVX__)
+#define LW 4
+#else
+#define LW 2
+#endif
+typedef double lvec __attribute__((vector_size(8 * LW)));
+typedef long long lmask __attribute__((vector_size(8 * LW)));
+#define LSELECT(m, a, b) ((lvec)(((m) & (lmask)(a)) | (~(m) & (lmask)(b))))
+
+_Static_assert(NL % LW == 0, "whole native vectors of lanes");
+
 /* One vector of lanes after a step: pd_osc_track_common's numbers lane for
  * lane (max |x| is the larger of the two one-sided maxima, formed at the
  * end: osc_batch.h's rare_load); pd_osc_track_events for
@@ -12,8 +28,8 @@
  * pd_osc_track_shift's. */
 static inline void track_vector(osc_batch *ob, int l)
 {
-    const vd zero = {0.0}, one = zero + 1.0;
-    vd x, v, P, Pi3, xto, xaw, mg, Pmax, cont, px, pP, pv;
+    const lvec zero = {0.0}, one = zero + 1.0;
+    lvec x, v, P, Pi3, xto, xaw, mg, Pmax, cont, px, pP, pv;
 #define LOAD(var, arr) memcpy(&var, &(arr)[l], sizeof var)
 #define STORE(arr, var) memcpy(&(arr)[l], &var, sizeof var)
     LOAD(x, ob->mjb.q);
@@ -28,29 +44,29 @@ static inline void track_vector(osc_batch *ob, int l)
     LOAD(px, ob->prev_x);
     LOAD(pP, ob->prev_P);
     LOAD(pv, ob->prev_v);
-    vd gap = Pi3 - x, nx = -x;
-    vd t, mf;
+    lvec gap = Pi3 - x, nx = -x;
+    lvec t, mf;
     LOAD(t, ob->mjb.t);
     LOAD(mf, ob->meas_from);
-    vm pos = P > zero, meas = t >= mf;
-    xto = SELECT(meas, SELECT(xto > x, xto, x), xto);
-    xaw = SELECT(meas, SELECT(xaw > nx, xaw, nx), xaw);
-    cont = cont + (vd)(pos & (vm)one);
-    Pmax = SELECT(pos, SELECT(Pmax > P, Pmax, P), Pmax);
-    mg = SELECT(mg < gap, mg, gap);
-    vd gprev = Pi3 - px;
+    lmask pos = P > zero, meas = t >= mf;
+    xto = LSELECT(meas, LSELECT(xto > x, xto, x), xto);
+    xaw = LSELECT(meas, LSELECT(xaw > nx, xaw, nx), xaw);
+    cont = cont + (lvec)(pos & (lmask)one);
+    Pmax = LSELECT(pos, LSELECT(Pmax > P, Pmax, P), Pmax);
+    mg = LSELECT(mg < gap, mg, gap);
+    lvec gprev = Pi3 - px;
     /* every lane has taken a step: step > 0 */
-    vm due = ((gprev > zero) & ((gap <= zero) | pos)) | (pos & (pP == zero));
+    lmask due = ((gprev > zero) & ((gap <= zero) | pos)) | (pos & (pP == zero));
     STORE(ob->xtoward, xto);
     STORE(ob->xaway, xaw);
     STORE(ob->min_gap, mg);
     STORE(ob->Pmax, Pmax);
     STORE(ob->contact, cont);
     long long hit = 0;
-    for (int i = 0; i < VW; i++)
+    for (int i = 0; i < LW; i++)
         hit |= due[i];
     if (hit)
-        for (int i = 0; i < VW; i++)
+        for (int i = 0; i < LW; i++)
             if (due[i] && ob->id[l + i] >= 0) {
                 rare_load(ob, l + i);
                 pd_osc_track_events(&ob->rare[l + i], (long)ob->mjb.steps[l + i],
@@ -69,7 +85,10 @@ int OSC_BATCH_OBSERVE(const pd_mjb *b, void *ctx)
 {
     osc_batch *ob = ctx;
     (void)b;
-    for (int j = 0; j < NV; j++)
-        track_vector(ob, j * VW);
+    for (int l = 0; l < NL; l += LW)
+        track_vector(ob, l);
     return 0;
 }
+
+#undef LW
+#undef LSELECT

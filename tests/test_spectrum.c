@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "pd_problems.h"
+#include "pd_cpu.h"
 #include "pd_test.h"
 
 /* |a - b| <= tol max(|a|, |b|), NaN equal to NaN. */
@@ -650,7 +651,37 @@ static void seen_done(void *ctx, long t, const pd_spec_result *r, const pd_err *
  * theta, gamma, damping, restitution 0 and 1, the no-wall twins, a record;
  * the event-driven and penalty tasks too (run alone); a task that blows up
  * fails with pd_spec_run_task's status and message. */
+static void stream_matches_single(pd_test_ctx *ctx);
+
+/* ... with each instruction set's batch this processor has (POUND_ISA caps
+ * pd_cpu_level: every variant computes the scalar kernel's numbers). */
 static void test_spectrum_stream_matches_single(pd_test_ctx *ctx)
+{
+    static const struct {
+        const char *isa;
+        int level;
+    } variants[] = {{"avx512", 4}, {"avx2", 3}, {"baseline", 0}};
+    const char *old = getenv("POUND_ISA");
+    char saved[32];
+    snprintf(saved, sizeof saved, "%s", old ? old : "");
+    int have = pd_cpu_level(), ran = 0;
+    for (int k = 0; k < 3; k++) {
+        if (variants[k].level > have)
+            continue;
+        setenv("POUND_ISA", variants[k].isa, 1);
+        CHECK(ctx, pd_cpu_level() == variants[k].level, "POUND_ISA=%s: level %d",
+              variants[k].isa, pd_cpu_level());
+        stream_matches_single(ctx);
+        ran++;
+    }
+    if (old)
+        setenv("POUND_ISA", saved, 1);
+    else
+        unsetenv("POUND_ISA");
+    CHECK(ctx, ran >= 1, "no variant ran");
+}
+
+static void stream_matches_single(pd_test_ctx *ctx)
 {
     pd_record rec;
     memset(&rec, 0, sizeof rec);
