@@ -20,7 +20,8 @@
 #                 mpirun -np K build-mpi/pound spectrum ...
 #   make OPENMP=  without OpenMP (spectrum then runs one thread)
 #
-# Layers: cli -> problems -> engine -> lcp; HDF5 is used by cli/ only.
+# Layers: cli -> problems -> engine -> lcp; HDF5 is used by cli/ only; bench/
+# holds the drivers of `pound bench` (cli/cmd_bench.c calls them).
 
 CC      ?= cc
 OPT     ?= -O2
@@ -75,12 +76,15 @@ else
 CLI_LIBS  = $(LIBS)
 endif
 
-INC      = -Icore -Ilcp -Iengine -Iproblems -Icli
+INC      = -Icore -Ilcp -Iengine -Iproblems -Icli -Ibench
 ALL_CFLAGS = $(WARN) $(DEFS) $(LAZY_DEFS) $(FPFLAGS) $(CFLAGS) $(OPENMP) $(INC) $(PKG_CFLAGS) $(SS_CFLAGS) $(XCFLAGS)
 LIBS     = $(PKG_LIBS) $(SS_LIBS) -lm
 
 LIB_SRC  = $(wildcard core/*.c) $(wildcard lcp/*.c) $(wildcard engine/*.c) $(wildcard problems/*.c)
-CLI_SRC  = $(wildcard cli/*.c)
+# the benchmarks' drivers (bench/) are part of the pound binary; bench/siconos_lcp.c
+# is a program of its own (bench/build.sh, make bench)
+BENCH_SRC = $(filter-out bench/siconos_lcp.c,$(wildcard bench/*.c))
+CLI_SRC  = $(wildcard cli/*.c) $(BENCH_SRC)
 TEST_SRC = $(wildcard tests/*.c)
 LIB_OBJ  = $(LIB_SRC:%.c=$(BUILD)/%.o)
 CLI_OBJ  = $(CLI_SRC:%.c=$(BUILD)/%.o)

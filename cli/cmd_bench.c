@@ -1,27 +1,10 @@
-/* cmd_bench.c — `pound bench [--lcp] [--engine] [--scene] [--spectrum] [--records] [--json]
- * [--shared DIR]`. */
-#include <math.h>
+/* cmd_bench.c — `pound bench [--lcp] [--engine] [--scene] [--spectrum] [--records]
+ * [--startup] [--json] [--shared DIR]`: the flags, then the drivers of
+ * bench/ (pd_bench.h) after the machine's line. */
 #include <string.h>
 
+#include "pd_bench.h"
 #include "pd_cli.h"
-#include "pd_spectrum.h"
-
-void pd_loglog_add(pd_loglog_fit *f, double x, double y)
-{
-    double lx = log(x), ly = log(y);
-    f->sx += lx;
-    f->sy += ly;
-    f->sxx += lx * lx;
-    f->sxy += lx * ly;
-    f->k++;
-}
-
-double pd_loglog_slope(const pd_loglog_fit *f)
-{
-    if (f->k < 2)
-        return NAN;
-    return (f->k * f->sxy - f->sx * f->sy) / (f->k * f->sxx - f->sx * f->sx);
-}
 
 int pd_cmd_bench(int argc, char **argv)
 {
@@ -50,13 +33,16 @@ int pd_cmd_bench(int argc, char **argv)
                  "                   [--startup] [--json]\n"
                  "                   [--shared DIR]\n"
                  "  no selection runs every benchmark; --shared points at the shared data\n"
-                 "  folder holding lcp/siconos (default ../shared)\n"
+                 "  folder holding lcp/siconos (default ../shared); the processor and the\n"
+                 "  instruction set of the vector kernels come first, every time as the wall\n"
+                 "  clock and the thread's CPU time\n"
                  "  --lcp: the LCP solvers on the Siconos set and chains of 10 ... 10^5 contacts\n"
                  "  --engine: Moreau-Jean steps/s on the one-wall oscillator (scalar, batched and\n"
                  "  general kernels) beside the bound of each step's dependency chain\n"
                  "  --scene: ns per DOF-step on --chain rows of 10 ... 10^5 SDOFs, the one-wall\n"
                  "  scene against the oscillator\n"
-                 "  --spectrum: the paper-scale sweep, serial and on 2 OpenMP threads\n"
+                 "  --spectrum: the paper-scale sweep, serial with each instruction set the\n"
+                 "  processor has (POUND_ISA caps it) and on 2 OpenMP threads\n"
                  "  --records: every shared record x 200 Pi2 x 4 Pi3 x 3 eps, exact reference and\n"
                  "  Moreau-Jean, on 2 OpenMP threads\n"
                  "  --startup: the time a pound process takes to start, against /bin/true");
@@ -74,7 +60,7 @@ int pd_cmd_bench(int argc, char **argv)
         pd_json_begin_object(&js, NULL);
         jp = &js;
     }
-    int rc = 0;
+    int rc = pd_bench_machine(jp);
     if (want_lcp)
         rc |= pd_bench_lcp(jp, shared);
     if (want_engine)

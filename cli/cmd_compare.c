@@ -7,7 +7,7 @@
 
 static const char compare_usage[] =
     "usage: pound compare [model flags | --scene F.json | --chain N] [--dt H] [--theta T]\n"
-    "                     [--methods moreau[,penalty][,event-general]] [--json]\n"
+    "                     [--methods moreau[,penalty][,newmark][,event-general]] [--json]\n"
     "  errors against the event-driven reference on the step grid t_k = k dt:\n"
     "  err_umax_rel = |umax - umax_ref| / umax_ref,\n"
     "  err_hist_linf = max_k |u(t_k) - u_ref(t_k)| / umax_ref\n"
@@ -15,7 +15,7 @@ static const char compare_usage[] =
     "  figures without a structure are the worst structure's; event-general (scenes):\n"
     "  the GSL-based general reference measured against the exact one\n";
 
-enum { NMETHOD = PD_METHOD_EVENT_GENERAL + 1 }; /* want[] and the results by method code */
+enum { NMETHOD = PD_METHOD_NEWMARK + 1 }; /* want[] and the results by method code */
 
 /* "moreau,penalty,event-general" -> flags by method code; 0 or 2. */
 static int parse_methods(const char *list, int *want)
@@ -30,8 +30,9 @@ static int parse_methods(const char *list, int *want)
     for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ","), n++) {
         pd_method m;
         if (pd_method_parse(tok, &m) ||
-            (m != PD_METHOD_MOREAU && m != PD_METHOD_PENALTY && m != PD_METHOD_EVENT_GENERAL))
-            return pd_cli_usage_error("--methods: '%s' is not one of moreau, penalty, "
+            (m != PD_METHOD_MOREAU && m != PD_METHOD_PENALTY && m != PD_METHOD_EVENT_GENERAL &&
+             m != PD_METHOD_NEWMARK))
+            return pd_cli_usage_error("--methods: '%s' is not one of moreau, penalty, newmark, "
                                       "event-general", tok);
         want[m] = 1;
     }
@@ -180,7 +181,7 @@ int pd_cmd_compare(int argc, char **argv)
 
     pd_trace ref = {0}, work = {0};
     pd_osc_result rr;
-    pd_measured mres[3];
+    pd_measured mres[NMETHOD];
     pd_err err;
     if (pd_trace_alloc(&ref, &k.opts) || pd_trace_alloc(&work, &k.opts)) {
         fprintf(stderr, "pound: compare: out of memory for the histories\n");
@@ -192,7 +193,7 @@ int pd_cmd_compare(int argc, char **argv)
         status = rc == PD_EINVAL ? 2 : 1;
         goto done;
     }
-    for (int m = 0; m < 3; m++) {
+    for (int m = 0; m < NMETHOD; m++) {
         pd_run_opts om = k.opts;
         om.method = (pd_method)m;
         if (want[m] && (rc = pd_measure_run(&k.c, &om, &ref, rr.umax, &work, &mres[m], &err))) {
@@ -201,7 +202,9 @@ int pd_cmd_compare(int argc, char **argv)
             goto done;
         }
     }
-    int first = want[0] ? 0 : 2;
+    int first = 0;
+    while (first < NMETHOD - 1 && !want[first])
+        first++;
     if (json) {
         pd_json js;
         pd_json_init(&js, stdout);
@@ -222,7 +225,7 @@ int pd_cmd_compare(int argc, char **argv)
         pd_json_num(&js, "Pi3", k.c.Pi3);
         pd_json_num(&js, "eps", k.c.eps);
         pd_json_begin_array(&js, "methods");
-        for (int m = 0; m < 3; m++)
+        for (int m = 0; m < NMETHOD; m++)
             if (want[m]) {
                 pd_json_begin_object(&js, NULL);
                 pd_json_str(&js, "method", pd_method_name((pd_method)m));
@@ -244,7 +247,7 @@ int pd_cmd_compare(int argc, char **argv)
                "impacts", "cpu [s]");
         printf("  %-10s %14.9g %12s %12s %8ld %10.3g\n", "event", rr.umax, "(ref)", "(ref)",
                rr.impacts, rr.cpu_s);
-        for (int m = 0; m < 3; m++)
+        for (int m = 0; m < NMETHOD; m++)
             if (want[m])
                 printf("  %-10s %14.9g %12.3g %12.3g %8ld %10.3g\n", pd_method_name((pd_method)m),
                        mres[m].r.umax, mres[m].err_umax_rel, mres[m].err_hist_linf,

@@ -12,11 +12,12 @@
 
 static const char converge_usage[] =
     "usage: pound converge [model flags | --scene F.json | --chain N] --dt MAX:MIN:N\n"
-    "                      [--methods moreau,penalty,event-general]\n"
+    "                      [--methods moreau,penalty,newmark,event-general]\n"
     "                      [--theta LIST] [--kcs LIST] [--plot FILE.png] [-o FILE] [--json]\n"
     "  --dt MAX:MIN:N  N step sizes, log-spaced from MAX down to MIN (Moreau-Jean rows)\n"
     "  --theta LIST    one Moreau-Jean curve per theta (default 0.5)\n"
-    "  --methods LIST  the rows: moreau (per dt and theta), penalty (per stiffness),\n"
+    "  --methods LIST  the rows: moreau (per dt and theta), newmark (per dt), penalty (per\n"
+    "                  stiffness),\n"
     "                  event-general (scenes: the GSL-based general reference, one row)\n"
     "  --kcs LIST      penalty rows: stiffness multiples of w0^2 (default 1e2,1e3,1e4,1e5,1e6),\n"
     "                  measured on the finest dt grid\n"
@@ -39,7 +40,8 @@ typedef struct row {
 typedef struct conv_args {
     pd_cli_case k;
     double dt_max, dt_min;
-    int ndt, ntheta, nkc, want_moreau, want_penalty, want_general, json, have_dt_range;
+    int ndt, ntheta, nkc, want_moreau, want_penalty, want_general, want_newmark, json,
+        have_dt_range;
     int use_umax; /* --error umax: chart and order err_umax_rel */
     double thetas[MAX_LIST], kcs[MAX_LIST];
     const char *plot, *out;
@@ -92,9 +94,10 @@ static int parse_methods(conv_args *a, const char *text)
     if (!text || strlen(text) >= sizeof buf)
         return pd_cli_usage_error("--methods needs a list such as moreau,penalty");
     if (!text[0])
-        return pd_cli_usage_error("--methods: give moreau, penalty, event-general (got '')");
+        return pd_cli_usage_error("--methods: give moreau, penalty, newmark, event-general "
+                                  "(got '')");
     strcpy(buf, text);
-    a->want_moreau = a->want_penalty = a->want_general = 0;
+    a->want_moreau = a->want_penalty = a->want_general = a->want_newmark = 0;
     for (int k = 1; p; k++) {
         char *tok = next_element(&p);
         if (!tok[0])
@@ -105,9 +108,11 @@ static int parse_methods(conv_args *a, const char *text)
             a->want_penalty = 1;
         else if (!strcmp(tok, "event-general"))
             a->want_general = 1;
+        else if (!strcmp(tok, "newmark"))
+            a->want_newmark = 1;
         else
-            return pd_cli_usage_error("--methods: '%s' is not one of moreau, penalty, event-general",
-                                      tok);
+            return pd_cli_usage_error("--methods: '%s' is not one of moreau, penalty, newmark, "
+                                      "event-general", tok);
     }
     return 0;
 }
@@ -301,7 +306,9 @@ static int measure_row(measurer *M, const pd_run_opts *o, int r, row *out, pd_er
     *out = (row){.method = o->method,
                  .theta = o->method == PD_METHOD_MOREAU ? o->theta : NAN,
                  .dt = o->dt,
-                 .kc = o->method == PD_METHOD_PENALTY ? o->pen.kc_mult : NAN,
+                 .kc = o->method == PD_METHOD_PENALTY || o->method == PD_METHOD_NEWMARK
+                           ? o->pen.kc_mult
+                           : NAN,
                  .order = NAN};
     if (!M->sc) {
         pd_measured m;
@@ -357,7 +364,7 @@ static int compute_rows(conv_args *a, measurer *M, row *rows, int *nrows, double
     int rc, n = 0;
     o.dt = a->dt_min;
     *ref_cpu = 0.0;
-    if ((rc = measurer_alloc(M, &o, a->ndt * a->ntheta + a->nkc + 1, err)))
+    if ((rc = measurer_alloc(M, &o, a->ndt * (a->ntheta + 1) + a->nkc + 1, err)))
         goto done;
     int once = M->sc && nested_grid(a);
     if (once && (rc = measure_reference(M, &o, ref_cpu, err)))
@@ -372,6 +379,16 @@ static int compute_rows(conv_args *a, measurer *M, row *rows, int *nrows, double
             if ((rc = measure_row(M, &o, n, &rows[n], err)))
                 goto done;
         }
+    }
+    for (int i = 0; i < a->ndt && a->want_newmark; i++, n++) {
+        /* the penalty elements (kc: --kc, else the method's default) on
+         * Newmark's fixed steps dt */
+        o.dt = dt_at(a, i);
+        if (!once && (rc = measure_reference(M, &o, ref_cpu, err)))
+            goto done;
+        o.method = PD_METHOD_NEWMARK;
+        if ((rc = measure_row(M, &o, n, &rows[n], err)))
+            goto done;
     }
     if (a->want_penalty) {
         o.dt = a->dt_min;
@@ -394,11 +411,13 @@ static int compute_rows(conv_args *a, measurer *M, row *rows, int *nrows, double
             goto done;
         n++;
     }
-    /* observed order between successive Moreau–Jean rows of one theta */
+    /* observed order between successive Moreau–Jean rows of one theta, and
+     * between successive Newmark rows */
     for (int r = 0; r < n; r++)
         for (int q = r - 1; q >= 0; q--)
-            if (rows[q].method == PD_METHOD_MOREAU && rows[r].method == PD_METHOD_MOREAU &&
-                rows[q].theta == rows[r].theta) {
+            if ((rows[q].method == PD_METHOD_MOREAU && rows[r].method == PD_METHOD_MOREAU &&
+                 rows[q].theta == rows[r].theta) ||
+                (rows[q].method == PD_METHOD_NEWMARK && rows[r].method == PD_METHOD_NEWMARK)) {
                 rows[r].order = log(row_error(a, &rows[q]) / row_error(a, &rows[r])) /
                                 log(rows[q].dt / rows[r].dt);
                 break;
@@ -482,9 +501,9 @@ static void print_rows(const conv_args *a, const measurer *M, const row *rows, i
 static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int n,
                      double ref_cpu, pd_err *err)
 {
-    static double xs[2][MAX_LIST + 2][MAX_ROWS], ys[2][MAX_LIST + 2][MAX_ROWS];
-    pd_curve by_dt[MAX_LIST], by_cpu[MAX_LIST + 2];
-    char labels[MAX_LIST + 2][64], work_png[4096];
+    static double xs[2][MAX_LIST + 3][MAX_ROWS], ys[2][MAX_LIST + 3][MAX_ROWS];
+    pd_curve by_dt[MAX_LIST + 1], by_cpu[MAX_LIST + 3];
+    char labels[MAX_LIST + 3][64], work_png[4096];
     int ncurve = 0;
     for (int t = 0; t < a->ntheta && a->want_moreau; t++, ncurve++) {
         int m = 0;
@@ -501,6 +520,23 @@ static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int
                                    .y = ys[0][ncurve]};
         by_cpu[ncurve] = (pd_curve){.label = labels[ncurve], .n = m, .x = xs[1][ncurve],
                                     .y = ys[1][ncurve]};
+    }
+    if (a->want_newmark) {
+        int m = 0;
+        for (int r = 0; r < n; r++)
+            if (rows[r].method == PD_METHOD_NEWMARK) {
+                xs[0][ncurve][m] = rows[r].dt;
+                ys[0][ncurve][m] = row_error(a, &rows[r]);
+                xs[1][ncurve][m] = rows[r].cpu_s;
+                ys[1][ncurve][m] = row_error(a, &rows[r]);
+                m++;
+            }
+        snprintf(labels[ncurve], sizeof labels[0], "Newmark penalty");
+        by_dt[ncurve] = (pd_curve){.label = labels[ncurve], .n = m, .x = xs[0][ncurve],
+                                   .y = ys[0][ncurve]};
+        by_cpu[ncurve] = (pd_curve){.label = labels[ncurve], .n = m, .x = xs[1][ncurve],
+                                    .y = ys[1][ncurve]};
+        ncurve++;
     }
     int npen = 0;
     if (a->want_penalty) {
@@ -565,7 +601,8 @@ static int write_rows(const conv_args *a, const measurer *M, const row *rows, in
     static double col[NC][MAX_ROWS];
     const char *methods[] = {pd_method_name(PD_METHOD_MOREAU), pd_method_name(PD_METHOD_EVENT),
                              pd_method_name(PD_METHOD_PENALTY), pd_method_name(PD_METHOD_AUTO),
-                             pd_method_name(PD_METHOD_EVENT_GENERAL)}; /* by code, as in --json */
+                             pd_method_name(PD_METHOD_EVENT_GENERAL),
+                             pd_method_name(PD_METHOD_NEWMARK)}; /* by code, as in --json */
     char chain[64];
     for (int r = 0; r < n; r++) {
         double v[NC] = {(double)rows[r].method, rows[r].theta, rows[r].dt, rows[r].kc,
@@ -575,7 +612,7 @@ static int write_rows(const conv_args *a, const measurer *M, const row *rows, in
             col[c][r] = v[c];
     }
     pd_column cols[NC] = {
-        {.name = "method", .units = "1", .values = col[0], .labels = methods, .nlabels = 5},
+        {.name = "method", .units = "1", .values = col[0], .labels = methods, .nlabels = 6},
         {.name = "theta", .units = "1", .values = col[1]},
         {.name = "dt", .units = "s", .values = col[2]},
         {.name = "kc", .units = "1", .values = col[3]}, /* a multiple of w0^2 */
@@ -625,7 +662,7 @@ int pd_cmd_converge(int argc, char **argv)
     if ((rc = parse_args(&a, argc, argv)))
         return rc;
     pd_provenance_set(argc, argv, PD_FORMAT_CONVERGE, 0);
-    if (a.ndt * a.ntheta + a.nkc + 1 > MAX_ROWS) {
+    if (a.ndt * (a.ntheta + 1) + a.nkc + 1 > MAX_ROWS) {
         pd_cli_case_free(&a.k);
         return pd_cli_usage_error("converge: too many rows (at most %d)", MAX_ROWS);
     }

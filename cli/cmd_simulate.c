@@ -497,11 +497,11 @@ static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_sum
                "LCP %s, %ld LCPs)\n",
                r->theta, r->dt, r->steps, r->tend, r->kernel, r->factor, r->lcp_solver,
                r->lcp_solves);
-    else
-        printf("  %s (%s), %ld %s to %g s\n",
-               a->k.opts.method == PD_METHOD_PENALTY ? "penalty" : "event-driven reference",
-               r->kernel, r->steps, a->k.opts.method == PD_METHOD_PENALTY ? "steps" : "events",
-               r->tend);
+    else {
+        int pen = a->k.opts.method == PD_METHOD_PENALTY || a->k.opts.method == PD_METHOD_NEWMARK;
+        printf("  %s (%s), %ld %s to %g s\n", pen ? "penalty" : "event-driven reference",
+               r->kernel, r->steps, pen ? "steps" : "events", r->tend);
+    }
     method_line(&a->k);
     if (a->k.opts.method == PD_METHOD_EVENT) {
         long impacts = 0;

@@ -126,22 +126,4 @@ void pd_json_finish(pd_json *js); /* newline after the top-level value */
 void pd_cli_ref_decisions_json(pd_json *js, const pd_scene_result *ref);
 void pd_cli_ref_decisions_text(FILE *f, const pd_scene_result *ref);
 
-/* Benchmarks, one per module.  With js NULL they print a readable table on
- * stdout; otherwise they add one member ("lcp", "engine") to the JSON object
- * that js has open.  Return 0, or 1 when a benchmark run failed. */
-int pd_bench_lcp(pd_json *js, const char *shared_dir);
-int pd_bench_engine(pd_json *js);
-int pd_bench_scene(pd_json *js);
-int pd_bench_records(pd_json *js, const char *shared_dir);
-int pd_bench_startup(pd_json *js);
-
-/* The least-squares slope of log y against log x over the points added
- * (the growth exponents of the benchmarks); NAN with fewer than two. */
-typedef struct pd_loglog_fit {
-    double sx, sy, sxx, sxy;
-    int k;
-} pd_loglog_fit;
-void pd_loglog_add(pd_loglog_fit *f, double x, double y);
-double pd_loglog_slope(const pd_loglog_fit *f);
-
 #endif

@@ -126,8 +126,4 @@ typedef struct pd_spec_totals {
 void pd_spec_print_json(const pd_spectrum *s, const pd_spec_row *rows, const pd_spec_totals *t);
 void pd_spec_print_text(const pd_spectrum *s, const pd_spec_row *rows, const pd_spec_totals *t);
 
-/* `pound bench --spectrum` (bench_spectrum.c): the paper-scale sweep serial
- * and on 2 OpenMP threads; like pd_bench_engine (js NULL: a table). */
-int pd_bench_spectrum(pd_json *js);
-
 #endif

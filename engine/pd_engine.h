@@ -291,7 +291,10 @@ typedef struct pd_penalty_opts {
     pd_penalty_law law;
     double kc;           /* contact stiffness (force per unit penetration[^1.5]) > 0 */
     double rtol, atol;   /* adaptive tolerances > 0 */
-    const char *stepper; /* GSL stepper: "rk8pd", "rkf45", "rk4imp", "msbdf" */
+    const char *stepper; /* GSL stepper: "rk8pd", "rkf45", "rk4imp", "msbdf"; or "newmark":
+                            fixed steps h of the implicit average-acceleration Newmark
+                            scheme with Newton iterations (rtol, atol unused) */
+    double h;            /* newmark: the step > 0 (the others ignore it) */
     double h_out;        /* > 0: the observer is called every h_out (and at t1) */
     long max_steps;      /* budget of accepted steps >= 1 */
     double time_unit;    /* > 0: the model's unit of time in seconds, for messages */

@@ -31,6 +31,7 @@
 #include "pd_core.h"
 #include "pd_engine.h"
 #include "pd_factor.h"
+#include "penalty_law.h"
 
 /* A GSL stepper the baseline offers. */
 typedef struct pen_stepper {
@@ -112,7 +113,8 @@ static int check_opts(pen *p, double t0, double t1, pd_err *err)
                           o->rtol, o->atol);
     if (!(p->stp = find_stepper(o->stepper)))
         return pd_err_set(err, PD_EINVAL,
-                          "penalty: stepper \"%s\" is unknown (rk8pd, rkf45, rk4imp, msbdf)",
+                          "penalty: stepper \"%s\" is unknown (rk8pd, rkf45, rk4imp, msbdf, "
+                          "newmark)",
                           o->stepper);
     if (!(o->h_out >= 0.0) || !isfinite(o->h_out))
         return pd_err_set(err, PD_EINVAL, "penalty: h_out must be >= 0 (got %g)", o->h_out);
@@ -132,21 +134,13 @@ pd_penalty_opts pd_penalty_default_opts(void)
                              .rtol = 1e-10,
                              .atol = 1e-12,
                              .stepper = "rk8pd",
+                             .h = 0.0,
                              .h_out = 0.0,
                              .max_steps = 100000000L,
                              .time_unit = 1.0,
                              .on_step = NULL,
                              .on_step_ctx = NULL,
                              .factor = PD_FACTOR_AUTO};
-}
-
-/* Anagnostopoulos: zeta = -ln e / sqrt(pi^2 + ln^2 e); zeta(0) = 1 (the limit). */
-static double kv_zeta(double e)
-{
-    if (e <= 0.0)
-        return 1.0;
-    double l = log(e);
-    return -l / sqrt(PD_PI * PD_PI + l * l);
 }
 
 /* Free what the run took (safe on a partly set up run). */
@@ -229,7 +223,7 @@ static int setup_mass(pen *p, pd_err *err)
                               "penalty: contact %d has no effective mass (W_a^T M^-1 W_a = %g)",
                               a, s);
         if (p->o.law == PD_PENALTY_KELVIN)
-            p->cd[a] = 2.0 * kv_zeta(md->e[a]) * sqrt(p->o.kc / s);
+            p->cd[a] = pd_kelvin_damping(p->o.kc, md->e[a], 1.0 / s);
     }
     return PD_OK;
 }
@@ -248,14 +242,10 @@ static double rate_of(const pen *p, int a, const double *v)
     return pd_matrix_col_dot(&p->md->W, a, v);
 }
 
-/* Element force: KV kc d + c d'; Hertz-damp d^1.5 (kc + c d'), zero for d <= 0. */
+/* Element force (penalty_law.h). */
 static double element_force(const pen *p, int a, double d, double dd)
 {
-    if (p->o.law == PD_PENALTY_KELVIN)
-        return p->o.kc * d + p->cd[a] * dd;
-    if (d <= 0.0)
-        return 0.0;
-    return d * sqrt(d) * (p->o.kc + p->cd[a] * dd);
+    return pd_penalty_force(p->o.law, p->o.kc, p->cd[a], d, dd);
 }
 
 /* lambda of every contact at (q, v) under the engaged set (0 if released). */
@@ -304,17 +294,10 @@ static int rhs(double t, const double y[], double dydt[], void *params)
     return rhs_value(p, t, y, dydt);
 }
 
-/* d lambda / d d and d lambda / d d' of an engaged element. */
+/* d lambda / d d and d lambda / d d' of an engaged element (penalty_law.h). */
 static void element_slopes(const pen *p, int a, double d, double dd, double *kd, double *cdd)
 {
-    if (p->o.law == PD_PENALTY_KELVIN) {
-        *kd = p->o.kc;
-        *cdd = p->cd[a];
-        return;
-    }
-    double sd = d > 0.0 ? sqrt(d) : 0.0;
-    *kd = 1.5 * sd * (p->o.kc + p->cd[a] * dd);
-    *cdd = p->cd[a] * d * sd;
+    pd_penalty_slopes(p->o.law, p->o.kc, p->cd[a], d, dd, kd, cdd);
 }
 
 /* Aq = -K - sum_a kd_a W_a W_a^T,  Av = -C - sum_a cdd_a W_a W_a^T. */
@@ -650,7 +633,7 @@ static void switch_element(pen *p, int a)
     if (p->mode[a] && p->o.law == PD_PENALTY_HERTZDAMP) {
         double e = p->md->e[a], vimp = -rate_of(p, a, p->y + p->n);
         p->vseen = fmax(p->vseen, vimp);
-        p->cd[a] = 0.75 * p->o.kc * (1.0 - e * e) / fmax(vimp, fmax(p->vfloor, 1e-3 * p->vseen));
+        p->cd[a] = pd_hertz_damping(p->o.kc, e, vimp, p->vfloor, p->vseen);
     }
 }
 
@@ -888,6 +871,10 @@ int pd_penalty_run(const pd_model *model, double t0, const double *q0, const dou
     p.observer = observer;
     p.obs_ctx = ctx;
     p.o = opts ? *opts : pd_penalty_default_opts();
+    if (p.o.stepper && !strcmp(p.o.stepper, "newmark"))
+        return (rc = pd_model_check(model, err))
+                   ? rc
+                   : pd_penalty_newmark(model, t0, q0, v0, t1, &p.o, observer, ctx, res, err);
     if (!(rc = pd_model_check(model, err)) && !(rc = check_opts(&p, t0, t1, err))) {
         p.n = model->n;
         p.m = model->m;

@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "osc_priv.h"
 #include "pd_null.h"
 #include "pd_problems.h"
 
@@ -229,8 +230,14 @@ static int emit_sample(const pd_state *st, void *ctx)
     return tr->sampler(&s, tr->sampler_ctx);
 }
 
+double pd_newmark_step(double dt, double Tc)
+{
+    double k = ceil(dt * PD_NEWMARK_STEPS_PER_CONTACT / Tc);
+    return k > 1.0 && isfinite(k) ? dt / k : dt;
+}
+
 /* Contact stiffness in Pi units (see the file comment). */
-static double pi_stiffness(const pd_osc *c, const pd_penalty_setup *po)
+double pd_osc_penalty_kc(const pd_osc *c, const pd_penalty_setup *po)
 {
     double wp = pd_osc_wp(c);
     if (po->kc_abs > 0.0)
@@ -326,10 +333,13 @@ int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler samp
     tr.sampler_ctx = ctx;
     pd_penalty_opts eo = pd_penalty_default_opts();
     eo.law = o.pen.law;
-    eo.kc = pi_stiffness(c, &o.pen);
+    eo.kc = pd_osc_penalty_kc(c, &o.pen);
     eo.rtol = o.pen.rtol;
     eo.atol = o.pen.atol;
-    eo.stepper = o.pen.stepper;
+    eo.stepper = o.method == PD_METHOD_NEWMARK ? "newmark" : o.pen.stepper;
+    /* stepper newmark: dt, or dt / k for PD_NEWMARK_STEPS_PER_CONTACT steps per
+     * period of the element on the unit mass (2 pi / sqrt(kc) in tau) */
+    eo.h = model.m ? pd_newmark_step(h_out, PD_TWO_PI / sqrt(eo.kc)) : h_out;
     eo.h_out = sampler ? h_out : 0.0;
     eo.on_step = track_step;
     eo.on_step_ctx = &tr;

@@ -555,7 +555,8 @@ int pd_osc_run(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler,
     pd_run_opts o = opts ? *opts : pd_run_default_opts();
     switch (pd_osc_method(c, &o)) {
     case PD_METHOD_EVENT: return pd_osc_reference(c, &o, sampler, ctx, res, err);
-    case PD_METHOD_PENALTY: return pd_osc_penalty(c, &o, sampler, ctx, res, err);
+    case PD_METHOD_PENALTY:
+    case PD_METHOD_NEWMARK: return pd_osc_penalty(c, &o, sampler, ctx, res, err);
     default: return pd_osc_simulate(c, &o, sampler, ctx, res, err);
     }
 }

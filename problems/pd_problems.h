@@ -160,11 +160,14 @@ typedef enum {
     PD_METHOD_EVENT = 1,
     PD_METHOD_PENALTY = 2,
     PD_METHOD_AUTO = 3,
-    PD_METHOD_EVENT_GENERAL = 4 /* scenes: the GSL-based general reference (pd_edg_run) */
+    PD_METHOD_EVENT_GENERAL = 4, /* scenes: the GSL-based general reference (pd_edg_run) */
+    PD_METHOD_NEWMARK = 5 /* the penalty elements on fixed steps dt of the implicit
+                             average-acceleration Newmark scheme with Newton iterations
+                             (pd_penalty_run's stepper "newmark"): what OpenSees users run */
 } pd_method;
 
-/* "moreau", "event", "penalty", "auto", "event-general"; parse: PD_OK or
- * PD_EINVAL. */
+/* "moreau", "event", "penalty", "auto", "event-general", "newmark"; parse:
+ * PD_OK or PD_EINVAL. */
 PD_API const char *pd_method_name(pd_method method);
 PD_API int pd_method_parse(const char *name, pd_method *method);
 

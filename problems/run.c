@@ -11,6 +11,7 @@ const char *pd_method_name(pd_method method)
            : method == PD_METHOD_PENALTY       ? "penalty"
            : method == PD_METHOD_AUTO          ? "auto"
            : method == PD_METHOD_EVENT_GENERAL ? "event-general"
+           : method == PD_METHOD_NEWMARK       ? "newmark"
                                                : "moreau";
 }
 
@@ -28,6 +29,8 @@ int pd_method_parse(const char *name, pd_method *method)
         *method = PD_METHOD_AUTO;
     else if (!strcmp(name, "event-general"))
         *method = PD_METHOD_EVENT_GENERAL;
+    else if (!strcmp(name, "newmark"))
+        *method = PD_METHOD_NEWMARK;
     else
         return PD_EINVAL;
     return PD_OK;
@@ -63,7 +66,7 @@ int pd_run_opts_check(const pd_run_opts *o, pd_err *err)
         return PD_NULL_ARG(err, "o");
     if (o->method != PD_METHOD_MOREAU && o->method != PD_METHOD_EVENT &&
         o->method != PD_METHOD_PENALTY && o->method != PD_METHOD_AUTO &&
-        o->method != PD_METHOD_EVENT_GENERAL)
+        o->method != PD_METHOD_EVENT_GENERAL && o->method != PD_METHOD_NEWMARK)
         return pd_err_set(err, PD_EINVAL, "method: unknown method %d", (int)o->method);
     if (!(o->dt >= 0.0) || !isfinite(o->dt))
         return pd_err_set(err, PD_EINVAL, "dt: must be a finite number > 0 (got %g)", o->dt);

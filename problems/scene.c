@@ -641,14 +641,31 @@ static double floor_mass(const pd_scene *sc, int s, int level)
     return s == PD_WALL ? INFINITY : sc->st[s].mass[level - 1];
 }
 
+/* The reduced mass of contact a's two floors (one floor's against a wall). */
+static double contact_mass(const pd_scene *sc, int a)
+{
+    const pd_contact *ct = &sc->ct[a];
+    double ma = floor_mass(sc, ct->a, ct->level_a), mb = floor_mass(sc, ct->b, ct->level_b);
+    return isinf(ma) ? mb : isinf(mb) ? ma : ma * mb / (ma + mb);
+}
+
+/* The period of contact a's penalty element (pd_scene_contact_period_min). */
+static double contact_period(const pd_scene *sc, const pd_run_opts *o, int a)
+{
+    double kc = pd_scene_penalty_kc(sc, o);
+    if (o->pen.law == PD_PENALTY_HERTZDAMP && o->pen.kc_abs > 0.0)
+        kc = 1.5 * o->pen.kc_abs * sqrt(0.01 * pd_scene_Le(sc));
+    return PD_TWO_PI * sqrt(contact_mass(sc, a) / kc);
+}
+
 /* The work of the methods that resolve every mode (all but Moreau–Jean,
  * whose implicit step is stable at any period) within their budget: a 64th
  * of the shortest period of each structure (and, for Kelvin–Voigt
  * elements, of each contact element on its two floors) over the run. */
 static int check_budget(const pd_scene *sc, const pd_run_opts *o, pd_err *err)
 {
-    if (o->method == PD_METHOD_MOREAU)
-        return PD_OK;
+    if (o->method == PD_METHOD_MOREAU || o->method == PD_METHOD_NEWMARK)
+        return PD_OK; /* fixed implicit steps: the step budget (PD_MAX_STEPS) */
     const char *m = pd_method_name(o->method);
     for (int s = 0; s < sc->nstruct; s++) {
         const pd_structure *st = &sc->st[s];
@@ -673,9 +690,8 @@ static int check_budget(const pd_scene *sc, const pd_run_opts *o, pd_err *err)
     double kc = pd_scene_penalty_kc(sc, o);
     for (int a = 0; a < sc->ncontact; a++) {
         const pd_contact *ct = &sc->ct[a];
-        double ma = floor_mass(sc, ct->a, ct->level_a), mb = floor_mass(sc, ct->b, ct->level_b);
-        double mred = isinf(ma) ? mb : isinf(mb) ? ma : ma * mb / (ma + mb);
-        double Tc = PD_TWO_PI * sqrt(mred / kc), pts = SCENE_SCAN_DIV * o->tend / Tc;
+        double mred = contact_mass(sc, a);
+        double Tc = contact_period(sc, o, a), pts = SCENE_SCAN_DIV * o->tend / Tc;
         if (!(pts <= SCENE_MAX_POINTS))
             return pd_err_set(err, PD_EINVAL,
                               "contacts[%d]: its element (kc = %.3g N/m on %.3g kg) vibrates with "
@@ -685,6 +701,17 @@ static int check_budget(const pd_scene *sc, const pd_run_opts *o, pd_err *err)
                               ct->entry, kc, mred, Tc, pts, o->tend, SCENE_MAX_POINTS);
     }
     return PD_OK;
+}
+
+/* The shortest period of the penalty elements (Kelvin-Voigt's kc on the
+ * contact's reduced mass; for Hertz-damp, the tangent 1.5 kc sqrt(d) at a
+ * penetration of 1 % of Le, kc_abs in N/m^1.5): HUGE_VAL without contacts. */
+double pd_scene_contact_period_min(const pd_scene *sc, const pd_run_opts *o)
+{
+    double Tmin = HUGE_VAL;
+    for (int a = 0; a < sc->ncontact; a++)
+        Tmin = fmin(Tmin, contact_period(sc, o, a));
+    return Tmin;
 }
 
 int pd_scene_resolve_opts(const pd_scene *sc, const pd_run_opts *in, pd_run_opts *out,

@@ -15,4 +15,9 @@ double pd_scene_stiffest(const pd_scene *sc);
  * or kc_mult, default SCENE_PEN_KC, times the stiffest storey). */
 double pd_scene_penalty_kc(const pd_scene *sc, const pd_run_opts *o);
 
+/* The shortest period of the penalty elements [s] (Kelvin-Voigt's kc on the
+ * contact's reduced mass; for Hertz-damp with kc_abs [N/m^1.5], the tangent
+ * 1.5 kc sqrt(d) at a penetration of 1 % of Le): HUGE_VAL without contacts. */
+double pd_scene_contact_period_min(const pd_scene *sc, const pd_run_opts *o);
+
 #endif

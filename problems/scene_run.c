@@ -20,6 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "osc_priv.h"
 #include "pd_null.h"
 #include "pd_problems.h"
 #include "scene_priv.h"
@@ -370,7 +371,7 @@ static int step_penalty(const pd_state *st, void *ctx)
 static int observe_grid(const pd_state *st, void *ctx)
 {
     track *tr = ctx;
-    if (tr->method == PD_METHOD_PENALTY)
+    if (tr->method == PD_METHOD_PENALTY || tr->method == PD_METHOD_NEWMARK)
         for (int a = 0; a < tr->model_m; a++) {
             double lam = st->active[a] ? st->P[a] : 0.0;
             tr->imp[a] += 0.5 * (tr->imp_lam[a] + lam) * (st->t - tr->imp_t);
@@ -611,7 +612,11 @@ static int run_penalty(const pd_model *md, const pd_run_opts *o, double tau_end,
         po.kc = pd_scene_penalty_kc(tr->sc, o) / wp2;
     po.rtol = o->pen.rtol;
     po.atol = o->pen.atol;
-    po.stepper = o->pen.stepper;
+    po.stepper = o->method == PD_METHOD_NEWMARK ? "newmark" : o->pen.stepper;
+    /* stepper newmark: the grid's step, or a whole fraction of it for
+     * PD_NEWMARK_STEPS_PER_CONTACT steps per period of the stiffest element */
+    po.h = md->m ? pd_newmark_step(tr->h, tr->wp * pd_scene_contact_period_min(tr->sc, o))
+                 : tr->h;
     po.h_out = tr->fn ? tr->h : 0.0;
     po.time_unit = 1.0 / tr->wp;
     po.on_step = step_penalty;
@@ -656,7 +661,8 @@ static int run_general(const pd_scene *sc, const pd_run_opts *o, pd_scene_sample
     case PD_METHOD_EVENT_GENERAL:
         rc = run_event_general(&sm.model, o, tau_end, &tr, res, err);
         break;
-    case PD_METHOD_PENALTY: rc = run_penalty(&sm.model, o, tau_end, &tr, res, err); break;
+    case PD_METHOD_PENALTY:
+    case PD_METHOD_NEWMARK: rc = run_penalty(&sm.model, o, tau_end, &tr, res, err); break;
     default: rc = run_moreau(&sm.model, o, nsteps, &tr, res, err); break;
     }
     fill_result(&tr, res);

@@ -184,7 +184,7 @@ check "man page" man_page
 completion() {
     command -v bash >/dev/null || return 0
     bash -c '. "$1"; COMP_WORDS=(pound simulate --method ""); COMP_CWORD=3; _pound
-        [ "${COMPREPLY[*]}" = "auto moreau event penalty event-general" ] || { echo "got: ${COMPREPLY[*]}"; exit 1; }
+        [ "${COMPREPLY[*]}" = "auto moreau event penalty newmark event-general" ] || { echo "got: ${COMPREPLY[*]}"; exit 1; }
         COMP_WORDS=(pound sp); COMP_CWORD=1; _pound; [ "${COMPREPLY[*]}" = spectrum ]' - \
         "$root/share/bash-completion/completions/pound"
 }

@@ -430,10 +430,12 @@ def converge(ctx):
                 for k in ("theta", "dt", "kc", "err_umax_rel", "err_hist_linf", "order", "impacts", "steps"):
                     ok = all(close(a, r[k]) for a, r in zip(f[k][:], j))
                     check(ok, f"{out}: {k} differs from --json rows")
-                codes = {0: "moreau", 1: "event", 2: "penalty", 3: "auto", 4: "event-general"}
+                codes = {0: "moreau", 1: "event", 2: "penalty", 3: "auto", 4: "event-general",
+                         5: "newmark"}
                 check([codes[int(m)] for m in f["method"][:]] == [r["method"] for r in j], f"{out}: method codes")
                 check(text(f["method"].attrs["codes"]) ==
-                      "0 = moreau, 1 = event, 2 = penalty, 3 = auto, 4 = event-general", f"{out}: codes")
+                      "0 = moreau, 1 = event, 2 = penalty, 3 = auto, 4 = event-general, 5 = newmark",
+                      f"{out}: codes")
                 f.close()
             else:
                 cols = [(d["name"], d["units"]) for d in ctx.doc[fmt]["datasets"]]

@@ -141,7 +141,7 @@ def scheme_opts(kw):
         have[key] = True
         if key == "method":
             o.method = parse_name("method", lib.pd_method_parse, v,
-                                  "moreau, event, penalty, auto, event-general")
+                                  "moreau, event, penalty, auto, event-general, newmark")
         elif key in ("dt", "tend", "theta", "gamma", "close_tol"):
             setattr(o, key, number(key, v))
         elif key in ("allow_unstable", "no_accumulation", "no_wall"):

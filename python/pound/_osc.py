@@ -156,16 +156,17 @@ def simulate(history=True, every=1, **case):
 
 # ---- compare ------------------------------------------------------------------------------
 
-_METHOD_CODE = {"moreau": 0, "penalty": 2, "event-general": 4}  # pd_method
+_METHOD_CODE = {"moreau": 0, "penalty": 2, "event-general": 4, "newmark": 5}  # pd_method
+_NMETHOD = 6
 
 
 def parse_methods(methods):
-    """('moreau', 'penalty', 'event-general') -> want[] by pd_method code."""
+    """('moreau', 'penalty', 'newmark', 'event-general') -> want[] by pd_method code."""
     if isinstance(methods, str):
         methods = methods.split(",")
-    want = [0] * 5
+    want = [0] * _NMETHOD
     if methods is None or (hasattr(methods, "__len__") and len(methods) == 0):
-        raise InputError("methods: give moreau, penalty, event-general")
+        raise InputError("methods: give moreau, penalty, newmark, event-general")
     for m in _args.values("methods", methods):
         want[_METHOD_CODE[_args.choice("methods", m, _METHOD_CODE)]] = 1
     return want
@@ -211,8 +212,8 @@ def compare(methods=("moreau",), scene=None, **case):
         st = lib.pd_measure_reference(k.c, o, tr.ref, rr, err)
         if st:
             raise _lib.make_error(st, "reference: " + err.text())
-        res = [None] * 3
-        for m in range(3):
+        res = [None] * _NMETHOD
+        for m in range(_NMETHOD):
             if not want[m]:
                 continue
             om = copy_opts(o)
@@ -223,7 +224,7 @@ def compare(methods=("moreau",), scene=None, **case):
                 raise _lib.make_error(st, "%s: %s" % (s(lib.pd_method_name(m)), err.text()))
     finally:
         tr.close()
-    first = 0 if want[0] else 2
+    first = next(m for m in range(_NMETHOD) if want[m])
     f = res[first]
     out = Result(method=s(lib.pd_method_name(first)), err_umax_rel=f.err_umax_rel,
                  err_hist_linf=f.err_hist_linf, impacts=f.r.impacts, impacts_ref=rr.impacts,
@@ -233,7 +234,7 @@ def compare(methods=("moreau",), scene=None, **case):
     out["methods"] = [Result(method=s(lib.pd_method_name(m)), err_umax_rel=res[m].err_umax_rel,
                              err_hist_linf=res[m].err_hist_linf, impacts=res[m].r.impacts,
                              steps=res[m].r.steps, cpu_s=res[m].r.cpu_s)
-                      for m in range(3) if want[m]]
+                      for m in range(_NMETHOD) if want[m]]
     return out
 
 
@@ -296,7 +297,7 @@ def converge(dts, theta=(0.5,), methods=("moreau",), kcs=None, error="hist", sce
         raise InputError("theta: give 1 to 32 values")
     want = parse_methods(methods)
     _scenes_only(want, scene)
-    want_moreau, want_penalty, want_general = want[0], want[2], want[4]
+    want_moreau, want_penalty, want_general, want_newmark = want[0], want[2], want[4], want[5]
     kcs = [1e2, 1e3, 1e4, 1e5, 1e6] if kcs is None else \
         [number("kcs", x) for x in _args.values("kcs", kcs)]
     if any(not x > 0.0 for x in kcs):
@@ -314,7 +315,7 @@ def converge(dts, theta=(0.5,), methods=("moreau",), kcs=None, error="hist", sce
         meas = _OscMeasurer(Case(case).resolve())
     try:
         rows, ref_cpu = _rows(meas, steps, dt_min, thetas, want_moreau, want_penalty, kcs,
-                              error, want_general)
+                              error, want_general, want_newmark)
         out = Result(rows=rows, cpu_s_ref=ref_cpu)
         if scene is not None:
             out.update(meas.summary())
@@ -350,7 +351,8 @@ class _OscMeasurer:
             self.tr.close()
 
 
-def _rows(M, steps, dt_min, thetas, want_moreau, want_penalty, kcs, error, want_general=False):
+def _rows(M, steps, dt_min, thetas, want_moreau, want_penalty, kcs, error, want_general=False,
+          want_newmark=False):
     """cli/cmd_converge.c compute_rows."""
     o = copy_opts(M.opts)
     err = PdErr()
@@ -371,7 +373,7 @@ def _rows(M, steps, dt_min, thetas, want_moreau, want_penalty, kcs, error, want_
     def row():
         r = Result(method=s(lib.pd_method_name(o.method)),
                    theta=o.theta if o.method == 0 else NAN, dt=o.dt,
-                   kc=o.pen.kc_mult if o.method == 2 else NAN)
+                   kc=o.pen.kc_mult if o.method in (2, 5) else NAN)
         st, m = M.row(o, err)
         if st:
             raise _lib.make_error(st, err.text())
@@ -391,6 +393,12 @@ def _rows(M, steps, dt_min, thetas, want_moreau, want_penalty, kcs, error, want_
             o.theta = t
             o.method = 0
             row()
+    for d in steps if want_newmark else ():  # the penalty elements on Newmark's steps dt
+        o.dt = d
+        if not once:
+            reference()
+        o.method = 5
+        row()
     if want_penalty:
         o.dt = dt_min
         if not once:
@@ -410,7 +418,8 @@ def _rows(M, steps, dt_min, thetas, want_moreau, want_penalty, kcs, error, want_
     for i, r in enumerate(rows):
         for q in range(i - 1, -1, -1):
             p = rows[q]
-            if p["method"] == "moreau" and r["method"] == "moreau" and p["theta"] == r["theta"]:
+            if (p["method"] == "moreau" and r["method"] == "moreau" and p["theta"] == r["theta"]) \
+                    or (p["method"] == "newmark" and r["method"] == "newmark"):
                 r["order"] = _order(p[key], r[key], p["dt"], r["dt"])
                 break
     # the CLI's column order

@@ -16,13 +16,13 @@ SCENE = EXAMPLES / "scenes" / "two-sdof.json"
 LCP = EXAMPLES / "murty1978.lcp"
 
 
-@pytest.mark.parametrize("method", ["moreau", "event", "penalty"])
+@pytest.mark.parametrize("method", ["moreau", "event", "penalty", "newmark"])
 def test_simulate(cli, same, method):
     r = pound.simulate(method=method, history=False, **FIG9)
     same(r, cli("simulate", *FIG9_ARGS, "--method", method))
 
 
-@pytest.mark.parametrize("method", ["moreau", "event", "penalty"])
+@pytest.mark.parametrize("method", ["moreau", "event", "penalty", "newmark"])
 def test_simulate_history_is_the_cli_file(cli, same, method, tmp_path):
     """With a history the run has a sampler, as the CLI's with -o: the same
     figures and, column by column, the same file."""
@@ -142,6 +142,12 @@ def test_scene_compare_converge(cli, same):
     same(pound.converge("0.0008:0.0002:3", scene=SCENE),
          cli("converge", "--scene", SCENE, "--dt", "0.0008:0.0002:3"))
     # the GSL-based reference measured against the exact row reference
+    # the penalty elements on Newmark's fixed steps, per dt like Moreau-Jean
+    same(pound.compare(scene=SCENE, methods="moreau,newmark"),
+         cli("compare", "--scene", SCENE, "--methods", "moreau,newmark"))
+    same(pound.converge("0.0008:0.0004:2", scene=SCENE, methods="moreau,newmark"),
+         cli("converge", "--scene", SCENE, "--dt", "0.0008:0.0004:2", "--methods",
+             "moreau,newmark"))
     same(pound.compare(scene=SCENE, methods="moreau,event-general"),
          cli("compare", "--scene", SCENE, "--methods", "moreau,event-general"))
     same(pound.converge("0.0008:0.0004:2", scene=SCENE, methods="moreau,event-general",

@@ -10,14 +10,15 @@
  * BENCH_MIN_RUNS batches and BENCH_MIN_S seconds (3 runs once a solve takes
  * longer than BENCH_LONG_S), divided by the batch size.  Solves are cold
  * (no warm start).  The growth exponent is the least-squares slope of log
- * time against log N over N = 10^3 ... 10^5.  One thread. */
+ * time against log N over N = 10^3 ... 10^5.  One thread; every figure in
+ * wall time and in the thread's CPU time (median of each). */
 #include <dirent.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "pd_cli.h"
+#include "pd_bench.h"
 #include "pd_lcp.h"
 
 #define BENCH_MIN_RUNS 21
@@ -36,7 +37,8 @@ typedef struct bench_row {
     int n, pivots, iterations;
     pd_lcp_outcome outcome;
     double residual;
-    double median_us;
+    double median_us;     /* wall */
+    double median_cpu_us; /* the thread's CPU */
 } bench_row;
 
 /* The report: rows to print as a table or as JSON. */
@@ -48,28 +50,15 @@ typedef struct bench_report {
     const char *siconos_dir;
 } bench_report;
 
-/* Ascending order of doubles, for qsort. */
-static int cmp_double(const void *a, const void *b)
+/* Wall and CPU seconds for `batch` solves of (M, q). */
+static pd_bench_clock time_batch(pd_lcp_solver *sv, const pd_matrix *M, const double *q,
+                                 const pd_lcp_opts *o, double *z, double *w, int batch,
+                                 pd_lcp_info *info)
 {
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-/* Median of x[0..n) (sorts x). */
-static double median(double *x, int n)
-{
-    qsort(x, (size_t)n, sizeof *x, cmp_double);
-    return n % 2 ? x[n / 2] : 0.5 * (x[n / 2 - 1] + x[n / 2]);
-}
-
-/* Seconds for `batch` solves of (M, q). */
-static double time_batch(pd_lcp_solver *sv, const pd_matrix *M, const double *q,
-                         const pd_lcp_opts *o, double *z, double *w, int batch, pd_lcp_info *info)
-{
-    double t0 = pd_wall_seconds();
+    pd_bench_clock t0 = pd_bench_now();
     for (int b = 0; b < batch; b++)
         pd_lcp_solve(sv, M, q, o, z, w, info);
-    return pd_wall_seconds() - t0;
+    return pd_bench_since(t0);
 }
 
 /* Median µs per solve with `method` over repeated batches; the outcome into
@@ -83,7 +72,7 @@ static int measure(pd_lcp_method method, const pd_matrix *M, const double *q, in
     pd_err err;
     pd_lcp_solver *sv = pd_lcp_solver_alloc(method, n, nnz, &err);
     double *zw = malloc(2 * (size_t)n * sizeof(double));
-    double runs[BENCH_MAX_RUNS];
+    double runs[BENCH_MAX_RUNS], cpu_runs[BENCH_MAX_RUNS];
     pd_lcp_opts o = pd_lcp_default_opts();
     o.max_iterations = max_iterations;
     if (!sv || !zw) {
@@ -92,15 +81,16 @@ static int measure(pd_lcp_method method, const pd_matrix *M, const double *q, in
         return 1;
     }
     pd_lcp_info info;
-    double once = time_batch(sv, M, q, &o, zw, zw + n, 1, &info);
+    double once = time_batch(sv, M, q, &o, zw, zw + n, 1, &info).wall_s;
     int batch = once >= BENCH_BATCH_S ? 1 : (int)(BENCH_BATCH_S / (once + 1e-9)) + 1;
     int min_runs = once > BENCH_LONG_S ? 3 : BENCH_MIN_RUNS;
     double total = 0.0;
     int nruns = 0;
     while (nruns < BENCH_MAX_RUNS && (nruns < min_runs || (total < BENCH_MIN_S && once <= BENCH_LONG_S))) {
-        double t = time_batch(sv, M, q, &o, zw, zw + n, batch, &info);
-        total += t;
-        runs[nruns++] = 1e6 * t / batch;
+        pd_bench_clock t = time_batch(sv, M, q, &o, zw, zw + n, batch, &info);
+        total += t.wall_s;
+        cpu_runs[nruns] = 1e6 * t.cpu_s / batch;
+        runs[nruns++] = 1e6 * t.wall_s / batch;
     }
     row->n = n;
     row->solver = info.solver;
@@ -108,7 +98,8 @@ static int measure(pd_lcp_method method, const pd_matrix *M, const double *q, in
     row->iterations = info.iterations;
     row->outcome = info.outcome;
     row->residual = info.residual;
-    row->median_us = median(runs, nruns);
+    row->median_us = pd_bench_median(runs, nruns);
+    row->median_cpu_us = pd_bench_median(cpu_runs, nruns);
     pd_lcp_solver_free(sv);
     free(zw);
     return 0;
@@ -164,7 +155,7 @@ static int chain_make(chain *c, int N, int with_dense, int seed)
 static int measure_seeds(pd_lcp_method method, int N, int seeds, bench_row *row)
 {
     int failed = 0;
-    double us = 0.0, iterations = 0.0, pivots = 0.0, residual = 0.0;
+    double us = 0.0, cpu_us = 0.0, iterations = 0.0, pivots = 0.0, residual = 0.0;
     for (int s = 0; s < seeds; s++) {
         chain c;
         bench_row one = *row;
@@ -178,6 +169,7 @@ static int measure_seeds(pd_lcp_method method, int N, int seeds, bench_row *row)
                           method == PD_LCP_PGS ? BENCH_PGS_SWEEPS : 0, &one);
         failed |= method != PD_LCP_PGS && one.outcome != PD_LCP_SOLVED;
         us += one.median_us / seeds;
+        cpu_us += one.median_cpu_us / seeds;
         iterations += (double)one.iterations / seeds;
         pivots += (double)one.pivots / seeds;
         residual = fmax(residual, one.residual);
@@ -188,6 +180,7 @@ static int measure_seeds(pd_lcp_method method, int N, int seeds, bench_row *row)
         chain_free(&c);
     }
     row->median_us = us;
+    row->median_cpu_us = cpu_us;
     row->iterations = (int)lround(iterations);
     row->pivots = (int)lround(pivots);
     row->residual = residual;
@@ -307,16 +300,17 @@ static void bench_siconos(bench_report *rep, const char *shared_dir, char *dir, 
 static void print_table(const bench_report *rep)
 {
     printf("LCP solvers, median us per cold solve over >= %d timed batches (3 for solves over "
-           "%g s), one thread\n", BENCH_MIN_RUNS, BENCH_LONG_S);
+           "%g s), one thread; wall clock (median_us) and CPU time (cpu_us)\n", BENCH_MIN_RUNS,
+           BENCH_LONG_S);
     if (!rep->siconos_found)
         printf("Siconos set: skipped (no .dat files in %s)\n", rep->siconos_dir);
-    printf("%-28s %6s %-26s %-14s %7s %6s %9s %12s\n", "problem", "n", "solver", "status",
-           "pivots", "iters", "residual", "median_us");
+    printf("%-28s %6s %-26s %-14s %7s %6s %9s %12s %12s\n", "problem", "n", "solver", "status",
+           "pivots", "iters", "residual", "median_us", "cpu_us");
     for (int k = 0; k < rep->nrows; k++) {
         const bench_row *r = &rep->rows[k];
-        printf("%-28s %6d %-26s %-14s %7d %6d %9.2g %12.3f\n", r->name, r->n, r->solver,
+        printf("%-28s %6d %-26s %-14s %7d %6d %9.2g %12.3f %12.3f\n", r->name, r->n, r->solver,
                pd_lcp_outcome_name(r->outcome), r->pivots, r->iterations, r->residual,
-               r->median_us);
+               r->median_us, r->median_cpu_us);
     }
     printf("chains: means over %d right-hand sides q (pgs: one); against Siconos numerics, "
            "paired in one run: make bench (bench/siconos_lcp)\n", CHAIN_SEEDS);
@@ -345,6 +339,7 @@ static void print_json(pd_json *js, const bench_report *rep)
         pd_json_str(js, "status", pd_lcp_outcome_name(r->outcome));
         pd_json_num(js, "residual", r->residual);
         pd_json_num(js, "median_us", r->median_us);
+        pd_json_num(js, "median_cpu_us", r->median_cpu_us);
         pd_json_end_object(js);
     }
     pd_json_end_array(js);

@@ -9,14 +9,16 @@
  * time over N = 10^3 ... 10^5.  Beside them the one-wall scene against the
  * oscillator it is (bench --engine's many_impacts case) in the same run:
  * the scene layer must cost the one-wall oscillator nothing.  Then the
- * exact event-driven reference on rows (below). */
+ * exact event-driven reference on rows (below).  Every time is the
+ * thread's CPU time, with the wall clock's beside it. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "pd_cli.h"
+#include "pd_bench.h"
 #include "pd_problems.h"
 
+#define SCENE_STEPS_PER_TP 200  /* dt = Tp / 200 [s] */
 #define SCENE_WARM_STEPS 200    /* one excitation period */
 #define SCENE_DOF_STEPS 5e6     /* DOF-steps timed per row */
 #define SCENE_MIN_STEPS 100
@@ -27,7 +29,8 @@
 typedef struct chain_case {
     int N;
     long steps;
-    double ns_per_dof_step, active_fraction, lcp_iterations;
+    double ns_per_dof_step, wall_ns_per_dof_step; /* CPU, wall */
+    double active_fraction, lcp_iterations;
     const char *factor, *lcp_solver;
 } chain_case;
 
@@ -48,7 +51,9 @@ static int time_chain(int N, chain_case *cc)
         goto done;
     built = 1;
     pd_mj_opts mo = pd_mj_default_opts();
-    mo.h = wp * exc.Tp / 200.0;
+    /* the model's time is tau = wp t (pd_scene_model_build, as pd_scene_run
+     * steps it: h = wp dt), so dt = Tp / 200 is h = wp Tp / 200 = 2 pi / 200 */
+    mo.h = wp * exc.Tp / SCENE_STEPS_PER_TP;
     if (!(mj = pd_mj_alloc(&sm.model, &mo, &err)) || pd_mj_reset(mj, 0.0, NULL, NULL, &err))
         goto done;
     for (int s = 0; s < SCENE_WARM_STEPS; s++)
@@ -56,7 +61,7 @@ static int time_chain(int N, chain_case *cc)
             goto done;
     long steps = (long)(SCENE_DOF_STEPS / N), active = 0, iterations = 0;
     steps = steps > SCENE_MIN_STEPS ? steps : SCENE_MIN_STEPS;
-    double t0 = pd_cpu_seconds();
+    pd_bench_clock t0 = pd_bench_now();
     for (long s = 0; s < steps; s++) {
         if (pd_mj_step(mj, &err))
             goto done;
@@ -64,9 +69,10 @@ static int time_chain(int N, chain_case *cc)
         active += st->nactive;
         iterations += st->lcp_pivots;
     }
-    double cpu = pd_cpu_seconds() - t0;
+    pd_bench_clock t = pd_bench_since(t0);
     cc->steps = steps;
-    cc->ns_per_dof_step = 1e9 * cpu / ((double)steps * (double)sm.model.n);
+    cc->ns_per_dof_step = 1e9 * t.cpu_s / ((double)steps * (double)sm.model.n);
+    cc->wall_ns_per_dof_step = 1e9 * t.wall_s / ((double)steps * (double)sm.model.n);
     cc->active_fraction = (double)active / ((double)steps * (double)sm.model.m);
     cc->lcp_iterations = (double)iterations / (double)steps;
     cc->factor = pd_mj_factor_name(mj);
@@ -91,19 +97,24 @@ static double growth(const chain_case *cc, int count, int lo, int hi)
     return pd_loglog_slope(&fit);
 }
 
-/* Median of three steps-per-second figures of a run (the scene path when
- * sc is given, else the oscillator's own). */
-static int one_wall_rate(const pd_scene *sc, const pd_osc *c, const pd_run_opts *o, double *rate)
+/* The median of three steps-per-second figures of a run (the scene path
+ * when sc is given, else the oscillator's own), per second of CPU time
+ * (rate) and of wall time (wall_rate). */
+static int one_wall_rate(const pd_scene *sc, const pd_osc *c, const pd_run_opts *o, double *rate,
+                         double *wall_rate)
 {
-    double r[3];
+    double r[3], w[3];
     pd_err err;
     for (int k = 0; k < 3; k++) {
+        double t0 = pd_wall_seconds();
+        long steps = 0;
         if (sc) {
             pd_scene_result res;
             if (pd_scene_result_alloc(sc, &res, &err))
                 return 1;
             int rc = pd_scene_run(sc, o, NULL, NULL, &res, &err);
             r[k] = (double)res.steps / fmax(res.cpu_s, 1e-9);
+            steps = res.steps;
             pd_scene_result_free(&res);
             if (rc)
                 return 1;
@@ -112,16 +123,20 @@ static int one_wall_rate(const pd_scene *sc, const pd_osc *c, const pd_run_opts 
             if (pd_osc_simulate(c, o, NULL, NULL, &res, &err))
                 return 1;
             r[k] = (double)res.steps / fmax(res.cpu_s, 1e-9);
+            steps = res.steps;
         }
+        w[k] = (double)steps / fmax(pd_wall_seconds() - t0, 1e-9);
     }
-    double lo = fmin(r[0], fmin(r[1], r[2])), hi = fmax(r[0], fmax(r[1], r[2]));
-    *rate = r[0] + r[1] + r[2] - lo - hi;
+    *rate = pd_bench_median(r, 3);
+    *wall_rate = pd_bench_median(w, 3);
     return 0;
 }
 
 /* The one-wall scene against the oscillator (harmonic, Pi2 = 0.5, Pi3 =
- * 0.01, e = 0.8, dt = 1e-4 s over 1000 s). */
-static int one_wall(double *scene_rate, double *osc_rate)
+ * 0.01, e = 0.8, dt = 1e-4 s over 1000 s): steps per second of CPU time
+ * (rate[0] the scene's, rate[1] the oscillator's) and of wall time
+ * (rate[2], rate[3]). */
+static int one_wall(double rate[4])
 {
     pd_osc c = {.pulse = PD_PULSE_HARMONIC, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5,
                 .Pi3 = 0.01, .eps = 0.8, .xi = 0.05};
@@ -135,8 +150,8 @@ static int one_wall(double *scene_rate, double *osc_rate)
     pd_scene *sc = pd_scene_new(&exc);
     int rc = !sc || pd_scene_add_sdof(sc, "oscillator", c.Tp / c.Pi2, c.xi, 1.0, &err) ||
              pd_scene_add_contact(sc, 0, 1, PD_WALL, 0, c.Pi3 * c.ap / (wp * wp), c.eps, 0, &err) ||
-             pd_scene_finish(sc, &err) || one_wall_rate(sc, NULL, &o, scene_rate) ||
-             one_wall_rate(NULL, &c, &o, osc_rate);
+             pd_scene_finish(sc, &err) || one_wall_rate(sc, NULL, &o, &rate[0], &rate[2]) ||
+             one_wall_rate(NULL, &c, &o, &rate[1], &rate[3]);
     pd_scene_free(sc);
     return rc;
 }
@@ -153,7 +168,7 @@ enum { ROW_SIZES = 4 };
 typedef struct row_case {
     int N;
     long events, impacts;
-    double cpu_s, us_per_event;
+    double cpu_s, wall_s, us_per_event; /* us_per_event: CPU */
 } row_case;
 
 /* The row of N under the event method m: PD_OK or the failure (stderr). */
@@ -171,8 +186,10 @@ static int time_row(int N, pd_method m, row_case *rc_out)
     o.method = m;
     if ((rc = pd_scene_chain(N, &exc, 1.0, 1.5, 0.05, gap, 0.6, &sc, &err)) == PD_OK) {
         sc->tend = 4.0;
+        double t0 = pd_wall_seconds();
         if (!(rc = pd_scene_result_alloc(sc, &r, &err)))
             rc = pd_scene_run(sc, &o, NULL, NULL, &r, &err);
+        rc_out->wall_s = pd_wall_seconds() - t0;
     }
     if (rc)
         fprintf(stderr, "pound: bench --scene: row of %d (%s): %s\n", N, pd_method_name(m),
@@ -190,8 +207,8 @@ static int time_row(int N, pd_method m, row_case *rc_out)
 }
 
 /* The three-structure row's 200-point spectrum (Pi2 0.1 ... 5 of S1) on one
- * thread: its CPU time. */
-static int time_row_spectrum(double *cpu_s)
+ * thread: its CPU and wall time. */
+static int time_row_spectrum(pd_bench_clock *time)
 {
     pd_scene_excitation exc = {.pulse = PD_PULSE_SINE, .dir = -1, .ap = 4.0, .Tp = 0.5};
     pd_scene *sc = pd_scene_new(&exc);
@@ -209,9 +226,10 @@ static int time_row_spectrum(double *cpu_s)
         w.opts.method = PD_METHOD_EVENT;
         long n = pd_scene_sweep_twins(&w) + pd_scene_sweep_points(&w);
         pd_scene_point *pts = calloc((size_t)n, sizeof *pts);
-        double *umax = calloc((size_t)n * 3, sizeof *umax), c0 = pd_cpu_seconds();
+        double *umax = calloc((size_t)n * 3, sizeof *umax);
+        pd_bench_clock t0 = pd_bench_now();
         rc = !pts || !umax || pd_scene_sweep_run(&w, 1, pts, umax, &err);
-        *cpu_s = pd_cpu_seconds() - c0;
+        *time = pd_bench_since(t0);
         free(pts);
         free(umax);
     }
@@ -229,19 +247,20 @@ int pd_bench_scene(pd_json *js)
     int rc = 0;
     for (int k = 0; k < NSIZES; k++)
         rc |= time_chain(sizes[k], &cc[k]);
-    double scene_rate = 0.0, osc_rate = 0.0;
-    rc |= one_wall(&scene_rate, &osc_rate);
+    double ow[4] = {0.0, 0.0, 0.0, 0.0}; /* one wall: scene, oscillator; CPU, wall */
+    rc |= one_wall(ow);
     double expo = growth(cc, NSIZES, 1000, 100000);
     static const int rsizes[ROW_SIZES] = {10, 100, 1000, 10000};
     row_case rows[ROW_SIZES], general;
-    double lo = HUGE_VAL, hi = 0.0, spec_cpu = 0.0;
+    double lo = HUGE_VAL, hi = 0.0;
+    pd_bench_clock spec = {0.0, 0.0};
     for (int k = 0; k < ROW_SIZES; k++) {
         rc |= time_row(rsizes[k], PD_METHOD_EVENT, &rows[k]);
         lo = fmin(lo, rows[k].us_per_event);
         hi = fmax(hi, rows[k].us_per_event);
     }
     rc |= time_row(10, PD_METHOD_EVENT_GENERAL, &general);
-    rc |= time_row_spectrum(&spec_cpu);
+    rc |= time_row_spectrum(&spec);
     if (js) {
         pd_json_begin_object(js, "scene");
         pd_json_begin_array(js, "chains");
@@ -251,6 +270,7 @@ int pd_bench_scene(pd_json *js)
             pd_json_int(js, "steps", cc[k].steps);
             pd_json_num(js, "ns_per_dof_step", cc[k].ns_per_dof_step);
             pd_json_num(js, "dof_steps_per_s", 1e9 / cc[k].ns_per_dof_step);
+            pd_json_num(js, "wall_ns_per_dof_step", cc[k].wall_ns_per_dof_step);
             pd_json_num(js, "active_fraction", cc[k].active_fraction);
             pd_json_num(js, "lcp_iterations_per_step", cc[k].lcp_iterations);
             pd_json_str(js, "factor", cc[k].factor ? cc[k].factor : "?");
@@ -259,14 +279,18 @@ int pd_bench_scene(pd_json *js)
         pd_json_end_array(js);
         pd_json_num(js, "growth_exponent", expo);
         pd_json_num(js, "target_dof_steps_per_s", SCENE_TARGET);
-        pd_json_num(js, "one_wall_scene_steps_per_s", scene_rate);
-        pd_json_num(js, "one_wall_oscillator_steps_per_s", osc_rate);
-        pd_json_num(js, "one_wall_ratio", scene_rate / osc_rate);
+        pd_json_int(js, "chains_steps_per_Tp", SCENE_STEPS_PER_TP);
+        pd_json_num(js, "one_wall_scene_steps_per_s", ow[0]);
+        pd_json_num(js, "one_wall_oscillator_steps_per_s", ow[1]);
+        pd_json_num(js, "one_wall_ratio", ow[0] / ow[1]);
+        pd_json_num(js, "one_wall_scene_wall_steps_per_s", ow[2]);
+        pd_json_num(js, "one_wall_oscillator_wall_steps_per_s", ow[3]);
         pd_json_begin_array(js, "event_rows");
         for (int k = 0; k < ROW_SIZES; k++) {
             pd_json_begin_object(js, NULL);
             pd_json_int(js, "N", rows[k].N);
             pd_json_num(js, "cpu_s", rows[k].cpu_s);
+            pd_json_num(js, "wall_s", rows[k].wall_s);
             pd_json_int(js, "events", rows[k].events);
             pd_json_int(js, "impacts", rows[k].impacts);
             pd_json_num(js, "us_per_event", rows[k].us_per_event);
@@ -275,34 +299,41 @@ int pd_bench_scene(pd_json *js)
         pd_json_end_array(js);
         pd_json_num(js, "event_rows_cost_spread", hi / lo);
         pd_json_num(js, "event_general_row10_cpu_s", general.cpu_s);
+        pd_json_num(js, "event_general_row10_wall_s", general.wall_s);
         pd_json_num(js, "event_general_row10_ratio", general.cpu_s / rows[0].cpu_s);
-        pd_json_num(js, "row_spectrum_200_cpu_s", spec_cpu);
+        pd_json_num(js, "row_spectrum_200_cpu_s", spec.cpu_s);
+        pd_json_num(js, "row_spectrum_200_wall_s", spec.wall_s);
         pd_json_end_object(js);
     } else {
-        printf("Moreau-Jean on --chain N rows (harmonic, Pi3 = %g, e = 0, dt = Tp/200; one core)\n",
-               SCENE_PI3);
-        printf("  %8s %8s %12s %14s %8s %10s  %s\n", "N", "steps", "ns/DOF-step", "DOF-steps/s",
-               "active", "LCP its", "factor");
+        printf("Moreau-Jean on --chain N rows (harmonic, Pi3 = %g, e = 0, dt = Tp/%d; one core)\n",
+               SCENE_PI3, SCENE_STEPS_PER_TP);
+        printf("  %8s %8s %12s %14s %8s %8s %10s  %s\n", "N", "steps", "ns/DOF-step",
+               "DOF-steps/s", "wall ns", "active", "LCP its", "factor");
         for (int k = 0; k < NSIZES; k++)
-            printf("  %8d %8ld %12.1f %14.4g %7.1f%% %10.1f  %s\n", cc[k].N, cc[k].steps,
-                   cc[k].ns_per_dof_step, 1e9 / cc[k].ns_per_dof_step, 100 * cc[k].active_fraction,
+            printf("  %8d %8ld %12.1f %14.4g %8.1f %7.1f%% %10.1f  %s\n", cc[k].N, cc[k].steps,
+                   cc[k].ns_per_dof_step, 1e9 / cc[k].ns_per_dof_step,
+                   cc[k].wall_ns_per_dof_step, 100 * cc[k].active_fraction,
                    cc[k].lcp_iterations, cc[k].factor ? cc[k].factor : "?");
+        printf("  (ns/DOF-step and DOF-steps/s in CPU time; wall ns: per DOF-step of the wall "
+               "clock)\n");
         printf("  growth exponent of the time per step, N = 1e3 ... 1e5: %.3f (goal <= 1.2); "
                "goal %.0e DOF-steps/s at N = 1e4\n", expo, SCENE_TARGET);
-        printf("  one-wall scene %.4g steps/s, the oscillator %.4g steps/s: ratio %.3f\n",
-               scene_rate, osc_rate, scene_rate / osc_rate);
+        printf("  one-wall scene %.4g steps/s, the oscillator %.4g steps/s: ratio %.3f (CPU; wall "
+               "%.4g and %.4g)\n", ow[0], ow[1], ow[0] / ow[1], ow[2], ow[3]);
         printf("the exact event-driven reference on --chain N rows (sine Tp = 1 s, Pi3 = 0.05, "
                "e = 0.6, 4 s; one core)\n");
-        printf("  %8s %10s %10s %10s %12s\n", "N", "cpu [s]", "events", "impacts", "us/event");
+        printf("  %8s %10s %10s %10s %10s %12s\n", "N", "cpu [s]", "wall [s]", "events",
+               "impacts", "us/event");
         for (int k = 0; k < ROW_SIZES; k++)
-            printf("  %8d %10.4g %10ld %10ld %12.3g\n", rows[k].N, rows[k].cpu_s,
-                   rows[k].events, rows[k].impacts, rows[k].us_per_event);
-        printf("  cost per event from N = 10 to 1e4 within %.2fx (goal 2x); the row of 100 in "
-               "%.3g s (goal 0.2 s)\n", hi / lo, rows[1].cpu_s);
-        printf("  the GSL-based general reference (event-general) on the row of 10: %.3g s, "
-               "%.3gx the exact one\n", general.cpu_s, general.cpu_s / rows[0].cpu_s);
-        printf("  200-point spectrum of a three-structure row (event): %.3g s (goal 1 s)\n",
-               spec_cpu);
+            printf("  %8d %10.4g %10.4g %10ld %10ld %12.3g\n", rows[k].N, rows[k].cpu_s,
+                   rows[k].wall_s, rows[k].events, rows[k].impacts, rows[k].us_per_event);
+        printf("  cost per event (CPU) from N = 10 to 1e4 within %.2fx (goal 2x); the row of 100 in "
+               "%.3g s CPU, %.3g s wall (goal 0.2 s)\n", hi / lo, rows[1].cpu_s, rows[1].wall_s);
+        printf("  the GSL-based general reference (event-general) on the row of 10: %.3g s CPU, "
+               "%.3g s wall, %.3gx the exact one\n", general.cpu_s, general.wall_s,
+               general.cpu_s / rows[0].cpu_s);
+        printf("  200-point spectrum of a three-structure row (event): %.3g s CPU, %.3g s wall "
+               "(goal 1 s)\n", spec.cpu_s, spec.wall_s);
     }
     return rc ? 1 : 0;
 }

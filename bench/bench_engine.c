@@ -3,12 +3,14 @@
  * contact (an LCP every step) and with many impacts; scalar, batched and
  * general kernels; the median of three timed runs each, beside the bound
  * the step's dependency chain sets (its operations in a row, each at the
- * latency of one dependent multiply or add measured here). */
+ * latency of one dependent multiply or add measured here).  Rates are per
+ * second of the thread's CPU time, with the wall clock's beside them (the
+ * median of each). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "pd_cli.h"
+#include "pd_bench.h"
 #include "pd_problems.h"
 
 /* A scene of its own for persistent contact: x'' + k x = 1 pressing the
@@ -21,16 +23,11 @@ static void push_force(double t, int side, double *F, void *ctx)
     F[0] = 1.0;
 }
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 typedef struct bench_case {
     const char *name;
     const char *what;
-    double steps_per_s;
+    double steps_per_s;      /* per second of CPU time */
+    double wall_steps_per_s; /* per second of wall time */
     double lcp_fraction; /* steps with an active contact */
     long steps;
     double chain_ns;     /* the dependency chain's bound per step (NAN: not estimated) */
@@ -46,24 +43,27 @@ typedef struct bench_case {
 #define CHAIN_CONTACT 15
 
 /* The latency of one dependent double multiply or add on this machine
- * [ns]: a chain of them timed (the median of three). */
-static double fp_latency_ns(void)
+ * [ns] in CPU time, and in wall time: a chain of them timed (the median of
+ * three). */
+static double fp_latency_ns(double *wall_ns)
 {
     volatile double seed = 1.0000001, tiny = 1e-300;
-    double lat[3];
+    double lat[3], wall[3];
     const long n = 20000000;
     for (int k = 0; k < 3; k++) {
         double x = seed, y = seed, z = tiny;
-        double t0 = pd_cpu_seconds();
+        pd_bench_clock t0 = pd_bench_now();
         for (long i = 0; i < n; i++) {
             x = x * y; /* each waits for the one before */
             x = x + z;
         }
-        lat[k] = (pd_cpu_seconds() - t0) / (2.0 * (double)n) * 1e9;
+        pd_bench_clock t = pd_bench_since(t0);
+        lat[k] = t.cpu_s / (2.0 * (double)n) * 1e9;
+        wall[k] = t.wall_s / (2.0 * (double)n) * 1e9;
         seed = x > 0.0 ? seed : x; /* keep x alive */
     }
-    qsort(lat, 3, sizeof lat[0], cmp_double);
-    return lat[1];
+    *wall_ns = pd_bench_median(wall, 3);
+    return pd_bench_median(lat, 3);
 }
 
 /* The batched kernel: 4 x PD_MJB_LANES copies of case c (their Pi2 spread
@@ -97,18 +97,20 @@ static void batch_done(void *ctx, long id, const pd_osc_result *res, int status,
 
 static int time_batched(const pd_osc *c, const pd_run_opts *o, bench_case *bc)
 {
-    double rate[3];
+    double rate[3], wall[3];
     pd_err err;
     for (int k = 0; k < 3; k++) {
         batch_src b = {.c = *c, .o = *o, .n = 4 * PD_MJB_LANES};
         b.o.method = PD_METHOD_MOREAU;
-        double t0 = pd_cpu_seconds();
+        pd_bench_clock t0 = pd_bench_now();
         pd_osc_run_stream(batch_next, batch_done, &b, &err);
-        rate[k] = (double)b.steps / fmax(pd_cpu_seconds() - t0, 1e-9);
+        pd_bench_clock t = pd_bench_since(t0);
+        rate[k] = (double)b.steps / fmax(t.cpu_s, 1e-9);
+        wall[k] = (double)b.steps / fmax(t.wall_s, 1e-9);
         bc->steps = b.steps;
     }
-    qsort(rate, 3, sizeof rate[0], cmp_double);
-    bc->steps_per_s = rate[1];
+    bc->steps_per_s = pd_bench_median(rate, 3);
+    bc->wall_steps_per_s = pd_bench_median(wall, 3);
     bc->lcp_fraction = NAN;
     return 0;
 }
@@ -116,16 +118,18 @@ static int time_batched(const pd_osc *c, const pd_run_opts *o, bench_case *bc)
 /* Median rate of pd_osc_simulate over three runs. */
 static int time_oscillator(const pd_osc *c, const pd_run_opts *o, bench_case *bc)
 {
-    double rate[3];
+    double rate[3], wall[3];
     pd_osc_result r;
     pd_err err;
     for (int k = 0; k < 3; k++) {
+        double t0 = pd_wall_seconds();
         if (pd_osc_simulate(c, o, NULL, NULL, &r, &err))
             return 1;
         rate[k] = (double)r.steps / fmax(r.cpu_s, 1e-9);
+        wall[k] = (double)r.steps / fmax(pd_wall_seconds() - t0, 1e-9);
     }
-    qsort(rate, 3, sizeof rate[0], cmp_double);
-    bc->steps_per_s = rate[1];
+    bc->steps_per_s = pd_bench_median(rate, 3);
+    bc->wall_steps_per_s = pd_bench_median(wall, 3);
     bc->steps = r.steps;
     bc->lcp_fraction = r.contact_time / r.tend;
     return 0;
@@ -134,7 +138,7 @@ static int time_oscillator(const pd_osc *c, const pd_run_opts *o, bench_case *bc
 /* Median rate of the bare engine (no observer) on the pressing scene. */
 static int time_pressing(pd_kernel kernel, pd_lcp_method solver, long nsteps, bench_case *bc)
 {
-    double M = 1, K = 0.01, W = -1, g0 = 0, e = 0, rate[3];
+    double M = 1, K = 0.01, W = -1, g0 = 0, e = 0, rate[3], wall[3];
     pd_model md = {.n = 1,
                    .m = 1,
                    .M = pd_matrix_dense(1, 1, &M),
@@ -155,7 +159,7 @@ static int time_pressing(pd_kernel kernel, pd_lcp_method solver, long nsteps, be
     long active = 0;
     for (int k = 0; k < 3; k++) {
         pd_mj_reset(mj, 0.0, NULL, NULL, &err);
-        double t0 = pd_cpu_seconds();
+        pd_bench_clock t0 = pd_bench_now();
         active = 0;
         for (long s = 0; s < nsteps; s++) {
             if (pd_mj_step(mj, &err)) {
@@ -164,11 +168,13 @@ static int time_pressing(pd_kernel kernel, pd_lcp_method solver, long nsteps, be
             }
             active += pd_mj_state(mj)->nactive;
         }
-        rate[k] = (double)nsteps / fmax(pd_cpu_seconds() - t0, 1e-9);
+        pd_bench_clock t = pd_bench_since(t0);
+        rate[k] = (double)nsteps / fmax(t.cpu_s, 1e-9);
+        wall[k] = (double)nsteps / fmax(t.wall_s, 1e-9);
     }
     pd_mj_free(mj);
-    qsort(rate, 3, sizeof rate[0], cmp_double);
-    bc->steps_per_s = rate[1];
+    bc->steps_per_s = pd_bench_median(rate, 3);
+    bc->wall_steps_per_s = pd_bench_median(wall, 3);
     bc->steps = nsteps;
     bc->lcp_fraction = (double)active / (double)nsteps;
     return 0;
@@ -215,7 +221,7 @@ int pd_bench_engine(pd_json *js)
     rc |= time_batched(&imp_c, &ob, &cases[n++]);
     /* the chains' bounds: the scalar kernel's per step, the batch's per
      * oscillator-step (its lanes' chains overlap) */
-    double lat = fp_latency_ns();
+    double lat_wall, lat = fp_latency_ns(&lat_wall);
     for (int k = 0; k < n; k++) {
         const char *nm = cases[k].name;
         int batched = !strncmp(nm, "batched", 7), general = strstr(nm, "general") ||
@@ -229,6 +235,7 @@ int pd_bench_engine(pd_json *js)
         pd_json_num(js, "target_free_steps_per_s", 20e6);
         pd_json_num(js, "target_lcp_steps_per_s", 5e6);
         pd_json_num(js, "fp_latency_ns", lat);
+        pd_json_num(js, "fp_latency_wall_ns", lat_wall);
         pd_json_int(js, "batch_lanes", PD_MJB_LANES);
         pd_json_begin_array(js, "cases");
         for (int k = 0; k < n; k++) {
@@ -237,6 +244,8 @@ int pd_bench_engine(pd_json *js)
             pd_json_str(js, "what", cases[k].what);
             pd_json_num(js, "steps_per_s", cases[k].steps_per_s);
             pd_json_num(js, "ns_per_step", 1e9 / cases[k].steps_per_s);
+            pd_json_num(js, "wall_steps_per_s", cases[k].wall_steps_per_s);
+            pd_json_num(js, "wall_ns_per_step", 1e9 / cases[k].wall_steps_per_s);
             pd_json_num(js, "chain_ns_per_step", cases[k].chain_ns);
             pd_json_num(js, "active_fraction", cases[k].lcp_fraction);
             pd_json_int(js, "steps", cases[k].steps);
@@ -245,21 +254,24 @@ int pd_bench_engine(pd_json *js)
         pd_json_end_array(js);
         pd_json_end_object(js);
     } else {
-        printf("Moreau-Jean engine, one-wall oscillator (median of 3 runs, one core)\n");
-        printf("  %-20s %14s %10s %10s %8s  %s\n", "case", "steps/s", "ns/step", "chain", "active",
-               "what");
+        printf("Moreau-Jean engine, one-wall oscillator (median of 3 runs, one core; steps/s and "
+               "ns/step in CPU time, wall: ns/step of the wall clock)\n");
+        printf("  %-20s %14s %10s %10s %10s %8s  %s\n", "case", "steps/s", "ns/step", "wall ns",
+               "chain", "active", "what");
         for (int k = 0; k < n; k++) {
             char chain[16] = "-", active[16] = "-";
             if (isfinite(cases[k].chain_ns))
                 snprintf(chain, sizeof chain, "%.2f", cases[k].chain_ns);
             if (isfinite(cases[k].lcp_fraction))
                 snprintf(active, sizeof active, "%.1f%%", 100 * cases[k].lcp_fraction);
-            printf("  %-20s %14.4g %10.2f %10s %8s  %s\n", cases[k].name, cases[k].steps_per_s,
-                   1e9 / cases[k].steps_per_s, chain, active, cases[k].what);
+            printf("  %-20s %14.4g %10.2f %10.2f %10s %8s  %s\n", cases[k].name,
+                   cases[k].steps_per_s, 1e9 / cases[k].steps_per_s,
+                   1e9 / cases[k].wall_steps_per_s, chain, active, cases[k].what);
         }
         printf("  chain: the bound of the step's dependency chain (%d dependent operations, %d "
-               "with an impulse, at %.2f ns each, measured; batched: per oscillator, the %d "
-               "lanes' chains overlapping)\n", CHAIN_FREE, CHAIN_CONTACT, lat, PD_MJB_LANES);
+               "with an impulse, at %.2f ns each, measured (wall %.2f ns); batched: per "
+               "oscillator, the %d lanes' chains overlapping)\n", CHAIN_FREE, CHAIN_CONTACT, lat,
+               lat_wall, PD_MJB_LANES);
         printf("  targets: 20e6 steps/s in free flight, 5e6 steps/s with an LCP every step\n");
     }
     return rc ? 1 : 0;
