@@ -250,7 +250,7 @@ def test_chain():
 
 # ---- records --------------------------------------------------------------------------------
 
-RECORD = RECORDS / "NGA_no_1063_RRS228.AT2"
+RECORD = EXAMPLES / "records" / "NGA_no_1063_RRS228.AT2"  # shipped (examples/records)
 
 
 @pytest.mark.skipif(not RECORD.exists(), reason="no records in %s" % RECORDS)
