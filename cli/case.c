@@ -14,7 +14,7 @@ const char pd_cli_case_help[] =
     "  --T0 T   oscillator period, s  or  --Pi2 X = Tp/T0 [1]\n"
     "  --gap D  initial gap, m        or  --Pi3 X = gap wp^2/ap [0.05]\n"
     "  --eps E  restitution in [0,1] [0.5]    --xi Z   damping ratio in [0,1) [0.05]\n"
-    "records (SPEC 5, docs/records.md):\n"
+    "records (docs/records.md):\n"
     "  --record F    the ground acceleration of a record (PEER .AT2, COSMOS V2, or text\n"
     "                't a'): replaces the pulse; ap and Tp come from its fitted pulse\n"
     "  --scale S [1]  multiplies the record   --dir normal|reverse as for pulses\n"

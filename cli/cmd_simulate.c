@@ -182,11 +182,11 @@ static void method_line(const pd_cli_case *k)
     if (k->method_by)
         printf("  method    = %s (%s)\n", m, k->method_by);
     else if (pd_cli_is_scene(k))
-        printf("  method    = %s (the default for scenes; --method event|penalty for the "
-               "others)\n", m);
+        printf("  method    = %s (the default for scenes; --method event|penalty|newmark for "
+               "the others)\n", m);
     else
         printf("  method    = %s (the default for one oscillator: %s; --method moreau|event|"
-               "penalty chooses)\n", m,
+               "penalty|newmark chooses)\n", m,
                k->opts.method == PD_METHOD_EVENT ? "exact and fastest"
                                                  : "the exact reference's scan is over budget");
 }
@@ -258,7 +258,10 @@ static void print_text(const sim_args *a, const pd_osc_summary *s)
     else
         printf("  Pi2 = %.6g  Pi3 = %.6g   %s (%s), %ld %s to %g s\n", c->Pi2, c->Pi3,
                a->k.opts.method == PD_METHOD_EVENT ? "event-driven reference" : "penalty",
-               s->r.kernel, s->r.steps, a->k.opts.method == PD_METHOD_EVENT ? "events" : "steps",
+               s->r.kernel, s->r.steps,
+               a->k.opts.method != PD_METHOD_EVENT ? "steps"
+               : c->record ? "events (impacts, ends of contact, the record's samples)"
+                           : "events (impacts, ends of contact, the pulse's end)",
                s->r.tend);
     method_line(&a->k);
     printf("  umax      = %.6g m   (Pi1 = %.6g)\n", s->r.umax, s->Pi1);

@@ -23,7 +23,7 @@ static const char usage[] =
     "  spectrum   response spectra Pi1(Pi2) over lists of Pi3, eps, xi, pulses (OpenMP, MPI)\n"
     "  record F   ground-motion measures and the fitted pulse of strong-motion records\n"
     "  lcp FILE   solve one linear complementarity problem (Lemke, structured, PGS)\n"
-    "  bench      performance figures (--lcp, --engine, --scene, --spectrum)\n"
+    "  bench      performance figures (--lcp, --engine, --scene, --spectrum, --records, --startup)\n"
     "  help CMD   the options of a command (as `pound CMD --help`)\n"
     "\n"
     "  --version  pound's version and the libraries it was built with\n"

@@ -142,7 +142,8 @@ case $cflags in *"$root/include"*) ;; *) check "pkg-config --cflags" false ;; es
 example() {
     ex=$1 how=$2 bin=$tmp/$1-$2
     if [ "$how" = shared ]; then
-        $CC -std=c11 -Wall -Wextra -Wpedantic -Werror examples/api/$ex.c $cflags $libs -lm -o "$bin" ||
+        # the README's line: cc prog.c $(pkg-config --cflags --libs pound), no -lm
+        $CC -std=c11 -Wall -Wextra -Wpedantic -Werror examples/api/$ex.c $cflags $libs -o "$bin" ||
             return 1
         LD_LIBRARY_PATH=$root/lib ldd "$bin" | grep -q "libpound.so.0 => $root/lib/" ||
             { LD_LIBRARY_PATH=$root/lib ldd "$bin"; return 1; }

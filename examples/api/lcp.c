@@ -28,8 +28,10 @@ static int solve(pd_lcp_method method, const pd_matrix *M, const double *q, cons
     int rc = pd_lcp_solve(s, M, q, NULL, z, w, &info);
     pd_lcp_solver_free(s);
     double d = 0.0;
-    for (int i = 0; i < N; i++)
-        d = fmax(d, fabs(z[i] - zref[i]));
+    for (int i = 0; i < N; i++) { /* no libm call: the README's link line has no -lm */
+        double di = fabs(z[i] - zref[i]);
+        d = di > d ? di : d;
+    }
     printf("%-10s %-5s z = [%.6f %.6f %.6f %.6f]  %s (%s, residual %.1e)\n",
            pd_lcp_method_name(method), view, z[0], z[1], z[2], z[3],
            pd_lcp_outcome_name(info.outcome), info.solver, info.residual);
