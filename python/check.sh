@@ -31,15 +31,22 @@ export POUND_LIBRARY POUND_BIN
 
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/pound-py.XXXXXX")
 trap 'rm -rf "$tmp"' EXIT INT TERM
-# a venv that sees Debian's NumPy, pytest and Matplotlib; the package installed offline
-"$PYTHON" -m venv --system-site-packages --without-pip "$tmp/venv"
-# from a copy: pip builds in the tree it is given (build/, *.egg-info)
-mkdir "$tmp/src"
-cp -R "$here/pyproject.toml" "$here/README.md" "$here/pound" "$tmp/src/"
-"$tmp/venv/bin/python" -m pip install --quiet --no-build-isolation --no-index --no-deps \
-    --disable-pip-version-check "$tmp/src" >"$tmp/pip.log" 2>&1 ||
+# The README's install, word for word, in a fresh venv (Debian's python3
+# with NumPy, pytest, Matplotlib): the package bundles the library at
+# install time (python/setup.py), so it imports with no POUND_LIBRARY.
+(cd "$root" && env -u POUND_LIBRARY "$PYTHON" -m venv --system-site-packages "$tmp/V" &&
+    env -u POUND_LIBRARY "$tmp/V/bin/python" -m pip install --no-build-isolation --no-index \
+        ./python) >"$tmp/pip.log" 2>&1 ||
     { cat "$tmp/pip.log" >&2; exit 1; }
+rm -rf "$here/build" "$here"/*.egg-info # what pip's in-tree build leaves
+(cd "$tmp" && env -u POUND_LIBRARY "$tmp/V/bin/python" -c '
+import os, pound
+want = os.path.join(os.path.dirname(pound.__file__), "libpound.so")
+assert pound.library_path == want, (pound.library_path, want)
+print("pound", pound.version(), "imports with its bundled", pound.library_path)') ||
+    { echo "python: the installed package does not find its bundled library" >&2; exit 1; }
+# the tests, on that install, against the library and the CLI of one build
 cd "$tmp" # not the source tree: the tests import the installed package
-"$tmp/venv/bin/python" -c 'import pound, sys; print("pound", pound.version(), "from",
+"$tmp/V/bin/python" -c 'import pound, sys; print("pound", pound.version(), "from",
     pound.__file__, "on", pound.library_path, file=sys.stderr)'
-MPLBACKEND=Agg "$tmp/venv/bin/python" -m pytest -q -p no:cacheprovider "$here/tests" "$@"
+MPLBACKEND=Agg "$tmp/V/bin/python" -m pytest -q -p no:cacheprovider "$here/tests" "$@"

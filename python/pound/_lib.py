@@ -427,12 +427,14 @@ _HERE = os.path.dirname(os.path.abspath(__file__))
 
 def _candidates():
     """Where the library is looked for, in order: $POUND_LIBRARY (a path), the
-    installed libpound.so.0 (the loader's search path), the build tree."""
+    copy bundled at install time (python/setup.py), the installed
+    libpound.so.0 (the loader's search path), the build tree."""
     env = os.environ.get("POUND_LIBRARY")
     if env:
         return [env]
-    return ["libpound.so.0", os.path.normpath(os.path.join(_HERE, "..", "..", "build",
-                                                           "libpound.so"))]
+    bundled = os.path.join(_HERE, "libpound.so")
+    return ([bundled] if os.path.exists(bundled) else []) + [
+        "libpound.so.0", os.path.normpath(os.path.join(_HERE, "..", "..", "build", "libpound.so"))]
 
 
 def _load():
