@@ -98,7 +98,7 @@ int pd_bench_records(pd_json *js, const char *shared_dir)
     for (int k = 0; k < nrec && !rc; k++) {
         pd_cli_record *r = NULL;
         pd_spectrum s;
-        if ((rc = pd_cli_record_load(names[k], PD_RECORD_AUTO, PD_UNITS_G, &r)))
+        if ((rc = pd_cli_record_load(names[k], PD_RECORD_AUTO, PD_UNITS_G, 0, &r)))
             break;
         record_sweep(&s, r, PD_METHOD_EVENT);
         long n = pd_spec_tasks(&s);

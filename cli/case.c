@@ -65,11 +65,19 @@ void pd_cli_case_free(pd_cli_case *a)
 }
 
 int pd_cli_record_load(const char *path, pd_record_format format, pd_record_units units,
-                       pd_cli_record **out)
+                       int units_given, pd_cli_record **out)
 {
     pd_err err;
-    pd_cli_record *r = calloc(1, sizeof *r);
+    pd_record_format fmt = format;
     *out = NULL;
+    if (units_given && fmt == PD_RECORD_AUTO && pd_record_detect(path, &fmt, &err))
+        return pd_cli_usage_error("%s", err.msg);
+    if (units_given && fmt != PD_RECORD_TEXT)
+        return pd_cli_usage_error("--units: %s is read as %s, whose file states its units "
+                                  "(--units is for two-column text records)",
+                                  path, fmt == PD_RECORD_AT2 ? "a PEER AT2 record (in g)"
+                                                             : "a COSMOS V2 record");
+    pd_cli_record *r = calloc(1, sizeof *r);
     if (!r) {
         fprintf(stderr, "pound: out of memory for the record %s\n", path);
         return 1;
@@ -86,6 +94,9 @@ int pd_cli_record_load(const char *path, pd_record_format format, pd_record_unit
                                       pd_record_format_name(format));
         return pd_cli_usage_error("%s", err.msg);
     }
+    char warn[512];
+    if (!pd_record_plausible(&r->rec, units, warn, sizeof warn))
+        fprintf(stderr, "pound: warning: %s\n", warn);
     *out = r;
     return 0;
 }
@@ -198,8 +209,10 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
     else if (!strcmp(f, "--lcp-solver"))
         rc = named(f, val, pd_lcp_method_parse(val, &a->opts.lcp_solver) != PD_OK,
                    pd_lcp_method_list());
-    else if (!strcmp(f, "--units"))
+    else if (!strcmp(f, "--units")) {
+        a->have_units = 1;
         rc = named(f, val, pd_record_units_parse(val, &a->rec_units) != PD_OK, "g, m/s2, cm/s2");
+    }
     else if (!strcmp(f, "--record-format"))
         rc = named(f, val, pd_record_format_parse(val, &a->rec_format) != PD_OK,
                    "auto, at2, v2, text");
@@ -388,7 +401,7 @@ static int case_record(pd_cli_case *a)
                                   "and Tp; --scale scales it)", a->pulse_flag);
     if (!(a->scale > 0.0) || !isfinite(a->scale))
         return pd_cli_usage_error("--scale: must be > 0 (got %.10g)", a->scale);
-    int rc = a->record ? 0 : pd_cli_record_load(a->record_path, a->rec_format, a->rec_units,
+    int rc = a->record ? 0 : pd_cli_record_load(a->record_path, a->rec_format, a->rec_units, a->have_units,
                                                 &a->record);
     if (!rc)
         pd_osc_set_record(&a->c, &a->record->rec, &a->record->pulse, a->scale);

@@ -32,6 +32,7 @@ typedef struct record_args {
     const char *plot;
     pd_record_format format;
     pd_record_units units;
+    int have_units; /* --units given */
 } record_args;
 
 /* One record read, measured and fitted. */
@@ -52,7 +53,8 @@ static int parse_args(record_args *a, int argc, char **argv)
                 return pd_cli_usage_error("%s needs a value", f);
             if (!strcmp(f, "--plot"))
                 a->plot = val;
-            else if (!strcmp(f, "--units") && pd_record_units_parse(val, &a->units))
+            else if (!strcmp(f, "--units") && (a->have_units = 1) &&
+                     pd_record_units_parse(val, &a->units))
                 return pd_cli_usage_error("--units: '%s' is not one of g, m/s2, cm/s2", val);
             else if (!strcmp(f, "--record-format") && pd_record_format_parse(val, &a->format))
                 return pd_cli_usage_error("--record-format: '%s' is not one of auto, at2, v2, "
@@ -142,7 +144,7 @@ int pd_cmd_record(int argc, char **argv)
     memset(items, 0, sizeof items);
     for (; n < a.nfiles; n++) {
         pd_err err;
-        if ((rc = pd_cli_record_load(a.files[n], a.format, a.units, &items[n].r)))
+        if ((rc = pd_cli_record_load(a.files[n], a.format, a.units, a.have_units, &items[n].r)))
             break;
         if (pd_record_measure(&items[n].r->rec, &items[n].m, &err)) {
             rc = pd_cli_usage_error("%s", err.msg);

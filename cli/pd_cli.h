@@ -42,6 +42,7 @@ typedef struct pd_cli_case {
     int have_scale;
     pd_record_format rec_format; /* --record-format */
     pd_record_units rec_units;   /* --units (text records) */
+    int have_units;              /* --units given */
     pd_cli_record *record;  /* read by pd_cli_case_finish; released by pd_cli_case_free */
     /* the method: --method's, else the one the flags given belong to (a
      * flag of one method's only: --theta, --kc, ...), else the default;
@@ -76,9 +77,12 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i);
 int pd_cli_case_finish(pd_cli_case *a);
 /* What pd_cli_case_finish took (the record). */
 void pd_cli_case_free(pd_cli_case *a);
-/* Read a record and fit its pulse: 0, or 2 after printing the file's error. */
+/* Read a record and fit its pulse: 0, or 2 after printing the file's error.
+ * --units given (units_given) on a format that fixes its units (AT2, V2) is
+ * refused; a peak acceleration implausible in its units (pd_record_plausible)
+ * gets one warning line on stderr. */
 int pd_cli_record_load(const char *path, pd_record_format format, pd_record_units units,
-                       pd_cli_record **out);
+                       int units_given, pd_cli_record **out);
 /* The paper's Fig. 2 for up to 6 records (plot_records.c). */
 int pd_plot_records(const char *png, const pd_cli_record *const *recs, int n, pd_err *err);
 /* 1 when --scene or --chain was given. */

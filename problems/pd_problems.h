@@ -87,6 +87,23 @@ typedef struct pd_record {
 PD_API int pd_record_read(const char *path, pd_record_format format, pd_record_units units,
                           pd_record *rec, pd_err *err);
 PD_API void pd_record_free(pd_record *rec);
+/* The format pd_record_read would read path as (PD_RECORD_AUTO's
+ * detection: an AT2 or V2 header, else the file name's extension, else
+ * text). */
+PD_API int pd_record_detect(const char *path, pd_record_format *format, pd_err *err);
+/* Whether the record's peak ground acceleration is plausible in the units
+ * it was read in (1e-4 g to 5 g): 1 if so; 0 with a warning in msg (up to
+ * cap bytes; msg may be NULL) naming the units that would make it
+ * plausible; 0 for a NULL or empty record. */
+PD_API int pd_record_plausible(const pd_record *rec, pd_record_units units, char *msg,
+                               size_t cap);
+/* A record from npts >= 2 accelerations acc[k] at t_k = k dt, in units
+ * (converted to m/s^2 as the readers do: the same values give the same
+ * record bit for bit), named name (NULL: "array").  acc is copied (rec owns
+ * it: pd_record_free); every value must be finite, dt in
+ * [PD_RECORD_DT_MIN, PD_RECORD_DT_MAX]; on error rec is left empty. */
+PD_API int pd_record_from_array(pd_record *rec, const char *name, const double *acc, long npts,
+                                double dt, pd_record_units units, pd_err *err);
 /* The record's duration (npts - 1) dt [s]. */
 PD_API double pd_record_duration(const pd_record *rec);
 /* ug''(t) [m/s^2]: linear between samples, 0 before 0 and after the last

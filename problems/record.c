@@ -1016,6 +1016,84 @@ static void set_name(pd_record *rec, const char *path)
     snprintf(rec->name, sizeof rec->name, "%s", slash ? slash + 1 : path);
 }
 
+int pd_record_detect(const char *path, pd_record_format *format, pd_err *err)
+{
+    if (!path || !format)
+        return PD_NULL_ARG(err, !path ? "path" : "format");
+    rec_reader r;
+    int st = reader_open(&r, path, err);
+    if (st == PD_OK)
+        st = detect_format(&r, format);
+    reader_close(&r);
+    return st;
+}
+
+/* The plausible peak ground accelerations, in g. */
+#define RECORD_PGA_MIN_G 1e-4
+#define RECORD_PGA_MAX_G 5.0
+
+int pd_record_plausible(const pd_record *rec, pd_record_units units, char *msg, size_t cap)
+{
+    if (!rec || !rec->acc || rec->npts < 1)
+        return 0;
+    double pga = 0.0;
+    for (long k = 0; k < rec->npts; k++)
+        pga = fmax(pga, fabs(rec->acc[k]));
+    double g = pga / PD_G_STANDARD, s = units_scale(units);
+    if (g >= RECORD_PGA_MIN_G && g <= RECORD_PGA_MAX_G)
+        return 1;
+    /* the units the same numbers would be plausible in */
+    const pd_record_units all[] = {PD_UNITS_G, PD_UNITS_M_S2, PD_UNITS_CM_S2};
+    const char *fix = NULL;
+    for (int i = 0; i < 3; i++) {
+        double gi = pga / s * units_scale(all[i]) / PD_G_STANDARD;
+        if (all[i] != units && gi >= RECORD_PGA_MIN_G && gi <= RECORD_PGA_MAX_G) {
+            fix = pd_record_units_name(all[i]);
+            break;
+        }
+    }
+    if (msg && cap > 0)
+        snprintf(msg, cap, "%s: its peak ground acceleration is %.3g g read in %s, %s than %g "
+                 "g%s%s%s", rec->name, g, pd_record_units_name(units),
+                 g > RECORD_PGA_MAX_G ? "more" : "less",
+                 g > RECORD_PGA_MAX_G ? RECORD_PGA_MAX_G : RECORD_PGA_MIN_G,
+                 fix ? ": are its values in " : "", fix ? fix : "", fix ? "? (--units)" : "");
+    return 0;
+}
+
+int pd_record_from_array(pd_record *rec, const char *name, const double *acc, long npts,
+                         double dt, pd_record_units units, pd_err *err)
+{
+    if (!rec || !acc)
+        return PD_NULL_ARG(err, !rec ? "rec" : "acc");
+    *rec = (pd_record){.npts = 0};
+    if (npts < 2 || npts > RECORD_NPTS_MAX)
+        return pd_err_set(err, PD_EINVAL, "record: %ld samples (expected 2 to %ld)", npts,
+                          RECORD_NPTS_MAX);
+    if (!(dt >= PD_RECORD_DT_MIN && dt <= PD_RECORD_DT_MAX))
+        return pd_err_set(err, PD_EINVAL,
+                          "record_dt: %g s: expected a sampling interval in [%g, %g] s", dt,
+                          PD_RECORD_DT_MIN, PD_RECORD_DT_MAX);
+    if (units != PD_UNITS_G && units != PD_UNITS_M_S2 && units != PD_UNITS_CM_S2)
+        return pd_err_set(err, PD_EINVAL, "units: unknown units %d", (int)units);
+    double s = units_scale(units);
+    for (long k = 0; k < npts; k++)
+        if (!isfinite(s * acc[k]))
+            return pd_err_set(err, PD_EINVAL, "record: sample %ld is %g %s (not a finite "
+                              "acceleration)", k, acc[k], pd_record_units_name(units));
+    double *v = malloc((size_t)npts * sizeof(double));
+    if (!v)
+        return pd_err_set(err, PD_ENOMEM, "record: out of memory for %ld samples", npts);
+    for (long k = 0; k < npts; k++)
+        v[k] = s * acc[k]; /* as the readers: the unit times the value */
+    snprintf(rec->name, sizeof rec->name, "%s", name ? name : "array");
+    rec->npts = npts;
+    rec->dt = dt;
+    rec->acc = v;
+    pd_err_clear(err);
+    return PD_OK;
+}
+
 int pd_record_read(const char *path, pd_record_format format, pd_record_units units,
                    pd_record *rec, pd_err *err)
 {

@@ -40,11 +40,13 @@ OPTIONAL = {
     ("pd_scene_summarize", "opts"), ("pd_scene_trace_alloc", "o"),
     ("pd_osc_resolve_opts", "in"), ("pd_osc_run", "opts"), ("pd_osc_simulate", "opts"),
     ("pd_osc_reference", "opts"), ("pd_osc_penalty", "opts"), ("pd_osc_summarize", "opts"),
+    ("pd_record_plausible", "msg"),
 }
 
 # int functions whose value is a count, a flag or an index: NULL gives <= 0.
 COUNTS = {"pd_scene_as_oscillator", "pd_scene_result_fits", "pd_osc_batchable",
-          "pd_matrix_is_diagonal", "pd_lcp_nmax", "pd_lcp_solver_nmax", "pd_mjb_finite"}
+          "pd_matrix_is_diagonal", "pd_lcp_nmax", "pd_lcp_solver_nmax", "pd_mjb_finite",
+          "pd_record_plausible"}
 
 # Scalars given to the other arguments, by name (default: 1 / 1.0).
 ZERO_NAMES = {"i", "j", "k", "l", "lane", "task", "side", "seed", "index"}

@@ -1304,13 +1304,69 @@ static long api_case_159(void)
 static long api_case_160(void)
 {
     pd_err err = {0};
+    long v = pd_record_detect(NULL, (pd_record_format *)fx_object("pd_record_format", "pd_record_detect", 1), &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_161(void)
+{
+    pd_err err = {0};
+    long v = pd_record_detect((const char *)fx_string("pd_record_detect", "path"), NULL, &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_162(void)
+{
+    pd_err err = {0};
+    long v = pd_record_plausible(NULL, (pd_record_units)0, (char *)fx_string("pd_record_plausible", "msg"), 64);
+    (void)err;
+    return v;
+}
+
+static long api_case_163(void)
+{
+    pd_err err = {0};
+    long v = pd_record_plausible((const pd_record *)fx_object("pd_record", "pd_record_plausible", 0), (pd_record_units)0, NULL, 64);
+    (void)err;
+    return v;
+}
+
+static long api_case_164(void)
+{
+    pd_err err = {0};
+    long v = pd_record_from_array(NULL, (const char *)fx_string("pd_record_from_array", "name"), (const double *)fx_object("double", "pd_record_from_array", 2), 1, 1.0, (pd_record_units)0, &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_165(void)
+{
+    pd_err err = {0};
+    long v = pd_record_from_array((pd_record *)fx_object("pd_record", "pd_record_from_array", 0), NULL, (const double *)fx_object("double", "pd_record_from_array", 2), 1, 1.0, (pd_record_units)0, &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_166(void)
+{
+    pd_err err = {0};
+    long v = pd_record_from_array((pd_record *)fx_object("pd_record", "pd_record_from_array", 0), (const char *)fx_string("pd_record_from_array", "name"), NULL, 1, 1.0, (pd_record_units)0, &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_167(void)
+{
+    pd_err err = {0};
     double v = pd_record_duration(NULL);
     (void)v;
     (void)err;
     return 0;
 }
 
-static long api_case_161(void)
+static long api_case_168(void)
 {
     pd_err err = {0};
     double v = pd_record_acc(NULL, 1.0);
@@ -1319,7 +1375,7 @@ static long api_case_161(void)
     return 0;
 }
 
-static long api_case_162(void)
+static long api_case_169(void)
 {
     pd_err err = {0};
     long v = pd_record_measure(NULL, (pd_record_measures *)fx_object("pd_record_measures", "pd_record_measure", 1), &err);
@@ -1327,7 +1383,7 @@ static long api_case_162(void)
     return v;
 }
 
-static long api_case_163(void)
+static long api_case_170(void)
 {
     pd_err err = {0};
     long v = pd_record_measure((const pd_record *)fx_object("pd_record", "pd_record_measure", 0), NULL, &err);
@@ -1335,7 +1391,7 @@ static long api_case_163(void)
     return v;
 }
 
-static long api_case_164(void)
+static long api_case_171(void)
 {
     pd_err err = {0};
     long v = pd_record_integrate(NULL, (double *)fx_object("double", "pd_record_integrate", 1), (double *)fx_object("double", "pd_record_integrate", 2), &err);
@@ -1343,7 +1399,7 @@ static long api_case_164(void)
     return v;
 }
 
-static long api_case_165(void)
+static long api_case_172(void)
 {
     pd_err err = {0};
     long v = pd_record_integrate((const pd_record *)fx_object("pd_record", "pd_record_integrate", 0), NULL, (double *)fx_object("double", "pd_record_integrate", 2), &err);
@@ -1351,7 +1407,7 @@ static long api_case_165(void)
     return v;
 }
 
-static long api_case_166(void)
+static long api_case_173(void)
 {
     pd_err err = {0};
     long v = pd_record_integrate((const pd_record *)fx_object("pd_record", "pd_record_integrate", 0), (double *)fx_object("double", "pd_record_integrate", 1), NULL, &err);
@@ -1359,7 +1415,7 @@ static long api_case_166(void)
     return v;
 }
 
-static long api_case_167(void)
+static long api_case_174(void)
 {
     pd_err err = {0};
     long v = pd_record_fit_pulse(NULL, (pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_fit_pulse", 1), &err);
@@ -1367,7 +1423,7 @@ static long api_case_167(void)
     return v;
 }
 
-static long api_case_168(void)
+static long api_case_175(void)
 {
     pd_err err = {0};
     long v = pd_record_fit_pulse((const pd_record *)fx_object("pd_record", "pd_record_fit_pulse", 0), NULL, &err);
@@ -1375,7 +1431,7 @@ static long api_case_168(void)
     return v;
 }
 
-static long api_case_169(void)
+static long api_case_176(void)
 {
     pd_err err = {0};
     pd_record_pulse_eval(NULL, 1.0, (double *)fx_object("double", "pd_record_pulse_eval", 2), (double *)fx_object("double", "pd_record_pulse_eval", 3));
@@ -1383,7 +1439,7 @@ static long api_case_169(void)
     return 0;
 }
 
-static long api_case_170(void)
+static long api_case_177(void)
 {
     pd_err err = {0};
     pd_record_pulse_eval((const pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_pulse_eval", 0), 1.0, NULL, (double *)fx_object("double", "pd_record_pulse_eval", 3));
@@ -1391,7 +1447,7 @@ static long api_case_170(void)
     return 0;
 }
 
-static long api_case_171(void)
+static long api_case_178(void)
 {
     pd_err err = {0};
     pd_record_pulse_eval((const pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_pulse_eval", 0), 1.0, (double *)fx_object("double", "pd_record_pulse_eval", 2), NULL);
@@ -1399,7 +1455,7 @@ static long api_case_171(void)
     return 0;
 }
 
-static long api_case_172(void)
+static long api_case_179(void)
 {
     pd_err err = {0};
     double v = pd_record_one_cycle(NULL, 1.0);
@@ -1408,7 +1464,7 @@ static long api_case_172(void)
     return 0;
 }
 
-static long api_case_173(void)
+static long api_case_180(void)
 {
     pd_err err = {0};
     long v = pd_method_parse(NULL, (pd_method *)fx_object("pd_method", "pd_method_parse", 1));
@@ -1416,7 +1472,7 @@ static long api_case_173(void)
     return v;
 }
 
-static long api_case_174(void)
+static long api_case_181(void)
 {
     pd_err err = {0};
     long v = pd_method_parse((const char *)fx_string("pd_method_parse", "name"), NULL);
@@ -1424,7 +1480,7 @@ static long api_case_174(void)
     return v;
 }
 
-static long api_case_175(void)
+static long api_case_182(void)
 {
     pd_err err = {0};
     long v = pd_run_opts_check(NULL, &err);
@@ -1432,7 +1488,7 @@ static long api_case_175(void)
     return v;
 }
 
-static long api_case_176(void)
+static long api_case_183(void)
 {
     pd_err err = {0};
     double v = pd_osc_wp(NULL);
@@ -1441,7 +1497,7 @@ static long api_case_176(void)
     return 0;
 }
 
-static long api_case_177(void)
+static long api_case_184(void)
 {
     pd_err err = {0};
     double v = pd_osc_T0(NULL);
@@ -1450,7 +1506,7 @@ static long api_case_177(void)
     return 0;
 }
 
-static long api_case_178(void)
+static long api_case_185(void)
 {
     pd_err err = {0};
     double v = pd_osc_gap(NULL);
@@ -1459,7 +1515,7 @@ static long api_case_178(void)
     return 0;
 }
 
-static long api_case_179(void)
+static long api_case_186(void)
 {
     pd_err err = {0};
     double v = pd_osc_Le(NULL);
@@ -1468,7 +1524,7 @@ static long api_case_179(void)
     return 0;
 }
 
-static long api_case_180(void)
+static long api_case_187(void)
 {
     pd_err err = {0};
     pd_osc_set_T0(NULL, 1.0);
@@ -1476,7 +1532,7 @@ static long api_case_180(void)
     return 0;
 }
 
-static long api_case_181(void)
+static long api_case_188(void)
 {
     pd_err err = {0};
     pd_osc_set_gap(NULL, 1.0);
@@ -1484,7 +1540,7 @@ static long api_case_181(void)
     return 0;
 }
 
-static long api_case_182(void)
+static long api_case_189(void)
 {
     pd_err err = {0};
     double v = pd_osc_excitation(NULL, 1.0);
@@ -1493,7 +1549,7 @@ static long api_case_182(void)
     return 0;
 }
 
-static long api_case_183(void)
+static long api_case_190(void)
 {
     pd_err err = {0};
     pd_osc_set_record(NULL, (const pd_record *)fx_object("pd_record", "pd_osc_set_record", 1), (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_osc_set_record", 2), 1.0);
@@ -1501,7 +1557,7 @@ static long api_case_183(void)
     return 0;
 }
 
-static long api_case_184(void)
+static long api_case_191(void)
 {
     pd_err err = {0};
     pd_osc_set_record((pd_osc *)fx_object("pd_osc", "pd_osc_set_record", 0), NULL, (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_osc_set_record", 2), 1.0);
@@ -1509,7 +1565,7 @@ static long api_case_184(void)
     return 0;
 }
 
-static long api_case_185(void)
+static long api_case_192(void)
 {
     pd_err err = {0};
     pd_osc_set_record((pd_osc *)fx_object("pd_osc", "pd_osc_set_record", 0), (const pd_record *)fx_object("pd_record", "pd_osc_set_record", 1), NULL, 1.0);
@@ -1517,7 +1573,7 @@ static long api_case_185(void)
     return 0;
 }
 
-static long api_case_186(void)
+static long api_case_193(void)
 {
     pd_err err = {0};
     double v = pd_osc_shape(NULL, 1.0, 0);
@@ -1526,7 +1582,7 @@ static long api_case_186(void)
     return 0;
 }
 
-static long api_case_187(void)
+static long api_case_194(void)
 {
     pd_err err = {0};
     double v = pd_osc_shape_rate(NULL, 1.0, 0);
@@ -1535,7 +1591,7 @@ static long api_case_187(void)
     return 0;
 }
 
-static long api_case_188(void)
+static long api_case_195(void)
 {
     pd_err err = {0};
     double v = pd_osc_shape_end(NULL);
@@ -1544,7 +1600,7 @@ static long api_case_188(void)
     return 0;
 }
 
-static long api_case_189(void)
+static long api_case_196(void)
 {
     pd_err err = {0};
     long v = pd_osc_pieces(NULL, (pd_sine_piece **)fx_slot(), (int *)fx_object("int", "pd_osc_pieces", 2), &err);
@@ -1552,7 +1608,7 @@ static long api_case_189(void)
     return v;
 }
 
-static long api_case_190(void)
+static long api_case_197(void)
 {
     pd_err err = {0};
     long v = pd_osc_pieces((const pd_osc *)fx_object("pd_osc", "pd_osc_pieces", 0), NULL, (int *)fx_object("int", "pd_osc_pieces", 2), &err);
@@ -1560,7 +1616,7 @@ static long api_case_190(void)
     return v;
 }
 
-static long api_case_191(void)
+static long api_case_198(void)
 {
     pd_err err = {0};
     long v = pd_osc_pieces((const pd_osc *)fx_object("pd_osc", "pd_osc_pieces", 0), (pd_sine_piece **)fx_slot(), NULL, &err);
@@ -1568,7 +1624,7 @@ static long api_case_191(void)
     return v;
 }
 
-static long api_case_192(void)
+static long api_case_199(void)
 {
     pd_err err = {0};
     const char *s = pd_osc_excitation_name(NULL);
@@ -1576,7 +1632,7 @@ static long api_case_192(void)
     return s ? (long)strlen(s) + 1 : 0;
 }
 
-static long api_case_193(void)
+static long api_case_200(void)
 {
     pd_err err = {0};
     long v = pd_osc_check(NULL, &err);
@@ -1584,7 +1640,7 @@ static long api_case_193(void)
     return v;
 }
 
-static long api_case_194(void)
+static long api_case_201(void)
 {
     pd_err err = {0};
     long v = pd_osc_resolve_opts(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_resolve_opts", 1), (pd_run_opts *)fx_object("pd_run_opts", "pd_osc_resolve_opts", 2), &err);
@@ -1592,7 +1648,7 @@ static long api_case_194(void)
     return v;
 }
 
-static long api_case_195(void)
+static long api_case_202(void)
 {
     pd_err err = {0};
     long v = pd_osc_resolve_opts((const pd_osc *)fx_object("pd_osc", "pd_osc_resolve_opts", 0), NULL, (pd_run_opts *)fx_object("pd_run_opts", "pd_osc_resolve_opts", 2), &err);
@@ -1600,7 +1656,7 @@ static long api_case_195(void)
     return v;
 }
 
-static long api_case_196(void)
+static long api_case_203(void)
 {
     pd_err err = {0};
     long v = pd_osc_resolve_opts((const pd_osc *)fx_object("pd_osc", "pd_osc_resolve_opts", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_resolve_opts", 1), NULL, &err);
@@ -1608,7 +1664,7 @@ static long api_case_196(void)
     return v;
 }
 
-static long api_case_197(void)
+static long api_case_204(void)
 {
     pd_err err = {0};
     double v = pd_osc_default_dt(NULL);
@@ -1617,7 +1673,7 @@ static long api_case_197(void)
     return 0;
 }
 
-static long api_case_198(void)
+static long api_case_205(void)
 {
     pd_err err = {0};
     double v = pd_osc_default_tend(NULL);
@@ -1626,7 +1682,7 @@ static long api_case_198(void)
     return 0;
 }
 
-static long api_case_199(void)
+static long api_case_206(void)
 {
     pd_err err = {0};
     double v = pd_osc_measure_start(NULL, 1.0);
@@ -1635,7 +1691,7 @@ static long api_case_199(void)
     return 0;
 }
 
-static long api_case_200(void)
+static long api_case_207(void)
 {
     pd_err err = {0};
     pd_method v = pd_osc_method(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_method", 1));
@@ -1644,7 +1700,7 @@ static long api_case_200(void)
     return 0;
 }
 
-static long api_case_201(void)
+static long api_case_208(void)
 {
     pd_err err = {0};
     pd_method v = pd_osc_method((const pd_osc *)fx_object("pd_osc", "pd_osc_method", 0), NULL);
@@ -1653,7 +1709,7 @@ static long api_case_201(void)
     return 0;
 }
 
-static long api_case_202(void)
+static long api_case_209(void)
 {
     pd_err err = {0};
     long v = pd_osc_run(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_run", 1), NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_run", 4), &err);
@@ -1661,7 +1717,7 @@ static long api_case_202(void)
     return v;
 }
 
-static long api_case_203(void)
+static long api_case_210(void)
 {
     pd_err err = {0};
     long v = pd_osc_run((const pd_osc *)fx_object("pd_osc", "pd_osc_run", 0), NULL, NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_run", 4), &err);
@@ -1669,7 +1725,7 @@ static long api_case_203(void)
     return v;
 }
 
-static long api_case_204(void)
+static long api_case_211(void)
 {
     pd_err err = {0};
     long v = pd_osc_run((const pd_osc *)fx_object("pd_osc", "pd_osc_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_run", 1), NULL, NULL, NULL, &err);
@@ -1677,7 +1733,7 @@ static long api_case_204(void)
     return v;
 }
 
-static long api_case_205(void)
+static long api_case_212(void)
 {
     pd_err err = {0};
     long v = pd_osc_batchable(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_batchable", 1));
@@ -1685,7 +1741,7 @@ static long api_case_205(void)
     return v;
 }
 
-static long api_case_206(void)
+static long api_case_213(void)
 {
     pd_err err = {0};
     long v = pd_osc_batchable((const pd_osc *)fx_object("pd_osc", "pd_osc_batchable", 0), NULL);
@@ -1693,7 +1749,7 @@ static long api_case_206(void)
     return v;
 }
 
-static long api_case_207(void)
+static long api_case_214(void)
 {
     pd_err err = {0};
     double v = pd_osc_scan_points(NULL, 1.0);
@@ -1702,7 +1758,7 @@ static long api_case_207(void)
     return 0;
 }
 
-static long api_case_208(void)
+static long api_case_215(void)
 {
     pd_err err = {0};
     long v = pd_osc_simulate(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_simulate", 1), NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_simulate", 4), &err);
@@ -1710,7 +1766,7 @@ static long api_case_208(void)
     return v;
 }
 
-static long api_case_209(void)
+static long api_case_216(void)
 {
     pd_err err = {0};
     long v = pd_osc_simulate((const pd_osc *)fx_object("pd_osc", "pd_osc_simulate", 0), NULL, NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_simulate", 4), &err);
@@ -1718,7 +1774,7 @@ static long api_case_209(void)
     return v;
 }
 
-static long api_case_210(void)
+static long api_case_217(void)
 {
     pd_err err = {0};
     long v = pd_osc_simulate((const pd_osc *)fx_object("pd_osc", "pd_osc_simulate", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_simulate", 1), NULL, NULL, NULL, &err);
@@ -1726,7 +1782,7 @@ static long api_case_210(void)
     return v;
 }
 
-static long api_case_211(void)
+static long api_case_218(void)
 {
     pd_err err = {0};
     long v = pd_osc_reference(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_reference", 1), NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_reference", 4), &err);
@@ -1734,7 +1790,7 @@ static long api_case_211(void)
     return v;
 }
 
-static long api_case_212(void)
+static long api_case_219(void)
 {
     pd_err err = {0};
     long v = pd_osc_reference((const pd_osc *)fx_object("pd_osc", "pd_osc_reference", 0), NULL, NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_reference", 4), &err);
@@ -1742,7 +1798,7 @@ static long api_case_212(void)
     return v;
 }
 
-static long api_case_213(void)
+static long api_case_220(void)
 {
     pd_err err = {0};
     long v = pd_osc_reference((const pd_osc *)fx_object("pd_osc", "pd_osc_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_reference", 1), NULL, NULL, NULL, &err);
@@ -1750,7 +1806,7 @@ static long api_case_213(void)
     return v;
 }
 
-static long api_case_214(void)
+static long api_case_221(void)
 {
     pd_err err = {0};
     long v = pd_osc_penalty(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_penalty", 1), NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_penalty", 4), &err);
@@ -1758,7 +1814,7 @@ static long api_case_214(void)
     return v;
 }
 
-static long api_case_215(void)
+static long api_case_222(void)
 {
     pd_err err = {0};
     long v = pd_osc_penalty((const pd_osc *)fx_object("pd_osc", "pd_osc_penalty", 0), NULL, NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_penalty", 4), &err);
@@ -1766,7 +1822,7 @@ static long api_case_215(void)
     return v;
 }
 
-static long api_case_216(void)
+static long api_case_223(void)
 {
     pd_err err = {0};
     long v = pd_osc_penalty((const pd_osc *)fx_object("pd_osc", "pd_osc_penalty", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_penalty", 1), NULL, NULL, NULL, &err);
@@ -1774,7 +1830,7 @@ static long api_case_216(void)
     return v;
 }
 
-static long api_case_217(void)
+static long api_case_224(void)
 {
     pd_err err = {0};
     long v = pd_osc_summarize(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_summarize", 1), NULL, NULL, (pd_osc_summary *)fx_object("pd_osc_summary", "pd_osc_summarize", 4), &err);
@@ -1782,7 +1838,7 @@ static long api_case_217(void)
     return v;
 }
 
-static long api_case_218(void)
+static long api_case_225(void)
 {
     pd_err err = {0};
     long v = pd_osc_summarize((const pd_osc *)fx_object("pd_osc", "pd_osc_summarize", 0), NULL, NULL, NULL, (pd_osc_summary *)fx_object("pd_osc_summary", "pd_osc_summarize", 4), &err);
@@ -1790,7 +1846,7 @@ static long api_case_218(void)
     return v;
 }
 
-static long api_case_219(void)
+static long api_case_226(void)
 {
     pd_err err = {0};
     long v = pd_osc_summarize((const pd_osc *)fx_object("pd_osc", "pd_osc_summarize", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_summarize", 1), NULL, NULL, NULL, &err);
@@ -1798,7 +1854,7 @@ static long api_case_219(void)
     return v;
 }
 
-static long api_case_220(void)
+static long api_case_227(void)
 {
     pd_err err = {0};
     pd_osc_free_exact(NULL, 1.0, (double *)fx_object("double", "pd_osc_free_exact", 2), (double *)fx_object("double", "pd_osc_free_exact", 3));
@@ -1806,7 +1862,7 @@ static long api_case_220(void)
     return 0;
 }
 
-static long api_case_221(void)
+static long api_case_228(void)
 {
     pd_err err = {0};
     pd_osc_free_exact((const pd_osc *)fx_object("pd_osc", "pd_osc_free_exact", 0), 1.0, NULL, (double *)fx_object("double", "pd_osc_free_exact", 3));
@@ -1814,7 +1870,7 @@ static long api_case_221(void)
     return 0;
 }
 
-static long api_case_222(void)
+static long api_case_229(void)
 {
     pd_err err = {0};
     pd_osc_free_exact((const pd_osc *)fx_object("pd_osc", "pd_osc_free_exact", 0), 1.0, (double *)fx_object("double", "pd_osc_free_exact", 2), NULL);
@@ -1822,7 +1878,7 @@ static long api_case_222(void)
     return 0;
 }
 
-static long api_case_223(void)
+static long api_case_230(void)
 {
     pd_err err = {0};
     long v = pd_osc_free_first_contact(NULL, 1.0, (double *)fx_object("double", "pd_osc_free_first_contact", 2), (double *)fx_object("double", "pd_osc_free_first_contact", 3));
@@ -1830,7 +1886,7 @@ static long api_case_223(void)
     return v;
 }
 
-static long api_case_224(void)
+static long api_case_231(void)
 {
     pd_err err = {0};
     long v = pd_osc_free_first_contact((const pd_osc *)fx_object("pd_osc", "pd_osc_free_first_contact", 0), 1.0, NULL, (double *)fx_object("double", "pd_osc_free_first_contact", 3));
@@ -1838,7 +1894,7 @@ static long api_case_224(void)
     return v;
 }
 
-static long api_case_225(void)
+static long api_case_232(void)
 {
     pd_err err = {0};
     long v = pd_osc_free_first_contact((const pd_osc *)fx_object("pd_osc", "pd_osc_free_first_contact", 0), 1.0, (double *)fx_object("double", "pd_osc_free_first_contact", 2), NULL);
@@ -1846,7 +1902,7 @@ static long api_case_225(void)
     return v;
 }
 
-static long api_case_226(void)
+static long api_case_233(void)
 {
     pd_err err = {0};
     long v = pd_trace_alloc(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_trace_alloc", 1));
@@ -1854,7 +1910,7 @@ static long api_case_226(void)
     return v;
 }
 
-static long api_case_227(void)
+static long api_case_234(void)
 {
     pd_err err = {0};
     long v = pd_trace_alloc((pd_trace *)fx_object("pd_trace", "pd_trace_alloc", 0), NULL);
@@ -1862,7 +1918,7 @@ static long api_case_227(void)
     return v;
 }
 
-static long api_case_228(void)
+static long api_case_235(void)
 {
     pd_err err = {0};
     pd_trace_free(NULL);
@@ -1870,7 +1926,7 @@ static long api_case_228(void)
     return 0;
 }
 
-static long api_case_229(void)
+static long api_case_236(void)
 {
     pd_err err = {0};
     long v = pd_measure_reference(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_reference", 1), (pd_trace *)fx_object("pd_trace", "pd_measure_reference", 2), (pd_osc_result *)fx_object("pd_osc_result", "pd_measure_reference", 3), &err);
@@ -1878,7 +1934,7 @@ static long api_case_229(void)
     return v;
 }
 
-static long api_case_230(void)
+static long api_case_237(void)
 {
     pd_err err = {0};
     long v = pd_measure_reference((const pd_osc *)fx_object("pd_osc", "pd_measure_reference", 0), NULL, (pd_trace *)fx_object("pd_trace", "pd_measure_reference", 2), (pd_osc_result *)fx_object("pd_osc_result", "pd_measure_reference", 3), &err);
@@ -1886,7 +1942,7 @@ static long api_case_230(void)
     return v;
 }
 
-static long api_case_231(void)
+static long api_case_238(void)
 {
     pd_err err = {0};
     long v = pd_measure_reference((const pd_osc *)fx_object("pd_osc", "pd_measure_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_reference", 1), NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_measure_reference", 3), &err);
@@ -1894,7 +1950,7 @@ static long api_case_231(void)
     return v;
 }
 
-static long api_case_232(void)
+static long api_case_239(void)
 {
     pd_err err = {0};
     long v = pd_measure_reference((const pd_osc *)fx_object("pd_osc", "pd_measure_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_reference", 1), (pd_trace *)fx_object("pd_trace", "pd_measure_reference", 2), NULL, &err);
@@ -1902,7 +1958,7 @@ static long api_case_232(void)
     return v;
 }
 
-static long api_case_233(void)
+static long api_case_240(void)
 {
     pd_err err = {0};
     long v = pd_measure_run(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_run", 1), (const pd_trace *)fx_object("pd_trace", "pd_measure_run", 2), 1.0, (pd_trace *)fx_object("pd_trace", "pd_measure_run", 4), (pd_measured *)fx_object("pd_measured", "pd_measure_run", 5), &err);
@@ -1910,7 +1966,7 @@ static long api_case_233(void)
     return v;
 }
 
-static long api_case_234(void)
+static long api_case_241(void)
 {
     pd_err err = {0};
     long v = pd_measure_run((const pd_osc *)fx_object("pd_osc", "pd_measure_run", 0), NULL, (const pd_trace *)fx_object("pd_trace", "pd_measure_run", 2), 1.0, (pd_trace *)fx_object("pd_trace", "pd_measure_run", 4), (pd_measured *)fx_object("pd_measured", "pd_measure_run", 5), &err);
@@ -1918,7 +1974,7 @@ static long api_case_234(void)
     return v;
 }
 
-static long api_case_235(void)
+static long api_case_242(void)
 {
     pd_err err = {0};
     long v = pd_measure_run((const pd_osc *)fx_object("pd_osc", "pd_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_run", 1), NULL, 1.0, (pd_trace *)fx_object("pd_trace", "pd_measure_run", 4), (pd_measured *)fx_object("pd_measured", "pd_measure_run", 5), &err);
@@ -1926,7 +1982,7 @@ static long api_case_235(void)
     return v;
 }
 
-static long api_case_236(void)
+static long api_case_243(void)
 {
     pd_err err = {0};
     long v = pd_measure_run((const pd_osc *)fx_object("pd_osc", "pd_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_run", 1), (const pd_trace *)fx_object("pd_trace", "pd_measure_run", 2), 1.0, NULL, (pd_measured *)fx_object("pd_measured", "pd_measure_run", 5), &err);
@@ -1934,7 +1990,7 @@ static long api_case_236(void)
     return v;
 }
 
-static long api_case_237(void)
+static long api_case_244(void)
 {
     pd_err err = {0};
     long v = pd_measure_run((const pd_osc *)fx_object("pd_osc", "pd_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_run", 1), (const pd_trace *)fx_object("pd_trace", "pd_measure_run", 2), 1.0, (pd_trace *)fx_object("pd_trace", "pd_measure_run", 4), NULL, &err);
@@ -1942,7 +1998,7 @@ static long api_case_237(void)
     return v;
 }
 
-static long api_case_238(void)
+static long api_case_245(void)
 {
     pd_err err = {0};
     pd_scene * p = pd_scene_new(NULL);
@@ -1950,7 +2006,7 @@ static long api_case_238(void)
     return p != NULL;
 }
 
-static long api_case_239(void)
+static long api_case_246(void)
 {
     pd_err err = {0};
     pd_scene_free(NULL);
@@ -1958,7 +2014,7 @@ static long api_case_239(void)
     return 0;
 }
 
-static long api_case_240(void)
+static long api_case_247(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_sdof(NULL, (const char *)fx_string("pd_scene_add_sdof", "name"), 1.0, 1.0, 1.0, &err);
@@ -1966,7 +2022,7 @@ static long api_case_240(void)
     return v;
 }
 
-static long api_case_241(void)
+static long api_case_248(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_sdof((pd_scene *)fx_object("pd_scene", "pd_scene_add_sdof", 0), NULL, 1.0, 1.0, 1.0, &err);
@@ -1974,7 +2030,7 @@ static long api_case_241(void)
     return v;
 }
 
-static long api_case_242(void)
+static long api_case_249(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_building(NULL, (const char *)fx_string("pd_scene_add_building", "name"), 1, (const double *)fx_object("double", "pd_scene_add_building", 3), (const double *)fx_object("double", "pd_scene_add_building", 4), 1.0, &err);
@@ -1982,7 +2038,7 @@ static long api_case_242(void)
     return v;
 }
 
-static long api_case_243(void)
+static long api_case_250(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_building((pd_scene *)fx_object("pd_scene", "pd_scene_add_building", 0), NULL, 1, (const double *)fx_object("double", "pd_scene_add_building", 3), (const double *)fx_object("double", "pd_scene_add_building", 4), 1.0, &err);
@@ -1990,7 +2046,7 @@ static long api_case_243(void)
     return v;
 }
 
-static long api_case_244(void)
+static long api_case_251(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_building((pd_scene *)fx_object("pd_scene", "pd_scene_add_building", 0), (const char *)fx_string("pd_scene_add_building", "name"), 1, NULL, (const double *)fx_object("double", "pd_scene_add_building", 4), 1.0, &err);
@@ -1998,7 +2054,7 @@ static long api_case_244(void)
     return v;
 }
 
-static long api_case_245(void)
+static long api_case_252(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_building((pd_scene *)fx_object("pd_scene", "pd_scene_add_building", 0), (const char *)fx_string("pd_scene_add_building", "name"), 1, (const double *)fx_object("double", "pd_scene_add_building", 3), NULL, 1.0, &err);
@@ -2006,7 +2062,7 @@ static long api_case_245(void)
     return v;
 }
 
-static long api_case_246(void)
+static long api_case_253(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_uniform(NULL, (const char *)fx_string("pd_scene_add_uniform", "name"), 1, 1.0, 1.0, 1.0, &err);
@@ -2014,7 +2070,7 @@ static long api_case_246(void)
     return v;
 }
 
-static long api_case_247(void)
+static long api_case_254(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_uniform((pd_scene *)fx_object("pd_scene", "pd_scene_add_uniform", 0), NULL, 1, 1.0, 1.0, 1.0, &err);
@@ -2022,7 +2078,7 @@ static long api_case_247(void)
     return v;
 }
 
-static long api_case_248(void)
+static long api_case_255(void)
 {
     pd_err err = {0};
     long v = pd_scene_set_damping(NULL, (pd_damping)0, 1, 1, &err);
@@ -2030,7 +2086,7 @@ static long api_case_248(void)
     return v;
 }
 
-static long api_case_249(void)
+static long api_case_256(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_contact(NULL, 1, 1, 1, 1, 1.0, 1.0, 1, &err);
@@ -2038,7 +2094,7 @@ static long api_case_249(void)
     return v;
 }
 
-static long api_case_250(void)
+static long api_case_257(void)
 {
     pd_err err = {0};
     pd_scene * p = pd_scene_copy(NULL);
@@ -2046,7 +2102,7 @@ static long api_case_250(void)
     return p != NULL;
 }
 
-static long api_case_251(void)
+static long api_case_258(void)
 {
     pd_err err = {0};
     long v = pd_scene_find(NULL, (const char *)fx_string("pd_scene_find", "name"));
@@ -2054,7 +2110,7 @@ static long api_case_251(void)
     return v;
 }
 
-static long api_case_252(void)
+static long api_case_259(void)
 {
     pd_err err = {0};
     long v = pd_scene_find((const pd_scene *)fx_object("pd_scene", "pd_scene_find", 0), NULL);
@@ -2062,7 +2118,7 @@ static long api_case_252(void)
     return v;
 }
 
-static long api_case_253(void)
+static long api_case_260(void)
 {
     pd_err err = {0};
     long v = pd_scene_finish(NULL, &err);
@@ -2070,7 +2126,7 @@ static long api_case_253(void)
     return v;
 }
 
-static long api_case_254(void)
+static long api_case_261(void)
 {
     pd_err err = {0};
     long v = pd_scene_load(NULL, (pd_scene **)fx_slot(), &err);
@@ -2078,7 +2134,7 @@ static long api_case_254(void)
     return v;
 }
 
-static long api_case_255(void)
+static long api_case_262(void)
 {
     pd_err err = {0};
     long v = pd_scene_load((const char *)fx_string("pd_scene_load", "path"), NULL, &err);
@@ -2086,7 +2142,7 @@ static long api_case_255(void)
     return v;
 }
 
-static long api_case_256(void)
+static long api_case_263(void)
 {
     pd_err err = {0};
     long v = pd_scene_chain(1, NULL, 1.0, 1.0, 1.0, 1.0, 1.0, (pd_scene **)fx_slot(), &err);
@@ -2094,7 +2150,7 @@ static long api_case_256(void)
     return v;
 }
 
-static long api_case_257(void)
+static long api_case_264(void)
 {
     pd_err err = {0};
     long v = pd_scene_chain(1, (const pd_scene_excitation *)fx_object("pd_scene_excitation", "pd_scene_chain", 1), 1.0, 1.0, 1.0, 1.0, 1.0, NULL, &err);
@@ -2102,7 +2158,7 @@ static long api_case_257(void)
     return v;
 }
 
-static long api_case_258(void)
+static long api_case_265(void)
 {
     pd_err err = {0};
     double v = pd_scene_wp(NULL);
@@ -2111,7 +2167,7 @@ static long api_case_258(void)
     return 0;
 }
 
-static long api_case_259(void)
+static long api_case_266(void)
 {
     pd_err err = {0};
     double v = pd_scene_Le(NULL);
@@ -2120,7 +2176,7 @@ static long api_case_259(void)
     return 0;
 }
 
-static long api_case_260(void)
+static long api_case_267(void)
 {
     pd_err err = {0};
     double v = pd_scene_default_dt(NULL);
@@ -2129,7 +2185,7 @@ static long api_case_260(void)
     return 0;
 }
 
-static long api_case_261(void)
+static long api_case_268(void)
 {
     pd_err err = {0};
     double v = pd_scene_default_tend(NULL);
@@ -2138,7 +2194,7 @@ static long api_case_261(void)
     return 0;
 }
 
-static long api_case_262(void)
+static long api_case_269(void)
 {
     pd_err err = {0};
     double v = pd_scene_measure_start(NULL, 1.0);
@@ -2147,7 +2203,7 @@ static long api_case_262(void)
     return 0;
 }
 
-static long api_case_263(void)
+static long api_case_270(void)
 {
     pd_err err = {0};
     long v = pd_scene_resolve_opts(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_resolve_opts", 1), (pd_run_opts *)fx_object("pd_run_opts", "pd_scene_resolve_opts", 2), &err);
@@ -2155,7 +2211,7 @@ static long api_case_263(void)
     return v;
 }
 
-static long api_case_264(void)
+static long api_case_271(void)
 {
     pd_err err = {0};
     long v = pd_scene_resolve_opts((const pd_scene *)fx_object("pd_scene", "pd_scene_resolve_opts", 0), NULL, (pd_run_opts *)fx_object("pd_run_opts", "pd_scene_resolve_opts", 2), &err);
@@ -2163,7 +2219,7 @@ static long api_case_264(void)
     return v;
 }
 
-static long api_case_265(void)
+static long api_case_272(void)
 {
     pd_err err = {0};
     long v = pd_scene_resolve_opts((const pd_scene *)fx_object("pd_scene", "pd_scene_resolve_opts", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_resolve_opts", 1), NULL, &err);
@@ -2171,7 +2227,7 @@ static long api_case_265(void)
     return v;
 }
 
-static long api_case_266(void)
+static long api_case_273(void)
 {
     pd_err err = {0};
     long v = pd_scene_as_oscillator(NULL, (pd_osc *)fx_object("pd_osc", "pd_scene_as_oscillator", 1), (int *)fx_object("int", "pd_scene_as_oscillator", 2));
@@ -2179,7 +2235,7 @@ static long api_case_266(void)
     return v;
 }
 
-static long api_case_267(void)
+static long api_case_274(void)
 {
     pd_err err = {0};
     long v = pd_scene_as_oscillator((const pd_scene *)fx_object("pd_scene", "pd_scene_as_oscillator", 0), NULL, (int *)fx_object("int", "pd_scene_as_oscillator", 2));
@@ -2187,7 +2243,7 @@ static long api_case_267(void)
     return v;
 }
 
-static long api_case_268(void)
+static long api_case_275(void)
 {
     pd_err err = {0};
     long v = pd_scene_as_oscillator((const pd_scene *)fx_object("pd_scene", "pd_scene_as_oscillator", 0), (pd_osc *)fx_object("pd_osc", "pd_scene_as_oscillator", 1), NULL);
@@ -2195,7 +2251,7 @@ static long api_case_268(void)
     return v;
 }
 
-static long api_case_269(void)
+static long api_case_276(void)
 {
     pd_err err = {0};
     long v = pd_scene_model_build(NULL, 1, (pd_scene_model *)fx_object("pd_scene_model", "pd_scene_model_build", 2), &err);
@@ -2203,7 +2259,7 @@ static long api_case_269(void)
     return v;
 }
 
-static long api_case_270(void)
+static long api_case_277(void)
 {
     pd_err err = {0};
     long v = pd_scene_model_build((const pd_scene *)fx_object("pd_scene", "pd_scene_model_build", 0), 1, NULL, &err);
@@ -2211,7 +2267,7 @@ static long api_case_270(void)
     return v;
 }
 
-static long api_case_271(void)
+static long api_case_278(void)
 {
     pd_err err = {0};
     pd_scene_model_free(NULL);
@@ -2219,7 +2275,7 @@ static long api_case_271(void)
     return 0;
 }
 
-static long api_case_272(void)
+static long api_case_279(void)
 {
     pd_err err = {0};
     long v = pd_scene_result_alloc(NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_result_alloc", 1), &err);
@@ -2227,7 +2283,7 @@ static long api_case_272(void)
     return v;
 }
 
-static long api_case_273(void)
+static long api_case_280(void)
 {
     pd_err err = {0};
     long v = pd_scene_result_alloc((const pd_scene *)fx_object("pd_scene", "pd_scene_result_alloc", 0), NULL, &err);
@@ -2235,7 +2291,7 @@ static long api_case_273(void)
     return v;
 }
 
-static long api_case_274(void)
+static long api_case_281(void)
 {
     pd_err err = {0};
     long v = pd_scene_result_fits(NULL, (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_result_fits", 1));
@@ -2243,7 +2299,7 @@ static long api_case_274(void)
     return v;
 }
 
-static long api_case_275(void)
+static long api_case_282(void)
 {
     pd_err err = {0};
     long v = pd_scene_result_fits((const pd_scene *)fx_object("pd_scene", "pd_scene_result_fits", 0), NULL);
@@ -2251,7 +2307,7 @@ static long api_case_275(void)
     return v;
 }
 
-static long api_case_276(void)
+static long api_case_283(void)
 {
     pd_err err = {0};
     pd_scene_result_free(NULL);
@@ -2259,7 +2315,7 @@ static long api_case_276(void)
     return 0;
 }
 
-static long api_case_277(void)
+static long api_case_284(void)
 {
     pd_err err = {0};
     long v = pd_scene_run(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_run", 1), NULL, NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_run", 4), &err);
@@ -2267,7 +2323,7 @@ static long api_case_277(void)
     return v;
 }
 
-static long api_case_278(void)
+static long api_case_285(void)
 {
     pd_err err = {0};
     long v = pd_scene_run((const pd_scene *)fx_object("pd_scene", "pd_scene_run", 0), NULL, NULL, NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_run", 4), &err);
@@ -2275,7 +2331,7 @@ static long api_case_278(void)
     return v;
 }
 
-static long api_case_279(void)
+static long api_case_286(void)
 {
     pd_err err = {0};
     long v = pd_scene_run((const pd_scene *)fx_object("pd_scene", "pd_scene_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_run", 1), NULL, NULL, NULL, &err);
@@ -2283,7 +2339,7 @@ static long api_case_279(void)
     return v;
 }
 
-static long api_case_280(void)
+static long api_case_287(void)
 {
     pd_err err = {0};
     long v = pd_scene_summarize(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_summarize", 1), NULL, NULL, (pd_scene_summary *)fx_object("pd_scene_summary", "pd_scene_summarize", 4), &err);
@@ -2291,7 +2347,7 @@ static long api_case_280(void)
     return v;
 }
 
-static long api_case_281(void)
+static long api_case_288(void)
 {
     pd_err err = {0};
     long v = pd_scene_summarize((const pd_scene *)fx_object("pd_scene", "pd_scene_summarize", 0), NULL, NULL, NULL, (pd_scene_summary *)fx_object("pd_scene_summary", "pd_scene_summarize", 4), &err);
@@ -2299,7 +2355,7 @@ static long api_case_281(void)
     return v;
 }
 
-static long api_case_282(void)
+static long api_case_289(void)
 {
     pd_err err = {0};
     long v = pd_scene_summarize((const pd_scene *)fx_object("pd_scene", "pd_scene_summarize", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_summarize", 1), NULL, NULL, NULL, &err);
@@ -2307,7 +2363,7 @@ static long api_case_282(void)
     return v;
 }
 
-static long api_case_283(void)
+static long api_case_290(void)
 {
     pd_err err = {0};
     pd_scene_summary_free(NULL);
@@ -2315,7 +2371,7 @@ static long api_case_283(void)
     return 0;
 }
 
-static long api_case_284(void)
+static long api_case_291(void)
 {
     pd_err err = {0};
     long v = pd_scene_trace_alloc(NULL, (const pd_scene *)fx_object("pd_scene", "pd_scene_trace_alloc", 1), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_trace_alloc", 2), &err);
@@ -2323,7 +2379,7 @@ static long api_case_284(void)
     return v;
 }
 
-static long api_case_285(void)
+static long api_case_292(void)
 {
     pd_err err = {0};
     long v = pd_scene_trace_alloc((pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_trace_alloc", 0), NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_trace_alloc", 2), &err);
@@ -2331,7 +2387,7 @@ static long api_case_285(void)
     return v;
 }
 
-static long api_case_286(void)
+static long api_case_293(void)
 {
     pd_err err = {0};
     long v = pd_scene_trace_alloc((pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_trace_alloc", 0), (const pd_scene *)fx_object("pd_scene", "pd_scene_trace_alloc", 1), NULL, &err);
@@ -2339,7 +2395,7 @@ static long api_case_286(void)
     return v;
 }
 
-static long api_case_287(void)
+static long api_case_294(void)
 {
     pd_err err = {0};
     pd_scene_trace_free(NULL);
@@ -2347,7 +2403,7 @@ static long api_case_287(void)
     return 0;
 }
 
-static long api_case_288(void)
+static long api_case_295(void)
 {
     pd_err err = {0};
     long v = pd_scene_errors_alloc(NULL, (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_errors_alloc", 1), &err);
@@ -2355,7 +2411,7 @@ static long api_case_288(void)
     return v;
 }
 
-static long api_case_289(void)
+static long api_case_296(void)
 {
     pd_err err = {0};
     long v = pd_scene_errors_alloc((const pd_scene *)fx_object("pd_scene", "pd_scene_errors_alloc", 0), NULL, &err);
@@ -2363,7 +2419,7 @@ static long api_case_289(void)
     return v;
 }
 
-static long api_case_290(void)
+static long api_case_297(void)
 {
     pd_err err = {0};
     pd_scene_errors_free(NULL);
@@ -2371,7 +2427,7 @@ static long api_case_290(void)
     return 0;
 }
 
-static long api_case_291(void)
+static long api_case_298(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_reference(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_reference", 1), (pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_reference", 2), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_reference", 3), &err);
@@ -2379,7 +2435,7 @@ static long api_case_291(void)
     return v;
 }
 
-static long api_case_292(void)
+static long api_case_299(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_reference((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_reference", 0), NULL, (pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_reference", 2), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_reference", 3), &err);
@@ -2387,7 +2443,7 @@ static long api_case_292(void)
     return v;
 }
 
-static long api_case_293(void)
+static long api_case_300(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_reference((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_reference", 1), NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_reference", 3), &err);
@@ -2395,7 +2451,7 @@ static long api_case_293(void)
     return v;
 }
 
-static long api_case_294(void)
+static long api_case_301(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_reference((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_reference", 1), (pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_reference", 2), NULL, &err);
@@ -2403,7 +2459,7 @@ static long api_case_294(void)
     return v;
 }
 
-static long api_case_295(void)
+static long api_case_302(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2411,7 +2467,7 @@ static long api_case_295(void)
     return v;
 }
 
-static long api_case_296(void)
+static long api_case_303(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), NULL, (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2419,7 +2475,7 @@ static long api_case_296(void)
     return v;
 }
 
-static long api_case_297(void)
+static long api_case_304(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), NULL, (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2427,7 +2483,7 @@ static long api_case_297(void)
     return v;
 }
 
-static long api_case_298(void)
+static long api_case_305(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2435,7 +2491,7 @@ static long api_case_298(void)
     return v;
 }
 
-static long api_case_299(void)
+static long api_case_306(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), NULL, (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2443,7 +2499,7 @@ static long api_case_299(void)
     return v;
 }
 
-static long api_case_300(void)
+static long api_case_307(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), NULL, &err);
@@ -2451,7 +2507,7 @@ static long api_case_300(void)
     return v;
 }
 
-static long api_case_301(void)
+static long api_case_308(void)
 {
     pd_err err = {0};
     pd_spec_init(NULL);
@@ -2459,7 +2515,7 @@ static long api_case_301(void)
     return 0;
 }
 
-static long api_case_302(void)
+static long api_case_309(void)
 {
     pd_err err = {0};
     long v = pd_spec_curves(NULL);
@@ -2467,7 +2523,7 @@ static long api_case_302(void)
     return v;
 }
 
-static long api_case_303(void)
+static long api_case_310(void)
 {
     pd_err err = {0};
     long v = pd_spec_points(NULL);
@@ -2475,7 +2531,7 @@ static long api_case_303(void)
     return v;
 }
 
-static long api_case_304(void)
+static long api_case_311(void)
 {
     pd_err err = {0};
     long v = pd_spec_twins(NULL);
@@ -2483,7 +2539,7 @@ static long api_case_304(void)
     return v;
 }
 
-static long api_case_305(void)
+static long api_case_312(void)
 {
     pd_err err = {0};
     long v = pd_spec_tasks(NULL);
@@ -2491,7 +2547,7 @@ static long api_case_305(void)
     return v;
 }
 
-static long api_case_306(void)
+static long api_case_313(void)
 {
     pd_err err = {0};
     double v = pd_spec_pi2(NULL, 0);
@@ -2500,7 +2556,7 @@ static long api_case_306(void)
     return 0;
 }
 
-static long api_case_307(void)
+static long api_case_314(void)
 {
     pd_err err = {0};
     pd_spec_coords_of(NULL, 0, (pd_spec_coords *)fx_object("pd_spec_coords", "pd_spec_coords_of", 2));
@@ -2508,7 +2564,7 @@ static long api_case_307(void)
     return 0;
 }
 
-static long api_case_308(void)
+static long api_case_315(void)
 {
     pd_err err = {0};
     pd_spec_coords_of((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_coords_of", 0), 0, NULL);
@@ -2516,7 +2572,7 @@ static long api_case_308(void)
     return 0;
 }
 
-static long api_case_309(void)
+static long api_case_316(void)
 {
     pd_err err = {0};
     long v = pd_spec_twin_of(NULL, 0);
@@ -2524,7 +2580,7 @@ static long api_case_309(void)
     return v;
 }
 
-static long api_case_310(void)
+static long api_case_317(void)
 {
     pd_err err = {0};
     long v = pd_spec_case(NULL, 0, (pd_osc *)fx_object("pd_osc", "pd_spec_case", 2), (pd_run_opts *)fx_object("pd_run_opts", "pd_spec_case", 3), &err);
@@ -2532,7 +2588,7 @@ static long api_case_310(void)
     return v;
 }
 
-static long api_case_311(void)
+static long api_case_318(void)
 {
     pd_err err = {0};
     long v = pd_spec_case((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_case", 0), 0, NULL, (pd_run_opts *)fx_object("pd_run_opts", "pd_spec_case", 3), &err);
@@ -2540,7 +2596,7 @@ static long api_case_311(void)
     return v;
 }
 
-static long api_case_312(void)
+static long api_case_319(void)
 {
     pd_err err = {0};
     long v = pd_spec_case((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_case", 0), 0, (pd_osc *)fx_object("pd_osc", "pd_spec_case", 2), NULL, &err);
@@ -2548,7 +2604,7 @@ static long api_case_312(void)
     return v;
 }
 
-static long api_case_313(void)
+static long api_case_320(void)
 {
     pd_err err = {0};
     long v = pd_spec_validate(NULL, &err);
@@ -2556,7 +2612,7 @@ static long api_case_313(void)
     return v;
 }
 
-static long api_case_314(void)
+static long api_case_321(void)
 {
     pd_err err = {0};
     pd_spec_resolve_method(NULL);
@@ -2564,7 +2620,7 @@ static long api_case_314(void)
     return 0;
 }
 
-static long api_case_315(void)
+static long api_case_322(void)
 {
     pd_err err = {0};
     pd_spec_run_task(NULL, 0, (pd_spec_result *)fx_object("pd_spec_result", "pd_spec_run_task", 2), &err);
@@ -2572,7 +2628,7 @@ static long api_case_315(void)
     return 0;
 }
 
-static long api_case_316(void)
+static long api_case_323(void)
 {
     pd_err err = {0};
     pd_spec_run_task((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_run_task", 0), 0, NULL, &err);
@@ -2580,7 +2636,7 @@ static long api_case_316(void)
     return 0;
 }
 
-static long api_case_317(void)
+static long api_case_324(void)
 {
     pd_err err = {0};
     long v = pd_spec_stream(NULL, NULL, NULL, NULL, &err);
@@ -2588,7 +2644,7 @@ static long api_case_317(void)
     return v;
 }
 
-static long api_case_318(void)
+static long api_case_325(void)
 {
     pd_err err = {0};
     double v = pd_spec_cost(NULL, 0);
@@ -2597,7 +2653,7 @@ static long api_case_318(void)
     return 0;
 }
 
-static long api_case_319(void)
+static long api_case_326(void)
 {
     pd_err err = {0};
     char * p = pd_spec_key(NULL);
@@ -2605,7 +2661,7 @@ static long api_case_319(void)
     return p != NULL;
 }
 
-static long api_case_320(void)
+static long api_case_327(void)
 {
     pd_err err = {0};
     pd_spec_rows(NULL, (const pd_spec_result *)fx_object("pd_spec_result", "pd_spec_rows", 1), (pd_spec_row *)fx_object("pd_spec_row", "pd_spec_rows", 2));
@@ -2613,7 +2669,7 @@ static long api_case_320(void)
     return 0;
 }
 
-static long api_case_321(void)
+static long api_case_328(void)
 {
     pd_err err = {0};
     pd_spec_rows((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_rows", 0), NULL, (pd_spec_row *)fx_object("pd_spec_row", "pd_spec_rows", 2));
@@ -2621,7 +2677,7 @@ static long api_case_321(void)
     return 0;
 }
 
-static long api_case_322(void)
+static long api_case_329(void)
 {
     pd_err err = {0};
     pd_spec_rows((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_rows", 0), (const pd_spec_result *)fx_object("pd_spec_result", "pd_spec_rows", 1), NULL);
@@ -2629,7 +2685,7 @@ static long api_case_322(void)
     return 0;
 }
 
-static long api_case_323(void)
+static long api_case_330(void)
 {
     pd_err err = {0};
     pd_spec_curve_label(NULL, 1, (char *)fx_string("pd_spec_curve_label", "buf"), 64);
@@ -2637,7 +2693,7 @@ static long api_case_323(void)
     return 0;
 }
 
-static long api_case_324(void)
+static long api_case_331(void)
 {
     pd_err err = {0};
     pd_spec_curve_label((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_curve_label", 0), 1, NULL, 64);
@@ -2645,7 +2701,7 @@ static long api_case_324(void)
     return 0;
 }
 
-static long api_case_325(void)
+static long api_case_332(void)
 {
     pd_err err = {0};
     long v = pd_spec_sweep(NULL, NULL, NULL, &err);
@@ -2653,7 +2709,7 @@ static long api_case_325(void)
     return v;
 }
 
-static long api_case_326(void)
+static long api_case_333(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_twins(NULL);
@@ -2661,7 +2717,7 @@ static long api_case_326(void)
     return v;
 }
 
-static long api_case_327(void)
+static long api_case_334(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_points(NULL);
@@ -2669,7 +2725,7 @@ static long api_case_327(void)
     return v;
 }
 
-static long api_case_328(void)
+static long api_case_335(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_check(NULL, &err);
@@ -2677,7 +2733,7 @@ static long api_case_328(void)
     return v;
 }
 
-static long api_case_329(void)
+static long api_case_336(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_scene(NULL, 0, (pd_scene **)fx_slot(), (pd_scene_point *)fx_object("pd_scene_point", "pd_scene_sweep_scene", 3), &err);
@@ -2685,7 +2741,7 @@ static long api_case_329(void)
     return v;
 }
 
-static long api_case_330(void)
+static long api_case_337(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_scene((const pd_scene_sweep *)fx_object("pd_scene_sweep", "pd_scene_sweep_scene", 0), 0, NULL, (pd_scene_point *)fx_object("pd_scene_point", "pd_scene_sweep_scene", 3), &err);
@@ -2693,7 +2749,7 @@ static long api_case_330(void)
     return v;
 }
 
-static long api_case_331(void)
+static long api_case_338(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_scene((const pd_scene_sweep *)fx_object("pd_scene_sweep", "pd_scene_sweep_scene", 0), 0, (pd_scene **)fx_slot(), NULL, &err);
@@ -2701,7 +2757,7 @@ static long api_case_331(void)
     return v;
 }
 
-static long api_case_332(void)
+static long api_case_339(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_run(NULL, 1, (pd_scene_point *)fx_object("pd_scene_point", "pd_scene_sweep_run", 2), (double *)fx_object("double", "pd_scene_sweep_run", 3), &err);
@@ -2709,7 +2765,7 @@ static long api_case_332(void)
     return v;
 }
 
-static long api_case_333(void)
+static long api_case_340(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_run((const pd_scene_sweep *)fx_object("pd_scene_sweep", "pd_scene_sweep_run", 0), 1, NULL, (double *)fx_object("double", "pd_scene_sweep_run", 3), &err);
@@ -2717,7 +2773,7 @@ static long api_case_333(void)
     return v;
 }
 
-static long api_case_334(void)
+static long api_case_341(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_run((const pd_scene_sweep *)fx_object("pd_scene_sweep", "pd_scene_sweep_run", 0), 1, (pd_scene_point *)fx_object("pd_scene_point", "pd_scene_sweep_run", 2), NULL, &err);
@@ -2886,181 +2942,188 @@ const api_null_case api_null_cases[] = {
     {.function = "pd_record_read", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_157},
     {.function = "pd_record_read", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_158},
     {.function = "pd_record_free", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_159},
-    {.function = "pd_record_duration", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_160},
-    {.function = "pd_record_acc", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_161},
-    {.function = "pd_record_measure", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_162},
-    {.function = "pd_record_measure", .argument = "m", .expect = EXPECT_ERROR, .call = api_case_163},
-    {.function = "pd_record_integrate", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_164},
-    {.function = "pd_record_integrate", .argument = "vel", .expect = EXPECT_ERROR, .call = api_case_165},
-    {.function = "pd_record_integrate", .argument = "disp", .expect = EXPECT_ERROR, .call = api_case_166},
-    {.function = "pd_record_fit_pulse", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_167},
-    {.function = "pd_record_fit_pulse", .argument = "p", .expect = EXPECT_ERROR, .call = api_case_168},
-    {.function = "pd_record_pulse_eval", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_169},
-    {.function = "pd_record_pulse_eval", .argument = "acc", .expect = EXPECT_NOCRASH, .call = api_case_170},
-    {.function = "pd_record_pulse_eval", .argument = "vel", .expect = EXPECT_NOCRASH, .call = api_case_171},
-    {.function = "pd_record_one_cycle", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_172},
-    {.function = "pd_method_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_173},
-    {.function = "pd_method_parse", .argument = "method", .expect = EXPECT_ERROR, .call = api_case_174},
-    {.function = "pd_run_opts_check", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_175},
-    {.function = "pd_osc_wp", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_176},
-    {.function = "pd_osc_T0", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_177},
-    {.function = "pd_osc_gap", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_178},
-    {.function = "pd_osc_Le", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_179},
-    {.function = "pd_osc_set_T0", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_180},
-    {.function = "pd_osc_set_gap", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_181},
-    {.function = "pd_osc_excitation", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_182},
-    {.function = "pd_osc_set_record", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_183},
-    {.function = "pd_osc_set_record", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_184},
-    {.function = "pd_osc_set_record", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_185},
-    {.function = "pd_osc_shape", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_186},
-    {.function = "pd_osc_shape_rate", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_187},
-    {.function = "pd_osc_shape_end", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_188},
-    {.function = "pd_osc_pieces", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_189},
-    {.function = "pd_osc_pieces", .argument = "pieces", .expect = EXPECT_ERROR, .call = api_case_190},
-    {.function = "pd_osc_pieces", .argument = "npieces", .expect = EXPECT_ERROR, .call = api_case_191},
-    {.function = "pd_osc_excitation_name", .argument = "c", .expect = EXPECT_NAME, .call = api_case_192},
-    {.function = "pd_osc_check", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_193},
-    {.function = "pd_osc_resolve_opts", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_194},
-    {.function = "pd_osc_resolve_opts", .argument = "in", .expect = EXPECT_NOCRASH, .call = api_case_195},
-    {.function = "pd_osc_resolve_opts", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_196},
-    {.function = "pd_osc_default_dt", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_197},
-    {.function = "pd_osc_default_tend", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_198},
-    {.function = "pd_osc_measure_start", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_199},
-    {.function = "pd_osc_method", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_200},
-    {.function = "pd_osc_method", .argument = "o", .expect = EXPECT_NOCRASH, .call = api_case_201},
-    {.function = "pd_osc_run", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_202},
-    {.function = "pd_osc_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_203},
-    {.function = "pd_osc_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_204},
-    {.function = "pd_osc_batchable", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_205},
-    {.function = "pd_osc_batchable", .argument = "o", .expect = EXPECT_COUNT, .call = api_case_206},
-    {.function = "pd_osc_scan_points", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_207},
-    {.function = "pd_osc_simulate", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_208},
-    {.function = "pd_osc_simulate", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_209},
-    {.function = "pd_osc_simulate", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_210},
-    {.function = "pd_osc_reference", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_211},
-    {.function = "pd_osc_reference", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_212},
-    {.function = "pd_osc_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_213},
-    {.function = "pd_osc_penalty", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_214},
-    {.function = "pd_osc_penalty", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_215},
-    {.function = "pd_osc_penalty", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_216},
-    {.function = "pd_osc_summarize", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_217},
-    {.function = "pd_osc_summarize", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_218},
-    {.function = "pd_osc_summarize", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_219},
-    {.function = "pd_osc_free_exact", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_220},
-    {.function = "pd_osc_free_exact", .argument = "u", .expect = EXPECT_NOCRASH, .call = api_case_221},
-    {.function = "pd_osc_free_exact", .argument = "v", .expect = EXPECT_NOCRASH, .call = api_case_222},
-    {.function = "pd_osc_free_first_contact", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_223},
-    {.function = "pd_osc_free_first_contact", .argument = "t", .expect = EXPECT_ERROR, .call = api_case_224},
-    {.function = "pd_osc_free_first_contact", .argument = "v", .expect = EXPECT_ERROR, .call = api_case_225},
-    {.function = "pd_trace_alloc", .argument = "tr", .expect = EXPECT_ERROR, .call = api_case_226},
-    {.function = "pd_trace_alloc", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_227},
-    {.function = "pd_trace_free", .argument = "tr", .expect = EXPECT_NOCRASH, .call = api_case_228},
-    {.function = "pd_measure_reference", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_229},
-    {.function = "pd_measure_reference", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_230},
-    {.function = "pd_measure_reference", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_231},
-    {.function = "pd_measure_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_232},
-    {.function = "pd_measure_run", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_233},
-    {.function = "pd_measure_run", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_234},
-    {.function = "pd_measure_run", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_235},
-    {.function = "pd_measure_run", .argument = "work", .expect = EXPECT_ERROR, .call = api_case_236},
-    {.function = "pd_measure_run", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_237},
-    {.function = "pd_scene_new", .argument = "exc", .expect = EXPECT_NOCRASH, .call = api_case_238},
-    {.function = "pd_scene_free", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_239},
-    {.function = "pd_scene_add_sdof", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_240},
-    {.function = "pd_scene_add_sdof", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_241},
-    {.function = "pd_scene_add_building", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_242},
-    {.function = "pd_scene_add_building", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_243},
-    {.function = "pd_scene_add_building", .argument = "masses", .expect = EXPECT_ERROR, .call = api_case_244},
-    {.function = "pd_scene_add_building", .argument = "stiffnesses", .expect = EXPECT_ERROR, .call = api_case_245},
-    {.function = "pd_scene_add_uniform", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_246},
-    {.function = "pd_scene_add_uniform", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_247},
-    {.function = "pd_scene_set_damping", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_248},
-    {.function = "pd_scene_add_contact", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_249},
-    {.function = "pd_scene_copy", .argument = "sc", .expect = EXPECT_NULL, .call = api_case_250},
-    {.function = "pd_scene_find", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_251},
-    {.function = "pd_scene_find", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_252},
-    {.function = "pd_scene_finish", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_253},
-    {.function = "pd_scene_load", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_254},
-    {.function = "pd_scene_load", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_255},
-    {.function = "pd_scene_chain", .argument = "exc", .expect = EXPECT_ERROR, .call = api_case_256},
-    {.function = "pd_scene_chain", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_257},
-    {.function = "pd_scene_wp", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_258},
-    {.function = "pd_scene_Le", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_259},
-    {.function = "pd_scene_default_dt", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_260},
-    {.function = "pd_scene_default_tend", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_261},
-    {.function = "pd_scene_measure_start", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_262},
-    {.function = "pd_scene_resolve_opts", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_263},
-    {.function = "pd_scene_resolve_opts", .argument = "in", .expect = EXPECT_NOCRASH, .call = api_case_264},
-    {.function = "pd_scene_resolve_opts", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_265},
-    {.function = "pd_scene_as_oscillator", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_266},
-    {.function = "pd_scene_as_oscillator", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_267},
-    {.function = "pd_scene_as_oscillator", .argument = "mirrored", .expect = EXPECT_COUNT, .call = api_case_268},
-    {.function = "pd_scene_model_build", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_269},
-    {.function = "pd_scene_model_build", .argument = "sm", .expect = EXPECT_ERROR, .call = api_case_270},
-    {.function = "pd_scene_model_free", .argument = "sm", .expect = EXPECT_NOCRASH, .call = api_case_271},
-    {.function = "pd_scene_result_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_272},
-    {.function = "pd_scene_result_alloc", .argument = "r", .expect = EXPECT_ERROR, .call = api_case_273},
-    {.function = "pd_scene_result_fits", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_274},
-    {.function = "pd_scene_result_fits", .argument = "r", .expect = EXPECT_COUNT, .call = api_case_275},
-    {.function = "pd_scene_result_free", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_276},
-    {.function = "pd_scene_run", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_277},
-    {.function = "pd_scene_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_278},
-    {.function = "pd_scene_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_279},
-    {.function = "pd_scene_summarize", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_280},
-    {.function = "pd_scene_summarize", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_281},
-    {.function = "pd_scene_summarize", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_282},
-    {.function = "pd_scene_summary_free", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_283},
-    {.function = "pd_scene_trace_alloc", .argument = "tr", .expect = EXPECT_ERROR, .call = api_case_284},
-    {.function = "pd_scene_trace_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_285},
-    {.function = "pd_scene_trace_alloc", .argument = "o", .expect = EXPECT_NOCRASH, .call = api_case_286},
-    {.function = "pd_scene_trace_free", .argument = "tr", .expect = EXPECT_NOCRASH, .call = api_case_287},
-    {.function = "pd_scene_errors_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_288},
-    {.function = "pd_scene_errors_alloc", .argument = "e", .expect = EXPECT_ERROR, .call = api_case_289},
-    {.function = "pd_scene_errors_free", .argument = "e", .expect = EXPECT_NOCRASH, .call = api_case_290},
-    {.function = "pd_scene_measure_reference", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_291},
-    {.function = "pd_scene_measure_reference", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_292},
-    {.function = "pd_scene_measure_reference", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_293},
-    {.function = "pd_scene_measure_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_294},
-    {.function = "pd_scene_measure_run", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_295},
-    {.function = "pd_scene_measure_run", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_296},
-    {.function = "pd_scene_measure_run", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_297},
-    {.function = "pd_scene_measure_run", .argument = "ref_res", .expect = EXPECT_ERROR, .call = api_case_298},
-    {.function = "pd_scene_measure_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_299},
-    {.function = "pd_scene_measure_run", .argument = "e", .expect = EXPECT_ERROR, .call = api_case_300},
-    {.function = "pd_spec_init", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_301},
-    {.function = "pd_spec_curves", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_302},
-    {.function = "pd_spec_points", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_303},
-    {.function = "pd_spec_twins", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_304},
-    {.function = "pd_spec_tasks", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_305},
-    {.function = "pd_spec_pi2", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_306},
-    {.function = "pd_spec_coords_of", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_307},
-    {.function = "pd_spec_coords_of", .argument = "co", .expect = EXPECT_NOCRASH, .call = api_case_308},
-    {.function = "pd_spec_twin_of", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_309},
-    {.function = "pd_spec_case", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_310},
-    {.function = "pd_spec_case", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_311},
-    {.function = "pd_spec_case", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_312},
-    {.function = "pd_spec_validate", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_313},
-    {.function = "pd_spec_resolve_method", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_314},
-    {.function = "pd_spec_run_task", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_315},
-    {.function = "pd_spec_run_task", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_316},
-    {.function = "pd_spec_stream", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_317},
-    {.function = "pd_spec_cost", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_318},
-    {.function = "pd_spec_key", .argument = "s", .expect = EXPECT_NULL, .call = api_case_319},
-    {.function = "pd_spec_rows", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_320},
-    {.function = "pd_spec_rows", .argument = "res", .expect = EXPECT_NOCRASH, .call = api_case_321},
-    {.function = "pd_spec_rows", .argument = "rows", .expect = EXPECT_NOCRASH, .call = api_case_322},
-    {.function = "pd_spec_curve_label", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_323},
-    {.function = "pd_spec_curve_label", .argument = "buf", .expect = EXPECT_NOCRASH, .call = api_case_324},
-    {.function = "pd_spec_sweep", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_325},
-    {.function = "pd_scene_sweep_twins", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_326},
-    {.function = "pd_scene_sweep_points", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_327},
-    {.function = "pd_scene_sweep_check", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_328},
-    {.function = "pd_scene_sweep_scene", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_329},
-    {.function = "pd_scene_sweep_scene", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_330},
-    {.function = "pd_scene_sweep_scene", .argument = "pt", .expect = EXPECT_ERROR, .call = api_case_331},
-    {.function = "pd_scene_sweep_run", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_332},
-    {.function = "pd_scene_sweep_run", .argument = "pts", .expect = EXPECT_ERROR, .call = api_case_333},
-    {.function = "pd_scene_sweep_run", .argument = "umax", .expect = EXPECT_ERROR, .call = api_case_334},
+    {.function = "pd_record_detect", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_160},
+    {.function = "pd_record_detect", .argument = "format", .expect = EXPECT_ERROR, .call = api_case_161},
+    {.function = "pd_record_plausible", .argument = "rec", .expect = EXPECT_COUNT, .call = api_case_162},
+    {.function = "pd_record_plausible", .argument = "msg", .expect = EXPECT_NOCRASH, .call = api_case_163},
+    {.function = "pd_record_from_array", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_164},
+    {.function = "pd_record_from_array", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_165},
+    {.function = "pd_record_from_array", .argument = "acc", .expect = EXPECT_ERROR, .call = api_case_166},
+    {.function = "pd_record_duration", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_167},
+    {.function = "pd_record_acc", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_168},
+    {.function = "pd_record_measure", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_169},
+    {.function = "pd_record_measure", .argument = "m", .expect = EXPECT_ERROR, .call = api_case_170},
+    {.function = "pd_record_integrate", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_171},
+    {.function = "pd_record_integrate", .argument = "vel", .expect = EXPECT_ERROR, .call = api_case_172},
+    {.function = "pd_record_integrate", .argument = "disp", .expect = EXPECT_ERROR, .call = api_case_173},
+    {.function = "pd_record_fit_pulse", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_174},
+    {.function = "pd_record_fit_pulse", .argument = "p", .expect = EXPECT_ERROR, .call = api_case_175},
+    {.function = "pd_record_pulse_eval", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_176},
+    {.function = "pd_record_pulse_eval", .argument = "acc", .expect = EXPECT_NOCRASH, .call = api_case_177},
+    {.function = "pd_record_pulse_eval", .argument = "vel", .expect = EXPECT_NOCRASH, .call = api_case_178},
+    {.function = "pd_record_one_cycle", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_179},
+    {.function = "pd_method_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_180},
+    {.function = "pd_method_parse", .argument = "method", .expect = EXPECT_ERROR, .call = api_case_181},
+    {.function = "pd_run_opts_check", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_182},
+    {.function = "pd_osc_wp", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_183},
+    {.function = "pd_osc_T0", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_184},
+    {.function = "pd_osc_gap", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_185},
+    {.function = "pd_osc_Le", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_186},
+    {.function = "pd_osc_set_T0", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_187},
+    {.function = "pd_osc_set_gap", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_188},
+    {.function = "pd_osc_excitation", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_189},
+    {.function = "pd_osc_set_record", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_190},
+    {.function = "pd_osc_set_record", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_191},
+    {.function = "pd_osc_set_record", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_192},
+    {.function = "pd_osc_shape", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_193},
+    {.function = "pd_osc_shape_rate", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_194},
+    {.function = "pd_osc_shape_end", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_195},
+    {.function = "pd_osc_pieces", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_196},
+    {.function = "pd_osc_pieces", .argument = "pieces", .expect = EXPECT_ERROR, .call = api_case_197},
+    {.function = "pd_osc_pieces", .argument = "npieces", .expect = EXPECT_ERROR, .call = api_case_198},
+    {.function = "pd_osc_excitation_name", .argument = "c", .expect = EXPECT_NAME, .call = api_case_199},
+    {.function = "pd_osc_check", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_200},
+    {.function = "pd_osc_resolve_opts", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_201},
+    {.function = "pd_osc_resolve_opts", .argument = "in", .expect = EXPECT_NOCRASH, .call = api_case_202},
+    {.function = "pd_osc_resolve_opts", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_203},
+    {.function = "pd_osc_default_dt", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_204},
+    {.function = "pd_osc_default_tend", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_205},
+    {.function = "pd_osc_measure_start", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_206},
+    {.function = "pd_osc_method", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_207},
+    {.function = "pd_osc_method", .argument = "o", .expect = EXPECT_NOCRASH, .call = api_case_208},
+    {.function = "pd_osc_run", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_209},
+    {.function = "pd_osc_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_210},
+    {.function = "pd_osc_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_211},
+    {.function = "pd_osc_batchable", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_212},
+    {.function = "pd_osc_batchable", .argument = "o", .expect = EXPECT_COUNT, .call = api_case_213},
+    {.function = "pd_osc_scan_points", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_214},
+    {.function = "pd_osc_simulate", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_215},
+    {.function = "pd_osc_simulate", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_216},
+    {.function = "pd_osc_simulate", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_217},
+    {.function = "pd_osc_reference", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_218},
+    {.function = "pd_osc_reference", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_219},
+    {.function = "pd_osc_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_220},
+    {.function = "pd_osc_penalty", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_221},
+    {.function = "pd_osc_penalty", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_222},
+    {.function = "pd_osc_penalty", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_223},
+    {.function = "pd_osc_summarize", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_224},
+    {.function = "pd_osc_summarize", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_225},
+    {.function = "pd_osc_summarize", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_226},
+    {.function = "pd_osc_free_exact", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_227},
+    {.function = "pd_osc_free_exact", .argument = "u", .expect = EXPECT_NOCRASH, .call = api_case_228},
+    {.function = "pd_osc_free_exact", .argument = "v", .expect = EXPECT_NOCRASH, .call = api_case_229},
+    {.function = "pd_osc_free_first_contact", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_230},
+    {.function = "pd_osc_free_first_contact", .argument = "t", .expect = EXPECT_ERROR, .call = api_case_231},
+    {.function = "pd_osc_free_first_contact", .argument = "v", .expect = EXPECT_ERROR, .call = api_case_232},
+    {.function = "pd_trace_alloc", .argument = "tr", .expect = EXPECT_ERROR, .call = api_case_233},
+    {.function = "pd_trace_alloc", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_234},
+    {.function = "pd_trace_free", .argument = "tr", .expect = EXPECT_NOCRASH, .call = api_case_235},
+    {.function = "pd_measure_reference", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_236},
+    {.function = "pd_measure_reference", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_237},
+    {.function = "pd_measure_reference", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_238},
+    {.function = "pd_measure_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_239},
+    {.function = "pd_measure_run", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_240},
+    {.function = "pd_measure_run", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_241},
+    {.function = "pd_measure_run", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_242},
+    {.function = "pd_measure_run", .argument = "work", .expect = EXPECT_ERROR, .call = api_case_243},
+    {.function = "pd_measure_run", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_244},
+    {.function = "pd_scene_new", .argument = "exc", .expect = EXPECT_NOCRASH, .call = api_case_245},
+    {.function = "pd_scene_free", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_246},
+    {.function = "pd_scene_add_sdof", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_247},
+    {.function = "pd_scene_add_sdof", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_248},
+    {.function = "pd_scene_add_building", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_249},
+    {.function = "pd_scene_add_building", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_250},
+    {.function = "pd_scene_add_building", .argument = "masses", .expect = EXPECT_ERROR, .call = api_case_251},
+    {.function = "pd_scene_add_building", .argument = "stiffnesses", .expect = EXPECT_ERROR, .call = api_case_252},
+    {.function = "pd_scene_add_uniform", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_253},
+    {.function = "pd_scene_add_uniform", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_254},
+    {.function = "pd_scene_set_damping", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_255},
+    {.function = "pd_scene_add_contact", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_256},
+    {.function = "pd_scene_copy", .argument = "sc", .expect = EXPECT_NULL, .call = api_case_257},
+    {.function = "pd_scene_find", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_258},
+    {.function = "pd_scene_find", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_259},
+    {.function = "pd_scene_finish", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_260},
+    {.function = "pd_scene_load", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_261},
+    {.function = "pd_scene_load", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_262},
+    {.function = "pd_scene_chain", .argument = "exc", .expect = EXPECT_ERROR, .call = api_case_263},
+    {.function = "pd_scene_chain", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_264},
+    {.function = "pd_scene_wp", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_265},
+    {.function = "pd_scene_Le", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_266},
+    {.function = "pd_scene_default_dt", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_267},
+    {.function = "pd_scene_default_tend", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_268},
+    {.function = "pd_scene_measure_start", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_269},
+    {.function = "pd_scene_resolve_opts", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_270},
+    {.function = "pd_scene_resolve_opts", .argument = "in", .expect = EXPECT_NOCRASH, .call = api_case_271},
+    {.function = "pd_scene_resolve_opts", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_272},
+    {.function = "pd_scene_as_oscillator", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_273},
+    {.function = "pd_scene_as_oscillator", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_274},
+    {.function = "pd_scene_as_oscillator", .argument = "mirrored", .expect = EXPECT_COUNT, .call = api_case_275},
+    {.function = "pd_scene_model_build", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_276},
+    {.function = "pd_scene_model_build", .argument = "sm", .expect = EXPECT_ERROR, .call = api_case_277},
+    {.function = "pd_scene_model_free", .argument = "sm", .expect = EXPECT_NOCRASH, .call = api_case_278},
+    {.function = "pd_scene_result_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_279},
+    {.function = "pd_scene_result_alloc", .argument = "r", .expect = EXPECT_ERROR, .call = api_case_280},
+    {.function = "pd_scene_result_fits", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_281},
+    {.function = "pd_scene_result_fits", .argument = "r", .expect = EXPECT_COUNT, .call = api_case_282},
+    {.function = "pd_scene_result_free", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_283},
+    {.function = "pd_scene_run", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_284},
+    {.function = "pd_scene_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_285},
+    {.function = "pd_scene_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_286},
+    {.function = "pd_scene_summarize", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_287},
+    {.function = "pd_scene_summarize", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_288},
+    {.function = "pd_scene_summarize", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_289},
+    {.function = "pd_scene_summary_free", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_290},
+    {.function = "pd_scene_trace_alloc", .argument = "tr", .expect = EXPECT_ERROR, .call = api_case_291},
+    {.function = "pd_scene_trace_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_292},
+    {.function = "pd_scene_trace_alloc", .argument = "o", .expect = EXPECT_NOCRASH, .call = api_case_293},
+    {.function = "pd_scene_trace_free", .argument = "tr", .expect = EXPECT_NOCRASH, .call = api_case_294},
+    {.function = "pd_scene_errors_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_295},
+    {.function = "pd_scene_errors_alloc", .argument = "e", .expect = EXPECT_ERROR, .call = api_case_296},
+    {.function = "pd_scene_errors_free", .argument = "e", .expect = EXPECT_NOCRASH, .call = api_case_297},
+    {.function = "pd_scene_measure_reference", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_298},
+    {.function = "pd_scene_measure_reference", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_299},
+    {.function = "pd_scene_measure_reference", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_300},
+    {.function = "pd_scene_measure_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_301},
+    {.function = "pd_scene_measure_run", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_302},
+    {.function = "pd_scene_measure_run", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_303},
+    {.function = "pd_scene_measure_run", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_304},
+    {.function = "pd_scene_measure_run", .argument = "ref_res", .expect = EXPECT_ERROR, .call = api_case_305},
+    {.function = "pd_scene_measure_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_306},
+    {.function = "pd_scene_measure_run", .argument = "e", .expect = EXPECT_ERROR, .call = api_case_307},
+    {.function = "pd_spec_init", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_308},
+    {.function = "pd_spec_curves", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_309},
+    {.function = "pd_spec_points", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_310},
+    {.function = "pd_spec_twins", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_311},
+    {.function = "pd_spec_tasks", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_312},
+    {.function = "pd_spec_pi2", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_313},
+    {.function = "pd_spec_coords_of", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_314},
+    {.function = "pd_spec_coords_of", .argument = "co", .expect = EXPECT_NOCRASH, .call = api_case_315},
+    {.function = "pd_spec_twin_of", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_316},
+    {.function = "pd_spec_case", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_317},
+    {.function = "pd_spec_case", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_318},
+    {.function = "pd_spec_case", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_319},
+    {.function = "pd_spec_validate", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_320},
+    {.function = "pd_spec_resolve_method", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_321},
+    {.function = "pd_spec_run_task", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_322},
+    {.function = "pd_spec_run_task", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_323},
+    {.function = "pd_spec_stream", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_324},
+    {.function = "pd_spec_cost", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_325},
+    {.function = "pd_spec_key", .argument = "s", .expect = EXPECT_NULL, .call = api_case_326},
+    {.function = "pd_spec_rows", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_327},
+    {.function = "pd_spec_rows", .argument = "res", .expect = EXPECT_NOCRASH, .call = api_case_328},
+    {.function = "pd_spec_rows", .argument = "rows", .expect = EXPECT_NOCRASH, .call = api_case_329},
+    {.function = "pd_spec_curve_label", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_330},
+    {.function = "pd_spec_curve_label", .argument = "buf", .expect = EXPECT_NOCRASH, .call = api_case_331},
+    {.function = "pd_spec_sweep", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_332},
+    {.function = "pd_scene_sweep_twins", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_333},
+    {.function = "pd_scene_sweep_points", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_334},
+    {.function = "pd_scene_sweep_check", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_335},
+    {.function = "pd_scene_sweep_scene", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_336},
+    {.function = "pd_scene_sweep_scene", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_337},
+    {.function = "pd_scene_sweep_scene", .argument = "pt", .expect = EXPECT_ERROR, .call = api_case_338},
+    {.function = "pd_scene_sweep_run", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_339},
+    {.function = "pd_scene_sweep_run", .argument = "pts", .expect = EXPECT_ERROR, .call = api_case_340},
+    {.function = "pd_scene_sweep_run", .argument = "umax", .expect = EXPECT_ERROR, .call = api_case_341},
 };
-const int api_null_ncases = 335;
-const int api_null_nfunctions = 202;
+const int api_null_ncases = 342;
+const int api_null_nfunctions = 205;

@@ -1256,8 +1256,122 @@ static void test_record_text_reader_caps(pd_test_ctx *ctx)
     pd_test_rm_dir(dir);
 }
 
+/* Ground motions as arrays (issue 21): the Rinaldi record's own samples
+ * (m/s^2) give the record the file gives, bit for bit, and so the same
+ * oscillator run; values in g through pd_record_from_array and through the
+ * text reader (--units g) are the same doubles; bad arrays are refused. */
+static void test_record_from_array(pd_test_ctx *ctx)
+{
+    char path[1200];
+    pd_record file = {0}, arr = {0};
+    pd_err err;
+    if (shared_record(ctx, "NGA_no_1063_RRS228.AT2", path, sizeof path) != 0)
+        return;
+    if (!CHECK(ctx, pd_record_read(path, PD_RECORD_AUTO, PD_UNITS_G, &file, &err) == PD_OK,
+               "%s", err.msg))
+        return;
+    int rc = pd_record_from_array(&arr, "rinaldi", file.acc, file.npts, file.dt, PD_UNITS_M_S2,
+                                  &err);
+    CHECK(ctx, rc == PD_OK && arr.npts == file.npts && arr.dt == file.dt &&
+                   !memcmp(arr.acc, file.acc, (size_t)file.npts * sizeof(double)) &&
+                   !strcmp(arr.name, "rinaldi"),
+          "from_array: status %d (%s)", rc, err.msg);
+    pd_record_pulse pf, pa;
+    pd_osc_result rf, ra;
+    if (rc == PD_OK && !pd_record_fit_pulse(&file, &pf, &err) &&
+        !pd_record_fit_pulse(&arr, &pa, &err)) {
+        pd_osc c = pd_osc_default();
+        pd_run_opts o = pd_run_default_opts();
+        pd_osc_set_record(&c, &file, &pf, 1.0);
+        pd_osc_set_T0(&c, 0.8);
+        pd_osc_set_gap(&c, 0.01);
+        int r1 = pd_osc_run(&c, &o, NULL, NULL, &rf, &err);
+        pd_osc_set_record(&c, &arr, &pa, 1.0);
+        int r2 = pd_osc_run(&c, &o, NULL, NULL, &ra, &err);
+        CHECK(ctx, r1 == PD_OK && r2 == PD_OK && rf.umax == ra.umax && rf.impacts == ra.impacts,
+              "runs: %d %d, umax %.17g vs %.17g", r1, r2, rf.umax, ra.umax);
+    }
+    pd_record_free(&arr);
+    /* in g: the text reader and the array agree bit for bit */
+    char dir[] = "/tmp/pound-recarr-XXXXXX", body[4096], tpath[1200];
+    double g[5] = {0.0, 0.0123456789012345, -0.31, 1.7e-3, 0.0};
+    size_t len = 0;
+    for (int k = 0; k < 5; k++)
+        len += (size_t)snprintf(body + len, sizeof body - len, "%.2f %.17g\n", 0.01 * k, g[k]);
+    pd_record text = {0};
+    if (CHECK(ctx, mkdtemp(dir) && write_file(dir, "g.txt", body, len, tpath, sizeof tpath) == 0,
+              "scratch file") &&
+        CHECK(ctx, pd_record_read(tpath, PD_RECORD_TEXT, PD_UNITS_G, &text, &err) == PD_OK,
+              "%s", err.msg)) {
+        rc = pd_record_from_array(&arr, NULL, g, 5, 0.01, PD_UNITS_G, &err);
+        CHECK(ctx, rc == PD_OK && !memcmp(arr.acc, text.acc, 5 * sizeof(double)) &&
+                       !strcmp(arr.name, "array"),
+              "g: status %d, arrays differ", rc);
+        pd_record_free(&arr);
+    }
+    pd_record_free(&text);
+    unlink(tpath);
+    rmdir(dir);
+    /* refused: too short, a bad step, a NaN, an overflow in m/s^2, bad units */
+    double bad[3] = {0.1, NAN, 0.2}, huge[2] = {1e308, 0.0}, ok2[2] = {0.1, 0.2};
+    CHECK(ctx, pd_record_from_array(&arr, NULL, ok2, 1, 0.01, PD_UNITS_G, &err) == PD_EINVAL,
+          "one sample");
+    CHECK(ctx, pd_record_from_array(&arr, NULL, ok2, 2, 0.0, PD_UNITS_G, &err) == PD_EINVAL &&
+                   strstr(err.msg, "record_dt"),
+          "dt 0: %s", err.msg);
+    CHECK(ctx, pd_record_from_array(&arr, NULL, bad, 3, 0.01, PD_UNITS_G, &err) == PD_EINVAL &&
+                   strstr(err.msg, "sample 1"),
+          "NaN: %s", err.msg);
+    CHECK(ctx, pd_record_from_array(&arr, NULL, huge, 2, 0.01, PD_UNITS_G, &err) == PD_EINVAL,
+          "1e308 g: %s", err.msg);
+    CHECK(ctx, pd_record_from_array(&arr, NULL, ok2, 2, 0.01, (pd_record_units)7, &err) ==
+                   PD_EINVAL,
+          "units 7");
+    CHECK(ctx, arr.acc == NULL && arr.npts == 0, "a refused array leaves the record empty");
+    pd_record_free(&file);
+}
+
+/* Units plausibility: the Rinaldi record (0.83 g) is plausible in g; its
+ * values read as m/s^2 (0.085 g) too; multiplied by 9.81 and read as g
+ * (8.1 g) it is not, and the message names m/s2; a V2 file's units are
+ * its own, and --units on it (or on an AT2) is refused by the CLI. */
+static void test_record_units_plausible(pd_test_ctx *ctx)
+{
+    char path[1200], msg[512];
+    pd_record r = {0}, x = {0};
+    pd_err err;
+    if (shared_record(ctx, "NGA_no_1063_RRS228.AT2", path, sizeof path) != 0)
+        return;
+    if (!CHECK(ctx, pd_record_read(path, PD_RECORD_AUTO, PD_UNITS_G, &r, &err) == PD_OK, "%s",
+               err.msg))
+        return;
+    CHECK(ctx, pd_record_plausible(&r, PD_UNITS_G, msg, sizeof msg) == 1, "Rinaldi in g");
+    /* the samples in m/s^2 typed as if they were g */
+    if (CHECK(ctx, pd_record_from_array(&x, "as-g", r.acc, r.npts, r.dt, PD_UNITS_G, &err) ==
+                       PD_OK,
+              "%s", err.msg)) {
+        int p = pd_record_plausible(&x, PD_UNITS_G, msg, sizeof msg);
+        CHECK(ctx, p == 0 && strstr(msg, "more than 5 g") && strstr(msg, "m/s2"),
+              "m/s^2 values read as g: %d, %s", p, msg);
+    }
+    pd_record_free(&x);
+    pd_record_format f;
+    CHECK(ctx, pd_record_detect(path, &f, &err) == PD_OK && f == PD_RECORD_AT2, "detect: %d", f);
+    if (pd_test_have_pound(ctx)) {
+        const char *args[] = {"record", path, "--units", "m/s2", NULL};
+        proc_out o;
+        pd_test_pound(ctx, args, &o);
+        CHECK(ctx, o.status == 2 && strstr(o.err, "--units") && strstr(o.err, "AT2"),
+              "--units on an AT2: exit %d, %s", o.status, o.err);
+        pd_test_proc_free(&o);
+    }
+    pd_record_free(&r);
+}
+
 void suite_record(pd_test_ctx *ctx)
 {
+    PD_RUN(ctx, test_record_from_array);
+    PD_RUN(ctx, test_record_units_plausible);
     PD_RUN(ctx, test_record_read_shared);
     PD_RUN(ctx, test_record_read_formats);
     PD_RUN(ctx, test_record_peer_at_rest);

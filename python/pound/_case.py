@@ -3,6 +3,7 @@ it from its flags (cli/case.c): the same library calls in the same order, so
 that the numbers are the CLI's to the last bit."""
 import ctypes
 import math
+import os
 
 import numpy as np
 
@@ -13,7 +14,7 @@ from ._lib import InputError, PdErr, PdRecord, PdRecordPulse, lib
 # Keyword arguments and the CLI flags they mirror (the names without "--",
 # "-" written "_").
 MODEL_KEYS = ("pulse", "dir", "ap", "Tp", "T0", "Pi2", "gap", "Pi3", "eps", "xi")
-RECORD_KEYS = ("record", "scale", "units", "record_format")
+RECORD_KEYS = ("record", "scale", "units", "record_format", "record_dt")
 SCHEME_KEYS = ("method", "dt", "tend", "theta", "gamma", "allow_unstable", "no_accumulation",
                "no_wall", "kernel", "factor", "lcp_solver", "contact", "kc", "kc_abs", "rtol",
                "atol", "stepper", "close_tol")
@@ -58,12 +59,25 @@ class Record:
     """A strong-motion record read and its pulse fitted by the library
     (pd_record_read, pd_record_fit_pulse); owns the C arrays."""
 
-    def __init__(self, path, units="g", format="auto"):
+    def __init__(self, path, units=None, format="auto"):
+        """units: of a two-column text record ['g']; an AT2 or V2 file states its
+        own, and units given for one raise InputError (as the CLI's --units)."""
         self._owned = False
         cpath, self.path = _args.path("record", path)
         fmt_code = parse_name("record_format", lib.pd_record_format_parse, format,
                               "auto, at2, v2, text")
-        unit_code = parse_name("units", lib.pd_record_units_parse, units, "g, m/s2, cm/s2")
+        unit_code = parse_name("units", lib.pd_record_units_parse,
+                               "g" if units is None else units, "g, m/s2, cm/s2")
+        if units is not None:
+            f, err = ctypes.c_int(fmt_code), PdErr()
+            if fmt_code == 0 and lib.pd_record_detect(cpath, f, err):
+                raise InputError(err.text())
+            if f.value != 3:  # PD_RECORD_TEXT
+                raise InputError("units: %s is read as %s, whose file states its units (units "
+                                 "is for two-column text records)" % (
+                                     self.path, "a PEER AT2 record (in g)" if f.value == 1
+                                     else "a COSMOS V2 record"))
+        self.units_code = unit_code
         self.rec = PdRecord()
         self.pulse = PdRecordPulse()
         err = PdErr()
@@ -77,6 +91,43 @@ class Record:
                 msg = "%s (read as record_format %s)" % (msg, format)
             self.close()
             raise _lib.make_error(st, msg)
+        self._warn_units()
+
+    def _warn_units(self):
+        """The CLI's warning for a peak acceleration implausible in its units."""
+        buf = ctypes.create_string_buffer(512)
+        if not lib.pd_record_plausible(self.rec, self.units_code, buf, len(buf)):
+            import warnings
+            warnings.warn(buf.value.decode("utf-8", "replace"), stacklevel=4)
+
+    @classmethod
+    def from_array(cls, acc, dt, units="g", name="array"):
+        """A record from the accelerations acc[k] at t_k = k dt (pd_record_from_array):
+        the same values as a file's give the same record, bit for bit."""
+        self = cls.__new__(cls)
+        self._owned = False
+        self.path = None
+        a = np.ascontiguousarray(np.asarray(acc, dtype=float).ravel())
+        if np.asarray(acc).ndim != 1:
+            raise InputError("record: expected a 1-D array of accelerations (got shape %s)"
+                             % (np.asarray(acc).shape,))
+        dt = number("record_dt", dt)
+        unit_code = parse_name("units", lib.pd_record_units_parse, units, "g, m/s2, cm/s2")
+        self.units_code = unit_code
+        self.rec = PdRecord()
+        self.pulse = PdRecordPulse()
+        err = PdErr()
+        st = lib.pd_record_from_array(self.rec, str(name).encode(), a.ctypes.data_as(
+            ctypes.POINTER(ctypes.c_double)), a.size, dt, unit_code, err)
+        if st == 0:
+            self._owned = True
+            st = lib.pd_record_fit_pulse(self.rec, self.pulse, err)
+        if st != 0:
+            msg = err.text()
+            self.close()
+            raise _lib.make_error(st, msg)
+        self._warn_units()
+        return self
 
     def close(self):
         if self._owned:
@@ -235,8 +286,21 @@ class Case:
             if not scale > 0.0:
                 raise InputError("scale: must be > 0 (got %s)" % fmt(scale))
             rec = kw["record"]
-            if not isinstance(rec, Record):
-                rec = Record(rec, kw.get("units", "g"), kw.get("record_format", "auto"))
+            if isinstance(rec, Record):
+                pass
+            elif not isinstance(rec, (str, bytes, os.PathLike)):
+                # a ground motion as an array: its samples every record_dt, in units
+                if "record_dt" not in kw:
+                    raise InputError("record_dt: give the sampling interval of the record "
+                                     "array [s]")
+                if "record_format" in kw:
+                    raise InputError("record_format: goes with a record file, not an array")
+                rec = Record.from_array(rec, kw["record_dt"], kw.get("units") or "g")
+            else:
+                if "record_dt" in kw:
+                    raise InputError("record_dt: goes with a record array (a file gives its "
+                                     "own)")
+                rec = Record(rec, kw.get("units"), kw.get("record_format", "auto"))
             self.record = rec
             lib.pd_osc_set_record(c, rec.rec, rec.pulse, scale)
         elif "scale" in kw:

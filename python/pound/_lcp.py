@@ -131,9 +131,10 @@ def lcp(M, q, solver="auto", cover=None, max_pivots=0, max_iterations=0, tol=Non
                   solved=(st == 0))
 
 
-def record(path, units="g", format="auto"):
+def record(path, units=None, format="auto"):
     """A strong-motion record's measures and fitted pulse, as `pound record F
-    --json` (name, npts, dt, duration, pga, pgv, pgd, t_pga, t_pgv, t_pgd,
+    --json` (units: of a two-column text file ['g']; refused for AT2 and V2,
+    which state theirs) (name, npts, dt, duration, pga, pgv, pgd, t_pga, t_pgv, t_pgd,
     arias, t5_75, t5_95, pulse {Tp, vp, ap, wp, Le, fp, nu, gamma, t0, r2,
     shape, t_start}), with the arrays t, acc [m/s^2], vel [m/s], disp [m]
     (pd_record_integrate) and pulse_acc (the paper's one-cycle pulse)."""

@@ -334,6 +334,10 @@ _PROTOTYPES = {
     # records
     "pd_record_read": (c_int, [c_char_p, c_int, c_int, P(PdRecord), P(PdErr)]),
     "pd_record_free": (None, [P(PdRecord)]),
+    "pd_record_from_array": (c_int, [P(PdRecord), c_char_p, P(c_double), c_long, c_double, c_int,
+                                     P(PdErr)]),
+    "pd_record_detect": (c_int, [c_char_p, P(c_int), P(PdErr)]),
+    "pd_record_plausible": (c_int, [P(PdRecord), c_int, c_char_p, ctypes.c_size_t]),
     "pd_record_duration": (c_double, [P(PdRecord)]),
     "pd_record_measure": (c_int, [P(PdRecord), P(PdRecordMeasures), P(PdErr)]),
     "pd_record_integrate": (c_int, [P(PdRecord), P(c_double), P(c_double), P(PdErr)]),

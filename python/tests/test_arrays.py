@@ -1,0 +1,60 @@
+"""Ground motions as arrays (issue 21): record= takes a NumPy array with
+record_dt= and units=, and gives the run the same motion read from a file
+gives, bit for bit; the units are checked for plausibility."""
+import numpy as np
+import pytest
+
+import pound
+from conftest import EXAMPLES
+
+RINALDI = EXAMPLES / "records" / "NGA_no_1063_RRS228.AT2"
+CASE = dict(T0=0.8, gap=0.01, eps=0.6, history=False)
+
+
+def rinaldi_in_g():
+    """The AT2 file's samples as the reader parses them (4 header lines)."""
+    lines = RINALDI.read_text().splitlines()[4:]
+    return np.array([float(x) for line in lines for x in line.split()])
+
+
+@pytest.mark.parametrize("method", ["event", "moreau"])
+def test_array_in_g_is_the_file(method):
+    a = pound.simulate(record=str(RINALDI), method=method, **CASE)
+    b = pound.simulate(record=rinaldi_in_g(), record_dt=0.01, units="g", method=method, **CASE)
+    assert a["umax"] == b["umax"] and a["impacts"] == b["impacts"]
+
+
+def test_array_in_m_s2_is_the_file():
+    acc = pound.record(str(RINALDI))["acc"]  # m/s^2, as read
+    a = pound.simulate(record=str(RINALDI), method="event", **CASE)
+    b = pound.simulate(record=acc, record_dt=0.01, units="m/s2", method="event", **CASE)
+    assert a["umax"] == b["umax"]
+
+
+def test_array_misuse():
+    acc = rinaldi_in_g()
+    with pytest.raises(pound.InputError, match="record_dt"):
+        pound.simulate(record=acc, **CASE)
+    with pytest.raises(pound.InputError, match="1-D"):
+        pound.simulate(record=acc.reshape(11, 181), record_dt=0.01, **CASE)
+    with pytest.raises(pound.InputError, match="record_format"):
+        pound.simulate(record=acc, record_dt=0.01, record_format="at2", **CASE)
+    with pytest.raises(pound.InputError, match="record_dt"):
+        pound.simulate(record=str(RINALDI), record_dt=0.01, **CASE)
+    bad = acc.copy()
+    bad[7] = np.nan
+    with pytest.raises(pound.InputError, match="sample 7"):
+        pound.simulate(record=bad, record_dt=0.01, **CASE)
+    with pytest.raises(pound.InputError, match="record_dt"):
+        pound.simulate(record=acc, record_dt=0.0, **CASE)
+
+
+def test_units_on_a_file_that_states_them():
+    with pytest.raises(pound.InputError, match="AT2"):
+        pound.record(str(RINALDI), units="m/s2")
+
+
+def test_implausible_units_warn():
+    acc = pound.record(str(RINALDI))["acc"]  # m/s^2 values (8.1 at most) ...
+    with pytest.warns(UserWarning, match="m/s2"):  # ... called g: 8.3 g
+        pound.simulate(record=acc, record_dt=0.01, units="g", **CASE)
