@@ -12,7 +12,7 @@ pkgs="gcc make pkg-config libgsl-dev libsuitesparse-dev libhdf5-dev hdf5-tools l
 [ "${1:-}" = "--ci" ] && pkgs="$pkgs python3 libopenmpi-dev openmpi-bin libsiconos-numerics-dev"
 stress="python3 python3-numpy python3-pytest clang libomp-dev libclang-rt-dev util-linux"
 # the Python package's tests and the files read back with h5py
-py="python3 python3-venv python3-numpy python3-pytest python3-matplotlib python3-h5py python3-pip python3-setuptools python3-wheel"
+py="python3 python3-venv python3-numpy python3-pytest python3-matplotlib python3-h5py python3-pip python3-setuptools python3-wheel python3-pandas python3-xarray"
 [ "${1:-}" = "--ci" ] && pkgs="$pkgs $py groff-base g++"
 [ "${1:-}" = "--python" ] && pkgs="$pkgs $py"
 [ "${1:-}" = "--ci" ] && pkgs="$pkgs $stress"

@@ -13,7 +13,9 @@ NAN = float("nan")
 
 
 class Result(dict):
-    """A dict whose keys are also attributes (r.umax is r['umax'])."""
+    """A dict whose keys are also attributes (r.umax is r['umax']), with a
+    short repr and, when pandas or xarray is installed, to_pandas() and
+    to_xarray() of its history."""
 
     def __getattr__(self, key):
         try:
@@ -23,6 +25,68 @@ class Result(dict):
 
     def __dir__(self):
         return list(self.keys()) + list(dict.__dir__(self))
+
+    def __repr__(self):
+        def short(v):
+            if isinstance(v, np.ndarray):
+                return "array(%s)" % "x".join(str(d) for d in v.shape)
+            if isinstance(v, Result):
+                return "Result(%d keys)" % len(v)
+            if isinstance(v, list):
+                return "[%d items]" % len(v)
+            if isinstance(v, float):
+                return "%.6g" % v
+            return repr(v)
+        items = ["%s=%s" % (k, short(v)) for k, v in self.items()]
+        more = len(items) - 12
+        return "Result(%s%s)" % (", ".join(items[:12]), ", ... %d more" % more if more > 0 else "")
+
+    def _columns(self):
+        """The history's arrays as columns: a 2-D array k of n columns gives
+        k[0] ... k[n-1]."""
+        h = self["history"] if "history" in self else self
+        cols = {}
+        for k, v in h.items():
+            if isinstance(v, np.ndarray) and v.ndim == 1:
+                cols[k] = v
+            elif isinstance(v, np.ndarray) and v.ndim == 2:
+                for j in range(v.shape[1]):
+                    cols["%s[%d]" % (k, j)] = v[:, j]
+        return cols
+
+    def _scalars(self):
+        return {k: v for k, v in self.items()
+                if isinstance(v, (int, float, str, np.integer, np.floating))}
+
+    def to_pandas(self):
+        """The history as a pandas DataFrame indexed by t (the results
+        without a history: a Series of the scalars)."""
+        import pandas as pd
+        cols = self._columns()
+        if not cols:
+            return pd.Series(self._scalars())
+        df = pd.DataFrame(cols)
+        if "t" in df:
+            df = df.set_index("t")
+        df.attrs.update(self._scalars())
+        return df
+
+    def to_xarray(self):
+        """The history as an xarray Dataset with t as its coordinate (a scene's
+        x, v along (t, dof), gap and impulse along (t, contact)); the scalars as
+        attributes."""
+        import xarray as xr
+        h = self["history"] if "history" in self else self
+        if "t" not in h:
+            raise ValueError("to_xarray: no history (run with history=True)")
+        data = {}
+        for k, v in h.items():
+            if k == "t" or not isinstance(v, np.ndarray):
+                continue
+            second = {"x": "dof", "v": "dof", "gap": "contact", "impulse": "contact"}.get(
+                k, k + "_index")
+            data[k] = (("t",) if v.ndim == 1 else ("t", second)), v
+        return xr.Dataset(data, coords={"t": h["t"]}, attrs=self._scalars())
 
 
 class _History:

@@ -1,0 +1,38 @@
+"""Results in the tools of notebooks: a short repr, to_pandas() and
+to_xarray() of a history (pandas and xarray: python3-pandas, python3-xarray,
+installed by scripts/deps.sh --python)."""
+import numpy as np
+import pytest
+
+import pound
+from conftest import EXAMPLES
+
+FIG9 = dict(pulse="sine", Tp=0.3, T0=3, ap=4, gap=0.004, eps=0.6)
+
+
+def test_short_repr():
+    r = pound.simulate(**FIG9)
+    text = repr(r)
+    assert len(text) < 400 and "umax=0.175108" in text and "more)" in text
+    assert repr(r.history).count("array(") == 6
+
+
+def test_to_pandas_oscillator():
+    pd = pytest.importorskip("pandas")
+    r = pound.simulate(**FIG9)
+    df = r.to_pandas()
+    assert isinstance(df, pd.DataFrame) and df.index.name == "t"
+    assert np.array_equal(df.index.values, r.t) and np.array_equal(df["u"].values, r.u)
+    assert df.attrs["umax"] == r.umax
+    # without a history: the scalars
+    s = pound.simulate(history=False, **FIG9).to_pandas()
+    assert s["umax"] == r.umax
+
+
+def test_to_xarray_scene():
+    xr = pytest.importorskip("xarray")
+    r = pound.simulate_scene(EXAMPLES / "scenes" / "two-sdof.json")
+    ds = r.to_xarray()
+    assert isinstance(ds, xr.Dataset) and "t" in ds.coords
+    assert ds["x"].dims == ("t", "dof") and np.array_equal(ds["x"].values, r.x)
+    assert float(ds["x"].sel(t=r.t[10]).values[0]) == r.x[10, 0]
