@@ -22,6 +22,12 @@ void pd_bpp_free(pd_bpp_work *ws);
 int pd_bpp_nmax(const pd_bpp_work *ws);
 int pd_bpp_solve(pd_bpp_work *ws, const pd_matrix *M, const double *q, const pd_lcp_opts *o,
                  double *z, double *w, unsigned char *flag, pd_lcp_info *info);
+/* Its direct method for tridiagonal Stieltjes matrices alone (the first
+ * thing pd_bpp_solve tries): 1 with z (unverified), 0 when M is not in
+ * compressed columns, tridiagonal, symmetric, with a positive diagonal and
+ * off-diagonal entries <= 0 (or n > nmax), -1 when a pivot is not positive
+ * (a singular principal block). */
+int pd_bpp_stieltjes(pd_bpp_work *ws, const pd_matrix *M, const double *q, double *z);
 
 /* Projected Gauss-Seidel (pgs.c). */
 typedef struct pd_pgs_work pd_pgs_work;

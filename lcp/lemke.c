@@ -8,7 +8,10 @@
  * of B^-1 is exactly the unit vector e_r while w_i is basic in row r, which
  * keeps a pivot at O(n k) work for k basic z's.  Ties in the ratio test are
  * broken by the lexicographic rule (rows of B^-1 scaled by the pivot column),
- * letting z0 leave whenever it is among the tied rows. */
+ * letting z0 leave whenever it is among the tied rows.  For n <= 4 on a
+ * processor with AVX2 the same pivots run with a column of B^-1 a vector of
+ * four lanes kept in locals, and no workspace but the stack's (section
+ * "n <= LEMKE_SMALL_N"): the same arithmetic, the same answers to the bit. */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -26,6 +29,14 @@
 #define LEMKE_NMAX_LIMIT 46340    /* n*n must fit an int */
 #define LEMKE_SINGULAR_TOL 1e-14  /* relative pivot floor of the final polish */
 #define LEMKE_REPAIR_ROUNDS 8     /* principal solves of the final repair at most */
+#define LEMKE_SMALL_N 4           /* up to this n, a column of B^-1 in one vector */
+/* GNU C vectors of four lanes for n <= LEMKE_SMALL_N where the pivoting loop
+ * has an AVX2 build (LEMKE_KERNEL below), when the processor has AVX2;
+ * -DLEMKE_NO_VECTORS leaves every n to the general code. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) &&  \
+    !defined(LEMKE_NO_VECTORS)
+#define LEMKE_VECTORS 1
+#endif
 
 enum { RATIO_RAY = -1, RATIO_NUMERICAL = -2 };
 
@@ -34,7 +45,7 @@ struct pd_lcp_work {
     double *binv;    /* B^-1, n x n column-major with leading dimension n */
     double *xb;      /* x_B: value of the variable basic in each row */
     double *col;     /* entering column B^-1 a; the answer kept while repairing */
-    double *cover;   /* covering vector d of the current solve */
+    double *cover;   /* all ones (the default covering vector), set once */
     double *scratch; /* refinement residual, polish right-hand side */
     double *rows;    /* row sizes of the verification */
     int *basis;      /* variable basic in each row */
@@ -46,11 +57,27 @@ struct pd_lcp_work {
 /* Everything one solve reads: data, options, workspace. */
 typedef struct lemke_state {
     int n;
+    int ld;            /* leading dimension of B^-1: n, or LEMKE_SMALL_N in vectors */
+    int vec;           /* in vectors (n <= LEMKE_SMALL_N, ws a lemke_small's) */
     const double *M, *q, *d;
+    int unit_cover;    /* d is all ones (the default) */
     double tol;        /* relative tolerance for ties and tiny pivots */
     double qmax;       /* max|q| */
     pd_lcp_work *ws;
 } lemke_state;
+
+/* The workspace of a solve in vectors, on the stack (nothing of the caller's
+ * touched, nothing to clear): B^-1 with a leading dimension of
+ * LEMKE_SMALL_N, so that each column, x_B and col are aligned vectors. */
+typedef struct lemke_small {
+    _Alignas(32) double binv[LEMKE_SMALL_N * LEMKE_SMALL_N];
+    _Alignas(32) double xb[LEMKE_SMALL_N];
+    _Alignas(32) double col[LEMKE_SMALL_N];
+    double scratch[LEMKE_SMALL_N], rows[LEMKE_SMALL_N];
+    int basis[LEMKE_SMALL_N], row_of[2 * LEMKE_SMALL_N + 1], ties[LEMKE_SMALL_N],
+        perm[LEMKE_SMALL_N];
+    pd_lcp_work ws;
+} lemke_small;
 
 /* "solved", "no_solution", "max_pivots", "numerical", "max_iterations". */
 const char *pd_lcp_outcome_name(pd_lcp_outcome outcome)
@@ -108,6 +135,8 @@ pd_lcp_work *pd_lcp_alloc(int nmax)
         pd_lcp_free(work);
         return NULL;
     }
+    for (size_t i = 0; i < n; i++)
+        work->cover[i] = 1.0;
     return work;
 }
 
@@ -199,7 +228,7 @@ static int complement(int n, int var)
     return var < n ? var + n : var - n;
 }
 
-/* B = I (all w basic), x_B = q. */
+/* B = I (all w basic), x_B = q, and the column of z0, -d. */
 static void start_basis(const lemke_state *st)
 {
     int n = st->n;
@@ -208,6 +237,7 @@ static void start_basis(const lemke_state *st)
     for (int i = 0; i < n; i++) {
         ws->binv[i + (size_t)i * n] = 1.0;
         ws->xb[i] = st->q[i];
+        ws->col[i] = -st->d[i];
         ws->basis[i] = i;
         ws->row_of[i] = i;
     }
@@ -223,19 +253,19 @@ static void start_basis(const lemke_state *st)
  * of max|q| a row with q_i = 0 tied with one with q_i = -2e-16 (a zero
  * relative velocity's rounding, the only term of its row) and left that
  * w_i < 0 behind, a violation the verification counts in full (issue 19). */
-static int first_leaving_row(const lemke_state *st)
+LEMKE_INLINE int first_leaving_row(const lemke_state *st)
 {
     int n = st->n, best = 0;
     double tmax = -INFINITY;
     for (int i = 0; i < n; i++) {
-        double t = -st->q[i] / st->d[i];
+        double t = st->unit_cover ? -st->q[i] : -st->q[i] / st->d[i]; /* x / 1 = x */
         if (t > tmax) {
             tmax = t;
             best = i;
         }
     }
     for (int i = n - 1; i > best; i--)
-        if (-st->q[i] / st->d[i] >= tmax - st->tol * tmax)
+        if ((st->unit_cover ? -st->q[i] : -st->q[i] / st->d[i]) >= tmax - st->tol * tmax)
             return i;
     return best;
 }
@@ -268,7 +298,7 @@ static int lex_filter_column(const lemke_state *st, int c, int nties)
 {
     int n = st->n;
     pd_lcp_work *ws = st->ws;
-    const double *bc = ws->binv + (size_t)c * n, *col = ws->col;
+    const double *bc = ws->binv + (size_t)c * st->ld, *col = ws->col;
     int *ties = ws->ties;
     double *value = ws->scratch, vmin = INFINITY, colmin = INFINITY;
     for (int k = 0; k < nties; k++) {
@@ -325,23 +355,40 @@ static double row_scale(const lemke_state *st, int i)
     for (int c = 0; c < n; c++) {
         int r = ws->row_of[c];
         if (r < 0)
-            s += fabs(ws->binv[i + (size_t)c * n] * st->q[c]);
+            s += fabs(ws->binv[i + (size_t)c * st->ld] * st->q[c]);
         else if (r == i)
             s += fabs(st->q[c]);
     }
     return s;
 }
 
+/* Whether row i ties in the ratio test with theta and slack = tol xscale
+ * (blocking_row). */
+LEMKE_INLINE int ties_row(const lemke_state *st, int i, double ptol, double theta,
+                         double slack)
+{
+    const double *col = st->ws->col;
+    double gap = max2(st->ws->xb[i], 0.0) - theta * col[i];
+    return col[i] > ptol &&
+           (gap <= 0.0 ||
+            (gap <= slack && gap <= st->tol * (row_scale(st, i) + theta * col[i])));
+}
+
+static int blocking_ties(const lemke_state *st, double ptol, double theta, double slack,
+                         int argmin);
+
 /* The blocking row among col_i > ptol: theta = min max(x_i, 0)/col_i; rows whose
  * x_i - theta col_i is zero to within their rounding tie -- within tol*xscale,
  * and within tol times the terms it is made of (row_scale + theta col_i);
  * z0 leaves if it ties, else the lexicographic rule decides.  -1 if no entry
- * exceeds ptol.  The second bound keeps a row whose terms are all tiny (a
- * q_i of rounding size next to q_j of order one) from tying at the scale
- * of the others: z0 would leave with that row's x_i - theta_z0 col_i < 0
- * left behind, all of its own size, a violation the verification counts in
- * full (issue 19). */
-LEMKE_INLINE int blocking_row(const lemke_state *st, double ptol)
+ * exceeds ptol; else theta and the row that attains it (argmin) into
+ * *theta_out, *argmin_out.  The second bound keeps a row whose terms are all
+ * tiny (a q_i of rounding size next to q_j of order one) from tying at the
+ * scale of the others: z0 would leave with that row's x_i - theta_z0 col_i
+ * < 0 left behind, all of its own size, a violation the verification
+ * counts in full (issue 19). */
+LEMKE_INLINE int blocking_row(const lemke_state *st, double ptol, double *theta_out,
+                              int *argmin_out)
 {
     int n = st->n;
     pd_lcp_work *ws = st->ws;
@@ -358,15 +405,30 @@ LEMKE_INLINE int blocking_row(const lemke_state *st, double ptol)
     }
     if (argmin < 0)
         return -1;
+    *theta_out = theta;
+    *argmin_out = argmin;
+    /* Whether the blocking row ties itself matters only when another row
+     * does, and none can unless col_i > ptol and gap_i <= slack (ties_row):
+     * the ties, their row sizes, only then. */
     double slack = st->tol * xscale;
+    for (int i = 0; i < n; i++)
+        if (i != argmin && col[i] > ptol && max2(xb[i], 0.0) - theta * col[i] <= slack)
+            return blocking_ties(st, ptol, theta, slack, argmin);
+    return argmin;
+}
+
+/* blocking_row once theta, its row argmin and slack = tol xscale are known
+ * and another row might tie: the rows that tie, and the one of them that
+ * leaves. */
+static int blocking_ties(const lemke_state *st, double ptol, double theta, double slack,
+                         int argmin)
+{
+    int n = st->n;
+    pd_lcp_work *ws = st->ws;
     int nties = 0, z0row = ws->row_of[2 * n];
-    for (int i = 0; i < n; i++) {
-        double gap = max2(xb[i], 0.0) - theta * col[i];
-        if (col[i] > ptol &&
-            (gap <= 0.0 ||
-             (gap <= slack && gap <= st->tol * (row_scale(st, i) + theta * col[i]))))
+    for (int i = 0; i < n; i++)
+        if (ties_row(st, i, ptol, theta, slack))
             ws->ties[nties++] = i;
-    }
     if (nties <= 1)
         return argmin;
     for (int k = 0; k < nties; k++)
@@ -375,29 +437,43 @@ LEMKE_INLINE int blocking_row(const lemke_state *st, double ptol)
     return lex_choice(st, nties);
 }
 
-/* Minimum-ratio test on pivots col_i > tol max|col|; when none is that large
- * but some exceed roundoff (8 n eps max|col|), those are used rather than
- * declaring a ray on a column that is merely small.  Returns the row,
- * RATIO_RAY (no positive entry above roundoff) or RATIO_NUMERICAL. */
-LEMKE_INLINE int ratio_test(const lemke_state *st, double colmax)
+/* The value x_r / col_r the entering variable takes in row r: theta itself
+ * when r is the blocking row and x_r > 0 (theta = max(x_r, 0) / col_r, the
+ * same division), else divided here. */
+LEMKE_INLINE double leaving_value(const lemke_state *st, int r, int argmin, double theta)
 {
-    int n = st->n;
-    if (!isfinite(colmax))
-        return RATIO_NUMERICAL;
-    int r = blocking_row(st, st->tol * colmax);
-    if (r < 0)
-        r = blocking_row(st, 8.0 * n * DBL_EPSILON * colmax);
-    return r >= 0 ? r : RATIO_RAY;
+    const double *xb = st->ws->xb;
+    return r == argmin && xb[r] > 0.0 ? theta : xb[r] / st->ws->col[r];
 }
 
-/* Gauss–Jordan pivot on (r, col): x_B <- E x_B, B^-1 <- E B^-1 with the eta
- * matrix E.  Returns -1 (nothing changed) if the new basic value overflows. */
-LEMKE_INLINE int pivot(const lemke_state *st, int r, int entering)
+/* Minimum-ratio test on pivots col_i > tol max|col|; when none is that large
+ * but some exceed roundoff (8 n eps max|col|), those are used rather than
+ * declaring a ray on a column that is merely small.  Returns the row (its
+ * leaving_value into *xr), RATIO_RAY (no positive entry above roundoff) or
+ * RATIO_NUMERICAL. */
+LEMKE_INLINE int ratio_test(const lemke_state *st, double colmax, double *xr)
+{
+    int n = st->n, argmin = -1;
+    double theta = 0.0;
+    if (!isfinite(colmax))
+        return RATIO_NUMERICAL;
+    int r = blocking_row(st, st->tol * colmax, &theta, &argmin);
+    if (r < 0)
+        r = blocking_row(st, 8.0 * n * DBL_EPSILON * colmax, &theta, &argmin);
+    if (r < 0)
+        return RATIO_RAY;
+    *xr = leaving_value(st, r, argmin, theta);
+    return r;
+}
+
+/* Gauss–Jordan pivot on (r, col), xr = x_r / col_r: x_B <- E x_B, B^-1 <-
+ * E B^-1 with the eta matrix E.  Returns -1 (nothing changed) if the new
+ * basic value overflows. */
+LEMKE_INLINE int pivot(const lemke_state *st, int r, int entering, double xr)
 {
     int n = st->n;
     pd_lcp_work *ws = st->ws;
     const double *col = ws->col;
-    double xr = ws->xb[r] / col[r];
     if (!isfinite(xr))
         return -1;
     axpy_minus(n, xr, col, ws->xb);
@@ -472,7 +548,7 @@ static void extract_z(const lemke_state *st, double *z)
  * backward residual is within LEMKE_VERIFY_TOL (pd_lcp_residual). */
 static int verify(const lemke_state *st, const double *z, double *w, pd_lcp_info *info)
 {
-    pd_matrix M = pd_matrix_dense(st->n, st->n, st->M);
+    pd_matrix M = {.kind = PD_MATRIX_DENSE, .rows = st->n, .cols = st->n, .values = st->M};
     pd_lcp_verify(&M, st->q, z, w, st->ws->rows, info);
     return info->residual <= LEMKE_VERIFY_TOL;
 }
@@ -555,18 +631,29 @@ static int repair(const lemke_state *st, double *z, double *w, pd_lcp_info *info
     return 0;
 }
 
+/* x_r / col_r and 1 / col_r of the pivot that brings z0 in at row r, where
+ * x_B = q and col = -d: with d all ones, -q_r and -1 (a division by -1 is
+ * exact), without a division to wait for. */
+LEMKE_INLINE double first_xr(const lemke_state *st, int r)
+{
+    return st->unit_cover ? -st->q[r] : st->q[r] / -st->d[r];
+}
+
+LEMKE_INLINE double first_rp(const lemke_state *st, int r)
+{
+    return st->unit_cover ? -1.0 : 1.0 / -st->d[r];
+}
+
 /* The pivoting loop from B = I until z0 leaves, a ray, or the cap. */
-LEMKE_KERNEL
-static pd_lcp_outcome run_pivots(const lemke_state *st, int cap, int *pivots)
+LEMKE_INLINE pd_lcp_outcome pivot_loop(const lemke_state *st, int cap, int *pivots)
 {
     int n = st->n, z0 = 2 * n;
     pd_lcp_work *ws = st->ws;
     start_basis(st);
     int r = first_leaving_row(st);
-    for (int i = 0; i < n; i++)
-        ws->col[i] = -st->d[i];
     int leaving = ws->basis[r];
-    if (pivot(st, r, z0) != 0)
+    double xr = first_xr(st, r);
+    if (pivot(st, r, z0, xr) != 0)
         return PD_LCP_NUMERICAL;
     *pivots = 1;
     for (int entering = complement(n, leaving);; entering = complement(n, leaving)) {
@@ -574,13 +661,13 @@ static pd_lcp_outcome run_pivots(const lemke_state *st, int cap, int *pivots)
             return PD_LCP_MAX_PIVOTS;
         if (*pivots % LEMKE_REFINE_EVERY == 0)
             refine(st);
-        r = ratio_test(st, entering_column(st, entering));
+        r = ratio_test(st, entering_column(st, entering), &xr);
         if (r == RATIO_RAY)
             return PD_LCP_NO_SOLUTION;
         if (r == RATIO_NUMERICAL)
             return PD_LCP_NUMERICAL;
         leaving = ws->basis[r];
-        if (pivot(st, r, entering) != 0)
+        if (pivot(st, r, entering, xr) != 0)
             return PD_LCP_NUMERICAL;
         ++*pivots;
         if (leaving == z0)
@@ -588,22 +675,332 @@ static pd_lcp_outcome run_pivots(const lemke_state *st, int cap, int *pivots)
     }
 }
 
+/* ---- n <= LEMKE_SMALL_N: a column of B^-1 in one vector ---------------------
+ * The same pivoting as above and the same arithmetic, lane by lane (no
+ * contraction, no reordering: the same answers to the bit), on vectors of
+ * four lanes kept in locals (registers, as far as they go): B^-1 by
+ * columns, x_B, the entering column;
+ * built for AVX2 alone (run_lemke_v4), once for each n = 1..4, the loops
+ * over n unrolled.  Lanes past n are zero or whatever the lane arithmetic
+ * makes of them, and no decision reads them.  The workspace on the stack
+ * (lemke_small) keeps a copy of each vector, stored as it changes, for what
+ * reads single entries: the ties and the lexicographic rule, the
+ * refinement, the finish, the polish and the repair (the general code, with
+ * B^-1's leading dimension 4).  A single entry is never stored alone (a
+ * changed entry is blended into its vector): a vector load right after a
+ * narrower store into it waits for the store to retire. */
+#ifdef LEMKE_VECTORS
+typedef double lemke_v4 __attribute__((vector_size(32), may_alias));
+typedef long long lemke_m4 __attribute__((vector_size(32), may_alias));
+#define LEMKE_UNROLL _Pragma("GCC unroll 4") /* loops over n <= 4: straight code */
+
+/* The lane r, all bits set. */
+static const lemke_m4 LEMKE_LANE[4] = {{-1, 0, 0, 0}, {0, -1, 0, 0}, {0, 0, -1, 0}, {0, 0, 0, -1}};
+/* All bits set in the lanes below n. */
+static const lemke_m4 LEMKE_BELOW[5] = {
+    {0, 0, 0, 0}, {-1, 0, 0, 0}, {-1, -1, 0, 0}, {-1, -1, -1, 0}, {-1, -1, -1, -1}};
+/* The sign bit cleared in the lanes below n, everything cleared above. */
+static const lemke_m4 LEMKE_ABS_BELOW[5] = {
+    {0, 0, 0, 0},
+    {0x7fffffffffffffff, 0, 0, 0},
+    {0x7fffffffffffffff, 0x7fffffffffffffff, 0, 0},
+    {0x7fffffffffffffff, 0x7fffffffffffffff, 0x7fffffffffffffff, 0},
+    {0x7fffffffffffffff, 0x7fffffffffffffff, 0x7fffffffffffffff, 0x7fffffffffffffff}};
+static const lemke_v4 LEMKE_UNIT[4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}};
+
+/* Vectors pass through memory or macros, never by value through a function
+ * (the ABI of a 32-byte vector differs with and without AVX). */
+/* a with its lane r that of b. */
+#define V4_BLEND(a, b, r)                                                                   \
+    ((lemke_v4)(((lemke_m4)(a) & ~LEMKE_LANE[r]) | ((lemke_m4)(b) & LEMKE_LANE[r])))
+/* All four lanes t. */
+#define V4_SPLAT(t) ((lemke_v4){(t), (t), (t), (t)})
+/* The n <= 4 entries of a, the other lanes 0 (built in registers). */
+#define V4_LOAD_N(a, n)                                                                     \
+    ((n) >= 4   ? (lemke_v4){(a)[0], (a)[1], (a)[2], (a)[3]}                                 \
+     : (n) == 3 ? (lemke_v4){(a)[0], (a)[1], (a)[2], 0.0}                                    \
+     : (n) == 2 ? (lemke_v4){(a)[0], (a)[1], 0.0, 0.0}                                       \
+                : (lemke_v4){(a)[0], 0.0, 0.0, 0.0})
+
+/* The vectors of the pivoting (their copies: ws->binv, ws->xb, ws->col). */
+typedef struct v4_regs {
+    lemke_v4 binv[LEMKE_SMALL_N]; /* column c of B^-1 */
+    lemke_v4 xb, col;
+} v4_regs;
+
+/* *out = B^-1 v (binv_times), B^-1 from *reg or from its copy, v the n
+ * entries of data or the lanes of *vv. */
+LEMKE_INLINE void v4_binv_times(const lemke_state *st, const lemke_v4 *binv, const double *v,
+                                const lemke_v4 *vv, lemke_v4 *out)
+{
+    const pd_lcp_work *ws = st->ws;
+    lemke_v4 acc = {0.0, 0.0, 0.0, 0.0};
+    LEMKE_UNROLL
+    for (int i = 0; i < LEMKE_SMALL_N; i++) {
+        if (i >= st->n)
+            break;
+        double vi = v ? v[i] : (*vv)[i];
+        if (vi == 0.0)
+            continue;
+        int r = ws->row_of[i];
+        if (r >= 0)
+            acc = V4_BLEND(acc, acc + vi, r);
+        else
+            acc = acc - (-vi) * binv[i];
+    }
+    *out = acc;
+}
+
+/* start_basis, and the column of z0, -d. */
+LEMKE_INLINE void v4_start(const lemke_state *st, v4_regs *reg)
+{
+    int n = st->n;
+    pd_lcp_work *ws = st->ws;
+    LEMKE_UNROLL
+    for (int c = 0; c < LEMKE_SMALL_N; c++)
+        if (c < n)
+            ((lemke_v4 *)ws->binv)[c] = reg->binv[c] = LEMKE_UNIT[c];
+    *(lemke_v4 *)ws->xb = reg->xb = V4_LOAD_N(st->q, n);
+    *(lemke_v4 *)ws->col = reg->col = -V4_LOAD_N(st->d, n);
+    LEMKE_UNROLL
+    for (int i = 0; i < n; i++) {
+        ws->basis[i] = i;
+        ws->row_of[i] = i;
+    }
+    for (int v = n; v <= 2 * n; v++)
+        ws->row_of[v] = -1;
+}
+
+/* entering_column: max|col| over the lanes below n, NaN if one is NaN (the
+ * largest of the same numbers and 0: the same as the loop's). */
+LEMKE_INLINE double v4_column(const lemke_state *st, v4_regs *reg, int var)
+{
+    int n = st->n;
+    if (var < n) {
+        LEMKE_UNROLL
+        for (int c = 0; c < LEMKE_SMALL_N; c++)
+            if (c < n && c == var)
+                reg->col = reg->binv[c];
+    } else {
+        v4_binv_times(st, reg->binv, data_column(st, var), NULL, &reg->col);
+        reg->col = -reg->col;
+    }
+    *(lemke_v4 *)st->ws->col = reg->col;
+    lemke_v4 a = (lemke_v4)((lemke_m4)reg->col & LEMKE_ABS_BELOW[n]);
+    lemke_m4 nan = (lemke_m4)(a != a);
+    if (nan[0] | nan[1] | nan[2] | nan[3])
+        return NAN;
+    return max2(max2(a[0], a[1]), max2(a[2], a[3]));
+}
+
+/* blocking_row with ptol, and what the pivot on its row needs: x_r / col_r
+ * into *xr (leaving_value) and 1 / col_r into *rp.  The divisions of the
+ * minimum are made side by side ahead of it, with 1 / col; the rows that
+ * might tie are found in the vectors, blocking_ties called only when one
+ * might. */
+LEMKE_INLINE int v4_blocking_row(const lemke_state *st, const v4_regs *reg, double ptol,
+                                 double *xr, double *rp)
+{
+    int n = st->n, argmin = -1, positive = 0;
+    lemke_v4 col = reg->col, xb = reg->xb, zero = V4_SPLAT(0.0);
+    lemke_v4 x = (lemke_v4)((lemke_m4)xb & (lemke_m4)(xb > zero)); /* max(x_B, 0) */
+    lemke_v4 ratio = x / col, recip = V4_SPLAT(1.0) / col;
+    double theta = INFINITY, rp_min = 0.0;
+    LEMKE_UNROLL
+    for (int i = 0; i < n; i++) {
+        if (col[i] > ptol && x[i] < theta * col[i]) {
+            theta = ratio[i];
+            argmin = i;
+            rp_min = recip[i];
+            positive = xb[i] > 0.0;
+        }
+    }
+    if (argmin < 0)
+        return -1;
+    x = (lemke_v4)((lemke_m4)x & LEMKE_BELOW[n]); /* xscale: the largest of the same numbers */
+    double xscale = max2(st->qmax, max2(max2(x[0], x[1]), max2(x[2], x[3])));
+    double slack = st->tol * xscale;
+    lemke_v4 gap = x - theta * col;
+    lemke_m4 other = (lemke_m4)(col > V4_SPLAT(ptol)) & LEMKE_BELOW[n] & ~LEMKE_LANE[argmin];
+    lemke_m4 maybe = other & (lemke_m4)(gap <= V4_SPLAT(slack)); /* gap <= 0 among them */
+    int r = argmin;
+    if (maybe[0] | maybe[1] | maybe[2] | maybe[3])
+        r = blocking_ties(st, ptol, theta, slack, argmin);
+    const double *xbp = st->ws->xb, *colp = st->ws->col;
+    *xr = r == argmin && positive ? theta : xbp[r] / colp[r];
+    *rp = r == argmin ? rp_min : 1.0 / colp[r];
+    return r;
+}
+
+/* ratio_test. */
+LEMKE_INLINE int v4_ratio_test(const lemke_state *st, const v4_regs *reg, double colmax,
+                               double *xr, double *rp)
+{
+    if (!isfinite(colmax))
+        return RATIO_NUMERICAL;
+    int r = v4_blocking_row(st, reg, st->tol * colmax, xr, rp);
+    if (r < 0)
+        r = v4_blocking_row(st, reg, 8.0 * st->n * DBL_EPSILON * colmax, xr, rp);
+    return r >= 0 ? r : RATIO_RAY;
+}
+
+/* pivot, with x_r / col_r and 1 / col_r given.  B^-1[r, c] is read from the
+ * copy. */
+LEMKE_INLINE int v4_pivot(const lemke_state *st, v4_regs *reg, int r, int entering, double xr,
+                          double rp)
+{
+    int n = st->n;
+    pd_lcp_work *ws = st->ws;
+    lemke_v4 *copy = (lemke_v4 *)ws->binv;
+    if (!isfinite(xr))
+        return -1;
+    *(lemke_v4 *)ws->xb = reg->xb = V4_BLEND(reg->xb - xr * reg->col, V4_SPLAT(xr), r);
+    LEMKE_UNROLL
+    for (int c = 0; c < LEMKE_SMALL_N; c++) {
+        if (c >= n)
+            break;
+        double bcr = ws->binv[r + LEMKE_SMALL_N * c];
+        if (bcr == 0.0)
+            continue;
+        double t = bcr * rp;
+        copy[c] = reg->binv[c] = V4_BLEND(reg->binv[c] - t * reg->col, V4_SPLAT(t), r);
+    }
+    ws->row_of[ws->basis[r]] = -1;
+    ws->basis[r] = entering;
+    ws->row_of[entering] = r;
+    if (entering < n) {
+        LEMKE_UNROLL
+        for (int c = 0; c < LEMKE_SMALL_N; c++)
+            if (c < n && c == entering)
+                copy[c] = reg->binv[c] = LEMKE_UNIT[r];
+    }
+    return 0;
+}
+
+/* refine: res = q - B x_B, then x_B += B^-1 res; on the vectors *reg (their
+ * copy of x_B kept), or on the copies when reg is NULL. */
+LEMKE_INLINE void v4_refine(const lemke_state *st, v4_regs *reg)
+{
+    int n = st->n;
+    pd_lcp_work *ws = st->ws;
+    lemke_v4 res = V4_LOAD_N(st->q, n), dx, *xb = reg ? &reg->xb : (lemke_v4 *)ws->xb;
+    LEMKE_UNROLL
+    for (int r = 0; r < LEMKE_SMALL_N; r++) {
+        if (r >= n)
+            break;
+        int v = ws->basis[r];
+        double x = (*xb)[r];
+        if (x == 0.0)
+            continue;
+        if (v < n) {
+            res = V4_BLEND(res, res - x, v);
+        } else {
+            const double *a = data_column(st, v);
+            res = res - (-x) * V4_LOAD_N(a, n);
+        }
+    }
+    v4_binv_times(st, reg ? reg->binv : (const lemke_v4 *)ws->binv, NULL, &res, &dx);
+    *xb += dx;
+    if (reg)
+        *(lemke_v4 *)ws->xb = reg->xb;
+}
+
+/* extract_z, z made in registers (no load of what was just stored). */
+LEMKE_INLINE void v4_extract_z(const lemke_state *st, double *z)
+{
+    int n = st->n;
+    const pd_lcp_work *ws = st->ws;
+    double zj[LEMKE_SMALL_N], m = 0.0;
+    LEMKE_UNROLL
+    for (int j = 0; j < LEMKE_SMALL_N; j++) {
+        if (j >= n)
+            break;
+        int r = ws->row_of[n + j];
+        zj[j] = r >= 0 ? ws->xb[r] : 0.0;
+        double a = fabs(zj[j]);
+        m = a > m ? a : m; /* max|z|, as pd_lcp_max_abs */
+    }
+    double floor_ = -LEMKE_VERIFY_TOL * m;
+    LEMKE_UNROLL
+    for (int j = 0; j < LEMKE_SMALL_N; j++) {
+        if (j >= n)
+            break;
+        z[j] = zj[j] < 0.0 && zj[j] >= floor_ ? 0.0 : zj[j];
+    }
+}
+
+/* pivot_loop in the vectors. */
+LEMKE_INLINE pd_lcp_outcome v4_pivot_loop(const lemke_state *st, int cap, int *pivots)
+{
+    int n = st->n, z0 = 2 * n;
+    pd_lcp_work *ws = st->ws;
+    v4_regs reg;
+    v4_start(st, &reg);
+    int r = first_leaving_row(st);
+    int leaving = ws->basis[r];
+    double xr = first_xr(st, r), rp = first_rp(st, r);
+    if (v4_pivot(st, &reg, r, z0, xr, rp) != 0)
+        return PD_LCP_NUMERICAL;
+    *pivots = 1;
+    for (int entering = complement(n, leaving);; entering = complement(n, leaving)) {
+        if (*pivots >= cap)
+            return PD_LCP_MAX_PIVOTS;
+        if (*pivots % LEMKE_REFINE_EVERY == 0)
+            v4_refine(st, &reg);
+        r = v4_ratio_test(st, &reg, v4_column(st, &reg, entering), &xr, &rp);
+        if (r == RATIO_RAY)
+            return PD_LCP_NO_SOLUTION;
+        if (r == RATIO_NUMERICAL)
+            return PD_LCP_NUMERICAL;
+        leaving = ws->basis[r];
+        if (v4_pivot(st, &reg, r, entering, xr, rp) != 0)
+            return PD_LCP_NUMERICAL;
+        ++*pivots;
+        if (leaving == z0) {
+            v4_refine(st, &reg); /* finish_solved's first, on the vectors */
+            return PD_LCP_SOLVED;
+        }
+    }
+}
+#endif
+
+LEMKE_LOOPS
+static pd_lcp_outcome finish_repaired(const lemke_state *st, double *z, double *w,
+                                      pd_lcp_info *info);
+
 /* A claimed solution: x_B refined until it verifies (at most LEMKE_FINAL_REFINES
  * times), else recomputed from the support (polish), else the better of the
  * two repaired (repair); solved if one verifies, else the better of the two
  * is returned as numerical.  The first refinement is never skipped: it buys
  * forward accuracy on ill-conditioned bases that the backward residual
- * alone would accept. */
-LEMKE_LOOPS
-static pd_lcp_outcome finish_solved(const lemke_state *st, double *z, double *w,
-                                    pd_lcp_info *info)
+ * alone would accept (in vectors, v4_pivot_loop makes it on its own). */
+LEMKE_INLINE pd_lcp_outcome finish_solved(const lemke_state *st, int vec, double *z, double *w,
+                                          pd_lcp_info *info)
 {
+    (void)vec; /* without LEMKE_VECTORS */
     for (int k = 0; k < LEMKE_FINAL_REFINES; k++) {
-        refine(st);
-        extract_z(st, z);
+#ifdef LEMKE_VECTORS
+        if (vec) {
+            if (k > 0) /* the first made by v4_pivot_loop */
+                v4_refine(st, NULL);
+            v4_extract_z(st, z);
+        } else
+#endif
+        {
+            refine(st);
+            extract_z(st, z);
+        }
         if (verify(st, z, w, info))
             return PD_LCP_SOLVED;
     }
+    return finish_repaired(st, z, w, info);
+}
+
+/* finish_solved once the refinements failed: the polish, the repair (cold
+ * code, in no vector build). */
+static pd_lcp_outcome finish_repaired(const lemke_state *st, double *z, double *w,
+                                      pd_lcp_info *info)
+{
     double pivoting = info->residual;
     int polished = polish(st, z) == 0;
     if (polished) {
@@ -624,54 +1021,110 @@ static pd_lcp_outcome finish_solved(const lemke_state *st, double *z, double *w,
     return PD_LCP_NUMERICAL;
 }
 
-/* max|x_k| over count entries; *finite cleared if one is NaN or infinite
- * (0 * x_k is NaN exactly then; four lanes so that -O2 vectorises it). */
-static double scan_max_abs(int count, const double *x, int *finite)
+/* The pivots from B = I and the answer they give, verified; vec and nn (=
+ * st0->n) constants where they can be. */
+LEMKE_INLINE pd_lcp_outcome pivot_and_finish(const lemke_state *st0, int vec, int nn, int cap,
+                                             double *z, double *w, pd_lcp_info *info)
 {
-    double p0 = 0.0, p1 = 0.0, p2 = 0.0, p3 = 0.0;
-    int k = 0;
-    for (; k + 4 <= count; k += 4) {
-        p0 += 0.0 * x[k];
-        p1 += 0.0 * x[k + 1];
-        p2 += 0.0 * x[k + 2];
-        p3 += 0.0 * x[k + 3];
+    lemke_state local = *st0;
+    local.n = nn;
+    const lemke_state *st = &local;
+#ifdef LEMKE_VECTORS
+    pd_lcp_outcome outcome = vec ? v4_pivot_loop(st, cap, &info->pivots)
+                                 : pivot_loop(st, cap, &info->pivots);
+#else
+    pd_lcp_outcome outcome = pivot_loop(st, cap, &info->pivots);
+#endif
+    if (outcome == PD_LCP_SOLVED)
+        return finish_solved(st, vec, z, w, info);
+    extract_z(st, z);
+    verify(st, z, w, info);
+    return outcome;
+}
+
+/* pivot_and_finish on the caller's workspace. */
+LEMKE_KERNEL
+static pd_lcp_outcome run_lemke(const lemke_state *st, int cap, double *z, double *w,
+                                pd_lcp_info *info)
+{
+    return pivot_and_finish(st, 0, st->n, cap, z, w, info);
+}
+
+#ifdef LEMKE_VECTORS
+/* pivot_and_finish in vectors on the stack, n a constant in each case; built
+ * for AVX2 alone, called only where the processor has it. */
+__attribute__((target("avx2"), optimize("no-tree-loop-distribute-patterns"))) static pd_lcp_outcome
+run_lemke_v4(const lemke_state *st, int cap, double *z, double *w, pd_lcp_info *info)
+{
+    switch (st->n) {
+    case 1: return pivot_and_finish(st, 1, 1, cap, z, w, info);
+    case 2: return pivot_and_finish(st, 1, 2, cap, z, w, info);
+    case 3: return pivot_and_finish(st, 1, 3, cap, z, w, info);
+    default: return pivot_and_finish(st, 1, 4, cap, z, w, info);
     }
-    for (; k < count; k++)
-        p0 += 0.0 * x[k];
-    if (isnan(p0 + p1 + p2 + p3))
-        *finite = 0;
-    return pd_lcp_max_abs(count, x);
 }
+#endif
 
-/* max|q|; 0 if every entry of q and M is finite. */
-static int scan_data(lemke_state *st)
+/* 0 if every one of count entries is finite, else -1: |x_k| <= DBL_MAX,
+ * in pairs (GNU C vectors of two lanes, native wherever there are SIMD
+ * registers) or four scalar lanes, no chain of operations to wait for. */
+static int scan_finite(int count, const double *x)
 {
-    int finite = 1;
-    st->qmax = scan_max_abs(st->n, st->q, &finite);
-    scan_max_abs(st->n * st->n, st->M, &finite);
-    return finite ? 0 : -1;
+    int k = 0, bad = 0;
+#ifdef __GNUC__
+    typedef double v2 __attribute__((vector_size(16), may_alias, aligned(8)));
+    typedef long long m2 __attribute__((vector_size(16)));
+    const v2 big = {DBL_MAX, DBL_MAX};
+    const m2 sign = {0x7fffffffffffffffLL, 0x7fffffffffffffffLL};
+    m2 ok = {-1, -1};
+    for (; k + 2 <= count; k += 2) {
+        v2 v = *(const v2 *)(x + k);
+        ok &= (m2)((v2)((m2)v & sign) <= big);
+    }
+    bad = !(ok[0] & ok[1]);
+#else
+    int b1 = 0, b2 = 0, b3 = 0;
+    for (; k + 4 <= count; k += 4) {
+        bad |= !(fabs(x[k]) <= DBL_MAX);
+        b1 |= !(fabs(x[k + 1]) <= DBL_MAX);
+        b2 |= !(fabs(x[k + 2]) <= DBL_MAX);
+        b3 |= !(fabs(x[k + 3]) <= DBL_MAX);
+    }
+    bad |= b1 | b2 | b3;
+#endif
+    for (; k < count; k++)
+        bad |= !(fabs(x[k]) <= DBL_MAX);
+    return bad ? -1 : 0;
 }
 
-/* Covering vector: the user's (all entries finite and > 0) or all ones. */
+/* max|q| into st->qmax and whether q >= 0 into *q_nonneg; 0 if every entry of
+ * q and M is finite, else -1. */
+static int scan_data(lemke_state *st, int *q_nonneg)
+{
+    const double *q = st->q;
+    double qmax = 0.0;
+    int neg = 0, bad = 0;
+    for (int i = 0; i < st->n; i++) {
+        double a = fabs(q[i]);
+        qmax = a > qmax ? a : qmax;
+        bad |= !(a <= DBL_MAX);
+        neg |= q[i] < 0.0;
+    }
+    st->qmax = qmax;
+    *q_nonneg = !neg;
+    return bad ? -1 : scan_finite(st->n * st->n, st->M);
+}
+
+/* Covering vector: the user's (all entries finite and > 0), read in place, or
+ * the workspace's all ones. */
 static int set_cover(lemke_state *st, const double *cover)
 {
-    double *d = st->ws->cover;
-    for (int i = 0; i < st->n; i++) {
-        d[i] = cover ? cover[i] : 1.0;
-        if (!(d[i] > 0.0) || !isfinite(d[i]))
+    st->unit_cover = !cover;
+    st->d = cover ? cover : st->ws->cover;
+    for (int i = 0; cover && i < st->n; i++)
+        if (!(cover[i] > 0.0) || !isfinite(cover[i]))
             return -1;
-    }
-    st->d = d;
     return 0;
-}
-
-/* All entries of q >= 0. */
-static int q_nonnegative(int n, const double *q)
-{
-    for (int i = 0; i < n; i++)
-        if (q[i] < 0.0)
-            return 0;
-    return 1;
 }
 
 /* Status code of an outcome. */
@@ -706,6 +1159,16 @@ pd_lcp_opts pd_lcp_default_opts(void)
                          .guess = NULL};
 }
 
+/* n = 2, support {s}: whether w of the other row, made as the verification
+ * makes it (q_o + M_os z_s, its size |q_o| + |M_os z_s|), is below 0 beyond
+ * the verification's tolerance, which would then fail. */
+static int other_row_fails(const lemke_state *st, int s, double zs)
+{
+    int o = 1 - s;
+    double p = st->M[o + 2 * s] * zs, wo = st->q[o] + p;
+    return wo < 0.0 && -wo / (fabs(st->q[o]) + fabs(p)) > LEMKE_VERIFY_TOL;
+}
+
 /* n <= 2: the supports {1}, {2}, {1, 2} by their closed forms (z_S =
  * -M_SS^-1 q_S, Cramer's rule), the first that verifies; 0 if none does
  * (Lemke's pivots then decide the outcome). */
@@ -720,6 +1183,8 @@ static int small_closed_form(const lemke_state *st, double *z, double *w, pd_lcp
             if (d == 0.0)
                 continue;
             z[s] = -q[s] / d;
+            if (n == 2 && other_row_fails(st, s, z[s]))
+                continue;
         } else {
             double det = M[0] * M[3] - M[2] * M[1];
             if (det == 0.0)
@@ -746,11 +1211,24 @@ int pd_lcp_lemke(pd_lcp_work *work, int n, const double *M, const double *q,
     info->outcome = PD_LCP_NUMERICAL;
     if (!work || !M || !q || !z || !w || n < 1 || n > work->nmax)
         return PD_EINVAL;
-    lemke_state st = {.n = n, .M = M, .q = q, .ws = work};
-    int cap = 0;
-    if (set_options(&st, opts, &cap) != 0 || scan_data(&st) != 0)
+    lemke_state st = {.n = n, .ld = n, .M = M, .q = q, .ws = work};
+#ifdef LEMKE_VECTORS
+    lemke_small small;
+    if (n <= LEMKE_SMALL_N && __builtin_cpu_supports("avx2")) {
+        small.ws = (pd_lcp_work){.nmax = LEMKE_SMALL_N, .binv = small.binv, .xb = small.xb,
+                                 .col = small.col, .cover = work->cover,
+                                 .scratch = small.scratch, .rows = small.rows,
+                                 .basis = small.basis, .row_of = small.row_of,
+                                 .ties = small.ties, .perm = small.perm};
+        st.ws = &small.ws;
+        st.ld = LEMKE_SMALL_N;
+        st.vec = 1;
+    }
+#endif
+    int cap = 0, q_nonneg = 0;
+    if (set_options(&st, opts, &cap) != 0 || scan_data(&st, &q_nonneg) != 0)
         return PD_EINVAL;
-    if (q_nonnegative(n, q)) {
+    if (q_nonneg) {
         memset(z, 0, (size_t)n * sizeof(double));
         info->outcome = verify(&st, z, w, info) ? PD_LCP_SOLVED : PD_LCP_NUMERICAL;
         return outcome_status(info->outcome);
@@ -759,13 +1237,12 @@ int pd_lcp_lemke(pd_lcp_work *work, int n, const double *M, const double *q,
         info->outcome = PD_LCP_SOLVED;
         return PD_OK;
     }
-    pd_lcp_outcome outcome = run_pivots(&st, cap, &info->pivots);
-    if (outcome == PD_LCP_SOLVED) {
-        outcome = finish_solved(&st, z, w, info);
-    } else {
-        extract_z(&st, z);
-        verify(&st, z, w, info);
-    }
+#ifdef LEMKE_VECTORS
+    pd_lcp_outcome outcome =
+        st.vec ? run_lemke_v4(&st, cap, z, w, info) : run_lemke(&st, cap, z, w, info);
+#else
+    pd_lcp_outcome outcome = run_lemke(&st, cap, z, w, info);
+#endif
     info->outcome = outcome;
     return outcome_status(outcome);
 }

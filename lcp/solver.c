@@ -8,7 +8,10 @@
  * numerical (or the structured solver as max_iterations) hands the problem
  * on: Lemke to the structured solver, and what neither finishes to PGS on
  * a bounded budget; a ray of Lemke's (no solution), its pivot cap and bad
- * input end the solve.  Every answer is verified, whoever gives it. */
+ * input end the solve.  Every answer is verified, whoever gives it.  A dense
+ * matrix that is mostly zeros (a band) reaches the structured solver as a
+ * compressed-column copy made in one pass (dense_copy). */
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -17,6 +20,10 @@
 #define HANDOVER_PGS_WORK 1e9 /* auto's last resort: PGS sweeps of at most this many
                                  multiply-adds in all (about a second) */
 #define HANDOVER_PGS_MIN 64   /* ... but at least this many sweeps */
+#define SPARSE_COPY_PER_ROW 17 /* a dense matrix for the structured solver with at most
+                                  this many nonzero entries a row on average (a band of
+                                  half-width 8), and no more than half of them nonzero,
+                                  is copied into compressed columns (dense_copy) */
 
 /* A method of the table. */
 typedef struct solver_type {
@@ -43,6 +50,9 @@ struct pd_lcp_solver {
     pd_bpp_work *bpp;         /* the structured solver */
     pd_pgs_work *pgs;
     unsigned char *flag;      /* nmax: scratch of the structured solver */
+    long copy_cap;            /* SPARSE_COPY_PER_ROW nmax: the entries of ... */
+    int *copy_colptr, *copy_rowind; /* ... a dense matrix's copy in compressed columns */
+    double *copy_values;            /* for the structured solver (dense_copy) */
 };
 
 const char *pd_lcp_method_name(pd_lcp_method method)
@@ -79,6 +89,9 @@ void pd_lcp_solver_free(pd_lcp_solver *s)
     pd_bpp_free(s->bpp);
     pd_pgs_free(s->pgs);
     free(s->flag);
+    free(s->copy_colptr);
+    free(s->copy_rowind);
+    free(s->copy_values);
     free(s);
 }
 
@@ -109,6 +122,13 @@ pd_lcp_solver *pd_lcp_solver_alloc(pd_lcp_method method, int nmax, long nnzmax, 
         /* the envelope of a banded matrix holds about half its entries */
         long env = nnzmax > 0 ? 2 * nnzmax + nmax : (long)nmax * (nmax + 1) / 2;
         if (!(s->bpp = pd_bpp_alloc(nmax, env)) || !(s->flag = malloc((size_t)nmax)))
+            goto oom;
+        /* dense input: room for a sparse one's copy (dense_copy) */
+        s->copy_cap = nnzmax > 0 ? 0 : (long)SPARSE_COPY_PER_ROW * nmax;
+        if (s->copy_cap > 0 &&
+            (!(s->copy_colptr = malloc(((size_t)nmax + 1) * sizeof(int))) ||
+             !(s->copy_rowind = malloc((size_t)s->copy_cap * sizeof(int))) ||
+             !(s->copy_values = malloc((size_t)s->copy_cap * sizeof(double)))))
             goto oom;
     }
     if (type->pgs && !(s->pgs = pd_pgs_alloc(nmax)))
@@ -145,13 +165,92 @@ static int solve_lemke(pd_lcp_solver *s, const pd_matrix *M, const double *q,
     return rc;
 }
 
+/* 1 when the 8 k doubles at x (k = 1 or 4) are all zeros (of either sign):
+ * their bits or'ed, the sign bit shifted off; in two-lane vectors where
+ * the compiler has them, so that a column is read at the speed of memory. */
+static inline int zeros(const double *x, int k)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    typedef uint64_t u64x2 __attribute__((vector_size(16)));
+    u64x2 v0, v1, v2, v3, acc = {0, 0};
+    for (int b = 0; b < k; b++, x += 8) {
+        memcpy(&v0, x, sizeof v0);
+        memcpy(&v1, x + 2, sizeof v1);
+        memcpy(&v2, x + 4, sizeof v2);
+        memcpy(&v3, x + 6, sizeof v3);
+        acc |= (v0 | v1) | (v2 | v3);
+    }
+    acc <<= 1;
+    return !(acc[0] | acc[1]);
+#else
+    uint64_t acc = 0, u;
+    for (int i = 0; i < 8 * k; i++) {
+        memcpy(&u, x + i, sizeof u);
+        acc |= u;
+    }
+    return !(acc << 1);
+#endif
+}
+
+/* A dense M with at most SPARSE_COPY_PER_ROW nonzero entries a row on
+ * average, and at most half of its entries nonzero, is copied into
+ * compressed columns in one pass over it: *out is then the copy (the same
+ * matrix, its zeros left out), and the structured solver works on its band
+ * (a chain's three diagonals: the tridiagonal direct method) instead of
+ * scanning whole columns in every product and factorisation.  Else *out is
+ * M, after at most the pass.  A column is read in blocks of 8 entries, a
+ * block of zeros (of either sign) skipped after one test; a NaN counts as
+ * nonzero, so it is kept. */
+static void dense_copy(pd_lcp_solver *s, const pd_matrix *M, pd_matrix *out)
+{
+    int n = M->rows;
+    long nz = 0, cap = (long)SPARSE_COPY_PER_ROW * n, half = (long)n * n / 2;
+    int *colptr = s->copy_colptr, *rowind = s->copy_rowind;
+    double *values = s->copy_values;
+    *out = *M;
+    cap = cap < half ? cap : half;
+    if (M->kind != PD_MATRIX_DENSE || !colptr || cap > s->copy_cap)
+        return;
+    for (int j = 0; j < n; j++) {
+        const double *c = M->values + (size_t)j * (size_t)n;
+        colptr[j] = (int)nz;
+        for (int i0 = 0; i0 < n; i0 += 8) {
+            int i1 = n - i0 >= 8 ? i0 + 8 : n;
+            if (n - i0 >= 32 && zeros(c + i0, 4)) { /* four cache lines at once */
+                i0 += 24;
+                continue;
+            }
+            if (i1 - i0 == 8 && zeros(c + i0, 1))
+                continue;
+            for (int i = i0; i < i1; i++)
+                if (c[i] != 0.0) { /* true for a NaN */
+                    if (nz == cap)
+                        return; /* too many: M as it is */
+                    rowind[nz] = i;
+                    values[nz++] = c[i];
+                }
+        }
+    }
+    colptr[n] = (int)nz;
+    *out = pd_matrix_csc(n, n, colptr, rowind, values);
+}
+
+/* The structured solver on M, or on its sparse copy (dense_copy). */
+static int solve_bpp(pd_lcp_solver *s, const pd_matrix *M, const double *q,
+                     const pd_lcp_opts *opts, double *z, double *w, pd_lcp_info *info)
+{
+    pd_matrix A;
+    dense_copy(s, M, &A);
+    return pd_bpp_solve(s->bpp, &A, q, opts, z, w, s->flag, info);
+}
+
 /* The structured solver; Lemke takes over a problem it cannot finish when
  * the problem fits Lemke's workspace. */
 static int solve_structured(pd_lcp_solver *s, const pd_matrix *M, const double *q,
                             const pd_lcp_opts *opts, double *z, double *w, pd_lcp_info *info)
 {
     info->solver = "structured";
-    int rc = pd_bpp_solve(s->bpp, M, q, opts, z, w, s->flag, info);
+    int rc = solve_bpp(s, M, q, opts, z, w, info);
     if (rc == PD_OK || M->rows > s->lemke_nmax || (M->kind == PD_MATRIX_CSC && !s->dense))
         return rc;
     int iterations = info->iterations;
@@ -203,7 +302,7 @@ static int solve_auto(pd_lcp_solver *s, const pd_matrix *M, const double *q,
         if (!hands_over(rc))
             return rc;
         int pivots = info->pivots;
-        rc = pd_bpp_solve(s->bpp, M, q, o, z, w, s->flag, info);
+        rc = solve_bpp(s, M, q, o, z, w, info);
         info->pivots = pivots;
         info->solver = "structured (after lemke)";
         if (!hands_over(rc))

@@ -49,6 +49,16 @@
 #define IPM_SHIFT 1e-8      /* regularisation of the least-squares start, times max M_ii */
 #define IPM_START 0.1       /* the start's distance from the boundary, times the scales */
 
+/* An interval a .. k of the support in the direct method for tridiagonal
+ * Stieltjes matrices (stieltjes_support): its rows condensed on the two
+ * ends, S (z_a, z_k) = f with S = [s11 s12; s12 s22] (a single row: s11
+ * z_a = f1), when the rows a - 1 and k + 1 next to it have z = 0; zk: the
+ * value of z_k then, once the interval is left behind. */
+typedef struct tri_port {
+    int a, k;
+    double s11, s12, s22, f1, f2, zk;
+} tri_port;
+
 struct pd_bpp_work {
     int nmax;
     long envmax;
@@ -72,6 +82,8 @@ struct pd_bpp_work {
     double *ta, *tb;    /* n: its diagonal A_ii and subdiagonal A_i,i-1 (tb_0 = 0) */
     double *tl, *tu;    /* n: the twisted factor's multipliers (tri_factor) */
     double *iz, *iw, *dz, *dw, *az, *aw, *r; /* n each: the interior point's */
+    tri_port *port;     /* n / 2 + 1: the support's intervals (stieltjes_support) */
+    int nport;          /* ... how many */
 };
 
 void pd_bpp_free(pd_bpp_work *ws)
@@ -98,6 +110,7 @@ void pd_bpp_free(pd_bpp_work *ws)
     double *ipm[] = {ws->iz, ws->iw, ws->dz, ws->dw, ws->az, ws->aw, ws->r};
     for (size_t k = 0; k < sizeof ipm / sizeof ipm[0]; k++)
         free(ipm[k]);
+    free(ws->port);
     free(ws);
 }
 
@@ -125,6 +138,7 @@ pd_bpp_work *pd_bpp_alloc(int nmax, long envmax)
     ws->mii = malloc(n * sizeof(double));
     ws->rz = malloc(n * sizeof(double));
     ws->sup = malloc(n);
+    ws->port = malloc((n / 2 + 1) * sizeof(tri_port));
     double **ipm[] = {&ws->iz, &ws->iw, &ws->dz, &ws->dw, &ws->az, &ws->aw, &ws->r,
                       &ws->ta, &ws->tb, &ws->tl, &ws->tu};
     int ok = 1;
@@ -132,7 +146,7 @@ pd_bpp_work *pd_bpp_alloc(int nmax, long envmax)
         ok &= (*ipm[k] = malloc(n * sizeof(double))) != NULL;
     if (!ok || !ws->inF || !ws->loc || !ws->glob || !ws->first || !ws->rowptr || !ws->env ||
         !ws->diag || !ws->rhs || !ws->rows || !ws->dinv || !ws->tmpl ||
-        !ws->mii || !ws->rz || !ws->sup) {
+        !ws->mii || !ws->rz || !ws->sup || !ws->port) {
         pd_bpp_free(ws);
         return NULL;
     }
@@ -218,11 +232,14 @@ static int load_envelope(pd_bpp_work *ws, const pd_matrix *M, int k)
  * multipliers l_i = A_i,i-1 / d_i-1 in tl), rows below upwards (pivots e_j,
  * u_j = A_j+1,j / e_j+1 in tu), both into row m (pivot g).  The two
  * continued fractions are independent, so they run side by side at half
- * the latency of one.  1 / pivot in dinv; -1 when a pivot is not positive. */
-static int tri_factor(pd_bpp_work *ws, int k, const double *shift)
+ * the latency of one.  1 / pivot in dinv; -1 when a pivot is not positive.
+ * The rows are off .. off + k - 1 of ta, tb (tb[off], the coupling to the
+ * row before, enters multiplied by 0), and of tl, tu, dinv; shift is
+ * indexed from 0 (the interior point's, with off = 0). */
+static int tri_factor(pd_bpp_work *ws, int off, int k, const double *shift)
 {
-    const double *a = ws->ta, *b = ws->tb;
-    double *tl = ws->tl, *tu = ws->tu, *dinv = ws->dinv, rd = 0.0, re = 0.0;
+    const double *a = ws->ta + off, *b = ws->tb + off;
+    double *tl = ws->tl + off, *tu = ws->tu + off, *dinv = ws->dinv + off, rd = 0.0, re = 0.0;
     int m = k / 2;
     if (k == 0) /* an empty support: nothing to factor */
         return 0;
@@ -254,9 +271,9 @@ static int tri_factor(pd_bpp_work *ws, int k, const double *shift)
 }
 
 /* x = (N P N^T)^-1 x in place, the two halves side by side. */
-static void tri_solve(const pd_bpp_work *ws, int k, double *x)
+static void tri_solve(const pd_bpp_work *ws, int off, int k, double *x)
 {
-    const double *tl = ws->tl, *tu = ws->tu, *dinv = ws->dinv;
+    const double *tl = ws->tl + off, *tu = ws->tu + off, *dinv = ws->dinv + off;
     int m = k / 2;
     if (k == 0)
         return;
@@ -355,9 +372,217 @@ static void envelope_solve(const pd_bpp_work *ws, int k, double *x)
 static void factor_solve(const pd_bpp_work *ws, int k, double *x)
 {
     if (ws->tridiagonal)
-        tri_solve(ws, k, x);
+        tri_solve(ws, 0, k, x);
     else
         envelope_solve(ws, k, x);
+}
+
+/* ---- tridiagonal Stieltjes matrices: a direct method ----------------------- *
+ * M tridiagonal and symmetric, with a positive diagonal and off-diagonal
+ * entries <= 0: once positive definite, a Stieltjes matrix (a symmetric
+ * M-matrix), as is the Delassus matrix of a row of bodies with a contact
+ * between each two neighbours.  Then M_FF^-1 >= 0 for every F, and the LCP
+ * is solved by Chandrasekaran's method: an index with w_i < 0 joins the
+ * support F, z_F = -M_FF^-1 q_F, until no w_i < 0 is left.  z only grows
+ * (the change solves M_FF dz_F = -w_i e_i >= 0), no index ever leaves, and
+ * the end is the LCP's solution (the least element of the feasible set),
+ * whatever order the indices join in.
+ *
+ * stieltjes_support runs it in one sweep from the first row to the last.
+ * The support is a stack of intervals (its components), each condensed on
+ * its two end rows (tri_port).  Row j joins when w_j = q_j + M_j,j-1 z_j-1
+ * < 0; that raises z along its interval, and the only w that can then fall
+ * below 0 is that of the row just left of the interval: it joins too,
+ * merging with the interval before it when they touch, and so on to the
+ * left.  Rows to the right of j are not seen yet (z = 0 there).  Each row
+ * joins at most once, and each join is one merge, O(1): the eliminations of
+ * the two rows where two intervals meet.  So the sweep is O(n) whatever the
+ * data, where pivoting moves an impact along a chain one index per solve
+ * and the interior point takes a number of iterations that grows with n.
+ * Its tests compare w's numerators with the end values' common denominator
+ * (the determinant of the condensed system), so that a row that joins the
+ * interval on top costs one division.  The sweep also reads M, column by
+ * column, and gives up at the first column that does not fit.
+ *
+ * Then z is solved on the support by the twisted factorisation, interval by
+ * interval, and verified as every other answer.  Condensation is Gaussian
+ * elimination in another order, backward stable on a positive definite
+ * matrix; a pivot below BPP_PIVOT_TOL times its diagonal entry (a singular
+ * M_FF: redundant contacts) ends the method, and the general one takes the
+ * problem. */
+
+#define STIELTJES_SYM 1e-12 /* M_i,i-1 and M_i-1,i equal to this, relative */
+
+/* The interval L followed by R (R->a = L->k + 1, beta = M_R->a,L->k) into
+ * *out (which may be R): rows c = L->k and d = R->a eliminated from the
+ * system of the four ends (a single-row interval has one); -1 when a pivot
+ * is not positive. */
+static inline int port_merge(const pd_bpp_work *ws, const tri_port *L, const tri_port *R,
+                             double beta, tri_port *out)
+{
+    /* row a: a1 z_a + m z_d = f; row d gains dd on its diagonal, df on its
+     * right-hand side, once row c is eliminated */
+    double a1 = L->s11, m = beta, f = L->f1, dd = 0.0, df = 0.0;
+    if (L->a < L->k) {
+        if (!(L->s22 > BPP_PIVOT_TOL * ws->ta[L->k]))
+            return -1;
+        double r = 1.0 / L->s22, lb = beta * r;
+        a1 -= L->s12 * L->s12 * r;
+        f -= L->s12 * L->f2 * r;
+        m = -L->s12 * lb;
+        dd = -beta * lb;
+        df = -L->f2 * lb;
+    }
+    double p = R->s11 + dd, h = R->f1 + df;
+    tri_port o = {.a = L->a, .k = R->k};
+    if (R->a == R->k) { /* d is the new end */
+        o.s11 = a1;
+        o.s12 = m;
+        o.s22 = p;
+        o.f1 = f;
+        o.f2 = h;
+    } else { /* eliminate row d */
+        if (!(p > BPP_PIVOT_TOL * ws->ta[R->a]))
+            return -1;
+        double r = 1.0 / p, mr = m * r, sr = R->s12 * r;
+        o.s11 = a1 - m * mr;
+        o.s12 = -R->s12 * mr;
+        o.s22 = R->s22 - R->s12 * sr;
+        o.f1 = f - h * mr;
+        o.f2 = R->f2 - h * sr;
+    }
+    *out = o;
+    return 0;
+}
+
+/* The end values of an interval with zero neighbours as z_a = *na / *den,
+ * z_k = *nk / *den, *den > 0; -1 when a pivot is not positive. */
+static inline int port_ends(const pd_bpp_work *ws, const tri_port *p, double *na, double *nk,
+                            double *den)
+{
+    if (p->a == p->k) { /* s11 = M_aa > 0 */
+        *na = *nk = p->f1;
+        *den = p->s11;
+        return 0;
+    }
+    *den = p->s11 * p->s22 - p->s12 * p->s12;
+    *na = p->s22 * p->f1 - p->s12 * p->f2;
+    *nk = p->s11 * p->f2 - p->s12 * p->f1;
+    return p->s11 > BPP_PIVOT_TOL * ws->ta[p->a] &&
+                   *den > BPP_PIVOT_TOL * p->s11 * ws->ta[p->k]
+               ? 0
+               : -1;
+}
+
+/* w_g = q_g + M_g,g-1 z_g-1 of a row g with z_g = 0 before the interval
+ * on top (z_g-1 from the last interval left behind, if it ends at g - 1);
+ * 0 for g < 0. */
+static inline double gap_w(const double *q, const double *b, const tri_port *st, int depth,
+                           int g)
+{
+    if (g < 0)
+        return 0.0;
+    return q[g] + (depth > 0 && st[depth - 1].k == g - 1 ? b[g] * st[depth - 1].zk : 0.0);
+}
+
+/* Chandrasekaran's method in one sweep (above), reading M as it goes: its
+ * diagonal into ta and subdiagonal into tb (tb[0] = 0), the support's
+ * intervals into ws->port.  1 when done; 0 when M is not in compressed
+ * columns, tridiagonal, symmetric (to STIELTJES_SYM), with a positive
+ * diagonal and off-diagonal entries <= 0; -1 when a pivot is not
+ * positive. */
+static int stieltjes_support(pd_bpp_work *ws, const pd_matrix *M, const double *q)
+{
+    int n = M->rows, depth = 0, has = 0;
+    const int *cp = M->colptr, *ri = M->rowind;
+    const double *v = M->values;
+    double *a = ws->ta, *b = ws->tb, na = 0.0, nk = 0.0, den = 1.0, c0 = 0.0;
+    tri_port *st = ws->port, t = {.a = -2, .k = -2}; /* t: the interval on top */
+    if (M->kind != PD_MATRIX_CSC)
+        return 0;
+    b[0] = 0.0;
+    for (int j = 0; j < n; j++) {
+        double d = 0.0, up = 0.0, lo = 0.0; /* column j: M_jj, M_j-1,j, M_j+1,j */
+        for (int k = cp[j]; k < cp[j + 1]; k++) {
+            int i = ri[k];
+            if (i == j)
+                d = v[k];
+            else if (i == j - 1)
+                up = v[k];
+            else if (i == j + 1 && i < n)
+                lo = v[k];
+            else
+                return 0;
+        }
+        if (!(d > 0.0) || !(up <= 0.0) || !(lo <= 0.0) ||
+            !(fabs(up - b[j]) <= STIELTJES_SYM * -(up + b[j]))) /* NaN fails */
+            return 0;
+        a[j] = d;
+        if (j + 1 < n)
+            b[j + 1] = lo;
+        /* row j: w_j = q_j + M_j,j-1 z_j-1 (z_j-1 = nk / den on top) */
+        int touch = has && t.k == j - 1;
+        if (!(touch ? q[j] * den + b[j] * nk < 0.0 : q[j] < 0.0))
+            continue; /* w_j >= 0 with z_j = 0 (or NaN: verification refuses it) */
+        tri_port one = {.a = j, .k = j, .s11 = d, .f1 = -q[j]};
+        if (touch) {
+            if (port_merge(ws, &t, &one, b[j], &t))
+                return -1;
+        } else {
+            if (has) { /* t is left behind: its right end value is final */
+                t.zk = nk / den;
+                st[depth++] = t;
+            }
+            t = one;
+            has = 1;
+            c0 = gap_w(q, b, st, depth, j - 1);
+        }
+        for (;;) { /* z rose along t: the row g left of it joins when
+                      w_g = c0 + M_g,a z_a < 0, c0 = q_g + M_g,g-1 z_g-1 */
+            if (port_ends(ws, &t, &na, &nk, &den))
+                return -1;
+            int g = t.a - 1;
+            if (g < 0 || !(c0 * den + b[t.a] * na < 0.0))
+                break;
+            int left = depth > 0 && st[depth - 1].k == g - 1;
+            one = (tri_port){.a = g, .k = g, .s11 = a[g], .f1 = -q[g]};
+            if (port_merge(ws, &one, &t, b[t.a], &t) ||
+                (left && port_merge(ws, &st[--depth], &t, b[g], &t)))
+                return -1;
+            c0 = gap_w(q, b, st, depth, t.a - 1);
+        }
+    }
+    if (has)
+        st[depth++] = t;
+    ws->nport = depth;
+    return 1;
+}
+
+/* z on the support of stieltjes_support (0 elsewhere), by the twisted
+ * factorisation of each interval; -1 when a pivot is not positive. */
+static int stieltjes_solve(pd_bpp_work *ws, int n, const double *q, double *z)
+{
+    int done = 0; /* z is set below this */
+    for (int p = 0; p < ws->nport; p++) {
+        int s = ws->port[p].a, k = ws->port[p].k - s + 1;
+        if (tri_factor(ws, s, k, NULL))
+            return -1;
+        memset(z + done, 0, (size_t)(s - done) * sizeof(double));
+        for (int i = s; i < s + k; i++)
+            z[i] = -q[i];
+        tri_solve(ws, s, k, z + s);
+        done = s + k;
+    }
+    memset(z + done, 0, (size_t)(n - done) * sizeof(double));
+    return 0;
+}
+
+int pd_bpp_stieltjes(pd_bpp_work *ws, const pd_matrix *M, const double *q, double *z)
+{
+    int rc = M->rows <= ws->nmax ? stieltjes_support(ws, M, q) : 0;
+    if (rc <= 0)
+        return rc;
+    return stieltjes_solve(ws, M->rows, q, z) ? -1 : 1;
 }
 
 /* z on F from the principal system, w = M z + q with the row sizes; the
@@ -375,7 +600,7 @@ static int principal_solve(pd_bpp_work *ws, const pd_matrix *M, const double *q,
     }
     if (load_envelope(ws, M, k))
         return -1;
-    if (ws->tridiagonal ? tri_factor(ws, k, NULL) : envelope_ldlt(ws, k))
+    if (ws->tridiagonal ? tri_factor(ws, 0, k, NULL) : envelope_ldlt(ws, k))
         return -2;
     for (int l = 0; l < k; l++)
         ws->rhs[l] = -q[ws->glob[l]];
@@ -508,7 +733,7 @@ static int ipm_pattern(pd_bpp_work *ws, const pd_matrix *M)
 static int ipm_factor(pd_bpp_work *ws, int n, const double *shift)
 {
     if (ws->tridiagonal)
-        return tri_factor(ws, n, shift);
+        return tri_factor(ws, 0, n, shift);
     memcpy(ws->env, ws->tmpl, (size_t)ws->rowptr[n] * sizeof(double));
     for (int i = 0; i < n; i++)
         ws->env[ws->rowptr[i] + i - ws->first[i]] += shift[i];
@@ -634,6 +859,13 @@ int pd_bpp_solve(pd_bpp_work *ws, const pd_matrix *M, const double *q, const pd_
     double qs = pd_lcp_max_abs(n, q), ds = 0.0;
     info->iterations = 0;
     info->outcome = PD_LCP_NUMERICAL;
+    /* a tridiagonal Stieltjes matrix: the direct method, one sweep and one
+     * principal solve, warm or cold */
+    if ((rc = pd_bpp_stieltjes(ws, M, q, z)) != 0) {
+        its = 1;
+        if (rc > 0 && accept(ws, M, q, z, w, info))
+            goto solved;
+    }
     for (int i = 0; i < n; i++) {
         ws->mii[i] = pd_matrix_get(M, i, i);
         ds = fmax(ds, ws->mii[i]);

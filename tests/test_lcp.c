@@ -780,6 +780,197 @@ static void test_lcp_cover_vector(pd_test_ctx *ctx)
     }
 }
 
+/* ---- the small problems' path and the fixed costs ----------------------------------- */
+
+/* Both answers, to the bit: status, outcome, pivots, figures, z and w. */
+static int same_answer(int n, int sa, const pd_lcp_info *a, const double *za, const double *wa,
+                       int sb, const pd_lcp_info *b, const double *zb, const double *wb)
+{
+    return sa == sb && a->outcome == b->outcome && a->pivots == b->pivots &&
+           !memcmp(&a->residual, &b->residual, sizeof(double)) &&
+           !memcmp(&a->complementarity, &b->complementarity, sizeof(double)) &&
+           !memcmp(&a->infeasibility, &b->infeasibility, sizeof(double)) &&
+           !memcmp(&a->scale, &b->scale, sizeof(double)) &&
+           !memcmp(za, zb, (size_t)n * sizeof(double)) && !memcmp(wa, wb, (size_t)n * sizeof(double));
+}
+
+/* A covering vector given as all ones and the default (NULL, all ones without a
+ * division by them: -q_i / 1 = -q_i, q_r / -1 = -q_r exactly) give the same
+ * answers to the bit, on the vector path (n <= 4) and the general one, for
+ * solved problems, rays and degenerate ones. */
+static void test_lcp_unit_cover_same_bits(pd_test_ctx *ctx)
+{
+    uint64_t rng = 0xc07e;
+    double ones[9] = {1, 1, 1, 1, 1, 1, 1, 1, 1};
+    for (int rep = 0; rep < 400; rep++) {
+        int n = 1 + rep % 9;
+        lcp_case c = case_new(n);
+        double *z2 = calloc((size_t)n, sizeof(double)), *w2 = calloc((size_t)n, sizeof(double));
+        if (!case_ok(&c) || !z2 || !w2) {
+            CHECK(ctx, 0, "out of memory");
+            free(z2);
+            free(w2);
+            case_free(&c);
+            return;
+        }
+        for (int k = 0; k < n * n; k++) /* integers: ties, singular blocks, rays */
+            c.M[k] = rep % 2 ? (double)((int)(pd_rand_next(&rng) % 5) - 2) : pd_rand_pm1(&rng);
+        for (int i = 0; i < n; i++)
+            c.q[i] = rep % 3 ? pd_rand_pm1(&rng) : (double)((int)(pd_rand_next(&rng) % 3) - 1);
+        pd_lcp_opts opts = pd_lcp_default_opts();
+        opts.cover = ones;
+        pd_lcp_info a, b;
+        int sa = solve(&c, NULL, &a);
+        int sb = solve(&(lcp_case){n, c.M, c.q, z2, w2}, &opts, &b);
+        CHECK(ctx, same_answer(n, sa, &a, c.z, c.w, sb, &b, z2, w2),
+              "rep %d, n = %d: cover NULL (status %d, %s, %d pivots) and ones (status %d, %s, %d "
+              "pivots) differ", rep, n, sa, pd_lcp_outcome_name(a.outcome), a.pivots, sb,
+              pd_lcp_outcome_name(b.outcome), b.pivots);
+        free(z2);
+        free(w2);
+        case_free(&c);
+    }
+}
+
+/* n = 1..4 (the vector path where the processor has AVX2), degenerate: M = I +
+ * G G^T with G in {-2..1}^(n x 2) (a P-matrix), q with zeros, repeats and
+ * entries of 1e-17 beside entries of order one: every answer solved,
+ * verified and the enumeration's (unique); the same again from a workspace
+ * sized for 40 that just solved a larger problem. */
+static void test_lcp_small_degenerate_vs_enumeration(pd_test_ctx *ctx)
+{
+    uint64_t rng = 0x5a11;
+    pd_lcp_work *big = pd_lcp_alloc(40);
+    CHECK(ctx, big != NULL, "out of memory");
+    for (int rep = 0; big && rep < 800; rep++) {
+        int n = 1 + rep % 4, G[8];
+        lcp_case c = case_new(n);
+        double z2[4], w2[4], qs[5] = {-2.0, -1.0, 0.0, 1e-17, -1e-17};
+        if (!case_ok(&c)) {
+            CHECK(ctx, 0, "out of memory");
+            case_free(&c);
+            break;
+        }
+        for (int e = 0; e < 2 * n; e++)
+            G[e] = (int)(pd_rand_next(&rng) % 4) - 2;
+        for (int j = 0; j < n; j++) {
+            for (int i = 0; i < n; i++)
+                c.M[i + j * n] = G[2 * i] * G[2 * j] + G[2 * i + 1] * G[2 * j + 1] + (i == j);
+            c.q[j] = qs[pd_rand_next(&rng) % 5];
+        }
+        pd_lcp_info a, b;
+        check_against_enumeration(ctx, &c, "small degenerate");
+        int sa = solve(&c, NULL, &a);
+        lcp_case large = case_new(40);
+        if (case_ok(&large)) {
+            random_spd(&large, 3, &rng);
+            random_q(&large, &rng);
+            pd_lcp_lemke(big, 40, large.M, large.q, NULL, large.z, large.w, NULL);
+        }
+        case_free(&large);
+        int sb = pd_lcp_lemke(big, n, c.M, c.q, NULL, z2, w2, &b);
+        CHECK(ctx, same_answer(n, sa, &a, c.z, c.w, sb, &b, z2, w2),
+              "rep %d, n = %d: a used workspace of 40 gives another answer", rep, n);
+        case_free(&c);
+    }
+    pd_lcp_free(big);
+}
+
+/* A NaN or an infinity anywhere in M or q is invalid input, whatever its
+ * place (the scan of M runs in pairs with a tail): PD_EINVAL, outcome
+ * numerical, z and w untouched. */
+static void test_lcp_nonfinite_anywhere(pd_test_ctx *ctx)
+{
+    const double bad[3] = {NAN, INFINITY, -INFINITY};
+    pd_lcp_work *work = pd_lcp_alloc(7);
+    double M[49], q[7], z[7], w[7];
+    for (int n = 1; work && n <= 7; n++) {
+        for (int k = 0; k < n * n + n; k++) {
+            for (int b = 0; b < 3; b++) {
+                for (int j = 0; j < n; j++) {
+                    for (int i = 0; i < n; i++)
+                        M[i + j * n] = i == j ? 2.0 : -0.5;
+                    q[j] = -1.0;
+                    z[j] = w[j] = 7.0;
+                }
+                if (k < n * n)
+                    M[k] = bad[b];
+                else
+                    q[k - n * n] = bad[b];
+                pd_lcp_info info;
+                int st = pd_lcp_lemke(work, n, M, q, NULL, z, w, &info);
+                int untouched = 1;
+                for (int i = 0; i < n; i++)
+                    untouched &= z[i] == 7.0 && w[i] == 7.0;
+                CHECK(ctx, st == PD_EINVAL && info.outcome == PD_LCP_NUMERICAL && untouched,
+                      "n = %d, entry %d = %g: status %d, outcome %s, z and w %s", n, k, bad[b],
+                      st, pd_lcp_outcome_name(info.outcome), untouched ? "kept" : "written");
+            }
+        }
+    }
+    pd_lcp_free(work);
+}
+
+/* A solve allocates nothing: n = 1..6 and 40, solved, rays, a covering
+ * vector, the closed forms, q >= 0. */
+static void test_lcp_solve_allocates_nothing(pd_test_ctx *ctx)
+{
+    uint64_t rng = 0xa110c;
+    pd_lcp_work *work = pd_lcp_alloc(40);
+    lcp_case c = case_new(40);
+    double d[40];
+    if (!work || !case_ok(&c)) {
+        CHECK(ctx, 0, "out of memory");
+        pd_lcp_free(work);
+        case_free(&c);
+        return;
+    }
+    for (int i = 0; i < 40; i++)
+        d[i] = 0.5 + i % 3;
+    int sizes[] = {1, 2, 3, 4, 5, 6, 40};
+    long before = pd_test_allocations();
+    int solved = 0, rays = 0;
+    for (int rep = 0; rep < 70; rep++) {
+        int n = sizes[rep % 7];
+        c.n = n;
+        for (int k = 0; k < n * n; k++)
+            c.M[k] = rep % 2 ? pd_rand_pm1(&rng) : (double)(k % (n + 1) == 0) + 0.1;
+        random_q(&c, &rng);
+        pd_lcp_opts opts = pd_lcp_default_opts();
+        opts.cover = rep % 5 == 0 ? d : NULL;
+        pd_lcp_info info;
+        int st = pd_lcp_lemke(work, n, c.M, c.q, &opts, c.z, c.w, &info);
+        solved += st == PD_OK;
+        rays += st == PD_ENOSOLUTION;
+    }
+    long used = pd_test_allocations() - before;
+    CHECK(ctx, used == 0, "%ld allocations in 70 solves (%d solved, %d rays)", used, solved, rays);
+    CHECK(ctx, solved > 0 && rays > 0, "both outcomes met: %d solved, %d rays", solved, rays);
+    pd_lcp_free(work);
+    c.n = 40;
+    case_free(&c);
+}
+
+/* n = 2, support {1}: the closed form's answer stands when w_2 < 0 is within
+ * the verification's tolerance of its row (|w_2| / (|q_2| + |M_21 z_1|) <=
+ * 1e-10), and gives way to the next support beyond it; 0 pivots either way. */
+static void test_lcp_closed_form_within_tolerance(pd_test_ctx *ctx)
+{
+    double M[4] = {1.0, 1.0, 1.0, 1.0}, z[2], w[2];
+    pd_lcp_work *work = pd_lcp_alloc(2);
+    pd_lcp_info info;
+    double q_in[2] = {-1.0, -1.0 - 1e-13}; /* w_2 = -1e-13, row size 2 */
+    int st = pd_lcp_lemke(work, 2, M, q_in, NULL, z, w, &info);
+    CHECK(ctx, st == PD_OK && info.pivots == 0 && z[0] == 1.0 && z[1] == 0.0 && w[1] < 0.0,
+          "within: status %d, %d pivots, z = (%g, %g), w_2 = %g", st, info.pivots, z[0], z[1],
+          w[1]);
+    double q_out[2] = {-1.0, -1.0 - 1e-9}; /* w_2 = -1e-9: support {2} */
+    st = pd_lcp_lemke(work, 2, M, q_out, NULL, z, w, &info);
+    CHECK(ctx, st == PD_OK && info.pivots == 0 && z[0] == 0.0 && z[1] == 1.0 + 1e-9,
+          "beyond: status %d, %d pivots, z = (%g, %.17g)", st, info.pivots, z[0], z[1]);
+    pd_lcp_free(work);
+}
+
 /* ---- workspace, arguments ----------------------------------------------------------- */
 
 static void test_lcp_workspace_reuse(pd_test_ctx *ctx)
@@ -1169,6 +1360,11 @@ void suite_lcp(pd_test_ctx *ctx)
     PD_RUN(ctx, test_lcp_numerical_outcome);
     PD_RUN(ctx, test_lcp_max_pivots);
     PD_RUN(ctx, test_lcp_cover_vector);
+    PD_RUN(ctx, test_lcp_unit_cover_same_bits);
+    PD_RUN(ctx, test_lcp_small_degenerate_vs_enumeration);
+    PD_RUN(ctx, test_lcp_nonfinite_anywhere);
+    PD_RUN(ctx, test_lcp_solve_allocates_nothing);
+    PD_RUN(ctx, test_lcp_closed_form_within_tolerance);
     PD_RUN(ctx, test_lcp_workspace_reuse);
     PD_RUN(ctx, test_lcp_invalid_arguments);
     PD_RUN(ctx, test_lcp_outcome_names);

@@ -10,6 +10,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "lcp_internal.h"
 #include "pd_problems.h"
 #include "pd_test.h"
 
@@ -670,6 +671,398 @@ static void test_solvers_auto_hands_over(pd_test_ctx *ctx)
           info.pivots);
 }
 
+/* ---- the direct method for tridiagonal Stieltjes matrices ------------------ */
+
+/* A tridiagonal Stieltjes matrix in compressed columns (and dense): its
+ * diagonal a, its subdiagonal b (b[0] unused, entries <= 0). */
+static void tri_csc(int n, const double *a, const double *b, int *colptr, int *rowind,
+                    double *values, double *dense)
+{
+    int k = 0;
+    for (int j = 0; j < n; j++) {
+        colptr[j] = k;
+        if (j > 0) {
+            rowind[k] = j - 1;
+            values[k++] = b[j];
+        }
+        rowind[k] = j;
+        values[k++] = a[j];
+        if (j + 1 < n) {
+            rowind[k] = j + 1;
+            values[k++] = b[j + 1];
+        }
+    }
+    colptr[n] = k;
+    if (dense) {
+        memset(dense, 0, (size_t)n * (size_t)n * sizeof(double));
+        pd_matrix M = pd_matrix_csc(n, n, colptr, rowind, values);
+        pd_matrix_to_dense(&M, dense);
+    }
+}
+
+/* Problem `kind` of size n from a seed, into a, b, q (z*: its solution, when
+ * kind 2 builds it):
+ *   0  diagonally dominant: b_i in (-1, 0] (some exactly 0: the chain cut),
+ *      a_i = |b_i| + |b_i+1| + s_i, s_i in [1e-3, 1); q in [-1, 1) with
+ *      exact zeros and entries of 1e-17;
+ *   1  S A S of kind 0 with s_i in [0.1, 10]: not diagonally dominant;
+ *   2  the chain tridiag(-1, 2, -1) with q = w* - M z*, z* in {0, 1, 2}, w*
+ *      in {0, 1} off the support of z*, and a third of the indices with
+ *      z* = w* = 0 (degenerate: zero gaps that neither push nor open), all
+ *      in integers, exact;
+ *   3  the chain with q = -e_1 (an impact that runs along touching bodies:
+ *      every other q_i = 0). */
+static void stieltjes_problem(int kind, int n, uint64_t seed, double *a, double *b, double *q,
+                              double *zstar)
+{
+    uint64_t s = seed;
+    for (int i = 0; i < n; i++) {
+        double u = rnd(&s);
+        b[i] = kind >= 2 ? -1.0 : i == 0 || u > 0.8 ? 0.0 : -0.5 * (u + 1.0);
+    }
+    b[0] = 0.0;
+    for (int i = 0; i < n; i++)
+        a[i] = kind >= 2 ? 2.0
+                         : -b[i] - (i + 1 < n ? b[i + 1] : 0.0) + 1e-3 + 0.5 * (rnd(&s) + 1.0);
+    if (kind == 1) {
+        double sc[16];
+        for (int i = 0; i < n; i++)
+            sc[i] = pow(10.0, rnd(&s));
+        for (int i = 0; i < n; i++) {
+            a[i] *= sc[i] * sc[i];
+            b[i] *= i > 0 ? sc[i] * sc[i - 1] : 0.0;
+        }
+    }
+    for (int i = 0; i < n; i++) {
+        double u = rnd(&s);
+        q[i] = u < -0.8 ? 0.0 : u > 0.85 ? (u > 0.92 ? 1e-17 : -1e-17) : rnd(&s);
+        zstar[i] = 0.0;
+    }
+    if (kind == 2) {
+        double wstar[16];
+        for (int i = 0; i < n; i++) {
+            double u = rnd(&s);
+            zstar[i] = u < -1.0 / 3 ? 0.0 : u < 1.0 / 3 ? 1.0 : 2.0;
+            wstar[i] = zstar[i] > 0.0 || rnd(&s) < 0.0 ? 0.0 : 1.0;
+        }
+        for (int i = 0; i < n; i++)
+            q[i] = wstar[i] - 2.0 * zstar[i] + (i > 0 ? zstar[i - 1] : 0.0) +
+                   (i + 1 < n ? zstar[i + 1] : 0.0);
+    }
+    if (kind == 3)
+        for (int i = 0; i < n; i++)
+            q[i] = i == 0 ? -1.0 : 0.0;
+}
+
+/* max_i |x_i - y_i| over max(max_i |y_i|, tiny). */
+static double rel_diff(int n, const double *x, const double *y)
+{
+    double d = 0.0, s = 0.0;
+    for (int i = 0; i < n; i++) {
+        d = fmax(d, fabs(x[i] - y[i]));
+        s = fmax(s, fabs(y[i]));
+    }
+    return d / fmax(s, 1e-300);
+}
+
+/* The direct method itself (pd_bpp_stieltjes), then the structured solver
+ * through the table, against the enumeration oracle on the four kinds of
+ * stieltjes_problem, n = 1..10 (800 cases): the direct method takes each
+ * one, and the table's answer is the structured solver's own, verified,
+ * in one iteration. */
+static void test_solvers_stieltjes_oracle(pd_test_ctx *ctx)
+{
+    int cases = 0;
+    pd_bpp_work *ws = pd_bpp_alloc(10, 100);
+    if (!CHECK(ctx, ws != NULL, "memory"))
+        return;
+    for (int kind = 0; kind < 4; kind++)
+        for (int n = 1; n <= 10; n++)
+            for (uint64_t seed = 1; seed <= 20; seed++) {
+                int colptr[11], rowind[30];
+                double a[10], b[10], q[10], zs[10], values[30], dense[100], zo[10], wo[10];
+                double z[10], w[10];
+                stieltjes_problem(kind, n, seed * 7919 + (uint64_t)(n + 13 * kind), a, b, q, zs);
+                tri_csc(n, a, b, colptr, rowind, values, dense);
+                pd_matrix M = pd_matrix_csc(n, n, colptr, rowind, values);
+                if (!CHECK(ctx, pd_lcp_enumerate(n, dense, q, zo, wo) == PD_OK, "oracle n %d", n))
+                    continue;
+                cases++;
+                int rc = pd_bpp_stieltjes(ws, &M, q, z);
+                double d = rel_diff(n, z, zo), res = 1.0;
+                pd_lcp_residual(n, dense, q, z, w, NULL, NULL, &res);
+                CHECK(ctx, rc == 1 && d <= 1e-12 && res <= 1e-10,
+                      "direct, kind %d n %d seed %llu: %d, |z - z_oracle| %.3g, residual %.3g",
+                      kind, n, (unsigned long long)seed, rc, d, res);
+                if (kind == 2)
+                    CHECK(ctx, rel_diff(n, z, zs) <= 1e-15, "kind 2 n %d: not z*", n);
+                pd_lcp_info info;
+                int st = solve_with(PD_LCP_STRUCTURED, &M, q, NULL, z, w, &info);
+                d = rel_diff(n, z, zo);
+                CHECK(ctx, st == PD_OK && !strcmp(info.solver, "structured") &&
+                               info.iterations == 1 && d <= 1e-12,
+                      "structured, kind %d n %d seed %llu: status %d by %s, %d iterations, "
+                      "|z - z_oracle| %.3g",
+                      kind, n, (unsigned long long)seed, st, info.solver, info.iterations, d);
+            }
+    CHECK(ctx, cases == 800, "%d cases", cases);
+    pd_bpp_free(ws);
+}
+
+/* Where the direct method does not apply it says so (0) and the structured
+ * solver answers as before: a positive off-diagonal entry, a nonsymmetric
+ * pair, an entry beyond the tridiagonal band (even an explicit 0), a dense
+ * view; where a principal block is singular (the Laplacian of two free
+ * bodies, q = (-1, -1): infeasible) it stops at the pivot (-1), and no
+ * solver calls the problem solved. */
+static void test_solvers_stieltjes_not_taken(pd_test_ctx *ctx)
+{
+    pd_bpp_work *ws = pd_bpp_alloc(4, 64);
+    if (!CHECK(ctx, ws != NULL, "memory"))
+        return;
+    int colptr[5] = {0, 2, 5, 8, 10}, rowind[10] = {0, 1, 0, 1, 2, 1, 2, 3, 2, 3};
+    double z[4], w[4], zo[4], wo[4], q[4] = {-1.0, 0.5, -0.25, 0.1};
+    const double base[10] = {2, -1, -1, 2, -1, -1, 2, -1, -1, 2};
+    for (int c = 0; c < 3; c++) {
+        double v[10], dense[16];
+        memcpy(v, base, sizeof v);
+        if (c == 0) /* M_12 = M_21 > 0 */
+            v[3] = v[5] = 0.5;
+        else if (c == 1) /* M_12 != M_21 */
+            v[5] = -0.5;
+        pd_matrix M = pd_matrix_csc(4, 4, colptr, rowind, v);
+        if (c == 2) { /* the dense view of the chain */
+            pd_matrix_to_dense(&M, dense);
+            M = pd_matrix_dense(4, 4, dense);
+        }
+        CHECK(ctx, pd_bpp_stieltjes(ws, &M, q, z) == 0, "case %d taken", c);
+        pd_lcp_info info;
+        int st = solve_with(PD_LCP_STRUCTURED, &M, q, NULL, z, w, &info);
+        if (c == 1) { /* nonsymmetric: the table still answers, verified */
+            CHECK(ctx, st == PD_OK && info.residual <= 1e-10, "case 1: status %d", st);
+            continue;
+        }
+        if (c == 0)
+            pd_matrix_to_dense(&M, dense);
+        pd_lcp_enumerate(4, dense, q, zo, wo);
+        CHECK(ctx, st == PD_OK && rel_diff(4, z, zo) <= 1e-12, "case %d: status %d by %s", c,
+              st, info.solver);
+    }
+    { /* pentadiagonal pattern with an explicit zero at (0, 2) */
+        int cp[5] = {0, 3, 6, 10, 12}, ri[12] = {0, 1, 2, 0, 1, 2, 0, 1, 2, 3, 2, 3};
+        double v[12] = {2, -1, 0, -1, 2, -1, 0, -1, 2, -1, -1, 2};
+        pd_matrix M = pd_matrix_csc(4, 4, cp, ri, v);
+        CHECK(ctx, pd_bpp_stieltjes(ws, &M, q, z) == 0, "pentadiagonal pattern taken");
+    }
+    { /* singular: D = [1 -1; -1 1], q = (-1, -1) */
+        int cp[3] = {0, 2, 4}, ri[4] = {0, 1, 0, 1};
+        double v[4] = {1, -1, -1, 1}, q2[2] = {-1.0, -1.0};
+        pd_matrix M = pd_matrix_csc(2, 2, cp, ri, v);
+        CHECK(ctx, pd_bpp_stieltjes(ws, &M, q2, z) == -1, "singular block: not -1");
+        pd_lcp_info info;
+        int st = solve_with(PD_LCP_STRUCTURED, &M, q2, NULL, z, w, &info);
+        CHECK(ctx, st != PD_OK && info.outcome != PD_LCP_SOLVED, "singular: status %d", st);
+    }
+    pd_bpp_free(ws);
+}
+
+/* The direct method against the solver it bypasses, at sizes the oracle
+ * cannot reach: chains of 3000 and 20000 bodies of random masses in [0.5,
+ * 2] (D_ii = 1/m_i + 1/m_i+1, D_i,i+1 = -1/m_i+1), q random (with zeros) or
+ * an impact at the first contact, every other q_i = 0 or 1e-4 (a support
+ * that grows along the whole chain); the same matrix with one explicit zero
+ * outside the band (so not taken: pivoting and the interior point) gives
+ * the same z to 1e-8.  The direct answer takes one iteration, the other at
+ * least two on the impacts.  At 400, Lemke on the dense matrix agrees. */
+static void test_solvers_stieltjes_large(pd_test_ctx *ctx)
+{
+    const int sizes[] = {400, 3000, 20000};
+    for (int k = 0; k < 3; k++)
+        for (int form = 0; form < 3; form++) {
+            int n = sizes[k];
+            size_t un = (size_t)n;
+            double *a = malloc(un * sizeof(double)), *b = malloc(un * sizeof(double));
+            double *q = malloc(un * sizeof(double)), *z = malloc(un * sizeof(double));
+            double *w = malloc(un * sizeof(double)), *z2 = malloc(un * sizeof(double));
+            double *m = malloc((un + 1) * sizeof(double));
+            double *values = malloc(3 * un * sizeof(double));
+            int *colptr = malloc((un + 1) * sizeof(int)), *rowind = malloc(3 * un * sizeof(int));
+            int *cp2 = malloc((un + 1) * sizeof(int)), *ri2 = malloc((3 * un + 2) * sizeof(int));
+            double *v2 = malloc((3 * un + 2) * sizeof(double));
+            if (!CHECK(ctx, a && b && q && z && w && z2 && m && values && colptr && rowind && cp2 &&
+                                ri2 && v2,
+                       "memory"))
+                goto next;
+            uint64_t s = 1234u + (uint64_t)(31 * k + form);
+            for (int i = 0; i <= n; i++)
+                m[i] = pow(2.0, rnd(&s));
+            for (int i = 0; i < n; i++) {
+                a[i] = 1.0 / m[i] + 1.0 / m[i + 1];
+                b[i] = i > 0 ? -1.0 / m[i] : 0.0;
+                double u = rnd(&s);
+                q[i] = form == 0   ? (u < -0.9 ? 0.0 : rnd(&s))
+                       : i == 0    ? -1.0
+                       : form == 1 ? 0.0
+                                   : 1e-4;
+            }
+            tri_csc(n, a, b, colptr, rowind, values, NULL);
+            pd_matrix M = pd_matrix_csc(n, n, colptr, rowind, values);
+            pd_lcp_info info, i2;
+            int st = solve_with(PD_LCP_STRUCTURED, &M, q, NULL, z, w, &info);
+            CHECK(ctx, st == PD_OK && info.iterations == 1 && !strcmp(info.solver, "structured"),
+                  "n %d form %d: status %d by %s, %d iterations", n, form, st, info.solver,
+                  info.iterations);
+            /* the same matrix with an explicit zero at (2, 0) and (0, 2) */
+            int t = 0;
+            for (int j = 0; j < n; j++) {
+                cp2[j] = t;
+                for (int r = colptr[j]; r < colptr[j + 1]; r++) {
+                    if (j == 2 && rowind[r] == 1) {
+                        ri2[t] = 0;
+                        v2[t++] = 0.0;
+                    }
+                    ri2[t] = rowind[r];
+                    v2[t++] = values[r];
+                    if (j == 0 && rowind[r] == 1) {
+                        ri2[t] = 2;
+                        v2[t++] = 0.0;
+                    }
+                }
+            }
+            cp2[n] = t;
+            pd_matrix M2 = pd_matrix_csc(n, n, cp2, ri2, v2);
+            int st2 = solve_with(PD_LCP_STRUCTURED, &M2, q, NULL, z2, w, &i2);
+            double d = rel_diff(n, z, z2);
+            CHECK(ctx, st2 == PD_OK && d <= 1e-8 && (form == 0 || i2.iterations >= 2),
+                  "n %d form %d: pivoting / interior point status %d (%d iterations), |dz| %.3g",
+                  n, form, st2, i2.iterations, d);
+            if (n <= 500) {
+                double *dense = malloc(un * un * sizeof(double));
+                if (dense) {
+                    pd_matrix_to_dense(&M, dense);
+                    pd_matrix Md = pd_matrix_dense(n, n, dense);
+                    st2 = solve_with(PD_LCP_LEMKE, &Md, q, NULL, z2, w, &i2);
+                    d = rel_diff(n, z, z2);
+                    CHECK(ctx, st2 == PD_OK && d <= 1e-8,
+                          "n %d form %d: lemke status %d, |dz| %.3g", n, form, st2, d);
+                }
+                free(dense);
+            }
+        next:
+            free(a);
+            free(b);
+            free(q);
+            free(z);
+            free(w);
+            free(z2);
+            free(m);
+            free(values);
+            free(colptr);
+            free(rowind);
+            free(cp2);
+            free(ri2);
+            free(v2);
+        }
+}
+
+/* Warm starts on a Stieltjes chain (2000 contacts): the direct method does
+ * not need one, and any guess -- right, wrong everywhere, no idea, random
+ * -- gives the cold answer, bit for bit, in one iteration. */
+static void test_solvers_stieltjes_warm(pd_test_ctx *ctx)
+{
+    chain c;
+    int n = 2000;
+    double *zc = malloc((size_t)n * sizeof(double));
+    unsigned char *guess = malloc((size_t)n);
+    if (!CHECK(ctx, chain_make(&c, n, 99u) == 0 && zc && guess, "memory"))
+        goto done;
+    pd_matrix M = pd_matrix_csc(n, n, c.colptr, c.rowind, c.values);
+    pd_lcp_info info;
+    int st = solve_with(PD_LCP_STRUCTURED, &M, c.q, NULL, zc, c.w, &info);
+    CHECK(ctx, st == PD_OK && info.iterations == 1, "cold: status %d, %d iterations", st,
+          info.iterations);
+    uint64_t s = 5u;
+    for (int g = 0; g < 4; g++) {
+        for (int i = 0; i < n; i++)
+            guess[i] = g == 0 ? zc[i] > 0.0 : g == 1 ? !(zc[i] > 0.0) : g == 2 ? 2 : rnd(&s) < 0.0;
+        pd_lcp_opts o = pd_lcp_default_opts();
+        o.guess = guess;
+        st = solve_with(PD_LCP_STRUCTURED, &M, c.q, &o, c.z, c.w, &info);
+        CHECK(ctx,
+              st == PD_OK && info.iterations == 1 &&
+                  !memcmp(c.z, zc, (size_t)n * sizeof(double)),
+              "guess %d: status %d, %d iterations, |dz| %.3g", g, st, info.iterations,
+              rel_diff(n, c.z, zc));
+    }
+done:
+    chain_free(&c);
+    free(zc);
+    free(guess);
+}
+
+/* A banded matrix given densely (a plain LCP file) is copied once into
+ * compressed columns for the structured solver: a tridiagonal Stieltjes one
+ * of 300 rows with an impact at its first row is answered by the direct
+ * method (one iteration, where pivoting and the interior point take more),
+ * bit for bit as in compressed columns; the same with one more pair of
+ * entries far from the band (-1e-3 at (0, 299)) is answered on the copy by
+ * the general method and agrees with Lemke; a dense SPD matrix with more
+ * entries than the copy holds (17 a row) is solved as it is. */
+static void test_solvers_dense_banded(pd_test_ctx *ctx)
+{
+    enum { N = 300 };
+    double *dense = malloc((size_t)N * N * sizeof(double)), a[N], b[N], q[N], z[N], w[N];
+    double zc[N], zl[N];
+    int colptr[N + 1], rowind[3 * N];
+    double values[3 * N];
+    if (!CHECK(ctx, dense != NULL, "memory"))
+        return;
+    for (int i = 0; i < N; i++) {
+        a[i] = 2.0;
+        b[i] = i > 0 ? -1.0 : 0.0;
+        q[i] = i == 0 ? -1.0 : 1e-3;
+    }
+    tri_csc(N, a, b, colptr, rowind, values, dense);
+    pd_matrix Mc = pd_matrix_csc(N, N, colptr, rowind, values), Md = pd_matrix_dense(N, N, dense);
+    pd_lcp_info ic, id;
+    int sc = solve_with(PD_LCP_STRUCTURED, &Mc, q, NULL, zc, w, &ic);
+    int sd = solve_with(PD_LCP_STRUCTURED, &Md, q, NULL, z, w, &id);
+    CHECK(ctx, sc == PD_OK && sd == PD_OK && ic.iterations == 1 && id.iterations == 1 &&
+                   !strcmp(id.solver, "structured") && !memcmp(z, zc, sizeof z),
+          "tridiagonal: compressed status %d (%d iterations), dense status %d by %s (%d "
+          "iterations), |dz| %.3g",
+          sc, ic.iterations, sd, id.solver, id.iterations, rel_diff(N, z, zc));
+    dense[0 + (size_t)(N - 1) * N] = dense[N - 1] = -1e-3;
+    sd = solve_with(PD_LCP_STRUCTURED, &Md, q, NULL, z, w, &id);
+    int sl = solve_with(PD_LCP_LEMKE, &Md, q, NULL, zl, w, &ic);
+    CHECK(ctx, sd == PD_OK && !strcmp(id.solver, "structured") && sl == PD_OK &&
+                   rel_diff(N, z, zl) <= 1e-9,
+          "one entry off the band: status %d by %s, lemke %d, |dz| %.3g", sd, id.solver, sl,
+          rel_diff(N, z, zl));
+    { /* 30 x 30 SPD, full: 900 entries, more than 17 * 30 */
+        double M[900], qq[30], z1[30], w1[30], z2[30];
+        uint64_t s = 77u;
+        double B[900];
+        for (int k = 0; k < 900; k++)
+            B[k] = rnd(&s);
+        for (int j = 0; j < 30; j++)
+            for (int i = 0; i < 30; i++) {
+                double x = i == j ? 7.5 : 0.0;
+                for (int r = 0; r < 30; r++)
+                    x += B[r + i * 30] * B[r + j * 30];
+                M[i + j * 30] = x;
+            }
+        for (int i = 0; i < 30; i++)
+            qq[i] = 2.0 * rnd(&s);
+        pd_matrix A = pd_matrix_dense(30, 30, M);
+        sd = solve_with(PD_LCP_STRUCTURED, &A, qq, NULL, z1, w1, &id);
+        sl = solve_with(PD_LCP_LEMKE, &A, qq, NULL, z2, w1, &ic);
+        CHECK(ctx, sd == PD_OK && sl == PD_OK && rel_diff(30, z1, z2) <= 1e-9,
+              "full 30 x 30: status %d by %s, lemke %d", sd, id.solver, sl);
+    }
+    free(dense);
+}
+
 void suite_solvers(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_solvers_match_oracle);
@@ -687,4 +1080,9 @@ void suite_solvers(pd_test_ctx *ctx)
     PD_RUN(ctx, test_solvers_rounding_size_q);
     PD_RUN(ctx, test_solvers_auto_hands_over);
     PD_RUN(ctx, test_solvers_subnormal_never_solved);
+    PD_RUN(ctx, test_solvers_stieltjes_oracle);
+    PD_RUN(ctx, test_solvers_stieltjes_not_taken);
+    PD_RUN(ctx, test_solvers_stieltjes_large);
+    PD_RUN(ctx, test_solvers_stieltjes_warm);
+    PD_RUN(ctx, test_solvers_dense_banded);
 }
