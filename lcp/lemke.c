@@ -639,10 +639,12 @@ LEMKE_INLINE double first_xr(const lemke_state *st, int r)
     return st->unit_cover ? -st->q[r] : st->q[r] / -st->d[r];
 }
 
+#ifdef LEMKE_VECTORS /* only the vector path takes the reciprocal */
 LEMKE_INLINE double first_rp(const lemke_state *st, int r)
 {
     return st->unit_cover ? -1.0 : 1.0 / -st->d[r];
 }
+#endif
 
 /* The pivoting loop from B = I until z0 leaves, a ray, or the cap. */
 LEMKE_INLINE pd_lcp_outcome pivot_loop(const lemke_state *st, int cap, int *pivots)
