@@ -52,5 +52,8 @@ int pd_plot_with(const char *png, pd_plot_data_fn *data_fn, pd_plot_script_fn *s
  * '`' and '@' as octal escapes, control bytes and bytes beyond ASCII as '?'.
  * Every text and file name in a script goes through it. */
 void pd_plot_text(FILE *g, const char *s);
+/* s as a gnuplot string literal shown literally in enhanced text (names:
+ * '_', '^', '{', '}', '@', '&', '~' escaped): chart titles and keys. */
+void pd_plot_literal(FILE *g, const char *s);
 
 #endif

@@ -52,6 +52,24 @@ void pd_plot_text(FILE *g, const char *s)
     fputc('"', g);
 }
 
+/* s as a gnuplot string literal shown as it is in enhanced text: names
+ * (records, structures, files) whose '_' or '^' would otherwise become
+ * subscripts and superscripts ("NGA_no_1063" as "NGA_n o_1 063"). */
+void pd_plot_literal(FILE *g, const char *s)
+{
+    fputc('"', g);
+    for (const unsigned char *c = (const unsigned char *)(s ? s : ""); *c; c++)
+        if (*c == '"' || *c == '\\')
+            fprintf(g, "\\\\\\%c", *c); /* a literal backslash or quote */
+        else if (strchr("_^{}&~", *c))
+            fprintf(g, "\\\\%c", *c);
+        else if (*c == '`' || *c == '@')
+            fprintf(g, "\\\\\\%03o", (unsigned)*c);
+        else
+            fputc(*c >= 0x20 && *c < 0x7f ? *c : '?', g);
+    fputc('"', g);
+}
+
 /* A guide line of slope s through the first point of the first curve. */
 static void slope_guide(FILE *g, const pd_chart *c)
 {
@@ -75,7 +93,7 @@ static void chart_script(FILE *g, const char *data, const char *png_tmp, const v
     if (c->logy)
         fputs("set logscale y\nset format y '10^{%L}'\n", g);
     fputs("set title ", g);
-    pd_plot_text(g, c->title);
+    pd_plot_literal(g, c->title);
     fputs("\nset xlabel ", g);
     pd_plot_text(g, c->xlabel);
     fputs("\nset ylabel ", g);
@@ -96,7 +114,7 @@ static void chart_script(FILE *g, const char *data, const char *png_tmp, const v
         fprintf(g, "set arrow from %.17g, graph 0 to %.17g, graph 1 nohead dt 3 lc rgb 'black'\n",
                 c->vline, c->vline);
         fprintf(g, "set label ");
-        pd_plot_text(g, c->vline_label ? c->vline_label : "");
+        pd_plot_literal(g, c->vline_label ? c->vline_label : "");
         fprintf(g, " at %.17g, graph 0.05 right offset -0.5,0\n", c->vline);
     }
     fputs("plot ", g);
@@ -106,7 +124,7 @@ static void chart_script(FILE *g, const char *data, const char *png_tmp, const v
         fputs(k ? ", " : "", g);
         pd_plot_text(g, data);
         fprintf(g, " index %d with %s title ", k, styles[c->curves[k].style]);
-        pd_plot_text(g, c->curves[k].label);
+        pd_plot_literal(g, c->curves[k].label);
     }
     slope_guide(g, c);
     fputc('\n', g);

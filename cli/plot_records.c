@@ -48,13 +48,14 @@ static int records_data(FILE *f, const void *ctx)
     return ferror(f) ? -1 : 0;
 }
 
-/* The title over record r's column: its name (any bytes, through
- * pd_plot_text), then its pulse on a second line. */
+/* The title over record r's column: its name as it is (any bytes,
+ * pd_plot_literal), then its pulse on a second line, its units in enhanced
+ * text (m/s², m⁻¹). */
 static void record_title(FILE *g, const pd_cli_record *r)
 {
     fputs("set title ", g);
-    pd_plot_text(g, r->rec.name);
-    fprintf(g, " . \"\\nTp = %.3g s, ap = %.3g m/s^2, 1/Le = %.3g m^{-1}\" noenhanced\n",
+    pd_plot_literal(g, r->rec.name);
+    fprintf(g, " . \"\\nT_p = %.3g s, a_p = %.3g m/s^2, 1/L_e = %.3g m^{-1}\"\n",
             r->pulse.Tp, r->pulse.ap, 1.0 / r->pulse.Le);
 }
 

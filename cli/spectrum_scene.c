@@ -122,7 +122,7 @@ static int draw(const pd_scene_sweep_args *a, const sweep_out *o, pd_err *err)
                                 .y = y + (size_t)nc * npi2};
         }
     char title[256];
-    snprintf(title, sizeof title, "%s: Pi_2 of %s", a->k->scene_path, o->sc->st[o->w.ref].name);
+    snprintf(title, sizeof title, "%s: Pi2 of %s", a->k->scene_path, o->sc->st[o->w.ref].name);
     pd_chart ch = {.title = title,
                    .xlabel = "Pi_2 = T_p / T_0",
                    .ylabel = "Pi_1 = u_{max} w_p^2 / a_p",
