@@ -171,9 +171,9 @@ int pd_scene_writer_open(pd_scene_writer **out, const char *path, const pd_scene
 {
     pd_scene_writer *w;
     int smax = 1, m = sc->ncontact > 0 ? sc->ncontact : 1, rc, e;
+    int hdf5 = ends_with(path, ".h5") || ends_with(path, ".hdf5");
     *out = NULL;
-    if ((ends_with(path, ".h5") || ends_with(path, ".hdf5")) &&
-        sc->nstruct + sc->ncontact > SCENE_H5_GROUPS_MAX)
+    if (hdf5 && sc->nstruct + sc->ncontact > SCENE_H5_GROUPS_MAX)
         return pd_err_set(err, PD_EINVAL,
                           "-o %s: %d structures and %d contacts are more than an HDF5 file holds "
                           "here (at most %d groups in all); write CSV (-o FILE.csv)",
@@ -184,7 +184,7 @@ int pd_scene_writer_open(pd_scene_writer **out, const char *path, const pd_scene
     w->every = every;
     w->file = w->ds_t = -1;
     w->out.slot = -1;
-    w->hdf5 = ends_with(path, ".h5") || ends_with(path, ".hdf5");
+    w->hdf5 = hdf5;
     pd_provenance_now(&w->prov, PD_FORMAT_SCENE);
     w->width = 1 + 2 * sc->n + 2 * sc->ncontact;
     w->cap = OUT_BUFFER_DOUBLES / w->width;

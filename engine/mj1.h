@@ -65,20 +65,15 @@ static inline int mj1_step(double h, double th, double hgamma, const mj1_coef *s
     return active;
 }
 
-/* ---- the same step on a vector of systems ---------------------------- *
- * MJ1_WIDTH lanes of doubles (one AVX-512 register; two AVX2 or four SSE2
- * registers otherwise), each lane plain IEEE double arithmetic: lane i of
- * mj1_stepv computes mj1_step's numbers for system i, the same operations
- * in the same order (tests/test_engine.c compares them bit for bit; the
- * build keeps the compiler from fusing multiplications and additions).  The
- * choices are selections, not branches: many systems side by side are a
- * question of throughput, not latency. */
+/* ---- the constants of a vector of systems -------------------------- *
+ * The batch (engine/mj_batch.c) keeps its systems' constants in groups of
+ * MJ1_WIDTH lanes; its step (mj_batch_lanes.h) computes, lane by lane,
+ * mj1_step's numbers: the same operations in the same order, plain IEEE
+ * double arithmetic (tests/test_engine.c compares them bit for bit; the
+ * build keeps the compiler from fusing multiplications and additions), the
+ * choices as selections, not branches. */
 #define MJ1_WIDTH 8
 typedef double mj1_vec __attribute__((vector_size(8 * MJ1_WIDTH)));
-typedef long long mj1_mask __attribute__((vector_size(8 * MJ1_WIDTH))); /* all ones or zero */
-
-/* a where the mask m is set, else b. */
-#define MJ1_SELECT(m, a, b) ((mj1_vec)(((m) & (mj1_mask)(a)) | (~(m) & (mj1_mask)(b))))
 
 /* The same vectors at any address of a double (the batch object may sit
  * where malloc puts it): loads and stores that do not assume alignment. */
@@ -108,29 +103,6 @@ static inline void mj1_coef_setv(mj1_coefv *s, int i, const mj1_coef *one, doubl
     s->hth[i] = h * th;
     s->hgamma[i] = h * gamma;
     s->wall[i] = one->wall ? -1 : 0;
-}
-
-/* mj1_step on a vector of lanes (steps h): P is 0 where the contact was
- * not active. */
-static inline void mj1_stepv(double th, const mj1_vec *hp, const mj1_coefv *s,
-                             const mj1_vec *F0, const mj1_vec *F1, mj1_vec *q, mj1_vec *v,
-                             mj1_vec *g, mj1_vec *P)
-{
-    const mj1_vec zero = {0.0};
-    mj1_vec q0 = *q, v0 = *v, h = *hp;
-    mj1_vec Fth = th * *F1 + (1.0 - th) * *F0;
-    mj1_vec rhs = h * (Fth - s->c * v0 - s->k * (q0 + s->hth * v0));
-    mj1_vec vfree = v0 + rhs * s->whatinv;
-    mj1_vec U0 = s->w * v0;
-    mj1_mask active = s->wall & (*g + s->hgamma * U0 <= zero);
-    mj1_vec b = s->w * vfree + s->e * U0;
-    mj1_vec imp = MJ1_SELECT(active & (b < zero), -b * s->delinv, zero);
-    mj1_vec vnew = MJ1_SELECT(active, vfree + s->winv * imp, vfree);
-    mj1_vec qnew = q0 + h * (th * vnew + (1.0 - th) * v0);
-    *q = qnew;
-    *v = vnew;
-    *g = s->g0 + s->w * qnew;
-    *P = imp;
 }
 
 /* The batch's step over every lane, per instruction set (mj_batch_lanes.h):

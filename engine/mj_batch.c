@@ -1,6 +1,6 @@
 /* mj_batch.c — Moreau–Jean for a batch of one-DOF systems (pd_engine.h).
  *
- * Each vector of lanes runs mj1_stepv, lane for lane the scalar kernel's
+ * Each vector of lanes runs mj1_step's operations, lane for lane the scalar kernel's
  * arithmetic, so a lane's numbers equal pd_mj's for its system alone.  The
  * step has no division, no call and no branch.  The lanes' clocks and
  * steps are their own; the breakpoints are met as pd_mj meets them

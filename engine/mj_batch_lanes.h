@@ -14,18 +14,7 @@
 #include <string.h>
 
 #include "mj1.h"
-
-#if defined(__AVX512F__)
-#define LW 8
-#elif defined(__AVX__)
-#define LW 4
-#else
-#define LW 2
-#endif
-
-typedef double lvec __attribute__((vector_size(8 * LW)));
-typedef long long lmask __attribute__((vector_size(8 * LW)));
-#define LSELECT(m, a, b) ((lvec)(((m) & (lmask)(a)) | (~(m) & (lmask)(b))))
+#include "pd_lanes.h"
 
 #define NVEC (PD_MJB_LANES / MJ1_WIDTH)
 
@@ -48,7 +37,7 @@ static inline lvec lload(const void *p)
     return x;
 }
 
-/* mj1_stepv's operations, in its order, on lanes l .. l + LW - 1, whose
+/* mj1_step's operations, in its order, on lanes l .. l + LW - 1, whose
  * constants are at offset o of their group s; the forces F1 at the step's
  * end become the next step's F0. */
 static inline void lanes_step(pd_mjb *b, const mj1_coefv *s, int l, int o)
@@ -90,6 +79,4 @@ void MJB_LANES_STEP(pd_mjb *b)
             lanes_step(b, mjb_coef(b, j), j * MJ1_WIDTH + o, o);
 }
 
-#undef LW
-#undef LSELECT
 

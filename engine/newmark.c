@@ -228,6 +228,9 @@ static int step(nm_run *w, double t1, int at_break, pd_err *err)
         w->q[i] = w->q0[i] + h * w->v0[i] + 2.0 * g4 * w->a0[i];
     int it, done = 0;
     w->frozen = 0;
+    for (int i = 0; i < n; i++)
+        w->v[i] = (2.0 / h) * (w->q[i] - w->q0[i]) - w->v0[i];
+    elements(w, w->q, w->v, w->v0); /* then after each update, below */
     for (it = 0; it < NM_MAX_NEWTON && !done; it++) {
         /* a Kelvin-Voigt element whose force jumps at d = 0 (c d' != 0) can
          * make the engaged set cycle: no set is consistent within the step.
@@ -235,9 +238,6 @@ static int step(nm_run *w, double t1, int at_break, pd_err *err)
          * elements acting on both sides of d = 0 (as penalty.c's, frozen to
          * their mode within a step); the next step's set follows d again. */
         w->frozen = it >= NM_FREEZE;
-        for (int i = 0; i < n; i++)
-            w->v[i] = (2.0 / h) * (w->q[i] - w->q0[i]) - w->v0[i];
-        elements(w, w->q, w->v, w->v0);
         /* r = b + h^2/4 (F1 + W lambda) - What q */
         what_times(w, w->q, w->r);
         for (int i = 0; i < n; i++)
@@ -302,25 +302,15 @@ static int step(nm_run *w, double t1, int at_break, pd_err *err)
     return PD_OK;
 }
 
-/* The options newmark needs: a law, kc and the step h > 0. */
+/* The options newmark needs: the shared ones and the step h > 0. */
 static int nm_check(const nm_run *w, double t0, double t1, pd_err *err)
 {
     const pd_penalty_opts *o = &w->o;
-    if (o->law != PD_PENALTY_KELVIN && o->law != PD_PENALTY_HERTZDAMP)
-        return pd_err_set(err, PD_EINVAL, "newmark: law must be Kelvin-Voigt or Hertz-damp");
-    if (!(o->kc > 0.0) || !isfinite(o->kc))
-        return pd_err_set(err, PD_EINVAL,
-                          "newmark: kc (contact stiffness) must be a finite number > 0 (got %g)",
-                          o->kc);
+    int rc = pd_penalty_check_opts(o, t0, t1, "newmark", err);
+    if (rc)
+        return rc;
     if (!(o->h > 0.0) || !isfinite(o->h))
         return pd_err_set(err, PD_EINVAL, "newmark: the step h must be > 0 (got %g)", o->h);
-    if (!(o->h_out >= 0.0) || !isfinite(o->h_out))
-        return pd_err_set(err, PD_EINVAL, "newmark: h_out must be >= 0 (got %g)", o->h_out);
-    if (!(o->time_unit > 0.0) || !isfinite(o->time_unit))
-        return pd_err_set(err, PD_EINVAL, "newmark: time_unit must be > 0 (got %g)",
-                          o->time_unit);
-    if (!isfinite(t0) || !isfinite(t1) || t1 < t0)
-        return pd_err_set(err, PD_EINVAL, "newmark: need finite t0 <= t1 (got %g, %g)", t0, t1);
     double steps = (t1 - t0) / o->h;
     if (!(steps <= (double)o->max_steps))
         return pd_err_set(err, PD_EBUDGET, "newmark: %.3g steps of %g s (at most %ld)", steps,

@@ -99,15 +99,34 @@ static const pen_stepper *find_stepper(const char *name)
 }
 
 /* Options in range; zero tolerances and budget take their defaults. */
+int pd_penalty_check_opts(const pd_penalty_opts *o, double t0, double t1, const char *who,
+                          pd_err *err)
+{
+    if (o->law != PD_PENALTY_KELVIN && o->law != PD_PENALTY_HERTZDAMP)
+        return pd_err_set(err, PD_EINVAL, "%s: law must be Kelvin-Voigt or Hertz-damp", who);
+    if (!(o->kc > 0.0) || !isfinite(o->kc))
+        return pd_err_set(err, PD_EINVAL,
+                          "%s: kc (contact stiffness) must be a finite number > 0 (got %g)", who,
+                          o->kc);
+    if (!(o->h_out >= 0.0) || !isfinite(o->h_out))
+        return pd_err_set(err, PD_EINVAL, "%s: h_out must be >= 0 (got %g)", who, o->h_out);
+    if (o->max_steps < 1)
+        return pd_err_set(err, PD_EINVAL, "%s: max_steps must be >= 1", who);
+    if (!(o->time_unit > 0.0) || !isfinite(o->time_unit))
+        return pd_err_set(err, PD_EINVAL, "%s: time_unit must be > 0 (got %g)", who,
+                          o->time_unit);
+    if (!isfinite(t0) || !isfinite(t1) || t1 < t0)
+        return pd_err_set(err, PD_EINVAL, "%s: need finite t0 <= t1 (got %g, %g)", who, t0, t1);
+    return PD_OK;
+}
+
+/* The adaptive integration's own: tolerances and a known stepper. */
 static int check_opts(pen *p, double t0, double t1, pd_err *err)
 {
     pd_penalty_opts *o = &p->o;
-    if (o->law != PD_PENALTY_KELVIN && o->law != PD_PENALTY_HERTZDAMP)
-        return pd_err_set(err, PD_EINVAL, "penalty: law must be Kelvin-Voigt or Hertz-damp");
-    if (!(o->kc > 0.0) || !isfinite(o->kc))
-        return pd_err_set(err, PD_EINVAL,
-                          "penalty: kc (contact stiffness) must be a finite number > 0 (got %g)",
-                          o->kc);
+    int rc = pd_penalty_check_opts(o, t0, t1, "penalty", err);
+    if (rc)
+        return rc;
     if (!(o->rtol > 0.0) || !isfinite(o->rtol) || !(o->atol > 0.0) || !isfinite(o->atol))
         return pd_err_set(err, PD_EINVAL, "penalty: rtol and atol must be > 0 (got %g, %g)",
                           o->rtol, o->atol);
@@ -116,14 +135,6 @@ static int check_opts(pen *p, double t0, double t1, pd_err *err)
                           "penalty: stepper \"%s\" is unknown (rk8pd, rkf45, rk4imp, msbdf, "
                           "newmark)",
                           o->stepper);
-    if (!(o->h_out >= 0.0) || !isfinite(o->h_out))
-        return pd_err_set(err, PD_EINVAL, "penalty: h_out must be >= 0 (got %g)", o->h_out);
-    if (o->max_steps < 1)
-        return pd_err_set(err, PD_EINVAL, "penalty: max_steps must be >= 1");
-    if (!(o->time_unit > 0.0) || !isfinite(o->time_unit))
-        return pd_err_set(err, PD_EINVAL, "penalty: time_unit must be > 0 (got %g)", o->time_unit);
-    if (!isfinite(t0) || !isfinite(t1) || t1 < t0)
-        return pd_err_set(err, PD_EINVAL, "penalty: need finite t0 <= t1 (got %g, %g)", t0, t1);
     return PD_OK;
 }
 

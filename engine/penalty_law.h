@@ -61,6 +61,11 @@ static inline void pd_penalty_slopes(pd_penalty_law law, double kc, double c, do
     *cdd = c * d * sd;
 }
 
+/* The options both integrations take, in range (the law, kc, h_out,
+ * max_steps, time_unit, t0 <= t1); messages start with who (penalty.c). */
+int pd_penalty_check_opts(const pd_penalty_opts *o, double t0, double t1, const char *who,
+                          pd_err *err);
+
 /* The fixed-step Newmark integration of the elements (newmark.c):
  * pd_penalty_run with stepper "newmark" (opts->h the step). */
 int pd_penalty_newmark(const pd_model *model, double t0, const double *q0, const double *v0,

@@ -30,9 +30,7 @@ static void lanes_force(const double *t, int side, double *F, void *ctx)
     osc_batch *ob = ctx;
     double base = 0.0;
     int prev = -1; /* the last lane whose base was computed or reused */
-    const vd zero = {0.0};
-    for (int j = 0; j < NV; j++) /* whole vectors: the step reads them so */
-        memcpy(&F[j * VW], &zero, sizeof zero);
+    memset(F, 0, NL * sizeof *F); /* every lane: the step reads them all */
     if (side > 0) { /* a lane's start or its excitation's end: every lane asked */
         for (int l = 0; l < NL; l++)
             if (ob->id[l] >= 0)

@@ -13,14 +13,6 @@
 #include "pd_problems.h"
 
 #define NL PD_MJB_LANES
-#define VW 8 /* doubles per vector */
-#define NV (NL / VW)
-
-typedef double vd __attribute__((vector_size(8 * VW)));
-typedef long long vm __attribute__((vector_size(8 * VW))); /* masks: all ones or zero */
-
-/* a where the mask m is set, else b. */
-#define SELECT(m, a, b) ((vd)(((m) & (vm)(a)) | (~(m) & (vm)(b))))
 
 /* The batch: the integrator, each lane's case and measurements (allocated
  * on a 64-byte boundary: the arrays marked so sit on cache lines). */

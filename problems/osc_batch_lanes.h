@@ -5,19 +5,7 @@
  * for lane. */
 #include "osc_batch.h"
 
-/* The processor's own vector, as in engine/mj_batch_lanes.h: 8 lanes under
- * AVX-512, 4 under AVX2, 2 on the baseline (8-lane vectors on AVX2 went
- * through the stack). */
-#if defined(__AVX512F__)
-#define LW 8
-#elif defined(__AVX__)
-#define LW 4
-#else
-#define LW 2
-#endif
-typedef double lvec __attribute__((vector_size(8 * LW)));
-typedef long long lmask __attribute__((vector_size(8 * LW)));
-#define LSELECT(m, a, b) ((lvec)(((m) & (lmask)(a)) | (~(m) & (lmask)(b))))
+#include "pd_lanes.h" /* the processor's own vector (after the target pragma) */
 
 _Static_assert(NL % LW == 0, "whole native vectors of lanes");
 
@@ -90,5 +78,3 @@ int OSC_BATCH_OBSERVE(const pd_mjb *b, void *ctx)
     return 0;
 }
 
-#undef LW
-#undef LSELECT

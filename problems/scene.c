@@ -649,13 +649,14 @@ static double contact_mass(const pd_scene *sc, int a)
     return isinf(ma) ? mb : isinf(mb) ? ma : ma * mb / (ma + mb);
 }
 
-/* The period of contact a's penalty element (pd_scene_contact_period_min). */
-static double contact_period(const pd_scene *sc, const pd_run_opts *o, int a)
+/* The linear stiffness of the penalty elements [N/m]: kc, or for
+ * Hertz-damp with kc_abs [N/m^1.5] its tangent at 1 % of Le
+ * (pd_scene_contact_period_min). */
+static double element_stiffness(const pd_scene *sc, const pd_run_opts *o)
 {
-    double kc = pd_scene_penalty_kc(sc, o);
     if (o->pen.law == PD_PENALTY_HERTZDAMP && o->pen.kc_abs > 0.0)
-        kc = 1.5 * o->pen.kc_abs * sqrt(0.01 * pd_scene_Le(sc));
-    return PD_TWO_PI * sqrt(contact_mass(sc, a) / kc);
+        return 1.5 * o->pen.kc_abs * sqrt(0.01 * pd_scene_Le(sc));
+    return pd_scene_penalty_kc(sc, o);
 }
 
 /* The work of the methods that resolve every mode (all but Moreau–Jean,
@@ -691,7 +692,7 @@ static int check_budget(const pd_scene *sc, const pd_run_opts *o, pd_err *err)
     for (int a = 0; a < sc->ncontact; a++) {
         const pd_contact *ct = &sc->ct[a];
         double mred = contact_mass(sc, a);
-        double Tc = contact_period(sc, o, a), pts = SCENE_SCAN_DIV * o->tend / Tc;
+        double Tc = PD_TWO_PI * sqrt(mred / kc), pts = SCENE_SCAN_DIV * o->tend / Tc;
         if (!(pts <= SCENE_MAX_POINTS))
             return pd_err_set(err, PD_EINVAL,
                               "contacts[%d]: its element (kc = %.3g N/m on %.3g kg) vibrates with "
@@ -708,10 +709,10 @@ static int check_budget(const pd_scene *sc, const pd_run_opts *o, pd_err *err)
  * penetration of 1 % of Le, kc_abs in N/m^1.5): HUGE_VAL without contacts. */
 double pd_scene_contact_period_min(const pd_scene *sc, const pd_run_opts *o)
 {
-    double Tmin = HUGE_VAL;
+    double mmin = HUGE_VAL, kc = element_stiffness(sc, o);
     for (int a = 0; a < sc->ncontact; a++)
-        Tmin = fmin(Tmin, contact_period(sc, o, a));
-    return Tmin;
+        mmin = fmin(mmin, contact_mass(sc, a));
+    return sc->ncontact ? PD_TWO_PI * sqrt(mmin / kc) : HUGE_VAL;
 }
 
 int pd_scene_resolve_opts(const pd_scene *sc, const pd_run_opts *in, pd_run_opts *out,
