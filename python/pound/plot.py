@@ -42,7 +42,7 @@ def _pyplot() -> Any:
 def _axes(ax: Optional[Axes]) -> Tuple[Figure, Axes]:
     if ax is not None:
         return ax.figure, ax
-    return _pyplot().subplots(figsize=(8, 4))
+    return _pyplot().subplots(figsize=(9, 4), layout="constrained")
 
 
 def _history_of(r: Mapping[str, Any]) -> Mapping[str, Any]:
@@ -159,16 +159,24 @@ def _scene_history(r: Mapping[str, Any], ax: Axes, impacts: bool, wall: bool,
     ts, ls, tlabel, ulabel = _scales(r, scaled)
     t, x = np.asarray(h["t"]) / ts, np.asarray(h["x"]) / ls
     first, curves = _scene_dofs(r)
-    color = {}
-    for i, (name, lv) in enumerate(curves):
-        color[(name, lv)] = "C%d" % (i % 10)
+    # one colour per structure, its higher storeys darker; one legend entry per structure
+    names = list(first)
+    color = {name: "C%d" % (i % 10) for i, name in enumerate(names)}
+    for name in names:
+        lvs = [lv for n, lv in curves if n == name]
         storeys = next(int(s["storeys"]) for s in r["structures"] if s["name"] == name)
-        ax.plot(t, x[:, first[name] + lv - 1], lw=1.0, color=color[(name, lv)],
-                label=name if storeys == 1 else "%s, storey %d" % (name, lv))
+        for j, lv in enumerate(lvs):
+            label = "_nolegend_" if j else name if storeys == 1 else "%s, storey%s %s" % (
+                name, "s" if len(lvs) > 1 else "", ",".join(str(v) for v in lvs))
+            ax.plot(t, x[:, first[name] + lv - 1], lw=1.0, color=color[name],
+                    alpha=0.4 + 0.6 * (j + 1) / len(lvs), label=label)
     walls = set()
+    pairs: Dict[Tuple[str, str], int] = {}
+    for ct in r["contacts"]:
+        pairs[(ct["a"], ct["b"])] = pairs.get((ct["a"], ct["b"]), 0) + int(ct["impacts"])
+    labelled = set()
     for a, ct in enumerate(r["contacts"]):
-        at_wall = "wall" in (ct["a"], ct["b"])
-        if wall and at_wall:
+        if wall and "wall" in (ct["a"], ct["b"]):
             # gap = gap0 + x_b - x_a: a wall on side a stands at x = -gap0, on side b at +gap0
             pos = -float(ct["gap"]) if ct["a"] == "wall" else float(ct["gap"])
             if pos not in walls:
@@ -180,19 +188,22 @@ def _scene_history(r: Mapping[str, Any], ax: Axes, impacts: bool, wall: bool,
         k, when = impact_times(r, a)
         if not len(k):
             continue
+        pair = (ct["a"], ct["b"])
         for side, lv in ((ct["a"], ct["level"]), (ct["b"], ct["level_b"])):
             if side == "wall":
                 continue
+            label = "_nolegend_" if pair in labelled else \
+                "impacts %s-%s (%d)" % (pair[0], pair[1], pairs[pair])
+            labelled.add(pair)
             ax.plot(when / ts, x[k, first[side] + int(lv) - 1], ls="none", marker="o",
-                    mfc="none", color=color[(side, int(lv))],
-                    label="impacts %s-%s (%d)" % (ct["a"], ct["b"], len(k)))
+                    ms=5, mfc="none", color=color[side], label=label)
     ax.set_xlabel(tlabel)
     ax.set_ylabel("x " + ulabel)
     ax.set_title("scene: %d structures, %d contacts, %d impacts (%s)"
                  % (len(r["structures"]), len(r["contacts"]), int(r.get("impacts", 0)),
                     r.get("method", "?")))
     ax.grid(True, alpha=0.3)
-    ax.legend(loc="best", fontsize="x-small", ncol=2)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
 
 
 def history(r: Mapping[str, Any], ax: Optional[Axes] = None, impacts: bool = True,
@@ -246,7 +257,7 @@ def spectrum(s: Mapping[str, Any], axes: Optional[Any] = None, traditional: bool
     rows = 2 if traditional else 1
     if axes is None:
         fig, axes = _pyplot().subplots(rows, len(panels), figsize=(5.5 * len(panels), 4 * rows),
-                                       squeeze=False)
+                                       squeeze=False, layout="constrained")
     else:
         axes = np.asarray(axes, dtype=object).reshape(rows, len(panels))
         fig = axes[0, 0].figure
@@ -254,13 +265,15 @@ def spectrum(s: Mapping[str, Any], axes: Optional[Any] = None, traditional: bool
             if len({c[k] for c in curves if k in c}) > 1]
     Pi2 = np.asarray(s["Pi2"])
     Y = np.asarray(s[y])
+    drawn = [0] * len(panels)
     for k, c in enumerate(curves):
         j = panels.index((c["pulse"], c["dir"]))
-        label = _curve_label(c, keys)
-        axes[0, j].plot(Pi2, Y[k], lw=1.5, color="C%d" % (k % 10), label=label)
+        label, colour = _curve_label(c, keys), "C%d" % (drawn[j] % 10)
+        drawn[j] += 1
+        axes[0, j].plot(Pi2, Y[k], lw=1.5, color=colour, label=label)
         if traditional:
             axes[1, j].plot(np.asarray(s["chi"])[k], np.asarray(s["gamma"])[k], lw=1.5,
-                            color="C%d" % (k % 10), label=label)
+                            color=colour, label=label)
     ylabel = {"Pi1": "$\\Pi_1 = u_{max}\\,\\omega_p^2 / a_p = u_{max} / L_e$",
               "gamma": "$\\gamma = u_{max} / u_{max,free}$"}.get(y, y)
     for j, (pulse, d) in enumerate(panels):
@@ -269,7 +282,8 @@ def spectrum(s: Mapping[str, Any], axes: Optional[Any] = None, traditional: bool
         ax.set_yscale("log")
         ax.set_xlabel("$\\Pi_2 = T_p / T_0$")
         ax.set_ylabel(ylabel)
-        ax.set_title("one-%s pulse, %s" % (pulse, d))
+        ax.set_title("%s, %s" % ("one-%s pulse" % pulse if pulse in ("sine", "cosine") else
+                                 "harmonic" if pulse == "harmonic" else "record " + pulse, d))
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(loc="lower left", fontsize="small")
         if traditional:
