@@ -15,7 +15,7 @@
 #   make install-check  the examples/api/ programs built against an installed
 #                 copy (scripts/api-check.sh; part of make check)
 #   make formats-check  every output file read back with h5py (docs/formats.md)
-#   make python-check   the Python package (python/) tested against the CLI
+#   make python-check   the Python package (python/) tested against the CLI, mypy, its notebook
 #   make MPI=1    the MPI build (OpenMPI's mpicc, -DPD_MPI) in build-mpi/:
 #                 mpirun -np K build-mpi/pound spectrum ...
 #   make OPENMP=  without OpenMP (spectrum then runs one thread)

@@ -7,9 +7,9 @@ from typing import TYPE_CHECKING, Any, List, Optional, Sequence, Union
 import numpy as np
 
 from . import _args, _lib
-from ._types import Floats, Int, Names, PathArg, Range
 from ._case import Case, InputError, copy_opts, number
 from ._lib import PdErr, lib, s
+from ._types import Floats, Int, Names, PathArg, Range
 
 if TYPE_CHECKING:
     from ._scene import Scene
@@ -193,10 +193,11 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
     steps (counts); first_impact, contact_time, dt, tend [s];
     first_impact_velocity, max_impact_velocity [m/s]; max_impulse per unit
     mass [m/s]; min_gap, gap [m]; ap [m/s^2], Tp, T0 [s]; cpu_s [s of
-    CPU]; method, method_by, pulse, dir, kernel (names).  With history, r.history: the arrays step, t, u, v,
-    impulse, gap of every every-th step (the CLI's -o file: t [s], u [m],
-    v [m/s], impulse per unit mass since the last sample [m/s], gap
-    delta - u [m]), with t, u, v, impulse also as r.t, r.u, r.v, r.impulse."""
+    CPU]; method, method_by, pulse, dir, kernel (names).  With history,
+    r.history: the arrays step, t, u, v, impulse, gap of every every-th
+    step (the CLI's -o file: t [s], u [m], v [m/s], impulse per unit mass
+    since the last sample [m/s], gap delta - u [m]), with t, u, v, impulse
+    also as r.t, r.u, r.v, r.impulse."""
     history, every = history_args(history, every)
     k = Case(case).resolve()
     o = k.opts
