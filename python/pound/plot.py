@@ -118,15 +118,16 @@ def _osc_history(r: Mapping[str, Any], ax: Axes, impacts: bool, wall: bool,
     if impacts:
         k, when = impact_times(r)
         if len(k):
-            # on the wall: the oscillator is at u = gap when it strikes
-            at = np.full(len(k), float(r["gap"]) / ls) if not _onsets(h["impulse"]).size \
-                else u[k]
+            # a stepper's at its sample; the reference's on the wall (u = gap when it strikes)
+            sampled = _onsets(h["impulse"]).size > 0
+            at = u[k] if sampled else np.full(len(k), float(r["gap"]) / ls)
             ax.plot(when / ts, at, ls="none", marker="o", mfc="none", color="C3",
                     label="impacts (%d)" % len(k))
     ax.set_xlabel(tlabel)
     ax.set_ylabel("u " + ulabel)
-    ax.set_title("%s pulse, %s: umax = %.4g m, %d impacts"
-                 % (r.get("pulse", "?"), r.get("dir", "?"), float(r.get("umax", np.nan)),
+    what = "record %s" % r["record"] if "record" in r else "%s pulse" % r.get("pulse", "?")
+    ax.set_title("%s, %s: umax = %.4g m, %d impacts"
+                 % (what, r.get("dir", "?"), float(r.get("umax", np.nan)),
                     int(r.get("impacts", 0))))
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize="small")
