@@ -9,7 +9,7 @@
 # Then the types (mypy: the package, and tests/typing_usage.py with --strict
 # against the install, which needs its py.typed) and the notebook
 # examples/pound_tour.ipynb executed with nbconvert on a kernel of that
-# install (at most $NB_TIMEOUT s, default 300; it takes ~10 s).
+# install (at most $NB_TIMEOUT s, default 300; it takes 7 to 24 s).
 #
 # Environment: POUND_LIBRARY (a built libpound.so: nothing is built),
 # POUND_BIN (the CLI the tests compare with, default: the one built next to
