@@ -1,7 +1,7 @@
 /* lazy.c — the shared libraries only some runs need, loaded when first
  * called: HDF5 and its high-level library (the -o/--dump-lcp writers and
- * readers, the dimension scales) and CHOLMOD (with
- * the BLAS it pulls in, for large sparse scenes).  Linked, they cost every
+ * readers, the dimension scales) and CHOLMOD (with the BLAS it pulls in,
+ * for large sparse scenes).  Linked, they cost every
  * `pound` process some 25 ms of dynamic loading and initialisation
  * (HDF5 brings its network drivers' libraries: curl, TLS, Kerberos, LDAP;
  * CHOLMOD an OpenBLAS that starts its threads) -- a hundred times the work
@@ -17,8 +17,8 @@
  * which the callers already report, after one line saying why.
  *
  * Built when the Makefile finds the sonames (PD_LAZY_HDF5, PD_LAZY_HDF5_HL,
- * PD_LAZY_CHOLMOD);
- * otherwise the libraries are linked as usual and this file is empty. */
+ * PD_LAZY_CHOLMOD); otherwise the libraries are linked as usual and this
+ * file is empty. */
 #include <stdio.h>
 #include <string.h>
 
