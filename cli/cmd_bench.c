@@ -28,7 +28,7 @@ int pd_cmd_bench(int argc, char **argv)
             want_startup = 1;
         else if (!strcmp(argv[i], "--shared") && i + 1 < argc)
             shared = argv[++i];
-        else if (!strcmp(argv[i], "--help")) {
+        else if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             puts("usage: pound bench [--lcp] [--engine] [--scene] [--spectrum] [--records]\n"
                  "                   [--startup] [--json]\n"
                  "                   [--shared DIR]\n"

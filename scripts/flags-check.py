@@ -25,6 +25,9 @@ It asserts:
    case-driven command's help lists).
 
 --help, which every command takes, is checked as if each help listed it.
+`pound --help` is checked too: its commands are the completion's and the
+man page's COMMANDS, its flags (--version, --help) completed first and in
+the SYNOPSIS.
 
 It exits 1 with one line per discrepancy, and prints one summary line.
 Standard library only (and bash for the completion).
@@ -177,6 +180,29 @@ def parser_takes(pound, cmd, flag, follow, cwd):
     return last.startswith(f"pound: {flag}:"), last
 
 
+def top_level(pound, entries):
+    """`pound --help`: its commands against the completion's and the man
+    page's, its flags (with --help) offered first and in the SYNOPSIS."""
+    p = subprocess.run([pound, "--help"], capture_output=True, text=True, timeout=30)
+    check(p.returncode == 0, f"pound --help: exit {p.returncode}")
+    listed, _, rest = p.stdout.partition("commands:")
+    cmds = re.findall(r"^  ([a-z]+) ", rest, re.M)
+    flags = re.findall(r"^  (--[\w-]+)", rest, re.M) + ["--help"]  # its own lines, not a command's
+    script = f'source "{COMPLETION}"; echo "$_pound_commands"'
+    comp = subprocess.run(["bash", "-c", script], capture_output=True, text=True, timeout=30).stdout.split()
+    check(sorted(cmds) == sorted(comp), f"completion: commands {comp}, pound --help lists {cmds}")
+    check(sorted(cmds) == sorted(entries), f"pound.1: COMMANDS has {sorted(entries)}, pound --help lists {cmds}")
+    check(sorted(set(cmds) - {"help"}) == sorted(COMMANDS), f"flags-check knows {COMMANDS}, pound --help lists {cmds}")
+    src = open(COMPLETION, encoding="utf-8").read()
+    first = re.search(r'compgen -W "\$_pound_commands ([^"]*)"', src)
+    man = open(MAN, encoding="utf-8").read()
+    synopsis = man.partition(".SH SYNOPSIS")[2].partition(".SH ")[0]
+    for f in flags:
+        check(first is not None and f in first.group(1).split(), f"completion: {f} is not offered as the first word")
+        check(f in roff_flags(synopsis), f"pound.1: {f} is not in the SYNOPSIS")
+    return len(flags)
+
+
 def main():
     if len(sys.argv) != 2:
         sys.exit("usage: python3 scripts/flags-check.py PATH/TO/pound")
@@ -214,6 +240,7 @@ def main():
                 check(f in listed, f"pound.1: {cmd}: the entry names {f}, which pound {cmd} --help does not list")
             for f in comp:
                 check(f in listed, f"completion: {cmd}: offers {f}, which pound {cmd} --help does not list")
+    nflags += top_level(pound, entries)
     for f in man_shared:
         check(f in all_shared or f in all_listed,
               f"pound.1: MODEL/SCHEME FLAGS name {f}, which no command's --help lists")
