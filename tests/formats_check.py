@@ -23,7 +23,9 @@ asserts:
 - every group opened by xarray (engine="h5netcdf", Debian's python3-xarray
   and python3-h5netcdf; skipped, and said so, without them): no phony
   dimension, each variable along the dims the page names with the lengths
-  h5py reads, the dimensions with values coordinates, text attributes str.
+  h5py reads, the dimensions with values coordinates, text attributes str;
+  and, when netCDF-C's ncdump is installed (netcdf-bin), every HDF5 file
+  read by `ncdump -h` without a phony dimension.
 
 It exits 1 with one line per mismatch, and always prints one summary line.
 It needs Debian's python3-h5py and python3-numpy.
@@ -50,6 +52,7 @@ try:  # the files opened by xarray too (python3-xarray, python3-h5netcdf)
     import xarray as xr
 except ImportError:
     xr = None
+NCDUMP = shutil.which("ncdump")  # netCDF-C's (Debian's netcdf-bin), when installed
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DOC = os.path.join(ROOT, "docs", "formats.md")
@@ -183,7 +186,7 @@ class Ctx:
     def __init__(self, pound, tmp, doc, version):
         self.pound, self.tmp, self.doc, self.version = pound, tmp, doc, version
         self.files = 0
-        self.xarray_groups, self.xarray_skipped = 0, False
+        self.xarray_groups, self.xarray_skipped, self.ncdumped = 0, False, 0
         self.t0 = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0)
 
 
@@ -278,6 +281,12 @@ def check_xarray(ctx, path, f, spec, shapes):
     h5py reads; a dimension with values (a 1-D dataset of its name) a
     coordinate, one without values (NAME "This is a netCDF dimension but
     not a netCDF variable") absent from the variables; text attributes str."""
+    if NCDUMP:  # netCDF-C reads it too, every axis named
+        p = subprocess.run([NCDUMP, "-h", path], capture_output=True, text=True, timeout=60)
+        check(p.returncode == 0 and "phony_dim" not in p.stdout,
+              f"{os.path.basename(path)}: ncdump -h: exit {p.returncode} {p.stderr.strip()[:200]}"
+              f"{' (phony dims)' if 'phony_dim' in p.stdout else ''}")
+        ctx.ncdumped += 1
     if xr is None:
         ctx.xarray_skipped = True
         return
@@ -626,6 +635,7 @@ def main():
     status = "ok" if not failures else f"FAILED {len(failures)} of"
     opened = (f"xarray skipped: python3-xarray or python3-h5netcdf not installed" if ctx.xarray_skipped
               else f"{ctx.xarray_groups} groups opened by xarray")
+    opened += f", {ctx.ncdumped} files by ncdump" if NCDUMP else ", ncdump not installed"
     print(f"formats_check: {status} {checks} checks on {nfiles} files of 7 kinds, {opened} "
           f"(pound {version}) in {time.monotonic() - t0:.1f} s")
     return 1 if failures else 0
