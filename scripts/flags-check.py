@@ -20,6 +20,9 @@ It asserts:
 3. the parser takes each: `pound CMD FLAG [VALUE] --zz-sentinel` stops at
    the sentinel ("unknown flag '--zz-sentinel'"), so FLAG (and a plausible
    VALUE: the first of a|b|c, a number, a range, a file) was read;
+   and where the help names a flag's values (--kernel auto|general), the
+   completion offers those values, the man page names the same (where it
+   names any) and the parser takes each;
 4. the reverse: the flags a command's man entry or completion names that
    its --help does not list (and those of MODEL/SCHEME FLAGS that no
    case-driven command's help lists).
@@ -81,7 +84,10 @@ def help_of(pound, cmd):
         words = plain[m.end():m.end() + 40].split("\n")[0].split()
         if words:
             follow.setdefault(m.group(1), []).append(words[0])
-    return flags_of_text(own), flags_of_text(shared), follow
+    choices = {}  # --flag a|b|c: the values it names
+    for m in re.finditer(r"(?<![\w-])(--[A-Za-z0-9][\w-]*) ([a-z0-9/]+(?:\|[a-z0-9/-]+)+)(?![\w.])", plain):
+        choices.setdefault(m.group(1), set()).update(m.group(2).split("|"))
+    return flags_of_text(own), flags_of_text(shared), follow, choices
 
 
 # ---- the man page ------------------------------------------------------------------
@@ -96,6 +102,16 @@ def roff_flags(text):
     if re.search(r"(?<![\w\\-])\\-o(?![\w\\])", text.replace("\\-\\-", "  ")):
         found.append("-o")
     return found
+
+
+def roff_choices(text):
+    """{flag: values} of the roff's "\\-\\-flag a|b|c"."""
+    out = {}
+    rx = r"\\-\\-((?:[A-Za-z0-9]|\\-)+)\s+((?:[a-z0-9/]|\\-)+(?:\|(?:[a-z0-9/]|\\-)+)+)"
+    for m in re.finditer(rx, text):
+        vals = m.group(2).replace("\\-", "-").split("|")
+        out.setdefault("--" + m.group(1).replace("\\-", "-"), set()).update(vals)
+    return out
 
 
 def man_sections():
@@ -209,11 +225,13 @@ def main():
     pound = os.path.abspath(sys.argv[1])
     entries, shared_roff = man_sections()
     man_shared = roff_flags(shared_roff)
-    all_shared, all_listed = set(), set()
+    all_shared, all_listed, all_choices = set(), set(), {}
     nflags = 0
     with tempfile.TemporaryDirectory(prefix="pound_flags_") as tmp:
         for cmd in COMMANDS:
-            own, shared, follow = help_of(pound, cmd)
+            own, shared, follow, choices = help_of(pound, cmd)
+            for f, vals in choices.items():
+                all_choices.setdefault(f, set()).update(vals)
             takes_case = bool(shared)
             listed = own + [f for f in shared if f not in own]
             if "--help" not in listed:  # every command's, which its help need not list
@@ -236,11 +254,24 @@ def main():
                 check(f in comp, f"completion: {cmd}: {f} is not offered")
                 ok, why = parser_takes(pound, cmd, f, follow, tmp)
                 check(ok, f"parser: pound {cmd} {f}: not taken ({why})")
+            for f, vals in sorted(choices.items()):  # the values: completion, parser
+                offered, _ = completion_values(cmd, f)
+                check(set(offered) == vals, f"completion: {cmd} {f}: offers {sorted(offered)}, "
+                      f"the help names {sorted(vals)}")
+                for v in sorted(vals):
+                    p = subprocess.run([pound, cmd, f, v, SENTINEL], capture_output=True, text=True,
+                                       timeout=20, cwd=tmp)
+                    check(f"unknown flag '{SENTINEL}'" in p.stderr,
+                          f"parser: pound {cmd} {f} {v}: {p.stderr.strip()[:200]}")
             for f in man_own:
                 check(f in listed, f"pound.1: {cmd}: the entry names {f}, which pound {cmd} --help does not list")
             for f in comp:
                 check(f in listed, f"completion: {cmd}: offers {f}, which pound {cmd} --help does not list")
     nflags += top_level(pound, entries)
+    man_choices = roff_choices(open(MAN, encoding="utf-8").read())
+    for f, vals in sorted(man_choices.items()):
+        check(vals == all_choices.get(f), f"pound.1: {f} {'|'.join(sorted(vals))}, the help names "
+              f"{'|'.join(sorted(all_choices.get(f, [])))}")
     for f in man_shared:
         check(f in all_shared or f in all_listed,
               f"pound.1: MODEL/SCHEME FLAGS name {f}, which no command's --help lists")
