@@ -1,80 +1,145 @@
-/* osc_batch_lanes.h — the batch's measurements after each step, a text
- * compiled once per instruction set under the name OSC_BATCH_OBSERVE:
+/* osc_batch_lanes.h — the batch's steps with their measurements fused in,
+ * a text compiled once per instruction set under the name OSC_BATCH_RUN:
  * osc_batch.c (the baseline), osc_batch_x86v3.c (AVX2), osc_batch_x86v4.c
- * (AVX-512).  Every variant computes pd_osc_track_common's numbers, lane
- * for lane. */
+ * (AVX-512), after their target pragma.  A vector of lanes is loaded once
+ * per step: the engine's arithmetic (engine/mj1_lanes.h, mj1_step's
+ * numbers lane for lane), then pd_osc_track_common's numbers on the
+ * registers, pd_osc_track_events for the lanes that need it (rare: a gap
+ * closing, an impact begun), pd_osc_track_shift's; stored once.  The
+ * forces come from a table filled per block of steps (osc_batch.c), so a
+ * step has no call. */
 #include "osc_batch.h"
 
-#include "pd_lanes.h" /* the processor's own vector (after the target pragma) */
+#include "mj1_lanes.h" /* the processor's own vector (after the target pragma) */
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 _Static_assert(NL % LW == 0, "whole native vectors of lanes");
 
-/* One vector of lanes after a step: pd_osc_track_common's numbers lane for
- * lane (max |x| is the larger of the two one-sided maxima, formed at the
- * end: osc_batch.h's rare_load); pd_osc_track_events for
- * the lanes that need it (rare: a gap closing, an impact begun); then
- * pd_osc_track_shift's. */
-static inline void track_vector(osc_batch *ob, int l)
+/* pd_max and the minimum's a < b ? a : b, lane by lane (the x86 max and min
+ * instructions are exactly these: the second operand when the two are
+ * equal or unordered). */
+#if defined(__AVX512F__)
+#define LMAX(a, b) ((lvec)_mm512_max_pd((__m512d)(a), (__m512d)(b)))
+#define LMIN(a, b) ((lvec)_mm512_min_pd((__m512d)(a), (__m512d)(b)))
+#elif defined(__AVX__)
+#define LMAX(a, b) ((lvec)_mm256_max_pd((__m256d)(a), (__m256d)(b)))
+#define LMIN(a, b) ((lvec)_mm256_min_pd((__m256d)(a), (__m256d)(b)))
+#elif defined(__SSE2__)
+#define LMAX(a, b) ((lvec)_mm_max_pd((__m128d)(a), (__m128d)(b)))
+#define LMIN(a, b) ((lvec)_mm_min_pd((__m128d)(a), (__m128d)(b)))
+#else
+#define LMAX(a, b) LSELECT((a) > (b), a, b)
+#define LMIN(a, b) LSELECT((a) < (b), a, b)
+#endif
+
+/* Is any lane of m set? */
+static inline int lany(lmask m)
 {
-    const lvec zero = {0.0}, one = zero + 1.0;
-    lvec x, v, P, Pi3, xto, xaw, mg, Pmax, cont, px, pP, pv;
-#define LOAD(var, arr) memcpy(&var, &(arr)[l], sizeof var)
-#define STORE(arr, var) memcpy(&(arr)[l], &var, sizeof var)
-    LOAD(x, ob->mjb.q);
-    LOAD(v, ob->mjb.v);
-    LOAD(P, ob->mjb.P);
-    LOAD(Pi3, ob->Pi3);
-    LOAD(xto, ob->xtoward);
-    LOAD(xaw, ob->xaway);
-    LOAD(mg, ob->min_gap);
-    LOAD(Pmax, ob->Pmax);
-    LOAD(cont, ob->contact);
-    LOAD(px, ob->prev_x);
-    LOAD(pP, ob->prev_P);
-    LOAD(pv, ob->prev_v);
-    lvec gap = Pi3 - x, nx = -x;
-    lvec t, mf;
-    LOAD(t, ob->mjb.t);
-    LOAD(mf, ob->meas_from);
-    lmask pos = P > zero, meas = t >= mf;
-    xto = LSELECT(meas, LSELECT(xto > x, xto, x), xto);
-    xaw = LSELECT(meas, LSELECT(xaw > nx, xaw, nx), xaw);
-    cont = cont + (lvec)(pos & (lmask)one);
-    Pmax = LSELECT(pos, LSELECT(Pmax > P, Pmax, P), Pmax);
-    mg = LSELECT(mg < gap, mg, gap);
-    lvec gprev = Pi3 - px;
-    /* every lane has taken a step: step > 0 */
-    lmask due = ((gprev > zero) & ((gap <= zero) | pos)) | (pos & (pP == zero));
-    STORE(ob->xtoward, xto);
-    STORE(ob->xaway, xaw);
-    STORE(ob->min_gap, mg);
-    STORE(ob->Pmax, Pmax);
-    STORE(ob->contact, cont);
-    long long hit = 0;
+#if defined(__AVX512F__)
+    return _mm512_test_epi64_mask((__m512i)m, (__m512i)m) != 0;
+#elif defined(__AVX__)
+    return !_mm256_testz_si256((__m256i)m, (__m256i)m);
+#elif defined(__SSE2__)
+    return _mm_movemask_pd((__m128d)m) != 0;
+#else
+    long long any = 0;
     for (int i = 0; i < LW; i++)
-        hit |= due[i];
-    if (hit)
-        for (int i = 0; i < LW; i++)
-            if (due[i] && ob->id[l + i] >= 0) {
-                rare_load(ob, l + i);
-                pd_osc_track_events(&ob->rare[l + i], (long)ob->mjb.steps[l + i],
-                                    ob->mjb.t[l + i], x[i], v[i], P[i]);
-            }
-    STORE(ob->prev2_v, pv);
-    STORE(ob->prev_x, x);
-    STORE(ob->prev_v, v);
-    STORE(ob->prev_P, P);
-#undef LOAD
-#undef STORE
+        any |= m[i];
+    return any != 0;
+#endif
 }
 
-/* After every step, every vector of lanes. */
-int OSC_BATCH_OBSERVE(const pd_mjb *b, void *ctx)
+/* The rare events of the lanes of l .. l + LW - 1 marked in due, from
+ * their state before the step (q0, v0, P0, and v two steps back pv2) and
+ * after it at step st, time t. */
+static void lanes_events(osc_batch *ob, int l, lmask due, lvec st, lvec t, lvec x, lvec v,
+                         lvec P, lvec q0, lvec v0, lvec P0, lvec pv2)
 {
-    osc_batch *ob = ctx;
-    (void)b;
-    for (int l = 0; l < NL; l += LW)
-        track_vector(ob, l);
-    return 0;
+    for (int i = 0; i < LW; i++)
+        if (due[i] && ob->id[l + i] >= 0) {
+            pd_osc_track *tr = &ob->rare[l + i];
+            tr->prev_x = q0[i];
+            tr->prev_v = v0[i];
+            tr->prev2_v = pv2[i];
+            tr->prev_P = P0[i];
+            pd_osc_track_events(tr, (long)st[i], t[i], x[i], v[i], P[i]);
+        }
 }
 
+/* Vectors of lanes stepped together (their chains interleaved). */
+#ifndef OSC_G
+#define OSC_G (LW == 8 ? 1 : 2)
+#endif
+_Static_assert(NL % (OSC_G * LW) == 0, "whole sets of vectors");
+
+/* Lanes l .. l + OSC_G LW - 1 one step (step s of the block): the step,
+ * then the measurements of pd_osc_track_step (every lane has taken a step:
+ * step > 0; max |x| is the larger of the two one-sided maxima, formed at
+ * the end: osc_batch.h's rare_load). */
+static inline __attribute__((always_inline)) void lanes_step_measure(osc_batch *ob, int s,
+                                                                   int l0)
+{
+    enum { G = OSC_G };
+    pd_mjb *b = &ob->mjb;
+    const lvec zero = {0.0}, one = zero + 1.0;
+    const double *cs[G];
+    lvec h[G], st[G], t[G], q0[G], v0[G], P0[G], x[G], v[G], g[G], P[G], F0[G], F1[G];
+    lvec gap[G], gprev[G], m1[G], m2[G];
+    lmask pos[G], meas[G], due[G];
+    MJ1_EACH(G, cs[i] = mj1_lanes_coef(b, l0 + i * LW))
+    MJ1_EACH(G, h[i] = lload(&b->h[l0 + i * LW]))
+    MJ1_EACH(G, st[i] = lload(&b->steps[l0 + i * LW]) + 1.0)
+    MJ1_EACH(G, t[i] = st[i] * h[i])
+    MJ1_EACH(G, x[i] = q0[i] = lload(&b->q[l0 + i * LW]))
+    MJ1_EACH(G, v[i] = v0[i] = lload(&b->v[l0 + i * LW]))
+    MJ1_EACH(G, P0[i] = lload(&b->P[l0 + i * LW]))
+    MJ1_EACH(G, g[i] = lload(&b->g[l0 + i * LW]))
+    MJ1_EACH(G, F0[i] = lload(&ob->F[s][l0 + i * LW]))
+    MJ1_EACH(G, F1[i] = lload(&ob->F[s + 1][l0 + i * LW]))
+    mj1_lanes_step(G, cs, b->theta, h, F0, F1, x, v, g, P);
+    MJ1_EACH(G, lstore(&b->steps[l0 + i * LW], st[i]))
+    MJ1_EACH(G, lstore(&b->q[l0 + i * LW], x[i]))
+    MJ1_EACH(G, lstore(&b->v[l0 + i * LW], v[i]))
+    MJ1_EACH(G, lstore(&b->g[l0 + i * LW], g[i]))
+    MJ1_EACH(G, lstore(&b->P[l0 + i * LW], P[i]))
+    MJ1_EACH(G, gap[i] = lload(&ob->Pi3[l0 + i * LW]) - x[i])
+    MJ1_EACH(G, gprev[i] = lload(&ob->Pi3[l0 + i * LW]) - q0[i])
+    MJ1_EACH(G, pos[i] = P[i] > zero)
+    MJ1_EACH(G, meas[i] = t[i] >= lload(&ob->meas_from[l0 + i * LW]))
+    MJ1_EACH(G, m1[i] = lload(&ob->xtoward[l0 + i * LW]))
+    MJ1_EACH(G, lstore(&ob->xtoward[l0 + i * LW], LSELECT(meas[i], LMAX(m1[i], x[i]), m1[i])))
+    MJ1_EACH(G, m2[i] = lload(&ob->xaway[l0 + i * LW]))
+    MJ1_EACH(G, lstore(&ob->xaway[l0 + i * LW], LSELECT(meas[i], LMAX(m2[i], -x[i]), m2[i])))
+    MJ1_EACH(G, lstore(&ob->contact[l0 + i * LW],
+                       lload(&ob->contact[l0 + i * LW]) + (lvec)(pos[i] & (lmask)one)))
+    MJ1_EACH(G, m1[i] = lload(&ob->Pmax[l0 + i * LW]))
+    MJ1_EACH(G, lstore(&ob->Pmax[l0 + i * LW], LSELECT(pos[i], LMAX(m1[i], P[i]), m1[i])))
+    MJ1_EACH(G, lstore(&ob->min_gap[l0 + i * LW], LMIN(lload(&ob->min_gap[l0 + i * LW]), gap[i])))
+    MJ1_EACH(G, due[i] = ((gprev[i] > zero) & ((gap[i] <= zero) | pos[i])) |
+                         (pos[i] & (P0[i] == zero)))
+    for (int i = 0; i < G; i++)
+        if (lany(due[i]))
+            lanes_events(ob, l0 + i * LW, due[i], st[i], t[i], x[i], v[i], P[i], q0[i], v0[i],
+                         P0[i], lload(&ob->prev2_v[l0 + i * LW]));
+    MJ1_EACH(G, lstore(&ob->prev2_v[l0 + i * LW], v0[i]))
+}
+
+/* k steps of every lane: step by step, every vector of lanes in turn (their
+ * chains overlap); then the lanes' clocks, the forces F[k] as the next
+ * step's F0, the batch's step count. */
+void OSC_BATCH_RUN(osc_batch *ob_, int k)
+{
+    osc_batch *ob = __builtin_assume_aligned(ob_, 64); /* batch_open's aligned_alloc */
+    pd_mjb *b = &ob->mjb;
+    for (int s = 0; s < k; s++)
+        for (int j = 0; j < NL / (OSC_G * LW); j++)
+            lanes_step_measure(ob, s, j * OSC_G * LW);
+    for (int l = 0; l < NL; l += LW) {
+        lstore(&b->t[l], lload(&b->steps[l]) * lload(&b->h[l]));
+        lstore(&b->F0[l], lload(&ob->F[k][l]));
+    }
+    b->iter += k;
+}
