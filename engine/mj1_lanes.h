@@ -57,17 +57,19 @@ static inline __attribute__((always_inline)) void mj1_lanes_step(int n, const do
     const lvec zero = {0.0};
     const size_t W = MJ1_WIDTH; /* one constant's lanes in the group */
     lvec rhs[8], vfree[8], U0[8], bb[8];
-    lmask active[8], wall[8];
+    lcond active[8], wall[8];
+    lmask wm[8];
     MJ1_EACH(n, rhs[i] = th * F1[i] + (1.0 - th) * F0[i])
     MJ1_EACH(n, rhs[i] = h[i] * (rhs[i] - lload(cs[i] + 0 * W) * v[i] -
                                  lload(cs[i] + 1 * W) * (q[i] + lload(cs[i] + 8 * W) * v[i])))
     MJ1_EACH(n, vfree[i] = v[i] + rhs[i] * lload(cs[i] + 5 * W))
     MJ1_EACH(n, U0[i] = lload(cs[i] + 2 * W) * v[i])
-    MJ1_EACH(n, memcpy(&wall[i], cs[i] + 10 * W, sizeof wall[i]))
-    MJ1_EACH(n, active[i] = wall[i] & (g[i] + lload(cs[i] + 9 * W) * U0[i] <= zero))
+    MJ1_EACH(n, memcpy(&wm[i], cs[i] + 10 * W, sizeof wm[i]))
+    MJ1_EACH(n, wall[i] = LCOND_OF(wm[i]))
+    MJ1_EACH(n, active[i] = wall[i] & LLE(g[i] + lload(cs[i] + 9 * W) * U0[i], zero))
     MJ1_EACH(n, bb[i] = lload(cs[i] + 2 * W) * vfree[i] + lload(cs[i] + 3 * W) * U0[i])
-    MJ1_EACH(n, P[i] = LSELECT(active[i] & (bb[i] < zero), -bb[i] * lload(cs[i] + 7 * W), zero))
-    MJ1_EACH(n, vfree[i] = LSELECT(active[i], vfree[i] + lload(cs[i] + 6 * W) * P[i], vfree[i]))
+    MJ1_EACH(n, P[i] = LKEEP(active[i] & LLT(bb[i], zero), -bb[i] * lload(cs[i] + 7 * W)))
+    MJ1_EACH(n, vfree[i] = LSEL(active[i], vfree[i] + lload(cs[i] + 6 * W) * P[i], vfree[i]))
     MJ1_EACH(n, q[i] = q[i] + h[i] * (th * vfree[i] + (1.0 - th) * v[i]))
     MJ1_EACH(n, v[i] = vfree[i])
     MJ1_EACH(n, g[i] = lload(cs[i] + 4 * W) + lload(cs[i] + 2 * W) * q[i])

@@ -12,7 +12,7 @@
 
 #include "mj1_lanes.h" /* the processor's own vector (after the target pragma) */
 
-#if defined(__SSE2__)
+#if defined(__SSE2__) && defined(__x86_64__)
 #include <immintrin.h>
 #endif
 
@@ -21,13 +21,13 @@ _Static_assert(NL % LW == 0, "whole native vectors of lanes");
 /* pd_max and the minimum's a < b ? a : b, lane by lane (the x86 max and min
  * instructions are exactly these: the second operand when the two are
  * equal or unordered). */
-#if defined(__AVX512F__)
+#if defined(__AVX512F__) && defined(__x86_64__)
 #define LMAX(a, b) ((lvec)_mm512_max_pd((__m512d)(a), (__m512d)(b)))
 #define LMIN(a, b) ((lvec)_mm512_min_pd((__m512d)(a), (__m512d)(b)))
-#elif defined(__AVX__)
+#elif defined(__AVX__) && defined(__x86_64__)
 #define LMAX(a, b) ((lvec)_mm256_max_pd((__m256d)(a), (__m256d)(b)))
 #define LMIN(a, b) ((lvec)_mm256_min_pd((__m256d)(a), (__m256d)(b)))
-#elif defined(__SSE2__)
+#elif defined(__SSE2__) && defined(__x86_64__)
 #define LMAX(a, b) ((lvec)_mm_max_pd((__m128d)(a), (__m128d)(b)))
 #define LMIN(a, b) ((lvec)_mm_min_pd((__m128d)(a), (__m128d)(b)))
 #else
@@ -35,14 +35,13 @@ _Static_assert(NL % LW == 0, "whole native vectors of lanes");
 #define LMIN(a, b) LSELECT((a) < (b), a, b)
 #endif
 
-/* Is any lane of m set? */
+/* Is any lane of the condition c set? */
+#ifndef LANY
 static inline int lany(lmask m)
 {
-#if defined(__AVX512F__)
-    return _mm512_test_epi64_mask((__m512i)m, (__m512i)m) != 0;
-#elif defined(__AVX__)
+#if defined(__AVX__) && defined(__x86_64__)
     return !_mm256_testz_si256((__m256i)m, (__m256i)m);
-#elif defined(__SSE2__)
+#elif defined(__SSE2__) && defined(__x86_64__)
     return _mm_movemask_pd((__m128d)m) != 0;
 #else
     long long any = 0;
@@ -51,15 +50,17 @@ static inline int lany(lmask m)
     return any != 0;
 #endif
 }
+#define LANY(c) lany(c)
+#endif
 
 /* The rare events of the lanes of l .. l + LW - 1 marked in due, from
  * their state before the step (q0, v0, P0, and v two steps back pv2) and
  * after it at step st, time t. */
-static void lanes_events(osc_batch *ob, int l, lmask due, lvec st, lvec t, lvec x, lvec v,
+static void lanes_events(osc_batch *ob, int l, lcond due, lvec st, lvec t, lvec x, lvec v,
                          lvec P, lvec q0, lvec v0, lvec P0, lvec pv2)
 {
     for (int i = 0; i < LW; i++)
-        if (due[i] && ob->id[l + i] >= 0) {
+        if (LLANE(due, i) && ob->id[l + i] >= 0) {
             pd_osc_track *tr = &ob->rare[l + i];
             tr->prev_x = q0[i];
             tr->prev_v = v0[i];
@@ -69,9 +70,11 @@ static void lanes_events(osc_batch *ob, int l, lmask due, lvec st, lvec t, lvec 
         }
 }
 
-/* Vectors of lanes stepped together (their chains interleaved). */
+/* Vectors of lanes stepped together, their chains interleaved (measured
+ * on an AMD EPYC with AVX-512: 2 the fastest with each instruction set;
+ * 1 leaves the chain's latency bare, 4 spills registers). */
 #ifndef OSC_G
-#define OSC_G (LW == 8 ? 1 : 2)
+#define OSC_G 2
 #endif
 _Static_assert(NL % (OSC_G * LW) == 0, "whole sets of vectors");
 
@@ -88,7 +91,7 @@ static inline __attribute__((always_inline)) void lanes_step_measure(osc_batch *
     const double *cs[G];
     lvec h[G], st[G], t[G], q0[G], v0[G], P0[G], x[G], v[G], g[G], P[G], F0[G], F1[G];
     lvec gap[G], gprev[G], m1[G], m2[G];
-    lmask pos[G], meas[G], due[G];
+    lcond pos[G], meas[G], due[G];
     MJ1_EACH(G, cs[i] = mj1_lanes_coef(b, l0 + i * LW))
     MJ1_EACH(G, h[i] = lload(&b->h[l0 + i * LW]))
     MJ1_EACH(G, st[i] = lload(&b->steps[l0 + i * LW]) + 1.0)
@@ -107,24 +110,103 @@ static inline __attribute__((always_inline)) void lanes_step_measure(osc_batch *
     MJ1_EACH(G, lstore(&b->P[l0 + i * LW], P[i]))
     MJ1_EACH(G, gap[i] = lload(&ob->Pi3[l0 + i * LW]) - x[i])
     MJ1_EACH(G, gprev[i] = lload(&ob->Pi3[l0 + i * LW]) - q0[i])
-    MJ1_EACH(G, pos[i] = P[i] > zero)
-    MJ1_EACH(G, meas[i] = t[i] >= lload(&ob->meas_from[l0 + i * LW]))
+    MJ1_EACH(G, pos[i] = LGT(P[i], zero))
+    MJ1_EACH(G, meas[i] = LGE(t[i], lload(&ob->meas_from[l0 + i * LW])))
     MJ1_EACH(G, m1[i] = lload(&ob->xtoward[l0 + i * LW]))
-    MJ1_EACH(G, lstore(&ob->xtoward[l0 + i * LW], LSELECT(meas[i], LMAX(m1[i], x[i]), m1[i])))
+    MJ1_EACH(G, lstore(&ob->xtoward[l0 + i * LW], LSEL(meas[i], LMAX(m1[i], x[i]), m1[i])))
     MJ1_EACH(G, m2[i] = lload(&ob->xaway[l0 + i * LW]))
-    MJ1_EACH(G, lstore(&ob->xaway[l0 + i * LW], LSELECT(meas[i], LMAX(m2[i], -x[i]), m2[i])))
+    MJ1_EACH(G, lstore(&ob->xaway[l0 + i * LW], LSEL(meas[i], LMAX(m2[i], -x[i]), m2[i])))
     MJ1_EACH(G, lstore(&ob->contact[l0 + i * LW],
-                       lload(&ob->contact[l0 + i * LW]) + (lvec)(pos[i] & (lmask)one)))
+                       lload(&ob->contact[l0 + i * LW]) + LKEEP(pos[i], one)))
     MJ1_EACH(G, m1[i] = lload(&ob->Pmax[l0 + i * LW]))
-    MJ1_EACH(G, lstore(&ob->Pmax[l0 + i * LW], LSELECT(pos[i], LMAX(m1[i], P[i]), m1[i])))
+    MJ1_EACH(G, lstore(&ob->Pmax[l0 + i * LW], LSEL(pos[i], LMAX(m1[i], P[i]), m1[i])))
     MJ1_EACH(G, lstore(&ob->min_gap[l0 + i * LW], LMIN(lload(&ob->min_gap[l0 + i * LW]), gap[i])))
-    MJ1_EACH(G, due[i] = ((gprev[i] > zero) & ((gap[i] <= zero) | pos[i])) |
-                         (pos[i] & (P0[i] == zero)))
+    MJ1_EACH(G, due[i] = (LGT(gprev[i], zero) & (LLE(gap[i], zero) | pos[i])) |
+                         (pos[i] & LEQ(P0[i], zero)))
     for (int i = 0; i < G; i++)
-        if (lany(due[i]))
+        if (LANY(due[i]))
             lanes_events(ob, l0 + i * LW, due[i], st[i], t[i], x[i], v[i], P[i], q0[i], v0[i],
                          P0[i], lload(&ob->prev2_v[l0 + i * LW]));
     MJ1_EACH(G, lstore(&ob->prev2_v[l0 + i * LW], v0[i]))
+}
+
+/* Whether a set of vectors stays in registers over the block's steps
+ * (then each set's steps run in a row; the sets' chains overlap only at
+ * their ends): with 16 registers of 2 lanes (the baseline's SSE2) the
+ * state would not fit, and the sets step in turn, through memory. */
+#ifndef OSC_RESIDENT
+#define OSC_RESIDENT (LW >= 4)
+#endif
+
+/* Lanes l0 .. l0 + OSC_G LW - 1 the k steps of the block with their state
+ * and measurements in registers: lanes_step_measure's operations, step
+ * after step. */
+static inline __attribute__((always_inline)) void lanes_run_resident(osc_batch *ob, int l0,
+                                                                    int k)
+{
+    enum { G = OSC_G };
+    pd_mjb *b = &ob->mjb;
+    const lvec zero = {0.0}, one = zero + 1.0;
+    const double *cs[G];
+    lvec h[G], st0[G], q[G], v[G], g[G], P[G], pv2[G], xto[G], xaw[G], mg[G], Pmax[G];
+    lvec cont[G], Pi3[G], mf[G];
+    MJ1_EACH(G, cs[i] = mj1_lanes_coef(b, l0 + i * LW))
+    MJ1_EACH(G, h[i] = lload(&b->h[l0 + i * LW]))
+    MJ1_EACH(G, st0[i] = lload(&b->steps[l0 + i * LW]))
+    MJ1_EACH(G, q[i] = lload(&b->q[l0 + i * LW]))
+    MJ1_EACH(G, v[i] = lload(&b->v[l0 + i * LW]))
+    MJ1_EACH(G, g[i] = lload(&b->g[l0 + i * LW]))
+    MJ1_EACH(G, P[i] = lload(&b->P[l0 + i * LW]))
+    MJ1_EACH(G, pv2[i] = lload(&ob->prev2_v[l0 + i * LW]))
+    MJ1_EACH(G, xto[i] = lload(&ob->xtoward[l0 + i * LW]))
+    MJ1_EACH(G, xaw[i] = lload(&ob->xaway[l0 + i * LW]))
+    MJ1_EACH(G, mg[i] = lload(&ob->min_gap[l0 + i * LW]))
+    MJ1_EACH(G, Pmax[i] = lload(&ob->Pmax[l0 + i * LW]))
+    MJ1_EACH(G, cont[i] = lload(&ob->contact[l0 + i * LW]))
+    MJ1_EACH(G, Pi3[i] = lload(&ob->Pi3[l0 + i * LW]))
+    MJ1_EACH(G, mf[i] = lload(&ob->meas_from[l0 + i * LW]))
+    for (int s = 0; s < k; s++) {
+        /* the step count: st0 + s + 1 (whole numbers: the sum of ones) */
+        const double ds = (double)(s + 1);
+        lvec st[G], t[G], x[G], vn[G], Pn[G], F0[G], F1[G], gap[G];
+        lcond pos[G], meas[G], due[G];
+        MJ1_EACH(G, st[i] = st0[i] + ds)
+        MJ1_EACH(G, t[i] = st[i] * h[i])
+        MJ1_EACH(G, F0[i] = lload(&ob->F[s][l0 + i * LW]))
+        MJ1_EACH(G, F1[i] = lload(&ob->F[s + 1][l0 + i * LW]))
+        MJ1_EACH(G, x[i] = q[i])
+        MJ1_EACH(G, vn[i] = v[i])
+        mj1_lanes_step(G, cs, b->theta, h, F0, F1, x, vn, g, Pn);
+        MJ1_EACH(G, gap[i] = Pi3[i] - x[i])
+        MJ1_EACH(G, pos[i] = LGT(Pn[i], zero))
+        MJ1_EACH(G, meas[i] = LGE(t[i], mf[i]))
+        MJ1_EACH(G, xto[i] = LSEL(meas[i], LMAX(xto[i], x[i]), xto[i]))
+        MJ1_EACH(G, xaw[i] = LSEL(meas[i], LMAX(xaw[i], -x[i]), xaw[i]))
+        MJ1_EACH(G, cont[i] = cont[i] + LKEEP(pos[i], one))
+        MJ1_EACH(G, Pmax[i] = LSEL(pos[i], LMAX(Pmax[i], Pn[i]), Pmax[i]))
+        MJ1_EACH(G, mg[i] = LMIN(mg[i], gap[i]))
+        MJ1_EACH(G, due[i] = (LGT(Pi3[i] - q[i], zero) & (LLE(gap[i], zero) | pos[i])) |
+                             (pos[i] & LEQ(P[i], zero)))
+        for (int i = 0; i < G; i++)
+            if (__builtin_expect(LANY(due[i]), 0))
+                lanes_events(ob, l0 + i * LW, due[i], st[i], t[i], x[i], vn[i], Pn[i], q[i],
+                             v[i], P[i], pv2[i]);
+        MJ1_EACH(G, pv2[i] = v[i])
+        MJ1_EACH(G, q[i] = x[i])
+        MJ1_EACH(G, v[i] = vn[i])
+        MJ1_EACH(G, P[i] = Pn[i])
+    }
+    MJ1_EACH(G, lstore(&b->steps[l0 + i * LW], st0[i] + (double)k))
+    MJ1_EACH(G, lstore(&b->q[l0 + i * LW], q[i]))
+    MJ1_EACH(G, lstore(&b->v[l0 + i * LW], v[i]))
+    MJ1_EACH(G, lstore(&b->g[l0 + i * LW], g[i]))
+    MJ1_EACH(G, lstore(&b->P[l0 + i * LW], P[i]))
+    MJ1_EACH(G, lstore(&ob->prev2_v[l0 + i * LW], pv2[i]))
+    MJ1_EACH(G, lstore(&ob->xtoward[l0 + i * LW], xto[i]))
+    MJ1_EACH(G, lstore(&ob->xaway[l0 + i * LW], xaw[i]))
+    MJ1_EACH(G, lstore(&ob->min_gap[l0 + i * LW], mg[i]))
+    MJ1_EACH(G, lstore(&ob->Pmax[l0 + i * LW], Pmax[i]))
+    MJ1_EACH(G, lstore(&ob->contact[l0 + i * LW], cont[i]))
 }
 
 /* k steps of every lane: step by step, every vector of lanes in turn (their
@@ -134,9 +216,13 @@ void OSC_BATCH_RUN(osc_batch *ob_, int k)
 {
     osc_batch *ob = __builtin_assume_aligned(ob_, 64); /* batch_open's aligned_alloc */
     pd_mjb *b = &ob->mjb;
-    for (int s = 0; s < k; s++)
+    if (OSC_RESIDENT)
         for (int j = 0; j < NL / (OSC_G * LW); j++)
-            lanes_step_measure(ob, s, j * OSC_G * LW);
+            lanes_run_resident(ob, j * OSC_G * LW, k);
+    else
+        for (int s = 0; s < k; s++)
+            for (int j = 0; j < NL / (OSC_G * LW); j++)
+                lanes_step_measure(ob, s, j * OSC_G * LW);
     for (int l = 0; l < NL; l += LW) {
         lstore(&b->t[l], lload(&b->steps[l]) * lload(&b->h[l]));
         lstore(&b->F0[l], lload(&ob->F[k][l]));
