@@ -1,13 +1,13 @@
 /* osc_batch_lanes.h — the batch's steps with their measurements fused in,
  * a text compiled once per instruction set under the name OSC_BATCH_RUN:
  * osc_batch.c (the baseline), osc_batch_x86v3.c (AVX2), osc_batch_x86v4.c
- * (AVX-512), after their target pragma.  A vector of lanes is loaded once
- * per step: the engine's arithmetic (engine/mj1_lanes.h, mj1_step's
- * numbers lane for lane), then pd_osc_track_common's numbers on the
- * registers, pd_osc_track_events for the lanes that need it (rare: a gap
- * closing, an impact begun), pd_osc_track_shift's; stored once.  The
- * forces come from a table filled per block of steps (osc_batch.c), so a
- * step has no call. */
+ * (AVX-512), after their target pragma.  A few vectors of lanes are loaded
+ * once per block of steps and run its steps in registers: the engine's
+ * arithmetic (engine/mj1_lanes.h, mj1_step's numbers lane for lane), then
+ * pd_osc_track_common's numbers, pd_osc_track_events for the lanes that
+ * need it (rare: a gap closing, an impact begun), pd_osc_track_shift's;
+ * stored at the block's end.  The forces come from a table filled per
+ * block (osc_batch.c), so a step has no call. */
 #include "osc_batch.h"
 
 #include "mj1_lanes.h" /* the processor's own vector (after the target pragma) */
@@ -71,76 +71,19 @@ static void lanes_events(osc_batch *ob, int l, lcond due, lvec st, lvec t, lvec 
 }
 
 /* Vectors of lanes stepped together, their chains interleaved (measured
- * on an AMD EPYC with AVX-512: 2 the fastest with each instruction set;
- * 1 leaves the chain's latency bare, 4 spills registers). */
+ * on an AMD EPYC with AVX-512: 2 with AVX-512 and AVX2, 4 on the baseline's
+ * 2-lane SSE2; 1 leaves the chain's latency bare; more spill registers). */
 #ifndef OSC_G
-#define OSC_G 2
+#define OSC_G (LW == 2 ? 4 : 2)
 #endif
 _Static_assert(NL % (OSC_G * LW) == 0, "whole sets of vectors");
 
-/* Lanes l .. l + OSC_G LW - 1 one step (step s of the block): the step,
- * then the measurements of pd_osc_track_step (every lane has taken a step:
- * step > 0; max |x| is the larger of the two one-sided maxima, formed at
- * the end: osc_batch.h's rare_load). */
-static inline __attribute__((always_inline)) void lanes_step_measure(osc_batch *ob, int s,
-                                                                   int l0)
-{
-    enum { G = OSC_G };
-    pd_mjb *b = &ob->mjb;
-    const lvec zero = {0.0}, one = zero + 1.0;
-    const double *cs[G];
-    lvec h[G], st[G], t[G], q0[G], v0[G], P0[G], x[G], v[G], g[G], P[G], F0[G], F1[G];
-    lvec gap[G], gprev[G], m1[G], m2[G];
-    lcond pos[G], meas[G], due[G];
-    MJ1_EACH(G, cs[i] = mj1_lanes_coef(b, l0 + i * LW))
-    MJ1_EACH(G, h[i] = lload(&b->h[l0 + i * LW]))
-    MJ1_EACH(G, st[i] = lload(&b->steps[l0 + i * LW]) + 1.0)
-    MJ1_EACH(G, t[i] = st[i] * h[i])
-    MJ1_EACH(G, x[i] = q0[i] = lload(&b->q[l0 + i * LW]))
-    MJ1_EACH(G, v[i] = v0[i] = lload(&b->v[l0 + i * LW]))
-    MJ1_EACH(G, P0[i] = lload(&b->P[l0 + i * LW]))
-    MJ1_EACH(G, g[i] = lload(&b->g[l0 + i * LW]))
-    MJ1_EACH(G, F0[i] = lload(&ob->F[s][l0 + i * LW]))
-    MJ1_EACH(G, F1[i] = lload(&ob->F[s + 1][l0 + i * LW]))
-    mj1_lanes_step(G, cs, b->theta, h, F0, F1, x, v, g, P);
-    MJ1_EACH(G, lstore(&b->steps[l0 + i * LW], st[i]))
-    MJ1_EACH(G, lstore(&b->q[l0 + i * LW], x[i]))
-    MJ1_EACH(G, lstore(&b->v[l0 + i * LW], v[i]))
-    MJ1_EACH(G, lstore(&b->g[l0 + i * LW], g[i]))
-    MJ1_EACH(G, lstore(&b->P[l0 + i * LW], P[i]))
-    MJ1_EACH(G, gap[i] = lload(&ob->Pi3[l0 + i * LW]) - x[i])
-    MJ1_EACH(G, gprev[i] = lload(&ob->Pi3[l0 + i * LW]) - q0[i])
-    MJ1_EACH(G, pos[i] = LGT(P[i], zero))
-    MJ1_EACH(G, meas[i] = LGE(t[i], lload(&ob->meas_from[l0 + i * LW])))
-    MJ1_EACH(G, m1[i] = lload(&ob->xtoward[l0 + i * LW]))
-    MJ1_EACH(G, lstore(&ob->xtoward[l0 + i * LW], LSEL(meas[i], LMAX(m1[i], x[i]), m1[i])))
-    MJ1_EACH(G, m2[i] = lload(&ob->xaway[l0 + i * LW]))
-    MJ1_EACH(G, lstore(&ob->xaway[l0 + i * LW], LSEL(meas[i], LMAX(m2[i], -x[i]), m2[i])))
-    MJ1_EACH(G, lstore(&ob->contact[l0 + i * LW],
-                       lload(&ob->contact[l0 + i * LW]) + LKEEP(pos[i], one)))
-    MJ1_EACH(G, m1[i] = lload(&ob->Pmax[l0 + i * LW]))
-    MJ1_EACH(G, lstore(&ob->Pmax[l0 + i * LW], LSEL(pos[i], LMAX(m1[i], P[i]), m1[i])))
-    MJ1_EACH(G, lstore(&ob->min_gap[l0 + i * LW], LMIN(lload(&ob->min_gap[l0 + i * LW]), gap[i])))
-    MJ1_EACH(G, due[i] = (LGT(gprev[i], zero) & (LLE(gap[i], zero) | pos[i])) |
-                         (pos[i] & LEQ(P0[i], zero)))
-    for (int i = 0; i < G; i++)
-        if (LANY(due[i]))
-            lanes_events(ob, l0 + i * LW, due[i], st[i], t[i], x[i], v[i], P[i], q0[i], v0[i],
-                         P0[i], lload(&ob->prev2_v[l0 + i * LW]));
-    MJ1_EACH(G, lstore(&ob->prev2_v[l0 + i * LW], v0[i]))
-}
-
-/* Whether a set of vectors stays in registers over the block's steps
- * (then each set's steps run in a row; the sets' chains overlap only at
- * their ends): with 16 registers of 2 lanes (the baseline's SSE2) the
- * state would not fit, and the sets step in turn, through memory. */
-#ifndef OSC_RESIDENT
-#define OSC_RESIDENT (LW >= 4)
-#endif
-
 /* Lanes l0 .. l0 + OSC_G LW - 1 the k steps of the block with their state
- * and measurements in registers: lanes_step_measure's operations, step
- * after step. */
+ * and measurements in registers (the compiler's to spill where there are
+ * too few), step after step: the step, then the measurements of
+ * pd_osc_track_step (every lane has taken a step: step > 0; max |x| is the
+ * larger of the two one-sided maxima, formed at the end: osc_batch.h's
+ * rare_load). */
 static inline __attribute__((always_inline)) void lanes_run_resident(osc_batch *ob, int l0,
                                                                     int k)
 {
@@ -209,20 +152,14 @@ static inline __attribute__((always_inline)) void lanes_run_resident(osc_batch *
     MJ1_EACH(G, lstore(&ob->contact[l0 + i * LW], cont[i]))
 }
 
-/* k steps of every lane: step by step, every vector of lanes in turn (their
- * chains overlap); then the lanes' clocks, the forces F[k] as the next
- * step's F0, the batch's step count. */
+/* k steps of every lane, OSC_G vectors at a time; then the lanes' clocks,
+ * the forces F[k] as the next step's F0, the batch's step count. */
 void OSC_BATCH_RUN(osc_batch *ob_, int k)
 {
     osc_batch *ob = __builtin_assume_aligned(ob_, 64); /* batch_open's aligned_alloc */
     pd_mjb *b = &ob->mjb;
-    if (OSC_RESIDENT)
-        for (int j = 0; j < NL / (OSC_G * LW); j++)
-            lanes_run_resident(ob, j * OSC_G * LW, k);
-    else
-        for (int s = 0; s < k; s++)
-            for (int j = 0; j < NL / (OSC_G * LW); j++)
-                lanes_step_measure(ob, s, j * OSC_G * LW);
+    for (int j = 0; j < NL / (OSC_G * LW); j++)
+        lanes_run_resident(ob, j * OSC_G * LW, k);
     for (int l = 0; l < NL; l += LW) {
         lstore(&b->t[l], lload(&b->steps[l]) * lload(&b->h[l]));
         lstore(&b->F0[l], lload(&ob->F[k][l]));
