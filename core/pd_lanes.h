@@ -21,12 +21,20 @@
 #define LW 2
 #endif
 
+/* The x86 instructions' forms below (PD_LANES_GENERIC: the generic vector
+ * code everywhere, to check it on x86). */
+#if defined(__x86_64__) && !defined(PD_LANES_GENERIC)
+#define PD_LANES_X86 1
+#else
+#define PD_LANES_X86 0
+#endif
+
 typedef double lvec __attribute__((vector_size(8 * LW)));
 typedef long long lmask __attribute__((vector_size(8 * LW))); /* all ones or zero */
 /* a where the mask m is set, else b. */
 #define LSELECT(m, a, b) ((lvec)(((m) & (lmask)(a)) | (~(m) & (lmask)(b))))
 
-#if defined(__AVX512F__) && defined(__x86_64__)
+#if defined(__AVX512F__) && PD_LANES_X86
 #include <immintrin.h>
 typedef __mmask8 lcond;
 #define LCMP_(a, b, p) _mm512_cmp_pd_mask((__m512d)(a), (__m512d)(b), p)
@@ -49,7 +57,7 @@ typedef lmask lcond;
 #define LGT(a, b) ((a) > (b))
 #define LGE(a, b) ((a) >= (b))
 #define LEQ(a, b) ((a) == (b))
-#if defined(__AVX__) && defined(__x86_64__)
+#if defined(__AVX__) && PD_LANES_X86
 #include <immintrin.h>
 #define LSEL(c, a, b) ((lvec)_mm256_blendv_pd((__m256d)(b), (__m256d)(a), (__m256d)(c)))
 #else

@@ -12,7 +12,7 @@
 
 #include "mj1_lanes.h" /* the processor's own vector (after the target pragma) */
 
-#if defined(__SSE2__) && defined(__x86_64__)
+#if defined(__SSE2__) && PD_LANES_X86
 #include <immintrin.h>
 #endif
 
@@ -21,13 +21,13 @@ _Static_assert(NL % LW == 0, "whole native vectors of lanes");
 /* pd_max and the minimum's a < b ? a : b, lane by lane (the x86 max and min
  * instructions are exactly these: the second operand when the two are
  * equal or unordered). */
-#if defined(__AVX512F__) && defined(__x86_64__)
+#if defined(__AVX512F__) && PD_LANES_X86
 #define LMAX(a, b) ((lvec)_mm512_max_pd((__m512d)(a), (__m512d)(b)))
 #define LMIN(a, b) ((lvec)_mm512_min_pd((__m512d)(a), (__m512d)(b)))
-#elif defined(__AVX__) && defined(__x86_64__)
+#elif defined(__AVX__) && PD_LANES_X86
 #define LMAX(a, b) ((lvec)_mm256_max_pd((__m256d)(a), (__m256d)(b)))
 #define LMIN(a, b) ((lvec)_mm256_min_pd((__m256d)(a), (__m256d)(b)))
-#elif defined(__SSE2__) && defined(__x86_64__)
+#elif defined(__SSE2__) && PD_LANES_X86
 #define LMAX(a, b) ((lvec)_mm_max_pd((__m128d)(a), (__m128d)(b)))
 #define LMIN(a, b) ((lvec)_mm_min_pd((__m128d)(a), (__m128d)(b)))
 #else
@@ -39,9 +39,9 @@ _Static_assert(NL % LW == 0, "whole native vectors of lanes");
 #ifndef LANY
 static inline int lany(lmask m)
 {
-#if defined(__AVX__) && defined(__x86_64__)
+#if defined(__AVX__) && PD_LANES_X86
     return !_mm256_testz_si256((__m256i)m, (__m256i)m);
-#elif defined(__SSE2__) && defined(__x86_64__)
+#elif defined(__SSE2__) && PD_LANES_X86
     return _mm_movemask_pd((__m128d)m) != 0;
 #else
     long long any = 0;
