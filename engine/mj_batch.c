@@ -18,6 +18,14 @@
 #define MJB_LANES_STEP pd_mjb_lanes_step_base
 #include "mj_batch_lanes.h"
 
+#define NVEC (PD_MJB_LANES / MJ1_WIDTH)
+
+/* The constants of group j. */
+static mj1_coefv *mjb_coef(pd_mjb *b, int j)
+{
+    return (mj1_coefv *)(void *)b->coef + j;
+}
+
 _Static_assert(offsetof(pd_mjb, brk_iter) % 64 == 0 && offsetof(pd_mjb, t) % 64 == 0 &&
                    offsetof(pd_mjb, coef) % 64 == 0 && sizeof(pd_mjb) % 64 == 0,
                "pd_mjb's lane arrays start on 64-byte lines");
@@ -149,7 +157,7 @@ static void step_clocks(pd_mjb *b)
 
 /* Lanes meeting their breakpoint at this step: those landing on it start
  * the next step from F(t+), as pd_mj's advance_force. */
-static void breakpoints(pd_mjb *b)
+void pd_mjb_breakpoints(pd_mjb *b)
 {
     unsigned long long any = 0;
     for (int l = 0; l < PD_MJB_LANES; l++) {
@@ -183,7 +191,7 @@ void pd_mjb_run(pd_mjb *b, long nsteps, pd_mjb_observer observer, void *ctx)
         b->lanes_step(b);
         b->iter++;
         if (b->iter == b->next_event)
-            breakpoints(b);
+            pd_mjb_breakpoints(b);
         if (observer && observer(b, ctx) > 0)
             return;
     }

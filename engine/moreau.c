@@ -264,16 +264,14 @@ static int check_finite(const pd_mj *mj, pd_err *err)
     return PD_OK;
 }
 
-/* One step of the scalar kernel (n = 1, m <= 1): mj1.h's. */
-static int step_scalar(pd_mj *mj, pd_err *err)
+/* One step of the scalar kernel (n = 1, m <= 1): mj1.h's, with the force
+ * F1 = F(t_k+1 -). */
+static inline int step_scalar_f(pd_mj *mj, double F1, pd_err *err)
 {
     const pd_model *md = mj->model;
     pd_state *st = &mj->st;
     double h = mj->opts.h;
     double t1 = mj->t0 + (double)(st->step + 1) * h;
-    double F1 = 0.0;
-    if (md->force)
-        md->force(t1, -1, &F1, md->force_ctx);
     double g = st->g[0], P;
     int active = mj1_step(h, mj->opts.theta, h * mj->opts.gamma, &mj->s1, mj->F0[0], F1,
                           &st->q[0], &st->v[0], &g, &P);
@@ -294,6 +292,45 @@ static int step_scalar(pd_mj *mj, pd_err *err)
     st->step++;
     if (!isfinite(st->q[0]) || !isfinite(st->v[0]))
         return check_finite(mj, err);
+    return PD_OK;
+}
+
+/* The force's left limit F(t_k+1 -) at the end of step k (0 without one). */
+static inline double scalar_force(const pd_mj *mj, long k)
+{
+    const pd_model *md = mj->model;
+    double F1 = 0.0;
+    if (md->force)
+        md->force(mj->t0 + (double)(k + 1) * mj->opts.h, -1, &F1, md->force_ctx);
+    return F1;
+}
+
+static int step_scalar(pd_mj *mj, pd_err *err)
+{
+    return step_scalar_f(mj, scalar_force(mj, mj->st.step), err);
+}
+
+/* The scalar kernel's steps with the observer after each.  The forces are
+ * asked MJ_FORCE_AHEAD steps ahead (the same values, at the same instants,
+ * in the same order), so that the excitation's evaluation of a later step
+ * runs beside the step's chain of latencies instead of in it. */
+#define MJ_FORCE_AHEAD 8 /* a power of 2 */
+static int run_scalar(pd_mj *mj, long nsteps, pd_observer observer, void *ctx, pd_err *err)
+{
+    double F[MJ_FORCE_AHEAD];
+    long step0 = mj->st.step;
+    int rc;
+    for (long k = 0; k < nsteps && k < MJ_FORCE_AHEAD; k++)
+        F[k] = scalar_force(mj, step0 + k);
+    for (long k = 0; k < nsteps; k++) {
+        double F1 = F[k & (MJ_FORCE_AHEAD - 1)];
+        if (k + MJ_FORCE_AHEAD < nsteps)
+            F[k & (MJ_FORCE_AHEAD - 1)] = scalar_force(mj, step0 + k + MJ_FORCE_AHEAD);
+        if ((rc = step_scalar_f(mj, F1, err)))
+            return rc;
+        if (observer && observer(&mj->st, ctx) > 0)
+            return PD_OK;
+    }
     return PD_OK;
 }
 
@@ -437,6 +474,8 @@ int pd_mj_run(pd_mj *mj, long nsteps, pd_observer observer, void *ctx, pd_err *e
     if (observer && observer(&mj->st, ctx) > 0)
         return PD_OK;
     mj->stop = 0;
+    if (mj->scalar)
+        return run_scalar(mj, nsteps, observer, ctx, err);
     for (long k = 0; k < nsteps && !mj->stop; k++) {
         if ((rc = mj_step(mj, err)))
             return rc;

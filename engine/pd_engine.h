@@ -45,7 +45,9 @@ PD_API int pd_factor_kind_parse(const char *name, pd_factor_kind *kind);
 
 /* Effective force F(t) (n entries) written to F; ctx is the model's.
  * side = -1 asks for the left limit F(t-), +1 for the right limit F(t+);
- * they differ only at the model's breakpoints. */
+ * they differ only at the model's breakpoints.  A function of t: the
+ * scalar kernel's pd_mj_run asks for the left limits of a few steps ahead
+ * (in increasing t), so that their evaluation overlaps the steps. */
 typedef void (*pd_force_fn)(double t, int side, double *F, void *ctx);
 
 typedef struct pd_model {

@@ -2,6 +2,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "osc_priv.h"
 #include "pd_problems.h"
 
 const char *pd_pulse_name(pd_pulse pulse)
@@ -47,7 +48,7 @@ int pd_dir_parse(const char *name, int *dir)
 
 double pd_shape_cut(double end, int side)
 {
-    return end * (1.0 + (side < 0 ? 1e-12 : -1e-12));
+    return pd_shape_cut_inline(end, side);
 }
 
 /* 1 when tau lies past the pulse end on the requested side. */
@@ -60,9 +61,7 @@ static int after_pulse(pd_pulse pulse, double tau, int side)
 /* s phi(tau). */
 double pd_pulse_shape(pd_pulse pulse, int dir, double tau, int side)
 {
-    if (after_pulse(pulse, tau, side))
-        return 0.0;
-    return dir * (pulse == PD_PULSE_COSINE ? cos(tau) : sin(tau));
+    return pd_pulse_shape_inline(pulse, dir, tau, side);
 }
 
 /* d/dtau of s phi(tau). */

@@ -14,42 +14,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define OSC_BATCH_OBSERVE pd_osc_batch_observe_base
+#define OSC_BATCH_RUN pd_osc_batch_run_base
 #include "osc_batch_lanes.h"
 
 #include "osc_batch.h"
 #include "pd_null.h"
-
-/* Every lane's force at its own clock: the case's pd_osc_shape, computed
- * once for neighbouring lanes at the same instant of the same excitation
- * (scaled by dir: pd_osc_shape is odd in dir), 0 past the excitation.  The
- * left limits ask only the lanes still inside their excitation (the list
- * `live`, pruned as they leave it). */
-static void lanes_force(const double *t, int side, double *F, void *ctx)
-{
-    osc_batch *ob = ctx;
-    double base = 0.0;
-    int prev = -1; /* the last lane whose base was computed or reused */
-    memset(F, 0, NL * sizeof *F); /* every lane: the step reads them all */
-    if (side > 0) { /* a lane's start or its excitation's end: every lane asked */
-        for (int l = 0; l < NL; l++)
-            if (ob->id[l] >= 0)
-                F[l] = pd_osc_shape(&ob->c[l], t[l], side);
-        return;
-    }
-    int n = 0;
-    for (int i = 0; i < ob->nlive; i++) {
-        int l = ob->live[i];
-        if (ob->mjb.iter >= ob->quiet_iter[l]) /* past its excitation from now on */
-            continue;
-        ob->live[n++] = l;
-        if (!(prev == l - 1 && ob->same_prev[l] && t[l] == t[prev]))
-            base = pd_osc_shape(&ob->unit[l], t[l], side);
-        F[l] = ob->dir[l] * base;
-        prev = l;
-    }
-    ob->nlive = n;
-}
 
 /* Cases a and b excite their oscillators by one shape. */
 static int same_shape(const pd_osc *a, const pd_osc *b)
@@ -57,6 +26,119 @@ static int same_shape(const pd_osc *a, const pd_osc *b)
     if (a->record || b->record)
         return a->record == b->record && a->Tp == b->Tp && a->rec_ap == b->rec_ap;
     return a->pulse == b->pulse;
+}
+
+/* Lane l stops reading its excitation table. */
+static void table_release(osc_batch *ob, int l)
+{
+    if (ob->table[l] >= 0)
+        ob->tab[ob->table[l]].users--;
+    ob->table[l] = -1;
+}
+
+/* Lane l reads the table of its excitation at its step h, n steps long
+ * (the steps inside it): one kept with the same shape and step, else one
+ * no lane reads, filled; none (the lane computes its forces per step) when
+ * the excitation is longer than OSC_TABLE_MAX steps or memory is short.
+ * The values are the ones the lane would compute: pd_osc_shape at s h. */
+static void table_acquire(osc_batch *ob, int l, double h, long n)
+{
+    int free_slot = -1;
+    ob->table[l] = -1;
+    if (n < 1 || n > OSC_TABLE_MAX)
+        return;
+    for (int i = 0; i < OSC_TABLES; i++) {
+        osc_table *tb = &ob->tab[i];
+        if (tb->n == n && tb->h == h && same_shape(&tb->unit, &ob->unit[l])) {
+            tb->users++;
+            ob->table[l] = i;
+            return;
+        }
+        if (tb->users == 0 && (free_slot < 0 || tb->n == 0))
+            free_slot = i;
+    }
+    if (free_slot < 0)
+        return;
+    osc_table *tb = &ob->tab[free_slot];
+    if (tb->cap < n) {
+        double *v = realloc(tb->v, (size_t)(n + 1) * sizeof *v);
+        if (!v)
+            return;
+        tb->v = v;
+        tb->cap = n;
+    }
+    tb->unit = ob->unit[l];
+    tb->h = h;
+    tb->n = n;
+    tb->v[0] = 0.0;
+    for (long s = 1; s <= n; s++)
+        tb->v[s] = pd_osc_shape(&tb->unit, (double)s * h, -1);
+    tb->users = 1;
+    ob->table[l] = free_slot;
+}
+
+/* Every lane's force at its own clock (the pd_mjb's force: the right
+ * limits at a lane's start and its excitation's end; the steps' left
+ * limits come from fill_forces): the case's pd_osc_shape, 0 past the
+ * excitation and for idle lanes. */
+static void lanes_force(const double *t, int side, double *F, void *ctx)
+{
+    osc_batch *ob = ctx;
+    for (int l = 0; l < NL; l++)
+        F[l] = ob->id[l] >= 0 && (side > 0 || ob->mjb.iter < ob->quiet_iter[l])
+                   ? pd_osc_shape(&ob->c[l], t[l], side)
+                   : 0.0;
+}
+
+/* The forces of the next k steps of the block: F[0] the first step's
+ * start (the integrator's F0), F[s] the left limit at the end of step s
+ * of every lane, dir times its excitation's table or, without one, its
+ * shape (computed once for neighbouring lanes at the same instant of the
+ * same excitation; pd_osc_shape is odd in dir); 0 past the excitation.
+ * Lanes past their excitation leave the list `live` and their table. */
+static void fill_forces(osc_batch *ob, int k)
+{
+    pd_mjb *b = &ob->mjb;
+    long iter = b->iter;
+    int n = 0;
+    memcpy(ob->F[0], b->F0, sizeof ob->F[0]);
+    memset(ob->F[1], 0, (size_t)k * sizeof ob->F[1]); /* rows 1 .. k */
+    for (int i = 0; i < ob->nlive; i++) {
+        int l = ob->live[i];
+        if (iter >= ob->quiet_iter[l]) { /* past its excitation from now on */
+            table_release(ob, l);
+            continue;
+        }
+        ob->live[n++] = l;
+        long left = ob->quiet_iter[l] - iter; /* steps s <= left are inside it */
+        int m = left < k ? (int)left : k;
+        if (ob->table[l] >= 0) {
+            const double *v = ob->tab[ob->table[l]].v + (long)b->steps[l];
+            double dir = ob->dir[l];
+            for (int s = 1; s <= m; s++)
+                ob->F[s][l] = dir * v[s];
+        }
+    }
+    ob->nlive = n;
+    int own[NL], nown = 0; /* the live lanes without a table, in order */
+    for (int i = 0; i < n; i++)
+        if (ob->table[ob->live[i]] < 0)
+            own[nown++] = ob->live[i];
+    for (int s = 1; s <= k && nown > 0; s++) {
+        double base = 0.0, tp = 0.0;
+        int prev = -1; /* the last lane whose base was computed or reused */
+        for (int i = 0; i < nown; i++) {
+            int l = own[i];
+            if (iter + s - 1 >= ob->quiet_iter[l])
+                continue;
+            double t = (b->steps[l] + (double)s) * b->h[l];
+            if (!(prev == l - 1 && ob->same_prev[l] && t == tp))
+                base = pd_osc_shape(&ob->unit[l], t, -1);
+            ob->F[s][l] = ob->dir[l] * base;
+            prev = l;
+            tp = t;
+        }
+    }
 }
 
 /* Recompute lane l's and lane l + 1's neighbour flags. */
@@ -131,6 +213,7 @@ static int lane_start(osc_batch *ob, int l, long id, const pd_osc *c, const pd_r
     long sc = cut_step(pd_shape_cut(end, -1), h), it = ob->mjb.iter;
     ob->quiet_iter[l] = sc > 0 && sc - 1 <= LONG_MAX - it ? it + sc - 1 : LONG_MAX;
     live_insert(ob, l);
+    table_acquire(ob, l, h, sc > 0 ? sc - 1 : 0);
     ob->cpu[l] = 0.0;
     neighbours(ob, l);
     int rc = pd_mjb_set_lane(&ob->mjb, l, &ln, err);
@@ -151,11 +234,12 @@ static void lane_idle(osc_batch *ob, int l)
     static const pd_mjb_lane idle = {.M = 1.0, .h = 1.0, .brk = INFINITY};
     ob->id[l] = -1;
     live_remove(ob, l);
+    table_release(ob, l);
     neighbours(ob, l);
     pd_mjb_set_lane(&ob->mjb, l, &idle, NULL);
     ob->Pi3[l] = 1.0; /* a gap that never closes */
     ob->meas_from[l] = HUGE_VAL;
-    ob->prev_x[l] = ob->prev_P[l] = 0.0;
+    ob->prev2_v[l] = 0.0;
 }
 
 /* The result of lane l's finished run, as pd_osc_simulate gives it. */
@@ -179,17 +263,45 @@ int pd_osc_batchable(const pd_osc *c, const pd_run_opts *o)
     return o->method == PD_METHOD_MOREAU && o->kernel == PD_KERNEL_AUTO && !o->on_lcp;
 }
 
-/* The measurements for this processor (osc_batch_lanes.h, as for the
- * engine's step). */
-static pd_mjb_observer observe_for_cpu(void)
+/* The steps for this processor (osc_batch_lanes.h, as for the engine's
+ * step). */
+static osc_batch_run_fn run_for_cpu(void)
 {
     switch (pd_cpu_level()) {
 #if PD_X86_VARIANTS
-    case 4: return pd_osc_batch_observe_x86v4;
-    case 3: return pd_osc_batch_observe_x86v3;
+    case 4: return pd_osc_batch_run_x86v4;
+    case 3: return pd_osc_batch_run_x86v3;
 #endif
-    default: return pd_osc_batch_observe_base;
+    default: return pd_osc_batch_run_base;
     }
+}
+
+/* k steps of every lane (no lane ends before the last), in blocks that
+ * end where a lane meets its breakpoint (pd_mjb_run's order: the step,
+ * then the breakpoints). */
+static void run_steps(osc_batch *ob, long k)
+{
+    pd_mjb *b = &ob->mjb;
+    while (k > 0) {
+        long to_event = b->next_event - b->iter; /* >= 1 */
+        int n = (int)(k < OSC_BLOCK ? k : OSC_BLOCK);
+        n = to_event < n ? (int)to_event : n;
+        fill_forces(ob, n);
+        ob->run(ob, n);
+        k -= n;
+        if (b->iter == b->next_event)
+            pd_mjb_breakpoints(b);
+    }
+}
+
+/* The batch's memory. */
+static void batch_free(osc_batch *ob)
+{
+    if (!ob)
+        return;
+    for (int i = 0; i < OSC_TABLES; i++)
+        free(ob->tab[i].v);
+    free(ob);
 }
 
 /* The stream's state: the source, the batch (allocated on the first
@@ -231,7 +343,9 @@ static int batch_open(stream *s, const pd_run_opts *o, pd_err *err)
     mo.theta = o->theta;
     mo.gamma = o->gamma;
     mo.allow_unstable = o->allow_unstable;
-    s->ob->observe = observe_for_cpu();
+    s->ob->run = run_for_cpu();
+    for (int l = 0; l < NL; l++)
+        s->ob->table[l] = -1;
     int rc = pd_mjb_init(&s->ob->mjb, &mo, lanes_force, s->ob, err);
     if (rc) {
         free(s->ob);
@@ -314,7 +428,7 @@ int pd_osc_run_stream(pd_osc_stream_next next, pd_osc_stream_done done, void *ct
                 k = k < 0 || left < k ? left : k;
             }
         double cpu0 = pd_cpu_seconds();
-        pd_mjb_run(&ob->mjb, k, ob->observe, ob);
+        run_steps(ob, k);
         double share = (pd_cpu_seconds() - cpu0) / ob->busy;
         for (int l = 0; l < NL; l++)
             if (ob->id[l] >= 0)
@@ -323,6 +437,6 @@ int pd_osc_run_stream(pd_osc_stream_next next, pd_osc_stream_done done, void *ct
             if (ob->id[l] >= 0 && (long)ob->mjb.steps[l] >= ob->nsteps[l])
                 finish(&s, l);
     }
-    free(s.ob);
+    batch_free(s.ob);
     return PD_OK;
 }

@@ -13,10 +13,31 @@
 #include "pd_problems.h"
 
 #define NL PD_MJB_LANES
+#define OSC_BLOCK 64   /* batch steps run at a time between the forces' fills */
+#define OSC_TABLES 16  /* excitation tables kept */
+#define OSC_TABLE_MAX 32768 /* the longest excitation tabulated, in steps */
+
+/* An excitation's left limits at the steps of one h: v[s] = the shape at
+ * s h (s = 1 .. n), shared by the lanes that run this shape with this
+ * step (dir scales it: pd_osc_shape is odd in dir). */
+typedef struct osc_table {
+    pd_osc unit; /* the shape (dir = +1) */
+    double h;
+    long n, cap;
+    double *v;   /* cap + 1 values, v[0] unused */
+    int users;   /* lanes reading it */
+} osc_table;
+
+typedef struct osc_batch osc_batch;
+/* Run k steps of every lane (k <= OSC_BLOCK, no lane ending or meeting its
+ * breakpoint before the last), the forces at the steps' ends in F[1..k]
+ * and F[0] the first step's start: the lanes' step and measurements, per
+ * instruction set (osc_batch_lanes.h). */
+typedef void (*osc_batch_run_fn)(osc_batch *ob, int k);
 
 /* The batch: the integrator, each lane's case and measurements (allocated
  * on a 64-byte boundary: the arrays marked so sit on cache lines). */
-typedef struct osc_batch {
+struct osc_batch {
     pd_mjb mjb;
     /* a lane's case: id, options, length; -1: idle */
     long id[NL], nsteps[NL];
@@ -29,16 +50,21 @@ typedef struct osc_batch {
     int busy;         /* lanes running a case */
     long quiet_iter[NL]; /* the batch step from which lane l's force is 0 */
     int live[NL], nlive; /* the lanes still inside their excitation, in order */
-    /* the measurements: what every step updates, by vectors of lanes */
+    int table[NL];    /* the lane's excitation table (-1: none, computed per step) */
+    osc_table tab[OSC_TABLES];
+    /* the forces of a block of steps (row s: at the end of its step s) */
+    double F[OSC_BLOCK + 1][NL] __attribute__((aligned(64)));
+    /* the measurements: what every step updates, by vectors of lanes (the
+     * previous x, v and P are the integrator's q, v and P before the step) */
     double Pi3[NL] __attribute__((aligned(64))), meas_from[NL]; /* window start - h/2 */
     /* (umax, max |x|, is the larger of xtoward and xaway: not kept apart) */
     double xtoward[NL] __attribute__((aligned(64))), xaway[NL], min_gap[NL], Pmax[NL];
     double contact[NL] __attribute__((aligned(64))); /* contact steps (whole numbers) */
-    double prev_x[NL] __attribute__((aligned(64))), prev_v[NL], prev2_v[NL], prev_P[NL];
+    double prev2_v[NL] __attribute__((aligned(64)));
     /* ... and what the rare events update */
     pd_osc_track rare[NL];
-    pd_mjb_observer observe; /* the measurements for this processor */
-} osc_batch;
+    osc_batch_run_fn run; /* the steps for this processor */
+};
 
 /* The lane's measurements into the struct the rare events use and back. */
 static inline void rare_load(osc_batch *ob, int l)
@@ -51,12 +77,13 @@ static inline void rare_load(osc_batch *ob, int l)
     tr->min_gap = ob->min_gap[l];
     tr->Pmax = ob->Pmax[l];
     tr->contact_steps = (long)ob->contact[l];
-    tr->prev_x = ob->prev_x[l];
-    tr->prev_v = ob->prev_v[l];
+    tr->prev_x = ob->mjb.q[l];
+    tr->prev_v = ob->mjb.v[l];
     tr->prev2_v = ob->prev2_v[l];
-    tr->prev_P = ob->prev_P[l];
+    tr->prev_P = ob->mjb.P[l];
 }
 
+/* (prev_x, prev_v, prev_P are the integrator's state: the lane's q, v, P.) */
 static inline void rare_store(osc_batch *ob, int l)
 {
     const pd_osc_track *tr = &ob->rare[l];
@@ -65,15 +92,12 @@ static inline void rare_store(osc_batch *ob, int l)
     ob->min_gap[l] = tr->min_gap;
     ob->Pmax[l] = tr->Pmax;
     ob->contact[l] = (double)tr->contact_steps;
-    ob->prev_x[l] = tr->prev_x;
-    ob->prev_v[l] = tr->prev_v;
     ob->prev2_v[l] = tr->prev2_v;
-    ob->prev_P[l] = tr->prev_P;
 }
 
-/* The measurements after a step, per instruction set (pd_cpu.h). */
-int pd_osc_batch_observe_base(const pd_mjb *b, void *ctx);
-int pd_osc_batch_observe_x86v3(const pd_mjb *b, void *ctx);
-int pd_osc_batch_observe_x86v4(const pd_mjb *b, void *ctx);
+/* The steps per instruction set (pd_cpu.h). */
+void pd_osc_batch_run_base(osc_batch *ob, int k);
+void pd_osc_batch_run_x86v3(osc_batch *ob, int k);
+void pd_osc_batch_run_x86v4(osc_batch *ob, int k);
 
 #endif

@@ -5,7 +5,7 @@
 
 #if PD_X86_VARIANTS
 #pragma GCC target("arch=x86-64-v3")
-#define OSC_BATCH_OBSERVE pd_osc_batch_observe_x86v3
+#define OSC_BATCH_RUN pd_osc_batch_run_x86v3
 #include "osc_batch_lanes.h"
 #else
 typedef int pd_osc_batch_x86v3_unused; /* nothing to compile here */

@@ -5,7 +5,7 @@
 
 #if PD_X86_VARIANTS
 #pragma GCC target("arch=x86-64-v4")
-#define OSC_BATCH_OBSERVE pd_osc_batch_observe_x86v4
+#define OSC_BATCH_RUN pd_osc_batch_run_x86v4
 #include "osc_batch_lanes.h"
 #else
 typedef int pd_osc_batch_x86v4_unused; /* nothing to compile here */

@@ -2,7 +2,27 @@
 #ifndef PD_OSC_PRIV_H
 #define PD_OSC_PRIV_H
 
+#include <math.h>
+
 #include "pd_problems.h"
+
+/* pd_shape_cut's and pd_pulse_shape's texts (excitation.c), inline for the loop of the single
+ * Moreau-Jean run (oscillator.c): s phi(tau), 0 past the pulse's end on
+ * the requested side. */
+static inline double pd_shape_cut_inline(double end, int side)
+{
+    return end * (1.0 + (side < 0 ? 1e-12 : -1e-12));
+}
+
+static inline double pd_pulse_shape_inline(pd_pulse pulse, int dir, double tau, int side)
+{
+    if (pulse != PD_PULSE_HARMONIC) {
+        double cut = pd_shape_cut_inline(PD_TWO_PI, side);
+        if (side < 0 ? tau > cut : tau >= cut)
+            return 0.0;
+    }
+    return dir * (pulse == PD_PULSE_COSINE ? cos(tau) : sin(tau));
+}
 
 /* Steps of the Newmark penalty method per period of its stiffest contact
  * element, at least: its step is the output step dt, or dt / k for the

@@ -8,6 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mj1.h"
+#include "osc_priv.h"
 #include "osc_track.h"
 #include "pd_null.h"
 #include "pd_problems.h"
@@ -326,6 +328,60 @@ static int observe(const pd_state *st, void *ctx)
     return 0;
 }
 
+/* pd_mj_run's scalar kernel on the oscillator with the measurements
+ * inline: the same step (mj1.h's mj1_step), the same forces asked at the
+ * same instants (OSC_FORCE_AHEAD steps ahead, so that the excitation's
+ * evaluation runs beside the step's chain of latencies), the breakpoint
+ * met as pd_mj meets it, the same failure; the state stays in registers
+ * (no call through a pointer between two steps).  Its steps taken go to
+ * *steps. */
+#define OSC_FORCE_AHEAD 8 /* a power of 2 */
+
+/* pd_osc_shape, a pulse's inline. */
+static inline double osc_force(const pd_osc *c, double tau, int side)
+{
+    return c->record ? pd_osc_shape(c, tau, side)
+                     : pd_pulse_shape_inline(c->pulse, c->dir, tau, side);
+}
+
+static int simulate_scalar(const pd_osc *c, const pd_model *md, const pd_mj_opts *mo,
+                           long nsteps, pd_osc_track *tr, long *steps, pd_err *err)
+{
+    const double h = mo->h, th = mo->theta, hgamma = h * mo->gamma, t0 = 0.0;
+    const double tol = 1e-9 * h;
+    mj1_coef s1 = mj1_coef_make(1.0, pd_matrix_get(&md->C, 0, 0), pd_matrix_get(&md->K, 0, 0),
+                                md->m > 0, md->m ? -1.0 : 0.0, md->m ? md->g0[0] : 0.0,
+                                md->m ? md->e[0] : 0.0, h, th);
+    int next = 0;
+    while (next < md->nbreaks && md->breaks[next] < t0 - tol)
+        next++;
+    double q = 0.0, v = 0.0, P = 0.0, g = s1.g0 + s1.w * q, F[OSC_FORCE_AHEAD];
+    double F0 = osc_force(c, t0, +1);
+    long k = 0;
+    pd_osc_track_step(tr, 0, t0, q, v, P);
+    for (long i = 0; i < nsteps && i < OSC_FORCE_AHEAD; i++)
+        F[i] = osc_force(c, t0 + (double)(i + 1) * h, -1);
+    for (; k < nsteps; k++) {
+        double t1 = t0 + (double)(k + 1) * h, F1 = F[k & (OSC_FORCE_AHEAD - 1)];
+        if (k + OSC_FORCE_AHEAD < nsteps)
+            F[k & (OSC_FORCE_AHEAD - 1)] =
+                osc_force(c, t0 + (double)(k + OSC_FORCE_AHEAD + 1) * h, -1);
+        mj1_step(h, th, hgamma, &s1, F0, F1, &q, &v, &g, &P);
+        F0 = F1;
+        if (next < md->nbreaks && mj_break_at(md->breaks, md->nbreaks, &next, t1, tol))
+            F0 = osc_force(c, t1, +1);
+        if (!isfinite(q) || !isfinite(v)) {
+            *steps = k + 1;
+            return pd_err_set(err, PD_ENONFINITE,
+                              "Moreau-Jean: non-finite state at t = %.9g (step %ld, dof %d)", t1,
+                              k + 1, 0);
+        }
+        pd_osc_track_step(tr, k + 1, t1, q, v, P);
+    }
+    *steps = k;
+    return PD_OK;
+}
+
 int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler,
                     void *ctx, pd_osc_result *res, pd_err *err)
 {
@@ -366,12 +422,26 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
     long nsteps = pd_steps_for(o.tend, o.dt);
 
     double cpu0 = pd_cpu_seconds();
-    pd_mj *mj = pd_mj_alloc(&model, &mo, err);
-    if (!mj)
-        return err ? err->status : PD_EINVAL;
     double wp = pd_osc_wp(c), Le = pd_osc_Le(c);
     tracker tr = {.Le = Le, .vscale = Le * wp, .wp = wp, .sampler = sampler, .sampler_ctx = ctx};
     pd_osc_track_init(&tr.m, c, mo.h, wp * pd_osc_measure_start(c, o.tend));
+    if (!sampler && mo.kernel == PD_KERNEL_AUTO && mo.factor == PD_FACTOR_AUTO) {
+        /* the scalar kernel, which pd_mj would choose (n = 1, m <= 1) */
+        long steps = 0;
+        if ((rc = pd_model_check(&model, err)) || (rc = pd_mj_check_opts(&mo, err)))
+            return rc;
+        rc = simulate_scalar(c, &model, &mo, nsteps, &tr.m, &steps, err);
+        pd_osc_track_result(&tr.m, c, o.dt, steps, res);
+        res->tend = o.tend;
+        res->theta = mo.theta;
+        res->gamma = mo.gamma;
+        res->kernel = "scalar";
+        res->cpu_s = pd_cpu_seconds() - cpu0;
+        return rc;
+    }
+    pd_mj *mj = pd_mj_alloc(&model, &mo, err);
+    if (!mj)
+        return err ? err->status : PD_EINVAL;
     rc = pd_mj_run(mj, nsteps, observe, &tr, err);
     pd_osc_track_result(&tr.m, c, o.dt, pd_mj_state(mj)->step, res);
     res->tend = o.tend;

@@ -107,7 +107,26 @@ static int case_moreau_general(void)
     return st;
 }
 
+static int keep_sample(const pd_osc_sample *s, void *ctx)
+{
+    *(double *)ctx = s->u;
+    return 0;
+}
+
+/* With a sampler: through pd_mj (without one the run allocates nothing:
+ * test_alloc_every_failure_reported). */
 static int case_oscillator(void)
+{
+    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5, .Pi3 = 0.05, .eps = 0.5, .xi = 0.05};
+    pd_run_opts o = pd_run_default_opts();
+    pd_osc_result r;
+    pd_err err;
+    double u = 0.0;
+    o.dt = 0.01;
+    return pd_osc_simulate(&c, &o, keep_sample, &u, &r, &err);
+}
+
+static int case_oscillator_plain(void)
 {
     pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5, .Pi3 = 0.05, .eps = 0.5, .xi = 0.05};
     pd_run_opts o = pd_run_default_opts();
@@ -201,6 +220,12 @@ static void test_alloc_every_failure_reported(pd_test_ctx *ctx)
     n[5] = fail_each(ctx, "pd_edr_alloc, pd_edr_run (modal clusters)", case_rows);
     CHECK(ctx, n[5] >= 50, "the row reference takes many allocations (%ld)", n[5]);
     CHECK(ctx, n[1] >= 10, "the general kernel takes many allocations (%ld)", n[1]);
+    /* the single Moreau-Jean run without a sampler: no allocation at all */
+    alloc_countdown = -1;
+    alloc_seen = 0;
+    int st = case_oscillator_plain();
+    CHECK(ctx, st == PD_OK && alloc_seen == 0, "pd_osc_simulate without a sampler: status %d, "
+          "%ld allocations", st, alloc_seen);
 }
 
 void suite_alloc(pd_test_ctx *ctx)

@@ -281,6 +281,66 @@ static void test_osc_scalar_vs_general_kernel(pd_test_ctx *ctx)
           worst, ra.umax);
 }
 
+static int count_sample(const pd_osc_sample *s, void *ctx)
+{
+    (void)s;
+    ++*(long *)ctx;
+    return 0;
+}
+
+/* The single Moreau-Jean run without a sampler (its own loop: the scalar
+ * kernel's step with the measurements inline, the forces asked ahead) gives
+ * the figures of the run through pd_mj_run (with a sampler) bit for bit:
+ * pulses with their end's breakpoint, the harmonic excitation, the no-wall
+ * twin, theta, gamma, restitution 0 and 1, and a run that blows up (theta
+ * outside the stable range) with the same status, message and steps. */
+static void test_osc_inline_run_matches_pd_mj(pd_test_ctx *ctx)
+{
+    static const struct {
+        pd_pulse pulse;
+        int dir, no_wall;
+        double Pi2, Pi3, eps, theta, gamma;
+    } cases[] = {
+        {PD_PULSE_SINE, 1, 0, 0.7, 0.05, 0.5, 0.5, 0.5},
+        {PD_PULSE_COSINE, -1, 0, 2.3, 0.01, 0.0, 0.5, 0.5},
+        {PD_PULSE_SINE, -1, 1, 1.3, 0.05, 0.5, 0.5, 0.5},
+        {PD_PULSE_HARMONIC, 1, 0, 0.5, 0.01, 1.0, 0.6, 0.0},
+        {PD_PULSE_COSINE, 1, 0, 3.1, 0.0, 0.8, 1.0, 1.0},
+        {PD_PULSE_SINE, 1, 0, 5.0, 1e9, 0.5, 0.0, 0.5}, /* unstable: blows up */
+    };
+    int failed = 0;
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        pd_osc c = {.pulse = cases[k].pulse, .dir = cases[k].dir, .ap = 1.0, .Tp = 1.0,
+                    .Pi2 = cases[k].Pi2, .Pi3 = cases[k].Pi3, .eps = cases[k].eps, .xi = 0.05};
+        pd_run_opts o = pd_run_default_opts();
+        pd_osc_result ra, rb;
+        pd_err ea, eb;
+        long samples = 0;
+        o.method = PD_METHOD_MOREAU;
+        o.no_wall = cases[k].no_wall;
+        o.theta = cases[k].theta;
+        o.gamma = cases[k].gamma;
+        o.allow_unstable = 1;
+        o.tend = cases[k].pulse == PD_PULSE_HARMONIC ? 30.0 : 0.0;
+        if (cases[k].theta == 0.0) /* h w = 6.3: the state grows ~6x a step */
+            o.dt = 0.2, o.tend = 400.0;
+        int sa = pd_osc_simulate(&c, &o, NULL, NULL, &ra, &ea);
+        int sb = pd_osc_simulate(&c, &o, count_sample, &samples, &rb, &eb);
+        failed += sa != PD_OK;
+        ra.cpu_s = rb.cpu_s = 0.0;
+        CHECK(ctx, sa == sb && !strcmp(ra.kernel, "scalar") && !strcmp(rb.kernel, "scalar"),
+              "case %zu: status %d vs %d, kernels %s %s", k, sa, sb, ra.kernel, rb.kernel);
+        ra.kernel = rb.kernel;
+        CHECK(ctx, !memcmp(&ra, &rb, sizeof ra), "case %zu: figures differ (umax %.17g vs "
+              "%.17g, impacts %ld vs %ld, steps %ld vs %ld)", k, ra.umax, rb.umax, ra.impacts,
+              rb.impacts, ra.steps, rb.steps);
+        CHECK(ctx, sa == PD_OK ? samples == ra.steps + 1 : !strcmp(ea.msg, eb.msg),
+              "case %zu: %ld samples for %ld steps; messages '%s' '%s'", k, samples, ra.steps,
+              sa ? ea.msg : "", sa ? eb.msg : "");
+    }
+    CHECK(ctx, failed == 1, "%d runs failed (the unstable one expected)", failed);
+}
+
 /* Defaults a user expects: dt = min(Tp, T0)/2000, tend = Tp + 2 T0. */
 static void test_osc_defaults_and_checks(pd_test_ctx *ctx)
 {
@@ -317,5 +377,6 @@ void suite_oscillator(pd_test_ctx *ctx)
     PD_RUN(ctx, test_osc_energy_across_impacts);
     PD_RUN(ctx, test_osc_first_impact);
     PD_RUN(ctx, test_osc_scalar_vs_general_kernel);
+    PD_RUN(ctx, test_osc_inline_run_matches_pd_mj);
     PD_RUN(ctx, test_osc_defaults_and_checks);
 }

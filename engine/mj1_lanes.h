@@ -1,0 +1,82 @@
+/* mj1_lanes.h — (library-private) mj1_step's operations on the processor's
+ * own vector of lanes, in registers: the one text of the batch's step
+ * (mj_batch_lanes.h, over pd_mjb's arrays) and of the oscillator's batch,
+ * which fuses its measurements into the same loop (problems/
+ * osc_batch_lanes.h).  Include it after the file's `#pragma GCC target`
+ * (pd_lanes.h: the width follows the target).  Every variant computes
+ * mj1_step's numbers lane for lane: the same IEEE operations in the same
+ * order, no fused multiply-adds (the Makefile's FPFLAGS), the choices as
+ * selections. */
+#ifndef PD_MJ1_LANES_H
+#define PD_MJ1_LANES_H
+
+#include <string.h>
+
+#include "mj1.h"
+#include "pd_lanes.h"
+
+_Static_assert(PD_MJB_LANES % MJ1_WIDTH == 0, "whole groups of lanes");
+_Static_assert(MJ1_WIDTH % LW == 0, "whole native vectors in a group");
+_Static_assert(sizeof(mj1_coefv) * (PD_MJB_LANES / MJ1_WIDTH) <= sizeof(((pd_mjb *)0)->coef),
+               "pd_mjb.coef holds the constants of every group of lanes");
+
+/* LW values from p (any alignment of a double). */
+static inline lvec lload(const void *p)
+{
+    lvec x;
+    memcpy(&x, p, sizeof x);
+    return x;
+}
+
+/* LW values to p. */
+static inline void lstore(void *p, lvec x)
+{
+    memcpy(p, &x, sizeof x);
+}
+
+/* The constants of lanes l .. l + LW - 1 (their group's, pd_mjb.coef). */
+static inline const double *mj1_lanes_coef(const pd_mjb *b, int l)
+{
+    const mj1_coefv *s = (const mj1_coefv *)(const void *)b->coef + l / MJ1_WIDTH;
+    return (const double *)(const void *)s + l % MJ1_WIDTH;
+}
+
+/* For each i < n (a constant once inlined: the statements' loops unroll,
+ * so that the vectors' chains interleave and overlap). */
+#define MJ1_EACH(n, stmt)                                                  \
+    _Pragma("GCC unroll 8") for (int i = 0; i < (n); i++) { stmt; }
+
+/* mj1_step's operations, in its order, on n vectors of LW lanes (n <= 8),
+ * vector i with steps h[i] and its constants at cs[i] (mj1_lanes_coef):
+ * from (q, v) with the gap g and the forces F0 at the step's start and F1
+ * at its end, q, v and g move to the step's end and P gets the impulse. */
+static inline __attribute__((always_inline)) void mj1_lanes_step(int n, const double *const *cs, double th, const lvec *h,
+                                  const lvec *F0, const lvec *F1, lvec *q, lvec *v, lvec *g,
+                                  lvec *P)
+{
+    const lvec zero = {0.0};
+    const size_t W = MJ1_WIDTH; /* one constant's lanes in the group */
+    lvec rhs[8], vfree[8], U0[8], bb[8];
+    lcond active[8], wall[8];
+    lmask wm[8];
+    MJ1_EACH(n, rhs[i] = th * F1[i] + (1.0 - th) * F0[i])
+    MJ1_EACH(n, rhs[i] = h[i] * (rhs[i] - lload(cs[i] + 0 * W) * v[i] -
+                                 lload(cs[i] + 1 * W) * (q[i] + lload(cs[i] + 8 * W) * v[i])))
+    MJ1_EACH(n, vfree[i] = v[i] + rhs[i] * lload(cs[i] + 5 * W))
+    MJ1_EACH(n, U0[i] = lload(cs[i] + 2 * W) * v[i])
+    MJ1_EACH(n, memcpy(&wm[i], cs[i] + 10 * W, sizeof wm[i]))
+    MJ1_EACH(n, wall[i] = LCOND_OF(wm[i]))
+    MJ1_EACH(n, active[i] = wall[i] & LLE(g[i] + lload(cs[i] + 9 * W) * U0[i], zero))
+    MJ1_EACH(n, bb[i] = lload(cs[i] + 2 * W) * vfree[i] + lload(cs[i] + 3 * W) * U0[i])
+    MJ1_EACH(n, P[i] = LKEEP(active[i] & LLT(bb[i], zero), -bb[i] * lload(cs[i] + 7 * W)))
+    MJ1_EACH(n, vfree[i] = LSEL(active[i], vfree[i] + lload(cs[i] + 6 * W) * P[i], vfree[i]))
+    MJ1_EACH(n, q[i] = q[i] + h[i] * (th * vfree[i] + (1.0 - th) * v[i]))
+    MJ1_EACH(n, v[i] = vfree[i])
+    MJ1_EACH(n, g[i] = lload(cs[i] + 4 * W) + lload(cs[i] + 2 * W) * q[i])
+}
+
+/* Lanes meeting their breakpoint at this batch step (b->iter ==
+ * b->next_event): mj_batch.c's, for a caller running the steps itself. */
+void pd_mjb_breakpoints(pd_mjb *b);
+
+#endif
