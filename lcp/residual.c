@@ -1,7 +1,9 @@
 /* residual.c — residuals of an LCP candidate. */
 #include <float.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "lcp_internal.h"
 #include "pd_lcp.h"
@@ -41,13 +43,29 @@ double pd_lcp_max_abs(int n, const double *x)
 /* A row too small to be judged: 0 < r < (n + 1) VERIFY_ROW_MIN. */
 static int row_too_small(int n, double r)
 {
-    return r > 0.0 && r < VERIFY_ROW_BOUND && r < (n + 1.0) * VERIFY_ROW_MIN;
+    return (r > 0.0) & (r < VERIFY_ROW_BOUND) && r < (n + 1.0) * VERIFY_ROW_MIN;
 }
 
-/* Ratio a / b with 0 / 0 = 0 (a term that is exactly zero is exact). */
+/* c ? x : y without a branch: the verification judges rows whose z_i is
+ * 0 or not in no order a branch predictor could learn beyond a few
+ * thousand rows, where a mispredicted branch costs more than the row. */
+static inline double select_bits(int c, double x, double y)
+{
+    uint64_t m = (uint64_t)0 - (uint64_t)(c != 0), bx, by;
+    memcpy(&bx, &x, sizeof bx);
+    memcpy(&by, &y, sizeof by);
+    bx = (bx & m) | (by & ~m);
+    memcpy(&x, &bx, sizeof x);
+    return x;
+}
+
+/* Ratio a / b with 0 / 0 = 0 (a term that is exactly zero is exact), for
+ * a, b >= 0 or NaN; the division is made whatever a and b are (its value
+ * is dropped when it is not the answer). */
 static double ratio(double a, double b)
 {
-    return a == 0.0 ? 0.0 : b > 0.0 ? a / b : HUGE_VAL;
+    double r = a / b;
+    return select_bits(a == 0.0, 0.0, select_bits(b > 0.0, r, HUGE_VAL));
 }
 
 /* Up to this n, a dense row i is made at once (w_i and r_i in registers, the
@@ -67,12 +85,13 @@ static inline void verify_row(verify_acc *acc, int n, double zi_, double wi_, do
 {
     double za = fabs(zi_), wa = fabs(wi_), zi = ratio(za, zs), wi = ratio(wa, ri);
     double v = wi < zi ? wi : zi;
-    acc->nan |= !isfinite(zi_) || !isfinite(wi_) || !isfinite(ri); /* NaN compares false */
+    /* NaN compares false; | and & rather than || and &&: no branches */
+    acc->nan |= !isfinite(zi_) | !isfinite(wi_) | !isfinite(ri);
     acc->nan |= row_too_small(n, ri);
     acc->comp = pd_max(acc->comp, za * wa);
     acc->infeas = pd_max(acc->infeas, pd_max(-zi_, -wi_));
-    v = zi_ < 0.0 ? pd_max(v, zi) : v;
-    v = wi_ < 0.0 ? pd_max(v, wi) : v;
+    v = select_bits(zi_ < 0.0, pd_max(v, zi), v);
+    v = select_bits(wi_ < 0.0, pd_max(v, wi), v);
     acc->rel = pd_max(acc->rel, v);
     acc->scale = pd_max(acc->scale, ri);
 }
@@ -128,6 +147,57 @@ static void affine_rows(const pd_matrix *M, const double *q, const double *z, do
     }
 }
 
+/* w = M z + q, the row sizes and their figures for a tridiagonal M in
+ * compressed columns, in one pass over the columns: the three rows column j
+ * reaches are kept in registers, and row j - 1, complete once column j is
+ * added, is judged at once (while it is in the first-level cache, where
+ * affine_rows makes three passes over n-vectors and a fourth to judge).
+ * The same sums in the same order as affine_rows (a row's terms by
+ * ascending column, a column with z_j = 0 left out), so the same bits.  0,
+ * or -1 at the first entry beyond the band of a column with z_j != 0 (w,
+ * rows and acc then partial: the caller starts again). */
+static int verify_tridiagonal(const pd_matrix *M, const double *q, const double *z, double *w,
+                              double *rows, double zs, verify_acc *acc)
+{
+    int n = M->rows;
+    const int *cp = M->colptr, *ri = M->rowind;
+    const double *v = M->values;
+    /* rows j - 1, j, j + 1 while column j is added */
+    double wa = 0.0, ra = 0.0, wb = q[0], rb = fabs(q[0]), wc, rc;
+    for (int j = 0; j < n; j++) {
+        wc = j + 1 < n ? q[j + 1] : 0.0;
+        rc = fabs(wc);
+        /* a column with z_j = 0 adds -0 (x + -0 = x, a NaN of M dropped as
+         * affine_rows drops the column): no branch on z_j */
+        double zj = z[j];
+        int live = zj != 0.0;
+        for (int k = cp[j]; k < cp[j + 1]; k++) {
+            double p = select_bits(live, v[k] * zj, -0.0), pa = fabs(p);
+            switch (ri[k] - j) {
+            case -1: wa += p; ra += pa; break;
+            case 0: wb += p; rb += pa; break;
+            case 1: wc += p; rc += pa; break;
+            default:
+                if (live)
+                    return -1;
+            }
+        }
+        if (j > 0) {
+            w[j - 1] = wa;
+            rows[j - 1] = ra;
+            verify_row(acc, n, z[j - 1], wa, ra, zs);
+        }
+        wa = wb;
+        ra = rb;
+        wb = wc;
+        rb = rc;
+    }
+    w[n - 1] = wa;
+    rows[n - 1] = ra;
+    verify_row(acc, n, z[n - 1], wa, ra, zs);
+    return 0;
+}
+
 /* The residual figures of a candidate z, with the relative backward residual
  *   max_i max(-z_i / zs, -w_i / r_i, min(|w_i| / r_i, |z_i| / zs)),
  * zs = max|z|, r_i the size of the terms that make w_i: invariant under
@@ -136,15 +206,19 @@ static void affine_rows(const pd_matrix *M, const double *q, const double *z, do
  * diverged iteration), is no answer: its figures are NaN, which no
  * tolerance accepts (x / inf would otherwise pass as a ratio of 0); so
  * are they when a row is too small to be judged (VERIFY_ROW_MIN). */
-void pd_lcp_verify(const pd_matrix *M, const double *q, const double *z, double *w, double *rows,
-                   pd_lcp_info *info)
+void pd_lcp_verify_zs(const pd_matrix *M, const double *q, const double *z, double *w,
+                      double *rows, double zs, pd_lcp_info *info)
 {
     int n = M->rows;
-    double zs = pd_lcp_max_abs(n, z);
-    verify_acc acc = {.comp = 0.0, .infeas = 0.0, .rel = 0.0, .scale = 0.0, .nan = 0};
+    const verify_acc zero = {.comp = 0.0, .infeas = 0.0, .rel = 0.0, .scale = 0.0, .nan = 0};
+    verify_acc acc = zero;
     if (M->kind == PD_MATRIX_DENSE && M->cols == n && n <= VERIFY_ROWWISE_N) {
         verify_rowwise(M, q, z, w, rows, zs, &acc);
+    } else if (M->kind == PD_MATRIX_CSC && M->cols == n &&
+               verify_tridiagonal(M, q, z, w, rows, zs, &acc) == 0) {
+        /* done in one pass */
     } else {
+        acc = zero;
         affine_rows(M, q, z, w, rows);
         for (int i = 0; i < n; i++)
             verify_row(&acc, n, z[i], w[i], rows[i], zs);
@@ -153,6 +227,12 @@ void pd_lcp_verify(const pd_matrix *M, const double *q, const double *z, double 
     info->infeasibility = acc.nan ? NAN : acc.infeas;
     info->residual = acc.nan ? NAN : acc.rel;
     info->scale = acc.scale;
+}
+
+void pd_lcp_verify(const pd_matrix *M, const double *q, const double *z, double *w, double *rows,
+                   pd_lcp_info *info)
+{
+    pd_lcp_verify_zs(M, q, z, w, rows, pd_lcp_max_abs(M->rows, z), info);
 }
 
 void pd_lcp_residual(int n, const double *M, const double *q, const double *z, double *w,
