@@ -1,9 +1,10 @@
 /* residual.c — residuals of an LCP candidate. */
 #include <float.h>
 #include <math.h>
-#include <stdint.h>
 #include <stdlib.h>
-#include <string.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "lcp_internal.h"
 #include "pd_lcp.h"
@@ -43,29 +44,17 @@ double pd_lcp_max_abs(int n, const double *x)
 /* A row too small to be judged: 0 < r < (n + 1) VERIFY_ROW_MIN. */
 static int row_too_small(int n, double r)
 {
-    return (r > 0.0) & (r < VERIFY_ROW_BOUND) && r < (n + 1.0) * VERIFY_ROW_MIN;
-}
-
-/* c ? x : y without a branch: the verification judges rows whose z_i is
- * 0 or not in no order a branch predictor could learn beyond a few
- * thousand rows, where a mispredicted branch costs more than the row. */
-static inline double select_bits(int c, double x, double y)
-{
-    uint64_t m = (uint64_t)0 - (uint64_t)(c != 0), bx, by;
-    memcpy(&bx, &x, sizeof bx);
-    memcpy(&by, &y, sizeof by);
-    bx = (bx & m) | (by & ~m);
-    memcpy(&x, &bx, sizeof x);
-    return x;
+    return r > 0.0 && r < VERIFY_ROW_BOUND && r < (n + 1.0) * VERIFY_ROW_MIN;
 }
 
 /* Ratio a / b with 0 / 0 = 0 (a term that is exactly zero is exact), for
- * a, b >= 0 or NaN; the division is made whatever a and b are (its value
- * is dropped when it is not the answer). */
+ * a, b >= 0 or NaN.  b > 0 is tested first: a row's size is positive
+ * almost always, so that branch is predicted, and a / b is then right for
+ * a = 0 too; testing a = 0 first would branch on whether z_i (or w_i) is
+ * zero, in an order no branch predictor learns past a few thousand rows. */
 static double ratio(double a, double b)
 {
-    double r = a / b;
-    return select_bits(a == 0.0, 0.0, select_bits(b > 0.0, r, HUGE_VAL));
+    return b > 0.0 ? a / b : a == 0.0 ? 0.0 : HUGE_VAL;
 }
 
 /* Up to this n, a dense row i is made at once (w_i and r_i in registers, the
@@ -79,21 +68,58 @@ typedef struct verify_acc {
     int nan;
 } verify_acc;
 
-/* Row i into the figures: z_i, w_i, its size r_i; zs = max|z|. */
+/* a > b ? a : b, and x < 0 ? r : 0, without a branch: whether w_i is
+ * negative (a rounding of 0 on the support) or z_i is zero follows no
+ * order a branch predictor learns past a few thousand rows, and the
+ * compiler may branch on a selection of doubles (gcc does here).  A
+ * column with z_j = 0 adds -0 (live_term): x + -0 = x, and a NaN of M
+ * there is dropped as affine_rows drops the column. */
+#if defined(__SSE2__)
+static inline double max_nb(double a, double b)
+{
+    return _mm_cvtsd_f64(_mm_max_sd(_mm_set_sd(a), _mm_set_sd(b)));
+}
+static inline double if_negative(double x, double r)
+{
+    return _mm_cvtsd_f64(_mm_and_pd(_mm_cmplt_sd(_mm_set_sd(x), _mm_setzero_pd()), _mm_set_sd(r)));
+}
+/* zj != 0 ? p : -0 */
+static inline double live_term(double zj, double p)
+{
+    __m128d m = _mm_cmpneq_sd(_mm_set_sd(zj), _mm_setzero_pd());
+    return _mm_cvtsd_f64(_mm_or_pd(_mm_and_pd(m, _mm_set_sd(p)), _mm_andnot_pd(m, _mm_set_sd(-0.0))));
+}
+#else
+static inline double max_nb(double a, double b)
+{
+    return a > b ? a : b;
+}
+static inline double live_term(double zj, double p)
+{
+    return zj != 0.0 ? p : -0.0;
+}
+static inline double if_negative(double x, double r)
+{
+    return x < 0.0 ? r : 0.0;
+}
+#endif
+
+/* Row i into the figures: z_i, w_i, its size r_i; zs = max|z|.  The
+ * relative residual of the row is max(min(wi, zi), zi if z_i < 0, wi if
+ * w_i < 0), each term >= 0 (when a term is NaN, acc->nan makes the
+ * figures NaN whatever they are). */
 static inline void verify_row(verify_acc *acc, int n, double zi_, double wi_, double ri,
                               double zs)
 {
     double za = fabs(zi_), wa = fabs(wi_), zi = ratio(za, zs), wi = ratio(wa, ri);
     double v = wi < zi ? wi : zi;
-    /* NaN compares false; | and & rather than || and &&: no branches */
-    acc->nan |= !isfinite(zi_) | !isfinite(wi_) | !isfinite(ri);
+    acc->nan |= !isfinite(zi_) || !isfinite(wi_) || !isfinite(ri); /* NaN compares false */
     acc->nan |= row_too_small(n, ri);
-    acc->comp = pd_max(acc->comp, za * wa);
-    acc->infeas = pd_max(acc->infeas, pd_max(-zi_, -wi_));
-    v = select_bits(zi_ < 0.0, pd_max(v, zi), v);
-    v = select_bits(wi_ < 0.0, pd_max(v, wi), v);
-    acc->rel = pd_max(acc->rel, v);
-    acc->scale = pd_max(acc->scale, ri);
+    acc->comp = max_nb(acc->comp, za * wa);
+    acc->infeas = max_nb(acc->infeas, max_nb(-zi_, -wi_));
+    v = max_nb(v, max_nb(if_negative(zi_, zi), if_negative(wi_, wi)));
+    acc->rel = max_nb(acc->rel, v);
+    acc->scale = max_nb(acc->scale, ri);
 }
 
 /* w = M z + q, the row sizes and their figures for a dense M with n <=
@@ -167,12 +193,23 @@ static int verify_tridiagonal(const pd_matrix *M, const double *q, const double 
     for (int j = 0; j < n; j++) {
         wc = j + 1 < n ? q[j + 1] : 0.0;
         rc = fabs(wc);
-        /* a column with z_j = 0 adds -0 (x + -0 = x, a NaN of M dropped as
-         * affine_rows drops the column): no branch on z_j */
+        /* a column with z_j = 0 adds -0 (live_term): no branch on z_j */
         double zj = z[j];
         int live = zj != 0.0;
+        int k0 = cp[j];
+        if (cp[j + 1] - k0 == 3 && ri[k0] == j - 1 && ri[k0 + 1] == j && ri[k0 + 2] == j + 1) {
+            /* a chain's column, in order: no switch */
+            double p0 = live_term(zj, v[k0] * zj), p1 = live_term(zj, v[k0 + 1] * zj);
+            double p2 = live_term(zj, v[k0 + 2] * zj);
+            wa += p0;
+            ra += fabs(p0);
+            wb += p1;
+            rb += fabs(p1);
+            wc += p2;
+            rc += fabs(p2);
+        } else
         for (int k = cp[j]; k < cp[j + 1]; k++) {
-            double p = select_bits(live, v[k] * zj, -0.0), pa = fabs(p);
+            double p = live_term(zj, v[k] * zj), pa = fabs(p);
             switch (ri[k] - j) {
             case -1: wa += p; ra += pa; break;
             case 0: wb += p; rb += pa; break;

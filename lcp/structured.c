@@ -563,12 +563,13 @@ static int stieltjes_support(pd_bpp_work *ws, const pd_matrix *M, const double *
  * factorisation (its y into z) and the back substitution stores z clamped
  * at 0 (as accept does), so that z is made in two passes instead of four.
  * The same operations in the same order as tri_factor, tri_solve and
- * accept, so the same bits.  max z of the interval, or -1 when a pivot is
- * not positive. */
+ * accept, so the same bits; the multipliers are made again on the way
+ * back rather than stored and read.  max z of the interval, or -1 when a
+ * pivot is not positive. */
 static double tri_factor_solve(pd_bpp_work *ws, int off, int k, const double *q, double *z)
 {
     const double *a = ws->ta + off, *b = ws->tb + off;
-    double *tl = ws->tl + off, *tu = ws->tu + off, *dinv = ws->dinv + off, *x = z + off;
+    double *dinv = ws->dinv + off, *x = z + off;
     double rd = 0.0, re = 0.0, yt = 0.0, yb = 0.0, zmax = 0.0;
     int m = k / 2;
     q += off;
@@ -577,14 +578,12 @@ static double tri_factor_solve(pd_bpp_work *ws, int off, int k, const double *q,
         double l = b[i] * rd, d = a[i] - l * b[i];
         if (!(d > BPP_PIVOT_TOL * a[i]) || !(d > 0.0))
             return -1.0;
-        tl[i] = l;
         dinv[i] = rd = 1.0 / d;
         x[i] = yt = -q[i] - l * yt;
         if (j > m) {
             double bj = b[j + 1 < k ? j + 1 : 0], u = bj * re, e = a[j] - u * bj;
             if (!(e > BPP_PIVOT_TOL * a[j]) || !(e > 0.0))
                 return -1.0;
-            tu[j] = u;
             dinv[j] = re = 1.0 / e;
             x[j] = yb = -q[j] - u * yb;
         }
@@ -593,19 +592,19 @@ static double tri_factor_solve(pd_bpp_work *ws, int off, int k, const double *q,
     double g = a[m] - l * b[m] - u * bm1;
     if (!(g > BPP_PIVOT_TOL * a[m]) || !(g > 0.0))
         return -1.0;
-    tl[m] = l;
-    tu[m] = u;
     dinv[m] = 1.0 / g;
     double xm = (-q[m] - l * yt - u * yb) * dinv[m], xt = xm, xb = xm;
     x[m] = xm > 0.0 ? xm : 0.0;
     zmax = x[m];
+    /* the multipliers again, not stored: tri_factor's tl_i+1 = b_i+1 / d_i
+     * and tu_j-1 = b_j / e_j, the same products */
     for (int s = 1; s <= m; s++) {
         int i = m - s, j = m + s;
-        xt = x[i] * dinv[i] - tl[i + 1] * xt;
+        xt = x[i] * dinv[i] - b[i + 1] * dinv[i] * xt;
         x[i] = xt > 0.0 ? xt : 0.0;
         zmax = x[i] > zmax ? x[i] : zmax;
         if (j < k) {
-            xb = x[j] * dinv[j] - tu[j - 1] * xb;
+            xb = x[j] * dinv[j] - b[j] * dinv[j] * xb;
             x[j] = xb > 0.0 ? xb : 0.0;
             zmax = x[j] > zmax ? x[j] : zmax;
         }

@@ -1404,6 +1404,62 @@ static void test_lcp_cli(pd_test_ctx *ctx)
     remove(bad);
 }
 
+/* The plain file of the n x n tridiagonal (lo, 2, up) with q = -e_1, and
+ * with far != 0 the entries M_0,n-1 = M_n-1,0 = far, into path. */
+static int write_tridiagonal(char *path, int n, double lo, double up, double far)
+{
+    static char text[4 * 300 * 300 + 4096];
+    size_t at = (size_t)snprintf(text, sizeof text, "%d\n", n);
+    for (int i = 0; i < n && at < sizeof text; i++)
+        for (int j = 0; j < n && at < sizeof text; j++) {
+            double x = i == j ? 2.0 : j == i - 1 ? lo : j == i + 1 ? up
+                       : (i == 0 && j == n - 1) || (i == n - 1 && j == 0) ? far : 0.0;
+            at += (size_t)snprintf(text + at, sizeof text - at, "%g%c", x, j + 1 < n ? ' ' : '\n');
+        }
+    for (int i = 0; i < n && at < sizeof text; i++)
+        at += (size_t)snprintf(text + at, sizeof text - at, "%d%c", i == 0 ? -1 : 0,
+                               i + 1 < n ? ' ' : '\n');
+    return at < sizeof text ? write_temp(path, text) : -1;
+}
+
+/* `pound lcp --solver structured` on a band given densely (a chain of 300,
+ * an impact q = -e_1): the band noted while reading, solved in compressed
+ * columns by the direct method (1 iteration, verified); with one pair of
+ * far entries not taken for banded (the general method, more iterations,
+ * solved); a nonsymmetric band that the structured solver cannot finish
+ * solved again densely, where the hand-over to Lemke takes it (n = 300 is
+ * above the sparse hand-over's 256). */
+static void test_lcp_cli_band(pd_test_ctx *ctx)
+{
+    if (access(ctx->pound, X_OK) != 0) {
+        pd_test_skip(ctx, "no pound binary");
+        return;
+    }
+    char chain[64], far[64], skew[64], cmd[512];
+    static char out[1 << 16];
+    if (write_tridiagonal(chain, 300, -1.0, -1.0, 0.0) ||
+        write_tridiagonal(far, 300, -1.0, -1.0, -1e-3) ||
+        write_tridiagonal(skew, 300, -1.5, -0.25, 0.0)) {
+        CHECK(ctx, 0, "temporary files");
+        return;
+    }
+    snprintf(cmd, sizeof cmd, "%s lcp %s --solver structured --json", ctx->pound, chain);
+    CHECK(ctx, run_capture(cmd, out, sizeof out) == 0 && strstr(out, "\"status\":\"solved\"") &&
+                   strstr(out, "\"solver\":\"structured\"") && strstr(out, "\"iterations\":1,"),
+          "chain: %.200s", out);
+    snprintf(cmd, sizeof cmd, "%s lcp %s --solver structured --json", ctx->pound, far);
+    CHECK(ctx, run_capture(cmd, out, sizeof out) == 0 && strstr(out, "\"status\":\"solved\"") &&
+                   strstr(out, "\"solver\":\"structured\"") && !strstr(out, "\"iterations\":1,"),
+          "far entry: %.200s", out);
+    snprintf(cmd, sizeof cmd, "%s lcp %s --solver structured --json", ctx->pound, skew);
+    CHECK(ctx, run_capture(cmd, out, sizeof out) == 0 && strstr(out, "\"status\":\"solved\"") &&
+                   strstr(out, "\"solver\":\"lemke (after structured)\""),
+          "nonsymmetric band: %.200s", out);
+    remove(chain);
+    remove(far);
+    remove(skew);
+}
+
 void suite_lcp(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_lcp_siconos_outcomes);
@@ -1445,4 +1501,5 @@ void suite_lcp(pd_test_ctx *ctx)
     PD_RUN(ctx, test_lcp_read_band);
     PD_RUN(ctx, test_lcp_example_file);
     PD_RUN(ctx, test_lcp_cli);
+    PD_RUN(ctx, test_lcp_cli_band);
 }
