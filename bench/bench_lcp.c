@@ -10,7 +10,7 @@
  * BENCH_MIN_RUNS batches and BENCH_MIN_S seconds (3 runs once a solve takes
  * longer than BENCH_LONG_S), divided by the batch size.  Solves are cold
  * (no warm start).  The growth exponent is the least-squares slope of log
- * time against log N over N = 10^3 ... 10^5.  One thread; every figure in
+ * CPU time against log N over N = 10^3 ... 10^5.  One thread; every figure in
  * wall time and in the thread's CPU time (median of each). */
 #include <dirent.h>
 #include <math.h>
@@ -317,8 +317,9 @@ static double per_contact_growth(const bench_report *rep)
     return t5 / t3;
 }
 
-/* Least-squares slope of log(us) against log(n) of a solver's chains with
- * n in [lo, hi]; NAN with fewer than two. */
+/* Least-squares slope of log(CPU us) against log(n) of a solver's chains
+ * with n in [lo, hi] (CPU time: the wall clock of a shared machine doubles
+ * with its load); NAN with fewer than two. */
 static double growth(const bench_report *rep, const char *solver, int lo, int hi)
 {
     pd_loglog_fit fit = {0};
@@ -326,7 +327,7 @@ static double growth(const bench_report *rep, const char *solver, int lo, int hi
         const bench_row *row = &rep->rows[r];
         if (!strncmp(row->name, "chain_", 6) && row->n >= lo && row->n <= hi &&
             !strcmp(row->solver, solver))
-            pd_loglog_add(&fit, (double)row->n, row->median_us);
+            pd_loglog_add(&fit, (double)row->n, row->median_cpu_us);
     }
     return pd_loglog_slope(&fit);
 }
@@ -427,7 +428,7 @@ static void print_table(const bench_report *rep)
     }
     printf("chains: means over %d right-hand sides q (pgs: one); against Siconos numerics, "
            "paired in one run: make bench (bench/siconos_lcp)\n", CHAIN_SEEDS);
-    printf("growth exponent of the time on chains, N = 1e3 ... 1e5: structured %.3f, pgs (%d "
+    printf("growth exponent of the CPU time on chains, N = 1e3 ... 1e5: structured %.3f, pgs (%d "
            "sweeps) %.3f\n",
            growth(rep, "structured", 1000, 100000), BENCH_PGS_SWEEPS,
            growth(rep, "pgs", 1000, 100000));

@@ -213,7 +213,7 @@ static void print_json(int n, const double *z, const double *w, const pd_lcp_inf
 }
 
 /* The band of a dense M (from pd_lcp_read_band) worth compressed columns
- * for the structured solver and PGS: at most BAND_PER_ROW entries a row in
+ * for the structured solver: at most BAND_PER_ROW entries a row in
  * the band, and as the solver table's own copy asks, at most that many
  * nonzero entries a row on average and at most half of them nonzero. */
 #define BAND_PER_ROW 17
@@ -253,8 +253,8 @@ static int solve_once(const lcp_args *a, const pd_matrix *M, const double *q,
 }
 
 /* Solve (M, q) and print; the exit status.  A banded M (band >= 0, nnz
- * entries, from the reader) goes to the structured solver and PGS as
- * compressed columns built from its band; when they do not solve it, M
+ * entries, from the reader) goes to the structured solver as compressed
+ * columns built from its band; when that does not solve it, M
  * goes again densely, as it would without its band (the hand-over to
  * Lemke is larger for dense input).  cpu_s counts the copy of the band
  * and the solves, not the solvers' allocation. */
@@ -270,8 +270,8 @@ static int solve_and_print(const lcp_args *a, int n, const double *M, const doub
     pd_lcp_info info;
     pd_matrix Mv = pd_matrix_dense(n, n, M);
     long cap = (long)BAND_PER_ROW * n < (long)n * n / 2 ? (long)BAND_PER_ROW * n : (long)n * n / 2;
-    int banded = (a->solver == PD_LCP_STRUCTURED || a->solver == PD_LCP_PGS) && band >= 0 &&
-                 2 * band + 1 <= BAND_PER_ROW && nnz <= cap;
+    int banded = a->solver == PD_LCP_STRUCTURED && band >= 0 && 2 * band + 1 <= BAND_PER_ROW &&
+                 nnz <= cap;
     int *colptr = NULL, *rowind = NULL, st = PD_ENUMERICAL;
     double *values = NULL;
     double t0 = pd_cpu_seconds(), cpu_s = 0.0;
