@@ -10,10 +10,11 @@
  * BENCH_MIN_RUNS batches and BENCH_MIN_S seconds (3 runs once a solve takes
  * longer than BENCH_LONG_S), divided by the batch size.  Solves are cold
  * (no warm start).  The growth exponent is the least-squares slope of log
- * time against log N over N = 10^3 ... 10^5.  One thread; every figure in
+ * CPU time against log N over N = 10^3 ... 10^5.  One thread; every figure in
  * wall time and in the thread's CPU time (median of each). */
 #include <dirent.h>
 #include <math.h>
+#include <unistd.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -29,6 +30,9 @@
 #define BENCH_MAX_FILES 256
 #define BENCH_PGS_SWEEPS 2000 /* PGS's budget on the chains: its residual is reported */
 #define CHAIN_SEEDS 5
+#define DENSE_BAND_N 1000 /* the chain given densely (issue 20, goal 4) */
+#define GOAL_PER_CONTACT 1.1 /* time per contact at N = 1e5 over that at 1e3, at most */
+#define GOAL_DENSE_BAND 2.0  /* a band given densely over the banded path, at most */
 
 /* One measured problem and solver. */
 typedef struct bench_row {
@@ -48,6 +52,12 @@ typedef struct bench_report {
     int failed;
     int siconos_found;
     const char *siconos_dir;
+    /* a chain of DENSE_BAND_N given densely (seed 0), CPU µs per solve: in
+     * compressed columns, dense in memory (the table's pass over n^2
+     * entries each solve), the band's copy from the dense matrix
+     * (pd_lcp_band_csc), and the parse of its plain file (one read) */
+    double band_csc_us, band_dense_us, band_copy_us, band_parse_us;
+    int band_ok;
 } bench_report;
 
 /* Wall and CPU seconds for `batch` solves of (M, q). */
@@ -204,8 +214,112 @@ static void bench_chains(bench_report *rep)
         }
 }
 
-/* Least-squares slope of log(us) against log(n) of a solver's chains with
- * n in [lo, hi]; NAN with fewer than two. */
+/* The median CPU µs of `runs` batches of `batch` copies of M's band. */
+static double time_band_copy(const chain *c, int band, long cap, int *colptr, int *rowind,
+                             double *values)
+{
+    double runs[BENCH_MIN_RUNS];
+    int batch = 20;
+    for (int r = 0; r < BENCH_MIN_RUNS; r++) {
+        pd_bench_clock t0 = pd_bench_now();
+        for (int b = 0; b < batch; b++)
+            pd_lcp_band_csc(c->N, c->dense, band, cap, colptr, rowind, values);
+        runs[r] = 1e6 * pd_bench_since(t0).cpu_s / batch;
+    }
+    return pd_bench_median(runs, BENCH_MIN_RUNS);
+}
+
+/* The plain file of a chain into path (mkstemp); 0, or -1. */
+static int write_plain(const chain *c, char *path)
+{
+    int fd = mkstemp(path);
+    FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
+    if (!f) {
+        if (fd >= 0)
+            close(fd);
+        return -1;
+    }
+    int N = c->N;
+    fprintf(f, "%d\n", N);
+    for (int i = 0; i < N; i++)
+        for (int j = 0; j < N; j++)
+            fprintf(f, "%.17g%c", c->dense[i + (size_t)j * N], j + 1 < N ? ' ' : '\n');
+    for (int i = 0; i < N; i++)
+        fprintf(f, "%.17g%c", c->q[i], i + 1 < N ? ' ' : '\n');
+    return fclose(f) ? -1 : 0;
+}
+
+/* The chain of DENSE_BAND_N given densely (seed 0): the structured solver
+ * on it in compressed columns and densely in memory; the copy of its band
+ * and the parse of its plain file (pd_lcp_read_band, the path of `pound
+ * lcp --solver structured FILE`: parse, band noted while reading, band
+ * copied, solved in compressed columns). */
+static void bench_dense_band(bench_report *rep)
+{
+    chain c;
+    bench_row csc_row = {0}, dense_row = {0};
+    char path[] = "/tmp/pound_bench_bandXXXXXX";
+    int n = 0, band = -1, *colptr = NULL, *rowind = NULL;
+    long nnz = 0;
+    double *M = NULL, *q = NULL, *values = NULL;
+    pd_err err;
+    rep->band_ok = 0;
+    if (chain_make(&c, DENSE_BAND_N, 1, 0) || write_plain(&c, path)) {
+        chain_free(&c);
+        rep->failed = 1;
+        return;
+    }
+    pd_matrix csc = pd_matrix_csc(c.N, c.N, c.colptr, c.rowind, c.values);
+    pd_matrix dense = pd_matrix_dense(c.N, c.N, c.dense);
+    int failed = measure(PD_LCP_STRUCTURED, &csc, c.q, 0, &csc_row) ||
+                 measure(PD_LCP_STRUCTURED, &dense, c.q, 0, &dense_row) ||
+                 csc_row.outcome != PD_LCP_SOLVED || dense_row.outcome != PD_LCP_SOLVED;
+    pd_bench_clock t0 = pd_bench_now();
+    int rd = pd_lcp_read_band(path, PD_LCP_FORMAT_PLAIN, &n, &M, &q, &band, &nnz, &err);
+    rep->band_parse_us = 1e6 * pd_bench_since(t0).cpu_s;
+    remove(path);
+    colptr = malloc(((size_t)c.N + 1) * sizeof(int));
+    rowind = malloc(((size_t)nnz + 1) * sizeof(int));
+    values = malloc(((size_t)nnz + 1) * sizeof(double));
+    failed |= rd != PD_OK || band != 1 || nnz != c.colptr[c.N] || !colptr || !rowind || !values;
+    if (!failed) {
+        rep->band_copy_us = time_band_copy(&c, band, nnz, colptr, rowind, values);
+        failed |= pd_lcp_band_csc(c.N, M, band, nnz, colptr, rowind, values) != nnz ||
+                  memcmp(colptr, c.colptr, ((size_t)c.N + 1) * sizeof(int)) ||
+                  memcmp(values, c.values, (size_t)nnz * sizeof(double));
+    }
+    rep->band_csc_us = csc_row.median_cpu_us;
+    rep->band_dense_us = dense_row.median_cpu_us;
+    rep->band_ok = !failed;
+    rep->failed |= failed;
+    free(colptr);
+    free(rowind);
+    free(values);
+    free(M);
+    free(q);
+    chain_free(&c);
+}
+
+/* The structured solver's CPU µs per contact at N = 1e5 over that at 1e3
+ * (the chains' means over the seeds); NAN without both. */
+static double per_contact_growth(const bench_report *rep)
+{
+    double t3 = NAN, t5 = NAN;
+    for (int r = 0; r < rep->nrows; r++) {
+        const bench_row *row = &rep->rows[r];
+        if (strncmp(row->name, "chain_", 6) || strcmp(row->solver, "structured"))
+            continue;
+        if (row->n == 1000)
+            t3 = row->median_cpu_us / 1e3;
+        else if (row->n == 100000)
+            t5 = row->median_cpu_us / 1e5;
+    }
+    return t5 / t3;
+}
+
+/* Least-squares slope of log(CPU us) against log(n) of a solver's chains
+ * with n in [lo, hi] (CPU time: the wall clock of a shared machine doubles
+ * with its load); NAN with fewer than two. */
 static double growth(const bench_report *rep, const char *solver, int lo, int hi)
 {
     pd_loglog_fit fit = {0};
@@ -213,7 +327,7 @@ static double growth(const bench_report *rep, const char *solver, int lo, int hi
         const bench_row *row = &rep->rows[r];
         if (!strncmp(row->name, "chain_", 6) && row->n >= lo && row->n <= hi &&
             !strcmp(row->solver, solver))
-            pd_loglog_add(&fit, (double)row->n, row->median_us);
+            pd_loglog_add(&fit, (double)row->n, row->median_cpu_us);
     }
     return pd_loglog_slope(&fit);
 }
@@ -314,10 +428,27 @@ static void print_table(const bench_report *rep)
     }
     printf("chains: means over %d right-hand sides q (pgs: one); against Siconos numerics, "
            "paired in one run: make bench (bench/siconos_lcp)\n", CHAIN_SEEDS);
-    printf("growth exponent of the time on chains, N = 1e3 ... 1e5: structured %.3f, pgs (%d "
+    printf("growth exponent of the CPU time on chains, N = 1e3 ... 1e5: structured %.3f, pgs (%d "
            "sweeps) %.3f\n",
            growth(rep, "structured", 1000, 100000), BENCH_PGS_SWEEPS,
            growth(rep, "pgs", 1000, 100000));
+    double g = per_contact_growth(rep);
+    printf("structured, CPU time per contact at N = 1e5 over N = 1e3: %.3f (goal <= %.1f: %s)\n",
+           g, GOAL_PER_CONTACT, g <= GOAL_PER_CONTACT ? "met" : "not met");
+    if (!rep->band_ok) {
+        printf("band given densely: FAILED\n");
+        return;
+    }
+    double copy_solve = rep->band_copy_us + rep->band_csc_us;
+    printf("chain of %d given densely, structured, CPU us per solve: compressed columns %.3f; "
+           "dense in memory %.3f (%.2fx: each solve reads all n^2 entries);\n"
+           "  plain file as `pound lcp --solver structured` takes it: parse %.0f (once; the band "
+           "noted while reading), then band copy %.3f + solve %.3f = %.3f: %.2fx the banded "
+           "path (goal <= %.0f: %s)\n",
+           DENSE_BAND_N, rep->band_csc_us, rep->band_dense_us,
+           rep->band_dense_us / rep->band_csc_us, rep->band_parse_us, rep->band_copy_us,
+           rep->band_csc_us, copy_solve, copy_solve / rep->band_csc_us, GOAL_DENSE_BAND,
+           copy_solve <= GOAL_DENSE_BAND * rep->band_csc_us ? "met" : "not met");
 }
 
 /* The member "lcp": {...} of the open JSON object. */
@@ -345,6 +476,16 @@ static void print_json(pd_json *js, const bench_report *rep)
     pd_json_end_array(js);
     pd_json_num(js, "growth_structured", growth(rep, "structured", 1000, 100000));
     pd_json_num(js, "growth_pgs", growth(rep, "pgs", 1000, 100000));
+    pd_json_num(js, "per_contact_growth_structured", per_contact_growth(rep));
+    pd_json_begin_object(js, "dense_band");
+    pd_json_int(js, "n", DENSE_BAND_N);
+    pd_json_bool(js, "ok", rep->band_ok);
+    pd_json_num(js, "csc_cpu_us", rep->band_csc_us);
+    pd_json_num(js, "dense_cpu_us", rep->band_dense_us);
+    pd_json_num(js, "band_copy_cpu_us", rep->band_copy_us);
+    pd_json_num(js, "parse_cpu_us", rep->band_parse_us);
+    pd_json_num(js, "ratio", (rep->band_copy_us + rep->band_csc_us) / rep->band_csc_us);
+    pd_json_end_object(js);
     pd_json_bool(js, "failed", rep->failed);
     pd_json_end_object(js);
 }
@@ -359,6 +500,7 @@ int pd_bench_lcp(pd_json *js, const char *shared_dir)
     }
     bench_siconos(rep, shared_dir, dir, sizeof dir);
     bench_chains(rep);
+    bench_dense_band(rep);
     if (js)
         print_json(js, rep);
     else

@@ -212,16 +212,55 @@ static void print_json(int n, const double *z, const double *w, const pd_lcp_inf
     pd_json_finish(&js);
 }
 
-/* Solve (M, q) and print; the exit status. */
-static int solve_and_print(const lcp_args *a, int n, const double *M, const double *q,
-                           const double *cover, double *z, double *w)
+/* The band of a dense M (from pd_lcp_read_band) worth compressed columns
+ * for the structured solver: at most BAND_PER_ROW entries a row in
+ * the band, and as the solver table's own copy asks, at most that many
+ * nonzero entries a row on average and at most half of them nonzero. */
+#define BAND_PER_ROW 17
+
+/* M's band (half-width band) into compressed columns (pd_lcp_band_csc),
+ * the arrays malloc'd into *colptr, *rowind, *values; -1 when out of
+ * memory. */
+static int band_to_csc(int n, const double *M, int band, long nnz, int **colptr, int **rowind,
+                       double **values)
+{
+    *colptr = malloc(((size_t)n + 1) * sizeof(int));
+    *rowind = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof(int));
+    *values = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof(double));
+    if (!*colptr || !*rowind || !*values)
+        return -1;
+    return pd_lcp_band_csc(n, M, band, nnz, *colptr, *rowind, *values) < 0 ? -1 : 0;
+}
+
+/* One solve of (M, q) with a solver of the table for up to n unknowns and
+ * nnzmax stored entries, its CPU time added to *cpu_s (the solver's
+ * allocation left out); PD_ENOMEM when it cannot be allocated. */
+static int solve_once(const lcp_args *a, const pd_matrix *M, const double *q,
+                      const pd_lcp_opts *opts, long nnzmax, double *z, double *w,
+                      pd_lcp_info *info, double *cpu_s)
 {
     pd_err err;
-    pd_lcp_solver *solver = pd_lcp_solver_alloc(a->solver, n, 0, &err);
+    pd_lcp_solver *solver = pd_lcp_solver_alloc(a->solver, M->rows, nnzmax, &err);
     if (!solver) {
         fprintf(stderr, "pound: lcp: %s\n", err.msg);
-        return 1;
+        return PD_ENOMEM;
     }
+    double t0 = pd_cpu_seconds();
+    int st = pd_lcp_solve(solver, M, q, opts, z, w, info);
+    *cpu_s += pd_cpu_seconds() - t0;
+    pd_lcp_solver_free(solver);
+    return st;
+}
+
+/* Solve (M, q) and print; the exit status.  A banded M (band >= 0, nnz
+ * entries, from the reader) goes to the structured solver as compressed
+ * columns built from its band; when that does not solve it, M
+ * goes again densely, as it would without its band (the hand-over to
+ * Lemke is larger for dense input).  cpu_s counts the copy of the band
+ * and the solves, not the solvers' allocation. */
+static int solve_and_print(const lcp_args *a, int n, const double *M, const double *q,
+                           int band, long nnz, const double *cover, double *z, double *w)
+{
     pd_lcp_opts opts = pd_lcp_default_opts();
     opts.cover = cover;
     opts.max_pivots = a->max_pivots;
@@ -230,10 +269,26 @@ static int solve_and_print(const lcp_args *a, int n, const double *M, const doub
         opts.tol = a->tol;
     pd_lcp_info info;
     pd_matrix Mv = pd_matrix_dense(n, n, M);
-    double t0 = pd_cpu_seconds();
-    int st = pd_lcp_solve(solver, &Mv, q, &opts, z, w, &info);
-    double cpu_s = pd_cpu_seconds() - t0;
-    pd_lcp_solver_free(solver);
+    long cap = (long)BAND_PER_ROW * n < (long)n * n / 2 ? (long)BAND_PER_ROW * n : (long)n * n / 2;
+    int banded = a->solver == PD_LCP_STRUCTURED && band >= 0 && 2 * band + 1 <= BAND_PER_ROW &&
+                 nnz <= cap;
+    int *colptr = NULL, *rowind = NULL, st = PD_ENUMERICAL;
+    double *values = NULL;
+    double t0 = pd_cpu_seconds(), cpu_s = 0.0;
+    if (banded && band_to_csc(n, M, band, nnz, &colptr, &rowind, &values) == 0) {
+        cpu_s = pd_cpu_seconds() - t0;
+        pd_matrix Mc = pd_matrix_csc(n, n, colptr, rowind, values);
+        st = solve_once(a, &Mc, q, &opts, nnz > 0 ? nnz : 1, z, w, &info, &cpu_s);
+    } else {
+        banded = 0;
+    }
+    if (!banded || (st != PD_OK && st != PD_ENOMEM))
+        st = solve_once(a, &Mv, q, &opts, 0, z, w, &info, &cpu_s);
+    free(colptr);
+    free(rowind);
+    free(values);
+    if (st == PD_ENOMEM)
+        return 1;
     if (st == PD_EINVAL) /* the reader refuses non-finite data: the size is what is left */
         return pd_cli_usage_error("lcp: %s: n = %d is more than the %s solver takes (Lemke: at "
                                   "most %d unknowns)",
@@ -342,17 +397,19 @@ int pd_cmd_lcp(int argc, char **argv)
         return resolve_dump(&a);
     if (a.all || a.index >= 0)
         return pd_cli_usage_error("lcp: --all and --index go with an LCP dump (FILE.h5)");
-    int n = 0;
+    int n = 0, band = -1;
+    long nnz = 0;
     double *M = NULL, *q = NULL, *buf = NULL;
     pd_err err;
-    if (pd_lcp_read(a.path, a.format, &n, &M, &q, &err) != PD_OK)
+    if (pd_lcp_read_band(a.path, a.format, &n, &M, &q, &band, &nnz, &err) != PD_OK)
         return pd_cli_usage_error("lcp: %s", err.msg);
     buf = malloc(3 * (size_t)n * sizeof(double));
     if (!buf) {
         fprintf(stderr, "pound: lcp: out of memory for n = %d\n", n);
         rc = 1;
     } else if (!a.cover_text || (rc = parse_cover(a.cover_text, n, buf + 2 * n)) == 0) {
-        rc = solve_and_print(&a, n, M, q, a.cover_text ? buf + 2 * n : NULL, buf, buf + n);
+        rc = solve_and_print(&a, n, M, q, band, nnz, a.cover_text ? buf + 2 * n : NULL, buf,
+                             buf + n);
     }
     free(buf);
     free(M);

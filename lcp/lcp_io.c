@@ -179,17 +179,32 @@ static int alloc_problem(const lcp_text *t, int n, double **M, double **q, pd_er
     return pd_err_set(err, PD_ENOMEM, "%s: out of memory for n = %d", t->path, n);
 }
 
-/* n*n entries of M from c on; row_major selects the layout. */
+/* The band of M seen while it is read: max |i - j| over the nonzero M_ij
+ * (-1: none), and how many there are. */
+typedef struct lcp_band {
+    int band;
+    long nnz;
+} lcp_band;
+
+/* n*n entries of M from c on; row_major selects the layout.  The band is
+ * noted entry by entry as it is read: no pass of its own. */
 static int read_matrix(const lcp_text *t, lcp_cursor *c, int n, int row_major, double *M,
-                       pd_err *err)
+                       lcp_band *band, pd_err *err)
 {
     size_t nn = (size_t)n * (size_t)n;
+    band->band = -1;
+    band->nnz = 0;
     for (size_t k = 0; k < nn; k++) {
         size_t i = k / (size_t)n, j = k % (size_t)n;
         size_t at = row_major ? i + j * (size_t)n : k;
         int st = token_number(t, c, "matrix entry", &M[at], err);
         if (st != PD_OK)
             return st;
+        if (M[at] != 0.0) {
+            int d = (int)(i > j ? i - j : j - i);
+            band->band = d > band->band ? d : band->band;
+            band->nnz++;
+        }
     }
     return PD_OK;
 }
@@ -222,7 +237,7 @@ static int check_nothing_after(const lcp_text *t, lcp_cursor c, int n, pd_err *e
 
 /* plain: n, M row by row, q, and nothing more. */
 static int read_plain(const lcp_text *t, lcp_cursor c, int *n, double **M, double **q,
-                      pd_err *err)
+                      lcp_band *band, pd_err *err)
 {
     if (count_tokens(t, c, 1) == 0)
         return pd_err_set(err, PD_EPARSE, "%s: line %d: empty file, expected the size n",
@@ -235,7 +250,7 @@ static int read_plain(const lcp_text *t, lcp_cursor c, int *n, double **M, doubl
     if (st == PD_OK)
         st = alloc_problem(t, *n, M, q, err);
     if (st == PD_OK)
-        st = read_matrix(t, &c, *n, 1, *M, err);
+        st = read_matrix(t, &c, *n, 1, *M, band, err);
     if (st == PD_OK)
         st = read_vector(t, &c, *n, *q, err);
     return st;
@@ -262,7 +277,7 @@ static int check_siconos_header(const lcp_text *t, lcp_cursor *c, int n, pd_err 
 
 /* siconos: header, M column by column, q; the rest is free text. */
 static int read_siconos(const lcp_text *t, lcp_cursor c, int *n, double **M, double **q,
-                        pd_err *err)
+                        lcp_band *band, pd_err *err)
 {
     if (count_tokens(t, c, 1) == 0)
         return pd_err_set(err, PD_EPARSE, "%s: line %d: empty file, expected the size n",
@@ -275,7 +290,7 @@ static int read_siconos(const lcp_text *t, lcp_cursor c, int *n, double **M, dou
     if (st == PD_OK)
         st = alloc_problem(t, *n, M, q, err);
     if (st == PD_OK)
-        st = read_matrix(t, &c, *n, 0, *M, err);
+        st = read_matrix(t, &c, *n, 0, *M, band, err);
     if (st == PD_OK)
         st = read_vector(t, &c, *n, *q, err);
     return st;
@@ -303,6 +318,13 @@ static int looks_siconos(const lcp_text *t, lcp_cursor c)
 int pd_lcp_read(const char *path, pd_lcp_format format, int *n, double **M, double **q,
                 pd_err *err)
 {
+    return pd_lcp_read_band(path, format, n, M, q, NULL, NULL, err);
+}
+
+int pd_lcp_read_band(const char *path, pd_lcp_format format, int *n, double **M, double **q,
+                     int *band, long *nnz, pd_err *err)
+{
+    lcp_band b = {.band = -1, .nnz = 0};
     pd_err_clear(err);
     if (!path || !n || !M || !q)
         return pd_err_set(err, PD_EINVAL, "pd_lcp_read: NULL argument");
@@ -317,7 +339,7 @@ int pd_lcp_read(const char *path, pd_lcp_format format, int *n, double **M, doub
         lcp_cursor c = text_start(&t);
         int siconos = format == PD_LCP_FORMAT_SICONOS ||
                       (format == PD_LCP_FORMAT_AUTO && looks_siconos(&t, c));
-        st = siconos ? read_siconos(&t, c, n, M, q, err) : read_plain(&t, c, n, M, q, err);
+        st = siconos ? read_siconos(&t, c, n, M, q, &b, err) : read_plain(&t, c, n, M, q, &b, err);
     }
     if (st != PD_OK) {
         free(*M);
@@ -326,5 +348,31 @@ int pd_lcp_read(const char *path, pd_lcp_format format, int *n, double **M, doub
         *n = 0;
     }
     free(t.buf);
+    if (band)
+        *band = st == PD_OK ? b.band : -1;
+    if (nnz)
+        *nnz = st == PD_OK ? b.nnz : 0;
     return st;
+}
+
+long pd_lcp_band_csc(int n, const double *M, int band, long cap, int *colptr, int *rowind,
+                     double *values)
+{
+    if (n < 1 || !M || band < -1 || !colptr || !rowind || !values)
+        return PD_EINVAL;
+    long k = 0;
+    for (int j = 0; j < n; j++) {
+        const double *c = M + (size_t)j * (size_t)n;
+        int lo = j - band > 0 ? j - band : 0, hi = j + band < n - 1 ? j + band : n - 1;
+        colptr[j] = (int)k;
+        for (int i = lo; i <= hi; i++)
+            if (c[i] != 0.0) { /* true for a NaN */
+                if (k == cap)
+                    return PD_EINVAL;
+                rowind[k] = i;
+                values[k++] = c[i];
+            }
+    }
+    colptr[n] = (int)k;
+    return k;
 }

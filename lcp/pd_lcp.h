@@ -165,5 +165,19 @@ typedef enum { PD_LCP_FORMAT_AUTO, PD_LCP_FORMAT_PLAIN, PD_LCP_FORMAT_SICONOS } 
  * a message naming the line. */
 PD_API int pd_lcp_read(const char *path, pd_lcp_format format, int *n, double **M, double **q,
                        pd_err *err);
+/* pd_lcp_read, and the band of M noted while its entries are read (no
+ * pass of its own): *band = max |i - j| over the nonzero entries M_ij (-1
+ * when M is zero), *nnz their number; band and nnz may each be NULL. A
+ * caller with a banded M may hand the structured solver compressed
+ * columns built from the band alone (`pound lcp` does, docs/lcp.md). */
+PD_API int pd_lcp_read_band(const char *path, pd_lcp_format format, int *n, double **M,
+                            double **q, int *band, long *nnz, pd_err *err);
+/* The nonzero entries of the band |i - j| <= band of the dense n x n M
+ * (column-major) into compressed columns colptr (n + 1), rowind, values
+ * (cap entries each), reading the band alone; the number of entries, or
+ * PD_EINVAL when there are more than cap (or an argument is bad).  With
+ * the band of pd_lcp_read_band, the matrix itself. */
+PD_API long pd_lcp_band_csc(int n, const double *M, int band, long cap, int *colptr,
+                            int *rowind, double *values);
 
 #endif

@@ -2,6 +2,9 @@
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "lcp_internal.h"
 #include "pd_lcp.h"
@@ -44,10 +47,14 @@ static int row_too_small(int n, double r)
     return r > 0.0 && r < VERIFY_ROW_BOUND && r < (n + 1.0) * VERIFY_ROW_MIN;
 }
 
-/* Ratio a / b with 0 / 0 = 0 (a term that is exactly zero is exact). */
+/* Ratio a / b with 0 / 0 = 0 (a term that is exactly zero is exact), for
+ * a, b >= 0 or NaN.  b > 0 is tested first: a row's size is positive
+ * almost always, so that branch is predicted, and a / b is then right for
+ * a = 0 too; testing a = 0 first would branch on whether z_i (or w_i) is
+ * zero, in an order no branch predictor learns past a few thousand rows. */
 static double ratio(double a, double b)
 {
-    return a == 0.0 ? 0.0 : b > 0.0 ? a / b : HUGE_VAL;
+    return b > 0.0 ? a / b : a == 0.0 ? 0.0 : HUGE_VAL;
 }
 
 /* Up to this n, a dense row i is made at once (w_i and r_i in registers, the
@@ -61,7 +68,46 @@ typedef struct verify_acc {
     int nan;
 } verify_acc;
 
-/* Row i into the figures: z_i, w_i, its size r_i; zs = max|z|. */
+/* a > b ? a : b, and x < 0 ? r : 0, without a branch: whether w_i is
+ * negative (a rounding of 0 on the support) or z_i is zero follows no
+ * order a branch predictor learns past a few thousand rows, and the
+ * compiler may branch on a selection of doubles (gcc does here).  A
+ * column with z_j = 0 adds -0 (live_term): x + -0 = x, and a NaN of M
+ * there is dropped as affine_rows drops the column. */
+#if defined(__SSE2__)
+static inline double max_nb(double a, double b)
+{
+    return _mm_cvtsd_f64(_mm_max_sd(_mm_set_sd(a), _mm_set_sd(b)));
+}
+static inline double if_negative(double x, double r)
+{
+    return _mm_cvtsd_f64(_mm_and_pd(_mm_cmplt_sd(_mm_set_sd(x), _mm_setzero_pd()), _mm_set_sd(r)));
+}
+/* zj != 0 ? p : -0 */
+static inline double live_term(double zj, double p)
+{
+    __m128d m = _mm_cmpneq_sd(_mm_set_sd(zj), _mm_setzero_pd());
+    return _mm_cvtsd_f64(_mm_or_pd(_mm_and_pd(m, _mm_set_sd(p)), _mm_andnot_pd(m, _mm_set_sd(-0.0))));
+}
+#else
+static inline double max_nb(double a, double b)
+{
+    return a > b ? a : b;
+}
+static inline double live_term(double zj, double p)
+{
+    return zj != 0.0 ? p : -0.0;
+}
+static inline double if_negative(double x, double r)
+{
+    return x < 0.0 ? r : 0.0;
+}
+#endif
+
+/* Row i into the figures: z_i, w_i, its size r_i; zs = max|z|.  The
+ * relative residual of the row is max(min(wi, zi), zi if z_i < 0, wi if
+ * w_i < 0), each term >= 0 (when a term is NaN, acc->nan makes the
+ * figures NaN whatever they are). */
 static inline void verify_row(verify_acc *acc, int n, double zi_, double wi_, double ri,
                               double zs)
 {
@@ -69,12 +115,11 @@ static inline void verify_row(verify_acc *acc, int n, double zi_, double wi_, do
     double v = wi < zi ? wi : zi;
     acc->nan |= !isfinite(zi_) || !isfinite(wi_) || !isfinite(ri); /* NaN compares false */
     acc->nan |= row_too_small(n, ri);
-    acc->comp = pd_max(acc->comp, za * wa);
-    acc->infeas = pd_max(acc->infeas, pd_max(-zi_, -wi_));
-    v = zi_ < 0.0 ? pd_max(v, zi) : v;
-    v = wi_ < 0.0 ? pd_max(v, wi) : v;
-    acc->rel = pd_max(acc->rel, v);
-    acc->scale = pd_max(acc->scale, ri);
+    acc->comp = max_nb(acc->comp, za * wa);
+    acc->infeas = max_nb(acc->infeas, max_nb(-zi_, -wi_));
+    v = max_nb(v, max_nb(if_negative(zi_, zi), if_negative(wi_, wi)));
+    acc->rel = max_nb(acc->rel, v);
+    acc->scale = max_nb(acc->scale, ri);
 }
 
 /* w = M z + q, the row sizes and their figures for a dense M with n <=
@@ -128,6 +173,68 @@ static void affine_rows(const pd_matrix *M, const double *q, const double *z, do
     }
 }
 
+/* w = M z + q, the row sizes and their figures for a tridiagonal M in
+ * compressed columns, in one pass over the columns: the three rows column j
+ * reaches are kept in registers, and row j - 1, complete once column j is
+ * added, is judged at once (while it is in the first-level cache, where
+ * affine_rows makes three passes over n-vectors and a fourth to judge).
+ * The same sums in the same order as affine_rows (a row's terms by
+ * ascending column, a column with z_j = 0 left out), so the same bits.  0,
+ * or -1 at the first entry beyond the band of a column with z_j != 0 (w,
+ * rows and acc then partial: the caller starts again). */
+static int verify_tridiagonal(const pd_matrix *M, const double *q, const double *z, double *w,
+                              double *rows, double zs, verify_acc *acc)
+{
+    int n = M->rows;
+    const int *cp = M->colptr, *ri = M->rowind;
+    const double *v = M->values;
+    /* rows j - 1, j, j + 1 while column j is added */
+    double wa = 0.0, ra = 0.0, wb = q[0], rb = fabs(q[0]), wc, rc;
+    for (int j = 0; j < n; j++) {
+        wc = j + 1 < n ? q[j + 1] : 0.0;
+        rc = fabs(wc);
+        /* a column with z_j = 0 adds -0 (live_term): no branch on z_j */
+        double zj = z[j];
+        int live = zj != 0.0;
+        int k0 = cp[j];
+        if (cp[j + 1] - k0 == 3 && ri[k0] == j - 1 && ri[k0 + 1] == j && ri[k0 + 2] == j + 1) {
+            /* a chain's column, in order: no switch */
+            double p0 = live_term(zj, v[k0] * zj), p1 = live_term(zj, v[k0 + 1] * zj);
+            double p2 = live_term(zj, v[k0 + 2] * zj);
+            wa += p0;
+            ra += fabs(p0);
+            wb += p1;
+            rb += fabs(p1);
+            wc += p2;
+            rc += fabs(p2);
+        } else
+        for (int k = cp[j]; k < cp[j + 1]; k++) {
+            double p = live_term(zj, v[k] * zj), pa = fabs(p);
+            switch (ri[k] - j) {
+            case -1: wa += p; ra += pa; break;
+            case 0: wb += p; rb += pa; break;
+            case 1: wc += p; rc += pa; break;
+            default:
+                if (live)
+                    return -1;
+            }
+        }
+        if (j > 0) {
+            w[j - 1] = wa;
+            rows[j - 1] = ra;
+            verify_row(acc, n, z[j - 1], wa, ra, zs);
+        }
+        wa = wb;
+        ra = rb;
+        wb = wc;
+        rb = rc;
+    }
+    w[n - 1] = wa;
+    rows[n - 1] = ra;
+    verify_row(acc, n, z[n - 1], wa, ra, zs);
+    return 0;
+}
+
 /* The residual figures of a candidate z, with the relative backward residual
  *   max_i max(-z_i / zs, -w_i / r_i, min(|w_i| / r_i, |z_i| / zs)),
  * zs = max|z|, r_i the size of the terms that make w_i: invariant under
@@ -136,15 +243,19 @@ static void affine_rows(const pd_matrix *M, const double *q, const double *z, do
  * diverged iteration), is no answer: its figures are NaN, which no
  * tolerance accepts (x / inf would otherwise pass as a ratio of 0); so
  * are they when a row is too small to be judged (VERIFY_ROW_MIN). */
-void pd_lcp_verify(const pd_matrix *M, const double *q, const double *z, double *w, double *rows,
-                   pd_lcp_info *info)
+void pd_lcp_verify_zs(const pd_matrix *M, const double *q, const double *z, double *w,
+                      double *rows, double zs, pd_lcp_info *info)
 {
     int n = M->rows;
-    double zs = pd_lcp_max_abs(n, z);
-    verify_acc acc = {.comp = 0.0, .infeas = 0.0, .rel = 0.0, .scale = 0.0, .nan = 0};
+    const verify_acc zero = {.comp = 0.0, .infeas = 0.0, .rel = 0.0, .scale = 0.0, .nan = 0};
+    verify_acc acc = zero;
     if (M->kind == PD_MATRIX_DENSE && M->cols == n && n <= VERIFY_ROWWISE_N) {
         verify_rowwise(M, q, z, w, rows, zs, &acc);
+    } else if (M->kind == PD_MATRIX_CSC && M->cols == n &&
+               verify_tridiagonal(M, q, z, w, rows, zs, &acc) == 0) {
+        /* done in one pass */
     } else {
+        acc = zero;
         affine_rows(M, q, z, w, rows);
         for (int i = 0; i < n; i++)
             verify_row(&acc, n, z[i], w[i], rows[i], zs);
@@ -153,6 +264,12 @@ void pd_lcp_verify(const pd_matrix *M, const double *q, const double *z, double 
     info->infeasibility = acc.nan ? NAN : acc.infeas;
     info->residual = acc.nan ? NAN : acc.rel;
     info->scale = acc.scale;
+}
+
+void pd_lcp_verify(const pd_matrix *M, const double *q, const double *z, double *w, double *rows,
+                   pd_lcp_info *info)
+{
+    pd_lcp_verify_zs(M, q, z, w, rows, pd_lcp_max_abs(M->rows, z), info);
 }
 
 void pd_lcp_residual(int n, const double *M, const double *q, const double *z, double *w,

@@ -41,6 +41,7 @@ OPTIONAL = {
     ("pd_osc_resolve_opts", "in"), ("pd_osc_run", "opts"), ("pd_osc_simulate", "opts"),
     ("pd_osc_reference", "opts"), ("pd_osc_penalty", "opts"), ("pd_osc_summarize", "opts"),
     ("pd_record_plausible", "msg"),
+    ("pd_lcp_read_band", "band"), ("pd_lcp_read_band", "nnz"),
 }
 
 # int functions whose value is a count, a flag or an index: NULL gives <= 0.

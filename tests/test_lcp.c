@@ -212,6 +212,73 @@ static int read_text(const char *text, pd_lcp_format format, int *n, double **M,
     return st;
 }
 
+/* The band noted while a file is read (pd_lcp_read_band) and the copy of
+ * the band (pd_lcp_band_csc): a tridiagonal chain of 40 has band 1 and
+ * 118 nonzero entries, and its band's copy is the matrix; the same chain
+ * with one far entry M_0,39 (plain, row-major) or M_39,0 (Siconos,
+ * column-major) has band 39, so it is not taken for banded, and the copy
+ * of its band 39 is the matrix too; a copy over its capacity is refused. */
+static void test_lcp_read_band(pd_test_ctx *ctx)
+{
+    enum { N = 40 };
+    for (int far = 0; far < 2; far++)
+        for (int siconos = 0; siconos < 2; siconos++) {
+            static char text[16 * N * N + 256];
+            size_t at = 0;
+            at += (size_t)snprintf(text + at, sizeof text - at, siconos ? "%d\n0\n%d\n%d\n%d %d\n"
+                                                                        : "%d\n",
+                                   N, N, N, N, N);
+            for (int r = 0; r < N; r++) /* row r of the file: M's row (plain), column (siconos) */
+                for (int c = 0; c < N; c++) {
+                    int i = siconos ? c : r, j = siconos ? r : c;
+                    double x = i == j ? 2.0 : abs(i - j) == 1 ? -1.0 : far && i == 39 && j == 0 ? 0.5 : 0.0;
+                    at += (size_t)snprintf(text + at, sizeof text - at, "%g%c", x, c + 1 < N ? ' ' : '\n');
+                }
+            for (int i = 0; i < N; i++)
+                at += (size_t)snprintf(text + at, sizeof text - at, "%d%c", i % 3 - 1, i + 1 < N ? ' ' : '\n');
+            char path[64];
+            int n = 0, band = -2;
+            long nnz = -1;
+            double *M = NULL, *q = NULL;
+            pd_err err;
+            if (!CHECK(ctx, write_temp(path, text) == 0, "temp file"))
+                return;
+            int st = pd_lcp_read_band(path, siconos ? PD_LCP_FORMAT_SICONOS : PD_LCP_FORMAT_PLAIN,
+                                      &n, &M, &q, &band, &nnz, &err);
+            remove(path);
+            if (!CHECK(ctx, st == PD_OK && n == N, "read: %s", err.msg))
+                continue;
+            CHECK(ctx, band == (far ? 39 : 1) && nnz == 3 * N - 2 + far,
+                  "far %d siconos %d: band %d, nnz %ld", far, siconos, band, nnz);
+            int colptr[N + 1], rowind[3 * N];
+            double values[3 * N], back[N * N];
+            long k = pd_lcp_band_csc(n, M, band, 3 * N, colptr, rowind, values);
+            CHECK(ctx, k == nnz, "copy: %ld entries", k);
+            if (k == nnz) {
+                pd_matrix A = pd_matrix_csc(n, n, colptr, rowind, values);
+                pd_matrix_to_dense(&A, back);
+                CHECK(ctx, !memcmp(back, M, sizeof back), "far %d: the copy is not M", far);
+            }
+            CHECK(ctx, pd_lcp_band_csc(n, M, band, nnz - 1, colptr, rowind, values) == PD_EINVAL,
+                  "over its capacity: not refused");
+            free(M);
+            free(q);
+        }
+    int n = 0, band = 7;
+    long nnz = 7;
+    double *M = NULL, *q = NULL;
+    pd_err err;
+    char path[64];
+    if (CHECK(ctx, write_temp(path, "2\n0 0\n0 0\n1 1\n") == 0, "temp file")) {
+        CHECK(ctx, pd_lcp_read_band(path, PD_LCP_FORMAT_PLAIN, &n, &M, &q, &band, &nnz, &err) ==
+                           PD_OK && band == -1 && nnz == 0,
+              "zero M: band %d nnz %ld", band, nnz);
+        remove(path);
+        free(M);
+        free(q);
+    }
+}
+
 /* ---- Siconos test set --------------------------------------------------------------- */
 
 static const char *const siconos_files[] = {
@@ -1337,6 +1404,62 @@ static void test_lcp_cli(pd_test_ctx *ctx)
     remove(bad);
 }
 
+/* The plain file of the n x n tridiagonal (lo, 2, up) with q = -e_1, and
+ * with far != 0 the entries M_0,n-1 = M_n-1,0 = far, into path. */
+static int write_tridiagonal(char *path, int n, double lo, double up, double far)
+{
+    static char text[4 * 300 * 300 + 4096];
+    size_t at = (size_t)snprintf(text, sizeof text, "%d\n", n);
+    for (int i = 0; i < n && at < sizeof text; i++)
+        for (int j = 0; j < n && at < sizeof text; j++) {
+            double x = i == j ? 2.0 : j == i - 1 ? lo : j == i + 1 ? up
+                       : (i == 0 && j == n - 1) || (i == n - 1 && j == 0) ? far : 0.0;
+            at += (size_t)snprintf(text + at, sizeof text - at, "%g%c", x, j + 1 < n ? ' ' : '\n');
+        }
+    for (int i = 0; i < n && at < sizeof text; i++)
+        at += (size_t)snprintf(text + at, sizeof text - at, "%d%c", i == 0 ? -1 : 0,
+                               i + 1 < n ? ' ' : '\n');
+    return at < sizeof text ? write_temp(path, text) : -1;
+}
+
+/* `pound lcp --solver structured` on a band given densely (a chain of 300,
+ * an impact q = -e_1): the band noted while reading, solved in compressed
+ * columns by the direct method (1 iteration, verified); with one pair of
+ * far entries not taken for banded (the general method, more iterations,
+ * solved); a nonsymmetric band that the structured solver cannot finish
+ * solved again densely, where the hand-over to Lemke takes it (n = 300 is
+ * above the sparse hand-over's 256). */
+static void test_lcp_cli_band(pd_test_ctx *ctx)
+{
+    if (access(ctx->pound, X_OK) != 0) {
+        pd_test_skip(ctx, "no pound binary");
+        return;
+    }
+    char chain[64], far[64], skew[64], cmd[512];
+    static char out[1 << 16];
+    if (write_tridiagonal(chain, 300, -1.0, -1.0, 0.0) ||
+        write_tridiagonal(far, 300, -1.0, -1.0, -1e-3) ||
+        write_tridiagonal(skew, 300, -1.5, -0.25, 0.0)) {
+        CHECK(ctx, 0, "temporary files");
+        return;
+    }
+    snprintf(cmd, sizeof cmd, "%s lcp %s --solver structured --json", ctx->pound, chain);
+    CHECK(ctx, run_capture(cmd, out, sizeof out) == 0 && strstr(out, "\"status\":\"solved\"") &&
+                   strstr(out, "\"solver\":\"structured\"") && strstr(out, "\"iterations\":1,"),
+          "chain: %.200s", out);
+    snprintf(cmd, sizeof cmd, "%s lcp %s --solver structured --json", ctx->pound, far);
+    CHECK(ctx, run_capture(cmd, out, sizeof out) == 0 && strstr(out, "\"status\":\"solved\"") &&
+                   strstr(out, "\"solver\":\"structured\"") && !strstr(out, "\"iterations\":1,"),
+          "far entry: %.200s", out);
+    snprintf(cmd, sizeof cmd, "%s lcp %s --solver structured --json", ctx->pound, skew);
+    CHECK(ctx, run_capture(cmd, out, sizeof out) == 0 && strstr(out, "\"status\":\"solved\"") &&
+                   strstr(out, "\"solver\":\"lemke (after structured)\""),
+          "nonsymmetric band: %.200s", out);
+    remove(chain);
+    remove(far);
+    remove(skew);
+}
+
 void suite_lcp(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_lcp_siconos_outcomes);
@@ -1375,6 +1498,8 @@ void suite_lcp(pd_test_ctx *ctx)
     PD_RUN(ctx, test_lcp_read_plain);
     PD_RUN(ctx, test_lcp_read_siconos);
     PD_RUN(ctx, test_lcp_read_malformed);
+    PD_RUN(ctx, test_lcp_read_band);
     PD_RUN(ctx, test_lcp_example_file);
     PD_RUN(ctx, test_lcp_cli);
+    PD_RUN(ctx, test_lcp_cli_band);
 }

@@ -765,6 +765,108 @@ static double rel_diff(int n, const double *x, const double *y)
     return d / fmax(s, 1e-300);
 }
 
+/* Chandrasekaran's method with dense LU, the reference for Stieltjes
+ * matrices (M-matrices: z only grows, every index with w_i < 0 joins, no
+ * index leaves): F grows by the indices whose w_i is below -1e-13 of its
+ * row's terms until none is; z into z.  -1 when a solve fails. */
+static int chandrasekaran_dense(int n, const double *M, const double *q, double *z)
+{
+    static double A[128 * 128], rhs[128];
+    static int perm[128], idx[128];
+    unsigned char in[128] = {0};
+    memset(z, 0, (size_t)n * sizeof(double));
+    for (int round = 0; round <= n; round++) {
+        int added = 0, k = 0;
+        for (int i = 0; i < n; i++) {
+            double wi = q[i], ri = fabs(q[i]);
+            for (int j = 0; j < n; j++) {
+                wi += M[i + (size_t)j * n] * z[j];
+                ri += fabs(M[i + (size_t)j * n] * z[j]);
+            }
+            if (!in[i] && wi < -1e-13 * ri)
+                in[i] = 1, added = 1;
+        }
+        if (!added)
+            return 0;
+        for (int i = 0; i < n; i++)
+            if (in[i])
+                idx[k++] = i;
+        for (int b = 0; b < k; b++) {
+            for (int a = 0; a < k; a++)
+                A[a + b * k] = M[idx[a] + (size_t)idx[b] * n];
+            rhs[b] = -q[idx[b]];
+        }
+        if (pd_dense_lu(k, A, k, perm, 1e-14) != PD_OK)
+            return -1;
+        pd_dense_lu_solve(k, A, k, perm, rhs);
+        for (int b = 0; b < k; b++)
+            z[idx[b]] = rhs[b];
+    }
+    return 0;
+}
+
+/* Block-tridiagonal Stieltjes matrices (blocks of 2 and 3, 1 to 40 of
+ * them, n up to 120): off-diagonal entries in [-1, 0] (a fifth exactly 0)
+ * within neighbouring blocks, symmetric, the diagonal dominant by [1e-3,
+ * 1); q random with exact zeros and entries of 1e-17, or an impact (-e_1,
+ * every other q_i = 0: degenerate), or an impact with q_i = 1e-4.  The
+ * structured solver (the envelope, not the tridiagonal direct method)
+ * answers itself, verified, with the z of Chandrasekaran's method to 1e-9
+ * of max z. */
+static void test_solvers_block_mmatrix(pd_test_ctx *ctx)
+{
+    static const int nblocks[] = {1, 2, 5, 13, 40};
+    static double dense[120 * 120], values[120 * 120];
+    static int rowind[120 * 120];
+    int colptr[121], cases = 0;
+    double q[120], z[120], w[120], zr[120];
+    uint64_t s = 4242;
+    for (int bs = 2; bs <= 3; bs++)
+        for (size_t kb = 0; kb < sizeof nblocks / sizeof nblocks[0]; kb++)
+            for (int form = 0; form < 3; form++)
+                for (int rep = 0; rep < 4; rep++) {
+                    int n = bs * nblocks[kb];
+                    memset(dense, 0, (size_t)n * n * sizeof(double));
+                    for (int j = 0; j < n; j++)
+                        for (int i = j + 1; i < n && i / bs <= j / bs + 1; i++) {
+                            double u = rnd(&s);
+                            dense[i + j * n] = dense[j + i * n] = u < -0.6 ? 0.0 : -0.5 * (u + 1.0);
+                        }
+                    for (int i = 0; i < n; i++) {
+                        double d = 0.0;
+                        for (int j = 0; j < n; j++)
+                            d += fabs(dense[i + j * n]);
+                        dense[i + i * n] = d + 1e-3 + 0.5 * (rnd(&s) + 1.0);
+                        double u = rnd(&s);
+                        q[i] = form == 0 ? (u < -0.7 ? 0.0 : u > 0.9 ? 1e-17 : rnd(&s))
+                               : i == 0  ? -1.0
+                               : form == 1 ? 0.0
+                                           : 1e-4;
+                    }
+                    int k = 0;
+                    for (int j = 0; j < n; j++) {
+                        colptr[j] = k;
+                        for (int i = 0; i < n; i++)
+                            if (dense[i + j * n] != 0.0 || i == j) {
+                                rowind[k] = i;
+                                values[k++] = dense[i + j * n];
+                            }
+                    }
+                    colptr[n] = k;
+                    pd_matrix M = pd_matrix_csc(n, n, colptr, rowind, values);
+                    if (!CHECK(ctx, chandrasekaran_dense(n, dense, q, zr) == 0, "reference n %d", n))
+                        continue;
+                    pd_lcp_info info;
+                    int st = solve_with(PD_LCP_STRUCTURED, &M, q, NULL, z, w, &info);
+                    double d = rel_diff(n, z, zr);
+                    cases++;
+                    CHECK(ctx, st == PD_OK && !strcmp(info.solver, "structured") && d <= 1e-9,
+                          "blocks of %d, n %d form %d: status %d by %s, |z - z_ref| %.3g", bs, n,
+                          form, st, info.solver, d);
+                }
+    CHECK(ctx, cases == 120, "%d cases", cases);
+}
+
 /* The direct method itself (pd_bpp_stieltjes), then the structured solver
  * through the table, against the enumeration oracle on the four kinds of
  * stieltjes_problem, n = 1..10 (800 cases): the direct method takes each
@@ -781,14 +883,14 @@ static void test_solvers_stieltjes_oracle(pd_test_ctx *ctx)
             for (uint64_t seed = 1; seed <= 20; seed++) {
                 int colptr[11], rowind[30];
                 double a[10], b[10], q[10], zs[10], values[30], dense[100], zo[10], wo[10];
-                double z[10], w[10];
+                double z[10], w[10], zmax = 0.0;
                 stieltjes_problem(kind, n, seed * 7919 + (uint64_t)(n + 13 * kind), a, b, q, zs);
                 tri_csc(n, a, b, colptr, rowind, values, dense);
                 pd_matrix M = pd_matrix_csc(n, n, colptr, rowind, values);
                 if (!CHECK(ctx, pd_lcp_enumerate(n, dense, q, zo, wo) == PD_OK, "oracle n %d", n))
                     continue;
                 cases++;
-                int rc = pd_bpp_stieltjes(ws, &M, q, z);
+                int rc = pd_bpp_stieltjes(ws, &M, q, z, &zmax);
                 double d = rel_diff(n, z, zo), res = 1.0;
                 pd_lcp_residual(n, dense, q, z, w, NULL, NULL, &res);
                 CHECK(ctx, rc == 1 && d <= 1e-12 && res <= 1e-10,
@@ -821,7 +923,7 @@ static void test_solvers_stieltjes_not_taken(pd_test_ctx *ctx)
     if (!CHECK(ctx, ws != NULL, "memory"))
         return;
     int colptr[5] = {0, 2, 5, 8, 10}, rowind[10] = {0, 1, 0, 1, 2, 1, 2, 3, 2, 3};
-    double z[4], w[4], zo[4], wo[4], q[4] = {-1.0, 0.5, -0.25, 0.1};
+    double z[4], w[4], zo[4], wo[4], q[4] = {-1.0, 0.5, -0.25, 0.1}, zmax = 0.0;
     const double base[10] = {2, -1, -1, 2, -1, -1, 2, -1, -1, 2};
     for (int c = 0; c < 3; c++) {
         double v[10], dense[16];
@@ -835,7 +937,7 @@ static void test_solvers_stieltjes_not_taken(pd_test_ctx *ctx)
             pd_matrix_to_dense(&M, dense);
             M = pd_matrix_dense(4, 4, dense);
         }
-        CHECK(ctx, pd_bpp_stieltjes(ws, &M, q, z) == 0, "case %d taken", c);
+        CHECK(ctx, pd_bpp_stieltjes(ws, &M, q, z, &zmax) == 0, "case %d taken", c);
         pd_lcp_info info;
         int st = solve_with(PD_LCP_STRUCTURED, &M, q, NULL, z, w, &info);
         if (c == 1) { /* nonsymmetric: the table still answers, verified */
@@ -852,13 +954,13 @@ static void test_solvers_stieltjes_not_taken(pd_test_ctx *ctx)
         int cp[5] = {0, 3, 6, 10, 12}, ri[12] = {0, 1, 2, 0, 1, 2, 0, 1, 2, 3, 2, 3};
         double v[12] = {2, -1, 0, -1, 2, -1, 0, -1, 2, -1, -1, 2};
         pd_matrix M = pd_matrix_csc(4, 4, cp, ri, v);
-        CHECK(ctx, pd_bpp_stieltjes(ws, &M, q, z) == 0, "pentadiagonal pattern taken");
+        CHECK(ctx, pd_bpp_stieltjes(ws, &M, q, z, &zmax) == 0, "pentadiagonal pattern taken");
     }
     { /* singular: D = [1 -1; -1 1], q = (-1, -1) */
         int cp[3] = {0, 2, 4}, ri[4] = {0, 1, 0, 1};
         double v[4] = {1, -1, -1, 1}, q2[2] = {-1.0, -1.0};
         pd_matrix M = pd_matrix_csc(2, 2, cp, ri, v);
-        CHECK(ctx, pd_bpp_stieltjes(ws, &M, q2, z) == -1, "singular block: not -1");
+        CHECK(ctx, pd_bpp_stieltjes(ws, &M, q2, z, &zmax) == -1, "singular block: not -1");
         pd_lcp_info info;
         int st = solve_with(PD_LCP_STRUCTURED, &M, q2, NULL, z, w, &info);
         CHECK(ctx, st != PD_OK && info.outcome != PD_LCP_SOLVED, "singular: status %d", st);
@@ -1000,6 +1102,82 @@ done:
     free(guess);
 }
 
+/* The verification's one pass for tridiagonal compressed columns against
+ * its general path (the same matrix densely, n > 32: column by column)
+ * and against itself with an entry beyond the band (the general path
+ * again): w, the row sizes and every figure the same to the bit, on random
+ * tridiagonals, n = 1..120, z with zeros, negatives and NaN, q with -0
+ * (w alike as numbers: a stored 0 adds +0 to a -0);
+ * a NaN of M in a column whose z_j = 0 is left out by both. */
+static void test_solvers_verify_tridiagonal(pd_test_ctx *ctx)
+{
+    enum { NMAX = 120 };
+    static double dense[NMAX * NMAX];
+    int colptr[NMAX + 1], rowind[3 * NMAX + 1], cp2[NMAX + 1], ri2[3 * NMAX + 1], mism = 0, cases = 0;
+    double a[NMAX], b[NMAX], values[3 * NMAX + 1], v2[3 * NMAX + 1], q[NMAX], z[NMAX];
+    double w1[NMAX], w2[NMAX], w3[NMAX], r1[NMAX], r2[NMAX], r3[NMAX];
+    uint64_t s = 99;
+    for (int n = 1; n <= NMAX; n += n < 10 ? 1 : 7)
+        for (int rep = 0; rep < 20; rep++) {
+            for (int i = 0; i < n; i++) {
+                a[i] = 2.0 + rnd(&s);
+                b[i] = i > 0 ? rnd(&s) : 0.0;
+                double u = rnd(&s);
+                q[i] = u < -0.8 ? -0.0 : u < -0.6 ? 0.0 : rnd(&s);
+                u = rnd(&s);
+                z[i] = u < 0.0 ? 0.0 : u < 0.1 ? -u : rep == 3 && i == n / 2 ? NAN : u;
+            }
+            tri_csc(n, a, b, colptr, rowind, values, NULL);
+            if (rep == 5) /* a NaN in M where z_j = 0: dropped by both */
+                for (int j = 0; j < n; j++)
+                    if (z[j] == 0.0) {
+                        values[colptr[j]] = NAN;
+                        break;
+                    }
+            pd_matrix M = pd_matrix_csc(n, n, colptr, rowind, values);
+            memset(dense, 0, sizeof dense);
+            pd_matrix_to_dense(&M, dense);
+            /* the same with an explicit 0 at (n - 1, 0): beyond the band for n > 2 */
+            int t = 0;
+            for (int j = 0; j < n; j++) {
+                cp2[j] = t;
+                for (int k = colptr[j]; k < colptr[j + 1]; k++) {
+                    ri2[t] = rowind[k];
+                    v2[t++] = values[k];
+                }
+                if (j == 0 && n > 2) {
+                    ri2[t] = n - 1;
+                    v2[t++] = 0.0;
+                }
+            }
+            cp2[n] = t;
+            z[0] = n > 2 && z[0] == 0.0 ? 0.5 : z[0]; /* column 0 is used */
+            pd_matrix D = pd_matrix_dense(n, n, dense), M2 = pd_matrix_csc(n, n, cp2, ri2, v2);
+            pd_lcp_info i1, i2, i3;
+            pd_lcp_verify(&M, q, z, w1, r1, &i1);
+            pd_lcp_verify(&M2, q, z, w3, r3, &i3);
+            pd_lcp_verify(&D, q, z, w2, r2, &i2);
+            /* w alike as numbers: an explicit 0 adds a +0 that the band
+             * does not (-0 + 0 = +0); a NaN of z spreads further densely */
+            int same = 1;
+            for (int i = 0; i < n; i++)
+                same &= (w1[i] == w3[i] || (isnan(w1[i]) && isnan(w3[i]))) &&
+                        (n <= 32 || rep == 3 || w1[i] == w2[i] || (isnan(w1[i]) && isnan(w2[i])));
+            same = same && !memcmp(r1, r3, (size_t)n * sizeof(double)) &&
+                       !memcmp(&i1.residual, &i3.residual, sizeof(double)) &&
+                       !memcmp(&i1.complementarity, &i3.complementarity, sizeof(double)) &&
+                       !memcmp(&i1.infeasibility, &i3.infeasibility, sizeof(double)) &&
+                       !memcmp(&i1.scale, &i3.scale, sizeof(double));
+            if (n > 32 && rep != 3) /* the dense general path (n <= 32 is made row by row;
+                                       a NaN of z spreads over the dense rows) */
+                same &= !memcmp(&i1.residual, &i2.residual, sizeof(double)) &&
+                        !memcmp(&i1.scale, &i2.scale, sizeof(double));
+            mism += !same;
+            cases++;
+        }
+    CHECK(ctx, mism == 0, "%d of %d cases differ from the general path", mism, cases);
+}
+
 /* A banded matrix given densely (a plain LCP file) is copied once into
  * compressed columns for the structured solver: a tridiagonal Stieltjes one
  * of 300 rows with an impact at its first row is answered by the direct
@@ -1085,4 +1263,6 @@ void suite_solvers(pd_test_ctx *ctx)
     PD_RUN(ctx, test_solvers_stieltjes_large);
     PD_RUN(ctx, test_solvers_stieltjes_warm);
     PD_RUN(ctx, test_solvers_dense_banded);
+    PD_RUN(ctx, test_solvers_verify_tridiagonal);
+    PD_RUN(ctx, test_solvers_block_mmatrix);
 }
