@@ -436,6 +436,7 @@ typedef struct pd_edr_event {
     int ndofs;             /* the dofs of the clusters involved */
     const int *dofs;
     const double *v_minus, *v_plus; /* their velocities before and after */
+    const double *x;       /* their positions at t */
     int accumulation;      /* an accumulation of impacts was jumped here */
 } pd_edr_event;
 

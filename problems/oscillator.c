@@ -10,6 +10,7 @@
 
 #include "osc_track.h"
 #include "pd_null.h"
+#include "demand.h"
 #include "pd_problems.h"
 
 
@@ -236,6 +237,8 @@ static void scene_force(double tau, int side, double *F, void *ctx)
 typedef struct tracker {
     pd_osc_track m;
     double Le, vscale, wp;
+    pd_demand_osc dem;    /* the absolute acceleration's peak (Pi units) */
+    int demands;          /* 0: not measured (pd_run_opts.no_demands) */
     pd_osc_sampler sampler;
     void *sampler_ctx;
 } tracker;
@@ -306,6 +309,8 @@ void pd_osc_track_result(const pd_osc_track *tr, const pd_osc *c, double dt, lon
     res->min_gap = tr->min_gap * Le;
     res->steps = steps;
     res->dt = dt;
+    /* demands: not measured here (the single runs measure and set them) */
+    res->acc_max = res->force_max = res->force_equiv = res->contact_duration = NAN;
 }
 
 /* Per step: the measurements, then the sample. */
@@ -314,6 +319,8 @@ static int observe(const pd_state *st, void *ctx)
     tracker *tr = ctx;
     double x = st->q[0], v = st->v[0], P = st->P[0];
     pd_osc_track_step(&tr->m, st->step, st->t, x, v, P);
+    if (tr->demands)
+        pd_demand_osc_note(&tr->dem, st->t, x, v, NULL, 0); /* the steps' own: as umax */
     if (tr->sampler) {
         pd_osc_sample smp = {.step = st->step,
                              .t = st->t / tr->wp,
@@ -370,8 +377,10 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
     if (!mj)
         return err ? err->status : PD_EINVAL;
     double wp = pd_osc_wp(c), Le = pd_osc_Le(c);
-    tracker tr = {.Le = Le, .vscale = Le * wp, .wp = wp, .sampler = sampler, .sampler_ctx = ctx};
+    tracker tr = {.Le = Le, .vscale = Le * wp, .wp = wp, .demands = !o.no_demands,
+                  .sampler = sampler, .sampler_ctx = ctx};
     pd_osc_track_init(&tr.m, c, mo.h, wp * pd_osc_measure_start(c, o.tend));
+    tr.dem = (pd_demand_osc){.C = C, .K = K, .tau_measure = tr.m.tau_measure - 0.5 * mo.h};
     rc = pd_mj_run(mj, nsteps, observe, &tr, err);
     pd_osc_track_result(&tr.m, c, o.dt, pd_mj_state(mj)->step, res);
     res->tend = o.tend;
@@ -379,6 +388,7 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
     res->gamma = mo.gamma;
     res->kernel = pd_mj_kernel_name(mj);
     pd_mj_free(mj);
+    pd_demand_osc_finish(res, &o, tr.demands ? tr.dem.peak * c->ap : NAN, NAN);
     res->cpu_s = pd_cpu_seconds() - cpu0;
     return rc;
 }
@@ -386,6 +396,9 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
 /* Sampler bridge: Pi units to metres and seconds. */
 typedef struct ref_bridge {
     double wp, Le, vscale, Pi3;
+    const pd_osc *c;
+    pd_demand_osc dem;    /* the absolute acceleration's peak (Pi units) */
+    double pv, pa;        /* the previous sample's velocity and acceleration */
     long step;
     pd_osc_sampler sampler;
     void *ctx;
@@ -394,6 +407,19 @@ typedef struct ref_bridge {
 static int ref_sample(double tau, double x, double v, int in_contact, void *ctx)
 {
     ref_bridge *b = ctx;
+    /* free flight: x'' = f - C x' - K x; an interval is smooth (no impact in it)
+     * when the trapezoid rule of x'' gives its velocity change (to (w h)^2 / 12) */
+    double a = in_contact ? 0.0 : pd_osc_shape(b->c, tau, -1) - b->dem.C * v - b->dem.K * x;
+    double h = tau - b->dem.t, dv = v - b->pv - 0.5 * h * (a + b->pa);
+    int smooth = !in_contact &&
+                 fabs(dv) <= 1e-4 * (fabs(v) + fabs(b->pv) + h * (fabs(a) + fabs(b->pa)));
+    pd_demand_osc_note(&b->dem, tau, x, v, in_contact ? NULL : &a, smooth);
+    b->pv = v;
+    b->pa = a;
+    if (!b->sampler) {
+        b->step++;
+        return 0;
+    }
     pd_osc_sample s = {.step = b->step++,
                        .t = tau / b->wp,
                        .u = x * b->Le,
@@ -475,12 +501,17 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     pd_ed_opts eo = pd_ed_default_opts();
     eo.t_end = wp * o.tend;
     eo.t_measure = wp * pd_osc_measure_start(c, o.tend);
-    eo.h_out = sampler ? PD_TWO_PI * (o.dt / c->Tp) : 0.0;
+    /* the grid: samples, and the demand's states (every dt: the impacts' jumps of
+     * the damping force are seen on it) */
+    eo.h_out = sampler || !o.no_demands ? PD_TWO_PI * (o.dt / c->Tp) : 0.0;
     eo.no_accumulation = o.no_accumulation;
-    ref_bridge bridge = {.wp = wp, .Le = Le, .vscale = Le * wp, .Pi3 = c->Pi3, .step = 0,
-                         .sampler = sampler, .ctx = ctx};
+    ref_bridge bridge = {.wp = wp, .Le = Le, .vscale = Le * wp, .Pi3 = c->Pi3, .c = c,
+                         .dem = {.C = 2.0 * c->xi * c->Pi2, .K = c->Pi2 * c->Pi2,
+                                 .tau_measure = eo.t_measure},
+                         .step = 0, .sampler = sampler, .ctx = ctx};
     double cpu0 = pd_cpu_seconds();
-    rc = pd_ed_sdof_run(&prob, 0.0, 0.0, &eo, sampler ? ref_sample : NULL, &bridge, &er, err);
+    rc = pd_ed_sdof_run(&prob, 0.0, 0.0, &eo, eo.h_out > 0.0 ? ref_sample : NULL, &bridge, &er,
+                        err);
     free(pieces);
     memset(res, 0, sizeof *res);
     res->umax = er.xmax * Le;
@@ -500,6 +531,7 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     res->theta = NAN;
     res->gamma = NAN;
     res->kernel = "event";
+    pd_demand_osc_finish(res, &o, o.no_demands ? NAN : bridge.dem.peak * c->ap, NAN);
     res->cpu_s = pd_cpu_seconds() - cpu0;
     return rc;
 }
@@ -572,6 +604,7 @@ int pd_osc_summarize(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     memset(s, 0, sizeof *s);
     double cpu0 = pd_cpu_seconds();
     twin.no_wall = 1;
+    twin.no_demands = 1; /* the twin's figure is umax */
     if ((rc = pd_osc_run(c, opts, sampler, ctx, &s->r, err)) ||
         (rc = pd_osc_run(c, &twin, NULL, NULL, &s->free, err)))
         return rc;

@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 
-from . import _args, _lib
+from . import _args, _demand, _lib
 from ._case import Case, InputError, copy_opts, number
 from ._lib import PdErr, lib, s
 
@@ -186,6 +186,7 @@ def simulate(history=True, every=1, **case):
     v [m/s], impulse per unit mass since the last sample [m/s], gap
     delta - u [m]), with t, u, v, impulse also as r.t, r.u, r.v, r.impulse."""
     history, every = history_args(history, every)
+    height = _demand.pop_height(case)
     k = Case(case).resolve()
     o = k.opts
     h = sampler = None
@@ -207,6 +208,7 @@ def simulate(history=True, every=1, **case):
                  max_impact_velocity=r.max_impact_velocity, max_impulse=r.max_impulse,
                  contact_time=r.contact_time, min_gap=r.min_gap, umax_free=sm.free.umax,
                  gamma=sm.gamma, chi=sm.chi, steps=r.steps, cpu_s=sm.cpu_s)
+    _demand.osc_fields(out, r, height)
     _case_json(k, out)
     out.update(dt=r.dt, theta=r.theta, gamma_active=r.gamma, tend=r.tend, kernel=s(r.kernel))
     if h is not None:

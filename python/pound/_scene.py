@@ -4,7 +4,7 @@ import ctypes
 
 import numpy as np
 
-from . import _args, _lib
+from . import _args, _demand, _lib
 from ._case import SCHEME_KEYS, Case, InputError, copy_opts, number, scheme_opts
 from ._lib import PD_WALL, PdErr, lib, s
 from ._osc import Result, _History, history_args
@@ -225,6 +225,7 @@ class Scene:
                                    contact_time=r.contact_time[a], approach=r.approach[a],
                                    chi=sm.chi[a]))
         out["contacts"] = contacts
+        _demand.scene_fields(out, sc, r)
         return out
 
     def __repr__(self):
