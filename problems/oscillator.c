@@ -398,7 +398,8 @@ typedef struct ref_bridge {
     double wp, Le, vscale, Pi3;
     const pd_osc *c;
     pd_demand_osc dem;    /* the absolute acceleration's peak (Pi units) */
-    double pv, pa;        /* the previous sample's velocity and acceleration */
+    long impacts, impacts_prev; /* impacts seen, and by the previous sample */
+    int rest_prev;        /* the previous sample was resting on the wall */
     long step;
     pd_osc_sampler sampler;
     void *ctx;
@@ -407,15 +408,13 @@ typedef struct ref_bridge {
 static int ref_sample(double tau, double x, double v, int in_contact, void *ctx)
 {
     ref_bridge *b = ctx;
-    /* free flight: x'' = f - C x' - K x; an interval is smooth (no impact in it)
-     * when the trapezoid rule of x'' gives its velocity change (to (w h)^2 / 12) */
+    /* free flight: x'' = f - C x' - K x; the interval since the previous sample
+     * is smooth when it held no impact and no rest */
     double a = in_contact ? 0.0 : pd_osc_shape(b->c, tau, -1) - b->dem.C * v - b->dem.K * x;
-    double h = tau - b->dem.t, dv = v - b->pv - 0.5 * h * (a + b->pa);
-    int smooth = !in_contact &&
-                 fabs(dv) <= 1e-4 * (fabs(v) + fabs(b->pv) + h * (fabs(a) + fabs(b->pa)));
+    int smooth = !in_contact && !b->rest_prev && b->impacts == b->impacts_prev;
     pd_demand_osc_note(&b->dem, tau, x, v, in_contact ? NULL : &a, smooth);
-    b->pv = v;
-    b->pa = a;
+    b->impacts_prev = b->impacts;
+    b->rest_prev = in_contact;
     if (!b->sampler) {
         b->step++;
         return 0;
@@ -426,8 +425,27 @@ static int ref_sample(double tau, double x, double v, int in_contact, void *ctx)
                        .v = v * b->vscale,
                        .impulse = 0.0,
                        .gap = (b->Pi3 - x) * b->Le};
-    (void)in_contact;
     return b->sampler(&s, b->ctx);
+}
+
+/* An impact: the demand at the wall with the velocities before and after it. */
+static void ref_impact(double tau, double vn, double v_plus, void *ctx)
+{
+    ref_bridge *b = ctx;
+    pd_demand_osc *d = &b->dem;
+    b->impacts++;
+    if (tau >= d->tau_measure)
+        d->peak = pd_max(d->peak, pd_max(fabs(d->C * vn + d->K * b->Pi3),
+                                         fabs(d->C * v_plus + d->K * b->Pi3)));
+}
+
+/* The reference's demand grid without a sampler: the largest whole multiple
+ * of dt with OSC_DEMAND_GRID points per shortest period (of T0 and Tp). */
+#define OSC_DEMAND_GRID 128.0
+static double ref_demand_grid(const pd_osc *c, double dt)
+{
+    double k = floor(fmin(c->Tp, pd_osc_T0(c)) / (OSC_DEMAND_GRID * dt));
+    return (k > 1.0 ? k : 1.0) * dt;
 }
 
 int pd_osc_pieces(const pd_osc *c, pd_sine_piece **pieces, int *npieces, pd_err *err)
@@ -501,14 +519,17 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     pd_ed_opts eo = pd_ed_default_opts();
     eo.t_end = wp * o.tend;
     eo.t_measure = wp * pd_osc_measure_start(c, o.tend);
-    /* the grid: samples, and the demand's states (every dt: the impacts' jumps of
-     * the damping force are seen on it) */
-    eo.h_out = sampler || !o.no_demands ? PD_TWO_PI * (o.dt / c->Tp) : 0.0;
+    /* the grid: samples every dt; else the demand's states (with its impacts) */
+    eo.h_out = sampler ? PD_TWO_PI * (o.dt / c->Tp)
+               : o.no_demands ? 0.0
+                              : PD_TWO_PI * (ref_demand_grid(c, o.dt) / c->Tp);
+    eo.on_impact = o.no_demands ? NULL : ref_impact;
     eo.no_accumulation = o.no_accumulation;
     ref_bridge bridge = {.wp = wp, .Le = Le, .vscale = Le * wp, .Pi3 = c->Pi3, .c = c,
                          .dem = {.C = 2.0 * c->xi * c->Pi2, .K = c->Pi2 * c->Pi2,
                                  .tau_measure = eo.t_measure},
                          .step = 0, .sampler = sampler, .ctx = ctx};
+    eo.on_impact_ctx = &bridge;
     double cpu0 = pd_cpu_seconds();
     rc = pd_ed_sdof_run(&prob, 0.0, 0.0, &eo, eo.h_out > 0.0 ? ref_sample : NULL, &bridge, &er,
                         err);
