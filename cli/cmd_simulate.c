@@ -283,10 +283,13 @@ static void print_text(const sim_args *a, const pd_osc_summary *s)
         printf("  impacts   = 0 (the oscillator never reaches the wall)\n");
     printf("  demands   = drift ratio %.5g (height %g m), a_abs %.6g m/s^2 (= base shear per "
            "unit mass, N/kg)\n", s->r.umax / a->k.height, a->k.height, s->r.acc_max);
-    if (s->r.impacts)
-        printf("  contact   = equivalent force %.6g N/kg (td = %g s, --contact-duration), peak "
-               "force %.6g N/kg%s\n", s->r.force_equiv, s->r.contact_duration, s->r.force_max,
-               isnan(s->r.force_max) ? " (impulsive method: --method penalty|newmark)" : "");
+    if (s->r.impacts && isnan(s->r.force_max)) /* an impulsive method */
+        printf("  contact   = equivalent force %.6g N/kg (pi I / (2 td), td = %g s, "
+               "--contact-duration)\n", s->r.force_equiv, s->r.contact_duration);
+    else if (s->r.impacts)
+        printf("  contact   = equivalent force %.6g N/kg (pi I / (2 td), td = %g s, "
+               "--contact-duration), peak force %.6g N/kg\n", s->r.force_equiv,
+               s->r.contact_duration, s->r.force_max);
     printf("  cpu       = %.3g s\n", s->cpu_s);
 }
 
