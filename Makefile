@@ -14,8 +14,10 @@
 #                 page and the bash completion (docs/api.md); make uninstall
 #   make install-check  the examples/api/ programs built against an installed
 #                 copy (scripts/api-check.sh; part of make check)
-#   make formats-check  every output file read back with h5py (docs/formats.md)
-#   make python-check   the Python package (python/) tested against the CLI
+#   make formats-check  every output file read back with h5py and xarray (docs/formats.md)
+#   make flags-check    every command's --help against the man page, the bash
+#                 completion and the parser (scripts/flags-check.py)
+#   make python-check   the Python package (python/) tested against the CLI, mypy, its notebook
 #   make MPI=1    the MPI build (OpenMPI's mpicc, -DPD_MPI) in build-mpi/:
 #                 mpirun -np K build-mpi/pound spectrum ...
 #   make OPENMP=  without OpenMP (spectrum then runs one thread)
@@ -63,13 +65,20 @@ lib_soname = $(shell for d in $(patsubst -L%,%,$(filter -L%,$(1))) \
     "$$(dirname "$$($(CC) -print-file-name=lib$(2).so)")"; do \
     if [ -e "$$d/lib$(2).so" ]; then \
     objdump -p "$$d/lib$(2).so" 2>/dev/null | awk '/SONAME/ {print $$2; exit}'; break; fi; done)
+# HDF5's high-level library (the dimension scales, H5DS) sits beside HDF5
+# as lib<hdf5>_hl: libhdf5_hl.so, whose soname is libhdf5_serial_hl.so.100
+# on Debian.
 H5_LIBS        := $(shell pkg-config --libs hdf5 2>/dev/null)
+H5_NAME        := $(patsubst -l%,%,$(firstword $(filter -l%,$(H5_LIBS))))
+H5HL_LIBS      := $(if $(H5_NAME),-l$(H5_NAME)_hl,-lhdf5_hl)
 ifeq ($(LAZY),1)
-H5_SONAME      := $(call lib_soname,$(H5_LIBS),$(patsubst -l%,%,$(firstword $(filter -l%,$(H5_LIBS)))))
+H5_SONAME      := $(call lib_soname,$(H5_LIBS),$(H5_NAME))
+H5HL_SONAME    := $(call lib_soname,$(H5_LIBS),$(H5_NAME)_hl)
 CHOLMOD_SONAME := $(call lib_soname,,cholmod)
 endif
-ifneq ($(and $(H5_SONAME),$(CHOLMOD_SONAME)),)
-LAZY_DEFS = -DPD_LAZY_HDF5='"$(H5_SONAME)"' -DPD_LAZY_CHOLMOD='"$(CHOLMOD_SONAME)"'
+ifneq ($(and $(H5_SONAME),$(H5HL_SONAME),$(CHOLMOD_SONAME)),)
+LAZY_DEFS = -DPD_LAZY_HDF5='"$(H5_SONAME)"' -DPD_LAZY_HDF5_HL='"$(H5HL_SONAME)"' \
+            -DPD_LAZY_CHOLMOD='"$(CHOLMOD_SONAME)"'
 CLI_LIBS  = $(shell pkg-config --libs gsl jansson 2>/dev/null) \
             $(shell pkg-config --libs cxsparse 2>/dev/null || echo -lcxsparse) -ldl -lm
 else
@@ -78,7 +87,7 @@ endif
 
 INC      = -Icore -Ilcp -Iengine -Iproblems -Icli -Ibench
 ALL_CFLAGS = $(WARN) $(DEFS) $(LAZY_DEFS) $(FPFLAGS) $(CFLAGS) $(OPENMP) $(INC) $(PKG_CFLAGS) $(SS_CFLAGS) $(XCFLAGS)
-LIBS     = $(PKG_LIBS) $(SS_LIBS) -lm
+LIBS     = $(H5HL_LIBS) $(PKG_LIBS) $(SS_LIBS) -lm
 
 LIB_SRC  = $(wildcard core/*.c) $(wildcard lcp/*.c) $(wildcard engine/*.c) $(wildcard problems/*.c)
 # the benchmarks' drivers (bench/) are part of the pound binary; bench/siconos_lcp.c
@@ -119,7 +128,7 @@ INSTALLED   = $(bindir)/pound $(libdir)/libpound.a $(libdir)/$(SOREAL) $(libdir)
 API_CHECK  ?= 1
 
 .PHONY: all deps demo test check asan bench clean acceptance figures paper stress print-libs \
-        shared install uninstall install-check formats-check python-check
+        shared install uninstall install-check formats-check flags-check python-check
 
 all: $(BUILD)/pound $(BUILD)/pound_tests
 
@@ -174,6 +183,14 @@ check: all
 	$(BUILD)/pound_tests --pound $(BUILD)/pound
 	@$(if $(API_CHECK),$(MAKE) --no-print-directory install-check)
 	@$(if $(API_CHECK),$(MAKE) --no-print-directory formats-check)
+	@$(if $(API_CHECK),$(MAKE) --no-print-directory flags-check)
+
+# Every command's flags (its --help) against the man page, the bash
+# completion and the parser (scripts/flags-check.py; Python's standard library).
+flags-check: all
+	@py=$$(command -v /usr/bin/python3 || command -v python3); \
+	if [ -n "$$py" ]; then "$$py" scripts/flags-check.py $(BUILD)/pound; \
+	else echo "flags: skipped (no python3)"; fi
 
 # Every output file read back with h5py against docs/formats.md (Debian's
 # python3-h5py; skipped without it: scripts/deps.sh --python installs it).

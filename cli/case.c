@@ -34,6 +34,7 @@ const char pd_cli_case_help[] =
     "  --dt H [min(Tp,T0)/2000]   --theta T [0.5]   --gamma G [0.5]   --tend T [Tp+2 T0;\n"
     "         harmonic: transient + window, see docs/scheme.md]\n"
     "  --allow-unstable  accept theta outside [1/2, 1]\n"
+    "  --no-wall  without contacts: the oscillator's no-wall twin, a free scene\n"
     "  --no-accumulation  event-driven: do not jump accumulations of impacts\n"
     "  --close-tol X [1e-10]  event-driven rows: contacts within X Le of zero at an impact\n"
     "           take part in it (simultaneous); counted in the output (docs/methods.md)\n"

@@ -28,7 +28,7 @@ int pd_cmd_bench(int argc, char **argv)
             want_startup = 1;
         else if (!strcmp(argv[i], "--shared") && i + 1 < argc)
             shared = argv[++i];
-        else if (!strcmp(argv[i], "--help")) {
+        else if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             puts("usage: pound bench [--lcp] [--engine] [--scene] [--spectrum] [--records]\n"
                  "                   [--startup] [--json]\n"
                  "                   [--shared DIR]\n"
@@ -39,7 +39,7 @@ int pd_cmd_bench(int argc, char **argv)
                  "  --lcp: the LCP solvers on the Siconos set and chains of 10 ... 10^5 contacts\n"
                  "  --engine: Moreau-Jean steps/s on the one-wall oscillator (scalar, batched and\n"
                  "  general kernels) beside the bound of each step's dependency chain\n"
-                 "  --scene: ns per DOF-step on --chain rows of 10 ... 10^5 SDOFs, the one-wall\n"
+                 "  --scene: ns per DOF-step on rows (`--chain N`) of 10 ... 10^5 SDOFs, the one-wall\n"
                  "  scene against the oscillator\n"
                  "  --spectrum: the paper-scale sweep, serial with each instruction set the\n"
                  "  processor has (POUND_ISA caps it) and on 2 OpenMP threads\n"

@@ -643,9 +643,10 @@ static int write_rows(const conv_args *a, const measurer *M, const row *rows, in
                        NUM("ap", "m/s^2", x ? x->ap : 0.0), NUM("Tp", "s", x ? x->Tp : 0.0)};
 #undef NUM
 #undef TXT
-    pd_table t = {n, NC, cols, M->sc ? (int)(sizeof scene / sizeof scene[0])
-                                     : (int)(sizeof osc / sizeof osc[0]),
-                  M->sc ? scene : osc};
+    pd_table t = {.rows = n, .ncols = NC, .cols = cols,
+                  .nattrs = M->sc ? (int)(sizeof scene / sizeof scene[0])
+                                  : (int)(sizeof osc / sizeof osc[0]),
+                  .attrs = M->sc ? scene : osc, .dim = "row"};
     return pd_output_write(a->out, &t, err);
 }
 

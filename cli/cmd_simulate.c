@@ -368,7 +368,7 @@ static int simulate_oscillator(sim_args *a)
         goto done;
     if ((status = dump_open(a, &dump, &a->k.opts)))
         goto done;
-    if (a->out && (rc = pd_table_open(&o.file, a->out, OSC_COLS, osc_cols, o.rows_max, &err))) {
+    if (a->out && (rc = pd_table_open(&o.file, a->out, OSC_COLS, osc_cols, "t", o.rows_max, &err))) {
         fprintf(stderr, "pound: simulate: %s\n", err.msg);
         status = rc == PD_EINVAL ? 2 : 1;
         goto done;

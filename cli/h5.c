@@ -237,13 +237,16 @@ int pd_h5_close_id(hid_t *id)
              : t == H5I_GROUP ? H5Gclose(*id)
              : t == H5I_GENPROP_LST ? H5Pclose(*id)
              : t == H5I_DATASPACE ? H5Sclose(*id)
+             : t == H5I_DATATYPE  ? H5Tclose(*id)
                                   : -1;
     }
     *id = -1;
     return st < 0 ? -1 : 0;
 }
 
-/* A scalar attribute: text when text is non-NULL, else the number x. */
+/* A scalar attribute: text when text is non-NULL, else the number x.  Text
+ * is a fixed-length, null-terminated UTF-8 string of at least 2 bytes (a
+ * 1-byte string is a netCDF "char", which h5netcdf leaves as bytes). */
 int pd_h5_attr(hid_t obj, const char *name, const char *text, double x)
 {
     hid_t space = H5Screate(H5S_SCALAR), type = -1, attr = -1;
@@ -251,8 +254,13 @@ int pd_h5_attr(hid_t obj, const char *name, const char *text, double x)
     if (space < 0)
         return -1;
     if (text) {
+        size_t len = strlen(text);
+        char pad[2] = "";
         type = H5Tcopy(H5T_C_S1);
-        if (type >= 0 && H5Tset_size(type, strlen(text) + 1) >= 0 &&
+        if (len == 0) /* "" as 2 bytes: the library reads size bytes from text */
+            text = pad;
+        if (type >= 0 && H5Tset_size(type, len < 1 ? 2 : len + 1) >= 0 &&
+            H5Tset_cset(type, H5T_CSET_UTF8) >= 0 &&
             (attr = H5Acreate2(obj, name, type, space, H5P_DEFAULT, H5P_DEFAULT)) >= 0)
             st = H5Awrite(attr, type, text);
     } else if ((attr = H5Acreate2(obj, name, H5T_NATIVE_DOUBLE, space, H5P_DEFAULT,
@@ -319,16 +327,20 @@ hid_t pd_h5_untimed(hid_t cls)
     return p;
 }
 
-/* An extendible chunked dataset of rows x cols (cols 0: 1-D) of type with units. */
-hid_t pd_h5_extendible(hid_t loc, const char *name, hid_t type, int cols, long chunk,
-                       const char *units)
+/* An extendible chunked dataset of rows x cols (cols 0: 1-D) of type with
+ * units; many: with the object header that takes attributes of any size. */
+static hid_t extendible(hid_t loc, const char *name, hid_t type, int cols, long chunk,
+                        const char *units, int many)
 {
     int rank = cols > 0 ? 2 : 1;
     hsize_t dims[2] = {0, (hsize_t)cols}, maxd[2] = {H5S_UNLIMITED, (hsize_t)cols};
     hsize_t ch[2] = {(hsize_t)chunk, (hsize_t)(cols > 0 ? cols : 1)};
     hid_t space = H5Screate_simple(rank, dims, maxd), dcpl = pd_h5_untimed(H5P_DATASET_CREATE);
     hid_t ds = -1;
-    if (space >= 0 && dcpl >= 0 && H5Pset_chunk(dcpl, rank, ch) >= 0)
+    /* tracking the attributes' order gives a version-2 object header, whose
+     * attributes move to dense storage when one outgrows the header (64 kB) */
+    if (space >= 0 && dcpl >= 0 && H5Pset_chunk(dcpl, rank, ch) >= 0 &&
+        (!many || H5Pset_attr_creation_order(dcpl, H5P_CRT_ORDER_TRACKED) >= 0))
         ds = H5Dcreate2(loc, name, type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
     if (ds >= 0 && pd_h5_attr(ds, "units", units, 0.0)) {
         H5Dclose(ds);
@@ -338,6 +350,20 @@ hid_t pd_h5_extendible(hid_t loc, const char *name, hid_t type, int cols, long c
         H5Pclose(dcpl);
     if (space >= 0)
         H5Sclose(space);
+    return ds;
+}
+
+hid_t pd_h5_extendible(hid_t loc, const char *name, hid_t type, int cols, long chunk,
+                       const char *units)
+{
+    return extendible(loc, name, type, cols, chunk, units, 0);
+}
+
+hid_t pd_h5_extendible_coord(hid_t loc, const char *name, long chunk, const char *units)
+{
+    hid_t ds = extendible(loc, name, H5T_NATIVE_DOUBLE, 0, chunk, units, 1);
+    if (ds >= 0 && pd_h5_coord(ds, name))
+        pd_h5_close_id(&ds);
     return ds;
 }
 
@@ -360,3 +386,96 @@ int pd_h5_append(hid_t ds, hid_t type, long r0, long nrows, int cols, const void
     return rc ? -1 : 0;
 }
 
+
+/* ---- dimension scales (netCDF-4's dimensions) ------------------------------ */
+
+/* The NAME of a dimension that has no coordinate variable (netCDF-4's
+ * convention, which h5netcdf and netCDF-C read). */
+#define NC_DIM_ONLY "This is a netCDF dimension but not a netCDF variable."
+
+int pd_h5_coord(hid_t ds, const char *dim)
+{
+    return H5DSset_scale(ds, dim) < 0 ? -1 : 0;
+}
+
+hid_t pd_h5_dimension(hid_t loc, const char *name, long len)
+{
+    char label[sizeof NC_DIM_ONLY + 16];
+    hsize_t n[1] = {(hsize_t)(len > 0 ? len : 0)};
+    hid_t space = H5Screate_simple(1, n, NULL), dcpl = pd_h5_untimed(H5P_DATASET_CREATE);
+    hid_t ds = -1;
+    snprintf(label, sizeof label, "%s%10ld", NC_DIM_ONLY, len);
+    if (space >= 0 && dcpl >= 0) /* never written: no storage */
+        ds = H5Dcreate2(loc, name, H5T_NATIVE_INT, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+    if (ds >= 0 && (pd_h5_attr(ds, "units", "1", 0.0) || H5DSset_scale(ds, label) < 0))
+        pd_h5_close_id(&ds);
+    pd_h5_close_id(&dcpl);
+    pd_h5_close_id(&space);
+    return ds;
+}
+
+int pd_h5_index(hid_t loc, const char *name, long n, int first, const char *units)
+{
+    hsize_t len[1] = {(hsize_t)(n > 0 ? n : 0)};
+    int *x = malloc((size_t)(n > 0 ? n : 1) * sizeof *x);
+    hid_t space = H5Screate_simple(1, len, NULL), dcpl = pd_h5_untimed(H5P_DATASET_CREATE);
+    hid_t ds = -1;
+    int rc = -1;
+    for (long k = 0; x && k < n; k++)
+        x[k] = first + (int)k;
+    if (x && space >= 0 && dcpl >= 0 &&
+        (ds = H5Dcreate2(loc, name, H5T_NATIVE_INT, space, H5P_DEFAULT, dcpl, H5P_DEFAULT)) >= 0)
+        rc = (n > 0 && H5Dwrite(ds, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, x) < 0) ||
+                     pd_h5_attr(ds, "units", units, 0.0) || pd_h5_coord(ds, name)
+                 ? -1
+                 : 0;
+    free(x);
+    if (pd_h5_close_id(&ds))
+        rc = -1;
+    pd_h5_close_id(&dcpl);
+    pd_h5_close_id(&space);
+    return rc;
+}
+
+/* The dimension scale `name` seen from the group of the object at path: in
+ * that group or the nearest enclosing one (netCDF's scoping); -1: none. */
+static hid_t find_scale(hid_t file, const char *path, const char *name)
+{
+    char at[1024];
+    size_t dir = strlen(path);
+    for (;;) {
+        while (dir > 0 && path[dir - 1] != '/')
+            dir--;
+        if (dir == 0 || (size_t)snprintf(at, sizeof at, "%.*s%s", (int)dir, path, name) >= sizeof at)
+            return -1;
+        if (H5Lexists(file, at, H5P_DEFAULT) > 0)
+            return H5Dopen2(file, at, H5P_DEFAULT);
+        dir--; /* the '/' ending the group: up one */
+    }
+}
+
+int pd_h5_dims(hid_t ds, const char *dims)
+{
+    char path[1024], name[64];
+    ssize_t len = H5Iget_name(ds, path, sizeof path);
+    hid_t file = len > 0 && (size_t)len < sizeof path ? H5Iget_file_id(ds) : -1;
+    int rc = file < 0 ? -1 : 0;
+    unsigned axis = 0;
+    for (const char *p = dims; *p && !rc; axis++) {
+        size_t k = strcspn(p, ",");
+        hid_t scale = -1;
+        if (k >= sizeof name)
+            rc = -1;
+        else {
+            memcpy(name, p, k);
+            name[k] = '\0';
+            scale = find_scale(file, path, name);
+            rc = scale < 0 || H5DSattach_scale(ds, scale, axis) < 0 ? -1 : 0;
+        }
+        pd_h5_close_id(&scale);
+        p += k + (p[k] == ',');
+    }
+    if (file >= 0 && H5Fclose(file) < 0)
+        rc = -1;
+    return rc;
+}

@@ -1,6 +1,7 @@
 /* lazy.c — the shared libraries only some runs need, loaded when first
- * called: HDF5 (the -o/--dump-lcp writers and readers) and CHOLMOD (with
- * the BLAS it pulls in, for large sparse scenes).  Linked, they cost every
+ * called: HDF5 and its high-level library (the -o/--dump-lcp writers and
+ * readers, the dimension scales) and CHOLMOD (with the BLAS it pulls in,
+ * for large sparse scenes).  Linked, they cost every
  * `pound` process some 25 ms of dynamic loading and initialisation
  * (HDF5 brings its network drivers' libraries: curl, TLS, Kerberos, LDAP;
  * CHOLMOD an OpenBLAS that starts its threads) -- a hundred times the work
@@ -15,8 +16,9 @@
  * the libraries' own failure values (negative ids and statuses, NULL, 0),
  * which the callers already report, after one line saying why.
  *
- * Built when the Makefile finds the sonames (PD_LAZY_HDF5, PD_LAZY_CHOLMOD);
- * otherwise the libraries are linked as usual and this file is empty. */
+ * Built when the Makefile finds the sonames (PD_LAZY_HDF5, PD_LAZY_HDF5_HL,
+ * PD_LAZY_CHOLMOD); otherwise the libraries are linked as usual and this
+ * file is empty. */
 #include <stdio.h>
 #include <string.h>
 
@@ -138,6 +140,24 @@ H5_FN(herr_t, H5Dclose, (hid_t dset_id), (dset_id), -1)
 H5_FN(hid_t, H5Acreate2, (hid_t loc_id, const char *attr_name, hid_t type_id, hid_t space_id, hid_t acpl_id, hid_t aapl_id), (loc_id, attr_name, type_id, space_id, acpl_id, aapl_id), -1)
 H5_FN(herr_t, H5Awrite, (hid_t attr_id, hid_t type_id, const void *buf), (attr_id, type_id, buf), -1)
 H5_FN(herr_t, H5Aclose, (hid_t attr_id), (attr_id), -1)
+H5_FN(herr_t, H5Tset_cset, (hid_t type_id, H5T_cset_t cset), (type_id, cset), -1)
+H5_FN(htri_t, H5Lexists, (hid_t loc_id, const char *name, hid_t lapl_id), (loc_id, name, lapl_id), -1)
+H5_FN(ssize_t, H5Iget_name, (hid_t id, char *name, size_t size), (id, name, size), -1)
+H5_FN(hid_t, H5Iget_file_id, (hid_t id), (id), -1)
+H5_FN(herr_t, H5Pset_attr_creation_order, (hid_t plist_id, unsigned crt_order_flags), (plist_id, crt_order_flags), -1)
+#endif
+
+/* ---- HDF5's high-level library (dimension scales) ------------------------- */
+#ifdef PD_LAZY_HDF5_HL
+#include <hdf5_hl.h>
+
+/* Loaded after HDF5 (every caller has a file open): the library it needs,
+ * by the same soname, is the one already loaded. */
+static lazy_lib hdf5_hl = {.soname = PD_LAZY_HDF5_HL, .what = "HDF5 output (dimension scales)"};
+#define H5HL_FN(ret, name, params, args, fail) LAZY_FN(hdf5_hl, ret, name, params, args, fail)
+
+H5HL_FN(herr_t, H5DSset_scale, (hid_t dsid, const char *dimname), (dsid, dimname), -1)
+H5HL_FN(herr_t, H5DSattach_scale, (hid_t did, hid_t dsid, unsigned int idx), (did, dsid, idx), -1)
 #endif
 
 /* ---- CHOLMOD --------------------------------------------------------------- */

@@ -60,15 +60,33 @@ struct pd_lcp_dump {
 /* The datasets and their units: a scene's (D = W^T M^-1 W in 1/kg, b a
  * velocity, z an impulse), and the oscillator's, which runs in its Pi
  * units (time wp t, lengths in Le, unit mass): all dimensionless. */
+/* Each set's dimension: t (one per LCP, t its coordinate), and three
+ * without values: pointer (colptr), nonzero (D's entries) and row (the
+ * LCPs' rows). */
 static const struct {
     const char *name;
     int is_int;
-    const char *units;
-} set_defs[NSETS] = {{"n", 1, "1"},         {"t", 0, "s"},          {"solver", 1, "1"},
-                     {"outcome", 1, "1"},   {"pivots", 1, "1"},     {"iterations", 1, "1"},
-                     {"residual", 0, "1"},  {"colptr", 1, "1"},     {"rowind", 1, "1"},
-                     {"values", 0, "1/kg"}, {"b", 0, "m/s"},        {"z", 0, "N s"},
-                     {"contact", 1, "1"}};
+    const char *units, *dim;
+} set_defs[NSETS] = {
+    {"n", 1, "1", "t"},                {"t", 0, "s", "t"},          {"solver", 1, "1", "t"},
+    {"outcome", 1, "1", "t"},          {"pivots", 1, "1", "t"},     {"iterations", 1, "1", "t"},
+    {"residual", 0, "1", "t"},         {"colptr", 1, "1", "pointer"}, {"rowind", 1, "1", "nonzero"},
+    {"values", 0, "1/kg", "nonzero"},  {"b", 0, "m/s", "row"},      {"z", 0, "N s", "row"},
+    {"contact", 1, "1", "row"}};
+
+/* The dimensions, their lengths the sets' (all written), attached: 0 or -1. */
+static int dump_dims(pd_lcp_dump *d)
+{
+    static const int len_of[] = {S_COLPTR, S_VALUES, S_B}; /* pointer, nonzero, row */
+    int rc = pd_h5_coord(d->set[S_T].ds, "t");
+    for (int k = 0; k < 3 && !rc; k++) {
+        hid_t dim = pd_h5_dimension(d->file, set_defs[len_of[k]].dim, d->set[len_of[k]].written);
+        rc = dim < 0 || pd_h5_close_id(&dim);
+    }
+    for (int k = 0; k < NSETS && !rc; k++)
+        rc = k == S_T ? 0 : pd_h5_dims(d->set[k].ds, set_defs[k].dim);
+    return rc ? -1 : 0;
+}
 
 void pd_lcp_dump_free(pd_lcp_dump *d)
 {
@@ -215,7 +233,7 @@ int pd_lcp_dump_finish(pd_lcp_dump *d, pd_err *err)
     for (int k = 0; k < NSETS && !rc; k++)
         rc = flush_set(&d->set[k]);
     rc = rc || pd_h5_attr(d->file, "solver_codes", names, 0.0) ||
-         pd_h5_num(d->file, "count", (double)d->count, "1");
+         pd_h5_num(d->file, "count", (double)d->count, "1") || dump_dims(d);
     for (int k = 0; k < NSETS; k++)
         rc |= pd_h5_close_id(&d->set[k].ds);
     e = pd_h5_close(&d->file, &d->failure);

@@ -477,6 +477,7 @@ struct pd_table_writer {
     pd_outfile out;
     int hdf5, ncols, failure; /* failure: errno of the first failed write */
     const pd_column *cols;
+    const char *dim; /* the rows' dimension */
     long rows, nbuf, chunk;
     double *buf, *col; /* HDF5: TABLE_BLOCK_ROWS rows, and one column of them */
     hid_t file, *ds;
@@ -565,15 +566,15 @@ void pd_table_free(pd_table_writer *w)
 }
 
 int pd_table_open(pd_table_writer **out, const char *path, int ncols, const pd_column *cols,
-                  long expected_rows, pd_err *err)
+                  const char *dim, long expected_rows, pd_err *err)
 {
     pd_table_writer *w = calloc(1, sizeof *w);
     int rc, e;
     *out = NULL;
     if (!w)
         return pd_err_set(err, PD_ENOMEM, "-o %s: out of memory", path);
-    *w = (pd_table_writer){.hdf5 = is_hdf5(path), .ncols = ncols, .cols = cols, .file = -1,
-                           .out = {.slot = -1}};
+    *w = (pd_table_writer){.hdf5 = is_hdf5(path), .ncols = ncols, .cols = cols,
+                           .dim = dim ? dim : "row", .file = -1, .out = {.slot = -1}};
     w->chunk = expected_rows < 1 ? 1 : expected_rows < TABLE_BLOCK_ROWS ? expected_rows
                                                                         : TABLE_BLOCK_ROWS;
     pd_provenance_now(&w->prov, NULL);
@@ -645,12 +646,30 @@ static int h5_attr_with_units(hid_t obj, const pd_attr *a)
     return 0;
 }
 
-/* HDF5: the last rows, the attributes, every id closed: 0 or an errno. */
+/* HDF5: the rows' dimension, the column of its name or one without
+ * values, attached to every other column; 0 or -1. */
+static int h5_table_dims(pd_table_writer *w)
+{
+    int coord = -1, rc = 0;
+    for (int j = 0; j < w->ncols; j++)
+        if (!strcmp(w->cols[j].name, w->dim))
+            coord = j;
+    hid_t dim = coord < 0 ? pd_h5_dimension(w->file, w->dim, w->rows) : -1;
+    if (coord >= 0 ? pd_h5_coord(w->ds[coord], w->dim) : dim < 0)
+        return -1;
+    for (int j = 0; j < w->ncols && !rc; j++)
+        rc = j == coord ? 0 : pd_h5_dims(w->ds[j], w->dim);
+    return pd_h5_close_id(&dim) || rc ? -1 : 0;
+}
+
+/* HDF5: the last rows, the attributes, the dimension, every id closed: 0
+ * or an errno. */
 static int h5_table_finish(pd_table_writer *w, int nattrs, const pd_attr *attrs)
 {
     int rc = flush_rows(w);
     for (int i = 0; i < nattrs && !rc; i++)
         rc = h5_attr_with_units(w->file, &attrs[i]);
+    rc = rc ? rc : h5_table_dims(w);
     for (int j = 0; j < w->ncols; j++)
         rc |= pd_h5_close_id(&w->ds[j]);
     int e = pd_h5_close(&w->file, &w->failure);
@@ -718,7 +737,7 @@ int pd_output_write(const char *path, const pd_table *t, pd_err *err)
 {
     pd_table_writer *w;
     double *row = malloc((size_t)(t->ncols > 0 ? t->ncols : 1) * sizeof *row);
-    int rc = row ? pd_table_open(&w, path, t->ncols, t->cols, t->rows, err)
+    int rc = row ? pd_table_open(&w, path, t->ncols, t->cols, t->dim, t->rows, err)
                  : pd_err_set(err, PD_ENOMEM, "-o %s: out of memory", path);
     if (rc) {
         free(row);

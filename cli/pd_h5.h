@@ -4,6 +4,7 @@
 #define PD_H5_H
 
 #include <hdf5.h>
+#include <hdf5_hl.h>
 
 #include "pd_output.h"
 
@@ -47,6 +48,37 @@ hid_t pd_h5_untimed(hid_t cls);
  * chunked by `chunk` rows, with a "units" attribute; -1 on failure. */
 hid_t pd_h5_extendible(hid_t loc, const char *name, hid_t type, int cols, long chunk,
                        const char *units);
+
+/* ---- dimensions: what xarray (engine="h5netcdf") and netCDF-4 read --------
+ * A dataset's axes are named by dimension scales (HDF5's H5DS), netCDF-4's
+ * dimensions: a 1-D dataset that is its own dimension (t, storey, Pi2) is a
+ * coordinate; an axis without one (a table's rows) gets a dimension that
+ * has no values.  Every dataset written names every axis so: create it,
+ * then pd_h5_dims(ds, "t,storey") (the scales must exist already). */
+
+/* Make the 1-D dataset ds the coordinate of dimension dim (its own name). */
+int pd_h5_coord(hid_t ds, const char *dim);
+
+/* A dimension of length len without values (netCDF's "dimension but not a
+ * variable": an int32 dataset that is never written) at loc/name; its id,
+ * or -1. */
+hid_t pd_h5_dimension(hid_t loc, const char *name, long len);
+
+/* A coordinate loc/name of the n int32 values first, first + 1, ... (floor
+ * numbers, contact numbers) with its units; 0 or -1. */
+int pd_h5_index(hid_t loc, const char *name, long n, int first, const char *units);
+
+/* Attach to each axis of ds the dimension named in the comma-separated
+ * dims ("t,storey"), found by name in ds's group or the nearest group
+ * above it that has one (netCDF's scoping).  0, or -1 (a dimension not
+ * found, or the library failed). */
+int pd_h5_dims(hid_t ds, const char *dims);
+
+/* An extendible 1-D float64 coordinate loc/name (pd_h5_extendible, then
+ * pd_h5_coord) that any number of datasets may be attached to (the list
+ * of them, an attribute, may outgrow the 64 kB an object header holds: a
+ * scene's t has two per structure and contact); -1 on failure. */
+hid_t pd_h5_extendible_coord(hid_t loc, const char *name, long chunk, const char *units);
 
 /* Append nrows x cols values (row-major) at row r0, extending the dataset. */
 int pd_h5_append(hid_t ds, hid_t type, long r0, long nrows, int cols, const void *x);

@@ -162,11 +162,12 @@ typedef struct pd_table {
     const pd_column *cols;
     int nattrs;
     const pd_attr *attrs;
+    const char *dim; /* the rows' dimension (pd_table_open); NULL: "row" */
 } pd_table;
 
 /* Write the table to path: HDF5 when it ends in .h5/.hdf5 (the provenance
  * and the attributes on the root, one 1-D dataset per column with a "units"
- * attribute), CSV when it ends in .csv ('#' lines with the provenance and
+ * attribute, all along the dimension table->dim), CSV when it ends in .csv ('#' lines with the provenance and
  * the attributes, "# units = U1,U2,..." with one unit per column, the
  * header row, the rows); anything else is PD_EINVAL. */
 int pd_output_write(const char *path, const pd_table *table, pd_err *err);
@@ -176,9 +177,12 @@ int pd_output_write(const char *path, const pd_table *table, pd_err *err);
 typedef struct pd_table_writer pd_table_writer;
 
 /* Open path.tmpPID for ncols columns (names and units kept until finish);
- * expected_rows sizes the HDF5 chunks.  PD_OK, PD_EINVAL or PD_EIO. */
+ * expected_rows sizes the HDF5 chunks.  The HDF5 columns are along the
+ * dimension dim (NULL: "row"): a column of that name is its coordinate
+ * ("t"), else the file gets a dimension of that name without values
+ * (pd_h5_dimension).  PD_OK, PD_EINVAL or PD_EIO. */
 int pd_table_open(pd_table_writer **w, const char *path, int ncols, const pd_column *cols,
-                  long expected_rows, pd_err *err);
+                  const char *dim, long expected_rows, pd_err *err);
 /* One row of ncols values: 0, or -1 once a write has failed (stop). */
 int pd_table_row(pd_table_writer *w, const double *row);
 /* The rows buffered, the attributes; close, rename into place. */

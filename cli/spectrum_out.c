@@ -83,7 +83,8 @@ static int h5_dataset(hid_t grp, hid_t dcpl, const char *name, const char *units
         return -1;
     ds = H5Dcreate2(grp, name, H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
     if (ds >= 0 && H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, x) >= 0)
-        rc = pd_h5_attr(ds, "units", units, 0.0);
+        rc = pd_h5_attr(ds, "units", units, 0.0) || /* along Pi2 (the first column) */
+             (strcmp(name, "Pi2") ? pd_h5_dims(ds, "Pi2") : pd_h5_coord(ds, "Pi2"));
     if (pd_h5_close_id(&ds) || H5Sclose(space) < 0)
         rc = -1;
     return rc;

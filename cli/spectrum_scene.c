@@ -87,7 +87,8 @@ static int write_table(const pd_scene_sweep_args *a, const sweep_out *o, pd_err 
                        {.name = "close_tol", .units = "Le", .num = close_tol(o)},
                        {.name = "ap", .units = "m/s^2", .num = o->sc->exc.ap}};
     pd_table t = {.rows = np, .ncols = ncols, .cols = cols,
-                  .nattrs = (int)(sizeof attrs / sizeof attrs[0]), .attrs = attrs};
+                  .nattrs = (int)(sizeof attrs / sizeof attrs[0]), .attrs = attrs,
+                  .dim = "point"};
     rc = pd_output_write(a->out, &t, err);
     free(data);
     free(cols);

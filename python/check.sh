@@ -6,10 +6,16 @@
 #
 #   sh python/check.sh [pytest args...]
 #
+# Then the types (mypy: the package, and tests/typing_usage.py with --strict
+# against the install, which needs its py.typed) and the notebook
+# examples/pound_tour.ipynb executed with nbconvert on a kernel of that
+# install (at most $NB_TIMEOUT s, default 300; it takes 7 to 24 s).
+#
 # Environment: POUND_LIBRARY (a built libpound.so: nothing is built),
 # POUND_BIN (the CLI the tests compare with, default: the one built next to
 # the library, else build/pound), PY_BUILD (build folder, default build-py),
-# PYTHON (default /usr/bin/python3: NumPy, pytest, Matplotlib, pip).
+# PYTHON (default /usr/bin/python3: NumPy, pytest, Matplotlib, pip, mypy, cffi,
+# nbconvert, ipykernel: scripts/deps.sh --python installs them).
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(dirname "$here")
@@ -50,3 +56,29 @@ cd "$tmp" # not the source tree: the tests import the installed package
 "$tmp/V/bin/python" -c 'import pound, sys; print("pound", pound.version(), "from",
     pound.__file__, "on", pound.library_path, file=sys.stderr)'
 MPLBACKEND=Agg "$tmp/V/bin/python" -m pytest -q -p no:cacheprovider "$here/tests" "$@"
+
+need() { # a module of the venv's Python, or a clear error
+    "$tmp/V/bin/python" -c "import $1" 2>/dev/null ||
+        { echo "python: $1 is not importable by $PYTHON: install $2" \
+               "(sh scripts/deps.sh --python)" >&2; exit 1; }
+}
+# the types: the package's own code, then a user's code against the install
+need mypy mypy
+"$tmp/V/bin/python" -m mypy --config-file "$here/pyproject.toml" --cache-dir "$tmp/mypy" \
+    "$here/pound"
+"$tmp/V/bin/python" -m mypy --config-file "$here/pyproject.toml" --cache-dir "$tmp/mypy" \
+    --strict "$here/tests/typing_usage.py"
+# the notebook, on a kernel of the install (its own data and config folders: no
+# kernel of the user's takes its place), outputs written to $tmp only
+need nbconvert python3-nbconvert
+need ipykernel python3-ipykernel
+export JUPYTER_DATA_DIR="$tmp/jupyter" JUPYTER_CONFIG_DIR="$tmp/jupyter-config" \
+    JUPYTER_RUNTIME_DIR="$tmp/jupyter-run" IPYTHONDIR="$tmp/ipython" PYDEVD_DISABLE_FILE_VALIDATION=1
+"$tmp/V/bin/python" -m ipykernel install --prefix "$tmp/V" --name pound-check >/dev/null 2>&1
+start=$(date +%s)
+timeout "${NB_TIMEOUT:-300}" \
+    "$tmp/V/bin/python" -m nbconvert --to notebook --execute \
+    --ExecutePreprocessor.kernel_name=pound-check --ExecutePreprocessor.timeout=120 \
+    --output-dir "$tmp" "$here/examples/pound_tour.ipynb" >"$tmp/nb.log" 2>&1 ||
+    { cat "$tmp/nb.log" >&2; echo "python: examples/pound_tour.ipynb failed" >&2; exit 1; }
+echo "python: examples/pound_tour.ipynb ran in $(($(date +%s) - start)) s"

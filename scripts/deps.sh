@@ -6,13 +6,18 @@
 # quick start does not need, and Siconos numerics, which bench/siconos_lcp
 # is timed against, and the stress suite's clang, LLVM OpenMP and libFuzzer;
 # --bench adds Siconos numerics alone; --stress the stress suite's tools;
-# --python the Python package's: NumPy, pytest, Matplotlib, h5py, pip)
+# --python the Python package's: NumPy, pytest, Matplotlib, h5py, pip, mypy, cffi,
+# nbconvert, ipykernel; and xarray with h5netcdf and netCDF-C's ncdump, which
+# make formats-check opens every HDF5 file with)
 set -u
 pkgs="gcc make pkg-config libgsl-dev libsuitesparse-dev libhdf5-dev hdf5-tools libjansson-dev gnuplot-nox"
 [ "${1:-}" = "--ci" ] && pkgs="$pkgs python3 libopenmpi-dev openmpi-bin libsiconos-numerics-dev"
 stress="python3 python3-numpy python3-pytest clang libomp-dev libclang-rt-dev util-linux"
-# the Python package's tests and the files read back with h5py
-py="python3 python3-venv python3-numpy python3-pytest python3-matplotlib python3-h5py python3-pip python3-setuptools python3-wheel python3-pandas python3-xarray"
+# the Python package's tests and the files read back with h5py (and xarray's
+# h5netcdf, netCDF-C's ncdump); its type check (mypy), its notebook
+# (nbconvert on an ipykernel: python/check.sh) and the check of its ctypes
+# mirrors against the headers read by cffi
+py="python3 python3-venv python3-numpy python3-pytest python3-matplotlib python3-h5py python3-pip python3-setuptools python3-wheel python3-pandas python3-xarray python3-h5netcdf netcdf-bin mypy python3-nbconvert python3-ipykernel python3-cffi"
 [ "${1:-}" = "--ci" ] && pkgs="$pkgs $py groff-base g++"
 [ "${1:-}" = "--python" ] && pkgs="$pkgs $py"
 [ "${1:-}" = "--ci" ] && pkgs="$pkgs $stress"

@@ -19,7 +19,13 @@ asserts:
   quoted; spectra without -o/--plot/--json/--threads/--resume/--stop-after),
   `pound_version` (that of `pound --version`, else PD_VERSION in
   core/pd_core.h) and `created` (UTC ISO 8601, now; absent from spectra);
-- a few values against --json, such as max |u| = umax within 1e-12.
+- a few values against --json, such as max |u| = umax within 1e-12;
+- every group opened by xarray (engine="h5netcdf", Debian's python3-xarray
+  and python3-h5netcdf; skipped, and said so, without them): no phony
+  dimension, each variable along the dims the page names with the lengths
+  h5py reads, the dimensions with values coordinates, text attributes str;
+  and, when netCDF-C's ncdump is installed (netcdf-bin), every HDF5 file
+  read by `ncdump -h` without a phony dimension.
 
 It exits 1 with one line per mismatch, and always prints one summary line.
 It needs Debian's python3-h5py and python3-numpy.
@@ -41,6 +47,12 @@ try:
     import numpy as np
 except ImportError as e:  # the wrong interpreter: say which one is needed
     sys.exit(f"formats_check: {e} (run with /usr/bin/python3, which has h5py and numpy)")
+try:  # the files opened by xarray too (python3-xarray, python3-h5netcdf)
+    import h5netcdf  # noqa: F401  (xarray's engine="h5netcdf")
+    import xarray as xr
+except ImportError:
+    xr = None
+NCDUMP = shutil.which("ncdump")  # netCDF-C's (Debian's netcdf-bin), when installed
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DOC = os.path.join(ROOT, "docs", "formats.md")
@@ -108,8 +120,12 @@ def parse_doc(path):
                 i += 1
             if head[0] == "dataset":
                 for r in rows:
+                    c = dict(zip(head, r))
                     doc[section]["datasets"].append(
-                        {"name": unquote(r[0]), "shape": unquote(r[1]), "dtype": r[2], "units": r[3]})
+                        {"name": unquote(c["dataset"]), "shape": unquote(c["shape"]),
+                         "dims": tuple(d.strip() for d in unquote(c.get("dims", "()")).strip("()").split(",") if d.strip()),
+                         "dtype": c["dtype"], "units": c["units"],
+                         "valueless": "without values" in c.get("contents", "")})
             elif head[0].startswith("root attribute") or head[0].startswith("attribute of"):
                 m = re.match(r"attribute of `([^`]+)`", head[0])
                 obj = m.group(1) if m else "/"
@@ -170,6 +186,7 @@ class Ctx:
     def __init__(self, pound, tmp, doc, version):
         self.pound, self.tmp, self.doc, self.version = pound, tmp, doc, version
         self.files = 0
+        self.xarray_groups, self.xarray_skipped, self.ncdumped = 0, False, 0
         self.t0 = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0)
 
 
@@ -228,7 +245,7 @@ def check_h5(ctx, path, fmt, command, env, reproducible=False, root_qualifier=No
     if root_qualifier:
         root.update(spec["attrs"]["/:" + root_qualifier])
     check_attrs(where + " /", f, {**root, **prov})
-    found = []
+    found, shapes = [], {}
     f.visititems(lambda n, o: found.append(n) if isinstance(o, h5py.Dataset) else None)
     for d in spec["datasets"]:
         check(any(pattern(d["name"]).match(n) for n in found), f"{where}: no dataset {d['name']}")
@@ -243,6 +260,8 @@ def check_h5(ctx, path, fmt, command, env, reproducible=False, root_qualifier=No
         check(ds.dtype.name == d["dtype"], f"{where}: {n} is {ds.dtype.name}, want {d['dtype']}")
         want = eval(d["shape"], {}, env(n) if callable(env) else env)
         check(ds.shape == want, f"{where}: {n} has shape {ds.shape}, want {d['shape']} = {want}")
+        check(len(d["dims"]) == ds.ndim, f"{where}: {n}: the page names dims {d['dims']} for {ds.ndim} axes")
+        shapes[n] = (d["dims"], ds.shape)
     for key, documented in spec["attrs"].items():
         if key.startswith("/"):
             continue
@@ -252,7 +271,58 @@ def check_h5(ctx, path, fmt, command, env, reproducible=False, root_qualifier=No
         check(groups, f"{where}: no group {key}")
         for g in groups:
             check_attrs(f"{where} /{g}", f[g], documented)
+    check_xarray(ctx, path, f, spec, shapes)
     return f
+
+
+def check_xarray(ctx, path, f, spec, shapes):
+    """Every group of the file opened by xarray (engine="h5netcdf"): no
+    phony_dim; each variable along the dims the page names, of the lengths
+    h5py reads; a dimension with values (a 1-D dataset of its name) a
+    coordinate, one without values (NAME "This is a netCDF dimension but
+    not a netCDF variable") absent from the variables; text attributes str."""
+    if NCDUMP:  # netCDF-C reads it too, every axis named
+        p = subprocess.run([NCDUMP, "-h", path], capture_output=True, text=True, timeout=60)
+        check(p.returncode == 0 and "phony_dim" not in p.stdout,
+              f"{os.path.basename(path)}: ncdump -h: exit {p.returncode} {p.stderr.strip()[:200]}"
+              f"{' (phony dims)' if 'phony_dim' in p.stdout else ''}")
+        ctx.ncdumped += 1
+    if xr is None:
+        ctx.xarray_skipped = True
+        return
+    where = os.path.basename(path) + " (xarray)"
+    groups = [""]
+    f.visititems(lambda n, o: groups.append(n) if isinstance(o, h5py.Group) else None)
+    for g in groups:
+        try:
+            ds = xr.open_dataset(path, engine="h5netcdf", group=g or None)
+        except Exception as e:  # phony dimensions refused, or a malformed scale
+            check(False, f"{where}: group /{g}: {type(e).__name__}: {e}")
+            continue
+        with ds:
+            check(not any(str(d).startswith("phony_dim") for d in ds.dims), f"{where}: /{g}: phony dims {dict(ds.dims)}")
+            names = [n for n in shapes if n.rpartition("/")[0] == g]
+            for n in names:
+                dims, shape = shapes[n]
+                leaf = n.rpartition("/")[2]
+                valueless = b"not a netCDF variable" in bytes(f[n].attrs.get("NAME", b""))
+                if valueless:
+                    check(leaf not in ds.variables and ds.sizes.get(leaf) == shape[0],
+                          f"{where}: /{n}: a dimension without values, xarray has {dict(ds.sizes)}")
+                    continue
+                if not check(leaf in ds.variables, f"{where}: /{n} is not a variable"):
+                    continue
+                v = ds[leaf]
+                check(v.dims == dims and v.shape == shape, f"{where}: /{n} has dims {v.dims} {v.shape}, want {dims} {shape}")
+                if dims == (leaf,):
+                    check(leaf in ds.coords, f"{where}: /{n} is not a coordinate")
+                u = v.attrs.get("units")
+                check(isinstance(u, str), f"{where}: /{n}.units is {type(u).__name__}, want str")
+            for k, a in ds.attrs.items():
+                h = f[g or "/"].attrs[k]
+                if isinstance(h, (bytes, np.bytes_, str)):
+                    check(isinstance(a, str), f"{where}: /{g} attribute {k} is {type(a).__name__}, want str")
+        ctx.xarray_groups += 1
 
 
 def read_csv(path):
@@ -299,6 +369,12 @@ def column(header, rows, name):
     return np.array([float(r[header.index(name)]) for r in rows])
 
 
+def columns(ctx, fmt):
+    """The datasets of a format that are CSV columns too (not the HDF5
+    dimensions without values)."""
+    return [d for d in ctx.doc[fmt]["datasets"] if not d["valueless"]]
+
+
 def doc_units(ctx, fmt, name):
     for d in ctx.doc[fmt]["datasets"]:
         if pattern(d["name"]).match(name):
@@ -329,7 +405,7 @@ def oscillator(ctx):
             check(close(f["t"][-1], j["steps"] * j["dt"], 1e-9), f"{out}: last t {f['t'][-1]} != steps dt")
             f.close()
         else:
-            cols = [(d["name"], d["units"]) for d in ctx.doc[fmt]["datasets"]]
+            cols = [(d["name"], d["units"]) for d in columns(ctx, fmt)]
             header, rows, md, _ = check_csv(ctx, path, fmt, command_of(args), cols, n)
             check(close(float(md["umax"].split(" [")[0]), j["umax"]), f"{out}: # umax differs from --json")
             check(md["umax"].endswith(" [m]"), f"{out}: # umax has no [m]")
@@ -438,7 +514,7 @@ def converge(ctx):
                       f"{out}: codes")
                 f.close()
             else:
-                cols = [(d["name"], d["units"]) for d in ctx.doc[fmt]["datasets"]]
+                cols = [(d["name"], d["units"]) for d in columns(ctx, fmt)]
                 header, rows, md, _ = check_csv(ctx, path, fmt, command_of(args), cols, len(j))
                 check([r[0] for r in rows] == [r["method"] for r in j], f"{out}: method column")
                 check(all(close(a, r["err_hist_linf"]) for a, r in zip(column(header, rows, "err_hist_linf"), j)),
@@ -475,7 +551,7 @@ def spectrum(ctx):
             curve_attrs = ctx.doc[fmt]["attrs"]["curve_NNNN"]
             cols = [(n, "1" if curve_attrs[n][0] == "text" else curve_attrs[n][1])
                     for n in ("pulse", "dir", "method", "ap", "Tp", "Pi3", "gap", "eps", "xi")]
-            cols += [(d["name"].split("/", 1)[1], d["units"]) for d in ctx.doc[fmt]["datasets"]]
+            cols += [(d["name"].split("/", 1)[1], d["units"]) for d in columns(ctx, fmt)]
             header, rows, md, _ = check_csv(ctx, path, fmt, command, cols, len(pts), reproducible=True)
             check(all(close(a, p["Pi1"]) for a, p in zip(column(header, rows, "Pi1"), pts)), f"{out}: Pi1 differs from --json")
             check([r[0] for r in rows] == [p["pulse"] for p in pts], f"{out}: pulse column")
@@ -502,7 +578,7 @@ def spectrum_scene(ctx):
             f.close()
         else:
             cols = []
-            for d in ctx.doc[fmt]["datasets"]:
+            for d in columns(ctx, fmt):
                 if d["name"].startswith("NAME."):
                     continue
                 cols.append((d["name"], d["units"]))
@@ -557,7 +633,10 @@ def main():
     for m in failures:
         print("FAIL", m)
     status = "ok" if not failures else f"FAILED {len(failures)} of"
-    print(f"formats_check: {status} {checks} checks on {nfiles} files of 7 kinds "
+    opened = (f"xarray skipped: python3-xarray or python3-h5netcdf not installed" if ctx.xarray_skipped
+              else f"{ctx.xarray_groups} groups opened by xarray")
+    opened += f", {ctx.ncdumped} files by ncdump" if NCDUMP else ", ncdump not installed"
+    print(f"formats_check: {status} {checks} checks on {nfiles} files of 7 kinds, {opened} "
           f"(pound {version}) in {time.monotonic() - t0:.1f} s")
     return 1 if failures else 0
 

@@ -12,7 +12,10 @@ The library: $POUND_LIBRARY (a path), else the installed libpound.so.0,
 else the build tree (../build/libpound.so next to this package's source).
 Errors raise pound.PoundError (InputError for PD_EINVAL, ParseError,
 FileError, NumericalError, SolverError, BudgetError) with the library's
-message and status.
+message and status.  pound.plot draws results with Matplotlib (imported
+when a figure is asked for).  Every public function is annotated (PEP 484;
+the package ships py.typed); values are in SI units, stated in each
+docstring.
 """
 from ._lib import (BudgetError, FileError, InputError, LayoutError, NumericalError, ParseError,
                    PoundError, PoundMemoryError, SolverError, library_path, version)
@@ -21,10 +24,11 @@ from ._osc import Result, compare, converge, dt_range, simulate
 from ._scene import Scene, scene, simulate_scene
 from ._spectrum import spectrum
 from ._lcp import lcp, read_lcp, record
+from . import plot
 
 __version__ = "0.12.0"
 
 __all__ = ["simulate", "compare", "converge", "dt_range", "spectrum", "lcp", "read_lcp",
            "scene", "simulate_scene", "Scene", "record", "Record", "Result", "PoundError",
            "InputError", "ParseError", "FileError", "NumericalError", "SolverError",
-           "BudgetError", "PoundMemoryError", "LayoutError", "library_path", "version"]
+           "BudgetError", "PoundMemoryError", "LayoutError", "library_path", "version", "plot"]

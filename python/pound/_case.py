@@ -4,12 +4,14 @@ that the numbers are the CLI's to the last bit."""
 import ctypes
 import math
 import os
+from typing import Any, Optional
 
 import numpy as np
 
 from . import _args, _demand, _lib
 from ._args import number
 from ._lib import InputError, PdErr, PdRecord, PdRecordPulse, lib
+from ._types import ArrayLike, PathArg
 
 # Keyword arguments and the CLI flags they mirror (the names without "--",
 # "-" written "_").
@@ -57,11 +59,15 @@ def parse_dir(value):
 
 class Record:
     """A strong-motion record read and its pulse fitted by the library
-    (pd_record_read, pd_record_fit_pulse); owns the C arrays."""
+    (pd_record_read, pd_record_fit_pulse); owns the C arrays.  Give it as
+    record= to simulate() or spectrum(); pound.record(path) measures one."""
 
-    def __init__(self, path, units=None, format="auto"):
-        """units: of a two-column text record ['g']; an AT2 or V2 file states its
-        own, and units given for one raise InputError (as the CLI's --units)."""
+    def __init__(self, path: PathArg, units: Optional[str] = None,
+                 format: str = "auto") -> None:
+        """Read the record at path (format 'auto', 'at2', 'v2', 'text').
+        units: of a two-column text record, 'g', 'm/s2', 'cm/s2' ['g']; an AT2
+        or V2 file states its own, and units given for one raise InputError
+        (as the CLI's --units)."""
         self._owned = False
         cpath, self.path = _args.path("record", path)
         fmt_code = parse_name("record_format", lib.pd_record_format_parse, format,
@@ -101,8 +107,10 @@ class Record:
             warnings.warn(buf.value.decode("utf-8", "replace"), stacklevel=4)
 
     @classmethod
-    def from_array(cls, acc, dt, units="g", name="array"):
-        """A record from the accelerations acc[k] at t_k = k dt (pd_record_from_array):
+    def from_array(cls, acc: ArrayLike, dt: float, units: str = "g",
+                   name: str = "array") -> "Record":
+        """A record from the accelerations acc[k] (in units: 'g', 'm/s2',
+        'cm/s2') at t_k = k dt [s] (pd_record_from_array):
         the same values as a file's give the same record, bit for bit."""
         self = cls.__new__(cls)
         self._owned = False
@@ -129,23 +137,25 @@ class Record:
         self._warn_units()
         return self
 
-    def close(self):
+    def close(self) -> None:
+        """Free the C arrays now (a closed record is not to be used)."""
         if self._owned:
             lib.pd_record_free(self.rec)
             self._owned = False
 
-    def __del__(self):
+    def __del__(self) -> None:
         try:
             self.close()
         except Exception:  # interpreter shutdown
             pass
 
     @property
-    def name(self):
+    def name(self) -> str:
+        """The record's name (its file's, or from_array's name)."""
         return self.rec.name.decode("utf-8", "replace")
 
     @property
-    def acc(self):
+    def acc(self) -> np.ndarray:
         """The ground accelerations [m/s^2] (a copy)."""
         return np.ctypeslib.as_array(self.rec.acc, (self.rec.npts,)).copy()
 

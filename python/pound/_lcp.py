@@ -1,6 +1,7 @@
 """Linear complementarity problems (`pound lcp`) and records (`pound record`)."""
 import ctypes
 import time
+from typing import Any, Optional, Tuple
 
 import numpy as np
 
@@ -8,6 +9,7 @@ from . import _args, _lib
 from ._case import InputError, Record, parse_name
 from ._lib import PdErr, PdMatrix, lib, s
 from ._osc import Result
+from ._types import ArrayLike, Int, PathArg
 
 _libc = ctypes.CDLL(None)
 _libc.free.argtypes = [ctypes.c_void_p]
@@ -18,7 +20,7 @@ _DPTR = ctypes.POINTER(ctypes.c_double)
 PD_LCP_LEMKE_NMAX = 2048  # lcp/pd_lcp.h
 
 
-def read_lcp(path, format="auto"):
+def read_lcp(path: PathArg, format: str = "auto") -> Tuple[np.ndarray, np.ndarray]:
     """Read an LCP file (plain: n, M row by row, q; or Siconos): (M, q) as
     NumPy arrays (pd_lcp_read)."""
     fmt_code = _FORMATS[_args.choice("format", format, _FORMATS)]
@@ -37,7 +39,8 @@ def read_lcp(path, format="auto"):
     return Ma, qa
 
 
-def lcp(M, q, solver="auto", cover=None, max_pivots=0, max_iterations=0, tol=None):
+def lcp(M: Any, q: ArrayLike, solver: str = "auto", cover: Optional[ArrayLike] = None,
+        max_pivots: Int = 0, max_iterations: Int = 0, tol: Optional[float] = None) -> Result:
     """Solve z >= 0, w = M z + q >= 0, z'w = 0 with a solver of the table
     (pd_lcp_solve), as `pound lcp FILE --json`: a Result with status
     ('solved', 'no_solution', 'max_pivots', 'numerical', 'max_iterations'),
@@ -48,7 +51,9 @@ def lcp(M, q, solver="auto", cover=None, max_pivots=0, max_iterations=0, tol=Non
     M: a square array (dense), or a SciPy sparse matrix (compressed columns);
     solver: 'auto', 'lemke', 'structured', 'pgs'; cover: Lemke's covering
     vector (one value or n); max_pivots, max_iterations: the budgets (0:
-    from n).  M, q and cover must be finite: the library refuses what is
+    from n); tol: the solver's tolerance (in (0, 1e-3)).  The problem is
+    dimensionless (z, w in the units of q; cpu_s in s of CPU).  M, q and
+    cover must be finite: the library refuses what is
     not (PD_EINVAL without a message), so they are checked here first."""
     method = parse_name("solver", lib.pd_lcp_method_parse, solver,
                         s(lib.pd_lcp_method_list()))
@@ -97,10 +102,10 @@ def lcp(M, q, solver="auto", cover=None, max_pivots=0, max_iterations=0, tol=Non
             raise InputError("%s: must be >= 0 (got %d)" % (key, k))
         setattr(opts, key, k)
     if tol is not None:
-        tol = _args.number("tol", tol)
-        if not 0.0 < tol < 1e-3:
-            raise InputError("tol: must lie in (0, 1e-3), got %g" % tol)
-        opts.tol = tol
+        tolv = _args.number("tol", tol)
+        if not 0.0 < tolv < 1e-3:
+            raise InputError("tol: must lie in (0, 1e-3), got %g" % tolv)
+        opts.tol = tolv
     err = PdErr()
     solver_p = lib.pd_lcp_solver_alloc(method, n, nnz, err)
     if not solver_p:
@@ -131,12 +136,13 @@ def lcp(M, q, solver="auto", cover=None, max_pivots=0, max_iterations=0, tol=Non
                   solved=(st == 0))
 
 
-def record(path, units=None, format="auto"):
+def record(path: PathArg, units: Optional[str] = None, format: str = "auto") -> Result:
     """A strong-motion record's measures and fitted pulse, as `pound record F
     --json` (units: of a two-column text file ['g']; refused for AT2 and V2,
-    which state theirs) (name, npts, dt, duration, pga, pgv, pgd, t_pga, t_pgv, t_pgd,
-    arias, t5_75, t5_95, pulse {Tp, vp, ap, wp, Le, fp, nu, gamma, t0, r2,
-    shape, t_start}), with the arrays t, acc [m/s^2], vel [m/s], disp [m]
+    which state theirs): name, npts, dt [s], duration [s], pga [m/s^2], pgv
+    [m/s], pgd [m], t_pga, t_pgv, t_pgd [s], arias [m/s], t5_75, t5_95 [s],
+    pulse {Tp [s], vp [m/s], ap [m/s^2], wp [rad/s], Le [m], fp [Hz], nu,
+    gamma, t0 [s], r2, shape, t_start [s]}, with the arrays t, acc [m/s^2], vel [m/s], disp [m]
     (pd_record_integrate) and pulse_acc (the paper's one-cycle pulse)."""
     r = Record(path, units, format)
     try:

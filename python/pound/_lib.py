@@ -11,6 +11,7 @@ import math
 import os
 from ctypes import (CFUNCTYPE, POINTER, Structure, c_char, c_char_p, c_double, c_int, c_long,
                     c_ubyte, c_void_p)
+from typing import List, Optional, Tuple
 
 # ---- errors --------------------------------------------------------------------------
 
@@ -26,17 +27,18 @@ class PoundError(Exception):
     """A libpound failure: `status` is the PD_E* code (negative int), `message`
     the library's one-line message (str(e) is the message)."""
 
-    def __init__(self, message, status=PD_EINVAL):
+    def __init__(self, message: str, status: int = PD_EINVAL) -> None:
+        """message: the library's text; status: the PD_E* code (a negative int)."""
         Exception.__init__(self, message)
         self.message = message
         self.status = status
 
     @property
-    def code(self):
+    def code(self) -> str:
         """The status's name, e.g. 'PD_EINVAL'."""
         return STATUS_NAMES.get(self.status, str(self.status))
 
-    def __str__(self):
+    def __str__(self) -> str:
         return self.message
 
 
@@ -51,15 +53,17 @@ class ParseError(PoundError, ValueError):
 class FileError(PoundError, OSError):
     """PD_EIO: a file could not be opened, read or written."""
 
-    def __init__(self, message, status=PD_EIO):
+    def __init__(self, message: str, status: int = PD_EIO) -> None:
+        """message: the library's text (it names the file); status: PD_EIO."""
         PoundError.__init__(self, message, status)
 
-    def __str__(self):
+    def __str__(self) -> str:
         return self.message
 
 
 class NumericalError(PoundError, ArithmeticError):
-    """PD_ENUMERICAL, PD_ENONFINITE, PD_ESINGULAR."""
+    """PD_ENUMERICAL, PD_ENONFINITE, PD_ESINGULAR: a computation failed (a
+    non-finite number, a singular matrix)."""
 
 
 class SolverError(PoundError):
@@ -71,7 +75,7 @@ class BudgetError(PoundError):
 
 
 class PoundMemoryError(PoundError, MemoryError):
-    """PD_ENOMEM."""
+    """PD_ENOMEM: the library could not allocate memory (a run too large)."""
 
 
 class LayoutError(ImportError):
@@ -85,7 +89,7 @@ _ERROR_CLASSES = {
 }
 
 
-def make_error(status, message):
+def make_error(status: int, message: str) -> PoundError:
     cls = _ERROR_CLASSES.get(status, PoundError)
     return cls(message, status)
 
@@ -435,7 +439,7 @@ _OPTIONAL = {
 _HERE = os.path.dirname(os.path.abspath(__file__))
 
 
-def _candidates():
+def _candidates() -> List[str]:
     """Where the library is looked for, in order: $POUND_LIBRARY (a path), the
     copy bundled at install time (python/setup.py), the installed
     libpound.so.0 (the loader's search path), the build tree."""
@@ -447,7 +451,7 @@ def _candidates():
         "libpound.so.0", os.path.normpath(os.path.join(_HERE, "..", "..", "build", "libpound.so"))]
 
 
-def _load():
+def _load() -> Tuple[ctypes.CDLL, str]:
     errors = []
     for name in _candidates():
         try:
@@ -477,11 +481,13 @@ def _bind(lib, path):
             f.restype, f.argtypes = res, args
 
 
+lib: ctypes.CDLL
+library_path: str  # the file libpound was loaded from
 lib, library_path = _load()
 _bind(lib, library_path)
 
 
-def version():
+def version() -> Optional[str]:
     """The version of the library loaded (pd_version()), or None when it has no
     pd_version."""
     f = getattr(lib, "pd_version", None)

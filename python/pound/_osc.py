@@ -2,12 +2,17 @@
 cli/cmd_compare.c, cli/cmd_converge.c reproduced from library calls)."""
 import ctypes
 import math
+from typing import TYPE_CHECKING, Any, List, Optional, Sequence, Union
 
 import numpy as np
 
 from . import _args, _demand, _lib
 from ._case import Case, InputError, copy_opts, number
 from ._lib import PdErr, lib, s
+from ._types import Floats, Int, Names, PathArg, Range
+
+if TYPE_CHECKING:
+    from ._scene import Scene
 
 NAN = float("nan")
 
@@ -15,18 +20,20 @@ NAN = float("nan")
 class Result(dict):
     """A dict whose keys are also attributes (r.umax is r['umax']), with a
     short repr and, when pandas or xarray is installed, to_pandas() and
-    to_xarray() of its history."""
+    to_xarray() of its history.  Values are in SI units (s, m, m/s, m/s^2,
+    N s; impulses of the oscillator per unit mass, m/s) and the Pi terms
+    are dimensionless; each function's docstring lists its keys."""
 
-    def __getattr__(self, key):
+    def __getattr__(self, key: str) -> Any:
         try:
             return self[key]
         except KeyError:
             raise AttributeError(key) from None
 
-    def __dir__(self):
+    def __dir__(self) -> List[str]:
         return list(self.keys()) + list(dict.__dir__(self))
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         def short(v):
             if isinstance(v, np.ndarray):
                 return "array(%s)" % "x".join(str(d) for d in v.shape)
@@ -58,7 +65,7 @@ class Result(dict):
         return {k: v for k, v in self.items()
                 if isinstance(v, (int, float, str, np.integer, np.floating))}
 
-    def to_pandas(self):
+    def to_pandas(self) -> Any:
         """The history as a pandas DataFrame indexed by t (the results
         without a history: a Series of the scalars)."""
         import pandas as pd
@@ -71,7 +78,7 @@ class Result(dict):
         df.attrs.update(self._scalars())
         return df
 
-    def to_xarray(self):
+    def to_xarray(self) -> Any:
         """The history as an xarray Dataset with t as its coordinate (a scene's
         x, v along (t, dof), gap and impulse along (t, contact)); the scalars as
         attributes."""
@@ -163,7 +170,7 @@ def _case_json(case, out):
         out["scale"] = c.scale
 
 
-def simulate(history=True, every=1, **case):
+def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
     """One run of the pounding oscillator and its no-wall twin, as
     `pound simulate [flags] --json`.
 
@@ -180,11 +187,17 @@ def simulate(history=True, every=1, **case):
     'auto'|'general', factor, lcp_solver, contact 'kelvin'|'hertz', kc,
     kc_abs, rtol, atol, stepper.
 
-    Returns a Result with the keys of the CLI's JSON (umax, Pi1, gamma,
-    impacts, ...) and, with history, r.history: the arrays step, t, u, v,
-    impulse, gap of every every-th step (the CLI's -o file: t [s], u [m],
-    v [m/s], impulse per unit mass since the last sample [m/s], gap
-    delta - u [m]), with t, u, v, impulse also as r.t, r.u, r.v, r.impulse."""
+    Returns a Result with the keys of the CLI's JSON: umax, u_toward,
+    u_away, umax_free [m]; Pi1 = umax / Le, gamma = umax / umax_free, chi =
+    gap / umax_free, Pi2, Pi3 (dimensionless); impacts, accumulations,
+    steps (counts); first_impact, contact_time, dt, tend [s];
+    first_impact_velocity, max_impact_velocity [m/s]; max_impulse per unit
+    mass [m/s]; min_gap, gap [m]; ap [m/s^2], Tp, T0 [s]; cpu_s [s of
+    CPU]; method, method_by, pulse, dir, kernel (names).  With history,
+    r.history: the arrays step, t, u, v, impulse, gap of every every-th
+    step (the CLI's -o file: t [s], u [m], v [m/s], impulse per unit mass
+    since the last sample [m/s], gap delta - u [m]), with t, u, v, impulse
+    also as r.t, r.u, r.v, r.impulse."""
     history, every = history_args(history, every)
     height = _demand.pop_height(case)
     k = Case(case).resolve()
@@ -195,7 +208,8 @@ def simulate(history=True, every=1, **case):
         sampler = _osc_sampler(h)
     sm = _lib.PdOscSummary()
     err = PdErr()
-    st = lib.pd_osc_summarize(k.c, o, sampler or _lib.OscSampler(), None, sm, err)
+    st = lib.pd_osc_summarize(k.c, o, sampler or _lib.OscSampler(),  # type: ignore[call-overload]
+                              None, sm, err)
     if h is not None and h.error is not None:
         raise h.error
     _lib.check(st, err)
@@ -259,12 +273,19 @@ class _Traces:
         lib.pd_trace_free(self.work)
 
 
-def compare(methods=("moreau",), scene=None, **case):
+def compare(methods: Names = ("moreau",), scene: Optional[Union[PathArg, "Scene"]] = None,
+            **case: Any) -> Result:
     """Errors against the event-driven reference, as `pound compare --json`:
     err_umax_rel = |umax - umax_ref| / umax_ref and err_hist_linf =
     max_k |u(t_k) - u_ref(t_k)| / umax_ref on t_k = k dt, for Moreau-Jean
     and/or penalty (methods; scenes also 'event-general', the GSL-based
-    reference).  scene=path: the scene's (per structure)."""
+    reference).  scene=path (or a pound.Scene): the scene's (per structure).
+
+    Returns a Result: method, err_umax_rel, err_hist_linf (of the first
+    method; dimensionless, relative to the reference's umax), impacts and
+    impacts_ref (counts), umax and umax_ref [m], dt [s], cpu_s and cpu_s_ref
+    [s of CPU], and methods: one Result per method asked.  The case keywords
+    are simulate()'s."""
     want = parse_methods(methods)
     _scenes_only(want, scene)
     if scene is not None:
@@ -278,7 +299,7 @@ def compare(methods=("moreau",), scene=None, **case):
         st = lib.pd_measure_reference(k.c, o, tr.ref, rr, err)
         if st:
             raise _lib.make_error(st, "reference: " + err.text())
-        res = [None] * _NMETHOD
+        res: List[Any] = [None] * _NMETHOD
         for m in range(_NMETHOD):
             if not want[m]:
                 continue
@@ -306,9 +327,9 @@ def compare(methods=("moreau",), scene=None, **case):
 
 # ---- converge -----------------------------------------------------------------------------
 
-def dt_range(dt_max, dt_min, n):
-    """The steps of the CLI's --dt MAX:MIN:N: n values log-spaced from dt_max
-    down to dt_min (cli/cmd_converge.c dt_at)."""
+def dt_range(dt_max: float, dt_min: float, n: Int) -> List[float]:
+    """The steps [s] of the CLI's --dt MAX:MIN:N: n values log-spaced from
+    dt_max [s] down to dt_min [s] (cli/cmd_converge.c dt_at); 1 <= n <= 64."""
     dt_max, dt_min = number("dt", dt_max, "MAX ="), number("dt", dt_min, "MIN =")
     n = _args.integer("dt", n, "N =")
     if not (dt_min > 0.0) or dt_max < dt_min or n < 1 or n > 64:
@@ -346,8 +367,9 @@ def _c_round(x):
     return f + 1.0 if x - f >= 0.5 else f
 
 
-def converge(dts, theta=(0.5,), methods=("moreau",), kcs=None, error="hist", scene=None,
-             **case):
+def converge(dts: Union[Range, Sequence[float]], theta: Floats = (0.5,),
+             methods: Names = ("moreau",), kcs: Optional[Floats] = None, error: str = "hist",
+             scene: Optional[Union[PathArg, "Scene"]] = None, **case: Any) -> Result:
     """Error and cost as dt shrinks, as `pound converge --dt ... --json`: one
     row per (dt, theta) for Moreau-Jean, one per contact stiffness multiple
     kc (kcs [1e2, 1e3, 1e4, 1e5, 1e6]) on the finest grid for penalty, and
@@ -356,7 +378,11 @@ def converge(dts, theta=(0.5,), methods=("moreau",), kcs=None, error="hist", sce
     theta, on err_hist_linf (error='hist') or err_umax_rel ('umax').
 
     dts: 'MAX:MIN:N' or (MAX, MIN, N) with an int N (the CLI's --dt), or a
-    sequence of steps.  Returns {'rows': [...], 'cpu_s_ref': ...}."""
+    sequence of steps [s].  kcs: multiples of the structure's stiffness
+    (dimensionless).  Returns a Result: rows (one Result per row: method,
+    theta, dt [s], kc, err_umax_rel, err_hist_linf (dimensionless), cpu_s
+    [s of CPU], order, impacts, steps) and cpu_s_ref [s of CPU]; a scene's
+    also impacts_ref and the reference's decisions."""
     steps, dt_min, dt_first = _steps(dts)
     thetas = [number("theta", t) for t in _args.values("theta", theta)]
     if len(thetas) > 32:
@@ -374,6 +400,7 @@ def converge(dts, theta=(0.5,), methods=("moreau",), kcs=None, error="hist", sce
             if not 0.5 <= t <= 1.0:
                 raise InputError("theta: %g is outside [1/2, 1] (allow_unstable=True)" % t)
     case = dict(case, dt=dt_first)
+    meas: Any
     if scene is not None:
         from ._scene import SceneMeasurer
         meas = SceneMeasurer(scene, case)

@@ -1,6 +1,7 @@
 """Scenes: rows of structures read from JSON files (docs/scenes.md) or
 generated (chain), run as `pound simulate --scene F --json` runs them."""
 import ctypes
+from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -8,6 +9,7 @@ from . import _args, _demand, _lib
 from ._case import SCHEME_KEYS, Case, InputError, copy_opts, number, scheme_opts
 from ._lib import PD_WALL, PdErr, lib, s
 from ._osc import Result, _History, history_args
+from ._types import Int, PathArg
 
 SCENE_OPTS = SCHEME_KEYS
 
@@ -23,7 +25,10 @@ class Scene:
     file, Scene.chain(N, ...) generates a row of N SDOFs between two walls.
     structures, contacts and excitation describe it; simulate() runs it."""
 
-    def __init__(self, path=None, _ptr=None, _name=None):
+    def __init__(self, path: Optional[PathArg] = None, _ptr: Any = None,
+                 _name: Optional[str] = None) -> None:
+        """Read the scene file at path (JSON, docs/scenes.md); _ptr and _name
+        are Scene.chain's."""
         self._p = None
         if _ptr is not None:
             self._p, self.path = _ptr, _name
@@ -35,11 +40,11 @@ class Scene:
         self._p, self.path = p, text
 
     @classmethod
-    def chain(cls, N, ratio=1.5, **model):
+    def chain(cls, N: Int, ratio: float = 1.5, **model: Any) -> "Scene":
         """`pound simulate --chain N`: N SDOFs of unit mass between two walls,
         periods alternating T0 and ratio T0, every gap `gap` (or Pi3), every
-        restitution eps; the model keywords of simulate() (pulse, dir, ap, Tp,
-        T0 or Pi2, gap or Pi3, eps, xi)."""
+        restitution eps; the model keywords of simulate() (pulse, dir, ap
+        [m/s^2], Tp [s], T0 [s] or Pi2, gap [m] or Pi3, eps, xi)."""
         N = _args.integer("chain", N)
         if not 1 <= N <= 10000000:
             raise InputError("chain: N must be in [1, 1e7] (got %d)" % N)
@@ -59,21 +64,23 @@ class Scene:
                                       c.eps, ctypes.byref(p), err), err)
         return cls(_ptr=p, _name="chain of %d" % N)
 
-    def close(self):
+    def close(self) -> None:
+        """Free the C scene now (also on leaving a with block); later uses
+        raise ValueError."""
         if self._p:
             lib.pd_scene_free(self._p)
             self._p = None
 
-    def __del__(self):
+    def __del__(self) -> None:
         try:
             self.close()
         except Exception:  # interpreter shutdown
             pass
 
-    def __enter__(self):
+    def __enter__(self) -> "Scene":
         return self
 
-    def __exit__(self, *exc):
+    def __exit__(self, *exc: Any) -> None:
         self.close()
 
     @property
@@ -83,28 +90,33 @@ class Scene:
         return self._p[0]
 
     @property
-    def n(self):
-        """Degrees of freedom."""
+    def n(self) -> int:
+        """Degrees of freedom (one per storey)."""
         return self._sc.n
 
     @property
-    def tend(self):
+    def tend(self) -> float:
         """The file's tend [s] (0: derived)."""
         return self._sc.tend
 
     @property
-    def Le(self):
+    def Le(self) -> float:
+        """The excitation's length scale Le = ap / wp^2 [m] (the Pi terms' unit)."""
         return lib.pd_scene_Le(self._p)
 
     @property
-    def wp(self):
+    def wp(self) -> float:
+        """The excitation's circular frequency wp = 2 pi / Tp [rad/s]."""
         return lib.pd_scene_wp(self._p)
 
     def _side(self, k):
         return "wall" if k == PD_WALL else s(self._sc.st[k].name)
 
     @property
-    def structures(self):
+    def structures(self) -> List[Result]:
+        """One Result per structure: name, storeys, T0 [s], xi, mass [kg] and
+        stiffness [N/m] per storey, dof (its first), damping, alpha [1/s] and
+        beta [s] (Rayleigh)."""
         sc = self._sc
         out = []
         for k in range(sc.nstruct):
@@ -118,7 +130,9 @@ class Scene:
         return out
 
     @property
-    def contacts(self):
+    def contacts(self) -> List[Result]:
+        """One Result per contact: a, b (structure names or 'wall'), level_a,
+        level_b (storeys, 1 = the first), gap [m], eps."""
         sc = self._sc
         out = []
         for a in range(sc.ncontact):
@@ -128,7 +142,9 @@ class Scene:
         return out
 
     @property
-    def excitation(self):
+    def excitation(self) -> Result:
+        """The ground motion: pulse (or the record's name), dir ('+x', '-x'),
+        ap [m/s^2], Tp [s]; a record's also record and scale."""
         x = self._sc.exc
         out = Result(pulse=s(x.record[0].name) if x.record else s(lib.pd_pulse_name(x.pulse)),
                      dir="+x" if x.dir > 0 else "-x", ap=x.ap, Tp=x.Tp)
@@ -137,8 +153,9 @@ class Scene:
             out["scale"] = x.scale
         return out
 
-    def opts(self, kw):
-        """The run options of the scheme keywords, resolved for this scene."""
+    def opts(self, kw: Dict[str, Any]) -> Tuple[Any, Any]:
+        """The run options (pd_run_opts) of the scheme keywords, as given and
+        resolved for this scene (dt, tend [s] completed)."""
         unknown = sorted(set(kw) - set(SCENE_OPTS))
         if unknown:
             raise TypeError("unexpected keyword argument(s) %s (a scene run takes %s)"
@@ -149,11 +166,15 @@ class Scene:
         self._method_by = have["method_by"] or "default"
         return o, out
 
-    def simulate(self, history=True, every=1, **opts):
+    def simulate(self, history: bool = True, every: Int = 1, **opts: Any) -> Result:
         """The run and its contact-free twin, as `pound simulate --scene F
-        --json`: per structure umax, u_pos, u_neg, drift, Pi1, umax_free, gamma
-        (one value per storey), per contact impacts, first_impact,
-        max_impulse, contact_time, approach, Pi3, chi; with history,
+        --json`: per structure (r.structures) umax, u_pos, u_neg, drift,
+        umax_free [m] and Pi1, gamma (one value per storey), T0 [s], Pi2; per
+        contact (r.contacts) impacts, first_impact [s], max_impulse [N s],
+        contact_time [s], approach [m], Pi3, chi; dt, tend [s], Le [m], ap
+        [m/s^2], Tp [s], impacts (all contacts), cpu_s [s of CPU].  opts: the
+        scheme keywords of simulate() (method, dt, tend, theta, ...).  With
+        history,
         r.history: step, t (N), x and v (N x dofs) [m, m/s], gap [m] and
         impulse [N s] (N x contacts), every every-th sample, the impulses
         summed since the last one kept (the CLI's -o file; t, x, v also as
@@ -171,8 +192,8 @@ class Scene:
         sm = _lib.PdSceneSummary()
         err = PdErr()
         try:
-            st = lib.pd_scene_summarize(self._p, o, sampler or _lib.SceneSampler(), None, sm,
-                                        err)
+            st = lib.pd_scene_summarize(self._p, o, sampler or _lib.SceneSampler(),  # type: ignore
+                                        None, sm, err)
             if h is not None and h.error is not None:
                 raise h.error
             _lib.check(st, err)
@@ -228,7 +249,7 @@ class Scene:
         _demand.scene_fields(out, sc, r)
         return out
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         if not self._p:
             return "<pound.Scene closed>"
         sc = self._sc
@@ -281,13 +302,15 @@ def _scene_sampler(h, n, m):
     return _lib.SceneSampler(sample)
 
 
-def scene(path):
+def scene(path: PathArg) -> Scene:
     """Read a scene file (JSON, docs/scenes.md): a pound.Scene."""
     return Scene(path)
 
 
-def simulate_scene(path, history=True, every=1, **opts):
-    """`pound simulate --scene path --json`: Scene(path).simulate(**opts)."""
+def simulate_scene(path: Union[PathArg, Scene], history: bool = True, every: Int = 1,
+                   **opts: Any) -> Result:
+    """`pound simulate --scene path --json`: Scene(path).simulate(**opts), the
+    keys and units of Scene.simulate (path may be a Scene, left open)."""
     sc = path if isinstance(path, Scene) else Scene(path)
     try:
         return sc.simulate(history=history, every=every, **opts)

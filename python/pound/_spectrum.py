@@ -6,6 +6,7 @@ the threads), the points from pd_spec_rows."""
 import ctypes
 import os
 import threading
+from typing import Any, Callable, Optional, Sequence, Union
 
 import numpy as np
 
@@ -14,6 +15,7 @@ from ._case import (CASE_KEYS, PD_METHOD_AUTO, Case, InputError, implied_method,
                     parse_dir, parse_name)
 from ._lib import PD_SPEC_MAX_LIST, PdErr, lib, s
 from ._osc import Result
+from ._types import Floats, Int, Names, Range
 
 # the keywords a spectrum takes besides its lists (no T0, Pi2, no_wall: it sweeps Pi2 and
 # runs the no-wall twins itself)
@@ -233,13 +235,19 @@ def _point(r, method):
         tend=r.tend, steps=r.steps, cpu_s=r.cpu_s)
 
 
-def spectrum(Pi2, linear=False, pulse=None, dir=None, ap=None, xi=None, Pi3=None, gap=None,
-             eps=None, dt_per_Tp=None, threads=None, on_point=None, **case):
+def spectrum(Pi2: Union[Range, Sequence[float]], linear: bool = False,
+             pulse: Optional[Names] = None,
+             dir: Optional[Union[Names, int, Sequence[int]]] = None, ap: Optional[Floats] = None,
+             xi: Optional[Floats] = None, Pi3: Optional[Floats] = None,
+             gap: Optional[Floats] = None, eps: Optional[Floats] = None,
+             dt_per_Tp: Optional[float] = None, threads: Optional[Int] = None,
+             on_point: Optional[Callable[[Result], Any]] = None, **case: Any) -> Result:
     """Pounding spectra, as `pound spectrum --Pi2 MIN:MAX:N ... --json`.
 
     Pi2: (MIN, MAX, N) or 'MIN:MAX:N', log-spaced (linear=True: equal steps).
     Lists (a value or a sequence; one curve per combination): pulse, dir,
-    ap (the dimensional view), xi, Pi3 or gap [m], eps.  Other keywords as
+    ap [m/s^2] (the dimensional view), xi, Pi3 or gap [m], eps.  dt_per_Tp:
+    steps per pulse period (dt = Tp / dt_per_Tp [s]).  Other keywords as
     for simulate(): Tp, record, scale, units, method, dt (or dt_per_Tp),
     tend, theta, ...
 
@@ -250,8 +258,10 @@ def spectrum(Pi2, linear=False, pulse=None, dir=None, ap=None, xi=None, Pi3=None
     stops the sweep: PoundError PD_ESTOPPED).  The numbers are the same
     either way, and the CLI's.
 
-    Returns a Result: Pi2 (N,), the arrays Pi1, gamma, chi, umax, umax_free,
-    impacts, ... of shape (curves, N), curves (a dict per curve: pulse, dir,
+    Returns a Result: Pi2 (N,), the arrays of shape (curves, N) Pi1 =
+    umax / Le, gamma, chi (dimensionless), umax, umax_free, u_toward, u_away,
+    gap [m], contact_time, first_impact, T0, dt, tend [s], impacts, steps
+    (counts), curves (a dict per curve: pulse, dir,
     ap, xi, Pi3 or gap, eps, label), points (the CLI's JSON points), runs,
     twins."""
     sp, k = build(Pi2, linear, pulse, dir, ap, xi, Pi3, gap, eps, dt_per_Tp, **case)
