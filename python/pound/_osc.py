@@ -185,7 +185,8 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
     and r.method_by say which and why], dt [min(Tp, T0)/2000], tend [Tp + 2 T0], theta [0.5],
     gamma [0.5], allow_unstable, no_accumulation, no_wall, kernel
     'auto'|'general', factor, lcp_solver, contact 'kelvin'|'hertz', kc,
-    kc_abs, rtol, atol, stepper.
+    kc_abs, rtol, atol, stepper; height [3] m and contact_duration [0.005] s
+    of the demands.
 
     Returns a Result with the keys of the CLI's JSON: umax, u_toward,
     u_away, umax_free [m]; Pi1 = umax / Le, gamma = umax / umax_free, chi =
@@ -193,7 +194,10 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
     steps (counts); first_impact, contact_time, dt, tend [s];
     first_impact_velocity, max_impact_velocity [m/s]; max_impulse per unit
     mass [m/s]; min_gap, gap [m]; ap [m/s^2], Tp, T0 [s]; cpu_s [s of
-    CPU]; method, method_by, pulse, dir, kernel (names).  With history,
+    CPU]; method, method_by, pulse, dir, kernel (names); the demands per
+    unit mass (docs/scenes.md, "Demands"): drift_ratio, acc_max [m/s^2],
+    shear_max, force_equiv, force_max [N/kg] (NaN: not a penalty method),
+    height [m], contact_duration [s].  With history,
     r.history: the arrays step, t, u, v, impulse, gap of every every-th
     step (the CLI's -o file: t [s], u [m], v [m/s], impulse per unit mass
     since the last sample [m/s], gap delta - u [m]), with t, u, v, impulse

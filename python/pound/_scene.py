@@ -172,8 +172,12 @@ class Scene:
         umax_free [m] and Pi1, gamma (one value per storey), T0 [s], Pi2; per
         contact (r.contacts) impacts, first_impact [s], max_impulse [N s],
         contact_time [s], approach [m], Pi3, chi; dt, tend [s], Le [m], ap
-        [m/s^2], Tp [s], impacts (all contacts), cpu_s [s of CPU].  opts: the
-        scheme keywords of simulate() (method, dt, tend, theta, ...).  With
+        [m/s^2], Tp [s], impacts (all contacts), cpu_s [s of CPU]; the demands
+        (docs/scenes.md, "Demands"): per structure storey_heights [m],
+        drift_ratio, acc_max [m/s^2], shear_max, base_shear_max [N], per
+        contact force_equiv, force_max [N] (NaN: not a penalty method), and
+        contact_duration [s].  opts: the scheme keywords of simulate()
+        (method, dt, tend, theta, ..., contact_duration).  With
         history,
         r.history: step, t (N), x and v (N x dofs) [m, m/s], gap [m] and
         impulse [N s] (N x contacts), every every-th sample, the impulses
