@@ -14,6 +14,7 @@ const char pd_cli_case_help[] =
     "  --T0 T   oscillator period, s  or  --Pi2 X = Tp/T0 [1]\n"
     "  --gap D  initial gap, m        or  --Pi3 X = gap wp^2/ap [0.05]\n"
     "  --eps E  restitution in [0,1] [0.5]    --xi Z   damping ratio in [0,1) [0.05]\n"
+    "  --height H  the oscillator's storey height, m, for its drift ratio [3]\n"
     "records (docs/records.md):\n"
     "  --record F    the ground acceleration of a record (PEER .AT2, COSMOS V2, or text\n"
     "                't a'): replaces the pulse; ap and Tp come from its fitted pulse\n"
@@ -37,6 +38,8 @@ const char pd_cli_case_help[] =
     "  --no-accumulation  event-driven: do not jump accumulations of impacts\n"
     "  --close-tol X [1e-10]  event-driven rows: contacts within X Le of zero at an impact\n"
     "           take part in it (simultaneous); counted in the output (docs/methods.md)\n"
+    "  --contact-duration TD [0.005]  s: the equivalent contact force pi I / (2 TD) of an\n"
+    "           impact of impulse I (a half-sine pulse; docs/scenes.md, \"Demands\")\n"
     "  --kernel auto|general [auto]  general: no fast path (scalar kernel, exact reference)\n"
     "  --factor auto|scalar|dense|cholmod [auto]  storage of the iteration matrix\n"
     "  --lcp-solver auto|lemke|structured|pgs [auto]  the contact LCP solver (docs/lcp.md)\n"
@@ -54,6 +57,8 @@ void pd_cli_case_init(pd_cli_case *a)
     a->opts = pd_run_default_opts();
     a->chain_ratio = 1.5;
     a->scale = 1.0;
+    a->height = PD_STOREY_HEIGHT;
+    a->opts.contact_duration = PD_CONTACT_DURATION;
 }
 
 void pd_cli_case_free(pd_cli_case *a)
@@ -141,7 +146,9 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
                        {"--atol", &a->opts.pen.atol, NULL, 0},
                        {"--chain-ratio", &a->chain_ratio, NULL, 1},
                        {"--scale", &a->scale, &a->have_scale, 0},
-                       {"--close-tol", &a->opts.close_tol, NULL, 0}};
+                       {"--close-tol", &a->opts.close_tol, NULL, 0},
+                       {"--height", &a->height, &a->have_height, 1},
+                       {"--contact-duration", &a->opts.contact_duration, NULL, 0}};
     /* flags that only one method takes choose it, unless --method says another */
     static const struct {
         const char *flag;
@@ -275,6 +282,12 @@ static int check_scheme(const pd_cli_case *a)
     if (!(o->close_tol >= 0.0 && o->close_tol <= 1.0))
         return pd_cli_usage_error("--close-tol: the closing tolerance must be in [0, 1] (in "
                                   "units of Le; got %.10g)", o->close_tol);
+    if (!(o->contact_duration > 0.0) || !isfinite(o->contact_duration))
+        return pd_cli_usage_error("--contact-duration: must be a finite number > 0 [s] "
+                                  "(got %.10g)", o->contact_duration);
+    if (!(a->height > 0.0) || !isfinite(a->height))
+        return pd_cli_usage_error("--height: the storey height must be a finite number > 0 "
+                                  "[m] (got %.10g)", a->height);
     return 0;
 }
 
@@ -464,6 +477,9 @@ static int case_finish(pd_cli_case *a)
                                   a->model_flag);
     if ((rc = check_scheme(a)))
         return rc;
+    if (a->chain && a->have_height)
+        return pd_cli_usage_error("--height: the oscillator's; a --chain's SDOFs have the "
+                                  "default storey height (%g m)", PD_STOREY_HEIGHT);
     if (a->scene_path)
         return a->record_path ? pd_cli_usage_error("--record: a scene names its record in its "
                                                    "excitation (docs/scenes.md)")

@@ -211,6 +211,14 @@ static void print_json(const sim_args *a, const pd_osc_summary *s)
     pd_json_num(&js, "max_impulse", s->r.max_impulse);
     pd_json_num(&js, "contact_time", s->r.contact_time);
     pd_json_num(&js, "min_gap", s->r.min_gap);
+    /* demands, per unit mass (docs/scenes.md, "Demands") */
+    pd_json_num(&js, "height", a->k.height);
+    pd_json_num(&js, "drift_ratio", s->r.umax / a->k.height);
+    pd_json_num(&js, "acc_max", s->r.acc_max);
+    pd_json_num(&js, "shear_max", s->r.acc_max); /* per unit mass: k u + c u' = m a_abs */
+    pd_json_num(&js, "force_equiv", s->r.force_equiv);
+    pd_json_num(&js, "force_max", s->r.force_max); /* NaN -> null: not compliant */
+    pd_json_num(&js, "contact_duration", s->r.contact_duration);
     pd_json_num(&js, "umax_free", s->free.umax);
     pd_json_num(&js, "gamma", s->gamma);
     pd_json_num(&js, "chi", s->chi);
@@ -273,6 +281,15 @@ static void print_text(const sim_args *a, const pd_osc_summary *s)
                s->r.impacts, s->r.first_impact, s->r.first_impact_velocity, s->r.contact_time);
     else
         printf("  impacts   = 0 (the oscillator never reaches the wall)\n");
+    printf("  demands   = drift ratio %.5g (height %g m), a_abs %.6g m/s^2 (= base shear per "
+           "unit mass, N/kg)\n", s->r.umax / a->k.height, a->k.height, s->r.acc_max);
+    if (s->r.impacts && isnan(s->r.force_max)) /* an impulsive method */
+        printf("  contact   = equivalent force %.6g N/kg (pi I / (2 td), td = %g s, "
+               "--contact-duration)\n", s->r.force_equiv, s->r.contact_duration);
+    else if (s->r.impacts)
+        printf("  contact   = equivalent force %.6g N/kg (pi I / (2 td), td = %g s, "
+               "--contact-duration), peak force %.6g N/kg\n", s->r.force_equiv,
+               s->r.contact_duration, s->r.force_max);
     printf("  cpu       = %.3g s\n", s->cpu_s);
 }
 
@@ -307,6 +324,13 @@ static int finish_output(const sim_args *a, const pd_osc_summary *s, pd_table_wr
                        NUM("first_impact", "s", s->r.first_impact),
                        NUM("max_impulse", "m/s", s->r.max_impulse),
                        NUM("contact_time", "s", s->r.contact_time),
+                       NUM("height", "m", a->k.height),
+                       NUM("drift_ratio", "1", s->r.umax / a->k.height),
+                       NUM("acc_max", "m/s^2", s->r.acc_max),
+                       NUM("shear_max", "N/kg", s->r.acc_max),
+                       NUM("force_equiv", "N/kg", s->r.force_equiv),
+                       NUM("force_max", "N/kg", s->r.force_max),
+                       NUM("contact_duration", "s", s->r.contact_duration),
                        NUM("umax_free", "m", s->free.umax),
                        NUM("gamma", "1", s->gamma),
                        NUM("steps", "1", (double)s->r.steps),
@@ -427,6 +451,7 @@ static void scene_json(const sim_args *a, const pd_scene *sc, const pd_scene_sum
     pd_json_int(&js, "tol_closed", r->tol_closed);
     pd_json_int(&js, "accumulations", r->accumulations);
     pd_json_num(&js, "close_tol", r->close_tol);
+    pd_json_num(&js, "contact_duration", r->contact_duration);
     pd_json_num(&js, "dt", r->dt);
     pd_json_num(&js, "theta", r->theta);
     pd_json_num(&js, "tend", r->tend);
@@ -453,6 +478,11 @@ static void scene_json(const sim_args *a, const pd_scene *sc, const pd_scene_sum
         pd_json_nums(&js, "u_pos", n, r->u_pos + o);
         pd_json_nums(&js, "u_neg", n, r->u_neg + o);
         pd_json_nums(&js, "drift", n, r->drift + o);
+        pd_json_nums(&js, "storey_heights", n, st->height);
+        pd_json_nums(&js, "drift_ratio", n, r->drift_ratio + o);
+        pd_json_nums(&js, "acc_max", n, r->acc_max + o);
+        pd_json_nums(&js, "shear_max", n, r->shear_max + o);
+        pd_json_num(&js, "base_shear_max", r->shear_max[o]);
         pd_json_nums(&js, "Pi1", n, s->Pi1 + o);
         pd_json_nums(&js, "umax_free", n, s->free.umax + o);
         pd_json_nums(&js, "gamma", n, s->gamma + o);
@@ -475,6 +505,8 @@ static void scene_json(const sim_args *a, const pd_scene *sc, const pd_scene_sum
         pd_json_num(&js, "max_impulse", r->max_impulse[c]);
         pd_json_num(&js, "contact_time", r->contact_time[c]);
         pd_json_num(&js, "approach", r->approach[c]);
+        pd_json_num(&js, "force_equiv", r->force_equiv[c]);
+        pd_json_num(&js, "force_max", r->force_max[c]); /* NaN -> null: not compliant */
         pd_json_num(&js, "chi", s->chi[c]);
         pd_json_end_object(&js);
     }
@@ -534,6 +566,17 @@ static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_sum
     if (sc->nstruct > TEXT_MAX_STRUCTURES)
         printf("  ... %d more structures (--json or -o for all)\n",
                sc->nstruct - TEXT_MAX_STRUCTURES);
+    printf("  demands (peaks; storey shear with damping, storey 1 = base shear):\n");
+    printf("  %-12s %7s %12s %12s %14s %14s\n", "structure", "storey", "height [m]",
+           "drift ratio", "a_abs [m/s^2]", "shear [N]");
+    for (int k = 0; k < sc->nstruct && k < TEXT_MAX_STRUCTURES; k++) {
+        const pd_structure *st = &sc->st[k];
+        for (int i = 0; i < st->storeys; i++) {
+            int d = st->dof + i;
+            printf("  %-12s %7d %12.4g %12.5g %14.6g %14.6g\n", i ? "" : st->name, i + 1,
+                   st->height[i], r->drift_ratio[d], r->acc_max[d], r->shear_max[d]);
+        }
+    }
     if (sc->ncontact)
         printf("  %-22s %6s %10s %8s %12s %14s %10s\n", "contact", "level", "gap [m]", "impacts",
                "first [s]", "max imp. [N s]", "chi");
@@ -547,6 +590,20 @@ static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_sum
     }
     if (sc->ncontact > TEXT_MAX_CONTACTS)
         printf("  ... %d more contacts (--json or -o for all)\n", sc->ncontact - TEXT_MAX_CONTACTS);
+    if (sc->ncontact)
+        printf("  %-22s %18s %18s\n", "contact forces", "equivalent [N]", "peak (penalty) [N]");
+    for (int c = 0; c < sc->ncontact && c < TEXT_MAX_CONTACTS; c++) {
+        const pd_contact *ct = &sc->ct[c];
+        char pair[2 * PD_NAME_MAX + 8];
+        snprintf(pair, sizeof pair, "%s-%s", side_name(sc, ct->a), side_name(sc, ct->b));
+        char peak[32] = "-"; /* an impulsive method: no force history */
+        if (!isnan(r->force_max[c]))
+            snprintf(peak, sizeof peak, "%.6g", r->force_max[c]);
+        printf("  %-22s %18.6g %18s\n", pair, r->force_equiv[c], peak);
+    }
+    if (sc->ncontact)
+        printf("  (equivalent: pi I / (2 td), a half-sine pulse of td = %g s, --contact-duration)\n",
+               r->contact_duration);
     printf("  cpu       = %.3g s (the run and its contact-free twin)\n", s->cpu_s);
 }
 

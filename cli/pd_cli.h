@@ -30,6 +30,8 @@ typedef struct pd_cli_case {
     pd_osc c;
     pd_run_opts opts;
     double T0, gap; /* dimensional forms when given */
+    double height;  /* --height: the oscillator's storey height [m] (drift ratio) */
+    int have_height;
     int have_T0, have_Pi2, have_gap, have_Pi3, have_dt, have_tend, have_kc;
     const char *model_flag; /* the first model flag given (refused with --scene) */
     const char *scene_path; /* --scene F */

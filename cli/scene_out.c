@@ -341,6 +341,7 @@ static int put_run(pd_scene_writer *w, const pd_scene_run_info *ri)
            put_num(w, f, "", "tol_closed", (double)r->tol_closed, "1") ||
            put_num(w, f, "", "accumulations", (double)r->accumulations, "1") ||
            put_num(w, f, "", "close_tol", r->close_tol, "Le") ||
+           put_num(w, f, "", "contact_duration", r->contact_duration, "s") ||
            put_num(w, f, "", "cpu_s", ri->sum->cpu_s, "s");
 }
 
@@ -371,6 +372,11 @@ static int put_structure(pd_scene_writer *w, const pd_scene_summary *sum, int s)
          put_nums(w, g, prefix, "u_pos", k, sum->r.u_pos + o, "m") ||
          put_nums(w, g, prefix, "u_neg", k, sum->r.u_neg + o, "m") ||
          put_nums(w, g, prefix, "drift", k, sum->r.drift + o, "m") ||
+         put_nums(w, g, prefix, "storey_heights", k, st->height, "m") ||
+         put_nums(w, g, prefix, "drift_ratio", k, sum->r.drift_ratio + o, "1") ||
+         put_nums(w, g, prefix, "acc_max", k, sum->r.acc_max + o, "m/s^2") ||
+         put_nums(w, g, prefix, "shear_max", k, sum->r.shear_max + o, "N") ||
+         put_num(w, g, prefix, "base_shear_max", sum->r.shear_max[o], "N") ||
          put_nums(w, g, prefix, "Pi1", k, sum->Pi1 + o, "1") ||
          put_nums(w, g, prefix, "umax_free", k, sum->free.umax + o, "m") ||
          put_nums(w, g, prefix, "gamma", k, sum->gamma + o, "1");
@@ -405,7 +411,9 @@ static int put_contact(pd_scene_writer *w, const pd_scene_summary *sum, int a)
          put_num(w, g, prefix, "first_impact", sum->r.first_impact[a], "s") ||
          put_num(w, g, prefix, "max_impulse", sum->r.max_impulse[a], "N s") ||
          put_num(w, g, prefix, "contact_time", sum->r.contact_time[a], "s") ||
-         put_num(w, g, prefix, "approach", sum->r.approach[a], "m");
+         put_num(w, g, prefix, "approach", sum->r.approach[a], "m") ||
+         put_num(w, g, prefix, "force_equiv", sum->r.force_equiv[a], "N") ||
+         put_num(w, g, prefix, "force_max", sum->r.force_max[a], "N");
     if (g >= 0 && H5Gclose(g) < 0)
         rc = -1;
     return rc;

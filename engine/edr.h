@@ -229,7 +229,7 @@ struct pd_edr {
     pd_lcp_solver *dsolver;    /* the clusters' small dense LCPs */
     int *epos;                 /* an event's contacts between clusters (g_ct indices) */
     double *qtmp, *ztmp;       /* the clusters' LCP data */
-    double *ev_vminus, *ev_vplus;
+    double *ev_vminus, *ev_vplus, *ev_x;
     /* scratch */
     int *stack, *pe, *pdof;    /* trees: scratch; per dof its parent edge and dof */
     int *bfs_next;             /* per dof: the next in its tree's breadth-first order */

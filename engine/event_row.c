@@ -984,8 +984,10 @@ static int report(pd_edr *r, double t, pd_edr_kind kind, int acc)
 {
     if (!r->o.on_event)
         return 0;
-    for (int k = 0; k < r->ngd; k++)
+    for (int k = 0; k < r->ngd; k++) {
         r->ev_vplus[k] = r->gv[r->g_dof[k]];
+        r->ev_x[k] = r->gx[r->g_dof[k]];
+    }
     pd_edr_event ev = {.t = t,
                        .kind = kind,
                        .ncontacts = r->ngc,
@@ -997,6 +999,7 @@ static int report(pd_edr *r, double t, pd_edr_kind kind, int acc)
                        .dofs = r->g_dof,
                        .v_minus = r->ev_vminus,
                        .v_plus = r->ev_vplus,
+                       .x = r->ev_x,
                        .accumulation = acc};
     return r->o.on_event(&ev, r->o.on_event_ctx);
 }
@@ -1758,7 +1761,7 @@ void pd_edr_free(pd_edr *r)
                       r->held_tail, r->excluded, r->guess, r->epos, r->qtmp, r->ztmp, r->pos_in, r->Dval, r->Dcol, r->Drow,
                       r->stack, r->pe, r->pdof, r->bfs_next, r->ceta, r->cmu, r->cvy, r->ext, r->nimp, r->crow, r->crow_c, r->keybuf, r->uf, r->gblk,
                       r->newcl, r->plist, r->dofc_ptr, r->dofc, r->loc, r->wk, r->mctx,
-                      r->mscan, r->mprev, r->ev_vminus, r->ev_vplus, r->st.q,
+                      r->mscan, r->mprev, r->ev_vminus, r->ev_vplus, r->ev_x, r->st.q,
                       r->st.v, r->st.P, r->st.g, r->st.active, r->st.acc};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(arrays[k]);
@@ -2037,7 +2040,7 @@ pd_edr *pd_edr_alloc(const pd_model *md, const pd_piecewise_force *F, const pd_e
         !ALLOC(r->keybuf, 2 * (nb + m + 1)) || !ALLOC(r->uf, nb) || !ALLOC(r->gblk, nb) ||
         !ALLOC(r->newcl, nb) || !ALLOC(r->plist, nb) || !ALLOC(r->loc, n) || !ALLOC(r->wk, 8L * n) ||
         !ALLOC(r->mctx, nf) || !ALLOC(r->mscan, nf) || !ALLOC(r->mprev, nf) ||
-        !ALLOC(r->ev_vminus, n) || !ALLOC(r->ev_vplus, n) ||
+        !ALLOC(r->ev_vminus, n) || !ALLOC(r->ev_vplus, n) || !ALLOC(r->ev_x, n) ||
         !ALLOC(r->st.q, n) || !ALLOC(r->st.v, n) || !ALLOC(r->st.P, m) || !ALLOC(r->st.g, m) ||
         !ALLOC(r->st.active, m) || !ALLOC(r->st.acc, n))
         goto nomem;

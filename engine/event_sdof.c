@@ -497,7 +497,9 @@ pd_ed_opts pd_ed_default_opts(void)
                         .max_events = 10000000L,
                         .max_burst = 100000L,
                         .length_scale = 1.0,
-                        .scan_divisions = 64};
+                        .scan_divisions = 64,
+                        .on_impact = NULL,
+                        .on_impact_ctx = NULL};
 }
 
 /* After an impact at t with post-impact speed vp (<= 0): 1 when the
@@ -544,6 +546,8 @@ static int impact(ed_run *ed, int j, double t_hit, double vn, double tb, double 
                           t_hit, ed->burst - 1,
                           ed->o->no_accumulation ? " (accumulation handling is off)" : "");
     *v = -ed->p->e * vn;
+    if (ed->o->on_impact)
+        ed->o->on_impact(t_hit, vn, *v, ed->o->on_impact_ctx);
     if (settle(ed, j, t_hit, *v, tb, &t_rest)) {
         ed_origin o = {.j = j, .t = t_hit, .x = ed->p->delta, .v = 0.0};
         emit(ed, &o, t_rest, 1);

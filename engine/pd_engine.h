@@ -438,6 +438,7 @@ typedef struct pd_edr_event {
     int ndofs;             /* the dofs of the clusters involved */
     const int *dofs;
     const double *v_minus, *v_plus; /* their velocities before and after */
+    const double *x;       /* their positions at t */
     int accumulation;      /* an accumulation of impacts was jumped here */
 } pd_edr_event;
 
@@ -548,10 +549,14 @@ typedef struct pd_ed_opts {
                              v+^2 / (2 a) is below 1e-10 * length_scale (> 0):
                              the motion left out stays that close to the wall */
     int scan_divisions;   /* bracketing grid: shortest period / this, >= 1 */
+    /* optional: every impact at t with the approach speed vn and the rebound
+     * -e vn (before an accumulation jumped or a rest begins) */
+    void (*on_impact)(double t, double vn, double v_plus, void *ctx);
+    void *on_impact_ctx;
 } pd_ed_opts;
 
 /* t_end 0 (must be set), t_measure 0, h_out 0, accumulations jumped, 10^7
- * events, bursts of 10^5, length scale 1, 64 scan divisions. */
+ * events, bursts of 10^5, length scale 1, 64 scan divisions, no on_impact. */
 PD_API pd_ed_opts pd_ed_default_opts(void);
 
 typedef struct pd_ed_result {

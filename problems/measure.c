@@ -55,7 +55,9 @@ int pd_measure_run(const pd_osc *c, const pd_run_opts *o, const pd_trace *ref, d
     /* its cost without the sampling (the penalty method integrates to every
      * sample time; the work-precision chart compares bare runs) */
     pd_osc_result timed;
-    if ((rc = pd_osc_run(c, o, NULL, NULL, &timed, err)))
+    pd_run_opts bare = *o;
+    bare.no_demands = 1;
+    if ((rc = pd_osc_run(c, &bare, NULL, NULL, &timed, err)))
         return rc;
     out->r.cpu_s = timed.cpu_s;
     return PD_OK;
@@ -71,8 +73,10 @@ int pd_measure_reference(const pd_osc *c, const pd_run_opts *o, pd_trace *ref,
     ref->n = 0;
     if ((rc = pd_osc_reference(c, o, record_u, ref, res, err)))
         return rc;
-    /* its cost without the sampling */
-    if ((rc = pd_osc_reference(c, o, NULL, NULL, &timed, err)))
+    /* its cost without the sampling (nor the demands) */
+    pd_run_opts bare = *o;
+    bare.no_demands = 1;
+    if ((rc = pd_osc_reference(c, &bare, NULL, NULL, &timed, err)))
         return rc;
     res->cpu_s = timed.cpu_s;
     if (!(res->umax > 0.0))

@@ -16,6 +16,7 @@
 
 #include "osc_priv.h"
 #include "pd_null.h"
+#include "demand.h"
 #include "pd_problems.h"
 
 #define OSC_PEN_KC_W0 1e4    /* the default contact stiffness: at least this * w0^2, ... */
@@ -35,6 +36,9 @@ typedef struct pen_track {
     int m;                        /* 0: no wall */
     double C, K, Pi3, tau_measure;
     double xmax, xtoward, xaway, xpeak;
+    pd_demand_osc dem;            /* the absolute acceleration's peak */
+    double fpeak;                 /* the largest element force */
+    int no_demands;
     long impacts;
     double first_tau, first_v, vimp_max, contact_tau;
     int have_prev, pactive;
@@ -194,6 +198,11 @@ static int track_step(const pd_state *st, void *ctx)
     if (tr->have_prev && tau > tr->pt)
         close_step(tr, tau, x, v, lam, active);
     record_x(tr, tau, x);
+    double a = pd_osc_shape(tr->c, tau, -1) - tr->C * v - tr->K * x - lam;
+    if (!tr->no_demands)
+        pd_demand_osc_note(&tr->dem, tau, x, v, &a, !active && !tr->pactive); /* free steps */
+    if (active)
+        tr->fpeak = fmax(tr->fpeak, lam);
     if (active && !tr->pactive) { /* an element engaged at a located closing */
         tr->episode = 0.0;
         tr->impacts++;
@@ -273,6 +282,8 @@ static void fill_result(const pen_track *tr, const pd_run_opts *o,
     res->theta = NAN;
     res->gamma = NAN;
     res->kernel = pr->stepper ? pr->stepper : "penalty";
+    pd_demand_osc_finish(res, o, tr->no_demands ? NAN : tr->dem.peak * tr->c->ap,
+                         tr->m ? tr->fpeak * tr->c->ap : NAN);
 }
 
 int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
@@ -325,6 +336,8 @@ int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler samp
     tr.K = K;
     tr.Pi3 = c->Pi3;
     tr.tau_measure = tau_measure;
+    tr.dem = (pd_demand_osc){.C = C, .K = K, .tau_measure = tau_measure};
+    tr.no_demands = o.no_demands;
     tr.first_tau = tr.first_v = NAN;
     tr.Le = pd_osc_Le(c);
     tr.wp = wp;

@@ -12,6 +12,7 @@
 #include "osc_priv.h"
 #include "osc_track.h"
 #include "pd_null.h"
+#include "demand.h"
 #include "pd_problems.h"
 
 
@@ -238,6 +239,8 @@ static void scene_force(double tau, int side, double *F, void *ctx)
 typedef struct tracker {
     pd_osc_track m;
     double Le, vscale, wp;
+    pd_demand_osc dem;    /* the absolute acceleration's peak (Pi units) */
+    int demands;          /* 0: not measured (pd_run_opts.no_demands) */
     pd_osc_sampler sampler;
     void *sampler_ctx;
 } tracker;
@@ -308,6 +311,8 @@ void pd_osc_track_result(const pd_osc_track *tr, const pd_osc *c, double dt, lon
     res->min_gap = tr->min_gap * Le;
     res->steps = steps;
     res->dt = dt;
+    /* demands: not measured here (the single runs measure and set them) */
+    res->acc_max = res->force_max = res->force_equiv = res->contact_duration = NAN;
 }
 
 /* Per step: the measurements, then the sample. */
@@ -316,6 +321,8 @@ static int observe(const pd_state *st, void *ctx)
     tracker *tr = ctx;
     double x = st->q[0], v = st->v[0], P = st->P[0];
     pd_osc_track_step(&tr->m, st->step, st->t, x, v, P);
+    if (tr->demands)
+        pd_demand_osc_note(&tr->dem, st->t, x, v, NULL, 0); /* the steps' own: as umax */
     if (tr->sampler) {
         pd_osc_sample smp = {.step = st->step,
                              .t = st->t / tr->wp,
@@ -345,7 +352,8 @@ static inline double osc_force(const pd_osc *c, double tau, int side)
 }
 
 static int simulate_scalar(const pd_osc *c, const pd_model *md, const pd_mj_opts *mo,
-                           long nsteps, pd_osc_track *tr, long *steps, pd_err *err)
+                           long nsteps, pd_osc_track *tr, pd_demand_osc *dem, long *steps,
+                           pd_err *err)
 {
     const double h = mo->h, th = mo->theta, hgamma = h * mo->gamma, t0 = 0.0;
     const double tol = 1e-9 * h;
@@ -359,6 +367,8 @@ static int simulate_scalar(const pd_osc *c, const pd_model *md, const pd_mj_opts
     double F0 = osc_force(c, t0, +1);
     long k = 0;
     pd_osc_track_step(tr, 0, t0, q, v, P);
+    if (dem)
+        pd_demand_osc_note_state(dem, t0, q, v);
     for (long i = 0; i < nsteps && i < OSC_FORCE_AHEAD; i++)
         F[i] = osc_force(c, t0 + (double)(i + 1) * h, -1);
     for (; k < nsteps; k++) {
@@ -377,6 +387,8 @@ static int simulate_scalar(const pd_osc *c, const pd_model *md, const pd_mj_opts
                               k + 1, 0);
         }
         pd_osc_track_step(tr, k + 1, t1, q, v, P);
+        if (dem)
+            pd_demand_osc_note_state(dem, t1, q, v);
     }
     *steps = k;
     return PD_OK;
@@ -423,19 +435,23 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
 
     double cpu0 = pd_cpu_seconds();
     double wp = pd_osc_wp(c), Le = pd_osc_Le(c);
-    tracker tr = {.Le = Le, .vscale = Le * wp, .wp = wp, .sampler = sampler, .sampler_ctx = ctx};
+    tracker tr = {.Le = Le, .vscale = Le * wp, .wp = wp, .demands = !o.no_demands,
+                  .sampler = sampler, .sampler_ctx = ctx};
     pd_osc_track_init(&tr.m, c, mo.h, wp * pd_osc_measure_start(c, o.tend));
+    tr.dem = (pd_demand_osc){.C = C, .K = K, .tau_measure = tr.m.tau_measure - 0.5 * mo.h};
     if (!sampler && mo.kernel == PD_KERNEL_AUTO && mo.factor == PD_FACTOR_AUTO) {
         /* the scalar kernel, which pd_mj would choose (n = 1, m <= 1) */
         long steps = 0;
         if ((rc = pd_model_check(&model, err)) || (rc = pd_mj_check_opts(&mo, err)))
             return rc;
-        rc = simulate_scalar(c, &model, &mo, nsteps, &tr.m, &steps, err);
+        rc = simulate_scalar(c, &model, &mo, nsteps, &tr.m, tr.demands ? &tr.dem : NULL, &steps,
+                             err);
         pd_osc_track_result(&tr.m, c, o.dt, steps, res);
         res->tend = o.tend;
         res->theta = mo.theta;
         res->gamma = mo.gamma;
         res->kernel = "scalar";
+        pd_demand_osc_finish(res, &o, tr.demands ? tr.dem.peak * c->ap : NAN, NAN);
         res->cpu_s = pd_cpu_seconds() - cpu0;
         return rc;
     }
@@ -449,6 +465,7 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
     res->gamma = mo.gamma;
     res->kernel = pd_mj_kernel_name(mj);
     pd_mj_free(mj);
+    pd_demand_osc_finish(res, &o, tr.demands ? tr.dem.peak * c->ap : NAN, NAN);
     res->cpu_s = pd_cpu_seconds() - cpu0;
     return rc;
 }
@@ -456,6 +473,10 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
 /* Sampler bridge: Pi units to metres and seconds. */
 typedef struct ref_bridge {
     double wp, Le, vscale, Pi3;
+    const pd_osc *c;
+    pd_demand_osc dem;    /* the absolute acceleration's peak (Pi units) */
+    long impacts, impacts_prev; /* impacts seen, and by the previous sample */
+    int rest_prev;        /* the previous sample was resting on the wall */
     long step;
     pd_osc_sampler sampler;
     void *ctx;
@@ -464,14 +485,44 @@ typedef struct ref_bridge {
 static int ref_sample(double tau, double x, double v, int in_contact, void *ctx)
 {
     ref_bridge *b = ctx;
+    /* free flight: x'' = f - C x' - K x; the interval since the previous sample
+     * is smooth when it held no impact and no rest */
+    double a = in_contact ? 0.0 : pd_osc_shape(b->c, tau, -1) - b->dem.C * v - b->dem.K * x;
+    int smooth = !in_contact && !b->rest_prev && b->impacts == b->impacts_prev;
+    pd_demand_osc_note(&b->dem, tau, x, v, in_contact ? NULL : &a, smooth);
+    b->impacts_prev = b->impacts;
+    b->rest_prev = in_contact;
+    if (!b->sampler) {
+        b->step++;
+        return 0;
+    }
     pd_osc_sample s = {.step = b->step++,
                        .t = tau / b->wp,
                        .u = x * b->Le,
                        .v = v * b->vscale,
                        .impulse = 0.0,
                        .gap = (b->Pi3 - x) * b->Le};
-    (void)in_contact;
     return b->sampler(&s, b->ctx);
+}
+
+/* An impact: the demand at the wall with the velocities before and after it. */
+static void ref_impact(double tau, double vn, double v_plus, void *ctx)
+{
+    ref_bridge *b = ctx;
+    pd_demand_osc *d = &b->dem;
+    b->impacts++;
+    if (tau >= d->tau_measure)
+        d->peak = pd_max(d->peak, pd_max(fabs(d->C * vn + d->K * b->Pi3),
+                                         fabs(d->C * v_plus + d->K * b->Pi3)));
+}
+
+/* The reference's demand grid without a sampler: the largest whole multiple
+ * of dt with OSC_DEMAND_GRID points per shortest period (of T0 and Tp). */
+#define OSC_DEMAND_GRID 128.0
+static double ref_demand_grid(const pd_osc *c, double dt)
+{
+    double k = floor(fmin(c->Tp, pd_osc_T0(c)) / (OSC_DEMAND_GRID * dt));
+    return (k > 1.0 ? k : 1.0) * dt;
 }
 
 int pd_osc_pieces(const pd_osc *c, pd_sine_piece **pieces, int *npieces, pd_err *err)
@@ -545,12 +596,20 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     pd_ed_opts eo = pd_ed_default_opts();
     eo.t_end = wp * o.tend;
     eo.t_measure = wp * pd_osc_measure_start(c, o.tend);
-    eo.h_out = sampler ? PD_TWO_PI * (o.dt / c->Tp) : 0.0;
+    /* the grid: samples every dt; else the demand's states (with its impacts) */
+    eo.h_out = sampler ? PD_TWO_PI * (o.dt / c->Tp)
+               : o.no_demands ? 0.0
+                              : PD_TWO_PI * (ref_demand_grid(c, o.dt) / c->Tp);
+    eo.on_impact = o.no_demands ? NULL : ref_impact;
     eo.no_accumulation = o.no_accumulation;
-    ref_bridge bridge = {.wp = wp, .Le = Le, .vscale = Le * wp, .Pi3 = c->Pi3, .step = 0,
-                         .sampler = sampler, .ctx = ctx};
+    ref_bridge bridge = {.wp = wp, .Le = Le, .vscale = Le * wp, .Pi3 = c->Pi3, .c = c,
+                         .dem = {.C = 2.0 * c->xi * c->Pi2, .K = c->Pi2 * c->Pi2,
+                                 .tau_measure = eo.t_measure},
+                         .step = 0, .sampler = sampler, .ctx = ctx};
+    eo.on_impact_ctx = &bridge;
     double cpu0 = pd_cpu_seconds();
-    rc = pd_ed_sdof_run(&prob, 0.0, 0.0, &eo, sampler ? ref_sample : NULL, &bridge, &er, err);
+    rc = pd_ed_sdof_run(&prob, 0.0, 0.0, &eo, eo.h_out > 0.0 ? ref_sample : NULL, &bridge, &er,
+                        err);
     free(pieces);
     memset(res, 0, sizeof *res);
     res->umax = er.xmax * Le;
@@ -570,6 +629,7 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     res->theta = NAN;
     res->gamma = NAN;
     res->kernel = "event";
+    pd_demand_osc_finish(res, &o, o.no_demands ? NAN : bridge.dem.peak * c->ap, NAN);
     res->cpu_s = pd_cpu_seconds() - cpu0;
     return rc;
 }
@@ -642,6 +702,7 @@ int pd_osc_summarize(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     memset(s, 0, sizeof *s);
     double cpu0 = pd_cpu_seconds();
     twin.no_wall = 1;
+    twin.no_demands = 1; /* the twin's figure is umax */
     if ((rc = pd_osc_run(c, opts, sampler, ctx, &s->r, err)) ||
         (rc = pd_osc_run(c, &twin, NULL, NULL, &s->free, err)))
         return rc;

@@ -221,7 +221,29 @@ typedef struct pd_run_opts {
     void *on_lcp_ctx;
     double close_tol;   /* event-driven rows: at an impact, contacts whose gap is within
                            close_tol Le are closed too (simultaneous); >= 0 */
+    double contact_duration; /* td [s] of the equivalent contact force pi I / (2 td) of an
+                                impact of impulse I (a half-sine pulse); 0 = PD_CONTACT_DURATION */
+    int no_demands;     /* 1: do not measure the peak accelerations and shears (NAN): the
+                           sweeps, the contact-free twins and the timed re-runs, whose
+                           figures do not use them (the exact references sample a grid
+                           for them) */
 } pd_run_opts;
+
+/* ---- demand parameters (docs/scenes.md, "Demands") ------------------------ *
+ * What earthquake engineers read off a run, per storey and per contact:
+ *   absolute floor acceleration, its smooth part  a_abs = u'' + a_g = -M^-1 (C u' + K u)
+ *     (the contact forces are impulses, reported as such);
+ *   storey shear V_k = sum over the floors i >= k of (C u' + K u)_i = -sum m_i a_abs_i:
+ *     spring plus damping (with Rayleigh's mass-proportional part of the floors above),
+ *     so that the base shear V_1 balances the floors' inertia forces; an SDOF: k u + c u';
+ *   drift ratio = peak interstorey drift / storey height;
+ *   equivalent contact force of an impulse I over a half-sine pulse of duration td:
+ *     F = pi I / (2 td); the actual peak contact force where a compliant method ran. */
+#define PD_CONTACT_DURATION 0.005 /* default td [s] */
+#define PD_STOREY_HEIGHT 3.0      /* default storey height [m] */
+
+/* pi I / (2 td): the peak of a half-sine force pulse of impulse I and duration td. */
+PD_API double pd_equivalent_force(double impulse, double td);
 
 /* The default closing tolerance of the event-driven reference for rows
  * [in Le]: gaps within it at an impact take part in it.  The same scale
@@ -345,6 +367,14 @@ typedef struct pd_osc_result {
     double dt, tend, theta, gamma;
     double cpu_s;
     const char *kernel;   /* "scalar", "general", "event", or the penalty stepper */
+    /* demands over the measuring window (pd_run_opts, "demand parameters"), per unit
+     * mass; NAN where not measured (the batched runs of pd_osc_run_stream) */
+    double acc_max;       /* peak |2 xi w0 u' + w0^2 u|: the absolute acceleration's smooth
+                             part [m/s^2], and the base shear per unit mass [N/kg] */
+    double force_max;     /* peak contact force per unit mass [N/kg] (penalty, newmark;
+                             NAN for the impulsive methods) */
+    double force_equiv;   /* pd_equivalent_force(max_impulse, td) [N/kg] */
+    double contact_duration; /* the td used [s] */
 } pd_osc_result;
 
 /* The method a run of (c, o) takes: o's, or for PD_METHOD_AUTO the exact
@@ -488,6 +518,7 @@ typedef struct pd_structure {
     double Tmin;         /* shortest natural period (the highest mode) [s] */
     double alpha, beta;  /* C = alpha M + beta K */
     int dof;             /* first dof of the structure in the scene's model */
+    double *height;      /* storeys entries: storey heights [m] (PD_STOREY_HEIGHT unless set) */
 } pd_structure;
 
 typedef struct pd_contact {
@@ -541,6 +572,9 @@ PD_API int pd_scene_add_uniform(pd_scene *sc, const char *name, int storeys, dou
 /* Damping of the last structure added: the model and (Rayleigh) its modes. */
 PD_API int pd_scene_set_damping(pd_scene *sc, pd_damping damping, int mode1, int mode2,
                                 pd_err *err);
+/* Storey heights of the last structure added (storeys entries, each finite
+ * and > 0 [m]; the message names "storey_heights"). */
+PD_API int pd_scene_set_heights(pd_scene *sc, const double *heights, pd_err *err);
 /* A contact; a or b PD_WALL for a wall (level 0 there). */
 PD_API int pd_scene_add_contact(pd_scene *sc, int a, int level_a, int b, int level_b, double gap,
                                 double eps, int entry, pd_err *err);
@@ -630,6 +664,13 @@ typedef struct pd_scene_result {
     double close_tol;      /* the closing tolerance used [in Le] (NAN: not event-driven) */
     double dt, tend, theta, cpu_s;
     const char *method, *kernel, *factor, *lcp_solver;
+    /* demands over the measuring window (pd_run_opts, "demand parameters"): */
+    double *acc_max;       /* n: peak |a_abs| per floor [m/s^2] */
+    double *shear_max;     /* n: peak |V_k| per storey [N] (storey 1: the base shear) */
+    double *drift_ratio;   /* n: drift / storey height [-] */
+    double *force_max;     /* m: peak contact force [N] (penalty, newmark; NAN otherwise) */
+    double *force_equiv;   /* m: pd_equivalent_force(max_impulse, td) [N] */
+    double contact_duration; /* the td used [s] */
 } pd_scene_result;
 
 /* Arrays for the finished scene sc (PD_EINVAL before pd_scene_finish). */

@@ -57,7 +57,9 @@ pd_run_opts pd_run_default_opts(void)
                                  .stepper = "rk8pd"},
                          .on_lcp = NULL,
                          .on_lcp_ctx = NULL,
-                         .close_tol = PD_CLOSE_TOL};
+                         .close_tol = PD_CLOSE_TOL,
+                         .contact_duration = 0.0,
+                         .no_demands = 0};
 }
 
 int pd_run_opts_check(const pd_run_opts *o, pd_err *err)
@@ -84,6 +86,10 @@ int pd_run_opts_check(const pd_run_opts *o, pd_err *err)
     if (!(o->close_tol >= 0.0 && o->close_tol <= 1.0))
         return pd_err_set(err, PD_EINVAL, "close-tol: the closing tolerance must be in [0, 1] "
                           "(in units of Le; got %g)", o->close_tol);
+    if (!(o->contact_duration >= 0.0) || !isfinite(o->contact_duration))
+        return pd_err_set(err, PD_EINVAL, "contact-duration: the duration of the equivalent "
+                          "contact force must be a finite number > 0 [s], or 0 for the default "
+                          "(got %g)", o->contact_duration);
     const pd_penalty_setup *p = &o->pen;
     if (p->law != PD_PENALTY_KELVIN && p->law != PD_PENALTY_HERTZDAMP)
         return pd_err_set(err, PD_EINVAL, "contact: unknown contact law %d", (int)p->law);

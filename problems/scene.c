@@ -33,6 +33,7 @@ void pd_scene_free(pd_scene *sc)
     for (int s = 0; s < sc->nstruct; s++) {
         free(sc->st[s].mass);
         free(sc->st[s].stiffness);
+        free(sc->st[s].height);
     }
     free(sc->st);
     free(sc->ct);
@@ -58,11 +59,15 @@ pd_scene *pd_scene_copy(const pd_scene *sc)
             c->st[s] = (pd_structure){.storeys = st->storeys,
                                       .mass = c->st[s].mass,
                                       .stiffness = c->st[s].stiffness,
+                                      .height = c->st[s].height,
                                       .xi = st->xi,
                                       .damping = st->damping,
                                       .modes = {st->modes[0], st->modes[1]}};
-        if (ok)
+        if (ok) {
             memcpy(c->st[s].name, st->name, sizeof st->name);
+            if (st->height)
+                memcpy(c->st[s].height, st->height, (size_t)st->storeys * sizeof(double));
+        }
     }
     for (int a = 0; ok && a < sc->ncontact; a++) {
         const pd_contact *ct = &sc->ct[a];
@@ -190,13 +195,17 @@ static pd_structure *new_structure(pd_scene *sc, const char *name, int storeys, 
     memset(st, 0, sizeof *st);
     st->mass = malloc((size_t)storeys * sizeof(double));
     st->stiffness = malloc((size_t)storeys * sizeof(double));
-    if (!st->mass || !st->stiffness) {
+    st->height = malloc((size_t)storeys * sizeof(double));
+    if (!st->mass || !st->stiffness || !st->height) {
         free(st->mass);
         free(st->stiffness);
+        free(st->height);
         pd_err_set(err, PD_ENOMEM, "out of memory for structure '%s'", name);
         return NULL;
     }
     snprintf(st->name, sizeof st->name, "%s", name);
+    for (int i = 0; i < storeys; i++)
+        st->height[i] = PD_STOREY_HEIGHT;
     st->storeys = storeys;
     st->xi = xi;
     st->damping = PD_DAMPING_RAYLEIGH;
@@ -306,6 +315,22 @@ int pd_scene_set_damping(pd_scene *sc, pd_damping damping, int mode1, int mode2,
     st->modes[0] = mode1;
     st->modes[1] = mode2;
     sc->finished = 0;
+    return PD_OK;
+}
+
+int pd_scene_set_heights(pd_scene *sc, const double *heights, pd_err *err)
+{
+    if (!sc || !heights)
+        return PD_NULL_ARG(err, !sc ? "sc" : "heights");
+    if (sc->nstruct == 0)
+        return pd_err_set(err, PD_EINVAL, "storey_heights: no structure to apply them to");
+    pd_structure *st = &sc->st[sc->nstruct - 1];
+    for (int i = 0; i < st->storeys; i++)
+        if (!positive(heights[i]))
+            return pd_err_set(err, PD_EINVAL,
+                              "storey_heights: storey %d has height %g, must be a finite "
+                              "number > 0 [m]", i + 1, heights[i]);
+    memcpy(st->height, heights, (size_t)st->storeys * sizeof(double));
     return PD_OK;
 }
 

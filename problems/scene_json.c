@@ -473,6 +473,50 @@ static int read_damping(loader *L, pd_scene *sc, json_t *st, const char *path)
     return PD_OK;
 }
 
+/* "storey_heights" of the last structure at path: a number (every storey)
+ * or one per storey, each finite and > 0 [m]; absent: PD_STOREY_HEIGHT. */
+static int read_heights(loader *L, pd_scene *sc, json_t *st, const char *path)
+{
+    json_t *h = json_object_get(st, "storey_heights");
+    pd_structure *s = &sc->st[sc->nstruct - 1];
+    char at[160], el[200];
+    double *v = NULL, one;
+    int n = 0, rc;
+    pd_err e;
+    if (!h)
+        return PD_OK;
+    field(at, sizeof at, path, "storey_heights");
+    if (json_is_number(h)) {
+        one = json_number_value(h);
+        if (!(one > 0.0) || !isfinite(one))
+            return fail(L, at, "the storey height must be a finite number > 0 [m] (got %g)", one);
+        for (int i = 0; i < s->storeys; i++)
+            s->height[i] = one;
+        return PD_OK;
+    }
+    if ((rc = get_numbers(L, h, at, 0, &v, &n)))
+        return rc;
+    if (n != s->storeys)
+        rc = fail(L, at, "%d heights for %d storeys: give one per storey (or one number for "
+                  "all)", n, s->storeys);
+    for (int i = 0; i < n && !rc; i++)
+        if (!(v[i] > 0.0)) {
+            snprintf(el, sizeof el, "%s[%d]", at, i);
+            rc = fail(L, el, "the storey height must be a finite number > 0 [m] (got %g)", v[i]);
+        }
+    if (!rc && pd_scene_set_heights(sc, v, &e))
+        rc = fail_builder(L, path, &e);
+    free(v);
+    return rc;
+}
+
+/* The damping fields, then the storey heights, of the last structure at path. */
+static int read_extras(loader *L, pd_scene *sc, json_t *st, const char *path)
+{
+    int rc = read_damping(L, sc, st, path);
+    return rc ? rc : read_heights(L, sc, st, path);
+}
+
 /* Every storey's mass and stiffness of a building at path in the usable ranges. */
 static int storeys_in_range(loader *L, const char *path, int n, const double *m,
                             const double *k)
@@ -495,7 +539,7 @@ static int read_structure(loader *L, pd_scene *sc, json_t *st, int k)
 {
     static const char *const keys[] = {"name",   "T0",          "xi",      "mass",
                                        "masses", "stiffnesses", "storeys", "damping",
-                                       "rayleigh_modes", NULL};
+                                       "rayleigh_modes", "storey_heights", NULL};
     char path[64], at[160];
     const char *name;
     double xi, T0 = 0.0, mass = 1.0;
@@ -530,7 +574,7 @@ static int read_structure(loader *L, pd_scene *sc, json_t *st, int k)
             rc = fail_builder(L, path, &e);
         free(m);
         free(kk);
-        return rc ? rc : read_damping(L, sc, st, path);
+        return rc ? rc : read_extras(L, sc, st, path);
     }
     if (json_object_get(st, "stiffnesses"))
         return fail(L, path, "missing field 'masses' (one per storey)");
@@ -551,7 +595,7 @@ static int read_structure(loader *L, pd_scene *sc, json_t *st, int k)
         rc = pd_scene_add_sdof(sc, name, T0, xi, mass, &e);
     if (rc)
         return fail_builder(L, path, &e);
-    return read_damping(L, sc, st, path);
+    return read_extras(L, sc, st, path);
 }
 
 /* The structure named by field key of contact entry at path. */

@@ -120,6 +120,7 @@ int pd_scene_measure_reference(const pd_scene *sc, const pd_run_opts *o, pd_scen
         return rc;
     if ((rc = pd_scene_result_alloc(sc, &timed, err)))
         return rc;
+    r.no_demands = 1;
     rc = pd_scene_run(sc, &r, NULL, NULL, &timed, err); /* its cost without the sampling */
     res->cpu_s = timed.cpu_s;
     pd_scene_result_free(&timed);
@@ -189,7 +190,9 @@ int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scen
         free(scale);
         return rc;
     }
-    rc = pd_scene_run(sc, o, NULL, NULL, &timed, err); /* its cost without the sampling */
+    pd_run_opts bare = o ? *o : pd_run_default_opts();
+    bare.no_demands = 1;
+    rc = pd_scene_run(sc, &bare, NULL, NULL, &timed, err); /* its cost without the sampling */
     e->cpu_s = timed.cpu_s;
     pd_scene_result_free(&timed);
     e->err_umax_max = e->err_hist_max = 0.0;

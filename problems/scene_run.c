@@ -14,7 +14,16 @@
  *              element engaging);
  *   impulse    of one impact: the step's P_a, the event's P_a, or the integral
  *              of the element force over one engagement;
- *   approach   max over t of x_a - x_b (how far the gap closes). */
+ *   approach   max over t of x_a - x_b (how far the gap closes);
+ *   demands    peak |a_abs| per floor and |V| per storey (demand.c): at every
+ *              step (Moreau–Jean, the discrete maximum as for umax); at every
+ *              accepted step (penalty, newmark) or event (event-general) and
+ *              between them on the cubic Hermite of the values and rates
+ *              (free steps); the row reference at its impacts (before and
+ *              after) and on a grid of whole multiples of dt, at most
+ *              DEMAND_GRID per shortest period (or dt when sampling), with the
+ *              same cubic between grid points without an impulse; the peak
+ *              element force (penalty, newmark) at every accepted step. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,8 +31,11 @@
 
 #include "osc_priv.h"
 #include "pd_null.h"
+#include "demand.h"
 #include "pd_problems.h"
 #include "scene_priv.h"
+
+#define DEMAND_GRID 128.0 /* the row reference's demand states per shortest period */
 
 
 /* What a run tracks, in reference units. */
@@ -36,6 +48,15 @@ typedef struct track {
     int *below;        /* n: the dof of the storey below, -1 for storey 1 */
     int *dof_a, *dof_b; /* m: the dofs a contact joins, -1 at a wall */
     double *xmax, *xpos, *xneg, *drift; /* n */
+    double *acc, *shear;                /* n: demand peaks [SI] */
+    double *da, *dV, *dad, *dVd;        /* n: the instant's a_abs, V and their rates */
+    double *qa, *qV, *qad, *qVd;        /* n: the same at the previous demand state */
+    double dem_t;                       /* its time */
+    int dem_prev;                       /* 1: it has rates (an interval can be refined) */
+    int demands;                        /* 0: not measured (pd_run_opts.no_demands) */
+    int *st_of;                         /* n: the structure of each dof */
+    double *ex, *ev;                    /* n: an impact's positions and velocities */
+    double *fpeak;                      /* m: largest element force (reference units) */
     long *impacts;     /* m */
     double *first, *maxP, *ctime, *approach, *episode; /* m */
     double *g_prev, *U_prev, *U_prev2;  /* m: Moreau–Jean first-impact estimate */
@@ -75,8 +96,14 @@ int pd_scene_result_alloc(const pd_scene *sc, pd_scene_result *r, pd_err *err)
     r->max_impulse = calloc(m, sizeof(double));
     r->contact_time = calloc(m, sizeof(double));
     r->approach = calloc(m, sizeof(double));
+    r->acc_max = calloc(n, sizeof(double));
+    r->shear_max = calloc(n, sizeof(double));
+    r->drift_ratio = calloc(n, sizeof(double));
+    r->force_max = calloc(m, sizeof(double));
+    r->force_equiv = calloc(m, sizeof(double));
     if (!r->umax || !r->u_pos || !r->u_neg || !r->drift || !r->impacts || !r->first_impact ||
-        !r->max_impulse || !r->contact_time || !r->approach) {
+        !r->max_impulse || !r->contact_time || !r->approach || !r->acc_max || !r->shear_max ||
+        !r->drift_ratio || !r->force_max || !r->force_equiv) {
         pd_scene_result_free(r);
         return pd_err_set(err, PD_ENOMEM, "out of memory for the results of %d dofs", sc->n);
     }
@@ -87,7 +114,8 @@ int pd_scene_result_fits(const pd_scene *sc, const pd_scene_result *r)
 {
     return sc && r && r->n == sc->n && r->m == sc->ncontact && r->umax && r->u_pos && r->u_neg &&
            r->drift && r->impacts && r->first_impact && r->max_impulse && r->contact_time &&
-           r->approach;
+           r->approach && r->acc_max && r->shear_max && r->drift_ratio && r->force_max &&
+           r->force_equiv;
 }
 
 void pd_scene_result_free(pd_scene_result *r)
@@ -103,6 +131,11 @@ void pd_scene_result_free(pd_scene_result *r)
     free(r->max_impulse);
     free(r->contact_time);
     free(r->approach);
+    free(r->acc_max);
+    free(r->shear_max);
+    free(r->drift_ratio);
+    free(r->force_max);
+    free(r->force_equiv);
     memset(r, 0, sizeof *r);
 }
 
@@ -114,7 +147,9 @@ static void track_free(track *tr)
                       tr->drift, tr->impacts, tr->first, tr->maxP, tr->ctime, tr->approach,
                       tr->episode, tr->g_prev, tr->U_prev, tr->U_prev2, tr->touching, tr->px,
                       tr->pv, tr->pa, tr->plam, tr->pactive, tr->sx, tr->sv, tr->sg, tr->sP,
-                      tr->imp, tr->imp_lam};
+                      tr->imp, tr->imp_lam, tr->acc, tr->shear, tr->da, tr->dV, tr->fpeak,
+                      tr->dad, tr->dVd, tr->qa, tr->qV, tr->qad, tr->qVd,
+                      tr->st_of, tr->ex, tr->ev};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(arrays[k]);
 }
@@ -134,14 +169,19 @@ static int track_alloc(track *tr, const pd_scene *sc, pd_err *err)
         !TA(tr->U_prev2, m) || !TA(tr->touching, m) || !TA(tr->px, n) || !TA(tr->pv, n) ||
         !TA(tr->pa, n) || !TA(tr->plam, m) || !TA(tr->pactive, m) || !TA(tr->sx, n) ||
         !TA(tr->sv, n) || !TA(tr->sg, m) || !TA(tr->sP, m) || !TA(tr->imp, m) ||
-        !TA(tr->imp_lam, m)) {
+        !TA(tr->imp_lam, m) || !TA(tr->acc, n) || !TA(tr->shear, n) || !TA(tr->da, n) ||
+        !TA(tr->dV, n) || !TA(tr->fpeak, m) || !TA(tr->dad, n) || !TA(tr->dVd, n) ||
+        !TA(tr->qa, n) || !TA(tr->qV, n) || !TA(tr->qad, n) || !TA(tr->qVd, n) ||
+        !TA(tr->st_of, n) || !TA(tr->ex, n) || !TA(tr->ev, n)) {
 #undef TA
         track_free(tr);
         return pd_err_set(err, PD_ENOMEM, "out of memory for tracking %d dofs", sc->n);
     }
     for (int s = 0; s < sc->nstruct; s++)
-        for (int k = 0; k < sc->st[s].storeys; k++)
+        for (int k = 0; k < sc->st[s].storeys; k++) {
             tr->below[sc->st[s].dof + k] = k == 0 ? -1 : sc->st[s].dof + k - 1;
+            tr->st_of[sc->st[s].dof + k] = s;
+        }
     for (int a = 0; a < tr->m; a++) {
         const pd_contact *ct = &sc->ct[a];
         tr->dof_a[a] = ct->a == PD_WALL ? -1 : sc->st[ct->a].dof + ct->level_a - 1;
@@ -164,6 +204,90 @@ static void note_point(track *tr, double t, const double *x)
         tr->xneg[i] = pd_max(tr->xneg[i], -x[i]);
         tr->drift[i] = pd_max(tr->drift[i], fabs(d));
     }
+}
+
+/* The demands of the state (x, v) at t, inside the window; with its
+ * accelerations acc (NULL: none), their peaks between it and the previous
+ * state on the cubic Hermite of the values and rates, when the interval
+ * was smooth (no impulse in it). */
+static void note_demand(track *tr, double t, const double *x, const double *v,
+                        const double *acc, int smooth)
+{
+    double us = tr->Le, vs = tr->Le * tr->wp, as = vs * tr->wp;
+    if (!tr->demands)
+        return;
+    if (t < tr->tau_measure - 0.5 * tr->h) {
+        tr->dem_prev = 0;
+        return;
+    }
+    pd_demand_note(tr->sc, x, v, us, vs, tr->da, tr->dV, tr->acc, tr->shear);
+    if (!acc) {
+        tr->dem_prev = 0;
+        return;
+    }
+    pd_demand_eval(tr->sc, v, acc, vs, as, tr->dad, tr->dVd); /* the rates [1/s] */
+    double h = (t - tr->dem_t) / tr->wp;
+    if (tr->dem_prev && smooth && h > 0.0)
+        for (int i = 0; i < tr->n; i++) {
+            tr->acc[i] = pd_max(tr->acc[i], pd_demand_cubic_peak(tr->qa[i], tr->qad[i],
+                                                                 tr->da[i], tr->dad[i], h));
+            tr->shear[i] = pd_max(tr->shear[i], pd_demand_cubic_peak(tr->qV[i], tr->qVd[i],
+                                                                     tr->dV[i], tr->dVd[i], h));
+        }
+    size_t bytes = (size_t)tr->n * sizeof(double);
+    memcpy(tr->qa, tr->da, bytes);
+    memcpy(tr->qV, tr->dV, bytes);
+    memcpy(tr->qad, tr->dad, bytes);
+    memcpy(tr->qVd, tr->dVd, bytes);
+    tr->dem_t = t;
+    tr->dem_prev = 1;
+}
+
+/* The row reference's impacts: the demands of the structures involved with
+ * the velocities before and after (positions are continuous). */
+static int on_edr_event(const pd_edr_event *e, void *ctx)
+{
+    track *tr = ctx;
+    double us = tr->Le, vs = tr->Le * tr->wp;
+    if (e->kind != PD_EDR_IMPACT || e->t < tr->tau_measure - 0.5 * tr->h)
+        return 0;
+    for (int side = 0; side < 2; side++) {
+        for (int k = 0; k < e->ndofs; k++) {
+            int d = e->dofs[k];
+            tr->ex[d] = e->x[k];
+            tr->ev[d] = side ? e->v_plus[k] : e->v_minus[k];
+        }
+        for (int k = 0; k < e->ndofs; k++) {
+            const pd_structure *st = &tr->sc->st[tr->st_of[e->dofs[k]]];
+            if (st->dof != e->dofs[k]) /* once per structure, from its first floor */
+                continue;
+            pd_demand_eval_structure(st, tr->ex, tr->ev, us, vs, tr->da, tr->dV);
+            for (int i = st->dof; i < st->dof + st->storeys; i++) {
+                tr->acc[i] = pd_max(tr->acc[i], fabs(tr->da[i]));
+                tr->shear[i] = pd_max(tr->shear[i], fabs(tr->dV[i]));
+            }
+        }
+    }
+    return 0;
+}
+
+/* 1 when no element is engaged at st nor at the previous report (penalty:
+ * the cubic of a free step; an engaged step's rates follow the stiff force). */
+static int no_element(const track *tr, const pd_state *st)
+{
+    for (int a = 0; a < tr->model_m; a++)
+        if (st->active[a] || tr->pactive[a])
+            return 0;
+    return 1;
+}
+
+/* 1 when no impulse is reported in st (P holds impulses). */
+static int no_impulse(const track *tr, const pd_state *st)
+{
+    for (int a = 0; a < tr->model_m; a++)
+        if (st->P[a] > 0.0)
+            return 0;
+    return 1;
 }
 
 /* How far each gap has closed: x_a - x_b (walls at 0). */
@@ -292,6 +416,7 @@ static int observe_moreau(const pd_state *st, void *ctx)
     track *tr = ctx;
     note_point(tr, st->t, st->q);
     note_approach(tr, st->q);
+    note_demand(tr, st->t, st->q, st->v, NULL, 0); /* the steps' own: as umax */
     tr->lcp_solves += st->nactive > 0;
     for (int a = 0; a < tr->model_m; a++) {
         double P = st->P[a], U = gap_rate(tr, a, st->v);
@@ -323,6 +448,7 @@ static int step_event(const pd_state *st, void *ctx)
         note_between(tr, st->t, st->q, st->v, st->acc);
     note_point(tr, st->t, st->q);
     note_approach(tr, st->q);
+    note_demand(tr, st->t, st->q, st->v, st->has_acc ? st->acc : NULL, no_impulse(tr, st));
     for (int a = 0; a < tr->model_m; a++) {
         double P = st->P[a];
         if (tr->pactive[a] && tr->have_prev)
@@ -348,8 +474,11 @@ static int step_penalty(const pd_state *st, void *ctx)
         note_between(tr, st->t, st->q, st->v, st->acc);
     note_point(tr, st->t, st->q);
     note_approach(tr, st->q);
+    note_demand(tr, st->t, st->q, st->v, st->has_acc ? st->acc : NULL, no_element(tr, st));
     for (int a = 0; a < tr->model_m; a++) {
         double dt = tr->have_prev ? st->t - tr->pt : 0.0;
+        if (st->active[a])
+            tr->fpeak[a] = pd_max(tr->fpeak[a], st->P[a]);
         double di = 0.5 * (tr->plam[a] + (st->active[a] ? st->P[a] : 0.0)) * dt;
         if (tr->pactive[a])
             tr->ctime[a] += dt;
@@ -390,6 +519,8 @@ static void fill_result(const track *tr, pd_scene_result *r)
         r->u_pos[i] = tr->xpos[i] * tr->Le;
         r->u_neg[i] = tr->xneg[i] * tr->Le;
         r->drift[i] = tr->drift[i] * tr->Le;
+        r->acc_max[i] = tr->demands ? tr->acc[i] : NAN;
+        r->shear_max[i] = tr->demands ? tr->shear[i] : NAN;
     }
     for (int a = 0; a < tr->m; a++) {
         r->impacts[a] = tr->impacts[a];
@@ -397,6 +528,9 @@ static void fill_result(const track *tr, pd_scene_result *r)
         r->max_impulse[a] = tr->maxP[a] * Ps;
         r->contact_time[a] = tr->ctime[a] / tr->wp;
         r->approach[a] = tr->approach[a] * tr->Le;
+        r->force_max[a] = tr->method == PD_METHOD_PENALTY || tr->method == PD_METHOD_NEWMARK
+                              ? tr->fpeak[a] * tr->sc->exc.ap /* force unit: ap kg */
+                              : NAN;
     }
     r->lcp_solves = tr->lcp_solves;
 }
@@ -440,6 +574,8 @@ static int run_oscillator(const pd_scene *sc, const pd_osc *c, int mirrored,
     if ((rc = pd_osc_run(c, &oo, fn ? osc_sample : NULL, &b, &r, err)))
         return rc;
     res->umax[0] = res->drift[0] = r.umax;
+    res->acc_max[0] = r.acc_max;
+    res->shear_max[0] = r.acc_max * mass;
     res->u_pos[0] = mirrored ? r.u_away : r.u_toward;
     res->u_neg[0] = mirrored ? r.u_toward : r.u_away;
     if (sc->ncontact > 0) {
@@ -448,6 +584,7 @@ static int run_oscillator(const pd_scene *sc, const pd_osc *c, int mirrored,
         res->max_impulse[0] = r.max_impulse * mass;
         res->contact_time[0] = r.contact_time;
         res->approach[0] = r.u_toward;
+        res->force_max[0] = r.force_max * mass;
     }
     res->steps = r.steps;
     res->accumulations = r.accumulations;
@@ -492,9 +629,24 @@ static int run_moreau(const pd_model *md, const pd_run_opts *o, long nsteps, tra
 static int observe_edr(const pd_state *st, void *ctx)
 {
     track *tr = ctx;
+    note_demand(tr, st->t, st->q, st->v, st->has_acc ? st->acc : NULL, no_impulse(tr, st));
+    if (!tr->fn)
+        return 0;
     for (int a = 0; a < tr->model_m; a++)
         tr->imp[a] += st->P[a];
     return sample(tr, st);
+}
+
+/* The row reference's demand grid: the largest whole multiple of the step
+ * with DEMAND_GRID points per shortest period (of the structures' highest
+ * modes and the pulse), in tau. */
+static double demand_grid(const track *tr)
+{
+    double T = tr->sc->exc.Tp;
+    for (int s = 0; s < tr->sc->nstruct; s++)
+        T = fmin(T, tr->sc->st[s].Tmin);
+    double k = floor(tr->wp * T / (DEMAND_GRID * tr->h));
+    return k > 1.0 ? k * tr->h : tr->h;
 }
 
 /* The exact event-driven reference for rows (pd_edr) on the scene's model:
@@ -511,7 +663,10 @@ static int run_event(const pd_scene_model *sm, const pd_run_opts *o, double tau_
     eo.close_tol = o->close_tol;
     eo.time_unit = 1.0 / tr->wp;
     eo.t_measure = tr->tau_measure;
-    eo.h_out = tr->fn ? tr->h : 0.0;
+    /* the grid: samples every dt; else the demands' states */
+    eo.h_out = tr->fn ? tr->h : tr->demands ? demand_grid(tr) : 0.0;
+    eo.on_event = tr->demands ? on_edr_event : NULL;
+    eo.on_event_ctx = tr;
     eo.below = tr->below;
     eo.no_accumulation = o->no_accumulation;
     eo.inactive = o->no_wall;
@@ -521,7 +676,7 @@ static int run_event(const pd_scene_model *sm, const pd_run_opts *o, double tau_
         free(pieces);
         return err ? err->status : PD_ENOMEM;
     }
-    rc = pd_edr_run(edr, 0.0, NULL, NULL, tau_end, tr->fn ? observe_edr : NULL, tr, err);
+    rc = pd_edr_run(edr, 0.0, NULL, NULL, tau_end, eo.h_out > 0.0 ? observe_edr : NULL, tr, err);
     if (err && (rc == PD_ENUMERICAL || rc == PD_ESINGULAR)) { /* a cluster without modes */
         char why[sizeof err->msg];
         snprintf(why, sizeof why, "%s", err->msg);
@@ -654,6 +809,7 @@ static int run_general(const pd_scene *sc, const pd_run_opts *o, pd_scene_sample
     tr.tau_measure = tr.wp * pd_scene_measure_start(sc, o->tend);
     tr.fn = fn;
     tr.ctx = ctx;
+    tr.demands = !o->no_demands;
     long nsteps = pd_steps_for(o->tend, o->dt);
     double tau_end = (double)nsteps * tr.h;
     switch (o->method) {
@@ -688,11 +844,12 @@ int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler s
     if ((rc = pd_scene_resolve_opts(sc, opts, &o, err)))
         return rc;
     for (int i = 0; i < res->n; i++)
-        res->umax[i] = res->u_pos[i] = res->u_neg[i] = res->drift[i] = 0.0;
+        res->umax[i] = res->u_pos[i] = res->u_neg[i] = res->drift[i] = res->acc_max[i] =
+            res->shear_max[i] = res->drift_ratio[i] = 0.0;
     for (int a = 0; a < res->m; a++) {
         res->impacts[a] = 0;
-        res->first_impact[a] = NAN;
-        res->max_impulse[a] = res->contact_time[a] = res->approach[a] = 0.0;
+        res->first_impact[a] = res->force_max[a] = NAN;
+        res->max_impulse[a] = res->contact_time[a] = res->approach[a] = res->force_equiv[a] = 0.0;
     }
     res->dt = o.dt;
     res->tend = o.tend;
@@ -707,6 +864,13 @@ int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler s
     else
         rc = run_general(sc, &o, sampler, ctx, res, err);
     res->cpu_s = pd_cpu_seconds() - cpu0;
+    res->contact_duration = pd_demand_td(&o);
+    for (int s = 0; s < sc->nstruct; s++)
+        for (int k = 0; k < sc->st[s].storeys; k++)
+            res->drift_ratio[sc->st[s].dof + k] = res->drift[sc->st[s].dof + k] /
+                                                  sc->st[s].height[k];
+    for (int a = 0; a < res->m; a++)
+        res->force_equiv[a] = pd_equivalent_force(res->max_impulse[a], res->contact_duration);
     return rc;
 }
 
@@ -738,6 +902,7 @@ int pd_scene_summarize(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sam
     int rc;
     memset(s, 0, sizeof *s);
     twin.no_wall = 1;
+    twin.no_demands = 1; /* the twin's figures are umax and the approach */
     s->Pi1 = malloc(n * sizeof(double));
     s->gamma = malloc(n * sizeof(double));
     s->Pi2 = malloc((size_t)sc->nstruct * sizeof(double));

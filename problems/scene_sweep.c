@@ -121,6 +121,7 @@ static int run_task(const pd_scene_sweep *w, long t, pd_scene_point *pt, double 
     if ((rc = pd_scene_sweep_scene(w, t, &c, pt, err)))
         return pt->status = rc; /* the run's own status: pd_scene_sweep_run returns it */
     o.no_wall = t < pd_scene_sweep_twins(w);
+    o.no_demands = 1; /* a sweep keeps umax */
     if (!(rc = pd_scene_result_alloc(c, &r, err))) {
         rc = pd_scene_run(c, &o, NULL, NULL, &r, err);
         for (int s = 0; s < c->nstruct; s++) {

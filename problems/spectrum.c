@@ -137,6 +137,7 @@ int pd_spec_case(const pd_spectrum *s, long task, pd_osc *c, pd_run_opts *o, pd_
     if (s->dt_per_Tp > 0.0)
         o->dt = c->Tp / s->dt_per_Tp;
     o->no_wall = co.twin;
+    o->no_demands = 1; /* a spectrum keeps umax and the impacts */
     return pd_osc_resolve_opts(c, o, o, err);
 }
 

@@ -83,6 +83,7 @@ int main(int argc, char **argv)
     suite_cli(&ctx);
     suite_spectrum(&ctx);
     suite_scene(&ctx);
+    suite_demand(&ctx);
     suite_solvers(&ctx);
     suite_impacts(&ctx);
     suite_record(&ctx);

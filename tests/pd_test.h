@@ -90,6 +90,7 @@ void suite_alloc(pd_test_ctx *ctx);
 void suite_cli(pd_test_ctx *ctx);
 void suite_spectrum(pd_test_ctx *ctx);
 void suite_scene(pd_test_ctx *ctx);
+void suite_demand(pd_test_ctx *ctx);
 void suite_solvers(pd_test_ctx *ctx);
 void suite_impacts(pd_test_ctx *ctx);
 void suite_record(pd_test_ctx *ctx);

@@ -8,7 +8,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-from . import _args, _lib
+from . import _args, _demand, _lib
 from ._args import number
 from ._lib import InputError, PdErr, PdRecord, PdRecordPulse, lib
 from ._types import ArrayLike, PathArg
@@ -19,7 +19,7 @@ MODEL_KEYS = ("pulse", "dir", "ap", "Tp", "T0", "Pi2", "gap", "Pi3", "eps", "xi"
 RECORD_KEYS = ("record", "scale", "units", "record_format", "record_dt")
 SCHEME_KEYS = ("method", "dt", "tend", "theta", "gamma", "allow_unstable", "no_accumulation",
                "no_wall", "kernel", "factor", "lcp_solver", "contact", "kc", "kc_abs", "rtol",
-               "atol", "stepper", "close_tol")
+               "atol", "stepper", "close_tol", "contact_duration")
 CASE_KEYS = MODEL_KEYS + RECORD_KEYS + SCHEME_KEYS
 # cli/case.c: the keywords only one method takes choose it (moreau 0,
 # event 1, penalty 2) unless method says another; the flags only
@@ -188,6 +188,7 @@ def _check_scheme(o, have):
     if not 0.0 <= o.close_tol <= 1.0:
         raise InputError("close_tol: the closing tolerance must be in [0, 1] (in units of Le; "
                          "got %s)" % fmt(o.close_tol))
+    _demand.check_opts(o, have)
 
 
 def scheme_opts(kw):
@@ -203,7 +204,7 @@ def scheme_opts(kw):
         if key == "method":
             o.method = parse_name("method", lib.pd_method_parse, v,
                                   "moreau, event, penalty, auto, event-general, newmark")
-        elif key in ("dt", "tend", "theta", "gamma", "close_tol"):
+        elif key in ("dt", "tend", "theta", "gamma", "close_tol", "contact_duration"):
             setattr(o, key, number(key, v))
         elif key in ("allow_unstable", "no_accumulation", "no_wall"):
             setattr(o, key, 1 if _args.flag(key, v) else 0)

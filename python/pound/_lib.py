@@ -130,7 +130,8 @@ class PdRunOpts(Structure):
                 ("gamma", c_double), ("allow_unstable", c_int), ("kernel", c_int),
                 ("factor", c_int), ("lcp_solver", c_int), ("no_accumulation", c_int),
                 ("no_wall", c_int), ("pen", PdPenaltySetup), ("on_lcp", c_void_p),
-                ("on_lcp_ctx", c_void_p), ("close_tol", c_double)]
+                ("on_lcp_ctx", c_void_p), ("close_tol", c_double),
+                ("contact_duration", c_double), ("no_demands", c_int)]
 
 
 class PdRecord(Structure):
@@ -168,7 +169,9 @@ class PdOscResult(Structure):
                 ("max_impulse", c_double), ("contact_time", c_double), ("min_gap", c_double),
                 ("accumulations", c_long), ("steps", c_long), ("dt", c_double),
                 ("tend", c_double), ("theta", c_double), ("gamma", c_double),
-                ("cpu_s", c_double), ("kernel", c_char_p)]
+                ("cpu_s", c_double), ("kernel", c_char_p), ("acc_max", c_double),
+                ("force_max", c_double), ("force_equiv", c_double),
+                ("contact_duration", c_double)]
 
 
 class PdOscSummary(Structure):
@@ -194,7 +197,7 @@ class PdStructure(Structure):
                 ("mass", POINTER(c_double)), ("stiffness", POINTER(c_double)), ("xi", c_double),
                 ("damping", c_int), ("modes", c_int * 2), ("T0", c_double),
                 ("period", c_double * 2), ("Tmin", c_double), ("alpha", c_double),
-                ("beta", c_double), ("dof", c_int)]
+                ("beta", c_double), ("dof", c_int), ("height", POINTER(c_double))]
 
 
 class PdContact(Structure):
@@ -231,7 +234,10 @@ class PdSceneResult(Structure):
                 ("simultaneous", c_long), ("tol_closed", c_long), ("accumulations", c_long),
                 ("close_tol", c_double), ("dt", c_double), ("tend", c_double), ("theta", c_double), ("cpu_s", c_double),
                 ("method", c_char_p), ("kernel", c_char_p), ("factor", c_char_p),
-                ("lcp_solver", c_char_p)]
+                ("lcp_solver", c_char_p), ("acc_max", POINTER(c_double)),
+                ("shear_max", POINTER(c_double)), ("drift_ratio", POINTER(c_double)),
+                ("force_max", POINTER(c_double)), ("force_equiv", POINTER(c_double)),
+                ("contact_duration", c_double)]
 
 
 class PdSceneSummary(Structure):

@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING, Any, List, Optional, Sequence, Union
 
 import numpy as np
 
-from . import _args, _lib
+from . import _args, _demand, _lib
 from ._case import Case, InputError, copy_opts, number
 from ._lib import PdErr, lib, s
 from ._types import Floats, Int, Names, PathArg, Range
@@ -185,7 +185,8 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
     and r.method_by say which and why], dt [min(Tp, T0)/2000], tend [Tp + 2 T0], theta [0.5],
     gamma [0.5], allow_unstable, no_accumulation, no_wall, kernel
     'auto'|'general', factor, lcp_solver, contact 'kelvin'|'hertz', kc,
-    kc_abs, rtol, atol, stepper.
+    kc_abs, rtol, atol, stepper; height [3] m and contact_duration [0.005] s
+    of the demands.
 
     Returns a Result with the keys of the CLI's JSON: umax, u_toward,
     u_away, umax_free [m]; Pi1 = umax / Le, gamma = umax / umax_free, chi =
@@ -193,12 +194,16 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
     steps (counts); first_impact, contact_time, dt, tend [s];
     first_impact_velocity, max_impact_velocity [m/s]; max_impulse per unit
     mass [m/s]; min_gap, gap [m]; ap [m/s^2], Tp, T0 [s]; cpu_s [s of
-    CPU]; method, method_by, pulse, dir, kernel (names).  With history,
+    CPU]; method, method_by, pulse, dir, kernel (names); the demands per
+    unit mass (docs/scenes.md, "Demands"): drift_ratio, acc_max [m/s^2],
+    shear_max, force_equiv, force_max [N/kg] (NaN: not a penalty method),
+    height [m], contact_duration [s].  With history,
     r.history: the arrays step, t, u, v, impulse, gap of every every-th
     step (the CLI's -o file: t [s], u [m], v [m/s], impulse per unit mass
     since the last sample [m/s], gap delta - u [m]), with t, u, v, impulse
     also as r.t, r.u, r.v, r.impulse."""
     history, every = history_args(history, every)
+    height = _demand.pop_height(case)
     k = Case(case).resolve()
     o = k.opts
     h = sampler = None
@@ -221,6 +226,7 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
                  max_impact_velocity=r.max_impact_velocity, max_impulse=r.max_impulse,
                  contact_time=r.contact_time, min_gap=r.min_gap, umax_free=sm.free.umax,
                  gamma=sm.gamma, chi=sm.chi, steps=r.steps, cpu_s=sm.cpu_s)
+    _demand.osc_fields(out, r, height)
     _case_json(k, out)
     out.update(dt=r.dt, theta=r.theta, gamma_active=r.gamma, tend=r.tend, kernel=s(r.kernel))
     if h is not None:

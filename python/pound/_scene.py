@@ -5,7 +5,7 @@ from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 
-from . import _args, _lib
+from . import _args, _demand, _lib
 from ._case import SCHEME_KEYS, Case, InputError, copy_opts, number, scheme_opts
 from ._lib import PD_WALL, PdErr, lib, s
 from ._osc import Result, _History, history_args
@@ -172,8 +172,12 @@ class Scene:
         umax_free [m] and Pi1, gamma (one value per storey), T0 [s], Pi2; per
         contact (r.contacts) impacts, first_impact [s], max_impulse [N s],
         contact_time [s], approach [m], Pi3, chi; dt, tend [s], Le [m], ap
-        [m/s^2], Tp [s], impacts (all contacts), cpu_s [s of CPU].  opts: the
-        scheme keywords of simulate() (method, dt, tend, theta, ...).  With
+        [m/s^2], Tp [s], impacts (all contacts), cpu_s [s of CPU]; the demands
+        (docs/scenes.md, "Demands"): per structure storey_heights [m],
+        drift_ratio, acc_max [m/s^2], shear_max, base_shear_max [N], per
+        contact force_equiv, force_max [N] (NaN: not a penalty method), and
+        contact_duration [s].  opts: the scheme keywords of simulate()
+        (method, dt, tend, theta, ..., contact_duration).  With
         history,
         r.history: step, t (N), x and v (N x dofs) [m, m/s], gap [m] and
         impulse [N s] (N x contacts), every every-th sample, the impulses
@@ -246,6 +250,7 @@ class Scene:
                                    contact_time=r.contact_time[a], approach=r.approach[a],
                                    chi=sm.chi[a]))
         out["contacts"] = contacts
+        _demand.scene_fields(out, sc, r)
         return out
 
     def __repr__(self) -> str:

@@ -1,0 +1,62 @@
+/* demand.h — (problems-private) the demand parameters both runners measure
+ * (pd_problems.h, "demand parameters"): the absolute floor accelerations'
+ * smooth part and the storey shears of a scene's state, their peaks. */
+#ifndef PD_DEMAND_H
+#define PD_DEMAND_H
+
+#include <math.h>
+
+#include "pd_problems.h"
+
+/* The td of o: its contact_duration, or PD_CONTACT_DURATION for 0. */
+double pd_demand_td(const pd_run_opts *o);
+
+/* a_abs (a, n) [m/s^2] and the storey shears (V, n) [N], signed, of the
+ * state x, v of sc's dofs given in units of us [m] and vs [m/s] (the SI
+ * state is us x, vs v). */
+void pd_demand_eval(const pd_scene *sc, const double *x, const double *v, double us, double vs,
+                    double *a, double *V);
+
+/* The same for structure st alone (its entries of x, v, a, V). */
+void pd_demand_eval_structure(const pd_structure *st, const double *x, const double *v,
+                              double us, double vs, double *a, double *V);
+
+/* The same into the scratch a, V (n), raising the peaks acc = max |a| and
+ * shear = max |V| (n). */
+void pd_demand_note(const pd_scene *sc, const double *x, const double *v, double us, double vs,
+                    double *a, double *V, double *acc, double *shear);
+
+/* The largest |p| at the turning points inside (0, h) of the cubic Hermite p
+ * with values f0, f1 and slopes d0, d1 at the ends of a step h (0 when it
+ * has none there): a peak of a demand between two states. */
+double pd_demand_cubic_peak(double f0, double d0, double f1, double d1, double h);
+
+/* The oscillator's absolute acceleration in Pi units, |C x' + K x| (C = 2 xi
+ * Pi2, K = Pi2^2), its peak from tau_measure on: at each state, and between
+ * two states with accelerations a (NULL: none) on the cubic Hermite when
+ * the interval was smooth. */
+typedef struct pd_demand_osc {
+    double C, K, tau_measure;
+    double peak;
+    double f, fd, t; /* the previous state's value, rate and time */
+    int prev;        /* 1: it has a rate */
+} pd_demand_osc;
+
+void pd_demand_osc_note(pd_demand_osc *d, double tau, double x, double v, const double *a,
+                        int smooth);
+
+/* pd_demand_osc_note without an acceleration (a step's state: no peak
+ * between states), inline for the scalar kernel's loop. */
+static inline void pd_demand_osc_note_state(pd_demand_osc *d, double tau, double x, double v)
+{
+    d->prev = 0;
+    if (tau >= d->tau_measure)
+        d->peak = pd_max(d->peak, fabs(d->C * v + d->K * x));
+}
+
+/* The oscillator's demands into res: acc_max and force_max [per unit mass],
+ * the td of o and the equivalent force of res->max_impulse. */
+void pd_demand_osc_finish(pd_osc_result *res, const pd_run_opts *o, double acc_max,
+                          double force_max);
+
+#endif
