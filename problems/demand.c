@@ -104,8 +104,10 @@ void pd_demand_osc_note(pd_demand_osc *d, double tau, double x, double v, const 
                         int smooth)
 {
     pd_demand_osc_note_state(d, tau, x, v);
-    if (tau < d->tau_measure || !a)
+    if (tau < d->tau_measure || !a) {
+        d->prev = 0;
         return;
+    }
     double f = d->C * v + d->K * x;
     double fd = d->C * *a + d->K * v, h = tau - d->t;
     if (d->prev && smooth && h > 0.0)

@@ -45,11 +45,10 @@ typedef struct pd_demand_osc {
 void pd_demand_osc_note(pd_demand_osc *d, double tau, double x, double v, const double *a,
                         int smooth);
 
-/* pd_demand_osc_note without an acceleration (a step's state: no peak
- * between states), inline for the scalar kernel's loop. */
+/* The peak at one state (no rate: pd_demand_osc_note with a NULL keeps
+ * prev 0 beside it), inline for the scalar kernel's loop. */
 static inline void pd_demand_osc_note_state(pd_demand_osc *d, double tau, double x, double v)
 {
-    d->prev = 0;
     if (tau >= d->tau_measure)
         d->peak = pd_max(d->peak, fabs(d->C * v + d->K * x));
 }
