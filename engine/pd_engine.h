@@ -317,6 +317,7 @@ typedef struct pd_penalty_result {
     double max_penetration_velocity; /* largest -W_a^T v while contact a is engaged */
     long switches;       /* contact elements engaged or released (located crossings) */
     const char *stepper; /* canonical GSL stepper name (static string) */
+    int diagonal_mass;   /* 1: M was diagonal and inverted entrywise (no factor) */
 } pd_penalty_result;
 
 /* Integrate the model from (t0, q0, v0) to t1 (NULL = zeros; opts NULL: the

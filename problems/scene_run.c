@@ -626,7 +626,8 @@ static int run_penalty(const pd_model *md, const pd_run_opts *o, double tau_end,
                             &pr, err);
     res->steps = pr.steps;
     res->kernel = pr.stepper ? pr.stepper : "penalty";
-    res->factor = pd_factor_kind_name(pd_factor_choose(md, o->factor));
+    res->factor =
+        pr.diagonal_mass ? "diagonal" : pd_factor_kind_name(pd_factor_choose(md, o->factor));
     res->lcp_solver = "none";
     return rc;
 }
