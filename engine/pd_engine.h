@@ -299,7 +299,10 @@ typedef struct pd_penalty_opts {
     long max_steps;      /* budget of accepted steps >= 1 */
     double time_unit;    /* > 0: the model's unit of time in seconds, for messages */
     pd_observer on_step; /* optional: called at t0 and after every accepted step
-                            whatever h_out (measurements next to the outputs) */
+                            whatever h_out (measurements next to the outputs); where
+                            elements switch, twice: the step's end under the engaged
+                            set it ran with (acc its left limits), then the same
+                            instant after the switch (right limits) */
     void *on_step_ctx;
     pd_factor_kind factor; /* storage of M */
 } pd_penalty_opts;

@@ -926,7 +926,11 @@ static int one_step(pen *p, double *t, double tb, double *h, pd_err *err)
                           "atol = %g); --method newmark or moreau run the scene",
                           seconds(p, ta), PEN_MAX_STALL, PEN_STALL_REL, p->o.rtol, p->o.atol);
     track_extremes(p, *t - ta);
-    int switched = which >= 0 || across ? apply_switches(p, which) : 0;
+    int switching = which >= 0 || across, switched = 0;
+    if (switching) { /* the step's end under the set it ran with (left limits) */
+        notify_step(p, *t, p->fb);
+        switched = apply_switches(p, which);
+    }
     if (switched)
         track_extremes(p, 0.0);
     if (which >= 0) { /* the step was cut: its stepper restarts from the crossing */
@@ -934,7 +938,10 @@ static int one_step(pen *p, double *t, double tb, double *h, pd_err *err)
         gsl_odeiv2_step_reset(d->s);
     }
     output_at_end(p, *t);
-    notify_step(p, *t, switched ? NULL : p->fb);
+    if (switched) /* the same instant after the switch (right limits) */
+        notify_step(p, *t, NULL);
+    else if (!switching)
+        notify_step(p, *t, p->fb);
     fill_state(p, *t, p->y);
     if (p->o.h_out == 0.0)
         notify(p, p->observer, p->obs_ctx);

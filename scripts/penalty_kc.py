@@ -9,9 +9,12 @@ reference (--method event) and, for kc = 1e6 ... 1e10 times the largest
 storey stiffness, both penalty methods: the adaptive GSL integration
 (--method penalty, rk8pd, rtol 1e-10) and Newmark's fixed steps (--method
 newmark, 10 steps per element period).  Prints per row: kc, the relative
-error of the peak displacement of the worst structure, the error of the
-largest impulse of one impact (worst contact, relative to the reference's
-largest), accepted steps and the run's CPU seconds.
+error of the peak displacement of the worst structure, accepted steps and
+the run's CPU seconds.  (Impulses are not compared with that reference:
+an element engaged while the row rests compressed integrates its force over
+the whole resting phase where the reference counts impacts, and the
+reference's sampled impulses leave out the force of contacts resting
+closed: docs/methods.md.)
 """
 import json
 import subprocess
@@ -27,21 +30,18 @@ def run(extra):
     out = subprocess.run([POUND, "simulate", *ROW, *extra, "--json"], check=True,
                          capture_output=True, text=True).stdout
     d = json.loads(out)
-    return ([s["umax"][0] for s in d["structures"]],
-            [c["max_impulse"] for c in d["contacts"]], d["steps"], d["cpu_s_run"])
+    return [s["umax"][0] for s in d["structures"]], d["steps"], d["cpu_s_run"]
 
 
 def main():
-    ru, rp, _, rcpu = run(["--method", "event"])
-    pmax = max(rp)
+    ru, _, rcpu = run(["--method", "event"])
     print(f"chain {N}: exact row reference (--method event) in {rcpu:.3g} s")
-    print(f"{'method':8} {'kc':>7} {'err_umax':>10} {'err_impulse':>12} {'steps':>9} {'cpu [s]':>8}")
+    print(f"{'method':8} {'kc':>7} {'err_umax':>10} {'steps':>9} {'cpu [s]':>8}")
     for kc in ["1e6", "1e7", "1e8", "1e9", "1e10"]:
         for method in ["penalty", "newmark"]:
-            u, p, steps, cpu = run(["--method", method, "--kc", kc])
+            u, steps, cpu = run(["--method", method, "--kc", kc])
             eu = max(abs(a / b - 1.0) for a, b in zip(u, ru))
-            ep = max(abs(a - b) for a, b in zip(p, rp)) / pmax
-            print(f"{method:8} {kc:>7} {eu:10.3g} {ep:12.3g} {steps:9d} {cpu:8.3g}")
+            print(f"{method:8} {kc:>7} {eu:10.3g} {steps:9d} {cpu:8.3g}")
 
 
 if __name__ == "__main__":
