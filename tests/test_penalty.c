@@ -1006,7 +1006,7 @@ static void test_newmark_tends_to_adaptive(pd_test_ctx *ctx)
 }
 
 /* A chain of 10 at kc 1e8 times the storey stiffness (the adaptive
- * integration stalls on it: elements switching at one instant): Newmark's
+ * integration stalled on it until issue 20): Newmark's
  * default step (10 per element period) runs it, and its umax agree with
  * Moreau-Jean's to 1 % (the elements' compliance and two discretisations). */
 static void test_newmark_stiff_chain(pd_test_ctx *ctx)
