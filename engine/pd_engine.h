@@ -301,7 +301,10 @@ typedef struct pd_penalty_opts {
     long max_steps;      /* budget of accepted steps >= 1 */
     double time_unit;    /* > 0: the model's unit of time in seconds, for messages */
     pd_observer on_step; /* optional: called at t0 and after every accepted step
-                            whatever h_out (measurements next to the outputs) */
+                            whatever h_out (measurements next to the outputs); where
+                            elements switch, twice: the step's end under the engaged
+                            set it ran with (acc its left limits), then the same
+                            instant after the switch (right limits) */
     void *on_step_ctx;
     pd_factor_kind factor; /* storage of M */
 } pd_penalty_opts;
@@ -319,6 +322,7 @@ typedef struct pd_penalty_result {
     double max_penetration_velocity; /* largest -W_a^T v while contact a is engaged */
     long switches;       /* contact elements engaged or released (located crossings) */
     const char *stepper; /* canonical GSL stepper name (static string) */
+    int diagonal_mass;   /* 1: M was diagonal and inverted entrywise (no factor) */
 } pd_penalty_result;
 
 /* Integrate the model from (t0, q0, v0) to t1 (NULL = zeros; opts NULL: the

@@ -61,8 +61,10 @@ typedef struct pen {
     const pen_stepper *stp;
     int n, m;
     size_t dim;            /* 2 n */
-    pd_factor *fac;        /* M factored (What with h = 0) */
+    pd_factor *fac;        /* M factored (What with h = 0); NULL when minv is used */
+    double *minv;          /* n: 1 / M_ii when M is diagonal (factor auto), else NULL */
     double *cd;            /* m: damping constants c_a */
+    double *sa;            /* m: W_a^T M^-1 W_a (inverse effective masses) */
     double vfloor;         /* smallest approach speed used by Hertz-damp */
     double vseen;          /* largest approach speed at an engagement so far */
     unsigned char *mode;   /* m: 1 = element engaged (the RHS is frozen to it) */
@@ -72,6 +74,10 @@ typedef struct pen {
     double *y, *ya, *yt, *yo; /* dim: state, step start, trial, output */
     double *ys;            /* dim: state before a GSL step (retries) */
     double *ga, *Ua;       /* m: gaps and W^T v at the step start */
+    double *fa, *fb;       /* dim: y' at the step start and end under the step's engaged set */
+    double *fo;            /* dim: y' at the crossing state of the earliest crossing */
+    double *fp;            /* dim: y' at the end of the last probe (valid if probe_f) */
+    int probe_f;           /* the last probe ended with a step (fp is y' at its end) */
     double *acc_work;      /* dim: y' for the accelerations of an on_step report */
     gsl_odeiv2_system sys;
     gsl_odeiv2_driver *main_drv, *probe_drv;
@@ -162,7 +168,13 @@ static void pen_free(pen *p)
     if (p->probe_drv)
         gsl_odeiv2_driver_free(p->probe_drv);
     pd_factor_free(p->fac);
+    free(p->minv);
     free(p->cd);
+    free(p->sa);
+    free(p->fa);
+    free(p->fb);
+    free(p->fo);
+    free(p->fp);
     free(p->mode);
     free(p->F);
     free(p->lam);
@@ -191,6 +203,11 @@ static int alloc_arrays(pen *p)
     size_t n = (size_t)p->n, m = p->m > 0 ? (size_t)p->m : 1, d = p->dim;
     size_t nn = p->stp->implicit ? n * n : 1;
     p->cd = calloc(m, sizeof(double));
+    p->sa = calloc(m, sizeof(double));
+    p->fa = calloc(d, sizeof(double));
+    p->fb = calloc(d, sizeof(double));
+    p->fo = calloc(d, sizeof(double));
+    p->fp = calloc(d, sizeof(double));
     p->mode = calloc(m, 1);
     p->F = calloc(n, sizeof(double));
     p->lam = calloc(m, sizeof(double));
@@ -211,24 +228,61 @@ static int alloc_arrays(pen *p)
     p->st.P = calloc(m, sizeof(double));
     p->st.g = calloc(m, sizeof(double));
     p->st.active = calloc(m, 1);
-    return p->cd && p->mode && p->F && p->lam && p->col && p->Aq && p->Av &&
+    return p->cd && p->sa && p->fa && p->fb && p->fo && p->fp && p->mode && p->F && p->lam && p->col && p->Aq && p->Av &&
                    p->y && p->ya && p->yt && p->yo && p->ys && p->ga && p->Ua && p->st.q && p->st.acc && p->acc_work && p->st.v &&
                    p->st.P && p->st.g && p->st.active
                ? PD_OK
                : PD_ENOMEM;
 }
 
-/* Factor M once; KV damping c_a = 2 zeta_a sqrt(kc m_a), m_a = 1 / (W_a^T M^-1 W_a). */
+/* x = M^-1 x: entrywise for a diagonal M, else by the factor. */
+static void mass_solve(const pen *p, double *x)
+{
+    if (p->minv)
+        for (int i = 0; i < p->n; i++)
+            x[i] *= p->minv[i];
+    else
+        pd_factor_solve(p->fac, x);
+}
+
+/* W_a^T M^-1 W_a, W_a dense in p->col. */
+static double inverse_mass(pen *p, int a)
+{
+    double s = 0.0;
+    if (!p->minv) {
+        pd_factor_delassus_dense(p->fac, &a, 1, &s);
+        return s;
+    }
+    memset(p->col, 0, (size_t)p->n * sizeof(double));
+    pd_matrix_col_axpy(&p->md->W, a, 1.0, p->col);
+    for (int i = 0; i < p->n; i++)
+        s += p->col[i] * p->col[i] * p->minv[i];
+    return s;
+}
+
+/* M^-1 once: a diagonal M (and the automatic storage) is inverted entrywise,
+ * any other factored; KV damping c_a = 2 zeta_a sqrt(kc m_a), m_a = 1 / (W_a^T
+ * M^-1 W_a). */
 static int setup_mass(pen *p, pd_err *err)
 {
     const pd_model *md = p->md;
-    if (!(p->fac = pd_factor_alloc(md, 0.0, 1.0, p->o.factor, err)))
+    if (p->o.factor == PD_FACTOR_AUTO && pd_matrix_is_diagonal(&md->M)) {
+        if (!(p->minv = malloc((size_t)p->n * sizeof(double))))
+            return pd_err_set(err, PD_ENOMEM, "penalty: out of memory for n = %d", p->n);
+        for (int i = 0; i < p->n; i++) {
+            double Mii = pd_matrix_get(&md->M, i, i);
+            if (!(Mii > 0.0))
+                return pd_err_set(err, PD_ESINGULAR, "penalty: the mass matrix M is singular");
+            p->minv[i] = 1.0 / Mii;
+        }
+        p->res.diagonal_mass = 1;
+    } else if (!(p->fac = pd_factor_alloc(md, 0.0, 1.0, p->o.factor, err)))
         return err && err->status == PD_ESINGULAR
                    ? pd_err_set(err, PD_ESINGULAR, "penalty: the mass matrix M is singular")
                    : (err ? err->status : PD_ENOMEM);
     for (int a = 0; a < p->m; a++) {
-        double s;
-        pd_factor_delassus_dense(p->fac, &a, 1, &s);
+        double s = inverse_mass(p, a);
+        p->sa[a] = s;
         if (!(s > 0.0) || !isfinite(s))
             return pd_err_set(err, PD_EINVAL,
                               "penalty: contact %d has no effective mass (W_a^T M^-1 W_a = %g)",
@@ -289,7 +343,7 @@ static int rhs_value(pen *p, double t, const double y[], double dydt[])
         contact_forces(p, q, v, p->lam);
         pd_matrix_gemv(&md->W, 1.0, p->lam, 1.0, r);
     }
-    pd_factor_solve(p->fac, r);
+    mass_solve(p, r);
     memmove(dydt, v, (size_t)n * sizeof(double));
     for (size_t i = 0; i < p->dim; i++)
         if (!isfinite(dydt[i]))
@@ -366,14 +420,14 @@ static int jacobian(double t, const double y[], double *dfdy, double dfdt[], voi
         for (int j = 0; j < n; j++) {
             const double *A = blk ? p->Av : p->Aq;
             memcpy(p->col, A + (size_t)j * n, (size_t)n * sizeof(double));
-            pd_factor_solve(p->fac, p->col);
+            mass_solve(p, p->col);
             for (int i = 0; i < n; i++)
                 dfdy[(size_t)(n + i) * dim + (size_t)(blk * n + j)] = p->col[i];
         }
     force_rate(p, t, dfdt + n);
     for (int i = 0; i < n; i++)
         dfdt[i] = 0.0;
-    pd_factor_solve(p->fac, dfdt + n);
+    mass_solve(p, dfdt + n);
     return GSL_SUCCESS;
 }
 
@@ -449,8 +503,13 @@ static int probe(pen *p, double ta, const double *ya, double tb, double *yb, pd_
     gsl_odeiv2_evolve_reset(d->e);
     gsl_odeiv2_step_reset(d->s);
     int rc = PD_OK;
+    p->probe_f = 0;
     while (t < tb && !rc)
         rc = evolve_once(p, d, &t, tb, &h, yb, err);
+    if (!rc && t > ta && (*p->stp->probe)->gives_exact_dydt_out) {
+        memcpy(p->fp, d->e->dydt_out, p->dim * sizeof(double));
+        p->probe_f = 1;
+    }
     return rc;
 }
 
@@ -482,15 +541,17 @@ static void notify(pen *p, pd_observer fn, void *ctx)
         p->stopped = 1;
 }
 
-/* on_step: the state at t (end of a step, or t0) with its accelerations. */
-static void notify_step(pen *p, double t)
+/* on_step: the state at t (end of a step, or t0) with its accelerations:
+ * from f = y' there under the engaged set when the caller has it (a step's
+ * end without a switch: GSL's own evaluation), else evaluated (counted). */
+static void notify_step(pen *p, double t, const double *f)
 {
     if (!p->o.on_step || p->stopped)
         return;
     fill_state(p, t, p->y);
-    p->st.has_acc = rhs_value(p, t, p->y, p->acc_work) == GSL_SUCCESS;
+    p->st.has_acc = f || rhs(t, p->y, p->acc_work, p) == GSL_SUCCESS;
     if (p->st.has_acc)
-        memcpy(p->st.acc, p->acc_work + p->n, (size_t)p->n * sizeof(double));
+        memcpy(p->st.acc, (f ? f : p->acc_work) + p->n, (size_t)p->n * sizeof(double));
     notify(p, p->o.on_step, p->o.on_step_ctx);
 }
 
@@ -572,129 +633,6 @@ static int hermite_critical(double f0, double d0, double f1, double d1, double h
     return k;
 }
 
-/* phi = sigma g with sigma = +1 released, -1 engaged: a crossing makes phi < 0. */
-static double phi_sign(const pen *p, int a)
-{
-    return p->mode[a] ? -1.0 : 1.0;
-}
-
-/* Smallest s in (0, h] where the cubic of phi (ends a: start, b: end) may turn
- * negative: h if phi_b < 0, the dip's bottom if the cubic dips below zero,
- * else 0 (no crossing). */
-static double crossing_bound(double fa, double da, double fb, double db, double h)
-{
-    double s[2];
-    if (fb < 0.0)
-        return h;
-    if (!(fa > 0.0 && da < 0.0 && db > 0.0))
-        return 0.0;
-    int k = hermite_critical(fa, da, fb, db, h, s);
-    for (int i = 0; i < k; i++)
-        if (hermite(fa, da, fb, db, h, s[i]) < 0.0)
-            return s[i];
-    return 0.0;
-}
-
-/* phi_a and its rate at ta + s (probe state left in p->yt). */
-static int phi_at(pen *p, int a, double ta, double s, double *f, double *df, pd_err *err)
-{
-    int rc = probe(p, ta, p->ya, ta + s, p->yt, err);
-    double sg = phi_sign(p, a);
-    *f = sg * gap_of(p, a, p->yt);
-    *df = sg * rate_of(p, a, p->yt + p->n);
-    return rc;
-}
-
-/* Root of phi_a in (0, hi] with phi_a(hi) < 0 by safeguarded Newton from the
- * cubic's estimate; *s gets the crossing, p->yt the state there (the last
- * trial is the answer). */
-static int locate_root(pen *p, int a, double ta, double hi, const double cub[4], double h,
-                       double *s, pd_err *err)
-{
-    double lo = 0.0, x = hi, f, df;
-    int rc;
-    for (int it = 0; it < 60; it++) { /* the cubic's root in [lo, hi] by bisection */
-        double mid = 0.5 * (lo + x);
-        if (hermite(cub[0], cub[1], cub[2], cub[3], h, mid) < 0.0)
-            x = mid;
-        else
-            lo = mid;
-    }
-    lo = 0.0;
-    for (int it = 0;; it++) {
-        if ((rc = phi_at(p, a, ta, x, &f, &df, err)))
-            return rc;
-        *(f < 0.0 ? &hi : &lo) = x;
-        double tol = 4.0 * DBL_EPSILON * (fabs(ta) + hi);
-        double nx = df != 0.0 ? x - f / df : 0.5 * (lo + hi);
-        if (f == 0.0 || fabs(nx - x) <= tol || hi - lo <= tol || it == 100)
-            break;
-        x = nx > lo && nx < hi ? nx : 0.5 * (lo + hi);
-    }
-    *s = x;
-    return PD_OK;
-}
-
-/* Engage or release element a at the current state p->y; Hertz-damp takes
- * c_a = 3 kc (1 - e^2) / (4 v_a) from the approach speed v_a = -W_a^T v. */
-static void switch_element(pen *p, int a)
-{
-    p->mode[a] = (unsigned char)!p->mode[a];
-    p->res.switches++;
-    if (p->mode[a] && p->o.law == PD_PENALTY_HERTZDAMP) {
-        double e = p->md->e[a], vimp = -rate_of(p, a, p->y + p->n);
-        p->vseen = fmax(p->vseen, vimp);
-        p->cd[a] = pd_hertz_damping(p->o.kc, e, vimp, p->vfloor, p->vseen);
-    }
-}
-
-/* After a step (ta, ya) -> (*t, p->y): find the earliest crossing; if any,
- * cut the step there (p->y, *t) and return its contact in *which (else -1). */
-static int earliest_crossing(pen *p, double ta, double *t, int *which, pd_err *err)
-{
-    double h = *t - ta, best = h;
-    const double *vb = p->y + p->n;
-    int rc;
-    *which = -1;
-    for (int a = 0; a < p->m; a++) {
-        double sg = phi_sign(p, a), s;
-        double cub[4] = {sg * p->ga[a], sg * p->Ua[a], sg * gap_of(p, a, p->y),
-                         sg * rate_of(p, a, vb)};
-        double bound = crossing_bound(cub[0], cub[1], cub[2], cub[3], h);
-        if (!(bound > 0.0))
-            continue;
-        if (bound < h) { /* a dip: is the true phi negative at its bottom? */
-            double f, df;
-            if ((rc = phi_at(p, a, ta, bound, &f, &df, err)))
-                return rc;
-            if (f >= 0.0)
-                continue;
-        }
-        if ((rc = locate_root(p, a, ta, bound, cub, h, &s, err)))
-            return rc;
-        if (s <= best) {
-            best = s;
-            *which = a;
-            memcpy(p->yo, p->yt, p->dim * sizeof(double));
-        }
-    }
-    if (*which >= 0) {
-        memcpy(p->y, p->yo, p->dim * sizeof(double));
-        *t = ta + best;
-    }
-    return PD_OK;
-}
-
-/* Switch the crossing contact, and any other already across at this state. */
-static void apply_switches(pen *p, int which)
-{
-    for (int a = 0; a < p->m; a++) {
-        double phi = phi_sign(p, a) * gap_of(p, a, p->y);
-        if (a == which || phi < 0.0)
-            switch_element(p, a);
-    }
-}
-
 /* The quintic Hermite of (f, f', f'') on [0, h] at time s: value, and slope in *df. */
 static double quintic(const double e0[3], const double e1[3], double h, double s, double *df)
 {
@@ -726,28 +664,224 @@ static double quintic_min(const double e0[3], const double e1[3], double h)
     return best;
 }
 
+/* y' at the step's ends under its engaged set: GSL's evolve evaluates both
+ * (dydt_in, dydt_out) for every stepper offered; one that did not would get
+ * them here, counted. */
+static void step_rates(pen *p, double ta, double tb)
+{
+    const gsl_odeiv2_evolve *e = p->main_drv->e;
+    const gsl_odeiv2_step_type *T = *p->stp->type;
+    if (T->can_use_dydt_in)
+        memcpy(p->fa, e->dydt_in, p->dim * sizeof(double));
+    else
+        rhs(ta, p->ya, p->fa, p);
+    if (T->gives_exact_dydt_out)
+        memcpy(p->fb, e->dydt_out, p->dim * sizeof(double));
+    else
+        rhs(tb, p->y, p->fb, p);
+}
+
+/* phi = sigma g with sigma = +1 released, -1 engaged: a crossing makes phi < 0. */
+static double phi_sign(const pen *p, int a)
+{
+    return p->mode[a] ? -1.0 : 1.0;
+}
+
+/* (phi, phi', phi'') of contact a at the step's start (e0) and end (e1). */
+static void phi_jets(const pen *p, int a, double e0[3], double e1[3])
+{
+    double sg = phi_sign(p, a);
+    int n = p->n;
+    e0[0] = sg * p->ga[a];
+    e0[1] = sg * p->Ua[a];
+    e0[2] = sg * rate_of(p, a, p->fa + n);
+    e1[0] = sg * gap_of(p, a, p->y);
+    e1[1] = sg * rate_of(p, a, p->y + n);
+    e1[2] = sg * rate_of(p, a, p->fb + n);
+}
+
+/* Whether element a may stay on the wrong side of g = 0 by the depth dep
+ * (gap rate r) for up to h without the crossing being located: the element's
+ * force there, for the time it takes to get that deep (dep / |r|, at most h),
+ * changes the velocities by W_a^T M^-1 W_a |lambda| min(h, dep / |r|); with
+ * that and dep itself within atol, locating the crossing would change the
+ * state by less than GSL's error control allows a step.  (Hertz-damp's
+ * force at depth dep is at most 1.75 kc dep^1.5.) */
+static int tolerable(const pen *p, int a, double dep, double r, double h)
+{
+    double kc = p->o.kc, ar = fabs(r);
+    dep = fabs(dep);
+    if (!(dep <= p->o.atol))
+        return 0;
+    double lam = p->o.law == PD_PENALTY_KELVIN ? kc * dep + p->cd[a] * ar
+                                               : 1.75 * kc * dep * sqrt(dep);
+    double tw = ar > 0.0 ? fmin(h, dep / ar) : h;
+    return p->sa[a] * lam * tw <= p->o.atol;
+}
+
+/* Smallest s in (0, h] where the cubic of phi (ends a: start, b: end) may turn
+ * negative: h if phi_b < 0, the dip's bottom if the cubic dips below zero,
+ * else 0 (no crossing). */
+static double crossing_bound(double fa, double da, double fb, double db, double h)
+{
+    double s[2];
+    if (fb < 0.0)
+        return h;
+    if (!(fa > 0.0 && da < 0.0 && db > 0.0))
+        return 0.0;
+    int k = hermite_critical(fa, da, fb, db, h, s);
+    for (int i = 0; i < k; i++)
+        if (hermite(fa, da, fb, db, h, s[i]) < 0.0)
+            return s[i];
+    return 0.0;
+}
+
+/* phi_a and its rate at ta + s (probe state left in p->yt). */
+static int phi_at(pen *p, int a, double ta, double s, double *f, double *df, pd_err *err)
+{
+    int rc = probe(p, ta, p->ya, ta + s, p->yt, err);
+    double sg = phi_sign(p, a);
+    *f = sg * gap_of(p, a, p->yt);
+    *df = sg * rate_of(p, a, p->yt + p->n);
+    return rc;
+}
+
+/* Root of phi_a in (0, hi] with phi_a(hi) < 0: the quintic Hermite's root
+ * (the cubic's where the quintic stays positive), then safeguarded Newton on
+ * probes until the state is within the tolerance of the crossing (tolerable)
+ * or converged; *s gets the crossing, p->yt the state there (the last trial
+ * is the answer). */
+static int locate_root(pen *p, int a, double ta, double hi, const double e0[3],
+                       const double e1[3], double h, double *s, pd_err *err)
+{
+    double lo = 0.0, x = hi, f, df, d;
+    int use5 = quintic(e0, e1, h, hi, &d) < 0.0;
+    int rc;
+    for (int it = 0; it < 60; it++) { /* the interpolant's root in [lo, x] by bisection */
+        double mid = 0.5 * (lo + x);
+        double v = use5 ? quintic(e0, e1, h, mid, &d)
+                        : hermite(e0[0], e0[1], e1[0], e1[1], h, mid);
+        *(v < 0.0 ? &x : &lo) = mid;
+    }
+    lo = 0.0;
+    for (int it = 0;; it++) {
+        if ((rc = phi_at(p, a, ta, x, &f, &df, err)))
+            return rc;
+        *(f < 0.0 ? &hi : &lo) = x;
+        double tol = 4.0 * DBL_EPSILON * (fabs(ta) + hi);
+        double nx = df != 0.0 ? x - f / df : 0.5 * (lo + hi);
+        if (f == 0.0 || tolerable(p, a, f, df, h) || fabs(nx - x) <= tol || hi - lo <= tol ||
+            it == 100)
+            break;
+        x = nx > lo && nx < hi ? nx : 0.5 * (lo + hi);
+    }
+    *s = x;
+    return PD_OK;
+}
+
+/* Engage or release element a at the current state p->y; Hertz-damp takes
+ * c_a = 3 kc (1 - e^2) / (4 v_a) from the approach speed v_a = -W_a^T v. */
+static void switch_element(pen *p, int a)
+{
+    p->mode[a] = (unsigned char)!p->mode[a];
+    p->res.switches++;
+    if (p->mode[a] && p->o.law == PD_PENALTY_HERTZDAMP) {
+        double e = p->md->e[a], vimp = -rate_of(p, a, p->y + p->n);
+        p->vseen = fmax(p->vseen, vimp);
+        p->cd[a] = pd_hertz_damping(p->o.kc, e, vimp, p->vfloor, p->vseen);
+    }
+}
+
+/* After a step (ta, ya) -> (*t, p->y): find the earliest crossing that must
+ * be located; if any, cut the step there (p->y, *t, its rates in p->fb) and
+ * return its contact in *which (else -1).  A crossing the tolerance lets
+ * pass (tolerable: the end across by no more, a dip no deeper) is not
+ * located: *across says an element ended the step across, to be switched
+ * there. */
+static int earliest_crossing(pen *p, double ta, double *t, int *which, int *across, pd_err *err)
+{
+    double h = *t - ta, best = h;
+    int rc;
+    *which = -1;
+    *across = 0;
+    for (int a = 0; a < p->m; a++) {
+        double e0[3], e1[3], s;
+        phi_jets(p, a, e0, e1);
+        double bound = crossing_bound(e0[0], e0[1], e1[0], e1[1], h);
+        if (!(bound > 0.0))
+            continue;
+        if (bound < h) { /* a dip: is the true phi negative at its bottom? */
+            double f, df;
+            if (tolerable(p, a, hermite(e0[0], e0[1], e1[0], e1[1], h, bound), 0.0, h))
+                continue;
+            if ((rc = phi_at(p, a, ta, bound, &f, &df, err)))
+                return rc;
+            if (f >= 0.0)
+                continue;
+        } else if (tolerable(p, a, e1[0], e1[1], h)) {
+            *across = 1;
+            continue;
+        }
+        if ((rc = locate_root(p, a, ta, bound, e0, e1, h, &s, err)))
+            return rc;
+        if (s <= best) {
+            best = s;
+            *which = a;
+            memcpy(p->yo, p->yt, p->dim * sizeof(double));
+            if (p->probe_f)
+                memcpy(p->fo, p->fp, p->dim * sizeof(double));
+            else
+                rhs(ta + s, p->yo, p->fo, p);
+        }
+    }
+    if (*which >= 0) {
+        memcpy(p->y, p->yo, p->dim * sizeof(double));
+        memcpy(p->fb, p->fo, p->dim * sizeof(double));
+        *t = ta + best;
+    }
+    return PD_OK;
+}
+
+/* Switch the located crossing's contact (which >= 0), and every other one
+ * across at this state and still moving across (phi < 0, phi' <= 0): one
+ * across by rounding but already coming back is left alone, else it would
+ * switch back and forth at one instant.  Returns how many switched. */
+static int apply_switches(pen *p, int which)
+{
+    int k = 0;
+    for (int a = 0; a < p->m; a++) {
+        double sg = phi_sign(p, a), phi = sg * gap_of(p, a, p->y);
+        double dphi = sg * rate_of(p, a, p->y + p->n);
+        if (a == which || (phi < 0.0 && dphi <= 0.0)) {
+            switch_element(p, a);
+            k++;
+        }
+    }
+    return k;
+}
+
 /* Smallest gap a over the step (ta, ya) -> (ta + h, p->y): the cubic of
- * (g, U) tells whether it dips inside; then the quintic with g'' = W^T a
- * (two RHS evaluations under the step's engaged set) gives its bottom. */
-static double step_min_gap(pen *p, int a, double ta, double h)
+ * (g, U) tells whether it dips inside; then the quintic with g'' = W^T a at
+ * both ends (GSL's own evaluations, p->fa and p->fb) gives its bottom. */
+static double step_min_gap(pen *p, int a, double h)
 {
     double g1 = gap_of(p, a, p->y), U1 = rate_of(p, a, p->y + p->n), s[2];
     double gmin = fmin(p->ga[a], g1), cub = gmin;
     int k = h > 0.0 ? hermite_critical(p->ga[a], p->Ua[a], g1, U1, h, s) : 0;
     for (int i = 0; i < k; i++)
         cub = fmin(cub, hermite(p->ga[a], p->Ua[a], g1, U1, h, s[i]));
-    if (!(cub < gmin) || rhs(ta, p->ya, p->yt, p) || rhs(ta + h, p->y, p->yo, p))
+    if (!(cub < gmin))
         return cub;
-    double e0[3] = {p->ga[a], p->Ua[a], rate_of(p, a, p->yt + p->n)};
-    double e1[3] = {g1, U1, rate_of(p, a, p->yo + p->n)};
+    double e0[3] = {p->ga[a], p->Ua[a], rate_of(p, a, p->fa + p->n)};
+    double e1[3] = {g1, U1, rate_of(p, a, p->fb + p->n)};
     return quintic_min(e0, e1, h);
 }
 
 /* min gap over the step and the largest engaged penetration rate at its end. */
-static void track_extremes(pen *p, double ta, double h)
+static void track_extremes(pen *p, double h)
 {
     for (int a = 0; a < p->m; a++) {
-        p->res.min_gap = fmin(p->res.min_gap, step_min_gap(p, a, ta, h));
+        p->res.min_gap = fmin(p->res.min_gap, step_min_gap(p, a, h));
         if (p->mode[a])
             p->res.max_penetration_velocity =
                 fmax(p->res.max_penetration_velocity, -rate_of(p, a, p->y + p->n));
@@ -771,7 +905,7 @@ static int one_step(pen *p, double *t, double tb, double *h, pd_err *err)
 {
     gsl_odeiv2_driver *d = p->main_drv;
     double ta = *t;
-    int which, rc;
+    int which, across, rc;
     if (p->res.steps >= p->o.max_steps)
         return pd_err_set(err, PD_EBUDGET,
                           "penalty: budget of %ld accepted steps exhausted at t = %.9g s",
@@ -780,24 +914,34 @@ static int one_step(pen *p, double *t, double tb, double *h, pd_err *err)
     if ((rc = evolve_once(p, d, t, tb, h, p->y, err)))
         return rc;
     p->res.steps++;
-    if ((rc = earliest_crossing(p, ta, t, &which, err)) ||
+    step_rates(p, ta, *t);
+    if ((rc = earliest_crossing(p, ta, t, &which, &across, err)) ||
         (rc = outputs_inside(p, ta, *t, err)))
         return rc;
     p->stalled = *t - ta > PEN_STALL_REL * fmax(fabs(ta), 1.0) ? 0 : p->stalled + 1;
     if (p->stalled > PEN_MAX_STALL) /* switching back and forth at one instant */
-        return pd_err_set(err, PD_ENUMERICAL, "penalty: no progress at t = %.9g s after %d steps "
-                          "(elements switching at one instant; rtol = %g, atol = %g: tighter "
-                          "tolerances or a softer contact may resolve it, Moreau-Jean runs it)",
-                          seconds(p, ta), PEN_MAX_STALL, p->o.rtol, p->o.atol);
-    track_extremes(p, ta, *t - ta);
-    if (which >= 0) {
-        apply_switches(p, which);
-        track_extremes(p, *t, 0.0);
+        return pd_err_set(err, PD_ENUMERICAL,
+                          "penalty: no progress at t = %.9g s (%d steps in a row advanced t by "
+                          "less than %g of it: elements switching at one instant; rtol = %g, "
+                          "atol = %g); --method newmark or moreau run the scene",
+                          seconds(p, ta), PEN_MAX_STALL, PEN_STALL_REL, p->o.rtol, p->o.atol);
+    track_extremes(p, *t - ta);
+    int switching = which >= 0 || across, switched = 0;
+    if (switching) { /* the step's end under the set it ran with (left limits) */
+        notify_step(p, *t, p->fb);
+        switched = apply_switches(p, which);
+    }
+    if (switched)
+        track_extremes(p, 0.0);
+    if (which >= 0) { /* the step was cut: its stepper restarts from the crossing */
         gsl_odeiv2_evolve_reset(d->e);
         gsl_odeiv2_step_reset(d->s);
     }
     output_at_end(p, *t);
-    notify_step(p, *t);
+    if (switched) /* the same instant after the switch (right limits) */
+        notify_step(p, *t, NULL);
+    else if (!switching)
+        notify_step(p, *t, p->fb);
     fill_state(p, *t, p->y);
     if (p->o.h_out == 0.0)
         notify(p, p->observer, p->obs_ctx);
@@ -863,7 +1007,7 @@ static int start(pen *p, double t0, const double *q0, const double *v0, pd_err *
     p->res.switches = 0;
     p->t_out0 = t0;
     p->next_out = 1;
-    notify_step(p, t0);
+    notify_step(p, t0, NULL);
     fill_state(p, t0, p->y);
     notify(p, p->observer, p->obs_ctx);
     return PD_OK;

@@ -659,6 +659,12 @@ double pd_scene_measure_start(const pd_scene *sc, double tend)
  * at every point: at most this many points times n^2 (a uniform building
  * of 50 storeys over 4.5 s: 2.3e7, 0.8 s; 100 storeys: 1.8e8, 17 s). */
 #define SCENE_MAX_MODAL_WORK 1e8
+/* The adaptive penalty follows an engaged Kelvin–Voigt element at about 11
+ * steps a period at the default tolerances (rk8pd; a row of 10 at kc = 1e10
+ * times its storeys' stiffness: 6.3e6 steps over 4 s, 35 s): its elements
+ * count 16 points a period, at most 1e7 of them over the run. */
+#define SCENE_PEN_DIV 16.0
+#define SCENE_PEN_MAX_POINTS 1e7
 
 /* The floor mass at storey level (1-based) of structure s; INFINITY at a wall. */
 static double floor_mass(const pd_scene *sc, int s, int level)
@@ -687,7 +693,8 @@ static double element_stiffness(const pd_scene *sc, const pd_run_opts *o)
 /* The work of the methods that resolve every mode (all but Moreau–Jean,
  * whose implicit step is stable at any period) within their budget: a 64th
  * of the shortest period of each structure (and, for Kelvin–Voigt
- * elements, of each contact element on its two floors) over the run. */
+ * elements, a 16th of each contact element's on its two floors) over the
+ * run. */
 static int check_budget(const pd_scene *sc, const pd_run_opts *o, pd_err *err)
 {
     if (o->method == PD_METHOD_MOREAU || o->method == PD_METHOD_NEWMARK)
@@ -717,14 +724,14 @@ static int check_budget(const pd_scene *sc, const pd_run_opts *o, pd_err *err)
     for (int a = 0; a < sc->ncontact; a++) {
         const pd_contact *ct = &sc->ct[a];
         double mred = contact_mass(sc, a);
-        double Tc = PD_TWO_PI * sqrt(mred / kc), pts = SCENE_SCAN_DIV * o->tend / Tc;
-        if (!(pts <= SCENE_MAX_POINTS))
+        double Tc = PD_TWO_PI * sqrt(mred / kc), pts = SCENE_PEN_DIV * o->tend / Tc;
+        if (!(pts <= SCENE_PEN_MAX_POINTS))
             return pd_err_set(err, PD_EINVAL,
                               "contacts[%d]: its element (kc = %.3g N/m on %.3g kg) vibrates with "
                               "a period of %.3g s; --method penalty would follow it at %.3g "
                               "points over %.3g s (at most %.3g): a softer --kc, or --method "
                               "moreau, runs it",
-                              ct->entry, kc, mred, Tc, pts, o->tend, SCENE_MAX_POINTS);
+                              ct->entry, kc, mred, Tc, pts, o->tend, SCENE_PEN_MAX_POINTS);
     }
     return PD_OK;
 }

@@ -465,11 +465,25 @@ static int step_event(const pd_state *st, void *ctx)
     return 0;
 }
 
+/* The element forces integrated since the last sample, by the trapezoid
+ * rule over every point reported (accepted steps and samples, in time
+ * order): samples alone would alias the elements' vibration. */
+static void integrate_forces(track *tr, const pd_state *st)
+{
+    for (int a = 0; a < tr->model_m; a++) {
+        double lam = st->active[a] ? st->P[a] : 0.0;
+        tr->imp[a] += 0.5 * (tr->imp_lam[a] + lam) * (st->t - tr->imp_t);
+        tr->imp_lam[a] = lam;
+    }
+    tr->imp_t = st->t;
+}
+
 /* Penalty, on_step: extremes between reports, engagements, the element
  * impulses by the trapezoid rule over the accepted steps. */
 static int step_penalty(const pd_state *st, void *ctx)
 {
     track *tr = ctx;
+    integrate_forces(tr, st);
     if (tr->have_prev && st->has_acc)
         note_between(tr, st->t, st->q, st->v, st->acc);
     note_point(tr, st->t, st->q);
@@ -496,16 +510,13 @@ static int step_penalty(const pd_state *st, void *ctx)
 }
 
 /* The output grid (event-driven, penalty): impulses since the last sample
- * (event impulses summed by step_event; element forces integrated here). */
+ * (event impulses summed by step_event; element forces integrated here and
+ * by step_penalty). */
 static int observe_grid(const pd_state *st, void *ctx)
 {
     track *tr = ctx;
     if (tr->method == PD_METHOD_PENALTY || tr->method == PD_METHOD_NEWMARK)
-        for (int a = 0; a < tr->model_m; a++) {
-            double lam = st->active[a] ? st->P[a] : 0.0;
-            tr->imp[a] += 0.5 * (tr->imp_lam[a] + lam) * (st->t - tr->imp_t);
-            tr->imp_lam[a] = lam;
-        }
+        integrate_forces(tr, st);
     tr->imp_t = st->t;
     return sample(tr, st);
 }
@@ -781,7 +792,8 @@ static int run_penalty(const pd_model *md, const pd_run_opts *o, double tau_end,
                             &pr, err);
     res->steps = pr.steps;
     res->kernel = pr.stepper ? pr.stepper : "penalty";
-    res->factor = pd_factor_kind_name(pd_factor_choose(md, o->factor));
+    res->factor =
+        pr.diagonal_mass ? "diagonal" : pd_factor_kind_name(pd_factor_choose(md, o->factor));
     res->lcp_solver = "none";
     return rc;
 }

@@ -502,7 +502,8 @@ static int record_end(const pd_state *st, void *ctx)
  * away.  Without damping and with e = 1 the total energy is kept to the
  * tolerances through many engagements (both laws); with e = 0.5 and
  * damping, the implicit steppers (Jacobian with n = 2) agree with rk8pd.
- * Outputs land on t_k = k h_out; on_step sees every accepted step. */
+ * Outputs land on t_k = k h_out; on_step sees every accepted step (and an
+ * instant of switches twice). */
 static void test_penalty_two_mass_chain(pd_test_ctx *ctx)
 {
     double M[4] = {1, 0, 0, 2}, K[4] = {2, -1, -1, 1}, C[4] = {0.02, 0, 0, 0.01};
@@ -526,8 +527,10 @@ static void test_penalty_two_mass_chain(pd_test_ctx *ctx)
         CHECK(ctx, res.switches >= 10 && res.min_gap < 0.0, "law %d: %ld switches, min gap %.3g",
               law, res.switches, res.min_gap);
         CHECK(ctx, ct.worst <= 1e-8, "law %d: energy drift %.3g", law, ct.worst);
-        CHECK(ctx, ct.calls == res.steps + 1, "law %d: on_step %ld calls for %ld steps", law,
-              ct.calls, res.steps);
+        /* once a step, and at a switch once more (before and after it) */
+        CHECK(ctx, ct.calls > res.steps + 1 && ct.calls <= res.steps + 1 + res.switches,
+              "law %d: on_step %ld calls for %ld steps, %ld switches", law, ct.calls, res.steps,
+              res.switches);
         CHECK(ctx, ct.outputs == 2001 && ct.worst_grid <= 1e-12,
               "law %d: %ld outputs, off the grid by %.3g", law, ct.outputs, ct.worst_grid);
     }
@@ -559,6 +562,203 @@ static void test_penalty_two_mass_chain(pd_test_ctx *ctx)
               "%s: end q (%.10g, %.10g) vs (%.10g, %.10g), min gap %.10g vs %.10g, switches %ld vs %ld",
               names[s], q_end[s][0], q_end[s][1], q_end[0][0], q_end[0][1], gmin[s], gmin[0],
               sw[s], sw[0]);
+}
+
+/* ---- the adaptive integration's costs (issue 20) ----------------------- */
+
+/* The two-mass chain of test_penalty_two_mass_chain with damping and
+ * e = 0.5 (Kelvin-Voigt, kc = 1e5): with a diagonal M and the automatic
+ * storage, M^-1 is applied entrywise (no factor); the dense and CHOLMOD
+ * factors are the general path.  The same switches, and end states and min
+ * gap equal to 1e-10: the paths differ by rounding alone (1 / M_ii against
+ * a Cholesky solve), which ten switches and the tolerances (1e-10) may
+ * amplify, not beyond them (measured: dense identical, CHOLMOD 8.7e-13). */
+static void test_penalty_diagonal_mass_path(pd_test_ctx *ctx)
+{
+    double M[4] = {1, 0, 0, 2}, K[4] = {2, -1, -1, 1}, C[4] = {0.02, 0, 0, 0.01};
+    double W[4] = {1, 0, 0, -1}, g0[2] = {0.1, 0.1}, v0[2] = {-1.0, 0.7}, e5[2] = {0.5, 0.5};
+    const pd_factor_kind kinds[3] = {PD_FACTOR_AUTO, PD_FACTOR_DENSE, PD_FACTOR_CHOLMOD};
+    double q_end[3][2], gmin[3];
+    long sw[3];
+    int diag[3];
+    for (int s = 0; s < 3; s++) {
+        pd_model md = {.n = 2, .m = 2, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_dense(2, 2, C), .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_dense(2, 2, W), .g0 = g0, .e = e5};
+        pd_penalty_opts o = pd_penalty_default_opts();
+        pd_penalty_result res;
+        pd_err e;
+        o.kc = 1e5;
+        o.factor = kinds[s];
+        CHECK(ctx, pd_penalty_run(&md, 0.0, NULL, v0, 8.0, &o, record_end, q_end[s], &res, &e) ==
+                       PD_OK,
+              "factor %d: %s", (int)kinds[s], e.msg);
+        gmin[s] = res.min_gap;
+        sw[s] = res.switches;
+        diag[s] = res.diagonal_mass;
+    }
+    CHECK(ctx, diag[0] && !diag[1] && !diag[2], "diagonal path taken: auto %d, dense %d, cholmod %d",
+          diag[0], diag[1], diag[2]);
+    for (int s = 1; s < 3; s++)
+        CHECK(ctx, fabs(q_end[s][0] - q_end[0][0]) + fabs(q_end[s][1] - q_end[0][1]) <= 1e-10 &&
+                       fabs(gmin[s] - gmin[0]) <= 1e-10 * fabs(gmin[0]) && sw[s] == sw[0] &&
+                       sw[0] >= 4,
+              "factor %d: end q (%.14g, %.14g) vs diagonal (%.14g, %.14g), min gap %.14g vs "
+              "%.14g, switches %ld vs %ld",
+              (int)kinds[s], q_end[s][0], q_end[s][1], q_end[0][0], q_end[0][1], gmin[s], gmin[0],
+              sw[s], sw[0]);
+}
+
+/* The smallest gap of contact 0 on a fine grid of outputs, each local
+ * minimum of the samples refined by the parabola through its neighbours,
+ * and the smallest gap at the accepted steps' ends. */
+typedef struct gap_track {
+    double t[3], g[3];
+    long k;
+    double fine, ends;
+} gap_track;
+
+static int track_fine_gap(const pd_state *st, void *ctx)
+{
+    gap_track *gt = ctx;
+    gt->t[0] = gt->t[1], gt->g[0] = gt->g[1];
+    gt->t[1] = gt->t[2], gt->g[1] = gt->g[2];
+    gt->t[2] = st->t, gt->g[2] = st->g[0];
+    gt->fine = fmin(gt->fine, st->g[0]);
+    if (++gt->k >= 3 && gt->g[1] < gt->g[0] && gt->g[1] <= gt->g[2]) {
+        double h = gt->t[1] - gt->t[0], d2 = gt->g[0] - 2.0 * gt->g[1] + gt->g[2];
+        double d1 = 0.5 * (gt->g[2] - gt->g[0]);
+        if (d2 > 0.0 && fabs(gt->t[2] - gt->t[1] - h) <= 1e-9 * h)
+            gt->fine = fmin(gt->fine, gt->g[1] - 0.5 * d1 * d1 / d2);
+    }
+    return 0;
+}
+
+static int track_end_gap(const pd_state *st, void *ctx)
+{
+    gap_track *gt = ctx;
+    gt->ends = fmin(gt->ends, st->g[0]);
+    return 0;
+}
+
+/* The deepest penetration (min_gap) is refined inside each accepted step on
+ * the quintic Hermite of (g, g', g''), g'' from GSL's own evaluations at the
+ * step's ends (no extra right-hand side).  Against a fine-step reference
+ * (outputs every 2e-5 s, each integrated to the tolerances, the sampled
+ * minimum refined by a parabola: error ~ h^3 g''' ~ 1e-10) on the two-mass
+ * chain (Kelvin-Voigt, kc = 1e5, 2 s): equal to 1e-8 of the penetration
+ * (measured 1.4e-9), while the steps' ends alone miss it by more than 1e-4
+ * of it (measured 4.9e-4). */
+static void test_penalty_extremum_from_interpolant(pd_test_ctx *ctx)
+{
+    double M[4] = {1, 0, 0, 2}, K[4] = {2, -1, -1, 1}, C[4] = {0.02, 0, 0, 0.01};
+    double W[4] = {1, 0, 0, -1}, g0[2] = {0.1, 0.1}, v0[2] = {-1.0, 0.7}, e5[2] = {0.5, 0.5};
+    pd_model md = {.n = 2, .m = 2, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_dense(2, 2, C), .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_dense(2, 2, W), .g0 = g0, .e = e5};
+    pd_penalty_opts o = pd_penalty_default_opts();
+    pd_penalty_result res;
+    pd_err e;
+    gap_track gt = {.fine = HUGE_VAL, .ends = HUGE_VAL};
+    o.kc = 1e5;
+    o.h_out = 2e-5;
+    o.on_step = track_end_gap;
+    o.on_step_ctx = &gt;
+    if (!CHECK(ctx, pd_penalty_run(&md, 0.0, NULL, v0, 2.0, &o, track_fine_gap, &gt, &res, &e) ==
+                        PD_OK,
+               "%s", e.msg))
+        return;
+    double pen = -gt.fine;
+    CHECK(ctx, pen > 0.0 && fabs(res.min_gap - gt.fine) <= 1e-8 * pen &&
+                   gt.ends - res.min_gap > 1e-4 * pen,
+          "min gap %.15g, fine reference %.15g (%.3g of the penetration), step ends %.15g",
+          res.min_gap, gt.fine, fabs(res.min_gap - gt.fine) / pen, gt.ends);
+}
+
+/* A row of 30 under Kelvin-Voigt elements 1e8 times its storeys' stiffness
+ * (issue 20): the elements used to switch back and forth at one instant
+ * (a released one a rounding error across g = 0 but already opening was
+ * engaged again), a run of 681 s, then stopped by the stall guard at
+ * t = 0.26 s.  The first 0.4 s (the first impacts from 0.24 s, the former
+ * stall included) now run, and the peak displacements agree with Newmark's
+ * (the same elements, 10 steps per element period) and Moreau-Jean's
+ * (dt = 1e-5 s, rigid contacts) to 1e-2: the elements' compliance and
+ * near-simultaneous impacts in the compressed row (measured 4.9e-3 and
+ * 5.0e-3). */
+static void test_penalty_stiff_row_runs(pd_test_ctx *ctx)
+{
+    pd_scene_excitation xc = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0};
+    pd_scene *row = NULL;
+    pd_scene_result r[3] = {{0}};
+    pd_err e;
+    if (!CHECK(ctx, !pd_scene_chain(30, &xc, 1.0, 1.5, 0.05, 0.05 / (TWO_PI * TWO_PI), 0.5, &row,
+                                    &e) &&
+                        !pd_scene_result_alloc(row, &r[0], &e) &&
+                        !pd_scene_result_alloc(row, &r[1], &e) &&
+                        !pd_scene_result_alloc(row, &r[2], &e),
+               "%s", e.msg))
+        goto done;
+    const pd_method methods[3] = {PD_METHOD_PENALTY, PD_METHOD_NEWMARK, PD_METHOD_MOREAU};
+    for (int k = 0; k < 3; k++) {
+        pd_run_opts o = pd_run_default_opts();
+        o.method = methods[k];
+        o.tend = 0.4;
+        if (k < 2)
+            o.pen.kc_mult = 1e8;
+        else
+            o.dt = 1e-5;
+        int rc = pd_scene_run(row, &o, NULL, NULL, &r[k], &e);
+        if (!CHECK(ctx, rc == PD_OK, "%s: %d %s", pd_method_name(methods[k]), rc, e.msg))
+            goto done;
+    }
+    long impacts = 0;
+    for (int a = 0; a < row->ncontact; a++)
+        impacts += r[0].impacts[a];
+    for (int k = 1; k < 3; k++) {
+        double worst = 0.0;
+        for (int i = 0; i < row->n; i++)
+            worst = fmax(worst, fabs(r[0].umax[i] / r[k].umax[i] - 1.0));
+        CHECK(ctx, worst <= 1e-2 && impacts >= 30, "umax against %s: worst %.3g (%ld impacts)",
+              pd_method_name(methods[k]), worst, impacts);
+    }
+done:
+    for (int k = 0; k < 3; k++)
+        pd_scene_result_free(&r[k]);
+    pd_scene_free(row);
+}
+
+/* A row of 2 at kc = 1e9 times the storey stiffness: where an element
+ * switches, on_step reports the step's end under the set it ran with, then
+ * the instant after the switch, so the scene's tracker never interpolates a
+ * step with Kelvin-Voigt's c d' jump in its end acceleration.  Before, the
+ * peak displacement came out 1.2e-1 off the exact row reference (2.4 times
+ * the answer at 1e10); now within 1e-4 (measured 9.0e-6; the elements' own
+ * error, falling like 1 / sqrt(kc)). */
+static void test_penalty_stiff_row_peak(pd_test_ctx *ctx)
+{
+    pd_scene_excitation xc = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0};
+    pd_scene *row = NULL;
+    pd_scene_result r[2] = {{0}};
+    pd_err e;
+    if (!CHECK(ctx, !pd_scene_chain(2, &xc, 1.0, 1.5, 0.05, 0.05 / (TWO_PI * TWO_PI), 0.6, &row,
+                                    &e) &&
+                        !pd_scene_result_alloc(row, &r[0], &e) &&
+                        !pd_scene_result_alloc(row, &r[1], &e),
+               "%s", e.msg))
+        goto done;
+    for (int k = 0; k < 2; k++) {
+        pd_run_opts o = pd_run_default_opts();
+        o.method = k ? PD_METHOD_EVENT : PD_METHOD_PENALTY;
+        o.tend = 4.0;
+        o.pen.kc_mult = 1e9;
+        int rc = pd_scene_run(row, &o, NULL, NULL, &r[k], &e);
+        if (!CHECK(ctx, rc == PD_OK, "%s: %s", k ? "event" : "penalty", e.msg))
+            goto done;
+    }
+    double worst = 0.0;
+    for (int i = 0; i < row->n; i++)
+        worst = fmax(worst, fabs(r[0].umax[i] / r[1].umax[i] - 1.0));
+    CHECK(ctx, worst <= 1e-4, "umax against the exact row reference: worst %.3g", worst);
+done:
+    pd_scene_result_free(&r[0]);
+    pd_scene_result_free(&r[1]);
+    pd_scene_free(row);
 }
 
 /* ---- options ------------------------------------------------------------ */
@@ -654,22 +854,26 @@ static void test_penalty_default_resolves_gap(pd_test_ctx *ctx)
 }
 
 /* Loose tolerances used to switch a contact on and off at one instant for
- * ever (rtol = 0.5 ran for hours): the run now stops with PD_ENUMERICAL
- * after PEN_MAX_STALL steps that end where they began, naming the
- * tolerances, while rtol = 1e-3 on the same case still runs to the end. */
-static void test_penalty_stall_reported(pd_test_ctx *ctx)
+ * ever (rtol = 0.5 ran for hours, then stopped with "no progress"): a
+ * crossing within the tolerance is now switched where the step ends, so
+ * rtol = 0.5 runs to the end (its answer is as loose as asked), and
+ * rtol = 1e-3 agrees with the event-driven reference to 1e-4 of umax
+ * (measured 7.8e-6). */
+static void test_penalty_loose_tolerance_runs(pd_test_ctx *ctx)
 {
     pd_osc c = pd_osc_default();
-    pd_run_opts o = pd_run_default_opts();
-    pd_osc_result res;
+    pd_run_opts o = pd_run_default_opts(), d = pd_run_default_opts();
+    pd_osc_result res, ref;
     pd_err err;
     o.pen.rtol = 0.5;
     int rc = pd_osc_penalty(&c, &o, NULL, NULL, &res, &err);
-    CHECK(ctx, rc == PD_ENUMERICAL && strstr(err.msg, "no progress") && strstr(err.msg, "rtol"),
-          "rtol 0.5: status %d (%s), expected PD_ENUMERICAL naming the tolerances", rc, err.msg);
+    CHECK(ctx, rc == PD_OK && res.impacts > 0, "rtol 0.5: status %d (%s)", rc, err.msg);
     o.pen.rtol = 1e-3;
-    rc = pd_osc_penalty(&c, &o, NULL, NULL, &res, &err);
-    CHECK(ctx, rc == PD_OK && res.impacts > 0, "rtol 1e-3: status %d (%s)", rc, err.msg);
+    rc = pd_osc_penalty(&c, &o, NULL, NULL, &res, &err) ||
+         pd_osc_reference(&c, &d, NULL, NULL, &ref, &err);
+    CHECK(ctx, rc == PD_OK && res.impacts > 0 && fabs(res.umax / ref.umax - 1.0) <= 1e-4,
+          "rtol 1e-3: status %d (%s), umax %.12g against the reference %.12g", rc, err.msg,
+          res.umax, ref.umax);
 }
 
 
@@ -802,7 +1006,7 @@ static void test_newmark_tends_to_adaptive(pd_test_ctx *ctx)
 }
 
 /* A chain of 10 at kc 1e8 times the storey stiffness (the adaptive
- * integration stalls on it: elements switching at one instant): Newmark's
+ * integration stalled on it until issue 20): Newmark's
  * default step (10 per element period) runs it, and its umax agree with
  * Moreau-Jean's to 1 % (the elements' compliance and two discretisations). */
 static void test_newmark_stiff_chain(pd_test_ctx *ctx)
@@ -837,7 +1041,7 @@ static void test_newmark_stiff_chain(pd_test_ctx *ctx)
 
 void suite_penalty(pd_test_ctx *ctx)
 {
-    PD_RUN(ctx, test_penalty_stall_reported);
+    PD_RUN(ctx, test_penalty_loose_tolerance_runs);
     PD_RUN(ctx, test_penalty_default_resolves_gap);
     PD_RUN(ctx, test_penalty_free_flight_exact);
     PD_RUN(ctx, test_penalty_breakpoint_not_crossed);
@@ -851,6 +1055,10 @@ void suite_penalty(pd_test_ctx *ctx)
     PD_RUN(ctx, test_penalty_steppers_agree);
     PD_RUN(ctx, test_penalty_two_mass_chain);
     PD_RUN(ctx, test_penalty_bad_options);
+    PD_RUN(ctx, test_penalty_diagonal_mass_path);
+    PD_RUN(ctx, test_penalty_extremum_from_interpolant);
+    PD_RUN(ctx, test_penalty_stiff_row_runs);
+    PD_RUN(ctx, test_penalty_stiff_row_peak);
     PD_RUN(ctx, test_newmark_kelvin_restitution);
     PD_RUN(ctx, test_newmark_energy_without_contact);
     PD_RUN(ctx, test_newmark_tends_to_adaptive);
