@@ -110,6 +110,7 @@ typedef struct edr_cluster {
     double h;               /* scan step */
     double T_min;           /* shortest period of the flight (incl. the piece) */
     double meas_t;          /* extremes measured up to here */
+    double imp_t;           /* held forces integrated up to here (sampled impulses) */
     /* SDOF / REST */
     int root;               /* root dof */
     pd_sdof osc;
@@ -192,7 +193,8 @@ struct pd_edr {
     pd_edr_result res;
     double *xpos, *xneg, *drift, *gmin;
     long *impacts;
-    double *first, *maxP, *ctime, *imp_out;
+    double *first, *maxP, *ctime, *imp_out; /* imp_out: impulses since the last sample */
+    int sample_forces;         /* the held forces' integrals go into imp_out (a sampler) */
     /* queue: contacts 0..m-1, clusters m..m+nb-1, piece m+nb, output m+nb+1 */
     edr_queue q;
     int slot_piece, slot_out;

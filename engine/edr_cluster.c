@@ -933,6 +933,7 @@ int edr_cluster_start(pd_edr *r, int ci, double t, pd_err *err)
     edr_cluster *c = &r->cl[ci];
     int all_sdof = 1, rc;
     c->t0 = t;
+    c->imp_t = t;
     c->piece = edr_piece_at(r, t);
     c->cached = 0;
     c->ndof = 0;

@@ -455,7 +455,10 @@ typedef struct pd_edr_opts {
     double time_unit;      /* > 0: the model's unit of time in seconds (1 / wp for a
                               scene), for the times the messages give */
     double t_measure;      /* extremes count from here */
-    double h_out;          /* > 0: the observer every h_out from t0 (and at t1) */
+    double h_out;          /* > 0: the observer every h_out from t0 (and at t1); its
+                              state's P: each contact's impulse since the last
+                              output, the impacts' plus its held force integrated */
+    int impacts_only;      /* 1: the outputs' P hold the impacts only (cheaper) */
     const int *below;      /* NULL, or n: the dof whose displacement is subtracted for the
                               drift of dof i (-1: the ground) */
     int no_accumulation;   /* 1: never jump an accumulation */
@@ -472,7 +475,8 @@ typedef struct pd_edr_opts {
 } pd_edr_opts;
 
 /* close_tol 1e-10 (the accumulation's bounce height: one "in contact"
- * scale), length scale 1, time unit 1 s, t_measure 0, no output grid, drift of
+ * scale), length scale 1, time unit 1 s, t_measure 0, no output grid (its P
+ * with the held forces when there is one), drift of
  * each dof against the ground, accumulations jumped, active contacts, 10^7
  * events, bursts of 10^5, 4e9 evaluations, 64 scan divisions, automatic
  * LCP solver. */

@@ -13,7 +13,10 @@
  *              step without; event-driven: an impulse at an event; penalty: an
  *              element engaging);
  *   impulse    of one impact: the step's P_a, the event's P_a, or the integral
- *              of the element force over one engagement;
+ *              of the element force over one engagement; a sample's impulse
+ *              is everything since the previous sample: the contact force
+ *              integrated plus the impacts' impulses (the row reference
+ *              integrates its held forces itself; event-general: impacts);
  *   approach   max over t of x_a - x_b (how far the gap closes);
  *   demands    peak |a_abs| per floor and |V| per storey (demand.c): at every
  *              step (Moreau–Jean, the discrete maximum as for umax); at every
@@ -72,6 +75,9 @@ typedef struct track {
     double *sx, *sv, *sg, *sP, *imp; /* SI scratch; impulses since the last sample */
     double imp_t;                     /* penalty: time the impulses were integrated to */
     double *imp_lam;                  /* penalty: forces at imp_t */
+    int edr_hit;                      /* row reference: an impulsive impact since the
+                                         last sample (its samples' P also hold the
+                                         held contacts' force integrals) */
 } track;
 
 /* ---- results ---------------------------------------------------------------- */
@@ -249,7 +255,11 @@ static int on_edr_event(const pd_edr_event *e, void *ctx)
 {
     track *tr = ctx;
     double us = tr->Le, vs = tr->Le * tr->wp;
-    if (e->kind != PD_EDR_IMPACT || e->t < tr->tau_measure - 0.5 * tr->h)
+    if (e->kind != PD_EDR_IMPACT)
+        return 0;
+    for (int j = 0; j < e->ncontacts; j++)
+        tr->edr_hit |= e->P[j] > 0.0;
+    if (e->t < tr->tau_measure - 0.5 * tr->h)
         return 0;
     for (int side = 0; side < 2; side++) {
         for (int k = 0; k < e->ndofs; k++) {
@@ -636,11 +646,15 @@ static int run_moreau(const pd_model *md, const pd_run_opts *o, long nsteps, tra
 }
 
 /* The row reference's samples: impulses since the last sample come with
- * the state. */
+ * the state (the impacts' and the held contacts' force integrals, so P > 0
+ * does not mean an impact: the demands' cubic is kept to grid intervals
+ * without an impact, which on_edr_event flags). */
 static int observe_edr(const pd_state *st, void *ctx)
 {
     track *tr = ctx;
-    note_demand(tr, st->t, st->q, st->v, st->has_acc ? st->acc : NULL, no_impulse(tr, st));
+    int smooth = !tr->edr_hit;
+    tr->edr_hit = 0;
+    note_demand(tr, st->t, st->q, st->v, st->has_acc ? st->acc : NULL, smooth);
     if (!tr->fn)
         return 0;
     for (int a = 0; a < tr->model_m; a++)
@@ -676,6 +690,7 @@ static int run_event(const pd_scene_model *sm, const pd_run_opts *o, double tau_
     eo.t_measure = tr->tau_measure;
     /* the grid: samples every dt; else the demands' states */
     eo.h_out = tr->fn ? tr->h : tr->demands ? demand_grid(tr) : 0.0;
+    eo.impacts_only = !tr->fn; /* the demands' grid needs no impulses */
     eo.on_event = tr->demands ? on_edr_event : NULL;
     eo.on_event_ctx = tr;
     eo.below = tr->below;
