@@ -515,7 +515,7 @@ static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int
                 ys[1][ncurve][m] = row_error(a, &rows[r]);
                 m++;
             }
-        snprintf(labels[ncurve], sizeof labels[0], "Moreau-Jean theta = %g", a->thetas[t]);
+        snprintf(labels[ncurve], sizeof labels[0], "Moreau\u2013Jean \u03b8 = %g", a->thetas[t]);
         by_dt[ncurve] = (pd_curve){.label = labels[ncurve], .n = m, .x = xs[0][ncurve],
                                    .y = ys[0][ncurve]};
         by_cpu[ncurve] = (pd_curve){.label = labels[ncurve], .n = m, .x = xs[1][ncurve],
@@ -546,7 +546,7 @@ static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int
                 ys[1][ncurve][npen] = row_error(a, &rows[r]);
                 npen++;
             }
-        snprintf(labels[ncurve], sizeof labels[0], "penalty (kc = %g..%g w0^2)", a->kcs[0],
+        snprintf(labels[ncurve], sizeof labels[0], "penalty (kc = %g \u2026 %g \u03c9\u2080\u00b2)", a->kcs[0],
                  a->kcs[a->nkc - 1]);
         by_cpu[ncurve] = (pd_curve){.label = labels[ncurve], .n = npen, .x = xs[1][ncurve],
                                     .y = ys[1][ncurve]};

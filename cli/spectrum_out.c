@@ -270,7 +270,7 @@ static int chart(const char *png, const pd_spectrum *s, const pd_spec_row *rows,
     }
     common_title(s, title, sizeof title);
     pd_chart ch = {.title = title,
-                   .xlabel = use_T0 ? "T_0 [s]" : "Pi_2 = T_p / T_0",
+                   .xlabel = use_T0 ? "T_0 [s]" : "{/Symbol P}_2 = T_p / T_0",
                    .ylabel = ylabel,
                    .logx = 1,
                    .logy = logy,
@@ -291,11 +291,11 @@ int pd_spec_plot(const char *png, const pd_spectrum *s, const pd_spec_row *rows,
     char other[4200];
     size_t len = strlen(png);
     int rc = chart(png, s, rows, 0, offsetof(pd_spec_row, Pi1), 1.0,
-                   "Pi_1 = u_{max} w_p^2 / a_p", 1, err);
+                   "{/Symbol P}_1 = u_{max} {/Symbol w}_p^2 / a_p", 1, err);
     snprintf(other, sizeof other, "%.*s-gamma.png", (int)(len - 4), png);
     if (!rc)
         rc = chart(other, s, rows, 0, offsetof(pd_spec_row, gamma), 1.0,
-                   "gamma = u_{max} / u_{max,free}", 0, err);
+                   "{/Symbol g} = u_{max} / u_{max,free}", 0, err);
     snprintf(other, sizeof other, "%.*s-dim.png", (int)(len - 4), png);
     if (!rc && s->dimensional)
         rc = chart(other, s, rows, 1, offsetof(pd_spec_row, umax), 100.0, "u_{max} [cm]", 1, err);

@@ -125,8 +125,8 @@ static int draw(const pd_scene_sweep_args *a, const sweep_out *o, pd_err *err)
     char title[256];
     snprintf(title, sizeof title, "%s: Pi2 of %s", a->k->scene_path, o->sc->st[o->w.ref].name);
     pd_chart ch = {.title = title,
-                   .xlabel = "Pi_2 = T_p / T_0",
-                   .ylabel = "Pi_1 = u_{max} w_p^2 / a_p",
+                   .xlabel = "{/Symbol P}_2 = T_p / T_0",
+                   .ylabel = "{/Symbol P}_1 = u_{max} {/Symbol w}_p^2 / a_p",
                    .logx = 1,
                    .logy = 1,
                    .ncurves = nc,
