@@ -48,17 +48,24 @@ static void dir_close(const plot_dir *d)
     pd_test_rm_dir(d->dir);
 }
 
+/* Run pound with args (NULL-terminated) and env ("NAME=value") added. */
+static int run_pound_env(const pd_test_ctx *ctx, const char *env, const char *const *args,
+                         proc_out *r)
+{
+    const char *argv[40];
+    int n = 0;
+    argv[n++] = ctx->pound;
+    for (; args[n - 1] && n < 39; n++)
+        argv[n] = args[n - 1];
+    argv[n] = NULL;
+    return pd_test_spawn(argv, env, r);
+}
+
 /* Run pound with args (NULL-terminated) and TMPDIR set to the tmp/ folder. */
 static int run_pound(const pd_test_ctx *ctx, const plot_dir *d, const char *const *args,
                      proc_out *r)
 {
-    const char *argv[32];
-    int n = 0;
-    argv[n++] = ctx->pound;
-    for (; args[n - 1] && n < 31; n++)
-        argv[n] = args[n - 1];
-    argv[n] = NULL;
-    return pd_test_spawn(argv, d->env, r);
+    return run_pound_env(ctx, d->env, args, r);
 }
 
 /* Does path exist? */
@@ -317,13 +324,7 @@ static void test_plot_record_name(pd_test_ctx *ctx)
  * --plot; 0 when it exited 0. */
 static int run_keep(const pd_test_ctx *ctx, const char *const *args, proc_out *r)
 {
-    const char *argv[40];
-    int n = 0;
-    argv[n++] = ctx->pound;
-    for (; args[n - 1] && n < 39; n++)
-        argv[n] = args[n - 1];
-    argv[n] = NULL;
-    return pd_test_spawn(argv, "POUND_PLOT_SCRIPT=1", r) == 0 && r->status == 0 ? 0 : -1;
+    return run_pound_env(ctx, "POUND_PLOT_SCRIPT=1", args, r) == 0 && r->status == 0 ? 0 : -1;
 }
 
 /* The rows (x y) of block k of a gnuplot data file (blocks end with two
