@@ -95,7 +95,7 @@ set grid; set ylabel 'u / L_e'; set xlabel 't / T_p'
 L = 1/(2*pi)**2
 do for [P in '0.2 1 3'] {
   set title '{/Symbol P}_2 = '.P
-  plot '$tmp/f8-'.P u 1:(\$2/L) w l lw 2 t 'with the wall', '$tmp/f8f-'.P u 1:(\$2/L) w l lw 1 dt 2 t 'without', 0.05 w l lc rgb 'black' t 'wall'
+  plot '$tmp/f8-'.P u 1:(\$2/L) w l lw 2 t 'with the wall', '$tmp/f8f-'.P u 1:(\$2/L) w l lw 1 dt 2 t 'without', 0.05 w l dt 2 lc rgb 'black' t 'wall'
 }
 unset multiplot
 GP
@@ -111,8 +111,8 @@ $term
 set output '$out/paper-fig9.png'
 set multiplot layout 2,1 title 'Fig. 9: T_0 = 3 s, one-sine pulse T_p = 0.3 s, a_p = 4 m/s^2, gap 4 mm, {/Symbol e} = 0.6'
 set grid; set xlabel 't [s]'; set ylabel 'u [cm]'
-set title 'normal'; plot '$tmp/f9-normal' u 1:(100*\$2) w l lw 2 t '', 0.4 w l lc rgb 'black' t 'wall'
-set title 'reverse'; plot '$tmp/f9-reverse' u 1:(100*\$2) w l lw 2 t '', 0.4 w l lc rgb 'black' t 'wall'
+set title 'normal'; plot '$tmp/f9-normal' u 1:(100*\$2) w l lw 2 t '', 0.4 w l dt 2 lc rgb 'black' t 'wall'
+set title 'reverse'; plot '$tmp/f9-reverse' u 1:(100*\$2) w l lw 2 t '', 0.4 w l dt 2 lc rgb 'black' t 'wall'
 unset multiplot
 GP
 
@@ -143,11 +143,11 @@ gnuplot <<GP
 $term
 set output '$out/paper-fig11.png'
 set multiplot layout 2,2 title 'Fig. 11: {/Symbol P}_2 = 1.16, one-cosine reverse pulse (T_p = 1 s): {/Symbol e} = 0.2 against {/Symbol e} = 1'
-set grid; set xlabel 't / T_p'
+set grid; set xlabel 't / T_p'; set key below
 L = 1/(2*pi)**2; V = 1/(2*pi)
 do for [P in '0.3 0.05'] {
   set title '{/Symbol P}_3 = '.P; set ylabel 'u / L_e'
-  plot '$tmp/f11-'.P.'-0.2' u 1:(\$2/L) w l lw 2 t '{/Symbol e} = 0.2', '$tmp/f11-'.P.'-1' u 1:(\$2/L) w l lw 2 t '{/Symbol e} = 1', P+0 w l lc rgb 'black' t 'wall'
+  plot '$tmp/f11-'.P.'-0.2' u 1:(\$2/L) w l lw 2 t '{/Symbol e} = 0.2', '$tmp/f11-'.P.'-1' u 1:(\$2/L) w l lw 2 t '{/Symbol e} = 1', P+0 w l dt 2 lc rgb 'black' t 'wall'
 }
 do for [P in '0.3 0.05'] {
   set title '{/Symbol P}_3 = '.P; set ylabel '(du/dt) / (a_p / {/Symbol w}_p)'
@@ -189,7 +189,8 @@ if [ -d "$recs" ]; then
     all=$(ls "$recs"/*.AT2 "$recs"/*.at2 "$recs"/*.V2 2>/dev/null | sort)
     "$pound" record $all > "$out/paper-records.txt"
     "$pound" record $all --json | tr '{' '\n' | awk -F'"name":"' 'NF > 1 {split($2, a, "\""); n = a[1]}
-        /"Le":/ {sub(/.*"Le":/, ""); sub(/,.*/, ""); printf "%s %.6g\n", n, 1 / $0}' > "$tmp/le"
+        /"Le":/ {sub(/.*"Le":/, ""); sub(/,.*/, ""); printf "%s %.6g\n", n, 1 / $0}' |
+        sort -g -k2,2 | awk '{print $0, 0.002 + 0.024 * ((NR - 1) % 3)}' > "$tmp/le"
     # Fig. 7: contours of Pi3 = gap / Le on the (1/Le, gap) plane, the records placed
     gnuplot <<GP
 $term
@@ -203,7 +204,8 @@ set label 'Tabas (paper)' at 1.25, 0.095 font ',9'
 set arrow from 5.3, graph 0 to 5.3, graph 1 nohead dt 2 lc rgb 'black'
 set label 'Parkfield C02 (paper)' at 5.35, 0.095 font ',9'
 plot for [p in '0.01 0.02 0.05 0.1 0.2 0.5'] p/x w l lw 2 t '{/Symbol P}_3 = '.p, \
-     '$tmp/le' u 2:(0.002):(strcol(1)) w labels rotate by 90 left font ',7' noenhanced \
+     '$tmp/le' u 2:(0.0015):(0):(\$3 - 0.0015) w vectors nohead dt 3 lc rgb 'gray60' t '', \
+     '$tmp/le' u 2:3:(strcol(1)) w labels rotate by 90 left font ',7' noenhanced \
         offset 0,0.5 t '', '$tmp/le' u 2:(0.0015) w points pt 7 ps 0.8 lc rgb 'black' \
         t 'shared records (fitted 1/L_e)'
 GP

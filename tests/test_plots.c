@@ -570,7 +570,7 @@ static void test_plot_palette(pd_test_ctx *ctx)
         char colour[36][8] = {{0}}, seen[36][8];
         int dash[36] = {0}, ncol = 0;
         for (int k = 0; k < 36; k++) {
-            char key[32];
+            char key[48];
             snprintf(key, sizeof key, "set linetype %d lc rgb '", k + 1);
             const char *l = strstr(gp, key);
             if (!CHECK(ctx, l != NULL, "no line type %d", k + 1))
