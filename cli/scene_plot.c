@@ -281,7 +281,7 @@ static void plot_script(FILE *g, const char *data, const char *png_tmp, const vo
     pd_plot_style(g);
     fputs("set output ", g);
     pd_plot_text(g, png_tmp);
-    fputs("\nset grid\n", g);
+    fputs("\nset grid\nset autoscale xfix\n", g); /* the time axis: the run, no more */
     if (!p->panel_mode) {
         fputs("set key below font ',9'\nset title ", g);
         pd_plot_literal(g, fig->title);

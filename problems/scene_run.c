@@ -571,7 +571,8 @@ static int osc_sample(const pd_osc_sample *s, void *ctx)
                           .x = &x,
                           .v = &v,
                           .gap = b->m ? &s->gap : NULL,
-                          .impulse = b->m ? &imp : NULL};
+                          .impulse = b->m ? &imp : NULL,
+                          .impacts = b->m ? &s->impacts : NULL};
     return b->fn(&ss, b->ctx);
 }
 

@@ -251,7 +251,7 @@ static int osc_sum(const pd_osc_sample *s, void *ctx)
 static int scene_sum(const pd_scene_sample *s, void *ctx)
 {
     sample_sum *q = ctx;
-    for (long a = 0; a < q->m; a++)
+    for (long a = 0; a < q->m && s->impacts; a++)
         q->per[a] += s->impacts[a];
     return 0;
 }
@@ -260,7 +260,7 @@ static int scene_sum(const pd_scene_sample *s, void *ctx)
  * sample, and over the run they add up to the result's count: the
  * oscillator of the paper's Fig. 9 (5 impacts, far apart), and two SDOFs
  * beside a wall (per contact, the exact references and penalty on their
- * output grid too).  The event-driven oscillator's samples carry its
+ * output grid too), and one SDOF beside a wall (the oscillator's paths).  The event-driven oscillator's samples carry its
  * impulses: its impacts fall in different samples, so the largest sample
  * is the largest impact's (1 + eps) v, to rounding of the unit change. */
 static void test_samples_count_impacts(pd_test_ctx *ctx)
@@ -319,6 +319,26 @@ static void test_samples_count_impacts(pd_test_ctx *ctx)
                       r.impacts[a]);
             }
         CHECK(ctx, all > 0, "%s: no impact to count", pd_method_name(o.method));
+        pd_scene_result_free(&r);
+    }
+    pd_scene_free(sc);
+    /* one SDOF and a wall: the oscillator's fast paths */
+    sc = pd_scene_new(&x);
+    ok = sc && !pd_scene_add_sdof(sc, "A", 0.4, 0.05, 1e5, &e) &&
+         !pd_scene_add_contact(sc, 0, 1, PD_WALL, 1, 0.01, 0.5, 0, &e) && !pd_scene_finish(sc, &e);
+    CHECK(ctx, ok, "building the one-wall scene: %s", ok ? "" : e.msg);
+    for (int k = 0; ok && k < 4; k++) {
+        pd_run_opts o = pd_run_default_opts();
+        pd_scene_result r;
+        sample_sum q = {.m = 1};
+        o.method = osc_methods[k];
+        o.tend = 3.0;
+        if (!CHECK(ctx, pd_scene_result_alloc(sc, &r, &e) == PD_OK, "%s", e.msg))
+            break;
+        int rc = pd_scene_run(sc, &o, scene_sum, &q, &r, &e);
+        CHECK(ctx, rc == PD_OK && r.impacts[0] > 0 && q.per[0] == r.impacts[0],
+              "one wall, %s: samples report %ld impacts, the result %ld (%s)",
+              pd_method_name(o.method), q.per[0], r.impacts[0], rc ? e.msg : "");
         pd_scene_result_free(&r);
     }
     pd_scene_free(sc);
