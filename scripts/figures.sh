@@ -63,7 +63,7 @@ gnuplot <<GP
 set terminal pngcairo size 900,600 enhanced font 'sans,11'
 load 'scripts/plot_style.gp'
 set output '$out/stability-theta.png'
-set logscale xy; set grid; set key top left
+set logscale xy; set grid; set key top left; set format y '10^{%L}'
 set title 'Moreau-Jean below {/Symbol q} = 1/2: max |u| over 200 s ({/Symbol x} = 0.05, no wall)'
 set xlabel '{/Symbol w}_0 h'; set ylabel 'max |u| [m]'
 set arrow from 0.25,graph 0 to 0.25,graph 1 nohead dt 3
@@ -87,7 +87,7 @@ gnuplot <<GP
 set terminal pngcairo size 900,500 enhanced font 'sans,11'
 load 'scripts/plot_style.gp'
 set output '$out/energy-eps1.png'
-set grid; set key bottom left; set logscale y
+set grid; set key center right; set logscale y; set format y '10^{%L}'
 set title 'Energy after the pulse, {/Symbol q} = 1/2, {/Symbol x} = 0 (Moreau-Jean, dt = Tp/2000)'
 set xlabel 't [s]'; set ylabel 'v^2/2 + {/Symbol w}_0^2 u^2/2 [m^2/s^2]'
 plot '$tmp/e1.dat' w l lw 2 t '{/Symbol e} = 1 (kept)', '$tmp/e08.dat' w l lw 2 t '{/Symbol e} = 0.8 (falls at each impact)'
