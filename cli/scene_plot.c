@@ -161,6 +161,23 @@ static void mark(pd_scene_plot *p, const pd_scene_sample *s, int a)
     }
 }
 
+/* Keep the points at even indices (their samples are the multiples of
+ * twice the stride) and double the stride: the curves still reach the end
+ * of a run with more samples than expected (the references' events). */
+static void halve(pd_scene_plot *p)
+{
+    long n = (p->np + 1) / 2;
+    for (long i = 0; i < n; i++)
+        p->t[i] = p->t[2 * i];
+    for (int k = 0; k < p->ncurves; k++) {
+        double *y = p->y + (size_t)k * (PLOT_POINTS + 2);
+        for (long i = 0; i < n; i++)
+            y[i] = y[2 * i];
+    }
+    p->np = n;
+    p->stride *= 2;
+}
+
 int pd_scene_plot_sample(const pd_scene_sample *s, void *ctx)
 {
     pd_scene_plot *p = ctx;
@@ -168,8 +185,10 @@ int pd_scene_plot_sample(const pd_scene_sample *s, void *ctx)
     for (int a = 0; a < sc->ncontact && s->impacts; a++)
         if (s->impacts[a] > 0)
             mark(p, s, a);
-    if (p->seen++ % p->stride || p->np >= PLOT_POINTS + 2)
+    if (p->seen++ % p->stride)
         return 0;
+    if (p->np == PLOT_POINTS + 2) /* more samples than expected: every other point kept */
+        halve(p);
     p->t[p->np] = s->t;
     for (int k = 0; k < p->ncurves; k++)
         p->y[(size_t)k * (PLOT_POINTS + 2) + p->np] = storey_x(sc, s, p->cv[k].st, p->cv[k].storey);
