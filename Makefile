@@ -4,7 +4,10 @@
 #   make test     install missing packages (as root), build, run the tests
 #   make asan     the tests under AddressSanitizer + UndefinedBehaviorSanitizer
 #   make bench    performance figures (pound bench; pound against Siconos numerics)
-#   make figures  docs/figures/*.png (convergence, stability, energy)
+#   make figures  the figures (convergence, work-precision, stability, energy)
+#                 and the paper's (make paper alone) into build/figures/;
+#                 DOCS=1 (or make figures-docs, paper-docs) refreshes the
+#                 tracked docs/figures/ instead
 #   make stress   the adversarial suite (stress/run.py): hostile flags and
 #                 files, full disks, signals, hangs, libFuzzer, TSan;
 #                 STRESS_ARGS="--report docs/reliability.md" rewrites its table
@@ -127,7 +130,8 @@ INSTALLED   = $(bindir)/pound $(libdir)/libpound.a $(libdir)/$(SOREAL) $(libdir)
 # make check ends with scripts/api-check.sh (not under the sanitizers)
 API_CHECK  ?= 1
 
-.PHONY: all deps demo test check asan bench clean acceptance figures paper stress print-libs \
+.PHONY: all deps demo test check asan bench clean acceptance figures paper figures-docs \
+        paper-docs stress print-libs \
         shared install uninstall install-check formats-check flags-check python-check
 
 all: $(BUILD)/pound $(BUILD)/pound_tests
@@ -218,14 +222,24 @@ bench: deps
 	@st=0; sh bench/build.sh $(BUILD) || st=$$?; \
 	if [ $$st = 0 ]; then $(BUILD)/siconos_lcp --chains; elif [ $$st != 3 ]; then exit $$st; fi
 
+# Figures go to $(BUILD)/figures/ (untracked); DOCS=1 writes the tracked
+# docs/figures/ that the docs show.
+FIG_OUT = $(if $(DOCS),docs/figures,$(BUILD)/figures)
+
 figures: deps
 	@$(MAKE) --no-print-directory all
-	sh scripts/figures.sh $(BUILD)/pound
-	sh scripts/paper.sh $(BUILD)/pound
+	sh scripts/figures.sh $(BUILD)/pound $(FIG_OUT)
+	sh scripts/paper.sh $(BUILD)/pound $(FIG_OUT)
 
 paper: deps
 	@$(MAKE) --no-print-directory all
-	sh scripts/paper.sh $(BUILD)/pound
+	sh scripts/paper.sh $(BUILD)/pound $(FIG_OUT)
+
+figures-docs:
+	@$(MAKE) --no-print-directory figures DOCS=1
+
+paper-docs:
+	@$(MAKE) --no-print-directory paper DOCS=1
 
 # The adversarial suite: fuzzers and a TSan binary built with clang in
 # $(BUILD)/stress, then stress/run.py against $(BUILD)/pound (about 5 min).

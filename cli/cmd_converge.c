@@ -427,22 +427,30 @@ done:
     return rc;
 }
 
-/* The case in words, for titles. */
-static void case_title(const conv_args *a, const measurer *M, char *buf, size_t cap)
+/* The case in words, for titles: the text's, or (chart) the chart's in
+ * UTF-8 (Π₂, Π₃, ε; a record named as such, a chain as a chain). */
+static void case_title(const conv_args *a, const measurer *M, int chart, char *buf, size_t cap)
 {
-    if (M->sc)
+    const pd_osc *c = &a->k.c;
+    if (M->sc && (!chart || a->k.scene_path))
         snprintf(buf, cap, "scene %s (%d structures)", a->k.scene_path ? a->k.scene_path : "chain",
                  M->sc->nstruct);
+    else if (M->sc)
+        snprintf(buf, cap, "a row of %d SDOFs between two walls (--chain)", M->sc->nstruct);
+    else if (!chart)
+        snprintf(buf, cap, "%s %s pulse, Pi2 = %.3g, Pi3 = %.3g, eps = %g", pd_dir_name(c->dir),
+                 pd_osc_excitation_name(c), c->Pi2, c->Pi3, c->eps);
     else
-        snprintf(buf, cap, "%s %s pulse, Pi2 = %.3g, Pi3 = %.3g, eps = %g", pd_dir_name(a->k.c.dir),
-                 pd_osc_excitation_name(&a->k.c), a->k.c.Pi2, a->k.c.Pi3, a->k.c.eps);
+        snprintf(buf, cap, "%s %s%s, \u03a0\u2082 = %.3g, \u03a0\u2083 = %.3g, \u03b5 = %g",
+                 c->record ? "record" : pd_dir_name(c->dir), pd_osc_excitation_name(c),
+                 c->record ? "" : " pulse", c->Pi2, c->Pi3, c->eps);
 }
 
 static void print_rows(const conv_args *a, const measurer *M, const row *rows, int n,
                        double ref_cpu)
 {
     char title[256];
-    case_title(a, M, title, sizeof title);
+    case_title(a, M, 0, title, sizeof title);
     if (a->json) {
         pd_json js;
         pd_json_init(&js, stdout);
@@ -515,7 +523,7 @@ static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int
                 ys[1][ncurve][m] = row_error(a, &rows[r]);
                 m++;
             }
-        snprintf(labels[ncurve], sizeof labels[0], "Moreau-Jean theta = %g", a->thetas[t]);
+        snprintf(labels[ncurve], sizeof labels[0], "Moreau\u2013Jean \u03b8 = %g", a->thetas[t]);
         by_dt[ncurve] = (pd_curve){.label = labels[ncurve], .n = m, .x = xs[0][ncurve],
                                    .y = ys[0][ncurve]};
         by_cpu[ncurve] = (pd_curve){.label = labels[ncurve], .n = m, .x = xs[1][ncurve],
@@ -546,7 +554,7 @@ static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int
                 ys[1][ncurve][npen] = row_error(a, &rows[r]);
                 npen++;
             }
-        snprintf(labels[ncurve], sizeof labels[0], "penalty (kc = %g..%g w0^2)", a->kcs[0],
+        snprintf(labels[ncurve], sizeof labels[0], "penalty (kc = %g \u2026 %g \u03c9\u2080\u00b2)", a->kcs[0],
                  a->kcs[a->nkc - 1]);
         by_cpu[ncurve] = (pd_curve){.label = labels[ncurve], .n = npen, .x = xs[1][ncurve],
                                     .y = ys[1][ncurve]};
@@ -565,7 +573,7 @@ static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int
     char title[256];
     const char *ylabel = a->use_umax ? "|u_{max} - u_{max,ref}| / u_{max,ref}"
                                      : "max |u - u_{ref}| / u_{max,ref}";
-    case_title(a, M, title, sizeof title);
+    case_title(a, M, 1, title, sizeof title);
     pd_chart c1 = {.title = title,
                    .xlabel = "dt [s]",
                    .ylabel = ylabel,

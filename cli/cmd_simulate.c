@@ -24,7 +24,8 @@ static const char simulate_usage[] =
     "              estimated above 100 MB is announced on stderr (\"pound: writing about\n"
     "              N MB to FILE\"), and one larger than the free space of FILE's file\n"
     "              system is refused (exit 2; fewer rows with --every K)\n"
-    "  --plot F    the displacement histories with the impacts marked\n"
+    "  --plot F    the displacement histories, every wall drawn where it stands, each\n"
+    "              impact marked once at the storey of its contact\n"
     "  --dump-lcp F.h5  every contact LCP Moreau-Jean solves (D, b, z, solver, pivots or\n"
     "              iterations), for `pound lcp F.h5 --all` (docs/lcp.md)\n"
     "  --json      one JSON object on stdout\n";
@@ -165,7 +166,8 @@ static int record(const pd_osc_sample *s, void *ctx)
     osc_out *o = ctx;
     if (o->plot) {
         pd_scene_sample ss = {.step = s->step, .t = s->t, .x = &s->u, .v = &s->v,
-                              .gap = &s->gap, .impulse = &s->impulse};
+                              .gap = &s->gap, .impulse = &s->impulse,
+                              .impacts = &s->impacts};
         pd_scene_plot_sample(&ss, o->plot);
     }
     if (!o->file || s->step % o->every || o->rows >= o->rows_max)
@@ -385,8 +387,13 @@ static int simulate_oscillator(sim_args *a)
         status = rc == PD_EINVAL ? 2 : 1;
         goto done;
     }
+    char title[PD_NAME_MAX + 160];
+    snprintf(title, sizeof title, "pounding oscillator: %s %s%s, T0 = %.3g s, gap = %.3g m, "
+             "eps = %.3g (%s)", pd_osc_excitation_name(&a->k.c), pd_dir_name(a->k.c.dir),
+             a->k.c.record ? "" : " pulse", pd_osc_T0(&a->k.c), pd_osc_gap(&a->k.c), a->k.c.eps,
+             pd_method_name(a->k.opts.method));
     if ((o.file && finish_output(a, &s, o.file, &err)) ||
-        (a->plot && pd_scene_plot_draw(o.plot, a->plot, "pounding oscillator", &err))) {
+        (a->plot && pd_scene_plot_draw(o.plot, a->plot, title, &err))) {
         fprintf(stderr, "pound: simulate: %s\n", err.msg);
         status = 1;
         goto done;

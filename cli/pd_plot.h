@@ -47,9 +47,17 @@ typedef void pd_plot_script_fn(FILE *g, const char *data, const char *png_tmp, c
 int pd_plot_with(const char *png, pd_plot_data_fn *data_fn, pd_plot_script_fn *script_fn,
                  const void *ctx, pd_err *err);
 
+/* The settings every figure starts with: UTF-8 text and the palette, line
+ * types 1..PD_PLOT_LINETYPES: PD_PLOT_COLOURS distinct colours, solid, then
+ * the same dashed, then dash-dotted (a chart of many curves never repeats
+ * a style). */
+enum { PD_PLOT_COLOURS = 12, PD_PLOT_LINETYPES = 36 };
+void pd_plot_style(FILE *g);
+
 /* Write s (NULL: "") into a gnuplot script as one double-quoted string
  * literal that cannot end early or run anything: '"' and '\\' escaped,
- * '`' and '@' as octal escapes, control bytes and bytes beyond ASCII as '?'.
+ * '`' and '@' as octal escapes, well-formed UTF-8 as it is, control bytes and
+ * any other byte beyond ASCII as '?'.
  * Every text and file name in a script goes through it. */
 void pd_plot_text(FILE *g, const char *s);
 /* s as a gnuplot string literal shown literally in enhanced text (names:

@@ -26,11 +26,14 @@ void pd_scene_writer_free(pd_scene_writer *w);
 
 typedef struct pd_scene_plot pd_scene_plot;
 
-/* A decimated copy of the top-storey histories of up to 12 structures
- * (evenly spread over the row) for about `expected` samples. */
+/* A decimated copy, for about `expected` samples, of the histories drawn:
+ * up to four structures with contacts below their tops a panel each (their
+ * contacts' storeys and top), else the top storeys of up to 12 structures
+ * evenly spread over the row; and the impacts the samples report
+ * (pd_scene_sample.impacts), each at its contact's storey. */
 int pd_scene_plot_open(pd_scene_plot **p, const pd_scene *sc, long expected, pd_err *err);
 int pd_scene_plot_sample(const pd_scene_sample *s, void *ctx);
-/* Draw the histories with the impacts marked into png. */
+/* Draw the histories, the walls and the impacts into png. */
 int pd_scene_plot_draw(pd_scene_plot *p, const char *png, const char *title, pd_err *err);
 void pd_scene_plot_free(pd_scene_plot *p);
 

@@ -38,6 +38,34 @@ static int write_data(FILE *f, const pd_chart *c)
     return ferror(f) ? -1 : 0;
 }
 
+/* The length of the well-formed UTF-8 character of two to four bytes at c
+ * (no overlong form, no surrogate, at most U+10FFFF), else 0. */
+static int utf8_len(const unsigned char *c)
+{
+    int n = c[0] >= 0xc2 && c[0] <= 0xdf ? 2 : c[0] >= 0xe0 && c[0] <= 0xef ? 3
+          : c[0] >= 0xf0 && c[0] <= 0xf4 ? 4 : 0;
+    for (int k = 1; k < n; k++)
+        if ((c[k] & 0xc0) != 0x80)
+            return 0;
+    if ((c[0] == 0xe0 && c[1] < 0xa0) || (c[0] == 0xed && c[1] >= 0xa0) ||
+        (c[0] == 0xf0 && c[1] < 0x90) || (c[0] == 0xf4 && c[1] >= 0x90))
+        return 0;
+    return n;
+}
+
+/* The byte at *c (a control byte or one of a malformed sequence: '?') or
+ * the whole UTF-8 character there (the scripts say `set encoding utf8`);
+ * *c moved to the last byte written. */
+static void put_char(FILE *g, const unsigned char **c)
+{
+    int n = **c >= 0x80 ? utf8_len(*c) : 0;
+    if (n) {
+        fwrite(*c, 1, (size_t)n, g);
+        *c += n - 1;
+    } else
+        fputc(**c >= 0x20 && **c < 0x7f ? **c : '?', g);
+}
+
 /* s as one gnuplot string literal that cannot escape (pd_plot.h). */
 void pd_plot_text(FILE *g, const char *s)
 {
@@ -48,7 +76,7 @@ void pd_plot_text(FILE *g, const char *s)
         else if (*c == '`' || *c == '@') /* \140, \100: three digits never take a fourth */
             fprintf(g, "\\%03o", (unsigned)*c);
         else
-            fputc(*c >= 0x20 && *c < 0x7f ? *c : '?', g);
+            put_char(g, &c);
     fputc('"', g);
 }
 
@@ -66,8 +94,25 @@ void pd_plot_literal(FILE *g, const char *s)
         else if (*c == '`' || *c == '@')
             fprintf(g, "\\\\\\%03o", (unsigned)*c);
         else
-            fputc(*c >= 0x20 && *c < 0x7f ? *c : '?', g);
+            put_char(g, &c);
     fputc('"', g);
+}
+
+/* The colours of the palette: Okabe and Ito's (yellow left out: too pale
+ * on white) and six of Paul Tol's muted set, told apart on screen and in
+ * print; a curve past the twelfth takes them again with another dash type. */
+static const char *const palette[PD_PLOT_COLOURS] = {
+    "#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9",
+    "#332288", "#882255", "#999933", "#44AA99", "#CC6677", "#555555"};
+
+void pd_plot_style(FILE *g)
+{
+    static const int dash[3] = {1, 2, 4}; /* solid, dashed, dash-dot */
+    fputs("set encoding utf8\n", g);
+    for (int k = 0; k < PD_PLOT_LINETYPES; k++)
+        fprintf(g, "set linetype %d lc rgb '%s' lw 1.5 dt %d pt %d\n", k + 1,
+                palette[k % PD_PLOT_COLOURS], dash[k / PD_PLOT_COLOURS], k % 12 + 1);
+    fprintf(g, "set linetype cycle %d\n", PD_PLOT_LINETYPES);
 }
 
 /* A guide line of slope s through the first point of the first curve. */
@@ -85,9 +130,11 @@ static void chart_script(FILE *g, const char *data, const char *png_tmp, const v
 {
     const pd_chart *c = ctx;
     fprintf(g, "set terminal pngcairo size 900,650 enhanced font 'sans,11'\n");
+    pd_plot_style(g);
     fputs("set output ", g);
     pd_plot_text(g, png_tmp);
-    fputs("\nset grid\nset key below\n", g);
+    /* the key under the chart, in a smaller font as the curves grow */
+    fprintf(g, "\nset grid\nset key below font ',%d' spacing 0.9\n", c->ncurves > 6 ? 9 : 10);
     if (c->logx)
         fputs("set logscale x\nset format x '10^{%L}'\n", g);
     if (c->logy)
@@ -115,7 +162,7 @@ static void chart_script(FILE *g, const char *data, const char *png_tmp, const v
                 c->vline, c->vline);
         fprintf(g, "set label ");
         pd_plot_literal(g, c->vline_label ? c->vline_label : "");
-        fprintf(g, " at %.17g, graph 0.05 right offset -0.5,0\n", c->vline);
+        fprintf(g, " at %.17g, graph 0.03 left rotate by 90 offset -0.8,0\n", c->vline);
     }
     fputs("plot ", g);
     for (int k = 0; k < c->ncurves; k++) {
@@ -294,6 +341,24 @@ static int move_into_place(const char *src, const char *dst)
     return errno == EXDEV ? copy_into_place(src, dst) : -1;
 }
 
+/* POUND_PLOT_SCRIPT=1: the script and its data kept beside the chart, as
+ * F.gp and F.dat for F.png (to read or adapt; the paths in the script are
+ * the temporary ones).  0, or PD_EIO. */
+static int keep_script(const plot_work *w, const char *png, pd_err *err)
+{
+    const char *keep = getenv("POUND_PLOT_SCRIPT");
+    char gp[4096], dat[4096];
+    size_t n = strlen(png);
+    if (!keep || strcmp(keep, "1") || n < 4 || n + 1 > sizeof gp)
+        return PD_OK;
+    snprintf(gp, sizeof gp, "%.*s.gp", (int)(n - 4), png);
+    snprintf(dat, sizeof dat, "%.*s.dat", (int)(n - 4), png);
+    if (copy_into_place(w->script, gp) || copy_into_place(w->data, dat))
+        return pd_err_set(err, PD_EIO, "--plot %s: POUND_PLOT_SCRIPT: cannot write %s: %s", png,
+                          gp, strerror(errno));
+    return PD_OK;
+}
+
 /* The steps in the private folder w: data, script, gnuplot, the PNG
  * checked and moved to png. */
 static int draw(const plot_work *w, const char *png, pd_plot_data_fn *data_fn,
@@ -311,7 +376,7 @@ static int draw(const plot_work *w, const char *png, pd_plot_data_fn *data_fn,
     if (move_into_place(w->png, png))
         return pd_err_set(err, PD_EIO, "--plot %s: cannot write the file: %s", png,
                           strerror(errno));
-    return PD_OK;
+    return keep_script(w, png, err);
 }
 
 int pd_plot_with(const char *png, pd_plot_data_fn *data_fn, pd_plot_script_fn *script_fn,

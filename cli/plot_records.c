@@ -67,9 +67,11 @@ static void records_script(FILE *g, const char *data, const char *png_tmp, const
                                         "displacement [m]"};
     fprintf(g, "set terminal pngcairo size %d,900 enhanced font 'sans,10'\n",
             360 * fig->n + 120);
+    pd_plot_style(g);
     fputs("set output ", g);
     pd_plot_text(g, png_tmp);
-    fprintf(g, "\nset multiplot layout 3,%d\nset grid\nset key top right font ',8'\n", fig->n);
+    fprintf(g, "\nset multiplot layout 3,%d\nset grid\nset key top right font ',8' box opaque\n",
+            fig->n);
     for (int row = 0; row < 3; row++)
         for (int k = 0; k < fig->n; k++) {
             const pd_cli_record *r = fig->recs[k];
@@ -77,6 +79,7 @@ static void records_script(FILE *g, const char *data, const char *png_tmp, const
                 record_title(g, r);
             else
                 fputs("unset title\n", g);
+            fputs(k ? "unset key\n" : "set key\n", g); /* the same key in every column */
             fprintf(g, "set ylabel '%s'\nset xlabel '%s'\nplot ", k ? "" : rows[row],
                     row == 2 ? "t [s]" : "");
             pd_plot_text(g, data);

@@ -226,7 +226,8 @@ int pd_spec_write(const char *path, const pd_spectrum *s, const pd_spec_row *row
 
 /* ---- charts ------------------------------------------------------------- */
 
-/* The parameters every curve shares, for a chart title. */
+/* The parameters every curve shares, for a chart title (UTF-8: the charts
+ * show names as they are, pd_plot_literal). */
 static void common_title(const pd_spectrum *s, char *buf, size_t cap)
 {
     size_t n = (size_t)snprintf(buf, cap, "spectra (%s", pd_method_name(s->opts.method));
@@ -236,13 +237,48 @@ static void common_title(const pd_spectrum *s, char *buf, size_t cap)
     if (s->ndir == 1)
         ADD(" %s", pd_dir_name(s->dir[0]));
     if (s->nsize == 1)
-        ADD(", %s = %g", s->size_is_gap ? "gap" : "Pi3", s->size[0]);
+        ADD(", %s = %g%s", s->size_is_gap ? "gap" : "\u03a0\u2083", s->size[0],
+            s->size_is_gap ? " m" : "");
     if (s->neps == 1)
-        ADD(", eps = %g", s->eps[0]);
+        ADD(", \u03b5 = %g", s->eps[0]);
     if (s->nxi == 1)
-        ADD(", xi = %g", s->xi[0]);
+        ADD(", \u03be = %g", s->xi[0]);
     ADD(")");
 #undef ADD
+}
+
+/* A curve's key from its label (pd_spec_curve_label: words and key=value
+ * pairs): "sine normal ap=3 Pi3=0.05 eps=0.5" as "sine normal, ap = 3 m/s²,
+ * Π₃ = 0.05, ε = 0.5". */
+static void curve_key(const char *label, char *buf, size_t cap)
+{
+    static const struct {
+        const char *key, *shown, *units;
+    } names[] = {{"ap", "ap", " m/s\u00b2"},
+                 {"xi", "\u03be", ""},
+                 {"Pi3", "\u03a0\u2083", ""},
+                 {"gap", "gap", " m"},
+                 {"eps", "\u03b5", ""}};
+    size_t n = 0;
+    int pairs = 0;
+    buf[0] = '\0';
+    for (const char *w = label; *w;) {
+        size_t len = strcspn(w, " ");
+        const char *eq = memchr(w, '=', len);
+        const char *sep = pairs || (eq && n) ? ", " : n ? " " : "";
+        int k = 0;
+        while (eq && k < 5 && (strlen(names[k].key) != (size_t)(eq - w) ||
+                                strncmp(w, names[k].key, (size_t)(eq - w))))
+            k++;
+        if (eq && k < 5)
+            n += (size_t)snprintf(buf + n, n < cap ? cap - n : 0, "%s%s = %.*s%s", sep,
+                                  names[k].shown, (int)(w + len - eq - 1), eq + 1, names[k].units);
+        else
+            n += (size_t)snprintf(buf + n, n < cap ? cap - n : 0, "%s%.*s", sep, (int)len, w);
+        pairs |= eq != NULL;
+        w += len;
+        w += *w == ' ';
+    }
 }
 
 /* One chart, one curve per spectrum curve; y = f(row) scaled; x = T0 or Pi2. */
@@ -264,13 +300,15 @@ static int chart(const char *png, const pd_spectrum *s, const pd_spec_row *rows,
         y[p] *= yscale;
     }
     for (long c = 0; c < nc; c++) {
-        pd_spec_curve_label(s, c, labels + 128 * c, 128);
+        char label[128];
+        pd_spec_curve_label(s, c, label, sizeof label);
+        curve_key(label, labels + 128 * c, 128);
         cv[c] = (pd_curve){.label = labels + 128 * c, .n = s->npi2, .x = x + c * s->npi2,
                            .y = y + c * s->npi2};
     }
     common_title(s, title, sizeof title);
     pd_chart ch = {.title = title,
-                   .xlabel = use_T0 ? "T_0 [s]" : "Pi_2 = T_p / T_0",
+                   .xlabel = use_T0 ? "T_0 [s]" : "{/Symbol P}_2 = T_p / T_0",
                    .ylabel = ylabel,
                    .logx = 1,
                    .logy = logy,
@@ -291,11 +329,11 @@ int pd_spec_plot(const char *png, const pd_spectrum *s, const pd_spec_row *rows,
     char other[4200];
     size_t len = strlen(png);
     int rc = chart(png, s, rows, 0, offsetof(pd_spec_row, Pi1), 1.0,
-                   "Pi_1 = u_{max} w_p^2 / a_p", 1, err);
+                   "{/Symbol P}_1 = u_{max} {/Symbol w}_p^2 / a_p", 1, err);
     snprintf(other, sizeof other, "%.*s-gamma.png", (int)(len - 4), png);
     if (!rc)
         rc = chart(other, s, rows, 0, offsetof(pd_spec_row, gamma), 1.0,
-                   "gamma = u_{max} / u_{max,free}", 0, err);
+                   "{/Symbol g} = u_{max} / u_{max,free}", 0, err);
     snprintf(other, sizeof other, "%.*s-dim.png", (int)(len - 4), png);
     if (!rc && s->dimensional)
         rc = chart(other, s, rows, 1, offsetof(pd_spec_row, umax), 100.0, "u_{max} [cm]", 1, err);

@@ -117,16 +117,17 @@ static int draw(const pd_scene_sweep_args *a, const sweep_out *o, pd_err *err)
                 x[(size_t)nc * npi2 + j] = o->pts[o->ntw + c * npi2 + j].Pi2;
                 y[(size_t)nc * npi2 + j] = o->Pi1[(size_t)(c * npi2 + j) * ns + s];
             }
-            snprintf(labels[nc], sizeof labels[nc], "%s, Pi3 = %.3g, eps = %.3g",
+            snprintf(labels[nc], sizeof labels[nc], "%s, \u03a0\u2083 = %.3g, \u03b5 = %.3g",
                      o->sc->st[s].name, pt->Pi3, pt->eps);
             cv[nc] = (pd_curve){.label = labels[nc], .n = npi2, .x = x + (size_t)nc * npi2,
                                 .y = y + (size_t)nc * npi2};
         }
     char title[256];
-    snprintf(title, sizeof title, "%s: Pi2 of %s", a->k->scene_path, o->sc->st[o->w.ref].name);
+    snprintf(title, sizeof title, "%s: \u03a0\u2082 of %s", a->k->scene_path,
+             o->sc->st[o->w.ref].name);
     pd_chart ch = {.title = title,
-                   .xlabel = "Pi_2 = T_p / T_0",
-                   .ylabel = "Pi_1 = u_{max} w_p^2 / a_p",
+                   .xlabel = "{/Symbol P}_2 = T_p / T_0",
+                   .ylabel = "{/Symbol P}_1 = u_{max} {/Symbol w}_p^2 / a_p",
                    .logx = 1,
                    .logy = 1,
                    .ncurves = nc,

@@ -538,6 +538,7 @@ static int impact(ed_run *ed, int j, double t_hit, double vn, double tb, double 
         res->first_impact_velocity = vn;
     }
     res->max_impact_velocity = fmax(res->max_impact_velocity, vn);
+    res->impulse += (1.0 + ed->p->e) * vn;
     *t = t_hit;
     if (++ed->burst > ed->max_burst)
         return pd_err_set(err, PD_EBUDGET,

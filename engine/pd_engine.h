@@ -518,7 +518,8 @@ PD_API void pd_edr_free(pd_edr *r);
 PD_API int pd_edr_run(pd_edr *r, double t0, const double *q0, const double *v0, double t1,
                       pd_observer observer, void *ctx, pd_err *err);
 
-/* The last run's results (valid until the next run or pd_edr_free). */
+/* The last run's results (valid until the next run or pd_edr_free).  During
+ * a run (from its observer) contact_impacts holds the impacts so far. */
 PD_API const pd_edr_result *pd_edr_result_of(const pd_edr *r);
 
 /* ---- event-driven reference: one oscillator, one wall (event_sdof.c) --
@@ -573,13 +574,15 @@ typedef struct pd_ed_result {
     double first_impact, first_impact_velocity, max_impact_velocity; /* NAN: none */
     double contact_time;          /* time spent resting on the wall */
     double t_reached;             /* where the run stopped (t_end unless it failed) */
+    double impulse;               /* sum of the impacts' impulses (1 + e) vn per unit mass */
 } pd_ed_result;
 
 /* Called on the output grid with the exact state; return > 0 to stop. */
 typedef int (*pd_ed_sampler)(double t, double x, double v, int in_contact, void *ctx);
 
 /* Run from (x0, v0) at pieces[0].t_start to opts->t_end (opts NULL: the
- * defaults, t_end 0).  PD_EBUDGET when an event budget is exhausted (message
+ * defaults, t_end 0).  res is kept up to date as the run goes: the sampler
+ * may read the impacts and their impulse so far.  PD_EBUDGET when an event budget is exhausted (message
  * names the time and the count). */
 PD_API int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opts *opts,
                           pd_ed_sampler sampler, void *ctx, pd_ed_result *res, pd_err *err);

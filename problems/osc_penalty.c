@@ -39,7 +39,7 @@ typedef struct pen_track {
     pd_demand_osc dem;            /* the absolute acceleration's peak */
     double fpeak;                 /* the largest element force */
     int no_demands;
-    long impacts;
+    long impacts, sampled;        /* sampled: impacts reported to the sampler */
     double first_tau, first_v, vimp_max, contact_tau;
     int have_prev, pactive;
     double pt, px, pv, pP;        /* previous accepted state and its force */
@@ -233,7 +233,9 @@ static int emit_sample(const pd_state *st, void *ctx)
                        .u = x * tr->Le,
                        .v = st->v[0] * tr->vscale,
                        .impulse = tr->imp * tr->vscale,
-                       .gap = (tr->Pi3 - x) * tr->Le};
+                       .gap = (tr->Pi3 - x) * tr->Le,
+                       .impacts = tr->impacts - tr->sampled};
+    tr->sampled = tr->impacts;
     tr->imp = 0.0;
     tr->imp_lam = lam;
     return tr->sampler(&s, tr->sampler_ctx);

@@ -238,6 +238,7 @@ static void scene_force(double tau, int side, double *F, void *ctx)
 /* The observer's context: the measurements and the sampler. */
 typedef struct tracker {
     pd_osc_track m;
+    long sampled;         /* impacts reported to the sampler */
     double Le, vscale, wp;
     pd_demand_osc dem;    /* the absolute acceleration's peak (Pi units) */
     int demands;          /* 0: not measured (pd_run_opts.no_demands) */
@@ -329,7 +330,9 @@ static int observe(const pd_state *st, void *ctx)
                              .u = x * tr->Le,
                              .v = v * tr->vscale,
                              .impulse = P * tr->vscale,
-                             .gap = (tr->m.Pi3 - x) * tr->Le};
+                             .gap = (tr->m.Pi3 - x) * tr->Le,
+                             .impacts = tr->m.impacts - tr->sampled};
+        tr->sampled = tr->m.impacts;
         return tr->sampler(&smp, tr->sampler_ctx);
     }
     return 0;
@@ -478,6 +481,9 @@ typedef struct ref_bridge {
     long impacts, impacts_prev; /* impacts seen, and by the previous sample */
     int rest_prev;        /* the previous sample was resting on the wall */
     long step;
+    const pd_ed_result *er; /* the run's impacts and impulse so far */
+    long reported;          /* impacts and impulse reported to the sampler */
+    double impulse_reported;
     pd_osc_sampler sampler;
     void *ctx;
 } ref_bridge;
@@ -500,8 +506,11 @@ static int ref_sample(double tau, double x, double v, int in_contact, void *ctx)
                        .t = tau / b->wp,
                        .u = x * b->Le,
                        .v = v * b->vscale,
-                       .impulse = 0.0,
-                       .gap = (b->Pi3 - x) * b->Le};
+                       .impulse = (b->er->impulse - b->impulse_reported) * b->vscale,
+                       .gap = (b->Pi3 - x) * b->Le,
+                       .impacts = b->er->impacts - b->reported};
+    b->reported = b->er->impacts;
+    b->impulse_reported = b->er->impulse;
     return b->sampler(&s, b->ctx);
 }
 
@@ -605,7 +614,7 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     ref_bridge bridge = {.wp = wp, .Le = Le, .vscale = Le * wp, .Pi3 = c->Pi3, .c = c,
                          .dem = {.C = 2.0 * c->xi * c->Pi2, .K = c->Pi2 * c->Pi2,
                                  .tau_measure = eo.t_measure},
-                         .step = 0, .sampler = sampler, .ctx = ctx};
+                         .step = 0, .er = &er, .sampler = sampler, .ctx = ctx};
     eo.on_impact_ctx = &bridge;
     double cpu0 = pd_cpu_seconds();
     rc = pd_ed_sdof_run(&prob, 0.0, 0.0, &eo, eo.h_out > 0.0 ? ref_sample : NULL, &bridge, &er,

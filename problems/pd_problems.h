@@ -345,6 +345,8 @@ typedef struct pd_osc_sample {
     double t, u, v;
     double impulse; /* contact impulse per unit mass since the last sample [m/s] */
     double gap;     /* delta - u [m] */
+    long impacts;   /* impacts begun since the last sample (over the run they sum to
+                       pd_osc_result.impacts; each method's count) */
 } pd_osc_sample;
 
 /* Called at t = 0 and after every step (or output); return > 0 to stop. */
@@ -639,6 +641,8 @@ typedef struct pd_scene_sample {
     const double *v;       /* n velocities [m/s] */
     const double *gap;     /* m gaps [m] */
     const double *impulse; /* m contact impulses since the last sample [N s] */
+    const long *impacts;   /* m impacts begun since the last sample (over the run they sum
+                              to pd_scene_result.impacts) */
 } pd_scene_sample;
 
 typedef int (*pd_scene_sampler)(const pd_scene_sample *s, void *ctx);

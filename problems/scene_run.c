@@ -73,6 +73,8 @@ typedef struct track {
     pd_scene_sampler fn;
     void *ctx;
     double *sx, *sv, *sg, *sP, *imp; /* SI scratch; impulses since the last sample */
+    long *sI, *sampled;               /* m: impacts since the last sample; reported */
+    const long *live_impacts;         /* the row reference's counts during its run */
     double imp_t;                     /* penalty: time the impulses were integrated to */
     double *imp_lam;                  /* penalty: forces at imp_t */
     int edr_hit;                      /* row reference: an impulsive impact since the
@@ -155,7 +157,7 @@ static void track_free(track *tr)
                       tr->pv, tr->pa, tr->plam, tr->pactive, tr->sx, tr->sv, tr->sg, tr->sP,
                       tr->imp, tr->imp_lam, tr->acc, tr->shear, tr->da, tr->dV, tr->fpeak,
                       tr->dad, tr->dVd, tr->qa, tr->qV, tr->qad, tr->qVd,
-                      tr->st_of, tr->ex, tr->ev};
+                      tr->st_of, tr->ex, tr->ev, tr->sI, tr->sampled};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(arrays[k]);
 }
@@ -178,7 +180,8 @@ static int track_alloc(track *tr, const pd_scene *sc, pd_err *err)
         !TA(tr->imp_lam, m) || !TA(tr->acc, n) || !TA(tr->shear, n) || !TA(tr->da, n) ||
         !TA(tr->dV, n) || !TA(tr->fpeak, m) || !TA(tr->dad, n) || !TA(tr->dVd, n) ||
         !TA(tr->qa, n) || !TA(tr->qV, n) || !TA(tr->qad, n) || !TA(tr->qVd, n) ||
-        !TA(tr->st_of, n) || !TA(tr->ex, n) || !TA(tr->ev, n)) {
+        !TA(tr->st_of, n) || !TA(tr->ex, n) || !TA(tr->ev, n) || !TA(tr->sI, m) ||
+        !TA(tr->sampled, m)) {
 #undef TA
         track_free(tr);
         return pd_err_set(err, PD_ENOMEM, "out of memory for tracking %d dofs", sc->n);
@@ -402,13 +405,16 @@ static int sample(track *tr, const pd_state *st)
         tr->sg[a] = tr->sc->ct[a].gap + (xb - xa) * tr->Le;
         tr->sP[a] = tr->imp[a] * Ps;
         tr->imp[a] = 0.0;
+        tr->sI[a] = tr->impacts[a] - tr->sampled[a];
+        tr->sampled[a] = tr->impacts[a];
     }
     pd_scene_sample s = {.step = st->step,
                          .t = st->t / tr->wp,
                          .x = tr->sx,
                          .v = tr->sv,
                          .gap = tr->sg,
-                         .impulse = tr->sP};
+                         .impulse = tr->sP,
+                         .impacts = tr->sI};
     return tr->fn(&s, tr->ctx);
 }
 
@@ -575,7 +581,8 @@ static int osc_sample(const pd_osc_sample *s, void *ctx)
                           .x = &x,
                           .v = &v,
                           .gap = b->m ? &s->gap : NULL,
-                          .impulse = b->m ? &imp : NULL};
+                          .impulse = b->m ? &imp : NULL,
+                          .impacts = b->m ? &s->impacts : NULL};
     return b->fn(&ss, b->ctx);
 }
 
@@ -657,8 +664,10 @@ static int observe_edr(const pd_state *st, void *ctx)
     note_demand(tr, st->t, st->q, st->v, st->has_acc ? st->acc : NULL, smooth);
     if (!tr->fn)
         return 0;
-    for (int a = 0; a < tr->model_m; a++)
+    for (int a = 0; a < tr->model_m; a++) {
         tr->imp[a] += st->P[a];
+        tr->impacts[a] = tr->live_impacts[a];
+    }
     return sample(tr, st);
 }
 
@@ -702,6 +711,7 @@ static int run_event(const pd_scene_model *sm, const pd_run_opts *o, double tau_
         free(pieces);
         return err ? err->status : PD_ENOMEM;
     }
+    tr->live_impacts = pd_edr_result_of(edr)->contact_impacts;
     rc = pd_edr_run(edr, 0.0, NULL, NULL, tau_end, eo.h_out > 0.0 ? observe_edr : NULL, tr, err);
     if (err && (rc == PD_ENUMERICAL || rc == PD_ESINGULAR)) { /* a cluster without modes */
         char why[sizeof err->msg];

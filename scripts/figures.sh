@@ -1,9 +1,11 @@
 #!/bin/sh
-# figures.sh — regenerate docs/figures/*.png with the pound CLI and gnuplot.
-# Usage: scripts/figures.sh [path/to/pound]   (run from the project root)
+# figures.sh — the figures (convergence, work-precision, stability, energy)
+# with the pound CLI and gnuplot, into OUT (default build/figures; `make
+# figures DOCS=1` passes docs/figures, the tracked copies the docs show).
+# Usage: scripts/figures.sh [path/to/pound [OUT]]   (run from the project root)
 set -eu
 pound=${1:-build/pound}
-out=docs/figures
+out=${2:-build/figures}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 mkdir -p "$out"
@@ -59,16 +61,17 @@ for th in 0.3 0.4 0.45 0.5; do
 done
 gnuplot <<GP
 set terminal pngcairo size 900,600 enhanced font 'sans,11'
+load 'scripts/plot_style.gp'
 set output '$out/stability-theta.png'
-set logscale xy; set grid; set key top left
-set title 'Moreau-Jean below theta = 1/2: max |u| over 200 s (xi = 0.05, no wall)'
-set xlabel 'w_0 h'; set ylabel 'max |u| [m]'
+set logscale xy; set grid; set key top left; set format y '10^{%L}'
+set title 'Moreau-Jean below {/Symbol q} = 1/2: max |u| over 200 s ({/Symbol x} = 0.05, no wall)'
+set xlabel '{/Symbol w}_0 h'; set ylabel 'max |u| [m]'
 set arrow from 0.25,graph 0 to 0.25,graph 1 nohead dt 3
 set arrow from 0.5,graph 0 to 0.5,graph 1 nohead dt 3
 set arrow from 1.0,graph 0 to 1.0,graph 1 nohead dt 3
-set label 'predicted limits 2 xi/(1-2 theta)' at 0.27,1e25
-plot '$tmp/stab-0.3.dat' w lp lw 2 t 'theta = 0.3', '$tmp/stab-0.4.dat' w lp lw 2 t 'theta = 0.4', \
-     '$tmp/stab-0.45.dat' w lp lw 2 t 'theta = 0.45', '$tmp/stab-0.5.dat' w lp lw 2 t 'theta = 0.5'
+set label 'predicted limits 2 {/Symbol x}/(1 - 2 {/Symbol q})' at 0.27,1e25
+plot '$tmp/stab-0.3.dat' w lp lw 2 t '{/Symbol q} = 0.3', '$tmp/stab-0.4.dat' w lp lw 2 t '{/Symbol q} = 0.4', \
+     '$tmp/stab-0.45.dat' w lp lw 2 t '{/Symbol q} = 0.45', '$tmp/stab-0.5.dat' w lp lw 2 t '{/Symbol q} = 0.5'
 GP
 
 # 3. eps = 1, theta = 1/2, no damping, 200 periods after a pulse: the energy
@@ -82,11 +85,12 @@ for f in e1 e08; do
 done
 gnuplot <<GP
 set terminal pngcairo size 900,500 enhanced font 'sans,11'
+load 'scripts/plot_style.gp'
 set output '$out/energy-eps1.png'
-set grid; set key bottom left; set logscale y
-set title 'Energy after the pulse, theta = 1/2, xi = 0 (Moreau-Jean, dt = Tp/2000)'
-set xlabel 't [s]'; set ylabel 'v^2/2 + w_0^2 u^2/2 [m^2/s^2]'
-plot '$tmp/e1.dat' w l lw 2 t 'eps = 1 (kept)', '$tmp/e08.dat' w l lw 2 t 'eps = 0.8 (falls at each impact)'
+set grid; set key center right; set logscale y; set format y '10^{%L}'
+set title 'Energy after the pulse, {/Symbol q} = 1/2, {/Symbol x} = 0 (Moreau-Jean, dt = Tp/2000)'
+set xlabel 't [s]'; set ylabel 'v^2/2 + {/Symbol w}_0^2 u^2/2 [m^2/s^2]'
+plot '$tmp/e1.dat' w l lw 2 t '{/Symbol e} = 1 (kept)', '$tmp/e08.dat' w l lw 2 t '{/Symbol e} = 0.8 (falls at each impact)'
 GP
 echo "figures written to $out/"
 

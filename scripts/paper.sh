@@ -1,15 +1,17 @@
 #!/bin/sh
 # paper.sh — the source paper's figures (Dimitrakopoulos, Makris & Kappos
-# 2010), regenerated with pound into docs/figures/paper-*.png, plus the
-# numbers docs/paper.md quotes (docs/figures/paper-*.txt).
-# Usage: scripts/paper.sh [path/to/pound]   (run from the project root)
+# 2010), regenerated with pound into OUT/paper-*.png, plus the numbers
+# docs/paper.md quotes (OUT/paper-*.txt).  OUT: build/figures by default;
+# `make paper DOCS=1` passes docs/figures, the tracked copies the docs show.
+# Usage: scripts/paper.sh [path/to/pound [OUT]]   (run from the project root)
 set -eu
 pound=${1:-build/pound}
-out=docs/figures
+out=${2:-build/figures}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 mkdir -p "$out"
-term="set terminal pngcairo size 1100,800 enhanced font 'sans,10'"
+term="set terminal pngcairo size 1100,800 enhanced font 'sans,10'
+load 'scripts/plot_style.gp'"
 
 # A history as "t u v" rows (CSV of pound simulate, comments dropped).
 hist() { # file args...
@@ -31,7 +33,7 @@ hist "$tmp/f3b" --pulse cosine --ap 5 --Tp 0.9 --T0 1.5 --Pi3 0.2 --eps 0.7 --dt
 gnuplot <<GP
 $term
 set output '$out/paper-fig3.png'
-set multiplot layout 2,2 title 'Fig. 3: T_0 = 0.5 s (a_p = 3 m/s^2, T_p = 0.3 s) and T_0 = 1.5 s (a_p = 5 m/s^2, T_p = 0.9 s), {/Symbol P}_2 = 0.6, {/Symbol P}_3 = 0.2, eps = 0.7'
+set multiplot layout 2,2 title 'Fig. 3: T_0 = 0.5 s (a_p = 3 m/s^2, T_p = 0.3 s) and T_0 = 1.5 s (a_p = 5 m/s^2, T_p = 0.9 s), {/Symbol P}_2 = 0.6, {/Symbol P}_3 = 0.2, {/Symbol e} = 0.7'
 set grid
 set xlabel 't [s]'; set ylabel 'u [cm]'
 plot '$tmp/f3a' u 1:(100*\$2) w l lw 2 t 'T_0 = 0.5 s', '$tmp/f3b' u 1:(100*\$2) w l lw 2 t 'T_0 = 1.5 s'
@@ -63,7 +65,7 @@ for pulse in sine cosine; do
     gnuplot <<GP
 $term
 set output '$out/paper-fig$n.png'
-set multiplot layout 2,2 title 'Fig. $n: one-$pulse pulse, eps = 0.5, xi = 0.05 (event-driven reference)'
+set multiplot layout 2,2 title 'Fig. $n: one-$pulse pulse, {/Symbol e} = 0.5, {/Symbol x} = 0.05 (event-driven reference)'
 set grid; set logscale xy; set key bottom left
 set xlabel '{/Symbol P}_2 = T_p / T_0'; set ylabel '{/Symbol P}_1 = u_{max} {/Symbol w}_p^2 / a_p'
 do for [d in 'normal reverse'] {
@@ -88,12 +90,12 @@ done
 gnuplot <<GP
 $term
 set output '$out/paper-fig8.png'
-set multiplot layout 3,1 title 'Fig. 8: normal sine pulse (a_p = 1 m/s^2, T_p = 1 s), {/Symbol P}_3 = 0.05, eps = 0.5'
+set multiplot layout 3,1 title 'Fig. 8: normal sine pulse (a_p = 1 m/s^2, T_p = 1 s), {/Symbol P}_3 = 0.05, {/Symbol e} = 0.5'
 set grid; set ylabel 'u / L_e'; set xlabel 't / T_p'
 L = 1/(2*pi)**2
 do for [P in '0.2 1 3'] {
   set title '{/Symbol P}_2 = '.P
-  plot '$tmp/f8-'.P u 1:(\$2/L) w l lw 2 t 'with the wall', '$tmp/f8f-'.P u 1:(\$2/L) w l lw 1 dt 2 t 'without', 0.05 w l lc rgb 'black' t 'wall'
+  plot '$tmp/f8-'.P u 1:(\$2/L) w l lw 2 t 'with the wall', '$tmp/f8f-'.P u 1:(\$2/L) w l lw 1 dt 2 t 'without', 0.05 w l dt 2 lc rgb 'black' t 'wall'
 }
 unset multiplot
 GP
@@ -107,10 +109,10 @@ cat "$tmp/f9-normal.txt" "$tmp/f9-reverse.txt" > "$out/paper-fig9.txt"
 gnuplot <<GP
 $term
 set output '$out/paper-fig9.png'
-set multiplot layout 2,1 title 'Fig. 9: T_0 = 3 s, one-sine pulse T_p = 0.3 s, a_p = 4 m/s^2, gap 4 mm, eps = 0.6'
+set multiplot layout 2,1 title 'Fig. 9: T_0 = 3 s, one-sine pulse T_p = 0.3 s, a_p = 4 m/s^2, gap 4 mm, {/Symbol e} = 0.6'
 set grid; set xlabel 't [s]'; set ylabel 'u [cm]'
-set title 'normal'; plot '$tmp/f9-normal' u 1:(100*\$2) w l lw 2 t '', 0.4 w l lc rgb 'black' t 'wall'
-set title 'reverse'; plot '$tmp/f9-reverse' u 1:(100*\$2) w l lw 2 t '', 0.4 w l lc rgb 'black' t 'wall'
+set title 'normal'; plot '$tmp/f9-normal' u 1:(100*\$2) w l lw 2 t '', 0.4 w l dt 2 lc rgb 'black' t 'wall'
+set title 'reverse'; plot '$tmp/f9-reverse' u 1:(100*\$2) w l lw 2 t '', 0.4 w l dt 2 lc rgb 'black' t 'wall'
 unset multiplot
 GP
 
@@ -123,12 +125,12 @@ done; done; done
 gnuplot <<GP
 $term
 set output '$out/paper-fig10.png'
-set multiplot layout 2,2 title 'Fig. 10: {/Symbol P}_3 = 0.05, xi = 0.05, eps from 0 to 1'
+set multiplot layout 2,2 title 'Fig. 10: {/Symbol P}_3 = 0.05, {/Symbol x} = 0.05, eps from 0 to 1'
 set grid; set logscale x; set key top right  # linear Pi1: on log axes the eps curves overlapped
 set xlabel '{/Symbol P}_2'; set ylabel '{/Symbol P}_1'
 do for [p in 'sine cosine'] { do for [d in 'normal reverse'] {
   set title p.', '.d
-  plot for [e in '0 0.25 0.5 0.75 1'] '$tmp/f10-'.p.'-'.d.'-'.e u 1:2 w l lw 2 t 'eps = '.e
+  plot for [e in '0 0.25 0.5 0.75 1'] '$tmp/f10-'.p.'-'.d.'-'.e u 1:2 w l lw 2 t '{/Symbol e} = '.e
 } }
 unset multiplot
 GP
@@ -140,16 +142,16 @@ done; done
 gnuplot <<GP
 $term
 set output '$out/paper-fig11.png'
-set multiplot layout 2,2 title 'Fig. 11: {/Symbol P}_2 = 1.16, one-cosine reverse pulse (T_p = 1 s): eps = 0.2 against eps = 1'
-set grid; set xlabel 't / T_p'
+set multiplot layout 2,2 title 'Fig. 11: {/Symbol P}_2 = 1.16, one-cosine reverse pulse (T_p = 1 s): {/Symbol e} = 0.2 against {/Symbol e} = 1'
+set grid; set xlabel 't / T_p'; set key below
 L = 1/(2*pi)**2; V = 1/(2*pi)
 do for [P in '0.3 0.05'] {
   set title '{/Symbol P}_3 = '.P; set ylabel 'u / L_e'
-  plot '$tmp/f11-'.P.'-0.2' u 1:(\$2/L) w l lw 2 t 'eps = 0.2', '$tmp/f11-'.P.'-1' u 1:(\$2/L) w l lw 2 t 'eps = 1', P+0 w l lc rgb 'black' t 'wall'
+  plot '$tmp/f11-'.P.'-0.2' u 1:(\$2/L) w l lw 2 t '{/Symbol e} = 0.2', '$tmp/f11-'.P.'-1' u 1:(\$2/L) w l lw 2 t '{/Symbol e} = 1', P+0 w l dt 2 lc rgb 'black' t 'wall'
 }
 do for [P in '0.3 0.05'] {
   set title '{/Symbol P}_3 = '.P; set ylabel '(du/dt) / (a_p / {/Symbol w}_p)'
-  plot '$tmp/f11-'.P.'-0.2' u 1:(\$3/V) w l lw 2 t 'eps = 0.2', '$tmp/f11-'.P.'-1' u 1:(\$3/V) w l lw 2 t 'eps = 1'
+  plot '$tmp/f11-'.P.'-0.2' u 1:(\$3/V) w l lw 2 t '{/Symbol e} = 0.2', '$tmp/f11-'.P.'-1' u 1:(\$3/V) w l lw 2 t '{/Symbol e} = 1'
 }
 unset multiplot
 GP
@@ -161,11 +163,11 @@ for e in 0.3 0.6 0.9; do rows "$tmp/f12.csv" harmonic normal "\$8 == $e" > "$tmp
 gnuplot <<GP
 $term
 set output '$out/paper-fig12.png'
-set title 'Fig. 12: harmonic excitation, steady state, {/Symbol P}_3 = 0.001, xi = 0.05'
+set title 'Fig. 12: harmonic excitation, steady state, {/Symbol P}_3 = 0.001, {/Symbol x} = 0.05'
 set grid; set logscale y; set key top left
 set xlabel '1/{/Symbol P}_2 = T_0 / T_p'; set ylabel '{/Symbol P}_1 (steady state)'
 set xtics 1
-plot for [e in '0.3 0.6 0.9'] '$tmp/f12-'.e u (1/\$1):2 w l lw 2 t 'eps = '.e
+plot for [e in '0.3 0.6 0.9'] '$tmp/f12-'.e u (1/\$1):2 w l lw 2 t '{/Symbol e} = '.e
 GP
 # the largest Pi1 within 0.7 of 1/Pi2 = 2, 4, 6, 8 (the subharmonic peaks)
 for e in 0.3 0.6 0.9; do
@@ -187,7 +189,8 @@ if [ -d "$recs" ]; then
     all=$(ls "$recs"/*.AT2 "$recs"/*.at2 "$recs"/*.V2 2>/dev/null | sort)
     "$pound" record $all > "$out/paper-records.txt"
     "$pound" record $all --json | tr '{' '\n' | awk -F'"name":"' 'NF > 1 {split($2, a, "\""); n = a[1]}
-        /"Le":/ {sub(/.*"Le":/, ""); sub(/,.*/, ""); printf "%s %.6g\n", n, 1 / $0}' > "$tmp/le"
+        /"Le":/ {sub(/.*"Le":/, ""); sub(/,.*/, ""); printf "%s %.6g\n", n, 1 / $0}' |
+        sort -g -k2,2 | awk '{print $0, 0.002 + 0.024 * ((NR - 1) % 3)}' > "$tmp/le"
     # Fig. 7: contours of Pi3 = gap / Le on the (1/Le, gap) plane, the records placed
     gnuplot <<GP
 $term
@@ -201,7 +204,8 @@ set label 'Tabas (paper)' at 1.25, 0.095 font ',9'
 set arrow from 5.3, graph 0 to 5.3, graph 1 nohead dt 2 lc rgb 'black'
 set label 'Parkfield C02 (paper)' at 5.35, 0.095 font ',9'
 plot for [p in '0.01 0.02 0.05 0.1 0.2 0.5'] p/x w l lw 2 t '{/Symbol P}_3 = '.p, \
-     '$tmp/le' u 2:(0.002):(strcol(1)) w labels rotate by 90 left font ',7' noenhanced \
+     '$tmp/le' u 2:(0.0015):(0):(\$3 - 0.0015) w vectors nohead dt 3 lc rgb 'gray60' t '', \
+     '$tmp/le' u 2:3:(strcol(1)) w labels rotate by 90 left font ',7' noenhanced \
         offset 0,0.5 t '', '$tmp/le' u 2:(0.0015) w points pt 7 ps 0.8 lc rgb 'black' \
         t 'shared records (fitted 1/L_e)'
 GP
@@ -240,7 +244,7 @@ GP
     gnuplot <<GP
 $term
 set output '$out/paper-records-collapse.png'
-set title 'Pi_1({/Symbol P}_2) at {/Symbol P}_3 = 0.05, eps = 0.5, xi = 0.05: pulse-like records and the one-cycle pulses'
+set title '{/Symbol P}_1({/Symbol P}_2) at {/Symbol P}_3 = 0.05, {/Symbol e} = 0.5, {/Symbol x} = 0.05: pulse-like records and the one-cycle pulses'
 set xlabel '{/Symbol P}_2 = T_p / T_0'; set ylabel '{/Symbol P}_1 = u_{max} / L_e'
 set logscale x; set grid; set key top right
 plot for [r in '$pulse_like'] '$tmp/c-'.r w l lw 2 t r noenhanced, \

@@ -412,6 +412,15 @@ def oscillator(ctx):
             u = column(header, rows, "u")
             check(np.abs(u).max() <= j["umax"] * (1 + 1e-12), f"{out}: a sampled |u| exceeds umax")
             check(close(column(header, rows, "t")[1], 7 * j["dt"]), f"{out}: the second row is not t = 7 dt")
+    # the event-driven reference: each sample's impulse sums the impacts since the previous one
+    # ((1 + eps) v of each); these impacts fall in different samples
+    args = base[:-1] + ["event", "-o", "osc-event.h5", "--json"]
+    j = json.loads(run(ctx.pound, args, ctx.tmp))
+    f = h5py.File(os.path.join(ctx.tmp, "osc-event.h5"), "r")
+    p = f["impulse"][:]
+    f.close()
+    check(np.count_nonzero(p) == j["impacts"] > 0, f"osc-event.h5: {np.count_nonzero(p)} nonzero impulses, {j['impacts']} impacts")
+    check(close(p.max(), j["max_impulse"]), f"osc-event.h5: max impulse {p.max()!r} != max_impulse {j['max_impulse']!r}")
 
 
 def scene(ctx):

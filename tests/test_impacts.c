@@ -232,9 +232,122 @@ static void test_impacts_cradle_inelastic_touching(pd_test_ctx *ctx)
         }
 }
 
+/* ---- the samples' impact counts ---------------------------------------- */
+
+/* What a sampler adds up: impacts and the largest impulse of one sample. */
+typedef struct sample_sum {
+    long impacts, m, per[3];
+    double max_impulse;
+} sample_sum;
+
+static int osc_sum(const pd_osc_sample *s, void *ctx)
+{
+    sample_sum *q = ctx;
+    q->impacts += s->impacts;
+    q->max_impulse = fmax(q->max_impulse, s->impulse);
+    return 0;
+}
+
+static int scene_sum(const pd_scene_sample *s, void *ctx)
+{
+    sample_sum *q = ctx;
+    for (long a = 0; a < q->m && s->impacts; a++)
+        q->per[a] += s->impacts[a];
+    return 0;
+}
+
+/* Every method's samples report the impacts begun since the previous
+ * sample, and over the run they add up to the result's count: the
+ * oscillator of the paper's Fig. 9 (5 impacts, far apart), and two SDOFs
+ * beside a wall (per contact, the exact references and penalty on their
+ * output grid too), and one SDOF beside a wall (the oscillator's paths).  The event-driven oscillator's samples carry its
+ * impulses: its impacts fall in different samples, so the largest sample
+ * is the largest impact's (1 + eps) v, to rounding of the unit change. */
+static void test_samples_count_impacts(pd_test_ctx *ctx)
+{
+    static const pd_method osc_methods[] = {PD_METHOD_MOREAU, PD_METHOD_EVENT, PD_METHOD_PENALTY,
+                                            PD_METHOD_NEWMARK};
+    pd_osc c = pd_osc_default();
+    c.pulse = PD_PULSE_SINE;
+    c.ap = 4.0;
+    c.Tp = 0.3;
+    c.eps = 0.6;
+    pd_osc_set_T0(&c, 3.0);
+    pd_osc_set_gap(&c, 0.004);
+    for (int k = 0; k < 4; k++) {
+        pd_run_opts o = pd_run_default_opts();
+        pd_osc_result r;
+        pd_err e;
+        sample_sum q = {0};
+        o.method = osc_methods[k];
+        int rc = pd_osc_run(&c, &o, osc_sum, &q, &r, &e);
+        if (!CHECK(ctx, rc == PD_OK, "%s: %s", pd_method_name(o.method), e.msg))
+            continue;
+        CHECK(ctx, r.impacts == 5 && q.impacts == r.impacts, "%s: samples report %ld impacts, "
+              "the result %ld (5 expected)", pd_method_name(o.method), q.impacts, r.impacts);
+        if (o.method == PD_METHOD_EVENT)
+            CHECK_NEAR(ctx, q.max_impulse, r.max_impulse, 1e-14 * r.max_impulse);
+    }
+    static const pd_method scene_methods[] = {PD_METHOD_MOREAU, PD_METHOD_EVENT,
+                                              PD_METHOD_EVENT_GENERAL, PD_METHOD_PENALTY,
+                                              PD_METHOD_NEWMARK};
+    pd_scene_excitation x = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 4.0, .Tp = 0.5};
+    pd_scene *sc = pd_scene_new(&x);
+    pd_err e;
+    int ok = sc && !pd_scene_add_sdof(sc, "A", 0.4, 0.05, 1e5, &e) &&
+             !pd_scene_add_sdof(sc, "B", 1.2, 0.05, 1e5, &e) &&
+             !pd_scene_add_contact(sc, PD_WALL, 1, 0, 1, 0.01, 0.5, 0, &e) &&
+             !pd_scene_add_contact(sc, 0, 1, 1, 1, 0.01, 0.5, 0, &e) &&
+             !pd_scene_add_contact(sc, 1, 1, PD_WALL, 1, 0.02, 0.5, 0, &e) &&
+             !pd_scene_finish(sc, &e);
+    CHECK(ctx, ok, "building the scene: %s", ok ? "" : e.msg);
+    for (int k = 0; ok && k < 5; k++) {
+        pd_run_opts o = pd_run_default_opts();
+        pd_scene_result r;
+        sample_sum q = {.m = 3};
+        long all = 0;
+        o.method = scene_methods[k];
+        o.tend = 3.0;
+        if (!CHECK(ctx, pd_scene_result_alloc(sc, &r, &e) == PD_OK, "%s", e.msg))
+            break;
+        int rc = pd_scene_run(sc, &o, scene_sum, &q, &r, &e);
+        if (CHECK(ctx, rc == PD_OK, "%s: %s", pd_method_name(o.method), e.msg))
+            for (int a = 0; a < 3; a++) {
+                all += r.impacts[a];
+                CHECK(ctx, q.per[a] == r.impacts[a], "%s, contact %d: samples report %ld "
+                      "impacts, the result %ld", pd_method_name(o.method), a, q.per[a],
+                      r.impacts[a]);
+            }
+        CHECK(ctx, all > 0, "%s: no impact to count", pd_method_name(o.method));
+        pd_scene_result_free(&r);
+    }
+    pd_scene_free(sc);
+    /* one SDOF and a wall: the oscillator's fast paths */
+    sc = pd_scene_new(&x);
+    ok = sc && !pd_scene_add_sdof(sc, "A", 0.4, 0.05, 1e5, &e) &&
+         !pd_scene_add_contact(sc, 0, 1, PD_WALL, 1, 0.01, 0.5, 0, &e) && !pd_scene_finish(sc, &e);
+    CHECK(ctx, ok, "building the one-wall scene: %s", ok ? "" : e.msg);
+    for (int k = 0; ok && k < 4; k++) {
+        pd_run_opts o = pd_run_default_opts();
+        pd_scene_result r;
+        sample_sum q = {.m = 1};
+        o.method = osc_methods[k];
+        o.tend = 3.0;
+        if (!CHECK(ctx, pd_scene_result_alloc(sc, &r, &e) == PD_OK, "%s", e.msg))
+            break;
+        int rc = pd_scene_run(sc, &o, scene_sum, &q, &r, &e);
+        CHECK(ctx, rc == PD_OK && r.impacts[0] > 0 && q.per[0] == r.impacts[0],
+              "one wall, %s: samples report %ld impacts, the result %ld (%s)",
+              pd_method_name(o.method), q.per[0], r.impacts[0], rc ? e.msg : "");
+        pd_scene_result_free(&r);
+    }
+    pd_scene_free(sc);
+}
+
 void suite_impacts(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_impacts_cradle_touching);
     PD_RUN(ctx, test_impacts_cradle_gapped);
     PD_RUN(ctx, test_impacts_cradle_inelastic_touching);
+    PD_RUN(ctx, test_samples_count_impacts);
 }

@@ -159,7 +159,7 @@ class PdOsc(Structure):
 
 class PdOscSample(Structure):
     _fields_ = [("step", c_long), ("t", c_double), ("u", c_double), ("v", c_double),
-                ("impulse", c_double), ("gap", c_double)]
+                ("impulse", c_double), ("gap", c_double), ("impacts", c_long)]
 
 
 class PdOscResult(Structure):
@@ -221,7 +221,7 @@ class PdScene(Structure):
 class PdSceneSample(Structure):
     _fields_ = [("step", c_long), ("t", c_double), ("x", POINTER(c_double)),
                 ("v", POINTER(c_double)), ("gap", POINTER(c_double)),
-                ("impulse", POINTER(c_double))]
+                ("impulse", POINTER(c_double)), ("impacts", POINTER(c_long))]
 
 
 class PdSceneResult(Structure):

@@ -116,7 +116,7 @@ class _History:
 
 
 OSC_SAMPLE = [("step", "i8"), ("t", "f8"), ("u", "f8"), ("v", "f8"), ("impulse", "f8"),
-              ("gap", "f8")]
+              ("gap", "f8"), ("impacts", "i8")]
 
 
 def _osc_sampler(h):
@@ -198,10 +198,11 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
     unit mass (docs/scenes.md, "Demands"): drift_ratio, acc_max [m/s^2],
     shear_max, force_equiv, force_max [N/kg] (NaN: not a penalty method),
     height [m], contact_duration [s].  With history,
-    r.history: the arrays step, t, u, v, impulse, gap of every every-th
-    step (the CLI's -o file: t [s], u [m], v [m/s], impulse per unit mass
-    since the last sample [m/s], gap delta - u [m]), with t, u, v, impulse
-    also as r.t, r.u, r.v, r.impulse."""
+    r.history: the arrays step, t, u, v, impulse, gap, impacts of every
+    every-th step (the CLI's -o file: t [s], u [m], v [m/s], impulse per
+    unit mass since the last sample [m/s], gap delta - u [m]; and the
+    impacts begun since the last sample), with t, u, v, impulse also as
+    r.t, r.u, r.v, r.impulse."""
     history, every = history_args(history, every)
     height = _demand.pop_height(case)
     k = Case(case).resolve()

@@ -67,19 +67,20 @@ def impact_times(r: Mapping[str, Any], contact: int = 0) -> Tuple[np.ndarray, np
     A sample whose impulse is > 0 after one whose impulse is 0 is an impact
     (the library counts impacts so: for Moreau-Jean one marker per counted
     impact; for a sampled reference, impacts between two samples show as
-    one).  The oscillator's event-driven reference samples carry no impulse:
-    there an impact is a sample pair across which the velocity turns from
-    toward the wall (v > 0) to away (v < 0) while the gap is within one
-    sample's travel of zero; its time is the gap's linear closing time
-    t[k-1] + gap[k-1] / v[k-1] and the index is k.  contact: the scene
-    contact's index (an oscillator has one)."""
+    one).  The oscillator's event-driven reference places its impacts
+    more closely (its samples carry the impulses of the impacts between
+    them, but at the next sample): there an impact is a sample pair across
+    which the velocity turns from toward the wall (v > 0) to away (v < 0)
+    while the gap is within one sample's travel of zero; its time is the
+    gap's linear closing time t[k-1] + gap[k-1] / v[k-1] and the index is k.
+    contact: the scene contact's index (an oscillator has one)."""
     h = _history_of(r)
     t = np.asarray(h["t"], dtype=float)
     imp = np.asarray(h["impulse"], dtype=float)
     if imp.ndim == 2:
         imp = imp[:, contact]
     k = _onsets(imp)
-    if len(k) or imp.ndim != 1 or "u" not in h or not r.get("impacts"):
+    if not _exact_oscillator(r, h) or not r.get("impacts"):
         return k, t[k]
     # the oscillator without impulses in its samples (the exact reference)
     v, gap = np.asarray(h["v"], dtype=float), np.asarray(h["gap"], dtype=float)
@@ -91,6 +92,11 @@ def impact_times(r: Mapping[str, Any], contact: int = 0) -> Tuple[np.ndarray, np
     k = np.flatnonzero(turn & reach) + 1
     when = t[k - 1] + np.clip(gap[k - 1] / v[k - 1], 0.0, dt[k - 1])
     return k, when
+
+
+def _exact_oscillator(r: Mapping[str, Any], h: Mapping[str, Any]) -> bool:
+    """An oscillator's history from the exact event-driven reference."""
+    return "u" in h and np.ndim(h["impulse"]) == 1 and r.get("method") == "event"
 
 
 def _scales(r: Mapping[str, Any], scaled: bool) -> Tuple[float, float, str, str]:
@@ -119,8 +125,8 @@ def _osc_history(r: Mapping[str, Any], ax: Axes, impacts: bool, wall: bool,
         k, when = impact_times(r)
         if len(k):
             # a stepper's at its sample; the reference's on the wall (u = gap when it strikes)
-            sampled = _onsets(h["impulse"]).size > 0
-            at = u[k] if sampled else np.full(len(k), float(r["gap"]) / ls)
+            exact = _exact_oscillator(r, h)
+            at = np.full(len(k), float(r["gap"]) / ls) if exact else u[k]
             ax.plot(when / ts, at, ls="none", marker="o", mfc="none", color="C3",
                     label="impacts (%d)" % len(k))
     ax.set_xlabel(tlabel)

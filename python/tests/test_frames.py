@@ -14,7 +14,7 @@ def test_short_repr():
     r = pound.simulate(**FIG9)
     text = repr(r)
     assert len(text) < 400 and "umax=0.175108" in text and "more)" in text
-    assert repr(r.history).count("array(") == 6
+    assert repr(r.history).count("array(") == 7  # step, t, u, v, impulse, gap, impacts
 
 
 def test_to_pandas_oscillator():
