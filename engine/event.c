@@ -60,6 +60,8 @@ typedef struct edg {
     double last_event;    /* time of the last event */
     long same_instant;    /* consecutive events within rounding of it */
     double last_emit;
+    int sample_forces;    /* the observer's P: impulses since its last report (z) */
+    double *zout;         /* m: z at the observer's last report */
     /* constant data: M factored, M^-1 W and D = W^T M^-1 W (pd_factor.h) */
     pd_factor *fac;
     const pd_matrix *W;
@@ -141,6 +143,7 @@ static size_t layout(edg *w, char *base)
     TAKE(w->tolg, m, double);
     TAKE(w->tolU, m, double);
     TAKE(w->P, m, double);
+    TAKE(w->zout, m, double);
     TAKE(w->tail, m, double);
     TAKE(w->Uprev, m, double);
     TAKE(w->rest_from, m, double);
@@ -223,6 +226,7 @@ pd_edg_opts pd_edg_default_opts(void)
     return (pd_edg_opts){.rtol = 1e-12,
                          .atol = 1e-14,
                          .h_out = 0.0,
+                         .impacts_only = 0,
                          .no_accumulation = 0,
                          .max_events = 1000000L,
                          .max_burst = 100000L,
@@ -797,6 +801,14 @@ static void emit(edg *w, double t, const double *y, int with_P, int to)
     if (!(to & TO_OBSERVER) || !w->obs || w->stopped)
         return;
     fill_state(w, t, y, with_P);
+    /* a sampler's P: the held forces' integral since the last report (z
+     * holds int lambda dt and is constant while a contact is free, so a
+     * free contact's P is its impacts' bit for bit) */
+    for (int a = 0; w->sample_forces && a < w->m; a++) {
+        double z = y[2 * w->n + a];
+        w->st.P[a] += z - w->zout[a];
+        w->zout[a] = z;
+    }
     w->st.has_acc = 0;
     w->last_emit = t;
     if (w->obs(&w->st, w->obs_ctx) > 0)
@@ -1262,6 +1274,7 @@ int pd_edg_run(const pd_model *model, double t0, const double *q0, const double 
     w.obs_ctx = ctx;
     w.last_emit = NAN;
     w.last_event = -HUGE_VAL;
+    w.sample_forces = observer && w.o.h_out > 0.0 && !w.o.impacts_only;
     if (!(rc = edg_alloc(&w, err)) && !(rc = factor_mass(&w, err)))
         rc = start(&w, q0, v0, err);
     while (!rc && !w.stopped && w.t < t1)

@@ -244,7 +244,11 @@ PD_API int pd_mjb_finite(const pd_mjb *b, int l);
  * contact (criterion in docs/methods.md). */
 typedef struct pd_edg_opts {
     double rtol, atol;      /* GSL tolerances > 0 */
-    double h_out;           /* > 0: observer every h_out (and at t1); 0: every event/step */
+    double h_out;           /* > 0: observer every h_out (and at t1) and at every event;
+                               its P: each contact's impulse since its last report, the
+                               held force integrated plus the impacts'; 0: every
+                               event/step, P the impacts at that instant */
+    int impacts_only;       /* 1: with h_out > 0 the observer's P holds the impacts only */
     int no_accumulation;    /* 1: never jump an accumulation */
     long max_events;        /* event budget >= 1 */
     long max_burst;         /* impacts of one accumulation before giving up, >= 1 */
@@ -259,7 +263,8 @@ typedef struct pd_edg_opts {
     pd_lcp_method lcp_solver; /* the impact and contact-force LCPs */
 } pd_edg_opts;
 
-/* rtol 1e-12, atol 1e-14, h_out 0, accumulations jumped, 10^6 events,
+/* rtol 1e-12, atol 1e-14, h_out 0 (with an output grid: P with the held
+ * forces), accumulations jumped, 10^6 events,
  * bursts of 10^5, length scale 1, automatic factor and solver. */
 PD_API pd_edg_opts pd_edg_default_opts(void);
 
@@ -271,8 +276,11 @@ typedef struct pd_edg_result {
 
 /* Run the model from (t0, q0, v0) (NULL = zeros) to t1 (opts NULL: the
  * defaults).  The observer gets pd_state: P holds the impulses of an impact
- * at that instant (zero otherwise), active flags the contacts in persistent
- * contact. */
+ * at that instant (zero otherwise; with h_out > 0 and not impacts_only,
+ * each contact's impulse since the observer's previous report: its held
+ * force integrated by the integrator, to its tolerances, plus the impacts'),
+ * active flags the contacts in persistent contact.  on_step's P holds the
+ * impacts at that instant only. */
 PD_API int pd_edg_run(const pd_model *model, double t0, const double *q0, const double *v0,
                       double t1, const pd_edg_opts *opts, pd_observer observer, void *ctx,
                       pd_edg_result *res, pd_err *err);

@@ -15,8 +15,9 @@
  *   impulse    of one impact: the step's P_a, the event's P_a, or the integral
  *              of the element force over one engagement; a sample's impulse
  *              is everything since the previous sample: the contact force
- *              integrated plus the impacts' impulses (the row reference
- *              integrates its held forces itself; event-general: impacts);
+ *              integrated plus the impacts' impulses (both references
+ *              integrate their held forces themselves: the row reference in
+ *              closed form, event-general by its integrator);
  *   approach   max over t of x_a - x_b (how far the gap closes);
  *   demands    peak |a_abs| per floor and |V| per storey (demand.c): at every
  *              step (Moreau–Jean, the discrete maximum as for umax); at every
@@ -472,7 +473,6 @@ static int step_event(const pd_state *st, void *ctx)
         if (P > 0.0) {
             tr->impacts[a]++;
             tr->maxP[a] = pd_max(tr->maxP[a], P);
-            tr->imp[a] += P;
             if (isnan(tr->first[a]))
                 tr->first[a] = st->t;
         }
@@ -526,13 +526,16 @@ static int step_penalty(const pd_state *st, void *ctx)
 }
 
 /* The output grid (event-driven, penalty): impulses since the last sample
- * (event impulses summed by step_event; element forces integrated here and
- * by step_penalty). */
+ * (event-general: the engine's P, its impacts plus its held forces
+ * integrated; penalty: the element forces integrated here and by
+ * step_penalty). */
 static int observe_grid(const pd_state *st, void *ctx)
 {
     track *tr = ctx;
     if (tr->method == PD_METHOD_PENALTY || tr->method == PD_METHOD_NEWMARK)
         integrate_forces(tr, st);
+    else /* event-general: the engine's own, held forces included */
+        memcpy(tr->imp, st->P, (size_t)tr->model_m * sizeof(double));
     tr->imp_t = st->t;
     return sample(tr, st);
 }

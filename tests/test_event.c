@@ -216,6 +216,7 @@ static void test_edg_output_grid_leaves_path(pd_test_ctx *ctx)
     CHECK(ctx, pd_edg_run(&om.md, 0.0, NULL, NULL, tend, &o, keep_last, &f0, &r0, &err) == PD_OK,
           "%s", err.msg);
     o.h_out = 0.01;
+    o.impacts_only = 1; /* P > 0 only at the impacts (the held forces are not sampled) */
     CHECK(ctx, pd_edg_run(&om.md, 0.0, NULL, NULL, tend, &o, record, &tr, &r1, &err) == PD_OK,
           "%s", err.msg);
     CHECK(ctx, tr.x[tr.n - 1] == f0.x && tr.v[tr.n - 1] == f0.v && tr.t[tr.n - 1] == tend,
@@ -231,6 +232,25 @@ static void test_edg_output_grid_leaves_path(pd_test_ctx *ctx)
     }
     CHECK(ctx, grid >= (long)(tend / 0.01) && events == r1.impacts,
           "%ld grid outputs, %ld impact reports of %ld impacts", grid, events, r1.impacts);
+    /* sampling the held forces (the default) leaves the path too; every
+     * report's P gains the held force's integral (>= 0), nothing else */
+    trace ts = {0};
+    pd_edg_result r2;
+    o.impacts_only = 0;
+    CHECK(ctx, pd_edg_run(&om.md, 0.0, NULL, NULL, tend, &o, record, &ts, &r2, &err) == PD_OK,
+          "%s", err.msg);
+    int same = ts.n == tr.n && r2.steps == r1.steps && r2.events == r1.events, below = 0;
+    double held = 0.0;
+    for (long k = 0; same && k < tr.n; k++) {
+        same = ts.t[k] == tr.t[k] && ts.x[k] == tr.x[k] && ts.v[k] == tr.v[k];
+        below += ts.P[k] < tr.P[k];
+        held += ts.P[k] - tr.P[k];
+    }
+    CHECK(ctx, same && below == 0 && held > 0.0 && r1.accumulations > 0,
+          "sampled: same path %d, %d reports below the impacts', held impulse %g "
+          "(%ld accumulations)",
+          same, below, held, r1.accumulations);
+    trace_free(&ts);
     trace_free(&tr);
 }
 
