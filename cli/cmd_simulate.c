@@ -11,7 +11,7 @@
 #include "pd_scene_out.h"
 
 static const char simulate_usage[] =
-    "usage: pound simulate [model flags | --scene F.json | --chain N] [--method moreau|event|penalty|auto]\n"
+    "usage: pound simulate [model flags | --scene F.json | --chain N] [--method M]\n"
     "                      [--dt H] [--theta T] [--tend T] [-o FILE.h5|FILE.csv] [--every K]\n"
     "                      [--plot FILE.png] [--dump-lcp F.h5] [--json]\n"
     "  -o FILE     the histories (HDF5 or CSV by extension), every input and result as\n"

@@ -13,7 +13,7 @@
 static const char spectrum_usage[] =
     "usage: pound spectrum --Pi2 MIN:MAX:N [--linear] [model flags without --T0/--Pi2]\n"
     "                      [--Pi3 LIST | --gap LIST] [--eps LIST] [--xi LIST] [--pulse LIST]\n"
-    "                      [--dir LIST] [--ap LIST] [--method moreau|event|penalty|auto]\n"
+    "                      [--dir LIST] [--ap LIST] [--method M]\n"
     "                      [--dt H | --dt-per-Tp N] [-o FILE.h5|FILE.csv] [--plot FILE.png]\n"
     "                      [--json] [--resume] [--threads K]\n"
     "  --Pi2 MIN:MAX:N  N values of Pi2 = Tp/T0, log-spaced (--linear: equal steps)\n"

@@ -428,7 +428,7 @@ void pd_spec_print_text(const pd_spectrum *s, const pd_spec_row *rows, const pd_
     for (long c = 0; c < pd_spec_curves(s); c++)
         text_curve(s, rows + c * s->npi2, c);
     if (!strcmp(t->method_by, "default"))
-        printf("  method %s: the default for one oscillator (%s); --method moreau|event|penalty "
+        printf("  method %s: the default for one oscillator (%s); --method moreau|event|penalty|newmark "
                "chooses\n", pd_method_name(s->opts.method),
                s->opts.method == PD_METHOD_EVENT ? "exact and fastest"
                                                  : "the exact reference's scan is over budget");
