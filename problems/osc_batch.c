@@ -39,7 +39,8 @@ static void table_release(osc_batch *ob, int l)
 /* Lane l reads the table of its excitation at its step h, n steps long
  * (the steps inside it): one kept with the same shape and step, else one
  * no lane reads, filled; none (the lane computes its forces per step) when
- * the excitation is longer than OSC_TABLE_MAX steps or memory is short.
+ * the excitation is longer than OSC_TABLE_MAX steps or the table's memory
+ * was not had at batch_open.
  * The values are the ones the lane would compute: pd_osc_shape at s h. */
 static void table_acquire(osc_batch *ob, int l, double h, long n)
 {
@@ -60,13 +61,8 @@ static void table_acquire(osc_batch *ob, int l, double h, long n)
     if (free_slot < 0)
         return;
     osc_table *tb = &ob->tab[free_slot];
-    if (tb->cap < n) {
-        double *v = realloc(tb->v, (size_t)(n + 1) * sizeof *v);
-        if (!v)
-            return;
-        tb->v = v;
-        tb->cap = n;
-    }
+    if (tb->cap < n) /* its memory was not had at batch_open */
+        return;
     tb->unit = ob->unit[l];
     tb->h = h;
     tb->n = n;
@@ -346,9 +342,17 @@ static int batch_open(stream *s, const pd_run_opts *o, pd_err *err)
     s->ob->run = run_for_cpu();
     for (int l = 0; l < NL; l++)
         s->ob->table[l] = -1;
+    /* the tables' memory once, here (touched only as far as filled): no
+     * allocation while lanes start runs inside the batch's steps; a table
+     * not had stays empty, its lanes compute their forces per step */
+    for (int i = 0; i < OSC_TABLES; i++) {
+        osc_table *tb = &s->ob->tab[i];
+        if ((tb->v = malloc((size_t)(OSC_TABLE_MAX + 1) * sizeof *tb->v)))
+            tb->cap = OSC_TABLE_MAX;
+    }
     int rc = pd_mjb_init(&s->ob->mjb, &mo, lanes_force, s->ob, err);
     if (rc) {
-        free(s->ob);
+        batch_free(s->ob);
         s->ob = NULL;
         return rc;
     }
