@@ -80,11 +80,11 @@ typedef double mj1_vec __attribute__((vector_size(8 * MJ1_WIDTH)));
 typedef double mj1_uvec __attribute__((vector_size(8 * MJ1_WIDTH), aligned(8)));
 typedef long long mj1_umask __attribute__((vector_size(8 * MJ1_WIDTH), aligned(8)));
 
-/* mj1_coef's constants per lane, with the lane's h theta and h gamma,
+/* mj1_coef's constants per lane (-1/D for 1/D), with the lane's h theta and h gamma,
  * stored in pd_mjb's coef array (may_alias: read and written as this
  * type only, over storage declared as doubles). */
 typedef struct __attribute__((may_alias)) mj1_coefv {
-    mj1_uvec c, k, w, e, g0, whatinv, winv, delinv, hth, hgamma;
+    mj1_uvec c, k, w, e, g0, whatinv, winv, ndelinv, hth, hgamma;
     mj1_umask wall;
 } mj1_coefv;
 
@@ -98,8 +98,8 @@ static inline void mj1_coef_setv(mj1_coefv *s, int i, const mj1_coef *one, doubl
     s->e[i] = one->e;
     s->g0[i] = one->g0;
     s->whatinv[i] = one->whatinv;
-    s->winv[i] = one->winv;
-    s->delinv[i] = one->delinv;
+    s->winv[i] = one->wall ? one->winv : -0.0; /* (mj1_lanes_step's wall_neg) */
+    s->ndelinv[i] = -one->delinv;
     s->hth[i] = h * th;
     s->hgamma[i] = h * gamma;
     s->wall[i] = one->wall ? -1 : 0;

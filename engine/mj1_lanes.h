@@ -46,30 +46,68 @@ static inline const double *mj1_lanes_coef(const pd_mjb *b, int l)
 #define MJ1_EACH(n, stmt)                                                  \
     _Pragma("GCC unroll 8") for (int i = 0; i < (n); i++) { stmt; }
 
+/* pd_max and the minimum's a < b ? a : b, lane by lane (the x86 max and
+ * min instructions are exactly these: the second operand when the two are
+ * equal or unordered). */
+#if defined(__AVX512F__) && PD_LANES_X86
+#define LMAX(a, b) ((lvec)_mm512_max_pd((__m512d)(a), (__m512d)(b)))
+#define LMIN(a, b) ((lvec)_mm512_min_pd((__m512d)(a), (__m512d)(b)))
+#elif defined(__AVX__) && PD_LANES_X86
+#define LMAX(a, b) ((lvec)_mm256_max_pd((__m256d)(a), (__m256d)(b)))
+#define LMIN(a, b) ((lvec)_mm256_min_pd((__m256d)(a), (__m256d)(b)))
+#elif defined(__SSE2__) && PD_LANES_X86
+#include <immintrin.h>
+#define LMAX(a, b) ((lvec)_mm_max_pd((__m128d)(a), (__m128d)(b)))
+#define LMIN(a, b) ((lvec)_mm_min_pd((__m128d)(a), (__m128d)(b)))
+#else
+#define LMAX(a, b) LSELECT((a) > (b), a, b)
+#define LMIN(a, b) LSELECT((a) < (b), a, b)
+#endif
+
+/* theta F1 + (1 - theta) F0: the step's force from F0 at its start and F1
+ * at its end, as mj1_step forms it. */
+static inline lvec mj1_lanes_fth(double th, lvec F0, lvec F1)
+{
+    return th * F1 + (1.0 - th) * F0;
+}
+
 /* mj1_step's operations, in its order, on n vectors of LW lanes (n <= 8),
  * vector i with steps h[i] and its constants at cs[i] (mj1_lanes_coef):
- * from (q, v) with the gap g and the forces F0 at the step's start and F1
- * at its end, q, v and g move to the step's end and P gets the impulse. */
-static inline __attribute__((always_inline)) void mj1_lanes_step(int n, const double *const *cs, double th, const lvec *h,
-                                  const lvec *F0, const lvec *F1, lvec *q, lvec *v, lvec *g,
-                                  lvec *P)
+ * from (q, v) with the gap g and the step's force Fth (mj1_lanes_fth),
+ * q, v and g move to the step's end and P gets the impulse.
+ * The impulse is max(b (-1/D), +0) = mj1_step's (b < 0 ? -b/D : 0): the
+ * product is -b/D to the bit, and not above +0 when b >= 0 or unordered.
+ * wall_neg (a constant once inlined): every lane's W is negative or it has
+ * no contact (the oscillator's wall, W = -1), so that the lanes need no
+ * selection: a lane without a contact has g = +0, b = ±0 and P = +0, and
+ * v + (W/What) P adds -0 to v when P = +0 (x + -0 is x, -0 included) --
+ * mj1_coef_setv keeps W/What = -0 for such lanes. */
+static inline __attribute__((always_inline)) void
+mj1_lanes_step(int n, const double *const *cs, double th, const lvec *h, const lvec *Fth,
+               lvec *q, lvec *v, lvec *g, lvec *P, int wall_neg)
 {
     const lvec zero = {0.0};
     const size_t W = MJ1_WIDTH; /* one constant's lanes in the group */
     lvec rhs[8], vfree[8], U0[8], bb[8];
     lcond active[8], wall[8];
     lmask wm[8];
-    MJ1_EACH(n, rhs[i] = th * F1[i] + (1.0 - th) * F0[i])
-    MJ1_EACH(n, rhs[i] = h[i] * (rhs[i] - lload(cs[i] + 0 * W) * v[i] -
+    MJ1_EACH(n, rhs[i] = h[i] * (Fth[i] - lload(cs[i] + 0 * W) * v[i] -
                                  lload(cs[i] + 1 * W) * (q[i] + lload(cs[i] + 8 * W) * v[i])))
     MJ1_EACH(n, vfree[i] = v[i] + rhs[i] * lload(cs[i] + 5 * W))
     MJ1_EACH(n, U0[i] = lload(cs[i] + 2 * W) * v[i])
-    MJ1_EACH(n, memcpy(&wm[i], cs[i] + 10 * W, sizeof wm[i]))
-    MJ1_EACH(n, wall[i] = LCOND_OF(wm[i]))
-    MJ1_EACH(n, active[i] = wall[i] & LLE(g[i] + lload(cs[i] + 9 * W) * U0[i], zero))
+    if (wall_neg) {
+        MJ1_EACH(n, active[i] = LLE(g[i] + lload(cs[i] + 9 * W) * U0[i], zero))
+    } else {
+        MJ1_EACH(n, memcpy(&wm[i], cs[i] + 10 * W, sizeof wm[i]))
+        MJ1_EACH(n, wall[i] = LCOND_OF(wm[i]))
+        MJ1_EACH(n, active[i] = wall[i] & LLE(g[i] + lload(cs[i] + 9 * W) * U0[i], zero))
+    }
     MJ1_EACH(n, bb[i] = lload(cs[i] + 2 * W) * vfree[i] + lload(cs[i] + 3 * W) * U0[i])
-    MJ1_EACH(n, P[i] = LKEEP(active[i] & LLT(bb[i], zero), -bb[i] * lload(cs[i] + 7 * W)))
-    MJ1_EACH(n, vfree[i] = LSEL(active[i], vfree[i] + lload(cs[i] + 6 * W) * P[i], vfree[i]))
+    MJ1_EACH(n, P[i] = LKEEP(active[i], LMAX(bb[i] * lload(cs[i] + 7 * W), zero)))
+    if (wall_neg)
+        MJ1_EACH(n, vfree[i] = vfree[i] + lload(cs[i] + 6 * W) * P[i])
+    else
+        MJ1_EACH(n, vfree[i] = LSEL(active[i], vfree[i] + lload(cs[i] + 6 * W) * P[i], vfree[i]))
     MJ1_EACH(n, q[i] = q[i] + h[i] * (th * vfree[i] + (1.0 - th) * v[i]))
     MJ1_EACH(n, v[i] = vfree[i])
     MJ1_EACH(n, g[i] = lload(cs[i] + 4 * W) + lload(cs[i] + 2 * W) * q[i])

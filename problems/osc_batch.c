@@ -17,6 +17,7 @@
 #define OSC_BATCH_RUN pd_osc_batch_run_base
 #include "osc_batch_lanes.h"
 
+#include "demand.h"
 #include "osc_batch.h"
 #include "pd_null.h"
 
@@ -66,9 +67,13 @@ static void table_acquire(osc_batch *ob, int l, double h, long n)
     tb->unit = ob->unit[l];
     tb->h = h;
     tb->n = n;
-    tb->v[0] = 0.0;
+    const double th = ob->mjb.theta;
+    tb->v[0] = tb->vth[0] = 0.0;
     for (long s = 1; s <= n; s++)
         tb->v[s] = pd_osc_shape(&tb->unit, (double)s * h, -1);
+    tb->v[n + 1] = 0.0; /* past the excitation */
+    for (long s = 1; s <= n; s++)
+        tb->vth[s] = th * tb->v[s + 1] + (1.0 - th) * tb->v[s];
     tb->users = 1;
     ob->table[l] = free_slot;
 }
@@ -86,55 +91,85 @@ static void lanes_force(const double *t, int side, double *F, void *ctx)
                    : 0.0;
 }
 
-/* The forces of the next k steps of the block: F[0] the first step's
- * start (the integrator's F0), F[s] the left limit at the end of step s
- * of every lane, dir times its excitation's table or, without one, its
+/* Lane l's force rows 1 .. OSC_BLOCK - 1 cleared: it leaves its
+ * excitation (or the batch). */
+static void column_clear(osc_batch *ob, int l)
+{
+    for (int s = 1; s < OSC_BLOCK; s++)
+        ob->Fth[s][l] = 0.0;
+}
+
+/* The forces of the next k steps of the block: Fth[s] the force of step
+ * s + 1, theta F(s + 1) + (1 - theta) F(s), from the integrator's F0 at
+ * the block's start and the left limits F(s) at the steps' ends: dir
+ * times its excitation's table (its vth from row 1) or, without one, its
  * shape (computed once for neighbouring lanes at the same instant of the
  * same excitation; pd_osc_shape is odd in dir); 0 past the excitation.
- * Lanes past their excitation leave the list `live` and their table. */
+ * Fend: F(k), the next block's F0.  Lanes past their excitation leave the
+ * list `live` and their table, their rows cleared.  A table's dir vth is
+ * the step's own theta (dir a) + (1 - theta) (dir b) but for the sign of
+ * a zero sum, which cannot reach the state: it changes the step's
+ * h (Fth - C v - K (q + h theta v)) only when that is zero, and v + 0 is
+ * v whatever the zero's sign unless v is -0, which a lane's velocity
+ * never is (it starts at +0, and a sum is -0 only of two -0). */
 static void fill_forces(osc_batch *ob, int k)
 {
     pd_mjb *b = &ob->mjb;
+    const double th = b->theta;
     long iter = b->iter;
-    int n = 0;
-    memcpy(ob->F[0], b->F0, sizeof ob->F[0]);
-    memset(ob->F[1], 0, (size_t)k * sizeof ob->F[1]); /* rows 1 .. k */
+    int n = 0, own[NL], nown = 0; /* own: the live lanes without a table, in order */
+    double F1[NL]; /* F(1) of every lane */
+    for (int l = 0; l < NL; l++)
+        F1[l] = ob->Fend[l] = 0.0;
     for (int i = 0; i < ob->nlive; i++) {
         int l = ob->live[i];
         if (iter >= ob->quiet_iter[l]) { /* past its excitation from now on */
             table_release(ob, l);
+            column_clear(ob, l);
             continue;
         }
         ob->live[n++] = l;
         long left = ob->quiet_iter[l] - iter; /* steps s <= left are inside it */
         int m = left < k ? (int)left : k;
-        if (ob->table[l] >= 0) {
-            const double *v = ob->tab[ob->table[l]].v + (long)b->steps[l];
-            double dir = ob->dir[l];
-            for (int s = 1; s <= m; s++)
-                ob->F[s][l] = dir * v[s];
+        if (ob->table[l] < 0) {
+            own[nown++] = l;
+            continue;
         }
+        const osc_table *tb = &ob->tab[ob->table[l]];
+        long st = (long)b->steps[l];
+        double dir = ob->dir[l];
+        F1[l] = dir * tb->v[st + 1];
+        ob->Fend[l] = k <= m ? dir * tb->v[st + k] : 0.0;
+        for (int s = 1; s < k; s++)
+            ob->Fth[s][l] = s <= m ? dir * tb->vth[st + s] : 0.0;
     }
     ob->nlive = n;
-    int own[NL], nown = 0; /* the live lanes without a table, in order */
-    for (int i = 0; i < n; i++)
-        if (ob->table[ob->live[i]] < 0)
-            own[nown++] = ob->live[i];
     for (int s = 1; s <= k && nown > 0; s++) {
         double base = 0.0, tp = 0.0;
         int prev = -1; /* the last lane whose base was computed or reused */
         for (int i = 0; i < nown; i++) {
             int l = own[i];
-            if (iter + s - 1 >= ob->quiet_iter[l])
+            if (iter + s - 1 >= ob->quiet_iter[l]) {
+                ob->Fraw[s][l] = 0.0;
                 continue;
+            }
             double t = (b->steps[l] + (double)s) * b->h[l];
             if (!(prev == l - 1 && ob->same_prev[l] && t == tp))
                 base = pd_osc_shape(&ob->unit[l], t, -1);
-            ob->F[s][l] = ob->dir[l] * base;
+            ob->Fraw[s][l] = ob->dir[l] * base;
             prev = l;
             tp = t;
         }
     }
+    for (int i = 0; i < nown; i++) {
+        int l = own[i];
+        F1[l] = ob->Fraw[1][l];
+        ob->Fend[l] = ob->Fraw[k][l];
+        for (int s = 1; s < k; s++)
+            ob->Fth[s][l] = th * ob->Fraw[s + 1][l] + (1.0 - th) * ob->Fraw[s][l];
+    }
+    for (int l = 0; l < NL; l++)
+        ob->Fth[0][l] = th * F1[l] + (1.0 - th) * b->F0[l];
 }
 
 /* Recompute lane l's and lane l + 1's neighbour flags. */
@@ -173,10 +208,11 @@ static void live_insert(osc_batch *ob, int l)
     ob->nlive++;
 }
 
-/* Lane l leaves that list. */
+/* Lane l leaves that list (its force rows cleared). */
 static void live_remove(osc_batch *ob, int l)
 {
     int n = 0;
+    column_clear(ob, l);
     for (int i = 0; i < ob->nlive; i++)
         if (ob->live[i] != l)
             ob->live[n++] = ob->live[i];
@@ -250,6 +286,9 @@ static void lane_result(osc_batch *ob, int l, pd_osc_result *res)
     res->gamma = o->gamma;
     res->kernel = "batched";
     res->cpu_s = ob->cpu[l];
+    /* the equivalent force from the largest impulse, as a single run's;
+     * the peak acceleration is not measured on the lanes */
+    pd_demand_osc_finish(res, o, NAN, NAN);
 }
 
 int pd_osc_batchable(const pd_osc *c, const pd_run_opts *o)
@@ -347,8 +386,10 @@ static int batch_open(stream *s, const pd_run_opts *o, pd_err *err)
      * not had stays empty, its lanes compute their forces per step */
     for (int i = 0; i < OSC_TABLES; i++) {
         osc_table *tb = &s->ob->tab[i];
-        if ((tb->v = malloc((size_t)(OSC_TABLE_MAX + 1) * sizeof *tb->v)))
+        if ((tb->v = malloc((size_t)(2 * OSC_TABLE_MAX + 3) * sizeof *tb->v))) {
+            tb->vth = tb->v + OSC_TABLE_MAX + 2;
             tb->cap = OSC_TABLE_MAX;
+        }
     }
     int rc = pd_mjb_init(&s->ob->mjb, &mo, lanes_force, s->ob, err);
     if (rc) {

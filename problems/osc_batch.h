@@ -18,20 +18,24 @@
 #define OSC_TABLE_MAX 32768 /* the longest excitation tabulated, in steps */
 
 /* An excitation's left limits at the steps of one h: v[s] = the shape at
- * s h (s = 1 .. n), shared by the lanes that run this shape with this
- * step (dir scales it: pd_osc_shape is odd in dir). */
+ * s h (s = 1 .. n, 0 after), and the steps' forces vth[s] = theta v[s+1]
+ * + (1 - theta) v[s] (mj1_step's), shared by the lanes that run this
+ * shape with this step (dir scales them: pd_osc_shape is odd in dir, and
+ * dir (a + b) is (dir a) + (dir b) to the bit but for the sign of a zero,
+ * which a step's velocity never takes: osc_batch.c). */
 typedef struct osc_table {
     pd_osc unit; /* the shape (dir = +1) */
     double h;
     long n, cap;
-    double *v;   /* cap + 1 values, v[0] unused */
+    double *v;   /* cap + 2 values, v[0] unused */
+    double *vth; /* cap + 1 values (in v's memory), vth[0] unused */
     int users;   /* lanes reading it */
 } osc_table;
 
 typedef struct osc_batch osc_batch;
 /* Run k steps of every lane (k <= OSC_BLOCK, no lane ending or meeting its
- * breakpoint before the last), the forces at the steps' ends in F[1..k]
- * and F[0] the first step's start: the lanes' step and measurements, per
+ * breakpoint before the last), the steps' forces in Fth[0 .. k-1] and the
+ * last step's end force in Fend: the lanes' step and measurements, per
  * instruction set (osc_batch_lanes.h). */
 typedef void (*osc_batch_run_fn)(osc_batch *ob, int k);
 
@@ -52,8 +56,14 @@ struct osc_batch {
     int live[NL], nlive; /* the lanes still inside their excitation, in order */
     int table[NL];    /* the lane's excitation table (-1: none, computed per step) */
     osc_table tab[OSC_TABLES];
-    /* the forces of a block of steps (row s: at the end of its step s) */
-    double F[OSC_BLOCK + 1][NL] __attribute__((aligned(64)));
+    /* the forces of a block of steps: row s the force of its step s + 1,
+     * theta F(end) + (1 - theta) F(start) (rows 1 .. OSC_BLOCK - 1 of a lane
+     * outside its excitation are 0); the left limit at the last step's end
+     * (the next block's start); the left limits F(s h) of the lanes
+     * without a table (rows 1 .. k) */
+    double Fth[OSC_BLOCK][NL] __attribute__((aligned(64)));
+    double Fend[NL] __attribute__((aligned(64)));
+    double Fraw[OSC_BLOCK + 1][NL] __attribute__((aligned(64)));
     /* the measurements: what every step updates, by vectors of lanes (the
      * previous x, v and P are the integrator's q, v and P before the step) */
     double Pi3[NL] __attribute__((aligned(64))), meas_from[NL]; /* window start - h/2 */

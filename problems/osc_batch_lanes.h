@@ -18,23 +18,6 @@
 
 _Static_assert(NL % LW == 0, "whole native vectors of lanes");
 
-/* pd_max and the minimum's a < b ? a : b, lane by lane (the x86 max and min
- * instructions are exactly these: the second operand when the two are
- * equal or unordered). */
-#if defined(__AVX512F__) && PD_LANES_X86
-#define LMAX(a, b) ((lvec)_mm512_max_pd((__m512d)(a), (__m512d)(b)))
-#define LMIN(a, b) ((lvec)_mm512_min_pd((__m512d)(a), (__m512d)(b)))
-#elif defined(__AVX__) && PD_LANES_X86
-#define LMAX(a, b) ((lvec)_mm256_max_pd((__m256d)(a), (__m256d)(b)))
-#define LMIN(a, b) ((lvec)_mm256_min_pd((__m256d)(a), (__m256d)(b)))
-#elif defined(__SSE2__) && PD_LANES_X86
-#define LMAX(a, b) ((lvec)_mm_max_pd((__m128d)(a), (__m128d)(b)))
-#define LMIN(a, b) ((lvec)_mm_min_pd((__m128d)(a), (__m128d)(b)))
-#else
-#define LMAX(a, b) LSELECT((a) > (b), a, b)
-#define LMIN(a, b) LSELECT((a) < (b), a, b)
-#endif
-
 /* Is any lane of the condition c set? */
 #ifndef LANY
 static inline int lany(lmask m)
@@ -74,95 +57,181 @@ static void lanes_events(osc_batch *ob, int l, lcond due, lvec st, lvec t, lvec 
  * on an AMD EPYC with AVX-512: 2 with AVX-512 and AVX2, 4 on the baseline's
  * 2-lane SSE2; 1 leaves the chain's latency bare; more spill registers). */
 #ifndef OSC_G
-#define OSC_G (LW == 2 ? 4 : 2)
+#if LW == 8
+#define OSC_G OSC_G8
+#elif LW == 4
+#define OSC_G OSC_G4
+#else
+#define OSC_G OSC_G2
+#endif
+#endif
+#ifndef OSC_G8
+#define OSC_G8 4
+#endif
+#ifndef OSC_G4
+#define OSC_G4 4
+#endif
+#ifndef OSC_G2
+#define OSC_G2 4
 #endif
 _Static_assert(NL % (OSC_G * LW) == 0, "whole sets of vectors");
 
-/* Lanes l0 .. l0 + OSC_G LW - 1 the k steps of the block with their state
- * and measurements in registers (the compiler's to spill where there are
- * too few), step after step: the step, then the measurements of
- * pd_osc_track_step (every lane has taken a step: step > 0; max |x| is the
- * larger of the two one-sided maxima, formed at the end: osc_batch.h's
- * rare_load). */
+/* Contact steps counted in registers: AVX-512 adds one under the mask;
+ * the others subtract the all-ones lanes of the condition (-1) from a
+ * whole-number count, added to the lane's double at the block's end. */
+#if defined(__AVX512F__) && PD_LANES_X86
+typedef lvec lcount;
+#define LCOUNT_ZERO ((lvec){0.0})
+#define LCOUNT(n, c) ((lvec)_mm512_mask_add_pd((__m512d)(n), c, (__m512d)(n), _mm512_set1_pd(1.0)))
+#define LCOUNT_ADD(x, n) ((x) + (n))
+#else
+typedef lmask lcount;
+#define LCOUNT_ZERO ((lmask){0})
+#define LCOUNT(n, c) ((n) - (c))
+#define LCOUNT_ADD(x, n) ((x) + __builtin_convertvector(n, lvec))
+#endif
+
+/* Lanes l0 .. l0 + OSC_G LW - 1 the k steps of the block, their state in
+ * registers step after step (the compiler's to spill where there are too
+ * few): the step, then the test for pd_osc_track_events (rare: the lanes
+ * that need them call them at once); each step's x, v and P kept in
+ * rings, from which a second pass, free of the steps' chains, folds
+ * pd_osc_track_common's numbers (every lane has taken a step: step > 0;
+ * max |x| is the larger of the two one-sided maxima, formed at the end:
+ * osc_batch.h's rare_load).  `all` (a constant once inlined): every step
+ * of the block lies in every lane's window, so the extremes need no
+ * selection, and the smallest gap is Pi3 - max x, formed once (fl(Pi3 -
+ * x) falls as x grows, and every x of the maximum was a gap of the
+ * minimum before).  The other rewritings are exact too: the largest
+ * impulse folds every P (P >= +0, the maximum from +0); the gap is <= 0
+ * exactly when x >= Pi3 and > 0 when x < Pi3 (a difference of doubles is
+ * 0 only for equal ones), P == 0 when not P > 0 (P is +0 or positive); so
+ * the events' condition is pd_osc_track_events_due's, from conditions
+ * carried over from the previous step (a lane turned NaN may call the
+ * events once more: they test their own conditions, and the lane is run
+ * again alone). */
 static inline __attribute__((always_inline)) void lanes_run_resident(osc_batch *ob, int l0,
-                                                                    int k)
+                                                                    int k, int all)
 {
     enum { G = OSC_G };
     pd_mjb *b = &ob->mjb;
-    const lvec zero = {0.0}, one = zero + 1.0;
+    const lvec zero = {0.0};
     const double *cs[G];
-    lvec h[G], st0[G], q[G], v[G], g[G], P[G], pv2[G], xto[G], xaw[G], mg[G], Pmax[G];
-    lvec cont[G], Pi3[G], mf[G];
+    lvec h[G], q[G], v[G], g[G], Pi3[G];
+    lcond lt[G], pos[G]; /* x < Pi3 and P > 0 after the last step */
+    /* the rings: x after step s at xr[s]; v after it at vr[s + 2], P at
+     * Pr[s + 1]; the state before the block at vr[0] (two steps back),
+     * vr[1] and Pr[0] */
+    lvec xr[OSC_BLOCK][G], vr[OSC_BLOCK + 2][G], Pr[OSC_BLOCK + 1][G];
     MJ1_EACH(G, cs[i] = mj1_lanes_coef(b, l0 + i * LW))
     MJ1_EACH(G, h[i] = lload(&b->h[l0 + i * LW]))
-    MJ1_EACH(G, st0[i] = lload(&b->steps[l0 + i * LW]))
     MJ1_EACH(G, q[i] = lload(&b->q[l0 + i * LW]))
     MJ1_EACH(G, v[i] = lload(&b->v[l0 + i * LW]))
     MJ1_EACH(G, g[i] = lload(&b->g[l0 + i * LW]))
-    MJ1_EACH(G, P[i] = lload(&b->P[l0 + i * LW]))
-    MJ1_EACH(G, pv2[i] = lload(&ob->prev2_v[l0 + i * LW]))
+    MJ1_EACH(G, Pi3[i] = lload(&ob->Pi3[l0 + i * LW]))
+    MJ1_EACH(G, vr[0][i] = lload(&ob->prev2_v[l0 + i * LW]))
+    MJ1_EACH(G, vr[1][i] = v[i])
+    MJ1_EACH(G, Pr[0][i] = lload(&b->P[l0 + i * LW]))
+    MJ1_EACH(G, lt[i] = LLT(q[i], Pi3[i]))
+    MJ1_EACH(G, pos[i] = LGT(Pr[0][i], zero))
+    for (int s = 0; s < k; s++) {
+        lvec x[G], vn[G], Pn[G], Fth[G];
+        lcond ltn[G], posn[G], due[G];
+        MJ1_EACH(G, Fth[i] = lload(&ob->Fth[s][l0 + i * LW]))
+        MJ1_EACH(G, x[i] = q[i])
+        MJ1_EACH(G, vn[i] = v[i])
+        mj1_lanes_step(G, cs, b->theta, h, Fth, x, vn, g, Pn, 1);
+        MJ1_EACH(G, xr[s][i] = x[i])
+        MJ1_EACH(G, vr[s + 2][i] = vn[i])
+        MJ1_EACH(G, Pr[s + 1][i] = Pn[i])
+        MJ1_EACH(G, posn[i] = LGT(Pn[i], zero))
+        MJ1_EACH(G, ltn[i] = LLT(x[i], Pi3[i]))
+        /* the gap was open and closed (or an impulse stopped it closing),
+         * or an impact began */
+        MJ1_EACH(G, due[i] = (lt[i] & ~(ltn[i] & ~posn[i])) | (posn[i] & ~pos[i]))
+        lcond any = due[0];
+        for (int i = 1; i < G; i++)
+            any |= due[i];
+        if (__builtin_expect(LANY(any), 0))
+            for (int i = 0; i < G; i++)
+                if (LANY(due[i])) {
+                    lvec st = lload(&b->steps[l0 + i * LW]) + (double)(s + 1);
+                    lanes_events(ob, l0 + i * LW, due[i], st, st * h[i], x[i], vn[i], Pn[i],
+                                 q[i], v[i], Pr[s][i], vr[s][i]);
+                }
+        MJ1_EACH(G, q[i] = x[i])
+        MJ1_EACH(G, v[i] = vn[i])
+        MJ1_EACH(G, lt[i] = ltn[i])
+        MJ1_EACH(G, pos[i] = posn[i])
+    }
+    MJ1_EACH(G, lstore(&b->q[l0 + i * LW], q[i]))
+    MJ1_EACH(G, lstore(&b->v[l0 + i * LW], v[i]))
+    MJ1_EACH(G, lstore(&b->g[l0 + i * LW], g[i]))
+    MJ1_EACH(G, lstore(&b->P[l0 + i * LW], Pr[k][i]))
+    MJ1_EACH(G, lstore(&ob->prev2_v[l0 + i * LW], vr[k][i]))
+    /* the measurements from the rings, step by step in order */
+    lvec xto[G], xaw[G], mg[G], Pmax[G], st0[G], mf[G];
+    lcount cnt[G];
     MJ1_EACH(G, xto[i] = lload(&ob->xtoward[l0 + i * LW]))
     MJ1_EACH(G, xaw[i] = lload(&ob->xaway[l0 + i * LW]))
     MJ1_EACH(G, mg[i] = lload(&ob->min_gap[l0 + i * LW]))
     MJ1_EACH(G, Pmax[i] = lload(&ob->Pmax[l0 + i * LW]))
-    MJ1_EACH(G, cont[i] = lload(&ob->contact[l0 + i * LW]))
-    MJ1_EACH(G, Pi3[i] = lload(&ob->Pi3[l0 + i * LW]))
+    MJ1_EACH(G, st0[i] = lload(&b->steps[l0 + i * LW]))
     MJ1_EACH(G, mf[i] = lload(&ob->meas_from[l0 + i * LW]))
+    MJ1_EACH(G, cnt[i] = LCOUNT_ZERO)
     for (int s = 0; s < k; s++) {
-        /* the step count: st0 + s + 1 (whole numbers: the sum of ones) */
-        const double ds = (double)(s + 1);
-        lvec st[G], t[G], x[G], vn[G], Pn[G], F0[G], F1[G], gap[G];
-        lcond pos[G], meas[G], due[G];
-        MJ1_EACH(G, st[i] = st0[i] + ds)
-        MJ1_EACH(G, t[i] = st[i] * h[i])
-        MJ1_EACH(G, F0[i] = lload(&ob->F[s][l0 + i * LW]))
-        MJ1_EACH(G, F1[i] = lload(&ob->F[s + 1][l0 + i * LW]))
-        MJ1_EACH(G, x[i] = q[i])
-        MJ1_EACH(G, vn[i] = v[i])
-        mj1_lanes_step(G, cs, b->theta, h, F0, F1, x, vn, g, Pn);
-        MJ1_EACH(G, gap[i] = Pi3[i] - x[i])
-        MJ1_EACH(G, pos[i] = LGT(Pn[i], zero))
-        MJ1_EACH(G, meas[i] = LGE(t[i], mf[i]))
-        MJ1_EACH(G, xto[i] = LSEL(meas[i], LMAX(xto[i], x[i]), xto[i]))
-        MJ1_EACH(G, xaw[i] = LSEL(meas[i], LMAX(xaw[i], -x[i]), xaw[i]))
-        MJ1_EACH(G, cont[i] = cont[i] + LKEEP(pos[i], one))
-        MJ1_EACH(G, Pmax[i] = LSEL(pos[i], LMAX(Pmax[i], Pn[i]), Pmax[i]))
-        MJ1_EACH(G, mg[i] = LMIN(mg[i], gap[i]))
-        MJ1_EACH(G, due[i] = (LGT(Pi3[i] - q[i], zero) & (LLE(gap[i], zero) | pos[i])) |
-                             (pos[i] & LEQ(P[i], zero)))
-        for (int i = 0; i < G; i++)
-            if (__builtin_expect(LANY(due[i]), 0))
-                lanes_events(ob, l0 + i * LW, due[i], st[i], t[i], x[i], vn[i], Pn[i], q[i],
-                             v[i], P[i], pv2[i]);
-        MJ1_EACH(G, pv2[i] = v[i])
-        MJ1_EACH(G, q[i] = x[i])
-        MJ1_EACH(G, v[i] = vn[i])
-        MJ1_EACH(G, P[i] = Pn[i])
+        if (all) {
+            MJ1_EACH(G, xto[i] = LMAX(xto[i], xr[s][i]))
+            MJ1_EACH(G, xaw[i] = LMAX(xaw[i], -xr[s][i]))
+        } else {
+            /* the step's end t = (st0 + s + 1) h (whole numbers: the sum of ones) */
+            lcond meas[G];
+            MJ1_EACH(G, meas[i] = LGE((st0[i] + (double)(s + 1)) * h[i], mf[i]))
+            MJ1_EACH(G, xto[i] = LSEL(meas[i], LMAX(xto[i], xr[s][i]), xto[i]))
+            MJ1_EACH(G, xaw[i] = LSEL(meas[i], LMAX(xaw[i], -xr[s][i]), xaw[i]))
+            MJ1_EACH(G, mg[i] = LMIN(mg[i], Pi3[i] - xr[s][i]))
+        }
+        MJ1_EACH(G, cnt[i] = LCOUNT(cnt[i], LGT(Pr[s + 1][i], zero)))
+        MJ1_EACH(G, Pmax[i] = LMAX(Pmax[i], Pr[s + 1][i]))
     }
+    if (all)
+        MJ1_EACH(G, mg[i] = LMIN(mg[i], Pi3[i] - xto[i]))
     MJ1_EACH(G, lstore(&b->steps[l0 + i * LW], st0[i] + (double)k))
-    MJ1_EACH(G, lstore(&b->q[l0 + i * LW], q[i]))
-    MJ1_EACH(G, lstore(&b->v[l0 + i * LW], v[i]))
-    MJ1_EACH(G, lstore(&b->g[l0 + i * LW], g[i]))
-    MJ1_EACH(G, lstore(&b->P[l0 + i * LW], P[i]))
-    MJ1_EACH(G, lstore(&ob->prev2_v[l0 + i * LW], pv2[i]))
     MJ1_EACH(G, lstore(&ob->xtoward[l0 + i * LW], xto[i]))
     MJ1_EACH(G, lstore(&ob->xaway[l0 + i * LW], xaw[i]))
     MJ1_EACH(G, lstore(&ob->min_gap[l0 + i * LW], mg[i]))
     MJ1_EACH(G, lstore(&ob->Pmax[l0 + i * LW], Pmax[i]))
-    MJ1_EACH(G, lstore(&ob->contact[l0 + i * LW], cont[i]))
+    MJ1_EACH(G, lstore(&ob->contact[l0 + i * LW],
+                       LCOUNT_ADD(lload(&ob->contact[l0 + i * LW]), cnt[i])))
+}
+
+/* Is every step of the block (its first step's end: the lanes' clocks
+ * grow) inside the measuring window of lanes l0 .. l0 + OSC_G LW - 1? */
+static inline int lanes_all_measured(const osc_batch *ob, int l0)
+{
+    const pd_mjb *b = &ob->mjb;
+    for (int l = l0; l < l0 + OSC_G * LW; l++)
+        if (!((b->steps[l] + 1.0) * b->h[l] >= ob->meas_from[l]))
+            return 0;
+    return 1;
 }
 
 /* k steps of every lane, OSC_G vectors at a time; then the lanes' clocks,
- * the forces F[k] as the next step's F0, the batch's step count. */
+ * the force at the block's end as the next step's F0, the batch's step
+ * count. */
 void OSC_BATCH_RUN(osc_batch *ob_, int k)
 {
     osc_batch *ob = __builtin_assume_aligned(ob_, 64); /* batch_open's aligned_alloc */
     pd_mjb *b = &ob->mjb;
-    for (int j = 0; j < NL / (OSC_G * LW); j++)
-        lanes_run_resident(ob, j * OSC_G * LW, k);
+    for (int l0 = 0; l0 < NL; l0 += OSC_G * LW) {
+        if (lanes_all_measured(ob, l0))
+            lanes_run_resident(ob, l0, k, 1);
+        else
+            lanes_run_resident(ob, l0, k, 0);
+    }
     for (int l = 0; l < NL; l += LW) {
         lstore(&b->t[l], lload(&b->steps[l]) * lload(&b->h[l]));
-        lstore(&b->F0[l], lload(&ob->F[k][l]));
+        lstore(&b->F0[l], lload(&ob->Fend[l]));
     }
     b->iter += k;
 }

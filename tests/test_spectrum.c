@@ -653,7 +653,144 @@ static void seen_done(void *ctx, long t, const pd_spec_result *r, const pd_err *
  * fails with pd_spec_run_task's status and message. */
 static void stream_matches_single(pd_test_ctx *ctx);
 
-/* ... with each instruction set's batch this processor has (POUND_ISA caps
+/* The cases of an oscillator stream and what it reported. */
+typedef struct osc_seen {
+    pd_osc *c;
+    pd_run_opts *o;
+    long n, next, calls, batched;
+    pd_osc_result *r;
+    int *status;
+} osc_seen;
+
+static int osc_seen_next(void *ctx, pd_osc *c, pd_run_opts *o, long *id)
+{
+    osc_seen *w = ctx;
+    if (w->next >= w->n)
+        return 0;
+    *c = w->c[w->next];
+    *o = w->o[w->next];
+    *id = w->next++;
+    return 1;
+}
+
+static void osc_seen_done(void *ctx, long id, const pd_osc_result *r, int status,
+                          const pd_err *err)
+{
+    osc_seen *w = ctx;
+    (void)err;
+    w->calls++;
+    w->r[id] = *r;
+    w->status[id] = status;
+    w->batched += status == 0 && r->kernel && strcmp(r->kernel, "batched") == 0;
+}
+
+/* The same double to the bit (the sign of a zero and NaNs' payload included). */
+static int bits_same(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
+
+/* Every figure of a batched run to the bit: pd_osc_run's (cpu_s and the
+ * kernel's name aside). */
+static int osc_result_same(const pd_osc_result *a, const pd_osc_result *b)
+{
+    const double x[] = {a->umax, a->u_toward, a->u_away, a->first_impact,
+                        a->first_impact_velocity, a->max_impact_velocity, a->max_impulse,
+                        a->contact_time, a->min_gap, a->dt, a->tend, a->theta, a->gamma,
+                        a->acc_max, a->force_max, a->force_equiv, a->contact_duration};
+    const double y[] = {b->umax, b->u_toward, b->u_away, b->first_impact,
+                        b->first_impact_velocity, b->max_impact_velocity, b->max_impulse,
+                        b->contact_time, b->min_gap, b->dt, b->tend, b->theta, b->gamma,
+                        b->acc_max, b->force_max, b->force_equiv, b->contact_duration};
+    for (size_t i = 0; i < sizeof x / sizeof x[0]; i++)
+        if (!bits_same(x[i], y[i]))
+            return 0;
+    return a->impacts == b->impacts && a->accumulations == b->accumulations &&
+           a->steps == b->steps;
+}
+
+/* pd_osc_run_stream against pd_osc_run case by case, every figure of the
+ * result bit for bit (the impact velocities, the largest impulse and the
+ * smallest gap too, which the sweep's results leave out): sine, cosine and
+ * harmonic excitations (a window that opens late), both directions, gaps
+ * from 0 (on the wall at rest) to 2, restitution 0, 0.5 and 1, no-wall
+ * twins, a record, some of its runs with more steps than a force table
+ * holds (lanes computing their own forces); the default steps (one per
+ * Pi2 above 1) and common ones; then
+ * theta = 0.7 with gamma = 0.3.  Most cases must run on the lanes. */
+static void osc_stream_matches_run(pd_test_ctx *ctx)
+{
+    enum { NC = 240 };
+    pd_record rec;
+    memset(&rec, 0, sizeof rec);
+    snprintf(rec.name, sizeof rec.name, "burst");
+    rec.npts = 1201, rec.dt = 0.005;
+    osc_seen w = {.n = NC};
+    rec.acc = malloc((size_t)rec.npts * sizeof *rec.acc);
+    w.c = malloc(NC * sizeof *w.c);
+    w.o = malloc(NC * sizeof *w.o);
+    w.r = calloc(NC, sizeof *w.r);
+    w.status = calloc(NC, sizeof *w.status);
+    if (!CHECK(ctx, rec.acc && w.c && w.o && w.r && w.status, "out of memory"))
+        goto done;
+    for (long k = 0; k < rec.npts; k++) /* a decaying burst, then rest */
+        rec.acc[k] = k < 900 ? 3.0 * exp(-k / 300.0) * sin(PD_TWO_PI * k / 70.0) : 0.0;
+    pd_record_pulse rp = {.ap = 2.0, .Tp = 0.35};
+    static const double pi3[] = {0.0, 0.02, 0.3, 2.0}, eps[] = {0.0, 0.5, 1.0};
+    static const pd_pulse pulses[] = {PD_PULSE_SINE, PD_PULSE_COSINE, PD_PULSE_HARMONIC};
+    for (int pass = 0; pass < 2; pass++) {
+        for (int i = 0; i < NC; i++) {
+            pd_osc c = pd_osc_default();
+            pd_run_opts o = pd_run_default_opts();
+            o.method = PD_METHOD_MOREAU;
+            o.no_demands = 1;
+            c.pulse = pulses[i % 3];
+            c.dir = (i / 3) % 2 ? -1 : 1;
+            c.Pi2 = 0.15 * pow(1.25, i % 23);
+            c.Pi3 = pi3[(i / 7) % 4];
+            c.eps = eps[(i / 5) % 3];
+            c.xi = (i / 11) % 2 ? 0.0 : 0.05;
+            o.no_wall = i % 9 == 4;
+            if (c.pulse == PD_PULSE_HARMONIC)
+                o.dt = 0.004; /* (the default step: Tp / 2000 over 38 s) */
+            if (i % 13 == 6) { /* the record; some with more steps than a table holds */
+                pd_osc_set_record(&c, &rec, &rp, 1.0 + 0.1 * (i % 3));
+                o.dt = i % 26 == 6 ? 1.5e-4 : 2e-3;
+            }
+            if (pass == 1)
+                o.theta = 0.7, o.gamma = 0.3;
+            w.c[i] = c;
+            w.o[i] = o;
+        }
+        w.next = w.calls = w.batched = 0;
+        pd_err err;
+        CHECK(ctx, pd_osc_run_stream(osc_seen_next, osc_seen_done, &w, &err) == PD_OK,
+              "stream: %s", err.msg);
+        CHECK(ctx, w.calls == NC, "pass %d: %ld of %d cases reported", pass, w.calls, NC);
+        CHECK(ctx, w.batched > NC * 3 / 4, "pass %d: %ld of %d cases on the lanes", pass,
+              w.batched, NC);
+        long differ = 0, first = -1, impacts = 0;
+        for (int i = 0; i < NC; i++) {
+            pd_osc_result b;
+            int rc = pd_osc_run(&w.c[i], &w.o[i], NULL, NULL, &b, &err);
+            int bad = rc != w.status[i] || (rc == 0 && !osc_result_same(&w.r[i], &b));
+            differ += bad;
+            if (bad && first < 0)
+                first = i;
+            impacts += rc == 0 ? b.impacts : 0;
+        }
+        CHECK(ctx, differ == 0, "pass %d: %ld of %d cases differ from pd_osc_run (first: %ld)",
+              pass, differ, NC, first);
+        CHECK(ctx, impacts > 500, "pass %d: %ld impacts (the events' path must be exercised)",
+              pass, impacts);
+    }
+done:
+    free(rec.acc);
+    free(w.c);
+    free(w.o);
+    free(w.r);
+    free(w.status);
+}
+
+/* ... and pd_osc_run_stream's whole results against pd_osc_run's, with
+ * each instruction set's batch this processor has (POUND_ISA caps
  * pd_cpu_level: every variant computes the scalar kernel's numbers). */
 static void test_spectrum_stream_matches_single(pd_test_ctx *ctx)
 {
@@ -672,6 +809,7 @@ static void test_spectrum_stream_matches_single(pd_test_ctx *ctx)
         CHECK(ctx, pd_cpu_level() == variants[k].level, "POUND_ISA=%s: level %d",
               variants[k].isa, pd_cpu_level());
         stream_matches_single(ctx);
+        osc_stream_matches_run(ctx);
         ran++;
     }
     if (old)
