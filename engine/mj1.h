@@ -98,7 +98,7 @@ static inline void mj1_coef_setv(mj1_coefv *s, int i, const mj1_coef *one, doubl
     s->e[i] = one->e;
     s->g0[i] = one->g0;
     s->whatinv[i] = one->whatinv;
-    s->winv[i] = one->wall ? one->winv : -0.0; /* (mj1_lanes_step's wall_neg) */
+    s->winv[i] = one->winv;
     s->ndelinv[i] = -one->delinv;
     s->hth[i] = h * th;
     s->hgamma[i] = h * gamma;

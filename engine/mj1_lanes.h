@@ -10,6 +10,7 @@
 #ifndef PD_MJ1_LANES_H
 #define PD_MJ1_LANES_H
 
+#include <math.h>
 #include <string.h>
 
 #include "mj1.h"
@@ -77,14 +78,15 @@ static inline lvec mj1_lanes_fth(double th, lvec F0, lvec F1)
  * q, v and g move to the step's end and P gets the impulse.
  * The impulse is max(b (-1/D), +0) = mj1_step's (b < 0 ? -b/D : 0): the
  * product is -b/D to the bit, and not above +0 when b >= 0 or unordered.
- * wall_neg (a constant once inlined): every lane's W is negative or it has
- * no contact (the oscillator's wall, W = -1), so that the lanes need no
- * selection: a lane without a contact has g = +0, b = ±0 and P = +0, and
- * v + (W/What) P adds -0 to v when P = +0 (x + -0 is x, -0 included) --
- * mj1_coef_setv keeps W/What = -0 for such lanes. */
+ * unit_w (a constant once inlined): every lane has a contact with W = -1
+ * (the oscillator's wall; a run without one has its wall at g0 = +inf,
+ * mj1_lanes_far_wall), so that the products by W are negations, done as
+ * such: U = -v, b = e U - v, g = g0 - q (x + (-y) is x - y to the bit),
+ * and the lanes need no selection: an inactive lane's P is +0, and
+ * v + (W/What) P adds -0 to v (x + -0 is x, -0 included). */
 static inline __attribute__((always_inline)) void
 mj1_lanes_step(int n, const double *const *cs, double th, const lvec *h, const lvec *Fth,
-               lvec *q, lvec *v, lvec *g, lvec *P, int wall_neg)
+               lvec *q, lvec *v, lvec *g, lvec *P, int unit_w)
 {
     const lvec zero = {0.0};
     const size_t W = MJ1_WIDTH; /* one constant's lanes in the group */
@@ -94,23 +96,38 @@ mj1_lanes_step(int n, const double *const *cs, double th, const lvec *h, const l
     MJ1_EACH(n, rhs[i] = h[i] * (Fth[i] - lload(cs[i] + 0 * W) * v[i] -
                                  lload(cs[i] + 1 * W) * (q[i] + lload(cs[i] + 8 * W) * v[i])))
     MJ1_EACH(n, vfree[i] = v[i] + rhs[i] * lload(cs[i] + 5 * W))
-    MJ1_EACH(n, U0[i] = lload(cs[i] + 2 * W) * v[i])
-    if (wall_neg) {
+    if (unit_w) {
+        MJ1_EACH(n, U0[i] = -v[i])
         MJ1_EACH(n, active[i] = LLE(g[i] + lload(cs[i] + 9 * W) * U0[i], zero))
+        MJ1_EACH(n, bb[i] = lload(cs[i] + 3 * W) * U0[i] - vfree[i])
     } else {
+        MJ1_EACH(n, U0[i] = lload(cs[i] + 2 * W) * v[i])
         MJ1_EACH(n, memcpy(&wm[i], cs[i] + 10 * W, sizeof wm[i]))
         MJ1_EACH(n, wall[i] = LCOND_OF(wm[i]))
         MJ1_EACH(n, active[i] = wall[i] & LLE(g[i] + lload(cs[i] + 9 * W) * U0[i], zero))
+        MJ1_EACH(n, bb[i] = lload(cs[i] + 2 * W) * vfree[i] + lload(cs[i] + 3 * W) * U0[i])
     }
-    MJ1_EACH(n, bb[i] = lload(cs[i] + 2 * W) * vfree[i] + lload(cs[i] + 3 * W) * U0[i])
     MJ1_EACH(n, P[i] = LKEEP(active[i], LMAX(bb[i] * lload(cs[i] + 7 * W), zero)))
-    if (wall_neg)
+    if (unit_w)
         MJ1_EACH(n, vfree[i] = vfree[i] + lload(cs[i] + 6 * W) * P[i])
     else
         MJ1_EACH(n, vfree[i] = LSEL(active[i], vfree[i] + lload(cs[i] + 6 * W) * P[i], vfree[i]))
     MJ1_EACH(n, q[i] = q[i] + h[i] * (th * vfree[i] + (1.0 - th) * v[i]))
     MJ1_EACH(n, v[i] = vfree[i])
-    MJ1_EACH(n, g[i] = lload(cs[i] + 4 * W) + lload(cs[i] + 2 * W) * q[i])
+    if (unit_w)
+        MJ1_EACH(n, g[i] = lload(cs[i] + 4 * W) - q[i])
+    else
+        MJ1_EACH(n, g[i] = lload(cs[i] + 4 * W) + lload(cs[i] + 2 * W) * q[i])
+}
+
+/* Lane l's contact (W = -1) moved to g0 = +inf, where it never closes:
+ * the oscillator's run without a wall on a lane of unit_w's (its q, v and
+ * P are the no-contact step's to the bit: an inactive lane's P is +0). */
+static inline void mj1_lanes_far_wall(pd_mjb *b, int l)
+{
+    mj1_coefv *s = (mj1_coefv *)(void *)b->coef + l / MJ1_WIDTH;
+    s->g0[l % MJ1_WIDTH] = INFINITY;
+    b->g[l] = INFINITY;
 }
 
 /* Lanes meeting their breakpoint at this batch step (b->iter ==

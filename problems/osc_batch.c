@@ -229,7 +229,7 @@ static int lane_start(osc_batch *ob, int l, long id, const pd_osc *c, const pd_r
     pd_mjb_lane ln = {.M = 1.0,
                       .C = 2.0 * c->xi * c->Pi2,
                       .K = c->Pi2 * c->Pi2,
-                      .wall = !o->no_wall,
+                      .wall = 1, /* without one: a wall at +inf (osc_batch_lanes.h) */
                       .W = -1.0,
                       .g0 = c->Pi3,
                       .e = c->eps,
@@ -251,6 +251,8 @@ static int lane_start(osc_batch *ob, int l, long id, const pd_osc *c, const pd_r
     int rc = pd_mjb_set_lane(&ob->mjb, l, &ln, err);
     if (rc)
         return rc;
+    if (o->no_wall)
+        mj1_lanes_far_wall(&ob->mjb, l);
     pd_osc_track *tr = &ob->rare[l];
     pd_osc_track_init(tr, c, h, pd_osc_wp(c) * pd_osc_measure_start(c, o->tend));
     pd_osc_track_step(tr, 0, 0.0, 0.0, 0.0, 0.0);

@@ -18,32 +18,32 @@
 
 _Static_assert(NL % LW == 0, "whole native vectors of lanes");
 
-/* Is any lane of the condition c set? */
-#ifndef LANY
-static inline int lany(lmask m)
+/* The lanes of the condition c as the bits of a whole number (lane i:
+ * bit i). */
+static inline unsigned lbits(lcond c)
 {
-#if defined(__AVX__) && PD_LANES_X86
-    return !_mm256_testz_si256((__m256i)m, (__m256i)m);
+#if defined(__AVX512F__) && PD_LANES_X86
+    return (unsigned)c;
+#elif defined(__AVX__) && PD_LANES_X86
+    return (unsigned)_mm256_movemask_pd((__m256d)c);
 #elif defined(__SSE2__) && PD_LANES_X86
-    return _mm_movemask_pd((__m128d)m) != 0;
+    return (unsigned)_mm_movemask_pd((__m128d)c);
 #else
-    long long any = 0;
+    unsigned bits = 0;
     for (int i = 0; i < LW; i++)
-        any |= m[i];
-    return any != 0;
+        bits |= (c[i] != 0) << i;
+    return bits;
 #endif
 }
-#define LANY(c) lany(c)
-#endif
 
-/* The rare events of the lanes of l .. l + LW - 1 marked in due, from
- * their state before the step (q0, v0, P0, and v two steps back pv2) and
- * after it at step st, time t. */
-static void lanes_events(osc_batch *ob, int l, lcond due, lvec st, lvec t, lvec x, lvec v,
+/* The rare events of the lanes of l .. l + LW - 1 whose bits are set in
+ * due, from their state before the step (q0, v0, P0, and v two steps back
+ * pv2) and after it at step st, time t. */
+static void lanes_events(osc_batch *ob, int l, unsigned due, lvec st, lvec t, lvec x, lvec v,
                          lvec P, lvec q0, lvec v0, lvec P0, lvec pv2)
 {
     for (int i = 0; i < LW; i++)
-        if (LLANE(due, i) && ob->id[l + i] >= 0) {
+        if ((due >> i & 1u) && ob->id[l + i] >= 0) {
             pd_osc_track *tr = &ob->rare[l + i];
             tr->prev_x = q0[i];
             tr->prev_v = v0[i];
@@ -75,6 +75,7 @@ static void lanes_events(osc_batch *ob, int l, lcond due, lvec st, lvec t, lvec 
 #define OSC_G2 4
 #endif
 _Static_assert(NL % (OSC_G * LW) == 0, "whole sets of vectors");
+_Static_assert(OSC_G * LW <= 32, "a set's lanes are the bits of an unsigned");
 
 /* Contact steps counted in registers: AVX-512 adds one under the mask;
  * the others subtract the all-ones lanes of the condition (-1) from a
@@ -91,25 +92,27 @@ typedef lmask lcount;
 #define LCOUNT_ADD(x, n) ((x) + __builtin_convertvector(n, lvec))
 #endif
 
-/* Lanes l0 .. l0 + OSC_G LW - 1 the k steps of the block, their state in
- * registers step after step (the compiler's to spill where there are too
- * few): the step, then the test for pd_osc_track_events (rare: the lanes
- * that need them call them at once); each step's x, v and P kept in
- * rings, from which a second pass, free of the steps' chains, folds
+/* Lanes l0 .. l0 + OSC_G LW - 1 the k steps of the block, their state
+ * (q, v, g) in registers step after step (the compiler's to spill where
+ * there are too few), each step's x, v and P kept in rings; then a second
+ * pass, free of the steps' chains, over the rings in step order:
  * pd_osc_track_common's numbers (every lane has taken a step: step > 0;
  * max |x| is the larger of the two one-sided maxima, formed at the end:
- * osc_batch.h's rare_load).  `all` (a constant once inlined): every step
- * of the block lies in every lane's window, so the extremes need no
- * selection, and the smallest gap is Pi3 - max x, formed once (fl(Pi3 -
- * x) falls as x grows, and every x of the maximum was a gap of the
- * minimum before).  The other rewritings are exact too: the largest
- * impulse folds every P (P >= +0, the maximum from +0); the gap is <= 0
- * exactly when x >= Pi3 and > 0 when x < Pi3 (a difference of doubles is
- * 0 only for equal ones), P == 0 when not P > 0 (P is +0 or positive); so
- * the events' condition is pd_osc_track_events_due's, from conditions
- * carried over from the previous step (a lane turned NaN may call the
- * events once more: they test their own conditions, and the lane is run
- * again alone). */
+ * osc_batch.h's rare_load) and the test for pd_osc_track_events (rare:
+ * the lanes that need them call them there, in their steps' order).
+ * `all` (a constant once inlined): every step of the block lies in every
+ * lane's window, so the extremes need no selection, the largest -x is
+ * -(min x) and the smallest gap Pi3 - max x, formed once (the x86 maximum
+ * and minimum keep the last of equal values, so that -(min x) is the very
+ * -x the maxima pick, signed zeros included; fl(Pi3 - x) falls as x
+ * grows, and every x of the maximum was a gap of the minimum before).
+ * The other rewritings are exact too: the largest impulse folds every P
+ * (P >= +0, the maximum from +0); the gap is <= 0 exactly when x >= Pi3
+ * and > 0 when x < Pi3 (a difference of doubles is 0 only for equal
+ * ones), P == 0 when not P > 0 (P is +0 or positive); so the events'
+ * condition is pd_osc_track_events_due's, from conditions carried over
+ * from the previous step (a lane turned NaN may call the events once more:
+ * they test their own conditions, and the lane is run again alone). */
 static inline __attribute__((always_inline)) void lanes_run_resident(osc_batch *ob, int l0,
                                                                     int k, int all)
 {
@@ -117,85 +120,86 @@ static inline __attribute__((always_inline)) void lanes_run_resident(osc_batch *
     pd_mjb *b = &ob->mjb;
     const lvec zero = {0.0};
     const double *cs[G];
-    lvec h[G], q[G], v[G], g[G], Pi3[G];
-    lcond lt[G], pos[G]; /* x < Pi3 and P > 0 after the last step */
-    /* the rings: x after step s at xr[s]; v after it at vr[s + 2], P at
-     * Pr[s + 1]; the state before the block at vr[0] (two steps back),
-     * vr[1] and Pr[0] */
-    lvec xr[OSC_BLOCK][G], vr[OSC_BLOCK + 2][G], Pr[OSC_BLOCK + 1][G];
+    lvec h[G], q[G], v[G], g[G];
+    /* the rings: x after step s at xr[s + 1], v at vr[s + 2], P at
+     * Pr[s + 1]; the state before the block at xr[0], vr[1] and Pr[0],
+     * v two steps back at vr[0] */
+    lvec xr[OSC_BLOCK + 1][G], vr[OSC_BLOCK + 2][G], Pr[OSC_BLOCK + 1][G];
     MJ1_EACH(G, cs[i] = mj1_lanes_coef(b, l0 + i * LW))
     MJ1_EACH(G, h[i] = lload(&b->h[l0 + i * LW]))
     MJ1_EACH(G, q[i] = lload(&b->q[l0 + i * LW]))
     MJ1_EACH(G, v[i] = lload(&b->v[l0 + i * LW]))
     MJ1_EACH(G, g[i] = lload(&b->g[l0 + i * LW]))
-    MJ1_EACH(G, Pi3[i] = lload(&ob->Pi3[l0 + i * LW]))
+    MJ1_EACH(G, xr[0][i] = q[i])
     MJ1_EACH(G, vr[0][i] = lload(&ob->prev2_v[l0 + i * LW]))
     MJ1_EACH(G, vr[1][i] = v[i])
     MJ1_EACH(G, Pr[0][i] = lload(&b->P[l0 + i * LW]))
-    MJ1_EACH(G, lt[i] = LLT(q[i], Pi3[i]))
-    MJ1_EACH(G, pos[i] = LGT(Pr[0][i], zero))
     for (int s = 0; s < k; s++) {
-        lvec x[G], vn[G], Pn[G], Fth[G];
-        lcond ltn[G], posn[G], due[G];
+        lvec Fth[G], Pn[G];
         MJ1_EACH(G, Fth[i] = lload(&ob->Fth[s][l0 + i * LW]))
-        MJ1_EACH(G, x[i] = q[i])
-        MJ1_EACH(G, vn[i] = v[i])
-        mj1_lanes_step(G, cs, b->theta, h, Fth, x, vn, g, Pn, 1);
-        MJ1_EACH(G, xr[s][i] = x[i])
-        MJ1_EACH(G, vr[s + 2][i] = vn[i])
+        mj1_lanes_step(G, cs, b->theta, h, Fth, q, v, g, Pn, 1);
+        MJ1_EACH(G, xr[s + 1][i] = q[i])
+        MJ1_EACH(G, vr[s + 2][i] = v[i])
         MJ1_EACH(G, Pr[s + 1][i] = Pn[i])
-        MJ1_EACH(G, posn[i] = LGT(Pn[i], zero))
-        MJ1_EACH(G, ltn[i] = LLT(x[i], Pi3[i]))
-        /* the gap was open and closed (or an impulse stopped it closing),
-         * or an impact began */
-        MJ1_EACH(G, due[i] = (lt[i] & ~(ltn[i] & ~posn[i])) | (posn[i] & ~pos[i]))
-        lcond any = due[0];
-        for (int i = 1; i < G; i++)
-            any |= due[i];
-        if (__builtin_expect(LANY(any), 0))
-            for (int i = 0; i < G; i++)
-                if (LANY(due[i])) {
-                    lvec st = lload(&b->steps[l0 + i * LW]) + (double)(s + 1);
-                    lanes_events(ob, l0 + i * LW, due[i], st, st * h[i], x[i], vn[i], Pn[i],
-                                 q[i], v[i], Pr[s][i], vr[s][i]);
-                }
-        MJ1_EACH(G, q[i] = x[i])
-        MJ1_EACH(G, v[i] = vn[i])
-        MJ1_EACH(G, lt[i] = ltn[i])
-        MJ1_EACH(G, pos[i] = posn[i])
     }
     MJ1_EACH(G, lstore(&b->q[l0 + i * LW], q[i]))
     MJ1_EACH(G, lstore(&b->v[l0 + i * LW], v[i]))
     MJ1_EACH(G, lstore(&b->g[l0 + i * LW], g[i]))
     MJ1_EACH(G, lstore(&b->P[l0 + i * LW], Pr[k][i]))
     MJ1_EACH(G, lstore(&ob->prev2_v[l0 + i * LW], vr[k][i]))
-    /* the measurements from the rings, step by step in order */
-    lvec xto[G], xaw[G], mg[G], Pmax[G], st0[G], mf[G];
+    /* the measurements and the events from the rings, in step order */
+    lvec xto[G], xaw[G], xmin[G], mg[G], Pmax[G], st0[G], mf[G], Pi3[G];
     lcount cnt[G];
+    /* x < Pi3 and P > 0 after the previous step, lane l0 + j at bit j */
+    unsigned lt = 0, pos = 0;
     MJ1_EACH(G, xto[i] = lload(&ob->xtoward[l0 + i * LW]))
     MJ1_EACH(G, xaw[i] = lload(&ob->xaway[l0 + i * LW]))
     MJ1_EACH(G, mg[i] = lload(&ob->min_gap[l0 + i * LW]))
     MJ1_EACH(G, Pmax[i] = lload(&ob->Pmax[l0 + i * LW]))
     MJ1_EACH(G, st0[i] = lload(&b->steps[l0 + i * LW]))
     MJ1_EACH(G, mf[i] = lload(&ob->meas_from[l0 + i * LW]))
+    MJ1_EACH(G, Pi3[i] = lload(&ob->Pi3[l0 + i * LW]))
     MJ1_EACH(G, cnt[i] = LCOUNT_ZERO)
+    MJ1_EACH(G, xmin[i] = zero + HUGE_VAL)
+    MJ1_EACH(G, lt |= lbits(LLT(xr[0][i], Pi3[i])) << (i * LW))
+    MJ1_EACH(G, pos |= lbits(LGT(Pr[0][i], zero)) << (i * LW))
     for (int s = 0; s < k; s++) {
+        lcond posn[G];
+        unsigned ltn = 0, posb = 0;
         if (all) {
-            MJ1_EACH(G, xto[i] = LMAX(xto[i], xr[s][i]))
-            MJ1_EACH(G, xaw[i] = LMAX(xaw[i], -xr[s][i]))
+            MJ1_EACH(G, xto[i] = LMAX(xto[i], xr[s + 1][i]))
+            MJ1_EACH(G, xmin[i] = LMIN(xmin[i], xr[s + 1][i]))
         } else {
             /* the step's end t = (st0 + s + 1) h (whole numbers: the sum of ones) */
             lcond meas[G];
             MJ1_EACH(G, meas[i] = LGE((st0[i] + (double)(s + 1)) * h[i], mf[i]))
-            MJ1_EACH(G, xto[i] = LSEL(meas[i], LMAX(xto[i], xr[s][i]), xto[i]))
-            MJ1_EACH(G, xaw[i] = LSEL(meas[i], LMAX(xaw[i], -xr[s][i]), xaw[i]))
-            MJ1_EACH(G, mg[i] = LMIN(mg[i], Pi3[i] - xr[s][i]))
+            MJ1_EACH(G, xto[i] = LSEL(meas[i], LMAX(xto[i], xr[s + 1][i]), xto[i]))
+            MJ1_EACH(G, xaw[i] = LSEL(meas[i], LMAX(xaw[i], -xr[s + 1][i]), xaw[i]))
+            MJ1_EACH(G, mg[i] = LMIN(mg[i], Pi3[i] - xr[s + 1][i]))
         }
-        MJ1_EACH(G, cnt[i] = LCOUNT(cnt[i], LGT(Pr[s + 1][i], zero)))
+        MJ1_EACH(G, posn[i] = LGT(Pr[s + 1][i], zero))
+        MJ1_EACH(G, cnt[i] = LCOUNT(cnt[i], posn[i]))
         MJ1_EACH(G, Pmax[i] = LMAX(Pmax[i], Pr[s + 1][i]))
+        MJ1_EACH(G, posb |= lbits(posn[i]) << (i * LW))
+        MJ1_EACH(G, ltn |= lbits(LLT(xr[s + 1][i], Pi3[i])) << (i * LW))
+        /* the gap was open and closed (or an impulse stopped it closing),
+         * or an impact began */
+        unsigned due = (lt & ~(ltn & ~posb)) | (posb & ~pos);
+        if (__builtin_expect(due != 0, 0))
+            for (int i = 0; i < G; i++)
+                if (due >> (i * LW) & ((1u << LW) - 1)) {
+                    lvec st = st0[i] + (double)(s + 1);
+                    lanes_events(ob, l0 + i * LW, due >> (i * LW), st, st * h[i],
+                                 xr[s + 1][i], vr[s + 2][i], Pr[s + 1][i], xr[s][i],
+                                 vr[s + 1][i], Pr[s][i], vr[s][i]);
+                }
+        lt = ltn;
+        pos = posb;
     }
-    if (all)
+    if (all) {
+        MJ1_EACH(G, xaw[i] = LMAX(xaw[i], -xmin[i]))
         MJ1_EACH(G, mg[i] = LMIN(mg[i], Pi3[i] - xto[i]))
+    }
     MJ1_EACH(G, lstore(&b->steps[l0 + i * LW], st0[i] + (double)k))
     MJ1_EACH(G, lstore(&ob->xtoward[l0 + i * LW], xto[i]))
     MJ1_EACH(G, lstore(&ob->xaway[l0 + i * LW], xaw[i]))
