@@ -82,8 +82,10 @@ static inline lvec mj1_lanes_fth(double th, lvec F0, lvec F1)
  * (the oscillator's wall; a run without one has its wall at g0 = +inf,
  * mj1_lanes_far_wall), so that the products by W are negations, done as
  * such: U = -v, b = e U - v, g = g0 - q (x + (-y) is x - y to the bit),
- * and the lanes need no selection: an inactive lane's P is +0, and
- * v + (W/What) P adds -0 to v (x + -0 is x, -0 included). */
+ * the gap formed from q when the step needs it (g is neither read nor
+ * written: the caller's is g0 - q), and the lanes need no selection: an
+ * inactive lane's P is +0, and v + (W/What) P adds -0 to v (x + -0 is x,
+ * -0 included). */
 static inline __attribute__((always_inline)) void
 mj1_lanes_step(int n, const double *const *cs, double th, const lvec *h, const lvec *Fth,
                lvec *q, lvec *v, lvec *g, lvec *P, int unit_w)
@@ -98,7 +100,8 @@ mj1_lanes_step(int n, const double *const *cs, double th, const lvec *h, const l
     MJ1_EACH(n, vfree[i] = v[i] + rhs[i] * lload(cs[i] + 5 * W))
     if (unit_w) {
         MJ1_EACH(n, U0[i] = -v[i])
-        MJ1_EACH(n, active[i] = LLE(g[i] + lload(cs[i] + 9 * W) * U0[i], zero))
+        MJ1_EACH(n, active[i] = LLE((lload(cs[i] + 4 * W) - q[i]) + lload(cs[i] + 9 * W) * U0[i],
+                                    zero))
         MJ1_EACH(n, bb[i] = lload(cs[i] + 3 * W) * U0[i] - vfree[i])
     } else {
         MJ1_EACH(n, U0[i] = lload(cs[i] + 2 * W) * v[i])
@@ -114,9 +117,7 @@ mj1_lanes_step(int n, const double *const *cs, double th, const lvec *h, const l
         MJ1_EACH(n, vfree[i] = LSEL(active[i], vfree[i] + lload(cs[i] + 6 * W) * P[i], vfree[i]))
     MJ1_EACH(n, q[i] = q[i] + h[i] * (th * vfree[i] + (1.0 - th) * v[i]))
     MJ1_EACH(n, v[i] = vfree[i])
-    if (unit_w)
-        MJ1_EACH(n, g[i] = lload(cs[i] + 4 * W) - q[i])
-    else
+    if (!unit_w)
         MJ1_EACH(n, g[i] = lload(cs[i] + 4 * W) + lload(cs[i] + 2 * W) * q[i])
 }
 

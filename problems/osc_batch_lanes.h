@@ -69,13 +69,15 @@ static void lanes_events(osc_batch *ob, int l, unsigned due, lvec st, lvec t, lv
 #define OSC_G8 4
 #endif
 #ifndef OSC_G4
-#define OSC_G4 4
+#define OSC_G4 8
 #endif
 #ifndef OSC_G2
-#define OSC_G2 4
+#define OSC_G2 8
 #endif
 _Static_assert(NL % (OSC_G * LW) == 0, "whole sets of vectors");
 _Static_assert(OSC_G * LW <= 32, "a set's lanes are the bits of an unsigned");
+_Static_assert(OSC_G <= 8, "mj1_lanes_step takes at most 8 vectors");
+_Static_assert(OSC_G % 2 == 0, "the block's folds take vectors two by two");
 
 /* Contact steps counted in registers: AVX-512 adds one under the mask;
  * the others subtract the all-ones lanes of the condition (-1) from a
@@ -92,6 +94,38 @@ typedef lmask lcount;
 #define LCOUNT_ADD(x, n) ((x) + __builtin_convertvector(n, lvec))
 #endif
 
+/* Vector i of a set (lanes l .. l + LW - 1) over the k steps in the rings
+ * (lanes_run_resident's): its contact steps, returned, and the events of
+ * its lanes that need them (pd_osc_track_events_due's condition, from the
+ * conditions of the step before), in step order. */
+static inline __attribute__((always_inline)) lcount
+lanes_scan(osc_batch *ob, int l, int k, lvec h, lvec st0, lvec Pi3,
+           lvec (*xr)[OSC_G], lvec (*vr)[OSC_G], lvec (*Pr)[OSC_G], int i)
+{
+    const lvec zero = {0.0};
+    lcount cnt = LCOUNT_ZERO;
+    /* x < Pi3 and P > 0 after step s - 1 (s = 0: before the block), lane
+     * l + j at bit j: formed for every step first (no chain through them) */
+    unsigned char ltb[OSC_BLOCK + 1], posb[OSC_BLOCK + 1];
+    for (int s = 0; s <= k; s++) {
+        lcond posn = LGT(Pr[s][i], zero);
+        ltb[s] = (unsigned char)lbits(LLT(xr[s][i], Pi3));
+        posb[s] = (unsigned char)lbits(posn);
+        cnt = s > 0 ? LCOUNT(cnt, posn) : cnt;
+    }
+    for (int s = 0; s < k; s++) {
+        /* the gap was open and closed (or an impulse stopped it closing),
+         * or an impact began */
+        unsigned due = (ltb[s] & ~(ltb[s + 1] & ~posb[s + 1])) | (posb[s + 1] & ~posb[s]);
+        if (__builtin_expect(due != 0, 0)) {
+            lvec st = st0 + (double)(s + 1);
+            lanes_events(ob, l, due, st, st * h, xr[s + 1][i], vr[s + 2][i], Pr[s + 1][i],
+                         xr[s][i], vr[s + 1][i], Pr[s][i], vr[s][i]);
+        }
+    }
+    return cnt;
+}
+
 /* Lanes l0 .. l0 + OSC_G LW - 1 the k steps of the block, their state
  * (q, v, g) in registers step after step (the compiler's to spill where
  * there are too few), each step's x, v and P kept in rings; then a second
@@ -101,11 +135,15 @@ typedef lmask lcount;
  * osc_batch.h's rare_load) and the test for pd_osc_track_events (rare:
  * the lanes that need them call them there, in their steps' order).
  * `all` (a constant once inlined): every step of the block lies in every
- * lane's window, so the extremes need no selection, the largest -x is
- * -(min x) and the smallest gap Pi3 - max x, formed once (the x86 maximum
- * and minimum keep the last of equal values, so that -(min x) is the very
- * -x the maxima pick, signed zeros included; fl(Pi3 - x) falls as x
- * grows, and every x of the maximum was a gap of the minimum before).
+ * lane's window, so the extremes need no selection: the block's maxima of
+ * x and P and minimum of x are folded into the run's at its end, the
+ * largest -x is -(min x) and the smallest gap Pi3 - max x (the x86
+ * maximum and minimum keep the last of equal values, so that the block's
+ * extreme is the very value the step-by-step fold keeps, and -(min x) the
+ * very -x, signed zeros included; fl(Pi3 - x) falls as x grows, and every
+ * x of the maximum was a gap of the minimum before); and a vector whose
+ * lanes kept x < Pi3 and P = 0 over the block has no event and no contact
+ * step, the step-by-step scan (lanes_scan) left to the others.
  * The other rewritings are exact too: the largest impulse folds every P
  * (P >= +0, the maximum from +0); the gap is <= 0 exactly when x >= Pi3
  * and > 0 when x < Pi3 (a difference of doubles is 0 only for equal
@@ -120,7 +158,7 @@ static inline __attribute__((always_inline)) void lanes_run_resident(osc_batch *
     pd_mjb *b = &ob->mjb;
     const lvec zero = {0.0};
     const double *cs[G];
-    lvec h[G], q[G], v[G], g[G];
+    lvec h[G], q[G], v[G]; /* (the gaps: g0 - q, unit_w's) */
     /* the rings: x after step s at xr[s + 1], v at vr[s + 2], P at
      * Pr[s + 1]; the state before the block at xr[0], vr[1] and Pr[0],
      * v two steps back at vr[0] */
@@ -129,7 +167,6 @@ static inline __attribute__((always_inline)) void lanes_run_resident(osc_batch *
     MJ1_EACH(G, h[i] = lload(&b->h[l0 + i * LW]))
     MJ1_EACH(G, q[i] = lload(&b->q[l0 + i * LW]))
     MJ1_EACH(G, v[i] = lload(&b->v[l0 + i * LW]))
-    MJ1_EACH(G, g[i] = lload(&b->g[l0 + i * LW]))
     MJ1_EACH(G, xr[0][i] = q[i])
     MJ1_EACH(G, vr[0][i] = lload(&ob->prev2_v[l0 + i * LW]))
     MJ1_EACH(G, vr[1][i] = v[i])
@@ -137,68 +174,64 @@ static inline __attribute__((always_inline)) void lanes_run_resident(osc_batch *
     for (int s = 0; s < k; s++) {
         lvec Fth[G], Pn[G];
         MJ1_EACH(G, Fth[i] = lload(&ob->Fth[s][l0 + i * LW]))
-        mj1_lanes_step(G, cs, b->theta, h, Fth, q, v, g, Pn, 1);
+        mj1_lanes_step(G, cs, b->theta, h, Fth, q, v, NULL, Pn, 1);
         MJ1_EACH(G, xr[s + 1][i] = q[i])
         MJ1_EACH(G, vr[s + 2][i] = v[i])
         MJ1_EACH(G, Pr[s + 1][i] = Pn[i])
     }
     MJ1_EACH(G, lstore(&b->q[l0 + i * LW], q[i]))
     MJ1_EACH(G, lstore(&b->v[l0 + i * LW], v[i]))
-    MJ1_EACH(G, lstore(&b->g[l0 + i * LW], g[i]))
+    MJ1_EACH(G, lstore(&b->g[l0 + i * LW], lload(cs[i] + 4 * MJ1_WIDTH) - q[i]))
     MJ1_EACH(G, lstore(&b->P[l0 + i * LW], Pr[k][i]))
     MJ1_EACH(G, lstore(&ob->prev2_v[l0 + i * LW], vr[k][i]))
     /* the measurements and the events from the rings, in step order */
-    lvec xto[G], xaw[G], xmin[G], mg[G], Pmax[G], st0[G], mf[G], Pi3[G];
+    lvec xto[G], xaw[G], mg[G], Pmax[G], st0[G], Pi3[G];
     lcount cnt[G];
-    /* x < Pi3 and P > 0 after the previous step, lane l0 + j at bit j */
-    unsigned lt = 0, pos = 0;
     MJ1_EACH(G, xto[i] = lload(&ob->xtoward[l0 + i * LW]))
     MJ1_EACH(G, xaw[i] = lload(&ob->xaway[l0 + i * LW]))
     MJ1_EACH(G, mg[i] = lload(&ob->min_gap[l0 + i * LW]))
     MJ1_EACH(G, Pmax[i] = lload(&ob->Pmax[l0 + i * LW]))
     MJ1_EACH(G, st0[i] = lload(&b->steps[l0 + i * LW]))
-    MJ1_EACH(G, mf[i] = lload(&ob->meas_from[l0 + i * LW]))
     MJ1_EACH(G, Pi3[i] = lload(&ob->Pi3[l0 + i * LW]))
     MJ1_EACH(G, cnt[i] = LCOUNT_ZERO)
-    MJ1_EACH(G, xmin[i] = zero + HUGE_VAL)
-    MJ1_EACH(G, lt |= lbits(LLT(xr[0][i], Pi3[i])) << (i * LW))
-    MJ1_EACH(G, pos |= lbits(LGT(Pr[0][i], zero)) << (i * LW))
-    for (int s = 0; s < k; s++) {
-        lcond posn[G];
-        unsigned ltn = 0, posb = 0;
-        if (all) {
-            MJ1_EACH(G, xto[i] = LMAX(xto[i], xr[s + 1][i]))
-            MJ1_EACH(G, xmin[i] = LMIN(xmin[i], xr[s + 1][i]))
-        } else {
+    if (all) {
+        /* the block's extremes, folded into the run's at its end */
+        lvec bx[G], bxmin[G], bP[G];
+        MJ1_EACH(G, bx[i] = zero - HUGE_VAL)
+        MJ1_EACH(G, bxmin[i] = zero + HUGE_VAL)
+        MJ1_EACH(G, bP[i] = zero)
+        for (int i = 0; i < G; i += 2) /* two vectors at a time: their folds in registers */
+            for (int s = 1; s <= k; s++) {
+                bx[i] = LMAX(bx[i], xr[s][i]);
+                bxmin[i] = LMIN(bxmin[i], xr[s][i]);
+                bP[i] = LMAX(bP[i], Pr[s][i]);
+                bx[i + 1] = LMAX(bx[i + 1], xr[s][i + 1]);
+                bxmin[i + 1] = LMIN(bxmin[i + 1], xr[s][i + 1]);
+                bP[i + 1] = LMAX(bP[i + 1], Pr[s][i + 1]);
+            }
+        /* a vector whose gaps stayed open without an impulse has no event
+         * and no contact step in the block; the others are scanned */
+        for (int i = 0; i < G; i++)
+            if (lbits(LGE(bx[i], Pi3[i]) | LGT(bP[i], zero)))
+                cnt[i] = lanes_scan(ob, l0 + i * LW, k, h[i], st0[i], Pi3[i], xr, vr, Pr, i);
+        MJ1_EACH(G, xto[i] = LMAX(xto[i], bx[i]))
+        MJ1_EACH(G, xaw[i] = LMAX(xaw[i], -bxmin[i]))
+        MJ1_EACH(G, Pmax[i] = LMAX(Pmax[i], bP[i]))
+        MJ1_EACH(G, mg[i] = LMIN(mg[i], Pi3[i] - xto[i]))
+    } else {
+        lvec mf[G];
+        MJ1_EACH(G, mf[i] = lload(&ob->meas_from[l0 + i * LW]))
+        for (int s = 0; s < k; s++) {
             /* the step's end t = (st0 + s + 1) h (whole numbers: the sum of ones) */
             lcond meas[G];
             MJ1_EACH(G, meas[i] = LGE((st0[i] + (double)(s + 1)) * h[i], mf[i]))
             MJ1_EACH(G, xto[i] = LSEL(meas[i], LMAX(xto[i], xr[s + 1][i]), xto[i]))
             MJ1_EACH(G, xaw[i] = LSEL(meas[i], LMAX(xaw[i], -xr[s + 1][i]), xaw[i]))
             MJ1_EACH(G, mg[i] = LMIN(mg[i], Pi3[i] - xr[s + 1][i]))
+            MJ1_EACH(G, Pmax[i] = LMAX(Pmax[i], Pr[s + 1][i]))
         }
-        MJ1_EACH(G, posn[i] = LGT(Pr[s + 1][i], zero))
-        MJ1_EACH(G, cnt[i] = LCOUNT(cnt[i], posn[i]))
-        MJ1_EACH(G, Pmax[i] = LMAX(Pmax[i], Pr[s + 1][i]))
-        MJ1_EACH(G, posb |= lbits(posn[i]) << (i * LW))
-        MJ1_EACH(G, ltn |= lbits(LLT(xr[s + 1][i], Pi3[i])) << (i * LW))
-        /* the gap was open and closed (or an impulse stopped it closing),
-         * or an impact began */
-        unsigned due = (lt & ~(ltn & ~posb)) | (posb & ~pos);
-        if (__builtin_expect(due != 0, 0))
-            for (int i = 0; i < G; i++)
-                if (due >> (i * LW) & ((1u << LW) - 1)) {
-                    lvec st = st0[i] + (double)(s + 1);
-                    lanes_events(ob, l0 + i * LW, due >> (i * LW), st, st * h[i],
-                                 xr[s + 1][i], vr[s + 2][i], Pr[s + 1][i], xr[s][i],
-                                 vr[s + 1][i], Pr[s][i], vr[s][i]);
-                }
-        lt = ltn;
-        pos = posb;
-    }
-    if (all) {
-        MJ1_EACH(G, xaw[i] = LMAX(xaw[i], -xmin[i]))
-        MJ1_EACH(G, mg[i] = LMIN(mg[i], Pi3[i] - xto[i]))
+        for (int i = 0; i < G; i++)
+            cnt[i] = lanes_scan(ob, l0 + i * LW, k, h[i], st0[i], Pi3[i], xr, vr, Pr, i);
     }
     MJ1_EACH(G, lstore(&b->steps[l0 + i * LW], st0[i] + (double)k))
     MJ1_EACH(G, lstore(&ob->xtoward[l0 + i * LW], xto[i]))
