@@ -1,13 +1,14 @@
-/* osc_batch_lanes.h — the batch's steps with their measurements fused in,
- * a text compiled once per instruction set under the name OSC_BATCH_RUN:
+/* osc_batch_lanes.h — the batch's steps and their measurements, a text
+ * compiled once per instruction set under the name OSC_BATCH_RUN:
  * osc_batch.c (the baseline), osc_batch_x86v3.c (AVX2), osc_batch_x86v4.c
- * (AVX-512), after their target pragma.  A few vectors of lanes are loaded
- * once per block of steps and run its steps in registers: the engine's
- * arithmetic (engine/mj1_lanes.h, mj1_step's numbers lane for lane), then
- * pd_osc_track_common's numbers, pd_osc_track_events for the lanes that
- * need it (rare: a gap closing, an impact begun), pd_osc_track_shift's;
- * stored at the block's end.  The forces come from a table filled per
- * block (osc_batch.c), so a step has no call. */
+ * (AVX-512), after their target pragma.  A set of vectors of lanes is
+ * loaded once per block of steps and runs its steps in registers (the
+ * engine's arithmetic, engine/mj1_lanes.h: mj1_step's numbers lane for
+ * lane), keeping each step's x, v and P in rings; a second pass over the
+ * rings gives pd_osc_track_common's numbers and calls pd_osc_track_events
+ * for the lanes that need it (rare: a gap closing, an impact begun).  The
+ * steps' forces come from a table filled per block (osc_batch.c), so a
+ * step has no call. */
 #include "osc_batch.h"
 
 #include "mj1_lanes.h" /* the processor's own vector (after the target pragma) */
@@ -54,8 +55,10 @@ static void lanes_events(osc_batch *ob, int l, unsigned due, lvec st, lvec t, lv
 }
 
 /* Vectors of lanes stepped together, their chains interleaved (measured
- * on an AMD EPYC with AVX-512: 2 with AVX-512 and AVX2, 4 on the baseline's
- * 2-lane SSE2; 1 leaves the chain's latency bare; more spill registers). */
+ * on an AMD EPYC with AVX-512, the paper-scale sweep: 4 with AVX-512, all
+ * 32 lanes; 8 with AVX2 and the baseline's 2-lane SSE2, where 4 ran 5 and
+ * 10 % slower and 2 a third slower: the step's chain of about 45
+ * latencies wants many vectors in flight more than it minds spills). */
 #ifndef OSC_G
 #if LW == 8
 #define OSC_G OSC_G8
