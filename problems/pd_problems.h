@@ -395,7 +395,8 @@ PD_API int pd_osc_run(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler s
  * (pd_osc_batchable) run many at a time on the lanes of a pd_mjb
  * (pd_engine.h), a lane taking the next case as soon as its run ends; each
  * result equals pd_osc_run's for the case, bit for bit, but for cpu_s (the
- * lanes share the batch's time) and kernel ("batched").  The other cases,
+ * lanes share the batch's time), kernel ("batched") and acc_max (NAN: the
+ * lanes do not measure it).  The other cases,
  * and any case whose state stops being finite, run alone by pd_osc_run,
  * which gives their failure its message.  One stream per thread. */
 
