@@ -136,21 +136,14 @@ API_CHECK  ?= 1
 
 all: $(BUILD)/pound $(BUILD)/pound_tests
 
-# The kernels' files.  The batched ones: GCC's first instruction-scheduling
-# pass, aware of register pressure (off by default on x86), interleaves their
-# vectors' chains with fewer spills (the paper sweep 10-15 % faster on AVX2 and
-# the baseline; docs/spectrum.md).  These and the scalar kernel's: loops on
-# 64-byte boundaries, so that their speed does not hang on where the linker
-# puts them (two builds of one source ran the scalar kernel at 24 and 15.7
-# ns/step).  Compilers without these flags leave them out.
+# The batched kernels' files: GCC's first instruction-scheduling pass, aware of
+# register pressure (off by default on x86), interleaves their vectors' chains
+# with fewer spills (the paper sweep 10-15 % faster on AVX2 and the baseline;
+# docs/spectrum.md); compilers without it leave it out.
 LANES_SRC   = $(wildcard problems/osc_batch*.c) $(wildcard engine/mj_batch*.c)
-SCALAR_SRC  = problems/oscillator.c engine/moreau.c
 flag_if_ok  = $(shell $(CC) -Werror $(1) -x c -c /dev/null -o /dev/null 2>/dev/null && echo $(1))
 LANES_SCHED := $(call flag_if_ok,-fschedule-insns -fsched-pressure)
-LOOP_ALIGN  := $(call flag_if_ok,-falign-loops=64)
-$(LANES_SRC:%.c=$(BUILD)/%.o) $(LANES_SRC:%.c=$(BUILD)/pic/%.o): \
-  LANES_CFLAGS = $(LANES_SCHED) $(LOOP_ALIGN)
-$(SCALAR_SRC:%.c=$(BUILD)/%.o) $(SCALAR_SRC:%.c=$(BUILD)/pic/%.o): LANES_CFLAGS = $(LOOP_ALIGN)
+$(LANES_SRC:%.c=$(BUILD)/%.o) $(LANES_SRC:%.c=$(BUILD)/pic/%.o): LANES_CFLAGS = $(LANES_SCHED)
 
 $(BUILD)/%.o: %.c $(HDRS)
 	@mkdir -p $(dir $@)
