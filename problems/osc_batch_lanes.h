@@ -246,12 +246,13 @@ static inline __attribute__((always_inline)) void lanes_run_resident(osc_batch *
 }
 
 /* Is every step of the block (its first step's end: the lanes' clocks
- * grow) inside the measuring window of lanes l0 .. l0 + OSC_G LW - 1? */
+ * grow) inside the measuring window of the busy lanes among l0 .. l0 +
+ * OSC_G LW - 1 (an idle lane's figures are set anew when it starts)? */
 static inline int lanes_all_measured(const osc_batch *ob, int l0)
 {
     const pd_mjb *b = &ob->mjb;
     for (int l = l0; l < l0 + OSC_G * LW; l++)
-        if (!((b->steps[l] + 1.0) * b->h[l] >= ob->meas_from[l]))
+        if (ob->id[l] >= 0 && !((b->steps[l] + 1.0) * b->h[l] >= ob->meas_from[l]))
             return 0;
     return 1;
 }
