@@ -48,8 +48,6 @@ typedef __mmask8 lcond;
 /* a where c, else +0 */
 #define LKEEP(c, a) ((lvec)_mm512_maskz_mov_pd(c, (__m512d)(a)))
 #define LCOND_OF(m) _mm512_test_epi64_mask((__m512i)(m), (__m512i)(m))
-#define LANY(c) ((c) != 0)
-#define LLANE(c, i) (((c) >> (i)) & 1)
 #else
 typedef lmask lcond;
 #define LLE(a, b) ((a) <= (b))
@@ -65,7 +63,6 @@ typedef lmask lcond;
 #endif
 #define LKEEP(c, a) ((lvec)((c) & (lmask)(a)))
 #define LCOND_OF(m) (m)
-#define LLANE(c, i) ((c)[i] != 0)
 #endif
 
 #endif

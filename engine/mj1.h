@@ -39,6 +39,13 @@ static inline mj1_coef mj1_coef_make(double M, double C, double K, int wall, dou
     return s;
 }
 
+/* theta F1 + (1 - theta) F0: the step's force from F0 at its start and F1
+ * at its end (the batch's force tables form it by this too). */
+static inline double mj1_fth(double th, double F0, double F1)
+{
+    return th * F1 + (1.0 - th) * F0;
+}
+
 /* One step from (q, v) with the gap g at t_k and the forces F0 (t_k+) and
  * F1 (t_k+1-): q, v and g move to t_k+1, *P gets the impulse; returns 1
  * when the contact was active.  hgamma = h gamma.  The branches are the
@@ -47,7 +54,7 @@ static inline int mj1_step(double h, double th, double hgamma, const mj1_coef *s
                            double F1, double *q, double *v, double *g, double *P)
 {
     double q0 = *q, v0 = *v, imp = 0.0;
-    double Fth = th * F1 + (1.0 - th) * F0;
+    double Fth = mj1_fth(th, F0, F1);
     double rhs = h * (Fth - s->c * v0 - s->k * (q0 + h * th * v0));
     double vnew = v0 + rhs * s->whatinv;
     double U0 = s->w * v0;

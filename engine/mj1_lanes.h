@@ -65,8 +65,7 @@ static inline const double *mj1_lanes_coef(const pd_mjb *b, int l)
 #define LMIN(a, b) LSELECT((a) < (b), a, b)
 #endif
 
-/* theta F1 + (1 - theta) F0: the step's force from F0 at its start and F1
- * at its end, as mj1_step forms it. */
+/* mj1_fth on the lanes. */
 static inline lvec mj1_lanes_fth(double th, lvec F0, lvec F1)
 {
     return th * F1 + (1.0 - th) * F0;

@@ -73,7 +73,7 @@ static void table_acquire(osc_batch *ob, int l, double h, long n)
         tb->v[s] = pd_osc_shape(&tb->unit, (double)s * h, -1);
     tb->v[n + 1] = 0.0; /* past the excitation */
     for (long s = 1; s <= n; s++)
-        tb->vth[s] = th * tb->v[s + 1] + (1.0 - th) * tb->v[s];
+        tb->vth[s] = mj1_fth(th, tb->v[s], tb->v[s + 1]);
     tb->users = 1;
     ob->table[l] = free_slot;
 }
@@ -166,10 +166,10 @@ static void fill_forces(osc_batch *ob, int k)
         F1[l] = ob->Fraw[1][l];
         ob->Fend[l] = ob->Fraw[k][l];
         for (int s = 1; s < k; s++)
-            ob->Fth[s][l] = th * ob->Fraw[s + 1][l] + (1.0 - th) * ob->Fraw[s][l];
+            ob->Fth[s][l] = mj1_fth(th, ob->Fraw[s][l], ob->Fraw[s + 1][l]);
     }
     for (int l = 0; l < NL; l++)
-        ob->Fth[0][l] = th * F1[l] + (1.0 - th) * b->F0[l];
+        ob->Fth[0][l] = mj1_fth(th, b->F0[l], F1[l]);
 }
 
 /* Recompute lane l's and lane l + 1's neighbour flags. */
