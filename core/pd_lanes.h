@@ -55,8 +55,10 @@ typedef lmask lcond;
 #define LGT(a, b) ((a) > (b))
 #define LGE(a, b) ((a) >= (b))
 #define LEQ(a, b) ((a) == (b))
-#if defined(__AVX__) && PD_LANES_X86
+#if (defined(__AVX__) || defined(__SSE2__)) && PD_LANES_X86
 #include <immintrin.h>
+#endif
+#if defined(__AVX__) && PD_LANES_X86
 #define LSEL(c, a, b) ((lvec)_mm256_blendv_pd((__m256d)(b), (__m256d)(a), (__m256d)(c)))
 #else
 #define LSEL(c, a, b) LSELECT(c, a, b)
@@ -64,5 +66,23 @@ typedef lmask lcond;
 #define LKEEP(c, a) ((lvec)((c) & (lmask)(a)))
 #define LCOND_OF(m) (m)
 #endif
+
+/* The lanes of the condition c as the bits of a whole number (lane i:
+ * bit i). */
+static inline unsigned lbits(lcond c)
+{
+#if defined(__AVX512F__) && PD_LANES_X86
+    return (unsigned)c;
+#elif defined(__AVX__) && PD_LANES_X86
+    return (unsigned)_mm256_movemask_pd((__m256d)c);
+#elif defined(__SSE2__) && PD_LANES_X86
+    return (unsigned)_mm_movemask_pd((__m128d)c);
+#else
+    unsigned bits = 0;
+    for (int i = 0; i < LW; i++)
+        bits |= (c[i] != 0) << i;
+    return bits;
+#endif
+}
 
 #endif

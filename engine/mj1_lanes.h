@@ -57,7 +57,6 @@ static inline const double *mj1_lanes_coef(const pd_mjb *b, int l)
 #define LMAX(a, b) ((lvec)_mm256_max_pd((__m256d)(a), (__m256d)(b)))
 #define LMIN(a, b) ((lvec)_mm256_min_pd((__m256d)(a), (__m256d)(b)))
 #elif defined(__SSE2__) && PD_LANES_X86
-#include <immintrin.h>
 #define LMAX(a, b) ((lvec)_mm_max_pd((__m128d)(a), (__m128d)(b)))
 #define LMIN(a, b) ((lvec)_mm_min_pd((__m128d)(a), (__m128d)(b)))
 #else
@@ -84,8 +83,11 @@ static inline lvec mj1_lanes_fth(double th, lvec F0, lvec F1)
  * the gap formed from q when the step needs it (g is neither read nor
  * written: the caller's is g0 - q), and the lanes need no selection: an
  * inactive lane's P is +0, and v + (W/What) P adds -0 to v (x + -0 is x,
- * -0 included). */
-static inline __attribute__((always_inline)) void
+ * -0 included), so that a step where no lane's contact may close skips
+ * the impulses' arithmetic.
+ * Returns nonzero when a lane's contact may close (always without
+ * unit_w). */
+static inline __attribute__((always_inline)) unsigned
 mj1_lanes_step(int n, const double *const *cs, double th, const lvec *h, const lvec *Fth,
                lvec *q, lvec *v, lvec *g, lvec *P, int unit_w)
 {
@@ -94,30 +96,40 @@ mj1_lanes_step(int n, const double *const *cs, double th, const lvec *h, const l
     lvec rhs[8], vfree[8], U0[8], bb[8];
     lcond active[8], wall[8];
     lmask wm[8];
+    unsigned closing = ~0u; /* nonzero when a lane's contact may close */
     MJ1_EACH(n, rhs[i] = h[i] * (Fth[i] - lload(cs[i] + 0 * W) * v[i] -
                                  lload(cs[i] + 1 * W) * (q[i] + lload(cs[i] + 8 * W) * v[i])))
     MJ1_EACH(n, vfree[i] = v[i] + rhs[i] * lload(cs[i] + 5 * W))
     if (unit_w) {
-        MJ1_EACH(n, U0[i] = -v[i])
-        MJ1_EACH(n, active[i] = LLE((lload(cs[i] + 4 * W) - q[i]) + lload(cs[i] + 9 * W) * U0[i],
+        /* g + h gamma U0 <= 0 with U0 = -v: (g0 - q) - (h gamma) v <= 0
+         * to the bit; the impulses only when a lane's contact may close
+         * (rare: in a step of none, P is +0 and v + (W/What) P is v) */
+        MJ1_EACH(n, active[i] = LLE((lload(cs[i] + 4 * W) - q[i]) - lload(cs[i] + 9 * W) * v[i],
                                     zero))
-        MJ1_EACH(n, bb[i] = lload(cs[i] + 3 * W) * U0[i] - vfree[i])
+        closing = 0;
+        MJ1_EACH(n, closing |= lbits(active[i]))
+        if (__builtin_expect(closing != 0, 0)) {
+            MJ1_EACH(n, U0[i] = -v[i])
+            MJ1_EACH(n, bb[i] = lload(cs[i] + 3 * W) * U0[i] - vfree[i])
+            MJ1_EACH(n, P[i] = LKEEP(active[i], LMAX(bb[i] * lload(cs[i] + 7 * W), zero)))
+            MJ1_EACH(n, vfree[i] = vfree[i] + lload(cs[i] + 6 * W) * P[i])
+        } else {
+            MJ1_EACH(n, P[i] = zero)
+        }
     } else {
         MJ1_EACH(n, U0[i] = lload(cs[i] + 2 * W) * v[i])
         MJ1_EACH(n, memcpy(&wm[i], cs[i] + 10 * W, sizeof wm[i]))
         MJ1_EACH(n, wall[i] = LCOND_OF(wm[i]))
         MJ1_EACH(n, active[i] = wall[i] & LLE(g[i] + lload(cs[i] + 9 * W) * U0[i], zero))
         MJ1_EACH(n, bb[i] = lload(cs[i] + 2 * W) * vfree[i] + lload(cs[i] + 3 * W) * U0[i])
-    }
-    MJ1_EACH(n, P[i] = LKEEP(active[i], LMAX(bb[i] * lload(cs[i] + 7 * W), zero)))
-    if (unit_w)
-        MJ1_EACH(n, vfree[i] = vfree[i] + lload(cs[i] + 6 * W) * P[i])
-    else
+        MJ1_EACH(n, P[i] = LKEEP(active[i], LMAX(bb[i] * lload(cs[i] + 7 * W), zero)))
         MJ1_EACH(n, vfree[i] = LSEL(active[i], vfree[i] + lload(cs[i] + 6 * W) * P[i], vfree[i]))
+    }
     MJ1_EACH(n, q[i] = q[i] + h[i] * (th * vfree[i] + (1.0 - th) * v[i]))
     MJ1_EACH(n, v[i] = vfree[i])
     if (!unit_w)
         MJ1_EACH(n, g[i] = lload(cs[i] + 4 * W) + lload(cs[i] + 2 * W) * q[i])
+    return closing;
 }
 
 /* Lane l's contact (W = -1) moved to g0 = +inf, where it never closes:

@@ -4,38 +4,17 @@
  * (AVX-512), after their target pragma.  A set of vectors of lanes is
  * loaded once per block of steps and runs its steps in registers (the
  * engine's arithmetic, engine/mj1_lanes.h: mj1_step's numbers lane for
- * lane), keeping each step's x, v and P in rings; a second pass over the
- * rings gives pd_osc_track_common's numbers and calls pd_osc_track_events
- * for the lanes that need it (rare: a gap closing, an impact begun).  The
- * steps' forces come from a table filled per block (osc_batch.c), so a
- * step has no call. */
+ * lane), keeping each step's x, v and P in rings and, where the whole
+ * block is measured, folding the block's extremes as it goes; a second
+ * pass over the rings gives the other measurements and calls
+ * pd_osc_track_events for the lanes that need it (rare: a gap closing, an
+ * impact begun).  The steps' forces come from a table filled per block
+ * (osc_batch.c), so a step has no call. */
 #include "osc_batch.h"
 
 #include "mj1_lanes.h" /* the processor's own vector (after the target pragma) */
 
-#if defined(__SSE2__) && PD_LANES_X86
-#include <immintrin.h>
-#endif
-
 _Static_assert(NL % LW == 0, "whole native vectors of lanes");
-
-/* The lanes of the condition c as the bits of a whole number (lane i:
- * bit i). */
-static inline unsigned lbits(lcond c)
-{
-#if defined(__AVX512F__) && PD_LANES_X86
-    return (unsigned)c;
-#elif defined(__AVX__) && PD_LANES_X86
-    return (unsigned)_mm256_movemask_pd((__m256d)c);
-#elif defined(__SSE2__) && PD_LANES_X86
-    return (unsigned)_mm_movemask_pd((__m128d)c);
-#else
-    unsigned bits = 0;
-    for (int i = 0; i < LW; i++)
-        bits |= (c[i] != 0) << i;
-    return bits;
-#endif
-}
 
 /* The rare events of the lanes of l .. l + LW - 1 whose bits are set in
  * due, from their state before the step (q0, v0, P0, and v two steps back
@@ -54,33 +33,18 @@ static void lanes_events(osc_batch *ob, int l, unsigned due, lvec st, lvec t, lv
         }
 }
 
-/* Vectors of lanes stepped together, their chains interleaved (measured
- * on an AMD EPYC with AVX-512, the paper-scale sweep: 4 with AVX-512, all
- * 32 lanes; 8 with AVX2 and the baseline's 2-lane SSE2, where 4 ran 5 and
- * 10 % slower and 2 a third slower: the step's chain of about 45
- * latencies wants many vectors in flight more than it minds spills). */
+/* Vectors of lanes stepped together, their chains interleaved: 4 on
+ * every instruction set (measured on an AMD EPYC with AVX-512, the
+ * paper-scale sweep, since the steps without a contact take the short
+ * path: 8 vectors ran 7 % (SSE2) and 15 % (AVX2) slower, their q, v and
+ * block extremes spilled from the 16 registers; 2 a third slower, the
+ * step's chain of about 30 latencies too long for them). */
 #ifndef OSC_G
-#if LW == 8
-#define OSC_G OSC_G8
-#elif LW == 4
-#define OSC_G OSC_G4
-#else
-#define OSC_G OSC_G2
-#endif
-#endif
-#ifndef OSC_G8
-#define OSC_G8 4
-#endif
-#ifndef OSC_G4
-#define OSC_G4 8
-#endif
-#ifndef OSC_G2
-#define OSC_G2 8
+#define OSC_G 4
 #endif
 _Static_assert(NL % (OSC_G * LW) == 0, "whole sets of vectors");
 _Static_assert(OSC_G * LW <= 32, "a set's lanes are the bits of an unsigned");
 _Static_assert(OSC_G <= 8, "mj1_lanes_step takes at most 8 vectors");
-_Static_assert(OSC_G % 2 == 0, "the block's folds take vectors two by two");
 
 /* Contact steps counted in registers: AVX-512 adds one under the mask;
  * the others subtract the all-ones lanes of the condition (-1) from a
@@ -97,6 +61,33 @@ typedef lmask lcount;
 #define LCOUNT_ADD(x, n) ((x) + __builtin_convertvector(n, lvec))
 #endif
 
+/* Sixteen steps' lane bits (a byte a step). */
+typedef unsigned char stepbytes __attribute__((vector_size(16)));
+_Static_assert(LW <= 8, "a step's lanes are the bits of a byte");
+_Static_assert(OSC_BLOCK % 16 == 0, "whole sixteens of steps");
+
+/* Sixteen bytes from p (any alignment). */
+static inline stepbytes sbload(const unsigned char *p)
+{
+    stepbytes x;
+    memcpy(&x, p, sizeof x);
+    return x;
+}
+
+/* The nonzero bytes of d as the bits of a whole number (byte i: bit i). */
+static inline unsigned sbnonzero(stepbytes d)
+{
+#if PD_LANES_X86
+    const stepbytes none = {0};
+    return 0xffffu & ~(unsigned)_mm_movemask_epi8((__m128i)(d == none));
+#else
+    unsigned bits = 0;
+    for (int i = 0; i < 16; i++)
+        bits |= (d[i] != 0) << i;
+    return bits;
+#endif
+}
+
 /* Vector i of a set (lanes l .. l + LW - 1) over the k steps in the rings
  * (lanes_run_resident's): its contact steps, returned, and the events of
  * its lanes that need them (pd_osc_track_events_due's condition, from the
@@ -108,22 +99,32 @@ lanes_scan(osc_batch *ob, int l, int k, lvec h, lvec st0, lvec Pi3,
     const lvec zero = {0.0};
     lcount cnt = LCOUNT_ZERO;
     /* x < Pi3 and P > 0 after step s - 1 (s = 0: before the block), lane
-     * l + j at bit j: formed for every step first (no chain through them) */
-    unsigned char ltb[OSC_BLOCK + 1], posb[OSC_BLOCK + 1];
-    for (int s = 0; s <= k; s++) {
+     * l + j at bit j: formed for every step first (no chain through them);
+     * zero past k (read by the last sixteen, which ignores them) */
+    unsigned char ltb[OSC_BLOCK + 16] = {0}, posb[OSC_BLOCK + 16] = {0};
+    ltb[0] = (unsigned char)lbits(LLT(xr[0][i], Pi3));
+    posb[0] = (unsigned char)lbits(LGT(Pr[0][i], zero));
+    for (int s = 1; s <= k; s++) {
         lcond posn = LGT(Pr[s][i], zero);
         ltb[s] = (unsigned char)lbits(LLT(xr[s][i], Pi3));
         posb[s] = (unsigned char)lbits(posn);
-        cnt = s > 0 ? LCOUNT(cnt, posn) : cnt;
+        cnt = LCOUNT(cnt, posn);
     }
-    for (int s = 0; s < k; s++) {
-        /* the gap was open and closed (or an impulse stopped it closing),
-         * or an impact began */
-        unsigned due = (ltb[s] & ~(ltb[s + 1] & ~posb[s + 1])) | (posb[s + 1] & ~posb[s]);
-        if (__builtin_expect(due != 0, 0)) {
+    /* the gap was open and closed (or an impulse stopped it closing), or
+     * an impact began: sixteen steps at a time, the steps due as bits */
+    for (int s0 = 0; s0 < k; s0 += 16) {
+        stepbytes lt0 = sbload(ltb + s0), lt1 = sbload(ltb + s0 + 1);
+        stepbytes pos0 = sbload(posb + s0), pos1 = sbload(posb + s0 + 1);
+        unsigned steps = sbnonzero((lt0 & ~(lt1 & ~pos1)) | (pos1 & ~pos0));
+        if (k - s0 < 16)
+            steps &= (1u << (k - s0)) - 1u;
+        while (__builtin_expect(steps != 0, 0)) {
+            int s = s0 + __builtin_ctz(steps);
+            unsigned due = (ltb[s] & ~(ltb[s + 1] & ~posb[s + 1])) | (posb[s + 1] & ~posb[s]);
             lvec st = st0 + (double)(s + 1);
             lanes_events(ob, l, due, st, st * h, xr[s + 1][i], vr[s + 2][i], Pr[s + 1][i],
                          xr[s][i], vr[s + 1][i], Pr[s][i], vr[s][i]);
+            steps &= steps - 1u;
         }
     }
     return cnt;
@@ -138,15 +139,17 @@ lanes_scan(osc_batch *ob, int l, int k, lvec h, lvec st0, lvec Pi3,
  * osc_batch.h's rare_load) and the test for pd_osc_track_events (rare:
  * the lanes that need them call them there, in their steps' order).
  * `all` (a constant once inlined): every step of the block lies in every
- * lane's window, so the extremes need no selection: the block's maxima of
- * x and P and minimum of x are folded into the run's at its end, the
- * largest -x is -(min x) and the smallest gap Pi3 - max x (the x86
- * maximum and minimum keep the last of equal values, so that the block's
- * extreme is the very value the step-by-step fold keeps, and -(min x) the
- * very -x, signed zeros included; fl(Pi3 - x) falls as x grows, and every
- * x of the maximum was a gap of the minimum before); and a vector whose
- * lanes kept x < Pi3 and P = 0 over the block has no event and no contact
- * step, the step-by-step scan (lanes_scan) left to the others.
+ * lane's window, so the extremes need no selection: the steps fold the
+ * block's maxima of x and P and minimum of x (P only in a step with a
+ * contact: the others' P is +0, which leaves a maximum from +0 as it is),
+ * folded into the run's at the block's end, the largest -x is -(min x)
+ * and the smallest gap Pi3 - max x (the x86 maximum and minimum keep the
+ * last of equal values, so that the block's extreme is the very value the
+ * step-by-step fold keeps, and -(min x) the very -x, signed zeros
+ * included; fl(Pi3 - x) falls as x grows, and every x of the maximum was
+ * a gap of the minimum before); and a vector whose lanes kept x < Pi3 and
+ * P = 0 over the block has no event and no contact step, the
+ * step-by-step scan (lanes_scan) left to the others.
  * The other rewritings are exact too: the largest impulse folds every P
  * (P >= +0, the maximum from +0); the gap is <= 0 exactly when x >= Pi3
  * and > 0 when x < Pi3 (a difference of doubles is 0 only for equal
@@ -174,13 +177,23 @@ static inline __attribute__((always_inline)) void lanes_run_resident(osc_batch *
     MJ1_EACH(G, vr[0][i] = lload(&ob->prev2_v[l0 + i * LW]))
     MJ1_EACH(G, vr[1][i] = v[i])
     MJ1_EACH(G, Pr[0][i] = lload(&b->P[l0 + i * LW]))
+    lvec bx[G], bxmin[G], bP[G]; /* all's: the block's extremes, folded by the steps */
+    MJ1_EACH(G, bx[i] = zero - HUGE_VAL)
+    MJ1_EACH(G, bxmin[i] = zero + HUGE_VAL)
+    MJ1_EACH(G, bP[i] = zero)
     for (int s = 0; s < k; s++) {
         lvec Fth[G], Pn[G];
         MJ1_EACH(G, Fth[i] = lload(&ob->Fth[s][l0 + i * LW]))
-        mj1_lanes_step(G, cs, b->theta, h, Fth, q, v, NULL, Pn, 1);
+        unsigned contact = mj1_lanes_step(G, cs, b->theta, h, Fth, q, v, NULL, Pn, 1);
         MJ1_EACH(G, xr[s + 1][i] = q[i])
         MJ1_EACH(G, vr[s + 2][i] = v[i])
         MJ1_EACH(G, Pr[s + 1][i] = Pn[i])
+        if (all) {
+            MJ1_EACH(G, bx[i] = LMAX(bx[i], q[i]))
+            MJ1_EACH(G, bxmin[i] = LMIN(bxmin[i], q[i]))
+            if (contact)
+                MJ1_EACH(G, bP[i] = LMAX(bP[i], Pn[i]))
+        }
     }
     MJ1_EACH(G, lstore(&b->q[l0 + i * LW], q[i]))
     MJ1_EACH(G, lstore(&b->v[l0 + i * LW], v[i]))
@@ -198,20 +211,6 @@ static inline __attribute__((always_inline)) void lanes_run_resident(osc_batch *
     MJ1_EACH(G, Pi3[i] = lload(&ob->Pi3[l0 + i * LW]))
     MJ1_EACH(G, cnt[i] = LCOUNT_ZERO)
     if (all) {
-        /* the block's extremes, folded into the run's at its end */
-        lvec bx[G], bxmin[G], bP[G];
-        MJ1_EACH(G, bx[i] = zero - HUGE_VAL)
-        MJ1_EACH(G, bxmin[i] = zero + HUGE_VAL)
-        MJ1_EACH(G, bP[i] = zero)
-        for (int i = 0; i < G; i += 2) /* two vectors at a time: their folds in registers */
-            for (int s = 1; s <= k; s++) {
-                bx[i] = LMAX(bx[i], xr[s][i]);
-                bxmin[i] = LMIN(bxmin[i], xr[s][i]);
-                bP[i] = LMAX(bP[i], Pr[s][i]);
-                bx[i + 1] = LMAX(bx[i + 1], xr[s][i + 1]);
-                bxmin[i + 1] = LMIN(bxmin[i + 1], xr[s][i + 1]);
-                bP[i + 1] = LMAX(bP[i + 1], Pr[s][i + 1]);
-            }
         /* a vector whose gaps stayed open without an impulse has no event
          * and no contact step in the block; the others are scanned */
         for (int i = 0; i < G; i++)
