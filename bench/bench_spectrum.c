@@ -3,10 +3,13 @@
  * cosine pulses x normal, reverse (3200 points: 3200 runs with the wall and
  * 800 no-wall twins), eps = 0.5, xi = 0.05, Moreau–Jean at dt = Tp/2000.
  * First one task at a time by the scalar kernel (pd_spec_run_task; it has
- * no variants; best of two runs); then batched on one thread with each instruction
- * set the processor has (avx512, avx2, baseline up to pd_cpu_level, chosen
- * through POUND_ISA; best of two runs each), each compared bit for bit with
- * the scalar kernel; at the processor's own level on two OpenMP threads too
+ * no variants); then batched on one thread with each instruction set the
+ * processor has (avx512, avx2, baseline up to pd_cpu_level, chosen through
+ * POUND_ISA), each compared bit for bit with the scalar kernel: ROUNDS
+ * rounds of one scalar computation and BATCH_RUNS of each variant, the best
+ * of each kept (a shared host's slow spells last seconds: rounds give each
+ * method its share of the quick ones); then
+ * at the processor's own level on two OpenMP threads
  * (compared with one thread); then the same sweep by the exact
  * event-driven reference on one thread: runs/s by method and the
  * Moreau-Jean umax errors against it (median, worst).  Times are wall and
@@ -60,16 +63,26 @@ static double tasks_cpu(const pd_spec_result *res, long n)
     return cpu;
 }
 
-/* The best (by wall time) of two computations of the sweep on `threads`
- * threads: its wall time, and its CPU time (one thread: the calling
- * thread's; more: the sum of the tasks'). */
-static int timed(const pd_spectrum *s, int threads, pd_spec_result *res, pd_bench_clock *best)
+/* Rounds of the scalar kernel and the variants, and each variant's
+ * computations in a round (the batch takes a tenth of the scalar's time). */
+enum { ROUNDS = 3, BATCH_RUNS = 2 };
+
+/* A clock that any measurement beats. */
+static void clock_reset(pd_bench_clock *c)
+{
+    c->wall_s = c->cpu_s = HUGE_VAL;
+}
+
+/* `runs` computations of the sweep on `threads` threads, the best (by wall
+ * time) kept in *best: its wall time, and its CPU time (one thread: the
+ * calling thread's; more: the sum of the tasks'). */
+static int timed(const pd_spectrum *s, int threads, int runs, pd_spec_result *res,
+                 pd_bench_clock *best)
 {
     long n = pd_spec_tasks(s);
     pd_spec_exec ex = {.threads = threads, .rank = 0, .size = 1};
     pd_err err;
-    best->wall_s = best->cpu_s = HUGE_VAL;
-    for (int k = 0; k < 2; k++) {
+    for (int k = 0; k < runs; k++) {
         memset(res, 0, (size_t)n * sizeof *res);
         pd_bench_clock t0 = pd_bench_now();
         if (pd_spec_compute(s, &ex, res, &err)) {
@@ -86,27 +99,23 @@ static int timed(const pd_spectrum *s, int threads, pd_spec_result *res, pd_benc
 }
 
 /* The sweep one task at a time by the scalar kernel (pd_spec_run_task),
- * on this thread: the best (by wall time) of two computations, as for the
- * batch (timed), its wall and CPU time. */
+ * on this thread, once: its wall and CPU time kept in *best when better. */
 static int timed_scalar(const pd_spectrum *s, pd_spec_result *res, pd_bench_clock *best)
 {
     long n = pd_spec_tasks(s);
     pd_err err;
-    best->wall_s = best->cpu_s = HUGE_VAL;
-    for (int k = 0; k < 2; k++) {
-        memset(res, 0, (size_t)n * sizeof *res);
-        pd_bench_clock t0 = pd_bench_now();
-        for (long t = 0; t < n; t++) {
-            pd_spec_run_task(s, t, &res[t], &err);
-            if (res[t].status) {
-                fprintf(stderr, "pound: bench --spectrum: %s\n", err.msg);
-                return 1;
-            }
+    memset(res, 0, (size_t)n * sizeof *res);
+    pd_bench_clock t0 = pd_bench_now();
+    for (long t = 0; t < n; t++) {
+        pd_spec_run_task(s, t, &res[t], &err);
+        if (res[t].status) {
+            fprintf(stderr, "pound: bench --spectrum: %s\n", err.msg);
+            return 1;
         }
-        pd_bench_clock t = pd_bench_since(t0);
-        if (t.wall_s < best->wall_s)
-            *best = t;
     }
+    pd_bench_clock t = pd_bench_since(t0);
+    if (t.wall_s < best->wall_s)
+        *best = t;
     return 0;
 }
 
@@ -243,25 +252,31 @@ static void print_fig(pd_json *js, const bench_fig *f)
     pd_json_end_object(js);
 }
 
-/* The batched serial run of each instruction set up to f->level (POUND_ISA
- * set for each, the environment restored after): its figures into f->var,
- * the results at f->level into own; rs: the scalar kernel's; rv: scratch. */
+/* A round of the batched serial runs of each instruction set up to
+ * f->level (POUND_ISA set for each, the environment restored after): its
+ * figures into f->var (listed in the first round), the results at
+ * f->level into own; rs: the scalar kernel's; rv: scratch. */
 static int run_variants(const pd_spectrum *s, const pd_spec_result *rs, pd_spec_result *own,
-                        pd_spec_result *rv, bench_fig *f)
+                        pd_spec_result *rv, int round, bench_fig *f)
 {
     const char *old = getenv("POUND_ISA");
     char saved[64];
-    int rc = 0;
+    int rc = 0, nv = 0;
     snprintf(saved, sizeof saved, "%s", old ? old : "");
     for (int k = 0; k < NVARIANTS && !rc; k++) {
         if (variants[k].level > f->level)
             continue;
-        variant_fig *v = &f->var[f->nvar++];
+        variant_fig *v = &f->var[nv++];
         pd_spec_result *r = variants[k].level == f->level ? own : rv;
         setenv("POUND_ISA", variants[k].isa, 1);
-        v->level = pd_cpu_level();
-        rc = timed(s, 1, r, &v->serial);
-        v->identical = !rc && v->level == variants[k].level && same_results(rs, r, f->runs);
+        if (round == 0) {
+            f->nvar = nv;
+            v->level = pd_cpu_level();
+            v->identical = 1;
+            clock_reset(&v->serial);
+        }
+        rc = timed(s, 1, BATCH_RUNS, r, &v->serial);
+        v->identical &= !rc && v->level == variants[k].level && same_results(rs, r, f->runs);
     }
     if (old)
         setenv("POUND_ISA", saved, 1);
@@ -285,8 +300,12 @@ int pd_bench_spectrum(pd_json *js)
     double *err = malloc((size_t)f.runs * sizeof *err);
     pd_spectrum se = s; /* the same sweep, exact */
     se.opts.method = PD_METHOD_EVENT;
-    int rc = !r1 || !rs || !r2 || !err || pd_spec_validate(&s, NULL) ||
-             timed_scalar(&s, rs, &f.scalar) || run_variants(&s, rs, r1, r2, &f);
+    int rc = !r1 || !rs || !r2 || !err || pd_spec_validate(&s, NULL);
+    clock_reset(&f.scalar);
+    clock_reset(&f.omp2);
+    clock_reset(&f.event);
+    for (int round = 0; round < ROUNDS && !rc; round++)
+        rc = timed_scalar(&s, rs, &f.scalar) || run_variants(&s, rs, r1, r2, round, &f);
     if (!rc) {
         for (int k = 0; k < f.nvar; k++)
             if (f.var[k].level == f.level) {
@@ -295,9 +314,9 @@ int pd_bench_spectrum(pd_json *js)
             }
         for (long t = 0; t < f.runs; t++)
             f.steps += (double)r1[t].steps;
-        rc = timed(&s, 2, r2, &f.omp2);
+        rc = timed(&s, 2, ROUNDS * BATCH_RUNS, r2, &f.omp2);
         f.identical = !rc && same_results(r1, r2, f.runs);
-        rc = rc || timed(&se, 1, r2, &f.event);
+        rc = rc || timed(&se, 1, 2, r2, &f.event);
     }
     if (!rc) {
         umax_errors(&s, r1, r2, err, &f);
