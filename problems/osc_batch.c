@@ -271,6 +271,7 @@ static void lane_idle(osc_batch *ob, int l)
     table_release(ob, l);
     neighbours(ob, l);
     pd_mjb_set_lane(&ob->mjb, l, &idle, NULL);
+    mj1_lanes_far_wall(&ob->mjb, l); /* so that its set's steps may skip the impulses */
     ob->Pi3[l] = 1.0; /* a gap that never closes */
     ob->meas_from[l] = HUGE_VAL;
     ob->prev2_v[l] = 0.0;
