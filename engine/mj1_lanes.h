@@ -6,7 +6,8 @@
  * (pd_lanes.h: the width follows the target).  Every variant computes
  * mj1_step's numbers lane for lane: the same IEEE operations in the same
  * order, no fused multiply-adds (the Makefile's FPFLAGS), the choices as
- * selections. */
+ * selections (unit_w's one branch, a step where no lane's contact may
+ * close, skips arithmetic whose result it knows). */
 #ifndef PD_MJ1_LANES_H
 #define PD_MJ1_LANES_H
 
@@ -83,8 +84,9 @@ static inline lvec mj1_lanes_fth(double th, lvec F0, lvec F1)
  * the gap formed from q when the step needs it (g is neither read nor
  * written: the caller's is g0 - q), and the lanes need no selection: an
  * inactive lane's P is +0, and v + (W/What) P adds -0 to v (x + -0 is x,
- * -0 included), so that a step where no lane's contact may close skips
- * the impulses' arithmetic.
+ * -0 included; What > 0, as for the oscillator's M = 1, C, K >= 0), so
+ * that a step where no lane's contact may close skips the impulses'
+ * arithmetic.
  * Returns nonzero when a lane's contact may close (always without
  * unit_w). */
 static inline __attribute__((always_inline)) unsigned
@@ -133,8 +135,9 @@ mj1_lanes_step(int n, const double *const *cs, double th, const lvec *h, const l
 }
 
 /* Lane l's contact (W = -1) moved to g0 = +inf, where it never closes:
- * the oscillator's run without a wall on a lane of unit_w's (its q, v and
- * P are the no-contact step's to the bit: an inactive lane's P is +0). */
+ * the oscillator's run without a wall, or an idle lane, on a lane of
+ * unit_w's (its q, v and P are the no-contact step's to the bit: an
+ * inactive lane's P is +0). */
 static inline void mj1_lanes_far_wall(pd_mjb *b, int l)
 {
     mj1_coefv *s = (mj1_coefv *)(void *)b->coef + l / MJ1_WIDTH;

@@ -265,13 +265,13 @@ static int lane_start(osc_batch *ob, int l, long id, const pd_osc *c, const pd_r
 /* Lane l without a case. */
 static void lane_idle(osc_batch *ob, int l)
 {
-    static const pd_mjb_lane idle = {.M = 1.0, .h = 1.0, .brk = INFINITY};
+    static const pd_mjb_lane idle = {.M = 1.0, .wall = 1, .W = -1.0, .h = 1.0, .brk = INFINITY};
     ob->id[l] = -1;
     live_remove(ob, l);
     table_release(ob, l);
     neighbours(ob, l);
     pd_mjb_set_lane(&ob->mjb, l, &idle, NULL);
-    mj1_lanes_far_wall(&ob->mjb, l); /* so that its set's steps may skip the impulses */
+    mj1_lanes_far_wall(&ob->mjb, l); /* never closing: its set's steps may skip the impulses */
     ob->Pi3[l] = 1.0; /* a gap that never closes */
     ob->meas_from[l] = HUGE_VAL;
     ob->prev2_v[l] = 0.0;

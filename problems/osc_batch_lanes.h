@@ -35,9 +35,9 @@ static void lanes_events(osc_batch *ob, int l, unsigned due, lvec st, lvec t, lv
 
 /* Vectors of lanes stepped together, their chains interleaved: 4 on
  * every instruction set (measured on an AMD EPYC with AVX-512, the
- * paper-scale sweep, since the steps without a contact take the short
- * path: 8 vectors ran 7 % (SSE2) and 15 % (AVX2) slower, their q, v and
- * block extremes spilled from the 16 registers; 2 a third slower, the
+ * paper-scale sweep, since the steps where no contact may close take the
+ * short path: 8 vectors ran 4 % (SSE2) and 12 % (AVX2) slower, their q, v
+ * and block extremes spilled from the 16 registers; 2 a third slower, the
  * step's chain of about 30 latencies too long for them). */
 #ifndef OSC_G
 #define OSC_G 4
@@ -64,7 +64,6 @@ typedef lmask lcount;
 /* Sixteen steps' lane bits (a byte a step). */
 typedef unsigned char stepbytes __attribute__((vector_size(16)));
 _Static_assert(LW <= 8, "a step's lanes are the bits of a byte");
-_Static_assert(OSC_BLOCK % 16 == 0, "whole sixteens of steps");
 
 /* Sixteen bytes from p (any alignment). */
 static inline stepbytes sbload(const unsigned char *p)
@@ -134,7 +133,8 @@ lanes_scan(osc_batch *ob, int l, int k, lvec h, lvec st0, lvec Pi3,
  * (q, v, g) in registers step after step (the compiler's to spill where
  * there are too few), each step's x, v and P kept in rings; then a second
  * pass, free of the steps' chains, over the rings in step order:
- * pd_osc_track_common's numbers (every lane has taken a step: step > 0;
+ * pd_osc_track_common's numbers (the extremes folded by the steps instead
+ * when `all`, below; every lane has taken a step: step > 0;
  * max |x| is the larger of the two one-sided maxima, formed at the end:
  * osc_batch.h's rare_load) and the test for pd_osc_track_events (rare:
  * the lanes that need them call them there, in their steps' order).
@@ -184,14 +184,14 @@ static inline __attribute__((always_inline)) void lanes_run_resident(osc_batch *
     for (int s = 0; s < k; s++) {
         lvec Fth[G], Pn[G];
         MJ1_EACH(G, Fth[i] = lload(&ob->Fth[s][l0 + i * LW]))
-        unsigned contact = mj1_lanes_step(G, cs, b->theta, h, Fth, q, v, NULL, Pn, 1);
+        unsigned closing = mj1_lanes_step(G, cs, b->theta, h, Fth, q, v, NULL, Pn, 1);
         MJ1_EACH(G, xr[s + 1][i] = q[i])
         MJ1_EACH(G, vr[s + 2][i] = v[i])
         MJ1_EACH(G, Pr[s + 1][i] = Pn[i])
         if (all) {
             MJ1_EACH(G, bx[i] = LMAX(bx[i], q[i]))
             MJ1_EACH(G, bxmin[i] = LMIN(bxmin[i], q[i]))
-            if (contact)
+            if (closing)
                 MJ1_EACH(G, bP[i] = LMAX(bP[i], Pn[i]))
         }
     }
