@@ -223,9 +223,10 @@ static int chain_figures(pd_lcp_method method, const pd_matrix *M, const double 
 }
 
 /* A solver's figures on the chain of N into row: its time with a new
- * right-hand side for every solve (PGS, whose sweeps are fixed: q of seed
- * 0 each time), the rest as means over the seeds 0 .. seeds - 1; 1 on a
- * failure (Lemke or structured not solving one is one). */
+ * right-hand side for every solve, the rest as means over the seeds 0 ..
+ * seeds - 1 (PGS, whose sweeps are fixed: the q of seed 0 each time, its
+ * figures that solve's); 1 on a failure (Lemke or structured not solving
+ * one is one). */
 static int measure_chain(pd_lcp_method method, int N, int seeds, bench_row *row)
 {
     chain c;
@@ -238,8 +239,9 @@ static int measure_chain(pd_lcp_method method, int N, int seeds, bench_row *row)
     pd_matrix dense = pd_matrix_dense(N, N, c.dense);
     pd_matrix csc = pd_matrix_csc(N, N, c.colptr, c.rowind, c.values);
     const pd_matrix *M = method == PD_LCP_LEMKE ? &dense : &csc;
-    int failed = measure(method, M, c.q, method != PD_LCP_PGS, its, row, &unsolved) ||
-                 chain_figures(method, M, c.q, seeds, its, row);
+    int fresh = method != PD_LCP_PGS; /* PGS: measure's last solve is of seed 0 */
+    int failed = measure(method, M, c.q, fresh, its, row, &unsolved) ||
+                 (fresh && chain_figures(method, M, c.q, seeds, its, row));
     failed |= method != PD_LCP_PGS && (unsolved > 0 || row->outcome != PD_LCP_SOLVED);
     chain_free(&c);
     return failed;
