@@ -84,21 +84,35 @@ static pd_bench_clock time_batch(pd_lcp_solver *sv, const pd_matrix *M, const do
     return pd_bench_since(t0);
 }
 
+/* A solve's figures (info) into row: its pivots and iterations added to
+ * sums, the largest residual, the first outcome that is not solved (else
+ * the first solve's). */
+static void add_figures(const pd_lcp_info *info, int first, bench_row *row, double *sums)
+{
+    sums[0] += info->pivots;
+    sums[1] += info->iterations;
+    row->residual = first ? info->residual : fmax(row->residual, info->residual);
+    if (first || info->outcome != PD_LCP_SOLVED)
+        row->outcome = info->outcome;
+    row->solver = info->solver;
+}
+
 /* Median µs per solve with `method` over repeated batches of (M, q) — or,
  * with fresh (M a chain of pd_lcp_chain_q's right-hand sides), of M with a
  * new right-hand side for every solve, made before its batch (seeds
- * CHAIN_FRESH_SEED on) — the outcome of the last solve into row, and how
- * many did not return PD_OK into *failed.  1 when the solver could not be
- * set up (Lemke or structured not solving a solvable problem is caught by
- * the callers). */
-static int measure(pd_lcp_method method, const pd_matrix *M, const double *q, int fresh,
-                   int max_iterations, bench_row *row, long *failed)
+ * CHAIN_FRESH_SEED on); the pivots, iterations and residual as means over
+ * the nfig right-hand sides at q (q + s n), and how many timed solves did
+ * not return PD_OK into *failed.  1 when the solver could not be set up
+ * (Lemke or structured not solving a solvable problem is caught by the
+ * callers). */
+static int measure(pd_lcp_method method, const pd_matrix *M, const double *q, int nfig,
+                   int fresh, int max_iterations, bench_row *row, long *failed)
 {
     int n = M->rows, seed = CHAIN_FRESH_SEED;
     long nnz = M->kind == PD_MATRIX_CSC ? M->colptr[n] : 0;
     pd_err err;
     pd_lcp_solver *sv = pd_lcp_solver_alloc(method, n, nnz, &err);
-    double *zw = malloc(2 * (size_t)n * sizeof(double)), *bank = NULL;
+    double *zw = malloc(2 * (size_t)n * sizeof(double)), *bank = NULL, sums[2] = {0.0, 0.0};
     double runs[BENCH_MAX_RUNS], cpu_runs[BENCH_MAX_RUNS];
     pd_lcp_opts o = pd_lcp_default_opts();
     o.max_iterations = max_iterations;
@@ -113,6 +127,11 @@ static int measure(pd_lcp_method method, const pd_matrix *M, const double *q, in
         free(zw);
         free(bank);
         return 1;
+    }
+    add_figures(&info, 1, row, sums); /* the first q's from the solve just timed */
+    for (int s = 1; s < nfig; s++) {
+        pd_lcp_solve(sv, M, q + (size_t)s * (size_t)n, &o, zw, zw + n, &info);
+        add_figures(&info, 0, row, sums);
     }
     int min_runs = once > BENCH_LONG_S ? 3 : BENCH_MIN_RUNS;
     double total = 0.0;
@@ -129,11 +148,8 @@ static int measure(pd_lcp_method method, const pd_matrix *M, const double *q, in
     }
     free(bank);
     row->n = n;
-    row->solver = info.solver;
-    row->pivots = info.pivots;
-    row->iterations = info.iterations;
-    row->outcome = info.outcome;
-    row->residual = info.residual;
+    row->pivots = (int)lround(sums[0] / nfig);
+    row->iterations = (int)lround(sums[1] / nfig);
     row->median_us = pd_bench_median(runs, nruns);
     row->median_cpu_us = pd_bench_median(cpu_runs, nruns);
     pd_lcp_solver_free(sv);
@@ -189,44 +205,10 @@ static int chain_make(chain *c, int N, int with_dense, int nq)
     return 0;
 }
 
-/* The mean pivots and iterations and the largest residual of the first
- * `seeds` right-hand sides at q into row, its outcome the first that is
- * not solved (else solved); 1 when the solver cannot be set up. */
-static int chain_figures(pd_lcp_method method, const pd_matrix *M, const double *q, int seeds,
-                         int max_iterations, bench_row *row)
-{
-    int n = M->rows;
-    long nnz = M->kind == PD_MATRIX_CSC ? M->colptr[n] : 0;
-    pd_err err;
-    pd_lcp_solver *sv = pd_lcp_solver_alloc(method, n, nnz, &err);
-    double *zw = malloc(2 * (size_t)n * sizeof(double));
-    double iterations = 0.0, pivots = 0.0;
-    pd_lcp_opts o = pd_lcp_default_opts();
-    o.max_iterations = max_iterations;
-    int rc = !sv || !zw;
-    row->residual = 0.0;
-    for (int s = 0; s < seeds && !rc; s++) {
-        pd_lcp_info info;
-        pd_lcp_solve(sv, M, q + (size_t)s * (size_t)n, &o, zw, zw + n, &info);
-        iterations += (double)info.iterations / seeds;
-        pivots += (double)info.pivots / seeds;
-        row->residual = fmax(row->residual, info.residual);
-        if (s == 0 || info.outcome != PD_LCP_SOLVED)
-            row->outcome = info.outcome;
-        row->solver = info.solver;
-    }
-    row->iterations = (int)lround(iterations);
-    row->pivots = (int)lround(pivots);
-    pd_lcp_solver_free(sv);
-    free(zw);
-    return rc;
-}
-
 /* A solver's figures on the chain of N into row: its time with a new
- * right-hand side for every solve, the rest as means over the seeds 0 ..
- * seeds - 1 (PGS, whose sweeps are fixed: the q of seed 0 each time, its
- * figures that solve's); 1 on a failure (Lemke or structured not solving
- * one is one). */
+ * right-hand side for every solve (PGS, whose sweeps are fixed: the q of
+ * seed 0 each time), the rest as means over the seeds 0 .. seeds - 1; 1
+ * on a failure (Lemke or structured not solving one is one). */
 static int measure_chain(pd_lcp_method method, int N, int seeds, bench_row *row)
 {
     chain c;
@@ -239,9 +221,7 @@ static int measure_chain(pd_lcp_method method, int N, int seeds, bench_row *row)
     pd_matrix dense = pd_matrix_dense(N, N, c.dense);
     pd_matrix csc = pd_matrix_csc(N, N, c.colptr, c.rowind, c.values);
     const pd_matrix *M = method == PD_LCP_LEMKE ? &dense : &csc;
-    int fresh = method != PD_LCP_PGS; /* PGS: measure's last solve is of seed 0 */
-    int failed = measure(method, M, c.q, fresh, its, row, &unsolved) ||
-                 (fresh && chain_figures(method, M, c.q, seeds, its, row));
+    int failed = measure(method, M, c.q, seeds, method != PD_LCP_PGS, its, row, &unsolved);
     failed |= method != PD_LCP_PGS && (unsolved > 0 || row->outcome != PD_LCP_SOLVED);
     chain_free(&c);
     return failed;
@@ -255,7 +235,7 @@ static int per_contact_ns(const chain *c, int fresh, double *best)
     bench_row row = {0};
     long unsolved = 0;
     pd_matrix csc = pd_matrix_csc(c->N, c->N, c->colptr, c->rowind, c->values);
-    if (measure(PD_LCP_STRUCTURED, &csc, c->q, fresh, 0, &row, &unsolved) || unsolved)
+    if (measure(PD_LCP_STRUCTURED, &csc, c->q, 1, fresh, 0, &row, &unsolved) || unsolved)
         return 1;
     *best = fmin(*best, 1e3 * row.median_cpu_us / c->N);
     return 0;
@@ -356,8 +336,8 @@ static void bench_dense_band(bench_report *rep)
     pd_matrix csc = pd_matrix_csc(c.N, c.N, c.colptr, c.rowind, c.values);
     pd_matrix dense = pd_matrix_dense(c.N, c.N, c.dense);
     long unsolved = 0, dense_unsolved = 0;
-    int failed = measure(PD_LCP_STRUCTURED, &csc, c.q, 0, 0, &csc_row, &unsolved) ||
-                 measure(PD_LCP_STRUCTURED, &dense, c.q, 0, 0, &dense_row, &dense_unsolved) ||
+    int failed = measure(PD_LCP_STRUCTURED, &csc, c.q, 1, 0, 0, &csc_row, &unsolved) ||
+                 measure(PD_LCP_STRUCTURED, &dense, c.q, 1, 0, 0, &dense_row, &dense_unsolved) ||
                  unsolved || dense_unsolved;
     pd_bench_clock t0 = pd_bench_now();
     int rd = pd_lcp_read_band(path, PD_LCP_FORMAT_PLAIN, &n, &M, &q, &band, &nnz, &err);
@@ -465,7 +445,7 @@ static void bench_siconos_file(bench_report *rep, const char *dir, const char *f
         if (m)
             *r = rep->rows[rep->nrows - 2];
         long unsolved;
-        rep->failed |= measure(methods[m], &Mv, q, 0, 0, r, &unsolved);
+        rep->failed |= measure(methods[m], &Mv, q, 1, 0, 0, r, &unsolved);
         rep->failed |= m == 0 && (r->outcome == PD_LCP_NUMERICAL || r->outcome == PD_LCP_MAX_PIVOTS);
     }
     free(M);

@@ -61,6 +61,12 @@ typedef lmask lcount;
 #define LCOUNT_ADD(x, n) ((x) + __builtin_convertvector(n, lvec))
 #endif
 
+/* The lanes due for pd_osc_track_events after a step, from x < Pi3 and
+ * P > 0 before it (lt0, pos0) and after it (lt1, pos1), as bits: the gap
+ * was open and closed (or an impulse stopped it closing), or an impact
+ * began. */
+#define EVENTS_DUE(lt0, lt1, pos0, pos1) (((lt0) & ~((lt1) & ~(pos1))) | ((pos1) & ~(pos0)))
+
 /* Sixteen steps' lane bits (a byte a step). */
 typedef unsigned char stepbytes __attribute__((vector_size(16)));
 _Static_assert(LW <= 8, "a step's lanes are the bits of a byte");
@@ -109,17 +115,15 @@ lanes_scan(osc_batch *ob, int l, int k, lvec h, lvec st0, lvec Pi3,
         posb[s] = (unsigned char)lbits(posn);
         cnt = LCOUNT(cnt, posn);
     }
-    /* the gap was open and closed (or an impulse stopped it closing), or
-     * an impact began: sixteen steps at a time, the steps due as bits */
+    /* sixteen steps at a time, the steps with a lane due as bits */
     for (int s0 = 0; s0 < k; s0 += 16) {
-        stepbytes lt0 = sbload(ltb + s0), lt1 = sbload(ltb + s0 + 1);
-        stepbytes pos0 = sbload(posb + s0), pos1 = sbload(posb + s0 + 1);
-        unsigned steps = sbnonzero((lt0 & ~(lt1 & ~pos1)) | (pos1 & ~pos0));
+        unsigned steps = sbnonzero(EVENTS_DUE(sbload(ltb + s0), sbload(ltb + s0 + 1),
+                                              sbload(posb + s0), sbload(posb + s0 + 1)));
         if (k - s0 < 16)
             steps &= (1u << (k - s0)) - 1u;
         while (__builtin_expect(steps != 0, 0)) {
             int s = s0 + __builtin_ctz(steps);
-            unsigned due = (ltb[s] & ~(ltb[s + 1] & ~posb[s + 1])) | (posb[s + 1] & ~posb[s]);
+            unsigned due = EVENTS_DUE(ltb[s], ltb[s + 1], posb[s], posb[s + 1]);
             lvec st = st0 + (double)(s + 1);
             lanes_events(ob, l, due, st, st * h, xr[s + 1][i], vr[s + 2][i], Pr[s + 1][i],
                          xr[s][i], vr[s + 1][i], Pr[s][i], vr[s][i]);
