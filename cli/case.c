@@ -33,6 +33,9 @@ const char pd_cli_case_help[] =
     "           fixed implicit Newmark steps (dt, or dt/k for 10 per element period)]\n"
     "  --dt H [min(Tp,T0)/2000]   --theta T [0.5]   --gamma G [0.5]   --tend T [Tp+2 T0;\n"
     "         harmonic: transient + window, see docs/scheme.md]\n"
+    "  --rtol R  Moreau-Jean to a tolerance: steps chosen so that every peak is within R of\n"
+    "           its value, relative, with an estimate of its error (err_est); --rtol alone\n"
+    "           chooses moreau; with --method penalty, its integrator's tolerance\n"
     "  --allow-unstable  accept theta outside [1/2, 1]\n"
     "  --no-wall  without contacts: the oscillator's no-wall twin, a free scene\n"
     "  --no-accumulation  event-driven: do not jump accumulations of impacts\n"
@@ -48,7 +51,8 @@ const char pd_cli_case_help[] =
     "         the largest storey stiffness) [max(1e4 w0^2, 1e3 wp^2 / Pi3^2): about 3 %\n"
     "         of the gap's penetration; scenes 1e4]\n"
     "  --kc-abs K  stiffness in N/m per kg (scenes: N/m; N/m^1.5 for hertz)\n"
-    "  --rtol R [1e-10]  --atol A [1e-12]  --stepper rk8pd|rkf45|rk4imp|msbdf [rk8pd]\n";
+    "  --rtol R [1e-10] (with --method penalty)  --atol A [1e-12]\n"
+    "  --stepper rk8pd|rkf45|rk4imp|msbdf [rk8pd]\n";
 
 void pd_cli_case_init(pd_cli_case *a)
 {
@@ -142,7 +146,7 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
                        {"--tend", &a->opts.tend, &a->have_tend, 0},
                        {"--kc", &a->opts.pen.kc_mult, &a->have_kc, 0},
                        {"--kc-abs", &a->opts.pen.kc_abs, NULL, 0},
-                       {"--rtol", &a->opts.pen.rtol, NULL, 0},
+                       {"--rtol", &a->rtol, &a->have_rtol, 0},
                        {"--atol", &a->opts.pen.atol, NULL, 0},
                        {"--chain-ratio", &a->chain_ratio, NULL, 1},
                        {"--scale", &a->scale, &a->have_scale, 0},
@@ -159,7 +163,7 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
                 {"--lcp-solver", PD_METHOD_MOREAU}, {"--no-accumulation", PD_METHOD_EVENT},
                 {"--close-tol", PD_METHOD_EVENT},
                 {"--kc", PD_METHOD_PENALTY},       {"--kc-abs", PD_METHOD_PENALTY},
-                {"--rtol", PD_METHOD_PENALTY},     {"--atol", PD_METHOD_PENALTY},
+                {"--atol", PD_METHOD_PENALTY},
                 {"--contact", PD_METHOD_PENALTY},  {"--stepper", PD_METHOD_PENALTY}};
     for (size_t n = 0; n < sizeof only / sizeof only[0]; n++)
         if (!strcmp(f, only[n].flag))
@@ -347,6 +351,8 @@ int pd_cli_case_check_derived(const pd_cli_case *a)
     double dt = a->have_dt ? a->opts.dt : pd_osc_default_dt(c);
     if (!isfinite(tend))
         return pd_cli_usage_error("%s: tend = Tp + 2 T0 overflows", extreme_period_flag(a));
+    if (a->opts.rtol > 0.0) /* to a tolerance: no step count of its own */
+        return 0;
     if (a->have_dt && !(dt < tend))
         return pd_cli_usage_error("%s: the step %.3g s is not shorter than the run (tend = "
                                   "%.3g s)", a->dt_flag ? a->dt_flag : "--dt", dt, tend);
@@ -428,14 +434,47 @@ void pd_cli_case_implies(pd_cli_case *a, const char *flag, pd_method method)
         a->implies[method] = flag;
 }
 
+/* --rtol to the method that takes it: Moreau-Jean's tolerance (which
+ * --rtol alone chooses), or the penalty integrator's; refused with --dt
+ * and with the methods that have none; 0 or 2. */
+static int case_rtol(pd_cli_case *a)
+{
+    pd_method m = a->opts.method;
+    if (!a->have_rtol)
+        return 0;
+    if (!(a->rtol >= PD_RTOL_MIN && a->rtol < 1.0))
+        return pd_cli_usage_error("--rtol: the relative tolerance must be in [%g, 1) (got "
+                                  "%.10g)", PD_RTOL_MIN, a->rtol);
+    if (m == PD_METHOD_PENALTY) {
+        a->opts.pen.rtol = a->rtol;
+        return 0;
+    }
+    if (a->methods_listed) /* compare, converge: the rows say */
+        return 0;
+    if (m != PD_METHOD_MOREAU && m != PD_METHOD_AUTO)
+        return pd_cli_usage_error("--rtol: the tolerance of moreau's steps or of penalty's "
+                                  "integrator; --method %s has none", pd_method_name(m));
+    if (a->have_dt)
+        return pd_cli_usage_error("--rtol and %s: Moreau-Jean takes fixed steps (--dt) or "
+                                  "steps to a tolerance (--rtol), not both",
+                                  a->dt_flag ? a->dt_flag : "--dt");
+    a->opts.method = PD_METHOD_MOREAU;
+    a->opts.rtol = a->rtol;
+    return 0;
+}
+
 /* The method when --method was not given: the one that the flags given
- * belong to (two methods' flags together need --method), else the
- * default, left PD_METHOD_AUTO for the library to resolve; 0 or 2. */
+ * belong to (two methods' flags together need --method; --rtol alone
+ * chooses moreau), else the default, left PD_METHOD_AUTO for the library
+ * to resolve; 0 or 2. */
 static int case_method(pd_cli_case *a)
 {
     const char *by = NULL;
     if (a->method_by || a->methods_listed)
         return 0;
+    if (a->have_rtol && !a->implies[PD_METHOD_MOREAU] && !a->implies[PD_METHOD_PENALTY] &&
+        !a->implies[PD_METHOD_EVENT])
+        pd_cli_case_implies(a, "--rtol", PD_METHOD_MOREAU);
     for (int m = 0; m < 3; m++) {
         if (!a->implies[m])
             continue;
@@ -466,7 +505,7 @@ static int case_finish(pd_cli_case *a)
 {
     int rc;
     pd_err err;
-    if ((rc = case_method(a)))
+    if ((rc = case_method(a)) || (rc = case_rtol(a)))
         return rc;
     a->opts.method = pd_cli_case_method(a); /* the oscillator's resolves below */
     if (a->scene_path && a->chain)

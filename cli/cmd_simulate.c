@@ -1,6 +1,7 @@
 /* cmd_simulate.c — `pound simulate`: one run of the pounding oscillator or
  * of a scene (a row of structures), with its contact-free twin, printed and
  * optionally written and drawn. */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -226,6 +227,12 @@ static void print_json(const sim_args *a, const pd_osc_summary *s)
     pd_json_num(&js, "chi", s->chi);
     pd_json_int(&js, "steps", s->r.steps);
     pd_json_num(&js, "cpu_s", s->cpu_s);
+    pd_json_num(&js, "rtol", s->r.rtol);
+    pd_json_num(&js, "err_est", s->err_est); /* NaN -> null: fixed steps */
+    pd_json_bool(&js, "rtol_met", s->rtol_met);
+    pd_json_int(&js, "steps_rejected", s->r.steps_rejected);
+    pd_json_num(&js, "dt_min", s->r.dt_min);
+    pd_json_num(&js, "dt_max", s->r.dt_max);
     pd_json_num(&js, "Pi2", c->Pi2);
     pd_json_num(&js, "Pi3", c->Pi3);
     pd_json_num(&js, "eps", c->eps);
@@ -262,7 +269,12 @@ static void print_text(const sim_args *a, const pd_osc_summary *s)
                "gap = %g m, eps = %g, xi = %g\n",
                pd_dir_name(c->dir), pd_pulse_name(c->pulse), c->ap, c->Tp, pd_osc_T0(c),
                pd_osc_gap(c), c->eps, c->xi);
-    if (a->k.opts.method == PD_METHOD_MOREAU)
+    if (a->k.opts.method == PD_METHOD_MOREAU && s->r.rtol > 0.0)
+        printf("  Pi2 = %.6g  Pi3 = %.6g   Moreau-Jean to rtol = %g: %ld steps (%ld tries "
+               "halved), dt %.3g to %.3g s, to %g s\n",
+               c->Pi2, c->Pi3, s->r.rtol, s->r.steps, s->r.steps_rejected, s->r.dt_min,
+               s->r.dt_max, s->r.tend);
+    else if (a->k.opts.method == PD_METHOD_MOREAU)
         printf("  Pi2 = %.6g  Pi3 = %.6g   Moreau-Jean theta = %g, dt = %.6g s, %ld steps to %g s\n",
                c->Pi2, c->Pi3, s->r.theta, s->r.dt, s->r.steps, s->r.tend);
     else
@@ -292,6 +304,9 @@ static void print_text(const sim_args *a, const pd_osc_summary *s)
         printf("  contact   = equivalent force %.6g N/kg (pi I / (2 td), td = %g s, "
                "--contact-duration), peak force %.6g N/kg\n", s->r.force_equiv,
                s->r.contact_duration, s->r.force_max);
+    if (s->r.rtol > 0.0)
+        printf("  err_est   = %.2g (the peaks' estimated relative error, the run's and its "
+               "no-wall twin's; %s)\n", s->err_est, s->rtol_met ? "rtol met" : "rtol NOT met");
     printf("  cpu       = %.3g s\n", s->cpu_s);
 }
 
@@ -336,7 +351,13 @@ static int finish_output(const sim_args *a, const pd_osc_summary *s, pd_table_wr
                        NUM("umax_free", "m", s->free.umax),
                        NUM("gamma", "1", s->gamma),
                        NUM("steps", "1", (double)s->r.steps),
-                       NUM("cpu_s", "s", s->cpu_s)};
+                       NUM("cpu_s", "s", s->cpu_s),
+                       NUM("rtol", "1", s->r.rtol),
+                       NUM("err_est", "1", s->err_est),
+                       NUM("rtol_met", "1", s->rtol_met),
+                       NUM("steps_rejected", "1", (double)s->r.steps_rejected),
+                       NUM("dt_min", "s", s->r.dt_min),
+                       NUM("dt_max", "s", s->r.dt_max)};
 #undef NUM
 #undef TXT
     return pd_table_finish(w, (int)(sizeof attrs / sizeof attrs[0]), attrs, err);
@@ -364,9 +385,13 @@ static int simulate_oscillator(sim_args *a)
     pd_lcp_dump *dump = NULL;
     pd_err err;
     int rc, status = 0;
-    long nsteps = pd_steps_for(a->k.opts.tend, a->k.opts.dt);
-    osc_out o = {.every = a->every, .rows_max = nsteps / a->every + 1};
-    if (a->out && (status = check_output_size(a->out, output_bytes(a->out, o.rows_max, OSC_COLS))))
+    /* to a tolerance the steps are the run's: the fixed scheme's count at the
+     * default dt stands for them in the size estimate, no cap on the rows */
+    int tol = a->k.opts.rtol > 0.0;
+    long nsteps = pd_steps_for(a->k.opts.tend, tol ? pd_osc_default_dt(&a->k.c) : a->k.opts.dt);
+    osc_out o = {.every = a->every, .rows_max = tol ? LONG_MAX : nsteps / a->every + 1};
+    if (a->out &&
+        (status = check_output_size(a->out, output_bytes(a->out, nsteps / a->every + 1, OSC_COLS))))
         goto done;
     if ((status = dump_open(a, &dump, &a->k.opts)))
         goto done;
@@ -462,6 +487,12 @@ static void scene_json(const sim_args *a, const pd_scene *sc, const pd_scene_sum
     pd_json_num(&js, "dt", r->dt);
     pd_json_num(&js, "theta", r->theta);
     pd_json_num(&js, "tend", r->tend);
+    pd_json_num(&js, "rtol", r->rtol);
+    pd_json_num(&js, "err_est", s->err_est); /* NaN -> null: fixed steps */
+    pd_json_bool(&js, "rtol_met", s->rtol_met);
+    pd_json_int(&js, "steps_rejected", r->steps_rejected);
+    pd_json_num(&js, "dt_min", r->dt_min);
+    pd_json_num(&js, "dt_max", r->dt_max);
     pd_json_int(&js, "dofs", sc->n);
     pd_json_str(&js, "pulse", sc->exc.record ? sc->exc.record->name : pd_pulse_name(sc->exc.pulse));
     pd_json_str(&js, "dir", sc->exc.dir > 0 ? "+x" : "-x");
@@ -493,6 +524,7 @@ static void scene_json(const sim_args *a, const pd_scene *sc, const pd_scene_sum
         pd_json_nums(&js, "Pi1", n, s->Pi1 + o);
         pd_json_nums(&js, "umax_free", n, s->free.umax + o);
         pd_json_nums(&js, "gamma", n, s->gamma + o);
+        pd_json_num(&js, "err_est", r->rtol > 0.0 ? fmax(r->err_est[k], s->free.err_est[k]) : NAN);
         pd_json_end_object(&js);
     }
     pd_json_end_array(&js);

@@ -14,38 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "pd_engine.h"
-#include "pd_factor.h"
+#include "mj.h"
 #include "pd_null.h"
-#include "mj1.h"
-
-
-struct pd_mj {
-    const pd_model *model;
-    pd_mj_opts opts;
-    int scalar;           /* 1: scalar kernel */
-    double t0;            /* time of the last reset */
-    int next_break;       /* index of the first model breakpoint after t */
-    pd_factor *factor;    /* What, What^-1 W and the Delassus matrix */
-    pd_lcp_solver *lcp;   /* the contact LCP solver, sized for lcp_nmax contacts */
-    int lcp_nmax;         /* most active contacts one LCP may have */
-    unsigned char *guess; /* m: the warm start of the active set's LCP: 1 pushed in the
-                             previous step, 0 active without pushing, 2 newly active */
-    int sparse;           /* 1: Delassus blocks in compressed columns */
-    int stop;             /* the LCP observer asked to stop */
-    double *F0, *F1;      /* n: force at t_k and t_k+1 */
-    double *work_n;       /* n: right-hand side, then velocity increment */
-    double *qtheta;       /* n: q_k + h theta v_k */
-    double *U0;           /* m: W^T v_k */
-    double *D_active;     /* Delassus block: lcp_nmax^2 (dense) or delassus_nnz (sparse) */
-    int *D_colptr, *D_rowind; /* sparse: its compressed columns */
-    double *b_active;     /* m: LCP vector of the active set */
-    double *P_active;     /* m: impulses of the active set */
-    double *w_active;     /* m: post-impact relative velocities of the active set */
-    int *idx_active;      /* m: indices of the active contacts */
-    mj1_coef s1;          /* scalar kernel constants (no division in a step) */
-    pd_state st;
-};
 
 pd_mj_opts pd_mj_default_opts(void)
 {
@@ -57,7 +27,14 @@ pd_mj_opts pd_mj_default_opts(void)
                         .factor = PD_FACTOR_AUTO,
                         .lcp_solver = PD_LCP_AUTO,
                         .on_lcp = NULL,
-                        .on_lcp_ctx = NULL};
+                        .on_lcp_ctx = NULL,
+                        .rtol = 0.0,
+                        .atol = 1e-12,
+                        .atol_dof = NULL,
+                        .max_level = PD_MJ_MAX_LEVEL,
+                        .max_evals = 1e9,
+                        .sim_gap = 1e-10,
+                        .pieces = NULL};
 }
 
 /* Closed-form scalar LCP  w = D P + b >= 0, P >= 0, wP = 0  (D > 0). */
@@ -70,6 +47,7 @@ void pd_mj_free(pd_mj *mj)
 {
     if (!mj)
         return;
+    mj_adapt_free(mj);
     pd_factor_free(mj->factor);
     pd_lcp_solver_free(mj->lcp);
     free(mj->F0);
@@ -85,11 +63,11 @@ void pd_mj_free(pd_mj *mj)
     free(mj->w_active);
     free(mj->idx_active);
     free(mj->guess);
-    free(mj->st.q);
-    free(mj->st.v);
-    free(mj->st.P);
-    free(mj->st.g);
-    free(mj->st.active);
+    free(mj->st_own.q);
+    free(mj->st_own.v);
+    free(mj->st_own.P);
+    free(mj->st_own.g);
+    free(mj->st_own.active);
     free(mj);
 }
 
@@ -107,6 +85,22 @@ int pd_mj_check_opts(const pd_mj_opts *o, pd_err *err)
                           o->theta);
     if (!(o->gamma >= 0.0 && o->gamma <= 1.0))
         return pd_err_set(err, PD_EINVAL, "gamma must be in [0, 1] (got %g)", o->gamma);
+    if (!(o->rtol >= 0.0 && o->rtol < 1.0))
+        return pd_err_set(err, PD_EINVAL, "rtol must be in [0, 1) (0: fixed steps; got %g)",
+                          o->rtol);
+    if (o->rtol > 0.0) {
+        if (!(o->atol > 0.0) || !isfinite(o->atol))
+            return pd_err_set(err, PD_EINVAL, "atol must be a finite number > 0 (got %g)",
+                              o->atol);
+        if (o->max_level < 1 || o->max_level > PD_MJ_MAX_LEVEL)
+            return pd_err_set(err, PD_EINVAL, "max_level must be in [1, %d] (got %d)",
+                              PD_MJ_MAX_LEVEL, o->max_level);
+        if (!(o->max_evals >= 1.0))
+            return pd_err_set(err, PD_EINVAL, "max_evals must be >= 1 (got %g)", o->max_evals);
+        if (!(o->sim_gap >= 0.0) || !isfinite(o->sim_gap))
+            return pd_err_set(err, PD_EINVAL, "sim_gap must be a finite number >= 0 (got %g)",
+                              o->sim_gap);
+    }
     return PD_OK;
 }
 
@@ -128,6 +122,7 @@ static int alloc_arrays(pd_mj *mj, int n, int m)
     mj->st.P = calloc(mm, sizeof(double));
     mj->st.g = calloc(mm, sizeof(double));
     mj->st.active = calloc(mm, 1);
+    mj->st_own = mj->st;
     return mj->F0 && mj->F1 && mj->work_n && mj->qtheta && mj->U0 && mj->b_active && mj->P_active && mj->w_active && mj->idx_active && mj->st.q &&
                    mj->st.v && mj->st.P && mj->st.g && mj->st.active
                ? PD_OK
@@ -191,7 +186,10 @@ pd_mj *pd_mj_alloc(const pd_model *model, const pd_mj_opts *opts, pd_err *err)
         goto fail;
     if (mj->scalar)
         scalar_setup(mj);
-    else if (model->m > 0 && contact_workspace(mj, err))
+    /* the LCP's workspace: the general kernel's, and exact flights' */
+    if ((!mj->scalar || (o.rtol > 0.0 && o.pieces)) && model->m > 0 && contact_workspace(mj, err))
+        goto fail;
+    if (o.rtol > 0.0 && mj_adapt_alloc(mj, err))
         goto fail;
     if (pd_mj_reset(mj, 0.0, NULL, NULL, err))
         goto fail;
@@ -213,6 +211,8 @@ int pd_mj_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_err
 {
     if (!mj)
         return PD_NULL_ARG(err, "mj");
+    if (mj->ad)
+        return mj_adapt_reset(mj, t0, q0, v0, err);
     const pd_model *md = mj->model;
     int n = md->n;
     for (int i = 0; i < n; i++) {
@@ -227,6 +227,8 @@ int pd_mj_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_err
     mj->st.nactive = 0;
     mj->st.lcp_pivots = 0;
     mj->st.lcp_solver = NULL;
+    mj->st.h = mj->opts.h;
+    mj->st.err = NULL;
     for (int a = 0; a < md->m; a++) {
         mj->st.P[a] = 0.0;
         mj->st.active[a] = 0;
@@ -253,14 +255,15 @@ static void advance_force(pd_mj *mj, double t1)
         memcpy(mj->F0, mj->F1, (size_t)md->n * sizeof(double));
 }
 
+
 /* Non-finite state: fail naming time and degree of freedom. */
-static int check_finite(const pd_mj *mj, pd_err *err)
+static int check_state(const pd_model *md, const pd_state *st, pd_err *err)
 {
-    for (int i = 0; i < mj->model->n; i++)
-        if (!isfinite(mj->st.q[i]) || !isfinite(mj->st.v[i]))
+    for (int i = 0; i < md->n; i++)
+        if (!isfinite(st->q[i]) || !isfinite(st->v[i]))
             return pd_err_set(err, PD_ENONFINITE,
                               "Moreau-Jean: non-finite state at t = %.9g (step %ld, dof %d)",
-                              mj->st.t, mj->st.step, i);
+                              st->t, st->step, i);
     return PD_OK;
 }
 
@@ -291,7 +294,7 @@ static inline int step_scalar_f(pd_mj *mj, double F1, pd_err *err)
     st->t = t1;
     st->step++;
     if (!isfinite(st->q[0]) || !isfinite(st->v[0]))
-        return check_finite(mj, err);
+        return check_state(md, st, err);
     return PD_OK;
 }
 
@@ -334,19 +337,23 @@ static int run_scalar(pd_mj *mj, long nsteps, pd_observer observer, void *ctx, p
     return PD_OK;
 }
 
-/* Active set {a : g_a + h gamma U_a <= 0}; returns its size. */
-static int predict_active(pd_mj *mj)
+/* Active set {a : g_a + h gamma U_a <= 0} of the state in, into out's
+ * flags (out may be in); returns its size. */
+static int predict_active(pd_mj *mj, double h, const pd_state *in, pd_state *out)
 {
     const pd_model *md = mj->model;
-    double hg = mj->opts.h * mj->opts.gamma;
+    double hg = h * mj->opts.gamma;
     int nI = 0;
-    pd_matrix_gemv_t(&md->W, mj->st.v, mj->U0);
+    pd_matrix_gemv_t(&md->W, in->v, mj->U0);
     for (int a = 0; a < md->m; a++) {
-        unsigned char was = mj->st.active[a] ? mj->st.P[a] > 0.0 : 2;
-        mj->st.active[a] = 0;
-        mj->st.P[a] = 0.0;
-        if (mj->st.g[a] + hg * mj->U0[a] <= 0.0) {
-            mj->st.active[a] = 1;
+        unsigned char was = in->active[a] ? in->P[a] > 0.0 : 2;
+        double ga = in->g[a];
+        out->active[a] = 0;
+        out->P[a] = 0.0;
+        /* the adaptive driver's: an opening contact takes no impulse (an
+         * impulse that makes it close leaves the next step its impact) */
+        if (ga + hg * mj->U0[a] <= 0.0 && !(mj->u_rest && mj->U0[a] > mj->u_rest[a])) {
+            out->active[a] = 1;
             if (mj->guess)
                 mj->guess[nI] = was;
             mj->idx_active[nI++] = a;
@@ -355,10 +362,11 @@ static int predict_active(pd_mj *mj)
     return nI;
 }
 
-/* Impulses of the active contacts: the LCP (D_II, W_I^T vfree + e U). */
-static int solve_contacts(pd_mj *mj, int nI, const double *vfree, pd_err *err)
+/* The LCP of the active set, its Delassus block in mj->D_active (dense, or
+ * compressed columns when mj->sparse) and its vector in mj->b_active: the
+ * impulses into P_active and out->P.  t1 is the step's end (messages). */
+int mj_solve_active(pd_mj *mj, int nI, double t1, pd_state *out, pd_err *err)
 {
-    const pd_model *md = mj->model;
     pd_lcp_info info;
     pd_lcp_opts lo = pd_lcp_default_opts();
     pd_matrix D;
@@ -367,91 +375,116 @@ static int solve_contacts(pd_mj *mj, int nI, const double *vfree, pd_err *err)
         return pd_err_set(err, PD_EBUDGET,
                           "Moreau-Jean: %d active contacts at t = %.9g: the lemke LCP solver "
                           "takes at most %d (use the structured one)",
-                          nI, mj->st.t + mj->opts.h, PD_LCP_LEMKE_NMAX);
-    if (mj->sparse)
-        pd_factor_delassus_csc(mj->factor, mj->idx_active, nI, mj->D_colptr, mj->D_rowind,
-                               mj->D_active);
-    else
-        pd_factor_delassus_dense(mj->factor, mj->idx_active, nI, mj->D_active);
-    for (int r = 0; r < nI; r++) {
-        int a = mj->idx_active[r];
-        mj->b_active[r] = pd_matrix_col_dot(&md->W, a, vfree) + md->e[a] * mj->U0[a];
-    }
+                          nI, t1, PD_LCP_LEMKE_NMAX);
     /* one contact, the solver left to choose, nobody watching: the closed
      * form of the scalar kernel (D_11 > 0 as What is positive definite) */
     if (nI == 1 && mj->opts.lcp_solver == PD_LCP_AUTO && !mj->opts.on_lcp &&
         (!mj->sparse || mj->D_colptr[1] == 1) && mj->D_active[0] > 0.0) {
-        mj->st.P[mj->idx_active[0]] = mj->P_active[0] =
+        out->P[mj->idx_active[0]] = mj->P_active[0] =
             pd_contact_impulse_1(mj->D_active[0], mj->b_active[0]);
-        mj->st.lcp_solver = "closed-form";
+        out->lcp_solver = "closed-form";
         return PD_OK;
     }
     D = mj->sparse ? pd_matrix_csc(nI, nI, mj->D_colptr, mj->D_rowind, mj->D_active)
                    : pd_matrix_dense(nI, nI, mj->D_active);
     int st = pd_lcp_solve(mj->lcp, &D, mj->b_active, &lo, mj->P_active, mj->w_active, &info);
-    mj->st.lcp_pivots = info.pivots + info.iterations;
-    mj->st.lcp_solver = info.solver;
+    out->lcp_pivots = info.pivots + info.iterations;
+    out->lcp_solver = info.solver;
     if (mj->opts.on_lcp && mj->opts.on_lcp(&D, mj->b_active, mj->P_active, mj->w_active, &info,
-                                           mj->idx_active, mj->st.t + mj->opts.h,
-                                           mj->opts.on_lcp_ctx) > 0)
+                                           mj->idx_active, t1, mj->opts.on_lcp_ctx) > 0)
         mj->stop = 1;
     if (st)
         return pd_err_set(err, st,
                           "Moreau-Jean: LCP over %d active contact(s) (first: contact %d) not "
                           "solved at t = %.9g: %s",
-                          nI, mj->idx_active[0], mj->st.t + mj->opts.h,
-                          pd_lcp_outcome_name(info.outcome));
+                          nI, mj->idx_active[0], t1, pd_lcp_outcome_name(info.outcome));
     for (int r = 0; r < nI; r++)
-        mj->st.P[mj->idx_active[r]] = mj->P_active[r];
+        out->P[mj->idx_active[r]] = mj->P_active[r];
     return PD_OK;
 }
 
-/* One step of the general kernel. */
-static int step_general(pd_mj *mj, pd_err *err)
+/* b_I = W_I^T vfree + e U_k of the active contacts; with the adaptive
+ * driver's u_rest, e = 0 for a contact that was opening (U_k > 0: it may
+ * not close through the step) or closing slower than u_rest. */
+void mj_active_rhs(pd_mj *mj, int nI, const double *vfree)
 {
     const pd_model *md = mj->model;
-    pd_state *st = &mj->st;
+    for (int r = 0; r < nI; r++) {
+        int a = mj->idx_active[r];
+        double e = mj->u_rest && (mj->U0[a] > 0.0 || -mj->U0[a] <= mj->u_rest[a]) ? 0.0
+                                                                                  : md->e[a];
+        mj->b_active[r] = pd_matrix_col_dot(&md->W, a, vfree) + e * mj->U0[a];
+    }
+}
+
+/* Impulses of the active contacts into out->P: the LCP (D_II, W_I^T vfree
+ * + e U) with D_II from the factor f; t1 is the step's end (messages). */
+static int solve_contacts(pd_mj *mj, const pd_factor *f, int nI, const double *vfree, double t1,
+                          pd_state *out, pd_err *err)
+{
+    if (mj->sparse)
+        pd_factor_delassus_csc(f, mj->idx_active, nI, mj->D_colptr, mj->D_rowind, mj->D_active);
+    else
+        pd_factor_delassus_dense(f, mj->idx_active, nI, mj->D_active);
+    mj_active_rhs(mj, nI, vfree);
+    return mj_solve_active(mj, nI, t1, out, err);
+}
+
+int mj_general_step(pd_mj *mj, const pd_factor *f, double h, double t1, const double *F0,
+                    const double *F1, const pd_state *in, pd_state *out, pd_err *err)
+{
+    const pd_model *md = mj->model;
     int n = md->n, nI = 0, rc;
-    double h = mj->opts.h, th = mj->opts.theta;
-    double t1 = mj->t0 + (double)(st->step + 1) * h;
+    double th = mj->opts.theta;
     double *x = mj->work_n;
     /* right-hand side h [F_theta - C v - K (q + h theta v)] */
-    if (md->force)
-        md->force(t1, -1, mj->F1, md->force_ctx);
     for (int i = 0; i < n; i++) {
-        x[i] = th * mj->F1[i] + (1.0 - th) * mj->F0[i];
-        mj->qtheta[i] = st->q[i] + h * th * st->v[i];
+        x[i] = th * F1[i] + (1.0 - th) * F0[i];
+        mj->qtheta[i] = in->q[i] + h * th * in->v[i];
     }
-    pd_matrix_gemv(&md->C, -1.0, st->v, 1.0, x);
+    pd_matrix_gemv(&md->C, -1.0, in->v, 1.0, x);
     pd_matrix_gemv(&md->K, -1.0, mj->qtheta, 1.0, x);
     for (int i = 0; i < n; i++)
         x[i] *= h;
     /* vfree - v_k = What^-1 rhs */
-    pd_factor_solve(mj->factor, x);
+    pd_factor_solve(f, x);
     if (md->m)
-        nI = predict_active(mj);
-    st->lcp_pivots = 0;
-    st->lcp_solver = NULL;
+        nI = predict_active(mj, h, in, out);
+    out->lcp_pivots = 0;
+    out->lcp_solver = NULL;
     /* q gets the (1 - theta) v_k part before v is overwritten */
     for (int i = 0; i < n; i++) {
-        st->q[i] += h * (1.0 - th) * st->v[i];
-        st->v[i] += x[i];
+        out->q[i] = in->q[i] + h * (1.0 - th) * in->v[i];
+        out->v[i] = in->v[i] + x[i];
     }
+    out->t = t1;
+    out->step = in->step + 1;
     if (nI > 0) {
-        if ((rc = solve_contacts(mj, nI, st->v, err)))
+        if ((rc = solve_contacts(mj, f, nI, out->v, t1, out, err)))
             return rc;
-        pd_factor_add_impulse(mj->factor, mj->idx_active, nI, mj->P_active, st->v);
+        pd_factor_add_impulse(f, mj->idx_active, nI, mj->P_active, out->v);
     }
     for (int i = 0; i < n; i++)
-        st->q[i] += h * th * st->v[i];
+        out->q[i] += h * th * out->v[i];
+    out->nactive = nI;
+    if (md->m)
+        gaps(md, out->q, out->g);
+    return check_state(md, out, err);
+}
+
+/* One step of the general kernel: F1 = F(t_k+1 -), then the step in place,
+ * then F_k of the next step. */
+static int step_general(pd_mj *mj, pd_err *err)
+{
+    const pd_model *md = mj->model;
+    double t1 = mj->t0 + (double)(mj->st.step + 1) * mj->opts.h;
+    int rc;
+    if (md->force)
+        md->force(t1, -1, mj->F1, md->force_ctx);
+    rc = mj_general_step(mj, mj->factor, mj->opts.h, t1, mj->F0, mj->F1, &mj->st, &mj->st, err);
     if (md->force)
         advance_force(mj, t1);
-    st->nactive = nI;
-    st->t = t1;
-    st->step++;
-    if (md->m)
-        gaps(md, st->q, st->g);
-    return check_finite(mj, err);
+    return rc;
 }
 
 static int mj_step(pd_mj *mj, pd_err *err)
@@ -459,10 +492,22 @@ static int mj_step(pd_mj *mj, pd_err *err)
     return mj->scalar ? step_scalar(mj, err) : step_general(mj, err);
 }
 
+/* The adaptive driver chooses its own steps: the fixed-step calls refuse it. */
+static int refuse_adaptive(const pd_mj *mj, const char *call, pd_err *err)
+{
+    if (!mj->ad)
+        return PD_OK;
+    return pd_err_set(err, PD_EINVAL, "%s: this Moreau-Jean object chooses its steps (rtol = "
+                      "%g): run it with pd_mj_run_until", call, mj->opts.rtol);
+}
+
 int pd_mj_step(pd_mj *mj, pd_err *err)
 {
+    int rc;
     if (!mj)
         return PD_NULL_ARG(err, "mj");
+    if ((rc = refuse_adaptive(mj, "pd_mj_step", err)))
+        return rc;
     return mj_step(mj, err);
 }
 
@@ -471,6 +516,8 @@ int pd_mj_run(pd_mj *mj, long nsteps, pd_observer observer, void *ctx, pd_err *e
     int rc;
     if (!mj)
         return PD_NULL_ARG(err, "mj");
+    if ((rc = refuse_adaptive(mj, "pd_mj_run", err)))
+        return rc;
     if (observer && observer(&mj->st, ctx) > 0)
         return PD_OK;
     mj->stop = 0;
@@ -482,6 +529,38 @@ int pd_mj_run(pd_mj *mj, long nsteps, pd_observer observer, void *ctx, pd_err *e
         if (observer && observer(&mj->st, ctx) > 0)
             break;
     }
+    return PD_OK;
+}
+
+int pd_mj_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx, pd_err *err)
+{
+    if (!mj)
+        return PD_NULL_ARG(err, "mj");
+    if (!isfinite(t_end))
+        return pd_err_set(err, PD_EINVAL, "pd_mj_run_until: t_end must be finite (got %g)", t_end);
+    if (mj->ad)
+        return mj_adapt_run_until(mj, t_end, observer, ctx, err);
+    long nsteps = t_end > mj->st.t ? pd_steps_for(t_end - mj->st.t, mj->opts.h) : 0;
+    return pd_mj_run(mj, nsteps, observer, ctx, err);
+}
+
+int pd_mj_get_stats(const pd_mj *mj, pd_mj_stats *s)
+{
+    if (!mj || !s)
+        return PD_EINVAL;
+    if (mj->ad) {
+        mj_adapt_stats(mj, s);
+        return PD_OK;
+    }
+    *s = (pd_mj_stats){.steps = mj->st.step,
+                       .rejected = 0,
+                       .evals = mj->st.step,
+                       .h_min = mj->opts.h,
+                       .h_max = mj->opts.h,
+                       .floor_hit = 0,
+                       .budget_hit = 0,
+                       .err_max = NAN,
+                       .h0 = mj->opts.h};
     return PD_OK;
 }
 

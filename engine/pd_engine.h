@@ -87,6 +87,11 @@ typedef struct pd_state {
     double *acc;           /* n accelerations q'' at t, valid when has_acc (the
                               on_step reports of the event-driven and penalty methods) */
     int has_acc;
+    double h;              /* Moreau-Jean: the size of the last step */
+    const double *err;     /* Moreau-Jean to a tolerance: n, the error estimate of each
+                              dof accumulated over the steps so far, in units of q
+                              (velocity errors e_v counted as e_v / w_i, w_i^2 = K_ii /
+                              M_ii); NULL for fixed steps and the other methods */
 } pd_state;
 
 /* Called with the state after reset and after every step: return 0 to go
@@ -109,20 +114,42 @@ typedef int (*pd_lcp_observer)(const pd_matrix *D, const double *b, const double
                                const double *w, const pd_lcp_info *info, const int *idx,
                                double t, void *ctx);
 
+/* The finest level of the adaptive ladder h 2^-k (pd_mj_opts.max_level). */
+#define PD_MJ_MAX_LEVEL 48
+
 typedef struct pd_mj_opts {
-    double h;           /* step size > 0 */
+    double h;           /* step size > 0 (rtol > 0: the coarsest step, h0) */
     double theta;       /* in [1/2, 1] */
     double gamma;       /* active-set look-ahead in [0, 1] */
     int allow_unstable; /* accept theta in [0, 2] outside [1/2, 1] (stability studies) */
     pd_kernel kernel;
     pd_factor_kind factor;     /* storage of What */
     pd_lcp_method lcp_solver;  /* the contact LCP solver */
-    pd_lcp_observer on_lcp;    /* optional: every LCP solved (dumps, solver studies) */
+    pd_lcp_observer on_lcp;    /* optional: every LCP solved (dumps, solver studies; with
+                                  rtol > 0 also those of steps the controller rejects) */
     void *on_lcp_ctx;
+    /* ---- to a tolerance (docs/scheme.md, "Moreau–Jean to a tolerance") ---- */
+    double rtol;        /* > 0: steps h 2^-k chosen so that the state's error stays within
+                           rtol of each dof's running amplitude (pd_mj_run_until); 0: fixed
+                           steps h */
+    double atol;        /* > 0: the amplitude below which a dof's error is measured
+                           absolutely (units of q) */
+    const double *atol_dof; /* optional, n: atol per dof */
+    int max_level;      /* finest level k, in [1, PD_MJ_MAX_LEVEL] */
+    double max_evals;   /* steps computed (kept or not) before refinement stops, >= 1 */
+    double sim_gap;     /* coupled impacts closer than this (a step of h |U| <= sim_gap,
+                           units of q) are simultaneous: one LCP, as the exact reference's
+                           close_tol; >= 0 */
+    const struct pd_piecewise_force *pieces; /* with rtol > 0: the model's force as
+                           pieces (F = b f(t), pd_piecewise_force below; the model's force
+                           callback must agree): flights between the contacts' impulses
+                           exact for each block of dofs M, C, K couple, impulses at
+                           mid-step; NULL: theta flights */
 } pd_mj_opts;
 
 /* Defaults: h = 0 (must be set), theta = 1/2, gamma = 1/2, automatic kernel,
- * factor and LCP solver. */
+ * factor and LCP solver; fixed steps (rtol 0; atol 1e-12, max_level 48, max_evals
+ * 1e9, sim_gap 1e-10, theta flights for rtol > 0). */
 PD_API pd_mj_opts pd_mj_default_opts(void);
 
 typedef struct pd_mj pd_mj;
@@ -137,12 +164,45 @@ PD_API void pd_mj_free(pd_mj *mj);
 PD_API int pd_mj_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_err *err);
 
 /* Advance one step of size h.  Fails, naming the time and the contact, when
- * the LCP is not solved or the state is not finite. */
+ * the LCP is not solved or the state is not finite.  Fixed steps only
+ * (PD_EINVAL for rtol > 0). */
 PD_API int pd_mj_step(pd_mj *mj, pd_err *err);
 
 /* Take nsteps steps, calling observer (may be NULL) after reset state and
- * after each step; stops early when the observer asks. */
+ * after each step; stops early when the observer asks.  Fixed steps only. */
 PD_API int pd_mj_run(pd_mj *mj, long nsteps, pd_observer observer, void *ctx, pd_err *err);
+
+/* Advance to t_end, calling observer after the reset state (the first call
+ * after a reset) and after every step kept: fixed steps of h (as pd_mj_run
+ * with pd_steps_for's count), or with rtol > 0 the adaptive steps: each
+ * step h_k = h 2^-k (k <= max_level) is taken once whole and once as two
+ * halves; the halves are kept when they agree with the whole step within
+ * the tolerance (rtol times each dof's running amplitude, spread over the
+ * run in proportion to the step), else the step is halved.  A step in which
+ * a contact starts or stops pushing is halved until the instant is known
+ * as well as rtol needs, and coupled impacts closer than a step are taken
+ * one at a time (down to sim_gap).  The state's err holds the estimate so
+ * far.  The breakpoint model->breaks[0] (when > 0) is a whole number of
+ * steps h from t = 0 (h is lowered to make it so), so that the force's jump
+ * falls between steps.  t_end is reached to within h 2^-max_level. */
+PD_API int pd_mj_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx,
+                           pd_err *err);
+
+/* What a run to a tolerance did (fixed steps: steps taken, no rejections,
+ * h_min = h_max = h, err_max NAN). */
+typedef struct pd_mj_stats {
+    long steps;          /* steps kept */
+    long rejected;       /* steps computed and thrown away (the whole steps of kept pairs
+                            not counted) */
+    long evals;          /* steps computed in all */
+    double h_min, h_max; /* the smallest and largest step kept */
+    int floor_hit;       /* a step at the finest level failed its test: rtol not met */
+    int budget_hit;      /* max_evals stopped the refinement: rtol not met */
+    double err_max;      /* the largest estimate over the dofs, relative to their
+                            amplitude, at the end */
+    double h0;           /* the coarsest step (h, lowered to the breakpoint) */
+} pd_mj_stats;
+PD_API int pd_mj_get_stats(const pd_mj *mj, pd_mj_stats *s);
 
 PD_API const pd_state *pd_mj_state(const pd_mj *mj);
 

@@ -117,3 +117,20 @@ void pd_demand_osc_note(pd_demand_osc *d, double tau, double x, double v, const 
     d->t = tau;
     d->prev = 1;
 }
+
+int pd_demand_quintic_turn(const double p0[3], const double p1[3], double h, double *f)
+{
+    double lo = 0.0, hi = 1.0, fd, s;
+    if (!(p0[1] * p1[1] < 0.0))
+        return 0;
+    for (int it = 0; it < 50; it++) {
+        s = 0.5 * (lo + hi);
+        pd_hermite5(p0, p1, h, s, f, &fd);
+        if ((fd < 0.0) == (p0[1] < 0.0))
+            lo = s;
+        else
+            hi = s;
+    }
+    pd_hermite5(p0, p1, h, 0.5 * (lo + hi), f, &fd);
+    return 1;
+}

@@ -31,6 +31,12 @@ void pd_demand_note(const pd_scene *sc, const double *x, const double *v, double
  * has none there): a peak of a demand between two states. */
 double pd_demand_cubic_peak(double f0, double d0, double f1, double d1, double h);
 
+/* A turning point of f inside a step of length h: when f' changes sign
+ * between its ends, the root of f' on the quintic Hermite of (f, f', f'')
+ * = p0 at the start and p1 at the end (bisection to rounding); *f gets the
+ * value there and the return is 1; 0 when f' keeps its sign. */
+int pd_demand_quintic_turn(const double p0[3], const double p1[3], double h, double *f);
+
 /* The oscillator's absolute acceleration in Pi units, |C x' + K x| (C = 2 xi
  * Pi2, K = Pi2^2), its peak from tau_measure on: at each state, and between
  * two states with accelerations a (NULL: none) on the cubic Hermite when

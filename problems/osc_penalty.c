@@ -284,6 +284,7 @@ static void fill_result(const pen_track *tr, const pd_run_opts *o,
     res->theta = NAN;
     res->gamma = NAN;
     res->kernel = pr->stepper ? pr->stepper : "penalty";
+    pd_osc_result_no_rtol(res, NAN);
     pd_demand_osc_finish(res, o, tr->no_demands ? NAN : tr->dem.peak * tr->c->ap,
                          tr->m ? tr->fpeak * tr->c->ap : NAN);
 }

@@ -24,6 +24,22 @@ static inline double pd_pulse_shape_inline(pd_pulse pulse, int dir, double tau, 
     return dir * (pulse == PD_PULSE_COSINE ? cos(tau) : sin(tau));
 }
 
+/* The fields of a run to a tolerance, for a run without one: rtol 0,
+ * err_est NAN, rtol_met 1, no rejections, dt_min = dt_max = step (NAN
+ * for the methods without steps of their own to report). */
+static inline void pd_osc_result_no_rtol(pd_osc_result *res, double step)
+{
+    res->rtol = 0.0;
+    res->err_est = NAN;
+    res->rtol_met = 1;
+    res->steps_rejected = 0;
+    res->dt_min = res->dt_max = step;
+}
+
+/* Moreau-Jean to a tolerance (osc_adapt.c): o resolved, rtol > 0. */
+int pd_osc_adapt(const pd_osc *c, const pd_run_opts *o, pd_osc_sampler sampler, void *ctx,
+                 pd_osc_result *res, pd_err *err);
+
 /* Steps of the Newmark penalty method per period of its stiffest contact
  * element, at least: its step is the output step dt, or dt / k for the
  * smallest whole k that gives this many (coarser steps pump energy into the

@@ -163,10 +163,17 @@ int pd_osc_resolve_opts(const pd_osc *c, const pd_run_opts *in, pd_run_opts *out
     if (out->method == PD_METHOD_EVENT_GENERAL)
         return pd_err_set(err, PD_EINVAL, "method: event-general is the general reference for "
                           "scenes; the oscillator's exact reference is event");
-    if (out->dt == 0.0)
+    if (out->dt == 0.0 && out->rtol == 0.0)
         out->dt = pd_osc_default_dt(c);
     if (out->tend == 0.0)
         out->tend = pd_osc_default_tend(c);
+    if (out->rtol > 0.0) { /* Moreau-Jean to a tolerance: no step of its own */
+        out->method = PD_METHOD_MOREAU;
+        if (!(out->tend > 0.0) || !isfinite(out->tend))
+            return pd_err_set(err, PD_EINVAL, "tend must be a finite number > 0 (got %g)",
+                              out->tend);
+        return PD_OK;
+    }
     if (!(out->dt > 0.0) || !isfinite(out->dt))
         return pd_err_set(err, PD_EINVAL, "dt must be a finite number > 0 (got %g)", out->dt);
     if (!(out->tend > 0.0) || !isfinite(out->tend))
@@ -184,6 +191,8 @@ pd_method pd_osc_method(const pd_osc *c, const pd_run_opts *o)
         return PD_METHOD_AUTO; /* nothing to resolve */
     if (o->method != PD_METHOD_AUTO)
         return o->method;
+    if (o->rtol > 0.0) /* a tolerance is Moreau-Jean's */
+        return PD_METHOD_MOREAU;
     double tend = o->tend > 0.0 ? o->tend : pd_osc_default_tend(c);
     return pd_osc_scan_points(c, tend) <= PD_OSC_MAX_SCAN ? PD_METHOD_EVENT : PD_METHOD_MOREAU;
 }
@@ -312,6 +321,7 @@ void pd_osc_track_result(const pd_osc_track *tr, const pd_osc *c, double dt, lon
     res->min_gap = tr->min_gap * Le;
     res->steps = steps;
     res->dt = dt;
+    pd_osc_result_no_rtol(res, dt);
     /* demands: not measured here (the single runs measure and set them) */
     res->acc_max = res->force_max = res->force_equiv = res->contact_duration = NAN;
 }
@@ -407,6 +417,8 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
     pd_err_clear(err);
     if ((rc = pd_osc_resolve_opts(c, opts, &o, err)))
         return rc;
+    if (o.rtol > 0.0)
+        return pd_osc_adapt(c, &o, sampler, ctx, res, err);
 
     /* model in Pi units; the step is 2 pi (dt / Tp) so equal dt/Tp gives equal h */
     double pulse_end = pd_osc_shape_end(c); /* the only breakpoint: the pulse's or record's end */
@@ -638,6 +650,7 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     res->theta = NAN;
     res->gamma = NAN;
     res->kernel = "event";
+    pd_osc_result_no_rtol(res, NAN);
     pd_demand_osc_finish(res, &o, o.no_demands ? NAN : bridge.dem.peak * c->ap, NAN);
     res->cpu_s = pd_cpu_seconds() - cpu0;
     return rc;
@@ -716,6 +729,8 @@ int pd_osc_summarize(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
         (rc = pd_osc_run(c, &twin, NULL, NULL, &s->free, err)))
         return rc;
     s->cpu_s = pd_cpu_seconds() - cpu0;
+    s->err_est = s->r.rtol > 0.0 ? fmax(s->r.err_est, s->free.err_est) : NAN;
+    s->rtol_met = s->r.rtol_met && s->free.rtol_met;
     s->Pi1 = s->r.umax / pd_osc_Le(c);
     s->gamma = s->free.umax > 0.0 ? s->r.umax / s->free.umax : NAN;
     s->chi = s->free.umax > 0.0 ? pd_osc_gap(c) / s->free.umax : NAN;

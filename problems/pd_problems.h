@@ -227,7 +227,14 @@ typedef struct pd_run_opts {
                            sweeps, the contact-free twins and the timed re-runs, whose
                            figures do not use them (the exact references sample a grid
                            for them) */
+    double rtol;        /* > 0: Moreau-Jean to this relative tolerance of every reported
+                           peak (docs/scheme.md, "Moreau–Jean to a tolerance"; then dt must
+                           be 0, the method moreau or auto, which it makes moreau); 0:
+                           fixed steps dt */
 } pd_run_opts;
+
+/* The tightest tolerance a run to a tolerance takes (below, rounding rules). */
+#define PD_RTOL_MIN 1e-12
 
 /* ---- demand parameters (docs/scenes.md, "Demands") ------------------------ *
  * What earthquake engineers read off a run, per storey and per contact:
@@ -377,6 +384,15 @@ typedef struct pd_osc_result {
                              NAN for the impulsive methods) */
     double force_equiv;   /* pd_equivalent_force(max_impulse, td) [N/kg] */
     double contact_duration; /* the td used [s] */
+    /* Moreau-Jean to a tolerance (rtol > 0; else rtol 0, err_est NAN, rtol_met 1,
+     * steps_rejected 0, dt_min = dt_max = dt): */
+    double rtol;          /* the tolerance asked */
+    double err_est;       /* the estimated relative error of the peaks (umax, u_toward,
+                             u_away, drift, acc_max): the largest */
+    int rtol_met;         /* 1: err_est <= rtol and no step floor or budget stopped the
+                             refinement */
+    long steps_rejected;  /* tries thrown away (a step halved) */
+    double dt_min, dt_max; /* the smallest and largest step kept [s] */
 } pd_osc_result;
 
 /* The method a run of (c, o) takes: o's, or for PD_METHOD_AUTO the exact
@@ -445,6 +461,8 @@ typedef struct pd_osc_summary {
     double gamma; /* umax / umax_free (NAN when umax_free = 0) */
     double chi;   /* gap / umax_free (NAN when umax_free = 0) */
     double cpu_s; /* both runs */
+    double err_est; /* to a tolerance: the larger of the two runs' (NAN: fixed steps) */
+    int rtol_met;   /* both runs met their tolerance (1 without one) */
 } pd_osc_summary;
 
 /* opts NULL: the defaults. */
@@ -676,6 +694,17 @@ typedef struct pd_scene_result {
     double *force_max;     /* m: peak contact force [N] (penalty, newmark; NAN otherwise) */
     double *force_equiv;   /* m: pd_equivalent_force(max_impulse, td) [N] */
     double contact_duration; /* the td used [s] */
+    /* Moreau-Jean to a tolerance (rtol > 0; else rtol 0, err_est NAN, rtol_met 1,
+     * steps_rejected 0, dt_min = dt_max = dt): */
+    double rtol;           /* the tolerance asked */
+    double *err_est;       /* nstruct: the estimated relative error of each structure's
+                              peaks (umax, drift and demands per storey): the largest */
+    double err_est_max;    /* the largest over the structures */
+    int rtol_met;          /* 1: err_est_max <= rtol and no step floor or budget stopped
+                              the refinement */
+    long steps_rejected;   /* tries thrown away (a step halved) */
+    double dt_min, dt_max; /* the smallest and largest step kept [s] */
+    int nstruct;           /* err_est's entries */
 } pd_scene_result;
 
 /* Arrays for the finished scene sc (PD_EINVAL before pd_scene_finish). */
@@ -703,6 +732,8 @@ typedef struct pd_scene_summary {
     double *Pi2;           /* nstruct */
     double *Pi3, *chi;     /* m */
     double cpu_s;
+    double err_est;        /* to a tolerance: the largest of both runs' (NAN: fixed steps) */
+    int rtol_met;          /* both runs met their tolerance (1 without one) */
 } pd_scene_summary;
 
 /* opts NULL: pd_run_default_opts(). */

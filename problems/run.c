@@ -59,7 +59,8 @@ pd_run_opts pd_run_default_opts(void)
                          .on_lcp_ctx = NULL,
                          .close_tol = PD_CLOSE_TOL,
                          .contact_duration = 0.0,
-                         .no_demands = 0};
+                         .no_demands = 0,
+                         .rtol = 0.0};
 }
 
 int pd_run_opts_check(const pd_run_opts *o, pd_err *err)
@@ -83,6 +84,15 @@ int pd_run_opts_check(const pd_run_opts *o, pd_err *err)
                           o->theta);
     if (!(o->gamma >= 0.0 && o->gamma <= 1.0))
         return pd_err_set(err, PD_EINVAL, "gamma: must be in [0, 1] (got %g)", o->gamma);
+    if (!(o->rtol >= PD_RTOL_MIN && o->rtol < 1.0) && o->rtol != 0.0)
+        return pd_err_set(err, PD_EINVAL, "rtol: Moreau-Jean's relative tolerance must be in "
+                          "[%g, 1), or 0 for fixed steps (got %g)", PD_RTOL_MIN, o->rtol);
+    if (o->rtol > 0.0 && o->method != PD_METHOD_MOREAU && o->method != PD_METHOD_AUTO)
+        return pd_err_set(err, PD_EINVAL, "rtol: the tolerance of Moreau-Jean's steps; method %s "
+                          "has none (penalty: pen.rtol)", pd_method_name(o->method));
+    if (o->rtol > 0.0 && o->dt > 0.0)
+        return pd_err_set(err, PD_EINVAL, "rtol with dt: Moreau-Jean takes fixed steps (dt) or "
+                          "steps to a tolerance (rtol), not both");
     if (!(o->close_tol >= 0.0 && o->close_tol <= 1.0))
         return pd_err_set(err, PD_EINVAL, "close-tol: the closing tolerance must be in [0, 1] "
                           "(in units of Le; got %g)", o->close_tol);

@@ -760,10 +760,12 @@ int pd_scene_resolve_opts(const pd_scene *sc, const pd_run_opts *in, pd_run_opts
         return rc;
     if (out->method == PD_METHOD_AUTO) /* a scene's default: Moreau-Jean */
         out->method = PD_METHOD_MOREAU;
-    if (out->dt == 0.0)
-        out->dt = pd_scene_default_dt(sc);
     if (out->tend == 0.0)
         out->tend = sc->tend > 0.0 ? sc->tend : pd_scene_default_tend(sc);
+    if (out->rtol > 0.0) /* to a tolerance: no step of its own */
+        return PD_OK;
+    if (out->dt == 0.0)
+        out->dt = pd_scene_default_dt(sc);
     if (!(out->tend / out->dt <= PD_MAX_STEPS))
         return pd_err_set(err, PD_EINVAL, "dt: tend / dt = %g steps is too many (at most %.0e)",
                           out->tend / out->dt, PD_MAX_STEPS);

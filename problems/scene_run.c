@@ -81,6 +81,13 @@ typedef struct track {
     int edr_hit;                      /* row reference: an impulsive impact since the
                                          last sample (its samples' P also hold the
                                          held contacts' force integrals) */
+    /* Moreau-Jean to a tolerance: the engine's estimate at each peak's instant */
+    const double *err;                /* the state's estimate (NULL: none) */
+    double *errx, *errd;              /* n: at the umax, drift peaks */
+    double *erra, *errv;              /* n: the structure's largest at the a_abs, V peaks */
+    double *acc0, *shear0;            /* n: the demand peaks before the state */
+    double *serr;                     /* nstruct: the structure's largest estimate now */
+    double *wdof;                     /* n: each dof's sqrt(K_ii / M_ii) (Pi units) */
 } track;
 
 /* ---- results ---------------------------------------------------------------- */
@@ -110,9 +117,11 @@ int pd_scene_result_alloc(const pd_scene *sc, pd_scene_result *r, pd_err *err)
     r->drift_ratio = calloc(n, sizeof(double));
     r->force_max = calloc(m, sizeof(double));
     r->force_equiv = calloc(m, sizeof(double));
+    r->nstruct = sc->nstruct;
+    r->err_est = calloc((size_t)sc->nstruct, sizeof(double));
     if (!r->umax || !r->u_pos || !r->u_neg || !r->drift || !r->impacts || !r->first_impact ||
         !r->max_impulse || !r->contact_time || !r->approach || !r->acc_max || !r->shear_max ||
-        !r->drift_ratio || !r->force_max || !r->force_equiv) {
+        !r->drift_ratio || !r->force_max || !r->force_equiv || !r->err_est) {
         pd_scene_result_free(r);
         return pd_err_set(err, PD_ENOMEM, "out of memory for the results of %d dofs", sc->n);
     }
@@ -124,7 +133,7 @@ int pd_scene_result_fits(const pd_scene *sc, const pd_scene_result *r)
     return sc && r && r->n == sc->n && r->m == sc->ncontact && r->umax && r->u_pos && r->u_neg &&
            r->drift && r->impacts && r->first_impact && r->max_impulse && r->contact_time &&
            r->approach && r->acc_max && r->shear_max && r->drift_ratio && r->force_max &&
-           r->force_equiv;
+           r->force_equiv && r->err_est && r->nstruct == sc->nstruct;
 }
 
 void pd_scene_result_free(pd_scene_result *r)
@@ -145,6 +154,7 @@ void pd_scene_result_free(pd_scene_result *r)
     free(r->drift_ratio);
     free(r->force_max);
     free(r->force_equiv);
+    free(r->err_est);
     memset(r, 0, sizeof *r);
 }
 
@@ -158,7 +168,8 @@ static void track_free(track *tr)
                       tr->pv, tr->pa, tr->plam, tr->pactive, tr->sx, tr->sv, tr->sg, tr->sP,
                       tr->imp, tr->imp_lam, tr->acc, tr->shear, tr->da, tr->dV, tr->fpeak,
                       tr->dad, tr->dVd, tr->qa, tr->qV, tr->qad, tr->qVd,
-                      tr->st_of, tr->ex, tr->ev, tr->sI, tr->sampled};
+                      tr->st_of, tr->ex, tr->ev, tr->sI, tr->sampled, tr->errx, tr->errd,
+                      tr->erra, tr->errv, tr->acc0, tr->shear0, tr->serr, tr->wdof};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(arrays[k]);
 }
@@ -182,7 +193,9 @@ static int track_alloc(track *tr, const pd_scene *sc, pd_err *err)
         !TA(tr->dV, n) || !TA(tr->fpeak, m) || !TA(tr->dad, n) || !TA(tr->dVd, n) ||
         !TA(tr->qa, n) || !TA(tr->qV, n) || !TA(tr->qad, n) || !TA(tr->qVd, n) ||
         !TA(tr->st_of, n) || !TA(tr->ex, n) || !TA(tr->ev, n) || !TA(tr->sI, m) ||
-        !TA(tr->sampled, m)) {
+        !TA(tr->sampled, m) || !TA(tr->errx, n) || !TA(tr->errd, n) || !TA(tr->erra, n) ||
+        !TA(tr->errv, n) || !TA(tr->acc0, n) || !TA(tr->shear0, n) ||
+        !TA(tr->serr, (size_t)sc->nstruct) || !TA(tr->wdof, n)) {
 #undef TA
         track_free(tr);
         return pd_err_set(err, PD_ENOMEM, "out of memory for tracking %d dofs", sc->n);
@@ -202,6 +215,42 @@ static int track_alloc(track *tr, const pd_scene *sc, pd_err *err)
     return PD_OK;
 }
 
+/* Nothing measured yet (a run to a tolerance repeated): the run's arrays
+ * as track_alloc left them. */
+static void track_clear(track *tr)
+{
+    size_t n = (size_t)tr->n * sizeof(double), m = (size_t)(tr->m > 0 ? tr->m : 1);
+    double *dn[] = {tr->xmax, tr->xpos, tr->xneg, tr->drift, tr->acc, tr->shear, tr->errx,
+                    tr->errd, tr->erra, tr->errv};
+    for (size_t k = 0; k < sizeof dn / sizeof dn[0]; k++)
+        memset(dn[k], 0, n);
+    double *dm[] = {tr->maxP, tr->ctime, tr->episode, tr->imp, tr->fpeak};
+    for (size_t k = 0; k < sizeof dm / sizeof dm[0]; k++)
+        memset(dm[k], 0, m * sizeof(double));
+    memset(tr->impacts, 0, m * sizeof(long));
+    memset(tr->sampled, 0, m * sizeof(long));
+    memset(tr->touching, 0, m);
+    for (int a = 0; a < tr->m; a++) {
+        tr->first[a] = NAN;
+        tr->approach[a] = -HUGE_VAL;
+    }
+    tr->have_prev = tr->dem_prev = 0;
+    tr->lcp_solves = 0;
+}
+
+/* The estimate at the instant a displacement (drift: 1) peak of dof i is
+ * raised to value p (the engine's, to a tolerance; the drift's adds the
+ * storey below). */
+static void note_err(track *tr, int i, int drift, double p, double old)
+{
+    if (!tr->err || !(p > old))
+        return;
+    if (drift)
+        tr->errd[i] = tr->err[i] + (tr->below[i] >= 0 ? tr->err[tr->below[i]] : 0.0);
+    else
+        tr->errx[i] = tr->err[i];
+}
+
 /* Extremes of the displacement and of the storey drift at one point in time. */
 static void note_point(track *tr, double t, const double *x)
 {
@@ -209,6 +258,8 @@ static void note_point(track *tr, double t, const double *x)
         return;
     for (int i = 0; i < tr->n; i++) {
         double d = x[i] - (tr->below[i] >= 0 ? x[tr->below[i]] : 0.0);
+        note_err(tr, i, 0, fabs(x[i]), tr->xmax[i]);
+        note_err(tr, i, 1, fabs(d), tr->drift[i]);
         tr->xmax[i] = pd_max(tr->xmax[i], fabs(x[i]));
         tr->xpos[i] = pd_max(tr->xpos[i], x[i]);
         tr->xneg[i] = pd_max(tr->xneg[i], -x[i]);
@@ -314,25 +365,6 @@ static void note_approach(track *tr, const double *x)
     }
 }
 
-/* A turning point of f inside a step: the root of f' on the quintic Hermite
- * of (f, f', f'') at both ends when f' changes sign; *f gets the value. */
-static int interior_turn(const double p0[3], const double p1[3], double h, double *f)
-{
-    double lo = 0.0, hi = 1.0, fd, s;
-    if (!(p0[1] * p1[1] < 0.0))
-        return 0;
-    for (int it = 0; it < 50; it++) {
-        s = 0.5 * (lo + hi);
-        pd_hermite5(p0, p1, h, s, f, &fd);
-        if ((fd < 0.0) == (p0[1] < 0.0))
-            lo = s;
-        else
-            hi = s;
-    }
-    pd_hermite5(p0, p1, h, 0.5 * (lo + hi), f, &fd);
-    return 1;
-}
-
 /* Extremes between the previous report and (t, x, v, a): turning points of
  * every dof and every storey drift. */
 static void note_between(track *tr, double t, const double *x, const double *v,
@@ -344,19 +376,24 @@ static void note_between(track *tr, double t, const double *x, const double *v,
     for (int i = 0; i < tr->n; i++) {
         double p0[3] = {tr->px[i], tr->pv[i], tr->pa[i]}, p1[3] = {x[i], v[i], acc[i]};
         int b = tr->below[i];
-        if (interior_turn(p0, p1, h, &f)) {
+        if (pd_demand_quintic_turn(p0, p1, h, &f)) {
+            note_err(tr, i, 0, fabs(f), tr->xmax[i]);
             tr->xmax[i] = pd_max(tr->xmax[i], fabs(f));
             tr->xpos[i] = pd_max(tr->xpos[i], f);
             tr->xneg[i] = pd_max(tr->xneg[i], -f);
-            if (b < 0) /* storey 1: the drift is the displacement */
+            if (b < 0) { /* storey 1: the drift is the displacement */
+                note_err(tr, i, 1, fabs(f), tr->drift[i]);
                 tr->drift[i] = pd_max(tr->drift[i], fabs(f));
+            }
         }
         if (b < 0)
             continue;
         double d0[3] = {tr->px[i] - tr->px[b], tr->pv[i] - tr->pv[b], tr->pa[i] - tr->pa[b]};
         double d1[3] = {x[i] - x[b], v[i] - v[b], acc[i] - acc[b]};
-        if (interior_turn(d0, d1, h, &f))
+        if (pd_demand_quintic_turn(d0, d1, h, &f)) {
+            note_err(tr, i, 1, fabs(f), tr->drift[i]);
             tr->drift[i] = pd_max(tr->drift[i], fabs(f));
+        }
     }
 }
 
@@ -453,6 +490,55 @@ static int observe_moreau(const pd_state *st, void *ctx)
         tr->U_prev[a] = U;
         tr->g_prev[a] = st->g[a];
     }
+    return tr->fn ? sample(tr, st) : 0;
+}
+
+/* Moreau-Jean to a tolerance, every kept step (its size st->h): extremes at
+ * the step and inside it (smooth steps: no impulse, on the quintic Hermite
+ * of the exact flights' accelerations), each raised peak with the engine's
+ * estimate at its instant (demands: the structure's largest), impacts (an
+ * impulse after a step without; the first at the middle of its step, a
+ * step the controller made short), contact time, the sample. */
+static int observe_adapt(const pd_state *st, void *ctx)
+{
+    track *tr = ctx;
+    int smooth = no_impulse(tr, st) && st->step > 0;
+    tr->err = st->err;
+    for (int s = 0; s < tr->sc->nstruct; s++) {
+        const pd_structure *ps = &tr->sc->st[s];
+        tr->serr[s] = 0.0;
+        for (int k = 0; k < ps->storeys; k++)
+            tr->serr[s] = pd_max(tr->serr[s], st->err[ps->dof + k]);
+    }
+    if (tr->have_prev && st->has_acc && smooth)
+        note_between(tr, st->t, st->q, st->v, st->acc);
+    note_point(tr, st->t, st->q);
+    note_approach(tr, st->q);
+    if (tr->demands) {
+        memcpy(tr->acc0, tr->acc, (size_t)tr->n * sizeof(double));
+        memcpy(tr->shear0, tr->shear, (size_t)tr->n * sizeof(double));
+        note_demand(tr, st->t, st->q, st->v, st->has_acc ? st->acc : NULL, smooth);
+        for (int i = 0; i < tr->n; i++) {
+            if (tr->acc[i] > tr->acc0[i])
+                tr->erra[i] = tr->serr[tr->st_of[i]];
+            if (tr->shear[i] > tr->shear0[i])
+                tr->errv[i] = tr->serr[tr->st_of[i]];
+        }
+    }
+    tr->lcp_solves += st->nactive > 0;
+    for (int a = 0; a < tr->model_m; a++) {
+        double P = st->P[a];
+        if (P > 0.0) {
+            if (!tr->touching[a] && isnan(tr->first[a]))
+                tr->first[a] = st->t - 0.5 * st->h;
+            tr->impacts[a] += !tr->touching[a];
+            tr->ctime[a] += st->h;
+            tr->maxP[a] = pd_max(tr->maxP[a], P);
+        }
+        tr->touching[a] = P > 0.0;
+        tr->imp[a] += P;
+    }
+    keep_report(tr, st);
     return tr->fn ? sample(tr, st) : 0;
 }
 
@@ -624,6 +710,15 @@ static int run_oscillator(const pd_scene *sc, const pd_osc *c, int mirrored,
     res->kernel = r.kernel;
     res->factor = o->method == PD_METHOD_MOREAU ? "scalar" : "none";
     res->lcp_solver = o->method == PD_METHOD_MOREAU && has_wall ? "closed-form" : "none";
+    if (o->rtol > 0.0) { /* to a tolerance: the oscillator's figures */
+        res->err_est[0] = res->err_est_max = r.err_est;
+        res->rtol_met = r.rtol_met;
+        res->steps_rejected = r.steps_rejected;
+        res->dt = r.dt;
+        res->dt_min = r.dt_min;
+        res->dt_max = r.dt_max;
+        res->factor = "exact-flight";
+    }
     return PD_OK;
 }
 
@@ -652,6 +747,163 @@ static int run_moreau(const pd_model *md, const pd_run_opts *o, long nsteps, tra
     res->factor = pd_mj_factor_name(mj);
     res->lcp_solver = pd_lcp_method_name(o->lcp_solver);
     pd_mj_free(mj);
+    return rc;
+}
+
+/* The largest change of a_abs (shear: 0) or V (shear: 1) of floor k of
+ * structure st [SI] for state errors |dx| <= E, |dv| <= w E on its floors
+ * (Pi units; us, vs their SI scales): the storey forces S = k (d + beta d')
+ * and the mass-proportional damping (demand.c's formulas, in bounds). */
+static double demand_bound(const pd_structure *st, int k, double E, double w, double us,
+                           double vs, int shear)
+{
+    double dd = 2.0 * E * us, ddv = 2.0 * w * E * vs, mv = st->alpha * w * E * vs;
+    double Sk = st->stiffness[k] * (dd + st->beta * ddv);
+    if (shear) {
+        double damp = 0.0;
+        for (int i = k; i < st->storeys; i++)
+            damp += st->mass[i] * mv;
+        return Sk + damp;
+    }
+    double Sup = k + 1 < st->storeys ? st->stiffness[k + 1] * (dd + st->beta * ddv) : 0.0;
+    return (Sk + Sup + st->mass[k] * mv) / st->mass[k];
+}
+
+/* Each structure's estimate: its peaks' (umax, drift, a_abs and V per
+ * storey) largest relative error; the largest over the structures. */
+static void structure_errors(const track *tr, pd_scene_result *res)
+{
+    const pd_scene *sc = tr->sc;
+    double us = tr->Le, vs = tr->Le * tr->wp;
+    res->err_est_max = 0.0;
+    for (int s = 0; s < sc->nstruct; s++) {
+        const pd_structure *st = &sc->st[s];
+        double e = 0.0, w = 0.0;
+        for (int k = 0; k < st->storeys; k++)
+            w = pd_max(w, tr->wdof[st->dof + k]);
+        for (int k = 0; k < st->storeys; k++) {
+            int i = st->dof + k;
+            if (tr->xmax[i] > 0.0)
+                e = pd_max(e, tr->errx[i] / tr->xmax[i]);
+            if (tr->drift[i] > 0.0)
+                e = pd_max(e, tr->errd[i] / tr->drift[i]);
+            if (tr->demands && tr->acc[i] > 0.0)
+                e = pd_max(e, demand_bound(st, k, tr->erra[i], w, us, vs, 0) / tr->acc[i]);
+            if (tr->demands && tr->shear[i] > 0.0)
+                e = pd_max(e, demand_bound(st, k, tr->errv[i], w, us, vs, 1) / tr->shear[i]);
+        }
+        res->err_est[s] = e;
+        res->err_est_max = pd_max(res->err_est_max, e);
+    }
+}
+
+/* The coarsest step of a run to a tolerance [tau]: the shortest of the
+ * pulse's and the structures' fundamental periods over 16. */
+#define SCENE_ADAPT_H0 16.0
+#define SCENE_ADAPT_TRIES 3
+#define SCENE_ADAPT_FLOOR 1e-3 /* errors below this share of a dof's static scale count as none */
+
+/* One run to the tolerance rtol, measured into tr; stats of the engine. */
+static int adapt_once(const pd_scene_model *sm, const pd_run_opts *o, double rtol,
+                      const pd_piecewise_force *F, const double *atol, double tau_end,
+                      track *tr, pd_scene_result *res, pd_mj_stats *stats, pd_err *err)
+{
+    const pd_scene *sc = tr->sc;
+    double T = sc->exc.Tp;
+    for (int k = 0; k < sc->nstruct; k++)
+        T = fmin(T, sc->st[k].T0);
+    pd_mj_opts mo = pd_mj_default_opts();
+    mo.h = tr->wp * T / SCENE_ADAPT_H0;
+    mo.theta = o->theta;
+    mo.gamma = o->gamma;
+    mo.allow_unstable = o->allow_unstable;
+    mo.kernel = o->kernel;
+    mo.factor = o->factor;
+    mo.lcp_solver = o->lcp_solver;
+    mo.on_lcp = o->on_lcp;
+    mo.on_lcp_ctx = o->on_lcp_ctx;
+    mo.rtol = rtol;
+    mo.atol_dof = atol;
+    mo.sim_gap = o->close_tol; /* the reference's scale of simultaneity, in Le */
+    mo.pieces = o->theta == 0.5 ? F : NULL; /* exact flights; theta flights for another theta */
+    track_clear(tr);
+    pd_mj *mj = pd_mj_alloc(&sm->model, &mo, err);
+    if (!mj)
+        return err ? err->status : PD_ENOMEM;
+    int rc = pd_mj_run_until(mj, tau_end, observe_adapt, tr, err);
+    pd_mj_get_stats(mj, stats);
+    res->steps = stats->steps;
+    res->steps_rejected = stats->rejected;
+    res->dt = stats->h0 / tr->wp;
+    res->dt_min = stats->h_min / tr->wp;
+    res->dt_max = stats->h_max / tr->wp;
+    res->kernel = mo.pieces ? "exact-flight" : pd_mj_kernel_name(mj);
+    res->factor = mo.pieces ? "blocks" : pd_mj_factor_name(mj);
+    res->lcp_solver = pd_lcp_method_name(o->lcp_solver);
+    pd_mj_free(mj);
+    structure_errors(tr, res);
+    if (getenv("SCENE_DEBUG"))
+        fprintf(stderr, "adapt_once rtol %g: steps %ld rej %ld floor %d budget %d err_max %g est %g hmin %g\n", rtol, stats->steps, stats->rejected, stats->floor_hit, stats->budget_hit, stats->err_max, res->err_est_max, stats->h_min);
+    return rc;
+}
+
+/* Moreau–Jean to a tolerance on the scene's model: runs repeated at a
+ * tolerance scaled down by the estimate's excess (at most
+ * SCENE_ADAPT_TRIES); the figures the last run's, the steps all runs'; a
+ * sampler sees the first run, and the last again when it was repeated. */
+static int run_moreau_adapt(const pd_scene_model *sm, const pd_run_opts *o, double tau_end,
+                            track *tr, pd_scene_result *res, pd_err *err)
+{
+    const pd_scene *sc = tr->sc;
+    pd_sine_piece *pieces;
+    int npieces, rc, runs = 0;
+    if ((rc = pd_osc_pieces(&sm->shape, &pieces, &npieces, err)))
+        return rc;
+    double *atol = malloc((size_t)tr->n * sizeof(double));
+    if (!atol) {
+        free(pieces);
+        return pd_err_set(err, PD_ENOMEM, "out of memory for the tolerances of %d dofs", tr->n);
+    }
+    /* a dof's error is measured absolutely below a thousandth of its static
+     * scale, the deflection under ap: (T0 / Tp)^2 Le, or Le */
+    for (int k = 0; k < sc->nstruct; k++)
+        for (int j = 0; j < sc->st[k].storeys; j++) {
+            double r = sc->st[k].T0 / sc->exc.Tp;
+            atol[sc->st[k].dof + j] = SCENE_ADAPT_FLOOR * fmin(1.0, r * r);
+        }
+    for (int i = 0; i < tr->n; i++) {
+        double kk = pd_matrix_get(&sm->model.K, i, i), mm = pd_matrix_get(&sm->model.M, i, i);
+        tr->wdof[i] = kk > 0.0 && mm > 0.0 ? sqrt(kk / mm) : 0.0;
+    }
+    pd_piecewise_force F = {.b = sm->mass, .pieces = pieces, .npieces = npieces};
+    pd_scene_sampler fn = tr->fn;
+    pd_mj_stats st;
+    double rtol = o->rtol;
+    long steps = 0, rejected = 0;
+    for (;;) {
+        tr->fn = runs ? NULL : fn;
+        rc = adapt_once(sm, o, rtol, &F, atol, tau_end, tr, res, &st, err);
+        runs++;
+        steps += res->steps;
+        rejected += res->steps_rejected;
+        if (rc || st.floor_hit || st.budget_hit || res->err_est_max <= o->rtol ||
+            runs >= SCENE_ADAPT_TRIES || rtol * 0.5 < PD_RTOL_MIN)
+            break;
+        rtol = fmax(rtol * fmin(0.5, 0.5 * o->rtol / res->err_est_max), PD_RTOL_MIN);
+    }
+    if (!rc && runs > 1 && fn) {
+        tr->fn = fn;
+        rc = adapt_once(sm, o, rtol, &F, atol, tau_end, tr, res, &st, err);
+        steps += res->steps;
+        rejected += res->steps_rejected;
+    }
+    tr->fn = fn;
+    res->steps = steps;
+    res->steps_rejected = rejected;
+    res->rtol = o->rtol;
+    res->rtol_met = !rc && !st.floor_hit && !st.budget_hit && res->err_est_max <= o->rtol;
+    free(atol);
+    free(pieces);
     return rc;
 }
 
@@ -850,8 +1102,8 @@ static int run_general(const pd_scene *sc, const pd_run_opts *o, pd_scene_sample
     tr.fn = fn;
     tr.ctx = ctx;
     tr.demands = !o->no_demands;
-    long nsteps = pd_steps_for(o->tend, o->dt);
-    double tau_end = (double)nsteps * tr.h;
+    long nsteps = o->rtol > 0.0 ? 0 : pd_steps_for(o->tend, o->dt);
+    double tau_end = o->rtol > 0.0 ? tr.wp * o->tend : (double)nsteps * tr.h;
     switch (o->method) {
     case PD_METHOD_EVENT: rc = run_event(&sm, o, tau_end, &tr, res, err); break;
     case PD_METHOD_EVENT_GENERAL:
@@ -859,7 +1111,10 @@ static int run_general(const pd_scene *sc, const pd_run_opts *o, pd_scene_sample
         break;
     case PD_METHOD_PENALTY:
     case PD_METHOD_NEWMARK: rc = run_penalty(&sm.model, o, tau_end, &tr, res, err); break;
-    default: rc = run_moreau(&sm.model, o, nsteps, &tr, res, err); break;
+    default:
+        rc = o->rtol > 0.0 ? run_moreau_adapt(&sm, o, tau_end, &tr, res, err)
+                           : run_moreau(&sm.model, o, nsteps, &tr, res, err);
+        break;
     }
     fill_result(&tr, res);
     track_free(&tr);
@@ -894,6 +1149,13 @@ int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler s
     res->dt = o.dt;
     res->tend = o.tend;
     res->theta = o.method == PD_METHOD_MOREAU ? o.theta : NAN;
+    res->rtol = o.rtol;
+    res->err_est_max = NAN;
+    for (int s = 0; s < res->nstruct; s++)
+        res->err_est[s] = NAN;
+    res->rtol_met = 1;
+    res->steps_rejected = 0;
+    res->dt_min = res->dt_max = o.method == PD_METHOD_MOREAU ? o.dt : NAN;
     res->method = pd_method_name(o.method);
     res->simultaneous = res->tol_closed = res->accumulations = 0;
     res->close_tol = o.method == PD_METHOD_EVENT ? o.close_tol : NAN;
@@ -961,6 +1223,8 @@ int pd_scene_summarize(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sam
         return rc;
     }
     s->cpu_s = pd_cpu_seconds() - cpu0;
+    s->err_est = s->r.rtol > 0.0 ? fmax(s->r.err_est_max, s->free.err_est_max) : NAN;
+    s->rtol_met = s->r.rtol_met && s->free.rtol_met;
     double Le = pd_scene_Le(sc);
     for (int i = 0; i < sc->n; i++) {
         s->Pi1[i] = s->r.umax[i] / Le;

@@ -1,0 +1,122 @@
+/* mj.h — (engine-private) the Moreau–Jean object, shared by its fixed-step
+ * driver (moreau.c) and its adaptive one (mj_adapt.c).
+ *
+ * One step of either driver is the same arithmetic (SPEC §2): the general
+ * kernel's mj_general_step, the scalar kernel's mj1_step (mj1.h).  A fixed
+ * run steps with h = opts.h in place on mj->st; an adaptive run steps on
+ * the ladder h_k = h0 2^-k, each level's iteration matrix factored once,
+ * from one snapshot of the state into another (docs/scheme.md, "Moreau–Jean
+ * to a tolerance"). */
+#ifndef PD_MJ_H
+#define PD_MJ_H
+
+#include "mj1.h"
+#include "pd_engine.h"
+#include "pd_factor.h"
+
+/* One rung of the ladder: its step, and What(h) as the kernel keeps it. */
+typedef struct mj_level {
+    double h;
+    mj1_coef s1;       /* scalar kernel */
+    pd_factor *factor; /* general kernel: formed at the level's first use */
+} mj_level;
+
+typedef struct mj_adapt mj_adapt;   /* the adaptive driver's own (mj_adapt.c) */
+typedef struct mj_flight mj_flight; /* its exact flights (mj_flight.c) */
+
+/* W by columns and by rows (the adaptive driver's): the dofs each contact
+ * acts on, and the contacts acting on each dof. */
+typedef struct mj_incidence {
+    int *ptr, *dof;    /* contact a: dof[ptr[a] .. ptr[a+1]) */
+    double *w;         /* W_ia of each (dof, contact) pair, as dof */
+    int *dptr, *con;   /* dof i: con[dptr[i] .. dptr[i+1]) */
+} mj_incidence;
+
+/* W_a^T x. */
+static inline double mj_inc_dot(const mj_incidence *in, int a, const double *x)
+{
+    double sum = 0.0;
+    for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
+        sum += in->w[j] * x[in->dof[j]];
+    return sum;
+}
+
+struct pd_mj {
+    const pd_model *model;
+    pd_mj_opts opts;
+    int scalar;           /* 1: scalar kernel */
+    double t0;            /* time of the last reset */
+    int next_break;       /* index of the first model breakpoint after t */
+    pd_factor *factor;    /* What, What^-1 W and the Delassus matrix (fixed steps) */
+    pd_lcp_solver *lcp;   /* the contact LCP solver, sized for lcp_nmax contacts */
+    int lcp_nmax;         /* most active contacts one LCP may have */
+    unsigned char *guess; /* m: the warm start of the active set's LCP: 1 pushed in the
+                             previous step, 0 active without pushing, 2 newly active */
+    int sparse;           /* 1: Delassus blocks in compressed columns */
+    int stop;             /* the LCP observer asked to stop */
+    double *F0, *F1;      /* n: force at t_k and t_k+1 */
+    double *work_n;       /* n: right-hand side, then velocity increment */
+    double *qtheta;       /* n: q_k + h theta v_k */
+    double *U0;           /* m: W^T v_k */
+    double *D_active;     /* Delassus block: lcp_nmax^2 (dense) or delassus_nnz (sparse) */
+    int *D_colptr, *D_rowind; /* sparse: its compressed columns */
+    double *b_active;     /* m: LCP vector of the active set */
+    double *P_active;     /* m: impulses of the active set */
+    double *w_active;     /* m: post-impact relative velocities of the active set */
+    int *idx_active;      /* m: indices of the active contacts */
+    mj1_coef s1;          /* scalar kernel constants (no division in a step) */
+    pd_state st;          /* the state the caller reads (pd_mj_state) */
+    pd_state st_own;      /* the arrays mj->st was allocated with (the adaptive driver
+                             points mj->st at its snapshots) */
+    mj_adapt *ad;         /* NULL: fixed steps */
+    mj_flight *fl;        /* adaptive with exact flights (linear blocks under piecewise
+                             forcing); NULL: theta flights */
+    mj_incidence inc;     /* the adaptive driver's view of W */
+    const double *u_rest; /* NULL, or m: closing speeds |U_k| at or below which a contact
+                             takes no restitution (the adaptive driver's: rebounds lower
+                             than its tolerance are plastic; an opening contact takes
+                             none either) */
+};
+
+/* One step of the general kernel with the factor f of What(h), from `in` at
+ * t to `out` at t1 = t + h (out may be in), with the forces F0 = F(t+) and
+ * F1 = F(t1-): q, v, P, g, active, nactive, the LCP's figures, t and step
+ * of out.  Fails naming t1 when the LCP is not solved or the state is not
+ * finite. */
+int mj_general_step(pd_mj *mj, const pd_factor *f, double h, double t1, const double *F0,
+                    const double *F1, const pd_state *in, pd_state *out, pd_err *err);
+
+/* The LCP of the active set mj->idx_active (nI contacts): its right-hand
+ * side W_I^T vfree + e U_k into mj->b_active (U_k in mj->U0; with
+ * mj->u_rest, no restitution for a contact opening or closing slower than
+ * it), and its solution with the Delassus
+ * block in mj->D_active (dense, or compressed columns when mj->sparse) into
+ * mj->P_active and out->P (t1 names the step's end in messages). */
+void mj_active_rhs(pd_mj *mj, int nI, const double *vfree);
+int mj_solve_active(pd_mj *mj, int nI, double t1, pd_state *out, pd_err *err);
+
+/* The adaptive driver: its workspaces for mj (opts.rtol > 0), their
+ * release, the state at rest at t0 (q0, v0 as pd_mj_reset's), and the run
+ * to t_end (mj_adapt.c). */
+int mj_adapt_alloc(pd_mj *mj, pd_err *err);
+void mj_adapt_free(pd_mj *mj);
+int mj_adapt_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_err *err);
+int mj_adapt_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx, pd_err *err);
+void mj_adapt_stats(const pd_mj *mj, pd_mj_stats *s);
+
+/* Exact flights (mj_flight.c): the tables of every block for the ladder
+ * h_k = h0 2^-k, k = 0..L + 1, under the forcing F; their release; the
+ * forcing state z (4) of piece p at t; the step of level k from (in, zin)
+ * to (out, zout) ending at t1; the highest frequency of the dof's block
+ * (for the grazing test) and of the forcing. */
+int mj_flight_alloc(pd_mj *mj, const pd_piecewise_force *F, double h0, int L, pd_err *err);
+void mj_flight_free(pd_mj *mj);
+void mj_flight_z(const pd_mj *mj, int p, double t, double *z);
+int mj_flight_step(pd_mj *mj, int k, double t1, const pd_state *in, const double *zin,
+                   pd_state *out, double *zout, pd_err *err);
+double mj_flight_wmax(const pd_mj *mj, int dof);
+double mj_flight_forcing_w(const pd_mj *mj);
+/* The accelerations of the free motion at st (the forcing's state z). */
+void mj_flight_acc(const pd_mj *mj, const pd_state *st, const double *z, double *acc);
+
+#endif

@@ -1,0 +1,1042 @@
+/* mj_adapt.c — Moreau–Jean to a tolerance: steps chosen from a dyadic ladder,
+ * impacts located by halving, an error estimate carried along.
+ *
+ *   ladder    h_k = h0 2^-k, k = 0..L; times on the grid t_origin + j h_L (integer
+ *             ticks), a step of level k starting on a multiple of its own length and
+ *             never crossing t_end or a forcing piece's start
+ *   flights   theta: the theta scheme (What(h_k) factored at level k's first use);
+ *             exact: the linear structures' exact flow (mj_flight.c), impulses at
+ *             mid-step.  An exact flight with no contact pushing, closing or grazing
+ *             is kept whole: it has no error to control
+ *   a try     from S at t: S1 = one step h_k; Sa, S2 = two steps h_k+1 (kept when
+ *             the try passes)
+ *   flight    no event: e_i = (|q2 - q1|_i + |v2 - v1|_i / w_i) / (2^p - 1)  (p = 2 at
+ *             theta 1/2) against the error per unit step kf rtol s_i h_k / T over the
+ *             run's span T; s_i = max(atol_i, the amplitude sqrt(q_i^2 + (v_i/w_i)^2)
+ *             seen so far), w_i^2 = K_ii / M_ii; the step doubles below 2^-p of that
+ *   events    on the dofs an event moves: an impact (a contact pushes while closing,
+ *             (1 + e) |U-| above the flight's reach), a gap closed past zero or
+ *             grazing inside a free step, a contact let go (its force's zero
+ *             extrapolated): e_i = |q2 - q1|_i + |v2 - v1|_i / w_i (first order) + the
+ *             events' bounds, against ke rtol s_i; no dof may take two significant
+ *             impacts in one step (a cascade: one at a time, down to h |U| <= sim_gap).
+ *             A try that fails is halved, keeping its first half when the event lies
+ *             in the second
+ *   estimate  E_i += e_i over the kept steps: the state's err
+ *
+ * No allocation once the levels in use are factored (theta flights); the
+ * scalar kernel's levels and the exact flights' tables are formed with the
+ * object. */
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <stdio.h>
+
+#include "mj.h"
+
+#define ADAPT_KF 0.5        /* share of rtol for the flight's errors over the run */
+#define ADAPT_KE 0.1        /* share of rtol for one event */
+#define ADAPT_GROW 0.9      /* double the step below ADAPT_GROW 2^-p of the tolerance */
+#define ADAPT_START 3       /* the first try's level */
+#define ADAPT_BREAK_TOL 1e-12 /* a time within this relative distance of a breakpoint is it */
+#define ADAPT_DEEP 6          /* the foot of the ladder: its last levels */
+#define ADAPT_DEEP_MAX 4096   /* tries in a row there before refinement stops (rounding's
+                                 scale: no finer step tells the states apart) */
+
+/* A state of the scheme with the forces at its instant. */
+typedef struct snap {
+    pd_state st;     /* q, v, P, g, active, t, step, ... */
+    double *Fl, *Fr; /* n: F(t-) and F(t+) (theta flights) */
+    double z[4];     /* the forcing's state (exact flights) */
+    int piece;       /* its piece (exact flights) */
+    uint64_t tick;   /* t = t_origin + tick h_L */
+    double *mem;     /* the arrays' block */
+} snap;
+
+struct mj_adapt {
+    int L;                 /* the finest level */
+    double h0, htick;      /* h_0 and h_L */
+    double t_origin;       /* the grid's origin (the last reset) */
+    double span;           /* T: the run's length (set by the first run after a reset) */
+    mj_level *lev;         /* L + 1 levels (theta flights) */
+    const pd_piecewise_force *F; /* exact flights' forcing (NULL: theta flights) */
+    uint64_t *piece_tick;  /* npieces: each piece's start */
+    snap sn[4];
+    snap *cur, *one, *half, *two; /* now; one step; the first half; both halves */
+    double *E;             /* n: the estimate kept so far */
+    double *Er;            /* n: E plus the last step's interpolation bound (state err) */
+    double *eps;           /* n: the try's estimate */
+    double *rate;          /* n: the last smooth pair's error over h^(p+1) */
+    double *amp;           /* n: the amplitudes seen */
+    double *w;             /* n: each dof's frequency */
+    double *atol;          /* n */
+    double *minv;          /* n: 1 / M_ii */
+    unsigned *mark;        /* n: the stamp of the last impact on each dof */
+    unsigned stamp;
+    unsigned *evmark;      /* n: try_stamp when an event marked the dof in this try */
+    unsigned try_stamp;
+    double *bound;         /* n: the try's events' bound */
+    long nmarked;          /* dofs marked for events so far */
+    double *u_rest;        /* m: closing speeds without restitution (mj->u_rest) */
+    int p;                 /* order of the flight's global error */
+    double div;            /* 2^p - 1 */
+    int k_flight;          /* exact flights: the coarsest level whose steps the observers'
+                              quintic interpolation keeps within a tenth of the event
+                              tolerance, (w h)^6 / 46080 <= ke rtol / 10 */
+    int k;                 /* the level of the next try */
+    int started;           /* the reset state was reported */
+    int impact_made;       /* the step that made the state had an impact */
+    long deep;             /* tries in a row at the ladder's foot */
+    pd_mj_stats stats;
+};
+
+static void rest_speeds(pd_mj *mj);
+static void report_err(pd_mj *mj, double h);
+
+/* ---- the object ---------------------------------------------------------------- */
+
+static void snap_free(snap *s)
+{
+    free(s->mem);
+    free(s->st.active);
+    memset(s, 0, sizeof *s);
+}
+
+/* q, v, Fl, Fr, acc (n) and g, P (m) in one block; active (m). */
+static int snap_alloc(snap *s, int n, int m)
+{
+    size_t mm = m > 0 ? (size_t)m : 1, nn = (size_t)n;
+    s->mem = calloc(5 * nn + 2 * mm, sizeof(double));
+    s->st.active = calloc(mm, 1);
+    if (!s->mem || !s->st.active)
+        return PD_ENOMEM;
+    s->st.q = s->mem;
+    s->st.v = s->mem + nn;
+    s->Fl = s->mem + 2 * nn;
+    s->Fr = s->mem + 3 * nn;
+    s->st.g = s->mem + 4 * nn;
+    s->st.P = s->mem + 4 * nn + mm;
+    s->st.acc = s->mem + 4 * nn + 2 * mm;
+    return PD_OK;
+}
+
+static void incidence_free(mj_incidence *in)
+{
+    free(in->ptr);
+    free(in->dof);
+    free(in->w);
+    free(in->dptr);
+    free(in->con);
+    memset(in, 0, sizeof *in);
+}
+
+void mj_adapt_free(pd_mj *mj)
+{
+    mj_adapt *ad = mj ? mj->ad : NULL;
+    if (!ad)
+        return;
+    mj_flight_free(mj);
+    incidence_free(&mj->inc);
+    if (ad->lev)
+        for (int k = 0; k <= ad->L; k++)
+            pd_factor_free(ad->lev[k].factor);
+    for (int s = 0; s < 4; s++)
+        snap_free(&ad->sn[s]);
+    void *arrays[] = {ad->lev, ad->piece_tick, ad->E, ad->Er, ad->eps, ad->rate, ad->amp, ad->w,
+                      ad->atol, ad->minv, ad->mark, ad->evmark, ad->bound, ad->u_rest};
+    for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
+        free(arrays[k]);
+    free(ad);
+    mj->ad = NULL;
+    mj->u_rest = NULL;
+    mj->st = mj->st_own;
+}
+
+/* h0: opts.h lowered so that the forcing's jumps fall between steps: the
+ * first model breakpoint after 0 a whole number of steps from t = 0
+ * (theta flights); every piece's start a whole number of steps from the
+ * first's when they are evenly spaced (a record's samples: h0 = their
+ * spacing / 2^j), else the first start after it (a pulse's end). */
+static double coarsest_step(const pd_model *md, const pd_piecewise_force *F, double h)
+{
+    double b = 0.0;
+    if (F && F->npieces >= 2) {
+        double d = F->pieces[1].t_start - F->pieces[0].t_start;
+        int even = d > 0.0;
+        for (int p = 2; p < F->npieces && even; p++)
+            even = fabs(F->pieces[p].t_start - F->pieces[0].t_start - p * d) <= 1e-9 * p * d;
+        if (even && F->npieces >= 3)
+            return h >= d ? d : ldexp(d, -(int)ceil(log2(d / h) - 1e-12));
+        b = d;
+    }
+    for (int j = 0; !F && j < md->nbreaks && b == 0.0; j++)
+        if (md->breaks[j] > 0.0)
+            b = md->breaks[j];
+    if (b > 0.0) {
+        double steps = ceil(b / h * (1.0 - 1e-12));
+        return b / (steps > 1.0 ? steps : 1.0);
+    }
+    return h;
+}
+
+/* Each dof's frequency w_i = sqrt(K_ii / M_ii) (floored at 1e-3 of the
+ * largest, so that a free dof's velocity error still counts). */
+static void dof_frequencies(const pd_model *md, double *w)
+{
+    double wmax = 0.0;
+    for (int i = 0; i < md->n; i++) {
+        double k = pd_matrix_get(&md->K, i, i), m = pd_matrix_get(&md->M, i, i);
+        w[i] = k > 0.0 && m > 0.0 ? sqrt(k / m) : 0.0;
+        wmax = fmax(wmax, w[i]);
+    }
+    for (int i = 0; i < md->n; i++)
+        w[i] = fmax(w[i], wmax > 0.0 ? 1e-3 * wmax : 1.0);
+}
+
+/* W by columns (with its entries) and by rows. */
+static int incidence(const pd_model *md, mj_incidence *in)
+{
+    int n = md->n, m = md->m, nnz = 0;
+    if (!(in->ptr = calloc((size_t)m + 1, sizeof(int))) ||
+        !(in->dptr = calloc((size_t)n + 1, sizeof(int))))
+        return PD_ENOMEM;
+    for (int a = 0; a < m; a++)
+        for (int i = 0; i < n; i++)
+            if (pd_matrix_get(&md->W, i, a) != 0.0) {
+                nnz++;
+                in->dptr[i + 1]++;
+            }
+    size_t cap = nnz > 0 ? (size_t)nnz : 1;
+    if (!(in->dof = malloc(cap * sizeof(int))) || !(in->w = malloc(cap * sizeof(double))) ||
+        !(in->con = malloc(cap * sizeof(int))))
+        return PD_ENOMEM;
+    for (int i = 0; i < n; i++)
+        in->dptr[i + 1] += in->dptr[i];
+    int *fill = calloc((size_t)n, sizeof(int));
+    if (!fill)
+        return PD_ENOMEM;
+    nnz = 0;
+    for (int a = 0; a < m; a++) {
+        in->ptr[a] = nnz;
+        for (int i = 0; i < n; i++) {
+            double wia = pd_matrix_get(&md->W, i, a);
+            if (wia == 0.0)
+                continue;
+            in->dof[nnz] = i;
+            in->w[nnz++] = wia;
+            in->con[in->dptr[i] + fill[i]++] = a;
+        }
+    }
+    in->ptr[m] = nnz;
+    free(fill);
+    return PD_OK;
+}
+
+/* Each piece's start on the grid of the last reset. */
+static void piece_ticks(mj_adapt *ad)
+{
+    for (int p = 0; ad->F && p < ad->F->npieces; p++) {
+        double r = (ad->F->pieces[p].t_start - ad->t_origin) / ad->htick;
+        ad->piece_tick[p] = r <= 0.0 ? 0 : r >= 0x1p63 ? UINT64_MAX : (uint64_t)llround(r);
+    }
+}
+
+int mj_adapt_alloc(pd_mj *mj, pd_err *err)
+{
+    const pd_model *md = mj->model;
+    const pd_mj_opts *o = &mj->opts;
+    int n = md->n, L = o->max_level, rc;
+    mj_adapt *ad = calloc(1, sizeof *ad);
+    if (!(mj->ad = ad))
+        return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for its levels");
+    ad->F = o->pieces;
+    ad->L = L;
+    ad->h0 = coarsest_step(md, ad->F, o->h);
+    ad->htick = ldexp(ad->h0, -L);
+    ad->p = o->theta == 0.5 || ad->F ? 2 : 1;
+    ad->div = ad->p == 2 ? 3.0 : 1.0;
+    ad->lev = calloc((size_t)L + 1, sizeof *ad->lev);
+    ad->piece_tick = calloc(ad->F ? (size_t)ad->F->npieces : 1, sizeof(uint64_t));
+    double **nv[] = {&ad->E, &ad->Er, &ad->eps, &ad->rate, &ad->amp, &ad->w, &ad->atol, &ad->minv,
+                     &ad->bound};
+    int bad = !ad->lev || !ad->piece_tick;
+    for (size_t k = 0; k < sizeof nv / sizeof nv[0]; k++)
+        bad |= !(*nv[k] = calloc((size_t)n, sizeof(double)));
+    ad->mark = calloc((size_t)n, sizeof(unsigned));
+    ad->evmark = calloc((size_t)n, sizeof(unsigned));
+    ad->u_rest = calloc(md->m > 0 ? (size_t)md->m : 1, sizeof(double));
+    bad |= !ad->mark || !ad->evmark || !ad->u_rest || incidence(md, &mj->inc);
+    for (int s = 0; s < 4 && !bad; s++)
+        bad = snap_alloc(&ad->sn[s], n, md->m) != PD_OK;
+    if (bad)
+        return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for its levels (n = %d)",
+                          n);
+    for (int k = 0; k <= L; k++) {
+        ad->lev[k].h = ldexp(ad->h0, -k);
+        if (mj->scalar)
+            ad->lev[k].s1 = mj1_coef_make(
+                pd_matrix_get(&md->M, 0, 0), pd_matrix_get(&md->C, 0, 0),
+                pd_matrix_get(&md->K, 0, 0), md->m > 0, md->m ? pd_matrix_get(&md->W, 0, 0) : 0.0,
+                md->m ? md->g0[0] : 0.0, md->m ? md->e[0] : 0.0, ad->lev[k].h, o->theta);
+    }
+    dof_frequencies(md, ad->w);
+    for (int i = 0; i < n; i++) {
+        ad->minv[i] = 1.0 / pd_matrix_get(&md->M, i, i);
+        ad->atol[i] = o->atol_dof ? o->atol_dof[i] : o->atol;
+        if (!(ad->atol[i] > 0.0) || !isfinite(ad->atol[i]))
+            return pd_err_set(err, PD_EINVAL, "atol of dof %d must be a finite number > 0 "
+                              "(got %g)", i, ad->atol[i]);
+    }
+    mj->u_rest = ad->u_rest;
+    if (ad->F && (rc = mj_flight_alloc(mj, ad->F, ad->h0, L, err)))
+        return rc;
+    if (ad->F) {
+        double w = 0.0, room = pow(46080.0 * 0.1 * ADAPT_KE * o->rtol, 1.0 / 6.0);
+        for (int i = 0; i < n; i++)
+            w = fmax(w, ad->w[i]);
+        w = fmax(w, mj_flight_forcing_w(mj));
+        while (ad->k_flight < L - 1 && w * ad->lev[ad->k_flight].h > room)
+            ad->k_flight++;
+    }
+    return PD_OK;
+}
+
+/* ---- time and forces ------------------------------------------------------------ */
+
+static double tick_time(const mj_adapt *ad, uint64_t tick)
+{
+    return ad->t_origin + (double)tick * ad->htick;
+}
+
+static uint64_t level_ticks(const mj_adapt *ad, int k)
+{
+    return (uint64_t)1 << (ad->L - k);
+}
+
+/* 1 when t is one of the model's breakpoints (to a relative ADAPT_BREAK_TOL). */
+static int at_break(const pd_model *md, double t)
+{
+    for (int j = 0; j < md->nbreaks; j++)
+        if (fabs(md->breaks[j] - t) <= ADAPT_BREAK_TOL * fmax(fabs(t), 1.0))
+            return 1;
+    return 0;
+}
+
+/* F(t-) and F(t+) into s (equal away from breakpoints; theta flights). */
+static void forces_at(const pd_mj *mj, double t, snap *s)
+{
+    const pd_model *md = mj->model;
+    size_t bytes = (size_t)md->n * sizeof(double);
+    if (mj->fl)
+        return;
+    if (!md->force) {
+        memset(s->Fl, 0, bytes);
+        memset(s->Fr, 0, bytes);
+        return;
+    }
+    md->force(t, -1, s->Fl, md->force_ctx);
+    if (at_break(md, t))
+        md->force(t, +1, s->Fr, md->force_ctx);
+    else
+        memcpy(s->Fr, s->Fl, bytes);
+}
+
+int mj_adapt_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_err *err)
+{
+    const pd_model *md = mj->model;
+    mj_adapt *ad = mj->ad;
+    snap *s = &ad->sn[0];
+    for (int i = 0; i < md->n; i++) {
+        s->st.q[i] = q0 ? q0[i] : 0.0;
+        s->st.v[i] = v0 ? v0[i] : 0.0;
+        if (!isfinite(s->st.q[i]) || !isfinite(s->st.v[i]))
+            return pd_err_set(err, PD_EINVAL, "initial state: dof %d is not finite", i);
+        ad->E[i] = ad->rate[i] = 0.0;
+        ad->amp[i] = hypot(s->st.q[i], s->st.v[i] / ad->w[i]);
+    }
+    for (int a = 0; a < md->m; a++) {
+        s->st.P[a] = 0.0;
+        s->st.active[a] = 0;
+        s->st.g[a] = md->g0[a] + mj_inc_dot(&mj->inc, a, s->st.q);
+    }
+    ad->cur = &ad->sn[0];
+    ad->one = &ad->sn[1];
+    ad->half = &ad->sn[2];
+    ad->two = &ad->sn[3];
+    ad->t_origin = t0;
+    ad->span = 0.0;
+    ad->k = ADAPT_START < ad->L ? ADAPT_START : ad->L - 1;
+    ad->k = ad->k > ad->k_flight ? ad->k : ad->k_flight;
+    ad->started = 0;
+    ad->impact_made = 0;
+    ad->deep = 0;
+    ad->stats = (pd_mj_stats){.h_min = HUGE_VAL, .h_max = 0.0, .h0 = ad->h0};
+    s->tick = 0;
+    s->st.t = t0;
+    s->st.step = 0;
+    s->st.nactive = 0;
+    s->st.lcp_pivots = 0;
+    s->st.lcp_solver = NULL;
+    s->st.h = 0.0;
+    forces_at(mj, t0, s);
+    if (ad->F) { /* the piece in force at t0 */
+        piece_ticks(ad);
+        s->piece = 0;
+        while (s->piece + 1 < ad->F->npieces && ad->F->pieces[s->piece + 1].t_start <= t0)
+            s->piece++;
+        mj_flight_z(mj, s->piece, t0, s->z);
+    }
+    rest_speeds(mj);
+    if (ad->F) {
+        mj_flight_acc(mj, &s->st, s->z, s->st.acc);
+        s->st.has_acc = 1;
+    }
+    mj->t0 = t0;
+    report_err(mj, 0.0);
+    mj->st = s->st;
+    mj->st.err = ad->Er;
+    return PD_OK;
+}
+
+/* ---- one step ------------------------------------------------------------------- */
+
+/* Level k's factor of What(h_k), formed at its first use. */
+static int level_factor(pd_mj *mj, int k, pd_err *err)
+{
+    mj_level *lv = &mj->ad->lev[k];
+    if (lv->factor)
+        return PD_OK;
+    lv->factor = pd_factor_alloc(mj->model, lv->h, mj->opts.theta, mj->factor->type->kind, err);
+    return lv->factor ? PD_OK : (err ? err->status : PD_ENOMEM);
+}
+
+/* The scalar kernel's step from x to y with level k's constants. */
+static int scalar_step(pd_mj *mj, int k, double t1, const snap *x, snap *y, pd_err *err)
+{
+    const pd_model *md = mj->model;
+    const mj_level *lv = &mj->ad->lev[k];
+    double q = x->st.q[0], v = x->st.v[0], g = md->m ? x->st.g[0] : 0.0, P;
+    mj1_coef s1 = lv->s1;
+    if (md->m && -(s1.w * v) <= mj->ad->u_rest[0])
+        s1.e = 0.0; /* opening, or closing too slowly for a rebound: the contact holds */
+    int active = mj1_step(lv->h, mj->opts.theta, lv->h * mj->opts.gamma, &s1, x->Fr[0],
+                          y->Fl[0], &q, &v, &g, &P);
+    y->st.q[0] = q;
+    y->st.v[0] = v;
+    if (md->m) {
+        y->st.g[0] = g;
+        y->st.P[0] = P;
+        y->st.active[0] = (unsigned char)active;
+    }
+    y->st.nactive = active;
+    y->st.lcp_pivots = 0;
+    y->st.lcp_solver = active ? "closed-form" : NULL;
+    y->st.t = t1;
+    y->st.step = x->st.step + 1;
+    if (!isfinite(q) || !isfinite(v))
+        return pd_err_set(err, PD_ENONFINITE,
+                          "Moreau-Jean: non-finite state at t = %.9g (step of %.3g)", t1, lv->h);
+    return PD_OK;
+}
+
+/* One step of level k from x into y (its forces at the end included). */
+static int take_step(pd_mj *mj, int k, const snap *x, snap *y, pd_err *err)
+{
+    mj_adapt *ad = mj->ad;
+    int rc;
+    y->tick = x->tick + level_ticks(ad, k);
+    double t1 = tick_time(ad, y->tick);
+    ad->stats.evals++;
+    y->st.h = ad->lev[k].h;
+    if (ad->F) { /* exact flight; at a piece's start its forcing takes over */
+        if ((rc = mj_flight_step(mj, k, t1, &x->st, x->z, &y->st, y->z, err)))
+            return rc;
+        y->piece = x->piece;
+        if (y->piece + 1 < ad->F->npieces && y->tick >= ad->piece_tick[y->piece + 1]) {
+            y->piece++;
+            mj_flight_z(mj, y->piece, ad->F->pieces[y->piece].t_start, y->z);
+        }
+        return PD_OK;
+    }
+    forces_at(mj, t1, y);
+    if (mj->scalar)
+        return scalar_step(mj, k, t1, x, y, err);
+    if ((rc = level_factor(mj, k, err)))
+        return rc;
+    return mj_general_step(mj, ad->lev[k].factor, ad->lev[k].h, t1, x->Fr, y->Fl, &x->st, &y->st,
+                           err);
+}
+
+/* ---- the tests of a try ------------------------------------------------------------ */
+
+/* s_i: the size a dof's error is measured against. */
+static double dof_scale(const mj_adapt *ad, int i)
+{
+    return ad->amp[i] > ad->atol[i] ? ad->amp[i] : ad->atol[i];
+}
+
+/* An impact in the step x -> y: contact a pushes (P > 0) while it was
+ * closing (U- = W_a^T v < 0); its change of gap rate (1 + e) |U-|, else 0. */
+static double impact_jump(const pd_mj *mj, int a, const snap *x, const snap *y)
+{
+    if (!(y->st.P[a] > 0.0))
+        return 0.0;
+    const pd_model *md = mj->model;
+    double U = mj_inc_dot(&mj->inc, a, x->st.v);
+    return U < 0.0 ? (1.0 + md->e[a]) * -U : 0.0;
+}
+
+/* 1 when contact a's impact jump could fail the flight's test at some step
+ * on one of its dofs: the first-order error jump h / 2 of a step h against
+ * the error per unit step, with room 4 ((2^p - 1) kf rtol s_i / T). */
+static int flight_event(const pd_mj *mj, int a, double jump)
+{
+    const mj_incidence *in = &mj->inc;
+    const mj_adapt *ad = mj->ad;
+    double flight = ad->div * ADAPT_KF * mj->opts.rtol / ad->span;
+    for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
+        if (jump > flight * dof_scale(ad, in->dof[j]))
+            return 1;
+    return 0;
+}
+
+/* Dof i takes part in the try's event with the bound b (units of q). */
+static void mark_event(mj_adapt *ad, int i, double b)
+{
+    ad->evmark[i] = ad->try_stamp;
+    ad->bound[i] += b;
+    ad->nmarked++;
+}
+
+/* The impacts of the step x -> y (of size h; weight 0: detection only).
+ * An impact is an event on the dofs it moves when its jump could fail the
+ * flight's test at some step (flight_event): those dofs are marked for the
+ * event's test with the bound jump h (exact flights: jump h / 2, the
+ * impulse at mid-step).  So is a gap closed past zero inside a step where
+ * no contact was predicted (theta flights: the impact comes a step late,
+ * the penetration is the error).  Returns 1 for a cascade: a dof taking
+ * two impacts whose jumps move it by more than the event tolerance,
+ * closing more than sim_gap over the step (to be taken one at a time). */
+static int scan_impacts(pd_mj *mj, const snap *x, const snap *y, double h, double weight)
+{
+    const pd_model *md = mj->model;
+    const mj_incidence *in = &mj->inc;
+    mj_adapt *ad = mj->ad;
+    double rtol = mj->opts.rtol, reach = ad->F ? 0.5 * h : h;
+    int cascade = 0;
+    unsigned stamp = ++ad->stamp;
+    for (int a = 0; a < md->m; a++) {
+        double jump = impact_jump(mj, a, x, y);
+        double missed = x->st.g[a] > 0.0 && y->st.g[a] < 0.0 && !(y->st.P[a] > 0.0)
+                            ? -y->st.g[a]
+                            : 0.0;
+        if (!(jump > 0.0) && !(missed > 0.0))
+            continue;
+        int big = jump * h > (1.0 + md->e[a]) * mj->opts.sim_gap;
+        int marks = missed > 0.0 || flight_event(mj, a, jump);
+        for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
+            int i = in->dof[j];
+            if (marks)
+                mark_event(ad, i, weight * pd_max(jump * reach, missed));
+            big &= jump > ADAPT_KE * rtol * dof_scale(ad, i) * ad->w[i];
+        }
+        if (!big)
+            continue;
+        for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
+            int i = in->dof[j];
+            cascade |= ad->mark[i] == stamp;
+            ad->mark[i] = stamp;
+        }
+    }
+    return cascade;
+}
+
+/* The smallest value of the cubic Hermite through (g0, U0) and (g1, U1)
+ * over a step h (its ends excluded: +inf when it turns nowhere inside). */
+static double hermite_min(double g0, double U0, double g1, double U1, double h)
+{
+    double c2 = (3.0 * (g1 - g0) / h - 2.0 * U0 - U1) / h;
+    double c3 = (2.0 * (g0 - g1) / h + U0 + U1) / (h * h);
+    double A = 3.0 * c3, B = 2.0 * c2, C = U0, best = HUGE_VAL, s[2];
+    int ns = 0;
+    if (A == 0.0) {
+        if (B != 0.0)
+            s[ns++] = -C / B;
+    } else {
+        double d = B * B - 4.0 * A * C;
+        if (d >= 0.0) {
+            double q = -0.5 * (B + copysign(sqrt(d), B));
+            s[ns++] = q / A;
+            if (q != 0.0)
+                s[ns++] = C / q;
+        }
+    }
+    for (int j = 0; j < ns; j++)
+        if (s[j] > 0.0 && s[j] < h)
+            best = fmin(best, g0 + s[j] * (U0 + s[j] * (c2 + s[j] * c3)));
+    return best;
+}
+
+/* A contact open at both ends of a free step x -> y whose gap may have
+ * dipped to zero inside it (a grazing impact the step would miss): the
+ * cubic Hermite of the gap, within its error (w h)^4 / 384 of the gap's
+ * scale (w: the highest frequency of the blocks it joins, exact flights;
+ * of its dofs, theta flights), comes below that margin.  Its dofs are
+ * marked with the margin as bound. */
+static void scan_dips(pd_mj *mj, const snap *x, const snap *y, double h)
+{
+    const pd_model *md = mj->model;
+    const mj_incidence *in = &mj->inc;
+    mj_adapt *ad = mj->ad;
+    for (int a = 0; a < md->m; a++) {
+        if (!(x->st.g[a] > 0.0 && y->st.g[a] > 0.0) || y->st.P[a] > 0.0)
+            continue;
+        double U0 = mj_inc_dot(in, a, x->st.v), U1 = mj_inc_dot(in, a, y->st.v);
+        if (!(U0 < 0.0 && U1 > 0.0))
+            continue;
+        double w = 0.0, scale = 0.0;
+        for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
+            int i = in->dof[j];
+            w = fmax(w, mj->fl ? mj_flight_wmax(mj, i) : ad->w[i]);
+            scale += fabs(in->w[j]) * dof_scale(ad, i);
+        }
+        double wh = w * h, margin = wh * wh * wh * wh / 384.0 * scale;
+        if (hermite_min(x->st.g[a], U0, y->st.g[a], U1, h) < margin)
+            for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
+                mark_event(ad, in->dof[j], margin);
+    }
+}
+
+/* Contact a's impulse error dP moves dof i by about |W_ia| dP / (M_ii w_i). */
+static void mark_impulse(pd_mj *mj, int a, double dP)
+{
+    mj_adapt *ad = mj->ad;
+    const mj_incidence *in = &mj->inc;
+    for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
+        int i = in->dof[j];
+        mark_event(ad, i, fabs(in->w[j]) * ad->minv[i] * dP / ad->w[i]);
+    }
+}
+
+/* The free motion's acceleration of dof i at x: the state's own (exact
+ * flights), else M_ii^-1 (F - C v - K q)_i (C, K symmetric: rows are columns). */
+static double free_acc(const pd_mj *mj, const snap *x, int i)
+{
+    const pd_model *md = mj->model;
+    if (x->st.has_acc)
+        return x->st.acc[i];
+    return mj->ad->minv[i] * (x->Fr[i] - pd_matrix_col_dot(&md->C, i, x->st.v) -
+                              pd_matrix_col_dot(&md->K, i, x->st.q));
+}
+
+/* A contact that pushed in the step that made y and not in the next, of
+ * size h: let go at y.  Right when it was not resting on its contact (|U|
+ * above the rest speed: an impact's rebound) or when the free motion opens
+ * it (its gap's acceleration G >= 0); else the contact would have held,
+ * and the step lost up to |G| h of gap rate: its dofs get the bound
+ * |G| h / w_i.  Returns 1 when marked. */
+static int released(pd_mj *mj, int a, const snap *y, double h)
+{
+    const mj_incidence *in = &mj->inc;
+    mj_adapt *ad = mj->ad;
+    if (fabs(mj_inc_dot(in, a, y->st.v)) > ad->u_rest[a])
+        return 0;
+    double G = 0.0;
+    for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
+        G += in->w[j] * free_acc(mj, y, in->dof[j]);
+    if (!(G < 0.0))
+        return 0;
+    for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
+        mark_event(ad, in->dof[j], -G * h / ad->w[in->dof[j]]);
+    return 1;
+}
+
+/* The overrun of a held contact whose force falls: lambda0 at time t0 and
+ * lambda1 at t1 > t0 (the means P / h of two held steps at their
+ * middles), their line's zero z; when z falls before the end `until` of
+ * the later held step, the force was applied d = until - z too long, an
+ * impulse error |lambda'| d^2 / 2 on the contact's dofs.  Returns the zero
+ * (+inf when the force does not fall or its zero is later). */
+static double overrun(pd_mj *mj, int a, double lambda0, double t0, double lambda1, double t1,
+                      double until)
+{
+    double rate = (lambda1 - lambda0) / (t1 - t0);
+    if (!(rate < 0.0))
+        return HUGE_VAL;
+    double zero = t1 + lambda1 / -rate;
+    if (!(zero < until))
+        return HUGE_VAL;
+    mark_impulse(mj, a, -rate * (until - zero) * (until - zero) / 2.0);
+    return zero;
+}
+
+/* Contacts that stop pushing in the try (its halves of size h, times from
+ * its start): the scheme lets go at the end of the step where the contact
+ * force's mean turns negative, so a held step may overrun the force's
+ * zero.  Held in the step before (size hc; no impact in it) and in the
+ * first half: the line through their forces (released() when the first
+ * half let go);
+ * held in both halves (no impact in the first): the line through theirs
+ * (released() when the second let go).  Returns 1 when an event may lie
+ * in the first half. */
+static int scan_releases(pd_mj *mj, double h)
+{
+    const pd_model *md = mj->model;
+    const mj_adapt *ad = mj->ad;
+    double hc = ad->cur->st.h;
+    int first = 0;
+    for (int a = 0; a < md->m; a++) {
+        double P0 = ad->cur->st.P[a], Pa = ad->half->st.P[a], P2 = ad->two->st.P[a];
+        if (P0 > 0.0 && !(Pa > 0.0))
+            first |= released(mj, a, ad->cur, h);
+        if (!(Pa > 0.0))
+            continue;
+        if (P0 > 0.0 && hc > 0.0 && !ad->impact_made &&
+            overrun(mj, a, P0 / hc, -0.5 * hc, Pa / h, 0.5 * h, h) < h)
+            first = 1;
+        if (!(P2 > 0.0)) {
+            released(mj, a, ad->half, h);
+            continue;
+        }
+        if (flight_event(mj, a, impact_jump(mj, a, ad->cur, ad->half)))
+            continue;
+        first |= overrun(mj, a, Pa / h, 0.5 * h, P2 / h, 1.5 * h, 2.0 * h) < h;
+    }
+    return first;
+}
+
+/* The try's events: impacts and dips of each half (with their bounds), of
+ * the whole step (detection), contacts let go; *first: one lies in the
+ * first half, *event: one lies in the try.  Returns 1 for a cascade. */
+static int scan_try(pd_mj *mj, double h, int *first, int *event)
+{
+    mj_adapt *ad = mj->ad;
+    long before = ad->nmarked;
+    int cascade = scan_impacts(mj, ad->cur, ad->half, h, 1.0);
+    scan_dips(mj, ad->cur, ad->half, h);
+    *first = ad->nmarked > before || scan_releases(mj, h);
+    cascade |= scan_impacts(mj, ad->half, ad->two, h, 1.0);
+    scan_dips(mj, ad->half, ad->two, h);
+    scan_impacts(mj, ad->cur, ad->one, 2.0 * h, 0.0);
+    *event = ad->nmarked > before;
+    return cascade;
+}
+
+/* The try's error against its tolerance (> 1: fails), its estimate into
+ * eps: on the dofs an event marked, the first-order difference |q2 - q1| +
+ * |v2 - v1| H plus the events' bounds against ke rtol s_i; on the others the
+ * doubling estimate (|q2 - q1| + |v2 - v1| / w) / (2^p - 1) against the
+ * error per unit step kf rtol s_i H / T.
+ * Differences within rounding of the state (64 ulps) count as none. */
+static double try_error(pd_mj *mj, double H)
+{
+    const mj_adapt *ad = mj->ad;
+    const snap *s1 = ad->one, *s2 = ad->two;
+    double rtol = mj->opts.rtol, div = ad->div, r = 0.0;
+    double tol_event = ADAPT_KE * rtol, tol_flight = ADAPT_KF * rtol * H / ad->span;
+    for (int i = 0; i < mj->model->n; i++) {
+        double dq = fabs(s2->st.q[i] - s1->st.q[i]), dv = fabs(s2->st.v[i] - s1->st.v[i]);
+        double noise = 64.0 * 2.2e-16 * (fabs(s2->st.q[i]) + fabs(s2->st.v[i]) / ad->w[i]);
+        int event = ad->evmark[i] == ad->try_stamp;
+        /* an event's velocities differ by impulses taken at other instants of
+         * the step (a next stage of an impact in the halves, the whole step's
+         * in its next step): that moves the dof by dv over the step, not dv / w */
+        double d = fmax(dq + dv * (event ? H : 1.0 / ad->w[i]) - noise, 0.0);
+        double e = event ? d + ad->bound[i] : d / div;
+        ad->eps[i] = e;
+        r = pd_max(r, e / (dof_scale(ad, i) * (event ? tol_event : tol_flight)));
+    }
+    return r;
+}
+
+/* A new try: no dof marked, no bound. */
+static void try_begin(mj_adapt *ad, int n)
+{
+    if (++ad->try_stamp == 0) { /* the stamps wrapped: clear the marks */
+        memset(ad->evmark, 0, (size_t)n * sizeof *ad->evmark);
+        ad->try_stamp = 1;
+    }
+    memset(ad->bound, 0, (size_t)n * sizeof *ad->bound);
+}
+
+/* ---- keeping steps ------------------------------------------------------------------ */
+
+/* The closing speeds below which a contact takes no restitution: a rebound
+ * e |U| <= ke rtol s_i w_i moves its dofs within the event tolerance (so
+ * that a contact pressed shut rests instead of chattering at O(h) speeds,
+ * as the references jump an accumulation to rest). */
+static void rest_speeds(pd_mj *mj)
+{
+    const pd_model *md = mj->model;
+    const mj_incidence *in = &mj->inc;
+    mj_adapt *ad = mj->ad;
+    for (int a = 0; a < md->m; a++) {
+        double u = HUGE_VAL;
+        for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
+            int i = in->dof[j];
+            u = fmin(u, ADAPT_KE * mj->opts.rtol * dof_scale(ad, i) * ad->w[i]);
+        }
+        ad->u_rest[a] = isfinite(u) ? u : 0.0;
+    }
+}
+
+/* The state's err: the estimate so far and, for exact flights, the bound
+ * of the observers' quintic interpolation inside the last step h, (w h)^6
+ * / 46080 s_i (w: the dof's frequency or the forcing's, the larger). */
+static void report_err(pd_mj *mj, double h)
+{
+    mj_adapt *ad = mj->ad;
+    double wf = ad->F ? mj_flight_forcing_w(mj) : 0.0;
+    for (int i = 0; i < mj->model->n; i++) {
+        double wh = fmax(ad->w[i], wf) * h, wh3 = wh * wh * wh;
+        ad->Er[i] = ad->E[i] + (ad->F ? wh3 * wh3 / 46080.0 * dof_scale(ad, i) : 0.0);
+    }
+}
+
+/* Keep x, made by a step from w, as the new state with the error eps
+ * scaled by f (0: none): the estimate, the amplitudes, the statistics;
+ * report it.  Returns the observer's verdict (> 0: stop). */
+static int keep(pd_mj *mj, const snap *w, snap *x, double f, pd_observer observer, void *ctx)
+{
+    const pd_model *md = mj->model;
+    mj_adapt *ad = mj->ad;
+    ad->impact_made = 0; /* an impact in the step w -> x (its impulses are no held force) */
+    for (int a = 0; a < md->m && !ad->impact_made; a++)
+        ad->impact_made = flight_event(mj, a, impact_jump(mj, a, w, x));
+    for (int i = 0; i < md->n; i++) {
+        if (f > 0.0)
+            ad->E[i] += f * ad->eps[i];
+        double vw = x->st.v[i] / ad->w[i];
+        ad->amp[i] = pd_max(ad->amp[i], sqrt(x->st.q[i] * x->st.q[i] + vw * vw));
+    }
+    rest_speeds(mj);
+    if (ad->F) { /* the free motion's accelerations, for the observers' interpolation */
+        mj_flight_acc(mj, &x->st, x->z, x->st.acc);
+        x->st.has_acc = 1;
+    }
+    ad->stats.steps++;
+    ad->stats.h_min = fmin(ad->stats.h_min, x->st.h);
+    ad->stats.h_max = fmax(ad->stats.h_max, x->st.h);
+    report_err(mj, x->st.h);
+    mj->st = x->st;
+    mj->st.err = ad->Er;
+    return observer ? observer(&mj->st, ctx) : 0;
+}
+
+static void swap(snap **a, snap **b)
+{
+    snap *t = *a;
+    *a = *b;
+    *b = t;
+}
+
+/* Keep the pair of halves: half then two become the state, each with half
+ * of the try's estimate. */
+static int keep_pair(pd_mj *mj, pd_observer observer, void *ctx)
+{
+    mj_adapt *ad = mj->ad;
+    int stop = keep(mj, ad->cur, ad->half, 0.5, observer, ctx);
+    if (!stop)
+        stop = keep(mj, ad->half, ad->two, 0.5, observer, ctx);
+    swap(&ad->cur, &ad->two);
+    return stop;
+}
+
+/* A smooth pair's error per h^(p+1), for steps kept without a try of their own. */
+static void note_rate(mj_adapt *ad, int n, double H)
+{
+    double scale = (ad->div + 1.0) / (ad->p == 2 ? H * H * H : H * H);
+    for (int i = 0; i < n; i++)
+        ad->rate[i] = ad->eps[i] * scale;
+}
+
+/* The estimate of one smooth step of size h from the last smooth pair. */
+static void rate_estimate(mj_adapt *ad, int n, double h)
+{
+    double hp = ad->p == 2 ? h * h * h : h * h;
+    for (int i = 0; i < n; i++)
+        ad->eps[i] = ad->rate[i] * hp;
+}
+
+/* ---- the run ---------------------------------------------------------------------------- */
+
+/* The last tick at or before t_end (t_end itself when within 1e-9 of a tick). */
+static int end_tick(const mj_adapt *ad, double t_end, uint64_t *tick, pd_err *err)
+{
+    double r = (t_end - ad->t_origin) / ad->htick, k = floor(r + 0.5);
+    if (!(r < 0x1p62))
+        return pd_err_set(err, PD_EINVAL,
+                          "Moreau-Jean: the run to t = %g spans %.3g coarsest steps of %g, more "
+                          "than the ladder of %d levels can count (a larger h)",
+                          t_end, (t_end - ad->t_origin) / ad->h0, ad->h0, ad->L);
+    *tick = r <= 0.0 ? 0 : fabs(r - k) <= 1e-9 * fmax(1.0, r) ? (uint64_t)k : (uint64_t)floor(r);
+    return PD_OK;
+}
+
+/* The tick no step may cross from x: t_end, or the next piece's start. */
+static uint64_t step_limit(const mj_adapt *ad, const snap *x, uint64_t tick_end)
+{
+    if (ad->F && x->piece + 1 < ad->F->npieces && ad->piece_tick[x->piece + 1] < tick_end)
+        return ad->piece_tick[x->piece + 1];
+    return tick_end;
+}
+
+/* 1 when no contact pushed in the step that made x. */
+static int none_pushing(const pd_model *md, const snap *x)
+{
+    for (int a = 0; a < md->m; a++)
+        if (x->st.P[a] > 0.0)
+            return 0;
+    return 1;
+}
+
+/* The finest level: one step, no try (the estimate from the last smooth
+ * pair, the events' bound); rtol is not met when an event needed more. */
+static int finest_step(pd_mj *mj, pd_observer observer, void *ctx, pd_err *err)
+{
+    mj_adapt *ad = mj->ad;
+    int n = mj->model->n, rc;
+    double h = ad->lev[ad->L].h;
+    if ((rc = take_step(mj, ad->L, ad->cur, ad->two, err)))
+        return rc;
+    try_begin(ad, n);
+    rate_estimate(ad, n, h);
+    scan_impacts(mj, ad->cur, ad->two, h, 1.0);
+    for (int i = 0; i < n; i++)
+        if (ad->evmark[i] == ad->try_stamp) {
+            ad->eps[i] += ad->bound[i];
+            if (ad->eps[i] > ADAPT_KE * mj->opts.rtol * dof_scale(ad, i))
+                ad->stats.floor_hit = 1;
+        }
+    int stop = keep(mj, ad->cur, ad->two, 1.0, observer, ctx);
+    swap(&ad->cur, &ad->two);
+    return stop;
+}
+
+/* An exact flight from a state where no contact pushes: kept whole when no
+ * contact shuts, grazes or closes in it (then it has no error).  Returns 1
+ * when kept, 0 when the step (in ad->one) needs a try, < 0 on failure. */
+static int exact_flight(pd_mj *mj, int k, pd_observer observer, void *ctx, int *stop,
+                        pd_err *err)
+{
+    mj_adapt *ad = mj->ad;
+    int rc;
+    if ((rc = take_step(mj, k, ad->cur, ad->one, err)))
+        return rc;
+    if (ad->one->st.nactive > 0)
+        return 0;
+    try_begin(ad, mj->model->n);
+    long before = ad->nmarked;
+    scan_dips(mj, ad->cur, ad->one, ad->lev[k].h);
+    if (ad->nmarked > before)
+        return 0;
+    *stop = keep(mj, ad->cur, ad->one, 0.0, observer, ctx);
+    swap(&ad->cur, &ad->one);
+    return 1;
+}
+
+int mj_adapt_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx, pd_err *err)
+{
+    const pd_model *md = mj->model;
+    mj_adapt *ad = mj->ad;
+    uint64_t tick_end = 0;
+    int n = md->n, rc, have_one = 0, stop = 0;
+    if ((rc = end_tick(ad, t_end, &tick_end, err)))
+        return rc;
+    if (!ad->started) {
+        ad->started = 1;
+        if (ad->span == 0.0)
+            ad->span = fmax(t_end - ad->t_origin, ad->h0);
+        if (observer && observer(&mj->st, ctx) > 0)
+            return PD_OK;
+    }
+    mj->stop = 0;
+    int k = ad->k;
+    while (ad->cur->tick < tick_end && !stop && !mj->stop) {
+        /* the coarsest level from k on that starts here and ends in time */
+        uint64_t limit = step_limit(ad, ad->cur, tick_end);
+        while (k < ad->L && ((ad->cur->tick & (level_ticks(ad, k) - 1)) != 0 ||
+                             ad->cur->tick + level_ticks(ad, k) > limit)) {
+            k++;
+            have_one = 0;
+        }
+        if (k >= ad->L) {
+            if ((rc = finest_step(mj, observer, ctx, err)) < 0)
+                return rc;
+            stop = rc;
+            k = ad->L - 1;
+            have_one = 0;
+            continue;
+        }
+        /* tries at the ladder's foot that do not end: the floor's budget */
+        ad->deep = k + ADAPT_DEEP >= ad->L ? ad->deep + 1 : 0;
+        ad->stats.floor_hit |= ad->deep > ADAPT_DEEP_MAX;
+        int budget = (double)ad->stats.evals >= mj->opts.max_evals || ad->deep > ADAPT_DEEP_MAX;
+        ad->stats.budget_hit |= budget;
+        double H = ad->lev[k].h, h = ad->lev[k + 1].h;
+        if (ad->F && !have_one && none_pushing(md, ad->cur)) {
+            /* an exact flight: no error to control, so back to the coarsest step */
+            if ((rc = exact_flight(mj, k, observer, ctx, &stop, err)) < 0)
+                return rc;
+            if (rc == 1) {
+                k = ad->k_flight;
+                continue;
+            }
+            have_one = 1;
+        }
+        if ((!have_one && (rc = take_step(mj, k, ad->cur, ad->one, err))) ||
+            (rc = take_step(mj, k + 1, ad->cur, ad->half, err)) ||
+            (rc = take_step(mj, k + 1, ad->half, ad->two, err)))
+            return rc;
+        /* the try: events mark their dofs for the event's test */
+        try_begin(ad, n);
+        int ev_half, event, cascade = scan_try(mj, h, &ev_half, &event);
+        double r = try_error(mj, H);
+        if (getenv("ADAPT_DEBUG") && ad->cur->st.t > atof(getenv("ADAPT_DEBUG")) && ad->cur->st.t < atof(getenv("ADAPT_DEBUG")) + 0.3)
+            fprintf(stderr, "try t %.15g k %d r %.3g cas %d ev %d evh %d P %.3g %.3g %.3g v %.3g %.3g %.3g %.3g g %.3g %.3g %.3g bound %.3g eps %.3g\n", ad->cur->st.t, k, r, cascade, event, ev_half,
+                    ad->one->st.P[0], ad->half->st.P[0], ad->two->st.P[0], ad->cur->st.v[0], ad->one->st.v[0], ad->half->st.v[0], ad->two->st.v[0], ad->cur->st.g[0], ad->half->st.g[0], ad->two->st.g[0], ad->bound[0], ad->eps[0]);
+        have_one = 0;
+        if ((r <= 1.0 && !cascade) || budget || k + 1 >= ad->L) {
+            ad->stats.floor_hit |= (r > 1.0 || cascade) && !budget;
+            if (getenv("FLOOR_DEBUG") && (r > 1.0 || cascade) && !budget) {
+                fprintf(stderr, "floor t %.17g k %d r %g cascade %d event %d\n", ad->cur->st.t, k, r, cascade, event);
+                for (int a = 0; a < md->m; a++) fprintf(stderr, "  c%d P %.3g %.3g %.3g %.3g g %.3g %.3g %.3g U %.3g %.3g\n", a, ad->cur->st.P[a], ad->one->st.P[a], ad->half->st.P[a], ad->two->st.P[a], ad->cur->st.g[a], ad->half->st.g[a], ad->two->st.g[a], mj_inc_dot(&mj->inc, a, ad->cur->st.v), mj_inc_dot(&mj->inc, a, ad->half->st.v));
+                for (int i = 0; i < n; i++) fprintf(stderr, "  d%d eps %.3g bound %.3g mark %d scale %.3g\n", i, ad->eps[i], ad->bound[i], ad->evmark[i] == ad->try_stamp, dof_scale(ad, i));
+            }
+            if (!event)
+                note_rate(ad, n, H);
+            stop = keep_pair(mj, observer, ctx);
+            if (!event && r <= ADAPT_GROW / (ad->div + 1.0) && k > 0)
+                k--;
+            continue;
+        }
+        ad->stats.rejected++;
+        if (event && !ev_half) {
+            /* the event lies in the second half: keep the first, try the second */
+            rate_estimate(ad, n, h);
+            stop = keep(mj, ad->cur, ad->half, 1.0, observer, ctx);
+            swap(&ad->cur, &ad->half);
+            swap(&ad->one, &ad->two); /* the second half's whole step */
+        } else {
+            swap(&ad->one, &ad->half); /* the first half is the next try's whole step */
+        }
+        have_one = 1;
+        k++;
+    }
+    ad->k = k;
+    mj->st = ad->cur->st;
+    mj->st.err = ad->Er;
+    return PD_OK;
+}
+
+void mj_adapt_stats(const pd_mj *mj, pd_mj_stats *s)
+{
+    const mj_adapt *ad = mj->ad;
+    *s = ad->stats;
+    s->err_max = 0.0;
+    for (int i = 0; i < mj->model->n; i++)
+        s->err_max = pd_max(s->err_max, ad->E[i] / dof_scale(ad, i));
+    if (s->steps == 0)
+        s->h_min = s->h_max = NAN;
+}

@@ -1,0 +1,767 @@
+/* mj_flight.c — exact flights for Moreau–Jean to a tolerance: linear
+ * structures under a piecewise forcing F(t) = b f(t).
+ *
+ *   blocks     the dofs that M, C, K couple (one structure each in a scene); blocks
+ *              alike (the same M, C, K, b) share one kind of table
+ *   augmented  per block x = [q; v] and the forcing's state z = [A sin(w t + phi),
+ *              A cos(w t + phi), c0 + c1 (t - ts), c1], f = z0 + z2:
+ *                x' = [[0, I], [-M^-1 K, -M^-1 C]] x + [0; M^-1 b] (z0 + z2),
+ *                z' = [w z1, -w z0, z3, 0]            (A~, na = 2 s + 4)
+ *   ladder     E_k = exp(A~ h_k) - I: the finest level's by its Taylor series, then
+ *              E_k-1 = 2 E_k + E_k^2 (the increment form keeps tiny steps exact:
+ *              x+ = x + E_k [x; z])
+ *   a step     the free flight of every block, z in closed form; contacts active
+ *              when their gap is shut at the step's start (within sim_gap, the scale
+ *              below which the reference takes contacts as closed) or at the free
+ *              flight's end; impulses P at mid-step (the exact-flow counterpart of theta =
+ *              1/2, which keeps a held gap shut to O(h^3)):
+ *                v+ = v_free + Phi_vv(h/2) M^-1 W P,  q+ = q_free + Phi_qv(h/2) M^-1 W P,
+ *                w = W^T v+ + e U_k >= 0 ⊥ P >= 0,  D = W^T Phi_vv(h/2) M^-1 W
+ * The tables are formed with the object (one table a level a kind); a step
+ * allocates nothing. */
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mj.h"
+
+#define FL_TAYLOR_MAX 40 /* terms of the finest level's series, at most */
+
+/* A kind of block: its tables. */
+typedef struct fl_kind {
+    int s, na;       /* dofs; 2 s + 4 */
+    double *E;       /* levels 0..L+1: the first 2 s rows of E_k (2 s x na, by columns) */
+    double *Minv;    /* s x s: M^-1 */
+    double *Av;      /* s x na: the rows of A~ for v' (the accelerations) */
+    double wmax;     /* a bound of its highest natural frequency */
+} fl_kind;
+
+/* A block: its kind and dofs. */
+typedef struct fl_block {
+    int kind, s;
+    int *dofs;       /* s dofs, increasing */
+} fl_block;
+
+struct mj_flight {
+    const pd_piecewise_force *F;
+    double w;                /* the sinusoids' frequency */
+    int L;                   /* levels 0..L + 1 */
+    double *h, *cm1, *sw;    /* L + 2: h_k, cos(w h_k) - 1, sin(w h_k) */
+    int nblocks, nkinds;
+    fl_block *blocks;
+    fl_kind *kinds;
+    int *block_of, *at;      /* n: each dof's block, its place in it */
+    int *dofs;               /* n: the blocks' dofs, end to end */
+    unsigned *touched;       /* nblocks: the stamp of the last visit */
+    unsigned *cmark;         /* m: the stamp of the last visit */
+    unsigned stamp;
+    int *pos;                /* m: place of a contact in the active set, or -1 */
+    double *r;               /* n: W P */
+    double *x, *dx, *y;      /* 2 smax + 4 */
+};
+
+/* ---- dense helpers ---------------------------------------------------------- */
+
+/* C = A B for na x na column-major A, B (C distinct). */
+static void matmul(int na, const double *A, const double *B, double *C)
+{
+    for (int j = 0; j < na; j++)
+        for (int i = 0; i < na; i++) {
+            double sum = 0.0;
+            for (int l = 0; l < na; l++)
+                sum += A[i + (size_t)l * na] * B[l + (size_t)j * na];
+            C[i + (size_t)j * na] = sum;
+        }
+}
+
+/* ||A||_1 (the largest column sum). */
+static double norm1(int na, const double *A)
+{
+    double best = 0.0;
+    for (int j = 0; j < na; j++) {
+        double sum = 0.0;
+        for (int i = 0; i < na; i++)
+            sum += fabs(A[i + (size_t)j * na]);
+        best = fmax(best, sum);
+    }
+    return best;
+}
+
+/* ---- blocks --------------------------------------------------------------- */
+
+static int find_root(int *parent, int i)
+{
+    while (parent[i] != i)
+        i = parent[i] = parent[parent[i]];
+    return i;
+}
+
+/* Join the dofs every stored off-diagonal entry of A couples. */
+static void join_entries(const pd_matrix *A, int *parent)
+{
+    for (int j = 0; j < A->cols; j++)
+        for (int i = 0; i < A->rows; i++) {
+            if (i == j || pd_matrix_get(A, i, j) == 0.0)
+                continue;
+            int a = find_root(parent, i), b = find_root(parent, j);
+            if (a != b)
+                parent[a < b ? b : a] = a < b ? a : b;
+        }
+}
+
+/* Blocks from the coupling of M, C, K: block_of, at, dofs and the blocks'
+ * sizes and dof lists (dofs increasing in each). */
+static int find_blocks(const pd_model *md, mj_flight *fl)
+{
+    int n = md->n;
+    int *parent = malloc((size_t)n * sizeof(int)), *first = malloc((size_t)n * sizeof(int));
+    int rc = PD_ENOMEM;
+    if (!parent || !first)
+        goto done;
+    for (int i = 0; i < n; i++)
+        parent[i] = i;
+    join_entries(&md->M, parent);
+    join_entries(&md->C, parent);
+    join_entries(&md->K, parent);
+    fl->nblocks = 0;
+    for (int i = 0; i < n; i++) /* roots are their block's smallest dof */
+        if (find_root(parent, i) == i)
+            first[i] = fl->nblocks++;
+    if (!(fl->blocks = calloc((size_t)fl->nblocks, sizeof *fl->blocks)))
+        goto done;
+    for (int i = 0; i < n; i++) {
+        int b = first[find_root(parent, i)];
+        fl->block_of[i] = b;
+        fl->at[i] = fl->blocks[b].s++;
+    }
+    for (int b = 0, off = 0; b < fl->nblocks; b++) {
+        fl->blocks[b].dofs = fl->dofs + off;
+        off += fl->blocks[b].s;
+    }
+    for (int i = 0; i < n; i++)
+        fl->blocks[fl->block_of[i]].dofs[fl->at[i]] = i;
+    rc = PD_OK;
+done:
+    free(parent);
+    free(first);
+    return rc;
+}
+
+/* 1 when blocks a and b have the same M, C, K and b entries. */
+static int same_block(const pd_model *md, const pd_piecewise_force *F, const fl_block *a,
+                      const fl_block *b)
+{
+    if (a->s != b->s)
+        return 0;
+    for (int i = 0; i < a->s; i++) {
+        if (F->b[a->dofs[i]] != F->b[b->dofs[i]])
+            return 0;
+        for (int j = 0; j < a->s; j++) {
+            int ai = a->dofs[i], aj = a->dofs[j], bi = b->dofs[i], bj = b->dofs[j];
+            if (pd_matrix_get(&md->M, ai, aj) != pd_matrix_get(&md->M, bi, bj) ||
+                pd_matrix_get(&md->C, ai, aj) != pd_matrix_get(&md->C, bi, bj) ||
+                pd_matrix_get(&md->K, ai, aj) != pd_matrix_get(&md->K, bi, bj))
+                return 0;
+        }
+    }
+    return 1;
+}
+
+/* A hash of a block's entries (blocks alike hash alike). */
+static uint64_t block_hash(const pd_model *md, const pd_piecewise_force *F, const fl_block *bl)
+{
+    uint64_t h = 1469598103934665603ull ^ (uint64_t)bl->s;
+    for (int i = 0; i < bl->s; i++)
+        for (int j = 0; j < bl->s; j++) {
+            int di = bl->dofs[i], dj = bl->dofs[j];
+            double v[4] = {pd_matrix_get(&md->M, di, dj), pd_matrix_get(&md->C, di, dj),
+                           pd_matrix_get(&md->K, di, dj), i == j ? F->b[di] : 0.0};
+            for (int k = 0; k < 4; k++) {
+                uint64_t bits;
+                memcpy(&bits, &v[k], sizeof bits);
+                h = (h ^ bits) * 1099511628211ull;
+            }
+        }
+    return h;
+}
+
+/* ---- the tables of a kind ---------------------------------------------------- */
+
+/* A~ of block bl (na x na, by columns) and M^-1 into the kind. */
+static int augmented(const pd_model *md, const mj_flight *fl, const fl_block *bl, fl_kind *kd,
+                     double *A, pd_err *err)
+{
+    int s = bl->s, na = kd->na;
+    double *LU = calloc((size_t)s * s, sizeof(double));
+    int *perm = calloc((size_t)s, sizeof(int));
+    if (!LU || !perm) {
+        free(LU);
+        free(perm);
+        return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for a block of %d dofs", s);
+    }
+    for (int j = 0; j < s; j++)
+        for (int i = 0; i < s; i++)
+            LU[i + (size_t)j * s] = pd_matrix_get(&md->M, bl->dofs[i], bl->dofs[j]);
+    int rc = pd_dense_lu(s, LU, s, perm, 1e-14);
+    if (rc) {
+        free(LU);
+        free(perm);
+        return pd_err_set(err, PD_ESINGULAR, "Moreau-Jean: the mass matrix of the block of dof "
+                          "%d is singular", bl->dofs[0]);
+    }
+    /* M^-1 by columns, then -M^-1 K and -M^-1 C into A~ */
+    memset(A, 0, (size_t)na * na * sizeof(double));
+    for (int j = 0; j < s; j++) {
+        double *mj_col = kd->Minv + (size_t)j * s;
+        for (int i = 0; i < s; i++)
+            mj_col[i] = i == j ? 1.0 : 0.0;
+        pd_dense_lu_solve(s, LU, s, perm, mj_col);
+    }
+    for (int j = 0; j < s; j++) {
+        for (int which = 0; which < 2; which++) {
+            const pd_matrix *X = which ? &md->C : &md->K;
+            for (int i = 0; i < s; i++) {
+                double sum = 0.0;
+                for (int l = 0; l < s; l++)
+                    sum += kd->Minv[i + (size_t)l * s] * pd_matrix_get(X, bl->dofs[l], bl->dofs[j]);
+                A[s + i + (size_t)(which ? s + j : j) * na] = -sum;
+            }
+        }
+        A[j + (size_t)(s + j) * na] = 1.0; /* q' = v */
+    }
+    for (int i = 0; i < s; i++) {
+        double sum = 0.0;
+        for (int l = 0; l < s; l++)
+            sum += kd->Minv[i + (size_t)l * s] * fl->F->b[bl->dofs[l]];
+        A[s + i + (size_t)(2 * s) * na] = sum;     /* z0 */
+        A[s + i + (size_t)(2 * s + 2) * na] = sum; /* z2 */
+    }
+    A[2 * s + (size_t)(2 * s + 1) * na] = fl->w;  /* z0' = w z1 */
+    A[2 * s + 1 + (size_t)(2 * s) * na] = -fl->w; /* z1' = -w z0 */
+    A[2 * s + 2 + (size_t)(2 * s + 3) * na] = 1.0; /* z2' = z3 */
+    free(LU);
+    free(perm);
+    return PD_OK;
+}
+
+/* Gershgorin's bound of the block's highest natural frequency, sqrt of
+ * max_i sum_j |(M^-1 K)_ij|, read off A~. */
+static double block_wmax(const fl_kind *kd, const double *A)
+{
+    int s = kd->s, na = kd->na;
+    double best = 0.0;
+    for (int i = 0; i < s; i++) {
+        double sum = 0.0;
+        for (int j = 0; j < s; j++)
+            sum += fabs(A[s + i + (size_t)j * na]);
+        best = fmax(best, sum);
+    }
+    return sqrt(best);
+}
+
+/* E at every level: the finest one's series, then E_k-1 = 2 E_k + E_k^2;
+ * the first 2 s rows kept. */
+static int ladder(const mj_flight *fl, fl_kind *kd, const double *A, pd_err *err)
+{
+    int na = kd->na, rows = 2 * kd->s, L = fl->L;
+    size_t nn = (size_t)na * na, lev = (size_t)rows * na;
+    double *E = malloc(nn * sizeof(double)), *T = malloc(nn * sizeof(double)),
+           *U = malloc(nn * sizeof(double));
+    if (!E || !T || !U) {
+        free(E);
+        free(T);
+        free(U);
+        return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for a block's ladder");
+    }
+    /* the finest level: E = sum_j>=1 (A h)^j / j! */
+    double hf = fl->h[L + 1];
+    for (size_t i = 0; i < nn; i++)
+        E[i] = T[i] = A[i] * hf;
+    for (int j = 2; j <= FL_TAYLOR_MAX && norm1(na, T) > 1e-18 * fmax(norm1(na, E), 1e-300);
+         j++) {
+        matmul(na, T, A, U);
+        for (size_t i = 0; i < nn; i++) {
+            T[i] = U[i] * hf / j;
+            E[i] += T[i];
+        }
+    }
+    for (int k = L + 1; k >= 0; k--) {
+        for (int c = 0; c < na; c++) /* keep the first 2 s rows */
+            for (int r = 0; r < rows; r++)
+                kd->E[(size_t)k * lev + r + (size_t)c * rows] = E[r + (size_t)c * na];
+        if (k == 0)
+            break;
+        matmul(na, E, E, U);
+        for (size_t i = 0; i < nn; i++)
+            E[i] = 2.0 * E[i] + U[i];
+    }
+    int finite = 1;
+    for (size_t i = 0; i < lev * (size_t)(L + 2); i++)
+        finite &= isfinite(kd->E[i]);
+    free(E);
+    free(T);
+    free(U);
+    return finite ? PD_OK
+                  : pd_err_set(err, PD_ENUMERICAL, "Moreau-Jean: the exact flight of a block of "
+                               "%d dofs overflows at the coarsest step (a smaller h)", kd->s);
+}
+
+/* The kinds: blocks alike share one; each kind's tables. */
+static int form_kinds(const pd_model *md, mj_flight *fl, pd_err *err)
+{
+    int nb = fl->nblocks, rc = PD_OK;
+    uint64_t *hash = malloc((size_t)nb * sizeof(uint64_t));
+    int *rep = malloc((size_t)nb * sizeof(int)); /* each kind's first block */
+    fl->kinds = calloc((size_t)nb, sizeof *fl->kinds);
+    if (!hash || !rep || !fl->kinds) {
+        rc = pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for %d blocks", nb);
+        goto done;
+    }
+    fl->nkinds = 0;
+    for (int b = 0; b < nb; b++) { /* a scene's kinds are few: compare with each */
+        fl_block *bl = &fl->blocks[b];
+        hash[b] = block_hash(md, fl->F, bl);
+        bl->kind = -1;
+        for (int k = 0; k < fl->nkinds && bl->kind < 0; k++)
+            if (hash[rep[k]] == hash[b] && same_block(md, fl->F, &fl->blocks[rep[k]], bl))
+                bl->kind = k;
+        if (bl->kind >= 0)
+            continue;
+        bl->kind = fl->nkinds;
+        rep[fl->nkinds++] = b;
+    }
+    for (int k = 0; k < fl->nkinds && !rc; k++) {
+        const fl_block *bl = &fl->blocks[rep[k]];
+        fl_kind *kd = &fl->kinds[k];
+        kd->s = bl->s;
+        kd->na = 2 * bl->s + 4;
+        size_t nn = (size_t)kd->na * kd->na;
+        double *A = malloc(nn * sizeof(double));
+        kd->Minv = malloc((size_t)bl->s * bl->s * sizeof(double));
+        kd->E = malloc((size_t)(fl->L + 2) * 2 * bl->s * kd->na * sizeof(double));
+        if (!A || !kd->Minv || !kd->E)
+            rc = pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for the tables of a "
+                            "block of %d dofs", bl->s);
+        if (!rc && !(kd->Av = malloc((size_t)bl->s * kd->na * sizeof(double))))
+            rc = pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for a block's tables");
+        if (!rc && !(rc = augmented(md, fl, bl, kd, A, err))) {
+            for (int c = 0; c < kd->na; c++)
+                for (int i = 0; i < bl->s; i++)
+                    kd->Av[i + (size_t)c * bl->s] = A[bl->s + i + (size_t)c * kd->na];
+            kd->wmax = block_wmax(kd, A);
+            rc = ladder(fl, kd, A, err);
+        }
+        free(A);
+    }
+done:
+    free(hash);
+    free(rep);
+    return rc;
+}
+
+/* ---- the object ------------------------------------------------------------------ */
+
+void mj_flight_free(pd_mj *mj)
+{
+    mj_flight *fl = mj ? mj->fl : NULL;
+    if (!fl)
+        return;
+    for (int k = 0; k < fl->nkinds && fl->kinds; k++) {
+        free(fl->kinds[k].E);
+        free(fl->kinds[k].Minv);
+        free(fl->kinds[k].Av);
+    }
+    free(fl->kinds);
+    free(fl->blocks);
+    free(fl->block_of);
+    free(fl->at);
+    free(fl->dofs);
+    free(fl->touched);
+    free(fl->cmark);
+    free(fl->pos);
+    free(fl->r);
+    free(fl->x);
+    free(fl->h);
+    free(fl);
+    mj->fl = NULL;
+}
+
+/* The forcing's one frequency: every sinusoidal piece's w (PD_EINVAL when
+ * they differ). */
+static int forcing_frequency(const pd_piecewise_force *F, double *w, pd_err *err)
+{
+    *w = 0.0;
+    for (int p = 0; p < F->npieces; p++) {
+        const pd_sine_piece *pc = &F->pieces[p];
+        if (pc->A == 0.0)
+            continue;
+        if (*w != 0.0 && pc->w != *w)
+            return pd_err_set(err, PD_EINVAL, "Moreau-Jean: exact flights need one forcing "
+                              "frequency (pieces %d: %g and earlier: %g)", p, pc->w, *w);
+        *w = pc->w;
+    }
+    return PD_OK;
+}
+
+int mj_flight_alloc(pd_mj *mj, const pd_piecewise_force *F, double h0, int L, pd_err *err)
+{
+    const pd_model *md = mj->model;
+    int n = md->n, rc;
+    mj_flight *fl = calloc(1, sizeof *fl);
+    if (!(mj->fl = fl))
+        return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for its flights");
+    fl->F = F;
+    fl->L = L;
+    if ((rc = forcing_frequency(F, &fl->w, err)))
+        return rc;
+    fl->h = malloc((size_t)3 * (L + 2) * sizeof(double));
+    fl->block_of = malloc((size_t)n * sizeof(int));
+    fl->at = malloc((size_t)n * sizeof(int));
+    fl->dofs = malloc((size_t)n * sizeof(int));
+    fl->r = calloc((size_t)n, sizeof(double));
+    fl->pos = malloc((md->m > 0 ? (size_t)md->m : 1) * sizeof(int));
+    if (!fl->h || !fl->block_of || !fl->at || !fl->dofs || !fl->r || !fl->pos ||
+        find_blocks(md, fl) ||
+        !(fl->touched = calloc((size_t)fl->nblocks, sizeof(unsigned))) ||
+        !(fl->cmark = calloc(md->m > 0 ? (size_t)md->m : 1, sizeof(unsigned))))
+        return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for its flights");
+    fl->cm1 = fl->h + L + 2;
+    fl->sw = fl->cm1 + L + 2;
+    for (int k = 0; k <= L + 1; k++) {
+        fl->h[k] = ldexp(h0, -k);
+        double half = sin(0.5 * fl->w * fl->h[k]);
+        fl->cm1[k] = -2.0 * half * half;
+        fl->sw[k] = sin(fl->w * fl->h[k]);
+    }
+    for (int a = 0; a < md->m; a++)
+        fl->pos[a] = -1;
+    int smax = 1;
+    for (int b = 0; b < fl->nblocks; b++)
+        smax = fl->blocks[b].s > smax ? fl->blocks[b].s : smax;
+    if (!(fl->x = malloc((size_t)3 * (2 * smax + 4) * sizeof(double))))
+        return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for its flights");
+    fl->dx = fl->x + 2 * smax + 4;
+    fl->y = fl->dx + 2 * smax + 4;
+    return form_kinds(md, fl, err);
+}
+
+void mj_flight_z(const pd_mj *mj, int p, double t, double *z)
+{
+    const pd_sine_piece *pc = &mj->fl->F->pieces[p];
+    double ph = pc->w * t + pc->phi;
+    z[0] = pc->A * sin(ph);
+    z[1] = pc->A * cos(ph);
+    z[2] = pc->c0 + pc->c1 * (t - pc->t_start);
+    z[3] = pc->c1;
+}
+
+double mj_flight_forcing_w(const pd_mj *mj)
+{
+    return mj->fl->w;
+}
+
+double mj_flight_wmax(const pd_mj *mj, int dof)
+{
+    const mj_flight *fl = mj->fl;
+    return fmax(fl->kinds[fl->blocks[fl->block_of[dof]].kind].wmax, fl->w);
+}
+
+/* ---- a step -------------------------------------------------------------------------- */
+
+/* The first 2 s rows of E_k of kind kd. */
+static const double *level_E(const fl_kind *kd, int k)
+{
+    return kd->E + (size_t)k * 2 * kd->s * kd->na;
+}
+
+/* The free flight of block bl over level k: out's q, v from in's and z. */
+static void free_flight(const mj_flight *fl, const fl_block *bl, int k, const pd_state *in,
+                        const double *z, pd_state *out)
+{
+    const fl_kind *kd = &fl->kinds[bl->kind];
+    const double *E = level_E(kd, k);
+    int s = bl->s, rows = 2 * s, na = kd->na;
+    double *x = fl->x, *dx = fl->dx;
+    if (s == 1) { /* an SDOF: rows q and v of E by columns q, v, z0..z3 */
+        int d = bl->dofs[0];
+        double q = in->q[d], v = in->v[d];
+        double dq = E[0] * q + E[2] * v + E[4] * z[0] + E[6] * z[1] + E[8] * z[2] + E[10] * z[3];
+        double dv = E[1] * q + E[3] * v + E[5] * z[0] + E[7] * z[1] + E[9] * z[2] + E[11] * z[3];
+        out->q[d] = q + dq;
+        out->v[d] = v + dv;
+        return;
+    }
+    for (int i = 0; i < s; i++) {
+        x[i] = in->q[bl->dofs[i]];
+        x[s + i] = in->v[bl->dofs[i]];
+    }
+    for (int i = 0; i < 4; i++)
+        x[rows + i] = z[i];
+    for (int r = 0; r < rows; r++)
+        dx[r] = 0.0;
+    for (int c = 0; c < na; c++) {
+        double xc = x[c];
+        if (xc == 0.0)
+            continue;
+        for (int r = 0; r < rows; r++)
+            dx[r] += E[r + (size_t)c * rows] * xc;
+    }
+    for (int i = 0; i < s; i++) {
+        out->q[bl->dofs[i]] = x[i] + dx[i];
+        out->v[bl->dofs[i]] = x[s + i] + dx[s + i];
+    }
+}
+
+/* D_ab = W_a^T Phi_vv(h/2) M^-1 W_b over the blocks they share (level
+ * k + 1 holds h/2). */
+static double delassus(const pd_mj *mj, int k, int a, int b)
+{
+    const mj_flight *fl = mj->fl;
+    const mj_incidence *in = &mj->inc;
+    double sum = 0.0;
+    for (int p = in->ptr[a]; p < in->ptr[a + 1]; p++) {
+        int i = in->dof[p], bi = fl->block_of[i];
+        const fl_block *bl = &fl->blocks[bi];
+        const fl_kind *kd = &fl->kinds[bl->kind];
+        const double *E = level_E(kd, k + 1);
+        int s = bl->s, rows = 2 * s, ri = fl->at[i];
+        for (int q = in->ptr[b]; q < in->ptr[b + 1]; q++) {
+            int j = in->dof[q];
+            if (fl->block_of[j] != bi)
+                continue;
+            int cj = fl->at[j];
+            /* (Phi_vv M^-1)_ij = sum_l (delta_il + E_vv,il) M^-1_lj */
+            double g = 0.0;
+            for (int l = 0; l < s; l++)
+                g += ((ri == l ? 1.0 : 0.0) + E[s + ri + (size_t)(s + l) * rows]) *
+                     kd->Minv[l + (size_t)cj * s];
+            sum += in->w[p] * g * in->w[q];
+        }
+    }
+    return sum;
+}
+
+/* The contacts that act on a block of contact a's: b's with a shared block. */
+static int shares_block(const pd_mj *mj, int a, int b)
+{
+    const mj_incidence *in = &mj->inc;
+    for (int p = in->ptr[a]; p < in->ptr[a + 1]; p++)
+        for (int q = in->ptr[b]; q < in->ptr[b + 1]; q++)
+            if (mj->fl->block_of[in->dof[p]] == mj->fl->block_of[in->dof[q]])
+                return 1;
+    return 0;
+}
+
+static int cmp_int(const void *x, const void *y)
+{
+    int a = *(const int *)x, b = *(const int *)y;
+    return a < b ? -1 : a > b;
+}
+
+/* D_II of the active set into mj->D_active: dense, or compressed columns
+ * with the contacts that share a block (found through the dofs of each
+ * block a contact acts on). */
+static void assemble_delassus(pd_mj *mj, int k, int nI)
+{
+    mj_flight *fl = mj->fl;
+    const mj_incidence *in = &mj->inc;
+    for (int r = 0; r < nI; r++)
+        fl->pos[mj->idx_active[r]] = r;
+    if (!mj->sparse) {
+        for (int c = 0; c < nI; c++)
+            for (int r = 0; r < nI; r++)
+                mj->D_active[r + (size_t)c * nI] =
+                    r == c || shares_block(mj, mj->idx_active[r], mj->idx_active[c])
+                        ? delassus(mj, k, mj->idx_active[r], mj->idx_active[c])
+                        : 0.0;
+    } else {
+        int nnz = 0;
+        for (int c = 0; c < nI; c++) {
+            int a = mj->idx_active[c], start = nnz;
+            unsigned stamp = ++fl->stamp;
+            mj->D_colptr[c] = nnz;
+            for (int p = in->ptr[a]; p < in->ptr[a + 1]; p++) {
+                int bi = fl->block_of[in->dof[p]];
+                if (fl->touched[bi] == stamp)
+                    continue;
+                fl->touched[bi] = stamp;
+                const fl_block *bl = &fl->blocks[bi];
+                for (int d = 0; d < bl->s; d++) {
+                    int i = bl->dofs[d];
+                    for (int q = in->dptr[i]; q < in->dptr[i + 1]; q++) {
+                        int b = in->con[q];
+                        if (fl->pos[b] < 0 || fl->cmark[b] == stamp)
+                            continue;
+                        fl->cmark[b] = stamp;
+                        mj->D_rowind[nnz++] = fl->pos[b];
+                    }
+                }
+            }
+            qsort(mj->D_rowind + start, (size_t)(nnz - start), sizeof(int), cmp_int);
+            for (int e = start; e < nnz; e++)
+                mj->D_active[e] = delassus(mj, k, mj->idx_active[mj->D_rowind[e]], a);
+        }
+        mj->D_colptr[nI] = nnz;
+    }
+    for (int r = 0; r < nI; r++)
+        fl->pos[mj->idx_active[r]] = -1;
+}
+
+/* The impulses' response at mid-step: v += Phi_vv(h/2) M^-1 W P, q +=
+ * Phi_qv(h/2) M^-1 W P on the blocks the active contacts act on. */
+static void apply_impulses(pd_mj *mj, int k, int nI, pd_state *out)
+{
+    mj_flight *fl = mj->fl;
+    const mj_incidence *in = &mj->inc;
+    fl->stamp++;
+    for (int c = 0; c < nI; c++) { /* r = W P on the dofs */
+        int a = mj->idx_active[c];
+        for (int p = in->ptr[a]; p < in->ptr[a + 1]; p++)
+            fl->r[in->dof[p]] += in->w[p] * mj->P_active[c];
+    }
+    for (int c = 0; c < nI; c++) {
+        int a = mj->idx_active[c];
+        for (int p = in->ptr[a]; p < in->ptr[a + 1]; p++) {
+            int bi = fl->block_of[in->dof[p]];
+            if (fl->touched[bi] == fl->stamp)
+                continue;
+            fl->touched[bi] = fl->stamp;
+            const fl_block *bl = &fl->blocks[bi];
+            const fl_kind *kd = &fl->kinds[bl->kind];
+            const double *E = level_E(kd, k + 1);
+            int s = bl->s, rows = 2 * s;
+            double *u = fl->x; /* M^-1 r on the block */
+            for (int i = 0; i < s; i++) {
+                double sum = 0.0;
+                for (int l = 0; l < s; l++)
+                    sum += kd->Minv[i + (size_t)l * s] * fl->r[bl->dofs[l]];
+                u[i] = sum;
+            }
+            for (int i = 0; i < s; i++) {
+                double dq = 0.0, dv = u[i];
+                for (int l = 0; l < s; l++) {
+                    dq += E[i + (size_t)(s + l) * rows] * u[l];
+                    dv += E[s + i + (size_t)(s + l) * rows] * u[l];
+                }
+                out->q[bl->dofs[i]] += dq;
+                out->v[bl->dofs[i]] += dv;
+            }
+            for (int i = 0; i < s; i++)
+                fl->r[bl->dofs[i]] = 0.0;
+        }
+    }
+}
+
+/* (M^-1)_ii of dof i. */
+static double minv_of(const mj_flight *fl, int i)
+{
+    const fl_block *bl = &fl->blocks[fl->block_of[i]];
+    return fl->kinds[bl->kind].Minv[fl->at[i] * (bl->s + 1)];
+}
+
+/* Held contacts (shut at the step's start and pushing) keep their gap: the
+ * impulses hold their gap rate at zero, the gap itself drifts by O(h^3)
+ * per step (the contact force varies inside the step); q moves along
+ * M^-1 W_a to put it back (Gauss-Seidel sweeps over held contacts that
+ * share a dof; M^-1 by its diagonal). */
+#define FL_HOLD_SWEEPS 3
+static void hold_gaps(pd_mj *mj, int nI, const pd_state *in, pd_state *out)
+{
+    const pd_model *md = mj->model;
+    const mj_incidence *inc = &mj->inc;
+    const mj_flight *fl = mj->fl;
+    for (int sweep = 0; sweep < FL_HOLD_SWEEPS; sweep++)
+        for (int r = 0; r < nI; r++) {
+            int a = mj->idx_active[r];
+            if (!(out->P[a] > 0.0) || in->g[a] > 0.0)
+                continue;
+            double g = md->g0[a] + mj_inc_dot(inc, a, out->q), d = in->g[a] - g;
+            double D0 = 0.0;
+            for (int j = inc->ptr[a]; j < inc->ptr[a + 1]; j++)
+                D0 += inc->w[j] * inc->w[j] * minv_of(fl, inc->dof[j]);
+            if (d == 0.0 || !(D0 > 0.0))
+                continue;
+            for (int j = inc->ptr[a]; j < inc->ptr[a + 1]; j++)
+                out->q[inc->dof[j]] += minv_of(fl, inc->dof[j]) * inc->w[j] * d / D0;
+        }
+}
+
+void mj_flight_acc(const pd_mj *mj, const pd_state *st, const double *z, double *acc)
+{
+    const mj_flight *fl = mj->fl;
+    for (int b = 0; b < fl->nblocks; b++) {
+        const fl_block *bl = &fl->blocks[b];
+        const fl_kind *kd = &fl->kinds[bl->kind];
+        int s = bl->s;
+        for (int i = 0; i < s; i++) {
+            double sum = 0.0;
+            for (int l = 0; l < s; l++)
+                sum += kd->Av[i + (size_t)l * s] * st->q[bl->dofs[l]] +
+                       kd->Av[i + (size_t)(s + l) * s] * st->v[bl->dofs[l]];
+            for (int c = 0; c < 4; c++)
+                sum += kd->Av[i + (size_t)(2 * s + c) * s] * z[c];
+            acc[bl->dofs[i]] = sum;
+        }
+    }
+}
+
+int mj_flight_step(pd_mj *mj, int k, double t1, const pd_state *in, const double *zin,
+                   pd_state *out, double *zout, pd_err *err)
+{
+    const pd_model *md = mj->model;
+    mj_flight *fl = mj->fl;
+    int nI = 0, rc;
+    double h = fl->h[k];
+    /* U_k before the free flight overwrites v (out may be in) */
+    for (int a = 0; a < md->m; a++)
+        mj->U0[a] = mj_inc_dot(&mj->inc, a, in->v);
+    for (int b = 0; b < fl->nblocks; b++)
+        free_flight(fl, &fl->blocks[b], k, in, zin, out);
+    double z0 = zin[0], z1 = zin[1];
+    zout[0] = z0 + fl->cm1[k] * z0 + fl->sw[k] * z1;
+    zout[1] = z1 + fl->cm1[k] * z1 - fl->sw[k] * z0;
+    zout[2] = zin[2] + h * zin[3];
+    zout[3] = zin[3];
+    out->t = t1;
+    out->step = in->step + 1;
+    out->lcp_pivots = 0;
+    out->lcp_solver = NULL;
+    /* the contacts shut at the start (within sim_gap) or at the free flight's end,
+     * but for those the free flight opens */
+    for (int a = 0; a < md->m; a++) {
+        unsigned char was = in->active[a] ? in->P[a] > 0.0 : 2;
+        double g_start = in->g[a], g_end = md->g0[a] + mj_inc_dot(&mj->inc, a, out->q);
+        out->active[a] = 0;
+        out->P[a] = 0.0;
+        out->g[a] = g_end;
+        /* an opening contact (faster than u_rest) left open by the free flight
+         * takes no impulse: if an impulse of this step makes it close, the
+         * next step's is its own impact (the references' next stage) */
+        int opening = mj->U0[a] > mj->u_rest[a] && g_end >= g_start;
+        if ((g_start <= mj->opts.sim_gap || g_end <= 0.0) && !opening) {
+            out->active[a] = 1;
+            if (mj->guess)
+                mj->guess[nI] = was;
+            mj->idx_active[nI++] = a;
+        }
+    }
+    out->nactive = nI;
+    if (nI > 0) {
+        assemble_delassus(mj, k, nI);
+        mj_active_rhs(mj, nI, out->v);
+        if ((rc = mj_solve_active(mj, nI, t1, out, err)))
+            return rc;
+        apply_impulses(mj, k, nI, out);
+        hold_gaps(mj, nI, in, out);
+        for (int r = 0; r < nI; r++) {
+            int a = mj->idx_active[r];
+            out->g[a] = md->g0[a] + mj_inc_dot(&mj->inc, a, out->q);
+        }
+    }
+    for (int i = 0; i < md->n; i++)
+        if (!isfinite(out->q[i]) || !isfinite(out->v[i]))
+            return pd_err_set(err, PD_ENONFINITE,
+                              "Moreau-Jean: non-finite state at t = %.9g (dof %d)", t1, i);
+    return PD_OK;
+}
