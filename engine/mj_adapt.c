@@ -40,9 +40,10 @@
 #define ADAPT_GROW 0.9      /* double the step below ADAPT_GROW 2^-p of the tolerance */
 #define ADAPT_START 3       /* the first try's level */
 #define ADAPT_BREAK_TOL 1e-12 /* a time within this relative distance of a breakpoint is it */
+#define ADAPT_CHATTER 4.0     /* rest speeds: this many steps' worth of the gap's force */
+#define ADAPT_HELD_DIFF 0.1   /* a held contact's impulses: the whole step's the halves' */
 #define ADAPT_DEEP 6          /* the foot of the ladder: its last levels */
-#define ADAPT_DEEP_MAX 4096   /* tries in a row there before refinement stops (rounding's
-                                 scale: no finer step tells the states apart) */
+#define ADAPT_DEEP_MAX 4096   /* tries in a row there before one is kept as it is */
 
 /* A state of the scheme with the forces at its instant. */
 typedef struct snap {
@@ -64,7 +65,10 @@ struct mj_adapt {
     uint64_t *piece_tick;  /* npieces: each piece's start */
     snap sn[4];
     snap *cur, *one, *half, *two; /* now; one step; the first half; both halves */
-    double *E;             /* n: the estimate kept so far */
+    double *E;             /* n: the flights' estimate kept so far (errors that add up) */
+    double *S2;            /* n: the events' estimates kept so far, squared and summed (the
+                              instants of impulses inside their steps: errors of either
+                              sign, independent) */
     double *Er;            /* n: E plus the last step's interpolation bound (state err) */
     double *eps;           /* n: the try's estimate */
     double *rate;          /* n: the last smooth pair's error over h^(p+1) */
@@ -75,10 +79,13 @@ struct mj_adapt {
     unsigned *mark;        /* n: the stamp of the last impact on each dof */
     unsigned stamp;
     unsigned *evmark;      /* n: try_stamp when an event marked the dof in this try */
+    unsigned *timed;       /* n: try_stamp when impulses at other instants moved the dof */
     unsigned try_stamp;
     double *bound;         /* n: the try's events' bound */
     long nmarked;          /* dofs marked for events so far */
     double *u_rest;        /* m: closing speeds without restitution (mj->u_rest) */
+    double *u_tol, *G;     /* m: the tolerance's rest speeds; |free gap acceleration| */
+    double *D0;            /* m: sum_i W_ia^2 / M_ii, a unit impulse's change of gap rate */
     int p;                 /* order of the flight's global error */
     double div;            /* 2^p - 1 */
     int k_flight;          /* exact flights: the coarsest level whose steps the observers'
@@ -91,7 +98,8 @@ struct mj_adapt {
     pd_mj_stats stats;
 };
 
-static void rest_speeds(pd_mj *mj);
+static void rest_speeds(pd_mj *mj, const snap *w, const snap *x);
+static void rest_for_step(pd_mj *mj, double h);
 static void report_err(pd_mj *mj, double h);
 
 /* ---- the object ---------------------------------------------------------------- */
@@ -143,8 +151,8 @@ void mj_adapt_free(pd_mj *mj)
             pd_factor_free(ad->lev[k].factor);
     for (int s = 0; s < 4; s++)
         snap_free(&ad->sn[s]);
-    void *arrays[] = {ad->lev, ad->piece_tick, ad->E, ad->Er, ad->eps, ad->rate, ad->amp, ad->w,
-                      ad->atol, ad->minv, ad->mark, ad->evmark, ad->bound, ad->u_rest};
+    void *arrays[] = {ad->lev, ad->piece_tick, ad->E, ad->S2, ad->Er, ad->eps, ad->rate, ad->amp, ad->w,
+                      ad->atol, ad->minv, ad->mark, ad->evmark, ad->timed, ad->bound, ad->u_rest, ad->D0, ad->u_tol, ad->G};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(arrays[k]);
     free(ad);
@@ -258,15 +266,19 @@ int mj_adapt_alloc(pd_mj *mj, pd_err *err)
     ad->div = ad->p == 2 ? 3.0 : 1.0;
     ad->lev = calloc((size_t)L + 1, sizeof *ad->lev);
     ad->piece_tick = calloc(ad->F ? (size_t)ad->F->npieces : 1, sizeof(uint64_t));
-    double **nv[] = {&ad->E, &ad->Er, &ad->eps, &ad->rate, &ad->amp, &ad->w, &ad->atol, &ad->minv,
+    double **nv[] = {&ad->E, &ad->S2, &ad->Er, &ad->eps, &ad->rate, &ad->amp, &ad->w, &ad->atol, &ad->minv,
                      &ad->bound};
     int bad = !ad->lev || !ad->piece_tick;
     for (size_t k = 0; k < sizeof nv / sizeof nv[0]; k++)
         bad |= !(*nv[k] = calloc((size_t)n, sizeof(double)));
     ad->mark = calloc((size_t)n, sizeof(unsigned));
     ad->evmark = calloc((size_t)n, sizeof(unsigned));
+    ad->timed = calloc((size_t)n, sizeof(unsigned));
     ad->u_rest = calloc(md->m > 0 ? (size_t)md->m : 1, sizeof(double));
-    bad |= !ad->mark || !ad->evmark || !ad->u_rest || incidence(md, &mj->inc);
+    ad->D0 = calloc(md->m > 0 ? (size_t)md->m : 1, sizeof(double));
+    ad->u_tol = calloc(md->m > 0 ? (size_t)md->m : 1, sizeof(double));
+    ad->G = calloc(md->m > 0 ? (size_t)md->m : 1, sizeof(double));
+    bad |= !ad->u_tol || !ad->G || !ad->mark || !ad->evmark || !ad->timed || !ad->u_rest || !ad->D0 || incidence(md, &mj->inc);
     for (int s = 0; s < 4 && !bad; s++)
         bad = snap_alloc(&ad->sn[s], n, md->m) != PD_OK;
     if (bad)
@@ -288,6 +300,9 @@ int mj_adapt_alloc(pd_mj *mj, pd_err *err)
             return pd_err_set(err, PD_EINVAL, "atol of dof %d must be a finite number > 0 "
                               "(got %g)", i, ad->atol[i]);
     }
+    for (int a = 0; a < md->m; a++)
+        for (int j = mj->inc.ptr[a]; j < mj->inc.ptr[a + 1]; j++)
+            ad->D0[a] += mj->inc.w[j] * mj->inc.w[j] * ad->minv[mj->inc.dof[j]];
     mj->u_rest = ad->u_rest;
     if (ad->F && (rc = mj_flight_alloc(mj, ad->F, ad->h0, L, err)))
         return rc;
@@ -352,7 +367,7 @@ int mj_adapt_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_
         s->st.v[i] = v0 ? v0[i] : 0.0;
         if (!isfinite(s->st.q[i]) || !isfinite(s->st.v[i]))
             return pd_err_set(err, PD_EINVAL, "initial state: dof %d is not finite", i);
-        ad->E[i] = ad->rate[i] = 0.0;
+        ad->E[i] = ad->S2[i] = ad->rate[i] = 0.0;
         ad->amp[i] = hypot(s->st.q[i], s->st.v[i] / ad->w[i]);
     }
     for (int a = 0; a < md->m; a++) {
@@ -380,6 +395,7 @@ int mj_adapt_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_
     s->st.lcp_solver = NULL;
     s->st.h = 0.0;
     forces_at(mj, t0, s);
+    s->st.has_acc = 0;
     if (ad->F) { /* the piece in force at t0 */
         piece_ticks(ad);
         s->piece = 0;
@@ -387,11 +403,11 @@ int mj_adapt_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_
             s->piece++;
         mj_flight_z(mj, s->piece, t0, s->z);
     }
-    rest_speeds(mj);
     if (ad->F) {
         mj_flight_acc(mj, &s->st, s->z, s->st.acc);
         s->st.has_acc = 1;
     }
+    rest_speeds(mj, s, s);
     mj->t0 = t0;
     report_err(mj, 0.0);
     mj->st = s->st;
@@ -448,6 +464,7 @@ static int take_step(pd_mj *mj, int k, const snap *x, snap *y, pd_err *err)
     y->tick = x->tick + level_ticks(ad, k);
     double t1 = tick_time(ad, y->tick);
     ad->stats.evals++;
+    rest_for_step(mj, ad->lev[k].h);
     y->st.h = ad->lev[k].h;
     if (ad->F) { /* exact flight; at a piece's start its forcing takes over */
         if ((rc = mj_flight_step(mj, k, t1, &x->st, x->z, &y->st, y->z, err)))
@@ -477,14 +494,20 @@ static double dof_scale(const mj_adapt *ad, int i)
 }
 
 /* An impact in the step x -> y: contact a pushes (P > 0) while it was
- * closing (U- = W_a^T v < 0); its change of gap rate (1 + e) |U-|, else 0. */
+ * closing (U- = W_a^T v < 0), or starts pushing (its impulse a next stage
+ * of an impact nearby): the change of gap rate it makes, the larger of
+ * (1 + e) |U-| and its impulse's own P D0_a (D0_a = sum_i W_ia^2 / M_ii);
+ * else 0. */
 static double impact_jump(const pd_mj *mj, int a, const snap *x, const snap *y)
 {
     if (!(y->st.P[a] > 0.0))
         return 0.0;
     const pd_model *md = mj->model;
     double U = mj_inc_dot(&mj->inc, a, x->st.v);
-    return U < 0.0 ? (1.0 + md->e[a]) * -U : 0.0;
+    double jump = U < 0.0 ? (1.0 + md->e[a]) * -U : 0.0;
+    if (!(x->st.P[a] > 0.0))
+        jump = pd_max(jump, y->st.P[a] * mj->ad->D0[a]);
+    return jump;
 }
 
 /* 1 when contact a's impact jump could fail the flight's test at some step
@@ -511,9 +534,9 @@ static void mark_event(mj_adapt *ad, int i, double b)
 
 /* The impacts of the step x -> y (of size h; weight 0: detection only).
  * An impact is an event on the dofs it moves when its jump could fail the
- * flight's test at some step (flight_event): those dofs are marked for the
- * event's test with the bound jump h (exact flights: jump h / 2, the
- * impulse at mid-step).  So is a gap closed past zero inside a step where
+ * flight's test at some step (flight_event): the instant of its impulse
+ * inside the step is unknown, so they are marked for the event's test with
+ * the bound jump h (exact flights: jump h / 2, the impulse at mid-step).  So is a gap closed past zero inside a step where
  * no contact was predicted (theta flights: the impact comes a step late,
  * the penetration is the error).  Returns 1 for a cascade: a dof taking
  * two impacts whose jumps move it by more than the event tolerance,
@@ -706,9 +729,43 @@ static int scan_releases(pd_mj *mj, double h)
     return first;
 }
 
+/* Contacts that push in some of the try's three steps and not in the
+ * others, or whose whole step's impulse is not the halves' (to
+ * ADAPT_HELD_DIFF): their impulses fall at other instants of the whole
+ * step and of the halves, and the states' velocities differ by them at any step size,
+ * which moves the dofs by those differences over the step, not over 1 / w:
+ * their dofs are timed (try_error).  When such an impulse changes a
+ * velocity by more than the event tolerance's (ke rtol s_i w_i, its jump
+ * P D0), its dofs take the event's test with the bound jump h. */
+static void scan_patterns(pd_mj *mj, double h)
+{
+    const pd_model *md = mj->model;
+    const mj_incidence *in = &mj->inc;
+    mj_adapt *ad = mj->ad;
+    double tol = ADAPT_KE * mj->opts.rtol;
+    for (int a = 0; a < md->m; a++) {
+        double P1 = ad->one->st.P[a], Pa = ad->half->st.P[a], P2 = ad->two->st.P[a];
+        int p1 = P1 > 0.0, pa = Pa > 0.0, p2 = P2 > 0.0;
+        /* held throughout with the whole step's impulse the halves' (a force) */
+        if (p1 == pa && pa == p2 &&
+            !(fabs(P1 - (Pa + P2)) > ADAPT_HELD_DIFF * pd_max(P1, Pa + P2)))
+            continue;
+        double jump = pd_max(P1, pd_max(Pa, P2)) * ad->D0[a];
+        if (getenv("PAT_DEBUG") && h > 3e-7 && h < 1e-6)
+            fprintf(stderr, "pattern t %.12g h %.3g c%d P %.4g %.4g %.4g U %.3g %.3g %.3g g %.3g %.3g urest %.3g jump %.3g\n", ad->cur->st.t, h, a, P1, Pa, P2, mj_inc_dot(in, a, ad->cur->st.v), mj_inc_dot(in, a, ad->half->st.v), mj_inc_dot(in, a, ad->two->st.v), ad->cur->st.g[a], ad->two->st.g[a], ad->u_rest[a], jump);
+        for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
+            int i = in->dof[j];
+            ad->timed[i] = ad->try_stamp;
+            if (jump > tol * dof_scale(ad, i) * ad->w[i])
+                mark_event(ad, i, jump * h);
+        }
+    }
+}
+
 /* The try's events: impacts and dips of each half (with their bounds), of
- * the whole step (detection), contacts let go; *first: one lies in the
- * first half, *event: one lies in the try.  Returns 1 for a cascade. */
+ * the whole step (detection), contacts let go, contacts whose pushing
+ * differs among the steps; *first: one lies in the first half, *event: one
+ * lies in the try.  Returns 1 for a cascade. */
 static int scan_try(pd_mj *mj, double h, int *first, int *event)
 {
     mj_adapt *ad = mj->ad;
@@ -719,6 +776,7 @@ static int scan_try(pd_mj *mj, double h, int *first, int *event)
     cascade |= scan_impacts(mj, ad->half, ad->two, h, 1.0);
     scan_dips(mj, ad->half, ad->two, h);
     scan_impacts(mj, ad->cur, ad->one, 2.0 * h, 0.0);
+    scan_patterns(mj, h);
     *event = ad->nmarked > before;
     return cascade;
 }
@@ -739,10 +797,12 @@ static double try_error(pd_mj *mj, double H)
         double dq = fabs(s2->st.q[i] - s1->st.q[i]), dv = fabs(s2->st.v[i] - s1->st.v[i]);
         double noise = 64.0 * 2.2e-16 * (fabs(s2->st.q[i]) + fabs(s2->st.v[i]) / ad->w[i]);
         int event = ad->evmark[i] == ad->try_stamp;
-        /* an event's velocities differ by impulses taken at other instants of
-         * the step (a next stage of an impact in the halves, the whole step's
-         * in its next step): that moves the dof by dv over the step, not dv / w */
-        double d = fmax(dq + dv * (event ? H : 1.0 / ad->w[i]) - noise, 0.0);
+        /* an event's velocities, or a timed dof's, differ by impulses taken at
+         * other instants of the step (a next stage of an impact in the halves,
+         * the whole step's in its next step): that moves the dof by dv over
+         * the step, not dv / w */
+        int timed = event || ad->timed[i] == ad->try_stamp;
+        double d = fmax(dq + dv * (timed ? H : 1.0 / ad->w[i]) - noise, 0.0);
         double e = event ? d + ad->bound[i] : d / div;
         ad->eps[i] = e;
         r = pd_max(r, e / (dof_scale(ad, i) * (event ? tol_event : tol_flight)));
@@ -755,6 +815,7 @@ static void try_begin(mj_adapt *ad, int n)
 {
     if (++ad->try_stamp == 0) { /* the stamps wrapped: clear the marks */
         memset(ad->evmark, 0, (size_t)n * sizeof *ad->evmark);
+        memset(ad->timed, 0, (size_t)n * sizeof *ad->timed);
         ad->try_stamp = 1;
     }
     memset(ad->bound, 0, (size_t)n * sizeof *ad->bound);
@@ -762,23 +823,46 @@ static void try_begin(mj_adapt *ad, int n)
 
 /* ---- keeping steps ------------------------------------------------------------------ */
 
-/* The closing speeds below which a contact takes no restitution: a rebound
- * e |U| <= ke rtol s_i w_i moves its dofs within the event tolerance (so
- * that a contact pressed shut rests instead of chattering at O(h) speeds,
- * as the references jump an accumulation to rest). */
-static void rest_speeds(pd_mj *mj)
+/* The closing speeds below which a contact takes no restitution, from the
+ * tolerance: a rebound e |U| <= ke rtol s_i w_i moves its dofs within the
+ * event tolerance; and the gap accelerations that press each contact shut
+ * at the state x (made by a step from w): its free motion's, G, and the
+ * held forces of the contacts it shares a dof with (their impulses in both
+ * steps, over the step), for the steps' own part (rest_for_step). */
+static void rest_speeds(pd_mj *mj, const snap *w, const snap *x)
 {
     const pd_model *md = mj->model;
     const mj_incidence *in = &mj->inc;
     mj_adapt *ad = mj->ad;
     for (int a = 0; a < md->m; a++) {
-        double u = HUGE_VAL;
+        double u = HUGE_VAL, G = 0.0, held = 0.0;
         for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
             int i = in->dof[j];
             u = fmin(u, ADAPT_KE * mj->opts.rtol * dof_scale(ad, i) * ad->w[i]);
+            G += in->w[j] * free_acc(mj, x, i);
+            for (int q = in->dptr[i]; x->st.h > 0.0 && q < in->dptr[i + 1]; q++) {
+                int b = in->con[q];
+                if (b != a && w->st.P[b] > 0.0 && x->st.P[b] > 0.0)
+                    held += fabs(in->w[j]) * ad->minv[i] * x->st.P[b] / x->st.h;
+            }
         }
-        ad->u_rest[a] = isfinite(u) ? u : 0.0;
+        ad->u_tol[a] = isfinite(u) ? u : 0.0;
+        ad->G[a] = fabs(G) + held;
     }
+}
+
+/* The rest speeds of a step of size h (mj->u_rest): the tolerance's, or
+ * ADAPT_CHATTER G h, the speed a contact pressed shut reaches in a few
+ * steps of the accelerations pressing it: a contact closing that slowly is
+ * resting on it
+ * (the scheme's chatter at O(h) speeds, else; a real impact that slow
+ * rebounds less than ADAPT_CHATTER^2 e^2 |G| h^2 / 2, which the event's
+ * bound already allows at the impact's step). */
+static void rest_for_step(pd_mj *mj, double h)
+{
+    mj_adapt *ad = mj->ad;
+    for (int a = 0; a < mj->model->m; a++)
+        ad->u_rest[a] = pd_max(ad->u_tol[a], ADAPT_CHATTER * ad->G[a] * h);
 }
 
 /* The state's err: the estimate so far and, for exact flights, the bound
@@ -790,14 +874,17 @@ static void report_err(pd_mj *mj, double h)
     double wf = ad->F ? mj_flight_forcing_w(mj) : 0.0;
     for (int i = 0; i < mj->model->n; i++) {
         double wh = fmax(ad->w[i], wf) * h, wh3 = wh * wh * wh;
-        ad->Er[i] = ad->E[i] + (ad->F ? wh3 * wh3 / 46080.0 * dof_scale(ad, i) : 0.0);
+        ad->Er[i] = ad->E[i] + sqrt(ad->S2[i]) +
+                    (ad->F ? wh3 * wh3 / 46080.0 * dof_scale(ad, i) : 0.0);
     }
 }
 
 /* Keep x, made by a step from w, as the new state with the error eps
- * scaled by f (0: none): the estimate, the amplitudes, the statistics;
- * report it.  Returns the observer's verdict (> 0: stop). */
-static int keep(pd_mj *mj, const snap *w, snap *x, double f, pd_observer observer, void *ctx)
+ * scaled by f (0: none; events: the dofs the try's events marked count it
+ * among the events'): the estimate, the amplitudes, the statistics; report
+ * it.  Returns the observer's verdict (> 0: stop). */
+static int keep(pd_mj *mj, const snap *w, snap *x, double f, int events, pd_observer observer,
+                void *ctx)
 {
     const pd_model *md = mj->model;
     mj_adapt *ad = mj->ad;
@@ -805,16 +892,20 @@ static int keep(pd_mj *mj, const snap *w, snap *x, double f, pd_observer observe
     for (int a = 0; a < md->m && !ad->impact_made; a++)
         ad->impact_made = flight_event(mj, a, impact_jump(mj, a, w, x));
     for (int i = 0; i < md->n; i++) {
-        if (f > 0.0)
+        if (f > 0.0 && events && ad->evmark[i] == ad->try_stamp)
+            ad->S2[i] += f * ad->eps[i] * f * ad->eps[i];
+        else if (f > 0.0)
             ad->E[i] += f * ad->eps[i];
+        if (getenv("E_DEBUG") && f * ad->eps[i] > atof(getenv("E_DEBUG")) * dof_scale(ad, i))
+            fprintf(stderr, "E t %.9g h %.3g dof %d eps %.3g rel %.3g mark %d timed %d bound %.3g E %.3g\n", x->st.t, x->st.h, i, f * ad->eps[i], f * ad->eps[i] / dof_scale(ad, i), ad->evmark[i] == ad->try_stamp, ad->timed[i] == ad->try_stamp, ad->bound[i], ad->E[i]);
         double vw = x->st.v[i] / ad->w[i];
         ad->amp[i] = pd_max(ad->amp[i], sqrt(x->st.q[i] * x->st.q[i] + vw * vw));
     }
-    rest_speeds(mj);
     if (ad->F) { /* the free motion's accelerations, for the observers' interpolation */
         mj_flight_acc(mj, &x->st, x->z, x->st.acc);
         x->st.has_acc = 1;
     }
+    rest_speeds(mj, w, x);
     ad->stats.steps++;
     ad->stats.h_min = fmin(ad->stats.h_min, x->st.h);
     ad->stats.h_max = fmax(ad->stats.h_max, x->st.h);
@@ -836,9 +927,9 @@ static void swap(snap **a, snap **b)
 static int keep_pair(pd_mj *mj, pd_observer observer, void *ctx)
 {
     mj_adapt *ad = mj->ad;
-    int stop = keep(mj, ad->cur, ad->half, 0.5, observer, ctx);
+    int stop = keep(mj, ad->cur, ad->half, 0.5, 1, observer, ctx);
     if (!stop)
-        stop = keep(mj, ad->half, ad->two, 0.5, observer, ctx);
+        stop = keep(mj, ad->half, ad->two, 0.5, 1, observer, ctx);
     swap(&ad->cur, &ad->two);
     return stop;
 }
@@ -909,7 +1000,7 @@ static int finest_step(pd_mj *mj, pd_observer observer, void *ctx, pd_err *err)
             if (ad->eps[i] > ADAPT_KE * mj->opts.rtol * dof_scale(ad, i))
                 ad->stats.floor_hit = 1;
         }
-    int stop = keep(mj, ad->cur, ad->two, 1.0, observer, ctx);
+    int stop = keep(mj, ad->cur, ad->two, 1.0, 1, observer, ctx);
     swap(&ad->cur, &ad->two);
     return stop;
 }
@@ -931,7 +1022,7 @@ static int exact_flight(pd_mj *mj, int k, pd_observer observer, void *ctx, int *
     scan_dips(mj, ad->cur, ad->one, ad->lev[k].h);
     if (ad->nmarked > before)
         return 0;
-    *stop = keep(mj, ad->cur, ad->one, 0.0, observer, ctx);
+    *stop = keep(mj, ad->cur, ad->one, 0.0, 0, observer, ctx);
     swap(&ad->cur, &ad->one);
     return 1;
 }
@@ -969,10 +1060,13 @@ int mj_adapt_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx,
             have_one = 0;
             continue;
         }
-        /* tries at the ladder's foot that do not end: the floor's budget */
+        /* tries in a row at the ladder's foot (rounding's scale: no finer step
+         * tells the states apart): after ADAPT_DEEP_MAX, one is kept as it is
+         * and the steps climb out; rtol is not met */
         ad->deep = k + ADAPT_DEEP >= ad->L ? ad->deep + 1 : 0;
-        ad->stats.floor_hit |= ad->deep > ADAPT_DEEP_MAX;
-        int budget = (double)ad->stats.evals >= mj->opts.max_evals || ad->deep > ADAPT_DEEP_MAX;
+        int stuck = ad->deep > ADAPT_DEEP_MAX;
+        ad->stats.floor_hit |= stuck;
+        int budget = (double)ad->stats.evals >= mj->opts.max_evals;
         ad->stats.budget_hit |= budget;
         double H = ad->lev[k].h, h = ad->lev[k + 1].h;
         if (ad->F && !have_one && none_pushing(md, ad->cur)) {
@@ -997,25 +1091,29 @@ int mj_adapt_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx,
             fprintf(stderr, "try t %.15g k %d r %.3g cas %d ev %d evh %d P %.3g %.3g %.3g v %.3g %.3g %.3g %.3g g %.3g %.3g %.3g bound %.3g eps %.3g\n", ad->cur->st.t, k, r, cascade, event, ev_half,
                     ad->one->st.P[0], ad->half->st.P[0], ad->two->st.P[0], ad->cur->st.v[0], ad->one->st.v[0], ad->half->st.v[0], ad->two->st.v[0], ad->cur->st.g[0], ad->half->st.g[0], ad->two->st.g[0], ad->bound[0], ad->eps[0]);
         have_one = 0;
-        if ((r <= 1.0 && !cascade) || budget || k + 1 >= ad->L) {
+        if ((r <= 1.0 && !cascade) || budget || stuck || k + 1 >= ad->L) {
             ad->stats.floor_hit |= (r > 1.0 || cascade) && !budget;
             if (getenv("FLOOR_DEBUG") && (r > 1.0 || cascade) && !budget) {
                 fprintf(stderr, "floor t %.17g k %d r %g cascade %d event %d\n", ad->cur->st.t, k, r, cascade, event);
                 for (int a = 0; a < md->m; a++) fprintf(stderr, "  c%d P %.3g %.3g %.3g %.3g g %.3g %.3g %.3g U %.3g %.3g\n", a, ad->cur->st.P[a], ad->one->st.P[a], ad->half->st.P[a], ad->two->st.P[a], ad->cur->st.g[a], ad->half->st.g[a], ad->two->st.g[a], mj_inc_dot(&mj->inc, a, ad->cur->st.v), mj_inc_dot(&mj->inc, a, ad->half->st.v));
-                for (int i = 0; i < n; i++) fprintf(stderr, "  d%d eps %.3g bound %.3g mark %d scale %.3g\n", i, ad->eps[i], ad->bound[i], ad->evmark[i] == ad->try_stamp, dof_scale(ad, i));
+                for (int i = 0; i < n; i++) fprintf(stderr, "  d%d eps %.3g bound %.3g mark %d timed %d scale %.3g q %.17g %.17g %.17g %.17g\n", i, ad->eps[i], ad->bound[i], ad->evmark[i] == ad->try_stamp, ad->timed[i] == ad->try_stamp, dof_scale(ad, i), ad->cur->st.q[i], ad->one->st.q[i], ad->half->st.q[i], ad->two->st.q[i]);
             }
             if (!event)
                 note_rate(ad, n, H);
             stop = keep_pair(mj, observer, ctx);
             if (!event && r <= ADAPT_GROW / (ad->div + 1.0) && k > 0)
                 k--;
+            if (stuck) {
+                ad->deep = 0;
+                k = ad->L - ADAPT_DEEP - 1;
+            }
             continue;
         }
         ad->stats.rejected++;
         if (event && !ev_half) {
             /* the event lies in the second half: keep the first, try the second */
             rate_estimate(ad, n, h);
-            stop = keep(mj, ad->cur, ad->half, 1.0, observer, ctx);
+            stop = keep(mj, ad->cur, ad->half, 1.0, 0, observer, ctx);
             swap(&ad->cur, &ad->half);
             swap(&ad->one, &ad->two); /* the second half's whole step */
         } else {
@@ -1036,7 +1134,7 @@ void mj_adapt_stats(const pd_mj *mj, pd_mj_stats *s)
     *s = ad->stats;
     s->err_max = 0.0;
     for (int i = 0; i < mj->model->n; i++)
-        s->err_max = pd_max(s->err_max, ad->E[i] / dof_scale(ad, i));
+        s->err_max = pd_max(s->err_max, (ad->E[i] + sqrt(ad->S2[i])) / dof_scale(ad, i));
     if (s->steps == 0)
         s->h_min = s->h_max = NAN;
 }

@@ -754,10 +754,10 @@ int mj_flight_step(pd_mj *mj, int k, double t1, const pd_state *in, const double
             return rc;
         apply_impulses(mj, k, nI, out);
         hold_gaps(mj, nI, in, out);
-        for (int r = 0; r < nI; r++) {
-            int a = mj->idx_active[r];
+        /* the impulses and the holds moved the dofs of the active contacts,
+         * which other contacts share: every gap anew */
+        for (int a = 0; a < md->m; a++)
             out->g[a] = md->g0[a] + mj_inc_dot(&mj->inc, a, out->q);
-        }
     }
     for (int i = 0; i < md->n; i++)
         if (!isfinite(out->q[i]) || !isfinite(out->v[i]))

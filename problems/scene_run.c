@@ -843,7 +843,7 @@ static int adapt_once(const pd_scene_model *sm, const pd_run_opts *o, double rto
     pd_mj_free(mj);
     structure_errors(tr, res);
     if (getenv("SCENE_DEBUG"))
-        fprintf(stderr, "adapt_once rtol %g: steps %ld rej %ld floor %d budget %d err_max %g est %g hmin %g\n", rtol, stats->steps, stats->rejected, stats->floor_hit, stats->budget_hit, stats->err_max, res->err_est_max, stats->h_min);
+        fprintf(stderr, "adapt_once rtol %g: steps %ld rej %ld floor %d budget %d err_max %g est %g hmin %g last %.8g first %.8g\n", rtol, stats->steps, stats->rejected, stats->floor_hit, stats->budget_hit, stats->err_max, res->err_est_max, stats->h_min, tr->xmax[tr->n - 1] * tr->Le, tr->xmax[0] * tr->Le);
     return rc;
 }
 
