@@ -99,7 +99,7 @@ struct mj_adapt {
 };
 
 static void rest_speeds(pd_mj *mj, const snap *w, const snap *x);
-static void rest_for_step(pd_mj *mj, double h);
+static void rest_for_step(pd_mj *mj, const snap *x, double h);
 static void report_err(pd_mj *mj, double h);
 
 /* ---- the object ---------------------------------------------------------------- */
@@ -464,7 +464,7 @@ static int take_step(pd_mj *mj, int k, const snap *x, snap *y, pd_err *err)
     y->tick = x->tick + level_ticks(ad, k);
     double t1 = tick_time(ad, y->tick);
     ad->stats.evals++;
-    rest_for_step(mj, ad->lev[k].h);
+    rest_for_step(mj, x, ad->lev[k].h);
     y->st.h = ad->lev[k].h;
     if (ad->F) { /* exact flight; at a piece's start its forcing takes over */
         if ((rc = mj_flight_step(mj, k, t1, &x->st, x->z, &y->st, y->z, err)))
@@ -851,18 +851,20 @@ static void rest_speeds(pd_mj *mj, const snap *w, const snap *x)
     }
 }
 
-/* The rest speeds of a step of size h (mj->u_rest): the tolerance's, or
- * ADAPT_CHATTER G h, the speed a contact pressed shut reaches in a few
- * steps of the accelerations pressing it: a contact closing that slowly is
- * resting on it
- * (the scheme's chatter at O(h) speeds, else; a real impact that slow
- * rebounds less than ADAPT_CHATTER^2 e^2 |G| h^2 / 2, which the event's
- * bound already allows at the impact's step). */
-static void rest_for_step(pd_mj *mj, double h)
+/* The rest speeds of a step of size h from x (mj->u_rest): the
+ * tolerance's, and for a contact shut at x (its gap within sim_gap: in
+ * contact, not arriving) ADAPT_CHATTER G h, the speed it reaches in a few
+ * steps of the accelerations pressing it: a contact in contact closing
+ * that slowly is resting on it (the scheme's chatter at O(h) speeds,
+ * else).  A contact arriving across an open gap rebounds at any speed
+ * above the tolerance's. */
+static void rest_for_step(pd_mj *mj, const snap *x, double h)
 {
     mj_adapt *ad = mj->ad;
     for (int a = 0; a < mj->model->m; a++)
-        ad->u_rest[a] = pd_max(ad->u_tol[a], ADAPT_CHATTER * ad->G[a] * h);
+        ad->u_rest[a] = x->st.g[a] <= mj->opts.sim_gap
+                            ? pd_max(ad->u_tol[a], ADAPT_CHATTER * ad->G[a] * h)
+                            : ad->u_tol[a];
 }
 
 /* The state's err: the estimate so far and, for exact flights, the bound
@@ -876,6 +878,47 @@ static void report_err(pd_mj *mj, double h)
         double wh = fmax(ad->w[i], wf) * h, wh3 = wh * wh * wh;
         ad->Er[i] = ad->E[i] + sqrt(ad->S2[i]) +
                     (ad->F ? wh3 * wh3 / 46080.0 * dof_scale(ad, i) : 0.0);
+    }
+}
+
+/* The accelerations at x for the observers' quintic interpolation of the
+ * step to it: the free motion's plus the held contacts' forces, their
+ * impulses over the step; none (has_acc 0) after a step with an impact,
+ * whose velocity jumps. */
+static void step_accelerations(pd_mj *mj, snap *x)
+{
+    const mj_incidence *in = &mj->inc;
+    mj_adapt *ad = mj->ad;
+    x->st.has_acc = !ad->impact_made;
+    if (ad->impact_made)
+        return;
+    mj_flight_acc(mj, &x->st, x->z, x->st.acc);
+    for (int a = 0; a < mj->model->m && x->st.h > 0.0; a++)
+        if (x->st.P[a] > 0.0)
+            for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
+                x->st.acc[in->dof[j]] += ad->minv[in->dof[j]] * in->w[j] * x->st.P[a] / x->st.h;
+}
+
+/* Errors cross contacts: a contact that pushed in the step to x moves
+ * each of its dofs by the others' motion (an impact exchanges their
+ * momentum, a held contact makes them one body), so each takes the
+ * largest estimate among them. */
+static void share_errors(pd_mj *mj, const snap *x)
+{
+    const mj_incidence *in = &mj->inc;
+    mj_adapt *ad = mj->ad;
+    for (int a = 0; a < mj->model->m; a++) {
+        if (!(x->st.P[a] > 0.0))
+            continue;
+        double E = 0.0, S2 = 0.0;
+        for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
+            E = pd_max(E, ad->E[in->dof[j]]);
+            S2 = pd_max(S2, ad->S2[in->dof[j]]);
+        }
+        for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
+            ad->E[in->dof[j]] = E;
+            ad->S2[in->dof[j]] = S2;
+        }
     }
 }
 
@@ -901,10 +944,9 @@ static int keep(pd_mj *mj, const snap *w, snap *x, double f, int events, pd_obse
         double vw = x->st.v[i] / ad->w[i];
         ad->amp[i] = pd_max(ad->amp[i], sqrt(x->st.q[i] * x->st.q[i] + vw * vw));
     }
-    if (ad->F) { /* the free motion's accelerations, for the observers' interpolation */
-        mj_flight_acc(mj, &x->st, x->z, x->st.acc);
-        x->st.has_acc = 1;
-    }
+    share_errors(mj, x);
+    if (ad->F) /* the accelerations, for the observers' interpolation */
+        step_accelerations(mj, x);
     rest_speeds(mj, w, x);
     ad->stats.steps++;
     ad->stats.h_min = fmin(ad->stats.h_min, x->st.h);

@@ -11,7 +11,7 @@
  * events than the controller's share expected) is repeated at the
  * tolerance scaled down by the excess, at most OSC_ADAPT_TRIES runs; the
  * figures are the last run's, the steps and the CPU time all runs'.  A
- * sampler sees the first run, and the last again when it was repeated. */
+ * sampler sees the last run, repeated for it (the same numbers). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -78,11 +78,13 @@ static int observe(const pd_state *st, void *ctx)
     if (tr->m.xaway > pw)
         tr->err_away = e;
     /* inside a smooth step (no impulse, both ends with their accelerations) */
-    if (inside && st->step > 0 && P == 0.0 && tr->pacc && st->has_acc && tr->pt >= tr->m.tau_measure)
+    /* the engine's accelerations hold where the state is smooth (a held
+     * contact's force included; none after an impact) */
+    if (inside && st->step > 0 && tr->pacc && st->has_acc && tr->pt >= tr->m.tau_measure)
         interior_extremes(tr, st, e);
     if (tr->demands) {
         pd_demand_osc_note(&tr->dem, st->t, x, v, st->has_acc ? st->acc : NULL,
-                           P == 0.0 && st->step > 0);
+                           st->has_acc && st->step > 0);
         if (tr->dem.peak > pd)
             tr->err_acc = e;
     }
@@ -194,9 +196,9 @@ int pd_osc_adapt(const pd_osc *c, const pd_run_opts *o, pd_osc_sampler sampler, 
     long rejected = 0, steps = 0;
     pd_mj_stats st;
     int rc = PD_OK, runs = 0;
-    /* a sampler sees one run: the one kept (the last, repeated when retried) */
+    /* a sampler sees one run: the one kept, repeated for it (the same numbers) */
     for (;;) {
-        rc = run_once(c, o, rtol, runs ? NULL : sampler, ctx, res, &st, err);
+        rc = run_once(c, o, rtol, NULL, ctx, res, &st, err);
         runs++;
         rejected += res->steps_rejected;
         steps += res->steps;
@@ -206,7 +208,7 @@ int pd_osc_adapt(const pd_osc *c, const pd_run_opts *o, pd_osc_sampler sampler, 
         rtol *= fmin(0.5, 0.5 * o->rtol / res->err_est);
         rtol = fmax(rtol, PD_RTOL_MIN);
     }
-    if (!rc && runs > 1 && sampler) {
+    if (!rc && sampler) {
         rc = run_once(c, o, rtol, sampler, ctx, res, &st, err);
         rejected += res->steps_rejected;
         steps += res->steps;

@@ -502,7 +502,9 @@ static int observe_moreau(const pd_state *st, void *ctx)
 static int observe_adapt(const pd_state *st, void *ctx)
 {
     track *tr = ctx;
-    int smooth = no_impulse(tr, st) && st->step > 0;
+    /* the engine's accelerations hold where the state is smooth (held contacts'
+     * forces included; none after an impact) */
+    int smooth = st->has_acc && st->step > 0;
     tr->err = st->err;
     for (int s = 0; s < tr->sc->nstruct; s++) {
         const pd_structure *ps = &tr->sc->st[s];
@@ -850,7 +852,7 @@ static int adapt_once(const pd_scene_model *sm, const pd_run_opts *o, double rto
 /* Moreau–Jean to a tolerance on the scene's model: runs repeated at a
  * tolerance scaled down by the estimate's excess (at most
  * SCENE_ADAPT_TRIES); the figures the last run's, the steps all runs'; a
- * sampler sees the first run, and the last again when it was repeated. */
+ * sampler sees the last run, repeated for it (the same numbers). */
 static int run_moreau_adapt(const pd_scene_model *sm, const pd_run_opts *o, double tau_end,
                             track *tr, pd_scene_result *res, pd_err *err)
 {
@@ -881,7 +883,7 @@ static int run_moreau_adapt(const pd_scene_model *sm, const pd_run_opts *o, doub
     double rtol = o->rtol;
     long steps = 0, rejected = 0;
     for (;;) {
-        tr->fn = runs ? NULL : fn;
+        tr->fn = NULL;
         rc = adapt_once(sm, o, rtol, &F, atol, tau_end, tr, res, &st, err);
         runs++;
         steps += res->steps;
@@ -891,7 +893,7 @@ static int run_moreau_adapt(const pd_scene_model *sm, const pd_run_opts *o, doub
             break;
         rtol = fmax(rtol * fmin(0.5, 0.5 * o->rtol / res->err_est_max), PD_RTOL_MIN);
     }
-    if (!rc && runs > 1 && fn) {
+    if (!rc && fn) { /* the run kept, again for the sampler (the same numbers) */
         tr->fn = fn;
         rc = adapt_once(sm, o, rtol, &F, atol, tau_end, tr, res, &st, err);
         steps += res->steps;
