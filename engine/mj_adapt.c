@@ -31,7 +31,6 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#include <stdio.h>
 
 #include "mj.h"
 
@@ -751,8 +750,6 @@ static void scan_patterns(pd_mj *mj, double h)
             !(fabs(P1 - (Pa + P2)) > ADAPT_HELD_DIFF * pd_max(P1, Pa + P2)))
             continue;
         double jump = pd_max(P1, pd_max(Pa, P2)) * ad->D0[a];
-        if (getenv("PAT_DEBUG") && h > 3e-7 && h < 1e-6)
-            fprintf(stderr, "pattern t %.12g h %.3g c%d P %.4g %.4g %.4g U %.3g %.3g %.3g g %.3g %.3g urest %.3g jump %.3g\n", ad->cur->st.t, h, a, P1, Pa, P2, mj_inc_dot(in, a, ad->cur->st.v), mj_inc_dot(in, a, ad->half->st.v), mj_inc_dot(in, a, ad->two->st.v), ad->cur->st.g[a], ad->two->st.g[a], ad->u_rest[a], jump);
         for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
             int i = in->dof[j];
             ad->timed[i] = ad->try_stamp;
@@ -939,8 +936,6 @@ static int keep(pd_mj *mj, const snap *w, snap *x, double f, int events, pd_obse
             ad->S2[i] += f * ad->eps[i] * f * ad->eps[i];
         else if (f > 0.0)
             ad->E[i] += f * ad->eps[i];
-        if (getenv("E_DEBUG") && f * ad->eps[i] > atof(getenv("E_DEBUG")) * dof_scale(ad, i))
-            fprintf(stderr, "E t %.9g h %.3g dof %d eps %.3g rel %.3g mark %d timed %d bound %.3g E %.3g\n", x->st.t, x->st.h, i, f * ad->eps[i], f * ad->eps[i] / dof_scale(ad, i), ad->evmark[i] == ad->try_stamp, ad->timed[i] == ad->try_stamp, ad->bound[i], ad->E[i]);
         double vw = x->st.v[i] / ad->w[i];
         ad->amp[i] = pd_max(ad->amp[i], sqrt(x->st.q[i] * x->st.q[i] + vw * vw));
     }
@@ -1129,17 +1124,9 @@ int mj_adapt_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx,
         try_begin(ad, n);
         int ev_half, event, cascade = scan_try(mj, h, &ev_half, &event);
         double r = try_error(mj, H);
-        if (getenv("ADAPT_DEBUG") && ad->cur->st.t > atof(getenv("ADAPT_DEBUG")) && ad->cur->st.t < atof(getenv("ADAPT_DEBUG")) + 0.3)
-            fprintf(stderr, "try t %.15g k %d r %.3g cas %d ev %d evh %d P %.3g %.3g %.3g v %.3g %.3g %.3g %.3g g %.3g %.3g %.3g bound %.3g eps %.3g\n", ad->cur->st.t, k, r, cascade, event, ev_half,
-                    ad->one->st.P[0], ad->half->st.P[0], ad->two->st.P[0], ad->cur->st.v[0], ad->one->st.v[0], ad->half->st.v[0], ad->two->st.v[0], ad->cur->st.g[0], ad->half->st.g[0], ad->two->st.g[0], ad->bound[0], ad->eps[0]);
         have_one = 0;
         if ((r <= 1.0 && !cascade) || budget || stuck || k + 1 >= ad->L) {
             ad->stats.floor_hit |= (r > 1.0 || cascade) && !budget;
-            if (getenv("FLOOR_DEBUG") && (r > 1.0 || cascade) && !budget) {
-                fprintf(stderr, "floor t %.17g k %d r %g cascade %d event %d\n", ad->cur->st.t, k, r, cascade, event);
-                for (int a = 0; a < md->m; a++) fprintf(stderr, "  c%d P %.3g %.3g %.3g %.3g g %.3g %.3g %.3g U %.3g %.3g\n", a, ad->cur->st.P[a], ad->one->st.P[a], ad->half->st.P[a], ad->two->st.P[a], ad->cur->st.g[a], ad->half->st.g[a], ad->two->st.g[a], mj_inc_dot(&mj->inc, a, ad->cur->st.v), mj_inc_dot(&mj->inc, a, ad->half->st.v));
-                for (int i = 0; i < n; i++) fprintf(stderr, "  d%d eps %.3g bound %.3g mark %d timed %d scale %.3g q %.17g %.17g %.17g %.17g\n", i, ad->eps[i], ad->bound[i], ad->evmark[i] == ad->try_stamp, ad->timed[i] == ad->try_stamp, dof_scale(ad, i), ad->cur->st.q[i], ad->one->st.q[i], ad->half->st.q[i], ad->two->st.q[i]);
-            }
             if (!event)
                 note_rate(ad, n, H);
             stop = keep_pair(mj, observer, ctx);

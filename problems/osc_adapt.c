@@ -35,6 +35,7 @@ typedef struct adapt_track {
     int pacc;                /* 1: it has an acceleration */
     pd_demand_osc dem;
     int demands;
+    int dem_skipped;         /* a state was left out of the demands since the last */
     double Le, vscale, wp;
     pd_osc_sampler sampler;
     void *sampler_ctx;
@@ -82,11 +83,14 @@ static int observe(const pd_state *st, void *ctx)
      * contact's force included; none after an impact) */
     if (inside && st->step > 0 && tr->pacc && st->has_acc && tr->pt >= tr->m.tau_measure)
         interior_extremes(tr, st, e);
-    if (tr->demands) {
-        pd_demand_osc_note(&tr->dem, st->t, x, v, st->has_acc ? st->acc : NULL,
-                           st->has_acc && st->step > 0);
+    /* demands at the smooth states only (right after an impact: none) */
+    if (tr->demands && st->has_acc) {
+        pd_demand_osc_note(&tr->dem, st->t, x, v, st->acc, st->step > 0 && !tr->dem_skipped);
+        tr->dem_skipped = 0;
         if (tr->dem.peak > pd)
             tr->err_acc = e;
+    } else if (tr->demands) {
+        tr->dem_skipped = 1;
     }
     tr->px = x;
     tr->pv = v;

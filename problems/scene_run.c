@@ -88,6 +88,7 @@ typedef struct track {
     double *acc0, *shear0;            /* n: the demand peaks before the state */
     double *serr;                     /* nstruct: the structure's largest estimate now */
     double *wdof;                     /* n: each dof's sqrt(K_ii / M_ii) (Pi units) */
+    int dem_skipped;                  /* a state was left out of the demands since the last */
 } track;
 
 /* ---- results ---------------------------------------------------------------- */
@@ -234,7 +235,7 @@ static void track_clear(track *tr)
         tr->first[a] = NAN;
         tr->approach[a] = -HUGE_VAL;
     }
-    tr->have_prev = tr->dem_prev = 0;
+    tr->have_prev = tr->dem_prev = tr->dem_skipped = 0;
     tr->lcp_solves = 0;
 }
 
@@ -516,16 +517,22 @@ static int observe_adapt(const pd_state *st, void *ctx)
         note_between(tr, st->t, st->q, st->v, st->acc);
     note_point(tr, st->t, st->q);
     note_approach(tr, st->q);
-    if (tr->demands) {
+    /* demands at the smooth states only: right after an impact the velocities
+     * may be a stage's, which the next step's impulse completes (the impact's
+     * outcome is the next state's, a step the controller made short) */
+    if (tr->demands && st->has_acc) {
         memcpy(tr->acc0, tr->acc, (size_t)tr->n * sizeof(double));
         memcpy(tr->shear0, tr->shear, (size_t)tr->n * sizeof(double));
-        note_demand(tr, st->t, st->q, st->v, st->has_acc ? st->acc : NULL, smooth);
+        note_demand(tr, st->t, st->q, st->v, st->acc, smooth && !tr->dem_skipped);
+        tr->dem_skipped = 0;
         for (int i = 0; i < tr->n; i++) {
             if (tr->acc[i] > tr->acc0[i])
                 tr->erra[i] = tr->serr[tr->st_of[i]];
             if (tr->shear[i] > tr->shear0[i])
                 tr->errv[i] = tr->serr[tr->st_of[i]];
         }
+    } else if (tr->demands) {
+        tr->dem_skipped = 1;
     }
     tr->lcp_solves += st->nactive > 0;
     for (int a = 0; a < tr->model_m; a++) {
@@ -803,6 +810,7 @@ static void structure_errors(const track *tr, pd_scene_result *res)
  * pulse's and the structures' fundamental periods over 16. */
 #define SCENE_ADAPT_H0 16.0
 #define SCENE_ADAPT_TRIES 3
+#define SCENE_ADAPT_LOOSE 4.0  /* the second pass: a tolerance this many times looser */
 #define SCENE_ADAPT_FLOOR 1e-3 /* errors below this share of a dof's static scale count as none */
 
 /* One run to the tolerance rtol, measured into tr; stats of the engine. */
@@ -844,13 +852,49 @@ static int adapt_once(const pd_scene_model *sm, const pd_run_opts *o, double rto
     res->lcp_solver = pd_lcp_method_name(o->lcp_solver);
     pd_mj_free(mj);
     structure_errors(tr, res);
-    if (getenv("SCENE_DEBUG"))
-        fprintf(stderr, "adapt_once rtol %g: steps %ld rej %ld floor %d budget %d err_max %g est %g hmin %g last %.8g first %.8g\n", rtol, stats->steps, stats->rejected, stats->floor_hit, stats->budget_hit, stats->err_max, res->err_est_max, stats->h_min, tr->xmax[tr->n - 1] * tr->Le, tr->xmax[0] * tr->Le);
     return rc;
 }
 
-/* Moreau–Jean to a tolerance on the scene's model: runs repeated at a
- * tolerance scaled down by the estimate's excess (at most
+/* The peaks of a run (umax, drift, a_abs, V per dof) into buf (4 n). */
+static void keep_peaks(const track *tr, double *buf)
+{
+    size_t n = (size_t)tr->n * sizeof(double);
+    memcpy(buf, tr->xmax, n);
+    memcpy(buf + tr->n, tr->drift, n);
+    memcpy(buf + 2 * tr->n, tr->acc, n);
+    memcpy(buf + 3 * tr->n, tr->shear, n);
+}
+
+/* The second pass's estimate: the run's peaks p against those of a run
+ * SCENE_ADAPT_LOOSE = c times looser, p_c: the errors scale with the
+ * tolerance (p_c - p* ~ c (p - p*)), so p - p* ~ |p - p_c| / (c - 1); it
+ * sees what the local estimates cannot, errors carried and amplified from
+ * structure to structure (docs/scheme.md).  Each structure's estimate is
+ * the larger of the two. */
+static void second_pass(const track *tr, const double *loose, pd_scene_result *res)
+{
+    const pd_scene *sc = tr->sc;
+    const double *cur[4] = {tr->xmax, tr->drift, tr->acc, tr->shear};
+    int kinds = tr->demands ? 4 : 2;
+    res->err_est_max = 0.0;
+    for (int s = 0; s < sc->nstruct; s++) {
+        double e = res->err_est[s];
+        for (int k = 0; k < sc->st[s].storeys; k++) {
+            int i = sc->st[s].dof + k;
+            for (int q = 0; q < kinds; q++)
+                if (cur[q][i] > 0.0)
+                    e = pd_max(e, fabs(cur[q][i] - loose[q * tr->n + i]) /
+                                      ((SCENE_ADAPT_LOOSE - 1.0) * cur[q][i]));
+        }
+        res->err_est[s] = e;
+        res->err_est_max = pd_max(res->err_est_max, e);
+    }
+}
+
+/* Moreau–Jean to a tolerance on the scene's model: with two contacts or
+ * more a second pass first, SCENE_ADAPT_LOOSE times looser; then runs at
+ * rtol, repeated SCENE_ADAPT_LOOSE times tighter while the estimate exceeds
+ * rtol (the run before is the next one's second pass; at most
  * SCENE_ADAPT_TRIES); the figures the last run's, the steps all runs'; a
  * sampler sees the last run, repeated for it (the same numbers). */
 static int run_moreau_adapt(const pd_scene_model *sm, const pd_run_opts *o, double tau_end,
@@ -858,13 +902,13 @@ static int run_moreau_adapt(const pd_scene_model *sm, const pd_run_opts *o, doub
 {
     const pd_scene *sc = tr->sc;
     pd_sine_piece *pieces;
-    int npieces, rc, runs = 0;
+    int npieces, rc, runs = 0, n = tr->n;
     if ((rc = pd_osc_pieces(&sm->shape, &pieces, &npieces, err)))
         return rc;
-    double *atol = malloc((size_t)tr->n * sizeof(double));
+    double *atol = malloc((size_t)n * 5 * sizeof(double)), *loose = atol + n;
     if (!atol) {
         free(pieces);
-        return pd_err_set(err, PD_ENOMEM, "out of memory for the tolerances of %d dofs", tr->n);
+        return pd_err_set(err, PD_ENOMEM, "out of memory for the tolerances of %d dofs", n);
     }
     /* a dof's error is measured absolutely below a thousandth of its static
      * scale, the deflection under ap: (T0 / Tp)^2 Le, or Le */
@@ -873,7 +917,7 @@ static int run_moreau_adapt(const pd_scene_model *sm, const pd_run_opts *o, doub
             double r = sc->st[k].T0 / sc->exc.Tp;
             atol[sc->st[k].dof + j] = SCENE_ADAPT_FLOOR * fmin(1.0, r * r);
         }
-    for (int i = 0; i < tr->n; i++) {
+    for (int i = 0; i < n; i++) {
         double kk = pd_matrix_get(&sm->model.K, i, i), mm = pd_matrix_get(&sm->model.M, i, i);
         tr->wdof[i] = kk > 0.0 && mm > 0.0 ? sqrt(kk / mm) : 0.0;
     }
@@ -882,20 +926,40 @@ static int run_moreau_adapt(const pd_scene_model *sm, const pd_run_opts *o, doub
     pd_mj_stats st;
     double rtol = o->rtol;
     long steps = 0, rejected = 0;
-    for (;;) {
-        tr->fn = NULL;
+    /* contacts that share structures carry errors into each other and can
+     * amplify them: the second pass, a run SCENE_ADAPT_LOOSE times looser */
+    int second = sc->ncontact >= 2;
+    tr->fn = NULL;
+    if (second) {
+        rc = adapt_once(sm, o, fmin(SCENE_ADAPT_LOOSE * rtol, 0.5), &F, atol, tau_end, tr, res,
+                        &st, err);
+        steps += res->steps;
+        rejected += res->steps_rejected;
+        keep_peaks(tr, loose);
+    }
+    while (!rc) {
         rc = adapt_once(sm, o, rtol, &F, atol, tau_end, tr, res, &st, err);
         runs++;
         steps += res->steps;
         rejected += res->steps_rejected;
+        if (second && !rc)
+            second_pass(tr, loose, res);
         if (rc || st.floor_hit || st.budget_hit || res->err_est_max <= o->rtol ||
-            runs >= SCENE_ADAPT_TRIES || rtol * 0.5 < PD_RTOL_MIN)
+            runs >= SCENE_ADAPT_TRIES || rtol / SCENE_ADAPT_LOOSE < PD_RTOL_MIN)
             break;
-        rtol = fmax(rtol * fmin(0.5, 0.5 * o->rtol / res->err_est_max), PD_RTOL_MIN);
+        /* again at a tighter tolerance: this run is the next one's looser pass */
+        keep_peaks(tr, loose);
+        rtol /= SCENE_ADAPT_LOOSE;
     }
     if (!rc && fn) { /* the run kept, again for the sampler (the same numbers) */
+        double est_max = res->err_est_max;
         tr->fn = fn;
+        for (int k = 0; k < sc->nstruct; k++)
+            loose[k] = res->err_est[k];
         rc = adapt_once(sm, o, rtol, &F, atol, tau_end, tr, res, &st, err);
+        for (int k = 0; k < sc->nstruct; k++) /* the estimates the second pass gave */
+            res->err_est[k] = pd_max(res->err_est[k], loose[k]);
+        res->err_est_max = pd_max(res->err_est_max, est_max);
         steps += res->steps;
         rejected += res->steps_rejected;
     }
