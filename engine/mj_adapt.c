@@ -40,7 +40,6 @@
 #define ADAPT_START 3       /* the first try's level */
 #define ADAPT_BREAK_TOL 1e-12 /* a time within this relative distance of a breakpoint is it */
 #define ADAPT_CHATTER 4.0     /* rest speeds: this many steps' worth of the gap's force */
-#define ADAPT_HELD_DIFF 0.1   /* a held contact's impulses: the whole step's the halves' */
 #define ADAPT_DEEP 6          /* the foot of the ladder: its last levels */
 #define ADAPT_DEEP_MAX 4096   /* tries in a row there before one is kept as it is */
 
@@ -728,14 +727,16 @@ static int scan_releases(pd_mj *mj, double h)
     return first;
 }
 
-/* Contacts that push in some of the try's three steps and not in the
- * others, or whose whole step's impulse is not the halves' (to
- * ADAPT_HELD_DIFF): their impulses fall at other instants of the whole
- * step and of the halves, and the states' velocities differ by them at any step size,
- * which moves the dofs by those differences over the step, not over 1 / w:
- * their dofs are timed (try_error).  When such an impulse changes a
- * velocity by more than the event tolerance's (ke rtol s_i w_i, its jump
- * P D0), its dofs take the event's test with the bound jump h. */
+/* Contacts that push in any of the try's three steps: an impulse taken at
+ * another instant of the whole step than of the halves (a next stage of an
+ * impact, a held force that turns) leaves their velocities apart at any
+ * step size, which moves the dofs by the difference over the step, not
+ * over 1 / w: their dofs are timed (try_error; a held contact's smooth
+ * velocity errors are measured a little more loosely so, by w H).  When
+ * such a contact pushes in some steps and not in others with an impulse
+ * that changes a velocity by more than the event tolerance's (ke rtol s_i
+ * w_i; its jump P D0), its dofs take the event's test with the bound
+ * jump h. */
 static void scan_patterns(pd_mj *mj, double h)
 {
     const pd_model *md = mj->model;
@@ -745,15 +746,14 @@ static void scan_patterns(pd_mj *mj, double h)
     for (int a = 0; a < md->m; a++) {
         double P1 = ad->one->st.P[a], Pa = ad->half->st.P[a], P2 = ad->two->st.P[a];
         int p1 = P1 > 0.0, pa = Pa > 0.0, p2 = P2 > 0.0;
-        /* held throughout with the whole step's impulse the halves' (a force) */
-        if (p1 == pa && pa == p2 &&
-            !(fabs(P1 - (Pa + P2)) > ADAPT_HELD_DIFF * pd_max(P1, Pa + P2)))
+        if (!p1 && !pa && !p2)
             continue;
+        int mixed = !(p1 == pa && pa == p2);
         double jump = pd_max(P1, pd_max(Pa, P2)) * ad->D0[a];
         for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
             int i = in->dof[j];
             ad->timed[i] = ad->try_stamp;
-            if (jump > tol * dof_scale(ad, i) * ad->w[i])
+            if (mixed && jump > tol * dof_scale(ad, i) * ad->w[i])
                 mark_event(ad, i, jump * h);
         }
     }

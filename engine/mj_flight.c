@@ -34,6 +34,8 @@ typedef struct fl_kind {
     double *E;       /* levels 0..L+1: the first 2 s rows of E_k (2 s x na, by columns) */
     double *Minv;    /* s x s: M^-1 */
     double *Av;      /* s x na: the rows of A~ for v' (the accelerations) */
+    double *PV, *PQ; /* levels 0..L: Phi_vv(h_k/2) M^-1 and Phi_qv(h_k/2) M^-1 (s x s), an
+                        impulse's response at mid-step */
     double wmax;     /* a bound of its highest natural frequency */
 } fl_kind;
 
@@ -58,6 +60,7 @@ struct mj_flight {
     unsigned stamp;
     int *pos;                /* m: place of a contact in the active set, or -1 */
     double *r;               /* n: W P */
+    double *minv;            /* n: (M^-1)_ii */
     double *x, *dx, *y;      /* 2 smax + 4 */
 };
 
@@ -307,6 +310,39 @@ static int ladder(const mj_flight *fl, fl_kind *kd, const double *A, pd_err *err
                                "%d dofs overflows at the coarsest step (a smaller h)", kd->s);
 }
 
+/* The first 2 s rows of E_k of kind kd. */
+static const double *level_E(const fl_kind *kd, int k)
+{
+    return kd->E + (size_t)k * 2 * kd->s * kd->na;
+}
+
+/* PV_k = Phi_vv(h_k / 2) M^-1 = (I + E_k+1,vv) M^-1 and PQ_k = E_k+1,qv M^-1
+ * for every level k = 0..L. */
+static int impulse_responses(const mj_flight *fl, fl_kind *kd, pd_err *err)
+{
+    int s = kd->s, rows = 2 * s;
+    size_t ss = (size_t)s * s;
+    if (!(kd->PV = malloc(2 * (size_t)(fl->L + 1) * ss * sizeof(double))))
+        return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for a block's tables");
+    kd->PQ = kd->PV + (size_t)(fl->L + 1) * ss;
+    for (int k = 0; k <= fl->L; k++) {
+        const double *E = level_E(kd, k + 1);
+        double *PV = kd->PV + (size_t)k * ss, *PQ = kd->PQ + (size_t)k * ss;
+        for (int j = 0; j < s; j++)
+            for (int i = 0; i < s; i++) {
+                double v = 0.0, q = 0.0;
+                for (int l = 0; l < s; l++) {
+                    double ml = kd->Minv[l + (size_t)j * s];
+                    v += ((i == l ? 1.0 : 0.0) + E[s + i + (size_t)(s + l) * rows]) * ml;
+                    q += E[i + (size_t)(s + l) * rows] * ml;
+                }
+                PV[i + (size_t)j * s] = v;
+                PQ[i + (size_t)j * s] = q;
+            }
+    }
+    return PD_OK;
+}
+
 /* The kinds: blocks alike share one; each kind's tables. */
 static int form_kinds(const pd_model *md, mj_flight *fl, pd_err *err)
 {
@@ -352,6 +388,8 @@ static int form_kinds(const pd_model *md, mj_flight *fl, pd_err *err)
             kd->wmax = block_wmax(kd, A);
             rc = ladder(fl, kd, A, err);
         }
+        if (!rc)
+            rc = impulse_responses(fl, kd, err);
         free(A);
     }
 done:
@@ -371,6 +409,7 @@ void mj_flight_free(pd_mj *mj)
         free(fl->kinds[k].E);
         free(fl->kinds[k].Minv);
         free(fl->kinds[k].Av);
+        free(fl->kinds[k].PV);
     }
     free(fl->kinds);
     free(fl->blocks);
@@ -381,6 +420,7 @@ void mj_flight_free(pd_mj *mj)
     free(fl->cmark);
     free(fl->pos);
     free(fl->r);
+    free(fl->minv);
     free(fl->x);
     free(fl->h);
     free(fl);
@@ -443,7 +483,15 @@ int mj_flight_alloc(pd_mj *mj, const pd_piecewise_force *F, double h0, int L, pd
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for its flights");
     fl->dx = fl->x + 2 * smax + 4;
     fl->y = fl->dx + 2 * smax + 4;
-    return form_kinds(md, fl, err);
+    if ((rc = form_kinds(md, fl, err)))
+        return rc;
+    if (!(fl->minv = malloc((size_t)n * sizeof(double))))
+        return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for its flights");
+    for (int i = 0; i < n; i++) {
+        const fl_block *bl = &fl->blocks[fl->block_of[i]];
+        fl->minv[i] = fl->kinds[bl->kind].Minv[fl->at[i] * (bl->s + 1)];
+    }
+    return PD_OK;
 }
 
 void mj_flight_z(const pd_mj *mj, int p, double t, double *z)
@@ -468,12 +516,6 @@ double mj_flight_wmax(const pd_mj *mj, int dof)
 }
 
 /* ---- a step -------------------------------------------------------------------------- */
-
-/* The first 2 s rows of E_k of kind kd. */
-static const double *level_E(const fl_kind *kd, int k)
-{
-    return kd->E + (size_t)k * 2 * kd->s * kd->na;
-}
 
 /* The free flight of block bl over level k: out's q, v from in's and z. */
 static void free_flight(const mj_flight *fl, const fl_block *bl, int k, const pd_state *in,
@@ -513,8 +555,7 @@ static void free_flight(const mj_flight *fl, const fl_block *bl, int k, const pd
     }
 }
 
-/* D_ab = W_a^T Phi_vv(h/2) M^-1 W_b over the blocks they share (level
- * k + 1 holds h/2). */
+/* D_ab = W_a^T Phi_vv(h/2) M^-1 W_b over the blocks they share (PV_k). */
 static double delassus(const pd_mj *mj, int k, int a, int b)
 {
     const mj_flight *fl = mj->fl;
@@ -524,19 +565,12 @@ static double delassus(const pd_mj *mj, int k, int a, int b)
         int i = in->dof[p], bi = fl->block_of[i];
         const fl_block *bl = &fl->blocks[bi];
         const fl_kind *kd = &fl->kinds[bl->kind];
-        const double *E = level_E(kd, k + 1);
-        int s = bl->s, rows = 2 * s, ri = fl->at[i];
+        int s = bl->s;
+        const double *PV = kd->PV + (size_t)k * s * s;
         for (int q = in->ptr[b]; q < in->ptr[b + 1]; q++) {
             int j = in->dof[q];
-            if (fl->block_of[j] != bi)
-                continue;
-            int cj = fl->at[j];
-            /* (Phi_vv M^-1)_ij = sum_l (delta_il + E_vv,il) M^-1_lj */
-            double g = 0.0;
-            for (int l = 0; l < s; l++)
-                g += ((ri == l ? 1.0 : 0.0) + E[s + ri + (size_t)(s + l) * rows]) *
-                     kd->Minv[l + (size_t)cj * s];
-            sum += in->w[p] * g * in->w[q];
+            if (fl->block_of[j] == bi)
+                sum += in->w[p] * PV[fl->at[i] + (size_t)fl->at[j] * s] * in->w[q];
         }
     }
     return sum;
@@ -629,20 +663,14 @@ static void apply_impulses(pd_mj *mj, int k, int nI, pd_state *out)
             fl->touched[bi] = fl->stamp;
             const fl_block *bl = &fl->blocks[bi];
             const fl_kind *kd = &fl->kinds[bl->kind];
-            const double *E = level_E(kd, k + 1);
-            int s = bl->s, rows = 2 * s;
-            double *u = fl->x; /* M^-1 r on the block */
+            int s = bl->s;
+            const double *PV = kd->PV + (size_t)k * s * s, *PQ = kd->PQ + (size_t)k * s * s;
             for (int i = 0; i < s; i++) {
-                double sum = 0.0;
-                for (int l = 0; l < s; l++)
-                    sum += kd->Minv[i + (size_t)l * s] * fl->r[bl->dofs[l]];
-                u[i] = sum;
-            }
-            for (int i = 0; i < s; i++) {
-                double dq = 0.0, dv = u[i];
+                double dq = 0.0, dv = 0.0;
                 for (int l = 0; l < s; l++) {
-                    dq += E[i + (size_t)(s + l) * rows] * u[l];
-                    dv += E[s + i + (size_t)(s + l) * rows] * u[l];
+                    double rl = fl->r[bl->dofs[l]];
+                    dq += PQ[i + (size_t)l * s] * rl;
+                    dv += PV[i + (size_t)l * s] * rl;
                 }
                 out->q[bl->dofs[i]] += dq;
                 out->v[bl->dofs[i]] += dv;
@@ -651,13 +679,6 @@ static void apply_impulses(pd_mj *mj, int k, int nI, pd_state *out)
                 fl->r[bl->dofs[i]] = 0.0;
         }
     }
-}
-
-/* (M^-1)_ii of dof i. */
-static double minv_of(const mj_flight *fl, int i)
-{
-    const fl_block *bl = &fl->blocks[fl->block_of[i]];
-    return fl->kinds[bl->kind].Minv[fl->at[i] * (bl->s + 1)];
 }
 
 /* Held contacts (shut at the step's start and pushing) keep their gap: the
@@ -679,11 +700,11 @@ static void hold_gaps(pd_mj *mj, int nI, const pd_state *in, pd_state *out)
             double g = md->g0[a] + mj_inc_dot(inc, a, out->q), d = in->g[a] - g;
             double D0 = 0.0;
             for (int j = inc->ptr[a]; j < inc->ptr[a + 1]; j++)
-                D0 += inc->w[j] * inc->w[j] * minv_of(fl, inc->dof[j]);
+                D0 += inc->w[j] * inc->w[j] * fl->minv[inc->dof[j]];
             if (d == 0.0 || !(D0 > 0.0))
                 continue;
             for (int j = inc->ptr[a]; j < inc->ptr[a + 1]; j++)
-                out->q[inc->dof[j]] += minv_of(fl, inc->dof[j]) * inc->w[j] * d / D0;
+                out->q[inc->dof[j]] += fl->minv[inc->dof[j]] * inc->w[j] * d / D0;
         }
 }
 

@@ -289,12 +289,18 @@ static void note_demand(track *tr, double t, const double *x, const double *v,
     }
     pd_demand_eval(tr->sc, v, acc, vs, as, tr->dad, tr->dVd); /* the rates [1/s] */
     double h = (t - tr->dem_t) / tr->wp;
+    /* the cubic's turns only where they could raise the peak: inside the step
+     * it strays from its ends by at most h (|d0| + |d1|) / 4 */
     if (tr->dem_prev && smooth && h > 0.0)
         for (int i = 0; i < tr->n; i++) {
-            tr->acc[i] = pd_max(tr->acc[i], pd_demand_cubic_peak(tr->qa[i], tr->qad[i],
-                                                                 tr->da[i], tr->dad[i], h));
-            tr->shear[i] = pd_max(tr->shear[i], pd_demand_cubic_peak(tr->qV[i], tr->qVd[i],
-                                                                     tr->dV[i], tr->dVd[i], h));
+            if (pd_max(fabs(tr->qa[i]), fabs(tr->da[i])) +
+                    0.25 * h * (fabs(tr->qad[i]) + fabs(tr->dad[i])) > tr->acc[i])
+                tr->acc[i] = pd_max(tr->acc[i], pd_demand_cubic_peak(tr->qa[i], tr->qad[i],
+                                                                     tr->da[i], tr->dad[i], h));
+            if (pd_max(fabs(tr->qV[i]), fabs(tr->dV[i])) +
+                    0.25 * h * (fabs(tr->qVd[i]) + fabs(tr->dVd[i])) > tr->shear[i])
+                tr->shear[i] = pd_max(tr->shear[i], pd_demand_cubic_peak(tr->qV[i], tr->qVd[i],
+                                                                         tr->dV[i], tr->dVd[i], h));
         }
     size_t bytes = (size_t)tr->n * sizeof(double);
     memcpy(tr->qa, tr->da, bytes);
