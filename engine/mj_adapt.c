@@ -47,6 +47,7 @@
 typedef struct snap {
     pd_state st;     /* q, v, P, g, active, t, step, ... */
     double *Fl, *Fr; /* n: F(t-) and F(t+) (theta flights) */
+    double *af;      /* n: the free motion's accelerations (valid with st.has_acc) */
     double z[4];     /* the forcing's state (exact flights) */
     int piece;       /* its piece (exact flights) */
     uint64_t tick;   /* t = t_origin + tick h_L */
@@ -109,11 +110,11 @@ static void snap_free(snap *s)
     memset(s, 0, sizeof *s);
 }
 
-/* q, v, Fl, Fr, acc (n) and g, P (m) in one block; active (m). */
+/* q, v, Fl, Fr, acc, af (n) and g, P (m) in one block; active (m). */
 static int snap_alloc(snap *s, int n, int m)
 {
     size_t mm = m > 0 ? (size_t)m : 1, nn = (size_t)n;
-    s->mem = calloc(5 * nn + 2 * mm, sizeof(double));
+    s->mem = calloc(6 * nn + 2 * mm, sizeof(double));
     s->st.active = calloc(mm, 1);
     if (!s->mem || !s->st.active)
         return PD_ENOMEM;
@@ -124,6 +125,7 @@ static int snap_alloc(snap *s, int n, int m)
     s->st.g = s->mem + 4 * nn;
     s->st.P = s->mem + 4 * nn + mm;
     s->st.acc = s->mem + 4 * nn + 2 * mm;
+    s->af = s->mem + 5 * nn + 2 * mm;
     return PD_OK;
 }
 
@@ -402,7 +404,8 @@ int mj_adapt_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_
         mj_flight_z(mj, s->piece, t0, s->z);
     }
     if (ad->F) {
-        mj_flight_acc(mj, &s->st, s->z, s->st.acc);
+        mj_flight_acc(mj, &s->st, s->z, s->af);
+        memcpy(s->st.acc, s->af, (size_t)mj->model->n * sizeof(double));
         s->st.has_acc = 1;
     }
     rest_speeds(mj, s, s);
@@ -646,7 +649,7 @@ static double free_acc(const pd_mj *mj, const snap *x, int i)
 {
     const pd_model *md = mj->model;
     if (x->st.has_acc)
-        return x->st.acc[i];
+        return x->af[i];
     return mj->ad->minv[i] * (x->Fr[i] - pd_matrix_col_dot(&md->C, i, x->st.v) -
                               pd_matrix_col_dot(&md->K, i, x->st.q));
 }
@@ -879,18 +882,17 @@ static void report_err(pd_mj *mj, double h)
 }
 
 /* The accelerations at x for the observers' quintic interpolation of the
- * step to it: the free motion's plus the held contacts' forces, their
- * impulses over the step; none (has_acc 0) after a step with an impact,
- * whose velocity jumps. */
+ * step to it and of the next: the free motion's plus the held contacts'
+ * forces, their impulses over the step; after a step with an impact the
+ * free motion's alone (the right limit: the impulses are no force). */
 static void step_accelerations(pd_mj *mj, snap *x)
 {
     const mj_incidence *in = &mj->inc;
     mj_adapt *ad = mj->ad;
-    x->st.has_acc = !ad->impact_made;
-    if (ad->impact_made)
-        return;
-    mj_flight_acc(mj, &x->st, x->z, x->st.acc);
-    for (int a = 0; a < mj->model->m && x->st.h > 0.0; a++)
+    x->st.has_acc = 1;
+    mj_flight_acc(mj, &x->st, x->z, x->af);
+    memcpy(x->st.acc, x->af, (size_t)mj->model->n * sizeof(double));
+    for (int a = 0; a < mj->model->m && x->st.h > 0.0 && !ad->impact_made; a++)
         if (x->st.P[a] > 0.0)
             for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
                 x->st.acc[in->dof[j]] += ad->minv[in->dof[j]] * in->w[j] * x->st.P[a] / x->st.h;
