@@ -206,7 +206,7 @@ int pd_osc_adapt(const pd_osc *c, const pd_run_opts *o, pd_osc_sampler sampler, 
         runs++;
         rejected += res->steps_rejected;
         steps += res->steps;
-        if (rc || st.floor_hit || st.budget_hit || res->err_est <= o->rtol ||
+        if (rc || st.budget_hit || res->err_est <= o->rtol ||
             runs >= OSC_ADAPT_TRIES || rtol * 0.5 < PD_RTOL_MIN)
             break;
         rtol *= fmin(0.5, 0.5 * o->rtol / res->err_est);

@@ -950,7 +950,7 @@ static int run_moreau_adapt(const pd_scene_model *sm, const pd_run_opts *o, doub
         rejected += res->steps_rejected;
         if (second && !rc)
             second_pass(tr, loose, res);
-        if (rc || st.floor_hit || st.budget_hit || res->err_est_max <= o->rtol ||
+        if (rc || st.budget_hit || res->err_est_max <= o->rtol ||
             runs >= SCENE_ADAPT_TRIES || rtol / SCENE_ADAPT_LOOSE < PD_RTOL_MIN)
             break;
         /* again at a tighter tolerance: this run is the next one's looser pass */
