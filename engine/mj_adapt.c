@@ -925,11 +925,45 @@ static void share_errors(pd_mj *mj, const snap *x)
  * scaled by f (0: none; events: the dofs the try's events marked count it
  * among the events'): the estimate, the amplitudes, the statistics; report
  * it.  Returns the observer's verdict (> 0: stop). */
+/* Held contacts (pushing, their gap rate at rest: |U| <= u_rest) sit at
+ * gap min(g(w), 0) in the kept state x: the impulses hold the gap rate at
+ * zero, the gap itself drifts by O(h^3) per step (the force varies inside
+ * the step), and a contact brought to rest by an impulse at mid-step
+ * stops short of zero where the exact motion stops at zero.  q moves along
+ * M^-1 W_a to put it there (Gauss-Seidel sweeps over the held contacts,
+ * M^-1 by its diagonal), in the kept state only: the tries compare the
+ * steps as the scheme made them.  A held gap left above sim_gap would
+ * leave the contact out of the next impact's LCP, an impact of one body
+ * where the pair strikes. */
+#define ADAPT_HOLD_SWEEPS 3
+static void hold_gaps(pd_mj *mj, const snap *w, snap *x)
+{
+    const pd_model *md = mj->model;
+    const mj_incidence *in = &mj->inc;
+    const mj_adapt *ad = mj->ad;
+    int moved = 0;
+    for (int sweep = 0; sweep < ADAPT_HOLD_SWEEPS; sweep++)
+        for (int a = 0; a < md->m; a++) {
+            if (!(x->st.P[a] > 0.0) || fabs(mj_inc_dot(in, a, x->st.v)) > mj->u_rest[a])
+                continue;
+            double d = fmin(w->st.g[a], 0.0) - (md->g0[a] + mj_inc_dot(in, a, x->st.q));
+            double D0 = ad->D0[a];
+            if (d == 0.0 || !(D0 > 0.0))
+                continue;
+            for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
+                x->st.q[in->dof[j]] += ad->minv[in->dof[j]] * in->w[j] * d / D0;
+            moved = 1;
+        }
+    for (int a = 0; moved && a < md->m; a++)
+        x->st.g[a] = md->g0[a] + mj_inc_dot(in, a, x->st.q);
+}
+
 static int keep(pd_mj *mj, const snap *w, snap *x, double f, int events, pd_observer observer,
                 void *ctx)
 {
     const pd_model *md = mj->model;
     mj_adapt *ad = mj->ad;
+    hold_gaps(mj, w, x);
     ad->impact_made = 0; /* an impact in the step w -> x (its impulses are no held force) */
     for (int a = 0; a < md->m && !ad->impact_made; a++)
         ad->impact_made = flight_event(mj, a, impact_jump(mj, a, w, x));

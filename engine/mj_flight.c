@@ -681,14 +681,13 @@ static void apply_impulses(pd_mj *mj, int k, int nI, pd_state *out)
     }
 }
 
-/* Held contacts (pushing, their gap rate at rest: |U| <= u_rest) sit at
- * gap min(g_start, 0): the impulses hold the gap rate at zero, the gap
- * itself drifts by O(h^3) per step (the force varies inside the step), and
- * a contact brought to rest by an impulse at mid-step stops short of zero
- * (the exact motion stops at zero); q moves along M^-1 W_a to put it there
- * (Gauss-Seidel sweeps over held contacts that share a dof; M^-1 by its
- * diagonal).  A held gap left above sim_gap would leave the contact out of
- * the next impact's LCP, an impact of one body instead of the pair. */
+/* Contacts held through the step (shut at its start and pushing) keep
+ * their gap inside the step: the impulses hold their gap rate at zero, the
+ * gap itself drifts by O(h^3) per step (the force varies inside the step),
+ * a drift the halves and the whole step would differ by; q moves along
+ * M^-1 W_a to put it back (Gauss-Seidel sweeps over held contacts that
+ * share a dof; M^-1 by its diagonal).  The kept states are put on the
+ * contacts again (mj_adapt.c, hold_gaps). */
 #define FL_HOLD_SWEEPS 3
 static void hold_gaps(pd_mj *mj, int nI, const pd_state *in, pd_state *out)
 {
@@ -698,9 +697,9 @@ static void hold_gaps(pd_mj *mj, int nI, const pd_state *in, pd_state *out)
     for (int sweep = 0; sweep < FL_HOLD_SWEEPS; sweep++)
         for (int r = 0; r < nI; r++) {
             int a = mj->idx_active[r];
-            if (!(out->P[a] > 0.0) || fabs(mj_inc_dot(inc, a, out->v)) > mj->u_rest[a])
+            if (!(out->P[a] > 0.0) || in->g[a] > 0.0)
                 continue;
-            double g = md->g0[a] + mj_inc_dot(inc, a, out->q), d = fmin(in->g[a], 0.0) - g;
+            double g = md->g0[a] + mj_inc_dot(inc, a, out->q), d = in->g[a] - g;
             double D0 = 0.0;
             for (int j = inc->ptr[a]; j < inc->ptr[a + 1]; j++)
                 D0 += inc->w[j] * inc->w[j] * fl->minv[inc->dof[j]];
