@@ -256,6 +256,16 @@ static void print_json(const sim_args *a, const pd_osc_summary *s)
     pd_json_finish(&js);
 }
 
+/* To a tolerance that was not met: one line on stderr (the figures stand,
+ * with their estimate). */
+static void warn_rtol(double rtol, double err_est, int met)
+{
+    if (rtol > 0.0 && !met)
+        fprintf(stderr, "pound: simulate: warning: rtol %g not met: err_est %.2g (the steps "
+                "reached their floor, the budget, or the estimate stayed above rtol after the "
+                "tighter runs; docs/scheme.md, \"Moreau-Jean to a tolerance\")\n", rtol, err_est);
+}
+
 static void print_text(const sim_args *a, const pd_osc_summary *s)
 {
     const pd_osc *c = &a->k.c;
@@ -425,6 +435,7 @@ static int simulate_oscillator(sim_args *a)
     }
     if ((status = dump_finish(dump)))
         goto done;
+    warn_rtol(s.r.rtol, s.err_est, s.rtol_met);
     if (a->json)
         print_json(a, &s);
     else
@@ -524,7 +535,7 @@ static void scene_json(const sim_args *a, const pd_scene *sc, const pd_scene_sum
         pd_json_nums(&js, "Pi1", n, s->Pi1 + o);
         pd_json_nums(&js, "umax_free", n, s->free.umax + o);
         pd_json_nums(&js, "gamma", n, s->gamma + o);
-        pd_json_num(&js, "err_est", r->rtol > 0.0 ? fmax(r->err_est[k], s->free.err_est[k]) : NAN);
+        pd_json_num(&js, "err_est", s->err_est_structure[k]); /* NaN -> null: fixed steps */
         pd_json_end_object(&js);
     }
     pd_json_end_array(&js);
@@ -566,7 +577,12 @@ static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_sum
            sc->exc.record ? "record" : pd_pulse_name(sc->exc.pulse),
            sc->exc.record ? sc->exc.record->name : "pulse", sc->exc.dir > 0 ? "+x" : "-x",
            sc->exc.ap, sc->exc.Tp, sc->exc.record ? " (its fitted pulse)" : "");
-    if (a->k.opts.method == PD_METHOD_MOREAU)
+    if (a->k.opts.method == PD_METHOD_MOREAU && r->rtol > 0.0)
+        printf("  Moreau-Jean to rtol = %g: %ld steps (%ld tries halved), dt %.3g to %.3g s, to "
+               "%g s (kernel %s, LCP %s, %ld LCPs)\n",
+               r->rtol, r->steps, r->steps_rejected, r->dt_min, r->dt_max, r->tend, r->kernel,
+               r->lcp_solver, r->lcp_solves);
+    else if (a->k.opts.method == PD_METHOD_MOREAU)
         printf("  Moreau-Jean theta = %g, dt = %.6g s, %ld steps to %g s (kernel %s, factor %s, "
                "LCP %s, %ld LCPs)\n",
                r->theta, r->dt, r->steps, r->tend, r->kernel, r->factor, r->lcp_solver,
@@ -589,17 +605,20 @@ static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_sum
                    "contacts closed within --close-tol %g Le, %ld accumulations jumped\n",
                    impacts, r->simultaneous, r->tol_closed, r->close_tol, r->accumulations);
     }
-    printf("  %-12s %7s %9s %12s %12s %10s %8s\n", "structure", "storey", "T0 [s]", "umax [m]",
-           "drift [m]", "Pi1", "gamma");
+    int tol = r->rtol > 0.0; /* to a tolerance: each structure's estimate */
+    printf("  %-12s %7s %9s %12s %12s %10s %8s%s\n", "structure", "storey", "T0 [s]", "umax [m]",
+           "drift [m]", "Pi1", "gamma", tol ? "    err_est" : "");
     for (int k = 0; k < sc->nstruct && k < TEXT_MAX_STRUCTURES; k++) {
         const pd_structure *st = &sc->st[k];
         for (int i = 0; i < st->storeys; i++) {
             int d = st->dof + i;
-            char T0[16] = "";
+            char T0[16] = "", est[24] = "";
             if (i == 0)
                 snprintf(T0, sizeof T0, "%.4g", st->T0);
-            printf("  %-12s %7d %9s %12.6g %12.6g %10.5g %8.4g\n", i ? "" : st->name, i + 1, T0,
-                   r->umax[d], r->drift[d], s->Pi1[d], s->gamma[d]);
+            if (i == 0 && tol)
+                snprintf(est, sizeof est, " %10.2g", s->err_est_structure[k]);
+            printf("  %-12s %7d %9s %12.6g %12.6g %10.5g %8.4g%s\n", i ? "" : st->name, i + 1, T0,
+                   r->umax[d], r->drift[d], s->Pi1[d], s->gamma[d], est);
         }
     }
     if (sc->nstruct > TEXT_MAX_STRUCTURES)
@@ -643,6 +662,10 @@ static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_sum
     if (sc->ncontact)
         printf("  (equivalent: pi I / (2 td), a half-sine pulse of td = %g s, --contact-duration)\n",
                r->contact_duration);
+    if (tol)
+        printf("  err_est   = %.2g (the peaks' estimated relative error: umax, drift and the "
+               "demands of every structure, the run's and its contact-free twin's; %s)\n",
+               s->err_est, s->rtol_met ? "rtol met" : "rtol NOT met");
     printf("  cpu       = %.3g s (the run and its contact-free twin)\n", s->cpu_s);
 }
 
@@ -689,6 +712,7 @@ static int simulate_scene(sim_args *a)
     }
     if ((status = dump_finish(dump)))
         goto done;
+    warn_rtol(s.r.rtol, s.err_est, s.rtol_met);
     if (a->json)
         scene_json(a, sc, &s);
     else

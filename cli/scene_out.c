@@ -342,7 +342,12 @@ static int put_run(pd_scene_writer *w, const pd_scene_run_info *ri)
            put_num(w, f, "", "accumulations", (double)r->accumulations, "1") ||
            put_num(w, f, "", "close_tol", r->close_tol, "Le") ||
            put_num(w, f, "", "contact_duration", r->contact_duration, "s") ||
-           put_num(w, f, "", "cpu_s", ri->sum->cpu_s, "s");
+           put_num(w, f, "", "cpu_s", ri->sum->cpu_s, "s") ||
+           put_num(w, f, "", "rtol", r->rtol, "1") ||
+           put_num(w, f, "", "err_est", ri->sum->err_est, "1") ||
+           put_num(w, f, "", "rtol_met", ri->sum->rtol_met, "1") ||
+           put_num(w, f, "", "steps_rejected", (double)r->steps_rejected, "1") ||
+           put_num(w, f, "", "dt_min", r->dt_min, "s") || put_num(w, f, "", "dt_max", r->dt_max, "s");
 }
 
 /* Structure s: its description and results (group /structures/NAME). */
@@ -379,7 +384,8 @@ static int put_structure(pd_scene_writer *w, const pd_scene_summary *sum, int s)
          put_num(w, g, prefix, "base_shear_max", sum->r.shear_max[o], "N") ||
          put_nums(w, g, prefix, "Pi1", k, sum->Pi1 + o, "1") ||
          put_nums(w, g, prefix, "umax_free", k, sum->free.umax + o, "m") ||
-         put_nums(w, g, prefix, "gamma", k, sum->gamma + o, "1");
+         put_nums(w, g, prefix, "gamma", k, sum->gamma + o, "1") ||
+         put_num(w, g, prefix, "err_est", sum->err_est_structure[s], "1");
     if (g >= 0 && H5Gclose(g) < 0)
         rc = -1;
     return rc;

@@ -734,6 +734,8 @@ typedef struct pd_scene_summary {
     double cpu_s;
     double err_est;        /* to a tolerance: the largest of both runs' (NAN: fixed steps) */
     int rtol_met;          /* both runs met their tolerance (1 without one) */
+    double *err_est_structure; /* nstruct: each structure's, the larger of both runs' (NAN:
+                                  fixed steps) */
 } pd_scene_summary;
 
 /* opts NULL: pd_run_default_opts(). */

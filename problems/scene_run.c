@@ -1261,6 +1261,7 @@ void pd_scene_summary_free(pd_scene_summary *s)
     free(s->Pi2);
     free(s->Pi3);
     free(s->chi);
+    free(s->err_est_structure);
     memset(s, 0, sizeof *s);
 }
 
@@ -1282,7 +1283,8 @@ int pd_scene_summarize(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sam
     s->Pi2 = malloc((size_t)sc->nstruct * sizeof(double));
     s->Pi3 = malloc(m * sizeof(double));
     s->chi = malloc(m * sizeof(double));
-    if (!s->Pi1 || !s->gamma || !s->Pi2 || !s->Pi3 || !s->chi) {
+    s->err_est_structure = malloc((size_t)sc->nstruct * sizeof(double));
+    if (!s->Pi1 || !s->gamma || !s->Pi2 || !s->Pi3 || !s->chi || !s->err_est_structure) {
         pd_scene_summary_free(s);
         return pd_err_set(err, PD_ENOMEM, "out of memory for the summary of %d dofs", sc->n);
     }
@@ -1302,8 +1304,11 @@ int pd_scene_summarize(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sam
         s->Pi1[i] = s->r.umax[i] / Le;
         s->gamma[i] = s->free.umax[i] > 0.0 ? s->r.umax[i] / s->free.umax[i] : NAN;
     }
-    for (int k = 0; k < sc->nstruct; k++)
+    for (int k = 0; k < sc->nstruct; k++) {
         s->Pi2[k] = sc->exc.Tp / sc->st[k].T0;
+        s->err_est_structure[k] =
+            s->r.rtol > 0.0 ? fmax(s->r.err_est[k], s->free.err_est[k]) : NAN;
+    }
     for (int a = 0; a < sc->ncontact; a++) {
         s->Pi3[a] = sc->ct[a].gap / Le;
         s->chi[a] = s->free.approach[a] > 0.0 ? sc->ct[a].gap / s->free.approach[a] : NAN;
