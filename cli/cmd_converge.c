@@ -12,13 +12,16 @@
 
 static const char converge_usage[] =
     "usage: pound converge [model flags | --scene F.json | --chain N] --dt MAX:MIN:N\n"
-    "                      [--methods moreau,penalty,newmark,event-general]\n"
-    "                      [--theta LIST] [--kcs LIST] [--plot FILE.png] [-o FILE] [--json]\n"
+    "                      [--methods moreau,moreau-rtol,penalty,newmark,event-general]\n"
+    "                      [--theta LIST] [--rtols LIST] [--kcs LIST] [--plot FILE.png]\n"
+    "                      [-o FILE] [--json]\n"
     "  --dt MAX:MIN:N  N step sizes, log-spaced from MAX down to MIN (Moreau-Jean rows)\n"
     "  --theta LIST    one Moreau-Jean curve per theta (default 0.5)\n"
-    "  --methods LIST  the rows: moreau (per dt and theta), newmark (per dt), penalty (per\n"
-    "                  stiffness),\n"
+    "  --methods LIST  the rows: moreau (per dt and theta), moreau-rtol (Moreau-Jean to a\n"
+    "                  tolerance, per --rtols), newmark (per dt), penalty (per stiffness),\n"
     "                  event-general (scenes: the GSL-based general reference, one row)\n"
+    "  --rtols LIST    moreau-rtol rows: tolerances (default 1e-2,1e-3,1e-4,1e-5,1e-6);\n"
+    "                  default methods: moreau,moreau-rtol\n"
     "  --kcs LIST      penalty rows: stiffness multiples of w0^2 (default 1e2,1e3,1e4,1e5,1e6),\n"
     "                  measured on the finest dt grid\n"
     "  --plot F.png    error vs dt in F.png, error vs CPU time (work-precision) in F-work.png\n"
@@ -33,6 +36,7 @@ enum { MAX_LIST = 32, MAX_ROWS = 1024 };
 typedef struct row {
     pd_method method;
     double theta, dt, kc, err_umax, err_hist, cpu_s, order;
+    double rtol, err_est; /* moreau-rtol rows (else NaN) */
     long impacts, steps;
     const double *serr_umax, *serr_hist; /* scenes: per structure */
 } row;
@@ -40,10 +44,10 @@ typedef struct row {
 typedef struct conv_args {
     pd_cli_case k;
     double dt_max, dt_min;
-    int ndt, ntheta, nkc, want_moreau, want_penalty, want_general, want_newmark, json,
-        have_dt_range;
+    int ndt, ntheta, nkc, nrtol, want_moreau, want_rtol, want_penalty, want_general, want_newmark,
+        json, have_dt_range;
     int use_umax; /* --error umax: chart and order err_umax_rel */
-    double thetas[MAX_LIST], kcs[MAX_LIST];
+    double thetas[MAX_LIST], kcs[MAX_LIST], rtols[MAX_LIST];
     const char *plot, *out;
 } conv_args;
 
@@ -94,16 +98,18 @@ static int parse_methods(conv_args *a, const char *text)
     if (!text || strlen(text) >= sizeof buf)
         return pd_cli_usage_error("--methods needs a list such as moreau,penalty");
     if (!text[0])
-        return pd_cli_usage_error("--methods: give moreau, penalty, newmark, event-general "
-                                  "(got '')");
+        return pd_cli_usage_error("--methods: give moreau, moreau-rtol, penalty, newmark, "
+                                  "event-general (got '')");
     strcpy(buf, text);
-    a->want_moreau = a->want_penalty = a->want_general = a->want_newmark = 0;
+    a->want_moreau = a->want_rtol = a->want_penalty = a->want_general = a->want_newmark = 0;
     for (int k = 1; p; k++) {
         char *tok = next_element(&p);
         if (!tok[0])
             return empty_element("--methods", text, k);
         if (!strcmp(tok, "moreau"))
             a->want_moreau = 1;
+        else if (!strcmp(tok, "moreau-rtol"))
+            a->want_rtol = 1;
         else if (!strcmp(tok, "penalty"))
             a->want_penalty = 1;
         else if (!strcmp(tok, "event-general"))
@@ -111,8 +117,8 @@ static int parse_methods(conv_args *a, const char *text)
         else if (!strcmp(tok, "newmark"))
             a->want_newmark = 1;
         else
-            return pd_cli_usage_error("--methods: '%s' is not one of moreau, penalty, newmark, "
-                                      "event-general", tok);
+            return pd_cli_usage_error("--methods: '%s' is not one of moreau, moreau-rtol, penalty, "
+                                      "newmark, event-general", tok);
     }
     return 0;
 }
@@ -157,7 +163,7 @@ static int parse_args(conv_args *a, int argc, char **argv)
     memset(a, 0, sizeof *a);
     pd_cli_case_init(&a->k);
     a->k.methods_listed = 1;
-    a->want_moreau = 1;
+    a->want_moreau = a->want_rtol = 1;
     for (int i = 1; i < argc; i++) {
         const char *f = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(f, "--dt")) { /* a range here, not a single step */
@@ -182,6 +188,10 @@ static int parse_args(conv_args *a, int argc, char **argv)
             if (!val || (strcmp(val, "hist") && strcmp(val, "umax")))
                 return pd_cli_usage_error("--error: expected hist or umax");
             a->use_umax = !strcmp(val, "umax");
+            i++;
+        } else if (!strcmp(f, "--rtols")) {
+            if ((rc = parse_list(f, val, a->rtols, &a->nrtol)))
+                return rc;
             i++;
         } else if (!strcmp(f, "--kcs")) {
             if ((rc = parse_list(f, val, a->kcs, &a->nkc)))
@@ -219,6 +229,15 @@ static int parse_args(conv_args *a, int argc, char **argv)
         memcpy(a->kcs, def, sizeof def);
         a->nkc = 5;
     }
+    if (!a->nrtol) {
+        const double def[] = {1e-2, 1e-3, 1e-4, 1e-5, 1e-6};
+        memcpy(a->rtols, def, sizeof def);
+        a->nrtol = 5;
+    }
+    for (int k = 0; k < a->nrtol; k++)
+        if (!(a->rtols[k] >= PD_RTOL_MIN && a->rtols[k] < 1.0))
+            return pd_cli_usage_error("--rtols: the tolerances must be in [%g, 1) (got %g)",
+                                      PD_RTOL_MIN, a->rtols[k]);
     for (int k = 0; k < a->nkc; k++)
         if (!(a->kcs[k] > 0.0))
             return pd_cli_usage_error("--kcs: stiffness multiples must be > 0 (got %g)", a->kcs[k]);
@@ -303,9 +322,12 @@ static int measure_reference(measurer *M, const pd_run_opts *o, double *cpu, pd_
 static int measure_row(measurer *M, const pd_run_opts *o, int r, row *out, pd_err *err)
 {
     int rc;
+    int tol = o->rtol > 0.0;
     *out = (row){.method = o->method,
-                 .theta = o->method == PD_METHOD_MOREAU ? o->theta : NAN,
-                 .dt = o->dt,
+                 .theta = o->method == PD_METHOD_MOREAU && !tol ? o->theta : NAN,
+                 .dt = tol ? NAN : o->dt,
+                 .rtol = tol ? o->rtol : NAN,
+                 .err_est = NAN,
                  .kc = o->method == PD_METHOD_PENALTY || o->method == PD_METHOD_NEWMARK
                            ? o->pen.kc_mult
                            : NAN,
@@ -319,6 +341,7 @@ static int measure_row(measurer *M, const pd_run_opts *o, int r, row *out, pd_er
         out->cpu_s = m.r.cpu_s;
         out->impacts = m.r.impacts;
         out->steps = m.r.steps;
+        out->err_est = tol ? m.r.err_est : NAN;
         return PD_OK;
     }
     if ((rc = pd_scene_measure_run(M->sc, o, &M->sref, &M->srr, &M->sres, &M->se, err)))
@@ -332,6 +355,7 @@ static int measure_row(measurer *M, const pd_run_opts *o, int r, row *out, pd_er
     out->cpu_s = M->se.cpu_s;
     out->impacts = M->se.impacts;
     out->steps = M->sres.steps;
+    out->err_est = tol ? M->sres.err_est_max : NAN;
     out->serr_umax = eu;
     out->serr_hist = eh;
     return PD_OK;
@@ -364,7 +388,7 @@ static int compute_rows(conv_args *a, measurer *M, row *rows, int *nrows, double
     int rc, n = 0;
     o.dt = a->dt_min;
     *ref_cpu = 0.0;
-    if ((rc = measurer_alloc(M, &o, a->ndt * (a->ntheta + 1) + a->nkc + 1, err)))
+    if ((rc = measurer_alloc(M, &o, a->ndt * (a->ntheta + 1) + a->nrtol + a->nkc + 1, err)))
         goto done;
     int once = M->sc && nested_grid(a);
     if (once && (rc = measure_reference(M, &o, ref_cpu, err)))
@@ -388,6 +412,19 @@ static int compute_rows(conv_args *a, measurer *M, row *rows, int *nrows, double
             goto done;
         o.method = PD_METHOD_NEWMARK;
         if ((rc = measure_row(M, &o, n, &rows[n], err)))
+            goto done;
+    }
+    for (int k = 0; k < a->nrtol && a->want_rtol; k++, n++) {
+        /* to a tolerance: measured on the finest grid */
+        o.dt = a->dt_min;
+        o.method = PD_METHOD_MOREAU;
+        if (!once && k == 0 && (rc = measure_reference(M, &o, ref_cpu, err)))
+            goto done;
+        o.dt = 0.0;
+        o.rtol = a->rtols[k];
+        rc = measure_row(M, &o, n, &rows[n], err);
+        o.rtol = 0.0;
+        if (rc)
             goto done;
     }
     if (a->want_penalty) {
@@ -416,7 +453,7 @@ static int compute_rows(conv_args *a, measurer *M, row *rows, int *nrows, double
     for (int r = 0; r < n; r++)
         for (int q = r - 1; q >= 0; q--)
             if ((rows[q].method == PD_METHOD_MOREAU && rows[r].method == PD_METHOD_MOREAU &&
-                 rows[q].theta == rows[r].theta) ||
+                 isnan(rows[q].rtol) && isnan(rows[r].rtol) && rows[q].theta == rows[r].theta) ||
                 (rows[q].method == PD_METHOD_NEWMARK && rows[r].method == PD_METHOD_NEWMARK)) {
                 rows[r].order = log(row_error(a, &rows[q]) / row_error(a, &rows[r])) /
                                 log(rows[q].dt / rows[r].dt);
@@ -458,9 +495,11 @@ static void print_rows(const conv_args *a, const measurer *M, const row *rows, i
         pd_json_begin_array(&js, "rows");
         for (int r = 0; r < n; r++) {
             pd_json_begin_object(&js, NULL);
-            pd_json_str(&js, "method", pd_method_name(rows[r].method));
+            pd_json_str(&js, "method", pd_method_name(rows[r].method)); /* rtol: its own */
             pd_json_num(&js, "theta", rows[r].theta);
             pd_json_num(&js, "dt", rows[r].dt);
+            pd_json_num(&js, "rtol", rows[r].rtol);
+            pd_json_num(&js, "err_est", rows[r].err_est);
             pd_json_num(&js, "kc", rows[r].kc);
             pd_json_num(&js, "err_umax_rel", rows[r].err_umax);
             pd_json_num(&js, "err_hist_linf", rows[r].err_hist);
@@ -497,12 +536,13 @@ static void print_rows(const conv_args *a, const measurer *M, const row *rows, i
     printf("%s; reference cost %.3g s\n", title, ref_cpu);
     if (M->sc)
         pd_cli_ref_decisions_text(stdout, &M->srr);
-    printf("  %-13s %6s %11s %8s %11s %11s %10s %7s %8s\n", "method", "theta", "dt [s]", "kc",
-           "err_umax", "err_hist", "cpu [s]", "order", "impacts");
+    printf("  %-13s %6s %11s %8s %8s %11s %11s %9s %10s %7s %8s\n", "method", "theta", "dt [s]",
+           "rtol", "kc", "err_umax", "err_hist", "err_est", "cpu [s]", "order", "impacts");
     for (int r = 0; r < n; r++)
-        printf("  %-13s %6.3g %11.4g %8.3g %11.3g %11.3g %10.3g %7.3f %8ld\n",
-               pd_method_name(rows[r].method), rows[r].theta, rows[r].dt, rows[r].kc,
-               rows[r].err_umax, rows[r].err_hist, rows[r].cpu_s, rows[r].order, rows[r].impacts);
+        printf("  %-13s %6.3g %11.4g %8.2g %8.3g %11.3g %11.3g %9.2g %10.3g %7.3f %8ld\n",
+               isnan(rows[r].rtol) ? pd_method_name(rows[r].method) : "moreau-rtol",
+               rows[r].theta, rows[r].dt, rows[r].rtol, rows[r].kc, rows[r].err_umax,
+               rows[r].err_hist, rows[r].err_est, rows[r].cpu_s, rows[r].order, rows[r].impacts);
 }
 
 /* err_hist against dt (Moreau–Jean curves) and against CPU time (all). */
@@ -516,7 +556,8 @@ static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int
     for (int t = 0; t < a->ntheta && a->want_moreau; t++, ncurve++) {
         int m = 0;
         for (int r = 0; r < n; r++)
-            if (rows[r].method == PD_METHOD_MOREAU && rows[r].theta == a->thetas[t]) {
+            if (rows[r].method == PD_METHOD_MOREAU && isnan(rows[r].rtol) &&
+                rows[r].theta == a->thetas[t]) {
                 xs[0][ncurve][m] = rows[r].dt;
                 ys[0][ncurve][m] = row_error(a, &rows[r]);
                 xs[1][ncurve][m] = rows[r].cpu_s;
@@ -546,23 +587,36 @@ static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int
                                     .y = ys[1][ncurve]};
         ncurve++;
     }
-    int npen = 0;
+    int nrt = 0; /* to a tolerance: a work-precision curve */
+    if (a->want_rtol) {
+        for (int r = 0; r < n; r++)
+            if (!isnan(rows[r].rtol)) {
+                xs[1][ncurve][nrt] = rows[r].cpu_s;
+                ys[1][ncurve][nrt] = row_error(a, &rows[r]);
+                nrt++;
+            }
+        snprintf(labels[ncurve], sizeof labels[0], "Moreau\u2013Jean to rtol %g \u2026 %g",
+                 a->rtols[0], a->rtols[a->nrtol - 1]);
+        by_cpu[ncurve] = (pd_curve){.label = labels[ncurve], .n = nrt, .x = xs[1][ncurve],
+                                    .y = ys[1][ncurve]};
+    }
+    int npen = 0, cpen = ncurve + (nrt > 0);
     if (a->want_penalty) {
         for (int r = 0; r < n; r++)
             if (rows[r].method == PD_METHOD_PENALTY) {
-                xs[1][ncurve][npen] = rows[r].cpu_s;
-                ys[1][ncurve][npen] = row_error(a, &rows[r]);
+                xs[1][cpen][npen] = rows[r].cpu_s;
+                ys[1][cpen][npen] = row_error(a, &rows[r]);
                 npen++;
             }
-        snprintf(labels[ncurve], sizeof labels[0], "penalty (kc = %g \u2026 %g \u03c9\u2080\u00b2)", a->kcs[0],
+        snprintf(labels[cpen], sizeof labels[0], "penalty (kc = %g \u2026 %g \u03c9\u2080\u00b2)", a->kcs[0],
                  a->kcs[a->nkc - 1]);
-        by_cpu[ncurve] = (pd_curve){.label = labels[ncurve], .n = npen, .x = xs[1][ncurve],
-                                    .y = ys[1][ncurve]};
+        by_cpu[cpen] = (pd_curve){.label = labels[cpen], .n = npen, .x = xs[1][cpen],
+                                  .y = ys[1][cpen]};
     }
     int ngen = 0;
     for (int r = 0; r < n && a->want_general; r++)
         if (rows[r].method == PD_METHOD_EVENT_GENERAL) {
-            int c = ncurve + (npen > 0);
+            int c = cpen + (npen > 0);
             xs[1][c][0] = rows[r].cpu_s;
             ys[1][c][0] = row_error(a, &rows[r]);
             snprintf(labels[c], sizeof labels[0], "general reference (event-general, GSL)");
@@ -588,13 +642,13 @@ static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int
                    .ylabel = ylabel,
                    .logx = 1,
                    .logy = 1,
-                   .ncurves = ncurve + (npen > 0) + ngen,
+                   .ncurves = ncurve + (nrt > 0) + (npen > 0) + ngen,
                    .curves = by_cpu,
                    .vline = ref_cpu,
                    .vline_label = "event-driven reference"};
     size_t len = strlen(a->plot);
     snprintf(work_png, sizeof work_png, "%.*s-work.png", (int)(len - 4), a->plot);
-    int rc = ncurve ? pd_plot(a->plot, &c1, err) : PD_OK;
+    int rc = ncurve ? pd_plot(a->plot, &c1, err) : PD_OK; /* the dt chart: fixed steps */
     return rc ? rc : pd_plot(work_png, &c2, err);
 }
 
@@ -605,7 +659,7 @@ static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int
 static int write_rows(const conv_args *a, const measurer *M, const row *rows, int n,
                       double ref_cpu, pd_err *err)
 {
-    enum { NC = 10 };
+    enum { NC = 12 };
     static double col[NC][MAX_ROWS];
     const char *methods[] = {pd_method_name(PD_METHOD_MOREAU), pd_method_name(PD_METHOD_EVENT),
                              pd_method_name(PD_METHOD_PENALTY), pd_method_name(PD_METHOD_AUTO),
@@ -615,7 +669,8 @@ static int write_rows(const conv_args *a, const measurer *M, const row *rows, in
     for (int r = 0; r < n; r++) {
         double v[NC] = {(double)rows[r].method, rows[r].theta, rows[r].dt, rows[r].kc,
                         rows[r].err_umax, rows[r].err_hist, rows[r].cpu_s, rows[r].order,
-                        (double)rows[r].impacts, (double)rows[r].steps};
+                        (double)rows[r].impacts, (double)rows[r].steps, rows[r].rtol,
+                        rows[r].err_est};
         for (int c = 0; c < NC; c++)
             col[c][r] = v[c];
     }
@@ -629,7 +684,9 @@ static int write_rows(const conv_args *a, const measurer *M, const row *rows, in
         {.name = "cpu_s", .units = "s", .values = col[6]},
         {.name = "order", .units = "1", .values = col[7]},
         {.name = "impacts", .units = "1", .values = col[8]},
-        {.name = "steps", .units = "1", .values = col[9]}};
+        {.name = "steps", .units = "1", .values = col[9]},
+        {.name = "rtol", .units = "1", .values = col[10]}, /* moreau-rtol rows, else NaN */
+        {.name = "err_est", .units = "1", .values = col[11]}};
 #define NUM(nm, u, x) {.name = nm, .units = u, .num = (x)}
 #define TXT(nm, x) {.name = nm, .is_text = 1, .text = (x)}
     const pd_osc *c = &a->k.c;
@@ -671,7 +728,7 @@ int pd_cmd_converge(int argc, char **argv)
     if ((rc = parse_args(&a, argc, argv)))
         return rc;
     pd_provenance_set(argc, argv, PD_FORMAT_CONVERGE, 0);
-    if (a.ndt * (a.ntheta + 1) + a.nkc + 1 > MAX_ROWS) {
+    if (a.ndt * (a.ntheta + 1) + a.nrtol + a.nkc + 1 > MAX_ROWS) {
         pd_cli_case_free(&a.k);
         return pd_cli_usage_error("converge: too many rows (at most %d)", MAX_ROWS);
     }

@@ -1,5 +1,6 @@
 /* interp.c — Hermite interpolation on a step. */
 #include "pd_core.h"
+#include <math.h>
 
 /* Quintic Hermite basis in r = s / h: H3, H4, H5 carry the end point, H1,
  * H2 the start's rate and acceleration (the start value enters as 1 - H3). */
@@ -20,4 +21,13 @@ void pd_hermite5(const double p0[3], const double p1[3], double h, double r, dou
     if (fd)
         *fd = (p1[0] - p0[0]) * D3 / h + p0[1] * D1 + p1[1] * D4 +
               h * (p0[2] * D2 + p1[2] * D5);
+}
+
+double pd_hermite3(const double p0[2], const double p1[2], double h, double r)
+{
+    if (!p0 || !p1)
+        return NAN;
+    double r2 = r * r, r3 = r2 * r;
+    return p0[0] + (p1[0] - p0[0]) * (3 * r2 - 2 * r3) +
+           h * (p0[1] * (r - 2 * r2 + r3) + p1[1] * (r3 - r2));
 }

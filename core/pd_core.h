@@ -109,6 +109,10 @@ PD_API double pd_rand_pm1(uint64_t *state);
 PD_API void pd_hermite5(const double p0[3], const double p1[3], double h, double r, double *f,
                         double *fd);
 
+/* The cubic Hermite interpolant on a step of length h through (f, f') = p0
+ * at its start and p1 at its end: its value at the fraction r in [0, 1]. */
+PD_API double pd_hermite3(const double p0[2], const double p1[2], double h, double r);
+
 /* ---- matrices -------------------------------------------------------------- */
 
 typedef enum {

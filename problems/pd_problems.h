@@ -487,6 +487,7 @@ PD_API int pd_osc_free_first_contact(const pd_osc *c, double tmax, double *t, do
 typedef struct pd_trace {
     double *u;
     long n, cap;
+    double dt; /* the grid's step (pd_trace_alloc) */
 } pd_trace;
 
 typedef struct pd_measured {

@@ -139,7 +139,54 @@ typedef struct compare_ctx {
     pd_scene_errors *e;
     const double *scale; /* nstruct */
     long stride, row; /* the run's step in reference rows; its next row */
+    double *x_prev, *v_prev, *x_at; /* to a tolerance: the last sample, a row between (n) */
+    double t_prev;
+    int have_prev;
 } compare_ctx;
+
+/* Row at of the reference against x (n displacements) into the errors. */
+static void compare_at(compare_ctx *c, long at, const double *x)
+{
+    const double *xr = c->ref->x + (size_t)at * c->ref->n;
+    for (int k = 0; k < c->sc->nstruct; k++) {
+        const pd_structure *st = &c->sc->st[k];
+        double worst = 0.0;
+        for (int i = st->dof; i < st->dof + st->storeys; i++)
+            worst = fmax(worst, fabs(x[i] - xr[i]));
+        c->e->err_hist[k] = fmax(c->e->err_hist[k], worst / c->scale[k]);
+    }
+}
+
+/* A run to a tolerance samples its own steps: each reference row inside a
+ * step compared with the cubic through the step's ends (x and v; the line
+ * across a step with an impulse), as measure.c does for the oscillator. */
+static int compare_steps(const pd_scene_sample *s, void *ctx)
+{
+    compare_ctx *c = ctx;
+    int n = c->ref->n;
+    double h = s->t - c->t_prev;
+    int jump = 0;
+    for (int a = 0; a < c->sc->ncontact; a++)
+        jump |= s->impulse[a] > 0.0;
+    for (; c->row < c->ref->rows && (double)c->row * c->ref->dt <= s->t; c->row++) {
+        if (!c->have_prev) { /* t = 0 */
+            compare_at(c, c->row, s->x);
+            continue;
+        }
+        double r = ((double)c->row * c->ref->dt - c->t_prev) / h;
+        for (int i = 0; i < n; i++) {
+            double p0[2] = {c->x_prev[i], c->v_prev[i]}, p1[2] = {s->x[i], s->v[i]};
+            c->x_at[i] = jump || !(h > 0.0) ? p0[0] + r * (p1[0] - p0[0])
+                                            : pd_hermite3(p0, p1, h, r);
+        }
+        compare_at(c, c->row, c->x_at);
+    }
+    memcpy(c->x_prev, s->x, (size_t)n * sizeof(double));
+    memcpy(c->v_prev, s->v, (size_t)n * sizeof(double));
+    c->t_prev = s->t;
+    c->have_prev = 1;
+    return 0;
+}
 
 static int compare_row(const pd_scene_sample *s, void *ctx)
 {
@@ -147,15 +194,8 @@ static int compare_row(const pd_scene_sample *s, void *ctx)
     long at = c->row * c->stride;
     if (at >= c->ref->rows || fabs(s->t - (double)at * c->ref->dt) > 1e-9 * c->ref->dt)
         return 0; /* past the reference, or an event's state between grid points */
-    const double *xr = c->ref->x + (size_t)at * c->ref->n;
     c->row++;
-    for (int k = 0; k < c->sc->nstruct; k++) {
-        const pd_structure *st = &c->sc->st[k];
-        double worst = 0.0;
-        for (int i = st->dof; i < st->dof + st->storeys; i++)
-            worst = fmax(worst, fabs(s->x[i] - xr[i]));
-        c->e->err_hist[k] = fmax(c->e->err_hist[k], worst / c->scale[k]);
-    }
+    compare_at(c, at, s->x);
     return 0;
 }
 
@@ -172,12 +212,13 @@ int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scen
         e->nstruct != sc->nstruct || !e->err_umax || !e->err_hist)
         return pd_err_set(err, PD_EINVAL, "the results or errors are not allocated for this "
                                           "scene (pd_scene_result_alloc, pd_scene_errors_alloc)");
-    double ratio = r.dt / ref->dt;
+    int tol = r.rtol > 0.0; /* to a tolerance: its own steps, interpolated */
+    double ratio = tol ? 1.0 : r.dt / ref->dt;
     long stride = lround(ratio);
     if (stride < 1 || fabs(ratio - (double)stride) > 1e-9 * ratio)
         return pd_err_set(err, PD_EINVAL, "dt: %g is not a whole multiple of the reference's %g",
                           r.dt, ref->dt);
-    double *scale = malloc((size_t)sc->nstruct * sizeof(double));
+    double *scale = malloc(((size_t)sc->nstruct + (tol ? 3 * (size_t)sc->n : 0)) * sizeof(double));
     if (!scale)
         return pd_err_set(err, PD_ENOMEM, "out of memory");
     for (int s = 0; s < sc->nstruct; s++) {
@@ -185,7 +226,12 @@ int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scen
         e->err_hist[s] = e->err_umax[s] = 0.0;
     }
     compare_ctx c = {.sc = sc, .ref = ref, .e = e, .scale = scale, .stride = stride, .row = 0};
-    if ((rc = pd_scene_run(sc, o, compare_row, &c, res, err)) ||
+    if (tol) {
+        c.x_prev = scale + sc->nstruct;
+        c.v_prev = c.x_prev + sc->n;
+        c.x_at = c.v_prev + sc->n;
+    }
+    if ((rc = pd_scene_run(sc, o, tol ? compare_steps : compare_row, &c, res, err)) ||
         (rc = pd_scene_result_alloc(sc, &timed, err))) {
         free(scale);
         return rc;

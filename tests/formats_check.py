@@ -501,8 +501,8 @@ def oscillator_dump(ctx):
 def converge(ctx):
     fmt = "pound converge 1"
     cases = [("oscillator", ["converge", "--pulse", "sine", "--Tp", "0.3", "--T0", "3", "--ap", "4", "--gap",
-                             "0.004", "--eps", "0.6", "--dt", "1e-3:2.5e-4:3", "--methods", "moreau,penalty",
-                             "--kcs", "1e3,1e4"]),
+                             "0.004", "--eps", "0.6", "--dt", "1e-3:2.5e-4:3", "--methods", "moreau,moreau-rtol,penalty",
+                             "--rtols", "1e-3,1e-5", "--kcs", "1e3,1e4"]),
              ("scene", ["converge", "--scene", "two sdof's.json", "--tend", "2", "--dt", "1e-3:5e-4:2",
                         "--methods", "moreau,event-general"])]
     for kind, base in cases:
@@ -512,7 +512,8 @@ def converge(ctx):
             path = os.path.join(ctx.tmp, out)
             if out.endswith(".h5"):
                 f = check_h5(ctx, path, fmt, command_of(args), {"rows": len(j)}, root_qualifier=kind)
-                for k in ("theta", "dt", "kc", "err_umax_rel", "err_hist_linf", "order", "impacts", "steps"):
+                for k in ("theta", "dt", "kc", "err_umax_rel", "err_hist_linf", "order", "impacts", "steps",
+                          "rtol", "err_est"):
                     ok = all(close(a, r[k]) for a, r in zip(f[k][:], j))
                     check(ok, f"{out}: {k} differs from --json rows")
                 codes = {0: "moreau", 1: "event", 2: "penalty", 3: "auto", 4: "event-general",

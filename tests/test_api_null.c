@@ -76,7 +76,7 @@ static long api_case_7(void)
 static long api_case_8(void)
 {
     pd_err err = {0};
-    pd_matrix v = pd_matrix_dense(1, 1, NULL);
+    double v = pd_hermite3(NULL, (const double *)fx_object("double", "pd_hermite3", 1), 1.0, 1.0);
     (void)v;
     (void)err;
     return 0;
@@ -85,7 +85,7 @@ static long api_case_8(void)
 static long api_case_9(void)
 {
     pd_err err = {0};
-    pd_matrix v = pd_matrix_csc(1, 1, NULL, (const int *)fx_object("int", "pd_matrix_csc", 3), (const double *)fx_object("double", "pd_matrix_csc", 4));
+    double v = pd_hermite3((const double *)fx_object("double", "pd_hermite3", 0), NULL, 1.0, 1.0);
     (void)v;
     (void)err;
     return 0;
@@ -94,7 +94,7 @@ static long api_case_9(void)
 static long api_case_10(void)
 {
     pd_err err = {0};
-    pd_matrix v = pd_matrix_csc(1, 1, (const int *)fx_object("int", "pd_matrix_csc", 2), NULL, (const double *)fx_object("double", "pd_matrix_csc", 4));
+    pd_matrix v = pd_matrix_dense(1, 1, NULL);
     (void)v;
     (void)err;
     return 0;
@@ -103,7 +103,7 @@ static long api_case_10(void)
 static long api_case_11(void)
 {
     pd_err err = {0};
-    pd_matrix v = pd_matrix_csc(1, 1, (const int *)fx_object("int", "pd_matrix_csc", 2), (const int *)fx_object("int", "pd_matrix_csc", 3), NULL);
+    pd_matrix v = pd_matrix_csc(1, 1, NULL, (const int *)fx_object("int", "pd_matrix_csc", 3), (const double *)fx_object("double", "pd_matrix_csc", 4));
     (void)v;
     (void)err;
     return 0;
@@ -112,7 +112,8 @@ static long api_case_11(void)
 static long api_case_12(void)
 {
     pd_err err = {0};
-    pd_matrix_gemv(NULL, 1.0, (const double *)fx_object("double", "pd_matrix_gemv", 2), 1.0, (double *)fx_object("double", "pd_matrix_gemv", 4));
+    pd_matrix v = pd_matrix_csc(1, 1, (const int *)fx_object("int", "pd_matrix_csc", 2), NULL, (const double *)fx_object("double", "pd_matrix_csc", 4));
+    (void)v;
     (void)err;
     return 0;
 }
@@ -120,7 +121,8 @@ static long api_case_12(void)
 static long api_case_13(void)
 {
     pd_err err = {0};
-    pd_matrix_gemv((const pd_matrix *)fx_object("pd_matrix", "pd_matrix_gemv", 0), 1.0, NULL, 1.0, (double *)fx_object("double", "pd_matrix_gemv", 4));
+    pd_matrix v = pd_matrix_csc(1, 1, (const int *)fx_object("int", "pd_matrix_csc", 2), (const int *)fx_object("int", "pd_matrix_csc", 3), NULL);
+    (void)v;
     (void)err;
     return 0;
 }
@@ -128,7 +130,7 @@ static long api_case_13(void)
 static long api_case_14(void)
 {
     pd_err err = {0};
-    pd_matrix_gemv((const pd_matrix *)fx_object("pd_matrix", "pd_matrix_gemv", 0), 1.0, (const double *)fx_object("double", "pd_matrix_gemv", 2), 1.0, NULL);
+    pd_matrix_gemv(NULL, 1.0, (const double *)fx_object("double", "pd_matrix_gemv", 2), 1.0, (double *)fx_object("double", "pd_matrix_gemv", 4));
     (void)err;
     return 0;
 }
@@ -136,7 +138,7 @@ static long api_case_14(void)
 static long api_case_15(void)
 {
     pd_err err = {0};
-    pd_matrix_gemv_t(NULL, (const double *)fx_object("double", "pd_matrix_gemv_t", 1), (double *)fx_object("double", "pd_matrix_gemv_t", 2));
+    pd_matrix_gemv((const pd_matrix *)fx_object("pd_matrix", "pd_matrix_gemv", 0), 1.0, NULL, 1.0, (double *)fx_object("double", "pd_matrix_gemv", 4));
     (void)err;
     return 0;
 }
@@ -144,7 +146,7 @@ static long api_case_15(void)
 static long api_case_16(void)
 {
     pd_err err = {0};
-    pd_matrix_gemv_t((const pd_matrix *)fx_object("pd_matrix", "pd_matrix_gemv_t", 0), NULL, (double *)fx_object("double", "pd_matrix_gemv_t", 2));
+    pd_matrix_gemv((const pd_matrix *)fx_object("pd_matrix", "pd_matrix_gemv", 0), 1.0, (const double *)fx_object("double", "pd_matrix_gemv", 2), 1.0, NULL);
     (void)err;
     return 0;
 }
@@ -152,12 +154,28 @@ static long api_case_16(void)
 static long api_case_17(void)
 {
     pd_err err = {0};
-    pd_matrix_gemv_t((const pd_matrix *)fx_object("pd_matrix", "pd_matrix_gemv_t", 0), (const double *)fx_object("double", "pd_matrix_gemv_t", 1), NULL);
+    pd_matrix_gemv_t(NULL, (const double *)fx_object("double", "pd_matrix_gemv_t", 1), (double *)fx_object("double", "pd_matrix_gemv_t", 2));
     (void)err;
     return 0;
 }
 
 static long api_case_18(void)
+{
+    pd_err err = {0};
+    pd_matrix_gemv_t((const pd_matrix *)fx_object("pd_matrix", "pd_matrix_gemv_t", 0), NULL, (double *)fx_object("double", "pd_matrix_gemv_t", 2));
+    (void)err;
+    return 0;
+}
+
+static long api_case_19(void)
+{
+    pd_err err = {0};
+    pd_matrix_gemv_t((const pd_matrix *)fx_object("pd_matrix", "pd_matrix_gemv_t", 0), (const double *)fx_object("double", "pd_matrix_gemv_t", 1), NULL);
+    (void)err;
+    return 0;
+}
+
+static long api_case_20(void)
 {
     pd_err err = {0};
     double v = pd_matrix_get(NULL, 0, 0);
@@ -166,7 +184,7 @@ static long api_case_18(void)
     return 0;
 }
 
-static long api_case_19(void)
+static long api_case_21(void)
 {
     pd_err err = {0};
     double v = pd_matrix_col_dot(NULL, 0, (const double *)fx_object("double", "pd_matrix_col_dot", 2));
@@ -175,7 +193,7 @@ static long api_case_19(void)
     return 0;
 }
 
-static long api_case_20(void)
+static long api_case_22(void)
 {
     pd_err err = {0};
     double v = pd_matrix_col_dot((const pd_matrix *)fx_object("pd_matrix", "pd_matrix_col_dot", 0), 0, NULL);
@@ -184,7 +202,7 @@ static long api_case_20(void)
     return 0;
 }
 
-static long api_case_21(void)
+static long api_case_23(void)
 {
     pd_err err = {0};
     pd_matrix_col_axpy(NULL, 0, 1.0, (double *)fx_object("double", "pd_matrix_col_axpy", 3));
@@ -192,7 +210,7 @@ static long api_case_21(void)
     return 0;
 }
 
-static long api_case_22(void)
+static long api_case_24(void)
 {
     pd_err err = {0};
     pd_matrix_col_axpy((const pd_matrix *)fx_object("pd_matrix", "pd_matrix_col_axpy", 0), 0, 1.0, NULL);
@@ -200,7 +218,7 @@ static long api_case_22(void)
     return 0;
 }
 
-static long api_case_23(void)
+static long api_case_25(void)
 {
     pd_err err = {0};
     double v = pd_matrix_col_absdot(NULL, 0, (const double *)fx_object("double", "pd_matrix_col_absdot", 2));
@@ -209,7 +227,7 @@ static long api_case_23(void)
     return 0;
 }
 
-static long api_case_24(void)
+static long api_case_26(void)
 {
     pd_err err = {0};
     double v = pd_matrix_col_absdot((const pd_matrix *)fx_object("pd_matrix", "pd_matrix_col_absdot", 0), 0, NULL);
@@ -218,7 +236,7 @@ static long api_case_24(void)
     return 0;
 }
 
-static long api_case_25(void)
+static long api_case_27(void)
 {
     pd_err err = {0};
     long v = pd_matrix_nnz(NULL);
@@ -226,7 +244,7 @@ static long api_case_25(void)
     return v;
 }
 
-static long api_case_26(void)
+static long api_case_28(void)
 {
     pd_err err = {0};
     pd_matrix_to_dense(NULL, (double *)fx_object("double", "pd_matrix_to_dense", 1));
@@ -234,7 +252,7 @@ static long api_case_26(void)
     return 0;
 }
 
-static long api_case_27(void)
+static long api_case_29(void)
 {
     pd_err err = {0};
     pd_matrix_to_dense((const pd_matrix *)fx_object("pd_matrix", "pd_matrix_to_dense", 0), NULL);
@@ -242,7 +260,7 @@ static long api_case_27(void)
     return 0;
 }
 
-static long api_case_28(void)
+static long api_case_30(void)
 {
     pd_err err = {0};
     long v = pd_matrix_is_diagonal(NULL);
@@ -250,7 +268,7 @@ static long api_case_28(void)
     return v;
 }
 
-static long api_case_29(void)
+static long api_case_31(void)
 {
     pd_err err = {0};
     long v = pd_matrix_check(NULL, 1, 1, (const char *)fx_string("pd_matrix_check", "name"), &err);
@@ -258,7 +276,7 @@ static long api_case_29(void)
     return v;
 }
 
-static long api_case_30(void)
+static long api_case_32(void)
 {
     pd_err err = {0};
     long v = pd_matrix_check((const pd_matrix *)fx_object("pd_matrix", "pd_matrix_check", 0), 1, 1, NULL, &err);
@@ -266,7 +284,7 @@ static long api_case_30(void)
     return v;
 }
 
-static long api_case_31(void)
+static long api_case_33(void)
 {
     pd_err err = {0};
     long v = pd_sparse_from_triplets(NULL, 1, 1, 1, (const int *)fx_object("int", "pd_sparse_from_triplets", 4), (const int *)fx_object("int", "pd_sparse_from_triplets", 5), (const double *)fx_object("double", "pd_sparse_from_triplets", 6), &err);
@@ -274,7 +292,7 @@ static long api_case_31(void)
     return v;
 }
 
-static long api_case_32(void)
+static long api_case_34(void)
 {
     pd_err err = {0};
     long v = pd_sparse_from_triplets((pd_sparse *)fx_object("pd_sparse", "pd_sparse_from_triplets", 0), 1, 1, 1, NULL, (const int *)fx_object("int", "pd_sparse_from_triplets", 5), (const double *)fx_object("double", "pd_sparse_from_triplets", 6), &err);
@@ -282,7 +300,7 @@ static long api_case_32(void)
     return v;
 }
 
-static long api_case_33(void)
+static long api_case_35(void)
 {
     pd_err err = {0};
     long v = pd_sparse_from_triplets((pd_sparse *)fx_object("pd_sparse", "pd_sparse_from_triplets", 0), 1, 1, 1, (const int *)fx_object("int", "pd_sparse_from_triplets", 4), NULL, (const double *)fx_object("double", "pd_sparse_from_triplets", 6), &err);
@@ -290,7 +308,7 @@ static long api_case_33(void)
     return v;
 }
 
-static long api_case_34(void)
+static long api_case_36(void)
 {
     pd_err err = {0};
     long v = pd_sparse_from_triplets((pd_sparse *)fx_object("pd_sparse", "pd_sparse_from_triplets", 0), 1, 1, 1, (const int *)fx_object("int", "pd_sparse_from_triplets", 4), (const int *)fx_object("int", "pd_sparse_from_triplets", 5), NULL, &err);
@@ -298,7 +316,7 @@ static long api_case_34(void)
     return v;
 }
 
-static long api_case_35(void)
+static long api_case_37(void)
 {
     pd_err err = {0};
     pd_sparse_free(NULL);
@@ -306,7 +324,7 @@ static long api_case_35(void)
     return 0;
 }
 
-static long api_case_36(void)
+static long api_case_38(void)
 {
     pd_err err = {0};
     pd_matrix v = pd_sparse_view(NULL);
@@ -315,7 +333,7 @@ static long api_case_36(void)
     return 0;
 }
 
-static long api_case_37(void)
+static long api_case_39(void)
 {
     pd_err err = {0};
     long v = pd_dense_lu(1, NULL, 1, (int *)fx_object("int", "pd_dense_lu", 3), 1.0);
@@ -323,7 +341,7 @@ static long api_case_37(void)
     return v;
 }
 
-static long api_case_38(void)
+static long api_case_40(void)
 {
     pd_err err = {0};
     long v = pd_dense_lu(1, (double *)fx_object("double", "pd_dense_lu", 1), 1, NULL, 1.0);
@@ -331,7 +349,7 @@ static long api_case_38(void)
     return v;
 }
 
-static long api_case_39(void)
+static long api_case_41(void)
 {
     pd_err err = {0};
     pd_dense_lu_solve(1, NULL, 1, (const int *)fx_object("int", "pd_dense_lu_solve", 3), (double *)fx_object("double", "pd_dense_lu_solve", 4));
@@ -339,7 +357,7 @@ static long api_case_39(void)
     return 0;
 }
 
-static long api_case_40(void)
+static long api_case_42(void)
 {
     pd_err err = {0};
     pd_dense_lu_solve(1, (const double *)fx_object("double", "pd_dense_lu_solve", 1), 1, NULL, (double *)fx_object("double", "pd_dense_lu_solve", 4));
@@ -347,7 +365,7 @@ static long api_case_40(void)
     return 0;
 }
 
-static long api_case_41(void)
+static long api_case_43(void)
 {
     pd_err err = {0};
     pd_dense_lu_solve(1, (const double *)fx_object("double", "pd_dense_lu_solve", 1), 1, (const int *)fx_object("int", "pd_dense_lu_solve", 3), NULL);
@@ -355,7 +373,7 @@ static long api_case_41(void)
     return 0;
 }
 
-static long api_case_42(void)
+static long api_case_44(void)
 {
     pd_err err = {0};
     long v = pd_text_open(NULL, (const char *)fx_string("pd_text_open", "path"), 1, (pd_text_at)0, &err);
@@ -363,7 +381,7 @@ static long api_case_42(void)
     return v;
 }
 
-static long api_case_43(void)
+static long api_case_45(void)
 {
     pd_err err = {0};
     long v = pd_text_open((pd_text *)fx_object("pd_text", "pd_text_open", 0), NULL, 1, (pd_text_at)0, &err);
@@ -371,7 +389,7 @@ static long api_case_43(void)
     return v;
 }
 
-static long api_case_44(void)
+static long api_case_46(void)
 {
     pd_err err = {0};
     long v = pd_text_line(NULL);
@@ -379,7 +397,7 @@ static long api_case_44(void)
     return v;
 }
 
-static long api_case_45(void)
+static long api_case_47(void)
 {
     pd_err err = {0};
     long v = pd_text_rewind(NULL);
@@ -387,7 +405,7 @@ static long api_case_45(void)
     return v;
 }
 
-static long api_case_46(void)
+static long api_case_48(void)
 {
     pd_err err = {0};
     pd_text_close(NULL);
@@ -395,7 +413,7 @@ static long api_case_46(void)
     return 0;
 }
 
-static long api_case_47(void)
+static long api_case_49(void)
 {
     pd_err err = {0};
     long v = pd_text_read_all(NULL, 1, (pd_text_at)0, (char **)fx_slot(), (size_t *)fx_object("size_t", "pd_text_read_all", 4), &err);
@@ -403,7 +421,7 @@ static long api_case_47(void)
     return v;
 }
 
-static long api_case_48(void)
+static long api_case_50(void)
 {
     pd_err err = {0};
     long v = pd_text_read_all((const char *)fx_string("pd_text_read_all", "path"), 1, (pd_text_at)0, NULL, (size_t *)fx_object("size_t", "pd_text_read_all", 4), &err);
@@ -411,7 +429,7 @@ static long api_case_48(void)
     return v;
 }
 
-static long api_case_49(void)
+static long api_case_51(void)
 {
     pd_err err = {0};
     long v = pd_text_read_all((const char *)fx_string("pd_text_read_all", "path"), 1, (pd_text_at)0, (char **)fx_slot(), NULL, &err);
@@ -419,7 +437,7 @@ static long api_case_49(void)
     return v;
 }
 
-static long api_case_50(void)
+static long api_case_52(void)
 {
     pd_err err = {0};
     pd_lcp_free(NULL);
@@ -427,7 +445,7 @@ static long api_case_50(void)
     return 0;
 }
 
-static long api_case_51(void)
+static long api_case_53(void)
 {
     pd_err err = {0};
     long v = pd_lcp_nmax(NULL);
@@ -435,7 +453,7 @@ static long api_case_51(void)
     return v;
 }
 
-static long api_case_52(void)
+static long api_case_54(void)
 {
     pd_err err = {0};
     long v = pd_lcp_lemke(NULL, 1, (const double *)fx_object("double", "pd_lcp_lemke", 2), (const double *)fx_object("double", "pd_lcp_lemke", 3), (const pd_lcp_opts *)fx_object("pd_lcp_opts", "pd_lcp_lemke", 4), (double *)fx_object("double", "pd_lcp_lemke", 5), (double *)fx_object("double", "pd_lcp_lemke", 6), (pd_lcp_info *)fx_object("pd_lcp_info", "pd_lcp_lemke", 7));
@@ -443,7 +461,7 @@ static long api_case_52(void)
     return v;
 }
 
-static long api_case_53(void)
+static long api_case_55(void)
 {
     pd_err err = {0};
     long v = pd_lcp_lemke((pd_lcp_work *)fx_object("pd_lcp_work", "pd_lcp_lemke", 0), 1, NULL, (const double *)fx_object("double", "pd_lcp_lemke", 3), (const pd_lcp_opts *)fx_object("pd_lcp_opts", "pd_lcp_lemke", 4), (double *)fx_object("double", "pd_lcp_lemke", 5), (double *)fx_object("double", "pd_lcp_lemke", 6), (pd_lcp_info *)fx_object("pd_lcp_info", "pd_lcp_lemke", 7));
@@ -451,7 +469,7 @@ static long api_case_53(void)
     return v;
 }
 
-static long api_case_54(void)
+static long api_case_56(void)
 {
     pd_err err = {0};
     long v = pd_lcp_lemke((pd_lcp_work *)fx_object("pd_lcp_work", "pd_lcp_lemke", 0), 1, (const double *)fx_object("double", "pd_lcp_lemke", 2), NULL, (const pd_lcp_opts *)fx_object("pd_lcp_opts", "pd_lcp_lemke", 4), (double *)fx_object("double", "pd_lcp_lemke", 5), (double *)fx_object("double", "pd_lcp_lemke", 6), (pd_lcp_info *)fx_object("pd_lcp_info", "pd_lcp_lemke", 7));
@@ -459,7 +477,7 @@ static long api_case_54(void)
     return v;
 }
 
-static long api_case_55(void)
+static long api_case_57(void)
 {
     pd_err err = {0};
     long v = pd_lcp_lemke((pd_lcp_work *)fx_object("pd_lcp_work", "pd_lcp_lemke", 0), 1, (const double *)fx_object("double", "pd_lcp_lemke", 2), (const double *)fx_object("double", "pd_lcp_lemke", 3), NULL, (double *)fx_object("double", "pd_lcp_lemke", 5), (double *)fx_object("double", "pd_lcp_lemke", 6), (pd_lcp_info *)fx_object("pd_lcp_info", "pd_lcp_lemke", 7));
@@ -467,7 +485,7 @@ static long api_case_55(void)
     return v;
 }
 
-static long api_case_56(void)
+static long api_case_58(void)
 {
     pd_err err = {0};
     long v = pd_lcp_lemke((pd_lcp_work *)fx_object("pd_lcp_work", "pd_lcp_lemke", 0), 1, (const double *)fx_object("double", "pd_lcp_lemke", 2), (const double *)fx_object("double", "pd_lcp_lemke", 3), (const pd_lcp_opts *)fx_object("pd_lcp_opts", "pd_lcp_lemke", 4), NULL, (double *)fx_object("double", "pd_lcp_lemke", 6), (pd_lcp_info *)fx_object("pd_lcp_info", "pd_lcp_lemke", 7));
@@ -475,7 +493,7 @@ static long api_case_56(void)
     return v;
 }
 
-static long api_case_57(void)
+static long api_case_59(void)
 {
     pd_err err = {0};
     long v = pd_lcp_lemke((pd_lcp_work *)fx_object("pd_lcp_work", "pd_lcp_lemke", 0), 1, (const double *)fx_object("double", "pd_lcp_lemke", 2), (const double *)fx_object("double", "pd_lcp_lemke", 3), (const pd_lcp_opts *)fx_object("pd_lcp_opts", "pd_lcp_lemke", 4), (double *)fx_object("double", "pd_lcp_lemke", 5), NULL, (pd_lcp_info *)fx_object("pd_lcp_info", "pd_lcp_lemke", 7));
@@ -483,7 +501,7 @@ static long api_case_57(void)
     return v;
 }
 
-static long api_case_58(void)
+static long api_case_60(void)
 {
     pd_err err = {0};
     long v = pd_lcp_lemke((pd_lcp_work *)fx_object("pd_lcp_work", "pd_lcp_lemke", 0), 1, (const double *)fx_object("double", "pd_lcp_lemke", 2), (const double *)fx_object("double", "pd_lcp_lemke", 3), (const pd_lcp_opts *)fx_object("pd_lcp_opts", "pd_lcp_lemke", 4), (double *)fx_object("double", "pd_lcp_lemke", 5), (double *)fx_object("double", "pd_lcp_lemke", 6), NULL);
@@ -491,7 +509,7 @@ static long api_case_58(void)
     return v;
 }
 
-static long api_case_59(void)
+static long api_case_61(void)
 {
     pd_err err = {0};
     long v = pd_lcp_enumerate(1, NULL, (const double *)fx_object("double", "pd_lcp_enumerate", 2), (double *)fx_object("double", "pd_lcp_enumerate", 3), (double *)fx_object("double", "pd_lcp_enumerate", 4));
@@ -499,7 +517,7 @@ static long api_case_59(void)
     return v;
 }
 
-static long api_case_60(void)
+static long api_case_62(void)
 {
     pd_err err = {0};
     long v = pd_lcp_enumerate(1, (const double *)fx_object("double", "pd_lcp_enumerate", 1), NULL, (double *)fx_object("double", "pd_lcp_enumerate", 3), (double *)fx_object("double", "pd_lcp_enumerate", 4));
@@ -507,7 +525,7 @@ static long api_case_60(void)
     return v;
 }
 
-static long api_case_61(void)
+static long api_case_63(void)
 {
     pd_err err = {0};
     long v = pd_lcp_enumerate(1, (const double *)fx_object("double", "pd_lcp_enumerate", 1), (const double *)fx_object("double", "pd_lcp_enumerate", 2), NULL, (double *)fx_object("double", "pd_lcp_enumerate", 4));
@@ -515,7 +533,7 @@ static long api_case_61(void)
     return v;
 }
 
-static long api_case_62(void)
+static long api_case_64(void)
 {
     pd_err err = {0};
     long v = pd_lcp_enumerate(1, (const double *)fx_object("double", "pd_lcp_enumerate", 1), (const double *)fx_object("double", "pd_lcp_enumerate", 2), (double *)fx_object("double", "pd_lcp_enumerate", 3), NULL);
@@ -523,7 +541,7 @@ static long api_case_62(void)
     return v;
 }
 
-static long api_case_63(void)
+static long api_case_65(void)
 {
     pd_err err = {0};
     pd_lcp_chain_q(1, 0, NULL);
@@ -531,7 +549,7 @@ static long api_case_63(void)
     return 0;
 }
 
-static long api_case_64(void)
+static long api_case_66(void)
 {
     pd_err err = {0};
     pd_lcp_residual(1, NULL, (const double *)fx_object("double", "pd_lcp_residual", 2), (const double *)fx_object("double", "pd_lcp_residual", 3), (double *)fx_object("double", "pd_lcp_residual", 4), (double *)fx_object("double", "pd_lcp_residual", 5), (double *)fx_object("double", "pd_lcp_residual", 6), (double *)fx_object("double", "pd_lcp_residual", 7));
@@ -539,7 +557,7 @@ static long api_case_64(void)
     return 0;
 }
 
-static long api_case_65(void)
+static long api_case_67(void)
 {
     pd_err err = {0};
     pd_lcp_residual(1, (const double *)fx_object("double", "pd_lcp_residual", 1), NULL, (const double *)fx_object("double", "pd_lcp_residual", 3), (double *)fx_object("double", "pd_lcp_residual", 4), (double *)fx_object("double", "pd_lcp_residual", 5), (double *)fx_object("double", "pd_lcp_residual", 6), (double *)fx_object("double", "pd_lcp_residual", 7));
@@ -547,7 +565,7 @@ static long api_case_65(void)
     return 0;
 }
 
-static long api_case_66(void)
+static long api_case_68(void)
 {
     pd_err err = {0};
     pd_lcp_residual(1, (const double *)fx_object("double", "pd_lcp_residual", 1), (const double *)fx_object("double", "pd_lcp_residual", 2), NULL, (double *)fx_object("double", "pd_lcp_residual", 4), (double *)fx_object("double", "pd_lcp_residual", 5), (double *)fx_object("double", "pd_lcp_residual", 6), (double *)fx_object("double", "pd_lcp_residual", 7));
@@ -555,7 +573,7 @@ static long api_case_66(void)
     return 0;
 }
 
-static long api_case_67(void)
+static long api_case_69(void)
 {
     pd_err err = {0};
     pd_lcp_residual(1, (const double *)fx_object("double", "pd_lcp_residual", 1), (const double *)fx_object("double", "pd_lcp_residual", 2), (const double *)fx_object("double", "pd_lcp_residual", 3), NULL, (double *)fx_object("double", "pd_lcp_residual", 5), (double *)fx_object("double", "pd_lcp_residual", 6), (double *)fx_object("double", "pd_lcp_residual", 7));
@@ -563,7 +581,7 @@ static long api_case_67(void)
     return 0;
 }
 
-static long api_case_68(void)
+static long api_case_70(void)
 {
     pd_err err = {0};
     pd_lcp_residual(1, (const double *)fx_object("double", "pd_lcp_residual", 1), (const double *)fx_object("double", "pd_lcp_residual", 2), (const double *)fx_object("double", "pd_lcp_residual", 3), (double *)fx_object("double", "pd_lcp_residual", 4), NULL, (double *)fx_object("double", "pd_lcp_residual", 6), (double *)fx_object("double", "pd_lcp_residual", 7));
@@ -571,7 +589,7 @@ static long api_case_68(void)
     return 0;
 }
 
-static long api_case_69(void)
+static long api_case_71(void)
 {
     pd_err err = {0};
     pd_lcp_residual(1, (const double *)fx_object("double", "pd_lcp_residual", 1), (const double *)fx_object("double", "pd_lcp_residual", 2), (const double *)fx_object("double", "pd_lcp_residual", 3), (double *)fx_object("double", "pd_lcp_residual", 4), (double *)fx_object("double", "pd_lcp_residual", 5), NULL, (double *)fx_object("double", "pd_lcp_residual", 7));
@@ -579,7 +597,7 @@ static long api_case_69(void)
     return 0;
 }
 
-static long api_case_70(void)
+static long api_case_72(void)
 {
     pd_err err = {0};
     pd_lcp_residual(1, (const double *)fx_object("double", "pd_lcp_residual", 1), (const double *)fx_object("double", "pd_lcp_residual", 2), (const double *)fx_object("double", "pd_lcp_residual", 3), (double *)fx_object("double", "pd_lcp_residual", 4), (double *)fx_object("double", "pd_lcp_residual", 5), (double *)fx_object("double", "pd_lcp_residual", 6), NULL);
@@ -587,7 +605,7 @@ static long api_case_70(void)
     return 0;
 }
 
-static long api_case_71(void)
+static long api_case_73(void)
 {
     pd_err err = {0};
     long v = pd_lcp_method_parse(NULL, (pd_lcp_method *)fx_object("pd_lcp_method", "pd_lcp_method_parse", 1));
@@ -595,7 +613,7 @@ static long api_case_71(void)
     return v;
 }
 
-static long api_case_72(void)
+static long api_case_74(void)
 {
     pd_err err = {0};
     long v = pd_lcp_method_parse((const char *)fx_string("pd_lcp_method_parse", "name"), NULL);
@@ -603,7 +621,7 @@ static long api_case_72(void)
     return v;
 }
 
-static long api_case_73(void)
+static long api_case_75(void)
 {
     pd_err err = {0};
     pd_lcp_solver_free(NULL);
@@ -611,7 +629,7 @@ static long api_case_73(void)
     return 0;
 }
 
-static long api_case_74(void)
+static long api_case_76(void)
 {
     pd_err err = {0};
     long v = pd_lcp_solver_nmax(NULL);
@@ -619,7 +637,7 @@ static long api_case_74(void)
     return v;
 }
 
-static long api_case_75(void)
+static long api_case_77(void)
 {
     pd_err err = {0};
     long v = pd_lcp_solve(NULL, (const pd_matrix *)fx_object("pd_matrix", "pd_lcp_solve", 1), (const double *)fx_object("double", "pd_lcp_solve", 2), (const pd_lcp_opts *)fx_object("pd_lcp_opts", "pd_lcp_solve", 3), (double *)fx_object("double", "pd_lcp_solve", 4), (double *)fx_object("double", "pd_lcp_solve", 5), (pd_lcp_info *)fx_object("pd_lcp_info", "pd_lcp_solve", 6));
@@ -627,7 +645,7 @@ static long api_case_75(void)
     return v;
 }
 
-static long api_case_76(void)
+static long api_case_78(void)
 {
     pd_err err = {0};
     long v = pd_lcp_solve((pd_lcp_solver *)fx_object("pd_lcp_solver", "pd_lcp_solve", 0), NULL, (const double *)fx_object("double", "pd_lcp_solve", 2), (const pd_lcp_opts *)fx_object("pd_lcp_opts", "pd_lcp_solve", 3), (double *)fx_object("double", "pd_lcp_solve", 4), (double *)fx_object("double", "pd_lcp_solve", 5), (pd_lcp_info *)fx_object("pd_lcp_info", "pd_lcp_solve", 6));
@@ -635,7 +653,7 @@ static long api_case_76(void)
     return v;
 }
 
-static long api_case_77(void)
+static long api_case_79(void)
 {
     pd_err err = {0};
     long v = pd_lcp_solve((pd_lcp_solver *)fx_object("pd_lcp_solver", "pd_lcp_solve", 0), (const pd_matrix *)fx_object("pd_matrix", "pd_lcp_solve", 1), NULL, (const pd_lcp_opts *)fx_object("pd_lcp_opts", "pd_lcp_solve", 3), (double *)fx_object("double", "pd_lcp_solve", 4), (double *)fx_object("double", "pd_lcp_solve", 5), (pd_lcp_info *)fx_object("pd_lcp_info", "pd_lcp_solve", 6));
@@ -643,7 +661,7 @@ static long api_case_77(void)
     return v;
 }
 
-static long api_case_78(void)
+static long api_case_80(void)
 {
     pd_err err = {0};
     long v = pd_lcp_solve((pd_lcp_solver *)fx_object("pd_lcp_solver", "pd_lcp_solve", 0), (const pd_matrix *)fx_object("pd_matrix", "pd_lcp_solve", 1), (const double *)fx_object("double", "pd_lcp_solve", 2), NULL, (double *)fx_object("double", "pd_lcp_solve", 4), (double *)fx_object("double", "pd_lcp_solve", 5), (pd_lcp_info *)fx_object("pd_lcp_info", "pd_lcp_solve", 6));
@@ -651,7 +669,7 @@ static long api_case_78(void)
     return v;
 }
 
-static long api_case_79(void)
+static long api_case_81(void)
 {
     pd_err err = {0};
     long v = pd_lcp_solve((pd_lcp_solver *)fx_object("pd_lcp_solver", "pd_lcp_solve", 0), (const pd_matrix *)fx_object("pd_matrix", "pd_lcp_solve", 1), (const double *)fx_object("double", "pd_lcp_solve", 2), (const pd_lcp_opts *)fx_object("pd_lcp_opts", "pd_lcp_solve", 3), NULL, (double *)fx_object("double", "pd_lcp_solve", 5), (pd_lcp_info *)fx_object("pd_lcp_info", "pd_lcp_solve", 6));
@@ -659,7 +677,7 @@ static long api_case_79(void)
     return v;
 }
 
-static long api_case_80(void)
+static long api_case_82(void)
 {
     pd_err err = {0};
     long v = pd_lcp_solve((pd_lcp_solver *)fx_object("pd_lcp_solver", "pd_lcp_solve", 0), (const pd_matrix *)fx_object("pd_matrix", "pd_lcp_solve", 1), (const double *)fx_object("double", "pd_lcp_solve", 2), (const pd_lcp_opts *)fx_object("pd_lcp_opts", "pd_lcp_solve", 3), (double *)fx_object("double", "pd_lcp_solve", 4), NULL, (pd_lcp_info *)fx_object("pd_lcp_info", "pd_lcp_solve", 6));
@@ -667,7 +685,7 @@ static long api_case_80(void)
     return v;
 }
 
-static long api_case_81(void)
+static long api_case_83(void)
 {
     pd_err err = {0};
     long v = pd_lcp_solve((pd_lcp_solver *)fx_object("pd_lcp_solver", "pd_lcp_solve", 0), (const pd_matrix *)fx_object("pd_matrix", "pd_lcp_solve", 1), (const double *)fx_object("double", "pd_lcp_solve", 2), (const pd_lcp_opts *)fx_object("pd_lcp_opts", "pd_lcp_solve", 3), (double *)fx_object("double", "pd_lcp_solve", 4), (double *)fx_object("double", "pd_lcp_solve", 5), NULL);
@@ -675,7 +693,7 @@ static long api_case_81(void)
     return v;
 }
 
-static long api_case_82(void)
+static long api_case_84(void)
 {
     pd_err err = {0};
     long v = pd_lcp_read(NULL, (pd_lcp_format)0, (int *)fx_object("int", "pd_lcp_read", 2), (double **)fx_slot(), (double **)fx_slot(), &err);
@@ -683,7 +701,7 @@ static long api_case_82(void)
     return v;
 }
 
-static long api_case_83(void)
+static long api_case_85(void)
 {
     pd_err err = {0};
     long v = pd_lcp_read((const char *)fx_string("pd_lcp_read", "path"), (pd_lcp_format)0, NULL, (double **)fx_slot(), (double **)fx_slot(), &err);
@@ -691,7 +709,7 @@ static long api_case_83(void)
     return v;
 }
 
-static long api_case_84(void)
+static long api_case_86(void)
 {
     pd_err err = {0};
     long v = pd_lcp_read((const char *)fx_string("pd_lcp_read", "path"), (pd_lcp_format)0, (int *)fx_object("int", "pd_lcp_read", 2), NULL, (double **)fx_slot(), &err);
@@ -699,7 +717,7 @@ static long api_case_84(void)
     return v;
 }
 
-static long api_case_85(void)
+static long api_case_87(void)
 {
     pd_err err = {0};
     long v = pd_lcp_read((const char *)fx_string("pd_lcp_read", "path"), (pd_lcp_format)0, (int *)fx_object("int", "pd_lcp_read", 2), (double **)fx_slot(), NULL, &err);
@@ -707,7 +725,7 @@ static long api_case_85(void)
     return v;
 }
 
-static long api_case_86(void)
+static long api_case_88(void)
 {
     pd_err err = {0};
     long v = pd_lcp_read_band(NULL, (pd_lcp_format)0, (int *)fx_object("int", "pd_lcp_read_band", 2), (double **)fx_slot(), (double **)fx_slot(), (int *)fx_object("int", "pd_lcp_read_band", 5), (long *)fx_object("long", "pd_lcp_read_band", 6), &err);
@@ -715,7 +733,7 @@ static long api_case_86(void)
     return v;
 }
 
-static long api_case_87(void)
+static long api_case_89(void)
 {
     pd_err err = {0};
     long v = pd_lcp_read_band((const char *)fx_string("pd_lcp_read_band", "path"), (pd_lcp_format)0, NULL, (double **)fx_slot(), (double **)fx_slot(), (int *)fx_object("int", "pd_lcp_read_band", 5), (long *)fx_object("long", "pd_lcp_read_band", 6), &err);
@@ -723,7 +741,7 @@ static long api_case_87(void)
     return v;
 }
 
-static long api_case_88(void)
+static long api_case_90(void)
 {
     pd_err err = {0};
     long v = pd_lcp_read_band((const char *)fx_string("pd_lcp_read_band", "path"), (pd_lcp_format)0, (int *)fx_object("int", "pd_lcp_read_band", 2), NULL, (double **)fx_slot(), (int *)fx_object("int", "pd_lcp_read_band", 5), (long *)fx_object("long", "pd_lcp_read_band", 6), &err);
@@ -731,7 +749,7 @@ static long api_case_88(void)
     return v;
 }
 
-static long api_case_89(void)
+static long api_case_91(void)
 {
     pd_err err = {0};
     long v = pd_lcp_read_band((const char *)fx_string("pd_lcp_read_band", "path"), (pd_lcp_format)0, (int *)fx_object("int", "pd_lcp_read_band", 2), (double **)fx_slot(), NULL, (int *)fx_object("int", "pd_lcp_read_band", 5), (long *)fx_object("long", "pd_lcp_read_band", 6), &err);
@@ -739,7 +757,7 @@ static long api_case_89(void)
     return v;
 }
 
-static long api_case_90(void)
+static long api_case_92(void)
 {
     pd_err err = {0};
     long v = pd_lcp_read_band((const char *)fx_string("pd_lcp_read_band", "path"), (pd_lcp_format)0, (int *)fx_object("int", "pd_lcp_read_band", 2), (double **)fx_slot(), (double **)fx_slot(), NULL, (long *)fx_object("long", "pd_lcp_read_band", 6), &err);
@@ -747,7 +765,7 @@ static long api_case_90(void)
     return v;
 }
 
-static long api_case_91(void)
+static long api_case_93(void)
 {
     pd_err err = {0};
     long v = pd_lcp_read_band((const char *)fx_string("pd_lcp_read_band", "path"), (pd_lcp_format)0, (int *)fx_object("int", "pd_lcp_read_band", 2), (double **)fx_slot(), (double **)fx_slot(), (int *)fx_object("int", "pd_lcp_read_band", 5), NULL, &err);
@@ -755,7 +773,7 @@ static long api_case_91(void)
     return v;
 }
 
-static long api_case_92(void)
+static long api_case_94(void)
 {
     pd_err err = {0};
     long v = pd_lcp_band_csc(1, NULL, 1, 1, (int *)fx_object("int", "pd_lcp_band_csc", 4), (int *)fx_object("int", "pd_lcp_band_csc", 5), (double *)fx_object("double", "pd_lcp_band_csc", 6));
@@ -763,7 +781,7 @@ static long api_case_92(void)
     return v;
 }
 
-static long api_case_93(void)
+static long api_case_95(void)
 {
     pd_err err = {0};
     long v = pd_lcp_band_csc(1, (const double *)fx_object("double", "pd_lcp_band_csc", 1), 1, 1, NULL, (int *)fx_object("int", "pd_lcp_band_csc", 5), (double *)fx_object("double", "pd_lcp_band_csc", 6));
@@ -771,7 +789,7 @@ static long api_case_93(void)
     return v;
 }
 
-static long api_case_94(void)
+static long api_case_96(void)
 {
     pd_err err = {0};
     long v = pd_lcp_band_csc(1, (const double *)fx_object("double", "pd_lcp_band_csc", 1), 1, 1, (int *)fx_object("int", "pd_lcp_band_csc", 4), NULL, (double *)fx_object("double", "pd_lcp_band_csc", 6));
@@ -779,7 +797,7 @@ static long api_case_94(void)
     return v;
 }
 
-static long api_case_95(void)
+static long api_case_97(void)
 {
     pd_err err = {0};
     long v = pd_lcp_band_csc(1, (const double *)fx_object("double", "pd_lcp_band_csc", 1), 1, 1, (int *)fx_object("int", "pd_lcp_band_csc", 4), (int *)fx_object("int", "pd_lcp_band_csc", 5), NULL);
@@ -787,7 +805,7 @@ static long api_case_95(void)
     return v;
 }
 
-static long api_case_96(void)
+static long api_case_98(void)
 {
     pd_err err = {0};
     long v = pd_factor_kind_parse(NULL, (pd_factor_kind *)fx_object("pd_factor_kind", "pd_factor_kind_parse", 1));
@@ -795,7 +813,7 @@ static long api_case_96(void)
     return v;
 }
 
-static long api_case_97(void)
+static long api_case_99(void)
 {
     pd_err err = {0};
     long v = pd_factor_kind_parse((const char *)fx_string("pd_factor_kind_parse", "name"), NULL);
@@ -803,7 +821,7 @@ static long api_case_97(void)
     return v;
 }
 
-static long api_case_98(void)
+static long api_case_100(void)
 {
     pd_err err = {0};
     long v = pd_model_check(NULL, &err);
@@ -811,7 +829,7 @@ static long api_case_98(void)
     return v;
 }
 
-static long api_case_99(void)
+static long api_case_101(void)
 {
     pd_err err = {0};
     pd_factor_kind v = pd_factor_choose(NULL, (pd_factor_kind)0);
@@ -820,7 +838,7 @@ static long api_case_99(void)
     return 0;
 }
 
-static long api_case_100(void)
+static long api_case_102(void)
 {
     pd_err err = {0};
     pd_mj * p = pd_mj_alloc(NULL, (const pd_mj_opts *)fx_object("pd_mj_opts", "pd_mj_alloc", 1), &err);
@@ -828,7 +846,7 @@ static long api_case_100(void)
     return p != NULL;
 }
 
-static long api_case_101(void)
+static long api_case_103(void)
 {
     pd_err err = {0};
     pd_mj * p = pd_mj_alloc((const pd_model *)fx_object("pd_model", "pd_mj_alloc", 0), NULL, &err);
@@ -836,7 +854,7 @@ static long api_case_101(void)
     return p != NULL;
 }
 
-static long api_case_102(void)
+static long api_case_104(void)
 {
     pd_err err = {0};
     pd_mj_free(NULL);
@@ -844,7 +862,7 @@ static long api_case_102(void)
     return 0;
 }
 
-static long api_case_103(void)
+static long api_case_105(void)
 {
     pd_err err = {0};
     long v = pd_mj_reset(NULL, 1.0, (const double *)fx_object("double", "pd_mj_reset", 2), (const double *)fx_object("double", "pd_mj_reset", 3), &err);
@@ -852,7 +870,7 @@ static long api_case_103(void)
     return v;
 }
 
-static long api_case_104(void)
+static long api_case_106(void)
 {
     pd_err err = {0};
     long v = pd_mj_reset((pd_mj *)fx_object("pd_mj", "pd_mj_reset", 0), 1.0, NULL, (const double *)fx_object("double", "pd_mj_reset", 3), &err);
@@ -860,7 +878,7 @@ static long api_case_104(void)
     return v;
 }
 
-static long api_case_105(void)
+static long api_case_107(void)
 {
     pd_err err = {0};
     long v = pd_mj_reset((pd_mj *)fx_object("pd_mj", "pd_mj_reset", 0), 1.0, (const double *)fx_object("double", "pd_mj_reset", 2), NULL, &err);
@@ -868,7 +886,7 @@ static long api_case_105(void)
     return v;
 }
 
-static long api_case_106(void)
+static long api_case_108(void)
 {
     pd_err err = {0};
     long v = pd_mj_step(NULL, &err);
@@ -876,7 +894,7 @@ static long api_case_106(void)
     return v;
 }
 
-static long api_case_107(void)
+static long api_case_109(void)
 {
     pd_err err = {0};
     long v = pd_mj_run(NULL, 1, NULL, NULL, &err);
@@ -884,7 +902,7 @@ static long api_case_107(void)
     return v;
 }
 
-static long api_case_108(void)
+static long api_case_110(void)
 {
     pd_err err = {0};
     long v = pd_mj_run_until(NULL, 1.0, NULL, NULL, &err);
@@ -892,7 +910,7 @@ static long api_case_108(void)
     return v;
 }
 
-static long api_case_109(void)
+static long api_case_111(void)
 {
     pd_err err = {0};
     long v = pd_mj_get_stats(NULL, (pd_mj_stats *)fx_object("pd_mj_stats", "pd_mj_get_stats", 1));
@@ -900,7 +918,7 @@ static long api_case_109(void)
     return v;
 }
 
-static long api_case_110(void)
+static long api_case_112(void)
 {
     pd_err err = {0};
     long v = pd_mj_get_stats((const pd_mj *)fx_object("pd_mj", "pd_mj_get_stats", 0), NULL);
@@ -908,7 +926,7 @@ static long api_case_110(void)
     return v;
 }
 
-static long api_case_111(void)
+static long api_case_113(void)
 {
     pd_err err = {0};
     const pd_state * p = pd_mj_state(NULL);
@@ -916,7 +934,7 @@ static long api_case_111(void)
     return p != NULL;
 }
 
-static long api_case_112(void)
+static long api_case_114(void)
 {
     pd_err err = {0};
     const char *s = pd_mj_kernel_name(NULL);
@@ -924,7 +942,7 @@ static long api_case_112(void)
     return s ? (long)strlen(s) + 1 : 0;
 }
 
-static long api_case_113(void)
+static long api_case_115(void)
 {
     pd_err err = {0};
     const char *s = pd_mj_factor_name(NULL);
@@ -932,7 +950,7 @@ static long api_case_113(void)
     return s ? (long)strlen(s) + 1 : 0;
 }
 
-static long api_case_114(void)
+static long api_case_116(void)
 {
     pd_err err = {0};
     long v = pd_mjb_init(NULL, (const pd_mj_opts *)fx_object("pd_mj_opts", "pd_mjb_init", 1), NULL, NULL, &err);
@@ -940,7 +958,7 @@ static long api_case_114(void)
     return v;
 }
 
-static long api_case_115(void)
+static long api_case_117(void)
 {
     pd_err err = {0};
     long v = pd_mjb_init((pd_mjb *)fx_object("pd_mjb", "pd_mjb_init", 0), NULL, NULL, NULL, &err);
@@ -948,7 +966,7 @@ static long api_case_115(void)
     return v;
 }
 
-static long api_case_116(void)
+static long api_case_118(void)
 {
     pd_err err = {0};
     long v = pd_mjb_set_lane(NULL, 0, (const pd_mjb_lane *)fx_object("pd_mjb_lane", "pd_mjb_set_lane", 2), &err);
@@ -956,7 +974,7 @@ static long api_case_116(void)
     return v;
 }
 
-static long api_case_117(void)
+static long api_case_119(void)
 {
     pd_err err = {0};
     long v = pd_mjb_set_lane((pd_mjb *)fx_object("pd_mjb", "pd_mjb_set_lane", 0), 0, NULL, &err);
@@ -964,7 +982,7 @@ static long api_case_117(void)
     return v;
 }
 
-static long api_case_118(void)
+static long api_case_120(void)
 {
     pd_err err = {0};
     pd_mjb_run(NULL, 1, NULL, NULL);
@@ -972,7 +990,7 @@ static long api_case_118(void)
     return 0;
 }
 
-static long api_case_119(void)
+static long api_case_121(void)
 {
     pd_err err = {0};
     long v = pd_mjb_finite(NULL, 0);
@@ -980,7 +998,7 @@ static long api_case_119(void)
     return v;
 }
 
-static long api_case_120(void)
+static long api_case_122(void)
 {
     pd_err err = {0};
     long v = pd_edg_run(NULL, 1.0, (const double *)fx_object("double", "pd_edg_run", 2), (const double *)fx_object("double", "pd_edg_run", 3), 1.0, (const pd_edg_opts *)fx_object("pd_edg_opts", "pd_edg_run", 5), NULL, NULL, (pd_edg_result *)fx_object("pd_edg_result", "pd_edg_run", 8), &err);
@@ -988,7 +1006,7 @@ static long api_case_120(void)
     return v;
 }
 
-static long api_case_121(void)
+static long api_case_123(void)
 {
     pd_err err = {0};
     long v = pd_edg_run((const pd_model *)fx_object("pd_model", "pd_edg_run", 0), 1.0, NULL, (const double *)fx_object("double", "pd_edg_run", 3), 1.0, (const pd_edg_opts *)fx_object("pd_edg_opts", "pd_edg_run", 5), NULL, NULL, (pd_edg_result *)fx_object("pd_edg_result", "pd_edg_run", 8), &err);
@@ -996,7 +1014,7 @@ static long api_case_121(void)
     return v;
 }
 
-static long api_case_122(void)
+static long api_case_124(void)
 {
     pd_err err = {0};
     long v = pd_edg_run((const pd_model *)fx_object("pd_model", "pd_edg_run", 0), 1.0, (const double *)fx_object("double", "pd_edg_run", 2), NULL, 1.0, (const pd_edg_opts *)fx_object("pd_edg_opts", "pd_edg_run", 5), NULL, NULL, (pd_edg_result *)fx_object("pd_edg_result", "pd_edg_run", 8), &err);
@@ -1004,7 +1022,7 @@ static long api_case_122(void)
     return v;
 }
 
-static long api_case_123(void)
+static long api_case_125(void)
 {
     pd_err err = {0};
     long v = pd_edg_run((const pd_model *)fx_object("pd_model", "pd_edg_run", 0), 1.0, (const double *)fx_object("double", "pd_edg_run", 2), (const double *)fx_object("double", "pd_edg_run", 3), 1.0, NULL, NULL, NULL, (pd_edg_result *)fx_object("pd_edg_result", "pd_edg_run", 8), &err);
@@ -1012,7 +1030,7 @@ static long api_case_123(void)
     return v;
 }
 
-static long api_case_124(void)
+static long api_case_126(void)
 {
     pd_err err = {0};
     long v = pd_edg_run((const pd_model *)fx_object("pd_model", "pd_edg_run", 0), 1.0, (const double *)fx_object("double", "pd_edg_run", 2), (const double *)fx_object("double", "pd_edg_run", 3), 1.0, (const pd_edg_opts *)fx_object("pd_edg_opts", "pd_edg_run", 5), NULL, NULL, NULL, &err);
@@ -1020,7 +1038,7 @@ static long api_case_124(void)
     return v;
 }
 
-static long api_case_125(void)
+static long api_case_127(void)
 {
     pd_err err = {0};
     long v = pd_penalty_run(NULL, 1.0, (const double *)fx_object("double", "pd_penalty_run", 2), (const double *)fx_object("double", "pd_penalty_run", 3), 1.0, (const pd_penalty_opts *)fx_object("pd_penalty_opts", "pd_penalty_run", 5), NULL, NULL, (pd_penalty_result *)fx_object("pd_penalty_result", "pd_penalty_run", 8), &err);
@@ -1028,7 +1046,7 @@ static long api_case_125(void)
     return v;
 }
 
-static long api_case_126(void)
+static long api_case_128(void)
 {
     pd_err err = {0};
     long v = pd_penalty_run((const pd_model *)fx_object("pd_model", "pd_penalty_run", 0), 1.0, NULL, (const double *)fx_object("double", "pd_penalty_run", 3), 1.0, (const pd_penalty_opts *)fx_object("pd_penalty_opts", "pd_penalty_run", 5), NULL, NULL, (pd_penalty_result *)fx_object("pd_penalty_result", "pd_penalty_run", 8), &err);
@@ -1036,7 +1054,7 @@ static long api_case_126(void)
     return v;
 }
 
-static long api_case_127(void)
+static long api_case_129(void)
 {
     pd_err err = {0};
     long v = pd_penalty_run((const pd_model *)fx_object("pd_model", "pd_penalty_run", 0), 1.0, (const double *)fx_object("double", "pd_penalty_run", 2), NULL, 1.0, (const pd_penalty_opts *)fx_object("pd_penalty_opts", "pd_penalty_run", 5), NULL, NULL, (pd_penalty_result *)fx_object("pd_penalty_result", "pd_penalty_run", 8), &err);
@@ -1044,7 +1062,7 @@ static long api_case_127(void)
     return v;
 }
 
-static long api_case_128(void)
+static long api_case_130(void)
 {
     pd_err err = {0};
     long v = pd_penalty_run((const pd_model *)fx_object("pd_model", "pd_penalty_run", 0), 1.0, (const double *)fx_object("double", "pd_penalty_run", 2), (const double *)fx_object("double", "pd_penalty_run", 3), 1.0, NULL, NULL, NULL, (pd_penalty_result *)fx_object("pd_penalty_result", "pd_penalty_run", 8), &err);
@@ -1052,7 +1070,7 @@ static long api_case_128(void)
     return v;
 }
 
-static long api_case_129(void)
+static long api_case_131(void)
 {
     pd_err err = {0};
     long v = pd_penalty_run((const pd_model *)fx_object("pd_model", "pd_penalty_run", 0), 1.0, (const double *)fx_object("double", "pd_penalty_run", 2), (const double *)fx_object("double", "pd_penalty_run", 3), 1.0, (const pd_penalty_opts *)fx_object("pd_penalty_opts", "pd_penalty_run", 5), NULL, NULL, NULL, &err);
@@ -1060,7 +1078,7 @@ static long api_case_129(void)
     return v;
 }
 
-static long api_case_130(void)
+static long api_case_132(void)
 {
     pd_err err = {0};
     double v = pd_sine_piece_force(NULL, 1.0);
@@ -1069,7 +1087,7 @@ static long api_case_130(void)
     return 0;
 }
 
-static long api_case_131(void)
+static long api_case_133(void)
 {
     pd_err err = {0};
     pd_sdof_increment_piece(NULL, (const pd_sine_piece *)fx_object("pd_sine_piece", "pd_sdof_increment_piece", 1), 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_increment_piece", 6), (double *)fx_object("double", "pd_sdof_increment_piece", 7));
@@ -1077,7 +1095,7 @@ static long api_case_131(void)
     return 0;
 }
 
-static long api_case_132(void)
+static long api_case_134(void)
 {
     pd_err err = {0};
     pd_sdof_increment_piece((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_increment_piece", 0), NULL, 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_increment_piece", 6), (double *)fx_object("double", "pd_sdof_increment_piece", 7));
@@ -1085,7 +1103,7 @@ static long api_case_132(void)
     return 0;
 }
 
-static long api_case_133(void)
+static long api_case_135(void)
 {
     pd_err err = {0};
     pd_sdof_increment_piece((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_increment_piece", 0), (const pd_sine_piece *)fx_object("pd_sine_piece", "pd_sdof_increment_piece", 1), 1.0, 1.0, 1.0, 1.0, NULL, (double *)fx_object("double", "pd_sdof_increment_piece", 7));
@@ -1093,7 +1111,7 @@ static long api_case_133(void)
     return 0;
 }
 
-static long api_case_134(void)
+static long api_case_136(void)
 {
     pd_err err = {0};
     pd_sdof_increment_piece((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_increment_piece", 0), (const pd_sine_piece *)fx_object("pd_sine_piece", "pd_sdof_increment_piece", 1), 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_increment_piece", 6), NULL);
@@ -1101,7 +1119,7 @@ static long api_case_134(void)
     return 0;
 }
 
-static long api_case_135(void)
+static long api_case_137(void)
 {
     pd_err err = {0};
     pd_sdof_advance_piece(NULL, (const pd_sine_piece *)fx_object("pd_sine_piece", "pd_sdof_advance_piece", 1), 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_advance_piece", 6), (double *)fx_object("double", "pd_sdof_advance_piece", 7));
@@ -1109,7 +1127,7 @@ static long api_case_135(void)
     return 0;
 }
 
-static long api_case_136(void)
+static long api_case_138(void)
 {
     pd_err err = {0};
     pd_sdof_advance_piece((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_advance_piece", 0), NULL, 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_advance_piece", 6), (double *)fx_object("double", "pd_sdof_advance_piece", 7));
@@ -1117,7 +1135,7 @@ static long api_case_136(void)
     return 0;
 }
 
-static long api_case_137(void)
+static long api_case_139(void)
 {
     pd_err err = {0};
     pd_sdof_advance_piece((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_advance_piece", 0), (const pd_sine_piece *)fx_object("pd_sine_piece", "pd_sdof_advance_piece", 1), 1.0, 1.0, 1.0, 1.0, NULL, (double *)fx_object("double", "pd_sdof_advance_piece", 7));
@@ -1125,7 +1143,7 @@ static long api_case_137(void)
     return 0;
 }
 
-static long api_case_138(void)
+static long api_case_140(void)
 {
     pd_err err = {0};
     pd_sdof_advance_piece((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_advance_piece", 0), (const pd_sine_piece *)fx_object("pd_sine_piece", "pd_sdof_advance_piece", 1), 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_advance_piece", 6), NULL);
@@ -1133,7 +1151,7 @@ static long api_case_138(void)
     return 0;
 }
 
-static long api_case_139(void)
+static long api_case_141(void)
 {
     pd_err err = {0};
     pd_sdof_flow_init(NULL, (const pd_sdof *)fx_object("pd_sdof", "pd_sdof_flow_init", 1), (const pd_sine_piece *)fx_object("pd_sine_piece", "pd_sdof_flow_init", 2), 1.0, 1.0, 1.0);
@@ -1141,7 +1159,7 @@ static long api_case_139(void)
     return 0;
 }
 
-static long api_case_140(void)
+static long api_case_142(void)
 {
     pd_err err = {0};
     pd_sdof_flow_init((pd_sdof_flow *)fx_object("pd_sdof_flow", "pd_sdof_flow_init", 0), NULL, (const pd_sine_piece *)fx_object("pd_sine_piece", "pd_sdof_flow_init", 2), 1.0, 1.0, 1.0);
@@ -1149,7 +1167,7 @@ static long api_case_140(void)
     return 0;
 }
 
-static long api_case_141(void)
+static long api_case_143(void)
 {
     pd_err err = {0};
     pd_sdof_flow_init((pd_sdof_flow *)fx_object("pd_sdof_flow", "pd_sdof_flow_init", 0), (const pd_sdof *)fx_object("pd_sdof", "pd_sdof_flow_init", 1), NULL, 1.0, 1.0, 1.0);
@@ -1157,7 +1175,7 @@ static long api_case_141(void)
     return 0;
 }
 
-static long api_case_142(void)
+static long api_case_144(void)
 {
     pd_err err = {0};
     pd_sdof_flow_at(NULL, 1.0, (double *)fx_object("double", "pd_sdof_flow_at", 2), (double *)fx_object("double", "pd_sdof_flow_at", 3));
@@ -1165,7 +1183,7 @@ static long api_case_142(void)
     return 0;
 }
 
-static long api_case_143(void)
+static long api_case_145(void)
 {
     pd_err err = {0};
     pd_sdof_flow_at((const pd_sdof_flow *)fx_object("pd_sdof_flow", "pd_sdof_flow_at", 0), 1.0, NULL, (double *)fx_object("double", "pd_sdof_flow_at", 3));
@@ -1173,7 +1191,7 @@ static long api_case_143(void)
     return 0;
 }
 
-static long api_case_144(void)
+static long api_case_146(void)
 {
     pd_err err = {0};
     pd_sdof_flow_at((const pd_sdof_flow *)fx_object("pd_sdof_flow", "pd_sdof_flow_at", 0), 1.0, (double *)fx_object("double", "pd_sdof_flow_at", 2), NULL);
@@ -1181,7 +1199,7 @@ static long api_case_144(void)
     return 0;
 }
 
-static long api_case_145(void)
+static long api_case_147(void)
 {
     pd_err err = {0};
     pd_sdof_advance(NULL, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_advance", 8), (double *)fx_object("double", "pd_sdof_advance", 9));
@@ -1189,7 +1207,7 @@ static long api_case_145(void)
     return 0;
 }
 
-static long api_case_146(void)
+static long api_case_148(void)
 {
     pd_err err = {0};
     pd_sdof_advance((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_advance", 0), 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, NULL, (double *)fx_object("double", "pd_sdof_advance", 9));
@@ -1197,7 +1215,7 @@ static long api_case_146(void)
     return 0;
 }
 
-static long api_case_147(void)
+static long api_case_149(void)
 {
     pd_err err = {0};
     pd_sdof_advance((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_advance", 0), 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_advance", 8), NULL);
@@ -1205,7 +1223,7 @@ static long api_case_147(void)
     return 0;
 }
 
-static long api_case_148(void)
+static long api_case_150(void)
 {
     pd_err err = {0};
     pd_sdof_increment(NULL, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_increment", 8), (double *)fx_object("double", "pd_sdof_increment", 9));
@@ -1213,7 +1231,7 @@ static long api_case_148(void)
     return 0;
 }
 
-static long api_case_149(void)
+static long api_case_151(void)
 {
     pd_err err = {0};
     pd_sdof_increment((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_increment", 0), 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, NULL, (double *)fx_object("double", "pd_sdof_increment", 9));
@@ -1221,7 +1239,7 @@ static long api_case_149(void)
     return 0;
 }
 
-static long api_case_150(void)
+static long api_case_152(void)
 {
     pd_err err = {0};
     pd_sdof_increment((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_increment", 0), 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_increment", 8), NULL);
@@ -1229,7 +1247,7 @@ static long api_case_150(void)
     return 0;
 }
 
-static long api_case_151(void)
+static long api_case_153(void)
 {
     pd_err err = {0};
     pd_edr * p = pd_edr_alloc(NULL, (const pd_piecewise_force *)fx_object("pd_piecewise_force", "pd_edr_alloc", 1), (const pd_edr_opts *)fx_object("pd_edr_opts", "pd_edr_alloc", 2), &err);
@@ -1237,7 +1255,7 @@ static long api_case_151(void)
     return p != NULL;
 }
 
-static long api_case_152(void)
+static long api_case_154(void)
 {
     pd_err err = {0};
     pd_edr * p = pd_edr_alloc((const pd_model *)fx_object("pd_model", "pd_edr_alloc", 0), NULL, (const pd_edr_opts *)fx_object("pd_edr_opts", "pd_edr_alloc", 2), &err);
@@ -1245,7 +1263,7 @@ static long api_case_152(void)
     return p != NULL;
 }
 
-static long api_case_153(void)
+static long api_case_155(void)
 {
     pd_err err = {0};
     pd_edr * p = pd_edr_alloc((const pd_model *)fx_object("pd_model", "pd_edr_alloc", 0), (const pd_piecewise_force *)fx_object("pd_piecewise_force", "pd_edr_alloc", 1), NULL, &err);
@@ -1253,7 +1271,7 @@ static long api_case_153(void)
     return p != NULL;
 }
 
-static long api_case_154(void)
+static long api_case_156(void)
 {
     pd_err err = {0};
     pd_edr_free(NULL);
@@ -1261,7 +1279,7 @@ static long api_case_154(void)
     return 0;
 }
 
-static long api_case_155(void)
+static long api_case_157(void)
 {
     pd_err err = {0};
     long v = pd_edr_run(NULL, 1.0, (const double *)fx_object("double", "pd_edr_run", 2), (const double *)fx_object("double", "pd_edr_run", 3), 1.0, NULL, NULL, &err);
@@ -1269,7 +1287,7 @@ static long api_case_155(void)
     return v;
 }
 
-static long api_case_156(void)
+static long api_case_158(void)
 {
     pd_err err = {0};
     long v = pd_edr_run((pd_edr *)fx_object("pd_edr", "pd_edr_run", 0), 1.0, NULL, (const double *)fx_object("double", "pd_edr_run", 3), 1.0, NULL, NULL, &err);
@@ -1277,7 +1295,7 @@ static long api_case_156(void)
     return v;
 }
 
-static long api_case_157(void)
+static long api_case_159(void)
 {
     pd_err err = {0};
     long v = pd_edr_run((pd_edr *)fx_object("pd_edr", "pd_edr_run", 0), 1.0, (const double *)fx_object("double", "pd_edr_run", 2), NULL, 1.0, NULL, NULL, &err);
@@ -1285,7 +1303,7 @@ static long api_case_157(void)
     return v;
 }
 
-static long api_case_158(void)
+static long api_case_160(void)
 {
     pd_err err = {0};
     const pd_edr_result * p = pd_edr_result_of(NULL);
@@ -1293,7 +1311,7 @@ static long api_case_158(void)
     return p != NULL;
 }
 
-static long api_case_159(void)
+static long api_case_161(void)
 {
     pd_err err = {0};
     long v = pd_ed_sdof_run(NULL, 1.0, 1.0, (const pd_ed_opts *)fx_object("pd_ed_opts", "pd_ed_sdof_run", 3), NULL, NULL, (pd_ed_result *)fx_object("pd_ed_result", "pd_ed_sdof_run", 6), &err);
@@ -1301,7 +1319,7 @@ static long api_case_159(void)
     return v;
 }
 
-static long api_case_160(void)
+static long api_case_162(void)
 {
     pd_err err = {0};
     long v = pd_ed_sdof_run((const pd_ed_sdof *)fx_object("pd_ed_sdof", "pd_ed_sdof_run", 0), 1.0, 1.0, NULL, NULL, NULL, (pd_ed_result *)fx_object("pd_ed_result", "pd_ed_sdof_run", 6), &err);
@@ -1309,7 +1327,7 @@ static long api_case_160(void)
     return v;
 }
 
-static long api_case_161(void)
+static long api_case_163(void)
 {
     pd_err err = {0};
     long v = pd_ed_sdof_run((const pd_ed_sdof *)fx_object("pd_ed_sdof", "pd_ed_sdof_run", 0), 1.0, 1.0, (const pd_ed_opts *)fx_object("pd_ed_opts", "pd_ed_sdof_run", 3), NULL, NULL, NULL, &err);
@@ -1317,7 +1335,7 @@ static long api_case_161(void)
     return v;
 }
 
-static long api_case_162(void)
+static long api_case_164(void)
 {
     pd_err err = {0};
     long v = pd_pulse_parse(NULL, (pd_pulse *)fx_object("pd_pulse", "pd_pulse_parse", 1));
@@ -1325,7 +1343,7 @@ static long api_case_162(void)
     return v;
 }
 
-static long api_case_163(void)
+static long api_case_165(void)
 {
     pd_err err = {0};
     long v = pd_pulse_parse((const char *)fx_string("pd_pulse_parse", "name"), NULL);
@@ -1333,7 +1351,7 @@ static long api_case_163(void)
     return v;
 }
 
-static long api_case_164(void)
+static long api_case_166(void)
 {
     pd_err err = {0};
     long v = pd_dir_parse(NULL, (int *)fx_object("int", "pd_dir_parse", 1));
@@ -1341,7 +1359,7 @@ static long api_case_164(void)
     return v;
 }
 
-static long api_case_165(void)
+static long api_case_167(void)
 {
     pd_err err = {0};
     long v = pd_dir_parse((const char *)fx_string("pd_dir_parse", "name"), NULL);
@@ -1349,7 +1367,7 @@ static long api_case_165(void)
     return v;
 }
 
-static long api_case_166(void)
+static long api_case_168(void)
 {
     pd_err err = {0};
     long v = pd_record_format_parse(NULL, (pd_record_format *)fx_object("pd_record_format", "pd_record_format_parse", 1));
@@ -1357,7 +1375,7 @@ static long api_case_166(void)
     return v;
 }
 
-static long api_case_167(void)
+static long api_case_169(void)
 {
     pd_err err = {0};
     long v = pd_record_format_parse((const char *)fx_string("pd_record_format_parse", "name"), NULL);
@@ -1365,7 +1383,7 @@ static long api_case_167(void)
     return v;
 }
 
-static long api_case_168(void)
+static long api_case_170(void)
 {
     pd_err err = {0};
     long v = pd_record_units_parse(NULL, (pd_record_units *)fx_object("pd_record_units", "pd_record_units_parse", 1));
@@ -1373,7 +1391,7 @@ static long api_case_168(void)
     return v;
 }
 
-static long api_case_169(void)
+static long api_case_171(void)
 {
     pd_err err = {0};
     long v = pd_record_units_parse((const char *)fx_string("pd_record_units_parse", "name"), NULL);
@@ -1381,7 +1399,7 @@ static long api_case_169(void)
     return v;
 }
 
-static long api_case_170(void)
+static long api_case_172(void)
 {
     pd_err err = {0};
     long v = pd_record_read(NULL, (pd_record_format)0, (pd_record_units)0, (pd_record *)fx_object("pd_record", "pd_record_read", 3), &err);
@@ -1389,7 +1407,7 @@ static long api_case_170(void)
     return v;
 }
 
-static long api_case_171(void)
+static long api_case_173(void)
 {
     pd_err err = {0};
     long v = pd_record_read((const char *)fx_string("pd_record_read", "path"), (pd_record_format)0, (pd_record_units)0, NULL, &err);
@@ -1397,7 +1415,7 @@ static long api_case_171(void)
     return v;
 }
 
-static long api_case_172(void)
+static long api_case_174(void)
 {
     pd_err err = {0};
     pd_record_free(NULL);
@@ -1405,7 +1423,7 @@ static long api_case_172(void)
     return 0;
 }
 
-static long api_case_173(void)
+static long api_case_175(void)
 {
     pd_err err = {0};
     long v = pd_record_detect(NULL, (pd_record_format *)fx_object("pd_record_format", "pd_record_detect", 1), &err);
@@ -1413,7 +1431,7 @@ static long api_case_173(void)
     return v;
 }
 
-static long api_case_174(void)
+static long api_case_176(void)
 {
     pd_err err = {0};
     long v = pd_record_detect((const char *)fx_string("pd_record_detect", "path"), NULL, &err);
@@ -1421,7 +1439,7 @@ static long api_case_174(void)
     return v;
 }
 
-static long api_case_175(void)
+static long api_case_177(void)
 {
     pd_err err = {0};
     long v = pd_record_plausible(NULL, (pd_record_units)0, (char *)fx_string("pd_record_plausible", "msg"), 64);
@@ -1429,7 +1447,7 @@ static long api_case_175(void)
     return v;
 }
 
-static long api_case_176(void)
+static long api_case_178(void)
 {
     pd_err err = {0};
     long v = pd_record_plausible((const pd_record *)fx_object("pd_record", "pd_record_plausible", 0), (pd_record_units)0, NULL, 64);
@@ -1437,7 +1455,7 @@ static long api_case_176(void)
     return v;
 }
 
-static long api_case_177(void)
+static long api_case_179(void)
 {
     pd_err err = {0};
     long v = pd_record_from_array(NULL, (const char *)fx_string("pd_record_from_array", "name"), (const double *)fx_object("double", "pd_record_from_array", 2), 1, 1.0, (pd_record_units)0, &err);
@@ -1445,7 +1463,7 @@ static long api_case_177(void)
     return v;
 }
 
-static long api_case_178(void)
+static long api_case_180(void)
 {
     pd_err err = {0};
     long v = pd_record_from_array((pd_record *)fx_object("pd_record", "pd_record_from_array", 0), NULL, (const double *)fx_object("double", "pd_record_from_array", 2), 1, 1.0, (pd_record_units)0, &err);
@@ -1453,7 +1471,7 @@ static long api_case_178(void)
     return v;
 }
 
-static long api_case_179(void)
+static long api_case_181(void)
 {
     pd_err err = {0};
     long v = pd_record_from_array((pd_record *)fx_object("pd_record", "pd_record_from_array", 0), (const char *)fx_string("pd_record_from_array", "name"), NULL, 1, 1.0, (pd_record_units)0, &err);
@@ -1461,7 +1479,7 @@ static long api_case_179(void)
     return v;
 }
 
-static long api_case_180(void)
+static long api_case_182(void)
 {
     pd_err err = {0};
     double v = pd_record_duration(NULL);
@@ -1470,7 +1488,7 @@ static long api_case_180(void)
     return 0;
 }
 
-static long api_case_181(void)
+static long api_case_183(void)
 {
     pd_err err = {0};
     double v = pd_record_acc(NULL, 1.0);
@@ -1479,7 +1497,7 @@ static long api_case_181(void)
     return 0;
 }
 
-static long api_case_182(void)
+static long api_case_184(void)
 {
     pd_err err = {0};
     long v = pd_record_measure(NULL, (pd_record_measures *)fx_object("pd_record_measures", "pd_record_measure", 1), &err);
@@ -1487,7 +1505,7 @@ static long api_case_182(void)
     return v;
 }
 
-static long api_case_183(void)
+static long api_case_185(void)
 {
     pd_err err = {0};
     long v = pd_record_measure((const pd_record *)fx_object("pd_record", "pd_record_measure", 0), NULL, &err);
@@ -1495,7 +1513,7 @@ static long api_case_183(void)
     return v;
 }
 
-static long api_case_184(void)
+static long api_case_186(void)
 {
     pd_err err = {0};
     long v = pd_record_integrate(NULL, (double *)fx_object("double", "pd_record_integrate", 1), (double *)fx_object("double", "pd_record_integrate", 2), &err);
@@ -1503,7 +1521,7 @@ static long api_case_184(void)
     return v;
 }
 
-static long api_case_185(void)
+static long api_case_187(void)
 {
     pd_err err = {0};
     long v = pd_record_integrate((const pd_record *)fx_object("pd_record", "pd_record_integrate", 0), NULL, (double *)fx_object("double", "pd_record_integrate", 2), &err);
@@ -1511,7 +1529,7 @@ static long api_case_185(void)
     return v;
 }
 
-static long api_case_186(void)
+static long api_case_188(void)
 {
     pd_err err = {0};
     long v = pd_record_integrate((const pd_record *)fx_object("pd_record", "pd_record_integrate", 0), (double *)fx_object("double", "pd_record_integrate", 1), NULL, &err);
@@ -1519,7 +1537,7 @@ static long api_case_186(void)
     return v;
 }
 
-static long api_case_187(void)
+static long api_case_189(void)
 {
     pd_err err = {0};
     long v = pd_record_fit_pulse(NULL, (pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_fit_pulse", 1), &err);
@@ -1527,7 +1545,7 @@ static long api_case_187(void)
     return v;
 }
 
-static long api_case_188(void)
+static long api_case_190(void)
 {
     pd_err err = {0};
     long v = pd_record_fit_pulse((const pd_record *)fx_object("pd_record", "pd_record_fit_pulse", 0), NULL, &err);
@@ -1535,7 +1553,7 @@ static long api_case_188(void)
     return v;
 }
 
-static long api_case_189(void)
+static long api_case_191(void)
 {
     pd_err err = {0};
     pd_record_pulse_eval(NULL, 1.0, (double *)fx_object("double", "pd_record_pulse_eval", 2), (double *)fx_object("double", "pd_record_pulse_eval", 3));
@@ -1543,7 +1561,7 @@ static long api_case_189(void)
     return 0;
 }
 
-static long api_case_190(void)
+static long api_case_192(void)
 {
     pd_err err = {0};
     pd_record_pulse_eval((const pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_pulse_eval", 0), 1.0, NULL, (double *)fx_object("double", "pd_record_pulse_eval", 3));
@@ -1551,7 +1569,7 @@ static long api_case_190(void)
     return 0;
 }
 
-static long api_case_191(void)
+static long api_case_193(void)
 {
     pd_err err = {0};
     pd_record_pulse_eval((const pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_pulse_eval", 0), 1.0, (double *)fx_object("double", "pd_record_pulse_eval", 2), NULL);
@@ -1559,7 +1577,7 @@ static long api_case_191(void)
     return 0;
 }
 
-static long api_case_192(void)
+static long api_case_194(void)
 {
     pd_err err = {0};
     double v = pd_record_one_cycle(NULL, 1.0);
@@ -1568,7 +1586,7 @@ static long api_case_192(void)
     return 0;
 }
 
-static long api_case_193(void)
+static long api_case_195(void)
 {
     pd_err err = {0};
     long v = pd_method_parse(NULL, (pd_method *)fx_object("pd_method", "pd_method_parse", 1));
@@ -1576,7 +1594,7 @@ static long api_case_193(void)
     return v;
 }
 
-static long api_case_194(void)
+static long api_case_196(void)
 {
     pd_err err = {0};
     long v = pd_method_parse((const char *)fx_string("pd_method_parse", "name"), NULL);
@@ -1584,7 +1602,7 @@ static long api_case_194(void)
     return v;
 }
 
-static long api_case_195(void)
+static long api_case_197(void)
 {
     pd_err err = {0};
     long v = pd_run_opts_check(NULL, &err);
@@ -1592,7 +1610,7 @@ static long api_case_195(void)
     return v;
 }
 
-static long api_case_196(void)
+static long api_case_198(void)
 {
     pd_err err = {0};
     double v = pd_osc_wp(NULL);
@@ -1601,7 +1619,7 @@ static long api_case_196(void)
     return 0;
 }
 
-static long api_case_197(void)
+static long api_case_199(void)
 {
     pd_err err = {0};
     double v = pd_osc_T0(NULL);
@@ -1610,7 +1628,7 @@ static long api_case_197(void)
     return 0;
 }
 
-static long api_case_198(void)
+static long api_case_200(void)
 {
     pd_err err = {0};
     double v = pd_osc_gap(NULL);
@@ -1619,7 +1637,7 @@ static long api_case_198(void)
     return 0;
 }
 
-static long api_case_199(void)
+static long api_case_201(void)
 {
     pd_err err = {0};
     double v = pd_osc_Le(NULL);
@@ -1628,7 +1646,7 @@ static long api_case_199(void)
     return 0;
 }
 
-static long api_case_200(void)
+static long api_case_202(void)
 {
     pd_err err = {0};
     pd_osc_set_T0(NULL, 1.0);
@@ -1636,7 +1654,7 @@ static long api_case_200(void)
     return 0;
 }
 
-static long api_case_201(void)
+static long api_case_203(void)
 {
     pd_err err = {0};
     pd_osc_set_gap(NULL, 1.0);
@@ -1644,7 +1662,7 @@ static long api_case_201(void)
     return 0;
 }
 
-static long api_case_202(void)
+static long api_case_204(void)
 {
     pd_err err = {0};
     double v = pd_osc_excitation(NULL, 1.0);
@@ -1653,7 +1671,7 @@ static long api_case_202(void)
     return 0;
 }
 
-static long api_case_203(void)
+static long api_case_205(void)
 {
     pd_err err = {0};
     pd_osc_set_record(NULL, (const pd_record *)fx_object("pd_record", "pd_osc_set_record", 1), (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_osc_set_record", 2), 1.0);
@@ -1661,7 +1679,7 @@ static long api_case_203(void)
     return 0;
 }
 
-static long api_case_204(void)
+static long api_case_206(void)
 {
     pd_err err = {0};
     pd_osc_set_record((pd_osc *)fx_object("pd_osc", "pd_osc_set_record", 0), NULL, (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_osc_set_record", 2), 1.0);
@@ -1669,7 +1687,7 @@ static long api_case_204(void)
     return 0;
 }
 
-static long api_case_205(void)
+static long api_case_207(void)
 {
     pd_err err = {0};
     pd_osc_set_record((pd_osc *)fx_object("pd_osc", "pd_osc_set_record", 0), (const pd_record *)fx_object("pd_record", "pd_osc_set_record", 1), NULL, 1.0);
@@ -1677,7 +1695,7 @@ static long api_case_205(void)
     return 0;
 }
 
-static long api_case_206(void)
+static long api_case_208(void)
 {
     pd_err err = {0};
     double v = pd_osc_shape(NULL, 1.0, 0);
@@ -1686,7 +1704,7 @@ static long api_case_206(void)
     return 0;
 }
 
-static long api_case_207(void)
+static long api_case_209(void)
 {
     pd_err err = {0};
     double v = pd_osc_shape_rate(NULL, 1.0, 0);
@@ -1695,7 +1713,7 @@ static long api_case_207(void)
     return 0;
 }
 
-static long api_case_208(void)
+static long api_case_210(void)
 {
     pd_err err = {0};
     double v = pd_osc_shape_end(NULL);
@@ -1704,7 +1722,7 @@ static long api_case_208(void)
     return 0;
 }
 
-static long api_case_209(void)
+static long api_case_211(void)
 {
     pd_err err = {0};
     long v = pd_osc_pieces(NULL, (pd_sine_piece **)fx_slot(), (int *)fx_object("int", "pd_osc_pieces", 2), &err);
@@ -1712,7 +1730,7 @@ static long api_case_209(void)
     return v;
 }
 
-static long api_case_210(void)
+static long api_case_212(void)
 {
     pd_err err = {0};
     long v = pd_osc_pieces((const pd_osc *)fx_object("pd_osc", "pd_osc_pieces", 0), NULL, (int *)fx_object("int", "pd_osc_pieces", 2), &err);
@@ -1720,7 +1738,7 @@ static long api_case_210(void)
     return v;
 }
 
-static long api_case_211(void)
+static long api_case_213(void)
 {
     pd_err err = {0};
     long v = pd_osc_pieces((const pd_osc *)fx_object("pd_osc", "pd_osc_pieces", 0), (pd_sine_piece **)fx_slot(), NULL, &err);
@@ -1728,7 +1746,7 @@ static long api_case_211(void)
     return v;
 }
 
-static long api_case_212(void)
+static long api_case_214(void)
 {
     pd_err err = {0};
     const char *s = pd_osc_excitation_name(NULL);
@@ -1736,7 +1754,7 @@ static long api_case_212(void)
     return s ? (long)strlen(s) + 1 : 0;
 }
 
-static long api_case_213(void)
+static long api_case_215(void)
 {
     pd_err err = {0};
     long v = pd_osc_check(NULL, &err);
@@ -1744,7 +1762,7 @@ static long api_case_213(void)
     return v;
 }
 
-static long api_case_214(void)
+static long api_case_216(void)
 {
     pd_err err = {0};
     long v = pd_osc_resolve_opts(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_resolve_opts", 1), (pd_run_opts *)fx_object("pd_run_opts", "pd_osc_resolve_opts", 2), &err);
@@ -1752,7 +1770,7 @@ static long api_case_214(void)
     return v;
 }
 
-static long api_case_215(void)
+static long api_case_217(void)
 {
     pd_err err = {0};
     long v = pd_osc_resolve_opts((const pd_osc *)fx_object("pd_osc", "pd_osc_resolve_opts", 0), NULL, (pd_run_opts *)fx_object("pd_run_opts", "pd_osc_resolve_opts", 2), &err);
@@ -1760,7 +1778,7 @@ static long api_case_215(void)
     return v;
 }
 
-static long api_case_216(void)
+static long api_case_218(void)
 {
     pd_err err = {0};
     long v = pd_osc_resolve_opts((const pd_osc *)fx_object("pd_osc", "pd_osc_resolve_opts", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_resolve_opts", 1), NULL, &err);
@@ -1768,7 +1786,7 @@ static long api_case_216(void)
     return v;
 }
 
-static long api_case_217(void)
+static long api_case_219(void)
 {
     pd_err err = {0};
     double v = pd_osc_default_dt(NULL);
@@ -1777,7 +1795,7 @@ static long api_case_217(void)
     return 0;
 }
 
-static long api_case_218(void)
+static long api_case_220(void)
 {
     pd_err err = {0};
     double v = pd_osc_default_tend(NULL);
@@ -1786,7 +1804,7 @@ static long api_case_218(void)
     return 0;
 }
 
-static long api_case_219(void)
+static long api_case_221(void)
 {
     pd_err err = {0};
     double v = pd_osc_measure_start(NULL, 1.0);
@@ -1795,7 +1813,7 @@ static long api_case_219(void)
     return 0;
 }
 
-static long api_case_220(void)
+static long api_case_222(void)
 {
     pd_err err = {0};
     pd_method v = pd_osc_method(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_method", 1));
@@ -1804,7 +1822,7 @@ static long api_case_220(void)
     return 0;
 }
 
-static long api_case_221(void)
+static long api_case_223(void)
 {
     pd_err err = {0};
     pd_method v = pd_osc_method((const pd_osc *)fx_object("pd_osc", "pd_osc_method", 0), NULL);
@@ -1813,7 +1831,7 @@ static long api_case_221(void)
     return 0;
 }
 
-static long api_case_222(void)
+static long api_case_224(void)
 {
     pd_err err = {0};
     long v = pd_osc_run(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_run", 1), NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_run", 4), &err);
@@ -1821,7 +1839,7 @@ static long api_case_222(void)
     return v;
 }
 
-static long api_case_223(void)
+static long api_case_225(void)
 {
     pd_err err = {0};
     long v = pd_osc_run((const pd_osc *)fx_object("pd_osc", "pd_osc_run", 0), NULL, NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_run", 4), &err);
@@ -1829,7 +1847,7 @@ static long api_case_223(void)
     return v;
 }
 
-static long api_case_224(void)
+static long api_case_226(void)
 {
     pd_err err = {0};
     long v = pd_osc_run((const pd_osc *)fx_object("pd_osc", "pd_osc_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_run", 1), NULL, NULL, NULL, &err);
@@ -1837,7 +1855,7 @@ static long api_case_224(void)
     return v;
 }
 
-static long api_case_225(void)
+static long api_case_227(void)
 {
     pd_err err = {0};
     long v = pd_osc_batchable(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_batchable", 1));
@@ -1845,7 +1863,7 @@ static long api_case_225(void)
     return v;
 }
 
-static long api_case_226(void)
+static long api_case_228(void)
 {
     pd_err err = {0};
     long v = pd_osc_batchable((const pd_osc *)fx_object("pd_osc", "pd_osc_batchable", 0), NULL);
@@ -1853,7 +1871,7 @@ static long api_case_226(void)
     return v;
 }
 
-static long api_case_227(void)
+static long api_case_229(void)
 {
     pd_err err = {0};
     double v = pd_osc_scan_points(NULL, 1.0);
@@ -1862,7 +1880,7 @@ static long api_case_227(void)
     return 0;
 }
 
-static long api_case_228(void)
+static long api_case_230(void)
 {
     pd_err err = {0};
     long v = pd_osc_simulate(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_simulate", 1), NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_simulate", 4), &err);
@@ -1870,7 +1888,7 @@ static long api_case_228(void)
     return v;
 }
 
-static long api_case_229(void)
+static long api_case_231(void)
 {
     pd_err err = {0};
     long v = pd_osc_simulate((const pd_osc *)fx_object("pd_osc", "pd_osc_simulate", 0), NULL, NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_simulate", 4), &err);
@@ -1878,7 +1896,7 @@ static long api_case_229(void)
     return v;
 }
 
-static long api_case_230(void)
+static long api_case_232(void)
 {
     pd_err err = {0};
     long v = pd_osc_simulate((const pd_osc *)fx_object("pd_osc", "pd_osc_simulate", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_simulate", 1), NULL, NULL, NULL, &err);
@@ -1886,7 +1904,7 @@ static long api_case_230(void)
     return v;
 }
 
-static long api_case_231(void)
+static long api_case_233(void)
 {
     pd_err err = {0};
     long v = pd_osc_reference(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_reference", 1), NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_reference", 4), &err);
@@ -1894,7 +1912,7 @@ static long api_case_231(void)
     return v;
 }
 
-static long api_case_232(void)
+static long api_case_234(void)
 {
     pd_err err = {0};
     long v = pd_osc_reference((const pd_osc *)fx_object("pd_osc", "pd_osc_reference", 0), NULL, NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_reference", 4), &err);
@@ -1902,7 +1920,7 @@ static long api_case_232(void)
     return v;
 }
 
-static long api_case_233(void)
+static long api_case_235(void)
 {
     pd_err err = {0};
     long v = pd_osc_reference((const pd_osc *)fx_object("pd_osc", "pd_osc_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_reference", 1), NULL, NULL, NULL, &err);
@@ -1910,7 +1928,7 @@ static long api_case_233(void)
     return v;
 }
 
-static long api_case_234(void)
+static long api_case_236(void)
 {
     pd_err err = {0};
     long v = pd_osc_penalty(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_penalty", 1), NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_penalty", 4), &err);
@@ -1918,7 +1936,7 @@ static long api_case_234(void)
     return v;
 }
 
-static long api_case_235(void)
+static long api_case_237(void)
 {
     pd_err err = {0};
     long v = pd_osc_penalty((const pd_osc *)fx_object("pd_osc", "pd_osc_penalty", 0), NULL, NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_penalty", 4), &err);
@@ -1926,7 +1944,7 @@ static long api_case_235(void)
     return v;
 }
 
-static long api_case_236(void)
+static long api_case_238(void)
 {
     pd_err err = {0};
     long v = pd_osc_penalty((const pd_osc *)fx_object("pd_osc", "pd_osc_penalty", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_penalty", 1), NULL, NULL, NULL, &err);
@@ -1934,7 +1952,7 @@ static long api_case_236(void)
     return v;
 }
 
-static long api_case_237(void)
+static long api_case_239(void)
 {
     pd_err err = {0};
     long v = pd_osc_summarize(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_summarize", 1), NULL, NULL, (pd_osc_summary *)fx_object("pd_osc_summary", "pd_osc_summarize", 4), &err);
@@ -1942,7 +1960,7 @@ static long api_case_237(void)
     return v;
 }
 
-static long api_case_238(void)
+static long api_case_240(void)
 {
     pd_err err = {0};
     long v = pd_osc_summarize((const pd_osc *)fx_object("pd_osc", "pd_osc_summarize", 0), NULL, NULL, NULL, (pd_osc_summary *)fx_object("pd_osc_summary", "pd_osc_summarize", 4), &err);
@@ -1950,7 +1968,7 @@ static long api_case_238(void)
     return v;
 }
 
-static long api_case_239(void)
+static long api_case_241(void)
 {
     pd_err err = {0};
     long v = pd_osc_summarize((const pd_osc *)fx_object("pd_osc", "pd_osc_summarize", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_summarize", 1), NULL, NULL, NULL, &err);
@@ -1958,7 +1976,7 @@ static long api_case_239(void)
     return v;
 }
 
-static long api_case_240(void)
+static long api_case_242(void)
 {
     pd_err err = {0};
     pd_osc_free_exact(NULL, 1.0, (double *)fx_object("double", "pd_osc_free_exact", 2), (double *)fx_object("double", "pd_osc_free_exact", 3));
@@ -1966,7 +1984,7 @@ static long api_case_240(void)
     return 0;
 }
 
-static long api_case_241(void)
+static long api_case_243(void)
 {
     pd_err err = {0};
     pd_osc_free_exact((const pd_osc *)fx_object("pd_osc", "pd_osc_free_exact", 0), 1.0, NULL, (double *)fx_object("double", "pd_osc_free_exact", 3));
@@ -1974,7 +1992,7 @@ static long api_case_241(void)
     return 0;
 }
 
-static long api_case_242(void)
+static long api_case_244(void)
 {
     pd_err err = {0};
     pd_osc_free_exact((const pd_osc *)fx_object("pd_osc", "pd_osc_free_exact", 0), 1.0, (double *)fx_object("double", "pd_osc_free_exact", 2), NULL);
@@ -1982,7 +2000,7 @@ static long api_case_242(void)
     return 0;
 }
 
-static long api_case_243(void)
+static long api_case_245(void)
 {
     pd_err err = {0};
     long v = pd_osc_free_first_contact(NULL, 1.0, (double *)fx_object("double", "pd_osc_free_first_contact", 2), (double *)fx_object("double", "pd_osc_free_first_contact", 3));
@@ -1990,7 +2008,7 @@ static long api_case_243(void)
     return v;
 }
 
-static long api_case_244(void)
+static long api_case_246(void)
 {
     pd_err err = {0};
     long v = pd_osc_free_first_contact((const pd_osc *)fx_object("pd_osc", "pd_osc_free_first_contact", 0), 1.0, NULL, (double *)fx_object("double", "pd_osc_free_first_contact", 3));
@@ -1998,7 +2016,7 @@ static long api_case_244(void)
     return v;
 }
 
-static long api_case_245(void)
+static long api_case_247(void)
 {
     pd_err err = {0};
     long v = pd_osc_free_first_contact((const pd_osc *)fx_object("pd_osc", "pd_osc_free_first_contact", 0), 1.0, (double *)fx_object("double", "pd_osc_free_first_contact", 2), NULL);
@@ -2006,7 +2024,7 @@ static long api_case_245(void)
     return v;
 }
 
-static long api_case_246(void)
+static long api_case_248(void)
 {
     pd_err err = {0};
     long v = pd_trace_alloc(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_trace_alloc", 1));
@@ -2014,7 +2032,7 @@ static long api_case_246(void)
     return v;
 }
 
-static long api_case_247(void)
+static long api_case_249(void)
 {
     pd_err err = {0};
     long v = pd_trace_alloc((pd_trace *)fx_object("pd_trace", "pd_trace_alloc", 0), NULL);
@@ -2022,7 +2040,7 @@ static long api_case_247(void)
     return v;
 }
 
-static long api_case_248(void)
+static long api_case_250(void)
 {
     pd_err err = {0};
     pd_trace_free(NULL);
@@ -2030,7 +2048,7 @@ static long api_case_248(void)
     return 0;
 }
 
-static long api_case_249(void)
+static long api_case_251(void)
 {
     pd_err err = {0};
     long v = pd_measure_reference(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_reference", 1), (pd_trace *)fx_object("pd_trace", "pd_measure_reference", 2), (pd_osc_result *)fx_object("pd_osc_result", "pd_measure_reference", 3), &err);
@@ -2038,7 +2056,7 @@ static long api_case_249(void)
     return v;
 }
 
-static long api_case_250(void)
+static long api_case_252(void)
 {
     pd_err err = {0};
     long v = pd_measure_reference((const pd_osc *)fx_object("pd_osc", "pd_measure_reference", 0), NULL, (pd_trace *)fx_object("pd_trace", "pd_measure_reference", 2), (pd_osc_result *)fx_object("pd_osc_result", "pd_measure_reference", 3), &err);
@@ -2046,7 +2064,7 @@ static long api_case_250(void)
     return v;
 }
 
-static long api_case_251(void)
+static long api_case_253(void)
 {
     pd_err err = {0};
     long v = pd_measure_reference((const pd_osc *)fx_object("pd_osc", "pd_measure_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_reference", 1), NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_measure_reference", 3), &err);
@@ -2054,7 +2072,7 @@ static long api_case_251(void)
     return v;
 }
 
-static long api_case_252(void)
+static long api_case_254(void)
 {
     pd_err err = {0};
     long v = pd_measure_reference((const pd_osc *)fx_object("pd_osc", "pd_measure_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_reference", 1), (pd_trace *)fx_object("pd_trace", "pd_measure_reference", 2), NULL, &err);
@@ -2062,7 +2080,7 @@ static long api_case_252(void)
     return v;
 }
 
-static long api_case_253(void)
+static long api_case_255(void)
 {
     pd_err err = {0};
     long v = pd_measure_run(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_run", 1), (const pd_trace *)fx_object("pd_trace", "pd_measure_run", 2), 1.0, (pd_trace *)fx_object("pd_trace", "pd_measure_run", 4), (pd_measured *)fx_object("pd_measured", "pd_measure_run", 5), &err);
@@ -2070,7 +2088,7 @@ static long api_case_253(void)
     return v;
 }
 
-static long api_case_254(void)
+static long api_case_256(void)
 {
     pd_err err = {0};
     long v = pd_measure_run((const pd_osc *)fx_object("pd_osc", "pd_measure_run", 0), NULL, (const pd_trace *)fx_object("pd_trace", "pd_measure_run", 2), 1.0, (pd_trace *)fx_object("pd_trace", "pd_measure_run", 4), (pd_measured *)fx_object("pd_measured", "pd_measure_run", 5), &err);
@@ -2078,7 +2096,7 @@ static long api_case_254(void)
     return v;
 }
 
-static long api_case_255(void)
+static long api_case_257(void)
 {
     pd_err err = {0};
     long v = pd_measure_run((const pd_osc *)fx_object("pd_osc", "pd_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_run", 1), NULL, 1.0, (pd_trace *)fx_object("pd_trace", "pd_measure_run", 4), (pd_measured *)fx_object("pd_measured", "pd_measure_run", 5), &err);
@@ -2086,7 +2104,7 @@ static long api_case_255(void)
     return v;
 }
 
-static long api_case_256(void)
+static long api_case_258(void)
 {
     pd_err err = {0};
     long v = pd_measure_run((const pd_osc *)fx_object("pd_osc", "pd_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_run", 1), (const pd_trace *)fx_object("pd_trace", "pd_measure_run", 2), 1.0, NULL, (pd_measured *)fx_object("pd_measured", "pd_measure_run", 5), &err);
@@ -2094,7 +2112,7 @@ static long api_case_256(void)
     return v;
 }
 
-static long api_case_257(void)
+static long api_case_259(void)
 {
     pd_err err = {0};
     long v = pd_measure_run((const pd_osc *)fx_object("pd_osc", "pd_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_run", 1), (const pd_trace *)fx_object("pd_trace", "pd_measure_run", 2), 1.0, (pd_trace *)fx_object("pd_trace", "pd_measure_run", 4), NULL, &err);
@@ -2102,7 +2120,7 @@ static long api_case_257(void)
     return v;
 }
 
-static long api_case_258(void)
+static long api_case_260(void)
 {
     pd_err err = {0};
     pd_scene * p = pd_scene_new(NULL);
@@ -2110,7 +2128,7 @@ static long api_case_258(void)
     return p != NULL;
 }
 
-static long api_case_259(void)
+static long api_case_261(void)
 {
     pd_err err = {0};
     pd_scene_free(NULL);
@@ -2118,7 +2136,7 @@ static long api_case_259(void)
     return 0;
 }
 
-static long api_case_260(void)
+static long api_case_262(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_sdof(NULL, (const char *)fx_string("pd_scene_add_sdof", "name"), 1.0, 1.0, 1.0, &err);
@@ -2126,7 +2144,7 @@ static long api_case_260(void)
     return v;
 }
 
-static long api_case_261(void)
+static long api_case_263(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_sdof((pd_scene *)fx_object("pd_scene", "pd_scene_add_sdof", 0), NULL, 1.0, 1.0, 1.0, &err);
@@ -2134,7 +2152,7 @@ static long api_case_261(void)
     return v;
 }
 
-static long api_case_262(void)
+static long api_case_264(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_building(NULL, (const char *)fx_string("pd_scene_add_building", "name"), 1, (const double *)fx_object("double", "pd_scene_add_building", 3), (const double *)fx_object("double", "pd_scene_add_building", 4), 1.0, &err);
@@ -2142,7 +2160,7 @@ static long api_case_262(void)
     return v;
 }
 
-static long api_case_263(void)
+static long api_case_265(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_building((pd_scene *)fx_object("pd_scene", "pd_scene_add_building", 0), NULL, 1, (const double *)fx_object("double", "pd_scene_add_building", 3), (const double *)fx_object("double", "pd_scene_add_building", 4), 1.0, &err);
@@ -2150,7 +2168,7 @@ static long api_case_263(void)
     return v;
 }
 
-static long api_case_264(void)
+static long api_case_266(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_building((pd_scene *)fx_object("pd_scene", "pd_scene_add_building", 0), (const char *)fx_string("pd_scene_add_building", "name"), 1, NULL, (const double *)fx_object("double", "pd_scene_add_building", 4), 1.0, &err);
@@ -2158,7 +2176,7 @@ static long api_case_264(void)
     return v;
 }
 
-static long api_case_265(void)
+static long api_case_267(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_building((pd_scene *)fx_object("pd_scene", "pd_scene_add_building", 0), (const char *)fx_string("pd_scene_add_building", "name"), 1, (const double *)fx_object("double", "pd_scene_add_building", 3), NULL, 1.0, &err);
@@ -2166,7 +2184,7 @@ static long api_case_265(void)
     return v;
 }
 
-static long api_case_266(void)
+static long api_case_268(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_uniform(NULL, (const char *)fx_string("pd_scene_add_uniform", "name"), 1, 1.0, 1.0, 1.0, &err);
@@ -2174,7 +2192,7 @@ static long api_case_266(void)
     return v;
 }
 
-static long api_case_267(void)
+static long api_case_269(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_uniform((pd_scene *)fx_object("pd_scene", "pd_scene_add_uniform", 0), NULL, 1, 1.0, 1.0, 1.0, &err);
@@ -2182,7 +2200,7 @@ static long api_case_267(void)
     return v;
 }
 
-static long api_case_268(void)
+static long api_case_270(void)
 {
     pd_err err = {0};
     long v = pd_scene_set_damping(NULL, (pd_damping)0, 1, 1, &err);
@@ -2190,7 +2208,7 @@ static long api_case_268(void)
     return v;
 }
 
-static long api_case_269(void)
+static long api_case_271(void)
 {
     pd_err err = {0};
     long v = pd_scene_set_heights(NULL, (const double *)fx_object("double", "pd_scene_set_heights", 1), &err);
@@ -2198,7 +2216,7 @@ static long api_case_269(void)
     return v;
 }
 
-static long api_case_270(void)
+static long api_case_272(void)
 {
     pd_err err = {0};
     long v = pd_scene_set_heights((pd_scene *)fx_object("pd_scene", "pd_scene_set_heights", 0), NULL, &err);
@@ -2206,7 +2224,7 @@ static long api_case_270(void)
     return v;
 }
 
-static long api_case_271(void)
+static long api_case_273(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_contact(NULL, 1, 1, 1, 1, 1.0, 1.0, 1, &err);
@@ -2214,7 +2232,7 @@ static long api_case_271(void)
     return v;
 }
 
-static long api_case_272(void)
+static long api_case_274(void)
 {
     pd_err err = {0};
     pd_scene * p = pd_scene_copy(NULL);
@@ -2222,7 +2240,7 @@ static long api_case_272(void)
     return p != NULL;
 }
 
-static long api_case_273(void)
+static long api_case_275(void)
 {
     pd_err err = {0};
     long v = pd_scene_find(NULL, (const char *)fx_string("pd_scene_find", "name"));
@@ -2230,7 +2248,7 @@ static long api_case_273(void)
     return v;
 }
 
-static long api_case_274(void)
+static long api_case_276(void)
 {
     pd_err err = {0};
     long v = pd_scene_find((const pd_scene *)fx_object("pd_scene", "pd_scene_find", 0), NULL);
@@ -2238,7 +2256,7 @@ static long api_case_274(void)
     return v;
 }
 
-static long api_case_275(void)
+static long api_case_277(void)
 {
     pd_err err = {0};
     long v = pd_scene_finish(NULL, &err);
@@ -2246,7 +2264,7 @@ static long api_case_275(void)
     return v;
 }
 
-static long api_case_276(void)
+static long api_case_278(void)
 {
     pd_err err = {0};
     long v = pd_scene_load(NULL, (pd_scene **)fx_slot(), &err);
@@ -2254,7 +2272,7 @@ static long api_case_276(void)
     return v;
 }
 
-static long api_case_277(void)
+static long api_case_279(void)
 {
     pd_err err = {0};
     long v = pd_scene_load((const char *)fx_string("pd_scene_load", "path"), NULL, &err);
@@ -2262,7 +2280,7 @@ static long api_case_277(void)
     return v;
 }
 
-static long api_case_278(void)
+static long api_case_280(void)
 {
     pd_err err = {0};
     long v = pd_scene_chain(1, NULL, 1.0, 1.0, 1.0, 1.0, 1.0, (pd_scene **)fx_slot(), &err);
@@ -2270,7 +2288,7 @@ static long api_case_278(void)
     return v;
 }
 
-static long api_case_279(void)
+static long api_case_281(void)
 {
     pd_err err = {0};
     long v = pd_scene_chain(1, (const pd_scene_excitation *)fx_object("pd_scene_excitation", "pd_scene_chain", 1), 1.0, 1.0, 1.0, 1.0, 1.0, NULL, &err);
@@ -2278,7 +2296,7 @@ static long api_case_279(void)
     return v;
 }
 
-static long api_case_280(void)
+static long api_case_282(void)
 {
     pd_err err = {0};
     double v = pd_scene_wp(NULL);
@@ -2287,7 +2305,7 @@ static long api_case_280(void)
     return 0;
 }
 
-static long api_case_281(void)
+static long api_case_283(void)
 {
     pd_err err = {0};
     double v = pd_scene_Le(NULL);
@@ -2296,7 +2314,7 @@ static long api_case_281(void)
     return 0;
 }
 
-static long api_case_282(void)
+static long api_case_284(void)
 {
     pd_err err = {0};
     double v = pd_scene_default_dt(NULL);
@@ -2305,7 +2323,7 @@ static long api_case_282(void)
     return 0;
 }
 
-static long api_case_283(void)
+static long api_case_285(void)
 {
     pd_err err = {0};
     double v = pd_scene_default_tend(NULL);
@@ -2314,7 +2332,7 @@ static long api_case_283(void)
     return 0;
 }
 
-static long api_case_284(void)
+static long api_case_286(void)
 {
     pd_err err = {0};
     double v = pd_scene_measure_start(NULL, 1.0);
@@ -2323,7 +2341,7 @@ static long api_case_284(void)
     return 0;
 }
 
-static long api_case_285(void)
+static long api_case_287(void)
 {
     pd_err err = {0};
     long v = pd_scene_resolve_opts(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_resolve_opts", 1), (pd_run_opts *)fx_object("pd_run_opts", "pd_scene_resolve_opts", 2), &err);
@@ -2331,7 +2349,7 @@ static long api_case_285(void)
     return v;
 }
 
-static long api_case_286(void)
+static long api_case_288(void)
 {
     pd_err err = {0};
     long v = pd_scene_resolve_opts((const pd_scene *)fx_object("pd_scene", "pd_scene_resolve_opts", 0), NULL, (pd_run_opts *)fx_object("pd_run_opts", "pd_scene_resolve_opts", 2), &err);
@@ -2339,7 +2357,7 @@ static long api_case_286(void)
     return v;
 }
 
-static long api_case_287(void)
+static long api_case_289(void)
 {
     pd_err err = {0};
     long v = pd_scene_resolve_opts((const pd_scene *)fx_object("pd_scene", "pd_scene_resolve_opts", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_resolve_opts", 1), NULL, &err);
@@ -2347,7 +2365,7 @@ static long api_case_287(void)
     return v;
 }
 
-static long api_case_288(void)
+static long api_case_290(void)
 {
     pd_err err = {0};
     long v = pd_scene_as_oscillator(NULL, (pd_osc *)fx_object("pd_osc", "pd_scene_as_oscillator", 1), (int *)fx_object("int", "pd_scene_as_oscillator", 2));
@@ -2355,7 +2373,7 @@ static long api_case_288(void)
     return v;
 }
 
-static long api_case_289(void)
+static long api_case_291(void)
 {
     pd_err err = {0};
     long v = pd_scene_as_oscillator((const pd_scene *)fx_object("pd_scene", "pd_scene_as_oscillator", 0), NULL, (int *)fx_object("int", "pd_scene_as_oscillator", 2));
@@ -2363,7 +2381,7 @@ static long api_case_289(void)
     return v;
 }
 
-static long api_case_290(void)
+static long api_case_292(void)
 {
     pd_err err = {0};
     long v = pd_scene_as_oscillator((const pd_scene *)fx_object("pd_scene", "pd_scene_as_oscillator", 0), (pd_osc *)fx_object("pd_osc", "pd_scene_as_oscillator", 1), NULL);
@@ -2371,7 +2389,7 @@ static long api_case_290(void)
     return v;
 }
 
-static long api_case_291(void)
+static long api_case_293(void)
 {
     pd_err err = {0};
     long v = pd_scene_model_build(NULL, 1, (pd_scene_model *)fx_object("pd_scene_model", "pd_scene_model_build", 2), &err);
@@ -2379,7 +2397,7 @@ static long api_case_291(void)
     return v;
 }
 
-static long api_case_292(void)
+static long api_case_294(void)
 {
     pd_err err = {0};
     long v = pd_scene_model_build((const pd_scene *)fx_object("pd_scene", "pd_scene_model_build", 0), 1, NULL, &err);
@@ -2387,7 +2405,7 @@ static long api_case_292(void)
     return v;
 }
 
-static long api_case_293(void)
+static long api_case_295(void)
 {
     pd_err err = {0};
     pd_scene_model_free(NULL);
@@ -2395,7 +2413,7 @@ static long api_case_293(void)
     return 0;
 }
 
-static long api_case_294(void)
+static long api_case_296(void)
 {
     pd_err err = {0};
     long v = pd_scene_result_alloc(NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_result_alloc", 1), &err);
@@ -2403,7 +2421,7 @@ static long api_case_294(void)
     return v;
 }
 
-static long api_case_295(void)
+static long api_case_297(void)
 {
     pd_err err = {0};
     long v = pd_scene_result_alloc((const pd_scene *)fx_object("pd_scene", "pd_scene_result_alloc", 0), NULL, &err);
@@ -2411,7 +2429,7 @@ static long api_case_295(void)
     return v;
 }
 
-static long api_case_296(void)
+static long api_case_298(void)
 {
     pd_err err = {0};
     long v = pd_scene_result_fits(NULL, (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_result_fits", 1));
@@ -2419,7 +2437,7 @@ static long api_case_296(void)
     return v;
 }
 
-static long api_case_297(void)
+static long api_case_299(void)
 {
     pd_err err = {0};
     long v = pd_scene_result_fits((const pd_scene *)fx_object("pd_scene", "pd_scene_result_fits", 0), NULL);
@@ -2427,7 +2445,7 @@ static long api_case_297(void)
     return v;
 }
 
-static long api_case_298(void)
+static long api_case_300(void)
 {
     pd_err err = {0};
     pd_scene_result_free(NULL);
@@ -2435,7 +2453,7 @@ static long api_case_298(void)
     return 0;
 }
 
-static long api_case_299(void)
+static long api_case_301(void)
 {
     pd_err err = {0};
     long v = pd_scene_run(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_run", 1), NULL, NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_run", 4), &err);
@@ -2443,7 +2461,7 @@ static long api_case_299(void)
     return v;
 }
 
-static long api_case_300(void)
+static long api_case_302(void)
 {
     pd_err err = {0};
     long v = pd_scene_run((const pd_scene *)fx_object("pd_scene", "pd_scene_run", 0), NULL, NULL, NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_run", 4), &err);
@@ -2451,7 +2469,7 @@ static long api_case_300(void)
     return v;
 }
 
-static long api_case_301(void)
+static long api_case_303(void)
 {
     pd_err err = {0};
     long v = pd_scene_run((const pd_scene *)fx_object("pd_scene", "pd_scene_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_run", 1), NULL, NULL, NULL, &err);
@@ -2459,7 +2477,7 @@ static long api_case_301(void)
     return v;
 }
 
-static long api_case_302(void)
+static long api_case_304(void)
 {
     pd_err err = {0};
     long v = pd_scene_summarize(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_summarize", 1), NULL, NULL, (pd_scene_summary *)fx_object("pd_scene_summary", "pd_scene_summarize", 4), &err);
@@ -2467,7 +2485,7 @@ static long api_case_302(void)
     return v;
 }
 
-static long api_case_303(void)
+static long api_case_305(void)
 {
     pd_err err = {0};
     long v = pd_scene_summarize((const pd_scene *)fx_object("pd_scene", "pd_scene_summarize", 0), NULL, NULL, NULL, (pd_scene_summary *)fx_object("pd_scene_summary", "pd_scene_summarize", 4), &err);
@@ -2475,7 +2493,7 @@ static long api_case_303(void)
     return v;
 }
 
-static long api_case_304(void)
+static long api_case_306(void)
 {
     pd_err err = {0};
     long v = pd_scene_summarize((const pd_scene *)fx_object("pd_scene", "pd_scene_summarize", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_summarize", 1), NULL, NULL, NULL, &err);
@@ -2483,7 +2501,7 @@ static long api_case_304(void)
     return v;
 }
 
-static long api_case_305(void)
+static long api_case_307(void)
 {
     pd_err err = {0};
     pd_scene_summary_free(NULL);
@@ -2491,7 +2509,7 @@ static long api_case_305(void)
     return 0;
 }
 
-static long api_case_306(void)
+static long api_case_308(void)
 {
     pd_err err = {0};
     long v = pd_scene_trace_alloc(NULL, (const pd_scene *)fx_object("pd_scene", "pd_scene_trace_alloc", 1), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_trace_alloc", 2), &err);
@@ -2499,7 +2517,7 @@ static long api_case_306(void)
     return v;
 }
 
-static long api_case_307(void)
+static long api_case_309(void)
 {
     pd_err err = {0};
     long v = pd_scene_trace_alloc((pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_trace_alloc", 0), NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_trace_alloc", 2), &err);
@@ -2507,7 +2525,7 @@ static long api_case_307(void)
     return v;
 }
 
-static long api_case_308(void)
+static long api_case_310(void)
 {
     pd_err err = {0};
     long v = pd_scene_trace_alloc((pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_trace_alloc", 0), (const pd_scene *)fx_object("pd_scene", "pd_scene_trace_alloc", 1), NULL, &err);
@@ -2515,7 +2533,7 @@ static long api_case_308(void)
     return v;
 }
 
-static long api_case_309(void)
+static long api_case_311(void)
 {
     pd_err err = {0};
     pd_scene_trace_free(NULL);
@@ -2523,7 +2541,7 @@ static long api_case_309(void)
     return 0;
 }
 
-static long api_case_310(void)
+static long api_case_312(void)
 {
     pd_err err = {0};
     long v = pd_scene_errors_alloc(NULL, (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_errors_alloc", 1), &err);
@@ -2531,7 +2549,7 @@ static long api_case_310(void)
     return v;
 }
 
-static long api_case_311(void)
+static long api_case_313(void)
 {
     pd_err err = {0};
     long v = pd_scene_errors_alloc((const pd_scene *)fx_object("pd_scene", "pd_scene_errors_alloc", 0), NULL, &err);
@@ -2539,7 +2557,7 @@ static long api_case_311(void)
     return v;
 }
 
-static long api_case_312(void)
+static long api_case_314(void)
 {
     pd_err err = {0};
     pd_scene_errors_free(NULL);
@@ -2547,7 +2565,7 @@ static long api_case_312(void)
     return 0;
 }
 
-static long api_case_313(void)
+static long api_case_315(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_reference(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_reference", 1), (pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_reference", 2), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_reference", 3), &err);
@@ -2555,7 +2573,7 @@ static long api_case_313(void)
     return v;
 }
 
-static long api_case_314(void)
+static long api_case_316(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_reference((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_reference", 0), NULL, (pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_reference", 2), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_reference", 3), &err);
@@ -2563,7 +2581,7 @@ static long api_case_314(void)
     return v;
 }
 
-static long api_case_315(void)
+static long api_case_317(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_reference((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_reference", 1), NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_reference", 3), &err);
@@ -2571,7 +2589,7 @@ static long api_case_315(void)
     return v;
 }
 
-static long api_case_316(void)
+static long api_case_318(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_reference((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_reference", 1), (pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_reference", 2), NULL, &err);
@@ -2579,7 +2597,7 @@ static long api_case_316(void)
     return v;
 }
 
-static long api_case_317(void)
+static long api_case_319(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2587,7 +2605,7 @@ static long api_case_317(void)
     return v;
 }
 
-static long api_case_318(void)
+static long api_case_320(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), NULL, (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2595,7 +2613,7 @@ static long api_case_318(void)
     return v;
 }
 
-static long api_case_319(void)
+static long api_case_321(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), NULL, (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2603,7 +2621,7 @@ static long api_case_319(void)
     return v;
 }
 
-static long api_case_320(void)
+static long api_case_322(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2611,7 +2629,7 @@ static long api_case_320(void)
     return v;
 }
 
-static long api_case_321(void)
+static long api_case_323(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), NULL, (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2619,7 +2637,7 @@ static long api_case_321(void)
     return v;
 }
 
-static long api_case_322(void)
+static long api_case_324(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), NULL, &err);
@@ -2627,7 +2645,7 @@ static long api_case_322(void)
     return v;
 }
 
-static long api_case_323(void)
+static long api_case_325(void)
 {
     pd_err err = {0};
     pd_spec_init(NULL);
@@ -2635,7 +2653,7 @@ static long api_case_323(void)
     return 0;
 }
 
-static long api_case_324(void)
+static long api_case_326(void)
 {
     pd_err err = {0};
     long v = pd_spec_curves(NULL);
@@ -2643,7 +2661,7 @@ static long api_case_324(void)
     return v;
 }
 
-static long api_case_325(void)
+static long api_case_327(void)
 {
     pd_err err = {0};
     long v = pd_spec_points(NULL);
@@ -2651,7 +2669,7 @@ static long api_case_325(void)
     return v;
 }
 
-static long api_case_326(void)
+static long api_case_328(void)
 {
     pd_err err = {0};
     long v = pd_spec_twins(NULL);
@@ -2659,7 +2677,7 @@ static long api_case_326(void)
     return v;
 }
 
-static long api_case_327(void)
+static long api_case_329(void)
 {
     pd_err err = {0};
     long v = pd_spec_tasks(NULL);
@@ -2667,7 +2685,7 @@ static long api_case_327(void)
     return v;
 }
 
-static long api_case_328(void)
+static long api_case_330(void)
 {
     pd_err err = {0};
     double v = pd_spec_pi2(NULL, 0);
@@ -2676,7 +2694,7 @@ static long api_case_328(void)
     return 0;
 }
 
-static long api_case_329(void)
+static long api_case_331(void)
 {
     pd_err err = {0};
     pd_spec_coords_of(NULL, 0, (pd_spec_coords *)fx_object("pd_spec_coords", "pd_spec_coords_of", 2));
@@ -2684,7 +2702,7 @@ static long api_case_329(void)
     return 0;
 }
 
-static long api_case_330(void)
+static long api_case_332(void)
 {
     pd_err err = {0};
     pd_spec_coords_of((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_coords_of", 0), 0, NULL);
@@ -2692,7 +2710,7 @@ static long api_case_330(void)
     return 0;
 }
 
-static long api_case_331(void)
+static long api_case_333(void)
 {
     pd_err err = {0};
     long v = pd_spec_twin_of(NULL, 0);
@@ -2700,7 +2718,7 @@ static long api_case_331(void)
     return v;
 }
 
-static long api_case_332(void)
+static long api_case_334(void)
 {
     pd_err err = {0};
     long v = pd_spec_case(NULL, 0, (pd_osc *)fx_object("pd_osc", "pd_spec_case", 2), (pd_run_opts *)fx_object("pd_run_opts", "pd_spec_case", 3), &err);
@@ -2708,7 +2726,7 @@ static long api_case_332(void)
     return v;
 }
 
-static long api_case_333(void)
+static long api_case_335(void)
 {
     pd_err err = {0};
     long v = pd_spec_case((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_case", 0), 0, NULL, (pd_run_opts *)fx_object("pd_run_opts", "pd_spec_case", 3), &err);
@@ -2716,7 +2734,7 @@ static long api_case_333(void)
     return v;
 }
 
-static long api_case_334(void)
+static long api_case_336(void)
 {
     pd_err err = {0};
     long v = pd_spec_case((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_case", 0), 0, (pd_osc *)fx_object("pd_osc", "pd_spec_case", 2), NULL, &err);
@@ -2724,7 +2742,7 @@ static long api_case_334(void)
     return v;
 }
 
-static long api_case_335(void)
+static long api_case_337(void)
 {
     pd_err err = {0};
     long v = pd_spec_validate(NULL, &err);
@@ -2732,7 +2750,7 @@ static long api_case_335(void)
     return v;
 }
 
-static long api_case_336(void)
+static long api_case_338(void)
 {
     pd_err err = {0};
     pd_spec_resolve_method(NULL);
@@ -2740,7 +2758,7 @@ static long api_case_336(void)
     return 0;
 }
 
-static long api_case_337(void)
+static long api_case_339(void)
 {
     pd_err err = {0};
     pd_spec_run_task(NULL, 0, (pd_spec_result *)fx_object("pd_spec_result", "pd_spec_run_task", 2), &err);
@@ -2748,7 +2766,7 @@ static long api_case_337(void)
     return 0;
 }
 
-static long api_case_338(void)
+static long api_case_340(void)
 {
     pd_err err = {0};
     pd_spec_run_task((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_run_task", 0), 0, NULL, &err);
@@ -2756,7 +2774,7 @@ static long api_case_338(void)
     return 0;
 }
 
-static long api_case_339(void)
+static long api_case_341(void)
 {
     pd_err err = {0};
     long v = pd_spec_stream(NULL, NULL, NULL, NULL, &err);
@@ -2764,7 +2782,7 @@ static long api_case_339(void)
     return v;
 }
 
-static long api_case_340(void)
+static long api_case_342(void)
 {
     pd_err err = {0};
     double v = pd_spec_cost(NULL, 0);
@@ -2773,7 +2791,7 @@ static long api_case_340(void)
     return 0;
 }
 
-static long api_case_341(void)
+static long api_case_343(void)
 {
     pd_err err = {0};
     char * p = pd_spec_key(NULL);
@@ -2781,7 +2799,7 @@ static long api_case_341(void)
     return p != NULL;
 }
 
-static long api_case_342(void)
+static long api_case_344(void)
 {
     pd_err err = {0};
     pd_spec_rows(NULL, (const pd_spec_result *)fx_object("pd_spec_result", "pd_spec_rows", 1), (pd_spec_row *)fx_object("pd_spec_row", "pd_spec_rows", 2));
@@ -2789,7 +2807,7 @@ static long api_case_342(void)
     return 0;
 }
 
-static long api_case_343(void)
+static long api_case_345(void)
 {
     pd_err err = {0};
     pd_spec_rows((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_rows", 0), NULL, (pd_spec_row *)fx_object("pd_spec_row", "pd_spec_rows", 2));
@@ -2797,7 +2815,7 @@ static long api_case_343(void)
     return 0;
 }
 
-static long api_case_344(void)
+static long api_case_346(void)
 {
     pd_err err = {0};
     pd_spec_rows((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_rows", 0), (const pd_spec_result *)fx_object("pd_spec_result", "pd_spec_rows", 1), NULL);
@@ -2805,7 +2823,7 @@ static long api_case_344(void)
     return 0;
 }
 
-static long api_case_345(void)
+static long api_case_347(void)
 {
     pd_err err = {0};
     pd_spec_curve_label(NULL, 1, (char *)fx_string("pd_spec_curve_label", "buf"), 64);
@@ -2813,7 +2831,7 @@ static long api_case_345(void)
     return 0;
 }
 
-static long api_case_346(void)
+static long api_case_348(void)
 {
     pd_err err = {0};
     pd_spec_curve_label((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_curve_label", 0), 1, NULL, 64);
@@ -2821,7 +2839,7 @@ static long api_case_346(void)
     return 0;
 }
 
-static long api_case_347(void)
+static long api_case_349(void)
 {
     pd_err err = {0};
     long v = pd_spec_sweep(NULL, NULL, NULL, &err);
@@ -2829,7 +2847,7 @@ static long api_case_347(void)
     return v;
 }
 
-static long api_case_348(void)
+static long api_case_350(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_twins(NULL);
@@ -2837,7 +2855,7 @@ static long api_case_348(void)
     return v;
 }
 
-static long api_case_349(void)
+static long api_case_351(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_points(NULL);
@@ -2845,7 +2863,7 @@ static long api_case_349(void)
     return v;
 }
 
-static long api_case_350(void)
+static long api_case_352(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_check(NULL, &err);
@@ -2853,7 +2871,7 @@ static long api_case_350(void)
     return v;
 }
 
-static long api_case_351(void)
+static long api_case_353(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_scene(NULL, 0, (pd_scene **)fx_slot(), (pd_scene_point *)fx_object("pd_scene_point", "pd_scene_sweep_scene", 3), &err);
@@ -2861,7 +2879,7 @@ static long api_case_351(void)
     return v;
 }
 
-static long api_case_352(void)
+static long api_case_354(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_scene((const pd_scene_sweep *)fx_object("pd_scene_sweep", "pd_scene_sweep_scene", 0), 0, NULL, (pd_scene_point *)fx_object("pd_scene_point", "pd_scene_sweep_scene", 3), &err);
@@ -2869,7 +2887,7 @@ static long api_case_352(void)
     return v;
 }
 
-static long api_case_353(void)
+static long api_case_355(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_scene((const pd_scene_sweep *)fx_object("pd_scene_sweep", "pd_scene_sweep_scene", 0), 0, (pd_scene **)fx_slot(), NULL, &err);
@@ -2877,7 +2895,7 @@ static long api_case_353(void)
     return v;
 }
 
-static long api_case_354(void)
+static long api_case_356(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_run(NULL, 1, (pd_scene_point *)fx_object("pd_scene_point", "pd_scene_sweep_run", 2), (double *)fx_object("double", "pd_scene_sweep_run", 3), &err);
@@ -2885,7 +2903,7 @@ static long api_case_354(void)
     return v;
 }
 
-static long api_case_355(void)
+static long api_case_357(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_run((const pd_scene_sweep *)fx_object("pd_scene_sweep", "pd_scene_sweep_run", 0), 1, NULL, (double *)fx_object("double", "pd_scene_sweep_run", 3), &err);
@@ -2893,7 +2911,7 @@ static long api_case_355(void)
     return v;
 }
 
-static long api_case_356(void)
+static long api_case_358(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_run((const pd_scene_sweep *)fx_object("pd_scene_sweep", "pd_scene_sweep_run", 0), 1, (pd_scene_point *)fx_object("pd_scene_point", "pd_scene_sweep_run", 2), NULL, &err);
@@ -2910,355 +2928,357 @@ const api_null_case api_null_cases[] = {
     {.function = "pd_hermite5", .argument = "p1", .expect = EXPECT_NOCRASH, .call = api_case_5},
     {.function = "pd_hermite5", .argument = "f", .expect = EXPECT_NOCRASH, .call = api_case_6},
     {.function = "pd_hermite5", .argument = "fd", .expect = EXPECT_NOCRASH, .call = api_case_7},
-    {.function = "pd_matrix_dense", .argument = "values", .expect = EXPECT_NOCRASH, .call = api_case_8},
-    {.function = "pd_matrix_csc", .argument = "colptr", .expect = EXPECT_NOCRASH, .call = api_case_9},
-    {.function = "pd_matrix_csc", .argument = "rowind", .expect = EXPECT_NOCRASH, .call = api_case_10},
-    {.function = "pd_matrix_csc", .argument = "values", .expect = EXPECT_NOCRASH, .call = api_case_11},
-    {.function = "pd_matrix_gemv", .argument = "A", .expect = EXPECT_NOCRASH, .call = api_case_12},
-    {.function = "pd_matrix_gemv", .argument = "x", .expect = EXPECT_NOCRASH, .call = api_case_13},
-    {.function = "pd_matrix_gemv", .argument = "y", .expect = EXPECT_NOCRASH, .call = api_case_14},
-    {.function = "pd_matrix_gemv_t", .argument = "A", .expect = EXPECT_NOCRASH, .call = api_case_15},
-    {.function = "pd_matrix_gemv_t", .argument = "x", .expect = EXPECT_NOCRASH, .call = api_case_16},
-    {.function = "pd_matrix_gemv_t", .argument = "y", .expect = EXPECT_NOCRASH, .call = api_case_17},
-    {.function = "pd_matrix_get", .argument = "A", .expect = EXPECT_NOCRASH, .call = api_case_18},
-    {.function = "pd_matrix_col_dot", .argument = "A", .expect = EXPECT_NOCRASH, .call = api_case_19},
-    {.function = "pd_matrix_col_dot", .argument = "x", .expect = EXPECT_NOCRASH, .call = api_case_20},
-    {.function = "pd_matrix_col_axpy", .argument = "A", .expect = EXPECT_NOCRASH, .call = api_case_21},
-    {.function = "pd_matrix_col_axpy", .argument = "y", .expect = EXPECT_NOCRASH, .call = api_case_22},
-    {.function = "pd_matrix_col_absdot", .argument = "A", .expect = EXPECT_NOCRASH, .call = api_case_23},
-    {.function = "pd_matrix_col_absdot", .argument = "x", .expect = EXPECT_NOCRASH, .call = api_case_24},
-    {.function = "pd_matrix_nnz", .argument = "A", .expect = EXPECT_NOCRASH, .call = api_case_25},
-    {.function = "pd_matrix_to_dense", .argument = "A", .expect = EXPECT_NOCRASH, .call = api_case_26},
-    {.function = "pd_matrix_to_dense", .argument = "out", .expect = EXPECT_NOCRASH, .call = api_case_27},
-    {.function = "pd_matrix_is_diagonal", .argument = "A", .expect = EXPECT_COUNT, .call = api_case_28},
-    {.function = "pd_matrix_check", .argument = "A", .expect = EXPECT_ERROR, .call = api_case_29},
-    {.function = "pd_matrix_check", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_30},
-    {.function = "pd_sparse_from_triplets", .argument = "sp", .expect = EXPECT_ERROR, .call = api_case_31},
-    {.function = "pd_sparse_from_triplets", .argument = "Ti", .expect = EXPECT_ERROR, .call = api_case_32},
-    {.function = "pd_sparse_from_triplets", .argument = "Tj", .expect = EXPECT_ERROR, .call = api_case_33},
-    {.function = "pd_sparse_from_triplets", .argument = "Tx", .expect = EXPECT_ERROR, .call = api_case_34},
-    {.function = "pd_sparse_free", .argument = "sp", .expect = EXPECT_NOCRASH, .call = api_case_35},
-    {.function = "pd_sparse_view", .argument = "sp", .expect = EXPECT_NOCRASH, .call = api_case_36},
-    {.function = "pd_dense_lu", .argument = "A", .expect = EXPECT_ERROR, .call = api_case_37},
-    {.function = "pd_dense_lu", .argument = "perm", .expect = EXPECT_ERROR, .call = api_case_38},
-    {.function = "pd_dense_lu_solve", .argument = "LU", .expect = EXPECT_NOCRASH, .call = api_case_39},
-    {.function = "pd_dense_lu_solve", .argument = "perm", .expect = EXPECT_NOCRASH, .call = api_case_40},
-    {.function = "pd_dense_lu_solve", .argument = "b", .expect = EXPECT_NOCRASH, .call = api_case_41},
-    {.function = "pd_text_open", .argument = "t", .expect = EXPECT_ERROR, .call = api_case_42},
-    {.function = "pd_text_open", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_43},
-    {.function = "pd_text_line", .argument = "t", .expect = EXPECT_ERROR, .call = api_case_44},
-    {.function = "pd_text_rewind", .argument = "t", .expect = EXPECT_ERROR, .call = api_case_45},
-    {.function = "pd_text_close", .argument = "t", .expect = EXPECT_NOCRASH, .call = api_case_46},
-    {.function = "pd_text_read_all", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_47},
-    {.function = "pd_text_read_all", .argument = "text", .expect = EXPECT_ERROR, .call = api_case_48},
-    {.function = "pd_text_read_all", .argument = "len", .expect = EXPECT_ERROR, .call = api_case_49},
-    {.function = "pd_lcp_free", .argument = "work", .expect = EXPECT_NOCRASH, .call = api_case_50},
-    {.function = "pd_lcp_nmax", .argument = "work", .expect = EXPECT_COUNT, .call = api_case_51},
-    {.function = "pd_lcp_lemke", .argument = "work", .expect = EXPECT_ERROR, .call = api_case_52},
-    {.function = "pd_lcp_lemke", .argument = "M", .expect = EXPECT_ERROR, .call = api_case_53},
-    {.function = "pd_lcp_lemke", .argument = "q", .expect = EXPECT_ERROR, .call = api_case_54},
-    {.function = "pd_lcp_lemke", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_55},
-    {.function = "pd_lcp_lemke", .argument = "z", .expect = EXPECT_ERROR, .call = api_case_56},
-    {.function = "pd_lcp_lemke", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_57},
-    {.function = "pd_lcp_lemke", .argument = "info", .expect = EXPECT_NOCRASH, .call = api_case_58},
-    {.function = "pd_lcp_enumerate", .argument = "M", .expect = EXPECT_ERROR, .call = api_case_59},
-    {.function = "pd_lcp_enumerate", .argument = "q", .expect = EXPECT_ERROR, .call = api_case_60},
-    {.function = "pd_lcp_enumerate", .argument = "z", .expect = EXPECT_ERROR, .call = api_case_61},
-    {.function = "pd_lcp_enumerate", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_62},
-    {.function = "pd_lcp_chain_q", .argument = "q", .expect = EXPECT_NOCRASH, .call = api_case_63},
-    {.function = "pd_lcp_residual", .argument = "M", .expect = EXPECT_NOCRASH, .call = api_case_64},
-    {.function = "pd_lcp_residual", .argument = "q", .expect = EXPECT_NOCRASH, .call = api_case_65},
-    {.function = "pd_lcp_residual", .argument = "z", .expect = EXPECT_NOCRASH, .call = api_case_66},
-    {.function = "pd_lcp_residual", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_67},
-    {.function = "pd_lcp_residual", .argument = "complementarity", .expect = EXPECT_NOCRASH, .call = api_case_68},
-    {.function = "pd_lcp_residual", .argument = "infeasibility", .expect = EXPECT_NOCRASH, .call = api_case_69},
-    {.function = "pd_lcp_residual", .argument = "residual", .expect = EXPECT_NOCRASH, .call = api_case_70},
-    {.function = "pd_lcp_method_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_71},
-    {.function = "pd_lcp_method_parse", .argument = "method", .expect = EXPECT_ERROR, .call = api_case_72},
-    {.function = "pd_lcp_solver_free", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_73},
-    {.function = "pd_lcp_solver_nmax", .argument = "s", .expect = EXPECT_COUNT, .call = api_case_74},
-    {.function = "pd_lcp_solve", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_75},
-    {.function = "pd_lcp_solve", .argument = "M", .expect = EXPECT_ERROR, .call = api_case_76},
-    {.function = "pd_lcp_solve", .argument = "q", .expect = EXPECT_ERROR, .call = api_case_77},
-    {.function = "pd_lcp_solve", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_78},
-    {.function = "pd_lcp_solve", .argument = "z", .expect = EXPECT_ERROR, .call = api_case_79},
-    {.function = "pd_lcp_solve", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_80},
-    {.function = "pd_lcp_solve", .argument = "info", .expect = EXPECT_NOCRASH, .call = api_case_81},
-    {.function = "pd_lcp_read", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_82},
-    {.function = "pd_lcp_read", .argument = "n", .expect = EXPECT_ERROR, .call = api_case_83},
-    {.function = "pd_lcp_read", .argument = "M", .expect = EXPECT_ERROR, .call = api_case_84},
-    {.function = "pd_lcp_read", .argument = "q", .expect = EXPECT_ERROR, .call = api_case_85},
-    {.function = "pd_lcp_read_band", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_86},
-    {.function = "pd_lcp_read_band", .argument = "n", .expect = EXPECT_ERROR, .call = api_case_87},
-    {.function = "pd_lcp_read_band", .argument = "M", .expect = EXPECT_ERROR, .call = api_case_88},
-    {.function = "pd_lcp_read_band", .argument = "q", .expect = EXPECT_ERROR, .call = api_case_89},
-    {.function = "pd_lcp_read_band", .argument = "band", .expect = EXPECT_NOCRASH, .call = api_case_90},
-    {.function = "pd_lcp_read_band", .argument = "nnz", .expect = EXPECT_NOCRASH, .call = api_case_91},
-    {.function = "pd_lcp_band_csc", .argument = "M", .expect = EXPECT_NOCRASH, .call = api_case_92},
-    {.function = "pd_lcp_band_csc", .argument = "colptr", .expect = EXPECT_NOCRASH, .call = api_case_93},
-    {.function = "pd_lcp_band_csc", .argument = "rowind", .expect = EXPECT_NOCRASH, .call = api_case_94},
-    {.function = "pd_lcp_band_csc", .argument = "values", .expect = EXPECT_NOCRASH, .call = api_case_95},
-    {.function = "pd_factor_kind_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_96},
-    {.function = "pd_factor_kind_parse", .argument = "kind", .expect = EXPECT_ERROR, .call = api_case_97},
-    {.function = "pd_model_check", .argument = "model", .expect = EXPECT_ERROR, .call = api_case_98},
-    {.function = "pd_factor_choose", .argument = "model", .expect = EXPECT_NOCRASH, .call = api_case_99},
-    {.function = "pd_mj_alloc", .argument = "model", .expect = EXPECT_NULL, .call = api_case_100},
-    {.function = "pd_mj_alloc", .argument = "opts", .expect = EXPECT_NULL, .call = api_case_101},
-    {.function = "pd_mj_free", .argument = "mj", .expect = EXPECT_NOCRASH, .call = api_case_102},
-    {.function = "pd_mj_reset", .argument = "mj", .expect = EXPECT_ERROR, .call = api_case_103},
-    {.function = "pd_mj_reset", .argument = "q0", .expect = EXPECT_NOCRASH, .call = api_case_104},
-    {.function = "pd_mj_reset", .argument = "v0", .expect = EXPECT_NOCRASH, .call = api_case_105},
-    {.function = "pd_mj_step", .argument = "mj", .expect = EXPECT_ERROR, .call = api_case_106},
-    {.function = "pd_mj_run", .argument = "mj", .expect = EXPECT_ERROR, .call = api_case_107},
-    {.function = "pd_mj_run_until", .argument = "mj", .expect = EXPECT_ERROR, .call = api_case_108},
-    {.function = "pd_mj_get_stats", .argument = "mj", .expect = EXPECT_ERROR, .call = api_case_109},
-    {.function = "pd_mj_get_stats", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_110},
-    {.function = "pd_mj_state", .argument = "mj", .expect = EXPECT_NULL, .call = api_case_111},
-    {.function = "pd_mj_kernel_name", .argument = "mj", .expect = EXPECT_NAME, .call = api_case_112},
-    {.function = "pd_mj_factor_name", .argument = "mj", .expect = EXPECT_NAME, .call = api_case_113},
-    {.function = "pd_mjb_init", .argument = "b", .expect = EXPECT_ERROR, .call = api_case_114},
-    {.function = "pd_mjb_init", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_115},
-    {.function = "pd_mjb_set_lane", .argument = "b", .expect = EXPECT_ERROR, .call = api_case_116},
-    {.function = "pd_mjb_set_lane", .argument = "ln", .expect = EXPECT_ERROR, .call = api_case_117},
-    {.function = "pd_mjb_run", .argument = "b", .expect = EXPECT_NOCRASH, .call = api_case_118},
-    {.function = "pd_mjb_finite", .argument = "b", .expect = EXPECT_COUNT, .call = api_case_119},
-    {.function = "pd_edg_run", .argument = "model", .expect = EXPECT_ERROR, .call = api_case_120},
-    {.function = "pd_edg_run", .argument = "q0", .expect = EXPECT_NOCRASH, .call = api_case_121},
-    {.function = "pd_edg_run", .argument = "v0", .expect = EXPECT_NOCRASH, .call = api_case_122},
-    {.function = "pd_edg_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_123},
-    {.function = "pd_edg_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_124},
-    {.function = "pd_penalty_run", .argument = "model", .expect = EXPECT_ERROR, .call = api_case_125},
-    {.function = "pd_penalty_run", .argument = "q0", .expect = EXPECT_NOCRASH, .call = api_case_126},
-    {.function = "pd_penalty_run", .argument = "v0", .expect = EXPECT_NOCRASH, .call = api_case_127},
-    {.function = "pd_penalty_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_128},
-    {.function = "pd_penalty_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_129},
-    {.function = "pd_sine_piece_force", .argument = "pc", .expect = EXPECT_NOCRASH, .call = api_case_130},
-    {.function = "pd_sdof_increment_piece", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_131},
-    {.function = "pd_sdof_increment_piece", .argument = "pc", .expect = EXPECT_NOCRASH, .call = api_case_132},
-    {.function = "pd_sdof_increment_piece", .argument = "du", .expect = EXPECT_NOCRASH, .call = api_case_133},
-    {.function = "pd_sdof_increment_piece", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_134},
-    {.function = "pd_sdof_advance_piece", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_135},
-    {.function = "pd_sdof_advance_piece", .argument = "pc", .expect = EXPECT_NOCRASH, .call = api_case_136},
-    {.function = "pd_sdof_advance_piece", .argument = "u1", .expect = EXPECT_NOCRASH, .call = api_case_137},
-    {.function = "pd_sdof_advance_piece", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_138},
-    {.function = "pd_sdof_flow_init", .argument = "f", .expect = EXPECT_NOCRASH, .call = api_case_139},
-    {.function = "pd_sdof_flow_init", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_140},
-    {.function = "pd_sdof_flow_init", .argument = "pc", .expect = EXPECT_NOCRASH, .call = api_case_141},
-    {.function = "pd_sdof_flow_at", .argument = "f", .expect = EXPECT_NOCRASH, .call = api_case_142},
-    {.function = "pd_sdof_flow_at", .argument = "du", .expect = EXPECT_NOCRASH, .call = api_case_143},
-    {.function = "pd_sdof_flow_at", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_144},
-    {.function = "pd_sdof_advance", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_145},
-    {.function = "pd_sdof_advance", .argument = "u1", .expect = EXPECT_NOCRASH, .call = api_case_146},
-    {.function = "pd_sdof_advance", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_147},
-    {.function = "pd_sdof_increment", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_148},
-    {.function = "pd_sdof_increment", .argument = "du", .expect = EXPECT_NOCRASH, .call = api_case_149},
-    {.function = "pd_sdof_increment", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_150},
-    {.function = "pd_edr_alloc", .argument = "model", .expect = EXPECT_NULL, .call = api_case_151},
-    {.function = "pd_edr_alloc", .argument = "force", .expect = EXPECT_NULL, .call = api_case_152},
-    {.function = "pd_edr_alloc", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_153},
-    {.function = "pd_edr_free", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_154},
-    {.function = "pd_edr_run", .argument = "r", .expect = EXPECT_ERROR, .call = api_case_155},
-    {.function = "pd_edr_run", .argument = "q0", .expect = EXPECT_NOCRASH, .call = api_case_156},
-    {.function = "pd_edr_run", .argument = "v0", .expect = EXPECT_NOCRASH, .call = api_case_157},
-    {.function = "pd_edr_result_of", .argument = "r", .expect = EXPECT_NULL, .call = api_case_158},
-    {.function = "pd_ed_sdof_run", .argument = "prob", .expect = EXPECT_ERROR, .call = api_case_159},
-    {.function = "pd_ed_sdof_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_160},
-    {.function = "pd_ed_sdof_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_161},
-    {.function = "pd_pulse_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_162},
-    {.function = "pd_pulse_parse", .argument = "pulse", .expect = EXPECT_ERROR, .call = api_case_163},
-    {.function = "pd_dir_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_164},
-    {.function = "pd_dir_parse", .argument = "dir", .expect = EXPECT_ERROR, .call = api_case_165},
-    {.function = "pd_record_format_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_166},
-    {.function = "pd_record_format_parse", .argument = "f", .expect = EXPECT_ERROR, .call = api_case_167},
-    {.function = "pd_record_units_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_168},
-    {.function = "pd_record_units_parse", .argument = "u", .expect = EXPECT_ERROR, .call = api_case_169},
-    {.function = "pd_record_read", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_170},
-    {.function = "pd_record_read", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_171},
-    {.function = "pd_record_free", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_172},
-    {.function = "pd_record_detect", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_173},
-    {.function = "pd_record_detect", .argument = "format", .expect = EXPECT_ERROR, .call = api_case_174},
-    {.function = "pd_record_plausible", .argument = "rec", .expect = EXPECT_COUNT, .call = api_case_175},
-    {.function = "pd_record_plausible", .argument = "msg", .expect = EXPECT_NOCRASH, .call = api_case_176},
-    {.function = "pd_record_from_array", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_177},
-    {.function = "pd_record_from_array", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_178},
-    {.function = "pd_record_from_array", .argument = "acc", .expect = EXPECT_ERROR, .call = api_case_179},
-    {.function = "pd_record_duration", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_180},
-    {.function = "pd_record_acc", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_181},
-    {.function = "pd_record_measure", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_182},
-    {.function = "pd_record_measure", .argument = "m", .expect = EXPECT_ERROR, .call = api_case_183},
-    {.function = "pd_record_integrate", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_184},
-    {.function = "pd_record_integrate", .argument = "vel", .expect = EXPECT_ERROR, .call = api_case_185},
-    {.function = "pd_record_integrate", .argument = "disp", .expect = EXPECT_ERROR, .call = api_case_186},
-    {.function = "pd_record_fit_pulse", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_187},
-    {.function = "pd_record_fit_pulse", .argument = "p", .expect = EXPECT_ERROR, .call = api_case_188},
-    {.function = "pd_record_pulse_eval", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_189},
-    {.function = "pd_record_pulse_eval", .argument = "acc", .expect = EXPECT_NOCRASH, .call = api_case_190},
-    {.function = "pd_record_pulse_eval", .argument = "vel", .expect = EXPECT_NOCRASH, .call = api_case_191},
-    {.function = "pd_record_one_cycle", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_192},
-    {.function = "pd_method_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_193},
-    {.function = "pd_method_parse", .argument = "method", .expect = EXPECT_ERROR, .call = api_case_194},
-    {.function = "pd_run_opts_check", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_195},
-    {.function = "pd_osc_wp", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_196},
-    {.function = "pd_osc_T0", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_197},
-    {.function = "pd_osc_gap", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_198},
-    {.function = "pd_osc_Le", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_199},
-    {.function = "pd_osc_set_T0", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_200},
-    {.function = "pd_osc_set_gap", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_201},
-    {.function = "pd_osc_excitation", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_202},
-    {.function = "pd_osc_set_record", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_203},
-    {.function = "pd_osc_set_record", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_204},
-    {.function = "pd_osc_set_record", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_205},
-    {.function = "pd_osc_shape", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_206},
-    {.function = "pd_osc_shape_rate", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_207},
-    {.function = "pd_osc_shape_end", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_208},
-    {.function = "pd_osc_pieces", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_209},
-    {.function = "pd_osc_pieces", .argument = "pieces", .expect = EXPECT_ERROR, .call = api_case_210},
-    {.function = "pd_osc_pieces", .argument = "npieces", .expect = EXPECT_ERROR, .call = api_case_211},
-    {.function = "pd_osc_excitation_name", .argument = "c", .expect = EXPECT_NAME, .call = api_case_212},
-    {.function = "pd_osc_check", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_213},
-    {.function = "pd_osc_resolve_opts", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_214},
-    {.function = "pd_osc_resolve_opts", .argument = "in", .expect = EXPECT_NOCRASH, .call = api_case_215},
-    {.function = "pd_osc_resolve_opts", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_216},
-    {.function = "pd_osc_default_dt", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_217},
-    {.function = "pd_osc_default_tend", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_218},
-    {.function = "pd_osc_measure_start", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_219},
-    {.function = "pd_osc_method", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_220},
-    {.function = "pd_osc_method", .argument = "o", .expect = EXPECT_NOCRASH, .call = api_case_221},
-    {.function = "pd_osc_run", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_222},
-    {.function = "pd_osc_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_223},
-    {.function = "pd_osc_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_224},
-    {.function = "pd_osc_batchable", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_225},
-    {.function = "pd_osc_batchable", .argument = "o", .expect = EXPECT_COUNT, .call = api_case_226},
-    {.function = "pd_osc_scan_points", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_227},
-    {.function = "pd_osc_simulate", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_228},
-    {.function = "pd_osc_simulate", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_229},
-    {.function = "pd_osc_simulate", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_230},
-    {.function = "pd_osc_reference", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_231},
-    {.function = "pd_osc_reference", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_232},
-    {.function = "pd_osc_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_233},
-    {.function = "pd_osc_penalty", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_234},
-    {.function = "pd_osc_penalty", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_235},
-    {.function = "pd_osc_penalty", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_236},
-    {.function = "pd_osc_summarize", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_237},
-    {.function = "pd_osc_summarize", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_238},
-    {.function = "pd_osc_summarize", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_239},
-    {.function = "pd_osc_free_exact", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_240},
-    {.function = "pd_osc_free_exact", .argument = "u", .expect = EXPECT_NOCRASH, .call = api_case_241},
-    {.function = "pd_osc_free_exact", .argument = "v", .expect = EXPECT_NOCRASH, .call = api_case_242},
-    {.function = "pd_osc_free_first_contact", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_243},
-    {.function = "pd_osc_free_first_contact", .argument = "t", .expect = EXPECT_ERROR, .call = api_case_244},
-    {.function = "pd_osc_free_first_contact", .argument = "v", .expect = EXPECT_ERROR, .call = api_case_245},
-    {.function = "pd_trace_alloc", .argument = "tr", .expect = EXPECT_ERROR, .call = api_case_246},
-    {.function = "pd_trace_alloc", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_247},
-    {.function = "pd_trace_free", .argument = "tr", .expect = EXPECT_NOCRASH, .call = api_case_248},
-    {.function = "pd_measure_reference", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_249},
-    {.function = "pd_measure_reference", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_250},
-    {.function = "pd_measure_reference", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_251},
-    {.function = "pd_measure_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_252},
-    {.function = "pd_measure_run", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_253},
-    {.function = "pd_measure_run", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_254},
-    {.function = "pd_measure_run", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_255},
-    {.function = "pd_measure_run", .argument = "work", .expect = EXPECT_ERROR, .call = api_case_256},
-    {.function = "pd_measure_run", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_257},
-    {.function = "pd_scene_new", .argument = "exc", .expect = EXPECT_NOCRASH, .call = api_case_258},
-    {.function = "pd_scene_free", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_259},
-    {.function = "pd_scene_add_sdof", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_260},
-    {.function = "pd_scene_add_sdof", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_261},
-    {.function = "pd_scene_add_building", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_262},
-    {.function = "pd_scene_add_building", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_263},
-    {.function = "pd_scene_add_building", .argument = "masses", .expect = EXPECT_ERROR, .call = api_case_264},
-    {.function = "pd_scene_add_building", .argument = "stiffnesses", .expect = EXPECT_ERROR, .call = api_case_265},
-    {.function = "pd_scene_add_uniform", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_266},
-    {.function = "pd_scene_add_uniform", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_267},
-    {.function = "pd_scene_set_damping", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_268},
-    {.function = "pd_scene_set_heights", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_269},
-    {.function = "pd_scene_set_heights", .argument = "heights", .expect = EXPECT_ERROR, .call = api_case_270},
-    {.function = "pd_scene_add_contact", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_271},
-    {.function = "pd_scene_copy", .argument = "sc", .expect = EXPECT_NULL, .call = api_case_272},
-    {.function = "pd_scene_find", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_273},
-    {.function = "pd_scene_find", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_274},
-    {.function = "pd_scene_finish", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_275},
-    {.function = "pd_scene_load", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_276},
-    {.function = "pd_scene_load", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_277},
-    {.function = "pd_scene_chain", .argument = "exc", .expect = EXPECT_ERROR, .call = api_case_278},
-    {.function = "pd_scene_chain", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_279},
-    {.function = "pd_scene_wp", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_280},
-    {.function = "pd_scene_Le", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_281},
-    {.function = "pd_scene_default_dt", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_282},
-    {.function = "pd_scene_default_tend", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_283},
-    {.function = "pd_scene_measure_start", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_284},
-    {.function = "pd_scene_resolve_opts", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_285},
-    {.function = "pd_scene_resolve_opts", .argument = "in", .expect = EXPECT_NOCRASH, .call = api_case_286},
-    {.function = "pd_scene_resolve_opts", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_287},
-    {.function = "pd_scene_as_oscillator", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_288},
-    {.function = "pd_scene_as_oscillator", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_289},
-    {.function = "pd_scene_as_oscillator", .argument = "mirrored", .expect = EXPECT_COUNT, .call = api_case_290},
-    {.function = "pd_scene_model_build", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_291},
-    {.function = "pd_scene_model_build", .argument = "sm", .expect = EXPECT_ERROR, .call = api_case_292},
-    {.function = "pd_scene_model_free", .argument = "sm", .expect = EXPECT_NOCRASH, .call = api_case_293},
-    {.function = "pd_scene_result_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_294},
-    {.function = "pd_scene_result_alloc", .argument = "r", .expect = EXPECT_ERROR, .call = api_case_295},
-    {.function = "pd_scene_result_fits", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_296},
-    {.function = "pd_scene_result_fits", .argument = "r", .expect = EXPECT_COUNT, .call = api_case_297},
-    {.function = "pd_scene_result_free", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_298},
-    {.function = "pd_scene_run", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_299},
-    {.function = "pd_scene_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_300},
-    {.function = "pd_scene_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_301},
-    {.function = "pd_scene_summarize", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_302},
-    {.function = "pd_scene_summarize", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_303},
-    {.function = "pd_scene_summarize", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_304},
-    {.function = "pd_scene_summary_free", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_305},
-    {.function = "pd_scene_trace_alloc", .argument = "tr", .expect = EXPECT_ERROR, .call = api_case_306},
-    {.function = "pd_scene_trace_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_307},
-    {.function = "pd_scene_trace_alloc", .argument = "o", .expect = EXPECT_NOCRASH, .call = api_case_308},
-    {.function = "pd_scene_trace_free", .argument = "tr", .expect = EXPECT_NOCRASH, .call = api_case_309},
-    {.function = "pd_scene_errors_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_310},
-    {.function = "pd_scene_errors_alloc", .argument = "e", .expect = EXPECT_ERROR, .call = api_case_311},
-    {.function = "pd_scene_errors_free", .argument = "e", .expect = EXPECT_NOCRASH, .call = api_case_312},
-    {.function = "pd_scene_measure_reference", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_313},
-    {.function = "pd_scene_measure_reference", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_314},
-    {.function = "pd_scene_measure_reference", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_315},
-    {.function = "pd_scene_measure_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_316},
-    {.function = "pd_scene_measure_run", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_317},
-    {.function = "pd_scene_measure_run", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_318},
-    {.function = "pd_scene_measure_run", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_319},
-    {.function = "pd_scene_measure_run", .argument = "ref_res", .expect = EXPECT_ERROR, .call = api_case_320},
-    {.function = "pd_scene_measure_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_321},
-    {.function = "pd_scene_measure_run", .argument = "e", .expect = EXPECT_ERROR, .call = api_case_322},
-    {.function = "pd_spec_init", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_323},
-    {.function = "pd_spec_curves", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_324},
-    {.function = "pd_spec_points", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_325},
-    {.function = "pd_spec_twins", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_326},
-    {.function = "pd_spec_tasks", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_327},
-    {.function = "pd_spec_pi2", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_328},
-    {.function = "pd_spec_coords_of", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_329},
-    {.function = "pd_spec_coords_of", .argument = "co", .expect = EXPECT_NOCRASH, .call = api_case_330},
-    {.function = "pd_spec_twin_of", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_331},
-    {.function = "pd_spec_case", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_332},
-    {.function = "pd_spec_case", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_333},
-    {.function = "pd_spec_case", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_334},
-    {.function = "pd_spec_validate", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_335},
-    {.function = "pd_spec_resolve_method", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_336},
-    {.function = "pd_spec_run_task", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_337},
-    {.function = "pd_spec_run_task", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_338},
-    {.function = "pd_spec_stream", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_339},
-    {.function = "pd_spec_cost", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_340},
-    {.function = "pd_spec_key", .argument = "s", .expect = EXPECT_NULL, .call = api_case_341},
-    {.function = "pd_spec_rows", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_342},
-    {.function = "pd_spec_rows", .argument = "res", .expect = EXPECT_NOCRASH, .call = api_case_343},
-    {.function = "pd_spec_rows", .argument = "rows", .expect = EXPECT_NOCRASH, .call = api_case_344},
-    {.function = "pd_spec_curve_label", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_345},
-    {.function = "pd_spec_curve_label", .argument = "buf", .expect = EXPECT_NOCRASH, .call = api_case_346},
-    {.function = "pd_spec_sweep", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_347},
-    {.function = "pd_scene_sweep_twins", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_348},
-    {.function = "pd_scene_sweep_points", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_349},
-    {.function = "pd_scene_sweep_check", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_350},
-    {.function = "pd_scene_sweep_scene", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_351},
-    {.function = "pd_scene_sweep_scene", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_352},
-    {.function = "pd_scene_sweep_scene", .argument = "pt", .expect = EXPECT_ERROR, .call = api_case_353},
-    {.function = "pd_scene_sweep_run", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_354},
-    {.function = "pd_scene_sweep_run", .argument = "pts", .expect = EXPECT_ERROR, .call = api_case_355},
-    {.function = "pd_scene_sweep_run", .argument = "umax", .expect = EXPECT_ERROR, .call = api_case_356},
+    {.function = "pd_hermite3", .argument = "p0", .expect = EXPECT_NOCRASH, .call = api_case_8},
+    {.function = "pd_hermite3", .argument = "p1", .expect = EXPECT_NOCRASH, .call = api_case_9},
+    {.function = "pd_matrix_dense", .argument = "values", .expect = EXPECT_NOCRASH, .call = api_case_10},
+    {.function = "pd_matrix_csc", .argument = "colptr", .expect = EXPECT_NOCRASH, .call = api_case_11},
+    {.function = "pd_matrix_csc", .argument = "rowind", .expect = EXPECT_NOCRASH, .call = api_case_12},
+    {.function = "pd_matrix_csc", .argument = "values", .expect = EXPECT_NOCRASH, .call = api_case_13},
+    {.function = "pd_matrix_gemv", .argument = "A", .expect = EXPECT_NOCRASH, .call = api_case_14},
+    {.function = "pd_matrix_gemv", .argument = "x", .expect = EXPECT_NOCRASH, .call = api_case_15},
+    {.function = "pd_matrix_gemv", .argument = "y", .expect = EXPECT_NOCRASH, .call = api_case_16},
+    {.function = "pd_matrix_gemv_t", .argument = "A", .expect = EXPECT_NOCRASH, .call = api_case_17},
+    {.function = "pd_matrix_gemv_t", .argument = "x", .expect = EXPECT_NOCRASH, .call = api_case_18},
+    {.function = "pd_matrix_gemv_t", .argument = "y", .expect = EXPECT_NOCRASH, .call = api_case_19},
+    {.function = "pd_matrix_get", .argument = "A", .expect = EXPECT_NOCRASH, .call = api_case_20},
+    {.function = "pd_matrix_col_dot", .argument = "A", .expect = EXPECT_NOCRASH, .call = api_case_21},
+    {.function = "pd_matrix_col_dot", .argument = "x", .expect = EXPECT_NOCRASH, .call = api_case_22},
+    {.function = "pd_matrix_col_axpy", .argument = "A", .expect = EXPECT_NOCRASH, .call = api_case_23},
+    {.function = "pd_matrix_col_axpy", .argument = "y", .expect = EXPECT_NOCRASH, .call = api_case_24},
+    {.function = "pd_matrix_col_absdot", .argument = "A", .expect = EXPECT_NOCRASH, .call = api_case_25},
+    {.function = "pd_matrix_col_absdot", .argument = "x", .expect = EXPECT_NOCRASH, .call = api_case_26},
+    {.function = "pd_matrix_nnz", .argument = "A", .expect = EXPECT_NOCRASH, .call = api_case_27},
+    {.function = "pd_matrix_to_dense", .argument = "A", .expect = EXPECT_NOCRASH, .call = api_case_28},
+    {.function = "pd_matrix_to_dense", .argument = "out", .expect = EXPECT_NOCRASH, .call = api_case_29},
+    {.function = "pd_matrix_is_diagonal", .argument = "A", .expect = EXPECT_COUNT, .call = api_case_30},
+    {.function = "pd_matrix_check", .argument = "A", .expect = EXPECT_ERROR, .call = api_case_31},
+    {.function = "pd_matrix_check", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_32},
+    {.function = "pd_sparse_from_triplets", .argument = "sp", .expect = EXPECT_ERROR, .call = api_case_33},
+    {.function = "pd_sparse_from_triplets", .argument = "Ti", .expect = EXPECT_ERROR, .call = api_case_34},
+    {.function = "pd_sparse_from_triplets", .argument = "Tj", .expect = EXPECT_ERROR, .call = api_case_35},
+    {.function = "pd_sparse_from_triplets", .argument = "Tx", .expect = EXPECT_ERROR, .call = api_case_36},
+    {.function = "pd_sparse_free", .argument = "sp", .expect = EXPECT_NOCRASH, .call = api_case_37},
+    {.function = "pd_sparse_view", .argument = "sp", .expect = EXPECT_NOCRASH, .call = api_case_38},
+    {.function = "pd_dense_lu", .argument = "A", .expect = EXPECT_ERROR, .call = api_case_39},
+    {.function = "pd_dense_lu", .argument = "perm", .expect = EXPECT_ERROR, .call = api_case_40},
+    {.function = "pd_dense_lu_solve", .argument = "LU", .expect = EXPECT_NOCRASH, .call = api_case_41},
+    {.function = "pd_dense_lu_solve", .argument = "perm", .expect = EXPECT_NOCRASH, .call = api_case_42},
+    {.function = "pd_dense_lu_solve", .argument = "b", .expect = EXPECT_NOCRASH, .call = api_case_43},
+    {.function = "pd_text_open", .argument = "t", .expect = EXPECT_ERROR, .call = api_case_44},
+    {.function = "pd_text_open", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_45},
+    {.function = "pd_text_line", .argument = "t", .expect = EXPECT_ERROR, .call = api_case_46},
+    {.function = "pd_text_rewind", .argument = "t", .expect = EXPECT_ERROR, .call = api_case_47},
+    {.function = "pd_text_close", .argument = "t", .expect = EXPECT_NOCRASH, .call = api_case_48},
+    {.function = "pd_text_read_all", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_49},
+    {.function = "pd_text_read_all", .argument = "text", .expect = EXPECT_ERROR, .call = api_case_50},
+    {.function = "pd_text_read_all", .argument = "len", .expect = EXPECT_ERROR, .call = api_case_51},
+    {.function = "pd_lcp_free", .argument = "work", .expect = EXPECT_NOCRASH, .call = api_case_52},
+    {.function = "pd_lcp_nmax", .argument = "work", .expect = EXPECT_COUNT, .call = api_case_53},
+    {.function = "pd_lcp_lemke", .argument = "work", .expect = EXPECT_ERROR, .call = api_case_54},
+    {.function = "pd_lcp_lemke", .argument = "M", .expect = EXPECT_ERROR, .call = api_case_55},
+    {.function = "pd_lcp_lemke", .argument = "q", .expect = EXPECT_ERROR, .call = api_case_56},
+    {.function = "pd_lcp_lemke", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_57},
+    {.function = "pd_lcp_lemke", .argument = "z", .expect = EXPECT_ERROR, .call = api_case_58},
+    {.function = "pd_lcp_lemke", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_59},
+    {.function = "pd_lcp_lemke", .argument = "info", .expect = EXPECT_NOCRASH, .call = api_case_60},
+    {.function = "pd_lcp_enumerate", .argument = "M", .expect = EXPECT_ERROR, .call = api_case_61},
+    {.function = "pd_lcp_enumerate", .argument = "q", .expect = EXPECT_ERROR, .call = api_case_62},
+    {.function = "pd_lcp_enumerate", .argument = "z", .expect = EXPECT_ERROR, .call = api_case_63},
+    {.function = "pd_lcp_enumerate", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_64},
+    {.function = "pd_lcp_chain_q", .argument = "q", .expect = EXPECT_NOCRASH, .call = api_case_65},
+    {.function = "pd_lcp_residual", .argument = "M", .expect = EXPECT_NOCRASH, .call = api_case_66},
+    {.function = "pd_lcp_residual", .argument = "q", .expect = EXPECT_NOCRASH, .call = api_case_67},
+    {.function = "pd_lcp_residual", .argument = "z", .expect = EXPECT_NOCRASH, .call = api_case_68},
+    {.function = "pd_lcp_residual", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_69},
+    {.function = "pd_lcp_residual", .argument = "complementarity", .expect = EXPECT_NOCRASH, .call = api_case_70},
+    {.function = "pd_lcp_residual", .argument = "infeasibility", .expect = EXPECT_NOCRASH, .call = api_case_71},
+    {.function = "pd_lcp_residual", .argument = "residual", .expect = EXPECT_NOCRASH, .call = api_case_72},
+    {.function = "pd_lcp_method_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_73},
+    {.function = "pd_lcp_method_parse", .argument = "method", .expect = EXPECT_ERROR, .call = api_case_74},
+    {.function = "pd_lcp_solver_free", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_75},
+    {.function = "pd_lcp_solver_nmax", .argument = "s", .expect = EXPECT_COUNT, .call = api_case_76},
+    {.function = "pd_lcp_solve", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_77},
+    {.function = "pd_lcp_solve", .argument = "M", .expect = EXPECT_ERROR, .call = api_case_78},
+    {.function = "pd_lcp_solve", .argument = "q", .expect = EXPECT_ERROR, .call = api_case_79},
+    {.function = "pd_lcp_solve", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_80},
+    {.function = "pd_lcp_solve", .argument = "z", .expect = EXPECT_ERROR, .call = api_case_81},
+    {.function = "pd_lcp_solve", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_82},
+    {.function = "pd_lcp_solve", .argument = "info", .expect = EXPECT_NOCRASH, .call = api_case_83},
+    {.function = "pd_lcp_read", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_84},
+    {.function = "pd_lcp_read", .argument = "n", .expect = EXPECT_ERROR, .call = api_case_85},
+    {.function = "pd_lcp_read", .argument = "M", .expect = EXPECT_ERROR, .call = api_case_86},
+    {.function = "pd_lcp_read", .argument = "q", .expect = EXPECT_ERROR, .call = api_case_87},
+    {.function = "pd_lcp_read_band", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_88},
+    {.function = "pd_lcp_read_band", .argument = "n", .expect = EXPECT_ERROR, .call = api_case_89},
+    {.function = "pd_lcp_read_band", .argument = "M", .expect = EXPECT_ERROR, .call = api_case_90},
+    {.function = "pd_lcp_read_band", .argument = "q", .expect = EXPECT_ERROR, .call = api_case_91},
+    {.function = "pd_lcp_read_band", .argument = "band", .expect = EXPECT_NOCRASH, .call = api_case_92},
+    {.function = "pd_lcp_read_band", .argument = "nnz", .expect = EXPECT_NOCRASH, .call = api_case_93},
+    {.function = "pd_lcp_band_csc", .argument = "M", .expect = EXPECT_NOCRASH, .call = api_case_94},
+    {.function = "pd_lcp_band_csc", .argument = "colptr", .expect = EXPECT_NOCRASH, .call = api_case_95},
+    {.function = "pd_lcp_band_csc", .argument = "rowind", .expect = EXPECT_NOCRASH, .call = api_case_96},
+    {.function = "pd_lcp_band_csc", .argument = "values", .expect = EXPECT_NOCRASH, .call = api_case_97},
+    {.function = "pd_factor_kind_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_98},
+    {.function = "pd_factor_kind_parse", .argument = "kind", .expect = EXPECT_ERROR, .call = api_case_99},
+    {.function = "pd_model_check", .argument = "model", .expect = EXPECT_ERROR, .call = api_case_100},
+    {.function = "pd_factor_choose", .argument = "model", .expect = EXPECT_NOCRASH, .call = api_case_101},
+    {.function = "pd_mj_alloc", .argument = "model", .expect = EXPECT_NULL, .call = api_case_102},
+    {.function = "pd_mj_alloc", .argument = "opts", .expect = EXPECT_NULL, .call = api_case_103},
+    {.function = "pd_mj_free", .argument = "mj", .expect = EXPECT_NOCRASH, .call = api_case_104},
+    {.function = "pd_mj_reset", .argument = "mj", .expect = EXPECT_ERROR, .call = api_case_105},
+    {.function = "pd_mj_reset", .argument = "q0", .expect = EXPECT_NOCRASH, .call = api_case_106},
+    {.function = "pd_mj_reset", .argument = "v0", .expect = EXPECT_NOCRASH, .call = api_case_107},
+    {.function = "pd_mj_step", .argument = "mj", .expect = EXPECT_ERROR, .call = api_case_108},
+    {.function = "pd_mj_run", .argument = "mj", .expect = EXPECT_ERROR, .call = api_case_109},
+    {.function = "pd_mj_run_until", .argument = "mj", .expect = EXPECT_ERROR, .call = api_case_110},
+    {.function = "pd_mj_get_stats", .argument = "mj", .expect = EXPECT_ERROR, .call = api_case_111},
+    {.function = "pd_mj_get_stats", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_112},
+    {.function = "pd_mj_state", .argument = "mj", .expect = EXPECT_NULL, .call = api_case_113},
+    {.function = "pd_mj_kernel_name", .argument = "mj", .expect = EXPECT_NAME, .call = api_case_114},
+    {.function = "pd_mj_factor_name", .argument = "mj", .expect = EXPECT_NAME, .call = api_case_115},
+    {.function = "pd_mjb_init", .argument = "b", .expect = EXPECT_ERROR, .call = api_case_116},
+    {.function = "pd_mjb_init", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_117},
+    {.function = "pd_mjb_set_lane", .argument = "b", .expect = EXPECT_ERROR, .call = api_case_118},
+    {.function = "pd_mjb_set_lane", .argument = "ln", .expect = EXPECT_ERROR, .call = api_case_119},
+    {.function = "pd_mjb_run", .argument = "b", .expect = EXPECT_NOCRASH, .call = api_case_120},
+    {.function = "pd_mjb_finite", .argument = "b", .expect = EXPECT_COUNT, .call = api_case_121},
+    {.function = "pd_edg_run", .argument = "model", .expect = EXPECT_ERROR, .call = api_case_122},
+    {.function = "pd_edg_run", .argument = "q0", .expect = EXPECT_NOCRASH, .call = api_case_123},
+    {.function = "pd_edg_run", .argument = "v0", .expect = EXPECT_NOCRASH, .call = api_case_124},
+    {.function = "pd_edg_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_125},
+    {.function = "pd_edg_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_126},
+    {.function = "pd_penalty_run", .argument = "model", .expect = EXPECT_ERROR, .call = api_case_127},
+    {.function = "pd_penalty_run", .argument = "q0", .expect = EXPECT_NOCRASH, .call = api_case_128},
+    {.function = "pd_penalty_run", .argument = "v0", .expect = EXPECT_NOCRASH, .call = api_case_129},
+    {.function = "pd_penalty_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_130},
+    {.function = "pd_penalty_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_131},
+    {.function = "pd_sine_piece_force", .argument = "pc", .expect = EXPECT_NOCRASH, .call = api_case_132},
+    {.function = "pd_sdof_increment_piece", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_133},
+    {.function = "pd_sdof_increment_piece", .argument = "pc", .expect = EXPECT_NOCRASH, .call = api_case_134},
+    {.function = "pd_sdof_increment_piece", .argument = "du", .expect = EXPECT_NOCRASH, .call = api_case_135},
+    {.function = "pd_sdof_increment_piece", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_136},
+    {.function = "pd_sdof_advance_piece", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_137},
+    {.function = "pd_sdof_advance_piece", .argument = "pc", .expect = EXPECT_NOCRASH, .call = api_case_138},
+    {.function = "pd_sdof_advance_piece", .argument = "u1", .expect = EXPECT_NOCRASH, .call = api_case_139},
+    {.function = "pd_sdof_advance_piece", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_140},
+    {.function = "pd_sdof_flow_init", .argument = "f", .expect = EXPECT_NOCRASH, .call = api_case_141},
+    {.function = "pd_sdof_flow_init", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_142},
+    {.function = "pd_sdof_flow_init", .argument = "pc", .expect = EXPECT_NOCRASH, .call = api_case_143},
+    {.function = "pd_sdof_flow_at", .argument = "f", .expect = EXPECT_NOCRASH, .call = api_case_144},
+    {.function = "pd_sdof_flow_at", .argument = "du", .expect = EXPECT_NOCRASH, .call = api_case_145},
+    {.function = "pd_sdof_flow_at", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_146},
+    {.function = "pd_sdof_advance", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_147},
+    {.function = "pd_sdof_advance", .argument = "u1", .expect = EXPECT_NOCRASH, .call = api_case_148},
+    {.function = "pd_sdof_advance", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_149},
+    {.function = "pd_sdof_increment", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_150},
+    {.function = "pd_sdof_increment", .argument = "du", .expect = EXPECT_NOCRASH, .call = api_case_151},
+    {.function = "pd_sdof_increment", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_152},
+    {.function = "pd_edr_alloc", .argument = "model", .expect = EXPECT_NULL, .call = api_case_153},
+    {.function = "pd_edr_alloc", .argument = "force", .expect = EXPECT_NULL, .call = api_case_154},
+    {.function = "pd_edr_alloc", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_155},
+    {.function = "pd_edr_free", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_156},
+    {.function = "pd_edr_run", .argument = "r", .expect = EXPECT_ERROR, .call = api_case_157},
+    {.function = "pd_edr_run", .argument = "q0", .expect = EXPECT_NOCRASH, .call = api_case_158},
+    {.function = "pd_edr_run", .argument = "v0", .expect = EXPECT_NOCRASH, .call = api_case_159},
+    {.function = "pd_edr_result_of", .argument = "r", .expect = EXPECT_NULL, .call = api_case_160},
+    {.function = "pd_ed_sdof_run", .argument = "prob", .expect = EXPECT_ERROR, .call = api_case_161},
+    {.function = "pd_ed_sdof_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_162},
+    {.function = "pd_ed_sdof_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_163},
+    {.function = "pd_pulse_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_164},
+    {.function = "pd_pulse_parse", .argument = "pulse", .expect = EXPECT_ERROR, .call = api_case_165},
+    {.function = "pd_dir_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_166},
+    {.function = "pd_dir_parse", .argument = "dir", .expect = EXPECT_ERROR, .call = api_case_167},
+    {.function = "pd_record_format_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_168},
+    {.function = "pd_record_format_parse", .argument = "f", .expect = EXPECT_ERROR, .call = api_case_169},
+    {.function = "pd_record_units_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_170},
+    {.function = "pd_record_units_parse", .argument = "u", .expect = EXPECT_ERROR, .call = api_case_171},
+    {.function = "pd_record_read", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_172},
+    {.function = "pd_record_read", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_173},
+    {.function = "pd_record_free", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_174},
+    {.function = "pd_record_detect", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_175},
+    {.function = "pd_record_detect", .argument = "format", .expect = EXPECT_ERROR, .call = api_case_176},
+    {.function = "pd_record_plausible", .argument = "rec", .expect = EXPECT_COUNT, .call = api_case_177},
+    {.function = "pd_record_plausible", .argument = "msg", .expect = EXPECT_NOCRASH, .call = api_case_178},
+    {.function = "pd_record_from_array", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_179},
+    {.function = "pd_record_from_array", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_180},
+    {.function = "pd_record_from_array", .argument = "acc", .expect = EXPECT_ERROR, .call = api_case_181},
+    {.function = "pd_record_duration", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_182},
+    {.function = "pd_record_acc", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_183},
+    {.function = "pd_record_measure", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_184},
+    {.function = "pd_record_measure", .argument = "m", .expect = EXPECT_ERROR, .call = api_case_185},
+    {.function = "pd_record_integrate", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_186},
+    {.function = "pd_record_integrate", .argument = "vel", .expect = EXPECT_ERROR, .call = api_case_187},
+    {.function = "pd_record_integrate", .argument = "disp", .expect = EXPECT_ERROR, .call = api_case_188},
+    {.function = "pd_record_fit_pulse", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_189},
+    {.function = "pd_record_fit_pulse", .argument = "p", .expect = EXPECT_ERROR, .call = api_case_190},
+    {.function = "pd_record_pulse_eval", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_191},
+    {.function = "pd_record_pulse_eval", .argument = "acc", .expect = EXPECT_NOCRASH, .call = api_case_192},
+    {.function = "pd_record_pulse_eval", .argument = "vel", .expect = EXPECT_NOCRASH, .call = api_case_193},
+    {.function = "pd_record_one_cycle", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_194},
+    {.function = "pd_method_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_195},
+    {.function = "pd_method_parse", .argument = "method", .expect = EXPECT_ERROR, .call = api_case_196},
+    {.function = "pd_run_opts_check", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_197},
+    {.function = "pd_osc_wp", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_198},
+    {.function = "pd_osc_T0", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_199},
+    {.function = "pd_osc_gap", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_200},
+    {.function = "pd_osc_Le", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_201},
+    {.function = "pd_osc_set_T0", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_202},
+    {.function = "pd_osc_set_gap", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_203},
+    {.function = "pd_osc_excitation", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_204},
+    {.function = "pd_osc_set_record", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_205},
+    {.function = "pd_osc_set_record", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_206},
+    {.function = "pd_osc_set_record", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_207},
+    {.function = "pd_osc_shape", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_208},
+    {.function = "pd_osc_shape_rate", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_209},
+    {.function = "pd_osc_shape_end", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_210},
+    {.function = "pd_osc_pieces", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_211},
+    {.function = "pd_osc_pieces", .argument = "pieces", .expect = EXPECT_ERROR, .call = api_case_212},
+    {.function = "pd_osc_pieces", .argument = "npieces", .expect = EXPECT_ERROR, .call = api_case_213},
+    {.function = "pd_osc_excitation_name", .argument = "c", .expect = EXPECT_NAME, .call = api_case_214},
+    {.function = "pd_osc_check", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_215},
+    {.function = "pd_osc_resolve_opts", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_216},
+    {.function = "pd_osc_resolve_opts", .argument = "in", .expect = EXPECT_NOCRASH, .call = api_case_217},
+    {.function = "pd_osc_resolve_opts", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_218},
+    {.function = "pd_osc_default_dt", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_219},
+    {.function = "pd_osc_default_tend", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_220},
+    {.function = "pd_osc_measure_start", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_221},
+    {.function = "pd_osc_method", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_222},
+    {.function = "pd_osc_method", .argument = "o", .expect = EXPECT_NOCRASH, .call = api_case_223},
+    {.function = "pd_osc_run", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_224},
+    {.function = "pd_osc_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_225},
+    {.function = "pd_osc_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_226},
+    {.function = "pd_osc_batchable", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_227},
+    {.function = "pd_osc_batchable", .argument = "o", .expect = EXPECT_COUNT, .call = api_case_228},
+    {.function = "pd_osc_scan_points", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_229},
+    {.function = "pd_osc_simulate", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_230},
+    {.function = "pd_osc_simulate", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_231},
+    {.function = "pd_osc_simulate", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_232},
+    {.function = "pd_osc_reference", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_233},
+    {.function = "pd_osc_reference", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_234},
+    {.function = "pd_osc_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_235},
+    {.function = "pd_osc_penalty", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_236},
+    {.function = "pd_osc_penalty", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_237},
+    {.function = "pd_osc_penalty", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_238},
+    {.function = "pd_osc_summarize", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_239},
+    {.function = "pd_osc_summarize", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_240},
+    {.function = "pd_osc_summarize", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_241},
+    {.function = "pd_osc_free_exact", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_242},
+    {.function = "pd_osc_free_exact", .argument = "u", .expect = EXPECT_NOCRASH, .call = api_case_243},
+    {.function = "pd_osc_free_exact", .argument = "v", .expect = EXPECT_NOCRASH, .call = api_case_244},
+    {.function = "pd_osc_free_first_contact", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_245},
+    {.function = "pd_osc_free_first_contact", .argument = "t", .expect = EXPECT_ERROR, .call = api_case_246},
+    {.function = "pd_osc_free_first_contact", .argument = "v", .expect = EXPECT_ERROR, .call = api_case_247},
+    {.function = "pd_trace_alloc", .argument = "tr", .expect = EXPECT_ERROR, .call = api_case_248},
+    {.function = "pd_trace_alloc", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_249},
+    {.function = "pd_trace_free", .argument = "tr", .expect = EXPECT_NOCRASH, .call = api_case_250},
+    {.function = "pd_measure_reference", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_251},
+    {.function = "pd_measure_reference", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_252},
+    {.function = "pd_measure_reference", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_253},
+    {.function = "pd_measure_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_254},
+    {.function = "pd_measure_run", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_255},
+    {.function = "pd_measure_run", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_256},
+    {.function = "pd_measure_run", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_257},
+    {.function = "pd_measure_run", .argument = "work", .expect = EXPECT_ERROR, .call = api_case_258},
+    {.function = "pd_measure_run", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_259},
+    {.function = "pd_scene_new", .argument = "exc", .expect = EXPECT_NOCRASH, .call = api_case_260},
+    {.function = "pd_scene_free", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_261},
+    {.function = "pd_scene_add_sdof", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_262},
+    {.function = "pd_scene_add_sdof", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_263},
+    {.function = "pd_scene_add_building", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_264},
+    {.function = "pd_scene_add_building", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_265},
+    {.function = "pd_scene_add_building", .argument = "masses", .expect = EXPECT_ERROR, .call = api_case_266},
+    {.function = "pd_scene_add_building", .argument = "stiffnesses", .expect = EXPECT_ERROR, .call = api_case_267},
+    {.function = "pd_scene_add_uniform", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_268},
+    {.function = "pd_scene_add_uniform", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_269},
+    {.function = "pd_scene_set_damping", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_270},
+    {.function = "pd_scene_set_heights", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_271},
+    {.function = "pd_scene_set_heights", .argument = "heights", .expect = EXPECT_ERROR, .call = api_case_272},
+    {.function = "pd_scene_add_contact", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_273},
+    {.function = "pd_scene_copy", .argument = "sc", .expect = EXPECT_NULL, .call = api_case_274},
+    {.function = "pd_scene_find", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_275},
+    {.function = "pd_scene_find", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_276},
+    {.function = "pd_scene_finish", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_277},
+    {.function = "pd_scene_load", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_278},
+    {.function = "pd_scene_load", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_279},
+    {.function = "pd_scene_chain", .argument = "exc", .expect = EXPECT_ERROR, .call = api_case_280},
+    {.function = "pd_scene_chain", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_281},
+    {.function = "pd_scene_wp", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_282},
+    {.function = "pd_scene_Le", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_283},
+    {.function = "pd_scene_default_dt", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_284},
+    {.function = "pd_scene_default_tend", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_285},
+    {.function = "pd_scene_measure_start", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_286},
+    {.function = "pd_scene_resolve_opts", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_287},
+    {.function = "pd_scene_resolve_opts", .argument = "in", .expect = EXPECT_NOCRASH, .call = api_case_288},
+    {.function = "pd_scene_resolve_opts", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_289},
+    {.function = "pd_scene_as_oscillator", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_290},
+    {.function = "pd_scene_as_oscillator", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_291},
+    {.function = "pd_scene_as_oscillator", .argument = "mirrored", .expect = EXPECT_COUNT, .call = api_case_292},
+    {.function = "pd_scene_model_build", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_293},
+    {.function = "pd_scene_model_build", .argument = "sm", .expect = EXPECT_ERROR, .call = api_case_294},
+    {.function = "pd_scene_model_free", .argument = "sm", .expect = EXPECT_NOCRASH, .call = api_case_295},
+    {.function = "pd_scene_result_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_296},
+    {.function = "pd_scene_result_alloc", .argument = "r", .expect = EXPECT_ERROR, .call = api_case_297},
+    {.function = "pd_scene_result_fits", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_298},
+    {.function = "pd_scene_result_fits", .argument = "r", .expect = EXPECT_COUNT, .call = api_case_299},
+    {.function = "pd_scene_result_free", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_300},
+    {.function = "pd_scene_run", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_301},
+    {.function = "pd_scene_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_302},
+    {.function = "pd_scene_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_303},
+    {.function = "pd_scene_summarize", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_304},
+    {.function = "pd_scene_summarize", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_305},
+    {.function = "pd_scene_summarize", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_306},
+    {.function = "pd_scene_summary_free", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_307},
+    {.function = "pd_scene_trace_alloc", .argument = "tr", .expect = EXPECT_ERROR, .call = api_case_308},
+    {.function = "pd_scene_trace_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_309},
+    {.function = "pd_scene_trace_alloc", .argument = "o", .expect = EXPECT_NOCRASH, .call = api_case_310},
+    {.function = "pd_scene_trace_free", .argument = "tr", .expect = EXPECT_NOCRASH, .call = api_case_311},
+    {.function = "pd_scene_errors_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_312},
+    {.function = "pd_scene_errors_alloc", .argument = "e", .expect = EXPECT_ERROR, .call = api_case_313},
+    {.function = "pd_scene_errors_free", .argument = "e", .expect = EXPECT_NOCRASH, .call = api_case_314},
+    {.function = "pd_scene_measure_reference", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_315},
+    {.function = "pd_scene_measure_reference", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_316},
+    {.function = "pd_scene_measure_reference", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_317},
+    {.function = "pd_scene_measure_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_318},
+    {.function = "pd_scene_measure_run", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_319},
+    {.function = "pd_scene_measure_run", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_320},
+    {.function = "pd_scene_measure_run", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_321},
+    {.function = "pd_scene_measure_run", .argument = "ref_res", .expect = EXPECT_ERROR, .call = api_case_322},
+    {.function = "pd_scene_measure_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_323},
+    {.function = "pd_scene_measure_run", .argument = "e", .expect = EXPECT_ERROR, .call = api_case_324},
+    {.function = "pd_spec_init", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_325},
+    {.function = "pd_spec_curves", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_326},
+    {.function = "pd_spec_points", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_327},
+    {.function = "pd_spec_twins", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_328},
+    {.function = "pd_spec_tasks", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_329},
+    {.function = "pd_spec_pi2", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_330},
+    {.function = "pd_spec_coords_of", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_331},
+    {.function = "pd_spec_coords_of", .argument = "co", .expect = EXPECT_NOCRASH, .call = api_case_332},
+    {.function = "pd_spec_twin_of", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_333},
+    {.function = "pd_spec_case", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_334},
+    {.function = "pd_spec_case", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_335},
+    {.function = "pd_spec_case", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_336},
+    {.function = "pd_spec_validate", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_337},
+    {.function = "pd_spec_resolve_method", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_338},
+    {.function = "pd_spec_run_task", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_339},
+    {.function = "pd_spec_run_task", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_340},
+    {.function = "pd_spec_stream", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_341},
+    {.function = "pd_spec_cost", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_342},
+    {.function = "pd_spec_key", .argument = "s", .expect = EXPECT_NULL, .call = api_case_343},
+    {.function = "pd_spec_rows", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_344},
+    {.function = "pd_spec_rows", .argument = "res", .expect = EXPECT_NOCRASH, .call = api_case_345},
+    {.function = "pd_spec_rows", .argument = "rows", .expect = EXPECT_NOCRASH, .call = api_case_346},
+    {.function = "pd_spec_curve_label", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_347},
+    {.function = "pd_spec_curve_label", .argument = "buf", .expect = EXPECT_NOCRASH, .call = api_case_348},
+    {.function = "pd_spec_sweep", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_349},
+    {.function = "pd_scene_sweep_twins", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_350},
+    {.function = "pd_scene_sweep_points", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_351},
+    {.function = "pd_scene_sweep_check", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_352},
+    {.function = "pd_scene_sweep_scene", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_353},
+    {.function = "pd_scene_sweep_scene", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_354},
+    {.function = "pd_scene_sweep_scene", .argument = "pt", .expect = EXPECT_ERROR, .call = api_case_355},
+    {.function = "pd_scene_sweep_run", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_356},
+    {.function = "pd_scene_sweep_run", .argument = "pts", .expect = EXPECT_ERROR, .call = api_case_357},
+    {.function = "pd_scene_sweep_run", .argument = "umax", .expect = EXPECT_ERROR, .call = api_case_358},
 };
-const int api_null_ncases = 357;
-const int api_null_nfunctions = 211;
+const int api_null_ncases = 359;
+const int api_null_nfunctions = 212;

@@ -23,12 +23,14 @@ SCHEME_KEYS = ("method", "dt", "tend", "theta", "gamma", "allow_unstable", "no_a
 CASE_KEYS = MODEL_KEYS + RECORD_KEYS + SCHEME_KEYS
 # cli/case.c: the keywords only one method takes choose it (moreau 0,
 # event 1, penalty 2) unless method says another; the flags only
-# (allow_unstable, no_accumulation) when true
+# (allow_unstable, no_accumulation) when true.  rtol is two methods': alone it
+# chooses moreau (Moreau-Jean to a tolerance), with penalty it is the
+# integrator's tolerance (case_rtol below)
 IMPLIES = {"dt": 0, "theta": 0, "gamma": 0, "allow_unstable": 0, "kernel": 0, "factor": 0,
            "lcp_solver": 0, "dt_per_Tp": 0, "no_accumulation": 1, "close_tol": 1, "kc": 2,
-           "kc_abs": 2,
-           "rtol": 2, "atol": 2, "contact": 2, "stepper": 2}
+           "kc_abs": 2, "atol": 2, "contact": 2, "stepper": 2}
 PD_METHOD_AUTO = 3
+PD_RTOL_MIN = 1e-12  # the tightest tolerance of Moreau-Jean's steps
 
 STEPPERS = {"rk8pd": b"rk8pd", "rkf45": b"rkf45", "rk4imp": b"rk4imp", "msbdf": b"msbdf"}
 CASE_MAX_STEPS = 2e9
@@ -191,11 +193,16 @@ def _check_scheme(o, have):
     _demand.check_opts(o, have)
 
 
-def scheme_opts(kw):
+def scheme_opts(kw, listed=False):
     """pd_run_opts from the scheme keywords (pd_run_default_opts() first):
-    (opts, which were given).  Unknown keys are the caller's."""
+    (opts, which were given).  Unknown keys are the caller's.  As cli/case.c
+    case_finish: the method given or implied (case_method), rtol to the
+    method that takes it (case_rtol), then the ranges (check_scheme).
+    listed: the methods are the caller's list (compare, converge: rtol is
+    then the penalty rows' integrator tolerance and chooses no method)."""
     o = _lib.default_opts()
     have = {}
+    rtol = None
     for key in SCHEME_KEYS:
         if key not in kw or kw[key] is None:
             continue
@@ -222,13 +229,39 @@ def scheme_opts(kw):
             o.pen.kc_mult = number(key, v)
         elif key == "kc_abs":
             o.pen.kc_abs = number(key, v)
-        elif key in ("rtol", "atol"):
-            setattr(o.pen, key, number(key, v))
+        elif key == "rtol":
+            rtol = number(key, v)
+        elif key == "atol":
+            o.pen.atol = number(key, v)
         elif key == "stepper":
             o.pen.stepper = STEPPERS[_args.choice(key, v, STEPPERS)]
+    have["method_by"] = _method_by(o, kw, listed)
+    if rtol is not None:
+        case_rtol(o, rtol, have, listed)
     _check_scheme(o, have)
-    have["method_by"] = _method_by(o, kw)
     return o, have
+
+
+def case_rtol(o, rtol, have, listed=False, dt_key="dt"):
+    """cli/case.c case_rtol: rtol to the method that takes it.  Moreau-Jean
+    (method moreau or auto, which it makes moreau) steps to the tolerance
+    (o.rtol); with method penalty (or listed methods) it is the GSL
+    integrator's tolerance (o.pen.rtol); refused with dt (fixed steps) and
+    with the methods that have none."""
+    if not PD_RTOL_MIN <= rtol < 1.0:
+        raise InputError("rtol: the relative tolerance must be in [%g, 1) (got %s)"
+                         % (PD_RTOL_MIN, fmt(rtol)))
+    if o.method == 2 or listed:
+        o.pen.rtol = rtol
+        return
+    if o.method not in (0, PD_METHOD_AUTO):
+        raise InputError("rtol: the tolerance of moreau's steps or of penalty's integrator; "
+                         "method %s has none" % _lib.s(lib.pd_method_name(o.method)))
+    if have.get("dt"):
+        raise InputError("rtol and %s: Moreau-Jean takes fixed steps (%s) or steps to a "
+                         "tolerance (rtol), not both" % (dt_key, dt_key))
+    o.method = 0
+    o.rtol = rtol
 
 
 def implied_method(kw, extra=()):
@@ -247,11 +280,15 @@ def implied_method(kw, extra=()):
     return chosen[0] if chosen else (None, None)
 
 
-def _method_by(o, kw):
-    """The method given, else the implied one set in o: what chose it."""
+def _method_by(o, kw, listed=False):
+    """The method given, else the implied one set in o: what chose it (rtol
+    alone chooses moreau, as cli/case.c case_method, but not among listed
+    methods)."""
     if "method" in kw and o.method != PD_METHOD_AUTO:
         return "--method"
     m, key = implied_method(kw)
+    if m is None and not listed and kw.get("rtol") is not None:
+        m, key = 0, "rtol"
     if m is None:
         return None
     o.method = m
@@ -260,9 +297,11 @@ def _method_by(o, kw):
 
 class Case:
     """The one-wall oscillator of a set of keywords: c (pd_osc) and opts
-    (pd_run_opts, resolved by resolve()), as `pound simulate` builds them."""
+    (pd_run_opts, resolved by resolve()), as `pound simulate` builds them
+    (listed: compare's and converge's, whose methods are a list: see
+    scheme_opts)."""
 
-    def __init__(self, kw, allowed=CASE_KEYS):
+    def __init__(self, kw, allowed=CASE_KEYS, listed=False):
         unknown = sorted(set(kw) - set(allowed))
         if unknown:
             raise TypeError("unexpected keyword argument%s %s (the case takes %s)"
@@ -272,7 +311,7 @@ class Case:
         self.kw = kw
         self.record = None
         c = _lib.default_osc()
-        self.opts, self.have = scheme_opts(kw)
+        self.opts, self.have = scheme_opts(kw, listed)
         if "pulse" in kw:
             c.pulse = parse_name("pulse", lib.pd_pulse_parse, kw["pulse"],
                                  "sine, cosine, harmonic")
@@ -344,6 +383,8 @@ class Case:
         dt = o.dt if have.get("dt") else lib.pd_osc_default_dt(c)
         if not math.isfinite(tend):
             raise InputError("T0: tend = Tp + 2 T0 overflows")
+        if o.rtol > 0.0:  # to a tolerance: no step count of its own
+            return
         if have.get("dt") and not dt < tend:
             raise InputError("%s: the step %.3g s is not shorter than the run (tend = %.3g s)"
                              % (dt_key, dt, tend))
@@ -361,7 +402,7 @@ class Case:
         self.finish_model()
         err = PdErr()
         _lib.check(lib.pd_osc_resolve_opts(self.c, self.opts, self.opts, err), err)
-        if self.opts.tend / self.opts.dt > 2e9:
+        if self.opts.rtol == 0.0 and self.opts.tend / self.opts.dt > 2e9:
             raise InputError("dt: %g s over %g s is more than 2e9 steps"
                              % (self.opts.dt, self.opts.tend))
         return self

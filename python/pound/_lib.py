@@ -131,7 +131,8 @@ class PdRunOpts(Structure):
                 ("factor", c_int), ("lcp_solver", c_int), ("no_accumulation", c_int),
                 ("no_wall", c_int), ("pen", PdPenaltySetup), ("on_lcp", c_void_p),
                 ("on_lcp_ctx", c_void_p), ("close_tol", c_double),
-                ("contact_duration", c_double), ("no_demands", c_int)]
+                ("contact_duration", c_double), ("no_demands", c_int),
+                ("rtol", c_double)]  # > 0: Moreau-Jean to a tolerance (pen.rtol: GSL's)
 
 
 class PdRecord(Structure):
@@ -171,16 +172,20 @@ class PdOscResult(Structure):
                 ("tend", c_double), ("theta", c_double), ("gamma", c_double),
                 ("cpu_s", c_double), ("kernel", c_char_p), ("acc_max", c_double),
                 ("force_max", c_double), ("force_equiv", c_double),
-                ("contact_duration", c_double)]
+                ("contact_duration", c_double),
+                # Moreau-Jean to a tolerance (fixed steps: rtol 0, err_est NAN, rtol_met 1)
+                ("rtol", c_double), ("err_est", c_double), ("rtol_met", c_int),
+                ("steps_rejected", c_long), ("dt_min", c_double), ("dt_max", c_double)]
 
 
 class PdOscSummary(Structure):
     _fields_ = [("r", PdOscResult), ("free", PdOscResult), ("Pi1", c_double),
-                ("gamma", c_double), ("chi", c_double), ("cpu_s", c_double)]
+                ("gamma", c_double), ("chi", c_double), ("cpu_s", c_double),
+                ("err_est", c_double), ("rtol_met", c_int)]
 
 
 class PdTrace(Structure):
-    _fields_ = [("u", POINTER(c_double)), ("n", c_long), ("cap", c_long)]
+    _fields_ = [("u", POINTER(c_double)), ("n", c_long), ("cap", c_long), ("dt", c_double)]
 
 
 class PdMeasured(Structure):
@@ -232,19 +237,25 @@ class PdSceneResult(Structure):
                 ("max_impulse", POINTER(c_double)), ("contact_time", POINTER(c_double)),
                 ("approach", POINTER(c_double)), ("steps", c_long), ("lcp_solves", c_long),
                 ("simultaneous", c_long), ("tol_closed", c_long), ("accumulations", c_long),
-                ("close_tol", c_double), ("dt", c_double), ("tend", c_double), ("theta", c_double), ("cpu_s", c_double),
+                ("close_tol", c_double), ("dt", c_double), ("tend", c_double),
+                ("theta", c_double), ("cpu_s", c_double),
                 ("method", c_char_p), ("kernel", c_char_p), ("factor", c_char_p),
                 ("lcp_solver", c_char_p), ("acc_max", POINTER(c_double)),
                 ("shear_max", POINTER(c_double)), ("drift_ratio", POINTER(c_double)),
                 ("force_max", POINTER(c_double)), ("force_equiv", POINTER(c_double)),
-                ("contact_duration", c_double)]
+                ("contact_duration", c_double),
+                # Moreau-Jean to a tolerance (fixed steps: rtol 0, err_est NAN, rtol_met 1)
+                ("rtol", c_double), ("err_est", POINTER(c_double)), ("err_est_max", c_double),
+                ("rtol_met", c_int), ("steps_rejected", c_long), ("dt_min", c_double),
+                ("dt_max", c_double), ("nstruct", c_int)]
 
 
 class PdSceneSummary(Structure):
     _fields_ = [("r", PdSceneResult), ("free", PdSceneResult),
                 ("Pi1", POINTER(c_double)), ("gamma", POINTER(c_double)),
                 ("Pi2", POINTER(c_double)), ("Pi3", POINTER(c_double)),
-                ("chi", POINTER(c_double)), ("cpu_s", c_double)]
+                ("chi", POINTER(c_double)), ("cpu_s", c_double), ("err_est", c_double),
+                ("rtol_met", c_int), ("err_est_structure", POINTER(c_double))]
 
 
 class PdSceneTrace(Structure):
@@ -553,10 +564,16 @@ def _fields(x):
     return x
 
 
-def _expect(what, got, want):
-    same = (got == want) or (isinstance(want, float) and isinstance(got, float)
+def _same(got, want):
+    """got == want, NaN equal to NaN, tuples element by element."""
+    if isinstance(want, tuple) and isinstance(got, tuple):
+        return len(got) == len(want) and all(_same(g, w) for g, w in zip(got, want))
+    return (got == want) or (isinstance(want, float) and isinstance(got, float)
                              and math.isnan(want) and math.isnan(got))
-    if not same:
+
+
+def _expect(what, got, want):
+    if not _same(got, want):
         _fail(what, "got %r where the library's defaults give %r" % (got, want))
 
 
@@ -586,7 +603,7 @@ def _check_layout():
             ("pd_run_opts.pen.rtol", o.pen.rtol, 1e-10),
             ("pd_run_opts.pen.atol", o.pen.atol, 1e-12),
             ("pd_run_opts.pen.stepper", s(o.pen.stepper), "rk8pd"),
-            ("pd_run_opts.on_lcp", o.on_lcp, None),
+            ("pd_run_opts.on_lcp", o.on_lcp, None), ("pd_run_opts.rtol", o.rtol, 0.0),
             ("pd_spectrum.npi2", sp.npi2, 0), ("pd_spectrum.npulse", sp.npulse, 1),
             ("pd_spectrum.neps", sp.neps, 1), ("pd_spectrum.dir", sp.dir[0], 1),
             ("pd_spectrum.ap", sp.ap[0], 1.0), ("pd_spectrum.xi", sp.xi[0], 0.05),
@@ -660,10 +677,25 @@ def _check_layout():
                               abs(seen[-1][1] - 0.01) < 1e-12,
                               abs(seen[-1][2] - (gap - seen[-1][3])) < 1e-12),
             (11, 0, 10, True, True))
+    # fixed steps: no tolerance (rtol 0, err_est NAN, rtol_met 1, dt_min = dt_max = dt)
+    _expect("pd_osc_result.rtol", (sm.r.rtol, sm.r.err_est, sm.r.rtol_met, sm.r.steps_rejected,
+                                   sm.r.dt_min, sm.r.dt_max, sm.free.rtol_met),
+            (0.0, math.nan, 1, 0, 0.001, 0.001, 1))
+    _expect("pd_osc_summary.err_est", (sm.err_est, sm.rtol_met), (math.nan, 1))
     tr = PdTrace()
     lib.pd_trace_alloc(tr, o)
-    _expect("pd_trace", (tr.n, tr.cap), (0, 12))
+    _expect("pd_trace", (tr.n, tr.cap, tr.dt), (0, 12, 0.001))
     lib.pd_trace_free(tr)
+    # Moreau-Jean to a tolerance (pd_run_opts.rtol): the asked tolerance and an estimate
+    o.dt, o.rtol = 0.0, 1e-3
+    sm = PdOscSummary()
+    check(lib.pd_osc_summarize(c, o, OscSampler(), None, sm, err), err)
+    r = sm.r
+    _expect("pd_osc_result.rtol", (r.rtol, r.rtol_met in (0, 1), math.isfinite(r.err_est),
+                                   r.steps_rejected >= 0, 0.0 < r.dt_min <= r.dt_max, r.tend),
+            (1e-3, True, True, True, True, 0.01))
+    _expect("pd_osc_summary.err_est", (sm.err_est, sm.rtol_met),
+            (max(r.err_est, sm.free.err_est), r.rtol_met & sm.free.rtol_met))
 
     # pd_lcp_info: a solve without a solver is refused after the info is cleared
     M = (c_double * 1)(2.0)
@@ -720,6 +752,11 @@ def _check_layout():
                                S.ct[0].b), (1, PD_WALL, 1, 0, 0.03, 0.5, 1, 1))
         _probe(PdSceneResult, lambda p: (lib.pd_scene_result_alloc(sc, p, err),
                                          lib.pd_scene_result_free(p)), "pd_scene_result")
+        sr = PdSceneResult()
+        check(lib.pd_scene_result_alloc(sc, sr, err), err)
+        _expect("pd_scene_result.nstruct", (sr.n, sr.m, sr.nstruct, bool(sr.err_est)),
+                (2, 2, 2, True))
+        lib.pd_scene_result_free(sr)
         o = default_opts()
         o.theta = 5.0  # refused after the summary is cleared
         _probe(PdSceneSummary, lambda p: (lib.pd_scene_summarize(sc, o, SceneSampler(), None,
@@ -747,6 +784,31 @@ def _check_layout():
                                         abs(seen[-1][1] - 0.003) < 1e-12,
                                         abs(seen[-1][3] - (0.03 - seen[-1][2])) < 1e-12),
                     (4, 3, True, True))
+            _expect("pd_scene_result.rtol", (ss.r.rtol, ss.r.err_est[1], ss.r.err_est_max,
+                                             ss.r.rtol_met, ss.r.steps_rejected, ss.r.dt_min,
+                                             ss.r.dt_max, ss.r.nstruct),
+                    (0.0, math.nan, math.nan, 1, 0, 0.001, 0.001, 2))
+            _expect("pd_scene_summary.err_est", (ss.err_est, ss.rtol_met,
+                                                 ss.err_est_structure[0]),
+                    (math.nan, 1, math.nan))
+        finally:
+            lib.pd_scene_summary_free(ss)
+        # to a tolerance: each structure's estimate, the larger of the run's and its twin's
+        o.dt, o.rtol = 0.0, 1e-3
+        ss = PdSceneSummary()
+        check(lib.pd_scene_summarize(sc, o, SceneSampler(), None, ss, err), err)
+        try:
+            r, f = ss.r, ss.free
+            _expect("pd_scene_result.rtol", (r.rtol, r.nstruct, r.rtol_met in (0, 1),
+                                             math.isfinite(r.err_est_max),
+                                             r.err_est_max == max(r.err_est[0], r.err_est[1]),
+                                             0.0 < r.dt_min <= r.dt_max),
+                    (1e-3, 2, True, True, True, True))
+            _expect("pd_scene_summary.err_est",
+                    (ss.err_est, ss.rtol_met, ss.err_est_structure[0],
+                     ss.err_est_structure[1]),
+                    (max(r.err_est_max, f.err_est_max), r.rtol_met & f.rtol_met,
+                     max(r.err_est[0], f.err_est[0]), max(r.err_est[1], f.err_est[1])))
         finally:
             lib.pd_scene_summary_free(ss)
     finally:

@@ -138,6 +138,22 @@ def _osc_sampler(h):
     return _lib.OscSampler(sample)
 
 
+def history_cap(o, every):
+    """Rows to start a history with: a fixed-step run's samples, or (steps
+    to a tolerance, dt 0: their number unknown) a start that grows."""
+    if o.rtol > 0.0 or not o.dt > 0.0:
+        return 4096
+    return lib.pd_steps_for(o.tend, o.dt) // every + 2
+
+
+def tolerance_fields(r, sm):
+    """The figures of Moreau-Jean to a tolerance (cmd_simulate.c's JSON): rtol
+    (0: fixed steps), err_est (NaN: fixed steps), rtol_met (a bool),
+    steps_rejected, dt_min, dt_max [s] (NaN: not Moreau-Jean)."""
+    return dict(rtol=r.rtol, err_est=sm.err_est, rtol_met=bool(sm.rtol_met),
+                steps_rejected=r.steps_rejected, dt_min=r.dt_min, dt_max=r.dt_max)
+
+
 def history_args(history, every):
     """The history switch and its stride, checked (every >= 1, an integer)."""
     history = _args.flag("history", history)
@@ -188,6 +204,15 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
     kc_abs, rtol, atol, stepper; height [3] m and contact_duration [0.005] s
     of the demands.
 
+    rtol, as the CLI's --rtol: Moreau-Jean to a tolerance, in [1e-12, 1):
+    steps chosen so that every peak (umax, u_toward, u_away, the drift,
+    acc_max) is within rtol of its value, relative, with an estimate of its
+    error (err_est); rtol alone chooses method 'moreau' (method_by
+    '--rtol'); with method='penalty' (or kc, ...) it is the GSL integrator's
+    tolerance [1e-10], as before.  With dt it raises InputError (fixed steps
+    or steps to a tolerance, not both), and with the methods that have no
+    tolerance (event, newmark).
+
     Returns a Result with the keys of the CLI's JSON: umax, u_toward,
     u_away, umax_free [m]; Pi1 = umax / Le, gamma = umax / umax_free, chi =
     gap / umax_free, Pi2, Pi3 (dimensionless); impacts, accumulations,
@@ -197,7 +222,15 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
     CPU]; method, method_by, pulse, dir, kernel (names); the demands per
     unit mass (docs/scenes.md, "Demands"): drift_ratio, acc_max [m/s^2],
     shear_max, force_equiv, force_max [N/kg] (NaN: not a penalty method),
-    height [m], contact_duration [s].  With history,
+    height [m], contact_duration [s]; Moreau-Jean to a tolerance: rtol (0:
+    fixed steps), err_est (the estimated relative error of the peaks, the
+    larger of the run's and its twin's; NaN for fixed steps, the CLI's null),
+    rtol_met (True when err_est <= rtol and no step floor or budget stopped
+    the refinement; True without a tolerance), steps_rejected (tries halved),
+    dt_min and dt_max [s] (the smallest and largest step kept: dt for fixed
+    steps, NaN for the other methods); steps counts every step taken (with
+    history the kept run is repeated for the sampler, as the CLI's -o).
+    With history,
     r.history: the arrays step, t, u, v, impulse, gap, impacts of every
     every-th step (the CLI's -o file: t [s], u [m], v [m/s], impulse per
     unit mass since the last sample [m/s], gap delta - u [m]; and the
@@ -209,7 +242,7 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
     o = k.opts
     h = sampler = None
     if history:
-        h = _History(OSC_SAMPLE, lib.pd_steps_for(o.tend, o.dt) // every + 2, every)
+        h = _History(OSC_SAMPLE, history_cap(o, every), every)
         sampler = _osc_sampler(h)
     sm = _lib.PdOscSummary()
     err = PdErr()
@@ -227,6 +260,7 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
                  max_impact_velocity=r.max_impact_velocity, max_impulse=r.max_impulse,
                  contact_time=r.contact_time, min_gap=r.min_gap, umax_free=sm.free.umax,
                  gamma=sm.gamma, chi=sm.chi, steps=r.steps, cpu_s=sm.cpu_s)
+    out.update(tolerance_fields(r, sm))
     _demand.osc_fields(out, r, height)
     _case_json(k, out)
     out.update(dt=r.dt, theta=r.theta, gamma_active=r.gamma, tend=r.tend, kernel=s(r.kernel))
@@ -290,13 +324,14 @@ def compare(methods: Names = ("moreau",), scene: Optional[Union[PathArg, "Scene"
     method; dimensionless, relative to the reference's umax), impacts and
     impacts_ref (counts), umax and umax_ref [m], dt [s], cpu_s and cpu_s_ref
     [s of CPU], and methods: one Result per method asked.  The case keywords
-    are simulate()'s."""
+    are simulate()'s, but rtol: the penalty rows' integrator tolerance
+    (Moreau-Jean runs on fixed steps dt here)."""
     want = parse_methods(methods)
     _scenes_only(want, scene)
     if scene is not None:
         from ._scene import compare_scene
         return compare_scene(scene, want, case)
-    k = Case(case).resolve()
+    k = Case(case, listed=True).resolve()
     o, err = k.opts, PdErr()
     tr = _Traces(o)
     try:
@@ -387,7 +422,8 @@ def converge(dts: Union[Range, Sequence[float]], theta: Floats = (0.5,),
     (dimensionless).  Returns a Result: rows (one Result per row: method,
     theta, dt [s], kc, err_umax_rel, err_hist_linf (dimensionless), cpu_s
     [s of CPU], order, impacts, steps) and cpu_s_ref [s of CPU]; a scene's
-    also impacts_ref and the reference's decisions."""
+    also impacts_ref and the reference's decisions.  The case keywords are
+    simulate()'s, but rtol: the penalty rows' integrator tolerance."""
     steps, dt_min, dt_first = _steps(dts)
     thetas = [number("theta", t) for t in _args.values("theta", theta)]
     if len(thetas) > 32:
@@ -410,7 +446,7 @@ def converge(dts: Union[Range, Sequence[float]], theta: Floats = (0.5,),
         from ._scene import SceneMeasurer
         meas = SceneMeasurer(scene, case)
     else:
-        meas = _OscMeasurer(Case(case).resolve())
+        meas = _OscMeasurer(Case(case, listed=True).resolve())
     try:
         rows, ref_cpu = _rows(meas, steps, dt_min, thetas, want_moreau, want_penalty, kcs,
                               error, want_general, want_newmark)

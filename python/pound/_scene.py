@@ -8,7 +8,7 @@ import numpy as np
 from . import _args, _demand, _lib
 from ._case import SCHEME_KEYS, Case, InputError, copy_opts, number, scheme_opts
 from ._lib import PD_WALL, PdErr, lib, s
-from ._osc import Result, _History, history_args
+from ._osc import Result, _History, history_args, history_cap, tolerance_fields
 from ._types import Int, PathArg
 
 SCENE_OPTS = SCHEME_KEYS
@@ -155,12 +155,18 @@ class Scene:
 
     def opts(self, kw: Dict[str, Any]) -> Tuple[Any, Any]:
         """The run options (pd_run_opts) of the scheme keywords, as given and
-        resolved for this scene (dt, tend [s] completed)."""
+        resolved for this scene (dt, tend [s] completed; to a tolerance,
+        rtol > 0, dt stays 0)."""
+        return self._opts(kw)
+
+    def _opts(self, kw, listed=False):
+        """opts(kw); listed: compare's and converge's (rtol: the penalty
+        rows' integrator tolerance)."""
         unknown = sorted(set(kw) - set(SCENE_OPTS))
         if unknown:
             raise TypeError("unexpected keyword argument(s) %s (a scene run takes %s)"
                             % (", ".join(unknown), ", ".join(SCENE_OPTS)))
-        o, have = scheme_opts({k: v for k, v in kw.items() if v is not None})
+        o, have = scheme_opts({k: v for k, v in kw.items() if v is not None}, listed)
         out, err = _lib.PdRunOpts(), PdErr()
         _lib.check(lib.pd_scene_resolve_opts(self._p, o, out, err), err)
         self._method_by = have["method_by"] or "default"
@@ -177,7 +183,16 @@ class Scene:
         drift_ratio, acc_max [m/s^2], shear_max, base_shear_max [N], per
         contact force_equiv, force_max [N] (NaN: not a penalty method), and
         contact_duration [s].  opts: the scheme keywords of simulate()
-        (method, dt, tend, theta, ..., contact_duration).  With
+        (method, dt, tend, theta, ..., contact_duration; rtol as there:
+        Moreau-Jean to a tolerance, or with method='penalty' the integrator's).
+        Moreau-Jean to a tolerance: rtol (0: fixed steps), err_est (the
+        largest estimated relative error of the peaks, umax, drift and
+        demands of every structure, the run's and its contact-free twin's;
+        NaN for fixed steps, the CLI's null) and per structure err_est (its
+        own), rtol_met (True when err_est <= rtol and no step floor or budget
+        stopped the refinement; True without a tolerance), steps_rejected
+        (tries halved), dt_min and dt_max [s] (the smallest and largest step
+        kept: dt for fixed steps, NaN for the other methods).  With
         history,
         r.history: step, t (N), x and v (N x dofs) [m, m/s], gap [m] and
         impulse [N s] (N x contacts), every every-th sample, the impulses
@@ -191,7 +206,7 @@ class Scene:
         if history:
             dtype = [("step", "i8"), ("t", "f8"), ("x", "f8", (n,)), ("v", "f8", (n,)),
                      ("gap", "f8", (m,)), ("impulse", "f8", (m,))]
-            h = _History(dtype, lib.pd_steps_for(o.tend, o.dt) // every + 2, every)
+            h = _History(dtype, history_cap(o, every), every)
             sampler = _scene_sampler(h, n, m)
         sm = _lib.PdSceneSummary()
         err = PdErr()
@@ -222,6 +237,7 @@ class Scene:
                      impacts=sum(r.impacts[c] for c in range(sc.ncontact)),
                      simultaneous=r.simultaneous, tol_closed=r.tol_closed,
                      accumulations=r.accumulations, close_tol=r.close_tol)
+        out.update(tolerance_fields(r, sm))
         x = self.excitation
         out["pulse"], out["dir"] = x["pulse"], x["dir"]
         if "record" in x:
@@ -237,7 +253,8 @@ class Scene:
             structs.append(Result(name=s(st.name), storeys=ns, T0=st.T0, Pi2=sm.Pi2[k],
                                   umax=part(r.umax), u_pos=part(r.u_pos), u_neg=part(r.u_neg),
                                   drift=part(r.drift), Pi1=part(sm.Pi1),
-                                  umax_free=part(sm.free.umax), gamma=part(sm.gamma)))
+                                  umax_free=part(sm.free.umax), gamma=part(sm.gamma),
+                                  err_est=sm.err_est_structure[k]))
         out["structures"] = structs
         contacts = []
         for a in range(sc.ncontact):
@@ -339,7 +356,7 @@ class SceneMeasurer:
         self.scene = scene if isinstance(scene, Scene) else Scene(scene)
         self.own = self.scene is not scene
         self.sc = self.scene._p
-        self.opts, _ = self.scene.opts(kw)  # checked and resolvable; kept unresolved
+        self.opts, _ = self.scene._opts(kw, listed=True)  # checked and resolvable; unresolved
         self.ref = _lib.PdSceneTrace()
         self.rr = _lib.PdSceneResult()
         self.res = _lib.PdSceneResult()
