@@ -449,8 +449,11 @@ static int case_rtol(pd_cli_case *a)
         a->opts.pen.rtol = a->rtol;
         return 0;
     }
-    if (a->methods_listed) /* compare, converge: the rows say */
+    if (a->methods_listed) { /* compare, converge: the penalty rows' (the commands refuse it
+                                without them; converge's rows to a tolerance take --rtols) */
+        a->opts.pen.rtol = a->rtol;
         return 0;
+    }
     if (m != PD_METHOD_MOREAU && m != PD_METHOD_AUTO)
         return pd_cli_usage_error("--rtol: the tolerance of moreau's steps or of penalty's "
                                   "integrator; --method %s has none", pd_method_name(m));

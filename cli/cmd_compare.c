@@ -168,6 +168,12 @@ int pd_cmd_compare(int argc, char **argv)
     }
     if ((rc = pd_cli_case_finish(&k)))
         return rc;
+    if (k.have_rtol && !want[PD_METHOD_PENALTY]) {
+        pd_cli_case_free(&k);
+        return pd_cli_usage_error("--rtol: in compare the penalty rows' integrator tolerance "
+                                  "(--methods ...,penalty); Moreau-Jean to a tolerance: "
+                                  "simulate --rtol, or converge --methods moreau-rtol");
+    }
     if (want[PD_METHOD_EVENT_GENERAL] && !pd_cli_is_scene(&k)) {
         pd_cli_case_free(&k);
         return pd_cli_usage_error("--methods: event-general is a reference for scenes (--scene, "

@@ -252,6 +252,10 @@ static int parse_args(conv_args *a, int argc, char **argv)
     a->k.opts.dt = a->dt_max;
     if ((rc = pd_cli_case_finish(&a->k)))
         return rc;
+    if (a->k.have_rtol && !a->want_penalty)
+        return pd_cli_usage_error("--rtol: in converge the penalty rows' integrator tolerance "
+                                  "(--methods ...,penalty); Moreau-Jean to a tolerance: "
+                                  "--methods moreau-rtol --rtols LIST");
     if (a->want_general && !pd_cli_is_scene(&a->k))
         return pd_cli_usage_error("--methods: event-general is a reference for scenes (--scene, "
                                   "--chain); the oscillator's reference is exact");

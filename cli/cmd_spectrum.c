@@ -250,7 +250,12 @@ static int check_scene_args(spec_args *a)
         return pd_cli_usage_error("%s", err.msg);
     if (check_outputs_distinct(a, &err))
         return pd_cli_usage_error("%s", err.msg);
-    return pd_cli_case_finish(&a->k);
+    int rc = pd_cli_case_finish(&a->k);
+    if (!rc && a->k.opts.rtol > 0.0)
+        return pd_cli_usage_error("--rtol: a scene sweep's Moreau-Jean points take fixed steps; "
+                                  "--rtol is the penalty integrator's tolerance here (--method "
+                                  "penalty); exact points: --method event");
+    return rc;
 }
 
 /* The sweep's corners (smallest and largest Pi2, every size and amplitude)
@@ -335,6 +340,11 @@ static int check_args(spec_args *a)
     int rc = pd_cli_case_finish(&checked);
     if (rc)
         return rc;
+    if (checked.opts.rtol > 0.0)
+        return pd_cli_usage_error("--rtol: a spectrum's Moreau-Jean points take fixed steps (its "
+                                  "batched kernels); --rtol is the penalty integrator's "
+                                  "tolerance here (--method penalty); exact points: --method "
+                                  "event");
     a->k.record = checked.record; /* a record and its pulse: the sweep's */
     s->base = a->k.c;
     if (a->k.record) { /* its pulse's amplitude (times --scale) unless --ap lists them */
@@ -343,6 +353,7 @@ static int check_args(spec_args *a)
             s->ap[0] = s->base.ap;
     }
     s->opts = a->k.opts; /* dt and tend stay 0 (per point) unless given */
+    s->opts.pen.rtol = checked.opts.pen.rtol; /* --rtol routed (penalty) */
     /* the method given or implied by the flags (as the checked case took
      * it), else one for the whole sweep */
     a->k.method_by = checked.method_by;

@@ -33,6 +33,26 @@ typedef struct mj_incidence {
 } mj_incidence;
 
 /* W_a^T x. */
+/* The stored entries of column j of A, one per call into (*i, *v), *p from
+ * -1 on; 0 after the last (zero matrices store none; dense ones all rows):
+ * the setup's walks over a model's structure, linear in its entries. */
+static inline int mj_col_next(const pd_matrix *A, int j, int *p, int *i, double *v)
+{
+    if (A->kind == PD_MATRIX_CSC) {
+        *p = *p < 0 ? A->colptr[j] : *p + 1;
+        if (*p >= A->colptr[j + 1])
+            return 0;
+        *i = A->rowind[*p];
+        *v = A->values[*p];
+        return 1;
+    }
+    if (A->kind != PD_MATRIX_DENSE || ++*p >= A->rows)
+        return 0;
+    *i = *p;
+    *v = A->values[*p + (size_t)j * (size_t)A->rows];
+    return 1;
+}
+
 static inline double mj_inc_dot(const mj_incidence *in, int a, const double *x)
 {
     double sum = 0.0;

@@ -206,12 +206,13 @@ static void dof_frequencies(const pd_model *md, double *w)
 static int incidence(const pd_model *md, mj_incidence *in)
 {
     int n = md->n, m = md->m, nnz = 0;
+    double wia;
     if (!(in->ptr = calloc((size_t)m + 1, sizeof(int))) ||
         !(in->dptr = calloc((size_t)n + 1, sizeof(int))))
         return PD_ENOMEM;
     for (int a = 0; a < m; a++)
-        for (int i = 0; i < n; i++)
-            if (pd_matrix_get(&md->W, i, a) != 0.0) {
+        for (int p = -1, i; mj_col_next(&md->W, a, &p, &i, &wia);)
+            if (wia != 0.0) {
                 nnz++;
                 in->dptr[i + 1]++;
             }
@@ -227,8 +228,7 @@ static int incidence(const pd_model *md, mj_incidence *in)
     nnz = 0;
     for (int a = 0; a < m; a++) {
         in->ptr[a] = nnz;
-        for (int i = 0; i < n; i++) {
-            double wia = pd_matrix_get(&md->W, i, a);
+        for (int p = -1, i; mj_col_next(&md->W, a, &p, &i, &wia);) {
             if (wia == 0.0)
                 continue;
             in->dof[nnz] = i;

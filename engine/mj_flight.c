@@ -103,9 +103,10 @@ static int find_root(int *parent, int i)
 /* Join the dofs every stored off-diagonal entry of A couples. */
 static void join_entries(const pd_matrix *A, int *parent)
 {
+    double v;
     for (int j = 0; j < A->cols; j++)
-        for (int i = 0; i < A->rows; i++) {
-            if (i == j || pd_matrix_get(A, i, j) == 0.0)
+        for (int p = -1, i; mj_col_next(A, j, &p, &i, &v);) {
+            if (i == j || v == 0.0)
                 continue;
             int a = find_root(parent, i), b = find_root(parent, j);
             if (a != b)

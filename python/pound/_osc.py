@@ -277,17 +277,24 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
 
 _METHOD_CODE = {"moreau": 0, "penalty": 2, "event-general": 4, "newmark": 5}  # pd_method
 _NMETHOD = 6
+# converge's rows also Moreau-Jean to a tolerance (not a pd_method: want[MOREAU_RTOL])
+MOREAU_RTOL = _NMETHOD
+_CONVERGE_CODE = {"moreau": 0, "moreau-rtol": MOREAU_RTOL, "penalty": 2, "newmark": 5,
+                  "event-general": 4}
+DEFAULT_RTOLS = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)  # converge --rtols
 
 
-def parse_methods(methods):
-    """('moreau', 'penalty', 'newmark', 'event-general') -> want[] by pd_method code."""
+def parse_methods(methods, codes=None):
+    """('moreau', 'penalty', 'newmark', 'event-general') -> want[] by pd_method
+    code (codes: converge's, with 'moreau-rtol' at want[MOREAU_RTOL])."""
+    codes = _METHOD_CODE if codes is None else codes
     if isinstance(methods, str):
         methods = methods.split(",")
-    want = [0] * _NMETHOD
+    want = [0] * (max(codes.values()) + 1)
     if methods is None or (hasattr(methods, "__len__") and len(methods) == 0):
-        raise InputError("methods: give moreau, penalty, newmark, event-general")
+        raise InputError("methods: give %s" % ", ".join(codes))
     for m in _args.values("methods", methods):
-        want[_METHOD_CODE[_args.choice("methods", m, _METHOD_CODE)]] = 1
+        want[codes[_args.choice("methods", m, codes)]] = 1
     return want
 
 
@@ -408,29 +415,48 @@ def _c_round(x):
 
 
 def converge(dts: Union[Range, Sequence[float]], theta: Floats = (0.5,),
-             methods: Names = ("moreau",), kcs: Optional[Floats] = None, error: str = "hist",
-             scene: Optional[Union[PathArg, "Scene"]] = None, **case: Any) -> Result:
+             methods: Names = ("moreau", "moreau-rtol"), kcs: Optional[Floats] = None,
+             error: str = "hist", scene: Optional[Union[PathArg, "Scene"]] = None,
+             rtols: Optional[Floats] = None, **case: Any) -> Result:
     """Error and cost as dt shrinks, as `pound converge --dt ... --json`: one
-    row per (dt, theta) for Moreau-Jean, one per contact stiffness multiple
-    kc (kcs [1e2, 1e3, 1e4, 1e5, 1e6]) on the finest grid for penalty, and
-    (scenes, 'event-general' in methods) one for the GSL-based reference; order =
-    log(err_prev / err) / log(dt_prev / dt) between successive rows of one
-    theta, on err_hist_linf (error='hist') or err_umax_rel ('umax').
+    row per (dt, theta) for Moreau-Jean ('moreau'), one per dt for 'newmark',
+    one per tolerance of rtols [1e-2, 1e-3, 1e-4, 1e-5, 1e-6] for
+    Moreau-Jean to a tolerance ('moreau-rtol': its histories at its own steps,
+    compared on the finest grid through the cubic between the steps' ends),
+    one per contact stiffness multiple kc (kcs [1e2, 1e3, 1e4, 1e5, 1e6]) on
+    the finest grid for penalty, and (scenes, 'event-general' in methods) one
+    for the GSL-based reference; methods ['moreau', 'moreau-rtol'], the
+    CLI's; order = log(err_prev / err) / log(dt_prev / dt) between
+    successive fixed-step rows of one theta, on err_hist_linf (error='hist')
+    or err_umax_rel ('umax').
 
     dts: 'MAX:MIN:N' or (MAX, MIN, N) with an int N (the CLI's --dt), or a
-    sequence of steps [s].  kcs: multiples of the structure's stiffness
-    (dimensionless).  Returns a Result: rows (one Result per row: method,
-    theta, dt [s], kc, err_umax_rel, err_hist_linf (dimensionless), cpu_s
-    [s of CPU], order, impacts, steps) and cpu_s_ref [s of CPU]; a scene's
-    also impacts_ref and the reference's decisions.  The case keywords are
-    simulate()'s, but rtol: the penalty rows' integrator tolerance."""
+    sequence of steps [s].  rtols: the moreau-rtol rows' tolerances, in
+    [1e-12, 1) (the CLI's --rtols).  kcs: multiples of the structure's
+    stiffness (dimensionless).  Returns a Result: rows (one Result per row:
+    method ('moreau' for moreau-rtol's rows too), theta, dt [s] (NaN for a
+    moreau-rtol row), rtol and err_est (a moreau-rtol row's tolerance and
+    its own estimate of its peaks' relative error; NaN for the others), kc,
+    err_umax_rel, err_hist_linf (dimensionless), cpu_s [s of CPU], order,
+    impacts, steps) and cpu_s_ref [s of CPU]; a scene's also impacts_ref and
+    the reference's decisions.  The case keywords are simulate()'s, but rtol:
+    the penalty rows' integrator tolerance (rtols sets the moreau-rtol
+    rows')."""
     steps, dt_min, dt_first = _steps(dts)
     thetas = [number("theta", t) for t in _args.values("theta", theta)]
     if len(thetas) > 32:
         raise InputError("theta: give 1 to 32 values")
-    want = parse_methods(methods)
+    want = parse_methods(methods, _CONVERGE_CODE)
     _scenes_only(want, scene)
     want_moreau, want_penalty, want_general, want_newmark = want[0], want[2], want[4], want[5]
+    want_rtol = want[MOREAU_RTOL]
+    tols = list(DEFAULT_RTOLS) if rtols is None else \
+        [number("rtols", x) for x in _args.values("rtols", rtols)]
+    if not 1 <= len(tols) <= 32:
+        raise InputError("rtols: give 1 to 32 values")
+    for x in tols:
+        if not 1e-12 <= x < 1.0:
+            raise InputError("rtols: the tolerances must be in [1e-12, 1) (got %g)" % x)
     kcs = [1e2, 1e3, 1e4, 1e5, 1e6] if kcs is None else \
         [number("kcs", x) for x in _args.values("kcs", kcs)]
     if any(not x > 0.0 for x in kcs):
@@ -449,7 +475,7 @@ def converge(dts: Union[Range, Sequence[float]], theta: Floats = (0.5,),
         meas = _OscMeasurer(Case(case, listed=True).resolve())
     try:
         rows, ref_cpu = _rows(meas, steps, dt_min, thetas, want_moreau, want_penalty, kcs,
-                              error, want_general, want_newmark)
+                              error, want_general, want_newmark, tols if want_rtol else ())
         out = Result(rows=rows, cpu_s_ref=ref_cpu)
         if scene is not None:
             out.update(meas.summary())
@@ -478,7 +504,8 @@ class _OscMeasurer:
         m = _lib.PdMeasured()
         st = lib.pd_measure_run(self.case.c, o, self.tr.ref, self.rr.umax, self.tr.work, m, err)
         return st, dict(err_umax=m.err_umax_rel, err_hist=m.err_hist_linf, cpu_s=m.r.cpu_s,
-                        impacts=m.r.impacts, steps=m.r.steps)
+                        impacts=m.r.impacts, steps=m.r.steps,
+                        err_est=m.r.err_est if o.rtol > 0.0 else NAN)
 
     def close(self):
         if self.tr is not None:
@@ -486,8 +513,8 @@ class _OscMeasurer:
 
 
 def _rows(M, steps, dt_min, thetas, want_moreau, want_penalty, kcs, error, want_general=False,
-          want_newmark=False):
-    """cli/cmd_converge.c compute_rows."""
+          want_newmark=False, rtols=()):
+    """cli/cmd_converge.c compute_rows (rtols: the moreau-rtol rows')."""
     o = copy_opts(M.opts)
     err = PdErr()
     o.dt = dt_min
@@ -505,14 +532,17 @@ def _rows(M, steps, dt_min, thetas, want_moreau, want_penalty, kcs, error, want_
             raise _lib.make_error(st, err.text())
 
     def row():
+        tol = o.rtol > 0.0
         r = Result(method=s(lib.pd_method_name(o.method)),
-                   theta=o.theta if o.method == 0 else NAN, dt=o.dt,
+                   theta=o.theta if o.method == 0 and not tol else NAN,
+                   dt=NAN if tol else o.dt, rtol=o.rtol if tol else NAN,
                    kc=o.pen.kc_mult if o.method in (2, 5) else NAN)
         st, m = M.row(o, err)
         if st:
             raise _lib.make_error(st, err.text())
         r.update(err_umax_rel=m["err_umax"], err_hist_linf=m["err_hist"], cpu_s=m["cpu_s"],
-                 order=NAN, impacts=m["impacts"], steps=m["steps"])
+                 order=NAN, impacts=m["impacts"], steps=m["steps"],
+                 err_est=m["err_est"] if tol else NAN)
         if "structures" in m:
             r["structures"] = m["structures"]
         rows.append(r)
@@ -533,6 +563,17 @@ def _rows(M, steps, dt_min, thetas, want_moreau, want_penalty, kcs, error, want_
             reference()
         o.method = 5
         row()
+    for i, tol in enumerate(rtols):  # to a tolerance: measured on the finest grid
+        o.dt = dt_min
+        o.method = 0
+        if not once and i == 0:
+            reference()
+        o.dt = 0.0
+        o.rtol = tol
+        try:
+            row()
+        finally:
+            o.rtol = 0.0
     if want_penalty:
         o.dt = dt_min
         if not once:
@@ -552,13 +593,14 @@ def _rows(M, steps, dt_min, thetas, want_moreau, want_penalty, kcs, error, want_
     for i, r in enumerate(rows):
         for q in range(i - 1, -1, -1):
             p = rows[q]
-            if (p["method"] == "moreau" and r["method"] == "moreau" and p["theta"] == r["theta"]) \
+            if (p["method"] == "moreau" and r["method"] == "moreau" and math.isnan(p["rtol"])
+                    and math.isnan(r["rtol"]) and p["theta"] == r["theta"]) \
                     or (p["method"] == "newmark" and r["method"] == "newmark"):
                 r["order"] = _order(p[key], r[key], p["dt"], r["dt"])
                 break
     # the CLI's column order
-    keys = ("method", "theta", "dt", "kc", "err_umax_rel", "err_hist_linf", "cpu_s", "order",
-            "impacts", "steps", "structures")
+    keys = ("method", "theta", "dt", "rtol", "err_est", "kc", "err_umax_rel", "err_hist_linf",
+            "cpu_s", "order", "impacts", "steps", "structures")
     return [Result((k, r[k]) for k in keys if k in r) for r in rows], ref_cpu
 
 

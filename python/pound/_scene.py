@@ -12,6 +12,7 @@ from ._osc import Result, _History, history_args, history_cap, tolerance_fields
 from ._types import Int, PathArg
 
 SCENE_OPTS = SCHEME_KEYS
+NAN = float("nan")
 
 
 def _array(ptr, n, dtype=np.float64):
@@ -383,6 +384,7 @@ class SceneMeasurer:
         e, sc = self.e, self.scene._sc
         return st, dict(err_umax=e.err_umax_max, err_hist=e.err_hist_max, cpu_s=e.cpu_s,
                         impacts=e.impacts, steps=self.res.steps,
+                        err_est=self.res.err_est_max if o.rtol > 0.0 else NAN,
                         structures=[Result(name=s(sc.st[k].name), err_umax_rel=e.err_umax[k],
                                            err_hist_linf=e.err_hist[k])
                                     for k in range(sc.nstruct)])

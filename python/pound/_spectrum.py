@@ -116,6 +116,10 @@ def build(Pi2, linear=False, pulse=None, dir=None, ap=None, xi=None, Pi3=None, g
                              % ("gap" if sp.size_is_gap else "Pi3", sp.size[i]))
     # the case flags' ranges (on a copy, as the CLI does), then the sweep's base
     checked = Case(dict(case))
+    if checked.opts.rtol > 0.0:
+        raise InputError("rtol: a spectrum runs Moreau-Jean on fixed steps (dt, dt_per_Tp); "
+                         "Moreau-Jean to a tolerance is simulate()'s (with method='penalty', "
+                         "rtol is the integrator's tolerance)")
     checked.resolve()
     k = Case(dict(case))
     k.record = checked.record
@@ -249,7 +253,9 @@ def spectrum(Pi2: Union[Range, Sequence[float]], linear: bool = False,
     ap [m/s^2] (the dimensional view), xi, Pi3 or gap [m], eps.  dt_per_Tp:
     steps per pulse period (dt = Tp / dt_per_Tp [s]).  Other keywords as
     for simulate(): Tp, record, scale, units, method, dt (or dt_per_Tp),
-    tend, theta, ...
+    tend, theta, ...; rtol only with method='penalty' (its integrator's
+    tolerance): a spectrum runs Moreau-Jean on fixed steps, and rtol for
+    Moreau-Jean raises InputError.
 
     threads: runs at once [OMP_NUM_THREADS or all cores]; the tasks go to a
     pool of threads (pd_spec_run_task), or with threads=1 or on_point to

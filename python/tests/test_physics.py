@@ -100,12 +100,18 @@ def test_compare_and_converge():
     assert c.err_umax_rel < 1e-5 and c.err_hist_linf < 1e-3 and c.impacts >= 1
     assert c.err_umax_rel == abs(c.umax - c.umax_ref) / c.umax_ref
     # without contact the theta = 1/2 scheme is of order 2, theta = 1 of order 1
+    # (the default methods also run Moreau-Jean to a tolerance: rows after the fixed steps')
     rows = pound.converge("0.01:0.0025:3", theta=[0.5, 1.0], pulse="sine", Pi2=0.5,
                           Pi3=100).rows
-    assert [r.theta for r in rows] == [0.5, 1.0] * 3 and math.isnan(rows[0].order)
-    for r in rows[2:]:
+    assert [r.theta for r in rows[:6]] == [0.5, 1.0] * 3 and math.isnan(rows[0].order)
+    for r in rows[2:6]:
         want = 2.0 if r.theta == 0.5 else 1.0
         assert abs(r.order - want) < 0.1, r
+    assert all(math.isnan(r.rtol) and math.isnan(r.err_est) for r in rows[:6])
+    assert [r.rtol for r in rows[6:]] == [1e-2, 1e-3, 1e-4, 1e-5, 1e-6]
+    fixed = pound.converge("0.01:0.0025:3", theta=[0.5, 1.0], methods="moreau", pulse="sine",
+                           Pi2=0.5, Pi3=100).rows
+    assert [r.err_hist_linf for r in fixed] == [r.err_hist_linf for r in rows[:6]]
     assert pound.dt_range(0.004, 0.0005, 4)[0] == 0.004
     assert abs(pound.dt_range(0.004, 0.0005, 4)[-1] - 0.0005) < 1e-18
 

@@ -31,6 +31,11 @@ def run() -> List[float]:
     z = pound.lcp(M, q, solver="lemke").z
     rec = pound.Record(EXAMPLES / "records" / "NGA_no_1063_RRS228.AT2")
     one = pound.simulate(record=rec, Pi2=1.0, Pi3=0.05, history=False)
+    tol = pound.simulate(Pi2=1.5, Pi3=0.1, rtol=1e-4, history=False)  # Moreau-Jean to rtol
+    met: bool = tol.rtol_met
+    est: float = tol.err_est
+    wp = pound.converge("1e-3:5e-4:2", methods="moreau-rtol", rtols=[1e-3, 1e-4], Pi2=1.0)
+    assert met and est <= 1e-4 and len(wp.rows) == 2
     version: str = pound.version() or "?"
     try:
         pound.simulate(ap=-1)
