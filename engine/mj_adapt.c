@@ -48,6 +48,9 @@ typedef struct snap {
     pd_state st;     /* q, v, P, g, active, t, step, ... */
     double *Fl, *Fr; /* n: F(t-) and F(t+) (theta flights) */
     double *af;      /* n: the free motion's accelerations (valid with st.has_acc) */
+    double *accr;    /* n: the accelerations' right limit where the forcing jumps */
+    double zl[4];    /* the forcing's state before a piece's start took over */
+    int switched;    /* the step to this state ended at a piece's start */
     double z[4];     /* the forcing's state (exact flights) */
     int piece;       /* its piece (exact flights) */
     uint64_t tick;   /* t = t_origin + tick h_L */
@@ -110,11 +113,11 @@ static void snap_free(snap *s)
     memset(s, 0, sizeof *s);
 }
 
-/* q, v, Fl, Fr, acc, af (n) and g, P (m) in one block; active (m). */
+/* q, v, Fl, Fr, acc, af, accr (n) and g, P (m) in one block; active (m). */
 static int snap_alloc(snap *s, int n, int m)
 {
     size_t mm = m > 0 ? (size_t)m : 1, nn = (size_t)n;
-    s->mem = calloc(6 * nn + 2 * mm, sizeof(double));
+    s->mem = calloc(7 * nn + 2 * mm, sizeof(double));
     s->st.active = calloc(mm, 1);
     if (!s->mem || !s->st.active)
         return PD_ENOMEM;
@@ -126,6 +129,8 @@ static int snap_alloc(snap *s, int n, int m)
     s->st.P = s->mem + 4 * nn + mm;
     s->st.acc = s->mem + 4 * nn + 2 * mm;
     s->af = s->mem + 5 * nn + 2 * mm;
+    s->accr = s->mem + 6 * nn + 2 * mm;
+    s->st.acc_right = s->st.acc;
     return PD_OK;
 }
 
@@ -394,6 +399,7 @@ int mj_adapt_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_
     s->st.lcp_pivots = 0;
     s->st.lcp_solver = NULL;
     s->st.h = 0.0;
+    s->st.impact = 0;
     forces_at(mj, t0, s);
     s->st.has_acc = 0;
     if (ad->F) { /* the piece in force at t0 */
@@ -407,6 +413,8 @@ int mj_adapt_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_
         mj_flight_acc(mj, &s->st, s->z, s->af);
         memcpy(s->st.acc, s->af, (size_t)mj->model->n * sizeof(double));
         s->st.has_acc = 1;
+        s->st.acc_right = s->st.acc;
+        s->switched = 0;
     }
     rest_speeds(mj, s, s);
     mj->t0 = t0;
@@ -471,7 +479,9 @@ static int take_step(pd_mj *mj, int k, const snap *x, snap *y, pd_err *err)
         if ((rc = mj_flight_step(mj, k, t1, &x->st, x->z, &y->st, y->z, err)))
             return rc;
         y->piece = x->piece;
-        if (y->piece + 1 < ad->F->npieces && y->tick >= ad->piece_tick[y->piece + 1]) {
+        y->switched = y->piece + 1 < ad->F->npieces && y->tick >= ad->piece_tick[y->piece + 1];
+        if (y->switched) {
+            memcpy(y->zl, y->z, sizeof y->zl);
             y->piece++;
             mj_flight_z(mj, y->piece, ad->F->pieces[y->piece].t_start, y->z);
         }
@@ -881,21 +891,36 @@ static void report_err(pd_mj *mj, double h)
     }
 }
 
-/* The accelerations at x for the observers' quintic interpolation of the
- * step to it and of the next: the free motion's plus the held contacts'
- * forces, their impulses over the step; after a step with an impact the
- * free motion's alone (the right limit: the impulses are no force). */
-static void step_accelerations(pd_mj *mj, snap *x)
+/* The held contacts' forces, their impulses over the step to x, into acc. */
+static void add_held(const pd_mj *mj, const snap *x, double *acc)
 {
     const mj_incidence *in = &mj->inc;
-    mj_adapt *ad = mj->ad;
-    x->st.has_acc = 1;
-    mj_flight_acc(mj, &x->st, x->z, x->af);
-    memcpy(x->st.acc, x->af, (size_t)mj->model->n * sizeof(double));
-    for (int a = 0; a < mj->model->m && x->st.h > 0.0 && !ad->impact_made; a++)
+    for (int a = 0; a < mj->model->m && x->st.h > 0.0; a++)
         if (x->st.P[a] > 0.0)
             for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
-                x->st.acc[in->dof[j]] += ad->minv[in->dof[j]] * in->w[j] * x->st.P[a] / x->st.h;
+                acc[in->dof[j]] += mj->ad->minv[in->dof[j]] * in->w[j] * x->st.P[a] / x->st.h;
+}
+
+/* The accelerations at x for the observers' quintic interpolation of the
+ * step to it and of the next: the free motion's plus the held contacts'
+ * forces (after a step with an impact the free motion's alone: the
+ * impulses are no force); where a piece's start ended the step, the left
+ * limit (the old piece's forcing) in acc, the right one in acc_right. */
+static void step_accelerations(pd_mj *mj, snap *x)
+{
+    size_t bytes = (size_t)mj->model->n * sizeof(double);
+    int held = !mj->ad->impact_made;
+    x->st.has_acc = 1;
+    mj_flight_acc(mj, &x->st, x->z, x->af);
+    x->st.acc_right = x->switched ? x->accr : x->st.acc;
+    memcpy((double *)x->st.acc_right, x->af, bytes);
+    if (held)
+        add_held(mj, x, (double *)x->st.acc_right);
+    if (!x->switched)
+        return;
+    mj_flight_acc(mj, &x->st, x->zl, x->st.acc);
+    if (held)
+        add_held(mj, x, x->st.acc);
 }
 
 /* Errors cross contacts: a contact that pushed in the step to x moves
@@ -967,6 +992,7 @@ static int keep(pd_mj *mj, const snap *w, snap *x, double f, int events, pd_obse
     ad->impact_made = 0; /* an impact in the step w -> x (its impulses are no held force) */
     for (int a = 0; a < md->m && !ad->impact_made; a++)
         ad->impact_made = flight_event(mj, a, impact_jump(mj, a, w, x));
+    x->st.impact = ad->impact_made;
     for (int i = 0; i < md->n; i++) {
         if (f > 0.0 && events && ad->evmark[i] == ad->try_stamp)
             ad->S2[i] += f * ad->eps[i] * f * ad->eps[i];

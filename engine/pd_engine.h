@@ -85,8 +85,16 @@ typedef struct pd_state {
     const char *lcp_solver; /* solver of the last step's LCP ("closed-form" for the
                                scalar kernel, NULL when none was solved) */
     double *acc;           /* n accelerations q'' at t, valid when has_acc (the
-                              on_step reports of the event-driven and penalty methods) */
+                              on_step reports of the event-driven and penalty methods;
+                              Moreau-Jean to a tolerance: the right limit at t) */
     int has_acc;
+    const double *acc_right; /* Moreau-Jean to a tolerance: n, the accelerations' right
+                              limit at t, where the forcing jumps (a piece's start: acc
+                              holds the left limit, the end of the step to t); acc
+                              itself elsewhere; NULL for the other methods */
+    int impact;            /* Moreau-Jean to a tolerance: 1 when the step to t had an
+                              impact (its velocities jump inside it: no interpolation
+                              across it); 0 otherwise */
     double h;              /* Moreau-Jean: the size of the last step */
     const double *err;     /* Moreau-Jean to a tolerance: n, the error estimate of each
                               dof accumulated over the steps so far, in units of q

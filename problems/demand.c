@@ -118,19 +118,40 @@ void pd_demand_osc_note(pd_demand_osc *d, double tau, double x, double v, const 
     d->prev = 1;
 }
 
+#define DEMAND_TURN_TOL 1e-12 /* the turn's place, in fractions of the step */
+#define DEMAND_TURN_ITERS 100
+
 int pd_demand_quintic_turn(const double p0[3], const double p1[3], double h, double *f)
 {
-    double lo = 0.0, hi = 1.0, fd, s;
+    /* the rate's sign change bracketed in [lo, hi]: Illinois steps (the
+     * secant through the bracket, the kept end's value halved when it is
+     * kept twice) to DEMAND_TURN_TOL; the value there is off by
+     * O(tol^2) of the step's curvature */
+    double lo = 0.0, hi = 1.0, flo = p0[1], fhi = p1[1], s = 0.5, fd;
+    int side = 0;
     if (!(p0[1] * p1[1] < 0.0))
         return 0;
-    for (int it = 0; it < 50; it++) {
-        s = 0.5 * (lo + hi);
+    for (int it = 0; it < DEMAND_TURN_ITERS && hi - lo > DEMAND_TURN_TOL; it++) {
+        s = (lo * fhi - hi * flo) / (fhi - flo);
+        if (!(s > lo && s < hi))
+            s = 0.5 * (lo + hi);
         pd_hermite5(p0, p1, h, s, f, &fd);
-        if ((fd < 0.0) == (p0[1] < 0.0))
+        if (fd == 0.0)
+            return 1;
+        if ((fd < 0.0) == (flo < 0.0)) {
             lo = s;
-        else
+            flo = fd;
+            if (side == -1)
+                fhi *= 0.5;
+            side = -1;
+        } else {
             hi = s;
+            fhi = fd;
+            if (side == 1)
+                flo *= 0.5;
+            side = 1;
+        }
     }
-    pd_hermite5(p0, p1, h, 0.5 * (lo + hi), f, &fd);
+    pd_hermite5(p0, p1, h, s, f, NULL);
     return 1;
 }

@@ -33,7 +33,7 @@ double pd_demand_cubic_peak(double f0, double d0, double f1, double d1, double h
 
 /* A turning point of f inside a step of length h: when f' changes sign
  * between its ends, the root of f' on the quintic Hermite of (f, f', f'')
- * = p0 at the start and p1 at the end (bisection to rounding); *f gets the
+ * = p0 at the start and p1 at the end (Illinois steps to 1e-12 of the step); *f gets the
  * value there and the return is 1; 0 when f' keeps its sign. */
 int pd_demand_quintic_turn(const double p0[3], const double p1[3], double h, double *f);
 

@@ -78,14 +78,16 @@ static int observe(const pd_state *st, void *ctx)
         tr->err_toward = e;
     if (tr->m.xaway > pw)
         tr->err_away = e;
-    /* inside a smooth step (no impulse, both ends with their accelerations) */
-    /* the engine's accelerations hold where the state is smooth (a held
-     * contact's force included; none after an impact) */
-    if (inside && st->step > 0 && tr->pacc && st->has_acc && tr->pt >= tr->m.tau_measure)
+    /* inside a smooth step (no impact in it, both ends with their
+     * accelerations: the right limits, a held contact's force included) */
+    if (inside && st->step > 0 && tr->pacc && st->has_acc && !st->impact &&
+        tr->pt >= tr->m.tau_measure)
         interior_extremes(tr, st, e);
-    /* demands at the smooth states only (right after an impact: none) */
+    /* demands at every state, between them across the smooth steps */
     if (tr->demands && st->has_acc) {
-        pd_demand_osc_note(&tr->dem, st->t, x, v, st->acc, st->step > 0 && !tr->dem_skipped);
+        pd_demand_osc_note(&tr->dem, st->t, x, v, st->acc,
+                           st->step > 0 && !tr->dem_skipped && !st->impact);
+        tr->dem.fd = tr->dem.C * st->acc_right[0] + tr->dem.K * v; /* the next step's start */
         tr->dem_skipped = 0;
         if (tr->dem.peak > pd)
             tr->err_acc = e;
@@ -94,7 +96,7 @@ static int observe(const pd_state *st, void *ctx)
     }
     tr->px = x;
     tr->pv = v;
-    tr->pa = st->has_acc ? st->acc[0] : 0.0;
+    tr->pa = st->has_acc ? st->acc_right[0] : 0.0; /* the next step's start */
     tr->pacc = st->has_acc;
     tr->pt = st->t;
     if (!tr->sampler)

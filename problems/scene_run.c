@@ -509,9 +509,9 @@ static int observe_moreau(const pd_state *st, void *ctx)
 static int observe_adapt(const pd_state *st, void *ctx)
 {
     track *tr = ctx;
-    /* the engine's accelerations hold where the state is smooth (held contacts'
-     * forces included; none after an impact) */
-    int smooth = st->has_acc && st->step > 0;
+    /* a smooth step: no impact in it, the accelerations at both ends (the
+     * right limits, held contacts' forces included) */
+    int smooth = st->has_acc && st->step > 0 && !st->impact;
     tr->err = st->err;
     for (int s = 0; s < tr->sc->nstruct; s++) {
         const pd_structure *ps = &tr->sc->st[s];
@@ -523,10 +523,11 @@ static int observe_adapt(const pd_state *st, void *ctx)
         note_between(tr, st->t, st->q, st->v, st->acc);
     note_point(tr, st->t, st->q);
     note_approach(tr, st->q);
-    /* demands at the smooth states only: right after an impact the velocities
-     * may be a stage's, which the next step's impulse completes (the impact's
-     * outcome is the next state's, a step the controller made short) */
-    if (tr->demands && st->has_acc) {
+    /* demands at the states after smooth steps only: right after an impact
+     * the velocities may be a stage's, which the next step's impulse
+     * completes (the impact's outcome is the next state's, a step the
+     * controller made short) */
+    if (tr->demands && st->has_acc && !st->impact) {
         memcpy(tr->acc0, tr->acc, (size_t)tr->n * sizeof(double));
         memcpy(tr->shear0, tr->shear, (size_t)tr->n * sizeof(double));
         note_demand(tr, st->t, st->q, st->v, st->acc, smooth && !tr->dem_skipped);
@@ -554,6 +555,12 @@ static int observe_adapt(const pd_state *st, void *ctx)
         tr->imp[a] += P;
     }
     keep_report(tr, st);
+    if (st->has_acc && st->acc_right != st->acc) { /* a forcing jump at t: the next step's start */
+        double vs = tr->Le * tr->wp, as = vs * tr->wp;
+        memcpy(tr->pa, st->acc_right, (size_t)tr->n * sizeof(double));
+        if (tr->demands && tr->dem_prev)
+            pd_demand_eval(tr->sc, st->v, st->acc_right, vs, as, tr->qad, tr->qVd);
+    }
     return tr->fn ? sample(tr, st) : 0;
 }
 

@@ -73,6 +73,7 @@ int main(int argc, char **argv)
 
     suite_lcp(&ctx);
     suite_engine(&ctx);
+    suite_adapt(&ctx);
     suite_oscillator(&ctx);
     suite_penalty(&ctx);
     suite_reference(&ctx);

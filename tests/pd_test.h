@@ -80,6 +80,7 @@ pd_run_opts pd_test_pen(const pd_run_opts *base, const pd_penalty_setup *po);
 /* Suites, one per test file. */
 void suite_lcp(pd_test_ctx *ctx);
 void suite_engine(pd_test_ctx *ctx);
+void suite_adapt(pd_test_ctx *ctx);
 void suite_oscillator(pd_test_ctx *ctx);
 void suite_rows(pd_test_ctx *ctx);
 void suite_penalty(pd_test_ctx *ctx);

@@ -1,0 +1,380 @@
+/* test_adapt.c — Moreau–Jean to a tolerance (docs/scheme.md, "Moreau–Jean
+ * to a tolerance"): its errors against the exact references on one wall,
+ * on rows and under a record; its estimate against the true error; the
+ * compressed cluster whose impacts come nanoseconds apart; no allocation
+ * in its steps; its refusals; the CLI's fields and warning. */
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "pd_problems.h"
+#include "pd_test.h"
+
+/* The issue's acceptance shares: the true error of umax within R on at
+ * least 95 % of the runs, within 3 err_est on at least 95 %. */
+#define ADAPT_SHARE 0.95
+#define ADAPT_NR 4
+static const double adapt_rtols[ADAPT_NR] = {1e-2, 1e-3, 1e-4, 1e-5};
+
+typedef struct tally {
+    int runs, within, within3, met_above; /* met_above: rtol_met with err_est > R */
+    double worst;                         /* the largest err / R */
+} tally;
+
+static void tally_run(tally *t, double err, double est, int met, double R)
+{
+    t->runs++;
+    t->within += err <= R;
+    t->within3 += err <= 3.0 * est;
+    t->met_above += met && !(est <= R);
+    t->worst = fmax(t->worst, err / R);
+}
+
+static void check_tally(pd_test_ctx *ctx, const char *what, const tally *t, double R)
+{
+    CHECK(ctx, t->runs > 0 && t->within >= ADAPT_SHARE * t->runs,
+          "%s, R %g: err <= R on %d of %d runs (worst %.3g R)", what, R, t->within, t->runs,
+          t->worst);
+    CHECK(ctx, t->within3 >= ADAPT_SHARE * t->runs, "%s, R %g: err <= 3 err_est on %d of %d runs",
+          what, R, t->within3, t->runs);
+    CHECK(ctx, t->met_above == 0, "%s, R %g: %d runs say rtol met with err_est > R", what, R,
+          t->met_above);
+}
+
+/* One wall, 180 cases (both pulses and directions, Pi2 0.3 ... 6, Pi3 0.01
+ * ... 0.5, eps 0, 0.5, 0.9: impacts, accumulations and held contact),
+ * against the exact reference at R = 1e-2 ... 1e-5. */
+static void test_adapt_one_wall_reliability(pd_test_ctx *ctx)
+{
+    const double pi2s[] = {0.3, 0.7, 1.5, 3.0, 6.0}, pi3s[] = {0.01, 0.1, 0.5},
+                 epss[] = {0.0, 0.5, 0.9};
+    tally t[ADAPT_NR] = {{0}};
+    long impacts = 0;
+    for (int p = 0; p < 2; p++)
+        for (int d = 0; d < 2; d++)
+            for (int a = 0; a < 5; a++)
+                for (int b = 0; b < 3; b++)
+                    for (int q = 0; q < 3; q++) {
+                        pd_osc c = pd_osc_default();
+                        c.pulse = p ? PD_PULSE_COSINE : PD_PULSE_SINE;
+                        c.dir = d ? -1 : 1;
+                        c.Pi2 = pi2s[a];
+                        c.Pi3 = pi3s[b];
+                        c.eps = epss[q];
+                        pd_run_opts o = pd_run_default_opts();
+                        pd_osc_result ref, r;
+                        pd_err err;
+                        if (!CHECK(ctx, pd_osc_reference(&c, &o, NULL, NULL, &ref, &err) == PD_OK,
+                                   "reference: %s", err.msg))
+                            return;
+                        impacts += ref.impacts;
+                        for (int k = 0; k < ADAPT_NR; k++) {
+                            o.method = PD_METHOD_MOREAU;
+                            o.rtol = adapt_rtols[k];
+                            if (!CHECK(ctx, pd_osc_run(&c, &o, NULL, NULL, &r, &err) == PD_OK,
+                                       "rtol %g: %s", o.rtol, err.msg))
+                                return;
+                            tally_run(&t[k], fabs(r.umax - ref.umax) / ref.umax, r.err_est,
+                                      r.rtol_met, o.rtol);
+                        }
+                    }
+    CHECK(ctx, impacts > 180, "the grid must strike the wall (%ld impacts)", impacts);
+    for (int k = 0; k < ADAPT_NR; k++)
+        check_tally(ctx, "one wall", &t[k], adapt_rtols[k]);
+}
+
+/* A row of ns SDOFs from the stream s: periods 0.2-1.5 s, gaps 2-30 mm,
+ * eps 0-0.9, a wall on the left (60 %) and on the right (30 %), a sine or
+ * cosine pulse of 2-8 m/s^2 and 0.3-1.5 s, to 4.5 s. */
+static pd_scene *random_row(uint64_t *s, pd_err *err)
+{
+    pd_scene_excitation x = {.pulse = pd_test_uniform(s) < 0.5 ? PD_PULSE_SINE : PD_PULSE_COSINE,
+                             .dir = pd_test_uniform(s) < 0.5 ? 1 : -1,
+                             .ap = 2.0 + 6.0 * pd_test_uniform(s),
+                             .Tp = 0.3 + 1.2 * pd_test_uniform(s)};
+    pd_scene *sc = pd_scene_new(&x);
+    int ns = 2 + (int)(3.0 * pd_test_uniform(s)), rc = !sc, entry = 0;
+    const double xis[3] = {0.0, 0.02, 0.05};
+    for (int i = 0; i < ns && !rc; i++) {
+        char name[16];
+        snprintf(name, sizeof name, "S%d", i + 1);
+        double T0 = 0.2 + 1.3 * pd_test_uniform(s), xi = xis[(int)(3.0 * pd_test_uniform(s))];
+        rc = pd_scene_add_sdof(sc, name, T0, xi, 1e5 * (1.0 + 3.0 * pd_test_uniform(s)), err);
+    }
+#define GAP() (0.002 + 0.028 * pd_test_uniform(s))
+#define EPS() (0.9 * pd_test_uniform(s))
+    if (!rc && pd_test_uniform(s) < 0.6)
+        rc = pd_scene_add_contact(sc, PD_WALL, 0, 0, 1, GAP(), EPS(), entry++, err);
+    for (int i = 0; i + 1 < ns && !rc; i++)
+        rc = pd_scene_add_contact(sc, i, 1, i + 1, 1, GAP(), EPS(), entry++, err);
+    if (!rc && pd_test_uniform(s) < 0.3)
+        rc = pd_scene_add_contact(sc, ns - 1, 1, PD_WALL, 0, GAP(), EPS(), entry++, err);
+#undef GAP
+#undef EPS
+    if (!rc)
+        rc = pd_scene_finish(sc, err);
+    if (rc) {
+        pd_scene_free(sc);
+        return NULL;
+    }
+    sc->tend = 4.5;
+    return sc;
+}
+
+/* The largest relative error of umax over the structures' storeys. */
+static double umax_error(const pd_scene *sc, const pd_scene_result *r, const pd_scene_result *ref)
+{
+    double e = 0.0;
+    for (int i = 0; i < sc->n; i++)
+        e = fmax(e, fabs(r->umax[i] - ref->umax[i]) / ref->umax[i]);
+    return e;
+}
+
+/* Rows of 2-4 SDOFs with walls (40 drawn from a seeded stream) against the
+ * exact row reference at R = 1e-2 ... 1e-5. */
+static void test_adapt_rows_reliability(pd_test_ctx *ctx)
+{
+    uint64_t s = 28;
+    tally t[ADAPT_NR] = {{0}};
+    for (int row = 0; row < 40; row++) {
+        pd_err err;
+        pd_scene *sc = random_row(&s, &err);
+        pd_scene_result ref = {0}, r = {0};
+        if (!CHECK(ctx, sc && pd_scene_result_alloc(sc, &ref, &err) == PD_OK &&
+                            pd_scene_result_alloc(sc, &r, &err) == PD_OK,
+                   "row %d: %s", row, err.msg)) {
+            pd_scene_free(sc);
+            return;
+        }
+        pd_run_opts o = pd_run_default_opts();
+        o.method = PD_METHOD_EVENT;
+        o.no_demands = 1;
+        int rc = pd_scene_run(sc, &o, NULL, NULL, &ref, &err);
+        CHECK(ctx, rc == PD_OK, "row %d: reference: %s", row, err.msg);
+        for (int k = 0; k < ADAPT_NR && !rc; k++) {
+            o.method = PD_METHOD_MOREAU;
+            o.rtol = adapt_rtols[k];
+            o.no_demands = 0;
+            rc = pd_scene_run(sc, &o, NULL, NULL, &r, &err);
+            if (CHECK(ctx, rc == PD_OK, "row %d, rtol %g: %s", row, o.rtol, err.msg))
+                tally_run(&t[k], umax_error(sc, &r, &ref), r.err_est_max, r.rtol_met, o.rtol);
+        }
+        pd_scene_result_free(&ref);
+        pd_scene_result_free(&r);
+        pd_scene_free(sc);
+    }
+    for (int k = 0; k < ADAPT_NR; k++)
+        check_tally(ctx, "rows", &t[k], adapt_rtols[k]);
+}
+
+/* A compressed cluster: stiff S1 (0.234 s) on a wall between it and S2,
+ * S3 behind (eps 0.08, 0.08, 0.71), a cosine pulse: near t = 0.377 s the
+ * pair S1-S2, held together, strikes the wall while S3 follows, impacts
+ * nanoseconds apart.  A held pair that drifts open by a fraction of a
+ * nanometre makes it a cascade of single impacts (a 0.7 % larger umax of
+ * S3); to a tolerance each structure's umax is the reference's within R,
+ * for R = 1e-2 ... 1e-5 and with the second pass's retries. */
+static void test_adapt_compressed_cluster(pd_test_ctx *ctx)
+{
+    pd_scene_excitation x = {.pulse = PD_PULSE_COSINE, .dir = 1, .ap = 4.0, .Tp = 0.5};
+    pd_scene *sc = pd_scene_new(&x);
+    pd_scene_result ref = {0}, r = {0};
+    pd_err err;
+    int rc = !sc || pd_scene_add_sdof(sc, "S1", 0.234, 0.05, 3e5, &err) ||
+             pd_scene_add_sdof(sc, "S2", 1.1, 0.05, 2e5, &err) ||
+             pd_scene_add_sdof(sc, "S3", 0.6, 0.05, 2.5e5, &err) ||
+             pd_scene_add_contact(sc, PD_WALL, 0, 0, 1, 0.01, 0.08, 0, &err) ||
+             pd_scene_add_contact(sc, 0, 1, 1, 1, 0.02, 0.08, 1, &err) ||
+             pd_scene_add_contact(sc, 1, 1, 2, 1, 0.015, 0.71, 2, &err) ||
+             pd_scene_finish(sc, &err) || pd_scene_result_alloc(sc, &ref, &err) ||
+             pd_scene_result_alloc(sc, &r, &err);
+    if (CHECK(ctx, !rc, "scene: %s", err.msg)) {
+        sc->tend = 4.5;
+        pd_run_opts o = pd_run_default_opts();
+        o.method = PD_METHOD_EVENT;
+        rc = pd_scene_run(sc, &o, NULL, NULL, &ref, &err);
+        long impacts = 0;
+        for (int a = 0; a < sc->ncontact; a++)
+            impacts += ref.impacts[a];
+        CHECK(ctx, rc == PD_OK && impacts > 15, "reference: %s (%ld impacts)",
+              rc ? err.msg : "ok", impacts);
+        for (int k = 0; k < ADAPT_NR && !rc; k++) {
+            o.method = PD_METHOD_MOREAU;
+            o.rtol = adapt_rtols[k];
+            rc = pd_scene_run(sc, &o, NULL, NULL, &r, &err);
+            double e = rc ? NAN : umax_error(sc, &r, &ref);
+            CHECK(ctx, rc == PD_OK && e <= o.rtol && r.rtol_met && r.err_est_max <= o.rtol,
+                  "rtol %g: umax error %.3g, err_est %.3g, met %d (%s)", o.rtol, e,
+                  r.err_est_max, r.rtol_met, rc ? err.msg : "ok");
+        }
+    }
+    pd_scene_result_free(&ref);
+    pd_scene_result_free(&r);
+    pd_scene_free(sc);
+}
+
+/* The Rinaldi record (examples/records): umax within R of the exact
+ * reference, R = 1e-2 ... 1e-5, the estimate within R. */
+static void test_adapt_record(pd_test_ctx *ctx)
+{
+    const char *path = "examples/records/NGA_no_1063_RRS228.AT2";
+    pd_record rec;
+    pd_record_pulse p;
+    pd_err err;
+    if (access(path, R_OK)) {
+        pd_test_skip(ctx, "the Rinaldi record is absent");
+        return;
+    }
+    if (!CHECK(ctx, pd_record_read(path, PD_RECORD_AUTO, PD_UNITS_G, &rec, &err) == PD_OK &&
+                        pd_record_fit_pulse(&rec, &p, &err) == PD_OK,
+               "%s", err.msg))
+        return;
+    pd_osc c = pd_osc_default();
+    pd_osc_set_record(&c, &rec, &p, 1.0);
+    pd_osc_set_T0(&c, 0.8);
+    pd_osc_set_gap(&c, 0.01);
+    c.eps = 0.6;
+    pd_run_opts o = pd_run_default_opts();
+    pd_osc_result ref, r;
+    if (CHECK(ctx, pd_osc_reference(&c, &o, NULL, NULL, &ref, &err) == PD_OK && ref.impacts > 5,
+              "reference: %s", err.msg))
+        for (int k = 0; k < ADAPT_NR; k++) {
+            o.method = PD_METHOD_MOREAU;
+            o.rtol = adapt_rtols[k];
+            int rc = pd_osc_run(&c, &o, NULL, NULL, &r, &err);
+            double e = rc ? NAN : fabs(r.umax - ref.umax) / ref.umax;
+            CHECK(ctx, rc == PD_OK && e <= o.rtol && r.rtol_met && r.err_est <= o.rtol,
+                  "rtol %g: umax error %.3g, err_est %.3g (%s)", o.rtol, e, r.err_est,
+                  rc ? err.msg : "ok");
+        }
+    pd_record_free(&rec);
+}
+
+static void wall_force(double t, int side, double *F, void *ctx)
+{
+    (void)side, (void)ctx;
+    F[0] = t < 2.0 ? sin(3.0 * t) : 0.0;
+}
+
+/* The engine to a tolerance on a model of its own: no allocation once
+ * allocated (a second stretch of the run, and after a reset), the fixed
+ * step's calls refused, its statistics consistent, the state's estimate
+ * within the tolerance of the amplitude. */
+static void test_adapt_engine_contract(pd_test_ctx *ctx)
+{
+    double M = 1.0, C = 0.1, K = 4.0, W = -1.0, g0 = 0.05, e = 0.5, brk = 2.0;
+    pd_model md = {.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, &M),
+                   .C = pd_matrix_dense(1, 1, &C), .K = pd_matrix_dense(1, 1, &K),
+                   .W = pd_matrix_dense(1, 1, &W), .g0 = &g0, .e = &e, .force = wall_force,
+                   .breaks = &brk, .nbreaks = 1};
+    pd_mj_opts o = pd_mj_default_opts();
+    o.h = 0.1;
+    o.rtol = 1e-6;
+    pd_err err;
+    pd_mj *mj = pd_mj_alloc(&md, &o, &err);
+    if (!CHECK(ctx, mj != NULL, "alloc: %s", err.msg))
+        return;
+    int rc = pd_mj_run_until(mj, 1.0, NULL, NULL, &err);
+    long allocs = pd_test_allocations();
+    rc = rc ? rc : pd_mj_run_until(mj, 6.0, NULL, NULL, &err);
+    rc = rc ? rc : pd_mj_reset(mj, 0.0, NULL, NULL, &err);
+    rc = rc ? rc : pd_mj_run_until(mj, 6.0, NULL, NULL, &err);
+    CHECK(ctx, rc == PD_OK, "run: %s", err.msg);
+    CHECK(ctx, pd_test_allocations() == allocs, "%ld allocations in the steps",
+          pd_test_allocations() - allocs);
+    pd_mj_stats st;
+    CHECK(ctx, pd_mj_get_stats(mj, &st) == PD_OK && st.steps > 10 && st.evals >= st.steps &&
+                   st.h_min > 0.0 && st.h_min <= st.h_max && st.h_max <= st.h0 &&
+                   !st.floor_hit && !st.budget_hit,
+          "stats: %ld steps, %ld evals, h %g ... %g (h0 %g), floor %d, budget %d", st.steps,
+          st.evals, st.h_min, st.h_max, st.h0, st.floor_hit, st.budget_hit);
+    const pd_state *s = pd_mj_state(mj);
+    CHECK(ctx, fabs(s->t - 6.0) <= 1e-12 && s->err && s->err[0] >= 0.0 && s->err[0] <= 1e-5,
+          "the state at t = %.17g: err %g", s->t, s->err ? s->err[0] : NAN);
+    rc = pd_mj_step(mj, &err);
+    CHECK(ctx, rc == PD_EINVAL && strstr(err.msg, "rtol"), "pd_mj_step on a run to a tolerance: %d (%s)",
+          rc, err.msg);
+    pd_mj_free(mj);
+    const double bad[] = {-1e-3, 1.0, NAN};
+    for (int k = 0; k < 3; k++) {
+        o.rtol = bad[k];
+        mj = pd_mj_alloc(&md, &o, &err);
+        CHECK(ctx, !mj && err.status == PD_EINVAL && strstr(err.msg, "rtol"),
+              "rtol %g: %s", bad[k], mj ? "accepted" : err.msg);
+        pd_mj_free(mj);
+    }
+}
+
+/* The problems' options: rtol with a fixed dt, with the event methods, out
+ * of range: refused naming it; with it the fixed scheme's figures report
+ * rtol 0, err_est NaN, rtol_met 1. */
+static void test_adapt_options(pd_test_ctx *ctx)
+{
+    pd_osc c = pd_osc_default();
+    pd_osc_result r;
+    pd_err err;
+    pd_run_opts o = pd_run_default_opts();
+    o.method = PD_METHOD_MOREAU;
+    o.rtol = 1e-4;
+    o.dt = 1e-3;
+    CHECK(ctx, pd_osc_run(&c, &o, NULL, NULL, &r, &err) == PD_EINVAL && strstr(err.msg, "rtol"),
+          "rtol with dt: %s", err.msg);
+    o.dt = 0.0;
+    o.method = PD_METHOD_EVENT;
+    CHECK(ctx, pd_osc_run(&c, &o, NULL, NULL, &r, &err) == PD_EINVAL && strstr(err.msg, "rtol"),
+          "rtol with event: %s", err.msg);
+    o.method = PD_METHOD_MOREAU;
+    o.rtol = 1.5;
+    CHECK(ctx, pd_osc_run(&c, &o, NULL, NULL, &r, &err) == PD_EINVAL && strstr(err.msg, "rtol"),
+          "rtol 1.5: %s", err.msg);
+    o.rtol = 0.0;
+    CHECK(ctx, pd_osc_run(&c, &o, NULL, NULL, &r, &err) == PD_OK && r.rtol == 0.0 &&
+                   isnan(r.err_est) && r.rtol_met && r.dt_min == r.dt && r.dt_max == r.dt &&
+                   r.steps_rejected == 0,
+          "fixed steps: rtol %g, err_est %g, met %d, dt %g ... %g", r.rtol, r.err_est,
+          r.rtol_met, r.dt_min, r.dt_max);
+}
+
+/* The CLI: the fields in the text and JSON, and the warning on stderr
+ * exactly when rtol_met is false (a row of 10, whose demands' estimate
+ * may stay above 1e-3). */
+static void test_adapt_cli(pd_test_ctx *ctx)
+{
+    proc_out r = {0};
+    const char *text[] = {ctx->pound, "simulate", "--Pi2", "1.5", "--Pi3", "0.1", "--eps", "0.5",
+                          "--rtol", "1e-4", NULL};
+    if (!CHECK(ctx, pd_test_spawn(text, NULL, &r) == 0 && r.status == 0, "simulate --rtol: %s",
+               r.err ? r.err : ""))
+        return;
+    CHECK(ctx, strstr(r.out, "Moreau-Jean to rtol = 0.0001") && strstr(r.out, "err_est") &&
+                   strstr(r.out, "rtol met") && !strstr(r.err, "warning"),
+          "text:\n%s", r.out);
+    pd_test_proc_free(&r);
+    const char *json[] = {ctx->pound, "simulate", "--chain", "10", "--pulse", "sine", "--Tp", "1",
+                          "--Pi3", "0.05", "--eps", "0.6", "--rtol", "1e-3", "--json", NULL};
+    if (!CHECK(ctx, pd_test_spawn(json, NULL, &r) == 0 && r.status == 0, "chain --rtol: %s",
+               r.err ? r.err : ""))
+        return;
+    int met = strstr(r.out, "\"rtol_met\":true") != NULL;
+    CHECK(ctx, strstr(r.out, "\"rtol\":0.001") && strstr(r.out, "\"steps_rejected\":") &&
+                   strstr(r.out, "\"dt_min\":") && strstr(r.out, "\"err_est\":0."),
+          "JSON: %.400s", r.out);
+    CHECK(ctx, met == !strstr(r.err, "warning: rtol 0.001 not met"),
+          "rtol_met %d, stderr: %s", met, r.err);
+    pd_test_proc_free(&r);
+    const char *both[] = {ctx->pound, "simulate", "--rtol", "1e-4", "--dt", "1e-3", NULL};
+    CHECK(ctx, pd_test_spawn(both, NULL, &r) == 2 && strstr(r.err, "--rtol") && !r.out[0],
+          "--rtol with --dt: status %d, %s", r.status, r.err);
+    pd_test_proc_free(&r);
+}
+
+void suite_adapt(pd_test_ctx *ctx)
+{
+    PD_RUN(ctx, test_adapt_one_wall_reliability);
+    PD_RUN(ctx, test_adapt_rows_reliability);
+    PD_RUN(ctx, test_adapt_compressed_cluster);
+    PD_RUN(ctx, test_adapt_record);
+    PD_RUN(ctx, test_adapt_engine_contract);
+    PD_RUN(ctx, test_adapt_options);
+    PD_RUN(ctx, test_adapt_cli);
+}
