@@ -29,6 +29,7 @@ int pd_bench_scene(pd_json *js);                         /* bench_scene.c */
 int pd_bench_spectrum(pd_json *js);                      /* bench_spectrum.c */
 int pd_bench_records(pd_json *js, const char *shared_dir); /* bench_records.c */
 int pd_bench_startup(pd_json *js);                       /* bench_startup.c */
+int pd_bench_adapt(pd_json *js);                         /* bench_adapt.c */
 
 /* ---- shared by the drivers (bench_util.c) -------------------------------- */
 

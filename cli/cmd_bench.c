@@ -1,4 +1,4 @@
-/* cmd_bench.c — `pound bench [--lcp] [--engine] [--scene] [--spectrum] [--records]
+/* cmd_bench.c — `pound bench [--lcp] [--engine] [--scene] [--rtol] [--spectrum] [--records]
  * [--startup] [--json] [--shared DIR]`: the flags, then the drivers of
  * bench/ (pd_bench.h) after the machine's line. */
 #include <string.h>
@@ -9,7 +9,7 @@
 int pd_cmd_bench(int argc, char **argv)
 {
     int json = 0, want_lcp = 0, want_engine = 0, want_scene = 0, want_spectrum = 0;
-    int want_records = 0, want_startup = 0;
+    int want_records = 0, want_startup = 0, want_rtol = 0;
     const char *shared = "../shared";
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--json"))
@@ -20,6 +20,8 @@ int pd_cmd_bench(int argc, char **argv)
             want_engine = 1;
         else if (!strcmp(argv[i], "--scene"))
             want_scene = 1;
+        else if (!strcmp(argv[i], "--rtol"))
+            want_rtol = 1;
         else if (!strcmp(argv[i], "--records"))
             want_records = 1;
         else if (!strcmp(argv[i], "--spectrum"))
@@ -29,8 +31,8 @@ int pd_cmd_bench(int argc, char **argv)
         else if (!strcmp(argv[i], "--shared") && i + 1 < argc)
             shared = argv[++i];
         else if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
-            puts("usage: pound bench [--lcp] [--engine] [--scene] [--spectrum] [--records]\n"
-                 "                   [--startup] [--json]\n"
+            puts("usage: pound bench [--lcp] [--engine] [--scene] [--rtol] [--spectrum]\n"
+                 "                   [--records] [--startup] [--json]\n"
                  "                   [--shared DIR]\n"
                  "  no selection runs every benchmark; --shared points at the shared data\n"
                  "  folder holding lcp/siconos (default ../shared); the processor and the\n"
@@ -41,6 +43,9 @@ int pd_cmd_bench(int argc, char **argv)
                  "  general kernels) beside the bound of each step's dependency chain\n"
                  "  --scene: ns per DOF-step on rows (`--chain N`) of 10 ... 10^5 SDOFs, the one-wall\n"
                  "  scene against the oscillator\n"
+                 "  --rtol: Moreau-Jean to a tolerance: the one-wall cost against fixed steps at\n"
+                 "  1e-5, error and CPU for rtol 1e-2 ... 1e-6 on one wall, rows of 2, 10, 100, a\n"
+                 "  compressed cluster and a record, ns per DOF-step on --chain 10000\n"
                  "  --spectrum: the paper-scale sweep, serial with each instruction set the\n"
                  "  processor has (POUND_ISA caps it) and on 2 OpenMP threads\n"
                  "  --records: every shared record x 200 Pi2 x 4 Pi3 x 3 eps, exact reference and\n"
@@ -51,8 +56,9 @@ int pd_cmd_bench(int argc, char **argv)
             return pd_cli_usage_error("bench: unknown flag '%s'", argv[i]);
     }
     if (!want_lcp && !want_engine && !want_scene && !want_spectrum && !want_records &&
-        !want_startup)
-        want_lcp = want_engine = want_scene = want_spectrum = want_records = want_startup = 1;
+        !want_startup && !want_rtol)
+        want_lcp = want_engine = want_scene = want_spectrum = want_records = want_startup =
+            want_rtol = 1;
 
     pd_json js, *jp = NULL;
     if (json) {
@@ -67,6 +73,8 @@ int pd_cmd_bench(int argc, char **argv)
         rc |= pd_bench_engine(jp);
     if (want_scene)
         rc |= pd_bench_scene(jp);
+    if (want_rtol)
+        rc |= pd_bench_adapt(jp);
     if (want_spectrum)
         rc |= pd_bench_spectrum(jp);
     if (want_records)
