@@ -145,14 +145,14 @@ static int bench_points(const adapt_case *k, int nr, point *pt, double *ref_cpu)
 /* The compressed cluster (docs/methods.md, "Moreau–Jean to a tolerance"). */
 static pd_scene *cluster_scene(void)
 {
-    pd_scene_excitation x = {.pulse = PD_PULSE_COSINE, .dir = 1, .ap = 4.0, .Tp = 0.5};
+    pd_scene_excitation x = {.pulse = PD_PULSE_COSINE, .dir = 1, .ap = 4.18, .Tp = 0.89};
     pd_scene *sc = pd_scene_new(&x);
     if (!sc || pd_scene_add_sdof(sc, "S1", 0.234, 0.05, 3e5, NULL) ||
-        pd_scene_add_sdof(sc, "S2", 1.1, 0.05, 2e5, NULL) ||
-        pd_scene_add_sdof(sc, "S3", 0.6, 0.05, 2.5e5, NULL) ||
-        pd_scene_add_contact(sc, PD_WALL, 0, 0, 1, 0.01, 0.08, 0, NULL) ||
-        pd_scene_add_contact(sc, 0, 1, 1, 1, 0.02, 0.08, 1, NULL) ||
-        pd_scene_add_contact(sc, 1, 1, 2, 1, 0.015, 0.71, 2, NULL) || pd_scene_finish(sc, NULL)) {
+        pd_scene_add_sdof(sc, "S2", 1.36, 0.05, 3.3e5, NULL) ||
+        pd_scene_add_sdof(sc, "S3", 0.81, 0.05, 2.1e5, NULL) ||
+        pd_scene_add_contact(sc, PD_WALL, 0, 0, 1, 0.0071, 0.08, 0, NULL) ||
+        pd_scene_add_contact(sc, 0, 1, 1, 1, 0.005, 0.08, 1, NULL) ||
+        pd_scene_add_contact(sc, 1, 1, 2, 1, 0.0246, 0.71, 2, NULL) || pd_scene_finish(sc, NULL)) {
         pd_scene_free(sc);
         return NULL;
     }
