@@ -45,7 +45,7 @@ int pd_cmd_bench(int argc, char **argv)
                  "  scene against the oscillator\n"
                  "  --rtol: Moreau-Jean to a tolerance: the one-wall cost against fixed steps at\n"
                  "  1e-5, error and CPU for rtol 1e-2 ... 1e-6 on one wall, rows of 2, 10, 100, a\n"
-                 "  compressed cluster and a record, ns per DOF-step on --chain 10000\n"
+                 "  compressed cluster and a record, ns per DOF-step on a row of 10^4 SDOFs\n"
                  "  --spectrum: the paper-scale sweep, serial with each instruction set the\n"
                  "  processor has (POUND_ISA caps it) and on 2 OpenMP threads\n"
                  "  --records: every shared record x 200 Pi2 x 4 Pi3 x 3 eps, exact reference and\n"

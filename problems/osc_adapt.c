@@ -112,11 +112,6 @@ static int observe(const pd_state *st, void *ctx)
     return tr->sampler(&smp, tr->sampler_ctx);
 }
 
-static void scene_force(double tau, int side, double *F, void *ctx)
-{
-    F[0] = pd_osc_shape(ctx, tau, side);
-}
-
 /* err_est of the peaks measured: the largest of their relative estimates. */
 static double peaks_error(const adapt_track *tr, const pd_osc *c)
 {
@@ -137,20 +132,9 @@ static int run_once(const pd_osc *c, const pd_run_opts *o, double rtol, pd_osc_s
                     void *ctx, pd_osc_result *res, pd_mj_stats *stats, pd_err *err)
 {
     double pulse_end = pd_osc_shape_end(c);
-    double M = 1.0, C = 2.0 * c->xi * c->Pi2, K = c->Pi2 * c->Pi2, W = -1.0, b = 1.0;
-    double g0 = c->Pi3, e = c->eps;
-    pd_model model = {.n = 1,
-                      .m = o->no_wall ? 0 : 1,
-                      .M = pd_matrix_dense(1, 1, &M),
-                      .C = pd_matrix_dense(1, 1, &C),
-                      .K = pd_matrix_dense(1, 1, &K),
-                      .W = pd_matrix_dense(1, 1, &W),
-                      .g0 = &g0,
-                      .e = &e,
-                      .force = scene_force,
-                      .force_ctx = (void *)c,
-                      .breaks = &pulse_end,
-                      .nbreaks = isfinite(pulse_end) ? 1 : 0};
+    double b = 1.0;
+    pd_osc_coefs k;
+    pd_model model = pd_osc_model(c, o->no_wall, &k, &pulse_end, isfinite(pulse_end) ? 1 : 0);
     pd_sine_piece *pieces;
     int npieces, rc;
     if ((rc = pd_osc_pieces(c, &pieces, &npieces, err)))
@@ -173,7 +157,7 @@ static int run_once(const pd_osc *c, const pd_run_opts *o, double rtol, pd_osc_s
     adapt_track tr = {.Le = Le, .vscale = Le * wp, .wp = wp, .demands = !o->no_demands,
                       .sampler = sampler, .sampler_ctx = ctx};
     pd_osc_track_init(&tr.m, c, mo.h, wp * pd_osc_measure_start(c, o->tend));
-    tr.dem = (pd_demand_osc){.C = C, .K = K, .tau_measure = tr.m.tau_measure};
+    tr.dem = (pd_demand_osc){.C = k.C, .K = k.K, .tau_measure = tr.m.tau_measure};
     pd_mj *mj = pd_mj_alloc(&model, &mo, err);
     if (!mj) {
         free(pieces);

@@ -23,11 +23,6 @@
 #define OSC_PEN_KC_GAP 1e3   /* ... and this * wp^2 / Pi3^2 (penetration ~ 3 % of the gap) */
 #define OSC_PEN_MIN_PI3 1e-3 /* the Pi3 of that rule at a zero gap */
 
-/* F = s phi(tau) (or the record's): the model's force callback. */
-static void scene_force(double tau, int side, double *F, void *ctx)
-{
-    F[0] = pd_osc_shape(ctx, tau, side);
-}
 
 /* Measurements in Pi units, updated after every accepted step. */
 typedef struct pen_track {
@@ -326,7 +321,7 @@ int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler samp
                       .W = pd_matrix_dense(1, 1, &W),
                       .g0 = &g0,
                       .e = &e,
-                      .force = scene_force,
+                      .force = pd_osc_model_force,
                       .force_ctx = (void *)c,
                       .breaks = brks ? brks + 1 : &brk,
                       .nbreaks = brks ? (int)(c->record->npts - 1) : brk > 0.0 ? 1 : 0};

@@ -36,6 +36,39 @@ static inline void pd_osc_result_no_rtol(pd_osc_result *res, double step)
     res->dt_min = res->dt_max = step;
 }
 
+/* F = s phi(tau) (or the record's): the oscillator model's force callback. */
+static inline void pd_osc_model_force(double tau, int side, double *F, void *ctx)
+{
+    F[0] = pd_osc_shape(ctx, tau, side);
+}
+
+/* The coefficients a pd_osc_model points at (they outlive the model). */
+typedef struct pd_osc_coefs {
+    double M, C, K, W, g0, e;
+} pd_osc_coefs;
+
+/* The oscillator's model in Pi units: M = 1, C = 2 xi Pi2, K = Pi2^2, one
+ * wall at gap Pi3 (W = -1; none with no_wall), the force pd_osc_shape with
+ * the breakpoints given; its coefficients in k. */
+static inline pd_model pd_osc_model(const pd_osc *c, int no_wall, pd_osc_coefs *k,
+                                    const double *breaks, int nbreaks)
+{
+    *k = (pd_osc_coefs){.M = 1.0, .C = 2.0 * c->xi * c->Pi2, .K = c->Pi2 * c->Pi2, .W = -1.0,
+                        .g0 = c->Pi3, .e = c->eps};
+    return (pd_model){.n = 1,
+                      .m = no_wall ? 0 : 1,
+                      .M = pd_matrix_dense(1, 1, &k->M),
+                      .C = pd_matrix_dense(1, 1, &k->C),
+                      .K = pd_matrix_dense(1, 1, &k->K),
+                      .W = pd_matrix_dense(1, 1, &k->W),
+                      .g0 = &k->g0,
+                      .e = &k->e,
+                      .force = pd_osc_model_force,
+                      .force_ctx = (void *)c,
+                      .breaks = breaks,
+                      .nbreaks = nbreaks};
+}
+
 /* Moreau-Jean to a tolerance (osc_adapt.c): o resolved, rtol > 0. */
 int pd_osc_adapt(const pd_osc *c, const pd_run_opts *o, pd_osc_sampler sampler, void *ctx,
                  pd_osc_result *res, pd_err *err);

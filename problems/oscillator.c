@@ -239,11 +239,6 @@ double pd_osc_measure_start(const pd_osc *c, double tend)
 
 /* ---- the scene -------------------------------------------------------- */
 
-static void scene_force(double tau, int side, double *F, void *ctx)
-{
-    F[0] = pd_osc_shape(ctx, tau, side);
-}
-
 /* The observer's context: the measurements and the sampler. */
 typedef struct tracker {
     pd_osc_track m;
@@ -422,20 +417,8 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
 
     /* model in Pi units; the step is 2 pi (dt / Tp) so equal dt/Tp gives equal h */
     double pulse_end = pd_osc_shape_end(c); /* the only breakpoint: the pulse's or record's end */
-    double M = 1.0, C = 2.0 * c->xi * c->Pi2, K = c->Pi2 * c->Pi2, W = -1.0;
-    double g0 = c->Pi3, e = c->eps;
-    pd_model model = {.n = 1,
-                      .m = o.no_wall ? 0 : 1,
-                      .M = pd_matrix_dense(1, 1, &M),
-                      .C = pd_matrix_dense(1, 1, &C),
-                      .K = pd_matrix_dense(1, 1, &K),
-                      .W = pd_matrix_dense(1, 1, &W),
-                      .g0 = &g0,
-                      .e = &e,
-                      .force = scene_force,
-                      .force_ctx = (void *)c,
-                      .breaks = &pulse_end,
-                      .nbreaks = isfinite(pulse_end) ? 1 : 0};
+    pd_osc_coefs k;
+    pd_model model = pd_osc_model(c, o.no_wall, &k, &pulse_end, isfinite(pulse_end) ? 1 : 0);
     pd_mj_opts mo = pd_mj_default_opts();
     mo.h = PD_TWO_PI * (o.dt / c->Tp);
     mo.theta = o.theta;
@@ -453,7 +436,7 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
     tracker tr = {.Le = Le, .vscale = Le * wp, .wp = wp, .demands = !o.no_demands,
                   .sampler = sampler, .sampler_ctx = ctx};
     pd_osc_track_init(&tr.m, c, mo.h, wp * pd_osc_measure_start(c, o.tend));
-    tr.dem = (pd_demand_osc){.C = C, .K = K, .tau_measure = tr.m.tau_measure - 0.5 * mo.h};
+    tr.dem = (pd_demand_osc){.C = k.C, .K = k.K, .tau_measure = tr.m.tau_measure - 0.5 * mo.h};
     if (!sampler && mo.kernel == PD_KERNEL_AUTO && mo.factor == PD_FACTOR_AUTO) {
         /* the scalar kernel, which pd_mj would choose (n = 1, m <= 1) */
         long steps = 0;

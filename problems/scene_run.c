@@ -746,12 +746,12 @@ static int run_oscillator(const pd_scene *sc, const pd_osc *c, int mirrored,
 
 /* ---- the general engines -------------------------------------------------- */
 
-/* Moreau–Jean on the scene's model. */
-static int run_moreau(const pd_model *md, const pd_run_opts *o, long nsteps, track *tr,
-                      pd_scene_result *res, pd_err *err)
+/* The engine's options of a run's: step h, the scheme's and the solvers'
+ * settings. */
+static pd_mj_opts mj_opts_of(const pd_run_opts *o, double h)
 {
     pd_mj_opts mo = pd_mj_default_opts();
-    mo.h = tr->h;
+    mo.h = h;
     mo.theta = o->theta;
     mo.gamma = o->gamma;
     mo.allow_unstable = o->allow_unstable;
@@ -760,6 +760,14 @@ static int run_moreau(const pd_model *md, const pd_run_opts *o, long nsteps, tra
     mo.lcp_solver = o->lcp_solver;
     mo.on_lcp = o->on_lcp;
     mo.on_lcp_ctx = o->on_lcp_ctx;
+    return mo;
+}
+
+/* Moreau–Jean on the scene's model. */
+static int run_moreau(const pd_model *md, const pd_run_opts *o, long nsteps, track *tr,
+                      pd_scene_result *res, pd_err *err)
+{
+    pd_mj_opts mo = mj_opts_of(o, tr->h);
     pd_mj *mj = pd_mj_alloc(md, &mo, err);
     if (!mj)
         return err ? err->status : PD_ENOMEM;
@@ -835,16 +843,7 @@ static int adapt_once(const pd_scene_model *sm, const pd_run_opts *o, double rto
     double T = sc->exc.Tp;
     for (int k = 0; k < sc->nstruct; k++)
         T = fmin(T, sc->st[k].T0);
-    pd_mj_opts mo = pd_mj_default_opts();
-    mo.h = tr->wp * T / SCENE_ADAPT_H0;
-    mo.theta = o->theta;
-    mo.gamma = o->gamma;
-    mo.allow_unstable = o->allow_unstable;
-    mo.kernel = o->kernel;
-    mo.factor = o->factor;
-    mo.lcp_solver = o->lcp_solver;
-    mo.on_lcp = o->on_lcp;
-    mo.on_lcp_ctx = o->on_lcp_ctx;
+    pd_mj_opts mo = mj_opts_of(o, tr->wp * T / SCENE_ADAPT_H0);
     mo.rtol = rtol;
     mo.atol_dof = atol;
     mo.sim_gap = o->close_tol; /* the reference's scale of simultaneity, in Le */
