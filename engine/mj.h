@@ -32,7 +32,6 @@ typedef struct mj_incidence {
     int *dptr, *con;   /* dof i: con[dptr[i] .. dptr[i+1]) */
 } mj_incidence;
 
-/* W_a^T x. */
 /* The stored entries of column j of A, one per call into (*i, *v), *p from
  * -1 on; 0 after the last (zero matrices store none; dense ones all rows):
  * the setup's walks over a model's structure, linear in its entries. */
@@ -53,6 +52,7 @@ static inline int mj_col_next(const pd_matrix *A, int j, int *p, int *i, double 
     return 1;
 }
 
+/* W_a^T x. */
 static inline double mj_inc_dot(const mj_incidence *in, int a, const double *x)
 {
     double sum = 0.0;
@@ -92,6 +92,8 @@ struct pd_mj {
     mj_flight *fl;        /* adaptive with exact flights (linear blocks under piecewise
                              forcing); NULL: theta flights */
     mj_incidence inc;     /* the adaptive driver's view of W */
+    const double *minv;   /* the adaptive driver's: n, 1 / M_ii (its projections' M^-1) */
+    const double *D0;     /* the adaptive driver's: m, sum_i W_ia^2 / M_ii */
     const double *u_rest; /* NULL, or m: closing speeds |U_k| at or below which a contact
                              takes no restitution (the adaptive driver's: rebounds lower
                              than its tolerance are plastic; an opening contact takes

@@ -309,6 +309,8 @@ int mj_adapt_alloc(pd_mj *mj, pd_err *err)
         for (int j = mj->inc.ptr[a]; j < mj->inc.ptr[a + 1]; j++)
             ad->D0[a] += mj->inc.w[j] * mj->inc.w[j] * ad->minv[mj->inc.dof[j]];
     mj->u_rest = ad->u_rest;
+    mj->minv = ad->minv;
+    mj->D0 = ad->D0;
     if (ad->F && (rc = mj_flight_alloc(mj, ad->F, ad->h0, L, err)))
         return rc;
     if (ad->F) {

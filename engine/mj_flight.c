@@ -60,7 +60,6 @@ struct mj_flight {
     unsigned stamp;
     int *pos;                /* m: place of a contact in the active set, or -1 */
     double *r;               /* n: W P */
-    double *minv;            /* n: (M^-1)_ii */
     double *x, *dx, *y;      /* 2 smax + 4 */
 };
 
@@ -421,7 +420,6 @@ void mj_flight_free(pd_mj *mj)
     free(fl->cmark);
     free(fl->pos);
     free(fl->r);
-    free(fl->minv);
     free(fl->x);
     free(fl->h);
     free(fl);
@@ -486,12 +484,6 @@ int mj_flight_alloc(pd_mj *mj, const pd_piecewise_force *F, double h0, int L, pd
     fl->y = fl->dx + 2 * smax + 4;
     if ((rc = form_kinds(md, fl, err)))
         return rc;
-    if (!(fl->minv = malloc((size_t)n * sizeof(double))))
-        return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for its flights");
-    for (int i = 0; i < n; i++) {
-        const fl_block *bl = &fl->blocks[fl->block_of[i]];
-        fl->minv[i] = fl->kinds[bl->kind].Minv[fl->at[i] * (bl->s + 1)];
-    }
     return PD_OK;
 }
 
@@ -694,20 +686,16 @@ static void hold_gaps(pd_mj *mj, int nI, const pd_state *in, pd_state *out)
 {
     const pd_model *md = mj->model;
     const mj_incidence *inc = &mj->inc;
-    const mj_flight *fl = mj->fl;
     for (int sweep = 0; sweep < FL_HOLD_SWEEPS; sweep++)
         for (int r = 0; r < nI; r++) {
             int a = mj->idx_active[r];
             if (!(out->P[a] > 0.0) || in->g[a] > 0.0)
                 continue;
             double g = md->g0[a] + mj_inc_dot(inc, a, out->q), d = in->g[a] - g;
-            double D0 = 0.0;
-            for (int j = inc->ptr[a]; j < inc->ptr[a + 1]; j++)
-                D0 += inc->w[j] * inc->w[j] * fl->minv[inc->dof[j]];
-            if (d == 0.0 || !(D0 > 0.0))
+            if (d == 0.0 || !(mj->D0[a] > 0.0))
                 continue;
             for (int j = inc->ptr[a]; j < inc->ptr[a + 1]; j++)
-                out->q[inc->dof[j]] += fl->minv[inc->dof[j]] * inc->w[j] * d / D0;
+                out->q[inc->dof[j]] += mj->minv[inc->dof[j]] * inc->w[j] * d / mj->D0[a];
         }
 }
 

@@ -255,7 +255,6 @@ static void advance_force(pd_mj *mj, double t1)
         memcpy(mj->F0, mj->F1, (size_t)md->n * sizeof(double));
 }
 
-
 /* Non-finite state: fail naming time and degree of freedom. */
 static int check_state(const pd_model *md, const pd_state *st, pd_err *err)
 {

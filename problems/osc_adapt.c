@@ -101,14 +101,8 @@ static int observe(const pd_state *st, void *ctx)
     tr->pt = st->t;
     if (!tr->sampler)
         return 0;
-    pd_osc_sample smp = {.step = st->step,
-                         .t = st->t / tr->wp,
-                         .u = x * tr->Le,
-                         .v = v * tr->vscale,
-                         .impulse = P * tr->vscale,
-                         .gap = (tr->m.Pi3 - x) * tr->Le,
-                         .impacts = tr->m.impacts - tr->sampled};
-    tr->sampled = tr->m.impacts;
+    pd_osc_sample smp = pd_osc_track_sample(&tr->m, &tr->sampled, st->step, st->t, x, v, P,
+                                            tr->wp, tr->Le, tr->vscale);
     return tr->sampler(&smp, tr->sampler_ctx);
 }
 
@@ -141,14 +135,7 @@ static int run_once(const pd_osc *c, const pd_run_opts *o, double rtol, pd_osc_s
         return rc;
     pd_piecewise_force F = {.b = &b, .pieces = pieces, .npieces = npieces};
     double wp = pd_osc_wp(c), Le = pd_osc_Le(c);
-    pd_mj_opts mo = pd_mj_default_opts();
-    mo.h = PD_TWO_PI * fmin(1.0, 1.0 / c->Pi2) / OSC_ADAPT_H0;
-    mo.theta = o->theta;
-    mo.gamma = o->gamma;
-    mo.allow_unstable = o->allow_unstable;
-    mo.lcp_solver = o->lcp_solver;
-    mo.on_lcp = o->on_lcp;
-    mo.on_lcp_ctx = o->on_lcp_ctx;
+    pd_mj_opts mo = pd_run_mj_opts(o, PD_TWO_PI * fmin(1.0, 1.0 / c->Pi2) / OSC_ADAPT_H0);
     mo.rtol = rtol;
     /* below a thousandth of the static deflection under ap (1 / Pi2^2 in Pi
      * units) or of Le, an error is measured absolutely */
@@ -172,7 +159,7 @@ static int run_once(const pd_osc *c, const pd_run_opts *o, double rtol, pd_osc_s
     res->dt_max = stats->h_max / wp;
     res->steps_rejected = stats->rejected;
     res->err_est = peaks_error(&tr, c);
-    res->kernel = pd_mj_kernel_name(mj);
+    res->kernel = "exact-flight"; /* the scenes' name for it (scene_run.c) */
     pd_demand_osc_finish(res, o, tr.demands ? tr.dem.peak * c->ap : NAN, NAN);
     pd_mj_free(mj);
     free(pieces);

@@ -1,4 +1,5 @@
-/* osc_priv.h — (problems-private) what oscillator.c and osc_penalty.c share. */
+/* osc_priv.h — (problems-private) what the oscillator's runs (oscillator.c, osc_penalty.c,
+ * osc_adapt.c) share, and the engine options the scenes' runs take too. */
 #ifndef PD_OSC_PRIV_H
 #define PD_OSC_PRIV_H
 
@@ -67,6 +68,23 @@ static inline pd_model pd_osc_model(const pd_osc *c, int no_wall, pd_osc_coefs *
                       .force_ctx = (void *)c,
                       .breaks = breaks,
                       .nbreaks = nbreaks};
+}
+
+/* The engine's options of a run's (Moreau-Jean): the step h, the scheme's
+ * and the solvers' settings of o. */
+static inline pd_mj_opts pd_run_mj_opts(const pd_run_opts *o, double h)
+{
+    pd_mj_opts mo = pd_mj_default_opts();
+    mo.h = h;
+    mo.theta = o->theta;
+    mo.gamma = o->gamma;
+    mo.allow_unstable = o->allow_unstable;
+    mo.kernel = o->kernel;
+    mo.factor = o->factor;
+    mo.lcp_solver = o->lcp_solver;
+    mo.on_lcp = o->on_lcp;
+    mo.on_lcp_ctx = o->on_lcp_ctx;
+    return mo;
 }
 
 /* Moreau-Jean to a tolerance (osc_adapt.c): o resolved, rtol > 0. */

@@ -77,4 +77,22 @@ static inline void pd_osc_track_step(pd_osc_track *tr, long step, double t, doub
 void pd_osc_track_result(const pd_osc_track *tr, const pd_osc *c, double dt, long steps,
                          pd_osc_result *res);
 
+/* The sampler's view of the state (x, v, P) after step `step` at t, in
+ * Pi units: back to seconds and metres (wp, Le, vscale = Le wp), with the
+ * impacts begun since the one sampled before (*sampled, moved on). */
+static inline pd_osc_sample pd_osc_track_sample(const pd_osc_track *tr, long *sampled, long step,
+                                                double t, double x, double v, double P,
+                                                double wp, double Le, double vscale)
+{
+    pd_osc_sample smp = {.step = step,
+                         .t = t / wp,
+                         .u = x * Le,
+                         .v = v * vscale,
+                         .impulse = P * vscale,
+                         .gap = (tr->Pi3 - x) * Le,
+                         .impacts = tr->impacts - *sampled};
+    *sampled = tr->impacts;
+    return smp;
+}
+
 #endif

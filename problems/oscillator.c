@@ -330,14 +330,8 @@ static int observe(const pd_state *st, void *ctx)
     if (tr->demands)
         pd_demand_osc_note(&tr->dem, st->t, x, v, NULL, 0); /* the steps' own: as umax */
     if (tr->sampler) {
-        pd_osc_sample smp = {.step = st->step,
-                             .t = st->t / tr->wp,
-                             .u = x * tr->Le,
-                             .v = v * tr->vscale,
-                             .impulse = P * tr->vscale,
-                             .gap = (tr->m.Pi3 - x) * tr->Le,
-                             .impacts = tr->m.impacts - tr->sampled};
-        tr->sampled = tr->m.impacts;
+        pd_osc_sample smp = pd_osc_track_sample(&tr->m, &tr->sampled, st->step, st->t, x, v, P,
+                                                tr->wp, tr->Le, tr->vscale);
         return tr->sampler(&smp, tr->sampler_ctx);
     }
     return 0;
@@ -419,16 +413,7 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
     double pulse_end = pd_osc_shape_end(c); /* the only breakpoint: the pulse's or record's end */
     pd_osc_coefs k;
     pd_model model = pd_osc_model(c, o.no_wall, &k, &pulse_end, isfinite(pulse_end) ? 1 : 0);
-    pd_mj_opts mo = pd_mj_default_opts();
-    mo.h = PD_TWO_PI * (o.dt / c->Tp);
-    mo.theta = o.theta;
-    mo.gamma = o.gamma;
-    mo.allow_unstable = o.allow_unstable;
-    mo.kernel = o.kernel;
-    mo.factor = o.factor;
-    mo.lcp_solver = o.lcp_solver;
-    mo.on_lcp = o.on_lcp;
-    mo.on_lcp_ctx = o.on_lcp_ctx;
+    pd_mj_opts mo = pd_run_mj_opts(&o, PD_TWO_PI * (o.dt / c->Tp));
     long nsteps = pd_steps_for(o.tend, o.dt);
 
     double cpu0 = pd_cpu_seconds();

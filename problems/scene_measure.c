@@ -218,8 +218,10 @@ int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scen
     if (stride < 1 || fabs(ratio - (double)stride) > 1e-9 * ratio)
         return pd_err_set(err, PD_EINVAL, "dt: %g is not a whole multiple of the reference's %g",
                           r.dt, ref->dt);
-    double *scale = malloc(((size_t)sc->nstruct + (tol ? 3 * (size_t)sc->n : 0)) * sizeof(double));
-    if (!scale)
+    /* nstruct scales, then (to a tolerance) x_prev, v_prev, x_at */
+    double *work = malloc(((size_t)sc->nstruct + (tol ? 3 * (size_t)sc->n : 0)) * sizeof(double));
+    double *scale = work;
+    if (!work)
         return pd_err_set(err, PD_ENOMEM, "out of memory");
     for (int s = 0; s < sc->nstruct; s++) {
         scale[s] = structure_scale(sc, ref_res, s);
@@ -227,13 +229,13 @@ int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scen
     }
     compare_ctx c = {.sc = sc, .ref = ref, .e = e, .scale = scale, .stride = stride, .row = 0};
     if (tol) {
-        c.x_prev = scale + sc->nstruct;
+        c.x_prev = work + sc->nstruct;
         c.v_prev = c.x_prev + sc->n;
         c.x_at = c.v_prev + sc->n;
     }
     if ((rc = pd_scene_run(sc, o, tol ? compare_steps : compare_row, &c, res, err)) ||
         (rc = pd_scene_result_alloc(sc, &timed, err))) {
-        free(scale);
+        free(work);
         return rc;
     }
     pd_run_opts bare = o ? *o : pd_run_default_opts();
@@ -252,6 +254,6 @@ int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scen
     for (int a = 0; a < sc->ncontact; a++)
         e->impacts += res->impacts[a];
     e->grid_points = c.row;
-    free(scale);
+    free(work);
     return rc;
 }

@@ -501,7 +501,7 @@ static int observe_moreau(const pd_state *st, void *ctx)
 }
 
 /* Moreau-Jean to a tolerance, every kept step (its size st->h): extremes at
- * the step and inside it (smooth steps: no impulse, on the quintic Hermite
+ * the step and inside it (smooth steps: no impact, on the quintic Hermite
  * of the exact flights' accelerations), each raised peak with the engine's
  * estimate at its instant (demands: the structure's largest), impacts (an
  * impulse after a step without; the first at the middle of its step, a
@@ -510,7 +510,8 @@ static int observe_adapt(const pd_state *st, void *ctx)
 {
     track *tr = ctx;
     /* a smooth step: no impact in it, the accelerations at both ends (the
-     * right limits, held contacts' forces included) */
+     * start's right limit, kept below, and the end's left one; held
+     * contacts' forces included) */
     int smooth = st->has_acc && st->step > 0 && !st->impact;
     tr->err = st->err;
     for (int s = 0; s < tr->sc->nstruct; s++) {
@@ -739,35 +740,18 @@ static int run_oscillator(const pd_scene *sc, const pd_osc *c, int mirrored,
         res->dt = r.dt;
         res->dt_min = r.dt_min;
         res->dt_max = r.dt_max;
-        res->factor = "exact-flight";
+        res->factor = "blocks"; /* as the scenes' runs to a tolerance */
     }
     return PD_OK;
 }
 
 /* ---- the general engines -------------------------------------------------- */
 
-/* The engine's options of a run's: step h, the scheme's and the solvers'
- * settings. */
-static pd_mj_opts mj_opts_of(const pd_run_opts *o, double h)
-{
-    pd_mj_opts mo = pd_mj_default_opts();
-    mo.h = h;
-    mo.theta = o->theta;
-    mo.gamma = o->gamma;
-    mo.allow_unstable = o->allow_unstable;
-    mo.kernel = o->kernel;
-    mo.factor = o->factor;
-    mo.lcp_solver = o->lcp_solver;
-    mo.on_lcp = o->on_lcp;
-    mo.on_lcp_ctx = o->on_lcp_ctx;
-    return mo;
-}
-
 /* Moreau–Jean on the scene's model. */
 static int run_moreau(const pd_model *md, const pd_run_opts *o, long nsteps, track *tr,
                       pd_scene_result *res, pd_err *err)
 {
-    pd_mj_opts mo = mj_opts_of(o, tr->h);
+    pd_mj_opts mo = pd_run_mj_opts(o, tr->h);
     pd_mj *mj = pd_mj_alloc(md, &mo, err);
     if (!mj)
         return err ? err->status : PD_ENOMEM;
@@ -843,7 +827,7 @@ static int adapt_once(const pd_scene_model *sm, const pd_run_opts *o, double rto
     double T = sc->exc.Tp;
     for (int k = 0; k < sc->nstruct; k++)
         T = fmin(T, sc->st[k].T0);
-    pd_mj_opts mo = mj_opts_of(o, tr->wp * T / SCENE_ADAPT_H0);
+    pd_mj_opts mo = pd_run_mj_opts(o, tr->wp * T / SCENE_ADAPT_H0);
     mo.rtol = rtol;
     mo.atol_dof = atol;
     mo.sim_gap = o->close_tol; /* the reference's scale of simultaneity, in Le */

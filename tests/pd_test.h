@@ -58,6 +58,13 @@ char *pd_test_slurp(const char *path);               /* whole file, malloc'd */
 void pd_test_proc_free(proc_out *r);
 /* Run argv with env ("NAME=value" or NULL) added; capture stdout, stderr. */
 int pd_test_spawn(const char *const *argv, const char *env, proc_out *r);
+
+/* The Rinaldi case of the records' tests: the record shipped with the
+ * examples (examples/records/README.md), its fitted pulse, T0 0.8 s, gap
+ * 1 cm, eps 0.6.  1 when loaded (*rec to free); 0 when the record is
+ * absent (the case skipped) or unreadable (the case failed). */
+#include "pd_problems.h"
+int pd_test_rinaldi_case(pd_test_ctx *ctx, pd_record *rec, pd_osc *c);
 /* Run ctx->pound with args (NULL-terminated). */
 int pd_test_pound(const pd_test_ctx *ctx, const char *const *args, proc_out *r);
 int pd_test_have_pound(pd_test_ctx *ctx);           /* else skips the case */

@@ -5,7 +5,6 @@
  * in its steps; its refusals; the CLI's fields and warning. */
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "pd_problems.h"
 #include "pd_test.h"
@@ -217,23 +216,11 @@ static void test_adapt_compressed_cluster(pd_test_ctx *ctx)
  * reference, R = 1e-2 ... 1e-5, the estimate within R. */
 static void test_adapt_record(pd_test_ctx *ctx)
 {
-    const char *path = "examples/records/NGA_no_1063_RRS228.AT2";
     pd_record rec;
-    pd_record_pulse p;
+    pd_osc c;
     pd_err err;
-    if (access(path, R_OK)) {
-        pd_test_skip(ctx, "the Rinaldi record is absent");
+    if (!pd_test_rinaldi_case(ctx, &rec, &c))
         return;
-    }
-    if (!CHECK(ctx, pd_record_read(path, PD_RECORD_AUTO, PD_UNITS_G, &rec, &err) == PD_OK &&
-                        pd_record_fit_pulse(&rec, &p, &err) == PD_OK,
-               "%s", err.msg))
-        return;
-    pd_osc c = pd_osc_default();
-    pd_osc_set_record(&c, &rec, &p, 1.0);
-    pd_osc_set_T0(&c, 0.8);
-    pd_osc_set_gap(&c, 0.01);
-    c.eps = 0.6;
     pd_run_opts o = pd_run_default_opts();
     pd_osc_result ref, r;
     if (CHECK(ctx, pd_osc_reference(&c, &o, NULL, NULL, &ref, &err) == PD_OK && ref.impacts > 5,

@@ -125,24 +125,11 @@ static double fitted_slope(const double *h, const double *e, int n)
  * on log dt is 1.23 (docs/records.md §5: about 1.2, not 1.5). */
 static void test_records_moreau_converges(pd_test_ctx *ctx)
 {
-    /* the record shipped with the examples (examples/records/README.md) */
-    char path[4096] = "examples/records/NGA_no_1063_RRS228.AT2";
     pd_record rec;
-    pd_record_pulse p;
+    pd_osc c;
     pd_err err;
-    if (access(path, R_OK)) {
-        pd_test_skip(ctx, "the Rinaldi record is absent");
+    if (!pd_test_rinaldi_case(ctx, &rec, &c))
         return;
-    }
-    if (!CHECK(ctx, pd_record_read(path, PD_RECORD_AUTO, PD_UNITS_G, &rec, &err) == PD_OK &&
-                        pd_record_fit_pulse(&rec, &p, &err) == PD_OK,
-               "%s", err.msg))
-        return;
-    pd_osc c = pd_osc_default();
-    pd_osc_set_record(&c, &rec, &p, 1.0);
-    pd_osc_set_T0(&c, 0.8);
-    pd_osc_set_gap(&c, 0.01);
-    c.eps = 0.6;
     pd_run_opts o = pd_run_default_opts();
     pd_osc_result ref, r;
     if (!CHECK(ctx, pd_osc_reference(&c, &o, NULL, NULL, &ref, &err) == PD_OK, "%s", err.msg)) {

@@ -216,3 +216,27 @@ int pd_test_zero_file(char *path, size_t cap, long long bytes)
         unlink(path);
     return rc;
 }
+
+int pd_test_rinaldi_case(pd_test_ctx *ctx, pd_record *rec, pd_osc *c)
+{
+    const char *path = "examples/records/NGA_no_1063_RRS228.AT2";
+    pd_record_pulse p;
+    pd_err err;
+    if (access(path, R_OK)) {
+        pd_test_skip(ctx, "the Rinaldi record is absent");
+        return 0;
+    }
+    if (!CHECK(ctx, pd_record_read(path, PD_RECORD_AUTO, PD_UNITS_G, rec, &err) == PD_OK,
+               "%s", err.msg))
+        return 0;
+    if (!CHECK(ctx, pd_record_fit_pulse(rec, &p, &err) == PD_OK, "%s", err.msg)) {
+        pd_record_free(rec);
+        return 0;
+    }
+    *c = pd_osc_default();
+    pd_osc_set_record(c, rec, &p, 1.0);
+    pd_osc_set_T0(c, 0.8);
+    pd_osc_set_gap(c, 0.01);
+    c->eps = 0.6;
+    return 1;
+}
