@@ -166,8 +166,11 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
                 {"--atol", PD_METHOD_PENALTY},
                 {"--contact", PD_METHOD_PENALTY},  {"--stepper", PD_METHOD_PENALTY}};
     for (size_t n = 0; n < sizeof only / sizeof only[0]; n++)
-        if (!strcmp(f, only[n].flag))
+        if (!strcmp(f, only[n].flag)) {
             pd_cli_case_implies(a, f, only[n].method);
+            if (a->n_method_flags < (int)(sizeof a->method_flags / sizeof a->method_flags[0]))
+                a->method_flags[a->n_method_flags++] = only[n].flag;
+        }
     for (size_t n = 0; n < sizeof nums / sizeof nums[0]; n++)
         if (!strcmp(f, nums[n].flag)) {
             if ((rc = pd_cli_double(f, val, &x)))
@@ -504,11 +507,66 @@ const char *pd_cli_method_by(const pd_cli_case *a)
     return a->method_by ? a->method_by : "default";
 }
 
+#define M_(m) (1u << (m))
+
+/* The methods that read each flag of one method's (or a few): a flag given
+ * with --method naming another is refused, not ignored. */
+static const struct {
+    const char *flag;
+    unsigned methods; /* M_(pd_method) bits */
+} method_flag_readers[] = {
+    {"--theta", M_(PD_METHOD_MOREAU)},
+    {"--gamma", M_(PD_METHOD_MOREAU)},
+    {"--allow-unstable", M_(PD_METHOD_MOREAU)},
+    {"--close-tol", M_(PD_METHOD_EVENT)}, /* and moreau's steps to a tolerance in scenes */
+    {"--no-accumulation", M_(PD_METHOD_EVENT) | M_(PD_METHOD_EVENT_GENERAL)},
+    {"--kc", M_(PD_METHOD_PENALTY) | M_(PD_METHOD_NEWMARK)},
+    {"--kc-abs", M_(PD_METHOD_PENALTY) | M_(PD_METHOD_NEWMARK)},
+    {"--contact", M_(PD_METHOD_PENALTY) | M_(PD_METHOD_NEWMARK)},
+    {"--atol", M_(PD_METHOD_PENALTY) | M_(PD_METHOD_NEWMARK)},
+    {"--stepper", M_(PD_METHOD_PENALTY)}};
+
+/* The names of the methods in bits, "a or b". */
+static void method_names(unsigned bits, char *buf, size_t cap)
+{
+    buf[0] = '\0';
+    for (int m = 0; m <= PD_METHOD_NEWMARK; m++)
+        if (bits & M_(m))
+            snprintf(buf + strlen(buf), cap - strlen(buf), "%s%s", buf[0] ? " or " : "",
+                     pd_method_name((pd_method)m));
+}
+
+/* Every method-specific flag given is read by the method chosen (one
+ * method per run; compare and converge choose per row): 0 or 2. */
+static int case_method_flags(const pd_cli_case *a)
+{
+    pd_method m = a->opts.method;
+    if (a->methods_listed || m == PD_METHOD_AUTO)
+        return 0;
+    for (int k = 0; k < a->n_method_flags; k++)
+        for (size_t n = 0; n < sizeof method_flag_readers / sizeof method_flag_readers[0]; n++) {
+            unsigned bits = method_flag_readers[n].methods;
+            if (strcmp(a->method_flags[k], method_flag_readers[n].flag))
+                continue;
+            if (!strcmp(a->method_flags[k], "--close-tol") && pd_cli_is_scene(a))
+                bits |= M_(PD_METHOD_MOREAU) * (a->have_rtol != 0);
+            if (bits & M_(m))
+                continue;
+            char names[64];
+            method_names(bits, names, sizeof names);
+            return pd_cli_usage_error("%s: a flag of %s%s; --method %s does not take it",
+                                      a->method_flags[k], names,
+                                      !strcmp(a->method_flags[k], "--close-tol") ? " (and of "
+                                      "moreau --rtol on scenes)" : "", pd_method_name(m));
+        }
+    return 0;
+}
+
 static int case_finish(pd_cli_case *a)
 {
     int rc;
     pd_err err;
-    if ((rc = case_method(a)) || (rc = case_rtol(a)))
+    if ((rc = case_method(a)) || (rc = case_rtol(a)) || (rc = case_method_flags(a)))
         return rc;
     a->opts.method = pd_cli_case_method(a); /* the oscillator's resolves below */
     if (a->scene_path && a->chain)

@@ -1,7 +1,9 @@
 /* cmd_bench.c — `pound bench [--lcp] [--engine] [--scene] [--rtol] [--spectrum] [--records]
  * [--startup] [--json] [--shared DIR]`: the flags, then the drivers of
  * bench/ (pd_bench.h) after the machine's line. */
+#include <errno.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "pd_bench.h"
 #include "pd_cli.h"
@@ -11,6 +13,7 @@ int pd_cmd_bench(int argc, char **argv)
     int json = 0, want_lcp = 0, want_engine = 0, want_scene = 0, want_spectrum = 0;
     int want_records = 0, want_startup = 0, want_rtol = 0;
     const char *shared = "../shared";
+    int shared_given = 0;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--json"))
             json = 1;
@@ -28,14 +31,17 @@ int pd_cmd_bench(int argc, char **argv)
             want_spectrum = 1;
         else if (!strcmp(argv[i], "--startup"))
             want_startup = 1;
-        else if (!strcmp(argv[i], "--shared") && i + 1 < argc)
+        else if (!strcmp(argv[i], "--shared") && i + 1 < argc) {
             shared = argv[++i];
+            shared_given = 1;
+        }
         else if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             puts("usage: pound bench [--lcp] [--engine] [--scene] [--rtol] [--spectrum]\n"
                  "                   [--records] [--startup] [--json]\n"
                  "                   [--shared DIR]\n"
                  "  no selection runs every benchmark; --shared points at the shared data\n"
-                 "  folder holding lcp/siconos (default ../shared); the processor and the\n"
+                 "  folder holding lcp/siconos (default ../shared, skipped when absent; a named\n"
+                 "  folder must exist); the processor and the\n"
                  "  instruction set of the vector kernels come first, every time as the wall\n"
                  "  clock and the thread's CPU time\n"
                  "  --lcp: the LCP solvers on the Siconos set and chains of 10 ... 10^5 contacts\n"
@@ -55,6 +61,11 @@ int pd_cmd_bench(int argc, char **argv)
         } else
             return pd_cli_usage_error("bench: unknown flag '%s'", argv[i]);
     }
+    /* a folder the user names must be there (the default's absence skips) */
+    struct stat sh;
+    if (shared_given && (stat(shared, &sh) != 0 || !S_ISDIR(sh.st_mode)))
+        return pd_cli_usage_error("--shared %s: %s", shared,
+                                  stat(shared, &sh) != 0 ? strerror(errno) : "not a folder");
     if (!want_lcp && !want_engine && !want_scene && !want_spectrum && !want_records &&
         !want_startup && !want_rtol)
         want_lcp = want_engine = want_scene = want_spectrum = want_records = want_startup =

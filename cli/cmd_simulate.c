@@ -417,7 +417,10 @@ static int simulate_oscillator(sim_args *a)
         goto done;
     }
     if ((rc = pd_osc_summarize(&a->k.c, &a->k.opts, a->out || a->plot ? record : NULL, &o, &s,
-                               &err))) {
+                               &err)) ||
+        (isfinite(s.r.umax) && !isfinite(s.r.umax / a->k.height) &&
+         (rc = pd_err_set(&err, PD_EINVAL, "--height: the drift ratio umax / H overflows "
+                          "(umax %g m, H %g m): give a larger height", s.r.umax, a->k.height)))) {
         fprintf(stderr, "pound: simulate: %s\n", err.msg);
         status = rc == PD_EINVAL ? 2 : 1;
         goto done;

@@ -437,8 +437,10 @@ int pd_h5_index(hid_t loc, const char *name, long n, int first, const char *unit
     return rc;
 }
 
-/* The dimension scale `name` seen from the group of the object at path: in
- * that group or the nearest enclosing one (netCDF's scoping); -1: none. */
+/* The dimension scale `name` seen from the group of the object at path: the
+ * dataset of that name in that group or the nearest enclosing one (netCDF's
+ * scoping; a group of that name, a structure named "t", is passed over);
+ * -1: none. */
 static hid_t find_scale(hid_t file, const char *path, const char *name)
 {
     char at[1024];
@@ -448,8 +450,11 @@ static hid_t find_scale(hid_t file, const char *path, const char *name)
             dir--;
         if (dir == 0 || (size_t)snprintf(at, sizeof at, "%.*s%s", (int)dir, path, name) >= sizeof at)
             return -1;
-        if (H5Lexists(file, at, H5P_DEFAULT) > 0)
-            return H5Dopen2(file, at, H5P_DEFAULT);
+        if (H5Lexists(file, at, H5P_DEFAULT) > 0) {
+            hid_t ds = H5Dopen2(file, at, H5P_DEFAULT); /* the library prints nothing */
+            if (ds >= 0)
+                return ds;
+        }
         dir--; /* the '/' ending the group: up one */
     }
 }

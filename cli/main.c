@@ -6,9 +6,11 @@
 #include <gsl/gsl_version.h>
 #include <hdf5.h>
 #include <jansson.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "pd_cli.h"
+#include "pd_cpu.h"
 #include "pd_output.h"
 #include "pd_spectrum.h"
 
@@ -105,6 +107,10 @@ static int dispatch(int argc, char **argv)
     if (!strcmp(cmd, "help"))
         return help(argc, argv);
     int k = find_command(cmd);
+    const char *isa = getenv("POUND_ISA");
+    if (k >= 0 && isa && pd_cpu_isa_parse(isa) < 0)
+        return pd_cli_usage_error("POUND_ISA='%s': the vector kernels' instruction set must be "
+                                  "baseline, avx2 or avx512 (or unset)", isa);
     if (k >= 0)
         return commands[k].run(argc - 1, argv + 1);
     return pd_cli_usage_error("unknown command '%s' (try `pound --help`)", cmd);

@@ -22,7 +22,8 @@
 
 enum { TMP_SLOTS = 4, TMP_PATH = PD_PATH_MAX + 32 };
 
-/* The one exception to "no globals": what the SIGINT/SIGTERM handler must
+/* The one exception to "no globals": what the handler of SIGINT, SIGTERM
+ * and the other terminating signals (pd_output_signals) must
  * remove.  A slot's path is written while its flag is 0, then published by
  * setting the flag; the handler only reads flags and paths and calls
  * unlink (async-signal-safe).  Several slots, because -o, --dump-lcp and a
@@ -42,7 +43,10 @@ static void on_signal(int sig)
 
 void pd_output_signals(void)
 {
-    static const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
+    /* the signals that end a process by default, but for faults: interrupts,
+     * a soft CPU limit (prlimit --cpu), timers, a closed pipe */
+    static const int sigs[] = {SIGINT,  SIGTERM,   SIGHUP,  SIGQUIT, SIGXCPU, SIGALRM,
+                               SIGVTALRM, SIGPROF, SIGUSR1, SIGUSR2, SIGPIPE};
     struct sigaction sa = {.sa_handler = on_signal, .sa_flags = SA_RESETHAND}, old;
     sigemptyset(&sa.sa_mask);
     for (size_t k = 0; k < sizeof sigs / sizeof sigs[0]; k++)

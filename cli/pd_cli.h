@@ -53,6 +53,8 @@ typedef struct pd_cli_case {
      * method_by names the flag that chose it (NULL: the default) */
     const char *method_by;
     const char *implies[4]; /* per pd_method: the first flag given that only it takes */
+    const char *method_flags[24]; /* the flags given that some methods only take */
+    int n_method_flags;
     int methods_listed;     /* compare, converge: --methods chooses per run */
 } pd_cli_case;
 

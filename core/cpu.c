@@ -4,20 +4,22 @@
 
 #include "pd_cpu.h"
 
-/* The level POUND_ISA asks for: 0 (baseline), 3 (avx2), 4 (avx512), or -1
- * when it is unset or names none of them. */
+int pd_cpu_isa_parse(const char *name)
+{
+    if (!strcmp(name, "baseline"))
+        return 0;
+    if (!strcmp(name, "avx2"))
+        return 3;
+    if (!strcmp(name, "avx512"))
+        return 4;
+    return -1;
+}
+
+/* The level POUND_ISA asks for, or -1 when it is unset or names none. */
 static int requested_level(void)
 {
     const char *isa = getenv("POUND_ISA");
-    if (!isa)
-        return -1;
-    if (!strcmp(isa, "baseline"))
-        return 0;
-    if (!strcmp(isa, "avx2"))
-        return 3;
-    if (!strcmp(isa, "avx512"))
-        return 4;
-    return -1;
+    return isa ? pd_cpu_isa_parse(isa) : -1;
 }
 
 /* The processor's level, capped by POUND_ISA (benchmarks and tests run each

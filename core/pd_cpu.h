@@ -16,6 +16,9 @@
  * POUND_ISA = baseline, avx2 or avx512 caps it (benchmarks and tests run
  * each variant this way). */
 int pd_cpu_level(void);
+/* The level an instruction set's name stands for (POUND_ISA's values):
+ * "baseline" 0, "avx2" 3, "avx512" 4; -1 for any other name. */
+int pd_cpu_isa_parse(const char *name);
 /* "avx512 (x86-64-v4)", "avx2 (x86-64-v3)", "baseline". */
 const char *pd_cpu_level_name(int level);
 

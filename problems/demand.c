@@ -10,12 +10,37 @@
  * floors' inertia), and for stiffness-proportional damping (alpha = 0) V_k is
  * the storey's spring plus damper force. */
 #include <math.h>
+#include <stdio.h>
 
 #include "demand.h"
 
 double pd_equivalent_force(double impulse, double td)
 {
     return 0.5 * PD_PI * impulse / td;
+}
+
+/* An equivalent force pi I / (2 td) that overflows while I does not: the
+ * duration's fault (contact a, or -1 for the oscillator's wall). */
+int pd_demand_check_force(double impulse, double force, int a, pd_err *err)
+{
+    if (isfinite(force) || !isfinite(impulse))
+        return PD_OK;
+    char which[32] = "";
+    if (a >= 0)
+        snprintf(which, sizeof which, " of contact %d", a);
+    return pd_err_set(err, PD_EINVAL, "contact-duration: the equivalent force pi I / (2 td)%s "
+                      "overflows (impulse I = %g): give a longer duration", which, impulse);
+}
+
+/* A drift ratio drift / h that overflows while the drift does not: the
+ * storey height's fault. */
+int pd_demand_check_drift(double drift, double ratio, const char *name, int storey, pd_err *err)
+{
+    if (isfinite(ratio) || !isfinite(drift))
+        return PD_OK;
+    return pd_err_set(err, PD_EINVAL, "storey_heights: the drift ratio of storey %d of %s "
+                      "overflows (drift %g m over its height): give a larger height", storey,
+                      name, drift);
 }
 
 double pd_demand_td(const pd_run_opts *o)

@@ -61,6 +61,11 @@ static inline void pd_demand_osc_note_state(pd_demand_osc *d, double tau, double
 
 /* The oscillator's demands into res: acc_max and force_max [per unit mass],
  * the td of o and the equivalent force of res->max_impulse. */
+/* PD_EINVAL when a derived demand overflows while its source does not: the
+ * equivalent force (contact a, -1: the oscillator's wall) or a storey's
+ * drift ratio (structure name, storey from 1). */
+int pd_demand_check_force(double impulse, double force, int a, pd_err *err);
+int pd_demand_check_drift(double drift, double ratio, const char *name, int storey, pd_err *err);
 void pd_demand_osc_finish(pd_osc_result *res, const pd_run_opts *o, double acc_max,
                           double force_max);
 

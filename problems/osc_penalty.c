@@ -242,6 +242,20 @@ double pd_newmark_step(double dt, double Tc)
     return k > 1.0 && isfinite(k) ? dt / k : dt;
 }
 
+int pd_newmark_budget(const pd_penalty_opts *po, double dt, double tau_end, pd_err *err)
+{
+    double steps = tau_end / po->h;
+    if (strcmp(po->stepper, "newmark") || steps <= (double)po->max_steps)
+        return PD_OK;
+    if (po->h < dt)
+        return pd_err_set(err, PD_EINVAL, "kc: newmark's steps resolve the stiffest contact "
+                          "element (%d per period): %.3g steps (at most %ld); a softer contact "
+                          "(kc, kc-abs) or --method penalty", (int)PD_NEWMARK_STEPS_PER_CONTACT, steps,
+                          po->max_steps);
+    return pd_err_set(err, PD_EINVAL, "dt: newmark's %.3g steps (at most %ld); a longer step",
+                      steps, po->max_steps);
+}
+
 /* Contact stiffness in Pi units (see the file comment). */
 double pd_osc_penalty_kc(const pd_osc *c, const pd_penalty_setup *po)
 {
@@ -358,6 +372,10 @@ int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler samp
     eo.time_unit = 1.0 / wp; /* tau = wp t */
 
     double cpu0 = pd_cpu_seconds();
+    if ((rc = pd_newmark_budget(&eo, h_out, tau_end, err))) {
+        free(brks);
+        return rc;
+    }
     rc = pd_penalty_run(&model, 0.0, NULL, NULL, tau_end, &eo, sampler ? emit_sample : NULL,
                         &tr, &pr, err);
     free(brks);

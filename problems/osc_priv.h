@@ -101,6 +101,10 @@ int pd_osc_adapt(const pd_osc *c, const pd_run_opts *o, pd_osc_sampler sampler, 
 
 /* dt / k, the Newmark step for the output step dt and the element period Tc. */
 double pd_newmark_step(double dt, double Tc);
+/* Newmark's steps of h over tau_end within po's budget, up front: PD_OK, or
+ * PD_EINVAL naming the flag that made them too many (kc when h is a
+ * fraction of the grid's step dt, else dt). */
+int pd_newmark_budget(const pd_penalty_opts *po, double dt, double tau_end, pd_err *err);
 
 /* The contact element's stiffness in Pi units (osc_penalty.c's file comment). */
 double pd_osc_penalty_kc(const pd_osc *c, const pd_penalty_setup *po);

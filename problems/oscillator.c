@@ -673,12 +673,14 @@ int pd_osc_run(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler,
     if (!c || !res)
         return PD_NULL_ARG(err, !c ? "c" : "res");
     pd_run_opts o = opts ? *opts : pd_run_default_opts();
+    int rc;
     switch (pd_osc_method(c, &o)) {
-    case PD_METHOD_EVENT: return pd_osc_reference(c, &o, sampler, ctx, res, err);
+    case PD_METHOD_EVENT: rc = pd_osc_reference(c, &o, sampler, ctx, res, err); break;
     case PD_METHOD_PENALTY:
-    case PD_METHOD_NEWMARK: return pd_osc_penalty(c, &o, sampler, ctx, res, err);
-    default: return pd_osc_simulate(c, &o, sampler, ctx, res, err);
+    case PD_METHOD_NEWMARK: rc = pd_osc_penalty(c, &o, sampler, ctx, res, err); break;
+    default: rc = pd_osc_simulate(c, &o, sampler, ctx, res, err); break;
     }
+    return rc ? rc : pd_demand_check_force(res->max_impulse, res->force_equiv, -1, err);
 }
 
 /* The run, its no-wall twin, Pi1 = umax / Le, gamma and chi. */

@@ -1130,7 +1130,10 @@ static int run_penalty(const pd_model *md, const pd_run_opts *o, double tau_end,
     po.on_step = step_penalty;
     po.on_step_ctx = tr;
     po.factor = o->factor;
-    int rc = pd_penalty_run(md, 0.0, NULL, NULL, tau_end, &po, tr->fn ? observe_grid : NULL, tr,
+    int rc = pd_newmark_budget(&po, tr->h, tau_end, err);
+    if (rc)
+        return rc;
+    rc = pd_penalty_run(md, 0.0, NULL, NULL, tau_end, &po, tr->fn ? observe_grid : NULL, tr,
                             &pr, err);
     res->steps = pr.steps;
     res->kernel = pr.stepper ? pr.stepper : "penalty";
@@ -1235,6 +1238,13 @@ int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler s
                                                   sc->st[s].height[k];
     for (int a = 0; a < res->m; a++)
         res->force_equiv[a] = pd_equivalent_force(res->max_impulse[a], res->contact_duration);
+    for (int s = 0; s < sc->nstruct && !rc; s++)
+        for (int k = 0; k < sc->st[s].storeys && !rc; k++)
+            rc = pd_demand_check_drift(res->drift[sc->st[s].dof + k],
+                                       res->drift_ratio[sc->st[s].dof + k], sc->st[s].name,
+                                       k + 1, err);
+    for (int a = 0; a < res->m && !rc; a++)
+        rc = pd_demand_check_force(res->max_impulse[a], res->force_equiv[a], a, err);
     return rc;
 }
 

@@ -106,6 +106,7 @@ void suite_ed_linear(pd_test_ctx *ctx);
 void suite_records_run(pd_test_ctx *ctx);
 void suite_plots(pd_test_ctx *ctx);
 void suite_outputs(pd_test_ctx *ctx);
+void suite_harden(pd_test_ctx *ctx);
 void suite_api_null(pd_test_ctx *ctx);
 
 #endif

@@ -1,0 +1,224 @@
+/* test_harden.c — the fourth hardening round's regressions (issue 29): each
+ * case failed before its fix. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <hdf5_hl.h>
+
+#include "pd_test.h"
+
+/* Two SDOFs 2 cm apart under a cosine pulse (examples/scenes/two-sdof.json),
+ * the second's storey height h (0: the default). */
+static pd_scene *two_sdof(pd_test_ctx *ctx, double h)
+{
+    pd_scene_excitation exc = {.pulse = PD_PULSE_COSINE, .dir = 1, .ap = 3.0, .Tp = 0.6};
+    pd_scene *sc = pd_scene_new(&exc);
+    pd_err e;
+    if (!CHECK(ctx, sc != NULL, "out of memory"))
+        return NULL;
+    if (!CHECK(ctx, !pd_scene_add_sdof(sc, "stiff", 0.4, 0.05, 2e5, &e) &&
+                        !pd_scene_add_sdof(sc, "flexible", 1.2, 0.05, 1e5, &e) &&
+                        (h == 0.0 || !pd_scene_set_heights(sc, &h, &e)) &&
+                        !pd_scene_add_contact(sc, 0, 1, 1, 1, 0.02, 0.65, 0, &e) &&
+                        !pd_scene_finish(sc, &e),
+               "scene: %s", e.msg)) {
+        pd_scene_free(sc);
+        return NULL;
+    }
+    return sc;
+}
+
+/* Defect 4: a derived demand that overflows (the equivalent force pi I /
+ * (2 td) of td = 1e-307 s, the drift ratio of a 5e-324 m storey) is refused
+ * naming its input, not reported as success with inf. */
+static void test_harden_derived_overflow(pd_test_ctx *ctx)
+{
+    pd_scene *sc = two_sdof(ctx, 0.0);
+    if (!sc)
+        return;
+    pd_scene_result r;
+    pd_err e;
+    if (!CHECK(ctx, !pd_scene_result_alloc(sc, &r, &e), "%s", e.msg)) {
+        pd_scene_free(sc);
+        return;
+    }
+    pd_run_opts o = pd_run_default_opts();
+    o.method = PD_METHOD_EVENT;
+    int rc = pd_scene_run(sc, &o, NULL, NULL, &r, &e);
+    CHECK(ctx, rc == PD_OK && isfinite(r.force_equiv[0]) && r.force_equiv[0] > 0.0,
+          "the default duration: rc %d, force %g", rc, r.force_equiv[0]);
+    o.contact_duration = 1e-307;
+    rc = pd_scene_run(sc, &o, NULL, NULL, &r, &e);
+    CHECK(ctx, rc == PD_EINVAL && strstr(e.msg, "contact-duration"),
+          "td 1e-307: rc %d (%s), force %g", rc, e.msg, r.force_equiv[0]);
+    pd_scene_result_free(&r);
+    pd_scene_free(sc);
+
+    /* the storey height: the last structure's */
+    sc = two_sdof(ctx, 5e-324);
+    if (!sc)
+        return;
+    rc = pd_scene_result_alloc(sc, &r, &e);
+    if (CHECK(ctx, rc == PD_OK, "%s", e.msg)) {
+        o.contact_duration = 0.0;
+        rc = pd_scene_run(sc, &o, NULL, NULL, &r, &e);
+        CHECK(ctx, rc == PD_EINVAL && strstr(e.msg, "storey_heights") && strstr(e.msg, "flexible"),
+              "height 5e-324: rc %d (%s), drift ratio %g", rc, e.msg, r.drift_ratio[1]);
+        pd_scene_result_free(&r);
+    }
+    pd_scene_free(sc);
+}
+
+/* A scene file of two SDOFs, the second named `name`, in dir: its path. */
+static int write_scene(const char *dir, const char *name, char *path, size_t cap)
+{
+    snprintf(path, cap, "%s/scene.json", dir);
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return -1;
+    fprintf(f, "{\"excitation\": {\"pulse\": \"cosine\", \"dir\": \"+x\", \"ap\": 3.0, \"Tp\": 0.6},\n"
+               " \"structures\": [{\"name\": \"stiff\", \"T0\": 0.4, \"xi\": 0.05, \"mass\": 2e5},\n"
+               "                {\"name\": \"%s\", \"T0\": 1.2, \"xi\": 0.05, \"mass\": 1e5}],\n"
+               " \"contacts\": [{\"a\": \"stiff\", \"b\": \"%s\", \"gap\": 0.02, \"eps\": 0.65}],\n"
+               " \"tend\": 2.0}\n", name, name);
+    return fclose(f) ? -1 : 0;
+}
+
+/* Defect 5: structures named as the file's dimensions (t, storey) keep
+ * their HDF5 output; t's scale is the root's. */
+static void test_harden_h5_dimension_names(pd_test_ctx *ctx)
+{
+    if (!pd_test_have_pound(ctx))
+        return;
+    const char *names[] = {"t", "storey", "x"};
+    for (int k = 0; k < 3; k++) {
+        char dir[] = "/tmp/pd_harden_XXXXXX", scene[512], out[512];
+        if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
+            return;
+        snprintf(out, sizeof out, "%s/o.h5", dir);
+        if (CHECK(ctx, write_scene(dir, names[k], scene, sizeof scene) == 0, "scene file")) {
+            const char *args[] = {"simulate", "--scene", scene, "-o", out, NULL};
+            proc_out r;
+            pd_test_pound(ctx, args, &r);
+            CHECK(ctx, r.status == 0, "structure '%s': exit %d: %s", names[k], r.status, r.err);
+            pd_test_proc_free(&r);
+            H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+            hid_t f = H5Fopen(out, H5F_ACC_RDONLY, H5P_DEFAULT);
+            char path[128];
+            snprintf(path, sizeof path, "structures/%s/x", names[k]);
+            hid_t ds = f >= 0 ? H5Dopen2(f, path, H5P_DEFAULT) : -1;
+            hid_t t = f >= 0 ? H5Dopen2(f, "t", H5P_DEFAULT) : -1;
+            CHECK(ctx, ds >= 0 && t >= 0 && H5DSis_attached(ds, t, 0) > 0,
+                  "structure '%s': %s not on the root's t", names[k], path);
+            if (ds >= 0)
+                H5Dclose(ds);
+            if (t >= 0)
+                H5Dclose(t);
+            if (f >= 0)
+                H5Fclose(f);
+        }
+        pd_test_rm_dir(dir);
+    }
+}
+
+/* Defect 7: a soft CPU limit (SIGXCPU) ends pound without its temporary
+ * output file, as SIGTERM does. */
+static void test_harden_cpu_limit_cleans_up(pd_test_ctx *ctx)
+{
+    if (!pd_test_have_pound(ctx))
+        return;
+    if (access("/usr/bin/prlimit", X_OK) != 0) {
+        pd_test_skip(ctx, "no /usr/bin/prlimit");
+        return;
+    }
+    char dir[] = "/tmp/pd_harden_XXXXXX", out[512];
+    if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
+        return;
+    snprintf(out, sizeof out, "%s/o.h5", dir);
+    /* about a minute of CPU: the limit of 1 s falls inside the run */
+    const char *argv[] = {"/usr/bin/prlimit", "--cpu=1:60", ctx->pound, "simulate", "--chain",
+                          "100", "--method", "moreau", "--dt", "1e-6", "--every", "1000", "-o",
+                          out, NULL};
+    proc_out r;
+    pd_test_spawn(argv, NULL, &r);
+    CHECK(ctx, r.status == -1, "exit %d, expected death by SIGXCPU: %s", r.status, r.err);
+    CHECK(ctx, pd_test_dir_entries(dir) == 0, "%d files left in %s", pd_test_dir_entries(dir),
+          dir);
+    pd_test_proc_free(&r);
+    pd_test_rm_dir(dir);
+}
+
+/* One run of pound (args after the binary, env as pd_test_spawn's): exit 2
+ * and one line naming `named`. */
+static void refused(pd_test_ctx *ctx, const char *const *args, const char *env, const char *named)
+{
+    const char *argv[16] = {ctx->pound};
+    for (int i = 0; args[i] && i < 14; i++)
+        argv[i + 1] = args[i];
+    proc_out r;
+    pd_test_spawn(argv, env, &r);
+    char *nl = strchr(r.err, '\n');
+    CHECK(ctx, r.status == 2 && strstr(r.err, named) && nl && nl[1] == '\0',
+          "%s %s (%s): exit %d, expected 2 and one line naming '%s': %s", args[0], args[1],
+          env ? env : "", r.status, named, r.err);
+    pd_test_proc_free(&r);
+}
+
+/* Defect 10: a shared folder the user names and a POUND_ISA naming no
+ * instruction set are refused, not skipped or ignored. */
+static void test_harden_bench_shared_and_isa(pd_test_ctx *ctx)
+{
+    if (!pd_test_have_pound(ctx))
+        return;
+    refused(ctx, (const char *[]){"bench", "--lcp", "--shared", "/nonexistent", NULL}, NULL,
+            "--shared /nonexistent");
+    refused(ctx, (const char *[]){"simulate", "--json", NULL}, "POUND_ISA=avx3", "POUND_ISA");
+    refused(ctx, (const char *[]){"spectrum", "--Pi2", "0.5:1:2", NULL}, "POUND_ISA=", "POUND_ISA");
+}
+
+/* Defect 9: Newmark's step budget refused up front naming the flag that
+ * made the steps too many; another method's flags refused with --method. */
+static void test_harden_method_flags(pd_test_ctx *ctx)
+{
+    if (!pd_test_have_pound(ctx))
+        return;
+    refused(ctx, (const char *[]){"simulate", "--method", "newmark", "--kc", "1e300", NULL}, NULL,
+            "kc:");
+    refused(ctx, (const char *[]){"simulate", "--method", "newmark", "--dt", "1e-8", NULL}, NULL,
+            "dt:");
+    refused(ctx, (const char *[]){"simulate", "--scene", "examples/scenes/two-sdof.json",
+                                  "--method", "newmark", "--kc", "1e300", NULL}, NULL, "kc:");
+    refused(ctx, (const char *[]){"simulate", "--method", "moreau", "--close-tol", "1e-9", NULL},
+            NULL, "--close-tol");
+    refused(ctx, (const char *[]){"simulate", "--method", "newmark", "--theta", "0.6", NULL}, NULL,
+            "--theta");
+    refused(ctx, (const char *[]){"simulate", "--method", "event", "--kc", "10", NULL}, NULL,
+            "--kc");
+    refused(ctx, (const char *[]){"simulate", "--method", "newmark", "--stepper", "rk4imp", NULL},
+            NULL, "--stepper");
+    /* what each method reads stays accepted */
+    const char *ok[][10] = {{"simulate", "--method", "newmark", "--kc", "10", NULL},
+                           {"simulate", "--method", "penalty", "--stepper", "rk4imp", NULL},
+                           {"simulate", "--method", "event", "--dt", "0.01", NULL},
+                           {"simulate", "--chain", "3", "--method", "moreau", "--rtol", "1e-3",
+                            "--close-tol", "1e-9", NULL}};
+    for (size_t k = 0; k < sizeof ok / sizeof ok[0]; k++) {
+        proc_out r;
+        pd_test_pound(ctx, ok[k], &r);
+        CHECK(ctx, r.status == 0, "%s %s %s: exit %d: %s", ok[k][1], ok[k][2], ok[k][3], r.status,
+              r.err);
+        pd_test_proc_free(&r);
+    }
+}
+
+void suite_harden(pd_test_ctx *ctx)
+{
+    pd_test_run(ctx, "harden_derived_overflow", test_harden_derived_overflow);
+    pd_test_run(ctx, "harden_h5_dimension_names", test_harden_h5_dimension_names);
+    pd_test_run(ctx, "harden_cpu_limit_cleans_up", test_harden_cpu_limit_cleans_up);
+    pd_test_run(ctx, "harden_bench_shared_and_isa", test_harden_bench_shared_and_isa);
+    pd_test_run(ctx, "harden_method_flags", test_harden_method_flags);
+}
