@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -199,14 +200,51 @@ static const H5FD_class_t sink_class = {
     .fl_map = H5FD_FLMAP_DICHOTOMY,
 };
 
+int pd_h5_headroom(double bytes)
+{
+    struct rlimit lim;
+    if (getrlimit(RLIMIT_AS, &lim) != 0 || lim.rlim_cur == RLIM_INFINITY)
+        return 0;
+    FILE *f = fopen("/proc/self/statm", "r");
+    unsigned long pages = 0;
+    int got = f && fscanf(f, "%lu", &pages) == 1;
+    if (f)
+        fclose(f);
+    if (!got)
+        return 0;
+    double used = (double)pages * (double)sysconf(_SC_PAGESIZE);
+    return (double)lim.rlim_cur - used < bytes ? ENOMEM : 0;
+}
+
+int pd_h5_errno(void)
+{
+    return errno == ENOMEM ? ENOMEM : EIO;
+}
+
+void pd_h5_start(void)
+{
+    /* no clean-up at exit: a file a failed run could not close (out of
+     * memory inside the library) would be closed then through its freed
+     * driver; the runs close what they open */
+    H5dont_atexit();
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL); /* the library must not print */
+    errno = 0;
+}
+
 hid_t pd_h5_create(const char *path, hid_t fcpl, int *failure)
 {
     sink_info info = {.failure = failure};
     hid_t file = -1;
     *failure = 0;
-    H5Eset_auto2(H5E_DEFAULT, NULL, NULL); /* the library must not print */
+    pd_h5_start();
+    if ((*failure = pd_h5_headroom(PD_H5_HEADROOM)))
+        return -1;
     hid_t drv = H5FDregister(&sink_class), fapl = H5Pcreate(H5P_FILE_ACCESS);
-    if (drv >= 0 && fapl >= 0 && H5Pset_driver(fapl, drv, &info) >= 0)
+    /* no chunk cache: every append is whole chunks (a writer's buffer is
+     * its datasets' chunk), and a cache of 1 MB per dataset is gigabytes
+     * for scenes of thousands of structures */
+    if (drv >= 0 && fapl >= 0 && H5Pset_driver(fapl, drv, &info) >= 0 &&
+        H5Pset_cache(fapl, 0, 521, 0, 0.75) >= 0)
         file = H5Fcreate(path, H5F_ACC_TRUNC, fcpl, fapl);
     if (fapl >= 0)
         H5Pclose(fapl);
@@ -215,7 +253,7 @@ hid_t pd_h5_create(const char *path, hid_t fcpl, int *failure)
     if (file >= 0 && *failure) /* the superblock could not be written */
         pd_h5_close(&file, failure);
     if (file < 0 && !*failure)
-        *failure = EIO;
+        *failure = pd_h5_errno();
     return file;
 }
 

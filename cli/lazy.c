@@ -19,6 +19,7 @@
  * Built when the Makefile finds the sonames (PD_LAZY_HDF5, PD_LAZY_HDF5_HL,
  * PD_LAZY_CHOLMOD); otherwise the libraries are linked as usual and this
  * file is empty. */
+#include <errno.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -30,6 +31,7 @@ typedef struct lazy_lib {
     const char *soname, *what;
     void *handle;
     int ok;
+    int oom; /* the loader ran out of memory (its segments could not be mapped) */
 } lazy_lib;
 
 /* Symbol `name` of the library, NULL (and one line) when it cannot be had. */
@@ -38,11 +40,17 @@ static void *lazy_sym(lazy_lib *lib, const char *name)
     if (lib->ok == 0) {
         lib->handle = dlopen(lib->soname, RTLD_NOW | RTLD_LOCAL);
         lib->ok = lib->handle ? 1 : -1;
-        if (!lib->handle)
-            fprintf(stderr, "pound: %s needs %s: %s\n", lib->what, lib->soname, dlerror());
+        if (!lib->handle) {
+            const char *why = dlerror();
+            lib->oom = why && (strstr(why, "map segment") || strstr(why, "memory"));
+            fprintf(stderr, "pound: %s needs %s: %s\n", lib->what, lib->soname, why);
+        }
     }
-    if (lib->ok < 0)
+    if (lib->ok < 0) {
+        if (lib->oom) /* the callers report the failure by errno */
+            errno = ENOMEM;
         return NULL;
+    }
     void *p = dlsym(lib->handle, name);
     if (!p)
         fprintf(stderr, "pound: %s: %s has no %s\n", lib->what, lib->soname, name);
@@ -59,6 +67,8 @@ static void *lazy_sym(lazy_lib *lib, const char *name)
             void *p = lazy_sym(&lib, #name);                                                  \
             memcpy(&fn, &p, sizeof fn); /* object to function pointer, as POSIX allows */     \
         }                                                                                     \
+        if (!fn && lib.oom) /* the callers report the failure by errno */                  \
+            errno = ENOMEM;                                                                   \
         return fn ? fn args : (fail);                                                         \
     }
 #endif
@@ -105,6 +115,7 @@ herr_t H5open(void)
 }
 
 H5_FN(herr_t, H5check_version, (unsigned majnum, unsigned minnum, unsigned relnum), (majnum, minnum, relnum), -1)
+H5_FN(herr_t, H5dont_atexit, (void), (), -1)
 H5_FN(herr_t, H5Eset_auto2, (hid_t estack_id, H5E_auto2_t func, void *client_data), (estack_id, func, client_data), -1)
 H5_FN(H5I_type_t, H5Iget_type, (hid_t id), (id), H5I_BADID)
 H5_FN(hid_t, H5Fcreate, (const char *filename, unsigned flags, hid_t fcpl_id, hid_t fapl_id), (filename, flags, fcpl_id, fapl_id), -1)
@@ -126,6 +137,7 @@ H5_FN(hid_t, H5Pcreate, (hid_t cls_id), (cls_id), -1)
 H5_FN(herr_t, H5Pclose, (hid_t plist_id), (plist_id), -1)
 H5_FN(herr_t, H5Pset_chunk, (hid_t plist_id, int ndims, const hsize_t dim[]), (plist_id, ndims, dim), -1)
 H5_FN(herr_t, H5Pset_obj_track_times, (hid_t plist_id, hbool_t track_times), (plist_id, track_times), -1)
+H5_FN(herr_t, H5Pset_cache, (hid_t plist_id, int mdc_nelmts, size_t rdcc_nslots, size_t rdcc_nbytes, double rdcc_w0), (plist_id, mdc_nelmts, rdcc_nslots, rdcc_nbytes, rdcc_w0), -1)
 H5_FN(herr_t, H5Pset_driver, (hid_t plist_id, hid_t driver_id, const void *driver_info), (plist_id, driver_id, driver_info), -1)
 H5_FN(const void *, H5Pget_driver_info, (hid_t plist_id), (plist_id), NULL)
 H5_FN(hid_t, H5FDregister, (const H5FD_class_t *cls), (cls), -1)

@@ -299,7 +299,7 @@ int pd_lcp_set_read(const char *path, pd_lcp_set *s, pd_err *err)
 {
     long len[11];
     memset(s, 0, sizeof *s);
-    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    pd_h5_start();
     hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
     if (f < 0)
         return pd_err_set(err, PD_EIO, "%s: cannot open as HDF5", path);

@@ -132,6 +132,11 @@ static int finish_stdout(int status)
 
 int main(int argc, char **argv)
 {
+    /* CHOLMOD's BLAS on the calling thread (unless the user says): its
+     * factors here are banded and small per column, and OpenBLAS's worker
+     * threads spin between calls and, out of memory, retry their buffers
+     * forever while exit waits for them */
+    setenv("OPENBLAS_NUM_THREADS", "1", 0);
     pd_output_signals();
     return finish_stdout(dispatch(argc, argv));
 }

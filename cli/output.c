@@ -527,7 +527,7 @@ static int h5_table_open(pd_table_writer *w)
         w->ds[j] = pd_h5_extendible(w->file, c->name, H5T_NATIVE_DOUBLE, 0, w->chunk,
                                     column_units(c));
         if (w->ds[j] < 0 || (c->labels && h5_codes_attr(w->ds[j], c)))
-            return w->failure ? w->failure : EIO;
+            return w->failure ? w->failure : pd_h5_errno();
     }
     return w->failure;
 }
@@ -605,6 +605,9 @@ int pd_table_open(pd_table_writer **out, const char *path, int ncols, const pd_c
 static int flush_rows(pd_table_writer *w)
 {
     int rc = 0;
+    if (!w->failure && w->nbuf > 0 &&
+        (w->failure = pd_h5_headroom(PD_H5_HEADROOM + 8.0 * (double)w->nbuf * w->ncols)))
+        return -1;
     for (int j = 0; j < w->ncols && w->nbuf > 0 && !rc && !w->failure; j++) {
         for (long r = 0; r < w->nbuf; r++)
             w->col[r] = w->buf[(size_t)r * w->ncols + j];
@@ -612,7 +615,7 @@ static int flush_rows(pd_table_writer *w)
     }
     w->nbuf = 0;
     if (rc && !w->failure)
-        w->failure = EIO;
+        w->failure = pd_h5_errno();
     return w->failure ? -1 : 0;
 }
 
@@ -677,7 +680,7 @@ static int h5_table_finish(pd_table_writer *w, int nattrs, const pd_attr *attrs)
     for (int j = 0; j < w->ncols; j++)
         rc |= pd_h5_close_id(&w->ds[j]);
     int e = pd_h5_close(&w->file, &w->failure);
-    return e ? e : rc ? EIO : 0;
+    return e ? e : rc ? pd_h5_errno() : 0;
 }
 
 /* Copy the rest of from into c. */

@@ -19,6 +19,20 @@
  * -1 with *failure set (nothing left open). */
 hid_t pd_h5_create(const char *path, hid_t fcpl, int *failure);
 
+/* Start the library for pound's use (before any other call): no clean-up
+ * at exit, nothing printed, errno cleared.  pd_h5_create calls it. */
+void pd_h5_start(void);
+/* The library's allocations fail inside it, and HDF5 1.10 does not survive
+ * that (a corrupted heap, a crash at exit).  A writer calls this before
+ * each block of writes: ENOMEM when the address-space limit (RLIMIT_AS)
+ * leaves less than `bytes` free (then it writes nothing more and reports
+ * out of memory), else 0. */
+#define PD_H5_HEADROOM (64.0 * 1048576.0) /* the library's caches and indexes */
+int pd_h5_headroom(double bytes);
+/* The errno of a failed library call: ENOMEM when the library ran out of
+ * memory, else EIO. */
+int pd_h5_errno(void);
+
 /* Close *file (set to -1); 0, or the errno of the first failure of the file
  * (EIO when the library itself failed). */
 int pd_h5_close(hid_t *file, const int *failure);

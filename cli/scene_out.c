@@ -51,6 +51,15 @@ static int ends_with(const char *path, const char *suffix)
     return n > k && !strcmp(path + n - k, suffix);
 }
 
+/* The first failure, or the address space running short for the library
+ * (pd_h5_headroom): 1 when the writer must stop. */
+static int short_of_memory(pd_scene_writer *w)
+{
+    if (!w->failure)
+        w->failure = pd_h5_headroom(PD_H5_HEADROOM);
+    return w->failure != 0;
+}
+
 /* The groups and extendible datasets of every structure and contact: 0 or
  * an errno. */
 static int h5_open(pd_scene_writer *w)
@@ -60,12 +69,12 @@ static int h5_open(pd_scene_writer *w)
     if ((w->file = pd_h5_create(w->out.tmp, H5P_DEFAULT, &w->failure)) < 0)
         return w->failure;
     if (pd_provenance_h5(w->file, &w->prov))
-        return w->failure ? w->failure : EIO;
+        return w->failure ? w->failure : pd_h5_errno();
     hid_t gs = H5Gcreate2(w->file, "structures", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     hid_t gc = H5Gcreate2(w->file, "contacts", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     /* the dimensions: t at the root, storey (floors 1..S) in each structure */
     int rc = gs < 0 || gc < 0 || (w->ds_t = pd_h5_extendible_coord(w->file, "t", w->cap, "s")) < 0;
-    for (int s = 0; s < sc->nstruct && !rc; s++) {
+    for (int s = 0; s < sc->nstruct && !rc && !short_of_memory(w); s++) {
         hid_t g = H5Gcreate2(gs, sc->st[s].name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
         rc = g < 0 || pd_h5_index(g, "storey", sc->st[s].storeys, 1, "1") ||
              (w->ds_x[s] = pd_h5_extendible(g, "x", H5T_NATIVE_DOUBLE, sc->st[s].storeys, w->cap, "m")) < 0 ||
@@ -73,7 +82,8 @@ static int h5_open(pd_scene_writer *w)
         if (g >= 0 && H5Gclose(g) < 0)
             rc = 1;
     }
-    for (int a = 0; a < sc->ncontact && !rc; a++) {
+    for (int a = 0; a < sc->ncontact && !rc && !short_of_memory(w);
+         a++) {
         snprintf(name, sizeof name, "%d", a);
         hid_t g = H5Gcreate2(gc, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
         rc = g < 0 || (w->ds_g[a] = pd_h5_extendible(g, "gap", H5T_NATIVE_DOUBLE, 0, w->cap, "m")) < 0 ||
@@ -86,15 +96,16 @@ static int h5_open(pd_scene_writer *w)
      * to it, and rewritten back to back the old lists' space is reused (10,000
      * attachments interleaved with the creations left 245 MB of dead lists).
      * A new dataset is attached here too. */
-    for (int s = 0; s < sc->nstruct && !rc; s++)
+    for (int s = 0; s < sc->nstruct && !rc && !short_of_memory(w); s++)
         rc = pd_h5_dims(w->ds_x[s], "t,storey") || pd_h5_dims(w->ds_v[s], "t,storey");
-    for (int a = 0; a < sc->ncontact && !rc; a++)
+    for (int a = 0; a < sc->ncontact && !rc && !short_of_memory(w);
+         a++)
         rc = pd_h5_dims(w->ds_g[a], "t") || pd_h5_dims(w->ds_p[a], "t");
     if (gs >= 0 && H5Gclose(gs) < 0)
         rc = 1;
     if (gc >= 0 && H5Gclose(gc) < 0)
         rc = 1;
-    return w->failure ? w->failure : rc ? EIO : 0;
+    return w->failure ? w->failure : rc ? pd_h5_errno() : 0;
 }
 
 /* The CSV's provenance, units and header rows: 0 or an errno. */
@@ -226,6 +237,8 @@ static int flush_rows(pd_scene_writer *w)
     int n = sc->n, m = sc->ncontact, rc = 0;
     if (nb == 0 || w->failure)
         return w->failure ? -1 : 0;
+    if (w->hdf5 && (w->failure = pd_h5_headroom(PD_H5_HEADROOM + 8.0 * (double)nb * w->width)))
+        return -1;
     if (!w->hdf5) {
         for (long r = 0; r < nb; r++) {
             const double *row = w->buf + (size_t)r * w->width;
@@ -254,7 +267,7 @@ static int flush_rows(pd_scene_writer *w)
     }
     w->nbuf = 0;
     if (rc && !w->failure)
-        w->failure = EIO;
+        w->failure = w->hdf5 ? pd_h5_errno() : EIO;
     return w->failure ? -1 : 0;
 }
 

@@ -224,6 +224,9 @@ struct pd_edr {
     int *pos_in;
     unsigned char *guess;      /* the LCP's warm start */
     double *Dd;                /* dense Delassus */
+    double *Dlu, *rtmp;        /* the clusters' refinement: D_AA's LU, 4 dm */
+    int *lu_perm;              /* 2 dm: its rows, the pushing contacts */
+    double *cG;                /* per cluster slot: a refined stage's impulse on it */
     double *Dval;              /* compressed Delassus */
     int *Dcol, *Drow;
     long Dcap;

@@ -32,6 +32,7 @@
  *      M-orthogonally by the cluster's start) if the force LCP and the
  *      force at the tail's middle and end keep it;
  *   5. new clusters from the held contacts, new flights, predictions. */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -66,6 +67,13 @@
 /* A closing must take the gap below -this times the size of its terms
  * (g0 and the displacements it adds): its rounding level. */
 #define EDR_GAP_ROUND 1e-14
+/* A stage's Newton residual, formed on the clusters, is refined when it
+ * exceeds this many roundings of its terms (DBL_EPSILON), in at most
+ * EDR_REFINE_MAX steps. */
+#define EDR_REFINE_TOL 64.0
+#define EDR_REFINE_MAX 8
+/* An impact's work may exceed 0 by this many roundings of its terms. */
+#define EDR_WORK_TOL 16.0
 
 pd_edr_opts pd_edr_default_opts(void)
 {
@@ -669,7 +677,7 @@ static void group_grow(pd_edr *r, double t)
                 if (!(g <= tol))
                     continue;
                 group_add_contact(r, a);
-                r->res.tol_closed += g > 0.0;
+                r->res.tol_closed += g + (r->md->g0[a] - r->ct[a].g0) > 0.0; /* the gap given */
                 const edr_contact *ct = &r->ct[a];
                 for (int s = 0; s < 2; s++)
                     if (ct->dof[s] >= 0)
@@ -1273,6 +1281,86 @@ static int movable(const pd_edr *r, int a)
     return side_sigma(r, a, 0) != 0.0 || side_sigma(r, a, 1) != 0.0;
 }
 
+/* r_x = q_x + sum_s sigma_xs G_c / mu_c, G_c = sum_y sigma_yc z_y the
+ * stage's impulse on the cluster c of side s (D z without D), and
+ * scale_x the sum of the magnitudes of its terms. */
+static void reduced_residual(const pd_edr *r, const int *idx, int k, const double *q,
+                             const double *z, double *res, double *scale)
+{
+    for (int x = 0; x < k; x++) {
+        int a = r->g_ct[idx[x]];
+        double sum = q[x], sc = fabs(q[x]);
+        for (int s = 0; s < 2; s++) {
+            double sa = side_sigma(r, a, s);
+            if (sa == 0.0)
+                continue;
+            int c = cl_of_dof(r, r->ct[a].dof[s]);
+            double G = 0.0;
+            for (int y = 0; y < k; y++) {
+                int b = r->g_ct[idx[y]];
+                for (int u = 0; u < 2; u++)
+                    if (r->ct[b].dof[u] >= 0 && cl_of_dof(r, r->ct[b].dof[u]) == c)
+                        G += side_sigma(r, b, u) * z[y];
+            }
+            double term = sa * (G / r->cmu[c]);
+            sum += term;
+            sc += fabs(term);
+        }
+        res[x] = sum;
+        scale[x] = sc;
+    }
+}
+
+/* z_A -= D_AA^-1 r_A on the pushing contacts A = {z > 0}, r from
+ * reduced_residual, while r shrinks: the entries of D lose a heavy
+ * cluster's 1/mu under a light one's (D = W^T M^-1 W of condition up to
+ * 1e13), and Lemke's z with them, while r keeps it.  Untouched when r_A
+ * is at its rounding level; 1 when z was refined. */
+static int refine_reduced(pd_edr *r, const int *idx, int k, const double *D, const double *q,
+                          double *z)
+{
+    double *res = r->rtmp, *scale = res + k, *zt = scale + k, *dz = zt + k;
+    int *ax = r->lu_perm + k, na = 0, trig = 0;
+    reduced_residual(r, idx, k, q, z, res, scale);
+    for (int x = 0; x < k; x++)
+        if (z[x] > 0.0) {
+            ax[na++] = x;
+            trig |= fabs(res[x]) > EDR_REFINE_TOL * DBL_EPSILON * scale[x];
+        }
+    if (!trig)
+        return 0;
+    for (int i = 0; i < na; i++)
+        for (int j = 0; j < na; j++)
+            r->Dlu[i + (size_t)j * na] = D[ax[i] + (size_t)ax[j] * k];
+    if (pd_dense_lu(na, r->Dlu, na, r->lu_perm, DBL_EPSILON))
+        return 0;
+    double norm = 0.0;
+    for (int i = 0; i < na; i++)
+        norm = fmax(norm, fabs(res[ax[i]]));
+    int refined = 0;
+    for (int it = 0; it < EDR_REFINE_MAX && norm > 0.0; it++) {
+        for (int i = 0; i < na; i++)
+            dz[i] = -res[ax[i]];
+        pd_dense_lu_solve(na, r->Dlu, na, r->lu_perm, dz);
+        int ok = 1;
+        memcpy(zt, z, (size_t)k * sizeof(double));
+        for (int i = 0; i < na; i++)
+            ok &= (zt[ax[i]] += dz[i]) > 0.0;
+        if (!ok)
+            break; /* the pushing set would change: Lemke's */
+        reduced_residual(r, idx, k, q, zt, res, scale);
+        double nt = 0.0;
+        for (int i = 0; i < na; i++)
+            nt = fmax(nt, fabs(res[ax[i]]));
+        if (!(nt < norm))
+            break;
+        memcpy(z, zt, (size_t)k * sizeof(double));
+        norm = nt;
+        refined = 1;
+    }
+    return refined;
+}
+
 /* The same stages on the clusters' coordinates: held trees move rigidly,
  * so only the closed contacts between clusters are unknowns (one or two,
  * not the whole compressed row), U_a = sum sigma eta_c, an impulse P_a
@@ -1338,6 +1426,7 @@ static int reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
                     }
                 D[x + (size_t)y * k] = dxy;
             }
+        int refined = 0;
         if (k == 1) {
             z[0] = pd_contact_impulse_1(D[0], q[0]);
         } else {
@@ -1345,19 +1434,41 @@ static int reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
             if ((rc = small_lcp(r, k, D, q, z, r->ztmp)))
                 return pd_err_set(err, rc, "row reference: the impact LCP of %d contacts at t = "
                                   "%.9g s was not solved", k, t * r->o.time_unit);
+            refined = refine_reduced(r, idx, k, D, q, z);
         }
         r->res.lcp_solves += k == 1;
         r->res.simultaneous += k > 1;
+        if (refined) /* each cluster's rate from its total impulse G_c (as the residual) */
+            for (int x = 0; x < k; x++) {
+                int a = r->g_ct[idx[x]];
+                for (int s = 0; s < 2; s++)
+                    if (r->ct[a].dof[s] >= 0)
+                        r->cG[cl_of_dof(r, r->ct[a].dof[s])] = 0.0;
+            }
         for (int x = 0; x < k; x++) {
             int j = idx[x], a = r->g_ct[j];
             for (int s = 0; s < 2; s++)
                 if (r->ct[a].dof[s] >= 0) {
                     int c = cl_of_dof(r, r->ct[a].dof[s]);
-                    if (r->cl[c].kind == EDR_SDOF)
+                    if (r->cl[c].kind != EDR_SDOF)
+                        continue;
+                    if (refined)
+                        r->cG[c] += side_sigma(r, a, s) * z[x];
+                    else
                         r->ceta[c] += side_sigma(r, a, s) * z[x] / r->cmu[c];
                 }
             r->P[j] += z[x];
             r->nimp[j] += q[x] < 0.0;
+        }
+        for (int x = 0; x < k && refined; x++) {
+            int a = r->g_ct[idx[x]];
+            for (int s = 0; s < 2; s++)
+                if (r->ct[a].dof[s] >= 0) {
+                    int c = cl_of_dof(r, r->ct[a].dof[s]);
+                    if (r->cl[c].kind == EDR_SDOF)
+                        r->ceta[c] += r->cG[c] / r->cmu[c];
+                    r->cG[c] = 0.0;
+                }
         }
     }
     /* dof rates, the impulses on each dof from the contacts between clusters */
@@ -1538,6 +1649,34 @@ static int reduced_force(pd_edr *r, const int *idx, int k, double t, pd_err *err
     return PD_OK;
 }
 
+/* The impact's work dK = 1/2 sum m (v+ - v-)(v+ + v-) over the group's
+ * dofs: with e <= 1 it is <= 0, up to its rounding, EDR_WORK_TOL eps
+ * sum (|v+| + |v-|) (m |v-| + sum_a |w_a P_a|); PD_ENUMERICAL beyond. */
+static int check_work(pd_edr *r, double t, pd_err *err)
+{
+    double dK = 0.0, tol = 0.0, K = 0.0;
+    for (int k = 0; k < r->ngd; k++)
+        r->gtmp[r->g_dof[k]] = 0.0;
+    for (int j = 0; j < r->ngc; j++) {
+        const edr_contact *ct = &r->ct[r->g_ct[j]];
+        for (int s = 0; s < 2; s++)
+            if (ct->dof[s] >= 0)
+                r->gtmp[ct->dof[s]] += fabs(ct->w[s] * r->P[j]);
+    }
+    for (int k = 0; k < r->ngd; k++) {
+        int i = r->g_dof[k];
+        double m = 1.0 / r->minv[i], vm = r->ev_vminus[k], vp = r->gv[i];
+        dK += 0.5 * m * (vp - vm) * (vp + vm);
+        tol += (fabs(vp) + fabs(vm)) * (m * fabs(vm) + r->gtmp[i]);
+        K += 0.5 * m * vm * vm;
+    }
+    if (dK <= EDR_WORK_TOL * DBL_EPSILON * tol)
+        return PD_OK;
+    return pd_err_set(err, PD_ENUMERICAL, "row reference: the impact at t = %.17g s adds %.3g of "
+                      "its kinetic energy (rounding allows %.3g): the impact LCP lost precision",
+                      t * r->o.time_unit, dK / K, EDR_WORK_TOL * DBL_EPSILON * tol / K);
+}
+
 /* Resolve the group at t: impact LCP if a contact closes, persistence,
  * accumulations, new clusters, predictions. */
 static int resolve_group(pd_edr *r, double t, pd_err *err)
@@ -1582,7 +1721,7 @@ static int resolve_group(pd_edr *r, double t, pd_err *err)
         rc = impact_stages(r, t, tolU, err);
     }
     r->res.accumulations += r->instant_acc;
-    if (rc || (rc = commit_impacts(r, t, err)))
+    if (rc || (rc = check_work(r, t, err)) || (rc = commit_impacts(r, t, err)))
         return rc;
     for (int j = 0; j < r->ngc; j++) {
         double U = contact_dot(r, r->g_ct[j], r->gv);
@@ -1803,7 +1942,7 @@ void pd_edr_free(pd_edr *r)
                       r->first, r->maxP, r->ctime, r->imp_out, r->q.heap, r->q.pos, r->q.key,
                       r->g_cl, r->cl_mark, r->g_ct, r->ct_mark, r->ct_mark2, r->ct_markD, r->ct_markP,
                       r->g_dof, r->gx, r->gv, r->gacc, r->gtmp, r->Uminus, r->Uplus, r->P,
-                      r->lam, r->wlcp, r->qlcp, r->wtmp, r->Dd, r->lcp_idx, r->jpos, r->held,
+                      r->lam, r->wlcp, r->qlcp, r->wtmp, r->Dd, r->Dlu, r->rtmp, r->lu_perm, r->cG, r->lcp_idx, r->jpos, r->held,
                       r->held_tail, r->excluded, r->guess, r->epos, r->qtmp, r->ztmp, r->pos_in, r->Dval, r->Dcol, r->Drow,
                       r->stack, r->pe, r->pdof, r->bfs_next, r->ceta, r->cmu, r->cvy, r->ext, r->nimp, r->crow, r->crow_c, r->keybuf, r->uf, r->gblk,
                       r->newcl, r->plist, r->dofc_ptr, r->dofc, r->loc, r->wk, r->mctx,
@@ -2077,7 +2216,8 @@ pd_edr *pd_edr_alloc(const pd_model *md, const pd_piecewise_force *F, const pd_e
         !ALLOC(r->ct_markD, m) || !ALLOC(r->ct_markP, m) || !ALLOC(r->g_dof, n) || !ALLOC(r->gx, n) || !ALLOC(r->gv, n) ||
         !ALLOC(r->gacc, n) || !ALLOC(r->gtmp, n) || !ALLOC(r->Uminus, m) || !ALLOC(r->Uplus, m) ||
         !ALLOC(r->P, m) || !ALLOC(r->lam, m) || !ALLOC(r->wlcp, m) || !ALLOC(r->qlcp, m) ||
-        !ALLOC(r->wtmp, m) || !ALLOC(r->Dd, (long)dm * dm) || !ALLOC(r->lcp_idx, m) ||
+        !ALLOC(r->wtmp, m) || !ALLOC(r->Dd, (long)dm * dm) || !ALLOC(r->Dlu, (long)dm * dm) ||
+        !ALLOC(r->rtmp, 4L * dm) || !ALLOC(r->lu_perm, 2L * dm) || !ALLOC(r->cG, nb) || !ALLOC(r->lcp_idx, m) ||
         !ALLOC(r->jpos, m) || !ALLOC(r->held, m) || !ALLOC(r->held_tail, m) ||
         !ALLOC(r->excluded, m) || !ALLOC(r->guess, m) || !ALLOC(r->epos, m) || !ALLOC(r->qtmp, m) || !ALLOC(r->ztmp, m) || !ALLOC(r->pos_in, m) || !ALLOC(r->Dval, r->Dcap) ||
         !ALLOC(r->Dcol, m + 1) || !ALLOC(r->Drow, r->Dcap) || !ALLOC(r->stack, n) ||
@@ -2126,6 +2266,13 @@ static void reset(pd_edr *r, double t0, const double *q0, const double *v0, doub
         r->vo[i] = v0 ? v0[i] : 0.0;
         r->xpos[i] = r->xneg[i] = r->drift[i] = -HUGE_VAL;
         r->loc[i] = -1;
+    }
+    /* a gap within the closing tolerance is closed: a row touching at gaps
+     * of 1e-300 runs as the row touching at 0, not as a cascade of bounces
+     * across gaps no event could tell apart */
+    for (int a = 0; a < m; a++) {
+        double g0 = r->md->g0[a];
+        r->ct[a].g0 = g0 > 0.0 && g0 <= r->o.close_tol * r->L ? 0.0 : g0;
     }
     for (int a = 0; a < m; a++) {
         r->cstate[a] = EDR_OPEN;

@@ -84,6 +84,10 @@ struct pd_mj {
     double *P_active;     /* m: impulses of the active set */
     double *w_active;     /* m: post-impact relative velocities of the active set */
     int *idx_active;      /* m: indices of the active contacts */
+    double *ref_lu;       /* dense Delassus only, m^2: D_AA's LU for the refinement */
+    double *ref_buf;      /* 4 m + 2 n: its residual, trial, step, What^-1 W_I P, W_I P */
+    int *ref_perm;        /* 2 m: its rows, the pushing contacts */
+    int refined;          /* 1: the last LCP was refined (v from ref_buf's What^-1 W_I P) */
     mj1_coef s1;          /* scalar kernel constants (no division in a step) */
     pd_state st;          /* the state the caller reads (pd_mj_state) */
     pd_state st_own;      /* the arrays mj->st was allocated with (the adaptive driver

@@ -10,12 +10,21 @@
  * oscillator, one wall: plain doubles, closed-form scalar LCP) and a general
  * one (the factorisation seam of pd_factor.h, Delassus blocks dense or in
  * compressed columns as the factor kind keeps them, the LCP solver table). */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "mj.h"
 #include "pd_null.h"
+
+/* A dense active LCP is refined when its D P cancels terms this many times
+ * larger than b (half the digits lost), until its Newton residual, formed
+ * through the factor, is within MJ_REFINE_TOL roundings (DBL_EPSILON) of
+ * its terms, in at most MJ_REFINE_MAX steps. */
+#define MJ_REFINE_GROWTH 1e8
+#define MJ_REFINE_TOL 64.0
+#define MJ_REFINE_MAX 8
 
 pd_mj_opts pd_mj_default_opts(void)
 {
@@ -62,6 +71,9 @@ void pd_mj_free(pd_mj *mj)
     free(mj->P_active);
     free(mj->w_active);
     free(mj->idx_active);
+    free(mj->ref_lu);
+    free(mj->ref_buf);
+    free(mj->ref_perm);
     free(mj->guess);
     free(mj->st_own.q);
     free(mj->st_own.v);
@@ -158,6 +170,11 @@ static int contact_workspace(pd_mj *mj, pd_err *err)
         mj->D_rowind = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof(int));
     } else {
         mj->D_active = malloc((size_t)m * (size_t)m * sizeof(double));
+        mj->ref_lu = malloc((size_t)m * (size_t)m * sizeof(double));
+        mj->ref_buf = malloc((4 * (size_t)m + 2 * (size_t)mj->model->n) * sizeof(double));
+        mj->ref_perm = malloc(2 * (size_t)m * sizeof(int));
+        if (!mj->ref_lu || !mj->ref_buf || !mj->ref_perm)
+            return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for the Delassus block");
     }
     if (!mj->D_active || (mj->sparse && (!mj->D_colptr || !mj->D_rowind)))
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for the Delassus block");
@@ -416,17 +433,111 @@ void mj_active_rhs(pd_mj *mj, int nI, const double *vfree)
     }
 }
 
+/* r = b_I + W_I^T y, y = What^-1 x, x = W_I P (ref_buf + 4 m, + 4 m + n:
+ * D_II never used), and the work of r, P^T r = P^T b + x^T y, into *work
+ * with the sum of the magnitudes of its terms into *scale. */
+static void active_residual(const pd_mj *mj, const pd_factor *f, int nI, const double *P,
+                            double *res, double *work, double *scale)
+{
+    const pd_model *md = mj->model;
+    double *y = mj->ref_buf + 4 * (size_t)md->m, *x = y + md->n, sum = 0.0, sc = 0.0;
+    memset(x, 0, (size_t)md->n * sizeof(double));
+    for (int r = 0; r < nI; r++)
+        pd_matrix_col_axpy(&md->W, mj->idx_active[r], P[r], x);
+    memcpy(y, x, (size_t)md->n * sizeof(double));
+    pd_factor_solve(f, y);
+    for (int r = 0; r < nI; r++) {
+        res[r] = mj->b_active[r] + pd_matrix_col_dot(&md->W, mj->idx_active[r], y);
+        sum += P[r] * mj->b_active[r];
+        sc += fabs(P[r] * mj->b_active[r]);
+    }
+    for (int i = 0; i < md->n; i++) {
+        sum += x[i] * y[i];
+        sc += fabs(x[i] * y[i]);
+    }
+    *work = sum;
+    *scale = sc;
+}
+
+/* Refinement of a dense active LCP whose D P cancels terms 1/sqrt(eps)
+ * larger than b (a heavy dof's What^-1 lost in D_II's entries under a
+ * light one's; D of condition up to 1e13): the impulses' work beyond
+ * Newton's law, P^T (D P + b), formed through the factor, must be within
+ * MJ_REFINE_TOL roundings of its terms; else P_A -= D_AA^-1 r_A on the
+ * pushing contacts A = {P > 0} while that work shrinks.  Sets
+ * mj->refined; PD_ENUMERICAL when it stays beyond. */
+static int refine_active(pd_mj *mj, const pd_factor *f, int nI, double t1, pd_err *err)
+{
+    int m = mj->model->m, na = 0, *ax = mj->ref_perm + m;
+    double *P = mj->P_active, *D = mj->D_active, grow = 0.0, work, scale;
+    double *res = mj->ref_buf, *zt = res + m, *dz = zt + m;
+    mj->refined = 0;
+    for (int r = 0; r < nI; r++) {
+        double s = 0.0;
+        for (int c = 0; c < nI; c++)
+            s += fabs(D[r + (size_t)c * nI] * P[c]);
+        if (P[r] > 0.0)
+            ax[na++] = r;
+        grow = fmax(grow, s / fmax(fabs(mj->b_active[r]), DBL_MIN));
+    }
+    if (na < 2 || !(grow > MJ_REFINE_GROWTH))
+        return PD_OK;
+    active_residual(mj, f, nI, P, res, &work, &scale);
+    if (fabs(work) <= MJ_REFINE_TOL * DBL_EPSILON * scale)
+        return PD_OK;
+    for (int i = 0; i < na; i++)
+        for (int j = 0; j < na; j++)
+            mj->ref_lu[i + (size_t)j * na] = D[ax[i] + (size_t)ax[j] * nI];
+    int rc = pd_dense_lu(na, mj->ref_lu, na, mj->ref_perm, DBL_EPSILON);
+    for (int it = 0; it < MJ_REFINE_MAX && !rc && fabs(work) > MJ_REFINE_TOL * DBL_EPSILON * scale;
+         it++) {
+        double wt, st;
+        for (int i = 0; i < na; i++)
+            dz[i] = -res[ax[i]];
+        pd_dense_lu_solve(na, mj->ref_lu, na, mj->ref_perm, dz);
+        int ok = 1;
+        memcpy(zt, P, (size_t)nI * sizeof(double));
+        for (int i = 0; i < na; i++)
+            ok &= (zt[ax[i]] += dz[i]) > 0.0;
+        if (!ok)
+            break; /* the pushing set would change */
+        active_residual(mj, f, nI, zt, res, &wt, &st);
+        if (!(fabs(wt) < fabs(work)))
+            break;
+        memcpy(P, zt, (size_t)nI * sizeof(double));
+        work = wt;
+        scale = st;
+        mj->refined = 1;
+    }
+    if (fabs(work) > MJ_REFINE_TOL * DBL_EPSILON * scale)
+        return pd_err_set(err, PD_ENUMERICAL, "Moreau-Jean: the LCP of %d active contacts at t = "
+                          "%.9g lost precision: its impulses do %.3g of work beyond Newton's law "
+                          "(rounding %.3g)", nI, t1, work, MJ_REFINE_TOL * DBL_EPSILON * scale);
+    if (mj->refined)
+        active_residual(mj, f, nI, P, res, &work, &scale); /* y of the impulses kept */
+    return PD_OK;
+}
+
 /* Impulses of the active contacts into out->P: the LCP (D_II, W_I^T vfree
- * + e U) with D_II from the factor f; t1 is the step's end (messages). */
+ * + e U) with D_II from the factor f, refined when it lost precision; t1
+ * is the step's end (messages). */
 static int solve_contacts(pd_mj *mj, const pd_factor *f, int nI, const double *vfree, double t1,
                           pd_state *out, pd_err *err)
 {
+    int rc;
+    mj->refined = 0;
     if (mj->sparse)
         pd_factor_delassus_csc(f, mj->idx_active, nI, mj->D_colptr, mj->D_rowind, mj->D_active);
     else
         pd_factor_delassus_dense(f, mj->idx_active, nI, mj->D_active);
     mj_active_rhs(mj, nI, vfree);
-    return mj_solve_active(mj, nI, t1, out, err);
+    if ((rc = mj_solve_active(mj, nI, t1, out, err)) || mj->sparse || nI < 2)
+        return rc;
+    if ((rc = refine_active(mj, f, nI, t1, err)))
+        return rc;
+    for (int r = 0; r < nI; r++)
+        out->P[mj->idx_active[r]] = mj->P_active[r];
+    return PD_OK;
 }
 
 int mj_general_step(pd_mj *mj, const pd_factor *f, double h, double t1, const double *F0,
@@ -461,7 +572,11 @@ int mj_general_step(pd_mj *mj, const pd_factor *f, double h, double t1, const do
     if (nI > 0) {
         if ((rc = solve_contacts(mj, f, nI, out->v, t1, out, err)))
             return rc;
-        pd_factor_add_impulse(f, mj->idx_active, nI, mj->P_active, out->v);
+        if (mj->refined) /* What^-1 W_I P formed whole, as the residual */
+            for (int i = 0; i < n; i++)
+                out->v[i] += mj->ref_buf[4 * (size_t)md->m + i];
+        else
+            pd_factor_add_impulse(f, mj->idx_active, nI, mj->P_active, out->v);
     }
     for (int i = 0; i < n; i++)
         out->q[i] += h * th * out->v[i];

@@ -1187,6 +1187,34 @@ static int run_general(const pd_scene *sc, const pd_run_opts *o, pd_scene_sample
     return rc;
 }
 
+/* The event-driven references' impact LCPs resolve two bodies that touch
+ * while their masses differ by less than this: beyond, 1/m_light + 1/m_heavy
+ * rounds to 1/m_light and the Delassus matrix of a light body squeezed
+ * between a heavy one and a wall is singular in double precision. */
+#define SCENE_EVENT_MASS_RATIO 1e15
+
+/* Contacts between masses beyond SCENE_EVENT_MASS_RATIO, refused up front
+ * for the event-driven references (Moreau-Jean runs them). */
+static int event_mass_ratio(const pd_scene *sc, const pd_run_opts *o, pd_err *err)
+{
+    if ((o->method != PD_METHOD_EVENT && o->method != PD_METHOD_EVENT_GENERAL) || o->no_wall)
+        return PD_OK;
+    for (int a = 0; a < sc->ncontact; a++) {
+        const pd_contact *ct = &sc->ct[a];
+        if (ct->a == PD_WALL || ct->b == PD_WALL)
+            continue;
+        double ma = sc->st[ct->a].mass[ct->level_a - 1], mb = sc->st[ct->b].mass[ct->level_b - 1];
+        double ratio = fmax(ma, mb) / fmin(ma, mb);
+        if (!(ratio <= SCENE_EVENT_MASS_RATIO))
+            return pd_err_set(err, PD_EINVAL, "mass: %s and %s touch with masses %g and %g kg, "
+                              "a ratio of %.3g: beyond %g the event-driven references' impact "
+                              "LCPs are singular in double precision (--method moreau runs it)",
+                              sc->st[ct->a].name, sc->st[ct->b].name, ma, mb, ratio,
+                              SCENE_EVENT_MASS_RATIO);
+    }
+    return PD_OK;
+}
+
 int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler sampler,
                  void *ctx, pd_scene_result *res, pd_err *err)
 {
@@ -1201,7 +1229,7 @@ int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler s
     if (!pd_scene_result_fits(sc, res))
         return pd_err_set(err, PD_EINVAL, "the result is not allocated for this scene "
                                           "(pd_scene_result_alloc)");
-    if ((rc = pd_scene_resolve_opts(sc, opts, &o, err)))
+    if ((rc = pd_scene_resolve_opts(sc, opts, &o, err)) || (rc = event_mass_ratio(sc, &o, err)))
         return rc;
     for (int i = 0; i < res->n; i++)
         res->umax[i] = res->u_pos[i] = res->u_neg[i] = res->drift[i] = res->acc_max[i] =

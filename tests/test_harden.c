@@ -214,6 +214,143 @@ static void test_harden_method_flags(pd_test_ctx *ctx)
     }
 }
 
+/* Ten SDOFs (T0 1 s) between two walls, every gap g, eps 0.7, a sine pulse. */
+static pd_scene *walled_row(pd_test_ctx *ctx, double g)
+{
+    pd_scene_excitation exc = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 3.0, .Tp = 1.0};
+    pd_scene *sc = pd_scene_new(&exc);
+    pd_err e;
+    int rc = sc ? PD_OK : PD_ENOMEM;
+    char name[16];
+    for (int i = 0; i < 10 && !rc; i++) {
+        snprintf(name, sizeof name, "S%d", i);
+        rc = pd_scene_add_sdof(sc, name, 1.0, 0.05, 1e5, &e);
+    }
+    for (int i = 0; i <= 10 && !rc; i++)
+        rc = pd_scene_add_contact(sc, i ? i - 1 : PD_WALL, i ? 1 : 0, i < 10 ? i : PD_WALL,
+                                  i < 10 ? 1 : 0, g, 0.7, i, &e);
+    if (!rc)
+        sc->tend = 3.0;
+    if (!CHECK(ctx, !rc && !pd_scene_finish(sc, &e), "scene: %s", sc ? e.msg : "no memory")) {
+        pd_scene_free(sc);
+        return NULL;
+    }
+    return sc;
+}
+
+/* Defects 2 and 3: gaps within the closing tolerance (1e-300, the smallest
+ * subnormal) are closed: the row reference runs them as the row at gap 0
+ * (10 impacts, in milliseconds) instead of exhausting its budget of events
+ * or failing its first LCP; a light body between heavy ones beyond what
+ * double precision resolves is refused up front naming the method that
+ * runs it. */
+static void test_harden_gaps_within_tolerance(pd_test_ctx *ctx)
+{
+    const double gaps[] = {0.0, 1e-300, 5e-324, 1e-12};
+    pd_scene_result r0, r;
+    pd_err e;
+    for (int k = 0; k < 4; k++) {
+        pd_scene *sc = walled_row(ctx, gaps[k]);
+        if (!sc || !CHECK(ctx, !pd_scene_result_alloc(sc, &r, &e), "%s", e.msg)) {
+            pd_scene_free(sc);
+            continue;
+        }
+        pd_run_opts o = pd_run_default_opts();
+        o.method = PD_METHOD_EVENT;
+        int rc = pd_scene_run(sc, &o, NULL, NULL, &r, &e);
+        CHECK(ctx, rc == PD_OK, "gap %g: %s", gaps[k], e.msg);
+        if (k == 0)
+            r0 = r;
+        else {
+            if (rc == PD_OK)
+                for (int i = 0; i < r.n; i++)
+                    CHECK(ctx, r.umax[i] == r0.umax[i], "gap %g: umax %d = %.17g, at gap 0 %.17g",
+                          gaps[k], i, r.umax[i], r0.umax[i]);
+            pd_scene_result_free(&r);
+        }
+        pd_scene_free(sc);
+    }
+    if (r0.umax)
+        pd_scene_result_free(&r0);
+
+    /* masses 1e-6 and 1e12 kg touching: refused for the references, run by Moreau-Jean */
+    pd_scene_excitation exc = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 3.0, .Tp = 1.0};
+    pd_scene *sc = pd_scene_new(&exc);
+    if (!CHECK(ctx, sc && !pd_scene_add_sdof(sc, "A", 1.0, 0.05, 1e-6, &e) &&
+                        !pd_scene_add_sdof(sc, "B", 1.0, 0.05, 1e12, &e) &&
+                        !pd_scene_add_contact(sc, PD_WALL, 0, 0, 1, 1e-300, 1.0, 0, &e) &&
+                        !pd_scene_add_contact(sc, 0, 1, 1, 1, 1e-300, 1.0, 1, &e) &&
+                        !pd_scene_add_contact(sc, 1, 1, PD_WALL, 0, 1e-300, 1.0, 2, &e) &&
+                        !pd_scene_finish(sc, &e) && !pd_scene_result_alloc(sc, &r, &e),
+               "scene: %s", e.msg)) {
+        pd_scene_free(sc);
+        return;
+    }
+    const pd_method methods[] = {PD_METHOD_EVENT, PD_METHOD_EVENT_GENERAL, PD_METHOD_MOREAU};
+    for (int k = 0; k < 3; k++) {
+        pd_run_opts o = pd_run_default_opts();
+        o.method = methods[k];
+        int rc = pd_scene_run(sc, &o, NULL, NULL, &r, &e);
+        if (k < 2)
+            CHECK(ctx, rc == PD_EINVAL && strstr(e.msg, "mass") && strstr(e.msg, "moreau"),
+                  "%s: rc %d: %s", pd_method_name(methods[k]), rc, e.msg);
+        else
+            CHECK(ctx, rc == PD_OK, "moreau: %s", e.msg);
+    }
+    pd_scene_result_free(&r);
+    pd_scene_free(sc);
+}
+
+/* Defect 6: under an address-space limit a scene of 1000 bodies written to
+ * HDF5 ends with "out of memory" (exit 1), never a signal, and leaves no
+ * file.  (Skipped under AddressSanitizer, whose shadow memory needs more
+ * address space than any such limit.) */
+static void test_harden_memory_limit(pd_test_ctx *ctx)
+{
+#if defined(__SANITIZE_ADDRESS__)
+    pd_test_skip(ctx, "AddressSanitizer");
+    return;
+#endif
+    if (!pd_test_have_pound(ctx))
+        return;
+    if (access("/usr/bin/prlimit", X_OK) != 0) {
+        pd_test_skip(ctx, "no /usr/bin/prlimit");
+        return;
+    }
+    char dir[] = "/tmp/pd_harden_XXXXXX", scene[512], out[512];
+    if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
+        return;
+    snprintf(scene, sizeof scene, "%s/cradle.json", dir);
+    snprintf(out, sizeof out, "%s/o.h5", dir);
+    FILE *f = fopen(scene, "w");
+    if (f) {
+        fprintf(f, "{\"excitation\": {\"pulse\": \"sine\", \"dir\": \"+x\", \"ap\": 3, \"Tp\": 1},\n"
+                   " \"tend\": 2, \"structures\": [");
+        for (int i = 0; i < 1000; i++)
+            fprintf(f, "%s{\"name\": \"S%d\", \"T0\": 1, \"xi\": 0.05, \"mass\": 1e5}", i ? ", " : "",
+                    i);
+        fprintf(f, "],\n \"contacts\": [{\"a\": \"wall\", \"b\": \"S0\", \"gap\": 0.01, \"eps\": 0.9}");
+        for (int i = 0; i + 1 < 1000; i++)
+            fprintf(f, ", {\"a\": \"S%d\", \"b\": \"S%d\", \"gap\": 0, \"eps\": 0.9}", i, i + 1);
+        fprintf(f, "]}\n");
+    }
+    if (CHECK(ctx, f && fclose(f) == 0, "scene file")) {
+        const char *limits[] = {"--as=300000000", "--as=150000000", "--as=50000000"};
+        for (int k = 0; k < 3; k++) {
+            const char *argv[] = {"/usr/bin/prlimit", limits[k], ctx->pound, "simulate", "--scene",
+                                  scene, "-o", out, NULL};
+            proc_out r;
+            pd_test_spawn(argv, NULL, &r);
+            CHECK(ctx, r.status == 1 && strstr(r.err, "memory"),
+                  "%s: exit %d, expected 1 and out of memory: %s", limits[k], r.status, r.err);
+            CHECK(ctx, pd_test_dir_entries(dir) == 1, "%s: %d files left", limits[k],
+                  pd_test_dir_entries(dir) - 1);
+            pd_test_proc_free(&r);
+        }
+    }
+    pd_test_rm_dir(dir);
+}
+
 void suite_harden(pd_test_ctx *ctx)
 {
     pd_test_run(ctx, "harden_derived_overflow", test_harden_derived_overflow);
@@ -221,4 +358,6 @@ void suite_harden(pd_test_ctx *ctx)
     pd_test_run(ctx, "harden_cpu_limit_cleans_up", test_harden_cpu_limit_cleans_up);
     pd_test_run(ctx, "harden_bench_shared_and_isa", test_harden_bench_shared_and_isa);
     pd_test_run(ctx, "harden_method_flags", test_harden_method_flags);
+    pd_test_run(ctx, "harden_gaps_within_tolerance", test_harden_gaps_within_tolerance);
+    pd_test_run(ctx, "harden_memory_limit", test_harden_memory_limit);
 }

@@ -10,11 +10,13 @@ with an InputError naming the argument (as the CLI names the flag):
   choice   a str among fixed choices
   path     str, bytes or os.PathLike without NUL: bytes for C, str for messages
   values   a value or a sequence of values, element types kept
-  real_array  a NumPy float64 array of finite numbers
+  real_array  a NumPy float64 array of finite real numbers (not bools, strings,
+              complex numbers; a masked array only with nothing masked)
 
 A value refused is shown as the CLI shows a flag's text ('%s'), or as its
 repr when that text has control characters (a NUL) in it."""
 import math
+import numbers
 import os
 
 import numpy as np
@@ -135,21 +137,78 @@ def values(what, value, cap=None):
     return vals
 
 
+def _kind(x):
+    """What an entry that is not a real number is, for a message."""
+    if x is None:
+        return "None"
+    if is_bool(x):
+        return "a bool (%s)" % show(x)
+    if isinstance(x, (str, bytes)):
+        return "a string (%r)" % (x,)
+    if isinstance(x, (complex, np.complexfloating)):
+        return "complex (%s)" % show(x)
+    return "a %s" % type(x).__name__
+
+
+def _entry(a, k):
+    """The index k of the flattened a as the message names it."""
+    index = np.unravel_index(k, a.shape) if a.ndim else ()
+    return str(int(index[0])) if len(index) == 1 else str(tuple(int(i) for i in index))
+
+
+def _real_entries(what, a):
+    """Refuse the first entry of the object array a that is not a real
+    number: a bool, a string, a complex, None, a sequence (a ragged list)."""
+    flat = a.reshape(-1)
+    types = {type(x) for x in flat.tolist()}
+    if all(issubclass(t, numbers.Real) and not issubclass(t, (bool, np.bool_)) for t in types):
+        return
+    for k, x in enumerate(flat.tolist()):
+        if not isinstance(x, numbers.Real) or is_bool(x):
+            if a.ndim == 0:
+                raise InputError("%s: not a real number or an array of them (%s)"
+                                 % (what, _kind(x)))
+            raise InputError("%s: not an array of real numbers (entry %s is %s)"
+                             % (what, _entry(a, k), _kind(x)))
+
+
 def real_array(what, value, finite=True):
     """A float64 array of value (the same doubles as np.asarray(value,
     np.float64)): real numbers, every entry finite (unless not finite); the
-    first one that is not named by its index."""
+    first one that is not named by its index.  Real means int or float
+    entries (NumPy's too): bools, strings, complex numbers (whose imaginary
+    part a conversion drops), dates and None are refused, in an array's
+    dtype as in a list's entries.  A masked array (numpy.ma) is taken when
+    no entry is masked (its data; a mask is never ignored), else refused
+    naming the first masked entry."""
+    if np.ma.isMaskedArray(value):
+        mask = np.ma.getmaskarray(value)
+        if mask.any():
+            k = int(np.flatnonzero(mask.reshape(-1))[0])
+            raise InputError("%s: entry %s is masked (a masked array is taken only with no "
+                             "entry masked: fill or drop the masked entries)"
+                             % (what, _entry(mask, k)))
+        value = np.ma.getdata(value)
     try:
-        a = np.asarray(value)
+        # a list's entries as given (np.asarray would make [0.5, True] floats)
+        a = np.asarray(value) if hasattr(value, "dtype") else np.asarray(value, dtype=object)
     except (TypeError, ValueError):
         raise InputError("%s: not an array of real numbers" % what) from None
-    if a.dtype.kind == "b":
+    kind = a.dtype.kind
+    if kind == "b":
         raise InputError("%s: the entries are bools, not numbers" % what)
-    if a.dtype.kind == "c":
-        raise InputError("%s: the entries are complex, not real numbers" % what)
+    if kind == "c":
+        raise InputError("%s: the entries are complex, not real numbers (refused, not "
+                         "their imaginary parts dropped)" % what)
+    if kind in "US":
+        raise InputError("%s: the entries are strings, not numbers" % what)
+    if kind == "O":
+        _real_entries(what, a)
+    elif kind not in "iuf":
+        raise InputError("%s: the entries are %s, not real numbers" % (what, a.dtype))
     try:
         a = np.asarray(a, dtype=np.float64)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InputError("%s: not an array of real numbers" % what) from None
     if not finite:
         return a

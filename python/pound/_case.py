@@ -59,6 +59,20 @@ def parse_dir(value):
     return parse_name("dir", lib.pd_dir_parse, value, "normal, reverse")
 
 
+def record_samples(acc):
+    """The samples of a ground motion given as an array (record=, every entry
+    point's: simulate, compare, converge, spectrum, Record.from_array), as
+    a contiguous 1-D float64 array: real numbers only (_args.real_array:
+    no bools, strings, complex numbers; a masked array only when nothing is
+    masked), each refusal naming record.  Their finiteness is the library's
+    to check (pd_record_from_array names the sample)."""
+    a = _args.real_array("record", acc, finite=False)
+    if a.ndim != 1:
+        raise InputError("record: expected a 1-D array of accelerations (got shape %s)"
+                         % (a.shape,))
+    return np.ascontiguousarray(a)
+
+
 class Record:
     """A strong-motion record read and its pulse fitted by the library
     (pd_record_read, pd_record_fit_pulse); owns the C arrays.  Give it as
@@ -113,14 +127,14 @@ class Record:
                    name: str = "array") -> "Record":
         """A record from the accelerations acc[k] (in units: 'g', 'm/s2',
         'cm/s2') at t_k = k dt [s] (pd_record_from_array):
-        the same values as a file's give the same record, bit for bit."""
+        the same values as a file's give the same record, bit for bit.
+        acc: a 1-D array or list of real numbers (ints or floats); bools,
+        strings, complex numbers and masked arrays with an entry masked raise
+        InputError naming record (record_samples)."""
         self = cls.__new__(cls)
         self._owned = False
         self.path = None
-        a = np.ascontiguousarray(np.asarray(acc, dtype=float).ravel())
-        if np.asarray(acc).ndim != 1:
-            raise InputError("record: expected a 1-D array of accelerations (got shape %s)"
-                             % (np.asarray(acc).shape,))
+        a = record_samples(acc)
         dt = number("record_dt", dt)
         unit_code = parse_name("units", lib.pd_record_units_parse, units, "g, m/s2, cm/s2")
         self.units_code = unit_code

@@ -20,7 +20,8 @@ NAN = float("nan")
 class Result(dict):
     """A dict whose keys are also attributes (r.umax is r['umax']), with a
     short repr and, when pandas or xarray is installed, to_pandas() and
-    to_xarray() of its history.  Values are in SI units (s, m, m/s, m/s^2,
+    to_xarray() of its history (of a spectrum: its points, one row each, and
+    its arrays along (curve, Pi2)).  Values are in SI units (s, m, m/s, m/s^2,
     N s; impulses of the oscillator per unit mass, m/s) and the Pi terms
     are dimensionless; each function's docstring lists its keys."""
 
@@ -48,9 +49,21 @@ class Result(dict):
         more = len(items) - 12
         return "Result(%s%s)" % (", ".join(items[:12]), ", ... %d more" % more if more > 0 else "")
 
+    def _table(self):
+        """The rows of a table-like result as a list of dicts, or None: a
+        spectrum's points (one per point of the sweep: its curve's pulse,
+        dir, Pi3 or gap, eps, xi, ap and its Pi2 with the results),
+        converge's rows, compare's methods."""
+        for key in TABLE_KEYS:
+            rows = self.get(key)
+            if isinstance(rows, list) and rows and all(isinstance(r, dict) for r in rows):
+                return [dict(r) for r in rows]
+        return None
+
     def _columns(self):
         """The history's arrays as columns: a 2-D array k of n columns gives
-        k[0] ... k[n-1]."""
+        k[0] ... k[n-1].  Columns of different lengths raise ValueError
+        naming them (not pandas' 'All arrays must be of the same length')."""
         h = self["history"] if "history" in self else self
         cols = {}
         for k, v in h.items():
@@ -59,6 +72,12 @@ class Result(dict):
             elif isinstance(v, np.ndarray) and v.ndim == 2:
                 for j in range(v.shape[1]):
                     cols["%s[%d]" % (k, j)] = v[:, j]
+        lengths = {}
+        for k, v in cols.items():
+            lengths.setdefault(len(v), k)
+        if len(lengths) > 1:
+            raise ValueError("to_pandas: the arrays are not of one length (%s), not a table"
+                             % ", ".join("%s: %d" % (k, n) for n, k in lengths.items()))
         return cols
 
     def _scalars(self):
@@ -66,9 +85,19 @@ class Result(dict):
                 if isinstance(v, (int, float, str, np.integer, np.floating))}
 
     def to_pandas(self) -> Any:
-        """The history as a pandas DataFrame indexed by t (the results
-        without a history: a Series of the scalars)."""
+        """The history as a pandas DataFrame indexed by t (the scalars in
+        df.attrs); a table-like result as a long (tidy) DataFrame, one row
+        per row of it: a spectrum's points (one per point of the sweep:
+        every swept parameter, pulse, dir, Pi3 or gap, eps, xi, ap, Pi2, and
+        every result, Pi1, gamma, ...), converge's rows, compare's methods;
+        the other results without a history: a Series of the scalars."""
         import pandas as pd
+        if "history" not in self:
+            rows = self._table()
+            if rows is not None:
+                df = pd.DataFrame(rows)
+                df.attrs.update(self._scalars())
+                return df
         cols = self._columns()
         if not cols:
             return pd.Series(self._scalars())
@@ -81,8 +110,12 @@ class Result(dict):
     def to_xarray(self) -> Any:
         """The history as an xarray Dataset with t as its coordinate (a scene's
         x, v along (t, dof), gap and impulse along (t, contact)); the scalars as
-        attributes."""
+        attributes.  A spectrum: its arrays along (curve, Pi2), the curves'
+        pulse, dir, ap, xi, Pi3 or gap, eps and label as coordinates along
+        curve."""
         import xarray as xr
+        if "history" not in self and "curves" in self and "Pi2" in self:
+            return self._spectrum_xarray(xr)
         h = self["history"] if "history" in self else self
         if "t" not in h:
             raise ValueError("to_xarray: no history (run with history=True)")
@@ -94,6 +127,21 @@ class Result(dict):
                 k, k + "_index")
             data[k] = (("t",) if v.ndim == 1 else ("t", second)), v
         return xr.Dataset(data, coords={"t": h["t"]}, attrs=self._scalars())
+
+    def _spectrum_xarray(self, xr):
+        curves = self["curves"]
+        data = {k: (("curve", "Pi2"), v) for k, v in self.items()
+                if isinstance(v, np.ndarray) and v.ndim == 2}
+        coords = {"Pi2": self["Pi2"], "curve": np.arange(len(curves))}
+        for key in ("pulse", "dir", "ap", "xi", "Pi3", "gap", "eps", "label"):
+            if all(key in c for c in curves):
+                coords[key] = ("curve", [c[key] for c in curves])
+        return xr.Dataset(data, coords=coords, attrs=self._scalars())
+
+
+# the keys of table-like results (to_pandas): a spectrum's points, converge's rows,
+# compare's methods
+TABLE_KEYS = ("points", "rows", "methods")
 
 
 class _History:

@@ -61,6 +61,21 @@ def _onsets(impulse: np.ndarray) -> np.ndarray:
     return np.flatnonzero(p & ~before)
 
 
+def _index(what: str, value: Any, n: int, of: str) -> int:
+    """value as an index in [0, n): an int (Python's or NumPy's; anything
+    else, a bool too, raises TypeError); a negative one or one past the end
+    raises ValueError naming what and the valid range (Python's wrap-around
+    of -1 would pick the last one without a word)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise TypeError("pound.plot: %s must be an integer index, got %r" % (what, value))
+    k = int(value)
+    if not 0 <= k < n:
+        valid = "only 0" if n == 1 else "0 to %d" % (n - 1) if n else "none"
+        raise ValueError("pound.plot: %s = %d is out of range: the result has %d %s (valid: %s)"
+                         % (what, k, n, of, valid))
+    return k
+
+
 def impact_times(r: Mapping[str, Any], contact: int = 0) -> Tuple[np.ndarray, np.ndarray]:
     """(indices, times [s]) of the impacts in a result's history.
 
@@ -73,12 +88,16 @@ def impact_times(r: Mapping[str, Any], contact: int = 0) -> Tuple[np.ndarray, np
     which the velocity turns from toward the wall (v > 0) to away (v < 0)
     while the gap is within one sample's travel of zero; its time is the
     gap's linear closing time t[k-1] + gap[k-1] / v[k-1] and the index is k.
-    contact: the scene contact's index (an oscillator has one)."""
+    contact: the scene contact's index, 0 to the number of contacts - 1 (an
+    oscillator has one, contact 0); another (a negative index too: -1 is not
+    the last contact) raises ValueError naming the valid range."""
     h = _history_of(r)
     t = np.asarray(h["t"], dtype=float)
     imp = np.asarray(h["impulse"], dtype=float)
+    a = _index("contact", contact, imp.shape[1] if imp.ndim == 2 else 1,
+               "contacts" if imp.ndim == 2 else "contact (an oscillator)")
     if imp.ndim == 2:
-        imp = imp[:, contact]
+        imp = imp[:, a]
     k = _onsets(imp)
     if not _exact_oscillator(r, h) or not r.get("impacts"):
         return k, t[k]
