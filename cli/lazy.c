@@ -43,7 +43,8 @@ static void *lazy_sym(lazy_lib *lib, const char *name)
         if (!lib->handle) {
             const char *why = dlerror();
             lib->oom = why && (strstr(why, "map segment") || strstr(why, "memory"));
-            fprintf(stderr, "pound: %s needs %s: %s\n", lib->what, lib->soname, why);
+            if (!lib->oom) /* out of memory: the callers report it as such */
+                fprintf(stderr, "pound: %s needs %s: %s\n", lib->what, lib->soname, why);
         }
     }
     if (lib->ok < 0) {

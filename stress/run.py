@@ -70,7 +70,8 @@ SHARED = os.path.normpath(os.environ.get("POUND_SHARED") or os.path.join(ROOT, "
 AS_LIMIT = 4 << 30          # address space of every run (bytes)
 RSS_BOUND_MB = 1024         # "bounded memory"
 CATEGORIES = ["corpus", "flags", "lcp", "scene", "record", "journal", "faults", "hangs",
-              "nonregular", "names", "bounds", "derived", "capi", "python", "fuzz", "tsan"]
+              "nonregular", "names", "bounds", "derived", "hostile", "capi", "python", "fuzz",
+              "tsan"]
 CAT_TEXT = {
     "corpus": "the in-repo corpus and tables (stress/corpus, stress/cases) equal what "
               "stress/gen_corpus.py makes; ../shared's LCPs and records present when expected",
@@ -87,7 +88,7 @@ CAT_TEXT = {
               "empty, no header, binary junk, CRLF; records as excitations",
     "journal": "spectrum journals (F.partial) corrupted, then `spectrum -o F --resume`",
     "faults": "full disk (RLIMIT_FSIZE), stdout on /dev/full or closed, missing or "
-              "read-only target folders, SIGTERM/SIGINT during long runs, then --resume",
+              "read-only target folders, SIGTERM/SIGINT/SIGXCPU during long runs, then --resume",
     "hangs": "inputs that could loop or run away: extreme periods, stiff penalties, "
              "Zeno accumulations, /dev/zero as an input",
     "nonregular": "FIFOs (with and without a reader or writer), device nodes, folders and links "
@@ -102,12 +103,19 @@ CAT_TEXT = {
               "Moreau-Jean named)",
     "derived": "derived quantities out of range (T0 = Tp / Pi2, steps over tend, gap / Le): "
                "the flag the user typed is named first",
+    "hostile": "the fourth round's inputs: rows at gaps within the closing tolerance (1e-300, "
+               "5e-324) and touching buildings run in seconds by the row reference; masses "
+               "beyond double precision refused naming moreau; derived demands that overflow "
+               "(contact-duration, storey_heights) and newmark's budgets refused naming the "
+               "field; another method's flags refused; 1000 bodies to HDF5 under an "
+               "address-space limit: out of memory, no signal, nothing left",
     "capi": "the C API misused under ASan + UBSan: every exported function with NULL in each "
             "pointer argument (generated from the headers), results of another shape, zeroed, "
             "or for an unfinished scene",
     "python": "the Python package misused: NaN/inf and wrong types in LCPs, options and "
               "scenes, paths with NUL bytes or as bytes, fractional counts, booleans as "
-              "numbers (python/tests/test_misuse.py)",
+              "numbers (python/tests/test_misuse.py); to_pandas of sweeps, plot indices, "
+              "record= arrays of every dtype (test_harden4.py)",
     "fuzz": "libFuzzer + ASan + UBSan on the readers: LCP, scene, record, spectrum journal",
     "tsan": "ThreadSanitizer on parallel spectrum sweeps (2 OpenMP threads); "
             "2 threads = 1 thread byte for byte",
@@ -1391,8 +1399,8 @@ def cases_faults(env):
         (["spectrum", "--Pi2", "0.05:5:5000", "--Pi3", "0.01,0.1", "--dt-per-Tp", "20000", "-o",
           "s.h5"], "s.h5", True),
     ]
-    for sig in (signal.SIGTERM, signal.SIGINT):
-        for argv, out, resumable in long_runs:
+    for sig in (signal.SIGTERM, signal.SIGINT, signal.SIGXCPU):
+        for argv, out, resumable in long_runs[:2] if sig == signal.SIGXCPU else long_runs:
             c = Case("faults", argv, "0", None, partial_ok=resumable, timeout=90,
                      run=signal_run(sig, 1.0, argv + ["--resume"] if resumable else None),
                      display="pound %s   (%s after 1 s%s)" % (" ".join(argv), signame(sig),
@@ -1652,7 +1660,8 @@ BAD_NAMES = [("comma", "a,b"), ("dot", "."), ("empty", ""), ("double-quote", 'a"
              ("slash", "a/b"), ("300-chars", "y" * 300), ("wall", "wall")]
 # names that must work, and be written as given
 GOOD_NAMES = [("space", "Building A"), ("utf8", "\u00e9t\u00e9"), ("63-chars", "y" * 63),
-              ("digits", "2")]
+              ("digits", "2"), ("dimension-t", "t"), ("dimension-storey", "storey"),
+              ("dataset-x", "x")]
 
 
 def cases_names(env):
@@ -1793,6 +1802,75 @@ def cases_derived(env):
     return cases
 
 
+# ---- category: the fourth round's hostile inputs ----------------------------------------
+
+
+def row_doc(n, gap, eps=0.7, storeys=1, walls=True, masses=None, tend=3.0):
+    """n structures in a row (SDOFs, or buildings of `storeys` touching at
+    every floor), every gap `gap`, between two walls when `walls`."""
+    st = [{"name": "S%d" % i, "T0": 1.0, "xi": 0.05, "mass": (masses[i] if masses else 1e5)}
+          if storeys == 1 else {"name": "S%d" % i, "storeys": storeys, "T0": 0.5 + 0.05 * i,
+                                "xi": 0.05, "mass": 1e5} for i in range(n)]
+    lv = {} if storeys == 1 else {"levels": list(range(1, storeys + 1))}
+    ct = [dict({"a": "S%d" % i, "b": "S%d" % (i + 1), "gap": gap, "eps": eps}, **lv)
+          for i in range(n - 1)]
+    if walls:
+        ct = [{"a": "wall", "b": "S0", "gap": gap, "eps": eps}] + ct + \
+             [{"a": "S%d" % (n - 1), "b": "wall", "gap": gap, "eps": eps}]
+    return json.dumps({"excitation": {"pulse": "sine", "dir": "+x", "ap": 3.0, "Tp": 1.0},
+                       "structures": st, "contacts": ct, "tend": tend}).encode("utf-8")
+
+
+def cases_hostile(env):
+    cases = []
+    # gaps within the closing tolerance are closed: seconds, not the event budget
+    for gap in ("1e-300", "5e-324", "1e-12", "0"):
+        doc = row_doc(10, 0.0).replace(b'"gap": 0.0', b'"gap": ' + gap.encode())
+        cases.append(Case("hostile", ["simulate", "--scene", "r.json", "--method", "event",
+                                      "--json"], "0", None, inputs={"r.json": doc}, timeout=20,
+                          display="pound simulate --scene r.json --method event   (10 SDOFs "
+                          "between walls, gaps %s)" % gap))
+    cases.append(Case("hostile", ["simulate", "--scene", "b.json", "--method", "event", "--json"],
+                      "0", None, inputs={"b.json": row_doc(10, 0.0, eps=0.5, storeys=5,
+                                                           walls=False)}, timeout=60,
+                      display="pound simulate --scene b.json --method event   (ten 5-storey "
+                      "buildings touching at every floor)"))
+    # masses beyond double precision: refused for the references, moreau named
+    doc = row_doc(2, 1e-300, eps=1.0, masses=[1e-6, 1e12])
+    for m in ("event", "event-general"):
+        cases.append(Case("hostile", ["simulate", "--scene", "m.json", "--method", m], "2",
+                          r"mass: .*moreau", inputs={"m.json": doc}, timeout=20))
+    # derived demands that overflow, newmark's budgets, another method's flags
+    heights = json.loads(scene_doc("A"))
+    heights["structures"][0]["storey_heights"] = 5e-324
+    for argv, ins, rx in [
+            (["simulate", "--scene", "n.json", "--contact-duration", "1e-307", "-o", "o.h5"],
+             {"n.json": row_doc(2, 0.02)}, r"contact-duration"),
+            (["simulate", "--scene", "n.json", "-o", "o.csv"],
+             {"n.json": json.dumps(heights).encode()}, r"storey_heights"),
+            (["simulate", "--method", "newmark", "--kc", "1e300"], None, r"kc:"),
+            (["simulate", "--method", "newmark", "--dt", "1e-8"], None, r"dt:"),
+            (["simulate", "--chain", "3", "--method", "newmark", "--kc", "1e300"], None, r"kc:"),
+            (["simulate", "--method", "moreau", "--close-tol", "1e-9"], None, r"--close-tol"),
+            (["simulate", "--method", "newmark", "--theta", "0.6"], None, r"--theta"),
+            (["simulate", "--method", "event", "--kc", "10"], None, r"--kc"),
+            (["bench", "--lcp", "--shared", "/nonexistent"], None, r"--shared")]:
+        cases.append(Case("hostile", argv, "2", rx, inputs=ins, timeout=20, check=check_output))
+    cases.append(Case("hostile", ["simulate", "--json"], "2", r"POUND_ISA",
+                      env={"POUND_ISA": "avx3"}, timeout=20))
+    # 1000 bodies to HDF5 under address-space limits: written whole, or out of
+    # memory with nothing left (never a signal, never a corrupted heap)
+    cradle = row_doc(1000, 0.0, eps=0.9, walls=False, tend=2.0)
+    for limit in (300 << 20, 150 << 20, 50 << 20):
+        cases.append(Case("hostile", ["simulate", "--scene", "c.json", "--every", "10", "-o",
+                                      "o.h5"], "01", None,
+                          inputs={"c.json": cradle}, timeout=60, as_limit=limit,
+                          rc1_regex=r"memory", check=check_output,
+                          display="pound simulate --scene c.json --every 10 -o o.h5   (1000 bodies, "
+                          "address space %d MB)" % (limit >> 20)))
+    return cases
+
+
 # ---- category 8: libFuzzer ------------------------------------------------------------
 
 
@@ -1882,7 +1960,8 @@ def run_capi(runner, env):
 
 
 def run_python(runner, env):
-    """python/tests/test_misuse.py against this build's libpound.so, from python/."""
+    """python/tests/test_misuse.py and test_harden4.py (to_pandas, plot indices,
+    record= dtypes) against this build's libpound.so, from python/."""
     lib = os.path.join(os.path.dirname(os.path.abspath(env["pound_built"])), "libpound.so")
     # Debian's Python, with NumPy and pytest (as python/check.sh), not a
     # python3 that PATH may find first
@@ -1897,7 +1976,8 @@ def run_python(runner, env):
     penv = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"), POUND_LIBRARY=lib,
                 POUND_BIN=env["pound_built"], MPLBACKEND="Agg")
     p = subprocess.run([py, "-m", "pytest", "-q", "-p", "no:cacheprovider",
-                        os.path.join(ROOT, "python", "tests", "test_misuse.py")],
+                        os.path.join(ROOT, "python", "tests", "test_misuse.py"),
+                        os.path.join(ROOT, "python", "tests", "test_harden4.py")],
                        cwd=runner.scratch, env=penv, stdin=subprocess.DEVNULL,
                        capture_output=True, timeout=600)
     out = p.stdout.decode("utf-8", "replace")
@@ -2079,7 +2159,7 @@ def main():
     gens = {"corpus": cases_corpus, "flags": cases_flags, "lcp": cases_lcp, "scene": cases_scene,
             "record": cases_record, "journal": cases_journal, "faults": cases_faults,
             "hangs": cases_hangs, "nonregular": cases_nonregular, "names": cases_names,
-            "bounds": cases_bounds, "derived": cases_derived}
+            "bounds": cases_bounds, "derived": cases_derived, "hostile": cases_hostile}
     all_cases = []
     for c in cats:
         if c in gens:
