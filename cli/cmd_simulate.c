@@ -218,7 +218,7 @@ static void print_json(const sim_args *a, const pd_osc_summary *s)
     pd_json_num(&js, "height", a->k.height);
     pd_json_num(&js, "drift_ratio", s->r.umax / a->k.height);
     pd_json_num(&js, "acc_max", s->r.acc_max);
-    pd_json_num(&js, "shear_max", s->r.acc_max); /* per unit mass: k u + c u' = m a_abs */
+    pd_json_num(&js, "shear_max", s->r.shear_max); /* per unit mass: |k u + c u'| / m */
     pd_json_num(&js, "force_equiv", s->r.force_equiv);
     pd_json_num(&js, "force_max", s->r.force_max); /* NaN -> null: not compliant */
     pd_json_num(&js, "contact_duration", s->r.contact_duration);
@@ -305,8 +305,9 @@ static void print_text(const sim_args *a, const pd_osc_summary *s)
                s->r.impacts, s->r.first_impact, s->r.first_impact_velocity, s->r.contact_time);
     else
         printf("  impacts   = 0 (the oscillator never reaches the wall)\n");
-    printf("  demands   = drift ratio %.5g (height %g m), a_abs %.6g m/s^2 (= base shear per "
-           "unit mass, N/kg)\n", s->r.umax / a->k.height, a->k.height, s->r.acc_max);
+    printf("  demands   = drift ratio %.5g (height %g m), a_abs %.6g m/s^2, base shear per "
+           "unit mass %.6g N/kg\n", s->r.umax / a->k.height, a->k.height, s->r.acc_max,
+           s->r.shear_max);
     if (s->r.impacts && isnan(s->r.force_max)) /* an impulsive method */
         printf("  contact   = equivalent force %.6g N/kg (pi I / (2 td), td = %g s, "
                "--contact-duration)\n", s->r.force_equiv, s->r.contact_duration);
@@ -354,7 +355,7 @@ static int finish_output(const sim_args *a, const pd_osc_summary *s, pd_table_wr
                        NUM("height", "m", a->k.height),
                        NUM("drift_ratio", "1", s->r.umax / a->k.height),
                        NUM("acc_max", "m/s^2", s->r.acc_max),
-                       NUM("shear_max", "N/kg", s->r.acc_max),
+                       NUM("shear_max", "N/kg", s->r.shear_max),
                        NUM("force_equiv", "N/kg", s->r.force_equiv),
                        NUM("force_max", "N/kg", s->r.force_max),
                        NUM("contact_duration", "s", s->r.contact_duration),

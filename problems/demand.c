@@ -86,9 +86,10 @@ void pd_demand_note(const pd_scene *sc, const double *x, const double *v, double
 }
 
 void pd_demand_osc_finish(pd_osc_result *res, const pd_run_opts *o, double acc_max,
-                          double force_max)
+                          double shear_max, double force_max)
 {
     res->acc_max = acc_max;
+    res->shear_max = shear_max;
     res->force_max = force_max;
     res->contact_duration = pd_demand_td(o);
     res->force_equiv = pd_equivalent_force(res->max_impulse, res->contact_duration);
@@ -126,17 +127,20 @@ double pd_demand_cubic_peak(double f0, double d0, double f1, double d1, double h
 }
 
 void pd_demand_osc_note(pd_demand_osc *d, double tau, double x, double v, const double *a,
-                        int smooth)
+                        double lam, int smooth)
 {
-    pd_demand_osc_note_state(d, tau, x, v);
-    if (tau < d->tau_measure || !a) {
+    pd_demand_osc_note_state(d, tau, x, v, lam);
+    if (tau < d->tau_measure || !a || lam != 0.0) {
         d->prev = 0;
         return;
     }
     double f = d->C * v + d->K * x;
     double fd = d->C * *a + d->K * v, h = tau - d->t;
-    if (d->prev && smooth && h > 0.0)
-        d->peak = pd_max(d->peak, pd_demand_cubic_peak(d->f, d->fd, f, fd, h));
+    if (d->prev && smooth && h > 0.0) { /* free at both ends: a_abs is the shear */
+        double p = pd_demand_cubic_peak(d->f, d->fd, f, fd, h);
+        d->peak = pd_max(d->peak, p);
+        d->shear = pd_max(d->shear, p);
+    }
     d->f = f;
     d->fd = fd;
     d->t = tau;

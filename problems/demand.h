@@ -37,29 +37,34 @@ double pd_demand_cubic_peak(double f0, double d0, double f1, double d1, double h
  * value there and the return is 1; 0 when f' keeps its sign. */
 int pd_demand_quintic_turn(const double p0[3], const double p1[3], double h, double *f);
 
-/* The oscillator's absolute acceleration in Pi units, |C x' + K x| (C = 2 xi
- * Pi2, K = Pi2^2), its peak from tau_measure on: at each state, and between
- * two states with accelerations a (NULL: none) on the cubic Hermite when
- * the interval was smooth. */
+/* The oscillator's absolute acceleration in Pi units, |C x' + K x + lam|
+ * (C = 2 xi Pi2, K = Pi2^2, lam the wall's held force, 0 when free: x'' = f
+ * - C x' - K x - lam), its peak from tau_measure on: at each state, and
+ * between two states with accelerations a (NULL: none) on the cubic
+ * Hermite when the interval was smooth and free at both ends. */
 typedef struct pd_demand_osc {
     double C, K, tau_measure;
     double peak;
+    double shear;    /* peak |C x' + K x|: the base shear per unit mass (Pi units) */
     double f, fd, t; /* the previous state's value, rate and time */
-    int prev;        /* 1: it has a rate */
+    int prev;        /* 1: it has a rate (free: no held force) */
 } pd_demand_osc;
 
 void pd_demand_osc_note(pd_demand_osc *d, double tau, double x, double v, const double *a,
-                        int smooth);
+                        double lam, int smooth);
 
 /* The peak at one state (no rate: pd_demand_osc_note with a NULL keeps
  * prev 0 beside it), inline for the scalar kernel's loop. */
-static inline void pd_demand_osc_note_state(pd_demand_osc *d, double tau, double x, double v)
+static inline void pd_demand_osc_note_state(pd_demand_osc *d, double tau, double x, double v,
+                                            double lam)
 {
-    if (tau >= d->tau_measure)
-        d->peak = pd_max(d->peak, fabs(d->C * v + d->K * x));
+    if (tau >= d->tau_measure) {
+        d->peak = pd_max(d->peak, fabs(d->C * v + d->K * x + lam));
+        d->shear = pd_max(d->shear, fabs(d->C * v + d->K * x));
+    }
 }
 
-/* The oscillator's demands into res: acc_max and force_max [per unit mass],
+/* The oscillator's demands into res: acc_max, shear_max and force_max [per unit mass],
  * the td of o and the equivalent force of res->max_impulse. */
 /* PD_EINVAL when a derived demand overflows while its source does not: the
  * equivalent force (contact a, -1: the oscillator's wall) or a storey's
@@ -67,6 +72,6 @@ static inline void pd_demand_osc_note_state(pd_demand_osc *d, double tau, double
 int pd_demand_check_force(double impulse, double force, int a, pd_err *err);
 int pd_demand_check_drift(double drift, double ratio, const char *name, int storey, pd_err *err);
 void pd_demand_osc_finish(pd_osc_result *res, const pd_run_opts *o, double acc_max,
-                          double force_max);
+                          double shear_max, double force_max);
 
 #endif

@@ -40,6 +40,7 @@ typedef struct adapt_track {
     pd_osc_sampler sampler;
     void *sampler_ctx;
     long sampled;
+    const pd_osc *c;         /* its excitation (a held contact's force) */
 } adapt_track;
 
 /* A peak p at err e: raise *peak (and its *perr) when p is above it. */
@@ -85,7 +86,12 @@ static int observe(const pd_state *st, void *ctx)
         interior_extremes(tr, st, e);
     /* demands at every state, between them across the smooth steps */
     if (tr->demands && st->has_acc) {
-        pd_demand_osc_note(&tr->dem, st->t, x, v, st->acc,
+        /* a held contact (an impulse in a step without an impact): its force
+         * from x'' = f - C x' - K x - lam, the accelerations' left limit */
+        double lam = P > 0.0 ? pd_osc_shape(tr->c, st->t, -1) - tr->dem.C * v -
+                                   tr->dem.K * x - st->acc[0]
+                             : 0.0;
+        pd_demand_osc_note(&tr->dem, st->t, x, v, st->acc, lam,
                            st->step > 0 && !tr->dem_skipped && !st->impact);
         tr->dem.fd = tr->dem.C * st->acc_right[0] + tr->dem.K * v; /* the next step's start */
         tr->dem_skipped = 0;
@@ -142,7 +148,7 @@ static int run_once(const pd_osc *c, const pd_run_opts *o, double rtol, pd_osc_s
     mo.atol = OSC_ADAPT_FLOOR * fmin(1.0, 1.0 / (c->Pi2 * c->Pi2));
     mo.pieces = &F;
     adapt_track tr = {.Le = Le, .vscale = Le * wp, .wp = wp, .demands = !o->no_demands,
-                      .sampler = sampler, .sampler_ctx = ctx};
+                      .sampler = sampler, .sampler_ctx = ctx, .c = c};
     pd_osc_track_init(&tr.m, c, mo.h, wp * pd_osc_measure_start(c, o->tend));
     tr.dem = (pd_demand_osc){.C = k.C, .K = k.K, .tau_measure = tr.m.tau_measure};
     pd_mj *mj = pd_mj_alloc(&model, &mo, err);
@@ -160,7 +166,8 @@ static int run_once(const pd_osc *c, const pd_run_opts *o, double rtol, pd_osc_s
     res->steps_rejected = stats->rejected;
     res->err_est = peaks_error(&tr, c);
     res->kernel = "exact-flight"; /* the scenes' name for it (scene_run.c) */
-    pd_demand_osc_finish(res, o, tr.demands ? tr.dem.peak * c->ap : NAN, NAN);
+    pd_demand_osc_finish(res, o, tr.demands ? tr.dem.peak * c->ap : NAN,
+                         tr.demands ? tr.dem.shear * c->ap : NAN, NAN);
     pd_mj_free(mj);
     free(pieces);
     return rc;

@@ -291,7 +291,7 @@ static void lane_result(osc_batch *ob, int l, pd_osc_result *res)
     res->cpu_s = ob->cpu[l];
     /* the equivalent force from the largest impulse, as a single run's;
      * the peak acceleration is not measured on the lanes */
-    pd_demand_osc_finish(res, o, NAN, NAN);
+    pd_demand_osc_finish(res, o, NAN, NAN, NAN);
 }
 
 int pd_osc_batchable(const pd_osc *c, const pd_run_opts *o)

@@ -195,7 +195,7 @@ static int track_step(const pd_state *st, void *ctx)
     record_x(tr, tau, x);
     double a = pd_osc_shape(tr->c, tau, -1) - tr->C * v - tr->K * x - lam;
     if (!tr->no_demands)
-        pd_demand_osc_note(&tr->dem, tau, x, v, &a, !active && !tr->pactive); /* free steps */
+        pd_demand_osc_note(&tr->dem, tau, x, v, &a, 0.0, !active && !tr->pactive); /* free steps */
     if (active)
         tr->fpeak = fmax(tr->fpeak, lam);
     if (active && !tr->pactive) { /* an element engaged at a located closing */
@@ -295,6 +295,7 @@ static void fill_result(const pen_track *tr, const pd_run_opts *o,
     res->kernel = pr->stepper ? pr->stepper : "penalty";
     pd_osc_result_no_rtol(res, NAN);
     pd_demand_osc_finish(res, o, tr->no_demands ? NAN : tr->dem.peak * tr->c->ap,
+                         tr->no_demands ? NAN : tr->dem.shear * tr->c->ap,
                          tr->m ? tr->fpeak * tr->c->ap : NAN);
 }
 

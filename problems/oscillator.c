@@ -242,6 +242,7 @@ double pd_osc_measure_start(const pd_osc *c, double tend)
 /* The observer's context: the measurements and the sampler. */
 typedef struct tracker {
     pd_osc_track m;
+    double Pprev;         /* the previous step's impulse (a held contact: two in a row) */
     long sampled;         /* impacts reported to the sampler */
     double Le, vscale, wp;
     pd_demand_osc dem;    /* the absolute acceleration's peak (Pi units) */
@@ -318,7 +319,7 @@ void pd_osc_track_result(const pd_osc_track *tr, const pd_osc *c, double dt, lon
     res->dt = dt;
     pd_osc_result_no_rtol(res, dt);
     /* demands: not measured here (the single runs measure and set them) */
-    res->acc_max = res->force_max = res->force_equiv = res->contact_duration = NAN;
+    res->acc_max = res->shear_max = res->force_max = res->force_equiv = res->contact_duration = NAN;
 }
 
 /* Per step: the measurements, then the sample. */
@@ -327,8 +328,10 @@ static int observe(const pd_state *st, void *ctx)
     tracker *tr = ctx;
     double x = st->q[0], v = st->v[0], P = st->P[0];
     pd_osc_track_step(&tr->m, st->step, st->t, x, v, P);
-    if (tr->demands)
-        pd_demand_osc_note(&tr->dem, st->t, x, v, NULL, 0); /* the steps' own: as umax */
+    if (tr->demands) /* the steps' own, as umax; a held contact's force P / h */
+        pd_demand_osc_note(&tr->dem, st->t, x, v, NULL,
+                           P > 0.0 && tr->Pprev > 0.0 ? P / st->h : 0.0, 0);
+    tr->Pprev = P;
     if (tr->sampler) {
         pd_osc_sample smp = pd_osc_track_sample(&tr->m, &tr->sampled, st->step, st->t, x, v, P,
                                                 tr->wp, tr->Le, tr->vscale);
@@ -365,12 +368,12 @@ static int simulate_scalar(const pd_osc *c, const pd_model *md, const pd_mj_opts
     int next = 0;
     while (next < md->nbreaks && md->breaks[next] < t0 - tol)
         next++;
-    double q = 0.0, v = 0.0, P = 0.0, g = s1.g0 + s1.w * q, F[OSC_FORCE_AHEAD];
+    double q = 0.0, v = 0.0, P = 0.0, Pprev = 0.0, g = s1.g0 + s1.w * q, F[OSC_FORCE_AHEAD];
     double F0 = osc_force(c, t0, +1);
     long k = 0;
     pd_osc_track_step(tr, 0, t0, q, v, P);
     if (dem)
-        pd_demand_osc_note_state(dem, t0, q, v);
+        pd_demand_osc_note_state(dem, t0, q, v, 0.0);
     for (long i = 0; i < nsteps && i < OSC_FORCE_AHEAD; i++)
         F[i] = osc_force(c, t0 + (double)(i + 1) * h, -1);
     for (; k < nsteps; k++) {
@@ -389,8 +392,9 @@ static int simulate_scalar(const pd_osc *c, const pd_model *md, const pd_mj_opts
                               k + 1, 0);
         }
         pd_osc_track_step(tr, k + 1, t1, q, v, P);
-        if (dem)
-            pd_demand_osc_note_state(dem, t1, q, v);
+        if (dem) /* a held contact (impulses in two steps in a row): its force P / h */
+            pd_demand_osc_note_state(dem, t1, q, v, P > 0.0 && Pprev > 0.0 ? P / h : 0.0);
+        Pprev = P;
     }
     *steps = k;
     return PD_OK;
@@ -434,7 +438,8 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
         res->theta = mo.theta;
         res->gamma = mo.gamma;
         res->kernel = "scalar";
-        pd_demand_osc_finish(res, &o, tr.demands ? tr.dem.peak * c->ap : NAN, NAN);
+        pd_demand_osc_finish(res, &o, tr.demands ? tr.dem.peak * c->ap : NAN,
+                             tr.demands ? tr.dem.shear * c->ap : NAN, NAN);
         res->cpu_s = pd_cpu_seconds() - cpu0;
         return rc;
     }
@@ -448,7 +453,8 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
     res->gamma = mo.gamma;
     res->kernel = pd_mj_kernel_name(mj);
     pd_mj_free(mj);
-    pd_demand_osc_finish(res, &o, tr.demands ? tr.dem.peak * c->ap : NAN, NAN);
+    pd_demand_osc_finish(res, &o, tr.demands ? tr.dem.peak * c->ap : NAN,
+                             tr.demands ? tr.dem.shear * c->ap : NAN, NAN);
     res->cpu_s = pd_cpu_seconds() - cpu0;
     return rc;
 }
@@ -471,11 +477,12 @@ typedef struct ref_bridge {
 static int ref_sample(double tau, double x, double v, int in_contact, void *ctx)
 {
     ref_bridge *b = ctx;
-    /* free flight: x'' = f - C x' - K x; the interval since the previous sample
-     * is smooth when it held no impact and no rest */
-    double a = in_contact ? 0.0 : pd_osc_shape(b->c, tau, -1) - b->dem.C * v - b->dem.K * x;
+    /* free flight: x'' = f - C x' - K x; at rest on the wall x'' = 0 and the
+     * held force is f - C x' - K x (a_abs = a_g); the interval since the
+     * previous sample is smooth when it held no impact and no rest */
+    double a = pd_osc_shape(b->c, tau, -1) - b->dem.C * v - b->dem.K * x;
     int smooth = !in_contact && !b->rest_prev && b->impacts == b->impacts_prev;
-    pd_demand_osc_note(&b->dem, tau, x, v, in_contact ? NULL : &a, smooth);
+    pd_demand_osc_note(&b->dem, tau, x, v, in_contact ? NULL : &a, in_contact ? a : 0.0, smooth);
     b->impacts_prev = b->impacts;
     b->rest_prev = in_contact;
     if (!b->sampler) {
@@ -500,9 +507,11 @@ static void ref_impact(double tau, double vn, double v_plus, void *ctx)
     ref_bridge *b = ctx;
     pd_demand_osc *d = &b->dem;
     b->impacts++;
-    if (tau >= d->tau_measure)
-        d->peak = pd_max(d->peak, pd_max(fabs(d->C * vn + d->K * b->Pi3),
-                                         fabs(d->C * v_plus + d->K * b->Pi3)));
+    if (tau >= d->tau_measure) {
+        double p = pd_max(fabs(d->C * vn + d->K * b->Pi3), fabs(d->C * v_plus + d->K * b->Pi3));
+        d->peak = pd_max(d->peak, p);
+        d->shear = pd_max(d->shear, p);
+    }
 }
 
 /* The reference's demand grid without a sampler: the largest whole multiple
@@ -619,7 +628,8 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     res->gamma = NAN;
     res->kernel = "event";
     pd_osc_result_no_rtol(res, NAN);
-    pd_demand_osc_finish(res, &o, o.no_demands ? NAN : bridge.dem.peak * c->ap, NAN);
+    pd_demand_osc_finish(res, &o, o.no_demands ? NAN : bridge.dem.peak * c->ap,
+                         o.no_demands ? NAN : bridge.dem.shear * c->ap, NAN);
     res->cpu_s = pd_cpu_seconds() - cpu0;
     return rc;
 }

@@ -238,9 +238,10 @@ typedef struct pd_run_opts {
 
 /* ---- demand parameters (docs/scenes.md, "Demands") ------------------------ *
  * What earthquake engineers read off a run, per storey and per contact:
- *   absolute floor acceleration, its smooth part  a_abs = u'' + a_g = -M^-1 (C u' + K u)
- *     (the contact forces are impulses, reported as such);
- *   storey shear V_k = sum over the floors i >= k of (C u' + K u)_i = -sum m_i a_abs_i:
+ *   absolute floor acceleration a_abs = u'' + a_g = M^-1 (W lambda - C u' - K u): the
+ *     held (persistent) contacts' finite forces lambda in it, the impacts' impulses
+ *     (Dirac pulses, reported as such) not; the penalty methods: the smooth part;
+ *   storey shear V_k = sum over the floors i >= k of (C u' + K u)_i:
  *     spring plus damping (with Rayleigh's mass-proportional part of the floors above),
  *     so that the base shear V_1 balances the floors' inertia forces; an SDOF: k u + c u';
  *   drift ratio = peak interstorey drift / storey height;
@@ -378,8 +379,11 @@ typedef struct pd_osc_result {
     const char *kernel;   /* "scalar", "general", "event", or the penalty stepper */
     /* demands over the measuring window (pd_run_opts, "demand parameters"), per unit
      * mass; NAN where not measured (the batched runs of pd_osc_run_stream) */
-    double acc_max;       /* peak |2 xi w0 u' + w0^2 u|: the absolute acceleration's smooth
-                             part [m/s^2], and the base shear per unit mass [N/kg] */
+    double acc_max;       /* peak |2 xi w0 u' + w0^2 u + lambda|: the absolute acceleration
+                             [m/s^2], the wall's held force lambda (per unit mass) in it,
+                             the impacts' impulses not */
+    double shear_max;     /* peak |2 xi w0 u' + w0^2 u|: the base shear per unit mass [N/kg]
+                             (acc_max where the wall holds no force) */
     double force_max;     /* peak contact force per unit mass [N/kg] (penalty, newmark;
                              NAN for the impulsive methods) */
     double force_equiv;   /* pd_equivalent_force(max_impulse, td) [N/kg] */

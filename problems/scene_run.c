@@ -55,6 +55,14 @@ typedef struct track {
     double *acc, *shear;                /* n: demand peaks [SI] */
     double *da, *dV, *dad, *dVd;        /* n: the instant's a_abs, V and their rates */
     double *qa, *qV, *qad, *qVd;        /* n: the same at the previous demand state */
+    double *hacc, *qh;                  /* n: the held contact forces' part M^-1 W lambda of
+                                           a_abs [SI] now and at the previous demand state */
+    double *hlam;                       /* m: Moreau-Jean: the held force P / h of the last
+                                           step without an impact (reference units) */
+    unsigned char *sheld;               /* nstruct: row reference: a closed contact at an
+                                           impact */
+    const pd_osc *shape;                /* the excitation's shape: f = F_i / m_i */
+    const double *mass;                 /* n: the floors' masses [kg] */
     double dem_t;                       /* its time */
     int dem_prev;                       /* 1: it has rates (an interval can be refined) */
     int demands;                        /* 0: not measured (pd_run_opts.no_demands) */
@@ -170,7 +178,8 @@ static void track_free(track *tr)
                       tr->imp, tr->imp_lam, tr->acc, tr->shear, tr->da, tr->dV, tr->fpeak,
                       tr->dad, tr->dVd, tr->qa, tr->qV, tr->qad, tr->qVd,
                       tr->st_of, tr->ex, tr->ev, tr->sI, tr->sampled, tr->errx, tr->errd,
-                      tr->erra, tr->errv, tr->acc0, tr->shear0, tr->serr, tr->wdof};
+                      tr->erra, tr->errv, tr->acc0, tr->shear0, tr->serr, tr->wdof,
+                      tr->hacc, tr->qh, tr->hlam, tr->sheld};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(arrays[k]);
 }
@@ -196,7 +205,9 @@ static int track_alloc(track *tr, const pd_scene *sc, pd_err *err)
         !TA(tr->st_of, n) || !TA(tr->ex, n) || !TA(tr->ev, n) || !TA(tr->sI, m) ||
         !TA(tr->sampled, m) || !TA(tr->errx, n) || !TA(tr->errd, n) || !TA(tr->erra, n) ||
         !TA(tr->errv, n) || !TA(tr->acc0, n) || !TA(tr->shear0, n) ||
-        !TA(tr->serr, (size_t)sc->nstruct) || !TA(tr->wdof, n)) {
+        !TA(tr->serr, (size_t)sc->nstruct) || !TA(tr->wdof, n) || !TA(tr->hacc, n) ||
+        !TA(tr->qh, n) || !TA(tr->hlam, m) ||
+        !TA(tr->sheld, (size_t)sc->nstruct)) {
 #undef TA
         track_free(tr);
         return pd_err_set(err, PD_ENOMEM, "out of memory for tracking %d dofs", sc->n);
@@ -225,7 +236,7 @@ static void track_clear(track *tr)
                     tr->errd, tr->erra, tr->errv};
     for (size_t k = 0; k < sizeof dn / sizeof dn[0]; k++)
         memset(dn[k], 0, n);
-    double *dm[] = {tr->maxP, tr->ctime, tr->episode, tr->imp, tr->fpeak};
+    double *dm[] = {tr->maxP, tr->ctime, tr->episode, tr->imp, tr->fpeak, tr->hlam};
     for (size_t k = 0; k < sizeof dm / sizeof dm[0]; k++)
         memset(dm[k], 0, m * sizeof(double));
     memset(tr->impacts, 0, m * sizeof(long));
@@ -268,12 +279,49 @@ static void note_point(track *tr, double t, const double *x)
     }
 }
 
-/* The demands of the state (x, v) at t, inside the window; with its
+/* The held contact forces' part of a_abs, M^-1 W lambda [SI], into
+ * tr->hacc: from forces lam (m, reference units, force unit ap kg; NULL:
+ * none held), W's column of contact a being -1 at dof_a and +1 at dof_b. */
+static void held_from_forces(track *tr, const double *lam)
+{
+    double ap = tr->sc->exc.ap;
+    memset(tr->hacc, 0, (size_t)tr->n * sizeof(double));
+    for (int a = 0; lam && a < tr->model_m; a++) {
+        if (lam[a] == 0.0)
+            continue;
+        if (tr->dof_a[a] >= 0)
+            tr->hacc[tr->dof_a[a]] -= ap * lam[a] / tr->mass[tr->dof_a[a]];
+        if (tr->dof_b[a] >= 0)
+            tr->hacc[tr->dof_b[a]] += ap * lam[a] / tr->mass[tr->dof_b[a]];
+    }
+}
+
+/* The same from the accelerations acc (reference units, held forces in
+ * them) of the state (x, v) at t: a_abs = ap (x'' - f(t)) with f = F_i / m_i
+ * the excitation's (side: its limit at a jump), less the smooth part
+ * -M^-1 (C u' + K u); zero when held is 0 (no contact held: rounding). */
+static void held_from_acc(track *tr, double t, int side, const double *x, const double *v,
+                          const double *acc, int held)
+{
+    double us = tr->Le, vs = tr->Le * tr->wp, ap = tr->sc->exc.ap;
+    if (!held || !acc || !tr->demands) {
+        held_from_forces(tr, NULL);
+        return;
+    }
+    double f = pd_osc_shape(tr->shape, t, side);
+    pd_demand_eval(tr->sc, x, v, us, vs, tr->hacc, tr->dV);
+    for (int i = 0; i < tr->n; i++)
+        tr->hacc[i] = ap * (acc[i] - f) - tr->hacc[i];
+}
+
+/* The demands of the state (x, v) at t, inside the window, a_abs with the
+ * held contact forces' part held (n, SI; NULL: none); with its
  * accelerations acc (NULL: none), their peaks between it and the previous
  * state on the cubic Hermite of the values and rates, when the interval
- * was smooth (no impulse in it). */
+ * was smooth (no impulse in it): the held part linear over the interval
+ * (its rate the secant's), the rest with its exact rates. */
 static void note_demand(track *tr, double t, const double *x, const double *v,
-                        const double *acc, int smooth)
+                        const double *acc, const double *held, int smooth)
 {
     double us = tr->Le, vs = tr->Le * tr->wp, as = vs * tr->wp;
     if (!tr->demands)
@@ -282,7 +330,12 @@ static void note_demand(track *tr, double t, const double *x, const double *v,
         tr->dem_prev = 0;
         return;
     }
-    pd_demand_note(tr->sc, x, v, us, vs, tr->da, tr->dV, tr->acc, tr->shear);
+    pd_demand_eval(tr->sc, x, v, us, vs, tr->da, tr->dV);
+    for (int i = 0; i < tr->n; i++) {
+        tr->da[i] += held ? held[i] : 0.0;
+        tr->acc[i] = pd_max(tr->acc[i], fabs(tr->da[i]));
+        tr->shear[i] = pd_max(tr->shear[i], fabs(tr->dV[i]));
+    }
     if (!acc) {
         tr->dem_prev = 0;
         return;
@@ -293,10 +346,12 @@ static void note_demand(track *tr, double t, const double *x, const double *v,
      * it strays from its ends by at most h (|d0| + |d1|) / 4 */
     if (tr->dem_prev && smooth && h > 0.0)
         for (int i = 0; i < tr->n; i++) {
-            if (pd_max(fabs(tr->qa[i]), fabs(tr->da[i])) +
-                    0.25 * h * (fabs(tr->qad[i]) + fabs(tr->dad[i])) > tr->acc[i])
-                tr->acc[i] = pd_max(tr->acc[i], pd_demand_cubic_peak(tr->qa[i], tr->qad[i],
-                                                                     tr->da[i], tr->dad[i], h));
+            double hs = held ? (held[i] - tr->qh[i]) / h : -tr->qh[i] / h; /* the secant */
+            double d0 = tr->qad[i] + hs, d1 = tr->dad[i] + hs;
+            if (pd_max(fabs(tr->qa[i]), fabs(tr->da[i])) + 0.25 * h * (fabs(d0) + fabs(d1)) >
+                tr->acc[i])
+                tr->acc[i] = pd_max(tr->acc[i],
+                                    pd_demand_cubic_peak(tr->qa[i], d0, tr->da[i], d1, h));
             if (pd_max(fabs(tr->qV[i]), fabs(tr->dV[i])) +
                     0.25 * h * (fabs(tr->qVd[i]) + fabs(tr->dVd[i])) > tr->shear[i])
                 tr->shear[i] = pd_max(tr->shear[i], pd_demand_cubic_peak(tr->qV[i], tr->qVd[i],
@@ -307,6 +362,10 @@ static void note_demand(track *tr, double t, const double *x, const double *v,
     memcpy(tr->qV, tr->dV, bytes);
     memcpy(tr->qad, tr->dad, bytes);
     memcpy(tr->qVd, tr->dVd, bytes);
+    if (held)
+        memcpy(tr->qh, held, bytes);
+    else
+        memset(tr->qh, 0, bytes);
     tr->dem_t = t;
     tr->dem_prev = 1;
 }
@@ -323,6 +382,22 @@ static int on_edr_event(const pd_edr_event *e, void *ctx)
         tr->edr_hit |= e->P[j] > 0.0;
     if (e->t < tr->tau_measure - 0.5 * tr->h)
         return 0;
+    /* a structure with a contact closed before or after the impact (held,
+     * or coming to rest) carries held forces the event does not give: its
+     * a_abs is left to the grid's states (the shears are exact here) */
+    double U = 0.0;
+    for (int j = 0; j < e->ncontacts; j++)
+        U = pd_max(U, fabs(e->U_minus[j]));
+    memset(tr->sheld, 0, (size_t)tr->sc->nstruct);
+    for (int j = 0; j < e->ncontacts; j++) {
+        int a = e->contacts[j];
+        if (e->U_minus[j] < -1e-9 * U && e->U_plus[j] > 1e-9 * U)
+            continue;
+        if (tr->dof_a[a] >= 0)
+            tr->sheld[tr->st_of[tr->dof_a[a]]] = 1;
+        if (tr->dof_b[a] >= 0)
+            tr->sheld[tr->st_of[tr->dof_b[a]]] = 1;
+    }
     for (int side = 0; side < 2; side++) {
         for (int k = 0; k < e->ndofs; k++) {
             int d = e->dofs[k];
@@ -335,7 +410,8 @@ static int on_edr_event(const pd_edr_event *e, void *ctx)
                 continue;
             pd_demand_eval_structure(st, tr->ex, tr->ev, us, vs, tr->da, tr->dV);
             for (int i = st->dof; i < st->dof + st->storeys; i++) {
-                tr->acc[i] = pd_max(tr->acc[i], fabs(tr->da[i]));
+                if (!tr->sheld[tr->st_of[i]])
+                    tr->acc[i] = pd_max(tr->acc[i], fabs(tr->da[i]));
                 tr->shear[i] = pd_max(tr->shear[i], fabs(tr->dV[i]));
             }
         }
@@ -469,6 +545,23 @@ static double gap_rate(const track *tr, int a, const double *v)
     return (tr->dof_b[a] >= 0 ? v[tr->dof_b[a]] : 0.0) - (tr->dof_a[a] >= 0 ? v[tr->dof_a[a]] : 0.0);
 }
 
+/* Moreau–Jean's held forces at a step into tr->hlam and tr->hacc: a
+ * contact with an impulse in this step and the one before is held, its
+ * force the step's mean P / h; a step where some contact starts (an
+ * impulse after none) carries impulses through every closed contact, and
+ * there the held ones keep the force of their step before. */
+static void moreau_held(track *tr, const pd_state *st)
+{
+    int impact = 0;
+    for (int a = 0; a < tr->model_m; a++)
+        impact |= st->P[a] > 0.0 && !tr->touching[a];
+    for (int a = 0; a < tr->model_m; a++)
+        tr->hlam[a] = !(st->P[a] > 0.0 && tr->touching[a]) ? 0.0
+                      : impact                           ? tr->hlam[a]
+                                                         : st->P[a] / tr->h;
+    held_from_forces(tr, tr->hlam);
+}
+
 /* Moreau–Jean, every step: extremes at the step, impacts (an impulse after a
  * step without) with the first one's instant estimated inside its step from
  * the step start and the previous step's gap acceleration, the sample. */
@@ -477,7 +570,9 @@ static int observe_moreau(const pd_state *st, void *ctx)
     track *tr = ctx;
     note_point(tr, st->t, st->q);
     note_approach(tr, st->q);
-    note_demand(tr, st->t, st->q, st->v, NULL, 0); /* the steps' own: as umax */
+    if (tr->demands)
+        moreau_held(tr, st);
+    note_demand(tr, st->t, st->q, st->v, NULL, tr->hacc, 0); /* the steps' own: as umax */
     tr->lcp_solves += st->nactive > 0;
     for (int a = 0; a < tr->model_m; a++) {
         double P = st->P[a], U = gap_rate(tr, a, st->v);
@@ -531,7 +626,8 @@ static int observe_adapt(const pd_state *st, void *ctx)
     if (tr->demands && st->has_acc && !st->impact) {
         memcpy(tr->acc0, tr->acc, (size_t)tr->n * sizeof(double));
         memcpy(tr->shear0, tr->shear, (size_t)tr->n * sizeof(double));
-        note_demand(tr, st->t, st->q, st->v, st->acc, smooth && !tr->dem_skipped);
+        held_from_acc(tr, st->t, -1, st->q, st->v, st->acc, !no_impulse(tr, st));
+        note_demand(tr, st->t, st->q, st->v, st->acc, tr->hacc, smooth && !tr->dem_skipped);
         tr->dem_skipped = 0;
         for (int i = 0; i < tr->n; i++) {
             if (tr->acc[i] > tr->acc0[i])
@@ -559,8 +655,16 @@ static int observe_adapt(const pd_state *st, void *ctx)
     if (st->has_acc && st->acc_right != st->acc) { /* a forcing jump at t: the next step's start */
         double vs = tr->Le * tr->wp, as = vs * tr->wp;
         memcpy(tr->pa, st->acc_right, (size_t)tr->n * sizeof(double));
-        if (tr->demands && tr->dem_prev)
+        if (tr->demands && tr->dem_prev) {
             pd_demand_eval(tr->sc, st->v, st->acc_right, vs, as, tr->qad, tr->qVd);
+            /* a_abs's right limit: the next interval's start, and a value it takes */
+            held_from_acc(tr, st->t, +1, st->q, st->v, st->acc_right, !no_impulse(tr, st));
+            for (int i = 0; i < tr->n; i++) {
+                tr->qa[i] += tr->hacc[i] - tr->qh[i];
+                tr->qh[i] = tr->hacc[i];
+                tr->acc[i] = pd_max(tr->acc[i], fabs(tr->qa[i]));
+            }
+        }
     }
     return tr->fn ? sample(tr, st) : 0;
 }
@@ -574,7 +678,9 @@ static int step_event(const pd_state *st, void *ctx)
         note_between(tr, st->t, st->q, st->v, st->acc);
     note_point(tr, st->t, st->q);
     note_approach(tr, st->q);
-    note_demand(tr, st->t, st->q, st->v, st->has_acc ? st->acc : NULL, no_impulse(tr, st));
+    held_from_acc(tr, st->t, -1, st->q, st->v, st->has_acc ? st->acc : NULL, st->nactive > 0);
+    note_demand(tr, st->t, st->q, st->v, st->has_acc ? st->acc : NULL, tr->hacc,
+                no_impulse(tr, st));
     for (int a = 0; a < tr->model_m; a++) {
         double P = st->P[a];
         if (tr->pactive[a] && tr->have_prev)
@@ -613,7 +719,11 @@ static int step_penalty(const pd_state *st, void *ctx)
         note_between(tr, st->t, st->q, st->v, st->acc);
     note_point(tr, st->t, st->q);
     note_approach(tr, st->q);
-    note_demand(tr, st->t, st->q, st->v, st->has_acc ? st->acc : NULL, no_element(tr, st));
+    /* the elements' forces are left out of a_abs: an element's force is its
+     * impact's and its hold's at once (a held part would need the rigid
+     * contact-force LCP of the engaged set; docs/scenes.md, "Demands") */
+    note_demand(tr, st->t, st->q, st->v, st->has_acc ? st->acc : NULL, NULL,
+                no_element(tr, st));
     for (int a = 0; a < tr->model_m; a++) {
         double dt = tr->have_prev ? st->t - tr->pt : 0.0;
         if (st->active[a])
@@ -715,7 +825,7 @@ static int run_oscillator(const pd_scene *sc, const pd_osc *c, int mirrored,
         return rc;
     res->umax[0] = res->drift[0] = r.umax;
     res->acc_max[0] = r.acc_max;
-    res->shear_max[0] = r.acc_max * mass;
+    res->shear_max[0] = r.shear_max * mass;
     res->u_pos[0] = mirrored ? r.u_away : r.u_toward;
     res->u_neg[0] = mirrored ? r.u_toward : r.u_away;
     if (sc->ncontact > 0) {
@@ -978,7 +1088,11 @@ static int observe_edr(const pd_state *st, void *ctx)
     track *tr = ctx;
     int smooth = !tr->edr_hit;
     tr->edr_hit = 0;
-    note_demand(tr, st->t, st->q, st->v, st->has_acc ? st->acc : NULL, smooth);
+    int held = 0;
+    for (int a = 0; a < tr->model_m; a++)
+        held |= st->active[a];
+    held_from_acc(tr, st->t, -1, st->q, st->v, st->has_acc ? st->acc : NULL, held);
+    note_demand(tr, st->t, st->q, st->v, st->has_acc ? st->acc : NULL, tr->hacc, smooth);
     if (!tr->fn)
         return 0;
     for (int a = 0; a < tr->model_m; a++) {
@@ -1167,6 +1281,8 @@ static int run_general(const pd_scene *sc, const pd_run_opts *o, pd_scene_sample
     tr.fn = fn;
     tr.ctx = ctx;
     tr.demands = !o->no_demands;
+    tr.shape = &sm.shape;
+    tr.mass = sm.mass;
     long nsteps = o->rtol > 0.0 ? 0 : pd_steps_for(o->tend, o->dt);
     double tau_end = o->rtol > 0.0 ? tr.wp * o->tend : (double)nsteps * tr.h;
     switch (o->method) {

@@ -37,7 +37,7 @@ def pop_height(case):
 def osc_fields(out, r, height):
     """The oscillator's demands per unit mass into out (cmd_simulate.c's JSON)."""
     out.update(height=height, drift_ratio=r.umax / height, acc_max=r.acc_max,
-               shear_max=r.acc_max, force_equiv=r.force_equiv, force_max=r.force_max,
+               shear_max=r.shear_max, force_equiv=r.force_equiv, force_max=r.force_max,
                contact_duration=r.contact_duration)
 
 

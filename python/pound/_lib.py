@@ -171,7 +171,7 @@ class PdOscResult(Structure):
                 ("accumulations", c_long), ("steps", c_long), ("dt", c_double),
                 ("tend", c_double), ("theta", c_double), ("gamma", c_double),
                 ("cpu_s", c_double), ("kernel", c_char_p), ("acc_max", c_double),
-                ("force_max", c_double), ("force_equiv", c_double),
+                ("shear_max", c_double), ("force_max", c_double), ("force_equiv", c_double),
                 ("contact_duration", c_double),
                 # Moreau-Jean to a tolerance (fixed steps: rtol 0, err_est NAN, rtol_met 1)
                 ("rtol", c_double), ("err_est", c_double), ("rtol_met", c_int),
