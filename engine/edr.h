@@ -205,6 +205,8 @@ struct pd_edr {
     int piece;                 /* the current piece */
     double *slot_t;            /* per queue slot: time of its last event */
     int *slot_same;            /* and how many it had there */
+    int *slot_run;             /* events of the slot since slot_t0 (count_event's chatter) */
+    double *slot_t0;
     int stopped;
     double vscale;             /* largest velocity met at an event */
     long evals;
@@ -220,6 +222,7 @@ struct pd_edr {
     double *lam, *wlcp, *qlcp, *wtmp;
     int *lcp_idx, *jpos, *excluded;
     unsigned char *held;
+    unsigned char *tie;        /* at zero rate, force and gap acceleration (decide_persistence) */
     double *held_tail;
     int *pos_in;
     unsigned char *guess;      /* the LCP's warm start */

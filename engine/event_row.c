@@ -57,6 +57,18 @@
 /* Stages of one impact (a closed contact closing again under the
  * others' impulses) before the run is declared stuck. */
 #define EDR_STAGES 10000
+/* A tie (zero rate, force and gap acceleration) is broken by the gap's
+ * jerk only while the bodies accelerate by more than this times the length
+ * scale (per unit time squared): bodies touching under the ground motion,
+ * not a structure coming to rest at a wall at its own rest position. */
+#define EDR_TIE_ACC 1e-6
+/* A hold ends a contact's burst of impacts (max_burst) when it lasts
+ * longer than this (units of the run's time). */
+#define EDR_HOLD_MIN 1e-6
+/* Events of one contact or cluster within this span (units of the run's
+ * time) before the run is declared stuck in a chatter. */
+#define EDR_CHATTER_EVENTS 10000
+#define EDR_CHATTER_SPAN 1e-4
 /* Events at one instant before the run is declared stuck. */
 #define EDR_SAME_INSTANT 1000
 /* The clusters' LCPs (contacts between clusters: one or two, a row's
@@ -870,6 +882,30 @@ static void free_accelerations(pd_edr *r, double t)
     }
 }
 
+/* The free jerks of the group's dofs into r->gtmp, from the free
+ * accelerations r->gacc:  j = M^-1 (b f'(t) - C a - K v). */
+static void free_jerks(pd_edr *r, double t)
+{
+    const pd_sine_piece *pc = &r->pieces[edr_piece_at(r, t)];
+    double df = pc->c1 + (pc->A == 0.0 ? 0.0 : pc->A * pc->w * cos(pc->w * t + pc->phi));
+    for (int k = 0; k < r->ngd; k++) {
+        int i = r->g_dof[k], b = r->dof_blk[i];
+        const edr_block *bk = &r->blk[b];
+        if (bk->sdof) {
+            r->gtmp[i] = (bk->b * df - bk->c * r->gacc[i] - bk->k * r->gv[i]) * r->minv[i];
+            continue;
+        }
+        int li = r->dof_loc[i];
+        long off = r->blk_off[b];
+        double s = r->b[i] * df;
+        for (int j = 0; j < bk->n; j++) {
+            int gj = r->blk_dofs[bk->first + j];
+            s -= r->Cb[off + li + (long)j * bk->n] * r->gacc[gj] + r->Kb[off + li + (long)j * bk->n] * r->gv[gj];
+        }
+        r->gtmp[i] = s * r->minv[i];
+    }
+}
+
 /* W_a^T y over the group's state array y (walls at rest). */
 static double contact_dot(const pd_edr *r, int a, const double *y)
 {
@@ -938,6 +974,10 @@ static int regroup(pd_edr *r, double t, pd_err *err)
         int was = r->cstate[a] == EDR_PERSIST;
         if (was && !r->held[j])
             r->ctime[a] += t - r->since[a] > 0.0 ? t - r->since[a] : 0.0;
+        /* a contact's burst of impacts ends with a hold that lasted: one
+         * released at once (a chatter through held states) bounces on */
+        if (was && !r->held[j] && t - r->since[a] > EDR_HOLD_MIN)
+            r->burst[a] = 0;
         if (r->held[j] && !was)
             r->since[a] = t + r->held_tail[j];
         r->cstate[a] = r->held[j] ? EDR_PERSIST : EDR_OPEN;
@@ -1072,6 +1112,18 @@ static int count_event(pd_edr *r, int slot, double t, pd_err *err)
         r->slot_t[slot] = t;
         r->slot_same[slot] = 0;
     }
+    /* a chatter: EDR_CHATTER_EVENTS events of one slot within EDR_CHATTER_SPAN
+     * (a Zeno sequence the accumulation jump did not end) */
+    if (++r->slot_run[slot] >= EDR_CHATTER_EVENTS) {
+        if (t - r->slot_t0[slot] < EDR_CHATTER_SPAN)
+            return pd_err_set(err, PD_EBUDGET, "row reference: %d events of one %s within %.3g "
+                              "s at t = %.9g s: a chatter it cannot resolve (Moreau-Jean, "
+                              "--method moreau, runs it)", EDR_CHATTER_EVENTS,
+                              slot < r->m ? "contact" : "cluster",
+                              (t - r->slot_t0[slot]) * r->o.time_unit, t * r->o.time_unit);
+        r->slot_run[slot] = 0;
+        r->slot_t0[slot] = t;
+    }
     return PD_OK;
 }
 
@@ -1100,6 +1152,32 @@ static int decide_persistence(pd_edr *r, double t, int *acc_jumped, pd_err *err)
     for (int j = 0; j < r->ngc; j++)
         if (r->jpos[j] >= 0)
             r->held[j] = r->lam[r->jpos[j]] > 0.0;
+    /* a contact at zero force and zero gap acceleration whose bodies are
+     * still but accelerate (touching at rest under one ground motion, as at
+     * the start) is held when the free gap's jerk closes it: its force
+     * grows from zero.  Left open, its gap would
+     * close as t^3 and bounce at ever smaller speeds, never reaching the
+     * accumulation jump (no closing acceleration to bound the bounces). */
+    int ties = 0;
+    for (int j = 0; j < r->ngc; j++) {
+        const edr_contact *ct = &r->ct[r->g_ct[j]];
+        double as = 0.0; /* its bodies' accelerations; at rest: both still */
+        int rest = 1;
+        for (int k = 0; k < 2; k++)
+            if (ct->dof[k] >= 0) {
+                as = fmax(as, fabs(r->gacc[ct->dof[k]]));
+                rest &= r->gv[ct->dof[k]] == 0.0;
+            }
+        r->tie[j] = r->jpos[j] >= 0 && !r->held[j] && rest && as > EDR_TIE_ACC * r->L &&
+                    !(fabs(r->wlcp[j]) > EDR_RATE_TOL * as);
+        ties |= r->tie[j];
+    }
+    if (ties) {
+        free_jerks(r, t);
+        for (int j = 0; j < r->ngc; j++)
+            if (r->tie[j])
+                r->held[j] = contact_dot(r, r->g_ct[j], r->gtmp) < 0.0;
+    }
     if (r->o.no_accumulation)
         return PD_OK;
     /* accumulations: contacts bouncing off with a tiny height under a closing acceleration */
@@ -1206,8 +1284,9 @@ static int commit_impacts(pd_edr *r, double t, pd_err *err)
             r->res.first_impact = t;
         if ((r->burst[a] += r->nimp[j]) > r->o.max_burst)
             return pd_err_set(err, PD_EBUDGET, "row reference: accumulation of impacts of "
-                              "contact %d at t = %.9g s: %ld impacts without reaching persistent "
-                              "contact%s", a, t * r->o.time_unit, r->burst[a] - 1,
+                              "contact %d at t = %.9g s: %ld impacts without a lasting persistent "
+                              "contact%s (Moreau-Jean, --method moreau, runs it)", a,
+                              t * r->o.time_unit, r->burst[a] - 1,
                               r->o.no_accumulation ? " (accumulation handling is off)" : "");
     }
     return PD_OK;
@@ -1741,15 +1820,8 @@ static int resolve_group(pd_edr *r, double t, pd_err *err)
         if ((rc = regroup(r, t, err)))
             return rc;
     }
-    if (acc) {
+    if (acc)
         r->res.accumulations++;
-        for (int j = 0; j < r->ngc; j++)
-            if (r->held[j] && r->held_tail[j] > 0.0)
-                r->burst[r->g_ct[j]] = 0;
-    }
-    for (int j = 0; j < r->ngc; j++)
-        if (r->held[j])
-            r->burst[r->g_ct[j]] = 0;
     for (int k = 0; k < r->ngd; k++)
         r->gv[r->g_dof[k]] = r->vo[r->g_dof[k]];
     if (report(r, t, PD_EDR_IMPACT, acc) > 0)
@@ -1810,10 +1882,8 @@ static int on_detach(pd_edr *r, int c, double t, pd_err *err)
         return rc;
     for (int j = 0; j < r->ngc; j++) {
         r->excluded[j] = 0;
-        if (r->cstate[r->g_ct[j]] == EDR_PERSIST && !r->held[j]) {
+        if (r->cstate[r->g_ct[j]] == EDR_PERSIST && !r->held[j])
             r->res.detachments++;
-            r->burst[r->g_ct[j]] = 0;
-        }
     }
     if ((rc = regroup(r, t, err)))
         return rc;
@@ -1937,12 +2007,12 @@ void pd_edr_free(pd_edr *r)
     void *arrays[] = {r->b, r->pieces, r->blk, r->blk_dofs, r->dof_blk, r->dof_loc, r->Mb,
                       r->Cb, r->Kb, r->blk_off, r->blk_cont, r->ct, r->minv, r->cl, r->blk_cl,
                       r->blk_next, r->free_cl, r->s, r->d, r->xo, r->vo, r->cstate, r->pers_next,
-                      r->la, r->lb, r->lg, r->ld, r->base_t, r->base_g, r->qkind, r->win, r->slot_t, r->slot_same, r->gmeas_t,
+                      r->la, r->lb, r->lg, r->ld, r->base_t, r->base_g, r->qkind, r->win, r->slot_t, r->slot_same, r->slot_run, r->slot_t0, r->gmeas_t,
                       r->since, r->burst, r->xpos, r->xneg, r->drift, r->gmin, r->impacts,
                       r->first, r->maxP, r->ctime, r->imp_out, r->q.heap, r->q.pos, r->q.key,
                       r->g_cl, r->cl_mark, r->g_ct, r->ct_mark, r->ct_mark2, r->ct_markD, r->ct_markP,
                       r->g_dof, r->gx, r->gv, r->gacc, r->gtmp, r->Uminus, r->Uplus, r->P,
-                      r->lam, r->wlcp, r->qlcp, r->wtmp, r->Dd, r->Dlu, r->rtmp, r->lu_perm, r->cG, r->lcp_idx, r->jpos, r->held,
+                      r->lam, r->wlcp, r->qlcp, r->wtmp, r->Dd, r->Dlu, r->rtmp, r->lu_perm, r->cG, r->lcp_idx, r->jpos, r->held, r->tie,
                       r->held_tail, r->excluded, r->guess, r->epos, r->qtmp, r->ztmp, r->pos_in, r->Dval, r->Dcol, r->Drow,
                       r->stack, r->pe, r->pdof, r->bfs_next, r->ceta, r->cmu, r->cvy, r->ext, r->nimp, r->crow, r->crow_c, r->keybuf, r->uf, r->gblk,
                       r->newcl, r->plist, r->dofc_ptr, r->dofc, r->loc, r->wk, r->mctx,
@@ -2206,7 +2276,8 @@ pd_edr *pd_edr_alloc(const pd_model *md, const pd_piecewise_force *F, const pd_e
         !ALLOC(r->vo, n) || !ALLOC(r->cstate, m) || !ALLOC(r->pers_next, m) || !ALLOC(r->la, m) ||
         !ALLOC(r->lb, m) || !ALLOC(r->lg, m) || !ALLOC(r->ld, m) || !ALLOC(r->base_t, m) ||
         !ALLOC(r->base_g, m) || !ALLOC(r->qkind, m + nb + 2) || !ALLOC(r->win, m + nb + 2) ||
-        !ALLOC(r->slot_t, m + nb + 2) || !ALLOC(r->slot_same, m + nb + 2) || !ALLOC(r->gmeas_t, m) ||
+        !ALLOC(r->slot_t, m + nb + 2) || !ALLOC(r->slot_same, m + nb + 2) ||
+        !ALLOC(r->slot_run, m + nb + 2) || !ALLOC(r->slot_t0, m + nb + 2) || !ALLOC(r->gmeas_t, m) ||
         !ALLOC(r->since, m) || !ALLOC(r->burst, m) || !ALLOC(r->xpos, n) || !ALLOC(r->xneg, n) ||
         !ALLOC(r->drift, n) || !ALLOC(r->gmin, m) || !ALLOC(r->impacts, m) || !ALLOC(r->first, m) ||
         !ALLOC(r->maxP, m) || !ALLOC(r->ctime, m) || !ALLOC(r->imp_out, m) ||
@@ -2218,7 +2289,7 @@ pd_edr *pd_edr_alloc(const pd_model *md, const pd_piecewise_force *F, const pd_e
         !ALLOC(r->P, m) || !ALLOC(r->lam, m) || !ALLOC(r->wlcp, m) || !ALLOC(r->qlcp, m) ||
         !ALLOC(r->wtmp, m) || !ALLOC(r->Dd, (long)dm * dm) || !ALLOC(r->Dlu, (long)dm * dm) ||
         !ALLOC(r->rtmp, 4L * dm) || !ALLOC(r->lu_perm, 2L * dm) || !ALLOC(r->cG, nb) || !ALLOC(r->lcp_idx, m) ||
-        !ALLOC(r->jpos, m) || !ALLOC(r->held, m) || !ALLOC(r->held_tail, m) ||
+        !ALLOC(r->jpos, m) || !ALLOC(r->held, m) || !ALLOC(r->tie, m) || !ALLOC(r->held_tail, m) ||
         !ALLOC(r->excluded, m) || !ALLOC(r->guess, m) || !ALLOC(r->epos, m) || !ALLOC(r->qtmp, m) || !ALLOC(r->ztmp, m) || !ALLOC(r->pos_in, m) || !ALLOC(r->Dval, r->Dcap) ||
         !ALLOC(r->Dcol, m + 1) || !ALLOC(r->Drow, r->Dcap) || !ALLOC(r->stack, n) ||
         !ALLOC(r->pe, n) || !ALLOC(r->pdof, n) || !ALLOC(r->bfs_next, n) ||
@@ -2301,6 +2372,8 @@ static void reset(pd_edr *r, double t0, const double *q0, const double *v0, doub
     for (int k = 0; k < m + r->nb + 2; k++) {
         r->slot_t[k] = NAN;
         r->slot_same[k] = 0;
+        r->slot_run[k] = 0;
+        r->slot_t0[k] = t0;
     }
     r->stopped = 0;
     r->vscale = 0.0;

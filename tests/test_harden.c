@@ -351,6 +351,96 @@ static void test_harden_memory_limit(pd_test_ctx *ctx)
     pd_test_rm_dir(dir);
 }
 
+/* A row of n SDOFs (T0, xi, mass) between walls when walls (n + 1 contacts
+ * of gap, eps), or free at both ends (n - 1 contacts), under a cosine pulse. */
+static pd_scene *row_of(pd_test_ctx *ctx, int n, const double *T0, const double *xi,
+                        const double *mass, const double *gap, const double *eps, int walls,
+                        double ap, double Tp, double tend)
+{
+    pd_scene_excitation exc = {.pulse = PD_PULSE_COSINE, .dir = 1, .ap = ap, .Tp = Tp};
+    pd_scene *sc = pd_scene_new(&exc);
+    pd_err e;
+    int rc = sc ? PD_OK : PD_ENOMEM, k = 0;
+    char name[16];
+    for (int i = 0; i < n && !rc; i++) {
+        snprintf(name, sizeof name, "S%d", i);
+        rc = pd_scene_add_sdof(sc, name, T0[i], xi[i], mass[i], &e);
+    }
+    if (walls && !rc)
+        rc = pd_scene_add_contact(sc, PD_WALL, 0, 0, 1, gap[k], eps[k], k, &e), k++;
+    for (int i = 0; i + 1 < n && !rc; i++, k++)
+        rc = pd_scene_add_contact(sc, i, 1, i + 1, 1, gap[k], eps[k], k, &e);
+    if (walls && !rc)
+        rc = pd_scene_add_contact(sc, n - 1, 1, PD_WALL, 0, gap[k], eps[k], k, &e);
+    if (!rc)
+        sc->tend = tend;
+    if (!CHECK(ctx, !rc && !pd_scene_finish(sc, &e), "scene: %s", sc ? e.msg : "no memory")) {
+        pd_scene_free(sc);
+        return NULL;
+    }
+    return sc;
+}
+
+/* Defect 2 (generated rows): two SDOFs touching at rest at t = 0 under a
+ * cosine pulse (one ground acceleration: zero gap rate and acceleration,
+ * a closing jerk) are held from the start, not bounced at t ~ 1e-67 s
+ * for ever; the reference agrees with fine Moreau-Jean.  A row whose
+ * chatter the reference cannot resolve ends in milliseconds naming the
+ * method that runs it, not after its budget of 10^7 events. */
+static void test_harden_touching_at_rest_and_chatter(pd_test_ctx *ctx)
+{
+    const double T0[] = {0.287, 0.112}, xi[] = {0.02, 0.05}, mass[] = {62780.4, 9470914.4};
+    const double gap[] = {0.0}, eps[] = {0.869};
+    pd_scene *sc = row_of(ctx, 2, T0, xi, mass, gap, eps, 0, 7.22, 0.24, 0.5);
+    pd_scene_result r, m;
+    pd_err e;
+    if (sc && CHECK(ctx, !pd_scene_result_alloc(sc, &r, &e) && !pd_scene_result_alloc(sc, &m, &e),
+                    "%s", e.msg)) {
+        pd_run_opts o = pd_run_default_opts();
+        o.method = PD_METHOD_EVENT;
+        int rc = pd_scene_run(sc, &o, NULL, NULL, &r, &e);
+        CHECK(ctx, rc == PD_OK && r.impacts[0] < 100, "event: %s (%ld impacts)", e.msg,
+              r.impacts[0]);
+        o.method = PD_METHOD_MOREAU;
+        o.dt = 1e-6;
+        if (CHECK(ctx, rc == PD_OK && pd_scene_run(sc, &o, NULL, NULL, &m, &e) == PD_OK, "%s",
+                  e.msg))
+            for (int i = 0; i < 2; i++) /* Moreau-Jean's O(dt) at the impacts: 1e-4 */
+                CHECK(ctx, fabs(r.umax[i] - m.umax[i]) <= 1e-4 * m.umax[i],
+                      "umax %d: event %.9g, Moreau-Jean %.9g", i, r.umax[i], m.umax[i]);
+        pd_scene_result_free(&r);
+        pd_scene_result_free(&m);
+    }
+    pd_scene_free(sc);
+
+    static const double T18[] = {0.301, 0.76, 0.547, 0.124, 0.287, 0.112, 0.583, 0.268, 0.135,
+                                 0.734, 0.253, 0.419, 0.175, 0.37, 1.232, 0.342, 0.141, 0.152};
+    static const double xi18[] = {0.02, 0.05, 0, 0.05, 0.02, 0.05, 0, 0.05, 0.02,
+                                  0.05, 0, 0.02, 0.02, 0.05, 0.05, 0, 0.05, 0.05};
+    static const double m18[] = {1036737.4, 157757.7, 10642.3, 3648224.2, 62780.4, 9470914.4,
+                                 28070.3, 45986.2, 395486.1, 6343564.5, 8779038.8, 29045.4,
+                                 1938422.1, 1610.4, 26957.4, 669901.1, 7169234.3, 47809.5};
+    static const double g19[] = {0.05, 0, 0.01, 0.0001, 0.001, 0, 0, 0.01, 0.0001, 0.01,
+                                 0, 0.001, 0.05, 0.05, 0.001, 0.001, 0.05, 0.05, 0};
+    static const double e19[] = {0.198, 0.385, 0.034, 0.766, 0.454, 0.869, 0.712, 0.855, 0.664,
+                                 0.913, 0.304, 0.052, 0.087, 0.078, 0.704, 0.311, 0.36, 0.592,
+                                 0.424};
+    sc = row_of(ctx, 18, T18, xi18, m18, g19, e19, 1, 7.22, 0.24, 2.0);
+    if (sc && CHECK(ctx, !pd_scene_result_alloc(sc, &r, &e), "%s", e.msg)) {
+        pd_run_opts o = pd_run_default_opts();
+        o.method = PD_METHOD_EVENT;
+        double cpu0 = pd_cpu_seconds();
+        int rc = pd_scene_run(sc, &o, NULL, NULL, &r, &e);
+        double cpu = pd_cpu_seconds() - cpu0;
+        /* an answer, or the chatter named with the method that runs it */
+        CHECK(ctx, rc == PD_OK || (rc == PD_EBUDGET && strstr(e.msg, "chatter") &&
+                                   strstr(e.msg, "--method moreau")),
+              "rc %d after %.3g s: %s", rc, cpu, e.msg);
+        pd_scene_result_free(&r);
+    }
+    pd_scene_free(sc);
+}
+
 void suite_harden(pd_test_ctx *ctx)
 {
     pd_test_run(ctx, "harden_derived_overflow", test_harden_derived_overflow);
@@ -360,4 +450,5 @@ void suite_harden(pd_test_ctx *ctx)
     pd_test_run(ctx, "harden_method_flags", test_harden_method_flags);
     pd_test_run(ctx, "harden_gaps_within_tolerance", test_harden_gaps_within_tolerance);
     pd_test_run(ctx, "harden_memory_limit", test_harden_memory_limit);
+    pd_test_run(ctx, "harden_touching_at_rest_and_chatter", test_harden_touching_at_rest_and_chatter);
 }
