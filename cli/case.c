@@ -41,6 +41,9 @@ const char pd_cli_case_help[] =
     "  --no-accumulation  event-driven: do not jump accumulations of impacts\n"
     "  --close-tol X [1e-10]  event-driven rows: contacts within X Le of zero at an impact\n"
     "           take part in it (simultaneous); counted in the output (docs/methods.md)\n"
+    "  --impact-law staged|single [staged]  event-driven rows: the law of an impact of\n"
+    "           several contacts: LCPs in stages, or one LCP (event-general's); a run with\n"
+    "           simultaneous impacts reports law_band, its peaks under the other law\n"
     "  --contact-duration TD [0.005]  s: the equivalent contact force pi I / (2 TD) of an\n"
     "           impact of impulse I (a half-sine pulse; docs/scenes.md, \"Demands\")\n"
     "  --kernel auto|general [auto]  general: no fast path (scalar kernel, exact reference)\n"
@@ -161,7 +164,7 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
                 {"--gamma", PD_METHOD_MOREAU},     {"--allow-unstable", PD_METHOD_MOREAU},
                 {"--kernel", PD_METHOD_MOREAU},    {"--factor", PD_METHOD_MOREAU},
                 {"--lcp-solver", PD_METHOD_MOREAU}, {"--no-accumulation", PD_METHOD_EVENT},
-                {"--close-tol", PD_METHOD_EVENT},
+                {"--close-tol", PD_METHOD_EVENT},  {"--impact-law", PD_METHOD_EVENT},
                 {"--kc", PD_METHOD_PENALTY},       {"--kc-abs", PD_METHOD_PENALTY},
                 {"--atol", PD_METHOD_PENALTY},
                 {"--contact", PD_METHOD_PENALTY},  {"--stepper", PD_METHOD_PENALTY}};
@@ -221,6 +224,9 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
     } else if (!strcmp(f, "--factor"))
         rc = named(f, val, pd_factor_kind_parse(val, &a->opts.factor) != PD_OK,
                    "auto, scalar, dense, cholmod");
+    else if (!strcmp(f, "--impact-law"))
+        rc = named(f, val, pd_impact_law_parse(val, &a->opts.impact_law) != PD_OK,
+                   "staged, single");
     else if (!strcmp(f, "--lcp-solver"))
         rc = named(f, val, pd_lcp_method_parse(val, &a->opts.lcp_solver) != PD_OK,
                    pd_lcp_method_list());
@@ -519,6 +525,7 @@ static const struct {
     {"--gamma", M_(PD_METHOD_MOREAU)},
     {"--allow-unstable", M_(PD_METHOD_MOREAU)},
     {"--close-tol", M_(PD_METHOD_EVENT)}, /* and moreau's steps to a tolerance in scenes */
+    {"--impact-law", M_(PD_METHOD_EVENT)},
     {"--no-accumulation", M_(PD_METHOD_EVENT) | M_(PD_METHOD_EVENT_GENERAL)},
     {"--kc", M_(PD_METHOD_PENALTY) | M_(PD_METHOD_NEWMARK)},
     {"--kc-abs", M_(PD_METHOD_PENALTY) | M_(PD_METHOD_NEWMARK)},

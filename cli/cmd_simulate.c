@@ -498,6 +498,9 @@ static void scene_json(const sim_args *a, const pd_scene *sc, const pd_scene_sum
     pd_json_int(&js, "tol_closed", r->tol_closed);
     pd_json_int(&js, "accumulations", r->accumulations);
     pd_json_num(&js, "close_tol", r->close_tol);
+    /* the row reference: its impact law ("none": another method), the peaks under the other */
+    pd_json_str(&js, "impact_law", r->impact_law ? r->impact_law : "none");
+    pd_json_num(&js, "law_band", r->law_band_max); /* NaN -> null: no simultaneous impact */
     pd_json_num(&js, "contact_duration", r->contact_duration);
     pd_json_num(&js, "dt", r->dt);
     pd_json_num(&js, "theta", r->theta);
@@ -540,6 +543,7 @@ static void scene_json(const sim_args *a, const pd_scene *sc, const pd_scene_sum
         pd_json_nums(&js, "umax_free", n, s->free.umax + o);
         pd_json_nums(&js, "gamma", n, s->gamma + o);
         pd_json_num(&js, "err_est", s->err_est_structure[k]); /* NaN -> null: fixed steps */
+        pd_json_num(&js, "law_band", r->law_band[k]);
         pd_json_end_object(&js);
     }
     pd_json_end_array(&js);
@@ -608,21 +612,35 @@ static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_sum
             printf("  decisions = %ld impacts: %ld LCPs of several contacts (simultaneous), %ld "
                    "contacts closed within --close-tol %g Le, %ld accumulations jumped\n",
                    impacts, r->simultaneous, r->tol_closed, r->close_tol, r->accumulations);
+        if (r->impact_law && isinf(r->law_band_max))
+            printf("  impact law = %s: law_band = inf (the run under --impact-law %s did not "
+                   "finish)\n", r->impact_law, strcmp(r->impact_law, "single") ? "single"
+                                                                           : "staged");
+        else if (r->impact_law && !isnan(r->law_band_max))
+            printf("  impact law = %s: law_band = %.2g (umax under --impact-law %s moves by "
+                   "this, relative; per structure below)\n", r->impact_law, r->law_band_max,
+                   strcmp(r->impact_law, "single") ? "single" : "staged");
+        else if (r->impact_law)
+            printf("  impact law = %s (no simultaneous impact: the laws agree)\n",
+                   r->impact_law);
     }
     int tol = r->rtol > 0.0; /* to a tolerance: each structure's estimate */
-    printf("  %-12s %7s %9s %12s %12s %10s %8s%s\n", "structure", "storey", "T0 [s]", "umax [m]",
-           "drift [m]", "Pi1", "gamma", tol ? "    err_est" : "");
+    int band = !isnan(r->law_band_max); /* simultaneous impacts: each structure's law_band */
+    printf("  %-12s %7s %9s %12s %12s %10s %8s%s%s\n", "structure", "storey", "T0 [s]", "umax [m]",
+           "drift [m]", "Pi1", "gamma", tol ? "    err_est" : "", band ? "   law_band" : "");
     for (int k = 0; k < sc->nstruct && k < TEXT_MAX_STRUCTURES; k++) {
         const pd_structure *st = &sc->st[k];
         for (int i = 0; i < st->storeys; i++) {
             int d = st->dof + i;
-            char T0[16] = "", est[24] = "";
+            char T0[16] = "", est[24] = "", lb[24] = "";
             if (i == 0)
                 snprintf(T0, sizeof T0, "%.4g", st->T0);
             if (i == 0 && tol)
                 snprintf(est, sizeof est, " %10.2g", s->err_est_structure[k]);
-            printf("  %-12s %7d %9s %12.6g %12.6g %10.5g %8.4g%s\n", i ? "" : st->name, i + 1, T0,
-                   r->umax[d], r->drift[d], s->Pi1[d], s->gamma[d], est);
+            if (i == 0 && band)
+                snprintf(lb, sizeof lb, " %10.2g", r->law_band[k]);
+            printf("  %-12s %7d %9s %12.6g %12.6g %10.5g %8.4g%s%s\n", i ? "" : st->name, i + 1,
+                   T0, r->umax[d], r->drift[d], s->Pi1[d], s->gamma[d], est, lb);
         }
     }
     if (sc->nstruct > TEXT_MAX_STRUCTURES)

@@ -354,6 +354,8 @@ static int put_run(pd_scene_writer *w, const pd_scene_run_info *ri)
            put_num(w, f, "", "tol_closed", (double)r->tol_closed, "1") ||
            put_num(w, f, "", "accumulations", (double)r->accumulations, "1") ||
            put_num(w, f, "", "close_tol", r->close_tol, "Le") ||
+           put_text(w, f, "", "impact_law", r->impact_law ? r->impact_law : "none") ||
+           put_num(w, f, "", "law_band", r->law_band_max, "1") ||
            put_num(w, f, "", "contact_duration", r->contact_duration, "s") ||
            put_num(w, f, "", "cpu_s", ri->sum->cpu_s, "s") ||
            put_num(w, f, "", "rtol", r->rtol, "1") ||
@@ -398,7 +400,8 @@ static int put_structure(pd_scene_writer *w, const pd_scene_summary *sum, int s)
          put_nums(w, g, prefix, "Pi1", k, sum->Pi1 + o, "1") ||
          put_nums(w, g, prefix, "umax_free", k, sum->free.umax + o, "m") ||
          put_nums(w, g, prefix, "gamma", k, sum->gamma + o, "1") ||
-         put_num(w, g, prefix, "err_est", sum->err_est_structure[s], "1");
+         put_num(w, g, prefix, "err_est", sum->err_est_structure[s], "1") ||
+         put_num(w, g, prefix, "law_band", sum->r.law_band[s], "1");
     if (g >= 0 && H5Gclose(g) < 0)
         rc = -1;
     return rc;

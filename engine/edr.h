@@ -245,6 +245,7 @@ struct pd_edr {
     double *ext;               /* per dof: impulse from the contacts between clusters */
     long *nimp;                /* per closed contact of an event: its impacts */
     int instant_acc;           /* the event's stages met an accumulation at one instant */
+    int law_multi;             /* the event's first LCP could take several closed contacts */
     int *keybuf;               /* configuration keys */
     int *uf, *gblk, *newcl, *plist;
     int *loc;                  /* n: local index */

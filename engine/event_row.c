@@ -22,7 +22,9 @@
  *      until no closed contact closes; a contact closing a third time at
  *      one instant is plastic (an accumulation at that instant).  On the
  *      clusters' coordinates when it can (reduced_stages), on the dofs
- *      otherwise;
+ *      otherwise.  The single law (PD_IMPACT_SINGLE) solves one LCP over
+ *      every closed contact, separating ones included, and stops there
+ *      (event-general's and Moreau-Jean's law);
  *   4. the contacts left at zero rate decide persistence by the
  *      contact-force LCP (g'' = D lambda + W^T M^-1 (b f - C v - K q));
  *      a contact leaving with a bounce height U+^2 / (2 a) below 1e-10 L
@@ -103,6 +105,7 @@ pd_edr_opts pd_edr_default_opts(void)
                          .max_evals = 4e9,
                          .scan_divisions = 64,
                          .lcp_solver = PD_LCP_AUTO,
+                         .impact_law = PD_IMPACT_STAGED,
                          .on_event = NULL,
                          .on_event_ctx = NULL};
 }
@@ -1292,6 +1295,20 @@ static int commit_impacts(pd_edr *r, double t, pd_err *err)
     return PD_OK;
 }
 
+/* q_x = 0 where |q_x| <= EDR_RATE_TOL max |q|: the single law's rates at
+ * the rounding level of the impact (a contact resting in a row that
+ * another one strikes) are zero, as event-general zeroes them, so that the
+ * LCP does not chase their sign. */
+static void single_law_zero(double *q, int k)
+{
+    double qmax = 0.0;
+    for (int x = 0; x < k; x++)
+        qmax = fmax(qmax, fabs(q[x]));
+    for (int x = 0; x < k; x++)
+        if (fabs(q[x]) <= EDR_RATE_TOL * qmax)
+            q[x] = 0.0;
+}
+
 /* The impact at t, in stages: each takes the closed contacts whose rate
  * is not separating (U <= 0) into one LCP with Newton's law,
  *   w = D P + U + e min(U, 0),  0 <= w _|_ P >= 0,
@@ -1300,34 +1317,40 @@ static int commit_impacts(pd_edr *r, double t, pd_err *err)
  * impulse, and if the others' impulses make it close it takes part in the
  * next stage at the same instant (as Moreau-Jean's active set leaves a
  * separating contact to the next step).  Stages end when no closed contact
- * closes.  Totals in r->P, r->nimp. */
+ * closes.  The single law takes every closed contact, separating ones
+ * included, into one LCP and ends there.  Totals in r->P, r->nimp. */
 static int impact_stages(pd_edr *r, double t, double tolU, pd_err *err)
 {
-    int rc, *idx = r->lcp_idx, stage = 0;
+    int rc, *idx = r->lcp_idx, stage = 0, single = r->o.impact_law == PD_IMPACT_SINGLE;
     double *q = r->qlcp, *z = r->lam;
     for (;;) {
-        int k = 0, closing = 0;
+        int k = 0, closing = 0, pressing = 0, all = 0;
         for (int j = 0; j < r->ngc; j++) {
             double U = contact_dot(r, r->g_ct[j], r->gv);
             if (fabs(U) <= tolU)
                 U = 0.0;
-            if (U > 0.0) {
+            all++;
+            if (U > 0.0 && !single) {
                 r->jpos[j] = -1;
                 continue;
             }
             closing += U < 0.0;
+            pressing += U <= 0.0;
             r->jpos[j] = k;
             idx[k] = r->g_ct[j];
             q[k++] = U + stage_e(r, j) * fmin(U, 0.0);
         }
         if (!closing)
             return PD_OK;
+        r->law_multi |= stage == 0 && all > 1;
         if (++stage > EDR_STAGES)
             return pd_err_set(err, PD_EBUDGET, "row reference: the impact at t = %.17g s did not "
                               "end in %d stages", t * r->o.time_unit, EDR_STAGES);
+        if (single)
+            single_law_zero(q, k);
         if ((rc = solve_lcp(r, idx, k, q, z, r->wtmp, t, err)))
             return rc;
-        r->res.simultaneous += k > 1;
+        r->res.simultaneous += pressing > 1;
         for (int j = 0; j < r->ngc; j++) {
             if (r->jpos[j] < 0)
                 continue;
@@ -1339,6 +1362,8 @@ static int impact_stages(pd_edr *r, double t, double tolU, pd_err *err)
             r->P[j] += P;
             r->nimp[j] += q[r->jpos[j]] < 0.0;
         }
+        if (single)
+            return PD_OK;
     }
 }
 
@@ -1450,7 +1475,7 @@ static int refine_reduced(pd_edr *r, const int *idx, int k, const double *D, con
  * solver takes — then the dof-level stages run instead. */
 static int reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
 {
-    int rc, stage = 0, ne = 0, *idx = r->lcp_idx;
+    int rc, stage = 0, ne = 0, *idx = r->lcp_idx, single = r->o.impact_law == PD_IMPACT_SINGLE;
     double *q = r->qlcp, *z = r->lam, *D = r->Dd;
     for (int i = 0; i < r->ng; i++) {
         edr_cluster *cl = &r->cl[r->g_cl[i]];
@@ -1465,7 +1490,7 @@ static int reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
         if (r->cstate[r->g_ct[j]] == EDR_OPEN)
             r->epos[ne++] = j;
     for (;;) {
-        int k = 0, closing = 0;
+        int k = 0, closing = 0, pressing = 0, all = 0;
         for (int e = 0; e < ne; e++) {
             int j = r->epos[e], a = r->g_ct[j];
             double U = 0.0;
@@ -1474,19 +1499,28 @@ static int reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
                     U += side_sigma(r, a, s) * r->ceta[cl_of_dof(r, r->ct[a].dof[s])];
             if (fabs(U) <= tolU)
                 U = 0.0;
-            if (U > 0.0 || !movable(r, a)) { /* separating, or held still on both sides */
+            if (!movable(r, a)) { /* held still on both sides */
+                r->jpos[j] = -1;
+                continue;
+            }
+            all++;
+            if (U > 0.0 && !single) { /* separating (staged) */
                 r->jpos[j] = -1;
                 continue;
             }
             if (k >= EDR_REDUCED_MAX)
                 return 1;
             closing += U < 0.0;
+            pressing += U <= 0.0;
             r->jpos[j] = k;
             idx[k] = j;
             q[k++] = U + stage_e(r, j) * fmin(U, 0.0);
         }
         if (!closing)
             break;
+        r->law_multi |= stage == 0 && all > 1;
+        if (single)
+            single_law_zero(q, k);
         if (++stage > EDR_STAGES)
             return pd_err_set(err, PD_EBUDGET, "row reference: the impact at t = %.17g s did not "
                               "end in %d stages", t * r->o.time_unit, EDR_STAGES);
@@ -1516,7 +1550,7 @@ static int reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
             refined = refine_reduced(r, idx, k, D, q, z);
         }
         r->res.lcp_solves += k == 1;
-        r->res.simultaneous += k > 1;
+        r->res.simultaneous += pressing > 1;
         if (refined) /* each cluster's rate from its total impulse G_c (as the residual) */
             for (int x = 0; x < k; x++) {
                 int a = r->g_ct[idx[x]];
@@ -1549,6 +1583,8 @@ static int reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
                     r->cG[c] = 0.0;
                 }
         }
+        if (single)
+            break;
     }
     /* dof rates, the impulses on each dof from the contacts between clusters */
     for (int k = 0; k < r->ngd; k++) {
@@ -1729,11 +1765,17 @@ static int reduced_force(pd_edr *r, const int *idx, int k, double t, pd_err *err
 }
 
 /* The impact's work dK = 1/2 sum m (v+ - v-)(v+ + v-) over the group's
- * dofs: with e <= 1 it is <= 0, up to its rounding, EDR_WORK_TOL eps
+ * dofs: with e <= 1 it is <= 0 under the staged law (<= 1/2 sum P_a U-_a
+ * over the contacts separating before it under the single law, whose
+ * impulses on them end at U+ = 0), up to its rounding, EDR_WORK_TOL eps
  * sum (|v+| + |v-|) (m |v-| + sum_a |w_a P_a|); PD_ENUMERICAL beyond. */
 static int check_work(pd_edr *r, double t, pd_err *err)
 {
     double dK = 0.0, tol = 0.0, K = 0.0;
+    if (r->o.impact_law == PD_IMPACT_SINGLE)
+        for (int j = 0; j < r->ngc; j++)
+            if (r->Uminus[j] > 0.0)
+                dK -= 0.5 * r->P[j] * r->Uminus[j];
     for (int k = 0; k < r->ngd; k++)
         r->gtmp[r->g_dof[k]] = 0.0;
     for (int j = 0; j < r->ngc; j++) {
@@ -1788,6 +1830,7 @@ static int resolve_group(pd_edr *r, double t, pd_err *err)
     for (int j = 0; j < r->ngc; j++)
         r->nimp[j] = 0;
     r->instant_acc = 0;
+    r->law_multi = 0;
     rc = reduced_stages(r, t, tolU, err);
     if (rc == 1) { /* on the dofs: back to the rates before the impact */
         for (int k = 0; k < r->ngd; k++)
@@ -1800,6 +1843,7 @@ static int resolve_group(pd_edr *r, double t, pd_err *err)
         rc = impact_stages(r, t, tolU, err);
     }
     r->res.accumulations += r->instant_acc;
+    r->res.law_decided += r->law_multi;
     if (rc || (rc = check_work(r, t, err)) || (rc = commit_impacts(r, t, err)))
         return rc;
     for (int j = 0; j < r->ngc; j++) {
@@ -2097,6 +2141,9 @@ static int check_opts(const pd_edr_opts *o, pd_err *err)
     if (o->max_events < 1 || o->max_burst < 1 || o->scan_divisions < 1 || !(o->max_evals >= 1.0))
         return pd_err_set(err, PD_EINVAL, "row reference: budgets and scan divisions must be "
                                           ">= 1");
+    if (o->impact_law != PD_IMPACT_STAGED && o->impact_law != PD_IMPACT_SINGLE)
+        return pd_err_set(err, PD_EINVAL, "row reference: impact_law must be staged (0) or "
+                                          "single (1) (got %d)", (int)o->impact_law);
     if (!(o->h_out >= 0.0) || !isfinite(o->h_out) || !isfinite(o->t_measure))
         return pd_err_set(err, PD_EINVAL, "row reference: h_out and t_measure must be finite");
     return PD_OK;

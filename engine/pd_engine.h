@@ -524,6 +524,16 @@ typedef struct pd_edr_event {
 
 typedef int (*pd_edr_event_fn)(const pd_edr_event *ev, void *ctx);
 
+/* The impact law at an impact of several closed contacts (docs/methods.md,
+ * "The impact law"):
+ *   STAGED  LCPs with Newton's law over the closed contacts that are not
+ *           separating, stage after stage until none closes (dissipative);
+ *   SINGLE  one LCP over every closed contact, Newton's law on each one's
+ *           rate before the impact: U+ = U- + D P, 0 <= U+ + e min(U-, 0)
+ *           _|_ P >= 0 (as event-general and Moreau-Jean pose it).
+ * They agree wherever an impact ends in one stage. */
+typedef enum { PD_IMPACT_STAGED = 0, PD_IMPACT_SINGLE = 1 } pd_impact_law;
+
 typedef struct pd_edr_opts {
     double close_tol;      /* at an impact, contacts with gap <= close_tol * length_scale
                               are closed too (one LCP); >= 0 */
@@ -546,6 +556,7 @@ typedef struct pd_edr_opts {
     pd_lcp_method lcp_solver; /* the LCPs on the dofs (a modal cluster takes part, or more
                                  than 64 contacts between clusters); the clusters' own
                                  LCPs are Lemke's */
+    pd_impact_law impact_law; /* PD_IMPACT_STAGED (the default) or PD_IMPACT_SINGLE */
     pd_edr_event_fn on_event; /* optional: every impact, detachment, piece change */
     void *on_event_ctx;
 } pd_edr_opts;
@@ -555,7 +566,7 @@ typedef struct pd_edr_opts {
  * with the held forces when there is one), drift of
  * each dof against the ground, accumulations jumped, active contacts, 10^7
  * events, bursts of 10^5, 4e9 evaluations, 64 scan divisions, automatic
- * LCP solver. */
+ * LCP solver, the staged impact law. */
 PD_API pd_edr_opts pd_edr_default_opts(void);
 
 typedef struct pd_edr_result {
@@ -575,6 +586,9 @@ typedef struct pd_edr_result {
     const double *max_impulse;  /* largest impulse of one event */
     const double *contact_time; /* time persistent */
     const double *min_gap;      /* smallest gap (0 once closed) */
+    long law_decided;      /* impacts whose LCP could take several closed contacts, one
+                              closing (separating ones included): where the staged and
+                              single impact laws may differ */
 } pd_edr_result;
 
 typedef struct pd_edr pd_edr;

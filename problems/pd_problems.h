@@ -188,6 +188,11 @@ typedef enum {
 PD_API const char *pd_method_name(pd_method method);
 PD_API int pd_method_parse(const char *name, pd_method *method);
 
+/* The row reference's impact laws (pd_impact_law, pd_engine.h): "staged",
+ * "single"; parse: PD_OK or PD_EINVAL. */
+PD_API const char *pd_impact_law_name(pd_impact_law law);
+PD_API int pd_impact_law_parse(const char *name, pd_impact_law *law);
+
 /* The penalty baseline's contact elements (see pd_penalty_run). */
 typedef struct pd_penalty_setup {
     pd_penalty_law law;
@@ -221,6 +226,10 @@ typedef struct pd_run_opts {
     void *on_lcp_ctx;
     double close_tol;   /* event-driven rows: at an impact, contacts whose gap is within
                            close_tol Le are closed too (simultaneous); >= 0 */
+    pd_impact_law impact_law; /* event-driven rows: the impact law of several closed
+                                 contacts (PD_IMPACT_STAGED, PD_IMPACT_SINGLE) */
+    int no_law_band;    /* 1: no second run under the other impact law (law_band NAN):
+                           the sweeps and the timed re-runs */
     double contact_duration; /* td [s] of the equivalent contact force pi I / (2 td) of an
                                 impact of impulse I (a half-sine pulse); 0 = PD_CONTACT_DURATION */
     int no_demands;     /* 1: do not measure the peak accelerations and shears (NAN): the
@@ -709,7 +718,19 @@ typedef struct pd_scene_result {
                               the refinement */
     long steps_rejected;   /* tries thrown away (a step halved) */
     double dt_min, dt_max; /* the smallest and largest step kept [s] */
-    int nstruct;           /* err_est's entries */
+    int nstruct;           /* err_est's and law_band's entries */
+    /* the event-driven reference for rows (method event): its impact law, and when
+     * its result rests on simultaneous impacts (law_decided > 0: impacts whose LCP
+     * could take several closed contacts, one closing, separating ones included:
+     * where the staged and single laws may differ) how far each structure's peak
+     * moves under the other law (a second run):
+     *   law_band = max over storeys |umax_other - umax| / max over storeys umax,
+     * NAN without simultaneous impacts, for the other methods, and with
+     * pd_run_opts.no_law_band. */
+    const char *impact_law; /* "staged", "single" (NULL: not the row reference) */
+    double *law_band;      /* nstruct */
+    double law_band_max;   /* the largest over the structures (NAN: none measured) */
+    long law_decided;
 } pd_scene_result;
 
 /* Arrays for the finished scene sc (PD_EINVAL before pd_scene_finish). */

@@ -36,6 +36,24 @@ int pd_method_parse(const char *name, pd_method *method)
     return PD_OK;
 }
 
+const char *pd_impact_law_name(pd_impact_law law)
+{
+    return law == PD_IMPACT_SINGLE ? "single" : "staged";
+}
+
+int pd_impact_law_parse(const char *name, pd_impact_law *law)
+{
+    if (!name || !law)
+        return PD_EINVAL;
+    if (!strcmp(name, "staged"))
+        *law = PD_IMPACT_STAGED;
+    else if (!strcmp(name, "single"))
+        *law = PD_IMPACT_SINGLE;
+    else
+        return PD_EINVAL;
+    return PD_OK;
+}
+
 pd_run_opts pd_run_default_opts(void)
 {
     return (pd_run_opts){.method = PD_METHOD_AUTO,
@@ -58,6 +76,8 @@ pd_run_opts pd_run_default_opts(void)
                          .on_lcp = NULL,
                          .on_lcp_ctx = NULL,
                          .close_tol = PD_CLOSE_TOL,
+                         .impact_law = PD_IMPACT_STAGED,
+                         .no_law_band = 0,
                          .contact_duration = 0.0,
                          .no_demands = 0,
                          .rtol = 0.0};
@@ -96,6 +116,9 @@ int pd_run_opts_check(const pd_run_opts *o, pd_err *err)
     if (!(o->close_tol >= 0.0 && o->close_tol <= 1.0))
         return pd_err_set(err, PD_EINVAL, "close-tol: the closing tolerance must be in [0, 1] "
                           "(in units of Le; got %g)", o->close_tol);
+    if (o->impact_law != PD_IMPACT_STAGED && o->impact_law != PD_IMPACT_SINGLE)
+        return pd_err_set(err, PD_EINVAL, "impact-law: must be staged (%d) or single (%d) (got "
+                          "%d)", (int)PD_IMPACT_STAGED, (int)PD_IMPACT_SINGLE, (int)o->impact_law);
     if (!(o->contact_duration >= 0.0) || !isfinite(o->contact_duration))
         return pd_err_set(err, PD_EINVAL, "contact-duration: the duration of the equivalent "
                           "contact force must be a finite number > 0 [s], or 0 for the default "

@@ -114,6 +114,7 @@ int pd_scene_measure_reference(const pd_scene *sc, const pd_run_opts *o, pd_scen
         return pd_err_set(err, PD_EINVAL, "the result is not allocated for this scene "
                                           "(pd_scene_result_alloc)");
     r.method = PD_METHOD_EVENT;
+    r.no_law_band = 1; /* the measurements report no law_band: no second run */
     ref->rows = 0;
     ref->dt = r.dt;
     if ((rc = pd_scene_run(sc, &r, keep_row, ref, res, err)))
@@ -240,6 +241,7 @@ int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scen
     }
     pd_run_opts bare = o ? *o : pd_run_default_opts();
     bare.no_demands = 1;
+    bare.no_law_band = 1;
     rc = pd_scene_run(sc, &bare, NULL, NULL, &timed, err); /* its cost without the sampling */
     e->cpu_s = timed.cpu_s;
     pd_scene_result_free(&timed);

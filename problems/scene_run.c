@@ -128,9 +128,10 @@ int pd_scene_result_alloc(const pd_scene *sc, pd_scene_result *r, pd_err *err)
     r->force_equiv = calloc(m, sizeof(double));
     r->nstruct = sc->nstruct;
     r->err_est = calloc((size_t)sc->nstruct, sizeof(double));
+    r->law_band = calloc((size_t)sc->nstruct, sizeof(double));
     if (!r->umax || !r->u_pos || !r->u_neg || !r->drift || !r->impacts || !r->first_impact ||
         !r->max_impulse || !r->contact_time || !r->approach || !r->acc_max || !r->shear_max ||
-        !r->drift_ratio || !r->force_max || !r->force_equiv || !r->err_est) {
+        !r->drift_ratio || !r->force_max || !r->force_equiv || !r->err_est || !r->law_band) {
         pd_scene_result_free(r);
         return pd_err_set(err, PD_ENOMEM, "out of memory for the results of %d dofs", sc->n);
     }
@@ -142,7 +143,7 @@ int pd_scene_result_fits(const pd_scene *sc, const pd_scene_result *r)
     return sc && r && r->n == sc->n && r->m == sc->ncontact && r->umax && r->u_pos && r->u_neg &&
            r->drift && r->impacts && r->first_impact && r->max_impulse && r->contact_time &&
            r->approach && r->acc_max && r->shear_max && r->drift_ratio && r->force_max &&
-           r->force_equiv && r->err_est && r->nstruct == sc->nstruct;
+           r->force_equiv && r->err_est && r->law_band && r->nstruct == sc->nstruct;
 }
 
 void pd_scene_result_free(pd_scene_result *r)
@@ -164,6 +165,7 @@ void pd_scene_result_free(pd_scene_result *r)
     free(r->force_max);
     free(r->force_equiv);
     free(r->err_est);
+    free(r->law_band);
     memset(r, 0, sizeof *r);
 }
 
@@ -1137,6 +1139,7 @@ static int run_event(const pd_scene_model *sm, const pd_run_opts *o, double tau_
     eo.no_accumulation = o->no_accumulation;
     eo.inactive = o->no_wall;
     eo.lcp_solver = o->lcp_solver;
+    eo.impact_law = o->impact_law;
     pd_edr *edr = pd_edr_alloc(&sm->model, &F, &eo, err);
     if (!edr) {
         free(pieces);
@@ -1169,6 +1172,8 @@ static int run_event(const pd_scene_model *sm, const pd_run_opts *o, double tau_
     res->tol_closed = er->tol_closed;
     res->accumulations = er->accumulations;
     res->close_tol = o->close_tol;
+    res->impact_law = pd_impact_law_name(o->impact_law);
+    res->law_decided = er->law_decided;
     res->kernel = "event-rows";
     res->factor = "none";
     res->lcp_solver = pd_lcp_method_name(o->lcp_solver);
@@ -1331,6 +1336,47 @@ static int event_mass_ratio(const pd_scene *sc, const pd_run_opts *o, pd_err *er
     return PD_OK;
 }
 
+/* law_band_s = max_k |umax'_k - umax_k| / max_k umax_k over structure s's
+ * storeys, umax' the peaks of the run again under the other impact law
+ * (o resolved, res the run's); inf when that run fails (a budget: the run
+ * itself stands), PD_ENOMEM returned. */
+static int scene_law_band(const pd_scene *sc, const pd_run_opts *o, pd_scene_result *res,
+                          pd_err *err)
+{
+    pd_run_opts other = *o;
+    pd_scene_result alt;
+    int rc;
+    other.impact_law = o->impact_law == PD_IMPACT_SINGLE ? PD_IMPACT_STAGED : PD_IMPACT_SINGLE;
+    other.no_law_band = 1;
+    other.no_demands = 1; /* its figure is umax */
+    other.on_lcp = NULL;
+    if ((rc = pd_scene_result_alloc(sc, &alt, err)))
+        return rc;
+    if ((rc = pd_scene_run(sc, &other, NULL, NULL, &alt, err))) {
+        pd_scene_result_free(&alt);
+        if (rc == PD_ENOMEM)
+            return rc;
+        pd_err_clear(err);
+        res->law_band_max = INFINITY;
+        for (int s = 0; s < sc->nstruct; s++)
+            res->law_band[s] = INFINITY;
+        return PD_OK;
+    }
+    res->law_band_max = 0.0;
+    for (int s = 0; s < sc->nstruct; s++) {
+        double top = 0.0, moved = 0.0;
+        for (int k = 0; k < sc->st[s].storeys; k++) {
+            int i = sc->st[s].dof + k;
+            top = fmax(top, res->umax[i]);
+            moved = fmax(moved, fabs(alt.umax[i] - res->umax[i]));
+        }
+        res->law_band[s] = top > 0.0 ? moved / top : moved > 0.0 ? INFINITY : 0.0;
+        res->law_band_max = fmax(res->law_band_max, res->law_band[s]);
+    }
+    pd_scene_result_free(&alt);
+    return PD_OK;
+}
+
 int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler sampler,
                  void *ctx, pd_scene_result *res, pd_err *err)
 {
@@ -1368,6 +1414,11 @@ int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler s
     res->method = pd_method_name(o.method);
     res->simultaneous = res->tol_closed = res->accumulations = 0;
     res->close_tol = o.method == PD_METHOD_EVENT ? o.close_tol : NAN;
+    res->impact_law = NULL;
+    res->law_decided = 0;
+    res->law_band_max = NAN;
+    for (int s = 0; s < res->nstruct; s++)
+        res->law_band[s] = NAN;
     double cpu0 = pd_cpu_seconds();
     if (o.kernel == PD_KERNEL_AUTO && o.method != PD_METHOD_EVENT_GENERAL &&
         pd_scene_as_oscillator(sc, &c, &mirrored))
@@ -1389,6 +1440,8 @@ int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler s
                                        k + 1, err);
     for (int a = 0; a < res->m && !rc; a++)
         rc = pd_demand_check_force(res->max_impulse[a], res->force_equiv[a], a, err);
+    if (!rc && o.method == PD_METHOD_EVENT && res->law_decided > 0 && !o.no_law_band)
+        rc = scene_law_band(sc, &o, res, err);
     return rc;
 }
 

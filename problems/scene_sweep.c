@@ -122,6 +122,7 @@ static int run_task(const pd_scene_sweep *w, long t, pd_scene_point *pt, double 
         return pt->status = rc; /* the run's own status: pd_scene_sweep_run returns it */
     o.no_wall = t < pd_scene_sweep_twins(w);
     o.no_demands = 1; /* a sweep keeps umax */
+    o.no_law_band = 1; /* nor the other impact law's run */
     if (!(rc = pd_scene_result_alloc(c, &r, err))) {
         rc = pd_scene_run(c, &o, NULL, NULL, &r, err);
         for (int s = 0; s < c->nstruct; s++) {

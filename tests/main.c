@@ -94,6 +94,7 @@ int main(int argc, char **argv)
     suite_outputs(&ctx);
     suite_harden(&ctx);
     suite_aabs(&ctx);
+    suite_law(&ctx);
     suite_api_null(&ctx);
 
     printf("%d passed, %d failed, %d skipped\n", ctx.passed, ctx.failed, ctx.skipped);

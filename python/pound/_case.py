@@ -19,7 +19,7 @@ MODEL_KEYS = ("pulse", "dir", "ap", "Tp", "T0", "Pi2", "gap", "Pi3", "eps", "xi"
 RECORD_KEYS = ("record", "scale", "units", "record_format", "record_dt")
 SCHEME_KEYS = ("method", "dt", "tend", "theta", "gamma", "allow_unstable", "no_accumulation",
                "no_wall", "kernel", "factor", "lcp_solver", "contact", "kc", "kc_abs", "rtol",
-               "atol", "stepper", "close_tol", "contact_duration")
+               "atol", "stepper", "close_tol", "impact_law", "contact_duration")
 CASE_KEYS = MODEL_KEYS + RECORD_KEYS + SCHEME_KEYS
 # cli/case.c: the keywords only one method takes choose it (moreau 0,
 # event 1, penalty 2) unless method says another; the flags only
@@ -27,7 +27,8 @@ CASE_KEYS = MODEL_KEYS + RECORD_KEYS + SCHEME_KEYS
 # chooses moreau (Moreau-Jean to a tolerance), with penalty it is the
 # integrator's tolerance (case_rtol below)
 IMPLIES = {"dt": 0, "theta": 0, "gamma": 0, "allow_unstable": 0, "kernel": 0, "factor": 0,
-           "lcp_solver": 0, "dt_per_Tp": 0, "no_accumulation": 1, "close_tol": 1, "kc": 2,
+           "lcp_solver": 0, "dt_per_Tp": 0, "no_accumulation": 1, "close_tol": 1,
+           "impact_law": 1, "kc": 2,
            "kc_abs": 2, "atol": 2, "contact": 2, "stepper": 2}
 PD_METHOD_AUTO = 3
 PD_RTOL_MIN = 1e-12  # the tightest tolerance of Moreau-Jean's steps
@@ -234,6 +235,8 @@ def scheme_opts(kw, listed=False):
         elif key == "factor":
             o.factor = parse_name("factor", lib.pd_factor_kind_parse, v,
                                   "auto, scalar, dense, cholmod")
+        elif key == "impact_law":
+            o.impact_law = parse_name("impact_law", lib.pd_impact_law_parse, v, "staged, single")
         elif key == "lcp_solver":
             o.lcp_solver = parse_name("lcp_solver", lib.pd_lcp_method_parse, v,
                                       _lib.s(lib.pd_lcp_method_list()))

@@ -131,6 +131,7 @@ class PdRunOpts(Structure):
                 ("factor", c_int), ("lcp_solver", c_int), ("no_accumulation", c_int),
                 ("no_wall", c_int), ("pen", PdPenaltySetup), ("on_lcp", c_void_p),
                 ("on_lcp_ctx", c_void_p), ("close_tol", c_double),
+                ("impact_law", c_int), ("no_law_band", c_int),  # 0 staged, 1 single
                 ("contact_duration", c_double), ("no_demands", c_int),
                 ("rtol", c_double)]  # > 0: Moreau-Jean to a tolerance (pen.rtol: GSL's)
 
@@ -247,7 +248,10 @@ class PdSceneResult(Structure):
                 # Moreau-Jean to a tolerance (fixed steps: rtol 0, err_est NAN, rtol_met 1)
                 ("rtol", c_double), ("err_est", POINTER(c_double)), ("err_est_max", c_double),
                 ("rtol_met", c_int), ("steps_rejected", c_long), ("dt_min", c_double),
-                ("dt_max", c_double), ("nstruct", c_int)]
+                ("dt_max", c_double), ("nstruct", c_int),
+                # the row reference: its impact law, the peaks under the other (NAN: none)
+                ("impact_law", c_char_p), ("law_band", POINTER(c_double)),
+                ("law_band_max", c_double), ("law_decided", c_long)]
 
 
 class PdSceneSummary(Structure):
@@ -350,6 +354,8 @@ _PROTOTYPES = {
     "pd_dir_parse": (c_int, [c_char_p, P(c_int)]),
     "pd_method_name": (c_char_p, [c_int]),
     "pd_method_parse": (c_int, [c_char_p, P(c_int)]),
+    "pd_impact_law_name": (c_char_p, [c_int]),
+    "pd_impact_law_parse": (c_int, [c_char_p, P(c_int)]),
     "pd_record_format_parse": (c_int, [c_char_p, P(c_int)]),
     "pd_record_units_parse": (c_int, [c_char_p, P(c_int)]),
     # records

@@ -237,7 +237,9 @@ class Scene:
                      lcp_solves=r.lcp_solves, dt=r.dt, theta=r.theta, tend=r.tend, dofs=sc.n,
                      impacts=sum(r.impacts[c] for c in range(sc.ncontact)),
                      simultaneous=r.simultaneous, tol_closed=r.tol_closed,
-                     accumulations=r.accumulations, close_tol=r.close_tol)
+                     accumulations=r.accumulations, close_tol=r.close_tol,
+                     impact_law=s(r.impact_law) if r.impact_law else "none",
+                     law_band=r.law_band_max)
         out.update(tolerance_fields(r, sm))
         x = self.excitation
         out["pulse"], out["dir"] = x["pulse"], x["dir"]
@@ -255,7 +257,8 @@ class Scene:
                                   umax=part(r.umax), u_pos=part(r.u_pos), u_neg=part(r.u_neg),
                                   drift=part(r.drift), Pi1=part(sm.Pi1),
                                   umax_free=part(sm.free.umax), gamma=part(sm.gamma),
-                                  err_est=sm.err_est_structure[k]))
+                                  err_est=sm.err_est_structure[k],
+                                  law_band=r.law_band[k]))
         out["structures"] = structs
         contacts = []
         for a in range(sc.ncontact):
