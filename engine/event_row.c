@@ -1,7 +1,7 @@
 /* event_row.c — the exact event-driven reference for rows (pd_edr).
  *
  * Asynchronous events, as event-driven molecular dynamics schedules them:
- * every structure belongs to a cluster (edr_cluster.c) that moves by an
+ * every structure belongs to a cluster (event_row_cluster.c) that moves by an
  * exact flight from its origin; each open contact holds one prediction of
  * its next closing (from the flights of its two sides), each cluster with
  * persistent contacts one of its next detachment, and a priority queue
@@ -39,7 +39,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "edr.h"
+#include "event_row.h"
 #include "pd_null.h"
 
 /* Bounce heights below this times the length scale are jumped (as the

@@ -1,5 +1,5 @@
 /* mj.h — (engine-private) the Moreau–Jean object, shared by its fixed-step
- * driver (moreau.c) and its adaptive one (mj_adapt.c).
+ * driver (mj.c) and its adaptive one (mj_adapt.c).
  *
  * One step of either driver is the same arithmetic (SPEC §2): the general
  * kernel's mj_general_step, the scalar kernel's mj1_step (mj1.h).  A fixed

@@ -1,5 +1,5 @@
 /* mj1.h — the one-degree-of-freedom, at-most-one-contact Moreau–Jean step
- * (engine-private), shared by the scalar kernel of pd_mj (moreau.c) and the
+ * (engine-private), shared by the scalar kernel of pd_mj (mj.c) and the
  * batch pd_mjb (mj_batch.c), so that both compute the same numbers, bit for
  * bit.
  *

@@ -302,7 +302,7 @@ PD_API void pd_mjb_run(pd_mjb *b, long nsteps, pd_mjb_observer observer, void *c
  * it failed. */
 PD_API int pd_mjb_finite(const pd_mjb *b, int l);
 
-/* ---- event-driven reference for the general system (engine/event.c) --- *
+/* ---- event-driven reference for the general system (engine/event_general.c) --- *
  * Smooth motion between events integrated by GSL (rk8pd, tight tolerances)
  * with the persistent contacts held by the acceleration-level LCP
  * (paper Eqs. 2, 7); every gap closing located by root finding; impacts of

@@ -1,6 +1,6 @@
 /* penalty_law.h — (internal) the penalty baseline's contact elements, shared
  * by the adaptive integrator (penalty.c) and the fixed-step Newmark scheme
- * (newmark.c); penetration d = -g > 0, its rate d' = -W^T v:
+ * (penalty_newmark.c); penetration d = -g > 0, its rate d' = -W^T v:
  *   Kelvin-Voigt (Anagnostopoulos):   lambda = kc d + c d',
  *       c = 2 zeta sqrt(kc m),  zeta = -ln e / sqrt(pi^2 + ln^2 e),  m = 1 / (W^T M^-1 W)
  *   Hertz-damp (Muthukumar-DesRoches): lambda = d^1.5 (kc + c d'),
@@ -66,7 +66,7 @@ static inline void pd_penalty_slopes(pd_penalty_law law, double kc, double c, do
 int pd_penalty_check_opts(const pd_penalty_opts *o, double t0, double t1, const char *who,
                           pd_err *err);
 
-/* The fixed-step Newmark integration of the elements (newmark.c):
+/* The fixed-step Newmark integration of the elements (penalty_newmark.c):
  * pd_penalty_run with stepper "newmark" (opts->h the step). */
 int pd_penalty_newmark(const pd_model *model, double t0, const double *q0, const double *v0,
                        double t1, const pd_penalty_opts *opts, pd_observer observer, void *ctx,

@@ -978,3 +978,20 @@ int pd_scene_chain(int N, const pd_scene_excitation *exc, double T0, double rati
     *out = sc;
     return PD_OK;
 }
+
+/* Largest storey stiffness of the scene [N/m]. */
+double pd_scene_stiffest(const pd_scene *sc)
+{
+    double k = 0.0;
+    for (int s = 0; s < sc->nstruct; s++)
+        for (int i = 0; i < sc->st[s].storeys; i++)
+            k = fmax(k, sc->st[s].stiffness[i]);
+    return k;
+}
+
+double pd_scene_penalty_kc(const pd_scene *sc, const pd_run_opts *o)
+{
+    if (o->pen.kc_abs > 0.0)
+        return o->pen.kc_abs;
+    return (o->pen.kc_mult > 0.0 ? o->pen.kc_mult : SCENE_PEN_KC) * pd_scene_stiffest(sc);
+}

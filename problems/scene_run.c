@@ -1206,23 +1206,6 @@ static int run_event_general(const pd_model *md, const pd_run_opts *o, double ta
     return rc;
 }
 
-/* Largest storey stiffness of the scene [N/m]. */
-double pd_scene_stiffest(const pd_scene *sc)
-{
-    double k = 0.0;
-    for (int s = 0; s < sc->nstruct; s++)
-        for (int i = 0; i < sc->st[s].storeys; i++)
-            k = fmax(k, sc->st[s].stiffness[i]);
-    return k;
-}
-
-double pd_scene_penalty_kc(const pd_scene *sc, const pd_run_opts *o)
-{
-    if (o->pen.kc_abs > 0.0)
-        return o->pen.kc_abs;
-    return (o->pen.kc_mult > 0.0 ? o->pen.kc_mult : SCENE_PEN_KC) * pd_scene_stiffest(sc);
-}
-
 /* The penalty baseline on the scene's model: kc in reference units is
  * kc_abs / wp^2 (Kelvin) or kc_abs sqrt(Le) / wp^2 (Hertz), or kc_mult times
  * the largest storey stiffness / wp^2 for both laws. */

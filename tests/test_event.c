@@ -1,4 +1,4 @@
-/* test_event.c — the general event-driven reference (engine/event.c) against
+/* test_event.c — the general event-driven reference (engine/event_general.c) against
  * the exact one-wall reference, Newton's law, invariants and Moreau–Jean. */
 #include <malloc.h>
 #include <math.h>

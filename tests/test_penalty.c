@@ -877,7 +877,7 @@ static void test_penalty_loose_tolerance_runs(pd_test_ctx *ctx)
 }
 
 
-/* ---- the Newmark penalty method (engine/newmark.c) ----------------------- */
+/* ---- the Newmark penalty method (engine/penalty_newmark.c) ----------------------- */
 
 /* The free mass of free_mass_impact on fixed Newmark steps of `per` steps
  * per period of the element (2 pi / sqrt(kc)). */

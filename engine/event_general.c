@@ -1,4 +1,4 @@
-/* event.c — event-driven reference for the general system (SPEC §2):
+/* event_general.c — event-driven reference for the general system (SPEC §2):
  *
  *   M q'' + C q' + K q = F(t) + W lambda,   g = g0 + W^T q >= 0 ⊥ lambda >= 0.
  *

@@ -1,4 +1,4 @@
-/* edr_cluster.c — clusters of the row reference and their exact flights.
+/* event_row_cluster.c — clusters of the row reference and their exact flights.
  *
  * SDOF trees.  Blocks of one dof joined by persistent contacts move
  * rigidly: rooted at one dof (the one next to the wall when a wall holds
@@ -40,7 +40,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "edr.h"
+#include "event_row.h"
 
 /* A constraint direction within this (relative) of the span of the others
  * is dependent: the contact is LOCKED. */

@@ -1,4 +1,4 @@
-/* moreau.c — Moreau–Jean theta time-stepping (SPEC §2).
+/* mj.c — Moreau–Jean theta time-stepping (SPEC §2).
  *
  *   What  = M + h theta C + h^2 theta^2 K                       (factored once)
  *   vfree = v_k + What^-1 h [F_theta - C v_k - K (q_k + h theta v_k)]

@@ -1,4 +1,4 @@
-/* newmark.c — the penalty baseline the practitioners' way: a fixed-step
+/* penalty_newmark.c — the penalty baseline the practitioners' way: a fixed-step
  * implicit Newmark scheme (average acceleration, beta = 1/4, gamma = 1/2)
  * with Newton iterations on the contact elements, as OpenSees users run
  * zeroLength impact elements (docs/methods.md, "Penalty baseline").

@@ -1,5 +1,5 @@
-/* edr.h — private to the exact event-driven reference for rows
- * (engine/event_row.c, edr_cluster.c, edr_scan.c); the public interface is
+/* event_row.h — private to the exact event-driven reference for rows
+ * (engine/event_row.c, event_row_cluster.c, event_row_scan.c); the public interface is
  * pd_edr_* in pd_engine.h.
  *
  * Vocabulary.  A *block* is a structure: the dofs that M, C, K couple (an
@@ -25,10 +25,10 @@ typedef double complex edr_cplx;
 
 enum { EDR_SDOF = 1, EDR_REST = 2, EDR_MODAL = 3 };
 
-/* Degree of a flight's Taylor series near its origin (edr_cluster.c). */
+/* Degree of a flight's Taylor series near its origin (event_row_cluster.c). */
 #define EDR_TAYLOR_N 7
 
-/* ---- scanning a scalar function f (edr_scan.c) ------------------------- *
+/* ---- scanning a scalar function f (event_row_scan.c) ------------------------- *
  * The one-wall reference's scan carried to any closed-form function with
  * its first two derivatives: on each scan interval f' is nearly quadratic,
  * so it turns at most twice; every turn is located (an extremum, noted)
@@ -261,7 +261,7 @@ struct pd_edr {
     pd_state st;
 };
 
-/* ---- clusters (edr_cluster.c) ------------------------------------------- */
+/* ---- clusters (event_row_cluster.c) ------------------------------------------- */
 
 /* f(t) of piece j. */
 double edr_force(const pd_edr *r, int j, double t);

@@ -1,4 +1,4 @@
-/* edr_scan.c — the scan of a closed-form scalar function f over one
+/* event_row_scan.c — the scan of a closed-form scalar function f over one
  * interval, as the one-wall reference scans its flight (event_sdof.c):
  * with (f, f', f'') known at every t, f' is nearly quadratic over an
  * interval of a 64th of the shortest period, so it changes sign at most
@@ -14,7 +14,7 @@
  * to a width (f is flat there). */
 #include <math.h>
 
-#include "edr.h"
+#include "event_row.h"
 
 /* f' may turn twice in an interval only within this many |f''| h of zero. */
 #define TURN_MARGIN 2.0
