@@ -102,7 +102,7 @@ static pd_scene *law_row(pd_test_ctx *ctx, pd_pulse pulse, const double *T0, con
         return NULL;
     int ok = 1;
     for (int s = 0; s < 4 && ok; s++) {
-        char name[8];
+        char name[16];
         snprintf(name, sizeof name, "S%d", s + 1);
         ok = !pd_scene_add_sdof(sc, name, T0[s], 0.05, mass[s], &e);
     }
