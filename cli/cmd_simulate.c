@@ -421,7 +421,13 @@ static int simulate_oscillator(sim_args *a)
                                &err)) ||
         (isfinite(s.r.umax) && !isfinite(s.r.umax / a->k.height) &&
          (rc = pd_err_set(&err, PD_EINVAL, "--height: the drift ratio umax / H overflows "
-                          "(umax %g m, H %g m): give a larger height", s.r.umax, a->k.height)))) {
+                          "(umax %g m, H %g m): give a larger height", s.r.umax, a->k.height))) ||
+        /* an impulse whose equivalent force overflows at any duration: the
+         * excitation's scale (the duration's own case is the library's) */
+        (isfinite(s.r.max_impulse) && !isfinite(s.r.force_equiv) &&
+         (rc = pd_err_set(&err, PD_EINVAL, "%s: the impacts' equivalent force pi I / (2 td) "
+                          "overflows (impulse I = %g): a weaker excitation",
+                          a->k.record_path ? "--scale" : "--ap", s.r.max_impulse)))) {
         fprintf(stderr, "pound: simulate: %s\n", err.msg);
         status = rc == PD_EINVAL ? 2 : 1;
         goto done;

@@ -19,11 +19,13 @@ double pd_equivalent_force(double impulse, double td)
     return 0.5 * PD_PI * impulse / td;
 }
 
-/* An equivalent force pi I / (2 td) that overflows while I does not: the
- * duration's fault (contact a, or -1 for the oscillator's wall). */
+/* An equivalent force pi I / (2 td) that overflows while I's at the
+ * default duration does not: the duration's fault (contact a, or -1 for the
+ * oscillator's wall).  An impulse too large for any duration is the
+ * excitation's, which the callers name. */
 int pd_demand_check_force(double impulse, double force, int a, pd_err *err)
 {
-    if (isfinite(force) || !isfinite(impulse))
+    if (isfinite(force) || !isfinite(pd_equivalent_force(impulse, PD_CONTACT_DURATION)))
         return PD_OK;
     char which[32] = "";
     if (a >= 0)

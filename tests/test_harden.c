@@ -199,6 +199,9 @@ static void test_harden_method_flags(pd_test_ctx *ctx)
             "--kc");
     refused(ctx, (const char *[]){"simulate", "--method", "newmark", "--stepper", "rk4imp", NULL},
             NULL, "--stepper");
+    /* defect 4's other face: an excitation whose impacts' equivalent force
+     * overflows at any duration names the excitation, not the duration */
+    refused(ctx, (const char *[]){"simulate", "--ap", "1e308", NULL}, NULL, "--ap:");
     /* what each method reads stays accepted */
     const char *ok[][10] = {{"simulate", "--method", "newmark", "--kc", "10", NULL},
                            {"simulate", "--method", "penalty", "--stepper", "rk4imp", NULL},
