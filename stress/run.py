@@ -96,7 +96,8 @@ CAT_TEXT = {
                   "--dump-lcp, --plot: refused at once, the node left as it was",
     "names": "structure names the writers cannot carry (comma, '.', empty, quote, control "
              "characters, 300 characters, '/', 'wall'): refused naming structures[i].name; "
-             "spaces, UTF-8, 63 characters: written as given (CSV header, HDF5 groups)",
+             "spaces, UTF-8, 63 characters, the file's own names (t, storey, x): written as "
+             "given (CSV header, HDF5 groups)",
     "bounds": "work and memory refused up front: 20000 or 5e6 contact levels, 20000 pairs or "
               "entries, a 160 kHz mode for the event-driven and penalty methods; penalty "
               "chains whose elements switch at one instant stopped within the 10 s (exit 1, "
