@@ -67,6 +67,8 @@
 /* A hold ends a contact's burst of impacts (max_burst) when it lasts
  * longer than this (units of the run's time). */
 #define EDR_HOLD_MIN 1e-6
+/* The shift of a singular contact LCP's unit diagonal (scaled_lcp). */
+#define EDR_LCP_SHIFT 1e-10
 /* Events of one contact or cluster within this span (units of the run's
  * time) before the run is declared stuck in a chatter. */
 #define EDR_CHATTER_EVENTS 10000
@@ -835,6 +837,59 @@ static pd_matrix delassus(pd_edr *r, const int *idx, int k)
 }
 
 /* Solve the LCP D z + q over idx[0..k) into z (w = D z + q). */
+/* The LCP (D, q) posed on unit diagonal, when pivoting on D failed (masses
+ * of many decades: D's entries span them):  z = S z', w = S^-1 w',
+ * (S D S) z' + S q = w', S = diag(D_jj^-1/2) (positive: complementarity
+ * kept). */
+static int scaled_lcp(pd_edr *r, pd_matrix *D, int k, const double *q, const pd_lcp_opts *lo,
+                      double *z, double *w, pd_lcp_info *info)
+{
+    double *sc = r->lcp_scale, *qs = r->lcp_q;
+    for (int j = 0; j < k; j++) {
+        double d = 0.0;
+        if (D->kind == PD_MATRIX_DENSE)
+            d = D->values[j + (size_t)j * k];
+        else
+            for (int p = D->colptr[j]; p < D->colptr[j + 1]; p++)
+                d = D->rowind[p] == j ? D->values[p] : d;
+        if (!(d > 0.0))
+            return PD_ENUMERICAL;
+        sc[j] = 1.0 / sqrt(d);
+        qs[j] = sc[j] * q[j];
+    }
+    double *val = (double *)D->values; /* delassus()'s: r->Dd or r->Dval, formed per solve */
+    for (int j = 0; j < k; j++) {
+        if (D->kind == PD_MATRIX_DENSE)
+            for (int i = 0; i < k; i++)
+                val[i + (size_t)j * k] *= sc[i] * sc[j];
+        else
+            for (int p = D->colptr[j]; p < D->colptr[j + 1]; p++)
+                val[p] *= sc[D->rowind[p]] * sc[j];
+    }
+    int rc = pd_lcp_solve(r->solver, D, qs, lo, z, w, info);
+    if (rc) {
+        /* a closed loop (a row touching wall to wall, or with a body whose
+         * rows D barely tells apart): D singular and q a rounding outside its
+         * range; D + EDR_LCP_SHIFT I (on unit diagonal) has one answer, the
+         * forces' error of the shift's order */
+        for (int j = 0; j < k; j++) {
+            if (D->kind == PD_MATRIX_DENSE)
+                val[j + (size_t)j * k] += EDR_LCP_SHIFT;
+            else
+                for (int p = D->colptr[j]; p < D->colptr[j + 1]; p++)
+                    val[p] += D->rowind[p] == j ? EDR_LCP_SHIFT : 0.0;
+        }
+        rc = pd_lcp_solve(r->solver, D, qs, lo, z, w, info);
+        for (int j = 0; j < k && !rc; j++) /* w of D itself */
+            w[j] -= EDR_LCP_SHIFT * z[j];
+    }
+    for (int j = 0; j < k && !rc; j++) {
+        z[j] *= sc[j];
+        w[j] /= sc[j];
+    }
+    return rc;
+}
+
 static int solve_lcp(pd_edr *r, const int *idx, int k, const double *q, double *z, double *w,
                      double t, pd_err *err)
 {
@@ -857,6 +912,8 @@ static int solve_lcp(pd_edr *r, const int *idx, int k, const double *q, double *
     lo.guess = r->guess;
     pd_lcp_info info;
     int rc = pd_lcp_solve(r->solver, &D, q, &lo, z, w, &info);
+    if (rc)
+        rc = scaled_lcp(r, &D, k, q, &lo, z, w, &info);
     if (rc)
         return pd_err_set(err, rc, "row reference: the contact LCP of %d contacts at t = %.9g s "
                           "was not solved (%s)", k, t * r->o.time_unit, pd_lcp_outcome_name(info.outcome));
@@ -2057,7 +2114,7 @@ void pd_edr_free(pd_edr *r)
                       r->g_cl, r->cl_mark, r->g_ct, r->ct_mark, r->ct_mark2, r->ct_markD, r->ct_markP,
                       r->g_dof, r->gx, r->gv, r->gacc, r->gtmp, r->Uminus, r->Uplus, r->P,
                       r->lam, r->wlcp, r->qlcp, r->wtmp, r->Dd, r->Dlu, r->rtmp, r->lu_perm, r->cG, r->lcp_idx, r->jpos, r->held, r->tie,
-                      r->held_tail, r->excluded, r->guess, r->epos, r->qtmp, r->ztmp, r->pos_in, r->Dval, r->Dcol, r->Drow,
+                      r->held_tail, r->excluded, r->guess, r->epos, r->qtmp, r->ztmp, r->lcp_scale, r->lcp_q, r->pos_in, r->Dval, r->Dcol, r->Drow,
                       r->stack, r->pe, r->pdof, r->bfs_next, r->ceta, r->cmu, r->cvy, r->ext, r->nimp, r->crow, r->crow_c, r->keybuf, r->uf, r->gblk,
                       r->newcl, r->plist, r->dofc_ptr, r->dofc, r->loc, r->wk, r->mctx,
                       r->mscan, r->mprev, r->ev_vminus, r->ev_vplus, r->ev_x, r->st.q,
@@ -2337,7 +2394,7 @@ pd_edr *pd_edr_alloc(const pd_model *md, const pd_piecewise_force *F, const pd_e
         !ALLOC(r->wtmp, m) || !ALLOC(r->Dd, (long)dm * dm) || !ALLOC(r->Dlu, (long)dm * dm) ||
         !ALLOC(r->rtmp, 4L * dm) || !ALLOC(r->lu_perm, 2L * dm) || !ALLOC(r->cG, nb) || !ALLOC(r->lcp_idx, m) ||
         !ALLOC(r->jpos, m) || !ALLOC(r->held, m) || !ALLOC(r->tie, m) || !ALLOC(r->held_tail, m) ||
-        !ALLOC(r->excluded, m) || !ALLOC(r->guess, m) || !ALLOC(r->epos, m) || !ALLOC(r->qtmp, m) || !ALLOC(r->ztmp, m) || !ALLOC(r->pos_in, m) || !ALLOC(r->Dval, r->Dcap) ||
+        !ALLOC(r->excluded, m) || !ALLOC(r->guess, m) || !ALLOC(r->epos, m) || !ALLOC(r->qtmp, m) || !ALLOC(r->ztmp, m) || !ALLOC(r->lcp_scale, m) || !ALLOC(r->lcp_q, m) || !ALLOC(r->pos_in, m) || !ALLOC(r->Dval, r->Dcap) ||
         !ALLOC(r->Dcol, m + 1) || !ALLOC(r->Drow, r->Dcap) || !ALLOC(r->stack, n) ||
         !ALLOC(r->pe, n) || !ALLOC(r->pdof, n) || !ALLOC(r->bfs_next, n) ||
         !ALLOC(r->ceta, nb) || !ALLOC(r->cmu, nb) || !ALLOC(r->cvy, nb) || !ALLOC(r->ext, n) || !ALLOC(r->nimp, m) || !ALLOC(r->crow, n) || !ALLOC(r->crow_c, m) ||

@@ -226,6 +226,7 @@ struct pd_edr {
     double *held_tail;
     int *pos_in;
     unsigned char *guess;      /* the LCP's warm start */
+    double *lcp_scale, *lcp_q; /* m: scaled_lcp's S and S q */
     double *Dd;                /* dense Delassus */
     double *Dlu, *rtmp;        /* the clusters' refinement: D_AA's LU, 4 dm */
     int *lu_perm;              /* 2 dm: its rows, the pushing contacts */

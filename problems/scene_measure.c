@@ -115,6 +115,7 @@ int pd_scene_measure_reference(const pd_scene *sc, const pd_run_opts *o, pd_scen
                                           "(pd_scene_result_alloc)");
     r.method = PD_METHOD_EVENT;
     r.no_law_band = 1; /* the measurements report no law_band: no second run */
+    r.no_demands = 1;  /* nor demands: umax and the history */
     ref->rows = 0;
     ref->dt = r.dt;
     if ((rc = pd_scene_run(sc, &r, keep_row, ref, res, err)))
@@ -234,7 +235,10 @@ int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scen
         c.v_prev = c.x_prev + sc->n;
         c.x_at = c.v_prev + sc->n;
     }
-    if ((rc = pd_scene_run(sc, o, tol ? compare_steps : compare_row, &c, res, err)) ||
+    pd_run_opts measured = o ? *o : pd_run_default_opts();
+    measured.no_demands = 1; /* umax and the history are measured, not the demands */
+    measured.no_law_band = 1;
+    if ((rc = pd_scene_run(sc, &measured, tol ? compare_steps : compare_row, &c, res, err)) ||
         (rc = pd_scene_result_alloc(sc, &timed, err))) {
         free(work);
         return rc;
