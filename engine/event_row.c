@@ -920,26 +920,33 @@ static int solve_lcp(pd_edr *r, const int *idx, int k, const double *q, double *
     return PD_OK;
 }
 
-/* Free accelerations M^-1 (b f - C v - K x) of the group's dofs at t. */
-static void free_accelerations(pd_edr *r, double t)
+/* out = M^-1 (b f - C v - K x) over the group's dofs (global index): the
+ * free accelerations from (x, v) = (gx, gv) and f(t), the free jerks from
+ * (v, a) and f'(t). */
+static void group_rhs(pd_edr *r, double f, const double *x, const double *v, double *out)
 {
-    double f = edr_force(r, edr_piece_at(r, t), t);
     for (int k = 0; k < r->ngd; k++) {
         int i = r->g_dof[k], b = r->dof_blk[i];
         const edr_block *bk = &r->blk[b];
         if (bk->sdof) {
-            r->gacc[i] = (bk->b * f - bk->c * r->gv[i] - bk->k * r->gx[i]) * r->minv[i];
+            out[i] = (bk->b * f - bk->c * v[i] - bk->k * x[i]) * r->minv[i];
             continue;
         }
         int li = r->dof_loc[i];
         long off = r->blk_off[b];
         double s = r->b[i] * f;
-        for (int j = 0; j < bk->n; j++) {
-            int gj = r->blk_dofs[bk->first + j];
-            s -= r->Cb[off + li + (long)j * bk->n] * r->gv[gj] + r->Kb[off + li + (long)j * bk->n] * r->gx[gj];
+        for (int jj = 0; jj < bk->n; jj++) {
+            int gj = r->blk_dofs[bk->first + jj];
+            s -= r->Cb[off + li + (long)jj * bk->n] * v[gj] + r->Kb[off + li + (long)jj * bk->n] * x[gj];
         }
-        r->gacc[i] = s * r->minv[i];
+        out[i] = s * r->minv[i];
     }
+}
+
+/* Free accelerations M^-1 (b f - C v - K x) of the group's dofs at t. */
+static void free_accelerations(pd_edr *r, double t)
+{
+    group_rhs(r, edr_force(r, edr_piece_at(r, t), t), r->gx, r->gv, r->gacc);
 }
 
 /* The free jerks of the group's dofs into r->gtmp, from the free
@@ -948,22 +955,7 @@ static void free_jerks(pd_edr *r, double t)
 {
     const pd_sine_piece *pc = &r->pieces[edr_piece_at(r, t)];
     double df = pc->c1 + (pc->A == 0.0 ? 0.0 : pc->A * pc->w * cos(pc->w * t + pc->phi));
-    for (int k = 0; k < r->ngd; k++) {
-        int i = r->g_dof[k], b = r->dof_blk[i];
-        const edr_block *bk = &r->blk[b];
-        if (bk->sdof) {
-            r->gtmp[i] = (bk->b * df - bk->c * r->gacc[i] - bk->k * r->gv[i]) * r->minv[i];
-            continue;
-        }
-        int li = r->dof_loc[i];
-        long off = r->blk_off[b];
-        double s = r->b[i] * df;
-        for (int j = 0; j < bk->n; j++) {
-            int gj = r->blk_dofs[bk->first + j];
-            s -= r->Cb[off + li + (long)j * bk->n] * r->gacc[gj] + r->Kb[off + li + (long)j * bk->n] * r->gv[gj];
-        }
-        r->gtmp[i] = s * r->minv[i];
-    }
+    group_rhs(r, df, r->gv, r->gacc, r->gtmp);
 }
 
 /* W_a^T y over the group's state array y (walls at rest). */

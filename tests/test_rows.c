@@ -320,6 +320,25 @@ static int check_impact(const pd_edr_event *ev, void *vctx)
     return 0;
 }
 
+/* The row reference over sc to its default end, each impact checked by
+ * check_impact into ic: pd_edr_run's status (e its message), or -1 when the
+ * row could not be set up (a failed check). */
+static int run_checked(pd_test_ctx *ctx, const pd_scene *sc, impact_check *ic, pd_err *e)
+{
+    pd_edr_opts eo = pd_edr_default_opts();
+    row_run rr;
+    int rc = -1;
+    eo.on_event = check_impact;
+    eo.on_event_ctx = ic;
+    ic->sm = &rr.sm;
+    ic->pscale = 0.0;
+    if (row_open(ctx, sc, &eo, &rr))
+        rc = pd_edr_run(rr.edr, 0.0, NULL, NULL, pd_scene_wp(sc) * pd_scene_default_tend(sc), NULL,
+                        NULL, e);
+    row_close(&rr);
+    return rc;
+}
+
 static void test_rows_impulses_balance_energy_falls(pd_test_ctx *ctx)
 {
     uint64_t rng = 0x5eed1234;
@@ -329,17 +348,8 @@ static void test_rows_impulses_balance_energy_falls(pd_test_ctx *ctx)
         pd_scene *sc = random_row(&rng, 2 + k % 5, 0.0, 1.0, 0.05, k % 2 ? PD_PULSE_COSINE : PD_PULSE_SINE, &e);
         if (!CHECK(ctx, sc != NULL, "row: %s", e.msg))
             continue;
-        pd_edr_opts eo = pd_edr_default_opts();
-        row_run rr;
-        eo.on_event = check_impact;
-        eo.on_event_ctx = &ic;
-        ic.sm = &rr.sm;
-        ic.pscale = 0.0;
-        if (row_open(ctx, sc, &eo, &rr)) {
-            double t1 = pd_scene_wp(sc) * pd_scene_default_tend(sc);
-            CHECK(ctx, pd_edr_run(rr.edr, 0.0, NULL, NULL, t1, NULL, NULL, &e) == PD_OK, "row %d: %s", k, e.msg);
-        }
-        row_close(&rr);
+        int rc = run_checked(ctx, sc, &ic, &e);
+        CHECK(ctx, rc == PD_OK || rc < 0, "row %d: %s", k, e.msg);
         pd_scene_free(sc);
     }
     CHECK(ctx, ic.impacts > 200, "impacts checked: %ld", ic.impacts);
@@ -382,15 +392,7 @@ static void test_rows_hostile_physics(pd_test_ctx *ctx)
             pd_scene_free(sc);
             continue;
         }
-        pd_edr_opts eo = pd_edr_default_opts();
-        row_run rr;
-        eo.on_event = check_impact;
-        eo.on_event_ctx = &ic;
-        ic.sm = &rr.sm;
-        ic.pscale = 0.0;
-        if (row_open(ctx, sc, &eo, &rr)) {
-            double t1 = pd_scene_wp(sc) * pd_scene_default_tend(sc);
-            rc = pd_edr_run(rr.edr, 0.0, NULL, NULL, t1, NULL, NULL, &e);
+        if ((rc = run_checked(ctx, sc, &ic, &e)) >= 0) {
             answered += rc == PD_OK;
             chatter += rc == PD_EBUDGET && strstr(e.msg, "--method moreau") != NULL;
             double ratio = 1.0;
@@ -402,7 +404,6 @@ static void test_rows_hostile_physics(pd_test_ctx *ctx)
             CHECK(ctx, rc == PD_OK || (rc == PD_EBUDGET && strstr(e.msg, "--method moreau")),
                   "row %d (touching mass ratio up to %.3g): %s", k, ratio, e.msg);
         }
-        row_close(&rr);
         pd_scene_free(sc);
     }
     CHECK(ctx, answered >= 30 && ic.impacts > 200, "answered %d of 40 (chatter %d), impacts %ld",
