@@ -59,6 +59,9 @@ typedef struct track {
                                            a_abs [SI] now and at the previous demand state */
     double *hlam;                       /* m: Moreau-Jean: the held force P / h of the last
                                            step without an impact (reference units) */
+    double *hsm;                        /* n: Moreau-Jean: the smooth a_abs of the step [SI] */
+    double *hP;                         /* m: Moreau-Jean: the previous step's impulse */
+    unsigned char *hwas;                /* m: Moreau-Jean: held in the previous step */
     unsigned char *sheld;               /* nstruct: row reference: a closed contact at an
                                            impact */
     const pd_osc *shape;                /* the excitation's shape: f = F_i / m_i */
@@ -181,7 +184,7 @@ static void track_free(track *tr)
                       tr->dad, tr->dVd, tr->qa, tr->qV, tr->qad, tr->qVd,
                       tr->st_of, tr->ex, tr->ev, tr->sI, tr->sampled, tr->errx, tr->errd,
                       tr->erra, tr->errv, tr->acc0, tr->shear0, tr->serr, tr->wdof,
-                      tr->hacc, tr->qh, tr->hlam, tr->sheld};
+                      tr->hacc, tr->qh, tr->hlam, tr->hsm, tr->hP, tr->hwas, tr->sheld};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(arrays[k]);
 }
@@ -208,7 +211,8 @@ static int track_alloc(track *tr, const pd_scene *sc, pd_err *err)
         !TA(tr->sampled, m) || !TA(tr->errx, n) || !TA(tr->errd, n) || !TA(tr->erra, n) ||
         !TA(tr->errv, n) || !TA(tr->acc0, n) || !TA(tr->shear0, n) ||
         !TA(tr->serr, (size_t)sc->nstruct) || !TA(tr->wdof, n) || !TA(tr->hacc, n) ||
-        !TA(tr->qh, n) || !TA(tr->hlam, m) ||
+        !TA(tr->qh, n) || !TA(tr->hlam, m) || !TA(tr->hsm, n) || !TA(tr->hP, m) ||
+        !TA(tr->hwas, m) ||
         !TA(tr->sheld, (size_t)sc->nstruct)) {
 #undef TA
         track_free(tr);
@@ -244,6 +248,7 @@ static void track_clear(track *tr)
     memset(tr->impacts, 0, m * sizeof(long));
     memset(tr->sampled, 0, m * sizeof(long));
     memset(tr->touching, 0, m);
+    memset(tr->hwas, 0, m);
     for (int a = 0; a < tr->m; a++) {
         tr->first[a] = NAN;
         tr->approach[a] = -HUGE_VAL;
@@ -547,20 +552,43 @@ static double gap_rate(const track *tr, int a, const double *v)
     return (tr->dof_b[a] >= 0 ? v[tr->dof_b[a]] : 0.0) - (tr->dof_a[a] >= 0 ? v[tr->dof_a[a]] : 0.0);
 }
 
+/* A Moreau–Jean contact is held while its gap rate after the step stays
+ * within this many steps' worth of the excitation's acceleration (reference
+ * units: ap = 1), and its force P / h within MJ_HELD_FORCE times what the
+ * smooth forces on its two sides could ask of it,
+ * m_eff (|a_abs,a| + |a_abs,b| + ap), m_eff = (1/m_a + 1/m_b)^-1: a hold
+ * leaves U+ = -e U- with U- of one step's push and carries a force of the
+ * structures' own size; an impact, or a cascade a step merges, leaves an
+ * impact's speed or an impulse far beyond. */
+#define MJ_HELD_RATE 4.0
+#define MJ_HELD_FORCE 2.0
+
 /* Moreau–Jean's held forces at a step into tr->hlam and tr->hacc: a
- * contact with an impulse in this step and the one before is held, its
- * force the step's mean P / h; a step where some contact starts (an
- * impulse after none) carries impulses through every closed contact, and
- * there the held ones keep the force of their step before. */
+ * contact with an impulse in this step and the one before, held by the
+ * tests above, its force the step's mean P / h; a step where some contact
+ * starts (an impulse after none) carries impulses through every closed
+ * contact, and there the held ones keep the force of their step before. */
 static void moreau_held(track *tr, const pd_state *st)
 {
     int impact = 0;
+    double rest = MJ_HELD_RATE * tr->h, ap = tr->sc->exc.ap;
     for (int a = 0; a < tr->model_m; a++)
         impact |= st->P[a] > 0.0 && !tr->touching[a];
-    for (int a = 0; a < tr->model_m; a++)
-        tr->hlam[a] = !(st->P[a] > 0.0 && tr->touching[a]) ? 0.0
-                      : impact                           ? tr->hlam[a]
-                                                         : st->P[a] / tr->h;
+    pd_demand_eval(tr->sc, st->q, st->v, tr->Le, tr->Le * tr->wp, tr->hsm, tr->dV);
+    for (int a = 0; a < tr->model_m; a++) {
+        int i = tr->dof_a[a], j = tr->dof_b[a];
+        double inv = (i >= 0 ? 1.0 / tr->mass[i] : 0.0) + (j >= 0 ? 1.0 / tr->mass[j] : 0.0);
+        double ask = (ap + (i >= 0 ? fabs(tr->hsm[i]) : 0.0) + (j >= 0 ? fabs(tr->hsm[j]) : 0.0)) / inv;
+        int held = st->P[a] > 0.0 && tr->touching[a] && fabs(tr->U_prev[a]) <= rest &&
+                   fabs(gap_rate(tr, a, st->v)) <= rest &&
+                   ap * st->P[a] / tr->h <= MJ_HELD_FORCE * ask;
+        /* theta = 1/2 alternates a hold's impulses step to step: their mean
+         * over two held steps */
+        tr->hlam[a] = !held ? 0.0 : impact ? tr->hlam[a]
+                    : tr->hwas[a] ? 0.5 * (st->P[a] + tr->hP[a]) / tr->h : 0.0;
+        tr->hwas[a] = (unsigned char)held;
+        tr->hP[a] = st->P[a];
+    }
     held_from_forces(tr, tr->hlam);
 }
 
