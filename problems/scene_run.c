@@ -60,8 +60,9 @@ typedef struct track {
     double *hlam;                       /* m: Moreau-Jean: the held force P / h of the last
                                            step without an impact (reference units) */
     double *hsm;                        /* n: Moreau-Jean: the smooth a_abs of the step [SI] */
-    double *hP;                         /* m: Moreau-Jean: the previous step's impulse */
-    unsigned char *hwas;                /* m: Moreau-Jean: held in the previous step */
+    int *hJ;                            /* m: Moreau-Jean: the candidate holds */
+    double *hG, *hz, *hw, *hD;          /* their LCP: q (MJ_HELD_LCP), z, w, D (^2) */
+    pd_lcp_solver *hlcp;
     unsigned char *sheld;               /* nstruct: row reference: a closed contact at an
                                            impact */
     const pd_osc *shape;                /* the excitation's shape: f = F_i / m_i */
@@ -172,6 +173,17 @@ void pd_scene_result_free(pd_scene_result *r)
     memset(r, 0, sizeof *r);
 }
 
+/* A Moreau–Jean contact is a candidate hold when it takes an impulse in
+ * this step and the one before and is at rest after both: a gap rate within
+ * MJ_HELD_RATE steps' worth of the excitation's acceleration (reference
+ * units: ap = 1).  The candidates' forces are those of the contact-force
+ * LCP at the step's state, as the references' (up to MJ_HELD_LCP of them;
+ * beyond, no held part), not P / h: theta = 1/2 alternates a hold's
+ * impulses, and a step that merges an impact's cascade has impulses far
+ * beyond any hold. */
+#define MJ_HELD_RATE 4.0
+#define MJ_HELD_LCP 64
+
 /* ---- the tracker ------------------------------------------------------------ */
 
 static void track_free(track *tr)
@@ -184,9 +196,11 @@ static void track_free(track *tr)
                       tr->dad, tr->dVd, tr->qa, tr->qV, tr->qad, tr->qVd,
                       tr->st_of, tr->ex, tr->ev, tr->sI, tr->sampled, tr->errx, tr->errd,
                       tr->erra, tr->errv, tr->acc0, tr->shear0, tr->serr, tr->wdof,
-                      tr->hacc, tr->qh, tr->hlam, tr->hsm, tr->hP, tr->hwas, tr->sheld};
+                      tr->hacc, tr->qh, tr->hlam, tr->hsm, tr->hJ, tr->hG, tr->hz, tr->hw, tr->hD,
+                      tr->sheld};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(arrays[k]);
+    pd_lcp_solver_free(tr->hlcp);
 }
 
 /* Every array once, the topology of the scene. */
@@ -211,8 +225,9 @@ static int track_alloc(track *tr, const pd_scene *sc, pd_err *err)
         !TA(tr->sampled, m) || !TA(tr->errx, n) || !TA(tr->errd, n) || !TA(tr->erra, n) ||
         !TA(tr->errv, n) || !TA(tr->acc0, n) || !TA(tr->shear0, n) ||
         !TA(tr->serr, (size_t)sc->nstruct) || !TA(tr->wdof, n) || !TA(tr->hacc, n) ||
-        !TA(tr->qh, n) || !TA(tr->hlam, m) || !TA(tr->hsm, n) || !TA(tr->hP, m) ||
-        !TA(tr->hwas, m) ||
+        !TA(tr->qh, n) || !TA(tr->hlam, m) || !TA(tr->hsm, n) || !TA(tr->hJ, m) ||
+        !TA(tr->hG, MJ_HELD_LCP) || !TA(tr->hz, MJ_HELD_LCP) || !TA(tr->hw, MJ_HELD_LCP) ||
+        !TA(tr->hD, (size_t)MJ_HELD_LCP * MJ_HELD_LCP) ||
         !TA(tr->sheld, (size_t)sc->nstruct)) {
 #undef TA
         track_free(tr);
@@ -248,7 +263,6 @@ static void track_clear(track *tr)
     memset(tr->impacts, 0, m * sizeof(long));
     memset(tr->sampled, 0, m * sizeof(long));
     memset(tr->touching, 0, m);
-    memset(tr->hwas, 0, m);
     for (int a = 0; a < tr->m; a++) {
         tr->first[a] = NAN;
         tr->approach[a] = -HUGE_VAL;
@@ -552,43 +566,50 @@ static double gap_rate(const track *tr, int a, const double *v)
     return (tr->dof_b[a] >= 0 ? v[tr->dof_b[a]] : 0.0) - (tr->dof_a[a] >= 0 ? v[tr->dof_a[a]] : 0.0);
 }
 
-/* A Moreau–Jean contact is held while its gap rate after the step stays
- * within this many steps' worth of the excitation's acceleration (reference
- * units: ap = 1), and its force P / h within MJ_HELD_FORCE times what the
- * smooth forces on its two sides could ask of it,
- * m_eff (|a_abs,a| + |a_abs,b| + ap), m_eff = (1/m_a + 1/m_b)^-1: a hold
- * leaves U+ = -e U- with U- of one step's push and carries a force of the
- * structures' own size; an impact, or a cascade a step merges, leaves an
- * impact's speed or an impulse far beyond. */
-#define MJ_HELD_RATE 4.0
-#define MJ_HELD_FORCE 2.0
 
-/* Moreau–Jean's held forces at a step into tr->hlam and tr->hacc: a
- * contact with an impulse in this step and the one before, held by the
- * tests above, its force the step's mean P / h; a step where some contact
- * starts (an impulse after none) carries impulses through every closed
- * contact, and there the held ones keep the force of their step before. */
+/* The free relative acceleration of dof i (reference units; -1: a wall, at
+ * rest with the ground) from the smooth a_abs (SI) and the forcing f. */
+static double free_rel_acc(const track *tr, int i, double f)
+{
+    return i < 0 ? 0.0 : tr->hsm[i] / tr->sc->exc.ap + f;
+}
+
+/* Moreau–Jean's held forces at a step into tr->hlam and tr->hacc: the
+ * contact-force LCP over the candidate holds J,
+ *   g'' = D lambda + G >= 0 _|_ lambda >= 0,  D_ab = sum_i W_ia W_ib / m_i,
+ *   G_a = W_a^T u''_free  (u''_free from the smooth a_abs and f(t)). */
 static void moreau_held(track *tr, const pd_state *st)
 {
-    int impact = 0;
-    double rest = MJ_HELD_RATE * tr->h, ap = tr->sc->exc.ap;
-    for (int a = 0; a < tr->model_m; a++)
-        impact |= st->P[a] > 0.0 && !tr->touching[a];
-    pd_demand_eval(tr->sc, st->q, st->v, tr->Le, tr->Le * tr->wp, tr->hsm, tr->dV);
+    double rest = MJ_HELD_RATE * tr->h, f = pd_osc_shape(tr->shape, st->t, -1);
+    int k = 0, *J = tr->hJ;
     for (int a = 0; a < tr->model_m; a++) {
-        int i = tr->dof_a[a], j = tr->dof_b[a];
-        double inv = (i >= 0 ? 1.0 / tr->mass[i] : 0.0) + (j >= 0 ? 1.0 / tr->mass[j] : 0.0);
-        double ask = (ap + (i >= 0 ? fabs(tr->hsm[i]) : 0.0) + (j >= 0 ? fabs(tr->hsm[j]) : 0.0)) / inv;
-        int held = st->P[a] > 0.0 && tr->touching[a] && fabs(tr->U_prev[a]) <= rest &&
-                   fabs(gap_rate(tr, a, st->v)) <= rest &&
-                   ap * st->P[a] / tr->h <= MJ_HELD_FORCE * ask;
-        /* theta = 1/2 alternates a hold's impulses step to step: their mean
-         * over two held steps */
-        tr->hlam[a] = !held ? 0.0 : impact ? tr->hlam[a]
-                    : tr->hwas[a] ? 0.5 * (st->P[a] + tr->hP[a]) / tr->h : 0.0;
-        tr->hwas[a] = (unsigned char)held;
-        tr->hP[a] = st->P[a];
+        tr->hlam[a] = 0.0;
+        if (st->P[a] > 0.0 && tr->touching[a] && fabs(tr->U_prev[a]) <= rest &&
+            fabs(gap_rate(tr, a, st->v)) <= rest)
+            J[k++] = a;
     }
+    if (k == 0 || k > MJ_HELD_LCP || !tr->hlcp) {
+        held_from_forces(tr, NULL);
+        return;
+    }
+    pd_demand_eval(tr->sc, st->q, st->v, tr->Le, tr->Le * tr->wp, tr->hsm, tr->dV);
+    for (int r = 0; r < k; r++) {
+        int a = J[r], ia = tr->dof_a[a], ib = tr->dof_b[a];
+        tr->hG[r] = free_rel_acc(tr, ib, f) - free_rel_acc(tr, ia, f);
+        for (int c = 0; c < k; c++) { /* W_a = -e_ia + e_ib */
+            int b = J[c], ja = tr->dof_a[b], jb = tr->dof_b[b];
+            double d = 0.0;
+            if (ia >= 0)
+                d += ((ia == ja) - (ia == jb)) / tr->mass[ia];
+            if (ib >= 0)
+                d += ((ib == jb) - (ib == ja)) / tr->mass[ib];
+            tr->hD[r + (size_t)c * k] = d;
+        }
+    }
+    pd_matrix D = pd_matrix_dense(k, k, tr->hD);
+    if (pd_lcp_solve(tr->hlcp, &D, tr->hG, NULL, tr->hz, tr->hw, NULL) == PD_OK)
+        for (int r = 0; r < k; r++)
+            tr->hlam[J[r]] = tr->hz[r];
     held_from_forces(tr, tr->hlam);
 }
 
@@ -892,6 +913,10 @@ static int run_moreau(const pd_model *md, const pd_run_opts *o, long nsteps, tra
                       pd_scene_result *res, pd_err *err)
 {
     pd_mj_opts mo = pd_run_mj_opts(o, tr->h);
+    if (tr->demands && md->m > 0 && !tr->hlcp &&
+        !(tr->hlcp = pd_lcp_solver_alloc(PD_LCP_LEMKE, md->m < MJ_HELD_LCP ? md->m : MJ_HELD_LCP,
+                                         0, err)))
+        return err ? err->status : PD_ENOMEM;
     pd_mj *mj = pd_mj_alloc(md, &mo, err);
     if (!mj)
         return err ? err->status : PD_ENOMEM;

@@ -187,8 +187,9 @@ static void test_aabs_three_structures(pd_test_ctx *ctx)
 
 /* Fixed-step Moreau–Jean's held part on a row where impacts and holds
  * alternate (examples/scenes/three-sdof.json): against the reference,
- * within 1 % at dt 1e-5, and bounded at the default dt (an impact's
- * impulses taken for a hold gave 2.8 times the reference's S2). */
+ * within 1 % at dt 1e-5 and 2 % at the default dt (its O(dt) error at the
+ * impacts: 0.5 % measured; P / h of merged impulses gave 2.8 times the
+ * reference's S2). */
 static void test_aabs_moreau_cascade(pd_test_ctx *ctx)
 {
     pd_scene *sc = NULL;
@@ -211,8 +212,7 @@ static void test_aabs_moreau_cascade(pd_test_ctx *ctx)
             if (!CHECK(ctx, pd_scene_run(sc, &o, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg))
                 continue;
             for (int i = 0; i < r.n; i++)
-                CHECK(ctx, k == 0 ? fabs(r.acc_max[i] - ref.acc_max[i]) <= 0.01 * ref.acc_max[i]
-                                  : r.acc_max[i] <= 2.0 * ref.acc_max[i],
+                CHECK(ctx, fabs(r.acc_max[i] - ref.acc_max[i]) <= (k ? 0.02 : 0.01) * ref.acc_max[i],
                       "dt %g: a_abs %d = %.6g, reference %.6g", r.dt, i, r.acc_max[i],
                       ref.acc_max[i]);
         }
