@@ -59,7 +59,8 @@ typedef struct track {
                                            a_abs [SI] now and at the previous demand state */
     double *hlam;                       /* m: Moreau-Jean: the held force P / h of the last
                                            step without an impact (reference units) */
-    double *hsm;                        /* n: Moreau-Jean: the smooth a_abs of the step [SI] */
+    double *hsm;                        /* n: Moreau-Jean: the smooth a_abs of the step [SI]
+                                           (the holds' structures' entries) */
     int *hJ;                            /* m: Moreau-Jean: the candidate holds */
     double *hG, *hz, *hw, *hD;          /* their LCP: q (MJ_HELD_LCP), z, w, D (^2) */
     pd_lcp_solver *hlcp;
@@ -592,7 +593,15 @@ static void moreau_held(track *tr, const pd_state *st)
         held_from_forces(tr, NULL);
         return;
     }
-    pd_demand_eval(tr->sc, st->q, st->v, tr->Le, tr->Le * tr->wp, tr->hsm, tr->dV);
+    /* the smooth a_abs of the holds' structures only (note_demand takes the
+     * whole scene's): O(their storeys) per step with holds */
+    for (int r = 0; r < k; r++)
+        for (int side = 0; side < 2; side++) {
+            int i = side ? tr->dof_b[J[r]] : tr->dof_a[J[r]];
+            if (i >= 0)
+                pd_demand_eval_structure(&tr->sc->st[tr->st_of[i]], st->q, st->v, tr->Le,
+                                         tr->Le * tr->wp, tr->hsm, tr->dV);
+        }
     for (int r = 0; r < k; r++) {
         int a = J[r], ia = tr->dof_a[a], ib = tr->dof_b[a];
         tr->hG[r] = free_rel_acc(tr, ib, f) - free_rel_acc(tr, ia, f);

@@ -217,23 +217,29 @@ static void test_harden_method_flags(pd_test_ctx *ctx)
     }
 }
 
-/* Ten SDOFs (T0 1 s) between two walls, every gap g, eps 0.7, a sine pulse. */
-static pd_scene *walled_row(pd_test_ctx *ctx, double g)
+/* A row of n SDOFs (T0, xi, mass) between walls when walls (n + 1 contacts
+ * of gap, eps), or free at both ends (n - 1 contacts), under a pulse. */
+static pd_scene *row_of(pd_test_ctx *ctx, int n, const double *T0, const double *xi,
+                        const double *mass, const double *gap, const double *eps, int walls,
+                        pd_pulse pulse, double ap, double Tp, double tend)
 {
-    pd_scene_excitation exc = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 3.0, .Tp = 1.0};
+    pd_scene_excitation exc = {.pulse = pulse, .dir = 1, .ap = ap, .Tp = Tp};
     pd_scene *sc = pd_scene_new(&exc);
     pd_err e;
-    int rc = sc ? PD_OK : PD_ENOMEM;
+    int rc = sc ? PD_OK : PD_ENOMEM, k = 0;
     char name[16];
-    for (int i = 0; i < 10 && !rc; i++) {
+    for (int i = 0; i < n && !rc; i++) {
         snprintf(name, sizeof name, "S%d", i);
-        rc = pd_scene_add_sdof(sc, name, 1.0, 0.05, 1e5, &e);
+        rc = pd_scene_add_sdof(sc, name, T0[i], xi[i], mass[i], &e);
     }
-    for (int i = 0; i <= 10 && !rc; i++)
-        rc = pd_scene_add_contact(sc, i ? i - 1 : PD_WALL, i ? 1 : 0, i < 10 ? i : PD_WALL,
-                                  i < 10 ? 1 : 0, g, 0.7, i, &e);
+    if (walls && !rc)
+        rc = pd_scene_add_contact(sc, PD_WALL, 0, 0, 1, gap[k], eps[k], k, &e), k++;
+    for (int i = 0; i + 1 < n && !rc; i++, k++)
+        rc = pd_scene_add_contact(sc, i, 1, i + 1, 1, gap[k], eps[k], k, &e);
+    if (walls && !rc)
+        rc = pd_scene_add_contact(sc, n - 1, 1, PD_WALL, 0, gap[k], eps[k], k, &e);
     if (!rc)
-        sc->tend = 3.0;
+        sc->tend = tend;
     if (!CHECK(ctx, !rc && !pd_scene_finish(sc, &e), "scene: %s", sc ? e.msg : "no memory")) {
         pd_scene_free(sc);
         return NULL;
@@ -252,8 +258,17 @@ static void test_harden_gaps_within_tolerance(pd_test_ctx *ctx)
     const double gaps[] = {0.0, 1e-300, 5e-324, 1e-12};
     pd_scene_result r0, r;
     pd_err e;
+    /* ten SDOFs (T0 1 s) between two walls, every gap g, eps 0.7, a sine pulse */
+    double T0[10], xi[10], mass[10], g[11], eps[11];
+    for (int i = 0; i < 11; i++) {
+        if (i < 10)
+            T0[i] = 1.0, xi[i] = 0.05, mass[i] = 1e5;
+        eps[i] = 0.7;
+    }
     for (int k = 0; k < 4; k++) {
-        pd_scene *sc = walled_row(ctx, gaps[k]);
+        for (int i = 0; i < 11; i++)
+            g[i] = gaps[k];
+        pd_scene *sc = row_of(ctx, 10, T0, xi, mass, g, eps, 1, PD_PULSE_SINE, 3.0, 1.0, 3.0);
         if (!sc || !CHECK(ctx, !pd_scene_result_alloc(sc, &r, &e), "%s", e.msg)) {
             pd_scene_free(sc);
             continue;
@@ -354,36 +369,6 @@ static void test_harden_memory_limit(pd_test_ctx *ctx)
     pd_test_rm_dir(dir);
 }
 
-/* A row of n SDOFs (T0, xi, mass) between walls when walls (n + 1 contacts
- * of gap, eps), or free at both ends (n - 1 contacts), under a cosine pulse. */
-static pd_scene *row_of(pd_test_ctx *ctx, int n, const double *T0, const double *xi,
-                        const double *mass, const double *gap, const double *eps, int walls,
-                        double ap, double Tp, double tend)
-{
-    pd_scene_excitation exc = {.pulse = PD_PULSE_COSINE, .dir = 1, .ap = ap, .Tp = Tp};
-    pd_scene *sc = pd_scene_new(&exc);
-    pd_err e;
-    int rc = sc ? PD_OK : PD_ENOMEM, k = 0;
-    char name[16];
-    for (int i = 0; i < n && !rc; i++) {
-        snprintf(name, sizeof name, "S%d", i);
-        rc = pd_scene_add_sdof(sc, name, T0[i], xi[i], mass[i], &e);
-    }
-    if (walls && !rc)
-        rc = pd_scene_add_contact(sc, PD_WALL, 0, 0, 1, gap[k], eps[k], k, &e), k++;
-    for (int i = 0; i + 1 < n && !rc; i++, k++)
-        rc = pd_scene_add_contact(sc, i, 1, i + 1, 1, gap[k], eps[k], k, &e);
-    if (walls && !rc)
-        rc = pd_scene_add_contact(sc, n - 1, 1, PD_WALL, 0, gap[k], eps[k], k, &e);
-    if (!rc)
-        sc->tend = tend;
-    if (!CHECK(ctx, !rc && !pd_scene_finish(sc, &e), "scene: %s", sc ? e.msg : "no memory")) {
-        pd_scene_free(sc);
-        return NULL;
-    }
-    return sc;
-}
-
 /* Defect 2 (generated rows): two SDOFs touching at rest at t = 0 under a
  * cosine pulse (one ground acceleration: zero gap rate and acceleration,
  * a closing jerk) are held from the start, not bounced at t ~ 1e-67 s
@@ -394,7 +379,7 @@ static void test_harden_touching_at_rest_and_chatter(pd_test_ctx *ctx)
 {
     const double T0[] = {0.287, 0.112}, xi[] = {0.02, 0.05}, mass[] = {62780.4, 9470914.4};
     const double gap[] = {0.0}, eps[] = {0.869};
-    pd_scene *sc = row_of(ctx, 2, T0, xi, mass, gap, eps, 0, 7.22, 0.24, 0.5);
+    pd_scene *sc = row_of(ctx, 2, T0, xi, mass, gap, eps, 0, PD_PULSE_COSINE, 7.22, 0.24, 0.5);
     pd_scene_result r, m;
     pd_err e;
     if (sc && CHECK(ctx, !pd_scene_result_alloc(sc, &r, &e) && !pd_scene_result_alloc(sc, &m, &e),
@@ -428,7 +413,7 @@ static void test_harden_touching_at_rest_and_chatter(pd_test_ctx *ctx)
     static const double e19[] = {0.198, 0.385, 0.034, 0.766, 0.454, 0.869, 0.712, 0.855, 0.664,
                                  0.913, 0.304, 0.052, 0.087, 0.078, 0.704, 0.311, 0.36, 0.592,
                                  0.424};
-    sc = row_of(ctx, 18, T18, xi18, m18, g19, e19, 1, 7.22, 0.24, 2.0);
+    sc = row_of(ctx, 18, T18, xi18, m18, g19, e19, 1, PD_PULSE_COSINE, 7.22, 0.24, 2.0);
     if (sc && CHECK(ctx, !pd_scene_result_alloc(sc, &r, &e), "%s", e.msg)) {
         pd_run_opts o = pd_run_default_opts();
         o.method = PD_METHOD_EVENT;
