@@ -19,12 +19,15 @@
 #include "pd_null.h"
 
 /* A dense active LCP is refined when its D P cancels terms this many times
- * larger than b (half the digits lost), until its Newton residual, formed
- * through the factor, is within MJ_REFINE_TOL roundings (DBL_EPSILON) of
- * its terms, in at most MJ_REFINE_MAX steps. */
+ * larger than b (half the digits lost), until the Newton residual of its
+ * velocities, formed through the factor, is within MJ_REFINE_TOL roundings
+ * (DBL_EPSILON) of its terms (1e-12 relative: the basis vectors' rounding
+ * times the light dofs' What^-1 leaves tens), in at most MJ_REFINE_MAX
+ * steps. */
 #define MJ_REFINE_GROWTH 1e8
-#define MJ_REFINE_TOL 64.0
+#define MJ_REFINE_TOL 4096.0
 #define MJ_REFINE_MAX 8
+#define MJ_REFINE_NMAX 64 /* pushing contacts a refinement takes (2 n of memory each) */
 
 pd_mj_opts pd_mj_default_opts(void)
 {
@@ -71,8 +74,8 @@ void pd_mj_free(pd_mj *mj)
     free(mj->P_active);
     free(mj->w_active);
     free(mj->idx_active);
-    free(mj->ref_lu);
-    free(mj->ref_buf);
+    free(mj->ref_R);
+    free(mj->ref_res);
     free(mj->ref_perm);
     free(mj->guess);
     free(mj->st_own.q);
@@ -170,11 +173,17 @@ static int contact_workspace(pd_mj *mj, pd_err *err)
         mj->D_rowind = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof(int));
     } else {
         mj->D_active = malloc((size_t)m * (size_t)m * sizeof(double));
-        mj->ref_lu = malloc((size_t)m * (size_t)m * sizeof(double));
-        mj->ref_buf = malloc((4 * (size_t)m + 2 * (size_t)mj->model->n) * sizeof(double));
-        mj->ref_perm = malloc(2 * (size_t)m * sizeof(int));
-        if (!mj->ref_lu || !mj->ref_buf || !mj->ref_perm)
+        size_t n = (size_t)mj->model->n, cap = (size_t)(m < MJ_REFINE_NMAX ? m : MJ_REFINE_NMAX);
+        mj->ref_nmax = (int)cap;
+        mj->ref_R = malloc((cap * cap + 2 * cap * n + 2 * cap) * sizeof(double));
+        mj->ref_res = malloc((2 * (size_t)m + 2 * n) * sizeof(double));
+        mj->ref_perm = malloc(((size_t)m + cap) * sizeof(int));
+        if (!mj->ref_R || !mj->ref_res || !mj->ref_perm)
             return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for the Delassus block");
+        mj->ref_C = mj->ref_R + cap * cap;
+        mj->ref_SC = mj->ref_C + cap * n;
+        mj->ref_z = mj->ref_SC + cap * n;
+        mj->ref_y = mj->ref_res + 2 * (size_t)m;
     }
     if (!mj->D_active || (mj->sparse && (!mj->D_colptr || !mj->D_rowind)))
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for the Delassus block");
@@ -433,44 +442,134 @@ void mj_active_rhs(pd_mj *mj, int nI, const double *vfree)
     }
 }
 
-/* r = b_I + W_I^T y, y = What^-1 x, x = W_I P (ref_buf + 4 m, + 4 m + n:
- * D_II never used), and the work of r, P^T r = P^T b + x^T y, into *work
- * with the sum of the magnitudes of its terms into *scale. */
-static void active_residual(const pd_mj *mj, const pd_factor *f, int nI, const double *P,
-                            double *res, double *work, double *scale)
+/* r_I = b_I + W_I^T y, the Newton residual of v = vfree + y, and the worst
+ * pushing contact's |r_a| over the rounding of its terms, eps (|W_a|^T
+ * (|vfree| + |y|) + |b_a|), returned. */
+static double velocity_residual(const pd_mj *mj, int nI, const int *ax, int na,
+                                const double *vfree, const double *y, double *res)
+{
+    const pd_matrix *W = &mj->model->W;
+    double worst = 0.0;
+    for (int r = 0; r < nI; r++)
+        res[r] = mj->b_active[r] + pd_matrix_col_dot(W, mj->idx_active[r], y);
+    for (int i = 0; i < na; i++) {
+        int r = ax[i], a = mj->idx_active[r];
+        double sc = pd_matrix_col_absdot(W, a, vfree) + pd_matrix_col_absdot(W, a, y) +
+                    fabs(mj->b_active[r]);
+        worst = fmax(worst, fabs(res[r]) / (DBL_EPSILON * fmax(sc, DBL_MIN)));
+    }
+    return worst;
+}
+
+/* x^T y over n entries. */
+static double dot_n(int n, const double *x, const double *y)
+{
+    double s = 0.0;
+    for (int i = 0; i < n; i++)
+        s += x[i] * y[i];
+    return s;
+}
+
+/* What^-1-orthonormal basis of the pushing contacts' columns, pivoted
+ * Gram-Schmidt on the vectors (not on D's entries, which hold the heavy
+ * dofs' What^-1 only to eps cond(D)):  W_A Pi = Q R,  Q^T What^-1 Q = I,
+ * R upper triangular (ref_R, column j for pivot j), Q and What^-1 Q in
+ * ref_C and ref_SC.  Returns the rank reached (< na: dependent columns). */
+static int orthogonalise_pushing(pd_mj *mj, const pd_factor *f, const int *ax, int na)
 {
     const pd_model *md = mj->model;
-    double *y = mj->ref_buf + 4 * (size_t)md->m, *x = y + md->n, sum = 0.0, sc = 0.0;
-    memset(x, 0, (size_t)md->n * sizeof(double));
-    for (int r = 0; r < nI; r++)
-        pd_matrix_col_axpy(&md->W, mj->idx_active[r], P[r], x);
-    memcpy(y, x, (size_t)md->n * sizeof(double));
-    pd_factor_solve(f, y);
-    for (int r = 0; r < nI; r++) {
-        res[r] = mj->b_active[r] + pd_matrix_col_dot(&md->W, mj->idx_active[r], y);
-        sum += P[r] * mj->b_active[r];
-        sc += fabs(P[r] * mj->b_active[r]);
+    int n = md->n, *piv = mj->ref_perm + md->m;
+    double *C = mj->ref_C, *SC = mj->ref_SC, *R = mj->ref_R;
+    for (int j = 0; j < na; j++) {
+        double *c = C + (size_t)j * n;
+        memset(c, 0, (size_t)n * sizeof(double));
+        pd_matrix_col_axpy(&md->W, mj->idx_active[ax[j]], 1.0, c);
+        memcpy(SC + (size_t)j * n, c, (size_t)n * sizeof(double));
+        pd_factor_solve(f, SC + (size_t)j * n);
+        piv[j] = j;
     }
-    for (int i = 0; i < md->n; i++) {
-        sum += x[i] * y[i];
-        sc += fabs(x[i] * y[i]);
+    memset(R, 0, (size_t)na * (size_t)na * sizeof(double));
+    for (int k = 0; k < na; k++) {
+        /* pivot: the remaining column of largest What^-1 norm */
+        int best = k;
+        double nb = -1.0;
+        for (int i = k; i < na; i++) {
+            double nrm = dot_n(n, C + (size_t)piv[i] * n, SC + (size_t)piv[i] * n);
+            if (nrm > nb) {
+                nb = nrm;
+                best = i;
+            }
+        }
+        if (!(nb > 0.0))
+            return k;
+        int p = piv[best];
+        piv[best] = piv[k];
+        piv[k] = p;
+        double d = sqrt(nb), *q = C + (size_t)p * n, *sq = SC + (size_t)p * n;
+        R[k + (size_t)p * na] = d;
+        for (int i = 0; i < n; i++) {
+            q[i] /= d;
+            sq[i] /= d;
+        }
+        /* the remaining columns lose their q_k part, twice (the first
+         * pass leaves eps |c| along q_k, which the light dofs' What^-1
+         * would magnify) */
+        for (int i = k + 1; i < na; i++) {
+            double *c = C + (size_t)piv[i] * n, *sc = SC + (size_t)piv[i] * n;
+            for (int pass = 0; pass < 2; pass++) {
+                double rho = dot_n(n, c, sq);
+                R[k + (size_t)piv[i] * na] += rho;
+                for (int l = 0; l < n; l++) {
+                    c[l] -= rho * q[l];
+                    sc[l] -= rho * sq[l];
+                }
+            }
+        }
     }
-    *work = sum;
-    *scale = sc;
+    return na;
+}
+
+/* One correction of y toward W_A^T (vfree + y) + e U_A = 0 on the pushing
+ * contacts:  R^T z = -r_A (forward, pivoted order),  y += What^-1 Q z,
+ * the impulses P_A += R^-1 z (backward). */
+static void correct_pushing(pd_mj *mj, const int *ax, int na, const double *res, double *y)
+{
+    int n = mj->model->n, *piv = mj->ref_perm + mj->model->m;
+    double *R = mj->ref_R, *z = mj->ref_z, *G = z + na;
+    for (int i = 0; i < na; i++) {
+        double s = -res[ax[piv[i]]];
+        for (int k = 0; k < i; k++)
+            s -= R[k + (size_t)piv[i] * na] * z[k];
+        z[i] = s / R[i + (size_t)piv[i] * na];
+        const double *sq = mj->ref_SC + (size_t)piv[i] * n;
+        for (int l = 0; l < n; l++)
+            y[l] += z[i] * sq[l];
+    }
+    for (int i = na - 1; i >= 0; i--) {
+        double s = z[i];
+        for (int j = i + 1; j < na; j++)
+            s -= R[i + (size_t)piv[j] * na] * G[j];
+        G[i] = s / R[i + (size_t)piv[i] * na];
+        mj->P_active[ax[piv[i]]] += G[i];
+    }
 }
 
 /* Refinement of a dense active LCP whose D P cancels terms 1/sqrt(eps)
  * larger than b (a heavy dof's What^-1 lost in D_II's entries under a
- * light one's; D of condition up to 1e13): the impulses' work beyond
- * Newton's law, P^T (D P + b), formed through the factor, must be within
- * MJ_REFINE_TOL roundings of its terms; else P_A -= D_AA^-1 r_A on the
- * pushing contacts A = {P > 0} while that work shrinks.  Sets
- * mj->refined; PD_ENUMERICAL when it stays beyond. */
-static int refine_active(pd_mj *mj, const pd_factor *f, int nI, double t1, pd_err *err)
+ * light one's; D of condition up to 1e13).  The velocity of the impulses,
+ * y = What^-1 W_I P, is what the step needs, and it cannot come through P
+ * (a light body squeezed between a heavy one and a wall takes two nearly
+ * equal impulses whose difference is below their rounding): y is corrected
+ * on an orthonormal basis of the pushing contacts A = {P > 0}, each step
+ * solving for r_A -> 0 with R of condition sqrt(cond D), while the worst
+ * |r_a| shrinks and stays beyond MJ_REFINE_TOL roundings of its terms.
+ * Sets mj->refined (y in mj->ref_y); PD_ENUMERICAL when it stays beyond. */
+static int refine_active(pd_mj *mj, const pd_factor *f, int nI, const double *vfree, double t1,
+                         pd_err *err)
 {
-    int m = mj->model->m, na = 0, *ax = mj->ref_perm + m;
-    double *P = mj->P_active, *D = mj->D_active, grow = 0.0, work, scale;
-    double *res = mj->ref_buf, *zt = res + m, *dz = zt + m;
+    int n = mj->model->n, na = 0, *ax = mj->ref_perm;
+    double *P = mj->P_active, *D = mj->D_active, grow = 0.0;
+    double *res = mj->ref_res, *rt = res + mj->model->m, *y = mj->ref_y, *yt = y + n;
     mj->refined = 0;
     for (int r = 0; r < nI; r++) {
         double s = 0.0;
@@ -480,41 +579,37 @@ static int refine_active(pd_mj *mj, const pd_factor *f, int nI, double t1, pd_er
             ax[na++] = r;
         grow = fmax(grow, s / fmax(fabs(mj->b_active[r]), DBL_MIN));
     }
-    if (na < 2 || !(grow > MJ_REFINE_GROWTH))
+    if (na < 2 || na > mj->ref_nmax || !(grow > MJ_REFINE_GROWTH))
         return PD_OK;
-    active_residual(mj, f, nI, P, res, &work, &scale);
-    if (fabs(work) <= MJ_REFINE_TOL * DBL_EPSILON * scale)
+    memset(yt, 0, (size_t)n * sizeof(double));
+    for (int r = 0; r < nI; r++)
+        pd_matrix_col_axpy(&mj->model->W, mj->idx_active[r], P[r], yt);
+    memcpy(y, yt, (size_t)n * sizeof(double));
+    pd_factor_solve(f, y);
+    double worst = velocity_residual(mj, nI, ax, na, vfree, y, res);
+    if (worst <= MJ_REFINE_TOL)
         return PD_OK;
-    for (int i = 0; i < na; i++)
-        for (int j = 0; j < na; j++)
-            mj->ref_lu[i + (size_t)j * na] = D[ax[i] + (size_t)ax[j] * nI];
-    int rc = pd_dense_lu(na, mj->ref_lu, na, mj->ref_perm, DBL_EPSILON);
-    for (int it = 0; it < MJ_REFINE_MAX && !rc && fabs(work) > MJ_REFINE_TOL * DBL_EPSILON * scale;
-         it++) {
-        double wt, st;
-        for (int i = 0; i < na; i++)
-            dz[i] = -res[ax[i]];
-        pd_dense_lu_solve(na, mj->ref_lu, na, mj->ref_perm, dz);
-        int ok = 1;
-        memcpy(zt, P, (size_t)nI * sizeof(double));
-        for (int i = 0; i < na; i++)
-            ok &= (zt[ax[i]] += dz[i]) > 0.0;
-        if (!ok)
-            break; /* the pushing set would change */
-        active_residual(mj, f, nI, zt, res, &wt, &st);
-        if (!(fabs(wt) < fabs(work)))
-            break;
-        memcpy(P, zt, (size_t)nI * sizeof(double));
-        work = wt;
-        scale = st;
-        mj->refined = 1;
+    mj->refined = 1; /* y is kept even when no correction improves it */
+    memcpy(yt, y, (size_t)n * sizeof(double)); /* the iterate; y the best */
+    int full = orthogonalise_pushing(mj, f, ax, na) == na;
+    /* not monotone: a first correction can carry the basis vectors'
+     * rounding times a large z into a light dof; the next removes it */
+    double wt = worst;
+    for (int it = 0; it < MJ_REFINE_MAX && full && worst > MJ_REFINE_TOL; it++) {
+        correct_pushing(mj, ax, na, it ? rt : res, yt);
+        wt = velocity_residual(mj, nI, ax, na, vfree, yt, rt);
+        if (wt < worst) {
+            memcpy(y, yt, (size_t)n * sizeof(double));
+            memcpy(res, rt, (size_t)nI * sizeof(double));
+            worst = wt;
+        }
     }
-    if (fabs(work) > MJ_REFINE_TOL * DBL_EPSILON * scale)
+    for (int i = 0; i < na; i++)
+        P[ax[i]] = fmax(P[ax[i]], 0.0); /* P is reported; y carries the step */
+    if (worst > MJ_REFINE_TOL)
         return pd_err_set(err, PD_ENUMERICAL, "Moreau-Jean: the LCP of %d active contacts at t = "
-                          "%.9g lost precision: its impulses do %.3g of work beyond Newton's law "
-                          "(rounding %.3g)", nI, t1, work, MJ_REFINE_TOL * DBL_EPSILON * scale);
-    if (mj->refined)
-        active_residual(mj, f, nI, P, res, &work, &scale); /* y of the impulses kept */
+                          "%.9g lost precision: its velocities miss Newton's law by %.3g roundings "
+                          "of their terms (at most %g)", nI, t1, worst, MJ_REFINE_TOL);
     return PD_OK;
 }
 
@@ -533,7 +628,7 @@ static int solve_contacts(pd_mj *mj, const pd_factor *f, int nI, const double *v
     mj_active_rhs(mj, nI, vfree);
     if ((rc = mj_solve_active(mj, nI, t1, out, err)) || mj->sparse || nI < 2)
         return rc;
-    if ((rc = refine_active(mj, f, nI, t1, err)))
+    if ((rc = refine_active(mj, f, nI, vfree, t1, err)))
         return rc;
     for (int r = 0; r < nI; r++)
         out->P[mj->idx_active[r]] = mj->P_active[r];
@@ -572,9 +667,9 @@ int mj_general_step(pd_mj *mj, const pd_factor *f, double h, double t1, const do
     if (nI > 0) {
         if ((rc = solve_contacts(mj, f, nI, out->v, t1, out, err)))
             return rc;
-        if (mj->refined) /* What^-1 W_I P formed whole, as the residual */
+        if (mj->refined) /* the impulses' velocity corrected on the pushing contacts */
             for (int i = 0; i < n; i++)
-                out->v[i] += mj->ref_buf[4 * (size_t)md->m + i];
+                out->v[i] += mj->ref_y[i];
         else
             pd_factor_add_impulse(f, mj->idx_active, nI, mj->P_active, out->v);
     }

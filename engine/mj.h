@@ -84,10 +84,17 @@ struct pd_mj {
     double *P_active;     /* m: impulses of the active set */
     double *w_active;     /* m: post-impact relative velocities of the active set */
     int *idx_active;      /* m: indices of the active contacts */
-    double *ref_lu;       /* dense Delassus only, m^2: D_AA's LU for the refinement */
-    double *ref_buf;      /* 4 m + 2 n: its residual, trial, step, What^-1 W_I P, W_I P */
-    int *ref_perm;        /* 2 m: its rows, the pushing contacts */
-    int refined;          /* 1: the last LCP was refined (v from ref_buf's What^-1 W_I P) */
+    /* the refinement of a dense active LCP (dense Delassus only), for up to
+     * ref_nmax pushing contacts: */
+    int ref_nmax;         /* min(m, MJ_REFINE_NMAX) */
+    double *ref_R;        /* ref_nmax^2: R of W_A = Q R; owns ref_C, ref_SC, ref_z */
+    double *ref_C;        /* n ref_nmax: Q */
+    double *ref_SC;       /* n ref_nmax: What^-1 Q */
+    double *ref_z;        /* 2 ref_nmax: a correction's z and R^-1 z */
+    double *ref_res;      /* 2 m: residual, trial residual; owns ref_y */
+    double *ref_y;        /* 2 n: What^-1 W_I P, its trial */
+    int *ref_perm;        /* m + ref_nmax: the pushing contacts, the pivot order */
+    int refined;          /* 1: the last LCP was refined (v = vfree + ref_y) */
     mj1_coef s1;          /* scalar kernel constants (no division in a step) */
     pd_state st;          /* the state the caller reads (pd_mj_state) */
     pd_state st_own;      /* the arrays mj->st was allocated with (the adaptive driver

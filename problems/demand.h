@@ -64,6 +64,24 @@ static inline void pd_demand_osc_note_state(pd_demand_osc *d, double tau, double
     }
 }
 
+/* The one-wall oscillator's held force [Pi units] after a Moreau-Jean
+ * step of length h ending at (x, v) under the excitation f: a contact with
+ * impulses in this step and the one before (P, Pprev), at rest after both
+ * (|v|, |vprev| within PD_OSC_HELD_RATE steps' worth of the excitation's
+ * unit amplitude), pushes with what holding it takes, max(0, f - C v - K x);
+ * 0 otherwise.  Not P / h: theta = 1/2 alternates a hold's impulses (one
+ * step's P / h is up to twice the force), and a bounce's impulses are no
+ * force at all. */
+#define PD_OSC_HELD_RATE 4.0
+static inline double pd_demand_osc_held(const pd_demand_osc *d, double h, double P, double Pprev,
+                                        double v, double vprev, double x, double f)
+{
+    if (!(P > 0.0 && Pprev > 0.0) || fabs(v) > PD_OSC_HELD_RATE * h ||
+        fabs(vprev) > PD_OSC_HELD_RATE * h)
+        return 0.0;
+    return pd_max(0.0, f - d->C * v - d->K * x);
+}
+
 /* The oscillator's demands into res: acc_max, shear_max and force_max [per unit mass],
  * the td of o and the equivalent force of res->max_impulse. */
 /* PD_EINVAL when a derived demand overflows while its source does not: the

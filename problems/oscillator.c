@@ -242,7 +242,8 @@ double pd_osc_measure_start(const pd_osc *c, double tend)
 /* The observer's context: the measurements and the sampler. */
 typedef struct tracker {
     pd_osc_track m;
-    double Pprev;         /* the previous step's impulse (a held contact: two in a row) */
+    double Pprev, vprev;  /* the previous step's impulse and rate (a held contact) */
+    const pd_osc *c;      /* its excitation (the held force) */
     long sampled;         /* impacts reported to the sampler */
     double Le, vscale, wp;
     pd_demand_osc dem;    /* the absolute acceleration's peak (Pi units) */
@@ -328,10 +329,13 @@ static int observe(const pd_state *st, void *ctx)
     tracker *tr = ctx;
     double x = st->q[0], v = st->v[0], P = st->P[0];
     pd_osc_track_step(&tr->m, st->step, st->t, x, v, P);
-    if (tr->demands) /* the steps' own, as umax; a held contact's force P / h */
+    if (tr->demands) /* the steps' own, as umax, with a held contact's force */
         pd_demand_osc_note(&tr->dem, st->t, x, v, NULL,
-                           P > 0.0 && tr->Pprev > 0.0 ? P / st->h : 0.0, 0);
+                           pd_demand_osc_held(&tr->dem, st->h, P, tr->Pprev, v, tr->vprev, x,
+                                              pd_osc_shape(tr->c, st->t, -1)),
+                           0);
     tr->Pprev = P;
+    tr->vprev = v;
     if (tr->sampler) {
         pd_osc_sample smp = pd_osc_track_sample(&tr->m, &tr->sampled, st->step, st->t, x, v, P,
                                                 tr->wp, tr->Le, tr->vscale);
@@ -368,7 +372,8 @@ static int simulate_scalar(const pd_osc *c, const pd_model *md, const pd_mj_opts
     int next = 0;
     while (next < md->nbreaks && md->breaks[next] < t0 - tol)
         next++;
-    double q = 0.0, v = 0.0, P = 0.0, Pprev = 0.0, g = s1.g0 + s1.w * q, F[OSC_FORCE_AHEAD];
+    double q = 0.0, v = 0.0, P = 0.0, Pprev = 0.0, vprev = 0.0, g = s1.g0 + s1.w * q;
+    double F[OSC_FORCE_AHEAD];
     double F0 = osc_force(c, t0, +1);
     long k = 0;
     pd_osc_track_step(tr, 0, t0, q, v, P);
@@ -392,9 +397,11 @@ static int simulate_scalar(const pd_osc *c, const pd_model *md, const pd_mj_opts
                               k + 1, 0);
         }
         pd_osc_track_step(tr, k + 1, t1, q, v, P);
-        if (dem) /* a held contact (impulses in two steps in a row): its force P / h */
-            pd_demand_osc_note_state(dem, t1, q, v, P > 0.0 && Pprev > 0.0 ? P / h : 0.0);
+        if (dem) /* with a held contact's force */
+            pd_demand_osc_note_state(dem, t1, q, v,
+                                     pd_demand_osc_held(dem, h, P, Pprev, v, vprev, q, F1));
         Pprev = P;
+        vprev = v;
     }
     *steps = k;
     return PD_OK;
@@ -422,7 +429,7 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
 
     double cpu0 = pd_cpu_seconds();
     double wp = pd_osc_wp(c), Le = pd_osc_Le(c);
-    tracker tr = {.Le = Le, .vscale = Le * wp, .wp = wp, .demands = !o.no_demands,
+    tracker tr = {.Le = Le, .vscale = Le * wp, .wp = wp, .demands = !o.no_demands, .c = c,
                   .sampler = sampler, .sampler_ctx = ctx};
     pd_osc_track_init(&tr.m, c, mo.h, wp * pd_osc_measure_start(c, o.tend));
     tr.dem = (pd_demand_osc){.C = k.C, .K = k.K, .tau_measure = tr.m.tau_measure - 0.5 * mo.h};
@@ -466,6 +473,7 @@ typedef struct ref_bridge {
     pd_demand_osc dem;    /* the absolute acceleration's peak (Pi units) */
     long impacts, impacts_prev; /* impacts seen, and by the previous sample */
     int rest_prev;        /* the previous sample was resting on the wall */
+    double tprev, fprev, fdprev; /* its time, excitation and excitation's rate */
     long step;
     const pd_ed_result *er; /* the run's impacts and impulse so far */
     long reported;          /* impacts and impulse reported to the sampler */
@@ -480,9 +488,18 @@ static int ref_sample(double tau, double x, double v, int in_contact, void *ctx)
     /* free flight: x'' = f - C x' - K x; at rest on the wall x'' = 0 and the
      * held force is f - C x' - K x (a_abs = a_g); the interval since the
      * previous sample is smooth when it held no impact and no rest */
-    double a = pd_osc_shape(b->c, tau, -1) - b->dem.C * v - b->dem.K * x;
+    double f = pd_osc_shape(b->c, tau, -1), fd = pd_osc_shape_rate(b->c, tau, -1);
+    double a = f - b->dem.C * v - b->dem.K * x;
     int smooth = !in_contact && !b->rest_prev && b->impacts == b->impacts_prev;
     pd_demand_osc_note(&b->dem, tau, x, v, in_contact ? NULL : &a, in_contact ? a : 0.0, smooth);
+    /* at rest from the previous sample on, a_abs = |f|: its peak between
+     * them on the cubic Hermite of (f, f') */
+    if (in_contact && b->rest_prev && tau > b->tprev && b->tprev >= b->dem.tau_measure)
+        b->dem.peak = pd_max(b->dem.peak, pd_demand_cubic_peak(b->fprev, b->fdprev, f, fd,
+                                                               tau - b->tprev));
+    b->tprev = tau;
+    b->fprev = f;
+    b->fdprev = fd;
     b->impacts_prev = b->impacts;
     b->rest_prev = in_contact;
     if (!b->sampler) {

@@ -19,20 +19,14 @@
 /* The largest |2 xi w0 u' + w0^2 u| over the samples (SI). */
 typedef struct osc_peak {
     double C, K, peak;
-    double dt, Pprev, apeak; /* a_abs's peak: a held contact's impulse over its step in it */
 } osc_peak;
 
-/* Per step: the peak of |C v + K u| (the shear per unit mass), and of a_abs
- * = -(C v + K u + lambda), lambda the wall's held force, the impulse over dt
- * of a step with an impulse after one with an impulse. */
+/* Per step: the peak of |C v + K u| (the shear per unit mass). */
 static int osc_peak_sample(const pd_osc_sample *s, void *ctx)
 {
     osc_peak *p = ctx;
     double f = p->C * s->v + p->K * s->u;
-    double lam = s->impulse > 0.0 && p->Pprev > 0.0 ? s->impulse / p->dt : 0.0;
     p->peak = fmax(p->peak, fabs(f));
-    p->apeak = fmax(p->apeak, fabs(f + lam));
-    p->Pprev = s->impulse;
     return 0;
 }
 
@@ -119,17 +113,53 @@ static void test_demand_sdof_closed_form(pd_test_ctx *ctx)
     CHECK(ctx, err[1] < 0.4 * err[0] || err[0] < 1e-9,
           "moreau: halving dt took the error from %.3g to %.3g only", err[0], err[1]);
     /* with the wall the SDOF's shear is the same quantity, the sampled peak;
-     * its a_abs has the wall's held force in it (the SDOF comes to rest on
-     * the wall: impulses in steps in a row) */
+     * its a_abs, with the wall's held force in it, is the reference's (3.22494
+     * m/s^2, its peak free; a held step's P / h gave 4.249) */
     o = pd_run_default_opts();
     o.method = PD_METHOD_MOREAU;
-    osc_peak p = {.C = 2.0 * c.xi * w0, .K = w0 * w0, .peak = 0.0,
-                  .dt = pd_osc_default_dt(&c)};
-    if (CHECK(ctx, pd_osc_run(&c, &o, osc_peak_sample, &p, &r, &e) == PD_OK, "%s", e.msg))
+    osc_peak p = {.C = 2.0 * c.xi * w0, .K = w0 * w0, .peak = 0.0};
+    pd_osc_result ref;
+    pd_run_opts oe = pd_run_default_opts();
+    oe.method = PD_METHOD_EVENT;
+    if (CHECK(ctx, pd_osc_run(&c, &o, osc_peak_sample, &p, &r, &e) == PD_OK, "%s", e.msg) &&
+        CHECK(ctx, pd_osc_run(&c, &oe, NULL, NULL, &ref, &e) == PD_OK, "event: %s", e.msg))
         CHECK(ctx, r.impacts > 0 && fabs(r.shear_max - p.peak) <= 1e-12 * p.peak &&
-                       fabs(r.acc_max - p.apeak) <= 1e-12 * p.apeak,
-              "moreau with the wall: %ld impacts, shear_max %.17g vs %.17g, acc_max %.17g vs "
-              "%.17g", r.impacts, r.shear_max, p.peak, r.acc_max, p.apeak);
+                       fabs(r.acc_max - ref.acc_max) <= 1e-5 * ref.acc_max,
+              "moreau with the wall: %ld impacts, shear_max %.17g vs %.17g, acc_max %.12g vs "
+              "the reference's %.12g", r.impacts, r.shear_max, p.peak, r.acc_max, ref.acc_max);
+}
+
+/* Held on the wall a_abs is the ground's acceleration (x'' = 0): a flexible
+ * SDOF (T0 4 s) 1 mm from the wall, eps 0, under a sine pulse (ap 3, Tp 0.5)
+ * rests on the wall through the pulse's peak at Tp / 4, its free shear
+ * below 0.7: the peak of a_abs is ap, in every method that has the hold --
+ * the reference between its samples (the cubic of (f, f'): 3e-8; its
+ * samples alone gave 2.99963), Moreau-Jean from the held force of the
+ * step's state (P / h left it 2.5e-6 short at the default dt). */
+static void test_demand_sdof_held_peak(pd_test_ctx *ctx)
+{
+    pd_osc c = pd_osc_default();
+    c.ap = 3.0;
+    c.Tp = 0.5;
+    pd_osc_set_T0(&c, 4.0);
+    c.xi = 0.05;
+    c.eps = 0.0;
+    c.Pi3 = 0.001;
+    static const pd_method methods[] = {PD_METHOD_EVENT, PD_METHOD_MOREAU};
+    static const double dts[] = {0.0, 1e-4};
+    for (int k = 0; k < 3; k++) {
+        pd_run_opts o = pd_run_default_opts();
+        pd_osc_result r;
+        pd_err e;
+        o.method = methods[k > 0];
+        o.dt = dts[k > 1];
+        if (CHECK(ctx, pd_osc_run(&c, &o, NULL, NULL, &r, &e) == PD_OK, "%s: %s",
+                  pd_method_name(o.method), e.msg))
+            CHECK(ctx, r.contact_time > 0.1 && r.shear_max < 0.25 * c.ap &&
+                           fabs(r.acc_max - c.ap) <= 1e-6 * c.ap,
+                  "%s (dt %g): acc_max %.12g, want ap = %g (held %.3g s, shear_max %.3g)",
+                  pd_method_name(o.method), o.dt, r.acc_max, c.ap, r.contact_time, r.shear_max);
+    }
 }
 
 /* ---- (b) a building without contact: dynamic equilibrium ---------------------- */
@@ -543,6 +573,7 @@ static void test_demand_cli_refusals(pd_test_ctx *ctx)
 void suite_demand(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_demand_sdof_closed_form);
+    PD_RUN(ctx, test_demand_sdof_held_peak);
     PD_RUN(ctx, test_demand_base_shear_equilibrium);
     PD_RUN(ctx, test_demand_moreau_converges);
     PD_RUN(ctx, test_demand_penalty_force);

@@ -1072,7 +1072,13 @@ static void test_scene_squeezed_light_structure(pd_test_ctx *ctx)
                 CHECK(ctx, w.rise <= 1e-9 && r.impacts[0] >= 1000,
                       "event: energy rises by %.3g across an episode (%ld impacts)", w.rise,
                       r.impacts[0]);
-            CHECK(ctx, r.umax[0] <= 1.5e-3, "%s: umax of the heavy one %.6g m (about 8e-4)",
+            /* event: 7.838e-4 m, the heavy one alone on the wall.  Moreau-Jean
+             * alone on the wall at the default dt: 7.99e-4 m; squeezed 8.115e-4
+             * (its velocities refined on the pushing contacts; the rest is the
+             * single law over a light body that the scheme let penetrate and
+             * spring back at 3e-7 m/s); 8.9e-4 at t = 100 s with D's rounding */
+            CHECK(ctx, r.umax[0] <= (k ? 8.2e-4 : 7.85e-4),
+                  "%s: umax of the heavy one %.6g m (event 7.838e-4, Moreau-Jean 8.115e-4)",
                   pd_method_name(o.method), r.umax[0]);
         }
         pd_scene_result_free(&r);
