@@ -140,6 +140,8 @@ static int parse_range(conv_args *a, const char *text)
         return 2;
     if (!(a->dt_min > 0.0) || a->dt_max < a->dt_min || a->ndt < 1 || a->ndt > 64)
         return pd_cli_usage_error("--dt: need MAX >= MIN > 0 and 1 <= N <= 64 (got %s)", text);
+    if (a->ndt > 1 && !(a->dt_max > a->dt_min))
+        return pd_cli_usage_error("--dt: MAX equals MIN: one step size is N = 1 (got %s)", text);
     a->have_dt_range = 1;
     return 0;
 }
@@ -295,7 +297,7 @@ static void measurer_free(measurer *M)
     free(M->serr);
 }
 
-/* Room for the finest grid o. */
+/* Room for the grid of o (the finest, or the scenes' comparison grid). */
 static int measurer_alloc(measurer *M, const pd_run_opts *o, int nrows, pd_err *err)
 {
     int rc;
@@ -320,6 +322,19 @@ static int measure_reference(measurer *M, const pd_run_opts *o, double *cpu, pd_
                    : pd_measure_reference(&M->k->c, o, &M->ref, &M->rr, err);
     *cpu = fmax(*cpu, M->sc ? M->srr.cpu_s : M->rr.cpu_s);
     return rc;
+}
+
+/* A scene's method run once for ten steps of o, untimed, before its first
+ * row: the libraries a run loads on first use (CHOLMOD and its BLAS, some
+ * ms: cli/lazy.c) are not the method's cost. */
+static int warm_up(measurer *M, const pd_run_opts *o, pd_err *err)
+{
+    if (!M->sc)
+        return PD_OK;
+    pd_run_opts w = *o;
+    w.tend = 10.0 * (o->dt > 0.0 ? o->dt : pd_scene_default_dt(M->sc));
+    w.no_demands = w.no_law_band = 1;
+    return pd_scene_run(M->sc, &w, NULL, NULL, &M->sres, err);
 }
 
 /* Row r: the method of o measured against the reference. */
@@ -365,36 +380,40 @@ static int measure_row(measurer *M, const pd_run_opts *o, int r, row *out, pd_er
     return PD_OK;
 }
 
-/* 1 when every step of the range is a whole multiple of the finest. */
-static int nested_grid(const conv_args *a)
-{
-    for (int i = 0; i < a->ndt; i++) {
-        double r = dt_at(a, i) / a->dt_min;
-        if (fabs(r - round(r)) > 1e-9 * r)
-            return 0;
-    }
-    return 1;
-}
-
 /* The error a row is charted and ordered by. */
 static double row_error(const conv_args *a, const row *r)
 {
     return a->use_umax ? r->err_umax : r->err_hist;
 }
 
-/* Rows: for each dt the reference on that grid (once on the finest grid of a
- * nested range, e.g. dt halving: a scene's reference can cost minutes), then
- * Moreau–Jean per theta; penalty per stiffness on the finest grid. */
+/* A scene's rows are compared with its reference on one grid, the coarsest
+ * step of the range (every row resolves it; a row on another grid is
+ * interpolated between its own steps) but at most CONVERGE_GRID_DEFAULTS
+ * default steps (min(Tp, T0) / 200) and at least the finest: the
+ * reference's sampling, closed-form flights of every dof at every row, cost
+ * 4-7x the runs on the finest grid. */
+#define CONVERGE_GRID_DEFAULTS 10.0
+static double converge_grid(const conv_args *a, const pd_scene *sc)
+{
+    double cap = CONVERGE_GRID_DEFAULTS * pd_scene_default_dt(sc);
+    return fmax(a->dt_min, fmin(a->dt_max, cap));
+}
+
+/* Rows: the reference (a scene's once, on the comparison grid; the
+ * oscillator's on each row's grid, exact and cheap), then Moreau–Jean per dt
+ * and theta, Newmark per dt, to a tolerance per rtol, penalty per stiffness
+ * on the finest grid. */
 static int compute_rows(conv_args *a, measurer *M, row *rows, int *nrows, double *ref_cpu,
                         pd_err *err)
 {
     pd_run_opts o = a->k.opts;
     int rc, n = 0;
-    o.dt = a->dt_min;
+    /* scenes: the reference once, on the comparison grid (converge_grid) */
+    int once = M->sc != NULL;
+    o.dt = once ? converge_grid(a, M->sc) : a->dt_min;
     *ref_cpu = 0.0;
     if ((rc = measurer_alloc(M, &o, a->ndt * (a->ntheta + 1) + a->nrtol + a->nkc + 1, err)))
         goto done;
-    int once = M->sc && nested_grid(a);
     if (once && (rc = measure_reference(M, &o, ref_cpu, err)))
         goto done;
     for (int i = 0; i < a->ndt && a->want_moreau; i++) {
@@ -404,7 +423,8 @@ static int compute_rows(conv_args *a, measurer *M, row *rows, int *nrows, double
         for (int t = 0; t < a->ntheta; t++, n++) {
             o.theta = a->thetas[t];
             o.method = PD_METHOD_MOREAU;
-            if ((rc = measure_row(M, &o, n, &rows[n], err)))
+            if ((n == 0 && (rc = warm_up(M, &o, err))) ||
+                (rc = measure_row(M, &o, n, &rows[n], err)))
                 goto done;
         }
     }
@@ -415,7 +435,8 @@ static int compute_rows(conv_args *a, measurer *M, row *rows, int *nrows, double
         if (!once && (rc = measure_reference(M, &o, ref_cpu, err)))
             goto done;
         o.method = PD_METHOD_NEWMARK;
-        if ((rc = measure_row(M, &o, n, &rows[n], err)))
+        if ((i == 0 && (rc = warm_up(M, &o, err))) ||
+            (rc = measure_row(M, &o, n, &rows[n], err)))
             goto done;
     }
     for (int k = 0; k < a->nrtol && a->want_rtol; k++, n++) {
@@ -426,7 +447,9 @@ static int compute_rows(conv_args *a, measurer *M, row *rows, int *nrows, double
             goto done;
         o.dt = 0.0;
         o.rtol = a->rtols[k];
-        rc = measure_row(M, &o, n, &rows[n], err);
+        rc = k == 0 ? warm_up(M, &o, err) : PD_OK;
+        if (!rc)
+            rc = measure_row(M, &o, n, &rows[n], err);
         o.rtol = 0.0;
         if (rc)
             goto done;
@@ -439,7 +462,8 @@ static int compute_rows(conv_args *a, measurer *M, row *rows, int *nrows, double
             o.method = PD_METHOD_PENALTY;
             o.pen.kc_mult = a->kcs[k];
             o.pen.kc_abs = 0.0;
-            if ((rc = measure_row(M, &o, n, &rows[n], err)))
+            if ((k == 0 && (rc = warm_up(M, &o, err))) ||
+                (rc = measure_row(M, &o, n, &rows[n], err)))
                 goto done;
         }
     }

@@ -699,7 +699,8 @@ typedef struct pd_scene_result {
      * impacts jumped to their limit */
     long simultaneous, tol_closed, accumulations;
     double close_tol;      /* the closing tolerance used [in Le] (NAN: not event-driven) */
-    double dt, tend, theta, cpu_s;
+    double dt, tend, theta;
+    double cpu_s;          /* the run's CPU time, its sampler's (sample() and the caller's) left out */
     const char *method, *kernel, *factor, *lcp_solver;
     /* demands over the measuring window (pd_run_opts, "demand parameters"): */
     double *acc_max;       /* n: peak |a_abs| per floor [m/s^2] */
@@ -788,7 +789,7 @@ typedef struct pd_scene_errors {
     double err_umax_max, err_hist_max; /* the worst structure */
     long impacts;                     /* over every contact */
     long grid_points;
-    double cpu_s;                     /* a second run without sampling */
+    double cpu_s;                     /* the run's, the sampling and comparison left out */
     int nstruct;                      /* the shape: set by pd_scene_errors_alloc */
 } pd_scene_errors;
 
@@ -804,10 +805,14 @@ PD_API int pd_scene_errors_alloc(const pd_scene *sc, pd_scene_errors *e, pd_err 
 PD_API void pd_scene_errors_free(pd_scene_errors *e);
 
 /* The event-driven reference of o's scene on its grid (res allocated by
- * pd_scene_result_alloc; res->cpu_s is its cost without sampling). */
+ * pd_scene_result_alloc; res->cpu_s is its cost, the sampler's time left out:
+ * its states on the grid stay in it). */
 PD_API int pd_scene_measure_reference(const pd_scene *sc, const pd_run_opts *o, pd_scene_trace *ref,
                                       pd_scene_result *res, pd_err *err);
-/* The method of o on the same grid and its errors against ref. */
+/* The method of o and its errors against ref, on ref's rows: the run's own
+ * states when its dt is a whole multiple of ref's, else its steps
+ * interpolated (the cubic through a step's ends, the line across a step
+ * with an impulse; to a tolerance, or any other grid). */
 PD_API int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scene_trace *ref,
                                 const pd_scene_result *ref_res, pd_scene_result *res,
                                 pd_scene_errors *e, pd_err *err);

@@ -85,9 +85,7 @@ static int trace_fits(const pd_scene *sc, const pd_scene_trace *tr, pd_err *err)
 static int keep_row(const pd_scene_sample *s, void *ctx)
 {
     pd_scene_trace *tr = ctx;
-    if (fabs(s->t - (double)tr->rows * tr->dt) > 1e-9 * tr->dt)
-        return 0;
-    if (tr->rows < tr->cap)
+    if (fabs(s->t - (double)tr->rows * tr->dt) <= 1e-9 * tr->dt && tr->rows < tr->cap)
         memcpy(tr->x + (size_t)tr->rows++ * tr->n, s->x, (size_t)tr->n * sizeof(double));
     return 0;
 }
@@ -105,7 +103,6 @@ int pd_scene_measure_reference(const pd_scene *sc, const pd_run_opts *o, pd_scen
                                pd_scene_result *res, pd_err *err)
 {
     pd_run_opts r;
-    pd_scene_result timed;
     int rc;
     if ((rc = pd_scene_resolve_opts(sc, o, &r, err)) || /* dt 0: the scene's default */
         (rc = trace_fits(sc, ref, err)))
@@ -118,14 +115,8 @@ int pd_scene_measure_reference(const pd_scene *sc, const pd_run_opts *o, pd_scen
     r.no_demands = 1;  /* nor demands: umax and the history */
     ref->rows = 0;
     ref->dt = r.dt;
-    if ((rc = pd_scene_run(sc, &r, keep_row, ref, res, err)))
+    if ((rc = pd_scene_run(sc, &r, keep_row, ref, res, err))) /* cpu_s: without sample() */
         return rc;
-    if ((rc = pd_scene_result_alloc(sc, &timed, err)))
-        return rc;
-    r.no_demands = 1;
-    rc = pd_scene_run(sc, &r, NULL, NULL, &timed, err); /* its cost without the sampling */
-    res->cpu_s = timed.cpu_s;
-    pd_scene_result_free(&timed);
     for (int s = 0; s < sc->nstruct && !rc; s++)
         if (!(structure_scale(sc, res, s) > 0.0))
             rc = pd_err_set(err, PD_EINVAL,
@@ -144,6 +135,7 @@ typedef struct compare_ctx {
     double *x_prev, *v_prev, *x_at; /* to a tolerance: the last sample, a row between (n) */
     double t_prev;
     int have_prev;
+    int interp;     /* 1: the run's steps interpolated onto the rows */
 } compare_ctx;
 
 /* Row at of the reference against x (n displacements) into the errors. */
@@ -159,12 +151,11 @@ static void compare_at(compare_ctx *c, long at, const double *x)
     }
 }
 
-/* A run to a tolerance samples its own steps: each reference row inside a
+/* A run to a tolerance or on another grid: each reference row inside a
  * step compared with the cubic through the step's ends (x and v; the line
  * across a step with an impulse), as measure.c does for the oscillator. */
-static int compare_steps(const pd_scene_sample *s, void *ctx)
+static void compare_steps(compare_ctx *c, const pd_scene_sample *s)
 {
-    compare_ctx *c = ctx;
     int n = c->ref->n;
     double h = s->t - c->t_prev;
     int jump = 0;
@@ -187,17 +178,26 @@ static int compare_steps(const pd_scene_sample *s, void *ctx)
     memcpy(c->v_prev, s->v, (size_t)n * sizeof(double));
     c->t_prev = s->t;
     c->have_prev = 1;
-    return 0;
 }
 
-static int compare_row(const pd_scene_sample *s, void *ctx)
+/* The run's own state on a reference row. */
+static void compare_row(compare_ctx *c, const pd_scene_sample *s)
 {
-    compare_ctx *c = ctx;
     long at = c->row * c->stride;
     if (at >= c->ref->rows || fabs(s->t - (double)at * c->ref->dt) > 1e-9 * c->ref->dt)
-        return 0; /* past the reference, or an event's state between grid points */
+        return; /* past the reference, or an event's state between grid points */
     c->row++;
     compare_at(c, at, s->x);
+}
+
+/* Sampler: the comparison (pd_scene_run's cpu_s leaves its time out). */
+static int compare_sample(const pd_scene_sample *s, void *ctx)
+{
+    compare_ctx *c = ctx;
+    if (c->interp)
+        compare_steps(c, s);
+    else
+        compare_row(c, s);
     return 0;
 }
 
@@ -205,7 +205,6 @@ int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scen
                          const pd_scene_result *ref_res, pd_scene_result *res,
                          pd_scene_errors *e, pd_err *err)
 {
-    pd_scene_result timed;
     pd_run_opts r;
     int rc;
     if ((rc = pd_scene_resolve_opts(sc, o, &r, err)) || (rc = trace_fits(sc, ref, err)))
@@ -214,14 +213,15 @@ int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scen
         e->nstruct != sc->nstruct || !e->err_umax || !e->err_hist)
         return pd_err_set(err, PD_EINVAL, "the results or errors are not allocated for this "
                                           "scene (pd_scene_result_alloc, pd_scene_errors_alloc)");
-    int tol = r.rtol > 0.0; /* to a tolerance: its own steps, interpolated */
-    double ratio = tol ? 1.0 : r.dt / ref->dt;
+    /* on the reference's rows: the run's own states where its grid holds
+     * them (a whole multiple), else its steps interpolated (to a tolerance,
+     * or another grid) */
+    double ratio = r.rtol > 0.0 ? 0.5 : r.dt / ref->dt;
     long stride = lround(ratio);
-    if (stride < 1 || fabs(ratio - (double)stride) > 1e-9 * ratio)
-        return pd_err_set(err, PD_EINVAL, "dt: %g is not a whole multiple of the reference's %g",
-                          r.dt, ref->dt);
-    /* nstruct scales, then (to a tolerance) x_prev, v_prev, x_at */
-    double *work = malloc(((size_t)sc->nstruct + (tol ? 3 * (size_t)sc->n : 0)) * sizeof(double));
+    int interp = stride < 1 || fabs(ratio - (double)stride) > 1e-9 * ratio;
+    /* nstruct scales, then (interpolated) x_prev, v_prev, x_at */
+    double *work =
+        malloc(((size_t)sc->nstruct + (interp ? 3 * (size_t)sc->n : 0)) * sizeof(double));
     double *scale = work;
     if (!work)
         return pd_err_set(err, PD_ENOMEM, "out of memory");
@@ -229,8 +229,9 @@ int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scen
         scale[s] = structure_scale(sc, ref_res, s);
         e->err_hist[s] = e->err_umax[s] = 0.0;
     }
-    compare_ctx c = {.sc = sc, .ref = ref, .e = e, .scale = scale, .stride = stride, .row = 0};
-    if (tol) {
+    compare_ctx c = {.sc = sc, .ref = ref, .e = e, .scale = scale, .stride = stride, .row = 0,
+                     .interp = interp};
+    if (interp) {
         c.x_prev = work + sc->nstruct;
         c.v_prev = c.x_prev + sc->n;
         c.x_at = c.v_prev + sc->n;
@@ -238,17 +239,11 @@ int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scen
     pd_run_opts measured = o ? *o : pd_run_default_opts();
     measured.no_demands = 1; /* umax and the history are measured, not the demands */
     measured.no_law_band = 1;
-    if ((rc = pd_scene_run(sc, &measured, tol ? compare_steps : compare_row, &c, res, err)) ||
-        (rc = pd_scene_result_alloc(sc, &timed, err))) {
+    if ((rc = pd_scene_run(sc, &measured, compare_sample, &c, res, err))) {
         free(work);
         return rc;
     }
-    pd_run_opts bare = o ? *o : pd_run_default_opts();
-    bare.no_demands = 1;
-    bare.no_law_band = 1;
-    rc = pd_scene_run(sc, &bare, NULL, NULL, &timed, err); /* its cost without the sampling */
-    e->cpu_s = timed.cpu_s;
-    pd_scene_result_free(&timed);
+    e->cpu_s = res->cpu_s; /* sample() and the comparison left out */
     e->err_umax_max = e->err_hist_max = 0.0;
     e->impacts = 0;
     for (int s = 0; s < sc->nstruct; s++) {

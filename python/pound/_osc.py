@@ -430,6 +430,9 @@ def dt_range(dt_max: float, dt_min: float, n: Int) -> List[float]:
     if not (dt_min > 0.0) or dt_max < dt_min or n < 1 or n > 64:
         raise InputError("dt: need MAX >= MIN > 0 and 1 <= N <= 64 (got %g:%g:%d)"
                          % (dt_max, dt_min, n))
+    if n > 1 and not dt_max > dt_min:
+        raise InputError("dt: MAX equals MIN: one step size is N = 1 (got %g:%g:%d)"
+                         % (dt_max, dt_min, n))
     if n == 1:
         return [dt_max]
     return [dt_max * math.pow(dt_min / dt_max, i / (n - 1)) for i in range(n)]
@@ -454,12 +457,6 @@ def _steps(dts):
     if len(steps) > 64 or not all(x > 0.0 for x in steps):
         raise InputError("dt: give 1 to 64 steps > 0")
     return steps, min(steps), steps[0]
-
-
-def _c_round(x):
-    """C's round() (halves away from zero) for x >= 0."""
-    f = math.floor(x)
-    return f + 1.0 if x - f >= 0.5 else f
 
 
 def converge(dts: Union[Range, Sequence[float]], theta: Floats = (0.5,),
@@ -548,6 +545,9 @@ class _OscMeasurer:
         st = lib.pd_measure_reference(self.case.c, o, self.tr.ref, self.rr, err)
         return st, self.rr.cpu_s
 
+    def warm_up(self, o, err):
+        """The oscillator's runs load no library on first use."""
+
     def row(self, o, err):
         m = _lib.PdMeasured()
         st = lib.pd_measure_run(self.case.c, o, self.tr.ref, self.rr.umax, self.tr.work, m, err)
@@ -565,11 +565,12 @@ def _rows(M, steps, dt_min, thetas, want_moreau, want_penalty, kcs, error, want_
     """cli/cmd_converge.c compute_rows (rtols: the moreau-rtol rows')."""
     o = copy_opts(M.opts)
     err = PdErr()
-    o.dt = dt_min
+    # scenes: the reference once, on the comparison grid (converge_grid)
+    once = M.sc is not None
+    o.dt = max(dt_min, min(max(steps), 10.0 * lib.pd_scene_default_dt(M.sc))) if once \
+        else dt_min
     ref_cpu = 0.0
     M.alloc(o)
-    nested = all(abs(d / dt_min - _c_round(d / dt_min)) <= 1e-9 * (d / dt_min) for d in steps)
-    once = M.sc is not None and nested
     rows = []
 
     def reference():
@@ -579,7 +580,9 @@ def _rows(M, steps, dt_min, thetas, want_moreau, want_penalty, kcs, error, want_
         if st:
             raise _lib.make_error(st, err.text())
 
-    def row():
+    def row(first=False):
+        if first:
+            M.warm_up(o, err)
         tol = o.rtol > 0.0
         r = Result(method=s(lib.pd_method_name(o.method)),
                    theta=o.theta if o.method == 0 and not tol else NAN,
@@ -604,13 +607,13 @@ def _rows(M, steps, dt_min, thetas, want_moreau, want_penalty, kcs, error, want_
         for t in thetas:
             o.theta = t
             o.method = 0
-            row()
-    for d in steps if want_newmark else ():  # the penalty elements on Newmark's steps dt
+            row(not rows)
+    for i, d in enumerate(steps if want_newmark else ()):  # penalty elements, Newmark's dt
         o.dt = d
         if not once:
             reference()
         o.method = 5
-        row()
+        row(i == 0)
     for i, tol in enumerate(rtols):  # to a tolerance: measured on the finest grid
         o.dt = dt_min
         o.method = 0
@@ -619,18 +622,18 @@ def _rows(M, steps, dt_min, thetas, want_moreau, want_penalty, kcs, error, want_
         o.dt = 0.0
         o.rtol = tol
         try:
-            row()
+            row(i == 0)
         finally:
             o.rtol = 0.0
     if want_penalty:
         o.dt = dt_min
         if not once:
             reference()
-        for kc in kcs:
+        for i, kc in enumerate(kcs):
             o.method = 2
             o.pen.kc_mult = kc
             o.pen.kc_abs = 0.0
-            row()
+            row(i == 0)
     if want_general:  # one more point: the GSL-based reference on the finest grid
         o.dt = dt_min
         o.method = 4

@@ -376,6 +376,13 @@ class SceneMeasurer:
                      lambda: lib.pd_scene_errors_alloc(self.sc, self.e, err)):
             _lib.check(call(), err)
 
+    def warm_up(self, o, err):
+        """cli/cmd_converge.c warm_up: ten untimed steps of o."""
+        w = copy_opts(o)
+        w.tend = 10.0 * (o.dt if o.dt > 0.0 else lib.pd_scene_default_dt(self.sc))
+        w.no_demands = w.no_law_band = 1
+        _lib.check(lib.pd_scene_run(self.sc, w, _lib.SceneSampler(), None, self.res, err), err)
+
     def reference(self, o, err):
         st = lib.pd_scene_measure_reference(self.sc, o, self.ref, self.rr, err)
         return st, self.rr.cpu_s

@@ -225,3 +225,21 @@ def test_lcp_arrays_refused_alike():
     with pytest.raises(pound.InputError, match="q: the entries are strings"):
         pound.lcp([[1, 0], [0, 1]], np.array(["-1", "-1"]))
     assert pound.lcp([[1, 0], [0, 1]], np.ma.masked_array([-1.0, -1.0])).solved
+
+
+# ---- converge: one comparison grid, a degenerate range refused ------------------------------
+
+def test_converge_equal_max_min_with_several_steps_refused():
+    with pytest.raises(pound.InputError, match="MAX equals MIN"):
+        pound.converge("1e-3:1e-3:3", **CASE)
+    assert len(pound.converge("1e-3:1e-3:1", methods=("moreau",), **CASE).rows) == 1
+
+
+def test_scene_converge_log_spaced_rows_on_one_grid():
+    """Rows off the comparison grid (4.64e-4 against 1e-3) are compared at
+    their steps interpolated onto it: the errors fall with dt as on their
+    own grids, and each row's cpu_s is the run's alone (positive)."""
+    r = pound.converge("1e-3:1e-4:4", scene=THREE_SDOF, methods=("moreau",))
+    errs = [row.err_umax_rel for row in r.rows]
+    assert all(b < a for a, b in zip(errs, errs[1:])), errs
+    assert all(row.cpu_s > 0.0 for row in r.rows)
