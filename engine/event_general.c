@@ -42,11 +42,19 @@
 #define EDG_STUCK 100       /* events at one instant before giving up */
 #define EDG_SET_MAX 512     /* most contacts at zero gap at one instant (dense blocks) */
 #define EDG_SINGULAR 1e-14  /* relative pivot floor of a contact set's D block */
+/* The integrator's step budget, scaled by time: EDG_STEPS_FLOOR plus
+ * EDG_STEPS_PER_RADIAN per radian of the fastest mode's motion (the docs'
+ * row of 100: 58k steps where the budget allows 350k).  Past it the motion
+ * is stiff under its held contacts or chatters: PD_EBUDGET naming the fixed
+ * step scheme, not hours of steps of 1e-8 s. */
+#define EDG_STEPS_FLOOR 100000.0
+#define EDG_STEPS_PER_RADIAN 10000.0
 
 enum { EV_NONE = 0, EV_GAP = 1, EV_FORCE = 2 };
 
 typedef struct edg {
     const pd_model *md;
+    double omega_max; /* fastest_frequency: the step budget's scale */
     pd_edg_opts o;
     pd_edg_result *res;
     pd_observer obs;
@@ -474,9 +482,31 @@ static int step_once(edg *w, pd_err *err)
     if (w->t == w->seg_b && w->h < h_try) /* a step cut at the segment end says nothing */
         w->h = h_try;
     w->tb = w->t;
-    w->res->steps++;
+    if (++w->res->steps > EDG_STEPS_FLOOR + EDG_STEPS_PER_RADIAN * w->omega_max * (w->t - w->t0))
+        return pd_err_set(err, PD_EBUDGET,
+                          "event-driven: %ld integration steps by t = %.9g s (last %.3g s; budget "
+                          "%g + %g per radian of the fastest mode exhausted): the motion is stiff "
+                          "under its held contacts or chatters; Moreau-Jean (--method moreau) "
+                          "runs it", w->res->steps, w->t * w->o.time_unit,
+                          (w->tb - w->ta) * w->o.time_unit, EDG_STEPS_FLOOR,
+                          EDG_STEPS_PER_RADIAN);
     step_ends(w);
     return PD_OK;
+}
+
+/* An upper bound of the fastest mode's frequency: sqrt of Gershgorin's
+ * bound on M^-1 K, max_i sum_j |K_ij| / M_ii (0 without stiffness). */
+static double fastest_frequency(const pd_model *md)
+{
+    double w2 = 0.0;
+    for (int i = 0; i < md->n; i++) {
+        double row = 0.0, mi = pd_matrix_get(&md->M, i, i);
+        for (int j = 0; j < md->n; j++)
+            row += fabs(pd_matrix_get(&md->K, i, j));
+        if (mi > 0.0)
+            w2 = fmax(w2, row / mi);
+    }
+    return sqrt(w2);
 }
 
 /* ---- event location ----------------------------------------------------- */
@@ -1275,6 +1305,7 @@ int pd_edg_run(const pd_model *model, double t0, const double *q0, const double 
     w.last_emit = NAN;
     w.last_event = -HUGE_VAL;
     w.sample_forces = observer && w.o.h_out > 0.0 && !w.o.impacts_only;
+    w.omega_max = fmax(fastest_frequency(model), PD_TWO_PI / (t1 - t0)); /* free bodies: a turn */
     if (!(rc = edg_alloc(&w, err)) && !(rc = factor_mass(&w, err)))
         rc = start(&w, q0, v0, err);
     while (!rc && !w.stopped && w.t < t1)

@@ -841,8 +841,8 @@ static pd_matrix delassus(pd_edr *r, const int *idx, int k)
  * of many decades: D's entries span them):  z = S z', w = S^-1 w',
  * (S D S) z' + S q = w', S = diag(D_jj^-1/2) (positive: complementarity
  * kept). */
-static int scaled_lcp(pd_edr *r, pd_matrix *D, int k, const double *q, const pd_lcp_opts *lo,
-                      double *z, double *w, pd_lcp_info *info)
+static int scaled_lcp(pd_edr *r, pd_lcp_solver *solver, pd_matrix *D, int k, const double *q,
+                      const pd_lcp_opts *lo, double *z, double *w, pd_lcp_info *info)
 {
     double *sc = r->lcp_scale, *qs = r->lcp_q;
     for (int j = 0; j < k; j++) {
@@ -866,7 +866,7 @@ static int scaled_lcp(pd_edr *r, pd_matrix *D, int k, const double *q, const pd_
             for (int p = D->colptr[j]; p < D->colptr[j + 1]; p++)
                 val[p] *= sc[D->rowind[p]] * sc[j];
     }
-    int rc = pd_lcp_solve(r->solver, D, qs, lo, z, w, info);
+    int rc = pd_lcp_solve(solver, D, qs, lo, z, w, info);
     if (rc) {
         /* a closed loop (a row touching wall to wall, or with a body whose
          * rows D barely tells apart): D singular and q a rounding outside its
@@ -879,7 +879,7 @@ static int scaled_lcp(pd_edr *r, pd_matrix *D, int k, const double *q, const pd_
                 for (int p = D->colptr[j]; p < D->colptr[j + 1]; p++)
                     val[p] += D->rowind[p] == j ? EDR_LCP_SHIFT : 0.0;
         }
-        rc = pd_lcp_solve(r->solver, D, qs, lo, z, w, info);
+        rc = pd_lcp_solve(solver, D, qs, lo, z, w, info);
         for (int j = 0; j < k && !rc; j++) /* w of D itself */
             w[j] -= EDR_LCP_SHIFT * z[j];
     }
@@ -913,7 +913,7 @@ static int solve_lcp(pd_edr *r, const int *idx, int k, const double *q, double *
     pd_lcp_info info;
     int rc = pd_lcp_solve(r->solver, &D, q, &lo, z, w, &info);
     if (rc)
-        rc = scaled_lcp(r, &D, k, q, &lo, z, w, &info);
+        rc = scaled_lcp(r, r->solver, &D, k, q, &lo, z, w, &info);
     if (rc)
         return pd_err_set(err, rc, "row reference: the contact LCP of %d contacts at t = %.9g s "
                           "was not solved (%s)", k, t * r->o.time_unit, pd_lcp_outcome_name(info.outcome));
@@ -1311,11 +1311,18 @@ static double stage_e(pd_edr *r, int j)
 
 /* The small dense LCP  w = D z + q >= 0 _|_ z >= 0  of the clusters (k <=
  * EDR_REDUCED_MAX): closed forms for k <= 2 and Lemke beyond (a cluster
- * pinned between two held still makes D singular: Lemke takes it). */
+ * pinned between two held still makes D singular: Lemke takes it; when
+ * pivoting fails, posed again on unit diagonal, then shifted: scaled_lcp). */
 static int small_lcp(pd_edr *r, int k, const double *D, const double *q, double *z, double *w)
 {
     pd_matrix Dm = pd_matrix_dense(k, k, D);
-    return pd_lcp_solve(r->dsolver, &Dm, q, NULL, z, w, NULL);
+    int rc = pd_lcp_solve(r->dsolver, &Dm, q, NULL, z, w, NULL);
+    if (rc) { /* posed again on unit diagonal (then shifted), on a copy: D is refined on */
+        memcpy(r->Dlu, D, (size_t)k * k * sizeof(double));
+        Dm = pd_matrix_dense(k, k, r->Dlu);
+        rc = scaled_lcp(r, r->dsolver, &Dm, k, q, NULL, z, w, NULL);
+    }
+    return rc;
 }
 
 /* Commit an impact's totals: every closed contact's impulse (r->P) and

@@ -70,8 +70,8 @@ SHARED = os.path.normpath(os.environ.get("POUND_SHARED") or os.path.join(ROOT, "
 AS_LIMIT = 4 << 30          # address space of every run (bytes)
 RSS_BOUND_MB = 1024         # "bounded memory"
 CATEGORIES = ["corpus", "flags", "lcp", "scene", "record", "journal", "faults", "hangs",
-              "nonregular", "names", "bounds", "derived", "hostile", "capi", "python", "fuzz",
-              "tsan"]
+              "nonregular", "names", "bounds", "derived", "hostile", "physics", "capi", "python",
+              "fuzz", "tsan"]
 CAT_TEXT = {
     "corpus": "the in-repo corpus and tables (stress/corpus, stress/cases) equal what "
               "stress/gen_corpus.py makes; ../shared's LCPs and records present when expected",
@@ -110,6 +110,11 @@ CAT_TEXT = {
                "(contact-duration, storey_heights) and newmark's budgets refused naming the "
                "field; another method's flags refused; 1000 bodies to HDF5 under an "
                "address-space limit: out of memory, no signal, nothing left",
+    "physics": "the row reference's physics at every impact over generated hostile rows (2 to "
+               "12 SDOFs between walls, masses over 12 decades, gaps 0, 1e-300, 1e-13 m, 1e-6 "
+               "m, 1 cm, restitutions in [0, 1]; PHYSICS_SEEDS seeds of PHYSICS_ROWS rows): "
+               "momentum balances, kinetic energy never rises, every row answers or ends with "
+               "its chatter named (tests/test_rows.c test_rows_hostile_physics)",
     "capi": "the C API misused under ASan + UBSan: every exported function with NULL in each "
             "pointer argument (generated from the headers), results of another shape, zeroed, "
             "or for an unfinished scene",
@@ -1941,6 +1946,31 @@ def run_fuzz(runner, env, fuzz_time):
 # ---- category 9: ThreadSanitizer -------------------------------------------------------
 
 
+PHYSICS_SEEDS = (1, 2, 3, 4, 5, 6)
+PHYSICS_ROWS = 300
+
+
+def run_physics(runner, env):
+    """tests/test_rows.c's impact observer over PHYSICS_ROWS generated hostile
+    rows per seed (the build's pound_tests): one input per row, a failure per
+    seed whose run failed, with its messages."""
+    tests = os.path.join(os.path.dirname(os.path.abspath(env["pound_built"])), "pound_tests")
+    if not os.path.exists(tests):
+        return [("physics", 0, ["%s missing (make all)" % tests])], []
+    n, fails = 0, []
+    for seed in PHYSICS_SEEDS:
+        penv = dict(os.environ, POUND_STRESS_ROWS=str(PHYSICS_ROWS), POUND_STRESS_SEED=str(seed))
+        p = subprocess.run([tests, "test_rows_hostile_physics"], cwd=runner.scratch, env=penv,
+                           stdin=subprocess.DEVNULL, capture_output=True, timeout=600)
+        out = p.stdout.decode("utf-8", "replace")
+        n += PHYSICS_ROWS
+        if p.returncode != 0 or "1 passed, 0 failed" not in out:
+            msgs = [l.strip() for l in out.splitlines() if "test_rows.c:" in l]
+            fails.append("seed %d: exit %d: %s" % (seed, p.returncode,
+                                                   "; ".join(msgs[:5]) or out[-400:]))
+    return [("physics", n, fails)], []
+
+
 def run_capi(runner, env):
     """The C API misuse binary (scripts/stress.sh builds it): one result per
     case it runs, a failure per FAIL line or for a sanitizer's abort."""
@@ -2194,7 +2224,7 @@ def main():
             for t, n, fs in fuzz_results:
                 for f in fs:
                     per_cat["fuzz"][1].append((Case("fuzz", [t], "0", display=t), None, [f]))
-    for c, fn in (("capi", run_capi), ("python", run_python)):
+    for c, fn in (("physics", run_physics), ("capi", run_capi), ("python", run_python)):
         if c in cats:
             results, skips = fn(runner, env)
             if skips and os.environ.get("POUND_STRESS_STRICT"):  # .ci/run: nothing skipped
