@@ -32,6 +32,7 @@ typedef struct pen_track {
     double C, K, Pi3, tau_measure;
     double xmax, xtoward, xaway, xpeak;
     pd_demand_osc dem;            /* the absolute acceleration's peak */
+    double h_out;                 /* the output grid's step (a hold's rest rate) */
     double fpeak;                 /* the largest element force */
     int no_demands;
     long impacts, sampled;        /* sampled: impacts reported to the sampler */
@@ -193,9 +194,15 @@ static int track_step(const pd_state *st, void *ctx)
     if (tr->have_prev && tau > tr->pt)
         close_step(tr, tau, x, v, lam, active);
     record_x(tr, tau, x);
-    double a = pd_osc_shape(tr->c, tau, -1) - tr->C * v - tr->K * x - lam;
+    double f = pd_osc_shape(tr->c, tau, -1), a = f - tr->C * v - tr->K * x - lam;
+    /* a_abs: the element's force is an impact's and a hold's at once; a
+     * hold (engaged, at rest after this step and the one before) takes the
+     * rigid wall's held force, never the element's ringing */
     if (!tr->no_demands)
-        pd_demand_osc_note(&tr->dem, tau, x, v, &a, 0.0, !active && !tr->pactive); /* free steps */
+        pd_demand_osc_note(&tr->dem, tau, x, v, &a,
+                           pd_demand_osc_held(&tr->dem, tr->h_out, active, tr->pactive, v, tr->pv,
+                                              x, f),
+                           !active && !tr->pactive); /* free steps */
     if (active)
         tr->fpeak = fmax(tr->fpeak, lam);
     if (active && !tr->pactive) { /* an element engaged at a located closing */
@@ -350,6 +357,7 @@ int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler samp
     tr.Pi3 = c->Pi3;
     tr.tau_measure = tau_measure;
     tr.dem = (pd_demand_osc){.C = C, .K = K, .tau_measure = tau_measure};
+    tr.h_out = h_out;
     tr.no_demands = o.no_demands;
     tr.first_tau = tr.first_v = NAN;
     tr.Le = pd_osc_Le(c);

@@ -579,12 +579,14 @@ static double free_rel_acc(const track *tr, int i, double f)
 }
 
 /* Moreau–Jean's held forces at a step into tr->hlam and tr->hacc: the
- * contact-force LCP over the candidate holds J,
+ * contact-force LCP (held_lcp) over the candidate holds J,
  *   g'' = D lambda + G >= 0 _|_ lambda >= 0,  D_ab = sum_i W_ia W_ib / m_i,
  *   G_a = W_a^T u''_free  (u''_free from the smooth a_abs and f(t)). */
+static void held_lcp(track *tr, const pd_state *st, int k);
+
 static void moreau_held(track *tr, const pd_state *st)
 {
-    double rest = MJ_HELD_RATE * tr->h, f = pd_osc_shape(tr->shape, st->t, -1);
+    double rest = MJ_HELD_RATE * tr->h;
     int k = 0, *J = tr->hJ;
     for (int a = 0; a < tr->model_m; a++) {
         tr->hlam[a] = 0.0;
@@ -592,6 +594,34 @@ static void moreau_held(track *tr, const pd_state *st)
             fabs(gap_rate(tr, a, st->v)) <= rest)
             J[k++] = a;
     }
+    held_lcp(tr, st, k);
+}
+
+/* The penalty methods' holds: an element engaged after this step and the
+ * one before, at rest after both (a gap rate within MJ_HELD_RATE grid
+ * steps' worth of ap), takes the rigid contact-force LCP's force, not the
+ * element's (an impact's and a hold's at once: its ringing is no floor
+ * acceleration); the gap rates kept in U_prev. */
+static void penalty_held(track *tr, const pd_state *st)
+{
+    double rest = MJ_HELD_RATE * tr->h;
+    int k = 0, *J = tr->hJ;
+    for (int a = 0; a < tr->model_m; a++) {
+        double U = gap_rate(tr, a, st->v);
+        tr->hlam[a] = 0.0;
+        if (st->active[a] && tr->pactive[a] && fabs(tr->U_prev[a]) <= rest && fabs(U) <= rest)
+            J[k++] = a;
+        tr->U_prev[a] = U;
+    }
+    held_lcp(tr, st, k);
+}
+
+/* The contact-force LCP over the candidate holds J[0..k) at the state st
+ * into tr->hlam and tr->hacc (none beyond MJ_HELD_LCP holds). */
+static void held_lcp(track *tr, const pd_state *st, int k)
+{
+    double f = pd_osc_shape(tr->shape, st->t, -1);
+    int *J = tr->hJ;
     if (k == 0 || k > MJ_HELD_LCP || !tr->hlcp) {
         held_from_forces(tr, NULL);
         return;
@@ -782,11 +812,12 @@ static int step_penalty(const pd_state *st, void *ctx)
         note_between(tr, st->t, st->q, st->v, st->acc);
     note_point(tr, st->t, st->q);
     note_approach(tr, st->q);
-    /* the elements' forces are left out of a_abs: an element's force is its
-     * impact's and its hold's at once (a held part would need the rigid
-     * contact-force LCP of the engaged set; docs/scenes.md, "Demands") */
-    note_demand(tr, st->t, st->q, st->v, st->has_acc ? st->acc : NULL, NULL,
-                no_element(tr, st));
+    /* the elements' forces are left out of a_abs (an element's force is its
+     * impact's and its hold's at once); holds take the rigid held force */
+    if (tr->demands)
+        penalty_held(tr, st);
+    note_demand(tr, st->t, st->q, st->v, st->has_acc ? st->acc : NULL,
+                tr->demands ? tr->hacc : NULL, no_element(tr, st));
     for (int a = 0; a < tr->model_m; a++) {
         double dt = tr->have_prev ? st->t - tr->pt : 0.0;
         if (st->active[a])
@@ -920,15 +951,25 @@ static int run_oscillator(const pd_scene *sc, const pd_osc *c, int mirrored,
 
 /* ---- the general engines -------------------------------------------------- */
 
+/* The holds' contact-force LCP solver (demands measured, contacts in the
+ * model), once per run. */
+static int held_solver(track *tr, const pd_model *md, pd_err *err)
+{
+    if (tr->demands && md->m > 0 && !tr->hlcp &&
+        !(tr->hlcp = pd_lcp_solver_alloc(PD_LCP_LEMKE, md->m < MJ_HELD_LCP ? md->m : MJ_HELD_LCP,
+                                         0, err)))
+        return err ? err->status : PD_ENOMEM;
+    return PD_OK;
+}
+
 /* Moreau–Jean on the scene's model. */
 static int run_moreau(const pd_model *md, const pd_run_opts *o, long nsteps, track *tr,
                       pd_scene_result *res, pd_err *err)
 {
     pd_mj_opts mo = pd_run_mj_opts(o, tr->h);
-    if (tr->demands && md->m > 0 && !tr->hlcp &&
-        !(tr->hlcp = pd_lcp_solver_alloc(PD_LCP_LEMKE, md->m < MJ_HELD_LCP ? md->m : MJ_HELD_LCP,
-                                         0, err)))
-        return err ? err->status : PD_ENOMEM;
+    int rc0 = held_solver(tr, md, err);
+    if (rc0)
+        return rc0;
     pd_mj *mj = pd_mj_alloc(md, &mo, err);
     if (!mj)
         return err ? err->status : PD_ENOMEM;
@@ -1298,6 +1339,8 @@ static int run_penalty(const pd_model *md, const pd_run_opts *o, double tau_end,
     po.on_step_ctx = tr;
     po.factor = o->factor;
     int rc = pd_newmark_budget(&po, tr->h, tau_end, err);
+    if (!rc)
+        rc = held_solver(tr, md, err);
     if (rc)
         return rc;
     rc = pd_penalty_run(md, 0.0, NULL, NULL, tau_end, &po, tr->fn ? observe_grid : NULL, tr,
