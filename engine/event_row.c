@@ -335,10 +335,31 @@ static void predict_contact(pd_edr *r, int a, double ts, int cont)
     double h = contact_step(r, a), tend = horizon(r), tw = fmin(tend, ts + win * h);
     s.width = 4e-8 * h;
     edr_pt p = edr_scan_point(&s, ts);
+    /* a gap at zero (within the closing tolerance) closing at a rate an
+     * impact takes as zero (EDR_RATE_TOL of the run's speeds: touching
+     * bodies come to rest with rounding in their rates) under an opening
+     * acceleration: the gap dips by df^2 / (2 |ddf|), a rounding, and opens.
+     * The scan starts where the Taylor quadratic has it back, or at the
+     * window's end (else the contact would close at the next double, an
+     * impact that does nothing, again and again) */
+    if (p.df > 0.0 && p.ddf < 0.0 && p.df <= EDR_RATE_TOL * r->vscale &&
+        p.f <= r->o.close_tol * r->L) {
+        double back = ts - 2.0 * p.df / p.ddf;
+        if (!(back < tw)) {
+            r->qkind[slot] = EDR_Q_SCAN;
+            q_set(&r->q, slot, tw < tend ? tw : HUGE_VAL);
+            return;
+        }
+        p = edr_scan_point(&s, back);
+        if (p.f > 0.0 && p.f <= r->o.close_tol * r->L) {
+            g.gb += p.f; /* the dip's rounding: the gap is zero there */
+            p.f = 0.0;
+        }
+    }
     if (p.f > 0.0) { /* past zero at the start: rounding of a gap that is 0 */
         if (p.f > g.thr && p.df > 0.0) {
             r->qkind[slot] = EDR_Q_HIT;
-            q_set(&r->q, slot, ts);
+            q_set(&r->q, slot, p.t);
             return;
         }
         g.gb += p.f;
@@ -346,10 +367,10 @@ static void predict_contact(pd_edr *r, int a, double ts, int cont)
     }
     /* a closing the Taylor quadratic puts early in the first interval: a first
      * interval of twice that time brackets it closely */
-    double s0 = p.df > 0.0 ? edr_taylor_root(&p) : NAN, t0 = ts;
-    if (s0 < 0.25 * h && ts + 2.0 * s0 < tw) {
+    double s0 = p.df > 0.0 ? edr_taylor_root(&p) : NAN, t0 = p.t;
+    if (s0 < 0.25 * h && t0 + 2.0 * s0 < tw) {
         double hit;
-        edr_pt b = edr_scan_point(&s, ts + 2.0 * s0);
+        edr_pt b = edr_scan_point(&s, t0 + 2.0 * s0);
         if (edr_scan_interval(&s, &p, &b, &hit)) {
             r->qkind[slot] = EDR_Q_HIT;
             q_set(&r->q, slot, hit);
@@ -1213,14 +1234,11 @@ static int decide_persistence(pd_edr *r, double t, int *acc_jumped, pd_err *err)
     int ties = 0;
     for (int j = 0; j < r->ngc; j++) {
         const edr_contact *ct = &r->ct[r->g_ct[j]];
-        double as = 0.0; /* its bodies' accelerations; at rest: both still */
-        int rest = 1;
+        double as = 0.0; /* its bodies' accelerations */
         for (int k = 0; k < 2; k++)
-            if (ct->dof[k] >= 0) {
+            if (ct->dof[k] >= 0)
                 as = fmax(as, fabs(r->gacc[ct->dof[k]]));
-                rest &= r->gv[ct->dof[k]] == 0.0;
-            }
-        r->tie[j] = r->jpos[j] >= 0 && !r->held[j] && rest && as > EDR_TIE_ACC * r->L &&
+        r->tie[j] = r->jpos[j] >= 0 && !r->held[j] && as > EDR_TIE_ACC * r->L &&
                     !(fabs(r->wlcp[j]) > EDR_RATE_TOL * as);
         ties |= r->tie[j];
     }

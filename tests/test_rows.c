@@ -372,7 +372,7 @@ static void test_rows_impulses_balance_energy_falls(pd_test_ctx *ctx)
  * balances and kinetic energy does not rise beyond rounding (64 eps of the
  * energy before: the impulses' sums carry a few roundings of it). */
 /* `make stress` (category physics) runs it over POUND_STRESS_ROWS rows (up
- * to 12 structures) from the seed POUND_STRESS_SEED. */
+ * to 30 structures) from the seed POUND_STRESS_SEED. */
 static void test_rows_hostile_physics(pd_test_ctx *ctx)
 {
     const char *env_rows = getenv("POUND_STRESS_ROWS"), *env_seed = getenv("POUND_STRESS_SEED");
@@ -385,7 +385,7 @@ static void test_rows_hostile_physics(pd_test_ctx *ctx)
         return;
     for (int k = 0; k < rows; k++) {
         pd_err e;
-        int n = 2 + k % (wide ? 11 : 6), rc = 0;
+        int n = 2 + k % (wide ? 29 : 6), rc = 0;
         pd_scene *sc = new_scene(k % 2 ? PD_PULSE_COSINE : PD_PULSE_SINE, 1,
                                  2.0 + 4.0 * pd_test_uniform(&rng), 0.3 + 0.7 * pd_test_uniform(&rng));
         char name[16];
@@ -418,13 +418,17 @@ static void test_rows_hostile_physics(pd_test_ctx *ctx)
         }
         pd_scene_free(sc);
     }
-    CHECK(ctx, answered >= 0.75 * rows && ic.impacts > 5 * rows,
+    CHECK(ctx, answered >= 0.9 * rows && ic.impacts > 5 * rows,
           "answered %d of %d (chatter %d), impacts %ld", answered, rows, chatter, ic.impacts);
     if (wide) /* the stress category's line */
         printf("physics: %d rows, %d answered, %d chatter, %ld impacts, momentum %.3g, "
                "energy %.3g\n", rows, answered, chatter, ic.impacts, ic.worst_momentum,
                ic.worst_energy);
-    CHECK(ctx, ic.worst_momentum <= 1e-12, "momentum balance at impacts: worst %.3g per term",
+    /* the reference zeroes rates within 1e-12 of the run's speeds (a heavy
+     * body's rounding-level rate set to rest at a wall: 1.7e-11 of the
+     * momentum scale over 10 terms measured); an impulse wrong beyond
+     * rounding is far above */
+    CHECK(ctx, ic.worst_momentum <= 4e-12, "momentum balance at impacts: worst %.3g per term",
           ic.worst_momentum);
     CHECK(ctx, ic.worst_energy <= 64.0 * DBL_EPSILON, "kinetic energy rises at an impact by %.3g",
           ic.worst_energy);
@@ -483,6 +487,55 @@ static void test_rows_locked_wall_to_wall(pd_test_ctx *ctx)
                                    strstr(e.msg, "integration steps")),
               "event-general: %d %s", rc, e.msg);
     }
+    pd_scene_result_free(&r);
+    pd_scene_free(sc);
+}
+
+/* A light SDOF (220 kg) pressed between two heavy ones (6.1e8, 2.5e8 kg)
+ * on a wall, all touching (`make stress`'s physics, seed 3, row 59): the
+ * three move off the wall as one block, their contacts at zero gap with
+ * rates of rounding size (4.5e-15 closing) under opening accelerations.
+ * Each such rate was a closing at the next double, an impact doing nothing,
+ * 10^4 times: the chatter stop (exit 1).  A rate an impact takes as zero
+ * closes no gap: the run answers, every impact checked by the observer;
+ * the light body stays pressed (umax of S2 that of its neighbours within
+ * the gaps, 1e-300 m). */
+static void test_rows_rounding_rates_close_nothing(pd_test_ctx *ctx)
+{
+    static const double T0[] = {0.39995863161832895, 0.81760554690779208, 1.8225458117405942};
+    static const double xi[] = {0.01971357992926619, 0.034216388903202458, 0.039980014141982698};
+    static const double mass[] = {610038466.36050868, 220.12522749920504, 245679587.5938938};
+    static const double gap[] = {1e-300, 0.0, 1e-300, 0.01};
+    static const double eps[] = {0.52305778889608845, 0.077247540809392334,
+                                 0.43391133422720229, 0.33328883762731099};
+    pd_err e;
+    pd_scene *sc = new_scene(PD_PULSE_COSINE, 1, 4.5464921150000475, 0.81166502612086289);
+    int rc = sc ? 0 : PD_ENOMEM;
+    char name[8];
+    for (int i = 0; i < 3 && !rc; i++) {
+        snprintf(name, sizeof name, "S%d", i + 1);
+        rc = pd_scene_add_sdof(sc, name, T0[i], xi[i], mass[i], &e);
+    }
+    for (int i = 0; i <= 3 && !rc; i++)
+        rc = pd_scene_add_contact(sc, i == 0 ? PD_WALL : i - 1, i == 0 ? 0 : 1,
+                                  i == 3 ? PD_WALL : i, i == 3 ? 0 : 1, gap[i], eps[i], i, &e);
+    if (!CHECK(ctx, !rc && !pd_scene_finish(sc, &e), "scene: %s", e.msg)) {
+        pd_scene_free(sc);
+        return;
+    }
+    impact_check ic = {0};
+    rc = run_checked(ctx, sc, &ic, &e);
+    CHECK(ctx, rc == PD_OK, "row: %s", e.msg);
+    CHECK(ctx, ic.worst_momentum <= 4e-12 && ic.worst_energy <= 64.0 * DBL_EPSILON,
+          "momentum %.3g per term, energy %.3g at its %ld impacts", ic.worst_momentum,
+          ic.worst_energy, ic.impacts);
+    pd_scene_result r = {0};
+    pd_run_opts o = pd_run_default_opts();
+    o.method = PD_METHOD_EVENT;
+    if (run_m(ctx, sc, &o, &r) == PD_OK)
+        CHECK(ctx, r.umax[1] <= fmax(r.umax[0], r.umax[2]) * (1.0 + 1e-9) + 1e-12,
+              "umax %.9g %.9g %.9g m: the light one pressed between", r.umax[0], r.umax[1],
+              r.umax[2]);
     pd_scene_result_free(&r);
     pd_scene_free(sc);
 }
@@ -1205,6 +1258,7 @@ void suite_rows(pd_test_ctx *ctx)
     PD_RUN(ctx, test_rows_impulses_balance_energy_falls);
     PD_RUN(ctx, test_rows_hostile_physics);
     PD_RUN(ctx, test_rows_locked_wall_to_wall);
+    PD_RUN(ctx, test_rows_rounding_rates_close_nothing);
     PD_RUN(ctx, test_rows_elastic_energy_constant);
     PD_RUN(ctx, test_rows_mirrored);
     PD_RUN(ctx, test_rows_scaling);
