@@ -32,9 +32,9 @@
  * MINOR adds to it; PATCH fixes.  pd_version() is the string of the
  * library actually linked, PD_VERSION the one compiled against. */
 #define PD_VERSION_MAJOR 0
-#define PD_VERSION_MINOR 12
+#define PD_VERSION_MINOR 13
 #define PD_VERSION_PATCH 0
-#define PD_VERSION "0.12.0"
+#define PD_VERSION "0.13.0"
 PD_API const char *pd_version(void);
 
 enum {

@@ -458,7 +458,7 @@ static void test_rows_locked_wall_to_wall(pd_test_ctx *ctx)
     pd_err e;
     pd_scene *sc = new_scene(PD_PULSE_COSINE, 1, 4.168807041886021, 0.58481851902564641);
     int rc = sc ? 0 : PD_ENOMEM;
-    char name[8];
+    char name[16];
     for (int i = 0; i < 5 && !rc; i++) {
         snprintf(name, sizeof name, "S%d", i + 1);
         rc = pd_scene_add_sdof(sc, name, T0[i], xi[i], mass[i], &e);
@@ -511,7 +511,7 @@ static void test_rows_rounding_rates_close_nothing(pd_test_ctx *ctx)
     pd_err e;
     pd_scene *sc = new_scene(PD_PULSE_COSINE, 1, 4.5464921150000475, 0.81166502612086289);
     int rc = sc ? 0 : PD_ENOMEM;
-    char name[8];
+    char name[16];
     for (int i = 0; i < 3 && !rc; i++) {
         snprintf(name, sizeof name, "S%d", i + 1);
         rc = pd_scene_add_sdof(sc, name, T0[i], xi[i], mass[i], &e);

@@ -26,7 +26,7 @@ from ._spectrum import spectrum
 from ._lcp import lcp, read_lcp, record
 from . import plot
 
-__version__ = "0.12.0"
+__version__ = "0.13.0"
 
 __all__ = ["simulate", "compare", "converge", "dt_range", "spectrum", "lcp", "read_lcp",
            "scene", "simulate_scene", "Scene", "record", "Record", "Result", "PoundError",
