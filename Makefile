@@ -130,7 +130,7 @@ INSTALLED   = $(bindir)/pound $(libdir)/libpound.a $(libdir)/$(SOREAL) $(libdir)
 # make check ends with scripts/api-check.sh (not under the sanitizers)
 API_CHECK  ?= 1
 
-.PHONY: all deps demo test check asan bench clean acceptance figures paper figures-docs \
+.PHONY: all deps demo test check asan bench mutate clean acceptance figures paper figures-docs \
         paper-docs stress print-libs \
         shared install uninstall install-check formats-check flags-check python-check
 
@@ -249,6 +249,13 @@ figures-docs:
 
 paper-docs:
 	@$(MAKE) --no-print-directory paper DOCS=1
+
+# Mutation testing of the numerical core (scripts/mutate.py; minutes, not
+# part of CI): MUTATE_ARGS="--files lcp/lemke.c --n 30 --seed 1 --report F".
+MUTATE_ARGS ?=
+mutate: deps
+	@$(MAKE) --no-print-directory all
+	python3 scripts/mutate.py $(MUTATE_ARGS)
 
 # The adversarial suite: fuzzers and a TSan binary built with clang in
 # $(BUILD)/stress, then stress/run.py against $(BUILD)/pound (about 5 min).

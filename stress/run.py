@@ -2162,7 +2162,19 @@ def make_inputs(runner, env):
     env["flag_inputs"] = {name: ("copy", os.path.join(d, name)) for name in files}
 
 
+def signals_delivered():
+    """The fault cases send SIGINT, SIGTERM, SIGHUP and SIGQUIT: a suite
+    started in the background (`cmd &` without job control, nohup) would
+    pass them on ignored, and pound rightly keeps an ignored signal
+    ignored.  The runner's children get them as a terminal's would."""
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    for s in (signal.SIGTERM, signal.SIGHUP, signal.SIGQUIT):
+        if signal.getsignal(s) == signal.SIG_IGN:
+            signal.signal(s, signal.SIG_DFL)
+
+
 def main():
+    signals_delivered()
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--pound", default=os.path.join(ROOT, "build", "pound"))
     ap.add_argument("--stress", default=os.path.join(ROOT, "build", "stress"),

@@ -1,12 +1,45 @@
 /* main.c — test runner: runs every suite, ends with "N passed, N failed". 
  *
- * usage: pound_tests [--pound PATH] [--shared DIR] [FILTER] */
+ * usage: pound_tests [--pound PATH] [--shared DIR] [FILTER]
+ *
+ * Each case runs under a wall-clock limit, POUND_TEST_TIMEOUT seconds
+ * (default TEST_TIMEOUT): a case still running then (a loop that never
+ * ends, as a mutant's) fails the run with its name, exit status 1, instead
+ * of hanging it.  POUND_TEST_FAILFAST set: the run stops at the first
+ * failed case (make mutate). */
+#include <signal.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "pd_test.h"
+
+#define TEST_TIMEOUT 300 /* s: the slowest case takes about 10 s, 40 s under ASan */
+
+static const char *running_case; /* for the alarm's message */
+
+/* SIGALRM: the running case is over its limit; async-signal-safe writes. */
+static void over_time(int sig)
+{
+    static const char head[] = "FAIL  ", tail[] = ": over the per-case time limit "
+                                                   "(POUND_TEST_TIMEOUT)\n";
+    (void)sig;
+    if (write(STDOUT_FILENO, head, sizeof head - 1) < 0 ||
+        (running_case && write(STDOUT_FILENO, running_case, strlen(running_case)) < 0) ||
+        write(STDOUT_FILENO, tail, sizeof tail - 1) < 0)
+        _exit(1);
+    _exit(1);
+}
+
+/* The limit in seconds: POUND_TEST_TIMEOUT (0: none), else TEST_TIMEOUT. */
+static unsigned case_limit(void)
+{
+    const char *s = getenv("POUND_TEST_TIMEOUT");
+    long v = s ? strtol(s, NULL, 10) : TEST_TIMEOUT;
+    return v > 0 && v < 86400 ? (unsigned)v : 0;
+}
 
 void pd_test_run(pd_test_ctx *ctx, const char *name, void (*fn)(pd_test_ctx *))
 {
@@ -15,10 +48,26 @@ void pd_test_run(pd_test_ctx *ctx, const char *name, void (*fn)(pd_test_ctx *))
     ctx->case_failures = 0;
     ctx->case_skipped = 0;
     ctx->case_name = name;
+    /* the handler again before each case: a case may install its own */
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = over_time;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGALRM, &sa, NULL);
+    running_case = name;
+    fflush(stdout);
+    alarm(case_limit());
     fn(ctx);
+    alarm(0);
     if (ctx->case_failures) {
         ctx->failed++;
         printf("FAIL  %s\n", name);
+        if (getenv("POUND_TEST_FAILFAST")) { /* make mutate: the first failure kills */
+            printf("%d passed, %d failed, %d skipped (stopped at the first failure)\n",
+                   ctx->passed, ctx->failed, ctx->skipped);
+            fflush(stdout);
+            exit(1);
+        }
     } else if (ctx->case_skipped) {
         ctx->skipped++;
     } else {

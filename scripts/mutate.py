@@ -1,0 +1,328 @@
+#!/usr/bin/env python3
+"""scripts/mutate.py -- `make mutate`: mutation testing of pound's numerical
+core.  Does the C suite fail when the code is wrong?
+
+For each file, the code is masked (comments, string and character literals
+blanked, #include lines left out) and every mutation site inside a function
+body is listed; a seeded sample of N sites is taken, so that a run is
+reproducible.  Operators, one textual change each:
+
+  relop    <  <=  >  >=  ==  !=   turned into their neighbour (< to <=, == to !=)
+  arith    binary + - * /         + to -, - to +, * to /, / to *
+  logic    && ||                  swapped
+  const    a numeric literal      nudged: an integer n to n + 1, a real x to 2 x
+  delete   an assignment statement (x = ...; x += ...;) replaced by ;
+  negate   !x                     to x
+
+Each mutant is built in a copy of the tree (incremental make: the file and
+the links), then run: the file's own cases first (a filter of the test
+runner's names), then the whole C suite, both stopping at the first failure
+(POUND_TEST_FAILFAST) and under a per-case time limit (POUND_TEST_TIMEOUT)
+and a per-mutant limit.  A mutant is
+
+  stillborn  it does not compile (not counted),
+  killed     a case failed, the run crashed, or it ran out of time,
+  survived   every case passed.
+
+Survivors listed in scripts/mutate_equivalent.txt (FILE:LINE: ORIGINAL ->
+MUTANT  # why it cannot change a result) count as equivalent and leave the
+denominator: killed / (mutants - stillborn - equivalent) is the file's score.
+The other survivors are the suite's gaps, printed with their line.
+
+usage: python3 scripts/mutate.py [--files F,...] [--n 30] [--seed 1]
+                                 [--timeout S] [--report FILE] [--keep]
+"""
+import argparse
+import os
+import random
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+# The numerical core (issue 33) and each file's own cases: substrings of
+# the runner's case names, run first.
+DEFAULT_FILES = {
+    "lcp/lemke.c": ["lcp", "lemke", "solver"],
+    "engine/mj1.h": ["engine", "moreau", "mj", "osc"],
+    "engine/event_row.c": ["rows", "edr", "row_"],
+    "engine/event_row_cluster.c": ["rows", "edr", "row_"],
+    "engine/event_row_scan.c": ["rows", "edr", "row_"],
+    "problems/demand.c": ["demand", "aabs"],
+    "problems/scene_measure.c": ["measure", "general_history", "other_grid", "compare",
+                                 "converge"],
+}
+
+SKIP_DIRS = {".git", "build", "build-asan", "build-mpi", "build-tsan"}
+
+
+# ---- masking and sites ----------------------------------------------------------
+
+
+def mask(text):
+    """text with comments, string and character literals and #include lines
+    blanked (newlines kept): positions match the original."""
+    out = list(text)
+    i, n = 0, len(text)
+
+    def blank(a, b):
+        for k in range(a, b):
+            if out[k] != "\n":
+                out[k] = " "
+
+    while i < n:
+        c = text[i]
+        if text.startswith("/*", i):
+            j = text.find("*/", i + 2)
+            j = n if j < 0 else j + 2
+            blank(i, j)
+            i = j
+        elif text.startswith("//", i):
+            j = text.find("\n", i)
+            j = n if j < 0 else j
+            blank(i, j)
+            i = j
+        elif c in "\"'":
+            j = i + 1
+            while j < n and text[j] != c:
+                j += 2 if text[j] == "\\" else 1
+            blank(i, min(j + 1, n))
+            i = j + 1
+        elif c == "#" and (i == 0 or text[i - 1] == "\n"):
+            j = text.find("\n", i)
+            j = n if j < 0 else j
+            line = text[i:j]
+            if re.match(r"#\s*(include|pragma|if|ifdef|ifndef|endif|else|elif|undef)", line):
+                blank(i, j)
+            i = j
+        else:
+            i += 1
+    return "".join(out)
+
+
+def depth_map(masked):
+    """Brace depth at each position (function bodies: depth >= 1)."""
+    d, depth = 0, [0] * (len(masked) + 1)
+    for i, c in enumerate(masked):
+        if c == "{":
+            d += 1
+        depth[i] = d
+        if c == "}":
+            d -= 1
+    return depth
+
+
+BEFORE_BINARY = r"(?<=[\w\)\]])\s"  # an operand, then a space
+RELOPS = {"<=": "<", ">=": ">", "==": "!=", "!=": "==", "<": "<=", ">": ">="}
+
+
+def sites(text):
+    """Every mutation site: (start, end, replacement, operator)."""
+    m = mask(text)
+    depth = depth_map(m)
+    out = []
+
+    def add(a, b, new, op):
+        if depth[a] >= 1:
+            out.append((a, b, new, op))
+
+    for mo in re.finditer(r"(?<![<>=!\-])(<=|>=|==|!=|<|>)(?![<>=])", m):
+        a = mo.start()
+        if m[a] in "<>" and (m[a - 1:a + 1] == "->" or m[a:a + 2] in ("<<", ">>")):
+            continue
+        if m[a] == ">" and m[a - 1] == "-":
+            continue
+        add(a, mo.end(), RELOPS[mo.group(1)], "relop")
+    for mo in re.finditer(r"(?<=[\w\)\]]) ([+\-*/]) (?=[\w\(\-.])", m):
+        op = mo.group(1)
+        new = {"+": "-", "-": "+", "*": "/", "/": "*"}[op]
+        add(mo.start(1), mo.end(1), new, "arith")
+    for mo in re.finditer(r"&&|\|\|", m):
+        add(mo.start(), mo.end(), "||" if mo.group() == "&&" else "&&", "logic")
+    for mo in re.finditer(r"(?<![\w.])(\d+\.\d*(?:[eE][-+]?\d+)?|\d+[eE][-+]?\d+|\.\d+(?:[eE][-+]?\d+)?|\d+)(?![\w.])", m):
+        lit = mo.group(1)
+        if re.fullmatch(r"\d+", lit):
+            new = str(int(lit) + 1)
+        elif float(lit) == 0.0:
+            new = "1.0"
+        else:
+            new = "(2.0 * %s)" % lit
+        add(mo.start(1), mo.end(1), new, "const")
+    for mo in re.finditer(r"(?m)^([ \t]+)([A-Za-z_][\w\[\]\.>\-\*\s]*?\s*(?:[+\-*/]?=)\s*[^=;][^;]*;)[ \t]*$", m):
+        stmt = mo.group(2)
+        if re.match(r"(double|int|long|unsigned|size_t|const|static|char|float|"
+                     r"return|for|if|while|else|pd_\w+\s|struct|uint64_t)\b", stmt):
+            continue
+        if "{" in stmt or "}" in stmt:
+            continue
+        add(mo.start(2), mo.end(2), ";", "delete")
+    for mo in re.finditer(r"!(?=[\w\(])", m):
+        add(mo.start(), mo.end(), "", "negate")
+    out.sort()
+    return out
+
+
+def line_of(text, pos):
+    return text.count("\n", 0, pos) + 1
+
+
+# ---- the copy of the tree, builds and runs ----------------------------------------
+
+
+def copy_tree(dst):
+    def ignore(d, names):
+        return [n for n in names if n in SKIP_DIRS and os.path.abspath(d) == ROOT]
+    shutil.copytree(ROOT, dst, ignore=ignore, symlinks=True)
+
+
+def build(work, log):
+    p = subprocess.run(["make", "-j2", "all"], cwd=work, stdout=subprocess.PIPE,
+                       stderr=subprocess.STDOUT, timeout=900)
+    if p.returncode != 0:
+        log.write(p.stdout.decode("utf-8", "replace")[-2000:])
+    return p.returncode == 0
+
+
+def run_suite(work, filt, limit):
+    """(status, last lines): 'pass', 'fail' or 'time'."""
+    env = dict(os.environ, POUND_TEST_FAILFAST="1", POUND_TEST_TIMEOUT=str(int(limit)),
+               OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
+    argv = ["./build/pound_tests"] + ([filt] if filt else [])
+    try:
+        p = subprocess.run(argv, cwd=work, env=env, stdout=subprocess.PIPE,
+                           stderr=subprocess.STDOUT, timeout=limit * 4, start_new_session=True)
+    except subprocess.TimeoutExpired:
+        return "time", "over %g s" % (limit * 4)
+    out = p.stdout.decode("utf-8", "replace")
+    tail = [l for l in out.splitlines() if l.startswith("FAIL") or "test_" in l and ":" in l][:3]
+    if p.returncode == 0 and re.search(r" 0 failed", out):
+        return "pass", ""
+    return "fail", "; ".join(tail) or "exit %d" % p.returncode
+
+
+def load_equivalent(path):
+    eq = {}
+    if not os.path.exists(path):
+        return eq
+    for raw in open(path, encoding="utf-8"):
+        line = raw.strip()
+        if not line or line.startswith("#"):
+            continue
+        m = re.match(r"(\S+):(\d+): (.*?) -> (.*?)\s+#\s*(.*)$", line)
+        if m:
+            eq[(m.group(1), int(m.group(2)), m.group(3), m.group(4))] = m.group(5)
+    return eq
+
+
+# ---- the run -----------------------------------------------------------------
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--files", default=",".join(DEFAULT_FILES))
+    ap.add_argument("--n", type=int, default=30, help="mutants per file")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--timeout", type=float, default=0.0,
+                    help="per-case limit in s (default: 3 x the slowest baseline, >= 60)")
+    ap.add_argument("--report", default=None, help="write the table into this file")
+    ap.add_argument("--keep", action="store_true", help="keep the work tree")
+    args = ap.parse_args()
+    files = [f for f in args.files.split(",") if f]
+    eq = load_equivalent(os.path.join(ROOT, "scripts", "mutate_equivalent.txt"))
+    work = tempfile.mkdtemp(prefix="pound-mutate-")
+    log = open(os.path.join(work, "mutate.log"), "w")
+    print("mutate: a copy of the tree in %s" % work, flush=True)
+    try:
+        src = os.path.join(work, "src")
+        copy_tree(src)
+        if not build(src, log):
+            print("mutate: the unmutated tree does not build (%s)" % log.name)
+            return 2
+        t0 = time.monotonic()
+        st, why = run_suite(src, None, 600)
+        base = time.monotonic() - t0
+        if st != "pass":
+            print("mutate: the unmutated suite fails: %s" % why)
+            return 2
+        limit = args.timeout or max(60.0, 3.0 * base)
+        print("mutate: baseline suite %.0f s; limit %.0f s a case" % (base, limit), flush=True)
+        rows, gaps = [], []
+        for f in files:
+            path = os.path.join(src, f)
+            text = open(path, encoding="utf-8").read()
+            all_sites = sites(text)
+            rnd = random.Random("%d:%s" % (args.seed, f))
+            pick = sorted(rnd.sample(all_sites, min(args.n, len(all_sites))))
+            counts = {"stillborn": 0, "killed": 0, "survived": 0, "equivalent": 0}
+            for (a, b, new, op) in pick:
+                mutated = text[:a] + new + text[b:]
+                line = line_of(text, a)
+                orig = text[a:b]
+                key = (f, line, orig, new if new else "(removed)")
+                with open(path, "w", encoding="utf-8") as fh:
+                    fh.write(mutated)
+                try:
+                    if not build(src, log):
+                        counts["stillborn"] += 1
+                        verdict = "stillborn"
+                    else:
+                        verdict = "survived"
+                        for filt in DEFAULT_FILES.get(f, []) + [None]:
+                            st, why = run_suite(src, filt, limit)
+                            if st != "pass":
+                                verdict = "killed"
+                                break
+                        if verdict == "survived" and key in eq:
+                            verdict = "equivalent"
+                        counts[verdict] += 1
+                        if verdict == "survived":
+                            gaps.append("%s:%d: %s -> %s  (%s)" % (f, line, orig, key[3], op))
+                finally:
+                    with open(path, "w", encoding="utf-8") as fh:
+                        fh.write(text)
+                print("  %-28s %5d %-7s %-12s -> %-12s %s" % (f, line, op, orig[:12],
+                                                                key[3][:12], verdict),
+                      flush=True)
+            live = len(pick) - counts["stillborn"] - counts["equivalent"]
+            score = counts["killed"] / live if live else 1.0
+            rows.append((f, len(pick), counts, score))
+        build(src, log)  # the tree as it was
+        table = ["| file | mutants | stillborn | equivalent | killed | survived | killed of the "
+                 "non-equivalent |", "| --- | --- | --- | --- | --- | --- | --- |"]
+        for f, n, c, score in rows:
+            table.append("| %s | %d | %d | %d | %d | %d | %.0f %% |" % (
+                f, n, c["stillborn"], c["equivalent"], c["killed"], c["survived"],
+                100.0 * score))
+        text = "\n".join(table)
+        print("\nmutate: seed %d, %d mutants a file\n%s" % (args.seed, args.n, text))
+        if gaps:
+            print("survivors (the suite's gaps):\n  " + "\n  ".join(gaps))
+        if args.report:
+            write_report(args.report, args, text, gaps)
+        return 0 if all(score >= 0.9 for _, _, _, score in rows) else 1
+    finally:
+        log.close()
+        if not args.keep:
+            shutil.rmtree(work, ignore_errors=True)
+
+
+def write_report(path, args, table, gaps):
+    """The table between the <!-- mutate --> markers of path."""
+    body = ("<!-- mutate -->\n`make mutate` (seed %d, %d mutants a file; %s):\n\n%s\n\n%s\n"
+            "<!-- /mutate -->" % (args.seed, args.n, time.strftime("%Y-%m-%d"), table,
+                                  "Survivors: " + ("; ".join(gaps) if gaps else "none beyond "
+                                                   "scripts/mutate_equivalent.txt.")))
+    old = open(path, encoding="utf-8").read()
+    if "<!-- mutate -->" in old:
+        old = re.sub(r"<!-- mutate -->.*?<!-- /mutate -->", lambda _: body, old, flags=re.S)
+    else:
+        old = old.rstrip("\n") + "\n\n" + body + "\n"
+    open(path, "w", encoding="utf-8").write(old)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
