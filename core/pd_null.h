@@ -12,4 +12,14 @@
 
 #define PD_NULL_ARG(err, name) pd_err_set((err), PD_EINVAL, "%s: %s is NULL", __func__, (name))
 
+/* The caller's pd_err, or local when it passed none: a failure's status is
+ * then read back from it, never guessed. */
+static inline pd_err *pd_err_or(pd_err *err, pd_err *local)
+{
+    if (err)
+        return err;
+    pd_err_clear(local);
+    return local;
+}
+
 #endif

@@ -33,6 +33,7 @@
 
 #include "pd_engine.h"
 #include "pd_factor.h"
+#include "pd_null.h"
 
 #define EDG_GAP_SAMPLES 16  /* gap samples per accepted step */
 #define EDG_FORCE_SAMPLES 8 /* contact-force samples per step */
@@ -280,11 +281,13 @@ static void add_minv_w(const edg *w, int a, double s, double *x)
 /* M factored once (What with h = 0): M^-1 W and D = W^T M^-1 W with it. */
 static int factor_mass(edg *w, pd_err *err)
 {
+    pd_err own_err; /* the status read back when the caller passed no pd_err */
+    err = pd_err_or(err, &own_err);
     w->fac = pd_factor_alloc(w->md, 0.0, 1.0, w->o.factor, err);
     if (!w->fac)
         return err && err->status == PD_ESINGULAR
                    ? pd_err_set(err, PD_ESINGULAR, "event-driven: the mass matrix M is singular")
-                   : (err ? err->status : PD_ENOMEM);
+                   : err->status;
     return PD_OK;
 }
 

@@ -158,6 +158,8 @@ static void scalar_setup(pd_mj *mj)
  * dense, compressed columns bounded by the entries of D otherwise. */
 static int contact_workspace(pd_mj *mj, pd_err *err)
 {
+    pd_err own_err; /* the status read back when the caller passed no pd_err */
+    err = pd_err_or(err, &own_err);
     int m = mj->model->m;
     long nnz = mj->factor->delassus_nnz;
     mj->sparse = mj->factor->type->kind == PD_FACTOR_CHOLMOD;
@@ -166,7 +168,7 @@ static int contact_workspace(pd_mj *mj, pd_err *err)
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for %d contacts", m);
     if (!(mj->lcp = pd_lcp_solver_alloc(mj->opts.lcp_solver, mj->lcp_nmax, mj->sparse ? nnz : 0,
                                         err)))
-        return err ? err->status : PD_ENOMEM;
+        return err->status;
     if (mj->sparse) {
         mj->D_active = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof(double));
         mj->D_colptr = malloc(((size_t)m + 1) * sizeof(int));

@@ -33,6 +33,7 @@
 #include <string.h>
 
 #include "mj.h"
+#include "pd_null.h"
 
 #define ADAPT_KF 0.5        /* share of rtol for the flight's errors over the run */
 #define ADAPT_KE 0.1        /* share of rtol for one event */
@@ -431,11 +432,13 @@ int mj_adapt_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_
 /* Level k's factor of What(h_k), formed at its first use. */
 static int level_factor(pd_mj *mj, int k, pd_err *err)
 {
+    pd_err own_err; /* the status read back when the caller passed no pd_err */
+    err = pd_err_or(err, &own_err);
     mj_level *lv = &mj->ad->lev[k];
     if (lv->factor)
         return PD_OK;
     lv->factor = pd_factor_alloc(mj->model, lv->h, mj->opts.theta, mj->factor->type->kind, err);
-    return lv->factor ? PD_OK : (err ? err->status : PD_ENOMEM);
+    return lv->factor ? PD_OK : err->status;
 }
 
 /* The scalar kernel's step from x to y with level k's constants. */

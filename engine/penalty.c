@@ -32,6 +32,7 @@
 #include "pd_engine.h"
 #include "pd_factor.h"
 #include "penalty_law.h"
+#include "pd_null.h"
 
 /* A GSL stepper the baseline offers. */
 typedef struct pen_stepper {
@@ -243,6 +244,8 @@ static double inverse_mass(pen *p, int a)
  * M^-1 W_a). */
 static int setup_mass(pen *p, pd_err *err)
 {
+    pd_err own_err; /* the status read back when the caller passed no pd_err */
+    err = pd_err_or(err, &own_err);
     const pd_model *md = p->md;
     if (p->o.factor == PD_FACTOR_AUTO && pd_matrix_is_diagonal(&md->M)) {
         if (!(p->minv = malloc((size_t)p->n * sizeof(double))))
@@ -257,7 +260,7 @@ static int setup_mass(pen *p, pd_err *err)
     } else if (!(p->fac = pd_factor_alloc(md, 0.0, 1.0, p->o.factor, err)))
         return err && err->status == PD_ESINGULAR
                    ? pd_err_set(err, PD_ESINGULAR, "penalty: the mass matrix M is singular")
-                   : (err ? err->status : PD_ENOMEM);
+                   : err->status;
     for (int a = 0; a < p->m; a++) {
         double s = inverse_mass(p, a);
         p->sa[a] = s;

@@ -28,6 +28,7 @@
 #include "pd_engine.h"
 #include "pd_factor.h"
 #include "penalty_law.h"
+#include "pd_null.h"
 
 #define NM_MAX_ACTIVE 1024 /* elements engaged at once (a dense LU of that size) */
 #define NM_MAX_NEWTON 50   /* Newton iterations of one step */
@@ -321,10 +322,12 @@ static int nm_check(const nm_run *w, double t0, double t1, pd_err *err)
 /* The factors, damping constants and the state at t0. */
 static int nm_start(nm_run *w, double t0, const double *q0, const double *v0, pd_err *err)
 {
+    pd_err own_err; /* the status read back when the caller passed no pd_err */
+    err = pd_err_or(err, &own_err);
     const pd_model *md = w->md;
     if (!(w->fac = pd_factor_alloc(md, w->h, 0.5, w->o.factor, err)) ||
         !(w->mass = pd_factor_alloc(md, 0.0, 1.0, w->o.factor, err)))
-        return err ? err->status : PD_ENOMEM;
+        return err->status;
     w->qscale = 0.0;
     for (int a = 0; a < w->m; a++) {
         double s;

@@ -131,6 +131,8 @@ static double peaks_error(const adapt_track *tr, const pd_osc *c)
 static int run_once(const pd_osc *c, const pd_run_opts *o, double rtol, pd_osc_sampler sampler,
                     void *ctx, pd_osc_result *res, pd_mj_stats *stats, pd_err *err)
 {
+    pd_err own_err; /* the status read back when the caller passed no pd_err */
+    err = pd_err_or(err, &own_err);
     double pulse_end = pd_osc_shape_end(c);
     double b = 1.0;
     pd_osc_coefs k;
@@ -154,7 +156,7 @@ static int run_once(const pd_osc *c, const pd_run_opts *o, double rtol, pd_osc_s
     pd_mj *mj = pd_mj_alloc(&model, &mo, err);
     if (!mj) {
         free(pieces);
-        return err ? err->status : PD_ENOMEM;
+        return err->status;
     }
     rc = pd_mj_run_until(mj, wp * o->tend, observe, &tr, err);
     pd_mj_get_stats(mj, stats);

@@ -410,6 +410,8 @@ static int simulate_scalar(const pd_osc *c, const pd_model *md, const pd_mj_opts
 int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler,
                     void *ctx, pd_osc_result *res, pd_err *err)
 {
+    pd_err own_err; /* the status read back when the caller passed no pd_err */
+    err = pd_err_or(err, &own_err);
     pd_run_opts o;
     int rc;
     if (!c || !res)
@@ -452,7 +454,7 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
     }
     pd_mj *mj = pd_mj_alloc(&model, &mo, err);
     if (!mj)
-        return err ? err->status : PD_EINVAL;
+        return err->status;
     rc = pd_mj_run(mj, nsteps, observe, &tr, err);
     pd_osc_track_result(&tr.m, c, o.dt, pd_mj_state(mj)->step, res);
     res->tend = o.tend;

@@ -236,6 +236,8 @@ static int derived_stiffness(double k, double T0, double mass, pd_err *err)
 int pd_scene_add_sdof(pd_scene *sc, const char *name, double T0, double xi, double mass,
                       pd_err *err)
 {
+    pd_err own_err; /* the status read back when the caller passed no pd_err */
+    err = pd_err_or(err, &own_err);
     if (!sc || !name)
         return PD_NULL_ARG(err, !sc ? "sc" : "name");
     if (!positive(T0))
@@ -246,7 +248,7 @@ int pd_scene_add_sdof(pd_scene *sc, const char *name, double T0, double xi, doub
     int rc = derived_stiffness(k, T0, mass, err);
     pd_structure *st = rc ? NULL : new_structure(sc, name, 1, xi, err);
     if (!st)
-        return rc ? rc : err ? err->status : PD_EINVAL;
+        return rc ? rc : err->status;
     st->mass[0] = mass;
     st->stiffness[0] = k;
     return PD_OK;
@@ -255,6 +257,8 @@ int pd_scene_add_sdof(pd_scene *sc, const char *name, double T0, double xi, doub
 int pd_scene_add_building(pd_scene *sc, const char *name, int storeys, const double *masses,
                           const double *stiffnesses, double xi, pd_err *err)
 {
+    pd_err own_err; /* the status read back when the caller passed no pd_err */
+    err = pd_err_or(err, &own_err);
     if (!sc || !name || !masses || !stiffnesses)
         return PD_NULL_ARG(err, !sc ? "sc" : !name ? "name" : !masses ? "masses" : "stiffnesses");
     for (int i = 0; i < storeys && storeys <= SCENE_MAX_STOREYS; i++) {
@@ -268,7 +272,7 @@ int pd_scene_add_building(pd_scene *sc, const char *name, int storeys, const dou
     }
     pd_structure *st = new_structure(sc, name, storeys, xi, err);
     if (!st)
-        return err ? err->status : PD_EINVAL;
+        return err->status;
     memcpy(st->mass, masses, (size_t)storeys * sizeof(double));
     memcpy(st->stiffness, stiffnesses, (size_t)storeys * sizeof(double));
     return PD_OK;
@@ -278,6 +282,8 @@ int pd_scene_add_building(pd_scene *sc, const char *name, int storeys, const dou
 int pd_scene_add_uniform(pd_scene *sc, const char *name, int storeys, double mass, double T0,
                          double xi, pd_err *err)
 {
+    pd_err own_err; /* the status read back when the caller passed no pd_err */
+    err = pd_err_or(err, &own_err);
     if (!sc || !name)
         return PD_NULL_ARG(err, !sc ? "sc" : "name");
     if (!positive(T0))
@@ -289,7 +295,7 @@ int pd_scene_add_uniform(pd_scene *sc, const char *name, int storeys, double mas
     int rc = derived_stiffness(k, T0, mass, err);
     pd_structure *st = rc ? NULL : new_structure(sc, name, storeys, xi, err);
     if (!st)
-        return rc ? rc : err ? err->status : PD_EINVAL;
+        return rc ? rc : err->status;
     for (int i = 0; i < storeys; i++) {
         st->mass[i] = mass;
         st->stiffness[i] = k;

@@ -955,10 +955,12 @@ static int run_oscillator(const pd_scene *sc, const pd_osc *c, int mirrored,
  * model), once per run. */
 static int held_solver(track *tr, const pd_model *md, pd_err *err)
 {
+    pd_err own_err; /* the status read back when the caller passed no pd_err */
+    err = pd_err_or(err, &own_err);
     if (tr->demands && md->m > 0 && !tr->hlcp &&
         !(tr->hlcp = pd_lcp_solver_alloc(PD_LCP_LEMKE, md->m < MJ_HELD_LCP ? md->m : MJ_HELD_LCP,
                                          0, err)))
-        return err ? err->status : PD_ENOMEM;
+        return err->status;
     return PD_OK;
 }
 
@@ -966,13 +968,15 @@ static int held_solver(track *tr, const pd_model *md, pd_err *err)
 static int run_moreau(const pd_model *md, const pd_run_opts *o, long nsteps, track *tr,
                       pd_scene_result *res, pd_err *err)
 {
+    pd_err own_err; /* the status read back when the caller passed no pd_err */
+    err = pd_err_or(err, &own_err);
     pd_mj_opts mo = pd_run_mj_opts(o, tr->h);
     int rc0 = held_solver(tr, md, err);
     if (rc0)
         return rc0;
     pd_mj *mj = pd_mj_alloc(md, &mo, err);
     if (!mj)
-        return err ? err->status : PD_ENOMEM;
+        return err->status;
     int rc = pd_mj_run(mj, nsteps, observe_moreau, tr, err);
     res->steps = pd_mj_state(mj)->step;
     res->kernel = pd_mj_kernel_name(mj);
@@ -1041,6 +1045,8 @@ static int adapt_once(const pd_scene_model *sm, const pd_run_opts *o, double rto
                       const pd_piecewise_force *F, const double *atol, double tau_end,
                       track *tr, pd_scene_result *res, pd_mj_stats *stats, pd_err *err)
 {
+    pd_err own_err; /* the status read back when the caller passed no pd_err */
+    err = pd_err_or(err, &own_err);
     const pd_scene *sc = tr->sc;
     double T = sc->exc.Tp;
     for (int k = 0; k < sc->nstruct; k++)
@@ -1053,7 +1059,7 @@ static int adapt_once(const pd_scene_model *sm, const pd_run_opts *o, double rto
     track_clear(tr);
     pd_mj *mj = pd_mj_alloc(&sm->model, &mo, err);
     if (!mj)
-        return err ? err->status : PD_ENOMEM;
+        return err->status;
     int rc = pd_mj_run_until(mj, tau_end, observe_adapt, tr, err);
     pd_mj_get_stats(mj, stats);
     res->steps = stats->steps;
@@ -1227,6 +1233,8 @@ static double demand_grid(const track *tr)
 static int run_event(const pd_scene_model *sm, const pd_run_opts *o, double tau_end, track *tr,
                      pd_scene_result *res, pd_err *err)
 {
+    pd_err own_err; /* the status read back when the caller passed no pd_err */
+    err = pd_err_or(err, &own_err);
     pd_edr_opts eo = pd_edr_default_opts();
     pd_sine_piece *pieces;
     int npieces, rc;
@@ -1249,7 +1257,7 @@ static int run_event(const pd_scene_model *sm, const pd_run_opts *o, double tau_
     pd_edr *edr = pd_edr_alloc(&sm->model, &F, &eo, err);
     if (!edr) {
         free(pieces);
-        return err ? err->status : PD_ENOMEM;
+        return err->status;
     }
     tr->live_impacts = pd_edr_result_of(edr)->contact_impacts;
     rc = pd_edr_run(edr, 0.0, NULL, NULL, tau_end, eo.h_out > 0.0 ? observe_edr : NULL, tr, err);
@@ -1390,9 +1398,12 @@ static int run_general(const pd_scene *sc, const pd_run_opts *o, pd_scene_sample
         break;
     case PD_METHOD_PENALTY:
     case PD_METHOD_NEWMARK: rc = run_penalty(&sm.model, o, tau_end, &tr, res, err); break;
-    default:
+    case PD_METHOD_MOREAU:
         rc = o->rtol > 0.0 ? run_moreau_adapt(&sm, o, tau_end, &tr, res, err)
                            : run_moreau(&sm.model, o, nsteps, &tr, res, err);
+        break;
+    default: /* resolved opts name one of the above: never silently another */
+        rc = pd_err_set(err, PD_EINVAL, "method: %d is no method", (int)o->method);
         break;
     }
     fill_result(&tr, res);

@@ -429,9 +429,34 @@ static void test_harden_touching_at_rest_and_chatter(pd_test_ctx *ctx)
     pd_scene_free(sc);
 }
 
+/* A status is read back, never guessed, when the caller passes no pd_err:
+ * a singular (not diagonal) mass matrix fails the factorisation with
+ * PD_ESINGULAR for every engine, err or none (its callers returned
+ * PD_ENOMEM without one). */
+static void test_harden_status_without_err(pd_test_ctx *ctx)
+{
+    double M[4] = {1.0, 1.0, 1.0, 1.0}, K[4] = {1.0, 0.0, 0.0, 1.0};
+    pd_model md = {.n = 2, .m = 0, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_zero(2, 2),
+                   .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_zero(2, 0)};
+    for (int with = 0; with < 2; with++) {
+        pd_err e;
+        pd_penalty_opts po = pd_penalty_default_opts();
+        po.factor = PD_FACTOR_DENSE;
+        po.kc = 1e4;
+        int rp = pd_penalty_run(&md, 0.0, NULL, NULL, 1.0, &po, NULL, NULL, NULL, with ? &e : NULL);
+        pd_edg_opts go = pd_edg_default_opts();
+        go.factor = PD_FACTOR_DENSE;
+        int rg = pd_edg_run(&md, 0.0, NULL, NULL, 1.0, &go, NULL, NULL, NULL, with ? &e : NULL);
+        CHECK(ctx, rp == PD_ESINGULAR && rg == PD_ESINGULAR,
+              "%s pd_err: penalty %d, event-general %d, want %d", with ? "with" : "without", rp,
+              rg, PD_ESINGULAR);
+    }
+}
+
 void suite_harden(pd_test_ctx *ctx)
 {
     pd_test_run(ctx, "harden_derived_overflow", test_harden_derived_overflow);
+    pd_test_run(ctx, "harden_status_without_err", test_harden_status_without_err);
     pd_test_run(ctx, "harden_h5_dimension_names", test_harden_h5_dimension_names);
     pd_test_run(ctx, "harden_cpu_limit_cleans_up", test_harden_cpu_limit_cleans_up);
     pd_test_run(ctx, "harden_bench_shared_and_isa", test_harden_bench_shared_and_isa);
