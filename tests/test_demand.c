@@ -4,13 +4,15 @@
  * the floors' inertia forces from the kinematics, Moreau–Jean's demands
  * converging to the event-driven reference's, the penalty's peak contact
  * force against the impulse and the contact time (oscillator and scene),
- * the other results untouched by measuring the demands, and the scene field
- * storey_heights and the flags refused. */
+ * the other results untouched by measuring the demands, the scene field
+ * storey_heights and the flags refused, and the peak of a cubic between two
+ * states against closed forms. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
+#include "demand.h"
 #include "pd_problems.h"
 #include "pd_test.h"
 
@@ -573,6 +575,62 @@ static void test_demand_cli_refusals(pd_test_ctx *ctx)
     pd_test_rm_dir(dir);
 }
 
+/* ---- the peak between two states ------------------------------------------------ */
+
+/* pd_demand_cubic_peak against cubics whose turning points are known: p
+ * given by its values and slopes at the ends of [0, h] is the cubic itself,
+ * so the peak is max |p| at the roots of p' inside (0, h), in closed form.
+ * The function forms the Hermite coefficients from the four data (a few
+ * roundings each, their sizes those of p) and the roots from them by the
+ * stable quadratic formula: 1e-12 relative leaves the roundings room and
+ * no wrong root (a wrong root's value differs here by percents).
+ *   - p' = 3 (s - 0.5)(s - 1.5) on h = 2: both turns inside, p(0.5) =
+ *     -0.3, p(1.5) = -0.8: the peak 0.8 is the second root's;
+ *   - the same reflected (p -> -p, the roots' order swapped by s -> h - s);
+ *   - p = 3 + 2 (s - 1/4)^2 on h = 1 (A = 0 exactly: p' linear, the
+ *     degenerate branch): the peak 3 at s = 1/4; with the turn at s = 1.5
+ *     past h = 1: none inside, 0;
+ *   - p' = (s - 1)^2 + 1 > 0 (no real turn): 0. */
+static double cubic_p(double p0, double alpha, double r1, double r2, double s)
+{
+    return p0 + alpha * (s * s * s / 3.0 - 0.5 * (r1 + r2) * s * s + r1 * r2 * s);
+}
+
+static double cubic_dp(double alpha, double r1, double r2, double s)
+{
+    return alpha * (s - r1) * (s - r2);
+}
+
+static void test_demand_cubic_peak(pd_test_ctx *ctx)
+{
+    const double tol = 1e-12;
+    /* two turns inside */
+    double h = 2.0, p0 = -0.8, al = 3.0, r1 = 0.5, r2 = 1.5;
+    double want = fmax(fabs(cubic_p(p0, al, r1, r2, r1)), fabs(cubic_p(p0, al, r1, r2, r2)));
+    double got = pd_demand_cubic_peak(cubic_p(p0, al, r1, r2, 0.0), cubic_dp(al, r1, r2, 0.0),
+                                      cubic_p(p0, al, r1, r2, h), cubic_dp(al, r1, r2, h), h);
+    CHECK(ctx, fabs(want - 0.8) <= 1e-15 && fabs(got - want) <= tol * want,
+          "cubic, turns at 0.5 and 1.5: peak %.17g, closed form %.17g", got, want);
+    /* reflected: q(s) = -p(h - s), its slopes q'(s) = p'(h - s) */
+    got = pd_demand_cubic_peak(-cubic_p(p0, al, r1, r2, h), cubic_dp(al, r1, r2, h),
+                               -cubic_p(p0, al, r1, r2, 0.0), cubic_dp(al, r1, r2, 0.0), h);
+    CHECK(ctx, fabs(got - want) <= tol * want, "reflected cubic: peak %.17g, closed form %.17g",
+          got, want);
+    /* p' linear: p = 3 + 2 (s - r)^2 on h = 1 */
+    for (int k = 0; k < 2; k++) {
+        double r = k ? 1.5 : 0.25, b = 2.0, c0 = 3.0, h1 = 1.0;
+        double f0 = c0 + b * r * r, f1 = c0 + b * (h1 - r) * (h1 - r);
+        double d0 = -2.0 * b * r, d1 = 2.0 * b * (h1 - r);
+        got = pd_demand_cubic_peak(f0, d0, f1, d1, h1);
+        want = k ? 0.0 : c0;
+        CHECK(ctx, fabs(got - want) <= tol * c0,
+              "quadratic, turn at s = %g on [0, 1]: peak %.17g, expected %.17g", r, got, want);
+    }
+    /* no real turn: p' = (s - 1)^2 + 1 = s^2 - 2 s + 2, p = s^3 / 3 - s^2 + 2 s - 1 */
+    got = pd_demand_cubic_peak(-1.0, 2.0, 8.0 / 3.0 - 4.0 + 4.0 - 1.0, 2.0, 2.0);
+    CHECK(ctx, got == 0.0, "monotone cubic: peak %.17g, expected 0", got);
+}
+
 void suite_demand(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_demand_sdof_closed_form);
@@ -584,4 +642,5 @@ void suite_demand(pd_test_ctx *ctx)
     PD_RUN(ctx, test_demand_leaves_results_alone);
     PD_RUN(ctx, test_demand_storey_heights);
     PD_RUN(ctx, test_demand_cli_refusals);
+    PD_RUN(ctx, test_demand_cubic_peak);
 }

@@ -694,6 +694,104 @@ static void test_engine_dense_factor_scaled(pd_test_ctx *ctx)
     pd_factor_free(f);
 }
 
+/* ---- breakpoints closer than a step ---------------------------------------------- */
+
+/* F(t) = F_k on [b_k, b_k+1): a load jumping at every breakpoint; side -1
+ * the left limit, +1 the right one (they differ only at the b_k). */
+typedef struct jumpy_force {
+    const double *b, *F; /* nb breakpoints, nb values */
+    int nb;
+    long right_calls;    /* right limits asked */
+} jumpy_force;
+
+static void jumpy_at(double t, int side, double *F, void *vctx)
+{
+    jumpy_force *j = vctx;
+    int k = -1;
+    while (k + 1 < j->nb && (side > 0 ? j->b[k + 1] <= t : j->b[k + 1] < t))
+        k++;
+    F[0] = k < 0 ? 0.0 : j->F[k];
+    j->right_calls += side > 0;
+}
+
+/* The states of a run, step by step. */
+typedef struct step_log {
+    double q[400], v[400], P[400];
+    int n;
+} step_log;
+
+static int log_step(const pd_state *s, void *vctx)
+{
+    step_log *l = vctx;
+    if (l->n < 400) {
+        l->q[l->n] = s->q[0];
+        l->v[l->n] = s->v[0];
+        l->P[l->n++] = s->P[0];
+    }
+    return 0;
+}
+
+/* A breakpoint inside a step changes nothing (the step's end sees the load
+ * past it as the left limit there), one on a step's end starts the next
+ * step from the right limit.  An SDOF on a wall (the scalar kernel) under a
+ * load jumping every 0.3 h (h = 0.01 s, 300 steps, 1000 breakpoints, one in
+ * ten on a step's end): the run told every breakpoint equals, to the bit at
+ * every step (the same operations on the same loads), the run told only
+ * the 100 on its grid; the right limit is asked at the start (t = 0, one of
+ * them) and at the other 99 only, not at the ends of steps that merely
+ * contain one. */
+static void test_engine_breaks_inside_steps(pd_test_ctx *ctx)
+{
+    enum { NB = 1000, NSTEPS = 300 };
+    static double b[NB], F[NB], grid_b[NB];
+    static step_log all, grid;
+    const double h = 0.01;
+    int ng = 0;
+    for (int k = 0; k < NB; k++) {
+        b[k] = (double)k * 0.3 * h;
+        F[k] = 50.0 * sin(1.7 * k);
+        double j = round(b[k] / h); /* on the grid as pd_mj sees it: within 1e-9 h */
+        if (fabs(b[k] - j * h) <= 1e-9 * h)
+            grid_b[ng++] = b[k];
+    }
+    double M = 1.0, K = 4.0 * PD_PI * PD_PI, C = 0.1, W = -1.0, g0 = 0.05, e = 0.5;
+    int cp[2] = {0, 1}, ri[1] = {0};
+    jumpy_force fine = {.b = b, .F = F, .nb = NB};
+    pd_model md = {.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, &M), .C = pd_matrix_dense(1, 1, &C),
+                   .K = pd_matrix_dense(1, 1, &K), .W = pd_matrix_csc(1, 1, cp, ri, &W),
+                   .g0 = &g0, .e = &e, .force = jumpy_at, .force_ctx = &fine, .breaks = b,
+                   .nbreaks = NB};
+    pd_mj_opts o = pd_mj_default_opts();
+    o.h = h;
+    for (int run = 0; run < 2; run++) {
+        step_log *l = run ? &grid : &all;
+        pd_model m2 = md;
+        if (run) { /* the same load, told only the breakpoints on the grid */
+            m2.breaks = grid_b;
+            m2.nbreaks = ng;
+        }
+        pd_err err;
+        fine.right_calls = 0;
+        l->n = 0;
+        pd_mj *mj = pd_mj_alloc(&m2, &o, &err);
+        int rc = mj ? pd_mj_run(mj, NSTEPS, log_step, l, &err) : -1;
+        CHECK(ctx, mj && rc == PD_OK && l->n == NSTEPS + 1 &&
+                       !strcmp(pd_mj_kernel_name(mj), "scalar"),
+              "run %d: %s (%d states)", run, mj ? err.msg : "alloc", l->n);
+        CHECK(ctx, fine.right_calls == 1 + (ng - 1),
+              "run %d: the right limit asked %ld times: at t = 0 and the %d breakpoints on the "
+              "grid after it", run, fine.right_calls, ng - 1);
+        pd_mj_free(mj);
+    }
+    CHECK(ctx, ng == 100 && !memcmp(all.q, grid.q, sizeof all.q) &&
+                   !memcmp(all.v, grid.v, sizeof all.v) && !memcmp(all.P, grid.P, sizeof all.P),
+          "every breakpoint (%d) or only the %d on the grid: the same steps to the bit", NB, ng);
+    double worst = 0.0;
+    for (int k = 0; k < NSTEPS; k++)
+        worst = fmax(worst, fabs(all.P[k]));
+    CHECK(ctx, worst > 0.0, "the wall takes impulses (largest %g)", worst);
+}
+
 void suite_engine(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_engine_sdof_closed_form);
@@ -709,4 +807,5 @@ void suite_engine(pd_test_ctx *ctx)
     PD_RUN(ctx, test_engine_batch_flags_nonfinite);
     PD_RUN(ctx, test_engine_dense_lu_scaled);
     PD_RUN(ctx, test_engine_dense_factor_scaled);
+    PD_RUN(ctx, test_engine_breaks_inside_steps);
 }

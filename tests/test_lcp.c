@@ -943,6 +943,83 @@ static void test_lcp_small_degenerate_vs_enumeration(pd_test_ctx *ctx)
     pd_lcp_free(big);
 }
 
+/* n = 3, 4 (the vector path where the processor has AVX2) against the
+ * general code on the same problem with one more row, decoupled (M = 1 on
+ * its diagonal, 0 elsewhere; q = 1: its w = 1 + z0 stays basic, its z = 0):
+ * the same pivots on the first n rows, the same operations in the same
+ * order (the extra row adds only zero terms to them), so the same status,
+ * pivots, z and w to the bit, on 400 random P-matrix problems (a wrong z
+ * from the vector path that the polish or the repair would put right to
+ * within the verification's tolerance is still another z). */
+static void test_lcp_vector_path_same_bits(pd_test_ctx *ctx)
+{
+    uint64_t rng = 0x5ec70;
+    int differ = 0;
+    for (int rep = 0; rep < 400; rep++) {
+        int n = 3 + rep % 2, n1 = n + 1;
+        lcp_case c = case_new(n), e = case_new(n1);
+        if (!case_ok(&c) || !case_ok(&e)) {
+            CHECK(ctx, 0, "out of memory");
+            case_free(&c);
+            case_free(&e);
+            return;
+        }
+        if (rep % 4 < 2)
+            random_pd_skew(&c, 2, &rng);
+        else
+            random_diag_dominant(&c, &rng);
+        random_q(&c, &rng);
+        for (int j = 0; j < n; j++) {
+            for (int i = 0; i < n; i++)
+                e.M[i + j * n1] = c.M[i + j * n];
+            e.q[j] = c.q[j];
+        }
+        e.M[n + n * n1] = 1.0;
+        e.q[n] = 1.0;
+        pd_lcp_info a, b;
+        int sa = solve(&c, NULL, &a), sb = solve(&e, NULL, &b);
+        int same = sa == PD_OK && sb == PD_OK && a.pivots == b.pivots && e.z[n] == 0.0 &&
+                   !memcmp(c.z, e.z, (size_t)n * sizeof(double)) &&
+                   !memcmp(c.w, e.w, (size_t)n * sizeof(double));
+        if (!same && differ++ < 3)
+            CHECK(ctx, 0, "rep %d, n = %d: status %d / %d, pivots %d / %d, z differs by %.3g",
+                  rep, n, sa, sb, a.pivots, b.pivots, max_diff(n, c.z, e.z));
+        case_free(&c);
+        case_free(&e);
+    }
+    CHECK(ctx, differ == 0, "%d of 400 problems differ between the two paths", differ);
+}
+
+/* The last tie-break of the ratio test: rows still tied after every column
+ * of the lexicographic rule leave by the largest pivot.  With tol 0.5 (the
+ * ties and the rule's roundoff level half of their scale; any tol in
+ * (0, 1) is allowed) rows of this degenerate n = 6 problem (integer M, q
+ * with zeros, found among random ones) stay tied through every column, and
+ * taking the first of them instead makes the pivots cycle to the cap
+ * (10000).  Lemke answers in 17 pivots, verified independently (relative
+ * residual <= 1e-10, pd_lcp_residual). */
+static void test_lcp_final_tie_break(pd_test_ctx *ctx)
+{
+    static const double M[36] = {3, -1, -1, 0,  1, -1, -2, 2, 1,  2, -1, 0,
+                                 -2, -1, 2, 1, 2, 1,  1, -1, 2, 2, 1, -2,
+                                 0, 0,  1, -2, 2, -2, -2, -2, 2, -1, 1, 3};
+    static const double q[6] = {1, 0, -1, -1, 0, 1};
+    double z[6], w[6], wr[6], comp = NAN, infeas = NAN, residual = NAN;
+    pd_lcp_work *work = pd_lcp_alloc(6);
+    pd_lcp_opts opts = pd_lcp_default_opts();
+    pd_lcp_info info;
+    opts.tol = 0.5;
+    if (!CHECK(ctx, work != NULL, "out of memory"))
+        return;
+    int st = pd_lcp_lemke(work, 6, M, q, &opts, z, w, &info);
+    pd_lcp_residual(6, M, q, z, wr, &comp, &infeas, &residual);
+    CHECK(ctx, st == PD_OK && info.outcome == PD_LCP_SOLVED && info.pivots < 100 &&
+                   residual <= VERIFY_TOL,
+          "status %d (%s) after %d pivots, relative residual %.3g", st,
+          pd_lcp_outcome_name(info.outcome), info.pivots, residual);
+    pd_lcp_free(work);
+}
+
 /* A NaN or an infinity anywhere in M or q is invalid input, whatever its
  * place (the scan of M runs in pairs with a tail): PD_EINVAL, outcome
  * numerical, z and w untouched. */
@@ -1485,6 +1562,8 @@ void suite_lcp(pd_test_ctx *ctx)
     PD_RUN(ctx, test_lcp_cover_vector);
     PD_RUN(ctx, test_lcp_unit_cover_same_bits);
     PD_RUN(ctx, test_lcp_small_degenerate_vs_enumeration);
+    PD_RUN(ctx, test_lcp_vector_path_same_bits);
+    PD_RUN(ctx, test_lcp_final_tie_break);
     PD_RUN(ctx, test_lcp_nonfinite_anywhere);
     PD_RUN(ctx, test_lcp_solve_allocates_nothing);
     PD_RUN(ctx, test_lcp_closed_form_within_tolerance);

@@ -19,7 +19,13 @@
  *   - an SDOF row's run allocates nothing;
  *   - the sampled impulses hold the held contacts' force integrals: the
  *     closed form on a wall (both references), Moreau-Jean's and the
- *     general reference's totals per contact on rows of 2 and 3. */
+ *     general reference's totals per contact on rows of 2 and 3;
+ *   - the figures of a measurement (pd_scene_measure_run) recomputed from
+ *     its results; an impact of 69 contacts (D in compressed columns)
+ *     against its closed form; one object run again gives the same bits;
+ *     no forcing piece is refused; the scan's work does not grow with the
+ *     start time; SDOF trees held by contacts of weights other than 1 and
+ *     a modal cluster's scan step against closed forms. */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -869,6 +875,122 @@ static void test_rows_measure_other_grid(pd_test_ctx *ctx)
     pd_scene_free(sc);
 }
 
+/* The history of a run on the reference grid, for err_hist recomputed. */
+typedef struct grid_hist {
+    const pd_scene *sc;
+    const pd_scene_trace *ref;
+    const double *scale; /* nstruct */
+    double *err;         /* nstruct: max over rows and storeys |x - x_ref| / scale */
+    long rows;
+} grid_hist;
+
+static int grid_hist_sample(const pd_scene_sample *s, void *vctx)
+{
+    grid_hist *g = vctx;
+    double k = s->t / g->ref->dt;
+    long row = lround(k);
+    if (fabs(k - (double)row) > 1e-9 || row >= g->ref->rows)
+        return 0; /* a state between grid points */
+    const double *xr = g->ref->x + (size_t)row * g->ref->n;
+    for (int st = 0; st < g->sc->nstruct; st++)
+        for (int i = g->sc->st[st].dof; i < g->sc->st[st].dof + g->sc->st[st].storeys; i++)
+            g->err[st] = fmax(g->err[st], fabs(s->x[i] - xr[i]) / g->scale[st]);
+    g->rows++;
+    return 0;
+}
+
+/* What pd_scene_measure_run reports, recomputed from its two results: a
+ * 3-storey building between a wall and an SDOF (contacts at its first and
+ * top floors), Moreau-Jean at dt 5e-3 against the reference on the grid
+ * 1e-3 (stride 5: the run's own states compared).  Its first-order steps
+ * across 21 impacts have a real error: every err_* > 1e-6 (measured 2.8e-4
+ * to 0.12).  Each figure is the same operations on the same doubles as the
+ * measurement's (a max of |difference| / scale), so equal exactly:
+ * err_umax[s] = max over storeys |umax - umax_ref| / max over storeys
+ * umax_ref, the maxima the max over structures, err_hist from the run's own
+ * samples on the grid against the trace; impacts the sum of the run's per
+ * contact (both contacts pound), grid_points 3 / 5e-3 + 1 = 601, cpu_s the
+ * run's own (> 0). */
+static void test_rows_measure_figures(pd_test_ctx *ctx)
+{
+    static const double masses[] = {3.0e5, 3.0e5, 2.5e5}, stiff[] = {6.0e8, 5.0e8, 4.0e8};
+    pd_err e;
+    pd_scene *sc = new_scene(PD_PULSE_SINE, 1, 4.0, 0.8);
+    int ok = sc && !pd_scene_add_building(sc, "low", 3, masses, stiff, 0.05, &e) &&
+             !pd_scene_add_sdof(sc, "flex", 1.0, 0.05, 2.0e5, &e) &&
+             !pd_scene_add_contact(sc, PD_WALL, 0, 0, 1, 0.002, 0.5, 0, &e) &&
+             !pd_scene_add_contact(sc, 0, 3, 1, 1, 0.01, 0.6, 1, &e) && !pd_scene_finish(sc, &e);
+    if (!CHECK(ctx, ok, "scene: %s", sc ? e.msg : "out of memory")) {
+        pd_scene_free(sc);
+        return;
+    }
+    sc->tend = 3.0;
+    pd_scene_trace ref = {0};
+    pd_scene_result rr = {0}, mr = {0}, own = {0};
+    pd_scene_errors se = {0};
+    pd_run_opts o = pd_run_default_opts();
+    o.dt = 1e-3;
+    int rc = pd_scene_trace_alloc(&ref, sc, &o, &e);
+    if (!rc)
+        rc = pd_scene_result_alloc(sc, &rr, &e);
+    if (!rc)
+        rc = pd_scene_result_alloc(sc, &mr, &e);
+    if (!rc)
+        rc = pd_scene_result_alloc(sc, &own, &e);
+    if (!rc)
+        rc = pd_scene_errors_alloc(sc, &se, &e);
+    if (!rc)
+        rc = pd_scene_measure_reference(sc, &o, &ref, &rr, &e);
+    o.method = PD_METHOD_MOREAU;
+    o.dt = 5e-3;
+    if (!rc)
+        rc = pd_scene_measure_run(sc, &o, &ref, &rr, &mr, &se, &e);
+    double scale[2], err[2] = {0.0, 0.0};
+    grid_hist gh = {.sc = sc, .ref = &ref, .scale = scale, .err = err};
+    if (CHECK(ctx, rc == PD_OK && se.nstruct == 2, "measure: %s", e.msg)) {
+        double umax_max = 0.0, hist_max = 0.0;
+        long impacts = 0;
+        for (int s = 0; s < 2; s++) {
+            double worst = 0.0;
+            scale[s] = 0.0;
+            for (int i = sc->st[s].dof; i < sc->st[s].dof + sc->st[s].storeys; i++)
+                scale[s] = fmax(scale[s], rr.umax[i]);
+            for (int i = sc->st[s].dof; i < sc->st[s].dof + sc->st[s].storeys; i++)
+                worst = fmax(worst, fabs(mr.umax[i] - rr.umax[i]) / scale[s]);
+            CHECK(ctx, se.err_umax[s] > 1e-6 && se.err_hist[s] > 1e-6,
+                  "%s: a coarse step has errors (umax %.3g, history %.3g)", sc->st[s].name,
+                  se.err_umax[s], se.err_hist[s]);
+            CHECK(ctx, se.err_umax[s] == worst, "%s: err_umax %.17g, recomputed %.17g",
+                  sc->st[s].name, se.err_umax[s], worst);
+            umax_max = fmax(umax_max, se.err_umax[s]);
+            hist_max = fmax(hist_max, se.err_hist[s]);
+        }
+        CHECK(ctx, se.err_umax_max == umax_max && se.err_hist_max == hist_max,
+              "maxima %.17g %.17g, over the structures %.17g %.17g", se.err_umax_max,
+              se.err_hist_max, umax_max, hist_max);
+        for (int a = 0; a < sc->ncontact; a++)
+            impacts += mr.impacts[a];
+        CHECK(ctx, mr.impacts[0] > 0 && mr.impacts[1] > 0 && se.impacts == impacts,
+              "impacts %ld, per contact %ld + %ld", se.impacts, mr.impacts[0], mr.impacts[1]);
+        CHECK(ctx, se.grid_points == 601, "%ld grid points compared, 601 expected",
+              se.grid_points);
+        CHECK(ctx, se.cpu_s > 0.0 && se.cpu_s == mr.cpu_s, "cpu_s %.3g, the run's %.3g",
+              se.cpu_s, mr.cpu_s);
+        o.no_demands = o.no_law_band = 1; /* as the measurement runs it */
+        rc = pd_scene_run(sc, &o, grid_hist_sample, &gh, &own, &e);
+        if (CHECK(ctx, rc == PD_OK && gh.rows == 601, "own run: %s (%ld rows)", e.msg, gh.rows))
+            for (int s = 0; s < 2; s++)
+                CHECK(ctx, se.err_hist[s] == err[s], "%s: err_hist %.17g, recomputed %.17g",
+                      sc->st[s].name, se.err_hist[s], err[s]);
+    }
+    pd_scene_errors_free(&se);
+    pd_scene_result_free(&own);
+    pd_scene_result_free(&mr);
+    pd_scene_result_free(&rr);
+    pd_scene_trace_free(&ref);
+    pd_scene_free(sc);
+}
+
 /* A scene run's cpu_s leaves its sampler's time out: a sampler that spends
  * 50 us of CPU at each of the 4001 samples of a run of some ms (0.2 s in
  * all) is not charged to the run. */
@@ -1000,6 +1122,381 @@ static void test_rows_tolerance_decides(pd_test_ctx *ctx)
                   res->simultaneous);
         pd_edr_free(r);
     }
+}
+
+/* The first impact's impulses and velocities, by contact and by dof. */
+typedef struct first_impact {
+    int seen, ncontacts, ndofs;
+    double t, *P, *v_minus, *v_plus;
+} first_impact;
+
+static int keep_first_impact(const pd_edr_event *ev, void *vctx)
+{
+    first_impact *fi = vctx;
+    if (ev->kind != PD_EDR_IMPACT || fi->seen++)
+        return 0;
+    fi->t = ev->t;
+    fi->ncontacts = ev->ncontacts;
+    fi->ndofs = ev->ndofs;
+    for (int j = 0; j < ev->ncontacts; j++)
+        fi->P[ev->contacts[j]] = ev->P[j];
+    for (int k = 0; k < ev->ndofs; k++) {
+        fi->v_minus[ev->dofs[k]] = ev->v_minus[k];
+        fi->v_plus[ev->dofs[k]] = ev->v_plus[k];
+    }
+    return 0;
+}
+
+/* A row of 70 free unit masses touching (gaps 0), compressed at t = 0 with
+ * v_p = V (1 - 2 p / 69) at position p: its 69 contacts close at once, one
+ * impact of more contacts than the clusters' LCPs take (EDR_REDUCED_MAX
+ * 64): the impulses on the dofs, D assembled in compressed columns (more
+ * than EDR_DENSE_MAX 8 contacts).  The dofs are numbered right to left, so
+ * that each column's entries come unsorted from the dofs' contact lists.
+ * Closed form (e = 0.5): every contact closes at the rate -2V/69 and leaves
+ * at e times it, so v+_p = -e v_p (momentum 0 kept), and the impulse of
+ * contact j (positions j, j + 1) is the momentum change of the masses left
+ * of it, P_j = (1 + e) V (j + 1) (1 - j / 69).  One stage (every contact
+ * then opens).  The LCP of 69 contacts (D tridiagonal, condition about
+ * 2000) carries some hundred roundings of its figures: 1e-12 relative
+ * (measured 1.6e-14, 2.0e-14). */
+static void test_rows_sparse_impact(pd_test_ctx *ctx)
+{
+    enum { N = 70, MC = N - 1 };
+    static double one[N], zero[N], g0[MC], e[MC], wv[2 * MC], v0[N], P[MC], vm[N], vp[N];
+    static int cp[MC + 1], ri[2 * MC];
+    const double V = 1.0, eps = 0.5;
+    for (int i = 0; i < N; i++) {
+        int p = N - 1 - i; /* dof i sits at position p */
+        one[i] = 1.0;
+        zero[i] = 0.0;
+        v0[i] = V * (1.0 - 2.0 * p / (N - 1.0));
+    }
+    for (int j = 0; j < MC; j++) { /* contact j: positions j (dof N-1-j) and j + 1 (dof N-2-j) */
+        g0[j] = 0.0;
+        e[j] = eps;
+        cp[j] = 2 * j;
+        ri[2 * j] = N - 2 - j; /* g = x(j + 1) - x(j) */
+        wv[2 * j] = 1.0;
+        ri[2 * j + 1] = N - 1 - j;
+        wv[2 * j + 1] = -1.0;
+    }
+    cp[MC] = 2 * MC;
+    int dp[N + 1], di[N];
+    for (int i = 0; i <= N; i++)
+        dp[i] = i;
+    for (int i = 0; i < N; i++)
+        di[i] = i;
+    pd_model md = {.n = N, .m = MC, .M = pd_matrix_csc(N, N, dp, di, one),
+                   .C = pd_matrix_zero(N, N), .K = pd_matrix_zero(N, N),
+                   .W = pd_matrix_csc(N, MC, cp, ri, wv), .g0 = g0, .e = e};
+    pd_sine_piece pc = {.t_start = 0.0};
+    pd_piecewise_force F = {.b = zero, .pieces = &pc, .npieces = 1};
+    first_impact fi = {.P = P, .v_minus = vm, .v_plus = vp};
+    pd_edr_opts eo = pd_edr_default_opts();
+    eo.on_event = keep_first_impact;
+    eo.on_event_ctx = &fi;
+    pd_err err;
+    pd_edr *r = pd_edr_alloc(&md, &F, &eo, &err);
+    if (!CHECK(ctx, r != NULL, "%s", err.msg))
+        return;
+    int rc = pd_edr_run(r, 0.0, NULL, v0, 1.0, NULL, NULL, &err);
+    const pd_edr_result *res = pd_edr_result_of(r);
+    if (CHECK(ctx, rc == PD_OK && fi.seen >= 1 && fi.t == 0.0 && fi.ncontacts == MC &&
+                       fi.ndofs == N && res->impacts == MC && res->simultaneous == 1,
+              "%s: the first impact at t = %g of %d contacts and %d dofs; impacts %ld, "
+              "simultaneous %ld", err.msg, fi.t, fi.ncontacts, fi.ndofs, res->impacts,
+              res->simultaneous)) {
+        double worst_P = 0.0, worst_v = 0.0;
+        for (int j = 0; j < MC; j++) {
+            double want = (1.0 + eps) * V * (j + 1.0) * (1.0 - j / (N - 1.0));
+            worst_P = fmax(worst_P, fabs(P[j] - want) / want);
+        }
+        for (int i = 0; i < N; i++)
+            worst_v = fmax(worst_v, fabs(vp[i] + eps * v0[i]) / V);
+        CHECK(ctx, worst_P <= 1e-12 && worst_v <= 1e-12,
+              "impulses off the closed form by %.3g (relative), velocities by %.3g V", worst_P,
+              worst_v);
+    }
+    pd_edr_free(r);
+}
+
+/* ---- one object, several runs; its refusals; the scan's work -------------------- */
+
+/* What a run measured (pd_edr_result's figures and arrays), copied. */
+typedef struct edr_snap {
+    long events, impacts, simultaneous, tol_closed, accumulations, detachments, lcp_solves;
+    double evals, first_impact, t_reached, max_penetration;
+    double xpos[4], xneg[4], drift[4], first[4], max_impulse[4], contact_time[4], min_gap[4];
+    long contact_impacts[4];
+} edr_snap;
+
+static void edr_snap_take(const pd_edr *r, int n, int m, edr_snap *s)
+{
+    const pd_edr_result *res = pd_edr_result_of(r);
+    memset(s, 0, sizeof *s);
+    *s = (edr_snap){.events = res->events, .impacts = res->impacts,
+                    .simultaneous = res->simultaneous, .tol_closed = res->tol_closed,
+                    .accumulations = res->accumulations, .detachments = res->detachments,
+                    .lcp_solves = res->lcp_solves, .evals = res->evals,
+                    .first_impact = res->first_impact, .t_reached = res->t_reached,
+                    .max_penetration = res->max_penetration};
+    memcpy(s->xpos, res->xpos, (size_t)n * sizeof(double));
+    memcpy(s->xneg, res->xneg, (size_t)n * sizeof(double));
+    memcpy(s->drift, res->drift, (size_t)n * sizeof(double));
+    memcpy(s->first, res->first, (size_t)m * sizeof(double));
+    memcpy(s->max_impulse, res->max_impulse, (size_t)m * sizeof(double));
+    memcpy(s->contact_time, res->contact_time, (size_t)m * sizeof(double));
+    memcpy(s->min_gap, res->min_gap, (size_t)m * sizeof(double));
+    memcpy(s->contact_impacts, res->contact_impacts, (size_t)m * sizeof(long));
+}
+
+/* A run depends on its arguments only: one object runs a row (two SDOFs
+ * that pound, a wall 1 m right of the second that they never reach), then
+ * the row from another start (t0 0.5, moving), then the first run again,
+ * which gives the first run's results to the bit (every figure, every
+ * extreme and contact array: the extremes of each flight measured from the
+ * run's start, the smallest gaps too). */
+static void test_rows_run_again_same(pd_test_ctx *ctx)
+{
+    pd_err e;
+    pd_scene *sc = new_scene(PD_PULSE_SINE, 1, 4.0, 1.0);
+    int ok = sc && !pd_scene_add_sdof(sc, "A", 1.0, 0.05, 1.0, &e) &&
+             !pd_scene_add_sdof(sc, "B", 1.6, 0.05, 1.5, &e) &&
+             !pd_scene_add_contact(sc, 0, 1, 1, 1, 0.01, 0.6, 0, &e) &&
+             !pd_scene_add_contact(sc, 1, 1, PD_WALL, 0, 1.0, 0.6, 1, &e) &&
+             !pd_scene_finish(sc, &e);
+    if (!CHECK(ctx, ok, "scene: %s", sc ? e.msg : "out of memory")) {
+        pd_scene_free(sc);
+        return;
+    }
+    pd_edr_opts eo = pd_edr_default_opts();
+    row_run rr;
+    if (row_open(ctx, sc, &eo, &rr)) {
+        double Le = pd_scene_Le(sc), t1 = pd_scene_wp(sc) * 4.0, v0[2] = {0.3, -0.2};
+        edr_snap a, b, again;
+        int rc = pd_edr_run(rr.edr, 0.0, NULL, NULL, t1, NULL, NULL, &e);
+        edr_snap_take(rr.edr, 2, 2, &a);
+        if (!rc)
+            rc = pd_edr_run(rr.edr, 0.5, NULL, v0, t1 + 1.0, NULL, NULL, &e);
+        edr_snap_take(rr.edr, 2, 2, &b);
+        if (!rc)
+            rc = pd_edr_run(rr.edr, 0.0, NULL, NULL, t1, NULL, NULL, &e);
+        edr_snap_take(rr.edr, 2, 2, &again);
+        if (CHECK(ctx, rc == PD_OK, "runs: %s", e.msg)) {
+            CHECK(ctx, a.contact_impacts[0] > 0 && a.contact_impacts[1] == 0 &&
+                           a.min_gap[1] > 0.0 && a.min_gap[1] < 1.0 / Le,
+                  "the row pounds (%ld impacts), never reaches the wall (%ld; smallest gap %g)",
+                  a.contact_impacts[0], a.contact_impacts[1], a.min_gap[1]);
+            CHECK(ctx, memcmp(&a, &b, sizeof a) != 0, "the other start changes the results");
+            CHECK(ctx, memcmp(&a, &again, sizeof a) == 0,
+                  "run again: xpos %.17g %.17g vs %.17g %.17g, min_gap %.17g vs %.17g, impacts "
+                  "%ld vs %ld, evals %.17g vs %.17g",
+                  again.xpos[0], again.xpos[1], a.xpos[0], a.xpos[1], again.min_gap[1],
+                  a.min_gap[1], again.impacts, a.impacts, again.evals, a.evals);
+        }
+    }
+    row_close(&rr);
+    pd_scene_free(sc);
+}
+
+/* A piecewise force of no piece (or fewer) is refused: NULL, PD_EINVAL. */
+static void test_rows_no_pieces_refused(pd_test_ctx *ctx)
+{
+    double g0[1] = {0.1}, e[1] = {0.5}, b[1] = {1.0}, one[1] = {1.0};
+    int cp[2] = {0, 1}, ri[1] = {0};
+    double wv[1] = {-1.0};
+    pd_model md = {.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, one),
+                   .C = pd_matrix_zero(1, 1), .K = pd_matrix_dense(1, 1, one),
+                   .W = pd_matrix_csc(1, 1, cp, ri, wv), .g0 = g0, .e = e};
+    pd_sine_piece pc = {.t_start = 0.0, .c0 = 1.0};
+    for (int np = 0; np >= -1; np--) {
+        pd_piecewise_force F = {.b = b, .pieces = &pc, .npieces = np};
+        pd_err err = {0};
+        pd_edr *r = pd_edr_alloc(&md, &F, NULL, &err);
+        CHECK(ctx, r == NULL && err.status == PD_EINVAL && strstr(err.msg, "piecewise force"),
+              "npieces %d: %s (status %d: %s)", np, r ? "accepted" : "refused", err.status,
+              err.msg);
+        pd_edr_free(r);
+    }
+}
+
+/* The work of a run does not depend on when it starts.  Two systems, each
+ * over 10 periods 2 pi from t0 = 0 and from t0 = 10^4 (10^5 scan steps of
+ * 2 pi / 64 later):
+ *   - an undamped unit oscillator (w0 = 1) bouncing elastically on a wall
+ *     at x = 0.5 (v0 = 1: amplitude 1, the phase jumping from pi/6 to
+ *     5 pi/6 at each impact: one every 4 pi / 3), free of forcing: 15
+ *     impacts, the extremes 0.5 and -1;
+ *   - a two-storey shear building (unit masses and springs) pressed by a
+ *     constant unit load on a wall at its first floor (gap 0: held, its
+ *     force 1 + x2 > 0 throughout; a modal cluster, whose predictions have
+ *     no flight bounds and scan), its top floor then x2 = 1 - cos t: the
+ *     extremes 2 and 0, a second wall at x2 = 5 never reached (smallest
+ *     gap 3).
+ * The extremes to the rounding of t0 = 10^4 in the phase (1e-9), and the
+ * flight evaluations within 10 % of each other (every scan covers its own
+ * window from where it starts: the grid points differ by roundings only;
+ * measured 1108 and 1145 for the oscillator, 3649 and 3722 for the
+ * building). */
+static void test_rows_scan_work_independent_of_start(pd_test_ctx *ctx)
+{
+    double g0[2] = {0.5, 5.0}, e[2] = {1.0, 0.5}, b0[1] = {0.0}, b1[2] = {1.0, 1.0};
+    double one[4] = {1.0, 0.0, 0.0, 1.0}, K[4] = {2.0, -1.0, -1.0, 1.0}, v0[1] = {1.0};
+    double g1[2] = {0.0, 5.0}, wv[2] = {-1.0, -1.0};
+    int cp[3] = {0, 1, 2}, ri[2] = {0, 1};
+    pd_model osc = {.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, one),
+                    .C = pd_matrix_zero(1, 1), .K = pd_matrix_dense(1, 1, one),
+                    .W = pd_matrix_csc(1, 1, cp, ri, wv), .g0 = g0, .e = e};
+    pd_model bld = {.n = 2, .m = 2, .M = pd_matrix_dense(2, 2, one),
+                    .C = pd_matrix_zero(2, 2), .K = pd_matrix_dense(2, 2, K),
+                    .W = pd_matrix_csc(2, 2, cp, ri, wv), .g0 = g1, .e = e};
+    pd_sine_piece free_pc = {.t_start = 0.0}, load = {.t_start = 0.0, .c0 = 1.0};
+    pd_piecewise_force Fo = {.b = b0, .pieces = &free_pc, .npieces = 1};
+    pd_piecewise_force Fb = {.b = b1, .pieces = &load, .npieces = 1};
+    const double starts[2] = {0.0, 1e4}, span = 10.0 * PD_TWO_PI;
+    for (int sys = 0; sys < 2; sys++) {
+        pd_err err;
+        pd_edr *r = pd_edr_alloc(sys ? &bld : &osc, sys ? &Fb : &Fo, NULL, &err);
+        if (!CHECK(ctx, r != NULL, "%s", err.msg))
+            continue;
+        double evals[2] = {0, 0};
+        for (int k = 0; k < 2; k++) {
+            int rc = pd_edr_run(r, starts[k], NULL, sys ? NULL : v0, starts[k] + span, NULL,
+                                NULL, &err);
+            const pd_edr_result *res = pd_edr_result_of(r);
+            double tol = k ? 1e-9 : 1e-12;
+            if (!CHECK(ctx, rc == PD_OK, "system %d, t0 %g: %s", sys, starts[k], err.msg))
+                continue;
+            evals[k] = res->evals;
+            if (sys == 0)
+                CHECK(ctx, res->impacts == 15 && fabs(res->xpos[0] - 0.5) <= tol &&
+                               fabs(res->xneg[0] - 1.0) <= tol,
+                      "oscillator, t0 %g: impacts %ld, max x %.17g (0.5), max -x %.17g (1)",
+                      starts[k], res->impacts, res->xpos[0], res->xneg[0]);
+            else
+                CHECK(ctx, res->detachments == 0 && fabs(res->xpos[1] - 2.0) <= tol &&
+                               fabs(res->xneg[1]) <= tol && fabs(res->xpos[0]) <= tol &&
+                               fabs(res->min_gap[1] - 3.0) <= tol,
+                      "building, t0 %g: detachments %ld, top floor max %.17g (2), min %.17g "
+                      "(0), first floor %.3g (0), smallest gap %.17g (3)", starts[k],
+                      res->detachments, res->xpos[1], -res->xneg[1], res->xpos[0],
+                      res->min_gap[1]);
+        }
+        CHECK(ctx, evals[1] <= 1.1 * evals[0] && evals[0] <= 1.1 * evals[1],
+              "system %d: flight evaluations %.0f from t0 = 0, %.0f from t0 = 1e4", sys,
+              evals[0], evals[1]);
+        pd_edr_free(r);
+    }
+}
+
+/* ---- SDOF trees with contact weights other than 1 ------------------------------- */
+
+/* The sampled impulses of contact 0 and the largest error against a closed
+ * form of its force's integral. */
+typedef struct lever_ctx {
+    double h, c, d, w; /* lambda(t) = c + d cos(w t) */
+    double worst;
+    long samples;
+} lever_ctx;
+
+static int check_lever(const pd_state *s, void *vctx)
+{
+    lever_ctx *c = vctx;
+    if (s->t <= 0.0)
+        return 0;
+    double ta = s->t - c->h, tb = s->t;
+    double want = c->c * c->h + c->d * (sin(c->w * tb) - sin(c->w * ta)) / c->w;
+    c->worst = fmax(c->worst, fabs(s->P[0] - want) / (c->c * c->h));
+    c->samples++;
+    return 0;
+}
+
+/* Two undamped SDOFs (m0 = 1, k0 = 1; m1 = 2, k1 = 8) held by a lever: a
+ * contact g = 0.1 - 2 x0 + 0.5 x1 (weights -2 and 0.5, so the tree's
+ * scale factor s = -w_parent s_parent / w_child is 4 or 1/4, its offset
+ * -(g0 + w_parent d_parent) / w_child nonzero), closed at t = 0 (x0 = 0,
+ * x1 = -0.2, at rest) under a constant load 2 on dof 0 that keeps it
+ * closed.  With x0 = y, x1 = 4 y - 0.2: (m0 + 16 m1) y'' + (k0 + 16 k1) y
+ * = 2 + 6.4, so y = y* (1 - cos w t), y* = 8.4 / 129, w^2 = 129 / 33;
+ * the contact force lambda = 2 (m1 x1'' + k1 x1) = 2 (32 y* - 1.6) +
+ * 2 (8 w^2 - 32) y* cos w t stays in [0.87, 1.07] (no detachment).
+ * Extremes over 10 s (past the first half period 1.59 s): x0 in [0, 2 y*],
+ * x1 in [-0.2, 8 y* - 0.2], to 1e-12 (closed-form flights, extremes
+ * located to rounding: measured 0); the sampled impulses (every 0.25 s)
+ * the integral of lambda, to 1e-10 of a sample's (Gauss-Legendre on the
+ * closed-form force: exact to rounding, measured 9e-16). */
+static void test_rows_tree_weights(pd_test_ctx *ctx)
+{
+    double M[4] = {1.0, 0.0, 0.0, 2.0}, K[4] = {1.0, 0.0, 0.0, 8.0}, b[2] = {2.0, 0.0};
+    double g0[1] = {0.1}, e[1] = {0.5}, wv[2] = {-2.0, 0.5}, q0[2] = {0.0, -0.2};
+    int cp[2] = {0, 2}, ri[2] = {0, 1};
+    pd_model md = {.n = 2, .m = 1, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_zero(2, 2),
+                   .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_csc(2, 1, cp, ri, wv),
+                   .g0 = g0, .e = e};
+    pd_sine_piece pc = {.t_start = 0.0, .c0 = 1.0};
+    pd_piecewise_force F = {.b = b, .pieces = &pc, .npieces = 1};
+    pd_edr_opts eo = pd_edr_default_opts();
+    eo.h_out = 0.25;
+    pd_err err;
+    pd_edr *r = pd_edr_alloc(&md, &F, &eo, &err);
+    if (!CHECK(ctx, r != NULL, "%s", err.msg))
+        return;
+    double ys = 8.4 / 129.0, w = sqrt(129.0 / 33.0), t1 = 10.0;
+    lever_ctx lc = {.h = 0.25, .c = 2.0 * (32.0 * ys - 1.6), .d = 2.0 * (8.0 * w * w - 32.0) * ys,
+                    .w = w};
+    int rc = pd_edr_run(r, 0.0, q0, NULL, t1, check_lever, &lc, &err);
+    const pd_edr_result *res = pd_edr_result_of(r);
+    if (CHECK(ctx, rc == PD_OK, "%s", err.msg)) {
+        double want[4] = {2.0 * ys, 0.0, 8.0 * ys - 0.2, 0.2};
+        double got[4] = {res->xpos[0], res->xneg[0], res->xpos[1], res->xneg[1]}, worst = 0.0;
+        for (int k = 0; k < 4; k++)
+            worst = fmax(worst, fabs(got[k] - want[k]));
+        CHECK(ctx, res->detachments == 0 && fabs(res->contact_time[0] - t1) <= 1e-12 * t1,
+              "held throughout: detachments %ld, contact time %.17g of %g", res->detachments,
+              res->contact_time[0], t1);
+        CHECK(ctx, worst <= 1e-12,
+              "x0 in [%.17g, %.17g] (closed form [0, %.17g]), x1 in [%.17g, %.17g] (closed form "
+              "[-0.2, %.17g])", -got[1], got[0], want[0], -got[3], got[2], want[2]);
+        CHECK(ctx, lc.samples == 40 && lc.worst <= 1e-10,
+              "the lever's force integrated over %ld samples: off by %.3g of a sample's",
+              lc.samples, lc.worst);
+    }
+    pd_edr_free(r);
+}
+
+/* A modal cluster scans on its shortest period: a free two-storey shear
+ * building (unit masses and springs: w^2 = (3 -+ sqrt 5) / 2, the shortest
+ * period 2 pi / phi, phi the golden ratio, 3.88 s; the longest 2.6 times
+ * it), no contact, no load, thrown at v0 = (1, -1) and measured over ten
+ * shortest periods: its extremes are measured on the grid of 64 steps a
+ * period, 640 steps, each step end one flight evaluation, plus the
+ * locations of the extrema (20 of each floor, by counting the sign changes
+ * of the closed-form velocities; a Newton search of some 5 evaluations
+ * each, 8 at most).  So the evaluations lie in [640, 960] (measured 833);
+ * a step from another period (the longest: 245 steps; half the shortest:
+ * 1280) falls outside. */
+static void test_rows_modal_scan_step(pd_test_ctx *ctx)
+{
+    double M[4] = {1.0, 0.0, 0.0, 1.0}, K[4] = {2.0, -1.0, -1.0, 1.0}, b[2] = {0.0, 0.0};
+    double v0[2] = {1.0, -1.0};
+    int cp[1] = {0};
+    pd_model md = {.n = 2, .m = 0, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_zero(2, 2),
+                   .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_csc(2, 0, cp, NULL, NULL)};
+    pd_sine_piece pc = {.t_start = 0.0};
+    pd_piecewise_force F = {.b = b, .pieces = &pc, .npieces = 1};
+    pd_err err;
+    pd_edr *r = pd_edr_alloc(&md, &F, NULL, &err);
+    if (!CHECK(ctx, r != NULL, "%s", err.msg))
+        return;
+    double phi = 0.5 * (1.0 + sqrt(5.0)), T = PD_TWO_PI / phi;
+    int rc = pd_edr_run(r, 0.0, NULL, v0, 10.0 * T, NULL, NULL, &err);
+    const pd_edr_result *res = pd_edr_result_of(r);
+    if (CHECK(ctx, rc == PD_OK, "%s", err.msg))
+        CHECK(ctx, res->modal_bases == 1 && res->evals >= 640.0 && res->evals <= 960.0,
+              "%ld modal bases, %.0f flight evaluations (640 steps of T/64 and the extrema)",
+              res->modal_bases, res->evals);
+    pd_edr_free(r);
 }
 
 /* ---- sampled impulses: impacts plus the held forces' integrals ------------------ */
@@ -1266,9 +1763,16 @@ void suite_rows(pd_test_ctx *ctx)
     PD_RUN(ctx, test_rows_match_general_buildings);
     PD_RUN(ctx, test_rows_general_history);
     PD_RUN(ctx, test_rows_measure_other_grid);
+    PD_RUN(ctx, test_rows_measure_figures);
     PD_RUN(ctx, test_rows_cpu_leaves_sampler_out);
     PD_RUN(ctx, test_rows_moreau_converges);
     PD_RUN(ctx, test_rows_tolerance_decides);
+    PD_RUN(ctx, test_rows_sparse_impact);
+    PD_RUN(ctx, test_rows_run_again_same);
+    PD_RUN(ctx, test_rows_no_pieces_refused);
+    PD_RUN(ctx, test_rows_scan_work_independent_of_start);
+    PD_RUN(ctx, test_rows_tree_weights);
+    PD_RUN(ctx, test_rows_modal_scan_step);
     PD_RUN(ctx, test_rows_run_allocates_nothing);
     PD_RUN(ctx, test_rows_sampled_impulse_held);
     PD_RUN(ctx, test_rows_sampled_impulse_moreau);
