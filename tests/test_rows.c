@@ -440,6 +440,32 @@ static void test_rows_hostile_physics(pd_test_ctx *ctx)
           ic.worst_energy);
 }
 
+/* A row of n SDOFs between two walls (S1 .. Sn; contact i joins i - 1 and
+ * i, the walls at 0 and n) under a pulse: NULL (failed) when it cannot be
+ * built. */
+static pd_scene *sdof_row(pd_test_ctx *ctx, pd_pulse pulse, double ap, double Tp, int n,
+                          const double *T0, const double *xi, const double *mass,
+                          const double *gap, const double *eps)
+{
+    pd_err e;
+    pd_scene *sc = new_scene(pulse, 1, ap, Tp);
+    int rc = sc ? 0 : PD_ENOMEM;
+    char name[16];
+    for (int i = 0; i < n && !rc; i++) {
+        snprintf(name, sizeof name, "S%d", i + 1);
+        rc = pd_scene_add_sdof(sc, name, T0[i], xi[i], mass[i], &e);
+    }
+    for (int i = 0; i <= n && !rc; i++)
+        rc = pd_scene_add_contact(sc, i == 0 ? PD_WALL : i - 1, i == 0 ? 0 : 1,
+                                  i == n ? PD_WALL : i, i == n ? 0 : 1, gap[i], eps[i], i, &e);
+    if (!CHECK(ctx, !rc && !pd_scene_finish(sc, &e), "scene: %s",
+               rc == PD_ENOMEM ? "out of memory" : e.msg)) {
+        pd_scene_free(sc);
+        return NULL;
+    }
+    return sc;
+}
+
 /* A row locked wall to wall (gaps 0, 1e-300, 1e-13: all closed within the
  * closing tolerance), masses 56 kg to 2.4e11 kg, under a cosine pulse
  * (`make stress`'s physics category, seed 6, row 113): the impact at the
@@ -462,20 +488,11 @@ static void test_rows_locked_wall_to_wall(pd_test_ctx *ctx)
                                  0.0072605491073538531, 0.04339774657069928,
                                  0.52302586193737288, 0.3407051485895416};
     pd_err e;
-    pd_scene *sc = new_scene(PD_PULSE_COSINE, 1, 4.168807041886021, 0.58481851902564641);
-    int rc = sc ? 0 : PD_ENOMEM;
-    char name[16];
-    for (int i = 0; i < 5 && !rc; i++) {
-        snprintf(name, sizeof name, "S%d", i + 1);
-        rc = pd_scene_add_sdof(sc, name, T0[i], xi[i], mass[i], &e);
-    }
-    for (int i = 0; i <= 5 && !rc; i++)
-        rc = pd_scene_add_contact(sc, i == 0 ? PD_WALL : i - 1, i == 0 ? 0 : 1,
-                                  i == 5 ? PD_WALL : i, i == 5 ? 0 : 1, gap[i], eps[i], i, &e);
-    if (!CHECK(ctx, !rc && !pd_scene_finish(sc, &e), "scene: %s", e.msg)) {
-        pd_scene_free(sc);
+    int rc;
+    pd_scene *sc = sdof_row(ctx, PD_PULSE_COSINE, 4.168807041886021, 0.58481851902564641, 5, T0,
+                            xi, mass, gap, eps);
+    if (!sc)
         return;
-    }
     pd_scene_result r = {0};
     pd_run_opts o = pd_run_default_opts();
     o.method = PD_METHOD_EVENT;
@@ -515,20 +532,11 @@ static void test_rows_rounding_rates_close_nothing(pd_test_ctx *ctx)
     static const double eps[] = {0.52305778889608845, 0.077247540809392334,
                                  0.43391133422720229, 0.33328883762731099};
     pd_err e;
-    pd_scene *sc = new_scene(PD_PULSE_COSINE, 1, 4.5464921150000475, 0.81166502612086289);
-    int rc = sc ? 0 : PD_ENOMEM;
-    char name[16];
-    for (int i = 0; i < 3 && !rc; i++) {
-        snprintf(name, sizeof name, "S%d", i + 1);
-        rc = pd_scene_add_sdof(sc, name, T0[i], xi[i], mass[i], &e);
-    }
-    for (int i = 0; i <= 3 && !rc; i++)
-        rc = pd_scene_add_contact(sc, i == 0 ? PD_WALL : i - 1, i == 0 ? 0 : 1,
-                                  i == 3 ? PD_WALL : i, i == 3 ? 0 : 1, gap[i], eps[i], i, &e);
-    if (!CHECK(ctx, !rc && !pd_scene_finish(sc, &e), "scene: %s", e.msg)) {
-        pd_scene_free(sc);
+    int rc;
+    pd_scene *sc = sdof_row(ctx, PD_PULSE_COSINE, 4.5464921150000475, 0.81166502612086289, 3, T0,
+                            xi, mass, gap, eps);
+    if (!sc)
         return;
-    }
     impact_check ic = {0};
     rc = run_checked(ctx, sc, &ic, &e);
     CHECK(ctx, rc == PD_OK, "row: %s", e.msg);
@@ -815,6 +823,44 @@ static void test_rows_general_history(pd_test_ctx *ctx)
     pd_scene_free(sc);
 }
 
+/* A measurement's objects: the reference's trace and result, the run's
+ * result and errors. */
+typedef struct measure_kit {
+    pd_scene_trace ref;
+    pd_scene_result rr, mr;
+    pd_scene_errors se;
+} measure_kit;
+
+/* The reference of sc on the grid dt_ref, then run measured against it,
+ * into k (kit_free frees it, whatever the status). */
+static int kit_measure(const pd_scene *sc, double dt_ref, const pd_run_opts *run, measure_kit *k,
+                       pd_err *e)
+{
+    pd_run_opts o = pd_run_default_opts();
+    o.dt = dt_ref;
+    memset(k, 0, sizeof *k);
+    int rc = pd_scene_trace_alloc(&k->ref, sc, &o, e);
+    if (!rc)
+        rc = pd_scene_result_alloc(sc, &k->rr, e);
+    if (!rc)
+        rc = pd_scene_result_alloc(sc, &k->mr, e);
+    if (!rc)
+        rc = pd_scene_errors_alloc(sc, &k->se, e);
+    if (!rc)
+        rc = pd_scene_measure_reference(sc, &o, &k->ref, &k->rr, e);
+    if (!rc)
+        rc = pd_scene_measure_run(sc, run, &k->ref, &k->rr, &k->mr, &k->se, e);
+    return rc;
+}
+
+static void kit_free(measure_kit *k)
+{
+    pd_scene_errors_free(&k->se);
+    pd_scene_result_free(&k->mr);
+    pd_scene_result_free(&k->rr);
+    pd_scene_trace_free(&k->ref);
+}
+
 /* `converge` compares every row on one grid: a run whose dt is no whole
  * multiple of the reference's (dt 4.64e-4 against 1e-3; 1e-4, finer) is
  * compared at its steps interpolated onto the grid.  Its history error
@@ -837,34 +883,17 @@ static void test_rows_measure_other_grid(pd_test_ctx *ctx)
         double err[2] = {NAN, NAN}, umax[2] = {NAN, NAN};
         long points[2] = {0, 0};
         for (int own = 0; own < 2; own++) {
-            pd_scene_trace ref = {0};
-            pd_scene_result rr = {0}, mr = {0};
-            pd_scene_errors se = {0};
+            measure_kit m;
             pd_run_opts o = pd_run_default_opts();
-            o.dt = own ? dts[k] : 1e-3;
-            int rc = pd_scene_trace_alloc(&ref, sc, &o, &e);
-            if (!rc)
-                rc = pd_scene_result_alloc(sc, &rr, &e);
-            if (!rc)
-                rc = pd_scene_result_alloc(sc, &mr, &e);
-            if (!rc)
-                rc = pd_scene_errors_alloc(sc, &se, &e);
-            if (!rc)
-                rc = pd_scene_measure_reference(sc, &o, &ref, &rr, &e);
             o.method = PD_METHOD_MOREAU;
             o.dt = dts[k];
-            if (!rc)
-                rc = pd_scene_measure_run(sc, &o, &ref, &rr, &mr, &se, &e);
-            if (CHECK(ctx, rc == PD_OK, "dt %g (%s grid): %s", dts[k], own ? "own" : "1e-3",
-                      e.msg)) {
-                err[own] = se.err_hist_max;
-                umax[own] = se.err_umax_max;
-                points[own] = se.grid_points;
+            if (CHECK(ctx, kit_measure(sc, own ? dts[k] : 1e-3, &o, &m, &e) == PD_OK,
+                      "dt %g (%s grid): %s", dts[k], own ? "own" : "1e-3", e.msg)) {
+                err[own] = m.se.err_hist_max;
+                umax[own] = m.se.err_umax_max;
+                points[own] = m.se.grid_points;
             }
-            pd_scene_errors_free(&se);
-            pd_scene_result_free(&mr);
-            pd_scene_result_free(&rr);
-            pd_scene_trace_free(&ref);
+            kit_free(&m);
         }
         CHECK(ctx, points[0] == 4001 && err[0] <= err[1] * (1.0 + 1e-9) &&
                        err[0] >= 0.99 * err[1] && umax[0] == umax[1],
@@ -925,28 +954,18 @@ static void test_rows_measure_figures(pd_test_ctx *ctx)
         return;
     }
     sc->tend = 3.0;
-    pd_scene_trace ref = {0};
-    pd_scene_result rr = {0}, mr = {0}, own = {0};
-    pd_scene_errors se = {0};
+    measure_kit m;
+    pd_scene_result own = {0};
     pd_run_opts o = pd_run_default_opts();
-    o.dt = 1e-3;
-    int rc = pd_scene_trace_alloc(&ref, sc, &o, &e);
-    if (!rc)
-        rc = pd_scene_result_alloc(sc, &rr, &e);
-    if (!rc)
-        rc = pd_scene_result_alloc(sc, &mr, &e);
-    if (!rc)
-        rc = pd_scene_result_alloc(sc, &own, &e);
-    if (!rc)
-        rc = pd_scene_errors_alloc(sc, &se, &e);
-    if (!rc)
-        rc = pd_scene_measure_reference(sc, &o, &ref, &rr, &e);
     o.method = PD_METHOD_MOREAU;
     o.dt = 5e-3;
+    int rc = kit_measure(sc, 1e-3, &o, &m, &e);
     if (!rc)
-        rc = pd_scene_measure_run(sc, &o, &ref, &rr, &mr, &se, &e);
+        rc = pd_scene_result_alloc(sc, &own, &e);
+    const pd_scene_result rr = m.rr, mr = m.mr;
+    const pd_scene_errors se = m.se;
     double scale[2], err[2] = {0.0, 0.0};
-    grid_hist gh = {.sc = sc, .ref = &ref, .scale = scale, .err = err};
+    grid_hist gh = {.sc = sc, .ref = &m.ref, .scale = scale, .err = err};
     if (CHECK(ctx, rc == PD_OK && se.nstruct == 2, "measure: %s", e.msg)) {
         double umax_max = 0.0, hist_max = 0.0;
         long impacts = 0;
@@ -983,11 +1002,8 @@ static void test_rows_measure_figures(pd_test_ctx *ctx)
                 CHECK(ctx, se.err_hist[s] == err[s], "%s: err_hist %.17g, recomputed %.17g",
                       sc->st[s].name, se.err_hist[s], err[s]);
     }
-    pd_scene_errors_free(&se);
     pd_scene_result_free(&own);
-    pd_scene_result_free(&mr);
-    pd_scene_result_free(&rr);
-    pd_scene_trace_free(&ref);
+    kit_free(&m);
     pd_scene_free(sc);
 }
 
