@@ -24,8 +24,8 @@ and a per-mutant limit.  A mutant is
   killed     a case failed, the run crashed, or it ran out of time,
   survived   every case passed.
 
-Survivors listed in scripts/mutate_equivalent.txt (FILE:LINE: ORIGINAL ->
-MUTANT  # why it cannot change a result) count as equivalent and leave the
+Survivors listed in scripts/mutate_equivalent.txt (FILE:LINE:COLUMN: ORIGINAL
+-> MUTANT  # why it cannot change a result) count as equivalent and leave the
 denominator: killed / (mutants - stillborn - equivalent) is the file's score.
 The other survivors are the suite's gaps, printed with their line.
 
@@ -212,9 +212,9 @@ def load_equivalent(path):
         line = raw.strip()
         if not line or line.startswith("#"):
             continue
-        m = re.match(r"(\S+):(\d+): (.*?) -> (.*?)\s+#\s*(.*)$", line)
+        m = re.match(r"(\S+?):(\d+):(\d+): (.*?) -> (.*?)\s+#\s*(.*)$", line)
         if m:
-            eq[(m.group(1), int(m.group(2)), m.group(3), m.group(4))] = m.group(5)
+            eq[(m.group(1), int(m.group(2)), int(m.group(3)), m.group(4), m.group(5))] = m.group(6)
     return eq
 
 
@@ -261,8 +261,9 @@ def main():
             for (a, b, new, op) in pick:
                 mutated = text[:a] + new + text[b:]
                 line = line_of(text, a)
+                col = a - text.rfind("\n", 0, a)
                 orig = text[a:b]
-                key = (f, line, orig, new if new else "(removed)")
+                key = (f, line, col, orig, new if new else "(removed)")
                 with open(path, "w", encoding="utf-8") as fh:
                     fh.write(mutated)
                 try:
@@ -280,12 +281,13 @@ def main():
                             verdict = "equivalent"
                         counts[verdict] += 1
                         if verdict == "survived":
-                            gaps.append("%s:%d: %s -> %s  (%s)" % (f, line, orig, key[3], op))
+                            gaps.append("%s:%d:%d: %s -> %s  (%s)" % (f, line, col, orig, key[4],
+                                                                       op))
                 finally:
                     with open(path, "w", encoding="utf-8") as fh:
                         fh.write(text)
-                print("  %-28s %5d %-7s %-12s -> %-12s %s" % (f, line, op, orig[:12],
-                                                                key[3][:12], verdict),
+                print("  %-28s %5d:%-3d %-7s %-12s -> %-12s %s" % (f, line, col, op, orig[:12],
+                                                                     key[4][:12], verdict),
                       flush=True)
             live = len(pick) - counts["stillborn"] - counts["equivalent"]
             score = counts["killed"] / live if live else 1.0

@@ -792,9 +792,41 @@ static void test_engine_breaks_inside_steps(pd_test_ctx *ctx)
     CHECK(ctx, worst > 0.0, "the wall takes impulses (largest %g)", worst);
 }
 
+/* A free unit mass (no stiffness, no damping: What = M = 1, so the
+ * Delassus number W^2 / What is exactly 1) thrown at a wall, in the scalar
+ * kernel and the general one: it leaves at -e times its speed, Newton's
+ * law, with the same impulse (1 + e) v. */
+static void test_engine_free_unit_mass_rebounds(pd_test_ctx *ctx)
+{
+    double M = 1.0, K = 0.0, W = -1.0, g0 = 0.01, e = 0.5, v0 = 1.0;
+    pd_model md = {.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, &M), .C = pd_matrix_zero(1, 1),
+                   .K = pd_matrix_dense(1, 1, &K), .W = pd_matrix_dense(1, 1, &W), .g0 = &g0,
+                   .e = &e};
+    for (int general = 0; general < 2; general++) {
+        pd_err err;
+        pd_mj_opts o = pd_mj_default_opts();
+        o.h = 1e-3;
+        o.kernel = general ? PD_KERNEL_GENERAL : PD_KERNEL_AUTO;
+        pd_mj *mj = pd_mj_alloc(&md, &o, &err);
+        if (!CHECK(ctx, mj && !pd_mj_reset(mj, 0.0, NULL, &v0, &err), "%s", err.msg)) {
+            pd_mj_free(mj);
+            continue;
+        }
+        double P = 0.0;
+        for (int k = 0; k < 30 && !pd_mj_step(mj, &err); k++)
+            P += pd_mj_state(mj)->P[0];
+        const pd_state *st = pd_mj_state(mj);
+        CHECK(ctx, fabs(st->v[0] + e * v0) <= 1e-12 && fabs(P - (1.0 + e) * v0) <= 1e-12,
+              "%s kernel: v after %.17g (want %g), impulse %.17g (want %g)",
+              general ? "general" : "scalar", st->v[0], -e * v0, P, (1.0 + e) * v0);
+        pd_mj_free(mj);
+    }
+}
+
 void suite_engine(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_engine_sdof_closed_form);
+    PD_RUN(ctx, test_engine_free_unit_mass_rebounds);
     PD_RUN(ctx, test_engine_scalar_lcp_matches_lemke);
     PD_RUN(ctx, test_engine_two_mass_impact);
     PD_RUN(ctx, test_engine_chain_energy);
