@@ -331,8 +331,10 @@ static int observe(const pd_state *st, void *ctx)
     pd_osc_track_step(&tr->m, st->step, st->t, x, v, P);
     if (tr->demands) /* the steps' own, as umax, with a held contact's force */
         pd_demand_osc_note(&tr->dem, st->t, x, v, NULL,
-                           pd_demand_osc_held(&tr->dem, st->h, P, tr->Pprev, v, tr->vprev, x,
-                                              pd_osc_shape(tr->c, st->t, -1)),
+                           P > 0.0 && tr->Pprev > 0.0
+                               ? pd_demand_osc_held(&tr->dem, st->h, P, tr->Pprev, v, tr->vprev,
+                                                    x, pd_osc_shape(tr->c, st->t, -1))
+                               : 0.0,
                            0);
     tr->Pprev = P;
     tr->vprev = v;

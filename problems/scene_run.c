@@ -578,12 +578,50 @@ static double free_rel_acc(const track *tr, int i, double f)
     return i < 0 ? 0.0 : tr->hsm[i] / tr->sc->exc.ap + f;
 }
 
-/* Moreau–Jean's held forces at a step into tr->hlam and tr->hacc: the
- * contact-force LCP (held_lcp) over the candidate holds J,
+/* The holds' forces at the state st into tr->hlam and tr->hacc: the
+ * contact-force LCP over the candidate holds J[0..k) (none beyond
+ * MJ_HELD_LCP of them),
  *   g'' = D lambda + G >= 0 _|_ lambda >= 0,  D_ab = sum_i W_ia W_ib / m_i,
  *   G_a = W_a^T u''_free  (u''_free from the smooth a_abs and f(t)). */
-static void held_lcp(track *tr, const pd_state *st, int k);
+static void held_lcp(track *tr, const pd_state *st, int k)
+{
+    int *J = tr->hJ;
+    if (k == 0 || k > MJ_HELD_LCP || !tr->hlcp) {
+        held_from_forces(tr, NULL);
+        return;
+    }
+    double f = pd_osc_shape(tr->shape, st->t, -1);
+    /* the smooth a_abs of the holds' structures only (note_demand takes the
+     * whole scene's): O(their storeys) per step with holds */
+    for (int r = 0; r < k; r++)
+        for (int side = 0; side < 2; side++) {
+            int i = side ? tr->dof_b[J[r]] : tr->dof_a[J[r]];
+            if (i >= 0)
+                pd_demand_eval_structure(&tr->sc->st[tr->st_of[i]], st->q, st->v, tr->Le,
+                                         tr->Le * tr->wp, tr->hsm, tr->dV);
+        }
+    for (int r = 0; r < k; r++) {
+        int a = J[r], ia = tr->dof_a[a], ib = tr->dof_b[a];
+        tr->hG[r] = free_rel_acc(tr, ib, f) - free_rel_acc(tr, ia, f);
+        for (int c = 0; c < k; c++) { /* W_a = -e_ia + e_ib */
+            int b = J[c], ja = tr->dof_a[b], jb = tr->dof_b[b];
+            double d = 0.0;
+            if (ia >= 0)
+                d += ((ia == ja) - (ia == jb)) / tr->mass[ia];
+            if (ib >= 0)
+                d += ((ib == jb) - (ib == ja)) / tr->mass[ib];
+            tr->hD[r + (size_t)c * k] = d;
+        }
+    }
+    pd_matrix D = pd_matrix_dense(k, k, tr->hD);
+    if (pd_lcp_solve(tr->hlcp, &D, tr->hG, NULL, tr->hz, tr->hw, NULL) == PD_OK)
+        for (int r = 0; r < k; r++)
+            tr->hlam[J[r]] = tr->hz[r];
+    held_from_forces(tr, tr->hlam);
+}
 
+/* Moreau–Jean's holds (held_lcp): contacts with an impulse in this step and
+ * the one before, at rest after both. */
 static void moreau_held(track *tr, const pd_state *st)
 {
     double rest = MJ_HELD_RATE * tr->h;
@@ -614,45 +652,6 @@ static void penalty_held(track *tr, const pd_state *st)
         tr->U_prev[a] = U;
     }
     held_lcp(tr, st, k);
-}
-
-/* The contact-force LCP over the candidate holds J[0..k) at the state st
- * into tr->hlam and tr->hacc (none beyond MJ_HELD_LCP holds). */
-static void held_lcp(track *tr, const pd_state *st, int k)
-{
-    double f = pd_osc_shape(tr->shape, st->t, -1);
-    int *J = tr->hJ;
-    if (k == 0 || k > MJ_HELD_LCP || !tr->hlcp) {
-        held_from_forces(tr, NULL);
-        return;
-    }
-    /* the smooth a_abs of the holds' structures only (note_demand takes the
-     * whole scene's): O(their storeys) per step with holds */
-    for (int r = 0; r < k; r++)
-        for (int side = 0; side < 2; side++) {
-            int i = side ? tr->dof_b[J[r]] : tr->dof_a[J[r]];
-            if (i >= 0)
-                pd_demand_eval_structure(&tr->sc->st[tr->st_of[i]], st->q, st->v, tr->Le,
-                                         tr->Le * tr->wp, tr->hsm, tr->dV);
-        }
-    for (int r = 0; r < k; r++) {
-        int a = J[r], ia = tr->dof_a[a], ib = tr->dof_b[a];
-        tr->hG[r] = free_rel_acc(tr, ib, f) - free_rel_acc(tr, ia, f);
-        for (int c = 0; c < k; c++) { /* W_a = -e_ia + e_ib */
-            int b = J[c], ja = tr->dof_a[b], jb = tr->dof_b[b];
-            double d = 0.0;
-            if (ia >= 0)
-                d += ((ia == ja) - (ia == jb)) / tr->mass[ia];
-            if (ib >= 0)
-                d += ((ib == jb) - (ib == ja)) / tr->mass[ib];
-            tr->hD[r + (size_t)c * k] = d;
-        }
-    }
-    pd_matrix D = pd_matrix_dense(k, k, tr->hD);
-    if (pd_lcp_solve(tr->hlcp, &D, tr->hG, NULL, tr->hz, tr->hw, NULL) == PD_OK)
-        for (int r = 0; r < k; r++)
-            tr->hlam[J[r]] = tr->hz[r];
-    held_from_forces(tr, tr->hlam);
 }
 
 /* Moreau–Jean, every step: extremes at the step, impacts (an impulse after a
