@@ -22,6 +22,8 @@
 #define BISECT_REL 2e-16
 #define BISECT_MAX_IT 200
 #define NEWTON_MAX_IT 30
+/* Past a converged root, this many next doubles are tried one by one. */
+#define WALK_DOUBLES 4
 /* A turn is not located in hit mode when f stays below -this of the
  * interval's scale. */
 #define HERMITE_MARGIN 1e-3
@@ -93,22 +95,33 @@ static double locate_from(edr_scan *s, int k, double sign, double lo, double hi,
         else
             lo = t;
         double tn = t - f / df;
+        if (tn >= lo && tn <= hi && fabs(tn - t) <= tol) { /* converged, on a bracket end too */
+            if (w > 0.0)
+                return tn; /* a turn, wanted to a width: Newton is there */
+            /* a root: the bracket closed around tn; f's rounding may leave
+             * a plateau at zero above tn, so the step up doubles until f > 0 */
+            double a = fmax(tn - tol, lo);
+            if (a > lo) {
+                if (value(s, k, sign, a, NULL) <= 0.0)
+                    lo = a;
+                else
+                    hi = a;
+            }
+            for (double step = tol; fmax(tn, lo) + step < hi; step *= 2.0) {
+                double b = fmax(tn, lo) + step;
+                if (value(s, k, sign, b, NULL) > 0.0) {
+                    hi = b;
+                    break;
+                }
+                lo = b;
+            }
+            break;
+        }
         if (!(tn > lo && tn < hi)) {
             t = 0.5 * (lo + hi);
             continue;
         }
-        if (fabs(tn - t) > tol) {
-            t = tn;
-            continue;
-        }
-        if (w > 0.0) /* a turn, wanted to a width: Newton is there */
-            return fmin(fmax(tn, lo), hi);
-        double a = fmax(tn - tol, lo), b = fmin(tn + tol, hi);
-        if (a > lo && value(s, k, sign, a, NULL) <= 0.0)
-            lo = a;
-        if (b < hi && value(s, k, sign, b, NULL) > 0.0)
-            hi = b;
-        break;
+        t = tn;
     }
     return bisect_to(s, k, sign, lo, hi, w);
 }
@@ -143,14 +156,21 @@ static double crossing(edr_scan *s, double lo, double hi, double t0)
         }
         if (f > 0.0) /* converged past the crossing */
             return t;
-        for (double c = fmax(tn, nextafter(t, HUGE_VAL)); c < hi; c = nextafter(c, HUGE_VAL)) {
-            if (value(s, 0, 1.0, c, NULL) > 0.0)
-                return c;
-            lo = c;
-            if (++it >= NEWTON_MAX_IT)
+        /* f <= 0 within its rounding of the root: the next doubles, then
+         * steps doubling (f's rounding may hold it at zero over many
+         * doubles), then bisection of the last step */
+        double c = fmax(tn, nextafter(t, HUGE_VAL));
+        for (int j = 0; c < hi && j < NEWTON_MAX_IT; j++) {
+            if (value(s, 0, 1.0, c, NULL) > 0.0) {
+                if (j < WALK_DOUBLES)
+                    return c; /* the double after lo */
+                hi = c;
                 break;
+            }
+            lo = c;
+            c = j + 1 < WALK_DOUBLES ? nextafter(c, HUGE_VAL) : c + 2.0 * (c - t);
         }
-        break;
+        return bisect_to(s, 0, 1.0, lo, hi, 0.0);
     }
     return locate(s, 0, 1.0, lo, hi, 0.0);
 }
@@ -276,12 +296,14 @@ int edr_scan_interval(edr_scan *s, const edr_pt *a, const edr_pt *b, double *t_h
     if (dir != 0 && sgn(b->df) == dir && may_turn_twice(a, b, dir)) {
         /* f'' is nearly linear over the interval: its interpolated zero is
          * f' 's extremum to O(h^2); located precisely only when f' there is
-         * too close to zero to tell whether it dips through */
+         * too close to zero to tell whether it dips through.  (f'' changes
+         * sign, so the zero lies in [a, b]; rounded onto an end, f' has
+         * its extremum there, of the sign dir: no dip.) */
         double tm = a->t + (b->t - a->t) * (a->ddf / (a->ddf - b->ddf));
-        if (!(tm > a->t && tm < b->t))
-            tm = 0.5 * (a->t + b->t);
-        edr_pt mid = edr_scan_point(s, tm);
-        if (sgn(mid.df) == dir && fabs(mid.df) <= SPLIT_MARGIN * (fabs(a->df) + fabs(b->df))) {
+        int inside = tm > a->t && tm < b->t;
+        edr_pt mid = inside ? edr_scan_point(s, tm) : *a;
+        if (inside && sgn(mid.df) == dir &&
+            fabs(mid.df) <= SPLIT_MARGIN * (fabs(a->df) + fabs(b->df))) {
             tm = locate(s, 2, dir > 0 ? 1.0 : -1.0, a->t, b->t, s->width);
             mid = edr_scan_point(s, tm);
         }

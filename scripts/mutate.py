@@ -31,6 +31,7 @@ The other survivors are the suite's gaps, printed with their line.
 
 usage: python3 scripts/mutate.py [--files F,...] [--n 30] [--seed 1]
                                  [--timeout S] [--report FILE] [--keep]
+                                 [--only FILE:LINE:COL,...]
 """
 import argparse
 import os
@@ -230,8 +231,12 @@ def main():
                     help="per-case limit in s (default: 3 x the slowest baseline, >= 60)")
     ap.add_argument("--report", default=None, help="write the table into this file")
     ap.add_argument("--keep", action="store_true", help="keep the work tree")
+    ap.add_argument("--only", default="",
+                    help="FILE:LINE:COL,... : of the sample, run only these mutants (to "
+                         "check that a new test kills a survivor)")
     args = ap.parse_args()
     files = [f for f in args.files.split(",") if f]
+    only = set(x.strip() for x in args.only.split(",") if x.strip())
     eq = load_equivalent(os.path.join(ROOT, "scripts", "mutate_equivalent.txt"))
     work = tempfile.mkdtemp(prefix="pound-mutate-")
     log = open(os.path.join(work, "mutate.log"), "w")
@@ -264,6 +269,8 @@ def main():
                 col = a - text.rfind("\n", 0, a)
                 orig = text[a:b]
                 key = (f, line, col, orig, new if new else "(removed)")
+                if only and "%s:%d:%d" % (f, line, col) not in only:
+                    continue
                 with open(path, "w", encoding="utf-8") as fh:
                     fh.write(mutated)
                 try:
@@ -289,9 +296,10 @@ def main():
                 print("  %-28s %5d:%-3d %-7s %-12s -> %-12s %s" % (f, line, col, op, orig[:12],
                                                                      key[4][:12], verdict),
                       flush=True)
-            live = len(pick) - counts["stillborn"] - counts["equivalent"]
+            tried = sum(counts.values())
+            live = tried - counts["stillborn"] - counts["equivalent"]
             score = counts["killed"] / live if live else 1.0
-            rows.append((f, len(pick), counts, score))
+            rows.append((f, tried, counts, score))
         build(src, log)  # the tree as it was
         table = ["| file | mutants | stillborn | equivalent | killed | survived | killed of the "
                  "non-equivalent |", "| --- | --- | --- | --- | --- | --- | --- |"]

@@ -109,6 +109,7 @@ void suite_outputs(pd_test_ctx *ctx);
 void suite_harden(pd_test_ctx *ctx);
 void suite_aabs(pd_test_ctx *ctx);
 void suite_law(pd_test_ctx *ctx);
+void suite_scan(pd_test_ctx *ctx);
 void suite_api_null(pd_test_ctx *ctx);
 
 #endif
