@@ -145,6 +145,9 @@ int main(int argc, char **argv)
     suite_harden(&ctx);
     suite_aabs(&ctx);
     suite_law(&ctx);
+    suite_lemke_paths(&ctx);
+    suite_row_paths(&ctx);
+    suite_measure_paths(&ctx);
     suite_api_null(&ctx);
 
     printf("%d passed, %d failed, %d skipped\n", ctx.passed, ctx.failed, ctx.skipped);
