@@ -88,7 +88,17 @@ else
 CLI_LIBS  = $(LIBS)
 endif
 
-INC      = -Icore -Ilcp -Iengine -Iproblems -Icli -Ibench
+# Layers the compiler enforces: a folder sees its own headers and those of
+# the layers below it (cli -> problems -> engine -> lcp -> core; bench and
+# tests on top), nothing above.
+INC_core     = -Icore
+INC_lcp      = $(INC_core) -Ilcp
+INC_engine   = $(INC_lcp) -Iengine
+INC_problems = $(INC_engine) -Iproblems
+INC_cli      = $(INC_problems) -Icli
+INC_bench    = $(INC_cli) -Ibench
+INC_tests    = $(INC_bench) -Itests
+INC          = $(INC_$(firstword $(subst /, ,$<)))
 ALL_CFLAGS = $(WARN) $(DEFS) $(LAZY_DEFS) $(FPFLAGS) $(CFLAGS) $(OPENMP) $(INC) $(PKG_CFLAGS) $(SS_CFLAGS) $(LANES_CFLAGS) $(XCFLAGS)
 LIBS     = $(H5HL_LIBS) $(PKG_LIBS) $(SS_LIBS) -lm
 
@@ -194,6 +204,7 @@ test: deps
 
 check: all
 	$(BUILD)/pound_tests --pound $(BUILD)/pound
+	@sh scripts/layers-check.sh
 	@$(if $(API_CHECK),$(MAKE) --no-print-directory install-check)
 	@$(if $(API_CHECK),$(MAKE) --no-print-directory formats-check)
 	@$(if $(API_CHECK),$(MAKE) --no-print-directory flags-check)

@@ -33,7 +33,7 @@ typedef struct bench_case {
     double chain_ns;     /* the dependency chain's bound per step (NAN: not estimated) */
 } bench_case;
 
-/* The scalar kernel's loop-carried chain (engine/mj1.h), in dependent
+/* The scalar kernel's loop-carried chain (engine/pd_mj1.h), in dependent
  * operations per step: q_k -> q_k + h theta v_k (add) -> K (mul) -> the
  * force difference (sub) -> h (mul) -> 1/What (mul) -> + v_k (add) = v_k+1
  * -> theta v (mul) -> + (1 - theta) v_k (add) -> h (mul) -> + q_k (add) =

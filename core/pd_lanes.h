@@ -1,5 +1,5 @@
 /* pd_lanes.h — (library-private) the processor's own vector of doubles for
- * the batched kernels' texts (engine/mj1_lanes.h, engine/mj_batch_lanes.h,
+ * the batched kernels' texts (engine/pd_mj1_lanes.h, engine/mj_batch_lanes.h,
  * problems/osc_batch_lanes.h): 8 lanes under AVX-512, 4 under AVX2, 2 on
  * the baseline.  Include it after the file's `#pragma GCC target` (the
  * width follows the target's macros); generic vectors wider than the

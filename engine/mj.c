@@ -144,7 +144,7 @@ static int alloc_arrays(pd_mj *mj, int n, int m)
                : PD_ENOMEM;
 }
 
-/* Constants of the scalar kernel (mj1.h). */
+/* Constants of the scalar kernel (pd_mj1.h). */
 static void scalar_setup(pd_mj *mj)
 {
     const pd_model *md = mj->model;
@@ -294,7 +294,7 @@ static int check_state(const pd_model *md, const pd_state *st, pd_err *err)
     return PD_OK;
 }
 
-/* One step of the scalar kernel (n = 1, m <= 1): mj1.h's, with the force
+/* One step of the scalar kernel (n = 1, m <= 1): pd_mj1.h's, with the force
  * F1 = F(t_k+1 -). */
 static inline int step_scalar_f(pd_mj *mj, double F1, pd_err *err)
 {
@@ -340,28 +340,68 @@ static int step_scalar(pd_mj *mj, pd_err *err)
     return step_scalar_f(mj, scalar_force(mj, mj->st.step), err);
 }
 
-/* The scalar kernel's steps with the observer after each.  The forces are
- * asked MJ_FORCE_AHEAD steps ahead (the same values, at the same instants,
- * in the same order), so that the excitation's evaluation of a later step
- * runs beside the step's chain of latencies instead of in it. */
-#define MJ_FORCE_AHEAD 8 /* a power of 2 */
+/* run_scalar's hooks into pd_mj1.h's loop: the model's force, and the state
+ * written back for the observer. */
+typedef struct scalar_run {
+    pd_mj *mj;
+    pd_observer observer;
+    void *ctx;
+} scalar_run;
+
+static inline double scalar_force_at(void *ctx, double t, int side)
+{
+    const pd_model *md = ((const scalar_run *)ctx)->mj->model;
+    double F = 0.0;
+    if (md->force)
+        md->force(t, side, &F, md->force_ctx);
+    return F;
+}
+
+/* pd_state from the loop's state after the step ending at t. */
+static inline void scalar_store(pd_mj *mj, const mj1_state *x, double t)
+{
+    pd_state *st = &mj->st;
+    st->q[0] = x->q;
+    st->v[0] = x->v;
+    if (mj->model->m) {
+        st->P[0] = x->P;
+        st->active[0] = (unsigned char)x->active;
+        st->g[0] = x->g;
+    }
+    st->nactive = x->active;
+    st->lcp_pivots = 0;
+    st->lcp_solver = x->active ? "closed-form" : NULL;
+    st->t = t;
+    st->step = x->step;
+}
+
+static inline int scalar_observe(void *ctx, const mj1_state *x, double t)
+{
+    scalar_run *r = ctx;
+    scalar_store(r->mj, x, t);
+    return r->observer(&r->mj->st, r->ctx);
+}
+
+/* The scalar kernel's steps with the observer after each: pd_mj1.h's loop
+ * (the state written back once at the end when nobody observes). */
 static int run_scalar(pd_mj *mj, long nsteps, pd_observer observer, void *ctx, pd_err *err)
 {
-    double F[MJ_FORCE_AHEAD];
-    long step0 = mj->st.step;
-    int rc;
-    for (long k = 0; k < nsteps && k < MJ_FORCE_AHEAD; k++)
-        F[k] = scalar_force(mj, step0 + k);
-    for (long k = 0; k < nsteps; k++) {
-        double F1 = F[k & (MJ_FORCE_AHEAD - 1)];
-        if (k + MJ_FORCE_AHEAD < nsteps)
-            F[k & (MJ_FORCE_AHEAD - 1)] = scalar_force(mj, step0 + k + MJ_FORCE_AHEAD);
-        if ((rc = step_scalar_f(mj, F1, err)))
-            return rc;
-        if (observer && observer(&mj->st, ctx) > 0)
-            return PD_OK;
-    }
-    return PD_OK;
+    const pd_model *md = mj->model;
+    pd_state *st = &mj->st;
+    scalar_run r = {.mj = mj, .observer = observer, .ctx = ctx};
+    mj1_state x = {.q = st->q[0], .v = st->v[0], .g = md->m ? st->g[0] : 0.0,
+                   .P = md->m ? st->P[0] : 0.0, .F0 = mj->F0[0], .F1 = mj->F1[0],
+                   .step = st->step, .next_break = mj->next_break, .active = st->nactive};
+    double h = mj->opts.h, th = mj->opts.theta, gamma = mj->opts.gamma;
+    int rc = observer ? mj1_run(&mj->s1, h, th, gamma, mj->t0, md->breaks, md->nbreaks, nsteps,
+                                &x, scalar_force_at, scalar_observe, &r, err)
+                      : mj1_run(&mj->s1, h, th, gamma, mj->t0, md->breaks, md->nbreaks, nsteps,
+                                &x, scalar_force_at, NULL, &r, err);
+    scalar_store(mj, &x, mj->t0 + (double)x.step * h);
+    mj->F0[0] = x.F0;
+    mj->F1[0] = x.F1;
+    mj->next_break = x.next_break;
+    return rc;
 }
 
 /* Active set {a : g_a + h gamma U_a <= 0} of the state in, into out's

@@ -2,7 +2,7 @@
  * driver (mj.c) and its adaptive one (mj_adapt.c).
  *
  * One step of either driver is the same arithmetic (SPEC §2): the general
- * kernel's mj_general_step, the scalar kernel's mj1_step (mj1.h).  A fixed
+ * kernel's mj_general_step, the scalar kernel's mj1_step (pd_mj1.h).  A fixed
  * run steps with h = opts.h in place on mj->st; an adaptive run steps on
  * the ladder h_k = h0 2^-k, each level's iteration matrix factored once,
  * from one snapshot of the state into another (docs/scheme.md, "Moreau–Jean
@@ -10,7 +10,7 @@
 #ifndef PD_MJ_H
 #define PD_MJ_H
 
-#include "mj1.h"
+#include "pd_mj1.h"
 #include "pd_engine.h"
 #include "pd_factor.h"
 

@@ -11,7 +11,7 @@
 #include <stddef.h>
 #include <string.h>
 
-#include "mj1.h"
+#include "pd_mj1.h"
 #include "pd_engine.h"
 #include "pd_null.h"
 

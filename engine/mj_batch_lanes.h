@@ -3,11 +3,11 @@
  * baseline), mj_batch_x86v3.c (AVX2), mj_batch_x86v4.c (AVX-512), which
  * set their target for the whole file (a function's target attribute
  * would leave GCC expanding the wide vectors' comparisons lane by lane).
- * The arithmetic is mj1_lanes.h's, on the processor's own vector: 8 lanes
+ * The arithmetic is pd_mj1_lanes.h's, on the processor's own vector: 8 lanes
  * under AVX-512, 4 under AVX2, 2 on the baseline.  A vector wider than the
  * registers (8 lanes on AVX2) was split by GCC through the stack,
  * broadcasts included, and ran slower than the scalar kernel. */
-#include "mj1_lanes.h"
+#include "pd_mj1_lanes.h"
 
 /* Lanes l .. l + LW - 1 one step; the forces F1 at the step's end become
  * the next step's F0. */

@@ -1,6 +1,6 @@
 /* mj_batch_x86v4.c — the batch's step compiled for x86-64-v4 (AVX-512):
  * mj_batch_lanes.h's text; mj_batch.c picks it when the processor has it. */
-#include "mj1.h"
+#include "pd_mj1.h"
 
 #if PD_X86_VARIANTS
 #pragma GCC target("arch=x86-64-v4")

@@ -23,7 +23,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mj1.h"
+#include "pd_mj1.h"
 #include "pd_core.h"
 #include "pd_engine.h"
 #include "pd_factor.h"

@@ -4,7 +4,7 @@
  * The Moreau–Jean cases run on the lanes of a pd_mjb (engine/mj_batch.c):
  * a lane takes the next case as soon as its run ends, so runs of different
  * lengths keep every lane busy.  A case's figures are pd_osc_simulate's,
- * bit for bit: the same step (engine/mj1.h), the same excitation values
+ * bit for bit: the same step (engine/pd_mj1.h), the same excitation values
  * (pd_osc_shape, once per step for lanes at the same instant of the same
  * excitation), the same measurements (osc_track.h: the common ones here on
  * whole vectors of lanes, the rare ones -- a gap closing, an impact -- by

@@ -3,7 +3,7 @@
  * osc_batch.c (the baseline), osc_batch_x86v3.c (AVX2), osc_batch_x86v4.c
  * (AVX-512), after their target pragma.  A set of vectors of lanes is
  * loaded once per block of steps and runs its steps in registers (the
- * engine's arithmetic, engine/mj1_lanes.h: mj1_step's numbers lane for
+ * engine's arithmetic, engine/pd_mj1_lanes.h: mj1_step's numbers lane for
  * lane), keeping each step's x, v and P in rings and, where the whole
  * block is measured, folding the block's extremes as it goes; a second
  * pass over the rings gives the other measurements and calls
@@ -12,7 +12,7 @@
  * (osc_batch.c), so a step has no call. */
 #include "osc_batch.h"
 
-#include "mj1_lanes.h" /* the processor's own vector (after the target pragma) */
+#include "pd_mj1_lanes.h" /* the processor's own vector (after the target pragma) */
 
 _Static_assert(NL % LW == 0, "whole native vectors of lanes");
 

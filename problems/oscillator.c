@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mj1.h"
+#include "pd_mj1.h"
 #include "osc_priv.h"
 #include "osc_track.h"
 #include "pd_null.h"
@@ -346,15 +346,6 @@ static int observe(const pd_state *st, void *ctx)
     return 0;
 }
 
-/* pd_mj_run's scalar kernel on the oscillator with the measurements
- * inline: the same step (mj1.h's mj1_step), the same forces asked at the
- * same instants (OSC_FORCE_AHEAD steps ahead, so that the excitation's
- * evaluation runs beside the step's chain of latencies), the breakpoint
- * met as pd_mj meets it, the same failure; the state stays in registers
- * (no call through a pointer between two steps).  Its steps taken go to
- * *steps. */
-#define OSC_FORCE_AHEAD 8 /* a power of 2 */
-
 /* pd_osc_shape, a pulse's inline. */
 static inline double osc_force(const pd_osc *c, double tau, int side)
 {
@@ -362,51 +353,57 @@ static inline double osc_force(const pd_osc *c, double tau, int side)
                      : pd_pulse_shape_inline(c->pulse, c->dir, tau, side);
 }
 
+/* The measured run's hooks into the engine's loop (pd_mj1.h): the
+ * excitation, and after each step the tracks and demands. */
+typedef struct scalar_osc {
+    const pd_osc *c;
+    pd_osc_track *tr;
+    pd_demand_osc *dem;
+    double h, Pprev, vprev; /* the step; the previous step's impulse and velocity */
+} scalar_osc;
+
+static inline double scalar_osc_force(void *ctx, double tau, int side)
+{
+    return osc_force(((const scalar_osc *)ctx)->c, tau, side);
+}
+
+static inline int scalar_osc_observe(void *ctx, const mj1_state *x, double tau)
+{
+    scalar_osc *so = ctx;
+    pd_osc_track_step(so->tr, x->step, tau, x->q, x->v, x->P);
+    if (so->dem) /* with a held contact's force */
+        pd_demand_osc_note_state(
+            so->dem, tau, x->q, x->v,
+            pd_demand_osc_held(so->dem, so->h, x->P, so->Pprev, x->v, so->vprev, x->q, x->F1));
+    so->Pprev = x->P;
+    so->vprev = x->v;
+    return 0;
+}
+
+/* pd_mj_run's scalar kernel on the oscillator with the measurements
+ * inline: the engine's loop (pd_mj1.h's mj1_run, the same step, forces,
+ * breakpoints and failure as pd_mj's) with the tracks as its observer,
+ * called directly, so that the state stays in registers.  Its steps taken
+ * go to *steps. */
 static int simulate_scalar(const pd_osc *c, const pd_model *md, const pd_mj_opts *mo,
                            long nsteps, pd_osc_track *tr, pd_demand_osc *dem, long *steps,
                            pd_err *err)
 {
-    const double h = mo->h, th = mo->theta, hgamma = h * mo->gamma, t0 = 0.0;
-    const double tol = 1e-9 * h;
+    const double h = mo->h, t0 = 0.0;
     mj1_coef s1 = mj1_coef_make(1.0, pd_matrix_get(&md->C, 0, 0), pd_matrix_get(&md->K, 0, 0),
                                 md->m > 0, md->m ? -1.0 : 0.0, md->m ? md->g0[0] : 0.0,
-                                md->m ? md->e[0] : 0.0, h, th);
-    int next = 0;
-    while (next < md->nbreaks && md->breaks[next] < t0 - tol)
-        next++;
-    double q = 0.0, v = 0.0, P = 0.0, Pprev = 0.0, vprev = 0.0, g = s1.g0 + s1.w * q;
-    double F[OSC_FORCE_AHEAD];
-    double F0 = osc_force(c, t0, +1);
-    long k = 0;
-    pd_osc_track_step(tr, 0, t0, q, v, P);
+                                md->m ? md->e[0] : 0.0, h, mo->theta);
+    scalar_osc so = {.c = c, .tr = tr, .dem = dem, .h = h};
+    mj1_state x = {.g = s1.g0, .F0 = osc_force(c, t0, +1)};
+    while (x.next_break < md->nbreaks && md->breaks[x.next_break] < t0 - 1e-9 * h)
+        x.next_break++;
+    pd_osc_track_step(tr, 0, t0, x.q, x.v, x.P);
     if (dem)
-        pd_demand_osc_note_state(dem, t0, q, v, 0.0);
-    for (long i = 0; i < nsteps && i < OSC_FORCE_AHEAD; i++)
-        F[i] = osc_force(c, t0 + (double)(i + 1) * h, -1);
-    for (; k < nsteps; k++) {
-        double t1 = t0 + (double)(k + 1) * h, F1 = F[k & (OSC_FORCE_AHEAD - 1)];
-        if (k + OSC_FORCE_AHEAD < nsteps)
-            F[k & (OSC_FORCE_AHEAD - 1)] =
-                osc_force(c, t0 + (double)(k + OSC_FORCE_AHEAD + 1) * h, -1);
-        mj1_step(h, th, hgamma, &s1, F0, F1, &q, &v, &g, &P);
-        F0 = F1;
-        if (next < md->nbreaks && mj_break_at(md->breaks, md->nbreaks, &next, t1, tol))
-            F0 = osc_force(c, t1, +1);
-        if (!isfinite(q) || !isfinite(v)) {
-            *steps = k + 1;
-            return pd_err_set(err, PD_ENONFINITE,
-                              "Moreau-Jean: non-finite state at t = %.9g (step %ld, dof %d)", t1,
-                              k + 1, 0);
-        }
-        pd_osc_track_step(tr, k + 1, t1, q, v, P);
-        if (dem) /* with a held contact's force */
-            pd_demand_osc_note_state(dem, t1, q, v,
-                                     pd_demand_osc_held(dem, h, P, Pprev, v, vprev, q, F1));
-        Pprev = P;
-        vprev = v;
-    }
-    *steps = k;
-    return PD_OK;
+        pd_demand_osc_note_state(dem, t0, x.q, x.v, 0.0);
+    int rc = mj1_run(&s1, h, mo->theta, mo->gamma, t0, md->breaks, md->nbreaks, nsteps, &x,
+                     scalar_osc_force, scalar_osc_observe, &so, err);
+    *steps = x.step;
+    return rc;
 }
 
 int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler,

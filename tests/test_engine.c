@@ -5,7 +5,7 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "mj1.h"
+#include "pd_mj1.h"
 #include "pd_engine.h"
 #include "pd_factor.h"
 #include "pd_test.h"

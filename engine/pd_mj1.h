@@ -1,7 +1,10 @@
-/* mj1.h — the one-degree-of-freedom, at-most-one-contact Moreau–Jean step
- * (engine-private), shared by the scalar kernel of pd_mj (mj.c) and the
- * batch pd_mjb (mj_batch.c), so that both compute the same numbers, bit for
- * bit.
+/* pd_mj1.h — the one-degree-of-freedom, at-most-one-contact Moreau–Jean step
+ * and its loop: the engine's inline interface (not installed) to the layers
+ * that fuse their measurements into the loop.  Its step is the one of the
+ * scalar kernel of pd_mj (mj.c), of the batch pd_mjb (mj_batch.c) and of
+ * the one-wall oscillator's measured run (problems/oscillator.c), so that
+ * all compute the same numbers, bit for bit; its loop is pd_mj_run's and
+ * the oscillator's.
  *
  *   What  = M + h theta C + h^2 theta^2 K,   W^ = W / What,  D = W W^
  *   vfree = v + What^-1 h [F_theta - C v - K (q + h theta v)]
@@ -10,6 +13,8 @@
  *   q+ = q + h [theta v+ + (1 - theta) v],  g+ = g0 + W q+ */
 #ifndef PD_MJ1_H
 #define PD_MJ1_H
+
+#include <math.h>
 
 #include "pd_cpu.h"
 #include "pd_engine.h"
@@ -129,6 +134,70 @@ static inline int mj_break_at(const double *breaks, int nbreaks, int *next, doub
         return 1;
     }
     return 0;
+}
+
+/* ---- the scalar kernel's loop ------------------------------------------ *
+ * nsteps steps of mj1_step from the state x at step x->step (its time t0 +
+ * step h): the force's left limits F(t_k+1 -) asked MJ1_FORCE_AHEAD steps
+ * ahead (the same values at the same instants, so that the excitation's
+ * evaluation runs beside the step's chain of latencies instead of in it),
+ * its right limit F(t+) after a breakpoint, observe after each step (> 0:
+ * stop).  force and observe are the caller's static functions: the loop
+ * is inlined where it is called and they in it, so that the state stays in
+ * registers (pd_mj_run's scalar kernel, engine/mj.c; the one-wall
+ * oscillator's measured run, problems/oscillator.c). */
+#define MJ1_FORCE_AHEAD 8 /* a power of 2 */
+
+typedef struct mj1_state {
+    double q, v, g;   /* the state at step */
+    double P;         /* the impulse of the last step */
+    double F0;        /* F(t_step +): the next step's force at its start */
+    double F1;        /* F(t_step -): the last step's force at its end */
+    long step;        /* steps taken */
+    int next_break;   /* the first force breakpoint not passed */
+    int active;       /* the last step's contact was active */
+} mj1_state;
+
+/* F(t) from the left (side -1) or the right (+1). */
+typedef double (*mj1_force_fn)(void *ctx, double t, int side);
+/* After a step ending at t; > 0 stops the run. */
+typedef int (*mj1_observe_fn)(void *ctx, const mj1_state *x, double t);
+
+static inline __attribute__((always_inline)) int
+mj1_run(const mj1_coef *s, double h, double th, double gamma, double t0, const double *breaks,
+        int nbreaks, long nsteps, mj1_state *x, mj1_force_fn force, mj1_observe_fn observe,
+        void *ctx, pd_err *err)
+{
+    const double hgamma = h * gamma, tol = 1e-9 * h;
+    const long k0 = x->step;
+    mj1_state y = *x; /* in registers */
+    double F[MJ1_FORCE_AHEAD];
+    for (long k = 0; k < nsteps && k < MJ1_FORCE_AHEAD; k++)
+        F[k] = force(ctx, t0 + (double)(k0 + k + 1) * h, -1);
+    for (long k = 0; k < nsteps; k++) {
+        /* F(t_k+1 -) from the ring; the slot refilled MJ1_FORCE_AHEAD ahead */
+        double t1 = t0 + (double)(k0 + k + 1) * h;
+        y.F1 = F[k & (MJ1_FORCE_AHEAD - 1)];
+        if (k + MJ1_FORCE_AHEAD < nsteps)
+            F[k & (MJ1_FORCE_AHEAD - 1)] =
+                force(ctx, t0 + (double)(k0 + k + MJ1_FORCE_AHEAD + 1) * h, -1);
+        y.active = mj1_step(h, th, hgamma, s, y.F0, y.F1, &y.q, &y.v, &y.g, &y.P);
+        y.step++;
+        /* the next step starts from F(t1 +): F1, or the right limit at a breakpoint */
+        y.F0 = y.F1;
+        if (y.next_break < nbreaks && mj_break_at(breaks, nbreaks, &y.next_break, t1, tol))
+            y.F0 = force(ctx, t1, +1);
+        if (!isfinite(y.q) || !isfinite(y.v)) {
+            *x = y;
+            return pd_err_set(err, PD_ENONFINITE,
+                              "Moreau-Jean: non-finite state at t = %.9g (step %ld, dof %d)", t1,
+                              y.step, 0);
+        }
+        if (observe && observe(ctx, &y, t1) > 0)
+            break;
+    }
+    *x = y;
+    return PD_OK;
 }
 
 /* h > 0 finite, theta in [1/2, 1] (in [0, 2] when allowed), gamma in

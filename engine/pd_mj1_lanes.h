@@ -1,4 +1,4 @@
-/* mj1_lanes.h — (library-private) mj1_step's operations on the processor's
+/* pd_mj1_lanes.h — (the engine's inline interface, not installed) mj1_step's operations on the processor's
  * own vector of lanes, in registers: the one text of the batch's step
  * (mj_batch_lanes.h, over pd_mjb's arrays) and of the oscillator's batch,
  * which fuses its measurements into the same loop (problems/
@@ -14,7 +14,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "mj1.h"
+#include "pd_mj1.h"
 #include "pd_lanes.h"
 
 _Static_assert(PD_MJB_LANES % MJ1_WIDTH == 0, "whole groups of lanes");
