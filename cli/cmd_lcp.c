@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pd_alloc.h"
 #include "pd_cli.h"
 #include "pd_lcp.h"
 #include "pd_lcp_dump.h"
@@ -225,8 +226,8 @@ static int band_to_csc(int n, const double *M, int band, long nnz, int **colptr,
                        double **values)
 {
     *colptr = malloc(((size_t)n + 1) * sizeof(int));
-    *rowind = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof(int));
-    *values = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof(double));
+    *rowind = pd_malloc(nnz, sizeof(int));
+    *values = pd_malloc(nnz, sizeof(double));
     if (!*colptr || !*rowind || !*values)
         return -1;
     return pd_lcp_band_csc(n, M, band, nnz, *colptr, *rowind, *values) < 0 ? -1 : 0;

@@ -7,6 +7,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "pd_alloc.h"
 #include "pd_output.h"
 #include "pd_spectrum.h"
 
@@ -500,7 +501,7 @@ static int sweep(spec_args *a, int rank, int size, double wall0)
 static int set_provenance(int argc, char **argv)
 {
     static const char *const with_value[] = {"-o", "--plot", "--threads", "--stop-after"};
-    char **kept = malloc((size_t)(argc > 0 ? argc : 1) * sizeof *kept);
+    char **kept = pd_malloc(argc, sizeof *kept);
     int n = 0;
     if (!kept) {
         fprintf(stderr, "pound: spectrum: out of memory\n");

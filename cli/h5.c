@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "pd_alloc.h"
 #include "pd_h5.h"
 
 /* ---- the sink driver --------------------------------------------------------
@@ -455,7 +456,7 @@ hid_t pd_h5_dimension(hid_t loc, const char *name, long len)
 int pd_h5_index(hid_t loc, const char *name, long n, int first, const char *units)
 {
     hsize_t len[1] = {(hsize_t)(n > 0 ? n : 0)};
-    int *x = malloc((size_t)(n > 0 ? n : 1) * sizeof *x);
+    int *x = pd_malloc(n, sizeof *x);
     hid_t space = H5Screate_simple(1, len, NULL), dcpl = pd_h5_untimed(H5P_DATASET_CREATE);
     hid_t ds = -1;
     int rc = -1;

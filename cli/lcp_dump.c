@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pd_alloc.h"
 #include "pd_h5.h"
 #include "pd_lcp_dump.h"
 #include "pd_output.h"
@@ -281,7 +282,7 @@ static void *read_all(hid_t file, const char *name, hid_t type, size_t size, lon
     hid_t sp = H5Dget_space(ds);
     hsize_t dims[1] = {0};
     if (sp >= 0 && H5Sget_simple_extent_ndims(sp) == 1 && H5Sget_simple_extent_dims(sp, dims, NULL) == 1) {
-        buf = malloc((size_t)(dims[0] > 0 ? dims[0] : 1) * size);
+        buf = pd_malloc((long)dims[0], size);
         if (buf && (dims[0] == 0 || H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) >= 0))
             *len = (long)dims[0];
         else {

@@ -15,6 +15,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "pd_alloc.h"
 #include "pd_h5.h"
 #include "pd_output.h"
 
@@ -743,7 +744,7 @@ int pd_table_finish(pd_table_writer *w, int nattrs, const pd_attr *attrs, pd_err
 int pd_output_write(const char *path, const pd_table *t, pd_err *err)
 {
     pd_table_writer *w;
-    double *row = malloc((size_t)(t->ncols > 0 ? t->ncols : 1) * sizeof *row);
+    double *row = pd_malloc(t->ncols, sizeof *row);
     int rc = row ? pd_table_open(&w, path, t->ncols, t->cols, t->dim, t->rows, err)
                  : pd_err_set(err, PD_ENOMEM, "-o %s: out of memory", path);
     if (rc) {

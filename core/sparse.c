@@ -2,6 +2,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pd_alloc.h"
 #include "pd_core.h"
 #include "pd_null.h"
 
@@ -74,8 +75,8 @@ int pd_sparse_from_triplets(pd_sparse *sp, int rows, int cols, long nt, const in
     sp->rows = rows;
     sp->cols = cols;
     sp->colptr = calloc((size_t)cols + 1, sizeof(int));
-    sp->rowind = malloc((size_t)(nt > 0 ? nt : 1) * sizeof(int));
-    sp->values = malloc((size_t)(nt > 0 ? nt : 1) * sizeof(double));
+    sp->rowind = pd_malloc(nt, sizeof(int));
+    sp->values = pd_malloc(nt, sizeof(double));
     next = malloc(((size_t)cols + 1) * sizeof(int));
     if (!sp->colptr || !sp->rowind || !sp->values || !next) {
         free(next);

@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pd_alloc.h"
 #include "pd_problems.h"
 #include "pd_null.h"
 #include "scene_priv.h"
@@ -845,9 +846,9 @@ static void tri_add(triplets *t, int i, int j, double x)
 static int tri_alloc(triplets *t, long cap)
 {
     t->n = 0;
-    t->i = malloc((size_t)(cap > 0 ? cap : 1) * sizeof(int));
-    t->j = malloc((size_t)(cap > 0 ? cap : 1) * sizeof(int));
-    t->x = malloc((size_t)(cap > 0 ? cap : 1) * sizeof(double));
+    t->i = pd_malloc(cap, sizeof(int));
+    t->j = pd_malloc(cap, sizeof(int));
+    t->x = pd_malloc(cap, sizeof(double));
     return t->i && t->j && t->x ? PD_OK : PD_ENOMEM;
 }
 
@@ -895,8 +896,8 @@ int pd_scene_model_build(const pd_scene *sc, int with_contacts, pd_scene_model *
     memset(sm, 0, sizeof *sm);
     if (!sc->finished)
         return pd_err_set(err, PD_EINVAL, "scene: not finished (pd_scene_finish)");
-    sm->g0 = malloc((size_t)(m > 0 ? m : 1) * sizeof(double));
-    sm->e = malloc((size_t)(m > 0 ? m : 1) * sizeof(double));
+    sm->g0 = pd_malloc(m, sizeof(double));
+    sm->e = pd_malloc(m, sizeof(double));
     sm->mass = malloc((size_t)n * sizeof(double));
     if (!sm->g0 || !sm->e || !sm->mass || tri_alloc(&M, n) || tri_alloc(&K, 3L * n) ||
         tri_alloc(&C, 3L * n) || tri_alloc(&W, 2L * m)) {

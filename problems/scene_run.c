@@ -33,6 +33,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pd_alloc.h"
 #include "osc_priv.h"
 #include "pd_null.h"
 #include "demand.h"
@@ -115,26 +116,26 @@ int pd_scene_result_alloc(const pd_scene *sc, pd_scene_result *r, pd_err *err)
     if (!sc || !sc->finished)
         return pd_err_set(err, PD_EINVAL, "scene: %s", sc ? "not finished (pd_scene_finish)"
                                                           : "NULL");
-    size_t n = (size_t)sc->n, m = (size_t)(sc->ncontact > 0 ? sc->ncontact : 1);
+    long n = sc->n, m = sc->ncontact;
     r->n = sc->n;
     r->m = sc->ncontact;
-    r->umax = calloc(n, sizeof(double));
-    r->u_pos = calloc(n, sizeof(double));
-    r->u_neg = calloc(n, sizeof(double));
-    r->drift = calloc(n, sizeof(double));
-    r->impacts = calloc(m, sizeof(long));
-    r->first_impact = calloc(m, sizeof(double));
-    r->max_impulse = calloc(m, sizeof(double));
-    r->contact_time = calloc(m, sizeof(double));
-    r->approach = calloc(m, sizeof(double));
-    r->acc_max = calloc(n, sizeof(double));
-    r->shear_max = calloc(n, sizeof(double));
-    r->drift_ratio = calloc(n, sizeof(double));
-    r->force_max = calloc(m, sizeof(double));
-    r->force_equiv = calloc(m, sizeof(double));
+    r->umax = pd_calloc(n, sizeof(double));
+    r->u_pos = pd_calloc(n, sizeof(double));
+    r->u_neg = pd_calloc(n, sizeof(double));
+    r->drift = pd_calloc(n, sizeof(double));
+    r->impacts = pd_calloc(m, sizeof(long));
+    r->first_impact = pd_calloc(m, sizeof(double));
+    r->max_impulse = pd_calloc(m, sizeof(double));
+    r->contact_time = pd_calloc(m, sizeof(double));
+    r->approach = pd_calloc(m, sizeof(double));
+    r->acc_max = pd_calloc(n, sizeof(double));
+    r->shear_max = pd_calloc(n, sizeof(double));
+    r->drift_ratio = pd_calloc(n, sizeof(double));
+    r->force_max = pd_calloc(m, sizeof(double));
+    r->force_equiv = pd_calloc(m, sizeof(double));
     r->nstruct = sc->nstruct;
-    r->err_est = calloc((size_t)sc->nstruct, sizeof(double));
-    r->law_band = calloc((size_t)sc->nstruct, sizeof(double));
+    r->err_est = pd_calloc(sc->nstruct, sizeof(double));
+    r->law_band = pd_calloc(sc->nstruct, sizeof(double));
     if (!r->umax || !r->u_pos || !r->u_neg || !r->drift || !r->impacts || !r->first_impact ||
         !r->max_impulse || !r->contact_time || !r->approach || !r->acc_max || !r->shear_max ||
         !r->drift_ratio || !r->force_max || !r->force_equiv || !r->err_est || !r->law_band) {
@@ -208,11 +209,11 @@ static void track_free(track *tr)
 /* Every array once, the topology of the scene. */
 static int track_alloc(track *tr, const pd_scene *sc, pd_err *err)
 {
-    size_t n = (size_t)sc->n, m = (size_t)(sc->ncontact > 0 ? sc->ncontact : 1);
+    long n = sc->n, m = sc->ncontact;
     tr->sc = sc;
     tr->n = sc->n;
     tr->m = sc->ncontact;
-#define TA(p, cnt) ((p) = calloc((cnt), sizeof *(p)))
+#define TA(p, cnt) ((p) = pd_calloc((long)(cnt), sizeof *(p)))
     if (!TA(tr->below, n) || !TA(tr->dof_a, m) || !TA(tr->dof_b, m) || !TA(tr->xmax, n) ||
         !TA(tr->xpos, n) || !TA(tr->xneg, n) || !TA(tr->drift, n) || !TA(tr->impacts, m) ||
         !TA(tr->first, m) || !TA(tr->maxP, m) || !TA(tr->ctime, m) || !TA(tr->approach, m) ||
@@ -226,11 +227,10 @@ static int track_alloc(track *tr, const pd_scene *sc, pd_err *err)
         !TA(tr->st_of, n) || !TA(tr->ex, n) || !TA(tr->ev, n) || !TA(tr->sI, m) ||
         !TA(tr->sampled, m) || !TA(tr->errx, n) || !TA(tr->errd, n) || !TA(tr->erra, n) ||
         !TA(tr->errv, n) || !TA(tr->acc0, n) || !TA(tr->shear0, n) ||
-        !TA(tr->serr, (size_t)sc->nstruct) || !TA(tr->wdof, n) || !TA(tr->hacc, n) ||
+        !TA(tr->serr, sc->nstruct) || !TA(tr->wdof, n) || !TA(tr->hacc, n) ||
         !TA(tr->qh, n) || !TA(tr->hlam, m) || !TA(tr->hsm, n) || !TA(tr->hJ, m) ||
         !TA(tr->hG, MJ_HELD_LCP) || !TA(tr->hz, MJ_HELD_LCP) || !TA(tr->hw, MJ_HELD_LCP) ||
-        !TA(tr->hD, (size_t)MJ_HELD_LCP * MJ_HELD_LCP) ||
-        !TA(tr->sheld, (size_t)sc->nstruct)) {
+        !TA(tr->hD, MJ_HELD_LCP * MJ_HELD_LCP) || !TA(tr->sheld, sc->nstruct)) {
 #undef TA
         track_free(tr);
         return pd_err_set(err, PD_ENOMEM, "out of memory for tracking %d dofs", sc->n);
@@ -254,7 +254,7 @@ static int track_alloc(track *tr, const pd_scene *sc, pd_err *err)
  * as track_alloc left them. */
 static void track_clear(track *tr)
 {
-    size_t n = (size_t)tr->n * sizeof(double), m = (size_t)(tr->m > 0 ? tr->m : 1);
+    size_t n = (size_t)tr->n * sizeof(double), m = (size_t)tr->m;
     double *dn[] = {tr->xmax, tr->xpos, tr->xneg, tr->drift, tr->acc, tr->shear, tr->errx,
                     tr->errd, tr->erra, tr->errv};
     for (size_t k = 0; k < sizeof dn / sizeof dn[0]; k++)
@@ -1578,17 +1578,16 @@ int pd_scene_summarize(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sam
         return PD_NULL_ARG(err, !sc ? "sc" : "s");
     if (!sc->finished)
         return pd_err_set(err, PD_EINVAL, "scene: not finished (pd_scene_finish)");
-    size_t n = (size_t)sc->n, m = (size_t)(sc->ncontact > 0 ? sc->ncontact : 1);
     int rc;
     memset(s, 0, sizeof *s);
     twin.no_wall = 1;
     twin.no_demands = 1; /* the twin's figures are umax and the approach */
-    s->Pi1 = malloc(n * sizeof(double));
-    s->gamma = malloc(n * sizeof(double));
-    s->Pi2 = malloc((size_t)sc->nstruct * sizeof(double));
-    s->Pi3 = malloc(m * sizeof(double));
-    s->chi = malloc(m * sizeof(double));
-    s->err_est_structure = malloc((size_t)sc->nstruct * sizeof(double));
+    s->Pi1 = pd_malloc(sc->n, sizeof(double));
+    s->gamma = pd_malloc(sc->n, sizeof(double));
+    s->Pi2 = pd_malloc(sc->nstruct, sizeof(double));
+    s->Pi3 = pd_malloc(sc->ncontact, sizeof(double));
+    s->chi = pd_malloc(sc->ncontact, sizeof(double));
+    s->err_est_structure = pd_malloc(sc->nstruct, sizeof(double));
     if (!s->Pi1 || !s->gamma || !s->Pi2 || !s->Pi3 || !s->chi || !s->err_est_structure) {
         pd_scene_summary_free(s);
         return pd_err_set(err, PD_ENOMEM, "out of memory for the summary of %d dofs", sc->n);
