@@ -231,10 +231,16 @@ def main():
                     help="per-case limit in s (default: 3 x the slowest baseline, >= 60)")
     ap.add_argument("--report", default=None, help="write the table into this file")
     ap.add_argument("--keep", action="store_true", help="keep the work tree")
+    ap.add_argument("--remap", default="", metavar="REV",
+                    help="rewrite scripts/mutate_equivalent.txt's FILE:LINE:COLUMN keys for "
+                         "the files changed since REV by comments or layout only (the same "
+                         "mutation sites in the same order), then exit")
     ap.add_argument("--only", default="",
                     help="FILE:LINE:COL,... : of the sample, run only these mutants (to "
                          "check that a new test kills a survivor)")
     args = ap.parse_args()
+    if args.remap:
+        return remap(args.remap)
     files = [f for f in args.files.split(",") if f]
     only = set(x.strip() for x in args.only.split(",") if x.strip())
     eq = load_equivalent(os.path.join(ROOT, "scripts", "mutate_equivalent.txt"))
@@ -318,6 +324,47 @@ def main():
         log.close()
         if not args.keep:
             shutil.rmtree(work, ignore_errors=True)
+
+
+def site_keys(text):
+    """Each site's (line, column, original, replacement, operator), in order."""
+    return [(line_of(text, a), a - text.rfind("\n", 0, a), text[a:b], new or "(removed)", op)
+            for (a, b, new, op) in sites(text)]
+
+
+def remap(rev):
+    """The equivalents' keys moved with their sites: a file changed since rev
+    only by comments or layout has the same sites in the same order, so the
+    k-th site of the old text is the k-th of the new."""
+    path = os.path.join(ROOT, "scripts", "mutate_equivalent.txt")
+    out, moved, bad, cache = [], 0, 0, {}
+    for raw in open(path, encoding="utf-8"):
+        m = re.match(r"(\S+?):(\d+):(\d+): (.*?) -> (.*?)(\s+#.*)$", raw.rstrip("\n"))
+        if not m:
+            out.append(raw)
+            continue
+        f, line, col = m.group(1), int(m.group(2)), int(m.group(3))
+        if f not in cache:
+            old = subprocess.run(["git", "show", "%s:%s" % (rev, f)], cwd=ROOT,
+                                 capture_output=True, text=True)
+            new = open(os.path.join(ROOT, f), encoding="utf-8").read()
+            cache[f] = (site_keys(old.stdout) if old.returncode == 0 else None, site_keys(new))
+        old_keys, new_keys = cache[f]
+        idx = [i for i, k in enumerate(old_keys or []) if k[0] == line and k[1] == col
+               and k[2] == m.group(4)]
+        same = old_keys is not None and [k[2:] for k in old_keys] == [k[2:] for k in new_keys]
+        if not idx or not same:
+            print("remap: %s:%d:%d left as it is (%s)" % (f, line, col, "not a site at " + rev
+                  if not idx else "its sites changed since " + rev))
+            bad += 1
+            out.append(raw)
+            continue
+        k = new_keys[idx[0]]
+        moved += (k[0], k[1]) != (line, col)
+        out.append("%s:%d:%d: %s -> %s%s\n" % (f, k[0], k[1], m.group(4), m.group(5), m.group(6)))
+    open(path, "w", encoding="utf-8").writelines(out)
+    print("remap: %d keys moved, %d left" % (moved, bad))
+    return 1 if bad else 0
 
 
 def write_report(path, args, table, gaps):
