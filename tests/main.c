@@ -127,6 +127,7 @@ int main(int argc, char **argv)
     suite_penalty(&ctx);
     suite_reference(&ctx);
     suite_event(&ctx);
+    suite_root(&ctx);
     suite_scan(&ctx);
     suite_rows(&ctx);
     suite_paper(&ctx);

@@ -110,6 +110,7 @@ void suite_harden(pd_test_ctx *ctx);
 void suite_aabs(pd_test_ctx *ctx);
 void suite_law(pd_test_ctx *ctx);
 void suite_scan(pd_test_ctx *ctx);
+void suite_root(pd_test_ctx *ctx);
 void suite_measure_paths(pd_test_ctx *ctx);
 void suite_row_paths(pd_test_ctx *ctx);
 void suite_lemke_paths(pd_test_ctx *ctx);
