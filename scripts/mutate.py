@@ -215,7 +215,8 @@ def load_equivalent(path):
             continue
         m = re.match(r"(\S+?):(\d+):(\d+): (.*?) -> (.*?)\s+#\s*(.*)$", line)
         if m:
-            eq[(m.group(1), int(m.group(2)), int(m.group(3)), m.group(4), m.group(5))] = m.group(6)
+            eq[(m.group(1), int(m.group(2)), int(m.group(3)), " ".join(m.group(4).split()),
+                m.group(5))] = m.group(6)
     return eq
 
 
@@ -273,7 +274,7 @@ def main():
                 mutated = text[:a] + new + text[b:]
                 line = line_of(text, a)
                 col = a - text.rfind("\n", 0, a)
-                orig = text[a:b]
+                orig = " ".join(text[a:b].split())  # a statement's layout left out
                 key = (f, line, col, orig, new if new else "(removed)")
                 if only and "%s:%d:%d" % (f, line, col) not in only:
                     continue
@@ -328,8 +329,8 @@ def main():
 
 def site_keys(text):
     """Each site's (line, column, original, replacement, operator), in order."""
-    return [(line_of(text, a), a - text.rfind("\n", 0, a), text[a:b], new or "(removed)", op)
-            for (a, b, new, op) in sites(text)]
+    return [(line_of(text, a), a - text.rfind("\n", 0, a), " ".join(text[a:b].split()),
+             new or "(removed)", op) for (a, b, new, op) in sites(text)]
 
 
 def remap(rev):
@@ -351,7 +352,7 @@ def remap(rev):
             cache[f] = (site_keys(old.stdout) if old.returncode == 0 else None, site_keys(new))
         old_keys, new_keys = cache[f]
         idx = [i for i, k in enumerate(old_keys or []) if k[0] == line and k[1] == col
-               and k[2] == m.group(4)]
+               and k[2] == " ".join(m.group(4).split())]
         same = old_keys is not None and [k[2:] for k in old_keys] == [k[2:] for k in new_keys]
         if not idx or not same:
             print("remap: %s:%d:%d left as it is (%s)" % (f, line, col, "not a site at " + rev
@@ -361,7 +362,7 @@ def remap(rev):
             continue
         k = new_keys[idx[0]]
         moved += (k[0], k[1]) != (line, col)
-        out.append("%s:%d:%d: %s -> %s%s\n" % (f, k[0], k[1], m.group(4), m.group(5), m.group(6)))
+        out.append("%s:%d:%d: %s -> %s%s\n" % (f, k[0], k[1], k[2], m.group(5), m.group(6)))
     open(path, "w", encoding="utf-8").writelines(out)
     print("remap: %d keys moved, %d left" % (moved, bad))
     return 1 if bad else 0
