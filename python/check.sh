@@ -6,10 +6,13 @@
 #
 #   sh python/check.sh [pytest args...]
 #
-# Then the types (mypy: the package, and tests/typing_usage.py with --strict
-# against the install, which needs its py.typed) and the notebook
-# examples/pound_tour.ipynb executed with nbconvert on a kernel of that
-# install (at most $NB_TIMEOUT s, default 300; it takes 7 to 24 s).
+# Before the build: python/pound/_structs.py (the ctypes mirrors of the
+# public structs) must be what scripts/gen_py_structs.py generates from the
+# headers.  After the tests: the types (mypy: the package, and
+# tests/typing_usage.py with --strict against the install, which needs its
+# py.typed) and the notebook examples/pound_tour.ipynb executed with
+# nbconvert on a kernel of that install (at most $NB_TIMEOUT s, default 300;
+# it takes 7 to 24 s).
 #
 # Environment: POUND_LIBRARY (a built libpound.so: nothing is built),
 # POUND_BIN (the CLI the tests compare with, default: the one built next to
@@ -23,6 +26,9 @@ PYTHON=${PYTHON:-/usr/bin/python3}
 PY_BUILD=${PY_BUILD:-build-py}
 MAKE=${MAKE:-make}
 jobs=$(nproc 2>/dev/null || echo 2)
+
+# the mirrors against the headers (stale: the diff, and exit 1)
+"$PYTHON" "$root/scripts/gen_py_structs.py" --check
 
 if [ -z "${POUND_LIBRARY:-}" ]; then
     # the library and the CLI from one make run: the bit-identity tests need both

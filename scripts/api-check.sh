@@ -129,6 +129,14 @@ null_test() {
 }
 check "tests/test_api_null.c from the installed headers" null_test
 
+# python/pound/_structs.py, the Python package's ctypes mirrors of the public
+# structs, is generated from the headers too (scripts/gen_py_structs.py).
+py_structs() {
+    command -v python3 >/dev/null || { echo "skip: no python3" >&2; return 0; }
+    python3 scripts/gen_py_structs.py --check
+}
+check "python/pound/_structs.py from the headers" py_structs
+
 # ---- the examples against the installed library ------------------------
 PKG="pkg-config --define-variable=prefix=$root"
 cflags= libs= static=

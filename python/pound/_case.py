@@ -10,7 +10,7 @@ import numpy as np
 
 from . import _args, _demand, _lib
 from ._args import number
-from ._lib import InputError, PdErr, PdRecord, PdRecordPulse, lib
+from ._lib import InputError, PdErr, PdRecord, PdRecordPulse, err_text, lib
 from ._types import ArrayLike, PathArg
 
 # Keyword arguments and the CLI flags they mirror (the names without "--",
@@ -94,7 +94,7 @@ class Record:
         if units is not None:
             f, err = ctypes.c_int(fmt_code), PdErr()
             if fmt_code == 0 and lib.pd_record_detect(cpath, f, err):
-                raise InputError(err.text())
+                raise InputError(err_text(err))
             if f.value != 3:  # PD_RECORD_TEXT
                 raise InputError("units: %s is read as %s, whose file states its units (units "
                                  "is for two-column text records)" % (
@@ -109,7 +109,7 @@ class Record:
             self._owned = True
             st = lib.pd_record_fit_pulse(self.rec, self.pulse, err)
         if st != 0:
-            msg = err.text()
+            msg = err_text(err)
             if fmt_code != 0 and st != _lib.PD_ENOMEM:  # the user chose how to read it: say so
                 msg = "%s (read as record_format %s)" % (msg, format)
             self.close()
@@ -148,7 +148,7 @@ class Record:
             self._owned = True
             st = lib.pd_record_fit_pulse(self.rec, self.pulse, err)
         if st != 0:
-            msg = err.text()
+            msg = err_text(err)
             self.close()
             raise _lib.make_error(st, msg)
         self._warn_units()

@@ -7,7 +7,7 @@ import numpy as np
 
 from . import _args, _lib
 from ._case import InputError, Record, parse_name
-from ._lib import PdErr, PdMatrix, lib, s
+from ._lib import PdErr, PdMatrix, err_text, lib, s
 from ._osc import Result
 from ._types import ArrayLike, Int, PathArg
 
@@ -109,7 +109,7 @@ def lcp(M: Any, q: ArrayLike, solver: str = "auto", cover: Optional[ArrayLike] =
     err = PdErr()
     solver_p = lib.pd_lcp_solver_alloc(method, n, nnz, err)
     if not solver_p:
-        raise _lib.make_error(err.status or _lib.PD_ENOMEM, err.text())
+        raise _lib.make_error(err.status or _lib.PD_ENOMEM, err_text(err))
     z, w = np.zeros(n), np.zeros(n)
     info = _lib.PdLcpInfo()
     try:

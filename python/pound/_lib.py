@@ -1,6 +1,6 @@
 """libpound through ctypes: finding the library, the mirrors of its public
-structs, the prototypes of the functions used, errors, and the layout check
-run at import.
+structs (generated from the headers: _structs.py), the prototypes of the
+functions used, errors, and the layout check run at import.
 
 Only functions declared in the four public headers (core/pd_core.h,
 lcp/pd_lcp.h, engine/pd_engine.h, problems/pd_problems.h) are used: they are
@@ -9,9 +9,18 @@ the ones libpound.so exports.
 import ctypes
 import math
 import os
-from ctypes import (CFUNCTYPE, POINTER, Structure, c_char, c_char_p, c_double, c_int, c_long,
-                    c_ubyte, c_void_p)
+from ctypes import (CFUNCTYPE, POINTER, Structure, c_char_p, c_double, c_int, c_long, c_ubyte,
+                    c_void_p)
 from typing import List, Optional, Tuple
+
+# The mirrors of the public structs, generated from the headers by
+# scripts/gen_py_structs.py (the other modules take them from here).
+from ._structs import (PD_SPEC_MAX_LIST, PD_WALL, PdContact, PdErr, PdLcpInfo,  # noqa: F401
+                       PdLcpOpts, PdMatrix, PdMeasured, PdOsc, PdOscResult, PdOscSample,
+                       PdOscSummary, PdPenaltySetup, PdRecord, PdRecordMeasures, PdRecordPulse,
+                       PdRunOpts, PdScene, PdSceneErrors, PdSceneExcitation, PdSceneResult,
+                       PdSceneSample, PdSceneSummary, PdSceneTrace, PdSpecCoords, PdSpecResult,
+                       PdSpecRow, PdSpectrum, PdStructure, PdTrace)
 
 # ---- errors --------------------------------------------------------------------------
 
@@ -94,216 +103,11 @@ def make_error(status: int, message: str) -> PoundError:
     return cls(message, status)
 
 
-# ---- the structs ------------------------------------------------------------------------
+# ---- the structs' helpers ----------------------------------------------------------------
 
-class PdErr(Structure):
-    _fields_ = [("status", c_int), ("msg", c_char * 256)]
-
-    def text(self):
-        return self.msg.decode("utf-8", "replace")
-
-
-class PdMatrix(Structure):
-    _fields_ = [("kind", c_int), ("rows", c_int), ("cols", c_int),
-                ("values", POINTER(c_double)), ("colptr", POINTER(c_int)),
-                ("rowind", POINTER(c_int))]
-
-
-class PdLcpOpts(Structure):
-    _fields_ = [("cover", POINTER(c_double)), ("max_pivots", c_int), ("tol", c_double),
-                ("max_iterations", c_int), ("guess", POINTER(c_ubyte))]
-
-
-class PdLcpInfo(Structure):
-    _fields_ = [("outcome", c_int), ("pivots", c_int), ("iterations", c_int),
-                ("complementarity", c_double), ("infeasibility", c_double),
-                ("residual", c_double), ("scale", c_double), ("solver", c_char_p)]
-
-
-class PdPenaltySetup(Structure):
-    _fields_ = [("law", c_int), ("kc_mult", c_double), ("kc_abs", c_double),
-                ("rtol", c_double), ("atol", c_double), ("stepper", c_char_p)]
-
-
-class PdRunOpts(Structure):
-    _fields_ = [("method", c_int), ("dt", c_double), ("tend", c_double), ("theta", c_double),
-                ("gamma", c_double), ("allow_unstable", c_int), ("kernel", c_int),
-                ("factor", c_int), ("lcp_solver", c_int), ("no_accumulation", c_int),
-                ("no_wall", c_int), ("pen", PdPenaltySetup), ("on_lcp", c_void_p),
-                ("on_lcp_ctx", c_void_p), ("close_tol", c_double),
-                ("impact_law", c_int), ("no_law_band", c_int),  # 0 staged, 1 single
-                ("contact_duration", c_double), ("no_demands", c_int),
-                ("rtol", c_double)]  # > 0: Moreau-Jean to a tolerance (pen.rtol: GSL's)
-
-
-class PdRecord(Structure):
-    _fields_ = [("name", c_char * 256), ("npts", c_long), ("dt", c_double),
-                ("acc", POINTER(c_double))]
-
-
-class PdRecordMeasures(Structure):
-    _fields_ = [(k, c_double) for k in
-                ("pga", "pgv", "pgd", "t_pga", "t_pgv", "t_pgd", "arias", "t5_75", "t5_95")]
-
-
-class PdRecordPulse(Structure):
-    _fields_ = ([(k, c_double) for k in ("vp", "fp", "nu", "gamma", "t0", "Tp", "ap", "wp",
-                                          "Le", "r2")]
-                + [("iterations", c_long), ("shape", c_int), ("polarity", c_int),
-                   ("t_start", c_double)])
-
-
-class PdOsc(Structure):
-    _fields_ = [("pulse", c_int), ("dir", c_int), ("ap", c_double), ("Tp", c_double),
-                ("Pi2", c_double), ("Pi3", c_double), ("eps", c_double), ("xi", c_double),
-                ("record", POINTER(PdRecord)), ("rec_ap", c_double), ("scale", c_double)]
-
-
-class PdOscSample(Structure):
-    _fields_ = [("step", c_long), ("t", c_double), ("u", c_double), ("v", c_double),
-                ("impulse", c_double), ("gap", c_double), ("impacts", c_long)]
-
-
-class PdOscResult(Structure):
-    _fields_ = [("umax", c_double), ("u_toward", c_double), ("u_away", c_double),
-                ("impacts", c_long), ("first_impact", c_double),
-                ("first_impact_velocity", c_double), ("max_impact_velocity", c_double),
-                ("max_impulse", c_double), ("contact_time", c_double), ("min_gap", c_double),
-                ("accumulations", c_long), ("steps", c_long), ("dt", c_double),
-                ("tend", c_double), ("theta", c_double), ("gamma", c_double),
-                ("cpu_s", c_double), ("kernel", c_char_p), ("acc_max", c_double),
-                ("shear_max", c_double), ("force_max", c_double), ("force_equiv", c_double),
-                ("contact_duration", c_double),
-                # Moreau-Jean to a tolerance (fixed steps: rtol 0, err_est NAN, rtol_met 1)
-                ("rtol", c_double), ("err_est", c_double), ("rtol_met", c_int),
-                ("steps_rejected", c_long), ("dt_min", c_double), ("dt_max", c_double)]
-
-
-class PdOscSummary(Structure):
-    _fields_ = [("r", PdOscResult), ("free", PdOscResult), ("Pi1", c_double),
-                ("gamma", c_double), ("chi", c_double), ("cpu_s", c_double),
-                ("err_est", c_double), ("rtol_met", c_int)]
-
-
-class PdTrace(Structure):
-    _fields_ = [("u", POINTER(c_double)), ("n", c_long), ("cap", c_long), ("dt", c_double)]
-
-
-class PdMeasured(Structure):
-    _fields_ = [("r", PdOscResult), ("err_umax_rel", c_double), ("err_hist_linf", c_double),
-                ("grid_points", c_long)]
-
-
-PD_WALL = -1
-PD_NAME_MAX = 64
-
-
-class PdStructure(Structure):
-    _fields_ = [("name", c_char * PD_NAME_MAX), ("storeys", c_int),
-                ("mass", POINTER(c_double)), ("stiffness", POINTER(c_double)), ("xi", c_double),
-                ("damping", c_int), ("modes", c_int * 2), ("T0", c_double),
-                ("period", c_double * 2), ("Tmin", c_double), ("alpha", c_double),
-                ("beta", c_double), ("dof", c_int), ("height", POINTER(c_double))]
-
-
-class PdContact(Structure):
-    _fields_ = [("a", c_int), ("b", c_int), ("level_a", c_int), ("level_b", c_int),
-                ("gap", c_double), ("eps", c_double), ("entry", c_int)]
-
-
-class PdSceneExcitation(Structure):
-    _fields_ = [("pulse", c_int), ("dir", c_int), ("ap", c_double), ("Tp", c_double),
-                ("record", POINTER(PdRecord)), ("rec_ap", c_double), ("scale", c_double)]
-
-
-class PdScene(Structure):
-    _fields_ = [("nstruct", c_int), ("ncontact", c_int), ("st", POINTER(PdStructure)),
-                ("ct", POINTER(PdContact)), ("exc", PdSceneExcitation), ("tend", c_double),
-                ("n", c_int), ("finished", c_int), ("cap_struct", c_int),
-                ("cap_contact", c_int), ("names", POINTER(c_int)), ("name_cap", c_int),
-                ("own_record", POINTER(PdRecord))]
-
-
-class PdSceneSample(Structure):
-    _fields_ = [("step", c_long), ("t", c_double), ("x", POINTER(c_double)),
-                ("v", POINTER(c_double)), ("gap", POINTER(c_double)),
-                ("impulse", POINTER(c_double)), ("impacts", POINTER(c_long))]
-
-
-class PdSceneResult(Structure):
-    _fields_ = [("n", c_int), ("m", c_int),
-                ("umax", POINTER(c_double)), ("u_pos", POINTER(c_double)),
-                ("u_neg", POINTER(c_double)), ("drift", POINTER(c_double)),
-                ("impacts", POINTER(c_long)), ("first_impact", POINTER(c_double)),
-                ("max_impulse", POINTER(c_double)), ("contact_time", POINTER(c_double)),
-                ("approach", POINTER(c_double)), ("steps", c_long), ("lcp_solves", c_long),
-                ("simultaneous", c_long), ("tol_closed", c_long), ("accumulations", c_long),
-                ("close_tol", c_double), ("dt", c_double), ("tend", c_double),
-                ("theta", c_double), ("cpu_s", c_double),
-                ("method", c_char_p), ("kernel", c_char_p), ("factor", c_char_p),
-                ("lcp_solver", c_char_p), ("acc_max", POINTER(c_double)),
-                ("shear_max", POINTER(c_double)), ("drift_ratio", POINTER(c_double)),
-                ("force_max", POINTER(c_double)), ("force_equiv", POINTER(c_double)),
-                ("contact_duration", c_double),
-                # Moreau-Jean to a tolerance (fixed steps: rtol 0, err_est NAN, rtol_met 1)
-                ("rtol", c_double), ("err_est", POINTER(c_double)), ("err_est_max", c_double),
-                ("rtol_met", c_int), ("steps_rejected", c_long), ("dt_min", c_double),
-                ("dt_max", c_double), ("nstruct", c_int),
-                # the row reference: its impact law, the peaks under the other (NAN: none)
-                ("impact_law", c_char_p), ("law_band", POINTER(c_double)),
-                ("law_band_max", c_double), ("law_decided", c_long)]
-
-
-class PdSceneSummary(Structure):
-    _fields_ = [("r", PdSceneResult), ("free", PdSceneResult),
-                ("Pi1", POINTER(c_double)), ("gamma", POINTER(c_double)),
-                ("Pi2", POINTER(c_double)), ("Pi3", POINTER(c_double)),
-                ("chi", POINTER(c_double)), ("cpu_s", c_double), ("err_est", c_double),
-                ("rtol_met", c_int), ("err_est_structure", POINTER(c_double))]
-
-
-class PdSceneTrace(Structure):
-    _fields_ = [("x", POINTER(c_double)), ("rows", c_long), ("cap", c_long), ("n", c_int),
-                ("dt", c_double)]
-
-
-class PdSceneErrors(Structure):
-    _fields_ = [("err_umax", POINTER(c_double)), ("err_hist", POINTER(c_double)),
-                ("err_umax_max", c_double), ("err_hist_max", c_double), ("impacts", c_long),
-                ("grid_points", c_long), ("cpu_s", c_double), ("nstruct", c_int)]
-
-
-PD_SPEC_MAX_LIST = 64
-
-
-class PdSpectrum(Structure):
-    _fields_ = [("base", PdOsc), ("opts", PdRunOpts), ("pi2_min", c_double),
-                ("pi2_max", c_double), ("npi2", c_int), ("linear", c_int),
-                ("npulse", c_int), ("ndir", c_int), ("nap", c_int), ("nxi", c_int),
-                ("nsize", c_int), ("neps", c_int), ("pulse", c_int * 3), ("dir", c_int * 2),
-                ("ap", c_double * PD_SPEC_MAX_LIST), ("xi", c_double * PD_SPEC_MAX_LIST),
-                ("size", c_double * PD_SPEC_MAX_LIST), ("eps", c_double * PD_SPEC_MAX_LIST),
-                ("size_is_gap", c_int), ("dimensional", c_int), ("dt_per_Tp", c_double)]
-
-
-class PdSpecCoords(Structure):
-    _fields_ = [("twin", c_int), ("pulse", c_int), ("dir", c_int), ("ap", c_int),
-                ("xi", c_int), ("size", c_int), ("eps", c_int), ("j", c_int),
-                ("curve", c_long)]
-
-
-class PdSpecResult(Structure):
-    _fields_ = [(k, c_double) for k in ("umax", "u_toward", "u_away", "contact_time",
-                                         "first_impact", "cpu_s")] + \
-               [("impacts", c_long), ("steps", c_long), ("status", c_int), ("done", c_int)]
-
-
-class PdSpecRow(Structure):
-    _fields_ = ([("c", PdOsc), ("curve", c_long)]
-                + [(k, c_double) for k in ("T0", "gap", "dt", "tend", "umax", "Pi1",
-                                           "umax_free", "gamma", "chi", "u_toward", "u_away",
-                                           "contact_time", "first_impact", "cpu_s")]
-                + [("impacts", c_long), ("steps", c_long)])
+def err_text(err):
+    """A pd_err's message as str."""
+    return err.msg.decode("utf-8", "replace")
 
 
 # Samplers get the address of a pd_osc_sample / pd_scene_sample (read with
@@ -522,7 +326,7 @@ def s(b):
 def check(status, err):
     """Raise the PoundError of a failed call."""
     if status != 0:
-        msg = err.text() if err is not None and err.msg else s(lib.pd_strerror(status))
+        msg = err_text(err) if err is not None and err.msg else s(lib.pd_strerror(status))
         raise make_error(status, msg)
 
 
@@ -649,7 +453,7 @@ def _check_layout():
     r = PdSpecResult()
     lib.pd_spec_run_task(bad, 0, r, err)
     _expect("pd_spec_result.status", r.status, PD_EINVAL)
-    _expect("pd_err.msg", err.text().startswith("ap (pulse amplitude)"), True)
+    _expect("pd_err.msg", err_text(err).startswith("ap (pulse amplitude)"), True)
     # pd_spec_row: rows of given task results
     one = PdSpectrum()
     lib.pd_spec_init(one)

@@ -8,7 +8,7 @@ import numpy as np
 
 from . import _args, _demand, _lib
 from ._case import Case, InputError, copy_opts, number
-from ._lib import PdErr, lib, s
+from ._lib import PdErr, err_text, lib, s
 from ._types import Floats, Int, Names, PathArg, Range
 
 if TYPE_CHECKING:
@@ -393,7 +393,7 @@ def compare(methods: Names = ("moreau",), scene: Optional[Union[PathArg, "Scene"
         rr = _lib.PdOscResult()
         st = lib.pd_measure_reference(k.c, o, tr.ref, rr, err)
         if st:
-            raise _lib.make_error(st, "reference: " + err.text())
+            raise _lib.make_error(st, "reference: " + err_text(err))
         res: List[Any] = [None] * _NMETHOD
         for m in range(_NMETHOD):
             if not want[m]:
@@ -403,7 +403,7 @@ def compare(methods: Names = ("moreau",), scene: Optional[Union[PathArg, "Scene"
             res[m] = _lib.PdMeasured()
             st = lib.pd_measure_run(k.c, om, tr.ref, rr.umax, tr.work, res[m], err)
             if st:
-                raise _lib.make_error(st, "%s: %s" % (s(lib.pd_method_name(m)), err.text()))
+                raise _lib.make_error(st, "%s: %s" % (s(lib.pd_method_name(m)), err_text(err)))
     finally:
         tr.close()
     first = next(m for m in range(_NMETHOD) if want[m])
@@ -578,7 +578,7 @@ def _rows(M, steps, dt_min, thetas, want_moreau, want_penalty, kcs, error, want_
         st, cpu = M.reference(o, err)
         ref_cpu = max(ref_cpu, cpu)  # fmax: the CLI keeps the largest
         if st:
-            raise _lib.make_error(st, err.text())
+            raise _lib.make_error(st, err_text(err))
 
     def row(first=False):
         if first:
@@ -590,7 +590,7 @@ def _rows(M, steps, dt_min, thetas, want_moreau, want_penalty, kcs, error, want_
                    kc=o.pen.kc_mult if o.method in (2, 5) else NAN)
         st, m = M.row(o, err)
         if st:
-            raise _lib.make_error(st, err.text())
+            raise _lib.make_error(st, err_text(err))
         r.update(err_umax_rel=m["err_umax"], err_hist_linf=m["err_hist"], cpu_s=m["cpu_s"],
                  order=NAN, impacts=m["impacts"], steps=m["steps"],
                  err_est=m["err_est"] if tol else NAN)

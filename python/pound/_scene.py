@@ -7,7 +7,7 @@ import numpy as np
 
 from . import _args, _demand, _lib
 from ._case import SCHEME_KEYS, Case, InputError, copy_opts, number, scheme_opts
-from ._lib import PD_WALL, PdErr, lib, s
+from ._lib import PD_WALL, PdErr, err_text, lib, s
 from ._osc import Result, _History, history_args, history_cap, tolerance_fields
 from ._types import Int, PathArg
 
@@ -425,7 +425,7 @@ def compare_scene(scene, want, kw):
         M.alloc(o)
         st = lib.pd_scene_measure_reference(M.sc, o, M.ref, M.rr, err)
         if st:
-            raise _lib.make_error(st, "reference: " + err.text())
+            raise _lib.make_error(st, "reference: " + err_text(err))
         sc = M.scene._sc
         rows = {}
         for m in range(len(want)):
@@ -439,7 +439,7 @@ def compare_scene(scene, want, kw):
                 _lib.check(lib.pd_scene_errors_alloc(M.sc, e, err), err)
                 st = lib.pd_scene_measure_run(M.sc, om, M.ref, M.rr, res, e, err)
                 if st:
-                    raise _lib.make_error(st, "%s: %s" % (s(lib.pd_method_name(m)), err.text()))
+                    raise _lib.make_error(st, "%s: %s" % (s(lib.pd_method_name(m)), err_text(err)))
                 rows[m] = Result(method=s(lib.pd_method_name(m)), err_umax_rel=e.err_umax_max,
                                  err_hist_linf=e.err_hist_max, impacts=e.impacts,
                                  steps=res.steps, cpu_s=e.cpu_s,

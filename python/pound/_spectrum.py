@@ -13,7 +13,7 @@ import numpy as np
 from . import _args, _lib
 from ._case import (CASE_KEYS, PD_METHOD_AUTO, Case, InputError, implied_method, number,
                     parse_dir, parse_name)
-from ._lib import PD_SPEC_MAX_LIST, PdErr, lib, s
+from ._lib import PD_SPEC_MAX_LIST, PdErr, err_text, lib, s
 from ._osc import Result
 from ._types import Floats, Int, Names, Range
 
@@ -174,7 +174,7 @@ def run_tasks(sp, threads=None):
             lib.pd_spec_run_task(sp, t, res[t], err)
             if res[t].status:
                 with lock:
-                    msgs[t] = err.text()
+                    msgs[t] = err_text(err)
 
     if sp.opts.method == 2 and ntasks:
         # the penalty runs turn GSL's process-wide error handler off: once, before the threads
@@ -182,7 +182,7 @@ def run_tasks(sp, threads=None):
         err = PdErr()
         lib.pd_spec_run_task(sp, first, res[first], err)
         if res[first].status:
-            msgs[first] = err.text()
+            msgs[first] = err_text(err)
     if threads == 1:
         work()
     else:

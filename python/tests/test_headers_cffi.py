@@ -1,4 +1,5 @@
-"""The hand-written ctypes mirrors against the C headers, read by cffi.
+"""The ctypes mirrors (generated: pound/_structs.py) and the binding's
+prototypes against the C headers, read by cffi.
 
 The import-time layout check (pound/_lib.py) measures each struct's size
 from a call and reads some fields back; it cannot see a function's
@@ -11,7 +12,6 @@ argument and result types (kind and size; a struct by value returned into
 its padded mirror).  cffi is the checker only: the binding stays ctypes.
 Skipped without cffi or a C compiler."""
 import ctypes
-import inspect
 import re
 import shutil
 import subprocess
@@ -22,7 +22,7 @@ from conftest import REPO
 
 cffi = pytest.importorskip("cffi")
 
-from pound import _lib  # noqa: E402
+from pound import _lib, _structs  # noqa: E402
 
 MODULE_DIRS = ("core", "lcp", "engine", "problems")
 
@@ -96,9 +96,7 @@ def c_name(mirror):
     return "pd_" + re.sub(r"(?<!^)([A-Z])", r"_\1", mirror.__name__[2:]).lower()
 
 
-MIRRORS = sorted((c for n, c in vars(_lib).items()
-                  if inspect.isclass(c) and issubclass(c, ctypes.Structure) and n.startswith("Pd")),
-                 key=lambda c: c.__name__)
+MIRRORS = sorted(_structs.MIRRORS.values(), key=lambda c: c.__name__)
 
 
 def test_every_mirror_is_checked():
