@@ -38,8 +38,12 @@ STRUCTS = (
     "pd_scene_trace", "pd_scene_errors", "pd_spectrum", "pd_spec_coords", "pd_spec_result",
     "pd_spec_row",
 )
-# Integer constants the package uses besides the array sizes.
-CONSTANTS = ("PD_WALL",)
+# Integer constants the package uses besides the array sizes: the statuses,
+# the wall's index, the automatic method.
+STATUSES = ("PD_OK", "PD_ENOMEM", "PD_EINVAL", "PD_ENOSOLUTION", "PD_EMAXPIVOTS", "PD_ENUMERICAL",
+            "PD_ENONFINITE", "PD_EIO", "PD_EPARSE", "PD_ESINGULAR", "PD_EBUDGET", "PD_ESTOPPED",
+            "PD_EMAXITER")
+CONSTANTS = STATUSES + ("PD_WALL", "PD_METHOD_AUTO")
 
 SCALARS = {"double": "c_double", "int": "c_int", "long": "c_long", "size_t": "c_size_t",
            "unsigned char": "c_ubyte", "char": "c_char"}
@@ -223,6 +227,8 @@ def generate(root=ROOT):
         '"""ctypes mirrors of libpound\'s public structs, generated from its headers."""\n',
         "from ctypes import %s\n\n" % ", ".join(sorted(used, key=lambda u: (u.islower(), u))),
         "".join("%s = %d\n" % (c, hd.int_value(hd.consts[c])) for c in sorted(consts)),
+        "\n# status -> its name\nSTATUS_NAMES = {\n%s\n}\n" % "\n".join(
+            "    %s: \"%s\"," % (c, c) for c in STATUSES),
         "".join("\n\n" + c for c in classes),
         "\n\n# C name -> mirror, for the layout tests\n",
         "MIRRORS = {\n%s\n}\n" % "\n".join('    "%s": %s,' % (s, class_name(s)) for s in order),

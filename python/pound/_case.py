@@ -30,7 +30,7 @@ IMPLIES = {"dt": 0, "theta": 0, "gamma": 0, "allow_unstable": 0, "kernel": 0, "f
            "lcp_solver": 0, "dt_per_Tp": 0, "no_accumulation": 1, "close_tol": 1,
            "impact_law": 1, "kc": 2,
            "kc_abs": 2, "atol": 2, "contact": 2, "stepper": 2}
-PD_METHOD_AUTO = 3
+from ._structs import PD_METHOD_AUTO  # noqa: E402  (generated from pd_problems.h)
 PD_RTOL_MIN = 1e-12  # the tightest tolerance of Moreau-Jean's steps
 
 STEPPERS = {"rk8pd": b"rk8pd", "rkf45": b"rkf45", "rk4imp": b"rk4imp", "msbdf": b"msbdf"}

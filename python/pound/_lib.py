@@ -24,12 +24,10 @@ from ._structs import (PD_SPEC_MAX_LIST, PD_WALL, PdContact, PdErr, PdLcpInfo,  
 
 # ---- errors --------------------------------------------------------------------------
 
-STATUS_NAMES = {
-    0: "PD_OK", -1: "PD_ENOMEM", -2: "PD_EINVAL", -3: "PD_ENOSOLUTION", -4: "PD_EMAXPIVOTS",
-    -5: "PD_ENUMERICAL", -6: "PD_ENONFINITE", -7: "PD_EIO", -8: "PD_EPARSE",
-    -9: "PD_ESINGULAR", -10: "PD_EBUDGET", -11: "PD_ESTOPPED", -12: "PD_EMAXITER",
-}
-PD_OK, PD_ENOMEM, PD_EINVAL, PD_EIO, PD_EPARSE = 0, -1, -2, -7, -8
+# the statuses and their names: generated from core/pd_core.h (_structs.py)
+from ._structs import (PD_EBUDGET, PD_EINVAL, PD_EIO, PD_EMAXITER, PD_EMAXPIVOTS,  # noqa: E402
+                       PD_ENOMEM, PD_ENONFINITE, PD_ENOSOLUTION, PD_ENUMERICAL, PD_EPARSE,
+                       PD_ESINGULAR, PD_OK, STATUS_NAMES)
 
 
 class PoundError(Exception):
@@ -92,9 +90,10 @@ class LayoutError(ImportError):
 
 
 _ERROR_CLASSES = {
-    -1: PoundMemoryError, -2: InputError, -3: SolverError, -4: SolverError, -5: NumericalError,
-    -6: NumericalError, -7: FileError, -8: ParseError, -9: NumericalError, -10: BudgetError,
-    -12: SolverError,
+    PD_ENOMEM: PoundMemoryError, PD_EINVAL: InputError, PD_ENOSOLUTION: SolverError,
+    PD_EMAXPIVOTS: SolverError, PD_ENUMERICAL: NumericalError, PD_ENONFINITE: NumericalError,
+    PD_EIO: FileError, PD_EPARSE: ParseError, PD_ESINGULAR: NumericalError,
+    PD_EBUDGET: BudgetError, PD_EMAXITER: SolverError,
 }
 
 

@@ -6,9 +6,40 @@
 """ctypes mirrors of libpound's public structs, generated from its headers."""
 from ctypes import POINTER, Structure, c_char, c_char_p, c_double, c_int, c_long, c_ubyte, c_void_p
 
+PD_EBUDGET = -10
+PD_EINVAL = -2
+PD_EIO = -7
+PD_EMAXITER = -12
+PD_EMAXPIVOTS = -4
+PD_ENOMEM = -1
+PD_ENONFINITE = -6
+PD_ENOSOLUTION = -3
+PD_ENUMERICAL = -5
+PD_EPARSE = -8
+PD_ESINGULAR = -9
+PD_ESTOPPED = -11
+PD_METHOD_AUTO = 3
 PD_NAME_MAX = 64
+PD_OK = 0
 PD_SPEC_MAX_LIST = 64
 PD_WALL = -1
+
+# status -> its name
+STATUS_NAMES = {
+    PD_OK: "PD_OK",
+    PD_ENOMEM: "PD_ENOMEM",
+    PD_EINVAL: "PD_EINVAL",
+    PD_ENOSOLUTION: "PD_ENOSOLUTION",
+    PD_EMAXPIVOTS: "PD_EMAXPIVOTS",
+    PD_ENUMERICAL: "PD_ENUMERICAL",
+    PD_ENONFINITE: "PD_ENONFINITE",
+    PD_EIO: "PD_EIO",
+    PD_EPARSE: "PD_EPARSE",
+    PD_ESINGULAR: "PD_ESINGULAR",
+    PD_EBUDGET: "PD_EBUDGET",
+    PD_ESTOPPED: "PD_ESTOPPED",
+    PD_EMAXITER: "PD_EMAXITER",
+}
 
 
 class PdErr(Structure):
