@@ -25,7 +25,7 @@ from ._structs import (PD_SPEC_MAX_LIST, PD_WALL, PdContact, PdErr, PdLcpInfo,  
 # ---- errors --------------------------------------------------------------------------
 
 # the statuses and their names: generated from core/pd_core.h (_structs.py)
-from ._structs import (PD_EBUDGET, PD_EINVAL, PD_EIO, PD_EMAXITER, PD_EMAXPIVOTS,  # noqa: E402
+from ._structs import (PD_EBUDGET, PD_EINVAL, PD_EIO, PD_EMAXITER, PD_EMAXPIVOTS,  # noqa: E402,F401
                        PD_ENOMEM, PD_ENONFINITE, PD_ENOSOLUTION, PD_ENUMERICAL, PD_EPARSE,
                        PD_ESINGULAR, PD_OK, STATUS_NAMES)
 
