@@ -110,6 +110,7 @@ static size_t layout(edg *w, char *base)
 {
     size_t off = 0, n = (size_t)w->n, m = w->m > 0 ? (size_t)w->m : 1, d = (size_t)w->dim;
     size_t k = (size_t)w->kmax;
+    /* each array 16-byte aligned; base NULL: off only counts (the total) */
 #define TAKE(ptr, count, type)                                                                \
     do {                                                                                      \
         off = (off + 15u) & ~(size_t)15u;                                                     \
@@ -117,6 +118,7 @@ static size_t layout(edg *w, char *base)
             (ptr) = (type *)(void *)(base + off);                                             \
         off += (size_t)(count) * sizeof(type);                                                \
     } while (0)
+    /* A: flags, list, places; D_AA's LU (kmax^2) and pivots; lambda_A */
     TAKE(w->inA, m, unsigned char);
     TAKE(w->idxA, m, int);
     TAKE(w->posA, m, int);
@@ -124,10 +126,13 @@ static size_t layout(edg *w, char *base)
     TAKE(w->Dperm, m, int);
     TAKE(w->lam, m, double);
     TAKE(w->tmpA, m, double);
+    /* q = qref + d: the reference, K qref, its gaps and their rounding scale */
     TAKE(w->qref, n, double);
     TAKE(w->Kqref, n, double);
     TAKE(w->gref, m, double);
     TAKE(w->gscale, m, double);
+    /* GSL's states (dim = 2 n + m): y, the step's start ya,
+     * rates fa fb, probe yp, event yev, error yerr */
     TAKE(w->y, d, double);
     TAKE(w->ya, d, double);
     TAKE(w->fa, d, double);
@@ -138,12 +143,14 @@ static size_t layout(edg *w, char *base)
     TAKE(w->acc, n, double);
     TAKE(w->qs, n, double);
     TAKE(w->vs, n, double);
+    /* gap, rate, acceleration at ta, then at tb */
     TAKE(w->ga, m, double);
     TAKE(w->Ua, m, double);
     TAKE(w->Ga, m, double);
     TAKE(w->gb, m, double);
     TAKE(w->Ub, m, double);
     TAKE(w->Gb, m, double);
+    /* an event's gaps, rates and tolerances; impacts' bookkeeping */
     TAKE(w->g, m, double);
     TAKE(w->U, m, double);
     TAKE(w->Um, m, double);
@@ -160,10 +167,12 @@ static size_t layout(edg *w, char *base)
     TAKE(w->hit, m, unsigned char);
     TAKE(w->flag, m, unsigned char);
     TAKE(w->idx, m, int);
+    /* an LCP's block (kmax^2) and vectors */
     TAKE(w->Dsub, k * k, double);
     TAKE(w->bsub, m, double);
     TAKE(w->zsub, m, double);
     TAKE(w->wsub, m, double);
+    /* the reported state */
     TAKE(w->st.q, n, double);
     TAKE(w->st.acc, n, double);
     TAKE(w->st.v, n, double);
@@ -199,11 +208,12 @@ static int edg_alloc(edg *w, pd_err *err)
     w->block = calloc(1, bytes);
     if (w->block)
         layout(w, w->block);
+    /* two rk8pd steppers: step advances, probe re-integrates from the step's start */
     w->step = gsl_odeiv2_step_alloc(gsl_odeiv2_step_rk8pd, (size_t)w->dim);
     w->probe = gsl_odeiv2_step_alloc(gsl_odeiv2_step_rk8pd, (size_t)w->dim);
-    w->ctl = gsl_odeiv2_control_y_new(w->o.atol, w->o.rtol);
+    w->ctl = gsl_odeiv2_control_y_new(w->o.atol, w->o.rtol); /* per component atol + rtol |y| */
     w->evo = gsl_odeiv2_evolve_alloc((size_t)w->dim);
-    w->lcp = pd_lcp_solver_alloc(w->o.lcp_solver, w->kmax, 0, err);
+    w->lcp = pd_lcp_solver_alloc(w->o.lcp_solver, w->kmax, 0, err); /* dense blocks of kmax */
     if (!w->block || !w->step || !w->probe || !w->ctl || !w->evo || !w->lcp)
         return pd_err_set(err, PD_ENOMEM, "event-driven: out of memory for n = %d, m = %d", w->n,
                           w->m);
@@ -232,13 +242,13 @@ static int check_opts(const pd_edg_opts *o, pd_err *err)
 
 pd_edg_opts pd_edg_default_opts(void)
 {
-    return (pd_edg_opts){.rtol = 1e-12,
+    return (pd_edg_opts){.rtol = 1e-12, /* rk8pd's tolerances */
                          .atol = 1e-14,
                          .h_out = 0.0,
                          .impacts_only = 0,
                          .no_accumulation = 0,
                          .max_events = 1000000L,
-                         .max_burst = 100000L,
+                         .max_burst = 100000L, /* impacts of one contact's accumulation */
                          .length_scale = 1.0,
                          .time_unit = 1.0,
                          .on_step = NULL,
@@ -283,7 +293,7 @@ static int factor_mass(edg *w, pd_err *err)
 {
     pd_err own_err; /* the status read back when the caller passed no pd_err */
     err = pd_err_or(err, &own_err);
-    w->fac = pd_factor_alloc(w->md, 0.0, 1.0, w->o.factor, err);
+    w->fac = pd_factor_alloc(w->md, 0.0, 1.0, w->o.factor, err); /* What(h = 0) = M */
     if (!w->fac)
         return err && err->status == PD_ESINGULAR
                    ? pd_err_set(err, PD_ESINGULAR, "event-driven: the mass matrix M is singular")
@@ -312,6 +322,7 @@ static int factor_set(edg *w, double t, pd_err *err)
 {
     w->nA = 0;
     for (int a = 0; a < w->m; a++) {
+        /* idxA: A increasing; posA[a]: a's place in it, or -1 */
         w->posA[a] = -1;
         if (w->inA[a]) {
             w->posA[a] = w->nA;
@@ -320,6 +331,7 @@ static int factor_set(edg *w, double t, pd_err *err)
     }
     if (set_fits(w, w->nA, t, err))
         return PD_EBUDGET;
+    /* D_AA = W_A^T M^-1 W_A, LU with a relative pivot floor: dependent contacts fail */
     delassus(w, w->idxA, w->nA, w->Dlu);
     if (w->nA && pd_dense_lu(w->nA, w->Dlu, w->nA, w->Dperm, EDG_SINGULAR))
         return pd_err_set(err, PD_ESINGULAR,
@@ -337,8 +349,10 @@ static void project_on_A(edg *w, double *x, const double *shift)
         return;
     for (int r = 0; r < w->nA; r++) {
         int a = w->idxA[r];
+        /* r_A = W_A^T x + shift_A */
         w->tmpA[r] = wdot(w, a, x) + (shift ? shift[a] : 0.0);
     }
+    /* mu = D_AA^-1 r_A; x -= M^-1 W_A mu: W_A^T x + shift_A = r_A - D_AA mu = 0 */
     pd_dense_lu_solve(w->nA, w->Dlu, w->nA, w->Dperm, w->tmpA);
     for (int r = 0; r < w->nA; r++)
         add_minv_w(w, w->idxA[r], -w->tmpA[r], x);
@@ -349,8 +363,8 @@ static void project(edg *w, double *y)
 {
     if (!w->nA)
         return;
-    project_on_A(w, y, w->gref);
-    project_on_A(w, y + w->n, NULL);
+    project_on_A(w, y, w->gref); /* g_A = gref_A + W_A^T d = 0 */
+    project_on_A(w, y + w->n, NULL); /* U_A = W_A^T v = 0 */
 }
 
 /* ---- the smooth motion -------------------------------------------------- */
@@ -363,6 +377,8 @@ static void force_at(const edg *w, double t, double *out)
         memset(out, 0, (size_t)w->n * sizeof(double));
         return;
     }
+    /* t kept in the segment: its first half takes the right limit
+     * at seg_a, its second the left one at seg_b */
     double tc = fmin(fmax(t, w->seg_a), w->seg_b);
     md->force(tc, tc - w->seg_a <= w->seg_b - tc ? +1 : -1, out, md->force_ctx);
 }
@@ -372,17 +388,20 @@ static void force_at(const edg *w, double t, double *out)
 static void accel(edg *w, double t, const double *d, const double *v, double *acc)
 {
     int n = w->n;
+    /* acc = F - C v - K (qref + d), K qref kept */
     force_at(w, t, acc);
     pd_matrix_gemv(&w->md->C, -1.0, v, 1.0, acc);
     pd_matrix_gemv(&w->md->K, -1.0, d, 1.0, acc);
     for (int i = 0; i < n; i++)
         acc[i] -= w->Kqref[i];
-    pd_factor_solve(w->fac, acc);
+    pd_factor_solve(w->fac, acc); /* a_free = M^-1 (F - C v - K q) */
     if (!w->nA)
         return;
+    /* D_AA lambda_A = -W_A^T a_free: the held gaps do not accelerate */
     for (int r = 0; r < w->nA; r++)
         w->lam[r] = -wdot(w, w->idxA[r], acc);
     pd_dense_lu_solve(w->nA, w->Dlu, w->nA, w->Dperm, w->lam);
+    /* acc = a_free + M^-1 W_A lambda_A */
     for (int r = 0; r < w->nA; r++)
         add_minv_w(w, w->idxA[r], w->lam[r], acc);
 }
@@ -392,10 +411,12 @@ static int ode_rhs(double t, const double y[], double dydt[], void *params)
 {
     edg *w = params;
     int n = w->n;
-    memcpy(dydt, y + n, (size_t)n * sizeof(double));
+    memcpy(dydt, y + n, (size_t)n * sizeof(double)); /* d' = v */
     accel(w, t, y, y + n, dydt + n);
+    /* z' = lambda: 0 for a free contact */
     for (int a = 0; a < w->m; a++)
         dydt[2 * n + a] = w->posA[a] >= 0 ? w->lam[w->posA[a]] : 0.0;
+    /* a non-finite acceleration stops GSL with an error */
     for (int i = n; i < 2 * n; i++)
         if (!isfinite(dydt[i]))
             return GSL_EBADFUNC;
@@ -406,8 +427,9 @@ static int ode_rhs(double t, const double y[], double dydt[], void *params)
 static int probe(edg *w, double t, pd_err *err)
 {
     memcpy(w->yp, w->ya, (size_t)w->dim * sizeof(double));
-    if (t == w->ta)
+    if (t == w->ta) /* the start itself */
         return PD_OK;
+    /* one step of t - ta from (ta, ya) with its rate fa: the accepted path untouched */
     int s = gsl_odeiv2_step_apply(w->probe, w->ta, t - w->ta, w->yp, w->yerr, w->fa, NULL, &w->sys);
     if (s != GSL_SUCCESS)
         return pd_err_set(err, PD_ENUMERICAL, "event-driven: re-integration to t = %.9g s failed: %s",
@@ -457,7 +479,7 @@ static void step_ends(edg *w)
     for (int a = 0; a < w->m; a++) {
         w->ga[a] = gap_of(w, a, w->ya);
         w->Ua[a] = wdot(w, a, w->ya + n);
-        w->Ga[a] = wdot(w, a, w->fa + n);
+        w->Ga[a] = wdot(w, a, w->fa + n); /* G = W^T q'': the quintic's data */
         w->gb[a] = gap_of(w, a, w->y);
         w->Ub[a] = wdot(w, a, w->y + n);
         w->Gb[a] = wdot(w, a, w->fb + n);
@@ -470,11 +492,12 @@ static int step_once(edg *w, pd_err *err)
 {
     w->ta = w->t;
     memcpy(w->ya, w->y, (size_t)w->dim * sizeof(double));
-    int s = ode_rhs(w->ta, w->ya, w->fa, w);
+    int s = ode_rhs(w->ta, w->ya, w->fa, w); /* fa: the start rate */
     double h_try = w->h;
     /* GSL keeps the end rate of the last step as the next start rate: y, t or
      * the rates may have changed since (projection, event, breakpoint). */
     gsl_odeiv2_evolve_reset(w->evo);
+    /* one accepted step toward seg_b; w->h: the next size */
     if (s == GSL_SUCCESS)
         s = gsl_odeiv2_evolve_apply(w->evo, w->ctl, w->step, &w->sys, &w->t, w->seg_b, &w->h, w->y);
     if (s == GSL_SUCCESS)
@@ -485,6 +508,7 @@ static int step_once(edg *w, pd_err *err)
     if (w->t == w->seg_b && w->h < h_try) /* a step cut at the segment end says nothing */
         w->h = h_try;
     w->tb = w->t;
+    /* budget: EDG_STEPS_FLOOR + EDG_STEPS_PER_RADIAN w_max (t - t0) steps */
     if (++w->res->steps > EDG_STEPS_FLOOR + EDG_STEPS_PER_RADIAN * w->omega_max * (w->t - w->t0))
         return pd_err_set(err, PD_EBUDGET,
                           "event-driven: %ld integration steps by t = %.9g s (last %.3g s; budget "
@@ -506,13 +530,14 @@ static double fastest_frequency(const pd_model *md)
     double w2 = 0.0;
     for (int j = 0; j < md->n && K->kind != PD_MATRIX_ZERO; j++) {
         double col = 0.0, mj = pd_matrix_get(&md->M, j, j);
+        /* col = sum_i |K_ij| over the stored entries */
         if (K->kind == PD_MATRIX_DENSE)
             for (int i = 0; i < md->n; i++)
                 col += fabs(K->values[i + (size_t)j * K->rows]);
         else
             for (int p = K->colptr[j]; p < K->colptr[j + 1]; p++)
                 col += fabs(K->values[p]);
-        if (mj > 0.0)
+        if (mj > 0.0) /* a massless dof bounds nothing */
             w2 = fmax(w2, col / mj);
     }
     return sqrt(w2);
@@ -528,6 +553,7 @@ static void interp_state(edg *w, double s)
     for (int i = 0; i < n; i++) {
         double p0[3] = {w->ya[i], w->ya[n + i], w->fa[n + i]};
         double p1[3] = {w->y[i], w->y[n + i], w->fb[n + i]};
+        /* the quintic Hermite of (q, v, a) at both ends */
         pd_hermite5(p0, p1, h, s, &w->qs[i], &w->vs[i]);
     }
 }
@@ -536,6 +562,7 @@ static void interp_state(edg *w, double s)
  * bisection on the rate. */
 static double min_between(const double p0[3], const double p1[3], double h, double s0, double s1)
 {
+    /* 60 halvings: below a double's spacing on [0, 1] */
     for (int it = 0; it < 60; it++) {
         double sm = 0.5 * (s0 + s1), f, fd;
         pd_hermite5(p0, p1, h, sm, &f, &fd);
@@ -557,6 +584,7 @@ static int graze_check(edg *w, int a, double tm, double thr, double *lo, double 
     for (int it = 0; it < 3 && !rc; it++) {
         if ((rc = probe(w, tm, err)))
             break;
+        /* below zero beyond rounding on the true motion: a grazing impact in [ta, tm] */
         if (gap_of(w, a, w->yp) < -thr) {
             *lo = w->ta;
             *hi = tm;
@@ -567,6 +595,7 @@ static int graze_check(edg *w, int a, double tm, double thr, double *lo, double 
         double U = wdot(w, a, w->yp + n), G = wdot(w, a, w->acc);
         if (it == 2 || !(G > 0.0))
             break;
+        /* Newton on the rate toward the minimum: t -= U / G (G > 0) */
         tm = fmin(tm - U / G, w->tb);
         if (!(tm > w->ta))
             break;
@@ -582,6 +611,8 @@ static int scan_gap(edg *w, int a, double *lo, double *hi, int *found, pd_err *e
 {
     double h = w->tb - w->ta, thr = gap_noise(w, a, w->ya, h);
     double p0[3] = {w->ga[a], w->Ua[a], w->Ga[a]}, p1[3] = {w->gb[a], w->Ub[a], w->Gb[a]};
+    /* the gap's quintic from (g, U, G) at both ends, sampled at k / EDG_GAP_SAMPLES; slo: the
+     * last sample with g >= 0 */
     double slo = 0.0, sprev = 0.0, dprev = p0[1], gmin = HUGE_VAL, smin = 0.0;
     *found = 0;
     for (int k = 1; k <= EDG_GAP_SAMPLES; k++) {
@@ -590,6 +621,8 @@ static int scan_gap(edg *w, int a, double *lo, double *hi, int *found, pd_err *e
         if (dprev < 0.0 && fd > 0.0) { /* interior minimum in (sprev, s) */
             double sm = min_between(p0, p1, h, sprev, s), fm, fdm;
             pd_hermite5(p0, p1, h, sm, &fm, &fdm);
+            /* the minimum below zero: a graze, bracketed by the
+             * last sample at g >= 0 and the minimum */
             if (fm < -thr) {
                 *lo = w->ta + slo * h;
                 *hi = w->ta + sm * h;
@@ -601,6 +634,7 @@ static int scan_gap(edg *w, int a, double *lo, double *hi, int *found, pd_err *e
                 smin = sm;
             }
         }
+        /* a sample below zero beyond rounding: the gap closed */
         if (f < -thr) {
             *lo = w->ta + slo * h;
             *hi = k == EDG_GAP_SAMPLES ? w->tb : w->ta + s * h;
@@ -612,6 +646,8 @@ static int scan_gap(edg *w, int a, double *lo, double *hi, int *found, pd_err *e
         sprev = s;
         dprev = fd;
     }
+    /* a minimum within EDG_NEAR of the gap's scale: the interpolant's error could hide a graze,
+     * so the true motion decides */
     double near = EDG_NEAR * (fabs(p0[0]) + fabs(p1[0]) + h * (fabs(p0[1]) + fabs(p1[1])) +
                               h * h * (fabs(p0[2]) + fabs(p1[2])));
     if (gmin < near)
@@ -629,6 +665,7 @@ static void scan_force(edg *w, double *lo, double *hi, int *c, int *found)
         double s = (double)k / EDG_FORCE_SAMPLES;
         double t = k == EDG_FORCE_SAMPLES ? w->tb : w->ta + s * h;
         interp_state(w, s);
+        /* lambda_A at the interpolated state: the first negative one lets go */
         accel(w, t, w->qs, w->vs, w->acc);
         for (int r = 0; r < w->nA; r++)
             if (w->lam[r] < 0.0) {
@@ -651,6 +688,8 @@ static int scan(edg *w, int *kind, int *c, double *lo, double *hi, pd_err *err)
     for (int a = 0; a < w->m && !rc; a++) {
         if (w->inA[a])
             continue;
+        /* a held contact's force is watched instead (scan_force);
+         * the earliest bracket's end wins */
         rc = scan_gap(w, a, &l, &u, &found, err);
         if (!rc && found && (*kind == EV_NONE || u < *hi)) {
             *kind = EV_GAP;
@@ -680,10 +719,10 @@ static int value(edg *w, int kind, int c, double t, double *f, pd_err *err)
     if (rc)
         return rc;
     if (kind == EV_GAP) {
-        *f = gap_of(w, c, w->yp);
+        *f = gap_of(w, c, w->yp); /* g_c */
     } else {
         accel(w, t, w->yp, w->yp + w->n, w->acc);
-        *f = w->lam[w->posA[c]];
+        *f = w->lam[w->posA[c]]; /* lambda_c */
     }
     return PD_OK;
 }
@@ -697,14 +736,18 @@ static int illinois(edg *w, int kind, int c, double lo, double flo, double hi, d
     int side = 0, rc = PD_OK;
     double wref = hi - lo, last = NAN;
     for (int it = 0; it < 200 && !rc; it++) {
+        /* adjacent doubles (4 ulps): done */
         if (!(hi - lo > 4.0 * DBL_EPSILON * fmax(fabs(lo), fabs(hi))))
             break;
+        /* regula falsi: the secant's zero */
         double tc = (flo * hi - fhi * lo) / (flo - fhi), f;
+        /* every third iteration: a bisection unless the bracket halved since */
         if (it % 3 == 0 && it > 0) {
             if (hi - lo > 0.5 * wref)
                 tc = 0.5 * (lo + hi);
             wref = hi - lo;
         }
+        /* a secant point outside (rounding): bisect */
         if (!(tc > lo && tc < hi))
             tc = 0.5 * (lo + hi);
         if (tc <= lo || tc >= hi)
@@ -715,6 +758,7 @@ static int illinois(edg *w, int kind, int c, double lo, double flo, double hi, d
         if (f < 0.0) {
             hi = tc;
             fhi = f;
+            /* Illinois: the same side twice halves the kept end's f, so the secant leaves it */
             if (side == -1)
                 flo *= 0.5;
             side = -1;
@@ -726,6 +770,7 @@ static int illinois(edg *w, int kind, int c, double lo, double flo, double hi, d
             side = 1;
         }
     }
+    /* f <= 0 at hi: the event, its state in yp */
     *t_ev = hi;
     if (!rc && last != hi)
         rc = probe(w, hi, err);
@@ -741,6 +786,7 @@ static int earlier_event(edg *w, double t, int c, int *kind, int *a_out)
         if (w->inA[a] || a == c)
             continue;
         double g = gap_of(w, a, w->yp), U = wdot(w, a, w->yp + n);
+        /* zero: EDG_ZERO of the rounding scale, plus 64 ulps of t at its rate */
         double tol = EDG_ZERO * gap_noise(w, a, w->yp, 0.0) / (4.0 * DBL_EPSILON) +
                      64.0 * DBL_EPSILON * fabs(t) * fabs(U);
         if (g < -tol) {
@@ -751,6 +797,7 @@ static int earlier_event(edg *w, double t, int c, int *kind, int *a_out)
     }
     if (!w->nA)
         return 0;
+    /* a held force already negative at t */
     accel(w, t, w->yp, w->yp + n, w->acc);
     for (int r = 0; r < w->nA; r++)
         if (w->lam[r] < 0.0 && w->idxA[r] != c) {
@@ -773,6 +820,8 @@ static int locate(edg *w, int *kind, int *c, double lo, double hi, double *t_ev,
         *t_ev = w->tb;
         return PD_OK;
     }
+    /* each round locates a crossing; another contact's crossing before it starts the
+     * next (m + 2 rounds at most) */
     for (int round = 0; round <= w->m + 1 && !rc; round++) {
         double fhi, flo, thr = *kind == EV_GAP ? gap_noise(w, *c, w->ya, w->tb - w->ta) : 0.0;
         if ((rc = value(w, *kind, *c, hi, &fhi, err)))
@@ -783,6 +832,7 @@ static int locate(edg *w, int *kind, int *c, double lo, double hi, double *t_ev,
             *t_ev = hi;
             break;
         }
+        /* f(lo) >= 0 kept: lo falls back to ta (the step starts at g >= 0, lambda >= 0) */
         flo = 0.0;
         if (lo > w->ta && (rc = value(w, *kind, *c, lo, &flo, err)))
             break;
@@ -810,7 +860,7 @@ static void fill_state(edg *w, double t, const double *y, int with_P)
     st->step = w->res->steps;
     st->t = t;
     for (int i = 0; i < w->n; i++)
-        st->q[i] = w->qref[i] + y[i];
+        st->q[i] = w->qref[i] + y[i]; /* q = qref + d */
     memcpy(st->v, y + w->n, (size_t)w->n * sizeof(double));
     for (int a = 0; a < w->m; a++) {
         st->g[a] = gap_of(w, a, y);
@@ -832,6 +882,7 @@ static void emit(edg *w, double t, const double *y, int with_P, int to)
         return;
     if ((to & TO_ON_STEP) && w->o.on_step) {
         fill_state(w, t, y, with_P);
+        /* on_step gets the accelerations too */
         accel(w, t, y, y + w->n, w->st.acc);
         w->st.has_acc = 1;
         if (w->o.on_step(&w->st, w->o.on_step_ctx) > 0)
@@ -865,6 +916,7 @@ static int emit_grid(edg *w, double t_end, pd_err *err)
         double tk = w->t0 + (double)w->next_out * w->o.h_out;
         if (tk > t_end || tk > w->t1 || w->stopped)
             break;
+        /* the output time re-integrated from ta, then put on A */
         if ((rc = probe(w, fmax(tk, w->ta), err)))
             break;
         project(w, w->yp);
@@ -889,6 +941,7 @@ static void measure(edg *w, double t)
         w->g[a] = gap_of(w, a, d);
         w->U[a] = wdot(w, a, v);
         w->vsc[a] = vs;
+        /* gap_noise / (4 eps) is the rounding scale itself */
         w->tolg[a] = EDG_ZERO * gap_noise(w, a, w->y, 0.0) / (4.0 * DBL_EPSILON) +
                      64.0 * DBL_EPSILON * fabs(t) * fabs(w->U[a]);
         w->tolU[a] = EDG_ZERO * (vs + w->vpre[a]);
@@ -899,6 +952,7 @@ static void measure(edg *w, double t)
  * at one instant (within 64 ulp): the run would make no progress. */
 static int count_event(edg *w, double t, const char *what, int c, pd_err *err)
 {
+    /* events within 64 ulps of the last: one instant */
     w->same_instant = t - w->last_event <= 64.0 * DBL_EPSILON * fabs(t) ? w->same_instant + 1 : 0;
     w->last_event = t;
     if (w->same_instant > EDG_STUCK)
@@ -941,6 +995,7 @@ static int impact(edg *w, double t, int nI, pd_err *err)
     double bmax = 0.0;
     for (int r = 0; r < nI; r++) {
         int a = w->idx[r];
+        /* b = U- + e min(U-, 0): w = U+ + e U- closing, U+ opening; a rate within tolU is 0 */
         double U = fabs(w->U[a]) <= w->tolU[a] ? 0.0 : w->U[a];
         w->bsub[r] = U + w->md->e[a] * fmin(U, 0.0);
         bmax = fmax(bmax, fabs(w->bsub[r]));
@@ -958,6 +1013,7 @@ static int impact(edg *w, double t, int nI, pd_err *err)
                           nI, w->idx[0], t * w->o.time_unit, pd_lcp_outcome_name(info.outcome));
     for (int r = 0; r < nI; r++) {
         w->P[w->idx[r]] = w->zsub[r];
+        /* v += M^-1 W_I P */
         add_minv_w(w, w->idx[r], w->zsub[r], w->y + w->n);
     }
     lcp_rounding(w, nI);
@@ -971,12 +1027,13 @@ static int count_impacts(edg *w, double t, int nI, pd_err *err)
     for (int r = 0; r < nI; r++) {
         int a = w->idx[r];
         double speed = -w->Um[a];
-        if (!(w->Um[a] < -w->tolU[a]))
+        if (!(w->Um[a] < -w->tolU[a])) /* not closing: no impact */
             continue;
         w->hit[a] = 1;
         w->res->impacts++;
         if (isnan(w->res->first_impact))
             w->res->first_impact = t;
+        /* a burst goes on while each impact is slower than the last */
         w->burst[a] = speed < w->Uprev[a] * (1.0 - 1e-12) ? w->burst[a] + 1 : 1;
         w->Uprev[a] = speed;
         if (w->burst[a] > w->o.max_burst)
@@ -994,12 +1051,12 @@ static int count_impacts(edg *w, double t, int nI, pd_err *err)
 static void commit(edg *w, double t)
 {
     for (int a = 0; a < w->m; a++) {
-        if (w->inA[a] && !w->flag[a]) {
+        if (w->inA[a] && !w->flag[a]) { /* detaches */
             w->res->detachments++;
             w->res->contact_time += fmax(0.0, t - w->rest_from[a]);
             w->burst[a] = 0;
             w->Uprev[a] = 0.0;
-        } else if (!w->inA[a] && w->flag[a]) {
+        } else if (!w->inA[a] && w->flag[a]) { /* comes to rest */
             w->rest_from[a] = t;
             w->burst[a] = 0;
             w->Uprev[a] = 0.0;
@@ -1016,8 +1073,10 @@ static void zero_rates(edg *w, int nJ)
     if (!nJ)
         return;
     delassus(w, w->idx, nJ, w->Dsub);
+    /* D_JJ singular (dependent contacts): the rates stay as they are */
     if (pd_dense_lu(nJ, w->Dsub, nJ, w->Dperm, EDG_SINGULAR))
         return;
+    /* v -= M^-1 W_J D_JJ^-1 W_J^T v: U_J = 0 */
     for (int r = 0; r < nJ; r++)
         w->bsub[r] = wdot(w, w->idx[r], w->y + n);
     pd_dense_lu_solve(nJ, w->Dsub, nJ, w->Dperm, w->bsub);
@@ -1039,6 +1098,7 @@ static int decide(edg *w, double t, int nJ, pd_err *err)
     w->nA = 0;
     if (nJ) {
         pd_matrix D = pd_matrix_dense(nJ, nJ, w->Dsub);
+        /* nA = 0: acc is the free motion, b_J = W_J^T M^-1 (F(t+) - C v - K q) */
         accel(w, t, w->y, w->y + n, w->acc);
         delassus(w, w->idx, nJ, w->Dsub);
         for (int r = 0; r < nJ; r++)
@@ -1049,13 +1109,14 @@ static int decide(edg *w, double t, int nJ, pd_err *err)
                               "event-driven: contact-force LCP over %d contact(s) (first: contact "
                               "%d) not solved at t = %.9g s: %s",
                               nJ, w->idx[0], t * w->o.time_unit, pd_lcp_outcome_name(info.outcome));
+        /* A = {lambda > 0} */
         for (int r = 0; r < nJ; r++)
             w->flag[w->idx[r]] = w->zsub[r] > 0.0;
     }
     commit(w, t);
     if ((rc = factor_set(w, t, err)))
         return rc;
-    project(w, w->y);
+    project(w, w->y); /* on A: g_A = 0, U_A = 0 */
     return PD_OK;
 }
 
@@ -1064,6 +1125,7 @@ static int zero_set(edg *w, double t, int drop)
 {
     int nJ = 0;
     measure(w, t);
+    /* in contact (gap within tolg, or held) and at rest (rate within tolU) */
     for (int a = 0; a < w->m; a++)
         if (a != drop && (w->g[a] <= w->tolg[a] || w->inA[a]) && fabs(w->U[a]) <= w->tolU[a])
             w->idx[nJ++] = a;
@@ -1080,19 +1142,23 @@ static int try_jump(edg *w, double t, int a, int *jumped, pd_err *err)
     int n = w->n, rc, ok = 1;
     double e = w->md->e[a], Up = w->U[a];
     *jumped = 0;
+    /* e = 1 never accumulates; only a contact leaving at U+ > 0 can */
     if (!(e < 1.0) || !(Up > w->tolU[a]))
         return PD_OK;
     accel(w, t, w->y, w->y + n, w->acc);
-    double acl = -wdot(w, a, w->acc);
+    double acl = -wdot(w, a, w->acc); /* closing acceleration */
+    /* on only when pushed back (acl > 0) with a bounce height U+^2 / (2 acl) <= 1e-10 L */
     if (!(acl > 0.0) || Up * Up / (2.0 * acl) > EDG_BOUNCE * w->o.length_scale)
         return PD_OK;
+    /* the flights 2 U / acl with U -> e U sum to 2 U+ / (acl (1 - e)) */
     double tail = 2.0 * Up / (acl * (1.0 - e));
-    if (!(t + tail < w->seg_b))
+    if (!(t + tail < w->seg_b)) /* no breakpoint inside the tail */
         return PD_OK;
     w->inA[a] = 1; /* held tentatively, on a copy of the state */
     if (factor_set(w, t, NULL) == PD_OK) {
         memcpy(w->yp, w->y, (size_t)w->dim * sizeof(double));
         project_on_A(w, w->yp + n, NULL);
+        /* the held force at mid-tail and at its end, the state frozen */
         for (int k = 1; k <= 2 && ok; k++) {
             accel(w, t + 0.5 * k * tail, w->yp, w->yp + n, w->acc);
             ok = w->lam[w->posA[a]] > 0.0;
@@ -1104,7 +1170,7 @@ static int try_jump(edg *w, double t, int a, int *jumped, pd_err *err)
     if ((rc = factor_set(w, t, err)))
         return rc;
     if (ok) {
-        memcpy(w->y + n, w->yp + n, (size_t)n * sizeof(double));
+        memcpy(w->y + n, w->yp + n, (size_t)n * sizeof(double)); /* U_a = 0 */
         w->tail[a] = tail;
         *jumped = 1;
     }
@@ -1124,7 +1190,7 @@ static int jump_accumulations(edg *w, double t, int drop, pd_err *err)
             continue;
         measure(w, t);
         if (!(rc = try_jump(w, t, a, &jumped, err)) && jumped) {
-            w->flag[a] = 2;
+            w->flag[a] = 2; /* jumped */
             any = 1;
         }
     }
@@ -1132,12 +1198,13 @@ static int jump_accumulations(edg *w, double t, int drop, pd_err *err)
         return rc;
     for (int a = 0; a < w->m; a++)
         w->hit[a] = w->flag[a] == 2;
+    /* hit: the jumped contacts only; A decided again with them at rest */
     if ((rc = decide(w, t, zero_set(w, t, drop), err)))
         return rc;
     for (int a = 0; a < w->m; a++)
         if (w->hit[a] && w->inA[a]) {
             w->res->accumulations++;
-            w->rest_from[a] = t + w->tail[a];
+            w->rest_from[a] = t + w->tail[a]; /* rest from the accumulation point */
             w->burst[a] = 0;
         }
     return PD_OK;
@@ -1152,6 +1219,7 @@ static void snap(edg *w, int nI)
     delassus(w, w->idx, nI, w->Dsub);
     if (pd_dense_lu(nI, w->Dsub, nI, w->Dperm, EDG_SINGULAR))
         return;
+    /* qref -= M^-1 W_I D_II^-1 gref_I: g_I = 0 to rounding, then set exactly */
     for (int r = 0; r < nI; r++)
         w->bsub[r] = w->gref[w->idx[r]];
     pd_dense_lu_solve(nI, w->Dsub, nI, w->Dperm, w->bsub);
@@ -1169,15 +1237,17 @@ static int resolve(edg *w, double t, int forced, int drop, pd_err *err)
 {
     int nI = 0, closing = 0, rc;
     rebase(w);
+    /* vpre: the rates' scale before the impact (measured with vpre = 0) */
     memset(w->vpre, 0, (size_t)w->m * sizeof(double));
     measure(w, t);
     memcpy(w->vpre, w->vsc, (size_t)w->m * sizeof(double));
     for (int a = 0; a < w->m; a++) {
         w->P[a] = 0.0;
         w->hit[a] = 0;
+        /* at zero gap, the located one, or held: in the impact LCP */
         if (w->g[a] <= w->tolg[a] || a == forced || w->inA[a]) {
             w->idx[nI++] = a;
-            closing |= w->U[a] < -w->tolU[a];
+            closing |= w->U[a] < -w->tolU[a]; /* an impact only when one closes */
         }
     }
     if ((rc = set_fits(w, nI, t, err)))
@@ -1185,12 +1255,13 @@ static int resolve(edg *w, double t, int forced, int drop, pd_err *err)
     snap(w, nI);
     w->lcp_pivots = 0;
     if (closing) {
-        memcpy(w->Um, w->U, (size_t)w->m * sizeof(double));
+        memcpy(w->Um, w->U, (size_t)w->m * sizeof(double)); /* U- for the statistics */
         if ((rc = impact(w, t, nI, err)) || (rc = count_impacts(w, t, nI, err)))
             return rc;
     }
     if ((rc = decide(w, t, zero_set(w, t, drop), err)))
         return rc;
+    /* accumulations only after an impact */
     return closing ? jump_accumulations(w, t, drop, err) : PD_OK;
 }
 
@@ -1200,6 +1271,7 @@ static int resolve(edg *w, double t, int forced, int drop, pd_err *err)
 static void next_segment(edg *w)
 {
     const pd_model *md = w->md;
+    /* past the breakpoints at or before t */
     while (w->next_break < md->nbreaks && md->breaks[w->next_break] <= w->t)
         w->next_break++;
     w->seg_a = w->t;
@@ -1238,10 +1310,12 @@ static int advance(edg *w, pd_err *err)
     if ((rc = step_once(w, err)) || (rc = scan(w, &kind, &c, &lo, &hi, err)))
         return rc;
     t_end = w->tb;
+    /* the candidate on the true motion: t_end <= tb */
     if (kind != EV_NONE && (rc = locate(w, &kind, &c, lo, hi, &t_end, err)))
         return rc;
     if ((rc = emit_grid(w, t_end, err)))
         return rc;
+    /* the step cut at the event: the event's state */
     if (t_end < w->tb) {
         memcpy(w->y, w->yev, (size_t)w->dim * sizeof(double));
         w->t = t_end;
@@ -1250,7 +1324,7 @@ static int advance(edg *w, pd_err *err)
         emit(w, w->t, w->y, 0, TO_ON_STEP); /* the smooth motion up to the event */
         rc = on_event(w, kind, c, err);
     } else {
-        project(w, w->y);
+        project(w, w->y); /* back on A after the smooth step */
         emit(w, w->t, w->y, 0, TO_ON_STEP | (w->o.h_out > 0.0 ? 0 : TO_OBSERVER));
     }
     if (!rc && w->t >= w->seg_b && w->t < w->t1)
@@ -1270,12 +1344,13 @@ static int start(edg *w, const double *q0, const double *v0, pd_err *err)
     w->t = w->t0;
     next_segment(w);
     measure(w, w->t0);
+    /* a penetrating start is refused */
     for (int a = 0; a < w->m; a++)
         if (w->g[a] < -w->tolg[a])
             return pd_err_set(err, PD_EINVAL,
                               "event-driven: initial gap of contact %d is %g < 0 (q0 penetrates)",
                               a, w->g[a]);
-    w->h = 1e-4 * (w->t1 - w->t0);
+    w->h = 1e-4 * (w->t1 - w->t0); /* GSL's first try */
     if ((rc = resolve(w, w->t0, -1, -1, err)))
         return rc;
     emit(w, w->t0, w->y, 1, TO_OBSERVER | TO_ON_STEP);
@@ -1313,6 +1388,7 @@ int pd_edg_run(const pd_model *model, double t0, const double *q0, const double 
     w.obs_ctx = ctx;
     w.last_emit = NAN;
     w.last_event = -HUGE_VAL;
+    /* the observer's P on a grid: the held forces' integral with the impacts */
     w.sample_forces = observer && w.o.h_out > 0.0 && !w.o.impacts_only;
     w.omega_max = fmax(fastest_frequency(model), PD_TWO_PI / (t1 - t0)); /* free bodies: a turn */
     if (!(rc = edg_alloc(&w, err)) && !(rc = factor_mass(&w, err)))
@@ -1320,10 +1396,11 @@ int pd_edg_run(const pd_model *model, double t0, const double *q0, const double 
     while (!rc && !w.stopped && w.t < t1)
         rc = advance(&w, err);
     if (!rc) {
+        /* the contacts still held at the end */
         for (int a = 0; a < w.m; a++)
             if (w.inA[a])
                 w.res->contact_time += fmax(0.0, w.t - w.rest_from[a]);
-        if (w.last_emit != w.t)
+        if (w.last_emit != w.t) /* the last state, once */
             emit(&w, w.t, w.y, 0, TO_OBSERVER);
     }
     edg_free(&w);

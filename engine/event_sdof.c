@@ -131,6 +131,7 @@ static ed_point probe(const ed_run *ed, const ed_origin *o, double t)
     double dx, v;
     flow_inc(o, t, &dx, &v);
     ed_point q = {.t = t, .x = o->x + dx, .v = v, .past = (o->x - ed->p->delta) + dx};
+    /* not past the wall, but x = x_o + dx rounded beyond it: x clipped */
     if (ed->p->wall && q.past <= 0.0 && q.x > ed->p->delta)
         q.x = ed->p->delta;
     return q;
@@ -150,8 +151,8 @@ static void note(ed_run *ed, double t, double x)
     if (t < ed->o->t_measure)
         return;
     ed->r->xmax = fmax(ed->r->xmax, fabs(x));
-    ed->r->xtoward = fmax(ed->r->xtoward, x);
-    ed->r->xaway = fmax(ed->r->xaway, -x);
+    ed->r->xtoward = fmax(ed->r->xtoward, x); /* toward the wall */
+    ed->r->xaway = fmax(ed->r->xaway, -x); /* away from it */
 }
 
 /* Output times in (.., tb] of a flight (or resting at x_o when in_contact). */
@@ -160,10 +161,11 @@ static void emit(ed_run *ed, const ed_origin *o, double tb, int in_contact)
     if (!ed->sampler || ed->o->h_out <= 0.0 || ed->stopped)
         return;
     for (;;) {
+        /* t_k = t_first + k h_out up to tb, and to t_end within a relative 1e-15 */
         double t = ed->t_first + (double)ed->next_out * ed->o->h_out;
         if (t > tb || t > ed->o->t_end * (1 + OUT_END_REL))
             return;
-        double x = o->x, v = 0.0;
+        double x = o->x, v = 0.0; /* at rest: held at the wall */
         if (!in_contact) {
             ed_point q = probe(ed, o, t);
             x = q.x;
@@ -187,6 +189,7 @@ static double bracket_value(const ed_run *ed, const ed_origin *o, ed_kind kind, 
         return kind == ED_ACC ? q.acc : -q.acc;
     }
     ed_point q = probe(ed, o, t);
+    /* x - delta, -v or v */
     return kind == ED_GAP ? q.past : kind == ED_NEG_V ? -q.v : q.v;
 }
 
@@ -197,8 +200,9 @@ static double bisect_to(const ed_run *ed, const ed_origin *o, ed_kind kind, doub
 {
     for (int it = 0; it < BISECT_MAX_IT && hi - lo > fmax(w, BISECT_REL * fmax(fabs(hi), 1e-300));
          it++) {
+        /* f(lo) <= 0 < f(hi) kept while the bracket halves */
         double mid = 0.5 * (lo + hi);
-        if (mid <= lo || mid >= hi)
+        if (mid <= lo || mid >= hi) /* adjacent doubles */
             break;
         if (bracket_value(ed, o, kind, mid) > 0.0)
             hi = mid;
@@ -216,10 +220,10 @@ static double value_slope(const ed_run *ed, const ed_origin *o, ed_kind kind, do
     ed_point q = probe_acc(ed, o, t);
     double s = kind == ED_NEG_V ? -1.0 : 1.0;
     if (kind == ED_GAP) {
-        *df = q.v;
+        *df = q.v; /* d(x - delta) / dt = v */
         return q.past;
     }
-    *df = s * q.acc;
+    *df = s * q.acc; /* dv / dt = acc */
     return s * q.v;
 }
 
@@ -237,16 +241,18 @@ static double newton_to(const ed_run *ed, const ed_origin *o, ed_kind kind, doub
         double tol = fmax(w, BISECT_REL * fmax(fabs(hi), 1e-300));
         if (hi - lo <= tol)
             return hi;
+        /* each probe shrinks the bracket, whatever Newton's step does */
         double df, f = value_slope(ed, o, kind, t, &df);
         if (f > 0.0)
             hi = t;
         else
             lo = t;
-        double tn = t - f / df;
+        double tn = t - f / df; /* Newton's step */
         if (!(tn > lo && tn < hi)) { /* outside the bracket (or df = 0): bisect */
             t = 0.5 * (lo + hi);
             continue;
         }
+        /* a step beyond the tolerance: not converged yet */
         if (fabs(tn - t) > tol) {
             t = tn;
             continue;
@@ -259,6 +265,7 @@ static double newton_to(const ed_run *ed, const ed_origin *o, ed_kind kind, doub
             hi = b;
         break;
     }
+    /* bisection to the tolerance finishes: the same hi as bisect_to alone */
     return bisect_to(ed, o, kind, lo, hi, w);
 }
 
@@ -267,6 +274,7 @@ static double bisect(const ed_run *ed, const ed_origin *o, ed_kind kind, double 
 {
     if (kind == ED_GAP)
         return newton_to(ed, o, kind, lo, hi, 0.0);
+    /* the gap's slope v is at hand in closed form (Newton); lambda is bisected */
     return bisect_to(ed, o, kind, lo, hi, 0.0);
 }
 
@@ -275,6 +283,7 @@ static double bisect_turn(const ed_run *ed, const ed_origin *o, ed_kind kind, do
 {
     if (kind == ED_V || kind == ED_NEG_V)
         return newton_to(ed, o, kind, lo, hi, EXTREMUM_WIDTH * ed->scan);
+    /* a velocity zero by Newton on the acceleration; the acceleration's zero bisected */
     return bisect_to(ed, o, kind, lo, hi, EXTREMUM_WIDTH * ed->scan);
 }
 
@@ -297,14 +306,17 @@ static double scan_simple(ed_run *ed, const ed_origin *o, const ed_point *a, con
 {
     int s = dir_after(a), wall = ed->p->wall;
     double hit = -1.0;
+    /* v changes sign in (a, b]: one turn, located */
     if (s != 0 && sgn(b->v) != s) {
         double tc = bisect_turn(ed, o, s > 0 ? ED_NEG_V : ED_V, a->t, b->t);
         ed_point c = probe(ed, o, tc);
+        /* a maximum beyond the wall: the gap closed before it (grazing), in (a, tc] */
         if (wall && s > 0 && c.past > 0.0)
             hit = bisect(ed, o, ED_GAP, a->t, tc);
         else
             note(ed, tc, c.x);
     }
+    /* beyond the wall at b: the gap closed in (a, b] */
     if (hit < 0.0 && wall && b->past > 0.0)
         hit = bisect(ed, o, ED_GAP, a->t, b->t);
     return hit;
@@ -316,8 +328,10 @@ static double scan_simple(ed_run *ed, const ed_origin *o, const ed_point *a, con
 static int may_turn_twice(const ed_point *a, const ed_point *b, int s)
 {
     double h = b->t - a->t;
+    /* the acceleration drives v toward zero at a and back toward s at b */
     if (!(s * a->acc < 0.0 && s * b->acc > 0.0))
         return 0;
+    /* and v within TURN_MARGIN |acc| h of zero at an end */
     return fabs(a->v) <= TURN_MARGIN * fabs(a->acc) * h ||
            fabs(b->v) <= TURN_MARGIN * fabs(b->acc) * h;
 }
@@ -328,9 +342,10 @@ static double scan_interval(ed_run *ed, const ed_origin *o, const ed_point *a, c
 {
     int s = dir_after(a);
     if (s != 0 && sgn(b->v) == s && may_turn_twice(a, b, s)) {
+        /* the acceleration's zero: v's extreme toward zero */
         double tm = bisect_turn(ed, o, s > 0 ? ED_ACC : ED_NEG_ACC, a->t, b->t);
         ed_point m = probe_acc(ed, o, tm);
-        if (sgn(m.v) != s) {
+        if (sgn(m.v) != s) { /* v crossed zero: a turn on each side of tm */
             double hit = scan_simple(ed, o, a, &m);
             if (hit >= 0.0)
                 return hit;
@@ -355,6 +370,7 @@ static int free_flight(ed_run *ed, const ed_origin *o, double tb, double *t_hit,
 {
     ed_point a = {.t = o->t, .x = o->x, .v = o->v, .past = o->x - ed->p->delta};
     a.acc = free_accel(ed, o->j, o->t, o->x, o->v);
+    /* n equal intervals of at most the scan step, the last ending exactly at tb */
     long n = scan_count(ed, tb - o->t);
     for (long i = 1; i <= n; i++) {
         double tbi = i == n ? tb : o->t + (tb - o->t) * ((double)i / (double)n);
@@ -364,7 +380,7 @@ static int free_flight(ed_run *ed, const ed_origin *o, double tb, double *t_hit,
             emit(ed, o, hit, 0);
             *t_hit = hit;
             *v_end = probe(ed, o, hit).v;
-            *x_end = ed->p->delta;
+            *x_end = ed->p->delta; /* the impact exactly at the wall */
             note(ed, hit, ed->p->delta);
             return 1;
         }
@@ -384,11 +400,13 @@ static double detach_linear(const ed_run *ed, int j, double ta, double tb)
 {
     double c1 = ed->p->pieces[j].c1, lam_a = lambda_at(ed, j, ta);
     ed_origin o = {.j = j, .t = ta};
-    if (lam_a < 0.0)
+    if (lam_a < 0.0) /* already pulling away */
         return ta;
+    /* lambda = lambda(ta) + c1 (t - ta): a zero in [ta, tb] needs c1 < 0 and lambda(tb) < 0 */
     if (!(c1 < 0.0) || !(lambda_at(ed, j, tb) < 0.0))
         return tb;
-    double tr = fmin(fmax(ta + lam_a / -c1, ta), tb);
+    double tr = fmin(fmax(ta + lam_a / -c1, ta), tb); /* the line's zero */
+    /* a bracket of 16 relative ulps around it, else (rounding) all of [ta, tb] */
     double pad = ROOT_POLISH_ULPS * BISECT_REL * fmax(fabs(tr), 1e-300);
     double lo = fmax(tr - pad, ta), hi = fmin(tr + pad, tb);
     if (!(lambda_at(ed, j, lo) >= 0.0 && lambda_at(ed, j, hi) < 0.0)) {
@@ -406,6 +424,7 @@ static double detach_scan(const ed_run *ed, int j, double ta, double tb)
     for (long i = 1; i <= n; i++) {
         double a = ta + (tb - ta) * ((double)(i - 1) / (double)n);
         double b = i == n ? tb : ta + (tb - ta) * ((double)i / (double)n);
+        /* the first scan point with lambda < 0 closes the bracket */
         if (lambda_at(ed, j, b) < 0.0)
             return bisect(ed, &o, ED_NEG_LAMBDA, a, b);
     }
@@ -416,6 +435,7 @@ static double detach_scan(const ed_run *ed, int j, double ta, double tb)
  * (detachment), or tb if it stays >= 0. */
 static double rest(ed_run *ed, int j, double ta, double tb)
 {
+    /* a linear piece (A = 0): lambda's zero in closed form; a sinusoid: scanned */
     double td = ed->p->pieces[j].A == 0.0 ? detach_linear(ed, j, ta, tb)
                                           : detach_scan(ed, j, ta, tb);
     ed_origin o = {.j = j, .t = ta, .x = ed->p->delta, .v = 0.0};
@@ -434,7 +454,7 @@ static double rest(ed_run *ed, int j, double ta, double tb)
 static double scan_step(const pd_ed_sdof *p, int j, double span, int divisions)
 {
     const pd_sine_piece *pc = &p->pieces[j];
-    double T = p->osc.w0 > 0.0 ? PD_TWO_PI / p->osc.w0 : HUGE_VAL;
+    double T = p->osc.w0 > 0.0 ? PD_TWO_PI / p->osc.w0 : HUGE_VAL; /* the oscillator's period */
     if (pc->A != 0.0 && pc->w > 0.0)
         T = fmin(T, PD_TWO_PI / pc->w);
     if (!isfinite(T))
@@ -510,12 +530,16 @@ static int settle(ed_run *ed, int j, double t, double vp, double tb, double *t_r
 {
     double a = wall_accel(ed, j, t, vp), e = ed->p->e;
     *t_rest = t;
+    /* no rebound (e = 0): rest when the free acceleration pushes into the wall */
     if (vp == 0.0)
         return a > 0.0;
+    /* an accumulation needs e < 1 and a push toward the wall */
     if (ed->o->no_accumulation || e >= 1.0 || !(a > 0.0))
         return 0;
-    double height = vp * vp / (2.0 * a), scale = ed->o->length_scale;
-    double tail = 2.0 * fabs(vp) / (a * (1.0 - e));
+    double height = vp * vp / (2.0 * a), scale = ed->o->length_scale; /* v+^2 / (2 a) */
+    double tail = 2.0 * fabs(vp) / (a * (1.0 - e)); /* flights 2 |v| / a, v -> e v, summed */
+    /* jumped only when the bounce is below ACC_HEIGHT L, the tail ends before tb, and the push
+     * holds at its middle and end */
     if (height > ACC_HEIGHT * scale || t + tail >= tb ||
         !(wall_accel(ed, j, t + tail, 0.0) > 0.0) || !(wall_accel(ed, j, t + 0.5 * tail, 0.0) > 0.0))
         return 0;
@@ -538,7 +562,7 @@ static int impact(ed_run *ed, int j, double t_hit, double vn, double tb, double 
         res->first_impact_velocity = vn;
     }
     res->max_impact_velocity = fmax(res->max_impact_velocity, vn);
-    res->impulse += (1.0 + ed->p->e) * vn;
+    res->impulse += (1.0 + ed->p->e) * vn; /* per unit mass */
     *t = t_hit;
     if (++ed->burst > ed->max_burst)
         return pd_err_set(err, PD_EBUDGET,
@@ -546,9 +570,10 @@ static int impact(ed_run *ed, int j, double t_hit, double vn, double tb, double 
                           "without reaching persistent contact%s",
                           t_hit, ed->burst - 1,
                           ed->o->no_accumulation ? " (accumulation handling is off)" : "");
-    *v = -ed->p->e * vn;
+    *v = -ed->p->e * vn; /* Newton's law v+ = -e v- */
     if (ed->o->on_impact)
         ed->o->on_impact(t_hit, vn, *v, ed->o->on_impact_ctx);
+    /* at rest from t_rest: now, or the accumulation's limit */
     if (settle(ed, j, t_hit, *v, tb, &t_rest)) {
         ed_origin o = {.j = j, .t = t_hit, .x = ed->p->delta, .v = 0.0};
         emit(ed, &o, t_rest, 1);
@@ -589,9 +614,11 @@ int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opt
     note(&ed, t, x);
     if (prob->wall && x >= prob->delta && v >= 0.0) { /* starting on the wall */
         x = prob->delta;
+        /* resting only at v = 0 with a push into the wall */
         resting = v == 0.0 && wall_accel(&ed, j, t, 0.0) > 0.0;
     }
     while (t < opts->t_end && !ed.stopped) {
+        /* rest or flight up to the piece's end or t_end */
         double tb = fmin(piece_end(prob, j), opts->t_end), t_hit, xn, vn;
         if ((rc = count_event(&ed, t, err)))
             break;
@@ -607,6 +634,8 @@ int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opt
             v = 0.0;
         } else {
             ed_origin o = {.j = j, .t = t, .x = x, .v = v};
+            /* the flight's constants once: each later time is two
+             * sincos of half angles and one expm1 */
             pd_sdof_flow_init(&o.flow, &prob->osc, &prob->pieces[j], t, x, v);
             if (free_flight(&ed, &o, tb, &t_hit, &xn, &vn)) {
                 x = prob->delta;
@@ -622,6 +651,7 @@ int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opt
             j++; /* forcing breakpoint: re-decide rest or flight */
             ed.scan = scan_step(prob, j, opts->t_end - prob->pieces[0].t_start,
                                 opts->scan_divisions);
+            /* the new piece pulls away: detachment at its start */
             if (resting && !(wall_accel(&ed, j, t, 0.0) > 0.0)) {
                 resting = 0;
                 res->detachments++;

@@ -41,14 +41,15 @@ pd_factor_kind pd_factor_choose(const pd_model *model, pd_factor_kind requested)
     if (!model)
         return PD_FACTOR_AUTO;
     if (requested != PD_FACTOR_AUTO)
-        return requested;
+        return requested; /* the caller's choice stands */
     if (model->n == 1)
-        return PD_FACTOR_SCALAR;
+        return PD_FACTOR_SCALAR; /* What is a number */
+    /* small, or any matrix stored dense: the dense LU */
     if (model->n <= PD_FACTOR_DENSE_MAX || model->M.kind == PD_MATRIX_DENSE ||
         model->C.kind == PD_MATRIX_DENSE || model->K.kind == PD_MATRIX_DENSE ||
         (model->m > 0 && model->W.kind == PD_MATRIX_DENSE))
         return PD_FACTOR_DENSE;
-    return PD_FACTOR_CHOLMOD;
+    return PD_FACTOR_CHOLMOD; /* large and sparse */
 }
 
 pd_factor *pd_factor_alloc(const pd_model *model, double h, double theta, pd_factor_kind kind,
@@ -63,6 +64,7 @@ pd_factor *pd_factor_alloc(const pd_model *model, double h, double theta, pd_fac
         pd_err_set(err, PD_EINVAL, "factor: unknown storage kind %d", (int)kind);
         return NULL;
     }
+    /* the scalar kind asked for by name */
     if (chosen == PD_FACTOR_SCALAR && model->n != 1) {
         pd_err_set(err, PD_EINVAL, "factor: the scalar kind needs one degree of freedom (n = %d)",
                    model->n);
@@ -74,6 +76,7 @@ pd_factor *pd_factor_alloc(const pd_model *model, double h, double theta, pd_fac
         return NULL;
     }
     *f = (pd_factor){.type = type, .model = model, .h = h, .theta = theta};
+    /* the kind forms and factors What = M + h theta C + h^2 theta^2 K, What^-1 W and D */
     if (type->setup(f, err)) {
         pd_factor_free(f);
         return NULL;
@@ -85,14 +88,14 @@ void pd_factor_free(pd_factor *f)
 {
     if (!f)
         return;
-    f->type->release(f);
+    f->type->release(f); /* the kind's own data */
     free(f);
 }
 
 void pd_factor_gather_dense(const double *D, int m, const int *idx, int nI, double *out)
 {
     for (int s = 0; s < nI; s++) {
-        const double *col = D + (size_t)idx[s] * m;
+        const double *col = D + (size_t)idx[s] * m; /* out_rs = D_idx[r],idx[s] */
         for (int r = 0; r < nI; r++)
             out[r + (size_t)s * nI] = col[idx[r]];
     }
@@ -105,12 +108,13 @@ int pd_factor_gather_dense_csc(const double *D, int m, const int *idx, int nI, i
     for (int s = 0; s < nI; s++) {
         const double *col = D + (size_t)idx[s] * m;
         colptr[s] = nz;
+        /* exact zeros of D left out */
         for (int r = 0; r < nI; r++)
             if (col[idx[r]] != 0.0) {
                 rowind[nz] = r;
                 values[nz++] = col[idx[r]];
             }
     }
-    colptr[nI] = nz;
+    colptr[nI] = nz; /* the entries of D_II */
     return nz;
 }

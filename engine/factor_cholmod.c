@@ -17,6 +17,7 @@
 #include <cholmod.h>
 #include <cs.h>
 
+#include "pd_alloc.h"
 #include "pd_factor.h"
 
 #define CHOL_SYMMETRY_TOL 1e-12 /* |What_ij - What_ji| allowed, relative to max|What| */
@@ -65,9 +66,10 @@ static void chol_release(pd_factor *f)
 /* Triplets of s A (every stored entry of the view) appended at *nt. */
 static void add_triplets(const pd_matrix *A, double s, int *Ti, int *Tj, double *Tx, long *nt)
 {
-    if (A->kind == PD_MATRIX_ZERO || s == 0.0)
+    if (A->kind == PD_MATRIX_ZERO || s == 0.0) /* nothing to add */
         return;
     for (int j = 0; j < A->cols; j++) {
+        /* compressed columns: every stored entry; dense: the nonzeros */
         if (A->kind == PD_MATRIX_CSC)
             for (int k = A->colptr[j]; k < A->colptr[j + 1]; k++) {
                 Ti[*nt] = A->rowind[k];
@@ -87,6 +89,7 @@ static void add_triplets(const pd_matrix *A, double s, int *Ti, int *Tj, double 
 /* What = M + ht C + ht^2 K (or W alone: ht < 0) as an owned sparse matrix. */
 static int assemble(const pd_model *md, double ht, int which_w, pd_sparse *out, pd_err *err)
 {
+    /* room for every stored entry of W, or of M, C and K together */
     long cap = which_w ? pd_matrix_nnz(&md->W)
                        : pd_matrix_nnz(&md->M) + pd_matrix_nnz(&md->C) + pd_matrix_nnz(&md->K);
     int *Ti = malloc((size_t)(cap + 1) * sizeof(int)), *Tj = malloc((size_t)(cap + 1) * sizeof(int));
@@ -103,6 +106,7 @@ static int assemble(const pd_model *md, double ht, int which_w, pd_sparse *out, 
             add_triplets(&md->C, ht, Ti, Tj, Tx, &nt);
             add_triplets(&md->K, ht * ht, Ti, Tj, Tx, &nt);
         }
+        /* the triplets into compressed columns */
         rc = pd_sparse_from_triplets(out, md->n, which_w ? md->m : md->n, nt, Ti, Tj, Tx, err);
     }
     free(Ti);
@@ -118,6 +122,7 @@ static int is_symmetric(const pd_sparse *A)
     double amax = 0.0, dmax = 0.0;
     for (int k = 0; k < A->nnz; k++)
         amax = fmax(amax, fabs(A->values[k]));
+    /* each stored A_ij against A_ji */
     for (int j = 0; j < A->cols; j++)
         for (int k = A->colptr[j]; k < A->colptr[j + 1]; k++)
             dmax = fmax(dmax, fabs(A->values[k] - pd_matrix_get(&v, j, A->rowind[k])));
@@ -136,13 +141,16 @@ static int transpose_L(chol_data *d)
         free(next);
         return PD_ENOMEM;
     }
+    /* each row's count of L: the sizes of U's columns */
     for (int k = 0; k < nz; k++)
         d->Up[d->Li[k] + 1]++;
     for (int i = 0; i < n; i++)
         d->Up[i + 1] += d->Up[i];
+    /* Up: the running sums of L's row counts; next: each column of U's next free place */
     memcpy(next, d->Up, ((size_t)n + 1) * sizeof(int));
     for (int j = 0; j < n; j++)
         for (int k = d->Lp[j]; k < d->Lp[j + 1]; k++) {
+            /* L_ij = U_ji: columns j of L in order, so each row of U fills with j increasing */
             int p = next[d->Li[k]]++;
             d->Ui[p] = j;
             d->Ux[p] = d->Lx[k];
@@ -158,7 +166,7 @@ static int copy_factor(chol_data *d, const cholmod_factor *L)
     const double *x = L->x;
     int n = d->n, total = 0;
     for (int j = 0; j < n; j++)
-        total += nz[j];
+        total += nz[j]; /* L's entries, packed or not */
     d->Lp = malloc(((size_t)n + 1) * sizeof(int));
     d->Li = malloc((size_t)total * sizeof(int));
     d->Lx = malloc((size_t)total * sizeof(double));
@@ -168,6 +176,7 @@ static int copy_factor(chol_data *d, const cholmod_factor *L)
         return PD_ENOMEM;
     d->Lp[0] = 0;
     for (int j = 0; j < n; j++) {
+        /* column j of L, diagonal first; the order P, and pinv its inverse */
         memcpy(d->Li + d->Lp[j], i + p[j], (size_t)nz[j] * sizeof(int));
         memcpy(d->Lx + d->Lp[j], x + p[j], (size_t)nz[j] * sizeof(double));
         d->Lp[j + 1] = d->Lp[j] + nz[j];
@@ -186,10 +195,11 @@ static int cholesky(chol_data *d, pd_sparse *A, pd_err *err)
     cholmod_start(&c);
     c.print = 0;            /* the library never prints */
     c.error_handler = NULL;
-    c.supernodal = CHOLMOD_SIMPLICIAL;
-    c.final_ll = 1;
+    c.supernodal = CHOLMOD_SIMPLICIAL; /* plain columns to copy out */
+    c.final_ll = 1; /* L L^T, not L D L^T */
     c.final_pack = 1;
     c.final_monotonic = 1;
+    /* A's lower triangle (stype -1), a view of its arrays, not a copy */
     cholmod_sparse As = {.nrow = (size_t)A->rows,
                          .ncol = (size_t)A->cols,
                          .nzmax = (size_t)(A->nnz > 0 ? A->nnz : 1),
@@ -202,11 +212,12 @@ static int cholesky(chol_data *d, pd_sparse *A, pd_err *err)
                          .dtype = CHOLMOD_DOUBLE,
                          .sorted = 1,
                          .packed = 1};
-    L = cholmod_analyze(&As, &c);
+    L = cholmod_analyze(&As, &c); /* AMD ordering, symbolic factor */
     if (L)
         cholmod_factorize(&As, L, &c);
     if (!L || c.status == CHOLMOD_OUT_OF_MEMORY)
         rc = pd_err_set(err, PD_ENOMEM, "CHOLMOD: out of memory for n = %d", d->n);
+    /* minor < n: a non-positive pivot at column minor */
     else if (c.status == CHOLMOD_NOT_POSDEF || L->minor < L->n)
         rc = pd_err_set(err, PD_ESINGULAR,
                         "the iteration matrix M + h theta C + h^2 theta^2 K is not positive "
@@ -232,13 +243,15 @@ typedef struct col_builder {
 static int cb_push(col_builder *b, int row, double val)
 {
     if (b->nz == b->cap) {
-        long cap = 2 * b->cap + 64;
+        long cap = 2 * b->cap + 64; /* geometric growth */
         int *ni = realloc(b->i, (size_t)cap * sizeof(int));
         if (ni)
             b->i = ni;
         double *nx = realloc(b->x, (size_t)cap * sizeof(double));
         if (nx)
             b->x = nx;
+        /* a failed realloc keeps the old block (freed with the
+         * builder); int indices bound the size */
         if (!ni || !nx || cap > 2147483647L)
             return PD_ENOMEM;
         b->cap = cap;
@@ -255,6 +268,7 @@ static void cb_sort_tail(col_builder *b, long from)
         int r = b->i[k];
         double v = b->x[k];
         long p = k;
+        /* entry k inserted among [from, k), rows increasing */
         for (; p > from && b->i[p - 1] > r; p--) {
             b->i[p] = b->i[p - 1];
             b->x[p] = b->x[p - 1];
@@ -273,6 +287,7 @@ static int z_column(chol_data *d, const pd_sparse *W, int a, int *xi, double *x,
         bi[nb] = d->pinv[W->rowind[k]];
         bx[nb++] = W->values[k];
     }
+    /* B: P W_a as a one-column sparse matrix */
     int bp[2] = {0, nb};
     cs_di B = {.nzmax = nb > 0 ? nb : 1, .m = n, .n = 1, .p = bp, .i = bi, .x = bx, .nz = -1};
     cs_di Lc = {.nzmax = d->Lp[n], .m = n, .n = n, .p = d->Lp, .i = d->Li, .x = d->Lx, .nz = -1};
@@ -280,6 +295,7 @@ static int z_column(chol_data *d, const pd_sparse *W, int a, int *xi, double *x,
     int top = cs_di_spsolve(&Lc, &B, 0, xi, x, NULL, 1); /* y = L^-1 b */
     if (top < 0)
         return PD_ENUMERICAL;
+    /* the reach of y = L^-1 b, gathered as the next right-hand side */
     nb = 0;
     for (int p = top; p < n; p++) {
         bi[nb] = xi[p];
@@ -290,6 +306,7 @@ static int z_column(chol_data *d, const pd_sparse *W, int a, int *xi, double *x,
     top = cs_di_spsolve(&Uc, &B, 0, xi, x, NULL, 0); /* z = L^-T y */
     if (top < 0)
         return PD_ENUMERICAL;
+    /* Z_a = P^T z without its exact zeros, rows sorted */
     long from = Z->nz;
     for (int p = top; p < n; p++)
         if (x[xi[p]] != 0.0 && cb_push(Z, d->perm[xi[p]], x[xi[p]]))
@@ -303,6 +320,7 @@ static int form_z(chol_data *d, const pd_sparse *W, pd_err *err)
 {
     int n = d->n, rc = PD_OK;
     col_builder Z = {0};
+    /* cs_spsolve's workspaces (xi of 2 n, x of n) and a column's indices and values */
     int *xi = malloc(2 * (size_t)n * sizeof(int)), *bi = malloc((size_t)n * sizeof(int));
     double *x = calloc((size_t)n, sizeof(double)), *bx = malloc((size_t)n * sizeof(double));
     d->Zp = malloc(((size_t)d->m + 1) * sizeof(int));
@@ -333,13 +351,14 @@ static int form_d(chol_data *d, const pd_sparse *Wt, pd_err *err)
 {
     int m = d->m, rc = PD_OK;
     col_builder D = {0};
-    double *acc = calloc((size_t)(m > 0 ? m : 1), sizeof(double));
-    int *mark = malloc((size_t)(m > 0 ? m : 1) * sizeof(int));
+    double *acc = pd_calloc(m, sizeof(double));
+    int *mark = pd_malloc(m, sizeof(int));
     d->Dp = malloc(((size_t)m + 1) * sizeof(int));
     if (!acc || !mark || !d->Dp)
         rc = PD_ENOMEM;
     for (int a = 0; a < m && !rc; a++)
-        mark[a] = -1;
+        mark[a] = -1; /* in no column yet */
+    /* column b: D_ab = sum_i W_ia Z_ib over the dofs i of Z_b and the contacts a on them (Wt) */
     for (int b = 0; b < m && !rc; b++) {
         long from = D.nz;
         d->Dp[b] = (int)D.nz;
@@ -347,7 +366,7 @@ static int form_d(chol_data *d, const pd_sparse *Wt, pd_err *err)
             int i = d->Zi[k];
             for (int q = Wt->colptr[i]; q < Wt->colptr[i + 1] && !rc; q++) {
                 int a = Wt->rowind[q];
-                if (mark[a] != b) {
+                if (mark[a] != b) { /* a new row of column b */
                     mark[a] = b;
                     acc[a] = 0.0;
                     rc = cb_push(&D, a, 0.0);
@@ -355,6 +374,7 @@ static int form_d(chol_data *d, const pd_sparse *Wt, pd_err *err)
                 acc[a] += Wt->values[q] * d->Zx[k];
             }
         }
+        /* the sums into their entries, then the rows sorted */
         for (long k = from; k < D.nz; k++)
             D.x[k] = acc[D.i[k]];
         cb_sort_tail(&D, from);
@@ -378,6 +398,7 @@ static int contact_maps(const pd_model *md, pd_sparse *W, pd_sparse *Wt, pd_err 
     int *Ti = malloc((size_t)(nt + 1) * sizeof(int)), *Tj = malloc((size_t)(nt + 1) * sizeof(int));
     if (!Ti || !Tj)
         rc = pd_err_set(err, PD_ENOMEM, "factor: out of memory for W^T");
+    /* W^T's triplets: (a, i) for each entry W_ia */
     for (int a = 0; a < W->cols && !rc; a++)
         for (int k = W->colptr[a]; k < W->colptr[a + 1]; k++) {
             Ti[k] = a;
@@ -401,12 +422,13 @@ static int chol_setup(pd_factor *f, pd_err *err)
         return pd_err_set(err, PD_ENOMEM, "factor: out of memory");
     d->n = md->n;
     d->m = md->m;
-    d->pos = malloc((size_t)(md->m > 0 ? md->m : 1) * sizeof(int));
+    d->pos = pd_malloc(md->m, sizeof(int));
     d->work = malloc((size_t)md->n * sizeof(double));
     if (!d->pos || !d->work)
         return pd_err_set(err, PD_ENOMEM, "factor: out of memory for n = %d", md->n);
     for (int a = 0; a < md->m; a++)
-        d->pos[a] = -1;
+        d->pos[a] = -1; /* no contact placed */
+    /* What = M + h theta C + h^2 theta^2 K, symmetric to 1e-12 of its largest entry */
     if (!(rc = assemble(md, f->h * f->theta, 0, &A, err))) {
         if (!is_symmetric(&A))
             rc = pd_err_set(err, PD_EINVAL,
@@ -415,10 +437,11 @@ static int chol_setup(pd_factor *f, pd_err *err)
         else
             rc = cholesky(d, &A, err);
     }
+    /* Z = What^-1 W, then D = W^T Z */
     if (!rc && md->m > 0 && !(rc = contact_maps(md, &W, &Wt, err)) && !(rc = form_z(d, &W, err)))
         rc = form_d(d, &Wt, err);
     if (!rc)
-        f->delassus_nnz = md->m > 0 ? d->Dp[md->m] : 0;
+        f->delassus_nnz = md->m > 0 ? d->Dp[md->m] : 0; /* D's entries */
     pd_sparse_free(&A);
     pd_sparse_free(&W);
     pd_sparse_free(&Wt);
@@ -432,11 +455,12 @@ static void chol_solve(const pd_factor *f, double *x)
     int n = d->n;
     double *y = d->work;
     for (int k = 0; k < n; k++)
-        y[k] = x[d->perm[k]];
+        y[k] = x[d->perm[k]]; /* y = P x */
     for (int j = 0; j < n; j++) { /* L y = P x, diagonal first */
         int p = d->Lp[j];
+        /* y_j /= L_jj, then y_i -= L_ij y_j below it */
         double yj = y[j] /= d->Lx[p];
-        if (yj != 0.0)
+        if (yj != 0.0) /* nothing to eliminate */
             for (p++; p < d->Lp[j + 1]; p++)
                 y[d->Li[p]] -= d->Lx[p] * yj;
     }
@@ -448,7 +472,7 @@ static void chol_solve(const pd_factor *f, double *x)
         y[j] = s / d->Lx[p];
     }
     for (int k = 0; k < n; k++)
-        x[d->perm[k]] = y[k];
+        x[d->perm[k]] = y[k]; /* x = P^T z */
 }
 
 /* v += Z[:, idx] P. */
@@ -457,6 +481,7 @@ static void chol_add_impulse(const pd_factor *f, const int *idx, int nI, const d
 {
     const chol_data *d = f->data;
     for (int r = 0; r < nI; r++) {
+        /* v += Z_a P_a over the stored entries of Z_a */
         double pr = P[r];
         if (pr != 0.0)
             for (int k = d->Zp[idx[r]]; k < d->Zp[idx[r] + 1]; k++)
@@ -467,6 +492,7 @@ static void chol_add_impulse(const pd_factor *f, const int *idx, int nI, const d
 static void chol_delassus_dense(const pd_factor *f, const int *idx, int nI, double *D)
 {
     const chol_data *d = f->data;
+    /* pos: each chosen contact's row; D_II gathered from D's columns idx */
     memset(D, 0, (size_t)nI * (size_t)nI * sizeof(double));
     for (int r = 0; r < nI; r++)
         d->pos[idx[r]] = r;
@@ -475,7 +501,7 @@ static void chol_delassus_dense(const pd_factor *f, const int *idx, int nI, doub
             if (d->pos[d->Di[k]] >= 0)
                 D[d->pos[d->Di[k]] + (size_t)s * nI] = d->Dx[k];
     for (int r = 0; r < nI; r++)
-        d->pos[idx[r]] = -1;
+        d->pos[idx[r]] = -1; /* cleared for the next call */
 }
 
 static int chol_delassus_csc(const pd_factor *f, const int *idx, int nI, int *colptr,
@@ -486,6 +512,7 @@ static int chol_delassus_csc(const pd_factor *f, const int *idx, int nI, int *co
     for (int r = 0; r < nI; r++)
         d->pos[idx[r]] = r;
     for (int s = 0; s < nI; s++) {
+        /* column s: the entries of D's column idx[s] whose rows are chosen */
         colptr[s] = nz;
         for (int k = d->Dp[idx[s]]; k < d->Dp[idx[s] + 1]; k++)
             if (d->pos[d->Di[k]] >= 0) {
@@ -495,7 +522,7 @@ static int chol_delassus_csc(const pd_factor *f, const int *idx, int nI, int *co
     }
     colptr[nI] = nz;
     for (int r = 0; r < nI; r++)
-        d->pos[idx[r]] = -1;
+        d->pos[idx[r]] = -1; /* cleared for the next call */
     return nz;
 }
 

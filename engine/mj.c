@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "mj.h"
+#include "pd_alloc.h"
 #include "pd_null.h"
 
 /* A dense active LCP is refined when its D P cancels terms this many times
@@ -31,19 +32,19 @@
 
 pd_mj_opts pd_mj_default_opts(void)
 {
-    return (pd_mj_opts){.h = 0.0,
-                        .theta = 0.5,
-                        .gamma = 0.5,
+    return (pd_mj_opts){.h = 0.0, /* no default: check_opts refuses h <= 0 */
+                        .theta = 0.5, /* the trapezoidal rule: second order, energy kept */
+                        .gamma = 0.5, /* the active set looks half a step ahead */
                         .allow_unstable = 0,
                         .kernel = PD_KERNEL_AUTO,
                         .factor = PD_FACTOR_AUTO,
                         .lcp_solver = PD_LCP_AUTO,
                         .on_lcp = NULL,
                         .on_lcp_ctx = NULL,
-                        .rtol = 0.0,
+                        .rtol = 0.0, /* fixed steps */
                         .atol = 1e-12,
                         .atol_dof = NULL,
-                        .max_level = PD_MJ_MAX_LEVEL,
+                        .max_level = PD_MJ_MAX_LEVEL, /* finest step h 2^-48 */
                         .max_evals = 1e9,
                         .sim_gap = 1e-10,
                         .pieces = NULL};
@@ -52,7 +53,7 @@ pd_mj_opts pd_mj_default_opts(void)
 /* Closed-form scalar LCP  w = D P + b >= 0, P >= 0, wP = 0  (D > 0). */
 double pd_contact_impulse_1(double D, double b)
 {
-    return b < 0.0 ? -b / D : 0.0;
+    return b < 0.0 ? -b / D : 0.0; /* b >= 0: P = 0, w = b; else w = 0 */
 }
 
 void pd_mj_free(pd_mj *mj)
@@ -93,6 +94,7 @@ int pd_mj_check_opts(const pd_mj_opts *o, pd_err *err)
         return pd_err_set(err, PD_EINVAL, "dt must be a finite number > 0 (got %g)", o->h);
     if (!isfinite(o->theta) || o->theta < 0.0 || o->theta > 2.0)
         return pd_err_set(err, PD_EINVAL, "theta must be in [0, 2] (got %g)", o->theta);
+    /* theta < 1/2: |R|^2 = (1 + (1-theta)^2 Om^2) / (1 + theta^2 Om^2) > 1 at every h */
     if ((o->theta < 0.5 || o->theta > 1.0) && !o->allow_unstable)
         return pd_err_set(err, PD_EINVAL,
                           "theta = %g is outside [1/2, 1], where the scheme is not unconditionally "
@@ -103,6 +105,7 @@ int pd_mj_check_opts(const pd_mj_opts *o, pd_err *err)
     if (!(o->rtol >= 0.0 && o->rtol < 1.0))
         return pd_err_set(err, PD_EINVAL, "rtol must be in [0, 1) (0: fixed steps; got %g)",
                           o->rtol);
+    /* the adaptive driver's options, read only when it runs */
     if (o->rtol > 0.0) {
         if (!(o->atol > 0.0) || !isfinite(o->atol))
             return pd_err_set(err, PD_EINVAL, "atol must be a finite number > 0 (got %g)",
@@ -122,22 +125,22 @@ int pd_mj_check_opts(const pd_mj_opts *o, pd_err *err)
 /* Every array, sized once for (n, m). */
 static int alloc_arrays(pd_mj *mj, int n, int m)
 {
-    size_t mm = m > 0 ? (size_t)m : 1;
     mj->F0 = calloc((size_t)n, sizeof(double));
     mj->F1 = calloc((size_t)n, sizeof(double));
     mj->work_n = calloc((size_t)n, sizeof(double));
     mj->qtheta = calloc((size_t)n, sizeof(double));
-    mj->U0 = calloc(mm, sizeof(double));
-    mj->b_active = calloc(mm, sizeof(double));
-    mj->P_active = calloc(mm, sizeof(double));
-    mj->w_active = calloc(mm, sizeof(double));
-    mj->idx_active = calloc(mm, sizeof(int));
+    /* the contacts' arrays: one element when m = 0, so that NULL means out of memory */
+    mj->U0 = pd_calloc(m, sizeof(double));
+    mj->b_active = pd_calloc(m, sizeof(double));
+    mj->P_active = pd_calloc(m, sizeof(double));
+    mj->w_active = pd_calloc(m, sizeof(double));
+    mj->idx_active = pd_calloc(m, sizeof(int));
     mj->st.q = calloc((size_t)n, sizeof(double));
     mj->st.v = calloc((size_t)n, sizeof(double));
-    mj->st.P = calloc(mm, sizeof(double));
-    mj->st.g = calloc(mm, sizeof(double));
-    mj->st.active = calloc(mm, 1);
-    mj->st_own = mj->st;
+    mj->st.P = pd_calloc(m, sizeof(double));
+    mj->st.g = pd_calloc(m, sizeof(double));
+    mj->st.active = pd_calloc(m, 1);
+    mj->st_own = mj->st; /* freed through st_own: the adaptive driver repoints st */
     return mj->F0 && mj->F1 && mj->work_n && mj->qtheta && mj->U0 && mj->b_active && mj->P_active && mj->w_active && mj->idx_active && mj->st.q &&
                    mj->st.v && mj->st.P && mj->st.g && mj->st.active
                ? PD_OK
@@ -148,6 +151,7 @@ static int alloc_arrays(pd_mj *mj, int n, int m)
 static void scalar_setup(pd_mj *mj)
 {
     const pd_model *md = mj->model;
+    /* without a contact (m = 0) W, g0 and e are passed as 0 and ignored */
     mj->s1 = mj1_coef_make(pd_matrix_get(&md->M, 0, 0), pd_matrix_get(&md->C, 0, 0),
                            pd_matrix_get(&md->K, 0, 0), md->m > 0,
                            md->m ? pd_matrix_get(&md->W, 0, 0) : 0.0, md->m ? md->g0[0] : 0.0,
@@ -163,22 +167,27 @@ static int contact_workspace(pd_mj *mj, pd_err *err)
     int m = mj->model->m;
     long nnz = mj->factor->delassus_nnz;
     mj->sparse = mj->factor->type->kind == PD_FACTOR_CHOLMOD;
-    mj->lcp_nmax = m;
+    mj->lcp_nmax = m; /* an active set is at most every contact */
+    /* the warm start: 1 pushed, 0 active without pushing, 2 newly active */
     if (!(mj->guess = calloc((size_t)m, 1)))
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for %d contacts", m);
     if (!(mj->lcp = pd_lcp_solver_alloc(mj->opts.lcp_solver, mj->lcp_nmax, mj->sparse ? nnz : 0,
                                         err)))
         return err->status;
     if (mj->sparse) {
-        mj->D_active = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof(double));
+        /* D_II in compressed columns: no more entries than the whole D */
+        mj->D_active = pd_malloc(nnz, sizeof(double));
         mj->D_colptr = malloc(((size_t)m + 1) * sizeof(int));
-        mj->D_rowind = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof(int));
+        mj->D_rowind = pd_malloc(nnz, sizeof(int));
     } else {
+        /* D_II dense, nI x nI <= m x m; the refinement's R (cap^2), Q and What^-1 Q (n cap each), z
+         * and R^-1 z (cap each) in ref_R; r, its trial, y and its trial (2 m + 2 n) in ref_res */
         mj->D_active = malloc((size_t)m * (size_t)m * sizeof(double));
         size_t n = (size_t)mj->model->n, cap = (size_t)(m < MJ_REFINE_NMAX ? m : MJ_REFINE_NMAX);
         mj->ref_nmax = (int)cap;
         mj->ref_R = malloc((cap * cap + 2 * cap * n + 2 * cap) * sizeof(double));
         mj->ref_res = malloc((2 * (size_t)m + 2 * n) * sizeof(double));
+        /* the pushing contacts (m), the pivot order (cap) */
         mj->ref_perm = malloc(((size_t)m + cap) * sizeof(int));
         if (!mj->ref_R || !mj->ref_res || !mj->ref_perm)
             return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for the Delassus block");
@@ -208,7 +217,9 @@ pd_mj *pd_mj_alloc(const pd_model *model, const pd_mj_opts *opts, pd_err *err)
     }
     mj->model = model;
     mj->opts = o;
+    /* one dof, at most one wall */
     mj->scalar = o.kernel == PD_KERNEL_AUTO && model->n == 1 && model->m <= 1;
+    /* What = M + h theta C + h^2 theta^2 K, factored once for the run */
     mj->factor = pd_factor_alloc(model, o.h, o.theta, o.factor, err);
     if (!mj->factor)
         goto fail;
@@ -244,6 +255,7 @@ int pd_mj_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_err
     const pd_model *md = mj->model;
     int n = md->n;
     for (int i = 0; i < n; i++) {
+        /* NULL q0 or v0: at rest at q = 0 */
         mj->st.q[i] = q0 ? q0[i] : 0.0;
         mj->st.v[i] = v0 ? v0[i] : 0.0;
         if (!isfinite(mj->st.q[i]) || !isfinite(mj->st.v[i]))
@@ -258,10 +270,12 @@ int pd_mj_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_err
     mj->st.h = mj->opts.h;
     mj->st.err = NULL;
     for (int a = 0; a < md->m; a++) {
+        /* no impulse, no active contact before the first step */
         mj->st.P[a] = 0.0;
         mj->st.active[a] = 0;
     }
     gaps(md, mj->st.q, mj->st.g);
+    /* breakpoints before t0 are passed; F0 = F(t0 +) already takes the right limit of one at t0 */
     mj->next_break = 0;
     while (mj->next_break < md->nbreaks && md->breaks[mj->next_break] < t0 - 1e-9 * mj->opts.h)
         mj->next_break++;
@@ -278,9 +292,9 @@ static void advance_force(pd_mj *mj, double t1)
 {
     const pd_model *md = mj->model;
     if (mj_break_at(md->breaks, md->nbreaks, &mj->next_break, t1, 1e-9 * mj->opts.h))
-        md->force(t1, +1, mj->F0, md->force_ctx);
+        md->force(t1, +1, mj->F0, md->force_ctx); /* a jump at t1: its right limit */
     else
-        memcpy(mj->F0, mj->F1, (size_t)md->n * sizeof(double));
+        memcpy(mj->F0, mj->F1, (size_t)md->n * sizeof(double)); /* F continuous at t1 */
 }
 
 /* Non-finite state: fail naming time and degree of freedom. */
@@ -303,9 +317,11 @@ static inline int step_scalar_f(pd_mj *mj, double F1, pd_err *err)
     double h = mj->opts.h;
     double t1 = mj->t0 + (double)(st->step + 1) * h;
     double g = st->g[0], P;
+    /* vfree, the prediction g + h gamma U <= 0, P = max(0, -b) / D and q_k+1: mj1_step */
     int active = mj1_step(h, mj->opts.theta, h * mj->opts.gamma, &mj->s1, mj->F0[0], F1,
                           &st->q[0], &st->v[0], &g, &P);
     if (md->m) {
+        /* P, active and g exist only with the wall (m = 1) */
         st->P[0] = P;
         st->active[0] = (unsigned char)active;
         st->g[0] = g;
@@ -313,6 +329,7 @@ static inline int step_scalar_f(pd_mj *mj, double F1, pd_err *err)
     st->nactive = active;
     st->lcp_pivots = 0;
     st->lcp_solver = active ? "closed-form" : NULL;
+    /* the next step starts from F(t_k+1 -), or from F(t_k+1 +) at a breakpoint (advance_force) */
     mj->F0[0] = F1;
     if (mj->next_break < md->nbreaks) {
         mj->F1[0] = F1;
@@ -393,10 +410,12 @@ static int run_scalar(pd_mj *mj, long nsteps, pd_observer observer, void *ctx, p
                    .P = md->m ? st->P[0] : 0.0, .F0 = mj->F0[0], .F1 = mj->F1[0],
                    .step = st->step, .next_break = mj->next_break, .active = st->nactive};
     double h = mj->opts.h, th = mj->opts.theta, gamma = mj->opts.gamma;
+    /* two calls: without an observer the inlined loop drops its call */
     int rc = observer ? mj1_run(&mj->s1, h, th, gamma, mj->t0, md->breaks, md->nbreaks, nsteps,
                                 &x, scalar_force_at, scalar_observe, &r, err)
                       : mj1_run(&mj->s1, h, th, gamma, mj->t0, md->breaks, md->nbreaks, nsteps,
                                 &x, scalar_force_at, NULL, &r, err);
+    /* the state back into mj->st once, after the last step */
     scalar_store(mj, &x, mj->t0 + (double)x.step * h);
     mj->F0[0] = x.F0;
     mj->F1[0] = x.F1;
@@ -411,8 +430,9 @@ static int predict_active(pd_mj *mj, double h, const pd_state *in, pd_state *out
     const pd_model *md = mj->model;
     double hg = h * mj->opts.gamma;
     int nI = 0;
-    pd_matrix_gemv_t(&md->W, in->v, mj->U0);
+    pd_matrix_gemv_t(&md->W, in->v, mj->U0); /* U_k = W^T v_k */
     for (int a = 0; a < md->m; a++) {
+        /* 1 pushed, 0 active without pushing, 2 newly active */
         unsigned char was = in->active[a] ? in->P[a] > 0.0 : 2;
         double ga = in->g[a];
         out->active[a] = 0;
@@ -452,11 +472,13 @@ int mj_solve_active(pd_mj *mj, int nI, double t1, pd_state *out, pd_err *err)
         out->lcp_solver = "closed-form";
         return PD_OK;
     }
+    /* w = D_II P + b_I >= 0, P >= 0, w^T P = 0 */
     D = mj->sparse ? pd_matrix_csc(nI, nI, mj->D_colptr, mj->D_rowind, mj->D_active)
                    : pd_matrix_dense(nI, nI, mj->D_active);
     int st = pd_lcp_solve(mj->lcp, &D, mj->b_active, &lo, mj->P_active, mj->w_active, &info);
     out->lcp_pivots = info.pivots + info.iterations;
     out->lcp_solver = info.solver;
+    /* the observer sees every LCP, solved or not; > 0 stops the run after this step */
     if (mj->opts.on_lcp && mj->opts.on_lcp(&D, mj->b_active, mj->P_active, mj->w_active, &info,
                                            mj->idx_active, t1, mj->opts.on_lcp_ctx) > 0)
         mj->stop = 1;
@@ -465,6 +487,7 @@ int mj_solve_active(pd_mj *mj, int nI, double t1, pd_state *out, pd_err *err)
                           "Moreau-Jean: LCP over %d active contact(s) (first: contact %d) not "
                           "solved at t = %.9g: %s",
                           nI, mj->idx_active[0], t1, pd_lcp_outcome_name(info.outcome));
+    /* P_I back to the contacts' indices */
     for (int r = 0; r < nI; r++)
         out->P[mj->idx_active[r]] = mj->P_active[r];
     return PD_OK;
@@ -478,6 +501,8 @@ void mj_active_rhs(pd_mj *mj, int nI, const double *vfree)
     const pd_model *md = mj->model;
     for (int r = 0; r < nI; r++) {
         int a = mj->idx_active[r];
+        /* w_a = (D P + b)_a = U_a(v_k+1) + e U_a(v_k) >= 0: Newton's law
+         * U+ = -e U- where P_a > 0 */
         double e = mj->u_rest && (mj->U0[a] > 0.0 || -mj->U0[a] <= mj->u_rest[a]) ? 0.0
                                                                                   : md->e[a];
         mj->b_active[r] = pd_matrix_col_dot(&md->W, a, vfree) + e * mj->U0[a];
@@ -492,12 +517,14 @@ static double velocity_residual(const pd_mj *mj, int nI, const int *ax, int na,
 {
     const pd_matrix *W = &mj->model->W;
     double worst = 0.0;
+    /* r = U_I(vfree + y) + e U_I(v_k): Newton's law on every active contact */
     for (int r = 0; r < nI; r++)
         res[r] = mj->b_active[r] + pd_matrix_col_dot(W, mj->idx_active[r], y);
     for (int i = 0; i < na; i++) {
         int r = ax[i], a = mj->idx_active[r];
         double sc = pd_matrix_col_absdot(W, a, vfree) + pd_matrix_col_absdot(W, a, y) +
                     fabs(mj->b_active[r]);
+        /* fmax(sc, DBL_MIN): no 0 / 0 when every term is 0 */
         worst = fmax(worst, fabs(res[r]) / (DBL_EPSILON * fmax(sc, DBL_MIN)));
     }
     return worst;
@@ -523,6 +550,7 @@ static int orthogonalise_pushing(pd_mj *mj, const pd_factor *f, const int *ax, i
     int n = md->n, *piv = mj->ref_perm + md->m;
     double *C = mj->ref_C, *SC = mj->ref_SC, *R = mj->ref_R;
     for (int j = 0; j < na; j++) {
+        /* c_j = W_a (a the j-th pushing contact), and What^-1 c_j beside it */
         double *c = C + (size_t)j * n;
         memset(c, 0, (size_t)n * sizeof(double));
         pd_matrix_col_axpy(&md->W, mj->idx_active[ax[j]], 1.0, c);
@@ -536,17 +564,20 @@ static int orthogonalise_pushing(pd_mj *mj, const pd_factor *f, const int *ax, i
         int best = k;
         double nb = -1.0;
         for (int i = k; i < na; i++) {
+            /* |c|^2 = c^T What^-1 c */
             double nrm = dot_n(n, C + (size_t)piv[i] * n, SC + (size_t)piv[i] * n);
             if (nrm > nb) {
                 nb = nrm;
                 best = i;
             }
         }
+        /* no direction left (or a NaN): the columns are dependent, rank k */
         if (!(nb > 0.0))
             return k;
         int p = piv[best];
         piv[best] = piv[k];
         piv[k] = p;
+        /* q_k = c_p / |c_p| with |c|^2 = c^T What^-1 c, and R_kk = |c_p| */
         double d = sqrt(nb), *q = C + (size_t)p * n, *sq = SC + (size_t)p * n;
         R[k + (size_t)p * na] = d;
         for (int i = 0; i < n; i++) {
@@ -559,7 +590,7 @@ static int orthogonalise_pushing(pd_mj *mj, const pd_factor *f, const int *ax, i
         for (int i = k + 1; i < na; i++) {
             double *c = C + (size_t)piv[i] * n, *sc = SC + (size_t)piv[i] * n;
             for (int pass = 0; pass < 2; pass++) {
-                double rho = dot_n(n, c, sq);
+                double rho = dot_n(n, c, sq); /* rho = c^T What^-1 q_k, into R_ki */
                 R[k + (size_t)piv[i] * na] += rho;
                 for (int l = 0; l < n; l++) {
                     c[l] -= rho * q[l];
@@ -579,14 +610,17 @@ static void correct_pushing(pd_mj *mj, const int *ax, int na, const double *res,
     int n = mj->model->n, *piv = mj->ref_perm + mj->model->m;
     double *R = mj->ref_R, *z = mj->ref_z, *G = z + na;
     for (int i = 0; i < na; i++) {
+        /* R^T z = -r_A forward in the pivot order (R_ki, k < i, sits in column piv[i]) */
         double s = -res[ax[piv[i]]];
         for (int k = 0; k < i; k++)
             s -= R[k + (size_t)piv[i] * na] * z[k];
         z[i] = s / R[i + (size_t)piv[i] * na];
         const double *sq = mj->ref_SC + (size_t)piv[i] * n;
+        /* y += z_i What^-1 q_i: W_A^T y moves by Pi R^T z = -r_A */
         for (int l = 0; l < n; l++)
             y[l] += z[i] * sq[l];
     }
+    /* R G = z backward: the impulses R^-1 z whose velocity is What^-1 Q z (W_A Pi = Q R) */
     for (int i = na - 1; i >= 0; i--) {
         double s = z[i];
         for (int j = i + 1; j < na; j++)
@@ -615,14 +649,17 @@ static int refine_active(pd_mj *mj, const pd_factor *f, int nI, const double *vf
     mj->refined = 0;
     for (int r = 0; r < nI; r++) {
         double s = 0.0;
+        /* grow = max_r sum_c |D_rc P_c| / |b_r|, and A = {r : P_r > 0} */
         for (int c = 0; c < nI; c++)
             s += fabs(D[r + (size_t)c * nI] * P[c]);
         if (P[r] > 0.0)
             ax[na++] = r;
         grow = fmax(grow, s / fmax(fabs(mj->b_active[r]), DBL_MIN));
     }
+    /* one pushing contact, more than the basis holds, or D P's terms at most 1e8 b: P stands */
     if (na < 2 || na > mj->ref_nmax || !(grow > MJ_REFINE_GROWTH))
         return PD_OK;
+    /* y = What^-1 W_I P, the impulses' velocity, through the factor */
     memset(yt, 0, (size_t)n * sizeof(double));
     for (int r = 0; r < nI; r++)
         pd_matrix_col_axpy(&mj->model->W, mj->idx_active[r], P[r], yt);
@@ -640,6 +677,7 @@ static int refine_active(pd_mj *mj, const pd_factor *f, int nI, const double *vf
     for (int it = 0; it < MJ_REFINE_MAX && full && worst > MJ_REFINE_TOL; it++) {
         correct_pushing(mj, ax, na, it ? rt : res, yt);
         wt = velocity_residual(mj, nI, ax, na, vfree, yt, rt);
+        /* y, r and worst: the best iterate so far */
         if (wt < worst) {
             memcpy(y, yt, (size_t)n * sizeof(double));
             memcpy(res, rt, (size_t)nI * sizeof(double));
@@ -663,15 +701,18 @@ static int solve_contacts(pd_mj *mj, const pd_factor *f, int nI, const double *v
 {
     int rc;
     mj->refined = 0;
+    /* D_II = W_I^T What^-1 W_I from the factor, as it keeps D */
     if (mj->sparse)
         pd_factor_delassus_csc(f, mj->idx_active, nI, mj->D_colptr, mj->D_rowind, mj->D_active);
     else
         pd_factor_delassus_dense(f, mj->idx_active, nI, mj->D_active);
     mj_active_rhs(mj, nI, vfree);
+    /* refined only dense (the ref_ arrays exist only then), with two contacts or more */
     if ((rc = mj_solve_active(mj, nI, t1, out, err)) || mj->sparse || nI < 2)
         return rc;
     if ((rc = refine_active(mj, f, nI, vfree, t1, err)))
         return rc;
+    /* the refinement may have moved P_A (P_A += R^-1 z, clipped at 0) */
     for (int r = 0; r < nI; r++)
         out->P[mj->idx_active[r]] = mj->P_active[r];
     return PD_OK;
@@ -686,8 +727,8 @@ int mj_general_step(pd_mj *mj, const pd_factor *f, double h, double t1, const do
     double *x = mj->work_n;
     /* right-hand side h [F_theta - C v - K (q + h theta v)] */
     for (int i = 0; i < n; i++) {
-        x[i] = th * F1[i] + (1.0 - th) * F0[i];
-        mj->qtheta[i] = in->q[i] + h * th * in->v[i];
+        x[i] = th * F1[i] + (1.0 - th) * F0[i]; /* F_theta */
+        mj->qtheta[i] = in->q[i] + h * th * in->v[i]; /* q_k + h theta v_k */
     }
     pd_matrix_gemv(&md->C, -1.0, in->v, 1.0, x);
     pd_matrix_gemv(&md->K, -1.0, mj->qtheta, 1.0, x);
@@ -695,6 +736,7 @@ int mj_general_step(pd_mj *mj, const pd_factor *f, double h, double t1, const do
         x[i] *= h;
     /* vfree - v_k = What^-1 rhs */
     pd_factor_solve(f, x);
+    /* I = {a : g_a + h gamma U_a <= 0} at the step's start */
     if (md->m)
         nI = predict_active(mj, h, in, out);
     out->lcp_pivots = 0;
@@ -706,6 +748,7 @@ int mj_general_step(pd_mj *mj, const pd_factor *f, double h, double t1, const do
     }
     out->t = t1;
     out->step = in->step + 1;
+    /* out->v = vfree; v_k+1 = vfree + What^-1 W_I P */
     if (nI > 0) {
         if ((rc = solve_contacts(mj, f, nI, out->v, t1, out, err)))
             return rc;
@@ -715,9 +758,11 @@ int mj_general_step(pd_mj *mj, const pd_factor *f, double h, double t1, const do
         else
             pd_factor_add_impulse(f, mj->idx_active, nI, mj->P_active, out->v);
     }
+    /* q_k+1 = q_k + h [(1 - theta) v_k + theta v_k+1] */
     for (int i = 0; i < n; i++)
         out->q[i] += h * th * out->v[i];
     out->nactive = nI;
+    /* g_k+1 = g0 + W^T q_k+1: the next step's prediction */
     if (md->m)
         gaps(md, out->q, out->g);
     return check_state(md, out, err);
@@ -731,7 +776,8 @@ static int step_general(pd_mj *mj, pd_err *err)
     double t1 = mj->t0 + (double)(mj->st.step + 1) * mj->opts.h;
     int rc;
     if (md->force)
-        md->force(t1, -1, mj->F1, md->force_ctx);
+        md->force(t1, -1, mj->F1, md->force_ctx); /* F(t_k+1 -) */
+    /* in place: out = in = mj->st */
     rc = mj_general_step(mj, mj->factor, mj->opts.h, t1, mj->F0, mj->F1, &mj->st, &mj->st, err);
     if (md->force)
         advance_force(mj, t1);
@@ -771,9 +817,11 @@ int pd_mj_run(pd_mj *mj, long nsteps, pd_observer observer, void *ctx, pd_err *e
         return rc;
     if (observer && observer(&mj->st, ctx) > 0)
         return PD_OK;
+    /* the observer saw the start state first: > 0 stopped before any step */
     mj->stop = 0;
     if (mj->scalar)
         return run_scalar(mj, nsteps, observer, ctx, err);
+    /* mj->stop: the LCP observer asked to stop */
     for (long k = 0; k < nsteps && !mj->stop; k++) {
         if ((rc = mj_step(mj, err)))
             return rc;
@@ -791,6 +839,7 @@ int pd_mj_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx, pd
         return pd_err_set(err, PD_EINVAL, "pd_mj_run_until: t_end must be finite (got %g)", t_end);
     if (mj->ad)
         return mj_adapt_run_until(mj, t_end, observer, ctx, err);
+    /* the steps of h that reach t_end: the whole number within 1e-9 of the ratio, else one more */
     long nsteps = t_end > mj->st.t ? pd_steps_for(t_end - mj->st.t, mj->opts.h) : 0;
     return pd_mj_run(mj, nsteps, observer, ctx, err);
 }
@@ -803,6 +852,7 @@ int pd_mj_get_stats(const pd_mj *mj, pd_mj_stats *s)
         mj_adapt_stats(mj, s);
         return PD_OK;
     }
+    /* fixed steps: each taken once and kept, no error estimate */
     *s = (pd_mj_stats){.steps = mj->st.step,
                        .rejected = 0,
                        .evals = mj->st.step,

@@ -38,13 +38,14 @@ typedef struct mj_incidence {
 static inline int mj_col_next(const pd_matrix *A, int j, int *p, int *i, double *v)
 {
     if (A->kind == PD_MATRIX_CSC) {
-        *p = *p < 0 ? A->colptr[j] : *p + 1;
+        *p = *p < 0 ? A->colptr[j] : *p + 1; /* the first entry, then the next */
         if (*p >= A->colptr[j + 1])
             return 0;
         *i = A->rowind[*p];
         *v = A->values[*p];
         return 1;
     }
+    /* a zero matrix stores none; a dense one every row */
     if (A->kind != PD_MATRIX_DENSE || ++*p >= A->rows)
         return 0;
     *i = *p;
@@ -57,7 +58,7 @@ static inline double mj_inc_dot(const mj_incidence *in, int a, const double *x)
 {
     double sum = 0.0;
     for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
-        sum += in->w[j] * x[in->dof[j]];
+        sum += in->w[j] * x[in->dof[j]]; /* over the dofs contact a acts on */
     return sum;
 }
 

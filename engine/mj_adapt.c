@@ -33,6 +33,7 @@
 #include <string.h>
 
 #include "mj.h"
+#include "pd_alloc.h"
 #include "pd_null.h"
 
 #define ADAPT_KF 0.5        /* share of rtol for the flight's errors over the run */
@@ -118,8 +119,9 @@ static void snap_free(snap *s)
 static int snap_alloc(snap *s, int n, int m)
 {
     size_t mm = m > 0 ? (size_t)m : 1, nn = (size_t)n;
+    /* q v Fl Fr (n each), g P (max(m, 1) each), acc af accr (n each): the offsets below keep mm */
     s->mem = calloc(7 * nn + 2 * mm, sizeof(double));
-    s->st.active = calloc(mm, 1);
+    s->st.active = pd_calloc(m, 1);
     if (!s->mem || !s->st.active)
         return PD_ENOMEM;
     s->st.q = s->mem;
@@ -131,7 +133,7 @@ static int snap_alloc(snap *s, int n, int m)
     s->st.acc = s->mem + 4 * nn + 2 * mm;
     s->af = s->mem + 5 * nn + 2 * mm;
     s->accr = s->mem + 6 * nn + 2 * mm;
-    s->st.acc_right = s->st.acc;
+    s->st.acc_right = s->st.acc; /* no jump: the right limit is the left */
     return PD_OK;
 }
 
@@ -163,8 +165,8 @@ void mj_adapt_free(pd_mj *mj)
         free(arrays[k]);
     free(ad);
     mj->ad = NULL;
-    mj->u_rest = NULL;
-    mj->st = mj->st_own;
+    mj->u_rest = NULL; /* the fixed-step kernel: every restitution again */
+    mj->st = mj->st_own; /* st pointed into a snapshot */
 }
 
 /* h0: opts.h lowered so that the forcing's jumps fall between steps: the
@@ -176,18 +178,23 @@ static double coarsest_step(const pd_model *md, const pd_piecewise_force *F, dou
 {
     double b = 0.0;
     if (F && F->npieces >= 2) {
+        /* d: the first two starts' spacing; even when every
+         * start is p d after the first (to 1e-9) */
         double d = F->pieces[1].t_start - F->pieces[0].t_start;
         int even = d > 0.0;
         for (int p = 2; p < F->npieces && even; p++)
             even = fabs(F->pieces[p].t_start - F->pieces[0].t_start - p * d) <= 1e-9 * p * d;
+        /* a record: h0 = d 2^-j, the largest such step at most h */
         if (even && F->npieces >= 3)
             return h >= d ? d : ldexp(d, -(int)ceil(log2(d / h) - 1e-12));
-        b = d;
+        b = d; /* a pulse: its end on a step's end */
     }
+    /* theta flights: the first breakpoint after 0 */
     for (int j = 0; !F && j < md->nbreaks && b == 0.0; j++)
         if (md->breaks[j] > 0.0)
             b = md->breaks[j];
     if (b > 0.0) {
+        /* the fewest steps of at most h (to 1e-12) ending on b */
         double steps = ceil(b / h * (1.0 - 1e-12));
         return b / (steps > 1.0 ? steps : 1.0);
     }
@@ -201,9 +208,11 @@ static void dof_frequencies(const pd_model *md, double *w)
     double wmax = 0.0;
     for (int i = 0; i < md->n; i++) {
         double k = pd_matrix_get(&md->K, i, i), m = pd_matrix_get(&md->M, i, i);
+        /* w_i^2 = K_ii / M_ii (0 without stiffness: floored below) */
         w[i] = k > 0.0 && m > 0.0 ? sqrt(k / m) : 0.0;
         wmax = fmax(wmax, w[i]);
     }
+    /* 1 when no dof has a frequency: w_i divides v_i in every error */
     for (int i = 0; i < md->n; i++)
         w[i] = fmax(w[i], wmax > 0.0 ? 1e-3 * wmax : 1.0);
 }
@@ -222,12 +231,14 @@ static int incidence(const pd_model *md, mj_incidence *in)
                 nnz++;
                 in->dptr[i + 1]++;
             }
-    size_t cap = nnz > 0 ? (size_t)nnz : 1;
-    if (!(in->dof = malloc(cap * sizeof(int))) || !(in->w = malloc(cap * sizeof(double))) ||
-        !(in->con = malloc(cap * sizeof(int))))
+    /* W's nonzeros counted, per dof in dptr[i + 1]: by columns, then by rows */
+    if (!(in->dof = pd_malloc(nnz, sizeof(int))) || !(in->w = pd_malloc(nnz, sizeof(double))) ||
+        !(in->con = pd_malloc(nnz, sizeof(int))))
         return PD_ENOMEM;
+    /* the running sum: dptr[i] is dof i's first contact */
     for (int i = 0; i < n; i++)
         in->dptr[i + 1] += in->dptr[i];
+    /* fill[i]: the contacts dof i has so far */
     int *fill = calloc((size_t)n, sizeof(int));
     if (!fill)
         return PD_ENOMEM;
@@ -252,6 +263,7 @@ static void piece_ticks(mj_adapt *ad)
 {
     for (int p = 0; ad->F && p < ad->F->npieces; p++) {
         double r = (ad->F->pieces[p].t_start - ad->t_origin) / ad->htick;
+        /* a start before the origin at tick 0; beyond 2^63 ticks, never reached */
         ad->piece_tick[p] = r <= 0.0 ? 0 : r >= 0x1p63 ? UINT64_MAX : (uint64_t)llround(r);
     }
 }
@@ -267,10 +279,12 @@ int mj_adapt_alloc(pd_mj *mj, pd_err *err)
     ad->F = o->pieces;
     ad->L = L;
     ad->h0 = coarsest_step(md, ad->F, o->h);
-    ad->htick = ldexp(ad->h0, -L);
+    ad->htick = ldexp(ad->h0, -L); /* h_L: the tick */
+    /* the flight's global order p: 2 at theta = 1/2 and for exact flights, else 1 */
     ad->p = o->theta == 0.5 || ad->F ? 2 : 1;
-    ad->div = ad->p == 2 ? 3.0 : 1.0;
+    ad->div = ad->p == 2 ? 3.0 : 1.0; /* 2^p - 1: Richardson's divisor */
     ad->lev = calloc((size_t)L + 1, sizeof *ad->lev);
+    /* one element without pieces, so that NULL means out of memory */
     ad->piece_tick = calloc(ad->F ? (size_t)ad->F->npieces : 1, sizeof(uint64_t));
     double **nv[] = {&ad->E, &ad->S2, &ad->Er, &ad->eps, &ad->rate, &ad->amp, &ad->w, &ad->atol, &ad->minv,
                      &ad->bound};
@@ -280,10 +294,10 @@ int mj_adapt_alloc(pd_mj *mj, pd_err *err)
     ad->mark = calloc((size_t)n, sizeof(unsigned));
     ad->evmark = calloc((size_t)n, sizeof(unsigned));
     ad->timed = calloc((size_t)n, sizeof(unsigned));
-    ad->u_rest = calloc(md->m > 0 ? (size_t)md->m : 1, sizeof(double));
-    ad->D0 = calloc(md->m > 0 ? (size_t)md->m : 1, sizeof(double));
-    ad->u_tol = calloc(md->m > 0 ? (size_t)md->m : 1, sizeof(double));
-    ad->G = calloc(md->m > 0 ? (size_t)md->m : 1, sizeof(double));
+    ad->u_rest = pd_calloc(md->m, sizeof(double));
+    ad->D0 = pd_calloc(md->m, sizeof(double));
+    ad->u_tol = pd_calloc(md->m, sizeof(double));
+    ad->G = pd_calloc(md->m, sizeof(double));
     bad |= !ad->u_tol || !ad->G || !ad->mark || !ad->evmark || !ad->timed || !ad->u_rest || !ad->D0 || incidence(md, &mj->inc);
     for (int s = 0; s < 4 && !bad; s++)
         bad = snap_alloc(&ad->sn[s], n, md->m) != PD_OK;
@@ -291,6 +305,8 @@ int mj_adapt_alloc(pd_mj *mj, pd_err *err)
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for its levels (n = %d)",
                           n);
     for (int k = 0; k <= L; k++) {
+        /* h_k = h0 2^-k: the scalar kernel's constants now, the
+         * general kernel's factors at their first use */
         ad->lev[k].h = ldexp(ad->h0, -k);
         if (mj->scalar)
             ad->lev[k].s1 = mj1_coef_make(
@@ -306,15 +322,20 @@ int mj_adapt_alloc(pd_mj *mj, pd_err *err)
             return pd_err_set(err, PD_EINVAL, "atol of dof %d must be a finite number > 0 "
                               "(got %g)", i, ad->atol[i]);
     }
+    /* D0_a = sum_i W_ia^2 / M_ii: the gap rate a unit
+     * impulse makes (M^-1 by its diagonal) */
     for (int a = 0; a < md->m; a++)
         for (int j = mj->inc.ptr[a]; j < mj->inc.ptr[a + 1]; j++)
             ad->D0[a] += mj->inc.w[j] * mj->inc.w[j] * ad->minv[mj->inc.dof[j]];
+    /* the kernels read the driver's rest speeds and M^-1 through mj */
     mj->u_rest = ad->u_rest;
     mj->minv = ad->minv;
     mj->D0 = ad->D0;
     if (ad->F && (rc = mj_flight_alloc(mj, ad->F, ad->h0, L, err)))
         return rc;
     if (ad->F) {
+        /* k_flight: the coarsest level with (w h)^6 / 46080 <= ke rtol / 10,
+         * w the highest dof or forcing frequency */
         double w = 0.0, room = pow(46080.0 * 0.1 * ADAPT_KE * o->rtol, 1.0 / 6.0);
         for (int i = 0; i < n; i++)
             w = fmax(w, ad->w[i]);
@@ -334,7 +355,7 @@ static double tick_time(const mj_adapt *ad, uint64_t tick)
 
 static uint64_t level_ticks(const mj_adapt *ad, int k)
 {
-    return (uint64_t)1 << (ad->L - k);
+    return (uint64_t)1 << (ad->L - k); /* 2^(L - k) ticks */
 }
 
 /* 1 when t is one of the model's breakpoints (to a relative ADAPT_BREAK_TOL). */
@@ -358,6 +379,7 @@ static void forces_at(const pd_mj *mj, double t, snap *s)
         memset(s->Fr, 0, bytes);
         return;
     }
+    /* F(t-); F(t+) differs only at a breakpoint (exact flights carry the forcing in z) */
     md->force(t, -1, s->Fl, md->force_ctx);
     if (at_break(md, t))
         md->force(t, +1, s->Fr, md->force_ctx);
@@ -376,19 +398,21 @@ int mj_adapt_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_
         if (!isfinite(s->st.q[i]) || !isfinite(s->st.v[i]))
             return pd_err_set(err, PD_EINVAL, "initial state: dof %d is not finite", i);
         ad->E[i] = ad->S2[i] = ad->rate[i] = 0.0;
-        ad->amp[i] = hypot(s->st.q[i], s->st.v[i] / ad->w[i]);
+        ad->amp[i] = hypot(s->st.q[i], s->st.v[i] / ad->w[i]); /* sqrt(q^2 + (v / w)^2) */
     }
     for (int a = 0; a < md->m; a++) {
         s->st.P[a] = 0.0;
         s->st.active[a] = 0;
-        s->st.g[a] = md->g0[a] + mj_inc_dot(&mj->inc, a, s->st.q);
+        s->st.g[a] = md->g0[a] + mj_inc_dot(&mj->inc, a, s->st.q); /* g0 + W^T q */
     }
+    /* the four snapshots: now, one whole step, the first half, both halves */
     ad->cur = &ad->sn[0];
     ad->one = &ad->sn[1];
     ad->half = &ad->sn[2];
     ad->two = &ad->sn[3];
     ad->t_origin = t0;
-    ad->span = 0.0;
+    ad->span = 0.0; /* T: set by the first run */
+    /* the first try at level ADAPT_START (above the foot), or at k_flight when that is finer */
     ad->k = ADAPT_START < ad->L ? ADAPT_START : ad->L - 1;
     ad->k = ad->k > ad->k_flight ? ad->k : ad->k_flight;
     ad->started = 0;
@@ -413,17 +437,19 @@ int mj_adapt_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_
         mj_flight_z(mj, s->piece, t0, s->z);
     }
     if (ad->F) {
+        /* the free motion's accelerations, for the observers' interpolation */
         mj_flight_acc(mj, &s->st, s->z, s->af);
         memcpy(s->st.acc, s->af, (size_t)mj->model->n * sizeof(double));
         s->st.has_acc = 1;
         s->st.acc_right = s->st.acc;
         s->switched = 0;
     }
+    /* no step made this state (h = 0): no held force in its rest speeds */
     rest_speeds(mj, s, s);
     mj->t0 = t0;
     report_err(mj, 0.0);
     mj->st = s->st;
-    mj->st.err = ad->Er;
+    mj->st.err = ad->Er; /* the estimate: 0 here */
     return PD_OK;
 }
 
@@ -450,6 +476,7 @@ static int scalar_step(pd_mj *mj, int k, double t1, const snap *x, snap *y, pd_e
     mj1_coef s1 = lv->s1;
     if (md->m && -(s1.w * v) <= mj->ad->u_rest[0])
         s1.e = 0.0; /* opening, or closing too slowly for a rebound: the contact holds */
+    /* F(t+) at the start, F(t1-) at the end: the fixed-step kernel's arithmetic */
     int active = mj1_step(lv->h, mj->opts.theta, lv->h * mj->opts.gamma, &s1, x->Fr[0],
                           y->Fl[0], &q, &v, &g, &P);
     y->st.q[0] = q;
@@ -475,15 +502,16 @@ static int take_step(pd_mj *mj, int k, const snap *x, snap *y, pd_err *err)
 {
     mj_adapt *ad = mj->ad;
     int rc;
-    y->tick = x->tick + level_ticks(ad, k);
+    y->tick = x->tick + level_ticks(ad, k); /* t1 = t + h_k on the grid */
     double t1 = tick_time(ad, y->tick);
     ad->stats.evals++;
-    rest_for_step(mj, x, ad->lev[k].h);
+    rest_for_step(mj, x, ad->lev[k].h); /* mj->u_rest for this step size */
     y->st.h = ad->lev[k].h;
     if (ad->F) { /* exact flight; at a piece's start its forcing takes over */
         if ((rc = mj_flight_step(mj, k, t1, &x->st, x->z, &y->st, y->z, err)))
             return rc;
         y->piece = x->piece;
+        /* steps never cross a piece's start: one may end on it */
         y->switched = y->piece + 1 < ad->F->npieces && y->tick >= ad->piece_tick[y->piece + 1];
         if (y->switched) {
             memcpy(y->zl, y->z, sizeof y->zl);
@@ -492,6 +520,7 @@ static int take_step(pd_mj *mj, int k, const snap *x, snap *y, pd_err *err)
         }
         return PD_OK;
     }
+    /* theta flights: F(t1-) and F(t1+), then the scheme on What(h_k) */
     forces_at(mj, t1, y);
     if (mj->scalar)
         return scalar_step(mj, k, t1, x, y, err);
@@ -506,7 +535,7 @@ static int take_step(pd_mj *mj, int k, const snap *x, snap *y, pd_err *err)
 /* s_i: the size a dof's error is measured against. */
 static double dof_scale(const mj_adapt *ad, int i)
 {
-    return ad->amp[i] > ad->atol[i] ? ad->amp[i] : ad->atol[i];
+    return ad->amp[i] > ad->atol[i] ? ad->amp[i] : ad->atol[i]; /* max(amplitude, atol_i) */
 }
 
 /* An impact in the step x -> y: contact a pushes (P > 0) while it was
@@ -520,7 +549,8 @@ static double impact_jump(const pd_mj *mj, int a, const snap *x, const snap *y)
         return 0.0;
     const pd_model *md = mj->model;
     double U = mj_inc_dot(&mj->inc, a, x->st.v);
-    double jump = U < 0.0 ? (1.0 + md->e[a]) * -U : 0.0;
+    double jump = U < 0.0 ? (1.0 + md->e[a]) * -U : 0.0; /* (1 + e) |U-| while closing */
+    /* starting to push: at least its own impulse's change of gap rate, P D0_a */
     if (!(x->st.P[a] > 0.0))
         jump = pd_max(jump, y->st.P[a] * mj->ad->D0[a]);
     return jump;
@@ -533,6 +563,8 @@ static int flight_event(const pd_mj *mj, int a, double jump)
 {
     const mj_incidence *in = &mj->inc;
     const mj_adapt *ad = mj->ad;
+    /* h cancels: the error jump h / 2 and the allowance kf rtol
+     * s_i h / T both scale with the step */
     double flight = ad->div * ADAPT_KF * mj->opts.rtol / ad->span;
     for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
         if (jump > flight * dof_scale(ad, in->dof[j]))
@@ -562,16 +594,20 @@ static int scan_impacts(pd_mj *mj, const snap *x, const snap *y, double h, doubl
     const pd_model *md = mj->model;
     const mj_incidence *in = &mj->inc;
     mj_adapt *ad = mj->ad;
+    /* reach: how far the impulse's instant may be off, h (theta) or h / 2 (exact: at mid-step) */
     double rtol = mj->opts.rtol, reach = ad->F ? 0.5 * h : h;
     int cascade = 0;
-    unsigned stamp = ++ad->stamp;
+    unsigned stamp = ++ad->stamp; /* this scan's significant impacts, per dof */
     for (int a = 0; a < md->m; a++) {
         double jump = impact_jump(mj, a, x, y);
+        /* open to past zero without an impulse: the penetration is the error */
         double missed = x->st.g[a] > 0.0 && y->st.g[a] < 0.0 && !(y->st.P[a] > 0.0)
                             ? -y->st.g[a]
                             : 0.0;
         if (!(jump > 0.0) && !(missed > 0.0))
             continue;
+        /* significant: h jump beyond (1 + e) sim_gap and, on every dof it moves, a velocity
+         * change beyond ke rtol s_i w_i */
         int big = jump * h > (1.0 + md->e[a]) * mj->opts.sim_gap;
         int marks = missed > 0.0 || flight_event(mj, a, jump);
         for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
@@ -584,7 +620,7 @@ static int scan_impacts(pd_mj *mj, const snap *x, const snap *y, double h, doubl
             continue;
         for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
             int i = in->dof[j];
-            cascade |= ad->mark[i] == stamp;
+            cascade |= ad->mark[i] == stamp; /* a second significant impact on dof i */
             ad->mark[i] = stamp;
         }
     }
@@ -595,8 +631,10 @@ static int scan_impacts(pd_mj *mj, const snap *x, const snap *y, double h, doubl
  * over a step h (its ends excluded: +inf when it turns nowhere inside). */
 static double hermite_min(double g0, double U0, double g1, double U1, double h)
 {
+    /* g(s) = g0 + U0 s + c2 s^2 + c3 s^3 through (g0, U0) at 0 and (g1, U1) at h */
     double c2 = (3.0 * (g1 - g0) / h - 2.0 * U0 - U1) / h;
     double c3 = (2.0 * (g0 - g1) / h + U0 + U1) / (h * h);
+    /* its turns: g'(s) = A s^2 + B s + C = 0 */
     double A = 3.0 * c3, B = 2.0 * c2, C = U0, best = HUGE_VAL, s[2];
     int ns = 0;
     if (A == 0.0) {
@@ -605,12 +643,14 @@ static double hermite_min(double g0, double U0, double g1, double U1, double h)
     } else {
         double d = B * B - 4.0 * A * C;
         if (d >= 0.0) {
+            /* roots q / A and C / q: no cancellation between B and sqrt(d) */
             double q = -0.5 * (B + copysign(sqrt(d), B));
             s[ns++] = q / A;
             if (q != 0.0)
                 s[ns++] = C / q;
         }
     }
+    /* turns strictly inside the step only */
     for (int j = 0; j < ns; j++)
         if (s[j] > 0.0 && s[j] < h)
             best = fmin(best, g0 + s[j] * (U0 + s[j] * (c2 + s[j] * c3)));
@@ -629,11 +669,14 @@ static void scan_dips(pd_mj *mj, const snap *x, const snap *y, double h)
     const mj_incidence *in = &mj->inc;
     mj_adapt *ad = mj->ad;
     for (int a = 0; a < md->m; a++) {
+        /* open at both ends, no impulse */
         if (!(x->st.g[a] > 0.0 && y->st.g[a] > 0.0) || y->st.P[a] > 0.0)
             continue;
         double U0 = mj_inc_dot(in, a, x->st.v), U1 = mj_inc_dot(in, a, y->st.v);
+        /* closing at the start and opening at the end: it turned inside */
         if (!(U0 < 0.0 && U1 > 0.0))
             continue;
+        /* w: the fastest frequency the gap sees; scale = sum |W_ia| s_i, the gap's */
         double w = 0.0, scale = 0.0;
         for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
             int i = in->dof[j];
@@ -679,13 +722,15 @@ static int released(pd_mj *mj, int a, const snap *y, double h)
 {
     const mj_incidence *in = &mj->inc;
     mj_adapt *ad = mj->ad;
-    if (fabs(mj_inc_dot(in, a, y->st.v)) > ad->u_rest[a])
+    if (fabs(mj_inc_dot(in, a, y->st.v)) > ad->u_rest[a]) /* moving: an impact's rebound */
         return 0;
     double G = 0.0;
+    /* G = W_a^T a_free: the gap's free acceleration */
     for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
         G += in->w[j] * free_acc(mj, y, in->dof[j]);
-    if (!(G < 0.0))
+    if (!(G < 0.0)) /* the free motion opens it */
         return 0;
+    /* it would have held: |G| h of gap rate lost, |G| h / w_i on each dof */
     for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
         mark_event(ad, in->dof[j], -G * h / ad->w[in->dof[j]]);
     return 1;
@@ -700,12 +745,13 @@ static int released(pd_mj *mj, int a, const snap *y, double h)
 static double overrun(pd_mj *mj, int a, double lambda0, double t0, double lambda1, double t1,
                       double until)
 {
-    double rate = (lambda1 - lambda0) / (t1 - t0);
+    double rate = (lambda1 - lambda0) / (t1 - t0); /* lambda' */
     if (!(rate < 0.0))
         return HUGE_VAL;
-    double zero = t1 + lambda1 / -rate;
+    double zero = t1 + lambda1 / -rate; /* lambda1 + rate (z - t1) = 0 */
     if (!(zero < until))
         return HUGE_VAL;
+    /* the force held d = until - z too long: |lambda'| d^2 / 2 of impulse */
     mark_impulse(mj, a, -rate * (until - zero) * (until - zero) / 2.0);
     return zero;
 }
@@ -723,23 +769,28 @@ static int scan_releases(pd_mj *mj, double h)
 {
     const pd_model *md = mj->model;
     const mj_adapt *ad = mj->ad;
-    double hc = ad->cur->st.h;
+    double hc = ad->cur->st.h; /* the step before the try (0 after a reset) */
     int first = 0;
     for (int a = 0; a < md->m; a++) {
         double P0 = ad->cur->st.P[a], Pa = ad->half->st.P[a], P2 = ad->two->st.P[a];
+        /* pushed before the try, not in its first half: let go at the try's start */
         if (P0 > 0.0 && !(Pa > 0.0))
             first |= released(mj, a, ad->cur, h);
         if (!(Pa > 0.0))
             continue;
+        /* held before and in the first half: their means' line, times from the try's start */
         if (P0 > 0.0 && hc > 0.0 && !ad->impact_made &&
             overrun(mj, a, P0 / hc, -0.5 * hc, Pa / h, 0.5 * h, h) < h)
             first = 1;
+        /* let go at the half */
         if (!(P2 > 0.0)) {
             released(mj, a, ad->half, h);
             continue;
         }
+        /* an impact in the first half: its impulse is no held force */
         if (flight_event(mj, a, impact_jump(mj, a, ad->cur, ad->half)))
             continue;
+        /* held in both halves: a zero before h lies in the first */
         first |= overrun(mj, a, Pa / h, 0.5 * h, P2 / h, 1.5 * h, 2.0 * h) < h;
     }
     return first;
@@ -766,11 +817,11 @@ static void scan_patterns(pd_mj *mj, double h)
         int p1 = P1 > 0.0, pa = Pa > 0.0, p2 = P2 > 0.0;
         if (!p1 && !pa && !p2)
             continue;
-        int mixed = !(p1 == pa && pa == p2);
-        double jump = pd_max(P1, pd_max(Pa, P2)) * ad->D0[a];
+        int mixed = !(p1 == pa && pa == p2); /* pushes in some steps only */
+        double jump = pd_max(P1, pd_max(Pa, P2)) * ad->D0[a]; /* the largest change of gap rate */
         for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
             int i = in->dof[j];
-            ad->timed[i] = ad->try_stamp;
+            ad->timed[i] = ad->try_stamp; /* its velocity errors move it by dv H */
             if (mixed && jump > tol * dof_scale(ad, i) * ad->w[i])
                 mark_event(ad, i, jump * h);
         }
@@ -787,9 +838,11 @@ static int scan_try(pd_mj *mj, double h, int *first, int *event)
     long before = ad->nmarked;
     int cascade = scan_impacts(mj, ad->cur, ad->half, h, 1.0);
     scan_dips(mj, ad->cur, ad->half, h);
+    /* marks so far are the first half's: an event there */
     *first = ad->nmarked > before || scan_releases(mj, h);
     cascade |= scan_impacts(mj, ad->half, ad->two, h, 1.0);
     scan_dips(mj, ad->half, ad->two, h);
+    /* the whole step: detection only, weight 0 adds no bound */
     scan_impacts(mj, ad->cur, ad->one, 2.0 * h, 0.0);
     scan_patterns(mj, h);
     *event = ad->nmarked > before;
@@ -810,6 +863,7 @@ static double try_error(pd_mj *mj, double H)
     double tol_event = ADAPT_KE * rtol, tol_flight = ADAPT_KF * rtol * H / ad->span;
     for (int i = 0; i < mj->model->n; i++) {
         double dq = fabs(s2->st.q[i] - s1->st.q[i]), dv = fabs(s2->st.v[i] - s1->st.v[i]);
+        /* differences within 64 ulps of the state are rounding, not error */
         double noise = 64.0 * 2.2e-16 * (fabs(s2->st.q[i]) + fabs(s2->st.v[i]) / ad->w[i]);
         int event = ad->evmark[i] == ad->try_stamp;
         /* an event's velocities, or a timed dof's, differ by impulses taken at
@@ -818,8 +872,10 @@ static double try_error(pd_mj *mj, double H)
          * the step, not dv / w */
         int timed = event || ad->timed[i] == ad->try_stamp;
         double d = fmax(dq + dv * (timed ? H : 1.0 / ad->w[i]) - noise, 0.0);
+        /* an event's error: first order plus its bounds; a flight's: Richardson's d / (2^p - 1) */
         double e = event ? d + ad->bound[i] : d / div;
         ad->eps[i] = e;
+        /* r > 1: some dof fails its tolerance */
         r = pd_max(r, e / (dof_scale(ad, i) * (event ? tol_event : tol_flight)));
     }
     return r;
@@ -853,15 +909,17 @@ static void rest_speeds(pd_mj *mj, const snap *w, const snap *x)
         double u = HUGE_VAL, G = 0.0, held = 0.0;
         for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
             int i = in->dof[j];
+            /* u: the smallest ke rtol s_i w_i of its dofs */
             u = fmin(u, ADAPT_KE * mj->opts.rtol * dof_scale(ad, i) * ad->w[i]);
-            G += in->w[j] * free_acc(mj, x, i);
+            G += in->w[j] * free_acc(mj, x, i); /* W_a^T a_free */
+            /* the other contacts on dof i held through both steps: their mean forces P_b / h */
             for (int q = in->dptr[i]; x->st.h > 0.0 && q < in->dptr[i + 1]; q++) {
                 int b = in->con[q];
                 if (b != a && w->st.P[b] > 0.0 && x->st.P[b] > 0.0)
                     held += fabs(in->w[j]) * ad->minv[i] * x->st.P[b] / x->st.h;
             }
         }
-        ad->u_tol[a] = isfinite(u) ? u : 0.0;
+        ad->u_tol[a] = isfinite(u) ? u : 0.0; /* no dof: none */
         ad->G[a] = fabs(G) + held;
     }
 }
@@ -891,6 +949,7 @@ static void report_err(pd_mj *mj, double h)
     double wf = ad->F ? mj_flight_forcing_w(mj) : 0.0;
     for (int i = 0; i < mj->model->n; i++) {
         double wh = fmax(ad->w[i], wf) * h, wh3 = wh * wh * wh;
+        /* flights' errors add up (E), events' in quadrature (S2) */
         ad->Er[i] = ad->E[i] + sqrt(ad->S2[i]) +
                     (ad->F ? wh3 * wh3 / 46080.0 * dof_scale(ad, i) : 0.0);
     }
@@ -900,6 +959,7 @@ static void report_err(pd_mj *mj, double h)
 static void add_held(const pd_mj *mj, const snap *x, double *acc)
 {
     const mj_incidence *in = &mj->inc;
+    /* a_i += W_ia P_a / (h M_ii): the held force's mean */
     for (int a = 0; a < mj->model->m && x->st.h > 0.0; a++)
         if (x->st.P[a] > 0.0)
             for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
@@ -914,7 +974,7 @@ static void add_held(const pd_mj *mj, const snap *x, double *acc)
 static void step_accelerations(pd_mj *mj, snap *x)
 {
     size_t bytes = (size_t)mj->model->n * sizeof(double);
-    int held = !mj->ad->impact_made;
+    int held = !mj->ad->impact_made; /* an impact's impulses are no force */
     x->st.has_acc = 1;
     mj_flight_acc(mj, &x->st, x->z, x->af);
     x->st.acc_right = x->switched ? x->accr : x->st.acc;
@@ -923,6 +983,7 @@ static void step_accelerations(pd_mj *mj, snap *x)
         add_held(mj, x, (double *)x->st.acc_right);
     if (!x->switched)
         return;
+    /* the left limit, under the old piece's forcing zl */
     mj_flight_acc(mj, &x->st, x->zl, x->st.acc);
     if (held)
         add_held(mj, x, x->st.acc);
@@ -939,6 +1000,7 @@ static void share_errors(pd_mj *mj, const snap *x)
     for (int a = 0; a < mj->model->m; a++) {
         if (!(x->st.P[a] > 0.0))
             continue;
+        /* the largest E and S2 of the contact's dofs, to each */
         double E = 0.0, S2 = 0.0;
         for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
             E = pd_max(E, ad->E[in->dof[j]]);
@@ -974,16 +1036,20 @@ static void hold_gaps(pd_mj *mj, const snap *w, snap *x)
     int moved = 0;
     for (int sweep = 0; sweep < ADAPT_HOLD_SWEEPS; sweep++)
         for (int a = 0; a < md->m; a++) {
+            /* held: pushing, at rest (|U| <= u_rest) */
             if (!(x->st.P[a] > 0.0) || fabs(mj_inc_dot(in, a, x->st.v)) > mj->u_rest[a])
                 continue;
+            /* d: the gap's move to min(g(w), 0) */
             double d = fmin(w->st.g[a], 0.0) - (md->g0[a] + mj_inc_dot(in, a, x->st.q));
             double D0 = ad->D0[a];
             if (d == 0.0 || !(D0 > 0.0))
                 continue;
+            /* q += M^-1 W_a d / D0_a moves the gap by W_a^T M^-1 W_a d / D0_a = d */
             for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
                 x->st.q[in->dof[j]] += ad->minv[in->dof[j]] * in->w[j] * d / D0;
             moved = 1;
         }
+    /* the moved state's gaps */
     for (int a = 0; moved && a < md->m; a++)
         x->st.g[a] = md->g0[a] + mj_inc_dot(in, a, x->st.q);
 }
@@ -999,17 +1065,20 @@ static int keep(pd_mj *mj, const snap *w, snap *x, double f, int events, pd_obse
         ad->impact_made = flight_event(mj, a, impact_jump(mj, a, w, x));
     x->st.impact = ad->impact_made;
     for (int i = 0; i < md->n; i++) {
+        /* the estimate: an event's dofs in quadrature (S2), the others added (E) */
         if (f > 0.0 && events && ad->evmark[i] == ad->try_stamp)
             ad->S2[i] += f * ad->eps[i] * f * ad->eps[i];
         else if (f > 0.0)
             ad->E[i] += f * ad->eps[i];
         double vw = x->st.v[i] / ad->w[i];
+        /* sqrt(q^2 + (v/w)^2) */
         ad->amp[i] = pd_max(ad->amp[i], sqrt(x->st.q[i] * x->st.q[i] + vw * vw));
     }
     share_errors(mj, x);
     if (ad->F) /* the accelerations, for the observers' interpolation */
         step_accelerations(mj, x);
     rest_speeds(mj, w, x);
+    /* the statistics, the reported err, the observer */
     ad->stats.steps++;
     ad->stats.h_min = fmin(ad->stats.h_min, x->st.h);
     ad->stats.h_max = fmax(ad->stats.h_max, x->st.h);
@@ -1041,6 +1110,7 @@ static int keep_pair(pd_mj *mj, pd_observer observer, void *ctx)
 /* A smooth pair's error per h^(p+1), for steps kept without a try of their own. */
 static void note_rate(mj_adapt *ad, int n, double H)
 {
+    /* C of the local error C h^(p+1): the pair made 2 C (H/2)^(p+1) = C H^(p+1) / 2^p */
     double scale = (ad->div + 1.0) / (ad->p == 2 ? H * H * H : H * H);
     for (int i = 0; i < n; i++)
         ad->rate[i] = ad->eps[i] * scale;
@@ -1051,7 +1121,7 @@ static void rate_estimate(mj_adapt *ad, int n, double h)
 {
     double hp = ad->p == 2 ? h * h * h : h * h;
     for (int i = 0; i < n; i++)
-        ad->eps[i] = ad->rate[i] * hp;
+        ad->eps[i] = ad->rate[i] * hp; /* C h^(p+1) */
 }
 
 /* ---- the run ---------------------------------------------------------------------------- */
@@ -1060,6 +1130,7 @@ static void rate_estimate(mj_adapt *ad, int n, double h)
 static int end_tick(const mj_adapt *ad, double t_end, uint64_t *tick, pd_err *err)
 {
     double r = (t_end - ad->t_origin) / ad->htick, k = floor(r + 0.5);
+    /* ticks count in 64 bits; 2^62 leaves room for a step beyond */
     if (!(r < 0x1p62))
         return pd_err_set(err, PD_EINVAL,
                           "Moreau-Jean: the run to t = %g spans %.3g coarsest steps of %g, more "
@@ -1093,6 +1164,7 @@ static int finest_step(pd_mj *mj, pd_observer observer, void *ctx, pd_err *err)
     mj_adapt *ad = mj->ad;
     int n = mj->model->n, rc;
     double h = ad->lev[ad->L].h;
+    /* one step at the foot, no halves to compare */
     if ((rc = take_step(mj, ad->L, ad->cur, ad->two, err)))
         return rc;
     try_begin(ad, n);
@@ -1100,6 +1172,7 @@ static int finest_step(pd_mj *mj, pd_observer observer, void *ctx, pd_err *err)
     scan_impacts(mj, ad->cur, ad->two, h, 1.0);
     for (int i = 0; i < n; i++)
         if (ad->evmark[i] == ad->try_stamp) {
+            /* its events' bounds; beyond the event tolerance rtol is not met */
             ad->eps[i] += ad->bound[i];
             if (ad->eps[i] > ADAPT_KE * mj->opts.rtol * dof_scale(ad, i))
                 ad->stats.floor_hit = 1;
@@ -1119,14 +1192,16 @@ static int exact_flight(pd_mj *mj, int k, pd_observer observer, void *ctx, int *
     int rc;
     if ((rc = take_step(mj, k, ad->cur, ad->one, err)))
         return rc;
+    /* a contact predicted active: a try */
     if (ad->one->st.nactive > 0)
         return 0;
     try_begin(ad, mj->model->n);
     long before = ad->nmarked;
+    /* a grazing dip inside: a try */
     scan_dips(mj, ad->cur, ad->one, ad->lev[k].h);
     if (ad->nmarked > before)
         return 0;
-    *stop = keep(mj, ad->cur, ad->one, 0.0, 0, observer, ctx);
+    *stop = keep(mj, ad->cur, ad->one, 0.0, 0, observer, ctx); /* no error: f = 0 */
     swap(&ad->cur, &ad->one);
     return 1;
 }
@@ -1141,8 +1216,10 @@ int mj_adapt_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx,
         return rc;
     if (!ad->started) {
         ad->started = 1;
+        /* T: the first run's span, at least h0 */
         if (ad->span == 0.0)
             ad->span = fmax(t_end - ad->t_origin, ad->h0);
+        /* the reset state, reported once */
         if (observer && observer(&mj->st, ctx) > 0)
             return PD_OK;
     }
@@ -1156,6 +1233,7 @@ int mj_adapt_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx,
             k++;
             have_one = 0;
         }
+        /* at the foot: one step, no try */
         if (k >= ad->L) {
             if ((rc = finest_step(mj, observer, ctx, err)) < 0)
                 return rc;
@@ -1170,6 +1248,7 @@ int mj_adapt_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx,
         ad->deep = k + ADAPT_DEEP >= ad->L ? ad->deep + 1 : 0;
         int stuck = ad->deep > ADAPT_DEEP_MAX;
         ad->stats.floor_hit |= stuck;
+        /* max_evals spent: every try from here on is kept as it is */
         int budget = (double)ad->stats.evals >= mj->opts.max_evals;
         ad->stats.budget_hit |= budget;
         double H = ad->lev[k].h, h = ad->lev[k + 1].h;
@@ -1183,6 +1262,7 @@ int mj_adapt_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx,
             }
             have_one = 1;
         }
+        /* S1 = one step H (unless the last try left it), Sa and S2 = two steps h = H / 2 */
         if ((!have_one && (rc = take_step(mj, k, ad->cur, ad->one, err))) ||
             (rc = take_step(mj, k + 1, ad->cur, ad->half, err)) ||
             (rc = take_step(mj, k + 1, ad->half, ad->two, err)))
@@ -1192,11 +1272,13 @@ int mj_adapt_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx,
         int ev_half, event, cascade = scan_try(mj, h, &ev_half, &event);
         double r = try_error(mj, H);
         have_one = 0;
+        /* kept: within the tolerance without a cascade, or nothing finer to try */
         if ((r <= 1.0 && !cascade) || budget || stuck || k + 1 >= ad->L) {
             ad->stats.floor_hit |= (r > 1.0 || cascade) && !budget;
             if (!event)
-                note_rate(ad, n, H);
+                note_rate(ad, n, H); /* a smooth pair: its error constant */
             stop = keep_pair(mj, observer, ctx);
+            /* well within 2^-p of the tolerance: the step doubles */
             if (!event && r <= ADAPT_GROW / (ad->div + 1.0) && k > 0)
                 k--;
             if (stuck) {
@@ -1205,6 +1287,7 @@ int mj_adapt_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx,
             }
             continue;
         }
+        /* rejected: halve */
         ad->stats.rejected++;
         if (event && !ev_half) {
             /* the event lies in the second half: keep the first, try the second */
@@ -1229,8 +1312,9 @@ void mj_adapt_stats(const pd_mj *mj, pd_mj_stats *s)
     const mj_adapt *ad = mj->ad;
     *s = ad->stats;
     s->err_max = 0.0;
+    /* err_max = max_i (E_i + sqrt(S2_i)) / s_i */
     for (int i = 0; i < mj->model->n; i++)
         s->err_max = pd_max(s->err_max, (ad->E[i] + sqrt(ad->S2[i])) / dof_scale(ad, i));
     if (s->steps == 0)
-        s->h_min = s->h_max = NAN;
+        s->h_min = s->h_max = NAN; /* no step, no sizes */
 }

@@ -64,6 +64,7 @@ int pd_mjb_init(pd_mjb *b, const pd_mj_opts *opts, pd_mjb_force force, void *for
     b->force_ctx = force_ctx;
     b->next_event = LONG_MAX;
     b->lanes_step = lanes_step_for_cpu();
+    /* every lane idle until set */
     for (int l = 0; l < PD_MJB_LANES; l++)
         if ((rc = pd_mjb_set_lane(b, l, &idle_lane, err)))
             return rc;
@@ -80,6 +81,7 @@ static int check_lane(const pd_mjb_lane *ln, int l, pd_err *err)
     if (!(ln->h > 0.0) || !isfinite(ln->h) || isnan(ln->brk))
         return pd_err_set(err, PD_EINVAL, "batch: lane %d: h > 0 finite, a breakpoint "
                           "(INFINITY: none) needed", l);
+    /* W = 0 would make D = W^2 / What zero: a wall that never acts */
     if (ln->wall && (!isfinite(ln->W) || ln->W == 0.0 || !(ln->g0 >= 0.0) ||
                      !isfinite(ln->g0) || !(ln->e >= 0.0 && ln->e <= 1.0)))
         return pd_err_set(err, PD_EINVAL, "batch: lane %d: W finite and nonzero, g0 >= 0 "
@@ -93,8 +95,10 @@ static int check_lane(const pd_mjb_lane *ln, int l, pd_err *err)
 static long break_step(double brk, double h)
 {
     double tol = 1e-9 * h;
+    /* no breakpoint, or one before t = 0 */
     if (!isfinite(brk) || brk < -tol)
         return 0;
+    /* an estimate, then s corrected both ways by mj_break_at's own test brk <= s h + tol */
     double est = ceil((brk - tol) / h);
     long s = est < 1.0 ? 1 : (long)est;
     while (s > 1 && brk <= (double)(s - 1) * h + tol)
@@ -125,10 +129,11 @@ int pd_mjb_set_lane(pd_mjb *b, int l, const pd_mjb_lane *ln, pd_err *err)
     mj1_coef_setv(mjb_coef(b, l / MJ1_WIDTH), l % MJ1_WIDTH, &one, ln->h, b->theta, b->gamma);
     b->h[l] = ln->h;
     b->brk[l] = ln->brk;
-    b->t[l] = b->steps[l] = 0.0;
+    b->t[l] = b->steps[l] = 0.0; /* the lane's clock restarts at 0 */
     b->q[l] = b->v[l] = b->P[l] = 0.0;
-    b->g[l] = one.g0 + one.w * 0.0;
+    b->g[l] = one.g0 + one.w * 0.0; /* g0 + W q at q = 0, the step's expression */
     long s = break_step(ln->brk, ln->h);
+    /* the batch step at which the lane meets it (LONG_MAX: never) */
     b->brk_iter[l] = s > 0 && s <= LONG_MAX - b->iter ? b->iter + s : LONG_MAX;
     next_event(b);
     /* F(0+) for this lane: the force is asked for every lane at its clock */
@@ -148,6 +153,7 @@ static void step_clocks(pd_mjb *b)
         mj1_vec st, h;
         memcpy(&st, &b->steps[j * MJ1_WIDTH], sizeof st);
         memcpy(&h, &b->h[j * MJ1_WIDTH], sizeof h);
+        /* t = (steps + 1) h, not t + h: no drift, the clock of pd_mj to the bit */
         st += 1.0;
         mj1_vec t = st * h;
         memcpy(&b->steps[j * MJ1_WIDTH], &st, sizeof st);
@@ -163,11 +169,13 @@ void pd_mjb_breakpoints(pd_mjb *b)
     for (int l = 0; l < PD_MJB_LANES; l++) {
         if (b->brk_iter[l] != b->iter)
             continue;
+        /* mj_break_at on the lane's one breakpoint decides, as pd_mj's */
         int next = 0;
-        b->brk_iter[l] = LONG_MAX;
+        b->brk_iter[l] = LONG_MAX; /* met once */
         if (mj_break_at(&b->brk[l], 1, &next, b->t[l], 1e-9 * b->h[l]))
             any |= 1ULL << l;
     }
+    /* F(t+) asked once for every lane; the lanes on their breakpoint take it */
     if (any && b->force) {
         double Fr[PD_MJB_LANES];
         b->force(b->t, +1, Fr, b->force_ctx);
@@ -183,14 +191,15 @@ void pd_mjb_run(pd_mjb *b, long nsteps, pd_mjb_observer observer, void *ctx)
     if (!b)
         return;
     for (long n = 0; n < nsteps; n++) {
+        /* the lanes' t_k+1, F(t_k+1 -) for every lane, the step */
         step_clocks(b);
         if (b->force)
             b->force(b->t, -1, b->F1, b->force_ctx);
         else
-            memset(b->F1, 0, sizeof b->F1);
+            memset(b->F1, 0, sizeof b->F1); /* no force */
         b->lanes_step(b);
         b->iter++;
-        if (b->iter == b->next_event)
+        if (b->iter == b->next_event) /* one counter, not every lane */
             pd_mjb_breakpoints(b);
         if (observer && observer(b, ctx) > 0)
             return;

@@ -16,13 +16,13 @@ static inline void lanes_step(pd_mjb *b, int l)
     const double *cs = mj1_lanes_coef(b, l);
     lvec q = lload(&b->q[l]), v = lload(&b->v[l]), g = lload(&b->g[l]), P;
     lvec h = lload(&b->h[l]), F1 = lload(&b->F1[l]);
-    lvec Fth = mj1_lanes_fth(b->theta, lload(&b->F0[l]), F1);
-    mj1_lanes_step(1, &cs, b->theta, &h, &Fth, &q, &v, &g, &P, 0);
+    lvec Fth = mj1_lanes_fth(b->theta, lload(&b->F0[l]), F1); /* theta F1 + (1 - theta) F0 */
+    mj1_lanes_step(1, &cs, b->theta, &h, &Fth, &q, &v, &g, &P, 0); /* a wall per lane */
     lstore(&b->q[l], q);
     lstore(&b->v[l], v);
     lstore(&b->g[l], g);
     lstore(&b->P[l], P);
-    lstore(&b->F0[l], F1);
+    lstore(&b->F0[l], F1); /* unless a breakpoint replaces it */
 }
 
 /* Every lane one step. */

@@ -25,6 +25,7 @@
 #include <string.h>
 
 #include "mj.h"
+#include "pd_alloc.h"
 
 #define FL_TAYLOR_MAX 40 /* terms of the finest level's series, at most */
 
@@ -72,7 +73,7 @@ static void matmul(int na, const double *A, const double *B, double *C)
         for (int i = 0; i < na; i++) {
             double sum = 0.0;
             for (int l = 0; l < na; l++)
-                sum += A[i + (size_t)l * na] * B[l + (size_t)j * na];
+                sum += A[i + (size_t)l * na] * B[l + (size_t)j * na]; /* C_ij = sum_l A_il B_lj */
             C[i + (size_t)j * na] = sum;
         }
 }
@@ -95,7 +96,7 @@ static double norm1(int na, const double *A)
 static int find_root(int *parent, int i)
 {
     while (parent[i] != i)
-        i = parent[i] = parent[parent[i]];
+        i = parent[i] = parent[parent[i]]; /* path halving */
     return i;
 }
 
@@ -108,6 +109,7 @@ static void join_entries(const pd_matrix *A, int *parent)
             if (i == j || v == 0.0)
                 continue;
             int a = find_root(parent, i), b = find_root(parent, j);
+            /* the smaller root stays: a root is its block's smallest dof */
             if (a != b)
                 parent[a < b ? b : a] = a < b ? a : b;
         }
@@ -124,6 +126,7 @@ static int find_blocks(const pd_model *md, mj_flight *fl)
         goto done;
     for (int i = 0; i < n; i++)
         parent[i] = i;
+    /* union-find: each dof alone, then joined where M, C or K couples two */
     join_entries(&md->M, parent);
     join_entries(&md->C, parent);
     join_entries(&md->K, parent);
@@ -134,10 +137,12 @@ static int find_blocks(const pd_model *md, mj_flight *fl)
     if (!(fl->blocks = calloc((size_t)fl->nblocks, sizeof *fl->blocks)))
         goto done;
     for (int i = 0; i < n; i++) {
+        /* each dof's block, and its place there in increasing order */
         int b = first[find_root(parent, i)];
         fl->block_of[i] = b;
         fl->at[i] = fl->blocks[b].s++;
     }
+    /* the blocks' dof lists end to end in fl->dofs */
     for (int b = 0, off = 0; b < fl->nblocks; b++) {
         fl->blocks[b].dofs = fl->dofs + off;
         off += fl->blocks[b].s;
@@ -160,6 +165,7 @@ static int same_block(const pd_model *md, const pd_piecewise_force *F, const fl_
     for (int i = 0; i < a->s; i++) {
         if (F->b[a->dofs[i]] != F->b[b->dofs[i]])
             return 0;
+        /* M, C, K entry by entry, exactly: blocks alike share their tables bit for bit */
         for (int j = 0; j < a->s; j++) {
             int ai = a->dofs[i], aj = a->dofs[j], bi = b->dofs[i], bj = b->dofs[j];
             if (pd_matrix_get(&md->M, ai, aj) != pd_matrix_get(&md->M, bi, bj) ||
@@ -174,7 +180,7 @@ static int same_block(const pd_model *md, const pd_piecewise_force *F, const fl_
 /* A hash of a block's entries (blocks alike hash alike). */
 static uint64_t block_hash(const pd_model *md, const pd_piecewise_force *F, const fl_block *bl)
 {
-    uint64_t h = 1469598103934665603ull ^ (uint64_t)bl->s;
+    uint64_t h = 1469598103934665603ull ^ (uint64_t)bl->s; /* the size mixed in */
     for (int i = 0; i < bl->s; i++)
         for (int j = 0; j < bl->s; j++) {
             int di = bl->dofs[i], dj = bl->dofs[j];
@@ -183,7 +189,7 @@ static uint64_t block_hash(const pd_model *md, const pd_piecewise_force *F, cons
             for (int k = 0; k < 4; k++) {
                 uint64_t bits;
                 memcpy(&bits, &v[k], sizeof bits);
-                h = (h ^ bits) * 1099511628211ull;
+                h = (h ^ bits) * 1099511628211ull; /* FNV-1a's step over the entries' bits */
             }
         }
     return h;
@@ -206,6 +212,7 @@ static int augmented(const pd_model *md, const mj_flight *fl, const fl_block *bl
     for (int j = 0; j < s; j++)
         for (int i = 0; i < s; i++)
             LU[i + (size_t)j * s] = pd_matrix_get(&md->M, bl->dofs[i], bl->dofs[j]);
+    /* the block's M, LU with partial pivoting */
     int rc = pd_dense_lu(s, LU, s, perm, 1e-14);
     if (rc) {
         free(LU);
@@ -219,9 +226,11 @@ static int augmented(const pd_model *md, const mj_flight *fl, const fl_block *bl
         double *mj_col = kd->Minv + (size_t)j * s;
         for (int i = 0; i < s; i++)
             mj_col[i] = i == j ? 1.0 : 0.0;
+        /* M x = e_j: column j of M^-1 */
         pd_dense_lu_solve(s, LU, s, perm, mj_col);
     }
     for (int j = 0; j < s; j++) {
+        /* A~'s rows s..2 s - 1: -M^-1 K in the q columns, -M^-1 C in the v columns */
         for (int which = 0; which < 2; which++) {
             const pd_matrix *X = which ? &md->C : &md->K;
             for (int i = 0; i < s; i++) {
@@ -258,7 +267,7 @@ static double block_wmax(const fl_kind *kd, const double *A)
         double sum = 0.0;
         for (int j = 0; j < s; j++)
             sum += fabs(A[s + i + (size_t)j * na]);
-        best = fmax(best, sum);
+        best = fmax(best, sum); /* max row sum of |M^-1 K| >= rho(M^-1 K) = w_max^2 */
     }
     return sqrt(best);
 }
@@ -278,9 +287,10 @@ static int ladder(const mj_flight *fl, fl_kind *kd, const double *A, pd_err *err
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for a block's ladder");
     }
     /* the finest level: E = sum_j>=1 (A h)^j / j! */
-    double hf = fl->h[L + 1];
+    double hf = fl->h[L + 1]; /* h_L+1, the finest */
     for (size_t i = 0; i < nn; i++)
         E[i] = T[i] = A[i] * hf;
+    /* T = (A h)^j / j! added while it counts beyond 1e-18 of E, FL_TAYLOR_MAX terms at most */
     for (int j = 2; j <= FL_TAYLOR_MAX && norm1(na, T) > 1e-18 * fmax(norm1(na, E), 1e-300);
          j++) {
         matmul(na, T, A, U);
@@ -295,10 +305,12 @@ static int ladder(const mj_flight *fl, fl_kind *kd, const double *A, pd_err *err
                 kd->E[(size_t)k * lev + r + (size_t)c * rows] = E[r + (size_t)c * na];
         if (k == 0)
             break;
+        /* E_k-1 = exp(2 A~ h_k) - I = (I + E_k)^2 - I = 2 E_k + E_k^2 */
         matmul(na, E, E, U);
         for (size_t i = 0; i < nn; i++)
             E[i] = 2.0 * E[i] + U[i];
     }
+    /* an overflow at the coarse levels (large w h) refuses the run: a smaller h */
     int finite = 1;
     for (size_t i = 0; i < lev * (size_t)(L + 2); i++)
         finite &= isfinite(kd->E[i]);
@@ -326,6 +338,7 @@ static int impulse_responses(const mj_flight *fl, fl_kind *kd, pd_err *err)
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for a block's tables");
     kd->PQ = kd->PV + (size_t)(fl->L + 1) * ss;
     for (int k = 0; k <= fl->L; k++) {
+        /* h_k+1 = h_k / 2: Phi(h_k / 2) = I + E_k+1 */
         const double *E = level_E(kd, k + 1);
         double *PV = kd->PV + (size_t)k * ss, *PQ = kd->PQ + (size_t)k * ss;
         for (int j = 0; j < s; j++)
@@ -334,7 +347,7 @@ static int impulse_responses(const mj_flight *fl, fl_kind *kd, pd_err *err)
                 for (int l = 0; l < s; l++) {
                     double ml = kd->Minv[l + (size_t)j * s];
                     v += ((i == l ? 1.0 : 0.0) + E[s + i + (size_t)(s + l) * rows]) * ml;
-                    q += E[i + (size_t)(s + l) * rows] * ml;
+                    q += E[i + (size_t)(s + l) * rows] * ml; /* E_qv M^-1 */
                 }
                 PV[i + (size_t)j * s] = v;
                 PQ[i + (size_t)j * s] = q;
@@ -367,11 +380,12 @@ static int form_kinds(const pd_model *md, mj_flight *fl, pd_err *err)
         bl->kind = fl->nkinds;
         rep[fl->nkinds++] = b;
     }
+    /* each kind's tables, from its first block */
     for (int k = 0; k < fl->nkinds && !rc; k++) {
         const fl_block *bl = &fl->blocks[rep[k]];
         fl_kind *kd = &fl->kinds[k];
         kd->s = bl->s;
-        kd->na = 2 * bl->s + 4;
+        kd->na = 2 * bl->s + 4; /* q, v and the forcing's 4 states */
         size_t nn = (size_t)kd->na * kd->na;
         double *A = malloc(nn * sizeof(double));
         kd->Minv = malloc((size_t)bl->s * bl->s * sizeof(double));
@@ -382,6 +396,7 @@ static int form_kinds(const pd_model *md, mj_flight *fl, pd_err *err)
         if (!rc && !(kd->Av = malloc((size_t)bl->s * kd->na * sizeof(double))))
             rc = pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for a block's tables");
         if (!rc && !(rc = augmented(md, fl, bl, kd, A, err))) {
+            /* Av: A~'s v rows, the accelerations' map */
             for (int c = 0; c < kd->na; c++)
                 for (int i = 0; i < bl->s; i++)
                     kd->Av[i + (size_t)c * bl->s] = A[bl->s + i + (size_t)c * kd->na];
@@ -433,6 +448,7 @@ static int forcing_frequency(const pd_piecewise_force *F, double *w, pd_err *err
     *w = 0.0;
     for (int p = 0; p < F->npieces; p++) {
         const pd_sine_piece *pc = &F->pieces[p];
+        /* no sinusoid in this piece: any w */
         if (pc->A == 0.0)
             continue;
         if (*w != 0.0 && pc->w != *w)
@@ -454,27 +470,29 @@ int mj_flight_alloc(pd_mj *mj, const pd_piecewise_force *F, double h0, int L, pd
     fl->L = L;
     if ((rc = forcing_frequency(F, &fl->w, err)))
         return rc;
-    fl->h = malloc((size_t)3 * (L + 2) * sizeof(double));
+    fl->h = malloc((size_t)3 * (L + 2) * sizeof(double)); /* h, cm1, sw */
     fl->block_of = malloc((size_t)n * sizeof(int));
     fl->at = malloc((size_t)n * sizeof(int));
     fl->dofs = malloc((size_t)n * sizeof(int));
     fl->r = calloc((size_t)n, sizeof(double));
-    fl->pos = malloc((md->m > 0 ? (size_t)md->m : 1) * sizeof(int));
+    fl->pos = pd_malloc(md->m, sizeof(int));
     if (!fl->h || !fl->block_of || !fl->at || !fl->dofs || !fl->r || !fl->pos ||
         find_blocks(md, fl) ||
         !(fl->touched = calloc((size_t)fl->nblocks, sizeof(unsigned))) ||
-        !(fl->cmark = calloc(md->m > 0 ? (size_t)md->m : 1, sizeof(unsigned))))
+        !(fl->cmark = pd_calloc(md->m, sizeof(unsigned))))
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for its flights");
     fl->cm1 = fl->h + L + 2;
     fl->sw = fl->cm1 + L + 2;
     for (int k = 0; k <= L + 1; k++) {
         fl->h[k] = ldexp(h0, -k);
+        /* cos(w h) - 1 = -2 sin^2(w h / 2): no cancellation at small w h */
         double half = sin(0.5 * fl->w * fl->h[k]);
         fl->cm1[k] = -2.0 * half * half;
         fl->sw[k] = sin(fl->w * fl->h[k]);
     }
     for (int a = 0; a < md->m; a++)
         fl->pos[a] = -1;
+    /* x, dx and y: the largest block's augmented state, 2 smax + 4 each */
     int smax = 1;
     for (int b = 0; b < fl->nblocks; b++)
         smax = fl->blocks[b].s > smax ? fl->blocks[b].s : smax;
@@ -490,6 +508,7 @@ int mj_flight_alloc(pd_mj *mj, const pd_piecewise_force *F, double h0, int L, pd
 void mj_flight_z(const pd_mj *mj, int p, double t, double *z)
 {
     const pd_sine_piece *pc = &mj->fl->F->pieces[p];
+    /* z = [A sin(w t + phi), A cos(w t + phi), c0 + c1 (t - ts), c1] */
     double ph = pc->w * t + pc->phi;
     z[0] = pc->A * sin(ph);
     z[1] = pc->A * cos(ph);
@@ -505,6 +524,7 @@ double mj_flight_forcing_w(const pd_mj *mj)
 double mj_flight_wmax(const pd_mj *mj, int dof)
 {
     const mj_flight *fl = mj->fl;
+    /* the larger of the block's bound and the forcing's frequency */
     return fmax(fl->kinds[fl->blocks[fl->block_of[dof]].kind].wmax, fl->w);
 }
 
@@ -528,6 +548,7 @@ static void free_flight(const mj_flight *fl, const fl_block *bl, int k, const pd
         return;
     }
     for (int i = 0; i < s; i++) {
+        /* x = [q; v; z] of the block, dx = E_k x (its first 2 s rows) */
         x[i] = in->q[bl->dofs[i]];
         x[s + i] = in->v[bl->dofs[i]];
     }
@@ -537,12 +558,13 @@ static void free_flight(const mj_flight *fl, const fl_block *bl, int k, const pd
         dx[r] = 0.0;
     for (int c = 0; c < na; c++) {
         double xc = x[c];
-        if (xc == 0.0)
+        if (xc == 0.0) /* adds nothing: at rest, a zero of z */
             continue;
         for (int r = 0; r < rows; r++)
             dx[r] += E[r + (size_t)c * rows] * xc;
     }
     for (int i = 0; i < s; i++) {
+        /* x+ = x + E_k x: the increment keeps tiny steps exact */
         out->q[bl->dofs[i]] = x[i] + dx[i];
         out->v[bl->dofs[i]] = x[s + i] + dx[s + i];
     }
@@ -562,6 +584,7 @@ static double delassus(const pd_mj *mj, int k, int a, int b)
         const double *PV = kd->PV + (size_t)k * s * s;
         for (int q = in->ptr[b]; q < in->ptr[b + 1]; q++) {
             int j = in->dof[q];
+            /* PV is block diagonal: W_ia PV_ij W_jb for i, j in one block */
             if (fl->block_of[j] == bi)
                 sum += in->w[p] * PV[fl->at[i] + (size_t)fl->at[j] * s] * in->w[q];
         }
@@ -594,8 +617,9 @@ static void assemble_delassus(pd_mj *mj, int k, int nI)
     mj_flight *fl = mj->fl;
     const mj_incidence *in = &mj->inc;
     for (int r = 0; r < nI; r++)
-        fl->pos[mj->idx_active[r]] = r;
+        fl->pos[mj->idx_active[r]] = r; /* each active contact's row */
     if (!mj->sparse) {
+        /* D_rc = 0 unless r and c share a block */
         for (int c = 0; c < nI; c++)
             for (int r = 0; r < nI; r++)
                 mj->D_active[r + (size_t)c * nI] =
@@ -606,6 +630,8 @@ static void assemble_delassus(pd_mj *mj, int k, int nI)
         int nnz = 0;
         for (int c = 0; c < nI; c++) {
             int a = mj->idx_active[c], start = nnz;
+            /* column c: the active contacts on the blocks contact a
+             * touches, each block and each contact once (stamps) */
             unsigned stamp = ++fl->stamp;
             mj->D_colptr[c] = nnz;
             for (int p = in->ptr[a]; p < in->ptr[a + 1]; p++) {
@@ -625,6 +651,7 @@ static void assemble_delassus(pd_mj *mj, int k, int nI)
                     }
                 }
             }
+            /* rows increasing, as compressed columns have them */
             qsort(mj->D_rowind + start, (size_t)(nnz - start), sizeof(int), cmp_int);
             for (int e = start; e < nnz; e++)
                 mj->D_active[e] = delassus(mj, k, mj->idx_active[mj->D_rowind[e]], a);
@@ -632,7 +659,7 @@ static void assemble_delassus(pd_mj *mj, int k, int nI)
         mj->D_colptr[nI] = nnz;
     }
     for (int r = 0; r < nI; r++)
-        fl->pos[mj->idx_active[r]] = -1;
+        fl->pos[mj->idx_active[r]] = -1; /* clean for the next step */
 }
 
 /* The impulses' response at mid-step: v += Phi_vv(h/2) M^-1 W P, q +=
@@ -641,7 +668,7 @@ static void apply_impulses(pd_mj *mj, int k, int nI, pd_state *out)
 {
     mj_flight *fl = mj->fl;
     const mj_incidence *in = &mj->inc;
-    fl->stamp++;
+    fl->stamp++; /* each block once */
     for (int c = 0; c < nI; c++) { /* r = W P on the dofs */
         int a = mj->idx_active[c];
         for (int p = in->ptr[a]; p < in->ptr[a + 1]; p++)
@@ -657,6 +684,7 @@ static void apply_impulses(pd_mj *mj, int k, int nI, pd_state *out)
             const fl_block *bl = &fl->blocks[bi];
             const fl_kind *kd = &fl->kinds[bl->kind];
             int s = bl->s;
+            /* q += PQ_k r, v += PV_k r on the block, then r back to 0 */
             const double *PV = kd->PV + (size_t)k * s * s, *PQ = kd->PQ + (size_t)k * s * s;
             for (int i = 0; i < s; i++) {
                 double dq = 0.0, dv = 0.0;
@@ -689,11 +717,14 @@ static void hold_gaps(pd_mj *mj, int nI, const pd_state *in, pd_state *out)
     for (int sweep = 0; sweep < FL_HOLD_SWEEPS; sweep++)
         for (int r = 0; r < nI; r++) {
             int a = mj->idx_active[r];
+            /* held: pushing, and shut at the start */
             if (!(out->P[a] > 0.0) || in->g[a] > 0.0)
                 continue;
+            /* d: back to the gap at the step's start */
             double g = md->g0[a] + mj_inc_dot(inc, a, out->q), d = in->g[a] - g;
             if (d == 0.0 || !(mj->D0[a] > 0.0))
                 continue;
+            /* q += M^-1 W_a d / D0_a moves the gap by d (M^-1 by its diagonal) */
             for (int j = inc->ptr[a]; j < inc->ptr[a + 1]; j++)
                 out->q[inc->dof[j]] += mj->minv[inc->dof[j]] * inc->w[j] * d / mj->D0[a];
         }
@@ -713,6 +744,7 @@ void mj_flight_acc(const pd_mj *mj, const pd_state *st, const double *z, double 
                        kd->Av[i + (size_t)(s + l) * s] * st->v[bl->dofs[l]];
             for (int c = 0; c < 4; c++)
                 sum += kd->Av[i + (size_t)(2 * s + c) * s] * z[c];
+            /* a = Av [q; v; z] = -M^-1 (K q + C v) + M^-1 b f */
             acc[bl->dofs[i]] = sum;
         }
     }
@@ -730,6 +762,8 @@ int mj_flight_step(pd_mj *mj, int k, double t1, const pd_state *in, const double
         mj->U0[a] = mj_inc_dot(&mj->inc, a, in->v);
     for (int b = 0; b < fl->nblocks; b++)
         free_flight(fl, &fl->blocks[b], k, in, zin, out);
+    /* z: the sinusoid turned by w h, (z0, z1) += (cos - 1)
+     * (z0, z1) + sin (z1, -z0); the line advanced */
     double z0 = zin[0], z1 = zin[1];
     zout[0] = z0 + fl->cm1[k] * z0 + fl->sw[k] * z1;
     zout[1] = z1 + fl->cm1[k] * z1 - fl->sw[k] * z0;
@@ -750,6 +784,7 @@ int mj_flight_step(pd_mj *mj, int k, double t1, const pd_state *in, const double
         /* an opening contact (faster than u_rest) left open by the free flight
          * takes no impulse: if an impulse of this step makes it close, the
          * next step's is its own impact (the references' next stage) */
+        /* opening: U_k above its rest speed, and the free flight did not close it */
         int opening = mj->U0[a] > mj->u_rest[a] && g_end >= g_start;
         if ((g_start <= mj->opts.sim_gap || g_end <= 0.0) && !opening) {
             out->active[a] = 1;
@@ -760,6 +795,7 @@ int mj_flight_step(pd_mj *mj, int k, double t1, const pd_state *in, const double
     }
     out->nactive = nI;
     if (nI > 0) {
+        /* D = W_I^T Phi_vv(h/2) M^-1 W_I and b = W_I^T v_free + e U_k; the impulses at mid-step */
         assemble_delassus(mj, k, nI);
         mj_active_rhs(mj, nI, out->v);
         if ((rc = mj_solve_active(mj, nI, t1, out, err)))

@@ -8,6 +8,7 @@ int pd_model_check(const pd_model *model, pd_err *err)
     int st;
     if (!model || model->n <= 0 || model->m < 0)
         return pd_err_set(err, PD_EINVAL, "model: needs n > 0 degrees of freedom and m >= 0 contacts");
+    /* every method inverts or factors M */
     if (model->M.kind == PD_MATRIX_ZERO)
         return pd_err_set(err, PD_EINVAL, "model: the mass matrix M must be given");
     if ((st = pd_matrix_check(&model->M, model->n, model->n, "M", err)) ||
@@ -17,16 +18,18 @@ int pd_model_check(const pd_model *model, pd_err *err)
     if (model->nbreaks < 0 || (model->nbreaks > 0 && !model->breaks))
         return pd_err_set(err, PD_EINVAL, "model: %d breakpoints without their times",
                           model->nbreaks);
+    /* strictly increasing: each breakpoint is passed once */
     for (int k = 0; k < model->nbreaks; k++)
         if (!isfinite(model->breaks[k]) || (k > 0 && !(model->breaks[k] > model->breaks[k - 1])))
             return pd_err_set(err, PD_EINVAL, "model: breakpoints must be finite and increasing");
-    if (model->m == 0)
+    if (model->m == 0) /* no contact: W, g0 and e unused */
         return PD_OK;
     if ((st = pd_matrix_check(&model->W, model->n, model->m, "W", err)))
         return st;
     if (!model->g0 || !model->e)
         return pd_err_set(err, PD_EINVAL, "model: gaps g0 and restitution e are required");
     for (int a = 0; a < model->m; a++) {
+        /* no contact starts penetrated; e in [0, 1]: Newton's law never creates energy */
         if (!(model->g0[a] >= 0.0) || !isfinite(model->g0[a]))
             return pd_err_set(err, PD_EINVAL, "model: gap of contact %d is %g, must be >= 0", a,
                               model->g0[a]);
@@ -41,6 +44,7 @@ int pd_model_check(const pd_model *model, pd_err *err)
 long pd_steps_for(double tend, double h)
 {
     double r = tend / h, k = floor(r + 0.5);
+    /* tend / h within 1e-9 of a whole k: k steps; else the steps that pass tend */
     if (fabs(r - k) <= 1e-9 * fmax(1.0, r))
         return (long)k;
     return (long)ceil(r);

@@ -54,16 +54,16 @@ static inline void pd_factor_solve(const pd_factor *f, double *x) { f->type->sol
 static inline void pd_factor_add_impulse(const pd_factor *f, const int *idx, int nI,
                                          const double *P, double *v)
 {
-    f->type->add_impulse(f, idx, nI, P, v);
+    f->type->add_impulse(f, idx, nI, P, v); /* v += What^-1 W_I P */
 }
 static inline void pd_factor_delassus_dense(const pd_factor *f, const int *idx, int nI, double *D)
 {
-    f->type->delassus_dense(f, idx, nI, D);
+    f->type->delassus_dense(f, idx, nI, D); /* D_II = W_I^T What^-1 W_I */
 }
 static inline int pd_factor_delassus_csc(const pd_factor *f, const int *idx, int nI, int *colptr,
                                          int *rowind, double *values)
 {
-    return f->type->delassus_csc(f, idx, nI, colptr, rowind, values);
+    return f->type->delassus_csc(f, idx, nI, colptr, rowind, values); /* its entries */
 }
 
 /* ---- helpers the dense kinds share (factor.c) ------------------------------ */

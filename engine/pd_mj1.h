@@ -34,13 +34,13 @@ typedef struct mj1_coef {
 static inline mj1_coef mj1_coef_make(double M, double C, double K, int wall, double W, double g0,
                                      double e, double h, double th)
 {
-    double what = M + h * th * C + h * h * th * th * K;
+    double what = M + h * th * C + h * h * th * th * K; /* What */
     mj1_coef s = {.c = C, .k = K, .w = wall ? W : 0.0, .e = wall ? e : 0.0,
                   .g0 = wall ? g0 : 0.0, .wall = wall != 0};
-    s.winv = s.w / what;
-    double del = s.w * s.winv;
+    s.winv = s.w / what; /* W^ = W / What */
+    double del = s.w * s.winv; /* D = W W^ */
     s.whatinv = 1.0 / what;
-    s.delinv = del != 0.0 ? 1.0 / del : 0.0;
+    s.delinv = del != 0.0 ? 1.0 / del : 0.0; /* 1 / D, 0 without a wall */
     return s;
 }
 
@@ -60,19 +60,19 @@ static inline int mj1_step(double h, double th, double hgamma, const mj1_coef *s
 {
     double q0 = *q, v0 = *v, imp = 0.0;
     double Fth = mj1_fth(th, F0, F1);
-    double rhs = h * (Fth - s->c * v0 - s->k * (q0 + h * th * v0));
-    double vnew = v0 + rhs * s->whatinv;
-    double U0 = s->w * v0;
-    int active = s->wall && *g + hgamma * U0 <= 0.0;
+    double rhs = h * (Fth - s->c * v0 - s->k * (q0 + h * th * v0)); /* h (F_th - C v - K q_th) */
+    double vnew = v0 + rhs * s->whatinv; /* vfree */
+    double U0 = s->w * v0; /* U_k = W v_k */
+    int active = s->wall && *g + hgamma * U0 <= 0.0; /* g + h gamma U <= 0 */
     if (active) {
         double b = s->w * vnew + s->e * U0; /* the scalar LCP, closed form */
         imp = b < 0.0 ? -b * s->delinv : 0.0;
-        vnew += s->winv * imp;
+        vnew += s->winv * imp; /* v+ = vfree + W^ P */
     }
-    double qnew = q0 + h * (th * vnew + (1.0 - th) * v0);
+    double qnew = q0 + h * (th * vnew + (1.0 - th) * v0); /* q+ */
     *q = qnew;
     *v = vnew;
-    *g = s->g0 + s->w * qnew;
+    *g = s->g0 + s->w * qnew; /* g+ = g0 + W q+ */
     *P = imp;
     return active;
 }
@@ -111,7 +111,7 @@ static inline void mj1_coef_setv(mj1_coefv *s, int i, const mj1_coef *one, doubl
     s->g0[i] = one->g0;
     s->whatinv[i] = one->whatinv;
     s->winv[i] = one->winv;
-    s->ndelinv[i] = -one->delinv;
+    s->ndelinv[i] = -one->delinv; /* -1/D: the impulse as a product */
     s->hth[i] = h * th;
     s->hgamma[i] = h * gamma;
     s->wall[i] = one->wall ? -1 : 0;
@@ -168,7 +168,7 @@ mj1_run(const mj1_coef *s, double h, double th, double gamma, double t0, const d
         int nbreaks, long nsteps, mj1_state *x, mj1_force_fn force, mj1_observe_fn observe,
         void *ctx, pd_err *err)
 {
-    const double hgamma = h * gamma, tol = 1e-9 * h;
+    const double hgamma = h * gamma, tol = 1e-9 * h; /* tol: a breakpoint this near t1 is on it */
     const long k0 = x->step;
     mj1_state y = *x; /* in registers */
     double F[MJ1_FORCE_AHEAD];

@@ -95,6 +95,7 @@ mj1_lanes_step(int n, const double *const *cs, double th, const lvec *h, const l
 {
     const lvec zero = {0.0};
     const size_t W = MJ1_WIDTH; /* one constant's lanes in the group */
+    /* cs[i] + k W: constant k of mj1_coefv (c k w e g0 whatinv winv ndelinv hth hgamma wall) */
     lvec rhs[8], vfree[8], U0[8], bb[8];
     lcond active[8], wall[8];
     lmask wm[8];
@@ -127,6 +128,7 @@ mj1_lanes_step(int n, const double *const *cs, double th, const lvec *h, const l
         MJ1_EACH(n, P[i] = LKEEP(active[i], LMAX(bb[i] * lload(cs[i] + 7 * W), zero)))
         MJ1_EACH(n, vfree[i] = LSEL(active[i], vfree[i] + lload(cs[i] + 6 * W) * P[i], vfree[i]))
     }
+    /* q+ = q + h (theta v+ + (1 - theta) v), then v+ and g+ = g0 + W q+ */
     MJ1_EACH(n, q[i] = q[i] + h[i] * (th * vfree[i] + (1.0 - th) * v[i]))
     MJ1_EACH(n, v[i] = vfree[i])
     if (!unit_w)
@@ -141,7 +143,7 @@ mj1_lanes_step(int n, const double *const *cs, double th, const lvec *h, const l
 static inline void mj1_lanes_far_wall(pd_mjb *b, int l)
 {
     mj1_coefv *s = (mj1_coefv *)(void *)b->coef + l / MJ1_WIDTH;
-    s->g0[l % MJ1_WIDTH] = INFINITY;
+    s->g0[l % MJ1_WIDTH] = INFINITY; /* g0 - q = +inf > 0: never active */
     b->g[l] = INFINITY;
 }
 

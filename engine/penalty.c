@@ -28,6 +28,7 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_odeiv2.h>
 
+#include "pd_alloc.h"
 #include "pd_core.h"
 #include "pd_engine.h"
 #include "pd_factor.h"
@@ -112,6 +113,7 @@ static int check_opts(pen *p, double t0, double t1, pd_err *err)
     int rc = pd_penalty_check_opts(o, t0, t1, "penalty", err);
     if (rc)
         return rc;
+    /* GSL's tolerances: the adaptive steppers' own */
     if (!(o->rtol > 0.0) || !isfinite(o->rtol) || !(o->atol > 0.0) || !isfinite(o->atol))
         return pd_err_set(err, PD_EINVAL, "penalty: rtol and atol must be > 0 (got %g, %g)",
                           o->rtol, o->atol);
@@ -126,13 +128,13 @@ static int check_opts(pen *p, double t0, double t1, pd_err *err)
 pd_penalty_opts pd_penalty_default_opts(void)
 {
     return (pd_penalty_opts){.law = PD_PENALTY_KELVIN,
-                             .kc = 0.0,
+                             .kc = 0.0, /* no default: refused until set */
                              .rtol = 1e-10,
                              .atol = 1e-12,
                              .stepper = "rk8pd",
                              .h = 0.0,
                              .h_out = 0.0,
-                             .max_steps = 100000000L,
+                             .max_steps = 100000000L, /* accepted steps */
                              .time_unit = 1.0,
                              .on_step = NULL,
                              .on_step_ctx = NULL,
@@ -179,17 +181,19 @@ static void pen_free(pen *p)
 /* Every array, sized once for (n, m). */
 static int alloc_arrays(pen *p)
 {
-    size_t n = (size_t)p->n, m = p->m > 0 ? (size_t)p->m : 1, d = p->dim;
+    size_t n = (size_t)p->n, d = p->dim;
+    int m = p->m;
+    /* the Jacobian's blocks for the implicit steppers only */
     size_t nn = p->stp->implicit ? n * n : 1;
-    p->cd = calloc(m, sizeof(double));
-    p->sa = calloc(m, sizeof(double));
+    p->cd = pd_calloc(m, sizeof(double));
+    p->sa = pd_calloc(m, sizeof(double));
     p->fa = calloc(d, sizeof(double));
     p->fb = calloc(d, sizeof(double));
     p->fo = calloc(d, sizeof(double));
     p->fp = calloc(d, sizeof(double));
-    p->mode = calloc(m, 1);
+    p->mode = pd_calloc(m, 1);
     p->F = calloc(n, sizeof(double));
-    p->lam = calloc(m, sizeof(double));
+    p->lam = pd_calloc(m, sizeof(double));
     p->col = calloc(n, sizeof(double));
     p->Aq = calloc(nn, sizeof(double));
     p->Av = calloc(nn, sizeof(double));
@@ -198,15 +202,15 @@ static int alloc_arrays(pen *p)
     p->yt = calloc(d, sizeof(double));
     p->yo = calloc(d, sizeof(double));
     p->ys = calloc(d, sizeof(double));
-    p->ga = calloc(m, sizeof(double));
-    p->Ua = calloc(m, sizeof(double));
+    p->ga = pd_calloc(m, sizeof(double));
+    p->Ua = pd_calloc(m, sizeof(double));
     p->st.q = calloc(n, sizeof(double));
     p->st.acc = calloc(n, sizeof(double));
     p->acc_work = calloc(d, sizeof(double));
     p->st.v = calloc(n, sizeof(double));
-    p->st.P = calloc(m, sizeof(double));
-    p->st.g = calloc(m, sizeof(double));
-    p->st.active = calloc(m, 1);
+    p->st.P = pd_calloc(m, sizeof(double));
+    p->st.g = pd_calloc(m, sizeof(double));
+    p->st.active = pd_calloc(m, 1);
     return p->cd && p->sa && p->fa && p->fb && p->fo && p->fp && p->mode && p->F && p->lam && p->col && p->Aq && p->Av &&
                    p->y && p->ya && p->yt && p->yo && p->ys && p->ga && p->Ua && p->st.q && p->st.acc && p->acc_work && p->st.v &&
                    p->st.P && p->st.g && p->st.active
@@ -219,7 +223,7 @@ static void mass_solve(const pen *p, double *x)
 {
     if (p->minv)
         for (int i = 0; i < p->n; i++)
-            x[i] *= p->minv[i];
+            x[i] *= p->minv[i]; /* M diagonal: entrywise */
     else
         pd_factor_solve(p->fac, x);
 }
@@ -229,6 +233,7 @@ static double inverse_mass(pen *p, int a)
 {
     double s = 0.0;
     if (!p->minv) {
+        /* D_aa = W_a^T M^-1 W_a from the factor of What(h = 0) = M */
         pd_factor_delassus_dense(p->fac, &a, 1, &s);
         return s;
     }
@@ -252,6 +257,7 @@ static int setup_mass(pen *p, pd_err *err)
             return pd_err_set(err, PD_ENOMEM, "penalty: out of memory for n = %d", p->n);
         for (int i = 0; i < p->n; i++) {
             double Mii = pd_matrix_get(&md->M, i, i);
+            /* a mass must be positive */
             if (!(Mii > 0.0))
                 return pd_err_set(err, PD_ESINGULAR, "penalty: the mass matrix M is singular");
             p->minv[i] = 1.0 / Mii;
@@ -262,12 +268,14 @@ static int setup_mass(pen *p, pd_err *err)
                    ? pd_err_set(err, PD_ESINGULAR, "penalty: the mass matrix M is singular")
                    : err->status;
     for (int a = 0; a < p->m; a++) {
+        /* s_a = W_a^T M^-1 W_a = 1 / m_a, the contact's inverse effective mass */
         double s = inverse_mass(p, a);
         p->sa[a] = s;
         if (!(s > 0.0) || !isfinite(s))
             return pd_err_set(err, PD_EINVAL,
                               "penalty: contact %d has no effective mass (W_a^T M^-1 W_a = %g)",
                               a, s);
+        /* c_a = 2 zeta(e) sqrt(kc m_a); Hertz-damp's waits for the approach speed */
         if (p->o.law == PD_PENALTY_KELVIN)
             p->cd[a] = pd_kelvin_damping(p->o.kc, md->e[a], 1.0 / s);
     }
@@ -297,6 +305,7 @@ static double element_force(const pen *p, int a, double d, double dd)
 /* lambda of every contact at (q, v) under the engaged set (0 if released). */
 static void contact_forces(const pen *p, const double *q, const double *v, double *lam)
 {
+    /* d = -g_a, d' = -U_a */
     for (int a = 0; a < p->m; a++)
         lam[a] = p->mode[a] ? element_force(p, a, -gap_of(p, a, q), -rate_of(p, a, v)) : 0.0;
 }
@@ -317,6 +326,7 @@ static int rhs_value(pen *p, double t, const double y[], double dydt[])
     int n = p->n;
     const double *q = y, *v = y + n;
     double *r = dydt + n;
+    /* r = F - C v - K q + W lambda, then M^-1 r */
     force_at(p, t, r);
     pd_matrix_gemv(&md->C, -1.0, v, 1.0, r);
     pd_matrix_gemv(&md->K, -1.0, q, 1.0, r);
@@ -325,7 +335,7 @@ static int rhs_value(pen *p, double t, const double y[], double dydt[])
         pd_matrix_gemv(&md->W, 1.0, p->lam, 1.0, r);
     }
     mass_solve(p, r);
-    memmove(dydt, v, (size_t)n * sizeof(double));
+    memmove(dydt, v, (size_t)n * sizeof(double)); /* q' = v */
     for (size_t i = 0; i < p->dim; i++)
         if (!isfinite(dydt[i]))
             return GSL_ERANGE; /* an overflowing trial step: retried smaller */
@@ -336,7 +346,7 @@ static int rhs_value(pen *p, double t, const double y[], double dydt[])
 static int rhs(double t, const double y[], double dydt[], void *params)
 {
     pen *p = params;
-    p->res.rhs++;
+    p->res.rhs++; /* every evaluation, probes included */
     return rhs_value(p, t, y, dydt);
 }
 
@@ -353,6 +363,7 @@ static void stiffness_blocks(pen *p, const double *q, const double *v)
     int n = p->n;
     pd_matrix_to_dense(&md->K, p->Aq);
     pd_matrix_to_dense(&md->C, p->Av);
+    /* -K and -C */
     for (size_t k = 0; k < (size_t)n * n; k++) {
         p->Aq[k] = -p->Aq[k];
         p->Av[k] = -p->Av[k];
@@ -361,9 +372,11 @@ static void stiffness_blocks(pen *p, const double *q, const double *v)
         double kd, cdd;
         if (!p->mode[a])
             continue;
+        /* kd = dlambda/dd, cdd = dlambda/dd'; d = -W_a^T q, so d(W_a lambda)/dq = -kd W_a W_a^T */
         element_slopes(p, a, -gap_of(p, a, q), -rate_of(p, a, v), &kd, &cdd);
         memset(p->col, 0, (size_t)n * sizeof(double));
         pd_matrix_col_axpy(&md->W, a, 1.0, p->col); /* W_a, dense */
+        /* column j of W_a W_a^T is W_ja W_a */
         for (int j = 0; j < n; j++)
             if (p->col[j] != 0.0) {
                 pd_matrix_col_axpy(&md->W, a, -kd * p->col[j], p->Aq + (size_t)j * n);
@@ -377,12 +390,14 @@ static void force_rate(pen *p, double t, double *dF)
 {
     double dt = 1e-6 * fmax(1.0, fabs(t));
     double tc = fmin(fmax(t, p->seg_lo + dt), p->seg_hi - dt);
+    /* a segment shorter than 2 dt: dF/dt taken as 0 */
     if (!(p->seg_hi - p->seg_lo > 2.0 * dt)) {
         memset(dF, 0, (size_t)p->n * sizeof(double));
         return;
     }
     force_at(p, tc + dt, dF);
     force_at(p, tc - dt, p->col);
+    /* (F(t + dt) - F(t - dt)) / (2 dt) */
     for (int i = 0; i < p->n; i++)
         dF[i] = (dF[i] - p->col[i]) / (2.0 * dt);
 }
@@ -394,9 +409,11 @@ static int jacobian(double t, const double y[], double *dfdy, double dfdt[], voi
     int n = p->n;
     size_t dim = p->dim;
     memset(dfdy, 0, dim * dim * sizeof(double));
+    /* GSL's dfdy is row-major: row i, column n + i is dq'/dv = I */
     for (int i = 0; i < n; i++)
         dfdy[(size_t)i * dim + (size_t)(n + i)] = 1.0;
     stiffness_blocks(p, y, y + n);
+    /* rows n..2 n - 1: M^-1 Aq, then M^-1 Av, a column at a time */
     for (int blk = 0; blk < 2; blk++)
         for (int j = 0; j < n; j++) {
             const double *A = blk ? p->Av : p->Aq;
@@ -405,6 +422,7 @@ static int jacobian(double t, const double y[], double *dfdy, double dfdt[], voi
             for (int i = 0; i < n; i++)
                 dfdy[(size_t)(n + i) * dim + (size_t)(blk * n + j)] = p->col[i];
         }
+    /* df/dt = (0, M^-1 dF/dt) */
     force_rate(p, t, dfdt + n);
     for (int i = 0; i < n; i++)
         dfdt[i] = 0.0;
@@ -415,11 +433,12 @@ static int jacobian(double t, const double y[], double *dfdy, double dfdt[], voi
 /* Main and probe integrators (step, control, evolve), allocated once. */
 static int alloc_drivers(pen *p, double span, pd_err *err)
 {
-    double h0 = span > 0.0 ? 1e-3 * span : 1.0;
+    double h0 = span > 0.0 ? 1e-3 * span : 1.0; /* GSL's first try */
     p->sys.function = rhs;
     p->sys.jacobian = jacobian;
     p->sys.dimension = p->dim;
     p->sys.params = p;
+    /* error control on y: atol + rtol |y_i| per component */
     p->main_drv = gsl_odeiv2_driver_alloc_y_new(&p->sys, *p->stp->type, h0, p->o.atol, p->o.rtol);
     p->probe_drv =
         gsl_odeiv2_driver_alloc_y_new(&p->sys, *p->stp->probe, h0, p->o.atol, p->o.rtol);
@@ -458,12 +477,14 @@ static int evolve_once(pen *p, gsl_odeiv2_driver *d, double *t, double tb, doubl
     for (int tries = 0; tries < 30; tries++) {
         int s = gsl_odeiv2_evolve_apply(d->e, d->c, d->s, &p->sys, t, tb, h, y);
         int finite = 1;
+        /* GSL's error control may accept a non-finite state */
         for (size_t i = 0; i < p->dim && !s; i++)
             finite = finite && isfinite(y[i]);
         if (!s && finite)
             return PD_OK;
-        if (s && s != GSL_ERANGE)
+        if (s && s != GSL_ERANGE) /* a failure of its own */
             return gsl_failure(p, s, t_in, err);
+        /* undone: state, time and the stepper's memory; h / 10 */
         memcpy(y, p->ys, p->dim * sizeof(double));
         *t = t_in;
         *h *= 0.1;
@@ -479,7 +500,7 @@ static int evolve_once(pen *p, gsl_odeiv2_driver *d, double *t, double tb, doubl
 static int probe(pen *p, double ta, const double *ya, double tb, double *yb, pd_err *err)
 {
     gsl_odeiv2_driver *d = p->probe_drv;
-    double t = ta, h = tb - ta;
+    double t = ta, h = tb - ta; /* first try: the whole span */
     memcpy(yb, ya, p->dim * sizeof(double));
     gsl_odeiv2_evolve_reset(d->e);
     gsl_odeiv2_step_reset(d->s);
@@ -487,6 +508,7 @@ static int probe(pen *p, double ta, const double *ya, double tb, double *yb, pd_
     p->probe_f = 0;
     while (t < tb && !rc)
         rc = evolve_once(p, d, &t, tb, &h, yb, err);
+    /* y' at tb from the stepper, where exact: one evaluation saved */
     if (!rc && t > ta && (*p->stp->probe)->gives_exact_dydt_out) {
         memcpy(p->fp, d->e->dydt_out, p->dim * sizeof(double));
         p->probe_f = 1;
@@ -502,7 +524,7 @@ static void fill_state(pen *p, double t, const double *y)
     int n = p->n;
     memcpy(p->st.q, y, (size_t)n * sizeof(double));
     memcpy(p->st.v, y + n, (size_t)n * sizeof(double));
-    contact_forces(p, y, y + n, p->st.P);
+    contact_forces(p, y, y + n, p->st.P); /* P holds the forces lambda */
     p->st.nactive = 0;
     for (int a = 0; a < p->m; a++) {
         p->st.g[a] = gap_of(p, a, y);
@@ -530,6 +552,7 @@ static void notify_step(pen *p, double t, const double *f)
     if (!p->o.on_step || p->stopped)
         return;
     fill_state(p, t, p->y);
+    /* acc: the v part of y', the caller's f or one evaluation */
     p->st.has_acc = f || rhs(t, p->y, p->acc_work, p) == GSL_SUCCESS;
     if (p->st.has_acc)
         memcpy(p->st.acc, (f ? f : p->acc_work) + p->n, (size_t)p->n * sizeof(double));
@@ -552,8 +575,9 @@ static int outputs_inside(pen *p, double ta, double tb, pd_err *err)
     memcpy(p->yo, p->ya, p->dim * sizeof(double));
     while (!p->stopped && out_time(p, p->next_out) < tb - tol) {
         double tk = out_time(p, p->next_out++);
-        if (tk <= tprev)
+        if (tk <= tprev) /* at the start: already given */
             continue;
+        /* from the last output: the probes chain, the step untouched */
         memcpy(p->yt, p->yo, p->dim * sizeof(double));
         if ((rc = probe(p, tprev, p->yt, tk, p->yo, err)))
             return rc;
@@ -582,6 +606,7 @@ static void output_at_end(pen *p, double tb)
 static double hermite(double f0, double d0, double f1, double d1, double h, double s)
 {
     double x = s / h, x2 = x * x, x3 = x2 * x;
+    /* h00 f0 + h10 h d0 + h01 f1 + h11 h d1 */
     return (2 * x3 - 3 * x2 + 1) * f0 + (x3 - 2 * x2 + x) * h * d0 + (-2 * x3 + 3 * x2) * f1 +
            (x3 - x2) * h * d1;
 }
@@ -595,12 +620,14 @@ static int hermite_critical(double f0, double d0, double f1, double d1, double h
     double A = 3.0 * (d0 + d1 - 2.0 * D), B = 2.0 * (3.0 * D - 2.0 * d0 - d1), C = d0;
     double r[2];
     int nr = 0, k = 0;
+    /* A = 0 to rounding: a linear slope */
     if (fabs(A) <= 1e-14 * (fabs(B) + fabs(C))) {
         if (B != 0.0)
             r[nr++] = -C / B;
     } else {
         double disc = B * B - 4.0 * A * C;
         if (disc >= 0.0) {
+            /* roots qq / A and C / qq: no cancellation */
             double sq = sqrt(disc), qq = -0.5 * (B + (B >= 0.0 ? sq : -sq));
             if (qq != 0.0) {
                 r[nr++] = qq / A;
@@ -608,6 +635,7 @@ static int hermite_critical(double f0, double d0, double f1, double d1, double h
             }
         }
     }
+    /* interior points only */
     for (int i = 0; i < nr; i++)
         if (r[i] > 0.0 && r[i] < 1.0)
             s[k++] = r[i] * h;
@@ -630,6 +658,7 @@ static double quintic_min(const double e0[3], const double e1[3], double h)
     for (int k = 1; k <= 16; k++) {
         double s1 = h * k / 16.0;
         quintic(e0, e1, h, s1, &d1);
+        /* the slope turns upward: a minimum, bisected on the slope */
         if (d0 < 0.0 && d1 >= 0.0) {
             double lo = s0, hi = s1;
             for (int it = 0; it < 60; it++) {
@@ -652,6 +681,7 @@ static void step_rates(pen *p, double ta, double tb)
 {
     const gsl_odeiv2_evolve *e = p->main_drv->e;
     const gsl_odeiv2_step_type *T = *p->stp->type;
+    /* GSL's own evaluations when the stepper keeps them */
     if (T->can_use_dydt_in)
         memcpy(p->fa, e->dydt_in, p->dim * sizeof(double));
     else
@@ -673,6 +703,7 @@ static void phi_jets(const pen *p, int a, double e0[3], double e1[3])
 {
     double sg = phi_sign(p, a);
     int n = p->n;
+    /* phi = sigma g, phi' = sigma U, phi'' = sigma W^T a */
     e0[0] = sg * p->ga[a];
     e0[1] = sg * p->Ua[a];
     e0[2] = sg * rate_of(p, a, p->fa + n);
@@ -692,11 +723,12 @@ static int tolerable(const pen *p, int a, double dep, double r, double h)
 {
     double kc = p->o.kc, ar = fabs(r);
     dep = fabs(dep);
-    if (!(dep <= p->o.atol))
+    if (!(dep <= p->o.atol)) /* deeper than atol: located */
         return 0;
     double lam = p->o.law == PD_PENALTY_KELVIN ? kc * dep + p->cd[a] * ar
                                                : 1.75 * kc * dep * sqrt(dep);
-    double tw = ar > 0.0 ? fmin(h, dep / ar) : h;
+    double tw = ar > 0.0 ? fmin(h, dep / ar) : h; /* the time that deep */
+    /* its velocity change s_a |lambda| tw within atol */
     return p->sa[a] * lam * tw <= p->o.atol;
 }
 
@@ -706,8 +738,9 @@ static int tolerable(const pen *p, int a, double dep, double r, double h)
 static double crossing_bound(double fa, double da, double fb, double db, double h)
 {
     double s[2];
-    if (fb < 0.0)
+    if (fb < 0.0) /* across at the end */
         return h;
+    /* a dip: positive at the start, falling there, rising at the end */
     if (!(fa > 0.0 && da < 0.0 && db > 0.0))
         return 0.0;
     int k = hermite_critical(fa, da, fb, db, h, s);
@@ -736,7 +769,7 @@ static int locate_root(pen *p, int a, double ta, double hi, const double e0[3],
                        const double e1[3], double h, double *s, pd_err *err)
 {
     double lo = 0.0, x = hi, f, df, d;
-    int use5 = quintic(e0, e1, h, hi, &d) < 0.0;
+    int use5 = quintic(e0, e1, h, hi, &d) < 0.0; /* else the cubic */
     int rc;
     for (int it = 0; it < 60; it++) { /* the interpolant's root in [lo, x] by bisection */
         double mid = 0.5 * (lo + x);
@@ -745,12 +778,14 @@ static int locate_root(pen *p, int a, double ta, double hi, const double e0[3],
         *(v < 0.0 ? &x : &lo) = mid;
     }
     lo = 0.0;
+    /* Newton on probes, kept inside the bracket [lo, hi] with phi(hi) < 0 */
     for (int it = 0;; it++) {
         if ((rc = phi_at(p, a, ta, x, &f, &df, err)))
             return rc;
         *(f < 0.0 ? &hi : &lo) = x;
         double tol = 4.0 * DBL_EPSILON * (fabs(ta) + hi);
-        double nx = df != 0.0 ? x - f / df : 0.5 * (lo + hi);
+        double nx = df != 0.0 ? x - f / df : 0.5 * (lo + hi); /* Newton's step */
+        /* exact, within the tolerance, converged, or 100 probes */
         if (f == 0.0 || tolerable(p, a, f, df, h) || fabs(nx - x) <= tol || hi - lo <= tol ||
             it == 100)
             break;
@@ -767,7 +802,8 @@ static void switch_element(pen *p, int a)
     p->mode[a] = (unsigned char)!p->mode[a];
     p->res.switches++;
     if (p->mode[a] && p->o.law == PD_PENALTY_HERTZDAMP) {
-        double e = p->md->e[a], vimp = -rate_of(p, a, p->y + p->n);
+        double e = p->md->e[a], vimp = -rate_of(p, a, p->y + p->n); /* approach speed -U */
+        /* the floor's 1e-3 of the largest so far */
         p->vseen = fmax(p->vseen, vimp);
         p->cd[a] = pd_hertz_damping(p->o.kc, e, vimp, p->vfloor, p->vseen);
     }
@@ -788,6 +824,7 @@ static int earliest_crossing(pen *p, double ta, double *t, int *which, int *acro
     for (int a = 0; a < p->m; a++) {
         double e0[3], e1[3], s;
         phi_jets(p, a, e0, e1);
+        /* where the cubic of phi may first go negative (0: nowhere) */
         double bound = crossing_bound(e0[0], e0[1], e1[0], e1[1], h);
         if (!(bound > 0.0))
             continue;
@@ -800,11 +837,12 @@ static int earliest_crossing(pen *p, double ta, double *t, int *which, int *acro
             if (f >= 0.0)
                 continue;
         } else if (tolerable(p, a, e1[0], e1[1], h)) {
-            *across = 1;
+            *across = 1; /* switched at the end, not located */
             continue;
         }
         if ((rc = locate_root(p, a, ta, bound, e0, e1, h, &s, err)))
             return rc;
+        /* the earliest crossing wins: its state and rates kept */
         if (s <= best) {
             best = s;
             *which = a;
@@ -815,6 +853,7 @@ static int earliest_crossing(pen *p, double ta, double *t, int *which, int *acro
                 rhs(ta + s, p->yo, p->fo, p);
         }
     }
+    /* the step cut at the crossing */
     if (*which >= 0) {
         memcpy(p->y, p->yo, p->dim * sizeof(double));
         memcpy(p->fb, p->fo, p->dim * sizeof(double));
@@ -833,6 +872,7 @@ static int apply_switches(pen *p, int which)
     for (int a = 0; a < p->m; a++) {
         double sg = phi_sign(p, a), phi = sg * gap_of(p, a, p->y);
         double dphi = sg * rate_of(p, a, p->y + p->n);
+        /* the located one, and any other across and still moving across */
         if (a == which || (phi < 0.0 && dphi <= 0.0)) {
             switch_element(p, a);
             k++;
@@ -851,8 +891,10 @@ static double step_min_gap(pen *p, int a, double h)
     int k = h > 0.0 ? hermite_critical(p->ga[a], p->Ua[a], g1, U1, h, s) : 0;
     for (int i = 0; i < k; i++)
         cub = fmin(cub, hermite(p->ga[a], p->Ua[a], g1, U1, h, s[i]));
+    /* the cubic does not dip below the ends' minimum */
     if (!(cub < gmin))
         return cub;
+    /* a dip: the quintic with g'' = W^T a at both ends finds its bottom */
     double e0[3] = {p->ga[a], p->Ua[a], rate_of(p, a, p->fa + p->n)};
     double e1[3] = {g1, U1, rate_of(p, a, p->fb + p->n)};
     return quintic_min(e0, e1, h);
@@ -863,6 +905,7 @@ static void track_extremes(pen *p, double h)
 {
     for (int a = 0; a < p->m; a++) {
         p->res.min_gap = fmin(p->res.min_gap, step_min_gap(p, a, h));
+        /* penetration rate -U */
         if (p->mode[a])
             p->res.max_penetration_velocity =
                 fmax(p->res.max_penetration_velocity, -rate_of(p, a, p->y + p->n));
@@ -892,6 +935,7 @@ static int one_step(pen *p, double *t, double tb, double *h, pd_err *err)
                           "penalty: budget of %ld accepted steps exhausted at t = %.9g s",
                           p->o.max_steps, seconds(p, ta));
     mark_start(p);
+    /* one GSL step, the engaged set frozen: a smooth right-hand side */
     if ((rc = evolve_once(p, d, t, tb, h, p->y, err)))
         return rc;
     p->res.steps++;
@@ -899,6 +943,7 @@ static int one_step(pen *p, double *t, double tb, double *h, pd_err *err)
     if ((rc = earliest_crossing(p, ta, t, &which, &across, err)) ||
         (rc = outputs_inside(p, ta, *t, err)))
         return rc;
+    /* progress: more than 1e-12 of t */
     p->stalled = *t - ta > PEN_STALL_REL * fmax(fabs(ta), 1.0) ? 0 : p->stalled + 1;
     if (p->stalled > PEN_MAX_STALL) /* switching back and forth at one instant */
         return pd_err_set(err, PD_ENUMERICAL,
@@ -907,13 +952,14 @@ static int one_step(pen *p, double *t, double tb, double *h, pd_err *err)
                           "atol = %g); --method newmark or moreau run the scene",
                           seconds(p, ta), PEN_MAX_STALL, PEN_STALL_REL, p->o.rtol, p->o.atol);
     track_extremes(p, *t - ta);
+    /* elements switch at this instant: the located one, or one across */
     int switching = which >= 0 || across, switched = 0;
     if (switching) { /* the step's end under the set it ran with (left limits) */
         notify_step(p, *t, p->fb);
         switched = apply_switches(p, which);
     }
     if (switched)
-        track_extremes(p, 0.0);
+        track_extremes(p, 0.0); /* after the switch */
     if (which >= 0) { /* the step was cut: its stepper restarts from the crossing */
         gsl_odeiv2_evolve_reset(d->e);
         gsl_odeiv2_step_reset(d->s);
@@ -923,6 +969,7 @@ static int one_step(pen *p, double *t, double tb, double *h, pd_err *err)
         notify_step(p, *t, NULL);
     else if (!switching)
         notify_step(p, *t, p->fb);
+    /* without an output grid the observer sees every step */
     fill_state(p, *t, p->y);
     if (p->o.h_out == 0.0)
         notify(p, p->observer, p->obs_ctx);
@@ -938,7 +985,7 @@ static int run_segment(pen *p, double *t, double tb, double *h, pd_err *err)
     p->seg_hi = tb;
     gsl_odeiv2_evolve_reset(d->e);
     gsl_odeiv2_step_reset(d->s);
-    *h = fmin(*h, tb - *t);
+    *h = fmin(*h, tb - *t); /* no try beyond the segment */
     while (*t < tb && !p->stopped)
         if ((rc = one_step(p, t, tb, h, err)))
             return rc;
@@ -951,15 +998,18 @@ static int run_segments(pen *p, double t0, double t1, pd_err *err)
     const pd_model *md = p->md;
     double t = t0, h = 1e-3 * (t1 - t0), tol = 1e-12 * fmax(1.0, fmax(fabs(t0), fabs(t1)));
     int k = 0, rc;
+    /* breakpoints at or before t0 (within tol) passed */
     while (k < md->nbreaks && md->breaks[k] <= t0 + tol)
         k++;
     while (t < t1 && !p->stopped) {
         double tb = t1;
+        /* the segment ends at the next breakpoint before t1 */
         if (k < md->nbreaks && md->breaks[k] < t1 - tol)
             tb = md->breaks[k++];
         if ((rc = run_segment(p, &t, tb, &h, err)))
             return rc;
     }
+    /* the grid's last point at t1 when it fell short */
     if (p->observer && p->o.h_out > 0.0 && !p->stopped &&
         out_time(p, p->next_out - 1) < t1 - tol) {
         fill_state(p, t1, p->y);
@@ -978,14 +1028,15 @@ static int start(pen *p, double t0, const double *q0, const double *v0, pd_err *
         if (!isfinite(p->y[i]) || !isfinite(p->y[n + i]))
             return pd_err_set(err, PD_EINVAL, "penalty: initial state: dof %d is not finite", i);
     }
-    p->vfloor = 1e3 * p->o.atol;
+    p->vfloor = 1e3 * p->o.atol; /* Hertz-damp's smallest approach speed */
     p->res.min_gap = HUGE_VAL;
     for (int a = 0; a < p->m; a++) {
         p->res.min_gap = fmin(p->res.min_gap, gap_of(p, a, p->y));
+        /* engaged from the start where the gap is negative */
         if (gap_of(p, a, p->y) < 0.0)
             switch_element(p, a);
     }
-    p->res.switches = 0;
+    p->res.switches = 0; /* the initial engagements are no switches */
     p->t_out0 = t0;
     p->next_out = 1;
     notify_step(p, t0, NULL);
@@ -1007,6 +1058,7 @@ int pd_penalty_run(const pd_model *model, double t0, const double *q0, const dou
     p.observer = observer;
     p.obs_ctx = ctx;
     p.o = opts ? *opts : pd_penalty_default_opts();
+    /* the fixed-step scheme, penalty_newmark.c */
     if (p.o.stepper && !strcmp(p.o.stepper, "newmark"))
         return (rc = pd_model_check(model, err))
                    ? rc
@@ -1014,7 +1066,7 @@ int pd_penalty_run(const pd_model *model, double t0, const double *q0, const dou
     if (!(rc = pd_model_check(model, err)) && !(rc = check_opts(&p, t0, t1, err))) {
         p.n = model->n;
         p.m = model->m;
-        p.dim = 2 * (size_t)model->n;
+        p.dim = 2 * (size_t)model->n; /* y = (q, v) */
         p.res.stepper = p.stp->name;
         if (alloc_arrays(&p))
             rc = pd_err_set(err, PD_ENOMEM, "penalty: out of memory for n = %d, m = %d", p.n,
@@ -1023,6 +1075,7 @@ int pd_penalty_run(const pd_model *model, double t0, const double *q0, const dou
             !(rc = start(&p, t0, q0, v0, err)))
             rc = run_segments(&p, t0, t1, err);
     }
+    /* also on failure: what was reached */
     if (res)
         *res = p.res;
     pen_free(&p);

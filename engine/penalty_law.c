@@ -14,10 +14,12 @@ int pd_penalty_check_opts(const pd_penalty_opts *o, double t0, double t1, const 
 {
     if (o->law != PD_PENALTY_KELVIN && o->law != PD_PENALTY_HERTZDAMP)
         return pd_err_set(err, PD_EINVAL, "%s: law must be Kelvin-Voigt or Hertz-damp", who);
+    /* kc > 0: the elements' stiffness; their damping follows from it and e */
     if (!(o->kc > 0.0) || !isfinite(o->kc))
         return pd_err_set(err, PD_EINVAL,
                           "%s: kc (contact stiffness) must be a finite number > 0 (got %g)", who,
                           o->kc);
+    /* h_out = 0: the observer after every step */
     if (!(o->h_out >= 0.0) || !isfinite(o->h_out))
         return pd_err_set(err, PD_EINVAL, "%s: h_out must be >= 0 (got %g)", who, o->h_out);
     if (o->max_steps < 1)
@@ -25,6 +27,7 @@ int pd_penalty_check_opts(const pd_penalty_opts *o, double t0, double t1, const 
     if (!(o->time_unit > 0.0) || !isfinite(o->time_unit))
         return pd_err_set(err, PD_EINVAL, "%s: time_unit must be > 0 (got %g)", who,
                           o->time_unit);
+    /* a run of no length (t1 = t0) is allowed */
     if (!isfinite(t0) || !isfinite(t1) || t1 < t0)
         return pd_err_set(err, PD_EINVAL, "%s: need finite t0 <= t1 (got %g, %g)", who, t0, t1);
     return PD_OK;

@@ -16,7 +16,7 @@
 static inline double pd_kelvin_zeta(double e)
 {
     if (e <= 0.0)
-        return 1.0;
+        return 1.0; /* -ln e -> inf: critical damping */
     double l = log(e);
     return -l / sqrt(PD_PI * PD_PI + l * l);
 }
@@ -24,7 +24,7 @@ static inline double pd_kelvin_zeta(double e)
 /* The Kelvin-Voigt damping constant of a contact of effective mass m_eff. */
 static inline double pd_kelvin_damping(double kc, double e, double m_eff)
 {
-    return 2.0 * pd_kelvin_zeta(e) * sqrt(kc * m_eff);
+    return 2.0 * pd_kelvin_zeta(e) * sqrt(kc * m_eff); /* c = 2 zeta sqrt(kc m) */
 }
 
 /* The Hertz-damp damping constant for the approach speed vimp, floored at
@@ -33,6 +33,7 @@ static inline double pd_kelvin_damping(double kc, double e, double m_eff)
 static inline double pd_hertz_damping(double kc, double e, double vimp, double vfloor,
                                       double vseen)
 {
+    /* 3 kc (1 - e^2) / (4 v) */
     return 0.75 * kc * (1.0 - e * e) / fmax(vimp, fmax(vfloor, 1e-3 * vseen));
 }
 
@@ -40,6 +41,8 @@ static inline double pd_hertz_damping(double kc, double e, double vimp, double v
 static inline double pd_penalty_force(pd_penalty_law law, double kc, double c, double d,
                                       double dd)
 {
+    /* Kelvin-Voigt acts on both sides of d = 0 (the engaged set decides where);
+     * Hertz-damp's d^1.5 is 0 for d <= 0 */
     if (law == PD_PENALTY_KELVIN)
         return kc * d + c * dd;
     if (d <= 0.0)
@@ -56,6 +59,7 @@ static inline void pd_penalty_slopes(pd_penalty_law law, double kc, double c, do
         *cdd = c;
         return;
     }
+    /* d/dd [d^1.5 (kc + c d')] = 1.5 d^0.5 (kc + c d'), d/dd' = c d^1.5 */
     double sd = d > 0.0 ? sqrt(d) : 0.0;
     *kd = 1.5 * sd * (kc + c * dd);
     *cdd = c * d * sd;

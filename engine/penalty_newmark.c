@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include "pd_mj1.h"
+#include "pd_alloc.h"
 #include "pd_core.h"
 #include "pd_engine.h"
 #include "pd_factor.h"
@@ -75,8 +76,8 @@ static void nm_free(nm_run *w)
 /* Every array, sized once for (n, m). */
 static int nm_alloc(nm_run *w)
 {
-    size_t n = (size_t)w->n, m = w->m > 0 ? (size_t)w->m : 1;
-    size_t na = m < NM_MAX_ACTIVE ? m : NM_MAX_ACTIVE;
+    size_t n = (size_t)w->n;
+    int m = w->m, na = m < NM_MAX_ACTIVE ? m : NM_MAX_ACTIVE;
     double **dn[] = {&w->q0, &w->v0, &w->a0, &w->q, &w->v, &w->b, &w->r, &w->y, &w->F, &w->F2,
                      &w->tmp, &w->st.acc};
     double **dm[] = {&w->lam, &w->kt, &w->cd, &w->mu, &w->s, &w->st.g};
@@ -84,14 +85,14 @@ static int nm_alloc(nm_run *w)
     for (size_t k = 0; k < sizeof dn / sizeof dn[0]; k++)
         ok &= (*dn[k] = calloc(n, sizeof(double))) != NULL;
     for (size_t k = 0; k < sizeof dm / sizeof dm[0]; k++)
-        ok &= (*dm[k] = calloc(m, sizeof(double))) != NULL;
-    ok &= (w->D = calloc(na * na, sizeof(double))) != NULL;
-    ok &= (w->perm = calloc(na, sizeof(int))) != NULL;
-    ok &= (w->idx = calloc(m, sizeof(int))) != NULL;
-    ok &= (w->eng = calloc(m, 1)) != NULL;
-    ok &= (w->eng_prev = calloc(m, 1)) != NULL;
-    ok &= (w->eng_step = calloc(m, 1)) != NULL;
-    ok &= (w->st.active = calloc(m, 1)) != NULL;
+        ok &= (*dm[k] = pd_calloc(m, sizeof(double))) != NULL;
+    ok &= (w->D = pd_calloc((long)na * na, sizeof(double))) != NULL;
+    ok &= (w->perm = pd_calloc(na, sizeof(int))) != NULL;
+    ok &= (w->idx = pd_calloc(m, sizeof(int))) != NULL;
+    ok &= (w->eng = pd_calloc(m, 1)) != NULL;
+    ok &= (w->eng_prev = pd_calloc(m, 1)) != NULL;
+    ok &= (w->eng_step = pd_calloc(m, 1)) != NULL;
+    ok &= (w->st.active = pd_calloc(m, 1)) != NULL;
     return ok ? PD_OK : PD_ENOMEM;
 }
 
@@ -111,14 +112,16 @@ static void elements(nm_run *w, const double *q, const double *v, const double *
 {
     const pd_model *md = w->md;
     for (int a = 0; a < w->m; a++) {
-        double d = -(md->g0[a] + pd_matrix_col_dot(&md->W, a, q));
-        double dd = -pd_matrix_col_dot(&md->W, a, v);
+        double d = -(md->g0[a] + pd_matrix_col_dot(&md->W, a, q)); /* d = -g_a */
+        double dd = -pd_matrix_col_dot(&md->W, a, v); /* d' = -U_a */
+        /* engaged where d > 0, unless the set is frozen for the step */
         if (!w->frozen)
             w->eng[a] = d > 0.0;
         if (!w->eng[a]) {
             w->lam[a] = w->kt[a] = 0.0;
             continue;
         }
+        /* engaging in this step: Hertz-damp's constant from the approach speed at its start */
         if (!w->eng_step[a] && w->o.law == PD_PENALTY_HERTZDAMP) {
             double vimp = -pd_matrix_col_dot(&md->W, a, vstart);
             w->cd[a] = pd_hertz_damping(w->o.kc, md->e[a], vimp, w->vfloor, w->vseen);
@@ -126,6 +129,7 @@ static void elements(nm_run *w, const double *q, const double *v, const double *
         double kd, cdd;
         w->lam[a] = pd_penalty_force(w->o.law, w->o.kc, w->cd[a], d, dd);
         pd_penalty_slopes(w->o.law, w->o.kc, w->cd[a], d, dd, &kd, &cdd);
+        /* kt = dlambda/dd + (2/h) dlambda/dd', as v1 = (2/h)(q1 - q0) - v0 */
         double k = kd + (2.0 / w->h) * cdd;
         w->kt[a] = k > 0.0 ? k : 0.0; /* a modified Newton where the law softens */
     }
@@ -147,7 +151,8 @@ static int newton_solve(nm_run *w, pd_err *err)
     double g4 = 0.25 * w->h * w->h;
     int na = 0;
     memcpy(w->y, w->r, (size_t)w->n * sizeof(double));
-    pd_factor_solve(w->fac, w->y);
+    pd_factor_solve(w->fac, w->y); /* y = What^-1 r */
+    /* A: the engaged elements with kt > 0 */
     for (int a = 0; a < w->m; a++)
         if (w->eng[a] && w->kt[a] > 0.0) {
             if (na == NM_MAX_ACTIVE)
@@ -156,8 +161,9 @@ static int newton_solve(nm_run *w, pd_err *err)
                                   NM_MAX_ACTIVE);
             w->idx[na++] = a;
         }
-    if (na == 0)
+    if (na == 0) /* What alone */
         return PD_OK;
+    /* D_AA = W_A^T What^-1 W_A, made I + G D_AA in place; mu = G W_A^T y */
     pd_factor_delassus_dense(w->fac, w->idx, na, w->D);
     for (int j = 0; j < na; j++) {
         double G = g4 * w->kt[w->idx[j]];
@@ -170,6 +176,7 @@ static int newton_solve(nm_run *w, pd_err *err)
     pd_dense_lu_solve(na, w->D, na, w->perm, w->mu);
     for (int j = 0; j < na; j++)
         w->mu[j] = -w->mu[j];
+    /* Delta = y - What^-1 W_A mu */
     pd_factor_add_impulse(w->fac, w->idx, na, w->mu, w->y);
     return PD_OK;
 }
@@ -183,7 +190,7 @@ static void report(nm_run *w, long k, double t, pd_observer fn, void *ctx)
     w->st.t = t;
     w->st.q = w->q0;
     w->st.v = w->v0;
-    w->st.P = w->lam;
+    w->st.P = w->lam; /* the elements' forces */
     w->st.nactive = 0;
     for (int a = 0; a < w->m; a++) {
         w->st.g[a] = w->md->g0[a] + pd_matrix_col_dot(&w->md->W, a, w->q0);
@@ -224,10 +231,11 @@ static int step(nm_run *w, double t1, int at_break, pd_err *err)
     for (int i = 0; i < n; i++)
         w->tmp[i] = 0.5 * h * w->q0[i] + g4 * w->v0[i];
     pd_matrix_gemv(&md->C, 1.0, w->tmp, 1.0, w->b);
-    force_at(w, t1, -1, w->F);
+    force_at(w, t1, -1, w->F); /* F1 = F(t1-) */
     for (int i = 0; i < n; i++) /* predictor: a1 = a0 */
         w->q[i] = w->q0[i] + h * w->v0[i] + 2.0 * g4 * w->a0[i];
     int it, done = 0;
+    /* the engaged set follows d until NM_FREEZE iterations */
     w->frozen = 0;
     for (int i = 0; i < n; i++)
         w->v[i] = (2.0 / h) * (w->q[i] - w->q0[i]) - w->v0[i];
@@ -248,6 +256,7 @@ static int step(nm_run *w, double t1, int at_break, pd_err *err)
         w->res.rhs++;
         if ((rc = newton_solve(w, err)))
             return rc;
+        /* q += Delta, |Delta| against the state's scale */
         double dmax = 0.0, qmax = w->qscale;
         for (int i = 0; i < n; i++) {
             w->q[i] += w->y[i];
@@ -279,6 +288,7 @@ static int step(nm_run *w, double t1, int at_break, pd_err *err)
         w->v0[i] = w->v[i];
     }
     for (int a = 0; a < w->m; a++) {
+        /* the step's end: gaps, switches, the engaged elements' penetration rates */
         double g = md->g0[a] + pd_matrix_col_dot(&md->W, a, w->q0);
         w->res.min_gap = fmin(w->res.min_gap, g);
         if (w->eng[a] != w->eng_step[a]) {
@@ -295,7 +305,7 @@ static int step(nm_run *w, double t1, int at_break, pd_err *err)
         force_at(w, t1, +1, w->F2);
         for (int i = 0; i < n; i++)
             w->F2[i] -= w->F[i];
-        pd_factor_solve(w->mass, w->F2);
+        pd_factor_solve(w->mass, w->F2); /* a1 += M^-1 (F(t1+) - F(t1-)) */
         for (int i = 0; i < n; i++)
             w->a0[i] += w->F2[i];
     }
@@ -312,6 +322,7 @@ static int nm_check(const nm_run *w, double t0, double t1, pd_err *err)
         return rc;
     if (!(o->h > 0.0) || !isfinite(o->h))
         return pd_err_set(err, PD_EINVAL, "newmark: the step h must be > 0 (got %g)", o->h);
+    /* the run's steps within the budget */
     double steps = (t1 - t0) / o->h;
     if (!(steps <= (double)o->max_steps))
         return pd_err_set(err, PD_EBUDGET, "newmark: %.3g steps of %g s (at most %ld)", steps,
@@ -325,6 +336,7 @@ static int nm_start(nm_run *w, double t0, const double *q0, const double *v0, pd
     pd_err own_err; /* the status read back when the caller passed no pd_err */
     err = pd_err_or(err, &own_err);
     const pd_model *md = w->md;
+    /* What(h, theta = 1/2) = M + h/2 C + h^2/4 K; M itself for the accelerations */
     if (!(w->fac = pd_factor_alloc(md, w->h, 0.5, w->o.factor, err)) ||
         !(w->mass = pd_factor_alloc(md, 0.0, 1.0, w->o.factor, err)))
         return err->status;
@@ -338,7 +350,7 @@ static int nm_start(nm_run *w, double t0, const double *q0, const double *v0, pd
                               a, s);
         if (w->o.law == PD_PENALTY_KELVIN)
             w->cd[a] = pd_kelvin_damping(w->o.kc, md->e[a], 1.0 / s);
-        w->qscale = fmax(w->qscale, fabs(md->g0[a]));
+        w->qscale = fmax(w->qscale, fabs(md->g0[a])); /* Newton's scale: gaps and q */
     }
     for (int i = 0; i < w->n; i++) {
         w->q0[i] = q0 ? q0[i] : 0.0;
@@ -348,9 +360,10 @@ static int nm_start(nm_run *w, double t0, const double *q0, const double *v0, pd
         w->qscale = fmax(w->qscale, fabs(w->q0[i]));
     }
     if (!(w->qscale > 0.0))
-        w->qscale = 1e-300;
+        w->qscale = 1e-300; /* all zero */
     w->vfloor = 1e3 * w->o.atol;
     w->res.min_gap = HUGE_VAL;
+    /* the engaged set at t0 and its forces, for a0 */
     elements(w, w->q0, w->v0, w->v0);
     memcpy(w->eng_step, w->eng, (size_t)w->m);
     for (int a = 0; a < w->m; a++)
@@ -381,6 +394,7 @@ int pd_penalty_newmark(const pd_model *model, double t0, const double *q0, const
     if (!rc && !(rc = nm_start(&w, t0, q0, v0, err))) {
         long nsteps = pd_steps_for(t1 - t0, w.h), every = 1, k;
         int next_break = 0;
+        /* the observer every h_out (a whole number of steps) and at the end */
         if (w.o.h_out > w.h)
             every = lround(w.o.h_out / w.h);
         report(&w, 0, t0, w.o.on_step, w.o.on_step_ctx);

@@ -34,6 +34,8 @@ typedef struct kernels {
 static void sin_cos_diff(double a, double d, double *ds, double *dc)
 {
     double h = sin(0.5 * d), m = a + 0.5 * d;
+    /* sin(a + d) - sin a = 2 cos(a + d/2) sin(d/2),
+     * cos(a + d) - cos a = -2 sin(a + d/2) sin(d/2) */
     *ds = 2.0 * cos(m) * h;
     *dc = -2.0 * sin(m) * h;
 }
@@ -56,6 +58,7 @@ static kernels kernels_series(double w0, double a, double h)
         g += cur;
         s1 += cur / (k + 1);
         s2 += cur / ((double)(k + 1) * (k + 2));
+        /* two terms in a row below 1e-18 of g: the rest is below rounding */
         if (fabs(cur) + fabs(next) <= KERNEL_SERIES_TOL * fabs(g))
             break;
         prev = cur;
@@ -70,7 +73,7 @@ static kernels kernels_closed(double w0, double xi, double h)
 {
     double a = xi * w0, wd = w0 * sqrt(1.0 - xi * xi), k = w0 * w0;
     double em1 = expm1(-a * h), ex = 1.0 + em1, half = sin(0.5 * wd * h);
-    double cs_m1 = -2.0 * half * half, cs = cos(wd * h);
+    double cs_m1 = -2.0 * half * half, cs = cos(wd * h); /* cos(wd h) - 1 */
     double g = ex * sin(wd * h) / wd;
     double G1 = -(em1 * cs + cs_m1 + a * g) / k;
     return (kernels){.g = g, .G1 = G1, .G2 = (h - g - 2.0 * a * G1) / k};
@@ -80,6 +83,7 @@ static kernels kernels_closed(double w0, double xi, double h)
 static kernels kernels_at(const pd_sdof *osc, double h)
 {
     double w0 = osc->w0, a = w0 > 0.0 ? osc->xi * w0 : 0.0;
+    /* small w0 h: the series, where the closed forms would cancel */
     if (fabs(w0 * h) <= KERNEL_SERIES_MAX)
         return kernels_series(w0, a, h);
     return kernels_closed(w0, osc->xi, h);
@@ -126,6 +130,8 @@ static void particular(const pd_sdof *osc, double A, double w, double phi, doubl
         *dvp = -A * dc / (2.0 * w) + A * (t0 * ds + (t1 - t0) * s1) / 2.0;
         return;
     }
+    /* u_p = A Im(e^{i th} (re - i im)) / den
+     *     = A (re sin th - im cos th) / den, v_p its derivative */
     *up0 = A * (re * s0 - im * c0) / den;
     *vp0 = A * w * (re * c0 + im * s0) / den;
     *dup = A * (re * ds - im * dc) / den;
@@ -144,11 +150,12 @@ static void sine_increment(const pd_sdof *osc, double A, double w, double phi, d
     double up0, vp0, dup, dvp;
     particular(osc, A, w, phi, t0, t1, &up0, &vp0, &dup, &dvp);
     double a = osc->xi * osc->w0, wd = osc->w0 * sqrt(1.0 - osc->xi * osc->xi);
+    /* the homogeneous part meets (u0, v0): c1 = u0 - u_p0, wd c2 - a c1 = v0 - v_p0 */
     double c1 = u0 - up0, c2 = (v0 - vp0 + a * c1) / wd;
     double s = t1 - t0, em1 = expm1(-a * s), ex = 1.0 + em1;
     double cs = cos(wd * s), sn = sin(wd * s), half = sin(0.5 * wd * s);
     double cs_m1 = -2.0 * half * half; /* cos - 1 */
-    double dh = c1 * (em1 * cs + cs_m1) + c2 * ex * sn;
+    double dh = c1 * (em1 * cs + cs_m1) + c2 * ex * sn; /* e^{-a s}(c1 cos + c2 sin) - c1 */
     *du = dup + dh;
     *v1 = vp0 + dvp + ex * ((c2 * wd - a * c1) * cs - (c1 * wd + a * c2) * sn);
 }
@@ -178,6 +185,7 @@ void pd_sdof_increment_piece(const pd_sdof *osc, const pd_sine_piece *pc, double
     if (!osc || !pc || !du || !v1)
         return;
     double f0 = pc->c0 + pc->c1 * (t0 - pc->t_start);
+    /* A = 0: the linear force alone */
     if (pc->A == 0.0) {
         ramp_increment(osc, f0, pc->c1, u0, v0, t1 - t0, du, v1);
         return;
@@ -219,7 +227,7 @@ void pd_sdof_flow_init(pd_sdof_flow *f, const pd_sdof *osc, const pd_sine_piece 
     f->a = osc->xi * w0;
     f->wd = w0 * sqrt(1.0 - osc->xi * osc->xi);
     f->k0 = w0 * w0;
-    f->f0 = p->c0 + p->c1 * (t0 - p->t_start);
+    f->f0 = p->c0 + p->c1 * (t0 - p->t_start); /* F's linear part at t0 */
     double up0 = 0.0;
     if (p->A != 0.0) {
         double th0 = w * t0 + p->phi;
@@ -266,6 +274,8 @@ void pd_sdof_flow_at(const pd_sdof_flow *f, double t1, double *du, double *v1)
     if (p->A != 0.0) { /* particular increments by angle addition, then the homogeneous part */
         double ps, pc2;
         sincos_half(p->w * s, &ps, &pc2);
+        /* sin and cos of th0 + w s / 2 by angle addition, then
+         * the differences as in sin_cos_diff */
         double sm = f->s0 * pc2 + f->c0 * ps, cm = f->c0 * pc2 - f->s0 * ps;
         double ds = 2.0 * cm * ps, dc = -2.0 * sm * ps;
         *du = f->pre * ds - f->pim * dc + f->c1 * (em1 * cs + cs_m1) + f->c2 * ex * sn;
@@ -281,6 +291,7 @@ void pd_sdof_flow_at(const pd_sdof_flow *f, double t1, double *du, double *v1)
         double g = ex * sn / wd, G1 = -(em1 * cs + cs_m1 + a * g) / k0;
         k = (kernels){.g = g, .G1 = G1, .G2 = (s - g - 2.0 * a * G1) / k0};
     }
+    /* Duhamel: du = v g + (f0 - w0^2 u) G1 + c1 G2 */
     double rest = f->f0 - k0 * f->ur;
     *du += f->vr * k.g + rest * k.G1 + p->c1 * k.G2;
     *v1 += f->vr + ((rest - 2.0 * a * f->vr) * k.g + (p->c1 - k0 * f->vr) * k.G1);

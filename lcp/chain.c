@@ -8,6 +8,7 @@ void pd_lcp_chain_q(int N, int seed, double *q)
 {
     if (!q)
         return;
+    /* a stream per (N, seed) */
     uint64_t state = CHAIN_SEED + (uint64_t)N + 1000003u * (uint64_t)seed;
     for (int j = 0; j < N; j++)
         q[j] = pd_rand_pm1(&state);

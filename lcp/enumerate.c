@@ -17,7 +17,7 @@
 static int popcount(unsigned mask)
 {
     int count = 0;
-    for (; mask; mask &= mask - 1)
+    for (; mask; mask &= mask - 1) /* clears the lowest set bit */
         count++;
     return count;
 }
@@ -27,6 +27,7 @@ static int support_solution(int n, const double *M, const double *q, unsigned ma
 {
     double A[ENUM_NMAX * ENUM_NMAX], b[ENUM_NMAX];
     int idx[ENUM_NMAX], perm[ENUM_NMAX], k = 0;
+    /* idx: S in increasing order; A = M_SS, b = -q_S */
     for (int j = 0; j < n; j++)
         if (mask & (1u << j))
             idx[k++] = j;
@@ -35,11 +36,12 @@ static int support_solution(int n, const double *M, const double *q, unsigned ma
             A[r + c * k] = M[idx[r] + idx[c] * n];
         b[c] = -q[idx[c]];
     }
-    if (k > 0 && pd_dense_lu(k, A, k, perm, ENUM_SINGULAR_TOL) != PD_OK)
+    if (k > 0 && pd_dense_lu(k, A, k, perm, ENUM_SINGULAR_TOL) != PD_OK) /* M_SS singular */
         return -1;
     if (k > 0)
         pd_dense_lu_solve(k, A, k, perm, b);
     memset(z, 0, (size_t)n * sizeof(double));
+    /* a negative z_i of rounding size (above -ENUM_TOL) is 0 */
     for (int c = 0; c < k; c++)
         z[idx[c]] = b[c] < 0.0 && b[c] > -ENUM_TOL ? 0.0 : b[c];
     return 0;
@@ -58,6 +60,7 @@ int pd_lcp_enumerate(int n, const double *M, const double *q, double *z, double 
     if (n < 1 || n > ENUM_NMAX || !M || !q || !z || !w)
         return PD_EINVAL;
     unsigned count = 1u << n;
+    /* supports by size, then by mask: the first that verifies */
     for (int size = 0; size <= n; size++) {
         for (unsigned mask = 0; mask < count; mask++) {
             if (popcount(mask) != size)
@@ -67,6 +70,7 @@ int pd_lcp_enumerate(int n, const double *M, const double *q, double *z, double 
         }
     }
     double comp, infeas, residual;
+    /* none: z = 0 and its w = q reported */
     memset(z, 0, (size_t)n * sizeof(double));
     pd_lcp_residual(n, M, q, z, w, &comp, &infeas, &residual);
     return PD_ENOSOLUTION;

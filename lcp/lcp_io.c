@@ -64,6 +64,7 @@ static lcp_cursor text_start(lcp_text *t)
     int lines = 1;
     for (size_t k = 0; k < t->len; k++)
         lines += t->buf[k] == '\n';
+    /* a final newline opens no line of its own */
     t->last_line = t->len > 0 && t->buf[t->len - 1] == '\n' ? lines - 1 : lines;
     return (lcp_cursor){.p = t->buf, .line = 1};
 }
@@ -75,12 +76,13 @@ static int next_token(const lcp_text *t, lcp_cursor *c, lcp_token *tk)
     const char *end = t->buf + t->len;
     for (; c->p < end; c->p++) {
         char ch = *c->p;
-        if (ch == '\n') {
+        if (ch == '\n') { /* a comment ends with its line */
             c->line++;
             c->in_comment = 0;
         } else if (ch == '#') {
             c->in_comment = 1;
         } else if (!c->in_comment && !is_blank(ch)) {
+            /* a token: up to a blank, a newline or a # */
             const char *s = c->p;
             while (c->p < end && *c->p != '\n' && *c->p != '#' && !is_blank(*c->p))
                 c->p++;
@@ -111,8 +113,9 @@ static int shown(const lcp_token *tk)
 static int token_integer(const lcp_token *tk, long *v)
 {
     char *stop = NULL;
-    errno = 0;
+    errno = 0; /* strtol reports overflow through errno */
     *v = strtol(tk->text, &stop, 10);
+    /* all of the token, in range */
     return stop != tk->text && stop == tk->text + tk->len && errno == 0;
 }
 
@@ -120,14 +123,18 @@ static int token_integer(const lcp_token *tk, long *v)
 static int token_number(const lcp_text *t, lcp_cursor *c, const char *what, double *x,
                         pd_err *err)
 {
+    /* the end of the file if no token were left (the count was checked) */
     lcp_token tk = {.text = t->buf + t->len, .line = t->last_line};
     next_token(t, c, &tk);
     char *stop = NULL;
     errno = 0;
     double v = strtod(tk.text, &stop);
+    /* the whole token must be the number */
     if (stop == tk.text || stop != tk.text + tk.len)
         return pd_err_set(err, PD_EPARSE, "%s: line %d: %s: '%.*s' is not a number", t->path,
                           tk.line, what, shown(&tk), tk.text);
+    /* inf, nan and overflow refused; an underflow (ERANGE
+     * with |v| <= 1) is kept as strtod rounds it */
     if (isnan(v) || isinf(v) || (errno == ERANGE && fabs(v) > 1.0))
         return pd_err_set(err, PD_EPARSE, "%s: line %d: %s: '%.*s' is not a finite number",
                           t->path, tk.line, what, shown(&tk), tk.text);
@@ -147,6 +154,7 @@ static int token_size(const lcp_text *t, lcp_cursor *c, const char *what, int *n
         return pd_err_set(err, PD_EPARSE,
                           "%s: line %d: the %s must be a positive integer, got '%.*s'", t->path,
                           tk.line, what, shown(&tk), tk.text);
+    /* n n must fit an int */
     if (v > READ_NMAX)
         return pd_err_set(err, PD_EPARSE, "%s: line %d: the %s %ld is too large (at most %d)",
                           t->path, tk.line, what, v, READ_NMAX);
@@ -158,7 +166,7 @@ static int token_size(const lcp_text *t, lcp_cursor *c, const char *what, int *n
 static int check_count(const lcp_text *t, lcp_cursor c, int n, pd_err *err)
 {
     size_t need = (size_t)n * (size_t)n + (size_t)n;
-    size_t have = count_tokens(t, c, need);
+    size_t have = count_tokens(t, c, need); /* counted up to need only */
     if (have >= need)
         return PD_OK;
     return pd_err_set(err, PD_EPARSE,
@@ -175,7 +183,7 @@ static int alloc_problem(const lcp_text *t, int n, double **M, double **q, pd_er
         return PD_OK;
     free(*M);
     free(*q);
-    *M = *q = NULL;
+    *M = *q = NULL; /* the caller frees nothing */
     return pd_err_set(err, PD_ENOMEM, "%s: out of memory for n = %d", t->path, n);
 }
 
@@ -195,11 +203,14 @@ static int read_matrix(const lcp_text *t, lcp_cursor *c, int n, int row_major, d
     band->band = -1;
     band->nnz = 0;
     for (size_t k = 0; k < nn; k++) {
+        /* row by row, token k is M_ij, i = k / n, j = k % n, stored column-major at
+         * i + j n; column by column it is stored at k (|i - j| the same either way) */
         size_t i = k / (size_t)n, j = k % (size_t)n;
         size_t at = row_major ? i + j * (size_t)n : k;
         int st = token_number(t, c, "matrix entry", &M[at], err);
         if (st != PD_OK)
             return st;
+        /* band = max |i - j| over the nonzero entries */
         if (M[at] != 0.0) {
             int d = (int)(i > j ? i - j : j - i);
             band->band = d > band->band ? d : band->band;
@@ -226,6 +237,7 @@ static int check_nothing_after(const lcp_text *t, lcp_cursor c, int n, pd_err *e
 {
     size_t need = (size_t)n * (size_t)n + (size_t)n;
     lcp_token tk;
+    /* skip the n n + n values, then nothing may follow */
     for (size_t k = 0; k < need; k++)
         next_token(t, &c, &tk);
     if (!next_token(t, &c, &tk))
@@ -242,6 +254,7 @@ static int read_plain(const lcp_text *t, lcp_cursor c, int *n, double **M, doubl
     if (count_tokens(t, c, 1) == 0)
         return pd_err_set(err, PD_EPARSE, "%s: line %d: empty file, expected the size n",
                           t->path, t->last_line);
+    /* every check before the allocation: a malformed file costs no n^2 memory */
     int st = token_size(t, &c, "size n", n, err);
     if (st == PD_OK)
         st = check_count(t, c, *n, err);
@@ -265,9 +278,11 @@ static int check_siconos_header(const lcp_text *t, lcp_cursor *c, int n, pd_err 
         if (!next_token(t, c, &tk[k]))
             return pd_err_set(err, PD_EPARSE, "%s: line %d: file ends inside the Siconos header "
                               "(n, storage, rows, cols, rows cols)", t->path, t->last_line);
+    /* storage 0: dense */
     if (!token_integer(&tk[0], &v) || v != 0)
         return pd_err_set(err, PD_EPARSE, "%s: line %d: storage '%.*s' is not supported "
                           "(only 0 = dense)", t->path, tk[0].line, shown(&tk[0]), tk[0].text);
+    /* rows, cols, and "rows cols": all n */
     for (int k = 1; k < 5; k++)
         if (!token_integer(&tk[k], &v) || v != n)
             return pd_err_set(err, PD_EPARSE, "%s: line %d: matrix dimension '%.*s' does not "
@@ -282,6 +297,7 @@ static int read_siconos(const lcp_text *t, lcp_cursor c, int *n, double **M, dou
     if (count_tokens(t, c, 1) == 0)
         return pd_err_set(err, PD_EPARSE, "%s: line %d: empty file, expected the size n",
                           t->path, t->last_line);
+    /* header and count checked before the allocation; free text may follow q */
     int st = token_size(t, &c, "size n", n, err);
     if (st == PD_OK)
         st = check_siconos_header(t, &c, *n, err);
@@ -303,9 +319,11 @@ static int looks_siconos(const lcp_text *t, lcp_cursor c)
 {
     lcp_token tk[6];
     long v[6];
+    /* six integers: n, storage, rows, cols, rows cols */
     for (int k = 0; k < 6; k++)
         if (!next_token(t, &c, &tk[k]) || !token_integer(&tk[k], &v[k]))
             return 0;
+    /* the first four on lines of their own, the last two on one line */
     int lines_ok = tk[0].line < tk[1].line && tk[1].line < tk[2].line &&
                    tk[2].line < tk[3].line && tk[3].line < tk[4].line && tk[4].line == tk[5].line;
     if (!lines_ok || v[0] <= 0 || v[0] > READ_NMAX || v[2] != v[4] || v[3] != v[5])
@@ -337,10 +355,12 @@ int pd_lcp_read_band(const char *path, pd_lcp_format format, int *n, double **M,
     int st = slurp(&t, err);
     if (st == PD_OK) {
         lcp_cursor c = text_start(&t);
+        /* auto: the Siconos header, or else plain */
         int siconos = format == PD_LCP_FORMAT_SICONOS ||
                       (format == PD_LCP_FORMAT_AUTO && looks_siconos(&t, c));
         st = siconos ? read_siconos(&t, c, n, M, q, &b, err) : read_plain(&t, c, n, M, q, &b, err);
     }
+    /* a failure returns nothing: no half-read problem */
     if (st != PD_OK) {
         free(*M);
         free(*q);
@@ -349,7 +369,7 @@ int pd_lcp_read_band(const char *path, pd_lcp_format format, int *n, double **M,
     }
     free(t.buf);
     if (band)
-        *band = st == PD_OK ? b.band : -1;
+        *band = st == PD_OK ? b.band : -1; /* -1: no band */
     if (nnz)
         *nnz = st == PD_OK ? b.nnz : 0;
     return st;
@@ -363,16 +383,17 @@ long pd_lcp_band_csc(int n, const double *M, int band, long cap, int *colptr, in
     long k = 0;
     for (int j = 0; j < n; j++) {
         const double *c = M + (size_t)j * (size_t)n;
+        /* rows j - band .. j + band of column j, inside the matrix */
         int lo = j - band > 0 ? j - band : 0, hi = j + band < n - 1 ? j + band : n - 1;
         colptr[j] = (int)k;
         for (int i = lo; i <= hi; i++)
             if (c[i] != 0.0) { /* true for a NaN */
-                if (k == cap)
+                if (k == cap) /* more entries than the copy holds */
                     return PD_EINVAL;
                 rowind[k] = i;
                 values[k++] = c[i];
             }
     }
-    colptr[n] = (int)k;
+    colptr[n] = (int)k; /* the entries copied */
     return k;
 }

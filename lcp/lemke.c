@@ -113,6 +113,7 @@ void pd_lcp_free(pd_lcp_work *work)
 /* One allocation per array; NULL (everything released) if any fails. */
 pd_lcp_work *pd_lcp_alloc(int nmax)
 {
+    /* n^2 must fit an int */
     if (nmax < 1 || nmax > LEMKE_NMAX_LIMIT)
         return NULL;
     pd_lcp_work *work = calloc(1, sizeof *work);
@@ -135,6 +136,7 @@ pd_lcp_work *pd_lcp_alloc(int nmax)
         pd_lcp_free(work);
         return NULL;
     }
+    /* the default covering vector d = 1, set once */
     for (size_t i = 0; i < n; i++)
         work->cover[i] = 1.0;
     return work;
@@ -186,17 +188,18 @@ static inline __attribute__((always_inline)) void axpy_minus(int n, double t,
 LEMKE_INLINE void binv_times(int n, const double *binv, const int *row_of, const double *v,
                        double *restrict out)
 {
+    /* out = sum_i v_i B^-1[:, i] over the nonzero v_i */
     for (int r = 0; r < n; r++)
         out[r] = 0.0;
     for (int i = 0; i < n; i++) {
         double vi = v[i];
-        if (vi == 0.0)
+        if (vi == 0.0) /* adds nothing */
             continue;
         int r = row_of[i];
-        if (r >= 0)
+        if (r >= 0) /* B^-1[:, i] = e_r: one entry */
             out[r] += vi;
         else
-            axpy_minus(n, -vi, binv + (size_t)i * n, out);
+            axpy_minus(n, -vi, binv + (size_t)i * n, out); /* out += v_i B^-1[:, i] */
     }
 }
 
@@ -206,8 +209,9 @@ LEMKE_INLINE void eta_update(int n, double *binv, const double *restrict col, in
 {
     double rp = 1.0 / col[r]; /* one division per pivot, not one per column */
     for (int c = 0; c < n; c++) {
+        /* column c: bc -= (bc_r / col_r) col, then bc_r = bc_r / col_r */
         double *restrict bc = binv + (size_t)c * n;
-        if (bc[r] == 0.0)
+        if (bc[r] == 0.0) /* E leaves it as it is */
             continue;
         double t = bc[r] * rp;
         axpy_minus(n, t, col, bc);
@@ -219,7 +223,7 @@ LEMKE_INLINE void eta_update(int n, double *binv, const double *restrict col, in
 static const double *data_column(const lemke_state *st, int var)
 {
     int n = st->n;
-    return var == 2 * n ? st->d : st->M + (size_t)(var - n) * (size_t)n;
+    return var == 2 * n ? st->d : st->M + (size_t)(var - n) * (size_t)n; /* z0: d; z_j: M[:, j] */
 }
 
 /* Complementary partner: w_i <-> z_i. */
@@ -235,12 +239,14 @@ static void start_basis(const lemke_state *st)
     pd_lcp_work *ws = st->ws;
     memset(ws->binv, 0, (size_t)n * (size_t)n * sizeof(double));
     for (int i = 0; i < n; i++) {
+        /* B^-1 = I, x_B = q, z0's column -d; w_i basic in row i */
         ws->binv[i + (size_t)i * n] = 1.0;
         ws->xb[i] = st->q[i];
         ws->col[i] = -st->d[i];
         ws->basis[i] = i;
         ws->row_of[i] = i;
     }
+    /* every z_j and z0 nonbasic */
     for (int v = n; v <= 2 * n; v++)
         ws->row_of[v] = -1;
 }
@@ -258,12 +264,14 @@ LEMKE_INLINE int first_leaving_row(const lemke_state *st)
     int n = st->n, best = 0;
     double tmax = -INFINITY;
     for (int i = 0; i < n; i++) {
+        /* t_i = -q_i / d_i; t = the first largest */
         double t = st->unit_cover ? -st->q[i] : -st->q[i] / st->d[i]; /* x / 1 = x */
         if (t > tmax) {
             tmax = t;
             best = i;
         }
     }
+    /* from the last row down: the largest index within tol t of t */
     for (int i = n - 1; i > best; i--)
         if ((st->unit_cover ? -st->q[i] : -st->q[i] / st->d[i]) >= tmax - st->tol * tmax)
             return i;
@@ -278,12 +286,14 @@ LEMKE_INLINE double entering_column(const lemke_state *st, int var)
     pd_lcp_work *ws = st->ws;
     double *col = ws->col, cmax = 0.0;
     int nan = 0;
+    /* w_e enters: col = B^-1 e_e, column e of B^-1; z_j or z0: B^-1 a_v, negated below */
     if (var < n)
         for (int i = 0; i < n; i++)
             col[i] = ws->binv[i + (size_t)var * n];
     else
         binv_times(n, ws->binv, ws->row_of, data_column(st, var), col);
     for (int i = 0; i < n; i++) {
+        /* the tableau's -a_v, max|col| and any NaN in one pass */
         col[i] = var < n ? col[i] : -col[i];
         cmax = max2(cmax, fabs(col[i]));
         nan |= isnan(col[i]);
@@ -302,10 +312,12 @@ static int lex_filter_column(const lemke_state *st, int c, int nties)
     int *ties = ws->ties;
     double *value = ws->scratch, vmin = INFINITY, colmin = INFINITY;
     for (int k = 0; k < nties; k++) {
+        /* B^-1[t, c] / col_t over the tied rows t, its minimum, the smallest pivot */
         value[k] = bc[ties[k]] / col[ties[k]];
         vmin = value[k] < vmin ? value[k] : vmin;
         colmin = col[ties[k]] < colmin ? col[ties[k]] : colmin;
     }
+    /* the column's roundoff level over the smallest pivot */
     double eq = st->tol * pd_lcp_max_abs(n, bc) / colmin;
     int kept = 0;
     for (int k = 0; k < nties; k++)
@@ -333,10 +345,12 @@ static int lex_choice(const lemke_state *st, int nties)
 {
     const pd_lcp_work *ws = st->ws;
     int *ties = ws->ties;
+    /* column by column while more than one row is tied */
     for (int c = 0; c < st->n && nties > 1; c++) {
-        int s = ws->row_of[c];
+        int s = ws->row_of[c]; /* w_c basic in row s: a unit column */
         nties = s >= 0 ? lex_drop_row(ties, nties, s) : lex_filter_column(st, c, nties);
     }
+    /* still tied after every column: the largest pivot col_r */
     int best = ties[0];
     for (int k = 1; k < nties; k++)
         if (ws->col[ties[k]] > ws->col[best])
@@ -354,9 +368,9 @@ static double row_scale(const lemke_state *st, int i)
     double s = 0.0;
     for (int c = 0; c < n; c++) {
         int r = ws->row_of[c];
-        if (r < 0)
+        if (r < 0) /* w_c nonbasic: its column of B^-1 */
             s += fabs(ws->binv[i + (size_t)c * st->ld] * st->q[c]);
-        else if (r == i)
+        else if (r == i) /* w_c basic in row i: e_i */
             s += fabs(st->q[c]);
     }
     return s;
@@ -368,7 +382,8 @@ LEMKE_INLINE int ties_row(const lemke_state *st, int i, double ptol, double thet
                          double slack)
 {
     const double *col = st->ws->col;
-    double gap = max2(st->ws->xb[i], 0.0) - theta * col[i];
+    double gap = max2(st->ws->xb[i], 0.0) - theta * col[i]; /* x_i - theta col_i */
+    /* a pivot above ptol, and gap <= 0, or within slack and within tol of the row's own terms */
     return col[i] > ptol &&
            (gap <= 0.0 ||
             (gap <= slack && gap <= st->tol * (row_scale(st, i) + theta * col[i])));
@@ -396,14 +411,17 @@ LEMKE_INLINE int blocking_row(const lemke_state *st, double ptol, double *theta_
     double theta = INFINITY, xscale = st->qmax;
     int argmin = -1;
     for (int i = 0; i < n; i++) {
+        /* theta = min max(x_i, 0) / col_i over col_i > ptol, the first row attaining
+         * it; xscale = max(max|q|, max x_i) */
         double x = max2(xb[i], 0.0);
         xscale = max2(xscale, x);
+        /* x_i < theta col_i: the division only for a new minimum */
         if (col[i] > ptol && x < theta * col[i]) {
             theta = x / col[i];
             argmin = i;
         }
     }
-    if (argmin < 0)
+    if (argmin < 0) /* no pivot above ptol */
         return -1;
     *theta_out = theta;
     *argmin_out = argmin;
@@ -426,15 +444,17 @@ static int blocking_ties(const lemke_state *st, double ptol, double theta, doubl
     int n = st->n;
     pd_lcp_work *ws = st->ws;
     int nties = 0, z0row = ws->row_of[2 * n];
+    /* the tied rows into ws->ties */
     for (int i = 0; i < n; i++)
         if (ties_row(st, i, ptol, theta, slack))
             ws->ties[nties++] = i;
-    if (nties <= 1)
+    if (nties <= 1) /* argmin alone */
         return argmin;
+    /* z0 leaves whenever it ties: a solution at once */
     for (int k = 0; k < nties; k++)
         if (ws->ties[k] == z0row)
             return z0row;
-    return lex_choice(st, nties);
+    return lex_choice(st, nties); /* else the lexicographic rule */
 }
 
 /* The value x_r / col_r the entering variable takes in row r: theta itself
@@ -455,8 +475,11 @@ LEMKE_INLINE int ratio_test(const lemke_state *st, double colmax, double *xr)
 {
     int n = st->n, argmin = -1;
     double theta = 0.0;
+    /* a NaN or an infinity in the column: numerical */
     if (!isfinite(colmax))
         return RATIO_NUMERICAL;
+    /* pivots above tol max|col|, else above 8 n eps max|col|
+     * (a small column is no ray), else a ray */
     int r = blocking_row(st, st->tol * colmax, &theta, &argmin);
     if (r < 0)
         r = blocking_row(st, 8.0 * n * DBL_EPSILON * colmax, &theta, &argmin);
@@ -474,11 +497,13 @@ LEMKE_INLINE int pivot(const lemke_state *st, int r, int entering, double xr)
     int n = st->n;
     pd_lcp_work *ws = st->ws;
     const double *col = ws->col;
-    if (!isfinite(xr))
+    if (!isfinite(xr)) /* an overflowing basic value: nothing changed */
         return -1;
+    /* x_B -= x_r col, then x_r in row r */
     axpy_minus(n, xr, col, ws->xb);
     ws->xb[r] = xr;
     eta_update(n, ws->binv, col, r);
+    /* the leaving variable out, the entering one basic in row r */
     ws->row_of[ws->basis[r]] = -1;
     ws->basis[r] = entering;
     ws->row_of[entering] = r;
@@ -495,17 +520,18 @@ LEMKE_INLINE void basis_residual(const lemke_state *st, double *res)
 {
     int n = st->n;
     const pd_lcp_work *ws = st->ws;
+    /* res = q - sum_r x_r B[:, r]: B's column e_v for w_v, -a_v for z_j and z0 */
     for (int i = 0; i < n; i++)
         res[i] = st->q[i];
     for (int r = 0; r < n; r++) {
         int v = ws->basis[r];
         double x = ws->xb[r];
-        if (x == 0.0)
+        if (x == 0.0) /* nothing to subtract */
             continue;
         if (v < n) {
-            res[v] -= x;
+            res[v] -= x; /* w_v: e_v x */
         } else {
-            axpy_minus(n, -x, data_column(st, v), res);
+            axpy_minus(n, -x, data_column(st, v), res); /* -(-a_v) x */
         }
     }
 }
@@ -516,6 +542,7 @@ LEMKE_INLINE void refine(const lemke_state *st)
     int n = st->n;
     pd_lcp_work *ws = st->ws;
     double *res = ws->scratch, *dx = ws->col;
+    /* dx = B^-1 res with B^-1 as it is: x_B += dx */
     basis_residual(st, res);
     binv_times(n, ws->binv, ws->row_of, res, dx);
     for (int r = 0; r < n; r++)
@@ -539,7 +566,7 @@ static void extract_z(const lemke_state *st, double *z)
     const pd_lcp_work *ws = st->ws;
     for (int j = 0; j < n; j++) {
         int r = ws->row_of[n + j];
-        z[j] = r >= 0 ? ws->xb[r] : 0.0;
+        z[j] = r >= 0 ? ws->xb[r] : 0.0; /* basic z_j: its x_B */
     }
     clamp_roundoff(n, z);
 }
@@ -561,15 +588,17 @@ static int support_solve(const lemke_state *st, int k, double *z)
     int n = st->n;
     pd_lcp_work *ws = st->ws;
     double *A = ws->binv, *rhs = ws->scratch;
+    /* A = M_SS (k x k) over B^-1's storage, rhs = -q_S */
     for (int b = 0; b < k; b++) {
         const double *mcol = st->M + (size_t)ws->ties[b] * n;
         for (int a = 0; a < k; a++)
             A[a + (size_t)b * k] = mcol[ws->ties[a]];
         rhs[b] = -st->q[ws->ties[b]];
     }
-    if (pd_dense_lu(k, A, k, ws->perm, LEMKE_SINGULAR_TOL) != PD_OK)
+    if (pd_dense_lu(k, A, k, ws->perm, LEMKE_SINGULAR_TOL) != PD_OK) /* M_SS singular */
         return -1;
     pd_dense_lu_solve(k, A, k, ws->perm, rhs);
+    /* z_S from rhs, 0 off S */
     memset(z, 0, (size_t)n * sizeof(double));
     for (int a = 0; a < k; a++)
         z[ws->ties[a]] = rhs[a];
@@ -583,6 +612,7 @@ static int polish(const lemke_state *st, double *z)
 {
     int n = st->n, k = 0;
     pd_lcp_work *ws = st->ws;
+    /* S: the basic z_j */
     for (int j = 0; j < n; j++)
         if (ws->row_of[n + j] >= 0)
             ws->ties[k++] = j;
@@ -601,10 +631,12 @@ static int repair_support(const lemke_state *st, const double *z, const double *
     pd_lcp_work *ws = st->ws;
     double zs = pd_lcp_max_abs(n, z);
     for (int j = 0; j < n; j++) {
+        /* infeasible beyond the verification's tolerance: in S
+         * with z_j < 0, or off S with w_j < 0 */
         int in = z[j] != 0.0;
         int flip = in ? z[j] < -LEMKE_VERIFY_TOL * zs : w[j] < -LEMKE_VERIFY_TOL * ws->rows[j];
         changed |= flip;
-        if (in != flip)
+        if (in != flip) /* the new support: kept, or entering */
             ws->ties[k++] = j;
     }
     return changed ? k : -1;
@@ -623,6 +655,7 @@ static int repair(const lemke_state *st, double *z, double *w, pd_lcp_info *info
 {
     for (int round = 0; round < LEMKE_REPAIR_ROUNDS; round++) {
         int k = repair_support(st, z, w);
+        /* nothing infeasible, or M_SS singular: no repair */
         if (k < 0 || support_solve(st, k, z) != 0)
             return 0;
         if (verify(st, z, w, info))
@@ -651,17 +684,19 @@ LEMKE_INLINE pd_lcp_outcome pivot_loop(const lemke_state *st, int cap, int *pivo
 {
     int n = st->n, z0 = 2 * n;
     pd_lcp_work *ws = st->ws;
+    /* B = I; z0 enters at the row of max -q_i / d_i */
     start_basis(st);
     int r = first_leaving_row(st);
     int leaving = ws->basis[r];
     double xr = first_xr(st, r);
     if (pivot(st, r, z0, xr) != 0)
         return PD_LCP_NUMERICAL;
-    *pivots = 1;
+    *pivots = 1; /* the pivot that brings z0 in */
+    /* the complement of the variable that left enters */
     for (int entering = complement(n, leaving);; entering = complement(n, leaving)) {
         if (*pivots >= cap)
             return PD_LCP_MAX_PIVOTS;
-        if (*pivots % LEMKE_REFINE_EVERY == 0)
+        if (*pivots % LEMKE_REFINE_EVERY == 0) /* x_B refined every 50 pivots */
             refine(st);
         r = ratio_test(st, entering_column(st, entering), &xr);
         if (r == RATIO_RAY)
@@ -672,6 +707,7 @@ LEMKE_INLINE pd_lcp_outcome pivot_loop(const lemke_state *st, int cap, int *pivo
         if (pivot(st, r, entering, xr) != 0)
             return PD_LCP_NUMERICAL;
         ++*pivots;
+        /* z0 left: z0 = 0, the basis complementary, a solution */
         if (leaving == z0)
             return PD_LCP_SOLVED;
     }
@@ -745,6 +781,7 @@ LEMKE_INLINE void v4_binv_times(const lemke_state *st, const lemke_v4 *binv, con
         if (vi == 0.0)
             continue;
         int r = ws->row_of[i];
+        /* w_i basic in row r: lane r gains v_i; else acc += v_i B^-1[:, i] */
         if (r >= 0)
             acc = V4_BLEND(acc, acc + vi, r);
         else
@@ -785,10 +822,10 @@ LEMKE_INLINE double v4_column(const lemke_state *st, v4_regs *reg, int var)
                 reg->col = reg->binv[c];
     } else {
         v4_binv_times(st, reg->binv, data_column(st, var), NULL, &reg->col);
-        reg->col = -reg->col;
+        reg->col = -reg->col; /* the tableau's -a_v */
     }
     *(lemke_v4 *)st->ws->col = reg->col;
-    lemke_v4 a = (lemke_v4)((lemke_m4)reg->col & LEMKE_ABS_BELOW[n]);
+    lemke_v4 a = (lemke_v4)((lemke_m4)reg->col & LEMKE_ABS_BELOW[n]); /* |col|, lanes past n 0 */
     lemke_m4 nan = (lemke_m4)(a != a);
     if (nan[0] | nan[1] | nan[2] | nan[3])
         return NAN;
@@ -806,6 +843,7 @@ LEMKE_INLINE int v4_blocking_row(const lemke_state *st, const v4_regs *reg, doub
     int n = st->n, argmin = -1, positive = 0;
     lemke_v4 col = reg->col, xb = reg->xb, zero = V4_SPLAT(0.0);
     lemke_v4 x = (lemke_v4)((lemke_m4)xb & (lemke_m4)(xb > zero)); /* max(x_B, 0) */
+    /* the divisions side by side, ahead of the search for the minimum */
     lemke_v4 ratio = x / col, recip = V4_SPLAT(1.0) / col;
     double theta = INFINITY, rp_min = 0.0;
     LEMKE_UNROLL
@@ -822,13 +860,14 @@ LEMKE_INLINE int v4_blocking_row(const lemke_state *st, const v4_regs *reg, doub
     x = (lemke_v4)((lemke_m4)x & LEMKE_BELOW[n]); /* xscale: the largest of the same numbers */
     double xscale = max2(st->qmax, max2(max2(x[0], x[1]), max2(x[2], x[3])));
     double slack = st->tol * xscale;
-    lemke_v4 gap = x - theta * col;
+    lemke_v4 gap = x - theta * col; /* x_i - theta col_i */
     lemke_m4 other = (lemke_m4)(col > V4_SPLAT(ptol)) & LEMKE_BELOW[n] & ~LEMKE_LANE[argmin];
     lemke_m4 maybe = other & (lemke_m4)(gap <= V4_SPLAT(slack)); /* gap <= 0 among them */
     int r = argmin;
     if (maybe[0] | maybe[1] | maybe[2] | maybe[3])
         r = blocking_ties(st, ptol, theta, slack, argmin);
     const double *xbp = st->ws->xb, *colp = st->ws->col;
+    /* x_r / col_r and 1 / col_r: the minimum's own divisions when its row leaves */
     *xr = r == argmin && positive ? theta : xbp[r] / colp[r];
     *rp = r == argmin ? rp_min : 1.0 / colp[r];
     return r;
@@ -856,13 +895,15 @@ LEMKE_INLINE int v4_pivot(const lemke_state *st, v4_regs *reg, int r, int enteri
     lemke_v4 *copy = (lemke_v4 *)ws->binv;
     if (!isfinite(xr))
         return -1;
+    /* x_B -= x_r col, lane r = x_r */
     *(lemke_v4 *)ws->xb = reg->xb = V4_BLEND(reg->xb - xr * reg->col, V4_SPLAT(xr), r);
     LEMKE_UNROLL
     for (int c = 0; c < LEMKE_SMALL_N; c++) {
         if (c >= n)
             break;
+        /* column c: t = B^-1[r, c] / col_r, B^-1[:, c] -= t col, lane r = t */
         double bcr = ws->binv[r + LEMKE_SMALL_N * c];
-        if (bcr == 0.0)
+        if (bcr == 0.0) /* E leaves it as it is */
             continue;
         double t = bcr * rp;
         copy[c] = reg->binv[c] = V4_BLEND(reg->binv[c] - t * reg->col, V4_SPLAT(t), r);
@@ -885,6 +926,7 @@ LEMKE_INLINE void v4_refine(const lemke_state *st, v4_regs *reg)
 {
     int n = st->n;
     pd_lcp_work *ws = st->ws;
+    /* res = q - B x_B as basis_residual, then x_B += B^-1 res */
     lemke_v4 res = V4_LOAD_N(st->q, n), dx, *xb = reg ? &reg->xb : (lemke_v4 *)ws->xb;
     LEMKE_UNROLL
     for (int r = 0; r < LEMKE_SMALL_N; r++) {
@@ -922,6 +964,7 @@ LEMKE_INLINE void v4_extract_z(const lemke_state *st, double *z)
         double a = fabs(zj[j]);
         m = a > m ? a : m; /* max|z|, as pd_lcp_max_abs */
     }
+    /* negatives above -tol_verify max|z| become 0, as clamp_roundoff */
     double floor_ = -LEMKE_VERIFY_TOL * m;
     LEMKE_UNROLL
     for (int j = 0; j < LEMKE_SMALL_N; j++) {
@@ -943,7 +986,7 @@ LEMKE_INLINE pd_lcp_outcome v4_pivot_loop(const lemke_state *st, int cap, int *p
     double xr = first_xr(st, r), rp = first_rp(st, r);
     if (v4_pivot(st, &reg, r, z0, xr, rp) != 0)
         return PD_LCP_NUMERICAL;
-    *pivots = 1;
+    *pivots = 1; /* the pivot that brings z0 in */
     for (int entering = complement(n, leaving);; entering = complement(n, leaving)) {
         if (*pivots >= cap)
             return PD_LCP_MAX_PIVOTS;
@@ -980,6 +1023,7 @@ LEMKE_INLINE pd_lcp_outcome finish_solved(const lemke_state *st, int vec, double
                                           pd_lcp_info *info)
 {
     (void)vec; /* without LEMKE_VECTORS */
+    /* refine x_B, extract z, verify: at most LEMKE_FINAL_REFINES times */
     for (int k = 0; k < LEMKE_FINAL_REFINES; k++) {
 #ifdef LEMKE_VECTORS
         if (vec) {
@@ -1003,21 +1047,23 @@ LEMKE_INLINE pd_lcp_outcome finish_solved(const lemke_state *st, int vec, double
 static pd_lcp_outcome finish_repaired(const lemke_state *st, double *z, double *w,
                                       pd_lcp_info *info)
 {
-    double pivoting = info->residual;
+    double pivoting = info->residual; /* the pivoting answer's */
     int polished = polish(st, z) == 0;
     if (polished) {
         if (verify(st, z, w, info))
             return PD_LCP_SOLVED;
-        polished = info->residual < pivoting;
+        polished = info->residual < pivoting; /* kept only if better */
     }
     if (!polished) { /* the pivoting answer is the better one */
         extract_z(st, z);
         verify(st, z, w, info);
     }
+    /* the better answer kept while repair overwrites z */
     double *best = st->ws->col; /* free once the pivots are over */
     memcpy(best, z, (size_t)st->n * sizeof(double));
     if (repair(st, z, w, info))
         return PD_LCP_SOLVED;
+    /* no repair verified: the better answer again, with its figures */
     memcpy(z, best, (size_t)st->n * sizeof(double));
     verify(st, z, w, info);
     return PD_LCP_NUMERICAL;
@@ -1039,6 +1085,7 @@ LEMKE_INLINE pd_lcp_outcome pivot_and_finish(const lemke_state *st0, int vec, in
 #endif
     if (outcome == PD_LCP_SOLVED)
         return finish_solved(st, vec, z, w, info);
+    /* a ray, the cap, a numerical end: the last basis's z and its figures */
     extract_z(st, z);
     verify(st, z, w, info);
     return outcome;
@@ -1079,6 +1126,7 @@ static int scan_finite(int count, const double *x)
     const v2 big = {DBL_MAX, DBL_MAX};
     const m2 sign = {0x7fffffffffffffffLL, 0x7fffffffffffffffLL};
     m2 ok = {-1, -1};
+    /* |x| <= DBL_MAX with the sign bit cleared: false for an infinity or a NaN */
     for (; k + 2 <= count; k += 2) {
         v2 v = *(const v2 *)(x + k);
         ok &= (m2)((v2)((m2)v & sign) <= big);
@@ -1094,6 +1142,7 @@ static int scan_finite(int count, const double *x)
     }
     bad |= b1 | b2 | b3;
 #endif
+    /* the entries left over */
     for (; k < count; k++)
         bad |= !(fabs(x[k]) <= DBL_MAX);
     return bad ? -1 : 0;
@@ -1109,7 +1158,7 @@ static int scan_data(lemke_state *st, int *q_nonneg)
     for (int i = 0; i < st->n; i++) {
         double a = fabs(q[i]);
         qmax = a > qmax ? a : qmax;
-        bad |= !(a <= DBL_MAX);
+        bad |= !(a <= DBL_MAX); /* an infinity or a NaN */
         neg |= q[i] < 0.0;
     }
     st->qmax = qmax;
@@ -1121,7 +1170,7 @@ static int scan_data(lemke_state *st, int *q_nonneg)
  * the workspace's all ones. */
 static int set_cover(lemke_state *st, const double *cover)
 {
-    st->unit_cover = !cover;
+    st->unit_cover = !cover; /* d = 1: the first pivot divides by nothing */
     st->d = cover ? cover : st->ws->cover;
     for (int i = 0; cover && i < st->n; i++)
         if (!(cover[i] > 0.0) || !isfinite(cover[i]))
@@ -1144,7 +1193,7 @@ static int outcome_status(pd_lcp_outcome outcome)
 static int set_options(lemke_state *st, const pd_lcp_opts *opts, int *cap)
 {
     pd_lcp_opts o = opts ? *opts : pd_lcp_default_opts();
-    if (!(o.tol > 0.0 && o.tol < 1.0) || o.max_pivots < 0)
+    if (!(o.tol > 0.0 && o.tol < 1.0) || o.max_pivots < 0) /* tol in (0, 1), max_pivots >= 0 */
         return -1;
     st->tol = o.tol;
     int by_size = LEMKE_CAP_PER_N * st->n; /* n <= 46340: no overflow */
@@ -1167,7 +1216,7 @@ pd_lcp_opts pd_lcp_default_opts(void)
 static int other_row_fails(const lemke_state *st, int s, double zs)
 {
     int o = 1 - s;
-    double p = st->M[o + 2 * s] * zs, wo = st->q[o] + p;
+    double p = st->M[o + 2 * s] * zs, wo = st->q[o] + p; /* w_o = q_o + M_os z_s */
     return wo < 0.0 && -wo / (fabs(st->q[o]) + fabs(p)) > LEMKE_VERIFY_TOL;
 }
 
@@ -1178,22 +1227,25 @@ static int small_closed_form(const lemke_state *st, double *z, double *w, pd_lcp
 {
     const double *M = st->M, *q = st->q;
     int n = st->n;
+    /* s = 0: {1}, 1: {2}, 2: {1, 2} */
     for (int s = 0; s < (n == 1 ? 1 : 3); s++) {
         z[0] = z[n - 1] = 0.0;
         if (s < 2) {
             double d = M[s + (size_t)s * n];
-            if (d == 0.0)
+            if (d == 0.0) /* no pivot: the next support */
                 continue;
-            z[s] = -q[s] / d;
+            z[s] = -q[s] / d; /* M_ss z_s = -q_s */
             if (n == 2 && other_row_fails(st, s, z[s]))
                 continue;
         } else {
             double det = M[0] * M[3] - M[2] * M[1];
             if (det == 0.0)
                 continue;
+            /* Cramer: z = -M^-1 q */
             z[0] = (-q[0] * M[3] + q[1] * M[2]) / det;
             z[1] = (-q[1] * M[0] + q[0] * M[1]) / det;
         }
+        /* z >= 0 and verified */
         if (z[0] >= 0.0 && z[n - 1] >= 0.0 && verify(st, z, w, info))
             return 1;
     }
@@ -1216,6 +1268,7 @@ int pd_lcp_lemke(pd_lcp_work *work, int n, const double *M, const double *q,
     lemke_state st = {.n = n, .ld = n, .M = M, .q = q, .ws = work};
 #ifdef LEMKE_VECTORS
     lemke_small small;
+    /* n <= 4 with AVX2: the workspace on the stack, B^-1 of leading dimension 4 */
     if (n <= LEMKE_SMALL_N && __builtin_cpu_supports("avx2")) {
         small.ws = (pd_lcp_work){.nmax = LEMKE_SMALL_N, .binv = small.binv, .xb = small.xb,
                                  .col = small.col, .cover = work->cover,
@@ -1230,11 +1283,13 @@ int pd_lcp_lemke(pd_lcp_work *work, int n, const double *M, const double *q,
     int cap = 0, q_nonneg = 0;
     if (set_options(&st, opts, &cap) != 0 || scan_data(&st, &q_nonneg) != 0)
         return PD_EINVAL;
+    /* q >= 0: z = 0, w = q, no pivot */
     if (q_nonneg) {
         memset(z, 0, (size_t)n * sizeof(double));
         info->outcome = verify(&st, z, w, info) ? PD_LCP_SOLVED : PD_LCP_NUMERICAL;
         return outcome_status(info->outcome);
     }
+    /* n <= 2: the closed forms first, no pivot */
     if (n <= 2 && small_closed_form(&st, z, w, info)) {
         info->outcome = PD_LCP_SOLVED;
         return PD_OK;

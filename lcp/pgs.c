@@ -55,10 +55,12 @@ int pd_pgs_solve(pd_pgs_work *ws, const pd_matrix *M, const double *q, const pd_
                  double *z, double *w, pd_lcp_info *info)
 {
     int n = M->rows;
+    /* the budget: max_iterations sweeps, else 1000 n, at most 10^6 */
     long maxit = o->max_iterations > 0 ? o->max_iterations : 1000L * n;
     maxit = maxit > 1000000L ? 1000000L : maxit;
     info->iterations = 0;
     for (int i = 0; i < n; i++) {
+        /* the start z = 0, w = q; every M_ii must be positive */
         ws->diag[i] = pd_matrix_get(M, i, i);
         if (!(ws->diag[i] > 0.0)) {
             info->outcome = PD_LCP_NUMERICAL; /* a zero or negative pivot: PGS cannot move */
@@ -71,9 +73,10 @@ int pd_pgs_solve(pd_pgs_work *ws, const pd_matrix *M, const double *q, const pd_
     }
     for (long it = 1; it <= maxit; it++) {
         for (int i = 0; i < n; i++) {
+            /* z_i <- max(0, z_i - w_i / M_ii): the new w_i is 0 where z_i stays positive */
             double zi = z[i] - w[i] / ws->diag[i];
             zi = zi > 0.0 ? zi : 0.0;
-            if (zi != z[i]) {
+            if (zi != z[i]) { /* w += (z_i new - z_i) M[:, i] */
                 column_axpy(M, i, zi - z[i], w);
                 z[i] = zi;
             }
@@ -85,10 +88,11 @@ int pd_pgs_solve(pd_pgs_work *ws, const pd_matrix *M, const double *q, const pd_
                 info->outcome = PD_LCP_SOLVED;
                 return PD_OK;
             }
-            if (!isfinite(info->residual))
+            if (!isfinite(info->residual)) /* diverged: no sweep brings it back */
                 break;
         }
     }
+    /* the budget spent, or a residual that diverged: numerical */
     info->outcome = isfinite(info->residual) ? PD_LCP_MAX_ITERATIONS : PD_LCP_NUMERICAL;
     return isfinite(info->residual) ? PD_EMAXITER : PD_ENUMERICAL;
 }

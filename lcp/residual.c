@@ -14,6 +14,7 @@ double pd_lcp_max_abs(int n, const double *x)
 {
     double m0 = 0.0, m1 = 0.0, m2 = 0.0, m3 = 0.0;
     int i = 0;
+    /* four running maxima: independent chains that -O2 vectorises */
     for (; i + 4 <= n; i += 4) {
         double a0 = fabs(x[i]), a1 = fabs(x[i + 1]), a2 = fabs(x[i + 2]), a3 = fabs(x[i + 3]);
         m0 = a0 > m0 ? a0 : m0;
@@ -25,6 +26,7 @@ double pd_lcp_max_abs(int n, const double *x)
         double a = fabs(x[i]);
         m0 = a > m0 ? a : m0;
     }
+    /* the lanes' maxima combined */
     m0 = m1 > m0 ? m1 : m0;
     m2 = m3 > m2 ? m3 : m2;
     return m2 > m0 ? m2 : m0;
@@ -111,12 +113,14 @@ static inline double if_negative(double x, double r)
 static inline void verify_row(verify_acc *acc, int n, double zi_, double wi_, double ri,
                               double zs)
 {
+    /* |z_i| / zs and |w_i| / r_i, with 0 / 0 = 0 */
     double za = fabs(zi_), wa = fabs(wi_), zi = ratio(za, zs), wi = ratio(wa, ri);
     double v = wi < zi ? wi : zi;
     acc->nan |= !isfinite(zi_) || !isfinite(wi_) || !isfinite(ri); /* NaN compares false */
     acc->nan |= row_too_small(n, ri);
-    acc->comp = max_nb(acc->comp, za * wa);
-    acc->infeas = max_nb(acc->infeas, max_nb(-zi_, -wi_));
+    acc->comp = max_nb(acc->comp, za * wa); /* max |z_i w_i| */
+    acc->infeas = max_nb(acc->infeas, max_nb(-zi_, -wi_)); /* max(-z_i, -w_i) */
+    /* min(|w_i| / r_i, |z_i| / zs), and a negative z_i or w_i in full */
     v = max_nb(v, max_nb(if_negative(zi_, zi), if_negative(wi_, wi)));
     acc->rel = max_nb(acc->rel, v);
     acc->scale = max_nb(acc->scale, ri);
@@ -128,11 +132,13 @@ static void verify_rowwise(const pd_matrix *M, const double *q, const double *z,
                            double *rows, double zs, verify_acc *acc)
 {
     int n = M->rows, k = 0, supp[VERIFY_ROWWISE_N];
+    /* supp: the columns with z_j != 0 */
     for (int j = 0; j < M->cols; j++)
         if (z[j] != 0.0)
             supp[k++] = j;
     for (int i = 0; i < n; i++) {
         double wi = q[i], ri = fabs(q[i]);
+        /* w_i = q_i + sum_j M_ij z_j, r_i = |q_i| + sum_j |M_ij z_j| */
         for (int t = 0; t < k; t++) {
             double p = M->values[i + (size_t)supp[t] * (size_t)n] * z[supp[t]];
             wi += p;
@@ -156,7 +162,7 @@ static void affine_rows(const pd_matrix *M, const double *q, const double *z, do
     }
     for (int j = 0; j < M->cols; j++) {
         double zj = z[j];
-        if (zj == 0.0)
+        if (zj == 0.0) /* nothing to add (a NaN of M there is dropped) */
             continue;
         if (M->kind == PD_MATRIX_DENSE) {
             const double *mj = M->values + (size_t)j * (size_t)n;
@@ -191,6 +197,7 @@ static int verify_tridiagonal(const pd_matrix *M, const double *q, const double 
     /* rows j - 1, j, j + 1 while column j is added */
     double wa = 0.0, ra = 0.0, wb = q[0], rb = fabs(q[0]), wc, rc;
     for (int j = 0; j < n; j++) {
+        /* row j + 1 starts from q_j+1 */
         wc = j + 1 < n ? q[j + 1] : 0.0;
         rc = fabs(wc);
         /* a column with z_j = 0 adds -0 (live_term): no branch on z_j */
@@ -216,19 +223,22 @@ static int verify_tridiagonal(const pd_matrix *M, const double *q, const double 
             case 1: wc += p; rc += pa; break;
             default:
                 if (live)
-                    return -1;
+                    return -1; /* beyond the band: the general path */
             }
         }
+        /* row j - 1 is complete: stored and judged */
         if (j > 0) {
             w[j - 1] = wa;
             rows[j - 1] = ra;
             verify_row(acc, n, z[j - 1], wa, ra, zs);
         }
+        /* the window moves down a row */
         wa = wb;
         ra = rb;
         wb = wc;
         rb = rc;
     }
+    /* the last row */
     w[n - 1] = wa;
     rows[n - 1] = ra;
     verify_row(acc, n, z[n - 1], wa, ra, zs);
@@ -255,11 +265,13 @@ void pd_lcp_verify_zs(const pd_matrix *M, const double *q, const double *z, doub
                verify_tridiagonal(M, q, z, w, rows, zs, &acc) == 0) {
         /* done in one pass */
     } else {
+        /* a tridiagonal pass cut short left partial figures */
         acc = zero;
         affine_rows(M, q, z, w, rows);
         for (int i = 0; i < n; i++)
             verify_row(&acc, n, z[i], w[i], rows[i], zs);
     }
+    /* a NaN anywhere, or a row too small to judge: NaN figures, which no tolerance accepts */
     info->complementarity = acc.nan ? NAN : acc.comp;
     info->infeasibility = acc.nan ? NAN : acc.infeas;
     info->residual = acc.nan ? NAN : acc.rel;
@@ -279,8 +291,9 @@ void pd_lcp_residual(int n, const double *M, const double *q, const double *z, d
         return;
     pd_matrix A = pd_matrix_dense(n, n, M);
     pd_lcp_info info = {.complementarity = NAN, .infeasibility = NAN, .residual = NAN};
+    /* the row sizes on the stack up to n = 64 */
     double rows[64], *r = n <= 64 ? rows : malloc((size_t)n * sizeof(double));
-    if (r)
+    if (r) /* out of memory: the figures stay NaN */
         pd_lcp_verify(&A, q, z, w, r, &info);
     if (complementarity)
         *complementarity = info.complementarity;

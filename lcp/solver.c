@@ -110,10 +110,13 @@ pd_lcp_solver *pd_lcp_solver_alloc(pd_lcp_method method, int nmax, long nnzmax, 
         goto oom;
     s->type = type;
     s->nmax = nmax;
+    /* Lemke's workspace: a sparse problem handed over to it is copied densely (n^2), so
+     * the hand-over's cap, unless Lemke itself was asked for */
     int cap = method != PD_LCP_LEMKE && nnzmax > 0 ? PD_LCP_HANDOVER_NMAX : PD_LCP_LEMKE_NMAX;
     s->lemke_nmax = nmax < cap ? nmax : cap;
     if (type->lemke) {
         size_t ln = (size_t)s->lemke_nmax;
+        /* the dense copy only when sparse matrices will come */
         if (!(s->lemke = pd_lcp_alloc(s->lemke_nmax)) ||
             (nnzmax > 0 && !(s->dense = malloc(ln * ln * sizeof(double)))))
             goto oom;
@@ -152,11 +155,12 @@ static int solve_lemke(pd_lcp_solver *s, const pd_matrix *M, const double *q,
 {
     const double *dense = M->values;
     info->solver = "lemke";
-    if (M->rows > s->lemke_nmax)
+    if (M->rows > s->lemke_nmax) /* beyond its workspace */
         return PD_EINVAL;
     if (M->kind != PD_MATRIX_DENSE) {
         if (!s->dense)
             return PD_EINVAL;
+        /* compressed columns: Lemke works on a dense copy */
         pd_matrix_to_dense(M, s->dense);
         dense = s->dense;
     }
@@ -173,6 +177,7 @@ static inline int zeros(const double *x, int k)
 #if defined(__GNUC__) || defined(__clang__)
     typedef uint64_t u64x2 __attribute__((vector_size(16)));
     u64x2 v0, v1, v2, v3, acc = {0, 0};
+    /* or of every bit of the 8 k doubles */
     for (int b = 0; b < k; b++, x += 8) {
         memcpy(&v0, x, sizeof v0);
         memcpy(&v1, x + 2, sizeof v1);
@@ -180,7 +185,7 @@ static inline int zeros(const double *x, int k)
         memcpy(&v3, x + 6, sizeof v3);
         acc |= (v0 | v1) | (v2 | v3);
     }
-    acc <<= 1;
+    acc <<= 1; /* the sign bit off: -0 is zero */
     return !(acc[0] | acc[1]);
 #else
     uint64_t acc = 0, u;
@@ -208,14 +213,15 @@ static void dense_copy(pd_lcp_solver *s, const pd_matrix *M, pd_matrix *out)
     int *colptr = s->copy_colptr, *rowind = s->copy_rowind;
     double *values = s->copy_values;
     *out = *M;
-    cap = cap < half ? cap : half;
+    cap = cap < half ? cap : half; /* at most half the entries */
+    /* not dense, or no room for the copy: M as it is */
     if (M->kind != PD_MATRIX_DENSE || !colptr || cap > s->copy_cap)
         return;
     for (int j = 0; j < n; j++) {
         const double *c = M->values + (size_t)j * (size_t)n;
         colptr[j] = (int)nz;
         for (int i0 = 0; i0 < n; i0 += 8) {
-            int i1 = n - i0 >= 8 ? i0 + 8 : n;
+            int i1 = n - i0 >= 8 ? i0 + 8 : n; /* the block's end */
             if (n - i0 >= 32 && zeros(c + i0, 4)) { /* four cache lines at once */
                 i0 += 24;
                 continue;
@@ -231,6 +237,7 @@ static void dense_copy(pd_lcp_solver *s, const pd_matrix *M, pd_matrix *out)
                 }
         }
     }
+    /* every column copied: the same matrix in compressed columns */
     colptr[n] = (int)nz;
     *out = pd_matrix_csc(n, n, colptr, rowind, values);
 }
@@ -251,8 +258,10 @@ static int solve_structured(pd_lcp_solver *s, const pd_matrix *M, const double *
 {
     info->solver = "structured";
     int rc = solve_bpp(s, M, q, opts, z, w, info);
+    /* solved, too large for Lemke, or sparse with no room for its dense copy: the answer stands */
     if (rc == PD_OK || M->rows > s->lemke_nmax || (M->kind == PD_MATRIX_CSC && !s->dense))
         return rc;
+    /* Lemke's figures replace the structured solver's; its iteration count is kept */
     int iterations = info->iterations;
     rc = solve_lemke(s, M, q, opts, z, w, info);
     info->iterations = iterations;
@@ -279,13 +288,15 @@ static int solve_pgs_last(pd_lcp_solver *s, const pd_matrix *M, const double *q,
     pd_lcp_opts o = *opts;
     int pivots = info->pivots, iterations = info->iterations;
     long nnz = pd_matrix_nnz(M), n = M->rows;
+    /* a sweep costs about nnz multiply-adds (n at least): the sweeps within HANDOVER_PGS_WORK,
+     * at least HANDOVER_PGS_MIN */
     long sweeps = (long)(HANDOVER_PGS_WORK / (double)(nnz > n ? nnz : n));
     sweeps = sweeps > HANDOVER_PGS_MIN ? sweeps : HANDOVER_PGS_MIN;
     if (o.max_iterations <= 0 || o.max_iterations > sweeps)
         o.max_iterations = sweeps < 1000L * n ? (int)sweeps : 0; /* 0: PGS's own default */
     int rc = pd_pgs_solve(s->pgs, M, q, &o, z, w, info);
     info->pivots = pivots;
-    info->iterations += iterations;
+    info->iterations += iterations; /* the solvers before it */
     info->solver = name;
     return rc;
 }
@@ -297,11 +308,12 @@ static int solve_auto(pd_lcp_solver *s, const pd_matrix *M, const double *q,
                       const pd_lcp_opts *o, double *z, double *w, pd_lcp_info *info)
 {
     int rc;
+    /* n <= 2 (its closed forms), or dense within Lemke's workspace: Lemke first */
     if (M->rows <= 2 || (M->kind == PD_MATRIX_DENSE && M->rows <= s->lemke_nmax)) {
         rc = solve_lemke(s, M, q, o, z, w, info);
         if (!hands_over(rc))
             return rc;
-        int pivots = info->pivots;
+        int pivots = info->pivots; /* Lemke's, kept */
         rc = solve_bpp(s, M, q, o, z, w, info);
         info->pivots = pivots;
         info->solver = "structured (after lemke)";
@@ -309,6 +321,7 @@ static int solve_auto(pd_lcp_solver *s, const pd_matrix *M, const double *q,
             return rc;
         return solve_pgs_last(s, M, q, o, z, w, info, "pgs (after lemke, structured)");
     }
+    /* the structured solver (with its hand-over to Lemke), then PGS */
     rc = solve_structured(s, M, q, o, z, w, info);
     if (!hands_over(rc))
         return rc;
@@ -324,9 +337,11 @@ int pd_lcp_solve(pd_lcp_solver *s, const pd_matrix *M, const double *q, const pd
     pd_lcp_opts o = opts ? *opts : pd_lcp_default_opts();
     if (!info)
         info = &local;
+    /* info cleared; a bad call returns PD_EINVAL with the outcome numerical */
     memset(info, 0, sizeof *info);
     info->outcome = PD_LCP_NUMERICAL;
     info->solver = s ? s->type->name : "?";
+    /* square, 1 <= n <= nmax, dense or compressed columns */
     if (!s || !M || !q || !z || !w || M->rows != M->cols || M->rows < 1 || M->rows > s->nmax ||
         (M->kind != PD_MATRIX_DENSE && M->kind != PD_MATRIX_CSC))
         return PD_EINVAL;

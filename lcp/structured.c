@@ -196,10 +196,11 @@ static int load_envelope(pd_bpp_work *ws, const pd_matrix *M, int k)
         });
         ws->first[i] = f;
         ws->rowptr[i] = off;
-        off += i - f + 1;
+        off += i - f + 1; /* row i: columns f .. i */
         band = band > i - f ? band : i - f;
     }
     ws->rowptr[k] = off;
+    /* no row reaches back more than one column: three diagonals, no envelope */
     if ((ws->tridiagonal = band <= 1)) {
         for (int i = 0; i < k; i++) {
             ws->tb[i] = 0.0;
@@ -246,12 +247,14 @@ static int tri_factor(pd_bpp_work *ws, int off, int k, const double *shift)
 #define TRI_A(i) (shift ? a[i] + shift[i] : a[i])
     for (int s = 0; s < m; s++) {
         int i = s, j = k - 1 - s;
+        /* downward: l_i = A_i,i-1 / d_i-1, d_i = A_ii - l_i A_i,i-1 */
         double l = b[i] * rd, d = TRI_A(i) - l * b[i];
         if (!(d > BPP_PIVOT_TOL * TRI_A(i)) || !(d > 0.0))
             return -1;
         tl[i] = l;
         dinv[i] = rd = 1.0 / d;
         if (j > m) {
+            /* upward: u_j = A_j+1,j / e_j+1, e_j = A_jj - u_j A_j+1,j */
             double u = b[j + 1 < k ? j + 1 : 0] * re, e = TRI_A(j) - u * b[j + 1 < k ? j + 1 : 0];
             if (!(e > BPP_PIVOT_TOL * TRI_A(j)) || !(e > 0.0))
                 return -1;
@@ -259,6 +262,7 @@ static int tri_factor(pd_bpp_work *ws, int off, int k, const double *shift)
             dinv[j] = re = 1.0 / e;
         }
     }
+    /* row m takes both: g = A_mm - l_m A_m,m-1 - u_m A_m+1,m */
     double bm1 = m + 1 < k ? b[m + 1] : 0.0, l = b[m] * rd, u = bm1 * re;
     double g = TRI_A(m) - l * b[m] - u * bm1;
 #undef TRI_A
@@ -325,6 +329,7 @@ static int envelope_ldlt(pd_bpp_work *ws, int k)
                 d -= u * ri[j];
             }
         }
+        /* a pivot below 1e-13 of its diagonal entry: not positive definite to rounding */
         if (!(d > BPP_PIVOT_TOL * a) || !(d > 0.0))
             return -1;
         ri[i] = d;
@@ -465,6 +470,7 @@ static inline int port_ends(const pd_bpp_work *ws, const tri_port *p, double *na
         *den = p->s11;
         return 0;
     }
+    /* Cramer on S (z_a, z_k) = (f1, f2): den = det S */
     *den = p->s11 * p->s22 - p->s12 * p->s12;
     *na = p->s22 * p->f1 - p->s12 * p->f2;
     *nk = p->s11 * p->f2 - p->s12 * p->f1;
@@ -514,6 +520,7 @@ static int stieltjes_support(pd_bpp_work *ws, const pd_matrix *M, const double *
             else
                 return 0;
         }
+        /* a Stieltjes column: M_jj > 0, off-diagonal entries <= 0, M_j-1,j = M_j,j-1 */
         if (!(d > 0.0) || !(up <= 0.0) || !(lo <= 0.0) ||
             !(fabs(up - b[j]) <= STIELTJES_SYM * -(up + b[j]))) /* NaN fails */
             return 0;
@@ -524,8 +531,9 @@ static int stieltjes_support(pd_bpp_work *ws, const pd_matrix *M, const double *
         int touch = has && t.k == j - 1;
         if (!(touch ? q[j] * den + b[j] * nk < 0.0 : q[j] < 0.0))
             continue; /* w_j >= 0 with z_j = 0 (or NaN: verification refuses it) */
+        /* row j joins, an interval of its own: M_jj z_j = -q_j */
         tri_port one = {.a = j, .k = j, .s11 = d, .f1 = -q[j]};
-        if (touch) {
+        if (touch) { /* next to the interval on top: merged */
             if (port_merge(ws, &t, &one, b[j], &t))
                 return -1;
         } else {
@@ -553,7 +561,7 @@ static int stieltjes_support(pd_bpp_work *ws, const pd_matrix *M, const double *
         }
     }
     if (has)
-        st[depth++] = t;
+        st[depth++] = t; /* the last interval */
     ws->nport = depth;
     return 1;
 }
@@ -621,7 +629,7 @@ static double stieltjes_solve(pd_bpp_work *ws, int n, const double *q, double *z
     double zs = 0.0;
     for (int p = 0; p < ws->nport; p++) {
         int s = ws->port[p].a, k = ws->port[p].k - s + 1;
-        memset(z + done, 0, (size_t)(s - done) * sizeof(double));
+        memset(z + done, 0, (size_t)(s - done) * sizeof(double)); /* z = 0 between intervals */
         double zk = tri_factor_solve(ws, s, k, q, z);
         if (zk < 0.0)
             return -1.0;
@@ -648,7 +656,7 @@ static int principal_solve(pd_bpp_work *ws, const pd_matrix *M, const double *q,
 {
     int n = M->rows, k = 0;
     for (int i = 0; i < n; i++) {
-        ws->loc[i] = -1;
+        ws->loc[i] = -1; /* i's place in F, or -1; glob: the inverse */
         if (ws->inF[i]) {
             ws->loc[i] = k;
             ws->glob[k++] = i;
@@ -658,6 +666,7 @@ static int principal_solve(pd_bpp_work *ws, const pd_matrix *M, const double *q,
         return -1;
     if (ws->tridiagonal ? tri_factor(ws, 0, k, NULL) : envelope_ldlt(ws, k))
         return -2;
+    /* M_FF z_F = -q_F */
     for (int l = 0; l < k; l++)
         ws->rhs[l] = -q[ws->glob[l]];
     factor_solve(ws, k, ws->rhs);
@@ -665,6 +674,7 @@ static int principal_solve(pd_bpp_work *ws, const pd_matrix *M, const double *q,
     for (int l = 0; l < k; l++)
         z[ws->glob[l]] = ws->rhs[l];
     for (int i = 0; i < n; i++) {
+        /* w = M z + q and the row sizes, over F's columns */
         w[i] = q[i];
         ws->rows[i] = fabs(q[i]);
     }
@@ -688,6 +698,8 @@ static int infeasible(const pd_bpp_work *ws, int n, const double *z, const doubl
     int count = 0;
     *last = -1;
     for (int i = 0; i < n; i++) {
+        /* below -1e-11 of the scale (max |z|, or the row size
+         * r_i): a rounding of 0 is not infeasible */
         flag[i] = ws->inF[i] ? z[i] < -BPP_SIGN_TOL * zs : w[i] < -BPP_SIGN_TOL * ws->rows[i];
         if (flag[i]) {
             count++;
@@ -721,6 +733,7 @@ static int pivot_rounds(pd_bpp_work *ws, const pd_matrix *M, const double *q, in
             memset(flag, 0, (size_t)n);
             flag[last] = 1;
         }
+        /* the flagged indices change sides */
         for (int i = 0; i < n; i++)
             ws->inF[i] ^= flag[i];
     }
@@ -748,6 +761,7 @@ static void ipm_matvec(const pd_bpp_work *ws, const pd_matrix *M, const double *
     const double *a = ws->ta, *b = ws->tb;
     y[0] = a[0] * x[0];
     for (int i = 1; i < n; i++) {
+        /* M symmetric: row i takes M_i,i-1 x_i-1, row i - 1 takes M_i-1,i x_i */
         y[i] = a[i] * x[i] + b[i] * x[i - 1];
         y[i - 1] += b[i] * x[i];
     }
@@ -791,6 +805,7 @@ static int ipm_factor(pd_bpp_work *ws, int n, const double *shift)
     if (ws->tridiagonal)
         return tri_factor(ws, 0, n, shift);
     memcpy(ws->env, ws->tmpl, (size_t)ws->rowptr[n] * sizeof(double));
+    /* the shift on the diagonal, the last entry of row i's envelope */
     for (int i = 0; i < n; i++)
         ws->env[ws->rowptr[i] + i - ws->first[i]] += shift[i];
     return envelope_ldlt(ws, n);
@@ -810,6 +825,7 @@ static int ipm_start(pd_bpp_work *ws, const pd_matrix *M, const double *q, doubl
         return -1;
     factor_solve(ws, n, z);
     double zs = fmax(pd_lcp_max_abs(n, z), qs / ds);
+    /* inside the orthant: z_i = max(z_i, 0) + IPM_START zs, w likewise */
     for (int i = 0; i < n; i++)
         z[i] = fmax(z[i], 0.0) + IPM_START * zs;
     ipm_matvec(ws, M, z, w);
@@ -854,15 +870,16 @@ static int interior_point(pd_bpp_work *ws, const pd_matrix *M, const double *q, 
         double mu = 0.0, rmax = 0.0;
         ipm_matvec(ws, M, z, ws->r);
         for (int i = 0; i < n; i++) {
-            mu += z[i] * w[i] / n;
+            mu += z[i] * w[i] / n; /* mu = z.w / n */
             ws->r[i] += q[i]; /* M z + q */
             double gap = fabs(w[i] - ws->r[i]);
             rmax = gap > rmax ? gap : rmax;
             rz[i] = 1.0 / z[i];
-            ws->diag[i] = w[i] * rz[i];
+            ws->diag[i] = w[i] * rz[i]; /* W Z^-1 */
         }
         ws->mu = mu;
         ws->rmax = rmax;
+        /* mu and the residual small against the scales qs^2 / ds and qs */
         if (mu <= tol * qs * qs / ds && rmax <= tol * qs)
             break;
         mu0 = mu0 < 0.0 ? mu : mu0;
@@ -881,13 +898,14 @@ static int interior_point(pd_bpp_work *ws, const pd_matrix *M, const double *q, 
         double a = step_to_boundary(n, z, az, w, ws->diag, NULL, aw), mua = 0.0;
         for (int i = 0; i < n; i++)
             mua += (z[i] + a * az[i]) * (w[i] + a * aw[i]) / n;
-        double sigma = pow(mua / mu, 3.0);
+        double sigma = pow(mua / mu, 3.0); /* Mehrotra's centring */
         for (int i = 0; i < n; i++) { /* corrector */
             double c = (sigma * mu - az[i] * aw[i]) * rz[i];
             dz[i] = -ws->r[i] + c;
             ws->rows[i] = c;
         }
         factor_solve(ws, n, dz);
+        /* 0.995 of the way to the boundary */
         a = IPM_STEP * step_to_boundary(n, z, dz, w, ws->diag, ws->rows, dw);
         for (int i = 0; i < n; i++) {
             z[i] += a * dz[i];
@@ -911,7 +929,7 @@ int pd_bpp_solve(pd_bpp_work *ws, const pd_matrix *M, const double *q, const pd_
                  double *z, double *w, unsigned char *flag, pd_lcp_info *info)
 {
     int n = M->rows, its = 0, rc;
-    int maxit = o->max_iterations > 0 ? o->max_iterations : 3 * n + 10;
+    int maxit = o->max_iterations > 0 ? o->max_iterations : 3 * n + 10; /* principal solves */
     double qs = pd_lcp_max_abs(n, q), ds = 0.0;
     info->iterations = 0;
     info->outcome = PD_LCP_NUMERICAL;
@@ -967,6 +985,7 @@ int pd_bpp_solve(pd_bpp_work *ws, const pd_matrix *M, const double *q, const pd_
         its += more > 0 ? more : 0;
         ipm = more == IPM_STALLED ? IPM_STALLED : ipm;
     }
+    /* the point itself only when converged to IPM_MU_TOL */
     int converged = ws->rmax <= IPM_MU_TOL * qs && ws->mu <= IPM_MU_TOL * qs * qs / ds;
     if ((ipm >= 0 || ipm == IPM_STALLED) && converged) {
         memcpy(z, ws->iz, (size_t)n * sizeof(double));
@@ -974,6 +993,7 @@ int pd_bpp_solve(pd_bpp_work *ws, const pd_matrix *M, const double *q, const pd_
             goto solved;
     }
     info->iterations = its;
+    /* pivoting out of rounds: max_iterations; anything else: numerical */
     info->outcome = rc > 0 ? PD_LCP_MAX_ITERATIONS : PD_LCP_NUMERICAL;
     return rc > 0 ? PD_EMAXITER : PD_ENUMERICAL;
 solved:
