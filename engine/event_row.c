@@ -40,6 +40,7 @@
 #include <string.h>
 
 #include "event_row.h"
+#include "pd_alloc.h"
 #include "pd_null.h"
 
 /* Bounce heights below this times the length scale are jumped (as the
@@ -116,6 +117,8 @@ pd_edr_opts pd_edr_default_opts(void)
 
 static int q_less(const edr_queue *q, int a, int b)
 {
+    /* earlier first; at one time the lower slot (contacts, clusters, the piece,
+     * the output): simultaneous events in an order fixed by the model */
     return q->key[a] < q->key[b] || (q->key[a] == q->key[b] && a < b);
 }
 
@@ -124,6 +127,7 @@ static void q_swap(edr_queue *q, int i, int j)
     int a = q->heap[i], b = q->heap[j];
     q->heap[i] = b;
     q->heap[j] = a;
+    /* pos stays the inverse of heap: pos[heap[i]] = i */
     q->pos[b] = i;
     q->pos[a] = j;
 }
@@ -131,6 +135,7 @@ static void q_swap(edr_queue *q, int i, int j)
 static void q_up(edr_queue *q, int i)
 {
     while (i > 0) {
+        /* the parent of heap index i is (i - 1) / 2 */
         int p = (i - 1) / 2;
         if (!q_less(q, q->heap[i], q->heap[p]))
             break;
@@ -142,6 +147,7 @@ static void q_up(edr_queue *q, int i)
 static void q_down(edr_queue *q, int i)
 {
     for (;;) {
+        /* down past the earlier of the children 2 i + 1, 2 i + 2 */
         int l = 2 * i + 1, rr = l + 1, s = i;
         if (l < q->n && q_less(q, q->heap[l], q->heap[s]))
             s = l;
@@ -158,6 +164,8 @@ static void q_down(edr_queue *q, int i)
 static void q_set(edr_queue *q, int slot, double t)
 {
     int i = q->pos[slot];
+    /* HUGE_VAL (or NaN): out; the heap's last entry takes its place and
+     * moves up or down from there */
     if (!(t < HUGE_VAL)) {
         if (i < 0)
             return;
@@ -170,6 +178,8 @@ static void q_set(edr_queue *q, int slot, double t)
         }
         return;
     }
+    /* a new slot goes at the end; a key moved earlier rises, one moved later
+     * sinks (only one of the two moves it) */
     q->key[slot] = t;
     if (i < 0) {
         i = q->n++;
@@ -188,6 +198,7 @@ static int cl_of_dof(const pd_edr *r, int dof) { return r->blk_cl[r->dof_blk[dof
 static void dof_state(pd_edr *r, int dof, double t, double *x, double *v, double *a)
 {
     double dx;
+    /* the flight gives x - xo, the increment from its origin's state */
     edr_dof_at(r, cl_of_dof(r, dof), dof, t, &dx, v, a);
     *x = r->xo[dof] + dx;
 }
@@ -196,6 +207,7 @@ static void dof_state(pd_edr *r, int dof, double t, double *x, double *v, double
 static double gap_now(pd_edr *r, int a, double t, double *U)
 {
     const edr_contact *ct = &r->ct[a];
+    /* g = g0 + w0 x0 + w1 x1 and U = w0 v0 + w1 v1 (a wall side: dof -1, at rest) */
     double g = ct->g0, u = 0.0;
     for (int s = 0; s < 2; s++)
         if (ct->dof[s] >= 0) {
@@ -224,6 +236,9 @@ static void gap_fn(void *vctx, double t, double out[3])
 {
     gap_ctx *g = vctx;
     const edr_contact *ct = &g->r->ct[g->a];
+    /* g(t) = g(tb) + sum_s w_s (dx_s(t) - dx_s(tb)): the base gap moved by the
+     * flights' increments, so that a gap known exactly (0 after a closing)
+     * keeps its value, free of the positions' rounding in g0 + W^T x */
     double gap = g->gb, U = 0.0, G = 0.0;
     for (int s = 0; s < 2; s++)
         if (ct->dof[s] >= 0) {
@@ -243,6 +258,8 @@ static void gap_fn(void *vctx, double t, double out[3])
 static void gap_base(pd_edr *r, int a, gap_ctx *g)
 {
     const edr_contact *ct = &r->ct[a];
+    /* tb: the later of its sides' flight origins; the gap is one smooth
+     * function of t since */
     double tb = -HUGE_VAL;
     for (int s = 0; s < 2; s++)
         if (ct->dof[s] >= 0)
@@ -258,6 +275,8 @@ static void gap_base(pd_edr *r, int a, gap_ctx *g)
             gap += ct->w[s] * (r->xo[ct->dof[s]] + g->dxb[s]);
         }
     }
+    /* an event that closed the contact set its gap to 0 at base_t: exact while
+     * neither side has left its origin since; else g0 + W^T x at tb */
     g->gb = r->base_t[a] == tb ? r->base_g[a] : gap;
     /* the rounding level of the gap: its terms' size */
     double size = fabs(ct->g0);
@@ -285,8 +304,10 @@ static double contact_step(const pd_edr *r, int a)
  * g + U s - G2 s^2 / 2 (HUGE_VAL when it never does). */
 static double safe_time(double g, double U, double G2)
 {
+    /* at zero or past it: no time is safe */
     if (!(g > 0.0))
         return 0.0;
+    /* no curvature: the line g + U s reaches 0 at g / -U when U < 0 */
     if (!(G2 > 0.0))
         return U < 0.0 ? g / -U : HUGE_VAL;
     return (U + sqrt(U * U + 2.0 * G2 * g)) / G2;
@@ -303,6 +324,7 @@ static double gap_curvature(const pd_edr *r, int a)
             const edr_cluster *cl = &r->cl[cl_of_dof(r, ct->dof[s])];
             if (!cl->bnd)
                 return -1.0;
+            /* x_i = s_i y + d_i: |g''| <= sum_s |w_s s_i| max |y''| of its side's flight */
             G2 += fabs(ct->w[s] * r->s[ct->dof[s]]) * cl->Y2;
         }
     return G2;
@@ -332,6 +354,7 @@ static void predict_contact(pd_edr *r, int a, double ts, int cont)
     /* windows double from EDR_WINDOW0 intervals as the prediction continues */
     int win = cont && r->win[slot] > 0 ? r->win[slot] : EDR_WINDOW0;
     r->win[slot] = win < EDR_WINDOW ? 2 * win : EDR_WINDOW;
+    /* the window: win scan steps from ts, cut at the horizon */
     double h = contact_step(r, a), tend = horizon(r), tw = fmin(tend, ts + win * h);
     s.width = 4e-8 * h;
     edr_pt p = edr_scan_point(&s, ts);
@@ -386,6 +409,8 @@ static void predict_contact(pd_edr *r, int a, double ts, int cont)
         q_set(&r->q, slot, ts + sf < tend ? ts + sf : HUGE_VAL);
         return;
     }
+    /* the window interval by interval on the contact's grid (the last
+     * interval ends at tw exactly): the first closing found is the prediction */
     long n = (long)ceil((tw - t0) / h);
     if (n < 1)
         n = 1;
@@ -401,6 +426,8 @@ static void predict_contact(pd_edr *r, int a, double ts, int cont)
         }
         p = b;
     }
+    /* nothing in the window: its continuation is queued at tw (none at the
+     * horizon: a piece change predicts every contact again, t1 ends the run) */
     r->qkind[slot] = EDR_Q_SCAN;
     q_set(&r->q, slot, tw < tend ? tw : HUGE_VAL);
 }
@@ -414,6 +441,7 @@ static void force_fn(void *vctx, double t, double out[3])
 {
     force_ctx *f = vctx;
     out[0] = edr_force_at(f->r, f->c, f->a, t);
+    /* the force alone: it is only bisected on its sign (edr_bisect_sign) */
     out[1] = out[2] = 0.0;
 }
 
@@ -423,10 +451,15 @@ static double detach_linear(pd_edr *r, int c, int a, double ta, double tb)
 {
     force_ctx f = {.r = r, .c = c, .a = a};
     double la = edr_force_at(r, c, a, ta), lb = edr_force_at(r, c, a, tb);
+    /* negative at ta already: it detaches now */
     if (la < 0.0)
         return ta;
+    /* a line positive at both ends stays positive */
     if (!(lb < 0.0))
         return HUGE_VAL;
+    /* the line's zero ta + la (tb - ta) / (la - lb), then a bracket of 16
+     * roundings about it; the whole interval when rounding puts the sign
+     * change outside */
     double tr = fmin(fmax(ta + la * (tb - ta) / (la - lb), ta), tb);
     double pad = 16.0 * 2e-16 * fmax(fabs(tr), 1e-300);
     double lo = fmax(tr - pad, ta), hi = fmin(tr + pad, tb);
@@ -450,6 +483,7 @@ static void predict_detach(pd_edr *r, int c, double ts, int cont)
     double tend = horizon(r), best = HUGE_VAL;
     int who = -1;
     const pd_sine_piece *pc = &r->pieces[cl->piece];
+    /* a REST tree's forces are lg f + ld: linear in t on a piece without sine */
     if (cl->kind == EDR_REST && pc->A == 0.0) { /* linear forces: closed form */
         for (int a = cl->pers_head; a >= 0; a = r->pers_next[a]) {
             double td = detach_linear(r, c, a, ts, tend);
@@ -471,11 +505,13 @@ static void predict_detach(pd_edr *r, int c, double ts, int cont)
         const pd_sine_piece *pc2 = &r->pieces[cl->piece];
         double sf = HUGE_VAL, df = pc2->A * pc2->w * cos(pc2->w * ts + pc2->phi) + pc2->c1;
         for (int a = cl->pers_head; a >= 0; a = r->pers_next[a]) {
+            /* lambda' = la y' + lb y'' + lg f' at ts; safe_time: no zero of lambda before */
             double lam = edr_force_at(r, c, a, ts);
             double dl = r->la[a] * cl->vy + r->lb[a] * cl->ay + r->lg[a] * df;
             double L2 = fabs(r->la[a]) * cl->Y2 + fabs(r->lb[a]) * cl->Y3 + fabs(r->lg[a]) * cl->F2;
             sf = fmin(sf, safe_time(lam, dl, L2));
         }
+        /* every force stays positive that long: no scan before */
         if (sf > EDR_SAFE_SCANS * h) {
             r->qkind[slot] = EDR_Q_SCAN;
             q_set(&r->q, slot, ts + sf < tend ? ts + sf : HUGE_VAL);
@@ -483,12 +519,15 @@ static void predict_detach(pd_edr *r, int c, double ts, int cont)
         }
     }
     for (int a = cl->pers_head; a >= 0; a = r->pers_next[a])
+        /* a force negative at ts already (at a re-origin, by rounding): detach now */
         if (edr_force_at(r, c, a, ts) < 0.0) {
             cl->det_contact = a;
             r->qkind[slot] = EDR_Q_HIT;
             q_set(&r->q, slot, ts);
             return;
         }
+    /* the window on the cluster's grid: a force negative at a grid point is
+     * bisected back to its first negative double; the earliest contact wins */
     long n = (long)ceil((tw - ts) / h);
     if (n < 1)
         n = 1;
@@ -513,6 +552,7 @@ static void predict_detach(pd_edr *r, int c, double ts, int cont)
         q_set(&r->q, slot, best);
         return;
     }
+    /* every force positive over the window: its continuation at tw */
     r->qkind[slot] = EDR_Q_SCAN;
     q_set(&r->q, slot, tw < tend ? tw : HUGE_VAL);
 }
@@ -528,6 +568,7 @@ static void meas_fn(void *vctx, double t, double out[3])
 {
     meas_ctx *m = vctx;
     double dx, v, a;
+    /* x = xo + dx, v, a of the dof; of the drift x_dof - x_below, their differences */
     edr_dof_at(m->r, m->c, m->dof, t, &dx, &v, &a);
     out[0] = m->r->xo[m->dof] + dx;
     out[1] = v;
@@ -543,6 +584,8 @@ static void meas_fn(void *vctx, double t, double out[3])
 /* Note f's extremes into the dof's results (x, or the drift). */
 static void note_meas(pd_edr *r, int dof, int drift, double fmax, double fmin)
 {
+    /* the drift's largest magnitude; x's largest excursions either way,
+     * xpos = max x and xneg = max (-x) */
     if (drift) {
         r->drift[dof] = pd_max(r->drift[dof], pd_max(fmax, -fmin));
         return;
@@ -563,6 +606,7 @@ static void tree_y_fn(void *vctx, double t, double out[3])
 {
     meas_ctx *m = vctx;
     edr_cluster *cl = &m->r->cl[m->c];
+    /* y = y0 + dy: the tree's one coordinate (every x_i = s_i y + d_i) */
     edr_cluster_eval(m->r, m->c, t);
     out[0] = cl->y0 + cl->dy;
     out[1] = cl->vy;
@@ -576,14 +620,18 @@ static void scan_functions(pd_edr *r, edr_cluster *cl, int nf, meas_ctx *mc, edr
 {
     edr_scan *sc = r->mscan;
     edr_pt *prev = r->mprev;
+    /* each function from ta, its value there noted (the extremes include the start) */
     for (int k = 0; k < nf; k++) {
         sc[k] = (edr_scan){.fn = fn, .ctx = &mc[k], .width = 4e-8 * cl->h, .hit_mode = 0,
                            .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
         prev[k] = edr_scan_point(&sc[k], ta);
         edr_scan_note(&sc[k], prev[k].f);
     }
+    /* held still (REST): constant, its value at ta is all */
     if (cl->kind == EDR_REST || !(tb > ta))
         return;
+    /* the cluster's grid, every function interval by interval (the last ends
+     * at tb); an interval notes its interior extrema and its end */
     long n = (long)ceil((tb - ta) / cl->h);
     if (n < 1)
         n = 1;
@@ -606,6 +654,7 @@ static void scan_functions(pd_edr *r, edr_cluster *cl, int nf, meas_ctx *mc, edr
 static void measure_cluster(pd_edr *r, int c, double tb)
 {
     edr_cluster *cl = &r->cl[c];
+    /* extremes count from t_measure on; meas_t: measured up to there */
     double ta = fmax(cl->meas_t, r->o.t_measure);
     cl->meas_t = fmax(cl->meas_t, tb);
     if (!(tb >= ta))
@@ -613,6 +662,9 @@ static void measure_cluster(pd_edr *r, int c, double tb)
     meas_ctx *mc = r->mctx;
     edr_scan *sc = r->mscan;
     if (cl->kind != EDR_MODAL) {
+        /* one scan of y: x_i = s_i y + d_i is monotone in y, its extremes
+         * s_i y_max + d_i and s_i y_min + d_i (swapped where s_i < 0); each block
+         * one dof, its structure's drift over the ground is its x */
         mc[0] = (meas_ctx){.r = r, .c = c, .dof = -1, .below = -1};
         scan_functions(r, cl, 1, mc, tree_y_fn, ta, tb);
         for (int b = cl->head; b >= 0; b = r->blk_next[b]) {
@@ -624,6 +676,9 @@ static void measure_cluster(pd_edr *r, int c, double tb)
         }
         return;
     }
+    /* modal: each dof's x and, above storey 1, its drift x_i - x_below as a
+     * function of its own (a difference's extremes are not the extremes'
+     * differences) */
     int nf = 0;
     for (int b = cl->head; b >= 0; b = r->blk_next[b]) {
         const edr_block *bk = &r->blk[b];
@@ -648,6 +703,8 @@ static void measure_contact(pd_edr *r, int a, double tb)
 {
     double ta = r->gmeas_t[a];
     r->gmeas_t[a] = fmax(ta, tb);
+    /* open contacts that never closed: once closed the minimum is 0 (an
+     * inactive contact never closes: its gap is measured throughout) */
     if (!(tb > ta) || (!(r->gmin[a] > 0.0) && !r->o.inactive) || r->cstate[a] != EDR_OPEN)
         return;
     gap_ctx g;
@@ -657,6 +714,7 @@ static void measure_contact(pd_edr *r, int a, double tb)
     s.width = 4e-8 * h;
     edr_pt p = edr_scan_point(&s, ta);
     edr_scan_note(&s, p.f);
+    /* f = -g on the contact's grid: the largest f is the smallest gap */
     long n = (long)ceil((tb - ta) / h);
     for (long i = 1; i <= n; i++) {
         double t = i == n ? tb : ta + (double)i * h, hit;
@@ -667,6 +725,8 @@ static void measure_contact(pd_edr *r, int a, double tb)
         p = b;
     }
     double gmin = -s.fmax;
+    /* an active contact below zero (a closing is located at the first double
+     * past zero): its penetration recorded, the minimum taken as 0 */
     if (gmin < 0.0 && !r->o.inactive) {
         r->res.max_penetration = fmax(r->res.max_penetration, -gmin);
         gmin = 0.0;
@@ -678,6 +738,7 @@ static void measure_contact(pd_edr *r, int a, double tb)
 
 static void group_add_cluster(pd_edr *r, int c)
 {
+    /* once per event: cl_mark holds the epoch of the event that took it */
     if (r->cl_mark[c] == r->epoch)
         return;
     r->cl_mark[c] = r->epoch;
@@ -696,6 +757,7 @@ static void group_add_contact(pd_edr *r, int a)
 static void group_grow(pd_edr *r, double t)
 {
     double tol = r->o.close_tol * r->L;
+    /* breadth first: ng grows as clusters join, each one searched in turn */
     for (int i = 0; i < r->ng; i++) {
         const edr_cluster *cl = &r->cl[r->g_cl[i]];
         for (int b = cl->head; b >= 0; b = r->blk_next[b]) {
@@ -704,7 +766,10 @@ static void group_grow(pd_edr *r, double t)
                 int a = r->blk_cont[bk->cont0 + k];
                 if (r->ct_mark[a] == r->epoch || r->ct_mark2[a] == r->epoch)
                     continue;
+                /* each contact looked at once per event (ct_mark2), taken once (ct_mark) */
                 r->ct_mark2[a] = r->epoch;
+                /* persistent and locked contacts are closed by definition; their
+                 * sides lie in this cluster already (or at a wall) */
                 if (r->cstate[a] != EDR_OPEN) {
                     group_add_contact(r, a);
                     continue;
@@ -715,7 +780,9 @@ static void group_grow(pd_edr *r, double t)
                 if (!(g <= tol))
                     continue;
                 group_add_contact(r, a);
+                /* tol_closed: closed at a gap that the model's own g0 leaves positive */
                 r->res.tol_closed += g + (r->md->g0[a] - r->ct[a].g0) > 0.0; /* the gap given */
+                /* its sides' clusters join: their contacts are searched in turn */
                 const edr_contact *ct = &r->ct[a];
                 for (int s = 0; s < 2; s++)
                     if (ct->dof[s] >= 0)
@@ -740,11 +807,13 @@ static void integrate_held(pd_edr *r, int c, double tb)
                                  0.4786286704993665, 0.2369268850561891};
     edr_cluster *cl = &r->cl[c];
     double ta = cl->imp_t;
+    /* no sampler, no held contact or nothing to integrate: only the mark moves */
     if (!r->sample_forces || cl->pers_head < 0 || !(tb > ta)) {
         cl->imp_t = fmax(ta, tb);
         return;
     }
     cl->imp_t = tb;
+    /* the cache and the evaluation count saved: sampling leaves the run as it was */
     long evals = r->evals;
     int cached = cl->cached;
     double tc = cl->tc;
@@ -753,6 +822,8 @@ static void integrate_held(pd_edr *r, int c, double tb)
     if (n < 1)
         n = 1;
     double w = (tb - ta) / (double)n;
+    /* n pieces of width w <= h; on each, int f = (w / 2) sum_k wg_k
+     * f(mid + (w / 2) xg_k), exact for polynomials of degree up to 9 */
     for (long i = 0; i < n; i++) {
         double mid = ta + ((double)i + 0.5) * w;
         for (int k = 0; k < 5; k++) {
@@ -761,6 +832,7 @@ static void integrate_held(pd_edr *r, int c, double tb)
                 r->imp_out[a] += f * edr_force_at(r, c, a, t);
         }
     }
+    /* the cache back at tc, where the run left it */
     if (cached)
         edr_cluster_eval(r, c, tc);
     r->evals = evals;
@@ -772,6 +844,8 @@ static void group_state(pd_edr *r, double t)
     r->ngd = 0;
     for (int i = 0; i < r->ng; i++) {
         int c = r->g_cl[i];
+        /* held forces integrated and extremes measured up to t, before the
+         * flights change at t */
         integrate_held(r, c, t);
         measure_cluster(r, c, t);
         for (int b = r->cl[c].head; b >= 0; b = r->blk_next[b]) {
@@ -793,9 +867,12 @@ static void group_state(pd_edr *r, double t)
 /* D = W_I^T M^-1 W_I over the contacts idx[0..k): dense (k <= EDR_DENSE_MAX) or CSC. */
 static pd_matrix delassus(pd_edr *r, const int *idx, int k)
 {
+    /* pos_in: each contact's row and column in D */
     for (int j = 0; j < k; j++)
         r->pos_in[idx[j]] = j;
     if (k <= EDR_DENSE_MAX) {
+        /* column j: D_aj = sum over the dofs i of contact j of w_ai w_ji / m_i,
+         * a running over the contacts of idx at dof i (marked by ct_markD) */
         double *D = r->Dd;
         memset(D, 0, (size_t)k * k * sizeof(double));
         for (int j = 0; j < k; j++) {
@@ -816,6 +893,8 @@ static pd_matrix delassus(pd_edr *r, const int *idx, int k)
         }
         return pd_matrix_dense(k, k, D);
     }
+    /* compressed: the same sums, each column's rows gathered as met (a row
+     * met at both of j's dofs summed into one entry) */
     int nz = 0;
     for (int j = 0; j < k; j++) {
         const edr_contact *cj = &r->ct[idx[j]];
@@ -866,6 +945,7 @@ static int scaled_lcp(pd_edr *r, pd_lcp_solver *solver, pd_matrix *D, int k, con
                       const pd_lcp_opts *lo, double *z, double *w, pd_lcp_info *info)
 {
     double *sc = r->lcp_scale, *qs = r->lcp_q;
+    /* S_jj = D_jj^-1/2 (a diagonal not > 0 cannot be scaled: PD_ENUMERICAL) */
     for (int j = 0; j < k; j++) {
         double d = 0.0;
         if (D->kind == PD_MATRIX_DENSE)
@@ -878,6 +958,7 @@ static int scaled_lcp(pd_edr *r, pd_lcp_solver *solver, pd_matrix *D, int k, con
         sc[j] = 1.0 / sqrt(d);
         qs[j] = sc[j] * q[j];
     }
+    /* D <- S D S in place, entry by entry */
     double *val = (double *)D->values; /* delassus()'s: r->Dd or r->Dval, formed per solve */
     for (int j = 0; j < k; j++) {
         if (D->kind == PD_MATRIX_DENSE)
@@ -904,6 +985,7 @@ static int scaled_lcp(pd_edr *r, pd_lcp_solver *solver, pd_matrix *D, int k, con
         for (int j = 0; j < k && !rc; j++) /* w of D itself */
             w[j] -= EDR_LCP_SHIFT * z[j];
     }
+    /* back from the scaled problem: z = S z', w = S^-1 w' */
     for (int j = 0; j < k && !rc; j++) {
         z[j] *= sc[j];
         w[j] /= sc[j];
@@ -916,11 +998,13 @@ static int solve_lcp(pd_edr *r, const int *idx, int k, const double *q, double *
 {
     if (k == 0)
         return PD_OK;
+    /* ct_markD: the contacts of idx, for delassus() to find them at each dof */
     r->epochD++;
     for (int j = 0; j < k; j++)
         r->ct_markD[idx[j]] = r->epochD;
     pd_matrix D = delassus(r, idx, k);
     r->res.lcp_solves++;
+    /* one contact: z = -q / D where q < 0, else 0 */
     if (k == 1) {
         z[0] = pd_contact_impulse_1(D.values[0], q[0]);
         w[0] = D.values[0] * z[0] + q[0];
@@ -933,6 +1017,7 @@ static int solve_lcp(pd_edr *r, const int *idx, int k, const double *q, double *
     lo.guess = r->guess;
     pd_lcp_info info;
     int rc = pd_lcp_solve(r->solver, &D, q, &lo, z, w, &info);
+    /* pivoting failed (masses of many decades): posed again on unit diagonal */
     if (rc)
         rc = scaled_lcp(r, r->solver, &D, k, q, &lo, z, w, &info);
     if (rc)
@@ -949,10 +1034,13 @@ static void group_rhs(pd_edr *r, double f, const double *x, const double *v, dou
     for (int k = 0; k < r->ngd; k++) {
         int i = r->g_dof[k], b = r->dof_blk[i];
         const edr_block *bk = &r->blk[b];
+        /* an SDOF block: (b f - c v - k x) / m */
         if (bk->sdof) {
             out[i] = (bk->b * f - bk->c * v[i] - bk->k * x[i]) * r->minv[i];
             continue;
         }
+        /* a block: row li of b f - C v - K x over its dofs (C, K column-major at
+         * blk_off), then 1 / M_ii */
         int li = r->dof_loc[i];
         long off = r->blk_off[b];
         double s = r->b[i] * f;
@@ -975,6 +1063,7 @@ static void free_accelerations(pd_edr *r, double t)
 static void free_jerks(pd_edr *r, double t)
 {
     const pd_sine_piece *pc = &r->pieces[edr_piece_at(r, t)];
+    /* f'(t) = c1 + A w cos(w t + phi) on the piece at t */
     double df = pc->c1 + (pc->A == 0.0 ? 0.0 : pc->A * pc->w * cos(pc->w * t + pc->phi));
     group_rhs(r, df, r->gv, r->gacc, r->gtmp);
 }
@@ -998,9 +1087,12 @@ static int reduced_force(pd_edr *r, const int *idx, int k, double t, pd_err *err
 static int force_lcp(pd_edr *r, const int *idx, int k, double t, pd_err *err)
 {
     double *q = r->qlcp, *lam = r->lam, *w = r->wtmp;
+    /* on the clusters' coordinates when it can (0, or an error); 1: the dofs decide */
     int rr = reduced_force(r, idx, k, t, err);
     if (rr != 1)
         return rr;
+    /* q_j = W_j^T a_free: the gap accelerations without contact forces, so that
+     * 0 <= g'' = D lambda + q _|_ lambda >= 0 */
     for (int j = 0; j < k; j++)
         q[j] = contact_dot(r, idx[j], r->gacc);
     int rc = solve_lcp(r, idx, k, q, lam, w, t, err);
@@ -1025,6 +1117,7 @@ static int force_lcp(pd_edr *r, const int *idx, int k, double t, pd_err *err)
 static int uf_find(int *p, int x)
 {
     while (p[x] != x) {
+        /* path halving: each node on the way to its grandparent */
         p[x] = p[p[x]];
         x = p[x];
     }
@@ -1036,6 +1129,7 @@ static int uf_find(int *p, int x)
 static int regroup(pd_edr *r, double t, pd_err *err)
 {
     int *uf = r->uf, rc;
+    /* the union-find over the group's blocks: each its own root */
     for (int i = 0; i < r->ng; i++) {
         int c = r->g_cl[i];
         for (int b = r->cl[c].head; b >= 0; b = r->blk_next[b])
@@ -1045,24 +1139,29 @@ static int regroup(pd_edr *r, double t, pd_err *err)
         int a = r->g_ct[j];
         const edr_contact *ct = &r->ct[a];
         int was = r->cstate[a] == EDR_PERSIST;
+        /* a persistent contact released: its time in contact since it was held */
         if (was && !r->held[j])
             r->ctime[a] += t - r->since[a] > 0.0 ? t - r->since[a] : 0.0;
         /* a contact's burst of impacts ends with a hold that lasted: one
          * released at once (a chatter through held states) bounces on */
         if (was && !r->held[j] && t - r->since[a] > EDR_HOLD_MIN)
             r->burst[a] = 0;
+        /* newly held: in contact from t, or from the end of a jumped accumulation's tail */
         if (r->held[j] && !was)
             r->since[a] = t + r->held_tail[j];
         r->cstate[a] = r->held[j] ? EDR_PERSIST : EDR_OPEN;
         r->pers_next[a] = -1;
+        /* every closed contact's gap is exactly 0 at t (gap_base) */
         r->base_t[a] = t;
         r->base_g[a] = 0.0;
+        /* a held contact between two blocks joins them; a wall joins nothing */
         if (r->held[j] && ct->blk[0] >= 0 && ct->blk[1] >= 0) {
             int x = uf_find(uf, ct->blk[0]), y = uf_find(uf, ct->blk[1]);
             if (x != y)
                 uf[x] = y;
         }
     }
+    /* the new flights start from the group's state at t */
     for (int k = 0; k < r->ngd; k++) {
         int i = r->g_dof[k];
         r->xo[i] = r->gx[i];
@@ -1099,6 +1198,7 @@ static int regroup(pd_edr *r, double t, pd_err *err)
         r->g_cl[r->ng++] = c;
     }
     for (int k = 0; k < nblk; k++) {
+        /* every block into its root's cluster */
         int b = r->gblk[k], c = r->newcl[uf_find(uf, b)];
         r->blk_cl[b] = c;
         r->blk_next[b] = r->cl[c].head;
@@ -1107,6 +1207,7 @@ static int regroup(pd_edr *r, double t, pd_err *err)
     }
     for (int j = 0; j < r->ngc; j++) {
         int a = r->g_ct[j];
+        /* every held contact into the persistent list of its cluster */
         if (!r->held[j])
             continue;
         const edr_contact *ct = &r->ct[a];
@@ -1116,6 +1217,7 @@ static int regroup(pd_edr *r, double t, pd_err *err)
         r->cl[c].npers++;
     }
     for (int i = 0; i < r->ng; i++)
+        /* each new cluster's flight: an SDOF tree, a REST tree or modal */
         if ((rc = edr_cluster_start(r, r->g_cl[i], t, err)))
             return rc;
     return PD_OK;
@@ -1132,6 +1234,7 @@ static void repredict(pd_edr *r, double t)
             const edr_block *bk = &r->blk[b];
             for (int k = 0; k < bk->ncont; k++) {
                 int a = r->blk_cont[bk->cont0 + k];
+                /* once each: a contact between two of the group's clusters is met twice */
                 if (r->ct_markP[a] == r->epochP)
                     continue;
                 r->ct_markP[a] = r->epochP;
@@ -1148,6 +1251,7 @@ static int report(pd_edr *r, double t, pd_edr_kind kind, int acc)
 {
     if (!r->o.on_event)
         return 0;
+    /* v+ and x of the group's dofs in g_dof order (v- was kept before the impact) */
     for (int k = 0; k < r->ngd; k++) {
         r->ev_vplus[k] = r->gv[r->g_dof[k]];
         r->ev_x[k] = r->gx[r->g_dof[k]];
@@ -1177,6 +1281,7 @@ static int count_event(pd_edr *r, int slot, double t, pd_err *err)
     if (++r->res.events > r->o.max_events)
         return pd_err_set(err, PD_EBUDGET, "row reference: %ld events by t = %.9g s (budget "
                           "exhausted)", r->res.events - 1, t * r->o.time_unit);
+    /* the same slot again at the same instant: time does not move for it */
     if (r->slot_t[slot] == t) {
         if (++r->slot_same[slot] > EDR_SAME_INSTANT)
             return pd_err_set(err, PD_EBUDGET, "row reference: %d events at t = %.17g s without "
@@ -1210,7 +1315,10 @@ static int decide_persistence(pd_edr *r, double t, int *acc_jumped, pd_err *err)
     *acc_jumped = 0;
     for (int k = 0; k < r->ngd; k++)
         vs = fmax(vs, fabs(r->gv[r->g_dof[k]]));
+    /* a rate is zero below EDR_RATE_TOL of the event's (and the run's) speeds */
     double tolU = EDR_RATE_TOL * fmax(vs, r->vscale);
+    /* the candidates: closed contacts at zero rate after the impact, the
+     * detaching one excluded; jpos[j]: a contact's place in idx, or -1 */
     for (int j = 0; j < r->ngc; j++) {
         r->held[j] = 0;
         r->held_tail[j] = 0.0;
@@ -1219,6 +1327,8 @@ static int decide_persistence(pd_edr *r, double t, int *acc_jumped, pd_err *err)
         else
             r->jpos[j] = -1;
     }
+    /* the force LCP, 0 <= g'' = D lambda + W^T a_free _|_ lambda >= 0: a
+     * positive force holds the contact */
     free_accelerations(r, t);
     if ((rc = force_lcp(r, idx, k0, t, err)))
         return rc;
@@ -1243,6 +1353,7 @@ static int decide_persistence(pd_edr *r, double t, int *acc_jumped, pd_err *err)
         ties |= r->tie[j];
     }
     if (ties) {
+        /* held when the free gap's jerk W^T j_free < 0 closes it */
         free_jerks(r, t);
         for (int j = 0; j < r->ngc; j++)
             if (r->tie[j])
@@ -1258,6 +1369,8 @@ static int decide_persistence(pd_edr *r, double t, int *acc_jumped, pd_err *err)
         double U = r->Uplus[j], acl = -r->wlcp[j], e = r->ct[a].e;
         if (r->jpos[j] >= 0 || r->excluded[j] || !(U > 0.0) || !(e < 1.0) || !(acl > 0.0))
             continue;
+        /* the next bounce's height U^2 / (2 a), and the time of all the bounces
+         * left, sum_k 2 e^k U / a = 2 U / (a (1 - e)): the tail jumped */
         double height = U * U / (2.0 * acl), tail = 2.0 * U / (acl * (1.0 - e));
         if (height > EDR_ACC_HEIGHT * r->L || !(t + tail < tend))
             continue;
@@ -1268,8 +1381,10 @@ static int decide_persistence(pd_edr *r, double t, int *acc_jumped, pd_err *err)
     }
     if (ns == 0)
         return PD_OK;
+    /* the force LCP with the jumped contacts taken as at rest */
     if ((rc = force_lcp(r, idx, k1, t, err)))
         return rc;
+    /* every jumped contact must push */
     int ok = 1;
     for (int j = 0; j < r->ngc && ok; j++)
         if (r->held_tail[j] > 0.0)
@@ -1302,8 +1417,10 @@ static int tails_hold(pd_edr *r)
         if (!(tail > 0.0) || !r->held[j])
             continue;
         int a = r->g_ct[j], c = r->blk_cl[r->ct[a].blk[0] >= 0 ? r->ct[a].blk[0] : r->ct[a].blk[1]];
+        /* not held after all (locked in a cycle): nothing to check */
         if (r->cstate[a] != EDR_PERSIST)
             continue;
+        /* lambda at the tail's middle and end on the new cluster's flight (from t0) */
         double t0 = r->cl[c].t0;
         if (!(edr_force_at(r, c, a, t0 + 0.5 * tail) > 0.0) || !(edr_force_at(r, c, a, t0 + tail) > 0.0))
             return 0;
@@ -1349,8 +1466,10 @@ static int commit_impacts(pd_edr *r, double t, pd_err *err)
 {
     for (int j = 0; j < r->ngc; j++) {
         int a = r->g_ct[j];
+        /* imp_out: impulses since the last sample; maxP: the largest impact's impulse */
         r->imp_out[a] += r->P[j];
         r->maxP[a] = pd_max(r->maxP[a], r->P[j]);
+        /* pressed, never closing: no impact to count */
         if (!r->nimp[j])
             continue;
         r->impacts[a] += r->nimp[j];
@@ -1359,6 +1478,8 @@ static int commit_impacts(pd_edr *r, double t, pd_err *err)
             r->first[a] = t;
         if (isnan(r->res.first_impact))
             r->res.first_impact = t;
+        /* burst: impacts since its last lasting hold; past max_burst the run is in
+         * an accumulation it does not end */
         if ((r->burst[a] += r->nimp[j]) > r->o.max_burst)
             return pd_err_set(err, PD_EBUDGET, "row reference: accumulation of impacts of "
                               "contact %d at t = %.9g s: %ld impacts without a lasting persistent "
@@ -1400,10 +1521,13 @@ static int impact_stages(pd_edr *r, double t, double tolU, pd_err *err)
     for (;;) {
         int k = 0, closing = 0, pressing = 0, all = 0;
         for (int j = 0; j < r->ngc; j++) {
+            /* U = W_j^T v, zero at the rounding level of the event's speeds */
             double U = contact_dot(r, r->g_ct[j], r->gv);
             if (fabs(U) <= tolU)
                 U = 0.0;
             all++;
+            /* separating (staged law): no impulse in this stage; the others' impulses
+             * may close it for the next */
             if (U > 0.0 && !single) {
                 r->jpos[j] = -1;
                 continue;
@@ -1412,10 +1536,13 @@ static int impact_stages(pd_edr *r, double t, double tolU, pd_err *err)
             pressing += U <= 0.0;
             r->jpos[j] = k;
             idx[k] = r->g_ct[j];
+            /* Newton's law: w = D P + q = U+ + e min(U-, 0) */
             q[k++] = U + stage_e(r, j) * fmin(U, 0.0);
         }
+        /* no closed contact closing: the impact is over */
         if (!closing)
             return PD_OK;
+        /* law_multi: its first LCP could take several closed contacts */
         r->law_multi |= stage == 0 && all > 1;
         if (++stage > EDR_STAGES)
             return pd_err_set(err, PD_EBUDGET, "row reference: the impact at t = %.17g s did not "
@@ -1425,6 +1552,7 @@ static int impact_stages(pd_edr *r, double t, double tolU, pd_err *err)
         if ((rc = solve_lcp(r, idx, k, q, z, r->wtmp, t, err)))
             return rc;
         r->res.simultaneous += pressing > 1;
+        /* v += M^-1 W_j P_j, the totals P; a stage where it closed is one impact */
         for (int j = 0; j < r->ngc; j++) {
             if (r->jpos[j] < 0)
                 continue;
@@ -1436,6 +1564,7 @@ static int impact_stages(pd_edr *r, double t, double tolU, pd_err *err)
             r->P[j] += P;
             r->nimp[j] += q[r->jpos[j]] < 0.0;
         }
+        /* the single law: one LCP, no further stage */
         if (single)
             return PD_OK;
     }
@@ -1467,12 +1596,14 @@ static void reduced_residual(const pd_edr *r, const int *idx, int k, const doubl
 {
     for (int x = 0; x < k; x++) {
         int a = r->g_ct[idx[x]];
+        /* sum: r_x; sc: its terms' magnitudes, the level of its rounding */
         double sum = q[x], sc = fabs(q[x]);
         for (int s = 0; s < 2; s++) {
             double sa = side_sigma(r, a, s);
             if (sa == 0.0)
                 continue;
             int c = cl_of_dof(r, r->ct[a].dof[s]);
+            /* G_c = sum_y sigma_yc z_y: the stage's total impulse on cluster c */
             double G = 0.0;
             for (int y = 0; y < k; y++) {
                 int b = r->g_ct[idx[y]];
@@ -1499,6 +1630,8 @@ static int refine_reduced(pd_edr *r, const int *idx, int k, const double *D, con
 {
     double *res = r->rtmp, *scale = res + k, *zt = scale + k, *dz = zt + k;
     int *ax = r->lu_perm + k, na = 0, trig = 0;
+    /* A = {z > 0}, the pushing contacts (ax); refined only when some r_A
+     * exceeds EDR_REFINE_TOL roundings of its terms */
     reduced_residual(r, idx, k, q, z, res, scale);
     for (int x = 0; x < k; x++)
         if (z[x] > 0.0) {
@@ -1507,6 +1640,7 @@ static int refine_reduced(pd_edr *r, const int *idx, int k, const double *D, con
         }
     if (!trig)
         return 0;
+    /* D_AA, LU-factored (singular: Lemke's z stays) */
     for (int i = 0; i < na; i++)
         for (int j = 0; j < na; j++)
             r->Dlu[i + (size_t)j * na] = D[ax[i] + (size_t)ax[j] * k];
@@ -1516,6 +1650,8 @@ static int refine_reduced(pd_edr *r, const int *idx, int k, const double *D, con
     for (int i = 0; i < na; i++)
         norm = fmax(norm, fabs(res[ax[i]]));
     int refined = 0;
+    /* Newton steps z_A -= D_AA^-1 r_A, each kept while every z_A stays > 0
+     * and the residual's largest entry falls */
     for (int it = 0; it < EDR_REFINE_MAX && norm > 0.0; it++) {
         for (int i = 0; i < na; i++)
             dz[i] = -res[ax[i]];
@@ -1539,18 +1675,20 @@ static int refine_reduced(pd_edr *r, const int *idx, int k, const double *D, con
     return refined;
 }
 
-/* The same stages on the clusters' coordinates: held trees move rigidly,
- * so only the closed contacts between clusters are unknowns (one or two,
- * not the whole compressed row), U_a = sum sigma eta_c, an impulse P_a
- * adds sigma P_a / mu_c to eta_c (mu_c = sum s^2 m).  The held edges'
- * impulses follow from each tree's momentum balance, subtree by subtree;
- * they must push (a held contact cannot pull): 1 when one would pull, or
- * the group holds a modal cluster, or the stage is larger than the dense
- * solver takes — then the dof-level stages run instead. */
-static int reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
+/* What one stage's pass over the contacts between clusters found. */
+typedef struct stage_set {
+    int k;        /* its unknowns: the closed contacts not separating (all, single law) */
+    int closing;  /* of them, closing (U < 0) */
+    int pressing; /* at U <= 0 */
+    int all;      /* closed contacts an impulse moves */
+} stage_set;
+
+/* The clusters' coordinates before the impact: eta_c = y_c' of an SDOF
+ * tree (a REST tree is held still: 0), kept in cvy, and the masses
+ * mu_c = sum s^2 m; the contacts between clusters into epos (*ne).  1 when
+ * the group holds a modal cluster (no one coordinate). */
+static int reduced_begin(pd_edr *r, double t, int *ne)
 {
-    int rc, stage = 0, ne = 0, *idx = r->lcp_idx, single = r->o.impact_law == PD_IMPACT_SINGLE;
-    double *q = r->qlcp, *z = r->lam, *D = r->Dd;
     for (int i = 0; i < r->ng; i++) {
         edr_cluster *cl = &r->cl[r->g_cl[i]];
         if (cl->kind == EDR_MODAL)
@@ -1560,118 +1698,153 @@ static int reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
         r->cvy[r->g_cl[i]] = r->ceta[r->g_cl[i]];
         r->cmu[r->g_cl[i]] = cl->mass;
     }
-    for (int j = 0; j < r->ngc; j++) /* the contacts between clusters */
+    /* the open ones: a persistent or locked contact lies inside a cluster
+     * and moves with it (a tree edge's impulse follows from the balance) */
+    *ne = 0;
+    for (int j = 0; j < r->ngc; j++)
         if (r->cstate[r->g_ct[j]] == EDR_OPEN)
-            r->epos[ne++] = j;
-    for (;;) {
-        int k = 0, closing = 0, pressing = 0, all = 0;
-        for (int e = 0; e < ne; e++) {
-            int j = r->epos[e], a = r->g_ct[j];
-            double U = 0.0;
-            for (int s = 0; s < 2; s++)
-                if (r->ct[a].dof[s] >= 0)
-                    U += side_sigma(r, a, s) * r->ceta[cl_of_dof(r, r->ct[a].dof[s])];
-            if (fabs(U) <= tolU)
-                U = 0.0;
-            if (!movable(r, a)) { /* held still on both sides */
-                r->jpos[j] = -1;
-                continue;
-            }
-            all++;
-            if (U > 0.0 && !single) { /* separating (staged) */
-                r->jpos[j] = -1;
-                continue;
-            }
-            if (k >= EDR_REDUCED_MAX)
-                return 1;
-            closing += U < 0.0;
-            pressing += U <= 0.0;
-            r->jpos[j] = k;
-            idx[k] = j;
-            q[k++] = U + stage_e(r, j) * fmin(U, 0.0);
+            r->epos[(*ne)++] = j;
+    return 0;
+}
+
+/* One stage's unknowns idx[0..k) (g_ct indices) and q = U + e min(U, 0),
+ * U = sum_s sigma_s eta_c(s) the contact's rate on the clusters'
+ * coordinates; 1 when they exceed EDR_REDUCED_MAX. */
+static int reduced_stage_set(pd_edr *r, int ne, double tolU, int single, stage_set *set)
+{
+    int *idx = r->lcp_idx;
+    double *q = r->qlcp;
+    *set = (stage_set){.k = 0, .closing = 0, .pressing = 0, .all = 0};
+    for (int e = 0; e < ne; e++) {
+        int j = r->epos[e], a = r->g_ct[j];
+        double U = 0.0;
+        for (int s = 0; s < 2; s++)
+            if (r->ct[a].dof[s] >= 0)
+                U += side_sigma(r, a, s) * r->ceta[cl_of_dof(r, r->ct[a].dof[s])];
+        if (fabs(U) <= tolU) /* a rate at the rounding of the event's speeds is zero */
+            U = 0.0;
+        if (!movable(r, a)) { /* held still on both sides */
+            r->jpos[j] = -1;
+            continue;
         }
-        if (!closing)
-            break;
-        r->law_multi |= stage == 0 && all > 1;
-        if (single)
-            single_law_zero(q, k);
-        if (++stage > EDR_STAGES)
-            return pd_err_set(err, PD_EBUDGET, "row reference: the impact at t = %.17g s did not "
-                              "end in %d stages", t * r->o.time_unit, EDR_STAGES);
-        for (int x = 0; x < k; x++) /* D_xy = sum over shared clusters sigma sigma / mu */
-            for (int y = 0; y < k; y++) {
-                int a = r->g_ct[idx[x]], b = r->g_ct[idx[y]];
-                double dxy = 0.0;
-                for (int s = 0; s < 2; s++)
-                    for (int u = 0; u < 2; u++) {
-                        int da = r->ct[a].dof[s], db = r->ct[b].dof[u];
-                        if (da < 0 || db < 0 || cl_of_dof(r, da) != cl_of_dof(r, db))
-                            continue;
-                        double sa = side_sigma(r, a, s), sb = side_sigma(r, b, u);
-                        if (sa != 0.0 && sb != 0.0)
-                            dxy += sa * sb / r->cmu[cl_of_dof(r, da)];
-                    }
-                D[x + (size_t)y * k] = dxy;
-            }
-        int refined = 0;
-        if (k == 1) {
-            z[0] = pd_contact_impulse_1(D[0], q[0]);
-        } else {
-            r->res.lcp_solves++;
-            if ((rc = small_lcp(r, k, D, q, z, r->ztmp)))
-                return pd_err_set(err, rc, "row reference: the impact LCP of %d contacts at t = "
-                                  "%.9g s was not solved", k, t * r->o.time_unit);
-            refined = refine_reduced(r, idx, k, D, q, z);
+        set->all++;
+        if (U > 0.0 && !single) { /* separating (staged) */
+            r->jpos[j] = -1;
+            continue;
         }
-        r->res.lcp_solves += k == 1;
-        r->res.simultaneous += pressing > 1;
-        if (refined) /* each cluster's rate from its total impulse G_c (as the residual) */
-            for (int x = 0; x < k; x++) {
-                int a = r->g_ct[idx[x]];
-                for (int s = 0; s < 2; s++)
-                    if (r->ct[a].dof[s] >= 0)
-                        r->cG[cl_of_dof(r, r->ct[a].dof[s])] = 0.0;
-            }
-        for (int x = 0; x < k; x++) {
-            int j = idx[x], a = r->g_ct[j];
+        if (set->k >= EDR_REDUCED_MAX)
+            return 1;
+        set->closing += U < 0.0;
+        set->pressing += U <= 0.0;
+        r->jpos[j] = set->k;
+        idx[set->k] = j;
+        /* Newton's law: w = U+ + e min(U-, 0) = D P + q */
+        q[set->k++] = U + stage_e(r, j) * fmin(U, 0.0);
+    }
+    return 0;
+}
+
+/* The stage's Delassus matrix on the clusters' coordinates, D = W^T M^-1 W
+ * with each tree rigid: D_xy = sum over the clusters c that x and y share
+ * of sigma_xc sigma_yc / mu_c. */
+static void reduced_delassus(pd_edr *r, const int *idx, int k, double *D)
+{
+    for (int x = 0; x < k; x++)
+        for (int y = 0; y < k; y++) {
+            int a = r->g_ct[idx[x]], b = r->g_ct[idx[y]];
+            double dxy = 0.0;
             for (int s = 0; s < 2; s++)
-                if (r->ct[a].dof[s] >= 0) {
-                    int c = cl_of_dof(r, r->ct[a].dof[s]);
-                    if (r->cl[c].kind != EDR_SDOF)
+                for (int u = 0; u < 2; u++) {
+                    int da = r->ct[a].dof[s], db = r->ct[b].dof[u];
+                    if (da < 0 || db < 0 || cl_of_dof(r, da) != cl_of_dof(r, db))
                         continue;
-                    if (refined)
-                        r->cG[c] += side_sigma(r, a, s) * z[x];
-                    else
-                        r->ceta[c] += side_sigma(r, a, s) * z[x] / r->cmu[c];
+                    /* a REST side (sigma = 0: held still) takes no share */
+                    double sa = side_sigma(r, a, s), sb = side_sigma(r, b, u);
+                    if (sa != 0.0 && sb != 0.0)
+                        dxy += sa * sb / r->cmu[cl_of_dof(r, da)];
                 }
-            r->P[j] += z[x];
-            r->nimp[j] += q[x] < 0.0;
+            D[x + (size_t)y * k] = dxy;
         }
-        for (int x = 0; x < k && refined; x++) {
+}
+
+/* The stage's impulses z (r->lam) from w = D z + q >= 0 _|_ z >= 0: the
+ * closed form for one contact, else the small dense LCP, refined on the
+ * residual formed without D (*refined: 1 when it was). */
+static int reduced_solve(pd_edr *r, const int *idx, int k, double t, int *refined, pd_err *err)
+{
+    double *q = r->qlcp, *z = r->lam, *D = r->Dd;
+    *refined = 0;
+    r->res.lcp_solves++;
+    if (k == 1) {
+        z[0] = pd_contact_impulse_1(D[0], q[0]);
+        return PD_OK;
+    }
+    int rc = small_lcp(r, k, D, q, z, r->ztmp);
+    if (rc)
+        return pd_err_set(err, rc, "row reference: the impact LCP of %d contacts at t = %.9g s "
+                          "was not solved", k, t * r->o.time_unit);
+    *refined = refine_reduced(r, idx, k, D, q, z);
+    return PD_OK;
+}
+
+/* The stage's impulses applied: eta_c += sigma_xc z_x / mu_c contact by
+ * contact, or, when z was refined, eta_c += G_c / mu_c from each
+ * cluster's total G_c = sum_x sigma_xc z_x (the sum the residual was
+ * refined on); the totals P and the impacts (stages where it closed). */
+static void reduced_apply(pd_edr *r, const int *idx, int k, int refined)
+{
+    const double *q = r->qlcp, *z = r->lam;
+    if (refined)
+        for (int x = 0; x < k; x++) {
             int a = r->g_ct[idx[x]];
             for (int s = 0; s < 2; s++)
-                if (r->ct[a].dof[s] >= 0) {
-                    int c = cl_of_dof(r, r->ct[a].dof[s]);
-                    if (r->cl[c].kind == EDR_SDOF)
-                        r->ceta[c] += r->cG[c] / r->cmu[c];
-                    r->cG[c] = 0.0;
-                }
+                if (r->ct[a].dof[s] >= 0)
+                    r->cG[cl_of_dof(r, r->ct[a].dof[s])] = 0.0;
         }
-        if (single)
-            break;
+    for (int x = 0; x < k; x++) {
+        int j = idx[x], a = r->g_ct[j];
+        for (int s = 0; s < 2; s++)
+            if (r->ct[a].dof[s] >= 0) {
+                int c = cl_of_dof(r, r->ct[a].dof[s]);
+                if (r->cl[c].kind != EDR_SDOF) /* held still: no coordinate to move */
+                    continue;
+                if (refined)
+                    r->cG[c] += side_sigma(r, a, s) * z[x];
+                else
+                    r->ceta[c] += side_sigma(r, a, s) * z[x] / r->cmu[c];
+            }
+        r->P[j] += z[x];
+        r->nimp[j] += q[x] < 0.0;
     }
-    /* dof rates, the impulses on each dof from the contacts between clusters */
+    /* each cluster's G_c added once (cG zeroed after its first visit) */
+    for (int x = 0; x < k && refined; x++) {
+        int a = r->g_ct[idx[x]];
+        for (int s = 0; s < 2; s++)
+            if (r->ct[a].dof[s] >= 0) {
+                int c = cl_of_dof(r, r->ct[a].dof[s]);
+                if (r->cl[c].kind == EDR_SDOF)
+                    r->ceta[c] += r->cG[c] / r->cmu[c];
+                r->cG[c] = 0.0;
+            }
+    }
+}
+
+/* The held edges' impulses from each tree's momentum balance: with ext_i
+ * the impulse of the contacts between clusters on dof i, edge e above
+ * child c takes P_e = sum over c's subtree of s (m s deta - ext) /
+ * (s_c w_c).  1 when one would pull (P_e < 0 beyond rounding). */
+static int held_edge_impulses(pd_edr *r, int ne)
+{
     for (int k = 0; k < r->ngd; k++) {
         int i = r->g_dof[k];
         r->ext[i] = 0.0;
     }
-    for (int e = 0; e < ne; e++) {
+    for (int e = 0; e < ne; e++) { /* ext = W_E P_E over the contacts between clusters */
         int j = r->epos[e], a = r->g_ct[j];
         for (int s = 0; s < 2; s++)
             if (r->ct[a].dof[s] >= 0)
                 r->ext[r->ct[a].dof[s]] += r->ct[a].w[s] * r->P[j];
     }
-    /* held edges: P_e = sum over the child's subtree of s (m dv - ext) / (s_c w_c) */
     for (int j = 0; j < r->ngc; j++)
         r->jpos[j] = -1;
     for (int j = 0; j < r->ngc; j++)
@@ -1682,9 +1855,10 @@ static int reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
         if (cl->npers == 0)
             continue;
         int nn = 0;
-        for (int d = cl->root; d >= 0; d = r->bfs_next[d])
+        for (int d = cl->root; d >= 0; d = r->bfs_next[d]) /* the tree breadth first */
             r->stack[nn++] = d;
         double deta = r->ceta[c] - r->cvy[c];
+        /* each dof's unbalanced impulse, s_i (m_i dv_i - ext_i), dv_i = s_i deta */
         for (int k = 0; k < nn; k++) {
             int d = r->stack[k];
             r->gtmp[d] = r->s[d] * (r->s[d] * deta / r->minv[d] - r->ext[d]);
@@ -1702,6 +1876,47 @@ static int reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
             r->P[r->pos_in[e]] = fmax(Pe, 0.0);
         }
     }
+    return 0;
+}
+
+/* The same stages on the clusters' coordinates: held trees move rigidly,
+ * so only the closed contacts between clusters are unknowns (one or two,
+ * not the whole compressed row), U_a = sum sigma eta_c, an impulse P_a
+ * adds sigma P_a / mu_c to eta_c (mu_c = sum s^2 m).  The held edges'
+ * impulses follow from each tree's momentum balance, subtree by subtree;
+ * they must push (a held contact cannot pull): 1 when one would pull, or
+ * the group holds a modal cluster, or the stage is larger than the dense
+ * solver takes — then the dof-level stages run instead. */
+static int reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
+{
+    int rc, stage = 0, ne, *idx = r->lcp_idx, single = r->o.impact_law == PD_IMPACT_SINGLE;
+    if (reduced_begin(r, t, &ne))
+        return 1;
+    for (;;) {
+        stage_set set;
+        if (reduced_stage_set(r, ne, tolU, single, &set))
+            return 1;
+        if (!set.closing) /* every closed contact at rest or separating: the impact is over */
+            break;
+        int k = set.k, refined;
+        r->law_multi |= stage == 0 && set.all > 1;
+        if (single)
+            single_law_zero(r->qlcp, k);
+        if (++stage > EDR_STAGES)
+            return pd_err_set(err, PD_EBUDGET, "row reference: the impact at t = %.17g s did not "
+                              "end in %d stages", t * r->o.time_unit, EDR_STAGES);
+        reduced_delassus(r, idx, k, r->Dd);
+        if ((rc = reduced_solve(r, idx, k, t, &refined, err)))
+            return rc;
+        r->res.simultaneous += set.pressing > 1;
+        reduced_apply(r, idx, k, refined);
+        /* the single law: one LCP, no further stage */
+        if (single)
+            break;
+    }
+    if (held_edge_impulses(r, ne))
+        return 1;
+    /* the dofs' rates from their trees: v_i = s_i eta_c (0 held still) */
     for (int k = 0; k < r->ngd; k++) {
         int i = r->g_dof[k], c = cl_of_dof(r, i);
         r->gv[i] = r->cl[c].kind == EDR_SDOF ? r->s[i] * r->ceta[c] : 0.0;
@@ -1709,18 +1924,11 @@ static int reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
     return PD_OK;
 }
 
-/* The contact-force LCP of force_lcp on the clusters' coordinates: the
- * held contacts of every tree hold (its coordinate's acceleration
- * alpha_c = (sum s_i F_i + sum sigma lambda) / mu_c, F the free forces),
- * the closed contacts between clusters are the unknowns (gap acceleration
- * sum sigma alpha_c), and each held edge's force follows from its
- * subtree's balance, m a = F + W lambda.  1 (the dof-level LCP decides)
- * when a held edge would pull, the group holds a modal cluster, or the
- * LCP is too large for the dense solver. */
-static int reduced_force(pd_edr *r, const int *idx, int k, double t, pd_err *err)
+/* The clusters' free coordinate accelerations alpha_c = sum s_i F_i / mu_c
+ * (F_i = m_i a_i the free force on dof i, a REST tree held still: 0) into
+ * ceta, mu_c into cmu.  1 when the group holds a modal cluster. */
+static int reduced_free_acc(pd_edr *r)
 {
-    int ku = 0, rc, *ux = r->epos;
-    double *q = r->qtmp, *z = r->ztmp, *D = r->Dd;
     for (int i = 0; i < r->ng; i++) {
         int c = r->g_cl[i];
         edr_cluster *cl = &r->cl[c];
@@ -1734,25 +1942,47 @@ static int reduced_force(pd_edr *r, const int *idx, int k, double t, pd_err *err
         r->cmu[c] = cl->mass;
         r->ceta[c] = cl->kind == EDR_SDOF ? phi / cl->mass : 0.0; /* alpha_c, free */
     }
-    for (int x = 0; x < k; x++) { /* unknowns: open contacts between two clusters (or a wall) */
+    return 0;
+}
+
+/* The unknowns of the reduced force LCP among J = idx[0..k): the open
+ * contacts between two clusters (or a cluster and a wall) an impulse
+ * moves, as their positions x in J (ux); their count, or -1 past
+ * EDR_REDUCED_MAX.  lambda starts at 0 over J. */
+static int reduced_force_unknowns(pd_edr *r, const int *idx, int k, int *ux)
+{
+    int ku = 0;
+    for (int x = 0; x < k; x++) {
         const edr_contact *ct = &r->ct[idx[x]];
         int internal = ct->dof[0] >= 0 && ct->dof[1] >= 0 &&
                        cl_of_dof(r, ct->dof[0]) == cl_of_dof(r, ct->dof[1]);
         r->lam[x] = 0.0;
         if (r->cstate[idx[x]] == EDR_OPEN && !internal && movable(r, idx[x])) {
             if (ku >= EDR_REDUCED_MAX)
-                return 1;
+                return -1;
             ux[ku++] = x;
         }
     }
+    return ku;
+}
+
+/* The reduced force LCP's data: q_x = sum_s sigma_xs alpha_c (the free gap
+ * acceleration) and D_xy = sum over the SDOF trees shared of
+ * sigma_xc sigma_yc / mu_c. */
+static void reduced_force_data(pd_edr *r, const int *idx, const int *ux, int ku, double *q,
+                               double *D)
+{
     for (int x = 0; x < ku; x++) {
         int a = idx[ux[x]];
+        /* q_x = sum_s sigma_xs alpha_c: the gap's acceleration without the
+         * unknowns' forces */
         q[x] = 0.0;
         for (int s = 0; s < 2; s++)
             if (r->ct[a].dof[s] >= 0)
                 q[x] += side_sigma(r, a, s) * r->ceta[cl_of_dof(r, r->ct[a].dof[s])];
         for (int y = 0; y < ku; y++) {
             int b = idx[ux[y]];
+            /* D_xy = sum over the SDOF trees x and y share of sigma_xc sigma_yc / mu_c */
             double dxy = 0.0;
             for (int s = 0; s < 2; s++)
                 for (int u = 0; u < 2; u++) {
@@ -1764,29 +1994,19 @@ static int reduced_force(pd_edr *r, const int *idx, int k, double t, pd_err *err
             D[x + (size_t)y * ku] = dxy;
         }
     }
-    if (ku == 1) {
-        z[0] = D[0] > 0.0 ? pd_contact_impulse_1(D[0], q[0]) : (q[0] >= 0.0 ? 0.0 : -1.0);
-        if (z[0] < 0.0)
-            return 1; /* held still on both sides and pressed: let the dofs decide */
-        r->res.lcp_solves++;
-    } else if (ku > 1) {
-        r->res.lcp_solves++;
-        if ((rc = small_lcp(r, ku, D, q, z, r->wtmp)))
-            return 1;
-    }
-    for (int x = 0; x < ku; x++) { /* alpha_c with the unknowns' forces */
-        int a = idx[ux[x]];
-        r->lam[ux[x]] = z[x];
-        for (int s = 0; s < 2; s++)
-            if (r->ct[a].dof[s] >= 0) {
-                int c = cl_of_dof(r, r->ct[a].dof[s]);
-                if (r->cl[c].kind == EDR_SDOF)
-                    r->ceta[c] += side_sigma(r, a, s) * z[x] / r->cmu[c];
-            }
-    }
-    /* held edges: lambda_e = sum over the subtree of s (m a - F - ext) / (s_c w_c) */
+}
+
+/* The held edges' forces from each subtree's balance m a = F + W lambda:
+ * with ext_i the unknowns' forces on dof i, edge e above child c carries
+ * lambda_e = sum over c's subtree of s (m a - F - ext) / (s_c w_c), into
+ * lam where e is in J.  1 when one would pull beyond the rounding of its
+ * terms (wk: their magnitudes, summed alike). */
+static int held_edge_forces(pd_edr *r, const int *idx, int k, const int *ux, int ku,
+                            const double *z)
+{
     for (int k2 = 0; k2 < r->ngd; k2++)
         r->ext[r->g_dof[k2]] = 0.0;
+    /* ext = W_U lambda_U: the unknowns' forces on the dofs */
     for (int x = 0; x < ku; x++) {
         int a = idx[ux[x]];
         for (int s = 0; s < 2; s++)
@@ -1805,11 +2025,13 @@ static int reduced_force(pd_edr *r, const int *idx, int k, double t, pd_err *err
             r->stack[nn++] = d;
         for (int x = 0; x < nn; x++) {
             int d = r->stack[x];
+            /* each dof's unbalanced force s_i (m_i a_i - F_i - ext_i) with
+             * a_i = s_i alpha_c, F_i = m_i a_free_i; wk its terms' magnitudes */
             double m = 1.0 / r->minv[d], a = r->s[d] * r->ceta[c];
             r->gtmp[d] = r->s[d] * (m * a - m * r->gacc[d] - r->ext[d]);
             r->wk[d] = fabs(m * a) + fabs(m * r->gacc[d]) + fabs(r->ext[d]);
         }
-        for (int x = nn - 1; x >= 0; x--) {
+        for (int x = nn - 1; x >= 0; x--) { /* children before their parents */
             int d = r->stack[x], e = r->pe[d];
             if (r->pdof[d] >= 0) {
                 r->gtmp[r->pdof[d]] += r->gtmp[d];
@@ -1821,10 +2043,54 @@ static int reduced_force(pd_edr *r, const int *idx, int k, double t, pd_err *err
             double le = r->gtmp[d] / (r->s[d] * ct->w[ct->dof[0] == d ? 0 : 1]);
             if (le < -EDR_RATE_TOL * r->wk[d])
                 return 1; /* a held contact would pull: it leaves */
+            /* the edge's force goes to lam when the edge is one of J */
             if (r->ct_mark[e] == r->epoch && r->pos_in[e] < k && idx[r->pos_in[e]] == e)
                 r->lam[r->pos_in[e]] = le;
         }
     }
+    return 0;
+}
+
+/* The contact-force LCP of force_lcp on the clusters' coordinates: the
+ * held contacts of every tree hold (its coordinate's acceleration
+ * alpha_c = (sum s_i F_i + sum sigma lambda) / mu_c, F the free forces),
+ * the closed contacts between clusters are the unknowns (gap acceleration
+ * sum sigma alpha_c), and each held edge's force follows from its
+ * subtree's balance, m a = F + W lambda.  1 (the dof-level LCP decides)
+ * when a held edge would pull, the group holds a modal cluster, or the
+ * LCP is too large for the dense solver. */
+static int reduced_force(pd_edr *r, const int *idx, int k, double t, pd_err *err)
+{
+    int ku, *ux = r->epos;
+    double *q = r->qtmp, *z = r->ztmp, *D = r->Dd;
+    if (reduced_free_acc(r) || (ku = reduced_force_unknowns(r, idx, k, ux)) < 0)
+        return 1;
+    reduced_force_data(r, idx, ux, ku, q, D);
+    if (ku == 1) {
+        /* one unknown: lambda = -q / D where q < 0, else 0; D = 0 (held
+         * still on both sides) can answer only a gap not pressed (q >= 0) */
+        z[0] = D[0] > 0.0 ? pd_contact_impulse_1(D[0], q[0]) : (q[0] >= 0.0 ? 0.0 : -1.0);
+        if (z[0] < 0.0)
+            return 1; /* held still on both sides and pressed: let the dofs decide */
+        r->res.lcp_solves++;
+    } else if (ku > 1) {
+        r->res.lcp_solves++;
+        if (small_lcp(r, ku, D, q, z, r->wtmp))
+            return 1;
+    }
+    /* alpha_c with the unknowns' forces: += sum_x sigma_xc lambda_x / mu_c */
+    for (int x = 0; x < ku; x++) {
+        int a = idx[ux[x]];
+        r->lam[ux[x]] = z[x];
+        for (int s = 0; s < 2; s++)
+            if (r->ct[a].dof[s] >= 0) {
+                int c = cl_of_dof(r, r->ct[a].dof[s]);
+                if (r->cl[c].kind == EDR_SDOF)
+                    r->ceta[c] += side_sigma(r, a, s) * z[x] / r->cmu[c];
+            }
+    }
+    if (held_edge_forces(r, idx, k, ux, ku, z))
+        return 1;
     for (int j = 0; j < r->ngc; j++) { /* gap accelerations of every closed contact */
         int a = r->g_ct[j];
         double w = 0.0;
@@ -1846,12 +2112,15 @@ static int reduced_force(pd_edr *r, const int *idx, int k, double t, pd_err *err
 static int check_work(pd_edr *r, double t, pd_err *err)
 {
     double dK = 0.0, tol = 0.0, K = 0.0;
+    /* the single law: an impulse that stops a separating contact (U- > 0 to
+     * U+ = 0) does the work 1/2 P U-, allowed */
     if (r->o.impact_law == PD_IMPACT_SINGLE)
         for (int j = 0; j < r->ngc; j++)
             if (r->Uminus[j] > 0.0)
                 dK -= 0.5 * r->P[j] * r->Uminus[j];
     for (int k = 0; k < r->ngd; k++)
         r->gtmp[r->g_dof[k]] = 0.0;
+    /* gtmp_i = sum |w P| over the contacts at dof i: the impulses' size */
     for (int j = 0; j < r->ngc; j++) {
         const edr_contact *ct = &r->ct[r->g_ct[j]];
         for (int s = 0; s < 2; s++)
@@ -1861,6 +2130,7 @@ static int check_work(pd_edr *r, double t, pd_err *err)
     for (int k = 0; k < r->ngd; k++) {
         int i = r->g_dof[k];
         double m = 1.0 / r->minv[i], vm = r->ev_vminus[k], vp = r->gv[i];
+        /* 1/2 m (v+^2 - v-^2) factored: no cancellation of two large squares */
         dK += 0.5 * m * (vp - vm) * (vp + vm);
         tol += (fabs(vp) + fabs(vm)) * (m * fabs(vm) + r->gtmp[i]);
         K += 0.5 * m * vm * vm;
@@ -1877,6 +2147,8 @@ static int check_work(pd_edr *r, double t, pd_err *err)
 static int resolve_group(pd_edr *r, double t, pd_err *err)
 {
     int rc, acc = 0;
+    /* the group: every contact closed at t with the clusters it joins, and
+     * their dofs' states at t */
     group_grow(r, t);
     group_state(r, t);
     double tol = r->o.close_tol * r->L, vs = 0.0;
@@ -1885,11 +2157,13 @@ static int resolve_group(pd_edr *r, double t, pd_err *err)
         r->excluded[j] = 0;
         if ((ct->dof[0] < 0) != (ct->dof[1] < 0)) {
             int s = ct->dof[0] >= 0 ? 0 : 1;
+            /* x = -g0 / w: the wall's gap at zero to a rounding, taken within close_tol */
             double x = -ct->g0 / ct->w[s];
             if (fabs(ct->g0 + ct->w[s] * r->gx[ct->dof[s]]) <= tol + fabs(ct->g0) * 1e-15)
                 r->gx[ct->dof[s]] = x;
         }
     }
+    /* the event's speed scale; v- kept for the work check and the report */
     for (int k = 0; k < r->ngd; k++) {
         vs = fmax(vs, fabs(r->gv[r->g_dof[k]]));
         r->ev_vminus[k] = r->gv[r->g_dof[k]];
@@ -1897,6 +2171,7 @@ static int resolve_group(pd_edr *r, double t, pd_err *err)
     r->vscale = fmax(r->vscale, vs);
     double tolU = EDR_RATE_TOL * fmax(vs, r->vscale);
     for (int j = 0; j < r->ngc; j++) {
+        /* U- = W^T v-, zero at the rounding level of the speeds */
         double U = contact_dot(r, r->g_ct[j], r->gv);
         r->Uminus[j] = fabs(U) <= tolU ? 0.0 : U;
         r->P[j] = 0.0;
@@ -1905,6 +2180,8 @@ static int resolve_group(pd_edr *r, double t, pd_err *err)
         r->nimp[j] = 0;
     r->instant_acc = 0;
     r->law_multi = 0;
+    /* the stages on the clusters' coordinates when they can (held trees move
+     * rigidly: only the contacts between clusters are unknowns) */
     rc = reduced_stages(r, t, tolU, err);
     if (rc == 1) { /* on the dofs: back to the rates before the impact */
         for (int k = 0; k < r->ngd; k++)
@@ -1916,11 +2193,13 @@ static int resolve_group(pd_edr *r, double t, pd_err *err)
         r->instant_acc = 0;
         rc = impact_stages(r, t, tolU, err);
     }
+    /* an instant's accumulation (stage_e) and a law that decided count once each */
     r->res.accumulations += r->instant_acc;
     r->res.law_decided += r->law_multi;
     if (rc || (rc = check_work(r, t, err)) || (rc = commit_impacts(r, t, err)))
         return rc;
     for (int j = 0; j < r->ngc; j++) {
+        /* U+ = W^T v+: a zero rate makes a contact a candidate to persist */
         double U = contact_dot(r, r->g_ct[j], r->gv);
         r->Uplus[j] = fabs(U) <= tolU ? 0.0 : U;
     }
@@ -1940,6 +2219,7 @@ static int resolve_group(pd_edr *r, double t, pd_err *err)
     }
     if (acc)
         r->res.accumulations++;
+    /* v+ as the new flights start: projected onto their held contacts */
     for (int k = 0; k < r->ngd; k++)
         r->gv[r->g_dof[k]] = r->vo[r->g_dof[k]];
     if (report(r, t, PD_EDR_IMPACT, acc) > 0)
@@ -1948,19 +2228,23 @@ static int resolve_group(pd_edr *r, double t, pd_err *err)
     return PD_OK;
 }
 
-/* Start a group from the seed contact a (its gap closing at t). */
+/* An empty group for the next event. */
 static void group_begin(pd_edr *r)
 {
+    /* a new epoch: every mark of the last group (cl_mark, ct_mark, ct_mark2)
+     * is stale at once, with no clearing */
     r->epoch++;
     r->ng = 0;
     r->ngc = 0;
 }
 
+/* Contact a closes at t: the group grows from it. */
 static int on_impact(pd_edr *r, int a, double t, pd_err *err)
 {
     int rc;
     if ((rc = count_event(r, a, t, err)))
         return rc;
+    /* the seed: the closing contact and its sides' clusters */
     group_begin(r);
     group_add_contact(r, a);
     const edr_contact *ct = &r->ct[a];
@@ -1977,6 +2261,7 @@ static int on_detach(pd_edr *r, int c, double t, pd_err *err)
     int rc, acc, a = r->cl[c].det_contact;
     if ((rc = count_event(r, r->m + c, t, err)))
         return rc;
+    /* the group: cluster c and its closed contacts (persistent or locked) */
     group_begin(r);
     group_add_cluster(r, c);
     for (int b = r->cl[c].head; b >= 0; b = r->blk_next[b]) {
@@ -1988,6 +2273,7 @@ static int on_detach(pd_edr *r, int c, double t, pd_err *err)
         }
     }
     group_state(r, t);
+    /* no impact: v- is the state's v; U- = U+ = 0, P = 0 */
     for (int k = 0; k < r->ngd; k++)
         r->ev_vminus[k] = r->gv[r->g_dof[k]];
     for (int j = 0; j < r->ngc; j++) {
@@ -1995,16 +2281,19 @@ static int on_detach(pd_edr *r, int c, double t, pd_err *err)
         r->P[j] = 0.0;
     }
     for (int j = 0; j < r->ngc; j++)
+        /* the detaching contact leaves: the force LCP decides the others without it */
         r->excluded[j] = r->g_ct[j] == a;
     if ((rc = decide_persistence(r, t, &acc, err)))
         return rc;
     for (int j = 0; j < r->ngc; j++) {
         r->excluded[j] = 0;
+        /* a persistent contact not held any more: one detachment */
         if (r->cstate[r->g_ct[j]] == EDR_PERSIST && !r->held[j])
             r->res.detachments++;
     }
     if ((rc = regroup(r, t, err)))
         return rc;
+    /* a jumped accumulation whose tail would not hold: open again */
     if (acc && !tails_hold(r)) {
         for (int j = 0; j < r->ngc; j++)
             if (r->held_tail[j] > 0.0)
@@ -2026,6 +2315,7 @@ static int on_piece(pd_edr *r, double t, pd_err *err)
     if ((rc = count_event(r, r->slot_piece, t, err)))
         return rc;
     r->piece = edr_piece_at(r, t);
+    /* the live clusters listed first: regroup frees and takes slots as it goes */
     int ncl = 0;
     for (int c = 0; c < r->nb; c++)
         if (r->cl[c].live)
@@ -2035,6 +2325,7 @@ static int on_piece(pd_edr *r, double t, pd_err *err)
         if (!r->cl[c].live || r->cl[c].t0 == t) /* gone, or started at t on the new piece */
             continue;
         edr_cluster *cl = &r->cl[c];
+        /* the group: the cluster and its closed contacts (persistent or locked) */
         group_begin(r);
         group_add_cluster(r, c);
         for (int b = cl->head; b >= 0; b = r->blk_next[b]) {
@@ -2048,6 +2339,7 @@ static int on_piece(pd_edr *r, double t, pd_err *err)
         group_state(r, t);
         for (int k = 0; k < r->ngd; k++)
             r->ev_vminus[k] = r->gv[r->g_dof[k]];
+        /* no impact: U- = U+ = P = 0 */
         int negative = 0;
         for (int j = 0; j < r->ngc; j++) {
             r->Uminus[j] = r->Uplus[j] = r->P[j] = 0.0;
@@ -2063,6 +2355,7 @@ static int on_piece(pd_edr *r, double t, pd_err *err)
             for (int j = 0; j < r->ngc; j++)
                 negative |= r->cstate[r->g_ct[j]] == EDR_PERSIST && !(r->lam[j] > 0.0);
         }
+        /* a held force negative under the new piece: persistence decided again */
         if (negative) {
             int acc;
             if ((rc = decide_persistence(r, t, &acc, err)))
@@ -2071,6 +2364,7 @@ static int on_piece(pd_edr *r, double t, pd_err *err)
                 if (r->cstate[r->g_ct[j]] == EDR_PERSIST && !r->held[j])
                     r->res.detachments++;
         } else
+            /* every closed contact stays held: the clusters re-origin on the piece */
             for (int j = 0; j < r->ngc; j++) {
                 r->held[j] = r->cstate[r->g_ct[j]] != EDR_OPEN;
                 r->held_tail[j] = 0.0;
@@ -2078,11 +2372,13 @@ static int on_piece(pd_edr *r, double t, pd_err *err)
         if ((rc = regroup(r, t, err)))
             return rc;
     }
+    /* every contact and cluster predicts again: every flight changed with the piece */
     for (int i = 0; i < r->m; i++)
         predict_contact(r, i, t, 0);
     for (int c = 0; c < r->nb; c++)
         if (r->cl[c].live)
             predict_detach(r, c, t, 0);
+    /* the next piece change, if before t1 */
     double next = edr_piece_end(r, r->piece);
     q_set(&r->q, r->slot_piece, next < r->t1 ? next : HUGE_VAL);
     return PD_OK;
@@ -2096,11 +2392,13 @@ static int emit(pd_edr *r, double t, pd_observer obs, void *ctx)
         dof_state(r, i, t, &r->st.q[i], &r->st.v[i], &a);
         r->st.acc[i] = a;
     }
+    /* the held forces' impulses up to t (a sampler only) */
     for (int c = 0; r->sample_forces && c < r->nb; c++)
         if (r->cl[c].live)
             integrate_held(r, c, t);
     for (int a = 0; a < r->m; a++) {
         r->st.g[a] = gap_now(r, a, t, NULL);
+        /* P: the impulses since the last sample (impacts and held forces), then restarted */
         r->st.P[a] = r->imp_out[a];
         r->imp_out[a] = 0.0;
         r->st.active[a] = r->cstate[a] == EDR_PERSIST;
@@ -2112,32 +2410,223 @@ static int emit(pd_edr *r, double t, pd_observer obs, void *ctx)
 
 /* ---- allocation ---------------------------------------------------------------------------- */
 
+/* Every array of struct pd_edr, declared once (MuJoCo's X-macro habit):
+ * X(field, element type, count), the count written in the sizes of
+ * edr_sizes.  A table per stage of pd_edr_alloc, each allocated as soon
+ * as its sizes are known (pd_calloc: max(count, 1) zeroed elements);
+ * pd_edr_free frees them all (EDR_ARRAYS), and a compile-time check ties
+ * each entry's type to its field's, so that the tables, the frees and the
+ * struct cannot drift apart. */
+
+/* Sized by the model alone. */
+#define EDR_MODEL_ARRAYS(X)                                                                   \
+    X(b, double, n)                                                                           \
+    X(pieces, pd_sine_piece, npieces)                                                         \
+    X(dof_blk, int, n)                                                                        \
+    X(dof_loc, int, n)                                                                        \
+    X(blk_dofs, int, n)                                                                       \
+    X(minv, double, n)                                                                        \
+    X(ct, edr_contact, m)                                                                     \
+    X(blk_cont, int, 2 * m) /* a contact is listed by each of its (at most two) blocks */     \
+    X(dofc_ptr, int, n + 1)                                                                   \
+    X(dofc, int, 2 * m)
+
+/* Sized by the blocks, once C and K's couplings have found them. */
+#define EDR_BLOCK_ARRAYS(X) \
+    X(blk, edr_block, nb)   \
+    X(blk_off, long, nb + 1)
+
+/* The blocks' dense damping and stiffness, sum over the blocks of n_b^2 entries. */
+#define EDR_MATRIX_ARRAYS(X) \
+    X(Cb, double, nentries) \
+    X(Kb, double, nentries)
+
+/* The run's state, results and scratch. */
+#define EDR_RUN_ARRAYS(X)                                                                     \
+    /* clusters */                                                                            \
+    X(cl, edr_cluster, nb)                                                                    \
+    X(blk_cl, int, nb)                                                                        \
+    X(blk_next, int, nb)                                                                      \
+    X(free_cl, int, nb)                                                                       \
+    X(s, double, n)                                                                           \
+    X(d, double, n)                                                                           \
+    X(xo, double, n)                                                                          \
+    X(vo, double, n)                                                                          \
+    X(crow, int, n)                                                                           \
+    X(crow_c, int, m)                                                                         \
+    /* contacts */                                                                            \
+    X(cstate, unsigned char, m)                                                               \
+    X(pers_next, int, m)                                                                      \
+    X(la, double, m)                                                                          \
+    X(lb, double, m)                                                                          \
+    X(lg, double, m)                                                                          \
+    X(ld, double, m)                                                                          \
+    X(base_t, double, m)                                                                      \
+    X(base_g, double, m)                                                                      \
+    X(gmeas_t, double, m)                                                                     \
+    X(since, double, m)                                                                       \
+    X(burst, long, m)                                                                         \
+    /* results */                                                                             \
+    X(xpos, double, n)                                                                        \
+    X(xneg, double, n)                                                                        \
+    X(drift, double, n)                                                                       \
+    X(gmin, double, m)                                                                        \
+    X(impacts, long, m)                                                                       \
+    X(first, double, m)                                                                       \
+    X(maxP, double, m)                                                                        \
+    X(ctime, double, m)                                                                       \
+    X(imp_out, double, m)                                                                     \
+    /* the queue and its slots */                                                             \
+    X(q.heap, int, nslot)                                                                     \
+    X(q.pos, int, nslot)                                                                      \
+    X(q.key, double, nslot)                                                                   \
+    X(qkind, unsigned char, nslot)                                                            \
+    X(win, int, nslot)                                                                        \
+    X(slot_t, double, nslot)                                                                  \
+    X(slot_same, int, nslot)                                                                  \
+    X(slot_run, int, nslot)                                                                   \
+    X(slot_t0, double, nslot)                                                                 \
+    /* the group of an event */                                                               \
+    X(g_cl, int, nb)                                                                          \
+    X(cl_mark, int, nb)                                                                       \
+    X(g_ct, int, m)                                                                           \
+    X(ct_mark, int, m)                                                                        \
+    X(ct_mark2, int, m)                                                                       \
+    X(ct_markD, int, m)                                                                       \
+    X(ct_markP, int, m)                                                                       \
+    X(g_dof, int, n)                                                                          \
+    X(gx, double, n)                                                                          \
+    X(gv, double, n)                                                                          \
+    X(gacc, double, n)                                                                        \
+    X(gtmp, double, n)                                                                        \
+    X(Uminus, double, m)                                                                      \
+    X(Uplus, double, m)                                                                       \
+    X(P, double, m)                                                                           \
+    X(lam, double, m)                                                                         \
+    X(wlcp, double, m)                                                                        \
+    X(qlcp, double, m)                                                                        \
+    X(wtmp, double, m)                                                                        \
+    X(lcp_idx, int, m)                                                                        \
+    X(jpos, int, m)                                                                           \
+    X(excluded, int, m)                                                                       \
+    X(held, unsigned char, m)                                                                 \
+    X(tie, unsigned char, m)                                                                  \
+    X(held_tail, double, m)                                                                   \
+    X(pos_in, int, m)                                                                         \
+    X(guess, unsigned char, m)                                                                \
+    X(lcp_scale, double, m)                                                                   \
+    X(lcp_q, double, m)                                                                       \
+    X(Dd, double, dm * dm)                                                                    \
+    X(Dlu, double, dm * dm)                                                                   \
+    X(rtmp, double, 4 * dm)                                                                   \
+    X(lu_perm, int, 2 * dm)                                                                   \
+    X(cG, double, nb)                                                                         \
+    X(Dval, double, dcap)                                                                     \
+    X(Dcol, int, m + 1)                                                                       \
+    X(Drow, int, dcap)                                                                        \
+    X(epos, int, m)                                                                           \
+    X(qtmp, double, m)                                                                        \
+    X(ztmp, double, m)                                                                        \
+    X(ev_vminus, double, n)                                                                   \
+    X(ev_vplus, double, n)                                                                    \
+    X(ev_x, double, n)                                                                        \
+    /* scratch */                                                                             \
+    X(stack, int, n)                                                                          \
+    X(pe, int, n)                                                                             \
+    X(pdof, int, n)                                                                           \
+    X(bfs_next, int, n)                                                                       \
+    X(ceta, double, nb)                                                                       \
+    X(cmu, double, nb)                                                                        \
+    X(cvy, double, nb)                                                                        \
+    X(ext, double, n)                                                                         \
+    X(nimp, long, m)                                                                          \
+    X(keybuf, int, 2 * (nb + m + 1))                                                          \
+    X(uf, int, nb)                                                                            \
+    X(gblk, int, nb)                                                                          \
+    X(newcl, int, nb)                                                                         \
+    X(plist, int, nb)                                                                         \
+    X(loc, int, n)                                                                            \
+    X(wk, double, 8 * n)                                                                      \
+    X(mctx, struct meas_ctx, nmeas)                                                           \
+    X(mscan, edr_scan, nmeas)                                                                 \
+    X(mprev, edr_pt, nmeas)                                                                   \
+    /* the observer's state */                                                                \
+    X(st.q, double, n)                                                                        \
+    X(st.v, double, n)                                                                        \
+    X(st.P, double, m)                                                                        \
+    X(st.g, double, m)                                                                        \
+    X(st.active, unsigned char, m)                                                            \
+    X(st.acc, double, n)
+
+#define EDR_ARRAYS(X) EDR_MODEL_ARRAYS(X) EDR_BLOCK_ARRAYS(X) EDR_MATRIX_ARRAYS(X) EDR_RUN_ARRAYS(X)
+
+/* Each entry's element type is its field's (checked, not evaluated). */
+#define EDR_ARRAY_TYPE(field, type, count)                              \
+    _Static_assert(_Generic(((pd_edr *)0)->field, type *: 1, default: 0), \
+                   "pd_edr." #field ": " #type);
+EDR_ARRAYS(EDR_ARRAY_TYPE)
+#undef EDR_ARRAY_TYPE
+
+/* The counts the tables are written in. */
+typedef struct edr_sizes {
+    long n, m, npieces; /* dofs, contacts, forcing pieces */
+    long nb;            /* blocks (and cluster slots: a cluster holds at least one) */
+    long nentries;      /* the blocks' dense matrices: sum of n_b^2 */
+    long nslot;         /* queue slots: the contacts, the clusters, the piece, the output */
+    long dm;            /* the clusters' dense LCPs: min(m, EDR_REDUCED_MAX) contacts */
+    long dcap;          /* entries of a compressed Delassus matrix */
+    long nmeas;         /* functions measured on one cluster: each dof's x and drift */
+} edr_sizes;
+
+/* One entry: PD_ENOMEM (the arrays taken so far are pd_edr_free's). */
+#define EDR_ALLOC_ARRAY(field, type, count)             \
+    if (!(r->field = pd_calloc((count), sizeof(type)))) \
+        return PD_ENOMEM;
+
+static int alloc_model_arrays(pd_edr *r, const edr_sizes *sizes)
+{
+    long n = sizes->n, m = sizes->m, npieces = sizes->npieces;
+    EDR_MODEL_ARRAYS(EDR_ALLOC_ARRAY)
+    return PD_OK;
+}
+
+static int alloc_block_arrays(pd_edr *r, const edr_sizes *sizes)
+{
+    long nb = sizes->nb;
+    EDR_BLOCK_ARRAYS(EDR_ALLOC_ARRAY)
+    return PD_OK;
+}
+
+static int alloc_matrix_arrays(pd_edr *r, const edr_sizes *sizes)
+{
+    long nentries = sizes->nentries;
+    EDR_MATRIX_ARRAYS(EDR_ALLOC_ARRAY)
+    return PD_OK;
+}
+
+static int alloc_run_arrays(pd_edr *r, const edr_sizes *sizes)
+{
+    long n = sizes->n, m = sizes->m, nb = sizes->nb, nslot = sizes->nslot;
+    long dm = sizes->dm, dcap = sizes->dcap, nmeas = sizes->nmeas;
+    EDR_RUN_ARRAYS(EDR_ALLOC_ARRAY)
+    return PD_OK;
+}
+#undef EDR_ALLOC_ARRAY
+
 void pd_edr_free(pd_edr *r)
 {
     if (!r)
         return;
+    /* the clusters' modal storage, the basis cache and the solvers, then the tables */
     if (r->cl)
         for (int c = 0; c < r->nb; c++)
             edr_cluster_free(&r->cl[c]);
     edr_basis_cache_free(r);
     pd_lcp_solver_free(r->solver);
     pd_lcp_solver_free(r->dsolver);
-    void *arrays[] = {r->b, r->pieces, r->blk, r->blk_dofs, r->dof_blk, r->dof_loc, r->Mb,
-                      r->Cb, r->Kb, r->blk_off, r->blk_cont, r->ct, r->minv, r->cl, r->blk_cl,
-                      r->blk_next, r->free_cl, r->s, r->d, r->xo, r->vo, r->cstate, r->pers_next,
-                      r->la, r->lb, r->lg, r->ld, r->base_t, r->base_g, r->qkind, r->win, r->slot_t, r->slot_same, r->slot_run, r->slot_t0, r->gmeas_t,
-                      r->since, r->burst, r->xpos, r->xneg, r->drift, r->gmin, r->impacts,
-                      r->first, r->maxP, r->ctime, r->imp_out, r->q.heap, r->q.pos, r->q.key,
-                      r->g_cl, r->cl_mark, r->g_ct, r->ct_mark, r->ct_mark2, r->ct_markD, r->ct_markP,
-                      r->g_dof, r->gx, r->gv, r->gacc, r->gtmp, r->Uminus, r->Uplus, r->P,
-                      r->lam, r->wlcp, r->qlcp, r->wtmp, r->Dd, r->Dlu, r->rtmp, r->lu_perm, r->cG, r->lcp_idx, r->jpos, r->held, r->tie,
-                      r->held_tail, r->excluded, r->guess, r->epos, r->qtmp, r->ztmp, r->lcp_scale, r->lcp_q, r->pos_in, r->Dval, r->Dcol, r->Drow,
-                      r->stack, r->pe, r->pdof, r->bfs_next, r->ceta, r->cmu, r->cvy, r->ext, r->nimp, r->crow, r->crow_c, r->keybuf, r->uf, r->gblk,
-                      r->newcl, r->plist, r->dofc_ptr, r->dofc, r->loc, r->wk, r->mctx,
-                      r->mscan, r->mprev, r->ev_vminus, r->ev_vplus, r->ev_x, r->st.q,
-                      r->st.v, r->st.P, r->st.g, r->st.active, r->st.acc};
-    for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
-        free(arrays[k]);
+#define EDR_FREE_ARRAY(field, type, count) free(r->field);
+    EDR_ARRAYS(EDR_FREE_ARRAY)
+#undef EDR_FREE_ARRAY
     free(r);
 }
 
@@ -2195,14 +2684,13 @@ static void wcol_entry(void *ctx, int i, int j, double x)
     if (ct->dof[0] < 0) {
         ct->dof[0] = i;
         ct->w[0] = x;
+    /* a third nonzero: no contact of the row reference (bad: its index + 1) */
     } else if (ct->dof[1] < 0) {
         ct->dof[1] = i;
         ct->w[1] = x;
     } else
         w->bad = j + 1;
 }
-
-#define ALLOC(p, cnt) (((p) = calloc((size_t)((cnt) > 0 ? (cnt) : 1), sizeof *(p))) != NULL)
 
 static int check_opts(const pd_edr_opts *o, pd_err *err)
 {
@@ -2223,122 +2711,132 @@ static int check_opts(const pd_edr_opts *o, pd_err *err)
     return PD_OK;
 }
 
-pd_edr *pd_edr_alloc(const pd_model *md, const pd_piecewise_force *F, const pd_edr_opts *opts,
-                     pd_err *err)
+/* The model, the force and the options as the row reference takes them. */
+static int check_inputs(const pd_model *md, const pd_piecewise_force *F, const pd_edr_opts *o,
+                        pd_err *err)
 {
-    pd_edr *r = NULL;
-    pd_edr_opts o = opts ? *opts : pd_edr_default_opts();
     int rc;
-    pd_err_clear(err);
-    if (!md || !F) {
-        PD_NULL_ARG(err, !md ? "model" : "force");
-        return NULL;
-    }
-    if (!F->b || !F->pieces || F->npieces < 1) {
-        pd_err_set(err, PD_EINVAL, "row reference: a model and a piecewise force are needed");
-        return NULL;
-    }
-    if ((rc = pd_model_check(md, err)) || (rc = check_opts(&o, err)))
-        return NULL;
-    if (!pd_matrix_is_diagonal(&md->M)) {
-        pd_err_set(err, PD_EINVAL, "M: the row reference needs a diagonal (lumped) mass matrix");
-        return NULL;
-    }
+    if (!F->b || !F->pieces || F->npieces < 1)
+        return pd_err_set(err, PD_EINVAL, "row reference: a model and a piecewise force are "
+                                          "needed");
+    if ((rc = pd_model_check(md, err)) || (rc = check_opts(o, err)))
+        return rc;
+    if (!pd_matrix_is_diagonal(&md->M))
+        return pd_err_set(err, PD_EINVAL, "M: the row reference needs a diagonal (lumped) mass "
+                                          "matrix");
+    /* finite pieces, their starts strictly increasing (edr_piece_at bisects on them) */
     for (int k = 0; k < F->npieces; k++) {
         const pd_sine_piece *pc = &F->pieces[k];
         if (!isfinite(pc->t_start) || (k > 0 && !(pc->t_start > F->pieces[k - 1].t_start)) ||
             !isfinite(pc->A) || !isfinite(pc->w) || !isfinite(pc->phi) || !isfinite(pc->c0) ||
-            !isfinite(pc->c1)) {
-            pd_err_set(err, PD_EINVAL, "row reference: forcing piece %d is not finite or not in "
-                                       "order", k);
-            return NULL;
-        }
+            !isfinite(pc->c1))
+            return pd_err_set(err, PD_EINVAL, "row reference: forcing piece %d is not finite or "
+                                              "not in order", k);
     }
-    int n = md->n, m = md->m;
-    for (int i = 0; i < n; i++)
-        if (!isfinite(F->b[i])) {
-            pd_err_set(err, PD_EINVAL, "row reference: load coefficient %d is not finite", i);
-            return NULL;
-        }
-    if (!(r = calloc(1, sizeof *r))) {
-        pd_err_set(err, PD_ENOMEM, "out of memory for the row reference");
-        return NULL;
-    }
-    r->md = md;
-    r->o = o;
-    r->n = n;
-    r->m = m;
-    int *uf = NULL;
-    if (!ALLOC(r->b, n) || !ALLOC(r->pieces, F->npieces) || !ALLOC(r->dof_blk, n) ||
-        !ALLOC(r->dof_loc, n) || !ALLOC(r->blk_dofs, n) || !ALLOC(r->minv, n) || !ALLOC(uf, n) ||
-        !ALLOC(r->ct, m))
-        goto nomem;
-    memcpy(r->b, F->b, (size_t)n * sizeof(double));
-    memcpy(r->pieces, F->pieces, (size_t)F->npieces * sizeof(pd_sine_piece));
-    r->npieces = F->npieces;
-    for (int i = 0; i < n; i++) {
-        double mi = pd_matrix_get(&md->M, i, i);
-        if (!(mi > 0.0)) {
-            pd_err_set(err, PD_EINVAL, "M: mass %d must be > 0 (got %g)", i, mi);
-            goto fail;
-        }
+    for (int i = 0; i < md->n; i++)
+        if (!isfinite(F->b[i]))
+            return pd_err_set(err, PD_EINVAL, "row reference: load coefficient %d is not "
+                                              "finite", i);
+    return PD_OK;
+}
+
+static int out_of_memory(const pd_edr *r, pd_err *err)
+{
+    return pd_err_set(err, PD_ENOMEM, "out of memory for the row reference (%d dofs, %d "
+                      "contacts)", r->n, r->m);
+}
+
+/* 1 / M_ii of the lumped masses, each > 0. */
+static int set_masses(pd_edr *r, pd_err *err)
+{
+    for (int i = 0; i < r->n; i++) {
+        double mi = pd_matrix_get(&r->md->M, i, i);
+        if (!(mi > 0.0))
+            return pd_err_set(err, PD_EINVAL, "M: mass %d must be > 0 (got %g)", i, mi);
         r->minv[i] = 1.0 / mi;
-        uf[i] = i;
     }
-    /* blocks: the components of C and K's couplings */
-    for_each_entry(&md->C, join_entry, uf);
-    for_each_entry(&md->K, join_entry, uf);
+    return PD_OK;
+}
+
+/* The blocks: the components of C and K's couplings (union-find in uf),
+ * each numbered at its root (dof_blk of the root); returns their count. */
+static int find_blocks(pd_edr *r, int *uf)
+{
+    for (int i = 0; i < r->n; i++)
+        uf[i] = i;
+    /* C_ij != 0 or K_ij != 0 (i != j) puts dofs i and j in one structure */
+    for_each_entry(&r->md->C, join_entry, uf);
+    for_each_entry(&r->md->K, join_entry, uf);
     int nb = 0;
-    for (int i = 0; i < n; i++)
+    for (int i = 0; i < r->n; i++)
         if (uf_find(uf, i) == i)
             r->dof_blk[i] = nb++;
-    r->nb = nb;
-    if (!ALLOC(r->blk, nb) || !ALLOC(r->blk_off, nb + 1))
-        goto nomem;
-    for (int i = 0; i < n; i++) {
+    return nb;
+}
+
+/* Each dof's block and local index, each block's dofs (blk_dofs[first ..
+ * first + n)) and the offset of its dense n_b x n_b matrices; returns
+ * their total size, sum n_b^2. */
+static long lay_out_blocks(pd_edr *r, int *uf)
+{
+    /* a root's dof_blk holds its block's number: every dof takes its root's */
+    for (int i = 0; i < r->n; i++) {
         int b = r->dof_blk[uf_find(uf, i)];
         r->dof_blk[i] = b;
         r->dof_loc[i] = r->blk[b].n++;
     }
+    /* the blocks' dofs contiguous in blk_dofs, in block order; their matrices
+     * n_b x n_b column-major from blk_off[b] */
     long off = 0;
     int at = 0;
-    for (int b = 0; b < nb; b++) {
+    for (int b = 0; b < r->nb; b++) {
         r->blk[b].first = at;
         at += r->blk[b].n;
         r->blk_off[b] = off;
         off += (long)r->blk[b].n * r->blk[b].n;
         r->blk[b].sdof = r->blk[b].n == 1;
     }
-    r->blk_off[nb] = off;
-    for (int i = 0; i < n; i++)
+    r->blk_off[r->nb] = off;
+    for (int i = 0; i < r->n; i++)
         r->blk_dofs[r->blk[r->dof_blk[i]].first + r->dof_loc[i]] = i;
-    if (!ALLOC(r->Cb, off) || !ALLOC(r->Kb, off) || !ALLOC(r->Mb, off))
-        goto nomem;
+    return off;
+}
+
+/* C and K block by block, and an SDOF block's scalars m, c, k, b. */
+static int fill_blocks(pd_edr *r, pd_err *err)
+{
     fill_ctx fc = {.r = r, .dst = r->Cb};
-    for_each_entry(&md->C, fill_entry, &fc);
+    for_each_entry(&r->md->C, fill_entry, &fc);
     fc.dst = r->Kb;
-    for_each_entry(&md->K, fill_entry, &fc);
-    for (int b = 0; b < nb; b++) {
+    for_each_entry(&r->md->K, fill_entry, &fc);
+    for (int b = 0; b < r->nb; b++) {
         edr_block *bk = &r->blk[b];
-        if (bk->sdof) {
-            int i = r->blk_dofs[bk->first];
-            bk->m = 1.0 / r->minv[i];
-            bk->c = r->Cb[r->blk_off[b]];
-            bk->k = r->Kb[r->blk_off[b]];
-            bk->b = r->b[i];
-            if (bk->k < 0.0 || bk->c < 0.0) {
-                pd_err_set(err, PD_EINVAL, "K, C: dof %d has a negative stiffness or damping", i);
-                goto fail;
-            }
-        }
+        if (!bk->sdof)
+            continue;
+        /* an SDOF block's scalars: its 1 x 1 M, C, K and load coefficient */
+        int i = r->blk_dofs[bk->first];
+        bk->m = 1.0 / r->minv[i];
+        bk->c = r->Cb[r->blk_off[b]];
+        bk->k = r->Kb[r->blk_off[b]];
+        bk->b = r->b[i];
+        if (bk->k < 0.0 || bk->c < 0.0)
+            return pd_err_set(err, PD_EINVAL, "K, C: dof %d has a negative stiffness or damping",
+                              i);
     }
-    /* contacts: one or two dofs each, in different structures */
-    for (int a = 0; a < m; a++) {
-        r->ct[a] = (edr_contact){.dof = {-1, -1}, .blk = {-1, -1}, .g0 = md->g0[a], .e = md->e[a]};
-    }
+    return PD_OK;
+}
+
+/* The contacts from W's columns: one or two dofs each, in different
+ * structures (g = g0 + w0 x_dof0 + w1 x_dof1). */
+static int set_contacts(pd_edr *r, pd_err *err)
+{
+    for (int a = 0; a < r->m; a++)
+        r->ct[a] = (edr_contact){.dof = {-1, -1}, .blk = {-1, -1}, .g0 = r->md->g0[a],
+                                 .e = r->md->e[a]};
     wcol_ctx wc = {.r = r, .bad = 0};
-    for_each_entry(&md->W, wcol_entry, &wc);
-    for (int a = 0; a < m && !wc.bad; a++) {
+    for_each_entry(&r->md->W, wcol_entry, &wc);
+    /* a first side always, a second (if any) in another structure */
+    for (int a = 0; a < r->m && !wc.bad; a++) {
         edr_contact *ct = &r->ct[a];
         if (ct->dof[0] < 0)
             wc.bad = a + 1;
@@ -2347,25 +2845,33 @@ pd_edr *pd_edr_alloc(const pd_model *md, const pd_piecewise_force *F, const pd_e
         if (ct->dof[1] >= 0 && ct->blk[0] == ct->blk[1])
             wc.bad = a + 1;
     }
-    if (wc.bad) {
-        pd_err_set(err, PD_EINVAL, "W: contact %d must join one dof of one structure to one of "
-                   "another, or to a wall (the row reference)", wc.bad - 1);
-        goto fail;
-    }
-    /* adjacency: contacts of each block and of each dof */
-    if (!ALLOC(r->blk_cont, 2 * m) || !ALLOC(r->dofc_ptr, n + 1) || !ALLOC(r->dofc, 2 * m))
-        goto nomem;
+    if (wc.bad)
+        return pd_err_set(err, PD_EINVAL, "W: contact %d must join one dof of one structure to "
+                          "one of another, or to a wall (the row reference)", wc.bad - 1);
+    return PD_OK;
+}
+
+/* The contacts of each block (blk_cont[cont0 .. cont0 + ncont)) and of
+ * each dof (dofc[dofc_ptr[i] .. dofc_ptr[i + 1]), uf counting each dof's
+ * filled); returns the Delassus matrix's largest pattern, sum over the
+ * dofs of (contacts at the dof)^2. */
+static long link_contacts(pd_edr *r, int *uf)
+{
+    int n = r->n, m = r->m;
+    /* count: contacts per block (ncont) and per dof (dofc_ptr[i + 1]) */
     for (int a = 0; a < m; a++)
         for (int s = 0; s < 2; s++)
             if (r->ct[a].dof[s] >= 0) {
                 r->blk[r->ct[a].blk[s]].ncont++;
                 r->dofc_ptr[r->ct[a].dof[s] + 1]++;
             }
-    for (int b = 0, c0 = 0; b < nb; b++) {
+    /* each block's list starts at cont0; its count restarts for the filling */
+    for (int b = 0, c0 = 0; b < r->nb; b++) {
         r->blk[b].cont0 = c0;
         c0 += r->blk[b].ncont;
         r->blk[b].ncont = 0;
     }
+    /* prefix sums: dof i's contacts from dofc_ptr[i] */
     for (int i = 0; i < n; i++)
         r->dofc_ptr[i + 1] += r->dofc_ptr[i];
     long dnnz = 0;
@@ -2377,7 +2883,8 @@ pd_edr *pd_edr_alloc(const pd_model *md, const pd_piecewise_force *F, const pd_e
             edr_block *bk = &r->blk[r->ct[a].blk[s]];
             r->blk_cont[bk->cont0 + bk->ncont++] = a;
         }
-    for (int i = 0; i < n; i++) /* uf now counts the contacts filled per dof */
+    /* uf[i]: the contacts filled so far into dof i's list */
+    for (int i = 0; i < n; i++)
         uf[i] = 0;
     for (int a = 0; a < m; a++)
         for (int s = 0; s < 2; s++) {
@@ -2386,55 +2893,89 @@ pd_edr *pd_edr_alloc(const pd_model *md, const pd_piecewise_force *F, const pd_e
                 r->dofc[r->dofc_ptr[dof] + uf[dof]++] = a;
         }
     for (int i = 0; i < n; i++) {
+        /* a dof with dg contacts couples each pair of them in D: dg^2 entries at most */
         long dg = r->dofc_ptr[i + 1] - r->dofc_ptr[i];
         dnnz += dg * dg;
     }
-    r->Dcap = dnnz + m;
-    int dm = m < EDR_REDUCED_MAX ? m : EDR_REDUCED_MAX;
-    int nf = 2 * n;
-    if (!ALLOC(r->cl, nb) || !ALLOC(r->blk_cl, nb) || !ALLOC(r->blk_next, nb) ||
-        !ALLOC(r->free_cl, nb) || !ALLOC(r->s, n) || !ALLOC(r->d, n) || !ALLOC(r->xo, n) ||
-        !ALLOC(r->vo, n) || !ALLOC(r->cstate, m) || !ALLOC(r->pers_next, m) || !ALLOC(r->la, m) ||
-        !ALLOC(r->lb, m) || !ALLOC(r->lg, m) || !ALLOC(r->ld, m) || !ALLOC(r->base_t, m) ||
-        !ALLOC(r->base_g, m) || !ALLOC(r->qkind, m + nb + 2) || !ALLOC(r->win, m + nb + 2) ||
-        !ALLOC(r->slot_t, m + nb + 2) || !ALLOC(r->slot_same, m + nb + 2) ||
-        !ALLOC(r->slot_run, m + nb + 2) || !ALLOC(r->slot_t0, m + nb + 2) || !ALLOC(r->gmeas_t, m) ||
-        !ALLOC(r->since, m) || !ALLOC(r->burst, m) || !ALLOC(r->xpos, n) || !ALLOC(r->xneg, n) ||
-        !ALLOC(r->drift, n) || !ALLOC(r->gmin, m) || !ALLOC(r->impacts, m) || !ALLOC(r->first, m) ||
-        !ALLOC(r->maxP, m) || !ALLOC(r->ctime, m) || !ALLOC(r->imp_out, m) ||
-        !ALLOC(r->q.heap, m + nb + 2) || !ALLOC(r->q.pos, m + nb + 2) ||
-        !ALLOC(r->q.key, m + nb + 2) || !ALLOC(r->g_cl, nb) || !ALLOC(r->cl_mark, nb) ||
-        !ALLOC(r->g_ct, m) || !ALLOC(r->ct_mark, m) || !ALLOC(r->ct_mark2, m) ||
-        !ALLOC(r->ct_markD, m) || !ALLOC(r->ct_markP, m) || !ALLOC(r->g_dof, n) || !ALLOC(r->gx, n) || !ALLOC(r->gv, n) ||
-        !ALLOC(r->gacc, n) || !ALLOC(r->gtmp, n) || !ALLOC(r->Uminus, m) || !ALLOC(r->Uplus, m) ||
-        !ALLOC(r->P, m) || !ALLOC(r->lam, m) || !ALLOC(r->wlcp, m) || !ALLOC(r->qlcp, m) ||
-        !ALLOC(r->wtmp, m) || !ALLOC(r->Dd, (long)dm * dm) || !ALLOC(r->Dlu, (long)dm * dm) ||
-        !ALLOC(r->rtmp, 4L * dm) || !ALLOC(r->lu_perm, 2L * dm) || !ALLOC(r->cG, nb) || !ALLOC(r->lcp_idx, m) ||
-        !ALLOC(r->jpos, m) || !ALLOC(r->held, m) || !ALLOC(r->tie, m) || !ALLOC(r->held_tail, m) ||
-        !ALLOC(r->excluded, m) || !ALLOC(r->guess, m) || !ALLOC(r->epos, m) || !ALLOC(r->qtmp, m) || !ALLOC(r->ztmp, m) || !ALLOC(r->lcp_scale, m) || !ALLOC(r->lcp_q, m) || !ALLOC(r->pos_in, m) || !ALLOC(r->Dval, r->Dcap) ||
-        !ALLOC(r->Dcol, m + 1) || !ALLOC(r->Drow, r->Dcap) || !ALLOC(r->stack, n) ||
-        !ALLOC(r->pe, n) || !ALLOC(r->pdof, n) || !ALLOC(r->bfs_next, n) ||
-        !ALLOC(r->ceta, nb) || !ALLOC(r->cmu, nb) || !ALLOC(r->cvy, nb) || !ALLOC(r->ext, n) || !ALLOC(r->nimp, m) || !ALLOC(r->crow, n) || !ALLOC(r->crow_c, m) ||
-        !ALLOC(r->keybuf, 2 * (nb + m + 1)) || !ALLOC(r->uf, nb) || !ALLOC(r->gblk, nb) ||
-        !ALLOC(r->newcl, nb) || !ALLOC(r->plist, nb) || !ALLOC(r->loc, n) || !ALLOC(r->wk, 8L * n) ||
-        !ALLOC(r->mctx, nf) || !ALLOC(r->mscan, nf) || !ALLOC(r->mprev, nf) ||
-        !ALLOC(r->ev_vminus, n) || !ALLOC(r->ev_vplus, n) || !ALLOC(r->ev_x, n) ||
-        !ALLOC(r->st.q, n) || !ALLOC(r->st.v, n) || !ALLOC(r->st.P, m) || !ALLOC(r->st.g, m) ||
-        !ALLOC(r->st.active, m) || !ALLOC(r->st.acc, n))
-        goto nomem;
-    if (m > 1 && (!(r->solver = pd_lcp_solver_alloc(o.lcp_solver, m, r->Dcap, err)) ||
-                  !(r->dsolver = pd_lcp_solver_alloc(PD_LCP_LEMKE, dm, 0, err))))
-        goto fail;
+    return dnnz;
+}
+
+/* The dof-level LCPs' solver (m contacts, Dcap entries) and the clusters'
+ * dense Lemke (dm contacts); none for one contact (closed forms). */
+static int alloc_solvers(pd_edr *r, int dm, pd_err *err)
+{
+    if (r->m > 1 && (!(r->solver = pd_lcp_solver_alloc(r->o.lcp_solver, r->m, r->Dcap, err)) ||
+                     !(r->dsolver = pd_lcp_solver_alloc(PD_LCP_LEMKE, dm, 0, err))))
+        return err && err->status ? err->status : PD_ENOMEM;
+    return PD_OK;
+}
+
+/* The model's blocks and contacts, then the run's arrays and solvers,
+ * each stage's arrays allocated once its sizes are known; uf: n ints of
+ * scratch.  A failure's status (err set). */
+static int build(pd_edr *r, const pd_piecewise_force *F, int *uf, pd_err *err)
+{
+    edr_sizes sizes = {.n = r->n, .m = r->m, .npieces = F->npieces};
+    int rc;
+    if (alloc_model_arrays(r, &sizes))
+        return out_of_memory(r, err);
+    memcpy(r->b, F->b, (size_t)r->n * sizeof(double));
+    memcpy(r->pieces, F->pieces, (size_t)F->npieces * sizeof(pd_sine_piece));
+    r->npieces = F->npieces;
+    if ((rc = set_masses(r, err)))
+        return rc;
+    sizes.nb = r->nb = find_blocks(r, uf);
+    if (alloc_block_arrays(r, &sizes))
+        return out_of_memory(r, err);
+    sizes.nentries = lay_out_blocks(r, uf);
+    if (alloc_matrix_arrays(r, &sizes))
+        return out_of_memory(r, err);
+    if ((rc = fill_blocks(r, err)) || (rc = set_contacts(r, err)))
+        return rc;
+    /* D's entries: at most sum over the dofs of dg^2; m more to spare */
+    r->Dcap = link_contacts(r, uf) + r->m;
+    int dm = r->m < EDR_REDUCED_MAX ? r->m : EDR_REDUCED_MAX;
+    sizes.nslot = r->m + r->nb + 2;
+    sizes.dm = dm;
+    sizes.dcap = r->Dcap;
+    sizes.nmeas = 2L * r->n;
+    if (alloc_run_arrays(r, &sizes))
+        return out_of_memory(r, err);
+    return alloc_solvers(r, dm, err);
+}
+
+pd_edr *pd_edr_alloc(const pd_model *md, const pd_piecewise_force *F, const pd_edr_opts *opts,
+                     pd_err *err)
+{
+    pd_edr_opts o = opts ? *opts : pd_edr_default_opts();
+    pd_err_clear(err);
+    if (!md || !F) {
+        PD_NULL_ARG(err, !md ? "model" : "force");
+        return NULL;
+    }
+    if (check_inputs(md, F, &o, err))
+        return NULL;
+    pd_edr *r = calloc(1, sizeof *r);
+    if (!r) {
+        pd_err_set(err, PD_ENOMEM, "out of memory for the row reference");
+        return NULL;
+    }
+    r->md = md;
+    r->o = o;
+    r->n = md->n;
+    r->m = md->m;
+    /* uf: the blocks' union-find, then link_contacts' fill counts */
+    int *uf = pd_malloc(r->n, sizeof *uf);
+    int rc = uf ? build(r, F, uf, err) : out_of_memory(r, err);
     free(uf);
-    r->slot_piece = m + nb;
-    r->slot_out = m + nb + 1;
+    if (rc) {
+        pd_edr_free(r);
+        return NULL;
+    }
+    /* the queue's last two slots: the piece change and the output */
+    r->slot_piece = r->m + r->nb;
+    r->slot_out = r->m + r->nb + 1;
     return r;
-nomem:
-    pd_err_set(err, PD_ENOMEM, "out of memory for the row reference (%d dofs, %d contacts)", n, m);
-fail:
-    free(uf);
-    pd_edr_free(r);
-    return NULL;
 }
 
 /* ---- the run -------------------------------------------------------------------------------- */
@@ -2448,6 +2989,7 @@ static void reset(pd_edr *r, double t0, const double *q0, const double *v0, doub
     r->t1 = t1;
     r->L = r->o.length_scale;
     r->piece = edr_piece_at(r, t0);
+    /* the queue empty: every slot out of it (pos -1, key +inf) */
     r->q.n = 0;
     for (int k = 0; k < m + r->nb + 2; k++) {
         r->q.pos[k] = -1;
@@ -2456,6 +2998,7 @@ static void reset(pd_edr *r, double t0, const double *q0, const double *v0, doub
     for (int i = 0; i < n; i++) {
         r->xo[i] = q0 ? q0[i] : 0.0;
         r->vo[i] = v0 ? v0[i] : 0.0;
+        /* extremes from -inf: finish zeroes those never measured */
         r->xpos[i] = r->xneg[i] = r->drift[i] = -HUGE_VAL;
         r->loc[i] = -1;
     }
@@ -2467,6 +3010,7 @@ static void reset(pd_edr *r, double t0, const double *q0, const double *v0, doub
         r->ct[a].g0 = g0 > 0.0 && g0 <= r->o.close_tol * r->L ? 0.0 : g0;
     }
     for (int a = 0; a < m; a++) {
+        /* every contact open with no exact gap (base_t -inf), minimum +inf, counts 0 */
         r->cstate[a] = EDR_OPEN;
         r->pers_next[a] = -1;
         r->base_t[a] = -HUGE_VAL;
@@ -2478,19 +3022,22 @@ static void reset(pd_edr *r, double t0, const double *q0, const double *v0, doub
         r->burst[a] = 0;
         r->since[a] = t0;
     }
+    /* every cluster slot free, stacked so that start gives block b slot b */
     r->nfree = 0;
     for (int c = r->nb - 1; c >= 0; c--) {
         r->cl[c].live = 0;
         r->free_cl[r->nfree++] = c;
     }
+    /* marks zeroed and epochs restarted: the first group's epoch, 1, matches none */
     r->epoch = r->epochD = 0;
     memset(r->cl_mark, 0, (size_t)r->nb * sizeof *r->cl_mark);
-    memset(r->ct_mark, 0, (size_t)(m > 0 ? m : 1) * sizeof *r->ct_mark);
-    memset(r->ct_mark2, 0, (size_t)(m > 0 ? m : 1) * sizeof *r->ct_mark2);
-    memset(r->ct_markD, 0, (size_t)(m > 0 ? m : 1) * sizeof *r->ct_markD);
-    memset(r->ct_markP, 0, (size_t)(m > 0 ? m : 1) * sizeof *r->ct_markP);
+    memset(r->ct_mark, 0, (size_t)m * sizeof *r->ct_mark);
+    memset(r->ct_mark2, 0, (size_t)m * sizeof *r->ct_mark2);
+    memset(r->ct_markD, 0, (size_t)m * sizeof *r->ct_markD);
+    memset(r->ct_markP, 0, (size_t)m * sizeof *r->ct_markP);
     r->epochP = 0;
     for (int k = 0; k < m + r->nb + 2; k++) {
+        /* NaN: no event yet (it equals no t) */
         r->slot_t[k] = NAN;
         r->slot_same[k] = 0;
         r->slot_run[k] = 0;
@@ -2505,6 +3052,7 @@ static void reset(pd_edr *r, double t0, const double *q0, const double *v0, doub
 static int start(pd_edr *r, double t0, pd_err *err)
 {
     int rc;
+    /* every structure a cluster of its own, its flight from (q0, v0) */
     for (int b = 0; b < r->nb; b++) {
         int c = r->free_cl[--r->nfree];
         edr_cluster *cl = &r->cl[c];
@@ -2519,6 +3067,7 @@ static int start(pd_edr *r, double t0, pd_err *err)
         if ((rc = edr_cluster_start(r, c, t0, err)))
             return rc;
     }
+    /* a gap below -tol at t0: the structures start overlapping */
     double tol = r->o.close_tol * r->L;
     for (int a = 0; a < r->m; a++) {
         double g = gap_now(r, a, t0, NULL);
@@ -2526,6 +3075,7 @@ static int start(pd_edr *r, double t0, pd_err *err)
             return pd_err_set(err, PD_EINVAL, "q0: contact %d starts with a negative gap (%g)",
                               a, g);
     }
+    /* contacts closed at t0 resolve at t0 (an impact, or persistence) */
     if (!r->o.inactive)
         for (int a = 0; a < r->m; a++) {
             if (r->cstate[a] != EDR_OPEN || !(gap_now(r, a, t0, NULL) <= tol))
@@ -2539,6 +3089,7 @@ static int start(pd_edr *r, double t0, pd_err *err)
             if ((rc = resolve_group(r, t0, err)))
                 return rc;
         }
+    /* every prediction, and the first piece change */
     for (int a = 0; a < r->m; a++)
         predict_contact(r, a, t0, 0);
     for (int c = 0; c < r->nb; c++)
@@ -2557,12 +3108,15 @@ static void finish(pd_edr *r, double t)
             measure_cluster(r, c, t);
     for (int a = 0; a < r->m; a++) {
         measure_contact(r, a, t);
+        /* a contact held at the end: its time in contact up to t */
         if (r->cstate[a] == EDR_PERSIST && t > r->since[a])
             r->ctime[a] += t - r->since[a];
+        /* never measured (never open, or no time to measure): its gap at t */
         if (!(r->gmin[a] < HUGE_VAL))
             r->gmin[a] = gap_now(r, a, t, NULL);
     }
     for (int i = 0; i < r->n; i++) {
+        /* NaN becomes -inf; -inf: never measured (t_measure at or past t), extremes 0 */
         r->xpos[i] = pd_max(r->xpos[i], -HUGE_VAL);
         if (!(r->xpos[i] > -HUGE_VAL))
             r->xpos[i] = r->xneg[i] = r->drift[i] = 0.0;
@@ -2583,12 +3137,14 @@ int pd_edr_run(pd_edr *r, double t0, const double *q0, const double *v0, double 
     for (int i = 0; q0 && i < r->n; i++)
         if (!isfinite(q0[i]) || (v0 && !isfinite(v0[i])))
             return pd_err_set(err, PD_EINVAL, "row reference: the initial state is not finite");
+    /* a sampler reports impulses over each output interval: held forces integrated */
     r->sample_forces = obs && r->o.h_out > 0.0 && !r->o.impacts_only;
     reset(r, t0, q0, v0, t1);
     if ((rc = start(r, t0, err)))
         goto out;
     r->t_out0 = t0;
     r->next_out = 0;
+    /* the observer's first state at t0, then the output grid */
     if (obs) {
         r->st.step = 0;
         if (emit(r, t0, obs, ctx) > 0)
@@ -2599,6 +3155,7 @@ int pd_edr_run(pd_edr *r, double t0, const double *q0, const double *v0, double 
     }
     double t = t0;
     while (!r->stopped) {
+        /* the earliest queued time; past t1 the run is done */
         int slot = r->q.n > 0 ? r->q.heap[0] : -1;
         double te = slot >= 0 ? r->q.key[slot] : HUGE_VAL;
         if (!(te <= t1))
@@ -2614,6 +3171,8 @@ int pd_edr_run(pd_edr *r, double t0, const double *q0, const double *v0, double 
             if (emit(r, t, obs, ctx) > 0)
                 break;
             r->next_out++;
+            /* the grid t0 + k h_out, not accumulated (no drift); a point past t1
+             * becomes t1 unless the last one was t1 already (to rounding) */
             double tn = r->t_out0 + (double)r->next_out * r->o.h_out;
             if (tn > t1 && t < t1 * (1.0 - 1e-15))
                 tn = t1;
@@ -2622,6 +3181,8 @@ int pd_edr_run(pd_edr *r, double t0, const double *q0, const double *v0, double 
         }
         if (slot == r->slot_piece) {
             rc = on_piece(r, t, err);
+        /* a contact's slot: a scan's continuation or an impact; a cluster's: a
+         * scan's continuation or a detachment */
         } else if (slot < r->m) {
             if (r->qkind[slot] == EDR_Q_SCAN)
                 predict_contact(r, slot, t, 1);
@@ -2637,6 +3198,7 @@ int pd_edr_run(pd_edr *r, double t0, const double *q0, const double *v0, double 
         if (rc)
             break;
     }
+    /* no error: measured up to t1, or to the event's t when its report stopped the run */
     if (!rc) {
         t = r->stopped ? t : t1;
         finish(r, t);
@@ -2653,6 +3215,7 @@ const pd_edr_result *pd_edr_result_of(const pd_edr *r)
 {
     if (!r)
         return NULL;
+    /* the arrays point into r: valid until its next run or its free */
     pd_edr_result *res = (pd_edr_result *)&r->res;
     res->xpos = r->xpos;
     res->xneg = r->xneg;

@@ -165,7 +165,7 @@ struct pd_edr {
     /* blocks and contacts */
     edr_block *blk;
     int *blk_dofs, *dof_blk, *dof_loc; /* dof lists, dof -> block, dof -> local index */
-    double *Mb, *Cb, *Kb;      /* dense n_b x n_b per block, at blk_off[b] */
+    double *Cb, *Kb;           /* dense n_b x n_b per block, at blk_off[b] */
     long *blk_off;
     int *blk_cont;             /* contacts of each block */
     int *dofc_ptr, *dofc;      /* contacts of each dof */

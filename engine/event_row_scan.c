@@ -53,6 +53,7 @@ static double value(edr_scan *s, int k, double sign, double t, double *slope)
     double o[3];
     s->fn(s->ctx, t, o);
     s->evals++;
+    /* the slope of sign * out[k] is sign * out[k + 1] (none given for f'') */
     if (slope)
         *slope = k < 2 ? sign * o[k + 1] : 0.0;
     return sign * o[k];
@@ -65,6 +66,7 @@ static double bisect_to(edr_scan *s, int k, double sign, double lo, double hi, d
     for (int it = 0; it < BISECT_MAX_IT && hi - lo > fmax(w, BISECT_REL * fmax(fabs(hi), 1e-300));
          it++) {
         double mid = 0.5 * (lo + hi);
+        /* lo and hi adjacent doubles: nothing between */
         if (mid <= lo || mid >= hi)
             break;
         if (value(s, k, sign, mid, NULL) > 0.0)
@@ -183,6 +185,8 @@ static double hermite_root(const edr_pt *a, const edr_pt *b)
     double p0 = a->f, p1 = b->f, m0 = a->df * h, m1 = b->df * h;
     for (int it = 0; it < 8; it++) { /* Newton on the cubic in u in [0, 1] */
         double u2 = u * u, u3 = u2 * u;
+        /* p(u) = h00 p0 + h10 m0 + h01 p1 + h11 m1 (the cubic Hermite basis on
+         * [0, 1]) and d = p'(u) */
         double f = (2 * u3 - 3 * u2 + 1) * p0 + (u3 - 2 * u2 + u) * m0 + (-2 * u3 + 3 * u2) * p1 +
                    (u3 - u2) * m1;
         double d = (6 * u2 - 6 * u) * p0 + (3 * u2 - 4 * u + 1) * m0 + (-6 * u2 + 6 * u) * p1 +
@@ -284,6 +288,9 @@ static int scan_simple(edr_scan *s, const edr_pt *a, const edr_pt *b, double *t_
 static int may_turn_twice(const edr_pt *a, const edr_pt *b, int dir)
 {
     double h = b->t - a->t;
+    /* f' heads toward zero at a and away at b: |f'| has a minimum inside,
+     * a dip through zero possible only if f' at an end is within
+     * TURN_MARGIN |f''| h of zero */
     if (!(dir * a->ddf < 0.0 && dir * b->ddf > 0.0))
         return 0;
     return fabs(a->df) <= TURN_MARGIN * fabs(a->ddf) * h ||

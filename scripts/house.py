@@ -25,8 +25,10 @@ def functions(path):
         parts = row.split()
         name, line = parts[0], int(parts[2])
         end = line
-        while end < len(lines) and not lines[end - 1].startswith("}"):
-            end += 1
+        first = lines[line - 1].rstrip()
+        if not ("{" in first and first.endswith("}")):  # not a one-line function
+            while end < len(lines) and not lines[end - 1].startswith("}"):
+                end += 1
         res.append((name, line, end))
     return res
 
