@@ -15,13 +15,10 @@
 #include <math.h>
 
 #include "event_row.h"
+#include "pd_root.h"
 
 /* f' may turn twice in an interval only within this many |f''| h of zero. */
 #define TURN_MARGIN 2.0
-/* Bisection stops at adjacent doubles. */
-#define BISECT_REL 2e-16
-#define BISECT_MAX_IT 200
-#define NEWTON_MAX_IT 30
 /* Past a converged root, this many next doubles are tried one by one. */
 #define WALK_DOUBLES 4
 /* A turn is not located in hit mode when f stays below -this of the
@@ -47,85 +44,53 @@ void edr_scan_note(edr_scan *s, double f)
     s->fmin = fmin(s->fmin, f);
 }
 
-/* sign * out[k] at t. */
-static double value(edr_scan *s, int k, double sign, double t, double *slope)
+/* sign * out[k] of the scanned function, as core/root.c's function. */
+typedef struct scan_fn {
+    edr_scan *s;
+    int k;
+    double sign;
+} scan_fn;
+
+/* sign * out[k] at t, counted in s->evals. */
+static double scan_value(void *ctx, double t, double *slope)
 {
+    const scan_fn *c = ctx;
     double o[3];
-    s->fn(s->ctx, t, o);
-    s->evals++;
+    c->s->fn(c->s->ctx, t, o);
+    c->s->evals++;
     /* the slope of sign * out[k] is sign * out[k + 1] (none given for f'') */
     if (slope)
-        *slope = k < 2 ? sign * o[k + 1] : 0.0;
-    return sign * o[k];
+        *slope = c->k < 2 ? c->sign * o[c->k + 1] : 0.0;
+    return c->sign * o[c->k];
+}
+
+static double value(edr_scan *s, int k, double sign, double t, double *slope)
+{
+    scan_fn c = {.s = s, .k = k, .sign = sign};
+    return scan_value(&c, t, slope);
 }
 
 /* Bisection between lo (value <= 0) and hi (> 0) to the width w (0:
- * adjacent doubles); returns hi. */
+ * adjacent doubles); returns hi (core/root.c). */
 static double bisect_to(edr_scan *s, int k, double sign, double lo, double hi, double w)
 {
-    for (int it = 0; it < BISECT_MAX_IT && hi - lo > fmax(w, BISECT_REL * fmax(fabs(hi), 1e-300));
-         it++) {
-        double mid = 0.5 * (lo + hi);
-        /* lo and hi adjacent doubles: nothing between */
-        if (mid <= lo || mid >= hi)
-            break;
-        if (value(s, k, sign, mid, NULL) > 0.0)
-            hi = mid;
-        else
-            lo = mid;
-    }
-    return hi;
+    scan_fn c = {.s = s, .k = k, .sign = sign};
+    pd_root r = {.f = scan_value, .ctx = &c};
+    return pd_root_bisect(&r, lo, hi, w);
 }
 
 /* The sign change of sign * out[k] between lo and hi by safeguarded Newton
- * on its closed-form slope (k < 2), from the guess t0 when it lies inside
- * (else the middle), closing the bracket around the converged step and
- * finishing by bisection: the same hi as bisection. */
+ * on its closed-form slope (k < 2; f'' has none: bisection), from the guess
+ * t0 when it lies inside (else the middle): core/root.c's, the same hi as
+ * bisection. */
 static double locate_from(edr_scan *s, int k, double sign, double lo, double hi, double w,
                           double t0)
 {
     if (k == 2)
         return bisect_to(s, k, sign, lo, hi, w);
-    double t = t0 > lo && t0 < hi ? t0 : 0.5 * (lo + hi);
-    for (int it = 0; it < NEWTON_MAX_IT; it++) {
-        double tol = fmax(w, BISECT_REL * fmax(fabs(hi), 1e-300));
-        if (hi - lo <= tol)
-            return hi;
-        double df, f = value(s, k, sign, t, &df);
-        if (f > 0.0)
-            hi = t;
-        else
-            lo = t;
-        double tn = t - f / df;
-        if (tn >= lo && tn <= hi && fabs(tn - t) <= tol) { /* converged, on a bracket end too */
-            if (w > 0.0)
-                return tn; /* a turn, wanted to a width: Newton is there */
-            /* a root: the bracket closed around tn; f's rounding may leave
-             * a plateau at zero above tn, so the step up doubles until f > 0 */
-            double a = fmax(tn - tol, lo);
-            if (a > lo) {
-                if (value(s, k, sign, a, NULL) <= 0.0)
-                    lo = a;
-                else
-                    hi = a;
-            }
-            for (double step = tol; fmax(tn, lo) + step < hi; step *= 2.0) {
-                double b = fmax(tn, lo) + step;
-                if (value(s, k, sign, b, NULL) > 0.0) {
-                    hi = b;
-                    break;
-                }
-                lo = b;
-            }
-            break;
-        }
-        if (!(tn > lo && tn < hi)) {
-            t = 0.5 * (lo + hi);
-            continue;
-        }
-        t = tn;
-    }
-    return bisect_to(s, k, sign, lo, hi, w);
+    scan_fn c = {.s = s, .k = k, .sign = sign};
+    pd_root r = {.f = scan_value, .ctx = &c};
+    return pd_root_newton(&r, lo, hi, w, t0);
 }
 
 static double locate(edr_scan *s, int k, double sign, double lo, double hi, double w)
@@ -141,7 +106,7 @@ static double locate(edr_scan *s, int k, double sign, double lo, double hi, doub
 static double crossing(edr_scan *s, double lo, double hi, double t0)
 {
     double t = t0 > lo && t0 < hi ? t0 : 0.5 * (lo + hi);
-    for (int it = 0; it < NEWTON_MAX_IT; it++) {
+    for (int it = 0; it < PD_ROOT_NEWTON_MAX; it++) {
         double df, f = value(s, 0, 1.0, t, &df);
         if (f > 0.0)
             hi = t;
@@ -150,7 +115,7 @@ static double crossing(edr_scan *s, double lo, double hi, double t0)
         double tn = t - f / df;
         if (!(df > 0.0) || !(tn >= lo && tn <= hi))
             break; /* outside the bracket: bisection's safety */
-        if (fabs(tn - t) > fmax(8.0 * BISECT_REL * fabs(tn), 2.0 * s->thr / df)) {
+        if (fabs(tn - t) > fmax(8.0 * PD_ROOT_REL * fabs(tn), 2.0 * s->thr / df)) {
             if (!(tn > lo && tn < hi))
                 break;
             t = tn;
@@ -162,7 +127,7 @@ static double crossing(edr_scan *s, double lo, double hi, double t0)
          * steps doubling (f's rounding may hold it at zero over many
          * doubles), then bisection of the last step */
         double c = fmax(tn, nextafter(t, HUGE_VAL));
-        for (int j = 0; c < hi && j < NEWTON_MAX_IT; j++) {
+        for (int j = 0; c < hi && j < PD_ROOT_NEWTON_MAX; j++) {
             if (value(s, 0, 1.0, c, NULL) > 0.0) {
                 if (j < WALK_DOUBLES)
                     return c; /* the double after lo */

@@ -18,6 +18,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "pd_root.h"
 #include "pd_core.h"
 #include "pd_engine.h"
 #include "pd_null.h"
@@ -26,11 +27,6 @@
  * within this many |acceleration| * h of zero at an end (2: twice what a
  * monotone acceleration needs). */
 #define TURN_MARGIN 2.0
-/* Bisection stops at adjacent doubles (relative spacing 2^-52). */
-#define BISECT_REL 2e-16
-#define BISECT_MAX_IT 200
-/* Newton steps before the bracket is handed to bisection. */
-#define NEWTON_MAX_IT 30
 /* Extrema and the split of a double turn are bisected to this fraction of
  * the scan step only: x is flat there, x(tc) is off by acc w^2 / 2, about
  * 1e-17 of the amplitude for w = 4e-8 T / 64 (w0 w ~ 4e-9). */
@@ -193,24 +189,13 @@ static double bracket_value(const ed_run *ed, const ed_origin *o, ed_kind kind, 
     return kind == ED_GAP ? q.past : kind == ED_NEG_V ? -q.v : q.v;
 }
 
-/* Bisection on the sign of f between lo (f <= 0) and hi (f > 0), to
- * adjacent doubles (or to the width w > 0); returns hi. */
-static double bisect_to(const ed_run *ed, const ed_origin *o, ed_kind kind, double lo, double hi,
-                        double w)
-{
-    for (int it = 0; it < BISECT_MAX_IT && hi - lo > fmax(w, BISECT_REL * fmax(fabs(hi), 1e-300));
-         it++) {
-        /* f(lo) <= 0 < f(hi) kept while the bracket halves */
-        double mid = 0.5 * (lo + hi);
-        if (mid <= lo || mid >= hi) /* adjacent doubles */
-            break;
-        if (bracket_value(ed, o, kind, mid) > 0.0)
-            hi = mid;
-        else
-            lo = mid;
-    }
-    return hi;
-}
+/* The bracketed function of kind, as core/root.c's function (the slope
+ * for the gap and the velocity only: value_slope). */
+typedef struct bracket_fn {
+    const ed_run *ed;
+    const ed_origin *o;
+    ed_kind kind;
+} bracket_fn;
 
 /* f of kind at t and its derivative in closed form: the gap's is v, the
  * velocity's the acceleration (kinds ED_GAP, ED_NEG_V, ED_V only). */
@@ -227,46 +212,33 @@ static double value_slope(const ed_run *ed, const ed_origin *o, ed_kind kind, do
     return s * q.v;
 }
 
+static double bracket_eval(void *ctx, double t, double *slope)
+{
+    const bracket_fn *c = ctx;
+    return slope ? value_slope(c->ed, c->o, c->kind, t, slope)
+                 : bracket_value(c->ed, c->o, c->kind, t);
+}
+
+/* Bisection on the sign of f between lo (f <= 0) and hi (f > 0), to
+ * adjacent doubles (or to the width w > 0); returns hi (core/root.c). */
+static double bisect_to(const ed_run *ed, const ed_origin *o, ed_kind kind, double lo, double hi,
+                        double w)
+{
+    bracket_fn c = {.ed = ed, .o = o, .kind = kind};
+    pd_root r = {.f = bracket_eval, .ctx = &c};
+    return pd_root_bisect(&r, lo, hi, w);
+}
+
 /* The sign change of f between lo (f <= 0) and hi (f > 0) to the width w
- * (0: adjacent doubles) by safeguarded Newton on the closed-form slope:
- * a step leaving the bracket is a bisection; once a step is within the
- * tolerance, the root is bracketed by two probes that close width and the
- * bisection finishes.  The same hi as bisect_to, in about a fifth of the
- * evaluations. */
+ * (0: adjacent doubles) by safeguarded Newton on the closed-form slope from
+ * the middle (core/root.c): the same hi as bisect_to, in about a fifth of
+ * the evaluations. */
 static double newton_to(const ed_run *ed, const ed_origin *o, ed_kind kind, double lo, double hi,
                         double w)
 {
-    double t = 0.5 * (lo + hi);
-    for (int it = 0; it < NEWTON_MAX_IT; it++) {
-        double tol = fmax(w, BISECT_REL * fmax(fabs(hi), 1e-300));
-        if (hi - lo <= tol)
-            return hi;
-        /* each probe shrinks the bracket, whatever Newton's step does */
-        double df, f = value_slope(ed, o, kind, t, &df);
-        if (f > 0.0)
-            hi = t;
-        else
-            lo = t;
-        double tn = t - f / df; /* Newton's step */
-        if (!(tn > lo && tn < hi)) { /* outside the bracket (or df = 0): bisect */
-            t = 0.5 * (lo + hi);
-            continue;
-        }
-        /* a step beyond the tolerance: not converged yet */
-        if (fabs(tn - t) > tol) {
-            t = tn;
-            continue;
-        }
-        /* converged: close the bracket around tn, then bisect the rest */
-        double a = fmax(tn - tol, lo), b = fmin(tn + tol, hi);
-        if (a > lo && bracket_value(ed, o, kind, a) <= 0.0)
-            lo = a;
-        if (b < hi && bracket_value(ed, o, kind, b) > 0.0)
-            hi = b;
-        break;
-    }
-    /* bisection to the tolerance finishes: the same hi as bisect_to alone */
-    return bisect_to(ed, o, kind, lo, hi, w);
+    bracket_fn c = {.ed = ed, .o = o, .kind = kind};
+    pd_root r = {.f = bracket_eval, .ctx = &c};
+    return pd_root_newton(&r, lo, hi, w, NAN);
 }
 
 /* Event times (gap closing, detachment): to adjacent doubles. */
@@ -407,7 +379,7 @@ static double detach_linear(const ed_run *ed, int j, double ta, double tb)
         return tb;
     double tr = fmin(fmax(ta + lam_a / -c1, ta), tb); /* the line's zero */
     /* a bracket of 16 relative ulps around it, else (rounding) all of [ta, tb] */
-    double pad = ROOT_POLISH_ULPS * BISECT_REL * fmax(fabs(tr), 1e-300);
+    double pad = ROOT_POLISH_ULPS * PD_ROOT_REL * fmax(fabs(tr), 1e-300);
     double lo = fmax(tr - pad, ta), hi = fmin(tr + pad, tb);
     if (!(lambda_at(ed, j, lo) >= 0.0 && lambda_at(ed, j, hi) < 0.0)) {
         lo = ta;
