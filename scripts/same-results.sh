@@ -8,7 +8,7 @@
 #   sh scripts/same-results.sh [BASE_REV]    (default: the refactors' base)
 set -u
 cd "$(dirname "$0")/.." || exit 2
-base=${1:-fc7f05f}
+base=${1:-c2b84e9}
 new=$PWD/build/pound
 work=$(mktemp -d /tmp/pound-same.XXXXXX)
 trap '[ -n "${KEEP:-}" ] || { git worktree remove --force "$work/base" >/dev/null 2>&1; rm -rf "$work"; }' EXIT INT TERM
