@@ -1233,7 +1233,7 @@ static void snap(edg *w, int nI)
 /* All contacts at an event at t: the reference re-based, impacts of those at
  * zero gap (forced: the located one), then the new set A (drop: a detaching
  * contact, kept out). */
-static int resolve(edg *w, double t, int forced, int drop, pd_err *err)
+static int impact_event(edg *w, double t, int forced, int drop, pd_err *err)
 {
     int nI = 0, closing = 0, rc;
     rebase(w);
@@ -1284,7 +1284,7 @@ static int on_break(edg *w, pd_err *err)
     int rc = count_event(w, w->t, "breakpoint", -1, err);
     next_segment(w);
     if (!rc)
-        rc = resolve(w, w->t, -1, -1, err);
+        rc = impact_event(w, w->t, -1, -1, err);
     if (!rc)
         emit(w, w->t, w->y, 1, TO_OBSERVER | TO_ON_STEP);
     return rc;
@@ -1295,7 +1295,7 @@ static int on_event(edg *w, int kind, int c, pd_err *err)
 {
     int rc = count_event(w, w->t, kind == EV_GAP ? "impact" : "detachment", c, err);
     if (!rc)
-        rc = resolve(w, w->t, kind == EV_GAP ? c : -1, kind == EV_FORCE ? c : -1, err);
+        rc = impact_event(w, w->t, kind == EV_GAP ? c : -1, kind == EV_FORCE ? c : -1, err);
     if (rc)
         return rc;
     emit(w, w->t, w->y, 1, TO_OBSERVER | TO_ON_STEP);
@@ -1351,7 +1351,7 @@ static int start(edg *w, const double *q0, const double *v0, pd_err *err)
                               "event-driven: initial gap of contact %d is %g < 0 (q0 penetrates)",
                               a, w->g[a]);
     w->h = 1e-4 * (w->t1 - w->t0); /* GSL's first try */
-    if ((rc = resolve(w, w->t0, -1, -1, err)))
+    if ((rc = impact_event(w, w->t0, -1, -1, err)))
         return rc;
     emit(w, w->t0, w->y, 1, TO_OBSERVER | TO_ON_STEP);
     w->next_out = 1;

@@ -21,7 +21,7 @@
  *        U+ = U- + D P,  0 <= U+ + e min(U-, 0) _|_ P >= 0,  D = W_Z^T M^-1 W_Z,
  *      until no closed contact closes; a contact closing a third time at
  *      one instant is plastic (an accumulation at that instant).  On the
- *      clusters' coordinates when it can (reduced_stages), on the dofs
+ *      clusters' coordinates when it can (impact_reduced_stages), on the dofs
  *      otherwise.  The single law (PD_IMPACT_SINGLE) solves one LCP over
  *      every closed contact, separating ones included, and stops there
  *      (event-general's and Moreau-Jean's law);
@@ -1887,7 +1887,7 @@ static int held_edge_impulses(pd_edr *r, int ne)
  * they must push (a held contact cannot pull): 1 when one would pull, or
  * the group holds a modal cluster, or the stage is larger than the dense
  * solver takes — then the dof-level stages run instead. */
-static int reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
+static int impact_reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
 {
     int rc, stage = 0, ne, *idx = r->lcp_idx, single = r->o.impact_law == PD_IMPACT_SINGLE;
     if (reduced_begin(r, t, &ne))
@@ -2144,7 +2144,7 @@ static int check_work(pd_edr *r, double t, pd_err *err)
 
 /* Resolve the group at t: impact LCP if a contact closes, persistence,
  * accumulations, new clusters, predictions. */
-static int resolve_group(pd_edr *r, double t, pd_err *err)
+static int impact_group(pd_edr *r, double t, pd_err *err)
 {
     int rc, acc = 0;
     /* the group: every contact closed at t with the clusters it joins, and
@@ -2182,7 +2182,7 @@ static int resolve_group(pd_edr *r, double t, pd_err *err)
     r->law_multi = 0;
     /* the stages on the clusters' coordinates when they can (held trees move
      * rigidly: only the contacts between clusters are unknowns) */
-    rc = reduced_stages(r, t, tolU, err);
+    rc = impact_reduced_stages(r, t, tolU, err);
     if (rc == 1) { /* on the dofs: back to the rates before the impact */
         for (int k = 0; k < r->ngd; k++)
             r->gv[r->g_dof[k]] = r->ev_vminus[k];
@@ -2251,7 +2251,7 @@ static int on_impact(pd_edr *r, int a, double t, pd_err *err)
     for (int s = 0; s < 2; s++)
         if (ct->dof[s] >= 0)
             group_add_cluster(r, cl_of_dof(r, ct->dof[s]));
-    return resolve_group(r, t, err);
+    return impact_group(r, t, err);
 }
 
 /* A persistent force of cluster c reaches zero at t: the force LCP
@@ -3086,7 +3086,7 @@ static int start(pd_edr *r, double t0, pd_err *err)
             for (int s = 0; s < 2; s++)
                 if (ct->dof[s] >= 0)
                     group_add_cluster(r, cl_of_dof(r, ct->dof[s]));
-            if ((rc = resolve_group(r, t0, err)))
+            if ((rc = impact_group(r, t0, err)))
                 return rc;
         }
     /* every prediction, and the first piece change */

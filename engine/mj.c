@@ -452,7 +452,7 @@ static int predict_active(pd_mj *mj, double h, const pd_state *in, pd_state *out
 /* The LCP of the active set, its Delassus block in mj->D_active (dense, or
  * compressed columns when mj->sparse) and its vector in mj->b_active: the
  * impulses into P_active and out->P.  t1 is the step's end (messages). */
-int mj_solve_active(pd_mj *mj, int nI, double t1, pd_state *out, pd_err *err)
+int mj_impact_active(pd_mj *mj, int nI, double t1, pd_state *out, pd_err *err)
 {
     pd_lcp_info info;
     pd_lcp_opts lo = pd_lcp_default_opts();
@@ -640,7 +640,7 @@ static void correct_pushing(pd_mj *mj, const int *ax, int na, const double *res,
  * solving for r_A -> 0 with R of condition sqrt(cond D), while the worst
  * |r_a| shrinks and stays beyond MJ_REFINE_TOL roundings of its terms.
  * Sets mj->refined (y in mj->ref_y); PD_ENUMERICAL when it stays beyond. */
-static int refine_active(pd_mj *mj, const pd_factor *f, int nI, const double *vfree, double t1,
+static int impact_refine(pd_mj *mj, const pd_factor *f, int nI, const double *vfree, double t1,
                          pd_err *err)
 {
     int n = mj->model->n, na = 0, *ax = mj->ref_perm;
@@ -696,7 +696,7 @@ static int refine_active(pd_mj *mj, const pd_factor *f, int nI, const double *vf
 /* Impulses of the active contacts into out->P: the LCP (D_II, W_I^T vfree
  * + e U) with D_II from the factor f, refined when it lost precision; t1
  * is the step's end (messages). */
-static int solve_contacts(pd_mj *mj, const pd_factor *f, int nI, const double *vfree, double t1,
+static int impact_contacts(pd_mj *mj, const pd_factor *f, int nI, const double *vfree, double t1,
                           pd_state *out, pd_err *err)
 {
     int rc;
@@ -708,9 +708,9 @@ static int solve_contacts(pd_mj *mj, const pd_factor *f, int nI, const double *v
         pd_factor_delassus_dense(f, mj->idx_active, nI, mj->D_active);
     mj_active_rhs(mj, nI, vfree);
     /* refined only dense (the ref_ arrays exist only then), with two contacts or more */
-    if ((rc = mj_solve_active(mj, nI, t1, out, err)) || mj->sparse || nI < 2)
+    if ((rc = mj_impact_active(mj, nI, t1, out, err)) || mj->sparse || nI < 2)
         return rc;
-    if ((rc = refine_active(mj, f, nI, vfree, t1, err)))
+    if ((rc = impact_refine(mj, f, nI, vfree, t1, err)))
         return rc;
     /* the refinement may have moved P_A (P_A += R^-1 z, clipped at 0) */
     for (int r = 0; r < nI; r++)
@@ -750,7 +750,7 @@ int mj_general_step(pd_mj *mj, const pd_factor *f, double h, double t1, const do
     out->step = in->step + 1;
     /* out->v = vfree; v_k+1 = vfree + What^-1 W_I P */
     if (nI > 0) {
-        if ((rc = solve_contacts(mj, f, nI, out->v, t1, out, err)))
+        if ((rc = impact_contacts(mj, f, nI, out->v, t1, out, err)))
             return rc;
         if (mj->refined) /* the impulses' velocity corrected on the pushing contacts */
             for (int i = 0; i < n; i++)

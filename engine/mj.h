@@ -127,7 +127,7 @@ int mj_general_step(pd_mj *mj, const pd_factor *f, double h, double t1, const do
  * block in mj->D_active (dense, or compressed columns when mj->sparse) into
  * mj->P_active and out->P (t1 names the step's end in messages). */
 void mj_active_rhs(pd_mj *mj, int nI, const double *vfree);
-int mj_solve_active(pd_mj *mj, int nI, double t1, pd_state *out, pd_err *err);
+int mj_impact_active(pd_mj *mj, int nI, double t1, pd_state *out, pd_err *err);
 
 /* The adaptive driver: its workspaces for mj (opts.rtol > 0), their
  * release, the state at rest at t0 (q0, v0 as pd_mj_reset's), and the run

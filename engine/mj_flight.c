@@ -798,7 +798,7 @@ int mj_flight_step(pd_mj *mj, int k, double t1, const pd_state *in, const double
         /* D = W_I^T Phi_vv(h/2) M^-1 W_I and b = W_I^T v_free + e U_k; the impulses at mid-step */
         assemble_delassus(mj, k, nI);
         mj_active_rhs(mj, nI, out->v);
-        if ((rc = mj_solve_active(mj, nI, t1, out, err)))
+        if ((rc = mj_impact_active(mj, nI, t1, out, err)))
             return rc;
         apply_impulses(mj, k, nI, out);
         hold_gaps(mj, nI, in, out);
