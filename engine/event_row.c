@@ -192,7 +192,7 @@ static void q_set(edr_queue *q, int slot, double t)
 
 /* ---- helpers -------------------------------------------------------------------- */
 
-static int cl_of_dof(const pd_edr *r, int dof) { return r->blk_cl[r->dof_blk[dof]]; }
+static int cl_of_dof(const pd_edr *r, int dof) { return r->rs.blk_cl[r->tp.dof_blk[dof]]; }
 
 /* x(t), v(t), a(t) of a dof. */
 static void dof_state(pd_edr *r, int dof, double t, double *x, double *v, double *a)
@@ -200,13 +200,13 @@ static void dof_state(pd_edr *r, int dof, double t, double *x, double *v, double
     double dx;
     /* the flight gives x - xo, the increment from its origin's state */
     edr_dof_at(r, cl_of_dof(r, dof), dof, t, &dx, v, a);
-    *x = r->xo[dof] + dx;
+    *x = r->rs.xo[dof] + dx;
 }
 
 /* The gap of contact a at t from the positions. */
 static double gap_now(pd_edr *r, int a, double t, double *U)
 {
-    const edr_contact *ct = &r->ct[a];
+    const edr_contact *ct = &r->tp.ct[a];
     /* g = g0 + w0 x0 + w1 x1 and U = w0 v0 + w1 v1 (a wall side: dof -1, at rest) */
     double g = ct->g0, u = 0.0;
     for (int s = 0; s < 2; s++)
@@ -235,7 +235,7 @@ typedef struct gap_ctx {
 static void gap_fn(void *vctx, double t, double out[3])
 {
     gap_ctx *g = vctx;
-    const edr_contact *ct = &g->r->ct[g->a];
+    const edr_contact *ct = &g->r->tp.ct[g->a];
     /* g(t) = g(tb) + sum_s w_s (dx_s(t) - dx_s(tb)): the base gap moved by the
      * flights' increments, so that a gap known exactly (0 after a closing)
      * keeps its value, free of the positions' rounding in g0 + W^T x */
@@ -257,13 +257,13 @@ static void gap_fn(void *vctx, double t, double out[3])
  * value is known exactly (0 after a closing) or taken from the positions. */
 static void gap_base(pd_edr *r, int a, gap_ctx *g)
 {
-    const edr_contact *ct = &r->ct[a];
+    const edr_contact *ct = &r->tp.ct[a];
     /* tb: the later of its sides' flight origins; the gap is one smooth
      * function of t since */
     double tb = -HUGE_VAL;
     for (int s = 0; s < 2; s++)
         if (ct->dof[s] >= 0)
-            tb = fmax(tb, r->cl[cl_of_dof(r, ct->dof[s])].t0);
+            tb = fmax(tb, r->rs.cl[cl_of_dof(r, ct->dof[s])].t0);
     g->r = r;
     g->a = a;
     double gap = ct->g0;
@@ -272,28 +272,28 @@ static void gap_base(pd_edr *r, int a, gap_ctx *g)
         if (ct->dof[s] >= 0) {
             double v, acc;
             edr_dof_at(r, cl_of_dof(r, ct->dof[s]), ct->dof[s], tb, &g->dxb[s], &v, &acc);
-            gap += ct->w[s] * (r->xo[ct->dof[s]] + g->dxb[s]);
+            gap += ct->w[s] * (r->rs.xo[ct->dof[s]] + g->dxb[s]);
         }
     }
     /* an event that closed the contact set its gap to 0 at base_t: exact while
      * neither side has left its origin since; else g0 + W^T x at tb */
-    g->gb = r->base_t[a] == tb ? r->base_g[a] : gap;
+    g->gb = r->rs.base_t[a] == tb ? r->rs.base_g[a] : gap;
     /* the rounding level of the gap: its terms' size */
     double size = fabs(ct->g0);
     for (int s = 0; s < 2; s++)
         if (ct->dof[s] >= 0)
-            size += fabs(ct->w[s]) * (fabs(r->xo[ct->dof[s]]) + fabs(g->dxb[s]));
+            size += fabs(ct->w[s]) * (fabs(r->rs.xo[ct->dof[s]]) + fabs(g->dxb[s]));
     g->thr = EDR_GAP_ROUND * size;
 }
 
 /* Scan step of a contact: the finer of its sides'. */
 static double contact_step(const pd_edr *r, int a)
 {
-    const edr_contact *ct = &r->ct[a];
+    const edr_contact *ct = &r->tp.ct[a];
     double h = HUGE_VAL;
     for (int s = 0; s < 2; s++)
         if (ct->dof[s] >= 0)
-            h = fmin(h, r->cl[r->blk_cl[r->dof_blk[ct->dof[s]]]].h);
+            h = fmin(h, r->rs.cl[r->rs.blk_cl[r->tp.dof_blk[ct->dof[s]]]].h);
     return h;
 }
 
@@ -317,34 +317,34 @@ static double safe_time(double g, double U, double G2)
  * has none. */
 static double gap_curvature(const pd_edr *r, int a)
 {
-    const edr_contact *ct = &r->ct[a];
+    const edr_contact *ct = &r->tp.ct[a];
     double G2 = 0.0;
     for (int s = 0; s < 2; s++)
         if (ct->dof[s] >= 0) {
-            const edr_cluster *cl = &r->cl[cl_of_dof(r, ct->dof[s])];
+            const edr_cluster *cl = &r->rs.cl[cl_of_dof(r, ct->dof[s])];
             if (!cl->bnd)
                 return -1.0;
             /* x_i = s_i y + d_i: |g''| <= sum_s |w_s s_i| max |y''| of its side's flight */
-            G2 += fabs(ct->w[s] * r->s[ct->dof[s]]) * cl->Y2;
+            G2 += fabs(ct->w[s] * r->rs.s[ct->dof[s]]) * cl->Y2;
         }
     return G2;
 }
 
 /* End of what a prediction may cover: the piece's end and t1. */
-static double horizon(const pd_edr *r) { return fmin(edr_piece_end(r, r->piece), r->t1); }
+static double horizon(const pd_edr *r) { return fmin(edr_piece_end(r, r->rs.piece), r->rs.t1); }
 
 /* Contact a's next closing after ts, or the end of its scan window. */
 static void predict_contact(pd_edr *r, int a, double ts, int cont)
 {
     int slot = a;
-    if (r->o.inactive || r->cstate[a] != EDR_OPEN) {
-        q_set(&r->q, slot, HUGE_VAL);
+    if (r->tp.o.inactive || r->rs.cstate[a] != EDR_OPEN) {
+        q_set(&r->rs.q, slot, HUGE_VAL);
         return;
     }
-    const edr_contact *ct = &r->ct[a];
+    const edr_contact *ct = &r->tp.ct[a];
     if (ct->dof[0] >= 0 && ct->dof[1] >= 0 && cl_of_dof(r, ct->dof[0]) == cl_of_dof(r, ct->dof[1]) &&
-        r->cl[cl_of_dof(r, ct->dof[0])].kind != EDR_MODAL) {
-        q_set(&r->q, slot, HUGE_VAL); /* both sides in one rigid tree: the gap is constant */
+        r->rs.cl[cl_of_dof(r, ct->dof[0])].kind != EDR_MODAL) {
+        q_set(&r->rs.q, slot, HUGE_VAL); /* both sides in one rigid tree: the gap is constant */
         return;
     }
     gap_ctx g;
@@ -352,8 +352,8 @@ static void predict_contact(pd_edr *r, int a, double ts, int cont)
     edr_scan s = {.fn = gap_fn, .ctx = &g, .hit_mode = 1, .thr = g.thr, .fmax = -HUGE_VAL,
                   .fmin = HUGE_VAL};
     /* windows double from EDR_WINDOW0 intervals as the prediction continues */
-    int win = cont && r->win[slot] > 0 ? r->win[slot] : EDR_WINDOW0;
-    r->win[slot] = win < EDR_WINDOW ? 2 * win : EDR_WINDOW;
+    int win = cont && r->rs.win[slot] > 0 ? r->rs.win[slot] : EDR_WINDOW0;
+    r->rs.win[slot] = win < EDR_WINDOW ? 2 * win : EDR_WINDOW;
     /* the window: win scan steps from ts, cut at the horizon */
     double h = contact_step(r, a), tend = horizon(r), tw = fmin(tend, ts + win * h);
     s.width = 4e-8 * h;
@@ -365,24 +365,24 @@ static void predict_contact(pd_edr *r, int a, double ts, int cont)
      * The scan starts where the Taylor quadratic has it back, or at the
      * window's end (else the contact would close at the next double, an
      * impact that does nothing, again and again) */
-    if (p.df > 0.0 && p.ddf < 0.0 && p.df <= EDR_RATE_TOL * r->vscale &&
-        p.f <= r->o.close_tol * r->L) {
+    if (p.df > 0.0 && p.ddf < 0.0 && p.df <= EDR_RATE_TOL * r->rs.vscale &&
+        p.f <= r->tp.o.close_tol * r->rs.L) {
         double back = ts - 2.0 * p.df / p.ddf;
         if (!(back < tw)) {
-            r->qkind[slot] = EDR_Q_SCAN;
-            q_set(&r->q, slot, tw < tend ? tw : HUGE_VAL);
+            r->rs.qkind[slot] = EDR_Q_SCAN;
+            q_set(&r->rs.q, slot, tw < tend ? tw : HUGE_VAL);
             return;
         }
         p = edr_scan_point(&s, back);
-        if (p.f > 0.0 && p.f <= r->o.close_tol * r->L) {
+        if (p.f > 0.0 && p.f <= r->tp.o.close_tol * r->rs.L) {
             g.gb += p.f; /* the dip's rounding: the gap is zero there */
             p.f = 0.0;
         }
     }
     if (p.f > 0.0) { /* past zero at the start: rounding of a gap that is 0 */
         if (p.f > g.thr && p.df > 0.0) {
-            r->qkind[slot] = EDR_Q_HIT;
-            q_set(&r->q, slot, p.t);
+            r->rs.qkind[slot] = EDR_Q_HIT;
+            q_set(&r->rs.q, slot, p.t);
             return;
         }
         g.gb += p.f;
@@ -395,8 +395,8 @@ static void predict_contact(pd_edr *r, int a, double ts, int cont)
         double hit;
         edr_pt b = edr_scan_point(&s, t0 + 2.0 * s0);
         if (edr_scan_interval(&s, &p, &b, &hit)) {
-            r->qkind[slot] = EDR_Q_HIT;
-            q_set(&r->q, slot, hit);
+            r->rs.qkind[slot] = EDR_Q_HIT;
+            q_set(&r->rs.q, slot, hit);
             return;
         }
         p = b;
@@ -405,8 +405,8 @@ static void predict_contact(pd_edr *r, int a, double ts, int cont)
     /* far from closing by the flights' bounds: no scan before the safe time */
     double G2, sf = safe_time(-p.f, -p.df, G2 = gap_curvature(r, a));
     if (G2 >= 0.0 && sf > EDR_SAFE_SCANS * h) {
-        r->qkind[slot] = EDR_Q_SCAN;
-        q_set(&r->q, slot, ts + sf < tend ? ts + sf : HUGE_VAL);
+        r->rs.qkind[slot] = EDR_Q_SCAN;
+        q_set(&r->rs.q, slot, ts + sf < tend ? ts + sf : HUGE_VAL);
         return;
     }
     /* the window interval by interval on the contact's grid (the last
@@ -420,16 +420,16 @@ static void predict_contact(pd_edr *r, int a, double ts, int cont)
             break;
         edr_pt b = edr_scan_point(&s, tb);
         if (edr_scan_interval(&s, &p, &b, &hit)) {
-            r->qkind[slot] = EDR_Q_HIT;
-            q_set(&r->q, slot, hit);
+            r->rs.qkind[slot] = EDR_Q_HIT;
+            q_set(&r->rs.q, slot, hit);
             return;
         }
         p = b;
     }
     /* nothing in the window: its continuation is queued at tw (none at the
      * horizon: a piece change predicts every contact again, t1 ends the run) */
-    r->qkind[slot] = EDR_Q_SCAN;
-    q_set(&r->q, slot, tw < tend ? tw : HUGE_VAL);
+    r->rs.qkind[slot] = EDR_Q_SCAN;
+    q_set(&r->rs.q, slot, tw < tend ? tw : HUGE_VAL);
 }
 
 typedef struct force_ctx {
@@ -474,18 +474,18 @@ static double detach_linear(pd_edr *r, int c, int a, double ta, double tb)
  * ts, or the end of its scan window. */
 static void predict_detach(pd_edr *r, int c, double ts, int cont)
 {
-    edr_cluster *cl = &r->cl[c];
-    int slot = r->m + c;
-    if (r->o.inactive || cl->npers == 0) {
-        q_set(&r->q, slot, HUGE_VAL);
+    edr_cluster *cl = &r->rs.cl[c];
+    int slot = r->tp.m + c;
+    if (r->tp.o.inactive || cl->npers == 0) {
+        q_set(&r->rs.q, slot, HUGE_VAL);
         return;
     }
     double tend = horizon(r), best = HUGE_VAL;
     int who = -1;
-    const pd_sine_piece *pc = &r->pieces[cl->piece];
+    const pd_sine_piece *pc = &r->tp.pieces[cl->piece];
     /* a REST tree's forces are lg f + ld: linear in t on a piece without sine */
     if (cl->kind == EDR_REST && pc->A == 0.0) { /* linear forces: closed form */
-        for (int a = cl->pers_head; a >= 0; a = r->pers_next[a]) {
+        for (int a = cl->pers_head; a >= 0; a = r->rs.pers_next[a]) {
             double td = detach_linear(r, c, a, ts, tend);
             if (td < best) {
                 best = td;
@@ -493,37 +493,37 @@ static void predict_detach(pd_edr *r, int c, double ts, int cont)
             }
         }
         cl->det_contact = who;
-        r->qkind[slot] = EDR_Q_HIT;
-        q_set(&r->q, slot, best);
+        r->rs.qkind[slot] = EDR_Q_HIT;
+        q_set(&r->rs.q, slot, best);
         return;
     }
-    int win = cont && r->win[slot] > 0 ? r->win[slot] : EDR_WINDOW0;
-    r->win[slot] = win < EDR_WINDOW ? 2 * win : EDR_WINDOW;
+    int win = cont && r->rs.win[slot] > 0 ? r->rs.win[slot] : EDR_WINDOW0;
+    r->rs.win[slot] = win < EDR_WINDOW ? 2 * win : EDR_WINDOW;
     double h = cl->h, tw = fmin(tend, ts + win * h), ta = ts;
     if (cl->bnd && (cl->kind == EDR_SDOF || cl->kind == EDR_REST)) {
         /* lambda = la y + lb y' + lg f + ld: |lambda''| <= |la| Y2 + |lb| Y3 + |lg| F2 */
-        const pd_sine_piece *pc2 = &r->pieces[cl->piece];
+        const pd_sine_piece *pc2 = &r->tp.pieces[cl->piece];
         double sf = HUGE_VAL, df = pc2->A * pc2->w * cos(pc2->w * ts + pc2->phi) + pc2->c1;
-        for (int a = cl->pers_head; a >= 0; a = r->pers_next[a]) {
+        for (int a = cl->pers_head; a >= 0; a = r->rs.pers_next[a]) {
             /* lambda' = la y' + lb y'' + lg f' at ts; safe_time: no zero of lambda before */
             double lam = edr_force_at(r, c, a, ts);
-            double dl = r->la[a] * cl->vy + r->lb[a] * cl->ay + r->lg[a] * df;
-            double L2 = fabs(r->la[a]) * cl->Y2 + fabs(r->lb[a]) * cl->Y3 + fabs(r->lg[a]) * cl->F2;
+            double dl = r->rs.la[a] * cl->vy + r->rs.lb[a] * cl->ay + r->rs.lg[a] * df;
+            double L2 = fabs(r->rs.la[a]) * cl->Y2 + fabs(r->rs.lb[a]) * cl->Y3 + fabs(r->rs.lg[a]) * cl->F2;
             sf = fmin(sf, safe_time(lam, dl, L2));
         }
         /* every force stays positive that long: no scan before */
         if (sf > EDR_SAFE_SCANS * h) {
-            r->qkind[slot] = EDR_Q_SCAN;
-            q_set(&r->q, slot, ts + sf < tend ? ts + sf : HUGE_VAL);
+            r->rs.qkind[slot] = EDR_Q_SCAN;
+            q_set(&r->rs.q, slot, ts + sf < tend ? ts + sf : HUGE_VAL);
             return;
         }
     }
-    for (int a = cl->pers_head; a >= 0; a = r->pers_next[a])
+    for (int a = cl->pers_head; a >= 0; a = r->rs.pers_next[a])
         /* a force negative at ts already (at a re-origin, by rounding): detach now */
         if (edr_force_at(r, c, a, ts) < 0.0) {
             cl->det_contact = a;
-            r->qkind[slot] = EDR_Q_HIT;
-            q_set(&r->q, slot, ts);
+            r->rs.qkind[slot] = EDR_Q_HIT;
+            q_set(&r->rs.q, slot, ts);
             return;
         }
     /* the window on the cluster's grid: a force negative at a grid point is
@@ -535,7 +535,7 @@ static void predict_detach(pd_edr *r, int c, double ts, int cont)
         double tb = i == n ? tw : ts + (double)i * h;
         if (!(tb > ta))
             break;
-        for (int a = cl->pers_head; a >= 0; a = r->pers_next[a])
+        for (int a = cl->pers_head; a >= 0; a = r->rs.pers_next[a])
             if (edr_force_at(r, c, a, tb) < 0.0) {
                 force_ctx f = {.r = r, .c = c, .a = a};
                 double td = edr_bisect_sign(force_fn, &f, 0, -1.0, ta, tb);
@@ -548,13 +548,13 @@ static void predict_detach(pd_edr *r, int c, double ts, int cont)
     }
     if (who >= 0) {
         cl->det_contact = who;
-        r->qkind[slot] = EDR_Q_HIT;
-        q_set(&r->q, slot, best);
+        r->rs.qkind[slot] = EDR_Q_HIT;
+        q_set(&r->rs.q, slot, best);
         return;
     }
     /* every force positive over the window: its continuation at tw */
-    r->qkind[slot] = EDR_Q_SCAN;
-    q_set(&r->q, slot, tw < tend ? tw : HUGE_VAL);
+    r->rs.qkind[slot] = EDR_Q_SCAN;
+    q_set(&r->rs.q, slot, tw < tend ? tw : HUGE_VAL);
 }
 
 /* ---- measurements ----------------------------------------------------------------- */
@@ -570,12 +570,12 @@ static void meas_fn(void *vctx, double t, double out[3])
     double dx, v, a;
     /* x = xo + dx, v, a of the dof; of the drift x_dof - x_below, their differences */
     edr_dof_at(m->r, m->c, m->dof, t, &dx, &v, &a);
-    out[0] = m->r->xo[m->dof] + dx;
+    out[0] = m->r->rs.xo[m->dof] + dx;
     out[1] = v;
     out[2] = a;
     if (m->below >= 0) {
         edr_dof_at(m->r, m->c, m->below, t, &dx, &v, &a);
-        out[0] -= m->r->xo[m->below] + dx;
+        out[0] -= m->r->rs.xo[m->below] + dx;
         out[1] -= v;
         out[2] -= a;
     }
@@ -587,25 +587,25 @@ static void note_meas(pd_edr *r, int dof, int drift, double fmax, double fmin)
     /* the drift's largest magnitude; x's largest excursions either way,
      * xpos = max x and xneg = max (-x) */
     if (drift) {
-        r->drift[dof] = pd_max(r->drift[dof], pd_max(fmax, -fmin));
+        r->rs.drift[dof] = pd_max(r->rs.drift[dof], pd_max(fmax, -fmin));
         return;
     }
-    r->xpos[dof] = pd_max(r->xpos[dof], fmax);
-    r->xneg[dof] = pd_max(r->xneg[dof], -fmin);
+    r->rs.xpos[dof] = pd_max(r->rs.xpos[dof], fmax);
+    r->rs.xneg[dof] = pd_max(r->rs.xneg[dof], -fmin);
 }
 
 /* The below-dof of dof i for the drift, if it lies in the same cluster
  * (storeys of one structure always do); -1 for the ground. */
 static int below_of(const pd_edr *r, int i)
 {
-    return r->o.below ? r->o.below[i] : -1;
+    return r->tp.o.below ? r->tp.o.below[i] : -1;
 }
 
 /* The coordinate y of an SDOF tree (x_i = s_i y + d_i). */
 static void tree_y_fn(void *vctx, double t, double out[3])
 {
     meas_ctx *m = vctx;
-    edr_cluster *cl = &m->r->cl[m->c];
+    edr_cluster *cl = &m->r->rs.cl[m->c];
     /* y = y0 + dy: the tree's one coordinate (every x_i = s_i y + d_i) */
     edr_cluster_eval(m->r, m->c, t);
     out[0] = cl->y0 + cl->dy;
@@ -618,8 +618,8 @@ static void tree_y_fn(void *vctx, double t, double out[3])
 static void scan_functions(pd_edr *r, edr_cluster *cl, int nf, meas_ctx *mc, edr_fn fn,
                            double ta, double tb)
 {
-    edr_scan *sc = r->mscan;
-    edr_pt *prev = r->mprev;
+    edr_scan *sc = r->ev.mscan;
+    edr_pt *prev = r->ev.mprev;
     /* each function from ta, its value there noted (the extremes include the start) */
     for (int k = 0; k < nf; k++) {
         sc[k] = (edr_scan){.fn = fn, .ctx = &mc[k], .width = 4e-8 * cl->h, .hit_mode = 0,
@@ -653,24 +653,24 @@ static void scan_functions(pd_edr *r, edr_cluster *cl, int nf, meas_ctx *mc, edr
  * above the first as its own function. */
 static void measure_cluster(pd_edr *r, int c, double tb)
 {
-    edr_cluster *cl = &r->cl[c];
+    edr_cluster *cl = &r->rs.cl[c];
     /* extremes count from t_measure on; meas_t: measured up to there */
-    double ta = fmax(cl->meas_t, r->o.t_measure);
+    double ta = fmax(cl->meas_t, r->tp.o.t_measure);
     cl->meas_t = fmax(cl->meas_t, tb);
     if (!(tb >= ta))
         return;
-    meas_ctx *mc = r->mctx;
-    edr_scan *sc = r->mscan;
+    meas_ctx *mc = r->ev.mctx;
+    edr_scan *sc = r->ev.mscan;
     if (cl->kind != EDR_MODAL) {
         /* one scan of y: x_i = s_i y + d_i is monotone in y, its extremes
          * s_i y_max + d_i and s_i y_min + d_i (swapped where s_i < 0); each block
          * one dof, its structure's drift over the ground is its x */
         mc[0] = (meas_ctx){.r = r, .c = c, .dof = -1, .below = -1};
         scan_functions(r, cl, 1, mc, tree_y_fn, ta, tb);
-        for (int b = cl->head; b >= 0; b = r->blk_next[b]) {
-            int i = r->blk_dofs[r->blk[b].first];
-            double si = r->s[i], hi = si * (si > 0.0 ? sc[0].fmax : sc[0].fmin) + r->d[i];
-            double lo = si * (si > 0.0 ? sc[0].fmin : sc[0].fmax) + r->d[i];
+        for (int b = cl->head; b >= 0; b = r->rs.blk_next[b]) {
+            int i = r->tp.blk_dofs[r->tp.blk[b].first];
+            double si = r->rs.s[i], hi = si * (si > 0.0 ? sc[0].fmax : sc[0].fmin) + r->rs.d[i];
+            double lo = si * (si > 0.0 ? sc[0].fmin : sc[0].fmax) + r->rs.d[i];
             note_meas(r, i, 0, hi, lo);
             note_meas(r, i, 1, hi, lo);
         }
@@ -680,10 +680,10 @@ static void measure_cluster(pd_edr *r, int c, double tb)
      * function of its own (a difference's extremes are not the extremes'
      * differences) */
     int nf = 0;
-    for (int b = cl->head; b >= 0; b = r->blk_next[b]) {
-        const edr_block *bk = &r->blk[b];
+    for (int b = cl->head; b >= 0; b = r->rs.blk_next[b]) {
+        const edr_block *bk = &r->tp.blk[b];
         for (int k = 0; k < bk->n; k++) {
-            int i = r->blk_dofs[bk->first + k], bl = below_of(r, i);
+            int i = r->tp.blk_dofs[bk->first + k], bl = below_of(r, i);
             mc[nf++] = (meas_ctx){.r = r, .c = c, .dof = i, .below = -1};
             if (bl >= 0)
                 mc[nf++] = (meas_ctx){.r = r, .c = c, .dof = i, .below = bl};
@@ -701,11 +701,11 @@ static void measure_cluster(pd_edr *r, int c, double tb)
  * closed: once closed, the minimum is 0). */
 static void measure_contact(pd_edr *r, int a, double tb)
 {
-    double ta = r->gmeas_t[a];
-    r->gmeas_t[a] = fmax(ta, tb);
+    double ta = r->rs.gmeas_t[a];
+    r->rs.gmeas_t[a] = fmax(ta, tb);
     /* open contacts that never closed: once closed the minimum is 0 (an
      * inactive contact never closes: its gap is measured throughout) */
-    if (!(tb > ta) || (!(r->gmin[a] > 0.0) && !r->o.inactive) || r->cstate[a] != EDR_OPEN)
+    if (!(tb > ta) || (!(r->rs.gmin[a] > 0.0) && !r->tp.o.inactive) || r->rs.cstate[a] != EDR_OPEN)
         return;
     gap_ctx g;
     gap_base(r, a, &g);
@@ -727,11 +727,11 @@ static void measure_contact(pd_edr *r, int a, double tb)
     double gmin = -s.fmax;
     /* an active contact below zero (a closing is located at the first double
      * past zero): its penetration recorded, the minimum taken as 0 */
-    if (gmin < 0.0 && !r->o.inactive) {
-        r->res.max_penetration = fmax(r->res.max_penetration, -gmin);
+    if (gmin < 0.0 && !r->tp.o.inactive) {
+        r->rs.res.max_penetration = fmax(r->rs.res.max_penetration, -gmin);
         gmin = 0.0;
     }
-    r->gmin[a] = fmin(r->gmin[a], gmin);
+    r->rs.gmin[a] = fmin(r->rs.gmin[a], gmin);
 }
 
 /* ---- the group of an event ---------------------------------------------------------- */
@@ -739,16 +739,16 @@ static void measure_contact(pd_edr *r, int a, double tb)
 static void group_add_cluster(pd_edr *r, int c)
 {
     /* once per event: cl_mark holds the epoch of the event that took it */
-    if (r->cl_mark[c] == r->epoch)
+    if (r->ev.cl_mark[c] == r->ev.epoch)
         return;
-    r->cl_mark[c] = r->epoch;
-    r->g_cl[r->ng++] = c;
+    r->ev.cl_mark[c] = r->ev.epoch;
+    r->ev.g_cl[r->ev.ng++] = c;
 }
 
 static void group_add_contact(pd_edr *r, int a)
 {
-    r->ct_mark[a] = r->epoch;
-    r->g_ct[r->ngc++] = a;
+    r->ev.ct_mark[a] = r->ev.epoch;
+    r->ev.g_ct[r->ev.ngc++] = a;
 }
 
 /* The group at t: from the clusters already in it, every contact at zero
@@ -756,34 +756,34 @@ static void group_add_contact(pd_edr *r, int a)
  * (contacts already in g_ct) count as closed. */
 static void group_grow(pd_edr *r, double t)
 {
-    double tol = r->o.close_tol * r->L;
+    double tol = r->tp.o.close_tol * r->rs.L;
     /* breadth first: ng grows as clusters join, each one searched in turn */
-    for (int i = 0; i < r->ng; i++) {
-        const edr_cluster *cl = &r->cl[r->g_cl[i]];
-        for (int b = cl->head; b >= 0; b = r->blk_next[b]) {
-            const edr_block *bk = &r->blk[b];
+    for (int i = 0; i < r->ev.ng; i++) {
+        const edr_cluster *cl = &r->rs.cl[r->ev.g_cl[i]];
+        for (int b = cl->head; b >= 0; b = r->rs.blk_next[b]) {
+            const edr_block *bk = &r->tp.blk[b];
             for (int k = 0; k < bk->ncont; k++) {
-                int a = r->blk_cont[bk->cont0 + k];
-                if (r->ct_mark[a] == r->epoch || r->ct_mark2[a] == r->epoch)
+                int a = r->tp.blk_cont[bk->cont0 + k];
+                if (r->ev.ct_mark[a] == r->ev.epoch || r->ev.ct_mark2[a] == r->ev.epoch)
                     continue;
                 /* each contact looked at once per event (ct_mark2), taken once (ct_mark) */
-                r->ct_mark2[a] = r->epoch;
+                r->ev.ct_mark2[a] = r->ev.epoch;
                 /* persistent and locked contacts are closed by definition; their
                  * sides lie in this cluster already (or at a wall) */
-                if (r->cstate[a] != EDR_OPEN) {
+                if (r->rs.cstate[a] != EDR_OPEN) {
                     group_add_contact(r, a);
                     continue;
                 }
-                if (r->o.inactive)
+                if (r->tp.o.inactive)
                     continue;
                 double g = gap_now(r, a, t, NULL);
                 if (!(g <= tol))
                     continue;
                 group_add_contact(r, a);
                 /* tol_closed: closed at a gap that the model's own g0 leaves positive */
-                r->res.tol_closed += g + (r->md->g0[a] - r->ct[a].g0) > 0.0; /* the gap given */
+                r->rs.res.tol_closed += g + (r->tp.md->g0[a] - r->tp.ct[a].g0) > 0.0; /* the gap given */
                 /* its sides' clusters join: their contacts are searched in turn */
-                const edr_contact *ct = &r->ct[a];
+                const edr_contact *ct = &r->tp.ct[a];
                 for (int s = 0; s < 2; s++)
                     if (ct->dof[s] >= 0)
                         group_add_cluster(r, cl_of_dof(r, ct->dof[s]));
@@ -805,16 +805,16 @@ static void integrate_held(pd_edr *r, int c, double tb)
                                  0.5384693101056831, 0.9061798459386640};
     static const double wg[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889,
                                  0.4786286704993665, 0.2369268850561891};
-    edr_cluster *cl = &r->cl[c];
+    edr_cluster *cl = &r->rs.cl[c];
     double ta = cl->imp_t;
     /* no sampler, no held contact or nothing to integrate: only the mark moves */
-    if (!r->sample_forces || cl->pers_head < 0 || !(tb > ta)) {
+    if (!r->rs.sample_forces || cl->pers_head < 0 || !(tb > ta)) {
         cl->imp_t = fmax(ta, tb);
         return;
     }
     cl->imp_t = tb;
     /* the cache and the evaluation count saved: sampling leaves the run as it was */
-    long evals = r->evals;
+    long evals = r->rs.evals;
     int cached = cl->cached;
     double tc = cl->tc;
     double h = cl->h > 0.0 ? cl->h : tb - ta;
@@ -828,36 +828,36 @@ static void integrate_held(pd_edr *r, int c, double tb)
         double mid = ta + ((double)i + 0.5) * w;
         for (int k = 0; k < 5; k++) {
             double t = mid + 0.5 * w * xg[k], f = 0.5 * w * wg[k];
-            for (int a = cl->pers_head; a >= 0; a = r->pers_next[a])
-                r->imp_out[a] += f * edr_force_at(r, c, a, t);
+            for (int a = cl->pers_head; a >= 0; a = r->rs.pers_next[a])
+                r->rs.imp_out[a] += f * edr_force_at(r, c, a, t);
         }
     }
     /* the cache back at tc, where the run left it */
     if (cached)
         edr_cluster_eval(r, c, tc);
-    r->evals = evals;
+    r->rs.evals = evals;
 }
 
 /* The state at t of every dof of the group (gx, gv), measured flights. */
 static void group_state(pd_edr *r, double t)
 {
-    r->ngd = 0;
-    for (int i = 0; i < r->ng; i++) {
-        int c = r->g_cl[i];
+    r->ev.ngd = 0;
+    for (int i = 0; i < r->ev.ng; i++) {
+        int c = r->ev.g_cl[i];
         /* held forces integrated and extremes measured up to t, before the
          * flights change at t */
         integrate_held(r, c, t);
         measure_cluster(r, c, t);
-        for (int b = r->cl[c].head; b >= 0; b = r->blk_next[b]) {
-            const edr_block *bk = &r->blk[b];
+        for (int b = r->rs.cl[c].head; b >= 0; b = r->rs.blk_next[b]) {
+            const edr_block *bk = &r->tp.blk[b];
             for (int k = 0; k < bk->n; k++) {
-                int dof = r->blk_dofs[bk->first + k];
+                int dof = r->tp.blk_dofs[bk->first + k];
                 double acc;
-                dof_state(r, dof, t, &r->gx[dof], &r->gv[dof], &acc);
-                r->g_dof[r->ngd++] = dof;
+                dof_state(r, dof, t, &r->ev.gx[dof], &r->ev.gv[dof], &acc);
+                r->ev.g_dof[r->ev.ngd++] = dof;
             }
             for (int k = 0; k < bk->ncont; k++) /* the gaps about to change flights */
-                measure_contact(r, r->blk_cont[bk->cont0 + k], t);
+                measure_contact(r, r->tp.blk_cont[bk->cont0 + k], t);
         }
     }
 }
@@ -869,25 +869,25 @@ static pd_matrix delassus(pd_edr *r, const int *idx, int k)
 {
     /* pos_in: each contact's row and column in D */
     for (int j = 0; j < k; j++)
-        r->pos_in[idx[j]] = j;
+        r->ev.pos_in[idx[j]] = j;
     if (k <= EDR_DENSE_MAX) {
         /* column j: D_aj = sum over the dofs i of contact j of w_ai w_ji / m_i,
          * a running over the contacts of idx at dof i (marked by ct_markD) */
-        double *D = r->Dd;
+        double *D = r->ev.Dd;
         memset(D, 0, (size_t)k * k * sizeof(double));
         for (int j = 0; j < k; j++) {
-            const edr_contact *cj = &r->ct[idx[j]];
+            const edr_contact *cj = &r->tp.ct[idx[j]];
             for (int s = 0; s < 2; s++) {
                 int dof = cj->dof[s];
                 if (dof < 0)
                     continue;
-                for (int e = r->dofc_ptr[dof]; e < r->dofc_ptr[dof + 1]; e++) {
-                    int a = r->dofc[e];
-                    if (r->ct_markD[a] != r->epochD)
+                for (int e = r->tp.dofc_ptr[dof]; e < r->tp.dofc_ptr[dof + 1]; e++) {
+                    int a = r->tp.dofc[e];
+                    if (r->ev.ct_markD[a] != r->ev.epochD)
                         continue;
-                    const edr_contact *ca = &r->ct[a];
+                    const edr_contact *ca = &r->tp.ct[a];
                     double wa = ca->dof[0] == dof ? ca->w[0] : ca->w[1];
-                    D[r->pos_in[a] + (size_t)j * k] += wa * cj->w[s] * r->minv[dof];
+                    D[r->ev.pos_in[a] + (size_t)j * k] += wa * cj->w[s] * r->tp.minv[dof];
                 }
             }
         }
@@ -897,43 +897,43 @@ static pd_matrix delassus(pd_edr *r, const int *idx, int k)
      * met at both of j's dofs summed into one entry) */
     int nz = 0;
     for (int j = 0; j < k; j++) {
-        const edr_contact *cj = &r->ct[idx[j]];
-        r->Dcol[j] = nz;
+        const edr_contact *cj = &r->tp.ct[idx[j]];
+        r->ev.Dcol[j] = nz;
         int start = nz;
         for (int s = 0; s < 2; s++) {
             int dof = cj->dof[s];
             if (dof < 0)
                 continue;
-            for (int e = r->dofc_ptr[dof]; e < r->dofc_ptr[dof + 1]; e++) {
-                int a = r->dofc[e];
-                if (r->ct_markD[a] != r->epochD)
+            for (int e = r->tp.dofc_ptr[dof]; e < r->tp.dofc_ptr[dof + 1]; e++) {
+                int a = r->tp.dofc[e];
+                if (r->ev.ct_markD[a] != r->ev.epochD)
                     continue;
-                const edr_contact *ca = &r->ct[a];
+                const edr_contact *ca = &r->tp.ct[a];
                 double wa = ca->dof[0] == dof ? ca->w[0] : ca->w[1];
-                int row = r->pos_in[a], f = -1;
+                int row = r->ev.pos_in[a], f = -1;
                 for (int p = start; p < nz && f < 0; p++)
-                    if (r->Drow[p] == row)
+                    if (r->ev.Drow[p] == row)
                         f = p;
                 if (f < 0) {
-                    r->Drow[nz] = row;
-                    r->Dval[nz++] = 0.0;
+                    r->ev.Drow[nz] = row;
+                    r->ev.Dval[nz++] = 0.0;
                     f = nz - 1;
                 }
-                r->Dval[f] += wa * cj->w[s] * r->minv[dof];
+                r->ev.Dval[f] += wa * cj->w[s] * r->tp.minv[dof];
             }
         }
         for (int p = start + 1; p < nz; p++) /* sort the column's rows */
-            for (int q = p; q > start && r->Drow[q - 1] > r->Drow[q]; q--) {
-                int ti = r->Drow[q];
-                double tv = r->Dval[q];
-                r->Drow[q] = r->Drow[q - 1];
-                r->Dval[q] = r->Dval[q - 1];
-                r->Drow[q - 1] = ti;
-                r->Dval[q - 1] = tv;
+            for (int q = p; q > start && r->ev.Drow[q - 1] > r->ev.Drow[q]; q--) {
+                int ti = r->ev.Drow[q];
+                double tv = r->ev.Dval[q];
+                r->ev.Drow[q] = r->ev.Drow[q - 1];
+                r->ev.Dval[q] = r->ev.Dval[q - 1];
+                r->ev.Drow[q - 1] = ti;
+                r->ev.Dval[q - 1] = tv;
             }
     }
-    r->Dcol[k] = nz;
-    return pd_matrix_csc(k, k, r->Dcol, r->Drow, r->Dval);
+    r->ev.Dcol[k] = nz;
+    return pd_matrix_csc(k, k, r->ev.Dcol, r->ev.Drow, r->ev.Dval);
 }
 
 /* Solve the LCP D z + q over idx[0..k) into z (w = D z + q). */
@@ -944,7 +944,7 @@ static pd_matrix delassus(pd_edr *r, const int *idx, int k)
 static int scaled_lcp(pd_edr *r, pd_lcp_solver *solver, pd_matrix *D, int k, const double *q,
                       const pd_lcp_opts *lo, double *z, double *w, pd_lcp_info *info)
 {
-    double *sc = r->lcp_scale, *qs = r->lcp_q;
+    double *sc = r->ev.lcp_scale, *qs = r->ev.lcp_q;
     /* S_jj = D_jj^-1/2 (a diagonal not > 0 cannot be scaled: PD_ENUMERICAL) */
     for (int j = 0; j < k; j++) {
         double d = 0.0;
@@ -959,7 +959,7 @@ static int scaled_lcp(pd_edr *r, pd_lcp_solver *solver, pd_matrix *D, int k, con
         qs[j] = sc[j] * q[j];
     }
     /* D <- S D S in place, entry by entry */
-    double *val = (double *)D->values; /* delassus()'s: r->Dd or r->Dval, formed per solve */
+    double *val = (double *)D->values; /* delassus()'s: r->ev.Dd or r->ev.Dval, formed per solve */
     for (int j = 0; j < k; j++) {
         if (D->kind == PD_MATRIX_DENSE)
             for (int i = 0; i < k; i++)
@@ -999,11 +999,11 @@ static int solve_lcp(pd_edr *r, const int *idx, int k, const double *q, double *
     if (k == 0)
         return PD_OK;
     /* ct_markD: the contacts of idx, for delassus() to find them at each dof */
-    r->epochD++;
+    r->ev.epochD++;
     for (int j = 0; j < k; j++)
-        r->ct_markD[idx[j]] = r->epochD;
+        r->ev.ct_markD[idx[j]] = r->ev.epochD;
     pd_matrix D = delassus(r, idx, k);
-    r->res.lcp_solves++;
+    r->rs.res.lcp_solves++;
     /* one contact: z = -q / D where q < 0, else 0 */
     if (k == 1) {
         z[0] = pd_contact_impulse_1(D.values[0], q[0]);
@@ -1013,16 +1013,16 @@ static int solve_lcp(pd_edr *r, const int *idx, int k, const double *q, double *
     /* a warm start: every contact pushing (stages move a whole cluster,
      * held forces keep it together), so that pivoting starts near the answer */
     pd_lcp_opts lo = pd_lcp_default_opts();
-    memset(r->guess, 1, (size_t)k);
-    lo.guess = r->guess;
+    memset(r->ev.guess, 1, (size_t)k);
+    lo.guess = r->ev.guess;
     pd_lcp_info info;
-    int rc = pd_lcp_solve(r->solver, &D, q, &lo, z, w, &info);
+    int rc = pd_lcp_solve(r->ev.solver, &D, q, &lo, z, w, &info);
     /* pivoting failed (masses of many decades): posed again on unit diagonal */
     if (rc)
-        rc = scaled_lcp(r, r->solver, &D, k, q, &lo, z, w, &info);
+        rc = scaled_lcp(r, r->ev.solver, &D, k, q, &lo, z, w, &info);
     if (rc)
         return pd_err_set(err, rc, "row reference: the contact LCP of %d contacts at t = %.9g s "
-                          "was not solved (%s)", k, t * r->o.time_unit, pd_lcp_outcome_name(info.outcome));
+                          "was not solved (%s)", k, t * r->tp.o.time_unit, pd_lcp_outcome_name(info.outcome));
     return PD_OK;
 }
 
@@ -1031,47 +1031,47 @@ static int solve_lcp(pd_edr *r, const int *idx, int k, const double *q, double *
  * (v, a) and f'(t). */
 static void group_rhs(pd_edr *r, double f, const double *x, const double *v, double *out)
 {
-    for (int k = 0; k < r->ngd; k++) {
-        int i = r->g_dof[k], b = r->dof_blk[i];
-        const edr_block *bk = &r->blk[b];
+    for (int k = 0; k < r->ev.ngd; k++) {
+        int i = r->ev.g_dof[k], b = r->tp.dof_blk[i];
+        const edr_block *bk = &r->tp.blk[b];
         /* an SDOF block: (b f - c v - k x) / m */
         if (bk->sdof) {
-            out[i] = (bk->b * f - bk->c * v[i] - bk->k * x[i]) * r->minv[i];
+            out[i] = (bk->b * f - bk->c * v[i] - bk->k * x[i]) * r->tp.minv[i];
             continue;
         }
         /* a block: row li of b f - C v - K x over its dofs (C, K column-major at
          * blk_off), then 1 / M_ii */
-        int li = r->dof_loc[i];
-        long off = r->blk_off[b];
-        double s = r->b[i] * f;
+        int li = r->tp.dof_loc[i];
+        long off = r->tp.blk_off[b];
+        double s = r->tp.b[i] * f;
         for (int jj = 0; jj < bk->n; jj++) {
-            int gj = r->blk_dofs[bk->first + jj];
-            s -= r->Cb[off + li + (long)jj * bk->n] * v[gj] + r->Kb[off + li + (long)jj * bk->n] * x[gj];
+            int gj = r->tp.blk_dofs[bk->first + jj];
+            s -= r->tp.Cb[off + li + (long)jj * bk->n] * v[gj] + r->tp.Kb[off + li + (long)jj * bk->n] * x[gj];
         }
-        out[i] = s * r->minv[i];
+        out[i] = s * r->tp.minv[i];
     }
 }
 
 /* Free accelerations M^-1 (b f - C v - K x) of the group's dofs at t. */
 static void free_accelerations(pd_edr *r, double t)
 {
-    group_rhs(r, edr_force(r, edr_piece_at(r, t), t), r->gx, r->gv, r->gacc);
+    group_rhs(r, edr_force(r, edr_piece_at(r, t), t), r->ev.gx, r->ev.gv, r->ev.gacc);
 }
 
-/* The free jerks of the group's dofs into r->gtmp, from the free
- * accelerations r->gacc:  j = M^-1 (b f'(t) - C a - K v). */
+/* The free jerks of the group's dofs into r->ev.gtmp, from the free
+ * accelerations r->ev.gacc:  j = M^-1 (b f'(t) - C a - K v). */
 static void free_jerks(pd_edr *r, double t)
 {
-    const pd_sine_piece *pc = &r->pieces[edr_piece_at(r, t)];
+    const pd_sine_piece *pc = &r->tp.pieces[edr_piece_at(r, t)];
     /* f'(t) = c1 + A w cos(w t + phi) on the piece at t */
     double df = pc->c1 + (pc->A == 0.0 ? 0.0 : pc->A * pc->w * cos(pc->w * t + pc->phi));
-    group_rhs(r, df, r->gv, r->gacc, r->gtmp);
+    group_rhs(r, df, r->ev.gv, r->ev.gacc, r->ev.gtmp);
 }
 
 /* W_a^T y over the group's state array y (walls at rest). */
 static double contact_dot(const pd_edr *r, int a, const double *y)
 {
-    const edr_contact *ct = &r->ct[a];
+    const edr_contact *ct = &r->tp.ct[a];
     double s = 0.0;
     for (int k = 0; k < 2; k++)
         if (ct->dof[k] >= 0)
@@ -1079,14 +1079,14 @@ static double contact_dot(const pd_edr *r, int a, const double *y)
     return s;
 }
 
-/* The contact-force LCP over J = idx[0..k): lambda (r->lam), and the gap
- * accelerations of every closed contact of the group (r->wlcp, indexed as
+/* The contact-force LCP over J = idx[0..k): lambda (r->ev.lam), and the gap
+ * accelerations of every closed contact of the group (r->ev.wlcp, indexed as
  * g_ct). */
 static int reduced_force(pd_edr *r, const int *idx, int k, double t, pd_err *err);
 
 static int force_lcp(pd_edr *r, const int *idx, int k, double t, pd_err *err)
 {
-    double *q = r->qlcp, *lam = r->lam, *w = r->wtmp;
+    double *q = r->ev.qlcp, *lam = r->ev.lam, *w = r->ev.wtmp;
     /* on the clusters' coordinates when it can (0, or an error); 1: the dofs decide */
     int rr = reduced_force(r, idx, k, t, err);
     if (rr != 1)
@@ -1094,21 +1094,21 @@ static int force_lcp(pd_edr *r, const int *idx, int k, double t, pd_err *err)
     /* q_j = W_j^T a_free: the gap accelerations without contact forces, so that
      * 0 <= g'' = D lambda + q _|_ lambda >= 0 */
     for (int j = 0; j < k; j++)
-        q[j] = contact_dot(r, idx[j], r->gacc);
+        q[j] = contact_dot(r, idx[j], r->ev.gacc);
     int rc = solve_lcp(r, idx, k, q, lam, w, t, err);
     if (rc)
         return rc;
     /* gap accelerations of all closed contacts: W^T (a_free + M^-1 W_J lambda) */
-    for (int k2 = 0; k2 < r->ngd; k2++)
-        r->gtmp[r->g_dof[k2]] = r->gacc[r->g_dof[k2]];
+    for (int k2 = 0; k2 < r->ev.ngd; k2++)
+        r->ev.gtmp[r->ev.g_dof[k2]] = r->ev.gacc[r->ev.g_dof[k2]];
     for (int j = 0; j < k; j++) {
-        const edr_contact *ct = &r->ct[idx[j]];
+        const edr_contact *ct = &r->tp.ct[idx[j]];
         for (int s = 0; s < 2; s++)
             if (ct->dof[s] >= 0)
-                r->gtmp[ct->dof[s]] += ct->w[s] * lam[j] * r->minv[ct->dof[s]];
+                r->ev.gtmp[ct->dof[s]] += ct->w[s] * lam[j] * r->tp.minv[ct->dof[s]];
     }
-    for (int j = 0; j < r->ngc; j++)
-        r->wlcp[j] = contact_dot(r, r->g_ct[j], r->gtmp);
+    for (int j = 0; j < r->ev.ngc; j++)
+        r->ev.wlcp[j] = contact_dot(r, r->ev.g_ct[j], r->ev.gtmp);
     return PD_OK;
 }
 
@@ -1125,100 +1125,100 @@ static int uf_find(int *p, int x)
 }
 
 /* Dissolve the group's clusters and make new ones from the contacts
- * flagged held (r->held), every dof starting at (gx, gv) at t. */
+ * flagged held (r->ev.held), every dof starting at (gx, gv) at t. */
 static int regroup(pd_edr *r, double t, pd_err *err)
 {
-    int *uf = r->uf, rc;
+    int *uf = r->ev.uf, rc;
     /* the union-find over the group's blocks: each its own root */
-    for (int i = 0; i < r->ng; i++) {
-        int c = r->g_cl[i];
-        for (int b = r->cl[c].head; b >= 0; b = r->blk_next[b])
+    for (int i = 0; i < r->ev.ng; i++) {
+        int c = r->ev.g_cl[i];
+        for (int b = r->rs.cl[c].head; b >= 0; b = r->rs.blk_next[b])
             uf[b] = b;
     }
-    for (int j = 0; j < r->ngc; j++) {
-        int a = r->g_ct[j];
-        const edr_contact *ct = &r->ct[a];
-        int was = r->cstate[a] == EDR_PERSIST;
+    for (int j = 0; j < r->ev.ngc; j++) {
+        int a = r->ev.g_ct[j];
+        const edr_contact *ct = &r->tp.ct[a];
+        int was = r->rs.cstate[a] == EDR_PERSIST;
         /* a persistent contact released: its time in contact since it was held */
-        if (was && !r->held[j])
-            r->ctime[a] += t - r->since[a] > 0.0 ? t - r->since[a] : 0.0;
+        if (was && !r->ev.held[j])
+            r->rs.ctime[a] += t - r->rs.since[a] > 0.0 ? t - r->rs.since[a] : 0.0;
         /* a contact's burst of impacts ends with a hold that lasted: one
          * released at once (a chatter through held states) bounces on */
-        if (was && !r->held[j] && t - r->since[a] > EDR_HOLD_MIN)
-            r->burst[a] = 0;
+        if (was && !r->ev.held[j] && t - r->rs.since[a] > EDR_HOLD_MIN)
+            r->rs.burst[a] = 0;
         /* newly held: in contact from t, or from the end of a jumped accumulation's tail */
-        if (r->held[j] && !was)
-            r->since[a] = t + r->held_tail[j];
-        r->cstate[a] = r->held[j] ? EDR_PERSIST : EDR_OPEN;
-        r->pers_next[a] = -1;
+        if (r->ev.held[j] && !was)
+            r->rs.since[a] = t + r->ev.held_tail[j];
+        r->rs.cstate[a] = r->ev.held[j] ? EDR_PERSIST : EDR_OPEN;
+        r->rs.pers_next[a] = -1;
         /* every closed contact's gap is exactly 0 at t (gap_base) */
-        r->base_t[a] = t;
-        r->base_g[a] = 0.0;
+        r->rs.base_t[a] = t;
+        r->rs.base_g[a] = 0.0;
         /* a held contact between two blocks joins them; a wall joins nothing */
-        if (r->held[j] && ct->blk[0] >= 0 && ct->blk[1] >= 0) {
+        if (r->ev.held[j] && ct->blk[0] >= 0 && ct->blk[1] >= 0) {
             int x = uf_find(uf, ct->blk[0]), y = uf_find(uf, ct->blk[1]);
             if (x != y)
                 uf[x] = y;
         }
     }
     /* the new flights start from the group's state at t */
-    for (int k = 0; k < r->ngd; k++) {
-        int i = r->g_dof[k];
-        r->xo[i] = r->gx[i];
-        r->vo[i] = r->gv[i];
+    for (int k = 0; k < r->ev.ngd; k++) {
+        int i = r->ev.g_dof[k];
+        r->rs.xo[i] = r->ev.gx[i];
+        r->rs.vo[i] = r->ev.gv[i];
     }
     /* release the old clusters, collect the blocks */
     int nblk = 0;
-    for (int i = 0; i < r->ng; i++) {
-        int c = r->g_cl[i];
-        for (int b = r->cl[c].head, nx; b >= 0; b = nx) {
-            nx = r->blk_next[b];
-            r->gblk[nblk++] = b;
+    for (int i = 0; i < r->ev.ng; i++) {
+        int c = r->ev.g_cl[i];
+        for (int b = r->rs.cl[c].head, nx; b >= 0; b = nx) {
+            nx = r->rs.blk_next[b];
+            r->ev.gblk[nblk++] = b;
         }
-        r->cl[c].live = 0;
-        r->cl[c].head = -1;
-        r->free_cl[r->nfree++] = c;
-        q_set(&r->q, r->m + c, HUGE_VAL);
+        r->rs.cl[c].live = 0;
+        r->rs.cl[c].head = -1;
+        r->rs.free_cl[r->rs.nfree++] = c;
+        q_set(&r->rs.q, r->tp.m + c, HUGE_VAL);
     }
     /* one cluster per root */
-    r->ng = 0;
+    r->ev.ng = 0;
     for (int k = 0; k < nblk; k++) {
-        int b = r->gblk[k];
+        int b = r->ev.gblk[k];
         if (uf_find(uf, b) != b)
             continue;
-        int c = r->free_cl[--r->nfree];
-        edr_cluster *cl = &r->cl[c];
+        int c = r->rs.free_cl[--r->rs.nfree];
+        edr_cluster *cl = &r->rs.cl[c];
         cl->live = 1;
         cl->head = -1;
         cl->nblk = 0;
         cl->pers_head = -1;
         cl->npers = 0;
         cl->meas_t = t;
-        r->newcl[b] = c;
-        r->g_cl[r->ng++] = c;
+        r->ev.newcl[b] = c;
+        r->ev.g_cl[r->ev.ng++] = c;
     }
     for (int k = 0; k < nblk; k++) {
         /* every block into its root's cluster */
-        int b = r->gblk[k], c = r->newcl[uf_find(uf, b)];
-        r->blk_cl[b] = c;
-        r->blk_next[b] = r->cl[c].head;
-        r->cl[c].head = b;
-        r->cl[c].nblk++;
+        int b = r->ev.gblk[k], c = r->ev.newcl[uf_find(uf, b)];
+        r->rs.blk_cl[b] = c;
+        r->rs.blk_next[b] = r->rs.cl[c].head;
+        r->rs.cl[c].head = b;
+        r->rs.cl[c].nblk++;
     }
-    for (int j = 0; j < r->ngc; j++) {
-        int a = r->g_ct[j];
+    for (int j = 0; j < r->ev.ngc; j++) {
+        int a = r->ev.g_ct[j];
         /* every held contact into the persistent list of its cluster */
-        if (!r->held[j])
+        if (!r->ev.held[j])
             continue;
-        const edr_contact *ct = &r->ct[a];
-        int c = r->blk_cl[ct->blk[0] >= 0 ? ct->blk[0] : ct->blk[1]];
-        r->pers_next[a] = r->cl[c].pers_head;
-        r->cl[c].pers_head = a;
-        r->cl[c].npers++;
+        const edr_contact *ct = &r->tp.ct[a];
+        int c = r->rs.blk_cl[ct->blk[0] >= 0 ? ct->blk[0] : ct->blk[1]];
+        r->rs.pers_next[a] = r->rs.cl[c].pers_head;
+        r->rs.cl[c].pers_head = a;
+        r->rs.cl[c].npers++;
     }
-    for (int i = 0; i < r->ng; i++)
+    for (int i = 0; i < r->ev.ng; i++)
         /* each new cluster's flight: an SDOF tree, a REST tree or modal */
-        if ((rc = edr_cluster_start(r, r->g_cl[i], t, err)))
+        if ((rc = edr_cluster_start(r, r->ev.g_cl[i], t, err)))
             return rc;
     return PD_OK;
 }
@@ -1227,17 +1227,17 @@ static int regroup(pd_edr *r, double t, pd_err *err)
  * clusters. */
 static void repredict(pd_edr *r, double t)
 {
-    r->epochP++;
-    for (int i = 0; i < r->ng; i++) {
-        int c = r->g_cl[i];
-        for (int b = r->cl[c].head; b >= 0; b = r->blk_next[b]) {
-            const edr_block *bk = &r->blk[b];
+    r->ev.epochP++;
+    for (int i = 0; i < r->ev.ng; i++) {
+        int c = r->ev.g_cl[i];
+        for (int b = r->rs.cl[c].head; b >= 0; b = r->rs.blk_next[b]) {
+            const edr_block *bk = &r->tp.blk[b];
             for (int k = 0; k < bk->ncont; k++) {
-                int a = r->blk_cont[bk->cont0 + k];
+                int a = r->tp.blk_cont[bk->cont0 + k];
                 /* once each: a contact between two of the group's clusters is met twice */
-                if (r->ct_markP[a] == r->epochP)
+                if (r->ev.ct_markP[a] == r->ev.epochP)
                     continue;
-                r->ct_markP[a] = r->epochP;
+                r->ev.ct_markP[a] = r->ev.epochP;
                 predict_contact(r, a, t, 0);
             }
         }
@@ -1249,27 +1249,27 @@ static void repredict(pd_edr *r, double t)
 
 static int report(pd_edr *r, double t, pd_edr_kind kind, int acc)
 {
-    if (!r->o.on_event)
+    if (!r->tp.o.on_event)
         return 0;
     /* v+ and x of the group's dofs in g_dof order (v- was kept before the impact) */
-    for (int k = 0; k < r->ngd; k++) {
-        r->ev_vplus[k] = r->gv[r->g_dof[k]];
-        r->ev_x[k] = r->gx[r->g_dof[k]];
+    for (int k = 0; k < r->ev.ngd; k++) {
+        r->ev.ev_vplus[k] = r->ev.gv[r->ev.g_dof[k]];
+        r->ev.ev_x[k] = r->ev.gx[r->ev.g_dof[k]];
     }
     pd_edr_event ev = {.t = t,
                        .kind = kind,
-                       .ncontacts = r->ngc,
-                       .contacts = r->g_ct,
-                       .P = r->P,
-                       .U_minus = r->Uminus,
-                       .U_plus = r->Uplus,
-                       .ndofs = r->ngd,
-                       .dofs = r->g_dof,
-                       .v_minus = r->ev_vminus,
-                       .v_plus = r->ev_vplus,
-                       .x = r->ev_x,
+                       .ncontacts = r->ev.ngc,
+                       .contacts = r->ev.g_ct,
+                       .P = r->ev.P,
+                       .U_minus = r->ev.Uminus,
+                       .U_plus = r->ev.Uplus,
+                       .ndofs = r->ev.ngd,
+                       .dofs = r->ev.g_dof,
+                       .v_minus = r->ev.ev_vminus,
+                       .v_plus = r->ev.ev_vplus,
+                       .x = r->ev.ev_x,
                        .accumulation = acc};
-    return r->o.on_event(&ev, r->o.on_event_ctx);
+    return r->tp.o.on_event(&ev, r->tp.o.on_event_ctx);
 }
 
 /* Count the event of queue slot `slot`; PD_EBUDGET past the budget, or
@@ -1278,29 +1278,29 @@ static int report(pd_edr *r, double t, pd_edr_kind kind, int acc)
  * together, are no stall). */
 static int count_event(pd_edr *r, int slot, double t, pd_err *err)
 {
-    if (++r->res.events > r->o.max_events)
+    if (++r->rs.res.events > r->tp.o.max_events)
         return pd_err_set(err, PD_EBUDGET, "row reference: %ld events by t = %.9g s (budget "
-                          "exhausted)", r->res.events - 1, t * r->o.time_unit);
+                          "exhausted)", r->rs.res.events - 1, t * r->tp.o.time_unit);
     /* the same slot again at the same instant: time does not move for it */
-    if (r->slot_t[slot] == t) {
-        if (++r->slot_same[slot] > EDR_SAME_INSTANT)
+    if (r->rs.slot_t[slot] == t) {
+        if (++r->rs.slot_same[slot] > EDR_SAME_INSTANT)
             return pd_err_set(err, PD_EBUDGET, "row reference: %d events at t = %.17g s without "
-                              "progress", EDR_SAME_INSTANT, t * r->o.time_unit);
+                              "progress", EDR_SAME_INSTANT, t * r->tp.o.time_unit);
     } else {
-        r->slot_t[slot] = t;
-        r->slot_same[slot] = 0;
+        r->rs.slot_t[slot] = t;
+        r->rs.slot_same[slot] = 0;
     }
     /* a chatter: EDR_CHATTER_EVENTS events of one slot within EDR_CHATTER_SPAN
      * (a Zeno sequence the accumulation jump did not end) */
-    if (++r->slot_run[slot] >= EDR_CHATTER_EVENTS) {
-        if (t - r->slot_t0[slot] < EDR_CHATTER_SPAN)
+    if (++r->rs.slot_run[slot] >= EDR_CHATTER_EVENTS) {
+        if (t - r->rs.slot_t0[slot] < EDR_CHATTER_SPAN)
             return pd_err_set(err, PD_EBUDGET, "row reference: %d events of one %s within %.3g "
                               "s at t = %.9g s: a chatter it cannot resolve (Moreau-Jean, "
                               "--method moreau, runs it)", EDR_CHATTER_EVENTS,
-                              slot < r->m ? "contact" : "cluster",
-                              (t - r->slot_t0[slot]) * r->o.time_unit, t * r->o.time_unit);
-        r->slot_run[slot] = 0;
-        r->slot_t0[slot] = t;
+                              slot < r->tp.m ? "contact" : "cluster",
+                              (t - r->rs.slot_t0[slot]) * r->tp.o.time_unit, t * r->tp.o.time_unit);
+        r->rs.slot_run[slot] = 0;
+        r->rs.slot_t0[slot] = t;
     }
     return PD_OK;
 }
@@ -1310,31 +1310,31 @@ static int count_event(pd_edr *r, int slot, double t, pd_err *err)
  * (zero rate), k0 of them. */
 static int decide_persistence(pd_edr *r, double t, int *acc_jumped, pd_err *err)
 {
-    int rc, k0 = 0, *idx = r->lcp_idx;
+    int rc, k0 = 0, *idx = r->ev.lcp_idx;
     double vs = 0.0;
     *acc_jumped = 0;
-    for (int k = 0; k < r->ngd; k++)
-        vs = fmax(vs, fabs(r->gv[r->g_dof[k]]));
+    for (int k = 0; k < r->ev.ngd; k++)
+        vs = fmax(vs, fabs(r->ev.gv[r->ev.g_dof[k]]));
     /* a rate is zero below EDR_RATE_TOL of the event's (and the run's) speeds */
-    double tolU = EDR_RATE_TOL * fmax(vs, r->vscale);
+    double tolU = EDR_RATE_TOL * fmax(vs, r->rs.vscale);
     /* the candidates: closed contacts at zero rate after the impact, the
      * detaching one excluded; jpos[j]: a contact's place in idx, or -1 */
-    for (int j = 0; j < r->ngc; j++) {
-        r->held[j] = 0;
-        r->held_tail[j] = 0.0;
-        if (fabs(r->Uplus[j]) <= tolU && !r->excluded[j])
-            idx[k0++] = r->g_ct[j], r->jpos[j] = k0 - 1;
+    for (int j = 0; j < r->ev.ngc; j++) {
+        r->ev.held[j] = 0;
+        r->ev.held_tail[j] = 0.0;
+        if (fabs(r->ev.Uplus[j]) <= tolU && !r->ev.excluded[j])
+            idx[k0++] = r->ev.g_ct[j], r->ev.jpos[j] = k0 - 1;
         else
-            r->jpos[j] = -1;
+            r->ev.jpos[j] = -1;
     }
     /* the force LCP, 0 <= g'' = D lambda + W^T a_free _|_ lambda >= 0: a
      * positive force holds the contact */
     free_accelerations(r, t);
     if ((rc = force_lcp(r, idx, k0, t, err)))
         return rc;
-    for (int j = 0; j < r->ngc; j++)
-        if (r->jpos[j] >= 0)
-            r->held[j] = r->lam[r->jpos[j]] > 0.0;
+    for (int j = 0; j < r->ev.ngc; j++)
+        if (r->ev.jpos[j] >= 0)
+            r->ev.held[j] = r->ev.lam[r->ev.jpos[j]] > 0.0;
     /* a contact at zero force and zero gap acceleration whose bodies are
      * still but accelerate (touching at rest under one ground motion, as at
      * the start) is held when the free gap's jerk closes it: its force
@@ -1342,40 +1342,40 @@ static int decide_persistence(pd_edr *r, double t, int *acc_jumped, pd_err *err)
      * close as t^3 and bounce at ever smaller speeds, never reaching the
      * accumulation jump (no closing acceleration to bound the bounces). */
     int ties = 0;
-    for (int j = 0; j < r->ngc; j++) {
-        const edr_contact *ct = &r->ct[r->g_ct[j]];
+    for (int j = 0; j < r->ev.ngc; j++) {
+        const edr_contact *ct = &r->tp.ct[r->ev.g_ct[j]];
         double as = 0.0; /* its bodies' accelerations */
         for (int k = 0; k < 2; k++)
             if (ct->dof[k] >= 0)
-                as = fmax(as, fabs(r->gacc[ct->dof[k]]));
-        r->tie[j] = r->jpos[j] >= 0 && !r->held[j] && as > EDR_TIE_ACC * r->L &&
-                    !(fabs(r->wlcp[j]) > EDR_RATE_TOL * as);
-        ties |= r->tie[j];
+                as = fmax(as, fabs(r->ev.gacc[ct->dof[k]]));
+        r->ev.tie[j] = r->ev.jpos[j] >= 0 && !r->ev.held[j] && as > EDR_TIE_ACC * r->rs.L &&
+                    !(fabs(r->ev.wlcp[j]) > EDR_RATE_TOL * as);
+        ties |= r->ev.tie[j];
     }
     if (ties) {
         /* held when the free gap's jerk W^T j_free < 0 closes it */
         free_jerks(r, t);
-        for (int j = 0; j < r->ngc; j++)
-            if (r->tie[j])
-                r->held[j] = contact_dot(r, r->g_ct[j], r->gtmp) < 0.0;
+        for (int j = 0; j < r->ev.ngc; j++)
+            if (r->ev.tie[j])
+                r->ev.held[j] = contact_dot(r, r->ev.g_ct[j], r->ev.gtmp) < 0.0;
     }
-    if (r->o.no_accumulation)
+    if (r->tp.o.no_accumulation)
         return PD_OK;
     /* accumulations: contacts bouncing off with a tiny height under a closing acceleration */
-    double tend = fmin(edr_piece_end(r, edr_piece_at(r, t)), r->t1);
+    double tend = fmin(edr_piece_end(r, edr_piece_at(r, t)), r->rs.t1);
     int ns = 0, k1 = k0;
-    for (int j = 0; j < r->ngc; j++) {
-        int a = r->g_ct[j];
-        double U = r->Uplus[j], acl = -r->wlcp[j], e = r->ct[a].e;
-        if (r->jpos[j] >= 0 || r->excluded[j] || !(U > 0.0) || !(e < 1.0) || !(acl > 0.0))
+    for (int j = 0; j < r->ev.ngc; j++) {
+        int a = r->ev.g_ct[j];
+        double U = r->ev.Uplus[j], acl = -r->ev.wlcp[j], e = r->tp.ct[a].e;
+        if (r->ev.jpos[j] >= 0 || r->ev.excluded[j] || !(U > 0.0) || !(e < 1.0) || !(acl > 0.0))
             continue;
         /* the next bounce's height U^2 / (2 a), and the time of all the bounces
          * left, sum_k 2 e^k U / a = 2 U / (a (1 - e)): the tail jumped */
         double height = U * U / (2.0 * acl), tail = 2.0 * U / (acl * (1.0 - e));
-        if (height > EDR_ACC_HEIGHT * r->L || !(t + tail < tend))
+        if (height > EDR_ACC_HEIGHT * r->rs.L || !(t + tail < tend))
             continue;
-        r->held_tail[j] = tail;
-        r->jpos[j] = k1;
+        r->ev.held_tail[j] = tail;
+        r->ev.jpos[j] = k1;
         idx[k1++] = a;
         ns++;
     }
@@ -1386,25 +1386,25 @@ static int decide_persistence(pd_edr *r, double t, int *acc_jumped, pd_err *err)
         return rc;
     /* every jumped contact must push */
     int ok = 1;
-    for (int j = 0; j < r->ngc && ok; j++)
-        if (r->held_tail[j] > 0.0)
-            ok = r->lam[r->jpos[j]] > 0.0;
+    for (int j = 0; j < r->ev.ngc && ok; j++)
+        if (r->ev.held_tail[j] > 0.0)
+            ok = r->ev.lam[r->ev.jpos[j]] > 0.0;
     if (ok) {
-        for (int j = 0; j < r->ngc; j++)
-            r->held[j] = r->jpos[j] >= 0 && r->lam[r->jpos[j]] > 0.0;
+        for (int j = 0; j < r->ev.ngc; j++)
+            r->ev.held[j] = r->ev.jpos[j] >= 0 && r->ev.lam[r->ev.jpos[j]] > 0.0;
         /* the force must hold through the tail: try the clusters */
         *acc_jumped = 1;
         return PD_OK;
     }
-    for (int j = 0; j < r->ngc; j++) /* rejected: the force LCP of the resting ones */
-        if (r->held_tail[j] > 0.0) {
-            r->held_tail[j] = 0.0;
-            r->jpos[j] = -1;
+    for (int j = 0; j < r->ev.ngc; j++) /* rejected: the force LCP of the resting ones */
+        if (r->ev.held_tail[j] > 0.0) {
+            r->ev.held_tail[j] = 0.0;
+            r->ev.jpos[j] = -1;
         }
     if ((rc = force_lcp(r, idx, k0, t, err)))
         return rc;
-    for (int j = 0; j < r->ngc; j++)
-        r->held[j] = r->jpos[j] >= 0 && r->lam[r->jpos[j]] > 0.0;
+    for (int j = 0; j < r->ev.ngc; j++)
+        r->ev.held[j] = r->ev.jpos[j] >= 0 && r->ev.lam[r->ev.jpos[j]] > 0.0;
     return PD_OK;
 }
 
@@ -1412,16 +1412,16 @@ static int decide_persistence(pd_edr *r, double t, int *acc_jumped, pd_err *err)
  * the new clusters: 1 when they hold. */
 static int tails_hold(pd_edr *r)
 {
-    for (int j = 0; j < r->ngc; j++) {
-        double tail = r->held_tail[j];
-        if (!(tail > 0.0) || !r->held[j])
+    for (int j = 0; j < r->ev.ngc; j++) {
+        double tail = r->ev.held_tail[j];
+        if (!(tail > 0.0) || !r->ev.held[j])
             continue;
-        int a = r->g_ct[j], c = r->blk_cl[r->ct[a].blk[0] >= 0 ? r->ct[a].blk[0] : r->ct[a].blk[1]];
+        int a = r->ev.g_ct[j], c = r->rs.blk_cl[r->tp.ct[a].blk[0] >= 0 ? r->tp.ct[a].blk[0] : r->tp.ct[a].blk[1]];
         /* not held after all (locked in a cycle): nothing to check */
-        if (r->cstate[a] != EDR_PERSIST)
+        if (r->rs.cstate[a] != EDR_PERSIST)
             continue;
         /* lambda at the tail's middle and end on the new cluster's flight (from t0) */
-        double t0 = r->cl[c].t0;
+        double t0 = r->rs.cl[c].t0;
         if (!(edr_force_at(r, c, a, t0 + 0.5 * tail) > 0.0) || !(edr_force_at(r, c, a, t0 + tail) > 0.0))
             return 0;
     }
@@ -1435,12 +1435,12 @@ static int tails_hold(pd_edr *r)
  * tolerance) is in an accumulation at that instant: its bounces shrink
  * geometrically, stage after stage, toward zero relative velocity, which
  * is where a plastic stage takes it at once (as the one-wall reference
- * jumps a bouncing ball to rest).  Counted in r->instant_acc. */
+ * jumps a bouncing ball to rest).  Counted in r->ev.instant_acc. */
 static double stage_e(pd_edr *r, int j)
 {
-    if (r->nimp[j] < EDR_INSTANT_BOUNCES || r->o.no_accumulation)
-        return r->ct[r->g_ct[j]].e;
-    r->instant_acc = 1;
+    if (r->ev.nimp[j] < EDR_INSTANT_BOUNCES || r->tp.o.no_accumulation)
+        return r->tp.ct[r->ev.g_ct[j]].e;
+    r->ev.instant_acc = 1;
     return 0.0;
 }
 
@@ -1451,41 +1451,41 @@ static double stage_e(pd_edr *r, int j)
 static int small_lcp(pd_edr *r, int k, const double *D, const double *q, double *z, double *w)
 {
     pd_matrix Dm = pd_matrix_dense(k, k, D);
-    int rc = pd_lcp_solve(r->dsolver, &Dm, q, NULL, z, w, NULL);
+    int rc = pd_lcp_solve(r->ev.dsolver, &Dm, q, NULL, z, w, NULL);
     if (rc) { /* posed again on unit diagonal (then shifted), on a copy: D is refined on */
-        memcpy(r->Dlu, D, (size_t)k * k * sizeof(double));
-        Dm = pd_matrix_dense(k, k, r->Dlu);
-        rc = scaled_lcp(r, r->dsolver, &Dm, k, q, NULL, z, w, NULL);
+        memcpy(r->ev.Dlu, D, (size_t)k * k * sizeof(double));
+        Dm = pd_matrix_dense(k, k, r->ev.Dlu);
+        rc = scaled_lcp(r, r->ev.dsolver, &Dm, k, q, NULL, z, w, NULL);
     }
     return rc;
 }
 
-/* Commit an impact's totals: every closed contact's impulse (r->P) and
- * impacts (r->nimp, stages where it was closing). */
+/* Commit an impact's totals: every closed contact's impulse (r->ev.P) and
+ * impacts (r->ev.nimp, stages where it was closing). */
 static int commit_impacts(pd_edr *r, double t, pd_err *err)
 {
-    for (int j = 0; j < r->ngc; j++) {
-        int a = r->g_ct[j];
+    for (int j = 0; j < r->ev.ngc; j++) {
+        int a = r->ev.g_ct[j];
         /* imp_out: impulses since the last sample; maxP: the largest impact's impulse */
-        r->imp_out[a] += r->P[j];
-        r->maxP[a] = pd_max(r->maxP[a], r->P[j]);
+        r->rs.imp_out[a] += r->ev.P[j];
+        r->rs.maxP[a] = pd_max(r->rs.maxP[a], r->ev.P[j]);
         /* pressed, never closing: no impact to count */
-        if (!r->nimp[j])
+        if (!r->ev.nimp[j])
             continue;
-        r->impacts[a] += r->nimp[j];
-        r->res.impacts += r->nimp[j];
-        if (isnan(r->first[a]))
-            r->first[a] = t;
-        if (isnan(r->res.first_impact))
-            r->res.first_impact = t;
+        r->rs.impacts[a] += r->ev.nimp[j];
+        r->rs.res.impacts += r->ev.nimp[j];
+        if (isnan(r->rs.first[a]))
+            r->rs.first[a] = t;
+        if (isnan(r->rs.res.first_impact))
+            r->rs.res.first_impact = t;
         /* burst: impacts since its last lasting hold; past max_burst the run is in
          * an accumulation it does not end */
-        if ((r->burst[a] += r->nimp[j]) > r->o.max_burst)
+        if ((r->rs.burst[a] += r->ev.nimp[j]) > r->tp.o.max_burst)
             return pd_err_set(err, PD_EBUDGET, "row reference: accumulation of impacts of "
                               "contact %d at t = %.9g s: %ld impacts without a lasting persistent "
                               "contact%s (Moreau-Jean, --method moreau, runs it)", a,
-                              t * r->o.time_unit, r->burst[a] - 1,
-                              r->o.no_accumulation ? " (accumulation handling is off)" : "");
+                              t * r->tp.o.time_unit, r->rs.burst[a] - 1,
+                              r->tp.o.no_accumulation ? " (accumulation handling is off)" : "");
     }
     return PD_OK;
 }
@@ -1513,29 +1513,29 @@ static void single_law_zero(double *q, int k)
  * next stage at the same instant (as Moreau-Jean's active set leaves a
  * separating contact to the next step).  Stages end when no closed contact
  * closes.  The single law takes every closed contact, separating ones
- * included, into one LCP and ends there.  Totals in r->P, r->nimp. */
+ * included, into one LCP and ends there.  Totals in r->ev.P, r->ev.nimp. */
 static int impact_stages(pd_edr *r, double t, double tolU, pd_err *err)
 {
-    int rc, *idx = r->lcp_idx, stage = 0, single = r->o.impact_law == PD_IMPACT_SINGLE;
-    double *q = r->qlcp, *z = r->lam;
+    int rc, *idx = r->ev.lcp_idx, stage = 0, single = r->tp.o.impact_law == PD_IMPACT_SINGLE;
+    double *q = r->ev.qlcp, *z = r->ev.lam;
     for (;;) {
         int k = 0, closing = 0, pressing = 0, all = 0;
-        for (int j = 0; j < r->ngc; j++) {
+        for (int j = 0; j < r->ev.ngc; j++) {
             /* U = W_j^T v, zero at the rounding level of the event's speeds */
-            double U = contact_dot(r, r->g_ct[j], r->gv);
+            double U = contact_dot(r, r->ev.g_ct[j], r->ev.gv);
             if (fabs(U) <= tolU)
                 U = 0.0;
             all++;
             /* separating (staged law): no impulse in this stage; the others' impulses
              * may close it for the next */
             if (U > 0.0 && !single) {
-                r->jpos[j] = -1;
+                r->ev.jpos[j] = -1;
                 continue;
             }
             closing += U < 0.0;
             pressing += U <= 0.0;
-            r->jpos[j] = k;
-            idx[k] = r->g_ct[j];
+            r->ev.jpos[j] = k;
+            idx[k] = r->ev.g_ct[j];
             /* Newton's law: w = D P + q = U+ + e min(U-, 0) */
             q[k++] = U + stage_e(r, j) * fmin(U, 0.0);
         }
@@ -1543,26 +1543,26 @@ static int impact_stages(pd_edr *r, double t, double tolU, pd_err *err)
         if (!closing)
             return PD_OK;
         /* law_multi: its first LCP could take several closed contacts */
-        r->law_multi |= stage == 0 && all > 1;
+        r->ev.law_multi |= stage == 0 && all > 1;
         if (++stage > EDR_STAGES)
             return pd_err_set(err, PD_EBUDGET, "row reference: the impact at t = %.17g s did not "
-                              "end in %d stages", t * r->o.time_unit, EDR_STAGES);
+                              "end in %d stages", t * r->tp.o.time_unit, EDR_STAGES);
         if (single)
             single_law_zero(q, k);
-        if ((rc = solve_lcp(r, idx, k, q, z, r->wtmp, t, err)))
+        if ((rc = solve_lcp(r, idx, k, q, z, r->ev.wtmp, t, err)))
             return rc;
-        r->res.simultaneous += pressing > 1;
+        r->rs.res.simultaneous += pressing > 1;
         /* v += M^-1 W_j P_j, the totals P; a stage where it closed is one impact */
-        for (int j = 0; j < r->ngc; j++) {
-            if (r->jpos[j] < 0)
+        for (int j = 0; j < r->ev.ngc; j++) {
+            if (r->ev.jpos[j] < 0)
                 continue;
-            double P = z[r->jpos[j]];
-            const edr_contact *ct = &r->ct[r->g_ct[j]];
+            double P = z[r->ev.jpos[j]];
+            const edr_contact *ct = &r->tp.ct[r->ev.g_ct[j]];
             for (int s = 0; s < 2; s++)
                 if (ct->dof[s] >= 0)
-                    r->gv[ct->dof[s]] += ct->w[s] * P * r->minv[ct->dof[s]];
-            r->P[j] += P;
-            r->nimp[j] += q[r->jpos[j]] < 0.0;
+                    r->ev.gv[ct->dof[s]] += ct->w[s] * P * r->tp.minv[ct->dof[s]];
+            r->ev.P[j] += P;
+            r->ev.nimp[j] += q[r->ev.jpos[j]] < 0.0;
         }
         /* the single law: one LCP, no further stage */
         if (single)
@@ -1574,11 +1574,11 @@ static int impact_stages(pd_edr *r, double t, double tolU, pd_err *err)
  * side's cluster coordinate (w s_i for an SDOF tree, 0 held still). */
 static double side_sigma(const pd_edr *r, int a, int s)
 {
-    int dof = r->ct[a].dof[s];
+    int dof = r->tp.ct[a].dof[s];
     if (dof < 0)
         return 0.0;
-    const edr_cluster *cl = &r->cl[cl_of_dof(r, dof)];
-    return cl->kind == EDR_SDOF ? r->ct[a].w[s] * r->s[dof] : 0.0;
+    const edr_cluster *cl = &r->rs.cl[cl_of_dof(r, dof)];
+    return cl->kind == EDR_SDOF ? r->tp.ct[a].w[s] * r->rs.s[dof] : 0.0;
 }
 
 /* 1 when contact a has a side whose cluster moves (an impulse on it does
@@ -1595,23 +1595,23 @@ static void reduced_residual(const pd_edr *r, const int *idx, int k, const doubl
                              const double *z, double *res, double *scale)
 {
     for (int x = 0; x < k; x++) {
-        int a = r->g_ct[idx[x]];
+        int a = r->ev.g_ct[idx[x]];
         /* sum: r_x; sc: its terms' magnitudes, the level of its rounding */
         double sum = q[x], sc = fabs(q[x]);
         for (int s = 0; s < 2; s++) {
             double sa = side_sigma(r, a, s);
             if (sa == 0.0)
                 continue;
-            int c = cl_of_dof(r, r->ct[a].dof[s]);
+            int c = cl_of_dof(r, r->tp.ct[a].dof[s]);
             /* G_c = sum_y sigma_yc z_y: the stage's total impulse on cluster c */
             double G = 0.0;
             for (int y = 0; y < k; y++) {
-                int b = r->g_ct[idx[y]];
+                int b = r->ev.g_ct[idx[y]];
                 for (int u = 0; u < 2; u++)
-                    if (r->ct[b].dof[u] >= 0 && cl_of_dof(r, r->ct[b].dof[u]) == c)
+                    if (r->tp.ct[b].dof[u] >= 0 && cl_of_dof(r, r->tp.ct[b].dof[u]) == c)
                         G += side_sigma(r, b, u) * z[y];
             }
-            double term = sa * (G / r->cmu[c]);
+            double term = sa * (G / r->ev.cmu[c]);
             sum += term;
             sc += fabs(term);
         }
@@ -1628,8 +1628,8 @@ static void reduced_residual(const pd_edr *r, const int *idx, int k, const doubl
 static int refine_reduced(pd_edr *r, const int *idx, int k, const double *D, const double *q,
                           double *z)
 {
-    double *res = r->rtmp, *scale = res + k, *zt = scale + k, *dz = zt + k;
-    int *ax = r->lu_perm + k, na = 0, trig = 0;
+    double *res = r->ev.rtmp, *scale = res + k, *zt = scale + k, *dz = zt + k;
+    int *ax = r->ev.lu_perm + k, na = 0, trig = 0;
     /* A = {z > 0}, the pushing contacts (ax); refined only when some r_A
      * exceeds EDR_REFINE_TOL roundings of its terms */
     reduced_residual(r, idx, k, q, z, res, scale);
@@ -1643,8 +1643,8 @@ static int refine_reduced(pd_edr *r, const int *idx, int k, const double *D, con
     /* D_AA, LU-factored (singular: Lemke's z stays) */
     for (int i = 0; i < na; i++)
         for (int j = 0; j < na; j++)
-            r->Dlu[i + (size_t)j * na] = D[ax[i] + (size_t)ax[j] * k];
-    if (pd_dense_lu(na, r->Dlu, na, r->lu_perm, DBL_EPSILON))
+            r->ev.Dlu[i + (size_t)j * na] = D[ax[i] + (size_t)ax[j] * k];
+    if (pd_dense_lu(na, r->ev.Dlu, na, r->ev.lu_perm, DBL_EPSILON))
         return 0;
     double norm = 0.0;
     for (int i = 0; i < na; i++)
@@ -1655,7 +1655,7 @@ static int refine_reduced(pd_edr *r, const int *idx, int k, const double *D, con
     for (int it = 0; it < EDR_REFINE_MAX && norm > 0.0; it++) {
         for (int i = 0; i < na; i++)
             dz[i] = -res[ax[i]];
-        pd_dense_lu_solve(na, r->Dlu, na, r->lu_perm, dz);
+        pd_dense_lu_solve(na, r->ev.Dlu, na, r->ev.lu_perm, dz);
         int ok = 1;
         memcpy(zt, z, (size_t)k * sizeof(double));
         for (int i = 0; i < na; i++)
@@ -1689,21 +1689,21 @@ typedef struct stage_set {
  * the group holds a modal cluster (no one coordinate). */
 static int reduced_begin(pd_edr *r, double t, int *ne)
 {
-    for (int i = 0; i < r->ng; i++) {
-        edr_cluster *cl = &r->cl[r->g_cl[i]];
+    for (int i = 0; i < r->ev.ng; i++) {
+        edr_cluster *cl = &r->rs.cl[r->ev.g_cl[i]];
         if (cl->kind == EDR_MODAL)
             return 1;
-        edr_cluster_eval(r, r->g_cl[i], t); /* (the measurements moved the cache) */
-        r->ceta[r->g_cl[i]] = cl->kind == EDR_SDOF ? cl->vy : 0.0;
-        r->cvy[r->g_cl[i]] = r->ceta[r->g_cl[i]];
-        r->cmu[r->g_cl[i]] = cl->mass;
+        edr_cluster_eval(r, r->ev.g_cl[i], t); /* (the measurements moved the cache) */
+        r->ev.ceta[r->ev.g_cl[i]] = cl->kind == EDR_SDOF ? cl->vy : 0.0;
+        r->ev.cvy[r->ev.g_cl[i]] = r->ev.ceta[r->ev.g_cl[i]];
+        r->ev.cmu[r->ev.g_cl[i]] = cl->mass;
     }
     /* the open ones: a persistent or locked contact lies inside a cluster
      * and moves with it (a tree edge's impulse follows from the balance) */
     *ne = 0;
-    for (int j = 0; j < r->ngc; j++)
-        if (r->cstate[r->g_ct[j]] == EDR_OPEN)
-            r->epos[(*ne)++] = j;
+    for (int j = 0; j < r->ev.ngc; j++)
+        if (r->rs.cstate[r->ev.g_ct[j]] == EDR_OPEN)
+            r->ev.epos[(*ne)++] = j;
     return 0;
 }
 
@@ -1712,31 +1712,31 @@ static int reduced_begin(pd_edr *r, double t, int *ne)
  * coordinates; 1 when they exceed EDR_REDUCED_MAX. */
 static int reduced_stage_set(pd_edr *r, int ne, double tolU, int single, stage_set *set)
 {
-    int *idx = r->lcp_idx;
-    double *q = r->qlcp;
+    int *idx = r->ev.lcp_idx;
+    double *q = r->ev.qlcp;
     *set = (stage_set){.k = 0, .closing = 0, .pressing = 0, .all = 0};
     for (int e = 0; e < ne; e++) {
-        int j = r->epos[e], a = r->g_ct[j];
+        int j = r->ev.epos[e], a = r->ev.g_ct[j];
         double U = 0.0;
         for (int s = 0; s < 2; s++)
-            if (r->ct[a].dof[s] >= 0)
-                U += side_sigma(r, a, s) * r->ceta[cl_of_dof(r, r->ct[a].dof[s])];
+            if (r->tp.ct[a].dof[s] >= 0)
+                U += side_sigma(r, a, s) * r->ev.ceta[cl_of_dof(r, r->tp.ct[a].dof[s])];
         if (fabs(U) <= tolU) /* a rate at the rounding of the event's speeds is zero */
             U = 0.0;
         if (!movable(r, a)) { /* held still on both sides */
-            r->jpos[j] = -1;
+            r->ev.jpos[j] = -1;
             continue;
         }
         set->all++;
         if (U > 0.0 && !single) { /* separating (staged) */
-            r->jpos[j] = -1;
+            r->ev.jpos[j] = -1;
             continue;
         }
         if (set->k >= EDR_REDUCED_MAX)
             return 1;
         set->closing += U < 0.0;
         set->pressing += U <= 0.0;
-        r->jpos[j] = set->k;
+        r->ev.jpos[j] = set->k;
         idx[set->k] = j;
         /* Newton's law: w = U+ + e min(U-, 0) = D P + q */
         q[set->k++] = U + stage_e(r, j) * fmin(U, 0.0);
@@ -1751,38 +1751,38 @@ static void reduced_delassus(pd_edr *r, const int *idx, int k, double *D)
 {
     for (int x = 0; x < k; x++)
         for (int y = 0; y < k; y++) {
-            int a = r->g_ct[idx[x]], b = r->g_ct[idx[y]];
+            int a = r->ev.g_ct[idx[x]], b = r->ev.g_ct[idx[y]];
             double dxy = 0.0;
             for (int s = 0; s < 2; s++)
                 for (int u = 0; u < 2; u++) {
-                    int da = r->ct[a].dof[s], db = r->ct[b].dof[u];
+                    int da = r->tp.ct[a].dof[s], db = r->tp.ct[b].dof[u];
                     if (da < 0 || db < 0 || cl_of_dof(r, da) != cl_of_dof(r, db))
                         continue;
                     /* a REST side (sigma = 0: held still) takes no share */
                     double sa = side_sigma(r, a, s), sb = side_sigma(r, b, u);
                     if (sa != 0.0 && sb != 0.0)
-                        dxy += sa * sb / r->cmu[cl_of_dof(r, da)];
+                        dxy += sa * sb / r->ev.cmu[cl_of_dof(r, da)];
                 }
             D[x + (size_t)y * k] = dxy;
         }
 }
 
-/* The stage's impulses z (r->lam) from w = D z + q >= 0 _|_ z >= 0: the
+/* The stage's impulses z (r->ev.lam) from w = D z + q >= 0 _|_ z >= 0: the
  * closed form for one contact, else the small dense LCP, refined on the
  * residual formed without D (*refined: 1 when it was). */
 static int reduced_solve(pd_edr *r, const int *idx, int k, double t, int *refined, pd_err *err)
 {
-    double *q = r->qlcp, *z = r->lam, *D = r->Dd;
+    double *q = r->ev.qlcp, *z = r->ev.lam, *D = r->ev.Dd;
     *refined = 0;
-    r->res.lcp_solves++;
+    r->rs.res.lcp_solves++;
     if (k == 1) {
         z[0] = pd_contact_impulse_1(D[0], q[0]);
         return PD_OK;
     }
-    int rc = small_lcp(r, k, D, q, z, r->ztmp);
+    int rc = small_lcp(r, k, D, q, z, r->ev.ztmp);
     if (rc)
         return pd_err_set(err, rc, "row reference: the impact LCP of %d contacts at t = %.9g s "
-                          "was not solved", k, t * r->o.time_unit);
+                          "was not solved", k, t * r->tp.o.time_unit);
     *refined = refine_reduced(r, idx, k, D, q, z);
     return PD_OK;
 }
@@ -1793,38 +1793,38 @@ static int reduced_solve(pd_edr *r, const int *idx, int k, double t, int *refine
  * refined on); the totals P and the impacts (stages where it closed). */
 static void reduced_apply(pd_edr *r, const int *idx, int k, int refined)
 {
-    const double *q = r->qlcp, *z = r->lam;
+    const double *q = r->ev.qlcp, *z = r->ev.lam;
     if (refined)
         for (int x = 0; x < k; x++) {
-            int a = r->g_ct[idx[x]];
+            int a = r->ev.g_ct[idx[x]];
             for (int s = 0; s < 2; s++)
-                if (r->ct[a].dof[s] >= 0)
-                    r->cG[cl_of_dof(r, r->ct[a].dof[s])] = 0.0;
+                if (r->tp.ct[a].dof[s] >= 0)
+                    r->ev.cG[cl_of_dof(r, r->tp.ct[a].dof[s])] = 0.0;
         }
     for (int x = 0; x < k; x++) {
-        int j = idx[x], a = r->g_ct[j];
+        int j = idx[x], a = r->ev.g_ct[j];
         for (int s = 0; s < 2; s++)
-            if (r->ct[a].dof[s] >= 0) {
-                int c = cl_of_dof(r, r->ct[a].dof[s]);
-                if (r->cl[c].kind != EDR_SDOF) /* held still: no coordinate to move */
+            if (r->tp.ct[a].dof[s] >= 0) {
+                int c = cl_of_dof(r, r->tp.ct[a].dof[s]);
+                if (r->rs.cl[c].kind != EDR_SDOF) /* held still: no coordinate to move */
                     continue;
                 if (refined)
-                    r->cG[c] += side_sigma(r, a, s) * z[x];
+                    r->ev.cG[c] += side_sigma(r, a, s) * z[x];
                 else
-                    r->ceta[c] += side_sigma(r, a, s) * z[x] / r->cmu[c];
+                    r->ev.ceta[c] += side_sigma(r, a, s) * z[x] / r->ev.cmu[c];
             }
-        r->P[j] += z[x];
-        r->nimp[j] += q[x] < 0.0;
+        r->ev.P[j] += z[x];
+        r->ev.nimp[j] += q[x] < 0.0;
     }
     /* each cluster's G_c added once (cG zeroed after its first visit) */
     for (int x = 0; x < k && refined; x++) {
-        int a = r->g_ct[idx[x]];
+        int a = r->ev.g_ct[idx[x]];
         for (int s = 0; s < 2; s++)
-            if (r->ct[a].dof[s] >= 0) {
-                int c = cl_of_dof(r, r->ct[a].dof[s]);
-                if (r->cl[c].kind == EDR_SDOF)
-                    r->ceta[c] += r->cG[c] / r->cmu[c];
-                r->cG[c] = 0.0;
+            if (r->tp.ct[a].dof[s] >= 0) {
+                int c = cl_of_dof(r, r->tp.ct[a].dof[s]);
+                if (r->rs.cl[c].kind == EDR_SDOF)
+                    r->ev.ceta[c] += r->ev.cG[c] / r->ev.cmu[c];
+                r->ev.cG[c] = 0.0;
             }
     }
 }
@@ -1835,45 +1835,45 @@ static void reduced_apply(pd_edr *r, const int *idx, int k, int refined)
  * (s_c w_c).  1 when one would pull (P_e < 0 beyond rounding). */
 static int held_edge_impulses(pd_edr *r, int ne)
 {
-    for (int k = 0; k < r->ngd; k++) {
-        int i = r->g_dof[k];
-        r->ext[i] = 0.0;
+    for (int k = 0; k < r->ev.ngd; k++) {
+        int i = r->ev.g_dof[k];
+        r->ev.ext[i] = 0.0;
     }
     for (int e = 0; e < ne; e++) { /* ext = W_E P_E over the contacts between clusters */
-        int j = r->epos[e], a = r->g_ct[j];
+        int j = r->ev.epos[e], a = r->ev.g_ct[j];
         for (int s = 0; s < 2; s++)
-            if (r->ct[a].dof[s] >= 0)
-                r->ext[r->ct[a].dof[s]] += r->ct[a].w[s] * r->P[j];
+            if (r->tp.ct[a].dof[s] >= 0)
+                r->ev.ext[r->tp.ct[a].dof[s]] += r->tp.ct[a].w[s] * r->ev.P[j];
     }
-    for (int j = 0; j < r->ngc; j++)
-        r->jpos[j] = -1;
-    for (int j = 0; j < r->ngc; j++)
-        r->pos_in[r->g_ct[j]] = j;
-    for (int i = 0; i < r->ng; i++) {
-        int c = r->g_cl[i];
-        edr_cluster *cl = &r->cl[c];
+    for (int j = 0; j < r->ev.ngc; j++)
+        r->ev.jpos[j] = -1;
+    for (int j = 0; j < r->ev.ngc; j++)
+        r->ev.pos_in[r->ev.g_ct[j]] = j;
+    for (int i = 0; i < r->ev.ng; i++) {
+        int c = r->ev.g_cl[i];
+        edr_cluster *cl = &r->rs.cl[c];
         if (cl->npers == 0)
             continue;
         int nn = 0;
-        for (int d = cl->root; d >= 0; d = r->bfs_next[d]) /* the tree breadth first */
-            r->stack[nn++] = d;
-        double deta = r->ceta[c] - r->cvy[c];
+        for (int d = cl->root; d >= 0; d = r->ev.bfs_next[d]) /* the tree breadth first */
+            r->ev.stack[nn++] = d;
+        double deta = r->ev.ceta[c] - r->ev.cvy[c];
         /* each dof's unbalanced impulse, s_i (m_i dv_i - ext_i), dv_i = s_i deta */
         for (int k = 0; k < nn; k++) {
-            int d = r->stack[k];
-            r->gtmp[d] = r->s[d] * (r->s[d] * deta / r->minv[d] - r->ext[d]);
+            int d = r->ev.stack[k];
+            r->ev.gtmp[d] = r->rs.s[d] * (r->rs.s[d] * deta / r->tp.minv[d] - r->ev.ext[d]);
         }
         for (int k = nn - 1; k >= 0; k--) { /* children before their parents */
-            int d = r->stack[k], e = r->pe[d];
-            if (r->pdof[d] >= 0)
-                r->gtmp[r->pdof[d]] += r->gtmp[d];
+            int d = r->ev.stack[k], e = r->ev.pe[d];
+            if (r->ev.pdof[d] >= 0)
+                r->ev.gtmp[r->ev.pdof[d]] += r->ev.gtmp[d];
             if (e < 0)
                 continue;
-            const edr_contact *ct = &r->ct[e];
-            double Pe = r->gtmp[d] / (r->s[d] * ct->w[ct->dof[0] == d ? 0 : 1]);
-            if (Pe < -EDR_RATE_TOL * (fabs(r->gtmp[d]) + fabs(r->ext[d])) - 1e-300)
+            const edr_contact *ct = &r->tp.ct[e];
+            double Pe = r->ev.gtmp[d] / (r->rs.s[d] * ct->w[ct->dof[0] == d ? 0 : 1]);
+            if (Pe < -EDR_RATE_TOL * (fabs(r->ev.gtmp[d]) + fabs(r->ev.ext[d])) - 1e-300)
                 return 1; /* a held contact would pull */
-            r->P[r->pos_in[e]] = fmax(Pe, 0.0);
+            r->ev.P[r->ev.pos_in[e]] = fmax(Pe, 0.0);
         }
     }
     return 0;
@@ -1889,7 +1889,7 @@ static int held_edge_impulses(pd_edr *r, int ne)
  * solver takes — then the dof-level stages run instead. */
 static int impact_reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
 {
-    int rc, stage = 0, ne, *idx = r->lcp_idx, single = r->o.impact_law == PD_IMPACT_SINGLE;
+    int rc, stage = 0, ne, *idx = r->ev.lcp_idx, single = r->tp.o.impact_law == PD_IMPACT_SINGLE;
     if (reduced_begin(r, t, &ne))
         return 1;
     for (;;) {
@@ -1899,16 +1899,16 @@ static int impact_reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
         if (!set.closing) /* every closed contact at rest or separating: the impact is over */
             break;
         int k = set.k, refined;
-        r->law_multi |= stage == 0 && set.all > 1;
+        r->ev.law_multi |= stage == 0 && set.all > 1;
         if (single)
-            single_law_zero(r->qlcp, k);
+            single_law_zero(r->ev.qlcp, k);
         if (++stage > EDR_STAGES)
             return pd_err_set(err, PD_EBUDGET, "row reference: the impact at t = %.17g s did not "
-                              "end in %d stages", t * r->o.time_unit, EDR_STAGES);
-        reduced_delassus(r, idx, k, r->Dd);
+                              "end in %d stages", t * r->tp.o.time_unit, EDR_STAGES);
+        reduced_delassus(r, idx, k, r->ev.Dd);
         if ((rc = reduced_solve(r, idx, k, t, &refined, err)))
             return rc;
-        r->res.simultaneous += set.pressing > 1;
+        r->rs.res.simultaneous += set.pressing > 1;
         reduced_apply(r, idx, k, refined);
         /* the single law: one LCP, no further stage */
         if (single)
@@ -1917,9 +1917,9 @@ static int impact_reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
     if (held_edge_impulses(r, ne))
         return 1;
     /* the dofs' rates from their trees: v_i = s_i eta_c (0 held still) */
-    for (int k = 0; k < r->ngd; k++) {
-        int i = r->g_dof[k], c = cl_of_dof(r, i);
-        r->gv[i] = r->cl[c].kind == EDR_SDOF ? r->s[i] * r->ceta[c] : 0.0;
+    for (int k = 0; k < r->ev.ngd; k++) {
+        int i = r->ev.g_dof[k], c = cl_of_dof(r, i);
+        r->ev.gv[i] = r->rs.cl[c].kind == EDR_SDOF ? r->rs.s[i] * r->ev.ceta[c] : 0.0;
     }
     return PD_OK;
 }
@@ -1929,18 +1929,18 @@ static int impact_reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
  * ceta, mu_c into cmu.  1 when the group holds a modal cluster. */
 static int reduced_free_acc(pd_edr *r)
 {
-    for (int i = 0; i < r->ng; i++) {
-        int c = r->g_cl[i];
-        edr_cluster *cl = &r->cl[c];
+    for (int i = 0; i < r->ev.ng; i++) {
+        int c = r->ev.g_cl[i];
+        edr_cluster *cl = &r->rs.cl[c];
         if (cl->kind == EDR_MODAL)
             return 1;
         double phi = 0.0;
-        for (int b = cl->head; b >= 0 && cl->kind == EDR_SDOF; b = r->blk_next[b]) {
-            int d = r->blk_dofs[r->blk[b].first];
-            phi += r->s[d] * r->gacc[d] / r->minv[d];
+        for (int b = cl->head; b >= 0 && cl->kind == EDR_SDOF; b = r->rs.blk_next[b]) {
+            int d = r->tp.blk_dofs[r->tp.blk[b].first];
+            phi += r->rs.s[d] * r->ev.gacc[d] / r->tp.minv[d];
         }
-        r->cmu[c] = cl->mass;
-        r->ceta[c] = cl->kind == EDR_SDOF ? phi / cl->mass : 0.0; /* alpha_c, free */
+        r->ev.cmu[c] = cl->mass;
+        r->ev.ceta[c] = cl->kind == EDR_SDOF ? phi / cl->mass : 0.0; /* alpha_c, free */
     }
     return 0;
 }
@@ -1953,11 +1953,11 @@ static int reduced_force_unknowns(pd_edr *r, const int *idx, int k, int *ux)
 {
     int ku = 0;
     for (int x = 0; x < k; x++) {
-        const edr_contact *ct = &r->ct[idx[x]];
+        const edr_contact *ct = &r->tp.ct[idx[x]];
         int internal = ct->dof[0] >= 0 && ct->dof[1] >= 0 &&
                        cl_of_dof(r, ct->dof[0]) == cl_of_dof(r, ct->dof[1]);
-        r->lam[x] = 0.0;
-        if (r->cstate[idx[x]] == EDR_OPEN && !internal && movable(r, idx[x])) {
+        r->ev.lam[x] = 0.0;
+        if (r->rs.cstate[idx[x]] == EDR_OPEN && !internal && movable(r, idx[x])) {
             if (ku >= EDR_REDUCED_MAX)
                 return -1;
             ux[ku++] = x;
@@ -1978,18 +1978,18 @@ static void reduced_force_data(pd_edr *r, const int *idx, const int *ux, int ku,
          * unknowns' forces */
         q[x] = 0.0;
         for (int s = 0; s < 2; s++)
-            if (r->ct[a].dof[s] >= 0)
-                q[x] += side_sigma(r, a, s) * r->ceta[cl_of_dof(r, r->ct[a].dof[s])];
+            if (r->tp.ct[a].dof[s] >= 0)
+                q[x] += side_sigma(r, a, s) * r->ev.ceta[cl_of_dof(r, r->tp.ct[a].dof[s])];
         for (int y = 0; y < ku; y++) {
             int b = idx[ux[y]];
             /* D_xy = sum over the SDOF trees x and y share of sigma_xc sigma_yc / mu_c */
             double dxy = 0.0;
             for (int s = 0; s < 2; s++)
                 for (int u = 0; u < 2; u++) {
-                    int da = r->ct[a].dof[s], db = r->ct[b].dof[u];
+                    int da = r->tp.ct[a].dof[s], db = r->tp.ct[b].dof[u];
                     if (da >= 0 && db >= 0 && cl_of_dof(r, da) == cl_of_dof(r, db) &&
-                        r->cl[cl_of_dof(r, da)].kind == EDR_SDOF)
-                        dxy += side_sigma(r, a, s) * side_sigma(r, b, u) / r->cmu[cl_of_dof(r, da)];
+                        r->rs.cl[cl_of_dof(r, da)].kind == EDR_SDOF)
+                        dxy += side_sigma(r, a, s) * side_sigma(r, b, u) / r->ev.cmu[cl_of_dof(r, da)];
                 }
             D[x + (size_t)y * ku] = dxy;
         }
@@ -2004,48 +2004,48 @@ static void reduced_force_data(pd_edr *r, const int *idx, const int *ux, int ku,
 static int held_edge_forces(pd_edr *r, const int *idx, int k, const int *ux, int ku,
                             const double *z)
 {
-    for (int k2 = 0; k2 < r->ngd; k2++)
-        r->ext[r->g_dof[k2]] = 0.0;
+    for (int k2 = 0; k2 < r->ev.ngd; k2++)
+        r->ev.ext[r->ev.g_dof[k2]] = 0.0;
     /* ext = W_U lambda_U: the unknowns' forces on the dofs */
     for (int x = 0; x < ku; x++) {
         int a = idx[ux[x]];
         for (int s = 0; s < 2; s++)
-            if (r->ct[a].dof[s] >= 0)
-                r->ext[r->ct[a].dof[s]] += r->ct[a].w[s] * z[x];
+            if (r->tp.ct[a].dof[s] >= 0)
+                r->ev.ext[r->tp.ct[a].dof[s]] += r->tp.ct[a].w[s] * z[x];
     }
     for (int x = 0; x < k; x++)
-        r->pos_in[idx[x]] = x;
-    for (int i = 0; i < r->ng; i++) {
-        int c = r->g_cl[i];
-        edr_cluster *cl = &r->cl[c];
+        r->ev.pos_in[idx[x]] = x;
+    for (int i = 0; i < r->ev.ng; i++) {
+        int c = r->ev.g_cl[i];
+        edr_cluster *cl = &r->rs.cl[c];
         if (cl->npers == 0)
             continue;
         int nn = 0;
-        for (int d = cl->root; d >= 0; d = r->bfs_next[d])
-            r->stack[nn++] = d;
+        for (int d = cl->root; d >= 0; d = r->ev.bfs_next[d])
+            r->ev.stack[nn++] = d;
         for (int x = 0; x < nn; x++) {
-            int d = r->stack[x];
+            int d = r->ev.stack[x];
             /* each dof's unbalanced force s_i (m_i a_i - F_i - ext_i) with
              * a_i = s_i alpha_c, F_i = m_i a_free_i; wk its terms' magnitudes */
-            double m = 1.0 / r->minv[d], a = r->s[d] * r->ceta[c];
-            r->gtmp[d] = r->s[d] * (m * a - m * r->gacc[d] - r->ext[d]);
-            r->wk[d] = fabs(m * a) + fabs(m * r->gacc[d]) + fabs(r->ext[d]);
+            double m = 1.0 / r->tp.minv[d], a = r->rs.s[d] * r->ev.ceta[c];
+            r->ev.gtmp[d] = r->rs.s[d] * (m * a - m * r->ev.gacc[d] - r->ev.ext[d]);
+            r->ev.wk[d] = fabs(m * a) + fabs(m * r->ev.gacc[d]) + fabs(r->ev.ext[d]);
         }
         for (int x = nn - 1; x >= 0; x--) { /* children before their parents */
-            int d = r->stack[x], e = r->pe[d];
-            if (r->pdof[d] >= 0) {
-                r->gtmp[r->pdof[d]] += r->gtmp[d];
-                r->wk[r->pdof[d]] += r->wk[d];
+            int d = r->ev.stack[x], e = r->ev.pe[d];
+            if (r->ev.pdof[d] >= 0) {
+                r->ev.gtmp[r->ev.pdof[d]] += r->ev.gtmp[d];
+                r->ev.wk[r->ev.pdof[d]] += r->ev.wk[d];
             }
             if (e < 0)
                 continue;
-            const edr_contact *ct = &r->ct[e];
-            double le = r->gtmp[d] / (r->s[d] * ct->w[ct->dof[0] == d ? 0 : 1]);
-            if (le < -EDR_RATE_TOL * r->wk[d])
+            const edr_contact *ct = &r->tp.ct[e];
+            double le = r->ev.gtmp[d] / (r->rs.s[d] * ct->w[ct->dof[0] == d ? 0 : 1]);
+            if (le < -EDR_RATE_TOL * r->ev.wk[d])
                 return 1; /* a held contact would pull: it leaves */
             /* the edge's force goes to lam when the edge is one of J */
-            if (r->ct_mark[e] == r->epoch && r->pos_in[e] < k && idx[r->pos_in[e]] == e)
-                r->lam[r->pos_in[e]] = le;
+            if (r->ev.ct_mark[e] == r->ev.epoch && r->ev.pos_in[e] < k && idx[r->ev.pos_in[e]] == e)
+                r->ev.lam[r->ev.pos_in[e]] = le;
         }
     }
     return 0;
@@ -2061,8 +2061,8 @@ static int held_edge_forces(pd_edr *r, const int *idx, int k, const int *ux, int
  * LCP is too large for the dense solver. */
 static int reduced_force(pd_edr *r, const int *idx, int k, double t, pd_err *err)
 {
-    int ku, *ux = r->epos;
-    double *q = r->qtmp, *z = r->ztmp, *D = r->Dd;
+    int ku, *ux = r->ev.epos;
+    double *q = r->ev.qtmp, *z = r->ev.ztmp, *D = r->ev.Dd;
     if (reduced_free_acc(r) || (ku = reduced_force_unknowns(r, idx, k, ux)) < 0)
         return 1;
     reduced_force_data(r, idx, ux, ku, q, D);
@@ -2072,32 +2072,32 @@ static int reduced_force(pd_edr *r, const int *idx, int k, double t, pd_err *err
         z[0] = D[0] > 0.0 ? pd_contact_impulse_1(D[0], q[0]) : (q[0] >= 0.0 ? 0.0 : -1.0);
         if (z[0] < 0.0)
             return 1; /* held still on both sides and pressed: let the dofs decide */
-        r->res.lcp_solves++;
+        r->rs.res.lcp_solves++;
     } else if (ku > 1) {
-        r->res.lcp_solves++;
-        if (small_lcp(r, ku, D, q, z, r->wtmp))
+        r->rs.res.lcp_solves++;
+        if (small_lcp(r, ku, D, q, z, r->ev.wtmp))
             return 1;
     }
     /* alpha_c with the unknowns' forces: += sum_x sigma_xc lambda_x / mu_c */
     for (int x = 0; x < ku; x++) {
         int a = idx[ux[x]];
-        r->lam[ux[x]] = z[x];
+        r->ev.lam[ux[x]] = z[x];
         for (int s = 0; s < 2; s++)
-            if (r->ct[a].dof[s] >= 0) {
-                int c = cl_of_dof(r, r->ct[a].dof[s]);
-                if (r->cl[c].kind == EDR_SDOF)
-                    r->ceta[c] += side_sigma(r, a, s) * z[x] / r->cmu[c];
+            if (r->tp.ct[a].dof[s] >= 0) {
+                int c = cl_of_dof(r, r->tp.ct[a].dof[s]);
+                if (r->rs.cl[c].kind == EDR_SDOF)
+                    r->ev.ceta[c] += side_sigma(r, a, s) * z[x] / r->ev.cmu[c];
             }
     }
     if (held_edge_forces(r, idx, k, ux, ku, z))
         return 1;
-    for (int j = 0; j < r->ngc; j++) { /* gap accelerations of every closed contact */
-        int a = r->g_ct[j];
+    for (int j = 0; j < r->ev.ngc; j++) { /* gap accelerations of every closed contact */
+        int a = r->ev.g_ct[j];
         double w = 0.0;
         for (int s = 0; s < 2; s++)
-            if (r->ct[a].dof[s] >= 0)
-                w += side_sigma(r, a, s) * r->ceta[cl_of_dof(r, r->ct[a].dof[s])];
-        r->wlcp[j] = w;
+            if (r->tp.ct[a].dof[s] >= 0)
+                w += side_sigma(r, a, s) * r->ev.ceta[cl_of_dof(r, r->tp.ct[a].dof[s])];
+        r->ev.wlcp[j] = w;
     }
     (void)t;
     (void)err;
@@ -2114,32 +2114,32 @@ static int check_work(pd_edr *r, double t, pd_err *err)
     double dK = 0.0, tol = 0.0, K = 0.0;
     /* the single law: an impulse that stops a separating contact (U- > 0 to
      * U+ = 0) does the work 1/2 P U-, allowed */
-    if (r->o.impact_law == PD_IMPACT_SINGLE)
-        for (int j = 0; j < r->ngc; j++)
-            if (r->Uminus[j] > 0.0)
-                dK -= 0.5 * r->P[j] * r->Uminus[j];
-    for (int k = 0; k < r->ngd; k++)
-        r->gtmp[r->g_dof[k]] = 0.0;
+    if (r->tp.o.impact_law == PD_IMPACT_SINGLE)
+        for (int j = 0; j < r->ev.ngc; j++)
+            if (r->ev.Uminus[j] > 0.0)
+                dK -= 0.5 * r->ev.P[j] * r->ev.Uminus[j];
+    for (int k = 0; k < r->ev.ngd; k++)
+        r->ev.gtmp[r->ev.g_dof[k]] = 0.0;
     /* gtmp_i = sum |w P| over the contacts at dof i: the impulses' size */
-    for (int j = 0; j < r->ngc; j++) {
-        const edr_contact *ct = &r->ct[r->g_ct[j]];
+    for (int j = 0; j < r->ev.ngc; j++) {
+        const edr_contact *ct = &r->tp.ct[r->ev.g_ct[j]];
         for (int s = 0; s < 2; s++)
             if (ct->dof[s] >= 0)
-                r->gtmp[ct->dof[s]] += fabs(ct->w[s] * r->P[j]);
+                r->ev.gtmp[ct->dof[s]] += fabs(ct->w[s] * r->ev.P[j]);
     }
-    for (int k = 0; k < r->ngd; k++) {
-        int i = r->g_dof[k];
-        double m = 1.0 / r->minv[i], vm = r->ev_vminus[k], vp = r->gv[i];
+    for (int k = 0; k < r->ev.ngd; k++) {
+        int i = r->ev.g_dof[k];
+        double m = 1.0 / r->tp.minv[i], vm = r->ev.ev_vminus[k], vp = r->ev.gv[i];
         /* 1/2 m (v+^2 - v-^2) factored: no cancellation of two large squares */
         dK += 0.5 * m * (vp - vm) * (vp + vm);
-        tol += (fabs(vp) + fabs(vm)) * (m * fabs(vm) + r->gtmp[i]);
+        tol += (fabs(vp) + fabs(vm)) * (m * fabs(vm) + r->ev.gtmp[i]);
         K += 0.5 * m * vm * vm;
     }
     if (dK <= EDR_WORK_TOL * DBL_EPSILON * tol)
         return PD_OK;
     return pd_err_set(err, PD_ENUMERICAL, "row reference: the impact at t = %.17g s adds %.3g of "
                       "its kinetic energy (rounding allows %.3g): the impact LCP lost precision",
-                      t * r->o.time_unit, dK / K, EDR_WORK_TOL * DBL_EPSILON * tol / K);
+                      t * r->tp.o.time_unit, dK / K, EDR_WORK_TOL * DBL_EPSILON * tol / K);
 }
 
 /* Resolve the group at t: impact LCP if a contact closes, persistence,
@@ -2151,79 +2151,79 @@ static int impact_group(pd_edr *r, double t, pd_err *err)
      * their dofs' states at t */
     group_grow(r, t);
     group_state(r, t);
-    double tol = r->o.close_tol * r->L, vs = 0.0;
-    for (int j = 0; j < r->ngc; j++) { /* closed walls exactly at their gap */
-        const edr_contact *ct = &r->ct[r->g_ct[j]];
-        r->excluded[j] = 0;
+    double tol = r->tp.o.close_tol * r->rs.L, vs = 0.0;
+    for (int j = 0; j < r->ev.ngc; j++) { /* closed walls exactly at their gap */
+        const edr_contact *ct = &r->tp.ct[r->ev.g_ct[j]];
+        r->ev.excluded[j] = 0;
         if ((ct->dof[0] < 0) != (ct->dof[1] < 0)) {
             int s = ct->dof[0] >= 0 ? 0 : 1;
             /* x = -g0 / w: the wall's gap at zero to a rounding, taken within close_tol */
             double x = -ct->g0 / ct->w[s];
-            if (fabs(ct->g0 + ct->w[s] * r->gx[ct->dof[s]]) <= tol + fabs(ct->g0) * 1e-15)
-                r->gx[ct->dof[s]] = x;
+            if (fabs(ct->g0 + ct->w[s] * r->ev.gx[ct->dof[s]]) <= tol + fabs(ct->g0) * 1e-15)
+                r->ev.gx[ct->dof[s]] = x;
         }
     }
     /* the event's speed scale; v- kept for the work check and the report */
-    for (int k = 0; k < r->ngd; k++) {
-        vs = fmax(vs, fabs(r->gv[r->g_dof[k]]));
-        r->ev_vminus[k] = r->gv[r->g_dof[k]];
+    for (int k = 0; k < r->ev.ngd; k++) {
+        vs = fmax(vs, fabs(r->ev.gv[r->ev.g_dof[k]]));
+        r->ev.ev_vminus[k] = r->ev.gv[r->ev.g_dof[k]];
     }
-    r->vscale = fmax(r->vscale, vs);
-    double tolU = EDR_RATE_TOL * fmax(vs, r->vscale);
-    for (int j = 0; j < r->ngc; j++) {
+    r->rs.vscale = fmax(r->rs.vscale, vs);
+    double tolU = EDR_RATE_TOL * fmax(vs, r->rs.vscale);
+    for (int j = 0; j < r->ev.ngc; j++) {
         /* U- = W^T v-, zero at the rounding level of the speeds */
-        double U = contact_dot(r, r->g_ct[j], r->gv);
-        r->Uminus[j] = fabs(U) <= tolU ? 0.0 : U;
-        r->P[j] = 0.0;
+        double U = contact_dot(r, r->ev.g_ct[j], r->ev.gv);
+        r->ev.Uminus[j] = fabs(U) <= tolU ? 0.0 : U;
+        r->ev.P[j] = 0.0;
     }
-    for (int j = 0; j < r->ngc; j++)
-        r->nimp[j] = 0;
-    r->instant_acc = 0;
-    r->law_multi = 0;
+    for (int j = 0; j < r->ev.ngc; j++)
+        r->ev.nimp[j] = 0;
+    r->ev.instant_acc = 0;
+    r->ev.law_multi = 0;
     /* the stages on the clusters' coordinates when they can (held trees move
      * rigidly: only the contacts between clusters are unknowns) */
     rc = impact_reduced_stages(r, t, tolU, err);
     if (rc == 1) { /* on the dofs: back to the rates before the impact */
-        for (int k = 0; k < r->ngd; k++)
-            r->gv[r->g_dof[k]] = r->ev_vminus[k];
-        for (int j = 0; j < r->ngc; j++) {
-            r->P[j] = 0.0;
-            r->nimp[j] = 0;
+        for (int k = 0; k < r->ev.ngd; k++)
+            r->ev.gv[r->ev.g_dof[k]] = r->ev.ev_vminus[k];
+        for (int j = 0; j < r->ev.ngc; j++) {
+            r->ev.P[j] = 0.0;
+            r->ev.nimp[j] = 0;
         }
-        r->instant_acc = 0;
+        r->ev.instant_acc = 0;
         rc = impact_stages(r, t, tolU, err);
     }
     /* an instant's accumulation (stage_e) and a law that decided count once each */
-    r->res.accumulations += r->instant_acc;
-    r->res.law_decided += r->law_multi;
+    r->rs.res.accumulations += r->ev.instant_acc;
+    r->rs.res.law_decided += r->ev.law_multi;
     if (rc || (rc = check_work(r, t, err)) || (rc = commit_impacts(r, t, err)))
         return rc;
-    for (int j = 0; j < r->ngc; j++) {
+    for (int j = 0; j < r->ev.ngc; j++) {
         /* U+ = W^T v+: a zero rate makes a contact a candidate to persist */
-        double U = contact_dot(r, r->g_ct[j], r->gv);
-        r->Uplus[j] = fabs(U) <= tolU ? 0.0 : U;
+        double U = contact_dot(r, r->ev.g_ct[j], r->ev.gv);
+        r->ev.Uplus[j] = fabs(U) <= tolU ? 0.0 : U;
     }
     if ((rc = decide_persistence(r, t, &acc, err)))
         return rc;
     if ((rc = regroup(r, t, err)))
         return rc;
     if (acc && !tails_hold(r)) { /* the tail would not hold: bounce on */
-        for (int j = 0; j < r->ngc; j++)
-            if (r->held_tail[j] > 0.0) {
-                r->held[j] = 0;
-                r->held_tail[j] = 0.0;
+        for (int j = 0; j < r->ev.ngc; j++)
+            if (r->ev.held_tail[j] > 0.0) {
+                r->ev.held[j] = 0;
+                r->ev.held_tail[j] = 0.0;
             }
         acc = 0;
         if ((rc = regroup(r, t, err)))
             return rc;
     }
     if (acc)
-        r->res.accumulations++;
+        r->rs.res.accumulations++;
     /* v+ as the new flights start: projected onto their held contacts */
-    for (int k = 0; k < r->ngd; k++)
-        r->gv[r->g_dof[k]] = r->vo[r->g_dof[k]];
+    for (int k = 0; k < r->ev.ngd; k++)
+        r->ev.gv[r->ev.g_dof[k]] = r->rs.vo[r->ev.g_dof[k]];
     if (report(r, t, PD_EDR_IMPACT, acc) > 0)
-        r->stopped = 1;
+        r->rs.stopped = 1;
     repredict(r, t);
     return PD_OK;
 }
@@ -2233,9 +2233,9 @@ static void group_begin(pd_edr *r)
 {
     /* a new epoch: every mark of the last group (cl_mark, ct_mark, ct_mark2)
      * is stale at once, with no clearing */
-    r->epoch++;
-    r->ng = 0;
-    r->ngc = 0;
+    r->ev.epoch++;
+    r->ev.ng = 0;
+    r->ev.ngc = 0;
 }
 
 /* Contact a closes at t: the group grows from it. */
@@ -2247,7 +2247,7 @@ static int on_impact(pd_edr *r, int a, double t, pd_err *err)
     /* the seed: the closing contact and its sides' clusters */
     group_begin(r);
     group_add_contact(r, a);
-    const edr_contact *ct = &r->ct[a];
+    const edr_contact *ct = &r->tp.ct[a];
     for (int s = 0; s < 2; s++)
         if (ct->dof[s] >= 0)
             group_add_cluster(r, cl_of_dof(r, ct->dof[s]));
@@ -2258,51 +2258,51 @@ static int on_impact(pd_edr *r, int a, double t, pd_err *err)
  * without that contact decides again. */
 static int on_detach(pd_edr *r, int c, double t, pd_err *err)
 {
-    int rc, acc, a = r->cl[c].det_contact;
-    if ((rc = count_event(r, r->m + c, t, err)))
+    int rc, acc, a = r->rs.cl[c].det_contact;
+    if ((rc = count_event(r, r->tp.m + c, t, err)))
         return rc;
     /* the group: cluster c and its closed contacts (persistent or locked) */
     group_begin(r);
     group_add_cluster(r, c);
-    for (int b = r->cl[c].head; b >= 0; b = r->blk_next[b]) {
-        const edr_block *bk = &r->blk[b];
+    for (int b = r->rs.cl[c].head; b >= 0; b = r->rs.blk_next[b]) {
+        const edr_block *bk = &r->tp.blk[b];
         for (int k = 0; k < bk->ncont; k++) {
-            int x = r->blk_cont[bk->cont0 + k];
-            if (r->cstate[x] != EDR_OPEN && r->ct_mark[x] != r->epoch)
+            int x = r->tp.blk_cont[bk->cont0 + k];
+            if (r->rs.cstate[x] != EDR_OPEN && r->ev.ct_mark[x] != r->ev.epoch)
                 group_add_contact(r, x);
         }
     }
     group_state(r, t);
     /* no impact: v- is the state's v; U- = U+ = 0, P = 0 */
-    for (int k = 0; k < r->ngd; k++)
-        r->ev_vminus[k] = r->gv[r->g_dof[k]];
-    for (int j = 0; j < r->ngc; j++) {
-        r->Uminus[j] = r->Uplus[j] = 0.0;
-        r->P[j] = 0.0;
+    for (int k = 0; k < r->ev.ngd; k++)
+        r->ev.ev_vminus[k] = r->ev.gv[r->ev.g_dof[k]];
+    for (int j = 0; j < r->ev.ngc; j++) {
+        r->ev.Uminus[j] = r->ev.Uplus[j] = 0.0;
+        r->ev.P[j] = 0.0;
     }
-    for (int j = 0; j < r->ngc; j++)
+    for (int j = 0; j < r->ev.ngc; j++)
         /* the detaching contact leaves: the force LCP decides the others without it */
-        r->excluded[j] = r->g_ct[j] == a;
+        r->ev.excluded[j] = r->ev.g_ct[j] == a;
     if ((rc = decide_persistence(r, t, &acc, err)))
         return rc;
-    for (int j = 0; j < r->ngc; j++) {
-        r->excluded[j] = 0;
+    for (int j = 0; j < r->ev.ngc; j++) {
+        r->ev.excluded[j] = 0;
         /* a persistent contact not held any more: one detachment */
-        if (r->cstate[r->g_ct[j]] == EDR_PERSIST && !r->held[j])
-            r->res.detachments++;
+        if (r->rs.cstate[r->ev.g_ct[j]] == EDR_PERSIST && !r->ev.held[j])
+            r->rs.res.detachments++;
     }
     if ((rc = regroup(r, t, err)))
         return rc;
     /* a jumped accumulation whose tail would not hold: open again */
     if (acc && !tails_hold(r)) {
-        for (int j = 0; j < r->ngc; j++)
-            if (r->held_tail[j] > 0.0)
-                r->held[j] = 0;
+        for (int j = 0; j < r->ev.ngc; j++)
+            if (r->ev.held_tail[j] > 0.0)
+                r->ev.held[j] = 0;
         if ((rc = regroup(r, t, err)))
             return rc;
     }
     if (report(r, t, PD_EDR_DETACH, 0) > 0)
-        r->stopped = 1;
+        r->rs.stopped = 1;
     repredict(r, t);
     return PD_OK;
 }
@@ -2312,100 +2312,100 @@ static int on_detach(pd_edr *r, int c, double t, pd_err *err)
 static int on_piece(pd_edr *r, double t, pd_err *err)
 {
     int rc;
-    if ((rc = count_event(r, r->slot_piece, t, err)))
+    if ((rc = count_event(r, r->rs.slot_piece, t, err)))
         return rc;
-    r->piece = edr_piece_at(r, t);
+    r->rs.piece = edr_piece_at(r, t);
     /* the live clusters listed first: regroup frees and takes slots as it goes */
     int ncl = 0;
-    for (int c = 0; c < r->nb; c++)
-        if (r->cl[c].live)
-            r->plist[ncl++] = c;
+    for (int c = 0; c < r->tp.nb; c++)
+        if (r->rs.cl[c].live)
+            r->ev.plist[ncl++] = c;
     for (int i = 0; i < ncl; i++) {
-        int c = r->plist[i];
-        if (!r->cl[c].live || r->cl[c].t0 == t) /* gone, or started at t on the new piece */
+        int c = r->ev.plist[i];
+        if (!r->rs.cl[c].live || r->rs.cl[c].t0 == t) /* gone, or started at t on the new piece */
             continue;
-        edr_cluster *cl = &r->cl[c];
+        edr_cluster *cl = &r->rs.cl[c];
         /* the group: the cluster and its closed contacts (persistent or locked) */
         group_begin(r);
         group_add_cluster(r, c);
-        for (int b = cl->head; b >= 0; b = r->blk_next[b]) {
-            const edr_block *bk = &r->blk[b];
+        for (int b = cl->head; b >= 0; b = r->rs.blk_next[b]) {
+            const edr_block *bk = &r->tp.blk[b];
             for (int k = 0; k < bk->ncont; k++) {
-                int x = r->blk_cont[bk->cont0 + k];
-                if (r->cstate[x] != EDR_OPEN && r->ct_mark[x] != r->epoch)
+                int x = r->tp.blk_cont[bk->cont0 + k];
+                if (r->rs.cstate[x] != EDR_OPEN && r->ev.ct_mark[x] != r->ev.epoch)
                     group_add_contact(r, x);
             }
         }
         group_state(r, t);
-        for (int k = 0; k < r->ngd; k++)
-            r->ev_vminus[k] = r->gv[r->g_dof[k]];
+        for (int k = 0; k < r->ev.ngd; k++)
+            r->ev.ev_vminus[k] = r->ev.gv[r->ev.g_dof[k]];
         /* no impact: U- = U+ = P = 0 */
         int negative = 0;
-        for (int j = 0; j < r->ngc; j++) {
-            r->Uminus[j] = r->Uplus[j] = r->P[j] = 0.0;
-            r->excluded[j] = 0;
+        for (int j = 0; j < r->ev.ngc; j++) {
+            r->ev.Uminus[j] = r->ev.Uplus[j] = r->ev.P[j] = 0.0;
+            r->ev.excluded[j] = 0;
         }
-        if (r->ngc > 0) { /* the held forces under the new piece */
+        if (r->ev.ngc > 0) { /* the held forces under the new piece */
             free_accelerations(r, t);
             int k0 = 0;
-            for (int j = 0; j < r->ngc; j++)
-                r->lcp_idx[k0++] = r->g_ct[j];
-            if ((rc = force_lcp(r, r->lcp_idx, k0, t, err)))
+            for (int j = 0; j < r->ev.ngc; j++)
+                r->ev.lcp_idx[k0++] = r->ev.g_ct[j];
+            if ((rc = force_lcp(r, r->ev.lcp_idx, k0, t, err)))
                 return rc;
-            for (int j = 0; j < r->ngc; j++)
-                negative |= r->cstate[r->g_ct[j]] == EDR_PERSIST && !(r->lam[j] > 0.0);
+            for (int j = 0; j < r->ev.ngc; j++)
+                negative |= r->rs.cstate[r->ev.g_ct[j]] == EDR_PERSIST && !(r->ev.lam[j] > 0.0);
         }
         /* a held force negative under the new piece: persistence decided again */
         if (negative) {
             int acc;
             if ((rc = decide_persistence(r, t, &acc, err)))
                 return rc;
-            for (int j = 0; j < r->ngc; j++)
-                if (r->cstate[r->g_ct[j]] == EDR_PERSIST && !r->held[j])
-                    r->res.detachments++;
+            for (int j = 0; j < r->ev.ngc; j++)
+                if (r->rs.cstate[r->ev.g_ct[j]] == EDR_PERSIST && !r->ev.held[j])
+                    r->rs.res.detachments++;
         } else
             /* every closed contact stays held: the clusters re-origin on the piece */
-            for (int j = 0; j < r->ngc; j++) {
-                r->held[j] = r->cstate[r->g_ct[j]] != EDR_OPEN;
-                r->held_tail[j] = 0.0;
+            for (int j = 0; j < r->ev.ngc; j++) {
+                r->ev.held[j] = r->rs.cstate[r->ev.g_ct[j]] != EDR_OPEN;
+                r->ev.held_tail[j] = 0.0;
             }
         if ((rc = regroup(r, t, err)))
             return rc;
     }
     /* every contact and cluster predicts again: every flight changed with the piece */
-    for (int i = 0; i < r->m; i++)
+    for (int i = 0; i < r->tp.m; i++)
         predict_contact(r, i, t, 0);
-    for (int c = 0; c < r->nb; c++)
-        if (r->cl[c].live)
+    for (int c = 0; c < r->tp.nb; c++)
+        if (r->rs.cl[c].live)
             predict_detach(r, c, t, 0);
     /* the next piece change, if before t1 */
-    double next = edr_piece_end(r, r->piece);
-    q_set(&r->q, r->slot_piece, next < r->t1 ? next : HUGE_VAL);
+    double next = edr_piece_end(r, r->rs.piece);
+    q_set(&r->rs.q, r->rs.slot_piece, next < r->rs.t1 ? next : HUGE_VAL);
     return PD_OK;
 }
 
 /* The observer's state at t. */
 static int emit(pd_edr *r, double t, pd_observer obs, void *ctx)
 {
-    for (int i = 0; i < r->n; i++) {
+    for (int i = 0; i < r->tp.n; i++) {
         double a;
-        dof_state(r, i, t, &r->st.q[i], &r->st.v[i], &a);
-        r->st.acc[i] = a;
+        dof_state(r, i, t, &r->rs.st.q[i], &r->rs.st.v[i], &a);
+        r->rs.st.acc[i] = a;
     }
     /* the held forces' impulses up to t (a sampler only) */
-    for (int c = 0; r->sample_forces && c < r->nb; c++)
-        if (r->cl[c].live)
+    for (int c = 0; r->rs.sample_forces && c < r->tp.nb; c++)
+        if (r->rs.cl[c].live)
             integrate_held(r, c, t);
-    for (int a = 0; a < r->m; a++) {
-        r->st.g[a] = gap_now(r, a, t, NULL);
+    for (int a = 0; a < r->tp.m; a++) {
+        r->rs.st.g[a] = gap_now(r, a, t, NULL);
         /* P: the impulses since the last sample (impacts and held forces), then restarted */
-        r->st.P[a] = r->imp_out[a];
-        r->imp_out[a] = 0.0;
-        r->st.active[a] = r->cstate[a] == EDR_PERSIST;
+        r->rs.st.P[a] = r->rs.imp_out[a];
+        r->rs.imp_out[a] = 0.0;
+        r->rs.st.active[a] = r->rs.cstate[a] == EDR_PERSIST;
     }
-    r->st.t = t;
-    r->st.has_acc = 1;
-    return obs(&r->st, ctx);
+    r->rs.st.t = t;
+    r->rs.st.has_acc = 1;
+    return obs(&r->rs.st, ctx);
 }
 
 /* ---- allocation ---------------------------------------------------------------------------- */
@@ -2420,143 +2420,143 @@ static int emit(pd_edr *r, double t, pd_observer obs, void *ctx)
 
 /* Sized by the model alone. */
 #define EDR_MODEL_ARRAYS(X)                                                                   \
-    X(b, double, n)                                                                           \
-    X(pieces, pd_sine_piece, npieces)                                                         \
-    X(dof_blk, int, n)                                                                        \
-    X(dof_loc, int, n)                                                                        \
-    X(blk_dofs, int, n)                                                                       \
-    X(minv, double, n)                                                                        \
-    X(ct, edr_contact, m)                                                                     \
-    X(blk_cont, int, 2 * m) /* a contact is listed by each of its (at most two) blocks */     \
-    X(dofc_ptr, int, n + 1)                                                                   \
-    X(dofc, int, 2 * m)
+    X(tp.b, double, n)                                                                           \
+    X(tp.pieces, pd_sine_piece, npieces)                                                         \
+    X(tp.dof_blk, int, n)                                                                        \
+    X(tp.dof_loc, int, n)                                                                        \
+    X(tp.blk_dofs, int, n)                                                                       \
+    X(tp.minv, double, n)                                                                        \
+    X(tp.ct, edr_contact, m)                                                                     \
+    X(tp.blk_cont, int, 2 * m) /* a contact is listed by each of its (at most two) blocks */     \
+    X(tp.dofc_ptr, int, n + 1)                                                                   \
+    X(tp.dofc, int, 2 * m)
 
 /* Sized by the blocks, once C and K's couplings have found them. */
 #define EDR_BLOCK_ARRAYS(X) \
-    X(blk, edr_block, nb)   \
-    X(blk_off, long, nb + 1)
+    X(tp.blk, edr_block, nb)   \
+    X(tp.blk_off, long, nb + 1)
 
 /* The blocks' dense damping and stiffness, sum over the blocks of n_b^2 entries. */
 #define EDR_MATRIX_ARRAYS(X) \
-    X(Cb, double, nentries) \
-    X(Kb, double, nentries)
+    X(tp.Cb, double, nentries) \
+    X(tp.Kb, double, nentries)
 
 /* The run's state, results and scratch. */
 #define EDR_RUN_ARRAYS(X)                                                                     \
     /* clusters */                                                                            \
-    X(cl, edr_cluster, nb)                                                                    \
-    X(blk_cl, int, nb)                                                                        \
-    X(blk_next, int, nb)                                                                      \
-    X(free_cl, int, nb)                                                                       \
-    X(s, double, n)                                                                           \
-    X(d, double, n)                                                                           \
-    X(xo, double, n)                                                                          \
-    X(vo, double, n)                                                                          \
-    X(crow, int, n)                                                                           \
-    X(crow_c, int, m)                                                                         \
+    X(rs.cl, edr_cluster, nb)                                                                    \
+    X(rs.blk_cl, int, nb)                                                                        \
+    X(rs.blk_next, int, nb)                                                                      \
+    X(rs.free_cl, int, nb)                                                                       \
+    X(rs.s, double, n)                                                                           \
+    X(rs.d, double, n)                                                                           \
+    X(rs.xo, double, n)                                                                          \
+    X(rs.vo, double, n)                                                                          \
+    X(rs.crow, int, n)                                                                           \
+    X(rs.crow_c, int, m)                                                                         \
     /* contacts */                                                                            \
-    X(cstate, unsigned char, m)                                                               \
-    X(pers_next, int, m)                                                                      \
-    X(la, double, m)                                                                          \
-    X(lb, double, m)                                                                          \
-    X(lg, double, m)                                                                          \
-    X(ld, double, m)                                                                          \
-    X(base_t, double, m)                                                                      \
-    X(base_g, double, m)                                                                      \
-    X(gmeas_t, double, m)                                                                     \
-    X(since, double, m)                                                                       \
-    X(burst, long, m)                                                                         \
+    X(rs.cstate, unsigned char, m)                                                               \
+    X(rs.pers_next, int, m)                                                                      \
+    X(rs.la, double, m)                                                                          \
+    X(rs.lb, double, m)                                                                          \
+    X(rs.lg, double, m)                                                                          \
+    X(rs.ld, double, m)                                                                          \
+    X(rs.base_t, double, m)                                                                      \
+    X(rs.base_g, double, m)                                                                      \
+    X(rs.gmeas_t, double, m)                                                                     \
+    X(rs.since, double, m)                                                                       \
+    X(rs.burst, long, m)                                                                         \
     /* results */                                                                             \
-    X(xpos, double, n)                                                                        \
-    X(xneg, double, n)                                                                        \
-    X(drift, double, n)                                                                       \
-    X(gmin, double, m)                                                                        \
-    X(impacts, long, m)                                                                       \
-    X(first, double, m)                                                                       \
-    X(maxP, double, m)                                                                        \
-    X(ctime, double, m)                                                                       \
-    X(imp_out, double, m)                                                                     \
+    X(rs.xpos, double, n)                                                                        \
+    X(rs.xneg, double, n)                                                                        \
+    X(rs.drift, double, n)                                                                       \
+    X(rs.gmin, double, m)                                                                        \
+    X(rs.impacts, long, m)                                                                       \
+    X(rs.first, double, m)                                                                       \
+    X(rs.maxP, double, m)                                                                        \
+    X(rs.ctime, double, m)                                                                       \
+    X(rs.imp_out, double, m)                                                                     \
     /* the queue and its slots */                                                             \
-    X(q.heap, int, nslot)                                                                     \
-    X(q.pos, int, nslot)                                                                      \
-    X(q.key, double, nslot)                                                                   \
-    X(qkind, unsigned char, nslot)                                                            \
-    X(win, int, nslot)                                                                        \
-    X(slot_t, double, nslot)                                                                  \
-    X(slot_same, int, nslot)                                                                  \
-    X(slot_run, int, nslot)                                                                   \
-    X(slot_t0, double, nslot)                                                                 \
+    X(rs.q.heap, int, nslot)                                                                     \
+    X(rs.q.pos, int, nslot)                                                                      \
+    X(rs.q.key, double, nslot)                                                                   \
+    X(rs.qkind, unsigned char, nslot)                                                            \
+    X(rs.win, int, nslot)                                                                        \
+    X(rs.slot_t, double, nslot)                                                                  \
+    X(rs.slot_same, int, nslot)                                                                  \
+    X(rs.slot_run, int, nslot)                                                                   \
+    X(rs.slot_t0, double, nslot)                                                                 \
     /* the group of an event */                                                               \
-    X(g_cl, int, nb)                                                                          \
-    X(cl_mark, int, nb)                                                                       \
-    X(g_ct, int, m)                                                                           \
-    X(ct_mark, int, m)                                                                        \
-    X(ct_mark2, int, m)                                                                       \
-    X(ct_markD, int, m)                                                                       \
-    X(ct_markP, int, m)                                                                       \
-    X(g_dof, int, n)                                                                          \
-    X(gx, double, n)                                                                          \
-    X(gv, double, n)                                                                          \
-    X(gacc, double, n)                                                                        \
-    X(gtmp, double, n)                                                                        \
-    X(Uminus, double, m)                                                                      \
-    X(Uplus, double, m)                                                                       \
-    X(P, double, m)                                                                           \
-    X(lam, double, m)                                                                         \
-    X(wlcp, double, m)                                                                        \
-    X(qlcp, double, m)                                                                        \
-    X(wtmp, double, m)                                                                        \
-    X(lcp_idx, int, m)                                                                        \
-    X(jpos, int, m)                                                                           \
-    X(excluded, int, m)                                                                       \
-    X(held, unsigned char, m)                                                                 \
-    X(tie, unsigned char, m)                                                                  \
-    X(held_tail, double, m)                                                                   \
-    X(pos_in, int, m)                                                                         \
-    X(guess, unsigned char, m)                                                                \
-    X(lcp_scale, double, m)                                                                   \
-    X(lcp_q, double, m)                                                                       \
-    X(Dd, double, dm * dm)                                                                    \
-    X(Dlu, double, dm * dm)                                                                   \
-    X(rtmp, double, 4 * dm)                                                                   \
-    X(lu_perm, int, 2 * dm)                                                                   \
-    X(cG, double, nb)                                                                         \
-    X(Dval, double, dcap)                                                                     \
-    X(Dcol, int, m + 1)                                                                       \
-    X(Drow, int, dcap)                                                                        \
-    X(epos, int, m)                                                                           \
-    X(qtmp, double, m)                                                                        \
-    X(ztmp, double, m)                                                                        \
-    X(ev_vminus, double, n)                                                                   \
-    X(ev_vplus, double, n)                                                                    \
-    X(ev_x, double, n)                                                                        \
+    X(ev.g_cl, int, nb)                                                                          \
+    X(ev.cl_mark, int, nb)                                                                       \
+    X(ev.g_ct, int, m)                                                                           \
+    X(ev.ct_mark, int, m)                                                                        \
+    X(ev.ct_mark2, int, m)                                                                       \
+    X(ev.ct_markD, int, m)                                                                       \
+    X(ev.ct_markP, int, m)                                                                       \
+    X(ev.g_dof, int, n)                                                                          \
+    X(ev.gx, double, n)                                                                          \
+    X(ev.gv, double, n)                                                                          \
+    X(ev.gacc, double, n)                                                                        \
+    X(ev.gtmp, double, n)                                                                        \
+    X(ev.Uminus, double, m)                                                                      \
+    X(ev.Uplus, double, m)                                                                       \
+    X(ev.P, double, m)                                                                           \
+    X(ev.lam, double, m)                                                                         \
+    X(ev.wlcp, double, m)                                                                        \
+    X(ev.qlcp, double, m)                                                                        \
+    X(ev.wtmp, double, m)                                                                        \
+    X(ev.lcp_idx, int, m)                                                                        \
+    X(ev.jpos, int, m)                                                                           \
+    X(ev.excluded, int, m)                                                                       \
+    X(ev.held, unsigned char, m)                                                                 \
+    X(ev.tie, unsigned char, m)                                                                  \
+    X(ev.held_tail, double, m)                                                                   \
+    X(ev.pos_in, int, m)                                                                         \
+    X(ev.guess, unsigned char, m)                                                                \
+    X(ev.lcp_scale, double, m)                                                                   \
+    X(ev.lcp_q, double, m)                                                                       \
+    X(ev.Dd, double, dm * dm)                                                                    \
+    X(ev.Dlu, double, dm * dm)                                                                   \
+    X(ev.rtmp, double, 4 * dm)                                                                   \
+    X(ev.lu_perm, int, 2 * dm)                                                                   \
+    X(ev.cG, double, nb)                                                                         \
+    X(ev.Dval, double, dcap)                                                                     \
+    X(ev.Dcol, int, m + 1)                                                                       \
+    X(ev.Drow, int, dcap)                                                                        \
+    X(ev.epos, int, m)                                                                           \
+    X(ev.qtmp, double, m)                                                                        \
+    X(ev.ztmp, double, m)                                                                        \
+    X(ev.ev_vminus, double, n)                                                                   \
+    X(ev.ev_vplus, double, n)                                                                    \
+    X(ev.ev_x, double, n)                                                                        \
     /* scratch */                                                                             \
-    X(stack, int, n)                                                                          \
-    X(pe, int, n)                                                                             \
-    X(pdof, int, n)                                                                           \
-    X(bfs_next, int, n)                                                                       \
-    X(ceta, double, nb)                                                                       \
-    X(cmu, double, nb)                                                                        \
-    X(cvy, double, nb)                                                                        \
-    X(ext, double, n)                                                                         \
-    X(nimp, long, m)                                                                          \
-    X(keybuf, int, 2 * (nb + m + 1))                                                          \
-    X(uf, int, nb)                                                                            \
-    X(gblk, int, nb)                                                                          \
-    X(newcl, int, nb)                                                                         \
-    X(plist, int, nb)                                                                         \
-    X(loc, int, n)                                                                            \
-    X(wk, double, 8 * n)                                                                      \
-    X(mctx, struct meas_ctx, nmeas)                                                           \
-    X(mscan, edr_scan, nmeas)                                                                 \
-    X(mprev, edr_pt, nmeas)                                                                   \
+    X(ev.stack, int, n)                                                                          \
+    X(ev.pe, int, n)                                                                             \
+    X(ev.pdof, int, n)                                                                           \
+    X(ev.bfs_next, int, n)                                                                       \
+    X(ev.ceta, double, nb)                                                                       \
+    X(ev.cmu, double, nb)                                                                        \
+    X(ev.cvy, double, nb)                                                                        \
+    X(ev.ext, double, n)                                                                         \
+    X(ev.nimp, long, m)                                                                          \
+    X(ev.keybuf, int, 2 * (nb + m + 1))                                                          \
+    X(ev.uf, int, nb)                                                                            \
+    X(ev.gblk, int, nb)                                                                          \
+    X(ev.newcl, int, nb)                                                                         \
+    X(ev.plist, int, nb)                                                                         \
+    X(ev.loc, int, n)                                                                            \
+    X(ev.wk, double, 8 * n)                                                                      \
+    X(ev.mctx, struct meas_ctx, nmeas)                                                           \
+    X(ev.mscan, edr_scan, nmeas)                                                                 \
+    X(ev.mprev, edr_pt, nmeas)                                                                   \
     /* the observer's state */                                                                \
-    X(st.q, double, n)                                                                        \
-    X(st.v, double, n)                                                                        \
-    X(st.P, double, m)                                                                        \
-    X(st.g, double, m)                                                                        \
-    X(st.active, unsigned char, m)                                                            \
-    X(st.acc, double, n)
+    X(rs.st.q, double, n)                                                                        \
+    X(rs.st.v, double, n)                                                                        \
+    X(rs.st.P, double, m)                                                                        \
+    X(rs.st.g, double, m)                                                                        \
+    X(rs.st.active, unsigned char, m)                                                            \
+    X(rs.st.acc, double, n)
 
 #define EDR_ARRAYS(X) EDR_MODEL_ARRAYS(X) EDR_BLOCK_ARRAYS(X) EDR_MATRIX_ARRAYS(X) EDR_RUN_ARRAYS(X)
 
@@ -2618,12 +2618,12 @@ void pd_edr_free(pd_edr *r)
     if (!r)
         return;
     /* the clusters' modal storage, the basis cache and the solvers, then the tables */
-    if (r->cl)
-        for (int c = 0; c < r->nb; c++)
-            edr_cluster_free(&r->cl[c]);
+    if (r->rs.cl)
+        for (int c = 0; c < r->tp.nb; c++)
+            edr_cluster_free(&r->rs.cl[c]);
     edr_basis_cache_free(r);
-    pd_lcp_solver_free(r->solver);
-    pd_lcp_solver_free(r->dsolver);
+    pd_lcp_solver_free(r->ev.solver);
+    pd_lcp_solver_free(r->ev.dsolver);
 #define EDR_FREE_ARRAY(field, type, count) free(r->field);
     EDR_ARRAYS(EDR_FREE_ARRAY)
 #undef EDR_FREE_ARRAY
@@ -2664,10 +2664,10 @@ static void fill_entry(void *ctx, int i, int j, double x)
 {
     fill_ctx *f = ctx;
     pd_edr *r = f->r;
-    int b = r->dof_blk[i];
-    if (x == 0.0 || r->dof_blk[j] != b)
+    int b = r->tp.dof_blk[i];
+    if (x == 0.0 || r->tp.dof_blk[j] != b)
         return;
-    f->dst[r->blk_off[b] + r->dof_loc[i] + (long)r->dof_loc[j] * r->blk[b].n] += x;
+    f->dst[r->tp.blk_off[b] + r->tp.dof_loc[i] + (long)r->tp.dof_loc[j] * r->tp.blk[b].n] += x;
 }
 
 typedef struct wcol_ctx {
@@ -2678,7 +2678,7 @@ typedef struct wcol_ctx {
 static void wcol_entry(void *ctx, int i, int j, double x)
 {
     wcol_ctx *w = ctx;
-    edr_contact *ct = &w->r->ct[j];
+    edr_contact *ct = &w->r->tp.ct[j];
     if (x == 0.0)
         return;
     if (ct->dof[0] < 0) {
@@ -2743,17 +2743,17 @@ static int check_inputs(const pd_model *md, const pd_piecewise_force *F, const p
 static int out_of_memory(const pd_edr *r, pd_err *err)
 {
     return pd_err_set(err, PD_ENOMEM, "out of memory for the row reference (%d dofs, %d "
-                      "contacts)", r->n, r->m);
+                      "contacts)", r->tp.n, r->tp.m);
 }
 
 /* 1 / M_ii of the lumped masses, each > 0. */
 static int set_masses(pd_edr *r, pd_err *err)
 {
-    for (int i = 0; i < r->n; i++) {
-        double mi = pd_matrix_get(&r->md->M, i, i);
+    for (int i = 0; i < r->tp.n; i++) {
+        double mi = pd_matrix_get(&r->tp.md->M, i, i);
         if (!(mi > 0.0))
             return pd_err_set(err, PD_EINVAL, "M: mass %d must be > 0 (got %g)", i, mi);
-        r->minv[i] = 1.0 / mi;
+        r->tp.minv[i] = 1.0 / mi;
     }
     return PD_OK;
 }
@@ -2762,15 +2762,15 @@ static int set_masses(pd_edr *r, pd_err *err)
  * each numbered at its root (dof_blk of the root); returns their count. */
 static int find_blocks(pd_edr *r, int *uf)
 {
-    for (int i = 0; i < r->n; i++)
+    for (int i = 0; i < r->tp.n; i++)
         uf[i] = i;
     /* C_ij != 0 or K_ij != 0 (i != j) puts dofs i and j in one structure */
-    for_each_entry(&r->md->C, join_entry, uf);
-    for_each_entry(&r->md->K, join_entry, uf);
+    for_each_entry(&r->tp.md->C, join_entry, uf);
+    for_each_entry(&r->tp.md->K, join_entry, uf);
     int nb = 0;
-    for (int i = 0; i < r->n; i++)
+    for (int i = 0; i < r->tp.n; i++)
         if (uf_find(uf, i) == i)
-            r->dof_blk[i] = nb++;
+            r->tp.dof_blk[i] = nb++;
     return nb;
 }
 
@@ -2780,45 +2780,45 @@ static int find_blocks(pd_edr *r, int *uf)
 static long lay_out_blocks(pd_edr *r, int *uf)
 {
     /* a root's dof_blk holds its block's number: every dof takes its root's */
-    for (int i = 0; i < r->n; i++) {
-        int b = r->dof_blk[uf_find(uf, i)];
-        r->dof_blk[i] = b;
-        r->dof_loc[i] = r->blk[b].n++;
+    for (int i = 0; i < r->tp.n; i++) {
+        int b = r->tp.dof_blk[uf_find(uf, i)];
+        r->tp.dof_blk[i] = b;
+        r->tp.dof_loc[i] = r->tp.blk[b].n++;
     }
     /* the blocks' dofs contiguous in blk_dofs, in block order; their matrices
      * n_b x n_b column-major from blk_off[b] */
     long off = 0;
     int at = 0;
-    for (int b = 0; b < r->nb; b++) {
-        r->blk[b].first = at;
-        at += r->blk[b].n;
-        r->blk_off[b] = off;
-        off += (long)r->blk[b].n * r->blk[b].n;
-        r->blk[b].sdof = r->blk[b].n == 1;
+    for (int b = 0; b < r->tp.nb; b++) {
+        r->tp.blk[b].first = at;
+        at += r->tp.blk[b].n;
+        r->tp.blk_off[b] = off;
+        off += (long)r->tp.blk[b].n * r->tp.blk[b].n;
+        r->tp.blk[b].sdof = r->tp.blk[b].n == 1;
     }
-    r->blk_off[r->nb] = off;
-    for (int i = 0; i < r->n; i++)
-        r->blk_dofs[r->blk[r->dof_blk[i]].first + r->dof_loc[i]] = i;
+    r->tp.blk_off[r->tp.nb] = off;
+    for (int i = 0; i < r->tp.n; i++)
+        r->tp.blk_dofs[r->tp.blk[r->tp.dof_blk[i]].first + r->tp.dof_loc[i]] = i;
     return off;
 }
 
 /* C and K block by block, and an SDOF block's scalars m, c, k, b. */
 static int fill_blocks(pd_edr *r, pd_err *err)
 {
-    fill_ctx fc = {.r = r, .dst = r->Cb};
-    for_each_entry(&r->md->C, fill_entry, &fc);
-    fc.dst = r->Kb;
-    for_each_entry(&r->md->K, fill_entry, &fc);
-    for (int b = 0; b < r->nb; b++) {
-        edr_block *bk = &r->blk[b];
+    fill_ctx fc = {.r = r, .dst = r->tp.Cb};
+    for_each_entry(&r->tp.md->C, fill_entry, &fc);
+    fc.dst = r->tp.Kb;
+    for_each_entry(&r->tp.md->K, fill_entry, &fc);
+    for (int b = 0; b < r->tp.nb; b++) {
+        edr_block *bk = &r->tp.blk[b];
         if (!bk->sdof)
             continue;
         /* an SDOF block's scalars: its 1 x 1 M, C, K and load coefficient */
-        int i = r->blk_dofs[bk->first];
-        bk->m = 1.0 / r->minv[i];
-        bk->c = r->Cb[r->blk_off[b]];
-        bk->k = r->Kb[r->blk_off[b]];
-        bk->b = r->b[i];
+        int i = r->tp.blk_dofs[bk->first];
+        bk->m = 1.0 / r->tp.minv[i];
+        bk->c = r->tp.Cb[r->tp.blk_off[b]];
+        bk->k = r->tp.Kb[r->tp.blk_off[b]];
+        bk->b = r->tp.b[i];
         if (bk->k < 0.0 || bk->c < 0.0)
             return pd_err_set(err, PD_EINVAL, "K, C: dof %d has a negative stiffness or damping",
                               i);
@@ -2830,18 +2830,18 @@ static int fill_blocks(pd_edr *r, pd_err *err)
  * structures (g = g0 + w0 x_dof0 + w1 x_dof1). */
 static int set_contacts(pd_edr *r, pd_err *err)
 {
-    for (int a = 0; a < r->m; a++)
-        r->ct[a] = (edr_contact){.dof = {-1, -1}, .blk = {-1, -1}, .g0 = r->md->g0[a],
-                                 .e = r->md->e[a]};
+    for (int a = 0; a < r->tp.m; a++)
+        r->tp.ct[a] = (edr_contact){.dof = {-1, -1}, .blk = {-1, -1}, .g0 = r->tp.md->g0[a],
+                                 .e = r->tp.md->e[a]};
     wcol_ctx wc = {.r = r, .bad = 0};
-    for_each_entry(&r->md->W, wcol_entry, &wc);
+    for_each_entry(&r->tp.md->W, wcol_entry, &wc);
     /* a first side always, a second (if any) in another structure */
-    for (int a = 0; a < r->m && !wc.bad; a++) {
-        edr_contact *ct = &r->ct[a];
+    for (int a = 0; a < r->tp.m && !wc.bad; a++) {
+        edr_contact *ct = &r->tp.ct[a];
         if (ct->dof[0] < 0)
             wc.bad = a + 1;
         for (int s = 0; s < 2; s++)
-            ct->blk[s] = ct->dof[s] >= 0 ? r->dof_blk[ct->dof[s]] : -1;
+            ct->blk[s] = ct->dof[s] >= 0 ? r->tp.dof_blk[ct->dof[s]] : -1;
         if (ct->dof[1] >= 0 && ct->blk[0] == ct->blk[1])
             wc.bad = a + 1;
     }
@@ -2857,44 +2857,44 @@ static int set_contacts(pd_edr *r, pd_err *err)
  * dofs of (contacts at the dof)^2. */
 static long link_contacts(pd_edr *r, int *uf)
 {
-    int n = r->n, m = r->m;
+    int n = r->tp.n, m = r->tp.m;
     /* count: contacts per block (ncont) and per dof (dofc_ptr[i + 1]) */
     for (int a = 0; a < m; a++)
         for (int s = 0; s < 2; s++)
-            if (r->ct[a].dof[s] >= 0) {
-                r->blk[r->ct[a].blk[s]].ncont++;
-                r->dofc_ptr[r->ct[a].dof[s] + 1]++;
+            if (r->tp.ct[a].dof[s] >= 0) {
+                r->tp.blk[r->tp.ct[a].blk[s]].ncont++;
+                r->tp.dofc_ptr[r->tp.ct[a].dof[s] + 1]++;
             }
     /* each block's list starts at cont0; its count restarts for the filling */
-    for (int b = 0, c0 = 0; b < r->nb; b++) {
-        r->blk[b].cont0 = c0;
-        c0 += r->blk[b].ncont;
-        r->blk[b].ncont = 0;
+    for (int b = 0, c0 = 0; b < r->tp.nb; b++) {
+        r->tp.blk[b].cont0 = c0;
+        c0 += r->tp.blk[b].ncont;
+        r->tp.blk[b].ncont = 0;
     }
     /* prefix sums: dof i's contacts from dofc_ptr[i] */
     for (int i = 0; i < n; i++)
-        r->dofc_ptr[i + 1] += r->dofc_ptr[i];
+        r->tp.dofc_ptr[i + 1] += r->tp.dofc_ptr[i];
     long dnnz = 0;
     for (int a = 0; a < m; a++)
         for (int s = 0; s < 2; s++) {
-            int dof = r->ct[a].dof[s];
+            int dof = r->tp.ct[a].dof[s];
             if (dof < 0)
                 continue;
-            edr_block *bk = &r->blk[r->ct[a].blk[s]];
-            r->blk_cont[bk->cont0 + bk->ncont++] = a;
+            edr_block *bk = &r->tp.blk[r->tp.ct[a].blk[s]];
+            r->tp.blk_cont[bk->cont0 + bk->ncont++] = a;
         }
     /* uf[i]: the contacts filled so far into dof i's list */
     for (int i = 0; i < n; i++)
         uf[i] = 0;
     for (int a = 0; a < m; a++)
         for (int s = 0; s < 2; s++) {
-            int dof = r->ct[a].dof[s];
+            int dof = r->tp.ct[a].dof[s];
             if (dof >= 0)
-                r->dofc[r->dofc_ptr[dof] + uf[dof]++] = a;
+                r->tp.dofc[r->tp.dofc_ptr[dof] + uf[dof]++] = a;
         }
     for (int i = 0; i < n; i++) {
         /* a dof with dg contacts couples each pair of them in D: dg^2 entries at most */
-        long dg = r->dofc_ptr[i + 1] - r->dofc_ptr[i];
+        long dg = r->tp.dofc_ptr[i + 1] - r->tp.dofc_ptr[i];
         dnnz += dg * dg;
     }
     return dnnz;
@@ -2904,8 +2904,8 @@ static long link_contacts(pd_edr *r, int *uf)
  * dense Lemke (dm contacts); none for one contact (closed forms). */
 static int alloc_solvers(pd_edr *r, int dm, pd_err *err)
 {
-    if (r->m > 1 && (!(r->solver = pd_lcp_solver_alloc(r->o.lcp_solver, r->m, r->Dcap, err)) ||
-                     !(r->dsolver = pd_lcp_solver_alloc(PD_LCP_LEMKE, dm, 0, err))))
+    if (r->tp.m > 1 && (!(r->ev.solver = pd_lcp_solver_alloc(r->tp.o.lcp_solver, r->tp.m, r->ev.Dcap, err)) ||
+                     !(r->ev.dsolver = pd_lcp_solver_alloc(PD_LCP_LEMKE, dm, 0, err))))
         return err && err->status ? err->status : PD_ENOMEM;
     return PD_OK;
 }
@@ -2915,16 +2915,16 @@ static int alloc_solvers(pd_edr *r, int dm, pd_err *err)
  * scratch.  A failure's status (err set). */
 static int build(pd_edr *r, const pd_piecewise_force *F, int *uf, pd_err *err)
 {
-    edr_sizes sizes = {.n = r->n, .m = r->m, .npieces = F->npieces};
+    edr_sizes sizes = {.n = r->tp.n, .m = r->tp.m, .npieces = F->npieces};
     int rc;
     if (alloc_model_arrays(r, &sizes))
         return out_of_memory(r, err);
-    memcpy(r->b, F->b, (size_t)r->n * sizeof(double));
-    memcpy(r->pieces, F->pieces, (size_t)F->npieces * sizeof(pd_sine_piece));
-    r->npieces = F->npieces;
+    memcpy(r->tp.b, F->b, (size_t)r->tp.n * sizeof(double));
+    memcpy(r->tp.pieces, F->pieces, (size_t)F->npieces * sizeof(pd_sine_piece));
+    r->tp.npieces = F->npieces;
     if ((rc = set_masses(r, err)))
         return rc;
-    sizes.nb = r->nb = find_blocks(r, uf);
+    sizes.nb = r->tp.nb = find_blocks(r, uf);
     if (alloc_block_arrays(r, &sizes))
         return out_of_memory(r, err);
     sizes.nentries = lay_out_blocks(r, uf);
@@ -2933,12 +2933,12 @@ static int build(pd_edr *r, const pd_piecewise_force *F, int *uf, pd_err *err)
     if ((rc = fill_blocks(r, err)) || (rc = set_contacts(r, err)))
         return rc;
     /* D's entries: at most sum over the dofs of dg^2; m more to spare */
-    r->Dcap = link_contacts(r, uf) + r->m;
-    int dm = r->m < EDR_REDUCED_MAX ? r->m : EDR_REDUCED_MAX;
-    sizes.nslot = r->m + r->nb + 2;
+    r->ev.Dcap = link_contacts(r, uf) + r->tp.m;
+    int dm = r->tp.m < EDR_REDUCED_MAX ? r->tp.m : EDR_REDUCED_MAX;
+    sizes.nslot = r->tp.m + r->tp.nb + 2;
     sizes.dm = dm;
-    sizes.dcap = r->Dcap;
-    sizes.nmeas = 2L * r->n;
+    sizes.dcap = r->ev.Dcap;
+    sizes.nmeas = 2L * r->tp.n;
     if (alloc_run_arrays(r, &sizes))
         return out_of_memory(r, err);
     return alloc_solvers(r, dm, err);
@@ -2960,12 +2960,12 @@ pd_edr *pd_edr_alloc(const pd_model *md, const pd_piecewise_force *F, const pd_e
         pd_err_set(err, PD_ENOMEM, "out of memory for the row reference");
         return NULL;
     }
-    r->md = md;
-    r->o = o;
-    r->n = md->n;
-    r->m = md->m;
+    r->tp.md = md;
+    r->tp.o = o;
+    r->tp.n = md->n;
+    r->tp.m = md->m;
     /* uf: the blocks' union-find, then link_contacts' fill counts */
-    int *uf = pd_malloc(r->n, sizeof *uf);
+    int *uf = pd_malloc(r->tp.n, sizeof *uf);
     int rc = uf ? build(r, F, uf, err) : out_of_memory(r, err);
     free(uf);
     if (rc) {
@@ -2973,8 +2973,8 @@ pd_edr *pd_edr_alloc(const pd_model *md, const pd_piecewise_force *F, const pd_e
         return NULL;
     }
     /* the queue's last two slots: the piece change and the output */
-    r->slot_piece = r->m + r->nb;
-    r->slot_out = r->m + r->nb + 1;
+    r->rs.slot_piece = r->tp.m + r->tp.nb;
+    r->rs.slot_out = r->tp.m + r->tp.nb + 1;
     return r;
 }
 
@@ -2982,70 +2982,70 @@ pd_edr *pd_edr_alloc(const pd_model *md, const pd_piecewise_force *F, const pd_e
 
 static void reset(pd_edr *r, double t0, const double *q0, const double *v0, double t1)
 {
-    int n = r->n, m = r->m;
-    memset(&r->res, 0, sizeof r->res);
-    r->res.first_impact = NAN;
-    r->t = t0;
-    r->t1 = t1;
-    r->L = r->o.length_scale;
-    r->piece = edr_piece_at(r, t0);
+    int n = r->tp.n, m = r->tp.m;
+    memset(&r->rs.res, 0, sizeof r->rs.res);
+    r->rs.res.first_impact = NAN;
+    r->rs.t = t0;
+    r->rs.t1 = t1;
+    r->rs.L = r->tp.o.length_scale;
+    r->rs.piece = edr_piece_at(r, t0);
     /* the queue empty: every slot out of it (pos -1, key +inf) */
-    r->q.n = 0;
-    for (int k = 0; k < m + r->nb + 2; k++) {
-        r->q.pos[k] = -1;
-        r->q.key[k] = HUGE_VAL;
+    r->rs.q.n = 0;
+    for (int k = 0; k < m + r->tp.nb + 2; k++) {
+        r->rs.q.pos[k] = -1;
+        r->rs.q.key[k] = HUGE_VAL;
     }
     for (int i = 0; i < n; i++) {
-        r->xo[i] = q0 ? q0[i] : 0.0;
-        r->vo[i] = v0 ? v0[i] : 0.0;
+        r->rs.xo[i] = q0 ? q0[i] : 0.0;
+        r->rs.vo[i] = v0 ? v0[i] : 0.0;
         /* extremes from -inf: finish zeroes those never measured */
-        r->xpos[i] = r->xneg[i] = r->drift[i] = -HUGE_VAL;
-        r->loc[i] = -1;
+        r->rs.xpos[i] = r->rs.xneg[i] = r->rs.drift[i] = -HUGE_VAL;
+        r->ev.loc[i] = -1;
     }
     /* a gap within the closing tolerance is closed: a row touching at gaps
      * of 1e-300 runs as the row touching at 0, not as a cascade of bounces
      * across gaps no event could tell apart */
     for (int a = 0; a < m; a++) {
-        double g0 = r->md->g0[a];
-        r->ct[a].g0 = g0 > 0.0 && g0 <= r->o.close_tol * r->L ? 0.0 : g0;
+        double g0 = r->tp.md->g0[a];
+        r->tp.ct[a].g0 = g0 > 0.0 && g0 <= r->tp.o.close_tol * r->rs.L ? 0.0 : g0;
     }
     for (int a = 0; a < m; a++) {
         /* every contact open with no exact gap (base_t -inf), minimum +inf, counts 0 */
-        r->cstate[a] = EDR_OPEN;
-        r->pers_next[a] = -1;
-        r->base_t[a] = -HUGE_VAL;
-        r->gmeas_t[a] = t0;
-        r->gmin[a] = HUGE_VAL;
-        r->impacts[a] = 0;
-        r->first[a] = NAN;
-        r->maxP[a] = r->ctime[a] = r->imp_out[a] = 0.0;
-        r->burst[a] = 0;
-        r->since[a] = t0;
+        r->rs.cstate[a] = EDR_OPEN;
+        r->rs.pers_next[a] = -1;
+        r->rs.base_t[a] = -HUGE_VAL;
+        r->rs.gmeas_t[a] = t0;
+        r->rs.gmin[a] = HUGE_VAL;
+        r->rs.impacts[a] = 0;
+        r->rs.first[a] = NAN;
+        r->rs.maxP[a] = r->rs.ctime[a] = r->rs.imp_out[a] = 0.0;
+        r->rs.burst[a] = 0;
+        r->rs.since[a] = t0;
     }
     /* every cluster slot free, stacked so that start gives block b slot b */
-    r->nfree = 0;
-    for (int c = r->nb - 1; c >= 0; c--) {
-        r->cl[c].live = 0;
-        r->free_cl[r->nfree++] = c;
+    r->rs.nfree = 0;
+    for (int c = r->tp.nb - 1; c >= 0; c--) {
+        r->rs.cl[c].live = 0;
+        r->rs.free_cl[r->rs.nfree++] = c;
     }
     /* marks zeroed and epochs restarted: the first group's epoch, 1, matches none */
-    r->epoch = r->epochD = 0;
-    memset(r->cl_mark, 0, (size_t)r->nb * sizeof *r->cl_mark);
-    memset(r->ct_mark, 0, (size_t)m * sizeof *r->ct_mark);
-    memset(r->ct_mark2, 0, (size_t)m * sizeof *r->ct_mark2);
-    memset(r->ct_markD, 0, (size_t)m * sizeof *r->ct_markD);
-    memset(r->ct_markP, 0, (size_t)m * sizeof *r->ct_markP);
-    r->epochP = 0;
-    for (int k = 0; k < m + r->nb + 2; k++) {
+    r->ev.epoch = r->ev.epochD = 0;
+    memset(r->ev.cl_mark, 0, (size_t)r->tp.nb * sizeof *r->ev.cl_mark);
+    memset(r->ev.ct_mark, 0, (size_t)m * sizeof *r->ev.ct_mark);
+    memset(r->ev.ct_mark2, 0, (size_t)m * sizeof *r->ev.ct_mark2);
+    memset(r->ev.ct_markD, 0, (size_t)m * sizeof *r->ev.ct_markD);
+    memset(r->ev.ct_markP, 0, (size_t)m * sizeof *r->ev.ct_markP);
+    r->ev.epochP = 0;
+    for (int k = 0; k < m + r->tp.nb + 2; k++) {
         /* NaN: no event yet (it equals no t) */
-        r->slot_t[k] = NAN;
-        r->slot_same[k] = 0;
-        r->slot_run[k] = 0;
-        r->slot_t0[k] = t0;
+        r->rs.slot_t[k] = NAN;
+        r->rs.slot_same[k] = 0;
+        r->rs.slot_run[k] = 0;
+        r->rs.slot_t0[k] = t0;
     }
-    r->stopped = 0;
-    r->vscale = 0.0;
-    r->evals = 0;
+    r->rs.stopped = 0;
+    r->rs.vscale = 0.0;
+    r->rs.evals = 0;
 }
 
 /* Every structure alone at t0; contacts closed at t0 resolved. */
@@ -3053,36 +3053,36 @@ static int start(pd_edr *r, double t0, pd_err *err)
 {
     int rc;
     /* every structure a cluster of its own, its flight from (q0, v0) */
-    for (int b = 0; b < r->nb; b++) {
-        int c = r->free_cl[--r->nfree];
-        edr_cluster *cl = &r->cl[c];
+    for (int b = 0; b < r->tp.nb; b++) {
+        int c = r->rs.free_cl[--r->rs.nfree];
+        edr_cluster *cl = &r->rs.cl[c];
         cl->live = 1;
         cl->head = b;
         cl->nblk = 1;
         cl->pers_head = -1;
         cl->npers = 0;
         cl->meas_t = t0;
-        r->blk_cl[b] = c;
-        r->blk_next[b] = -1;
+        r->rs.blk_cl[b] = c;
+        r->rs.blk_next[b] = -1;
         if ((rc = edr_cluster_start(r, c, t0, err)))
             return rc;
     }
     /* a gap below -tol at t0: the structures start overlapping */
-    double tol = r->o.close_tol * r->L;
-    for (int a = 0; a < r->m; a++) {
+    double tol = r->tp.o.close_tol * r->rs.L;
+    for (int a = 0; a < r->tp.m; a++) {
         double g = gap_now(r, a, t0, NULL);
-        if (g < -tol && !r->o.inactive)
+        if (g < -tol && !r->tp.o.inactive)
             return pd_err_set(err, PD_EINVAL, "q0: contact %d starts with a negative gap (%g)",
                               a, g);
     }
     /* contacts closed at t0 resolve at t0 (an impact, or persistence) */
-    if (!r->o.inactive)
-        for (int a = 0; a < r->m; a++) {
-            if (r->cstate[a] != EDR_OPEN || !(gap_now(r, a, t0, NULL) <= tol))
+    if (!r->tp.o.inactive)
+        for (int a = 0; a < r->tp.m; a++) {
+            if (r->rs.cstate[a] != EDR_OPEN || !(gap_now(r, a, t0, NULL) <= tol))
                 continue;
             group_begin(r);
             group_add_contact(r, a);
-            const edr_contact *ct = &r->ct[a];
+            const edr_contact *ct = &r->tp.ct[a];
             for (int s = 0; s < 2; s++)
                 if (ct->dof[s] >= 0)
                     group_add_cluster(r, cl_of_dof(r, ct->dof[s]));
@@ -3090,39 +3090,39 @@ static int start(pd_edr *r, double t0, pd_err *err)
                 return rc;
         }
     /* every prediction, and the first piece change */
-    for (int a = 0; a < r->m; a++)
+    for (int a = 0; a < r->tp.m; a++)
         predict_contact(r, a, t0, 0);
-    for (int c = 0; c < r->nb; c++)
-        if (r->cl[c].live)
+    for (int c = 0; c < r->tp.nb; c++)
+        if (r->rs.cl[c].live)
             predict_detach(r, c, t0, 0);
-    double next = edr_piece_end(r, r->piece);
-    q_set(&r->q, r->slot_piece, next < r->t1 ? next : HUGE_VAL);
+    double next = edr_piece_end(r, r->rs.piece);
+    q_set(&r->rs.q, r->rs.slot_piece, next < r->rs.t1 ? next : HUGE_VAL);
     return PD_OK;
 }
 
 /* Close the run at t: extremes and gaps to t, contact times. */
 static void finish(pd_edr *r, double t)
 {
-    for (int c = 0; c < r->nb; c++)
-        if (r->cl[c].live)
+    for (int c = 0; c < r->tp.nb; c++)
+        if (r->rs.cl[c].live)
             measure_cluster(r, c, t);
-    for (int a = 0; a < r->m; a++) {
+    for (int a = 0; a < r->tp.m; a++) {
         measure_contact(r, a, t);
         /* a contact held at the end: its time in contact up to t */
-        if (r->cstate[a] == EDR_PERSIST && t > r->since[a])
-            r->ctime[a] += t - r->since[a];
+        if (r->rs.cstate[a] == EDR_PERSIST && t > r->rs.since[a])
+            r->rs.ctime[a] += t - r->rs.since[a];
         /* never measured (never open, or no time to measure): its gap at t */
-        if (!(r->gmin[a] < HUGE_VAL))
-            r->gmin[a] = gap_now(r, a, t, NULL);
+        if (!(r->rs.gmin[a] < HUGE_VAL))
+            r->rs.gmin[a] = gap_now(r, a, t, NULL);
     }
-    for (int i = 0; i < r->n; i++) {
+    for (int i = 0; i < r->tp.n; i++) {
         /* NaN becomes -inf; -inf: never measured (t_measure at or past t), extremes 0 */
-        r->xpos[i] = pd_max(r->xpos[i], -HUGE_VAL);
-        if (!(r->xpos[i] > -HUGE_VAL))
-            r->xpos[i] = r->xneg[i] = r->drift[i] = 0.0;
+        r->rs.xpos[i] = pd_max(r->rs.xpos[i], -HUGE_VAL);
+        if (!(r->rs.xpos[i] > -HUGE_VAL))
+            r->rs.xpos[i] = r->rs.xneg[i] = r->rs.drift[i] = 0.0;
     }
-    r->res.t_reached = t;
-    r->res.evals = (double)r->evals;
+    r->rs.res.t_reached = t;
+    r->rs.res.evals = (double)r->rs.evals;
 }
 
 int pd_edr_run(pd_edr *r, double t0, const double *q0, const double *v0, double t1,
@@ -3134,63 +3134,63 @@ int pd_edr_run(pd_edr *r, double t0, const double *q0, const double *v0, double 
         return PD_NULL_ARG(err, "r");
     if (!isfinite(t0) || !(t1 > t0) || !isfinite(t1))
         return pd_err_set(err, PD_EINVAL, "row reference: need t0 < t1, both finite");
-    for (int i = 0; q0 && i < r->n; i++)
+    for (int i = 0; q0 && i < r->tp.n; i++)
         if (!isfinite(q0[i]) || (v0 && !isfinite(v0[i])))
             return pd_err_set(err, PD_EINVAL, "row reference: the initial state is not finite");
     /* a sampler reports impulses over each output interval: held forces integrated */
-    r->sample_forces = obs && r->o.h_out > 0.0 && !r->o.impacts_only;
+    r->rs.sample_forces = obs && r->tp.o.h_out > 0.0 && !r->tp.o.impacts_only;
     reset(r, t0, q0, v0, t1);
     if ((rc = start(r, t0, err)))
         goto out;
-    r->t_out0 = t0;
-    r->next_out = 0;
+    r->rs.t_out0 = t0;
+    r->rs.next_out = 0;
     /* the observer's first state at t0, then the output grid */
     if (obs) {
-        r->st.step = 0;
+        r->rs.st.step = 0;
         if (emit(r, t0, obs, ctx) > 0)
             goto out;
-        r->next_out = 1;
-        if (r->o.h_out > 0.0)
-            q_set(&r->q, r->slot_out, fmin(t0 + r->o.h_out, t1));
+        r->rs.next_out = 1;
+        if (r->tp.o.h_out > 0.0)
+            q_set(&r->rs.q, r->rs.slot_out, fmin(t0 + r->tp.o.h_out, t1));
     }
     double t = t0;
-    while (!r->stopped) {
+    while (!r->rs.stopped) {
         /* the earliest queued time; past t1 the run is done */
-        int slot = r->q.n > 0 ? r->q.heap[0] : -1;
-        double te = slot >= 0 ? r->q.key[slot] : HUGE_VAL;
+        int slot = r->rs.q.n > 0 ? r->rs.q.heap[0] : -1;
+        double te = slot >= 0 ? r->rs.q.key[slot] : HUGE_VAL;
         if (!(te <= t1))
             break;
         t = te;
-        if (r->evals > r->o.max_evals) {
+        if (r->rs.evals > r->tp.o.max_evals) {
             rc = pd_err_set(err, PD_EBUDGET, "row reference: %.3g flight evaluations by t = %.9g "
-                            "s (budget exhausted)", (double)r->evals, t * r->o.time_unit);
+                            "s (budget exhausted)", (double)r->rs.evals, t * r->tp.o.time_unit);
             break;
         }
-        if (slot == r->slot_out) {
-            r->st.step = r->next_out;
+        if (slot == r->rs.slot_out) {
+            r->rs.st.step = r->rs.next_out;
             if (emit(r, t, obs, ctx) > 0)
                 break;
-            r->next_out++;
+            r->rs.next_out++;
             /* the grid t0 + k h_out, not accumulated (no drift); a point past t1
              * becomes t1 unless the last one was t1 already (to rounding) */
-            double tn = r->t_out0 + (double)r->next_out * r->o.h_out;
+            double tn = r->rs.t_out0 + (double)r->rs.next_out * r->tp.o.h_out;
             if (tn > t1 && t < t1 * (1.0 - 1e-15))
                 tn = t1;
-            q_set(&r->q, r->slot_out, tn <= t1 * (1.0 + 1e-15) && tn > t ? tn : HUGE_VAL);
+            q_set(&r->rs.q, r->rs.slot_out, tn <= t1 * (1.0 + 1e-15) && tn > t ? tn : HUGE_VAL);
             continue;
         }
-        if (slot == r->slot_piece) {
+        if (slot == r->rs.slot_piece) {
             rc = on_piece(r, t, err);
         /* a contact's slot: a scan's continuation or an impact; a cluster's: a
          * scan's continuation or a detachment */
-        } else if (slot < r->m) {
-            if (r->qkind[slot] == EDR_Q_SCAN)
+        } else if (slot < r->tp.m) {
+            if (r->rs.qkind[slot] == EDR_Q_SCAN)
                 predict_contact(r, slot, t, 1);
             else
                 rc = on_impact(r, slot, t, err);
         } else {
-            int c = slot - r->m;
-            if (r->qkind[slot] == EDR_Q_SCAN)
+            int c = slot - r->tp.m;
+            if (r->rs.qkind[slot] == EDR_Q_SCAN)
                 predict_detach(r, c, t, 1);
             else
                 rc = on_detach(r, c, t, err);
@@ -3200,14 +3200,14 @@ int pd_edr_run(pd_edr *r, double t0, const double *q0, const double *v0, double 
     }
     /* no error: measured up to t1, or to the event's t when its report stopped the run */
     if (!rc) {
-        t = r->stopped ? t : t1;
+        t = r->rs.stopped ? t : t1;
         finish(r, t);
     } else
         finish(r, t);
 out:
-    r->res.t_reached = t1;
+    r->rs.res.t_reached = t1;
     if (rc)
-        r->res.t_reached = r->t;
+        r->rs.res.t_reached = r->rs.t;
     return rc;
 }
 
@@ -3216,15 +3216,15 @@ const pd_edr_result *pd_edr_result_of(const pd_edr *r)
     if (!r)
         return NULL;
     /* the arrays point into r: valid until its next run or its free */
-    pd_edr_result *res = (pd_edr_result *)&r->res;
-    res->xpos = r->xpos;
-    res->xneg = r->xneg;
-    res->drift = r->drift;
-    res->contact_impacts = r->impacts;
-    res->first = r->first;
-    res->max_impulse = r->maxP;
-    res->contact_time = r->ctime;
-    res->min_gap = r->gmin;
-    res->modal_bases = r->nbasis;
+    pd_edr_result *res = (pd_edr_result *)&r->rs.res;
+    res->xpos = r->rs.xpos;
+    res->xneg = r->rs.xneg;
+    res->drift = r->rs.drift;
+    res->contact_impacts = r->rs.impacts;
+    res->first = r->rs.first;
+    res->max_impulse = r->rs.maxP;
+    res->contact_time = r->rs.ctime;
+    res->min_gap = r->rs.gmin;
+    res->modal_bases = r->rs.nbasis;
     return res;
 }

@@ -65,11 +65,11 @@ double edr_bisect_sign(edr_fn fn, void *ctx, int k, double sign, double lo, doub
 
 typedef struct edr_block {
     int n;           /* dofs */
-    int first;       /* its dofs: r->blk_dofs[first .. first + n) */
+    int first;       /* its dofs: r->tp.blk_dofs[first .. first + n) */
     int sdof;        /* one dof */
     double m, c, k;  /* SDOF: its scalars */
     double b;        /* SDOF: its load coefficient */
-    int cont0, ncont; /* its contacts: r->blk_cont[cont0 .. cont0 + ncont) */
+    int cont0, ncont; /* its contacts: r->tp.blk_cont[cont0 .. cont0 + ncont) */
 } edr_block;
 
 typedef struct edr_contact {
@@ -103,8 +103,8 @@ typedef struct edr_basis {
 
 typedef struct edr_cluster {
     int kind;
-    int head, nblk, ndof;   /* blocks linked by r->blk_next */
-    int pers_head, npers;   /* persistent contacts linked by r->pers_next */
+    int head, nblk, ndof;   /* blocks linked by r->rs.blk_next */
+    int pers_head, npers;   /* persistent contacts linked by r->rs.pers_next */
     double t0;              /* flight origin */
     int piece;              /* its forcing piece */
     double h;               /* scan step */
@@ -154,7 +154,9 @@ typedef struct edr_queue {
     double *key;   /* slot -> time */
 } edr_queue;
 
-struct pd_edr {
+/* What pd_edr_alloc fixed: the model, its forcing, blocks and contacts
+ * (a reset sets the contacts' initial gaps). */
+typedef struct edr_topo {
     const pd_model *md;
     pd_edr_opts o;
     int n, m, nb;
@@ -171,6 +173,11 @@ struct pd_edr {
     int *dofc_ptr, *dofc;      /* contacts of each dof */
     edr_contact *ct;
     double *minv;              /* n: 1 / M_ii */
+} edr_topo;
+
+/* The run: clusters, the contacts' states, results, the event queue, the
+ * clock, the modal cache and the observer's state. */
+typedef struct edr_run {
     /* clusters */
     edr_cluster *cl;           /* nb slots */
     int *blk_cl, *blk_next;    /* block -> cluster, next block in its cluster */
@@ -210,6 +217,17 @@ struct pd_edr {
     int stopped;
     double vscale;             /* largest velocity met at an event */
     long evals;
+    /* modal cache */
+    edr_basis **bhash;
+    int nbhash;
+    long nbasis;
+    /* observer state */
+    pd_state st;
+} edr_run;
+
+/* One event's scratch: its group (clusters, contacts, dofs), the LCPs'
+ * data and the work arrays. */
+typedef struct edr_event {
     /* the group of an event */
     int epoch, epochD;
     int *g_cl, ng;             /* its clusters */
@@ -254,12 +272,12 @@ struct pd_edr {
     struct meas_ctx *mctx;     /* measurement functions (2 n) */
     edr_scan *mscan;
     edr_pt *mprev;
-    /* modal cache */
-    edr_basis **bhash;
-    int nbhash;
-    long nbasis;
-    /* observer state */
-    pd_state st;
+} edr_event;
+
+struct pd_edr {
+    edr_topo tp;  /* fixed at the allocation */
+    edr_run rs;   /* the run's state */
+    edr_event ev; /* one event's scratch */
 };
 
 /* ---- clusters (event_row_cluster.c) ------------------------------------------- */

@@ -59,20 +59,20 @@
 
 double edr_force(const pd_edr *r, int j, double t)
 {
-    return pd_sine_piece_force(&r->pieces[j], t);
+    return pd_sine_piece_force(&r->tp.pieces[j], t);
 }
 
 double edr_piece_end(const pd_edr *r, int j)
 {
-    return j + 1 < r->npieces ? r->pieces[j + 1].t_start : HUGE_VAL;
+    return j + 1 < r->tp.npieces ? r->tp.pieces[j + 1].t_start : HUGE_VAL;
 }
 
 int edr_piece_at(const pd_edr *r, double t)
 {
-    int lo = 0, hi = r->npieces - 1;
+    int lo = 0, hi = r->tp.npieces - 1;
     while (lo < hi) { /* the last piece starting at or before t */
         int mid = (lo + hi + 1) / 2;
-        if (r->pieces[mid].t_start <= t)
+        if (r->tp.pieces[mid].t_start <= t)
             lo = mid;
         else
             hi = mid - 1;
@@ -83,7 +83,7 @@ int edr_piece_at(const pd_edr *r, double t)
 /* Shortest period of piece j's sinusoid (HUGE_VAL: none). */
 static double piece_period(const pd_edr *r, int j)
 {
-    const pd_sine_piece *pc = &r->pieces[j];
+    const pd_sine_piece *pc = &r->tp.pieces[j];
     return pc->A != 0.0 && pc->w > 0.0 ? PD_TWO_PI / pc->w : HUGE_VAL;
 }
 
@@ -106,8 +106,8 @@ static int side_of(const edr_contact *ct, int i)
 /* The cluster's persistent wall contact, or -1. */
 static int wall_edge(const pd_edr *r, const edr_cluster *c)
 {
-    for (int a = c->pers_head; a >= 0; a = r->pers_next[a])
-        if (r->ct[a].dof[0] < 0 || r->ct[a].dof[1] < 0) /* a wall's side has no dof */
+    for (int a = c->pers_head; a >= 0; a = r->rs.pers_next[a])
+        if (r->tp.ct[a].dof[0] < 0 || r->tp.ct[a].dof[1] < 0) /* a wall's side has no dof */
             return a;
     return -1;
 }
@@ -117,13 +117,13 @@ static void lock_contact(pd_edr *r, edr_cluster *c, int a)
 {
     int *p = &c->pers_head; /* the link that points at a (singly linked list) */
     while (*p >= 0 && *p != a)
-        p = &r->pers_next[*p];
+        p = &r->rs.pers_next[*p];
     if (*p == a) {
-        *p = r->pers_next[a];
+        *p = r->rs.pers_next[a];
         c->npers--;
     }
-    r->pers_next[a] = -1;
-    r->cstate[a] = EDR_LOCKED;
+    r->rs.pers_next[a] = -1;
+    r->rs.cstate[a] = EDR_LOCKED;
 }
 
 /* Breadth-first numbering of the tree from the root: s, d, the parent
@@ -133,33 +133,33 @@ static void lock_contact(pd_edr *r, edr_cluster *c, int a)
 static int tree_order(pd_edr *r, edr_cluster *c, int root, int wedge, int *ord, int *pe, int *pd)
 {
     int nn = 0, head = 0; /* ord[head..nn) is the queue: reached, edges not yet followed */
-    for (int b = c->head; b >= 0; b = r->blk_next[b]) /* loc < 0: not reached yet */
-        r->loc[r->blk_dofs[r->blk[b].first]] = -1;
+    for (int b = c->head; b >= 0; b = r->rs.blk_next[b]) /* loc < 0: not reached yet */
+        r->ev.loc[r->tp.blk_dofs[r->tp.blk[b].first]] = -1;
     /* the root carries the coordinate itself: x_root = y */
-    r->s[root] = 1.0;
-    r->d[root] = 0.0;
-    r->loc[root] = 0;
+    r->rs.s[root] = 1.0;
+    r->rs.d[root] = 0.0;
+    r->ev.loc[root] = 0;
     pe[root] = wedge;
     pd[root] = -1;
     ord[nn++] = root;
     while (head < nn) {
         int u = ord[head++];
-        const edr_block *bk = &r->blk[r->dof_blk[u]];
+        const edr_block *bk = &r->tp.blk[r->tp.dof_blk[u]];
         for (int k = 0; k < bk->ncont; k++) {
-            int a = r->blk_cont[bk->cont0 + k];
-            if (r->cstate[a] != EDR_PERSIST || a == pe[u]) /* not back up the parent edge */
+            int a = r->tp.blk_cont[bk->cont0 + k];
+            if (r->rs.cstate[a] != EDR_PERSIST || a == pe[u]) /* not back up the parent edge */
                 continue;
-            const edr_contact *ct = &r->ct[a];
+            const edr_contact *ct = &r->tp.ct[a];
             int su = side_of(ct, u), v = ct->dof[1 - su];
-            if (v < 0 || r->loc[v] >= 0) { /* a second wall, or a cycle */
+            if (v < 0 || r->ev.loc[v] >= 0) { /* a second wall, or a cycle */
                 lock_contact(r, c, a);
                 continue;
             }
             /* the gap g0 + wu x_u + wv x_v stays zero: x_v = -(g0 + wu x_u) / wv */
             double wu = ct->w[su], wv = ct->w[1 - su];
-            r->s[v] = -wu * r->s[u] / wv;
-            r->d[v] = -(ct->g0 + wu * r->d[u]) / wv;
-            r->loc[v] = nn;
+            r->rs.s[v] = -wu * r->rs.s[u] / wv;
+            r->rs.d[v] = -(ct->g0 + wu * r->rs.d[u]) / wv;
+            r->ev.loc[v] = nn;
             pe[v] = a;
             pd[v] = u;
             ord[nn++] = v;
@@ -174,7 +174,7 @@ static int tree_order(pd_edr *r, edr_cluster *c, int root, int wedge, int *ord, 
  * (Omega s <= EDR_TAYLOR_REACH) the series is the flight to rounding. */
 static void taylor_init(pd_edr *r, edr_cluster *c, double t)
 {
-    const pd_sine_piece *p = &r->pieces[c->piece], *q = &c->pc;
+    const pd_sine_piece *p = &r->tp.pieces[c->piece], *q = &c->pc;
     double th = p->w * t + p->phi, sn = sin(th), cs = cos(th), w0 = c->osc.w0;
     /* d^k/dt^k sin(th) = sin(th + k pi / 2), one of cyc[k % 4]; wk = w^k */
     double cyc[4] = {sn, cs, -sn, -cs}, wk = 1.0, a2 = 2.0 * c->osc.xi * w0, k0 = w0 * w0;
@@ -213,7 +213,7 @@ static void taylor_init(pd_edr *r, edr_cluster *c, double t)
  * their predictions scan. */
 static void flight_bounds(pd_edr *r, edr_cluster *c)
 {
-    const pd_sine_piece *p = &r->pieces[c->piece];
+    const pd_sine_piece *p = &r->tp.pieces[c->piece];
     c->bnd = 0;
     /* f = A sin(w t + phi) + c0 + c1 (t - t_start): |f'| <= |A| w + |c1|, |f''| <= |A| w^2 */
     c->F1 = fabs(p->A) * p->w + fabs(p->c1);
@@ -236,7 +236,7 @@ static void flight_bounds(pd_edr *r, edr_cluster *c)
     c->bnd = 1;
 }
 
-/* The tree's per-node terms summed over each node's subtree (in r->wk). */
+/* The tree's per-node terms summed over each node's subtree (in r->ev.wk). */
 typedef struct tree_sums {
     double *Ms, *Cs, *Ks; /* sum s^2 m, sum s^2 c, sum s^2 k */
     double *KDs, *Bs;     /* sum s k d, sum s b */
@@ -246,17 +246,17 @@ typedef struct tree_sums {
  * oscillator's M, C, K and its load terms. */
 static tree_sums subtree_sums(pd_edr *r, const int *ord, const int *pd, int nn)
 {
-    double *wk = r->wk; /* 5 n of its 8 n */
-    tree_sums S = {.Ms = wk, .Cs = wk + r->n, .Ks = wk + 2 * r->n, .KDs = wk + 3 * r->n,
-                   .Bs = wk + 4 * r->n};
+    double *wk = r->ev.wk; /* 5 n of its 8 n */
+    tree_sums S = {.Ms = wk, .Cs = wk + r->tp.n, .Ks = wk + 2 * r->tp.n, .KDs = wk + 3 * r->tp.n,
+                   .Bs = wk + 4 * r->tp.n};
     for (int k = 0; k < nn; k++) { /* each node's own terms */
         int i = ord[k];
-        const edr_block *bk = &r->blk[r->dof_blk[i]];
-        double s = r->s[i];
+        const edr_block *bk = &r->tp.blk[r->tp.dof_blk[i]];
+        double s = r->rs.s[i];
         S.Ms[i] = s * s * bk->m;
         S.Cs[i] = s * s * bk->c;
         S.Ks[i] = s * s * bk->k;
-        S.KDs[i] = s * bk->k * r->d[i];
+        S.KDs[i] = s * bk->k * r->rs.d[i];
         S.Bs[i] = s * bk->b;
     }
     /* toward the root: in reverse breadth-first order every child is
@@ -281,7 +281,7 @@ static void tree_origin(pd_edr *r, edr_cluster *c, const int *ord, int nn, int w
     int root = c->root;
     double M = c->mass;
     if (c->kind == EDR_REST) {
-        const edr_contact *ct = &r->ct[wedge];
+        const edr_contact *ct = &r->tp.ct[wedge];
         double ww = ct->w[side_of(ct, root)];
         /* the wall's gap g0 + ww x_root is closed, and x_root = y */
         c->y0 = -ct->g0 / ww;
@@ -290,17 +290,17 @@ static void tree_origin(pd_edr *r, edr_cluster *c, const int *ord, int nn, int w
     } else {
         c->osc = (pd_sdof){.w0 = sqrt(K / M), .xi = K > 0.0 ? C / (2.0 * sqrt(K * M)) : 0.0};
         if (nn == 1) { /* one dof, no constraint: y = x */
-            c->y0 = r->xo[root];
-            c->vy0 = r->vo[root];
+            c->y0 = r->rs.xo[root];
+            c->vy0 = r->rs.vo[root];
         } else {
             /* the M-orthogonal projection onto x = s y + d, the least of
              * sum m (x - s y - d)^2: y0 = sum s m (x - d) / M, y0' = sum s m v / M */
             double sy = 0.0, sv = 0.0;
             for (int k = 0; k < nn; k++) {
                 int i = ord[k];
-                double m = r->blk[r->dof_blk[i]].m;
-                sy += r->s[i] * m * (r->xo[i] - r->d[i]);
-                sv += r->s[i] * m * r->vo[i];
+                double m = r->tp.blk[r->tp.dof_blk[i]].m;
+                sy += r->rs.s[i] * m * (r->rs.xo[i] - r->rs.d[i]);
+                sv += r->rs.s[i] * m * r->rs.vo[i];
             }
             c->y0 = sy / M;
             c->vy0 = sv / M;
@@ -310,8 +310,8 @@ static void tree_origin(pd_edr *r, edr_cluster *c, const int *ord, int nn, int w
     for (int k = 0; k < nn; k++) {
         int i = ord[k];
         if (nn > 1 || c->kind == EDR_REST) {
-            r->xo[i] = r->s[i] * c->y0 + r->d[i];
-            r->vo[i] = r->s[i] * c->vy0;
+            r->rs.xo[i] = r->rs.s[i] * c->y0 + r->rs.d[i];
+            r->rs.vo[i] = r->rs.s[i] * c->vy0;
         }
     }
 }
@@ -328,16 +328,16 @@ static void tree_edge_forces(pd_edr *r, const edr_cluster *c, const int *ord, co
         int i = ord[k], e = pe[i];
         if (e < 0) /* a free tree's root; held, the root's edge is the wall's (the whole tree) */
             continue;
-        double sw = r->s[i] * r->ct[e].w[side_of(&r->ct[e], i)];
+        double sw = r->rs.s[i] * r->tp.ct[e].w[side_of(&r->tp.ct[e], i)];
         if (c->kind == EDR_REST) { /* y fixed at y0, at rest: y' = y'' = 0 */
-            r->la[e] = r->lb[e] = 0.0;
-            r->lg[e] = -S->Bs[i] / sw;
-            r->ld[e] = (S->Ks[i] * c->y0 + S->KDs[i]) / sw;
+            r->rs.la[e] = r->rs.lb[e] = 0.0;
+            r->rs.lg[e] = -S->Bs[i] / sw;
+            r->rs.ld[e] = (S->Ks[i] * c->y0 + S->KDs[i]) / sw;
         } else {
-            r->la[e] = (S->Ks[i] - S->Ms[i] * w2) / sw;
-            r->lb[e] = (S->Cs[i] - S->Ms[i] * xw) / sw;
-            r->lg[e] = (S->Ms[i] * c->rho - S->Bs[i]) / sw;
-            r->ld[e] = (S->Ms[i] * c->kappa + S->KDs[i]) / sw;
+            r->rs.la[e] = (S->Ks[i] - S->Ms[i] * w2) / sw;
+            r->rs.lb[e] = (S->Cs[i] - S->Ms[i] * xw) / sw;
+            r->rs.lg[e] = (S->Ms[i] * c->rho - S->Bs[i]) / sw;
+            r->rs.ld[e] = (S->Ms[i] * c->kappa + S->KDs[i]) / sw;
         }
     }
 }
@@ -348,12 +348,12 @@ static int tree_start(pd_edr *r, edr_cluster *c, double t)
 {
     int wedge = wall_edge(r, c);
     /* rooted at the wall's dof (then x_root = y is the one the wall holds) */
-    int root = wedge >= 0 ? r->ct[wedge].dof[r->ct[wedge].dof[0] < 0 ? 1 : 0]
-                          : r->blk_dofs[r->blk[c->head].first];
-    int *ord = r->stack, *pe = r->pe, *pd = r->pdof;
+    int root = wedge >= 0 ? r->tp.ct[wedge].dof[r->tp.ct[wedge].dof[0] < 0 ? 1 : 0]
+                          : r->tp.blk_dofs[r->tp.blk[c->head].first];
+    int *ord = r->ev.stack, *pe = r->ev.pe, *pd = r->ev.pdof;
     int nn = tree_order(r, c, root, wedge, ord, pe, pd);
     for (int k = 0; k < nn; k++) /* the order kept for the impulses of held edges */
-        r->bfs_next[ord[k]] = k + 1 < nn ? ord[k + 1] : -1;
+        r->ev.bfs_next[ord[k]] = k + 1 < nn ? ord[k + 1] : -1;
     tree_sums S = subtree_sums(r, ord, pd, nn);
     /* the aggregates M = sum s^2 m, C = sum s^2 c, K = sum s^2 k; critical C = 2 sqrt(K M) */
     double M = S.Ms[root], C = S.Cs[root], K = S.Ks[root];
@@ -369,7 +369,7 @@ static int tree_start(pd_edr *r, edr_cluster *c, double t)
     tree_edge_forces(r, c, ord, pe, nn, &S);
     /* the flow's forcing F = rho f + kappa, the piece scaled (the piece itself when
      * rho = 1, kappa = 0) */
-    const pd_sine_piece *p = &r->pieces[c->piece];
+    const pd_sine_piece *p = &r->tp.pieces[c->piece];
     c->pc = *p;
     if (c->rho != 1.0 || c->kappa != 0.0) {
         c->pc.A = p->A * c->rho;
@@ -413,18 +413,18 @@ static void basis_free(edr_basis *b)
 
 void edr_basis_cache_free(pd_edr *r)
 {
-    if (!r->bhash)
+    if (!r->rs.bhash)
         return;
-    for (int h = 0; h < r->nbhash; h++) {
-        edr_basis *b = r->bhash[h];
+    for (int h = 0; h < r->rs.nbhash; h++) {
+        edr_basis *b = r->rs.bhash[h];
         while (b) {
             edr_basis *nx = b->next;
             basis_free(b);
             b = nx;
         }
     }
-    free(r->bhash);
-    r->bhash = NULL;
+    free(r->rs.bhash);
+    r->rs.bhash = NULL;
 }
 
 void edr_cluster_free(edr_cluster *c)
@@ -450,13 +450,13 @@ static int cmp_int(const void *a, const void *b)
 static int config_key(pd_edr *r, const edr_cluster *c, int *key, unsigned long *hash)
 {
     int nk = 0, nb0;
-    for (int b = c->head; b >= 0; b = r->blk_next[b])
+    for (int b = c->head; b >= 0; b = r->rs.blk_next[b])
         key[nk++] = b;
     nb0 = nk;
     qsort(key, (size_t)nb0, sizeof(int), cmp_int);
     key[nk++] = -1; /* the separator: a block and a contact may share a number */
     int a0 = nk;
-    for (int a = c->pers_head; a >= 0; a = r->pers_next[a])
+    for (int a = c->pers_head; a >= 0; a = r->rs.pers_next[a])
         key[nk++] = a;
     qsort(key + a0, (size_t)(nk - a0), sizeof(int), cmp_int);
     /* sorted, the key names the configuration whatever the lists' order;
@@ -559,17 +559,17 @@ static int gather_blocks(pd_edr *r, const int *key, int nk, edr_basis *B, basis_
     B->nkey = nk;
     int at = 0; /* the block's first local index */
     for (int k = 0; k < w->nb0; k++) {
-        const edr_block *bk = &r->blk[key[k]];
-        long off = r->blk_off[key[k]];
+        const edr_block *bk = &r->tp.blk[key[k]];
+        long off = r->tp.blk_off[key[k]];
         for (int i = 0; i < bk->n; i++) {
-            int gi = r->blk_dofs[bk->first + i];
+            int gi = r->tp.blk_dofs[bk->first + i];
             B->dofs[at + i] = gi;
-            r->loc[gi] = at + i;
-            w->bc[at + i] = r->b[gi];
+            r->ev.loc[gi] = at + i;
+            w->bc[at + i] = r->tp.b[gi];
             /* C[at + i, at + j] = C_b[i, j] (C nc x nc, C_b n_b x n_b, column-major) */
             for (int j = 0; j < bk->n; j++) {
-                w->Cc[(at + i) + (size_t)(at + j) * nc] = r->Cb[off + i + (long)j * bk->n];
-                w->Kc[(at + i) + (size_t)(at + j) * nc] = r->Kb[off + i + (long)j * bk->n];
+                w->Cc[(at + i) + (size_t)(at + j) * nc] = r->tp.Cb[off + i + (long)j * bk->n];
+                w->Kc[(at + i) + (size_t)(at + j) * nc] = r->tp.Kb[off + i + (long)j * bk->n];
             }
         }
         at += bk->n;
@@ -585,13 +585,13 @@ static int keep_independent(pd_edr *r, basis_scratch *w, int *dep, int *ndep, pd
 {
     int nc = w->nc, nr = 0;
     for (int k = 0; k < w->ncon; k++) {
-        const edr_contact *ct = &r->ct[w->cons[k]];
+        const edr_contact *ct = &r->tp.ct[w->cons[k]];
         /* the candidate goes in the column after the kept ones (overwritten if dependent) */
         double *col = w->Wd + (size_t)nr * nc, nrm0 = 0.0, nrm = 0.0;
         memset(col, 0, (size_t)nc * sizeof(double));
         for (int s = 0; s < 2; s++)
             if (ct->dof[s] >= 0) /* a wall side has no dof */
-                col[r->loc[ct->dof[s]]] += ct->w[s];
+                col[r->ev.loc[ct->dof[s]]] += ct->w[s];
         for (int i = 0; i < nc; i++) /* |w_a|^2 */
             nrm0 += col[i] * col[i];
         /* the exact test: Householder QR of the kept columns and w_a */
@@ -725,7 +725,7 @@ static int reduced_alloc(edr_basis *B, basis_scratch *w, pd_err *err)
 static void reduced_project(const pd_edr *r, const edr_basis *B, basis_scratch *w)
 {
     int nc = w->nc, k = w->k;
-    const double *minv = r->minv, *Cc = w->Cc, *Kc = w->Kc;
+    const double *minv = r->tp.minv, *Cc = w->Cc, *Kc = w->Kc;
     const gsl_matrix *N = w->N;
     for (int i = 0; i < nc; i++) { /* (K q*)_i = sum_j K_ij q*_j */
         double s = 0.0;
@@ -805,7 +805,7 @@ static int first_order_system(const pd_edr *r, edr_basis *B, basis_scratch *w, p
             double s = 0.0;
             for (int b2 = 0; b2 < k; b2++)
                 s += MG(Mr, a, b2) * MG(N, i, b2);
-            B->Y[a + (size_t)i * k] = s / r->minv[B->dofs[i]];
+            B->Y[a + (size_t)i * k] = s / r->tp.minv[B->dofs[i]];
         }
     }
     /* the dofs' accelerations per unit f (af) and from the constant force (ak) */
@@ -943,7 +943,7 @@ static void modes_store(edr_basis *B, const basis_scratch *w)
 static void contact_force_modes(const pd_edr *r, edr_basis *B, const basis_scratch *w)
 {
     int nc = w->nc, k = w->k, nr = w->nr, nm = B->nmodes;
-    const double *minv = r->minv, *Cc = w->Cc, *Kc = w->Kc, *L = w->L;
+    const double *minv = r->tp.minv, *Cc = w->Cc, *Kc = w->Kc, *L = w->L;
     for (int c2 = 0; c2 < nr; c2++) {
         double gsum = 0.0, dsum = 0.0;
         for (int i = 0; i < nc; i++) {
@@ -991,7 +991,7 @@ static int basis_build(pd_edr *r, const int *key, int nk, edr_basis **out, int *
     w.cons = key + w.nb0 + 1;
     w.ncon = nk - w.nb0 - 1;
     for (int k = 0; k < w.nb0; k++)
-        w.nc += r->blk[key[k]].n;
+        w.nc += r->tp.blk[key[k]].n;
     edr_basis *B = pd_calloc(1, sizeof *B);
     *ndep = 0;
     if (!B)
@@ -1025,15 +1025,15 @@ static int basis_build(pd_edr *r, const int *key, int nk, edr_basis **out, int *
 /* The cached basis of the cluster's configuration (built when first met). */
 static int basis_of(pd_edr *r, edr_cluster *c, edr_basis **out, pd_err *err)
 {
-    int *key = r->keybuf, *dep = r->keybuf + r->nb + r->m + 1, ndep = 0, rc;
+    int *key = r->ev.keybuf, *dep = r->ev.keybuf + r->tp.nb + r->tp.m + 1, ndep = 0, rc;
     unsigned long h;
     int nk = config_key(r, c, key, &h);
-    if (!r->bhash) { /* the buckets, taken when the first modal cluster starts */
-        r->nbhash = BASIS_BUCKETS;
-        if (!(r->bhash = pd_calloc(r->nbhash, sizeof *r->bhash)))
+    if (!r->rs.bhash) { /* the buckets, taken when the first modal cluster starts */
+        r->rs.nbhash = BASIS_BUCKETS;
+        if (!(r->rs.bhash = pd_calloc(r->rs.nbhash, sizeof *r->rs.bhash)))
             return pd_err_set(err, PD_ENOMEM, "out of memory for the modal cache");
     }
-    edr_basis **slot = &r->bhash[h % (unsigned long)r->nbhash];
+    edr_basis **slot = &r->rs.bhash[h % (unsigned long)r->rs.nbhash];
     /* a hit needs the whole key equal: two configurations may share a hash */
     for (edr_basis *b = *slot; b; b = b->next)
         if (b->key == h && b->nkey == nk && !memcmp(b->keyv, key, (size_t)nk * sizeof(int))) {
@@ -1047,7 +1047,7 @@ static int basis_of(pd_edr *r, edr_cluster *c, edr_basis **out, pd_err *err)
     b->key = h; /* pushed at the chain's head */
     b->next = *slot;
     *slot = b;
-    r->nbasis++;
+    r->rs.nbasis++;
     *out = b;
     return PD_OK;
 }
@@ -1058,16 +1058,16 @@ static int basis_of(pd_edr *r, edr_cluster *c, edr_basis **out, pd_err *err)
 static void modal_origin(pd_edr *r, edr_cluster *c, const edr_basis *B)
 {
     int nc = B->nc, k = B->k;
-    double *y = r->wk, *yd = y + nc; /* y0, y0' (k <= nc each) */
+    double *y = r->ev.wk, *yd = y + nc; /* y0, y0' (k <= nc each) */
     for (int i = 0; i < nc; i++) /* dof -> its row of Px, Pv */
-        r->crow[B->dofs[i]] = i;
+        r->rs.crow[B->dofs[i]] = i;
     /* y0 = Y (x - q*), y0' = Y v: the M-orthogonal projection onto q = q* + N y */
     for (int a = 0; a < k; a++) {
         double s1 = 0.0, s2 = 0.0;
         for (int i = 0; i < nc; i++) {
             int gi = B->dofs[i];
-            s1 += B->Y[a + (size_t)i * k] * (r->xo[gi] - B->qstar[i]);
-            s2 += B->Y[a + (size_t)i * k] * r->vo[gi];
+            s1 += B->Y[a + (size_t)i * k] * (r->rs.xo[gi] - B->qstar[i]);
+            s2 += B->Y[a + (size_t)i * k] * r->rs.vo[gi];
         }
         y[a] = s1;
         yd[a] = s2;
@@ -1086,8 +1086,8 @@ static void modal_origin(pd_edr *r, edr_cluster *c, const edr_basis *B)
             x += B->wt[q] * creal(B->Px[(size_t)i * B->nmodes + q] * c->eta0[q]);
             v += B->wt[q] * creal(B->Pv[(size_t)i * B->nmodes + q] * c->eta0[q]);
         }
-        r->xo[B->dofs[i]] = x;
-        r->vo[B->dofs[i]] = v;
+        r->rs.xo[B->dofs[i]] = x;
+        r->rs.vo[B->dofs[i]] = v;
     }
 }
 
@@ -1096,7 +1096,7 @@ static void modal_origin(pd_edr *r, edr_cluster *c, const edr_basis *B)
 static void modal_flight_constants(const pd_edr *r, edr_cluster *c, const edr_basis *B,
                                    double t)
 {
-    const pd_sine_piece *pc = &r->pieces[c->piece];
+    const pd_sine_piece *pc = &r->tp.pieces[c->piece];
     /* f_lin(t0) = c0 + c1 (t0 - t_start), th(t0) = w t0 + phi */
     double fl0 = pc->c0 + pc->c1 * (t - pc->t_start), th = pc->w * t + pc->phi;
     c->ath0 = pc->A != 0.0 ? pc->A / (2.0 * I) * (cos(th) + I * sin(th)) : 0.0;
@@ -1120,7 +1120,7 @@ static int modal_start(pd_edr *r, edr_cluster *c, double t, pd_err *err)
         return rc;
     /* persistent contacts the basis found dependent are locked */
     for (int a = c->pers_head, nx; a >= 0; a = nx) {
-        nx = r->pers_next[a];
+        nx = r->rs.pers_next[a];
         int in = 0;
         for (int j = 0; j < B->r && !in; j++)
             in = B->cons[j] == a;
@@ -1128,7 +1128,7 @@ static int modal_start(pd_edr *r, edr_cluster *c, double t, pd_err *err)
             lock_contact(r, c, a);
     }
     for (int j = 0; j < B->r; j++) /* contact -> its row of F, gam, del */
-        r->crow_c[B->cons[j]] = j;
+        r->rs.crow_c[B->cons[j]] = j;
     if (c->cap < B->nmodes) { /* the per-mode state grows to the largest basis met */
         edr_cluster_free(c);
         int cap = B->nmodes;
@@ -1156,16 +1156,16 @@ static int modal_start(pd_edr *r, edr_cluster *c, double t, pd_err *err)
 
 int edr_cluster_start(pd_edr *r, int ci, double t, pd_err *err)
 {
-    edr_cluster *c = &r->cl[ci];
+    edr_cluster *c = &r->rs.cl[ci];
     int all_sdof = 1, rc;
     c->t0 = t;
     c->imp_t = t;
     c->piece = edr_piece_at(r, t);
     c->cached = 0; /* a new flight: the state cached at tc belongs to the old one */
     c->ndof = 0;
-    for (int b = c->head; b >= 0; b = r->blk_next[b]) { /* a tree needs SDOF blocks only */
-        all_sdof &= r->blk[b].sdof;
-        c->ndof += r->blk[b].n;
+    for (int b = c->head; b >= 0; b = r->rs.blk_next[b]) { /* a tree needs SDOF blocks only */
+        all_sdof &= r->tp.blk[b].sdof;
+        c->ndof += r->tp.blk[b].n;
     }
     if (!all_sdof || tree_start(r, c, t)) {
         /* a tree may have locked contacts already: the modal start re-reads the list */
@@ -1176,8 +1176,8 @@ int edr_cluster_start(pd_edr *r, int ci, double t, pd_err *err)
      * forcing's periods; with neither, a quarter of the run */
     double T = fmin(c->T_min, piece_period(r, c->piece));
     if (!isfinite(T))
-        T = 0.25 * (r->t1 - r->pieces[0].t_start);
-    c->h = T / r->o.scan_divisions;
+        T = 0.25 * (r->rs.t1 - r->tp.pieces[0].t_start);
+    c->h = T / r->tp.o.scan_divisions;
     return PD_OK;
 }
 
@@ -1223,7 +1223,7 @@ static edr_cplx expm1_parts(double x, double y, edr_cplx *ez)
 static void modal_eval(const pd_edr *r, edr_cluster *c, double t)
 {
     const edr_basis *B = c->basis;
-    const pd_sine_piece *pc = &r->pieces[c->piece];
+    const pd_sine_piece *pc = &r->tp.pieces[c->piece];
     /* is = 1 / s is read only where |lam s| >= 1, so never at s = 0 */
     double s = t - c->t0, ft = pd_sine_piece_force(pc, t), is = 1.0 / s;
     edr_cplx ews = 1.0, Aep = 0.0, Aem = 0.0;
@@ -1269,10 +1269,10 @@ static void modal_eval(const pd_edr *r, edr_cluster *c, double t)
 
 void edr_cluster_eval(pd_edr *r, int ci, double t)
 {
-    edr_cluster *c = &r->cl[ci];
+    edr_cluster *c = &r->rs.cl[ci];
     if (c->cached && c->tc == t) /* the scans ask the same t of several dofs and contacts */
         return;
-    r->evals++;
+    r->rs.evals++;
     c->tc = t;
     c->cached = 1;
     switch (c->kind) {
@@ -1319,18 +1319,18 @@ void edr_cluster_eval(pd_edr *r, int ci, double t)
 
 void edr_dof_at(pd_edr *r, int ci, int dof, double t, double *dx, double *v, double *a)
 {
-    edr_cluster *c = &r->cl[ci];
+    edr_cluster *c = &r->rs.cl[ci];
     edr_cluster_eval(r, ci, t);
     if (c->kind != EDR_MODAL) { /* x = s y + d: dx = s dy, v = s y', a = s y'' */
-        double s = r->s[dof];
+        double s = r->rs.s[dof];
         *dx = s * c->dy;
         *v = s * c->vy;
         *a = s * c->ay;
         return;
     }
     const edr_basis *B = c->basis;
-    const edr_cplx *px = B->Px + (size_t)r->crow[dof] * B->nmodes;
-    const edr_cplx *pv = B->Pv + (size_t)r->crow[dof] * B->nmodes;
+    const edr_cplx *px = B->Px + (size_t)r->rs.crow[dof] * B->nmodes;
+    const edr_cplx *pv = B->Pv + (size_t)r->rs.crow[dof] * B->nmodes;
     /* dx = sum wt Re(Px deta), v = sum wt Re(Pv eta), a = sum wt Re(Pv eta'):
      * N times the upper and lower halves of z = V eta, z' = V eta' */
     double sx = 0.0, sv = 0.0, sa = 0.0;
@@ -1347,15 +1347,15 @@ void edr_dof_at(pd_edr *r, int ci, int dof, double t, double *dx, double *v, dou
 
 double edr_force_at(pd_edr *r, int ci, int a, double t)
 {
-    edr_cluster *c = &r->cl[ci];
+    edr_cluster *c = &r->rs.cl[ci];
     edr_cluster_eval(r, ci, t);
     if (c->kind == EDR_REST) /* lambda = lg f + ld (y held) */
-        return r->lg[a] * c->f_tc + r->ld[a];
+        return r->rs.lg[a] * c->f_tc + r->rs.ld[a];
     if (c->kind == EDR_SDOF)
-        return r->la[a] * (c->y0 + c->dy) + r->lb[a] * c->vy + r->lg[a] * c->f_tc + r->ld[a];
+        return r->rs.la[a] * (c->y0 + c->dy) + r->rs.lb[a] * c->vy + r->rs.lg[a] * c->f_tc + r->rs.ld[a];
     /* lambda = gam f + del + sum wt Re(F eta) (contact_force_modes) */
     const edr_basis *B = c->basis;
-    int row = r->crow_c[a];
+    int row = r->rs.crow_c[a];
     const edr_cplx *F = B->F + (size_t)row * B->nmodes;
     double s = B->gam[row] * c->f_tc + B->del[row];
     for (int q = 0; q < B->nmodes; q++)

@@ -333,10 +333,16 @@ def site_keys(text):
              new or "(removed)", op) for (a, b, new, op) in sites(text)]
 
 
+def shape(key):
+    """A site as a change of names or layout keeps it: its operator and
+    text (a deleted statement's text may name a field otherwise)."""
+    return (key[4], key[3]) if key[4] == "delete" else key[2:]
+
+
 def remap(rev):
     """The equivalents' keys moved with their sites: a file changed since rev
-    only by comments or layout has the same sites in the same order, so the
-    k-th site of the old text is the k-th of the new."""
+    only by comments, names or layout has the same sites in the same order,
+    so the k-th site of the old text is the k-th of the new."""
     path = os.path.join(ROOT, "scripts", "mutate_equivalent.txt")
     out, moved, bad, cache = [], 0, 0, {}
     for raw in open(path, encoding="utf-8"):
@@ -353,7 +359,7 @@ def remap(rev):
         old_keys, new_keys = cache[f]
         idx = [i for i, k in enumerate(old_keys or []) if k[0] == line and k[1] == col
                and k[2] == " ".join(m.group(4).split())]
-        same = old_keys is not None and [k[2:] for k in old_keys] == [k[2:] for k in new_keys]
+        same = old_keys is not None and [shape(k) for k in old_keys] == [shape(k) for k in new_keys]
         if not idx or not same:
             print("remap: %s:%d:%d left as it is (%s)" % (f, line, col, "not a site at " + rev
                   if not idx else "its sites changed since " + rev))
