@@ -140,7 +140,7 @@ INSTALLED   = $(bindir)/pound $(libdir)/libpound.a $(libdir)/$(SOREAL) $(libdir)
 # make check ends with scripts/api-check.sh (not under the sanitizers)
 API_CHECK  ?= 1
 
-.PHONY: all deps demo test check asan bench mutate clean acceptance figures paper figures-docs \
+.PHONY: all deps demo test check asan bench mutate format format-check house clean acceptance figures paper figures-docs \
         paper-docs stress print-libs \
         shared install uninstall install-check formats-check flags-check python-check
 
@@ -260,6 +260,18 @@ figures-docs:
 
 paper-docs:
 	@$(MAKE) --no-print-directory paper DOCS=1
+
+# The layout (.clang-format, clang-format 14) and the house's measures
+# (scripts/house.py: no function over 150 lines in core/ lcp/ engine/
+# problems/, comment lines inside engine/ and lcp/ bodies >= 10 %).
+FORMAT_FILES = $(filter-out tests/test_api_null.c,$(shell git ls-files '*.c' '*.h' 2>/dev/null))
+format:
+	clang-format -i --style=file $(FORMAT_FILES)
+format-check:
+	@clang-format --dry-run --Werror --style=file $(FORMAT_FILES) && \
+	  echo "format-check: $(words $(FORMAT_FILES)) files as .clang-format lays them out"
+house:
+	@python3 scripts/house.py
 
 # Mutation testing of the numerical core (scripts/mutate.py; minutes, not
 # part of CI): MUTATE_ARGS="--files lcp/lemke.c --n 30 --seed 1 --report F".

@@ -19,7 +19,7 @@
 #include "pd_bench.h"
 #include "pd_problems.h"
 
-#define ADAPT_ACC 1e-5   /* the one-wall comparison's accuracy */
+#define ADAPT_ACC 1e-5 /* the one-wall comparison's accuracy */
 #define ADAPT_NCASE 180
 
 /* The fixed-step run that reaches acc: dt halved from the default. */
@@ -115,8 +115,11 @@ static int bench_points(const adapt_case *k, int nr, point *pt, double *ref_cpu)
             o.rtol = point_rtols[j];
             if (pd_osc_run(&k->c, &o, NULL, NULL, &r, &err))
                 return 1;
-            pt[j] = (point){.rtol = o.rtol, .err = fabs(r.umax - ref.umax) / ref.umax,
-                            .est = r.err_est, .cpu = r.cpu_s, .met = r.rtol_met};
+            pt[j] = (point){.rtol = o.rtol,
+                            .err = fabs(r.umax - ref.umax) / ref.umax,
+                            .est = r.err_est,
+                            .cpu = r.cpu_s,
+                            .met = r.rtol_met};
         }
         return 0;
     }
@@ -132,8 +135,8 @@ static int bench_points(const adapt_case *k, int nr, point *pt, double *ref_cpu)
         double e = 0.0;
         for (int i = 0; i < k->sc->n && !rc; i++)
             e = fmax(e, fabs(r.umax[i] - ref.umax[i]) / ref.umax[i]);
-        pt[j] = (point){.rtol = o.rtol, .err = e, .est = r.err_est_max, .cpu = r.cpu_s,
-                        .met = r.rtol_met};
+        pt[j] = (point){
+            .rtol = o.rtol, .err = e, .est = r.err_est_max, .cpu = r.cpu_s, .met = r.rtol_met};
     }
     if (rc)
         fprintf(stderr, "pound: bench --rtol: %s: %s\n", k->name, err.msg);
@@ -234,7 +237,8 @@ int pd_bench_adapt(pd_json *js)
         if (absent || bench_points(&cases[k], npts[k], pts[k], &ref_cpu[k]))
             npts[k] = 0;
     }
-    double ns_adapt = per_dof_step(10000, 0.2, 1e-3, 0.0), ns_fixed = per_dof_step(10000, 0.2, 0.0, 0.0);
+    double ns_adapt = per_dof_step(10000, 0.2, 1e-3, 0.0),
+           ns_fixed = per_dof_step(10000, 0.2, 0.0, 0.0);
     if (js) {
         pd_json_begin_object(js, "rtol");
         pd_json_num(js, "one_wall_accuracy", ADAPT_ACC);
@@ -277,7 +281,8 @@ int pd_bench_adapt(pd_json *js)
         printf("  (goals: the compressed cluster within 1e-3 in < 2 s, the row of 100 within 1e-3 "
                "in < 20 s)\n");
         printf("  --chain 10000 to 0.2 s: %.1f ns per DOF-step to rtol 1e-3, %.1f at the default "
-               "dt: %.2fx (goal <= 2x)\n", ns_adapt, ns_fixed, ns_adapt / ns_fixed);
+               "dt: %.2fx (goal <= 2x)\n",
+               ns_adapt, ns_fixed, ns_adapt / ns_fixed);
     }
     for (int k = 0; k < NCASE; k++)
         pd_scene_free(cases[k].sc);

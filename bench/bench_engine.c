@@ -28,9 +28,9 @@ typedef struct bench_case {
     const char *what;
     double steps_per_s;      /* per second of CPU time */
     double wall_steps_per_s; /* per second of wall time */
-    double lcp_fraction; /* steps with an active contact */
+    double lcp_fraction;     /* steps with an active contact */
     long steps;
-    double chain_ns;     /* the dependency chain's bound per step (NAN: not estimated) */
+    double chain_ns; /* the dependency chain's bound per step (NAN: not estimated) */
 } bench_case;
 
 /* The scalar kernel's loop-carried chain (engine/pd_mj1.h), in dependent
@@ -186,23 +186,44 @@ int pd_bench_engine(pd_json *js)
     int n = 0, rc = 0;
     pd_run_opts o = pd_run_default_opts();
     /* free flight: harmonic excitation, the wall out of reach */
-    pd_osc free_c = {.pulse = PD_PULSE_HARMONIC, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5,
-                     .Pi3 = 1e9, .eps = 0.5, .xi = 0.05};
+    pd_osc free_c = {.pulse = PD_PULSE_HARMONIC,
+                     .dir = 1,
+                     .ap = 1.0,
+                     .Tp = 1.0,
+                     .Pi2 = 0.5,
+                     .Pi3 = 1e9,
+                     .eps = 0.5,
+                     .xi = 0.05};
     o.dt = 1e-4;
     o.tend = 1000.0;
-    cases[n] = (bench_case){.name = "free_flight", .what = "harmonic, no contact, oscillator observer"};
+    cases[n] =
+        (bench_case){.name = "free_flight", .what = "harmonic, no contact, oscillator observer"};
     rc |= time_oscillator(&free_c, &o, &cases[n++]);
     /* many impacts: harmonic, small gap, eps = 0.8 */
-    pd_osc imp_c = {.pulse = PD_PULSE_HARMONIC, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5,
-                    .Pi3 = 0.01, .eps = 0.8, .xi = 0.05};
+    pd_osc imp_c = {.pulse = PD_PULSE_HARMONIC,
+                    .dir = 1,
+                    .ap = 1.0,
+                    .Tp = 1.0,
+                    .Pi2 = 0.5,
+                    .Pi3 = 0.01,
+                    .eps = 0.8,
+                    .xi = 0.05};
     cases[n] = (bench_case){.name = "many_impacts", .what = "harmonic, Pi3 = 0.01, eps = 0.8"};
     rc |= time_oscillator(&imp_c, &o, &cases[n++]);
     /* persistent contact: a normal sine pulse, eps = 0, long resting phases */
-    pd_osc rest_c = {.pulse = PD_PULSE_HARMONIC, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.3,
-                     .Pi3 = 0.0, .eps = 0.0, .xi = 0.05};
-    cases[n] = (bench_case){.name = "contact_phases", .what = "harmonic, Pi3 = 0, eps = 0 (rests half the time)"};
+    pd_osc rest_c = {.pulse = PD_PULSE_HARMONIC,
+                     .dir = 1,
+                     .ap = 1.0,
+                     .Tp = 1.0,
+                     .Pi2 = 0.3,
+                     .Pi3 = 0.0,
+                     .eps = 0.0,
+                     .xi = 0.05};
+    cases[n] = (bench_case){.name = "contact_phases",
+                            .what = "harmonic, Pi3 = 0, eps = 0 (rests half the time)"};
     rc |= time_oscillator(&rest_c, &o, &cases[n++]);
-    cases[n] = (bench_case){.name = "persistent_scalar", .what = "pressed on the wall, LCP every step, scalar kernel"};
+    cases[n] = (bench_case){.name = "persistent_scalar",
+                            .what = "pressed on the wall, LCP every step, scalar kernel"};
     rc |= time_pressing(PD_KERNEL_AUTO, PD_LCP_AUTO, 10000000, &cases[n++]);
     cases[n] = (bench_case){.name = "persistent_general",
                             .what = "the same, general kernel (one contact: the closed form)"};
@@ -224,8 +245,8 @@ int pd_bench_engine(pd_json *js)
     double lat_wall, lat = fp_latency_ns(&lat_wall);
     for (int k = 0; k < n; k++) {
         const char *nm = cases[k].name;
-        int batched = !strncmp(nm, "batched", 7), general = strstr(nm, "general") ||
-                                                             strstr(nm, "lemke");
+        int batched = !strncmp(nm, "batched", 7),
+            general = strstr(nm, "general") || strstr(nm, "lemke");
         double ops = !strcmp(nm, "persistent_scalar") ? CHAIN_CONTACT : CHAIN_FREE;
         cases[k].chain_ns = general ? NAN : ops * lat / (batched ? PD_MJB_LANES : 1);
     }
@@ -270,8 +291,8 @@ int pd_bench_engine(pd_json *js)
         }
         printf("  chain: the bound of the step's dependency chain (%d dependent operations, %d "
                "with an impulse, at %.2f ns each, measured (wall %.2f ns); batched: per "
-               "oscillator, the %d lanes' chains overlapping)\n", CHAIN_FREE, CHAIN_CONTACT, lat,
-               lat_wall, PD_MJB_LANES);
+               "oscillator, the %d lanes' chains overlapping)\n",
+               CHAIN_FREE, CHAIN_CONTACT, lat, lat_wall, PD_MJB_LANES);
         printf("  targets: 20e6 steps/s in free flight, 5e6 steps/s with an LCP every step\n");
     }
     return rc ? 1 : 0;

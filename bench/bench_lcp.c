@@ -37,7 +37,7 @@
 #define CHAIN_SEEDS 5
 #define CHAIN_FRESH_SEED 1000 /* the timed solves' right-hand sides, seeds from here on */
 #define GROWTH_ROUNDS 3
-#define DENSE_BAND_N 1000 /* the chain given densely (issue 20, goal 4) */
+#define DENSE_BAND_N 1000    /* the chain given densely (issue 20, goal 4) */
 #define GOAL_PER_CONTACT 1.1 /* time per contact at N = 1e5 over that at 1e3, at most */
 #define GOAL_DENSE_BAND 2.0  /* a band given densely over the banded path, at most */
 
@@ -75,8 +75,8 @@ typedef struct bench_report {
  * right-hand side at q + b step (step 0: q each time); *failed gets the
  * solves that did not return PD_OK. */
 static pd_bench_clock time_batch(pd_lcp_solver *sv, const pd_matrix *M, const double *q,
-                                 size_t step, const pd_lcp_opts *o, double *z, double *w,
-                                 int batch, pd_lcp_info *info, long *failed)
+                                 size_t step, const pd_lcp_opts *o, double *z, double *w, int batch,
+                                 pd_lcp_info *info, long *failed)
 {
     pd_bench_clock t0 = pd_bench_now();
     for (int b = 0; b < batch; b++)
@@ -105,8 +105,8 @@ static void add_figures(const pd_lcp_info *info, int first, bench_row *row, doub
  * not return PD_OK into *failed.  1 when the solver could not be set up
  * (Lemke or structured not solving a solvable problem is caught by the
  * callers). */
-static int measure(pd_lcp_method method, const pd_matrix *M, const double *q, int nfig,
-                   int fresh, int max_iterations, bench_row *row, long *failed)
+static int measure(pd_lcp_method method, const pd_matrix *M, const double *q, int nfig, int fresh,
+                   int max_iterations, bench_row *row, long *failed)
 {
     int n = M->rows, seed = CHAIN_FRESH_SEED;
     long nnz = M->kind == PD_MATRIX_CSC ? M->colptr[n] : 0;
@@ -136,12 +136,13 @@ static int measure(pd_lcp_method method, const pd_matrix *M, const double *q, in
     int min_runs = once > BENCH_LONG_S ? 3 : BENCH_MIN_RUNS;
     double total = 0.0;
     int nruns = 0;
-    while (nruns < BENCH_MAX_RUNS && (nruns < min_runs || (total < BENCH_MIN_S && once <= BENCH_LONG_S))) {
+    while (nruns < BENCH_MAX_RUNS &&
+           (nruns < min_runs || (total < BENCH_MIN_S && once <= BENCH_LONG_S))) {
         for (int b = 0; fresh && b < batch; b++)
             pd_lcp_chain_q(n, seed++, bank + (size_t)b * (size_t)n);
-        pd_bench_clock t = fresh ? time_batch(sv, M, bank, (size_t)n, &o, zw, zw + n, batch,
-                                              &info, failed)
-                                 : time_batch(sv, M, q, 0, &o, zw, zw + n, batch, &info, failed);
+        pd_bench_clock t =
+            fresh ? time_batch(sv, M, bank, (size_t)n, &o, zw, zw + n, batch, &info, failed)
+                  : time_batch(sv, M, q, 0, &o, zw, zw + n, batch, &info, failed);
         total += t.wall_s;
         cpu_runs[nruns] = 1e6 * t.cpu_s / batch;
         runs[nruns++] = 1e6 * t.wall_s / batch;
@@ -273,8 +274,8 @@ static void bench_chains(bench_report *rep)
                 continue;
             bench_row *row = &rep->rows[rep->nrows++];
             snprintf(row->name, sizeof row->name, "chain_%d", N);
-            rep->failed |= measure_chain(methods[m], N,
-                                         methods[m] == PD_LCP_PGS ? 1 : CHAIN_SEEDS, row);
+            rep->failed |=
+                measure_chain(methods[m], N, methods[m] == PD_LCP_PGS ? 1 : CHAIN_SEEDS, row);
         }
 }
 
@@ -446,7 +447,8 @@ static void bench_siconos_file(bench_report *rep, const char *dir, const char *f
             *r = rep->rows[rep->nrows - 2];
         long unsolved;
         rep->failed |= measure(methods[m], &Mv, q, 1, 0, 0, r, &unsolved);
-        rep->failed |= m == 0 && (r->outcome == PD_LCP_NUMERICAL || r->outcome == PD_LCP_MAX_PIVOTS);
+        rep->failed |=
+            m == 0 && (r->outcome == PD_LCP_NUMERICAL || r->outcome == PD_LCP_MAX_PIVOTS);
     }
     free(M);
     free(q);
@@ -470,8 +472,8 @@ static void bench_siconos(bench_report *rep, const char *shared_dir, char *dir, 
 static void print_table(const bench_report *rep)
 {
     printf("LCP solvers, median us per cold solve over >= %d timed batches (3 for solves over "
-           "%g s), one thread; wall clock (median_us) and CPU time (cpu_us)\n", BENCH_MIN_RUNS,
-           BENCH_LONG_S);
+           "%g s), one thread; wall clock (median_us) and CPU time (cpu_us)\n",
+           BENCH_MIN_RUNS, BENCH_LONG_S);
     if (!rep->siconos_found)
         printf("Siconos set: skipped (no .dat files in %s)\n", rep->siconos_dir);
     printf("%-28s %6s %-26s %-14s %7s %6s %9s %12s %12s\n", "problem", "n", "solver", "status",
@@ -479,12 +481,13 @@ static void print_table(const bench_report *rep)
     for (int k = 0; k < rep->nrows; k++) {
         const bench_row *r = &rep->rows[k];
         printf("%-28s %6d %-26s %-14s %7d %6d %9.2g %12.3f %12.3f\n", r->name, r->n, r->solver,
-               pd_lcp_outcome_name(r->outcome), r->pivots, r->iterations, r->residual,
-               r->median_us, r->median_cpu_us);
+               pd_lcp_outcome_name(r->outcome), r->pivots, r->iterations, r->residual, r->median_us,
+               r->median_cpu_us);
     }
     printf("chains: a new right-hand side q for every timed solve (pgs: one q), pivots and "
            "iterations means over %d; against Siconos numerics, paired in one run: make bench "
-           "(bench/siconos_lcp)\n", CHAIN_SEEDS);
+           "(bench/siconos_lcp)\n",
+           CHAIN_SEEDS);
     printf("growth exponent of the CPU time on chains, N = 1e3 ... 1e5: structured %.3f, pgs (%d "
            "sweeps) %.3f\n",
            growth(rep, "structured", 1000, 100000), BENCH_PGS_SWEEPS,
@@ -495,7 +498,8 @@ static void print_table(const bench_report *rep)
            GROWTH_ROUNDS, rep->fresh_ns5, rep->fresh_ns3, g, GOAL_PER_CONTACT,
            g <= GOAL_PER_CONTACT ? "met" : "not met");
     printf("  one q repeated instead (the branch predictor trained on it): %.1f / %.1f ns = "
-           "%.3f\n", rep->repeated_ns5, rep->repeated_ns3, rep->repeated_ns5 / rep->repeated_ns3);
+           "%.3f\n",
+           rep->repeated_ns5, rep->repeated_ns3, rep->repeated_ns5 / rep->repeated_ns3);
     if (!rep->band_ok) {
         printf("band given densely: FAILED\n");
         return;

@@ -42,8 +42,7 @@ static void record_sweep(pd_spectrum *s, const pd_cli_record *r, pd_method metho
 }
 
 /* Compute a record's sweep with a method into res; its wall time added to f. */
-static int run_sweep(const pd_cli_record *r, pd_method method, pd_spec_result *res,
-                     method_fig *f)
+static int run_sweep(const pd_cli_record *r, pd_method method, pd_spec_result *res, method_fig *f)
 {
     pd_spectrum s;
     pd_err err;
@@ -77,8 +76,7 @@ static int list_records(const char *dir, char **names, int max)
         size_t len = strlen(e->d_name);
         int at2 = len > 4 && !strcasecmp(e->d_name + len - 4, ".AT2");
         int v2 = len > 3 && !strcasecmp(e->d_name + len - 3, ".V2");
-        if ((at2 || v2) &&
-            (names[n] = malloc(strlen(dir) + len + 2)))
+        if ((at2 || v2) && (names[n] = malloc(strlen(dir) + len + 2)))
             sprintf(names[n++], "%s/%s", dir, e->d_name);
     }
     closedir(d);
@@ -153,9 +151,10 @@ int pd_bench_records(pd_json *js, const char *shared_dir)
         printf("Record study: skipped (no records in %s)\n", dir);
     } else {
         printf("Record study: %d records x 200 Pi2 x 4 Pi3 x 3 eps (+ no-wall twins), xi = 0.05, "
-               "normal, %d OpenMP threads\n", nrec, RECORDS_THREADS);
-        printf("  %-26s %9s %9s %9s %12s %14s\n", "method", "runs", "wall [s]", "CPU [s]",
-               "runs/s", "steps or events");
+               "normal, %d OpenMP threads\n",
+               nrec, RECORDS_THREADS);
+        printf("  %-26s %9s %9s %9s %12s %14s\n", "method", "runs", "wall [s]", "CPU [s]", "runs/s",
+               "steps or events");
         printf("  %-26s %9ld %9.3f %9.3f %12.4g %14.4g\n", "event-driven (exact)", ev.runs,
                ev.wall_s, ev.cpu_s, (double)ev.runs / ev.wall_s, ev.steps);
         printf("  %-26s %9ld %9.3f %9.3f %12.4g %14.4g\n", "Moreau-Jean (default dt)", mj.runs,

@@ -18,12 +18,12 @@
 #include "pd_bench.h"
 #include "pd_problems.h"
 
-#define SCENE_STEPS_PER_TP 200  /* dt = Tp / 200 [s] */
-#define SCENE_WARM_STEPS 200    /* one excitation period */
-#define SCENE_DOF_STEPS 5e6     /* DOF-steps timed per row */
+#define SCENE_STEPS_PER_TP 200 /* dt = Tp / 200 [s] */
+#define SCENE_WARM_STEPS 200   /* one excitation period */
+#define SCENE_DOF_STEPS 5e6    /* DOF-steps timed per row */
 #define SCENE_MIN_STEPS 100
 #define SCENE_PI3 0.01
-#define SCENE_TARGET 5e6        /* DOF-steps per second at N = 10^4 */
+#define SCENE_TARGET 5e6 /* DOF-steps per second at N = 10^4 */
 
 /* One row's figures. */
 typedef struct chain_case {
@@ -138,8 +138,14 @@ static int one_wall_rate(const pd_scene *sc, const pd_osc *c, const pd_run_opts 
  * (rate[2], rate[3]). */
 static int one_wall(double rate[4])
 {
-    pd_osc c = {.pulse = PD_PULSE_HARMONIC, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5,
-                .Pi3 = 0.01, .eps = 0.8, .xi = 0.05};
+    pd_osc c = {.pulse = PD_PULSE_HARMONIC,
+                .dir = 1,
+                .ap = 1.0,
+                .Tp = 1.0,
+                .Pi2 = 0.5,
+                .Pi3 = 0.01,
+                .eps = 0.8,
+                .xi = 0.05};
     pd_scene_excitation exc = {.pulse = c.pulse, .dir = c.dir, .ap = c.ap, .Tp = c.Tp};
     double wp = 2.0 * PD_PI / c.Tp;
     pd_run_opts o = pd_run_default_opts();
@@ -218,11 +224,17 @@ static int time_row_spectrum(pd_bench_clock *time)
              pd_scene_add_sdof(sc, "S3", 0.6, 0.05, 2.5e5, &err) ||
              pd_scene_add_contact(sc, PD_WALL, 0, 0, 1, 0.01, 0.08, 0, &err) ||
              pd_scene_add_contact(sc, 0, 1, 1, 1, 0.02, 0.08, 1, &err) ||
-             pd_scene_add_contact(sc, 1, 1, 2, 1, 0.015, 0.71, 2, &err) || pd_scene_finish(sc, &err);
+             pd_scene_add_contact(sc, 1, 1, 2, 1, 0.015, 0.71, 2, &err) ||
+             pd_scene_finish(sc, &err);
     if (!rc) {
         sc->tend = 3.0;
-        pd_scene_sweep w = {.sc = sc, .opts = pd_run_default_opts(), .ref = 0, .ref_contact = 0,
-                            .pi2_min = 0.1, .pi2_max = 5.0, .npi2 = 200};
+        pd_scene_sweep w = {.sc = sc,
+                            .opts = pd_run_default_opts(),
+                            .ref = 0,
+                            .ref_contact = 0,
+                            .pi2_min = 0.1,
+                            .pi2_max = 5.0,
+                            .npi2 = 200};
         w.opts.method = PD_METHOD_EVENT;
         long n = pd_scene_sweep_twins(&w) + pd_scene_sweep_points(&w);
         pd_scene_point *pts = calloc((size_t)n, sizeof *pts);
@@ -307,33 +319,38 @@ int pd_bench_scene(pd_json *js)
     } else {
         printf("Moreau-Jean on --chain N rows (harmonic, Pi3 = %g, e = 0, dt = Tp/%d; one core)\n",
                SCENE_PI3, SCENE_STEPS_PER_TP);
-        printf("  %8s %8s %12s %14s %8s %8s %10s  %s\n", "N", "steps", "ns/DOF-step",
-               "DOF-steps/s", "wall ns", "active", "LCP its", "factor");
+        printf("  %8s %8s %12s %14s %8s %8s %10s  %s\n", "N", "steps", "ns/DOF-step", "DOF-steps/s",
+               "wall ns", "active", "LCP its", "factor");
         for (int k = 0; k < NSIZES; k++)
             printf("  %8d %8ld %12.1f %14.4g %8.1f %7.1f%% %10.1f  %s\n", cc[k].N, cc[k].steps,
-                   cc[k].ns_per_dof_step, 1e9 / cc[k].ns_per_dof_step,
-                   cc[k].wall_ns_per_dof_step, 100 * cc[k].active_fraction,
-                   cc[k].lcp_iterations, cc[k].factor ? cc[k].factor : "?");
+                   cc[k].ns_per_dof_step, 1e9 / cc[k].ns_per_dof_step, cc[k].wall_ns_per_dof_step,
+                   100 * cc[k].active_fraction, cc[k].lcp_iterations,
+                   cc[k].factor ? cc[k].factor : "?");
         printf("  (ns/DOF-step and DOF-steps/s in CPU time; wall ns: per DOF-step of the wall "
                "clock)\n");
         printf("  growth exponent of the time per step, N = 1e3 ... 1e5: %.3f (goal <= 1.2); "
-               "goal %.0e DOF-steps/s at N = 1e4\n", expo, SCENE_TARGET);
+               "goal %.0e DOF-steps/s at N = 1e4\n",
+               expo, SCENE_TARGET);
         printf("  one-wall scene %.4g steps/s, the oscillator %.4g steps/s: ratio %.3f (CPU; wall "
-               "%.4g and %.4g)\n", ow[0], ow[1], ow[0] / ow[1], ow[2], ow[3]);
+               "%.4g and %.4g)\n",
+               ow[0], ow[1], ow[0] / ow[1], ow[2], ow[3]);
         printf("the exact event-driven reference on --chain N rows (sine Tp = 1 s, Pi3 = 0.05, "
                "e = 0.6, 4 s; one core)\n");
-        printf("  %8s %10s %10s %10s %10s %12s\n", "N", "cpu [s]", "wall [s]", "events",
-               "impacts", "us/event");
+        printf("  %8s %10s %10s %10s %10s %12s\n", "N", "cpu [s]", "wall [s]", "events", "impacts",
+               "us/event");
         for (int k = 0; k < ROW_SIZES; k++)
             printf("  %8d %10.4g %10.4g %10ld %10ld %12.3g\n", rows[k].N, rows[k].cpu_s,
                    rows[k].wall_s, rows[k].events, rows[k].impacts, rows[k].us_per_event);
-        printf("  cost per event (CPU) from N = 10 to 1e4 within %.2fx (goal 2x); the row of 100 in "
-               "%.3g s CPU, %.3g s wall (goal 0.2 s)\n", hi / lo, rows[1].cpu_s, rows[1].wall_s);
+        printf(
+            "  cost per event (CPU) from N = 10 to 1e4 within %.2fx (goal 2x); the row of 100 in "
+            "%.3g s CPU, %.3g s wall (goal 0.2 s)\n",
+            hi / lo, rows[1].cpu_s, rows[1].wall_s);
         printf("  the GSL-based general reference (event-general) on the row of 10: %.3g s CPU, "
-               "%.3g s wall, %.3gx the exact one\n", general.cpu_s, general.wall_s,
-               general.cpu_s / rows[0].cpu_s);
+               "%.3g s wall, %.3gx the exact one\n",
+               general.cpu_s, general.wall_s, general.cpu_s / rows[0].cpu_s);
         printf("  200-point spectrum of a three-structure row (event): %.3g s CPU, %.3g s wall "
-               "(goal 1 s)\n", spec.cpu_s, spec.wall_s);
+               "(goal 1 s)\n",
+               spec.cpu_s, spec.wall_s);
     }
     return rc ? 1 : 0;
 }

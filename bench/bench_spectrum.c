@@ -142,14 +142,14 @@ typedef struct variant_fig {
 typedef struct bench_fig {
     variant_fig var[NVARIANTS];
     int nvar;
-    int level;                             /* the processor's (POUND_ISA capping it) */
-    pd_bench_clock serial, omp2, event;    /* at that level; event: the reference, one thread */
-    pd_bench_clock scalar;                 /* Moreau-Jean one task at a time */
+    int level;                          /* the processor's (POUND_ISA capping it) */
+    pd_bench_clock serial, omp2, event; /* at that level; event: the reference, one thread */
+    pd_bench_clock scalar;              /* Moreau-Jean one task at a time */
     double steps;
-    double err_median, err_worst;          /* Moreau-Jean umax against it, relative */
+    double err_median, err_worst; /* Moreau-Jean umax against it, relative */
     long runs, points;
-    int identical;                         /* 1 and 2 threads */
-    int scalar_identical;                  /* the processor's level and the scalar kernel */
+    int identical;        /* 1 and 2 threads */
+    int scalar_identical; /* the processor's level and the scalar kernel */
 } bench_fig;
 
 /* Median and worst |umax_mj - umax_ref| / umax_ref over the runs with the
@@ -192,17 +192,17 @@ static void print_fig(pd_json *js, const bench_fig *f)
             char name[48];
             snprintf(name, sizeof name, "1 thread, %s", pd_cpu_level_name(v->level));
             printf("  %-30s %8.3f %8.3f %14.4g  %.2fx the scalar kernel (CPU; wall %.2fx), "
-                   "bit-identical to it: %s\n", name, v->serial.wall_s, v->serial.cpu_s,
-                   f->steps / v->serial.wall_s, f->scalar.cpu_s / v->serial.cpu_s,
-                   f->scalar.wall_s / v->serial.wall_s, v->identical ? "yes" : "NO");
+                   "bit-identical to it: %s\n",
+                   name, v->serial.wall_s, v->serial.cpu_s, f->steps / v->serial.wall_s,
+                   f->scalar.cpu_s / v->serial.cpu_s, f->scalar.wall_s / v->serial.wall_s,
+                   v->identical ? "yes" : "NO");
         }
         printf("  at the processor's level, %s:\n", pd_cpu_level_name(f->level));
-        printf("  %-30s %8.3f %8.3f %14.4g  (%.2f ns per oscillator-step)\n",
-               "serial (1 thread)", f->serial.wall_s, f->serial.cpu_s,
-               f->steps / f->serial.wall_s, 1e9 * f->serial.wall_s / f->steps);
-        printf("  %-30s %8.3f %8.3f %14.4g  speedup %.2f, efficiency %.0f %%\n",
-               "OpenMP 2 threads", f->omp2.wall_s, f->omp2.cpu_s, f->steps / f->omp2.wall_s,
-               speedup, 100.0 * eff);
+        printf("  %-30s %8.3f %8.3f %14.4g  (%.2f ns per oscillator-step)\n", "serial (1 thread)",
+               f->serial.wall_s, f->serial.cpu_s, f->steps / f->serial.wall_s,
+               1e9 * f->serial.wall_s / f->steps);
+        printf("  %-30s %8.3f %8.3f %14.4g  speedup %.2f, efficiency %.0f %%\n", "OpenMP 2 threads",
+               f->omp2.wall_s, f->omp2.cpu_s, f->steps / f->omp2.wall_s, speedup, 100.0 * eff);
         printf("  results of 1 and 2 threads bit-identical: %s\n", f->identical ? "yes" : "NO");
         double er = f->serial.wall_s / f->event.wall_s; /* > 1: the exact method faster */
         printf("  %-30s %8.3f %8.3f  runs/s: event %.4g, Moreau-Jean %.4g (%s %.2fx faster)\n",
@@ -294,9 +294,9 @@ int pd_bench_spectrum(pd_json *js)
     f.level = pd_cpu_level();
     f.runs = pd_spec_tasks(&s);
     f.points = pd_spec_points(&s);
-    pd_spec_result *r1 = malloc((size_t)f.runs * sizeof *r1);  /* batched, the processor's level */
-    pd_spec_result *rs = malloc((size_t)f.runs * sizeof *rs);  /* the scalar kernel */
-    pd_spec_result *r2 = malloc((size_t)f.runs * sizeof *r2);  /* scratch */
+    pd_spec_result *r1 = malloc((size_t)f.runs * sizeof *r1); /* batched, the processor's level */
+    pd_spec_result *rs = malloc((size_t)f.runs * sizeof *rs); /* the scalar kernel */
+    pd_spec_result *r2 = malloc((size_t)f.runs * sizeof *r2); /* scratch */
     double *err = malloc((size_t)f.runs * sizeof *err);
     pd_spectrum se = s; /* the same sweep, exact */
     se.opts.method = PD_METHOD_EVENT;

@@ -112,12 +112,14 @@ int pd_bench_startup(pd_json *js)
                "spawns, median of 5 rounds)\n");
         printf("  /bin/true                 %7.2f ms  CPU %5.2f ms   (the smallest process here)\n",
                1e3 * t_true, 1e3 * c_true);
-        printf("  pound --version           %7.2f ms  CPU %5.2f ms   (%.2f ms more)\n",
-               1e3 * t_ver, 1e3 * c_ver, 1e3 * (t_ver - t_true));
+        printf("  pound --version           %7.2f ms  CPU %5.2f ms   (%.2f ms more)\n", 1e3 * t_ver,
+               1e3 * c_ver, 1e3 * (t_ver - t_true));
         printf("  pound simulate --json     %7.2f ms  CPU %5.2f ms   (%.2f ms more; two exact runs "
-               "of ~0.2 ms; target 5 ms)\n", 1e3 * t_sim, 1e3 * c_sim, 1e3 * (t_sim - t_true));
+               "of ~0.2 ms; target 5 ms)\n",
+               1e3 * t_sim, 1e3 * c_sim, 1e3 * (t_sim - t_true));
         printf("  shared libraries mapped at start: %d (HDF5 and CHOLMOD load when a run "
-               "needs them)\n", libs);
+               "needs them)\n",
+               libs);
     }
     return isfinite(t_sim) && isfinite(t_ver) ? 0 : 1;
 }

@@ -34,8 +34,7 @@ int pd_cmd_bench(int argc, char **argv)
         else if (!strcmp(argv[i], "--shared") && i + 1 < argc) {
             shared = argv[++i];
             shared_given = 1;
-        }
-        else if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+        } else if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             puts("usage: pound bench [--lcp] [--engine] [--scene] [--rtol] [--spectrum]\n"
                  "                   [--records] [--startup] [--json]\n"
                  "                   [--shared DIR]\n"
@@ -47,7 +46,8 @@ int pd_cmd_bench(int argc, char **argv)
                  "  --lcp: the LCP solvers on the Siconos set and chains of 10 ... 10^5 contacts\n"
                  "  --engine: Moreau-Jean steps/s on the one-wall oscillator (scalar, batched and\n"
                  "  general kernels) beside the bound of each step's dependency chain\n"
-                 "  --scene: ns per DOF-step on rows (`--chain N`) of 10 ... 10^5 SDOFs, the one-wall\n"
+                 "  --scene: ns per DOF-step on rows (`--chain N`) of 10 ... 10^5 SDOFs, the "
+                 "one-wall\n"
                  "  scene against the oscillator\n"
                  "  --rtol: Moreau-Jean to a tolerance: the one-wall cost against fixed steps at\n"
                  "  1e-5, error and CPU for rtol 1e-2 ... 1e-6 on one wall, rows of 2, 10, 100, a\n"

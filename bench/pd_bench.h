@@ -23,13 +23,13 @@
  * with (pd_cpu_level: the processor's, capped by POUND_ISA); printed once,
  * before the drivers. */
 int pd_bench_machine(pd_json *js);
-int pd_bench_lcp(pd_json *js, const char *shared_dir);   /* bench_lcp.c */
-int pd_bench_engine(pd_json *js);                        /* bench_engine.c */
-int pd_bench_scene(pd_json *js);                         /* bench_scene.c */
-int pd_bench_spectrum(pd_json *js);                      /* bench_spectrum.c */
+int pd_bench_lcp(pd_json *js, const char *shared_dir);     /* bench_lcp.c */
+int pd_bench_engine(pd_json *js);                          /* bench_engine.c */
+int pd_bench_scene(pd_json *js);                           /* bench_scene.c */
+int pd_bench_spectrum(pd_json *js);                        /* bench_spectrum.c */
 int pd_bench_records(pd_json *js, const char *shared_dir); /* bench_records.c */
-int pd_bench_startup(pd_json *js);                       /* bench_startup.c */
-int pd_bench_adapt(pd_json *js);                         /* bench_adapt.c */
+int pd_bench_startup(pd_json *js);                         /* bench_startup.c */
+int pd_bench_adapt(pd_json *js);                           /* bench_adapt.c */
 
 /* ---- shared by the drivers (bench_util.c) -------------------------------- */
 

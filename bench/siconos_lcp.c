@@ -58,10 +58,10 @@
 #define MAX_FILES 256
 #define MAX_ROWS (MAX_FILES + 16)
 #define CHAIN_SEEDS 5
-#define PGS_SEEDS 1       /* pound times PGS on the first seed only */
-#define PGS_SWEEPS 2000   /* PGS's budget on the chains, as pound's */
-#define PGS_TOL 1e-10     /* Siconos' relative error at which PGS stops */
-#define VERIFY_TOL 1e-10  /* relative residual of a verified answer, as pound's */
+#define PGS_SEEDS 1      /* pound times PGS on the first seed only */
+#define PGS_SWEEPS 2000  /* PGS's budget on the chains, as pound's */
+#define PGS_TOL 1e-10    /* Siconos' relative error at which PGS stops */
+#define VERIFY_TOL 1e-10 /* relative residual of a verified answer, as pound's */
 
 /* A Siconos solver and the options it is run with (0: Siconos' default). */
 typedef struct solver_kind {
@@ -259,8 +259,7 @@ static void record(const lcp_data *p, const siconos_side *sc, pound_side *pc,
 
 /* Time Siconos' `kind` against pound's `method` on p into row (name left
  * to the caller); 1 when out of memory.  Everything is made once here. */
-static int measure(const solver_kind *kind, pd_lcp_method method, const lcp_data *p,
-                   bench_row *row)
+static int measure(const solver_kind *kind, pd_lcp_method method, const lcp_data *p, bench_row *row)
 {
     NumericsMatrix *M = NM_create(NM_DENSE, p->n, p->n);
     SolverOptions *o = make_options(kind);
@@ -274,10 +273,14 @@ static int measure(const solver_kind *kind, pd_lcp_method method, const lcp_data
     if (!failed) {
         memcpy(M->matrix0, p->M, (size_t)p->n * (size_t)p->n * sizeof(double));
         LinearComplementarityProblem problem = {.size = p->n, .M = M, .q = p->q};
-        siconos_side sc = {.kind = kind, .problem = &problem, .options = o,
-                           .z = zw, .w = zw + p->n, .n = p->n};
-        pound_side pc = {.solver = solver, .q = p->q, .opts = pd_lcp_default_opts(),
-                         .z = zw + 2 * p->n, .w = zw + 3 * p->n, .n = p->n};
+        siconos_side sc = {
+            .kind = kind, .problem = &problem, .options = o, .z = zw, .w = zw + p->n, .n = p->n};
+        pound_side pc = {.solver = solver,
+                         .q = p->q,
+                         .opts = pd_lcp_default_opts(),
+                         .z = zw + 2 * p->n,
+                         .w = zw + 3 * p->n,
+                         .n = p->n};
         pc.M = dense ? pd_matrix_dense(p->n, p->n, p->M)
                      : pd_matrix_csc(p->n, p->n, colptr, rowind, values);
         if (method == PD_LCP_PGS)
@@ -388,8 +391,8 @@ static int read_header(FILE *f, int *n)
 {
     int storage, r1, c1, r2, c2;
     return read_int(f, n) && read_int(f, &storage) && read_int(f, &r1) && read_int(f, &c1) &&
-           read_int(f, &r2) && read_int(f, &c2) && *n > 0 && storage == 0 && r1 == *n &&
-           c1 == *n && r2 == *n && c2 == *n;
+           read_int(f, &r2) && read_int(f, &c2) && *n > 0 && storage == 0 && r1 == *n && c1 == *n &&
+           r2 == *n && c2 == *n;
 }
 
 /* A dense Siconos LCP file into p; -1 (with a message) on failure. */
@@ -513,8 +516,8 @@ static void print_json(const bench_report *rep)
                "\"pound_residual\": %.17g, \"pound_us\": %.17g, \"ratio\": %.17g}",
                k ? "," : "", r->name, r->n, r->siconos, r->status, r->verified ? "true" : "false",
                r->pivots, r->residual, r->siconos_us, r->pound,
-               r->pound_verified ? "true" : "false", r->pound_steps, r->pound_residual,
-               r->pound_us, r->ratio);
+               r->pound_verified ? "true" : "false", r->pound_steps, r->pound_residual, r->pound_us,
+               r->ratio);
     }
     printf("\n]}\n");
 }

@@ -43,7 +43,8 @@ int pd_cli_double(const char *flag, const char *text, double *out)
         return pd_cli_usage_error("%s: '%s' is not a number", flag, text);
     if (errno == ERANGE) /* beyond the doubles, or below their normal range */
         return pd_cli_usage_error("%s: '%s' is out of range (a magnitude between 1e-307 and "
-                                  "1e308, or 0)", flag, text);
+                                  "1e308, or 0)",
+                                  flag, text);
     if (!isfinite(x))
         return pd_cli_usage_error("%s: '%s' is not a finite number", flag, text);
     *out = x;

@@ -86,10 +86,10 @@ int pd_cli_record_load(const char *path, pd_record_format format, pd_record_unit
     if (units_given && fmt == PD_RECORD_AUTO && pd_record_detect(path, &fmt, &err))
         return pd_cli_usage_error("%s", err.msg);
     if (units_given && fmt != PD_RECORD_TEXT)
-        return pd_cli_usage_error("--units: %s is read as %s, whose file states its units "
-                                  "(--units is for two-column text records)",
-                                  path, fmt == PD_RECORD_AT2 ? "a PEER AT2 record (in g)"
-                                                             : "a COSMOS V2 record");
+        return pd_cli_usage_error(
+            "--units: %s is read as %s, whose file states its units "
+            "(--units is for two-column text records)",
+            path, fmt == PD_RECORD_AT2 ? "a PEER AT2 record (in g)" : "a COSMOS V2 record");
     pd_cli_record *r = calloc(1, sizeof *r);
     if (!r) {
         fprintf(stderr, "pound: out of memory for the record %s\n", path);
@@ -160,14 +160,14 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
     static const struct {
         const char *flag;
         pd_method method;
-    } only[] = {{"--dt", PD_METHOD_MOREAU},        {"--theta", PD_METHOD_MOREAU},
-                {"--gamma", PD_METHOD_MOREAU},     {"--allow-unstable", PD_METHOD_MOREAU},
-                {"--kernel", PD_METHOD_MOREAU},    {"--factor", PD_METHOD_MOREAU},
+    } only[] = {{"--dt", PD_METHOD_MOREAU},         {"--theta", PD_METHOD_MOREAU},
+                {"--gamma", PD_METHOD_MOREAU},      {"--allow-unstable", PD_METHOD_MOREAU},
+                {"--kernel", PD_METHOD_MOREAU},     {"--factor", PD_METHOD_MOREAU},
                 {"--lcp-solver", PD_METHOD_MOREAU}, {"--no-accumulation", PD_METHOD_EVENT},
-                {"--close-tol", PD_METHOD_EVENT},  {"--impact-law", PD_METHOD_EVENT},
-                {"--kc", PD_METHOD_PENALTY},       {"--kc-abs", PD_METHOD_PENALTY},
-                {"--atol", PD_METHOD_PENALTY},
-                {"--contact", PD_METHOD_PENALTY},  {"--stepper", PD_METHOD_PENALTY}};
+                {"--close-tol", PD_METHOD_EVENT},   {"--impact-law", PD_METHOD_EVENT},
+                {"--kc", PD_METHOD_PENALTY},        {"--kc-abs", PD_METHOD_PENALTY},
+                {"--atol", PD_METHOD_PENALTY},      {"--contact", PD_METHOD_PENALTY},
+                {"--stepper", PD_METHOD_PENALTY}};
     for (size_t n = 0; n < sizeof only / sizeof only[0]; n++)
         if (!strcmp(f, only[n].flag)) {
             pd_cli_case_implies(a, f, only[n].method);
@@ -203,9 +203,9 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
         rc = named(f, val, pd_method_parse(val, &a->opts.method) != PD_OK,
                    "moreau, event, penalty, auto, event-general");
         a->method_by = a->opts.method == PD_METHOD_AUTO ? NULL : f;
-    }
-    else if (!strcmp(f, "--contact")) {
-        rc = named(f, val, !val || (strcmp(val, "kelvin") && strcmp(val, "hertz")), "kelvin, hertz");
+    } else if (!strcmp(f, "--contact")) {
+        rc =
+            named(f, val, !val || (strcmp(val, "kelvin") && strcmp(val, "hertz")), "kelvin, hertz");
         if (rc == 1)
             a->opts.pen.law = strcmp(val, "hertz") ? PD_PENALTY_KELVIN : PD_PENALTY_HERTZDAMP;
     } else if (!strcmp(f, "--stepper")) {
@@ -218,23 +218,23 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
             }
         rc = named(f, val, !ok, "rk8pd, rkf45, rk4imp, msbdf");
     } else if (!strcmp(f, "--kernel")) {
-        rc = named(f, val, !val || (strcmp(val, "auto") && strcmp(val, "general")), "auto, general");
+        rc =
+            named(f, val, !val || (strcmp(val, "auto") && strcmp(val, "general")), "auto, general");
         if (rc == 1)
             a->opts.kernel = strcmp(val, "general") ? PD_KERNEL_AUTO : PD_KERNEL_GENERAL;
     } else if (!strcmp(f, "--factor"))
         rc = named(f, val, pd_factor_kind_parse(val, &a->opts.factor) != PD_OK,
                    "auto, scalar, dense, cholmod");
     else if (!strcmp(f, "--impact-law"))
-        rc = named(f, val, pd_impact_law_parse(val, &a->opts.impact_law) != PD_OK,
-                   "staged, single");
+        rc =
+            named(f, val, pd_impact_law_parse(val, &a->opts.impact_law) != PD_OK, "staged, single");
     else if (!strcmp(f, "--lcp-solver"))
         rc = named(f, val, pd_lcp_method_parse(val, &a->opts.lcp_solver) != PD_OK,
                    pd_lcp_method_list());
     else if (!strcmp(f, "--units")) {
         a->have_units = 1;
         rc = named(f, val, pd_record_units_parse(val, &a->rec_units) != PD_OK, "g, m/s2, cm/s2");
-    }
-    else if (!strcmp(f, "--record-format"))
+    } else if (!strcmp(f, "--record-format"))
         rc = named(f, val, pd_record_format_parse(val, &a->rec_format) != PD_OK,
                    "auto, at2, v2, text");
     else if (!strcmp(f, "--record")) {
@@ -294,13 +294,16 @@ static int check_scheme(const pd_cli_case *a)
                                   o->pen.atol);
     if (!(o->close_tol >= 0.0 && o->close_tol <= 1.0))
         return pd_cli_usage_error("--close-tol: the closing tolerance must be in [0, 1] (in "
-                                  "units of Le; got %.10g)", o->close_tol);
+                                  "units of Le; got %.10g)",
+                                  o->close_tol);
     if (!(o->contact_duration > 0.0) || !isfinite(o->contact_duration))
         return pd_cli_usage_error("--contact-duration: must be a finite number > 0 [s] "
-                                  "(got %.10g)", o->contact_duration);
+                                  "(got %.10g)",
+                                  o->contact_duration);
     if (!(a->height > 0.0) || !isfinite(a->height))
         return pd_cli_usage_error("--height: the storey height must be a finite number > 0 "
-                                  "[m] (got %.10g)", a->height);
+                                  "[m] (got %.10g)",
+                                  a->height);
     return 0;
 }
 
@@ -349,13 +352,15 @@ int pd_cli_case_check_derived(const pd_cli_case *a)
     double T0 = pd_osc_T0(c), wp = pd_osc_wp(c), Le = pd_osc_Le(c), gap = pd_osc_gap(c);
     if (!isfinite(T0) || !(T0 > 0.0) || !isfinite(PD_TWO_PI / T0) || !isfinite(c->Pi2))
         return pd_cli_usage_error("%s: the oscillator's period T0 = Tp / Pi2 = %.3g s / %.3g is "
-                                  "out of range", extreme_period_flag(a), c->Tp, c->Pi2);
+                                  "out of range",
+                                  extreme_period_flag(a), c->Tp, c->Pi2);
     if (!isfinite(wp) || !(Le > 0.0) || !isfinite(Le))
-        return pd_cli_usage_error("%s: Le = ap (Tp / 2 pi)^2 = %.3g m is out of range",
-                                  ap_flag(a), Le);
+        return pd_cli_usage_error("%s: Le = ap (Tp / 2 pi)^2 = %.3g m is out of range", ap_flag(a),
+                                  Le);
     if (!isfinite(gap) || !isfinite(c->Pi3))
         return pd_cli_usage_error("%s: the gap is too large for ap and Tp (Pi3 = gap / Le "
-                                  "overflows)", a->have_gap ? "--gap" : "--Pi3");
+                                  "overflows)",
+                                  a->have_gap ? "--gap" : "--Pi3");
     double tend = a->have_tend ? a->opts.tend : pd_osc_default_tend(c);
     double dt = a->have_dt ? a->opts.dt : pd_osc_default_dt(c);
     if (!isfinite(tend))
@@ -364,7 +369,8 @@ int pd_cli_case_check_derived(const pd_cli_case *a)
         return 0;
     if (a->have_dt && !(dt < tend))
         return pd_cli_usage_error("%s: the step %.3g s is not shorter than the run (tend = "
-                                  "%.3g s)", a->dt_flag ? a->dt_flag : "--dt", dt, tend);
+                                  "%.3g s)",
+                                  a->dt_flag ? a->dt_flag : "--dt", dt, tend);
     if (!(tend / dt <= PD_MAX_STEPS))
         return pd_cli_usage_error("%s: %.3g steps of %.3g s over %.3g s (at most %.0e)",
                                   steps_flag(a), tend / dt, dt, tend, PD_MAX_STEPS);
@@ -398,7 +404,8 @@ static int check_case(const pd_cli_case *a)
     if (a->have_gap && !(a->gap >= 0.0))
         return pd_cli_usage_error("--gap: the gap must be >= 0 (got %.10g)", a->gap);
     if (a->have_Pi3 && !(a->c.Pi3 >= 0.0))
-        return pd_cli_usage_error("--Pi3: the dimensionless gap must be >= 0 (got %.10g)", a->c.Pi3);
+        return pd_cli_usage_error("--Pi3: the dimensionless gap must be >= 0 (got %.10g)",
+                                  a->c.Pi3);
     if (!(a->c.eps >= 0.0 && a->c.eps <= 1.0))
         return pd_cli_usage_error("--eps: restitution must be in [0, 1] (got %.10g)", a->c.eps);
     if (!(a->c.xi >= 0.0 && a->c.xi < 1.0))
@@ -406,7 +413,8 @@ static int check_case(const pd_cli_case *a)
     if (a->chain && !(a->chain_ratio > 0.0))
         return pd_cli_usage_error("--chain-ratio: must be > 0 (got %.10g)", a->chain_ratio);
     /* the shorter period sets the step, the longer the run: at most CASE_MAX_RATIO apart */
-    if (a->chain > 1 && !(a->chain_ratio <= CASE_MAX_RATIO && a->chain_ratio >= 1.0 / CASE_MAX_RATIO))
+    if (a->chain > 1 &&
+        !(a->chain_ratio <= CASE_MAX_RATIO && a->chain_ratio >= 1.0 / CASE_MAX_RATIO))
         return pd_cli_usage_error("--chain-ratio: must be in [1e-4, 1e4] (got %.10g)",
                                   a->chain_ratio);
     if ((rc = pd_cli_case_check_derived(a)))
@@ -427,11 +435,13 @@ static int case_record(pd_cli_case *a)
                                   "file (docs/scenes.md)");
     if (a->pulse_flag)
         return pd_cli_usage_error("%s: the record replaces the pulse (its fitted pulse gives ap "
-                                  "and Tp; --scale scales it)", a->pulse_flag);
+                                  "and Tp; --scale scales it)",
+                                  a->pulse_flag);
     if (!(a->scale > 0.0) || !isfinite(a->scale))
         return pd_cli_usage_error("--scale: must be > 0 (got %.10g)", a->scale);
-    int rc = a->record ? 0 : pd_cli_record_load(a->record_path, a->rec_format, a->rec_units, a->have_units,
-                                                &a->record);
+    int rc = a->record ? 0
+                       : pd_cli_record_load(a->record_path, a->rec_format, a->rec_units,
+                                            a->have_units, &a->record);
     if (!rc)
         pd_osc_set_record(&a->c, &a->record->rec, &a->record->pulse, a->scale);
     return rc;
@@ -453,7 +463,8 @@ static int case_rtol(pd_cli_case *a)
         return 0;
     if (!(a->rtol >= PD_RTOL_MIN && a->rtol < 1.0))
         return pd_cli_usage_error("--rtol: the relative tolerance must be in [%g, 1) (got "
-                                  "%.10g)", PD_RTOL_MIN, a->rtol);
+                                  "%.10g)",
+                                  PD_RTOL_MIN, a->rtol);
     if (m == PD_METHOD_PENALTY) {
         a->opts.pen.rtol = a->rtol;
         return 0;
@@ -465,7 +476,8 @@ static int case_rtol(pd_cli_case *a)
     }
     if (m != PD_METHOD_MOREAU && m != PD_METHOD_AUTO)
         return pd_cli_usage_error("--rtol: the tolerance of moreau's steps or of penalty's "
-                                  "integrator; --method %s has none", pd_method_name(m));
+                                  "integrator; --method %s has none",
+                                  pd_method_name(m));
     if (a->have_dt)
         return pd_cli_usage_error("--rtol and %s: Moreau-Jean takes fixed steps (--dt) or "
                                   "steps to a tolerance (--rtol), not both",
@@ -492,8 +504,9 @@ static int case_method(pd_cli_case *a)
             continue;
         if (by)
             return pd_cli_usage_error("%s and %s belong to different methods (%s, %s): give "
-                                      "--method", by, a->implies[m],
-                                      pd_method_name(a->opts.method), pd_method_name((pd_method)m));
+                                      "--method",
+                                      by, a->implies[m], pd_method_name(a->opts.method),
+                                      pd_method_name((pd_method)m));
         by = a->implies[m];
         a->opts.method = (pd_method)m;
     }
@@ -561,10 +574,12 @@ static int case_method_flags(const pd_cli_case *a)
                 continue;
             char names[64];
             method_names(bits, names, sizeof names);
-            return pd_cli_usage_error("%s: a flag of %s%s; --method %s does not take it",
-                                      a->method_flags[k], names,
-                                      !strcmp(a->method_flags[k], "--close-tol") ? " (and of "
-                                      "moreau --rtol on scenes)" : "", pd_method_name(m));
+            return pd_cli_usage_error(
+                "%s: a flag of %s%s; --method %s does not take it", a->method_flags[k], names,
+                !strcmp(a->method_flags[k], "--close-tol") ? " (and of "
+                                                             "moreau --rtol on scenes)"
+                                                           : "",
+                pd_method_name(m));
         }
     return 0;
 }
@@ -586,7 +601,8 @@ static int case_finish(pd_cli_case *a)
         return rc;
     if (a->chain && a->have_height)
         return pd_cli_usage_error("--height: the oscillator's; a --chain's SDOFs have the "
-                                  "default storey height (%g m)", PD_STOREY_HEIGHT);
+                                  "default storey height (%g m)",
+                                  PD_STOREY_HEIGHT);
     if (a->scene_path)
         return a->record_path ? pd_cli_usage_error("--record: a scene names its record in its "
                                                    "excitation (docs/scenes.md)")
@@ -633,8 +649,9 @@ void pd_cli_ref_decisions_text(FILE *f, const pd_scene_result *ref)
         fprintf(f, "  reference decisions: %ld accumulations jumped (one contact)\n",
                 ref->accumulations);
     else
-        fprintf(f, "  reference decisions: %ld LCPs of several contacts, %ld contacts closed "
-                   "within --close-tol %g Le, %ld accumulations jumped\n",
+        fprintf(f,
+                "  reference decisions: %ld LCPs of several contacts, %ld contacts closed "
+                "within --close-tol %g Le, %ld accumulations jumped\n",
                 ref->simultaneous, ref->tol_closed, ref->close_tol, ref->accumulations);
 }
 
@@ -646,8 +663,8 @@ int pd_cli_scene(const pd_cli_case *a, pd_scene **sc)
     if (a->scene_path)
         rc = pd_scene_load(a->scene_path, sc, &err);
     else {
-        pd_scene_excitation x = {.pulse = a->c.pulse, .dir = a->c.dir, .ap = a->c.ap,
-                                 .Tp = a->c.Tp};
+        pd_scene_excitation x = {
+            .pulse = a->c.pulse, .dir = a->c.dir, .ap = a->c.ap, .Tp = a->c.Tp};
         rc = pd_scene_chain(a->chain, &x, pd_osc_T0(&a->c), a->chain_ratio, a->c.xi,
                             pd_osc_gap(&a->c), a->c.eps, sc, &err);
     }

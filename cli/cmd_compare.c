@@ -29,11 +29,11 @@ static int parse_methods(const char *list, int *want)
     memset(want, 0, NMETHOD * sizeof *want);
     for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ","), n++) {
         pd_method m;
-        if (pd_method_parse(tok, &m) ||
-            (m != PD_METHOD_MOREAU && m != PD_METHOD_PENALTY && m != PD_METHOD_EVENT_GENERAL &&
-             m != PD_METHOD_NEWMARK))
+        if (pd_method_parse(tok, &m) || (m != PD_METHOD_MOREAU && m != PD_METHOD_PENALTY &&
+                                         m != PD_METHOD_EVENT_GENERAL && m != PD_METHOD_NEWMARK))
             return pd_cli_usage_error("--methods: '%s' is not one of moreau, penalty, newmark, "
-                                      "event-general", tok);
+                                      "event-general",
+                                      tok);
         want[m] = 1;
     }
     return n ? 0 : pd_cli_usage_error("--methods needs a list such as moreau,penalty");
@@ -120,16 +120,16 @@ static int compare_scene(const pd_cli_case *k, const int *want, int json)
                k->scene_path ? k->scene_path : "(chain)", sc->nstruct, mr[first].dt, rr.steps,
                impacts_ref, rr.cpu_s);
         pd_cli_ref_decisions_text(stdout, &rr);
-        printf("  %-13s %-14s %12s %12s %8s %10s\n", "method", "structure", "err_umax",
-               "err_hist", "impacts", "cpu [s]");
+        printf("  %-13s %-14s %12s %12s %8s %10s\n", "method", "structure", "err_umax", "err_hist",
+               "impacts", "cpu [s]");
         for (int m = 0; m < NMETHOD; m++)
             if (want[m]) {
                 printf("  %-13s %-14s %12.3g %12.3g %8ld %10.3g\n", pd_method_name((pd_method)m),
                        "(worst)", me[m].err_umax_max, me[m].err_hist_max, me[m].impacts,
                        me[m].cpu_s);
                 for (int s = 0; s < sc->nstruct && s < 40; s++)
-                    printf("  %-13s %-14s %12.3g %12.3g\n", "", sc->st[s].name,
-                           me[m].err_umax[s], me[m].err_hist[s]);
+                    printf("  %-13s %-14s %12.3g %12.3g\n", "", sc->st[s].name, me[m].err_umax[s],
+                           me[m].err_hist[s]);
             }
     }
 done:
@@ -247,8 +247,8 @@ int pd_cmd_compare(int argc, char **argv)
         pd_json_finish(&js);
     } else {
         printf("%s %s pulse, Pi2 = %.6g, Pi3 = %.6g, eps = %g, xi = %g, dt = %.4g s\n",
-               pd_dir_name(k.c.dir), pd_osc_excitation_name(&k.c), k.c.Pi2, k.c.Pi3, k.c.eps, k.c.xi,
-               k.opts.dt);
+               pd_dir_name(k.c.dir), pd_osc_excitation_name(&k.c), k.c.Pi2, k.c.Pi3, k.c.eps,
+               k.c.xi, k.opts.dt);
         printf("  %-10s %14s %12s %12s %8s %10s\n", "method", "umax [m]", "err_umax", "err_hist",
                "impacts", "cpu [s]");
         printf("  %-10s %14.9g %12s %12s %8ld %10.3g\n", "event", rr.umax, "(ref)", "(ref)",

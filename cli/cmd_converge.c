@@ -118,7 +118,8 @@ static int parse_methods(conv_args *a, const char *text)
             a->want_newmark = 1;
         else
             return pd_cli_usage_error("--methods: '%s' is not one of moreau, moreau-rtol, penalty, "
-                                      "newmark, event-general", tok);
+                                      "newmark, event-general",
+                                      tok);
     }
     return 0;
 }
@@ -276,13 +277,13 @@ static double dt_at(const conv_args *a, int i)
  * scene's. */
 typedef struct measurer {
     const pd_cli_case *k;
-    pd_trace ref, work;      /* oscillator */
+    pd_trace ref, work; /* oscillator */
     pd_osc_result rr;
-    pd_scene *sc;            /* scene */
+    pd_scene *sc; /* scene */
     pd_scene_trace sref;
     pd_scene_result srr, sres;
     pd_scene_errors se;
-    double *serr;            /* rows x nstruct x 2: the per-structure errors of every row */
+    double *serr; /* rows x nstruct x 2: the per-structure errors of every row */
 } measurer;
 
 static void measurer_free(measurer *M)
@@ -435,8 +436,7 @@ static int compute_rows(conv_args *a, measurer *M, row *rows, int *nrows, double
         if (!once && (rc = measure_reference(M, &o, ref_cpu, err)))
             goto done;
         o.method = PD_METHOD_NEWMARK;
-        if ((i == 0 && (rc = warm_up(M, &o, err))) ||
-            (rc = measure_row(M, &o, n, &rows[n], err)))
+        if ((i == 0 && (rc = warm_up(M, &o, err))) || (rc = measure_row(M, &o, n, &rows[n], err)))
             goto done;
     }
     for (int k = 0; k < a->nrtol && a->want_rtol; k++, n++) {
@@ -568,14 +568,14 @@ static void print_rows(const conv_args *a, const measurer *M, const row *rows, i
            "rtol", "kc", "err_umax", "err_hist", "err_est", "cpu [s]", "order", "impacts");
     for (int r = 0; r < n; r++)
         printf("  %-13s %6.3g %11.4g %8.2g %8.3g %11.3g %11.3g %9.2g %10.3g %7.3f %8ld\n",
-               isnan(rows[r].rtol) ? pd_method_name(rows[r].method) : "moreau-rtol",
-               rows[r].theta, rows[r].dt, rows[r].rtol, rows[r].kc, rows[r].err_umax,
-               rows[r].err_hist, rows[r].err_est, rows[r].cpu_s, rows[r].order, rows[r].impacts);
+               isnan(rows[r].rtol) ? pd_method_name(rows[r].method) : "moreau-rtol", rows[r].theta,
+               rows[r].dt, rows[r].rtol, rows[r].kc, rows[r].err_umax, rows[r].err_hist,
+               rows[r].err_est, rows[r].cpu_s, rows[r].order, rows[r].impacts);
 }
 
 /* err_hist against dt (Moreau–Jean curves) and against CPU time (all). */
-static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int n,
-                     double ref_cpu, pd_err *err)
+static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int n, double ref_cpu,
+                     pd_err *err)
 {
     static double xs[2][MAX_LIST + 3][MAX_ROWS], ys[2][MAX_LIST + 3][MAX_ROWS];
     pd_curve by_dt[MAX_LIST + 1], by_cpu[MAX_LIST + 3];
@@ -593,10 +593,10 @@ static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int
                 m++;
             }
         snprintf(labels[ncurve], sizeof labels[0], "Moreau\u2013Jean \u03b8 = %g", a->thetas[t]);
-        by_dt[ncurve] = (pd_curve){.label = labels[ncurve], .n = m, .x = xs[0][ncurve],
-                                   .y = ys[0][ncurve]};
-        by_cpu[ncurve] = (pd_curve){.label = labels[ncurve], .n = m, .x = xs[1][ncurve],
-                                    .y = ys[1][ncurve]};
+        by_dt[ncurve] =
+            (pd_curve){.label = labels[ncurve], .n = m, .x = xs[0][ncurve], .y = ys[0][ncurve]};
+        by_cpu[ncurve] =
+            (pd_curve){.label = labels[ncurve], .n = m, .x = xs[1][ncurve], .y = ys[1][ncurve]};
     }
     if (a->want_newmark) {
         int m = 0;
@@ -609,10 +609,10 @@ static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int
                 m++;
             }
         snprintf(labels[ncurve], sizeof labels[0], "Newmark penalty");
-        by_dt[ncurve] = (pd_curve){.label = labels[ncurve], .n = m, .x = xs[0][ncurve],
-                                   .y = ys[0][ncurve]};
-        by_cpu[ncurve] = (pd_curve){.label = labels[ncurve], .n = m, .x = xs[1][ncurve],
-                                    .y = ys[1][ncurve]};
+        by_dt[ncurve] =
+            (pd_curve){.label = labels[ncurve], .n = m, .x = xs[0][ncurve], .y = ys[0][ncurve]};
+        by_cpu[ncurve] =
+            (pd_curve){.label = labels[ncurve], .n = m, .x = xs[1][ncurve], .y = ys[1][ncurve]};
         ncurve++;
     }
     int nrt = 0; /* to a tolerance: a work-precision curve */
@@ -625,8 +625,8 @@ static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int
             }
         snprintf(labels[ncurve], sizeof labels[0], "Moreau\u2013Jean to rtol %g \u2026 %g",
                  a->rtols[0], a->rtols[a->nrtol - 1]);
-        by_cpu[ncurve] = (pd_curve){.label = labels[ncurve], .n = nrt, .x = xs[1][ncurve],
-                                    .y = ys[1][ncurve]};
+        by_cpu[ncurve] =
+            (pd_curve){.label = labels[ncurve], .n = nrt, .x = xs[1][ncurve], .y = ys[1][ncurve]};
     }
     int npen = 0, cpen = ncurve + (nrt > 0);
     if (a->want_penalty) {
@@ -636,10 +636,10 @@ static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int
                 ys[1][cpen][npen] = row_error(a, &rows[r]);
                 npen++;
             }
-        snprintf(labels[cpen], sizeof labels[0], "penalty (kc = %g \u2026 %g \u03c9\u2080\u00b2)", a->kcs[0],
-                 a->kcs[a->nkc - 1]);
-        by_cpu[cpen] = (pd_curve){.label = labels[cpen], .n = npen, .x = xs[1][cpen],
-                                  .y = ys[1][cpen]};
+        snprintf(labels[cpen], sizeof labels[0], "penalty (kc = %g \u2026 %g \u03c9\u2080\u00b2)",
+                 a->kcs[0], a->kcs[a->nkc - 1]);
+        by_cpu[cpen] =
+            (pd_curve){.label = labels[cpen], .n = npen, .x = xs[1][cpen], .y = ys[1][cpen]};
     }
     int ngen = 0;
     for (int r = 0; r < n && a->want_general; r++)
@@ -648,13 +648,13 @@ static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int
             xs[1][c][0] = rows[r].cpu_s;
             ys[1][c][0] = row_error(a, &rows[r]);
             snprintf(labels[c], sizeof labels[0], "general reference (event-general, GSL)");
-            by_cpu[c] = (pd_curve){.label = labels[c], .n = 1, .x = xs[1][c], .y = ys[1][c],
-                                   .style = PD_CURVE_MARKER};
+            by_cpu[c] = (pd_curve){
+                .label = labels[c], .n = 1, .x = xs[1][c], .y = ys[1][c], .style = PD_CURVE_MARKER};
             ngen = 1;
         }
     char title[256];
-    const char *ylabel = a->use_umax ? "|u_{max} - u_{max,ref}| / u_{max,ref}"
-                                     : "max |u - u_{ref}| / u_{max,ref}";
+    const char *ylabel =
+        a->use_umax ? "|u_{max} - u_{max,ref}| / u_{max,ref}" : "max |u - u_{ref}| / u_{max,ref}";
     case_title(a, M, 1, title, sizeof title);
     pd_chart c1 = {.title = title,
                    .xlabel = "dt [s]",
@@ -684,21 +684,23 @@ static int plot_rows(const conv_args *a, const measurer *M, const row *rows, int
  * the method is a coded column: its name in the CSV ("moreau", "penalty"),
  * its pd_method code in the HDF5 file with a "codes" attribute naming them.
  * The case as attributes: the oscillator's, or the scene's excitation. */
-static int write_rows(const conv_args *a, const measurer *M, const row *rows, int n,
-                      double ref_cpu, pd_err *err)
+static int write_rows(const conv_args *a, const measurer *M, const row *rows, int n, double ref_cpu,
+                      pd_err *err)
 {
     enum { NC = 12 };
     static double col[NC][MAX_ROWS];
-    const char *methods[] = {pd_method_name(PD_METHOD_MOREAU), pd_method_name(PD_METHOD_EVENT),
-                             pd_method_name(PD_METHOD_PENALTY), pd_method_name(PD_METHOD_AUTO),
+    const char *methods[] = {pd_method_name(PD_METHOD_MOREAU),
+                             pd_method_name(PD_METHOD_EVENT),
+                             pd_method_name(PD_METHOD_PENALTY),
+                             pd_method_name(PD_METHOD_AUTO),
                              pd_method_name(PD_METHOD_EVENT_GENERAL),
                              pd_method_name(PD_METHOD_NEWMARK)}; /* by code, as in --json */
     char chain[64];
     for (int r = 0; r < n; r++) {
-        double v[NC] = {(double)rows[r].method, rows[r].theta, rows[r].dt, rows[r].kc,
-                        rows[r].err_umax, rows[r].err_hist, rows[r].cpu_s, rows[r].order,
-                        (double)rows[r].impacts, (double)rows[r].steps, rows[r].rtol,
-                        rows[r].err_est};
+        double v[NC] = {
+            (double)rows[r].method,  rows[r].theta,         rows[r].dt,    rows[r].kc,
+            rows[r].err_umax,        rows[r].err_hist,      rows[r].cpu_s, rows[r].order,
+            (double)rows[r].impacts, (double)rows[r].steps, rows[r].rtol,  rows[r].err_est};
         for (int c = 0; c < NC; c++)
             col[c][r] = v[c];
     }
@@ -715,31 +717,46 @@ static int write_rows(const conv_args *a, const measurer *M, const row *rows, in
         {.name = "steps", .units = "1", .values = col[9]},
         {.name = "rtol", .units = "1", .values = col[10]}, /* moreau-rtol rows, else NaN */
         {.name = "err_est", .units = "1", .values = col[11]}};
-#define NUM(nm, u, x) {.name = nm, .units = u, .num = (x)}
-#define TXT(nm, x) {.name = nm, .is_text = 1, .text = (x)}
+#define NUM(nm, u, x)                                                                              \
+    {                                                                                              \
+        .name = nm, .units = u, .num = (x)                                                         \
+    }
+#define TXT(nm, x)                                                                                 \
+    {                                                                                              \
+        .name = nm, .is_text = 1, .text = (x)                                                      \
+    }
     const pd_osc *c = &a->k.c;
     pd_attr osc[] = {TXT("error", a->use_umax ? "umax" : "hist"),
                      NUM("cpu_s_ref", "s", ref_cpu),
                      TXT("pulse", pd_osc_excitation_name(c)),
                      TXT("dir", pd_dir_name(c->dir)),
-                     NUM("Pi2", "1", c->Pi2), NUM("Pi3", "1", c->Pi3),
-                     NUM("eps", "1", c->eps), NUM("xi", "1", c->xi),
-                     NUM("ap", "m/s^2", c->ap), NUM("Tp", "s", c->Tp)};
+                     NUM("Pi2", "1", c->Pi2),
+                     NUM("Pi3", "1", c->Pi3),
+                     NUM("eps", "1", c->eps),
+                     NUM("xi", "1", c->xi),
+                     NUM("ap", "m/s^2", c->ap),
+                     NUM("Tp", "s", c->Tp)};
     const pd_scene_excitation *x = M->sc ? &M->sc->exc : NULL;
     snprintf(chain, sizeof chain, "chain of %d", a->k.chain);
     pd_attr scene[] = {TXT("error", a->use_umax ? "umax" : "hist"),
                        NUM("cpu_s_ref", "s", ref_cpu),
                        TXT("scene", a->k.scene_path ? a->k.scene_path : chain),
                        NUM("structures", "1", M->sc ? M->sc->nstruct : 0),
-                       TXT("pulse", !x ? "" : x->record ? x->record->name : pd_pulse_name(x->pulse)),
+                       TXT("pulse", !x          ? ""
+                                    : x->record ? x->record->name
+                                                : pd_pulse_name(x->pulse)),
                        TXT("dir", x && x->dir < 0 ? "-x" : "+x"),
-                       NUM("ap", "m/s^2", x ? x->ap : 0.0), NUM("Tp", "s", x ? x->Tp : 0.0)};
+                       NUM("ap", "m/s^2", x ? x->ap : 0.0),
+                       NUM("Tp", "s", x ? x->Tp : 0.0)};
 #undef NUM
 #undef TXT
-    pd_table t = {.rows = n, .ncols = NC, .cols = cols,
+    pd_table t = {.rows = n,
+                  .ncols = NC,
+                  .cols = cols,
                   .nattrs = M->sc ? (int)(sizeof scene / sizeof scene[0])
                                   : (int)(sizeof osc / sizeof osc[0]),
-                  .attrs = M->sc ? scene : osc, .dim = "row"};
+                  .attrs = M->sc ? scene : osc,
+                  .dim = "row"};
     return pd_output_write(a->out, &t, err);
 }
 

@@ -237,8 +237,8 @@ static int band_to_csc(int n, const double *M, int band, long nnz, int **colptr,
  * nnzmax stored entries, its CPU time added to *cpu_s (the solver's
  * allocation left out); PD_ENOMEM when it cannot be allocated. */
 static int solve_once(const lcp_args *a, const pd_matrix *M, const double *q,
-                      const pd_lcp_opts *opts, long nnzmax, double *z, double *w,
-                      pd_lcp_info *info, double *cpu_s)
+                      const pd_lcp_opts *opts, long nnzmax, double *z, double *w, pd_lcp_info *info,
+                      double *cpu_s)
 {
     pd_err err;
     pd_lcp_solver *solver = pd_lcp_solver_alloc(a->solver, M->rows, nnzmax, &err);
@@ -259,8 +259,8 @@ static int solve_once(const lcp_args *a, const pd_matrix *M, const double *q,
  * goes again densely, as it would without its band (the hand-over to
  * Lemke is larger for dense input).  cpu_s counts the copy of the band
  * and the solves, not the solvers' allocation. */
-static int solve_and_print(const lcp_args *a, int n, const double *M, const double *q,
-                           int band, long nnz, const double *cover, double *z, double *w)
+static int solve_and_print(const lcp_args *a, int n, const double *M, const double *q, int band,
+                           long nnz, const double *cover, double *z, double *w)
 {
     pd_lcp_opts opts = pd_lcp_default_opts();
     opts.cover = cover;
@@ -271,8 +271,8 @@ static int solve_and_print(const lcp_args *a, int n, const double *M, const doub
     pd_lcp_info info;
     pd_matrix Mv = pd_matrix_dense(n, n, M);
     long cap = (long)BAND_PER_ROW * n < (long)n * n / 2 ? (long)BAND_PER_ROW * n : (long)n * n / 2;
-    int banded = a->solver == PD_LCP_STRUCTURED && band >= 0 && 2 * band + 1 <= BAND_PER_ROW &&
-                 nnz <= cap;
+    int banded =
+        a->solver == PD_LCP_STRUCTURED && band >= 0 && 2 * band + 1 <= BAND_PER_ROW && nnz <= cap;
     int *colptr = NULL, *rowind = NULL, st = PD_ENUMERICAL;
     double *values = NULL;
     double t0 = pd_cpu_seconds(), cpu_s = 0.0;

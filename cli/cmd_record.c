@@ -58,7 +58,8 @@ static int parse_args(record_args *a, int argc, char **argv)
                 return pd_cli_usage_error("--units: '%s' is not one of g, m/s2, cm/s2", val);
             else if (!strcmp(f, "--record-format") && pd_record_format_parse(val, &a->format))
                 return pd_cli_usage_error("--record-format: '%s' is not one of auto, at2, v2, "
-                                          "text", val);
+                                          "text",
+                                          val);
             i++;
         } else if (f[0] == '-' && f[1] != '\0')
             return pd_cli_usage_error("record: unknown flag '%s' (see pound record --help)", f);
@@ -116,16 +117,16 @@ static void json_item(pd_json *js, const record_item *it)
 static void print_table(const record_item *items, int n)
 {
     printf("%-32s %6s %7s %8s %7s %7s %8s %6s %6s | %6s %6s %7s %8s %6s %6s\n", "record", "npts",
-           "dt [s]", "PGA m/s2", "PGV m/s", "PGD m", "Ia m/s", "T5-75", "T5-95", "Tp [s]",
-           "vp m/s", "ap m/s2", "Le [m]", "r2", "shape");
+           "dt [s]", "PGA m/s2", "PGV m/s", "PGD m", "Ia m/s", "T5-75", "T5-95", "Tp [s]", "vp m/s",
+           "ap m/s2", "Le [m]", "r2", "shape");
     for (int k = 0; k < n; k++) {
         const pd_record *r = &items[k].r->rec;
         const pd_record_measures *m = &items[k].m;
         const pd_record_pulse *p = &items[k].r->pulse;
         printf("%-32.32s %6ld %7.4g %8.4g %7.4g %7.4g %8.4g %6.3g %6.3g | %6.3g %6.3g %7.4g %8.4g "
                "%6.3f %6s\n",
-               r->name, r->npts, r->dt, m->pga, m->pgv, m->pgd, m->arias, m->t5_75, m->t5_95,
-               p->Tp, p->vp, p->ap, p->Le, p->r2, pd_pulse_name(p->shape));
+               r->name, r->npts, r->dt, m->pga, m->pgv, m->pgd, m->arias, m->t5_75, m->t5_95, p->Tp,
+               p->vp, p->ap, p->Le, p->r2, pd_pulse_name(p->shape));
     }
     printf("pulse: Mavroeidis-Papageorgiou velocity pulse fitted to the record's velocity; ap its "
            "largest acceleration, Le = ap Tp^2 / (4 pi^2); shape: the paper's one-cycle "

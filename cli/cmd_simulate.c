@@ -89,7 +89,8 @@ static int parse_args(sim_args *a, int argc, char **argv)
         return rc;
     if (a->dump && a->k.opts.method != PD_METHOD_MOREAU) {
         pd_cli_case_free(&a->k);
-        return pd_cli_usage_error("--dump-lcp: the LCPs dumped are Moreau-Jean's (--method moreau)");
+        return pd_cli_usage_error(
+            "--dump-lcp: the LCPs dumped are Moreau-Jean's (--method moreau)");
     }
     return 0;
 }
@@ -166,8 +167,12 @@ static int record(const pd_osc_sample *s, void *ctx)
 {
     osc_out *o = ctx;
     if (o->plot) {
-        pd_scene_sample ss = {.step = s->step, .t = s->t, .x = &s->u, .v = &s->v,
-                              .gap = &s->gap, .impulse = &s->impulse,
+        pd_scene_sample ss = {.step = s->step,
+                              .t = s->t,
+                              .x = &s->u,
+                              .v = &s->v,
+                              .gap = &s->gap,
+                              .impulse = &s->impulse,
                               .impacts = &s->impacts};
         pd_scene_plot_sample(&ss, o->plot);
     }
@@ -186,10 +191,12 @@ static void method_line(const pd_cli_case *k)
         printf("  method    = %s (%s)\n", m, k->method_by);
     else if (pd_cli_is_scene(k))
         printf("  method    = %s (the default for scenes; --method event|penalty|newmark for "
-               "the others)\n", m);
+               "the others)\n",
+               m);
     else
         printf("  method    = %s (the default for one oscillator: %s; --method moreau|event|"
-               "penalty|newmark chooses)\n", m,
+               "penalty|newmark chooses)\n",
+               m,
                k->opts.method == PD_METHOD_EVENT ? "exact and fastest"
                                                  : "the exact reference's scan is over budget");
 }
@@ -261,9 +268,11 @@ static void print_json(const sim_args *a, const pd_osc_summary *s)
 static void warn_rtol(double rtol, double err_est, int met)
 {
     if (rtol > 0.0 && !met)
-        fprintf(stderr, "pound: simulate: warning: rtol %g not met: err_est %.2g (the steps "
+        fprintf(stderr,
+                "pound: simulate: warning: rtol %g not met: err_est %.2g (the steps "
                 "reached their floor, the budget, or the estimate stayed above rtol after the "
-                "tighter runs; docs/scheme.md, \"Moreau-Jean to a tolerance\")\n", rtol, err_est);
+                "tighter runs; docs/scheme.md, \"Moreau-Jean to a tolerance\")\n",
+                rtol, err_est);
 }
 
 static void print_text(const sim_args *a, const pd_osc_summary *s)
@@ -282,11 +291,12 @@ static void print_text(const sim_args *a, const pd_osc_summary *s)
     if (a->k.opts.method == PD_METHOD_MOREAU && s->r.rtol > 0.0)
         printf("  Pi2 = %.6g  Pi3 = %.6g   Moreau-Jean to rtol = %g: %ld steps (%ld tries "
                "halved), dt %.3g to %.3g s, to %g s\n",
-               c->Pi2, c->Pi3, s->r.rtol, s->r.steps, s->r.steps_rejected, s->r.dt_min,
-               s->r.dt_max, s->r.tend);
+               c->Pi2, c->Pi3, s->r.rtol, s->r.steps, s->r.steps_rejected, s->r.dt_min, s->r.dt_max,
+               s->r.tend);
     else if (a->k.opts.method == PD_METHOD_MOREAU)
-        printf("  Pi2 = %.6g  Pi3 = %.6g   Moreau-Jean theta = %g, dt = %.6g s, %ld steps to %g s\n",
-               c->Pi2, c->Pi3, s->r.theta, s->r.dt, s->r.steps, s->r.tend);
+        printf(
+            "  Pi2 = %.6g  Pi3 = %.6g   Moreau-Jean theta = %g, dt = %.6g s, %ld steps to %g s\n",
+            c->Pi2, c->Pi3, s->r.theta, s->r.dt, s->r.steps, s->r.tend);
     else
         printf("  Pi2 = %.6g  Pi3 = %.6g   %s (%s), %ld %s to %g s\n", c->Pi2, c->Pi3,
                a->k.opts.method == PD_METHOD_EVENT ? "event-driven reference" : "penalty",
@@ -306,18 +316,20 @@ static void print_text(const sim_args *a, const pd_osc_summary *s)
     else
         printf("  impacts   = 0 (the oscillator never reaches the wall)\n");
     printf("  demands   = drift ratio %.5g (height %g m), a_abs %.6g m/s^2, base shear per "
-           "unit mass %.6g N/kg\n", s->r.umax / a->k.height, a->k.height, s->r.acc_max,
-           s->r.shear_max);
+           "unit mass %.6g N/kg\n",
+           s->r.umax / a->k.height, a->k.height, s->r.acc_max, s->r.shear_max);
     if (s->r.impacts && isnan(s->r.force_max)) /* an impulsive method */
         printf("  contact   = equivalent force %.6g N/kg (pi I / (2 td), td = %g s, "
-               "--contact-duration)\n", s->r.force_equiv, s->r.contact_duration);
+               "--contact-duration)\n",
+               s->r.force_equiv, s->r.contact_duration);
     else if (s->r.impacts)
         printf("  contact   = equivalent force %.6g N/kg (pi I / (2 td), td = %g s, "
-               "--contact-duration), peak force %.6g N/kg\n", s->r.force_equiv,
-               s->r.contact_duration, s->r.force_max);
+               "--contact-duration), peak force %.6g N/kg\n",
+               s->r.force_equiv, s->r.contact_duration, s->r.force_max);
     if (s->r.rtol > 0.0)
         printf("  err_est   = %.2g (the peaks' estimated relative error, the run's and its "
-               "no-wall twin's; %s)\n", s->err_est, s->rtol_met ? "rtol met" : "rtol NOT met");
+               "no-wall twin's; %s)\n",
+               s->err_est, s->rtol_met ? "rtol met" : "rtol NOT met");
     printf("  cpu       = %.3g s\n", s->cpu_s);
 }
 
@@ -327,7 +339,10 @@ static int finish_output(const sim_args *a, const pd_osc_summary *s, pd_table_wr
 {
     const pd_osc *c = &a->k.c;
 #define NUM(n, u, x) {.name = n, .units = u, .num = (x)}
-#define TXT(n, x) {.name = n, .is_text = 1, .text = (x)}
+#define TXT(n, x)                                                                                  \
+    {                                                                                              \
+        .name = n, .is_text = 1, .text = (x)                                                       \
+    }
     pd_attr attrs[] = {TXT("method", pd_method_name(a->k.opts.method)),
                        TXT("pulse", pd_osc_excitation_name(c)),
                        TXT("dir", pd_dir_name(c->dir)),
@@ -406,13 +421,14 @@ static int simulate_oscillator(sim_args *a)
         goto done;
     if ((status = dump_open(a, &dump, &a->k.opts)))
         goto done;
-    if (a->out && (rc = pd_table_open(&o.file, a->out, OSC_COLS, osc_cols, "t", o.rows_max, &err))) {
+    if (a->out &&
+        (rc = pd_table_open(&o.file, a->out, OSC_COLS, osc_cols, "t", o.rows_max, &err))) {
         fprintf(stderr, "pound: simulate: %s\n", err.msg);
         status = rc == PD_EINVAL ? 2 : 1;
         goto done;
     }
-    if (a->plot && (!(psc = oscillator_scene(&a->k.c)) ||
-                    pd_scene_plot_open(&o.plot, psc, nsteps, &err))) {
+    if (a->plot &&
+        (!(psc = oscillator_scene(&a->k.c)) || pd_scene_plot_open(&o.plot, psc, nsteps, &err))) {
         fprintf(stderr, "pound: simulate: out of memory for the chart\n");
         status = 1;
         goto done;
@@ -420,12 +436,15 @@ static int simulate_oscillator(sim_args *a)
     if ((rc = pd_osc_summarize(&a->k.c, &a->k.opts, a->out || a->plot ? record : NULL, &o, &s,
                                &err)) ||
         (isfinite(s.r.umax) && !isfinite(s.r.umax / a->k.height) &&
-         (rc = pd_err_set(&err, PD_EINVAL, "--height: the drift ratio umax / H overflows "
-                          "(umax %g m, H %g m): give a larger height", s.r.umax, a->k.height))) ||
+         (rc = pd_err_set(&err, PD_EINVAL,
+                          "--height: the drift ratio umax / H overflows "
+                          "(umax %g m, H %g m): give a larger height",
+                          s.r.umax, a->k.height))) ||
         /* an impulse whose equivalent force overflows at any duration: the
          * excitation's scale (the duration's own case is the library's) */
         (isfinite(s.r.max_impulse) && !isfinite(s.r.force_equiv) &&
-         (rc = pd_err_set(&err, PD_EINVAL, "%s: the impacts' equivalent force pi I / (2 td) "
+         (rc = pd_err_set(&err, PD_EINVAL,
+                          "%s: the impacts' equivalent force pi I / (2 td) "
                           "overflows (impulse I = %g): a weaker excitation",
                           a->k.record_path ? "--scale" : "--ap", s.r.max_impulse)))) {
         fprintf(stderr, "pound: simulate: %s\n", err.msg);
@@ -433,8 +452,10 @@ static int simulate_oscillator(sim_args *a)
         goto done;
     }
     char title[PD_NAME_MAX + 160];
-    snprintf(title, sizeof title, "pounding oscillator: %s %s%s, T0 = %.3g s, gap = %.3g m, "
-             "eps = %.3g (%s)", pd_osc_excitation_name(&a->k.c), pd_dir_name(a->k.c.dir),
+    snprintf(title, sizeof title,
+             "pounding oscillator: %s %s%s, T0 = %.3g s, gap = %.3g m, "
+             "eps = %.3g (%s)",
+             pd_osc_excitation_name(&a->k.c), pd_dir_name(a->k.c.dir),
              a->k.c.record ? "" : " pulse", pd_osc_T0(&a->k.c), pd_osc_gap(&a->k.c), a->k.c.eps,
              pd_method_name(a->k.opts.method));
     if ((o.file && finish_output(a, &s, o.file, &err)) ||
@@ -603,8 +624,8 @@ static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_sum
                r->lcp_solves);
     else {
         int pen = a->k.opts.method == PD_METHOD_PENALTY || a->k.opts.method == PD_METHOD_NEWMARK;
-        printf("  %s (%s), %ld %s to %g s\n", pen ? "penalty" : "event-driven reference",
-               r->kernel, r->steps, pen ? "steps" : "events", r->tend);
+        printf("  %s (%s), %ld %s to %g s\n", pen ? "penalty" : "event-driven reference", r->kernel,
+               r->steps, pen ? "steps" : "events", r->tend);
     }
     method_line(&a->k);
     if (a->k.opts.method == PD_METHOD_EVENT) {
@@ -620,17 +641,17 @@ static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_sum
                    impacts, r->simultaneous, r->tol_closed, r->close_tol, r->accumulations);
         if (r->impact_law && isinf(r->law_band_max))
             printf("  impact law = %s: law_band = inf (the run under --impact-law %s did not "
-                   "finish)\n", r->impact_law, strcmp(r->impact_law, "single") ? "single"
-                                                                           : "staged");
+                   "finish)\n",
+                   r->impact_law, strcmp(r->impact_law, "single") ? "single" : "staged");
         else if (r->impact_law && !isnan(r->law_band_max))
             printf("  impact law = %s: law_band = %.2g (umax under --impact-law %s moves by "
-                   "this, relative; per structure below)\n", r->impact_law, r->law_band_max,
+                   "this, relative; per structure below)\n",
+                   r->impact_law, r->law_band_max,
                    strcmp(r->impact_law, "single") ? "single" : "staged");
         else if (r->impact_law)
-            printf("  impact law = %s (no simultaneous impact: the laws agree)\n",
-                   r->impact_law);
+            printf("  impact law = %s (no simultaneous impact: the laws agree)\n", r->impact_law);
     }
-    int tol = r->rtol > 0.0; /* to a tolerance: each structure's estimate */
+    int tol = r->rtol > 0.0;            /* to a tolerance: each structure's estimate */
     int band = !isnan(r->law_band_max); /* simultaneous impacts: each structure's law_band */
     printf("  %-12s %7s %9s %12s %12s %10s %8s%s%s\n", "structure", "storey", "T0 [s]", "umax [m]",
            "drift [m]", "Pi1", "gamma", tol ? "    err_est" : "", band ? "   law_band" : "");
@@ -645,16 +666,16 @@ static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_sum
                 snprintf(est, sizeof est, " %10.2g", s->err_est_structure[k]);
             if (i == 0 && band)
                 snprintf(lb, sizeof lb, " %10.2g", r->law_band[k]);
-            printf("  %-12s %7d %9s %12.6g %12.6g %10.5g %8.4g%s%s\n", i ? "" : st->name, i + 1,
-                   T0, r->umax[d], r->drift[d], s->Pi1[d], s->gamma[d], est, lb);
+            printf("  %-12s %7d %9s %12.6g %12.6g %10.5g %8.4g%s%s\n", i ? "" : st->name, i + 1, T0,
+                   r->umax[d], r->drift[d], s->Pi1[d], s->gamma[d], est, lb);
         }
     }
     if (sc->nstruct > TEXT_MAX_STRUCTURES)
         printf("  ... %d more structures (--json or -o for all)\n",
                sc->nstruct - TEXT_MAX_STRUCTURES);
     printf("  demands (peaks; storey shear with damping, storey 1 = base shear):\n");
-    printf("  %-12s %7s %12s %12s %14s %14s\n", "structure", "storey", "height [m]",
-           "drift ratio", "a_abs [m/s^2]", "shear [N]");
+    printf("  %-12s %7s %12s %12s %14s %14s\n", "structure", "storey", "height [m]", "drift ratio",
+           "a_abs [m/s^2]", "shear [N]");
     for (int k = 0; k < sc->nstruct && k < TEXT_MAX_STRUCTURES; k++) {
         const pd_structure *st = &sc->st[k];
         for (int i = 0; i < st->storeys; i++) {
@@ -688,8 +709,9 @@ static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_sum
         printf("  %-22s %18.6g %18s\n", pair, r->force_equiv[c], peak);
     }
     if (sc->ncontact)
-        printf("  (equivalent: pi I / (2 td), a half-sine pulse of td = %g s, --contact-duration)\n",
-               r->contact_duration);
+        printf(
+            "  (equivalent: pi I / (2 td), a half-sine pulse of td = %g s, --contact-duration)\n",
+            r->contact_duration);
     if (tol)
         printf("  err_est   = %.2g (the peaks' estimated relative error: umax, drift and the "
                "demands of every structure, the run's and its contact-free twin's; %s)\n",
@@ -730,8 +752,7 @@ static int simulate_scene(sim_args *a)
         goto done;
     }
     snprintf(name, sizeof name, "chain of %d", a->k.chain);
-    pd_scene_run_info ri = {.sum = &s,
-                            .scene_name = a->k.scene_path ? a->k.scene_path : name};
+    pd_scene_run_info ri = {.sum = &s, .scene_name = a->k.scene_path ? a->k.scene_path : name};
     if ((fo.w && pd_scene_writer_finish(fo.w, &ri, &err)) ||
         (fo.p && pd_scene_plot_draw(fo.p, a->plot, ri.scene_name, &err))) {
         fprintf(stderr, "pound: simulate: %s\n", err.msg);
@@ -762,7 +783,8 @@ int pd_cmd_simulate(int argc, char **argv)
         return 0;
     if ((rc = parse_args(&a, argc, argv)))
         return rc;
-    pd_provenance_set(argc, argv, pd_cli_is_scene(&a.k) ? PD_FORMAT_SCENE : PD_FORMAT_OSCILLATOR, 0);
+    pd_provenance_set(argc, argv, pd_cli_is_scene(&a.k) ? PD_FORMAT_SCENE : PD_FORMAT_OSCILLATOR,
+                      0);
     rc = pd_cli_is_scene(&a.k) ? simulate_scene(&a) : simulate_oscillator(&a);
     pd_cli_case_free(&a.k);
     return rc;

@@ -44,9 +44,9 @@ typedef struct spec_args {
     pd_cli_case k; /* the model, scheme and method flags */
     const char *out, *plot;
     int json, resume, threads, have_pi2, have_pi3, have_gap, have_eps;
-    const char *scene_list;           /* a list flag a scene sweep refuses */
-    const char *pulse_flag;           /* --pulse or --dir when given (refused with --record) */
-    const char *ref_name;             /* --ref NAME (scene sweeps) */
+    const char *scene_list;            /* a list flag a scene sweep refuses */
+    const char *pulse_flag;            /* --pulse or --dir when given (refused with --record) */
+    const char *ref_name;              /* --ref NAME (scene sweeps) */
     int ref_contact, have_ref_contact; /* --ref-contact K */
     long stop_after;
 } spec_args;
@@ -80,13 +80,13 @@ static int parse_nums(const char *flag, const char *text, double *x, int *n)
         if (pd_cli_double(flag, tok, &x[(*n)++]))
             return 2;
     }
-    return text[strlen(text) - 1] == ',' ? pd_cli_usage_error("%s: '%s' ends in a comma", flag, text)
-                                         : 0;
+    return text[strlen(text) - 1] == ','
+               ? pd_cli_usage_error("%s: '%s' ends in a comma", flag, text)
+               : 0;
 }
 
 /* "sine,cosine" -> pulses, or "normal,reverse" -> directivities: 0 or 2. */
-static int parse_names(const char *flag, const char *text, int is_pulse, int *out, int *n,
-                       int cap)
+static int parse_names(const char *flag, const char *text, int is_pulse, int *out, int *n, int cap)
 {
     char tok[32];
     const char *p = text;
@@ -144,8 +144,7 @@ static int list_flag(spec_args *a, const char *f, const char *val)
     } else if (!strcmp(f, "--eps")) {
         a->have_eps = 1;
         rc = parse_nums(f, val, s->eps, &s->neps);
-    }
-    else if (!strcmp(f, "--xi"))
+    } else if (!strcmp(f, "--xi"))
         rc = parse_nums(f, val, s->xi, &s->nxi);
     else if (!strcmp(f, "--ap")) {
         s->dimensional = 1;
@@ -242,9 +241,10 @@ static int check_scene_args(spec_args *a)
                                   "(a scene sweep takes --Pi2, --Pi3 and --eps lists)",
                                   a->scene_list);
     if (a->resume || a->stop_after || a->s.dt_per_Tp > 0.0)
-        return pd_cli_usage_error("%s: not available for scene sweeps",
-                                  a->resume ? "--resume" : a->stop_after ? "--stop-after"
-                                                                         : "--dt-per-Tp");
+        return pd_cli_usage_error("%s: not available for scene sweeps", a->resume ? "--resume"
+                                                                        : a->stop_after
+                                                                            ? "--stop-after"
+                                                                            : "--dt-per-Tp");
     if (a->plot && (strlen(a->plot) < 5 || strcmp(a->plot + strlen(a->plot) - 4, ".png")))
         return pd_cli_usage_error("--plot: '%s' must end in .png", a->plot);
     if (a->out && pd_output_check_path(a->out, &err))
@@ -336,7 +336,8 @@ static int check_args(spec_args *a)
                                       s->size_is_gap ? "--gap" : "--Pi3", s->size[i]);
     if (a->k.record_path && a->pulse_flag)
         return pd_cli_usage_error("%s: the record replaces the pulse (its fitted pulse gives Tp; "
-                                  "--scale scales it)", a->pulse_flag);
+                                  "--scale scales it)",
+                                  a->pulse_flag);
     pd_cli_case checked = a->k; /* the flags' ranges, errors naming them */
     int rc = pd_cli_case_finish(&checked);
     if (rc)
@@ -353,7 +354,7 @@ static int check_args(spec_args *a)
         if (!s->dimensional)
             s->ap[0] = s->base.ap;
     }
-    s->opts = a->k.opts; /* dt and tend stay 0 (per point) unless given */
+    s->opts = a->k.opts;                      /* dt and tend stay 0 (per point) unless given */
     s->opts.pen.rtol = checked.opts.pen.rtol; /* --rtol routed (penalty) */
     /* the method given or implied by the flags (as the checked case took
      * it), else one for the whole sweep */
@@ -410,8 +411,7 @@ static int parse_on_rank(spec_args *a, int argc, char **argv, int rank)
 }
 
 /* Rank 0: the journal (read back with --resume): 0, 1 or 2. */
-static int open_journal(const spec_args *a, pd_spec_journal *j, pd_spec_result *res,
-                        long *loaded)
+static int open_journal(const spec_args *a, pd_spec_journal *j, pd_spec_result *res, long *loaded)
 {
     pd_err err;
     char *key = pd_spec_key(&a->s);

@@ -91,9 +91,8 @@ static int sink_cmp(const H5FD_t *a, const H5FD_t *b)
 static herr_t sink_query(const H5FD_t *file, unsigned long *flags)
 {
     (void)file;
-    *flags = H5FD_FEAT_AGGREGATE_METADATA | H5FD_FEAT_ACCUMULATE_METADATA |
-             H5FD_FEAT_DATA_SIEVE | H5FD_FEAT_AGGREGATE_SMALLDATA |
-             H5FD_FEAT_DEFAULT_VFD_COMPATIBLE;
+    *flags = H5FD_FEAT_AGGREGATE_METADATA | H5FD_FEAT_ACCUMULATE_METADATA | H5FD_FEAT_DATA_SIEVE |
+             H5FD_FEAT_AGGREGATE_SMALLDATA | H5FD_FEAT_DEFAULT_VFD_COMPATIBLE;
     return 0;
 }
 
@@ -272,12 +271,12 @@ int pd_h5_close_id(hid_t *id)
     herr_t st = 0;
     if (*id >= 0) {
         H5I_type_t t = H5Iget_type(*id);
-        st = t == H5I_DATASET ? H5Dclose(*id)
-             : t == H5I_GROUP ? H5Gclose(*id)
+        st = t == H5I_DATASET       ? H5Dclose(*id)
+             : t == H5I_GROUP       ? H5Gclose(*id)
              : t == H5I_GENPROP_LST ? H5Pclose(*id)
-             : t == H5I_DATASPACE ? H5Sclose(*id)
-             : t == H5I_DATATYPE  ? H5Tclose(*id)
-                                  : -1;
+             : t == H5I_DATASPACE   ? H5Sclose(*id)
+             : t == H5I_DATATYPE    ? H5Tclose(*id)
+                                    : -1;
     }
     *id = -1;
     return st < 0 ? -1 : 0;
@@ -302,8 +301,8 @@ int pd_h5_attr(hid_t obj, const char *name, const char *text, double x)
             H5Tset_cset(type, H5T_CSET_UTF8) >= 0 &&
             (attr = H5Acreate2(obj, name, type, space, H5P_DEFAULT, H5P_DEFAULT)) >= 0)
             st = H5Awrite(attr, type, text);
-    } else if ((attr = H5Acreate2(obj, name, H5T_NATIVE_DOUBLE, space, H5P_DEFAULT,
-                                  H5P_DEFAULT)) >= 0)
+    } else if ((attr = H5Acreate2(obj, name, H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, H5P_DEFAULT)) >=
+               0)
         st = H5Awrite(attr, H5T_NATIVE_DOUBLE, &x);
     if (attr >= 0)
         H5Aclose(attr);
@@ -425,7 +424,6 @@ int pd_h5_append(hid_t ds, hid_t type, long r0, long nrows, int cols, const void
     return rc ? -1 : 0;
 }
 
-
 /* ---- dimension scales (netCDF-4's dimensions) ------------------------------ */
 
 /* The NAME of a dimension that has no coordinate variable (netCDF-4's
@@ -487,7 +485,8 @@ static hid_t find_scale(hid_t file, const char *path, const char *name)
     for (;;) {
         while (dir > 0 && path[dir - 1] != '/')
             dir--;
-        if (dir == 0 || (size_t)snprintf(at, sizeof at, "%.*s%s", (int)dir, path, name) >= sizeof at)
+        if (dir == 0 ||
+            (size_t)snprintf(at, sizeof at, "%.*s%s", (int)dir, path, name) >= sizeof at)
             return -1;
         if (H5Lexists(file, at, H5P_DEFAULT) > 0) {
             hid_t ds = H5Dopen2(file, at, H5P_DEFAULT); /* the library prints nothing */

@@ -43,10 +43,22 @@ static void close_(pd_json *js, char bracket)
     fputc(bracket, js->out);
 }
 
-void pd_json_begin_object(pd_json *js, const char *key) { open(js, key, '{'); }
-void pd_json_end_object(pd_json *js) { close_(js, '}'); }
-void pd_json_begin_array(pd_json *js, const char *key) { open(js, key, '['); }
-void pd_json_end_array(pd_json *js) { close_(js, ']'); }
+void pd_json_begin_object(pd_json *js, const char *key)
+{
+    open(js, key, '{');
+}
+void pd_json_end_object(pd_json *js)
+{
+    close_(js, '}');
+}
+void pd_json_begin_array(pd_json *js, const char *key)
+{
+    open(js, key, '[');
+}
+void pd_json_end_array(pd_json *js)
+{
+    close_(js, ']');
+}
 
 void pd_json_num(pd_json *js, const char *key, double x)
 {

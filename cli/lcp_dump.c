@@ -47,8 +47,22 @@ typedef struct dump_set {
     long nbuf, written;
 } dump_set;
 
-enum { S_N, S_T, S_SOLVER, S_OUTCOME, S_PIVOTS, S_ITER, S_RES, S_COLPTR, S_ROWIND, S_VALUES,
-       S_B, S_Z, S_CONTACT, NSETS };
+enum {
+    S_N,
+    S_T,
+    S_SOLVER,
+    S_OUTCOME,
+    S_PIVOTS,
+    S_ITER,
+    S_RES,
+    S_COLPTR,
+    S_ROWIND,
+    S_VALUES,
+    S_B,
+    S_Z,
+    S_CONTACT,
+    NSETS
+};
 
 struct pd_lcp_dump {
     pd_outfile out;
@@ -68,12 +82,19 @@ static const struct {
     const char *name;
     int is_int;
     const char *units, *dim;
-} set_defs[NSETS] = {
-    {"n", 1, "1", "t"},                {"t", 0, "s", "t"},          {"solver", 1, "1", "t"},
-    {"outcome", 1, "1", "t"},          {"pivots", 1, "1", "t"},     {"iterations", 1, "1", "t"},
-    {"residual", 0, "1", "t"},         {"colptr", 1, "1", "pointer"}, {"rowind", 1, "1", "nonzero"},
-    {"values", 0, "1/kg", "nonzero"},  {"b", 0, "m/s", "row"},      {"z", 0, "N s", "row"},
-    {"contact", 1, "1", "row"}};
+} set_defs[NSETS] = {{"n", 1, "1", "t"},
+                     {"t", 0, "s", "t"},
+                     {"solver", 1, "1", "t"},
+                     {"outcome", 1, "1", "t"},
+                     {"pivots", 1, "1", "t"},
+                     {"iterations", 1, "1", "t"},
+                     {"residual", 0, "1", "t"},
+                     {"colptr", 1, "1", "pointer"},
+                     {"rowind", 1, "1", "nonzero"},
+                     {"values", 0, "1/kg", "nonzero"},
+                     {"b", 0, "m/s", "row"},
+                     {"z", 0, "N s", "row"},
+                     {"contact", 1, "1", "row"}};
 
 /* The dimensions, their lengths the sets' (all written), attached: 0 or -1. */
 static int dump_dims(pd_lcp_dump *d)
@@ -177,8 +198,14 @@ static int push(dump_set *s, const void *x, long count)
     return 0;
 }
 
-static int push_int(dump_set *s, int v) { return push(s, &v, 1); }
-static int push_num(dump_set *s, double v) { return push(s, &v, 1); }
+static int push_int(dump_set *s, int v)
+{
+    return push(s, &v, 1);
+}
+static int push_num(dump_set *s, double v)
+{
+    return push(s, &v, 1);
+}
 
 /* The code of a solver name. */
 static int solver_code(const char *name)
@@ -229,8 +256,8 @@ int pd_lcp_dump_finish(pd_lcp_dump *d, pd_err *err)
     int rc = d->failed, e;
     char names[160] = "";
     for (int k = 0; k < NSOLVERS; k++)
-        snprintf(names + strlen(names), sizeof names - strlen(names), "%s%d=%s", k ? ", " : "",
-                 k, dump_solvers[k]);
+        snprintf(names + strlen(names), sizeof names - strlen(names), "%s%d=%s", k ? ", " : "", k,
+                 dump_solvers[k]);
     for (int k = 0; k < NSETS && !rc; k++)
         rc = flush_set(&d->set[k]);
     rc = rc || pd_h5_attr(d->file, "solver_codes", names, 0.0) ||
@@ -281,7 +308,8 @@ static void *read_all(hid_t file, const char *name, hid_t type, size_t size, lon
         return NULL;
     hid_t sp = H5Dget_space(ds);
     hsize_t dims[1] = {0};
-    if (sp >= 0 && H5Sget_simple_extent_ndims(sp) == 1 && H5Sget_simple_extent_dims(sp, dims, NULL) == 1) {
+    if (sp >= 0 && H5Sget_simple_extent_ndims(sp) == 1 &&
+        H5Sget_simple_extent_dims(sp, dims, NULL) == 1) {
         buf = pd_malloc((long)dims[0], size);
         if (buf && (dims[0] == 0 || H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) >= 0))
             *len = (long)dims[0];

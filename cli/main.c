@@ -25,7 +25,8 @@ static const char usage[] =
     "  spectrum   response spectra Pi1(Pi2) over lists of Pi3, eps, xi, pulses (OpenMP, MPI)\n"
     "  record F   ground-motion measures and the fitted pulse of strong-motion records\n"
     "  lcp FILE   solve one linear complementarity problem (Lemke, structured, PGS)\n"
-    "  bench      performance figures (--lcp, --engine, --scene, --spectrum, --records, --startup)\n"
+    "  bench      performance figures (--lcp, --engine, --scene, --spectrum, --records, "
+    "--startup)\n"
     "  help CMD   the options of a command (as `pound CMD --help`)\n"
     "\n"
     "  --version  pound's version and the libraries it was built with\n"
@@ -86,7 +87,8 @@ static int help(int argc, char **argv)
     int k = find_command(argv[2]);
     if (k < 0)
         return pd_cli_usage_error("help: unknown command '%s' (simulate, compare, converge, "
-                                  "spectrum, record, lcp or bench)", argv[2]);
+                                  "spectrum, record, lcp or bench)",
+                                  argv[2]);
     char flag[] = "--help", *av[] = {argv[2], flag, NULL};
     return commands[k].run(2, av);
 }
@@ -110,7 +112,8 @@ static int dispatch(int argc, char **argv)
     const char *isa = getenv("POUND_ISA");
     if (k >= 0 && isa && pd_cpu_isa_parse(isa) < 0)
         return pd_cli_usage_error("POUND_ISA='%s': the vector kernels' instruction set must be "
-                                  "baseline, avx2 or avx512 (or unset)", isa);
+                                  "baseline, avx2 or avx512 (or unset)",
+                                  isa);
     if (k >= 0)
         return commands[k].run(argc - 1, argv + 1);
     return pd_cli_usage_error("unknown command '%s' (try `pound --help`)", cmd);

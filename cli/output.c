@@ -46,7 +46,7 @@ void pd_output_signals(void)
 {
     /* the signals that end a process by default, but for faults: interrupts,
      * a soft CPU limit (prlimit --cpu), timers, a closed pipe */
-    static const int sigs[] = {SIGINT,  SIGTERM,   SIGHUP,  SIGQUIT, SIGXCPU, SIGALRM,
+    static const int sigs[] = {SIGINT,    SIGTERM, SIGHUP,  SIGQUIT, SIGXCPU, SIGALRM,
                                SIGVTALRM, SIGPROF, SIGUSR1, SIGUSR2, SIGPIPE};
     struct sigaction sa = {.sa_handler = on_signal, .sa_flags = SA_RESETHAND}, old;
     sigemptyset(&sa.sa_mask);
@@ -91,7 +91,10 @@ static int ends_with(const char *path, const char *suffix)
     return n > k && !strcmp(path + n - k, suffix);
 }
 
-static int is_hdf5(const char *path) { return ends_with(path, ".h5") || ends_with(path, ".hdf5"); }
+static int is_hdf5(const char *path)
+{
+    return ends_with(path, ".h5") || ends_with(path, ".hdf5");
+}
 
 /* The extension rule: PD_OK or PD_EINVAL. */
 static int check_extension(const char *path, pd_err *err)
@@ -192,11 +195,14 @@ int pd_output_check_writable(const char *flag, const char *path, pd_err *err)
     struct stat st;
     int e = follow_links(path, real, sizeof real);
     if (!e && stat(real, &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode))
-        return pd_err_set(err, PD_EINVAL, "%s %s: not a regular file (%s): only a regular file "
-                                          "is replaced",
-                          flag, path, S_ISFIFO(st.st_mode) ? "a FIFO"
-                                      : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device"
-                                      : S_ISSOCK(st.st_mode) ? "a socket" : "not a file");
+        return pd_err_set(err, PD_EINVAL,
+                          "%s %s: not a regular file (%s): only a regular file "
+                          "is replaced",
+                          flag, path,
+                          S_ISFIFO(st.st_mode)                         ? "a FIFO"
+                          : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device"
+                          : S_ISSOCK(st.st_mode)                       ? "a socket"
+                                                                       : "not a file");
     if (!e)
         e = probe(real);
     return e ? pd_err_set(err, PD_EINVAL, "%s %s: %s", flag, path, strerror(e)) : PD_OK;
@@ -257,8 +263,7 @@ static int same_file(const file_id *a, const file_id *b)
     return !strcmp(a->dir, b->dir);
 }
 
-int pd_output_check_distinct(int n, const char *const *flags, const char *const *paths,
-                             pd_err *err)
+int pd_output_check_distinct(int n, const char *const *flags, const char *const *paths, pd_err *err)
 {
     file_id a, b;
     for (int i = 0; i < n; i++) {
@@ -270,8 +275,8 @@ int pd_output_check_distinct(int n, const char *const *flags, const char *const 
                 continue;
             file_identity(paths[j], &b);
             if (same_file(&a, &b))
-                return pd_err_set(err, PD_EINVAL, "%s %s and %s %s name the same file",
-                                  flags[i], paths[i], flags[j], paths[j]);
+                return pd_err_set(err, PD_EINVAL, "%s %s and %s %s name the same file", flags[i],
+                                  paths[i], flags[j], paths[j]);
         }
     }
     return PD_OK;
@@ -486,7 +491,7 @@ struct pd_table_writer {
     long rows, nbuf, chunk;
     double *buf, *col; /* HDF5: TABLE_BLOCK_ROWS rows, and one column of them */
     hid_t file, *ds;
-    pd_csv spill; /* CSV: the rows so far, in an unnamed file beside the output */
+    pd_csv spill;       /* CSV: the rows so far, in an unnamed file beside the output */
     pd_provenance prov; /* taken when the file is begun */
 };
 
@@ -511,8 +516,8 @@ static int h5_codes_attr(hid_t ds, const pd_column *c)
     size_t len = 0;
     for (int k = 0; k < c->nlabels && len < sizeof codes; k++)
         if (c->labels[k])
-            len += (size_t)snprintf(codes + len, sizeof codes - len, "%s%d = %s",
-                                    len ? ", " : "", k, c->labels[k]);
+            len += (size_t)snprintf(codes + len, sizeof codes - len, "%s%d = %s", len ? ", " : "",
+                                    k, c->labels[k]);
     return pd_h5_attr(ds, "codes", codes, 0.0);
 }
 
@@ -525,8 +530,8 @@ static int h5_table_open(pd_table_writer *w)
         return w->failure ? w->failure : EIO;
     for (int j = 0; j < w->ncols; j++) {
         const pd_column *c = &w->cols[j];
-        w->ds[j] = pd_h5_extendible(w->file, c->name, H5T_NATIVE_DOUBLE, 0, w->chunk,
-                                    column_units(c));
+        w->ds[j] =
+            pd_h5_extendible(w->file, c->name, H5T_NATIVE_DOUBLE, 0, w->chunk, column_units(c));
         if (w->ds[j] < 0 || (c->labels && h5_codes_attr(w->ds[j], c)))
             return w->failure ? w->failure : pd_h5_errno();
     }
@@ -578,10 +583,15 @@ int pd_table_open(pd_table_writer **out, const char *path, int ncols, const pd_c
     *out = NULL;
     if (!w)
         return pd_err_set(err, PD_ENOMEM, "-o %s: out of memory", path);
-    *w = (pd_table_writer){.hdf5 = is_hdf5(path), .ncols = ncols, .cols = cols,
-                           .dim = dim ? dim : "row", .file = -1, .out = {.slot = -1}};
-    w->chunk = expected_rows < 1 ? 1 : expected_rows < TABLE_BLOCK_ROWS ? expected_rows
-                                                                        : TABLE_BLOCK_ROWS;
+    *w = (pd_table_writer){.hdf5 = is_hdf5(path),
+                           .ncols = ncols,
+                           .cols = cols,
+                           .dim = dim ? dim : "row",
+                           .file = -1,
+                           .out = {.slot = -1}};
+    w->chunk = expected_rows < 1                  ? 1
+               : expected_rows < TABLE_BLOCK_ROWS ? expected_rows
+                                                  : TABLE_BLOCK_ROWS;
     pd_provenance_now(&w->prov, NULL);
     w->buf = malloc((size_t)TABLE_BLOCK_ROWS * (size_t)ncols * sizeof(double));
     w->col = malloc((size_t)TABLE_BLOCK_ROWS * sizeof(double));

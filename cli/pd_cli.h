@@ -33,29 +33,29 @@ typedef struct pd_cli_case {
     double height;  /* --height: the oscillator's storey height [m] (drift ratio) */
     int have_height;
     int have_T0, have_Pi2, have_gap, have_Pi3, have_dt, have_tend, have_kc;
-    double rtol;            /* --rtol: Moreau-Jean's tolerance, or the penalty integrator's */
+    double rtol; /* --rtol: Moreau-Jean's tolerance, or the penalty integrator's */
     int have_rtol;
-    const char *model_flag; /* the first model flag given (refused with --scene) */
-    const char *scene_path; /* --scene F */
-    int chain;              /* --chain N (0: none) */
-    double chain_ratio;     /* --chain-ratio R */
+    const char *model_flag;  /* the first model flag given (refused with --scene) */
+    const char *scene_path;  /* --scene F */
+    int chain;               /* --chain N (0: none) */
+    double chain_ratio;      /* --chain-ratio R */
     const char *record_path; /* --record F */
-    const char *pulse_flag; /* --pulse, --ap or --Tp when given (refused with --record) */
-    const char *dt_flag;    /* the flag that set dt (--dt, or spectrum's --dt-per-Tp) */
-    double scale;           /* --scale S */
+    const char *pulse_flag;  /* --pulse, --ap or --Tp when given (refused with --record) */
+    const char *dt_flag;     /* the flag that set dt (--dt, or spectrum's --dt-per-Tp) */
+    double scale;            /* --scale S */
     int have_scale;
     pd_record_format rec_format; /* --record-format */
     pd_record_units rec_units;   /* --units (text records) */
     int have_units;              /* --units given */
-    pd_cli_record *record;  /* read by pd_cli_case_finish; released by pd_cli_case_free */
+    pd_cli_record *record;       /* read by pd_cli_case_finish; released by pd_cli_case_free */
     /* the method: --method's, else the one the flags given belong to (a
      * flag of one method's only: --theta, --kc, ...), else the default;
      * method_by names the flag that chose it (NULL: the default) */
     const char *method_by;
-    const char *implies[4]; /* per pd_method: the first flag given that only it takes */
+    const char *implies[4];       /* per pd_method: the first flag given that only it takes */
     const char *method_flags[24]; /* the flags given that some methods only take */
     int n_method_flags;
-    int methods_listed;     /* compare, converge: --methods chooses per run */
+    int methods_listed; /* compare, converge: --methods chooses per run */
 } pd_cli_case;
 
 extern const char pd_cli_case_help[];
@@ -98,8 +98,7 @@ int pd_cli_is_scene(const pd_cli_case *a);
 int pd_cli_scene(const pd_cli_case *a, pd_scene **sc);
 
 /* Print "pound: <message>" on stderr and return 2 (bad input). */
-int pd_cli_usage_error(const char *fmt, ...)
-    __attribute__((format(printf, 1, 2)));
+int pd_cli_usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 
 /* When argv holds --help or -h: print usage (and the case flags' help when
  * with_case) on stdout and return 1; else 0. */

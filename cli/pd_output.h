@@ -51,11 +51,11 @@ void pd_output_signals(void);
 /* ---- an output file replaced atomically --------------------------------- */
 
 typedef struct pd_outfile {
-    const char *flag, *given;    /* "-o" and the path as given, for messages */
-    char path[PD_PATH_MAX];      /* the file replaced (symlinks followed) */
-    char tmp[PD_PATH_MAX + 32];  /* path.tmpPID, renamed onto path */
-    int slot;                    /* its signal-cleanup slot (-1: none) */
-    int keep_mode;               /* path exists: its mode goes to the new file */
+    const char *flag, *given;   /* "-o" and the path as given, for messages */
+    char path[PD_PATH_MAX];     /* the file replaced (symlinks followed) */
+    char tmp[PD_PATH_MAX + 32]; /* path.tmpPID, renamed onto path */
+    int slot;                   /* its signal-cleanup slot (-1: none) */
+    int keep_mode;              /* path exists: its mode goes to the new file */
     mode_t mode;
 } pd_outfile;
 
@@ -146,7 +146,7 @@ typedef struct pd_attr {
 
 typedef struct pd_column {
     const char *name;
-    const char *units; /* NULL or "": "1" (dimensionless, or a code) */
+    const char *units;    /* NULL or "": "1" (dimensionless, or a code) */
     const double *values; /* pd_output_write only */
     /* A coded column (labels non-NULL): its values are codes 0..nlabels-1;
      * the CSV writes labels[code] as text, the HDF5 file the code with a

@@ -26,9 +26,9 @@ typedef struct pd_chart {
     int logx, logy;
     int ncurves;
     const pd_curve *curves;
-    double vline;             /* NAN: none; else a vertical marker at x = vline */
+    double vline; /* NAN: none; else a vertical marker at x = vline */
     const char *vline_label;
-    double slope_ref;         /* 0: none; else a dashed guide of this log-log slope */
+    double slope_ref; /* 0: none; else a dashed guide of this log-log slope */
 } pd_chart;
 
 /* Draw the chart into png (gnuplot writes a private temporary file, which

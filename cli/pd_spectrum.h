@@ -104,15 +104,13 @@ int pd_spec_threads(int requested);
 /* Compute every task not yet done.  On rank 0 all results are in res at
  * the end; the status of the lowest failed task (0 if none) is returned
  * there, with its message in err. */
-int pd_spec_compute(const pd_spectrum *s, const pd_spec_exec *ex, pd_spec_result *res,
-                    pd_err *err);
+int pd_spec_compute(const pd_spectrum *s, const pd_spec_exec *ex, pd_spec_result *res, pd_err *err);
 
 /* ---- output (spectrum_out.c) --------------------------------------------- */
 
 /* HDF5 (one group per curve) or CSV (one row per point) by extension,
  * through a temporary file renamed on success. */
-int pd_spec_write(const char *path, const pd_spectrum *s, const pd_spec_row *rows,
-                  pd_err *err);
+int pd_spec_write(const char *path, const pd_spectrum *s, const pd_spec_row *rows, pd_err *err);
 /* PNG.png: Pi1 vs Pi2 (log-log); PNG-gamma.png: gamma vs Pi2; with the
  * dimensional view PNG-dim.png: umax [cm] vs T0 [s]. */
 int pd_spec_plot(const char *png, const pd_spectrum *s, const pd_spec_row *rows, pd_err *err);

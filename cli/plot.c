@@ -42,8 +42,10 @@ static int write_data(FILE *f, const pd_chart *c)
  * (no overlong form, no surrogate, at most U+10FFFF), else 0. */
 static int utf8_len(const unsigned char *c)
 {
-    int n = c[0] >= 0xc2 && c[0] <= 0xdf ? 2 : c[0] >= 0xe0 && c[0] <= 0xef ? 3
-          : c[0] >= 0xf0 && c[0] <= 0xf4 ? 4 : 0;
+    int n = c[0] >= 0xc2 && c[0] <= 0xdf   ? 2
+            : c[0] >= 0xe0 && c[0] <= 0xef ? 3
+            : c[0] >= 0xf0 && c[0] <= 0xf4 ? 4
+                                           : 0;
     for (int k = 1; k < n; k++)
         if ((c[k] & 0xc0) != 0x80)
             return 0;
@@ -101,9 +103,9 @@ void pd_plot_literal(FILE *g, const char *s)
 /* The colours of the palette: Okabe and Ito's (yellow left out: too pale
  * on white) and six of Paul Tol's muted set, told apart on screen and in
  * print; a curve past the twelfth takes them again with another dash type. */
-static const char *const palette[PD_PLOT_COLOURS] = {
-    "#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9",
-    "#332288", "#882255", "#999933", "#44AA99", "#CC6677", "#555555"};
+static const char *const palette[PD_PLOT_COLOURS] = {"#0072B2", "#D55E00", "#009E73", "#CC79A7",
+                                                     "#E69F00", "#56B4E9", "#332288", "#882255",
+                                                     "#999933", "#44AA99", "#CC6677", "#555555"};
 
 void pd_plot_style(FILE *g)
 {
@@ -354,8 +356,8 @@ static int keep_script(const plot_work *w, const char *png, pd_err *err)
     snprintf(gp, sizeof gp, "%.*s.gp", (int)(n - 4), png);
     snprintf(dat, sizeof dat, "%.*s.dat", (int)(n - 4), png);
     if (copy_into_place(w->script, gp) || copy_into_place(w->data, dat))
-        return pd_err_set(err, PD_EIO, "--plot %s: POUND_PLOT_SCRIPT: cannot write %s: %s", png,
-                          gp, strerror(errno));
+        return pd_err_set(err, PD_EIO, "--plot %s: POUND_PLOT_SCRIPT: cannot write %s: %s", png, gp,
+                          strerror(errno));
     return PD_OK;
 }
 

@@ -55,8 +55,8 @@ static void record_title(FILE *g, const pd_cli_record *r)
 {
     fputs("set title ", g);
     pd_plot_literal(g, r->rec.name);
-    fprintf(g, " . \"\\nT_p = %.3g s, a_p = %.3g m/s^2, 1/L_e = %.3g m^{-1}\"\n",
-            r->pulse.Tp, r->pulse.ap, 1.0 / r->pulse.Le);
+    fprintf(g, " . \"\\nT_p = %.3g s, a_p = %.3g m/s^2, 1/L_e = %.3g m^{-1}\"\n", r->pulse.Tp,
+            r->pulse.ap, 1.0 / r->pulse.Le);
 }
 
 /* Three rows (acceleration, velocity, displacement), a column per record. */
@@ -65,8 +65,7 @@ static void records_script(FILE *g, const char *data, const char *png_tmp, const
     const records_fig *fig = ctx;
     static const char *const rows[3] = {"acceleration [m/s^2]", "velocity [m/s]",
                                         "displacement [m]"};
-    fprintf(g, "set terminal pngcairo size %d,900 enhanced font 'sans,10'\n",
-            360 * fig->n + 120);
+    fprintf(g, "set terminal pngcairo size %d,900 enhanced font 'sans,10'\n", 360 * fig->n + 120);
     pd_plot_style(g);
     fputs("set output ", g);
     pd_plot_text(g, png_tmp);
@@ -83,12 +82,14 @@ static void records_script(FILE *g, const char *data, const char *png_tmp, const
             fprintf(g, "set ylabel '%s'\nset xlabel '%s'\nplot ", k ? "" : rows[row],
                     row == 2 ? "t [s]" : "");
             pd_plot_text(g, data);
-            fprintf(g, " index %d using 1:%d with lines lc rgb 'gray40' title 'record', "
-                       "'' index %d using 1:%d with lines lw 2 lc rgb 'red' title 'fitted pulse'",
+            fprintf(g,
+                    " index %d using 1:%d with lines lc rgb 'gray40' title 'record', "
+                    "'' index %d using 1:%d with lines lw 2 lc rgb 'red' title 'fitted pulse'",
                     k, 2 + row, k, 5 + row);
             if (row == 0)
-                fprintf(g, ", '' index %d using 1:8 with lines lw 1.5 dt 2 lc rgb 'blue' "
-                           "title 'one-cycle %s pulse'",
+                fprintf(g,
+                        ", '' index %d using 1:8 with lines lw 1.5 dt 2 lc rgb 'blue' "
+                        "title 'one-cycle %s pulse'",
                         k, pd_pulse_name(r->pulse.shape));
             fputc('\n', g);
         }

@@ -32,17 +32,16 @@ struct pd_scene_writer {
     pd_outfile out;
     int hdf5, failure; /* failure: errno of the first failed write, 0 if none */
     long every, seen, rows;
-    double *imp;        /* m: impulses since the last recorded row */
+    double *imp; /* m: impulses since the last recorded row */
     /* rows waiting to be written: t, x (n), v (n), gap (m), impulse (m) per row */
     long cap, nbuf;
-    double *buf, *col;  /* cap rows x width; col: one block of a structure */
+    double *buf, *col; /* cap rows x width; col: one block of a structure */
     int width;
     hid_t file, ds_t;
     hid_t *ds_x, *ds_v, *ds_g, *ds_p;
     pd_csv csv;
     pd_provenance prov;
 };
-
 
 /* Does path end with suffix? */
 static int ends_with(const char *path, const char *suffix)
@@ -76,17 +75,20 @@ static int h5_open(pd_scene_writer *w)
     int rc = gs < 0 || gc < 0 || (w->ds_t = pd_h5_extendible_coord(w->file, "t", w->cap, "s")) < 0;
     for (int s = 0; s < sc->nstruct && !rc && !short_of_memory(w); s++) {
         hid_t g = H5Gcreate2(gs, sc->st[s].name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-        rc = g < 0 || pd_h5_index(g, "storey", sc->st[s].storeys, 1, "1") ||
-             (w->ds_x[s] = pd_h5_extendible(g, "x", H5T_NATIVE_DOUBLE, sc->st[s].storeys, w->cap, "m")) < 0 ||
-             (w->ds_v[s] = pd_h5_extendible(g, "v", H5T_NATIVE_DOUBLE, sc->st[s].storeys, w->cap, "m/s")) < 0;
+        rc =
+            g < 0 || pd_h5_index(g, "storey", sc->st[s].storeys, 1, "1") ||
+            (w->ds_x[s] =
+                 pd_h5_extendible(g, "x", H5T_NATIVE_DOUBLE, sc->st[s].storeys, w->cap, "m")) < 0 ||
+            (w->ds_v[s] =
+                 pd_h5_extendible(g, "v", H5T_NATIVE_DOUBLE, sc->st[s].storeys, w->cap, "m/s")) < 0;
         if (g >= 0 && H5Gclose(g) < 0)
             rc = 1;
     }
-    for (int a = 0; a < sc->ncontact && !rc && !short_of_memory(w);
-         a++) {
+    for (int a = 0; a < sc->ncontact && !rc && !short_of_memory(w); a++) {
         snprintf(name, sizeof name, "%d", a);
         hid_t g = H5Gcreate2(gc, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-        rc = g < 0 || (w->ds_g[a] = pd_h5_extendible(g, "gap", H5T_NATIVE_DOUBLE, 0, w->cap, "m")) < 0 ||
+        rc = g < 0 ||
+             (w->ds_g[a] = pd_h5_extendible(g, "gap", H5T_NATIVE_DOUBLE, 0, w->cap, "m")) < 0 ||
              (w->ds_p[a] = pd_h5_extendible(g, "impulse", H5T_NATIVE_DOUBLE, 0, w->cap, "N s")) < 0;
         if (g >= 0 && H5Gclose(g) < 0)
             rc = 1;
@@ -98,8 +100,7 @@ static int h5_open(pd_scene_writer *w)
      * A new dataset is attached here too. */
     for (int s = 0; s < sc->nstruct && !rc && !short_of_memory(w); s++)
         rc = pd_h5_dims(w->ds_x[s], "t,storey") || pd_h5_dims(w->ds_v[s], "t,storey");
-    for (int a = 0; a < sc->ncontact && !rc && !short_of_memory(w);
-         a++)
+    for (int a = 0; a < sc->ncontact && !rc && !short_of_memory(w); a++)
         rc = pd_h5_dims(w->ds_g[a], "t") || pd_h5_dims(w->ds_p[a], "t");
     if (gs >= 0 && H5Gclose(gs) < 0)
         rc = 1;
@@ -256,13 +257,15 @@ static int flush_rows(pd_scene_writer *w)
                 for (long r = 0; r < nb; r++)
                     memcpy(w->col + (size_t)r * st, w->buf + (size_t)r * w->width + off,
                            (size_t)st * sizeof(double));
-                rc = pd_h5_append(part ? w->ds_v[s] : w->ds_x[s], H5T_NATIVE_DOUBLE, w->rows - nb, nb, st, w->col);
+                rc = pd_h5_append(part ? w->ds_v[s] : w->ds_x[s], H5T_NATIVE_DOUBLE, w->rows - nb,
+                                  nb, st, w->col);
             }
         for (int a = 0; a < m && !rc; a++)
             for (int part = 0; part < 2 && !rc; part++) {
                 for (long r = 0; r < nb; r++)
                     w->col[r] = w->buf[(size_t)r * w->width + 1 + 2 * n + part * m + a];
-                rc = pd_h5_append(part ? w->ds_p[a] : w->ds_g[a], H5T_NATIVE_DOUBLE, w->rows - nb, nb, 0, w->col);
+                rc = pd_h5_append(part ? w->ds_p[a] : w->ds_g[a], H5T_NATIVE_DOUBLE, w->rows - nb,
+                                  nb, 0, w->col);
             }
     }
     w->nbuf = 0;
@@ -336,9 +339,8 @@ static int put_run(pd_scene_writer *w, const pd_scene_run_info *ri)
     const pd_scene *sc = w->sc;
     const pd_scene_result *r = &ri->sum->r;
     hid_t f = w->hdf5 ? w->file : -1;
-    return put_text(w, f, "", "scene", ri->scene_name) ||
-           put_text(w, f, "", "method", r->method) || put_text(w, f, "", "kernel", r->kernel) ||
-           put_text(w, f, "", "factor", r->factor) ||
+    return put_text(w, f, "", "scene", ri->scene_name) || put_text(w, f, "", "method", r->method) ||
+           put_text(w, f, "", "kernel", r->kernel) || put_text(w, f, "", "factor", r->factor) ||
            put_text(w, f, "", "lcp_solver", r->lcp_solver) ||
            put_text(w, f, "", "pulse",
                     sc->exc.record ? sc->exc.record->name : pd_pulse_name(sc->exc.pulse)) ||
@@ -362,7 +364,8 @@ static int put_run(pd_scene_writer *w, const pd_scene_run_info *ri)
            put_num(w, f, "", "err_est", ri->sum->err_est, "1") ||
            put_num(w, f, "", "rtol_met", ri->sum->rtol_met, "1") ||
            put_num(w, f, "", "steps_rejected", (double)r->steps_rejected, "1") ||
-           put_num(w, f, "", "dt_min", r->dt_min, "s") || put_num(w, f, "", "dt_max", r->dt_max, "s");
+           put_num(w, f, "", "dt_min", r->dt_min, "s") ||
+           put_num(w, f, "", "dt_max", r->dt_max, "s");
 }
 
 /* Structure s: its description and results (group /structures/NAME). */
@@ -380,10 +383,12 @@ static int put_structure(pd_scene_writer *w, const pd_scene_summary *sum, int s)
             return -1;
     }
     rc = put_num(w, g, prefix, "storeys", k, "1") || put_num(w, g, prefix, "T0", st->T0, "s") ||
-         put_num(w, g, prefix, "Pi2", sum->Pi2[s], "1") || put_num(w, g, prefix, "xi", st->xi, "1") ||
+         put_num(w, g, prefix, "Pi2", sum->Pi2[s], "1") ||
+         put_num(w, g, prefix, "xi", st->xi, "1") ||
          put_text(w, g, prefix, "damping",
-                  st->storeys == 1 ? "exact" : st->damping == PD_DAMPING_STIFFNESS ? "stiffness"
-                                                                                   : "rayleigh") ||
+                  st->storeys == 1                      ? "exact"
+                  : st->damping == PD_DAMPING_STIFFNESS ? "stiffness"
+                                                        : "rayleigh") ||
          put_num(w, g, prefix, "alpha", st->alpha, "1/s") ||
          put_num(w, g, prefix, "beta", st->beta, "s") ||
          put_nums(w, g, prefix, "masses", k, st->mass, "kg") ||
@@ -426,7 +431,8 @@ static int put_contact(pd_scene_writer *w, const pd_scene_summary *sum, int a)
          put_text(w, g, prefix, "b", ct->b == PD_WALL ? "wall" : sc->st[ct->b].name) ||
          put_num(w, g, prefix, "level_a", ct->level_a, "1") ||
          put_num(w, g, prefix, "level_b", ct->level_b, "1") ||
-         put_num(w, g, prefix, "gap0", ct->gap, "m") || put_num(w, g, prefix, "eps", ct->eps, "1") ||
+         put_num(w, g, prefix, "gap0", ct->gap, "m") ||
+         put_num(w, g, prefix, "eps", ct->eps, "1") ||
          put_num(w, g, prefix, "Pi3", sum->Pi3[a], "1") ||
          put_num(w, g, prefix, "chi", sum->chi[a], "1") ||
          put_num(w, g, prefix, "impacts", (double)sum->r.impacts[a], "1") ||

@@ -16,11 +16,11 @@
 #include "pd_plot.h"
 #include "pd_scene_out.h"
 
-#define PLOT_STRUCTS 12    /* most structures in one panel */
-#define PLOT_PANELS 4      /* most structures drawn a panel each */
-#define PLOT_STOREYS 8     /* most storeys of one structure drawn */
-#define PLOT_POINTS 2000   /* points per curve (the samples are decimated) */
-#define PLOT_MARKS 4000    /* most impacts marked */
+#define PLOT_STRUCTS 12  /* most structures in one panel */
+#define PLOT_PANELS 4    /* most structures drawn a panel each */
+#define PLOT_STOREYS 8   /* most storeys of one structure drawn */
+#define PLOT_POINTS 2000 /* points per curve (the samples are decimated) */
+#define PLOT_MARKS 4000  /* most impacts marked */
 
 /* A curve: storey `storey` (1-based) of structure st, in panel `panel`. */
 typedef struct plot_curve {
@@ -33,12 +33,12 @@ struct pd_scene_plot {
     int ncurves;
     plot_curve *cv;
     long stride, seen, np;
-    double *t, *y;           /* np times; ncurves x (PLOT_POINTS + 2) displacements */
+    double *t, *y; /* np times; ncurves x (PLOT_POINTS + 2) displacements */
     long nmarks;
-    double *mt, *my;         /* marks: time and displacement of the storey hit */
-    int *mp;                 /* the panel of each mark */
+    double *mt, *my; /* marks: time and displacement of the storey hit */
+    int *mp;         /* the panel of each mark */
     long impacts[PLOT_PANELS > 1 ? PLOT_PANELS : 1]; /* impacts of each panel's contacts */
-    long impacts_all;        /* of the run */
+    long impacts_all;                                /* of the run */
 };
 
 void pd_scene_plot_free(pd_scene_plot *p)

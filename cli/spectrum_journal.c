@@ -60,11 +60,9 @@ static int parse_record(const char *line, size_t len, long ntasks, long *task, p
             hash = line + i;
             break;
         }
-    if (len >= sizeof buf || len < 4 || line[0] != 'T' || !hash || hash == line ||
-        hash[-1] != ' ')
+    if (len >= sizeof buf || len < 4 || line[0] != 'T' || !hash || hash == line || hash[-1] != ' ')
         return -1;
-    if (strtoul(hash + 1, &end, 16) != fnv1a(line, (size_t)(hash - 1 - line)) ||
-        end != line + len)
+    if (strtoul(hash + 1, &end, 16) != fnv1a(line, (size_t)(hash - 1 - line)) || end != line + len)
         return -1;
     memcpy(buf, line, (size_t)(hash - line));
     buf[hash - line] = '\0';
@@ -116,9 +114,8 @@ static int create_journal(pd_spec_journal *j, const char *key, pd_err *err)
                           j->path);
     if (j->fd < 0)
         return pd_err_set(err, PD_EIO, "-o: cannot create %s: %s", j->path, strerror(errno));
-    if (lock_fd(j->fd) || write_all(j->fd, magic, strlen(magic)) ||
-        write_all(j->fd, "key ", 4) || write_all(j->fd, key, strlen(key)) ||
-        write_all(j->fd, "\n", 1) || fdatasync(j->fd)) {
+    if (lock_fd(j->fd) || write_all(j->fd, magic, strlen(magic)) || write_all(j->fd, "key ", 4) ||
+        write_all(j->fd, key, strlen(key)) || write_all(j->fd, "\n", 1) || fdatasync(j->fd)) {
         int e = errno ? errno : EIO;
         close(j->fd);
         j->fd = -1;
@@ -173,8 +170,7 @@ static int check_header(const pd_spec_journal *j, const char *buf, const char *k
     size_t lm = strlen(magic), lk = strlen(key);
     char what[80];
     if (strncmp(buf, magic, lm) || strncmp(buf + lm, "key ", 4))
-        return pd_err_set(err, PD_EINVAL, "--resume: %s is not a pound spectrum journal",
-                          j->path);
+        return pd_err_set(err, PD_EINVAL, "--resume: %s is not a pound spectrum journal", j->path);
     const char *k = buf + lm + 4, *nl = strchr(k, '\n');
     if (!nl || (size_t)(nl - k) != lk || memcmp(k, key, lk)) {
         char *old = nl ? strndup(k, (size_t)(nl - k)) : NULL;
@@ -190,8 +186,8 @@ static int check_header(const pd_spec_journal *j, const char *buf, const char *k
 }
 
 /* Records after the header; a torn tail (no newline) is cut off the file. */
-static int load_records(pd_spec_journal *j, const char *buf, size_t len, size_t pos,
-                        long ntasks, pd_spec_result *res, long *loaded)
+static int load_records(pd_spec_journal *j, const char *buf, size_t len, size_t pos, long ntasks,
+                        pd_spec_result *res, long *loaded)
 {
     long t;
     pd_spec_result r;

@@ -38,7 +38,10 @@ void pd_spec_mpi_finalize(void)
         MPI_Finalize();
 }
 
-void pd_spec_mpi_abort(int status) { MPI_Abort(MPI_COMM_WORLD, status); }
+void pd_spec_mpi_abort(int status)
+{
+    MPI_Abort(MPI_COMM_WORLD, status);
+}
 
 void pd_spec_mpi_agree(int *status)
 {
@@ -131,9 +134,15 @@ int pd_spec_mpi_init(int *rank, int *size, int *threaded)
 
 void pd_spec_mpi_finalize(void) {}
 
-void pd_spec_mpi_abort(int status) { (void)status; }
+void pd_spec_mpi_abort(int status)
+{
+    (void)status;
+}
 
-void pd_spec_mpi_agree(int *status) { (void)status; }
+void pd_spec_mpi_agree(int *status)
+{
+    (void)status;
+}
 
 int pd_spec_mpi_bcast_done(pd_spec_result *res, long ntasks)
 {
@@ -142,7 +151,10 @@ int pd_spec_mpi_bcast_done(pd_spec_result *res, long ntasks)
     return 0;
 }
 
-void pd_spec_mpi_report(const pd_spec_report *m) { (void)m; }
+void pd_spec_mpi_report(const pd_spec_report *m)
+{
+    (void)m;
+}
 
 int pd_spec_mpi_poll_report(int block, pd_spec_report *m, int *from)
 {

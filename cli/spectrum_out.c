@@ -25,17 +25,29 @@ typedef struct col_def {
     int is_long;
 } col_def;
 
-#define DCOL(name, units, field) {name, units, offsetof(pd_spec_row, field), 0}
-#define LCOL(name, field) {name, "1", offsetof(pd_spec_row, field), 1}
-static const col_def point_cols[] = {
-    DCOL("Pi2", "1", c.Pi2),         DCOL("T0", "s", T0),
-    DCOL("Pi1", "1", Pi1),           DCOL("umax", "m", umax),
-    DCOL("umax_free", "m", umax_free), DCOL("gamma", "1", gamma),
-    DCOL("chi", "1", chi),           DCOL("u_toward", "m", u_toward),
-    DCOL("u_away", "m", u_away),     LCOL("impacts", impacts),
-    DCOL("contact_time", "s", contact_time), DCOL("first_impact", "s", first_impact),
-    LCOL("steps", steps),            DCOL("dt", "s", dt),
-    DCOL("tend", "s", tend)};
+#define DCOL(name, units, field)                                                                   \
+    {                                                                                              \
+        name, units, offsetof(pd_spec_row, field), 0                                               \
+    }
+#define LCOL(name, field)                                                                          \
+    {                                                                                              \
+        name, "1", offsetof(pd_spec_row, field), 1                                                 \
+    }
+static const col_def point_cols[] = {DCOL("Pi2", "1", c.Pi2),
+                                     DCOL("T0", "s", T0),
+                                     DCOL("Pi1", "1", Pi1),
+                                     DCOL("umax", "m", umax),
+                                     DCOL("umax_free", "m", umax_free),
+                                     DCOL("gamma", "1", gamma),
+                                     DCOL("chi", "1", chi),
+                                     DCOL("u_toward", "m", u_toward),
+                                     DCOL("u_away", "m", u_away),
+                                     LCOL("impacts", impacts),
+                                     DCOL("contact_time", "s", contact_time),
+                                     DCOL("first_impact", "s", first_impact),
+                                     LCOL("steps", steps),
+                                     DCOL("dt", "s", dt),
+                                     DCOL("tend", "s", tend)};
 enum { NCOLS = sizeof point_cols / sizeof point_cols[0] };
 
 /* The value of column d in row r. */
@@ -73,8 +85,8 @@ static void dt_rule(const pd_spectrum *s, char *buf, size_t cap)
 /* ---- HDF5 --------------------------------------------------------------- */
 
 /* A 1-D double dataset with a "units" attribute. */
-static int h5_dataset(hid_t grp, hid_t dcpl, const char *name, const char *units,
-                      const double *x, long n)
+static int h5_dataset(hid_t grp, hid_t dcpl, const char *name, const char *units, const double *x,
+                      long n)
 {
     hsize_t dims[1] = {(hsize_t)n};
     hid_t space = H5Screate_simple(1, dims, NULL), ds = -1;
@@ -95,7 +107,8 @@ static int h5_curve_attrs(hid_t g, const pd_spectrum *s, const pd_spec_row *r, l
 {
     char label[256];
     pd_spec_curve_label(s, curve, label, sizeof label);
-    return pd_h5_attr(g, "label", label, 0) || pd_h5_attr(g, "pulse", pd_osc_excitation_name(&r->c), 0) ||
+    return pd_h5_attr(g, "label", label, 0) ||
+           pd_h5_attr(g, "pulse", pd_osc_excitation_name(&r->c), 0) ||
            pd_h5_attr(g, "dir", pd_dir_name(r->c.dir), 0) ||
            pd_h5_attr(g, "method", pd_method_name(s->opts.method), 0) ||
            pd_h5_num(g, "ap", r->c.ap, "m/s^2") || pd_h5_num(g, "Tp", r->c.Tp, "s") ||
@@ -132,9 +145,10 @@ static int h5_root_attrs(hid_t file, const pd_spectrum *s)
     return pd_provenance_h5(file, &p) ||
            pd_h5_attr(file, "method", pd_method_name(s->opts.method), 0) ||
            pd_h5_attr(file, "Pi2_spacing", s->linear ? "linear" : "log", 0) ||
-           pd_h5_num(file, "Pi2_min", s->pi2_min, "1") || pd_h5_num(file, "Pi2_max", s->pi2_max, "1") ||
-           pd_h5_num(file, "Pi2_n", s->npi2, "1") || pd_h5_num(file, "Tp", s->base.Tp, "s") ||
-           pd_h5_attr(file, "dt", rule, 0) || pd_h5_num(file, "theta", s->opts.theta, "1") ||
+           pd_h5_num(file, "Pi2_min", s->pi2_min, "1") ||
+           pd_h5_num(file, "Pi2_max", s->pi2_max, "1") || pd_h5_num(file, "Pi2_n", s->npi2, "1") ||
+           pd_h5_num(file, "Tp", s->base.Tp, "s") || pd_h5_attr(file, "dt", rule, 0) ||
+           pd_h5_num(file, "theta", s->opts.theta, "1") ||
            pd_h5_num(file, "curves", (double)pd_spec_curves(s), "1") ||
            pd_h5_num(file, "points", (double)pd_spec_points(s), "1");
 }
@@ -164,9 +178,9 @@ static int write_hdf5(const char *path, const pd_spectrum *s, const pd_spec_row 
 /* ---- CSV ---------------------------------------------------------------- */
 
 /* The curve columns of the CSV (before the point columns), and their units. */
-static const char *const csv_curve_cols[][2] = {
-    {"pulse", "1"}, {"dir", "1"}, {"method", "1"}, {"ap", "m/s^2"}, {"Tp", "s"},
-    {"Pi3", "1"},   {"gap", "m"}, {"eps", "1"},    {"xi", "1"}};
+static const char *const csv_curve_cols[][2] = {{"pulse", "1"},  {"dir", "1"}, {"method", "1"},
+                                                {"ap", "m/s^2"}, {"Tp", "s"},  {"Pi3", "1"},
+                                                {"gap", "m"},    {"eps", "1"}, {"xi", "1"}};
 enum { NCURVE_COLS = sizeof csv_curve_cols / sizeof csv_curve_cols[0] };
 
 /* The provenance and "# name = value" lines, "# units = ..." (one per
@@ -199,8 +213,8 @@ static int write_csv(const char *path, const pd_spectrum *s, const pd_spec_row *
         const pd_spec_row *r = &rows[p];
         pd_csv_printf(&f, "%s,%s,%s,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
                       pd_osc_excitation_name(&r->c), pd_dir_name(r->c.dir),
-                      pd_method_name(s->opts.method), r->c.ap, r->c.Tp, r->c.Pi3, r->gap,
-                      r->c.eps, r->c.xi);
+                      pd_method_name(s->opts.method), r->c.ap, r->c.Tp, r->c.Pi3, r->gap, r->c.eps,
+                      r->c.xi);
         for (int k = 0; k < NCOLS; k++)
             pd_csv_printf(&f, ",%.17g", col_value(r, &point_cols[k]));
         pd_csv_printf(&f, "\n");
@@ -267,8 +281,9 @@ static void curve_key(const char *label, char *buf, size_t cap)
         const char *eq = memchr(w, '=', len);
         const char *sep = pairs || (eq && n) ? ", " : n ? " " : "";
         int k = 0;
-        while (eq && k < 5 && (strlen(names[k].key) != (size_t)(eq - w) ||
-                                strncmp(w, names[k].key, (size_t)(eq - w))))
+        while (eq && k < 5 &&
+               (strlen(names[k].key) != (size_t)(eq - w) ||
+                strncmp(w, names[k].key, (size_t)(eq - w))))
             k++;
         if (eq && k < 5)
             n += (size_t)snprintf(buf + n, n < cap ? cap - n : 0, "%s%s = %.*s%s", sep,
@@ -303,8 +318,8 @@ static int chart(const char *png, const pd_spectrum *s, const pd_spec_row *rows,
         char label[128];
         pd_spec_curve_label(s, c, label, sizeof label);
         curve_key(label, labels + 128 * c, 128);
-        cv[c] = (pd_curve){.label = labels + 128 * c, .n = s->npi2, .x = x + c * s->npi2,
-                           .y = y + c * s->npi2};
+        cv[c] = (pd_curve){
+            .label = labels + 128 * c, .n = s->npi2, .x = x + c * s->npi2, .y = y + c * s->npi2};
     }
     common_title(s, title, sizeof title);
     pd_chart ch = {.title = title,
@@ -428,8 +443,10 @@ void pd_spec_print_text(const pd_spectrum *s, const pd_spec_row *rows, const pd_
     for (long c = 0; c < pd_spec_curves(s); c++)
         text_curve(s, rows + c * s->npi2, c);
     if (!strcmp(t->method_by, "default"))
-        printf("  method %s: the default for one oscillator (%s); --method moreau|event|penalty|newmark "
-               "chooses\n", pd_method_name(s->opts.method),
+        printf("  method %s: the default for one oscillator (%s); --method "
+               "moreau|event|penalty|newmark "
+               "chooses\n",
+               pd_method_name(s->opts.method),
                s->opts.method == PD_METHOD_EVENT ? "exact and fastest"
                                                  : "the exact reference's scan is over budget");
     else

@@ -43,8 +43,8 @@ typedef struct run_ctx {
     long ntasks, ndone, finished_here;
     double total_cost, done_cost, start_cost, t0, last_draw;
     int bar_shown, workers_left;
-    long first_bad;  /* lowest failed task, -1 if none */
-    char msg[256];   /* its message ("" when a worker computed it) */
+    long first_bad; /* lowest failed task, -1 if none */
+    char msg[256];  /* its message ("" when a worker computed it) */
     /* a worker: tasks granted, results not yet reported */
     long *queue; /* a ring of qcap = PD_SPEC_CHUNK + nthreads + 1 */
     int qcap, qhead, qlen, asked, no_more;
@@ -297,8 +297,7 @@ static void drop_own_journal(const pd_spec_exec *ex)
         pd_spec_journal_close(j, 1);
 }
 
-int pd_spec_compute(const pd_spectrum *s, const pd_spec_exec *ex, pd_spec_result *res,
-                    pd_err *err)
+int pd_spec_compute(const pd_spectrum *s, const pd_spec_exec *ex, pd_spec_result *res, pd_err *err)
 {
     run_ctx *c = calloc(1, sizeof *c);
     int rc = PD_OK;
@@ -336,8 +335,8 @@ int pd_spec_compute(const pd_spectrum *s, const pd_spec_exec *ex, pd_spec_result
         failure_message(c, err);
         rc = err->status;
     } else if (ex->rank == 0 && c->ndone != c->ntasks)
-        rc = pd_err_set(err, PD_EIO, "%ld of %ld runs were not reported",
-                        c->ntasks - c->ndone, c->ntasks);
+        rc = pd_err_set(err, PD_EIO, "%ld of %ld runs were not reported", c->ntasks - c->ndone,
+                        c->ntasks);
 done:
     if (rc == PD_EINVAL)
         drop_own_journal(ex);

@@ -16,9 +16,9 @@ typedef struct sweep_out {
     const pd_scene *sc;
     pd_scene_sweep w;
     long ntw, np;
-    pd_scene_point *pts;  /* twins then points */
-    double *umax;         /* task x nstruct */
-    double *Pi1, *gamma;  /* point x nstruct */
+    pd_scene_point *pts; /* twins then points */
+    double *umax;        /* task x nstruct */
+    double *Pi1, *gamma; /* point x nstruct */
 } sweep_out;
 
 /* Rows: Pi1 = umax / Le and gamma = umax / umax of the twin (same Pi2). */
@@ -63,7 +63,9 @@ static int write_table(const pd_scene_sweep_args *a, const sweep_out *o, pd_err 
         for (int q = 0; q < 3; q++) {
             char *nm = names + (size_t)(3 * s + q) * (PD_NAME_MAX + 8);
             snprintf(nm, PD_NAME_MAX + 8, "%s.%s", o->sc->st[s].name,
-                     q == 0 ? "Pi1" : q == 1 ? "gamma" : "umax");
+                     q == 0   ? "Pi1"
+                     : q == 1 ? "gamma"
+                              : "umax");
             cols[6 + 3 * s + q] = (pd_column){.name = nm,
                                               .units = q == 2 ? "m" : "1",
                                               .values = data + (size_t)(6 + 3 * s + q) * np};
@@ -86,8 +88,11 @@ static int write_table(const pd_scene_sweep_args *a, const sweep_out *o, pd_err 
                        {.name = "method", .is_text = 1, .text = pd_method_name(o->w.opts.method)},
                        {.name = "close_tol", .units = "Le", .num = close_tol(o)},
                        {.name = "ap", .units = "m/s^2", .num = o->sc->exc.ap}};
-    pd_table t = {.rows = np, .ncols = ncols, .cols = cols,
-                  .nattrs = (int)(sizeof attrs / sizeof attrs[0]), .attrs = attrs,
+    pd_table t = {.rows = np,
+                  .ncols = ncols,
+                  .cols = cols,
+                  .nattrs = (int)(sizeof attrs / sizeof attrs[0]),
+                  .attrs = attrs,
                   .dim = "point"};
     rc = pd_output_write(a->out, &t, err);
     free(data);
@@ -119,7 +124,9 @@ static int draw(const pd_scene_sweep_args *a, const sweep_out *o, pd_err *err)
             }
             snprintf(labels[nc], sizeof labels[nc], "%s, \u03a0\u2083 = %.3g, \u03b5 = %.3g",
                      o->sc->st[s].name, pt->Pi3, pt->eps);
-            cv[nc] = (pd_curve){.label = labels[nc], .n = npi2, .x = x + (size_t)nc * npi2,
+            cv[nc] = (pd_curve){.label = labels[nc],
+                                .n = npi2,
+                                .x = x + (size_t)nc * npi2,
                                 .y = y + (size_t)nc * npi2};
         }
     char title[256];
@@ -176,8 +183,7 @@ static void print_json(const sweep_out *o, double cpu, double wall)
     pd_json_finish(&js);
 }
 
-static void print_text(const pd_scene_sweep_args *a, const sweep_out *o, double cpu,
-                       double wall)
+static void print_text(const pd_scene_sweep_args *a, const sweep_out *o, double cpu, double wall)
 {
     int ns = o->sc->nstruct, show = ns < 6 ? ns : 6;
     printf("scene %s: Pi2 of %s (T0 = %.4g s), %ld points, %s; cpu %.3g s, wall %.3g s\n",

@@ -4,8 +4,7 @@
 
 /* Quintic Hermite basis in r = s / h: H3, H4, H5 carry the end point, H1,
  * H2 the start's rate and acceleration (the start value enters as 1 - H3). */
-void pd_hermite5(const double p0[3], const double p1[3], double h, double r, double *f,
-                 double *fd)
+void pd_hermite5(const double p0[3], const double p1[3], double h, double r, double *f, double *fd)
 {
     if (!p0 || !p1 || !f)
         return;
@@ -19,8 +18,7 @@ void pd_hermite5(const double p0[3], const double p1[3], double h, double r, dou
     *f = p0[0] + (p1[0] - p0[0]) * H3 + h * (p0[1] * H1 + p1[1] * H4) +
          h * h * (p0[2] * H2 + p1[2] * H5);
     if (fd)
-        *fd = (p1[0] - p0[0]) * D3 / h + p0[1] * D1 + p1[1] * D4 +
-              h * (p0[2] * D2 + p1[2] * D5);
+        *fd = (p1[0] - p0[0]) * D3 / h + p0[1] * D1 + p1[1] * D4 + h * (p0[2] * D2 + p1[2] * D5);
 }
 
 double pd_hermite3(const double p0[2], const double p1[2], double h, double r)

@@ -221,7 +221,7 @@ typedef enum {
 typedef struct pd_text {
     const char *path;
     FILE *f;
-    long max_bytes;  /* the size cap */
+    long max_bytes; /* the size cap */
     pd_text_at at;
     char *line;      /* the current line with its '\n' (if any), NUL-terminated */
     size_t len, cap; /* its length and the buffer's size */

@@ -66,7 +66,7 @@ double pd_root_newton(pd_root *r, double lo, double hi, double w, double t0)
             hi = t;
         else
             lo = t;
-        double tn = t - f / df; /* Newton: f + f' (tn - t) = 0 */
+        double tn = t - f / df;                            /* Newton: f + f' (tn - t) = 0 */
         if (tn >= lo && tn <= hi && fabs(tn - t) <= tol) { /* converged, on a bracket end too */
             if (w > 0.0)
                 return tn; /* wanted to a width: Newton is there */

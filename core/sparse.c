@@ -66,8 +66,8 @@ int pd_sparse_from_triplets(pd_sparse *sp, int rows, int cols, long nt, const in
     if (nt > 0 && (!Ti || !Tj || !Tx))
         return PD_NULL_ARG(err, !Ti ? "Ti" : !Tj ? "Tj" : "Tx");
     if (rows < 0 || cols < 0 || nt < 0 || nt > 2147483647L)
-        return pd_err_set(err, PD_EINVAL, "sparse: bad size %d x %d with %ld entries", rows,
-                          cols, nt);
+        return pd_err_set(err, PD_EINVAL, "sparse: bad size %d x %d with %ld entries", rows, cols,
+                          nt);
     for (long k = 0; k < nt; k++)
         if (Ti[k] < 0 || Ti[k] >= rows || Tj[k] < 0 || Tj[k] >= cols)
             return pd_err_set(err, PD_EINVAL, "sparse: entry (%d, %d) outside %d x %d", Ti[k],

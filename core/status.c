@@ -8,20 +8,34 @@
 const char *pd_strerror(int status)
 {
     switch (status) {
-    case PD_OK: return "ok";
-    case PD_ENOMEM: return "out of memory";
-    case PD_EINVAL: return "invalid argument";
-    case PD_ENOSOLUTION: return "no solution (ray termination)";
-    case PD_EMAXPIVOTS: return "pivot limit reached";
-    case PD_ENUMERICAL: return "numerical failure";
-    case PD_ENONFINITE: return "non-finite value";
-    case PD_EIO: return "input/output error";
-    case PD_EPARSE: return "malformed input";
-    case PD_ESINGULAR: return "singular matrix";
-    case PD_EBUDGET: return "budget exhausted";
-    case PD_ESTOPPED: return "stopped by observer";
-    case PD_EMAXITER: return "iteration limit reached";
-    default: return "unknown status";
+    case PD_OK:
+        return "ok";
+    case PD_ENOMEM:
+        return "out of memory";
+    case PD_EINVAL:
+        return "invalid argument";
+    case PD_ENOSOLUTION:
+        return "no solution (ray termination)";
+    case PD_EMAXPIVOTS:
+        return "pivot limit reached";
+    case PD_ENUMERICAL:
+        return "numerical failure";
+    case PD_ENONFINITE:
+        return "non-finite value";
+    case PD_EIO:
+        return "input/output error";
+    case PD_EPARSE:
+        return "malformed input";
+    case PD_ESINGULAR:
+        return "singular matrix";
+    case PD_EBUDGET:
+        return "budget exhausted";
+    case PD_ESTOPPED:
+        return "stopped by observer";
+    case PD_EMAXITER:
+        return "iteration limit reached";
+    default:
+        return "unknown status";
     }
 }
 
@@ -75,4 +89,7 @@ double pd_cpu_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-const char *pd_version(void) { return PD_VERSION; }
+const char *pd_version(void)
+{
+    return PD_VERSION;
+}

@@ -43,10 +43,10 @@ static int fault_size(const char *path, pd_text_at at, long line, long col, long
     char loc[300];
     where(path, at, line, col, loc, sizeof loc);
     if (max_bytes % (1L << 20) == 0)
-        return pd_err_set(err, PD_EPARSE, "%s: the file is larger than %ld MiB, the most read",
-                          loc, max_bytes >> 20);
-    return pd_err_set(err, PD_EPARSE, "%s: the file is larger than %ld bytes, the most read",
-                      loc, max_bytes);
+        return pd_err_set(err, PD_EPARSE, "%s: the file is larger than %ld MiB, the most read", loc,
+                          max_bytes >> 20);
+    return pd_err_set(err, PD_EPARSE, "%s: the file is larger than %ld bytes, the most read", loc,
+                      max_bytes);
 }
 
 /* A read error (errno) on line. */
@@ -66,19 +66,17 @@ int pd_text_open(pd_text *t, const char *path, long max_bytes, pd_text_at at, pd
         return PD_NULL_ARG(err, "t");
     *t = (pd_text){.path = path, .max_bytes = max_bytes, .at = at, .err = err};
     if (!path || max_bytes < 1)
-        return pd_err_set(err, PD_EINVAL, "pd_text_open: no file or a cap of %ld bytes",
-                          max_bytes);
+        return pd_err_set(err, PD_EINVAL, "pd_text_open: no file or a cap of %ld bytes", max_bytes);
     /* without blocking: opening a FIFO for reading waits for a writer */
     errno = 0;
     int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0)
-        return pd_err_set(err, PD_EIO, "%s: cannot open: %s", path,
-                          strerror(errno ? errno : EIO));
+        return pd_err_set(err, PD_EIO, "%s: cannot open: %s", path, strerror(errno ? errno : EIO));
     struct stat st;
     if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-        const char *what = S_ISFIFO(st.st_mode)  ? "a FIFO"
-                           : S_ISDIR(st.st_mode) ? "a directory"
-                           : S_ISCHR(st.st_mode) ? "a device"
+        const char *what = S_ISFIFO(st.st_mode)   ? "a FIFO"
+                           : S_ISDIR(st.st_mode)  ? "a directory"
+                           : S_ISCHR(st.st_mode)  ? "a device"
                            : S_ISSOCK(st.st_mode) ? "a socket"
                                                   : "not a file";
         close(fd);
@@ -103,8 +101,8 @@ static int line_grow(pd_text *t, size_t need)
         cap = (size_t)PD_TEXT_LINE_MAX + 2;
     char *grown = realloc(t->line, cap);
     if (!grown)
-        return pd_err_set(t->err, PD_ENOMEM, "%s: out of memory for a line of %zu bytes",
-                          t->path, need);
+        return pd_err_set(t->err, PD_ENOMEM, "%s: out of memory for a line of %zu bytes", t->path,
+                          need);
     t->line = grown;
     t->cap = cap;
     return PD_OK;
@@ -125,8 +123,10 @@ int pd_text_line(pd_text *t)
         if (t->bytes >= t->max_bytes)
             return fault_size(t->path, t->at, line, (long)n + 1, t->max_bytes, t->err);
         if (n >= (size_t)PD_TEXT_LINE_MAX)
-            return pd_err_set(t->err, PD_EPARSE, "%s: a line longer than %ld MiB: not a text "
-                              "file", where(t->path, t->at, line, 1, loc, sizeof loc),
+            return pd_err_set(t->err, PD_EPARSE,
+                              "%s: a line longer than %ld MiB: not a text "
+                              "file",
+                              where(t->path, t->at, line, 1, loc, sizeof loc),
                               PD_TEXT_LINE_MAX >> 20);
         int st = n + 2 > t->cap ? line_grow(t, n + 2) : PD_OK;
         if (st != PD_OK)

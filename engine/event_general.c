@@ -60,30 +60,30 @@ typedef struct edg {
     pd_edg_result *res;
     pd_observer obs;
     void *obs_ctx;
-    int n, m, dim;        /* dim = 2 n + m */
-    double t0, t1, t;     /* run interval, current time */
-    double seg_a, seg_b;  /* current smooth segment (between breakpoints) */
-    double ta, tb, h;     /* accepted step [ta, tb], next step size */
+    int n, m, dim;       /* dim = 2 n + m */
+    double t0, t1, t;    /* run interval, current time */
+    double seg_a, seg_b; /* current smooth segment (between breakpoints) */
+    double ta, tb, h;    /* accepted step [ta, tb], next step size */
     int next_break, stopped, lcp_pivots;
-    long next_out;        /* index k of the next output time t0 + k h_out */
-    double last_event;    /* time of the last event */
-    long same_instant;    /* consecutive events within rounding of it */
+    long next_out;     /* index k of the next output time t0 + k h_out */
+    double last_event; /* time of the last event */
+    long same_instant; /* consecutive events within rounding of it */
     double last_emit;
-    int sample_forces;    /* the observer's P: impulses since its last report (z) */
-    double *zout;         /* m: z at the observer's last report */
+    int sample_forces; /* the observer's P: impulses since its last report (z) */
+    double *zout;      /* m: z at the observer's last report */
     /* constant data: M factored, M^-1 W and D = W^T M^-1 W (pd_factor.h) */
     pd_factor *fac;
     const pd_matrix *W;
-    int kmax;             /* most contacts in one set (dense blocks kmax x kmax) */
+    int kmax; /* most contacts in one set (dense blocks kmax x kmax) */
     /* persistent contacts */
     unsigned char *inA;
     int *idxA, *posA, nA;
-    double *Dlu;          /* nA x nA LU of D_AA (kmax^2) */
+    double *Dlu; /* nA x nA LU of D_AA (kmax^2) */
     int *Dperm;
-    double *lam;          /* nA: contact forces of the last acceleration */
-    double *tmpA;         /* nA: projection work */
+    double *lam;  /* nA: contact forces of the last acceleration */
+    double *tmpA; /* nA: projection work */
     /* states: q = qref + d */
-    double *qref, *Kqref; /* n: reference displacement and K qref */
+    double *qref, *Kqref;  /* n: reference displacement and K qref */
     double *gref, *gscale; /* m: gap at qref, and its rounding scale */
     double *y, *ya, *fa, *fb, *yp, *yev, *yerr, *acc, *qs, *vs;
     double *ga, *Ua, *Ga, *gb, *Ub, *Gb; /* m: gap, rate, acceleration at ta and tb */
@@ -111,12 +111,12 @@ static size_t layout(edg *w, char *base)
     size_t off = 0, n = (size_t)w->n, m = w->m > 0 ? (size_t)w->m : 1, d = (size_t)w->dim;
     size_t k = (size_t)w->kmax;
     /* each array 16-byte aligned; base NULL: off only counts (the total) */
-#define TAKE(ptr, count, type)                                                                \
-    do {                                                                                      \
-        off = (off + 15u) & ~(size_t)15u;                                                     \
-        if (base)                                                                             \
-            (ptr) = (type *)(void *)(base + off);                                             \
-        off += (size_t)(count) * sizeof(type);                                                \
+#define TAKE(ptr, count, type)                                                                     \
+    do {                                                                                           \
+        off = (off + 15u) & ~(size_t)15u;                                                          \
+        if (base)                                                                                  \
+            (ptr) = (type *)(void *)(base + off);                                                  \
+        off += (size_t)(count) * sizeof(type);                                                     \
     } while (0)
     /* A: flags, list, places; D_AA's LU (kmax^2) and pivots; lambda_A */
     TAKE(w->inA, m, unsigned char);
@@ -233,8 +233,9 @@ static int check_opts(const pd_edg_opts *o, pd_err *err)
                           o->h_out);
     if (!(o->length_scale > 0.0) || !isfinite(o->length_scale) || !(o->time_unit > 0.0) ||
         !isfinite(o->time_unit))
-        return pd_err_set(err, PD_EINVAL, "event-driven: length_scale and time_unit must be "
-                                          "finite and > 0");
+        return pd_err_set(err, PD_EINVAL,
+                          "event-driven: length_scale and time_unit must be "
+                          "finite and > 0");
     if (o->max_events < 1 || o->max_burst < 1)
         return pd_err_set(err, PD_EINVAL, "event-driven: budgets must be >= 1");
     return PD_OK;
@@ -334,10 +335,11 @@ static int factor_set(edg *w, double t, pd_err *err)
     /* D_AA = W_A^T M^-1 W_A, LU with a relative pivot floor: dependent contacts fail */
     delassus(w, w->idxA, w->nA, w->Dlu);
     if (w->nA && pd_dense_lu(w->nA, w->Dlu, w->nA, w->Dperm, EDG_SINGULAR))
-        return pd_err_set(err, PD_ESINGULAR,
-                          "event-driven: the %d contacts in persistent contact at t = %.9g s (first: "
-                          "contact %d) are redundant (D_AA singular)",
-                          w->nA, t * w->o.time_unit, w->idxA[0]);
+        return pd_err_set(
+            err, PD_ESINGULAR,
+            "event-driven: the %d contacts in persistent contact at t = %.9g s (first: "
+            "contact %d) are redundant (D_AA singular)",
+            w->nA, t * w->o.time_unit, w->idxA[0]);
     return PD_OK;
 }
 
@@ -363,7 +365,7 @@ static void project(edg *w, double *y)
 {
     if (!w->nA)
         return;
-    project_on_A(w, y, w->gref); /* g_A = gref_A + W_A^T d = 0 */
+    project_on_A(w, y, w->gref);     /* g_A = gref_A + W_A^T d = 0 */
     project_on_A(w, y + w->n, NULL); /* U_A = W_A^T v = 0 */
 }
 
@@ -432,7 +434,8 @@ static int probe(edg *w, double t, pd_err *err)
     /* one step of t - ta from (ta, ya) with its rate fa: the accepted path untouched */
     int s = gsl_odeiv2_step_apply(w->probe, w->ta, t - w->ta, w->yp, w->yerr, w->fa, NULL, &w->sys);
     if (s != GSL_SUCCESS)
-        return pd_err_set(err, PD_ENUMERICAL, "event-driven: re-integration to t = %.9g s failed: %s",
+        return pd_err_set(err, PD_ENUMERICAL,
+                          "event-driven: re-integration to t = %.9g s failed: %s",
                           t * w->o.time_unit, gsl_strerror(s));
     return PD_OK;
 }
@@ -514,9 +517,9 @@ static int step_once(edg *w, pd_err *err)
                           "event-driven: %ld integration steps by t = %.9g s (last %.3g s; budget "
                           "%g + %g per radian of the fastest mode exhausted): the motion is stiff "
                           "under its held contacts or chatters; Moreau-Jean (--method moreau) "
-                          "runs it", w->res->steps, w->t * w->o.time_unit,
-                          (w->tb - w->ta) * w->o.time_unit, EDG_STEPS_FLOOR,
-                          EDG_STEPS_PER_RADIAN);
+                          "runs it",
+                          w->res->steps, w->t * w->o.time_unit, (w->tb - w->ta) * w->o.time_unit,
+                          EDG_STEPS_FLOOR, EDG_STEPS_PER_RADIAN);
     step_ends(w);
     return PD_OK;
 }

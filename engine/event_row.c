@@ -192,7 +192,10 @@ static void q_set(edr_queue *q, int slot, double t)
 
 /* ---- helpers -------------------------------------------------------------------- */
 
-static int cl_of_dof(const pd_edr *r, int dof) { return r->rs.blk_cl[r->tp.dof_blk[dof]]; }
+static int cl_of_dof(const pd_edr *r, int dof)
+{
+    return r->rs.blk_cl[r->tp.dof_blk[dof]];
+}
 
 /* x(t), v(t), a(t) of a dof. */
 static void dof_state(pd_edr *r, int dof, double t, double *x, double *v, double *a)
@@ -226,9 +229,9 @@ static double gap_now(pd_edr *r, int a, double t, double *U)
 typedef struct gap_ctx {
     pd_edr *r;
     int a;
-    double gb;      /* the gap at tb */
-    double dxb[2];  /* the sides' increments at tb */
-    double thr;     /* the gap's rounding level */
+    double gb;     /* the gap at tb */
+    double dxb[2]; /* the sides' increments at tb */
+    double thr;    /* the gap's rounding level */
 } gap_ctx;
 
 /* f = -g, f' = -U, f'' = -G: positive past the closing. */
@@ -331,7 +334,10 @@ static double gap_curvature(const pd_edr *r, int a)
 }
 
 /* End of what a prediction may cover: the piece's end and t1. */
-static double horizon(const pd_edr *r) { return fmin(edr_piece_end(r, r->rs.piece), r->rs.t1); }
+static double horizon(const pd_edr *r)
+{
+    return fmin(edr_piece_end(r, r->rs.piece), r->rs.t1);
+}
 
 /* Contact a's next closing after ts, or the end of its scan window. */
 static void predict_contact(pd_edr *r, int a, double ts, int cont)
@@ -342,15 +348,16 @@ static void predict_contact(pd_edr *r, int a, double ts, int cont)
         return;
     }
     const edr_contact *ct = &r->tp.ct[a];
-    if (ct->dof[0] >= 0 && ct->dof[1] >= 0 && cl_of_dof(r, ct->dof[0]) == cl_of_dof(r, ct->dof[1]) &&
+    if (ct->dof[0] >= 0 && ct->dof[1] >= 0 &&
+        cl_of_dof(r, ct->dof[0]) == cl_of_dof(r, ct->dof[1]) &&
         r->rs.cl[cl_of_dof(r, ct->dof[0])].kind != EDR_MODAL) {
         q_set(&r->rs.q, slot, HUGE_VAL); /* both sides in one rigid tree: the gap is constant */
         return;
     }
     gap_ctx g;
     gap_base(r, a, &g);
-    edr_scan s = {.fn = gap_fn, .ctx = &g, .hit_mode = 1, .thr = g.thr, .fmax = -HUGE_VAL,
-                  .fmin = HUGE_VAL};
+    edr_scan s = {
+        .fn = gap_fn, .ctx = &g, .hit_mode = 1, .thr = g.thr, .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
     /* windows double from EDR_WINDOW0 intervals as the prediction continues */
     int win = cont && r->rs.win[slot] > 0 ? r->rs.win[slot] : EDR_WINDOW0;
     r->rs.win[slot] = win < EDR_WINDOW ? 2 * win : EDR_WINDOW;
@@ -508,7 +515,8 @@ static void predict_detach(pd_edr *r, int c, double ts, int cont)
             /* lambda' = la y' + lb y'' + lg f' at ts; safe_time: no zero of lambda before */
             double lam = edr_force_at(r, c, a, ts);
             double dl = r->rs.la[a] * cl->vy + r->rs.lb[a] * cl->ay + r->rs.lg[a] * df;
-            double L2 = fabs(r->rs.la[a]) * cl->Y2 + fabs(r->rs.lb[a]) * cl->Y3 + fabs(r->rs.lg[a]) * cl->F2;
+            double L2 = fabs(r->rs.la[a]) * cl->Y2 + fabs(r->rs.lb[a]) * cl->Y3 +
+                        fabs(r->rs.lg[a]) * cl->F2;
             sf = fmin(sf, safe_time(lam, dl, L2));
         }
         /* every force stays positive that long: no scan before */
@@ -615,15 +623,19 @@ static void tree_y_fn(void *vctx, double t, double out[3])
 
 /* Scan the functions mc[0..nf) of cluster c over [ta, tb] on its grid into
  * sc (their extremes). */
-static void scan_functions(pd_edr *r, edr_cluster *cl, int nf, meas_ctx *mc, edr_fn fn,
-                           double ta, double tb)
+static void scan_functions(pd_edr *r, edr_cluster *cl, int nf, meas_ctx *mc, edr_fn fn, double ta,
+                           double tb)
 {
     edr_scan *sc = r->ev.mscan;
     edr_pt *prev = r->ev.mprev;
     /* each function from ta, its value there noted (the extremes include the start) */
     for (int k = 0; k < nf; k++) {
-        sc[k] = (edr_scan){.fn = fn, .ctx = &mc[k], .width = 4e-8 * cl->h, .hit_mode = 0,
-                           .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
+        sc[k] = (edr_scan){.fn = fn,
+                           .ctx = &mc[k],
+                           .width = 4e-8 * cl->h,
+                           .hit_mode = 0,
+                           .fmax = -HUGE_VAL,
+                           .fmin = HUGE_VAL};
         prev[k] = edr_scan_point(&sc[k], ta);
         edr_scan_note(&sc[k], prev[k].f);
     }
@@ -781,7 +793,8 @@ static void group_grow(pd_edr *r, double t)
                     continue;
                 group_add_contact(r, a);
                 /* tol_closed: closed at a gap that the model's own g0 leaves positive */
-                r->rs.res.tol_closed += g + (r->tp.md->g0[a] - r->tp.ct[a].g0) > 0.0; /* the gap given */
+                r->rs.res.tol_closed +=
+                    g + (r->tp.md->g0[a] - r->tp.ct[a].g0) > 0.0; /* the gap given */
                 /* its sides' clusters join: their contacts are searched in turn */
                 const edr_contact *ct = &r->tp.ct[a];
                 for (int s = 0; s < 2; s++)
@@ -801,8 +814,8 @@ static void group_grow(pd_edr *r, double t)
  * the evaluation count are left as they were, so the run is unchanged. */
 static void integrate_held(pd_edr *r, int c, double tb)
 {
-    static const double xg[5] = {-0.9061798459386640, -0.5384693101056831, 0.0,
-                                 0.5384693101056831, 0.9061798459386640};
+    static const double xg[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831,
+                                 0.9061798459386640};
     static const double wg[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889,
                                  0.4786286704993665, 0.2369268850561891};
     edr_cluster *cl = &r->rs.cl[c];
@@ -1021,8 +1034,10 @@ static int solve_lcp(pd_edr *r, const int *idx, int k, const double *q, double *
     if (rc)
         rc = scaled_lcp(r, r->ev.solver, &D, k, q, &lo, z, w, &info);
     if (rc)
-        return pd_err_set(err, rc, "row reference: the contact LCP of %d contacts at t = %.9g s "
-                          "was not solved (%s)", k, t * r->tp.o.time_unit, pd_lcp_outcome_name(info.outcome));
+        return pd_err_set(err, rc,
+                          "row reference: the contact LCP of %d contacts at t = %.9g s "
+                          "was not solved (%s)",
+                          k, t * r->tp.o.time_unit, pd_lcp_outcome_name(info.outcome));
     return PD_OK;
 }
 
@@ -1046,7 +1061,8 @@ static void group_rhs(pd_edr *r, double f, const double *x, const double *v, dou
         double s = r->tp.b[i] * f;
         for (int jj = 0; jj < bk->n; jj++) {
             int gj = r->tp.blk_dofs[bk->first + jj];
-            s -= r->tp.Cb[off + li + (long)jj * bk->n] * v[gj] + r->tp.Kb[off + li + (long)jj * bk->n] * x[gj];
+            s -= r->tp.Cb[off + li + (long)jj * bk->n] * v[gj] +
+                 r->tp.Kb[off + li + (long)jj * bk->n] * x[gj];
         }
         out[i] = s * r->tp.minv[i];
     }
@@ -1279,13 +1295,17 @@ static int report(pd_edr *r, double t, pd_edr_kind kind, int acc)
 static int count_event(pd_edr *r, int slot, double t, pd_err *err)
 {
     if (++r->rs.res.events > r->tp.o.max_events)
-        return pd_err_set(err, PD_EBUDGET, "row reference: %ld events by t = %.9g s (budget "
-                          "exhausted)", r->rs.res.events - 1, t * r->tp.o.time_unit);
+        return pd_err_set(err, PD_EBUDGET,
+                          "row reference: %ld events by t = %.9g s (budget "
+                          "exhausted)",
+                          r->rs.res.events - 1, t * r->tp.o.time_unit);
     /* the same slot again at the same instant: time does not move for it */
     if (r->rs.slot_t[slot] == t) {
         if (++r->rs.slot_same[slot] > EDR_SAME_INSTANT)
-            return pd_err_set(err, PD_EBUDGET, "row reference: %d events at t = %.17g s without "
-                              "progress", EDR_SAME_INSTANT, t * r->tp.o.time_unit);
+            return pd_err_set(err, PD_EBUDGET,
+                              "row reference: %d events at t = %.17g s without "
+                              "progress",
+                              EDR_SAME_INSTANT, t * r->tp.o.time_unit);
     } else {
         r->rs.slot_t[slot] = t;
         r->rs.slot_same[slot] = 0;
@@ -1294,10 +1314,11 @@ static int count_event(pd_edr *r, int slot, double t, pd_err *err)
      * (a Zeno sequence the accumulation jump did not end) */
     if (++r->rs.slot_run[slot] >= EDR_CHATTER_EVENTS) {
         if (t - r->rs.slot_t0[slot] < EDR_CHATTER_SPAN)
-            return pd_err_set(err, PD_EBUDGET, "row reference: %d events of one %s within %.3g "
+            return pd_err_set(err, PD_EBUDGET,
+                              "row reference: %d events of one %s within %.3g "
                               "s at t = %.9g s: a chatter it cannot resolve (Moreau-Jean, "
-                              "--method moreau, runs it)", EDR_CHATTER_EVENTS,
-                              slot < r->tp.m ? "contact" : "cluster",
+                              "--method moreau, runs it)",
+                              EDR_CHATTER_EVENTS, slot < r->tp.m ? "contact" : "cluster",
                               (t - r->rs.slot_t0[slot]) * r->tp.o.time_unit, t * r->tp.o.time_unit);
         r->rs.slot_run[slot] = 0;
         r->rs.slot_t0[slot] = t;
@@ -1349,7 +1370,7 @@ static int decide_persistence(pd_edr *r, double t, int *acc_jumped, pd_err *err)
             if (ct->dof[k] >= 0)
                 as = fmax(as, fabs(r->ev.gacc[ct->dof[k]]));
         r->ev.tie[j] = r->ev.jpos[j] >= 0 && !r->ev.held[j] && as > EDR_TIE_ACC * r->rs.L &&
-                    !(fabs(r->ev.wlcp[j]) > EDR_RATE_TOL * as);
+                       !(fabs(r->ev.wlcp[j]) > EDR_RATE_TOL * as);
         ties |= r->ev.tie[j];
     }
     if (ties) {
@@ -1416,13 +1437,15 @@ static int tails_hold(pd_edr *r)
         double tail = r->ev.held_tail[j];
         if (!(tail > 0.0) || !r->ev.held[j])
             continue;
-        int a = r->ev.g_ct[j], c = r->rs.blk_cl[r->tp.ct[a].blk[0] >= 0 ? r->tp.ct[a].blk[0] : r->tp.ct[a].blk[1]];
+        int a = r->ev.g_ct[j],
+            c = r->rs.blk_cl[r->tp.ct[a].blk[0] >= 0 ? r->tp.ct[a].blk[0] : r->tp.ct[a].blk[1]];
         /* not held after all (locked in a cycle): nothing to check */
         if (r->rs.cstate[a] != EDR_PERSIST)
             continue;
         /* lambda at the tail's middle and end on the new cluster's flight (from t0) */
         double t0 = r->rs.cl[c].t0;
-        if (!(edr_force_at(r, c, a, t0 + 0.5 * tail) > 0.0) || !(edr_force_at(r, c, a, t0 + tail) > 0.0))
+        if (!(edr_force_at(r, c, a, t0 + 0.5 * tail) > 0.0) ||
+            !(edr_force_at(r, c, a, t0 + tail) > 0.0))
             return 0;
     }
     return 1;
@@ -1481,10 +1504,11 @@ static int commit_impacts(pd_edr *r, double t, pd_err *err)
         /* burst: impacts since its last lasting hold; past max_burst the run is in
          * an accumulation it does not end */
         if ((r->rs.burst[a] += r->ev.nimp[j]) > r->tp.o.max_burst)
-            return pd_err_set(err, PD_EBUDGET, "row reference: accumulation of impacts of "
+            return pd_err_set(err, PD_EBUDGET,
+                              "row reference: accumulation of impacts of "
                               "contact %d at t = %.9g s: %ld impacts without a lasting persistent "
-                              "contact%s (Moreau-Jean, --method moreau, runs it)", a,
-                              t * r->tp.o.time_unit, r->rs.burst[a] - 1,
+                              "contact%s (Moreau-Jean, --method moreau, runs it)",
+                              a, t * r->tp.o.time_unit, r->rs.burst[a] - 1,
                               r->tp.o.no_accumulation ? " (accumulation handling is off)" : "");
     }
     return PD_OK;
@@ -1545,8 +1569,10 @@ static int impact_stages(pd_edr *r, double t, double tolU, pd_err *err)
         /* law_multi: its first LCP could take several closed contacts */
         r->ev.law_multi |= stage == 0 && all > 1;
         if (++stage > EDR_STAGES)
-            return pd_err_set(err, PD_EBUDGET, "row reference: the impact at t = %.17g s did not "
-                              "end in %d stages", t * r->tp.o.time_unit, EDR_STAGES);
+            return pd_err_set(err, PD_EBUDGET,
+                              "row reference: the impact at t = %.17g s did not "
+                              "end in %d stages",
+                              t * r->tp.o.time_unit, EDR_STAGES);
         if (single)
             single_law_zero(q, k);
         if ((rc = solve_lcp(r, idx, k, q, z, r->ev.wtmp, t, err)))
@@ -1781,8 +1807,10 @@ static int reduced_solve(pd_edr *r, const int *idx, int k, double t, int *refine
     }
     int rc = small_lcp(r, k, D, q, z, r->ev.ztmp);
     if (rc)
-        return pd_err_set(err, rc, "row reference: the impact LCP of %d contacts at t = %.9g s "
-                          "was not solved", k, t * r->tp.o.time_unit);
+        return pd_err_set(err, rc,
+                          "row reference: the impact LCP of %d contacts at t = %.9g s "
+                          "was not solved",
+                          k, t * r->tp.o.time_unit);
     *refined = refine_reduced(r, idx, k, D, q, z);
     return PD_OK;
 }
@@ -1903,8 +1931,10 @@ static int impact_reduced_stages(pd_edr *r, double t, double tolU, pd_err *err)
         if (single)
             single_law_zero(r->ev.qlcp, k);
         if (++stage > EDR_STAGES)
-            return pd_err_set(err, PD_EBUDGET, "row reference: the impact at t = %.17g s did not "
-                              "end in %d stages", t * r->tp.o.time_unit, EDR_STAGES);
+            return pd_err_set(err, PD_EBUDGET,
+                              "row reference: the impact at t = %.17g s did not "
+                              "end in %d stages",
+                              t * r->tp.o.time_unit, EDR_STAGES);
         reduced_delassus(r, idx, k, r->ev.Dd);
         if ((rc = reduced_solve(r, idx, k, t, &refined, err)))
             return rc;
@@ -1989,7 +2019,8 @@ static void reduced_force_data(pd_edr *r, const int *idx, const int *ux, int ku,
                     int da = r->tp.ct[a].dof[s], db = r->tp.ct[b].dof[u];
                     if (da >= 0 && db >= 0 && cl_of_dof(r, da) == cl_of_dof(r, db) &&
                         r->rs.cl[cl_of_dof(r, da)].kind == EDR_SDOF)
-                        dxy += side_sigma(r, a, s) * side_sigma(r, b, u) / r->ev.cmu[cl_of_dof(r, da)];
+                        dxy +=
+                            side_sigma(r, a, s) * side_sigma(r, b, u) / r->ev.cmu[cl_of_dof(r, da)];
                 }
             D[x + (size_t)y * ku] = dxy;
         }
@@ -2137,7 +2168,8 @@ static int check_work(pd_edr *r, double t, pd_err *err)
     }
     if (dK <= EDR_WORK_TOL * DBL_EPSILON * tol)
         return PD_OK;
-    return pd_err_set(err, PD_ENUMERICAL, "row reference: the impact at t = %.17g s adds %.3g of "
+    return pd_err_set(err, PD_ENUMERICAL,
+                      "row reference: the impact at t = %.17g s adds %.3g of "
                       "its kinetic energy (rounding allows %.3g): the impact LCP lost precision",
                       t * r->tp.o.time_unit, dK / K, EDR_WORK_TOL * DBL_EPSILON * tol / K);
 }
@@ -2419,150 +2451,150 @@ static int emit(pd_edr *r, double t, pd_observer obs, void *ctx)
  * struct cannot drift apart. */
 
 /* Sized by the model alone. */
-#define EDR_MODEL_ARRAYS(X)                                                                   \
-    X(tp.b, double, n)                                                                           \
-    X(tp.pieces, pd_sine_piece, npieces)                                                         \
-    X(tp.dof_blk, int, n)                                                                        \
-    X(tp.dof_loc, int, n)                                                                        \
-    X(tp.blk_dofs, int, n)                                                                       \
-    X(tp.minv, double, n)                                                                        \
-    X(tp.ct, edr_contact, m)                                                                     \
-    X(tp.blk_cont, int, 2 * m) /* a contact is listed by each of its (at most two) blocks */     \
-    X(tp.dofc_ptr, int, n + 1)                                                                   \
+#define EDR_MODEL_ARRAYS(X)                                                                        \
+    X(tp.b, double, n)                                                                             \
+    X(tp.pieces, pd_sine_piece, npieces)                                                           \
+    X(tp.dof_blk, int, n)                                                                          \
+    X(tp.dof_loc, int, n)                                                                          \
+    X(tp.blk_dofs, int, n)                                                                         \
+    X(tp.minv, double, n)                                                                          \
+    X(tp.ct, edr_contact, m)                                                                       \
+    X(tp.blk_cont, int, 2 * m) /* a contact is listed by each of its (at most two) blocks */       \
+    X(tp.dofc_ptr, int, n + 1)                                                                     \
     X(tp.dofc, int, 2 * m)
 
 /* Sized by the blocks, once C and K's couplings have found them. */
-#define EDR_BLOCK_ARRAYS(X) \
-    X(tp.blk, edr_block, nb)   \
+#define EDR_BLOCK_ARRAYS(X)                                                                        \
+    X(tp.blk, edr_block, nb)                                                                       \
     X(tp.blk_off, long, nb + 1)
 
 /* The blocks' dense damping and stiffness, sum over the blocks of n_b^2 entries. */
-#define EDR_MATRIX_ARRAYS(X) \
-    X(tp.Cb, double, nentries) \
+#define EDR_MATRIX_ARRAYS(X)                                                                       \
+    X(tp.Cb, double, nentries)                                                                     \
     X(tp.Kb, double, nentries)
 
 /* The run's state, results and scratch. */
-#define EDR_RUN_ARRAYS(X)                                                                     \
-    /* clusters */                                                                            \
-    X(rs.cl, edr_cluster, nb)                                                                    \
-    X(rs.blk_cl, int, nb)                                                                        \
-    X(rs.blk_next, int, nb)                                                                      \
-    X(rs.free_cl, int, nb)                                                                       \
-    X(rs.s, double, n)                                                                           \
-    X(rs.d, double, n)                                                                           \
-    X(rs.xo, double, n)                                                                          \
-    X(rs.vo, double, n)                                                                          \
-    X(rs.crow, int, n)                                                                           \
-    X(rs.crow_c, int, m)                                                                         \
-    /* contacts */                                                                            \
-    X(rs.cstate, unsigned char, m)                                                               \
-    X(rs.pers_next, int, m)                                                                      \
-    X(rs.la, double, m)                                                                          \
-    X(rs.lb, double, m)                                                                          \
-    X(rs.lg, double, m)                                                                          \
-    X(rs.ld, double, m)                                                                          \
-    X(rs.base_t, double, m)                                                                      \
-    X(rs.base_g, double, m)                                                                      \
-    X(rs.gmeas_t, double, m)                                                                     \
-    X(rs.since, double, m)                                                                       \
-    X(rs.burst, long, m)                                                                         \
-    /* results */                                                                             \
-    X(rs.xpos, double, n)                                                                        \
-    X(rs.xneg, double, n)                                                                        \
-    X(rs.drift, double, n)                                                                       \
-    X(rs.gmin, double, m)                                                                        \
-    X(rs.impacts, long, m)                                                                       \
-    X(rs.first, double, m)                                                                       \
-    X(rs.maxP, double, m)                                                                        \
-    X(rs.ctime, double, m)                                                                       \
-    X(rs.imp_out, double, m)                                                                     \
-    /* the queue and its slots */                                                             \
-    X(rs.q.heap, int, nslot)                                                                     \
-    X(rs.q.pos, int, nslot)                                                                      \
-    X(rs.q.key, double, nslot)                                                                   \
-    X(rs.qkind, unsigned char, nslot)                                                            \
-    X(rs.win, int, nslot)                                                                        \
-    X(rs.slot_t, double, nslot)                                                                  \
-    X(rs.slot_same, int, nslot)                                                                  \
-    X(rs.slot_run, int, nslot)                                                                   \
-    X(rs.slot_t0, double, nslot)                                                                 \
-    /* the group of an event */                                                               \
-    X(ev.g_cl, int, nb)                                                                          \
-    X(ev.cl_mark, int, nb)                                                                       \
-    X(ev.g_ct, int, m)                                                                           \
-    X(ev.ct_mark, int, m)                                                                        \
-    X(ev.ct_mark2, int, m)                                                                       \
-    X(ev.ct_markD, int, m)                                                                       \
-    X(ev.ct_markP, int, m)                                                                       \
-    X(ev.g_dof, int, n)                                                                          \
-    X(ev.gx, double, n)                                                                          \
-    X(ev.gv, double, n)                                                                          \
-    X(ev.gacc, double, n)                                                                        \
-    X(ev.gtmp, double, n)                                                                        \
-    X(ev.Uminus, double, m)                                                                      \
-    X(ev.Uplus, double, m)                                                                       \
-    X(ev.P, double, m)                                                                           \
-    X(ev.lam, double, m)                                                                         \
-    X(ev.wlcp, double, m)                                                                        \
-    X(ev.qlcp, double, m)                                                                        \
-    X(ev.wtmp, double, m)                                                                        \
-    X(ev.lcp_idx, int, m)                                                                        \
-    X(ev.jpos, int, m)                                                                           \
-    X(ev.excluded, int, m)                                                                       \
-    X(ev.held, unsigned char, m)                                                                 \
-    X(ev.tie, unsigned char, m)                                                                  \
-    X(ev.held_tail, double, m)                                                                   \
-    X(ev.pos_in, int, m)                                                                         \
-    X(ev.guess, unsigned char, m)                                                                \
-    X(ev.lcp_scale, double, m)                                                                   \
-    X(ev.lcp_q, double, m)                                                                       \
-    X(ev.Dd, double, dm * dm)                                                                    \
-    X(ev.Dlu, double, dm * dm)                                                                   \
-    X(ev.rtmp, double, 4 * dm)                                                                   \
-    X(ev.lu_perm, int, 2 * dm)                                                                   \
-    X(ev.cG, double, nb)                                                                         \
-    X(ev.Dval, double, dcap)                                                                     \
-    X(ev.Dcol, int, m + 1)                                                                       \
-    X(ev.Drow, int, dcap)                                                                        \
-    X(ev.epos, int, m)                                                                           \
-    X(ev.qtmp, double, m)                                                                        \
-    X(ev.ztmp, double, m)                                                                        \
-    X(ev.ev_vminus, double, n)                                                                   \
-    X(ev.ev_vplus, double, n)                                                                    \
-    X(ev.ev_x, double, n)                                                                        \
-    /* scratch */                                                                             \
-    X(ev.stack, int, n)                                                                          \
-    X(ev.pe, int, n)                                                                             \
-    X(ev.pdof, int, n)                                                                           \
-    X(ev.bfs_next, int, n)                                                                       \
-    X(ev.ceta, double, nb)                                                                       \
-    X(ev.cmu, double, nb)                                                                        \
-    X(ev.cvy, double, nb)                                                                        \
-    X(ev.ext, double, n)                                                                         \
-    X(ev.nimp, long, m)                                                                          \
-    X(ev.keybuf, int, 2 * (nb + m + 1))                                                          \
-    X(ev.uf, int, nb)                                                                            \
-    X(ev.gblk, int, nb)                                                                          \
-    X(ev.newcl, int, nb)                                                                         \
-    X(ev.plist, int, nb)                                                                         \
-    X(ev.loc, int, n)                                                                            \
-    X(ev.wk, double, 8 * n)                                                                      \
-    X(ev.mctx, struct meas_ctx, nmeas)                                                           \
-    X(ev.mscan, edr_scan, nmeas)                                                                 \
-    X(ev.mprev, edr_pt, nmeas)                                                                   \
-    /* the observer's state */                                                                \
-    X(rs.st.q, double, n)                                                                        \
-    X(rs.st.v, double, n)                                                                        \
-    X(rs.st.P, double, m)                                                                        \
-    X(rs.st.g, double, m)                                                                        \
-    X(rs.st.active, unsigned char, m)                                                            \
+#define EDR_RUN_ARRAYS(X)                                                                          \
+    /* clusters */                                                                                 \
+    X(rs.cl, edr_cluster, nb)                                                                      \
+    X(rs.blk_cl, int, nb)                                                                          \
+    X(rs.blk_next, int, nb)                                                                        \
+    X(rs.free_cl, int, nb)                                                                         \
+    X(rs.s, double, n)                                                                             \
+    X(rs.d, double, n)                                                                             \
+    X(rs.xo, double, n)                                                                            \
+    X(rs.vo, double, n)                                                                            \
+    X(rs.crow, int, n)                                                                             \
+    X(rs.crow_c, int, m)                                                                           \
+    /* contacts */                                                                                 \
+    X(rs.cstate, unsigned char, m)                                                                 \
+    X(rs.pers_next, int, m)                                                                        \
+    X(rs.la, double, m)                                                                            \
+    X(rs.lb, double, m)                                                                            \
+    X(rs.lg, double, m)                                                                            \
+    X(rs.ld, double, m)                                                                            \
+    X(rs.base_t, double, m)                                                                        \
+    X(rs.base_g, double, m)                                                                        \
+    X(rs.gmeas_t, double, m)                                                                       \
+    X(rs.since, double, m)                                                                         \
+    X(rs.burst, long, m)                                                                           \
+    /* results */                                                                                  \
+    X(rs.xpos, double, n)                                                                          \
+    X(rs.xneg, double, n)                                                                          \
+    X(rs.drift, double, n)                                                                         \
+    X(rs.gmin, double, m)                                                                          \
+    X(rs.impacts, long, m)                                                                         \
+    X(rs.first, double, m)                                                                         \
+    X(rs.maxP, double, m)                                                                          \
+    X(rs.ctime, double, m)                                                                         \
+    X(rs.imp_out, double, m)                                                                       \
+    /* the queue and its slots */                                                                  \
+    X(rs.q.heap, int, nslot)                                                                       \
+    X(rs.q.pos, int, nslot)                                                                        \
+    X(rs.q.key, double, nslot)                                                                     \
+    X(rs.qkind, unsigned char, nslot)                                                              \
+    X(rs.win, int, nslot)                                                                          \
+    X(rs.slot_t, double, nslot)                                                                    \
+    X(rs.slot_same, int, nslot)                                                                    \
+    X(rs.slot_run, int, nslot)                                                                     \
+    X(rs.slot_t0, double, nslot)                                                                   \
+    /* the group of an event */                                                                    \
+    X(ev.g_cl, int, nb)                                                                            \
+    X(ev.cl_mark, int, nb)                                                                         \
+    X(ev.g_ct, int, m)                                                                             \
+    X(ev.ct_mark, int, m)                                                                          \
+    X(ev.ct_mark2, int, m)                                                                         \
+    X(ev.ct_markD, int, m)                                                                         \
+    X(ev.ct_markP, int, m)                                                                         \
+    X(ev.g_dof, int, n)                                                                            \
+    X(ev.gx, double, n)                                                                            \
+    X(ev.gv, double, n)                                                                            \
+    X(ev.gacc, double, n)                                                                          \
+    X(ev.gtmp, double, n)                                                                          \
+    X(ev.Uminus, double, m)                                                                        \
+    X(ev.Uplus, double, m)                                                                         \
+    X(ev.P, double, m)                                                                             \
+    X(ev.lam, double, m)                                                                           \
+    X(ev.wlcp, double, m)                                                                          \
+    X(ev.qlcp, double, m)                                                                          \
+    X(ev.wtmp, double, m)                                                                          \
+    X(ev.lcp_idx, int, m)                                                                          \
+    X(ev.jpos, int, m)                                                                             \
+    X(ev.excluded, int, m)                                                                         \
+    X(ev.held, unsigned char, m)                                                                   \
+    X(ev.tie, unsigned char, m)                                                                    \
+    X(ev.held_tail, double, m)                                                                     \
+    X(ev.pos_in, int, m)                                                                           \
+    X(ev.guess, unsigned char, m)                                                                  \
+    X(ev.lcp_scale, double, m)                                                                     \
+    X(ev.lcp_q, double, m)                                                                         \
+    X(ev.Dd, double, dm *dm)                                                                       \
+    X(ev.Dlu, double, dm *dm)                                                                      \
+    X(ev.rtmp, double, 4 * dm)                                                                     \
+    X(ev.lu_perm, int, 2 * dm)                                                                     \
+    X(ev.cG, double, nb)                                                                           \
+    X(ev.Dval, double, dcap)                                                                       \
+    X(ev.Dcol, int, m + 1)                                                                         \
+    X(ev.Drow, int, dcap)                                                                          \
+    X(ev.epos, int, m)                                                                             \
+    X(ev.qtmp, double, m)                                                                          \
+    X(ev.ztmp, double, m)                                                                          \
+    X(ev.ev_vminus, double, n)                                                                     \
+    X(ev.ev_vplus, double, n)                                                                      \
+    X(ev.ev_x, double, n)                                                                          \
+    /* scratch */                                                                                  \
+    X(ev.stack, int, n)                                                                            \
+    X(ev.pe, int, n)                                                                               \
+    X(ev.pdof, int, n)                                                                             \
+    X(ev.bfs_next, int, n)                                                                         \
+    X(ev.ceta, double, nb)                                                                         \
+    X(ev.cmu, double, nb)                                                                          \
+    X(ev.cvy, double, nb)                                                                          \
+    X(ev.ext, double, n)                                                                           \
+    X(ev.nimp, long, m)                                                                            \
+    X(ev.keybuf, int, 2 * (nb + m + 1))                                                            \
+    X(ev.uf, int, nb)                                                                              \
+    X(ev.gblk, int, nb)                                                                            \
+    X(ev.newcl, int, nb)                                                                           \
+    X(ev.plist, int, nb)                                                                           \
+    X(ev.loc, int, n)                                                                              \
+    X(ev.wk, double, 8 * n)                                                                        \
+    X(ev.mctx, struct meas_ctx, nmeas)                                                             \
+    X(ev.mscan, edr_scan, nmeas)                                                                   \
+    X(ev.mprev, edr_pt, nmeas)                                                                     \
+    /* the observer's state */                                                                     \
+    X(rs.st.q, double, n)                                                                          \
+    X(rs.st.v, double, n)                                                                          \
+    X(rs.st.P, double, m)                                                                          \
+    X(rs.st.g, double, m)                                                                          \
+    X(rs.st.active, unsigned char, m)                                                              \
     X(rs.st.acc, double, n)
 
 #define EDR_ARRAYS(X) EDR_MODEL_ARRAYS(X) EDR_BLOCK_ARRAYS(X) EDR_MATRIX_ARRAYS(X) EDR_RUN_ARRAYS(X)
 
 /* Each entry's element type is its field's (checked, not evaluated). */
-#define EDR_ARRAY_TYPE(field, type, count)                              \
-    _Static_assert(_Generic(((pd_edr *)0)->field, type *: 1, default: 0), \
+#define EDR_ARRAY_TYPE(field, type, count)                                                         \
+    _Static_assert(_Generic(((pd_edr *)0)->field, type * : 1, default : 0),                        \
                    "pd_edr." #field ": " #type);
 EDR_ARRAYS(EDR_ARRAY_TYPE)
 #undef EDR_ARRAY_TYPE
@@ -2579,8 +2611,8 @@ typedef struct edr_sizes {
 } edr_sizes;
 
 /* One entry: PD_ENOMEM (the arrays taken so far are pd_edr_free's). */
-#define EDR_ALLOC_ARRAY(field, type, count)             \
-    if (!(r->field = pd_calloc((count), sizeof(type)))) \
+#define EDR_ALLOC_ARRAY(field, type, count)                                                        \
+    if (!(r->field = pd_calloc((count), sizeof(type))))                                            \
         return PD_ENOMEM;
 
 static int alloc_model_arrays(pd_edr *r, const edr_sizes *sizes)
@@ -2684,7 +2716,7 @@ static void wcol_entry(void *ctx, int i, int j, double x)
     if (ct->dof[0] < 0) {
         ct->dof[0] = i;
         ct->w[0] = x;
-    /* a third nonzero: no contact of the row reference (bad: its index + 1) */
+        /* a third nonzero: no contact of the row reference (bad: its index + 1) */
     } else if (ct->dof[1] < 0) {
         ct->dof[1] = i;
         ct->w[1] = x;
@@ -2698,14 +2730,18 @@ static int check_opts(const pd_edr_opts *o, pd_err *err)
         return pd_err_set(err, PD_EINVAL, "close_tol: must be >= 0 (got %g)", o->close_tol);
     if (!(o->length_scale > 0.0) || !isfinite(o->length_scale) || !(o->time_unit > 0.0) ||
         !isfinite(o->time_unit))
-        return pd_err_set(err, PD_EINVAL, "row reference: the length scale and time unit must "
-                                          "be > 0");
+        return pd_err_set(err, PD_EINVAL,
+                          "row reference: the length scale and time unit must "
+                          "be > 0");
     if (o->max_events < 1 || o->max_burst < 1 || o->scan_divisions < 1 || !(o->max_evals >= 1.0))
-        return pd_err_set(err, PD_EINVAL, "row reference: budgets and scan divisions must be "
-                                          ">= 1");
+        return pd_err_set(err, PD_EINVAL,
+                          "row reference: budgets and scan divisions must be "
+                          ">= 1");
     if (o->impact_law != PD_IMPACT_STAGED && o->impact_law != PD_IMPACT_SINGLE)
-        return pd_err_set(err, PD_EINVAL, "row reference: impact_law must be staged (0) or "
-                                          "single (1) (got %d)", (int)o->impact_law);
+        return pd_err_set(err, PD_EINVAL,
+                          "row reference: impact_law must be staged (0) or "
+                          "single (1) (got %d)",
+                          (int)o->impact_law);
     if (!(o->h_out >= 0.0) || !isfinite(o->h_out) || !isfinite(o->t_measure))
         return pd_err_set(err, PD_EINVAL, "row reference: h_out and t_measure must be finite");
     return PD_OK;
@@ -2717,33 +2753,41 @@ static int check_inputs(const pd_model *md, const pd_piecewise_force *F, const p
 {
     int rc;
     if (!F->b || !F->pieces || F->npieces < 1)
-        return pd_err_set(err, PD_EINVAL, "row reference: a model and a piecewise force are "
-                                          "needed");
+        return pd_err_set(err, PD_EINVAL,
+                          "row reference: a model and a piecewise force are "
+                          "needed");
     if ((rc = pd_model_check(md, err)) || (rc = check_opts(o, err)))
         return rc;
     if (!pd_matrix_is_diagonal(&md->M))
-        return pd_err_set(err, PD_EINVAL, "M: the row reference needs a diagonal (lumped) mass "
-                                          "matrix");
+        return pd_err_set(err, PD_EINVAL,
+                          "M: the row reference needs a diagonal (lumped) mass "
+                          "matrix");
     /* finite pieces, their starts strictly increasing (edr_piece_at bisects on them) */
     for (int k = 0; k < F->npieces; k++) {
         const pd_sine_piece *pc = &F->pieces[k];
         if (!isfinite(pc->t_start) || (k > 0 && !(pc->t_start > F->pieces[k - 1].t_start)) ||
             !isfinite(pc->A) || !isfinite(pc->w) || !isfinite(pc->phi) || !isfinite(pc->c0) ||
             !isfinite(pc->c1))
-            return pd_err_set(err, PD_EINVAL, "row reference: forcing piece %d is not finite or "
-                                              "not in order", k);
+            return pd_err_set(err, PD_EINVAL,
+                              "row reference: forcing piece %d is not finite or "
+                              "not in order",
+                              k);
     }
     for (int i = 0; i < md->n; i++)
         if (!isfinite(F->b[i]))
-            return pd_err_set(err, PD_EINVAL, "row reference: load coefficient %d is not "
-                                              "finite", i);
+            return pd_err_set(err, PD_EINVAL,
+                              "row reference: load coefficient %d is not "
+                              "finite",
+                              i);
     return PD_OK;
 }
 
 static int out_of_memory(const pd_edr *r, pd_err *err)
 {
-    return pd_err_set(err, PD_ENOMEM, "out of memory for the row reference (%d dofs, %d "
-                      "contacts)", r->tp.n, r->tp.m);
+    return pd_err_set(err, PD_ENOMEM,
+                      "out of memory for the row reference (%d dofs, %d "
+                      "contacts)",
+                      r->tp.n, r->tp.m);
 }
 
 /* 1 / M_ii of the lumped masses, each > 0. */
@@ -2831,8 +2875,8 @@ static int fill_blocks(pd_edr *r, pd_err *err)
 static int set_contacts(pd_edr *r, pd_err *err)
 {
     for (int a = 0; a < r->tp.m; a++)
-        r->tp.ct[a] = (edr_contact){.dof = {-1, -1}, .blk = {-1, -1}, .g0 = r->tp.md->g0[a],
-                                 .e = r->tp.md->e[a]};
+        r->tp.ct[a] = (edr_contact){
+            .dof = {-1, -1}, .blk = {-1, -1}, .g0 = r->tp.md->g0[a], .e = r->tp.md->e[a]};
     wcol_ctx wc = {.r = r, .bad = 0};
     for_each_entry(&r->tp.md->W, wcol_entry, &wc);
     /* a first side always, a second (if any) in another structure */
@@ -2846,8 +2890,10 @@ static int set_contacts(pd_edr *r, pd_err *err)
             wc.bad = a + 1;
     }
     if (wc.bad)
-        return pd_err_set(err, PD_EINVAL, "W: contact %d must join one dof of one structure to "
-                          "one of another, or to a wall (the row reference)", wc.bad - 1);
+        return pd_err_set(err, PD_EINVAL,
+                          "W: contact %d must join one dof of one structure to "
+                          "one of another, or to a wall (the row reference)",
+                          wc.bad - 1);
     return PD_OK;
 }
 
@@ -2904,8 +2950,9 @@ static long link_contacts(pd_edr *r, int *uf)
  * dense Lemke (dm contacts); none for one contact (closed forms). */
 static int alloc_solvers(pd_edr *r, int dm, pd_err *err)
 {
-    if (r->tp.m > 1 && (!(r->ev.solver = pd_lcp_solver_alloc(r->tp.o.lcp_solver, r->tp.m, r->ev.Dcap, err)) ||
-                     !(r->ev.dsolver = pd_lcp_solver_alloc(PD_LCP_LEMKE, dm, 0, err))))
+    if (r->tp.m > 1 &&
+        (!(r->ev.solver = pd_lcp_solver_alloc(r->tp.o.lcp_solver, r->tp.m, r->ev.Dcap, err)) ||
+         !(r->ev.dsolver = pd_lcp_solver_alloc(PD_LCP_LEMKE, dm, 0, err))))
         return err && err->status ? err->status : PD_ENOMEM;
     return PD_OK;
 }
@@ -3072,8 +3119,8 @@ static int start(pd_edr *r, double t0, pd_err *err)
     for (int a = 0; a < r->tp.m; a++) {
         double g = gap_now(r, a, t0, NULL);
         if (g < -tol && !r->tp.o.inactive)
-            return pd_err_set(err, PD_EINVAL, "q0: contact %d starts with a negative gap (%g)",
-                              a, g);
+            return pd_err_set(err, PD_EINVAL, "q0: contact %d starts with a negative gap (%g)", a,
+                              g);
     }
     /* contacts closed at t0 resolve at t0 (an impact, or persistence) */
     if (!r->tp.o.inactive)
@@ -3125,8 +3172,8 @@ static void finish(pd_edr *r, double t)
     r->rs.res.evals = (double)r->rs.evals;
 }
 
-int pd_edr_run(pd_edr *r, double t0, const double *q0, const double *v0, double t1,
-               pd_observer obs, void *ctx, pd_err *err)
+int pd_edr_run(pd_edr *r, double t0, const double *q0, const double *v0, double t1, pd_observer obs,
+               void *ctx, pd_err *err)
 {
     int rc;
     pd_err_clear(err);
@@ -3162,8 +3209,10 @@ int pd_edr_run(pd_edr *r, double t0, const double *q0, const double *v0, double 
             break;
         t = te;
         if (r->rs.evals > r->tp.o.max_evals) {
-            rc = pd_err_set(err, PD_EBUDGET, "row reference: %.3g flight evaluations by t = %.9g "
-                            "s (budget exhausted)", (double)r->rs.evals, t * r->tp.o.time_unit);
+            rc = pd_err_set(err, PD_EBUDGET,
+                            "row reference: %.3g flight evaluations by t = %.9g "
+                            "s (budget exhausted)",
+                            (double)r->rs.evals, t * r->tp.o.time_unit);
             break;
         }
         if (slot == r->rs.slot_out) {
@@ -3181,7 +3230,7 @@ int pd_edr_run(pd_edr *r, double t0, const double *q0, const double *v0, double 
         }
         if (slot == r->rs.slot_piece) {
             rc = on_piece(r, t, err);
-        /* a contact's slot: a scan's continuation or an impact; a cluster's: a
+            /* a contact's slot: a scan's continuation or an impact; a cluster's: a
          * scan's continuation or a detachment */
         } else if (slot < r->tp.m) {
             if (r->rs.qkind[slot] == EDR_Q_SCAN)

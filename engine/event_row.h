@@ -43,9 +43,9 @@ typedef struct edr_pt {
 typedef struct edr_scan {
     edr_fn fn;
     void *ctx;
-    double width;  /* extrema located to this width (root times to adjacent doubles) */
-    int hit_mode;  /* 1: stop at the first f > 0 once f exceeds thr somewhere */
-    double thr;    /* the rounding level of f: a crossing must reach above it */
+    double width;      /* extrema located to this width (root times to adjacent doubles) */
+    int hit_mode;      /* 1: stop at the first f > 0 once f exceeds thr somewhere */
+    double thr;        /* the rounding level of f: a crossing must reach above it */
     double fmax, fmin; /* extremes noted (initialise to -inf / +inf) */
     long evals;
 } edr_scan;
@@ -64,38 +64,38 @@ double edr_bisect_sign(edr_fn fn, void *ctx, int k, double sign, double lo, doub
 /* ---- model pieces ----------------------------------------------------------- */
 
 typedef struct edr_block {
-    int n;           /* dofs */
-    int first;       /* its dofs: r->tp.blk_dofs[first .. first + n) */
-    int sdof;        /* one dof */
-    double m, c, k;  /* SDOF: its scalars */
-    double b;        /* SDOF: its load coefficient */
+    int n;            /* dofs */
+    int first;        /* its dofs: r->tp.blk_dofs[first .. first + n) */
+    int sdof;         /* one dof */
+    double m, c, k;   /* SDOF: its scalars */
+    double b;         /* SDOF: its load coefficient */
     int cont0, ncont; /* its contacts: r->tp.blk_cont[cont0 .. cont0 + ncont) */
 } edr_block;
 
 typedef struct edr_contact {
-    int dof[2];      /* side 0, side 1 (-1: wall) */
-    double w[2];     /* g = g0 + w[0] x[dof[0]] + w[1] x[dof[1]] */
-    int blk[2];      /* their blocks (-1: wall) */
+    int dof[2];  /* side 0, side 1 (-1: wall) */
+    double w[2]; /* g = g0 + w[0] x[dof[0]] + w[1] x[dof[1]] */
+    int blk[2];  /* their blocks (-1: wall) */
     double g0, e;
 } edr_contact;
 
 /* The modes of one cluster configuration (blocks and persistent contacts),
  * computed once and cached. */
 typedef struct edr_basis {
-    int nc, k, nmodes, r;   /* dofs, coordinates left, modes kept, constraints */
-    int *dofs;              /* nc global dofs */
-    int *cons;              /* r independent persistent contacts */
+    int nc, k, nmodes, r;       /* dofs, coordinates left, modes kept, constraints */
+    int *dofs;                  /* nc global dofs */
+    int *cons;                  /* r independent persistent contacts */
     edr_cplx *lam, *beta, *kap; /* nmodes: eta' = lam eta + beta f + kap */
-    edr_cplx *ilam;         /* 1 / lam */
-    double *wt;             /* nmodes: 2 for a conjugate pair, 1 for a real mode */
-    edr_cplx *Px, *Pv;      /* nc x nmodes, row per dof: x = q* + sum wt Re(Px eta) */
-    edr_cplx *Z;            /* nmodes x 2k: eta0 = Z (y0, y0') */
-    double *Y;              /* k x nc: y0 = Y (x - q*), y0' = Y v (M-orthogonal) */
-    double *qstar;          /* nc */
-    edr_cplx *F;            /* r x nmodes: lambda = sum wt Re(F eta) + gam f + del */
-    double *gam, *del;      /* r */
-    double T_min;           /* shortest period 2 pi / max |lam| */
-    unsigned long key;      /* hash of (blocks, constraints) */
+    edr_cplx *ilam;             /* 1 / lam */
+    double *wt;                 /* nmodes: 2 for a conjugate pair, 1 for a real mode */
+    edr_cplx *Px, *Pv;          /* nc x nmodes, row per dof: x = q* + sum wt Re(Px eta) */
+    edr_cplx *Z;                /* nmodes x 2k: eta0 = Z (y0, y0') */
+    double *Y;                  /* k x nc: y0 = Y (x - q*), y0' = Y v (M-orthogonal) */
+    double *qstar;              /* nc */
+    edr_cplx *F;                /* r x nmodes: lambda = sum wt Re(F eta) + gam f + del */
+    double *gam, *del;          /* r */
+    double T_min;               /* shortest period 2 pi / max |lam| */
+    unsigned long key;          /* hash of (blocks, constraints) */
     int nkey;
     int *keyv;              /* the configuration itself */
     struct edr_basis *next; /* hash chain */
@@ -103,20 +103,20 @@ typedef struct edr_basis {
 
 typedef struct edr_cluster {
     int kind;
-    int head, nblk, ndof;   /* blocks linked by r->rs.blk_next */
-    int pers_head, npers;   /* persistent contacts linked by r->rs.pers_next */
-    double t0;              /* flight origin */
-    int piece;              /* its forcing piece */
-    double h;               /* scan step */
-    double T_min;           /* shortest period of the flight (incl. the piece) */
-    double meas_t;          /* extremes measured up to here */
-    double imp_t;           /* held forces integrated up to here (sampled impulses) */
+    int head, nblk, ndof; /* blocks linked by r->rs.blk_next */
+    int pers_head, npers; /* persistent contacts linked by r->rs.pers_next */
+    double t0;            /* flight origin */
+    int piece;            /* its forcing piece */
+    double h;             /* scan step */
+    double T_min;         /* shortest period of the flight (incl. the piece) */
+    double meas_t;        /* extremes measured up to here */
+    double imp_t;         /* held forces integrated up to here (sampled impulses) */
     /* SDOF / REST */
-    int root;               /* root dof */
+    int root; /* root dof */
     pd_sdof osc;
-    double rho, kappa;      /* y'' + 2 xi w0 y' + w0^2 y = rho f + kappa */
-    double mass;            /* sum s^2 m */
-    pd_sine_piece pc;       /* the piece as the flow sees it */
+    double rho, kappa; /* y'' + 2 xi w0 y' + w0^2 y = rho f + kappa */
+    double mass;       /* sum s^2 m */
+    pd_sine_piece pc;  /* the piece as the flow sees it */
     pd_sdof_flow flow;
     double y0, vy0;
     double tay[EDR_TAYLOR_N + 3];  /* y^(k)(t0) / 1, k <= N + 2 (Taylor near the origin) */
@@ -128,17 +128,17 @@ typedef struct edr_cluster {
     /* MODAL */
     edr_basis *basis;
     edr_cplx *eta0, *deta, *etad; /* nmodes each (capacity cap) */
-    edr_cplx *gq, *bc1;     /* the flight's beta f_lin(t0) + kap, beta c1 */
-    edr_cplx *ilp, *ilm;    /* 1 / (lam - i w), 1 / (lam + i w) */
-    edr_cplx ath0;          /* A / (2i) e^{i th(t0)} */
+    edr_cplx *gq, *bc1;           /* the flight's beta f_lin(t0) + kap, beta c1 */
+    edr_cplx *ilp, *ilm;          /* 1 / (lam - i w), 1 / (lam + i w) */
+    edr_cplx ath0;                /* A / (2i) e^{i th(t0)} */
     int cap;
     /* the state at tc (cache) */
     double tc;
     int cached;
-    double dy, vy, ay;      /* SDOF */
-    double f_tc;            /* f(tc) */
+    double dy, vy, ay; /* SDOF */
+    double f_tc;       /* f(tc) */
     /* detachment prediction */
-    int det_contact;        /* the contact whose force turns negative */
+    int det_contact; /* the contact whose force turns negative */
     int live;
 } edr_cluster;
 
@@ -149,9 +149,9 @@ enum { EDR_Q_HIT = 1, EDR_Q_SCAN = 2 };
 
 typedef struct edr_queue {
     int n;
-    int *heap;     /* slots */
-    int *pos;      /* slot -> heap index, -1 */
-    double *key;   /* slot -> time */
+    int *heap;   /* slots */
+    int *pos;    /* slot -> heap index, -1 */
+    double *key; /* slot -> time */
 } edr_queue;
 
 /* What pd_edr_alloc fixed: the model, its forcing, blocks and contacts
@@ -161,33 +161,33 @@ typedef struct edr_topo {
     pd_edr_opts o;
     int n, m, nb;
     /* forcing */
-    double *b;                 /* n */
+    double *b; /* n */
     pd_sine_piece *pieces;
     int npieces;
     /* blocks and contacts */
     edr_block *blk;
     int *blk_dofs, *dof_blk, *dof_loc; /* dof lists, dof -> block, dof -> local index */
-    double *Cb, *Kb;           /* dense n_b x n_b per block, at blk_off[b] */
+    double *Cb, *Kb;                   /* dense n_b x n_b per block, at blk_off[b] */
     long *blk_off;
-    int *blk_cont;             /* contacts of each block */
-    int *dofc_ptr, *dofc;      /* contacts of each dof */
+    int *blk_cont;        /* contacts of each block */
+    int *dofc_ptr, *dofc; /* contacts of each dof */
     edr_contact *ct;
-    double *minv;              /* n: 1 / M_ii */
+    double *minv; /* n: 1 / M_ii */
 } edr_topo;
 
 /* The run: clusters, the contacts' states, results, the event queue, the
  * clock, the modal cache and the observer's state. */
 typedef struct edr_run {
     /* clusters */
-    edr_cluster *cl;           /* nb slots */
-    int *blk_cl, *blk_next;    /* block -> cluster, next block in its cluster */
+    edr_cluster *cl;        /* nb slots */
+    int *blk_cl, *blk_next; /* block -> cluster, next block in its cluster */
     int *free_cl, nfree;
-    double *s, *d;             /* n: SDOF trees x = s y + d */
-    double *xo, *vo;           /* n: state at the flight origin of its cluster */
-    int *crow;                 /* n: row of a dof in its modal cluster's basis */
-    int *crow_c;               /* m: row of a persistent contact in its basis */
+    double *s, *d;   /* n: SDOF trees x = s y + d */
+    double *xo, *vo; /* n: state at the flight origin of its cluster */
+    int *crow;       /* n: row of a dof in its modal cluster's basis */
+    int *crow_c;     /* m: row of a persistent contact in its basis */
     /* contacts */
-    unsigned char *cstate;     /* EDR_OPEN / PERSIST / LOCKED */
+    unsigned char *cstate; /* EDR_OPEN / PERSIST / LOCKED */
     int *pers_next;
     double *la, *lb, *lg, *ld; /* SDOF/REST force: lambda = la y + lb y' + lg f + ld */
     double *base_t, *base_g;   /* gap known exactly at base_t (0 after closing) */
@@ -201,7 +201,7 @@ typedef struct edr_run {
     double *xpos, *xneg, *drift, *gmin;
     long *impacts;
     double *first, *maxP, *ctime, *imp_out; /* imp_out: impulses since the last sample */
-    int sample_forces;         /* the held forces' integrals go into imp_out (a sampler) */
+    int sample_forces; /* the held forces' integrals go into imp_out (a sampler) */
     /* queue: contacts 0..m-1, clusters m..m+nb-1, piece m+nb, output m+nb+1 */
     edr_queue q;
     int slot_piece, slot_out;
@@ -209,13 +209,13 @@ typedef struct edr_run {
     double t_out0;
     /* the run */
     double t, t1, L;
-    int piece;                 /* the current piece */
-    double *slot_t;            /* per queue slot: time of its last event */
-    int *slot_same;            /* and how many it had there */
-    int *slot_run;             /* events of the slot since slot_t0 (count_event's chatter) */
+    int piece;      /* the current piece */
+    double *slot_t; /* per queue slot: time of its last event */
+    int *slot_same; /* and how many it had there */
+    int *slot_run;  /* events of the slot since slot_t0 (count_event's chatter) */
     double *slot_t0;
     int stopped;
-    double vscale;             /* largest velocity met at an event */
+    double vscale; /* largest velocity met at an event */
     long evals;
     /* modal cache */
     edr_basis **bhash;
@@ -230,17 +230,17 @@ typedef struct edr_run {
 typedef struct edr_event {
     /* the group of an event */
     int epoch, epochD;
-    int *g_cl, ng;             /* its clusters */
+    int *g_cl, ng; /* its clusters */
     int *cl_mark;
-    int *g_ct, ngc;            /* its closed contacts */
+    int *g_ct, ngc; /* its closed contacts */
     int *ct_mark, *ct_mark2, *ct_markD, *ct_markP, epochP;
-    int *g_dof, ngd;           /* its dofs */
+    int *g_dof, ngd;               /* its dofs */
     double *gx, *gv, *gacc, *gtmp; /* n: state of the group's dofs (global index) */
     double *Uminus, *Uplus, *P;    /* per closed contact (g_ct order) */
     double *lam, *wlcp, *qlcp, *wtmp;
     int *lcp_idx, *jpos, *excluded;
     unsigned char *held;
-    unsigned char *tie;        /* at zero rate, force and gap acceleration (decide_persistence) */
+    unsigned char *tie; /* at zero rate, force and gap acceleration (decide_persistence) */
     double *held_tail;
     int *pos_in;
     unsigned char *guess;      /* the LCP's warm start */
@@ -252,24 +252,24 @@ typedef struct edr_event {
     double *Dval;              /* compressed Delassus */
     int *Dcol, *Drow;
     long Dcap;
-    pd_lcp_solver *solver;     /* dof-level LCPs */
-    pd_lcp_solver *dsolver;    /* the clusters' small dense LCPs */
-    int *epos;                 /* an event's contacts between clusters (g_ct indices) */
-    double *qtmp, *ztmp;       /* the clusters' LCP data */
+    pd_lcp_solver *solver;  /* dof-level LCPs */
+    pd_lcp_solver *dsolver; /* the clusters' small dense LCPs */
+    int *epos;              /* an event's contacts between clusters (g_ct indices) */
+    double *qtmp, *ztmp;    /* the clusters' LCP data */
     double *ev_vminus, *ev_vplus, *ev_x;
     /* scratch */
-    int *stack, *pe, *pdof;    /* trees: scratch; per dof its parent edge and dof */
-    int *bfs_next;             /* per dof: the next in its tree's breadth-first order */
-    double *ceta, *cmu, *cvy;  /* per cluster slot: its coordinate's rate, mass, rate before */
-    double *ext;               /* per dof: impulse from the contacts between clusters */
-    long *nimp;                /* per closed contact of an event: its impacts */
-    int instant_acc;           /* the event's stages met an accumulation at one instant */
-    int law_multi;             /* the event's first LCP could take several closed contacts */
-    int *keybuf;               /* configuration keys */
+    int *stack, *pe, *pdof;   /* trees: scratch; per dof its parent edge and dof */
+    int *bfs_next;            /* per dof: the next in its tree's breadth-first order */
+    double *ceta, *cmu, *cvy; /* per cluster slot: its coordinate's rate, mass, rate before */
+    double *ext;              /* per dof: impulse from the contacts between clusters */
+    long *nimp;               /* per closed contact of an event: its impacts */
+    int instant_acc;          /* the event's stages met an accumulation at one instant */
+    int law_multi;            /* the event's first LCP could take several closed contacts */
+    int *keybuf;              /* configuration keys */
     int *uf, *gblk, *newcl, *plist;
-    int *loc;                  /* n: local index */
-    double *wk;                /* 8 n */
-    struct meas_ctx *mctx;     /* measurement functions (2 n) */
+    int *loc;              /* n: local index */
+    double *wk;            /* 8 n */
+    struct meas_ctx *mctx; /* measurement functions (2 n) */
     edr_scan *mscan;
     edr_pt *mprev;
 } edr_event;

@@ -247,7 +247,10 @@ typedef struct tree_sums {
 static tree_sums subtree_sums(pd_edr *r, const int *ord, const int *pd, int nn)
 {
     double *wk = r->ev.wk; /* 5 n of its 8 n */
-    tree_sums S = {.Ms = wk, .Cs = wk + r->tp.n, .Ks = wk + 2 * r->tp.n, .KDs = wk + 3 * r->tp.n,
+    tree_sums S = {.Ms = wk,
+                   .Cs = wk + r->tp.n,
+                   .Ks = wk + 2 * r->tp.n,
+                   .KDs = wk + 3 * r->tp.n,
                    .Bs = wk + 4 * r->tp.n};
     for (int k = 0; k < nn; k++) { /* each node's own terms */
         int i = ord[k];
@@ -275,8 +278,8 @@ static tree_sums subtree_sums(pd_edr *r, const int *ord, const int *pd, int nn)
 /* The oscillator w0 = sqrt(K / M), xi = C / (2 sqrt(K M)) and the flight's
  * origin (y0, y0'), the dofs' origin put on x = s y + d; held by the wall
  * (wedge >= 0), y0 closes its gap and nothing moves. */
-static void tree_origin(pd_edr *r, edr_cluster *c, const int *ord, int nn, int wedge,
-                        double C, double K)
+static void tree_origin(pd_edr *r, edr_cluster *c, const int *ord, int nn, int wedge, double C,
+                        double K)
 {
     int root = c->root;
     double M = c->mass;
@@ -320,8 +323,8 @@ static void tree_origin(pd_edr *r, edr_cluster *c, const int *ord, int nn, int w
  * below edge e (child i) balanced,
  *   lambda_e = (Ms y'' + Cs y' + Ks y + KDs - Bs f) / (s_i w_i),
  * with y'' = rho f + kappa - 2 xi w0 y' - w0^2 y substituted. */
-static void tree_edge_forces(pd_edr *r, const edr_cluster *c, const int *ord, const int *pe,
-                             int nn, const tree_sums *S)
+static void tree_edge_forces(pd_edr *r, const edr_cluster *c, const int *ord, const int *pe, int nn,
+                             const tree_sums *S)
 {
     double w2 = c->osc.w0 * c->osc.w0, xw = 2.0 * c->osc.xi * c->osc.w0;
     for (int k = 0; k < nn; k++) {
@@ -478,27 +481,27 @@ static int config_key(pd_edr *r, const edr_cluster *c, int *key, unsigned long *
  * column-major; every pointer is NULL until its phase allocates it and
  * scratch_free releases them all (the basis itself, B, is the caller's). */
 typedef struct basis_scratch {
-    int nb0, ncon;          /* blocks key[0..nb0), persistent contacts cons[0..ncon) */
-    const int *cons;        /* the key after its -1 */
-    int nc, nr, k;          /* dofs, independent constraints, coordinates left k = nc - nr */
-    double *Cc, *Kc;        /* nc x nc: the cluster's C, K (block diagonal) */
-    double *bc;             /* nc: the load coefficients b */
-    double *Wd;             /* nc x ncon: constraint directions, the kept ones first */
-    double *g0;             /* ncon, nr used: the kept contacts' gaps at q = 0 */
-    int *indep;             /* ncon, nr used: the kept contacts */
-    double *tmp;            /* 4 nc + 4: triangular solves, products before a copy */
-    gsl_matrix *Wm;         /* a QR's input and packed factors */
-    gsl_vector *tau;        /* its Householder coefficients */
-    gsl_matrix *Q, *R, *N;  /* W = Q1 R with Q = (Q1 Q2) nc x nc, R nc x nr; N = Q2, nc x k */
-    double *L;              /* nr x nc: L = R^-1 Q1^T = (W^T W)^-1 W^T */
+    int nb0, ncon;            /* blocks key[0..nb0), persistent contacts cons[0..ncon) */
+    const int *cons;          /* the key after its -1 */
+    int nc, nr, k;            /* dofs, independent constraints, coordinates left k = nc - nr */
+    double *Cc, *Kc;          /* nc x nc: the cluster's C, K (block diagonal) */
+    double *bc;               /* nc: the load coefficients b */
+    double *Wd;               /* nc x ncon: constraint directions, the kept ones first */
+    double *g0;               /* ncon, nr used: the kept contacts' gaps at q = 0 */
+    int *indep;               /* ncon, nr used: the kept contacts */
+    double *tmp;              /* 4 nc + 4: triangular solves, products before a copy */
+    gsl_matrix *Wm;           /* a QR's input and packed factors */
+    gsl_vector *tau;          /* its Householder coefficients */
+    gsl_matrix *Q, *R, *N;    /* W = Q1 R with Q = (Q1 Q2) nc x nc, R nc x nr; N = Q2, nc x k */
+    double *L;                /* nr x nc: L = R^-1 Q1^T = (W^T W)^-1 W^T */
     gsl_matrix *Mr, *Cr, *Kr; /* k x k: N^T M N (inverted in place), N^T C N, N^T K N */
-    gsl_matrix *Sm;         /* 2k x 2k: S = [0 I; -Mr^-1 Kr, -Mr^-1 Cr] */
-    double *Kq;             /* nc: K q* */
-    double *mrb, *mrk;      /* k: br = N^T b, kr = -N^T K q*, then Mr^-1 br, Mr^-1 kr */
-    double *af, *ak;        /* nc: N Mr^-1 br, N Mr^-1 kr (accelerations of f, of the constant) */
-    gsl_vector_complex *ev; /* 2k: the eigenvalues of S */
+    gsl_matrix *Sm;           /* 2k x 2k: S = [0 I; -Mr^-1 Kr, -Mr^-1 Cr] */
+    double *Kq;               /* nc: K q* */
+    double *mrb, *mrk;        /* k: br = N^T b, kr = -N^T K q*, then Mr^-1 br, Mr^-1 kr */
+    double *af, *ak;          /* nc: N Mr^-1 br, N Mr^-1 kr (accelerations of f, of the constant) */
+    gsl_vector_complex *ev;   /* 2k: the eigenvalues of S */
     gsl_matrix_complex *V, *Vi, *LU; /* 2k x 2k: S's eigenvectors, V^-1, V's LU */
-    gsl_permutation *perm;  /* the LU's rows */
+    gsl_permutation *perm;           /* the LU's rows */
     gsl_eigen_nonsymmv_workspace *ew;
 } basis_scratch;
 
@@ -713,8 +716,8 @@ static int reduced_alloc(edr_basis *B, basis_scratch *w, pd_err *err)
     w->perm = gsl_permutation_alloc(2 * k);
     w->ew = gsl_eigen_nonsymmv_alloc(2 * k);
     B->Y = pd_malloc((long)w->k * w->nc, sizeof(double));
-    if (!w->Mr || !w->Cr || !w->Kr || !w->Sm || !w->mrb || !w->mrk || !w->Kq || !w->af ||
-        !w->ak || !w->ev || !w->V || !w->Vi || !w->LU || !w->perm || !w->ew || !B->Y)
+    if (!w->Mr || !w->Cr || !w->Kr || !w->Sm || !w->mrb || !w->mrk || !w->Kq || !w->af || !w->ak ||
+        !w->ev || !w->V || !w->Vi || !w->LU || !w->perm || !w->ew || !B->Y)
         return pd_err_set(err, PD_ENOMEM, "out of memory for a cluster's modes (%d dofs)", w->nc);
     return PD_OK;
 }
@@ -776,8 +779,9 @@ static int first_order_system(const pd_edr *r, edr_basis *B, basis_scratch *w, p
     double *tmp = w->tmp;
     /* Mr = G G^T (Cholesky), then Mr^-1 in place: refused unless positive definite */
     if (gsl_linalg_cholesky_decomp1(w->Mr) || gsl_linalg_cholesky_invert(w->Mr))
-        return pd_err_set(err, PD_ESINGULAR, "row reference: a cluster's reduced mass matrix "
-                                             "is not positive definite");
+        return pd_err_set(err, PD_ESINGULAR,
+                          "row reference: a cluster's reduced mass matrix "
+                          "is not positive definite");
     for (int a = 0; a < k; a++) { /* Mr^-1 br, Mr^-1 kr into tmp: the products read mrb, mrk */
         double s1 = 0.0, s2 = 0.0;
         for (int b2 = 0; b2 < k; b2++) {
@@ -829,14 +833,18 @@ static int modal_decomposition(basis_scratch *w, int *nm, pd_err *err)
     int nc = w->nc, k = w->k, sgn;
     gsl_eigen_nonsymmv_params(1, w->ew);
     if (gsl_eigen_nonsymmv(w->Sm, w->ev, w->V, w->ew))
-        return pd_err_set(err, PD_ENUMERICAL, "row reference: the eigenvalues of a cluster of "
-                                              "%d dofs did not converge", nc);
+        return pd_err_set(err, PD_ENUMERICAL,
+                          "row reference: the eigenvalues of a cluster of "
+                          "%d dofs did not converge",
+                          nc);
     /* V^-1 by LU: a singular V (S defective) has no modal basis */
     gsl_matrix_complex_memcpy(w->LU, w->V);
     if (gsl_linalg_complex_LU_decomp(w->LU, w->perm, &sgn) ||
         gsl_linalg_complex_LU_invert(w->LU, w->perm, w->Vi))
-        return pd_err_set(err, PD_ENUMERICAL, "row reference: a cluster of %d dofs has a "
-                                              "defective modal basis", nc);
+        return pd_err_set(err, PD_ENUMERICAL,
+                          "row reference: a cluster of %d dofs has a "
+                          "defective modal basis",
+                          nc);
     double nv = 0.0, nvi = 0.0; /* |V|_1, |V^-1|_1: the largest column sums of |entries| */
     for (int j = 0; j < 2 * k; j++) {
         double s1 = 0.0, s2 = 0.0;
@@ -848,9 +856,11 @@ static int modal_decomposition(basis_scratch *w, int *nm, pd_err *err)
         nvi = fmax(nvi, s2);
     }
     if (!(nv * nvi < MODAL_COND_MAX)) /* (a NaN condition is refused too) */
-        return pd_err_set(err, PD_ENUMERICAL, "row reference: a cluster of %d dofs is nearly "
-                                              "defective (modal basis condition %.3g): a "
-                                              "critically damped mode?", nc, nv * nvi);
+        return pd_err_set(err, PD_ENUMERICAL,
+                          "row reference: a cluster of %d dofs is nearly "
+                          "defective (modal basis condition %.3g): a "
+                          "critically damped mode?",
+                          nc, nv * nvi);
     /* S is real: its complex modes come in conjugate pairs, each kept once */
     for (int j = 0; j < 2 * k; j++)
         *nm += GSL_IMAG(gsl_vector_complex_get(w->ev, (size_t)j)) >= 0.0;
@@ -885,8 +895,7 @@ static int modes_alloc(edr_basis *B, const basis_scratch *w, int nm, pd_err *err
     B->Pv = pd_malloc(nm * nc, sizeof(edr_cplx));
     B->Z = pd_malloc(nm * 2 * k, sizeof(edr_cplx));
     B->F = pd_malloc(nm * nr, sizeof(edr_cplx));
-    if (!B->lam || !B->ilam || !B->beta || !B->kap || !B->wt || !B->Px || !B->Pv || !B->Z ||
-        !B->F)
+    if (!B->lam || !B->ilam || !B->beta || !B->kap || !B->wt || !B->Px || !B->Pv || !B->Z || !B->F)
         return pd_err_set(err, PD_ENOMEM, "out of memory for a cluster's modes");
     return PD_OK;
 }
@@ -917,8 +926,8 @@ static void modes_store(edr_basis *B, const basis_scratch *w)
         B->wt[q] = GSL_IMAG(l) > 0.0 ? 2.0 : 1.0;
         lmax = fmax(lmax, cabs(lam));
         for (int l2 = 0; l2 < 2 * k; l2++) /* Z's row q: V^-1's row j */
-            B->Z[(size_t)q * 2 * k + l2] = cplx_of(gsl_matrix_complex_get(w->Vi, (size_t)j,
-                                                                          (size_t)l2));
+            B->Z[(size_t)q * 2 * k + l2] =
+                cplx_of(gsl_matrix_complex_get(w->Vi, (size_t)j, (size_t)l2));
         for (int i = 0; i < nc; i++) { /* Px_iq = sum_a N_ia V_aj, Pv_iq = sum_a N_ia V_(k+a)j */
             edr_cplx px = 0.0, pv = 0.0;
             for (int a = 0; a < k; a++) {
@@ -951,7 +960,7 @@ static void contact_force_modes(const pd_edr *r, edr_basis *B, const basis_scrat
             if (l == 0.0) /* the dof adds nothing to this contact's force */
                 continue;
             double mi = 1.0 / minv[B->dofs[i]], kq = 0.0; /* M_ii */
-            for (int j = 0; j < nc; j++) /* (K q*)_i */
+            for (int j = 0; j < nc; j++)                  /* (K q*)_i */
                 kq += Kc[i + (size_t)j * nc] * B->qstar[j];
             /* no coordinate left (k = 0): the cluster is held still, a = 0 */
             gsum += l * (mi * (k > 0 ? w->af[i] : 0.0) - w->bc[i]);
@@ -1059,7 +1068,7 @@ static void modal_origin(pd_edr *r, edr_cluster *c, const edr_basis *B)
 {
     int nc = B->nc, k = B->k;
     double *y = r->ev.wk, *yd = y + nc; /* y0, y0' (k <= nc each) */
-    for (int i = 0; i < nc; i++) /* dof -> its row of Px, Pv */
+    for (int i = 0; i < nc; i++)        /* dof -> its row of Px, Pv */
         r->rs.crow[B->dofs[i]] = i;
     /* y0 = Y (x - q*), y0' = Y v: the M-orthogonal projection onto q = q* + N y */
     for (int a = 0; a < k; a++) {
@@ -1093,8 +1102,7 @@ static void modal_origin(pd_edr *r, edr_cluster *c, const edr_basis *B)
 
 /* The flight's constants at its origin t0 (modal_eval): beta f_lin(t0) + kap,
  * beta c1, A / (2i) e^{i th(t0)} and 1 / (lam -+ i w). */
-static void modal_flight_constants(const pd_edr *r, edr_cluster *c, const edr_basis *B,
-                                   double t)
+static void modal_flight_constants(const pd_edr *r, edr_cluster *c, const edr_basis *B, double t)
 {
     const pd_sine_piece *pc = &r->tp.pieces[c->piece];
     /* f_lin(t0) = c0 + c1 (t0 - t_start), th(t0) = w t0 + phi */
@@ -1313,7 +1321,9 @@ void edr_cluster_eval(pd_edr *r, int ci, double t)
         c->dy = c->vy = c->ay = 0.0;
         c->f_tc = edr_force(r, c->piece, t);
         break;
-    default: modal_eval(r, c, t); break;
+    default:
+        modal_eval(r, c, t);
+        break;
     }
 }
 
@@ -1352,7 +1362,8 @@ double edr_force_at(pd_edr *r, int ci, int a, double t)
     if (c->kind == EDR_REST) /* lambda = lg f + ld (y held) */
         return r->rs.lg[a] * c->f_tc + r->rs.ld[a];
     if (c->kind == EDR_SDOF)
-        return r->rs.la[a] * (c->y0 + c->dy) + r->rs.lb[a] * c->vy + r->rs.lg[a] * c->f_tc + r->rs.ld[a];
+        return r->rs.la[a] * (c->y0 + c->dy) + r->rs.lb[a] * c->vy + r->rs.lg[a] * c->f_tc +
+               r->rs.ld[a];
     /* lambda = gam f + del + sum wt Re(F eta) (contact_force_modes) */
     const edr_basis *B = c->basis;
     int row = r->rs.crow_c[a];

@@ -190,10 +190,16 @@ double edr_bisect_sign(edr_fn fn, void *ctx, int k, double sign, double lo, doub
     return bisect_to(&s, k, sign, lo, hi, 0.0);
 }
 
-static int sgn(double x) { return (x > 0.0) - (x < 0.0); }
+static int sgn(double x)
+{
+    return (x > 0.0) - (x < 0.0);
+}
 
 /* Direction of f just after p: f' 's sign, or f'' 's where f' = 0. */
-static int dir_after(const edr_pt *p) { return p->df != 0.0 ? sgn(p->df) : sgn(p->ddf); }
+static int dir_after(const edr_pt *p)
+{
+    return p->df != 0.0 ? sgn(p->df) : sgn(p->ddf);
+}
 
 /* In hit mode, a maximum of f inside (a, b) that stays far below zero
  * need not be located.  With f' linear from p = f'(a) > 0 to q = f'(b) < 0
@@ -243,7 +249,8 @@ static int scan_simple(edr_scan *s, const edr_pt *a, const edr_pt *b, double *t_
         edr_scan_note(s, c.f);
     }
     if (s->hit_mode && b->f > s->thr) {
-        *t_hit = crossing(s, a->t, b->t, a->f <= 0.0 ? hermite_root(a, b) : a->t + edr_taylor_root(a));
+        *t_hit =
+            crossing(s, a->t, b->t, a->f <= 0.0 ? hermite_root(a, b) : a->t + edr_taylor_root(a));
         return 1;
     }
     return 0;

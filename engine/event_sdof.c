@@ -46,12 +46,12 @@ typedef struct ed_run {
     pd_ed_result *r;
     pd_ed_sampler sampler;
     void *ctx;
-    double scan;      /* bracketing grid step */
-    long next_out;    /* index k of the next output time t_start + k h_out */
-    long burst;       /* impacts since the oscillator last rested or left */
+    double scan;   /* bracketing grid step */
+    long next_out; /* index k of the next output time t_start + k h_out */
+    long burst;    /* impacts since the oscillator last rested or left */
     long max_events, max_burst;
     double t_first;
-    int stopped;      /* the sampler asked to stop */
+    int stopped; /* the sampler asked to stop */
 } ed_run;
 
 /* A flight's origin: the piece j and the state there. */
@@ -148,7 +148,7 @@ static void note(ed_run *ed, double t, double x)
         return;
     ed->r->xmax = fmax(ed->r->xmax, fabs(x));
     ed->r->xtoward = fmax(ed->r->xtoward, x); /* toward the wall */
-    ed->r->xaway = fmax(ed->r->xaway, -x); /* away from it */
+    ed->r->xaway = fmax(ed->r->xaway, -x);    /* away from it */
 }
 
 /* Output times in (.., tb] of a flight (or resting at x_o when in_contact). */
@@ -199,8 +199,7 @@ typedef struct bracket_fn {
 
 /* f of kind at t and its derivative in closed form: the gap's is v, the
  * velocity's the acceleration (kinds ED_GAP, ED_NEG_V, ED_V only). */
-static double value_slope(const ed_run *ed, const ed_origin *o, ed_kind kind, double t,
-                          double *df)
+static double value_slope(const ed_run *ed, const ed_origin *o, ed_kind kind, double t, double *df)
 {
     ed_point q = probe_acc(ed, o, t);
     double s = kind == ED_NEG_V ? -1.0 : 1.0;
@@ -408,8 +407,8 @@ static double detach_scan(const ed_run *ed, int j, double ta, double tb)
 static double rest(ed_run *ed, int j, double ta, double tb)
 {
     /* a linear piece (A = 0): lambda's zero in closed form; a sinusoid: scanned */
-    double td = ed->p->pieces[j].A == 0.0 ? detach_linear(ed, j, ta, tb)
-                                          : detach_scan(ed, j, ta, tb);
+    double td =
+        ed->p->pieces[j].A == 0.0 ? detach_linear(ed, j, ta, tb) : detach_scan(ed, j, ta, tb);
     ed_origin o = {.j = j, .t = ta, .x = ed->p->delta, .v = 0.0};
     note(ed, ta, ed->p->delta);
     emit(ed, &o, td, 1);
@@ -456,8 +455,7 @@ static int check_pieces(const pd_ed_sdof *p, pd_err *err)
                               j, pc->t_start);
         if (!isfinite(pc->A) || !isfinite(pc->w) || !isfinite(pc->phi) || !isfinite(pc->c0) ||
             !isfinite(pc->c1))
-            return pd_err_set(err, PD_EINVAL, "event-driven: forcing piece %d is not finite",
-                              j);
+            return pd_err_set(err, PD_EINVAL, "event-driven: forcing piece %d is not finite", j);
     }
     return PD_OK;
 }
@@ -513,7 +511,8 @@ static int settle(ed_run *ed, int j, double t, double vp, double tb, double *t_r
     /* jumped only when the bounce is below ACC_HEIGHT L, the tail ends before tb, and the push
      * holds at its middle and end */
     if (height > ACC_HEIGHT * scale || t + tail >= tb ||
-        !(wall_accel(ed, j, t + tail, 0.0) > 0.0) || !(wall_accel(ed, j, t + 0.5 * tail, 0.0) > 0.0))
+        !(wall_accel(ed, j, t + tail, 0.0) > 0.0) ||
+        !(wall_accel(ed, j, t + 0.5 * tail, 0.0) > 0.0))
         return 0;
     *t_rest = t + tail; /* bouncing-ball limit: sum of the geometric flight times */
     ed->r->accumulations++;
@@ -621,8 +620,8 @@ int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opt
         }
         if (t >= piece_end(prob, j) && j + 1 < prob->npieces) {
             j++; /* forcing breakpoint: re-decide rest or flight */
-            ed.scan = scan_step(prob, j, opts->t_end - prob->pieces[0].t_start,
-                                opts->scan_divisions);
+            ed.scan =
+                scan_step(prob, j, opts->t_end - prob->pieces[0].t_start, opts->scan_divisions);
             /* the new piece pulls away: detachment at its start */
             if (resting && !(wall_accel(&ed, j, t, 0.0) > 0.0)) {
                 resting = 0;

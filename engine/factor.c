@@ -5,8 +5,8 @@
 
 #include "pd_factor.h"
 
-static const pd_factor_type *const factor_types[] = {
-    &pd_factor_scalar_type, &pd_factor_dense_type, &pd_factor_cholmod_type};
+static const pd_factor_type *const factor_types[] = {&pd_factor_scalar_type, &pd_factor_dense_type,
+                                                     &pd_factor_cholmod_type};
 
 const char *pd_factor_kind_name(pd_factor_kind kind)
 {

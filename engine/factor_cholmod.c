@@ -24,18 +24,18 @@
 
 typedef struct chol_data {
     int n, m;
-    int *Lp, *Li;     /* L, n x n lower, diagonal first in each column */
+    int *Lp, *Li; /* L, n x n lower, diagonal first in each column */
     double *Lx;
-    int *Up, *Ui;     /* U = L^T, diagonal last in each column */
+    int *Up, *Ui; /* U = L^T, diagonal last in each column */
     double *Ux;
-    int *perm;        /* row k of P What P^T is row perm[k] of What */
-    int *pinv;        /* pinv[perm[k]] = k */
-    int *Zp, *Zi;     /* Z = What^-1 W, n x m */
+    int *perm;    /* row k of P What P^T is row perm[k] of What */
+    int *pinv;    /* pinv[perm[k]] = k */
+    int *Zp, *Zi; /* Z = What^-1 W, n x m */
     double *Zx;
-    int *Dp, *Di;     /* D = W^T Z, m x m */
+    int *Dp, *Di; /* D = W^T Z, m x m */
     double *Dx;
-    int *pos;         /* m: place of a contact in the current index set, or -1 */
-    double *work;     /* n: the permuted right-hand side */
+    int *pos;     /* m: place of a contact in the current index set, or -1 */
+    double *work; /* n: the permuted right-hand side */
 } chol_data;
 
 static void chol_release(pd_factor *f)
@@ -92,7 +92,8 @@ static int assemble(const pd_model *md, double ht, int which_w, pd_sparse *out, 
     /* room for every stored entry of W, or of M, C and K together */
     long cap = which_w ? pd_matrix_nnz(&md->W)
                        : pd_matrix_nnz(&md->M) + pd_matrix_nnz(&md->C) + pd_matrix_nnz(&md->K);
-    int *Ti = malloc((size_t)(cap + 1) * sizeof(int)), *Tj = malloc((size_t)(cap + 1) * sizeof(int));
+    int *Ti = malloc((size_t)(cap + 1) * sizeof(int)),
+        *Tj = malloc((size_t)(cap + 1) * sizeof(int));
     double *Tx = malloc((size_t)(cap + 1) * sizeof(double));
     long nt = 0;
     int rc;
@@ -193,10 +194,10 @@ static int cholesky(chol_data *d, pd_sparse *A, pd_err *err)
     cholmod_factor *L = NULL;
     int rc = PD_OK;
     cholmod_start(&c);
-    c.print = 0;            /* the library never prints */
+    c.print = 0; /* the library never prints */
     c.error_handler = NULL;
     c.supernodal = CHOLMOD_SIMPLICIAL; /* plain columns to copy out */
-    c.final_ll = 1; /* L L^T, not L D L^T */
+    c.final_ll = 1;                    /* L L^T, not L D L^T */
     c.final_pack = 1;
     c.final_monotonic = 1;
     /* A's lower triangle (stype -1), a view of its arrays, not a copy */
@@ -224,8 +225,7 @@ static int cholesky(chol_data *d, pd_sparse *A, pd_err *err)
                         "definite (CHOLMOD stopped at column %d)",
                         (int)L->minor);
     else if (c.status < CHOLMOD_OK || L->is_super || !L->is_ll)
-        rc = pd_err_set(err, PD_ENUMERICAL, "CHOLMOD: factorization failed (status %d)",
-                        c.status);
+        rc = pd_err_set(err, PD_ENUMERICAL, "CHOLMOD: factorization failed (status %d)", c.status);
     else if (copy_factor(d, L) || transpose_L(d))
         rc = pd_err_set(err, PD_ENOMEM, "factor: out of memory for the Cholesky factor");
     cholmod_free_factor(&L, &c);
@@ -455,7 +455,7 @@ static void chol_solve(const pd_factor *f, double *x)
     int n = d->n;
     double *y = d->work;
     for (int k = 0; k < n; k++)
-        y[k] = x[d->perm[k]]; /* y = P x */
+        y[k] = x[d->perm[k]];     /* y = P x */
     for (int j = 0; j < n; j++) { /* L y = P x, diagonal first */
         int p = d->Lp[j];
         /* y_j /= L_jj, then y_i -= L_ij y_j below it */
@@ -476,8 +476,7 @@ static void chol_solve(const pd_factor *f, double *x)
 }
 
 /* v += Z[:, idx] P. */
-static void chol_add_impulse(const pd_factor *f, const int *idx, int nI, const double *P,
-                             double *v)
+static void chol_add_impulse(const pd_factor *f, const int *idx, int nI, const double *P, double *v)
 {
     const chol_data *d = f->data;
     for (int r = 0; r < nI; r++) {
@@ -504,8 +503,8 @@ static void chol_delassus_dense(const pd_factor *f, const int *idx, int nI, doub
         d->pos[idx[r]] = -1; /* cleared for the next call */
 }
 
-static int chol_delassus_csc(const pd_factor *f, const int *idx, int nI, int *colptr,
-                             int *rowind, double *values)
+static int chol_delassus_csc(const pd_factor *f, const int *idx, int nI, int *colptr, int *rowind,
+                             double *values)
 {
     const chol_data *d = f->data;
     int nz = 0;

@@ -111,8 +111,7 @@ static int dense_setup(pd_factor *f, pd_err *err)
     f->data = d;
     if (!d || !(d->lu = calloc((size_t)n * n, sizeof(double))) ||
         !(d->perm = calloc((size_t)n, sizeof(int))) || alloc_contact_data(d, n, md->m))
-        return pd_err_set(err, PD_ENOMEM, "factor: out of memory for a dense %d x %d matrix", n,
-                          n);
+        return pd_err_set(err, PD_ENOMEM, "factor: out of memory for a dense %d x %d matrix", n, n);
     form_what(md, f->h * f->theta, d->lu);
     /* LU with partial pivoting; a pivot below 1e-14 (relative) is singular */
     if (pd_dense_lu(n, d->lu, n, d->perm, DENSE_SINGULAR_TOL))
@@ -150,8 +149,8 @@ static void dense_delassus(const pd_factor *f, const int *idx, int nI, double *D
     pd_factor_gather_dense(d->del, f->model->m, idx, nI, D); /* D_II out of the whole D */
 }
 
-static int dense_delassus_csc(const pd_factor *f, const int *idx, int nI, int *colptr,
-                              int *rowind, double *values)
+static int dense_delassus_csc(const pd_factor *f, const int *idx, int nI, int *colptr, int *rowind,
+                              double *values)
 {
     const dense_data *d = f->data;
     return pd_factor_gather_dense_csc(d->del, f->model->m, idx, nI, colptr, rowind, values);

@@ -32,7 +32,7 @@
 
 pd_mj_opts pd_mj_default_opts(void)
 {
-    return (pd_mj_opts){.h = 0.0, /* no default: check_opts refuses h <= 0 */
+    return (pd_mj_opts){.h = 0.0,     /* no default: check_opts refuses h <= 0 */
                         .theta = 0.5, /* the trapezoidal rule: second order, energy kept */
                         .gamma = 0.5, /* the active set looks half a step ahead */
                         .allow_unstable = 0,
@@ -108,8 +108,7 @@ int pd_mj_check_opts(const pd_mj_opts *o, pd_err *err)
     /* the adaptive driver's options, read only when it runs */
     if (o->rtol > 0.0) {
         if (!(o->atol > 0.0) || !isfinite(o->atol))
-            return pd_err_set(err, PD_EINVAL, "atol must be a finite number > 0 (got %g)",
-                              o->atol);
+            return pd_err_set(err, PD_EINVAL, "atol must be a finite number > 0 (got %g)", o->atol);
         if (o->max_level < 1 || o->max_level > PD_MJ_MAX_LEVEL)
             return pd_err_set(err, PD_EINVAL, "max_level must be in [1, %d] (got %d)",
                               PD_MJ_MAX_LEVEL, o->max_level);
@@ -141,8 +140,9 @@ static int alloc_arrays(pd_mj *mj, int n, int m)
     mj->st.g = pd_calloc(m, sizeof(double));
     mj->st.active = pd_calloc(m, 1);
     mj->st_own = mj->st; /* freed through st_own: the adaptive driver repoints st */
-    return mj->F0 && mj->F1 && mj->work_n && mj->qtheta && mj->U0 && mj->b_active && mj->P_active && mj->w_active && mj->idx_active && mj->st.q &&
-                   mj->st.v && mj->st.P && mj->st.g && mj->st.active
+    return mj->F0 && mj->F1 && mj->work_n && mj->qtheta && mj->U0 && mj->b_active && mj->P_active &&
+                   mj->w_active && mj->idx_active && mj->st.q && mj->st.v && mj->st.P && mj->st.g &&
+                   mj->st.active
                ? PD_OK
                : PD_ENOMEM;
 }
@@ -171,8 +171,8 @@ static int contact_workspace(pd_mj *mj, pd_err *err)
     /* the warm start: 1 pushed, 0 active without pushing, 2 newly active */
     if (!(mj->guess = calloc((size_t)m, 1)))
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for %d contacts", m);
-    if (!(mj->lcp = pd_lcp_solver_alloc(mj->opts.lcp_solver, mj->lcp_nmax, mj->sparse ? nnz : 0,
-                                        err)))
+    if (!(mj->lcp =
+              pd_lcp_solver_alloc(mj->opts.lcp_solver, mj->lcp_nmax, mj->sparse ? nnz : 0, err)))
         return err->status;
     if (mj->sparse) {
         /* D_II in compressed columns: no more entries than the whole D */
@@ -303,8 +303,8 @@ static int check_state(const pd_model *md, const pd_state *st, pd_err *err)
     for (int i = 0; i < md->n; i++)
         if (!isfinite(st->q[i]) || !isfinite(st->v[i]))
             return pd_err_set(err, PD_ENONFINITE,
-                              "Moreau-Jean: non-finite state at t = %.9g (step %ld, dof %d)",
-                              st->t, st->step, i);
+                              "Moreau-Jean: non-finite state at t = %.9g (step %ld, dof %d)", st->t,
+                              st->step, i);
     return PD_OK;
 }
 
@@ -318,8 +318,8 @@ static inline int step_scalar_f(pd_mj *mj, double F1, pd_err *err)
     double t1 = mj->t0 + (double)(st->step + 1) * h;
     double g = st->g[0], P;
     /* vfree, the prediction g + h gamma U <= 0, P = max(0, -b) / D and q_k+1: mj1_step */
-    int active = mj1_step(h, mj->opts.theta, h * mj->opts.gamma, &mj->s1, mj->F0[0], F1,
-                          &st->q[0], &st->v[0], &g, &P);
+    int active = mj1_step(h, mj->opts.theta, h * mj->opts.gamma, &mj->s1, mj->F0[0], F1, &st->q[0],
+                          &st->v[0], &g, &P);
     if (md->m) {
         /* P, active and g exist only with the wall (m = 1) */
         st->P[0] = P;
@@ -406,15 +406,21 @@ static int run_scalar(pd_mj *mj, long nsteps, pd_observer observer, void *ctx, p
     const pd_model *md = mj->model;
     pd_state *st = &mj->st;
     scalar_run r = {.mj = mj, .observer = observer, .ctx = ctx};
-    mj1_state x = {.q = st->q[0], .v = st->v[0], .g = md->m ? st->g[0] : 0.0,
-                   .P = md->m ? st->P[0] : 0.0, .F0 = mj->F0[0], .F1 = mj->F1[0],
-                   .step = st->step, .next_break = mj->next_break, .active = st->nactive};
+    mj1_state x = {.q = st->q[0],
+                   .v = st->v[0],
+                   .g = md->m ? st->g[0] : 0.0,
+                   .P = md->m ? st->P[0] : 0.0,
+                   .F0 = mj->F0[0],
+                   .F1 = mj->F1[0],
+                   .step = st->step,
+                   .next_break = mj->next_break,
+                   .active = st->nactive};
     double h = mj->opts.h, th = mj->opts.theta, gamma = mj->opts.gamma;
     /* two calls: without an observer the inlined loop drops its call */
-    int rc = observer ? mj1_run(&mj->s1, h, th, gamma, mj->t0, md->breaks, md->nbreaks, nsteps,
-                                &x, scalar_force_at, scalar_observe, &r, err)
-                      : mj1_run(&mj->s1, h, th, gamma, mj->t0, md->breaks, md->nbreaks, nsteps,
-                                &x, scalar_force_at, NULL, &r, err);
+    int rc = observer ? mj1_run(&mj->s1, h, th, gamma, mj->t0, md->breaks, md->nbreaks, nsteps, &x,
+                                scalar_force_at, scalar_observe, &r, err)
+                      : mj1_run(&mj->s1, h, th, gamma, mj->t0, md->breaks, md->nbreaks, nsteps, &x,
+                                scalar_force_at, NULL, &r, err);
     /* the state back into mj->st once, after the last step */
     scalar_store(mj, &x, mj->t0 + (double)x.step * h);
     mj->F0[0] = x.F0;
@@ -503,8 +509,7 @@ void mj_active_rhs(pd_mj *mj, int nI, const double *vfree)
         int a = mj->idx_active[r];
         /* w_a = (D P + b)_a = U_a(v_k+1) + e U_a(v_k) >= 0: Newton's law
          * U+ = -e U- where P_a > 0 */
-        double e = mj->u_rest && (mj->U0[a] > 0.0 || -mj->U0[a] <= mj->u_rest[a]) ? 0.0
-                                                                                  : md->e[a];
+        double e = mj->u_rest && (mj->U0[a] > 0.0 || -mj->U0[a] <= mj->u_rest[a]) ? 0.0 : md->e[a];
         mj->b_active[r] = pd_matrix_col_dot(&md->W, a, vfree) + e * mj->U0[a];
     }
 }
@@ -512,8 +517,8 @@ void mj_active_rhs(pd_mj *mj, int nI, const double *vfree)
 /* r_I = b_I + W_I^T y, the Newton residual of v = vfree + y, and the worst
  * pushing contact's |r_a| over the rounding of its terms, eps (|W_a|^T
  * (|vfree| + |y|) + |b_a|), returned. */
-static double velocity_residual(const pd_mj *mj, int nI, const int *ax, int na,
-                                const double *vfree, const double *y, double *res)
+static double velocity_residual(const pd_mj *mj, int nI, const int *ax, int na, const double *vfree,
+                                const double *y, double *res)
 {
     const pd_matrix *W = &mj->model->W;
     double worst = 0.0;
@@ -668,7 +673,7 @@ static int impact_refine(pd_mj *mj, const pd_factor *f, int nI, const double *vf
     double worst = velocity_residual(mj, nI, ax, na, vfree, y, res);
     if (worst <= MJ_REFINE_TOL)
         return PD_OK;
-    mj->refined = 1; /* y is kept even when no correction improves it */
+    mj->refined = 1;                           /* y is kept even when no correction improves it */
     memcpy(yt, y, (size_t)n * sizeof(double)); /* the iterate; y the best */
     int full = orthogonalise_pushing(mj, f, ax, na) == na;
     /* not monotone: a first correction can carry the basis vectors'
@@ -687,9 +692,11 @@ static int impact_refine(pd_mj *mj, const pd_factor *f, int nI, const double *vf
     for (int i = 0; i < na; i++)
         P[ax[i]] = fmax(P[ax[i]], 0.0); /* P is reported; y carries the step */
     if (worst > MJ_REFINE_TOL)
-        return pd_err_set(err, PD_ENUMERICAL, "Moreau-Jean: the LCP of %d active contacts at t = "
+        return pd_err_set(err, PD_ENUMERICAL,
+                          "Moreau-Jean: the LCP of %d active contacts at t = "
                           "%.9g lost precision: its velocities miss Newton's law by %.3g roundings "
-                          "of their terms (at most %g)", nI, t1, worst, MJ_REFINE_TOL);
+                          "of their terms (at most %g)",
+                          nI, t1, worst, MJ_REFINE_TOL);
     return PD_OK;
 }
 
@@ -697,7 +704,7 @@ static int impact_refine(pd_mj *mj, const pd_factor *f, int nI, const double *vf
  * + e U) with D_II from the factor f, refined when it lost precision; t1
  * is the step's end (messages). */
 static int impact_contacts(pd_mj *mj, const pd_factor *f, int nI, const double *vfree, double t1,
-                          pd_state *out, pd_err *err)
+                           pd_state *out, pd_err *err)
 {
     int rc;
     mj->refined = 0;
@@ -727,7 +734,7 @@ int mj_general_step(pd_mj *mj, const pd_factor *f, double h, double t1, const do
     double *x = mj->work_n;
     /* right-hand side h [F_theta - C v - K (q + h theta v)] */
     for (int i = 0; i < n; i++) {
-        x[i] = th * F1[i] + (1.0 - th) * F0[i]; /* F_theta */
+        x[i] = th * F1[i] + (1.0 - th) * F0[i];       /* F_theta */
         mj->qtheta[i] = in->q[i] + h * th * in->v[i]; /* q_k + h theta v_k */
     }
     pd_matrix_gemv(&md->C, -1.0, in->v, 1.0, x);
@@ -794,8 +801,10 @@ static int refuse_adaptive(const pd_mj *mj, const char *call, pd_err *err)
 {
     if (!mj->ad)
         return PD_OK;
-    return pd_err_set(err, PD_EINVAL, "%s: this Moreau-Jean object chooses its steps (rtol = "
-                      "%g): run it with pd_mj_run_until", call, mj->opts.rtol);
+    return pd_err_set(err, PD_EINVAL,
+                      "%s: this Moreau-Jean object chooses its steps (rtol = "
+                      "%g): run it with pd_mj_run_until",
+                      call, mj->opts.rtol);
 }
 
 int pd_mj_step(pd_mj *mj, pd_err *err)

@@ -27,9 +27,9 @@ typedef struct mj_flight mj_flight; /* its exact flights (mj_flight.c) */
 /* W by columns and by rows (the adaptive driver's): the dofs each contact
  * acts on, and the contacts acting on each dof. */
 typedef struct mj_incidence {
-    int *ptr, *dof;    /* contact a: dof[ptr[a] .. ptr[a+1]) */
-    double *w;         /* W_ia of each (dof, contact) pair, as dof */
-    int *dptr, *con;   /* dof i: con[dptr[i] .. dptr[i+1]) */
+    int *ptr, *dof;  /* contact a: dof[ptr[a] .. ptr[a+1]) */
+    double *w;       /* W_ia of each (dof, contact) pair, as dof */
+    int *dptr, *con; /* dof i: con[dptr[i] .. dptr[i+1]) */
 } mj_incidence;
 
 /* The stored entries of column j of A, one per call into (*i, *v), *p from
@@ -65,26 +65,26 @@ static inline double mj_inc_dot(const mj_incidence *in, int a, const double *x)
 struct pd_mj {
     const pd_model *model;
     pd_mj_opts opts;
-    int scalar;           /* 1: scalar kernel */
-    double t0;            /* time of the last reset */
-    int next_break;       /* index of the first model breakpoint after t */
-    pd_factor *factor;    /* What, What^-1 W and the Delassus matrix (fixed steps) */
-    pd_lcp_solver *lcp;   /* the contact LCP solver, sized for lcp_nmax contacts */
-    int lcp_nmax;         /* most active contacts one LCP may have */
-    unsigned char *guess; /* m: the warm start of the active set's LCP: 1 pushed in the
+    int scalar;               /* 1: scalar kernel */
+    double t0;                /* time of the last reset */
+    int next_break;           /* index of the first model breakpoint after t */
+    pd_factor *factor;        /* What, What^-1 W and the Delassus matrix (fixed steps) */
+    pd_lcp_solver *lcp;       /* the contact LCP solver, sized for lcp_nmax contacts */
+    int lcp_nmax;             /* most active contacts one LCP may have */
+    unsigned char *guess;     /* m: the warm start of the active set's LCP: 1 pushed in the
                              previous step, 0 active without pushing, 2 newly active */
-    int sparse;           /* 1: Delassus blocks in compressed columns */
-    int stop;             /* the LCP observer asked to stop */
-    double *F0, *F1;      /* n: force at t_k and t_k+1 */
-    double *work_n;       /* n: right-hand side, then velocity increment */
-    double *qtheta;       /* n: q_k + h theta v_k */
-    double *U0;           /* m: W^T v_k */
-    double *D_active;     /* Delassus block: lcp_nmax^2 (dense) or delassus_nnz (sparse) */
+    int sparse;               /* 1: Delassus blocks in compressed columns */
+    int stop;                 /* the LCP observer asked to stop */
+    double *F0, *F1;          /* n: force at t_k and t_k+1 */
+    double *work_n;           /* n: right-hand side, then velocity increment */
+    double *qtheta;           /* n: q_k + h theta v_k */
+    double *U0;               /* m: W^T v_k */
+    double *D_active;         /* Delassus block: lcp_nmax^2 (dense) or delassus_nnz (sparse) */
     int *D_colptr, *D_rowind; /* sparse: its compressed columns */
-    double *b_active;     /* m: LCP vector of the active set */
-    double *P_active;     /* m: impulses of the active set */
-    double *w_active;     /* m: post-impact relative velocities of the active set */
-    int *idx_active;      /* m: indices of the active contacts */
+    double *b_active;         /* m: LCP vector of the active set */
+    double *P_active;         /* m: impulses of the active set */
+    double *w_active;         /* m: post-impact relative velocities of the active set */
+    int *idx_active;          /* m: indices of the active contacts */
     /* the refinement of a dense active LCP (dense Delassus only), for up to
      * ref_nmax pushing contacts: */
     int ref_nmax;         /* min(m, MJ_REFINE_NMAX) */

@@ -36,10 +36,10 @@
 #include "pd_alloc.h"
 #include "pd_null.h"
 
-#define ADAPT_KF 0.5        /* share of rtol for the flight's errors over the run */
-#define ADAPT_KE 0.1        /* share of rtol for one event */
-#define ADAPT_GROW 0.9      /* double the step below ADAPT_GROW 2^-p of the tolerance */
-#define ADAPT_START 3       /* the first try's level */
+#define ADAPT_KF 0.5          /* share of rtol for the flight's errors over the run */
+#define ADAPT_KE 0.1          /* share of rtol for one event */
+#define ADAPT_GROW 0.9        /* double the step below ADAPT_GROW 2^-p of the tolerance */
+#define ADAPT_START 3         /* the first try's level */
 #define ADAPT_BREAK_TOL 1e-12 /* a time within this relative distance of a breakpoint is it */
 #define ADAPT_CHATTER 4.0     /* rest speeds: this many steps' worth of the gap's force */
 #define ADAPT_DEEP 6          /* the foot of the ladder: its last levels */
@@ -60,45 +60,45 @@ typedef struct snap {
 } snap;
 
 struct mj_adapt {
-    int L;                 /* the finest level */
-    double h0, htick;      /* h_0 and h_L */
-    double t_origin;       /* the grid's origin (the last reset) */
-    double span;           /* T: the run's length (set by the first run after a reset) */
-    mj_level *lev;         /* L + 1 levels (theta flights) */
+    int L;                       /* the finest level */
+    double h0, htick;            /* h_0 and h_L */
+    double t_origin;             /* the grid's origin (the last reset) */
+    double span;                 /* T: the run's length (set by the first run after a reset) */
+    mj_level *lev;               /* L + 1 levels (theta flights) */
     const pd_piecewise_force *F; /* exact flights' forcing (NULL: theta flights) */
-    uint64_t *piece_tick;  /* npieces: each piece's start */
+    uint64_t *piece_tick;        /* npieces: each piece's start */
     snap sn[4];
     snap *cur, *one, *half, *two; /* now; one step; the first half; both halves */
-    double *E;             /* n: the flights' estimate kept so far (errors that add up) */
-    double *S2;            /* n: the events' estimates kept so far, squared and summed (the
+    double *E;                    /* n: the flights' estimate kept so far (errors that add up) */
+    double *S2;                   /* n: the events' estimates kept so far, squared and summed (the
                               instants of impulses inside their steps: errors of either
                               sign, independent) */
-    double *Er;            /* n: E plus the last step's interpolation bound (state err) */
-    double *eps;           /* n: the try's estimate */
-    double *rate;          /* n: the last smooth pair's error over h^(p+1) */
-    double *amp;           /* n: the amplitudes seen */
-    double *w;             /* n: each dof's frequency */
-    double *atol;          /* n */
-    double *minv;          /* n: 1 / M_ii */
-    unsigned *mark;        /* n: the stamp of the last impact on each dof */
+    double *Er;                   /* n: E plus the last step's interpolation bound (state err) */
+    double *eps;                  /* n: the try's estimate */
+    double *rate;                 /* n: the last smooth pair's error over h^(p+1) */
+    double *amp;                  /* n: the amplitudes seen */
+    double *w;                    /* n: each dof's frequency */
+    double *atol;                 /* n */
+    double *minv;                 /* n: 1 / M_ii */
+    unsigned *mark;               /* n: the stamp of the last impact on each dof */
     unsigned stamp;
-    unsigned *evmark;      /* n: try_stamp when an event marked the dof in this try */
-    unsigned *timed;       /* n: try_stamp when impulses at other instants moved the dof */
+    unsigned *evmark; /* n: try_stamp when an event marked the dof in this try */
+    unsigned *timed;  /* n: try_stamp when impulses at other instants moved the dof */
     unsigned try_stamp;
-    double *bound;         /* n: the try's events' bound */
-    long nmarked;          /* dofs marked for events so far */
-    double *u_rest;        /* m: closing speeds without restitution (mj->u_rest) */
-    double *u_tol, *G;     /* m: the tolerance's rest speeds; |free gap acceleration| */
-    double *D0;            /* m: sum_i W_ia^2 / M_ii, a unit impulse's change of gap rate */
-    int p;                 /* order of the flight's global error */
-    double div;            /* 2^p - 1 */
-    int k_flight;          /* exact flights: the coarsest level whose steps the observers'
+    double *bound;     /* n: the try's events' bound */
+    long nmarked;      /* dofs marked for events so far */
+    double *u_rest;    /* m: closing speeds without restitution (mj->u_rest) */
+    double *u_tol, *G; /* m: the tolerance's rest speeds; |free gap acceleration| */
+    double *D0;        /* m: sum_i W_ia^2 / M_ii, a unit impulse's change of gap rate */
+    int p;             /* order of the flight's global error */
+    double div;        /* 2^p - 1 */
+    int k_flight;      /* exact flights: the coarsest level whose steps the observers'
                               quintic interpolation keeps within a tenth of the event
                               tolerance, (w h)^6 / 46080 <= ke rtol / 10 */
-    int k;                 /* the level of the next try */
-    int started;           /* the reset state was reported */
-    int impact_made;       /* the step that made the state had an impact */
-    long deep;             /* tries in a row at the ladder's foot */
+    int k;             /* the level of the next try */
+    int started;       /* the reset state was reported */
+    int impact_made;   /* the step that made the state had an impact */
+    long deep;         /* tries in a row at the ladder's foot */
     pd_mj_stats stats;
 };
 
@@ -159,13 +159,15 @@ void mj_adapt_free(pd_mj *mj)
             pd_factor_free(ad->lev[k].factor);
     for (int s = 0; s < 4; s++)
         snap_free(&ad->sn[s]);
-    void *arrays[] = {ad->lev, ad->piece_tick, ad->E, ad->S2, ad->Er, ad->eps, ad->rate, ad->amp, ad->w,
-                      ad->atol, ad->minv, ad->mark, ad->evmark, ad->timed, ad->bound, ad->u_rest, ad->D0, ad->u_tol, ad->G};
+    void *arrays[] = {ad->lev,    ad->piece_tick, ad->E,      ad->S2,    ad->Er,
+                      ad->eps,    ad->rate,       ad->amp,    ad->w,     ad->atol,
+                      ad->minv,   ad->mark,       ad->evmark, ad->timed, ad->bound,
+                      ad->u_rest, ad->D0,         ad->u_tol,  ad->G};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(arrays[k]);
     free(ad);
     mj->ad = NULL;
-    mj->u_rest = NULL; /* the fixed-step kernel: every restitution again */
+    mj->u_rest = NULL;   /* the fixed-step kernel: every restitution again */
     mj->st = mj->st_own; /* st pointed into a snapshot */
 }
 
@@ -286,8 +288,8 @@ int mj_adapt_alloc(pd_mj *mj, pd_err *err)
     ad->lev = calloc((size_t)L + 1, sizeof *ad->lev);
     /* one element without pieces, so that NULL means out of memory */
     ad->piece_tick = calloc(ad->F ? (size_t)ad->F->npieces : 1, sizeof(uint64_t));
-    double **nv[] = {&ad->E, &ad->S2, &ad->Er, &ad->eps, &ad->rate, &ad->amp, &ad->w, &ad->atol, &ad->minv,
-                     &ad->bound};
+    double **nv[] = {&ad->E,   &ad->S2, &ad->Er,   &ad->eps,  &ad->rate,
+                     &ad->amp, &ad->w,  &ad->atol, &ad->minv, &ad->bound};
     int bad = !ad->lev || !ad->piece_tick;
     for (size_t k = 0; k < sizeof nv / sizeof nv[0]; k++)
         bad |= !(*nv[k] = calloc((size_t)n, sizeof(double)));
@@ -298,12 +300,12 @@ int mj_adapt_alloc(pd_mj *mj, pd_err *err)
     ad->D0 = pd_calloc(md->m, sizeof(double));
     ad->u_tol = pd_calloc(md->m, sizeof(double));
     ad->G = pd_calloc(md->m, sizeof(double));
-    bad |= !ad->u_tol || !ad->G || !ad->mark || !ad->evmark || !ad->timed || !ad->u_rest || !ad->D0 || incidence(md, &mj->inc);
+    bad |= !ad->u_tol || !ad->G || !ad->mark || !ad->evmark || !ad->timed || !ad->u_rest ||
+           !ad->D0 || incidence(md, &mj->inc);
     for (int s = 0; s < 4 && !bad; s++)
         bad = snap_alloc(&ad->sn[s], n, md->m) != PD_OK;
     if (bad)
-        return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for its levels (n = %d)",
-                          n);
+        return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for its levels (n = %d)", n);
     for (int k = 0; k <= L; k++) {
         /* h_k = h0 2^-k: the scalar kernel's constants now, the
          * general kernel's factors at their first use */
@@ -319,8 +321,10 @@ int mj_adapt_alloc(pd_mj *mj, pd_err *err)
         ad->minv[i] = 1.0 / pd_matrix_get(&md->M, i, i);
         ad->atol[i] = o->atol_dof ? o->atol_dof[i] : o->atol;
         if (!(ad->atol[i] > 0.0) || !isfinite(ad->atol[i]))
-            return pd_err_set(err, PD_EINVAL, "atol of dof %d must be a finite number > 0 "
-                              "(got %g)", i, ad->atol[i]);
+            return pd_err_set(err, PD_EINVAL,
+                              "atol of dof %d must be a finite number > 0 "
+                              "(got %g)",
+                              i, ad->atol[i]);
     }
     /* D0_a = sum_i W_ia^2 / M_ii: the gap rate a unit
      * impulse makes (M^-1 by its diagonal) */
@@ -477,8 +481,8 @@ static int scalar_step(pd_mj *mj, int k, double t1, const snap *x, snap *y, pd_e
     if (md->m && -(s1.w * v) <= mj->ad->u_rest[0])
         s1.e = 0.0; /* opening, or closing too slowly for a rebound: the contact holds */
     /* F(t+) at the start, F(t1-) at the end: the fixed-step kernel's arithmetic */
-    int active = mj1_step(lv->h, mj->opts.theta, lv->h * mj->opts.gamma, &s1, x->Fr[0],
-                          y->Fl[0], &q, &v, &g, &P);
+    int active = mj1_step(lv->h, mj->opts.theta, lv->h * mj->opts.gamma, &s1, x->Fr[0], y->Fl[0],
+                          &q, &v, &g, &P);
     y->st.q[0] = q;
     y->st.v[0] = v;
     if (md->m) {
@@ -601,9 +605,8 @@ static int scan_impacts(pd_mj *mj, const snap *x, const snap *y, double h, doubl
     for (int a = 0; a < md->m; a++) {
         double jump = impact_jump(mj, a, x, y);
         /* open to past zero without an impulse: the penetration is the error */
-        double missed = x->st.g[a] > 0.0 && y->st.g[a] < 0.0 && !(y->st.P[a] > 0.0)
-                            ? -y->st.g[a]
-                            : 0.0;
+        double missed =
+            x->st.g[a] > 0.0 && y->st.g[a] < 0.0 && !(y->st.P[a] > 0.0) ? -y->st.g[a] : 0.0;
         if (!(jump > 0.0) && !(missed > 0.0))
             continue;
         /* significant: h jump beyond (1 + e) sim_gap and, on every dof it moves, a velocity
@@ -817,7 +820,7 @@ static void scan_patterns(pd_mj *mj, double h)
         int p1 = P1 > 0.0, pa = Pa > 0.0, p2 = P2 > 0.0;
         if (!p1 && !pa && !p2)
             continue;
-        int mixed = !(p1 == pa && pa == p2); /* pushes in some steps only */
+        int mixed = !(p1 == pa && pa == p2);                  /* pushes in some steps only */
         double jump = pd_max(P1, pd_max(Pa, P2)) * ad->D0[a]; /* the largest change of gap rate */
         for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
             int i = in->dof[j];
@@ -950,8 +953,8 @@ static void report_err(pd_mj *mj, double h)
     for (int i = 0; i < mj->model->n; i++) {
         double wh = fmax(ad->w[i], wf) * h, wh3 = wh * wh * wh;
         /* flights' errors add up (E), events' in quadrature (S2) */
-        ad->Er[i] = ad->E[i] + sqrt(ad->S2[i]) +
-                    (ad->F ? wh3 * wh3 / 46080.0 * dof_scale(ad, i) : 0.0);
+        ad->Er[i] =
+            ad->E[i] + sqrt(ad->S2[i]) + (ad->F ? wh3 * wh3 / 46080.0 * dof_scale(ad, i) : 0.0);
     }
 }
 
@@ -1185,8 +1188,7 @@ static int finest_step(pd_mj *mj, pd_observer observer, void *ctx, pd_err *err)
 /* An exact flight from a state where no contact pushes: kept whole when no
  * contact shuts, grazes or closes in it (then it has no error).  Returns 1
  * when kept, 0 when the step (in ad->one) needs a try, < 0 on failure. */
-static int exact_flight(pd_mj *mj, int k, pd_observer observer, void *ctx, int *stop,
-                        pd_err *err)
+static int exact_flight(pd_mj *mj, int k, pd_observer observer, void *ctx, int *stop, pd_err *err)
 {
     mj_adapt *ad = mj->ad;
     int rc;

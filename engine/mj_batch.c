@@ -36,18 +36,20 @@ static pd_mjb_step_fn lanes_step_for_cpu(void)
 {
     switch (pd_cpu_level()) {
 #if PD_X86_VARIANTS
-    case 4: return pd_mjb_lanes_step_x86v4;
-    case 3: return pd_mjb_lanes_step_x86v3;
+    case 4:
+        return pd_mjb_lanes_step_x86v4;
+    case 3:
+        return pd_mjb_lanes_step_x86v3;
 #endif
-    default: return pd_mjb_lanes_step_base;
+    default:
+        return pd_mjb_lanes_step_base;
     }
 }
 
 /* The idle lane: a unit mass at rest, no contact, no force breakpoint. */
 static const pd_mjb_lane idle_lane = {.M = 1.0, .h = 1.0, .brk = INFINITY};
 
-int pd_mjb_init(pd_mjb *b, const pd_mj_opts *opts, pd_mjb_force force, void *force_ctx,
-                pd_err *err)
+int pd_mjb_init(pd_mjb *b, const pd_mj_opts *opts, pd_mjb_force force, void *force_ctx, pd_err *err)
 {
     pd_mj_opts o = opts ? *opts : pd_mj_default_opts();
     int rc;
@@ -79,13 +81,17 @@ static int check_lane(const pd_mjb_lane *ln, int l, pd_err *err)
     if (!(ln->M > 0.0) || !isfinite(ln->M) || !isfinite(ln->C) || !isfinite(ln->K))
         return pd_err_set(err, PD_EINVAL, "batch: lane %d: M > 0, C and K finite needed", l);
     if (!(ln->h > 0.0) || !isfinite(ln->h) || isnan(ln->brk))
-        return pd_err_set(err, PD_EINVAL, "batch: lane %d: h > 0 finite, a breakpoint "
-                          "(INFINITY: none) needed", l);
+        return pd_err_set(err, PD_EINVAL,
+                          "batch: lane %d: h > 0 finite, a breakpoint "
+                          "(INFINITY: none) needed",
+                          l);
     /* W = 0 would make D = W^2 / What zero: a wall that never acts */
-    if (ln->wall && (!isfinite(ln->W) || ln->W == 0.0 || !(ln->g0 >= 0.0) ||
-                     !isfinite(ln->g0) || !(ln->e >= 0.0 && ln->e <= 1.0)))
-        return pd_err_set(err, PD_EINVAL, "batch: lane %d: W finite and nonzero, g0 >= 0 "
-                          "finite, e in [0, 1] needed", l);
+    if (ln->wall && (!isfinite(ln->W) || ln->W == 0.0 || !(ln->g0 >= 0.0) || !isfinite(ln->g0) ||
+                     !(ln->e >= 0.0 && ln->e <= 1.0)))
+        return pd_err_set(err, PD_EINVAL,
+                          "batch: lane %d: W finite and nonzero, g0 >= 0 "
+                          "finite, e in [0, 1] needed",
+                          l);
     return PD_OK;
 }
 
@@ -124,8 +130,8 @@ int pd_mjb_set_lane(pd_mjb *b, int l, const pd_mjb_lane *ln, pd_err *err)
         return PD_NULL_ARG(err, !b ? "b" : "ln");
     if ((rc = check_lane(ln, l, err)))
         return rc;
-    mj1_coef one = mj1_coef_make(ln->M, ln->C, ln->K, ln->wall, ln->W, ln->g0, ln->e, ln->h,
-                                 b->theta);
+    mj1_coef one =
+        mj1_coef_make(ln->M, ln->C, ln->K, ln->wall, ln->W, ln->g0, ln->e, ln->h, b->theta);
     mj1_coef_setv(mjb_coef(b, l / MJ1_WIDTH), l % MJ1_WIDTH, &one, ln->h, b->theta, b->gamma);
     b->h[l] = ln->h;
     b->brk[l] = ln->brk;

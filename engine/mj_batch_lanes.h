@@ -16,7 +16,7 @@ static inline void lanes_step(pd_mjb *b, int l)
     const double *cs = mj1_lanes_coef(b, l);
     lvec q = lload(&b->q[l]), v = lload(&b->v[l]), g = lload(&b->g[l]), P;
     lvec h = lload(&b->h[l]), F1 = lload(&b->F1[l]);
-    lvec Fth = mj1_lanes_fth(b->theta, lload(&b->F0[l]), F1); /* theta F1 + (1 - theta) F0 */
+    lvec Fth = mj1_lanes_fth(b->theta, lload(&b->F0[l]), F1);      /* theta F1 + (1 - theta) F0 */
     mj1_lanes_step(1, &cs, b->theta, &h, &Fth, &q, &v, &g, &P, 0); /* a wall per lane */
     lstore(&b->q[l], q);
     lstore(&b->v[l], v);

@@ -43,25 +43,25 @@ typedef struct fl_kind {
 /* A block: its kind and dofs. */
 typedef struct fl_block {
     int kind, s;
-    int *dofs;       /* s dofs, increasing */
+    int *dofs; /* s dofs, increasing */
 } fl_block;
 
 struct mj_flight {
     const pd_piecewise_force *F;
-    double w;                /* the sinusoids' frequency */
-    int L;                   /* levels 0..L + 1 */
-    double *h, *cm1, *sw;    /* L + 2: h_k, cos(w h_k) - 1, sin(w h_k) */
+    double w;             /* the sinusoids' frequency */
+    int L;                /* levels 0..L + 1 */
+    double *h, *cm1, *sw; /* L + 2: h_k, cos(w h_k) - 1, sin(w h_k) */
     int nblocks, nkinds;
     fl_block *blocks;
     fl_kind *kinds;
-    int *block_of, *at;      /* n: each dof's block, its place in it */
-    int *dofs;               /* n: the blocks' dofs, end to end */
-    unsigned *touched;       /* nblocks: the stamp of the last visit */
-    unsigned *cmark;         /* m: the stamp of the last visit */
+    int *block_of, *at; /* n: each dof's block, its place in it */
+    int *dofs;          /* n: the blocks' dofs, end to end */
+    unsigned *touched;  /* nblocks: the stamp of the last visit */
+    unsigned *cmark;    /* m: the stamp of the last visit */
     unsigned stamp;
-    int *pos;                /* m: place of a contact in the active set, or -1 */
-    double *r;               /* n: W P */
-    double *x, *dx, *y;      /* 2 smax + 4 */
+    int *pos;           /* m: place of a contact in the active set, or -1 */
+    double *r;          /* n: W P */
+    double *x, *dx, *y; /* 2 smax + 4 */
 };
 
 /* ---- dense helpers ---------------------------------------------------------- */
@@ -217,8 +217,10 @@ static int augmented(const pd_model *md, const mj_flight *fl, const fl_block *bl
     if (rc) {
         free(LU);
         free(perm);
-        return pd_err_set(err, PD_ESINGULAR, "Moreau-Jean: the mass matrix of the block of dof "
-                          "%d is singular", bl->dofs[0]);
+        return pd_err_set(err, PD_ESINGULAR,
+                          "Moreau-Jean: the mass matrix of the block of dof "
+                          "%d is singular",
+                          bl->dofs[0]);
     }
     /* M^-1 by columns, then -M^-1 K and -M^-1 C into A~ */
     memset(A, 0, (size_t)na * na * sizeof(double));
@@ -249,8 +251,8 @@ static int augmented(const pd_model *md, const mj_flight *fl, const fl_block *bl
         A[s + i + (size_t)(2 * s) * na] = sum;     /* z0 */
         A[s + i + (size_t)(2 * s + 2) * na] = sum; /* z2 */
     }
-    A[2 * s + (size_t)(2 * s + 1) * na] = fl->w;  /* z0' = w z1 */
-    A[2 * s + 1 + (size_t)(2 * s) * na] = -fl->w; /* z1' = -w z0 */
+    A[2 * s + (size_t)(2 * s + 1) * na] = fl->w;   /* z0' = w z1 */
+    A[2 * s + 1 + (size_t)(2 * s) * na] = -fl->w;  /* z1' = -w z0 */
     A[2 * s + 2 + (size_t)(2 * s + 3) * na] = 1.0; /* z2' = z3 */
     free(LU);
     free(perm);
@@ -291,8 +293,7 @@ static int ladder(const mj_flight *fl, fl_kind *kd, const double *A, pd_err *err
     for (size_t i = 0; i < nn; i++)
         E[i] = T[i] = A[i] * hf;
     /* T = (A h)^j / j! added while it counts beyond 1e-18 of E, FL_TAYLOR_MAX terms at most */
-    for (int j = 2; j <= FL_TAYLOR_MAX && norm1(na, T) > 1e-18 * fmax(norm1(na, E), 1e-300);
-         j++) {
+    for (int j = 2; j <= FL_TAYLOR_MAX && norm1(na, T) > 1e-18 * fmax(norm1(na, E), 1e-300); j++) {
         matmul(na, T, A, U);
         for (size_t i = 0; i < nn; i++) {
             T[i] = U[i] * hf / j;
@@ -318,8 +319,10 @@ static int ladder(const mj_flight *fl, fl_kind *kd, const double *A, pd_err *err
     free(T);
     free(U);
     return finite ? PD_OK
-                  : pd_err_set(err, PD_ENUMERICAL, "Moreau-Jean: the exact flight of a block of "
-                               "%d dofs overflows at the coarsest step (a smaller h)", kd->s);
+                  : pd_err_set(err, PD_ENUMERICAL,
+                               "Moreau-Jean: the exact flight of a block of "
+                               "%d dofs overflows at the coarsest step (a smaller h)",
+                               kd->s);
 }
 
 /* The first 2 s rows of E_k of kind kd. */
@@ -391,8 +394,10 @@ static int form_kinds(const pd_model *md, mj_flight *fl, pd_err *err)
         kd->Minv = malloc((size_t)bl->s * bl->s * sizeof(double));
         kd->E = malloc((size_t)(fl->L + 2) * 2 * bl->s * kd->na * sizeof(double));
         if (!A || !kd->Minv || !kd->E)
-            rc = pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for the tables of a "
-                            "block of %d dofs", bl->s);
+            rc = pd_err_set(err, PD_ENOMEM,
+                            "Moreau-Jean: out of memory for the tables of a "
+                            "block of %d dofs",
+                            bl->s);
         if (!rc && !(kd->Av = malloc((size_t)bl->s * kd->na * sizeof(double))))
             rc = pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for a block's tables");
         if (!rc && !(rc = augmented(md, fl, bl, kd, A, err))) {
@@ -452,8 +457,10 @@ static int forcing_frequency(const pd_piecewise_force *F, double *w, pd_err *err
         if (pc->A == 0.0)
             continue;
         if (*w != 0.0 && pc->w != *w)
-            return pd_err_set(err, PD_EINVAL, "Moreau-Jean: exact flights need one forcing "
-                              "frequency (pieces %d: %g and earlier: %g)", p, pc->w, *w);
+            return pd_err_set(err, PD_EINVAL,
+                              "Moreau-Jean: exact flights need one forcing "
+                              "frequency (pieces %d: %g and earlier: %g)",
+                              p, pc->w, *w);
         *w = pc->w;
     }
     return PD_OK;
@@ -477,8 +484,7 @@ int mj_flight_alloc(pd_mj *mj, const pd_piecewise_force *F, double h0, int L, pd
     fl->r = calloc((size_t)n, sizeof(double));
     fl->pos = pd_malloc(md->m, sizeof(int));
     if (!fl->h || !fl->block_of || !fl->at || !fl->dofs || !fl->r || !fl->pos ||
-        find_blocks(md, fl) ||
-        !(fl->touched = calloc((size_t)fl->nblocks, sizeof(unsigned))) ||
+        find_blocks(md, fl) || !(fl->touched = calloc((size_t)fl->nblocks, sizeof(unsigned))) ||
         !(fl->cmark = pd_calloc(md->m, sizeof(unsigned))))
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for its flights");
     fl->cm1 = fl->h + L + 2;
@@ -668,7 +674,7 @@ static void apply_impulses(pd_mj *mj, int k, int nI, pd_state *out)
 {
     mj_flight *fl = mj->fl;
     const mj_incidence *in = &mj->inc;
-    fl->stamp++; /* each block once */
+    fl->stamp++;                   /* each block once */
     for (int c = 0; c < nI; c++) { /* r = W P on the dofs */
         int a = mj->idx_active[c];
         for (int p = in->ptr[a]; p < in->ptr[a + 1]; p++)

@@ -7,7 +7,8 @@ int pd_model_check(const pd_model *model, pd_err *err)
 {
     int st;
     if (!model || model->n <= 0 || model->m < 0)
-        return pd_err_set(err, PD_EINVAL, "model: needs n > 0 degrees of freedom and m >= 0 contacts");
+        return pd_err_set(err, PD_EINVAL,
+                          "model: needs n > 0 degrees of freedom and m >= 0 contacts");
     /* every method inverts or factors M */
     if (model->M.kind == PD_MATRIX_ZERO)
         return pd_err_set(err, PD_EINVAL, "model: the mass matrix M must be given");

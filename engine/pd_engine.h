@@ -27,7 +27,7 @@
  * or CHOLMOD's sparse Cholesky (What symmetric positive definite) with
  * What^-1 W and W^T What^-1 W kept sparse -- no dense n x n or m x m matrix. */
 typedef enum {
-    PD_FACTOR_AUTO = 0,   /* scalar for n = 1; dense for n <= PD_FACTOR_DENSE_MAX or
+    PD_FACTOR_AUTO = 0, /* scalar for n = 1; dense for n <= PD_FACTOR_DENSE_MAX or
                              dense input; CHOLMOD otherwise */
     PD_FACTOR_SCALAR = 1,
     PD_FACTOR_DENSE = 2,
@@ -51,13 +51,13 @@ PD_API int pd_factor_kind_parse(const char *name, pd_factor_kind *kind);
 typedef void (*pd_force_fn)(double t, int side, double *F, void *ctx);
 
 typedef struct pd_model {
-    int n;              /* degrees of freedom */
-    int m;              /* contacts (0 = none) */
-    pd_matrix M, C, K;  /* n x n */
-    pd_matrix W;        /* n x m: contact directions, g = g0 + W^T q */
-    const double *g0;   /* m initial gaps */
-    const double *e;    /* m Newton restitution coefficients in [0, 1] */
-    pd_force_fn force;  /* F(t); NULL = no external force */
+    int n;             /* degrees of freedom */
+    int m;             /* contacts (0 = none) */
+    pd_matrix M, C, K; /* n x n */
+    pd_matrix W;       /* n x m: contact directions, g = g0 + W^T q */
+    const double *g0;  /* m initial gaps */
+    const double *e;   /* m Newton restitution coefficients in [0, 1] */
+    pd_force_fn force; /* F(t); NULL = no external force */
     void *force_ctx;
     const double *breaks; /* increasing times where F may jump (NULL if none) */
     int nbreaks;
@@ -74,17 +74,17 @@ PD_API pd_factor_kind pd_factor_choose(const pd_model *model, pd_factor_kind req
 /* ---- state and observers ---------------------------------------------- */
 
 typedef struct pd_state {
-    long step;             /* steps taken since reset */
-    double t;              /* time */
-    double *q, *v;         /* n displacements and velocities */
-    double *P;             /* m contact impulses over the last step */
-    double *g;             /* m gaps g0 + W^T q at t */
-    unsigned char *active; /* m flags: contact was in the last step's LCP */
-    int nactive;           /* number of active contacts in the last step */
-    int lcp_pivots;        /* pivots (or iterations) of the last step's LCP (0: none) */
+    long step;              /* steps taken since reset */
+    double t;               /* time */
+    double *q, *v;          /* n displacements and velocities */
+    double *P;              /* m contact impulses over the last step */
+    double *g;              /* m gaps g0 + W^T q at t */
+    unsigned char *active;  /* m flags: contact was in the last step's LCP */
+    int nactive;            /* number of active contacts in the last step */
+    int lcp_pivots;         /* pivots (or iterations) of the last step's LCP (0: none) */
     const char *lcp_solver; /* solver of the last step's LCP ("closed-form" for the
                                scalar kernel, NULL when none was solved) */
-    double *acc;           /* n accelerations q'' at t, valid when has_acc (the
+    double *acc;            /* n accelerations q'' at t, valid when has_acc (the
                               on_step reports of the event-driven and penalty methods;
                               Moreau-Jean to a tolerance: the right limit at t) */
     int has_acc;
@@ -92,11 +92,11 @@ typedef struct pd_state {
                               limit at t, where the forcing jumps (a piece's start: acc
                               holds the left limit, the end of the step to t); acc
                               itself elsewhere; NULL for the other methods */
-    int impact;            /* Moreau-Jean to a tolerance: 1 when the step to t had an
+    int impact;              /* Moreau-Jean to a tolerance: 1 when the step to t had an
                               impact (its velocities jump inside it: no interpolation
                               across it); 0 otherwise */
-    double h;              /* Moreau-Jean: the size of the last step */
-    const double *err;     /* Moreau-Jean to a tolerance: n, the error estimate of each
+    double h;                /* Moreau-Jean: the size of the last step */
+    const double *err;       /* Moreau-Jean to a tolerance: n, the error estimate of each
                               dof accumulated over the steps so far, in units of q
                               (velocity errors e_v counted as e_v / w_i, w_i^2 = K_ii /
                               M_ii); NULL for fixed steps and the other methods */
@@ -109,8 +109,8 @@ typedef int (*pd_observer)(const pd_state *state, void *ctx);
 /* ---- Moreau–Jean theta scheme (SPEC §2) ------------------------------- */
 
 typedef enum {
-    PD_KERNEL_AUTO = 0,    /* scalar kernel when n = 1 and m <= 1, else general */
-    PD_KERNEL_GENERAL = 1  /* the general kernel always (tests compare them) */
+    PD_KERNEL_AUTO = 0,   /* scalar kernel when n = 1 and m <= 1, else general */
+    PD_KERNEL_GENERAL = 1 /* the general kernel always (tests compare them) */
 } pd_kernel;
 
 /* Called after every contact LCP a step solves (solved or not): the
@@ -119,8 +119,8 @@ typedef enum {
  * idx (nI = D->rows of them) and the time at the end of the step.  Return
  * > 0 to stop the run. */
 typedef int (*pd_lcp_observer)(const pd_matrix *D, const double *b, const double *z,
-                               const double *w, const pd_lcp_info *info, const int *idx,
-                               double t, void *ctx);
+                               const double *w, const pd_lcp_info *info, const int *idx, double t,
+                               void *ctx);
 
 /* The finest level of the adaptive ladder h 2^-k (pd_mj_opts.max_level). */
 #define PD_MJ_MAX_LEVEL 48
@@ -131,21 +131,21 @@ typedef struct pd_mj_opts {
     double gamma;       /* active-set look-ahead in [0, 1] */
     int allow_unstable; /* accept theta in [0, 2] outside [1/2, 1] (stability studies) */
     pd_kernel kernel;
-    pd_factor_kind factor;     /* storage of What */
-    pd_lcp_method lcp_solver;  /* the contact LCP solver */
-    pd_lcp_observer on_lcp;    /* optional: every LCP solved (dumps, solver studies; with
+    pd_factor_kind factor;    /* storage of What */
+    pd_lcp_method lcp_solver; /* the contact LCP solver */
+    pd_lcp_observer on_lcp;   /* optional: every LCP solved (dumps, solver studies; with
                                   rtol > 0 also those of steps the controller rejects) */
     void *on_lcp_ctx;
     /* ---- to a tolerance (docs/scheme.md, "Moreau–Jean to a tolerance") ---- */
-    double rtol;        /* > 0: steps h 2^-k chosen so that the state's error stays within
+    double rtol;            /* > 0: steps h 2^-k chosen so that the state's error stays within
                            rtol of each dof's running amplitude (pd_mj_run_until); 0: fixed
                            steps h */
-    double atol;        /* > 0: the amplitude below which a dof's error is measured
+    double atol;            /* > 0: the amplitude below which a dof's error is measured
                            absolutely (units of q) */
     const double *atol_dof; /* optional, n: atol per dof */
-    int max_level;      /* finest level k, in [1, PD_MJ_MAX_LEVEL] */
-    double max_evals;   /* steps computed (kept or not) before refinement stops, >= 1 */
-    double sim_gap;     /* coupled impacts closer than this (a step of h |U| <= sim_gap,
+    int max_level;          /* finest level k, in [1, PD_MJ_MAX_LEVEL] */
+    double max_evals;       /* steps computed (kept or not) before refinement stops, >= 1 */
+    double sim_gap;         /* coupled impacts closer than this (a step of h |U| <= sim_gap,
                            units of q) are simultaneous: one LCP, as the exact reference's
                            close_tol; >= 0 */
     const struct pd_piecewise_force *pieces; /* with rtol > 0: the model's force as
@@ -193,8 +193,7 @@ PD_API int pd_mj_run(pd_mj *mj, long nsteps, pd_observer observer, void *ctx, pd
  * far.  The breakpoint model->breaks[0] (when > 0) is a whole number of
  * steps h from t = 0 (h is lowered to make it so), so that the force's jump
  * falls between steps.  t_end is reached to within h 2^-max_level. */
-PD_API int pd_mj_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx,
-                           pd_err *err);
+PD_API int pd_mj_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx, pd_err *err);
 
 /* What a run to a tolerance did (fixed steps: steps taken, no rejections,
  * h_min = h_max = h, err_max NAN). */
@@ -242,11 +241,11 @@ PD_API long pd_steps_for(double tend, double h);
 #define PD_MJB_LANES 32
 
 typedef struct pd_mjb_lane {
-    double M, C, K;   /* M > 0 */
-    int wall;         /* 1: the contact exists */
-    double W, g0, e;  /* its direction (nonzero), initial gap >= 0, restitution in [0, 1] */
-    double h;         /* step > 0 */
-    double brk;       /* the force's breakpoint (INFINITY: none) */
+    double M, C, K;  /* M > 0 */
+    int wall;        /* 1: the contact exists */
+    double W, g0, e; /* its direction (nonzero), initial gap >= 0, restitution in [0, 1] */
+    double h;        /* step > 0 */
+    double brk;      /* the force's breakpoint (INFINITY: none) */
 } pd_mjb_lane;
 
 /* F[l] = lane l's force at time t[l] (its left limit for side = -1, right
@@ -262,21 +261,21 @@ typedef void (*pd_mjb_step_fn)(pd_mjb *b); /* private */
  * loads of the step run fastest on. */
 struct pd_mjb {
     double theta, gamma;
-    pd_mjb_step_fn lanes_step;        /* private: the step for this processor */
+    pd_mjb_step_fn lanes_step; /* private: the step for this processor */
     pd_mjb_force force;
     void *force_ctx;
-    long iter;                        /* batch steps taken */
-    long next_event;                  /* iter at which a lane meets its breakpoint */
-    long reserved;                    /* (the first line's last word) */
-    long brk_iter[PD_MJB_LANES];      /* iter at which lane l does (LONG_MAX: never) */
-    double t[PD_MJB_LANES];     /* lane clocks */
-    double steps[PD_MJB_LANES]; /* lane step counts (whole numbers) */
-    double q[PD_MJB_LANES];     /* displacements at t */
-    double v[PD_MJB_LANES];     /* velocities at t */
-    double g[PD_MJB_LANES];     /* gaps at t */
-    double P[PD_MJB_LANES];     /* impulses of the last step */
-    double F0[PD_MJB_LANES];    /* forces at t+ */
-    double F1[PD_MJB_LANES];    /* forces at the step's end (scratch) */
+    long iter;                   /* batch steps taken */
+    long next_event;             /* iter at which a lane meets its breakpoint */
+    long reserved;               /* (the first line's last word) */
+    long brk_iter[PD_MJB_LANES]; /* iter at which lane l does (LONG_MAX: never) */
+    double t[PD_MJB_LANES];      /* lane clocks */
+    double steps[PD_MJB_LANES];  /* lane step counts (whole numbers) */
+    double q[PD_MJB_LANES];      /* displacements at t */
+    double v[PD_MJB_LANES];      /* velocities at t */
+    double g[PD_MJB_LANES];      /* gaps at t */
+    double P[PD_MJB_LANES];      /* impulses of the last step */
+    double F0[PD_MJB_LANES];     /* forces at t+ */
+    double F1[PD_MJB_LANES];     /* forces at the step's end (scratch) */
     double h[PD_MJB_LANES], brk[PD_MJB_LANES];
     double coef[11 * PD_MJB_LANES]; /* private: the lanes' constants */
 };
@@ -311,23 +310,23 @@ PD_API int pd_mjb_finite(const pd_mjb *b, int l);
  * breakpoints as events; accumulations of impacts jumped to persistent
  * contact (criterion in docs/methods.md). */
 typedef struct pd_edg_opts {
-    double rtol, atol;      /* GSL tolerances > 0 */
-    double h_out;           /* > 0: observer every h_out (and at t1) and at every event;
+    double rtol, atol;   /* GSL tolerances > 0 */
+    double h_out;        /* > 0: observer every h_out (and at t1) and at every event;
                                its P: each contact's impulse since its last report, the
                                held force integrated plus the impacts'; 0: every
                                event/step, P the impacts at that instant */
-    int impacts_only;       /* 1: with h_out > 0 the observer's P holds the impacts only */
-    int no_accumulation;    /* 1: never jump an accumulation */
-    long max_events;        /* event budget >= 1 */
-    long max_burst;         /* impacts of one accumulation before giving up, >= 1 */
-    double length_scale;    /* accumulation jumped once the bounce height is below
+    int impacts_only;    /* 1: with h_out > 0 the observer's P holds the impacts only */
+    int no_accumulation; /* 1: never jump an accumulation */
+    long max_events;     /* event budget >= 1 */
+    long max_burst;      /* impacts of one accumulation before giving up, >= 1 */
+    double length_scale; /* accumulation jumped once the bounce height is below
                                1e-10 * length_scale (> 0), as in pd_ed_opts */
-    double time_unit;       /* > 0: the model's unit of time in seconds, for messages */
-    pd_observer on_step;    /* optional: the state with its accelerations at t0, at the
+    double time_unit;    /* > 0: the model's unit of time in seconds, for messages */
+    pd_observer on_step; /* optional: the state with its accelerations at t0, at the
                                end of every accepted step, just before every event and
                                just after it (same t), whatever h_out */
     void *on_step_ctx;
-    pd_factor_kind factor;  /* storage of M */
+    pd_factor_kind factor;    /* storage of M */
     pd_lcp_method lcp_solver; /* the impact and contact-force LCPs */
 } pd_edg_opts;
 
@@ -338,8 +337,8 @@ PD_API pd_edg_opts pd_edg_default_opts(void);
 
 typedef struct pd_edg_result {
     long impacts, accumulations, detachments, events, steps;
-    double first_impact;    /* NAN when none */
-    double contact_time;    /* summed over contacts: time spent in persistent contact */
+    double first_impact; /* NAN when none */
+    double contact_time; /* summed over contacts: time spent in persistent contact */
 } pd_edg_result;
 
 /* Run the model from (t0, q0, v0) (NULL = zeros) to t1 (opts NULL: the
@@ -392,13 +391,13 @@ typedef struct pd_penalty_opts {
 PD_API pd_penalty_opts pd_penalty_default_opts(void);
 
 typedef struct pd_penalty_result {
-    long steps;    /* accepted steps */
-    long rhs;      /* right-hand-side evaluations (probes included) */
+    long steps; /* accepted steps */
+    long rhs;   /* right-hand-side evaluations (probes included) */
     double min_gap;
     double max_penetration_velocity; /* largest -W_a^T v while contact a is engaged */
-    long switches;       /* contact elements engaged or released (located crossings) */
-    const char *stepper; /* canonical GSL stepper name (static string) */
-    int diagonal_mass;   /* 1: M was diagonal and inverted entrywise (no factor) */
+    long switches;                   /* contact elements engaged or released (located crossings) */
+    const char *stepper;             /* canonical GSL stepper name (static string) */
+    int diagonal_mass;               /* 1: M was diagonal and inverted entrywise (no factor) */
 } pd_penalty_result;
 
 /* Integrate the model from (t0, q0, v0) to t1 (NULL = zeros; opts NULL: the
@@ -460,14 +459,14 @@ typedef struct pd_sdof_flow {
     pd_sdof osc;
     pd_sine_piece pc;
     double t0, u0, v0;
-    int fast;                /* 1: the cached form applies */
-    int constf;              /* 1: no ramp (c1 = 0): the constant's particular solution
+    int fast;           /* 1: the cached form applies */
+    int constf;         /* 1: no ramp (c1 = 0): the constant's particular solution
                                 folded into the sinusoid's, no series */
-    double a, wd, k0;        /* xi w0, the damped frequency, w0^2 */
-    double s0, c0;           /* sin, cos of the forcing phase at t0 */
-    double pre, pim;         /* A re / den, A im / den: the particular's amplitudes */
-    double vp0, c1, c2;      /* v_p(t0) and the homogeneous constants */
-    double f0, ur, vr;       /* the linear force at t0, its response's start state */
+    double a, wd, k0;   /* xi w0, the damped frequency, w0^2 */
+    double s0, c0;      /* sin, cos of the forcing phase at t0 */
+    double pre, pim;    /* A re / den, A im / den: the particular's amplitudes */
+    double vp0, c1, c2; /* v_p(t0) and the homogeneous constants */
+    double f0, ur, vr;  /* the linear force at t0, its response's start state */
 } pd_sdof_flow;
 PD_API void pd_sdof_flow_init(pd_sdof_flow *f, const pd_sdof *osc, const pd_sine_piece *pc,
                               double t0, double u0, double v0);
@@ -511,15 +510,15 @@ typedef enum { PD_EDR_IMPACT = 0, PD_EDR_DETACH = 1, PD_EDR_PIECE = 2 } pd_edr_k
 typedef struct pd_edr_event {
     double t;
     pd_edr_kind kind;
-    int ncontacts;         /* the contacts taken as closed (impact) or re-decided */
+    int ncontacts; /* the contacts taken as closed (impact) or re-decided */
     const int *contacts;
-    const double *P;       /* their impulses (impact) */
+    const double *P;                /* their impulses (impact) */
     const double *U_minus, *U_plus; /* their gap rates before and after */
-    int ndofs;             /* the dofs of the clusters involved */
+    int ndofs;                      /* the dofs of the clusters involved */
     const int *dofs;
     const double *v_minus, *v_plus; /* their velocities before and after */
-    const double *x;       /* their positions at t */
-    int accumulation;      /* an accumulation of impacts was jumped here */
+    const double *x;                /* their positions at t */
+    int accumulation;               /* an accumulation of impacts was jumped here */
 } pd_edr_event;
 
 typedef int (*pd_edr_event_fn)(const pd_edr_event *ev, void *ctx);
@@ -535,24 +534,24 @@ typedef int (*pd_edr_event_fn)(const pd_edr_event *ev, void *ctx);
 typedef enum { PD_IMPACT_STAGED = 0, PD_IMPACT_SINGLE = 1 } pd_impact_law;
 
 typedef struct pd_edr_opts {
-    double close_tol;      /* at an impact, contacts with gap <= close_tol * length_scale
+    double close_tol;         /* at an impact, contacts with gap <= close_tol * length_scale
                               are closed too (one LCP); >= 0 */
-    double length_scale;   /* > 0: the scene's length (1 in the reference units) */
-    double time_unit;      /* > 0: the model's unit of time in seconds (1 / wp for a
+    double length_scale;      /* > 0: the scene's length (1 in the reference units) */
+    double time_unit;         /* > 0: the model's unit of time in seconds (1 / wp for a
                               scene), for the times the messages give */
-    double t_measure;      /* extremes count from here */
-    double h_out;          /* > 0: the observer every h_out from t0 (and at t1); its
+    double t_measure;         /* extremes count from here */
+    double h_out;             /* > 0: the observer every h_out from t0 (and at t1); its
                               state's P: each contact's impulse since the last
                               output, the impacts' plus its held force integrated */
-    int impacts_only;      /* 1: the outputs' P hold the impacts only (cheaper) */
-    const int *below;      /* NULL, or n: the dof whose displacement is subtracted for the
+    int impacts_only;         /* 1: the outputs' P hold the impacts only (cheaper) */
+    const int *below;         /* NULL, or n: the dof whose displacement is subtracted for the
                               drift of dof i (-1: the ground) */
-    int no_accumulation;   /* 1: never jump an accumulation */
-    int inactive;          /* 1: contacts are measured (gaps) but never act (free twins) */
-    long max_events;       /* impacts, detachments and piece changes >= 1 */
-    long max_burst;        /* impacts of one contact before it rests or leaves, >= 1 */
-    double max_evals;      /* flight evaluations (the cost) before PD_EBUDGET, >= 1 */
-    int scan_divisions;    /* scan step: shortest period / this, >= 1 */
+    int no_accumulation;      /* 1: never jump an accumulation */
+    int inactive;             /* 1: contacts are measured (gaps) but never act (free twins) */
+    long max_events;          /* impacts, detachments and piece changes >= 1 */
+    long max_burst;           /* impacts of one contact before it rests or leaves, >= 1 */
+    double max_evals;         /* flight evaluations (the cost) before PD_EBUDGET, >= 1 */
+    int scan_divisions;       /* scan step: shortest period / this, >= 1 */
     pd_lcp_method lcp_solver; /* the LCPs on the dofs (a modal cluster takes part, or more
                                  than 64 contacts between clusters); the clusters' own
                                  LCPs are Lemke's */
@@ -572,9 +571,9 @@ PD_API pd_edr_opts pd_edr_default_opts(void);
 typedef struct pd_edr_result {
     long events, impacts, simultaneous, tol_closed, accumulations, detachments;
     long lcp_solves;
-    long modal_bases;      /* cluster configurations diagonalised */
-    double evals;          /* flight evaluations */
-    double first_impact;   /* NAN: none */
+    long modal_bases;    /* cluster configurations diagonalised */
+    double evals;        /* flight evaluations */
+    double first_impact; /* NAN: none */
     double t_reached;
     double max_penetration; /* deepest gap below zero the measurement found (rounding) */
     /* per dof (n), over [t_measure, t1]: */
@@ -586,7 +585,7 @@ typedef struct pd_edr_result {
     const double *max_impulse;  /* largest impulse of one event */
     const double *contact_time; /* time persistent */
     const double *min_gap;      /* smallest gap (0 once closed) */
-    long law_decided;      /* impacts whose LCP could take several closed contacts, one
+    long law_decided;           /* impacts whose LCP could take several closed contacts, one
                               closing (separating ones included): where the staged and
                               single impact laws may differ */
 } pd_edr_result;
@@ -629,25 +628,25 @@ PD_API const pd_edr_result *pd_edr_result_of(const pd_edr *r);
 
 typedef struct pd_ed_sdof {
     pd_sdof osc;
-    int wall;       /* 0: no wall (the free twin) */
-    double delta;   /* wall at x = delta >= 0 */
-    double e;       /* Newton restitution in [0, 1] */
-    int npieces;    /* >= 1; pieces[0].t_start is the start time, starts
+    int wall;     /* 0: no wall (the free twin) */
+    double delta; /* wall at x = delta >= 0 */
+    double e;     /* Newton restitution in [0, 1] */
+    int npieces;  /* >= 1; pieces[0].t_start is the start time, starts
                        non-decreasing and finite (PD_EINVAL otherwise) */
     const pd_sine_piece *pieces;
 } pd_ed_sdof;
 
 typedef struct pd_ed_opts {
     double t_end;
-    double t_measure;     /* extremes count from here on */
-    double h_out;         /* > 0: sampler at t_start + k h_out */
-    int no_accumulation;  /* 1: never jump an accumulation (shows the stall) */
-    long max_events;      /* event budget >= 1 */
-    long max_burst;       /* impacts in one accumulation before giving up, >= 1 */
-    double length_scale;  /* an accumulation is jumped once its bounce height
+    double t_measure;    /* extremes count from here on */
+    double h_out;        /* > 0: sampler at t_start + k h_out */
+    int no_accumulation; /* 1: never jump an accumulation (shows the stall) */
+    long max_events;     /* event budget >= 1 */
+    long max_burst;      /* impacts in one accumulation before giving up, >= 1 */
+    double length_scale; /* an accumulation is jumped once its bounce height
                              v+^2 / (2 a) is below 1e-10 * length_scale (> 0):
                              the motion left out stays that close to the wall */
-    int scan_divisions;   /* bracketing grid: shortest period / this, >= 1 */
+    int scan_divisions;  /* bracketing grid: shortest period / this, >= 1 */
     /* optional: every impact at t with the approach speed vn and the rebound
      * -e vn (before an accumulation jumped or a rest begins) */
     void (*on_impact)(double t, double vn, double v_plus, void *ctx);
@@ -659,12 +658,12 @@ typedef struct pd_ed_opts {
 PD_API pd_ed_opts pd_ed_default_opts(void);
 
 typedef struct pd_ed_result {
-    double xmax, xtoward, xaway;  /* max |x|, max x, max -x over the window */
+    double xmax, xtoward, xaway; /* max |x|, max x, max -x over the window */
     long impacts, accumulations, detachments, events;
     double first_impact, first_impact_velocity, max_impact_velocity; /* NAN: none */
-    double contact_time;          /* time spent resting on the wall */
-    double t_reached;             /* where the run stopped (t_end unless it failed) */
-    double impulse;               /* sum of the impacts' impulses (1 + e) vn per unit mass */
+    double contact_time; /* time spent resting on the wall */
+    double t_reached;    /* where the run stopped (t_end unless it failed) */
+    double impulse;      /* sum of the impacts' impulses (1 + e) vn per unit mass */
 } pd_ed_result;
 
 /* Called on the output grid with the exact state; return > 0 to stop. */

@@ -20,8 +20,8 @@ typedef struct pd_factor pd_factor;
 typedef struct pd_factor_type {
     const char *name;
     pd_factor_kind kind;
-    int (*setup)(pd_factor *f, pd_err *err);           /* form and factor, precompute */
-    void (*solve)(const pd_factor *f, double *x);      /* x = What^-1 x */
+    int (*setup)(pd_factor *f, pd_err *err);      /* form and factor, precompute */
+    void (*solve)(const pd_factor *f, double *x); /* x = What^-1 x */
     void (*add_impulse)(const pd_factor *f, const int *idx, int nI, const double *P, double *v);
     /* D_II into a dense nI x nI column-major array */
     void (*delassus_dense)(const pd_factor *f, const int *idx, int nI, double *D);
@@ -50,7 +50,10 @@ pd_factor *pd_factor_alloc(const pd_model *model, double h, double theta, pd_fac
                            pd_err *err);
 void pd_factor_free(pd_factor *f);
 
-static inline void pd_factor_solve(const pd_factor *f, double *x) { f->type->solve(f, x); }
+static inline void pd_factor_solve(const pd_factor *f, double *x)
+{
+    f->type->solve(f, x);
+}
 static inline void pd_factor_add_impulse(const pd_factor *f, const int *idx, int nI,
                                          const double *P, double *v)
 {

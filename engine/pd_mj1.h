@@ -35,9 +35,13 @@ static inline mj1_coef mj1_coef_make(double M, double C, double K, int wall, dou
                                      double e, double h, double th)
 {
     double what = M + h * th * C + h * h * th * th * K; /* What */
-    mj1_coef s = {.c = C, .k = K, .w = wall ? W : 0.0, .e = wall ? e : 0.0,
-                  .g0 = wall ? g0 : 0.0, .wall = wall != 0};
-    s.winv = s.w / what; /* W^ = W / What */
+    mj1_coef s = {.c = C,
+                  .k = K,
+                  .w = wall ? W : 0.0,
+                  .e = wall ? e : 0.0,
+                  .g0 = wall ? g0 : 0.0,
+                  .wall = wall != 0};
+    s.winv = s.w / what;       /* W^ = W / What */
     double del = s.w * s.winv; /* D = W W^ */
     s.whatinv = 1.0 / what;
     s.delinv = del != 0.0 ? 1.0 / del : 0.0; /* 1 / D, 0 without a wall */
@@ -61,9 +65,9 @@ static inline int mj1_step(double h, double th, double hgamma, const mj1_coef *s
     double q0 = *q, v0 = *v, imp = 0.0;
     double Fth = mj1_fth(th, F0, F1);
     double rhs = h * (Fth - s->c * v0 - s->k * (q0 + h * th * v0)); /* h (F_th - C v - K q_th) */
-    double vnew = v0 + rhs * s->whatinv; /* vfree */
-    double U0 = s->w * v0; /* U_k = W v_k */
-    int active = s->wall && *g + hgamma * U0 <= 0.0; /* g + h gamma U <= 0 */
+    double vnew = v0 + rhs * s->whatinv;                            /* vfree */
+    double U0 = s->w * v0;                                          /* U_k = W v_k */
+    int active = s->wall && *g + hgamma * U0 <= 0.0;                /* g + h gamma U <= 0 */
     if (active) {
         double b = s->w * vnew + s->e * U0; /* the scalar LCP, closed form */
         imp = b < 0.0 ? -b * s->delinv : 0.0;
@@ -149,13 +153,13 @@ static inline int mj_break_at(const double *breaks, int nbreaks, int *next, doub
 #define MJ1_FORCE_AHEAD 8 /* a power of 2 */
 
 typedef struct mj1_state {
-    double q, v, g;   /* the state at step */
-    double P;         /* the impulse of the last step */
-    double F0;        /* F(t_step +): the next step's force at its start */
-    double F1;        /* F(t_step -): the last step's force at its end */
-    long step;        /* steps taken */
-    int next_break;   /* the first force breakpoint not passed */
-    int active;       /* the last step's contact was active */
+    double q, v, g; /* the state at step */
+    double P;       /* the impulse of the last step */
+    double F0;      /* F(t_step +): the next step's force at its start */
+    double F1;      /* F(t_step -): the last step's force at its end */
+    long step;      /* steps taken */
+    int next_break; /* the first force breakpoint not passed */
+    int active;     /* the last step's contact was active */
 } mj1_state;
 
 /* F(t) from the left (side -1) or the right (+1). */

@@ -45,8 +45,11 @@ static inline const double *mj1_lanes_coef(const pd_mjb *b, int l)
 
 /* For each i < n (a constant once inlined: the statements' loops unroll,
  * so that the vectors' chains interleave and overlap). */
-#define MJ1_EACH(n, stmt)                                                  \
-    _Pragma("GCC unroll 8") for (int i = 0; i < (n); i++) { stmt; }
+#define MJ1_EACH(n, stmt)                                                                          \
+    _Pragma("GCC unroll 8") for (int i = 0; i < (n); i++)                                          \
+    {                                                                                              \
+        stmt;                                                                                      \
+    }
 
 /* pd_max and the minimum's a < b ? a : b, lane by lane (the x86 max and
  * min instructions are exactly these: the second operand when the two are
@@ -90,8 +93,8 @@ static inline lvec mj1_lanes_fth(double th, lvec F0, lvec F1)
  * Returns nonzero when a lane's contact may close (always without
  * unit_w). */
 static inline __attribute__((always_inline)) unsigned
-mj1_lanes_step(int n, const double *const *cs, double th, const lvec *h, const lvec *Fth,
-               lvec *q, lvec *v, lvec *g, lvec *P, int unit_w)
+mj1_lanes_step(int n, const double *const *cs, double th, const lvec *h, const lvec *Fth, lvec *q,
+               lvec *v, lvec *g, lvec *P, int unit_w)
 {
     const lvec zero = {0.0};
     const size_t W = MJ1_WIDTH; /* one constant's lanes in the group */
@@ -107,8 +110,8 @@ mj1_lanes_step(int n, const double *const *cs, double th, const lvec *h, const l
         /* g + h gamma U0 <= 0 with U0 = -v: (g0 - q) - (h gamma) v <= 0
          * to the bit; the impulses only when a lane's contact may close
          * (rare: in a step of none, P is +0 and v + (W/What) P is v) */
-        MJ1_EACH(n, active[i] = LLE((lload(cs[i] + 4 * W) - q[i]) - lload(cs[i] + 9 * W) * v[i],
-                                    zero))
+        MJ1_EACH(n,
+                 active[i] = LLE((lload(cs[i] + 4 * W) - q[i]) - lload(cs[i] + 9 * W) * v[i], zero))
         closing = 0;
         MJ1_EACH(n, closing |= lbits(active[i]))
         if (__builtin_expect(closing != 0, 0)) {

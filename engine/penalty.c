@@ -62,33 +62,33 @@ typedef struct pen {
     pd_penalty_opts o;
     const pen_stepper *stp;
     int n, m;
-    size_t dim;            /* 2 n */
-    pd_factor *fac;        /* M factored (What with h = 0); NULL when minv is used */
-    double *minv;          /* n: 1 / M_ii when M is diagonal (factor auto), else NULL */
-    double *cd;            /* m: damping constants c_a */
-    double *sa;            /* m: W_a^T M^-1 W_a (inverse effective masses) */
-    double vfloor;         /* smallest approach speed used by Hertz-damp */
-    double vseen;          /* largest approach speed at an engagement so far */
-    unsigned char *mode;   /* m: 1 = element engaged (the RHS is frozen to it) */
-    double seg_lo, seg_hi; /* the current force segment */
-    double *F, *lam, *col; /* n, m, n work */
-    double *Aq, *Av;       /* n x n: Jacobian blocks before M^-1 (implicit steppers only) */
+    size_t dim;               /* 2 n */
+    pd_factor *fac;           /* M factored (What with h = 0); NULL when minv is used */
+    double *minv;             /* n: 1 / M_ii when M is diagonal (factor auto), else NULL */
+    double *cd;               /* m: damping constants c_a */
+    double *sa;               /* m: W_a^T M^-1 W_a (inverse effective masses) */
+    double vfloor;            /* smallest approach speed used by Hertz-damp */
+    double vseen;             /* largest approach speed at an engagement so far */
+    unsigned char *mode;      /* m: 1 = element engaged (the RHS is frozen to it) */
+    double seg_lo, seg_hi;    /* the current force segment */
+    double *F, *lam, *col;    /* n, m, n work */
+    double *Aq, *Av;          /* n x n: Jacobian blocks before M^-1 (implicit steppers only) */
     double *y, *ya, *yt, *yo; /* dim: state, step start, trial, output */
-    double *ys;            /* dim: state before a GSL step (retries) */
-    double *ga, *Ua;       /* m: gaps and W^T v at the step start */
-    double *fa, *fb;       /* dim: y' at the step start and end under the step's engaged set */
-    double *fo;            /* dim: y' at the crossing state of the earliest crossing */
-    double *fp;            /* dim: y' at the end of the last probe (valid if probe_f) */
-    int probe_f;           /* the last probe ended with a step (fp is y' at its end) */
-    double *acc_work;      /* dim: y' for the accelerations of an on_step report */
+    double *ys;               /* dim: state before a GSL step (retries) */
+    double *ga, *Ua;          /* m: gaps and W^T v at the step start */
+    double *fa, *fb;          /* dim: y' at the step start and end under the step's engaged set */
+    double *fo;               /* dim: y' at the crossing state of the earliest crossing */
+    double *fp;               /* dim: y' at the end of the last probe (valid if probe_f) */
+    int probe_f;              /* the last probe ended with a step (fp is y' at its end) */
+    double *acc_work;         /* dim: y' for the accelerations of an on_step report */
     gsl_odeiv2_system sys;
     gsl_odeiv2_driver *main_drv, *probe_drv;
     pd_observer observer;
     void *obs_ctx;
-    double t_out0;         /* t0 (outputs at t0 + k h_out) */
-    long next_out;         /* k of the next output */
-    int stopped;           /* an observer asked to stop */
-    long stalled;          /* consecutive steps that did not advance t (PEN_STALL_REL) */
+    double t_out0; /* t0 (outputs at t0 + k h_out) */
+    long next_out; /* k of the next output */
+    int stopped;   /* an observer asked to stop */
+    long stalled;  /* consecutive steps that did not advance t (PEN_STALL_REL) */
     pd_state st;
     pd_penalty_result res;
 } pen;
@@ -211,9 +211,10 @@ static int alloc_arrays(pen *p)
     p->st.P = pd_calloc(m, sizeof(double));
     p->st.g = pd_calloc(m, sizeof(double));
     p->st.active = pd_calloc(m, 1);
-    return p->cd && p->sa && p->fa && p->fb && p->fo && p->fp && p->mode && p->F && p->lam && p->col && p->Aq && p->Av &&
-                   p->y && p->ya && p->yt && p->yo && p->ys && p->ga && p->Ua && p->st.q && p->st.acc && p->acc_work && p->st.v &&
-                   p->st.P && p->st.g && p->st.active
+    return p->cd && p->sa && p->fa && p->fb && p->fo && p->fp && p->mode && p->F && p->lam &&
+                   p->col && p->Aq && p->Av && p->y && p->ya && p->yt && p->yo && p->ys && p->ga &&
+                   p->Ua && p->st.q && p->st.acc && p->acc_work && p->st.v && p->st.P && p->st.g &&
+                   p->st.active
                ? PD_OK
                : PD_ENOMEM;
 }
@@ -273,8 +274,8 @@ static int setup_mass(pen *p, pd_err *err)
         p->sa[a] = s;
         if (!(s > 0.0) || !isfinite(s))
             return pd_err_set(err, PD_EINVAL,
-                              "penalty: contact %d has no effective mass (W_a^T M^-1 W_a = %g)",
-                              a, s);
+                              "penalty: contact %d has no effective mass (W_a^T M^-1 W_a = %g)", a,
+                              s);
         /* c_a = 2 zeta(e) sqrt(kc m_a); Hertz-damp's waits for the approach speed */
         if (p->o.law == PD_PENALTY_KELVIN)
             p->cd[a] = pd_kelvin_damping(p->o.kc, md->e[a], 1.0 / s);
@@ -440,8 +441,7 @@ static int alloc_drivers(pen *p, double span, pd_err *err)
     p->sys.params = p;
     /* error control on y: atol + rtol |y_i| per component */
     p->main_drv = gsl_odeiv2_driver_alloc_y_new(&p->sys, *p->stp->type, h0, p->o.atol, p->o.rtol);
-    p->probe_drv =
-        gsl_odeiv2_driver_alloc_y_new(&p->sys, *p->stp->probe, h0, p->o.atol, p->o.rtol);
+    p->probe_drv = gsl_odeiv2_driver_alloc_y_new(&p->sys, *p->stp->probe, h0, p->o.atol, p->o.rtol);
     if (!p->main_drv || !p->probe_drv)
         return pd_err_set(err, PD_ENOMEM, "penalty: out of memory for the GSL %s integrator",
                           p->stp->name);
@@ -449,7 +449,10 @@ static int alloc_drivers(pen *p, double span, pd_err *err)
 }
 
 /* Model time t in seconds, for messages. */
-static double seconds(const pen *p, double t) { return t * p->o.time_unit; }
+static double seconds(const pen *p, double t)
+{
+    return t * p->o.time_unit;
+}
 
 /* Map a GSL failure at time t to a pd status with a message. */
 static int gsl_failure(const pen *p, int status, double t, pd_err *err)
@@ -725,8 +728,8 @@ static int tolerable(const pen *p, int a, double dep, double r, double h)
     dep = fabs(dep);
     if (!(dep <= p->o.atol)) /* deeper than atol: located */
         return 0;
-    double lam = p->o.law == PD_PENALTY_KELVIN ? kc * dep + p->cd[a] * ar
-                                               : 1.75 * kc * dep * sqrt(dep);
+    double lam =
+        p->o.law == PD_PENALTY_KELVIN ? kc * dep + p->cd[a] * ar : 1.75 * kc * dep * sqrt(dep);
     double tw = ar > 0.0 ? fmin(h, dep / ar) : h; /* the time that deep */
     /* its velocity change s_a |lambda| tw within atol */
     return p->sa[a] * lam * tw <= p->o.atol;
@@ -765,16 +768,15 @@ static int phi_at(pen *p, int a, double ta, double s, double *f, double *df, pd_
  * probes until the state is within the tolerance of the crossing (tolerable)
  * or converged; *s gets the crossing, p->yt the state there (the last trial
  * is the answer). */
-static int locate_root(pen *p, int a, double ta, double hi, const double e0[3],
-                       const double e1[3], double h, double *s, pd_err *err)
+static int locate_root(pen *p, int a, double ta, double hi, const double e0[3], const double e1[3],
+                       double h, double *s, pd_err *err)
 {
     double lo = 0.0, x = hi, f, df, d;
     int use5 = quintic(e0, e1, h, hi, &d) < 0.0; /* else the cubic */
     int rc;
     for (int it = 0; it < 60; it++) { /* the interpolant's root in [lo, x] by bisection */
         double mid = 0.5 * (lo + x);
-        double v = use5 ? quintic(e0, e1, h, mid, &d)
-                        : hermite(e0[0], e0[1], e1[0], e1[1], h, mid);
+        double v = use5 ? quintic(e0, e1, h, mid, &d) : hermite(e0[0], e0[1], e1[0], e1[1], h, mid);
         *(v < 0.0 ? &x : &lo) = mid;
     }
     lo = 0.0;
@@ -960,7 +962,7 @@ static int one_step(pen *p, double *t, double tb, double *h, pd_err *err)
     }
     if (switched)
         track_extremes(p, 0.0); /* after the switch */
-    if (which >= 0) { /* the step was cut: its stepper restarts from the crossing */
+    if (which >= 0) {           /* the step was cut: its stepper restarts from the crossing */
         gsl_odeiv2_evolve_reset(d->e);
         gsl_odeiv2_step_reset(d->s);
     }
@@ -1010,8 +1012,7 @@ static int run_segments(pen *p, double t0, double t1, pd_err *err)
             return rc;
     }
     /* the grid's last point at t1 when it fell short */
-    if (p->observer && p->o.h_out > 0.0 && !p->stopped &&
-        out_time(p, p->next_out - 1) < t1 - tol) {
+    if (p->observer && p->o.h_out > 0.0 && !p->stopped && out_time(p, p->next_out - 1) < t1 - tol) {
         fill_state(p, t1, p->y);
         notify(p, p->observer, p->obs_ctx);
     }
@@ -1045,8 +1046,8 @@ static int start(pen *p, double t0, const double *q0, const double *v0, pd_err *
     return PD_OK;
 }
 
-int pd_penalty_run(const pd_model *model, double t0, const double *q0, const double *v0,
-                   double t1, const pd_penalty_opts *opts, pd_observer observer, void *ctx,
+int pd_penalty_run(const pd_model *model, double t0, const double *q0, const double *v0, double t1,
+                   const pd_penalty_opts *opts, pd_observer observer, void *ctx,
                    pd_penalty_result *res, pd_err *err)
 {
     pen p;
@@ -1069,8 +1070,7 @@ int pd_penalty_run(const pd_model *model, double t0, const double *q0, const dou
         p.dim = 2 * (size_t)model->n; /* y = (q, v) */
         p.res.stepper = p.stp->name;
         if (alloc_arrays(&p))
-            rc = pd_err_set(err, PD_ENOMEM, "penalty: out of memory for n = %d, m = %d", p.n,
-                            p.m);
+            rc = pd_err_set(err, PD_ENOMEM, "penalty: out of memory for n = %d, m = %d", p.n, p.m);
         if (!rc && !(rc = setup_mass(&p, err)) && !(rc = alloc_drivers(&p, t1 - t0, err)) &&
             !(rc = start(&p, t0, q0, v0, err)))
             rc = run_segments(&p, t0, t1, err);

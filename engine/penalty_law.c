@@ -25,8 +25,7 @@ int pd_penalty_check_opts(const pd_penalty_opts *o, double t0, double t1, const 
     if (o->max_steps < 1)
         return pd_err_set(err, PD_EINVAL, "%s: max_steps must be >= 1", who);
     if (!(o->time_unit > 0.0) || !isfinite(o->time_unit))
-        return pd_err_set(err, PD_EINVAL, "%s: time_unit must be > 0 (got %g)", who,
-                          o->time_unit);
+        return pd_err_set(err, PD_EINVAL, "%s: time_unit must be > 0 (got %g)", who, o->time_unit);
     /* a run of no length (t1 = t0) is allowed */
     if (!isfinite(t0) || !isfinite(t1) || t1 < t0)
         return pd_err_set(err, PD_EINVAL, "%s: need finite t0 <= t1 (got %g, %g)", who, t0, t1);

@@ -30,16 +30,14 @@ static inline double pd_kelvin_damping(double kc, double e, double m_eff)
 /* The Hertz-damp damping constant for the approach speed vimp, floored at
  * vfloor and at 1e-3 of the largest approach speed seen (a grazing contact
  * must not get an unbounded constant). */
-static inline double pd_hertz_damping(double kc, double e, double vimp, double vfloor,
-                                      double vseen)
+static inline double pd_hertz_damping(double kc, double e, double vimp, double vfloor, double vseen)
 {
     /* 3 kc (1 - e^2) / (4 v) */
     return 0.75 * kc * (1.0 - e * e) / fmax(vimp, fmax(vfloor, 1e-3 * vseen));
 }
 
 /* The element force: KV kc d + c d'; Hertz-damp d^1.5 (kc + c d'), 0 for d <= 0. */
-static inline double pd_penalty_force(pd_penalty_law law, double kc, double c, double d,
-                                      double dd)
+static inline double pd_penalty_force(pd_penalty_law law, double kc, double c, double d, double dd)
 {
     /* Kelvin-Voigt acts on both sides of d = 0 (the engaged set decides where);
      * Hertz-damp's d^1.5 is 0 for d <= 0 */

@@ -42,15 +42,15 @@ typedef struct nm_run {
     pd_penalty_opts o;
     int n, m;
     double h, qscale;
-    pd_factor *fac;   /* What at theta = 1/2 */
-    pd_factor *mass;  /* M (the accelerations at t0 and at breakpoints) */
+    pd_factor *fac;  /* What at theta = 1/2 */
+    pd_factor *mass; /* M (the accelerations at t0 and at breakpoints) */
     double *q0, *v0, *a0, *q, *v, *b, *r, *y, *F, *F2, *tmp; /* n */
     double *lam, *kt, *cd, *mu, *s;                          /* m */
-    unsigned char *eng, *eng_prev, *eng_step;                /* m: engaged now, last iterate, at t0 */
-    int frozen;       /* this step's engaged set no longer follows d (see step) */
-    int *idx;                                                 /* m */
-    double *D;                                                /* NM_MAX_ACTIVE^2 */
-    int *perm;                                                /* NM_MAX_ACTIVE */
+    unsigned char *eng, *eng_prev, *eng_step; /* m: engaged now, last iterate, at t0 */
+    int frozen; /* this step's engaged set no longer follows d (see step) */
+    int *idx;   /* m */
+    double *D;  /* NM_MAX_ACTIVE^2 */
+    int *perm;  /* NM_MAX_ACTIVE */
     double vfloor, vseen;
     pd_state st;
     pd_penalty_result res;
@@ -61,8 +61,8 @@ static void nm_free(nm_run *w)
 {
     pd_factor_free(w->fac);
     pd_factor_free(w->mass);
-    double *dbl[] = {w->q0, w->v0, w->a0, w->q, w->v, w->b, w->r, w->y, w->F, w->F2, w->tmp,
-                     w->lam, w->kt, w->cd, w->mu, w->s, w->D, w->st.g, w->st.acc};
+    double *dbl[] = {w->q0,  w->v0,  w->a0, w->q,  w->v,  w->b, w->r, w->y,    w->F,     w->F2,
+                     w->tmp, w->lam, w->kt, w->cd, w->mu, w->s, w->D, w->st.g, w->st.acc};
     for (size_t k = 0; k < sizeof dbl / sizeof dbl[0]; k++)
         free(dbl[k]);
     free(w->eng);
@@ -78,8 +78,8 @@ static int nm_alloc(nm_run *w)
 {
     size_t n = (size_t)w->n;
     int m = w->m, na = m < NM_MAX_ACTIVE ? m : NM_MAX_ACTIVE;
-    double **dn[] = {&w->q0, &w->v0, &w->a0, &w->q, &w->v, &w->b, &w->r, &w->y, &w->F, &w->F2,
-                     &w->tmp, &w->st.acc};
+    double **dn[] = {&w->q0, &w->v0, &w->a0, &w->q,  &w->v,   &w->b,
+                     &w->r,  &w->y,  &w->F,  &w->F2, &w->tmp, &w->st.acc};
     double **dm[] = {&w->lam, &w->kt, &w->cd, &w->mu, &w->s, &w->st.g};
     int ok = 1;
     for (size_t k = 0; k < sizeof dn / sizeof dn[0]; k++)
@@ -113,7 +113,7 @@ static void elements(nm_run *w, const double *q, const double *v, const double *
     const pd_model *md = w->md;
     for (int a = 0; a < w->m; a++) {
         double d = -(md->g0[a] + pd_matrix_col_dot(&md->W, a, q)); /* d = -g_a */
-        double dd = -pd_matrix_col_dot(&md->W, a, v); /* d' = -U_a */
+        double dd = -pd_matrix_col_dot(&md->W, a, v);              /* d' = -U_a */
         /* engaged where d > 0, unless the set is frozen for the step */
         if (!w->frozen)
             w->eng[a] = d > 0.0;
@@ -231,7 +231,7 @@ static int step(nm_run *w, double t1, int at_break, pd_err *err)
     for (int i = 0; i < n; i++)
         w->tmp[i] = 0.5 * h * w->q0[i] + g4 * w->v0[i];
     pd_matrix_gemv(&md->C, 1.0, w->tmp, 1.0, w->b);
-    force_at(w, t1, -1, w->F); /* F1 = F(t1-) */
+    force_at(w, t1, -1, w->F);  /* F1 = F(t1-) */
     for (int i = 0; i < n; i++) /* predictor: a1 = a0 */
         w->q[i] = w->q0[i] + h * w->v0[i] + 2.0 * g4 * w->a0[i];
     int it, done = 0;
@@ -346,8 +346,8 @@ static int nm_start(nm_run *w, double t0, const double *q0, const double *v0, pd
         pd_factor_delassus_dense(w->mass, &a, 1, &s);
         if (!(s > 0.0) || !isfinite(s))
             return pd_err_set(err, PD_EINVAL,
-                              "newmark: contact %d has no effective mass (W_a^T M^-1 W_a = %g)",
-                              a, s);
+                              "newmark: contact %d has no effective mass (W_a^T M^-1 W_a = %g)", a,
+                              s);
         if (w->o.law == PD_PENALTY_KELVIN)
             w->cd[a] = pd_kelvin_damping(w->o.kc, md->e[a], 1.0 / s);
         w->qscale = fmax(w->qscale, fabs(md->g0[a])); /* Newton's scale: gaps and q */
@@ -388,8 +388,7 @@ int pd_penalty_newmark(const pd_model *model, double t0, const double *q0, const
         w.m = model->m;
         w.h = w.o.h;
         if (nm_alloc(&w))
-            rc = pd_err_set(err, PD_ENOMEM, "newmark: out of memory for n = %d, m = %d", w.n,
-                            w.m);
+            rc = pd_err_set(err, PD_ENOMEM, "newmark: out of memory for n = %d, m = %d", w.n, w.m);
     }
     if (!rc && !(rc = nm_start(&w, t0, q0, v0, err))) {
         long nsteps = pd_steps_for(t1 - t0, w.h), every = 1, k;
@@ -402,8 +401,7 @@ int pd_penalty_newmark(const pd_model *model, double t0, const double *q0, const
         for (k = 1; k <= nsteps && !rc && !w.stopped; k++) {
             /* fixed steps (What holds h): step k ends at t0 + k h, the last at t1 */
             double tb = k == nsteps ? t1 : t0 + (double)k * w.h;
-            int at_break = mj_break_at(model->breaks, model->nbreaks, &next_break, tb,
-                                       1e-9 * w.h);
+            int at_break = mj_break_at(model->breaks, model->nbreaks, &next_break, tb, 1e-9 * w.h);
             if (!(rc = step(&w, tb, at_break, err))) {
                 report(&w, k, tb, w.o.on_step, w.o.on_step_ctx);
                 if (k % every == 0 || k == nsteps)

@@ -90,8 +90,8 @@ static kernels kernels_at(const pd_sdof *osc, double h)
 }
 
 /* Free mass (w0 = 0): du = v0 s + the double integral of A sin(w t + phi). */
-static void free_mass(double A, double w, double phi, double t0, double v0, double t1,
-                      double *du, double *v1)
+static void free_mass(double A, double w, double phi, double t0, double v0, double t1, double *du,
+                      double *v1)
 {
     double s = t1 - t0;
     if (w == 0.0) { /* constant force A sin(phi) */
@@ -140,8 +140,8 @@ static void particular(const pd_sdof *osc, double A, double w, double phi, doubl
 
 /* Response to A sin(w t + phi) from (u0, v0): particular solution plus the
  * damped homogeneous part e^{-a s}(c1 cos wd s + c2 sin wd s) minus its start c1. */
-static void sine_increment(const pd_sdof *osc, double A, double w, double phi, double t0,
-                           double u0, double v0, double t1, double *du, double *v1)
+static void sine_increment(const pd_sdof *osc, double A, double w, double phi, double t0, double u0,
+                           double v0, double t1, double *du, double *v1)
 {
     if (osc->w0 == 0.0) {
         free_mass(A, w, phi, t0, v0, t1, du, v1);
@@ -154,15 +154,15 @@ static void sine_increment(const pd_sdof *osc, double A, double w, double phi, d
     double c1 = u0 - up0, c2 = (v0 - vp0 + a * c1) / wd;
     double s = t1 - t0, em1 = expm1(-a * s), ex = 1.0 + em1;
     double cs = cos(wd * s), sn = sin(wd * s), half = sin(0.5 * wd * s);
-    double cs_m1 = -2.0 * half * half; /* cos - 1 */
+    double cs_m1 = -2.0 * half * half;                  /* cos - 1 */
     double dh = c1 * (em1 * cs + cs_m1) + c2 * ex * sn; /* e^{-a s}(c1 cos + c2 sin) - c1 */
     *du = dup + dh;
     *v1 = vp0 + dvp + ex * ((c2 * wd - a * c1) * cs - (c1 * wd + a * c2) * sn);
 }
 
 /* Response to f0 + c1 s from (u0, v0) over h (Duhamel with g, G1, G2). */
-static void ramp_increment(const pd_sdof *osc, double f0, double c1, double u0, double v0,
-                           double h, double *du, double *v1)
+static void ramp_increment(const pd_sdof *osc, double f0, double c1, double u0, double v0, double h,
+                           double *du, double *v1)
 {
     kernels k = kernels_at(osc, h);
     double k0 = osc->w0 * osc->w0, a2 = osc->w0 > 0.0 ? 2.0 * osc->xi * osc->w0 : 0.0;

@@ -13,8 +13,8 @@ double pd_lcp_max_abs(int n, const double *x);
 void pd_lcp_verify(const pd_matrix *M, const double *q, const double *z, double *w, double *rows,
                    pd_lcp_info *info);
 /* The same with zs = max|z| given (a solver that made z knows it). */
-void pd_lcp_verify_zs(const pd_matrix *M, const double *q, const double *z, double *w,
-                      double *rows, double zs, pd_lcp_info *info);
+void pd_lcp_verify_zs(const pd_matrix *M, const double *q, const double *z, double *w, double *rows,
+                      double zs, pd_lcp_info *info);
 
 /* The structured solver (structured.c): block principal pivoting and an
  * interior point on L D L^T factors of M_FF, an envelope of at most envmax
@@ -30,8 +30,7 @@ int pd_bpp_solve(pd_bpp_work *ws, const pd_matrix *M, const double *q, const pd_
  * compressed columns, tridiagonal, symmetric, with a positive diagonal and
  * off-diagonal entries <= 0 (or n > nmax), -1 when a pivot is not positive
  * (a singular principal block).  z is clamped at 0, *zs = max z. */
-int pd_bpp_stieltjes(pd_bpp_work *ws, const pd_matrix *M, const double *q, double *z,
-                     double *zs);
+int pd_bpp_stieltjes(pd_bpp_work *ws, const pd_matrix *M, const double *q, double *z, double *zs);
 
 /* Projected Gauss-Seidel (pgs.c). */
 typedef struct pd_pgs_work pd_pgs_work;

@@ -41,9 +41,9 @@ typedef struct lcp_cursor {
 /* The file's text. */
 typedef struct lcp_text {
     const char *path;
-    char *buf;       /* file contents + NUL (no NUL inside) */
+    char *buf; /* file contents + NUL (no NUL inside) */
     size_t len;
-    int last_line;   /* line of the end of the file */
+    int last_line; /* line of the end of the file */
 } lcp_text;
 
 /* Whole file into t->buf (NUL-terminated, no NUL inside: pd_text_read_all). */
@@ -120,8 +120,7 @@ static int token_integer(const lcp_token *tk, long *v)
 }
 
 /* The next token as a finite double (the count was checked: it exists). */
-static int token_number(const lcp_text *t, lcp_cursor *c, const char *what, double *x,
-                        pd_err *err)
+static int token_number(const lcp_text *t, lcp_cursor *c, const char *what, double *x, pd_err *err)
 {
     /* the end of the file if no token were left (the count was checked) */
     lcp_token tk = {.text = t->buf + t->len, .line = t->last_line};
@@ -136,8 +135,8 @@ static int token_number(const lcp_text *t, lcp_cursor *c, const char *what, doub
     /* inf, nan and overflow refused; an underflow (ERANGE
      * with |v| <= 1) is kept as strtod rounds it */
     if (isnan(v) || isinf(v) || (errno == ERANGE && fabs(v) > 1.0))
-        return pd_err_set(err, PD_EPARSE, "%s: line %d: %s: '%.*s' is not a finite number",
-                          t->path, tk.line, what, shown(&tk), tk.text);
+        return pd_err_set(err, PD_EPARSE, "%s: line %d: %s: '%.*s' is not a finite number", t->path,
+                          tk.line, what, shown(&tk), tk.text);
     *x = v;
     return PD_OK;
 }
@@ -171,7 +170,8 @@ static int check_count(const lcp_text *t, lcp_cursor c, int n, pd_err *err)
         return PD_OK;
     return pd_err_set(err, PD_EPARSE,
                       "%s: line %d: too few values: the file ends after %zu of the %zu numbers "
-                      "of M and q (n = %d)", t->path, t->last_line, have, need, n);
+                      "of M and q (n = %d)",
+                      t->path, t->last_line, have, need, n);
 }
 
 /* Allocate M and q. */
@@ -244,7 +244,8 @@ static int check_nothing_after(const lcp_text *t, lcp_cursor c, int n, pd_err *e
         return PD_OK;
     return pd_err_set(err, PD_EPARSE,
                       "%s: line %d: unexpected value '%.*s' after q (n = %d needs exactly "
-                      "%zu numbers)", t->path, tk.line, shown(&tk), tk.text, n, need + 1);
+                      "%zu numbers)",
+                      t->path, tk.line, shown(&tk), tk.text, n, need + 1);
 }
 
 /* plain: n, M row by row, q, and nothing more. */
@@ -252,8 +253,8 @@ static int read_plain(const lcp_text *t, lcp_cursor c, int *n, double **M, doubl
                       lcp_band *band, pd_err *err)
 {
     if (count_tokens(t, c, 1) == 0)
-        return pd_err_set(err, PD_EPARSE, "%s: line %d: empty file, expected the size n",
-                          t->path, t->last_line);
+        return pd_err_set(err, PD_EPARSE, "%s: line %d: empty file, expected the size n", t->path,
+                          t->last_line);
     /* every check before the allocation: a malformed file costs no n^2 memory */
     int st = token_size(t, &c, "size n", n, err);
     if (st == PD_OK)
@@ -276,17 +277,23 @@ static int check_siconos_header(const lcp_text *t, lcp_cursor *c, int n, pd_err 
     long v = 0;
     for (int k = 0; k < 5; k++)
         if (!next_token(t, c, &tk[k]))
-            return pd_err_set(err, PD_EPARSE, "%s: line %d: file ends inside the Siconos header "
-                              "(n, storage, rows, cols, rows cols)", t->path, t->last_line);
+            return pd_err_set(err, PD_EPARSE,
+                              "%s: line %d: file ends inside the Siconos header "
+                              "(n, storage, rows, cols, rows cols)",
+                              t->path, t->last_line);
     /* storage 0: dense */
     if (!token_integer(&tk[0], &v) || v != 0)
-        return pd_err_set(err, PD_EPARSE, "%s: line %d: storage '%.*s' is not supported "
-                          "(only 0 = dense)", t->path, tk[0].line, shown(&tk[0]), tk[0].text);
+        return pd_err_set(err, PD_EPARSE,
+                          "%s: line %d: storage '%.*s' is not supported "
+                          "(only 0 = dense)",
+                          t->path, tk[0].line, shown(&tk[0]), tk[0].text);
     /* rows, cols, and "rows cols": all n */
     for (int k = 1; k < 5; k++)
         if (!token_integer(&tk[k], &v) || v != n)
-            return pd_err_set(err, PD_EPARSE, "%s: line %d: matrix dimension '%.*s' does not "
-                              "match n = %d", t->path, tk[k].line, shown(&tk[k]), tk[k].text, n);
+            return pd_err_set(err, PD_EPARSE,
+                              "%s: line %d: matrix dimension '%.*s' does not "
+                              "match n = %d",
+                              t->path, tk[k].line, shown(&tk[k]), tk[k].text, n);
     return PD_OK;
 }
 
@@ -295,8 +302,8 @@ static int read_siconos(const lcp_text *t, lcp_cursor c, int *n, double **M, dou
                         lcp_band *band, pd_err *err)
 {
     if (count_tokens(t, c, 1) == 0)
-        return pd_err_set(err, PD_EPARSE, "%s: line %d: empty file, expected the size n",
-                          t->path, t->last_line);
+        return pd_err_set(err, PD_EPARSE, "%s: line %d: empty file, expected the size n", t->path,
+                          t->last_line);
     /* header and count checked before the allocation; free text may follow q */
     int st = token_size(t, &c, "size n", n, err);
     if (st == PD_OK)
@@ -324,8 +331,8 @@ static int looks_siconos(const lcp_text *t, lcp_cursor c)
         if (!next_token(t, &c, &tk[k]) || !token_integer(&tk[k], &v[k]))
             return 0;
     /* the first four on lines of their own, the last two on one line */
-    int lines_ok = tk[0].line < tk[1].line && tk[1].line < tk[2].line &&
-                   tk[2].line < tk[3].line && tk[3].line < tk[4].line && tk[4].line == tk[5].line;
+    int lines_ok = tk[0].line < tk[1].line && tk[1].line < tk[2].line && tk[2].line < tk[3].line &&
+                   tk[3].line < tk[4].line && tk[4].line == tk[5].line;
     if (!lines_ok || v[0] <= 0 || v[0] > READ_NMAX || v[2] != v[4] || v[3] != v[5])
         return 0;
     size_t plain_count = 1 + (size_t)v[0] * (size_t)v[0] + (size_t)v[0];
@@ -333,8 +340,7 @@ static int looks_siconos(const lcp_text *t, lcp_cursor c)
     return plain_count < 6 || 6 + count_tokens(t, c, plain_count - 5) != plain_count;
 }
 
-int pd_lcp_read(const char *path, pd_lcp_format format, int *n, double **M, double **q,
-                pd_err *err)
+int pd_lcp_read(const char *path, pd_lcp_format format, int *n, double **M, double **q, pd_err *err)
 {
     return pd_lcp_read_band(path, format, n, M, q, NULL, NULL, err);
 }
@@ -388,7 +394,7 @@ long pd_lcp_band_csc(int n, const double *M, int band, long cap, int *colptr, in
         colptr[j] = (int)k;
         for (int i = lo; i <= hi; i++)
             if (c[i] != 0.0) { /* true for a NaN */
-                if (k == cap) /* more entries than the copy holds */
+                if (k == cap)  /* more entries than the copy holds */
                     return PD_EINVAL;
                 rowind[k] = i;
                 values[k++] = c[i];

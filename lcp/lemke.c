@@ -20,20 +20,20 @@
 #include "lcp_internal.h"
 #include "pd_lcp.h"
 
-#define LEMKE_TOL_DEFAULT 1e-12   /* relative tolerance for ties and tiny pivots */
+#define LEMKE_TOL_DEFAULT 1e-12            /* relative tolerance for ties and tiny pivots */
 #define LEMKE_VERIFY_TOL PD_LCP_VERIFY_TOL /* relative backward residual of a solved answer */
-#define LEMKE_CAP_MIN 10000       /* default pivot cap: max(LEMKE_CAP_MIN, ... */
-#define LEMKE_CAP_PER_N 100       /* ... LEMKE_CAP_PER_N * n) */
-#define LEMKE_REFINE_EVERY 50     /* pivots between two refinements of x_B */
-#define LEMKE_FINAL_REFINES 2     /* at most this many refinements of x_B at the end */
-#define LEMKE_NMAX_LIMIT 46340    /* n*n must fit an int */
-#define LEMKE_SINGULAR_TOL 1e-14  /* relative pivot floor of the final polish */
-#define LEMKE_REPAIR_ROUNDS 8     /* principal solves of the final repair at most */
-#define LEMKE_SMALL_N 4           /* up to this n, a column of B^-1 in one vector */
+#define LEMKE_CAP_MIN 10000                /* default pivot cap: max(LEMKE_CAP_MIN, ... */
+#define LEMKE_CAP_PER_N 100                /* ... LEMKE_CAP_PER_N * n) */
+#define LEMKE_REFINE_EVERY 50              /* pivots between two refinements of x_B */
+#define LEMKE_FINAL_REFINES 2              /* at most this many refinements of x_B at the end */
+#define LEMKE_NMAX_LIMIT 46340             /* n*n must fit an int */
+#define LEMKE_SINGULAR_TOL 1e-14           /* relative pivot floor of the final polish */
+#define LEMKE_REPAIR_ROUNDS 8              /* principal solves of the final repair at most */
+#define LEMKE_SMALL_N 4                    /* up to this n, a column of B^-1 in one vector */
 /* GNU C vectors of four lanes for n <= LEMKE_SMALL_N where the pivoting loop
  * has an AVX2 build (LEMKE_KERNEL below), when the processor has AVX2;
  * -DLEMKE_NO_VECTORS leaves every n to the general code. */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) &&  \
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) &&       \
     !defined(LEMKE_NO_VECTORS)
 #define LEMKE_VECTORS 1
 #endif
@@ -57,12 +57,12 @@ struct pd_lcp_work {
 /* Everything one solve reads: data, options, workspace. */
 typedef struct lemke_state {
     int n;
-    int ld;            /* leading dimension of B^-1: n, or LEMKE_SMALL_N in vectors */
-    int vec;           /* in vectors (n <= LEMKE_SMALL_N, ws a lemke_small's) */
+    int ld;  /* leading dimension of B^-1: n, or LEMKE_SMALL_N in vectors */
+    int vec; /* in vectors (n <= LEMKE_SMALL_N, ws a lemke_small's) */
     const double *M, *q, *d;
-    int unit_cover;    /* d is all ones (the default) */
-    double tol;        /* relative tolerance for ties and tiny pivots */
-    double qmax;       /* max|q| */
+    int unit_cover; /* d is all ones (the default) */
+    double tol;     /* relative tolerance for ties and tiny pivots */
+    double qmax;    /* max|q| */
     pd_lcp_work *ws;
 } lemke_state;
 
@@ -83,12 +83,18 @@ typedef struct lemke_small {
 const char *pd_lcp_outcome_name(pd_lcp_outcome outcome)
 {
     switch (outcome) {
-    case PD_LCP_SOLVED: return "solved";
-    case PD_LCP_NO_SOLUTION: return "no_solution";
-    case PD_LCP_MAX_PIVOTS: return "max_pivots";
-    case PD_LCP_NUMERICAL: return "numerical";
-    case PD_LCP_MAX_ITERATIONS: return "max_iterations";
-    default: return "unknown";
+    case PD_LCP_SOLVED:
+        return "solved";
+    case PD_LCP_NO_SOLUTION:
+        return "no_solution";
+    case PD_LCP_MAX_PIVOTS:
+        return "max_pivots";
+    case PD_LCP_NUMERICAL:
+        return "numerical";
+    case PD_LCP_MAX_ITERATIONS:
+        return "max_iterations";
+    default:
+        return "unknown";
     }
 }
 
@@ -131,8 +137,8 @@ pd_lcp_work *pd_lcp_alloc(int nmax)
     work->row_of = malloc((2 * n + 1) * sizeof(int));
     work->ties = malloc(n * sizeof(int));
     work->perm = malloc(n * sizeof(int));
-    if (!work->binv || !work->xb || !work->col || !work->cover || !work->scratch ||
-        !work->rows || !work->basis || !work->row_of || !work->ties || !work->perm) {
+    if (!work->binv || !work->xb || !work->col || !work->cover || !work->scratch || !work->rows ||
+        !work->basis || !work->row_of || !work->ties || !work->perm) {
         pd_lcp_free(work);
         return NULL;
     }
@@ -157,8 +163,9 @@ static double max2(double a, double b)
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
 /* AVX2 and baseline builds of the pivoting loop (its O(n k) kernels inlined
  * into it), picked once at load time: one indirect call per solve. */
-#define LEMKE_KERNEL                                                                      \
-    __attribute__((target_clones("avx2", "default"), optimize("no-tree-loop-distribute-patterns")))
+#define LEMKE_KERNEL                                                                               \
+    __attribute__((target_clones("avx2", "default"), optimize("no-tree-loop-distribute-"           \
+                                                              "patterns")))
 /* Short loops stay loops (a call to memset or memcpy costs more for small n). */
 #define LEMKE_LOOPS __attribute__((optimize("no-tree-loop-distribute-patterns")))
 #else
@@ -169,9 +176,8 @@ static double max2(double a, double b)
 #define LEMKE_INLINE static inline __attribute__((always_inline))
 
 /* y <- y - t x; unrolled by four so that -O2 vectorises it. */
-static inline __attribute__((always_inline)) void axpy_minus(int n, double t,
-                                                             const double *restrict x,
-                                                             double *restrict y)
+static inline __attribute__((always_inline)) void
+axpy_minus(int n, double t, const double *restrict x, double *restrict y)
 {
     int i = 0;
     for (; i + 4 <= n; i += 4) {
@@ -186,7 +192,7 @@ static inline __attribute__((always_inline)) void axpy_minus(int n, double t,
 
 /* out = B^-1 v, taking B^-1[:,i] = e_row(w_i) for every basic w_i. */
 LEMKE_INLINE void binv_times(int n, const double *binv, const int *row_of, const double *v,
-                       double *restrict out)
+                             double *restrict out)
 {
     /* out = sum_i v_i B^-1[:, i] over the nonzero v_i */
     for (int r = 0; r < n; r++)
@@ -378,15 +384,13 @@ static double row_scale(const lemke_state *st, int i)
 
 /* Whether row i ties in the ratio test with theta and slack = tol xscale
  * (blocking_row). */
-LEMKE_INLINE int ties_row(const lemke_state *st, int i, double ptol, double theta,
-                         double slack)
+LEMKE_INLINE int ties_row(const lemke_state *st, int i, double ptol, double theta, double slack)
 {
     const double *col = st->ws->col;
     double gap = max2(st->ws->xb[i], 0.0) - theta * col[i]; /* x_i - theta col_i */
     /* a pivot above ptol, and gap <= 0, or within slack and within tol of the row's own terms */
     return col[i] > ptol &&
-           (gap <= 0.0 ||
-            (gap <= slack && gap <= st->tol * (row_scale(st, i) + theta * col[i])));
+           (gap <= 0.0 || (gap <= slack && gap <= st->tol * (row_scale(st, i) + theta * col[i])));
 }
 
 static int blocking_ties(const lemke_state *st, double ptol, double theta, double slack,
@@ -438,8 +442,7 @@ LEMKE_INLINE int blocking_row(const lemke_state *st, double ptol, double *theta_
 /* blocking_row once theta, its row argmin and slack = tol xscale are known
  * and another row might tie: the rows that tie, and the one of them that
  * leaves. */
-static int blocking_ties(const lemke_state *st, double ptol, double theta, double slack,
-                         int argmin)
+static int blocking_ties(const lemke_state *st, double ptol, double theta, double slack, int argmin)
 {
     int n = st->n;
     pd_lcp_work *ws = st->ws;
@@ -749,15 +752,15 @@ static const lemke_v4 LEMKE_UNIT[4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0},
 /* Vectors pass through memory or macros, never by value through a function
  * (the ABI of a 32-byte vector differs with and without AVX). */
 /* a with its lane r that of b. */
-#define V4_BLEND(a, b, r)                                                                   \
-    ((lemke_v4)(((lemke_m4)(a) & ~LEMKE_LANE[r]) | ((lemke_m4)(b) & LEMKE_LANE[r])))
+#define V4_BLEND(a, b, r)                                                                          \
+    ((lemke_v4)(((lemke_m4)(a) & ~LEMKE_LANE[r]) | ((lemke_m4)(b)&LEMKE_LANE[r])))
 /* All four lanes t. */
 #define V4_SPLAT(t) ((lemke_v4){(t), (t), (t), (t)})
 /* The n <= 4 entries of a, the other lanes 0 (built in registers). */
-#define V4_LOAD_N(a, n)                                                                     \
-    ((n) >= 4   ? (lemke_v4){(a)[0], (a)[1], (a)[2], (a)[3]}                                 \
-     : (n) == 3 ? (lemke_v4){(a)[0], (a)[1], (a)[2], 0.0}                                    \
-     : (n) == 2 ? (lemke_v4){(a)[0], (a)[1], 0.0, 0.0}                                       \
+#define V4_LOAD_N(a, n)                                                                            \
+    ((n) >= 4   ? (lemke_v4){(a)[0], (a)[1], (a)[2], (a)[3]}                                       \
+     : (n) == 3 ? (lemke_v4){(a)[0], (a)[1], (a)[2], 0.0}                                          \
+     : (n) == 2 ? (lemke_v4){(a)[0], (a)[1], 0.0, 0.0}                                             \
                 : (lemke_v4){(a)[0], 0.0, 0.0, 0.0})
 
 /* The vectors of the pivoting (their copies: ws->binv, ws->xb, ws->col). */
@@ -837,8 +840,8 @@ LEMKE_INLINE double v4_column(const lemke_state *st, v4_regs *reg, int var)
  * minimum are made side by side ahead of it, with 1 / col; the rows that
  * might tie are found in the vectors, blocking_ties called only when one
  * might. */
-LEMKE_INLINE int v4_blocking_row(const lemke_state *st, const v4_regs *reg, double ptol,
-                                 double *xr, double *rp)
+LEMKE_INLINE int v4_blocking_row(const lemke_state *st, const v4_regs *reg, double ptol, double *xr,
+                                 double *rp)
 {
     int n = st->n, argmin = -1, positive = 0;
     lemke_v4 col = reg->col, xb = reg->xb, zero = V4_SPLAT(0.0);
@@ -874,8 +877,8 @@ LEMKE_INLINE int v4_blocking_row(const lemke_state *st, const v4_regs *reg, doub
 }
 
 /* ratio_test. */
-LEMKE_INLINE int v4_ratio_test(const lemke_state *st, const v4_regs *reg, double colmax,
-                               double *xr, double *rp)
+LEMKE_INLINE int v4_ratio_test(const lemke_state *st, const v4_regs *reg, double colmax, double *xr,
+                               double *rp)
 {
     if (!isfinite(colmax))
         return RATIO_NUMERICAL;
@@ -1078,8 +1081,8 @@ LEMKE_INLINE pd_lcp_outcome pivot_and_finish(const lemke_state *st0, int vec, in
     local.n = nn;
     const lemke_state *st = &local;
 #ifdef LEMKE_VECTORS
-    pd_lcp_outcome outcome = vec ? v4_pivot_loop(st, cap, &info->pivots)
-                                 : pivot_loop(st, cap, &info->pivots);
+    pd_lcp_outcome outcome =
+        vec ? v4_pivot_loop(st, cap, &info->pivots) : pivot_loop(st, cap, &info->pivots);
 #else
     pd_lcp_outcome outcome = pivot_loop(st, cap, &info->pivots);
 #endif
@@ -1106,10 +1109,14 @@ __attribute__((target("avx2"), optimize("no-tree-loop-distribute-patterns"))) st
 run_lemke_v4(const lemke_state *st, int cap, double *z, double *w, pd_lcp_info *info)
 {
     switch (st->n) {
-    case 1: return pivot_and_finish(st, 1, 1, cap, z, w, info);
-    case 2: return pivot_and_finish(st, 1, 2, cap, z, w, info);
-    case 3: return pivot_and_finish(st, 1, 3, cap, z, w, info);
-    default: return pivot_and_finish(st, 1, 4, cap, z, w, info);
+    case 1:
+        return pivot_and_finish(st, 1, 1, cap, z, w, info);
+    case 2:
+        return pivot_and_finish(st, 1, 2, cap, z, w, info);
+    case 3:
+        return pivot_and_finish(st, 1, 3, cap, z, w, info);
+    default:
+        return pivot_and_finish(st, 1, 4, cap, z, w, info);
     }
 }
 #endif
@@ -1182,10 +1189,14 @@ static int set_cover(lemke_state *st, const double *cover)
 static int outcome_status(pd_lcp_outcome outcome)
 {
     switch (outcome) {
-    case PD_LCP_SOLVED: return PD_OK;
-    case PD_LCP_NO_SOLUTION: return PD_ENOSOLUTION;
-    case PD_LCP_MAX_PIVOTS: return PD_EMAXPIVOTS;
-    default: return PD_ENUMERICAL;
+    case PD_LCP_SOLVED:
+        return PD_OK;
+    case PD_LCP_NO_SOLUTION:
+        return PD_ENOSOLUTION;
+    case PD_LCP_MAX_PIVOTS:
+        return PD_EMAXPIVOTS;
+    default:
+        return PD_ENUMERICAL;
     }
 }
 
@@ -1270,11 +1281,17 @@ int pd_lcp_lemke(pd_lcp_work *work, int n, const double *M, const double *q,
     lemke_small small;
     /* n <= 4 with AVX2: the workspace on the stack, B^-1 of leading dimension 4 */
     if (n <= LEMKE_SMALL_N && __builtin_cpu_supports("avx2")) {
-        small.ws = (pd_lcp_work){.nmax = LEMKE_SMALL_N, .binv = small.binv, .xb = small.xb,
-                                 .col = small.col, .cover = work->cover,
-                                 .scratch = small.scratch, .rows = small.rows,
-                                 .basis = small.basis, .row_of = small.row_of,
-                                 .ties = small.ties, .perm = small.perm};
+        small.ws = (pd_lcp_work){.nmax = LEMKE_SMALL_N,
+                                 .binv = small.binv,
+                                 .xb = small.xb,
+                                 .col = small.col,
+                                 .cover = work->cover,
+                                 .scratch = small.scratch,
+                                 .rows = small.rows,
+                                 .basis = small.basis,
+                                 .row_of = small.row_of,
+                                 .ties = small.ties,
+                                 .perm = small.perm};
         st.ws = &small.ws;
         st.ld = LEMKE_SMALL_N;
         st.vec = 1;

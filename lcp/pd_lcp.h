@@ -45,10 +45,10 @@ PD_API const char *pd_lcp_outcome_name(pd_lcp_outcome outcome);
  * defaults).  Fields hold values, never "use the default" markers; a 0 pivot
  * or iteration budget is derived from n (documented in docs/lcp.md). */
 typedef struct pd_lcp_opts {
-    const double *cover; /* Lemke's covering vector d > 0 (n entries), NULL = all ones */
-    int max_pivots;      /* Lemke's pivot cap; 0 = max(10000, 100 n) */
-    double tol;          /* relative tolerance for ties and tiny pivots, in (0, 1) */
-    int max_iterations;  /* structured: principal solves of the pivoting, 0 = 3 n + 10
+    const double *cover;        /* Lemke's covering vector d > 0 (n entries), NULL = all ones */
+    int max_pivots;             /* Lemke's pivot cap; 0 = max(10000, 100 n) */
+    double tol;                 /* relative tolerance for ties and tiny pivots, in (0, 1) */
+    int max_iterations;         /* structured: principal solves of the pivoting, 0 = 3 n + 10
                             (its interior point is bounded apart, at 40 iterations
                             a call); pgs: sweeps, 0 = 1000 n (at most 10^6) */
     const unsigned char *guess; /* n flags, a warm start for the structured solver:
@@ -106,9 +106,8 @@ PD_API void pd_lcp_chain_q(int N, int seed, double *q);
  * make w_i (0/0 = 0).  It is invariant under scaling (q, z) or (M, 1/z), and
  * an answer is verified when it is at most 1e-10 (docs/lcp.md).
  * complementarity, infeasibility and residual may each be NULL (not wanted). */
-PD_API void pd_lcp_residual(int n, const double *M, const double *q, const double *z,
-                            double *w, double *complementarity, double *infeasibility,
-                            double *residual);
+PD_API void pd_lcp_residual(int n, const double *M, const double *q, const double *z, double *w,
+                            double *complementarity, double *infeasibility, double *residual);
 
 /* ---- the solver table ------------------------------------------------------ *
  * One entry point for every solver: a solver object sized once (no
@@ -170,14 +169,14 @@ PD_API int pd_lcp_read(const char *path, pd_lcp_format format, int *n, double **
  * when M is zero), *nnz their number; band and nnz may each be NULL. A
  * caller with a banded M may hand the structured solver compressed
  * columns built from the band alone (`pound lcp` does, docs/lcp.md). */
-PD_API int pd_lcp_read_band(const char *path, pd_lcp_format format, int *n, double **M,
-                            double **q, int *band, long *nnz, pd_err *err);
+PD_API int pd_lcp_read_band(const char *path, pd_lcp_format format, int *n, double **M, double **q,
+                            int *band, long *nnz, pd_err *err);
 /* The nonzero entries of the band |i - j| <= band of the dense n x n M
  * (column-major) into compressed columns colptr (n + 1), rowind, values
  * (cap entries each), reading the band alone; the number of entries, or
  * PD_EINVAL when there are more than cap (or an argument is bad).  With
  * the band of pd_lcp_read_band, the matrix itself. */
-PD_API long pd_lcp_band_csc(int n, const double *M, int band, long cap, int *colptr,
-                            int *rowind, double *values);
+PD_API long pd_lcp_band_csc(int n, const double *M, int band, long cap, int *colptr, int *rowind,
+                            double *values);
 
 #endif

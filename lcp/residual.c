@@ -89,7 +89,8 @@ static inline double if_negative(double x, double r)
 static inline double live_term(double zj, double p)
 {
     __m128d m = _mm_cmpneq_sd(_mm_set_sd(zj), _mm_setzero_pd());
-    return _mm_cvtsd_f64(_mm_or_pd(_mm_and_pd(m, _mm_set_sd(p)), _mm_andnot_pd(m, _mm_set_sd(-0.0))));
+    return _mm_cvtsd_f64(
+        _mm_or_pd(_mm_and_pd(m, _mm_set_sd(p)), _mm_andnot_pd(m, _mm_set_sd(-0.0))));
 }
 #else
 static inline double max_nb(double a, double b)
@@ -110,15 +111,14 @@ static inline double if_negative(double x, double r)
  * relative residual of the row is max(min(wi, zi), zi if z_i < 0, wi if
  * w_i < 0), each term >= 0 (when a term is NaN, acc->nan makes the
  * figures NaN whatever they are). */
-static inline void verify_row(verify_acc *acc, int n, double zi_, double wi_, double ri,
-                              double zs)
+static inline void verify_row(verify_acc *acc, int n, double zi_, double wi_, double ri, double zs)
 {
     /* |z_i| / zs and |w_i| / r_i, with 0 / 0 = 0 */
     double za = fabs(zi_), wa = fabs(wi_), zi = ratio(za, zs), wi = ratio(wa, ri);
     double v = wi < zi ? wi : zi;
     acc->nan |= !isfinite(zi_) || !isfinite(wi_) || !isfinite(ri); /* NaN compares false */
     acc->nan |= row_too_small(n, ri);
-    acc->comp = max_nb(acc->comp, za * wa); /* max |z_i w_i| */
+    acc->comp = max_nb(acc->comp, za * wa);                /* max |z_i w_i| */
     acc->infeas = max_nb(acc->infeas, max_nb(-zi_, -wi_)); /* max(-z_i, -w_i) */
     /* min(|w_i| / r_i, |z_i| / zs), and a negative z_i or w_i in full */
     v = max_nb(v, max_nb(if_negative(zi_, zi), if_negative(wi_, wi)));
@@ -152,8 +152,7 @@ static void verify_rowwise(const pd_matrix *M, const double *q, const double *z,
 
 /* w = M z + q and the row sizes r_i = |q_i| + sum_j |M_ij| |z_j|, column by
  * column over the support of z. */
-static void affine_rows(const pd_matrix *M, const double *q, const double *z, double *w,
-                        double *r)
+static void affine_rows(const pd_matrix *M, const double *q, const double *z, double *w, double *r)
 {
     int n = M->rows;
     for (int i = 0; i < n; i++) {
@@ -215,17 +214,26 @@ static int verify_tridiagonal(const pd_matrix *M, const double *q, const double 
             wc += p2;
             rc += fabs(p2);
         } else
-        for (int k = cp[j]; k < cp[j + 1]; k++) {
-            double p = live_term(zj, v[k] * zj), pa = fabs(p);
-            switch (ri[k] - j) {
-            case -1: wa += p; ra += pa; break;
-            case 0: wb += p; rb += pa; break;
-            case 1: wc += p; rc += pa; break;
-            default:
-                if (live)
-                    return -1; /* beyond the band: the general path */
+            for (int k = cp[j]; k < cp[j + 1]; k++) {
+                double p = live_term(zj, v[k] * zj), pa = fabs(p);
+                switch (ri[k] - j) {
+                case -1:
+                    wa += p;
+                    ra += pa;
+                    break;
+                case 0:
+                    wb += p;
+                    rb += pa;
+                    break;
+                case 1:
+                    wc += p;
+                    rc += pa;
+                    break;
+                default:
+                    if (live)
+                        return -1; /* beyond the band: the general path */
+                }
             }
-        }
         /* row j - 1 is complete: stored and judged */
         if (j > 0) {
             w[j - 1] = wa;
@@ -253,8 +261,8 @@ static int verify_tridiagonal(const pd_matrix *M, const double *q, const double 
  * diverged iteration), is no answer: its figures are NaN, which no
  * tolerance accepts (x / inf would otherwise pass as a ratio of 0); so
  * are they when a row is too small to be judged (VERIFY_ROW_MIN). */
-void pd_lcp_verify_zs(const pd_matrix *M, const double *q, const double *z, double *w,
-                      double *rows, double zs, pd_lcp_info *info)
+void pd_lcp_verify_zs(const pd_matrix *M, const double *q, const double *z, double *w, double *rows,
+                      double zs, pd_lcp_info *info)
 {
     int n = M->rows;
     const verify_acc zero = {.comp = 0.0, .infeas = 0.0, .rel = 0.0, .scale = 0.0, .nan = 0};

@@ -17,10 +17,12 @@
 
 #include "lcp_internal.h"
 
-#define HANDOVER_PGS_WORK 1e9 /* auto's last resort: PGS sweeps of at most this many
+#define HANDOVER_PGS_WORK                                                                          \
+    1e9                     /* auto's last resort: PGS sweeps of at most this many
                                  multiply-adds in all (about a second) */
-#define HANDOVER_PGS_MIN 64   /* ... but at least this many sweeps */
-#define SPARSE_COPY_PER_ROW 17 /* a dense matrix for the structured solver with at most
+#define HANDOVER_PGS_MIN 64 /* ... but at least this many sweeps */
+#define SPARSE_COPY_PER_ROW                                                                        \
+    17 /* a dense matrix for the structured solver with at most
                                   this many nonzero entries a row on average (a band of
                                   half-width 8), and no more than half of them nonzero,
                                   is copied into compressed columns (dense_copy) */
@@ -44,13 +46,13 @@ static const solver_type solver_types[] = {
 struct pd_lcp_solver {
     const solver_type *type;
     int nmax;
-    pd_lcp_work *lemke;       /* Lemke, for up to lemke_nmax unknowns */
+    pd_lcp_work *lemke; /* Lemke, for up to lemke_nmax unknowns */
     int lemke_nmax;
-    double *dense;            /* lemke_nmax^2: a sparse matrix copied for Lemke */
-    pd_bpp_work *bpp;         /* the structured solver */
+    double *dense;    /* lemke_nmax^2: a sparse matrix copied for Lemke */
+    pd_bpp_work *bpp; /* the structured solver */
     pd_pgs_work *pgs;
-    unsigned char *flag;      /* nmax: scratch of the structured solver */
-    long copy_cap;            /* SPARSE_COPY_PER_ROW nmax: the entries of ... */
+    unsigned char *flag;            /* nmax: scratch of the structured solver */
+    long copy_cap;                  /* SPARSE_COPY_PER_ROW nmax: the entries of ... */
     int *copy_colptr, *copy_rowind; /* ... a dense matrix's copy in compressed columns */
     double *copy_values;            /* for the structured solver (dense_copy) */
 };
@@ -128,10 +130,9 @@ pd_lcp_solver *pd_lcp_solver_alloc(pd_lcp_method method, int nmax, long nnzmax, 
             goto oom;
         /* dense input: room for a sparse one's copy (dense_copy) */
         s->copy_cap = nnzmax > 0 ? 0 : (long)SPARSE_COPY_PER_ROW * nmax;
-        if (s->copy_cap > 0 &&
-            (!(s->copy_colptr = malloc(((size_t)nmax + 1) * sizeof(int))) ||
-             !(s->copy_rowind = malloc((size_t)s->copy_cap * sizeof(int))) ||
-             !(s->copy_values = malloc((size_t)s->copy_cap * sizeof(double)))))
+        if (s->copy_cap > 0 && (!(s->copy_colptr = malloc(((size_t)nmax + 1) * sizeof(int))) ||
+                                !(s->copy_rowind = malloc((size_t)s->copy_cap * sizeof(int))) ||
+                                !(s->copy_values = malloc((size_t)s->copy_cap * sizeof(double)))))
             goto oom;
     }
     if (type->pgs && !(s->pgs = pd_pgs_alloc(nmax)))
@@ -221,7 +222,7 @@ static void dense_copy(pd_lcp_solver *s, const pd_matrix *M, pd_matrix *out)
         const double *c = M->values + (size_t)j * (size_t)n;
         colptr[j] = (int)nz;
         for (int i0 = 0; i0 < n; i0 += 8) {
-            int i1 = n - i0 >= 8 ? i0 + 8 : n; /* the block's end */
+            int i1 = n - i0 >= 8 ? i0 + 8 : n;      /* the block's end */
             if (n - i0 >= 32 && zeros(c + i0, 4)) { /* four cache lines at once */
                 i0 += 24;
                 continue;
@@ -243,8 +244,8 @@ static void dense_copy(pd_lcp_solver *s, const pd_matrix *M, pd_matrix *out)
 }
 
 /* The structured solver on M, or on its sparse copy (dense_copy). */
-static int solve_bpp(pd_lcp_solver *s, const pd_matrix *M, const double *q,
-                     const pd_lcp_opts *opts, double *z, double *w, pd_lcp_info *info)
+static int solve_bpp(pd_lcp_solver *s, const pd_matrix *M, const double *q, const pd_lcp_opts *opts,
+                     double *z, double *w, pd_lcp_info *info)
 {
     pd_matrix A;
     dense_copy(s, M, &A);
@@ -304,8 +305,8 @@ static int solve_pgs_last(pd_lcp_solver *s, const pd_matrix *M, const double *q,
 /* auto: Lemke first on small dense input, else the structured solver (with
  * its hand-over to Lemke); a failure that hands_over goes on to the other
  * one, then to PGS. */
-static int solve_auto(pd_lcp_solver *s, const pd_matrix *M, const double *q,
-                      const pd_lcp_opts *o, double *z, double *w, pd_lcp_info *info)
+static int solve_auto(pd_lcp_solver *s, const pd_matrix *M, const double *q, const pd_lcp_opts *o,
+                      double *z, double *w, pd_lcp_info *info)
 {
     int rc;
     /* n <= 2 (its closed forms), or dense within Lemke's workspace: Lemke first */
@@ -346,9 +347,14 @@ int pd_lcp_solve(pd_lcp_solver *s, const pd_matrix *M, const double *q, const pd
         (M->kind != PD_MATRIX_DENSE && M->kind != PD_MATRIX_CSC))
         return PD_EINVAL;
     switch (s->type->method) {
-    case PD_LCP_LEMKE: return solve_lemke(s, M, q, &o, z, w, info);
-    case PD_LCP_STRUCTURED: return solve_structured(s, M, q, &o, z, w, info);
-    case PD_LCP_PGS: info->solver = "pgs"; return pd_pgs_solve(s->pgs, M, q, &o, z, w, info);
-    default: return solve_auto(s, M, q, &o, z, w, info);
+    case PD_LCP_LEMKE:
+        return solve_lemke(s, M, q, &o, z, w, info);
+    case PD_LCP_STRUCTURED:
+        return solve_structured(s, M, q, &o, z, w, info);
+    case PD_LCP_PGS:
+        info->solver = "pgs";
+        return pd_pgs_solve(s->pgs, M, q, &o, z, w, info);
+    default:
+        return solve_auto(s, M, q, &o, z, w, info);
     }
 }

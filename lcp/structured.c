@@ -36,18 +36,21 @@
 #define BPP_SIGN_TOL 1e-11  /* z_i, w_i below -this * their scale count as infeasible */
 #define BPP_PIVOT_TOL 1e-13 /* a Cholesky pivot below this * the diagonal: not positive */
 #define IPM_MAX 40          /* interior-point iterations at most */
-#define IPM_MU_TOL 1e-9     /* complementarity z.w / n to reach, relative to the scales,
+#define IPM_MU_TOL                                                                                 \
+    1e-9 /* complementarity z.w / n to reach, relative to the scales,
                                before the support is handed to the pivoting */
-#define IPM_MU_FINAL 1e-17  /* the same when the point itself must be the answer
+#define IPM_MU_FINAL                                                                               \
+    1e-17                 /* the same when the point itself must be the answer
                                (a singular M_FF: redundant contacts) */
-#define IPM_STABLE 2        /* iterations the support guess must hold ... */
-#define IPM_CROSS_MU 1e-3   /* ... with mu below this * its start, to try the pivoting */
-#define IPM_CROSSINGS 3     /* such early tries at most */
-#define IPM_STALLED -2       /* interior_point: a factorisation failed on the way; the
+#define IPM_STABLE 2      /* iterations the support guess must hold ... */
+#define IPM_CROSS_MU 1e-3 /* ... with mu below this * its start, to try the pivoting */
+#define IPM_CROSSINGS 3   /* such early tries at most */
+#define IPM_STALLED                                                                                \
+    -2                 /* interior_point: a factorisation failed on the way; the
                                point reached is valid (z, w > 0) */
-#define IPM_STEP 0.995      /* fraction of the step to the boundary */
-#define IPM_SHIFT 1e-8      /* regularisation of the least-squares start, times max M_ii */
-#define IPM_START 0.1       /* the start's distance from the boundary, times the scales */
+#define IPM_STEP 0.995 /* fraction of the step to the boundary */
+#define IPM_SHIFT 1e-8 /* regularisation of the least-squares start, times max M_ii */
+#define IPM_START 0.1  /* the start's distance from the boundary, times the scales */
 
 /* An interval a .. k of the support in the direct method for tridiagonal
  * Stieltjes matrices (stieltjes_support): its rows condensed on the two
@@ -82,8 +85,8 @@ struct pd_bpp_work {
     double *ta, *tb;    /* n: its diagonal A_ii and subdiagonal A_i,i-1 (tb_0 = 0) */
     double *tl, *tu;    /* n: the twisted factor's multipliers (tri_factor) */
     double *iz, *iw, *dz, *dw, *az, *aw, *r; /* n each: the interior point's */
-    tri_port *port;     /* n / 2 + 1: the support's intervals (stieltjes_support) */
-    int nport;          /* ... how many */
+    tri_port *port; /* n / 2 + 1: the support's intervals (stieltjes_support) */
+    int nport;      /* ... how many */
 };
 
 void pd_bpp_free(pd_bpp_work *ws)
@@ -139,14 +142,14 @@ pd_bpp_work *pd_bpp_alloc(int nmax, long envmax)
     ws->rz = malloc(n * sizeof(double));
     ws->sup = malloc(n);
     ws->port = malloc((n / 2 + 1) * sizeof(tri_port));
-    double **ipm[] = {&ws->iz, &ws->iw, &ws->dz, &ws->dw, &ws->az, &ws->aw, &ws->r,
-                      &ws->ta, &ws->tb, &ws->tl, &ws->tu};
+    double **ipm[] = {&ws->iz, &ws->iw, &ws->dz, &ws->dw, &ws->az, &ws->aw,
+                      &ws->r,  &ws->ta, &ws->tb, &ws->tl, &ws->tu};
     int ok = 1;
     for (size_t k = 0; k < sizeof ipm / sizeof ipm[0]; k++)
         ok &= (*ipm[k] = malloc(n * sizeof(double))) != NULL;
     if (!ok || !ws->inF || !ws->loc || !ws->glob || !ws->first || !ws->rowptr || !ws->env ||
-        !ws->diag || !ws->rhs || !ws->rows || !ws->dinv || !ws->tmpl ||
-        !ws->mii || !ws->rz || !ws->sup || !ws->port) {
+        !ws->diag || !ws->rhs || !ws->rows || !ws->dinv || !ws->tmpl || !ws->mii || !ws->rz ||
+        !ws->sup || !ws->port) {
         pd_bpp_free(ws);
         return NULL;
     }
@@ -159,23 +162,23 @@ int pd_bpp_nmax(const pd_bpp_work *ws)
 }
 
 /* Entries of column j of M (the row j of a symmetric M): calls fn(i, Mij). */
-#define FOR_COLUMN(M, j, I, X, BODY)                                                          \
-    do {                                                                                      \
-        if ((M)->kind == PD_MATRIX_CSC) {                                                     \
-            for (int k_ = (M)->colptr[j]; k_ < (M)->colptr[(j) + 1]; k_++) {                  \
-                int I = (M)->rowind[k_];                                                      \
-                double X = (M)->values[k_];                                                   \
-                BODY;                                                                         \
-            }                                                                                 \
-        } else {                                                                              \
-            const double *c_ = (M)->values + (size_t)(j) * (size_t)(M)->rows;                 \
-            for (int I = 0; I < (M)->rows; I++) {                                             \
-                double X = c_[I];                                                             \
-                if (X != 0.0) {                                                               \
-                    BODY;                                                                     \
-                }                                                                             \
-            }                                                                                 \
-        }                                                                                     \
+#define FOR_COLUMN(M, j, I, X, BODY)                                                               \
+    do {                                                                                           \
+        if ((M)->kind == PD_MATRIX_CSC) {                                                          \
+            for (int k_ = (M)->colptr[j]; k_ < (M)->colptr[(j) + 1]; k_++) {                       \
+                int I = (M)->rowind[k_];                                                           \
+                double X = (M)->values[k_];                                                        \
+                BODY;                                                                              \
+            }                                                                                      \
+        } else {                                                                                   \
+            const double *c_ = (M)->values + (size_t)(j) * (size_t)(M)->rows;                      \
+            for (int I = 0; I < (M)->rows; I++) {                                                  \
+                double X = c_[I];                                                                  \
+                if (X != 0.0) {                                                                    \
+                    BODY;                                                                          \
+                }                                                                                  \
+            }                                                                                      \
+        }                                                                                          \
     } while (0)
 
 /* M_FF (k local rows) into the workspace: when every row reaches back at
@@ -359,7 +362,7 @@ static void envelope_solve(const pd_bpp_work *ws, int k, double *x)
     for (int i = 0; i < k; i++) /* D^-1 y */
         x[i] *= dinv[i];
     double zi = k > 0 ? x[k - 1] : 0.0; /* z_i, final */
-    for (int i = k - 1; i > 0; i--) { /* L^T z = D^-1 y: column i of L^T is row i of L */
+    for (int i = k - 1; i > 0; i--) {   /* L^T z = D^-1 y: column i of L^T is row i of L */
         int fi = ws->first[i];
         const double *ri = ws->env + ws->rowptr[i] - fi;
         if (fi == i - 1) {
@@ -474,8 +477,7 @@ static inline int port_ends(const pd_bpp_work *ws, const tri_port *p, double *na
     *den = p->s11 * p->s22 - p->s12 * p->s12;
     *na = p->s22 * p->f1 - p->s12 * p->f2;
     *nk = p->s11 * p->f2 - p->s12 * p->f1;
-    return p->s11 > BPP_PIVOT_TOL * ws->ta[p->a] &&
-                   *den > BPP_PIVOT_TOL * p->s11 * ws->ta[p->k]
+    return p->s11 > BPP_PIVOT_TOL * ws->ta[p->a] && *den > BPP_PIVOT_TOL * p->s11 * ws->ta[p->k]
                ? 0
                : -1;
 }
@@ -483,8 +485,7 @@ static inline int port_ends(const pd_bpp_work *ws, const tri_port *p, double *na
 /* w_g = q_g + M_g,g-1 z_g-1 of a row g with z_g = 0 before the interval
  * on top (z_g-1 from the last interval left behind, if it ends at g - 1);
  * 0 for g < 0. */
-static inline double gap_w(const double *q, const double *b, const tri_port *st, int depth,
-                           int g)
+static inline double gap_w(const double *q, const double *b, const tri_port *st, int depth, int g)
 {
     if (g < 0)
         return 0.0;
@@ -640,8 +641,7 @@ static double stieltjes_solve(pd_bpp_work *ws, int n, const double *q, double *z
     return zs;
 }
 
-int pd_bpp_stieltjes(pd_bpp_work *ws, const pd_matrix *M, const double *q, double *z,
-                     double *zs)
+int pd_bpp_stieltjes(pd_bpp_work *ws, const pd_matrix *M, const double *q, double *z, double *zs)
 {
     int rc = M->rows <= ws->nmax ? stieltjes_support(ws, M, q) : 0;
     if (rc <= 0)
@@ -712,8 +712,8 @@ static int infeasible(const pd_bpp_work *ws, int n, const double *z, const doubl
 /* Pivoting rounds from the support in ws->inF: 0 with z, w the answer
  * (not yet verified), -1 (M_FF not positive, or the envelope too large),
  * or 1 when `rounds` rounds did not settle.  *iterations counts the solves. */
-static int pivot_rounds(pd_bpp_work *ws, const pd_matrix *M, const double *q, int rounds,
-                        double *z, double *w, unsigned char *flag, int *iterations)
+static int pivot_rounds(pd_bpp_work *ws, const pd_matrix *M, const double *q, int rounds, double *z,
+                        double *w, unsigned char *flag, int *iterations)
 {
     int n = M->rows, best = n + 1, patience = BPP_PATIENCE;
     for (int round = 0; round < rounds; round++) {
@@ -871,7 +871,7 @@ static int interior_point(pd_bpp_work *ws, const pd_matrix *M, const double *q, 
         ipm_matvec(ws, M, z, ws->r);
         for (int i = 0; i < n; i++) {
             mu += z[i] * w[i] / n; /* mu = z.w / n */
-            ws->r[i] += q[i]; /* M z + q */
+            ws->r[i] += q[i];      /* M z + q */
             double gap = fabs(w[i] - ws->r[i]);
             rmax = gap > rmax ? gap : rmax;
             rz[i] = 1.0 / z[i];
@@ -899,7 +899,7 @@ static int interior_point(pd_bpp_work *ws, const pd_matrix *M, const double *q, 
         for (int i = 0; i < n; i++)
             mua += (z[i] + a * az[i]) * (w[i] + a * aw[i]) / n;
         double sigma = pow(mua / mu, 3.0); /* Mehrotra's centring */
-        for (int i = 0; i < n; i++) { /* corrector */
+        for (int i = 0; i < n; i++) {      /* corrector */
             double c = (sigma * mu - az[i] * aw[i]) * rz[i];
             dz[i] = -ws->r[i] + c;
             ws->rows[i] = c;
@@ -938,8 +938,8 @@ int pd_bpp_solve(pd_bpp_work *ws, const pd_matrix *M, const double *q, const pd_
     double zs = 0.0;
     if ((rc = pd_bpp_stieltjes(ws, M, q, z, &zs)) != 0) {
         its = 1; /* z is clamped already: verified as accept would */
-        if (rc > 0 && (pd_lcp_verify_zs(M, q, z, w, ws->rows, zs, info),
-                       info->residual <= PD_LCP_VERIFY_TOL))
+        if (rc > 0 &&
+            (pd_lcp_verify_zs(M, q, z, w, ws->rows, zs, info), info->residual <= PD_LCP_VERIFY_TOL))
             goto solved;
     }
     for (int i = 0; i < n; i++) {

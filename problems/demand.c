@@ -30,8 +30,10 @@ int pd_demand_check_force(double impulse, double force, int a, pd_err *err)
     char which[32] = "";
     if (a >= 0)
         snprintf(which, sizeof which, " of contact %d", a);
-    return pd_err_set(err, PD_EINVAL, "contact-duration: the equivalent force pi I / (2 td)%s "
-                      "overflows (impulse I = %g): give a longer duration", which, impulse);
+    return pd_err_set(err, PD_EINVAL,
+                      "contact-duration: the equivalent force pi I / (2 td)%s "
+                      "overflows (impulse I = %g): give a longer duration",
+                      which, impulse);
 }
 
 /* A drift ratio drift / h that overflows while the drift does not: the
@@ -40,9 +42,10 @@ int pd_demand_check_drift(double drift, double ratio, const char *name, int stor
 {
     if (isfinite(ratio) || !isfinite(drift))
         return PD_OK;
-    return pd_err_set(err, PD_EINVAL, "storey_heights: the drift ratio of storey %d of %s "
-                      "overflows (drift %g m over its height): give a larger height", storey,
-                      name, drift);
+    return pd_err_set(err, PD_EINVAL,
+                      "storey_heights: the drift ratio of storey %d of %s "
+                      "overflows (drift %g m over its height): give a larger height",
+                      storey, name, drift);
 }
 
 double pd_demand_td(const pd_run_opts *o)
@@ -57,8 +60,8 @@ void pd_demand_eval(const pd_scene *sc, const double *x, const double *v, double
         pd_demand_eval_structure(&sc->st[s], x, v, us, vs, a, V);
 }
 
-void pd_demand_eval_structure(const pd_structure *st, const double *x, const double *v,
-                              double us, double vs, double *a, double *V)
+void pd_demand_eval_structure(const pd_structure *st, const double *x, const double *v, double us,
+                              double vs, double *a, double *V)
 {
     {
         const double *xs = x + st->dof, *vs_ = v + st->dof;

@@ -18,8 +18,8 @@ void pd_demand_eval(const pd_scene *sc, const double *x, const double *v, double
                     double *a, double *V);
 
 /* The same for structure st alone (its entries of x, v, a, V). */
-void pd_demand_eval_structure(const pd_structure *st, const double *x, const double *v,
-                              double us, double vs, double *a, double *V);
+void pd_demand_eval_structure(const pd_structure *st, const double *x, const double *v, double us,
+                              double vs, double *a, double *V);
 
 /* The same into the scratch a, V (n), raising the peaks acc = max |a| and
  * shear = max |V| (n). */

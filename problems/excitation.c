@@ -8,9 +8,12 @@
 const char *pd_pulse_name(pd_pulse pulse)
 {
     switch (pulse) {
-    case PD_PULSE_SINE: return "sine";
-    case PD_PULSE_COSINE: return "cosine";
-    case PD_PULSE_HARMONIC: return "harmonic";
+    case PD_PULSE_SINE:
+        return "sine";
+    case PD_PULSE_COSINE:
+        return "cosine";
+    case PD_PULSE_HARMONIC:
+        return "harmonic";
     }
     return "?";
 }

@@ -54,8 +54,8 @@ static int record_grid(const pd_osc_sample *s, void *ctx)
     double h = s->t - g->t;
     for (; tr->n < tr->cap && g->have && (double)tr->n * tr->dt <= s->t; tr->n++) {
         double x = ((double)tr->n * tr->dt - g->t) / h, p[2] = {g->u, g->v}, q[2] = {s->u, s->v};
-        tr->u[tr->n] = s->impulse > 0.0 || !(h > 0.0) ? g->u + x * (s->u - g->u)
-                                                      : pd_hermite3(p, q, h, x);
+        tr->u[tr->n] =
+            s->impulse > 0.0 || !(h > 0.0) ? g->u + x * (s->u - g->u) : pd_hermite3(p, q, h, x);
     }
     if (!g->have && tr->n < tr->cap && s->t == 0.0)
         tr->u[tr->n++] = s->u; /* t = 0 */
@@ -72,8 +72,9 @@ int pd_measure_run(const pd_osc *c, const pd_run_opts *o, const pd_trace *ref, d
     work->n = 0;
     grid_fill fill = {.tr = work};
     if (o->rtol > 0.0 && !(work->dt > 0.0))
-        return pd_err_set(err, PD_EINVAL, "a run to a tolerance is measured on the grid of its "
-                                          "trace: dt unset (pd_trace_alloc)");
+        return pd_err_set(err, PD_EINVAL,
+                          "a run to a tolerance is measured on the grid of its "
+                          "trace: dt unset (pd_trace_alloc)");
     if ((rc = o->rtol > 0.0 ? pd_osc_run(c, o, record_grid, &fill, &out->r, err)
                             : pd_osc_run(c, o, record_u, work, &out->r, err)))
         return rc;
@@ -95,8 +96,8 @@ int pd_measure_run(const pd_osc *c, const pd_run_opts *o, const pd_trace *ref, d
     return PD_OK;
 }
 
-int pd_measure_reference(const pd_osc *c, const pd_run_opts *o, pd_trace *ref,
-                         pd_osc_result *res, pd_err *err)
+int pd_measure_reference(const pd_osc *c, const pd_run_opts *o, pd_trace *ref, pd_osc_result *res,
+                         pd_err *err)
 {
     int rc;
     pd_osc_result timed;

@@ -23,24 +23,24 @@
 #include "pd_problems.h"
 
 #define OSC_ADAPT_TRIES 3
-#define OSC_ADAPT_H0 16.0     /* the coarsest step: min(Tp, T0) / this */
-#define OSC_ADAPT_FLOOR 1e-3  /* errors below this share of the static scale count as none */
+#define OSC_ADAPT_H0 16.0    /* the coarsest step: min(Tp, T0) / this */
+#define OSC_ADAPT_FLOOR 1e-3 /* errors below this share of the static scale count as none */
 
 /* The observer's measurements in Pi units. */
 typedef struct adapt_track {
-    pd_osc_track m;          /* extremes, impacts, contact steps, min gap, largest impulse */
-    double contact_tau;      /* time with an impulse */
+    pd_osc_track m;     /* extremes, impacts, contact steps, min gap, largest impulse */
+    double contact_tau; /* time with an impulse */
     double err_max, err_toward, err_away, err_acc; /* the estimate at each peak */
-    double px, pv, pa, pt;   /* the previous state */
-    int pacc;                /* 1: it has an acceleration */
+    double px, pv, pa, pt;                         /* the previous state */
+    int pacc;                                      /* 1: it has an acceleration */
     pd_demand_osc dem;
     int demands;
-    int dem_skipped;         /* a state was left out of the demands since the last */
+    int dem_skipped; /* a state was left out of the demands since the last */
     double Le, vscale, wp;
     pd_osc_sampler sampler;
     void *sampler_ctx;
     long sampled;
-    const pd_osc *c;         /* its excitation (a held contact's force) */
+    const pd_osc *c; /* its excitation (a held contact's force) */
 } adapt_track;
 
 /* A peak p at err e: raise *peak (and its *perr) when p is above it. */
@@ -88,9 +88,9 @@ static int observe(const pd_state *st, void *ctx)
     if (tr->demands && st->has_acc) {
         /* a held contact (an impulse in a step without an impact): its force
          * from x'' = f - C x' - K x - lam, the accelerations' left limit */
-        double lam = P > 0.0 ? pd_osc_shape(tr->c, st->t, -1) - tr->dem.C * v -
-                                   tr->dem.K * x - st->acc[0]
-                             : 0.0;
+        double lam =
+            P > 0.0 ? pd_osc_shape(tr->c, st->t, -1) - tr->dem.C * v - tr->dem.K * x - st->acc[0]
+                    : 0.0;
         pd_demand_osc_note(&tr->dem, st->t, x, v, st->acc, lam,
                            st->step > 0 && !tr->dem_skipped && !st->impact);
         tr->dem.fd = tr->dem.C * st->acc_right[0] + tr->dem.K * v; /* the next step's start */
@@ -107,8 +107,8 @@ static int observe(const pd_state *st, void *ctx)
     tr->pt = st->t;
     if (!tr->sampler)
         return 0;
-    pd_osc_sample smp = pd_osc_track_sample(&tr->m, &tr->sampled, st->step, st->t, x, v, P,
-                                            tr->wp, tr->Le, tr->vscale);
+    pd_osc_sample smp = pd_osc_track_sample(&tr->m, &tr->sampled, st->step, st->t, x, v, P, tr->wp,
+                                            tr->Le, tr->vscale);
     return tr->sampler(&smp, tr->sampler_ctx);
 }
 
@@ -149,8 +149,13 @@ static int run_once(const pd_osc *c, const pd_run_opts *o, double rtol, pd_osc_s
      * units) or of Le, an error is measured absolutely */
     mo.atol = OSC_ADAPT_FLOOR * fmin(1.0, 1.0 / (c->Pi2 * c->Pi2));
     mo.pieces = &F;
-    adapt_track tr = {.Le = Le, .vscale = Le * wp, .wp = wp, .demands = !o->no_demands,
-                      .sampler = sampler, .sampler_ctx = ctx, .c = c};
+    adapt_track tr = {.Le = Le,
+                      .vscale = Le * wp,
+                      .wp = wp,
+                      .demands = !o->no_demands,
+                      .sampler = sampler,
+                      .sampler_ctx = ctx,
+                      .c = c};
     pd_osc_track_init(&tr.m, c, mo.h, wp * pd_osc_measure_start(c, o->tend));
     tr.dem = (pd_demand_osc){.C = k.C, .K = k.K, .tau_measure = tr.m.tau_measure};
     pd_mj *mj = pd_mj_alloc(&model, &mo, err);
@@ -188,8 +193,8 @@ int pd_osc_adapt(const pd_osc *c, const pd_run_opts *o, pd_osc_sampler sampler, 
         runs++;
         rejected += res->steps_rejected;
         steps += res->steps;
-        if (rc || st.budget_hit || res->err_est <= o->rtol ||
-            runs >= OSC_ADAPT_TRIES || rtol * 0.5 < PD_RTOL_MIN)
+        if (rc || st.budget_hit || res->err_est <= o->rtol || runs >= OSC_ADAPT_TRIES ||
+            rtol * 0.5 < PD_RTOL_MIN)
             break;
         rtol *= fmin(0.5, 0.5 * o->rtol / res->err_est);
         rtol = fmax(rtol, PD_RTOL_MIN);

@@ -118,7 +118,7 @@ static void fill_forces(osc_batch *ob, int k)
     const double th = b->theta;
     long iter = b->iter;
     int n = 0, own[NL], nown = 0; /* own: the live lanes without a table, in order */
-    double F1[NL]; /* F(1) of every lane */
+    double F1[NL];                /* F(1) of every lane */
     for (int l = 0; l < NL; l++)
         F1[l] = ob->Fend[l] = 0.0;
     for (int i = 0; i < ob->nlive; i++) {
@@ -272,7 +272,7 @@ static void lane_idle(osc_batch *ob, int l)
     neighbours(ob, l);
     pd_mjb_set_lane(&ob->mjb, l, &idle, NULL);
     mj1_lanes_far_wall(&ob->mjb, l); /* never closing: its set's steps may skip the impulses */
-    ob->Pi3[l] = 1.0; /* a gap that never closes */
+    ob->Pi3[l] = 1.0;                /* a gap that never closes */
     ob->meas_from[l] = HUGE_VAL;
     ob->prev2_v[l] = 0.0;
 }
@@ -307,10 +307,13 @@ static osc_batch_run_fn run_for_cpu(void)
 {
     switch (pd_cpu_level()) {
 #if PD_X86_VARIANTS
-    case 4: return pd_osc_batch_run_x86v4;
-    case 3: return pd_osc_batch_run_x86v3;
+    case 4:
+        return pd_osc_batch_run_x86v4;
+    case 3:
+        return pd_osc_batch_run_x86v3;
 #endif
-    default: return pd_osc_batch_run_base;
+    default:
+        return pd_osc_batch_run_base;
     }
 }
 

@@ -13,8 +13,8 @@
 #include "pd_problems.h"
 
 #define NL PD_MJB_LANES
-#define OSC_BLOCK 64   /* batch steps run at a time between the forces' fills */
-#define OSC_TABLES 16  /* excitation tables kept */
+#define OSC_BLOCK 64        /* batch steps run at a time between the forces' fills */
+#define OSC_TABLES 16       /* excitation tables kept */
 #define OSC_TABLE_MAX 32768 /* the longest excitation tabulated, in steps */
 
 /* An excitation's left limits at the steps of one h: v[s] = the shape at
@@ -45,16 +45,16 @@ struct osc_batch {
     pd_mjb mjb;
     /* a lane's case: id, options, length; -1: idle */
     long id[NL], nsteps[NL];
-    pd_osc c[NL];     /* the case */
-    pd_osc unit[NL];  /* the case with dir = +1: the shape the lane scales */
+    pd_osc c[NL];    /* the case */
+    pd_osc unit[NL]; /* the case with dir = +1: the shape the lane scales */
     pd_run_opts o[NL];
-    double dir[NL];   /* +1 or -1 */
-    int same_prev[NL]; /* 1: lane l - 1 has the same excitation */
-    double cpu[NL];   /* the lane's share of the batch's time so far */
-    int busy;         /* lanes running a case */
+    double dir[NL];      /* +1 or -1 */
+    int same_prev[NL];   /* 1: lane l - 1 has the same excitation */
+    double cpu[NL];      /* the lane's share of the batch's time so far */
+    int busy;            /* lanes running a case */
     long quiet_iter[NL]; /* the batch step from which lane l's force is 0 */
     int live[NL], nlive; /* the lanes still inside their excitation, in order */
-    int table[NL];    /* the lane's excitation table (-1: none, computed per step) */
+    int table[NL];       /* the lane's excitation table (-1: none, computed per step) */
     osc_table tab[OSC_TABLES];
     /* the forces of a block of steps: row s the force of its step s + 1,
      * theta F(end) + (1 - theta) F(start) (rows 1 .. OSC_BLOCK - 1 of a lane

@@ -43,7 +43,7 @@ static void lanes_events(osc_batch *ob, int l, unsigned due, lvec st, lvec t, lv
 #define OSC_G 4
 #endif
 _Static_assert(NL % (OSC_G * LW) == 0, "whole sets of vectors");
-_Static_assert(OSC_G * LW <= 32, "a set's lanes are the bits of an unsigned");
+_Static_assert(OSC_G *LW <= 32, "a set's lanes are the bits of an unsigned");
 _Static_assert(OSC_G <= 8, "mj1_lanes_step takes at most 8 vectors");
 
 /* Contact steps counted in registers: AVX-512 adds one under the mask;
@@ -97,9 +97,10 @@ static inline unsigned sbnonzero(stepbytes d)
  * (lanes_run_resident's): its contact steps, returned, and the events of
  * its lanes that need them (pd_osc_track_events_due's condition, from the
  * conditions of the step before), in step order. */
-static inline __attribute__((always_inline)) lcount
-lanes_scan(osc_batch *ob, int l, int k, lvec h, lvec st0, lvec Pi3,
-           lvec (*xr)[OSC_G], lvec (*vr)[OSC_G], lvec (*Pr)[OSC_G], int i)
+static inline __attribute__((always_inline)) lcount lanes_scan(osc_batch *ob, int l, int k, lvec h,
+                                                               lvec st0, lvec Pi3,
+                                                               lvec (*xr)[OSC_G], lvec (*vr)[OSC_G],
+                                                               lvec (*Pr)[OSC_G], int i)
 {
     const lvec zero = {0.0};
     lcount cnt = LCOUNT_ZERO;
@@ -125,8 +126,8 @@ lanes_scan(osc_batch *ob, int l, int k, lvec h, lvec st0, lvec Pi3,
             int s = s0 + __builtin_ctz(steps);
             unsigned due = EVENTS_DUE(ltb[s], ltb[s + 1], posb[s], posb[s + 1]);
             lvec st = st0 + (double)(s + 1);
-            lanes_events(ob, l, due, st, st * h, xr[s + 1][i], vr[s + 2][i], Pr[s + 1][i],
-                         xr[s][i], vr[s + 1][i], Pr[s][i], vr[s][i]);
+            lanes_events(ob, l, due, st, st * h, xr[s + 1][i], vr[s + 2][i], Pr[s + 1][i], xr[s][i],
+                         vr[s + 1][i], Pr[s][i], vr[s][i]);
             steps &= steps - 1u;
         }
     }
@@ -161,8 +162,8 @@ lanes_scan(osc_batch *ob, int l, int k, lvec h, lvec st0, lvec Pi3,
  * condition is pd_osc_track_events_due's, from conditions carried over
  * from the previous step (a lane turned NaN may call the events once more:
  * they test their own conditions, and the lane is run again alone). */
-static inline __attribute__((always_inline)) void lanes_run_resident(osc_batch *ob, int l0,
-                                                                    int k, int all)
+static inline __attribute__((always_inline)) void lanes_run_resident(osc_batch *ob, int l0, int k,
+                                                                     int all)
 {
     enum { G = OSC_G };
     pd_mjb *b = &ob->mjb;
@@ -244,8 +245,8 @@ static inline __attribute__((always_inline)) void lanes_run_resident(osc_batch *
     MJ1_EACH(G, lstore(&ob->xaway[l0 + i * LW], xaw[i]))
     MJ1_EACH(G, lstore(&ob->min_gap[l0 + i * LW], mg[i]))
     MJ1_EACH(G, lstore(&ob->Pmax[l0 + i * LW], Pmax[i]))
-    MJ1_EACH(G, lstore(&ob->contact[l0 + i * LW],
-                       LCOUNT_ADD(lload(&ob->contact[l0 + i * LW]), cnt[i])))
+    MJ1_EACH(
+        G, lstore(&ob->contact[l0 + i * LW], LCOUNT_ADD(lload(&ob->contact[l0 + i * LW]), cnt[i])))
 }
 
 /* Is every step of the block (its first step's end: the lanes' clocks

@@ -23,24 +23,23 @@
 #define OSC_PEN_KC_GAP 1e3   /* ... and this * wp^2 / Pi3^2 (penetration ~ 3 % of the gap) */
 #define OSC_PEN_MIN_PI3 1e-3 /* the Pi3 of that rule at a zero gap */
 
-
 /* Measurements in Pi units, updated after every accepted step. */
 typedef struct pen_track {
     const pd_osc *c;
     pd_penalty_law law;
-    int m;                        /* 0: no wall */
+    int m; /* 0: no wall */
     double C, K, Pi3, tau_measure;
     double xmax, xtoward, xaway, xpeak;
-    pd_demand_osc dem;            /* the absolute acceleration's peak */
-    double h_out;                 /* the output grid's step (a hold's rest rate) */
-    double fpeak;                 /* the largest element force */
+    pd_demand_osc dem; /* the absolute acceleration's peak */
+    double h_out;      /* the output grid's step (a hold's rest rate) */
+    double fpeak;      /* the largest element force */
     int no_demands;
-    long impacts, sampled;        /* sampled: impacts reported to the sampler */
+    long impacts, sampled; /* sampled: impacts reported to the sampler */
     double first_tau, first_v, vimp_max, contact_tau;
     int have_prev, pactive;
-    double pt, px, pv, pP;        /* previous accepted state and its force */
-    double imp_t, imp_lam, imp;   /* integral of lambda since the last sample */
-    double episode, episode_max;  /* integral of lambda over the current contact, its max */
+    double pt, px, pv, pP;       /* previous accepted state and its force */
+    double imp_t, imp_lam, imp;  /* integral of lambda since the last sample */
+    double episode, episode_max; /* integral of lambda over the current contact, its max */
     double Le, vscale, wp;
     pd_osc_sampler sampler;
     void *sampler_ctx;
@@ -199,10 +198,10 @@ static int track_step(const pd_state *st, void *ctx)
      * hold (engaged, at rest after this step and the one before) takes the
      * rigid wall's held force, never the element's ringing */
     if (!tr->no_demands)
-        pd_demand_osc_note(&tr->dem, tau, x, v, &a,
-                           pd_demand_osc_held(&tr->dem, tr->h_out, active, tr->pactive, v, tr->pv,
-                                              x, f),
-                           !active && !tr->pactive); /* free steps */
+        pd_demand_osc_note(
+            &tr->dem, tau, x, v, &a,
+            pd_demand_osc_held(&tr->dem, tr->h_out, active, tr->pactive, v, tr->pv, x, f),
+            !active && !tr->pactive); /* free steps */
     if (active)
         tr->fpeak = fmax(tr->fpeak, lam);
     if (active && !tr->pactive) { /* an element engaged at a located closing */
@@ -255,10 +254,11 @@ int pd_newmark_budget(const pd_penalty_opts *po, double dt, double tau_end, pd_e
     if (strcmp(po->stepper, "newmark") || steps <= (double)po->max_steps)
         return PD_OK;
     if (po->h < dt)
-        return pd_err_set(err, PD_EINVAL, "kc: newmark's steps resolve the stiffest contact "
+        return pd_err_set(err, PD_EINVAL,
+                          "kc: newmark's steps resolve the stiffest contact "
                           "element (%d per period): %.3g steps (at most %ld); a softer contact "
-                          "(kc, kc-abs) or --method penalty", (int)PD_NEWMARK_STEPS_PER_CONTACT, steps,
-                          po->max_steps);
+                          "(kc, kc-abs) or --method penalty",
+                          (int)PD_NEWMARK_STEPS_PER_CONTACT, steps, po->max_steps);
     return pd_err_set(err, PD_EINVAL, "dt: newmark's %.3g steps (at most %ld); a longer step",
                       steps, po->max_steps);
 }
@@ -280,8 +280,8 @@ double pd_osc_penalty_kc(const pd_osc *c, const pd_penalty_setup *po)
 }
 
 /* Results back in metres and seconds. */
-static void fill_result(const pen_track *tr, const pd_run_opts *o,
-                        const pd_penalty_result *pr, pd_osc_result *res)
+static void fill_result(const pen_track *tr, const pd_run_opts *o, const pd_penalty_result *pr,
+                        pd_osc_result *res)
 {
     memset(res, 0, sizeof *res);
     res->umax = tr->xmax * tr->Le;
@@ -346,7 +346,9 @@ int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler samp
                       .force = pd_osc_model_force,
                       .force_ctx = (void *)c,
                       .breaks = brks ? brks + 1 : &brk,
-                      .nbreaks = brks ? (int)(c->record->npts - 1) : brk > 0.0 ? 1 : 0};
+                      .nbreaks = brks        ? (int)(c->record->npts - 1)
+                                 : brk > 0.0 ? 1
+                                             : 0};
     pen_track tr;
     memset(&tr, 0, sizeof tr);
     tr.c = c;
@@ -385,8 +387,8 @@ int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler samp
         free(brks);
         return rc;
     }
-    rc = pd_penalty_run(&model, 0.0, NULL, NULL, tau_end, &eo, sampler ? emit_sample : NULL,
-                        &tr, &pr, err);
+    rc = pd_penalty_run(&model, 0.0, NULL, NULL, tau_end, &eo, sampler ? emit_sample : NULL, &tr,
+                        &pr, err);
     free(brks);
     fill_result(&tr, &o, &pr, res);
     res->cpu_s = pd_cpu_seconds() - cpu0;

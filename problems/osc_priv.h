@@ -54,8 +54,12 @@ typedef struct pd_osc_coefs {
 static inline pd_model pd_osc_model(const pd_osc *c, int no_wall, pd_osc_coefs *k,
                                     const double *breaks, int nbreaks)
 {
-    *k = (pd_osc_coefs){.M = 1.0, .C = 2.0 * c->xi * c->Pi2, .K = c->Pi2 * c->Pi2, .W = -1.0,
-                        .g0 = c->Pi3, .e = c->eps};
+    *k = (pd_osc_coefs){.M = 1.0,
+                        .C = 2.0 * c->xi * c->Pi2,
+                        .K = c->Pi2 * c->Pi2,
+                        .W = -1.0,
+                        .g0 = c->Pi3,
+                        .e = c->eps};
     return (pd_model){.n = 1,
                       .m = no_wall ? 0 : 1,
                       .M = pd_matrix_dense(1, 1, &k->M),

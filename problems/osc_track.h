@@ -10,9 +10,9 @@
 #include "pd_problems.h"
 
 typedef struct pd_osc_track {
-    double h;             /* dimensionless step */
-    double Pi3;           /* gap */
-    double tau_measure;   /* window start (dimensionless) */
+    double h;           /* dimensionless step */
+    double Pi3;         /* gap */
+    double tau_measure; /* window start (dimensionless) */
     double xmax, xtoward, xaway;
     long impacts, contact_steps;
     double first_tau, first_v, vimp_max, Pmax;
@@ -45,8 +45,7 @@ static inline void pd_osc_track_common(pd_osc_track *tr, double t, double x, dou
 static inline int pd_osc_track_events_due(const pd_osc_track *tr, long step, double x, double P)
 {
     double gap = tr->Pi3 - x, g_prev = tr->Pi3 - tr->prev_x;
-    return (step > 0 && g_prev > 0.0 && (gap <= 0.0 || P > 0.0)) ||
-           (P > 0.0 && tr->prev_P == 0.0);
+    return (step > 0 && g_prev > 0.0 && (gap <= 0.0 || P > 0.0)) || (P > 0.0 && tr->prev_P == 0.0);
 }
 
 /* The gap closing's instant and speed, and the impact begun (counted, its
@@ -81,8 +80,8 @@ void pd_osc_track_result(const pd_osc_track *tr, const pd_osc *c, double dt, lon
  * Pi units: back to seconds and metres (wp, Le, vscale = Le wp), with the
  * impacts begun since the one sampled before (*sampled, moved on). */
 static inline pd_osc_sample pd_osc_track_sample(const pd_osc_track *tr, long *sampled, long step,
-                                                double t, double x, double v, double P,
-                                                double wp, double Le, double vscale)
+                                                double t, double x, double v, double P, double wp,
+                                                double Le, double vscale)
 {
     pd_osc_sample smp = {.step = step,
                          .t = t / wp,

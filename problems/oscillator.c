@@ -15,7 +15,6 @@
 #include "demand.h"
 #include "pd_problems.h"
 
-
 pd_osc pd_osc_default(void)
 {
     return (pd_osc){.pulse = PD_PULSE_SINE,
@@ -28,10 +27,22 @@ pd_osc pd_osc_default(void)
                     .xi = 0.05};
 }
 
-double pd_osc_wp(const pd_osc *c) { return c ? PD_TWO_PI / c->Tp : NAN; }
-double pd_osc_T0(const pd_osc *c) { return c ? c->Tp / c->Pi2 : NAN; }
-double pd_osc_Le(const pd_osc *c) { return c ? c->ap / (pd_osc_wp(c) * pd_osc_wp(c)) : NAN; }
-double pd_osc_gap(const pd_osc *c) { return c ? c->Pi3 * pd_osc_Le(c) : NAN; }
+double pd_osc_wp(const pd_osc *c)
+{
+    return c ? PD_TWO_PI / c->Tp : NAN;
+}
+double pd_osc_T0(const pd_osc *c)
+{
+    return c ? c->Tp / c->Pi2 : NAN;
+}
+double pd_osc_Le(const pd_osc *c)
+{
+    return c ? c->ap / (pd_osc_wp(c) * pd_osc_wp(c)) : NAN;
+}
+double pd_osc_gap(const pd_osc *c)
+{
+    return c ? c->Pi3 * pd_osc_Le(c) : NAN;
+}
 
 void pd_osc_set_T0(pd_osc *c, double T0)
 {
@@ -79,8 +90,9 @@ double pd_osc_shape(const pd_osc *c, double tau, int side)
         return pd_pulse_shape(c->pulse, c->dir, tau, side);
     if (tau < 0.0 || after_record(c, tau, side))
         return 0.0;
-    return -c->dir * pd_record_acc(c->record, fmin(tau / pd_osc_wp(c),
-                                                   pd_record_duration(c->record))) / c->rec_ap;
+    return -c->dir *
+           pd_record_acc(c->record, fmin(tau / pd_osc_wp(c), pd_record_duration(c->record))) /
+           c->rec_ap;
 }
 
 /* d/dtau of the shape: the slope of the record's piece at tau. */
@@ -133,8 +145,10 @@ int pd_osc_check(const pd_osc *c, pd_err *err)
         return pd_err_set(err, PD_EINVAL, "pulse must be sine, cosine or harmonic");
     if (c->record && (!(c->rec_ap > 0.0) || !isfinite(c->rec_ap) || !(c->scale > 0.0) ||
                       !isfinite(c->scale) || c->record->npts < 2 || !(c->record->dt > 0.0)))
-        return pd_err_set(err, PD_EINVAL, "record %s: scale (got %g) and the fitted pulse's ap "
-                          "(got %g) must be > 0", c->record->name, c->scale, c->rec_ap);
+        return pd_err_set(err, PD_EINVAL,
+                          "record %s: scale (got %g) and the fitted pulse's ap "
+                          "(got %g) must be > 0",
+                          c->record->name, c->scale, c->rec_ap);
     if (c->dir != 1 && c->dir != -1)
         return pd_err_set(err, PD_EINVAL, "dir must be normal (+1) or reverse (-1)");
     if (!(c->ap > 0.0) || !isfinite(c->ap))
@@ -161,7 +175,8 @@ int pd_osc_resolve_opts(const pd_osc *c, const pd_run_opts *in, pd_run_opts *out
     if ((rc = pd_osc_check(c, err)) || (rc = pd_run_opts_check(out, err)))
         return rc;
     if (out->method == PD_METHOD_EVENT_GENERAL)
-        return pd_err_set(err, PD_EINVAL, "method: event-general is the general reference for "
+        return pd_err_set(err, PD_EINVAL,
+                          "method: event-general is the general reference for "
                           "scenes; the oscillator's exact reference is event");
     if (out->dt == 0.0 && out->rtol == 0.0)
         out->dt = pd_osc_default_dt(c);
@@ -223,8 +238,8 @@ double pd_osc_default_tend(const pd_osc *c)
     if (c->pulse != PD_PULSE_HARMONIC)
         return c->Tp + 2.0 * T0;
     double w0 = PD_TWO_PI / T0;
-    double transient = c->xi > 0.0 ? fmax(20.0 * c->Tp, log(1e3) / (c->xi * w0))
-                                   : 20.0 * c->Tp + 20.0 * T0;
+    double transient =
+        c->xi > 0.0 ? fmax(20.0 * c->Tp, log(1e3) / (c->xi * w0)) : 20.0 * c->Tp + 20.0 * T0;
     return transient + harmonic_window(c);
 }
 
@@ -242,12 +257,12 @@ double pd_osc_measure_start(const pd_osc *c, double tend)
 /* The observer's context: the measurements and the sampler. */
 typedef struct tracker {
     pd_osc_track m;
-    double Pprev, vprev;  /* the previous step's impulse and rate (a held contact) */
-    const pd_osc *c;      /* its excitation (the held force) */
-    long sampled;         /* impacts reported to the sampler */
+    double Pprev, vprev; /* the previous step's impulse and rate (a held contact) */
+    const pd_osc *c;     /* its excitation (the held force) */
+    long sampled;        /* impacts reported to the sampler */
     double Le, vscale, wp;
-    pd_demand_osc dem;    /* the absolute acceleration's peak (Pi units) */
-    int demands;          /* 0: not measured (pd_run_opts.no_demands) */
+    pd_demand_osc dem; /* the absolute acceleration's peak (Pi units) */
+    int demands;       /* 0: not measured (pd_run_opts.no_demands) */
     pd_osc_sampler sampler;
     void *sampler_ctx;
 } tracker;
@@ -332,8 +347,8 @@ static int observe(const pd_state *st, void *ctx)
     if (tr->demands) /* the steps' own, as umax, with a held contact's force */
         pd_demand_osc_note(&tr->dem, st->t, x, v, NULL,
                            P > 0.0 && tr->Pprev > 0.0
-                               ? pd_demand_osc_held(&tr->dem, st->h, P, tr->Pprev, v, tr->vprev,
-                                                    x, pd_osc_shape(tr->c, st->t, -1))
+                               ? pd_demand_osc_held(&tr->dem, st->h, P, tr->Pprev, v, tr->vprev, x,
+                                                    pd_osc_shape(tr->c, st->t, -1))
                                : 0.0,
                            0);
     tr->Pprev = P;
@@ -385,9 +400,8 @@ static inline int scalar_osc_observe(void *ctx, const mj1_state *x, double tau)
  * breakpoints and failure as pd_mj's) with the tracks as its observer,
  * called directly, so that the state stays in registers.  Its steps taken
  * go to *steps. */
-static int simulate_scalar(const pd_osc *c, const pd_model *md, const pd_mj_opts *mo,
-                           long nsteps, pd_osc_track *tr, pd_demand_osc *dem, long *steps,
-                           pd_err *err)
+static int simulate_scalar(const pd_osc *c, const pd_model *md, const pd_mj_opts *mo, long nsteps,
+                           pd_osc_track *tr, pd_demand_osc *dem, long *steps, pd_err *err)
 {
     const double h = mo->h, t0 = 0.0;
     mj1_coef s1 = mj1_coef_make(1.0, pd_matrix_get(&md->C, 0, 0), pd_matrix_get(&md->K, 0, 0),
@@ -406,8 +420,8 @@ static int simulate_scalar(const pd_osc *c, const pd_model *md, const pd_mj_opts
     return rc;
 }
 
-int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler,
-                    void *ctx, pd_osc_result *res, pd_err *err)
+int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
+                    pd_osc_result *res, pd_err *err)
 {
     pd_err own_err; /* the status read back when the caller passed no pd_err */
     err = pd_err_or(err, &own_err);
@@ -430,8 +444,13 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
 
     double cpu0 = pd_cpu_seconds();
     double wp = pd_osc_wp(c), Le = pd_osc_Le(c);
-    tracker tr = {.Le = Le, .vscale = Le * wp, .wp = wp, .demands = !o.no_demands, .c = c,
-                  .sampler = sampler, .sampler_ctx = ctx};
+    tracker tr = {.Le = Le,
+                  .vscale = Le * wp,
+                  .wp = wp,
+                  .demands = !o.no_demands,
+                  .c = c,
+                  .sampler = sampler,
+                  .sampler_ctx = ctx};
     pd_osc_track_init(&tr.m, c, mo.h, wp * pd_osc_measure_start(c, o.tend));
     tr.dem = (pd_demand_osc){.C = k.C, .K = k.K, .tau_measure = tr.m.tau_measure - 0.5 * mo.h};
     if (!sampler && mo.kernel == PD_KERNEL_AUTO && mo.factor == PD_FACTOR_AUTO) {
@@ -462,7 +481,7 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
     res->kernel = pd_mj_kernel_name(mj);
     pd_mj_free(mj);
     pd_demand_osc_finish(res, &o, tr.demands ? tr.dem.peak * c->ap : NAN,
-                             tr.demands ? tr.dem.shear * c->ap : NAN, NAN);
+                         tr.demands ? tr.dem.shear * c->ap : NAN, NAN);
     res->cpu_s = pd_cpu_seconds() - cpu0;
     return rc;
 }
@@ -471,9 +490,9 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
 typedef struct ref_bridge {
     double wp, Le, vscale, Pi3;
     const pd_osc *c;
-    pd_demand_osc dem;    /* the absolute acceleration's peak (Pi units) */
-    long impacts, impacts_prev; /* impacts seen, and by the previous sample */
-    int rest_prev;        /* the previous sample was resting on the wall */
+    pd_demand_osc dem;           /* the absolute acceleration's peak (Pi units) */
+    long impacts, impacts_prev;  /* impacts seen, and by the previous sample */
+    int rest_prev;               /* the previous sample was resting on the wall */
     double tprev, fprev, fdprev; /* its time, excitation and excitation's rate */
     long step;
     const pd_ed_result *er; /* the run's impacts and impulse so far */
@@ -496,8 +515,8 @@ static int ref_sample(double tau, double x, double v, int in_contact, void *ctx)
     /* at rest from the previous sample on, a_abs = |f|: its peak between
      * them on the cubic Hermite of (f, f') */
     if (in_contact && b->rest_prev && tau > b->tprev && b->tprev >= b->dem.tau_measure)
-        b->dem.peak = pd_max(b->dem.peak, pd_demand_cubic_peak(b->fprev, b->fdprev, f, fd,
-                                                               tau - b->tprev));
+        b->dem.peak =
+            pd_max(b->dem.peak, pd_demand_cubic_peak(b->fprev, b->fdprev, f, fd, tau - b->tprev));
     b->tprev = tau;
     b->fprev = f;
     b->fdprev = fd;
@@ -595,9 +614,10 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
         return rc;
     double scan = pd_osc_scan_points(c, o.tend); /* its scan grid: the cost */
     if (!(scan <= PD_OSC_MAX_SCAN))
-        return pd_err_set(err, PD_EINVAL, "Pi2: the event-driven reference would scan %.3g "
-                          "points over tend (T0 = %.3g s; at most %.0e)", scan, pd_osc_T0(c),
-                          PD_OSC_MAX_SCAN);
+        return pd_err_set(err, PD_EINVAL,
+                          "Pi2: the event-driven reference would scan %.3g "
+                          "points over tend (T0 = %.3g s; at most %.0e)",
+                          scan, pd_osc_T0(c), PD_OSC_MAX_SCAN);
     pd_sine_piece *pieces;
     int npieces;
     if ((rc = pd_osc_pieces(c, &pieces, &npieces, err)))
@@ -613,19 +633,26 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     eo.t_end = wp * o.tend;
     eo.t_measure = wp * pd_osc_measure_start(c, o.tend);
     /* the grid: samples every dt; else the demand's states (with its impacts) */
-    eo.h_out = sampler ? PD_TWO_PI * (o.dt / c->Tp)
+    eo.h_out = sampler        ? PD_TWO_PI * (o.dt / c->Tp)
                : o.no_demands ? 0.0
                               : PD_TWO_PI * (ref_demand_grid(c, o.dt) / c->Tp);
     eo.on_impact = o.no_demands ? NULL : ref_impact;
     eo.no_accumulation = o.no_accumulation;
-    ref_bridge bridge = {.wp = wp, .Le = Le, .vscale = Le * wp, .Pi3 = c->Pi3, .c = c,
-                         .dem = {.C = 2.0 * c->xi * c->Pi2, .K = c->Pi2 * c->Pi2,
-                                 .tau_measure = eo.t_measure},
-                         .step = 0, .er = &er, .sampler = sampler, .ctx = ctx};
+    ref_bridge bridge = {
+        .wp = wp,
+        .Le = Le,
+        .vscale = Le * wp,
+        .Pi3 = c->Pi3,
+        .c = c,
+        .dem = {.C = 2.0 * c->xi * c->Pi2, .K = c->Pi2 * c->Pi2, .tau_measure = eo.t_measure},
+        .step = 0,
+        .er = &er,
+        .sampler = sampler,
+        .ctx = ctx};
     eo.on_impact_ctx = &bridge;
     double cpu0 = pd_cpu_seconds();
-    rc = pd_ed_sdof_run(&prob, 0.0, 0.0, &eo, eo.h_out > 0.0 ? ref_sample : NULL, &bridge, &er,
-                        err);
+    rc =
+        pd_ed_sdof_run(&prob, 0.0, 0.0, &eo, eo.h_out > 0.0 ? ref_sample : NULL, &bridge, &er, err);
     free(pieces);
     memset(res, 0, sizeof *res);
     res->umax = er.xmax * Le;
@@ -703,10 +730,16 @@ int pd_osc_run(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler,
     pd_run_opts o = opts ? *opts : pd_run_default_opts();
     int rc;
     switch (pd_osc_method(c, &o)) {
-    case PD_METHOD_EVENT: rc = pd_osc_reference(c, &o, sampler, ctx, res, err); break;
+    case PD_METHOD_EVENT:
+        rc = pd_osc_reference(c, &o, sampler, ctx, res, err);
+        break;
     case PD_METHOD_PENALTY:
-    case PD_METHOD_NEWMARK: rc = pd_osc_penalty(c, &o, sampler, ctx, res, err); break;
-    default: rc = pd_osc_simulate(c, &o, sampler, ctx, res, err); break;
+    case PD_METHOD_NEWMARK:
+        rc = pd_osc_penalty(c, &o, sampler, ctx, res, err);
+        break;
+    default:
+        rc = pd_osc_simulate(c, &o, sampler, ctx, res, err);
+        break;
     }
     return rc ? rc : pd_demand_check_force(res->max_impulse, res->force_equiv, -1, err);
 }

@@ -76,10 +76,10 @@ PD_API int pd_record_units_parse(const char *name, pd_record_units *u);
 
 /* Standard gravity used to convert records given in g (PD_G_STANDARD). */
 typedef struct pd_record {
-    char name[256];  /* the file's name without its folders */
-    long npts;       /* samples >= 2 */
-    double dt;       /* sample step [s] > 0 */
-    double *acc;     /* npts ground accelerations [m/s^2] at t_k = k dt (malloc'd) */
+    char name[256]; /* the file's name without its folders */
+    long npts;      /* samples >= 2 */
+    double dt;      /* sample step [s] > 0 */
+    double *acc;    /* npts ground accelerations [m/s^2] at t_k = k dt (malloc'd) */
 } pd_record;
 
 /* Read a record; units apply to text files only (AT2 is in g, V2 says).
@@ -95,8 +95,7 @@ PD_API int pd_record_detect(const char *path, pd_record_format *format, pd_err *
  * it was read in (1e-4 g to 5 g): 1 if so; 0 with a warning in msg (up to
  * cap bytes; msg may be NULL) naming the units that would make it
  * plausible; 0 for a NULL or empty record. */
-PD_API int pd_record_plausible(const pd_record *rec, pd_record_units units, char *msg,
-                               size_t cap);
+PD_API int pd_record_plausible(const pd_record *rec, pd_record_units units, char *msg, size_t cap);
 /* A record from npts >= 2 accelerations acc[k] at t_k = k dt, in units
  * (converted to m/s^2 as the readers do: the same values give the same
  * record bit for bit), named name (NULL: "array").  acc is copied (rec owns
@@ -119,10 +118,10 @@ PD_API double pd_record_acc(const pd_record *rec, double t);
  * for the piecewise-linear a), significant durations T5-75 and T5-95 from
  * the normalised Husid curve (times solved inside their step). */
 typedef struct pd_record_measures {
-    double pga, pgv, pgd;        /* max |a| [m/s^2], |v| [m/s], |d| [m] */
-    double t_pga, t_pgv, t_pgd;  /* their times [s] */
-    double arias;                /* [m/s] */
-    double t5_75, t5_95;         /* [s] */
+    double pga, pgv, pgd;       /* max |a| [m/s^2], |v| [m/s], |d| [m] */
+    double t_pga, t_pgv, t_pgd; /* their times [s] */
+    double arias;               /* [m/s] */
+    double t5_75, t5_95;        /* [s] */
 } pd_record_measures;
 
 PD_API int pd_record_measure(const pd_record *rec, pd_record_measures *m, pd_err *err);
@@ -178,7 +177,7 @@ typedef enum {
     PD_METHOD_PENALTY = 2,
     PD_METHOD_AUTO = 3,
     PD_METHOD_EVENT_GENERAL = 4, /* scenes: the GSL-based general reference (pd_edg_run) */
-    PD_METHOD_NEWMARK = 5 /* the penalty elements on fixed steps dt of the implicit
+    PD_METHOD_NEWMARK = 5        /* the penalty elements on fixed steps dt of the implicit
                              average-acceleration Newmark scheme with Newton iterations
                              (pd_penalty_run's stepper "newmark"): what OpenSees users run */
 } pd_method;
@@ -224,19 +223,19 @@ typedef struct pd_run_opts {
     pd_penalty_setup pen;
     pd_lcp_observer on_lcp; /* Moreau–Jean's general kernel: every contact LCP solved */
     void *on_lcp_ctx;
-    double close_tol;   /* event-driven rows: at an impact, contacts whose gap is within
+    double close_tol;         /* event-driven rows: at an impact, contacts whose gap is within
                            close_tol Le are closed too (simultaneous); >= 0 */
     pd_impact_law impact_law; /* event-driven rows: the impact law of several closed
                                  contacts (PD_IMPACT_STAGED, PD_IMPACT_SINGLE) */
-    int no_law_band;    /* 1: no second run under the other impact law (law_band NAN):
+    int no_law_band;          /* 1: no second run under the other impact law (law_band NAN):
                            the sweeps and the timed re-runs */
-    double contact_duration; /* td [s] of the equivalent contact force pi I / (2 td) of an
+    double contact_duration;  /* td [s] of the equivalent contact force pi I / (2 td) of an
                                 impact of impulse I (a half-sine pulse); 0 = PD_CONTACT_DURATION */
-    int no_demands;     /* 1: do not measure the peak accelerations and shears (NAN): the
+    int no_demands;           /* 1: do not measure the peak accelerations and shears (NAN): the
                            sweeps, the contact-free twins and the timed re-runs, whose
                            figures do not use them (the exact references sample a grid
                            for them) */
-    double rtol;        /* > 0: Moreau-Jean to this relative tolerance of every reported
+    double rtol;              /* > 0: Moreau-Jean to this relative tolerance of every reported
                            peak (docs/scheme.md, "Moreau–Jean to a tolerance"; then dt must
                            be 0, the method moreau or auto, which it makes moreau); 0:
                            fixed steps dt */
@@ -296,8 +295,8 @@ typedef struct pd_osc {
     /* a record instead of the pulse (pd_osc_set_record; NULL: the pulse):
      * f(t) = -dir scale ug''(t), ap = scale rec_ap and Tp from its fitted pulse */
     const pd_record *record;
-    double rec_ap;      /* the fitted pulse's ap at scale 1 [m/s^2] */
-    double scale;       /* the record's scale S > 0 */
+    double rec_ap; /* the fitted pulse's ap at scale 1 [m/s^2] */
+    double scale;  /* the record's scale S > 0 */
 } pd_osc;
 
 /* sine, normal, ap = 1, Tp = 1, Pi2 = 1, Pi3 = 0.05, eps = 0.5, xi = 0.05. */
@@ -371,40 +370,40 @@ typedef int (*pd_osc_sampler)(const pd_osc_sample *s, void *ctx);
 
 /* What a run measures. */
 typedef struct pd_osc_result {
-    double umax;          /* max |u| over the measuring window [m] */
-    double u_toward;      /* max u (toward the wall) [m] */
-    double u_away;        /* max -u (away from the wall) [m] */
-    long impacts;         /* contact episodes begun */
-    double first_impact;  /* time of the first impact [s], NAN when none */
+    double umax;                  /* max |u| over the measuring window [m] */
+    double u_toward;              /* max u (toward the wall) [m] */
+    double u_away;                /* max -u (away from the wall) [m] */
+    long impacts;                 /* contact episodes begun */
+    double first_impact;          /* time of the first impact [s], NAN when none */
     double first_impact_velocity; /* u' at that instant [m/s], NAN when none */
     double max_impact_velocity;   /* largest approach speed of any impact [m/s] */
-    double max_impulse;   /* largest impulse of one impact per unit mass [m/s] */
-    double contact_time;  /* time spent in contact [s] */
-    double min_gap;       /* smallest gap seen [m] (negative: penetration) */
-    long accumulations;   /* event-driven: accumulations jumped to rest */
-    long steps;           /* steps (Moreau–Jean, penalty) or events (event-driven) */
+    double max_impulse;           /* largest impulse of one impact per unit mass [m/s] */
+    double contact_time;          /* time spent in contact [s] */
+    double min_gap;               /* smallest gap seen [m] (negative: penetration) */
+    long accumulations;           /* event-driven: accumulations jumped to rest */
+    long steps;                   /* steps (Moreau–Jean, penalty) or events (event-driven) */
     double dt, tend, theta, gamma;
     double cpu_s;
-    const char *kernel;   /* "scalar", "general", "event", or the penalty stepper */
+    const char *kernel; /* "scalar", "general", "event", or the penalty stepper */
     /* demands over the measuring window (pd_run_opts, "demand parameters"), per unit
      * mass; NAN where not measured (the batched runs of pd_osc_run_stream) */
-    double acc_max;       /* peak |2 xi w0 u' + w0^2 u + lambda|: the absolute acceleration
+    double acc_max;          /* peak |2 xi w0 u' + w0^2 u + lambda|: the absolute acceleration
                              [m/s^2], the wall's held force lambda (per unit mass) in it,
                              the impacts' impulses not */
-    double shear_max;     /* peak |2 xi w0 u' + w0^2 u|: the base shear per unit mass [N/kg]
+    double shear_max;        /* peak |2 xi w0 u' + w0^2 u|: the base shear per unit mass [N/kg]
                              (acc_max where the wall holds no force) */
-    double force_max;     /* peak contact force per unit mass [N/kg] (penalty, newmark;
+    double force_max;        /* peak contact force per unit mass [N/kg] (penalty, newmark;
                              NAN for the impulsive methods) */
-    double force_equiv;   /* pd_equivalent_force(max_impulse, td) [N/kg] */
+    double force_equiv;      /* pd_equivalent_force(max_impulse, td) [N/kg] */
     double contact_duration; /* the td used [s] */
     /* Moreau-Jean to a tolerance (rtol > 0; else rtol 0, err_est NAN, rtol_met 1,
      * steps_rejected 0, dt_min = dt_max = dt): */
-    double rtol;          /* the tolerance asked */
-    double err_est;       /* the estimated relative error of the peaks (umax, u_toward,
+    double rtol;           /* the tolerance asked */
+    double err_est;        /* the estimated relative error of the peaks (umax, u_toward,
                              u_away, drift, acc_max): the largest */
-    int rtol_met;         /* 1: err_est <= rtol and no step floor or budget stopped the
+    int rtol_met;          /* 1: err_est <= rtol and no step floor or budget stopped the
                              refinement */
-    long steps_rejected;  /* tries thrown away (a step halved) */
+    long steps_rejected;   /* tries thrown away (a step halved) */
     double dt_min, dt_max; /* the smallest and largest step kept [s] */
 } pd_osc_result;
 
@@ -470,10 +469,10 @@ PD_API int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampl
 /* A run and its no-wall twin, with the paper's figures. */
 typedef struct pd_osc_summary {
     pd_osc_result r, free;
-    double Pi1;   /* umax wp^2 / ap */
-    double gamma; /* umax / umax_free (NAN when umax_free = 0) */
-    double chi;   /* gap / umax_free (NAN when umax_free = 0) */
-    double cpu_s; /* both runs */
+    double Pi1;     /* umax wp^2 / ap */
+    double gamma;   /* umax / umax_free (NAN when umax_free = 0) */
+    double chi;     /* gap / umax_free (NAN when umax_free = 0) */
+    double cpu_s;   /* both runs */
     double err_est; /* to a tolerance: the larger of the two runs' (NAN: fixed steps) */
     int rtol_met;   /* both runs met their tolerance (1 without one) */
 } pd_osc_summary;
@@ -531,8 +530,8 @@ PD_API int pd_measure_run(const pd_osc *c, const pd_run_opts *o, const pd_trace 
  * structure b (right), or a structure to a rigid wall at either end, with
  * gap g = gap + x_b - x_a >= 0 and Newton restitution eps.                    */
 
-#define PD_WALL (-1)        /* the structure index of a rigid wall */
-#define PD_NAME_MAX 64      /* longest structure name + 1 */
+#define PD_WALL (-1)   /* the structure index of a rigid wall */
+#define PD_NAME_MAX 64 /* longest structure name + 1 */
 
 typedef enum {
     PD_DAMPING_RAYLEIGH = 0, /* C = alpha M + beta K: xi at two modes */
@@ -541,35 +540,35 @@ typedef enum {
 
 typedef struct pd_structure {
     char name[PD_NAME_MAX];
-    int storeys;         /* 1 for an SDOF */
-    double *mass;        /* storeys entries [kg] */
-    double *stiffness;   /* storeys entries [N/m]: k_i joins storey i - 1 (ground for i = 1) to i */
-    double xi;           /* damping ratio in [0, 1) */
+    int storeys;       /* 1 for an SDOF */
+    double *mass;      /* storeys entries [kg] */
+    double *stiffness; /* storeys entries [N/m]: k_i joins storey i - 1 (ground for i = 1) to i */
+    double xi;         /* damping ratio in [0, 1) */
     pd_damping damping;
-    int modes[2];        /* Rayleigh: the two modes (1-based) given xi; an SDOF uses mode 1 */
+    int modes[2]; /* Rayleigh: the two modes (1-based) given xi; an SDOF uses mode 1 */
     /* derived by pd_scene_finish */
-    double T0;           /* fundamental period [s] */
-    double period[2];    /* periods of the damping modes [s] */
-    double Tmin;         /* shortest natural period (the highest mode) [s] */
-    double alpha, beta;  /* C = alpha M + beta K */
-    int dof;             /* first dof of the structure in the scene's model */
-    double *height;      /* storeys entries: storey heights [m] (PD_STOREY_HEIGHT unless set) */
+    double T0;          /* fundamental period [s] */
+    double period[2];   /* periods of the damping modes [s] */
+    double Tmin;        /* shortest natural period (the highest mode) [s] */
+    double alpha, beta; /* C = alpha M + beta K */
+    int dof;            /* first dof of the structure in the scene's model */
+    double *height;     /* storeys entries: storey heights [m] (PD_STOREY_HEIGHT unless set) */
 } pd_structure;
 
 typedef struct pd_contact {
-    int a, b;            /* structure indices (file order), PD_WALL for a wall */
+    int a, b;             /* structure indices (file order), PD_WALL for a wall */
     int level_a, level_b; /* storeys, 1-based (0 at a wall) */
-    double gap;          /* [m] >= 0 */
-    double eps;          /* Newton restitution in [0, 1] */
-    int entry;           /* the contacts[] entry of the scene file it came from */
+    double gap;           /* [m] >= 0 */
+    double eps;           /* Newton restitution in [0, 1] */
+    int entry;            /* the contacts[] entry of the scene file it came from */
 } pd_contact;
 
 /* The excitation of a scene: a pulse along +x (dir +1) or -x, or a record
  * whose axis is +x (dir -1 flips it): effective forces -m dir S ug''(t). */
 typedef struct pd_scene_excitation {
     pd_pulse pulse;
-    int dir;             /* +1: first effective inertial force -m ug'' along +x */
-    double ap, Tp;       /* [m/s^2], [s]; a record: S times its fitted pulse's, and its */
+    int dir;                 /* +1: first effective inertial force -m ug'' along +x */
+    double ap, Tp;           /* [m/s^2], [s]; a record: S times its fitted pulse's, and its */
     const pd_record *record; /* NULL: the pulse */
     double rec_ap, scale;    /* the record's fitted ap at scale 1, and S */
 } pd_scene_excitation;
@@ -579,11 +578,11 @@ typedef struct pd_scene {
     pd_structure *st;
     pd_contact *ct;
     pd_scene_excitation exc;
-    double tend;         /* [s]; 0 = derived */
-    int n;               /* degrees of freedom (after pd_scene_finish) */
+    double tend; /* [s]; 0 = derived */
+    int n;       /* degrees of freedom (after pd_scene_finish) */
     int finished;
     int cap_struct, cap_contact; /* allocated entries */
-    int *names;          /* name_cap slots: structure index + 1 by name hash, 0 empty */
+    int *names;                  /* name_cap slots: structure index + 1 by name hash, 0 empty */
     int name_cap;
     pd_record *own_record; /* the record a scene file named (freed with the scene) */
 } pd_scene;
@@ -659,7 +658,7 @@ typedef struct pd_scene_model {
     pd_sparse M, C, K, W;
     double *g0, *e, *mass;
     double breaks[1];
-    pd_osc shape;         /* the excitation's shape in Pi units (pd_osc_shape) */
+    pd_osc shape; /* the excitation's shape in Pi units (pd_osc_shape) */
 } pd_scene_model;
 
 PD_API int pd_scene_model_build(const pd_scene *sc, int with_contacts, pd_scene_model *sm,
@@ -698,16 +697,16 @@ typedef struct pd_scene_result {
      * within the closing tolerance (gap in (0, close_tol Le]), accumulations of
      * impacts jumped to their limit */
     long simultaneous, tol_closed, accumulations;
-    double close_tol;      /* the closing tolerance used [in Le] (NAN: not event-driven) */
+    double close_tol; /* the closing tolerance used [in Le] (NAN: not event-driven) */
     double dt, tend, theta;
-    double cpu_s;          /* the run's CPU time, its sampler's (sample() and the caller's) left out */
+    double cpu_s; /* the run's CPU time, its sampler's (sample() and the caller's) left out */
     const char *method, *kernel, *factor, *lcp_solver;
     /* demands over the measuring window (pd_run_opts, "demand parameters"): */
-    double *acc_max;       /* n: peak |a_abs| per floor [m/s^2] */
-    double *shear_max;     /* n: peak |V_k| per storey [N] (storey 1: the base shear) */
-    double *drift_ratio;   /* n: drift / storey height [-] */
-    double *force_max;     /* m: peak contact force [N] (penalty, newmark; NAN otherwise) */
-    double *force_equiv;   /* m: pd_equivalent_force(max_impulse, td) [N] */
+    double *acc_max;         /* n: peak |a_abs| per floor [m/s^2] */
+    double *shear_max;       /* n: peak |V_k| per storey [N] (storey 1: the base shear) */
+    double *drift_ratio;     /* n: drift / storey height [-] */
+    double *force_max;       /* m: peak contact force [N] (penalty, newmark; NAN otherwise) */
+    double *force_equiv;     /* m: pd_equivalent_force(max_impulse, td) [N] */
     double contact_duration; /* the td used [s] */
     /* Moreau-Jean to a tolerance (rtol > 0; else rtol 0, err_est NAN, rtol_met 1,
      * steps_rejected 0, dt_min = dt_max = dt): */
@@ -729,8 +728,8 @@ typedef struct pd_scene_result {
      * NAN without simultaneous impacts, for the other methods, and with
      * pd_run_opts.no_law_band. */
     const char *impact_law; /* "staged", "single" (NULL: not the row reference) */
-    double *law_band;      /* nstruct */
-    double law_band_max;   /* the largest over the structures (NAN: none measured) */
+    double *law_band;       /* nstruct */
+    double law_band_max;    /* the largest over the structures (NAN: none measured) */
     long law_decided;
 } pd_scene_result;
 
@@ -755,12 +754,12 @@ PD_API int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sa
  *   gamma = umax / umax_free per dof,  chi = gap / approach_free per contact. */
 typedef struct pd_scene_summary {
     pd_scene_result r, free;
-    double *Pi1, *gamma;   /* n */
-    double *Pi2;           /* nstruct */
-    double *Pi3, *chi;     /* m */
+    double *Pi1, *gamma; /* n */
+    double *Pi2;         /* nstruct */
+    double *Pi3, *chi;   /* m */
     double cpu_s;
-    double err_est;        /* to a tolerance: the largest of both runs' (NAN: fixed steps) */
-    int rtol_met;          /* both runs met their tolerance (1 without one) */
+    double err_est;            /* to a tolerance: the largest of both runs' (NAN: fixed steps) */
+    int rtol_met;              /* both runs met their tolerance (1 without one) */
     double *err_est_structure; /* nstruct: each structure's, the larger of both runs' (NAN:
                                   fixed steps) */
 } pd_scene_summary;
@@ -785,12 +784,12 @@ typedef struct pd_scene_trace {
 } pd_scene_trace;
 
 typedef struct pd_scene_errors {
-    double *err_umax, *err_hist;      /* nstruct */
+    double *err_umax, *err_hist;       /* nstruct */
     double err_umax_max, err_hist_max; /* the worst structure */
-    long impacts;                     /* over every contact */
+    long impacts;                      /* over every contact */
     long grid_points;
-    double cpu_s;                     /* the run's, the sampling and comparison left out */
-    int nstruct;                      /* the shape: set by pd_scene_errors_alloc */
+    double cpu_s; /* the run's, the sampling and comparison left out */
+    int nstruct;  /* the shape: set by pd_scene_errors_alloc */
 } pd_scene_errors;
 
 /* Room for the grid of o (NULL: pd_run_default_opts(); PD_EINVAL when it
@@ -848,8 +847,8 @@ typedef struct pd_spectrum {
     int dir[2];
     double ap[PD_SPEC_MAX_LIST], xi[PD_SPEC_MAX_LIST];
     double size[PD_SPEC_MAX_LIST], eps[PD_SPEC_MAX_LIST];
-    int size_is_gap; /* size[] holds gaps in metres (--gap), else Pi3 values */
-    int dimensional; /* --ap given: add the dimensional view (umax vs T0) */
+    int size_is_gap;  /* size[] holds gaps in metres (--gap), else Pi3 values */
+    int dimensional;  /* --ap given: add the dimensional view (umax vs T0) */
     double dt_per_Tp; /* > 0: dt = Tp / dt_per_Tp for every point */
 } pd_spectrum;
 
@@ -912,8 +911,7 @@ PD_API void pd_spec_run_task(const pd_spectrum *s, long task, pd_spec_result *r,
  * gives it (cpu_s aside) with its message when r->status != 0.  The
  * Moreau-Jean tasks run many at a time.  One stream per thread. */
 typedef long (*pd_spec_task_next)(void *ctx);
-typedef void (*pd_spec_task_done)(void *ctx, long task, const pd_spec_result *r,
-                                  const pd_err *err);
+typedef void (*pd_spec_task_done)(void *ctx, long task, const pd_spec_result *r, const pd_err *err);
 PD_API int pd_spec_stream(const pd_spectrum *s, pd_spec_task_next next, pd_spec_task_done done,
                           void *ctx, pd_err *err);
 /* Expected cost of a task: its number of steps. */
@@ -955,12 +953,12 @@ PD_API int pd_spec_sweep(const pd_spectrum *s, pd_spec_point_fn fn, void *ctx, p
  * one per Pi2, then the points, Pi2 fastest, then Pi3, then eps. */
 typedef struct pd_scene_sweep {
     const pd_scene *sc;
-    pd_run_opts opts;      /* dt 0: the scene's default at each point */
-    int ref;               /* reference structure */
-    int ref_contact;       /* reference contact (its gap must be > 0 with Pi3 values) */
+    pd_run_opts opts; /* dt 0: the scene's default at each point */
+    int ref;          /* reference structure */
+    int ref_contact;  /* reference contact (its gap must be > 0 with Pi3 values) */
     double pi2_min, pi2_max;
     int npi2, linear;
-    int npi3, neps;        /* 0: the scene's own gaps, restitutions */
+    int npi3, neps; /* 0: the scene's own gaps, restitutions */
     const double *pi3, *eps;
 } pd_scene_sweep;
 

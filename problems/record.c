@@ -62,8 +62,8 @@
 typedef struct rec_reader {
     const char *path;
     pd_text t;
-    char *line;   /* the current line, NUL-terminated (t's buffer) */
-    long lineno;  /* of the current line, 1-based; 0 before the first */
+    char *line;  /* the current line, NUL-terminated (t's buffer) */
+    long lineno; /* of the current line, 1-based; 0 before the first */
     pd_err *err;
 } rec_reader;
 
@@ -78,10 +78,14 @@ typedef struct rec_buf {
 const char *pd_record_format_name(pd_record_format f)
 {
     switch (f) {
-    case PD_RECORD_AUTO: return "auto";
-    case PD_RECORD_AT2: return "at2";
-    case PD_RECORD_V2: return "v2";
-    case PD_RECORD_TEXT: return "text";
+    case PD_RECORD_AUTO:
+        return "auto";
+    case PD_RECORD_AT2:
+        return "at2";
+    case PD_RECORD_V2:
+        return "v2";
+    case PD_RECORD_TEXT:
+        return "text";
     }
     return "?";
 }
@@ -103,9 +107,12 @@ int pd_record_format_parse(const char *name, pd_record_format *f)
 const char *pd_record_units_name(pd_record_units u)
 {
     switch (u) {
-    case PD_UNITS_G: return "g";
-    case PD_UNITS_M_S2: return "m/s2";
-    case PD_UNITS_CM_S2: return "cm/s2";
+    case PD_UNITS_G:
+        return "g";
+    case PD_UNITS_M_S2:
+        return "m/s2";
+    case PD_UNITS_CM_S2:
+        return "cm/s2";
     }
     return "?";
 }
@@ -172,8 +179,8 @@ double pd_record_acc(const pd_record *rec, double t)
 /* Blank inside a line: space, tab, CR, VT, FF, comma, DOS end of file. */
 static int is_blank(int c)
 {
-    return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f' ||
-           c == ',' || c == 0x1a;
+    return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f' || c == ',' ||
+           c == 0x1a;
 }
 
 /* Past the blanks at p. */
@@ -297,13 +304,12 @@ static int scan_number(rec_reader *r, const char **p, double *x)
     }
     size_t n = number_len(s);
     char c = s[n];
-    if (!n || n >= RECORD_WORD_MAX || !(c == '\0' || is_blank((unsigned char)c) || c == '+' ||
-                                        c == '-')) {
+    if (!n || n >= RECORD_WORD_MAX ||
+        !(c == '\0' || is_blank((unsigned char)c) || c == '+' || c == '-')) {
         int wl = word_len(s);
         if (names_nonfinite(s, wl))
-            return pd_err_set(r->err, PD_EPARSE,
-                              "%s:%ld: expected a finite number, got '%.*s'", r->path,
-                              r->lineno, wl, s);
+            return pd_err_set(r->err, PD_EPARSE, "%s:%ld: expected a finite number, got '%.*s'",
+                              r->path, r->lineno, wl, s);
         return pd_err_set(r->err, PD_EPARSE, "%s:%ld: expected a number, got '%.*s'", r->path,
                           r->lineno, wl, s);
     }
@@ -313,8 +319,8 @@ static int scan_number(rec_reader *r, const char **p, double *x)
     buf[n] = '\0';
     double v = strtod(buf, NULL);
     if (!isfinite(v))
-        return pd_err_set(r->err, PD_EPARSE, "%s:%ld: expected a finite number, got '%s'",
-                          r->path, r->lineno, buf);
+        return pd_err_set(r->err, PD_EPARSE, "%s:%ld: expected a finite number, got '%s'", r->path,
+                          r->lineno, buf);
     *x = v;
     *p = s + n;
     return 1;
@@ -373,7 +379,7 @@ static int at2_npts_dt(const char *s, long *npts, double *dt)
     double n = 0.0;
     if (keyed_number(s, "NPTS", &n) == PD_OK)
         return parse_count(n, npts) == PD_OK && keyed_number(s, "DT", dt) == PD_OK ? PD_OK
-                                                                                 : PD_EPARSE;
+                                                                                   : PD_EPARSE;
     const char *p = skip_blanks(s), *key = find_nocase(s, "NPTS");
     char *end = NULL;
     double a = strtod(p, &end);
@@ -426,13 +432,11 @@ static int check_dt(rec_reader *r, long line, double dt, const char *what)
 static int check_npts_dt(rec_reader *r, long npts, double dt)
 {
     if (npts < 2)
-        return pd_err_set(r->err, PD_EPARSE,
-                          "%s:%ld: NPTS = %ld: expected at least 2 samples", r->path, r->lineno,
-                          npts);
+        return pd_err_set(r->err, PD_EPARSE, "%s:%ld: NPTS = %ld: expected at least 2 samples",
+                          r->path, r->lineno, npts);
     if (npts > RECORD_NPTS_MAX)
-        return pd_err_set(r->err, PD_EPARSE,
-                          "%s:%ld: NPTS = %ld: more samples than the %ld read", r->path,
-                          r->lineno, npts, RECORD_NPTS_MAX);
+        return pd_err_set(r->err, PD_EPARSE, "%s:%ld: NPTS = %ld: more samples than the %ld read",
+                          r->path, r->lineno, npts, RECORD_NPTS_MAX);
     if (!(dt > 0.0) || !isfinite(dt))
         return pd_err_set(r->err, PD_EPARSE, "%s:%ld: DT = %g: expected a positive time step",
                           r->path, r->lineno, dt);
@@ -450,7 +454,8 @@ static int at2_header(rec_reader *r, long *npts, double *dt)
             if (at2_npts_dt(r->line, npts, dt) != PD_OK)
                 return pd_err_set(r->err, PD_EPARSE,
                                   "%s:%ld: expected 'NPTS= N, DT= H SEC' or 'N H NPTS, DT', "
-                                  "got '%.*s'", r->path, r->lineno, shown_len(r->line), r->line);
+                                  "got '%.*s'",
+                                  r->path, r->lineno, shown_len(r->line), r->line);
             return check_npts_dt(r, *npts, *dt);
         }
         if (r->lineno >= RECORD_AT2_HEAD)
@@ -463,7 +468,8 @@ static int at2_header(rec_reader *r, long *npts, double *dt)
                           r->path);
     return pd_err_set(r->err, PD_EPARSE,
                       "%s:1: no PEER .AT2 header: expected a line with NPTS and DT in the "
-                      "first %d lines", r->path, RECORD_AT2_HEAD);
+                      "first %d lines",
+                      r->path, RECORD_AT2_HEAD);
 }
 
 /* A line that ends a V2 data block: the next block's header or "/&". */
@@ -499,8 +505,8 @@ static int read_values(rec_reader *r, long npts, double scale, int v2, rec_buf *
             if ((st = finite_si(r, x, scale)) != PD_OK)
                 return st;
             if (buf_push(b, scale * x, npts) != PD_OK)
-                return pd_err_set(r->err, PD_ENOMEM, "%s: out of memory for %ld samples",
-                                  r->path, npts);
+                return pd_err_set(r->err, PD_ENOMEM, "%s: out of memory for %ld samples", r->path,
+                                  npts);
         }
         if (st < 0)
             return st;
@@ -513,8 +519,8 @@ static int read_values(rec_reader *r, long npts, double scale, int v2, rec_buf *
         return st;
     if (b->n < npts)
         return pd_err_set(r->err, PD_EPARSE,
-                          "%s:%ld: truncated: the data end after %ld of NPTS = %ld values",
-                          r->path, last, b->n, npts);
+                          "%s:%ld: truncated: the data end after %ld of NPTS = %ld values", r->path,
+                          last, b->n, npts);
     return PD_OK;
 }
 
@@ -556,10 +562,12 @@ static int v2_units(rec_reader *r, double *scale)
         return PD_OK;
     const char *p = skip_blanks(u + 6);
     int n = (int)strcspn(p, ") \t\r\n");
-    static const struct { const char *name; double scale; } known[] = {
-        {"CM/SEC/SEC", 0.01}, {"CM/S/S", 0.01}, {"CM/SEC2", 0.01}, {"CM/S2", 0.01},
-        {"MM/SEC/SEC", 0.001}, {"MM/S/S", 0.001}, {"M/SEC/SEC", 1.0}, {"M/S/S", 1.0},
-        {"G", PD_G_STANDARD}};
+    static const struct {
+        const char *name;
+        double scale;
+    } known[] = {{"CM/SEC/SEC", 0.01}, {"CM/S/S", 0.01},      {"CM/SEC2", 0.01},
+                 {"CM/S2", 0.01},      {"MM/SEC/SEC", 0.001}, {"MM/S/S", 0.001},
+                 {"M/SEC/SEC", 1.0},   {"M/S/S", 1.0},        {"G", PD_G_STANDARD}};
     for (size_t i = 0; i < sizeof known / sizeof known[0]; i++)
         if ((int)strlen(known[i].name) == n && find_nocase(p, known[i].name) == p) {
             *scale = known[i].scale;
@@ -567,7 +575,8 @@ static int v2_units(rec_reader *r, double *scale)
         }
     return pd_err_set(r->err, PD_EPARSE,
                       "%s:%ld: unknown acceleration units '%.*s' (expected CM/SEC/SEC, "
-                      "M/SEC/SEC or G)", r->path, r->lineno, n, p);
+                      "M/SEC/SEC or G)",
+                      r->path, r->lineno, n, p);
 }
 
 /* NPTS and DT of the acceleration block header at the current line. */
@@ -579,7 +588,8 @@ static int v2_npts_dt(rec_reader *r, long *npts, double *dt)
     if (end == s || !at || parse_count(n, npts) != PD_OK)
         return pd_err_set(r->err, PD_EPARSE,
                           "%s:%ld: expected 'N POINTS OF ACCEL DATA EQUALLY SPACED AT H SEC', "
-                          "got '%.*s'", r->path, r->lineno, shown_len(s), s);
+                          "got '%.*s'",
+                          r->path, r->lineno, shown_len(s), s);
     *dt = strtod(at + 9, &end);
     if (end == at + 9)
         return pd_err_set(r->err, PD_EPARSE, "%s:%ld: expected the time step after 'SPACED AT'",
@@ -593,7 +603,7 @@ typedef struct v2_head {
                            * "UNCORRECTED ACCELEROGRAM DATA" */
     long npts, npts_line; /* the text's "N POINTS OF ... DATA" and its line (0: none) */
     double dt;
-    long dt_line;         /* the text's "INTERVALS OF H SEC" and its line (0: none) */
+    long dt_line; /* the text's "INTERVALS OF H SEC" and its line (0: none) */
     double ints[RECORD_V2_INTS], reals[RECORD_V2_REALS]; /* CDMG: the numeric headers */
 } v2_head;
 
@@ -652,8 +662,8 @@ static int v2_fields(const char *s, int n, int w, int integer, double *x)
 /* The current line, of a CDMG numeric header (`what`: "integer" or
  * "real") of count values from line first on, cols of width w to a line:
  * its values into x. */
-static int v2_numeric_line(rec_reader *r, const char *what, long first, int count, int cols,
-                           int w, int integer, double *x)
+static int v2_numeric_line(rec_reader *r, const char *what, long first, int count, int cols, int w,
+                           int integer, double *x)
 {
     long row = r->lineno - first;
     int at = (int)row * cols, n = count - at < cols ? count - at : cols;
@@ -662,8 +672,8 @@ static int v2_numeric_line(rec_reader *r, const char *what, long first, int coun
         return PD_OK;
     return pd_err_set(r->err, PD_EPARSE,
                       "%s:%ld: V2 %s header (lines %ld-%ld of the CDMG layout): expected %d %s "
-                      "in columns of %d, got %s", r->path, r->lineno, what, first,
-                      first + (count + cols - 1) / cols - 1, n,
+                      "in columns of %d, got %s",
+                      r->path, r->lineno, what, first, first + (count + cols - 1) / cols - 1, n,
                       integer ? "integers" : "numbers", w, v2_got(r->line, got, sizeof got));
 }
 
@@ -723,7 +733,8 @@ static int v2_header_end(rec_reader *r, const v2_head *h, int st)
     if (!h->cdmg)
         return pd_err_set(r->err, PD_EPARSE,
                           "%s:%ld: no V2 acceleration block ('N POINTS OF ACCEL DATA EQUALLY "
-                          "SPACED AT H SEC')", r->path, r->lineno);
+                          "SPACED AT H SEC')",
+                          r->path, r->lineno);
     const char *where = "ends before the acceleration block header";
     if (r->lineno < RECORD_V2_TEXT_LINES)
         where = "ends in the V2 text header";
@@ -733,9 +744,9 @@ static int v2_header_end(rec_reader *r, const v2_head *h, int st)
         where = "ends in the V2 real header";
     return pd_err_set(r->err, PD_EPARSE,
                       "%s:%ld: the file %s (the CDMG layout: %d text, %d integer and %d real "
-                      "lines, the acceleration block header on line %d)", r->path, r->lineno,
-                      where, RECORD_V2_TEXT_LINES, RECORD_V2_INT_LINES, RECORD_V2_REAL_LINES,
-                      RECORD_V2_HEAD_LINES + 1);
+                      "lines, the acceleration block header on line %d)",
+                      r->path, r->lineno, where, RECORD_V2_TEXT_LINES, RECORD_V2_INT_LINES,
+                      RECORD_V2_REAL_LINES, RECORD_V2_HEAD_LINES + 1);
 }
 
 /* Read a V2 header up to its first acceleration block's header (then the
@@ -754,9 +765,9 @@ static int v2_header(rec_reader *r, v2_head *h)
                 return pd_err_set(r->err, PD_EPARSE,
                                   "%s:%ld: the acceleration block header is on line %ld, but the "
                                   "CDMG V2 header's %ld lines put it on line %ld (%d text, %d "
-                                  "integer, %d real: a header line lost or added?)", r->path,
-                                  r->lineno, r->lineno, block - 1, block, RECORD_V2_TEXT_LINES,
-                                  RECORD_V2_INT_LINES, RECORD_V2_REAL_LINES);
+                                  "integer, %d real: a header line lost or added?)",
+                                  r->path, r->lineno, r->lineno, block - 1, block,
+                                  RECORD_V2_TEXT_LINES, RECORD_V2_INT_LINES, RECORD_V2_REAL_LINES);
             return PD_OK;
         }
         if ((st = v2_boundary(r)) != PD_OK)
@@ -775,9 +786,10 @@ static int v2_header(rec_reader *r, v2_head *h)
             return pd_err_set(r->err, PD_EPARSE,
                               "%s:%ld: expected the acceleration block header 'N POINTS OF "
                               "ACCEL DATA EQUALLY SPACED AT H SEC' after the CDMG V2 header's "
-                              "%ld lines (%d text, %d integer, %d real), got %s", r->path,
-                              r->lineno, block - 1, RECORD_V2_TEXT_LINES, RECORD_V2_INT_LINES,
-                              RECORD_V2_REAL_LINES, v2_got(r->line, got, sizeof got));
+                              "%ld lines (%d text, %d integer, %d real), got %s",
+                              r->path, r->lineno, block - 1, RECORD_V2_TEXT_LINES,
+                              RECORD_V2_INT_LINES, RECORD_V2_REAL_LINES,
+                              v2_got(r->line, got, sizeof got));
         else
             v2_declared(r, h);
         if (st != PD_OK)
@@ -864,8 +876,8 @@ static int text_where(rec_reader *r, const rec_buf *t, const long *lines, double
     if (k_bad)
         return pd_err_set(r->err, PD_EPARSE,
                           "%s:%ld: non-uniform time column: t = %.9g after %.9g, expected a "
-                          "step of %.9g", r->path, lines[k_bad], t->v[k_bad], t->v[k_bad - 1],
-                          med);
+                          "step of %.9g",
+                          r->path, lines[k_bad], t->v[k_bad], t->v[k_bad - 1], med);
     for (k_bad = 1; k_bad < n - 1; k_bad++)
         if (fabs(t->v[k_bad] - (t->v[0] + (double)k_bad * dt)) > RECORD_TEXT_TOL * dt)
             break;
@@ -925,10 +937,10 @@ static int text_pair(rec_reader *r, double *t, double *a)
     if ((st = scan_number(r, &p, a)) < 0)
         return st;
     if (st == 0 || (st = scan_number(r, &p, &extra)) != 0)
-        return st < 0 ? st
-                      : pd_err_set(r->err, PD_EPARSE,
-                                   "%s:%ld: expected two numbers 't a' on a line", r->path,
-                                   r->lineno);
+        return st < 0
+                   ? st
+                   : pd_err_set(r->err, PD_EPARSE, "%s:%ld: expected two numbers 't a' on a line",
+                                r->path, r->lineno);
     return 1;
 }
 
@@ -946,15 +958,15 @@ static int read_text(rec_reader *r, double scale, rec_buf *b, double *dt)
             continue;
         if (t.n > 0 && !(tk > t.v[t.n - 1])) { /* at once: not after 10^8 samples */
             st = pd_err_set(r->err, PD_EPARSE,
-                            "%s:%ld: the time column must increase (t = %.9g after %.9g)",
-                            r->path, r->lineno, tk, t.v[t.n - 1]);
+                            "%s:%ld: the time column must increase (t = %.9g after %.9g)", r->path,
+                            r->lineno, tk, t.v[t.n - 1]);
             break;
         }
         if ((st = finite_si(r, ak, scale)) != PD_OK)
             break;
         if (t.n >= RECORD_NPTS_MAX) {
-            st = pd_err_set(r->err, PD_EPARSE, "%s:%ld: more samples than the %ld read",
-                            r->path, r->lineno, RECORD_NPTS_MAX);
+            st = pd_err_set(r->err, PD_EPARSE, "%s:%ld: more samples than the %ld read", r->path,
+                            r->lineno, RECORD_NPTS_MAX);
             break;
         }
         if (buf_push(&t, tk, RECORD_NPTS_MAX) || buf_push(b, scale * ak, RECORD_NPTS_MAX) ||
@@ -1053,16 +1065,17 @@ int pd_record_plausible(const pd_record *rec, pd_record_units units, char *msg, 
         }
     }
     if (msg && cap > 0)
-        snprintf(msg, cap, "%s: its peak ground acceleration is %.3g g read in %s, %s than %g "
-                 "g%s%s%s", rec->name, g, pd_record_units_name(units),
-                 g > RECORD_PGA_MAX_G ? "more" : "less",
+        snprintf(msg, cap,
+                 "%s: its peak ground acceleration is %.3g g read in %s, %s than %g "
+                 "g%s%s%s",
+                 rec->name, g, pd_record_units_name(units), g > RECORD_PGA_MAX_G ? "more" : "less",
                  g > RECORD_PGA_MAX_G ? RECORD_PGA_MAX_G : RECORD_PGA_MIN_G,
                  fix ? ": are its values in " : "", fix ? fix : "", fix ? "? (--units)" : "");
     return 0;
 }
 
-int pd_record_from_array(pd_record *rec, const char *name, const double *acc, long npts,
-                         double dt, pd_record_units units, pd_err *err)
+int pd_record_from_array(pd_record *rec, const char *name, const double *acc, long npts, double dt,
+                         pd_record_units units, pd_err *err)
 {
     if (!rec || !acc)
         return PD_NULL_ARG(err, !rec ? "rec" : "acc");
@@ -1079,8 +1092,10 @@ int pd_record_from_array(pd_record *rec, const char *name, const double *acc, lo
     double s = units_scale(units);
     for (long k = 0; k < npts; k++)
         if (!isfinite(s * acc[k]))
-            return pd_err_set(err, PD_EINVAL, "record: sample %ld is %g %s (not a finite "
-                              "acceleration)", k, acc[k], pd_record_units_name(units));
+            return pd_err_set(err, PD_EINVAL,
+                              "record: sample %ld is %g %s (not a finite "
+                              "acceleration)",
+                              k, acc[k], pd_record_units_name(units));
     double *v = malloc((size_t)npts * sizeof(double));
     if (!v)
         return pd_err_set(err, PD_ENOMEM, "record: out of memory for %ld samples", npts);
@@ -1094,8 +1109,8 @@ int pd_record_from_array(pd_record *rec, const char *name, const double *acc, lo
     return PD_OK;
 }
 
-int pd_record_read(const char *path, pd_record_format format, pd_record_units units,
-                   pd_record *rec, pd_err *err)
+int pd_record_read(const char *path, pd_record_format format, pd_record_units units, pd_record *rec,
+                   pd_err *err)
 {
     if (!path || !rec)
         return PD_NULL_ARG(err, !path ? "path" : "rec");
@@ -1108,10 +1123,17 @@ int pd_record_read(const char *path, pd_record_format format, pd_record_units un
         st = detect_format(&r, &format);
     if (st == PD_OK) {
         switch (format) {
-        case PD_RECORD_AT2: st = read_at2(&r, &b, &dt); break;
-        case PD_RECORD_V2: st = read_v2(&r, &b, &dt); break;
-        case PD_RECORD_TEXT: st = read_text(&r, units_scale(units), &b, &dt); break;
-        default: st = pd_err_set(err, PD_EINVAL, "%s: unknown record format %d", path, format);
+        case PD_RECORD_AT2:
+            st = read_at2(&r, &b, &dt);
+            break;
+        case PD_RECORD_V2:
+            st = read_v2(&r, &b, &dt);
+            break;
+        case PD_RECORD_TEXT:
+            st = read_text(&r, units_scale(units), &b, &dt);
+            break;
+        default:
+            st = pd_err_set(err, PD_EINVAL, "%s: unknown record format %d", path, format);
         }
     }
     reader_close(&r);

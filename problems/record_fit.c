@@ -43,9 +43,9 @@
 #include "pd_null.h"
 #include "pd_problems.h"
 
-#define FIT_MAXITER 400        /* trust-region iterations per start */
-#define FIT_TOL 1e-10          /* xtol, gtol, ftol of the driver */
-#define FIT_GAMMA_MIN 1.0      /* gamma = 1 + 3 / (1 + exp(-q)) in (1, 4) */
+#define FIT_MAXITER 400   /* trust-region iterations per start */
+#define FIT_TOL 1e-10     /* xtol, gtol, ftol of the driver */
+#define FIT_GAMMA_MIN 1.0 /* gamma = 1 + 3 / (1 + exp(-q)) in (1, 4) */
 #define FIT_GAMMA_SPAN 3.0
 #define FIT_WINDOW 2.0         /* fit window: PGV time -/+ this many initial periods */
 #define FIT_SAMPLES 20000      /* most samples fitted (a stride thins longer windows) */
@@ -64,8 +64,10 @@ static int record_valid(const pd_record *rec, pd_err *err)
      * overflow or underflow, and indices t / dt are no longer integers */
     if (!(rec->dt >= PD_RECORD_DT_MIN && rec->dt <= PD_RECORD_DT_MAX) ||
         !isfinite(pd_record_duration(rec)))
-        return pd_err_set(err, PD_EINVAL, "%s: dt = %g s: expected a sampling interval in "
-                          "[%g, %g] s", rec->name, rec->dt, PD_RECORD_DT_MIN, PD_RECORD_DT_MAX);
+        return pd_err_set(err, PD_EINVAL,
+                          "%s: dt = %g s: expected a sampling interval in "
+                          "[%g, %g] s",
+                          rec->name, rec->dt, PD_RECORD_DT_MIN, PD_RECORD_DT_MAX);
     return PD_OK;
 }
 
@@ -156,8 +158,8 @@ static void peak_disp(const pd_record *rec, const double *v, const double *d, do
         double da = a[k + 1] - a[k], s[2];
         int n = roots_in_step(0.5 * da / h, a[k], v[k], h, s);
         for (int i = 0; i < n; i++) {
-            double ds = d[k] + v[k] * s[i] + 0.5 * a[k] * s[i] * s[i] +
-                        da * s[i] * s[i] * s[i] / (6.0 * h);
+            double ds =
+                d[k] + v[k] * s[i] + 0.5 * a[k] * s[i] * s[i] + da * s[i] * s[i] * s[i] / (6.0 * h);
             peak_keep(ds, (double)k * h + s[i], pgd, t_pgd);
         }
         peak_keep(d[k + 1], (double)(k + 1) * h, pgd, t_pgd);
@@ -286,8 +288,7 @@ static double mp_acc(const mp_pulse *p, double t)
     if (fabs(tau) > mp_half(p))
         return 0.0;
     double w = PD_TWO_PI * p->fp, phi = w * tau / p->gamma, psi = w * tau + p->nu;
-    return -0.5 * p->vp * w *
-           (sin(phi) * cos(psi) / p->gamma + (1.0 + cos(phi)) * sin(psi));
+    return -0.5 * p->vp * w * (sin(phi) * cos(psi) / p->gamma + (1.0 + cos(phi)) * sin(psi));
 }
 
 /* The velocities the pulse is fitted to: samples k0 + i stride, i < n. */
@@ -398,8 +399,8 @@ static void fit_start(const pd_record *rec, const double *v, mp_pulse *p0, mp_da
 }
 
 /* One trust-region solve from x (5 unknowns, updated); its r2 and iterations. */
-static int fit_once(gsl_multifit_nlinear_workspace *w, gsl_multifit_nlinear_fdf *fdf,
-                    double *x, double *r2, long *iters)
+static int fit_once(gsl_multifit_nlinear_workspace *w, gsl_multifit_nlinear_fdf *fdf, double *x,
+                    double *r2, long *iters)
 {
     gsl_vector_view xv = gsl_vector_view_array(x, 5);
     int info = 0;
@@ -415,7 +416,7 @@ static int fit_once(gsl_multifit_nlinear_workspace *w, gsl_multifit_nlinear_fdf 
     *r2 = mp_r2(fdf->params, &p);
     *iters = (long)gsl_multifit_nlinear_niter(w);
     return isfinite(*r2) && isfinite(p.fp) && isfinite(p.t0) && isfinite(p.vp) ? PD_OK
-                                                                              : PD_ENUMERICAL;
+                                                                               : PD_ENUMERICAL;
 }
 
 /* The best of the starts nu in {0, +-pi/2, pi} x gamma in {1.5, 2, 3}. */
@@ -436,8 +437,7 @@ static int fit_best(const mp_data *D, const mp_pulse *p0, mp_pulse *best, double
         for (size_t j = 0; j < sizeof gammas / sizeof gammas[0]; j++) {
             double g = gammas[j], r2 = 0.0;
             double x[5] = {p0->vp, log(p0->fp), nus[i],
-                           log((g - FIT_GAMMA_MIN) / (FIT_GAMMA_MIN + FIT_GAMMA_SPAN - g)),
-                           p0->t0};
+                           log((g - FIT_GAMMA_MIN) / (FIT_GAMMA_MIN + FIT_GAMMA_SPAN - g)), p0->t0};
             long it = 0;
             if (fit_once(w, &fdf, x, &r2, &it) == PD_OK && r2 > *r2_best) {
                 *r2_best = r2;
@@ -553,7 +553,8 @@ static int fit_check(const pd_record *rec, const mp_pulse *p, double r2, pd_err 
         return PD_OK;
     return pd_err_set(err, PD_ENUMERICAL,
                       "%s: no velocity pulse found: the best fit has r2 = %.3g, Tp = %.4g s "
-                      "at t0 = %.4g s (record %.4g s)", rec->name, r2, 1.0 / p->fp, p->t0, T);
+                      "at t0 = %.4g s (record %.4g s)",
+                      rec->name, r2, 1.0 / p->fp, p->t0, T);
 }
 
 int pd_record_fit_pulse(const pd_record *rec, pd_record_pulse *out, pd_err *err)

@@ -105,35 +105,48 @@ int pd_run_opts_check(const pd_run_opts *o, pd_err *err)
     if (!(o->gamma >= 0.0 && o->gamma <= 1.0))
         return pd_err_set(err, PD_EINVAL, "gamma: must be in [0, 1] (got %g)", o->gamma);
     if (!(o->rtol >= PD_RTOL_MIN && o->rtol < 1.0) && o->rtol != 0.0)
-        return pd_err_set(err, PD_EINVAL, "rtol: Moreau-Jean's relative tolerance must be in "
-                          "[%g, 1), or 0 for fixed steps (got %g)", PD_RTOL_MIN, o->rtol);
+        return pd_err_set(err, PD_EINVAL,
+                          "rtol: Moreau-Jean's relative tolerance must be in "
+                          "[%g, 1), or 0 for fixed steps (got %g)",
+                          PD_RTOL_MIN, o->rtol);
     if (o->rtol > 0.0 && o->method != PD_METHOD_MOREAU && o->method != PD_METHOD_AUTO)
-        return pd_err_set(err, PD_EINVAL, "rtol: the tolerance of Moreau-Jean's steps; method %s "
-                          "has none (penalty: pen.rtol)", pd_method_name(o->method));
+        return pd_err_set(err, PD_EINVAL,
+                          "rtol: the tolerance of Moreau-Jean's steps; method %s "
+                          "has none (penalty: pen.rtol)",
+                          pd_method_name(o->method));
     if (o->rtol > 0.0 && o->dt > 0.0)
-        return pd_err_set(err, PD_EINVAL, "rtol with dt: Moreau-Jean takes fixed steps (dt) or "
+        return pd_err_set(err, PD_EINVAL,
+                          "rtol with dt: Moreau-Jean takes fixed steps (dt) or "
                           "steps to a tolerance (rtol), not both");
     if (!(o->close_tol >= 0.0 && o->close_tol <= 1.0))
-        return pd_err_set(err, PD_EINVAL, "close-tol: the closing tolerance must be in [0, 1] "
-                          "(in units of Le; got %g)", o->close_tol);
+        return pd_err_set(err, PD_EINVAL,
+                          "close-tol: the closing tolerance must be in [0, 1] "
+                          "(in units of Le; got %g)",
+                          o->close_tol);
     if (o->impact_law != PD_IMPACT_STAGED && o->impact_law != PD_IMPACT_SINGLE)
-        return pd_err_set(err, PD_EINVAL, "impact-law: must be staged (%d) or single (%d) (got "
-                          "%d)", (int)PD_IMPACT_STAGED, (int)PD_IMPACT_SINGLE, (int)o->impact_law);
+        return pd_err_set(err, PD_EINVAL,
+                          "impact-law: must be staged (%d) or single (%d) (got "
+                          "%d)",
+                          (int)PD_IMPACT_STAGED, (int)PD_IMPACT_SINGLE, (int)o->impact_law);
     if (!(o->contact_duration >= 0.0) || !isfinite(o->contact_duration))
-        return pd_err_set(err, PD_EINVAL, "contact-duration: the duration of the equivalent "
+        return pd_err_set(err, PD_EINVAL,
+                          "contact-duration: the duration of the equivalent "
                           "contact force must be a finite number > 0 [s], or 0 for the default "
-                          "(got %g)", o->contact_duration);
+                          "(got %g)",
+                          o->contact_duration);
     const pd_penalty_setup *p = &o->pen;
     if (p->law != PD_PENALTY_KELVIN && p->law != PD_PENALTY_HERTZDAMP)
         return pd_err_set(err, PD_EINVAL, "contact: unknown contact law %d", (int)p->law);
     if (!(p->kc_mult >= 0.0) || !isfinite(p->kc_mult))
-        return pd_err_set(err, PD_EINVAL, "kc: the contact stiffness multiple must be > 0, or 0 "
-                          "for the derived default (got %g)", p->kc_mult);
+        return pd_err_set(err, PD_EINVAL,
+                          "kc: the contact stiffness multiple must be > 0, or 0 "
+                          "for the derived default (got %g)",
+                          p->kc_mult);
     if (!(p->kc_abs >= 0.0) || !isfinite(p->kc_abs))
         return pd_err_set(err, PD_EINVAL, "kc-abs: the contact stiffness must be >= 0 (got %g)",
                           p->kc_abs);
     if (!(p->rtol > 0.0 && p->atol > 0.0) || !isfinite(p->rtol) || !isfinite(p->atol))
-        return pd_err_set(err, PD_EINVAL, "rtol/atol: tolerances must be > 0 (got %g, %g)",
-                          p->rtol, p->atol);
+        return pd_err_set(err, PD_EINVAL, "rtol/atol: tolerances must be > 0 (got %g, %g)", p->rtol,
+                          p->atol);
     return PD_OK;
 }

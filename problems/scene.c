@@ -160,17 +160,22 @@ static pd_structure *new_structure(pd_scene *sc, const char *name, int storeys, 
      * JSON strings: nothing those read as syntax */
     for (const char *c = name; *c; c++)
         if ((unsigned char)*c < 0x20 || *c == 0x7f || strchr("/\\,\"'", *c)) {
-            pd_err_set(err, PD_EINVAL, "name: may not contain %s (it heads CSV columns and "
-                                       "HDF5 groups)",
+            pd_err_set(err, PD_EINVAL,
+                       "name: may not contain %s (it heads CSV columns and "
+                       "HDF5 groups)",
                        (unsigned char)*c < 0x20 || *c == 0x7f ? "control characters"
-                       : *c == ',' ? "','" : *c == '/' ? "'/'" : *c == '\\' ? "'\\'"
-                                                                              : "quotes");
+                       : *c == ','                            ? "','"
+                       : *c == '/'                            ? "'/'"
+                       : *c == '\\'                           ? "'\\'"
+                                                              : "quotes");
             return NULL;
         }
     if (!strcmp(name, ".") || !strcmp(name, "..") || name[0] == ' ' ||
         name[strlen(name) - 1] == ' ') {
-        pd_err_set(err, PD_EINVAL, "name: '%s' is not a usable name (not '.' or '..', no space "
-                                   "at either end)", name);
+        pd_err_set(err, PD_EINVAL,
+                   "name: '%s' is not a usable name (not '.' or '..', no space "
+                   "at either end)",
+                   name);
         return NULL;
     }
     if (pd_scene_find(sc, name) != -2) {
@@ -230,8 +235,10 @@ static int derived_stiffness(double k, double T0, double mass, pd_err *err)
 {
     if (isnormal(k) && k > 0.0)
         return PD_OK;
-    return pd_err_set(err, PD_EINVAL, "T0: a period of %g s with a mass of %g kg gives a "
-                      "stiffness of %g N/m, not a usable number", T0, mass, k);
+    return pd_err_set(err, PD_EINVAL,
+                      "T0: a period of %g s with a mass of %g kg gives a "
+                      "stiffness of %g N/m, not a usable number",
+                      T0, mass, k);
 }
 
 int pd_scene_add_sdof(pd_scene *sc, const char *name, double T0, double xi, double mass,
@@ -336,7 +343,8 @@ int pd_scene_set_heights(pd_scene *sc, const double *heights, pd_err *err)
         if (!positive(heights[i]))
             return pd_err_set(err, PD_EINVAL,
                               "storey_heights: storey %d has height %g, must be a finite "
-                              "number > 0 [m]", i + 1, heights[i]);
+                              "number > 0 [m]",
+                              i + 1, heights[i]);
     memcpy(st->height, heights, (size_t)st->storeys * sizeof(double));
     return PD_OK;
 }
@@ -351,8 +359,9 @@ int pd_scene_add_contact(pd_scene *sc, int a, int level_a, int b, int level_b, d
     if (!(eps >= 0.0 && eps <= 1.0))
         return pd_err_set(err, PD_EINVAL, "eps: the restitution must be in [0, 1] (got %g)", eps);
     if (a == PD_WALL && b == PD_WALL)
-        return pd_err_set(err, PD_EINVAL, "b: a contact joins a structure to a wall or to "
-                                          "another structure, not two walls");
+        return pd_err_set(err, PD_EINVAL,
+                          "b: a contact joins a structure to a wall or to "
+                          "another structure, not two walls");
     if (a < PD_WALL || a >= sc->nstruct)
         return pd_err_set(err, PD_EINVAL, "a: no structure %d", a);
     if (b < PD_WALL || b >= sc->nstruct)
@@ -493,10 +502,10 @@ typedef struct contact_key {
 static int key_cmp(const void *x, const void *y)
 {
     const contact_key *p = x, *q = y;
-    int d = p->a != q->a ? (p->a > q->a) - (p->a < q->a)
+    int d = p->a != q->a     ? (p->a > q->a) - (p->a < q->a)
             : p->la != q->la ? (p->la > q->la) - (p->la < q->la)
-            : p->b != q->b ? (p->b > q->b) - (p->b < q->b)
-                           : (p->lb > q->lb) - (p->lb < q->lb);
+            : p->b != q->b   ? (p->b > q->b) - (p->b < q->b)
+                             : (p->lb > q->lb) - (p->lb < q->lb);
     return d ? d : (p->k > q->k) - (p->k < q->k);
 }
 
@@ -511,14 +520,18 @@ static int check_duplicates(const pd_scene *sc, pd_err *err)
     if (!key)
         return pd_err_set(err, PD_ENOMEM, "out of memory for %d contacts", m);
     for (int k = 0; k < m; k++)
-        key[k] = (contact_key){.a = sc->ct[k].a, .la = sc->ct[k].level_a, .b = sc->ct[k].b,
-                               .lb = sc->ct[k].level_b, .k = k};
+        key[k] = (contact_key){.a = sc->ct[k].a,
+                               .la = sc->ct[k].level_a,
+                               .b = sc->ct[k].b,
+                               .lb = sc->ct[k].level_b,
+                               .k = k};
     qsort(key, (size_t)m, sizeof *key, key_cmp);
     for (int k = 1; k < m && !rc; k++) {
         const contact_key *p = &key[k - 1], *q = &key[k];
         if (p->a == q->a && p->la == q->la && p->b == q->b && p->lb == q->lb) {
             const pd_contact *c = &sc->ct[q->k];
-            rc = pd_err_set(err, PD_EINVAL, "contacts[%d]: '%s' storey %d and '%s' storey %d are "
+            rc = pd_err_set(err, PD_EINVAL,
+                            "contacts[%d]: '%s' storey %d and '%s' storey %d are "
                             "joined twice (also by contacts[%d])",
                             c->entry, c->a == PD_WALL ? "wall" : sc->st[c->a].name, c->level_a,
                             c->b == PD_WALL ? "wall" : sc->st[c->b].name, c->level_b,
@@ -548,7 +561,8 @@ static int check_coupling(const pd_scene *sc, pd_err *err)
             c[s]++;
         }
         if (!(fill <= SCENE_COUPLING_MAX))
-            rc = pd_err_set(err, PD_EINVAL, "contacts[%d]: the contacts up to here couple through "
+            rc = pd_err_set(err, PD_EINVAL,
+                            "contacts[%d]: the contacts up to here couple through "
                             "their structures into contact matrices of %.3g entries (at most "
                             "%.3g; %ld contacts on '%s')",
                             sc->ct[k].entry, fill, SCENE_COUPLING_MAX,
@@ -579,7 +593,8 @@ int pd_scene_finish(pd_scene *sc, pd_err *err)
             return rc;
         const pd_structure *st = &sc->st[s];
         if (!positive(st->T0) || !isfinite(st->alpha) || !isfinite(st->beta))
-            return pd_err_set(err, PD_EINVAL, "structures: '%s' has a fundamental period of %g s "
+            return pd_err_set(err, PD_EINVAL,
+                              "structures: '%s' has a fundamental period of %g s "
                               "and damping coefficients %g, %g: not usable numbers (masses "
                               "and stiffnesses out of proportion?)",
                               st->name, st->T0, st->alpha, st->beta);
@@ -591,7 +606,10 @@ int pd_scene_finish(pd_scene *sc, pd_err *err)
     return PD_OK;
 }
 
-double pd_scene_wp(const pd_scene *sc) { return sc ? PD_TWO_PI / sc->exc.Tp : NAN; }
+double pd_scene_wp(const pd_scene *sc)
+{
+    return sc ? PD_TWO_PI / sc->exc.Tp : NAN;
+}
 
 double pd_scene_Le(const pd_scene *sc)
 {
@@ -754,8 +772,7 @@ double pd_scene_contact_period_min(const pd_scene *sc, const pd_run_opts *o)
     return sc->ncontact ? PD_TWO_PI * sqrt(mmin / kc) : HUGE_VAL;
 }
 
-int pd_scene_resolve_opts(const pd_scene *sc, const pd_run_opts *in, pd_run_opts *out,
-                          pd_err *err)
+int pd_scene_resolve_opts(const pd_scene *sc, const pd_run_opts *in, pd_run_opts *out, pd_err *err)
 {
     int rc;
     if (!sc || !out)
@@ -781,7 +798,8 @@ int pd_scene_resolve_opts(const pd_scene *sc, const pd_run_opts *in, pd_run_opts
 
 int pd_scene_as_oscillator(const pd_scene *sc, pd_osc *c, int *mirrored)
 {
-    if (!sc || !c || !mirrored || !sc->finished || sc->nstruct != 1 || sc->st[0].storeys != 1 || sc->ncontact > 1)
+    if (!sc || !c || !mirrored || !sc->finished || sc->nstruct != 1 || sc->st[0].storeys != 1 ||
+        sc->ncontact > 1)
         return 0;
     const pd_contact *ct = sc->ncontact ? &sc->ct[0] : NULL;
     if (ct && ct->a != PD_WALL && ct->b != PD_WALL)

@@ -31,18 +31,18 @@
  * period also sets the run's cost: the default step is min(Tp, T0) / 2000,
  * so a period of 0.01 s makes it 5 us, 2 10^5 steps a second of motion (a
  * 1 kg storey on 6e8 N/m, T0 = 0.6 ms, asked for 10^7 steps and a hang). */
-#define SCENE_PERIOD_MIN 1e-2  /* s: T0, a building's fundamental period, Tp */
+#define SCENE_PERIOD_MIN 1e-2 /* s: T0, a building's fundamental period, Tp */
 #define SCENE_PERIOD_MAX 1e3
-#define SCENE_MASS_MIN 1e-6    /* kg, of a storey */
+#define SCENE_MASS_MIN 1e-6 /* kg, of a storey */
 #define SCENE_MASS_MAX 1e12
-#define SCENE_STIFF_MIN 1e-11  /* N/m: m w0^2 over the mass and period ranges */
+#define SCENE_STIFF_MIN 1e-11 /* N/m: m w0^2 over the mass and period ranges */
 #define SCENE_STIFF_MAX 1e18
-#define SCENE_AP_MIN 1e-6      /* m/s^2 (also a record's fitted ap times its scale) */
-#define SCENE_AP_MAX 1e4       /* about 1000 g */
-#define SCENE_SCALE_MIN 1e-6   /* a record's scale */
+#define SCENE_AP_MIN 1e-6    /* m/s^2 (also a record's fitted ap times its scale) */
+#define SCENE_AP_MAX 1e4     /* about 1000 g */
+#define SCENE_SCALE_MIN 1e-6 /* a record's scale */
 #define SCENE_SCALE_MAX 1e6
-#define SCENE_GAP_MAX 1e3      /* m */
-#define SCENE_TEND_MAX 1e5     /* s, about a day of motion */
+#define SCENE_GAP_MAX 1e3       /* m */
+#define SCENE_TEND_MAX 1e5      /* s, about a day of motion */
 #define SCENE_LEVELS_MAX 100000 /* entries of one levels or pairs list */
 
 /* The file being read. */
@@ -262,8 +262,8 @@ static int get_number(loader *L, json_t *obj, const char *path, const char *key,
 
 /* A value x > 0 (what, in unit) within the usable range [lo, hi] (the
  * SCENE_* ranges); the message names the field at path. */
-static int in_range(loader *L, const char *path, const char *what, double x, double lo,
-                    double hi, const char *unit)
+static int in_range(loader *L, const char *path, const char *what, double x, double lo, double hi,
+                    const char *unit)
 {
     const char *sp = unit[0] ? " " : "";
     if (!(x > 0.0) || (x >= lo && x <= hi)) /* <= 0: the builder's message */
@@ -273,8 +273,7 @@ static int in_range(loader *L, const char *path, const char *what, double x, dou
 }
 
 /* A string field (required). */
-static int get_string(loader *L, json_t *obj, const char *path, const char *key,
-                      const char **out)
+static int get_string(loader *L, json_t *obj, const char *path, const char *key, const char **out)
 {
     char at[160];
     json_t *v = json_object_get(obj, key);
@@ -348,7 +347,8 @@ static int read_record(loader *L, json_t *ex, pd_scene_excitation *x, pd_record 
     if ((rc = get_string(L, ex, "excitation", "record", &file)) ||
         (rc = get_number(L, ex, "excitation", "scale", 0, 1.0, &x->scale)) ||
         (json_object_get(ex, "units") && (rc = get_string(L, ex, "excitation", "units", &units))) ||
-        (json_object_get(ex, "format") && (rc = get_string(L, ex, "excitation", "format", &format))))
+        (json_object_get(ex, "format") &&
+         (rc = get_string(L, ex, "excitation", "format", &format))))
         return rc;
     if (!(x->scale > 0.0))
         return fail(L, "excitation.scale", "must be > 0 (got %g)", x->scale);
@@ -363,8 +363,10 @@ static int read_record(loader *L, json_t *ex, pd_scene_excitation *x, pd_record 
                     printable(format, name, sizeof name));
     for (const char *k = "pulse\0ap\0Tp\0"; *k; k += strlen(k) + 1)
         if (json_object_get(ex, k))
-            return fail(L, "excitation", "'%s' goes with a pulse, not with a record (its fitted "
-                        "pulse gives ap and Tp; 'scale' scales it)", k);
+            return fail(L, "excitation",
+                        "'%s' goes with a pulse, not with a record (its fitted "
+                        "pulse gives ap and Tp; 'scale' scales it)",
+                        k);
     record_path(L, file, path, sizeof path);
     if (!(*rec = calloc(1, sizeof **rec)))
         return pd_err_set(L->err, PD_ENOMEM, "%s: out of memory", L->path);
@@ -394,8 +396,8 @@ static int read_record(loader *L, json_t *ex, pd_scene_excitation *x, pd_record 
 
 static int read_excitation(loader *L, json_t *root, pd_scene_excitation *x, pd_record **rec)
 {
-    static const char *const keys[] = {"pulse", "dir", "ap", "Tp", "record", "scale", "units",
-                                       "format", NULL};
+    static const char *const keys[] = {"pulse", "dir",   "ap",     "Tp", "record",
+                                       "scale", "units", "format", NULL};
     json_t *ex = json_object_get(root, "excitation");
     const char *pulse, *dir = "+x";
     char name[64];
@@ -428,8 +430,8 @@ static int read_excitation(loader *L, json_t *root, pd_scene_excitation *x, pd_r
         return fail(L, "excitation.ap", "the pulse amplitude must be > 0 (got %g)", x->ap);
     if (!(x->Tp > 0.0))
         return fail(L, "excitation.Tp", "the pulse period must be > 0 (got %g)", x->Tp);
-    if ((rc = in_range(L, "excitation.ap", "the pulse amplitude", x->ap, SCENE_AP_MIN,
-                       SCENE_AP_MAX, "m/s^2")))
+    if ((rc = in_range(L, "excitation.ap", "the pulse amplitude", x->ap, SCENE_AP_MIN, SCENE_AP_MAX,
+                       "m/s^2")))
         return rc;
     return in_range(L, "excitation.Tp", "the pulse period", x->Tp, SCENE_PERIOD_MIN,
                     SCENE_PERIOD_MAX, "s");
@@ -497,8 +499,10 @@ static int read_heights(loader *L, pd_scene *sc, json_t *st, const char *path)
     if ((rc = get_numbers(L, h, at, 0, &v, &n)))
         return rc;
     if (n != s->storeys)
-        rc = fail(L, at, "%d heights for %d storeys: give one per storey (or one number for "
-                  "all)", n, s->storeys);
+        rc = fail(L, at,
+                  "%d heights for %d storeys: give one per storey (or one number for "
+                  "all)",
+                  n, s->storeys);
     for (int i = 0; i < n && !rc; i++)
         if (!(v[i] > 0.0)) {
             snprintf(el, sizeof el, "%s[%d]", at, i);
@@ -518,8 +522,7 @@ static int read_extras(loader *L, pd_scene *sc, json_t *st, const char *path)
 }
 
 /* Every storey's mass and stiffness of a building at path in the usable ranges. */
-static int storeys_in_range(loader *L, const char *path, int n, const double *m,
-                            const double *k)
+static int storeys_in_range(loader *L, const char *path, int n, const double *m, const double *k)
 {
     char at[200];
     int rc = PD_OK;
@@ -537,9 +540,10 @@ static int storeys_in_range(loader *L, const char *path, int n, const double *m,
  * (storeys, mass, T0). */
 static int read_structure(loader *L, pd_scene *sc, json_t *st, int k)
 {
-    static const char *const keys[] = {"name",   "T0",          "xi",      "mass",
-                                       "masses", "stiffnesses", "storeys", "damping",
-                                       "rayleigh_modes", "storey_heights", NULL};
+    static const char *const keys[] = {"name",           "T0",      "xi",
+                                       "mass",           "masses",  "stiffnesses",
+                                       "storeys",        "damping", "rayleigh_modes",
+                                       "storey_heights", NULL};
     char path[64], at[160];
     const char *name;
     double xi, T0 = 0.0, mass = 1.0;
@@ -627,8 +631,9 @@ static int read_levels(loader *L, json_t *ct, const char *path, int **la, int **
     size_t n = list ? json_array_size(list) : 1;
     field(at, sizeof at, path, levels ? "levels" : "pairs");
     if (list && (!json_is_array(list) || n == 0))
-        return fail(L, at, levels ? "expected a non-empty array of storeys [i, ...]"
-                                  : "expected a non-empty array of pairs [[level_a, level_b], ...]");
+        return fail(L, at,
+                    levels ? "expected a non-empty array of storeys [i, ...]"
+                           : "expected a non-empty array of pairs [[level_a, level_b], ...]");
     if (n > SCENE_LEVELS_MAX)
         return fail(L, at, "%zu entries: at most %d", n, SCENE_LEVELS_MAX);
     *la = malloc(n * sizeof(int));
@@ -688,10 +693,10 @@ static int read_contact(loader *L, pd_scene *sc, json_t *ct, int k)
         snprintf(el, sizeof el, "%s[%d]", at, i);
         if (!json_is_number(g) || !isfinite(json_number_value(g)))
             rc = fail(L, json_is_array(gap) ? el : at, "expected a finite number");
-        else if (!(rc = in_range(L, json_is_array(gap) ? el : at, "the gap",
-                                 json_number_value(g), 0.0, SCENE_GAP_MAX, "m")) &&
-                 pd_scene_add_contact(sc, a, a == PD_WALL ? 0 : la[i], b,
-                                      b == PD_WALL ? 0 : lb[i], json_number_value(g), eps, k, &e))
+        else if (!(rc = in_range(L, json_is_array(gap) ? el : at, "the gap", json_number_value(g),
+                                 0.0, SCENE_GAP_MAX, "m")) &&
+                 pd_scene_add_contact(sc, a, a == PD_WALL ? 0 : la[i], b, b == PD_WALL ? 0 : lb[i],
+                                      json_number_value(g), eps, k, &e))
             rc = fail_builder(L, path, &e);
     }
     free(la);
@@ -709,7 +714,8 @@ static int check_sections(loader *L, json_t *root)
         return fail(L, "structures", "expected a non-empty array (the row, left to right)");
     if (cts && !json_is_array(cts))
         return fail(L, "contacts", "expected an array");
-    if (json_object_get(root, "description") && !json_is_string(json_object_get(root, "description")))
+    if (json_object_get(root, "description") &&
+        !json_is_string(json_object_get(root, "description")))
         return fail(L, "description", "expected a string");
     return PD_OK;
 }
@@ -729,8 +735,8 @@ static int check_periods(loader *L, const pd_scene *sc, json_t *st, int k)
 
 static int read_scene(loader *L, json_t *root, pd_scene **out)
 {
-    static const char *const keys[] = {"excitation", "structures", "contacts", "tend",
-                                       "description", NULL};
+    static const char *const keys[] = {"excitation", "structures",  "contacts",
+                                       "tend",       "description", NULL};
     pd_scene_excitation x = {0};
     pd_record *rec = NULL;
     pd_scene *sc = NULL;

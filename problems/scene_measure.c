@@ -12,8 +12,7 @@
 
 #define TRACE_MAX_BYTES (2.0 * 1024 * 1024 * 1024) /* largest reference history kept */
 
-int pd_scene_trace_alloc(pd_scene_trace *tr, const pd_scene *sc, const pd_run_opts *o,
-                         pd_err *err)
+int pd_scene_trace_alloc(pd_scene_trace *tr, const pd_scene *sc, const pd_run_opts *o, pd_err *err)
 {
     pd_run_opts r;
     int rc;
@@ -58,8 +57,8 @@ int pd_scene_errors_alloc(const pd_scene *sc, pd_scene_errors *e, pd_err *err)
         return pd_err_set(err, PD_EINVAL, "errors: NULL");
     memset(e, 0, sizeof *e);
     if (!sc || !sc->finished)
-        return pd_err_set(err, PD_EINVAL, "scene: %s", sc ? "not finished (pd_scene_finish)"
-                                                          : "NULL");
+        return pd_err_set(err, PD_EINVAL, "scene: %s",
+                          sc ? "not finished (pd_scene_finish)" : "NULL");
     e->err_umax = calloc((size_t)sc->nstruct, sizeof(double));
     e->err_hist = calloc((size_t)sc->nstruct, sizeof(double));
     if (!e->err_umax || !e->err_hist) {
@@ -74,8 +73,9 @@ int pd_scene_errors_alloc(const pd_scene *sc, pd_scene_errors *e, pd_err *err)
 static int trace_fits(const pd_scene *sc, const pd_scene_trace *tr, pd_err *err)
 {
     if (!tr || !tr->x || tr->n != sc->n || tr->cap < 1 || tr->rows < 0 || tr->rows > tr->cap)
-        return pd_err_set(err, PD_EINVAL, "the reference trace is not allocated for this scene "
-                                          "(pd_scene_trace_alloc)");
+        return pd_err_set(err, PD_EINVAL,
+                          "the reference trace is not allocated for this scene "
+                          "(pd_scene_trace_alloc)");
     return PD_OK;
 }
 
@@ -108,8 +108,9 @@ int pd_scene_measure_reference(const pd_scene *sc, const pd_run_opts *o, pd_scen
         (rc = trace_fits(sc, ref, err)))
         return rc;
     if (!pd_scene_result_fits(sc, res))
-        return pd_err_set(err, PD_EINVAL, "the result is not allocated for this scene "
-                                          "(pd_scene_result_alloc)");
+        return pd_err_set(err, PD_EINVAL,
+                          "the result is not allocated for this scene "
+                          "(pd_scene_result_alloc)");
     r.method = PD_METHOD_EVENT;
     r.no_law_band = 1; /* the measurements report no law_band: no second run */
     r.no_demands = 1;  /* nor demands: umax and the history */
@@ -130,12 +131,12 @@ typedef struct compare_ctx {
     const pd_scene *sc;
     const pd_scene_trace *ref;
     pd_scene_errors *e;
-    const double *scale; /* nstruct */
-    long stride, row; /* the run's step in reference rows; its next row */
+    const double *scale;            /* nstruct */
+    long stride, row;               /* the run's step in reference rows; its next row */
     double *x_prev, *v_prev, *x_at; /* to a tolerance: the last sample, a row between (n) */
     double t_prev;
     int have_prev;
-    int interp;     /* 1: the run's steps interpolated onto the rows */
+    int interp; /* 1: the run's steps interpolated onto the rows */
 } compare_ctx;
 
 /* Row at of the reference against x (n displacements) into the errors. */
@@ -169,8 +170,8 @@ static void compare_steps(compare_ctx *c, const pd_scene_sample *s)
         double r = ((double)c->row * c->ref->dt - c->t_prev) / h;
         for (int i = 0; i < n; i++) {
             double p0[2] = {c->x_prev[i], c->v_prev[i]}, p1[2] = {s->x[i], s->v[i]};
-            c->x_at[i] = jump || !(h > 0.0) ? p0[0] + r * (p1[0] - p0[0])
-                                            : pd_hermite3(p0, p1, h, r);
+            c->x_at[i] =
+                jump || !(h > 0.0) ? p0[0] + r * (p1[0] - p0[0]) : pd_hermite3(p0, p1, h, r);
         }
         compare_at(c, c->row, c->x_at);
     }
@@ -202,8 +203,8 @@ static int compare_sample(const pd_scene_sample *s, void *ctx)
 }
 
 int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scene_trace *ref,
-                         const pd_scene_result *ref_res, pd_scene_result *res,
-                         pd_scene_errors *e, pd_err *err)
+                         const pd_scene_result *ref_res, pd_scene_result *res, pd_scene_errors *e,
+                         pd_err *err)
 {
     pd_run_opts r;
     int rc;
@@ -211,8 +212,9 @@ int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scen
         return rc;
     if (!pd_scene_result_fits(sc, ref_res) || !pd_scene_result_fits(sc, res) || !e ||
         e->nstruct != sc->nstruct || !e->err_umax || !e->err_hist)
-        return pd_err_set(err, PD_EINVAL, "the results or errors are not allocated for this "
-                                          "scene (pd_scene_result_alloc, pd_scene_errors_alloc)");
+        return pd_err_set(err, PD_EINVAL,
+                          "the results or errors are not allocated for this "
+                          "scene (pd_scene_result_alloc, pd_scene_errors_alloc)");
     /* on the reference's rows: the run's own states where its grid holds
      * them (a whole multiple), else its steps interpolated (to a tolerance,
      * or another grid) */
@@ -229,8 +231,8 @@ int pd_scene_measure_run(const pd_scene *sc, const pd_run_opts *o, const pd_scen
         scale[s] = structure_scale(sc, ref_res, s);
         e->err_hist[s] = e->err_umax[s] = 0.0;
     }
-    compare_ctx c = {.sc = sc, .ref = ref, .e = e, .scale = scale, .stride = stride, .row = 0,
-                     .interp = interp};
+    compare_ctx c = {
+        .sc = sc, .ref = ref, .e = e, .scale = scale, .stride = stride, .row = 0, .interp = interp};
     if (interp) {
         c.x_prev = work + sc->nstruct;
         c.v_prev = c.x_prev + sc->n;

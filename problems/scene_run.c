@@ -42,17 +42,16 @@
 
 #define DEMAND_GRID 128.0 /* the row reference's demand states per shortest period */
 
-
 /* What a run tracks, in reference units. */
 typedef struct track {
     const pd_scene *sc;
     pd_method method;
-    double sample_s;   /* wall time in sample(): the samples' assembly and the caller's sampler */
-    int n, m;          /* dofs, contacts of the scene (the model may have none) */
-    int model_m;       /* contacts of the model */
+    double sample_s; /* wall time in sample(): the samples' assembly and the caller's sampler */
+    int n, m;        /* dofs, contacts of the scene (the model may have none) */
+    int model_m;     /* contacts of the model */
     double Le, wp, h, tau_measure;
-    int *below;        /* n: the dof of the storey below, -1 for storey 1 */
-    int *dof_a, *dof_b; /* m: the dofs a contact joins, -1 at a wall */
+    int *below;                         /* n: the dof of the storey below, -1 for storey 1 */
+    int *dof_a, *dof_b;                 /* m: the dofs a contact joins, -1 at a wall */
     double *xmax, *xpos, *xneg, *drift; /* n */
     double *acc, *shear;                /* n: demand peaks [SI] */
     double *da, *dV, *dad, *dVd;        /* n: the instant's a_abs, V and their rates */
@@ -66,21 +65,21 @@ typedef struct track {
     int *hJ;                            /* m: Moreau-Jean: the candidate holds */
     double *hG, *hz, *hw, *hD;          /* their LCP: q (MJ_HELD_LCP), z, w, D (^2) */
     pd_lcp_solver *hlcp;
-    unsigned char *sheld;               /* nstruct: row reference: a closed contact at an
+    unsigned char *sheld; /* nstruct: row reference: a closed contact at an
                                            impact */
-    const pd_osc *shape;                /* the excitation's shape: f = F_i / m_i */
-    const double *mass;                 /* n: the floors' masses [kg] */
-    double dem_t;                       /* its time */
-    int dem_prev;                       /* 1: it has rates (an interval can be refined) */
-    int demands;                        /* 0: not measured (pd_run_opts.no_demands) */
-    int *st_of;                         /* n: the structure of each dof */
-    double *ex, *ev;                    /* n: an impact's positions and velocities */
-    double *fpeak;                      /* m: largest element force (reference units) */
-    long *impacts;     /* m */
+    const pd_osc *shape;  /* the excitation's shape: f = F_i / m_i */
+    const double *mass;   /* n: the floors' masses [kg] */
+    double dem_t;         /* its time */
+    int dem_prev;         /* 1: it has rates (an interval can be refined) */
+    int demands;          /* 0: not measured (pd_run_opts.no_demands) */
+    int *st_of;           /* n: the structure of each dof */
+    double *ex, *ev;      /* n: an impact's positions and velocities */
+    double *fpeak;        /* m: largest element force (reference units) */
+    long *impacts;        /* m */
     double *first, *maxP, *ctime, *approach, *episode; /* m */
-    double *g_prev, *U_prev, *U_prev2;  /* m: Moreau–Jean first-impact estimate */
-    unsigned char *touching;            /* m: in an impact episode */
-    double *px, *pv, *pa, *plam;        /* the previous on_step report */
+    double *g_prev, *U_prev, *U_prev2;                 /* m: Moreau–Jean first-impact estimate */
+    unsigned char *touching;                           /* m: in an impact episode */
+    double *px, *pv, *pa, *plam;                       /* the previous on_step report */
     unsigned char *pactive;
     double pt;
     int have_prev;
@@ -89,21 +88,21 @@ typedef struct track {
     pd_scene_sampler fn;
     void *ctx;
     double *sx, *sv, *sg, *sP, *imp; /* SI scratch; impulses since the last sample */
-    long *sI, *sampled;               /* m: impacts since the last sample; reported */
-    const long *live_impacts;         /* the row reference's counts during its run */
-    double imp_t;                     /* penalty: time the impulses were integrated to */
-    double *imp_lam;                  /* penalty: forces at imp_t */
-    int edr_hit;                      /* row reference: an impulsive impact since the
+    long *sI, *sampled;              /* m: impacts since the last sample; reported */
+    const long *live_impacts;        /* the row reference's counts during its run */
+    double imp_t;                    /* penalty: time the impulses were integrated to */
+    double *imp_lam;                 /* penalty: forces at imp_t */
+    int edr_hit;                     /* row reference: an impulsive impact since the
                                          last sample (its samples' P also hold the
                                          held contacts' force integrals) */
     /* Moreau-Jean to a tolerance: the engine's estimate at each peak's instant */
-    const double *err;                /* the state's estimate (NULL: none) */
-    double *errx, *errd;              /* n: at the umax, drift peaks */
-    double *erra, *errv;              /* n: the structure's largest at the a_abs, V peaks */
-    double *acc0, *shear0;            /* n: the demand peaks before the state */
-    double *serr;                     /* nstruct: the structure's largest estimate now */
-    double *wdof;                     /* n: each dof's sqrt(K_ii / M_ii) (Pi units) */
-    int dem_skipped;                  /* a state was left out of the demands since the last */
+    const double *err;     /* the state's estimate (NULL: none) */
+    double *errx, *errd;   /* n: at the umax, drift peaks */
+    double *erra, *errv;   /* n: the structure's largest at the a_abs, V peaks */
+    double *acc0, *shear0; /* n: the demand peaks before the state */
+    double *serr;          /* nstruct: the structure's largest estimate now */
+    double *wdof;          /* n: each dof's sqrt(K_ii / M_ii) (Pi units) */
+    int dem_skipped;       /* a state was left out of the demands since the last */
 } track;
 
 /* ---- results ---------------------------------------------------------------- */
@@ -114,8 +113,8 @@ int pd_scene_result_alloc(const pd_scene *sc, pd_scene_result *r, pd_err *err)
         return pd_err_set(err, PD_EINVAL, "result: NULL");
     memset(r, 0, sizeof *r);
     if (!sc || !sc->finished)
-        return pd_err_set(err, PD_EINVAL, "scene: %s", sc ? "not finished (pd_scene_finish)"
-                                                          : "NULL");
+        return pd_err_set(err, PD_EINVAL, "scene: %s",
+                          sc ? "not finished (pd_scene_finish)" : "NULL");
     long n = sc->n, m = sc->ncontact;
     r->n = sc->n;
     r->m = sc->ncontact;
@@ -191,16 +190,16 @@ void pd_scene_result_free(pd_scene_result *r)
 
 static void track_free(track *tr)
 {
-    void *arrays[] = {tr->below, tr->dof_a, tr->dof_b, tr->xmax, tr->xpos, tr->xneg,
-                      tr->drift, tr->impacts, tr->first, tr->maxP, tr->ctime, tr->approach,
-                      tr->episode, tr->g_prev, tr->U_prev, tr->U_prev2, tr->touching, tr->px,
-                      tr->pv, tr->pa, tr->plam, tr->pactive, tr->sx, tr->sv, tr->sg, tr->sP,
-                      tr->imp, tr->imp_lam, tr->acc, tr->shear, tr->da, tr->dV, tr->fpeak,
-                      tr->dad, tr->dVd, tr->qa, tr->qV, tr->qad, tr->qVd,
-                      tr->st_of, tr->ex, tr->ev, tr->sI, tr->sampled, tr->errx, tr->errd,
-                      tr->erra, tr->errv, tr->acc0, tr->shear0, tr->serr, tr->wdof,
-                      tr->hacc, tr->qh, tr->hlam, tr->hsm, tr->hJ, tr->hG, tr->hz, tr->hw, tr->hD,
-                      tr->sheld};
+    void *arrays[] = {
+        tr->below,   tr->dof_a,   tr->dof_b,    tr->xmax,  tr->xpos,     tr->xneg,    tr->drift,
+        tr->impacts, tr->first,   tr->maxP,     tr->ctime, tr->approach, tr->episode, tr->g_prev,
+        tr->U_prev,  tr->U_prev2, tr->touching, tr->px,    tr->pv,       tr->pa,      tr->plam,
+        tr->pactive, tr->sx,      tr->sv,       tr->sg,    tr->sP,       tr->imp,     tr->imp_lam,
+        tr->acc,     tr->shear,   tr->da,       tr->dV,    tr->fpeak,    tr->dad,     tr->dVd,
+        tr->qa,      tr->qV,      tr->qad,      tr->qVd,   tr->st_of,    tr->ex,      tr->ev,
+        tr->sI,      tr->sampled, tr->errx,     tr->errd,  tr->erra,     tr->errv,    tr->acc0,
+        tr->shear0,  tr->serr,    tr->wdof,     tr->hacc,  tr->qh,       tr->hlam,    tr->hsm,
+        tr->hJ,      tr->hG,      tr->hz,       tr->hw,    tr->hD,       tr->sheld};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(arrays[k]);
     pd_lcp_solver_free(tr->hlcp);
@@ -217,20 +216,20 @@ static int track_alloc(track *tr, const pd_scene *sc, pd_err *err)
     if (!TA(tr->below, n) || !TA(tr->dof_a, m) || !TA(tr->dof_b, m) || !TA(tr->xmax, n) ||
         !TA(tr->xpos, n) || !TA(tr->xneg, n) || !TA(tr->drift, n) || !TA(tr->impacts, m) ||
         !TA(tr->first, m) || !TA(tr->maxP, m) || !TA(tr->ctime, m) || !TA(tr->approach, m) ||
-        !TA(tr->episode, m) || !TA(tr->g_prev, m) || !TA(tr->U_prev, m) ||
-        !TA(tr->U_prev2, m) || !TA(tr->touching, m) || !TA(tr->px, n) || !TA(tr->pv, n) ||
-        !TA(tr->pa, n) || !TA(tr->plam, m) || !TA(tr->pactive, m) || !TA(tr->sx, n) ||
-        !TA(tr->sv, n) || !TA(tr->sg, m) || !TA(tr->sP, m) || !TA(tr->imp, m) ||
-        !TA(tr->imp_lam, m) || !TA(tr->acc, n) || !TA(tr->shear, n) || !TA(tr->da, n) ||
-        !TA(tr->dV, n) || !TA(tr->fpeak, m) || !TA(tr->dad, n) || !TA(tr->dVd, n) ||
-        !TA(tr->qa, n) || !TA(tr->qV, n) || !TA(tr->qad, n) || !TA(tr->qVd, n) ||
-        !TA(tr->st_of, n) || !TA(tr->ex, n) || !TA(tr->ev, n) || !TA(tr->sI, m) ||
-        !TA(tr->sampled, m) || !TA(tr->errx, n) || !TA(tr->errd, n) || !TA(tr->erra, n) ||
-        !TA(tr->errv, n) || !TA(tr->acc0, n) || !TA(tr->shear0, n) ||
-        !TA(tr->serr, sc->nstruct) || !TA(tr->wdof, n) || !TA(tr->hacc, n) ||
-        !TA(tr->qh, n) || !TA(tr->hlam, m) || !TA(tr->hsm, n) || !TA(tr->hJ, m) ||
-        !TA(tr->hG, MJ_HELD_LCP) || !TA(tr->hz, MJ_HELD_LCP) || !TA(tr->hw, MJ_HELD_LCP) ||
-        !TA(tr->hD, MJ_HELD_LCP * MJ_HELD_LCP) || !TA(tr->sheld, sc->nstruct)) {
+        !TA(tr->episode, m) || !TA(tr->g_prev, m) || !TA(tr->U_prev, m) || !TA(tr->U_prev2, m) ||
+        !TA(tr->touching, m) || !TA(tr->px, n) || !TA(tr->pv, n) || !TA(tr->pa, n) ||
+        !TA(tr->plam, m) || !TA(tr->pactive, m) || !TA(tr->sx, n) || !TA(tr->sv, n) ||
+        !TA(tr->sg, m) || !TA(tr->sP, m) || !TA(tr->imp, m) || !TA(tr->imp_lam, m) ||
+        !TA(tr->acc, n) || !TA(tr->shear, n) || !TA(tr->da, n) || !TA(tr->dV, n) ||
+        !TA(tr->fpeak, m) || !TA(tr->dad, n) || !TA(tr->dVd, n) || !TA(tr->qa, n) ||
+        !TA(tr->qV, n) || !TA(tr->qad, n) || !TA(tr->qVd, n) || !TA(tr->st_of, n) ||
+        !TA(tr->ex, n) || !TA(tr->ev, n) || !TA(tr->sI, m) || !TA(tr->sampled, m) ||
+        !TA(tr->errx, n) || !TA(tr->errd, n) || !TA(tr->erra, n) || !TA(tr->errv, n) ||
+        !TA(tr->acc0, n) || !TA(tr->shear0, n) || !TA(tr->serr, sc->nstruct) || !TA(tr->wdof, n) ||
+        !TA(tr->hacc, n) || !TA(tr->qh, n) || !TA(tr->hlam, m) || !TA(tr->hsm, n) ||
+        !TA(tr->hJ, m) || !TA(tr->hG, MJ_HELD_LCP) || !TA(tr->hz, MJ_HELD_LCP) ||
+        !TA(tr->hw, MJ_HELD_LCP) || !TA(tr->hD, MJ_HELD_LCP * MJ_HELD_LCP) ||
+        !TA(tr->sheld, sc->nstruct)) {
 #undef TA
         track_free(tr);
         return pd_err_set(err, PD_ENOMEM, "out of memory for tracking %d dofs", sc->n);
@@ -255,8 +254,8 @@ static int track_alloc(track *tr, const pd_scene *sc, pd_err *err)
 static void track_clear(track *tr)
 {
     size_t n = (size_t)tr->n * sizeof(double), m = (size_t)tr->m;
-    double *dn[] = {tr->xmax, tr->xpos, tr->xneg, tr->drift, tr->acc, tr->shear, tr->errx,
-                    tr->errd, tr->erra, tr->errv};
+    double *dn[] = {tr->xmax,  tr->xpos, tr->xneg, tr->drift, tr->acc,
+                    tr->shear, tr->errx, tr->errd, tr->erra,  tr->errv};
     for (size_t k = 0; k < sizeof dn / sizeof dn[0]; k++)
         memset(dn[k], 0, n);
     double *dm[] = {tr->maxP, tr->ctime, tr->episode, tr->imp, tr->fpeak, tr->hlam};
@@ -343,8 +342,8 @@ static void held_from_acc(track *tr, double t, int side, const double *x, const 
  * state on the cubic Hermite of the values and rates, when the interval
  * was smooth (no impulse in it): the held part linear over the interval
  * (its rate the secant's), the rest with its exact rates. */
-static void note_demand(track *tr, double t, const double *x, const double *v,
-                        const double *acc, const double *held, int smooth)
+static void note_demand(track *tr, double t, const double *x, const double *v, const double *acc,
+                        const double *held, int smooth)
 {
     double us = tr->Le, vs = tr->Le * tr->wp, as = vs * tr->wp;
     if (!tr->demands)
@@ -373,10 +372,11 @@ static void note_demand(track *tr, double t, const double *x, const double *v,
             double d0 = tr->qad[i] + hs, d1 = tr->dad[i] + hs;
             if (pd_max(fabs(tr->qa[i]), fabs(tr->da[i])) + 0.25 * h * (fabs(d0) + fabs(d1)) >
                 tr->acc[i])
-                tr->acc[i] = pd_max(tr->acc[i],
-                                    pd_demand_cubic_peak(tr->qa[i], d0, tr->da[i], d1, h));
+                tr->acc[i] =
+                    pd_max(tr->acc[i], pd_demand_cubic_peak(tr->qa[i], d0, tr->da[i], d1, h));
             if (pd_max(fabs(tr->qV[i]), fabs(tr->dV[i])) +
-                    0.25 * h * (fabs(tr->qVd[i]) + fabs(tr->dVd[i])) > tr->shear[i])
+                    0.25 * h * (fabs(tr->qVd[i]) + fabs(tr->dVd[i])) >
+                tr->shear[i])
                 tr->shear[i] = pd_max(tr->shear[i], pd_demand_cubic_peak(tr->qV[i], tr->qVd[i],
                                                                          tr->dV[i], tr->dVd[i], h));
         }
@@ -473,8 +473,7 @@ static void note_approach(track *tr, const double *x)
 
 /* Extremes between the previous report and (t, x, v, a): turning points of
  * every dof and every storey drift. */
-static void note_between(track *tr, double t, const double *x, const double *v,
-                         const double *acc)
+static void note_between(track *tr, double t, const double *x, const double *v, const double *acc)
 {
     double h = t - tr->pt, f;
     if (!(h > 0.0) || t < tr->tau_measure)
@@ -567,9 +566,9 @@ static int sample(track *tr, const pd_state *st)
 /* Gap rate of contact a: x_b' - x_a' (walls at rest). */
 static double gap_rate(const track *tr, int a, const double *v)
 {
-    return (tr->dof_b[a] >= 0 ? v[tr->dof_b[a]] : 0.0) - (tr->dof_a[a] >= 0 ? v[tr->dof_a[a]] : 0.0);
+    return (tr->dof_b[a] >= 0 ? v[tr->dof_b[a]] : 0.0) -
+           (tr->dof_a[a] >= 0 ? v[tr->dof_a[a]] : 0.0);
 }
-
 
 /* The free relative acceleration of dof i (reference units; -1: a wall, at
  * rest with the ground) from the smooth a_abs (SI) and the forcing f. */
@@ -671,8 +670,7 @@ static int observe_moreau(const pd_state *st, void *ctx)
         if (P > 0.0) {
             if (!tr->touching[a] && isnan(tr->first[a])) {
                 double G = st->step > 1 ? (tr->U_prev[a] - tr->U_prev2[a]) / tr->h : 0.0;
-                tr->first[a] =
-                    st->t - tr->h + closing_time(tr->g_prev[a], tr->U_prev[a], G, tr->h);
+                tr->first[a] = st->t - tr->h + closing_time(tr->g_prev[a], tr->U_prev[a], G, tr->h);
             }
             tr->impacts[a] += !tr->touching[a];
             tr->ctime[a] += tr->h;
@@ -902,16 +900,15 @@ static int osc_sample(const pd_osc_sample *s, void *ctx)
 }
 
 /* Run the one-wall scene as the oscillator c. */
-static int run_oscillator(const pd_scene *sc, const pd_osc *c, int mirrored,
-                          const pd_run_opts *o, pd_scene_sampler fn, void *ctx,
-                          pd_scene_result *res, pd_err *err)
+static int run_oscillator(const pd_scene *sc, const pd_osc *c, int mirrored, const pd_run_opts *o,
+                          pd_scene_sampler fn, void *ctx, pd_scene_result *res, pd_err *err)
 {
     pd_run_opts oo = *o;
     pd_osc_result r;
     double mass = sc->st[0].mass[0];
     int has_wall = sc->ncontact > 0 && !o->no_wall, rc;
-    osc_bridge b = {.fn = fn, .ctx = ctx, .sign = mirrored ? -1.0 : 1.0, .mass = mass,
-                    .m = sc->ncontact};
+    osc_bridge b = {
+        .fn = fn, .ctx = ctx, .sign = mirrored ? -1.0 : 1.0, .mass = mass, .m = sc->ncontact};
     oo.no_wall = !has_wall;
     oo.pen.kc_abs = o->pen.kc_abs / mass; /* N/m -> N/m per kg */
     if ((rc = pd_osc_run(c, &oo, fn ? osc_sample : NULL, &b, &r, err)))
@@ -957,8 +954,8 @@ static int held_solver(track *tr, const pd_model *md, pd_err *err)
     pd_err own_err; /* the status read back when the caller passed no pd_err */
     err = pd_err_or(err, &own_err);
     if (tr->demands && md->m > 0 && !tr->hlcp &&
-        !(tr->hlcp = pd_lcp_solver_alloc(PD_LCP_LEMKE, md->m < MJ_HELD_LCP ? md->m : MJ_HELD_LCP,
-                                         0, err)))
+        !(tr->hlcp =
+              pd_lcp_solver_alloc(PD_LCP_LEMKE, md->m < MJ_HELD_LCP ? md->m : MJ_HELD_LCP, 0, err)))
         return err->status;
     return PD_OK;
 }
@@ -989,8 +986,8 @@ static int run_moreau(const pd_model *md, const pd_run_opts *o, long nsteps, tra
  * structure st [SI] for state errors |dx| <= E, |dv| <= w E on its floors
  * (Pi units; us, vs their SI scales): the storey forces S = k (d + beta d')
  * and the mass-proportional damping (demand.c's formulas, in bounds). */
-static double demand_bound(const pd_structure *st, int k, double E, double w, double us,
-                           double vs, int shear)
+static double demand_bound(const pd_structure *st, int k, double E, double w, double us, double vs,
+                           int shear)
 {
     double dd = 2.0 * E * us, ddv = 2.0 * w * E * vs, mv = st->alpha * w * E * vs;
     double Sk = st->stiffness[k] * (dd + st->beta * ddv);
@@ -1041,8 +1038,8 @@ static void structure_errors(const track *tr, pd_scene_result *res)
 
 /* One run to the tolerance rtol, measured into tr; stats of the engine. */
 static int adapt_once(const pd_scene_model *sm, const pd_run_opts *o, double rtol,
-                      const pd_piecewise_force *F, const double *atol, double tau_end,
-                      track *tr, pd_scene_result *res, pd_mj_stats *stats, pd_err *err)
+                      const pd_piecewise_force *F, const double *atol, double tau_end, track *tr,
+                      pd_scene_result *res, pd_mj_stats *stats, pd_err *err)
 {
     pd_err own_err; /* the status read back when the caller passed no pd_err */
     err = pd_err_or(err, &own_err);
@@ -1053,7 +1050,7 @@ static int adapt_once(const pd_scene_model *sm, const pd_run_opts *o, double rto
     pd_mj_opts mo = pd_run_mj_opts(o, tr->wp * T / SCENE_ADAPT_H0);
     mo.rtol = rtol;
     mo.atol_dof = atol;
-    mo.sim_gap = o->close_tol; /* the reference's scale of simultaneity, in Le */
+    mo.sim_gap = o->close_tol;              /* the reference's scale of simultaneity, in Le */
     mo.pieces = o->theta == 0.5 ? F : NULL; /* exact flights; theta flights for another theta */
     track_clear(tr);
     pd_mj *mj = pd_mj_alloc(&sm->model, &mo, err);
@@ -1150,8 +1147,8 @@ static int run_moreau_adapt(const pd_scene_model *sm, const pd_run_opts *o, doub
     int second = sc->ncontact >= 2;
     tr->fn = NULL;
     if (second) {
-        rc = adapt_once(sm, o, fmin(SCENE_ADAPT_LOOSE * rtol, 0.5), &F, atol, tau_end, tr, res,
-                        &st, err);
+        rc = adapt_once(sm, o, fmin(SCENE_ADAPT_LOOSE * rtol, 0.5), &F, atol, tau_end, tr, res, &st,
+                        err);
         steps += res->steps;
         rejected += res->steps_rejected;
         keep_peaks(tr, loose);
@@ -1163,8 +1160,8 @@ static int run_moreau_adapt(const pd_scene_model *sm, const pd_run_opts *o, doub
         rejected += res->steps_rejected;
         if (second && !rc)
             second_pass(tr, loose, res);
-        if (rc || st.budget_hit || res->err_est_max <= o->rtol ||
-            runs >= SCENE_ADAPT_TRIES || rtol / SCENE_ADAPT_LOOSE < PD_RTOL_MIN)
+        if (rc || st.budget_hit || res->err_est_max <= o->rtol || runs >= SCENE_ADAPT_TRIES ||
+            rtol / SCENE_ADAPT_LOOSE < PD_RTOL_MIN)
             break;
         /* again at a tighter tolerance: this run is the next one's looser pass */
         keep_peaks(tr, loose);
@@ -1297,8 +1294,8 @@ static int run_event(const pd_scene_model *sm, const pd_run_opts *o, double tau_
 
 /* The general event-driven reference (pd_edg_run, GSL between events) on
  * the scene's model. */
-static int run_event_general(const pd_model *md, const pd_run_opts *o, double tau_end,
-                             track *tr, pd_scene_result *res, pd_err *err)
+static int run_event_general(const pd_model *md, const pd_run_opts *o, double tau_end, track *tr,
+                             pd_scene_result *res, pd_err *err)
 {
     pd_edg_opts eo = pd_edg_default_opts();
     pd_edg_result er;
@@ -1309,8 +1306,8 @@ static int run_event_general(const pd_model *md, const pd_run_opts *o, double ta
     eo.on_step_ctx = tr;
     eo.factor = o->factor;
     eo.lcp_solver = o->lcp_solver;
-    int rc = pd_edg_run(md, 0.0, NULL, NULL, tau_end, &eo, tr->fn ? observe_grid : NULL, tr, &er,
-                        err);
+    int rc =
+        pd_edg_run(md, 0.0, NULL, NULL, tau_end, &eo, tr->fn ? observe_grid : NULL, tr, &er, err);
     res->steps = er.events;
     res->accumulations = er.accumulations;
     res->kernel = "event-general";
@@ -1338,8 +1335,7 @@ static int run_penalty(const pd_model *md, const pd_run_opts *o, double tau_end,
     po.stepper = o->method == PD_METHOD_NEWMARK ? "newmark" : o->pen.stepper;
     /* stepper newmark: the grid's step, or a whole fraction of it for
      * PD_NEWMARK_STEPS_PER_CONTACT steps per period of the stiffest element */
-    po.h = md->m ? pd_newmark_step(tr->h, tr->wp * pd_scene_contact_period_min(tr->sc, o))
-                 : tr->h;
+    po.h = md->m ? pd_newmark_step(tr->h, tr->wp * pd_scene_contact_period_min(tr->sc, o)) : tr->h;
     po.h_out = tr->fn ? tr->h : 0.0;
     po.time_unit = 1.0 / tr->wp;
     po.on_step = step_penalty;
@@ -1350,8 +1346,8 @@ static int run_penalty(const pd_model *md, const pd_run_opts *o, double tau_end,
         rc = held_solver(tr, md, err);
     if (rc)
         return rc;
-    rc = pd_penalty_run(md, 0.0, NULL, NULL, tau_end, &po, tr->fn ? observe_grid : NULL, tr,
-                            &pr, err);
+    rc = pd_penalty_run(md, 0.0, NULL, NULL, tau_end, &po, tr->fn ? observe_grid : NULL, tr, &pr,
+                        err);
     res->steps = pr.steps;
     res->kernel = pr.stepper ? pr.stepper : "penalty";
     res->factor =
@@ -1363,8 +1359,8 @@ static int run_penalty(const pd_model *md, const pd_run_opts *o, double tau_end,
 /* Build the model, track, run the method, convert. */
 /* The run of o through the general model; *sample_s gets the time spent in
  * sample() (the run's cost leaves it out). */
-static int run_general(const pd_scene *sc, const pd_run_opts *o, pd_scene_sampler fn,
-                       void *ctx, pd_scene_result *res, double *sample_s, pd_err *err)
+static int run_general(const pd_scene *sc, const pd_run_opts *o, pd_scene_sampler fn, void *ctx,
+                       pd_scene_result *res, double *sample_s, pd_err *err)
 {
     pd_scene_model sm;
     track tr;
@@ -1391,12 +1387,16 @@ static int run_general(const pd_scene *sc, const pd_run_opts *o, pd_scene_sample
     long nsteps = o->rtol > 0.0 ? 0 : pd_steps_for(o->tend, o->dt);
     double tau_end = o->rtol > 0.0 ? tr.wp * o->tend : (double)nsteps * tr.h;
     switch (o->method) {
-    case PD_METHOD_EVENT: rc = run_event(&sm, o, tau_end, &tr, res, err); break;
+    case PD_METHOD_EVENT:
+        rc = run_event(&sm, o, tau_end, &tr, res, err);
+        break;
     case PD_METHOD_EVENT_GENERAL:
         rc = run_event_general(&sm.model, o, tau_end, &tr, res, err);
         break;
     case PD_METHOD_PENALTY:
-    case PD_METHOD_NEWMARK: rc = run_penalty(&sm.model, o, tau_end, &tr, res, err); break;
+    case PD_METHOD_NEWMARK:
+        rc = run_penalty(&sm.model, o, tau_end, &tr, res, err);
+        break;
     case PD_METHOD_MOREAU:
         rc = o->rtol > 0.0 ? run_moreau_adapt(&sm, o, tau_end, &tr, res, err)
                            : run_moreau(&sm.model, o, nsteps, &tr, res, err);
@@ -1431,7 +1431,8 @@ static int event_mass_ratio(const pd_scene *sc, const pd_run_opts *o, pd_err *er
         double ma = sc->st[ct->a].mass[ct->level_a - 1], mb = sc->st[ct->b].mass[ct->level_b - 1];
         double ratio = fmax(ma, mb) / fmin(ma, mb);
         if (!(ratio <= SCENE_EVENT_MASS_RATIO))
-            return pd_err_set(err, PD_EINVAL, "mass: %s and %s touch with masses %g and %g kg, "
+            return pd_err_set(err, PD_EINVAL,
+                              "mass: %s and %s touch with masses %g and %g kg, "
                               "a ratio of %.3g: beyond %g the event-driven references' impact "
                               "LCPs are singular in double precision (--method moreau runs it)",
                               sc->st[ct->a].name, sc->st[ct->b].name, ma, mb, ratio,
@@ -1481,8 +1482,8 @@ static int scene_law_band(const pd_scene *sc, const pd_run_opts *o, pd_scene_res
     return PD_OK;
 }
 
-int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler sampler,
-                 void *ctx, pd_scene_result *res, pd_err *err)
+int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler sampler, void *ctx,
+                 pd_scene_result *res, pd_err *err)
 {
     pd_run_opts o;
     pd_osc c;
@@ -1493,8 +1494,9 @@ int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler s
     if (!sc->finished)
         return pd_err_set(err, PD_EINVAL, "scene: not finished (pd_scene_finish)");
     if (!pd_scene_result_fits(sc, res))
-        return pd_err_set(err, PD_EINVAL, "the result is not allocated for this scene "
-                                          "(pd_scene_result_alloc)");
+        return pd_err_set(err, PD_EINVAL,
+                          "the result is not allocated for this scene "
+                          "(pd_scene_result_alloc)");
     if ((rc = pd_scene_resolve_opts(sc, opts, &o, err)) || (rc = event_mass_ratio(sc, &o, err)))
         return rc;
     for (int i = 0; i < res->n; i++)
@@ -1537,15 +1539,15 @@ int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler s
     res->contact_duration = pd_demand_td(&o);
     for (int s = 0; s < sc->nstruct; s++)
         for (int k = 0; k < sc->st[s].storeys; k++)
-            res->drift_ratio[sc->st[s].dof + k] = res->drift[sc->st[s].dof + k] /
-                                                  sc->st[s].height[k];
+            res->drift_ratio[sc->st[s].dof + k] =
+                res->drift[sc->st[s].dof + k] / sc->st[s].height[k];
     for (int a = 0; a < res->m; a++)
         res->force_equiv[a] = pd_equivalent_force(res->max_impulse[a], res->contact_duration);
     for (int s = 0; s < sc->nstruct && !rc; s++)
         for (int k = 0; k < sc->st[s].storeys && !rc; k++)
             rc = pd_demand_check_drift(res->drift[sc->st[s].dof + k],
-                                       res->drift_ratio[sc->st[s].dof + k], sc->st[s].name,
-                                       k + 1, err);
+                                       res->drift_ratio[sc->st[s].dof + k], sc->st[s].name, k + 1,
+                                       err);
     for (int a = 0; a < res->m && !rc; a++)
         rc = pd_demand_check_force(res->max_impulse[a], res->force_equiv[a], a, err);
     if (!rc && o.method == PD_METHOD_EVENT && res->law_decided > 0 && !o.no_law_band)
@@ -1610,8 +1612,7 @@ int pd_scene_summarize(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sam
     }
     for (int k = 0; k < sc->nstruct; k++) {
         s->Pi2[k] = sc->exc.Tp / sc->st[k].T0;
-        s->err_est_structure[k] =
-            s->r.rtol > 0.0 ? fmax(s->r.err_est[k], s->free.err_est[k]) : NAN;
+        s->err_est_structure[k] = s->r.rtol > 0.0 ? fmax(s->r.err_est[k], s->free.err_est[k]) : NAN;
     }
     for (int a = 0; a < sc->ncontact; a++) {
         s->Pi3[a] = sc->ct[a].gap / Le;

@@ -32,7 +32,8 @@ int pd_scene_sweep_check(const pd_scene_sweep *w, pd_err *err)
     if (!sc || !sc->finished)
         return pd_err_set(err, PD_EINVAL, "scene: not finished");
     if (sc->exc.record)
-        return pd_err_set(err, PD_EINVAL, "scene: the sweep varies the pulse period, which a "
+        return pd_err_set(err, PD_EINVAL,
+                          "scene: the sweep varies the pulse period, which a "
                           "record fixes (its fitted pulse's): sweep records with the oscillator");
     if (w->ref < 0 || w->ref >= sc->nstruct)
         return pd_err_set(err, PD_EINVAL, "ref: no structure %d", w->ref);
@@ -111,8 +112,7 @@ int pd_scene_sweep_scene(const pd_scene_sweep *w, long task, pd_scene **out, pd_
 }
 
 /* One task into its slots. */
-static int run_task(const pd_scene_sweep *w, long t, pd_scene_point *pt, double *umax,
-                    pd_err *err)
+static int run_task(const pd_scene_sweep *w, long t, pd_scene_point *pt, double *umax, pd_err *err)
 {
     pd_scene *c;
     pd_scene_result r;
@@ -121,7 +121,7 @@ static int run_task(const pd_scene_sweep *w, long t, pd_scene_point *pt, double 
     if ((rc = pd_scene_sweep_scene(w, t, &c, pt, err)))
         return pt->status = rc; /* the run's own status: pd_scene_sweep_run returns it */
     o.no_wall = t < pd_scene_sweep_twins(w);
-    o.no_demands = 1; /* a sweep keeps umax */
+    o.no_demands = 1;  /* a sweep keeps umax */
     o.no_law_band = 1; /* nor the other impact law's run */
     if (!(rc = pd_scene_result_alloc(c, &r, err))) {
         rc = pd_scene_run(c, &o, NULL, NULL, &r, err);

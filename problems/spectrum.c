@@ -34,7 +34,10 @@ long pd_spec_curves(const pd_spectrum *s)
     return (long)s->npulse * s->ndir * s->nap * s->nxi * s->nsize * s->neps;
 }
 
-long pd_spec_points(const pd_spectrum *s) { return s ? pd_spec_curves(s) * s->npi2 : 0; }
+long pd_spec_points(const pd_spectrum *s)
+{
+    return s ? pd_spec_curves(s) * s->npi2 : 0;
+}
 
 long pd_spec_twins(const pd_spectrum *s)
 {
@@ -43,7 +46,10 @@ long pd_spec_twins(const pd_spectrum *s)
     return (long)s->npulse * s->ndir * s->nap * s->nxi * s->npi2;
 }
 
-long pd_spec_tasks(const pd_spectrum *s) { return s ? pd_spec_twins(s) + pd_spec_points(s) : 0; }
+long pd_spec_tasks(const pd_spectrum *s)
+{
+    return s ? pd_spec_twins(s) + pd_spec_points(s) : 0;
+}
 
 double pd_grid_value(double lo, double hi, int n, int linear, int j)
 {
@@ -260,8 +266,7 @@ static int stream_next(void *ctx, pd_osc *c, pd_run_opts *o, long *id)
     }
 }
 
-static void stream_done(void *ctx, long id, const pd_osc_result *res, int status,
-                        const pd_err *err)
+static void stream_done(void *ctx, long id, const pd_osc_result *res, int status, const pd_err *err)
 {
     task_stream *ts = ctx;
     pd_spec_result r;
@@ -277,8 +282,8 @@ static void stream_done(void *ctx, long id, const pd_osc_result *res, int status
     ts->done(ts->ctx, id, &r, &e);
 }
 
-int pd_spec_stream(const pd_spectrum *s, pd_spec_task_next next, pd_spec_task_done done,
-                   void *ctx, pd_err *err)
+int pd_spec_stream(const pd_spectrum *s, pd_spec_task_next next, pd_spec_task_done done, void *ctx,
+                   pd_err *err)
 {
     if (!s || !next || !done)
         return PD_NULL_ARG(err, !s ? "s" : !next ? "next" : "done");
@@ -461,14 +466,17 @@ static int check_lists(const pd_spectrum *s, pd_err *err)
     const struct {
         const char *name;
         int n, max;
-    } lists[] = {{"pulse", s->npulse, 3},           {"dir", s->ndir, 2},
-                 {"ap", s->nap, PD_SPEC_MAX_LIST},  {"xi", s->nxi, PD_SPEC_MAX_LIST},
+    } lists[] = {{"pulse", s->npulse, 3},
+                 {"dir", s->ndir, 2},
+                 {"ap", s->nap, PD_SPEC_MAX_LIST},
+                 {"xi", s->nxi, PD_SPEC_MAX_LIST},
                  {s->size_is_gap ? "gap" : "Pi3", s->nsize, PD_SPEC_MAX_LIST},
-                 {"eps", s->neps, PD_SPEC_MAX_LIST}, {"Pi2", s->npi2, 1 << 24}};
+                 {"eps", s->neps, PD_SPEC_MAX_LIST},
+                 {"Pi2", s->npi2, 1 << 24}};
     for (size_t k = 0; k < sizeof lists / sizeof lists[0]; k++)
         if (lists[k].n < 1 || lists[k].n > lists[k].max)
-            return pd_err_set(err, PD_EINVAL, "%s: %d values (1 to %d)", lists[k].name,
-                              lists[k].n, lists[k].max);
+            return pd_err_set(err, PD_EINVAL, "%s: %d values (1 to %d)", lists[k].name, lists[k].n,
+                              lists[k].max);
     return PD_OK;
 }
 
@@ -490,8 +498,8 @@ typedef struct sweep_ctx {
     const pd_spectrum *s;
     pd_spec_point_fn fn;
     void *ctx;
-    pd_spec_result *res; /* every task's, as it ends */
-    long first_bad;      /* the lowest failed task so far (-1: none) */
+    pd_spec_result *res;                      /* every task's, as it ends */
+    long first_bad;                           /* the lowest failed task so far (-1: none) */
     char bad_msg[sizeof(((pd_err *)0)->msg)]; /* its message */
     long ntasks, ntw, next, emitted;
     int rc;
@@ -553,8 +561,13 @@ int pd_spec_sweep(const pd_spectrum *s, pd_spec_point_fn fn, void *ctx, pd_err *
         return rc;
     pd_spectrum one = *s; /* one method for every run */
     pd_spec_resolve_method(&one);
-    sweep_ctx w = {.s = &one, .fn = fn, .ctx = ctx, .ntasks = n, .ntw = pd_spec_twins(s),
-                   .first_bad = -1, .err = err};
+    sweep_ctx w = {.s = &one,
+                   .fn = fn,
+                   .ctx = ctx,
+                   .ntasks = n,
+                   .ntw = pd_spec_twins(s),
+                   .first_bad = -1,
+                   .err = err};
     w.res = calloc((size_t)n, sizeof *w.res);
     if (!w.res)
         return pd_err_set(err, PD_ENOMEM, "out of memory for %ld runs", n);

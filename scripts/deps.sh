@@ -2,7 +2,8 @@
 # deps.sh — make sure the Debian packages pound needs are installed.
 # As root, installs what is missing; otherwise prints the one apt-get line
 # needed and fails.  Usage: scripts/deps.sh [--ci|--bench]   (--ci adds
-# CI-only tools: python3, OpenMPI for the MPI build `make MPI=1`, which the
+# CI-only tools: python3, clang-format and ctags (make format-check, make
+# house), OpenMPI for the MPI build `make MPI=1`, which the
 # quick start does not need, and Siconos numerics, which bench/siconos_lcp
 # is timed against, and the stress suite's clang, LLVM OpenMP and libFuzzer;
 # --bench adds Siconos numerics alone; --stress the stress suite's tools;
@@ -11,7 +12,7 @@
 # make formats-check opens every HDF5 file with)
 set -u
 pkgs="gcc make pkg-config libgsl-dev libsuitesparse-dev libhdf5-dev hdf5-tools libjansson-dev gnuplot-nox"
-[ "${1:-}" = "--ci" ] && pkgs="$pkgs python3 libopenmpi-dev openmpi-bin libsiconos-numerics-dev"
+[ "${1:-}" = "--ci" ] && pkgs="$pkgs python3 libopenmpi-dev openmpi-bin libsiconos-numerics-dev clang-format universal-ctags"
 stress="python3 python3-numpy python3-pytest clang libomp-dev libclang-rt-dev util-linux"
 # the Python package's tests and the files read back with h5py (and xarray's
 # h5netcdf, netCDF-C's ncdump); its type check (mypy), its notebook

@@ -26,7 +26,10 @@ static void *fx_zeros(size_t bytes)
     return memset(p, 0, bytes);
 }
 
-void *fx_slot(void) { return fx_zeros(sizeof(void *) * 8); }
+void *fx_slot(void)
+{
+    return fx_zeros(sizeof(void *) * 8);
+}
 
 const char *fx_string(const char *fn, const char *name)
 {
@@ -49,9 +52,14 @@ static const double fx_one = 1.0, fx_half = 0.5;
 static pd_model *fx_model(void)
 {
     pd_model *m = fx_zeros(sizeof *m);
-    *m = (pd_model){.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, &fx_one),
-                    .C = pd_matrix_zero(1, 1), .K = pd_matrix_dense(1, 1, &fx_one),
-                    .W = pd_matrix_dense(1, 1, &fx_one), .g0 = &fx_one, .e = &fx_half};
+    *m = (pd_model){.n = 1,
+                    .m = 1,
+                    .M = pd_matrix_dense(1, 1, &fx_one),
+                    .C = pd_matrix_zero(1, 1),
+                    .K = pd_matrix_dense(1, 1, &fx_one),
+                    .W = pd_matrix_dense(1, 1, &fx_one),
+                    .g0 = &fx_one,
+                    .e = &fx_half};
     return m;
 }
 
@@ -71,12 +79,12 @@ void *fx_object(const char *type, const char *fn, int k)
         return fx_scene();
     if (!strcmp(type, "pd_model"))
         return fx_model();
-    /* value types with a default: a heap copy of it */
-#define FX_DEFAULT(T, value)                                                                  \
-    if (!strcmp(type, #T)) {                                                                  \
-        T *x = fx_zeros(sizeof *x);                                                           \
-        *x = value;                                                                           \
-        return x;                                                                             \
+        /* value types with a default: a heap copy of it */
+#define FX_DEFAULT(T, value)                                                                       \
+    if (!strcmp(type, #T)) {                                                                       \
+        T *x = fx_zeros(sizeof *x);                                                                \
+        *x = value;                                                                                \
+        return x;                                                                                  \
     }
     FX_DEFAULT(pd_osc, pd_osc_default())
     FX_DEFAULT(pd_run_opts, pd_run_default_opts())
@@ -164,11 +172,18 @@ static const char *api_null_run(const api_null_case *c, int *code)
         long v = c->call();
         int ok = 1;
         switch (c->expect) {
-        case EXPECT_ERROR: ok = v < 0; break;
-        case EXPECT_COUNT: ok = v <= 0; break;
-        case EXPECT_NULL: ok = v == 0; break;
+        case EXPECT_ERROR:
+            ok = v < 0;
+            break;
+        case EXPECT_COUNT:
+            ok = v <= 0;
+            break;
+        case EXPECT_NULL:
+            ok = v == 0;
+            break;
         case EXPECT_NAME:
-        case EXPECT_NOCRASH: break;
+        case EXPECT_NOCRASH:
+            break;
         }
         _exit(ok ? 0 : 1); /* _exit: no leak report for the fixtures */
     }
@@ -195,11 +210,14 @@ static void test_api_null(pd_test_ctx *ctx)
         const api_null_case *c = &api_null_cases[i];
         int code = 0;
         const char *why = api_null_run(c, &code);
-        CHECK(ctx, why == NULL, "%s(%s = NULL): %s (%d)", c->function, c->argument,
-              why ? why : "", code);
+        CHECK(ctx, why == NULL, "%s(%s = NULL): %s (%d)", c->function, c->argument, why ? why : "",
+              code);
     }
-    CHECK(ctx, api_null_ncases > 200 && api_null_nfunctions > 150,
-          "%d cases over %d functions", api_null_ncases, api_null_nfunctions);
+    CHECK(ctx, api_null_ncases > 200 && api_null_nfunctions > 150, "%d cases over %d functions",
+          api_null_ncases, api_null_nfunctions);
 }
 
-void suite_api_null(pd_test_ctx *ctx) { PD_RUN(ctx, test_api_null); }
+void suite_api_null(pd_test_ctx *ctx)
+{
+    PD_RUN(ctx, test_api_null);
+}

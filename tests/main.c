@@ -24,7 +24,7 @@ static const char *running_case; /* for the alarm's message */
 static void over_time(int sig)
 {
     static const char head[] = "FAIL  ", tail[] = ": over the per-case time limit "
-                                                   "(POUND_TEST_TIMEOUT)\n";
+                                                  "(POUND_TEST_TIMEOUT)\n";
     (void)sig;
     if (write(STDOUT_FILENO, head, sizeof head - 1) < 0 ||
         (running_case && write(STDOUT_FILENO, running_case, strlen(running_case)) < 0) ||
@@ -63,8 +63,8 @@ void pd_test_run(pd_test_ctx *ctx, const char *name, void (*fn)(pd_test_ctx *))
         ctx->failed++;
         printf("FAIL  %s\n", name);
         if (getenv("POUND_TEST_FAILFAST")) { /* make mutate: the first failure kills */
-            printf("%d passed, %d failed, %d skipped (stopped at the first failure)\n",
-                   ctx->passed, ctx->failed, ctx->skipped);
+            printf("%d passed, %d failed, %d skipped (stopped at the first failure)\n", ctx->passed,
+                   ctx->failed, ctx->skipped);
             fflush(stdout);
             exit(1);
         }

@@ -36,12 +36,12 @@ double pd_test_uniform(uint64_t *state);
 /* CHECK(ctx, cond, "fmt", ...) — the message says what was measured. */
 #define CHECK(ctx, cond, ...) pd_test_check((ctx), (cond) ? 1 : 0, __FILE__, __LINE__, __VA_ARGS__)
 /* |a - b| <= tol, printing both values on failure. */
-#define CHECK_NEAR(ctx, a, b, tol)                                                          \
-    do {                                                                                    \
-        double pd_a_ = (a), pd_b_ = (b), pd_t_ = (tol);                                     \
-        pd_test_check((ctx), fabs(pd_a_ - pd_b_) <= pd_t_, __FILE__, __LINE__,              \
-                      "%s = %.17g vs %s = %.17g (|diff| %.3g > tol %.3g)", #a, pd_a_, #b, pd_b_, \
-                      fabs(pd_a_ - pd_b_), pd_t_);                                          \
+#define CHECK_NEAR(ctx, a, b, tol)                                                                 \
+    do {                                                                                           \
+        double pd_a_ = (a), pd_b_ = (b), pd_t_ = (tol);                                            \
+        pd_test_check((ctx), fabs(pd_a_ - pd_b_) <= pd_t_, __FILE__, __LINE__,                     \
+                      "%s = %.17g vs %s = %.17g (|diff| %.3g > tol %.3g)", #a, pd_a_, #b, pd_b_,   \
+                      fabs(pd_a_ - pd_b_), pd_t_);                                                 \
     } while (0)
 
 /* ---- helpers for the CLI suites (test_util.c) ---------------------------- */
@@ -54,7 +54,7 @@ typedef struct proc_out {
     char *out, *err;
 } proc_out;
 
-char *pd_test_slurp(const char *path);               /* whole file, malloc'd */
+char *pd_test_slurp(const char *path); /* whole file, malloc'd */
 void pd_test_proc_free(proc_out *r);
 /* Run argv with env ("NAME=value" or NULL) added; capture stdout, stderr. */
 int pd_test_spawn(const char *const *argv, const char *env, proc_out *r);
@@ -67,10 +67,10 @@ int pd_test_spawn(const char *const *argv, const char *env, proc_out *r);
 int pd_test_rinaldi_case(pd_test_ctx *ctx, pd_record *rec, pd_osc *c);
 /* Run ctx->pound with args (NULL-terminated). */
 int pd_test_pound(const pd_test_ctx *ctx, const char *const *args, proc_out *r);
-int pd_test_have_pound(pd_test_ctx *ctx);           /* else skips the case */
+int pd_test_have_pound(pd_test_ctx *ctx);                          /* else skips the case */
 double pd_test_json_num(const char *json, const char *key, int k); /* k-th "key": */
 void pd_test_json_str(const char *json, const char *key, int k, char *buf, size_t cap);
-int pd_test_dir_entries(const char *dir);            /* besides . and .. */
+int pd_test_dir_entries(const char *dir); /* besides . and .. */
 void pd_test_rm_dir(const char *dir);
 /* A sparse regular file of `bytes` zero bytes (no disk used) at a fresh
  * /tmp name written into path: 0, or -1 (nothing left). */

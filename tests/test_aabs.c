@@ -30,9 +30,10 @@ static void test_aabs_rest_on_wall(pd_test_ctx *ctx)
     pd_err e;
     if (!CHECK(ctx, sc != NULL, "out of memory"))
         return;
-    if (!CHECK(ctx, !pd_scene_add_sdof(sc, "S", 0.5, 0.05, 1e5, &e) &&
-                        !pd_scene_add_contact(sc, 0, 1, PD_WALL, 0, 0.0, 0.5, 0, &e) &&
-                        !pd_scene_finish(sc, &e) && !pd_scene_result_alloc(sc, &r, &e),
+    if (!CHECK(ctx,
+               !pd_scene_add_sdof(sc, "S", 0.5, 0.05, 1e5, &e) &&
+                   !pd_scene_add_contact(sc, 0, 1, PD_WALL, 0, 0.0, 0.5, 0, &e) &&
+                   !pd_scene_finish(sc, &e) && !pd_scene_result_alloc(sc, &r, &e),
                "scene: %s", e.msg)) {
         pd_scene_free(sc);
         return;
@@ -67,8 +68,8 @@ static void test_aabs_rest_on_wall(pd_test_ctx *ctx)
         int rc = pd_scene_run(sc, &o, NULL, NULL, &r, &e);
         CHECK(ctx, rc == PD_OK && fabs(r.acc_max[0] - exc.ap) <= cases[k].tol * exc.ap,
               "%s kernel %d rtol %g: rc %d (%s), a_abs %.9g, a_g's peak %g",
-              pd_method_name(o.method), (int)o.kernel, o.rtol, rc, rc ? e.msg : "",
-              r.acc_max[0], exc.ap);
+              pd_method_name(o.method), (int)o.kernel, o.rtol, rc, rc ? e.msg : "", r.acc_max[0],
+              exc.ap);
     }
     pd_scene_result_free(&r);
     pd_scene_free(sc);
@@ -85,13 +86,14 @@ static pd_scene *three_structures(pd_test_ctx *ctx)
     pd_err e;
     if (!CHECK(ctx, sc != NULL, "out of memory"))
         return NULL;
-    if (!CHECK(ctx, !pd_scene_add_building(sc, "A", 3, m, k, 0.05, &e) &&
-                        !pd_scene_add_sdof(sc, "B", 1.0, 0.05, 2e5, &e) &&
-                        !pd_scene_add_uniform(sc, "C", 2, 2.5e5, 0.5, 0.05, &e) &&
-                        !pd_scene_add_contact(sc, PD_WALL, 0, 0, 2, 0.004, 0.0, 0, &e) &&
-                        !pd_scene_add_contact(sc, 0, 2, 1, 1, 0.006, 0.0, 1, &e) &&
-                        !pd_scene_add_contact(sc, 1, 1, 2, 1, 0.02, 0.5, 2, &e) &&
-                        !pd_scene_finish(sc, &e),
+    if (!CHECK(ctx,
+               !pd_scene_add_building(sc, "A", 3, m, k, 0.05, &e) &&
+                   !pd_scene_add_sdof(sc, "B", 1.0, 0.05, 2e5, &e) &&
+                   !pd_scene_add_uniform(sc, "C", 2, 2.5e5, 0.5, 0.05, &e) &&
+                   !pd_scene_add_contact(sc, PD_WALL, 0, 0, 2, 0.004, 0.0, 0, &e) &&
+                   !pd_scene_add_contact(sc, 0, 2, 1, 1, 0.006, 0.0, 1, &e) &&
+                   !pd_scene_add_contact(sc, 1, 1, 2, 1, 0.02, 0.5, 2, &e) &&
+                   !pd_scene_finish(sc, &e),
                "scene: %s", e.msg)) {
         pd_scene_free(sc);
         return NULL;
@@ -160,8 +162,10 @@ static void test_aabs_three_structures(pd_test_ctx *ctx)
     struct {
         pd_method method;
         double rtol;
-    } cases[] = {{PD_METHOD_EVENT, 0.0}, {PD_METHOD_EVENT_GENERAL, 0.0},
-                 {PD_METHOD_MOREAU, 0.0}, {PD_METHOD_MOREAU, 1e-5}};
+    } cases[] = {{PD_METHOD_EVENT, 0.0},
+                 {PD_METHOD_EVENT_GENERAL, 0.0},
+                 {PD_METHOD_MOREAU, 0.0},
+                 {PD_METHOD_MOREAU, 1e-5}};
     for (size_t c = 0; c < sizeof cases / sizeof cases[0] && !rc; c++) {
         o = pd_run_default_opts();
         o.method = cases[c].method;
@@ -202,8 +206,9 @@ static void test_aabs_moreau_cascade(pd_test_ctx *ctx)
     pd_scene *sc = NULL;
     pd_scene_result ref, r;
     pd_err e;
-    if (!CHECK(ctx, pd_scene_load("examples/scenes/three-sdof.json", &sc, &e) == PD_OK &&
-                        !pd_scene_result_alloc(sc, &ref, &e) && !pd_scene_result_alloc(sc, &r, &e),
+    if (!CHECK(ctx,
+               pd_scene_load("examples/scenes/three-sdof.json", &sc, &e) == PD_OK &&
+                   !pd_scene_result_alloc(sc, &ref, &e) && !pd_scene_result_alloc(sc, &r, &e),
                "%s", e.msg)) {
         pd_scene_free(sc);
         return;
@@ -219,7 +224,8 @@ static void test_aabs_moreau_cascade(pd_test_ctx *ctx)
             if (!CHECK(ctx, pd_scene_run(sc, &o, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg))
                 continue;
             for (int i = 0; i < r.n; i++)
-                CHECK(ctx, fabs(r.acc_max[i] - ref.acc_max[i]) <= (k ? 0.02 : 0.01) * ref.acc_max[i],
+                CHECK(ctx,
+                      fabs(r.acc_max[i] - ref.acc_max[i]) <= (k ? 0.02 : 0.01) * ref.acc_max[i],
                       "dt %g: a_abs %d = %.6g, reference %.6g", r.dt, i, r.acc_max[i],
                       ref.acc_max[i]);
         }

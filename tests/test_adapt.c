@@ -139,8 +139,9 @@ static void test_adapt_rows_reliability(pd_test_ctx *ctx)
         pd_err err;
         pd_scene *sc = random_row(&s, &err);
         pd_scene_result ref = {0}, r = {0};
-        if (!CHECK(ctx, sc && pd_scene_result_alloc(sc, &ref, &err) == PD_OK &&
-                            pd_scene_result_alloc(sc, &r, &err) == PD_OK,
+        if (!CHECK(ctx,
+                   sc && pd_scene_result_alloc(sc, &ref, &err) == PD_OK &&
+                       pd_scene_result_alloc(sc, &r, &err) == PD_OK,
                    "row %d: %s", row, err.msg)) {
             pd_scene_free(sc);
             return;
@@ -195,16 +196,16 @@ static void test_adapt_compressed_cluster(pd_test_ctx *ctx)
         long impacts = 0;
         for (int a = 0; a < sc->ncontact; a++)
             impacts += ref.impacts[a];
-        CHECK(ctx, rc == PD_OK && impacts > 15, "reference: %s (%ld impacts)",
-              rc ? err.msg : "ok", impacts);
+        CHECK(ctx, rc == PD_OK && impacts > 15, "reference: %s (%ld impacts)", rc ? err.msg : "ok",
+              impacts);
         for (int k = 0; k < ADAPT_NR && !rc; k++) {
             o.method = PD_METHOD_MOREAU;
             o.rtol = adapt_rtols[k];
             rc = pd_scene_run(sc, &o, NULL, NULL, &r, &err);
             double e = rc ? NAN : umax_error(sc, &r, &ref);
             CHECK(ctx, rc == PD_OK && e <= o.rtol && r.rtol_met && r.err_est_max <= o.rtol,
-                  "rtol %g: umax error %.3g, err_est %.3g, met %d (%s)", o.rtol, e,
-                  r.err_est_max, r.rtol_met, rc ? err.msg : "ok");
+                  "rtol %g: umax error %.3g, err_est %.3g, met %d (%s)", o.rtol, e, r.err_est_max,
+                  r.rtol_met, rc ? err.msg : "ok");
         }
     }
     pd_scene_result_free(&ref);
@@ -250,10 +251,17 @@ static void wall_force(double t, int side, double *F, void *ctx)
 static void test_adapt_engine_contract(pd_test_ctx *ctx)
 {
     double M = 1.0, C = 0.1, K = 4.0, W = -1.0, g0 = 0.05, e = 0.5, brk = 2.0;
-    pd_model md = {.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, &M),
-                   .C = pd_matrix_dense(1, 1, &C), .K = pd_matrix_dense(1, 1, &K),
-                   .W = pd_matrix_dense(1, 1, &W), .g0 = &g0, .e = &e, .force = wall_force,
-                   .breaks = &brk, .nbreaks = 1};
+    pd_model md = {.n = 1,
+                   .m = 1,
+                   .M = pd_matrix_dense(1, 1, &M),
+                   .C = pd_matrix_dense(1, 1, &C),
+                   .K = pd_matrix_dense(1, 1, &K),
+                   .W = pd_matrix_dense(1, 1, &W),
+                   .g0 = &g0,
+                   .e = &e,
+                   .force = wall_force,
+                   .breaks = &brk,
+                   .nbreaks = 1};
     pd_mj_opts o = pd_mj_default_opts();
     o.h = 0.1;
     o.rtol = 1e-6;
@@ -270,24 +278,25 @@ static void test_adapt_engine_contract(pd_test_ctx *ctx)
     CHECK(ctx, pd_test_allocations() == allocs, "%ld allocations in the steps",
           pd_test_allocations() - allocs);
     pd_mj_stats st;
-    CHECK(ctx, pd_mj_get_stats(mj, &st) == PD_OK && st.steps > 10 && st.evals >= st.steps &&
-                   st.h_min > 0.0 && st.h_min <= st.h_max && st.h_max <= st.h0 &&
-                   !st.floor_hit && !st.budget_hit,
+    CHECK(ctx,
+          pd_mj_get_stats(mj, &st) == PD_OK && st.steps > 10 && st.evals >= st.steps &&
+              st.h_min > 0.0 && st.h_min <= st.h_max && st.h_max <= st.h0 && !st.floor_hit &&
+              !st.budget_hit,
           "stats: %ld steps, %ld evals, h %g ... %g (h0 %g), floor %d, budget %d", st.steps,
           st.evals, st.h_min, st.h_max, st.h0, st.floor_hit, st.budget_hit);
     const pd_state *s = pd_mj_state(mj);
     CHECK(ctx, fabs(s->t - 6.0) <= 1e-12 && s->err && s->err[0] >= 0.0 && s->err[0] <= 1e-5,
           "the state at t = %.17g: err %g", s->t, s->err ? s->err[0] : NAN);
     rc = pd_mj_step(mj, &err);
-    CHECK(ctx, rc == PD_EINVAL && strstr(err.msg, "rtol"), "pd_mj_step on a run to a tolerance: %d (%s)",
-          rc, err.msg);
+    CHECK(ctx, rc == PD_EINVAL && strstr(err.msg, "rtol"),
+          "pd_mj_step on a run to a tolerance: %d (%s)", rc, err.msg);
     pd_mj_free(mj);
     const double bad[] = {-1e-3, 1.0, NAN};
     for (int k = 0; k < 3; k++) {
         o.rtol = bad[k];
         mj = pd_mj_alloc(&md, &o, &err);
-        CHECK(ctx, !mj && err.status == PD_EINVAL && strstr(err.msg, "rtol"),
-              "rtol %g: %s", bad[k], mj ? "accepted" : err.msg);
+        CHECK(ctx, !mj && err.status == PD_EINVAL && strstr(err.msg, "rtol"), "rtol %g: %s", bad[k],
+              mj ? "accepted" : err.msg);
         pd_mj_free(mj);
     }
 }
@@ -315,11 +324,11 @@ static void test_adapt_options(pd_test_ctx *ctx)
     CHECK(ctx, pd_osc_run(&c, &o, NULL, NULL, &r, &err) == PD_EINVAL && strstr(err.msg, "rtol"),
           "rtol 1.5: %s", err.msg);
     o.rtol = 0.0;
-    CHECK(ctx, pd_osc_run(&c, &o, NULL, NULL, &r, &err) == PD_OK && r.rtol == 0.0 &&
-                   isnan(r.err_est) && r.rtol_met && r.dt_min == r.dt && r.dt_max == r.dt &&
-                   r.steps_rejected == 0,
-          "fixed steps: rtol %g, err_est %g, met %d, dt %g ... %g", r.rtol, r.err_est,
-          r.rtol_met, r.dt_min, r.dt_max);
+    CHECK(ctx,
+          pd_osc_run(&c, &o, NULL, NULL, &r, &err) == PD_OK && r.rtol == 0.0 && isnan(r.err_est) &&
+              r.rtol_met && r.dt_min == r.dt && r.dt_max == r.dt && r.steps_rejected == 0,
+          "fixed steps: rtol %g, err_est %g, met %d, dt %g ... %g", r.rtol, r.err_est, r.rtol_met,
+          r.dt_min, r.dt_max);
 }
 
 /* The CLI: the fields in the text and JSON, and the warning on stderr
@@ -328,26 +337,29 @@ static void test_adapt_options(pd_test_ctx *ctx)
 static void test_adapt_cli(pd_test_ctx *ctx)
 {
     proc_out r = {0};
-    const char *text[] = {ctx->pound, "simulate", "--Pi2", "1.5", "--Pi3", "0.1", "--eps", "0.5",
-                          "--rtol", "1e-4", NULL};
+    const char *text[] = {ctx->pound, "simulate", "--Pi2",  "1.5",  "--Pi3", "0.1",
+                          "--eps",    "0.5",      "--rtol", "1e-4", NULL};
     if (!CHECK(ctx, pd_test_spawn(text, NULL, &r) == 0 && r.status == 0, "simulate --rtol: %s",
                r.err ? r.err : ""))
         return;
-    CHECK(ctx, strstr(r.out, "Moreau-Jean to rtol = 0.0001") && strstr(r.out, "err_est") &&
-                   strstr(r.out, "rtol met") && !strstr(r.err, "warning"),
+    CHECK(ctx,
+          strstr(r.out, "Moreau-Jean to rtol = 0.0001") && strstr(r.out, "err_est") &&
+              strstr(r.out, "rtol met") && !strstr(r.err, "warning"),
           "text:\n%s", r.out);
     pd_test_proc_free(&r);
-    const char *json[] = {ctx->pound, "simulate", "--chain", "10", "--pulse", "sine", "--Tp", "1",
-                          "--Pi3", "0.05", "--eps", "0.6", "--rtol", "1e-3", "--json", NULL};
+    const char *json[] = {ctx->pound, "simulate", "--chain", "10",   "--pulse", "sine",
+                          "--Tp",     "1",        "--Pi3",   "0.05", "--eps",   "0.6",
+                          "--rtol",   "1e-3",     "--json",  NULL};
     if (!CHECK(ctx, pd_test_spawn(json, NULL, &r) == 0 && r.status == 0, "chain --rtol: %s",
                r.err ? r.err : ""))
         return;
     int met = strstr(r.out, "\"rtol_met\":true") != NULL;
-    CHECK(ctx, strstr(r.out, "\"rtol\":0.001") && strstr(r.out, "\"steps_rejected\":") &&
-                   strstr(r.out, "\"dt_min\":") && strstr(r.out, "\"err_est\":0."),
+    CHECK(ctx,
+          strstr(r.out, "\"rtol\":0.001") && strstr(r.out, "\"steps_rejected\":") &&
+              strstr(r.out, "\"dt_min\":") && strstr(r.out, "\"err_est\":0."),
           "JSON: %.400s", r.out);
-    CHECK(ctx, met == !strstr(r.err, "warning: rtol 0.001 not met"),
-          "rtol_met %d, stderr: %s", met, r.err);
+    CHECK(ctx, met == !strstr(r.err, "warning: rtol 0.001 not met"), "rtol_met %d, stderr: %s", met,
+          r.err);
     pd_test_proc_free(&r);
     const char *both[] = {ctx->pound, "simulate", "--rtol", "1e-4", "--dt", "1e-3", NULL};
     CHECK(ctx, pd_test_spawn(both, NULL, &r) == 2 && strstr(r.err, "--rtol") && !r.out[0],

@@ -20,7 +20,7 @@ void *__real_realloc(void *p, size_t n);
 
 static long alloc_countdown = -1; /* < 0: never fail; 0: fail this one */
 static long alloc_seen = 0;
-static long alloc_total = 0;      /* every allocation call since the start */
+static long alloc_total = 0; /* every allocation call since the start */
 
 long pd_test_allocations(void)
 {
@@ -92,7 +92,14 @@ static int case_moreau_general(void)
 {
     double M[4] = {1, 0, 0, 2}, K[4] = {4, -1, -1, 3}, W[4] = {-1, 0, 1, -1};
     double g0[2] = {0.05, 0.02}, e[2] = {0.7, 0.3};
-    pd_model md = {.n = 2, .m = 2, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_zero(2, 2), .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_dense(2, 2, W), .g0 = g0, .e = e};
+    pd_model md = {.n = 2,
+                   .m = 2,
+                   .M = pd_matrix_dense(2, 2, M),
+                   .C = pd_matrix_zero(2, 2),
+                   .K = pd_matrix_dense(2, 2, K),
+                   .W = pd_matrix_dense(2, 2, W),
+                   .g0 = g0,
+                   .e = e};
     pd_mj_opts o = pd_mj_default_opts();
     pd_err err;
     double v0[2] = {1.0, -1.0};
@@ -117,7 +124,14 @@ static int keep_sample(const pd_osc_sample *s, void *ctx)
  * test_alloc_every_failure_reported). */
 static int case_oscillator(void)
 {
-    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5, .Pi3 = 0.05, .eps = 0.5, .xi = 0.05};
+    pd_osc c = {.pulse = PD_PULSE_SINE,
+                .dir = 1,
+                .ap = 1.0,
+                .Tp = 1.0,
+                .Pi2 = 0.5,
+                .Pi3 = 0.05,
+                .eps = 0.5,
+                .xi = 0.05};
     pd_run_opts o = pd_run_default_opts();
     pd_osc_result r;
     pd_err err;
@@ -128,7 +142,14 @@ static int case_oscillator(void)
 
 static int case_oscillator_plain(void)
 {
-    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5, .Pi3 = 0.05, .eps = 0.5, .xi = 0.05};
+    pd_osc c = {.pulse = PD_PULSE_SINE,
+                .dir = 1,
+                .ap = 1.0,
+                .Tp = 1.0,
+                .Pi2 = 0.5,
+                .Pi3 = 0.05,
+                .eps = 0.5,
+                .xi = 0.05};
     pd_run_opts o = pd_run_default_opts();
     pd_osc_result r;
     pd_err err;
@@ -138,7 +159,14 @@ static int case_oscillator_plain(void)
 
 static int case_penalty(void)
 {
-    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5, .Pi3 = 0.05, .eps = 0.5, .xi = 0.05};
+    pd_osc c = {.pulse = PD_PULSE_SINE,
+                .dir = 1,
+                .ap = 1.0,
+                .Tp = 1.0,
+                .Pi2 = 0.5,
+                .Pi3 = 0.05,
+                .eps = 0.5,
+                .xi = 0.05};
     pd_run_opts o = pd_run_default_opts();
     pd_osc_result r;
     pd_err err;
@@ -224,8 +252,10 @@ static void test_alloc_every_failure_reported(pd_test_ctx *ctx)
     alloc_countdown = -1;
     alloc_seen = 0;
     int st = case_oscillator_plain();
-    CHECK(ctx, st == PD_OK && alloc_seen == 0, "pd_osc_simulate without a sampler: status %d, "
-          "%ld allocations", st, alloc_seen);
+    CHECK(ctx, st == PD_OK && alloc_seen == 0,
+          "pd_osc_simulate without a sampler: status %d, "
+          "%ld allocations",
+          st, alloc_seen);
 }
 
 void suite_alloc(pd_test_ctx *ctx)

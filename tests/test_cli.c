@@ -10,15 +10,31 @@
 /* Every bad-input class: exit 2, one stderr line naming the flag, no file. */
 static void test_cli_bad_input(pd_test_ctx *ctx)
 {
-    static const struct { const char *flag, *value, *named; } cases[] = {
-        {"--gap", "-0.01", "gap"},     {"--eps", "1.5", "eps"},       {"--eps", "-0.2", "eps"},
-        {"--xi", "1.0", "xi"},         {"--xi", "-0.1", "xi"},        {"--dt", "0", "dt"},
-        {"--dt", "-1e-3", "dt"},       {"--T0", "nan", "T0"},         {"--T0", "0", "T0"},
-        {"--ap", "0", "ap"},           {"--Tp", "inf", "Tp"},         {"--pulse", "triangle", "pulse"},
-        {"--dir", "sideways", "dir"},  {"--theta", "0.3", "theta"},   {"--eps", "abc", "eps"},
-        {"--Pi3", "-1", "Pi3"},        {"--every", "0", "every"},     {"--bogus", "1", "bogus"},
-        {"--method", "magic", "method"}, {"--tend", "-2", "tend"},    {"--gamma", "2", "gamma"},
-        {"-o", "run.txt", "run.txt"},  {"--Pi2", "1", "Pi2"} /* with --T0: both given */};
+    static const struct {
+        const char *flag, *value, *named;
+    } cases[] = {{"--gap", "-0.01", "gap"},
+                 {"--eps", "1.5", "eps"},
+                 {"--eps", "-0.2", "eps"},
+                 {"--xi", "1.0", "xi"},
+                 {"--xi", "-0.1", "xi"},
+                 {"--dt", "0", "dt"},
+                 {"--dt", "-1e-3", "dt"},
+                 {"--T0", "nan", "T0"},
+                 {"--T0", "0", "T0"},
+                 {"--ap", "0", "ap"},
+                 {"--Tp", "inf", "Tp"},
+                 {"--pulse", "triangle", "pulse"},
+                 {"--dir", "sideways", "dir"},
+                 {"--theta", "0.3", "theta"},
+                 {"--eps", "abc", "eps"},
+                 {"--Pi3", "-1", "Pi3"},
+                 {"--every", "0", "every"},
+                 {"--bogus", "1", "bogus"},
+                 {"--method", "magic", "method"},
+                 {"--tend", "-2", "tend"},
+                 {"--gamma", "2", "gamma"},
+                 {"-o", "run.txt", "run.txt"},
+                 {"--Pi2", "1", "Pi2"} /* with --T0: both given */};
     if (!pd_test_have_pound(ctx))
         return;
     char dir[] = "/tmp/pd_cli_dirXXXXXX";
@@ -27,9 +43,10 @@ static void test_cli_bad_input(pd_test_ctx *ctx)
     char out[512];
     snprintf(out, sizeof out, "%s/out.h5", dir);
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
-        const char *args[] = {"simulate", "--pulse", "sine", "--ap", "1", "--Tp", "1", "--T0",
-                              "1", "--gap", "0.01", "--eps", "0.5", "-o", out,
-                              cases[k].flag, cases[k].value, NULL};
+        const char *args[] = {
+            "simulate", "--pulse",     "sine",         "--ap", "1",     "--Tp", "1",
+            "--T0",     "1",           "--gap",        "0.01", "--eps", "0.5",  "-o",
+            out,        cases[k].flag, cases[k].value, NULL};
         if (!strcmp(cases[k].flag, "--gap") || !strcmp(cases[k].flag, "--eps") ||
             !strcmp(cases[k].flag, "--T0")) { /* replace the base value instead of repeating */
             for (int i = 0; args[i]; i++)
@@ -56,8 +73,8 @@ static void test_cli_bad_input(pd_test_ctx *ctx)
               cases[k].flag, cases[k].value, cases[k].named, r.err);
         CHECK(ctx, nl && nl[1] == '\0', "%s %s: stderr must be one line: %s", cases[k].flag,
               cases[k].value, r.err);
-        CHECK(ctx, r.out[0] == '\0', "%s %s: nothing on stdout: %s", cases[k].flag,
-              cases[k].value, r.out);
+        CHECK(ctx, r.out[0] == '\0', "%s %s: nothing on stdout: %s", cases[k].flag, cases[k].value,
+              r.out);
         CHECK(ctx, pd_test_dir_entries(dir) == 0, "%s %s: a file was left behind", cases[k].flag,
               cases[k].value);
         pd_test_proc_free(&r);
@@ -92,12 +109,15 @@ static void test_cli_hardening(pd_test_ctx *ctx)
         {{"simulate", "--tend", "1e308", NULL}, "--tend"},
         /* Pi2 = Tp / T0 overflows: the extreme value is Tp's, not T0's */
         {{"simulate", "--pulse", "sine", "--ap", "4", "--Tp", "1e308", "--T0", "0.5", "--gap",
-          "0.004", NULL}, "--Tp:"},
+          "0.004", NULL},
+         "--Tp:"},
         /* too many steps because of Tp (stress: derived): --Tp, not --T0 */
         {{"simulate", "--pulse", "sine", "--ap", "4", "--Tp", "1e30", "--T0", "0.5", "--gap",
-          "0.004", NULL}, "--Tp:"},
+          "0.004", NULL},
+         "--Tp:"},
         {{"compare", "--pulse", "sine", "--ap", "4", "--Tp", "1e-30", "--T0", "0.5", "--gap",
-          "0.004", NULL}, "--Tp:"},
+          "0.004", NULL},
+         "--Tp:"},
         {{"simulate", "--dt", "1e308", NULL}, "--dt"},
         {{"simulate", "--chain", "3", "--chain-ratio", "1e308", NULL}, "--chain-ratio"},
         {{"spectrum", "--Pi2", "1e-300:1e300:2", NULL}, "--Pi2"},
@@ -115,8 +135,9 @@ static void test_cli_hardening(pd_test_ctx *ctx)
         proc_out r;
         pd_test_pound(ctx, cases[k].args, &r);
         char *nl = strchr(r.err, '\n');
-        CHECK(ctx, r.status == 2 && strstr(r.err, cases[k].named) && nl && nl[1] == '\0' &&
-                       !strchr(r.err, '\033'),
+        CHECK(ctx,
+              r.status == 2 && strstr(r.err, cases[k].named) && nl && nl[1] == '\0' &&
+                  !strchr(r.err, '\033'),
               "case %zu (%s %s): exit %d, expected 2 and one line naming '%s': %s", k,
               cases[k].args[0] ? cases[k].args[0] : "", cases[k].args[0] ? cases[k].args[1] : "",
               r.status, cases[k].named, r.err);
@@ -134,9 +155,10 @@ static void test_cli_hdf5_output(pd_test_ctx *ctx)
     if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
         return;
     snprintf(path, sizeof path, "%s/run.h5", dir);
-    const char *args[] = {"simulate", "--pulse", "cosine", "--dir", "normal", "--ap", "2",
-                          "--Tp", "0.5", "--T0", "0.6", "--gap", "0.002", "--eps", "0.7",
-                          "--dt", "1e-3", "--every", "3", "-o", path, "--json", NULL};
+    const char *args[] = {"simulate", "--pulse", "cosine", "--dir",  "normal", "--ap",
+                          "2",        "--Tp",    "0.5",    "--T0",   "0.6",    "--gap",
+                          "0.002",    "--eps",   "0.7",    "--dt",   "1e-3",   "--every",
+                          "3",        "-o",      path,     "--json", NULL};
     proc_out r;
     CHECK(ctx, pd_test_pound(ctx, args, &r) == 0, "exit %d: %s", r.status, r.err);
     double steps = pd_test_json_num(r.out, "steps", 0), umax = pd_test_json_num(r.out, "umax", 0);
@@ -189,13 +211,15 @@ static void test_cli_csv_and_json(pd_test_ctx *ctx)
     if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
         return;
     snprintf(path, sizeof path, "%s/run.csv", dir);
-    const char *args[] = {"simulate", "--pulse", "sine", "--ap", "1", "--Tp", "1", "--T0", "1",
-                          "--gap", "10", "--dt", "0.01", "-o", path, "--json", NULL};
+    const char *args[] = {"simulate", "--pulse", "sine", "--ap",   "1",  "--Tp",
+                          "1",        "--T0",    "1",    "--gap",  "10", "--dt",
+                          "0.01",     "-o",      path,   "--json", NULL};
     proc_out r;
     CHECK(ctx, pd_test_pound(ctx, args, &r) == 0, "exit %d: %s", r.status, r.err);
     CHECK(ctx, strstr(r.out, "\"first_impact\":null") != NULL, "no impact: first_impact null");
     CHECK(ctx, pd_test_json_num(r.out, "impacts", 0) == 0, "impacts must be 0");
-    double wp = 6.283185307179586, Pi1 = pd_test_json_num(r.out, "Pi1", 0), umax = pd_test_json_num(r.out, "umax", 0);
+    double wp = 6.283185307179586, Pi1 = pd_test_json_num(r.out, "Pi1", 0),
+           umax = pd_test_json_num(r.out, "umax", 0);
     CHECK_NEAR(ctx, Pi1, umax * wp * wp, 1e-12 * Pi1);
     CHECK_NEAR(ctx, pd_test_json_num(r.out, "gamma", 0), 1.0, 1e-15); /* no contact: same as free */
     char *text = pd_test_slurp(path);
@@ -225,8 +249,9 @@ static void test_cli_failed_run_leaves_no_file(pd_test_ctx *ctx)
     if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
         return;
     snprintf(path, sizeof path, "%s/run.h5", dir);
-    const char *args[] = {"simulate", "--Tp", "1", "--T0", "1", "--Pi3", "1e6", "--theta", "0",
-                          "--allow-unstable", "--dt", "0.5", "--tend", "2000", "-o", path, NULL};
+    const char *args[] = {
+        "simulate",         "--Tp", "1",   "--T0",   "1",    "--Pi3", "1e6", "--theta", "0",
+        "--allow-unstable", "--dt", "0.5", "--tend", "2000", "-o",    path,  NULL};
     proc_out r;
     pd_test_pound(ctx, args, &r);
     CHECK(ctx, r.status == 1, "exit %d, expected 1 (%s)", r.status, r.err);
@@ -257,19 +282,18 @@ static void test_cli_converge_empty_list_elements(pd_test_ctx *ctx)
     if (!pd_test_have_pound(ctx))
         return;
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
-        const char *args[] = {"converge", "--dt", "1e-2:1e-3:2", "--methods", "moreau,penalty",
-                              cases[k].flag, cases[k].list, NULL};
+        const char *args[] = {"converge",       "--dt",        "1e-2:1e-3:2", "--methods",
+                              "moreau,penalty", cases[k].flag, cases[k].list, NULL};
         proc_out r;
         pd_test_pound(ctx, args, &r);
         char *nl = strchr(r.err, '\n');
-        CHECK(ctx, r.status == 2, "%s '%s': exit %d, expected 2 (%s)", cases[k].flag,
-              cases[k].list, r.status, r.err);
-        CHECK(ctx, strstr(r.err, cases[k].flag) && strstr(r.err, cases[k].named) && nl &&
-                       nl[1] == '\0',
-              "%s '%s': one line naming '%s': %s", cases[k].flag, cases[k].list,
-              cases[k].named, r.err);
-        CHECK(ctx, r.out[0] == '\0', "%s '%s': stdout '%s'", cases[k].flag, cases[k].list,
-              r.out);
+        CHECK(ctx, r.status == 2, "%s '%s': exit %d, expected 2 (%s)", cases[k].flag, cases[k].list,
+              r.status, r.err);
+        CHECK(ctx,
+              strstr(r.err, cases[k].flag) && strstr(r.err, cases[k].named) && nl && nl[1] == '\0',
+              "%s '%s': one line naming '%s': %s", cases[k].flag, cases[k].list, cases[k].named,
+              r.err);
+        CHECK(ctx, r.out[0] == '\0', "%s '%s': stdout '%s'", cases[k].flag, cases[k].list, r.out);
         pd_test_proc_free(&r);
     }
 }
@@ -289,8 +313,7 @@ static void test_cli_version(pd_test_ctx *ctx)
     CHECK(ctx, r.status == 0 && r.err[0] == '\0', "exit %d, stderr '%s'", r.status, r.err);
     CHECK(ctx, !strncmp(r.out, first, strlen(first)), "first line '%s', expected '%s'", r.out,
           first);
-    CHECK(ctx, strstr(r.out, "GSL ") && strstr(r.out, "HDF5 "), "no GSL/HDF5 versions: %s",
-          r.out);
+    CHECK(ctx, strstr(r.out, "GSL ") && strstr(r.out, "HDF5 "), "no GSL/HDF5 versions: %s", r.out);
     pd_test_pound(ctx, hargs, &h);
     CHECK(ctx, h.status == 0 && strstr(h.out, "--version") && strstr(h.out, "help"),
           "--help: exit %d, lists --version and help: %s", h.status, h.out);
@@ -350,8 +373,7 @@ static void test_cli_default_method(pd_test_ctx *ctx)
         {{"simulate", "--no-accumulation", "--json"}, "event", "--no-accumulation"},
         {{"simulate", "--chain", "2", "--json"}, "moreau", "default"},
         {{"spectrum", "--Pi2", "0.5:2:3", "--json"}, "event", "default"},
-        {{"spectrum", "--Pi2", "0.5:2:3", "--dt-per-Tp", "500", "--json"}, "moreau",
-         "--dt-per-Tp"},
+        {{"spectrum", "--Pi2", "0.5:2:3", "--dt-per-Tp", "500", "--json"}, "moreau", "--dt-per-Tp"},
     };
     if (!pd_test_have_pound(ctx))
         return;
@@ -368,15 +390,16 @@ static void test_cli_default_method(pd_test_ctx *ctx)
     }
     /* the default is --method event, bit for bit; the text names it */
     const char *d[] = {"simulate", "--pulse", "cosine", "--Pi2", "2.5", "--json", NULL};
-    const char *e[] = {"simulate", "--pulse", "cosine", "--Pi2", "2.5", "--method", "event",
-                       "--json", NULL};
+    const char *e[] = {"simulate", "--pulse", "cosine", "--Pi2", "2.5",
+                       "--method", "event",   "--json", NULL};
     const char *t[] = {"simulate", NULL};
     proc_out rd, re, rt;
     pd_test_pound(ctx, d, &rd);
     pd_test_pound(ctx, e, &re);
     pd_test_pound(ctx, t, &rt);
-    CHECK(ctx, pd_test_json_num(rd.out, "umax", 0) == pd_test_json_num(re.out, "umax", 0) &&
-                   pd_test_json_num(rd.out, "umax", 0) > 0.0,
+    CHECK(ctx,
+          pd_test_json_num(rd.out, "umax", 0) == pd_test_json_num(re.out, "umax", 0) &&
+              pd_test_json_num(rd.out, "umax", 0) > 0.0,
           "default umax %.17g vs --method event %.17g", pd_test_json_num(rd.out, "umax", 0),
           pd_test_json_num(re.out, "umax", 0));
     CHECK(ctx, strstr(rt.out, "method    = event (the default for one oscillator"),
@@ -388,8 +411,9 @@ static void test_cli_default_method(pd_test_ctx *ctx)
     const char *both[] = {"simulate", "--theta", "0.6", "--kc", "1e5", NULL};
     proc_out rb;
     pd_test_pound(ctx, both, &rb);
-    CHECK(ctx, rb.status == 2 && strstr(rb.err, "--theta") && strstr(rb.err, "--kc") &&
-                   strstr(rb.err, "--method"),
+    CHECK(ctx,
+          rb.status == 2 && strstr(rb.err, "--theta") && strstr(rb.err, "--kc") &&
+              strstr(rb.err, "--method"),
           "--theta with --kc: exit %d: %s", rb.status, rb.err);
     pd_test_proc_free(&rb);
     /* over the exact reference's budget, the default is Moreau-Jean */

@@ -109,8 +109,8 @@ static void test_demand_sdof_closed_form(pd_test_ctx *ctx)
         double w = 2.0 * PD_PI / fmin(c.Tp, pd_osc_T0(&c)), wh2 = (w * o.dt) * (w * o.dt);
         double bound = wh2 / 8.0 + 2.0 * PD_PI * (tend / pd_osc_T0(&c)) * wh2 / 12.0;
         err[k] = fabs(r.acc_max - want) / want;
-        CHECK(ctx, err[k] <= bound, "moreau dt %g: acc_max %.12g vs %.12g (rel %.3g > %.3g)",
-              o.dt, r.acc_max, want, err[k], bound);
+        CHECK(ctx, err[k] <= bound, "moreau dt %g: acc_max %.12g vs %.12g (rel %.3g > %.3g)", o.dt,
+              r.acc_max, want, err[k], bound);
     }
     CHECK(ctx, err[1] < 0.4 * err[0] || err[0] < 1e-9,
           "moreau: halving dt took the error from %.3g to %.3g only", err[0], err[1]);
@@ -125,10 +125,12 @@ static void test_demand_sdof_closed_form(pd_test_ctx *ctx)
     oe.method = PD_METHOD_EVENT;
     if (CHECK(ctx, pd_osc_run(&c, &o, osc_peak_sample, &p, &r, &e) == PD_OK, "%s", e.msg) &&
         CHECK(ctx, pd_osc_run(&c, &oe, NULL, NULL, &ref, &e) == PD_OK, "event: %s", e.msg))
-        CHECK(ctx, r.impacts > 0 && fabs(r.shear_max - p.peak) <= 1e-12 * p.peak &&
-                       fabs(r.acc_max - ref.acc_max) <= 1e-5 * ref.acc_max,
+        CHECK(ctx,
+              r.impacts > 0 && fabs(r.shear_max - p.peak) <= 1e-12 * p.peak &&
+                  fabs(r.acc_max - ref.acc_max) <= 1e-5 * ref.acc_max,
               "moreau with the wall: %ld impacts, shear_max %.17g vs %.17g, acc_max %.12g vs "
-              "the reference's %.12g", r.impacts, r.shear_max, p.peak, r.acc_max, ref.acc_max);
+              "the reference's %.12g",
+              r.impacts, r.shear_max, p.peak, r.acc_max, ref.acc_max);
 }
 
 /* Held on the wall a_abs is the ground's acceleration (x'' = 0): a flexible
@@ -160,8 +162,9 @@ static void test_demand_sdof_held_peak(pd_test_ctx *ctx)
         o.dt = dts[k];
         if (CHECK(ctx, pd_osc_run(&c, &o, NULL, NULL, &r, &e) == PD_OK, "%s: %s",
                   pd_method_name(o.method), e.msg))
-            CHECK(ctx, r.contact_time > 0.1 && r.shear_max < 0.25 * c.ap &&
-                           fabs(r.acc_max - c.ap) <= 1e-6 * c.ap,
+            CHECK(ctx,
+                  r.contact_time > 0.1 && r.shear_max < 0.25 * c.ap &&
+                      fabs(r.acc_max - c.ap) <= 1e-6 * c.ap,
                   "%s (dt %g): acc_max %.12g, want ap = %g (held %.3g s, shear_max %.3g)",
                   pd_method_name(o.method), o.dt, r.acc_max, c.ap, r.contact_time, r.shear_max);
     }
@@ -203,9 +206,10 @@ static void test_demand_base_shear_equilibrium(pd_test_ctx *ctx)
     pd_scene *sc = pd_scene_new(&x);
     double m[3] = {2e5, 1.8e5, 1.5e5}, k[3] = {3e8, 2.5e8, 2e8};
     pd_err e;
-    if (!CHECK(ctx, sc && !pd_scene_add_building(sc, "B", 3, m, k, 0.05, &e) &&
-                        !pd_scene_set_damping(sc, PD_DAMPING_RAYLEIGH, 1, 3, &e) &&
-                        !pd_scene_finish(sc, &e),
+    if (!CHECK(ctx,
+               sc && !pd_scene_add_building(sc, "B", 3, m, k, 0.05, &e) &&
+                   !pd_scene_set_damping(sc, PD_DAMPING_RAYLEIGH, 1, 3, &e) &&
+                   !pd_scene_finish(sc, &e),
                "building: %s", sc ? e.msg : "out of memory")) {
         pd_scene_free(sc);
         return;
@@ -247,13 +251,13 @@ static void test_demand_base_shear_equilibrium(pd_test_ctx *ctx)
         }
         CHECK(ctx, h.rows > 1000 && worst <= 1e-4 * scale,
               "base shear vs the inertia forces: worst |V + sum m a| %.4g of peak %.4g "
-              "(%ld samples)", worst, scale, h.rows);
+              "(%ld samples)",
+              worst, scale, h.rows);
         CHECK(ctx, fabs(r.shear_max[0] - vpk) <= 2e-4 * vpk,
               "base shear peak %.10g vs the history's %.10g", r.shear_max[0], vpk);
         for (int i = 0; i < 3; i++)
             CHECK(ctx, fabs(r.acc_max[i] - apk[i]) <= 2e-4 * apk[i],
-                  "floor %d: acc_max %.10g vs the kinematics' %.10g", i + 1, r.acc_max[i],
-                  apk[i]);
+                  "floor %d: acc_max %.10g vs the kinematics' %.10g", i + 1, r.acc_max[i], apk[i]);
         /* every method: the same peaks to its own accuracy */
         static const pd_method others[] = {PD_METHOD_MOREAU, PD_METHOD_EVENT_GENERAL,
                                            PD_METHOD_PENALTY, PD_METHOD_NEWMARK};
@@ -264,9 +268,9 @@ static void test_demand_base_shear_equilibrium(pd_test_ctx *ctx)
             if (CHECK(ctx, pd_scene_run(sc, &oo, NULL, NULL, &q, &e) == PD_OK, "%s: %s",
                       pd_method_name(oo.method), e.msg))
                 for (int i = 0; i < 3; i++)
-                    CHECK(ctx, fabs(q.acc_max[i] - r.acc_max[i]) <= 1e-4 * r.acc_max[i] &&
-                                   fabs(q.shear_max[i] - r.shear_max[i]) <=
-                                       1e-4 * r.shear_max[i],
+                    CHECK(ctx,
+                          fabs(q.acc_max[i] - r.acc_max[i]) <= 1e-4 * r.acc_max[i] &&
+                              fabs(q.shear_max[i] - r.shear_max[i]) <= 1e-4 * r.shear_max[i],
                           "%s floor %d: acc %.10g vs %.10g, shear %.10g vs %.10g",
                           pd_method_name(oo.method), i + 1, q.acc_max[i], r.acc_max[i],
                           q.shear_max[i], r.shear_max[i]);
@@ -293,10 +297,11 @@ static void test_demand_moreau_converges(pd_test_ctx *ctx)
     pd_scene *sc = pd_scene_new(&x);
     double m[2] = {1e5, 1e5}, k[2] = {8e7, 6e7};
     pd_err e;
-    if (!CHECK(ctx, sc && !pd_scene_add_building(sc, "B", 2, m, k, 0.05, &e) &&
-                        !pd_scene_add_sdof(sc, "S", 0.4, 0.05, 1e5, &e) &&
-                        !pd_scene_add_contact(sc, 0, 2, 1, 1, 0.01, 0.6, 0, &e) &&
-                        !pd_scene_finish(sc, &e),
+    if (!CHECK(ctx,
+               sc && !pd_scene_add_building(sc, "B", 2, m, k, 0.05, &e) &&
+                   !pd_scene_add_sdof(sc, "S", 0.4, 0.05, 1e5, &e) &&
+                   !pd_scene_add_contact(sc, 0, 2, 1, 1, 0.01, 0.6, 0, &e) &&
+                   !pd_scene_finish(sc, &e),
                "scene: %s", sc ? e.msg : "out of memory")) {
         pd_scene_free(sc);
         return;
@@ -324,16 +329,15 @@ static void test_demand_moreau_converges(pd_test_ctx *ctx)
             break;
         for (int i = 0; i < sc->n; i++)
             err[j] = fmax(err[j], fmax(fabs(r.acc_max[i] - ref.acc_max[i]) / ref.acc_max[i],
-                                       fabs(r.shear_max[i] - ref.shear_max[i]) /
-                                           ref.shear_max[i]));
+                                       fabs(r.shear_max[i] - ref.shear_max[i]) / ref.shear_max[i]));
         pd_scene_result_free(&r);
     }
     int falls = 1;
     for (int j = 1; j < NDT; j++)
         falls &= err[j] < 0.25 * err[j - 1];
     CHECK(ctx, falls && err[NDT - 1] < 1e-6,
-          "moreau's demands against the reference: rel. error %.3g at dt %g, %.3g at %g",
-          err[0], 1.6e-3, err[NDT - 1], 1.6e-3 / (1 << (2 * (NDT - 1))));
+          "moreau's demands against the reference: rel. error %.3g at dt %g, %.3g at %g", err[0],
+          1.6e-3, err[NDT - 1], 1.6e-3 / (1 << (2 * (NDT - 1))));
     pd_scene_result_free(&ref);
     pd_scene_free(sc);
 }
@@ -368,7 +372,7 @@ static void test_demand_penalty_force(pd_test_ctx *ctx)
               "eps %g: %ld impacts, peak force %.6g below the mean %.6g", c.eps, r.impacts,
               r.force_max, mean);
         CHECK(ctx, fabs(r.force_max - half) <= tol[k] * half,
-                  "eps %g: peak force %.6g vs the half sine's %.6g", c.eps, r.force_max, half);
+              "eps %g: peak force %.6g vs the half sine's %.6g", c.eps, r.force_max, half);
         CHECK_NEAR(ctx, r.force_equiv, 0.5 * PD_PI * r.max_impulse / 0.01, 1e-12 * r.force_equiv);
         CHECK(ctx, r.contact_duration == 0.01, "td %g", r.contact_duration);
     }
@@ -382,8 +386,7 @@ static void test_demand_penalty_force_scene(pd_test_ctx *ctx)
 {
     pd_scene *sc = NULL;
     pd_err e;
-    if (!CHECK(ctx, pd_scene_load("examples/scenes/two-sdof.json", &sc, &e) == PD_OK, "%s",
-               e.msg))
+    if (!CHECK(ctx, pd_scene_load("examples/scenes/two-sdof.json", &sc, &e) == PD_OK, "%s", e.msg))
         return;
     static const pd_method methods[] = {PD_METHOD_PENALTY, PD_METHOD_NEWMARK};
     for (int k = 0; k < 2; k++) {
@@ -398,8 +401,9 @@ static void test_demand_penalty_force_scene(pd_test_ctx *ctx)
         }
         double mean = r.max_impulse[0] / r.contact_time[0];
         double half = pd_equivalent_force(r.max_impulse[0], r.contact_time[0]);
-        CHECK(ctx, r.impacts[0] == 1 && r.force_max[0] >= mean &&
-                       (k || fabs(r.force_max[0] - half) <= 0.1 * half),
+        CHECK(ctx,
+              r.impacts[0] == 1 && r.force_max[0] >= mean &&
+                  (k || fabs(r.force_max[0] - half) <= 0.1 * half),
               "%s: %ld impacts, peak %.6g, mean %.6g, half sine %.6g", pd_method_name(o.method),
               r.impacts[0], r.force_max[0], mean, half);
         pd_scene_result_free(&r);
@@ -428,18 +432,17 @@ static void test_demand_leaves_results_alone(pd_test_ctx *ctx)
             o.method = methods[k];
             o.no_demands = off;
             ok &= !pd_scene_result_alloc(sc, &r[off], &e) &&
-                  CHECK(ctx, pd_scene_run(sc, &o, NULL, NULL, &r[off], &e) == PD_OK, "%s",
-                        e.msg);
+                  CHECK(ctx, pd_scene_run(sc, &o, NULL, NULL, &r[off], &e) == PD_OK, "%s", e.msg);
         }
         size_t n = (size_t)sc->n * sizeof(double), m = (size_t)sc->ncontact * sizeof(double);
         if (ok)
-            CHECK(ctx, !memcmp(r[0].umax, r[1].umax, n) && !memcmp(r[0].drift, r[1].drift, n) &&
-                           !memcmp(r[0].max_impulse, r[1].max_impulse, m) &&
-                           !memcmp(r[0].approach, r[1].approach, m) &&
-                           !memcmp(r[0].impacts, r[1].impacts,
-                                   (size_t)sc->ncontact * sizeof(long)) &&
-                           r[0].steps == r[1].steps && isnan(r[1].acc_max[0]) &&
-                           isnan(r[1].shear_max[0]) && r[0].acc_max[0] > 0.0,
+            CHECK(ctx,
+                  !memcmp(r[0].umax, r[1].umax, n) && !memcmp(r[0].drift, r[1].drift, n) &&
+                      !memcmp(r[0].max_impulse, r[1].max_impulse, m) &&
+                      !memcmp(r[0].approach, r[1].approach, m) &&
+                      !memcmp(r[0].impacts, r[1].impacts, (size_t)sc->ncontact * sizeof(long)) &&
+                      r[0].steps == r[1].steps && isnan(r[1].acc_max[0]) &&
+                      isnan(r[1].shear_max[0]) && r[0].acc_max[0] > 0.0,
                   "%s: the results differ with and without the demands",
                   pd_method_name(methods[k]));
         pd_scene_result_free(&r[0]);
@@ -455,10 +458,11 @@ static void test_demand_leaves_results_alone(pd_test_ctx *ctx)
             o.no_demands = off;
             CHECK(ctx, pd_osc_run(&c, &o, NULL, NULL, &r[off], &e) == PD_OK, "%s", e.msg);
         }
-        CHECK(ctx, r[0].umax == r[1].umax && r[0].impacts == r[1].impacts &&
-                       r[0].max_impulse == r[1].max_impulse && r[0].steps == r[1].steps &&
-                       r[0].contact_time == r[1].contact_time && isnan(r[1].acc_max) &&
-                       r[0].acc_max > 0.0,
+        CHECK(ctx,
+              r[0].umax == r[1].umax && r[0].impacts == r[1].impacts &&
+                  r[0].max_impulse == r[1].max_impulse && r[0].steps == r[1].steps &&
+                  r[0].contact_time == r[1].contact_time && isnan(r[1].acc_max) &&
+                  r[0].acc_max > 0.0,
               "oscillator %s: the results differ with and without the demands",
               pd_method_name(methods[k]));
     }
@@ -478,8 +482,9 @@ static void scratch_file(const char *dir, const char *name, const char *text, ch
 }
 
 #define EXC "\"excitation\": {\"pulse\": \"sine\", \"ap\": 4, \"Tp\": 0.3},\n"
-#define BLD(h) "\"structures\": [{\"name\": \"A\", \"T0\": 1}, {\"name\": \"B\", \"storeys\": 3, " \
-               "\"mass\": 1e5, \"T0\": 0.5, \"storey_heights\": " h "}]\n"
+#define BLD(h)                                                                                     \
+    "\"structures\": [{\"name\": \"A\", \"T0\": 1}, {\"name\": \"B\", \"storeys\": 3, "            \
+    "\"mass\": 1e5, \"T0\": 0.5, \"storey_heights\": " h "}]\n"
 
 /* The heights of a file: drift_ratio = drift / height; a number for every
  * storey; without the field PD_STOREY_HEIGHT. */
@@ -502,11 +507,11 @@ static void test_demand_storey_heights(pd_test_ctx *ctx)
         if (!pd_scene_result_alloc(sc, &r, &e) &&
             CHECK(ctx, pd_scene_run(sc, NULL, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg)) {
             CHECK(ctx, r.drift_ratio[0] == r.drift[0] / PD_STOREY_HEIGHT,
-                  "the SDOF's drift ratio %g: not drift / %g", r.drift_ratio[0],
-                  PD_STOREY_HEIGHT);
+                  "the SDOF's drift ratio %g: not drift / %g", r.drift_ratio[0], PD_STOREY_HEIGHT);
             for (int i = 0; i < 3; i++)
-                CHECK(ctx, sc->st[1].height[i] == h[k][i] &&
-                               r.drift_ratio[1 + i] == r.drift[1 + i] / h[k][i],
+                CHECK(ctx,
+                      sc->st[1].height[i] == h[k][i] &&
+                          r.drift_ratio[1 + i] == r.drift[1 + i] / h[k][i],
                       "%s: storey %d height %g, drift ratio %g", given[k], i + 1,
                       sc->st[1].height[i], r.drift_ratio[1 + i]);
         }
@@ -550,8 +555,9 @@ static void test_demand_cli_refusals(pd_test_ctx *ctx)
         int lines = 0;
         for (const char *p = r.err; p && *p; p++)
             lines += *p == '\n';
-        CHECK(ctx, r.status == 2 && lines == 1 && r.err && strstr(r.err, bad[k].want) &&
-                       access(out, F_OK) != 0,
+        CHECK(ctx,
+              r.status == 2 && lines == 1 && r.err && strstr(r.err, bad[k].want) &&
+                  access(out, F_OK) != 0,
               "%s: exit %d, %d lines: %s", bad[k].name, r.status, lines, r.err ? r.err : "");
         pd_test_proc_free(&r);
     }
@@ -567,8 +573,7 @@ static void test_demand_cli_refusals(pd_test_ctx *ctx)
         snprintf(out, sizeof out, "%s/out-flag%zu.csv", dir, k);
         const char *args[] = {"simulate", flags[k].flag, flags[k].value, "-o", out, NULL};
         pd_test_pound(ctx, args, &r);
-        CHECK(ctx, r.status == 2 && r.err && strstr(r.err, flags[k].want) &&
-                       access(out, F_OK) != 0,
+        CHECK(ctx, r.status == 2 && r.err && strstr(r.err, flags[k].want) && access(out, F_OK) != 0,
               "%s %s: exit %d: %s", flags[k].flag, flags[k].value, r.status, r.err ? r.err : "");
         pd_test_proc_free(&r);
     }

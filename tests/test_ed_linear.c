@@ -56,7 +56,8 @@ static long double force_deriv(const pd_sine_piece *pc, long double t, int k)
 static void taylor_step(const pd_sdof *osc, const pd_sine_piece *pc, long double t, long double u,
                         long double v, long double s, long double *du, long double *dv)
 {
-    long double a2 = osc->w0 > 0 ? 2.0L * osc->xi * osc->w0 : 0.0L, k0 = (long double)osc->w0 * osc->w0;
+    long double a2 = osc->w0 > 0 ? 2.0L * osc->xi * osc->w0 : 0.0L,
+                k0 = (long double)osc->w0 * osc->w0;
     long double q[TAYLOR_TERMS + 2], r = 1.0L; /* r = s^k / k! */
     q[0] = u;
     q[1] = v * s;
@@ -115,12 +116,21 @@ static void test_edl_closed_form_vs_taylor(pd_test_ctx *ctx)
         {{2.0, 0.05}, {.t_start = 0.0, .c0 = 0.0, .c1 = 1.0}, 0.0, 0.0, 0.0},
         {{0.0, 0.0}, {.t_start = 0.0, .c0 = 0.0, .c1 = 1.0}, 0.0, 0.0, 0.0},
         {{200.0, 0.05}, {.t_start = 0.0, .c0 = 40.0, .c1 = -900.0}, 0.002, 1e-3, 0.05},
-        {{3.0, 0.02}, {.t_start = 0.2, .A = 1.5, .w = 2.2, .phi = 0.3, .c0 = 0.2, .c1 = 0.5},
-         0.4, 0.05, 0.1},
-        {{2.0, 0.0}, {.t_start = 0.0, .A = 1.0, .w = 2.0, .phi = 0.0, .c0 = -0.4, .c1 = 0.3},
-         0.7, 0.0, 0.3},
-        {{0.0, 0.0}, {.t_start = 0.0, .A = 2.0, .w = 1.5, .phi = 0.4, .c0 = 0.1, .c1 = 0.6},
-         0.3, 0.1, 0.2},
+        {{3.0, 0.02},
+         {.t_start = 0.2, .A = 1.5, .w = 2.2, .phi = 0.3, .c0 = 0.2, .c1 = 0.5},
+         0.4,
+         0.05,
+         0.1},
+        {{2.0, 0.0},
+         {.t_start = 0.0, .A = 1.0, .w = 2.0, .phi = 0.0, .c0 = -0.4, .c1 = 0.3},
+         0.7,
+         0.0,
+         0.3},
+        {{0.0, 0.0},
+         {.t_start = 0.0, .A = 2.0, .w = 1.5, .phi = 0.4, .c0 = 0.1, .c1 = 0.6},
+         0.3,
+         0.1,
+         0.2},
     };
     const double wh[] = {1e-7, 1e-4, 0.02, 0.5, 0.999, 1.001, 1.5, 6.0, 40.0, 300.0};
     double worst_u = 0.0, worst_v = 0.0;
@@ -136,9 +146,10 @@ static void test_edl_closed_form_vs_taylor(pd_test_ctx *ctx)
             double ev = (double)(fabsl(v1 - r.v1) / r.peak_v);
             worst_u = fmax(worst_u, eu);
             worst_v = fmax(worst_v, ev);
-            CHECK(ctx, eu <= CLOSED_FORM_TOL && ev <= CLOSED_FORM_TOL,
-                  "case %zu, w0 h = %g: du %.17g vs %.17Lg (rel %.3g), v %.17g vs %.17Lg (rel %.3g)",
-                  c, wh[k], du, r.du, eu, v1, r.v1, ev);
+            CHECK(
+                ctx, eu <= CLOSED_FORM_TOL && ev <= CLOSED_FORM_TOL,
+                "case %zu, w0 h = %g: du %.17g vs %.17Lg (rel %.3g), v %.17g vs %.17Lg (rel %.3g)",
+                c, wh[k], du, r.du, eu, v1, r.v1, ev);
             CHECK(ctx, u1 == q->u0 + du && v1b == v1, "case %zu: advance is u0 + increment", c);
         }
     CHECK(ctx, worst_u <= CLOSED_FORM_TOL && worst_v <= CLOSED_FORM_TOL,
@@ -171,13 +182,15 @@ static void test_edl_pieces_validated(pd_test_ctx *ctx)
     pd_ed_result r;
     pd_err e;
     o.t_end = 3.0;
-    CHECK(ctx, pd_ed_sdof_run(&prob, 0.0, 0.0, &o, NULL, NULL, &r, &e) == PD_EINVAL &&
-                   strstr(e.msg, "piece 2"),
+    CHECK(ctx,
+          pd_ed_sdof_run(&prob, 0.0, 0.0, &o, NULL, NULL, &r, &e) == PD_EINVAL &&
+              strstr(e.msg, "piece 2"),
           "out of order: %s", e.msg);
     prob.npieces = 2;
     prob.pieces = bad_value;
-    CHECK(ctx, pd_ed_sdof_run(&prob, 0.0, 0.0, &o, NULL, NULL, &r, &e) == PD_EINVAL &&
-                   strstr(e.msg, "piece 0"),
+    CHECK(ctx,
+          pd_ed_sdof_run(&prob, 0.0, 0.0, &o, NULL, NULL, &r, &e) == PD_EINVAL &&
+              strstr(e.msg, "piece 0"),
           "not finite: %s", e.msg);
 }
 
@@ -225,8 +238,12 @@ typedef struct pulse_case {
 static int run_pieces(const pulse_case *pc, const pd_sine_piece *pieces, int npieces, traj *tr,
                       pd_ed_result *r, pd_err *err)
 {
-    pd_ed_sdof prob = {.osc = pc->osc, .wall = pc->wall, .delta = pc->delta, .e = pc->e,
-                       .npieces = npieces, .pieces = pieces};
+    pd_ed_sdof prob = {.osc = pc->osc,
+                       .wall = pc->wall,
+                       .delta = pc->delta,
+                       .e = pc->e,
+                       .npieces = npieces,
+                       .pieces = pieces};
     pd_ed_opts o = pd_ed_default_opts();
     o.t_end = 3 * TWO_PI;
     o.h_out = TWO_PI / 500;
@@ -250,7 +267,8 @@ static void test_edl_sampled_pulse_order_two(pd_test_ctx *ctx)
     for (int c = 0; c < 3; c++) {
         const pulse_case *pc = &cases[c];
         long cap = 2000;
-        traj ref = {malloc(cap * sizeof(double)), 0, cap}, lin = {malloc(cap * sizeof(double)), 0, cap};
+        traj ref = {malloc(cap * sizeof(double)), 0, cap},
+             lin = {malloc(cap * sizeof(double)), 0, cap};
         pd_sine_piece pulse[2] = {{.t_start = 0.0, .A = pc->A, .w = 1.0, .phi = pc->phi},
                                   {.t_start = TWO_PI}};
         pd_ed_result rr, rl;
@@ -272,8 +290,8 @@ static void test_edl_sampled_pulse_order_two(pd_test_ctx *ctx)
             if (k == 2)
                 CHECK(ctx, rl.impacts > 0 || !pc->wall, "%s: impacts", pc->name);
             if (pc->wall && c == 1)
-                CHECK(ctx, rl.impacts == rr.impacts, "%s, n = %ld: %ld impacts vs %ld", pc->name,
-                      n, rl.impacts, rr.impacts);
+                CHECK(ctx, rl.impacts == rr.impacts, "%s, n = %ld: %ld impacts vs %ld", pc->name, n,
+                      rl.impacts, rr.impacts);
         }
         double p1 = log10(err[0] / err[1]), p2 = log10(err[1] / err[2]);
         CHECK(ctx, p1 > 1.9 && p1 < 2.1 && p2 > 1.9 && p2 < 2.1,
@@ -282,11 +300,10 @@ static void test_edl_sampled_pulse_order_two(pd_test_ctx *ctx)
         CHECK(ctx, err[2] < 1e-6, "%s: error %.3g at dt = Tp/10000", pc->name, err[2]);
         if (c == 2) {
             CHECK(ctx, rr.accumulations >= 1 && rr.detachments >= 1 && rr.contact_time > 0.1,
-                  "%s: the analytic run must accumulate, rest and detach (%ld, %ld, %g)",
-                  pc->name, rr.accumulations, rr.detachments, rr.contact_time);
+                  "%s: the analytic run must accumulate, rest and detach (%ld, %ld, %g)", pc->name,
+                  rr.accumulations, rr.detachments, rr.contact_time);
             CHECK(ctx, rl.accumulations >= 1 && rl.detachments >= 1,
-                  "%s: the sampled run too (%ld, %ld)", pc->name, rl.accumulations,
-                  rl.detachments);
+                  "%s: the sampled run too (%ld, %ld)", pc->name, rl.accumulations, rl.detachments);
             CHECK(ctx, dct[2] < 1e-6 && dct[1] < 1e-4 && dct[2] < 0.05 * dct[1],
                   "%s: contact time errors %.3g, %.3g, %.3g", pc->name, dct[0], dct[1], dct[2]);
         }
@@ -465,8 +482,12 @@ static void test_edl_matches_gsl(pd_test_ctx *ctx)
         long n = 300;
         double dt = 0.02, t_end = n * dt + 1.0, h_out = 1e-3;
         pd_sine_piece *pieces = random_record(n, dt, 30.0, 7 + c);
-        pd_ed_sdof prob = {.osc = {.w0 = TWO_PI, .xi = 0.03}, .wall = 1, .delta = 0.02,
-                           .e = es[c], .npieces = (int)n + 1, .pieces = pieces};
+        pd_ed_sdof prob = {.osc = {.w0 = TWO_PI, .xi = 0.03},
+                           .wall = 1,
+                           .delta = 0.02,
+                           .e = es[c],
+                           .npieces = (int)n + 1,
+                           .pieces = pieces};
         long cap = (long)(t_end / h_out) + 10;
         traj ed = {malloc(cap * sizeof(double)), 0, cap};
         ref_out ref = {.x = malloc(cap * sizeof(double)), .cap = cap};
@@ -486,11 +507,12 @@ static void test_edl_matches_gsl(pd_test_ctx *ctx)
         CHECK(ctx, ed.n == ref.n, "e = %g: %ld samples vs %ld", es[c], ed.n, ref.n);
         CHECK(ctx, r.impacts == ref.impacts && r.impacts >= 5, "e = %g: %ld impacts vs GSL %ld",
               es[c], r.impacts, ref.impacts);
-        CHECK(ctx, worst <= GSL_AGREE, "e = %g: trajectories differ by %.3g of %.3g", es[c],
-              worst, amp);
-        CHECK(ctx, fabs(r.first_impact - ref.first_impact) <= GSL_AGREE &&
-                       fabs(r.first_impact_velocity - ref.first_v) <= GSL_AGREE * ref.max_v &&
-                       fabs(r.max_impact_velocity - ref.max_v) <= GSL_AGREE * ref.max_v,
+        CHECK(ctx, worst <= GSL_AGREE, "e = %g: trajectories differ by %.3g of %.3g", es[c], worst,
+              amp);
+        CHECK(ctx,
+              fabs(r.first_impact - ref.first_impact) <= GSL_AGREE &&
+                  fabs(r.first_impact_velocity - ref.first_v) <= GSL_AGREE * ref.max_v &&
+                  fabs(r.max_impact_velocity - ref.max_v) <= GSL_AGREE * ref.max_v,
               "e = %g: first impact %.15g (%.15g) vs %.15g (%.15g), max speed %.15g vs %.15g",
               es[c], r.first_impact, r.first_impact_velocity, ref.first_impact, ref.first_v,
               r.max_impact_velocity, ref.max_v);
@@ -531,8 +553,12 @@ static void test_edl_energy_after_forcing(pd_test_ctx *ctx)
     long n = 500;
     double dt = 0.01, t_force = n * dt;
     pd_sine_piece *pieces = random_record(n, dt, 30.0, 11);
-    pd_ed_sdof prob = {.osc = {.w0 = TWO_PI, .xi = 0.0}, .wall = 1, .delta = 0.01, .e = 1.0,
-                       .npieces = (int)n + 1, .pieces = pieces};
+    pd_ed_sdof prob = {.osc = {.w0 = TWO_PI, .xi = 0.0},
+                       .wall = 1,
+                       .delta = 0.01,
+                       .e = 1.0,
+                       .npieces = (int)n + 1,
+                       .pieces = pieces};
     pd_ed_opts o = pd_ed_default_opts();
     o.t_end = t_force + 40.0;
     o.h_out = 1e-3;
@@ -558,8 +584,8 @@ static void test_edl_double_turn_in_one_piece(pd_test_ctx *ctx)
 {
     pd_sine_piece pc[2] = {{.t_start = 0.0, .c0 = -4.4, .c1 = 8.0}, {.t_start = 1.0}};
     double delta = 0.136;
-    pd_ed_sdof prob = {.osc = {0.0, 0.0}, .wall = 1, .delta = delta, .e = 0.5, .npieces = 2,
-                       .pieces = pc};
+    pd_ed_sdof prob = {
+        .osc = {0.0, 0.0}, .wall = 1, .delta = delta, .e = 0.5, .npieces = 2, .pieces = pc};
     pd_ed_opts o = pd_ed_default_opts();
     o.t_end = 4.0;
     o.scan_divisions = 1; /* scan step 1: the piece is one scan interval */
@@ -604,8 +630,12 @@ static void test_edl_long_record(pd_test_ctx *ctx)
     long n = RECORD_PIECES;
     double dt = 0.01;
     pd_sine_piece *pieces = random_record(n, dt, 30.0, 2024);
-    pd_ed_sdof prob = {.osc = {.w0 = TWO_PI / 0.3, .xi = 0.05}, .wall = 1, .delta = 0.004,
-                       .e = 0.6, .npieces = (int)n + 1, .pieces = pieces};
+    pd_ed_sdof prob = {.osc = {.w0 = TWO_PI / 0.3, .xi = 0.05},
+                       .wall = 1,
+                       .delta = 0.004,
+                       .e = 0.6,
+                       .npieces = (int)n + 1,
+                       .pieces = pieces};
     pd_ed_opts o = pd_ed_default_opts();
     o.t_end = n * dt + 1.0;
     pd_ed_result r, fine;
@@ -628,9 +658,10 @@ static void test_edl_long_record(pd_test_ctx *ctx)
     CHECK(ctx, pd_ed_sdof_run(&prob, 0.0, 0.0, &o, NULL, NULL, &fine, &e) == PD_OK, "%s", e.msg);
     CHECK(ctx, fine.impacts == r.impacts, "impacts %ld vs %ld on the 8x finer grid", r.impacts,
           fine.impacts);
-    CHECK(ctx, fabs(fine.xmax - r.xmax) <= 1e-10 * r.xmax &&
-                   fabs(fine.max_impact_velocity - r.max_impact_velocity) <=
-                       1e-10 * r.max_impact_velocity,
+    CHECK(ctx,
+          fabs(fine.xmax - r.xmax) <= 1e-10 * r.xmax &&
+              fabs(fine.max_impact_velocity - r.max_impact_velocity) <=
+                  1e-10 * r.max_impact_velocity,
           "8x finer grid: xmax %.17g vs %.17g, max speed %.17g vs %.17g", r.xmax, fine.xmax,
           r.max_impact_velocity, fine.max_impact_velocity);
     free(pieces);

@@ -61,7 +61,8 @@ static void test_engine_scalar_lcp_matches_lemke(pd_test_ctx *ctx)
         if (P > 0)
             worst = fmax(worst, fabs(P - z) / P);
     }
-    CHECK(ctx, mismatched_sign == 0, "%d scalar LCPs disagree with Lemke on the status", mismatched_sign);
+    CHECK(ctx, mismatched_sign == 0, "%d scalar LCPs disagree with Lemke on the status",
+          mismatched_sign);
     CHECK(ctx, worst <= 1e-15, "closed form vs Lemke: worst relative difference %.3g", worst);
     pd_lcp_free(work);
 }
@@ -73,7 +74,14 @@ static void test_engine_two_mass_impact(pd_test_ctx *ctx)
     const double es[] = {1.0, 0.5, 0.0};
     for (int c = 0; c < 3; c++) {
         double M[4] = {1, 0, 0, 1}, W[2] = {-1, 1}, g0 = 0.01, e = es[c];
-        pd_model md = {.n = 2, .m = 1, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_zero(2, 2), .K = pd_matrix_zero(2, 2), .W = pd_matrix_dense(2, 1, W), .g0 = &g0, .e = &e};
+        pd_model md = {.n = 2,
+                       .m = 1,
+                       .M = pd_matrix_dense(2, 2, M),
+                       .C = pd_matrix_zero(2, 2),
+                       .K = pd_matrix_zero(2, 2),
+                       .W = pd_matrix_dense(2, 1, W),
+                       .g0 = &g0,
+                       .e = &e};
         pd_mj_opts o = pd_mj_default_opts();
         o.h = 1e-3;
         pd_err err;
@@ -114,7 +122,14 @@ static void test_engine_chain_energy(pd_test_ctx *ctx)
         g0[a] = 0.02;
         e[a] = 1.0;
     }
-    pd_model md = {.n = N, .m = C, .M = pd_matrix_dense(N, N, M), .C = pd_matrix_zero(N, N), .K = pd_matrix_dense(N, N, K), .W = pd_matrix_dense(N, C, W), .g0 = g0, .e = e};
+    pd_model md = {.n = N,
+                   .m = C,
+                   .M = pd_matrix_dense(N, N, M),
+                   .C = pd_matrix_zero(N, N),
+                   .K = pd_matrix_dense(N, N, K),
+                   .W = pd_matrix_dense(N, C, W),
+                   .g0 = g0,
+                   .e = e};
     double v0[N] = {1.0, -0.5, 0.7};
     for (int pass = 0; pass < 2; pass++) {
         double h = pass ? 5e-4 : 1e-3, vmax = 0;
@@ -177,13 +192,18 @@ static void test_engine_chain_energy(pd_test_ctx *ctx)
 static void test_engine_theta_stability(pd_test_ctx *ctx)
 {
     double M = 1, K = 1, zero = 0;
-    pd_model md = {.n = 1, .m = 0, .M = pd_matrix_dense(1, 1, &M), .C = pd_matrix_dense(1, 1, &zero), .K = pd_matrix_dense(1, 1, &K), .W = pd_matrix_zero(1, 0)};
+    pd_model md = {.n = 1,
+                   .m = 0,
+                   .M = pd_matrix_dense(1, 1, &M),
+                   .C = pd_matrix_dense(1, 1, &zero),
+                   .K = pd_matrix_dense(1, 1, &K),
+                   .W = pd_matrix_zero(1, 0)};
     pd_mj_opts o = pd_mj_default_opts();
     pd_err err;
     o.h = 1.0; /* w0 h = 1 */
     o.theta = 0.3;
-    CHECK(ctx, pd_mj_alloc(&md, &o, &err) == NULL && err.status == PD_EINVAL &&
-                   strstr(err.msg, "theta"),
+    CHECK(ctx,
+          pd_mj_alloc(&md, &o, &err) == NULL && err.status == PD_EINVAL && strstr(err.msg, "theta"),
           "theta = 0.3 must be refused naming theta: %s", err.msg);
     const double thetas[] = {0.0, 0.3, 0.5, 1.0};
     for (int c = 0; c < 4; c++) {
@@ -217,7 +237,12 @@ static void test_engine_theta_damped_boundary(pd_test_ctx *ctx)
 {
     const double thetas[] = {0.3, 0.4, 0.45}, xi = 0.05, w0 = 1.0;
     double M = 1, K = w0 * w0, C = 2 * xi * w0;
-    pd_model md = {.n = 1, .m = 0, .M = pd_matrix_dense(1, 1, &M), .C = pd_matrix_dense(1, 1, &C), .K = pd_matrix_dense(1, 1, &K), .W = pd_matrix_zero(1, 0)};
+    pd_model md = {.n = 1,
+                   .m = 0,
+                   .M = pd_matrix_dense(1, 1, &M),
+                   .C = pd_matrix_dense(1, 1, &C),
+                   .K = pd_matrix_dense(1, 1, &K),
+                   .W = pd_matrix_zero(1, 0)};
     for (int c = 0; c < 3; c++)
         for (int side = 0; side < 2; side++) {
             double boundary = 2 * xi / (1 - 2 * thetas[c]) / w0;
@@ -253,7 +278,13 @@ static void nan_after_one(double t, int side, double *F, void *ctx)
 static void test_engine_failure_is_reported(pd_test_ctx *ctx)
 {
     double M = 1, K = 4;
-    pd_model md = {.n = 1, .m = 0, .M = pd_matrix_dense(1, 1, &M), .C = pd_matrix_zero(1, 1), .K = pd_matrix_dense(1, 1, &K), .W = pd_matrix_zero(1, 0), .force = nan_after_one};
+    pd_model md = {.n = 1,
+                   .m = 0,
+                   .M = pd_matrix_dense(1, 1, &M),
+                   .C = pd_matrix_zero(1, 1),
+                   .K = pd_matrix_dense(1, 1, &K),
+                   .W = pd_matrix_zero(1, 0),
+                   .force = nan_after_one};
     pd_mj_opts o = pd_mj_default_opts();
     o.h = 0.1;
     for (int kernel = 0; kernel < 2; kernel++) {
@@ -272,7 +303,14 @@ static void test_engine_failure_is_reported(pd_test_ctx *ctx)
 static void test_engine_model_check(pd_test_ctx *ctx)
 {
     double M = 1, K = 1, W = -1, g = -0.1, e = 0.5, Knan = NAN;
-    pd_model md = {.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, &M), .C = pd_matrix_zero(1, 1), .K = pd_matrix_dense(1, 1, &K), .W = pd_matrix_dense(1, 1, &W), .g0 = &g, .e = &e};
+    pd_model md = {.n = 1,
+                   .m = 1,
+                   .M = pd_matrix_dense(1, 1, &M),
+                   .C = pd_matrix_zero(1, 1),
+                   .K = pd_matrix_dense(1, 1, &K),
+                   .W = pd_matrix_dense(1, 1, &W),
+                   .g0 = &g,
+                   .e = &e};
     pd_err err;
     CHECK(ctx, pd_model_check(&md, &err) == PD_EINVAL && strstr(err.msg, "gap"), "%s", err.msg);
     g = 0.1;
@@ -304,7 +342,15 @@ static void test_engine_no_allocation_in_steps(pd_test_ctx *ctx)
 {
     double M[4] = {1, 0, 0, 2}, K[4] = {4, -1, -1, 3}, C[4] = {0.1, 0, 0, 0.1};
     double W[4] = {-1, 0, 1, -1}, g0[2] = {0.05, 0.02}, e[2] = {0.7, 0.3};
-    pd_model md = {.n = 2, .m = 2, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_dense(2, 2, C), .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_dense(2, 2, W), .g0 = g0, .e = e, .force = osc_force};
+    pd_model md = {.n = 2,
+                   .m = 2,
+                   .M = pd_matrix_dense(2, 2, M),
+                   .C = pd_matrix_dense(2, 2, C),
+                   .K = pd_matrix_dense(2, 2, K),
+                   .W = pd_matrix_dense(2, 2, W),
+                   .g0 = g0,
+                   .e = e,
+                   .force = osc_force};
     pd_mj_opts o = pd_mj_default_opts();
     o.h = 1e-3;
     pd_err err;
@@ -385,11 +431,17 @@ static void mjb_sys_force(const double *t, int side, double *F, void *ctx)
 static int mj_alone(const batch_sys *b, double theta, double gamma, long nsteps, double *out,
                     pd_err *err)
 {
-    pd_model md = {.n = 1, .m = b->wall, .M = pd_matrix_dense(1, 1, (double *)&b->M),
+    pd_model md = {.n = 1,
+                   .m = b->wall,
+                   .M = pd_matrix_dense(1, 1, (double *)&b->M),
                    .C = pd_matrix_dense(1, 1, (double *)&b->C),
                    .K = pd_matrix_dense(1, 1, (double *)&b->K),
-                   .W = pd_matrix_dense(1, 1, (double *)&b->W), .g0 = &b->g0, .e = &b->e,
-                   .force = mj_sys_force, .force_ctx = (void *)b, .breaks = &b->brk,
+                   .W = pd_matrix_dense(1, 1, (double *)&b->W),
+                   .g0 = &b->g0,
+                   .e = &b->e,
+                   .force = mj_sys_force,
+                   .force_ctx = (void *)b,
+                   .breaks = &b->brk,
                    .nbreaks = isfinite(b->brk) ? 1 : 0};
     pd_mj_opts o = pd_mj_default_opts();
     o.h = b->h;
@@ -455,16 +507,21 @@ static void test_engine_batch_matches_scalar(pd_test_ctx *ctx)
         pd_mj_opts o = pd_mj_default_opts();
         o.theta = theta;
         o.gamma = gamma;
-        if (!CHECK(ctx, b && !pd_mjb_init(b, &o, mjb_sys_force, &src, &err), "init: %s",
-                   err.msg)) {
+        if (!CHECK(ctx, b && !pd_mjb_init(b, &o, mjb_sys_force, &src, &err), "init: %s", err.msg)) {
             free(b);
             return;
         }
         b->lanes_step = variants[vi].fn;
         for (int l = 0; l < PD_MJB_LANES; l++) {
             src.sys[l] = A[l];
-            pd_mjb_lane ln = {.M = A[l].M, .C = A[l].C, .K = A[l].K, .wall = A[l].wall,
-                              .W = A[l].W, .g0 = A[l].g0, .e = A[l].e, .h = A[l].h,
+            pd_mjb_lane ln = {.M = A[l].M,
+                              .C = A[l].C,
+                              .K = A[l].K,
+                              .wall = A[l].wall,
+                              .W = A[l].W,
+                              .g0 = A[l].g0,
+                              .e = A[l].e,
+                              .h = A[l].h,
                               .brk = A[l].brk};
             CHECK(ctx, !pd_mjb_set_lane(b, l, &ln, &err), "lane %d: %s", l, err.msg);
         }
@@ -473,9 +530,15 @@ static void test_engine_batch_matches_scalar(pd_test_ctx *ctx)
             if (k == RESTART)
                 for (int l = 1; l < PD_MJB_LANES; l += 2) {
                     src.sys[l] = B[l];
-                    pd_mjb_lane ln = {.M = B[l].M, .C = B[l].C, .K = B[l].K,
-                                      .wall = B[l].wall, .W = B[l].W, .g0 = B[l].g0,
-                                      .e = B[l].e, .h = B[l].h, .brk = B[l].brk};
+                    pd_mjb_lane ln = {.M = B[l].M,
+                                      .C = B[l].C,
+                                      .K = B[l].K,
+                                      .wall = B[l].wall,
+                                      .W = B[l].W,
+                                      .g0 = B[l].g0,
+                                      .e = B[l].e,
+                                      .h = B[l].h,
+                                      .brk = B[l].brk};
                     pd_mjb_set_lane(b, l, &ln, &err);
                 }
             pd_mjb_run(b, 1, NULL, NULL);
@@ -488,21 +551,21 @@ static void test_engine_batch_matches_scalar(pd_test_ctx *ctx)
                 double got[4] = {b->q[l], b->v[l], src.sys[l].wall ? b->g[l] : 0.0, b->P[l]};
                 bad += memcmp(got, ref, sizeof got) != 0;
                 contacts += got[3] > 0.0;
-                breaks += isfinite(src.sys[l].brk) &&
-                          fabs(b->t[l] - src.sys[l].brk) < 0.5 * src.sys[l].h;
+                breaks +=
+                    isfinite(src.sys[l].brk) && fabs(b->t[l] - src.sys[l].brk) < 0.5 * src.sys[l].h;
                 compared++;
             }
         }
-        CHECK(ctx, bad == 0, "%s: %ld of the lanes' steps differ from pd_mj's",
-              variants[vi].name, bad);
+        CHECK(ctx, bad == 0, "%s: %ld of the lanes' steps differ from pd_mj's", variants[vi].name,
+              bad);
         for (int l = 0; l < PD_MJB_LANES; l++)
-            CHECK(ctx, pd_mjb_finite(b, l), "%s: lane %d flagged not finite", variants[vi].name,
-                  l);
+            CHECK(ctx, pd_mjb_finite(b, l), "%s: lane %d flagged not finite", variants[vi].name, l);
         free(b);
     }
     CHECK(ctx, compared > 0 && contacts > 100 && breaks > 10,
           "the comparison must cover impacts and breakpoints (%ld steps, %ld impulses, %ld "
-          "breakpoints)", compared, contacts, breaks);
+          "breakpoints)",
+          compared, contacts, breaks);
 }
 
 /* A lane that blows up is flagged, the others are not disturbed. */
@@ -539,7 +602,8 @@ static void test_engine_batch_flags_nonfinite(pd_test_ctx *ctx)
 /* ---- the dense factor on badly scaled matrices (issue 19) ---------------- */
 
 #define SCALED_N 6
-#define SCALED_SOLVE_TOL 1e-12 /* relative error of a solve of a well-conditioned-
+#define SCALED_SOLVE_TOL                                                                           \
+    1e-12 /* relative error of a solve of a well-conditioned-
                                   after-scaling system: about cond(B) n eps */
 
 /* A row-diagonally-dominant B: off-diagonal entries in [-0.1, 0.1), unit
@@ -595,8 +659,7 @@ static void test_engine_dense_lu_scaled(pd_test_ctx *ctx)
         int rc = pd_dense_lu(n, LU, n, perm, 1e-14);
         double err = rc ? INFINITY : scaled_solve_error(n, A, LU, perm, x, NULL);
         CHECK(ctx, rc == PD_OK && err <= SCALED_SOLVE_TOL,
-              "trial %d, rows scaled 1e-6 .. 1e12: status %d, relative error %.3g", trial, rc,
-              err);
+              "trial %d, rows scaled 1e-6 .. 1e12: status %d, relative error %.3g", trial, rc, err);
         /* symmetric scaling, as What = M + ... of a scene: A = S B S, the
          * diagonal 1e-6 .. 1e12; the answer to 1e-12 in the scaled norm
          * max |s_i dx_i| / max |s_i x_i| (x_i = y_i / s_i, y of order one) */
@@ -610,8 +673,8 @@ static void test_engine_dense_lu_scaled(pd_test_ctx *ctx)
         rc = pd_dense_lu(n, LU, n, perm, 1e-14);
         err = rc ? INFINITY : scaled_solve_error(n, A, LU, perm, y, s);
         CHECK(ctx, rc == PD_OK && err <= SCALED_SOLVE_TOL,
-              "trial %d, S B S with S^2 1e-6 .. 1e12: status %d, scaled relative error %.3g",
-              trial, rc, err);
+              "trial %d, S B S with S^2 1e-6 .. 1e12: status %d, scaled relative error %.3g", trial,
+              rc, err);
     }
     /* singular: S G G^T S with G 6 x 5 (rank 5), a zero row, equal rows */
     for (int trial = 0; trial < 20; trial++) {
@@ -626,8 +689,8 @@ static void test_engine_dense_lu_scaled(pd_test_ctx *ctx)
                 A[i + j * n] = s[i] * g * s[j];
             }
         int rc = pd_dense_lu(n, A, n, perm, 1e-14);
-        CHECK(ctx, rc == PD_ESINGULAR, "trial %d: S G G^T S of rank 5 factored (status %d)",
-              trial, rc);
+        CHECK(ctx, rc == PD_ESINGULAR, "trial %d: S G G^T S of rank 5 factored (status %d)", trial,
+              rc);
     }
     scaled_base(&seed, B);
     memcpy(A, B, sizeof A);
@@ -657,8 +720,13 @@ static void test_engine_dense_factor_scaled(pd_test_ctx *ctx)
         C[i * 3] = 2.0 * xi * w0 * mass[i];
         what[i] = M[i * 3] + h * theta * C[i * 3] + h * theta * h * theta * K[i * 3];
     }
-    pd_model md = {.n = 2, .m = 1, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_dense(2, 2, C),
-                   .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_dense(2, 1, W), .g0 = &g0,
+    pd_model md = {.n = 2,
+                   .m = 1,
+                   .M = pd_matrix_dense(2, 2, M),
+                   .C = pd_matrix_dense(2, 2, C),
+                   .K = pd_matrix_dense(2, 2, K),
+                   .W = pd_matrix_dense(2, 1, W),
+                   .g0 = &g0,
                    .e = &e};
     pd_err err;
     pd_factor *f = pd_factor_alloc(&md, h, theta, PD_FACTOR_DENSE, &err);
@@ -701,7 +769,7 @@ static void test_engine_dense_factor_scaled(pd_test_ctx *ctx)
 typedef struct jumpy_force {
     const double *b, *F; /* nb breakpoints, nb values */
     int nb;
-    long right_calls;    /* right limits asked */
+    long right_calls; /* right limits asked */
 } jumpy_force;
 
 static void jumpy_at(double t, int side, double *F, void *vctx)
@@ -757,9 +825,17 @@ static void test_engine_breaks_inside_steps(pd_test_ctx *ctx)
     double M = 1.0, K = 4.0 * PD_PI * PD_PI, C = 0.1, W = -1.0, g0 = 0.05, e = 0.5;
     int cp[2] = {0, 1}, ri[1] = {0};
     jumpy_force fine = {.b = b, .F = F, .nb = NB};
-    pd_model md = {.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, &M), .C = pd_matrix_dense(1, 1, &C),
-                   .K = pd_matrix_dense(1, 1, &K), .W = pd_matrix_csc(1, 1, cp, ri, &W),
-                   .g0 = &g0, .e = &e, .force = jumpy_at, .force_ctx = &fine, .breaks = b,
+    pd_model md = {.n = 1,
+                   .m = 1,
+                   .M = pd_matrix_dense(1, 1, &M),
+                   .C = pd_matrix_dense(1, 1, &C),
+                   .K = pd_matrix_dense(1, 1, &K),
+                   .W = pd_matrix_csc(1, 1, cp, ri, &W),
+                   .g0 = &g0,
+                   .e = &e,
+                   .force = jumpy_at,
+                   .force_ctx = &fine,
+                   .breaks = b,
                    .nbreaks = NB};
     pd_mj_opts o = pd_mj_default_opts();
     o.h = h;
@@ -775,16 +851,18 @@ static void test_engine_breaks_inside_steps(pd_test_ctx *ctx)
         l->n = 0;
         pd_mj *mj = pd_mj_alloc(&m2, &o, &err);
         int rc = mj ? pd_mj_run(mj, NSTEPS, log_step, l, &err) : -1;
-        CHECK(ctx, mj && rc == PD_OK && l->n == NSTEPS + 1 &&
-                       !strcmp(pd_mj_kernel_name(mj), "scalar"),
+        CHECK(ctx,
+              mj && rc == PD_OK && l->n == NSTEPS + 1 && !strcmp(pd_mj_kernel_name(mj), "scalar"),
               "run %d: %s (%d states)", run, mj ? err.msg : "alloc", l->n);
         CHECK(ctx, fine.right_calls == 1 + (ng - 1),
               "run %d: the right limit asked %ld times: at t = 0 and the %d breakpoints on the "
-              "grid after it", run, fine.right_calls, ng - 1);
+              "grid after it",
+              run, fine.right_calls, ng - 1);
         pd_mj_free(mj);
     }
-    CHECK(ctx, ng == 100 && !memcmp(all.q, grid.q, sizeof all.q) &&
-                   !memcmp(all.v, grid.v, sizeof all.v) && !memcmp(all.P, grid.P, sizeof all.P),
+    CHECK(ctx,
+          ng == 100 && !memcmp(all.q, grid.q, sizeof all.q) &&
+              !memcmp(all.v, grid.v, sizeof all.v) && !memcmp(all.P, grid.P, sizeof all.P),
           "every breakpoint (%d) or only the %d on the grid: the same steps to the bit", NB, ng);
     double worst = 0.0;
     for (int k = 0; k < NSTEPS; k++)
@@ -799,8 +877,13 @@ static void test_engine_breaks_inside_steps(pd_test_ctx *ctx)
 static void test_engine_free_unit_mass_rebounds(pd_test_ctx *ctx)
 {
     double M = 1.0, K = 0.0, W = -1.0, g0 = 0.01, e = 0.5, v0 = 1.0;
-    pd_model md = {.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, &M), .C = pd_matrix_zero(1, 1),
-                   .K = pd_matrix_dense(1, 1, &K), .W = pd_matrix_dense(1, 1, &W), .g0 = &g0,
+    pd_model md = {.n = 1,
+                   .m = 1,
+                   .M = pd_matrix_dense(1, 1, &M),
+                   .C = pd_matrix_zero(1, 1),
+                   .K = pd_matrix_dense(1, 1, &K),
+                   .W = pd_matrix_dense(1, 1, &W),
+                   .g0 = &g0,
                    .e = &e};
     for (int general = 0; general < 2; general++) {
         pd_err err;

@@ -43,7 +43,18 @@ static void osc_setup(osc_model *om, const osc_case *c)
     om->g0 = c->Pi3;
     om->e = c->eps;
     om->brk = TWO_PI;
-    om->md = (pd_model){.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, &om->M), .C = pd_matrix_dense(1, 1, &om->C), .K = pd_matrix_dense(1, 1, &om->K), .W = pd_matrix_dense(1, 1, &om->W), .g0 = &om->g0, .e = &om->e, .force = pulse_force, .force_ctx = &om->c, .breaks = &om->brk, .nbreaks = 1};
+    om->md = (pd_model){.n = 1,
+                        .m = 1,
+                        .M = pd_matrix_dense(1, 1, &om->M),
+                        .C = pd_matrix_dense(1, 1, &om->C),
+                        .K = pd_matrix_dense(1, 1, &om->K),
+                        .W = pd_matrix_dense(1, 1, &om->W),
+                        .g0 = &om->g0,
+                        .e = &om->e,
+                        .force = pulse_force,
+                        .force_ctx = &om->c,
+                        .breaks = &om->brk,
+                        .nbreaks = 1};
 }
 
 /* Every reported state of a one-dof run. */
@@ -131,11 +142,15 @@ static double continuous_max(const osc_model *om, const trace *r, int *failures)
 /* The same case through the exact one-wall reference. */
 static int exact_run(const osc_case *c, double tend, pd_ed_result *er, pd_err *err)
 {
-    pd_sine_piece pc[2] = {{.t_start = 0.0, .A = (double)c->dir, .w = 1.0,
-                            .phi = c->cosine ? TWO_PI / 4 : 0.0},
-                           {.t_start = TWO_PI}};
-    pd_ed_sdof prob = {.osc = {.w0 = c->Pi2, .xi = c->xi}, .wall = 1, .delta = c->Pi3,
-                       .e = c->eps, .npieces = 2, .pieces = pc};
+    pd_sine_piece pc[2] = {
+        {.t_start = 0.0, .A = (double)c->dir, .w = 1.0, .phi = c->cosine ? TWO_PI / 4 : 0.0},
+        {.t_start = TWO_PI}};
+    pd_ed_sdof prob = {.osc = {.w0 = c->Pi2, .xi = c->xi},
+                       .wall = 1,
+                       .delta = c->Pi3,
+                       .e = c->eps,
+                       .npieces = 2,
+                       .pieces = pc};
     pd_ed_opts o;
     o = pd_ed_default_opts();
     o.t_end = tend;
@@ -147,8 +162,8 @@ static int exact_run(const osc_case *c, double tend, pd_ed_result *er, pd_err *e
  * the resting phases (eps = 0) and the accumulation jump agree. */
 static void test_edg_oscillator_matches_exact(pd_test_ctx *ctx)
 {
-    const double triples[][3] = {{0.5, 0.05, 0.6}, {1.16, 0.1, 1.0}, {0.2, 0.01, 0.0},
-                                 {3.0, 0.001, 0.5}, {0.05, 1.0, 0.9}};
+    const double triples[][3] = {
+        {0.5, 0.05, 0.6}, {1.16, 0.1, 1.0}, {0.2, 0.01, 0.0}, {3.0, 0.001, 0.5}, {0.05, 1.0, 0.9}};
     double worst = 0.0, worst_t = 0.0;
     int cases = 0, resting = 0, accumulating = 0;
     for (int p = 0; p < 2; p++)
@@ -175,12 +190,13 @@ static void test_edg_oscillator_matches_exact(pd_test_ctx *ctx)
                 CHECK(ctx, rel <= 1e-9, "%s %s Pi2 %g Pi3 %g eps %g: umax %.15g vs exact %.15g",
                       p ? "cosine" : "sine", dir > 0 ? "normal" : "reverse", c.Pi2, c.Pi3, c.eps,
                       xmax, er.xmax);
-                CHECK(ctx, r.impacts == er.impacts && r.accumulations == er.accumulations &&
-                               r.detachments == er.detachments,
+                CHECK(ctx,
+                      r.impacts == er.impacts && r.accumulations == er.accumulations &&
+                          r.detachments == er.detachments,
                       "Pi2 %g Pi3 %g eps %g: impacts %ld/%ld accumulations %ld/%ld detachments "
                       "%ld/%ld",
-                      c.Pi2, c.Pi3, c.eps, r.impacts, er.impacts, r.accumulations,
-                      er.accumulations, r.detachments, er.detachments);
+                      c.Pi2, c.Pi3, c.eps, r.impacts, er.impacts, r.accumulations, er.accumulations,
+                      r.detachments, er.detachments);
                 if (er.impacts > 0) {
                     CHECK_NEAR(ctx, r.first_impact, er.first_impact, 1e-10);
                     worst_t = fmax(worst_t, fabs(r.first_impact - er.first_impact));
@@ -217,8 +233,8 @@ static void test_edg_output_grid_leaves_path(pd_test_ctx *ctx)
           "%s", err.msg);
     o.h_out = 0.01;
     o.impacts_only = 1; /* P > 0 only at the impacts (the held forces are not sampled) */
-    CHECK(ctx, pd_edg_run(&om.md, 0.0, NULL, NULL, tend, &o, record, &tr, &r1, &err) == PD_OK,
-          "%s", err.msg);
+    CHECK(ctx, pd_edg_run(&om.md, 0.0, NULL, NULL, tend, &o, record, &tr, &r1, &err) == PD_OK, "%s",
+          err.msg);
     CHECK(ctx, tr.x[tr.n - 1] == f0.x && tr.v[tr.n - 1] == f0.v && tr.t[tr.n - 1] == tend,
           "final state %.17g %.17g vs %.17g %.17g", tr.x[tr.n - 1], tr.v[tr.n - 1], f0.x, f0.v);
     CHECK(ctx, r0.steps == r1.steps && r0.events == r1.events, "steps %ld/%ld events %ld/%ld",
@@ -237,8 +253,8 @@ static void test_edg_output_grid_leaves_path(pd_test_ctx *ctx)
     trace ts = {0};
     pd_edg_result r2;
     o.impacts_only = 0;
-    CHECK(ctx, pd_edg_run(&om.md, 0.0, NULL, NULL, tend, &o, record, &ts, &r2, &err) == PD_OK,
-          "%s", err.msg);
+    CHECK(ctx, pd_edg_run(&om.md, 0.0, NULL, NULL, tend, &o, record, &ts, &r2, &err) == PD_OK, "%s",
+          err.msg);
     int same = ts.n == tr.n && r2.steps == r1.steps && r2.events == r1.events, below = 0;
     double held = 0.0;
     for (long k = 0; same && k < tr.n; k++) {
@@ -262,7 +278,14 @@ static void test_edg_grazing_is_found(pd_test_ctx *ctx)
     for (int pass = 0; pass < 2; pass++) {
         double w0 = 2.0, V = 1.0, A = V / w0, delta = A * (pass ? 1 + 1e-8 : 1 - 1e-8);
         double M = 1, C = 0, K = w0 * w0, W = -1, e = 1.0;
-        pd_model md = {.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, &M), .C = pd_matrix_dense(1, 1, &C), .K = pd_matrix_dense(1, 1, &K), .W = pd_matrix_dense(1, 1, &W), .g0 = &delta, .e = &e};
+        pd_model md = {.n = 1,
+                       .m = 1,
+                       .M = pd_matrix_dense(1, 1, &M),
+                       .C = pd_matrix_dense(1, 1, &C),
+                       .K = pd_matrix_dense(1, 1, &K),
+                       .W = pd_matrix_dense(1, 1, &W),
+                       .g0 = &delta,
+                       .e = &e};
         pd_edg_result r;
         pd_err err;
         CHECK(ctx, pd_edg_run(&md, 0.0, NULL, &V, 3.0, NULL, NULL, NULL, &r, &err) == PD_OK, "%s",
@@ -320,7 +343,14 @@ static void test_edg_two_masses_newton(pd_test_ctx *ctx)
     for (int k = 0; k < 3; k++) {
         double M[4] = {1, 0, 0, 1}, W[2] = {-1, 1}, g0 = 0.3, e = es[k], V = 1.7;
         double v0[2] = {V, 0.0}, mass[2] = {1, 1};
-        pd_model md = {.n = 2, .m = 1, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_zero(2, 2), .K = pd_matrix_zero(2, 2), .W = pd_matrix_dense(2, 1, W), .g0 = &g0, .e = &e};
+        pd_model md = {.n = 2,
+                       .m = 1,
+                       .M = pd_matrix_dense(2, 2, M),
+                       .C = pd_matrix_zero(2, 2),
+                       .K = pd_matrix_zero(2, 2),
+                       .W = pd_matrix_dense(2, 1, W),
+                       .g0 = &g0,
+                       .e = &e};
         rows w = {2, 1, 0, NAN, {0}, {0}, 0, 0, mass, 0};
         pd_edg_result r;
         pd_err err;
@@ -359,7 +389,14 @@ static void test_edg_cradle_simultaneous(pd_test_ctx *ctx)
             W[a + 1 + N * a] = 1.0;
             e[a] = es[k];
         }
-        pd_model md = {.n = N, .m = C, .M = pd_matrix_dense(N, N, M), .C = pd_matrix_zero(N, N), .K = pd_matrix_zero(N, N), .W = pd_matrix_dense(N, C, W), .g0 = g0, .e = e};
+        pd_model md = {.n = N,
+                       .m = C,
+                       .M = pd_matrix_dense(N, N, M),
+                       .C = pd_matrix_zero(N, N),
+                       .K = pd_matrix_zero(N, N),
+                       .W = pd_matrix_dense(N, C, W),
+                       .g0 = g0,
+                       .e = e};
         rows w = {N, C, 0, NAN, {0}, {0}, 0, 0, mass, 0};
         pd_edg_result r;
         pd_err err;
@@ -376,8 +413,8 @@ static void test_edg_cradle_simultaneous(pd_test_ctx *ctx)
             CHECK_NEAR(ctx, w.P[a], (1 + es[k]) * V / 4 * (3 - a), 1e-12);
         if (es[k] == 1.0)
             CHECK_NEAR(ctx, E1, E0, 1e-13 * E0);
-        CHECK(ctx, w.mom_err <= 1e-13 && w.gmin >= -1e-12, "e %g: momentum %.3g, gap %.3g",
-              es[k], w.mom_err, w.gmin);
+        CHECK(ctx, w.mom_err <= 1e-13 && w.gmin >= -1e-12, "e %g: momentum %.3g, gap %.3g", es[k],
+              w.mom_err, w.gmin);
         CHECK(ctx, r.impacts == 1, "e %g: %ld impacts (the resting contacts are not impacts)",
               es[k], r.impacts);
     }
@@ -411,7 +448,14 @@ static void chain_setup(chain *ch)
         ch->g0[a] = 0.02;
         ch->e[a] = 1.0;
     }
-    ch->md = (pd_model){.n = CN, .m = CC, .M = pd_matrix_dense(CN, CN, ch->M), .C = pd_matrix_zero(CN, CN), .K = pd_matrix_dense(CN, CN, ch->K), .W = pd_matrix_dense(CN, CC, ch->W), .g0 = ch->g0, .e = ch->e};
+    ch->md = (pd_model){.n = CN,
+                        .m = CC,
+                        .M = pd_matrix_dense(CN, CN, ch->M),
+                        .C = pd_matrix_zero(CN, CN),
+                        .K = pd_matrix_dense(CN, CN, ch->K),
+                        .W = pd_matrix_dense(CN, CC, ch->W),
+                        .g0 = ch->g0,
+                        .e = ch->e};
 }
 
 typedef struct energy_watch {
@@ -539,7 +583,16 @@ static void constant_force(double t, int side, double *F, void *ctx)
 static void ball_setup(ball *b, double e)
 {
     *b = (ball){1.0, 0.0, 0.0, -1.0, 0.5, e, 2.0, {0}};
-    b->md = (pd_model){.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, &b->M), .C = pd_matrix_dense(1, 1, &b->C), .K = pd_matrix_dense(1, 1, &b->K), .W = pd_matrix_dense(1, 1, &b->W), .g0 = &b->delta, .e = &b->e, .force = constant_force, .force_ctx = &b->a};
+    b->md = (pd_model){.n = 1,
+                       .m = 1,
+                       .M = pd_matrix_dense(1, 1, &b->M),
+                       .C = pd_matrix_dense(1, 1, &b->C),
+                       .K = pd_matrix_dense(1, 1, &b->K),
+                       .W = pd_matrix_dense(1, 1, &b->W),
+                       .g0 = &b->delta,
+                       .e = &b->e,
+                       .force = constant_force,
+                       .force_ctx = &b->a};
 }
 
 /* Bouncing ball: t1 = sqrt(2 delta / a), v1 = a t1, and the impacts
@@ -554,8 +607,12 @@ static void test_edg_zeno_accumulation(pd_test_ctx *ctx)
         double e = es[k], t1 = sqrt(2 * b.delta / b.a), v1 = b.a * t1;
         double t_inf = t1 + 2 * e * v1 / (b.a * (1 - e)), T = 2 * t_inf + 1.0;
         pd_sine_piece piece = {.t_start = 0.0, .A = b.a, .w = 0.0, .phi = TWO_PI / 4};
-        pd_ed_sdof prob = {.osc = {.w0 = 0.0, .xi = 0.0}, .wall = 1, .delta = b.delta, .e = e,
-                           .npieces = 1, .pieces = &piece};
+        pd_ed_sdof prob = {.osc = {.w0 = 0.0, .xi = 0.0},
+                           .wall = 1,
+                           .delta = b.delta,
+                           .e = e,
+                           .npieces = 1,
+                           .pieces = &piece};
         pd_ed_opts eo;
         pd_ed_result er;
         pd_edg_result r;
@@ -596,8 +653,9 @@ static void test_edg_zeno_without_jump_stalls(pd_test_ctx *ctx)
     int rc = pd_edg_run(&b.md, 0.0, NULL, NULL, 2 * t_inf, &o, keep_last, &f, &r, &err);
     double cpu = pd_cpu_seconds() - c0;
     CHECK(ctx, rc == PD_EBUDGET, "status %d, expected PD_EBUDGET", rc);
-    CHECK(ctx, strstr(err.msg, "accumulation") && strstr(err.msg, "contact 0") &&
-                   strstr(err.msg, "t = ") && strstr(err.msg, "off"),
+    CHECK(ctx,
+          strstr(err.msg, "accumulation") && strstr(err.msg, "contact 0") &&
+              strstr(err.msg, "t = ") && strstr(err.msg, "off"),
           "message: %s", err.msg);
     CHECK(ctx, r.impacts == 61 && r.accumulations == 0, "impacts %ld (burst budget 60)", r.impacts);
     CHECK(ctx, f.t < t_inf && t_inf - f.t < 1e-4, "stalled at %.15g, t_inf = %.15g", f.t, t_inf);
@@ -622,23 +680,28 @@ static void test_edg_bad_input(pd_test_ctx *ctx)
     pd_edg_result r;
     double bad_gap = -0.1, bad_e = 1.5, q_in = 0.6, q_nan = NAN;
     b.md.g0 = &bad_gap;
-    CHECK(ctx, pd_edg_run(&b.md, 0, NULL, NULL, 1, NULL, NULL, NULL, &r, &err) == PD_EINVAL &&
-                   strstr(err.msg, "gap"),
+    CHECK(ctx,
+          pd_edg_run(&b.md, 0, NULL, NULL, 1, NULL, NULL, NULL, &r, &err) == PD_EINVAL &&
+              strstr(err.msg, "gap"),
           "negative gap: %s", err.msg);
     b.md.g0 = &b.delta;
     b.md.e = &bad_e;
-    CHECK(ctx, pd_edg_run(&b.md, 0, NULL, NULL, 1, NULL, NULL, NULL, &r, &err) == PD_EINVAL &&
-                   strstr(err.msg, "restitution"),
+    CHECK(ctx,
+          pd_edg_run(&b.md, 0, NULL, NULL, 1, NULL, NULL, NULL, &r, &err) == PD_EINVAL &&
+              strstr(err.msg, "restitution"),
           "e > 1: %s", err.msg);
     b.md.e = &b.e;
-    CHECK(ctx, pd_edg_run(&b.md, 1, NULL, NULL, 1, NULL, NULL, NULL, &r, &err) == PD_EINVAL &&
-                   strstr(err.msg, "t1"),
+    CHECK(ctx,
+          pd_edg_run(&b.md, 1, NULL, NULL, 1, NULL, NULL, NULL, &r, &err) == PD_EINVAL &&
+              strstr(err.msg, "t1"),
           "t1 <= t0: %s", err.msg);
-    CHECK(ctx, pd_edg_run(&b.md, 0, &q_in, NULL, 1, NULL, NULL, NULL, &r, &err) == PD_EINVAL &&
-                   strstr(err.msg, "initial gap of contact 0"),
+    CHECK(ctx,
+          pd_edg_run(&b.md, 0, &q_in, NULL, 1, NULL, NULL, NULL, &r, &err) == PD_EINVAL &&
+              strstr(err.msg, "initial gap of contact 0"),
           "penetrating q0: %s", err.msg);
-    CHECK(ctx, pd_edg_run(&b.md, 0, &q_nan, NULL, 1, NULL, NULL, NULL, &r, &err) == PD_EINVAL &&
-                   strstr(err.msg, "dof 0"),
+    CHECK(ctx,
+          pd_edg_run(&b.md, 0, &q_nan, NULL, 1, NULL, NULL, NULL, &r, &err) == PD_EINVAL &&
+              strstr(err.msg, "dof 0"),
           "NaN q0: %s", err.msg);
 }
 

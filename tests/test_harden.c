@@ -19,11 +19,12 @@ static pd_scene *two_sdof(pd_test_ctx *ctx, double h)
     pd_err e;
     if (!CHECK(ctx, sc != NULL, "out of memory"))
         return NULL;
-    if (!CHECK(ctx, !pd_scene_add_sdof(sc, "stiff", 0.4, 0.05, 2e5, &e) &&
-                        !pd_scene_add_sdof(sc, "flexible", 1.2, 0.05, 1e5, &e) &&
-                        (h == 0.0 || !pd_scene_set_heights(sc, &h, &e)) &&
-                        !pd_scene_add_contact(sc, 0, 1, 1, 1, 0.02, 0.65, 0, &e) &&
-                        !pd_scene_finish(sc, &e),
+    if (!CHECK(ctx,
+               !pd_scene_add_sdof(sc, "stiff", 0.4, 0.05, 2e5, &e) &&
+                   !pd_scene_add_sdof(sc, "flexible", 1.2, 0.05, 1e5, &e) &&
+                   (h == 0.0 || !pd_scene_set_heights(sc, &h, &e)) &&
+                   !pd_scene_add_contact(sc, 0, 1, 1, 1, 0.02, 0.65, 0, &e) &&
+                   !pd_scene_finish(sc, &e),
                "scene: %s", e.msg)) {
         pd_scene_free(sc);
         return NULL;
@@ -79,11 +80,13 @@ static int write_scene(const char *dir, const char *name, char *path, size_t cap
     FILE *f = fopen(path, "w");
     if (!f)
         return -1;
-    fprintf(f, "{\"excitation\": {\"pulse\": \"cosine\", \"dir\": \"+x\", \"ap\": 3.0, \"Tp\": 0.6},\n"
-               " \"structures\": [{\"name\": \"stiff\", \"T0\": 0.4, \"xi\": 0.05, \"mass\": 2e5},\n"
-               "                {\"name\": \"%s\", \"T0\": 1.2, \"xi\": 0.05, \"mass\": 1e5}],\n"
-               " \"contacts\": [{\"a\": \"stiff\", \"b\": \"%s\", \"gap\": 0.02, \"eps\": 0.65}],\n"
-               " \"tend\": 2.0}\n", name, name);
+    fprintf(f,
+            "{\"excitation\": {\"pulse\": \"cosine\", \"dir\": \"+x\", \"ap\": 3.0, \"Tp\": 0.6},\n"
+            " \"structures\": [{\"name\": \"stiff\", \"T0\": 0.4, \"xi\": 0.05, \"mass\": 2e5},\n"
+            "                {\"name\": \"%s\", \"T0\": 1.2, \"xi\": 0.05, \"mass\": 1e5}],\n"
+            " \"contacts\": [{\"a\": \"stiff\", \"b\": \"%s\", \"gap\": 0.02, \"eps\": 0.65}],\n"
+            " \"tend\": 2.0}\n",
+            name, name);
     return fclose(f) ? -1 : 0;
 }
 
@@ -139,14 +142,25 @@ static void test_harden_cpu_limit_cleans_up(pd_test_ctx *ctx)
         return;
     snprintf(out, sizeof out, "%s/o.h5", dir);
     /* about a minute of CPU: the limit of 1 s falls inside the run */
-    const char *argv[] = {"/usr/bin/prlimit", "--cpu=1:60", ctx->pound, "simulate", "--chain",
-                          "100", "--method", "moreau", "--dt", "1e-6", "--every", "1000", "-o",
-                          out, NULL};
+    const char *argv[] = {"/usr/bin/prlimit",
+                          "--cpu=1:60",
+                          ctx->pound,
+                          "simulate",
+                          "--chain",
+                          "100",
+                          "--method",
+                          "moreau",
+                          "--dt",
+                          "1e-6",
+                          "--every",
+                          "1000",
+                          "-o",
+                          out,
+                          NULL};
     proc_out r;
     pd_test_spawn(argv, NULL, &r);
     CHECK(ctx, r.status == -1, "exit %d, expected death by SIGXCPU: %s", r.status, r.err);
-    CHECK(ctx, pd_test_dir_entries(dir) == 0, "%d files left in %s", pd_test_dir_entries(dir),
-          dir);
+    CHECK(ctx, pd_test_dir_entries(dir) == 0, "%d files left in %s", pd_test_dir_entries(dir), dir);
     pd_test_proc_free(&r);
     pd_test_rm_dir(dir);
 }
@@ -189,8 +203,10 @@ static void test_harden_method_flags(pd_test_ctx *ctx)
             "kc:");
     refused(ctx, (const char *[]){"simulate", "--method", "newmark", "--dt", "1e-8", NULL}, NULL,
             "dt:");
-    refused(ctx, (const char *[]){"simulate", "--scene", "examples/scenes/two-sdof.json",
-                                  "--method", "newmark", "--kc", "1e300", NULL}, NULL, "kc:");
+    refused(ctx,
+            (const char *[]){"simulate", "--scene", "examples/scenes/two-sdof.json", "--method",
+                             "newmark", "--kc", "1e300", NULL},
+            NULL, "kc:");
     refused(ctx, (const char *[]){"simulate", "--method", "moreau", "--close-tol", "1e-9", NULL},
             NULL, "--close-tol");
     refused(ctx, (const char *[]){"simulate", "--method", "newmark", "--theta", "0.6", NULL}, NULL,
@@ -204,10 +220,10 @@ static void test_harden_method_flags(pd_test_ctx *ctx)
     refused(ctx, (const char *[]){"simulate", "--ap", "1e308", NULL}, NULL, "--ap:");
     /* what each method reads stays accepted */
     const char *ok[][10] = {{"simulate", "--method", "newmark", "--kc", "10", NULL},
-                           {"simulate", "--method", "penalty", "--stepper", "rk4imp", NULL},
-                           {"simulate", "--method", "event", "--dt", "0.01", NULL},
-                           {"simulate", "--chain", "3", "--method", "moreau", "--rtol", "1e-3",
-                            "--close-tol", "1e-9", NULL}};
+                            {"simulate", "--method", "penalty", "--stepper", "rk4imp", NULL},
+                            {"simulate", "--method", "event", "--dt", "0.01", NULL},
+                            {"simulate", "--chain", "3", "--method", "moreau", "--rtol", "1e-3",
+                             "--close-tol", "1e-9", NULL}};
     for (size_t k = 0; k < sizeof ok / sizeof ok[0]; k++) {
         proc_out r;
         pd_test_pound(ctx, ok[k], &r);
@@ -294,12 +310,13 @@ static void test_harden_gaps_within_tolerance(pd_test_ctx *ctx)
     /* masses 1e-6 and 1e12 kg touching: refused for the references, run by Moreau-Jean */
     pd_scene_excitation exc = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 3.0, .Tp = 1.0};
     pd_scene *sc = pd_scene_new(&exc);
-    if (!CHECK(ctx, sc && !pd_scene_add_sdof(sc, "A", 1.0, 0.05, 1e-6, &e) &&
-                        !pd_scene_add_sdof(sc, "B", 1.0, 0.05, 1e12, &e) &&
-                        !pd_scene_add_contact(sc, PD_WALL, 0, 0, 1, 1e-300, 1.0, 0, &e) &&
-                        !pd_scene_add_contact(sc, 0, 1, 1, 1, 1e-300, 1.0, 1, &e) &&
-                        !pd_scene_add_contact(sc, 1, 1, PD_WALL, 0, 1e-300, 1.0, 2, &e) &&
-                        !pd_scene_finish(sc, &e) && !pd_scene_result_alloc(sc, &r, &e),
+    if (!CHECK(ctx,
+               sc && !pd_scene_add_sdof(sc, "A", 1.0, 0.05, 1e-6, &e) &&
+                   !pd_scene_add_sdof(sc, "B", 1.0, 0.05, 1e12, &e) &&
+                   !pd_scene_add_contact(sc, PD_WALL, 0, 0, 1, 1e-300, 1.0, 0, &e) &&
+                   !pd_scene_add_contact(sc, 0, 1, 1, 1, 1e-300, 1.0, 1, &e) &&
+                   !pd_scene_add_contact(sc, 1, 1, PD_WALL, 0, 1e-300, 1.0, 2, &e) &&
+                   !pd_scene_finish(sc, &e) && !pd_scene_result_alloc(sc, &r, &e),
                "scene: %s", e.msg)) {
         pd_scene_free(sc);
         return;
@@ -342,12 +359,14 @@ static void test_harden_memory_limit(pd_test_ctx *ctx)
     snprintf(out, sizeof out, "%s/o.h5", dir);
     FILE *f = fopen(scene, "w");
     if (f) {
-        fprintf(f, "{\"excitation\": {\"pulse\": \"sine\", \"dir\": \"+x\", \"ap\": 3, \"Tp\": 1},\n"
-                   " \"tend\": 2, \"structures\": [");
+        fprintf(f,
+                "{\"excitation\": {\"pulse\": \"sine\", \"dir\": \"+x\", \"ap\": 3, \"Tp\": 1},\n"
+                " \"tend\": 2, \"structures\": [");
         for (int i = 0; i < 1000; i++)
-            fprintf(f, "%s{\"name\": \"S%d\", \"T0\": 1, \"xi\": 0.05, \"mass\": 1e5}", i ? ", " : "",
-                    i);
-        fprintf(f, "],\n \"contacts\": [{\"a\": \"wall\", \"b\": \"S0\", \"gap\": 0.01, \"eps\": 0.9}");
+            fprintf(f, "%s{\"name\": \"S%d\", \"T0\": 1, \"xi\": 0.05, \"mass\": 1e5}",
+                    i ? ", " : "", i);
+        fprintf(
+            f, "],\n \"contacts\": [{\"a\": \"wall\", \"b\": \"S0\", \"gap\": 0.01, \"eps\": 0.9}");
         for (int i = 0; i + 1 < 1000; i++)
             fprintf(f, ", {\"a\": \"S%d\", \"b\": \"S%d\", \"gap\": 0, \"eps\": 0.9}", i, i + 1);
         fprintf(f, "]}\n");
@@ -355,8 +374,15 @@ static void test_harden_memory_limit(pd_test_ctx *ctx)
     if (CHECK(ctx, f && fclose(f) == 0, "scene file")) {
         const char *limits[] = {"--as=300000000", "--as=150000000", "--as=50000000"};
         for (int k = 0; k < 3; k++) {
-            const char *argv[] = {"/usr/bin/prlimit", limits[k], ctx->pound, "simulate", "--scene",
-                                  scene, "-o", out, NULL};
+            const char *argv[] = {"/usr/bin/prlimit",
+                                  limits[k],
+                                  ctx->pound,
+                                  "simulate",
+                                  "--scene",
+                                  scene,
+                                  "-o",
+                                  out,
+                                  NULL};
             proc_out r;
             pd_test_spawn(argv, NULL, &r);
             CHECK(ctx, r.status == 1 && strstr(r.err, "memory"),
@@ -401,18 +427,18 @@ static void test_harden_touching_at_rest_and_chatter(pd_test_ctx *ctx)
     }
     pd_scene_free(sc);
 
-    static const double T18[] = {0.301, 0.76, 0.547, 0.124, 0.287, 0.112, 0.583, 0.268, 0.135,
-                                 0.734, 0.253, 0.419, 0.175, 0.37, 1.232, 0.342, 0.141, 0.152};
-    static const double xi18[] = {0.02, 0.05, 0, 0.05, 0.02, 0.05, 0, 0.05, 0.02,
-                                  0.05, 0, 0.02, 0.02, 0.05, 0.05, 0, 0.05, 0.05};
-    static const double m18[] = {1036737.4, 157757.7, 10642.3, 3648224.2, 62780.4, 9470914.4,
-                                 28070.3, 45986.2, 395486.1, 6343564.5, 8779038.8, 29045.4,
-                                 1938422.1, 1610.4, 26957.4, 669901.1, 7169234.3, 47809.5};
-    static const double g19[] = {0.05, 0, 0.01, 0.0001, 0.001, 0, 0, 0.01, 0.0001, 0.01,
-                                 0, 0.001, 0.05, 0.05, 0.001, 0.001, 0.05, 0.05, 0};
-    static const double e19[] = {0.198, 0.385, 0.034, 0.766, 0.454, 0.869, 0.712, 0.855, 0.664,
-                                 0.913, 0.304, 0.052, 0.087, 0.078, 0.704, 0.311, 0.36, 0.592,
-                                 0.424};
+    static const double T18[] = {0.301, 0.76,  0.547, 0.124, 0.287, 0.112, 0.583, 0.268, 0.135,
+                                 0.734, 0.253, 0.419, 0.175, 0.37,  1.232, 0.342, 0.141, 0.152};
+    static const double xi18[] = {0.02, 0.05, 0,    0.05, 0.02, 0.05, 0, 0.05, 0.02,
+                                  0.05, 0,    0.02, 0.02, 0.05, 0.05, 0, 0.05, 0.05};
+    static const double m18[] = {1036737.4, 157757.7, 10642.3,  3648224.2, 62780.4,   9470914.4,
+                                 28070.3,   45986.2,  395486.1, 6343564.5, 8779038.8, 29045.4,
+                                 1938422.1, 1610.4,   26957.4,  669901.1,  7169234.3, 47809.5};
+    static const double g19[] = {0.05, 0,     0.01, 0.0001, 0.001, 0,     0,    0.01, 0.0001, 0.01,
+                                 0,    0.001, 0.05, 0.05,   0.001, 0.001, 0.05, 0.05, 0};
+    static const double e19[] = {0.198, 0.385, 0.034, 0.766, 0.454, 0.869, 0.712,
+                                 0.855, 0.664, 0.913, 0.304, 0.052, 0.087, 0.078,
+                                 0.704, 0.311, 0.36,  0.592, 0.424};
     sc = row_of(ctx, 18, T18, xi18, m18, g19, e19, 1, PD_PULSE_COSINE, 7.22, 0.24, 2.0);
     if (sc && CHECK(ctx, !pd_scene_result_alloc(sc, &r, &e), "%s", e.msg)) {
         pd_run_opts o = pd_run_default_opts();
@@ -421,8 +447,9 @@ static void test_harden_touching_at_rest_and_chatter(pd_test_ctx *ctx)
         int rc = pd_scene_run(sc, &o, NULL, NULL, &r, &e);
         double cpu = pd_cpu_seconds() - cpu0;
         /* an answer, or the chatter named with the method that runs it */
-        CHECK(ctx, rc == PD_OK || (rc == PD_EBUDGET && strstr(e.msg, "chatter") &&
-                                   strstr(e.msg, "--method moreau")),
+        CHECK(ctx,
+              rc == PD_OK || (rc == PD_EBUDGET && strstr(e.msg, "chatter") &&
+                              strstr(e.msg, "--method moreau")),
               "rc %d after %.3g s: %s", rc, cpu, e.msg);
         pd_scene_result_free(&r);
     }
@@ -436,8 +463,12 @@ static void test_harden_touching_at_rest_and_chatter(pd_test_ctx *ctx)
 static void test_harden_status_without_err(pd_test_ctx *ctx)
 {
     double M[4] = {1.0, 1.0, 1.0, 1.0}, K[4] = {1.0, 0.0, 0.0, 1.0};
-    pd_model md = {.n = 2, .m = 0, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_zero(2, 2),
-                   .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_zero(2, 0)};
+    pd_model md = {.n = 2,
+                   .m = 0,
+                   .M = pd_matrix_dense(2, 2, M),
+                   .C = pd_matrix_zero(2, 2),
+                   .K = pd_matrix_dense(2, 2, K),
+                   .W = pd_matrix_zero(2, 0)};
     for (int with = 0; with < 2; with++) {
         pd_err e;
         pd_penalty_opts po = pd_penalty_default_opts();
@@ -448,8 +479,8 @@ static void test_harden_status_without_err(pd_test_ctx *ctx)
         go.factor = PD_FACTOR_DENSE;
         int rg = pd_edg_run(&md, 0.0, NULL, NULL, 1.0, &go, NULL, NULL, NULL, with ? &e : NULL);
         CHECK(ctx, rp == PD_ESINGULAR && rg == PD_ESINGULAR,
-              "%s pd_err: penalty %d, event-general %d, want %d", with ? "with" : "without", rp,
-              rg, PD_ESINGULAR);
+              "%s pd_err: penalty %d, event-general %d, want %d", with ? "with" : "without", rp, rg,
+              PD_ESINGULAR);
     }
 }
 
@@ -463,5 +494,6 @@ void suite_harden(pd_test_ctx *ctx)
     pd_test_run(ctx, "harden_method_flags", test_harden_method_flags);
     pd_test_run(ctx, "harden_gaps_within_tolerance", test_harden_gaps_within_tolerance);
     pd_test_run(ctx, "harden_memory_limit", test_harden_memory_limit);
-    pd_test_run(ctx, "harden_touching_at_rest_and_chatter", test_harden_touching_at_rest_and_chatter);
+    pd_test_run(ctx, "harden_touching_at_rest_and_chatter",
+                test_harden_touching_at_rest_and_chatter);
 }

@@ -150,8 +150,8 @@ static void test_impacts_cradle_touching(pd_test_ctx *ctx)
         int rc = cradle_event(&c, v, &impacts, &err);
         double d = cradle_error(v, want, N, &energy);
         CHECK(ctx, rc == PD_OK && d <= 1e-12 && impacts == 1 && fabs(energy - 1.0) <= 1e-12,
-              "event-driven, N = %d: |v - simultaneous| %.3g in %ld impacts, energy ratio %.15g",
-              N, d, impacts, energy);
+              "event-driven, N = %d: |v - simultaneous| %.3g in %ld impacts, energy ratio %.15g", N,
+              d, impacts, energy);
     }
 }
 
@@ -194,9 +194,9 @@ static void test_impacts_cradle_gapped(pd_test_ctx *ctx)
  * (cond(D) <= 0.5 N^2), so the impact is checked to CRADLE_IMPACT_TOL N^3 eps
  * v0; each later step adds impulses at the rounding level of the relative
  * velocities, CRADLE_DRIFT_TOL N eps v0 a step at most. */
-#define CRADLE_AFTER 2000      /* steps after the impact, h = 1e-3 */
-#define CRADLE_IMPACT_TOL 1.0  /* the impact step: this * N^3 eps v0 */
-#define CRADLE_DRIFT_TOL 1.0   /* each later step: this * N eps v0 more */
+#define CRADLE_AFTER 2000     /* steps after the impact, h = 1e-3 */
+#define CRADLE_IMPACT_TOL 1.0 /* the impact step: this * N^3 eps v0 */
+#define CRADLE_DRIFT_TOL 1.0  /* each later step: this * N eps v0 more */
 static void test_impacts_cradle_inelastic_touching(pd_test_ctx *ctx)
 {
     const double eps_list[] = {0.0, 0.3, 0.5, 0.8};
@@ -220,14 +220,16 @@ static void test_impacts_cradle_inelastic_touching(pd_test_ctx *ctx)
             int nactive = rc ? 0 : pd_mj_state(mj)->nactive;
             CHECK(ctx, rc == PD_OK && nactive == N - 1 && d <= tol,
                   "eps = %g, N = %d: the impact step: %d contacts, |v - closed form| %.3g > %.3g "
-                  "(%s)", eps, N, nactive, d, tol, rc ? err.msg : "ok");
+                  "(%s)",
+                  eps, N, nactive, d, tol, rc ? err.msg : "ok");
             long steps = 0;
             for (; steps < CRADLE_AFTER && !rc; steps++)
                 rc = pd_mj_step(mj, &err);
             d = rc ? INFINITY : cradle_error(pd_mj_state(mj)->v, want, N, &energy);
             CHECK(ctx, rc == PD_OK && d <= tol + drift,
                   "eps = %g, N = %d: %ld steps after the impact, |v - closed form| %.3g > %.3g "
-                  "(%s)", eps, N, steps, d, tol + drift, rc ? err.msg : "ok");
+                  "(%s)",
+                  eps, N, steps, d, tol + drift, rc ? err.msg : "ok");
             pd_mj_free(mj);
         }
 }
@@ -283,8 +285,10 @@ static void test_samples_count_impacts(pd_test_ctx *ctx)
         int rc = pd_osc_run(&c, &o, osc_sum, &q, &r, &e);
         if (!CHECK(ctx, rc == PD_OK, "%s: %s", pd_method_name(o.method), e.msg))
             continue;
-        CHECK(ctx, r.impacts == 5 && q.impacts == r.impacts, "%s: samples report %ld impacts, "
-              "the result %ld (5 expected)", pd_method_name(o.method), q.impacts, r.impacts);
+        CHECK(ctx, r.impacts == 5 && q.impacts == r.impacts,
+              "%s: samples report %ld impacts, "
+              "the result %ld (5 expected)",
+              pd_method_name(o.method), q.impacts, r.impacts);
         if (o.method == PD_METHOD_EVENT)
             CHECK_NEAR(ctx, q.max_impulse, r.max_impulse, 1e-14 * r.max_impulse);
     }
@@ -314,9 +318,10 @@ static void test_samples_count_impacts(pd_test_ctx *ctx)
         if (CHECK(ctx, rc == PD_OK, "%s: %s", pd_method_name(o.method), e.msg))
             for (int a = 0; a < 3; a++) {
                 all += r.impacts[a];
-                CHECK(ctx, q.per[a] == r.impacts[a], "%s, contact %d: samples report %ld "
-                      "impacts, the result %ld", pd_method_name(o.method), a, q.per[a],
-                      r.impacts[a]);
+                CHECK(ctx, q.per[a] == r.impacts[a],
+                      "%s, contact %d: samples report %ld "
+                      "impacts, the result %ld",
+                      pd_method_name(o.method), a, q.per[a], r.impacts[a]);
             }
         CHECK(ctx, all > 0, "%s: no impact to count", pd_method_name(o.method));
         pd_scene_result_free(&r);

@@ -32,9 +32,14 @@ static void test_law_closed_forms(pd_test_ctx *ctx)
             double v0[3] = {1.0, 0.0, 0.5}, I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
             double wv[4] = {-1, 1, -1, 1};
             int cp[3] = {0, 2, 4}, ri[4] = {0, 1, 1, 2};
-            pd_model md = {.n = 3, .m = 2, .M = pd_matrix_dense(3, 3, I3),
-                           .C = pd_matrix_zero(3, 3), .K = pd_matrix_zero(3, 3),
-                           .W = pd_matrix_csc(3, 2, cp, ri, wv), .g0 = g0, .e = ev};
+            pd_model md = {.n = 3,
+                           .m = 2,
+                           .M = pd_matrix_dense(3, 3, I3),
+                           .C = pd_matrix_zero(3, 3),
+                           .K = pd_matrix_zero(3, 3),
+                           .W = pd_matrix_csc(3, 2, cp, ri, wv),
+                           .g0 = g0,
+                           .e = ev};
             pd_sine_piece pc = {.t_start = 0.0};
             pd_piecewise_force F = {.b = b, .pieces = &pc, .npieces = 1};
             pd_edr_opts eo = pd_edr_default_opts();
@@ -71,9 +76,14 @@ static void test_law_closed_forms(pd_test_ctx *ctx)
     bad.impact_law = (pd_impact_law)7;
     double g0 = 1.0, e1 = 0.5, m1 = 1.0, b1 = 0.0, w1 = 1.0;
     int cp1[2] = {0, 1}, ri1[1] = {0};
-    pd_model md1 = {.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, &m1), .C = pd_matrix_zero(1, 1),
-                    .K = pd_matrix_zero(1, 1), .W = pd_matrix_csc(1, 1, cp1, ri1, &w1),
-                    .g0 = &g0, .e = &e1};
+    pd_model md1 = {.n = 1,
+                    .m = 1,
+                    .M = pd_matrix_dense(1, 1, &m1),
+                    .C = pd_matrix_zero(1, 1),
+                    .K = pd_matrix_zero(1, 1),
+                    .W = pd_matrix_csc(1, 1, cp1, ri1, &w1),
+                    .g0 = &g0,
+                    .e = &e1};
     pd_sine_piece pc1 = {.t_start = 0.0};
     pd_piecewise_force F1 = {.b = &b1, .pieces = &pc1, .npieces = 1};
     pd_err err;
@@ -82,10 +92,11 @@ static void test_law_closed_forms(pd_test_ctx *ctx)
           "impact_law 7 refused: %s", r ? "allocated" : err.msg);
     pd_edr_free(r);
     pd_impact_law law;
-    CHECK(ctx, pd_impact_law_parse("single", &law) == PD_OK && law == PD_IMPACT_SINGLE &&
-                   pd_impact_law_parse("staged", &law) == PD_OK && law == PD_IMPACT_STAGED &&
-                   pd_impact_law_parse("newton", &law) == PD_EINVAL &&
-                   !strcmp(pd_impact_law_name(PD_IMPACT_SINGLE), "single"),
+    CHECK(ctx,
+          pd_impact_law_parse("single", &law) == PD_OK && law == PD_IMPACT_SINGLE &&
+              pd_impact_law_parse("staged", &law) == PD_OK && law == PD_IMPACT_STAGED &&
+              pd_impact_law_parse("newton", &law) == PD_EINVAL &&
+              !strcmp(pd_impact_law_name(PD_IMPACT_SINGLE), "single"),
           "impact law names");
 }
 
@@ -107,8 +118,7 @@ static pd_scene *law_row(pd_test_ctx *ctx, pd_pulse pulse, const double *T0, con
         ok = !pd_scene_add_sdof(sc, name, T0[s], 0.05, mass[s], &e);
     }
     for (int a = 0; a < 4 && ok; a++)
-        ok = !pd_scene_add_contact(sc, a ? a - 1 : PD_WALL, a ? 1 : 0, a, 1, gap[a], eps[a], a,
-                                   &e);
+        ok = !pd_scene_add_contact(sc, a ? a - 1 : PD_WALL, a ? 1 : 0, a, 1, gap[a], eps[a], a, &e);
     if (!CHECK(ctx, ok && !pd_scene_finish(sc, &e), "scene: %s", e.msg)) {
         pd_scene_free(sc);
         return NULL;
@@ -150,22 +160,25 @@ static void test_law_band(pd_test_ctx *ctx)
     pd_scene *sc = law_row(ctx, PD_PULSE_COSINE, T_a, m_a, g_a);
     if (!sc)
         return;
-    if (!CHECK(ctx, !pd_scene_result_alloc(sc, &st, &e) && !pd_scene_result_alloc(sc, &si, &e) &&
-                        !pd_scene_result_alloc(sc, &eg, &e),
+    if (!CHECK(ctx,
+               !pd_scene_result_alloc(sc, &st, &e) && !pd_scene_result_alloc(sc, &si, &e) &&
+                   !pd_scene_result_alloc(sc, &eg, &e),
                "%s", e.msg)) {
         pd_scene_free(sc);
         return;
     }
     if (!law_run(ctx, sc, PD_METHOD_EVENT, PD_IMPACT_STAGED, &st) &&
         !law_run(ctx, sc, PD_METHOD_EVENT, PD_IMPACT_SINGLE, &si)) {
-        CHECK(ctx, st.law_decided > 0 && !strcmp(st.impact_law, "staged") &&
-                       !strcmp(si.impact_law, "single"),
+        CHECK(ctx,
+              st.law_decided > 0 && !strcmp(st.impact_law, "staged") &&
+                  !strcmp(si.impact_law, "single"),
               "law_decided %ld, laws %s, %s", st.law_decided, st.impact_law, si.impact_law);
         double worst = 0.0;
         for (int s = 0; s < 4; s++) {
             double want = fabs(si.umax[s] - st.umax[s]) / st.umax[s];
-            CHECK(ctx, fabs(st.law_band[s] - want) <= 1e-15 &&
-                           fabs(si.law_band[s] - want * st.umax[s] / si.umax[s]) <= 1e-15,
+            CHECK(ctx,
+                  fabs(st.law_band[s] - want) <= 1e-15 &&
+                      fabs(si.law_band[s] - want * st.umax[s] / si.umax[s]) <= 1e-15,
                   "S%d: law_band %.6g (single's %.6g), want %.6g", s + 1, st.law_band[s],
                   si.law_band[s], want);
             worst = fmax(worst, st.law_band[s]);
@@ -189,8 +202,8 @@ static void test_law_band(pd_test_ctx *ctx)
     }
     if (!law_run(ctx, sc, PD_METHOD_EVENT, PD_IMPACT_SINGLE, &si) &&
         !law_run(ctx, sc, PD_METHOD_EVENT_GENERAL, PD_IMPACT_STAGED, &eg)) {
-        CHECK(ctx, si.simultaneous > 0 && si.law_band_max == 0.0,
-              "simultaneous %ld, law_band %.3g", si.simultaneous, si.law_band_max);
+        CHECK(ctx, si.simultaneous > 0 && si.law_band_max == 0.0, "simultaneous %ld, law_band %.3g",
+              si.simultaneous, si.law_band_max);
         for (int s = 0; s < 4; s++)
             CHECK(ctx, fabs(si.umax[s] - eg.umax[s]) <= 1e-9 * eg.umax[s],
                   "S%d: single %.12g, event-general %.12g", s + 1, si.umax[s], eg.umax[s]);

@@ -155,8 +155,10 @@ static void check_verified(pd_test_ctx *ctx, const lcp_case *c, const char *what
     double comp = NAN, infeas = NAN, residual = NAN;
     if (w)
         pd_lcp_residual(c->n, c->M, c->q, c->z, w, &comp, &infeas, &residual);
-    CHECK(ctx, residual <= VERIFY_TOL, "%s: relative residual %.3g > %.0e (complementarity %.3g, "
-          "infeasibility %.3g)", what, residual, VERIFY_TOL, comp, infeas);
+    CHECK(ctx, residual <= VERIFY_TOL,
+          "%s: relative residual %.3g > %.0e (complementarity %.3g, "
+          "infeasibility %.3g)",
+          what, residual, VERIFY_TOL, comp, infeas);
     free(w);
 }
 
@@ -225,17 +227,21 @@ static void test_lcp_read_band(pd_test_ctx *ctx)
         for (int siconos = 0; siconos < 2; siconos++) {
             static char text[16 * N * N + 256];
             size_t at = 0;
-            at += (size_t)snprintf(text + at, sizeof text - at, siconos ? "%d\n0\n%d\n%d\n%d %d\n"
-                                                                        : "%d\n",
-                                   N, N, N, N, N);
+            at += (size_t)snprintf(text + at, sizeof text - at,
+                                   siconos ? "%d\n0\n%d\n%d\n%d %d\n" : "%d\n", N, N, N, N, N);
             for (int r = 0; r < N; r++) /* row r of the file: M's row (plain), column (siconos) */
                 for (int c = 0; c < N; c++) {
                     int i = siconos ? c : r, j = siconos ? r : c;
-                    double x = i == j ? 2.0 : abs(i - j) == 1 ? -1.0 : far && i == 39 && j == 0 ? 0.5 : 0.0;
-                    at += (size_t)snprintf(text + at, sizeof text - at, "%g%c", x, c + 1 < N ? ' ' : '\n');
+                    double x = i == j                     ? 2.0
+                               : abs(i - j) == 1          ? -1.0
+                               : far && i == 39 && j == 0 ? 0.5
+                                                          : 0.0;
+                    at += (size_t)snprintf(text + at, sizeof text - at, "%g%c", x,
+                                           c + 1 < N ? ' ' : '\n');
                 }
             for (int i = 0; i < N; i++)
-                at += (size_t)snprintf(text + at, sizeof text - at, "%d%c", i % 3 - 1, i + 1 < N ? ' ' : '\n');
+                at += (size_t)snprintf(text + at, sizeof text - at, "%d%c", i % 3 - 1,
+                                       i + 1 < N ? ' ' : '\n');
             char path[64];
             int n = 0, band = -2;
             long nnz = -1;
@@ -270,8 +276,9 @@ static void test_lcp_read_band(pd_test_ctx *ctx)
     pd_err err;
     char path[64];
     if (CHECK(ctx, write_temp(path, "2\n0 0\n0 0\n1 1\n") == 0, "temp file")) {
-        CHECK(ctx, pd_lcp_read_band(path, PD_LCP_FORMAT_PLAIN, &n, &M, &q, &band, &nnz, &err) ==
-                           PD_OK && band == -1 && nnz == 0,
+        CHECK(ctx,
+              pd_lcp_read_band(path, PD_LCP_FORMAT_PLAIN, &n, &M, &q, &band, &nnz, &err) == PD_OK &&
+                  band == -1 && nnz == 0,
               "zero M: band %d nnz %ld", band, nnz);
         remove(path);
         free(M);
@@ -281,10 +288,23 @@ static void test_lcp_read_band(pd_test_ctx *ctx)
 
 /* ---- Siconos test set --------------------------------------------------------------- */
 
-static const char *const siconos_files[] = {
-    "CPS_1", "CPS_2", "CPS_3", "CPS_4", "CPS_4bis", "CPS_5", "Pang_isolated_sol",
-    "Pang_isolated_sol_perturbed", "deudeu", "enum_fails", "exp_murty", "exp_murty2",
-    "inf_sol_perturbed", "mmc", "ortiz", "tobenna", "trivial"};
+static const char *const siconos_files[] = {"CPS_1",
+                                            "CPS_2",
+                                            "CPS_3",
+                                            "CPS_4",
+                                            "CPS_4bis",
+                                            "CPS_5",
+                                            "Pang_isolated_sol",
+                                            "Pang_isolated_sol_perturbed",
+                                            "deudeu",
+                                            "enum_fails",
+                                            "exp_murty",
+                                            "exp_murty2",
+                                            "inf_sol_perturbed",
+                                            "mmc",
+                                            "ortiz",
+                                            "tobenna",
+                                            "trivial"};
 
 /* README: only these two end on a ray. */
 static int siconos_expects_ray(const char *name)
@@ -405,8 +425,8 @@ static void check_murty_1978(pd_test_ctx *ctx, int n, int upper)
     for (int i = 0; i < n; i++)
         c.q[i] = -1.0;
     pd_lcp_info info;
-    CHECK(ctx, solve(&c, NULL, &info) == PD_OK, "Murty %s n = %d solved",
-          upper ? "upper" : "lower", n);
+    CHECK(ctx, solve(&c, NULL, &info) == PD_OK, "Murty %s n = %d solved", upper ? "upper" : "lower",
+          n);
     int want = n <= 2 ? 0 : upper ? 2 : 1 << n; /* n <= 2: the closed forms, no pivots */
     CHECK(ctx, info.pivots == want, "Murty %s n = %d: %d pivots, expected %d",
           upper ? "upper" : "lower", n, info.pivots, want);
@@ -441,7 +461,7 @@ static void test_lcp_fathi_1979(pd_test_ctx *ctx)
         fathi_problem(&c);
         pd_lcp_info info;
         CHECK(ctx, solve(&c, NULL, &info) == PD_OK, "Fathi n = %d solved", n);
-        for (int i = 0; i < n; i++)   /* known solution z = e_1 */
+        for (int i = 0; i < n; i++) /* known solution z = e_1 */
             CHECK_NEAR(ctx, c.z[i], i == 0 ? 1.0 : 0.0, 1e-12);
         if (n <= 10)
             check_against_enumeration(ctx, &c, "Fathi");
@@ -553,8 +573,8 @@ static void random_large_verified(pd_test_ctx *ctx, int kind, const int *sizes, 
         int st = solve(&c, NULL, &info);
         CHECK(ctx, st == PD_OK, "kind %d, n = %d: status %d (%s)", kind, sizes[k], st,
               pd_lcp_outcome_name(info.outcome));
-        CHECK(ctx, info.pivots >= 1 && info.pivots <= 4 * sizes[k], "n = %d: %d pivots",
-              sizes[k], info.pivots);
+        CHECK(ctx, info.pivots >= 1 && info.pivots <= 4 * sizes[k], "n = %d: %d pivots", sizes[k],
+              info.pivots);
         check_verified(ctx, &c, "large random");
         case_free(&c);
     }
@@ -664,7 +684,7 @@ static void test_lcp_degenerate_repeated_q(pd_test_ctx *ctx)
             else
                 for (int i = 0; i < n; i++)
                     c.M[i + i * n] = 1.0; /* identity: every row ties */
-            for (int i = 0; i < n; i++) /* repeated equal negatives and zeros */
+            for (int i = 0; i < n; i++)   /* repeated equal negatives and zeros */
                 c.q[i] = i % 3 == 2 ? 0.0 : -1.0;
             pd_lcp_info info;
             int st = solve(&c, NULL, &info);
@@ -747,8 +767,10 @@ static void test_lcp_small_pivot_is_not_a_ray(pd_test_ctx *ctx)
     pd_lcp_work *work = pd_lcp_alloc(3);
     pd_lcp_info info;
     int st = pd_lcp_lemke(work, 3, M, q, NULL, z, w, &info);
-    CHECK(ctx, st == PD_OK && info.pivots >= 3, "status %d (%s), %d pivots, expected solved by "
-          "pivoting", st, pd_lcp_outcome_name(info.outcome), info.pivots);
+    CHECK(ctx, st == PD_OK && info.pivots >= 3,
+          "status %d (%s), %d pivots, expected solved by "
+          "pivoting",
+          st, pd_lcp_outcome_name(info.outcome), info.pivots);
     double z2 = 0.5 / (M[4] - 1.0); /* exact for this double data */
     CHECK_NEAR(ctx, z[1], z2, 1e-6 * z2);
     CHECK_NEAR(ctx, z[0], z2 - 0.5, 1e-6 * z2);
@@ -812,8 +834,8 @@ static void test_lcp_max_pivots(pd_test_ctx *ctx)
         opts.max_pivots = 63;
         CHECK(ctx, solve(&s, &opts, &info) == PD_EMAXPIVOTS, "cap 63 does not");
         /* the default cap (max(10000, 100 n)) lets n = 12 finish */
-        CHECK(ctx, solve(&c, NULL, &info) == PD_OK && info.pivots == 4096,
-              "default cap: %d pivots", info.pivots);
+        CHECK(ctx, solve(&c, NULL, &info) == PD_OK && info.pivots == 4096, "default cap: %d pivots",
+              info.pivots);
     }
     case_free(&s);
     case_free(&c);
@@ -858,7 +880,8 @@ static int same_answer(int n, int sa, const pd_lcp_info *a, const double *za, co
            !memcmp(&a->complementarity, &b->complementarity, sizeof(double)) &&
            !memcmp(&a->infeasibility, &b->infeasibility, sizeof(double)) &&
            !memcmp(&a->scale, &b->scale, sizeof(double)) &&
-           !memcmp(za, zb, (size_t)n * sizeof(double)) && !memcmp(wa, wb, (size_t)n * sizeof(double));
+           !memcmp(za, zb, (size_t)n * sizeof(double)) &&
+           !memcmp(wa, wb, (size_t)n * sizeof(double));
 }
 
 /* A covering vector given as all ones and the default (NULL, all ones without a
@@ -891,7 +914,8 @@ static void test_lcp_unit_cover_same_bits(pd_test_ctx *ctx)
         int sb = solve(&(lcp_case){n, c.M, c.q, z2, w2}, &opts, &b);
         CHECK(ctx, same_answer(n, sa, &a, c.z, c.w, sb, &b, z2, w2),
               "rep %d, n = %d: cover NULL (status %d, %s, %d pivots) and ones (status %d, %s, %d "
-              "pivots) differ", rep, n, sa, pd_lcp_outcome_name(a.outcome), a.pivots, sb,
+              "pivots) differ",
+              rep, n, sa, pd_lcp_outcome_name(a.outcome), a.pivots, sb,
               pd_lcp_outcome_name(b.outcome), b.pivots);
         free(z2);
         free(w2);
@@ -982,8 +1006,8 @@ static void test_lcp_vector_path_same_bits(pd_test_ctx *ctx)
                    !memcmp(c.z, e.z, (size_t)n * sizeof(double)) &&
                    !memcmp(c.w, e.w, (size_t)n * sizeof(double));
         if (!same && differ++ < 3)
-            CHECK(ctx, 0, "rep %d, n = %d: status %d / %d, pivots %d / %d, z differs by %.3g",
-                  rep, n, sa, sb, a.pivots, b.pivots, max_diff(n, c.z, e.z));
+            CHECK(ctx, 0, "rep %d, n = %d: status %d / %d, pivots %d / %d, z differs by %.3g", rep,
+                  n, sa, sb, a.pivots, b.pivots, max_diff(n, c.z, e.z));
         case_free(&c);
         case_free(&e);
     }
@@ -1000,9 +1024,8 @@ static void test_lcp_vector_path_same_bits(pd_test_ctx *ctx)
  * residual <= 1e-10, pd_lcp_residual). */
 static void test_lcp_final_tie_break(pd_test_ctx *ctx)
 {
-    static const double M[36] = {3, -1, -1, 0,  1, -1, -2, 2, 1,  2, -1, 0,
-                                 -2, -1, 2, 1, 2, 1,  1, -1, 2, 2, 1, -2,
-                                 0, 0,  1, -2, 2, -2, -2, -2, 2, -1, 1, 3};
+    static const double M[36] = {3, -1, -1, 0, 1, -1, -2, 2, 1, 2,  -1, 0,  -2, -1, 2, 1,  2, 1,
+                                 1, -1, 2,  2, 1, -2, 0,  0, 1, -2, 2,  -2, -2, -2, 2, -1, 1, 3};
     static const double q[6] = {1, 0, -1, -1, 0, 1};
     double z[6], w[6], wr[6], comp = NAN, infeas = NAN, residual = NAN;
     pd_lcp_work *work = pd_lcp_alloc(6);
@@ -1013,8 +1036,9 @@ static void test_lcp_final_tie_break(pd_test_ctx *ctx)
         return;
     int st = pd_lcp_lemke(work, 6, M, q, &opts, z, w, &info);
     pd_lcp_residual(6, M, q, z, wr, &comp, &infeas, &residual);
-    CHECK(ctx, st == PD_OK && info.outcome == PD_LCP_SOLVED && info.pivots < 100 &&
-                   residual <= VERIFY_TOL,
+    CHECK(ctx,
+          st == PD_OK && info.outcome == PD_LCP_SOLVED && info.pivots < 100 &&
+              residual <= VERIFY_TOL,
           "status %d (%s) after %d pivots, relative residual %.3g", st,
           pd_lcp_outcome_name(info.outcome), info.pivots, residual);
     pd_lcp_free(work);
@@ -1047,8 +1071,8 @@ static void test_lcp_nonfinite_anywhere(pd_test_ctx *ctx)
                 for (int i = 0; i < n; i++)
                     untouched &= z[i] == 7.0 && w[i] == 7.0;
                 CHECK(ctx, st == PD_EINVAL && info.outcome == PD_LCP_NUMERICAL && untouched,
-                      "n = %d, entry %d = %g: status %d, outcome %s, z and w %s", n, k, bad[b],
-                      st, pd_lcp_outcome_name(info.outcome), untouched ? "kept" : "written");
+                      "n = %d, entry %d = %g: status %d, outcome %s, z and w %s", n, k, bad[b], st,
+                      pd_lcp_outcome_name(info.outcome), untouched ? "kept" : "written");
             }
         }
     }
@@ -1213,8 +1237,7 @@ static void test_lcp_residual_nonfinite(pd_test_ctx *ctx)
     for (int k = 0; k < 3; k++) {
         pd_lcp_residual(3, M, q, zs[k], w, &comp, &infeas, &residual);
         CHECK(ctx, isnan(residual) && !(residual <= VERIFY_TOL),
-              "z = (%g, %g, %g): residual %g must be NaN", zs[k][0], zs[k][1], zs[k][2],
-              residual);
+              "z = (%g, %g, %g): residual %g must be NaN", zs[k][0], zs[k][1], zs[k][2], residual);
     }
     /* a finite candidate keeps a finite residual */
     double z0[3] = {0.0, 0.0, 0.0};
@@ -1233,8 +1256,9 @@ static void test_lcp_read_bounded(pd_test_ctx *ctx)
     pd_err err;
     char zero[64], want[128];
     int st = pd_lcp_read("/dev/zero", PD_LCP_FORMAT_AUTO, &n, &M, &q, &err);
-    CHECK(ctx, st == PD_EINVAL && strstr(err.msg, "/dev/zero: not a regular file") && n == 0 &&
-               !M && !q, "/dev/zero: %d %s", st, err.msg);
+    CHECK(ctx,
+          st == PD_EINVAL && strstr(err.msg, "/dev/zero: not a regular file") && n == 0 && !M && !q,
+          "/dev/zero: %d %s", st, err.msg);
     if (CHECK(ctx, pd_test_zero_file(zero, sizeof zero, 3LL << 30) == 0, "a sparse file")) {
         n = 5;
         st = pd_lcp_read(zero, PD_LCP_FORMAT_AUTO, &n, &M, &q, &err);
@@ -1252,9 +1276,10 @@ static void test_lcp_read_bounded(pd_test_ctx *ctx)
         return;
     close(fd);
     st = pd_lcp_read(path, PD_LCP_FORMAT_AUTO, &n, &M, &q, &err);
-    CHECK(ctx, st == PD_EPARSE && strstr(err.msg, path) &&
-               strstr(err.msg, ": line 3: not a text file (a NUL byte)"), "NUL: %d %s", st,
-          err.msg);
+    CHECK(ctx,
+          st == PD_EPARSE && strstr(err.msg, path) &&
+              strstr(err.msg, ": line 3: not a text file (a NUL byte)"),
+          "NUL: %d %s", st, err.msg);
     remove(path);
     /* n = 46340, then 10^5 ones on 1000 lines */
     size_t cap = 10 + 200000 + 1000;
@@ -1269,8 +1294,9 @@ static void test_lcp_read_bounded(pd_test_ctx *ctx)
     }
     *p = '\0';
     st = read_text(text, PD_LCP_FORMAT_AUTO, &n, &M, &q, &err);
-    CHECK(ctx, st == PD_EPARSE && strstr(err.msg, "line 1001: too few values: the file ends "
-                                                   "after 100000 of the 2147441940 numbers"),
+    CHECK(ctx,
+          st == PD_EPARSE && strstr(err.msg, "line 1001: too few values: the file ends "
+                                             "after 100000 of the 2147441940 numbers"),
           "stream: %d %s", st, err.msg);
     free(text);
 }
@@ -1389,8 +1415,8 @@ static void test_lcp_read_malformed(pd_test_ctx *ctx)
                     "line 4: matrix dimension '3'");
     check_malformed(ctx, "2\n0\n2\n2\n2 2\n1 0 0 1\n-1\n", PD_LCP_FORMAT_SICONOS,
                     "line 7: too few values");
-    check_malformed(ctx, "3\n0\n3\n3\n3 3\n1 0 0\n0 1 0\n0 0 1e999\n-1 -1 -1\n",
-                    PD_LCP_FORMAT_AUTO, "line 8: matrix entry: '1e999' is not a finite");
+    check_malformed(ctx, "3\n0\n3\n3\n3 3\n1 0 0\n0 1 0\n0 0 1e999\n-1 -1 -1\n", PD_LCP_FORMAT_AUTO,
+                    "line 8: matrix entry: '1e999' is not a finite");
     int n = 0;
     double *M = NULL, *q = NULL;
     pd_err err;
@@ -1455,8 +1481,9 @@ static void test_lcp_cli(pd_test_ctx *ctx)
     CHECK(ctx, run_capture(cmd, out, sizeof out) == 0, "solved: exit 0");
     CHECK(ctx, strstr(out, "\"status\":\"solved\"") && strstr(out, "\"z\":[1.3333333333333333,"),
           "solved JSON: %s", out);
-    CHECK(ctx, strstr(out, "\"pivots\":0") && strstr(out, "\"cpu_s\":") &&
-                   strstr(out, "\"complementarity\":") && strstr(out, "\"w\":["),
+    CHECK(ctx,
+          strstr(out, "\"pivots\":0") && strstr(out, "\"cpu_s\":") &&
+              strstr(out, "\"complementarity\":") && strstr(out, "\"w\":["),
           "JSON keys: %s", out);
     snprintf(cmd, sizeof cmd, "%s lcp %s --json", ctx->pound, ray);
     CHECK(ctx, run_capture(cmd, out, sizeof out) == 1, "ray: exit 1");
@@ -1489,8 +1516,11 @@ static int write_tridiagonal(char *path, int n, double lo, double up, double far
     size_t at = (size_t)snprintf(text, sizeof text, "%d\n", n);
     for (int i = 0; i < n && at < sizeof text; i++)
         for (int j = 0; j < n && at < sizeof text; j++) {
-            double x = i == j ? 2.0 : j == i - 1 ? lo : j == i + 1 ? up
-                       : (i == 0 && j == n - 1) || (i == n - 1 && j == 0) ? far : 0.0;
+            double x = i == j                                             ? 2.0
+                       : j == i - 1                                       ? lo
+                       : j == i + 1                                       ? up
+                       : (i == 0 && j == n - 1) || (i == n - 1 && j == 0) ? far
+                                                                          : 0.0;
             at += (size_t)snprintf(text + at, sizeof text - at, "%g%c", x, j + 1 < n ? ' ' : '\n');
         }
     for (int i = 0; i < n && at < sizeof text; i++)
@@ -1521,16 +1551,19 @@ static void test_lcp_cli_band(pd_test_ctx *ctx)
         return;
     }
     snprintf(cmd, sizeof cmd, "%s lcp %s --solver structured --json", ctx->pound, chain);
-    CHECK(ctx, run_capture(cmd, out, sizeof out) == 0 && strstr(out, "\"status\":\"solved\"") &&
-                   strstr(out, "\"solver\":\"structured\"") && strstr(out, "\"iterations\":1,"),
+    CHECK(ctx,
+          run_capture(cmd, out, sizeof out) == 0 && strstr(out, "\"status\":\"solved\"") &&
+              strstr(out, "\"solver\":\"structured\"") && strstr(out, "\"iterations\":1,"),
           "chain: %.200s", out);
     snprintf(cmd, sizeof cmd, "%s lcp %s --solver structured --json", ctx->pound, far);
-    CHECK(ctx, run_capture(cmd, out, sizeof out) == 0 && strstr(out, "\"status\":\"solved\"") &&
-                   strstr(out, "\"solver\":\"structured\"") && !strstr(out, "\"iterations\":1,"),
+    CHECK(ctx,
+          run_capture(cmd, out, sizeof out) == 0 && strstr(out, "\"status\":\"solved\"") &&
+              strstr(out, "\"solver\":\"structured\"") && !strstr(out, "\"iterations\":1,"),
           "far entry: %.200s", out);
     snprintf(cmd, sizeof cmd, "%s lcp %s --solver structured --json", ctx->pound, skew);
-    CHECK(ctx, run_capture(cmd, out, sizeof out) == 0 && strstr(out, "\"status\":\"solved\"") &&
-                   strstr(out, "\"solver\":\"lemke (after structured)\""),
+    CHECK(ctx,
+          run_capture(cmd, out, sizeof out) == 0 && strstr(out, "\"status\":\"solved\"") &&
+              strstr(out, "\"solver\":\"lemke (after structured)\""),
           "nonsymmetric band: %.200s", out);
     remove(chain);
     remove(far);

@@ -35,8 +35,9 @@ static int paths_same_as_general(pd_test_ctx *ctx, const double *M, const double
     M5[3 + 5 * 3] = M5[4 + 5 * 4] = 1.0;
     pd_lcp_info a, b;
     int sa = paths_solve(3, M, q, tol, z, w, &a), sb = paths_solve(5, M5, q5, tol, z5, w5, &b);
-    CHECK(ctx, sa == PD_OK && sb == PD_OK && a.pivots == b.pivots && z5[3] == 0.0 &&
-                   z5[4] == 0.0 && !memcmp(z, z5, 3 * sizeof(double)),
+    CHECK(ctx,
+          sa == PD_OK && sb == PD_OK && a.pivots == b.pivots && z5[3] == 0.0 && z5[4] == 0.0 &&
+              !memcmp(z, z5, 3 * sizeof(double)),
           "n = 3 vs n = 5: status %d / %d, pivots %d / %d, z0 %.17g / %.17g", sa, sb, a.pivots,
           b.pivots, z[0], z5[0]);
     return sa == PD_OK ? a.pivots : -1;
@@ -138,8 +139,7 @@ static void test_lemke_vector_tie_at_slack(pd_test_ctx *ctx)
  * of 0 there makes w_0 leave: 5 pivots. */
 static void test_lemke_vector_tie_row_size(pd_test_ctx *ctx)
 {
-    static const double M[9] = {2, 0, 0, -1.5, 0.5, -0.5, 6, 0, 2},
-                        q[3] = {1 - 3 * 0x1p-40, -1, 0};
+    static const double M[9] = {2, 0, 0, -1.5, 0.5, -0.5, 6, 0, 2}, q[3] = {1 - 3 * 0x1p-40, -1, 0};
     double z[3];
     int pivots = paths_same_as_general(ctx, M, q, PATHS_TOL, z);
     CHECK(ctx, pivots == 3 && z[0] == 0.0 && z[1] == 2.0 && z[2] == 0.5,
@@ -155,8 +155,9 @@ static void test_lemke_closed_form_det_one(pd_test_ctx *ctx)
     double z[2], w[2];
     pd_lcp_info info;
     int st = paths_solve(2, M, q, 0.0, z, w, &info);
-    CHECK(ctx, st == PD_OK && info.pivots == 0 && z[0] == 1.0 && z[1] == 1.0 && w[0] == 0.0 &&
-                   w[1] == 0.0,
+    CHECK(ctx,
+          st == PD_OK && info.pivots == 0 && z[0] == 1.0 && z[1] == 1.0 && w[0] == 0.0 &&
+              w[1] == 0.0,
           "status %d, %d pivots (0 expected), z = (%.17g, %.17g)", st, info.pivots, z[0], z[1]);
 }
 

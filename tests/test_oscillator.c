@@ -32,7 +32,14 @@ static void test_osc_free_flight_order(pd_test_ctx *ctx)
     const double thetas[] = {0.5, 1.0}, orders[] = {2.0, 1.0};
     for (int p = 0; p < 2; p++)
         for (int th = 0; th < 2; th++) {
-            pd_osc c = {.pulse = pulses[p], .dir = 1, .ap = 2.0, .Tp = 0.5, .Pi2 = 0.7, .Pi3 = 0.0, .eps = 0.5, .xi = 0.05};
+            pd_osc c = {.pulse = pulses[p],
+                        .dir = 1,
+                        .ap = 2.0,
+                        .Tp = 0.5,
+                        .Pi2 = 0.7,
+                        .Pi3 = 0.0,
+                        .eps = 0.5,
+                        .xi = 0.05};
             double err[4];
             for (int k = 0; k < 4; k++) {
                 pd_run_opts o = pd_run_default_opts();
@@ -50,8 +57,8 @@ static void test_osc_free_flight_order(pd_test_ctx *ctx)
                 double slope = log2(err[k - 1] / err[k]);
                 CHECK(ctx, fabs(slope - orders[th]) <= 0.2,
                       "%s theta %g: slope %.3f between dt/%d and dt/%d (errors %.3g, %.3g)",
-                      pd_pulse_name(pulses[p]), thetas[th], slope, 1 << (k - 1), 1 << k,
-                      err[k - 1], err[k]);
+                      pd_pulse_name(pulses[p]), thetas[th], slope, 1 << (k - 1), 1 << k, err[k - 1],
+                      err[k]);
             }
             CHECK(ctx, err[3] < (th ? 3e-2 : 1e-4), "finest error %.3g", err[3]);
         }
@@ -67,7 +74,14 @@ static void test_osc_self_similarity(pd_test_ctx *ctx)
             double Pi1[3];
             long impacts[3];
             for (int k = 0; k < 3; k++) {
-                pd_osc c = {.pulse = pulses[p], .dir = dir, .ap = scales[k][0], .Tp = scales[k][1], .Pi2 = 0.7, .Pi3 = 0.05, .eps = 0.6, .xi = 0.05};
+                pd_osc c = {.pulse = pulses[p],
+                            .dir = dir,
+                            .ap = scales[k][0],
+                            .Tp = scales[k][1],
+                            .Pi2 = 0.7,
+                            .Pi3 = 0.05,
+                            .eps = 0.6,
+                            .xi = 0.05};
                 pd_run_opts o = pd_run_default_opts();
                 pd_osc_result r;
                 pd_err e;
@@ -76,7 +90,8 @@ static void test_osc_self_similarity(pd_test_ctx *ctx)
                 Pi1[k] = r.umax / pd_osc_Le(&c);
                 impacts[k] = r.impacts;
             }
-            double spread = (fmax(Pi1[0], fmax(Pi1[1], Pi1[2])) - fmin(Pi1[0], fmin(Pi1[1], Pi1[2]))) / Pi1[0];
+            double spread =
+                (fmax(Pi1[0], fmax(Pi1[1], Pi1[2])) - fmin(Pi1[0], fmin(Pi1[1], Pi1[2]))) / Pi1[0];
             CHECK(ctx, spread <= 1e-12, "%s %s: Pi1 spread %.3g (%.17g %.17g %.17g)",
                   pd_pulse_name(pulses[p]), pd_dir_name(dir), spread, Pi1[0], Pi1[1], Pi1[2]);
             CHECK(ctx, impacts[0] == impacts[1] && impacts[1] == impacts[2] && impacts[0] > 0,
@@ -90,7 +105,14 @@ static void test_osc_self_similarity(pd_test_ctx *ctx)
  * Measured C = max(-min g / dt) over dt = Tp/500 ... Tp/4000. */
 static void test_osc_penetration_is_order_dt(pd_test_ctx *ctx)
 {
-    pd_osc c = {.pulse = PD_PULSE_COSINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5, .Pi3 = 0.02, .eps = 0.7, .xi = 0.05};
+    pd_osc c = {.pulse = PD_PULSE_COSINE,
+                .dir = 1,
+                .ap = 1.0,
+                .Tp = 1.0,
+                .Pi2 = 0.5,
+                .Pi3 = 0.02,
+                .eps = 0.7,
+                .xi = 0.05};
     double C = 0, vmax = 0;
     for (int k = 0; k < 4; k++) {
         pd_run_opts o = pd_run_default_opts();
@@ -148,7 +170,14 @@ static int track_rest(const pd_osc_sample *s, void *ctx)
 
 static void test_osc_persistent_contact(pd_test_ctx *ctx)
 {
-    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 3.0, .Tp = 0.8, .Pi2 = 0.3, .Pi3 = 0.05, .eps = 0.0, .xi = 0.05};
+    pd_osc c = {.pulse = PD_PULSE_SINE,
+                .dir = 1,
+                .ap = 3.0,
+                .Tp = 0.8,
+                .Pi2 = 0.3,
+                .Pi3 = 0.05,
+                .eps = 0.0,
+                .xi = 0.05};
     pd_run_opts o = pd_run_default_opts();
     pd_osc_result r;
     pd_err e;
@@ -196,7 +225,14 @@ static void test_osc_energy_across_impacts(pd_test_ctx *ctx)
 {
     const double eps[] = {0.0, 0.3, 0.7, 1.0};
     for (int k = 0; k < 4; k++) {
-        pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.6, .Pi3 = 0.02, .eps = eps[k], .xi = 0.0};
+        pd_osc c = {.pulse = PD_PULSE_SINE,
+                    .dir = 1,
+                    .ap = 1.0,
+                    .Tp = 1.0,
+                    .Pi2 = 0.6,
+                    .Pi3 = 0.02,
+                    .eps = eps[k],
+                    .xi = 0.0};
         pd_run_opts o = pd_run_default_opts();
         pd_osc_result r;
         pd_err e;
@@ -220,7 +256,14 @@ static void test_osc_energy_across_impacts(pd_test_ctx *ctx)
  * error O(dt) and falling with dt. */
 static void test_osc_first_impact(pd_test_ctx *ctx)
 {
-    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 2.0, .Tp = 0.5, .Pi2 = 0.8, .Pi3 = 0.3, .eps = 0.5, .xi = 0.05};
+    pd_osc c = {.pulse = PD_PULSE_SINE,
+                .dir = 1,
+                .ap = 2.0,
+                .Tp = 0.5,
+                .Pi2 = 0.8,
+                .Pi3 = 0.3,
+                .eps = 0.5,
+                .xi = 0.05};
     double t_star, v_star;
     CHECK(ctx, pd_osc_free_first_contact(&c, 2 * c.Tp, &t_star, &v_star) == PD_OK,
           "the free response must reach the gap");
@@ -261,7 +304,14 @@ static void test_osc_scalar_vs_general_kernel(pd_test_ctx *ctx)
 {
     enum { CAP = 8000 };
     static double ua[CAP], ub[CAP];
-    pd_osc c = {.pulse = PD_PULSE_COSINE, .dir = -1, .ap = 1.0, .Tp = 1.0, .Pi2 = 1.16, .Pi3 = 0.02, .eps = 0.2, .xi = 0.05};
+    pd_osc c = {.pulse = PD_PULSE_COSINE,
+                .dir = -1,
+                .ap = 1.0,
+                .Tp = 1.0,
+                .Pi2 = 1.16,
+                .Pi3 = 0.02,
+                .eps = 0.2,
+                .xi = 0.05};
     pd_run_opts o = pd_run_default_opts();
     pd_osc_result ra, rb;
     pd_err e;
@@ -310,8 +360,14 @@ static void test_osc_inline_run_matches_pd_mj(pd_test_ctx *ctx)
     };
     int failed = 0;
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
-        pd_osc c = {.pulse = cases[k].pulse, .dir = cases[k].dir, .ap = 1.0, .Tp = 1.0,
-                    .Pi2 = cases[k].Pi2, .Pi3 = cases[k].Pi3, .eps = cases[k].eps, .xi = 0.05};
+        pd_osc c = {.pulse = cases[k].pulse,
+                    .dir = cases[k].dir,
+                    .ap = 1.0,
+                    .Tp = 1.0,
+                    .Pi2 = cases[k].Pi2,
+                    .Pi3 = cases[k].Pi3,
+                    .eps = cases[k].eps,
+                    .xi = 0.05};
         pd_run_opts o = pd_run_default_opts();
         pd_osc_result ra, rb;
         pd_err ea, eb;
@@ -331,9 +387,10 @@ static void test_osc_inline_run_matches_pd_mj(pd_test_ctx *ctx)
         CHECK(ctx, sa == sb && !strcmp(ra.kernel, "scalar") && !strcmp(rb.kernel, "scalar"),
               "case %zu: status %d vs %d, kernels %s %s", k, sa, sb, ra.kernel, rb.kernel);
         ra.kernel = rb.kernel;
-        CHECK(ctx, !memcmp(&ra, &rb, sizeof ra), "case %zu: figures differ (umax %.17g vs "
-              "%.17g, impacts %ld vs %ld, steps %ld vs %ld)", k, ra.umax, rb.umax, ra.impacts,
-              rb.impacts, ra.steps, rb.steps);
+        CHECK(ctx, !memcmp(&ra, &rb, sizeof ra),
+              "case %zu: figures differ (umax %.17g vs "
+              "%.17g, impacts %ld vs %ld, steps %ld vs %ld)",
+              k, ra.umax, rb.umax, ra.impacts, rb.impacts, ra.steps, rb.steps);
         CHECK(ctx, sa == PD_OK ? samples == ra.steps + 1 : !strcmp(ea.msg, eb.msg),
               "case %zu: %ld samples for %ld steps; messages '%s' '%s'", k, samples, ra.steps,
               sa ? ea.msg : "", sa ? eb.msg : "");
@@ -344,7 +401,14 @@ static void test_osc_inline_run_matches_pd_mj(pd_test_ctx *ctx)
 /* Defaults a user expects: dt = min(Tp, T0)/2000, tend = Tp + 2 T0. */
 static void test_osc_defaults_and_checks(pd_test_ctx *ctx)
 {
-    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 0.3, .Pi2 = 0.1, .Pi3 = 0.4, .eps = 0.6, .xi = 0.05};
+    pd_osc c = {.pulse = PD_PULSE_SINE,
+                .dir = 1,
+                .ap = 1.0,
+                .Tp = 0.3,
+                .Pi2 = 0.1,
+                .Pi3 = 0.4,
+                .eps = 0.6,
+                .xi = 0.05};
     pd_osc_result r;
     pd_err e;
     CHECK_NEAR(ctx, pd_osc_default_dt(&c), 0.3 / 2000, 1e-18);

@@ -99,8 +99,8 @@ static int child_wait(child *c, proc_out *r, struct rusage *ru)
 }
 
 /* Run pound to the end. */
-static int run(const pd_test_ctx *ctx, const char *const *args, const child_opts *o,
-               proc_out *r, struct rusage *ru)
+static int run(const pd_test_ctx *ctx, const char *const *args, const child_opts *o, proc_out *r,
+               struct rusage *ru)
 {
     child c;
     if (child_start(ctx, args, o, &c)) {
@@ -217,8 +217,8 @@ static void test_outputs_full_disk_simulate(pd_test_ctx *ctx)
     static const struct {
         const char *name;
         long limit;
-    } cases[] = {{"x.h5", 2048}, {"x.h5", 1600000}, {"x.csv", 65536}, {"s.h5", 65536},
-                 {"s.csv", 65536}};
+    } cases[] = {
+        {"x.h5", 2048}, {"x.h5", 1600000}, {"x.csv", 65536}, {"s.h5", 65536}, {"s.csv", 65536}};
     char dir[64], out[128], scene[128], dump[128];
     if (!pd_test_have_pound(ctx) || scratch(ctx, "disk", dir, sizeof dir))
         return;
@@ -229,17 +229,16 @@ static void test_outputs_full_disk_simulate(pd_test_ctx *ctx)
         child_opts o = {.fsize = cases[k].limit};
         int is_scene = cases[k].name[0] == 's';
         in(dir, cases[k].name, out, sizeof out);
-        const char *osc[] = {"simulate", "--Tp", "0.3", "--T0", "3", "--ap", "4", "--gap",
-                             "0.004", "--eps", "0.6", "-o", out, NULL};
-        const char *sc[] = {"simulate", "--scene", scene, "--dt", "2e-5", "-o", out,
-                            "--dump-lcp", dump, NULL};
+        const char *osc[] = {"simulate", "--Tp",  "0.3",   "--T0", "3",  "--ap", "4",
+                             "--gap",    "0.004", "--eps", "0.6",  "-o", out,    NULL};
+        const char *sc[] = {"simulate", "--scene", scene,        "--dt", "2e-5",
+                            "-o",       out,       "--dump-lcp", dump,   NULL};
         if (is_scene && !CHECK(ctx, write_file(scene, two_sdof) == 0, "the scene file"))
             break;
         run(ctx, is_scene ? sc : osc, &o, &r, NULL);
         unlink(scene);
         expect_too_large(ctx, &r, cases[k].name, cases[k].limit,
-                         strstr(r.err, "File too large") && strstr(r.err, out) &&
-                             one_line(r.err),
+                         strstr(r.err, "File too large") && strstr(r.err, out) && one_line(r.err),
                          dir);
         next_case(&r, dir);
     }
@@ -259,11 +258,10 @@ static void test_outputs_full_disk_spectrum(pd_test_ctx *ctx)
         child_opts o = {.fsize = 4096};
         in(dir, names[k], out, sizeof out);
         snprintf(journal, sizeof journal, "%s.partial", out);
-        const char *args[] = {"spectrum", "--Pi2", "0.5:2:12", "--Pi3", "0.05,0.1", "-o", out,
-                              NULL};
+        const char *args[] = {"spectrum", "--Pi2", "0.5:2:12", "--Pi3",
+                              "0.05,0.1", "-o",    out,        NULL};
         run(ctx, args, &o, &r, NULL);
-        CHECK(ctx, r.status == 1, "%s: exit %d (128+11 is SIGSEGV): %s", names[k], r.status,
-              r.err);
+        CHECK(ctx, r.status == 1, "%s: exit %d (128+11 is SIGSEGV): %s", names[k], r.status, r.err);
         CHECK(ctx, r.err && strstr(r.err, "File too large") && one_line(r.err),
               "%s: one line with the reason: %s", names[k], r.err);
         CHECK(ctx, !exists(out) && exists(journal) && pd_test_dir_entries(dir) == 1,
@@ -327,9 +325,9 @@ static void test_outputs_memory_bounded(pd_test_ctx *ctx)
     for (int k = 0; k < 2; k++) {
         proc_out r;
         struct rusage ru;
-        const char *args[] = {"simulate", "--Tp", "0.3", "--T0", "3", "--ap", "4", "--gap",
-                              "0.004", "--eps", "0.6", "--dt", "1e-6", "--tend", tends[k],
-                              "-o", out, NULL};
+        const char *args[] = {"simulate", "--Tp",   "0.3",    "--T0",  "3",   "--ap",
+                              "4",        "--gap",  "0.004",  "--eps", "0.6", "--dt",
+                              "1e-6",     "--tend", tends[k], "-o",    out,   NULL};
         run(ctx, args, NULL, &r, &ru);
         rss[k] = ru.ru_maxrss; /* kB */
         CHECK(ctx, r.status == 0, "tend %s: exit %d: %s", tends[k], r.status, r.err);
@@ -370,8 +368,8 @@ static double *read_dataset(hid_t f, const char *name, long *n)
     if (ds < 0)
         return NULL;
     hid_t sp = H5Dget_space(ds);
-    if (sp >= 0 && H5Sget_simple_extent_ndims(sp) == 1 && H5Sget_simple_extent_dims(sp, dims, NULL) == 1 &&
-        (x = malloc((dims[0] + 1) * sizeof *x)) &&
+    if (sp >= 0 && H5Sget_simple_extent_ndims(sp) == 1 &&
+        H5Sget_simple_extent_dims(sp, dims, NULL) == 1 && (x = malloc((dims[0] + 1) * sizeof *x)) &&
         H5Dread(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, x) >= 0)
         *n = (long)dims[0];
     if (sp >= 0)
@@ -411,12 +409,13 @@ static void test_outputs_content_unchanged(pd_test_ctx *ctx)
         goto done;
     for (int f = 0; f < 2; f++) {
         proc_out r;
-        const char *args[] = {"simulate", "--ap", "4", "--Tp", "0.3", "--Pi2", "0.1", "--Pi3",
-                              "0.4", "--eps", "0.6", "--dt", "1e-4", "--tend", "2", "--every",
-                              "3", "-o", f ? csv : h5, NULL};
+        const char *args[] = {"simulate", "--ap", "4",     "--Tp",       "0.3",
+                              "--Pi2",    "0.1",  "--Pi3", "0.4",        "--eps",
+                              "0.6",      "--dt", "1e-4",  "--tend",     "2",
+                              "--every",  "3",    "-o",    f ? csv : h5, NULL};
         run(ctx, args, NULL, &r, NULL);
-        CHECK(ctx, r.status == 0 && r.err[0] == '\0', "%s: exit %d: %s", f ? "csv" : "h5",
-              r.status, r.err);
+        CHECK(ctx, r.status == 0 && r.err[0] == '\0', "%s: exit %d: %s", f ? "csv" : "h5", r.status,
+              r.err);
         pd_test_proc_free(&r);
     }
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
@@ -432,8 +431,9 @@ static void test_outputs_content_unchanged(pd_test_ctx *ctx)
         CHECK(ctx, x && bad == 0, "%s: %ld values differ from the run's samples", cols[j], bad);
         free(x);
     }
-    CHECK(ctx, pd_test_h5_num(file, "umax") == sum.r.umax && pd_test_h5_num(file, "every") == 3 &&
-                   pd_test_h5_num(file, "steps") == (double)sum.r.steps,
+    CHECK(ctx,
+          pd_test_h5_num(file, "umax") == sum.r.umax && pd_test_h5_num(file, "every") == 3 &&
+              pd_test_h5_num(file, "steps") == (double)sum.r.steps,
           "attributes umax %.17g (run %.17g), every, steps", pd_test_h5_num(file, "umax"),
           sum.r.umax);
     H5Fclose(file);
@@ -484,7 +484,6 @@ static void test_outputs_refuses_beyond_free_space(pd_test_ctx *ctx)
 
 /* ---- 4. signals and stale temporary files ------------------------------- */
 
-
 /* Wait up to 3 s until dir holds an entry starting with prefix: 1 or 0. */
 static int wait_for(const char *dir, const char *prefix)
 {
@@ -507,9 +506,9 @@ static void test_outputs_signal_leaves_no_temp(pd_test_ctx *ctx)
     in(dir, "x.h5", out, sizeof out);
     in(dir, "d.h5", dump, sizeof dump);
     for (int k = 0; k < 2; k++) {
-        const char *args[] = {"simulate", "--Tp", "0.3", "--T0", "3", "--ap", "4", "--gap",
-                              "0.004", "--eps", "0.6", "--dt", "1e-7", "--every", "100",
-                              "-o", out, "--dump-lcp", dump, NULL};
+        const char *args[] = {"simulate", "--Tp",  "0.3",   "--T0",       "3",    "--ap", "4",
+                              "--gap",    "0.004", "--eps", "0.6",        "--dt", "1e-7", "--every",
+                              "100",      "-o",    out,     "--dump-lcp", dump,   NULL};
         child c;
         proc_out r;
         if (!CHECK(ctx, child_start(ctx, args, NULL, &c) == 0, "fork"))
@@ -519,8 +518,7 @@ static void test_outputs_signal_leaves_no_temp(pd_test_ctx *ctx)
         kill(c.pid, sigs[k]);
         child_wait(&c, &r, NULL);
         CHECK(ctx, started, "signal %d: the temporary files never appeared", sigs[k]);
-        CHECK(ctx, r.status == 128 + sigs[k], "signal %d: status %d: %s", sigs[k], r.status,
-              r.err);
+        CHECK(ctx, r.status == 128 + sigs[k], "signal %d: status %d: %s", sigs[k], r.status, r.err);
         CHECK(ctx, pd_test_dir_entries(dir) == 0, "signal %d: %d files left", sigs[k],
               pd_test_dir_entries(dir));
         next_case(&r, dir);
@@ -642,8 +640,8 @@ static void test_outputs_missing_dir(pd_test_ctx *ctx)
         double t0 = now();
         run(ctx, k == 1 ? spec : sim, NULL, &r, NULL);
         snprintf(msg, sizeof msg, "pound: %s %s: %s\n", flags[k], paths[k], why[k]);
-        CHECK(ctx, r.status == 2 && now() - t0 < 1.5, "case %d: exit %d after %.2f s", k,
-              r.status, now() - t0);
+        CHECK(ctx, r.status == 2 && now() - t0 < 1.5, "case %d: exit %d after %.2f s", k, r.status,
+              now() - t0);
         CHECK(ctx, r.err && !strcmp(r.err, msg), "case %d: stderr '%s', expected '%s'", k,
               r.err ? r.err : "", msg);
         CHECK(ctx, r.out && r.out[0] == '\0', "case %d: stdout '%s'", k, r.out);
@@ -720,8 +718,9 @@ static void test_outputs_keeps_mode_and_link(pd_test_ctx *ctx)
     CHECK(ctx, stat(target, &st) == 0 && (st.st_mode & 07777) == 0640 && st.st_size > 100,
           "target.h5: mode %o, %ld bytes (expected 640, the new data)",
           (unsigned)(st.st_mode & 07777), (long)st.st_size);
-    CHECK(ctx, lstat(dangling, &st) == 0 && S_ISLNK(st.st_mode) && stat(newt, &st) == 0 &&
-                   st.st_size > 100,
+    CHECK(ctx,
+          lstat(dangling, &st) == 0 && S_ISLNK(st.st_mode) && stat(newt, &st) == 0 &&
+              st.st_size > 100,
           "dangling.csv: the link kept and new.csv written");
     CHECK(ctx, pd_test_dir_entries(dir) == 5, "%d files (expected 5)", pd_test_dir_entries(dir));
 done:
@@ -740,14 +739,15 @@ static void test_outputs_spectrum_bad_input_no_journal(pd_test_ctx *ctx)
         return;
     in(dir, "out.h5", out, sizeof out);
     const char *plain[] = {"spectrum", "--Pi2", "0.1:1:3", "--dt", "1e308", "-o", out, NULL};
-    const char *resume[] = {"spectrum", "--Pi2", "0.1:1:3", "--dt", "1e308", "-o", out,
-                            "--resume", NULL};
+    const char *resume[] = {"spectrum", "--Pi2", "0.1:1:3",  "--dt", "1e308",
+                            "-o",       out,     "--resume", NULL};
     const char *const *cases[] = {plain, plain, resume};
     for (int k = 0; k < 3; k++) {
         proc_out r;
         run(ctx, cases[k], NULL, &r, NULL);
-        CHECK(ctx, r.status == 2 && r.err && strstr(r.err, "dt") && !strstr(r.err, "interrupted") &&
-                       one_line(r.err),
+        CHECK(ctx,
+              r.status == 2 && r.err && strstr(r.err, "dt") && !strstr(r.err, "interrupted") &&
+                  one_line(r.err),
               "run %d: exit %d: %s", k, r.status, r.err);
         CHECK(ctx, pd_test_dir_entries(dir) == 0, "run %d: %d files left", k,
               pd_test_dir_entries(dir));
@@ -775,8 +775,8 @@ static void test_outputs_full_disk_converge(pd_test_ctx *ctx)
         const char *name;
         long limit;
         int fits;
-    } cases[] = {{"c.csv", 256, 0},  {"c.csv", 512, 0},  {"c.csv", 65536, 1},
-                 {"c.h5", 700, 0},   {"c.h5", 8192, 0},  {"c.h5", 65536, 1}};
+    } cases[] = {{"c.csv", 256, 0}, {"c.csv", 512, 0}, {"c.csv", 65536, 1},
+                 {"c.h5", 700, 0},  {"c.h5", 8192, 0}, {"c.h5", 65536, 1}};
     char dir[64], out[128];
     if (!pd_test_have_pound(ctx) || scratch(ctx, "cdisk", dir, sizeof dir))
         return;
@@ -790,8 +790,9 @@ static void test_outputs_full_disk_converge(pd_test_ctx *ctx)
         if (cases[k].fits) {
             CHECK(ctx, r.status == 0 && r.err[0] == '\0', "%s at %ld bytes: exit %d: %s",
                   cases[k].name, cases[k].limit, r.status, r.err);
-            CHECK(ctx, stat(out, &st) == 0 && st.st_size > 400 && st.st_size < cases[k].limit &&
-                           pd_test_dir_entries(dir) == 1,
+            CHECK(ctx,
+                  stat(out, &st) == 0 && st.st_size > 400 && st.st_size < cases[k].limit &&
+                      pd_test_dir_entries(dir) == 1,
                   "%s at %ld bytes: the whole file alone (%ld bytes)", cases[k].name,
                   cases[k].limit, (long)st.st_size);
         } else
@@ -818,8 +819,7 @@ static void test_outputs_full_disk_dump_keeps_old(pd_test_ctx *ctx)
         long limit = limits[k % 3];
         int had = k >= 3;
         child_opts o = {.fsize = limit};
-        const char *args[] = {"simulate", "--chain", "5", "--tend", "1", "--dump-lcp", dump,
-                              NULL};
+        const char *args[] = {"simulate", "--chain", "5", "--tend", "1", "--dump-lcp", dump, NULL};
         if (had && !CHECK(ctx, write_file(dump, old) == 0, "the old dump"))
             break;
         run(ctx, args, &o, &r, NULL);
@@ -828,8 +828,8 @@ static void test_outputs_full_disk_dump_keeps_old(pd_test_ctx *ctx)
               "%ld bytes%s: exit %d: '%s'", limit, had ? " (old d.h5)" : "", r.status, r.err);
         CHECK(ctx, pd_test_dir_entries(dir) == had && (!had || (text && !strcmp(text, old))),
               "%ld bytes%s: %d files, the old dump %s", limit, had ? " (old d.h5)" : "",
-              pd_test_dir_entries(dir), had ? (text && !strcmp(text, old) ? "kept" : "changed")
-                                            : "-");
+              pd_test_dir_entries(dir),
+              had ? (text && !strcmp(text, old) ? "kept" : "changed") : "-");
         free(text);
         next_case(&r, dir);
     }
@@ -860,10 +860,10 @@ static void test_outputs_same_file_refused(pd_test_ctx *ctx)
     in(dir, "w.h5", wlink, sizeof wlink);
     in(dir, "g.h5", glink, sizeof glink);
     in(dir, "s.json", scene, sizeof scene);
-    if (!CHECK(ctx, symlink("d2.h5", lnk) == 0 && write_file(e, "old\n") == 0 &&
-                        link(e, hard) == 0 && symlink("x.png", plink) == 0 &&
-                        symlink("x-work.png", wlink) == 0 && symlink("x-gamma.png", glink) == 0 &&
-                        write_file(scene, two_sdof) == 0,
+    if (!CHECK(ctx,
+               symlink("d2.h5", lnk) == 0 && write_file(e, "old\n") == 0 && link(e, hard) == 0 &&
+                   symlink("x.png", plink) == 0 && symlink("x-work.png", wlink) == 0 &&
+                   symlink("x-gamma.png", glink) == 0 && write_file(scene, two_sdof) == 0,
                "the links: %s", strerror(errno)))
         goto done;
     const int files = 7; /* link.h5, e.h5, hard.h5, p.h5, w.h5, g.h5, s.json */
@@ -882,25 +882,27 @@ static void test_outputs_same_file_refused(pd_test_ctx *ctx)
         {{"spectrum", "--Pi2", "0.5:1:2", "--plot", png, "-o", plink, NULL}, "-o", "--plot"},
         {{"spectrum", "--Pi2", "0.5:1:2", "--plot", png, "-o", glink, NULL}, "-o", "--plot"},
         {{"spectrum", "--scene", scene, "--Pi2", "0.5:1:2", "--plot", png, "-o", plink, NULL},
-         "-o", "--plot"}};
+         "-o",
+         "--plot"}};
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         proc_out r;
         run(ctx, cases[k].args, NULL, &r, NULL);
         CHECK(ctx, r.status == 2, "case %zu (%s): exit %d: %s", k, cases[k].args[0], r.status,
               r.err);
-        CHECK(ctx, one_line(r.err) && strstr(r.err, "name the same file") &&
-                       strstr(r.err, cases[k].f1) && strstr(r.err, cases[k].f2),
+        CHECK(ctx,
+              one_line(r.err) && strstr(r.err, "name the same file") &&
+                  strstr(r.err, cases[k].f1) && strstr(r.err, cases[k].f2),
               "case %zu (%s): stderr '%s'", k, cases[k].args[0], r.err);
-        CHECK(ctx, r.out[0] == '\0' && pd_test_dir_entries(dir) == files && !exists(d2) &&
-                       !exists(png),
-              "case %zu (%s): %d entries (expected the %d made by the test)", k,
-              cases[k].args[0], pd_test_dir_entries(dir), files);
+        CHECK(ctx,
+              r.out[0] == '\0' && pd_test_dir_entries(dir) == files && !exists(d2) && !exists(png),
+              "case %zu (%s): %d entries (expected the %d made by the test)", k, cases[k].args[0],
+              pd_test_dir_entries(dir), files);
         pd_test_proc_free(&r);
     }
     /* distinct files still run */
     proc_out r;
-    const char *ok[] = {"simulate", "--chain", "3", "--tend", "0.5", "--dump-lcp", d2, "-o",
-                        e, NULL};
+    const char *ok[] = {"simulate",   "--chain", "3",  "--tend", "0.5",
+                        "--dump-lcp", d2,        "-o", e,        NULL};
     run(ctx, ok, NULL, &r, NULL);
     CHECK(ctx, r.status == 0 && exists(d2), "-o e.h5 --dump-lcp d2.h5: exit %d: %s", r.status,
           r.err);
@@ -933,8 +935,9 @@ static void test_outputs_converge_method_text(pd_test_ctx *ctx)
     in(dir, "c.h5", h5, sizeof h5);
     for (int f = 0; f < 2; f++) {
         proc_out r;
-        const char *args[] = {"converge", "--dt", "1e-2:1e-3:2", "--methods", "moreau,penalty",
-                              "--kcs", "1e2", "-o", f ? h5 : csv, "--json", NULL};
+        const char *args[] = {"converge",       "--dt",   "1e-2:1e-3:2", "--methods",
+                              "moreau,penalty", "--kcs",  "1e2",         "-o",
+                              f ? h5 : csv,     "--json", NULL};
         run(ctx, args, NULL, &r, NULL);
         CHECK(ctx, r.status == 0, "%s: exit %d: %s", f ? "h5" : "csv", r.status, r.err);
         pd_test_json_str(r.out, "method", 0, name, sizeof name);
@@ -960,8 +963,7 @@ static void test_outputs_converge_method_text(pd_test_ctx *ctx)
         h5_text_attr(ds, "codes", codes, sizeof codes);
     CHECK(ctx, ds >= 0 && strstr(codes, "0 = moreau") && strstr(codes, "2 = penalty"),
           "h5: method's codes attribute '%s'", ds >= 0 ? codes : "(no dataset)");
-    CHECK(ctx, x && n == 3 && x[0] == 0 && x[1] == 0 && x[2] == 2, "h5: method codes %ld rows",
-          n);
+    CHECK(ctx, x && n == 3 && x[0] == 0 && x[1] == 0 && x[2] == 2, "h5: method codes %ld rows", n);
     free(x);
     if (ds >= 0)
         H5Dclose(ds);
@@ -1002,7 +1004,8 @@ static void test_outputs_provenance(pd_test_ctx *ctx)
     in(dir, "s.h5", spec, sizeof spec);
     for (int f = 0; f < 2; f++) {
         proc_out r;
-        const char *args[] = {"simulate", "--tend", "0.5", "--every", "10", "-o", f ? csv : h5, NULL};
+        const char *args[] = {"simulate", "--tend", "0.5",        "--every",
+                              "10",       "-o",     f ? csv : h5, NULL};
         run(ctx, args, NULL, &r, NULL);
         CHECK(ctx, r.status == 0, "simulate -o %s: exit %d: %s", f ? "csv" : "h5", r.status, r.err);
         pd_test_proc_free(&r);
@@ -1012,11 +1015,13 @@ static void test_outputs_provenance(pd_test_ctx *ctx)
     if (CHECK(ctx, file >= 0, "cannot open %s", h5)) {
         h5_text_attr(file, "format", buf, sizeof buf);
         CHECK(ctx, !strcmp(buf, "pound simulate oscillator 1"), "format '%s'", buf);
-        snprintf(want, sizeof want, "pound simulate --tend 0.5 --every 10 -o '%s/it'\"'\"'s.h5'", dir);
+        snprintf(want, sizeof want, "pound simulate --tend 0.5 --every 10 -o '%s/it'\"'\"'s.h5'",
+                 dir);
         h5_text_attr(file, "command", buf, sizeof buf);
         CHECK(ctx, !strcmp(buf, want), "command '%s', expected '%s'", buf, want);
         h5_text_attr(file, "pound_version", buf, sizeof buf);
-        CHECK(ctx, !strcmp(buf, pd_version()), "pound_version '%s', expected '%s'", buf, pd_version());
+        CHECK(ctx, !strcmp(buf, pd_version()), "pound_version '%s', expected '%s'", buf,
+              pd_version());
         h5_text_attr(file, "created", buf, sizeof buf);
         CHECK(ctx, iso_utc(buf), "created '%s' is not YYYY-MM-DDTHH:MM:SSZ", buf);
         for (int j = 0; j < 5; j++) {
@@ -1031,11 +1036,13 @@ static void test_outputs_provenance(pd_test_ctx *ctx)
         H5Fclose(file);
     }
     char *text = pd_test_slurp(csv);
-    snprintf(want, sizeof want,
-             "# format = pound simulate oscillator 1\n# command = pound simulate --tend 0.5 --every "
-             "10 -o %s\n# pound_version = %s\n# created = ",
-             csv, pd_version());
-    CHECK(ctx, text && !strncmp(text, want, strlen(want)) && iso_utc(strtok(text + strlen(want), "\n")),
+    snprintf(
+        want, sizeof want,
+        "# format = pound simulate oscillator 1\n# command = pound simulate --tend 0.5 --every "
+        "10 -o %s\n# pound_version = %s\n# created = ",
+        csv, pd_version());
+    CHECK(ctx,
+          text && !strncmp(text, want, strlen(want)) && iso_utc(strtok(text + strlen(want), "\n")),
           "csv: the first lines are not the provenance: '%.200s'", text ? text : "(none)");
     free(text);
     text = pd_test_slurp(csv);
@@ -1081,8 +1088,9 @@ static void test_outputs_fifos_refused(pd_test_ctx *ctx)
         proc_out r;
         struct stat st;
         run(ctx, cases[k], NULL, &r, NULL);
-        CHECK(ctx, r.status == 2 && one_line(r.err) && strstr(r.err, "not a regular file (a FIFO)") &&
-                       stat(f[k], &st) == 0 && S_ISFIFO(st.st_mode),
+        CHECK(ctx,
+              r.status == 2 && one_line(r.err) && strstr(r.err, "not a regular file (a FIFO)") &&
+                  stat(f[k], &st) == 0 && S_ISFIFO(st.st_mode),
               "%s: exit %d, %s", names[k], r.status, r.err);
         pd_test_proc_free(&r);
     }
@@ -1114,13 +1122,13 @@ static void test_outputs_h5_groups_bounded(pd_test_ctx *ctx)
     const char *ac[] = {"simulate", "--scene", path, "-o", csv, NULL};
     proc_out r;
     run(ctx, a5, NULL, &r, NULL);
-    CHECK(ctx, r.status == 2 && one_line(r.err) && strstr(r.err, "-o ") &&
-                   strstr(r.err, "5001 structures") && pd_test_dir_entries(dir) == 1,
+    CHECK(ctx,
+          r.status == 2 && one_line(r.err) && strstr(r.err, "-o ") &&
+              strstr(r.err, "5001 structures") && pd_test_dir_entries(dir) == 1,
           "HDF5: exit %d, %s, %d entries", r.status, r.err, pd_test_dir_entries(dir));
     pd_test_proc_free(&r);
     run(ctx, ac, NULL, &r, NULL);
-    CHECK(ctx, r.status == 0 && pd_test_dir_entries(dir) == 2, "CSV: exit %d, %s", r.status,
-          r.err);
+    CHECK(ctx, r.status == 0 && pd_test_dir_entries(dir) == 2, "CSV: exit %d, %s", r.status, r.err);
     pd_test_proc_free(&r);
 done:
     pd_test_rm_dir(dir);

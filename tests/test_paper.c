@@ -11,7 +11,14 @@
 /* Pi1 of a case by the exact reference (with or without the wall). */
 static double ref_Pi1(pd_pulse pulse, int dir, double Pi2, double Pi3, double eps, int no_wall)
 {
-    pd_osc c = {.pulse = pulse, .dir = dir, .ap = 1.0, .Tp = 1.0, .Pi2 = Pi2, .Pi3 = Pi3, .eps = eps, .xi = 0.05};
+    pd_osc c = {.pulse = pulse,
+                .dir = dir,
+                .ap = 1.0,
+                .Tp = 1.0,
+                .Pi2 = Pi2,
+                .Pi3 = Pi3,
+                .eps = eps,
+                .xi = 0.05};
     pd_run_opts o = pd_run_default_opts();
     pd_osc_result r;
     pd_err e;
@@ -48,8 +55,22 @@ static void test_paper_fig3_one_dimensionless_history(pd_test_ctx *ctx)
     enum { CAP = 20000 };
     static double xa[CAP], xb[CAP];
     /* Pi2 = Tp / T0 = 0.6: Tp = 0.3 s for T0 = 0.5 s, 0.9 s for T0 = 1.5 s */
-    pd_osc a = {.pulse = PD_PULSE_COSINE, .dir = 1, .ap = 3.0, .Tp = 0.3, .Pi2 = 0.6, .Pi3 = 0.2, .eps = 0.7, .xi = 0.05};
-    pd_osc b = {.pulse = PD_PULSE_COSINE, .dir = 1, .ap = 5.0, .Tp = 0.9, .Pi2 = 0.6, .Pi3 = 0.2, .eps = 0.7, .xi = 0.05};
+    pd_osc a = {.pulse = PD_PULSE_COSINE,
+                .dir = 1,
+                .ap = 3.0,
+                .Tp = 0.3,
+                .Pi2 = 0.6,
+                .Pi3 = 0.2,
+                .eps = 0.7,
+                .xi = 0.05};
+    pd_osc b = {.pulse = PD_PULSE_COSINE,
+                .dir = 1,
+                .ap = 5.0,
+                .Tp = 0.9,
+                .Pi2 = 0.6,
+                .Pi3 = 0.2,
+                .eps = 0.7,
+                .xi = 0.05};
     pd_run_opts o = pd_run_default_opts();
     pd_osc_result ra, rb;
     pd_err e;
@@ -78,9 +99,14 @@ static void test_paper_fig3_one_dimensionless_history(pd_test_ctx *ctx)
  * cosine reverse in [0.15, 0.65]. */
 static void test_paper_pi3_insensitivity(pd_test_ctx *ctx)
 {
-    const struct { pd_pulse p; int dir; double lo, hi; } ranges[] = {
-        {PD_PULSE_SINE, -1, 0.05, 5.0}, {PD_PULSE_SINE, 1, 0.05, 2.5},
-        {PD_PULSE_COSINE, 1, 0.05, 2.5}, {PD_PULSE_COSINE, -1, 0.15, 0.65}};
+    const struct {
+        pd_pulse p;
+        int dir;
+        double lo, hi;
+    } ranges[] = {{PD_PULSE_SINE, -1, 0.05, 5.0},
+                  {PD_PULSE_SINE, 1, 0.05, 2.5},
+                  {PD_PULSE_COSINE, 1, 0.05, 2.5},
+                  {PD_PULSE_COSINE, -1, 0.15, 0.65}};
     for (int k = 0; k < 4; k++)
         for (int i = 0; i < 16; i++) {
             double Pi2 = log_point(ranges[k].lo, ranges[k].hi, i, 16), v[3];
@@ -104,15 +130,17 @@ static void test_paper_three_regions(pd_test_ctx *ctx)
             for (int i = 0; i < 24; i++) {
                 pd_pulse pulse = p ? PD_PULSE_COSINE : PD_PULSE_SINE;
                 double Pi2 = log_point(0.05, 10.0, i, 24);
-                double g = ref_Pi1(pulse, dir, Pi2, 0.05, 0.5, 0) / ref_Pi1(pulse, dir, Pi2, 0.05, 0.5, 1);
+                double g =
+                    ref_Pi1(pulse, dir, Pi2, 0.05, 0.5, 0) / ref_Pi1(pulse, dir, Pi2, 0.05, 0.5, 1);
                 if (Pi2 < 0.35 && dir > 0)
-                    CHECK(ctx, g > 1, "%s normal Pi2 %.3g: gamma %.3f", pd_pulse_name(pulse), Pi2, g);
+                    CHECK(ctx, g > 1, "%s normal Pi2 %.3g: gamma %.3f", pd_pulse_name(pulse), Pi2,
+                          g);
                 if (Pi2 >= 0.65 && Pi2 <= 1.9)
                     CHECK(ctx, g < 1, "%s %s Pi2 %.3g: gamma %.3f", pd_pulse_name(pulse),
                           pd_dir_name(dir), Pi2, g);
                 if (Pi2 >= 4 && pulse == PD_PULSE_SINE)
-                    CHECK(ctx, fabs(g - 1) < 0.1, "sine %s Pi2 %.3g: gamma %.3f",
-                          pd_dir_name(dir), Pi2, g);
+                    CHECK(ctx, fabs(g - 1) < 0.1, "sine %s Pi2 %.3g: gamma %.3f", pd_dir_name(dir),
+                          Pi2, g);
             }
 }
 
@@ -124,8 +152,8 @@ static void test_paper_fig11_smaller_eps_larger_response(pd_test_ctx *ctx)
     for (int k = 0; k < 5; k++) {
         double lo = ref_Pi1(PD_PULSE_COSINE, -1, 1.16, holds[k], 0.2, 0);
         double hi = ref_Pi1(PD_PULSE_COSINE, -1, 1.16, holds[k], 1.0, 0);
-        CHECK(ctx, lo > 1.05 * hi, "Pi3 %g: Pi1(eps 0.2) = %.4f vs Pi1(eps 1) = %.4f", holds[k],
-              lo, hi);
+        CHECK(ctx, lo > 1.05 * hi, "Pi3 %g: Pi1(eps 0.2) = %.4f vs Pi1(eps 1) = %.4f", holds[k], lo,
+              hi);
     }
     for (int k = 0; k < 4; k++) { /* the exception, as measured */
         double lo = ref_Pi1(PD_PULSE_COSINE, -1, 1.16, fails[k], 0.2, 0);

@@ -65,7 +65,14 @@ static void test_penalty_free_flight_exact(pd_test_ctx *ctx)
     const pd_pulse pulses[] = {PD_PULSE_SINE, PD_PULSE_COSINE, PD_PULSE_HARMONIC};
     for (int p = 0; p < 3; p++)
         for (int k = 0; k < 2; k++) {
-            pd_osc c = {.pulse = pulses[p], .dir = k ? -1 : 1, .ap = 2.0, .Tp = 0.5, .Pi2 = k ? 3.0 : 0.3, .Pi3 = 0.0, .eps = 0.5, .xi = 0.05};
+            pd_osc c = {.pulse = pulses[p],
+                        .dir = k ? -1 : 1,
+                        .ap = 2.0,
+                        .Tp = 0.5,
+                        .Pi2 = k ? 3.0 : 0.3,
+                        .Pi3 = 0.0,
+                        .eps = 0.5,
+                        .xi = 0.05};
             pd_run_opts o = pd_run_default_opts();
             pd_osc_result r, r2;
             pd_err e;
@@ -74,8 +81,7 @@ static void test_penalty_free_flight_exact(pd_test_ctx *ctx)
             if (pulses[p] == PD_PULSE_HARMONIC)
                 o.tend = 12 * c.Tp;
             free_track ft = {&c, o.dt, 0, 0, 0, 0};
-            CHECK(ctx, pd_osc_penalty(&c, &o, track_free, &ft, &r, &e) == PD_OK, "%s",
-                  e.msg);
+            CHECK(ctx, pd_osc_penalty(&c, &o, track_free, &ft, &r, &e) == PD_OK, "%s", e.msg);
             CHECK(ctx, pd_osc_penalty(&c, &o, NULL, NULL, &r2, &e) == PD_OK, "%s", e.msg);
             const char *name = pd_pulse_name(pulses[p]);
             CHECK(ctx, ft.worst <= 1e-8 * ft.umax, "%s Pi2 %g: history error %.3g (umax %.3g)",
@@ -144,7 +150,16 @@ static void test_penalty_breakpoint_not_crossed(pd_test_ctx *ctx)
 {
     double M = 1.0, C = 2 * 0.02 * 0.7, K = 0.7 * 0.7, brk = TWO_PI;
     cos_scene cs = {0, 0, 0, 0};
-    pd_model md = {.n = 1, .m = 0, .M = pd_matrix_dense(1, 1, &M), .C = pd_matrix_dense(1, 1, &C), .K = pd_matrix_dense(1, 1, &K), .W = pd_matrix_dense(1, 0, NULL), .force = cos_force, .force_ctx = &cs, .breaks = &brk, .nbreaks = 1};
+    pd_model md = {.n = 1,
+                   .m = 0,
+                   .M = pd_matrix_dense(1, 1, &M),
+                   .C = pd_matrix_dense(1, 1, &C),
+                   .K = pd_matrix_dense(1, 1, &K),
+                   .W = pd_matrix_dense(1, 0, NULL),
+                   .force = cos_force,
+                   .force_ctx = &cs,
+                   .breaks = &brk,
+                   .nbreaks = 1};
     pd_sdof osc = {0.7, 0.02};
     hit_track ht = {0, 0, &osc};
     pd_penalty_opts o;
@@ -152,8 +167,8 @@ static void test_penalty_breakpoint_not_crossed(pd_test_ctx *ctx)
     pd_err e;
     o = pd_penalty_default_opts();
     o.kc = 1.0;
-    CHECK(ctx, pd_penalty_run(&md, 0.0, NULL, NULL, 5 * TWO_PI, &o, track_break, &ht, &res, &e) ==
-                   PD_OK,
+    CHECK(ctx,
+          pd_penalty_run(&md, 0.0, NULL, NULL, 5 * TWO_PI, &o, track_break, &ht, &res, &e) == PD_OK,
           "%s", e.msg);
     CHECK(ctx, ht.hit_break, "no accepted step ends at tau = 2 pi");
     CHECK(ctx, !cs.crossed, "F evaluated before 2 pi after an evaluation past it");
@@ -167,15 +182,30 @@ static void test_penalty_breakpoint_not_crossed(pd_test_ctx *ctx)
  * is root-found, so time and speed match the closed form. */
 static void test_penalty_first_impact_exact(pd_test_ctx *ctx)
 {
-    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 2.0, .Tp = 0.5, .Pi2 = 0.8, .Pi3 = 0.3, .eps = 0.5, .xi = 0.05};
+    pd_osc c = {.pulse = PD_PULSE_SINE,
+                .dir = 1,
+                .ap = 2.0,
+                .Tp = 0.5,
+                .Pi2 = 0.8,
+                .Pi3 = 0.3,
+                .eps = 0.5,
+                .xi = 0.05};
     double t_star, v_star;
     CHECK(ctx, pd_osc_free_first_contact(&c, 2 * c.Tp, &t_star, &v_star) == PD_OK,
           "the free response must reach the gap");
     for (int law = 0; law < 2; law++) {
-        pd_penalty_setup po = {.law = (pd_penalty_law)law, .kc_mult = 1e4, .kc_abs = 0, .rtol = 0, .atol = 0, .stepper = NULL};
+        pd_penalty_setup po = {.law = (pd_penalty_law)law,
+                               .kc_mult = 1e4,
+                               .kc_abs = 0,
+                               .rtol = 0,
+                               .atol = 0,
+                               .stepper = NULL};
         pd_osc_result r;
         pd_err e;
-        CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg);
+        CHECK(ctx,
+              pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r,
+                             &e) == PD_OK,
+              "%s", e.msg);
         CHECK(ctx, fabs(r.first_impact - t_star) <= 1e-9 * c.Tp,
               "law %d: first impact %.15g s vs exact %.15g s", law, r.first_impact, t_star);
         CHECK(ctx, fabs(r.first_impact_velocity - v_star) <= 1e-8 * v_star,
@@ -213,14 +243,21 @@ static int free_mass_impact(pd_penalty_law law, double e, double kc, episode *ep
                             pd_penalty_result *res, pd_err *err)
 {
     double M = 1.0, Z = 0.0, W = -1.0, g0 = 0.01, v0 = 1.0;
-    pd_model md = {.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, &M), .C = pd_matrix_dense(1, 1, &Z), .K = pd_matrix_dense(1, 1, &Z), .W = pd_matrix_dense(1, 1, &W), .g0 = &g0, .e = &e};
+    pd_model md = {.n = 1,
+                   .m = 1,
+                   .M = pd_matrix_dense(1, 1, &M),
+                   .C = pd_matrix_dense(1, 1, &Z),
+                   .K = pd_matrix_dense(1, 1, &Z),
+                   .W = pd_matrix_dense(1, 1, &W),
+                   .g0 = &g0,
+                   .e = &e};
     pd_penalty_opts o;
     o = pd_penalty_default_opts();
     memset(ep, 0, sizeof *ep);
     o.law = law;
     o.kc = kc;
-    return pd_penalty_run(&md, 0.0, NULL, &v0, 0.01 + 40.0 / sqrt(kc), &o, track_episode, ep,
-                          res, err);
+    return pd_penalty_run(&md, 0.0, NULL, &v0, 0.01 + 40.0 / sqrt(kc), &o, track_episode, ep, res,
+                          err);
 }
 
 /* Kelvin-Voigt (not clipped) with zeta = -ln e / sqrt(pi^2 + ln^2 e): the
@@ -265,8 +302,9 @@ static void test_penalty_hertz_restitution(pd_test_ctx *ctx)
             episode ep;
             pd_penalty_result res;
             pd_err err;
-            CHECK(ctx, free_mass_impact(PD_PENALTY_HERTZDAMP, es[k], j ? 1e8 : 1e4, &ep, &res,
-                                        &err) == PD_OK,
+            CHECK(ctx,
+                  free_mass_impact(PD_PENALTY_HERTZDAMP, es[k], j ? 1e8 : 1e4, &ep, &res, &err) ==
+                      PD_OK,
                   "%s", err.msg);
             e_meas[j] = -ep.v_out / ep.v_in;
         }
@@ -286,7 +324,14 @@ static void test_penalty_hertz_restitution(pd_test_ctx *ctx)
  * accepted steps grow (stiffer contacts need shorter steps). */
 static void test_penalty_converges_as_kc_grows(pd_test_ctx *ctx)
 {
-    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5, .Pi3 = 0.05, .eps = 0.6, .xi = 0.05};
+    pd_osc c = {.pulse = PD_PULSE_SINE,
+                .dir = 1,
+                .ap = 1.0,
+                .Tp = 1.0,
+                .Pi2 = 0.5,
+                .Pi3 = 0.05,
+                .eps = 0.6,
+                .xi = 0.05};
     pd_run_opts o = pd_run_default_opts();
     pd_osc_result ref;
     pd_err e;
@@ -296,9 +341,17 @@ static void test_penalty_converges_as_kc_grows(pd_test_ctx *ctx)
         double err[3];
         long steps[3], impacts[3];
         for (int k = 0; k < 3; k++) {
-            pd_penalty_setup po = {.law = (pd_penalty_law)law, .kc_mult = pow(10.0, 2 + 2 * k), .kc_abs = 0, .rtol = 0, .atol = 0, .stepper = NULL};
+            pd_penalty_setup po = {.law = (pd_penalty_law)law,
+                                   .kc_mult = pow(10.0, 2 + 2 * k),
+                                   .kc_abs = 0,
+                                   .rtol = 0,
+                                   .atol = 0,
+                                   .stepper = NULL};
             pd_osc_result r;
-            CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg);
+            CHECK(ctx,
+                  pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r,
+                                 &e) == PD_OK,
+                  "%s", e.msg);
             err[k] = fabs(r.umax - ref.umax) / ref.umax;
             steps[k] = r.steps;
             impacts[k] = r.impacts;
@@ -312,8 +365,8 @@ static void test_penalty_converges_as_kc_grows(pd_test_ctx *ctx)
         CHECK(ctx, steps[0] < steps[1] && steps[1] < steps[2],
               "law %d: steps %ld, %ld, %ld must grow with kc", law, steps[0], steps[1], steps[2]);
         CHECK(ctx, impacts[0] <= impacts[1] && impacts[1] <= impacts[2],
-              "law %d: impacts %ld, %ld, %ld (more of the accumulation resolved)", law,
-              impacts[0], impacts[1], impacts[2]);
+              "law %d: impacts %ld, %ld, %ld (more of the accumulation resolved)", law, impacts[0],
+              impacts[1], impacts[2]);
     }
 }
 
@@ -324,18 +377,33 @@ static void test_penalty_converges_as_kc_grows(pd_test_ctx *ctx)
  * the same answer. */
 static void test_penalty_stiffness_cost(pd_test_ctx *ctx)
 {
-    pd_osc c = {.pulse = PD_PULSE_HARMONIC, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 2.0, .Pi3 = 0.1, .eps = 0.0, .xi = 0.02};
+    pd_osc c = {.pulse = PD_PULSE_HARMONIC,
+                .dir = 1,
+                .ap = 1.0,
+                .Tp = 1.0,
+                .Pi2 = 2.0,
+                .Pi3 = 0.1,
+                .eps = 0.0,
+                .xi = 0.02};
     const char *names[] = {"rk8pd", "rk4imp"};
     long steps[2][2];
     double umax[2][2];
     for (int s = 0; s < 2; s++)
         for (int k = 0; k < 2; k++) {
             pd_run_opts o = pd_run_default_opts();
-            pd_penalty_setup po = {.law = PD_PENALTY_KELVIN, .kc_mult = k ? 1e7 : 1e4, .kc_abs = 0, .rtol = 0, .atol = 0, .stepper = names[s]};
+            pd_penalty_setup po = {.law = PD_PENALTY_KELVIN,
+                                   .kc_mult = k ? 1e7 : 1e4,
+                                   .kc_abs = 0,
+                                   .rtol = 0,
+                                   .atol = 0,
+                                   .stepper = names[s]};
             pd_osc_result r;
             pd_err e;
             o.tend = 4 * c.Tp;
-            CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(&o, &po)}, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg);
+            CHECK(ctx,
+                  pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(&o, &po)}, NULL, NULL, &r,
+                                 &e) == PD_OK,
+                  "%s", e.msg);
             CHECK(ctx, r.contact_time > 0.25 * o.tend, "%s: in contact %.3g of %.3g s", names[s],
                   r.contact_time, o.tend);
             steps[s][k] = r.steps;
@@ -345,8 +413,8 @@ static void test_penalty_stiffness_cost(pd_test_ctx *ctx)
     double grow_implicit = (double)steps[1][1] / steps[1][0];
     CHECK(ctx, grow_explicit > 5.0, "rk8pd steps %ld -> %ld (x %.2f) for kc x 1000", steps[0][0],
           steps[0][1], grow_explicit);
-    CHECK(ctx, grow_implicit < 1.5, "rk4imp steps %ld -> %ld (x %.2f) for kc x 1000",
-          steps[1][0], steps[1][1], grow_implicit);
+    CHECK(ctx, grow_implicit < 1.5, "rk4imp steps %ld -> %ld (x %.2f) for kc x 1000", steps[1][0],
+          steps[1][1], grow_implicit);
     for (int k = 0; k < 2; k++)
         CHECK(ctx, fabs(umax[1][k] - umax[0][k]) <= 1e-7 * umax[0][k],
               "kc %d: umax rk4imp %.12g vs rk8pd %.12g", k, umax[1][k], umax[0][k]);
@@ -359,20 +427,35 @@ static void test_penalty_stiffness_cost(pd_test_ctx *ctx)
  * pounding case; exactly for the free mass). */
 static void test_penalty_penetration_scaling(pd_test_ctx *ctx)
 {
-    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5, .Pi3 = 0.05, .eps = 0.6, .xi = 0.05};
+    pd_osc c = {.pulse = PD_PULSE_SINE,
+                .dir = 1,
+                .ap = 1.0,
+                .Tp = 1.0,
+                .Pi2 = 0.5,
+                .Pi3 = 0.05,
+                .eps = 0.6,
+                .xi = 0.05};
     const double expect[] = {10.0, pow(100.0, 0.4)};
     for (int law = 0; law < 2; law++) {
         double pen[2], pen_free[2];
         for (int k = 0; k < 2; k++) {
-            pd_penalty_setup po = {.law = (pd_penalty_law)law, .kc_mult = k ? 1e6 : 1e4, .kc_abs = 0, .rtol = 0, .atol = 0, .stepper = NULL};
+            pd_penalty_setup po = {.law = (pd_penalty_law)law,
+                                   .kc_mult = k ? 1e6 : 1e4,
+                                   .kc_abs = 0,
+                                   .rtol = 0,
+                                   .atol = 0,
+                                   .stepper = NULL};
             pd_osc_result r;
             pd_penalty_result res;
             episode ep;
             pd_err e;
-            CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg);
+            CHECK(ctx,
+                  pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r,
+                                 &e) == PD_OK,
+                  "%s", e.msg);
             pen[k] = -r.min_gap;
-            CHECK(ctx, free_mass_impact((pd_penalty_law)law, 0.6, k ? 1e6 : 1e4, &ep, &res, &e) ==
-                           PD_OK,
+            CHECK(ctx,
+                  free_mass_impact((pd_penalty_law)law, 0.6, k ? 1e6 : 1e4, &ep, &res, &e) == PD_OK,
                   "%s", e.msg);
             pen_free[k] = -res.min_gap;
         }
@@ -395,21 +478,39 @@ static void test_penalty_self_similar_and_kc_abs(pd_test_ctx *ctx)
     for (int law = 0; law < 2; law++) {
         double Pi1[3], Pi1_abs[3];
         for (int k = 0; k < 3; k++) {
-            pd_osc c = {.pulse = PD_PULSE_COSINE, .dir = -1, .ap = scales[k][0], .Tp = scales[k][1], .Pi2 = 0.7, .Pi3 = 0.05, .eps = 0.6, .xi = 0.05};
+            pd_osc c = {.pulse = PD_PULSE_COSINE,
+                        .dir = -1,
+                        .ap = scales[k][0],
+                        .Tp = scales[k][1],
+                        .Pi2 = 0.7,
+                        .Pi3 = 0.05,
+                        .eps = 0.6,
+                        .xi = 0.05};
             double w0 = TWO_PI / pd_osc_T0(&c);
-            pd_penalty_setup po = {.law = (pd_penalty_law)law, .kc_mult = 1e4, .kc_abs = 0, .rtol = 0, .atol = 0, .stepper = NULL};
+            pd_penalty_setup po = {.law = (pd_penalty_law)law,
+                                   .kc_mult = 1e4,
+                                   .kc_abs = 0,
+                                   .rtol = 0,
+                                   .atol = 0,
+                                   .stepper = NULL};
             pd_osc_result r;
             pd_err e;
-            CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg);
+            CHECK(ctx,
+                  pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r,
+                                 &e) == PD_OK,
+                  "%s", e.msg);
             Pi1[k] = r.umax / pd_osc_Le(&c);
             po.kc_abs = law ? 1e4 * w0 * w0 / sqrt(pd_osc_Le(&c)) : 1e4 * w0 * w0;
-            CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg);
+            CHECK(ctx,
+                  pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r,
+                                 &e) == PD_OK,
+                  "%s", e.msg);
             Pi1_abs[k] = r.umax / pd_osc_Le(&c);
             CHECK(ctx, r.impacts > 0, "impacts %ld", r.impacts);
         }
         for (int k = 1; k < 3; k++) {
-            CHECK(ctx, fabs(Pi1[k] - Pi1[0]) <= 1e-12 * Pi1[0], "law %d scale %d: Pi1 %.17g vs %.17g",
-                  law, k, Pi1[k], Pi1[0]);
+            CHECK(ctx, fabs(Pi1[k] - Pi1[0]) <= 1e-12 * Pi1[0],
+                  "law %d scale %d: Pi1 %.17g vs %.17g", law, k, Pi1[k], Pi1[0]);
             CHECK(ctx, fabs(Pi1_abs[k] - Pi1[0]) <= 1e-8 * Pi1[0],
                   "law %d scale %d: kc_abs gives Pi1 %.17g vs %.17g", law, k, Pi1_abs[k], Pi1[0]);
         }
@@ -421,24 +522,38 @@ static void test_penalty_self_similar_and_kc_abs(pd_test_ctx *ctx)
 static void test_penalty_steppers_agree(pd_test_ctx *ctx)
 {
     const char *names[] = {"rk8pd", "rkf45", "rk4imp", "msbdf"};
-    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5, .Pi3 = 0.05, .eps = 0.6, .xi = 0.05};
+    pd_osc c = {.pulse = PD_PULSE_SINE,
+                .dir = 1,
+                .ap = 1.0,
+                .Tp = 1.0,
+                .Pi2 = 0.5,
+                .Pi3 = 0.05,
+                .eps = 0.6,
+                .xi = 0.05};
     for (int law = 0; law < 2; law++) {
         double umax0 = 0;
         long impacts0 = 0;
         for (int s = 0; s < 4; s++) {
-            pd_penalty_setup po = {.law = (pd_penalty_law)law, .kc_mult = 1e4, .kc_abs = 0, .rtol = s >= 2 ? 1e-8 : 0, .atol = s >= 2 ? 1e-10 : 0, .stepper = names[s]};
+            pd_penalty_setup po = {.law = (pd_penalty_law)law,
+                                   .kc_mult = 1e4,
+                                   .kc_abs = 0,
+                                   .rtol = s >= 2 ? 1e-8 : 0,
+                                   .atol = s >= 2 ? 1e-10 : 0,
+                                   .stepper = names[s]};
             pd_osc_result r;
             pd_err e;
-            CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) == PD_OK, "%s: %s",
-                  names[s], e.msg);
+            CHECK(ctx,
+                  pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r,
+                                 &e) == PD_OK,
+                  "%s: %s", names[s], e.msg);
             CHECK(ctx, !strcmp(r.kernel, names[s]), "kernel %s for %s", r.kernel, names[s]);
             if (s == 0) {
                 umax0 = r.umax;
                 impacts0 = r.impacts;
             }
             CHECK(ctx, fabs(r.umax - umax0) <= 2e-6 * umax0 && r.impacts == impacts0,
-                  "law %d %s: umax %.12g vs rk8pd %.12g, impacts %ld vs %ld", law, names[s],
-                  r.umax, umax0, r.impacts, impacts0);
+                  "law %d %s: umax %.12g vs rk8pd %.12g, impacts %ld vs %ld", law, names[s], r.umax,
+                  umax0, r.impacts, impacts0);
         }
     }
 }
@@ -510,7 +625,14 @@ static void test_penalty_two_mass_chain(pd_test_ctx *ctx)
     double Z[4] = {0, 0, 0, 0}, W[4] = {1, 0, 0, -1}, g0[2] = {0.1, 0.1}, v0[2] = {-1.0, 0.7};
     for (int law = 0; law < 2; law++) {
         double e1[2] = {1.0, 1.0};
-        pd_model md = {.n = 2, .m = 2, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_dense(2, 2, Z), .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_dense(2, 2, W), .g0 = g0, .e = e1};
+        pd_model md = {.n = 2,
+                       .m = 2,
+                       .M = pd_matrix_dense(2, 2, M),
+                       .C = pd_matrix_dense(2, 2, Z),
+                       .K = pd_matrix_dense(2, 2, K),
+                       .W = pd_matrix_dense(2, 2, W),
+                       .g0 = g0,
+                       .e = e1};
         chain_track ct = {&md, (pd_penalty_law)law, 1e5, 0, 0, 0, 0, 0.01, 0};
         pd_penalty_opts o;
         pd_penalty_result res;
@@ -521,8 +643,9 @@ static void test_penalty_two_mass_chain(pd_test_ctx *ctx)
         o.h_out = ct.h_out;
         o.on_step = track_chain_step;
         o.on_step_ctx = &ct;
-        CHECK(ctx, pd_penalty_run(&md, 0.0, NULL, v0, 20.0, &o, track_chain_output, &ct, &res,
-                                  &e) == PD_OK,
+        CHECK(ctx,
+              pd_penalty_run(&md, 0.0, NULL, v0, 20.0, &o, track_chain_output, &ct, &res, &e) ==
+                  PD_OK,
               "%s", e.msg);
         CHECK(ctx, res.switches >= 10 && res.min_gap < 0.0, "law %d: %ld switches, min gap %.3g",
               law, res.switches, res.min_gap);
@@ -539,7 +662,14 @@ static void test_penalty_two_mass_chain(pd_test_ctx *ctx)
     long sw[3];
     for (int s = 0; s < 3; s++) {
         double e5[2] = {0.5, 0.5};
-        pd_model md = {.n = 2, .m = 2, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_dense(2, 2, C), .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_dense(2, 2, W), .g0 = g0, .e = e5};
+        pd_model md = {.n = 2,
+                       .m = 2,
+                       .M = pd_matrix_dense(2, 2, M),
+                       .C = pd_matrix_dense(2, 2, C),
+                       .K = pd_matrix_dense(2, 2, K),
+                       .W = pd_matrix_dense(2, 2, W),
+                       .g0 = g0,
+                       .e = e5};
         pd_penalty_opts o;
         pd_penalty_result res;
         pd_err e;
@@ -549,19 +679,21 @@ static void test_penalty_two_mass_chain(pd_test_ctx *ctx)
         o.stepper = names[s];
         o.rtol = s ? 1e-9 : 1e-10;
         o.atol = s ? 1e-11 : 1e-12;
-        CHECK(ctx, pd_penalty_run(&md, 0.0, NULL, v0, 8.0, &o, record_end, q_end[s], &res, &e) ==
-                       PD_OK,
+        CHECK(ctx,
+              pd_penalty_run(&md, 0.0, NULL, v0, 8.0, &o, record_end, q_end[s], &res, &e) == PD_OK,
               "%s: %s", names[s], e.msg);
         CHECK(ctx, res.stepper && !strcmp(res.stepper, names[s]), "stepper %s", res.stepper);
         gmin[s] = res.min_gap;
         sw[s] = res.switches;
     }
     for (int s = 1; s < 3; s++)
-        CHECK(ctx, fabs(q_end[s][0] - q_end[0][0]) + fabs(q_end[s][1] - q_end[0][1]) <= 1e-6 &&
-                       fabs(gmin[s] - gmin[0]) <= 1e-6 * fabs(gmin[0]) && sw[s] == sw[0] && sw[0] >= 4,
-              "%s: end q (%.10g, %.10g) vs (%.10g, %.10g), min gap %.10g vs %.10g, switches %ld vs %ld",
-              names[s], q_end[s][0], q_end[s][1], q_end[0][0], q_end[0][1], gmin[s], gmin[0],
-              sw[s], sw[0]);
+        CHECK(ctx,
+              fabs(q_end[s][0] - q_end[0][0]) + fabs(q_end[s][1] - q_end[0][1]) <= 1e-6 &&
+                  fabs(gmin[s] - gmin[0]) <= 1e-6 * fabs(gmin[0]) && sw[s] == sw[0] && sw[0] >= 4,
+              "%s: end q (%.10g, %.10g) vs (%.10g, %.10g), min gap %.10g vs %.10g, switches %ld vs "
+              "%ld",
+              names[s], q_end[s][0], q_end[s][1], q_end[0][0], q_end[0][1], gmin[s], gmin[0], sw[s],
+              sw[0]);
 }
 
 /* ---- the adaptive integration's costs (issue 20) ----------------------- */
@@ -582,25 +714,32 @@ static void test_penalty_diagonal_mass_path(pd_test_ctx *ctx)
     long sw[3];
     int diag[3];
     for (int s = 0; s < 3; s++) {
-        pd_model md = {.n = 2, .m = 2, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_dense(2, 2, C), .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_dense(2, 2, W), .g0 = g0, .e = e5};
+        pd_model md = {.n = 2,
+                       .m = 2,
+                       .M = pd_matrix_dense(2, 2, M),
+                       .C = pd_matrix_dense(2, 2, C),
+                       .K = pd_matrix_dense(2, 2, K),
+                       .W = pd_matrix_dense(2, 2, W),
+                       .g0 = g0,
+                       .e = e5};
         pd_penalty_opts o = pd_penalty_default_opts();
         pd_penalty_result res;
         pd_err e;
         o.kc = 1e5;
         o.factor = kinds[s];
-        CHECK(ctx, pd_penalty_run(&md, 0.0, NULL, v0, 8.0, &o, record_end, q_end[s], &res, &e) ==
-                       PD_OK,
+        CHECK(ctx,
+              pd_penalty_run(&md, 0.0, NULL, v0, 8.0, &o, record_end, q_end[s], &res, &e) == PD_OK,
               "factor %d: %s", (int)kinds[s], e.msg);
         gmin[s] = res.min_gap;
         sw[s] = res.switches;
         diag[s] = res.diagonal_mass;
     }
-    CHECK(ctx, diag[0] && !diag[1] && !diag[2], "diagonal path taken: auto %d, dense %d, cholmod %d",
-          diag[0], diag[1], diag[2]);
+    CHECK(ctx, diag[0] && !diag[1] && !diag[2],
+          "diagonal path taken: auto %d, dense %d, cholmod %d", diag[0], diag[1], diag[2]);
     for (int s = 1; s < 3; s++)
-        CHECK(ctx, fabs(q_end[s][0] - q_end[0][0]) + fabs(q_end[s][1] - q_end[0][1]) <= 1e-10 &&
-                       fabs(gmin[s] - gmin[0]) <= 1e-10 * fabs(gmin[0]) && sw[s] == sw[0] &&
-                       sw[0] >= 4,
+        CHECK(ctx,
+              fabs(q_end[s][0] - q_end[0][0]) + fabs(q_end[s][1] - q_end[0][1]) <= 1e-10 &&
+                  fabs(gmin[s] - gmin[0]) <= 1e-10 * fabs(gmin[0]) && sw[s] == sw[0] && sw[0] >= 4,
               "factor %d: end q (%.14g, %.14g) vs diagonal (%.14g, %.14g), min gap %.14g vs "
               "%.14g, switches %ld vs %ld",
               (int)kinds[s], q_end[s][0], q_end[s][1], q_end[0][0], q_end[0][1], gmin[s], gmin[0],
@@ -651,7 +790,14 @@ static void test_penalty_extremum_from_interpolant(pd_test_ctx *ctx)
 {
     double M[4] = {1, 0, 0, 2}, K[4] = {2, -1, -1, 1}, C[4] = {0.02, 0, 0, 0.01};
     double W[4] = {1, 0, 0, -1}, g0[2] = {0.1, 0.1}, v0[2] = {-1.0, 0.7}, e5[2] = {0.5, 0.5};
-    pd_model md = {.n = 2, .m = 2, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_dense(2, 2, C), .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_dense(2, 2, W), .g0 = g0, .e = e5};
+    pd_model md = {.n = 2,
+                   .m = 2,
+                   .M = pd_matrix_dense(2, 2, M),
+                   .C = pd_matrix_dense(2, 2, C),
+                   .K = pd_matrix_dense(2, 2, K),
+                   .W = pd_matrix_dense(2, 2, W),
+                   .g0 = g0,
+                   .e = e5};
     pd_penalty_opts o = pd_penalty_default_opts();
     pd_penalty_result res;
     pd_err e;
@@ -660,13 +806,14 @@ static void test_penalty_extremum_from_interpolant(pd_test_ctx *ctx)
     o.h_out = 2e-5;
     o.on_step = track_end_gap;
     o.on_step_ctx = &gt;
-    if (!CHECK(ctx, pd_penalty_run(&md, 0.0, NULL, v0, 2.0, &o, track_fine_gap, &gt, &res, &e) ==
-                        PD_OK,
+    if (!CHECK(ctx,
+               pd_penalty_run(&md, 0.0, NULL, v0, 2.0, &o, track_fine_gap, &gt, &res, &e) == PD_OK,
                "%s", e.msg))
         return;
     double pen = -gt.fine;
-    CHECK(ctx, pen > 0.0 && fabs(res.min_gap - gt.fine) <= 1e-8 * pen &&
-                   gt.ends - res.min_gap > 1e-4 * pen,
+    CHECK(ctx,
+          pen > 0.0 && fabs(res.min_gap - gt.fine) <= 1e-8 * pen &&
+              gt.ends - res.min_gap > 1e-4 * pen,
           "min gap %.15g, fine reference %.15g (%.3g of the penetration), step ends %.15g",
           res.min_gap, gt.fine, fabs(res.min_gap - gt.fine) / pen, gt.ends);
 }
@@ -687,11 +834,10 @@ static void test_penalty_stiff_row_runs(pd_test_ctx *ctx)
     pd_scene *row = NULL;
     pd_scene_result r[3] = {{0}};
     pd_err e;
-    if (!CHECK(ctx, !pd_scene_chain(30, &xc, 1.0, 1.5, 0.05, 0.05 / (TWO_PI * TWO_PI), 0.5, &row,
-                                    &e) &&
-                        !pd_scene_result_alloc(row, &r[0], &e) &&
-                        !pd_scene_result_alloc(row, &r[1], &e) &&
-                        !pd_scene_result_alloc(row, &r[2], &e),
+    if (!CHECK(ctx,
+               !pd_scene_chain(30, &xc, 1.0, 1.5, 0.05, 0.05 / (TWO_PI * TWO_PI), 0.5, &row, &e) &&
+                   !pd_scene_result_alloc(row, &r[0], &e) &&
+                   !pd_scene_result_alloc(row, &r[1], &e) && !pd_scene_result_alloc(row, &r[2], &e),
                "%s", e.msg))
         goto done;
     const pd_method methods[3] = {PD_METHOD_PENALTY, PD_METHOD_NEWMARK, PD_METHOD_MOREAU};
@@ -736,10 +882,9 @@ static void test_penalty_stiff_row_peak(pd_test_ctx *ctx)
     pd_scene *row = NULL;
     pd_scene_result r[2] = {{0}};
     pd_err e;
-    if (!CHECK(ctx, !pd_scene_chain(2, &xc, 1.0, 1.5, 0.05, 0.05 / (TWO_PI * TWO_PI), 0.6, &row,
-                                    &e) &&
-                        !pd_scene_result_alloc(row, &r[0], &e) &&
-                        !pd_scene_result_alloc(row, &r[1], &e),
+    if (!CHECK(ctx,
+               !pd_scene_chain(2, &xc, 1.0, 1.5, 0.05, 0.05 / (TWO_PI * TWO_PI), 0.6, &row, &e) &&
+                   !pd_scene_result_alloc(row, &r[0], &e) && !pd_scene_result_alloc(row, &r[1], &e),
                "%s", e.msg))
         goto done;
     for (int k = 0; k < 2; k++) {
@@ -768,7 +913,14 @@ done:
 static void test_penalty_bad_options(pd_test_ctx *ctx)
 {
     double M = 1.0, Z = 0.0, W = -1.0, g0 = 0.1, eps = 0.5;
-    pd_model md = {.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, &M), .C = pd_matrix_dense(1, 1, &Z), .K = pd_matrix_dense(1, 1, &Z), .W = pd_matrix_dense(1, 1, &W), .g0 = &g0, .e = &eps};
+    pd_model md = {.n = 1,
+                   .m = 1,
+                   .M = pd_matrix_dense(1, 1, &M),
+                   .C = pd_matrix_dense(1, 1, &Z),
+                   .K = pd_matrix_dense(1, 1, &Z),
+                   .W = pd_matrix_dense(1, 1, &W),
+                   .g0 = &g0,
+                   .e = &eps};
     const double bad_kc[] = {0.0, -1.0, NAN, INFINITY};
     pd_penalty_opts o;
     pd_penalty_result res;
@@ -776,55 +928,82 @@ static void test_penalty_bad_options(pd_test_ctx *ctx)
     for (int k = 0; k < 4; k++) {
         o = pd_penalty_default_opts();
         o.kc = bad_kc[k];
-        CHECK(ctx, pd_penalty_run(&md, 0, NULL, NULL, 1, &o, NULL, NULL, &res, &e) == PD_EINVAL &&
-                       strstr(e.msg, "kc"),
+        CHECK(ctx,
+              pd_penalty_run(&md, 0, NULL, NULL, 1, &o, NULL, NULL, &res, &e) == PD_EINVAL &&
+                  strstr(e.msg, "kc"),
               "kc = %g: %s", bad_kc[k], e.msg);
     }
     o = pd_penalty_default_opts();
     o.kc = 1.0;
     o.stepper = "rk99";
-    CHECK(ctx, pd_penalty_run(&md, 0, NULL, NULL, 1, &o, NULL, NULL, &res, &e) == PD_EINVAL &&
-                   strstr(e.msg, "stepper") && strstr(e.msg, "rk99"),
+    CHECK(ctx,
+          pd_penalty_run(&md, 0, NULL, NULL, 1, &o, NULL, NULL, &res, &e) == PD_EINVAL &&
+              strstr(e.msg, "stepper") && strstr(e.msg, "rk99"),
           "%s", e.msg);
     o.stepper = "rk8pd";
     o.rtol = -1e-6;
-    CHECK(ctx, pd_penalty_run(&md, 0, NULL, NULL, 1, &o, NULL, NULL, &res, &e) == PD_EINVAL &&
-                   strstr(e.msg, "rtol"),
+    CHECK(ctx,
+          pd_penalty_run(&md, 0, NULL, NULL, 1, &o, NULL, NULL, &res, &e) == PD_EINVAL &&
+              strstr(e.msg, "rtol"),
           "%s", e.msg);
     o.rtol = 1e-10;
-    CHECK(ctx, pd_penalty_run(&md, 1, NULL, NULL, 0, &o, NULL, NULL, &res, &e) == PD_EINVAL &&
-                   strstr(e.msg, "t0"),
+    CHECK(ctx,
+          pd_penalty_run(&md, 1, NULL, NULL, 0, &o, NULL, NULL, &res, &e) == PD_EINVAL &&
+              strstr(e.msg, "t0"),
           "%s", e.msg);
     o.max_steps = 5;
-    CHECK(ctx, pd_penalty_run(&md, 0, NULL, NULL, 100, &o, NULL, NULL, &res, &e) == PD_EBUDGET &&
-                   strstr(e.msg, "budget") && res.steps == 5,
+    CHECK(ctx,
+          pd_penalty_run(&md, 0, NULL, NULL, 100, &o, NULL, NULL, &res, &e) == PD_EBUDGET &&
+              strstr(e.msg, "budget") && res.steps == 5,
           "%s (%ld steps)", e.msg, res.steps);
 
-    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5, .Pi3 = 0.05, .eps = 0.6, .xi = 0.05};
+    pd_osc c = {.pulse = PD_PULSE_SINE,
+                .dir = 1,
+                .ap = 1.0,
+                .Tp = 1.0,
+                .Pi2 = 0.5,
+                .Pi3 = 0.05,
+                .eps = 0.6,
+                .xi = 0.05};
     pd_osc_result r;
-    pd_penalty_setup po = {.law = PD_PENALTY_KELVIN, .kc_mult = -1.0, .kc_abs = 0, .rtol = 0, .atol = 0, .stepper = NULL};
-    CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) == PD_EINVAL &&
-                   strstr(e.msg, "kc"),
+    pd_penalty_setup po = {.law = PD_PENALTY_KELVIN,
+                           .kc_mult = -1.0,
+                           .kc_abs = 0,
+                           .rtol = 0,
+                           .atol = 0,
+                           .stepper = NULL};
+    CHECK(ctx,
+          pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) ==
+                  PD_EINVAL &&
+              strstr(e.msg, "kc"),
           "%s", e.msg);
     po.kc_mult = 1e4;
     po.kc_abs = -5;
-    CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) == PD_EINVAL &&
-                   strstr(e.msg, "kc-abs"),
+    CHECK(ctx,
+          pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) ==
+                  PD_EINVAL &&
+              strstr(e.msg, "kc-abs"),
           "%s", e.msg);
     po.kc_abs = 0;
     po.stepper = "euler";
-    CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) == PD_EINVAL &&
-                   strstr(e.msg, "stepper"),
+    CHECK(ctx,
+          pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) ==
+                  PD_EINVAL &&
+              strstr(e.msg, "stepper"),
           "%s", e.msg);
     po.stepper = NULL;
     pd_run_opts oo = pd_run_default_opts();
     oo.dt = -1;
-    CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(&oo, &po)}, NULL, NULL, &r, &e) == PD_EINVAL &&
-                   strstr(e.msg, "dt"),
+    CHECK(ctx,
+          pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(&oo, &po)}, NULL, NULL, &r, &e) ==
+                  PD_EINVAL &&
+              strstr(e.msg, "dt"),
           "%s", e.msg);
     c.eps = 2;
-    CHECK(ctx, pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) == PD_EINVAL &&
-                   strstr(e.msg, "eps"),
+    CHECK(ctx,
+          pd_osc_penalty(&c, (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &r, &e) ==
+                  PD_EINVAL &&
+              strstr(e.msg, "eps"),
           "%s", e.msg);
 }
 
@@ -835,8 +1014,14 @@ static void test_penalty_bad_options(pd_test_ctx *ctx)
  * gap and umax within 2 % of the exact reference. */
 static void test_penalty_default_resolves_gap(pd_test_ctx *ctx)
 {
-    pd_osc c = {.pulse = PD_PULSE_COSINE, .dir = -1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.06999172416774613,
-                .Pi3 = 0.07733297836391044, .eps = 0.7785108586766508, .xi = 0.05395511737002854};
+    pd_osc c = {.pulse = PD_PULSE_COSINE,
+                .dir = -1,
+                .ap = 1.0,
+                .Tp = 1.0,
+                .Pi2 = 0.06999172416774613,
+                .Pi3 = 0.07733297836391044,
+                .eps = 0.7785108586766508,
+                .xi = 0.05395511737002854};
     pd_run_opts o = pd_run_default_opts();
     pd_osc_result ref, pen, old;
     pd_err err;
@@ -876,7 +1061,6 @@ static void test_penalty_loose_tolerance_runs(pd_test_ctx *ctx)
           res.umax, ref.umax);
 }
 
-
 /* ---- the Newmark penalty method (engine/penalty_newmark.c) ----------------------- */
 
 /* The free mass of free_mass_impact on fixed Newmark steps of `per` steps
@@ -885,9 +1069,14 @@ static int newmark_impact(pd_penalty_law law, double e, double kc, double per, e
                           pd_penalty_result *res, pd_err *err)
 {
     double M = 1.0, Z = 0.0, W = -1.0, g0 = 0.01, v0 = 1.0;
-    pd_model md = {.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, &M),
-                   .C = pd_matrix_dense(1, 1, &Z), .K = pd_matrix_dense(1, 1, &Z),
-                   .W = pd_matrix_dense(1, 1, &W), .g0 = &g0, .e = &e};
+    pd_model md = {.n = 1,
+                   .m = 1,
+                   .M = pd_matrix_dense(1, 1, &M),
+                   .C = pd_matrix_dense(1, 1, &Z),
+                   .K = pd_matrix_dense(1, 1, &Z),
+                   .W = pd_matrix_dense(1, 1, &W),
+                   .g0 = &g0,
+                   .e = &e};
     pd_penalty_opts o = pd_penalty_default_opts();
     memset(ep, 0, sizeof *ep);
     o.law = law;
@@ -896,8 +1085,7 @@ static int newmark_impact(pd_penalty_law law, double e, double kc, double per, e
     o.h = PI * 2.0 / sqrt(kc) / per;
     o.on_step = track_episode;
     o.on_step_ctx = ep;
-    return pd_penalty_run(&md, 0.0, NULL, &v0, 0.01 + 40.0 / sqrt(kc), &o, NULL, NULL, res,
-                          err);
+    return pd_penalty_run(&md, 0.0, NULL, &v0, 0.01 + 40.0 / sqrt(kc), &o, NULL, NULL, res, err);
 }
 
 /* Kelvin-Voigt on Newmark's steps: the rebound ratio tends to e as the
@@ -912,14 +1100,14 @@ static void test_newmark_kelvin_restitution(pd_test_ctx *ctx)
             episode ep;
             pd_penalty_result res;
             pd_err err;
-            int rc = newmark_impact(PD_PENALTY_KELVIN, es[k], 1e6, j ? 500.0 : 50.0, &ep, &res,
-                                    &err);
+            int rc =
+                newmark_impact(PD_PENALTY_KELVIN, es[k], 1e6, j ? 500.0 : 50.0, &ep, &res, &err);
             CHECK(ctx, rc == PD_OK && strcmp(res.stepper, "newmark") == 0, "%s", err.msg);
             err_at[j] = fabs(-ep.v_out / ep.v_in - es[k]);
         }
         CHECK(ctx, err_at[0] <= 2e-2 && err_at[1] <= 2e-3 && err_at[1] < err_at[0],
-              "e %g: rebound ratio off by %.3g (50 steps per period), %.3g (500)", es[k],
-              err_at[0], err_at[1]);
+              "e %g: rebound ratio off by %.3g (50 steps per period), %.3g (500)", es[k], err_at[0],
+              err_at[1]);
     }
 }
 
@@ -950,8 +1138,12 @@ static void test_newmark_energy_without_contact(pd_test_ctx *ctx)
 {
     double M[4] = {1.0, 0.0, 0.0, 2.0}, K[4] = {3.0, -1.0, -1.0, 2.0}, Z[4] = {0};
     double q0[2] = {0.3, -0.1}, v0[2] = {0.0, 0.5};
-    pd_model md = {.n = 2, .m = 0, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_dense(2, 2, Z),
-                   .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_zero(2, 0)};
+    pd_model md = {.n = 2,
+                   .m = 0,
+                   .M = pd_matrix_dense(2, 2, M),
+                   .C = pd_matrix_dense(2, 2, Z),
+                   .K = pd_matrix_dense(2, 2, K),
+                   .W = pd_matrix_zero(2, 0)};
     pd_penalty_opts o = pd_penalty_default_opts();
     nm_energy ne = {0};
     pd_penalty_result res;
@@ -973,8 +1165,8 @@ static void test_newmark_energy_without_contact(pd_test_ctx *ctx)
  * Hertz-damp agrees at the default dt. */
 static void test_newmark_tends_to_adaptive(pd_test_ctx *ctx)
 {
-    pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 4.0, .Tp = 0.3, .Pi2 = 0.1, .eps = 0.6,
-                .xi = 0.05};
+    pd_osc c = {
+        .pulse = PD_PULSE_SINE, .dir = 1, .ap = 4.0, .Tp = 0.3, .Pi2 = 0.1, .eps = 0.6, .xi = 0.05};
     pd_osc_set_gap(&c, 0.004);
     pd_run_opts o = pd_run_default_opts();
     pd_osc_result ref, r;
@@ -990,8 +1182,10 @@ static void test_newmark_tends_to_adaptive(pd_test_ctx *ctx)
         CHECK(ctx, r.impacts == ref.impacts, "dt %g: %ld impacts, adaptive %ld", o.dt, r.impacts,
               ref.impacts);
     }
-    CHECK(ctx, e[0] <= 2e-2 && e[1] <= e[0] / 4.0, "umax against rk8pd: %.3g (dt 1e-4), %.3g "
-          "(1e-5)", e[0], e[1]);
+    CHECK(ctx, e[0] <= 2e-2 && e[1] <= e[0] / 4.0,
+          "umax against rk8pd: %.3g (dt 1e-4), %.3g "
+          "(1e-5)",
+          e[0], e[1]);
     /* Hertz-damp: its force is continuous at d = 0, Newton converges in d;
      * at the default dt (1.5e-4 s) within 1e-4 of rk8pd (measured 5e-6) */
     o = pd_run_default_opts();
@@ -1014,8 +1208,8 @@ static void test_newmark_stiff_chain(pd_test_ctx *ctx)
     pd_scene_excitation exc = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0};
     pd_scene *sc = NULL;
     pd_err err;
-    if (!CHECK(ctx, pd_scene_chain(10, &exc, 1.0, 1.5, 0.05, 0.001, 0.5, &sc, &err) == PD_OK,
-               "%s", err.msg))
+    if (!CHECK(ctx, pd_scene_chain(10, &exc, 1.0, 1.5, 0.05, 0.001, 0.5, &sc, &err) == PD_OK, "%s",
+               err.msg))
         return;
     pd_scene_result a = {0}, b = {0};
     pd_run_opts o = pd_run_default_opts();

@@ -87,8 +87,8 @@ static int is_png(const char *path)
 
 /* The checks every successful plot shares: exit 0, the PNG under exactly
  * png, no injected file, no temporary left in TMPDIR or next to png. */
-static void check_plotted(pd_test_ctx *ctx, const plot_dir *d, const proc_out *r,
-                          const char *png, int entries)
+static void check_plotted(pd_test_ctx *ctx, const plot_dir *d, const proc_out *r, const char *png,
+                          int entries)
 {
     char pwned[128];
     snprintf(pwned, sizeof pwned, "%s/pwned", d->dir);
@@ -184,8 +184,8 @@ static void test_plot_across_file_systems(pd_test_ctx *ctx)
     proc_out r;
     run_pound(ctx, &d, args, &r);
     check_plotted(ctx, &d, &r, png, 2);
-    CHECK(ctx, pd_test_dir_entries(shm) == 0, "%d temporaries left in %s",
-          pd_test_dir_entries(shm), shm);
+    CHECK(ctx, pd_test_dir_entries(shm) == 0, "%d temporaries left in %s", pd_test_dir_entries(shm),
+          shm);
     pd_test_proc_free(&r);
     pd_test_rm_dir(shm);
     dir_close(&d);
@@ -232,15 +232,16 @@ static void test_plot_scene_names(pd_test_ctx *ctx)
     char scene[512], png[256], json[1024], bad[256];
     if (!have_tools(ctx) || dir_open(ctx, &d))
         return;
-    snprintf(json, sizeof json, "%s",
-             "{\"excitation\": {\"pulse\": \"cosine\", \"dir\": \"+x\", \"ap\": 3.0, \"Tp\": 0.6},\n"
-             " \"structures\": [\n"
-             "  {\"name\": \"x`touch pwned`\", \"T0\": 0.4, \"xi\": 0.05, \"mass\": 2.0e5},\n"
-             "  {\"name\": \"@y $HOME %c;system(x)\", \"T0\": 1.2, \"xi\": 0.05, \"mass\": 1.0e5},\n"
-             "  {\"name\": \"say `x` @y\", \"T0\": 0.8, \"xi\": 0.05, \"mass\": 1.0e5}],\n"
-             " \"contacts\": [{\"a\": \"x`touch pwned`\", \"b\": \"@y $HOME %c;system(x)\","
-             " \"gap\": 0.02, \"eps\": 0.65}],\n"
-             " \"tend\": 2.0}\n");
+    snprintf(
+        json, sizeof json, "%s",
+        "{\"excitation\": {\"pulse\": \"cosine\", \"dir\": \"+x\", \"ap\": 3.0, \"Tp\": 0.6},\n"
+        " \"structures\": [\n"
+        "  {\"name\": \"x`touch pwned`\", \"T0\": 0.4, \"xi\": 0.05, \"mass\": 2.0e5},\n"
+        "  {\"name\": \"@y $HOME %c;system(x)\", \"T0\": 1.2, \"xi\": 0.05, \"mass\": 1.0e5},\n"
+        "  {\"name\": \"say `x` @y\", \"T0\": 0.8, \"xi\": 0.05, \"mass\": 1.0e5}],\n"
+        " \"contacts\": [{\"a\": \"x`touch pwned`\", \"b\": \"@y $HOME %c;system(x)\","
+        " \"gap\": 0.02, \"eps\": 0.65}],\n"
+        " \"tend\": 2.0}\n");
     snprintf(scene, sizeof scene, "%s/sc\"e'ne\\\"; system(\"touch pwned\") \".json", d.dir);
     snprintf(png, sizeof png, "%s/scene.png", d.dir);
     if (!CHECK(ctx, write_text(scene, json) == 0, "cannot write %s", scene)) {
@@ -256,7 +257,8 @@ static void test_plot_scene_names(pd_test_ctx *ctx)
     for (int k = 0; k < 4; k++) {
         snprintf(json, sizeof json,
                  "{\"excitation\": {\"pulse\": \"cosine\", \"ap\": 3.0, \"Tp\": 0.6},\n"
-                 " \"structures\": [{\"name\": \"%s\", \"T0\": 0.4}]}\n", refused[k]);
+                 " \"structures\": [{\"name\": \"%s\", \"T0\": 0.4}]}\n",
+                 refused[k]);
         snprintf(bad, sizeof bad, "%s/bad.json", d.dir);
         if (!CHECK(ctx, write_text(bad, json) == 0, "cannot write %s", bad))
             break;
@@ -276,8 +278,8 @@ static int write_record(const char *path)
     FILE *f = fopen(path, "w");
     for (int i = 0; f && i <= 800; i++) {
         double t = 0.01 * i;
-        fprintf(f, "%.2f %.6g\n", t, t >= 1.0 && t <= 2.0 ? 3.0 * sin(6.283185307179586 * (t - 1.0))
-                                                           : 0.0);
+        fprintf(f, "%.2f %.6g\n", t,
+                t >= 1.0 && t <= 2.0 ? 3.0 * sin(6.283185307179586 * (t - 1.0)) : 0.0);
     }
     return f && fclose(f) == 0 ? 0 : -1;
 }
@@ -395,9 +397,10 @@ static void test_plot_oscillator_impacts(pd_test_ctx *ctx)
     snprintf(gpf, sizeof gpf, "%s/o.gp", dir);
     snprintf(datf, sizeof datf, "%s/o.dat", dir);
     for (int m = 0; m < 4; m++) {
-        const char *args[] = {"simulate", "--pulse", "sine", "--dir", "normal", "--Tp", "0.3",
-                              "--T0", "3", "--ap", "4", "--gap", "0.004", "--eps", "0.6",
-                              "--method", methods[m], "--json", "--plot", png, NULL};
+        const char *args[] = {"simulate", "--pulse", "sine", "--dir",    "normal",   "--Tp",
+                              "0.3",      "--T0",    "3",    "--ap",     "4",        "--gap",
+                              "0.004",    "--eps",   "0.6",  "--method", methods[m], "--json",
+                              "--plot",   png,       NULL};
         proc_out r;
         int ok = run_keep(ctx, args, &r) == 0;
         char *gp = ok ? pd_test_slurp(gpf) : NULL, *dat = ok ? pd_test_slurp(datf) : NULL;
@@ -410,8 +413,10 @@ static void test_plot_oscillator_impacts(pd_test_ctx *ctx)
             CHECK(ctx, wall_line(gp) == 0.004, "%s: wall drawn at %.17g, expected the gap 0.004",
                   methods[m], wall_line(gp));
             for (long i = 0; i < n && i < 64; i++)
-                CHECK(ctx, fabs(u[i] - 0.004) <= 5e-5, "%s: mark %ld at t = %g, u = %.6g m, off "
-                      "the wall", methods[m], i, t[i], u[i]);
+                CHECK(ctx, fabs(u[i] - 0.004) <= 5e-5,
+                      "%s: mark %ld at t = %g, u = %.6g m, off "
+                      "the wall",
+                      methods[m], i, t[i], u[i]);
         }
         free(gp);
         free(dat);
@@ -478,16 +483,19 @@ static void test_plot_scene_impacts(pd_test_ctx *ctx)
         "{\"excitation\": {\"pulse\": \"sine\", \"dir\": \"-x\", \"ap\": 4.0, \"Tp\": 0.8},\n"
         " \"structures\": [\n"
         "  {\"name\": \"low\", \"storeys\": 3, \"mass\": 3.0e5, \"T0\": 0.4, \"xi\": 0.05},\n"
-        "  {\"name\": \"b_x^{y}@z&w\", \"storeys\": 2, \"mass\": 3.0e5, \"T0\": 1.0, \"xi\": 0.05}],\n"
-        " \"contacts\": [{\"a\": \"wall\", \"b\": \"low\", \"levels\": [1], \"gap\": 0.01, \"eps\": 0.5},\n"
-        "  {\"a\": \"low\", \"b\": \"b_x^{y}@z&w\", \"levels\": [1, 2], \"gap\": 0.01, \"eps\": 0.5}],\n"
+        "  {\"name\": \"b_x^{y}@z&w\", \"storeys\": 2, \"mass\": 3.0e5, \"T0\": 1.0, \"xi\": "
+        "0.05}],\n"
+        " \"contacts\": [{\"a\": \"wall\", \"b\": \"low\", \"levels\": [1], \"gap\": 0.01, "
+        "\"eps\": 0.5},\n"
+        "  {\"a\": \"low\", \"b\": \"b_x^{y}@z&w\", \"levels\": [1, 2], \"gap\": 0.01, \"eps\": "
+        "0.5}],\n"
         " \"tend\": 2.0}\n";
     if (!CHECK(ctx, write_text(scene, json) == 0, "cannot write %s", scene)) {
         pd_test_rm_dir(dir);
         return;
     }
     const char *args[] = {"simulate", "--scene", scene, "--method", "moreau", "--dt", "0.0005",
-                          "--json", "-o", csvf, "--plot", png, NULL};
+                          "--json",   "-o",      csvf,  "--plot",   png,      NULL};
     proc_out r;
     int ok = run_keep(ctx, args, &r) == 0;
     char *gp = ok ? pd_test_slurp(gpf) : NULL, *dat = ok ? pd_test_slurp(datf) : NULL;
@@ -515,8 +523,10 @@ static void test_plot_scene_impacts(pd_test_ctx *ctx)
                 snprintf(cname, sizeof cname, "%s.x%d", name[s], L);
                 col[L] = csv_column(header + 1, cname);
             }
-            CHECK(ctx, n == (long)(want[s][1] + want[s][2]), "%s: %ld marks, %g impacts at its "
-                  "contacts", name[s], n, want[s][1] + want[s][2]);
+            CHECK(ctx, n == (long)(want[s][1] + want[s][2]),
+                  "%s: %ld marks, %g impacts at its "
+                  "contacts",
+                  name[s], n, want[s][1] + want[s][2]);
             for (long i = 0; i < n && i < 512; i++) {
                 int at = 0;
                 for (int L = 1; L <= 2; L++)
@@ -525,8 +535,10 @@ static void test_plot_scene_impacts(pd_test_ctx *ctx)
                         at = L;
                         break;
                     }
-                CHECK(ctx, at > 0, "%s: mark at t = %.17g, y = %.17g is no contact storey's "
-                      "displacement", name[s], t[i], y[i]);
+                CHECK(ctx, at > 0,
+                      "%s: mark at t = %.17g, y = %.17g is no contact storey's "
+                      "displacement",
+                      name[s], t[i], y[i]);
             }
             for (int L = 1; L <= 2; L++)
                 CHECK(ctx, got[L] == want[s][L], "%s storey %d: %g marks, %g impacts", name[s], L,
@@ -560,9 +572,20 @@ static void test_plot_palette(pd_test_ctx *ctx)
     snprintf(png, sizeof png, "%s/p.png", dir);
     snprintf(gpf, sizeof gpf, "%s/p.gp", dir);
     snprintf(datf, sizeof datf, "%s/p.dat", dir);
-    const char *args[] = {"spectrum", "--pulse", "sine", "--dir", "normal", "--Pi3",
-                          "0.01,0.02,0.05,0.1,0.2,0.3,0.5,1,2,5", "--eps", "0.5", "--Pi2",
-                          "0.5:2:3", "--plot", png, NULL};
+    const char *args[] = {"spectrum",
+                          "--pulse",
+                          "sine",
+                          "--dir",
+                          "normal",
+                          "--Pi3",
+                          "0.01,0.02,0.05,0.1,0.2,0.3,0.5,1,2,5",
+                          "--eps",
+                          "0.5",
+                          "--Pi2",
+                          "0.5:2:3",
+                          "--plot",
+                          png,
+                          NULL};
     proc_out r;
     int ok = run_keep(ctx, args, &r) == 0;
     char *gp = ok ? pd_test_slurp(gpf) : NULL;

@@ -50,8 +50,8 @@ static int shared_record(pd_test_ctx *ctx, const char *name, char *path, size_t 
 }
 
 /* Write len bytes of body to dir/name; the path into path. */
-static int write_file(const char *dir, const char *name, const char *body, size_t len,
-                      char *path, size_t cap)
+static int write_file(const char *dir, const char *name, const char *body, size_t len, char *path,
+                      size_t cap)
 {
     snprintf(path, cap, "%s/%s", dir, name);
     FILE *f = fopen(path, "wb");
@@ -72,8 +72,8 @@ static int names_line(const char *msg, const char *path, int line)
 /* A record of n samples a[k] at step dt (acc malloc'd; NULL on failure). */
 static pd_record make_record(long n, double dt)
 {
-    return (pd_record){.name = "synthetic", .npts = n, .dt = dt,
-                       .acc = calloc((size_t)n, sizeof(double))};
+    return (pd_record){
+        .name = "synthetic", .npts = n, .dt = dt, .acc = calloc((size_t)n, sizeof(double))};
 }
 
 /* ---- the shared records -------------------------------------------------------- */
@@ -153,10 +153,8 @@ static void test_record_read_formats(pd_test_ctx *ctx)
          * the peaks of the file's own velocity and displacement blocks (the agency's
          * processing, not read).  Ours integrate the printed accelerations from rest
          * (docs/records.md §3): 28.245 cm/s and 5.362 cm, within 1 and 5 % of those. */
-        CHECK(ctx, fabs(m.pgv - 0.28253) < 0.01 * 0.28253, "V2 PGV %g m/s, header 0.28253",
-              m.pgv);
-        CHECK(ctx, fabs(m.pgd - 0.05449) < 0.05 * 0.05449, "V2 PGD %g m, header 0.05449",
-              m.pgd);
+        CHECK(ctx, fabs(m.pgv - 0.28253) < 0.01 * 0.28253, "V2 PGV %g m/s, header 0.28253", m.pgv);
+        CHECK(ctx, fabs(m.pgd - 0.05449) < 0.05 * 0.05449, "V2 PGD %g m, header 0.05449", m.pgd);
         CHECK_NEAR(ctx, m.pgv, 0.28245, 5e-6);
         CHECK_NEAR(ctx, m.pgd, 0.05362, 5e-6);
     }
@@ -179,9 +177,10 @@ static void test_record_peer_at_rest(pd_test_ctx *ctx)
         double *v = malloc((size_t)r.npts * sizeof *v), *d = malloc((size_t)r.npts * sizeof *d);
         pd_record_measures m;
         pd_err err = {0};
-        if (CHECK(ctx, v && d, "malloc") &&
-            CHECK(ctx, pd_record_integrate(&r, v, d, &err) == PD_OK &&
-                           pd_record_measure(&r, &m, &err) == PD_OK, "%s", err.msg)) {
+        if (CHECK(ctx, v && d, "malloc") && CHECK(ctx,
+                                                  pd_record_integrate(&r, v, d, &err) == PD_OK &&
+                                                      pd_record_measure(&r, &m, &err) == PD_OK,
+                                                  "%s", err.msg)) {
             double ve = fabs(v[r.npts - 1]), de = fabs(d[r.npts - 1]);
             CHECK(ctx, ve <= 0.01 * m.pgv && de <= 0.01 * m.pgd,
                   "%s: at the end |v| %.3g m/s (PGV %.3g), |d| %.3g m (PGD %.3g)",
@@ -237,9 +236,12 @@ static void test_record_arias_reference_rule(pd_test_ctx *ctx)
     }
     double ia = PD_PI / (2.0 * 981.0) * cum[n - 1];
     long i5 = 0, i75 = 0, i95 = 0;
-    while (cum[i5] < 0.05 * cum[n - 1]) i5++;
-    while (cum[i75] < 0.75 * cum[n - 1]) i75++;
-    while (cum[i95] < 0.95 * cum[n - 1]) i95++;
+    while (cum[i5] < 0.05 * cum[n - 1])
+        i5++;
+    while (cum[i75] < 0.75 * cum[n - 1])
+        i75++;
+    while (cum[i95] < 0.95 * cum[n - 1])
+        i95++;
     /* the reference file's "Peak Arias Intensity (cm/sec): 750.317049" */
     CHECK(ctx, fabs(ia - 750.317049) <= 1e-6 * 750.317049, "reference rule: %.9g cm/s", ia);
     CHECK_NEAR(ctx, (double)(i75 - i5) * r.dt, 3.46, 1e-9);
@@ -375,8 +377,8 @@ static void test_record_integrate_sine(pd_test_ctx *ctx)
 
 /* A record read from a written file; st its status, err its message. */
 static int read_body(const char *dir, const char *name, const char *body, size_t len,
-                     pd_record_format f, pd_record_units u, pd_record *r, pd_err *err,
-                     char *path, size_t cap)
+                     pd_record_format f, pd_record_units u, pd_record *r, pd_err *err, char *path,
+                     size_t cap)
 {
     if (write_file(dir, name, body, len, path, cap) != 0)
         return pd_err_set(err, PD_EIO, "cannot write %s", name);
@@ -386,13 +388,12 @@ static int read_body(const char *dir, const char *name, const char *body, size_t
 /* Numbers that touch, the D exponent, CR CR LF line ends, the old header. */
 static void test_record_touching(pd_test_ctx *ctx)
 {
-    static const char body[] =
-        "PEER NGA STRONG MOTION DATABASE RECORD\r\r\n"
-        "TEST, touching numbers\r\r\n"
-        "ACCELERATION TIME HISTORY IN UNITS OF G\r\r\n"
-        "6    0.0100    NPTS, DT\r\r\n"
-        "1.234E-02-5.678E-03   0.123-0.456\r\r\n"
-        "  7.5D-01+2.5e+00\r\r\n";
+    static const char body[] = "PEER NGA STRONG MOTION DATABASE RECORD\r\r\n"
+                               "TEST, touching numbers\r\r\n"
+                               "ACCELERATION TIME HISTORY IN UNITS OF G\r\r\n"
+                               "6    0.0100    NPTS, DT\r\r\n"
+                               "1.234E-02-5.678E-03   0.123-0.456\r\r\n"
+                               "  7.5D-01+2.5e+00\r\r\n";
     const double want[] = {1.234E-02, -5.678E-03, 0.123, -0.456, 0.75, 2.5};
     char dir[] = "/tmp/pd_recordXXXXXX", path[512];
     if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
@@ -401,8 +402,8 @@ static void test_record_touching(pd_test_ctx *ctx)
     pd_err err = {0};
     int st = read_body(dir, "touch.AT2", body, sizeof body - 1, PD_RECORD_AUTO, PD_UNITS_G, &r,
                        &err, path, sizeof path);
-    CHECK(ctx, st == PD_OK && r.npts == 6 && r.dt == 0.01, "status %d (%s), npts %ld", st,
-          err.msg, r.npts);
+    CHECK(ctx, st == PD_OK && r.npts == 6 && r.dt == 0.01, "status %d (%s), npts %ld", st, err.msg,
+          r.npts);
     for (int k = 0; st == PD_OK && k < 6; k++)
         CHECK_NEAR(ctx, r.acc[k], want[k] * PD_G_STANDARD, 1e-15);
     pd_record_free(&r);
@@ -423,8 +424,8 @@ static void test_record_text(pd_test_ctx *ctx)
         return;
     pd_record r = {0};
     pd_err err = {0};
-    int st = read_body(dir, "three.txt", body, sizeof body - 1, PD_RECORD_AUTO, PD_UNITS_CM_S2,
-                       &r, &err, path, sizeof path);
+    int st = read_body(dir, "three.txt", body, sizeof body - 1, PD_RECORD_AUTO, PD_UNITS_CM_S2, &r,
+                       &err, path, sizeof path);
     CHECK(ctx, st == PD_OK && r.npts == 3, "status %d (%s)", st, err.msg);
     if (st == PD_OK) {
         CHECK_NEAR(ctx, r.dt, 0.02, 1e-15);
@@ -447,8 +448,8 @@ static void test_record_text(pd_test_ctx *ctx)
     size_t len = 0;
     for (int k = 0; k < 200; k++)
         len += (size_t)snprintf(rounded + len, sizeof rounded - len, "%.5f %d\n", k / 256.0, k);
-    st = read_body(dir, "rounded.txt", rounded, len, PD_RECORD_AUTO, PD_UNITS_M_S2, &r, &err,
-                   path, sizeof path);
+    st = read_body(dir, "rounded.txt", rounded, len, PD_RECORD_AUTO, PD_UNITS_M_S2, &r, &err, path,
+                   sizeof path);
     CHECK(ctx, st == PD_OK && r.npts == 200 && fabs(r.dt - 1.0 / 256.0) < 1e-7,
           "rounded t: %d %s dt %.9g", st, err.msg, r.dt);
     pd_record_free(&r);
@@ -511,16 +512,18 @@ static size_t v2_text(char *buf, size_t cap, long npts, double dt, const char *u
         ints[52] = ints[63] = ints[65] = (double)n;
         reals[60] = dt;
         if (put(buf, cap, &len, "CORRECTED ACCELEROGRAM   TEST-%d       CHAN  %d:  90 DEG\n%s\n",
-                c + 1, c + 1, cdmg ? "UNCORRECTED ACCELEROGRAM DATA      PROCESSED: TEST"
-                                   : "SYNTHETIC DATA") != 0)
+                c + 1, c + 1,
+                cdmg ? "UNCORRECTED ACCELEROGRAM DATA      PROCESSED: TEST" : "SYNTHETIC DATA") !=
+            0)
             return 0;
         for (int l = 3; l <= 25; l++) {
-            int st = l == 16 ? put(buf, cap, &len, "%6ld POINTS OF INSTRUMENT- AND BASELINE-"
-                                                   "CORRECTED ACCEL, VELOC AND DISPL DATA\n", n)
-                     : l == 17 ? put(buf, cap, &len, "AT EQUALLY-SPACED INTERVALS OF %7.3f  SEC.\n",
-                                     dt)
-                               : put(buf, cap, &len, "TEXT HEADER LINE %d OF CHANNEL %d\n", l,
-                                     c + 1);
+            int st = l == 16 ? put(buf, cap, &len,
+                                   "%6ld POINTS OF INSTRUMENT- AND BASELINE-"
+                                   "CORRECTED ACCEL, VELOC AND DISPL DATA\n",
+                                   n)
+                     : l == 17
+                         ? put(buf, cap, &len, "AT EQUALLY-SPACED INTERVALS OF %7.3f  SEC.\n", dt)
+                         : put(buf, cap, &len, "TEXT HEADER LINE %d OF CHANNEL %d\n", l, c + 1);
             if (st != 0)
                 return 0;
         }
@@ -529,8 +532,10 @@ static size_t v2_text(char *buf, size_t cap, long npts, double dt, const char *u
             return 0;
         static const char *const block[] = {"ACCEL", "VELOC", "DISPL"};
         for (int b = 0; b < 3; b++) {
-            if (put(buf, cap, &len, "%5ld POINTS OF %s DATA EQUALLY SPACED AT %5.3f SEC.  "
-                                    "(UNITS: %s)\n", n, block[b], dt, b ? "CM" : units) != 0)
+            if (put(buf, cap, &len,
+                    "%5ld POINTS OF %s DATA EQUALLY SPACED AT %5.3f SEC.  "
+                    "(UNITS: %s)\n",
+                    n, block[b], dt, b ? "CM" : units) != 0)
                 return 0;
             for (long k = 0; k < n; k++)
                 if (put(buf, cap, &len, "%10.3f%s", b ? 99.0 : v2_value(c, k),
@@ -591,8 +596,8 @@ static void test_record_v2(pd_test_ctx *ctx)
         size_t len = v2_text(body, sizeof body, npts, 0.01, "G", cdmg);
         pd_record r = {0};
         pd_err err = {0};
-        int st = read_body(dir, "test.v2", body, len, PD_RECORD_AUTO, PD_UNITS_M_S2, &r, &err,
-                           path, sizeof path);
+        int st = read_body(dir, "test.v2", body, len, PD_RECORD_AUTO, PD_UNITS_M_S2, &r, &err, path,
+                           sizeof path);
         CHECK(ctx, len > 0 && st == PD_OK && r.npts == npts && r.dt == 0.01,
               "cdmg %d: status %d (%s), npts %ld", cdmg, st, err.msg, r.npts);
         for (long k = 0; st == PD_OK && k < npts; k++)
@@ -603,10 +608,11 @@ static void test_record_v2(pd_test_ctx *ctx)
     size_t len = v2_text(body, sizeof body, npts, 0.005, "CM/SEC/SEC", 1), n = 0;
     pd_record r = {0};
     pd_err err = {0};
-    int st = read_body(dir, "cm.txt", body, len, PD_RECORD_V2, PD_UNITS_G, &r, &err, path,
-                       sizeof path);
-    CHECK(ctx, st == PD_OK && r.npts == npts && r.dt == 0.005 &&
-               fabs(r.acc[npts - 1] - 0.01 * v2_value(0, npts - 1)) < 1e-15,
+    int st =
+        read_body(dir, "cm.txt", body, len, PD_RECORD_V2, PD_UNITS_G, &r, &err, path, sizeof path);
+    CHECK(ctx,
+          st == PD_OK && r.npts == npts && r.dt == 0.005 &&
+              fabs(r.acc[npts - 1] - 0.01 * v2_value(0, npts - 1)) < 1e-15,
           "cm/s^2: status %d (%s)", st, err.msg);
     pd_record_free(&r);
     for (size_t i = 0; i < len && n + 2 < sizeof crlf; i++) {
@@ -614,8 +620,8 @@ static void test_record_v2(pd_test_ctx *ctx)
             crlf[n++] = '\r';
         crlf[n++] = body[i];
     }
-    st = read_body(dir, "crlf.V2", crlf, n, PD_RECORD_AUTO, PD_UNITS_G, &r, &err, path,
-                   sizeof path);
+    st =
+        read_body(dir, "crlf.V2", crlf, n, PD_RECORD_AUTO, PD_UNITS_G, &r, &err, path, sizeof path);
     CHECK(ctx, st == PD_OK && r.npts == npts && r.dt == 0.005, "CR LF: status %d (%s)", st,
           err.msg);
     pd_record_free(&r);
@@ -653,8 +659,10 @@ static const v2_damage v2_damages[] = {
     {"blank29.V2", 1, 29, "", 29, "integer header"},
     {"deleted40.V2", 1, 40, NULL, 44, "expected 8 numbers in columns of 10, got '     0.000"},
     {"blank40.V2", 1, 40, "", 40, REAL_HEAD "expected 8 numbers in columns of 10, got a blank"},
-    {"glued27.V2", 1, 27, "    0    0    0    0    0    0    0    0    0    0    0    0    0    0"
-                          "    0    0    7", 27, "integer header"},
+    {"glued27.V2", 1, 27,
+     "    0    0    0    0    0    0    0    0    0    0    0    0    0    0"
+     "    0    0    7",
+     27, "integer header"},
     {"early.V2", 1, 30, "   21" ACC_AT " .020 SEC.", 30,
      "on line 30, but the CDMG V2 header's 45 lines put it on line 46"},
     /* the block header's counts against the headers' */
@@ -677,8 +685,9 @@ static const v2_damage v2_damages[] = {
     {"ints.V2", 1, 28, V2_CUT, 28, "the file ends in the V2 integer header"},
     {"reals.V2", 1, 45, V2_CUT, 45, "the file ends before the acceleration block header"},
     /* without the CDMG layout: channel boundaries */
-    {"blank46-loose.V2", 0, 46, "", 50, "a VELOC data block before the first channel's "
-                                        "acceleration block"},
+    {"blank46-loose.V2", 0, 46, "", 50,
+     "a VELOC data block before the first channel's "
+     "acceleration block"},
     {"end46-loose.V2", 0, 46, "/&  ----------  END OF DATA FOR CHANNEL  1  ----------", 46,
      "the end of a channel ('/&') before the first channel's acceleration block"},
     {"chan46-loose.V2", 0, 46, "CORRECTED ACCELEROGRAM   TEST-2       CHAN  2:  90 DEG", 46,
@@ -713,8 +722,8 @@ static void test_record_v2_damaged(pd_test_ctx *ctx)
         CHECK(ctx, st == PD_EPARSE && err.status == PD_EPARSE, "%s: status %d (%s), npts %ld",
               c->name, st, err.msg, r.npts);
         CHECK(ctx, names_line(err.msg, path, c->says_line) && strstr(err.msg, c->says),
-              "%s: message '%s' should name line %d and say '%s'", c->name, err.msg,
-              c->says_line, c->says);
+              "%s: message '%s' should name line %d and say '%s'", c->name, err.msg, c->says_line,
+              c->says);
         CHECK(ctx, r.acc == NULL && r.npts == 0, "%s: record left empty", c->name);
         CHECK(ctx, !strchr(err.msg, '\n') && !strchr(err.msg, '\r'), "%s: one line", c->name);
         free(bad);
@@ -726,13 +735,14 @@ static void test_record_v2_damaged(pd_test_ctx *ctx)
             char *bad = edit_line(src, V2_ACC_LINE, del ? NULL : "");
             pd_record r = {.npts = 7};
             pd_err err = {0};
-            int st = bad ? read_body(dir, "ce36456p_CE36456.V2", bad, strlen(bad),
-                                     PD_RECORD_AUTO, PD_UNITS_G, &r, &err, path, sizeof path)
+            int st = bad ? read_body(dir, "ce36456p_CE36456.V2", bad, strlen(bad), PD_RECORD_AUTO,
+                                     PD_UNITS_G, &r, &err, path, sizeof path)
                          : PD_ENOMEM;
-            CHECK(ctx, st == PD_EPARSE && names_line(err.msg, path, V2_ACC_LINE) &&
-                       strstr(err.msg, "acceleration block header") && r.acc == NULL &&
-                       r.npts == 0, "shared V2, line 46 %s: status %d (%s), npts %ld",
-                  del ? "deleted" : "blanked", st, err.msg, r.npts);
+            CHECK(ctx,
+                  st == PD_EPARSE && names_line(err.msg, path, V2_ACC_LINE) &&
+                      strstr(err.msg, "acceleration block header") && r.acc == NULL && r.npts == 0,
+                  "shared V2, line 46 %s: status %d (%s), npts %ld", del ? "deleted" : "blanked",
+                  st, err.msg, r.npts);
             free(bad);
         }
         free(src);
@@ -751,18 +761,17 @@ typedef struct bad_case {
 #define AT2_HEAD "PEER\nTEST\nACCELERATION TIME SERIES IN UNITS OF G\n"
 
 static const bad_case bad_cases[] = {
-    {"short.AT2", AT2_HEAD "NPTS=  6, DT= .0100 SEC\n 0.1 0.2 0.3\n 0.4 0.5\n", PD_RECORD_AUTO,
-     6, "truncated"},
-    {"long.AT2", AT2_HEAD "NPTS=  4, DT= .0100 SEC\n 0.1 0.2 0.3\n 0.4 0.5\n", PD_RECORD_AUTO,
-     6, "more values than NPTS"},
+    {"short.AT2", AT2_HEAD "NPTS=  6, DT= .0100 SEC\n 0.1 0.2 0.3\n 0.4 0.5\n", PD_RECORD_AUTO, 6,
+     "truncated"},
+    {"long.AT2", AT2_HEAD "NPTS=  4, DT= .0100 SEC\n 0.1 0.2 0.3\n 0.4 0.5\n", PD_RECORD_AUTO, 6,
+     "more values than NPTS"},
     {"after.AT2", AT2_HEAD "NPTS=  2, DT= .0100 SEC\n 0.1 0.2\n\n 0.3\n", PD_RECORD_AUTO, 7,
      "more values than NPTS"},
     {"nan.AT2", AT2_HEAD "NPTS=  4, DT= .0100 SEC\n 0.1 0.2\n 0.3 NaN\n", PD_RECORD_AUTO, 6,
      "finite"},
-    {"nanglued.AT2", AT2_HEAD "NPTS=  4, DT= .0100 SEC\n -0.731461NaN2 0.2\n", PD_RECORD_AUTO,
-     5, "finite"},
-    {"inf.AT2", AT2_HEAD "NPTS=  3, DT= .0100 SEC\n 0.1 1e999 0.3\n", PD_RECORD_AUTO, 5,
+    {"nanglued.AT2", AT2_HEAD "NPTS=  4, DT= .0100 SEC\n -0.731461NaN2 0.2\n", PD_RECORD_AUTO, 5,
      "finite"},
+    {"inf.AT2", AT2_HEAD "NPTS=  3, DT= .0100 SEC\n 0.1 1e999 0.3\n", PD_RECORD_AUTO, 5, "finite"},
     {"word.AT2", AT2_HEAD "NPTS=  3, DT= .0100 SEC\n 0.1 abc 0.3\n", PD_RECORD_AUTO, 5,
      "expected a number"},
     {"empty.AT2", "", PD_RECORD_AUTO, 1, "empty"},
@@ -791,11 +800,14 @@ static const bad_case bad_cases[] = {
     {"comments.txt", "# nothing\n\n", PD_RECORD_AUTO, 2, "no data"},
     {"empty.txt", "", PD_RECORD_TEXT, 1, "empty"},
     {"header.txt", "time accel\n0 1\n", PD_RECORD_AUTO, 1, "expected a number"},
-    {"trunc.V2", "CORRECTED ACCELEROGRAM\n    5 POINTS OF ACCEL DATA EQUALLY SPACED AT  .020 SEC."
-                 "  (UNITS: CM/SEC/SEC)\n   1.0   2.0\n   3.0\n    5 POINTS OF VELOC DATA\n",
+    {"trunc.V2",
+     "CORRECTED ACCELEROGRAM\n    5 POINTS OF ACCEL DATA EQUALLY SPACED AT  .020 SEC."
+     "  (UNITS: CM/SEC/SEC)\n   1.0   2.0\n   3.0\n    5 POINTS OF VELOC DATA\n",
      PD_RECORD_AUTO, 4, "truncated"},
-    {"units.V2", "CORRECTED ACCELEROGRAM\n    2 POINTS OF ACCEL DATA EQUALLY SPACED AT  .020 SEC."
-                 "  (UNITS: FURLONGS)\n   1.0   2.0\n", PD_RECORD_AUTO, 2, "units"},
+    {"units.V2",
+     "CORRECTED ACCELEROGRAM\n    2 POINTS OF ACCEL DATA EQUALLY SPACED AT  .020 SEC."
+     "  (UNITS: FURLONGS)\n   1.0   2.0\n",
+     PD_RECORD_AUTO, 2, "units"},
     {"noblock.V2", "CORRECTED ACCELEROGRAM\nNOTHING\n", PD_RECORD_V2, 2, "no V2 acceleration"},
     /* header values that break the arithmetic (SIGSEGV at DT = 1e308 before):
      * refused where they are read, with the value */
@@ -807,17 +819,19 @@ static const bad_case bad_cases[] = {
      "DT = 1e-300 s"},
     {"dtlong.AT2", AT2_HEAD "NPTS=  3, DT= 10.5 SEC\n 0.1 0.2 0.3\n", PD_RECORD_AUTO, 4,
      "DT = 10.5 s"},
-    {"dtbig.V2", "CORRECTED ACCELEROGRAM\n    2 POINTS OF ACCEL DATA EQUALLY SPACED AT  1e308 "
-                 "SEC.  (UNITS: CM/SEC/SEC)\n   1.0   2.0\n", PD_RECORD_AUTO, 2,
-     "DT = 1e+308 s"},
-    {"dttiny.V2", "CORRECTED ACCELEROGRAM\nX\n    2 POINTS OF ACCEL DATA EQUALLY SPACED AT  "
-                  "1e-300 SEC.  (UNITS: G)\n   1.0   2.0\n", PD_RECORD_AUTO, 3, "DT = 1e-300 s"},
+    {"dtbig.V2",
+     "CORRECTED ACCELEROGRAM\n    2 POINTS OF ACCEL DATA EQUALLY SPACED AT  1e308 "
+     "SEC.  (UNITS: CM/SEC/SEC)\n   1.0   2.0\n",
+     PD_RECORD_AUTO, 2, "DT = 1e+308 s"},
+    {"dttiny.V2",
+     "CORRECTED ACCELEROGRAM\nX\n    2 POINTS OF ACCEL DATA EQUALLY SPACED AT  "
+     "1e-300 SEC.  (UNITS: G)\n   1.0   2.0\n",
+     PD_RECORD_AUTO, 3, "DT = 1e-300 s"},
     {"tinystep.txt", "# t a\n0 1\n1e-300 2\n2e-300 3\n", PD_RECORD_AUTO, 4,
      "the time step = 1e-300 s"},
     {"bigstep.txt", "0 1\n1e300 2\n2e300 3\n", PD_RECORD_AUTO, 3, "the time step = 1e+300 s"},
     {"infstep.txt", "-1e308 1\n1e308 2\n", PD_RECORD_AUTO, 2, "the time step = inf s"},
-    {"repeatfast.txt", "0 1\n0.01 2\n0.01 3\n0.02 4\n0.03 5\n", PD_RECORD_TEXT, 3,
-     "must increase"},
+    {"repeatfast.txt", "0 1\n0.01 2\n0.01 3\n0.02 4\n0.03 5\n", PD_RECORD_TEXT, 3, "must increase"},
     {"accinf.txt", "0 1\n0.01 1e308\n0.02 0\n", PD_RECORD_AUTO, 2,
      "acceleration 1e+308 times 9.80665 m/s^2 per unit is not a finite number"},
     {"accinf.AT2", AT2_HEAD "NPTS=  3, DT= .0100 SEC\n 0.1 -1e308 0.3\n", PD_RECORD_AUTO, 5,
@@ -834,10 +848,10 @@ static void test_record_malformed(pd_test_ctx *ctx)
         const bad_case *c = &bad_cases[i];
         pd_record r = {.npts = 7};
         pd_err err = {0};
-        int st = read_body(dir, c->name, c->body, strlen(c->body), c->format, PD_UNITS_G, &r,
-                           &err, path, sizeof path);
-        CHECK(ctx, st == PD_EPARSE && err.status == PD_EPARSE, "%s: status %d (%s)", c->name,
-              st, err.msg);
+        int st = read_body(dir, c->name, c->body, strlen(c->body), c->format, PD_UNITS_G, &r, &err,
+                           path, sizeof path);
+        CHECK(ctx, st == PD_EPARSE && err.status == PD_EPARSE, "%s: status %d (%s)", c->name, st,
+              err.msg);
         CHECK(ctx, names_line(err.msg, path, c->line) && strstr(err.msg, c->says),
               "%s: message '%s' should name line %d and say '%s'", c->name, err.msg, c->line,
               c->says);
@@ -867,10 +881,12 @@ static void test_record_unreadable(pd_test_ctx *ctx)
         char *src = pd_test_slurp(rin);
         if (CHECK(ctx, src != NULL, "read %s", rin)) {
             /* the acceptance check's cut: the first third of the bytes */
-            st = read_body(dir, "truncated.AT2", src, strlen(src) / 3, PD_RECORD_AUTO,
-                           PD_UNITS_G, &r, &err, path, sizeof path);
-            CHECK(ctx, st == PD_EPARSE && strstr(err.msg, "truncated.AT2:") &&
-                       strstr(err.msg, "truncated"), "truncated: %d %s", st, err.msg);
+            st = read_body(dir, "truncated.AT2", src, strlen(src) / 3, PD_RECORD_AUTO, PD_UNITS_G,
+                           &r, &err, path, sizeof path);
+            CHECK(ctx,
+                  st == PD_EPARSE && strstr(err.msg, "truncated.AT2:") &&
+                      strstr(err.msg, "truncated"),
+                  "truncated: %d %s", st, err.msg);
         }
         free(src);
     }
@@ -882,13 +898,17 @@ static void test_record_names(pd_test_ctx *ctx)
 {
     for (int f = PD_RECORD_AUTO; f <= PD_RECORD_TEXT; f++) {
         pd_record_format g = PD_RECORD_AUTO;
-        CHECK(ctx, pd_record_format_parse(pd_record_format_name((pd_record_format)f), &g) ==
-                       PD_OK && (int)g == f, "format %d", f);
+        CHECK(ctx,
+              pd_record_format_parse(pd_record_format_name((pd_record_format)f), &g) == PD_OK &&
+                  (int)g == f,
+              "format %d", f);
     }
     for (int u = PD_UNITS_G; u <= PD_UNITS_CM_S2; u++) {
         pd_record_units v = PD_UNITS_G;
-        CHECK(ctx, pd_record_units_parse(pd_record_units_name((pd_record_units)u), &v) == PD_OK &&
-                       (int)v == u, "units %d", u);
+        CHECK(ctx,
+              pd_record_units_parse(pd_record_units_name((pd_record_units)u), &v) == PD_OK &&
+                  (int)v == u,
+              "units %d", u);
     }
     pd_record_format g;
     pd_record_units v;
@@ -961,10 +981,10 @@ static void fit_synthetic(pd_test_ctx *ctx, const mp_true *p, double noise, doub
     if (st == PD_OK) {
         CHECK(ctx, fabs(q.vp - p->vp) <= tol * p->vp, "noise %g: vp %.9g vs %g", noise, q.vp,
               p->vp);
-        CHECK(ctx, fabs(q.Tp - 1.0 / p->fp) <= tol / p->fp, "noise %g: Tp %.9g vs %g", noise,
-              q.Tp, 1.0 / p->fp);
-        CHECK(ctx, fabs(q.gamma - p->gamma) <= tol * p->gamma, "noise %g: gamma %.9g vs %g",
-              noise, q.gamma, p->gamma);
+        CHECK(ctx, fabs(q.Tp - 1.0 / p->fp) <= tol / p->fp, "noise %g: Tp %.9g vs %g", noise, q.Tp,
+              1.0 / p->fp);
+        CHECK(ctx, fabs(q.gamma - p->gamma) <= tol * p->gamma, "noise %g: gamma %.9g vs %g", noise,
+              q.gamma, p->gamma);
         CHECK(ctx, fabs(q.nu - p->nu) <= tol * PD_PI, "noise %g: nu %.9g vs %g", noise, q.nu,
               p->nu);
         CHECK(ctx, fabs(q.t0 - p->t0) <= tol / p->fp, "noise %g: t0 %.9g vs %g", noise, q.t0,
@@ -1024,9 +1044,9 @@ static void test_record_fit_pulse_like(pd_test_ctx *ctx)
                   cases[i].file, p.Tp, cases[i].Tp);
             CHECK(ctx, p.r2 >= cases[i].r2_min, "%s: r2 %.3f < %.2f", cases[i].file, p.r2,
                   cases[i].r2_min);
-            CHECK(ctx, p.gamma > 1.0 && p.gamma < 4.0 && p.nu > -PD_PI && p.nu <= PD_PI &&
-                           p.vp > 0.0, "%s: gamma %g nu %g vp %g", cases[i].file, p.gamma, p.nu,
-                  p.vp);
+            CHECK(ctx,
+                  p.gamma > 1.0 && p.gamma < 4.0 && p.nu > -PD_PI && p.nu <= PD_PI && p.vp > 0.0,
+                  "%s: gamma %g nu %g vp %g", cases[i].file, p.gamma, p.nu, p.vp);
         }
         pd_record_free(&r);
     }
@@ -1046,10 +1066,11 @@ static void test_record_fit_all(pd_test_ctx *ctx)
         CHECK(ctx, st == PD_OK || (st == PD_ENUMERICAL && err.msg[0]), "%s: %d %s",
               shared_cases[i].file, st, err.msg);
         if (st == PD_OK)
-            CHECK(ctx, isfinite(p.r2) && p.Tp > 0.0 && isfinite(p.ap) && p.ap > 0.0 &&
-                           p.Le > 0.0 && (p.shape == PD_PULSE_SINE || p.shape == PD_PULSE_COSINE) &&
-                           (p.polarity == 1 || p.polarity == -1) && p.t_start >= 0.0 &&
-                           p.t_start <= pd_record_duration(&r),
+            CHECK(ctx,
+                  isfinite(p.r2) && p.Tp > 0.0 && isfinite(p.ap) && p.ap > 0.0 && p.Le > 0.0 &&
+                      (p.shape == PD_PULSE_SINE || p.shape == PD_PULSE_COSINE) &&
+                      (p.polarity == 1 || p.polarity == -1) && p.t_start >= 0.0 &&
+                      p.t_start <= pd_record_duration(&r),
                   "%s: Tp %g ap %g r2 %g t_start %g", shared_cases[i].file, p.Tp, p.ap, p.r2,
                   p.t_start);
         pd_record_free(&r);
@@ -1124,9 +1145,10 @@ static void test_record_fit_bad_dt(pd_test_ctx *ctx)
     for (int i = 0; i < 4; i++) {
         r.dt = dts[i];
         int st = pd_record_fit_pulse(&r, &p, &err);
-        CHECK(ctx, st == PD_EINVAL && strstr(err.msg, "synthetic: dt = ") &&
-                   strstr(err.msg, "sampling interval"), "fit, dt = %g: %d %s", dts[i], st,
-              err.msg);
+        CHECK(ctx,
+              st == PD_EINVAL && strstr(err.msg, "synthetic: dt = ") &&
+                  strstr(err.msg, "sampling interval"),
+              "fit, dt = %g: %d %s", dts[i], st, err.msg);
         st = pd_record_measure(&r, &m, &err);
         CHECK(ctx, st == PD_EINVAL, "measures, dt = %g: %d %s", dts[i], st, err.msg);
     }
@@ -1188,8 +1210,10 @@ static void test_record_bounded_input(pd_test_ctx *ctx)
     pd_record r = {0};
     pd_err err = {0};
     int st = pd_record_read("/dev/zero", PD_RECORD_TEXT, PD_UNITS_G, &r, &err);
-    CHECK(ctx, st == PD_EINVAL && strstr(err.msg, "/dev/zero: not a regular file (a device)") &&
-               r.acc == NULL, "/dev/zero: %d %s", st, err.msg);
+    CHECK(ctx,
+          st == PD_EINVAL && strstr(err.msg, "/dev/zero: not a regular file (a device)") &&
+              r.acc == NULL,
+          "/dev/zero: %d %s", st, err.msg);
     if (!CHECK(ctx, pd_test_zero_file(zero_path, sizeof zero_path, 3LL << 30) == 0,
                "a sparse file"))
         return;
@@ -1201,8 +1225,8 @@ static void test_record_bounded_input(pd_test_ctx *ctx)
     if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
         return;
     static const char at2[] = AT2_HEAD "NPTS=  4, DT= .0100 SEC\n 0.1 0.2\n 0.3\0 0.4\n";
-    st = read_body(dir, "nul.AT2", at2, sizeof at2 - 1, PD_RECORD_AUTO, PD_UNITS_G, &r, &err,
-                   path, sizeof path);
+    st = read_body(dir, "nul.AT2", at2, sizeof at2 - 1, PD_RECORD_AUTO, PD_UNITS_G, &r, &err, path,
+                   sizeof path);
     CHECK(ctx, st == PD_EPARSE && names_line(err.msg, path, 6) && strstr(err.msg, "NUL"),
           "NUL on line 6: %d %s", st, err.msg);
     pd_record_free(&r);
@@ -1242,10 +1266,14 @@ static void test_record_text_reader_caps(pd_test_ctx *ctx)
         while ((st = pd_text_line(&t)) == 1)
             lines++;
     snprintf(want, sizeof want, "%s:4: the file is larger than 20 bytes", path);
-    CHECK(ctx, lines == 3 && st == PD_EPARSE && strstr(err.msg, want), "lines, cap 20: %d lines, "
-          "%d %s", lines, st, err.msg);
-    CHECK(ctx, pd_text_rewind(&t) == PD_OK && pd_text_line(&t) == 1 && t.lineno == 1 &&
-               !strcmp(t.line, "0 1\n"), "rewound: line %ld '%s'", t.lineno, t.line);
+    CHECK(ctx, lines == 3 && st == PD_EPARSE && strstr(err.msg, want),
+          "lines, cap 20: %d lines, "
+          "%d %s",
+          lines, st, err.msg);
+    CHECK(ctx,
+          pd_text_rewind(&t) == PD_OK && pd_text_line(&t) == 1 && t.lineno == 1 &&
+              !strcmp(t.line, "0 1\n"),
+          "rewound: line %ld '%s'", t.lineno, t.line);
     pd_text_close(&t);
     static const char nul[] = "{\n  \"a\": 1,\n  \"b\0\": 2\n}\n";
     write_file(dir, "nul.json", nul, sizeof nul - 1, path, sizeof path);
@@ -1267,14 +1295,15 @@ static void test_record_from_array(pd_test_ctx *ctx)
     pd_err err;
     if (shared_record(ctx, "NGA_no_1063_RRS228.AT2", path, sizeof path) != 0)
         return;
-    if (!CHECK(ctx, pd_record_read(path, PD_RECORD_AUTO, PD_UNITS_G, &file, &err) == PD_OK,
-               "%s", err.msg))
+    if (!CHECK(ctx, pd_record_read(path, PD_RECORD_AUTO, PD_UNITS_G, &file, &err) == PD_OK, "%s",
+               err.msg))
         return;
-    int rc = pd_record_from_array(&arr, "rinaldi", file.acc, file.npts, file.dt, PD_UNITS_M_S2,
-                                  &err);
-    CHECK(ctx, rc == PD_OK && arr.npts == file.npts && arr.dt == file.dt &&
-                   !memcmp(arr.acc, file.acc, (size_t)file.npts * sizeof(double)) &&
-                   !strcmp(arr.name, "rinaldi"),
+    int rc =
+        pd_record_from_array(&arr, "rinaldi", file.acc, file.npts, file.dt, PD_UNITS_M_S2, &err);
+    CHECK(ctx,
+          rc == PD_OK && arr.npts == file.npts && arr.dt == file.dt &&
+              !memcmp(arr.acc, file.acc, (size_t)file.npts * sizeof(double)) &&
+              !strcmp(arr.name, "rinaldi"),
           "from_array: status %d (%s)", rc, err.msg);
     pd_record_pulse pf, pa;
     pd_osc_result rf, ra;
@@ -1301,11 +1330,12 @@ static void test_record_from_array(pd_test_ctx *ctx)
     pd_record text = {0};
     if (CHECK(ctx, mkdtemp(dir) && write_file(dir, "g.txt", body, len, tpath, sizeof tpath) == 0,
               "scratch file") &&
-        CHECK(ctx, pd_record_read(tpath, PD_RECORD_TEXT, PD_UNITS_G, &text, &err) == PD_OK,
-              "%s", err.msg)) {
+        CHECK(ctx, pd_record_read(tpath, PD_RECORD_TEXT, PD_UNITS_G, &text, &err) == PD_OK, "%s",
+              err.msg)) {
         rc = pd_record_from_array(&arr, NULL, g, 5, 0.01, PD_UNITS_G, &err);
-        CHECK(ctx, rc == PD_OK && !memcmp(arr.acc, text.acc, 5 * sizeof(double)) &&
-                       !strcmp(arr.name, "array"),
+        CHECK(ctx,
+              rc == PD_OK && !memcmp(arr.acc, text.acc, 5 * sizeof(double)) &&
+                  !strcmp(arr.name, "array"),
               "g: status %d, arrays differ", rc);
         pd_record_free(&arr);
     }
@@ -1316,16 +1346,18 @@ static void test_record_from_array(pd_test_ctx *ctx)
     double bad[3] = {0.1, NAN, 0.2}, huge[2] = {1e308, 0.0}, ok2[2] = {0.1, 0.2};
     CHECK(ctx, pd_record_from_array(&arr, NULL, ok2, 1, 0.01, PD_UNITS_G, &err) == PD_EINVAL,
           "one sample");
-    CHECK(ctx, pd_record_from_array(&arr, NULL, ok2, 2, 0.0, PD_UNITS_G, &err) == PD_EINVAL &&
-                   strstr(err.msg, "record_dt"),
+    CHECK(ctx,
+          pd_record_from_array(&arr, NULL, ok2, 2, 0.0, PD_UNITS_G, &err) == PD_EINVAL &&
+              strstr(err.msg, "record_dt"),
           "dt 0: %s", err.msg);
-    CHECK(ctx, pd_record_from_array(&arr, NULL, bad, 3, 0.01, PD_UNITS_G, &err) == PD_EINVAL &&
-                   strstr(err.msg, "sample 1"),
+    CHECK(ctx,
+          pd_record_from_array(&arr, NULL, bad, 3, 0.01, PD_UNITS_G, &err) == PD_EINVAL &&
+              strstr(err.msg, "sample 1"),
           "NaN: %s", err.msg);
     CHECK(ctx, pd_record_from_array(&arr, NULL, huge, 2, 0.01, PD_UNITS_G, &err) == PD_EINVAL,
           "1e308 g: %s", err.msg);
-    CHECK(ctx, pd_record_from_array(&arr, NULL, ok2, 2, 0.01, (pd_record_units)7, &err) ==
-                   PD_EINVAL,
+    CHECK(ctx,
+          pd_record_from_array(&arr, NULL, ok2, 2, 0.01, (pd_record_units)7, &err) == PD_EINVAL,
           "units 7");
     CHECK(ctx, arr.acc == NULL && arr.npts == 0, "a refused array leaves the record empty");
     pd_record_free(&file);
@@ -1347,8 +1379,7 @@ static void test_record_units_plausible(pd_test_ctx *ctx)
         return;
     CHECK(ctx, pd_record_plausible(&r, PD_UNITS_G, msg, sizeof msg) == 1, "Rinaldi in g");
     /* the samples in m/s^2 typed as if they were g */
-    if (CHECK(ctx, pd_record_from_array(&x, "as-g", r.acc, r.npts, r.dt, PD_UNITS_G, &err) ==
-                       PD_OK,
+    if (CHECK(ctx, pd_record_from_array(&x, "as-g", r.acc, r.npts, r.dt, PD_UNITS_G, &err) == PD_OK,
               "%s", err.msg)) {
         int p = pd_record_plausible(&x, PD_UNITS_G, msg, sizeof msg);
         CHECK(ctx, p == 0 && strstr(msg, "more than 5 g") && strstr(msg, "m/s2"),

@@ -65,8 +65,8 @@ static void test_records_sampled_pulse(pd_test_ctx *ctx)
         int rc = pd_osc_reference(&c, &o, NULL, NULL, &r, &err);
         errs[k] = fabs(r.umax - exact.umax) / exact.umax;
         CHECK(ctx, rc == PD_OK && r.impacts == exact.impacts,
-              "sampled %d: status %d (%s), %ld impacts against %ld", n[k], rc, err.msg,
-              r.impacts, exact.impacts);
+              "sampled %d: status %d (%s), %ld impacts against %ld", n[k], rc, err.msg, r.impacts,
+              exact.impacts);
         pd_record_free(&rec);
     }
     double order = log(errs[0] / errs[1]) / log(10.0);
@@ -144,12 +144,13 @@ static void test_records_moreau_converges(pd_test_ctx *ctx)
     }
     double order = log(e[0] / e[3]) / log(8.0);
     CHECK(ctx, ref.impacts > 5 && e[3] <= 1e-3 && order >= 0.8,
-          "%ld impacts; umax errors %.3g %.3g %.3g %.3g: order %.2f", ref.impacts, e[0], e[1],
-          e[2], e[3], order);
+          "%ld impacts; umax errors %.3g %.3g %.3g %.3g: order %.2f", ref.impacts, e[0], e[1], e[2],
+          e[3], order);
     double slope = fitted_slope(h + 3, e + 3, RINALDI_DTS - 3);
     CHECK(ctx, fabs(slope - RINALDI_SLOPE) <= RINALDI_SLOPE_TOL,
           "fitted slope %.3g over dt = 5e-4 ... 6.25e-5 s (errors %.3g %.3g %.3g %.3g), "
-          "docs/records.md: %.2f", slope, e[3], e[4], e[5], e[6], RINALDI_SLOPE);
+          "docs/records.md: %.2f",
+          slope, e[3], e[4], e[5], e[6], RINALDI_SLOPE);
     pd_record_free(&rec);
 }
 
@@ -162,8 +163,8 @@ static void test_records_scene(pd_test_ctx *ctx)
     if (!CHECK(ctx, sampled_pulse(&rec, 2.0, 0.5, 80) == 0, "memory"))
         return;
     pd_osc c = record_case(&rec, 2.0, 0.5, 1.0);
-    pd_scene_excitation x = {.dir = 1, .ap = c.ap, .Tp = c.Tp, .record = &rec,
-                             .rec_ap = c.rec_ap, .scale = 1.0};
+    pd_scene_excitation x = {
+        .dir = 1, .ap = c.ap, .Tp = c.Tp, .record = &rec, .rec_ap = c.rec_ap, .scale = 1.0};
     pd_scene *sc = pd_scene_new(&x);
     pd_err err;
     int ok = sc && !pd_scene_add_sdof(sc, "o", pd_osc_T0(&c), c.xi, 1.0, &err) &&
@@ -244,8 +245,8 @@ static void test_records_cli(pd_test_ctx *ctx)
     proc_out r;
     const char *a1[] = {"record", path, "--units", "m/s2", "--json", NULL};
     pd_test_pound(ctx, a1, &r);
-    const char *keys[] = {"npts", "dt", "pga", "pgv", "pgd", "arias", "t5_75", "t5_95", "Tp", "vp",
-                          "ap", "Le"};
+    const char *keys[] = {"npts",  "dt",    "pga", "pgv", "pgd", "arias",
+                          "t5_75", "t5_95", "Tp",  "vp",  "ap",  "Le"};
     CHECK(ctx, r.status == 0, "record: exit %d: %s", r.status, r.err);
     for (size_t k = 0; r.status == 0 && k < sizeof keys / sizeof keys[0]; k++)
         CHECK(ctx, isfinite(pd_test_json_num(r.out, keys[k], 0)), "record --json: key %s", keys[k]);
@@ -253,18 +254,19 @@ static void test_records_cli(pd_test_ctx *ctx)
     double r2 = pd_test_json_num(r.out, "r2", 0);
     char shape[16] = "";
     pd_test_json_str(r.out ? r.out : "", "shape", 0, shape, sizeof shape);
-    CHECK(ctx, Tp >= 0.5 && Tp <= 0.6 && r2 >= 0.95 && !strcmp(shape, "cosine") &&
-                   fabs(pga - 2.0) <= 1e-12,
+    CHECK(ctx,
+          Tp >= 0.5 && Tp <= 0.6 && r2 >= 0.95 && !strcmp(shape, "cosine") &&
+              fabs(pga - 2.0) <= 1e-12,
           "the cosine record's pulse: Tp %g s (0.5), r2 %g, shape %s, PGA %g (2)", Tp, r2, shape,
           pga);
     pd_test_proc_free(&r);
-    const char *a2[] = {"simulate", "--record", path, "--units", "m/s2", "--scale", "2", "--T0",
-                        "0.4", "--gap", "0.002", "--json", NULL};
+    const char *a2[] = {"simulate", "--record", path,    "--units", "m/s2",   "--scale", "2",
+                        "--T0",     "0.4",      "--gap", "0.002",   "--json", NULL};
     pd_test_pound(ctx, a2, &r);
     char name[64] = "";
     pd_test_json_str(r.out ? r.out : "", "record", 0, name, sizeof name);
-    CHECK(ctx, r.status == 0 && !strcmp(name, "sine.txt") &&
-                   pd_test_json_num(r.out, "scale", 0) == 2.0,
+    CHECK(ctx,
+          r.status == 0 && !strcmp(name, "sine.txt") && pd_test_json_num(r.out, "scale", 0) == 2.0,
           "simulate --record: exit %d, record '%s': %s", r.status, name, r.err);
     pd_test_proc_free(&r);
     const char *bad[][8] = {{"simulate", "--record", path, "--pulse", "sine", NULL},
@@ -277,8 +279,8 @@ static void test_records_cli(pd_test_ctx *ctx)
         int lines = 0;
         for (const char *p = r.err; p && *p; p++)
             lines += *p == '\n';
-        CHECK(ctx, r.status == 2 && lines == 1, "bad flags %zu: exit %d, %d lines: %s", k,
-              r.status, lines, r.err);
+        CHECK(ctx, r.status == 2 && lines == 1, "bad flags %zu: exit %d, %d lines: %s", k, r.status,
+              lines, r.err);
         pd_test_proc_free(&r);
     }
     temp_remove(path);
@@ -296,10 +298,11 @@ static void test_records_scene_file(pd_test_ctx *ctx)
     if (!CHECK(ctx, rec[0], "temporary record"))
         return;
     snprintf(scene, sizeof scene, "%.*s/scene.json", (int)(strrchr(rec, '/') - rec), rec);
-    const char *good = "{\"excitation\": {\"record\": \"sine.txt\", \"units\": \"m/s2\"},\n"
-                       " \"structures\": [{\"name\": \"a\", \"T0\": 0.4, \"xi\": 0.05, \"mass\": 1},\n"
-                       "                {\"name\": \"b\", \"T0\": 0.9, \"xi\": 0.05, \"mass\": 1}],\n"
-                       " \"contacts\": [{\"a\": \"a\", \"b\": \"b\", \"gap\": 0.001, \"eps\": 0.5}]}\n";
+    const char *good =
+        "{\"excitation\": {\"record\": \"sine.txt\", \"units\": \"m/s2\"},\n"
+        " \"structures\": [{\"name\": \"a\", \"T0\": 0.4, \"xi\": 0.05, \"mass\": 1},\n"
+        "                {\"name\": \"b\", \"T0\": 0.9, \"xi\": 0.05, \"mass\": 1}],\n"
+        " \"contacts\": [{\"a\": \"a\", \"b\": \"b\", \"gap\": 0.001, \"eps\": 0.5}]}\n";
     FILE *f = fopen(scene, "w");
     if (f) {
         fputs(good, f);
@@ -316,7 +319,8 @@ static void test_records_scene_file(pd_test_ctx *ctx)
     f = fopen(scene, "w");
     if (f) {
         fputs("{\"excitation\": {\"record\": \"sine.txt\", \"pulse\": \"sine\"},\n"
-              " \"structures\": [{\"name\": \"a\", \"T0\": 0.4, \"xi\": 0.05, \"mass\": 1}]}\n", f);
+              " \"structures\": [{\"name\": \"a\", \"T0\": 0.4, \"xi\": 0.05, \"mass\": 1}]}\n",
+              f);
         fclose(f);
     }
     pd_test_pound(ctx, a1, &r);

@@ -31,8 +31,14 @@ static void test_ref_no_wall_is_closed_form(pd_test_ctx *ctx)
 {
     const pd_pulse pulses[] = {PD_PULSE_SINE, PD_PULSE_COSINE, PD_PULSE_HARMONIC};
     for (int p = 0; p < 3; p++) {
-        pd_osc c = {.pulse = pulses[p], .dir = -1, .ap = 3.0, .Tp = 0.7, .Pi2 = 0.8,
-                    .Pi3 = 0.0, .eps = 0.5, .xi = 0.05};
+        pd_osc c = {.pulse = pulses[p],
+                    .dir = -1,
+                    .ap = 3.0,
+                    .Tp = 0.7,
+                    .Pi2 = 0.8,
+                    .Pi3 = 0.0,
+                    .eps = 0.5,
+                    .xi = 0.05};
         pd_run_opts o = pd_run_default_opts();
         pd_osc_result r;
         pd_err e;
@@ -180,8 +186,14 @@ static void test_ref_energy_balance(pd_test_ctx *ctx)
 {
     const double es[] = {1.0, 0.6};
     for (int k = 0; k < 2; k++) {
-        pd_osc c = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 2.0, .Tp = 0.5, .Pi2 = 0.8,
-                    .Pi3 = 0.2, .eps = es[k], .xi = 0.05};
+        pd_osc c = {.pulse = PD_PULSE_SINE,
+                    .dir = 1,
+                    .ap = 2.0,
+                    .Tp = 0.5,
+                    .Pi2 = 0.8,
+                    .Pi3 = 0.2,
+                    .eps = es[k],
+                    .xi = 0.05};
         pd_run_opts o = pd_run_default_opts();
         pd_osc_result r;
         pd_err e;
@@ -194,8 +206,8 @@ static void test_ref_energy_balance(pd_test_ctx *ctx)
         double loss = E - (wo.work - wo.damp);
         /* the trapezoid rule meets each impact's jump of f v: O(h) per impact */
         if (es[k] == 1.0)
-            CHECK(ctx, fabs(loss) <= 1e-5 * wo.work, "e = 1: balance off by %.3g (work %.3g)",
-                  loss, wo.work);
+            CHECK(ctx, fabs(loss) <= 1e-5 * wo.work, "e = 1: balance off by %.3g (work %.3g)", loss,
+                  wo.work);
         else /* the impact losses are what the balance misses */
             CHECK(ctx, loss < -1e-3 * wo.work && r.impacts > 0,
                   "e = 0.6: impacts must dissipate (%.3g, %ld impacts)", loss, r.impacts);
@@ -216,8 +228,13 @@ static void test_ref_self_consistent_on_grid(pd_test_ctx *ctx)
                 for (int j = 0; j < 4; j++)
                     for (int k = 0; k < 4; k++) {
                         pd_osc c = {.pulse = p ? PD_PULSE_COSINE : PD_PULSE_SINE,
-                                    .dir = dir, .ap = 1.0, .Tp = 1.0, .Pi2 = Pi2s[i],
-                                    .Pi3 = Pi3s[j], .eps = epss[k], .xi = 0.05};
+                                    .dir = dir,
+                                    .ap = 1.0,
+                                    .Tp = 1.0,
+                                    .Pi2 = Pi2s[i],
+                                    .Pi3 = Pi3s[j],
+                                    .eps = epss[k],
+                                    .xi = 0.05};
                         pd_osc_result r;
                         pd_err e;
                         pd_ed_result fine;
@@ -228,7 +245,7 @@ static void test_ref_self_consistent_on_grid(pd_test_ctx *ctx)
                         /* the same problem, bracketing grid 8x finer */
                         double phi = p ? TWO_PI / 4 : 0.0;
                         pd_sine_piece pc[2] = {{.t_start = 0, .A = (double)dir, .w = 1, .phi = phi},
-                                                {.t_start = TWO_PI}};
+                                               {.t_start = TWO_PI}};
                         pd_ed_sdof prob = {{Pi2s[i], 0.05}, 1, Pi3s[j], epss[k], 2, pc};
                         pd_ed_opts o;
                         o = pd_ed_default_opts();
@@ -258,8 +275,12 @@ static void test_ref_chatter_contact_time_consistent(pd_test_ctx *ctx)
     const int divs[] = {16, 64, 65, 512, 4096};
     pd_sine_piece pc[2] = {{.t_start = 0.0, .A = 1.0, .w = 1.0, .phi = TWO_PI / 4},
                            {.t_start = TWO_PI}};
-    pd_ed_sdof prob = {.osc = {.w0 = 0.7, .xi = 0.05}, .wall = 1, .delta = 0.001, .e = 0.9,
-                       .npieces = 2, .pieces = pc};
+    pd_ed_sdof prob = {.osc = {.w0 = 0.7, .xi = 0.05},
+                       .wall = 1,
+                       .delta = 0.001,
+                       .e = 0.9,
+                       .npieces = 2,
+                       .pieces = pc};
     double ct[5];
     for (int k = 0; k < 5; k++) {
         pd_ed_opts o = pd_ed_default_opts();
@@ -269,8 +290,8 @@ static void test_ref_chatter_contact_time_consistent(pd_test_ctx *ctx)
         o.scan_divisions = divs[k];
         CHECK(ctx, pd_ed_sdof_run(&prob, 0.0, 0.0, &o, NULL, NULL, &r, &err) == PD_OK, "%s",
               err.msg);
-        CHECK(ctx, r.accumulations == 1 && r.impacts > 60, "grid %d: %ld accumulations, %ld impacts",
-              divs[k], r.accumulations, r.impacts);
+        CHECK(ctx, r.accumulations == 1 && r.impacts > 60,
+              "grid %d: %ld accumulations, %ld impacts", divs[k], r.accumulations, r.impacts);
         ct[k] = r.contact_time;
         CHECK(ctx, fabs(ct[k] - ct[0]) <= 1e-11, "grid %d: contact time %.17g vs %.17g", divs[k],
               ct[k], ct[0]);
@@ -294,11 +315,22 @@ static int record_u(const pd_osc_sample *s, void *ctx)
 
 static void test_ref_moreau_order_one(pd_test_ctx *ctx)
 {
-    const pd_osc cases[] = {
-        {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5, .Pi3 = 0.05,
-         .eps = 0.6, .xi = 0.05},
-        {.pulse = PD_PULSE_COSINE, .dir = -1, .ap = 1.0, .Tp = 1.0, .Pi2 = 1.16, .Pi3 = 0.05,
-         .eps = 0.2, .xi = 0.05}};
+    const pd_osc cases[] = {{.pulse = PD_PULSE_SINE,
+                             .dir = 1,
+                             .ap = 1.0,
+                             .Tp = 1.0,
+                             .Pi2 = 0.5,
+                             .Pi3 = 0.05,
+                             .eps = 0.6,
+                             .xi = 0.05},
+                            {.pulse = PD_PULSE_COSINE,
+                             .dir = -1,
+                             .ap = 1.0,
+                             .Tp = 1.0,
+                             .Pi2 = 1.16,
+                             .Pi3 = 0.05,
+                             .eps = 0.2,
+                             .xi = 0.05}};
     for (int c = 0; c < 2; c++) {
         double err[4];
         for (int k = 0; k < 4; k++) {
@@ -307,9 +339,12 @@ static void test_ref_moreau_order_one(pd_test_ctx *ctx)
             pd_err e;
             o.dt = cases[c].Tp / (2000.0 * (1 << k));
             long cap = pd_steps_for(pd_osc_default_tend(&cases[c]), o.dt) + 2;
-            hist hm = {malloc(cap * sizeof(double)), 0, cap}, hr = {malloc(cap * sizeof(double)), 0, cap};
-            CHECK(ctx, pd_osc_simulate(&cases[c], &o, record_u, &hm, &rm, &e) == PD_OK, "%s", e.msg);
-            CHECK(ctx, pd_osc_reference(&cases[c], &o, record_u, &hr, &rr, &e) == PD_OK, "%s", e.msg);
+            hist hm = {malloc(cap * sizeof(double)), 0, cap},
+                 hr = {malloc(cap * sizeof(double)), 0, cap};
+            CHECK(ctx, pd_osc_simulate(&cases[c], &o, record_u, &hm, &rm, &e) == PD_OK, "%s",
+                  e.msg);
+            CHECK(ctx, pd_osc_reference(&cases[c], &o, record_u, &hr, &rr, &e) == PD_OK, "%s",
+                  e.msg);
             CHECK(ctx, labs(hm.n - hr.n) <= 1, "grids %ld vs %ld", hm.n, hr.n);
             double w = 0;
             for (long i = 0; i < hm.n && i < hr.n; i++)
@@ -334,26 +369,44 @@ static void test_ref_moreau_order_one(pd_test_ctx *ctx)
  * isolated-impact case at the 1/kc rate. */
 static void test_ref_stiff_penalty_limit(pd_test_ctx *ctx)
 {
-    const pd_osc cases[] = {
-        {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0, .Pi2 = 0.5, .Pi3 = 0.05,
-         .eps = 0.6, .xi = 0.05},
-        {.pulse = PD_PULSE_COSINE, .dir = -1, .ap = 1.0, .Tp = 1.0, .Pi2 = 1.16, .Pi3 = 0.3,
-         .eps = 0.2, .xi = 0.05}};
+    const pd_osc cases[] = {{.pulse = PD_PULSE_SINE,
+                             .dir = 1,
+                             .ap = 1.0,
+                             .Tp = 1.0,
+                             .Pi2 = 0.5,
+                             .Pi3 = 0.05,
+                             .eps = 0.6,
+                             .xi = 0.05},
+                            {.pulse = PD_PULSE_COSINE,
+                             .dir = -1,
+                             .ap = 1.0,
+                             .Tp = 1.0,
+                             .Pi2 = 1.16,
+                             .Pi3 = 0.3,
+                             .eps = 0.2,
+                             .xi = 0.05}};
     for (int c = 0; c < 2; c++) {
         pd_osc_result rr, rp;
         pd_err e;
         CHECK(ctx, pd_osc_reference(&cases[c], NULL, NULL, NULL, &rr, &e) == PD_OK, "%s", e.msg);
         double err[3];
         for (int k = 0; k < 3; k++) {
-            pd_penalty_setup po = {.law = PD_PENALTY_KELVIN, .kc_mult = pow(100.0, k + 2), .kc_abs = 0, .rtol = 0, .atol = 0, .stepper = NULL};
-            CHECK(ctx, pd_osc_penalty(&cases[c], (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL, NULL, &rp, &e) == PD_OK, "%s",
-                  e.msg);
+            pd_penalty_setup po = {.law = PD_PENALTY_KELVIN,
+                                   .kc_mult = pow(100.0, k + 2),
+                                   .kc_abs = 0,
+                                   .rtol = 0,
+                                   .atol = 0,
+                                   .stepper = NULL};
+            CHECK(ctx,
+                  pd_osc_penalty(&cases[c], (const pd_run_opts[]){pd_test_pen(NULL, &po)}, NULL,
+                                 NULL, &rp, &e) == PD_OK,
+                  "%s", e.msg);
             err[k] = fabs(rp.umax - rr.umax) / rr.umax;
         }
         double rate = c == 0 ? 0.03 : 0.15; /* 1/kc, or at least 1/sqrt(kc) per 100x */
         CHECK(ctx, err[1] < rate * err[0] && err[2] < rate * err[1],
-              "case %d: errors %.3g, %.3g, %.3g at kc = 1e4, 1e6, 1e8 w0^2 must fall", c,
-              err[0], err[1], err[2]);
+              "case %d: errors %.3g, %.3g, %.3g at kc = 1e4, 1e6, 1e8 w0^2 must fall", c, err[0],
+              err[1], err[2]);
         CHECK(ctx, err[2] < (c == 0 ? 1e-6 : 1e-5), "case %d: kc = 1e8 w0^2 within %.3g", c,
               err[2]);
     }
@@ -377,9 +430,14 @@ static void test_ref_scan_per_piece_matches_fixed(pd_test_ctx *ctx)
             for (int i = 0; i < 6; i++)
                 for (int j = 0; j < 3; j++)
                     for (int k = 0; k < 3; k++) {
-                        pd_osc c = {.pulse = p ? PD_PULSE_COSINE : PD_PULSE_SINE, .dir = dir,
-                                    .ap = 1.0, .Tp = 1.0, .Pi2 = Pi2s[i], .Pi3 = Pi3s[j],
-                                    .eps = epss[k], .xi = 0.05};
+                        pd_osc c = {.pulse = p ? PD_PULSE_COSINE : PD_PULSE_SINE,
+                                    .dir = dir,
+                                    .ap = 1.0,
+                                    .Tp = 1.0,
+                                    .Pi2 = Pi2s[i],
+                                    .Pi3 = Pi3s[j],
+                                    .eps = epss[k],
+                                    .xi = 0.05};
                         double phi = p ? TWO_PI / 4 : 0.0;
                         pd_sine_piece adaptive[2] = {
                             {.t_start = 0, .A = (double)dir, .w = 1, .phi = phi},
@@ -405,8 +463,8 @@ static void test_ref_scan_per_piece_matches_fixed(pd_test_ctx *ctx)
                         for (int q = 0; q < 5; q++)
                             worst = fmax(worst, fabs(a[q] - f[q]) / fmax(fabs(f[q]), 1e-300));
                         if (ra.impacts)
-                            worst = fmax(worst, fabs(ra.first_impact - rf.first_impact) /
-                                                    rf.first_impact);
+                            worst = fmax(worst,
+                                         fabs(ra.first_impact - rf.first_impact) / rf.first_impact);
                         differ += ra.impacts != rf.impacts || ra.events != rf.events;
                         points++;
                         pounding += ra.impacts > 0;

@@ -49,8 +49,12 @@ static void test_edr_observer_steps_numbered(pd_test_ctx *ctx)
 {
     double one[1] = {1.0}, b[1] = {0.0}, x0[1] = {1.0}, v0[1] = {0.0};
     int cp[1] = {0};
-    pd_model md = {.n = 1, .m = 0, .M = pd_matrix_dense(1, 1, one), .C = pd_matrix_zero(1, 1),
-                   .K = pd_matrix_dense(1, 1, one), .W = pd_matrix_csc(1, 0, cp, NULL, NULL)};
+    pd_model md = {.n = 1,
+                   .m = 0,
+                   .M = pd_matrix_dense(1, 1, one),
+                   .C = pd_matrix_zero(1, 1),
+                   .K = pd_matrix_dense(1, 1, one),
+                   .W = pd_matrix_csc(1, 0, cp, NULL, NULL)};
     pd_sine_piece pc = {.t_start = 0.0};
     pd_piecewise_force F = {.b = b, .pieces = &pc, .npieces = 1};
     pd_edr_opts eo = pd_edr_default_opts();
@@ -69,8 +73,9 @@ static void test_edr_observer_steps_numbered(pd_test_ctx *ctx)
                    sc.calls))
             continue;
         for (int k = 0; k < 9; k++)
-            CHECK(ctx, sc.step[k] == k && sc.t[k] == t0 + 0.25 * k &&
-                           fabs(sc.q[k] - cos(sc.t[k])) <= 1e-12,
+            CHECK(ctx,
+                  sc.step[k] == k && sc.t[k] == t0 + 0.25 * k &&
+                      fabs(sc.q[k] - cos(sc.t[k])) <= 1e-12,
                   "run %d, state %d: step %ld at t = %.17g, x = %.17g (cos t = %.17g)", run, k,
                   sc.step[k], sc.t[k], sc.q[k], cos(sc.t[k]));
     }
@@ -97,9 +102,14 @@ static void test_edr_piece_change_releases(pd_test_ctx *ctx)
 {
     double one[1] = {1.0}, g0[1] = {0.0}, e[1] = {0.5}, wv[1] = {1.0};
     int cp[2] = {0, 1}, ri[1] = {0};
-    pd_model md = {.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, one), .C = pd_matrix_zero(1, 1),
-                   .K = pd_matrix_dense(1, 1, one), .W = pd_matrix_csc(1, 1, cp, ri, wv),
-                   .g0 = g0, .e = e};
+    pd_model md = {.n = 1,
+                   .m = 1,
+                   .M = pd_matrix_dense(1, 1, one),
+                   .C = pd_matrix_zero(1, 1),
+                   .K = pd_matrix_dense(1, 1, one),
+                   .W = pd_matrix_csc(1, 1, cp, ri, wv),
+                   .g0 = g0,
+                   .e = e};
     pd_sine_piece pcs[2] = {{.t_start = 0.0, .c0 = -1.0}, {.t_start = 1.0, .c0 = 1.0}};
     pd_piecewise_force F = {.b = one, .pieces = pcs, .npieces = 2};
     int detach_events = 0;
@@ -113,9 +123,10 @@ static void test_edr_piece_change_releases(pd_test_ctx *ctx)
     int rc = pd_edr_run(r, 0.0, NULL, NULL, 5.0, NULL, NULL, &err);
     const pd_edr_result *res = pd_edr_result_of(r);
     if (CHECK(ctx, rc == PD_OK, "%s", err.msg))
-        CHECK(ctx, res->events == 1 && res->detachments == 1 && res->impacts == 0 &&
-                       detach_events == 0 && fabs(res->xpos[0] - 2.0) <= 1e-12 &&
-                       fabs(res->xneg[0]) <= 1e-12 && fabs(res->contact_time[0] - 1.0) <= 1e-12,
+        CHECK(ctx,
+              res->events == 1 && res->detachments == 1 && res->impacts == 0 &&
+                  detach_events == 0 && fabs(res->xpos[0] - 2.0) <= 1e-12 &&
+                  fabs(res->xneg[0]) <= 1e-12 && fabs(res->contact_time[0] - 1.0) <= 1e-12,
               "events %ld, detachments %ld (%d detachment events), impacts %ld; x in "
               "[%.17g, %.17g] (closed form [0, 2]), held %.17g (1)",
               res->events, res->detachments, detach_events, res->impacts, -res->xneg[0],
@@ -156,9 +167,14 @@ static void test_edr_rest_lever_forces(pd_test_ctx *ctx)
     double M[4] = {1.0, 0.0, 0.0, 2.0}, K[4] = {1.0, 0.0, 0.0, 8.0}, b[2] = {10.0, -3.6};
     double g0[2] = {0.1, 0.0}, e[2] = {0.5, 0.5}, wv[3] = {-2.0, 0.5, -1.0}, q0[2] = {0.0, -0.2};
     int cp[3] = {0, 2, 3}, ri[3] = {0, 1, 0};
-    pd_model md = {.n = 2, .m = 2, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_zero(2, 2),
-                   .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_csc(2, 2, cp, ri, wv),
-                   .g0 = g0, .e = e};
+    pd_model md = {.n = 2,
+                   .m = 2,
+                   .M = pd_matrix_dense(2, 2, M),
+                   .C = pd_matrix_zero(2, 2),
+                   .K = pd_matrix_dense(2, 2, K),
+                   .W = pd_matrix_csc(2, 2, cp, ri, wv),
+                   .g0 = g0,
+                   .e = e};
     pd_sine_piece pc = {.t_start = 0.0, .c0 = 1.0};
     pd_piecewise_force F = {.b = b, .pieces = &pc, .npieces = 1};
     pd_edr_opts eo = pd_edr_default_opts();
@@ -171,15 +187,15 @@ static void test_edr_rest_lever_forces(pd_test_ctx *ctx)
     int rc = pd_edr_run(r, 0.0, q0, NULL, 5.0, check_rest, &rest, &err);
     const pd_edr_result *res = pd_edr_result_of(r);
     if (CHECK(ctx, rc == PD_OK, "%s", err.msg)) {
-        CHECK(ctx, res->events == 0 && res->detachments == 0 && fabs(res->xpos[0]) <= 1e-12 &&
-                       fabs(res->xneg[0]) <= 1e-12 && fabs(res->xneg[1] - 0.2) <= 1e-12 &&
-                       fabs(res->xpos[1] + 0.2) <= 1e-12,
+        CHECK(ctx,
+              res->events == 0 && res->detachments == 0 && fabs(res->xpos[0]) <= 1e-12 &&
+                  fabs(res->xneg[0]) <= 1e-12 && fabs(res->xneg[1] - 0.2) <= 1e-12 &&
+                  fabs(res->xpos[1] + 0.2) <= 1e-12,
               "events %ld, detachments %ld; x0 in [%.3g, %.3g] (0), x1 in [%.17g, %.17g] (-0.2)",
               res->events, res->detachments, -res->xneg[0], res->xpos[0], -res->xneg[1],
               res->xpos[1]);
         CHECK(ctx, rest.samples == 10 && rest.worst <= 1e-12,
-              "%ld samples, impulses off the statics by %.3g (relative)", rest.samples,
-              rest.worst);
+              "%ld samples, impulses off the statics by %.3g (relative)", rest.samples, rest.worst);
     }
     pd_edr_free(r);
 }
@@ -213,8 +229,12 @@ static void test_edr_stiff_overdamped_runs(pd_test_ctx *ctx)
     const double w = 5.25e9, xi = 1.25;
     double one[1] = {1.0}, C[1] = {2.0 * xi * w}, K[1] = {w * w}, b[1] = {0.0}, x0[1] = {1.0};
     int cp[1] = {0};
-    pd_model md = {.n = 1, .m = 0, .M = pd_matrix_dense(1, 1, one), .C = pd_matrix_dense(1, 1, C),
-                   .K = pd_matrix_dense(1, 1, K), .W = pd_matrix_csc(1, 0, cp, NULL, NULL)};
+    pd_model md = {.n = 1,
+                   .m = 0,
+                   .M = pd_matrix_dense(1, 1, one),
+                   .C = pd_matrix_dense(1, 1, C),
+                   .K = pd_matrix_dense(1, 1, K),
+                   .W = pd_matrix_csc(1, 0, cp, NULL, NULL)};
     pd_sine_piece pc = {.t_start = 0.0};
     pd_piecewise_force F = {.b = b, .pieces = &pc, .npieces = 1};
     pd_edr_opts eo = pd_edr_default_opts();
@@ -244,9 +264,14 @@ static void test_edr_single_contact_impacts_counted(pd_test_ctx *ctx)
 {
     double one[1] = {1.0}, b[1] = {0.0}, g0[1] = {0.5}, e[1] = {1.0}, wv[1] = {-1.0}, v0[1] = {1.0};
     int cp[2] = {0, 1}, ri[1] = {0};
-    pd_model md = {.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, one), .C = pd_matrix_zero(1, 1),
-                   .K = pd_matrix_dense(1, 1, one), .W = pd_matrix_csc(1, 1, cp, ri, wv),
-                   .g0 = g0, .e = e};
+    pd_model md = {.n = 1,
+                   .m = 1,
+                   .M = pd_matrix_dense(1, 1, one),
+                   .C = pd_matrix_zero(1, 1),
+                   .K = pd_matrix_dense(1, 1, one),
+                   .W = pd_matrix_csc(1, 1, cp, ri, wv),
+                   .g0 = g0,
+                   .e = e};
     pd_sine_piece pc = {.t_start = 0.0};
     pd_piecewise_force F = {.b = b, .pieces = &pc, .npieces = 1};
     pd_err err;
@@ -272,8 +297,13 @@ static void test_edr_close_tol_zero_taken(pd_test_ctx *ctx)
     double g0[2] = {0.1, 1e-13}, e[2] = {1, 1}, b[3] = {0, 0, 0}, v0[3] = {1, 0, 0};
     double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, wv[4] = {-1, 1, -1, 1};
     int cp[3] = {0, 2, 4}, ri[4] = {0, 1, 1, 2};
-    pd_model md = {.n = 3, .m = 2, .M = pd_matrix_dense(3, 3, I3), .C = pd_matrix_zero(3, 3),
-                   .K = pd_matrix_zero(3, 3), .W = pd_matrix_csc(3, 2, cp, ri, wv), .g0 = g0,
+    pd_model md = {.n = 3,
+                   .m = 2,
+                   .M = pd_matrix_dense(3, 3, I3),
+                   .C = pd_matrix_zero(3, 3),
+                   .K = pd_matrix_zero(3, 3),
+                   .W = pd_matrix_csc(3, 2, cp, ri, wv),
+                   .g0 = g0,
                    .e = e};
     pd_sine_piece pc = {.t_start = 0.0};
     pd_piecewise_force F = {.b = b, .pieces = &pc, .npieces = 1};
@@ -291,11 +321,13 @@ static void test_edr_close_tol_zero_taken(pd_test_ctx *ctx)
     int rc = pd_edr_run(r, 0.0, NULL, v0, 1.0, NULL, NULL, &err);
     const pd_edr_result *res = pd_edr_result_of(r);
     if (CHECK(ctx, rc == PD_OK, "%s", err.msg))
-        CHECK(ctx, res->impacts == 2 && res->simultaneous == 0 && res->tol_closed == 0 &&
-                       res->contact_impacts[0] == 1 && res->contact_impacts[1] == 1,
+        CHECK(ctx,
+              res->impacts == 2 && res->simultaneous == 0 && res->tol_closed == 0 &&
+                  res->contact_impacts[0] == 1 && res->contact_impacts[1] == 1,
               "close_tol 0: impacts %ld (%ld, %ld), simultaneous %ld, closed within the "
-              "tolerance %ld", res->impacts, res->contact_impacts[0], res->contact_impacts[1],
-              res->simultaneous, res->tol_closed);
+              "tolerance %ld",
+              res->impacts, res->contact_impacts[0], res->contact_impacts[1], res->simultaneous,
+              res->tol_closed);
     pd_edr_free(r);
 }
 
@@ -321,9 +353,14 @@ static void test_edr_piece_changes_cost_little(pd_test_ctx *ctx)
     double M[4] = {1.0, 0.0, 0.0, 1.0}, K[4] = {2.0, -1.0, -1.0, 1.0}, b[2] = {1.0, 1.0};
     double g0[2] = {0.0, 1.5}, e[2] = {0.5, 1.0}, wv[2] = {-1.0, -1.0};
     int cp[3] = {0, 1, 2}, ri[2] = {0, 1};
-    pd_model md = {.n = 2, .m = 2, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_zero(2, 2),
-                   .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_csc(2, 2, cp, ri, wv),
-                   .g0 = g0, .e = e};
+    pd_model md = {.n = 2,
+                   .m = 2,
+                   .M = pd_matrix_dense(2, 2, M),
+                   .C = pd_matrix_zero(2, 2),
+                   .K = pd_matrix_dense(2, 2, K),
+                   .W = pd_matrix_csc(2, 2, cp, ri, wv),
+                   .g0 = g0,
+                   .e = e};
     pd_sine_piece pcs[NP];
     for (int k = 0; k < NP; k++) /* piece k from 0.8 before impact k (k >= 1) */
         pcs[k] = (pd_sine_piece){.t_start = k ? PD_TWO_PI / 3.0 * (2.0 * k - 1.0) - 0.8 : 0.0,
@@ -340,8 +377,9 @@ static void test_edr_piece_changes_cost_little(pd_test_ctx *ctx)
         const pd_edr_result *res = pd_edr_result_of(r);
         if (CHECK(ctx, rc == PD_OK, "%s", err.msg)) {
             evals[cut] = res->evals;
-            CHECK(ctx, res->impacts == 20 && res->detachments == 0 &&
-                           fabs(res->xpos[1] - 1.5) <= 1e-12 && fabs(res->xneg[1]) <= 1e-12,
+            CHECK(ctx,
+                  res->impacts == 20 && res->detachments == 0 &&
+                      fabs(res->xpos[1] - 1.5) <= 1e-12 && fabs(res->xneg[1]) <= 1e-12,
                   "%s load: impacts %ld, detachments %ld, top floor in [%.17g, %.17g]",
                   cut ? "cut" : "uncut", res->impacts, res->detachments, -res->xneg[1],
                   res->xpos[1]);
@@ -349,8 +387,8 @@ static void test_edr_piece_changes_cost_little(pd_test_ctx *ctx)
         pd_edr_free(r);
     }
     CHECK(ctx, evals[1] <= evals[0] + 10.0 * (NP - 1),
-          "flight evaluations: %.0f uncut, %.0f cut into %d pieces (%.1f a piece change)",
-          evals[0], evals[1], NP, (evals[1] - evals[0]) / (NP - 1));
+          "flight evaluations: %.0f uncut, %.0f cut into %d pieces (%.1f a piece change)", evals[0],
+          evals[1], NP, (evals[1] - evals[0]) / (NP - 1));
 }
 
 void suite_row_paths(pd_test_ctx *ctx)

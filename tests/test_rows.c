@@ -82,9 +82,13 @@ static pd_run_opts event_opts(void)
 /* The one-wall scene, the wall on the right (side 1) or the left. */
 static pd_scene *one_wall(const pd_osc *c, int wall_right, pd_err *e)
 {
-    pd_scene_excitation exc = {.pulse = c->pulse, .dir = wall_right ? c->dir : -c->dir,
-                               .ap = c->ap, .Tp = c->Tp, .record = c->record,
-                               .rec_ap = c->rec_ap, .scale = c->scale};
+    pd_scene_excitation exc = {.pulse = c->pulse,
+                               .dir = wall_right ? c->dir : -c->dir,
+                               .ap = c->ap,
+                               .Tp = c->Tp,
+                               .record = c->record,
+                               .rec_ap = c->rec_ap,
+                               .scale = c->scale};
     pd_scene *sc = pd_scene_new(&exc);
     double gap = pd_osc_gap(c);
     if (!sc || pd_scene_add_sdof(sc, "A", pd_osc_T0(c), c->xi, 2.5, e) ||
@@ -113,9 +117,9 @@ static int one_wall_case(pd_test_ctx *ctx, const pd_osc *c, int wall_right, int 
     if (!run_m(ctx, sc, &o, &r) && !run_m(ctx, sc, &f, &ref)) {
         ok = CHECK(ctx, strcmp(r.kernel, "event-rows") == 0 && strcmp(ref.kernel, "event") == 0,
                    "kernels %s / %s", r.kernel, ref.kernel);
-        ok &= CHECK(ctx, fabs(r.umax[0] - ref.umax[0]) <= ONE_WALL_TOL * ref.umax[0] &&
-                             r.impacts[0] == ref.impacts[0] &&
-                             r.accumulations == ref.accumulations,
+        ok &= CHECK(ctx,
+                    fabs(r.umax[0] - ref.umax[0]) <= ONE_WALL_TOL * ref.umax[0] &&
+                        r.impacts[0] == ref.impacts[0] && r.accumulations == ref.accumulations,
                     "%s %s Pi2 %g Pi3 %g eps %g wall %s: umax %.17g vs %.17g, impacts %ld vs "
                     "%ld, accumulations %ld vs %ld",
                     pd_osc_excitation_name(c), pd_dir_name(c->dir), c->Pi2, c->Pi3, c->eps,
@@ -143,8 +147,13 @@ static void test_rows_one_wall_equals_exact(pd_test_ctx *ctx)
                 for (int j = 0; j < 3; j++)
                     for (int k = 0; k < 5; k++) {
                         pd_osc c = {.pulse = p ? PD_PULSE_COSINE : PD_PULSE_SINE,
-                                    .dir = d ? -1 : 1, .ap = 3.0, .Tp = 0.5, .Pi2 = pi2[i],
-                                    .Pi3 = pi3[j], .eps = eps[k], .xi = 0.05};
+                                    .dir = d ? -1 : 1,
+                                    .ap = 3.0,
+                                    .Tp = 0.5,
+                                    .Pi2 = pi2[i],
+                                    .Pi3 = pi3[j],
+                                    .eps = eps[k],
+                                    .xi = 0.05};
                         cases++;
                         passed += one_wall_case(ctx, &c, (i + j + k) % 2, &accs);
                     }
@@ -160,7 +169,8 @@ static void test_rows_one_wall_record(pd_test_ctx *ctx)
     double acc[NPTS];
     for (int k = 0; k < NPTS; k++) {
         double t = 0.01 * k;
-        acc[k] = 3.0 * exp(-0.4 * t) * (sin(4.1 * t) + 0.6 * sin(9.7 * t + 1.0) + 0.3 * sin(23.0 * t));
+        acc[k] =
+            3.0 * exp(-0.4 * t) * (sin(4.1 * t) + 0.6 * sin(9.7 * t + 1.0) + 0.3 * sin(23.0 * t));
     }
     pd_record rec = {.npts = NPTS, .dt = 0.01, .acc = acc};
     strcpy(rec.name, "synthetic");
@@ -168,8 +178,15 @@ static void test_rows_one_wall_record(pd_test_ctx *ctx)
     const double eps[] = {0.3, 0.6, 0.8};
     for (int k = 0; k < 3; k++)
         for (int i = 0; i < 2; i++) {
-            pd_osc c = {.dir = i ? -1 : 1, .ap = 3.0, .Tp = 1.5, .record = &rec, .rec_ap = 3.0,
-                        .scale = 1.0, .Pi3 = 0.05, .eps = eps[k], .xi = 0.05};
+            pd_osc c = {.dir = i ? -1 : 1,
+                        .ap = 3.0,
+                        .Tp = 1.5,
+                        .record = &rec,
+                        .rec_ap = 3.0,
+                        .scale = 1.0,
+                        .Pi3 = 0.05,
+                        .eps = eps[k],
+                        .xi = 0.05};
             pd_osc_set_T0(&c, i ? 0.6 : 1.1);
             cases++;
             passed += one_wall_case(ctx, &c, i, &accs);
@@ -188,7 +205,8 @@ static void test_rows_heavy_partner_is_a_wall(pd_test_ctx *ctx)
     const double eps[] = {0.0, 0.5, 0.8};
     for (int k = 0; k < 3; k++) {
         pd_err e;
-        pd_scene *row = new_scene(PD_PULSE_COSINE, 1, 3.0, 0.5), *wall = new_scene(PD_PULSE_COSINE, 1, 3.0, 0.5);
+        pd_scene *row = new_scene(PD_PULSE_COSINE, 1, 3.0, 0.5),
+                 *wall = new_scene(PD_PULSE_COSINE, 1, 3.0, 0.5);
         int ok = row && wall && !pd_scene_add_sdof(row, "A", 3.0, 0.05, 1.0, &e) &&
                  !pd_scene_add_sdof(row, "B", 1e-3, 0.05, 1e9, &e) &&
                  !pd_scene_add_contact(row, 0, 1, 1, 1, 0.001, eps[k], 0, &e) &&
@@ -205,12 +223,13 @@ static void test_rows_heavy_partner_is_a_wall(pd_test_ctx *ctx)
              * which moves A by at most that times the run's length */
             double xb = r.umax[1], wp = pd_scene_wp(row), tend = pd_scene_default_tend(row);
             double bound = 4.0 * xb + (1.0 + eps[k]) * wp * xb * tend + 1e-12 * w.umax[0];
-            CHECK(ctx, fabs(r.umax[0] - w.umax[0]) <= bound &&
-                           r.impacts[0] == w.impacts[0] && r.accumulations == w.accumulations,
+            CHECK(ctx,
+                  fabs(r.umax[0] - w.umax[0]) <= bound && r.impacts[0] == w.impacts[0] &&
+                      r.accumulations == w.accumulations,
                   "eps %g: umax %.17g vs wall %.17g (partner moves %.3g: bound %.3g), impacts "
                   "%ld vs %ld, accumulations %ld vs %ld",
-                  eps[k], r.umax[0], w.umax[0], xb, bound, r.impacts[0], w.impacts[0], r.accumulations,
-                  w.accumulations);
+                  eps[k], r.umax[0], w.umax[0], xb, bound, r.impacts[0], w.impacts[0],
+                  r.accumulations, w.accumulations);
             CHECK(ctx, xb < 1e-5 * w.umax[0], "the partner barely moves (%.3g)", xb);
             if (k == 1)
                 CHECK(ctx, w.accumulations >= 1, "eps 0.5: an accumulation is met (%ld)",
@@ -230,8 +249,8 @@ static void test_rows_heavy_partner_is_a_wall(pd_test_ctx *ctx)
 static pd_scene *random_row(uint64_t *rng, int n, double eps_lo, double eps_hi, double xi,
                             pd_pulse pulse, pd_err *e)
 {
-    pd_scene *sc = new_scene(pulse, pd_test_uniform(rng) < 0.5 ? 1 : -1, 2.0 + 4.0 * pd_test_uniform(rng),
-                             0.3 + 0.7 * pd_test_uniform(rng));
+    pd_scene *sc = new_scene(pulse, pd_test_uniform(rng) < 0.5 ? 1 : -1,
+                             2.0 + 4.0 * pd_test_uniform(rng), 0.3 + 0.7 * pd_test_uniform(rng));
     int wl = pd_test_uniform(rng) < 0.5, wr = pd_test_uniform(rng) < 0.5, rc = sc ? 0 : PD_ENOMEM;
     char name[16];
     for (int i = 0; i < n && !rc; i++) {
@@ -321,8 +340,8 @@ static int check_impact(const pd_edr_event *ev, void *vctx)
      * contacts project them away) */
     ic->pscale = fmax(ic->pscale, scale);
     if (!ev->accumulation) /* a jump's tail impulses are not reported; per term summed */
-        ic->worst_momentum = fmax(ic->worst_momentum,
-                                  fabs(dp) / (ic->pscale * (ev->ndofs + ev->ncontacts)));
+        ic->worst_momentum =
+            fmax(ic->worst_momentum, fabs(dp) / (ic->pscale * (ev->ndofs + ev->ncontacts)));
     ic->worst_energy = fmax(ic->worst_energy, (ke1 - ke0) / fmax(ke0, 1e-300));
     ic->impacts++;
     return 0;
@@ -355,7 +374,8 @@ static void test_rows_impulses_balance_energy_falls(pd_test_ctx *ctx)
     impact_check ic = {0};
     for (int k = 0; k < 40; k++) {
         pd_err e;
-        pd_scene *sc = random_row(&rng, 2 + k % 5, 0.0, 1.0, 0.05, k % 2 ? PD_PULSE_COSINE : PD_PULSE_SINE, &e);
+        pd_scene *sc = random_row(&rng, 2 + k % 5, 0.0, 1.0, 0.05,
+                                  k % 2 ? PD_PULSE_COSINE : PD_PULSE_SINE, &e);
         if (!CHECK(ctx, sc != NULL, "row: %s", e.msg))
             continue;
         int rc = run_checked(ctx, sc, &ic, &e);
@@ -365,7 +385,8 @@ static void test_rows_impulses_balance_energy_falls(pd_test_ctx *ctx)
     CHECK(ctx, ic.impacts > 200, "impacts checked: %ld", ic.impacts);
     CHECK(ctx, ic.worst_momentum <= 1e-12,
           "momentum balance at impacts: worst %.3g per term (rates below 1e-12 of the scale are "
-          "zero)", ic.worst_momentum);
+          "zero)",
+          ic.worst_momentum);
     CHECK(ctx, ic.worst_energy <= 1e-13, "kinetic energy never rises at an impact: worst %.3g",
           ic.worst_energy);
 }
@@ -392,20 +413,20 @@ static void test_rows_hostile_physics(pd_test_ctx *ctx)
     for (int k = 0; k < rows; k++) {
         pd_err e;
         int n = 2 + k % (wide ? 29 : 6), rc = 0;
-        pd_scene *sc = new_scene(k % 2 ? PD_PULSE_COSINE : PD_PULSE_SINE, 1,
-                                 2.0 + 4.0 * pd_test_uniform(&rng), 0.3 + 0.7 * pd_test_uniform(&rng));
+        pd_scene *sc =
+            new_scene(k % 2 ? PD_PULSE_COSINE : PD_PULSE_SINE, 1, 2.0 + 4.0 * pd_test_uniform(&rng),
+                      0.3 + 0.7 * pd_test_uniform(&rng));
         char name[16];
         for (int i = 0; i < n && sc && !rc; i++) {
             snprintf(name, sizeof name, "S%d", i + 1);
             rc = pd_scene_add_sdof(sc, name, 0.2 + 1.8 * pd_test_uniform(&rng),
-                                   0.05 * pd_test_uniform(&rng), pow(10.0, 12.0 * pd_test_uniform(&rng)),
-                                   &e);
+                                   0.05 * pd_test_uniform(&rng),
+                                   pow(10.0, 12.0 * pd_test_uniform(&rng)), &e);
         }
         for (int i = 0; i <= n && sc && !rc; i++)
-            rc = pd_scene_add_contact(sc, i == 0 ? PD_WALL : i - 1, i == 0 ? 0 : 1,
-                                      i == n ? PD_WALL : i, i == n ? 0 : 1,
-                                      gaps[(int)(5.0 * pd_test_uniform(&rng)) % 5],
-                                      pd_test_uniform(&rng), i, &e);
+            rc = pd_scene_add_contact(
+                sc, i == 0 ? PD_WALL : i - 1, i == 0 ? 0 : 1, i == n ? PD_WALL : i, i == n ? 0 : 1,
+                gaps[(int)(5.0 * pd_test_uniform(&rng)) % 5], pd_test_uniform(&rng), i, &e);
         if (!CHECK(ctx, sc && !rc && !pd_scene_finish(sc, &e), "row %d: %s", k, e.msg)) {
             pd_scene_free(sc);
             continue;
@@ -428,8 +449,8 @@ static void test_rows_hostile_physics(pd_test_ctx *ctx)
           "answered %d of %d (chatter %d), impacts %ld", answered, rows, chatter, ic.impacts);
     if (wide) /* the stress category's line */
         printf("physics: %d rows, %d answered, %d chatter, %ld impacts, momentum %.3g, "
-               "energy %.3g\n", rows, answered, chatter, ic.impacts, ic.worst_momentum,
-               ic.worst_energy);
+               "energy %.3g\n",
+               rows, answered, chatter, ic.impacts, ic.worst_momentum, ic.worst_energy);
     /* the reference zeroes rates within 1e-12 of the run's speeds (a heavy
      * body's rounding-level rate set to rest at a wall: 1.7e-11 of the
      * momentum scale over 10 terms measured); an impulse wrong beyond
@@ -444,8 +465,8 @@ static void test_rows_hostile_physics(pd_test_ctx *ctx)
  * i, the walls at 0 and n) under a pulse: NULL (failed) when it cannot be
  * built. */
 static pd_scene *sdof_row(pd_test_ctx *ctx, pd_pulse pulse, double ap, double Tp, int n,
-                          const double *T0, const double *xi, const double *mass,
-                          const double *gap, const double *eps)
+                          const double *T0, const double *xi, const double *mass, const double *gap,
+                          const double *eps)
 {
     pd_err e;
     pd_scene *sc = new_scene(pulse, 1, ap, Tp);
@@ -484,13 +505,12 @@ static void test_rows_locked_wall_to_wall(pd_test_ctx *ctx)
     static const double mass[] = {14629048.449908029, 187056028.58680755, 241104556603.98386,
                                   3916513.6682937196, 56.122434545552139};
     static const double gap[] = {0.0, 1e-300, 0.0, 1e-13, 0.0, 1e-13};
-    static const double eps[] = {0.39681371293800483, 0.94496134433512524,
-                                 0.0072605491073538531, 0.04339774657069928,
-                                 0.52302586193737288, 0.3407051485895416};
+    static const double eps[] = {0.39681371293800483, 0.94496134433512524, 0.0072605491073538531,
+                                 0.04339774657069928, 0.52302586193737288, 0.3407051485895416};
     pd_err e;
     int rc;
-    pd_scene *sc = sdof_row(ctx, PD_PULSE_COSINE, 4.168807041886021, 0.58481851902564641, 5, T0,
-                            xi, mass, gap, eps);
+    pd_scene *sc = sdof_row(ctx, PD_PULSE_COSINE, 4.168807041886021, 0.58481851902564641, 5, T0, xi,
+                            mass, gap, eps);
     if (!sc)
         return;
     pd_scene_result r = {0};
@@ -506,8 +526,9 @@ static void test_rows_locked_wall_to_wall(pd_test_ctx *ctx)
     o.method = PD_METHOD_EVENT_GENERAL;
     if (CHECK(ctx, pd_scene_result_alloc(sc, &r, &e) == PD_OK, "%s", e.msg)) {
         rc = pd_scene_run(sc, &o, NULL, NULL, &r, &e);
-        CHECK(ctx, rc == PD_OK || (rc == PD_EBUDGET && strstr(e.msg, "--method moreau") &&
-                                   strstr(e.msg, "integration steps")),
+        CHECK(ctx,
+              rc == PD_OK || (rc == PD_EBUDGET && strstr(e.msg, "--method moreau") &&
+                              strstr(e.msg, "integration steps")),
               "event-general: %d %s", rc, e.msg);
     }
     pd_scene_result_free(&r);
@@ -529,8 +550,8 @@ static void test_rows_rounding_rates_close_nothing(pd_test_ctx *ctx)
     static const double xi[] = {0.01971357992926619, 0.034216388903202458, 0.039980014141982698};
     static const double mass[] = {610038466.36050868, 220.12522749920504, 245679587.5938938};
     static const double gap[] = {1e-300, 0.0, 1e-300, 0.01};
-    static const double eps[] = {0.52305778889608845, 0.077247540809392334,
-                                 0.43391133422720229, 0.33328883762731099};
+    static const double eps[] = {0.52305778889608845, 0.077247540809392334, 0.43391133422720229,
+                                 0.33328883762731099};
     pd_err e;
     int rc;
     pd_scene *sc = sdof_row(ctx, PD_PULSE_COSINE, 4.5464921150000475, 0.81166502612086289, 3, T0,
@@ -595,8 +616,8 @@ static void test_rows_elastic_energy_constant(pd_test_ctx *ctx)
         eo.h_out = 0.05;
         if (row_open(ctx, sc, &eo, &rr)) {
             double t1 = 60.0 * PD_TWO_PI; /* 60 pulse periods of free motion */
-            CHECK(ctx, pd_edr_run(rr.edr, 0.0, NULL, NULL, t1, watch_energy, &w, &e) == PD_OK,
-                  "%s", e.msg);
+            CHECK(ctx, pd_edr_run(rr.edr, 0.0, NULL, NULL, t1, watch_energy, &w, &e) == PD_OK, "%s",
+                  e.msg);
             const pd_edr_result *res = pd_edr_result_of(rr.edr);
             CHECK(ctx, res->impacts >= 100, "row %d: %ld impacts", k, res->impacts);
             CHECK(ctx, w.have && w.worst <= 1e-10,
@@ -629,7 +650,8 @@ static void test_rows_mirrored(pd_test_ctx *ctx)
                                    sc->st[s].mass[0], &e);
         for (int a = sc->ncontact - 1; a >= 0 && !rc; a--) {
             const pd_contact *c = &sc->ct[a];
-            int na = c->b == PD_WALL ? PD_WALL : n - 1 - c->b, nb = c->a == PD_WALL ? PD_WALL : n - 1 - c->a;
+            int na = c->b == PD_WALL ? PD_WALL : n - 1 - c->b,
+                nb = c->a == PD_WALL ? PD_WALL : n - 1 - c->a;
             rc = pd_scene_add_contact(mir, na, na == PD_WALL ? 0 : 1, nb, nb == PD_WALL ? 0 : 1,
                                       c->gap, c->eps, a, &e);
         }
@@ -639,8 +661,9 @@ static void test_rows_mirrored(pd_test_ctx *ctx)
             !run_m(ctx, sc, &o, &r) && !run_m(ctx, mir, &o, &m)) {
             n_cases++;
             for (int s = 0; s < n; s++)
-                bad += !CHECK(ctx, fabs(r.umax[s] - m.umax[n - 1 - s]) <= 1e-12 * r.umax[s] &&
-                                       fabs(r.u_pos[s] - m.u_neg[n - 1 - s]) <= 1e-12 * r.umax[s],
+                bad += !CHECK(ctx,
+                              fabs(r.umax[s] - m.umax[n - 1 - s]) <= 1e-12 * r.umax[s] &&
+                                  fabs(r.u_pos[s] - m.u_neg[n - 1 - s]) <= 1e-12 * r.umax[s],
                               "row %d S%d: umax %.17g vs mirrored %.17g", k, s + 1, r.umax[s],
                               m.umax[n - 1 - s]);
             for (int a = 0; a < sc->ncontact; a++)
@@ -723,7 +746,8 @@ static void test_rows_match_general_sdof(pd_test_ctx *ctx)
     double worst = 0.0;
     for (int k = 0; k < 40; k++) {
         pd_err e;
-        pd_scene *sc = random_row(&rng, 2 + k % 4, 0.5, 1.0, 0.05, k % 2 ? PD_PULSE_SINE : PD_PULSE_COSINE, &e);
+        pd_scene *sc = random_row(&rng, 2 + k % 4, 0.5, 1.0, 0.05,
+                                  k % 2 ? PD_PULSE_SINE : PD_PULSE_COSINE, &e);
         if (!CHECK(ctx, sc != NULL, "row: %s", e.msg))
             continue;
         char what[32];
@@ -742,7 +766,8 @@ static void test_rows_match_general_buildings(pd_test_ctx *ctx)
     double worst = 0.0;
     for (int k = 0; k < 16; k++) {
         pd_err e;
-        pd_scene *sc = new_scene(k % 2 ? PD_PULSE_SINE : PD_PULSE_COSINE, k % 4 < 2 ? 1 : -1, 3.0, 0.6);
+        pd_scene *sc =
+            new_scene(k % 2 ? PD_PULSE_SINE : PD_PULSE_COSINE, k % 4 < 2 ? 1 : -1, 3.0, 0.6);
         int rc = 0, ns = 2 + k % 2;
         int storeys[3];
         char name[16];
@@ -754,7 +779,8 @@ static void test_rows_match_general_buildings(pd_test_ctx *ctx)
                 kk[i] = 4e8 * (0.5 + pd_test_uniform(&rng));
             }
             snprintf(name, sizeof name, "B%d", s);
-            rc = pd_scene_add_building(sc, name, storeys[s], m, kk, 0.02 + 0.04 * pd_test_uniform(&rng), &e);
+            rc = pd_scene_add_building(sc, name, storeys[s], m, kk,
+                                       0.02 + 0.04 * pd_test_uniform(&rng), &e);
         }
         if (!rc && k % 3 == 0)
             rc = pd_scene_add_contact(sc, PD_WALL, 0, 0, 1, 0.01, 0.7, 0, &e);
@@ -773,7 +799,8 @@ static void test_rows_match_general_buildings(pd_test_ctx *ctx)
         }
         pd_scene_free(sc);
     }
-    CHECK(ctx, used >= 5, "%d building rows with isolated impacts compared (worst %.3g)", used, worst);
+    CHECK(ctx, used >= 5, "%d building rows with isolated impacts compared (worst %.3g)", used,
+          worst);
 }
 
 /* The docs' row of 10 measured as `pound converge` measures it: the general
@@ -811,7 +838,8 @@ static void test_rows_general_history(pd_test_ctx *ctx)
     if (!rc)
         rc = pd_scene_measure_run(sc, &o, &ref, &rr, &gr, &se, &e);
     if (CHECK(ctx, rc == PD_OK, "row of 10: %s", e.msg)) {
-        CHECK(ctx, se.grid_points == 4001, "%ld grid points compared, 4001 expected", se.grid_points);
+        CHECK(ctx, se.grid_points == 4001, "%ld grid points compared, 4001 expected",
+              se.grid_points);
         CHECK(ctx, se.err_hist_max < GENERAL_TOL && se.err_umax_max < GENERAL_TOL,
               "row of 10: the general reference's history differs by %.3g, its peaks by %.3g",
               se.err_hist_max, se.err_umax_max);
@@ -895,11 +923,12 @@ static void test_rows_measure_other_grid(pd_test_ctx *ctx)
             }
             kit_free(&m);
         }
-        CHECK(ctx, points[0] == 4001 && err[0] <= err[1] * (1.0 + 1e-9) &&
-                       err[0] >= 0.99 * err[1] && umax[0] == umax[1],
+        CHECK(ctx,
+              points[0] == 4001 && err[0] <= err[1] * (1.0 + 1e-9) && err[0] >= 0.99 * err[1] &&
+                  umax[0] == umax[1],
               "dt %g: err_hist %.6g on the 1e-3 grid (%ld points), %.6g on its own (%ld); "
-              "err_umax %.6g, %.6g", dts[k], err[0], points[0], err[1], points[1], umax[0],
-              umax[1]);
+              "err_umax %.6g, %.6g",
+              dts[k], err[0], points[0], err[1], points[1], umax[0], umax[1]);
     }
     pd_scene_free(sc);
 }
@@ -991,10 +1020,9 @@ static void test_rows_measure_figures(pd_test_ctx *ctx)
             impacts += mr.impacts[a];
         CHECK(ctx, mr.impacts[0] > 0 && mr.impacts[1] > 0 && se.impacts == impacts,
               "impacts %ld, per contact %ld + %ld", se.impacts, mr.impacts[0], mr.impacts[1]);
-        CHECK(ctx, se.grid_points == 601, "%ld grid points compared, 601 expected",
-              se.grid_points);
-        CHECK(ctx, se.cpu_s > 0.0 && se.cpu_s == mr.cpu_s, "cpu_s %.3g, the run's %.3g",
-              se.cpu_s, mr.cpu_s);
+        CHECK(ctx, se.grid_points == 601, "%ld grid points compared, 601 expected", se.grid_points);
+        CHECK(ctx, se.cpu_s > 0.0 && se.cpu_s == mr.cpu_s, "cpu_s %.3g, the run's %.3g", se.cpu_s,
+              mr.cpu_s);
         o.no_demands = o.no_law_band = 1; /* as the measurement runs it */
         rc = pd_scene_run(sc, &o, grid_hist_sample, &gh, &own, &e);
         if (CHECK(ctx, rc == PD_OK && gh.rows == 601, "own run: %s (%ld rows)", e.msg, gh.rows))
@@ -1109,8 +1137,13 @@ static void test_rows_tolerance_decides(pd_test_ctx *ctx)
         double g0[2] = {0.1, gaps[k]}, e[2] = {1, 1}, b[3] = {0, 0, 0}, v0[3] = {1, 0, 0};
         double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, wv[4] = {-1, 1, -1, 1};
         int cp[3] = {0, 2, 4}, ri[4] = {0, 1, 1, 2};
-        pd_model md = {.n = 3, .m = 2, .M = pd_matrix_dense(3, 3, I3), .C = pd_matrix_zero(3, 3),
-                       .K = pd_matrix_zero(3, 3), .W = pd_matrix_csc(3, 2, cp, ri, wv), .g0 = g0,
+        pd_model md = {.n = 3,
+                       .m = 2,
+                       .M = pd_matrix_dense(3, 3, I3),
+                       .C = pd_matrix_zero(3, 3),
+                       .K = pd_matrix_zero(3, 3),
+                       .W = pd_matrix_csc(3, 2, cp, ri, wv),
+                       .g0 = g0,
                        .e = e};
         pd_sine_piece pc = {.t_start = 0.0};
         pd_piecewise_force F = {.b = b, .pieces = &pc, .npieces = 1};
@@ -1130,8 +1163,8 @@ static void test_rows_tolerance_decides(pd_test_ctx *ctx)
                   i + 1, v[i], want[i]);
         if (k < 2) /* within 1e-12 Le: one simultaneous impact */
             CHECK(ctx, res->impacts == 1 && res->simultaneous == 1 && res->tol_closed == (k == 1),
-                  "gap %g: impacts %ld, simultaneous %ld, closed within the tolerance %ld",
-                  gaps[k], res->impacts, res->simultaneous, res->tol_closed);
+                  "gap %g: impacts %ld, simultaneous %ld, closed within the tolerance %ld", gaps[k],
+                  res->impacts, res->simultaneous, res->tol_closed);
         else
             CHECK(ctx, res->impacts == 2 && res->simultaneous == 0,
                   "gap %g: sequential, impacts %ld, simultaneous %ld", gaps[k], res->impacts,
@@ -1203,9 +1236,14 @@ static void test_rows_sparse_impact(pd_test_ctx *ctx)
         dp[i] = i;
     for (int i = 0; i < N; i++)
         di[i] = i;
-    pd_model md = {.n = N, .m = MC, .M = pd_matrix_csc(N, N, dp, di, one),
-                   .C = pd_matrix_zero(N, N), .K = pd_matrix_zero(N, N),
-                   .W = pd_matrix_csc(N, MC, cp, ri, wv), .g0 = g0, .e = e};
+    pd_model md = {.n = N,
+                   .m = MC,
+                   .M = pd_matrix_csc(N, N, dp, di, one),
+                   .C = pd_matrix_zero(N, N),
+                   .K = pd_matrix_zero(N, N),
+                   .W = pd_matrix_csc(N, MC, cp, ri, wv),
+                   .g0 = g0,
+                   .e = e};
     pd_sine_piece pc = {.t_start = 0.0};
     pd_piecewise_force F = {.b = zero, .pieces = &pc, .npieces = 1};
     first_impact fi = {.P = P, .v_minus = vm, .v_plus = vp};
@@ -1218,11 +1256,12 @@ static void test_rows_sparse_impact(pd_test_ctx *ctx)
         return;
     int rc = pd_edr_run(r, 0.0, NULL, v0, 1.0, NULL, NULL, &err);
     const pd_edr_result *res = pd_edr_result_of(r);
-    if (CHECK(ctx, rc == PD_OK && fi.seen >= 1 && fi.t == 0.0 && fi.ncontacts == MC &&
-                       fi.ndofs == N && res->impacts == MC && res->simultaneous == 1,
+    if (CHECK(ctx,
+              rc == PD_OK && fi.seen >= 1 && fi.t == 0.0 && fi.ncontacts == MC && fi.ndofs == N &&
+                  res->impacts == MC && res->simultaneous == 1,
               "%s: the first impact at t = %g of %d contacts and %d dofs; impacts %ld, "
-              "simultaneous %ld", err.msg, fi.t, fi.ncontacts, fi.ndofs, res->impacts,
-              res->simultaneous)) {
+              "simultaneous %ld",
+              err.msg, fi.t, fi.ncontacts, fi.ndofs, res->impacts, res->simultaneous)) {
         double worst_P = 0.0, worst_v = 0.0;
         for (int j = 0; j < MC; j++) {
             double want = (1.0 + eps) * V * (j + 1.0) * (1.0 - j / (N - 1.0));
@@ -1251,11 +1290,16 @@ static void edr_snap_take(const pd_edr *r, int n, int m, edr_snap *s)
 {
     const pd_edr_result *res = pd_edr_result_of(r);
     memset(s, 0, sizeof *s);
-    *s = (edr_snap){.events = res->events, .impacts = res->impacts,
-                    .simultaneous = res->simultaneous, .tol_closed = res->tol_closed,
-                    .accumulations = res->accumulations, .detachments = res->detachments,
-                    .lcp_solves = res->lcp_solves, .evals = res->evals,
-                    .first_impact = res->first_impact, .t_reached = res->t_reached,
+    *s = (edr_snap){.events = res->events,
+                    .impacts = res->impacts,
+                    .simultaneous = res->simultaneous,
+                    .tol_closed = res->tol_closed,
+                    .accumulations = res->accumulations,
+                    .detachments = res->detachments,
+                    .lcp_solves = res->lcp_solves,
+                    .evals = res->evals,
+                    .first_impact = res->first_impact,
+                    .t_reached = res->t_reached,
                     .max_penetration = res->max_penetration};
     memcpy(s->xpos, res->xpos, (size_t)n * sizeof(double));
     memcpy(s->xneg, res->xneg, (size_t)n * sizeof(double));
@@ -1300,8 +1344,9 @@ static void test_rows_run_again_same(pd_test_ctx *ctx)
             rc = pd_edr_run(rr.edr, 0.0, NULL, NULL, t1, NULL, NULL, &e);
         edr_snap_take(rr.edr, 2, 2, &again);
         if (CHECK(ctx, rc == PD_OK, "runs: %s", e.msg)) {
-            CHECK(ctx, a.contact_impacts[0] > 0 && a.contact_impacts[1] == 0 &&
-                           a.min_gap[1] > 0.0 && a.min_gap[1] < 1.0 / Le,
+            CHECK(ctx,
+                  a.contact_impacts[0] > 0 && a.contact_impacts[1] == 0 && a.min_gap[1] > 0.0 &&
+                      a.min_gap[1] < 1.0 / Le,
                   "the row pounds (%ld impacts), never reaches the wall (%ld; smallest gap %g)",
                   a.contact_impacts[0], a.contact_impacts[1], a.min_gap[1]);
             CHECK(ctx, memcmp(&a, &b, sizeof a) != 0, "the other start changes the results");
@@ -1322,9 +1367,14 @@ static void test_rows_no_pieces_refused(pd_test_ctx *ctx)
     double g0[1] = {0.1}, e[1] = {0.5}, b[1] = {1.0}, one[1] = {1.0};
     int cp[2] = {0, 1}, ri[1] = {0};
     double wv[1] = {-1.0};
-    pd_model md = {.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, one),
-                   .C = pd_matrix_zero(1, 1), .K = pd_matrix_dense(1, 1, one),
-                   .W = pd_matrix_csc(1, 1, cp, ri, wv), .g0 = g0, .e = e};
+    pd_model md = {.n = 1,
+                   .m = 1,
+                   .M = pd_matrix_dense(1, 1, one),
+                   .C = pd_matrix_zero(1, 1),
+                   .K = pd_matrix_dense(1, 1, one),
+                   .W = pd_matrix_csc(1, 1, cp, ri, wv),
+                   .g0 = g0,
+                   .e = e};
     pd_sine_piece pc = {.t_start = 0.0, .c0 = 1.0};
     for (int np = 0; np >= -1; np--) {
         pd_piecewise_force F = {.b = b, .pieces = &pc, .npieces = np};
@@ -1361,12 +1411,22 @@ static void test_rows_scan_work_independent_of_start(pd_test_ctx *ctx)
     double one[4] = {1.0, 0.0, 0.0, 1.0}, K[4] = {2.0, -1.0, -1.0, 1.0}, v0[1] = {1.0};
     double g1[2] = {0.0, 5.0}, wv[2] = {-1.0, -1.0};
     int cp[3] = {0, 1, 2}, ri[2] = {0, 1};
-    pd_model osc = {.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, one),
-                    .C = pd_matrix_zero(1, 1), .K = pd_matrix_dense(1, 1, one),
-                    .W = pd_matrix_csc(1, 1, cp, ri, wv), .g0 = g0, .e = e};
-    pd_model bld = {.n = 2, .m = 2, .M = pd_matrix_dense(2, 2, one),
-                    .C = pd_matrix_zero(2, 2), .K = pd_matrix_dense(2, 2, K),
-                    .W = pd_matrix_csc(2, 2, cp, ri, wv), .g0 = g1, .e = e};
+    pd_model osc = {.n = 1,
+                    .m = 1,
+                    .M = pd_matrix_dense(1, 1, one),
+                    .C = pd_matrix_zero(1, 1),
+                    .K = pd_matrix_dense(1, 1, one),
+                    .W = pd_matrix_csc(1, 1, cp, ri, wv),
+                    .g0 = g0,
+                    .e = e};
+    pd_model bld = {.n = 2,
+                    .m = 2,
+                    .M = pd_matrix_dense(2, 2, one),
+                    .C = pd_matrix_zero(2, 2),
+                    .K = pd_matrix_dense(2, 2, K),
+                    .W = pd_matrix_csc(2, 2, cp, ri, wv),
+                    .g0 = g1,
+                    .e = e};
     pd_sine_piece free_pc = {.t_start = 0.0}, load = {.t_start = 0.0, .c0 = 1.0};
     pd_piecewise_force Fo = {.b = b0, .pieces = &free_pc, .npieces = 1};
     pd_piecewise_force Fb = {.b = b1, .pieces = &load, .npieces = 1};
@@ -1378,30 +1438,32 @@ static void test_rows_scan_work_independent_of_start(pd_test_ctx *ctx)
             continue;
         double evals[2] = {0, 0};
         for (int k = 0; k < 2; k++) {
-            int rc = pd_edr_run(r, starts[k], NULL, sys ? NULL : v0, starts[k] + span, NULL,
-                                NULL, &err);
+            int rc =
+                pd_edr_run(r, starts[k], NULL, sys ? NULL : v0, starts[k] + span, NULL, NULL, &err);
             const pd_edr_result *res = pd_edr_result_of(r);
             double tol = k ? 1e-9 : 1e-12;
             if (!CHECK(ctx, rc == PD_OK, "system %d, t0 %g: %s", sys, starts[k], err.msg))
                 continue;
             evals[k] = res->evals;
             if (sys == 0)
-                CHECK(ctx, res->impacts == 15 && fabs(res->xpos[0] - 0.5) <= tol &&
-                               fabs(res->xneg[0] - 1.0) <= tol,
+                CHECK(ctx,
+                      res->impacts == 15 && fabs(res->xpos[0] - 0.5) <= tol &&
+                          fabs(res->xneg[0] - 1.0) <= tol,
                       "oscillator, t0 %g: impacts %ld, max x %.17g (0.5), max -x %.17g (1)",
                       starts[k], res->impacts, res->xpos[0], res->xneg[0]);
             else
-                CHECK(ctx, res->detachments == 0 && fabs(res->xpos[1] - 2.0) <= tol &&
-                               fabs(res->xneg[1]) <= tol && fabs(res->xpos[0]) <= tol &&
-                               fabs(res->min_gap[1] - 3.0) <= tol,
+                CHECK(ctx,
+                      res->detachments == 0 && fabs(res->xpos[1] - 2.0) <= tol &&
+                          fabs(res->xneg[1]) <= tol && fabs(res->xpos[0]) <= tol &&
+                          fabs(res->min_gap[1] - 3.0) <= tol,
                       "building, t0 %g: detachments %ld, top floor max %.17g (2), min %.17g "
-                      "(0), first floor %.3g (0), smallest gap %.17g (3)", starts[k],
-                      res->detachments, res->xpos[1], -res->xneg[1], res->xpos[0],
+                      "(0), first floor %.3g (0), smallest gap %.17g (3)",
+                      starts[k], res->detachments, res->xpos[1], -res->xneg[1], res->xpos[0],
                       res->min_gap[1]);
         }
         CHECK(ctx, evals[1] <= 1.1 * evals[0] && evals[0] <= 1.1 * evals[1],
-              "system %d: flight evaluations %.0f from t0 = 0, %.0f from t0 = 1e4", sys,
-              evals[0], evals[1]);
+              "system %d: flight evaluations %.0f from t0 = 0, %.0f from t0 = 1e4", sys, evals[0],
+              evals[1]);
         pd_edr_free(r);
     }
 }
@@ -1447,9 +1509,14 @@ static void test_rows_tree_weights(pd_test_ctx *ctx)
     double M[4] = {1.0, 0.0, 0.0, 2.0}, K[4] = {1.0, 0.0, 0.0, 8.0}, b[2] = {2.0, 0.0};
     double g0[1] = {0.1}, e[1] = {0.5}, wv[2] = {-2.0, 0.5}, q0[2] = {0.0, -0.2};
     int cp[2] = {0, 2}, ri[2] = {0, 1};
-    pd_model md = {.n = 2, .m = 1, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_zero(2, 2),
-                   .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_csc(2, 1, cp, ri, wv),
-                   .g0 = g0, .e = e};
+    pd_model md = {.n = 2,
+                   .m = 1,
+                   .M = pd_matrix_dense(2, 2, M),
+                   .C = pd_matrix_zero(2, 2),
+                   .K = pd_matrix_dense(2, 2, K),
+                   .W = pd_matrix_csc(2, 1, cp, ri, wv),
+                   .g0 = g0,
+                   .e = e};
     pd_sine_piece pc = {.t_start = 0.0, .c0 = 1.0};
     pd_piecewise_force F = {.b = b, .pieces = &pc, .npieces = 1};
     pd_edr_opts eo = pd_edr_default_opts();
@@ -1459,8 +1526,8 @@ static void test_rows_tree_weights(pd_test_ctx *ctx)
     if (!CHECK(ctx, r != NULL, "%s", err.msg))
         return;
     double ys = 8.4 / 129.0, w = sqrt(129.0 / 33.0), t1 = 10.0;
-    lever_ctx lc = {.h = 0.25, .c = 2.0 * (32.0 * ys - 1.6), .d = 2.0 * (8.0 * w * w - 32.0) * ys,
-                    .w = w};
+    lever_ctx lc = {
+        .h = 0.25, .c = 2.0 * (32.0 * ys - 1.6), .d = 2.0 * (8.0 * w * w - 32.0) * ys, .w = w};
     int rc = pd_edr_run(r, 0.0, q0, NULL, t1, check_lever, &lc, &err);
     const pd_edr_result *res = pd_edr_result_of(r);
     if (CHECK(ctx, rc == PD_OK, "%s", err.msg)) {
@@ -1473,7 +1540,8 @@ static void test_rows_tree_weights(pd_test_ctx *ctx)
               res->contact_time[0], t1);
         CHECK(ctx, worst <= 1e-12,
               "x0 in [%.17g, %.17g] (closed form [0, %.17g]), x1 in [%.17g, %.17g] (closed form "
-              "[-0.2, %.17g])", -got[1], got[0], want[0], -got[3], got[2], want[2]);
+              "[-0.2, %.17g])",
+              -got[1], got[0], want[0], -got[3], got[2], want[2]);
         CHECK(ctx, lc.samples == 40 && lc.worst <= 1e-10,
               "the lever's force integrated over %ld samples: off by %.3g of a sample's",
               lc.samples, lc.worst);
@@ -1497,8 +1565,12 @@ static void test_rows_modal_scan_step(pd_test_ctx *ctx)
     double M[4] = {1.0, 0.0, 0.0, 1.0}, K[4] = {2.0, -1.0, -1.0, 1.0}, b[2] = {0.0, 0.0};
     double v0[2] = {1.0, -1.0};
     int cp[1] = {0};
-    pd_model md = {.n = 2, .m = 0, .M = pd_matrix_dense(2, 2, M), .C = pd_matrix_zero(2, 2),
-                   .K = pd_matrix_dense(2, 2, K), .W = pd_matrix_csc(2, 0, cp, NULL, NULL)};
+    pd_model md = {.n = 2,
+                   .m = 0,
+                   .M = pd_matrix_dense(2, 2, M),
+                   .C = pd_matrix_zero(2, 2),
+                   .K = pd_matrix_dense(2, 2, K),
+                   .W = pd_matrix_csc(2, 0, cp, NULL, NULL)};
     pd_sine_piece pc = {.t_start = 0.0};
     pd_piecewise_force F = {.b = b, .pieces = &pc, .npieces = 1};
     pd_err err;
@@ -1527,7 +1599,7 @@ typedef struct held_ctx {
     const double *off;
     int m;
     long samples;
-    double worst;       /* largest |P - exact| / |exact| */
+    double worst; /* largest |P - exact| / |exact| */
 } held_ctx;
 
 static int check_held(const pd_state *s, void *vctx)
@@ -1606,20 +1678,35 @@ static void test_rows_sampled_impulse_held(pd_test_ctx *ctx)
         held_ctx hc = {.h = 0.1, .c0 = 3.0, .A = 1.0, .w = 2.0, .gain = gain1, .off = off0, .m = 1};
         const double *b = b1, *q0 = NULL;
         if (k == 0)
-            md = (pd_model){.n = 1, .m = 1, .M = pd_matrix_dense(1, 1, I1),
-                            .C = pd_matrix_dense(1, 1, C1), .K = pd_matrix_dense(1, 1, K1),
-                            .W = pd_matrix_csc(1, 1, cp1, ri1, w1), .g0 = g0, .e = e};
+            md = (pd_model){.n = 1,
+                            .m = 1,
+                            .M = pd_matrix_dense(1, 1, I1),
+                            .C = pd_matrix_dense(1, 1, C1),
+                            .K = pd_matrix_dense(1, 1, K1),
+                            .W = pd_matrix_csc(1, 1, cp1, ri1, w1),
+                            .g0 = g0,
+                            .e = e};
         else if (k == 1) {
-            md = (pd_model){.n = 2, .m = 2, .M = pd_matrix_dense(2, 2, M2),
-                            .C = pd_matrix_dense(2, 2, C2), .K = pd_matrix_dense(2, 2, K2),
-                            .W = pd_matrix_csc(2, 2, cp2, ri2, w2), .g0 = g0, .e = e};
+            md = (pd_model){.n = 2,
+                            .m = 2,
+                            .M = pd_matrix_dense(2, 2, M2),
+                            .C = pd_matrix_dense(2, 2, C2),
+                            .K = pd_matrix_dense(2, 2, K2),
+                            .W = pd_matrix_csc(2, 2, cp2, ri2, w2),
+                            .g0 = g0,
+                            .e = e};
             b = b2;
             hc.gain = gain2;
             hc.m = 2;
         } else {
-            md = (pd_model){.n = 2, .m = 1, .M = pd_matrix_dense(2, 2, M3),
-                            .C = pd_matrix_dense(2, 2, C3), .K = pd_matrix_dense(2, 2, K3),
-                            .W = pd_matrix_csc(2, 1, cp3, ri3, w3), .g0 = g0, .e = e};
+            md = (pd_model){.n = 2,
+                            .m = 1,
+                            .M = pd_matrix_dense(2, 2, M3),
+                            .C = pd_matrix_dense(2, 2, C3),
+                            .K = pd_matrix_dense(2, 2, K3),
+                            .W = pd_matrix_csc(2, 1, cp3, ri3, w3),
+                            .g0 = g0,
+                            .e = e};
             b = b3;
             q0 = q3;
             pc.A = hc.A = 0.0;
@@ -1633,15 +1720,15 @@ static void test_rows_sampled_impulse_held(pd_test_ctx *ctx)
         pd_edr *r = pd_edr_alloc(&md, &F, &eo, &err);
         if (!CHECK(ctx, r != NULL, "case %d: %s", k + 1, err.msg))
             continue;
-        CHECK(ctx, pd_edr_run(r, 0.0, q0, NULL, 2.0, check_held, &hc, &err) == PD_OK,
-              "case %d: %s", k + 1, err.msg);
+        CHECK(ctx, pd_edr_run(r, 0.0, q0, NULL, 2.0, check_held, &hc, &err) == PD_OK, "case %d: %s",
+              k + 1, err.msg);
         const pd_edr_result *res = pd_edr_result_of(r);
         /* 5-point Gauss on the scan step: the rounding of the force's sum */
         CHECK(ctx, hc.samples == 20 && hc.worst <= 1e-12 && res->impacts == 0,
               "case %d: %ld samples, worst relative impulse error %.3g, %ld impacts", k + 1,
               hc.samples, hc.worst, res->impacts);
-        CHECK(ctx, res->max_impulse[0] == 0.0, "case %d: max_impulse %g of a held contact",
-              k + 1, res->max_impulse[0]);
+        CHECK(ctx, res->max_impulse[0] == 0.0, "case %d: max_impulse %g of a held contact", k + 1,
+              res->max_impulse[0]);
         pd_edr_free(r);
         held_general(ctx, md, b, q0, hc, k);
     }
@@ -1745,9 +1832,10 @@ static void test_rows_run_allocates_nothing(pd_test_ctx *ctx)
     pd_scene_excitation exc = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0};
     pd_scene *sc;
     pd_err e;
-    if (!CHECK(ctx, !pd_scene_chain(30, &exc, 1.0, 1.5, 0.05, 0.05 / (PD_TWO_PI * PD_TWO_PI), 0.6,
-                                    &sc, &e),
-               "%s", e.msg))
+    if (!CHECK(
+            ctx,
+            !pd_scene_chain(30, &exc, 1.0, 1.5, 0.05, 0.05 / (PD_TWO_PI * PD_TWO_PI), 0.6, &sc, &e),
+            "%s", e.msg))
         return;
     pd_edr_opts eo = pd_edr_default_opts();
     row_run rr;
@@ -1756,7 +1844,8 @@ static void test_rows_run_allocates_nothing(pd_test_ctx *ctx)
         int rc = pd_edr_run(rr.edr, 0.0, NULL, NULL, 4.0 * PD_TWO_PI, NULL, NULL, &e);
         long used = pd_test_allocations() - a0;
         const pd_edr_result *res = pd_edr_result_of(rr.edr);
-        CHECK(ctx, rc == PD_OK && res->impacts > 1000, "run: %s (%ld impacts)", e.msg, res->impacts);
+        CHECK(ctx, rc == PD_OK && res->impacts > 1000, "run: %s (%ld impacts)", e.msg,
+              res->impacts);
         CHECK(ctx, used == 0, "%ld allocations during a run of %ld events", used, res->events);
     }
     row_close(&rr);

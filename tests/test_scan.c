@@ -116,8 +116,13 @@ static double fval(edr_fn fn, void *ctx, double t)
 static void test_edr_scan_crossing_adjacent_doubles(pd_test_ctx *ctx)
 {
     sine_fn g = {.A = 1.0, .w = 1.0, .p = 0.0, .B = -0.5};
-    edr_scan s = {.fn = sine_eval, .ctx = &g, .width = 4e-8, .hit_mode = 1, .thr = 1e-16,
-                  .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
+    edr_scan s = {.fn = sine_eval,
+                  .ctx = &g,
+                  .width = 4e-8,
+                  .hit_mode = 1,
+                  .thr = 1e-16,
+                  .fmax = -HUGE_VAL,
+                  .fmin = HUGE_VAL};
     double t = NAN;
     int hit = scan_range(&s, 0.0, TWO_PI, 64, &t);
     CHECK(ctx, hit == 1, "the crossing of sin t = 1/2 is found");
@@ -133,8 +138,13 @@ static void test_edr_scan_crossing_adjacent_doubles(pd_test_ctx *ctx)
 static void test_edr_scan_extrema_to_width(pd_test_ctx *ctx)
 {
     sine_fn g = {.A = 1.0, .w = 1.0, .p = 0.3, .B = 0.25};
-    edr_scan s = {.fn = sine_eval, .ctx = &g, .width = 1e-9, .hit_mode = 0, .thr = 1e-16,
-                  .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
+    edr_scan s = {.fn = sine_eval,
+                  .ctx = &g,
+                  .width = 1e-9,
+                  .hit_mode = 0,
+                  .thr = 1e-16,
+                  .fmax = -HUGE_VAL,
+                  .fmin = HUGE_VAL};
     double t = NAN;
     int hit = scan_range(&s, 0.0, TWO_PI, 64, &t);
     CHECK(ctx, hit == 0, "no hit outside hit mode");
@@ -151,8 +161,13 @@ static void test_edr_scan_extrema_to_width(pd_test_ctx *ctx)
 static void test_edr_scan_grazing_crossing(pd_test_ctx *ctx)
 {
     sine_fn g = {.A = 1.0, .w = 1.0, .p = 0.0, .B = -1.0 + 1e-6};
-    edr_scan s = {.fn = sine_eval, .ctx = &g, .width = 4e-8, .hit_mode = 1, .thr = 1e-16,
-                  .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
+    edr_scan s = {.fn = sine_eval,
+                  .ctx = &g,
+                  .width = 4e-8,
+                  .hit_mode = 1,
+                  .thr = 1e-16,
+                  .fmax = -HUGE_VAL,
+                  .fmin = HUGE_VAL};
     double t = NAN, exact = asin(1.0 - 1e-6);
     int hit = scan_range(&s, 0.0, TWO_PI, 64, &t);
     CHECK(ctx, hit == 1, "the grazing crossing is found");
@@ -176,8 +191,13 @@ static void test_edr_scan_grazing_crossing(pd_test_ctx *ctx)
 static void test_edr_scan_double_turn(pd_test_ctx *ctx)
 {
     cubic_fn g = {.c = 0.5, .e = 3e-4, .B = -1e-6};
-    edr_scan s = {.fn = cubic_eval, .ctx = &g, .width = 1e-10, .hit_mode = 0, .thr = 1e-18,
-                  .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
+    edr_scan s = {.fn = cubic_eval,
+                  .ctx = &g,
+                  .width = 1e-10,
+                  .hit_mode = 0,
+                  .thr = 1e-18,
+                  .fmax = -HUGE_VAL,
+                  .fmin = HUGE_VAL};
     edr_pt a = edr_scan_point(&s, 0.479), b = edr_scan_point(&s, 0.515);
     double t = NAN;
     CHECK(ctx, a.df > 0.0 && b.df > 0.0 && a.f < -3e-6 && b.f < 1e-6, "the ends (%g %g)", a.f, b.f);
@@ -187,8 +207,13 @@ static void test_edr_scan_double_turn(pd_test_ctx *ctx)
     /* the split at the zero of f'' (1) and two turns from their linear guesses */
     CHECK(ctx, s.evals <= 2 + 14, "%ld evaluations for a double turn", s.evals);
 
-    edr_scan h = {.fn = cubic_eval, .ctx = &g, .width = 1e-10, .hit_mode = 1, .thr = 1e-18,
-                  .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
+    edr_scan h = {.fn = cubic_eval,
+                  .ctx = &g,
+                  .width = 1e-10,
+                  .hit_mode = 1,
+                  .thr = 1e-18,
+                  .fmax = -HUGE_VAL,
+                  .fmin = HUGE_VAL};
     int hit = edr_scan_interval(&h, &a, &b, &t);
     CHECK(ctx, hit == 1, "the crossing inside a double turn is found");
     CHECK(ctx, t < g.c - 0.01, "it comes before the maximum (%.17g < 0.49)", t);
@@ -203,16 +228,28 @@ static void test_edr_scan_double_turn(pd_test_ctx *ctx)
 static void test_edr_scan_far_maximum_skipped(pd_test_ctx *ctx)
 {
     sine_fn g = {.A = 1.0, .w = 1.0, .p = 0.3, .B = -2.0};
-    edr_scan s = {.fn = sine_eval, .ctx = &g, .width = 4e-8, .hit_mode = 1, .thr = 1e-16,
-                  .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
+    edr_scan s = {.fn = sine_eval,
+                  .ctx = &g,
+                  .width = 4e-8,
+                  .hit_mode = 1,
+                  .thr = 1e-16,
+                  .fmax = -HUGE_VAL,
+                  .fmin = HUGE_VAL};
     double t = NAN;
     CHECK(ctx, scan_range(&s, 0.0, TWO_PI, 64, &t) == 0, "no hit below zero");
-    CHECK(ctx, s.evals <= 65 + 3, "%ld evaluations (the maximum far below is skipped, the "
-                                   "minimum located in 3)", s.evals);
+    CHECK(ctx, s.evals <= 65 + 3,
+          "%ld evaluations (the maximum far below is skipped, the "
+          "minimum located in 3)",
+          s.evals);
 
     sine_fn n = {.A = 1.0, .w = 1.0, .p = 0.3, .B = -1.0 - 1e-9};
-    edr_scan m = {.fn = sine_eval, .ctx = &n, .width = 4e-8, .hit_mode = 1, .thr = 1e-16,
-                  .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
+    edr_scan m = {.fn = sine_eval,
+                  .ctx = &n,
+                  .width = 4e-8,
+                  .hit_mode = 1,
+                  .thr = 1e-16,
+                  .fmax = -HUGE_VAL,
+                  .fmin = HUGE_VAL};
     CHECK(ctx, scan_range(&m, 0.0, TWO_PI, 64, &t) == 0, "no hit 1e-9 below zero");
     CHECK_NEAR(ctx, m.fmax, -1e-9, 1e-15);
     /* the maximum located coarsely (to 1e-4 h: f within 1e-10 of its top)
@@ -230,13 +267,19 @@ static void test_edr_scan_crossing_sweep(pd_test_ctx *ctx)
     for (int i = 1; i <= 19; i++) {
         double r = 0.7, u = 0.05 * i, h = 0.1;
         sine_fn g = {.A = 1.0, .w = 1.0, .p = 0.0, .B = -sin(r)};
-        edr_scan s = {.fn = sine_eval, .ctx = &g, .width = 4e-8 * h, .hit_mode = 1, .thr = 1e-16,
-                      .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
+        edr_scan s = {.fn = sine_eval,
+                      .ctx = &g,
+                      .width = 4e-8 * h,
+                      .hit_mode = 1,
+                      .thr = 1e-16,
+                      .fmax = -HUGE_VAL,
+                      .fmin = HUGE_VAL};
         edr_pt a = edr_scan_point(&s, r - u * h), b = edr_scan_point(&s, r + (1.0 - u) * h);
         double t = NAN;
         int hit = edr_scan_interval(&s, &a, &b, &t);
-        CHECK(ctx, hit == 1 && fval(sine_eval, &g, t) > 0.0 &&
-                       fval(sine_eval, &g, nextafter(t, 0.0)) <= 0.0,
+        CHECK(ctx,
+              hit == 1 && fval(sine_eval, &g, t) > 0.0 &&
+                  fval(sine_eval, &g, nextafter(t, 0.0)) <= 0.0,
               "u = %.2f: t = %.17g is the first double with f > 0", u, t);
         worst = s.evals - 2 > worst ? s.evals - 2 : worst;
     }
@@ -251,8 +294,13 @@ static void test_edr_scan_crossing_sweep(pd_test_ctx *ctx)
 static void test_edr_scan_hump_inside_interval(pd_test_ctx *ctx)
 {
     sine_fn g = {.A = 1.0, .w = 1.0, .p = 0.0, .B = -1.0 + 5e-6};
-    edr_scan s = {.fn = sine_eval, .ctx = &g, .width = 4e-8 * 0.098, .hit_mode = 1, .thr = 1e-16,
-                  .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
+    edr_scan s = {.fn = sine_eval,
+                  .ctx = &g,
+                  .width = 4e-8 * 0.098,
+                  .hit_mode = 1,
+                  .thr = 1e-16,
+                  .fmax = -HUGE_VAL,
+                  .fmin = HUGE_VAL};
     edr_pt a = edr_scan_point(&s, PI_HALF - 0.049), b = edr_scan_point(&s, PI_HALF + 0.049);
     double t = NAN, exact = asin(1.0 - 5e-6);
     CHECK(ctx, a.f < 0.0 && b.f < 0.0, "f < 0 at both ends");
@@ -271,8 +319,13 @@ static void test_edr_scan_hump_inside_interval(pd_test_ctx *ctx)
      * ends' slopes are far apart, the interval's scale is large, and the
      * Hermite bound must still see the maximum may reach above zero */
     sine_fn k = {.A = 1.0, .w = 1.0, .p = 0.0, .B = -1.0 + 1e-7};
-    edr_scan q = {.fn = sine_eval, .ctx = &k, .width = 4e-8 * 0.035, .hit_mode = 1, .thr = 1e-16,
-                  .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
+    edr_scan q = {.fn = sine_eval,
+                  .ctx = &k,
+                  .width = 4e-8 * 0.035,
+                  .hit_mode = 1,
+                  .thr = 1e-16,
+                  .fmax = -HUGE_VAL,
+                  .fmin = HUGE_VAL};
     a = edr_scan_point(&q, PI_HALF - 0.005);
     b = edr_scan_point(&q, PI_HALF + 0.03);
     CHECK(ctx, a.f < 0.0 && b.f < 0.0, "f < 0 at both ends");
@@ -287,12 +340,17 @@ static void test_edr_scan_hump_inside_interval(pd_test_ctx *ctx)
 static void test_edr_scan_start_just_past_zero(pd_test_ctx *ctx)
 {
     line_fn g = {.r = 1.0 - 1e-13};
-    edr_scan s = {.fn = line_eval, .ctx = &g, .width = 4e-9, .hit_mode = 1, .thr = 1e-12,
-                  .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
+    edr_scan s = {.fn = line_eval,
+                  .ctx = &g,
+                  .width = 4e-9,
+                  .hit_mode = 1,
+                  .thr = 1e-12,
+                  .fmax = -HUGE_VAL,
+                  .fmin = HUGE_VAL};
     edr_pt a = edr_scan_point(&s, 1.0), b = edr_scan_point(&s, 1.1);
     double t = NAN;
     int hit = edr_scan_interval(&s, &a, &b, &t);
-    CHECK(ctx, hit == 1 && t > 1.0 && t <= nextafter(1.0, 2.0) , "hit at %.17g (start 1)", t);
+    CHECK(ctx, hit == 1 && t > 1.0 && t <= nextafter(1.0, 2.0), "hit at %.17g (start 1)", t);
     /* measured: Newton leaves the bracket at once, bisection to adjacent doubles */
     CHECK(ctx, s.evals <= 2 + 49, "%ld evaluations", s.evals);
 }
@@ -302,8 +360,13 @@ static void test_edr_scan_start_just_past_zero(pd_test_ctx *ctx)
 static void test_edr_scan_near_double_turn(pd_test_ctx *ctx)
 {
     cubic_fn g = {.c = 0.5, .e = -2e-4, .B = 0.0};
-    edr_scan s = {.fn = cubic_eval, .ctx = &g, .width = 1e-10, .hit_mode = 0, .thr = 1e-18,
-                  .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
+    edr_scan s = {.fn = cubic_eval,
+                  .ctx = &g,
+                  .width = 1e-10,
+                  .hit_mode = 0,
+                  .thr = 1e-18,
+                  .fmax = -HUGE_VAL,
+                  .fmin = HUGE_VAL};
     edr_pt a = edr_scan_point(&s, 0.479), b = edr_scan_point(&s, 0.515);
     double t = NAN;
     CHECK(ctx, edr_scan_interval(&s, &a, &b, &t) == 0, "no hit outside hit mode");
@@ -326,8 +389,13 @@ static void test_edr_scan_double_turn_located(pd_test_ctx *ctx)
     const double ua[2] = {-0.4, -0.115}, ub[2] = {0.1, 0.09};
     for (int i = 0; i < 2; i++) {
         quintic_fn g = cases[i];
-        edr_scan s = {.fn = quintic_eval, .ctx = &g, .width = 1e-12, .hit_mode = 0, .thr = 1e-18,
-                      .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
+        edr_scan s = {.fn = quintic_eval,
+                      .ctx = &g,
+                      .width = 1e-12,
+                      .hit_mode = 0,
+                      .thr = 1e-18,
+                      .fmax = -HUGE_VAL,
+                      .fmin = HUGE_VAL};
         edr_pt a = edr_scan_point(&s, g.c + ua[i]), b = edr_scan_point(&s, g.c + ub[i]);
         double t = NAN, fmin = quintic_min(&g);
         CHECK(ctx, a.df > 0.0 && b.df > 0.0, "case %d: f' > 0 at both ends", i);
@@ -343,8 +411,13 @@ static void test_edr_scan_double_turn_located(pd_test_ctx *ctx)
 static void test_edr_scan_inflection_costs_nothing(pd_test_ctx *ctx)
 {
     cubic_fn g = {.c = 0.5, .e = -0.05, .B = 0.0};
-    edr_scan s = {.fn = cubic_eval, .ctx = &g, .width = 1e-10, .hit_mode = 0, .thr = 1e-18,
-                  .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
+    edr_scan s = {.fn = cubic_eval,
+                  .ctx = &g,
+                  .width = 1e-10,
+                  .hit_mode = 0,
+                  .thr = 1e-18,
+                  .fmax = -HUGE_VAL,
+                  .fmin = HUGE_VAL};
     edr_pt a = edr_scan_point(&s, 0.48), b = edr_scan_point(&s, 0.515);
     double t = NAN;
     CHECK(ctx, a.ddf < 0.0 && b.ddf > 0.0, "f'' changes sign");
@@ -358,8 +431,13 @@ static void test_edr_scan_inflection_costs_nothing(pd_test_ctx *ctx)
 static void test_edr_scan_below_maximum_costs_nothing(pd_test_ctx *ctx)
 {
     sine_fn g = {.A = 1.0, .w = 1.0, .p = 0.0, .B = -1.0 - 2e-4};
-    edr_scan s = {.fn = sine_eval, .ctx = &g, .width = 4e-8 * 0.098, .hit_mode = 1, .thr = 1e-16,
-                  .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
+    edr_scan s = {.fn = sine_eval,
+                  .ctx = &g,
+                  .width = 4e-8 * 0.098,
+                  .hit_mode = 1,
+                  .thr = 1e-16,
+                  .fmax = -HUGE_VAL,
+                  .fmin = HUGE_VAL};
     edr_pt a = edr_scan_point(&s, PI_HALF - 0.08), b = edr_scan_point(&s, PI_HALF + 0.018);
     double t = NAN;
     CHECK(ctx, edr_scan_interval(&s, &a, &b, &t) == 0, "no hit");
@@ -373,7 +451,8 @@ static void test_edr_scan_bisect_sign(pd_test_ctx *ctx)
 {
     line_fn g = {.r = 0.1};
     double t = edr_bisect_sign(line_eval, &g, 0, 1.0, 0.0, 1.0);
-    CHECK(ctx, t - g.r > 0.0 && nextafter(t, 0.0) - g.r <= 0.0, "t = %.17g: first double above 0.1", t);
+    CHECK(ctx, t - g.r > 0.0 && nextafter(t, 0.0) - g.r <= 0.0, "t = %.17g: first double above 0.1",
+          t);
     line_fn z = {.r = 0.0};
     double lo = edr_bisect_sign(line_eval, &z, 0, 1.0, -1.0, 1.0);
     CHECK(ctx, lo == ldexp(1.0, -199), "a root at 0 ends after 200 halvings: %.17g", lo);
@@ -382,8 +461,10 @@ static void test_edr_scan_bisect_sign(pd_test_ctx *ctx)
      * adjacent; its midpoint rounds to 1 + 2 u (even): the bisection stops */
     line_fn a = {.r = 1.0 + DBL_EPSILON};
     double hi = edr_bisect_sign(line_eval, &a, 0, 1.0, 1.0 + DBL_EPSILON, 1.0 + 2.0 * DBL_EPSILON);
-    CHECK(ctx, hi == 1.0 + 2.0 * DBL_EPSILON && a.calls == 0, "adjacent doubles: %.17g after %ld "
-          "evaluations", hi, a.calls);
+    CHECK(ctx, hi == 1.0 + 2.0 * DBL_EPSILON && a.calls == 0,
+          "adjacent doubles: %.17g after %ld "
+          "evaluations",
+          hi, a.calls);
 }
 
 /* The Taylor root: the smallest s > 0 with f + f' s + f''/2 s^2 = 0,

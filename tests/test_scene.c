@@ -64,27 +64,28 @@ static void test_scene_one_wall_is_the_oscillator(pd_test_ctx *ctx)
         pd_osc_result ro;
         pd_err e;
         o.method = methods[k];
-        if (run(ctx, sc, &o, &r) || !CHECK(ctx, pd_osc_run(&c, &o, NULL, NULL, &ro, &e) == PD_OK,
-                                           "%s", e.msg)) {
+        if (run(ctx, sc, &o, &r) ||
+            !CHECK(ctx, pd_osc_run(&c, &o, NULL, NULL, &ro, &e) == PD_OK, "%s", e.msg)) {
             pd_scene_result_free(&r);
             continue;
         }
         CHECK(ctx, fabs(r.umax[0] - ro.umax) <= 1e-12 * ro.umax && r.impacts[0] == ro.impacts,
-              "%s: scene umax %.17g (%ld impacts) vs oscillator %.17g (%ld)", pd_method_name(o.method),
-              r.umax[0], r.impacts[0], ro.umax, ro.impacts);
+              "%s: scene umax %.17g (%ld impacts) vs oscillator %.17g (%ld)",
+              pd_method_name(o.method), r.umax[0], r.impacts[0], ro.umax, ro.impacts);
         CHECK(ctx, fabs(r.first_impact[0] - ro.first_impact) <= 1e-12,
               "first impact %.17g vs %.17g", r.first_impact[0], ro.first_impact);
         /* mirrored: the wall on the left, the pulse along -x */
-        sc->ct[0] = (pd_contact){.a = PD_WALL, .b = 0, .level_a = 0, .level_b = 1, .gap = 0.004,
-                                 .eps = 0.6};
+        sc->ct[0] = (pd_contact){
+            .a = PD_WALL, .b = 0, .level_a = 0, .level_b = 1, .gap = 0.004, .eps = 0.6};
         sc->exc.dir = -1;
         if (!run(ctx, sc, &o, &rm))
-            CHECK(ctx, rm.umax[0] == r.umax[0] && rm.u_pos[0] == r.u_neg[0] &&
-                           rm.impacts[0] == r.impacts[0],
+            CHECK(ctx,
+                  rm.umax[0] == r.umax[0] && rm.u_pos[0] == r.u_neg[0] &&
+                      rm.impacts[0] == r.impacts[0],
                   "%s mirrored: umax %.17g vs %.17g, u_pos %.6g vs u_neg %.6g",
                   pd_method_name(o.method), rm.umax[0], r.umax[0], rm.u_pos[0], r.u_neg[0]);
-        sc->ct[0] = (pd_contact){.a = 0, .b = PD_WALL, .level_a = 1, .level_b = 0, .gap = 0.004,
-                                 .eps = 0.6};
+        sc->ct[0] = (pd_contact){
+            .a = 0, .b = PD_WALL, .level_a = 1, .level_b = 0, .gap = 0.004, .eps = 0.6};
         sc->exc.dir = 1;
         pd_scene_result_free(&r);
         pd_scene_result_free(&rm);
@@ -108,8 +109,9 @@ static void test_scene_general_paths_match_fast_paths(pd_test_ctx *ctx)
         g.kernel = PD_KERNEL_GENERAL;
         if (!run(ctx, sc, &o, &fast) && !run(ctx, sc, &g, &gen)) {
             double tol = k ? 1e-8 : 1e-12;
-            CHECK(ctx, fabs(gen.umax[0] - fast.umax[0]) <= tol * fast.umax[0] &&
-                           gen.impacts[0] == fast.impacts[0],
+            CHECK(ctx,
+                  fabs(gen.umax[0] - fast.umax[0]) <= tol * fast.umax[0] &&
+                      gen.impacts[0] == fast.impacts[0],
                   "%s: general %.17g (%ld impacts) vs fast path %.17g (%ld), tolerance %g",
                   o.method == PD_METHOD_EVENT ? "event" : "moreau", gen.umax[0], gen.impacts[0],
                   fast.umax[0], fast.impacts[0], tol);
@@ -183,8 +185,9 @@ static void test_scene_self_similar(pd_test_ctx *ctx)
                 sc->ct[a].gap /= 3.7;
             for (int i = 0; !bad && i < sc->n; i++)
                 worst = fmax(worst, fabs(r2.umax[i] / Le2 - r1.umax[i] / Le1) / (r1.umax[i] / Le1));
-            CHECK(ctx, !bad && worst <= 1e-12, "%s %s: Pi1 moves by %.3g when ap and the gaps scale",
-                  files[f], pd_method_name(o.method), worst);
+            CHECK(ctx, !bad && worst <= 1e-12,
+                  "%s %s: Pi1 moves by %.3g when ap and the gaps scale", files[f],
+                  pd_method_name(o.method), worst);
             pd_scene_result_free(&r1);
             pd_scene_result_free(&r2);
         }
@@ -264,8 +267,9 @@ static void test_scene_impulses_equal_and_opposite(pd_test_ctx *ctx)
                 worst = fmax(worst, fabs(p - p0));
                 Psum += st->P[0] + st->P[1];
             }
-            CHECK(ctx, worst <= 1e-13 && Psum > 0.5, "e = %g, %s: momentum drifts by %.3g (impulses %g)",
-                  es[ke], mo.factor == PD_FACTOR_DENSE ? "dense" : "cholmod", worst, Psum);
+            CHECK(ctx, worst <= 1e-13 && Psum > 0.5,
+                  "e = %g, %s: momentum drifts by %.3g (impulses %g)", es[ke],
+                  mo.factor == PD_FACTOR_DENSE ? "dense" : "cholmod", worst, Psum);
             pd_mj_free(mj);
         }
         pd_scene_model_free(&sm);
@@ -281,7 +285,8 @@ static double scene_energy(const pd_scene *sc, const pd_scene_sample *s)
         for (int i = 0; i < sc->st[k].storeys; i++) {
             int d = sc->st[k].dof + i;
             double dx = s->x[d] - (i ? s->x[d - 1] : 0.0);
-            E += 0.5 * sc->st[k].mass[i] * s->v[d] * s->v[d] + 0.5 * sc->st[k].stiffness[i] * dx * dx;
+            E += 0.5 * sc->st[k].mass[i] * s->v[d] * s->v[d] +
+                 0.5 * sc->st[k].stiffness[i] * dx * dx;
         }
     return E;
 }
@@ -367,10 +372,11 @@ static void test_scene_moreau_converges_to_reference(pd_test_ctx *ctx)
     pd_scene_excitation x = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 3.0, .Tp = 0.5};
     pd_scene *sc = pd_scene_new(&x);
     pd_err e;
-    if (!CHECK(ctx, sc && !pd_scene_add_sdof(sc, "L", 0.5, 0.05, 1.0, &e) &&
-                        !pd_scene_add_sdof(sc, "R", 1.0, 0.05, 2.0, &e) &&
-                        !pd_scene_add_contact(sc, 0, 1, 1, 1, 0.01, 0.7, 0, &e) &&
-                        !pd_scene_finish(sc, &e),
+    if (!CHECK(ctx,
+               sc && !pd_scene_add_sdof(sc, "L", 0.5, 0.05, 1.0, &e) &&
+                   !pd_scene_add_sdof(sc, "R", 1.0, 0.05, 2.0, &e) &&
+                   !pd_scene_add_contact(sc, 0, 1, 1, 1, 0.01, 0.7, 0, &e) &&
+                   !pd_scene_finish(sc, &e),
                "building: %s", e.msg)) {
         pd_scene_free(sc);
         return;
@@ -426,9 +432,10 @@ static void test_scene_building_modes(pd_test_ctx *ctx)
     pd_scene_excitation x = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 1.0};
     pd_scene *sc = pd_scene_new(&x);
     pd_err e;
-    if (!CHECK(ctx, sc && !pd_scene_add_uniform(sc, "B", 8, 3e5, 0.9, 0.05, &e) &&
-                        !pd_scene_set_damping(sc, PD_DAMPING_RAYLEIGH, 1, 3, &e) &&
-                        !pd_scene_finish(sc, &e),
+    if (!CHECK(ctx,
+               sc && !pd_scene_add_uniform(sc, "B", 8, 3e5, 0.9, 0.05, &e) &&
+                   !pd_scene_set_damping(sc, PD_DAMPING_RAYLEIGH, 1, 3, &e) &&
+                   !pd_scene_finish(sc, &e),
                "%s", e.msg)) {
         pd_scene_free(sc);
         return;
@@ -534,14 +541,17 @@ static void test_scene_row_memory_linear(pd_test_ctx *ctx)
         return;
     const row_heap *rows[2] = {&small, &large};
     for (int k = 0; k < 2; k++)
-        CHECK(ctx, rows[k]->step_allocations == 0 && rows[k]->step_heap_change == 0 &&
-                       rows[k]->active > 0.25 && rows[k]->active < 0.75,
+        CHECK(ctx,
+              rows[k]->step_allocations == 0 && rows[k]->step_heap_change == 0 &&
+                  rows[k]->active > 0.25 && rows[k]->active < 0.75,
               "N = %d: %ld allocations and %ld bytes of heap change in %d steps, %.0f%% of the "
-              "contacts active", k ? 10000 : 1000, rows[k]->step_allocations,
-              rows[k]->step_heap_change, ROW_STEPS, 100 * rows[k]->active);
+              "contacts active",
+              k ? 10000 : 1000, rows[k]->step_allocations, rows[k]->step_heap_change, ROW_STEPS,
+              100 * rows[k]->active);
     double per_dof = (double)(large.setup_bytes - small.setup_bytes) / 9000.0;
-    CHECK(ctx, per_dof > 0.0 && per_dof <= ROW_BYTES_PER_DOF &&
-                   large.setup_bytes <= 10 * small.setup_bytes,
+    CHECK(ctx,
+          per_dof > 0.0 && per_dof <= ROW_BYTES_PER_DOF &&
+              large.setup_bytes <= 10 * small.setup_bytes,
           "setup heap %ld bytes at N = 1000, %ld at N = 10000: %.0f bytes per added dof",
           small.setup_bytes, large.setup_bytes, per_dof);
 }
@@ -556,38 +566,55 @@ static void test_scene_cli_bad_files(pd_test_ctx *ctx)
     if (!mkdtemp(dir))
         return;
 #define EXC "\"excitation\": {\"pulse\": \"sine\", \"ap\": 4, \"Tp\": 0.3},\n"
-#define ST1 "\"structures\": [{\"name\": \"A\", \"T0\": 1}, {\"name\": \"B\", \"storeys\": 3, \"mass\": 1e5, \"T0\": 0.5}],\n"
+#define ST1                                                                                        \
+    "\"structures\": [{\"name\": \"A\", \"T0\": 1}, {\"name\": \"B\", \"storeys\": 3, \"mass\": "  \
+    "1e5, \"T0\": 0.5}],\n"
     static const struct {
         const char *name, *text, *want;
     } bad[] = {
         {"missing", "{\n" EXC "\"contacts\": []\n}\n", "missing field 'structures'"},
         {"type", "{\n" EXC "\"structures\": [{\"name\": \"A\", \"T0\": \"one\"}]\n}\n",
          "structures[0].T0: expected a number"},
-        {"storeys", "{\n" EXC "\"structures\": [{\"name\": \"A\", \"storeys\": 2.5, \"T0\": 1}]\n}\n",
+        {"storeys",
+         "{\n" EXC "\"structures\": [{\"name\": \"A\", \"storeys\": 2.5, \"T0\": 1}]\n}\n",
          "structures[0].storeys: expected a positive integer"},
-        {"gap", "{\n" EXC ST1 "\"contacts\": [{\"a\": \"A\", \"b\": \"B\", \"gap\": -1, \"eps\": 0.5}]\n}\n",
+        {"gap",
+         "{\n" EXC ST1
+         "\"contacts\": [{\"a\": \"A\", \"b\": \"B\", \"gap\": -1, \"eps\": 0.5}]\n}\n",
          "contacts[0].gap: must be >= 0"},
         {"mass", "{\n" EXC "\"structures\": [{\"name\": \"A\", \"T0\": 1, \"mass\": -3}]\n}\n",
          "structures[0].mass: must be > 0"},
-        {"eps", "{\n" EXC ST1 "\"contacts\": [{\"a\": \"A\", \"b\": \"B\", \"gap\": 0.1, \"eps\": 1.2}]\n}\n",
+        {"eps",
+         "{\n" EXC ST1
+         "\"contacts\": [{\"a\": \"A\", \"b\": \"B\", \"gap\": 0.1, \"eps\": 1.2}]\n}\n",
          "contacts[0].eps"},
-        {"unknown", "{\n" EXC ST1 "\"contacts\": [{\"a\": \"A\", \"b\": \"Z\", \"gap\": 0.1, \"eps\": 0.5}]\n}\n",
+        {"unknown",
+         "{\n" EXC ST1
+         "\"contacts\": [{\"a\": \"A\", \"b\": \"Z\", \"gap\": 0.1, \"eps\": 0.5}]\n}\n",
          "contacts[0].b: no structure named 'Z'"},
-        {"storey", "{\n" EXC ST1 "\"contacts\": [{\"a\": \"A\", \"b\": \"B\", \"levels\": [2], \"gap\": 0.1, \"eps\": 0.5}]\n}\n",
+        {"storey",
+         "{\n" EXC ST1 "\"contacts\": [{\"a\": \"A\", \"b\": \"B\", \"levels\": [2], \"gap\": 0.1, "
+         "\"eps\": 0.5}]\n}\n",
          "contacts[0].levels: 'A' has no storey 2"},
-        {"duplicate", "{\n" EXC "\"structures\": [{\"name\": \"A\", \"T0\": 1}, {\"name\": \"A\", \"T0\": 2}]\n}\n",
+        {"duplicate",
+         "{\n" EXC
+         "\"structures\": [{\"name\": \"A\", \"T0\": 1}, {\"name\": \"A\", \"T0\": 2}]\n}\n",
          "structures[1].name: 'A' is used twice"},
         {"garbage", "{\n" EXC ST1 "\"contacts\": []\n} }", "end of file expected"},
         {"empty", "{\n" EXC "\"structures\": []\n}\n", "structures: expected a non-empty array"},
         {"field", "{\n" EXC "\"structures\": [{\"name\": \"A\", \"T0\": 1, \"xii\": 0.1}]\n}\n",
          "structures[0].xii: unknown field"},
-        {"order", "{\n" EXC ST1 "\"contacts\": [{\"a\": \"B\", \"b\": \"A\", \"gap\": 0.1, \"eps\": 0.5}]\n}\n",
+        {"order",
+         "{\n" EXC ST1
+         "\"contacts\": [{\"a\": \"B\", \"b\": \"A\", \"gap\": 0.1, \"eps\": 0.5}]\n}\n",
          "contacts[0].b: 'A' must stand to the right of 'B'"},
         {"comma", "{\n" EXC "\"structures\": [{\"name\": \"a,b\", \"T0\": 1}]\n}\n",
          "structures[0].name: may not contain ','"},
         {"dot", "{\n" EXC "\"structures\": [{\"name\": \".\", \"T0\": 1}]\n}\n",
          "structures[0].name: '.' is not a usable name"},
-        {"twice", "{\n" EXC ST1 "\"contacts\": [{\"a\": \"A\", \"b\": \"B\", \"levels\": [1, 1], \"gap\": 0.1, \"eps\": 0.5}]\n}\n",
+        {"twice",
+         "{\n" EXC ST1 "\"contacts\": [{\"a\": \"A\", \"b\": \"B\", \"levels\": [1, 1], \"gap\": "
+         "0.1, \"eps\": 0.5}]\n}\n",
          "contacts[0]: 'A' storey 1 and 'B' storey 1 are joined twice"},
     };
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
@@ -603,14 +630,15 @@ static void test_scene_cli_bad_files(pd_test_ctx *ctx)
             lines += *p == '\n';
         char where[300];
         snprintf(where, sizeof where, "%s:", path);
-        CHECK(ctx, r.status == 2 && lines == 1 && r.err && strstr(r.err, where) &&
-                       strstr(r.err, bad[k].want) && access(out, F_OK) != 0,
+        CHECK(ctx,
+              r.status == 2 && lines == 1 && r.err && strstr(r.err, where) &&
+                  strstr(r.err, bad[k].want) && access(out, F_OK) != 0,
               "%s: exit %d, %d lines: %s", bad[k].name, r.status, lines, r.err ? r.err : "");
         /* FILE:LINE:COL with numbers */
         int line = 0, col = 0;
         const char *at = r.err ? strstr(r.err, where) : NULL;
-        CHECK(ctx, at && sscanf(at + strlen(where), "%d:%d:", &line, &col) == 2 && line >= 1 &&
-                       col >= 1,
+        CHECK(ctx,
+              at && sscanf(at + strlen(where), "%d:%d:", &line, &col) == 2 && line >= 1 && col >= 1,
               "%s: no line and column in %s", bad[k].name, r.err ? r.err : "");
         pd_test_proc_free(&r);
     }
@@ -626,8 +654,8 @@ typedef struct range_case {
 } range_case;
 
 /* The scene of c (text) written to dir/range.json (path). */
-static void range_scene(const char *dir, const range_case *c, char *text, size_t cap,
-                        char *path, size_t pcap)
+static void range_scene(const char *dir, const range_case *c, char *text, size_t cap, char *path,
+                        size_t pcap)
 {
     snprintf(text, cap,
              "{\n"
@@ -641,8 +669,7 @@ static void range_scene(const char *dir, const range_case *c, char *text, size_t
              "}\n",
              c->ap ? c->ap : "4", c->Tp ? c->Tp : "0.3", c->T0 ? c->T0 : "0.5",
              c->mass ? c->mass : "1e5", c->masses ? c->masses : "[2e5, 2e5]",
-             c->stiff ? c->stiff : "[3e8, 3e8]", c->gap ? c->gap : "0.02",
-             c->tend ? c->tend : "2");
+             c->stiff ? c->stiff : "[3e8, 3e8]", c->gap ? c->gap : "0.02", c->tend ? c->tend : "2");
     scratch(dir, "range.json", text, path, pcap);
 }
 
@@ -659,23 +686,39 @@ static void test_scene_values_in_range(pd_test_ctx *ctx)
     if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
         return;
     static const range_case cases[] = {
-        {.ap = "4.9e-324", .line = 2, .needle = "4.9e-324", .says = "excitation.ap: the pulse "
-         "amplitude 4.94066e-324 m/s^2 is outside the usable range [1e-06, 10000] m/s^2"},
+        {.ap = "4.9e-324",
+         .line = 2,
+         .needle = "4.9e-324",
+         .says = "excitation.ap: the pulse "
+                 "amplitude 4.94066e-324 m/s^2 is outside the usable range [1e-06, 10000] m/s^2"},
         {.ap = "1e308", .line = 2, .needle = "1e308", .says = "excitation.ap:"},
-        {.Tp = "1e308", .line = 2, .needle = "1e308", .says = "excitation.Tp: the pulse period "
-         "1e+308 s is outside the usable range [0.01, 1000] s"},
+        {.Tp = "1e308",
+         .line = 2,
+         .needle = "1e308",
+         .says = "excitation.Tp: the pulse period "
+                 "1e+308 s is outside the usable range [0.01, 1000] s"},
         {.Tp = "4.9e-324", .line = 2, .needle = "4.9e-324", .says = "excitation.Tp:"},
         {.T0 = "4.9e-324", .line = 4, .needle = "4.9e-324", .says = "structures[0].T0: the period"},
         {.T0 = "1e308", .line = 4, .needle = "1e308", .says = "structures[0].T0:"},
-        {.mass = "1e308", .line = 4, .needle = "1e308", .says = "structures[0].mass: the mass "
-         "1e+308 kg is outside"},
+        {.mass = "1e308",
+         .line = 4,
+         .needle = "1e308",
+         .says = "structures[0].mass: the mass "
+                 "1e+308 kg is outside"},
         {.mass = "4.9e-324", .line = 4, .needle = "4.9e-324", .says = "structures[0].mass:"},
         {.masses = "[2e5, 1e308]", .line = 5, .needle = "1e308", .says = "structures[1].masses[1]"},
-        {.stiff = "[1e308, 3e8]", .line = 5, .needle = "1e308",
+        {.stiff = "[1e308, 3e8]",
+         .line = 5,
+         .needle = "1e308",
          .says = "structures[1].stiffnesses[0]: the stiffness 1e+308 N/m"},
-        {.stiff = "[3e8, 4.9e-324]", .line = 5, .needle = "4.9e-324",
+        {.stiff = "[3e8, 4.9e-324]",
+         .line = 5,
+         .needle = "4.9e-324",
          .says = "structures[1].stiffnesses[1]"},
-        {.masses = "[1, 1]", .stiff = "[6e8, 5e8]", .line = 5, .needle = "[6e8",
+        {.masses = "[1, 1]",
+         .stiff = "[6e8, 5e8]",
+         .line = 5,
+         .needle = "[6e8",
          .says = "structures[1].stiffnesses: with these masses, the fundamental period 0.000"},
         {.gap = "1e308", .line = 7, .needle = "1e308", .says = "contacts[0].gap: the gap 1e+308 m"},
         {.tend = "1e308", .line = 8, .needle = "1e308", .says = "tend: 1e+308 s is outside"},
@@ -718,8 +761,10 @@ static void test_scene_builder_derived_finite(pd_test_ctx *ctx)
             return;
         int st = pd_scene_add_sdof(sc, "A", T0s[k], 0.05, 1.0, &e);
         int st2 = pd_scene_add_uniform(sc, "B", 3, 1.0, T0s[k], 0.05, &e);
-        CHECK(ctx, st == PD_EINVAL && st2 == PD_EINVAL && !strncmp(e.msg, "T0: a period of", 15) &&
-                   sc->nstruct == 0, "T0 = %g: %d %d %s", T0s[k], st, st2, e.msg);
+        CHECK(ctx,
+              st == PD_EINVAL && st2 == PD_EINVAL && !strncmp(e.msg, "T0: a period of", 15) &&
+                  sc->nstruct == 0,
+              "T0 = %g: %d %d %s", T0s[k], st, st2, e.msg);
         pd_scene_free(sc);
     }
 }
@@ -752,17 +797,21 @@ static void test_scene_result_shape(pd_test_ctx *ctx)
     CHECK(ctx, pd_scene_result_alloc(open, &r, &e) == PD_EINVAL && strstr(e.msg, "not finished"),
           "a result for an unfinished scene: %s", e.msg);
     CHECK(ctx, pd_scene_run(open, &o, NULL, NULL, &r, &e) == PD_EINVAL, "ran an unfinished scene");
-    if (!CHECK(ctx, !pd_scene_result_alloc(small, &rs, &e) && !pd_scene_result_alloc(big, &rb, &e) &&
-                        !pd_scene_result_alloc(big, &rb2, &e) &&
-                        !pd_scene_errors_alloc(small, &es, &e) &&
-                        !pd_scene_trace_alloc(&ts, small, &o, &e) &&
-                        !pd_scene_trace_alloc(&tb, big, &o, &e),
+    if (!CHECK(ctx,
+               !pd_scene_result_alloc(small, &rs, &e) && !pd_scene_result_alloc(big, &rb, &e) &&
+                   !pd_scene_result_alloc(big, &rb2, &e) &&
+                   !pd_scene_errors_alloc(small, &es, &e) &&
+                   !pd_scene_trace_alloc(&ts, small, &o, &e) &&
+                   !pd_scene_trace_alloc(&tb, big, &o, &e),
                "%s", e.msg))
         goto done;
-    CHECK(ctx, pd_scene_result_fits(big, &rb) && !pd_scene_result_fits(big, &rs) &&
-                   !pd_scene_result_fits(big, &r), "pd_scene_result_fits");
-    CHECK(ctx, pd_scene_run(big, &o, NULL, NULL, &rs, &e) == PD_EINVAL &&
-                   strstr(e.msg, "not allocated for this scene"),
+    CHECK(ctx,
+          pd_scene_result_fits(big, &rb) && !pd_scene_result_fits(big, &rs) &&
+              !pd_scene_result_fits(big, &r),
+          "pd_scene_result_fits");
+    CHECK(ctx,
+          pd_scene_run(big, &o, NULL, NULL, &rs, &e) == PD_EINVAL &&
+              strstr(e.msg, "not allocated for this scene"),
           "a smaller scene's result: %s", e.msg);
     CHECK(ctx, pd_scene_measure_reference(big, &o, &ts, &rb, &e) == PD_EINVAL,
           "a smaller scene's trace: %s", e.msg);
@@ -798,9 +847,10 @@ static void test_scene_work_budgets(pd_test_ctx *ctx)
     const pd_method refused[3] = {PD_METHOD_EVENT, PD_METHOD_EVENT_GENERAL, PD_METHOD_PENALTY};
     pd_scene_result r = {0};
     pd_err e = {0};
-    if (!CHECK(ctx, sc && !pd_scene_add_building(sc, "A", 2, m, k, 0.05, &e) &&
-                        !pd_scene_add_contact(sc, PD_WALL, 0, 0, 2, 0.01, 0.5, 0, &e) &&
-                        !pd_scene_finish(sc, &e) && !pd_scene_result_alloc(sc, &r, &e),
+    if (!CHECK(ctx,
+               sc && !pd_scene_add_building(sc, "A", 2, m, k, 0.05, &e) &&
+                   !pd_scene_add_contact(sc, PD_WALL, 0, 0, 2, 0.01, 0.5, 0, &e) &&
+                   !pd_scene_finish(sc, &e) && !pd_scene_result_alloc(sc, &r, &e),
                "%s", e.msg))
         goto done;
     /* the top storey on its spring: w^2 = k2 (1/m1 + 1/m2), to k1 / k2 = 4e-5 */
@@ -811,8 +861,9 @@ static void test_scene_work_budgets(pd_test_ctx *ctx)
         pd_run_opts o = pd_run_default_opts();
         o.method = refused[j];
         int rc = pd_scene_run(sc, &o, NULL, NULL, &r, &e);
-        CHECK(ctx, rc == PD_EINVAL && strstr(e.msg, "structures[0] ('A')") &&
-                       strstr(e.msg, "--method moreau runs it"),
+        CHECK(ctx,
+              rc == PD_EINVAL && strstr(e.msg, "structures[0] ('A')") &&
+                  strstr(e.msg, "--method moreau runs it"),
               "%s: %d %s", pd_method_name(refused[j]), rc, e.msg);
     }
     pd_run_opts mj = pd_run_default_opts();
@@ -852,8 +903,9 @@ static void test_scene_coupling_bounded(pd_test_ctx *ctx)
         if (!rc)
             rc = pd_scene_finish(sc, &e);
     }
-    CHECK(ctx, rc == PD_EINVAL && !strncmp(e.msg, "contacts[7]: ", 13) &&
-                   strstr(e.msg, "contact matrices") && !sc->finished,
+    CHECK(ctx,
+          rc == PD_EINVAL && !strncmp(e.msg, "contacts[7]: ", 13) &&
+              strstr(e.msg, "contact matrices") && !sc->finished,
           "20,000 coupled floors: %d %s", rc, e.msg);
     pd_scene_free(sc);
 }
@@ -881,17 +933,21 @@ static void test_scene_binary_input(pd_test_ctx *ctx)
     snprintf(fifo, sizeof fifo, "%s/fifo", dir);
     if (CHECK(ctx, mkfifo(fifo, 0600) == 0, "mkfifo")) {
         st = pd_scene_load(fifo, &sc, &e);
-        CHECK(ctx, st == PD_EINVAL && strstr(e.msg, "not a regular file (a FIFO)"),
-              "a FIFO: %d %s", st, e.msg);
+        CHECK(ctx, st == PD_EINVAL && strstr(e.msg, "not a regular file (a FIFO)"), "a FIFO: %d %s",
+              st, e.msg);
     }
-    snprintf(text, sizeof text, "{\n\"excitation\": {\"record\": \"%s\"},\n"
-             "\"structures\": [{\"name\": \"A\", \"T0\": 0.5}]\n}\n", zero);
+    snprintf(text, sizeof text,
+             "{\n\"excitation\": {\"record\": \"%s\"},\n"
+             "\"structures\": [{\"name\": \"A\", \"T0\": 0.5}]\n}\n",
+             zero);
     scratch(dir, "zero.json", text, path, sizeof path);
     st = pd_scene_load(path, &sc, &e);
     snprintf(want, sizeof want, "%s:2:26: excitation.record: %s:1: not a text file", path, zero);
     CHECK(ctx, st == PD_EPARSE && strstr(e.msg, want), "record of zeros: %d %s", st, e.msg);
-    snprintf(text, sizeof text, "{\n\"excitation\": {\"record\": \"%s\"},\n"
-             "\"structures\": [{\"name\": \"A\", \"T0\": 0.5}]\n}\n", fifo);
+    snprintf(text, sizeof text,
+             "{\n\"excitation\": {\"record\": \"%s\"},\n"
+             "\"structures\": [{\"name\": \"A\", \"T0\": 0.5}]\n}\n",
+             fifo);
     scratch(dir, "fifo.json", text, path, sizeof path);
     st = pd_scene_load(path, &sc, &e);
     CHECK(ctx, st != PD_OK && strstr(e.msg, "not a regular file (a FIFO)"), "record FIFO: %d %s",
@@ -923,8 +979,9 @@ static void test_scene_cli_outputs(pd_test_ctx *ctx)
     snprintf(csv, sizeof csv, "%s/run.csv", dir);
     snprintf(png, sizeof png, "%s/run.png", dir);
     proc_out r;
-    const char *a1[] = {"simulate", "--scene", SCENES "three-buildings.json", "--dt", "1e-3",
-                        "-o", h5, "--json", NULL};
+    const char *a1[] = {"simulate", "--scene", SCENES "three-buildings.json",
+                        "--dt",     "1e-3",    "-o",
+                        h5,         "--json",  NULL};
     pd_test_pound(ctx, a1, &r);
     CHECK(ctx, r.status == 0, "exit %d: %s", r.status, r.err);
     const char *um0 = r.out ? strstr(r.out, "\"umax\":[") : NULL;
@@ -969,8 +1026,10 @@ static void test_scene_cli_outputs(pd_test_ctx *ctx)
         }
         H5Fclose(f);
     }
-    const char *a2[] = {"simulate", "--scene", SCENES "two-sdof.json", "--dt", "1e-3", "--every",
-                        "10", "-o", csv, "--plot", png, NULL};
+    const char *a2[] = {"simulate", "--scene", SCENES "two-sdof.json",
+                        "--dt",     "1e-3",    "--every",
+                        "10",       "-o",      csv,
+                        "--plot",   png,       NULL};
     pd_test_pound(ctx, a2, &r);
     CHECK(ctx, r.status == 0, "exit %d: %s", r.status, r.err);
     pd_test_proc_free(&r);
@@ -978,20 +1037,22 @@ static void test_scene_cli_outputs(pd_test_ctx *ctx)
     long rows = 0;
     for (char *p = text; p && *p; p++)
         rows += *p == '\n';
-    CHECK(ctx, text && strstr(text, "t,stiff.x1,flexible.x1,stiff.v1,flexible.v1,c0.gap,c0.impulse"),
+    CHECK(ctx,
+          text && strstr(text, "t,stiff.x1,flexible.x1,stiff.v1,flexible.v1,c0.gap,c0.impulse"),
           "CSV header");
     CHECK(ctx, rows > 400 && rows < 500, "CSV has %ld lines (401 rows + header and attributes)",
           rows);
     free(text);
     /* several contacts: every gap, then every impulse, as the header says
      * (the first row: gaps 0.01 m, impulses 0) */
-    const char *a3[] = {"simulate", "--chain", "3", "--gap", "0.01", "--dt", "1e-3", "--tend",
-                        "0.01", "-o", csv, NULL};
+    const char *a3[] = {"simulate", "--chain", "3",    "--gap", "0.01", "--dt",
+                        "1e-3",     "--tend",  "0.01", "-o",    csv,    NULL};
     pd_test_pound(ctx, a3, &r);
     CHECK(ctx, r.status == 0, "exit %d: %s", r.status, r.err);
     pd_test_proc_free(&r);
     text = pd_test_slurp(csv);
-    const char *hdr = text ? strstr(text, "\nt,") : NULL, *row0 = hdr ? strchr(hdr + 1, '\n') : NULL;
+    const char *hdr = text ? strstr(text, "\nt,") : NULL,
+               *row0 = hdr ? strchr(hdr + 1, '\n') : NULL;
     double vals[16];
     int nv = 0;
     char line[1024] = "";
@@ -999,11 +1060,12 @@ static void test_scene_cli_outputs(pd_test_ctx *ctx)
         sscanf(row0 + 1, "%1023[^\n]", line);
     for (char *tok = strtok(line, ","); tok && nv < 16; tok = strtok(NULL, ","))
         vals[nv++] = strtod(tok, NULL);
-    CHECK(ctx, hdr && strstr(hdr, "c0.gap,c1.gap,c2.gap,c3.gap,c0.impulse,c1.impulse,c2.impulse,"
-                                  "c3.impulse\n"),
+    CHECK(ctx,
+          hdr && strstr(hdr, "c0.gap,c1.gap,c2.gap,c3.gap,c0.impulse,c1.impulse,c2.impulse,"
+                             "c3.impulse\n"),
           "CSV header of four contacts");
-    CHECK(ctx, nv == 15 && vals[7] == 0.01 && vals[10] == 0.01 && vals[11] == 0.0 &&
-                   vals[14] == 0.0,
+    CHECK(ctx,
+          nv == 15 && vals[7] == 0.01 && vals[10] == 0.01 && vals[11] == 0.0 && vals[14] == 0.0,
           "first row: %d values, gaps %g %g, impulses %g %g", nv, nv > 10 ? vals[7] : NAN,
           nv > 10 ? vals[10] : NAN, nv > 14 ? vals[11] : NAN, nv > 14 ? vals[14] : NAN);
     free(text);
@@ -1021,11 +1083,13 @@ static void test_scene_cli_spectrum(pd_test_ctx *ctx)
     if (!pd_test_have_pound(ctx))
         return;
     proc_out rs, ro;
-    const char *as[] = {"spectrum", "--scene", SCENES "oscillator.json", "--Pi2", "0.1:2:5",
-                        "--Pi3", "0.05", "--eps", "0.6", "--json", NULL};
-    const char *ao[] = {"spectrum", "--pulse", "sine", "--Tp", "0.3", "--ap", "4", "--Pi2",
-                        "0.1:2:5", "--Pi3", "0.05", "--eps", "0.6", "--method", "moreau",
-                        "--json", NULL};
+    const char *as[] = {"spectrum", "--scene", SCENES "oscillator.json",
+                        "--Pi2",    "0.1:2:5", "--Pi3",
+                        "0.05",     "--eps",   "0.6",
+                        "--json",   NULL};
+    const char *ao[] = {"spectrum", "--pulse",  "sine",    "--Tp",   "0.3",  "--ap",
+                        "4",        "--Pi2",    "0.1:2:5", "--Pi3",  "0.05", "--eps",
+                        "0.6",      "--method", "moreau",  "--json", NULL};
     pd_test_pound(ctx, as, &rs);
     pd_test_pound(ctx, ao, &ro);
     CHECK(ctx, rs.status == 0 && ro.status == 0, "exit %d, %d: %s %s", rs.status, ro.status, rs.err,
@@ -1050,13 +1114,14 @@ static void test_scene_squeezed_light_structure(pd_test_ctx *ctx)
     char dir[] = "/tmp/pd_squeezeXXXXXX", path[256];
     if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
         return;
-    scratch(dir, "squeeze.json",
-            "{\"excitation\": {\"pulse\": \"cosine\", \"dir\": \"+x\", \"ap\": 0.071, \"Tp\": 0.565},\n"
-            " \"structures\": [{\"name\": \"S13\", \"T0\": 0.508, \"xi\": 0, \"mass\": 9.49e7},\n"
-            "                {\"name\": \"S14\", \"T0\": 5.1, \"xi\": 0, \"mass\": 1.049e-5}],\n"
-            " \"contacts\": [{\"a\": \"S13\", \"b\": \"S14\", \"gap\": 1e-6, \"eps\": 1},\n"
-            "              {\"a\": \"S14\", \"b\": \"wall\", \"gap\": 1e-12, \"eps\": 0}]}\n",
-            path, sizeof path);
+    scratch(
+        dir, "squeeze.json",
+        "{\"excitation\": {\"pulse\": \"cosine\", \"dir\": \"+x\", \"ap\": 0.071, \"Tp\": 0.565},\n"
+        " \"structures\": [{\"name\": \"S13\", \"T0\": 0.508, \"xi\": 0, \"mass\": 9.49e7},\n"
+        "                {\"name\": \"S14\", \"T0\": 5.1, \"xi\": 0, \"mass\": 1.049e-5}],\n"
+        " \"contacts\": [{\"a\": \"S13\", \"b\": \"S14\", \"gap\": 1e-6, \"eps\": 1},\n"
+        "              {\"a\": \"S14\", \"b\": \"wall\", \"gap\": 1e-12, \"eps\": 0}]}\n",
+        path, sizeof path);
     pd_scene *sc = load(ctx, path);
     for (int k = 0; sc && k < 2; k++) {
         pd_err e;

@@ -40,8 +40,8 @@ static void random_spd(int n, uint64_t seed, double *M, double *q)
 }
 
 /* Solve with a method; the status. */
-static int solve_with(pd_lcp_method m, const pd_matrix *M, const double *q,
-                      const pd_lcp_opts *o, double *z, double *w, pd_lcp_info *info)
+static int solve_with(pd_lcp_method m, const pd_matrix *M, const double *q, const pd_lcp_opts *o,
+                      double *z, double *w, pd_lcp_info *info)
 {
     pd_err e;
     long nnz = M->kind == PD_MATRIX_CSC ? M->colptr[M->cols] : 0;
@@ -77,8 +77,8 @@ static void test_solvers_match_oracle(pd_test_ctx *ctx)
                 }
                 CHECK(ctx, st == PD_OK && info.residual <= 1e-10 && d <= 1e-9 * fmax(s, 1e-300),
                       "%s, n %d seed %llu: status %d (%s), residual %.3g, |z - z_oracle| %.3g",
-                      pd_lcp_method_name(methods[k]), n, (unsigned long long)seed, st,
-                      info.solver, info.residual, d);
+                      pd_lcp_method_name(methods[k]), n, (unsigned long long)seed, st, info.solver,
+                      info.residual, d);
             }
         }
     CHECK(ctx, cases == 200, "%d cases", cases);
@@ -126,8 +126,8 @@ static void test_solvers_banded_oracle(pd_test_ctx *ctx)
             for (uint64_t seed = 1; seed <= 20; seed++) {
                 int colptr[11], rowind[100];
                 double values[100], dense[100], q[10], zo[10], wo[10], z[10], w[10];
-                banded_spd(n, band, seed * 131 + (uint64_t)(n + 17 * band), colptr, rowind,
-                           values, dense, q);
+                banded_spd(n, band, seed * 131 + (uint64_t)(n + 17 * band), colptr, rowind, values,
+                           dense, q);
                 pd_matrix M = pd_matrix_csc(n, n, colptr, rowind, values);
                 if (!CHECK(ctx, pd_lcp_enumerate(n, dense, q, zo, wo) == PD_OK, "oracle n %d", n))
                     continue;
@@ -139,7 +139,9 @@ static void test_solvers_banded_oracle(pd_test_ctx *ctx)
                     d = fmax(d, fabs(z[i] - zo[i]));
                     zs = fmax(zs, fabs(zo[i]));
                 }
-                CHECK(ctx, st == PD_OK && !strcmp(info.solver, "structured") && d <= 1e-9 * fmax(zs, 1e-300),
+                CHECK(ctx,
+                      st == PD_OK && !strcmp(info.solver, "structured") &&
+                          d <= 1e-9 * fmax(zs, 1e-300),
                       "band %d, n %d seed %llu: status %d (%s), |z - z_oracle| %.3g", band, n,
                       (unsigned long long)seed, st, info.solver, d);
             }
@@ -166,8 +168,9 @@ static void test_solvers_closed_forms(pd_test_ctx *ctx)
         int so = pd_lcp_enumerate(n, n == 1 ? M : Md, q, zo, wo);
         if (so != PD_OK) /* M[1] M[2] >= M[0] M[3] can leave no solution */
             continue;
-        CHECK(ctx, st == PD_OK && info.pivots == 0 && fabs(z[0] - zo[0]) <= 1e-14 * (1 + fabs(zo[0])) &&
-                       fabs(z[n - 1] - zo[n - 1]) <= 1e-14 * (1 + fabs(zo[n - 1])),
+        CHECK(ctx,
+              st == PD_OK && info.pivots == 0 && fabs(z[0] - zo[0]) <= 1e-14 * (1 + fabs(zo[0])) &&
+                  fabs(z[n - 1] - zo[n - 1]) <= 1e-14 * (1 + fabs(zo[n - 1])),
               "n %d case %d: status %d, %d pivots, z (%g, %g) vs (%g, %g)", n, k, st, info.pivots,
               z[0], z[n - 1], zo[0], zo[n - 1]);
     }
@@ -236,7 +239,8 @@ static void test_solvers_chains(pd_test_ctx *ctx)
               "n %d: status %d by %s, residual %.3g, %d iterations", c.n, st, info.solver,
               info.residual, info.iterations);
         if (c.n <= 2048) {
-            double *zl = malloc((size_t)c.n * sizeof(double)), *wl = malloc((size_t)c.n * sizeof(double));
+            double *zl = malloc((size_t)c.n * sizeof(double)),
+                   *wl = malloc((size_t)c.n * sizeof(double));
             pd_lcp_info il;
             int sl = zl && wl ? solve_with(PD_LCP_LEMKE, &M, c.q, NULL, zl, wl, &il) : PD_ENOMEM;
             double d = 0.0, zs = 0.0;
@@ -244,8 +248,8 @@ static void test_solvers_chains(pd_test_ctx *ctx)
                 d = fmax(d, fabs(zl[i] - c.z[i]));
                 zs = fmax(zs, fabs(c.z[i]));
             }
-            CHECK(ctx, sl == PD_OK && d <= 1e-9 * zs,
-                  "n %d: Lemke status %d, |z - z_lemke| %.3g", c.n, sl, d);
+            CHECK(ctx, sl == PD_OK && d <= 1e-9 * zs, "n %d: Lemke status %d, |z - z_lemke| %.3g",
+                  c.n, sl, d);
             free(zl);
             free(wl);
         }
@@ -256,8 +260,8 @@ static void test_solvers_chains(pd_test_ctx *ctx)
         pd_lcp_opts o = pd_lcp_default_opts();
         o.guess = guess;
         st = solve_with(PD_LCP_STRUCTURED, &M, c.q, &o, c.z, c.w, &info);
-        CHECK(ctx, st == PD_OK && info.iterations == 1, "n %d warm: status %d, %d iterations",
-              c.n, st, info.iterations);
+        CHECK(ctx, st == PD_OK && info.iterations == 1, "n %d warm: status %d, %d iterations", c.n,
+              st, info.iterations);
         free(guess);
         chain_free(&c);
     }
@@ -282,10 +286,10 @@ static void test_solvers_degenerate(pd_test_ctx *ctx)
         pd_lcp_info info;
         pd_matrix Rm = pd_matrix_dense(2, 2, R), Sm = pd_matrix_dense(2, 2, S);
         int st = solve_with(methods[k], &Rm, qr, NULL, z, w, &info);
-        CHECK(ctx, st == PD_OK && info.residual <= 1e-10 && fabs(z[0]) <= 1e-9 &&
-                       fabs(z[1] - 2.0) <= 1e-9,
-              "%s redundant: status %d, z (%g, %g)", pd_lcp_method_name(methods[k]), st, z[0],
-              z[1]);
+        CHECK(
+            ctx,
+            st == PD_OK && info.residual <= 1e-10 && fabs(z[0]) <= 1e-9 && fabs(z[1] - 2.0) <= 1e-9,
+            "%s redundant: status %d, z (%g, %g)", pd_lcp_method_name(methods[k]), st, z[0], z[1]);
         st = solve_with(methods[k], &Rm, qt, NULL, z, w, &info);
         CHECK(ctx, st == PD_OK && info.residual <= 1e-10 && fabs(z[0] + z[1] - 1.0) <= 1e-9,
               "%s redundant, a segment of answers: status %d, z (%g, %g)",
@@ -319,8 +323,8 @@ static void test_solvers_degenerate(pd_test_ctx *ctx)
     pd_lcp_info info;
     int st = solve_with(PD_LCP_STRUCTURED, &C, q, NULL, z, w, &info);
     CHECK(ctx, st == PD_OK && info.residual <= 1e-10 && !strcmp(info.solver, "structured"),
-          "chain of %d with a doubled contact: status %d by %s, residual %.3g", NC, st,
-          info.solver, info.residual);
+          "chain of %d with a doubled contact: status %d by %s, residual %.3g", NC, st, info.solver,
+          info.residual);
 }
 
 /* PGS reports what it did: a zero pivot is numerical; a budget too small
@@ -339,8 +343,9 @@ static void test_solvers_pgs_honest(pd_test_ctx *ctx)
         pd_lcp_opts o = pd_lcp_default_opts();
         o.max_iterations = 20;
         st = solve_with(PD_LCP_PGS, &M, c.q, &o, c.z, c.w, &info);
-        CHECK(ctx, st == PD_EMAXITER && info.outcome == PD_LCP_MAX_ITERATIONS &&
-                       info.iterations == 20 && info.residual > 1e-10,
+        CHECK(ctx,
+              st == PD_EMAXITER && info.outcome == PD_LCP_MAX_ITERATIONS && info.iterations == 20 &&
+                  info.residual > 1e-10,
               "budget 20: status %d (%s), %d sweeps, residual %.3g", st,
               pd_lcp_outcome_name(info.outcome), info.iterations, info.residual);
     }
@@ -365,8 +370,9 @@ static void test_solvers_engine_independent(pd_test_ctx *ctx)
         o.lcp_solver = methods[k];
         o.factor = PD_FACTOR_CHOLMOD;
         o.tend = 1.5;
-        CHECK(ctx, pd_scene_result_alloc(sc, &r[k], &e) == PD_OK &&
-                       pd_scene_run(sc, &o, NULL, NULL, &r[k], &e) == PD_OK,
+        CHECK(ctx,
+              pd_scene_result_alloc(sc, &r[k], &e) == PD_OK &&
+                  pd_scene_run(sc, &o, NULL, NULL, &r[k], &e) == PD_OK,
               "%s: %s", pd_lcp_method_name(methods[k]), e.msg);
     }
     long impacts = 0;
@@ -397,9 +403,9 @@ static void test_solvers_dump_resolved(pd_test_ctx *ctx)
         return;
     snprintf(dump, sizeof dump, "%s/lcps.h5", dir);
     proc_out r;
-    const char *sim[] = {"simulate", "--chain", "30", "--pulse", "sine", "--Tp", "0.5", "--T0",
-                         "1", "--ap", "3", "--Pi3", "0.01", "--eps", "0.5", "--tend", "1",
-                         "--dump-lcp", dump, NULL};
+    const char *sim[] = {"simulate", "--chain", "30",   "--pulse",    "sine",  "--Tp", "0.5",
+                         "--T0",     "1",       "--ap", "3",          "--Pi3", "0.01", "--eps",
+                         "0.5",      "--tend",  "1",    "--dump-lcp", dump,    NULL};
     pd_test_pound(ctx, sim, &r);
     CHECK(ctx, r.status == 0, "simulate: %s", r.err);
     pd_test_proc_free(&r);
@@ -416,8 +422,7 @@ static void test_solvers_dump_resolved(pd_test_ctx *ctx)
                   "%s: exit %d, %g of %g solved, %g agree", solvers[k], r.status, solved, count,
                   agree);
         else
-            CHECK(ctx, count > 100 && solved >= 0.9 * count &&
-                           (r.status == 0) == (solved == count),
+            CHECK(ctx, count > 100 && solved >= 0.9 * count && (r.status == 0) == (solved == count),
                   "pgs: exit %d, %g of %g solved (worst residual %.3g)", r.status, solved, count,
                   res);
         pd_test_proc_free(&r);
@@ -436,7 +441,8 @@ static void test_solvers_nonfinite_never_solved(pd_test_ctx *ctx)
     double q[3] = {-1e300, -2e300, 3e300}, z[3], w[3];
     int colptr[4] = {0, 2, 5, 7}, rowind[7] = {0, 1, 0, 1, 2, 1, 2};
     double vals[7] = {4e-300, 1e-300, 1e-300, 4e-300, 1e-300, 1e-300, 4e-300};
-    const pd_matrix views[2] = {pd_matrix_dense(3, 3, M), pd_matrix_csc(3, 3, colptr, rowind, vals)};
+    const pd_matrix views[2] = {pd_matrix_dense(3, 3, M),
+                                pd_matrix_csc(3, 3, colptr, rowind, vals)};
     const pd_lcp_method methods[] = {PD_LCP_AUTO, PD_LCP_LEMKE, PD_LCP_STRUCTURED, PD_LCP_PGS};
     for (int v = 0; v < 2; v++)
         for (int k = 0; k < 4; k++) {
@@ -515,15 +521,17 @@ static void test_solvers_nonfinite_cli(pd_test_ctx *ctx)
     if (!CHECK(ctx, f != NULL, "write %s", path))
         return;
     fputs("3\n4e-300 1e-300 0.0\n1e-300 4e-300 1e-300\n0.0 1e-300 4e-300\n"
-          "-1e+300 -2e+300 3e+300\n", f);
+          "-1e+300 -2e+300 3e+300\n",
+          f);
     fclose(f);
     const char *solvers[] = {"structured", "auto", "lemke", "pgs"};
     for (int k = 0; k < 4; k++) {
         const char *a[] = {"lcp", path, "--json", "--solver", solvers[k], NULL};
         proc_out r;
         pd_test_pound(ctx, a, &r);
-        CHECK(ctx, r.status == 1 && r.out && strstr(r.out, "\"status\":\"") &&
-                   !strstr(r.out, "\"status\":\"solved\"") && !strstr(r.out, "null"),
+        CHECK(ctx,
+              r.status == 1 && r.out && strstr(r.out, "\"status\":\"") &&
+                  !strstr(r.out, "\"status\":\"solved\"") && !strstr(r.out, "null"),
               "%s: exit %d: %s", solvers[k], r.status, r.out ? r.out : "");
         pd_test_proc_free(&r);
     }
@@ -547,11 +555,12 @@ static void test_solvers_cradle_after_impact(pd_test_ctx *ctx)
         double z[3], w[3];
         pd_lcp_info info;
         int st = solve_with(methods[k], &Dm, q, NULL, z, w, &info);
-        CHECK(ctx, st == PD_OK && info.residual <= 1e-10 && fabs(z[1] + q[1] / 2.0) <= 1e-30 &&
-                       z[0] == 0.0 && z[2] == 0.0,
+        CHECK(ctx,
+              st == PD_OK && info.residual <= 1e-10 && fabs(z[1] + q[1] / 2.0) <= 1e-30 &&
+                  z[0] == 0.0 && z[2] == 0.0,
               "%s: status %d (%s) by %s, residual %.3g, z (%g, %g, %g)",
-              pd_lcp_method_name(methods[k]), st, pd_lcp_outcome_name(info.outcome),
-              info.solver, info.residual, z[0], z[1], z[2]);
+              pd_lcp_method_name(methods[k]), st, pd_lcp_outcome_name(info.outcome), info.solver,
+              info.residual, z[0], z[1], z[2]);
     }
 }
 
@@ -576,9 +585,15 @@ static void test_solvers_rounding_size_q(pd_test_ctx *ctx)
     static const double o9[8] = {-1.410037783941168,   -1.0447832052876409, -1.3944580443181545,
                                  -0.86090846843997249, -1.0073969777930041, -1.0448661612048209,
                                  -0.60141482457788864, -1.3575830452181386};
-    static const double q9[9] = {-0.92206794791839819, -0.063183171803975036, 0, 0,
-                                 0.34313256311911433,  -8.1089502575916512e-18,
-                                 -3.6568136374579563e-17, 0, 0.13650529119144461};
+    static const double q9[9] = {-0.92206794791839819,
+                                 -0.063183171803975036,
+                                 0,
+                                 0,
+                                 0.34313256311911433,
+                                 -8.1089502575916512e-18,
+                                 -3.6568136374579563e-17,
+                                 0,
+                                 0.13650529119144461};
     const pd_lcp_method methods[] = {PD_LCP_LEMKE, PD_LCP_AUTO, PD_LCP_STRUCTURED, PD_LCP_PGS};
     struct {
         int n;
@@ -621,19 +636,19 @@ static void test_solvers_rounding_size_q(pd_test_ctx *ctx)
  * Lemke's is final, test_solvers_degenerate). */
 static void test_solvers_auto_hands_over(pd_test_ctx *ctx)
 {
-    static const double D4[16] = {417386.51306114433, -417386.51306114433, 0, 0,
-                                  -417386.51306114433, 417386.51306179556,
-                                  -6.5121435460566592e-07, 0, 0, -6.5121435460566592e-07,
-                                  1.6457142655450299e-06, -9.9449991093936384e-07, 0, 0,
-                                  -9.9449991093936384e-07, 9.9456886771884702e-07};
+    static const double D4[16] = {
+        417386.51306114433,     -417386.51306114433,     0, 0, -417386.51306114433,
+        417386.51306179556,     -6.5121435460566592e-07, 0, 0, -6.5121435460566592e-07,
+        1.6457142655450299e-06, -9.9449991093936384e-07, 0, 0, -9.9449991093936384e-07,
+        9.9456886771884702e-07};
     static const double q4[4] = {-3.1180842755874724e-17, -0.97636601327127071,
                                  4.119965808919095e-17, -0.19371545894983699};
     static const double D5[25] = {
-        25842.610253135914, -1099.3041189440878, 0, 0, 0,
-        -1099.3041189440878, 1099.3041189440908, -3.0132670230515511e-12, 0, 0,
-        0, -3.0132670230515511e-12, 0.00026760355590129645, -0.00026760355288802941, 0,
-        0, 0, -0.00026760355288802941, 0.0045322791061028558, -0.0042646755532148263,
-        0, 0, 0, -0.0042646755532148263, 589938.42350120074};
+        25842.610253135914,     -1099.3041189440878,     0, 0, 0, -1099.3041189440878,
+        1099.3041189440908,     -3.0132670230515511e-12, 0, 0, 0, -3.0132670230515511e-12,
+        0.00026760355590129645, -0.00026760355288802941, 0, 0, 0, -0.00026760355288802941,
+        0.0045322791061028558,  -0.0042646755532148263,  0, 0, 0, -0.0042646755532148263,
+        589938.42350120074};
     static const double q5[5] = {4.8812983381857435e-17, 0, 0, 1.6896876525163484e-17,
                                  -0.57626793738914239};
     struct {
@@ -653,10 +668,11 @@ static void test_solvers_auto_hands_over(pd_test_ctx *ctx)
         double r = info.residual;
         pd_lcp_residual(cases[k].n, cases[k].D, cases[k].q, z, w, &info.complementarity,
                         &info.infeasibility, &info.residual);
-        CHECK(ctx, st == PD_OK && r <= 1e-10 && info.residual <= 1e-10 &&
-                       !strcmp(info.solver, cases[k].solver),
-              "n = %d: auto: status %d by %s, residual %.3g (%.3g), expected %s", cases[k].n,
-              st, info.solver, r, info.residual, cases[k].solver);
+        CHECK(ctx,
+              st == PD_OK && r <= 1e-10 && info.residual <= 1e-10 &&
+                  !strcmp(info.solver, cases[k].solver),
+              "n = %d: auto: status %d by %s, residual %.3g (%.3g), expected %s", cases[k].n, st,
+              info.solver, r, info.residual, cases[k].solver);
     }
     enum { N = 6 };
     double M[N * N], q[N], z[N], w[N];
@@ -722,8 +738,8 @@ static void stieltjes_problem(int kind, int n, uint64_t seed, double *a, double 
     }
     b[0] = 0.0;
     for (int i = 0; i < n; i++)
-        a[i] = kind >= 2 ? 2.0
-                         : -b[i] - (i + 1 < n ? b[i + 1] : 0.0) + 1e-3 + 0.5 * (rnd(&s) + 1.0);
+        a[i] =
+            kind >= 2 ? 2.0 : -b[i] - (i + 1 < n ? b[i + 1] : 0.0) + 1e-3 + 0.5 * (rnd(&s) + 1.0);
     if (kind == 1) {
         double sc[16];
         for (int i = 0; i < n; i++)
@@ -838,8 +854,10 @@ static void test_solvers_block_mmatrix(pd_test_ctx *ctx)
                             d += fabs(dense[i + j * n]);
                         dense[i + i * n] = d + 1e-3 + 0.5 * (rnd(&s) + 1.0);
                         double u = rnd(&s);
-                        q[i] = form == 0 ? (u < -0.7 ? 0.0 : u > 0.9 ? 1e-17 : rnd(&s))
-                               : i == 0  ? -1.0
+                        q[i] = form == 0   ? (u < -0.7  ? 0.0
+                                              : u > 0.9 ? 1e-17
+                                                        : rnd(&s))
+                               : i == 0    ? -1.0
                                : form == 1 ? 0.0
                                            : 1e-4;
                     }
@@ -854,7 +872,8 @@ static void test_solvers_block_mmatrix(pd_test_ctx *ctx)
                     }
                     colptr[n] = k;
                     pd_matrix M = pd_matrix_csc(n, n, colptr, rowind, values);
-                    if (!CHECK(ctx, chandrasekaran_dense(n, dense, q, zr) == 0, "reference n %d", n))
+                    if (!CHECK(ctx, chandrasekaran_dense(n, dense, q, zr) == 0, "reference n %d",
+                               n))
                         continue;
                     pd_lcp_info info;
                     int st = solve_with(PD_LCP_STRUCTURED, &M, q, NULL, z, w, &info);
@@ -901,8 +920,9 @@ static void test_solvers_stieltjes_oracle(pd_test_ctx *ctx)
                 pd_lcp_info info;
                 int st = solve_with(PD_LCP_STRUCTURED, &M, q, NULL, z, w, &info);
                 d = rel_diff(n, z, zo);
-                CHECK(ctx, st == PD_OK && !strcmp(info.solver, "structured") &&
-                               info.iterations == 1 && d <= 1e-12,
+                CHECK(ctx,
+                      st == PD_OK && !strcmp(info.solver, "structured") && info.iterations == 1 &&
+                          d <= 1e-12,
                       "structured, kind %d n %d seed %llu: status %d by %s, %d iterations, "
                       "|z - z_oracle| %.3g",
                       kind, n, (unsigned long long)seed, st, info.solver, info.iterations, d);
@@ -947,8 +967,8 @@ static void test_solvers_stieltjes_not_taken(pd_test_ctx *ctx)
         if (c == 0)
             pd_matrix_to_dense(&M, dense);
         pd_lcp_enumerate(4, dense, q, zo, wo);
-        CHECK(ctx, st == PD_OK && rel_diff(4, z, zo) <= 1e-12, "case %d: status %d by %s", c,
-              st, info.solver);
+        CHECK(ctx, st == PD_OK && rel_diff(4, z, zo) <= 1e-12, "case %d: status %d by %s", c, st,
+              info.solver);
     }
     { /* pentadiagonal pattern with an explicit zero at (0, 2) */
         int cp[5] = {0, 3, 6, 10, 12}, ri[12] = {0, 1, 2, 0, 1, 2, 0, 1, 2, 3, 2, 3};
@@ -991,8 +1011,9 @@ static void test_solvers_stieltjes_large(pd_test_ctx *ctx)
             int *colptr = malloc((un + 1) * sizeof(int)), *rowind = malloc(3 * un * sizeof(int));
             int *cp2 = malloc((un + 1) * sizeof(int)), *ri2 = malloc((3 * un + 2) * sizeof(int));
             double *v2 = malloc((3 * un + 2) * sizeof(double));
-            if (!CHECK(ctx, a && b && q && z && w && z2 && m && values && colptr && rowind && cp2 &&
-                                ri2 && v2,
+            if (!CHECK(ctx,
+                       a && b && q && z && w && z2 && m && values && colptr && rowind && cp2 &&
+                           ri2 && v2,
                        "memory"))
                 goto next;
             uint64_t s = 1234u + (uint64_t)(31 * k + form);
@@ -1036,8 +1057,8 @@ static void test_solvers_stieltjes_large(pd_test_ctx *ctx)
             int st2 = solve_with(PD_LCP_STRUCTURED, &M2, q, NULL, z2, w, &i2);
             double d = rel_diff(n, z, z2);
             CHECK(ctx, st2 == PD_OK && d <= 1e-8 && (form == 0 || i2.iterations >= 2),
-                  "n %d form %d: pivoting / interior point status %d (%d iterations), |dz| %.3g",
-                  n, form, st2, i2.iterations, d);
+                  "n %d form %d: pivoting / interior point status %d (%d iterations), |dz| %.3g", n,
+                  form, st2, i2.iterations, d);
             if (n <= 500) {
                 double *dense = malloc(un * un * sizeof(double));
                 if (dense) {
@@ -1091,8 +1112,7 @@ static void test_solvers_stieltjes_warm(pd_test_ctx *ctx)
         o.guess = guess;
         st = solve_with(PD_LCP_STRUCTURED, &M, c.q, &o, c.z, c.w, &info);
         CHECK(ctx,
-              st == PD_OK && info.iterations == 1 &&
-                  !memcmp(c.z, zc, (size_t)n * sizeof(double)),
+              st == PD_OK && info.iterations == 1 && !memcmp(c.z, zc, (size_t)n * sizeof(double)),
               "guess %d: status %d, %d iterations, |dz| %.3g", g, st, info.iterations,
               rel_diff(n, c.z, zc));
     }
@@ -1113,7 +1133,8 @@ static void test_solvers_verify_tridiagonal(pd_test_ctx *ctx)
 {
     enum { NMAX = 120 };
     static double dense[NMAX * NMAX];
-    int colptr[NMAX + 1], rowind[3 * NMAX + 1], cp2[NMAX + 1], ri2[3 * NMAX + 1], mism = 0, cases = 0;
+    int colptr[NMAX + 1], rowind[3 * NMAX + 1], cp2[NMAX + 1], ri2[3 * NMAX + 1], mism = 0,
+                                                                                  cases = 0;
     double a[NMAX], b[NMAX], values[3 * NMAX + 1], v2[3 * NMAX + 1], q[NMAX], z[NMAX];
     double w1[NMAX], w2[NMAX], w3[NMAX], r1[NMAX], r2[NMAX], r3[NMAX];
     uint64_t s = 99;
@@ -1164,10 +1185,10 @@ static void test_solvers_verify_tridiagonal(pd_test_ctx *ctx)
                 same &= (w1[i] == w3[i] || (isnan(w1[i]) && isnan(w3[i]))) &&
                         (n <= 32 || rep == 3 || w1[i] == w2[i] || (isnan(w1[i]) && isnan(w2[i])));
             same = same && !memcmp(r1, r3, (size_t)n * sizeof(double)) &&
-                       !memcmp(&i1.residual, &i3.residual, sizeof(double)) &&
-                       !memcmp(&i1.complementarity, &i3.complementarity, sizeof(double)) &&
-                       !memcmp(&i1.infeasibility, &i3.infeasibility, sizeof(double)) &&
-                       !memcmp(&i1.scale, &i3.scale, sizeof(double));
+                   !memcmp(&i1.residual, &i3.residual, sizeof(double)) &&
+                   !memcmp(&i1.complementarity, &i3.complementarity, sizeof(double)) &&
+                   !memcmp(&i1.infeasibility, &i3.infeasibility, sizeof(double)) &&
+                   !memcmp(&i1.scale, &i3.scale, sizeof(double));
             if (n > 32 && rep != 3) /* the dense general path (n <= 32 is made row by row;
                                        a NaN of z spreads over the dense rows) */
                 same &= !memcmp(&i1.residual, &i2.residual, sizeof(double)) &&
@@ -1205,16 +1226,18 @@ static void test_solvers_dense_banded(pd_test_ctx *ctx)
     pd_lcp_info ic, id;
     int sc = solve_with(PD_LCP_STRUCTURED, &Mc, q, NULL, zc, w, &ic);
     int sd = solve_with(PD_LCP_STRUCTURED, &Md, q, NULL, z, w, &id);
-    CHECK(ctx, sc == PD_OK && sd == PD_OK && ic.iterations == 1 && id.iterations == 1 &&
-                   !strcmp(id.solver, "structured") && !memcmp(z, zc, sizeof z),
+    CHECK(ctx,
+          sc == PD_OK && sd == PD_OK && ic.iterations == 1 && id.iterations == 1 &&
+              !strcmp(id.solver, "structured") && !memcmp(z, zc, sizeof z),
           "tridiagonal: compressed status %d (%d iterations), dense status %d by %s (%d "
           "iterations), |dz| %.3g",
           sc, ic.iterations, sd, id.solver, id.iterations, rel_diff(N, z, zc));
     dense[0 + (size_t)(N - 1) * N] = dense[N - 1] = -1e-3;
     sd = solve_with(PD_LCP_STRUCTURED, &Md, q, NULL, z, w, &id);
     int sl = solve_with(PD_LCP_LEMKE, &Md, q, NULL, zl, w, &ic);
-    CHECK(ctx, sd == PD_OK && !strcmp(id.solver, "structured") && sl == PD_OK &&
-                   rel_diff(N, z, zl) <= 1e-9,
+    CHECK(ctx,
+          sd == PD_OK && !strcmp(id.solver, "structured") && sl == PD_OK &&
+              rel_diff(N, z, zl) <= 1e-9,
           "one entry off the band: status %d by %s, lemke %d, |dz| %.3g", sd, id.solver, sl,
           rel_diff(N, z, zl));
     { /* 30 x 30 SPD, full: 900 entries, more than 17 * 30 */

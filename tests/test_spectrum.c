@@ -26,14 +26,14 @@ static int rel_close(double a, double b, double tol)
 static void test_spectrum_matches_simulate(pd_test_ctx *ctx)
 {
     static const char *const methods[] = {"moreau", "event"};
-    static const char *const keys[] = {"pulse", "dir", "Pi2", "Pi3", "eps", "xi", "Pi1",
-                                       "umax_free", "gamma", "chi", "impacts", "method"};
+    static const char *const keys[] = {"pulse", "dir",       "Pi2",   "Pi3", "eps",     "xi",
+                                       "Pi1",   "umax_free", "gamma", "chi", "impacts", "method"};
     if (!pd_test_have_pound(ctx))
         return;
     for (int m = 0; m < 2; m++) {
-        const char *args[] = {"spectrum", "--pulse", "sine,cosine", "--dir", "normal,reverse",
-                              "--Pi2", "0.2:3:3", "--Pi3", "0.05", "--eps", "0.6", "--method",
-                              methods[m], "--json", NULL};
+        const char *args[] = {"spectrum", "--pulse",  "sine,cosine", "--dir",  "normal,reverse",
+                              "--Pi2",    "0.2:3:3",  "--Pi3",       "0.05",   "--eps",
+                              "0.6",      "--method", methods[m],    "--json", NULL};
         proc_out sp;
         pd_test_pound(ctx, args, &sp);
         CHECK(ctx, sp.status == 0, "%s: exit %d: %s", methods[m], sp.status, sp.err);
@@ -43,24 +43,27 @@ static void test_spectrum_matches_simulate(pd_test_ctx *ctx)
             snprintf(pat, sizeof pat, "\"%s\":", keys[k]);
             CHECK(ctx, strstr(sp.out, pat) != NULL, "point key %s missing", keys[k]);
         }
-        CHECK(ctx, isfinite(pd_test_json_num(sp.out, "cpu_s", 12)) && isfinite(pd_test_json_num(sp.out, "wall_s", 0)),
+        CHECK(ctx,
+              isfinite(pd_test_json_num(sp.out, "cpu_s", 12)) &&
+                  isfinite(pd_test_json_num(sp.out, "wall_s", 0)),
               "totals cpu_s, wall_s missing");
         for (int p = 0; p < 12; p++) {
             char pulse[16], dir[16], pi2[40];
             pd_test_json_str(sp.out, "pulse", p, pulse, sizeof pulse);
             pd_test_json_str(sp.out, "dir", p, dir, sizeof dir);
             snprintf(pi2, sizeof pi2, "%.17g", pd_test_json_num(sp.out, "Pi2", p));
-            const char *sargs[] = {"simulate", "--pulse", pulse, "--dir", dir, "--Pi2", pi2,
-                                   "--Pi3", "0.05", "--eps", "0.6", "--method", methods[m],
-                                   "--json", NULL};
+            const char *sargs[] = {"simulate", "--pulse",  pulse,      "--dir",  dir,
+                                   "--Pi2",    pi2,        "--Pi3",    "0.05",   "--eps",
+                                   "0.6",      "--method", methods[m], "--json", NULL};
             proc_out sim;
             pd_test_pound(ctx, sargs, &sim);
             static const char *const cmp[] = {"Pi1", "gamma", "chi", "umax_free", "impacts"};
             for (int c = 0; c < 5; c++) {
-                double a = pd_test_json_num(sp.out, cmp[c], p), b = pd_test_json_num(sim.out, cmp[c], 0);
+                double a = pd_test_json_num(sp.out, cmp[c], p),
+                       b = pd_test_json_num(sim.out, cmp[c], 0);
                 CHECK(ctx, rel_close(a, b, 1e-12) && isfinite(a),
-                      "%s %s %s Pi2 = %s: %s spectrum %.17g vs simulate %.17g", methods[m],
-                      pulse, dir, pi2, cmp[c], a, b);
+                      "%s %s %s Pi2 = %s: %s spectrum %.17g vs simulate %.17g", methods[m], pulse,
+                      dir, pi2, cmp[c], a, b);
             }
             pd_test_proc_free(&sim);
         }
@@ -71,8 +74,9 @@ static void test_spectrum_matches_simulate(pd_test_ctx *ctx)
 /* ---- bit identity -------------------------------------------------------- */
 
 /* The sweep used for the identity checks: 4 curves x 12 Pi2. */
-#define SWEEP "--pulse", "sine,cosine", "--dir", "normal,reverse", "--Pi2", "0.08:4:12", \
-              "--Pi3", "0.02", "--eps", "0.7"
+#define SWEEP                                                                                      \
+    "--pulse", "sine,cosine", "--dir", "normal,reverse", "--Pi2", "0.08:4:12", "--Pi3", "0.02",    \
+        "--eps", "0.7"
 
 /* HDF5 and CSV written on 1 and on 2 threads are byte-identical. */
 static void test_spectrum_threads_bit_identical(pd_test_ctx *ctx)
@@ -119,8 +123,8 @@ static void test_spectrum_resume(pd_test_ctx *ctx)
     pd_test_pound(ctx, a_full, &r);
     CHECK(ctx, r.status == 0, "uninterrupted: exit %d: %s", r.status, r.err);
     pd_test_proc_free(&r);
-    const char *a_stop[] = {"spectrum", SWEEP, "-o", part, "--threads", "2", "--stop-after",
-                            "20", NULL};
+    const char *a_stop[] = {"spectrum", SWEEP,          "-o", part, "--threads",
+                            "2",        "--stop-after", "20", NULL};
     pd_test_pound(ctx, a_stop, &r);
     CHECK(ctx, r.status == 130, "killed run: exit %d, expected 130", r.status);
     CHECK(ctx, access(part, F_OK) != 0 && access(journal, F_OK) == 0,
@@ -138,11 +142,10 @@ static void test_spectrum_resume(pd_test_ctx *ctx)
     pd_test_proc_free(&r);
     const char *a_other[] = {"spectrum", SWEEP, "--xi", "0.02", "-o", part, "--resume", NULL};
     pd_test_pound(ctx, a_other, &r);
-    CHECK(ctx, r.status == 2 && strstr(r.err, "--xi"),
-          "resume with another xi: exit %d (%s)", r.status, r.err);
+    CHECK(ctx, r.status == 2 && strstr(r.err, "--xi"), "resume with another xi: exit %d (%s)",
+          r.status, r.err);
     pd_test_proc_free(&r);
-    const char *a_stop2[] = {"spectrum", SWEEP, "-o", part, "--resume", "--stop-after", "15",
-                             NULL};
+    const char *a_stop2[] = {"spectrum", SWEEP, "-o", part, "--resume", "--stop-after", "15", NULL};
     pd_test_pound(ctx, a_stop2, &r);
     CHECK(ctx, r.status == 130, "second kill: exit %d", r.status);
     pd_test_proc_free(&r);
@@ -167,22 +170,34 @@ static void test_spectrum_bad_input(pd_test_ctx *ctx)
         const char *a[5];
         const char *named;
         int no_out, no_pi2;
-    } cases[] = {
-        {{"--T0", "2"}, "--T0", 0, 0},           {{"--Pi2", "1"}, "--Pi2", 0, 0},
-        {{"--Pi2", "2:1:5"}, "--Pi2", 0, 0},     {{"--Pi2", "0:1:5"}, "--Pi2", 0, 0},
-        {{"--Pi2", "0.5:2:x"}, "--Pi2", 0, 0},   {{"--Pi2", "0.5:2"}, "--Pi2", 0, 0},
-        {{"--eps", "0.5,1.5"}, "--eps", 0, 0},   {{"--eps", "0.5,"}, "--eps", 0, 0},
-        {{"--xi", "0.05,1"}, "--xi", 0, 0},      {{"--Pi3", "0.1,-1"}, "--Pi3", 0, 0},
-        {{"--gap", "-0.01"}, "--gap", 0, 0},     {{"--pulse", "sine,triangle"}, "--pulse", 0, 0},
-        {{"--dir", "normal,up"}, "--dir", 0, 0}, {{"--ap", "1,0"}, "--ap", 0, 0},
-        {{"--Tp", "-1"}, "--Tp", 0, 0},          {{"--threads", "0"}, "--threads", 0, 0},
-        {{"--method", "magic"}, "--method", 0, 0}, {{"--dt", "0"}, "--dt", 0, 0},
-        {{"--dt-per-Tp", "-5"}, "--dt-per-Tp", 0, 0}, {{"--theta", "0.2"}, "--theta", 0, 0},
-        {{"--no-wall"}, "--no-wall", 0, 0},      {{"--bogus", "1"}, "bogus", 0, 0},
-        {{"--plot", "x.jpg"}, "--plot", 0, 0},   {{"-o", "x.txt"}, "x.txt", 0, 0},
-        {{"--Pi3", "0.1", "--gap", "0.01"}, "--gap", 0, 0},
-        {{"--dt", "0.001", "--dt-per-Tp", "100"}, "--dt-per-Tp", 0, 0},
-        {{"--resume"}, "--resume", 1, 0},        {{"--eps", "0.5"}, "--Pi2", 0, 1}};
+    } cases[] = {{{"--T0", "2"}, "--T0", 0, 0},
+                 {{"--Pi2", "1"}, "--Pi2", 0, 0},
+                 {{"--Pi2", "2:1:5"}, "--Pi2", 0, 0},
+                 {{"--Pi2", "0:1:5"}, "--Pi2", 0, 0},
+                 {{"--Pi2", "0.5:2:x"}, "--Pi2", 0, 0},
+                 {{"--Pi2", "0.5:2"}, "--Pi2", 0, 0},
+                 {{"--eps", "0.5,1.5"}, "--eps", 0, 0},
+                 {{"--eps", "0.5,"}, "--eps", 0, 0},
+                 {{"--xi", "0.05,1"}, "--xi", 0, 0},
+                 {{"--Pi3", "0.1,-1"}, "--Pi3", 0, 0},
+                 {{"--gap", "-0.01"}, "--gap", 0, 0},
+                 {{"--pulse", "sine,triangle"}, "--pulse", 0, 0},
+                 {{"--dir", "normal,up"}, "--dir", 0, 0},
+                 {{"--ap", "1,0"}, "--ap", 0, 0},
+                 {{"--Tp", "-1"}, "--Tp", 0, 0},
+                 {{"--threads", "0"}, "--threads", 0, 0},
+                 {{"--method", "magic"}, "--method", 0, 0},
+                 {{"--dt", "0"}, "--dt", 0, 0},
+                 {{"--dt-per-Tp", "-5"}, "--dt-per-Tp", 0, 0},
+                 {{"--theta", "0.2"}, "--theta", 0, 0},
+                 {{"--no-wall"}, "--no-wall", 0, 0},
+                 {{"--bogus", "1"}, "bogus", 0, 0},
+                 {{"--plot", "x.jpg"}, "--plot", 0, 0},
+                 {{"-o", "x.txt"}, "x.txt", 0, 0},
+                 {{"--Pi3", "0.1", "--gap", "0.01"}, "--gap", 0, 0},
+                 {{"--dt", "0.001", "--dt-per-Tp", "100"}, "--dt-per-Tp", 0, 0},
+                 {{"--resume"}, "--resume", 1, 0},
+                 {{"--eps", "0.5"}, "--Pi2", 0, 1}};
     if (!pd_test_have_pound(ctx))
         return;
     char dir[] = "/tmp/pd_spec_badXXXXXX", out[512], png[512];
@@ -285,16 +300,18 @@ static void check_group(pd_test_ctx *ctx, hid_t f, int c, const char *json)
     h5_str_attr(g, "pulse", pulse, sizeof pulse);
     pd_test_json_str(json, "pulse", 5 * c, jpulse, sizeof jpulse);
     CHECK(ctx, !strcmp(pulse, jpulse), "%s: pulse '%s' vs '%s'", name, pulse, jpulse);
-    CHECK(ctx, pd_test_h5_num(g, "Pi3") == pd_test_json_num(json, "Pi3", 5 * c) &&
-                   pd_test_h5_num(g, "eps") == 0.4 && pd_test_h5_num(g, "xi") == 0.05,
+    CHECK(ctx,
+          pd_test_h5_num(g, "Pi3") == pd_test_json_num(json, "Pi3", 5 * c) &&
+              pd_test_h5_num(g, "eps") == 0.4 && pd_test_h5_num(g, "xi") == 0.05,
           "%s: attributes Pi3 %g eps %g xi %g", name, pd_test_h5_num(g, "Pi3"),
           pd_test_h5_num(g, "eps"), pd_test_h5_num(g, "xi"));
     for (int k = 0; k < 6; k++) {
         if (!CHECK(ctx, h5_read(g, cols[k], x, 5) == 0, "%s/%s unreadable", name, cols[k]))
             continue;
         for (int j = 0; j < 5; j++)
-            CHECK(ctx, x[j] == pd_test_json_num(json, cols[k], 5 * c + j), "%s/%s[%d] = %.17g vs %.17g",
-                  name, cols[k], j, x[j], pd_test_json_num(json, cols[k], 5 * c + j));
+            CHECK(ctx, x[j] == pd_test_json_num(json, cols[k], 5 * c + j),
+                  "%s/%s[%d] = %.17g vs %.17g", name, cols[k], j, x[j],
+                  pd_test_json_num(json, cols[k], 5 * c + j));
     }
     H5Gclose(g);
 }
@@ -310,7 +327,8 @@ static void check_csv(pd_test_ctx *ctx, const char *path, const char *json)
             continue;
         if (col_pi1 < 0) { /* the header row */
             int c = 0;
-            for (char *s2 = NULL, *tok = strtok_r(line, ",", &s2); tok; tok = strtok_r(NULL, ",", &s2), c++) {
+            for (char *s2 = NULL, *tok = strtok_r(line, ",", &s2); tok;
+                 tok = strtok_r(NULL, ",", &s2), c++) {
                 col_pi1 = !strcmp(tok, "Pi1") ? c : col_pi1;
                 col_gamma = !strcmp(tok, "gamma") ? c : col_gamma;
             }
@@ -318,11 +336,14 @@ static void check_csv(pd_test_ctx *ctx, const char *path, const char *json)
         }
         int c = 0;
         double pi1 = NAN, gamma = NAN;
-        for (char *s2 = NULL, *tok = strtok_r(line, ",", &s2); tok; tok = strtok_r(NULL, ",", &s2), c++) {
+        for (char *s2 = NULL, *tok = strtok_r(line, ",", &s2); tok;
+             tok = strtok_r(NULL, ",", &s2), c++) {
             pi1 = c == col_pi1 ? strtod(tok, NULL) : pi1;
             gamma = c == col_gamma ? strtod(tok, NULL) : gamma;
         }
-        CHECK(ctx, pi1 == pd_test_json_num(json, "Pi1", rows) && gamma == pd_test_json_num(json, "gamma", rows),
+        CHECK(ctx,
+              pi1 == pd_test_json_num(json, "Pi1", rows) &&
+                  gamma == pd_test_json_num(json, "gamma", rows),
               "CSV row %d: Pi1 %.17g gamma %.17g differ from the JSON", rows, pi1, gamma);
         rows++;
     }
@@ -344,9 +365,9 @@ static void test_spectrum_hdf5_csv_read_back(pd_test_ctx *ctx)
     snprintf(h5, sizeof h5, "%s/s.h5", dir);
     snprintf(csv, sizeof csv, "%s/s.csv", dir);
     const char *a1[] = {"spectrum", "--pulse", "sine,cosine", "--Pi3", "0.01,0.1", "--eps", "0.4",
-                        "--Pi2", "0.3:3:5", "--json", "-o", h5, NULL};
-    const char *a2[] = {"spectrum", "--pulse", "sine,cosine", "--Pi3", "0.01,0.1", "--eps", "0.4",
-                        "--Pi2", "0.3:3:5", "-o", csv, NULL};
+                        "--Pi2",    "0.3:3:5", "--json",      "-o",    h5,         NULL};
+    const char *a2[] = {"spectrum", "--pulse", "sine,cosine", "--Pi3", "0.01,0.1", "--eps",
+                        "0.4",      "--Pi2",   "0.3:3:5",     "-o",    csv,        NULL};
     proc_out r, r2;
     pd_test_pound(ctx, a1, &r);
     pd_test_pound(ctx, a2, &r2);
@@ -375,8 +396,8 @@ static void test_spectrum_linear_vs_log(pd_test_ctx *ctx)
     if (!pd_test_have_pound(ctx))
         return;
     for (int lin = 0; lin < 2; lin++) {
-        const char *args[] = {"spectrum", "--Pi2", "0.5:2.5:5", "--json",
-                              lin ? "--linear" : NULL, NULL};
+        const char *args[] = {"spectrum", "--Pi2", "0.5:2.5:5", "--json", lin ? "--linear" : NULL,
+                              NULL};
         proc_out r;
         pd_test_pound(ctx, args, &r);
         CHECK(ctx, r.status == 0, "exit %d: %s", r.status, r.err);
@@ -386,7 +407,8 @@ static void test_spectrum_linear_vs_log(pd_test_ctx *ctx)
             CHECK(ctx, rel_close(x, want, 1e-15), "%s Pi2[%d] = %.17g, expected %.17g",
                   lin ? "linear" : "log", j, x, want);
         }
-        CHECK(ctx, pd_test_json_num(r.out, "Pi2", 0) == 0.5 && pd_test_json_num(r.out, "Pi2", 4) == 2.5,
+        CHECK(ctx,
+              pd_test_json_num(r.out, "Pi2", 0) == 0.5 && pd_test_json_num(r.out, "Pi2", 4) == 2.5,
               "end points not exact");
         pd_test_proc_free(&r);
     }
@@ -398,8 +420,8 @@ static void test_spectrum_twins_shared(pd_test_ctx *ctx)
 {
     if (!pd_test_have_pound(ctx))
         return;
-    const char *args[] = {"spectrum", "--Pi3", "0.01,0.1", "--eps", "0.2,0.9", "--Pi2",
-                          "0.3:3:4", "--json", NULL};
+    const char *args[] = {"spectrum", "--Pi3",   "0.01,0.1", "--eps", "0.2,0.9",
+                          "--Pi2",    "0.3:3:4", "--json",   NULL};
     proc_out r;
     pd_test_pound(ctx, args, &r);
     CHECK(ctx, r.status == 0, "exit %d: %s", r.status, r.err);
@@ -408,7 +430,9 @@ static void test_spectrum_twins_shared(pd_test_ctx *ctx)
           pd_test_json_num(r.out, "twins", 0));
     for (int c = 1; c < 4; c++)
         for (int j = 0; j < 4; j++)
-            CHECK(ctx, pd_test_json_num(r.out, "umax_free", 4 * c + j) == pd_test_json_num(r.out, "umax_free", j),
+            CHECK(ctx,
+                  pd_test_json_num(r.out, "umax_free", 4 * c + j) ==
+                      pd_test_json_num(r.out, "umax_free", j),
                   "curve %d Pi2 #%d: umax_free differs", c, j);
     pd_test_proc_free(&r);
 }
@@ -421,32 +445,38 @@ static void test_spectrum_dimensional_self_similar(pd_test_ctx *ctx)
     static const double ap[] = {1.0, 2.5, 7.0};
     if (!pd_test_have_pound(ctx))
         return;
-    const char *args[] = {"spectrum", "--ap", "1,2.5,7", "--Tp", "0.4", "--Pi3", "0.05",
-                          "--pulse", "cosine", "--dir", "reverse", "--Pi2", "0.3:3:6", "--json",
-                          NULL};
+    const char *args[] = {"spectrum", "--ap",  "1,2.5,7", "--Tp",   "0.4",
+                          "--Pi3",    "0.05",  "--pulse", "cosine", "--dir",
+                          "reverse",  "--Pi2", "0.3:3:6", "--json", NULL};
     proc_out r;
     pd_test_pound(ctx, args, &r);
     CHECK(ctx, r.status == 0, "exit %d: %s", r.status, r.err);
     for (int c = 1; c < 3; c++)
         for (int j = 0; j < 6; j++) {
             int p = 6 * c + j;
-            CHECK(ctx, rel_close(pd_test_json_num(r.out, "Pi1", p), pd_test_json_num(r.out, "Pi1", j), 1e-12),
+            CHECK(ctx,
+                  rel_close(pd_test_json_num(r.out, "Pi1", p), pd_test_json_num(r.out, "Pi1", j),
+                            1e-12),
                   "ap %g Pi2 #%d: Pi1 %.17g vs %.17g", ap[c], j, pd_test_json_num(r.out, "Pi1", p),
                   pd_test_json_num(r.out, "Pi1", j));
-            CHECK(ctx, rel_close(pd_test_json_num(r.out, "umax", p) / ap[c], pd_test_json_num(r.out, "umax", j),
-                                 1e-12),
+            CHECK(ctx,
+                  rel_close(pd_test_json_num(r.out, "umax", p) / ap[c],
+                            pd_test_json_num(r.out, "umax", j), 1e-12),
                   "ap %g: umax not proportional to ap", ap[c]);
-            CHECK(ctx, rel_close(pd_test_json_num(r.out, "T0", p), 0.4 / pd_test_json_num(r.out, "Pi2", p), 1e-15),
+            CHECK(ctx,
+                  rel_close(pd_test_json_num(r.out, "T0", p),
+                            0.4 / pd_test_json_num(r.out, "Pi2", p), 1e-15),
                   "T0 != Tp / Pi2");
         }
     pd_test_proc_free(&r);
-    const char *gargs[] = {"spectrum", "--ap", "1,2", "--Tp", "0.4", "--gap", "0.002", "--Pi2",
-                           "0.5:1:2", "--json", NULL};
+    const char *gargs[] = {"spectrum", "--ap",  "1,2",     "--Tp",   "0.4", "--gap",
+                           "0.002",    "--Pi2", "0.5:1:2", "--json", NULL};
     pd_test_pound(ctx, gargs, &r);
     CHECK(ctx, r.status == 0, "--gap: exit %d: %s", r.status, r.err);
     double wp = 6.283185307179586 / 0.4;
     for (int c = 0; c < 2; c++)
-        CHECK(ctx, rel_close(pd_test_json_num(r.out, "Pi3", 2 * c), 0.002 * wp * wp / (c + 1.0), 1e-12),
+        CHECK(ctx,
+              rel_close(pd_test_json_num(r.out, "Pi3", 2 * c), 0.002 * wp * wp / (c + 1.0), 1e-12),
               "--gap: curve %d Pi3 %.17g", c, pd_test_json_num(r.out, "Pi3", 2 * c));
     pd_test_proc_free(&r);
 }
@@ -469,8 +499,8 @@ static void test_spectrum_plot(pd_test_ctx *ctx)
     if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
         return;
     snprintf(png, sizeof png, "%s/s.png", dir);
-    const char *args[] = {"spectrum", "--ap", "1,2", "--Pi3", "0.01,0.1", "--Pi2", "0.2:5:8",
-                          "--plot", png, NULL};
+    const char *args[] = {"spectrum", "--ap",    "1,2",    "--Pi3", "0.01,0.1",
+                          "--Pi2",    "0.2:5:8", "--plot", png,     NULL};
     proc_out r;
     pd_test_pound(ctx, args, &r);
     CHECK(ctx, r.status == 0, "exit %d: %s", r.status, r.err);
@@ -517,15 +547,27 @@ static void test_spectrum_mpi_matches_serial(pd_test_ctx *ctx)
     CHECK(ctx, r.status == 0, "serial: exit %d: %s", r.status, r.err);
     pd_test_proc_free(&r);
     for (int th = 1; th <= 2; th++) {
-        const char *a_mpi[] = {"mpirun", "-np", "2", "--allow-run-as-root", "--oversubscribe",
-                               mpi, "spectrum", SWEEP, "--threads", th == 1 ? "1" : "2", "-o",
-                               par, "--json", NULL};
+        const char *a_mpi[] = {"mpirun",
+                               "-np",
+                               "2",
+                               "--allow-run-as-root",
+                               "--oversubscribe",
+                               mpi,
+                               "spectrum",
+                               SWEEP,
+                               "--threads",
+                               th == 1 ? "1" : "2",
+                               "-o",
+                               par,
+                               "--json",
+                               NULL};
         unlink(par);
         pd_test_spawn(a_mpi, NULL, &r);
         CHECK(ctx, r.status == 0, "mpirun: exit %d: %s", r.status, r.err);
         CHECK(ctx, pd_test_json_num(r.out, "ranks", 0) == 2, "ranks %g in the JSON, expected 2",
               pd_test_json_num(r.out, "ranks", 0));
-        CHECK(ctx, pd_test_same_file(ser, par), "MPI (2 ranks x %d threads) file differs from serial", th);
+        CHECK(ctx, pd_test_same_file(ser, par),
+              "MPI (2 ranks x %d threads) file differs from serial", th);
         pd_test_proc_free(&r);
     }
     pd_test_rm_dir(dir);
@@ -551,7 +593,10 @@ static int sweep_point(const pd_spec_coords *co, const pd_spec_row *row, void *c
 }
 
 /* Equal, NaN equal to NaN. */
-static int same(double a, double b) { return a == b || (isnan(a) && isnan(b)); }
+static int same(double a, double b)
+{
+    return a == b || (isnan(a) && isnan(b));
+}
 
 /* 2 pulses x 2 eps x 4 Pi2 (8 twins, 16 points), event-driven and
  * Moreau-Jean: the callback gets every point once, in order, with the
@@ -586,20 +631,21 @@ static void test_spectrum_sweep_callback(pd_test_ctx *ctx)
             const pd_spec_row *a = &seen.row[p], *b = &rows[p];
             pd_spec_coords_of(&s, ntw + p, &co);
             CHECK(ctx, !memcmp(&co, &seen.co[p], sizeof co), "point %d: coordinates differ", p);
-            CHECK(ctx, a->c.Pi2 == b->c.Pi2 && a->c.Pi3 == b->c.Pi3 && a->c.eps == b->c.eps &&
-                           a->c.pulse == b->c.pulse && a->c.dir == b->c.dir &&
-                           a->curve == b->curve && a->c.Pi2 == pd_spec_pi2(&s, co.j),
+            CHECK(ctx,
+                  a->c.Pi2 == b->c.Pi2 && a->c.Pi3 == b->c.Pi3 && a->c.eps == b->c.eps &&
+                      a->c.pulse == b->c.pulse && a->c.dir == b->c.dir && a->curve == b->curve &&
+                      a->c.Pi2 == pd_spec_pi2(&s, co.j),
                   "point %d: case differs", p);
             CHECK(ctx, a->umax == res[ntw + p].umax && a->umax > 0.0,
-                  "point %d: umax %.17g vs pd_spec_run_task %.17g", p, a->umax,
-                  res[ntw + p].umax);
+                  "point %d: umax %.17g vs pd_spec_run_task %.17g", p, a->umax, res[ntw + p].umax);
             CHECK(ctx, a->umax_free == res[pd_spec_twin_of(&s, ntw + p)].umax,
                   "point %d: umax_free %.17g vs the twin's %.17g", p, a->umax_free,
                   res[pd_spec_twin_of(&s, ntw + p)].umax);
-            CHECK(ctx, same(a->Pi1, b->Pi1) && same(a->gamma, b->gamma) && same(a->chi, b->chi) &&
-                           a->impacts == b->impacts && a->steps == b->steps && isfinite(a->gamma),
-                  "point %d: Pi1 %.17g/%.17g gamma %.17g/%.17g impacts %ld/%ld", p, a->Pi1,
-                  b->Pi1, a->gamma, b->gamma, a->impacts, b->impacts);
+            CHECK(ctx,
+                  same(a->Pi1, b->Pi1) && same(a->gamma, b->gamma) && same(a->chi, b->chi) &&
+                      a->impacts == b->impacts && a->steps == b->steps && isfinite(a->gamma),
+                  "point %d: Pi1 %.17g/%.17g gamma %.17g/%.17g impacts %ld/%ld", p, a->Pi1, b->Pi1,
+                  a->gamma, b->gamma, a->impacts, b->impacts);
         }
         sweep_seen stop = {.stop_at = 3};
         rc = pd_spec_sweep(&s, sweep_point, &stop, &err);
@@ -673,8 +719,7 @@ static int osc_seen_next(void *ctx, pd_osc *c, pd_run_opts *o, long *id)
     return 1;
 }
 
-static void osc_seen_done(void *ctx, long id, const pd_osc_result *r, int status,
-                          const pd_err *err)
+static void osc_seen_done(void *ctx, long id, const pd_osc_result *r, int status, const pd_err *err)
 {
     osc_seen *w = ctx;
     (void)err;
@@ -685,25 +730,53 @@ static void osc_seen_done(void *ctx, long id, const pd_osc_result *r, int status
 }
 
 /* The same double to the bit (the sign of a zero and NaNs' payload included). */
-static int bits_same(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
+static int bits_same(double a, double b)
+{
+    return memcmp(&a, &b, sizeof a) == 0;
+}
 
 /* Every figure of a batched run to the bit: pd_osc_run's (cpu_s and the
  * kernel's name aside). */
 static int osc_result_same(const pd_osc_result *a, const pd_osc_result *b)
 {
-    const double x[] = {a->umax, a->u_toward, a->u_away, a->first_impact,
-                        a->first_impact_velocity, a->max_impact_velocity, a->max_impulse,
-                        a->contact_time, a->min_gap, a->dt, a->tend, a->theta, a->gamma,
-                        a->acc_max, a->force_max, a->force_equiv, a->contact_duration};
-    const double y[] = {b->umax, b->u_toward, b->u_away, b->first_impact,
-                        b->first_impact_velocity, b->max_impact_velocity, b->max_impulse,
-                        b->contact_time, b->min_gap, b->dt, b->tend, b->theta, b->gamma,
-                        b->acc_max, b->force_max, b->force_equiv, b->contact_duration};
+    const double x[] = {a->umax,
+                        a->u_toward,
+                        a->u_away,
+                        a->first_impact,
+                        a->first_impact_velocity,
+                        a->max_impact_velocity,
+                        a->max_impulse,
+                        a->contact_time,
+                        a->min_gap,
+                        a->dt,
+                        a->tend,
+                        a->theta,
+                        a->gamma,
+                        a->acc_max,
+                        a->force_max,
+                        a->force_equiv,
+                        a->contact_duration};
+    const double y[] = {b->umax,
+                        b->u_toward,
+                        b->u_away,
+                        b->first_impact,
+                        b->first_impact_velocity,
+                        b->max_impact_velocity,
+                        b->max_impulse,
+                        b->contact_time,
+                        b->min_gap,
+                        b->dt,
+                        b->tend,
+                        b->theta,
+                        b->gamma,
+                        b->acc_max,
+                        b->force_max,
+                        b->force_equiv,
+                        b->contact_duration};
     for (size_t i = 0; i < sizeof x / sizeof x[0]; i++)
         if (!bits_same(x[i], y[i]))
             return 0;
-    return a->impacts == b->impacts && a->accumulations == b->accumulations &&
-           a->steps == b->steps;
+    return a->impacts == b->impacts && a->accumulations == b->accumulations && a->steps == b->steps;
 }
 
 /* pd_osc_run_stream against pd_osc_run case by case, every figure of the
@@ -749,7 +822,7 @@ static void osc_stream_matches_run(pd_test_ctx *ctx)
             c.xi = (i / 11) % 2 ? 0.0 : 0.05;
             o.no_wall = i % 9 == 4;
             if (c.pulse == PD_PULSE_HARMONIC)
-                o.dt = 0.004; /* (the default step: Tp / 2000 over 38 s) */
+                o.dt = 0.004;  /* (the default step: Tp / 2000 over 38 s) */
             if (i % 13 == 6) { /* the record; some with more steps than a table holds */
                 pd_osc_set_record(&c, &rec, &rp, 1.0 + 0.1 * (i % 3));
                 o.dt = i % 26 == 6 ? 1.5e-4 : 2e-3;
@@ -761,11 +834,11 @@ static void osc_stream_matches_run(pd_test_ctx *ctx)
         }
         w.next = w.calls = w.batched = 0;
         pd_err err;
-        CHECK(ctx, pd_osc_run_stream(osc_seen_next, osc_seen_done, &w, &err) == PD_OK,
-              "stream: %s", err.msg);
+        CHECK(ctx, pd_osc_run_stream(osc_seen_next, osc_seen_done, &w, &err) == PD_OK, "stream: %s",
+              err.msg);
         CHECK(ctx, w.calls == NC, "pass %d: %ld of %d cases reported", pass, w.calls, NC);
-        CHECK(ctx, w.batched > NC * 3 / 4, "pass %d: %ld of %d cases on the lanes", pass,
-              w.batched, NC);
+        CHECK(ctx, w.batched > NC * 3 / 4, "pass %d: %ld of %d cases on the lanes", pass, w.batched,
+              NC);
         long differ = 0, first = -1, impacts = 0;
         for (int i = 0; i < NC; i++) {
             pd_osc_result b;
@@ -778,8 +851,8 @@ static void osc_stream_matches_run(pd_test_ctx *ctx)
         }
         CHECK(ctx, differ == 0, "pass %d: %ld of %d cases differ from pd_osc_run (first: %ld)",
               pass, differ, NC, first);
-        CHECK(ctx, impacts > 500, "pass %d: %ld impacts (the events' path must be exercised)",
-              pass, impacts);
+        CHECK(ctx, impacts > 500, "pass %d: %ld impacts (the events' path must be exercised)", pass,
+              impacts);
     }
 done:
     free(rec.acc);
@@ -806,8 +879,8 @@ static void test_spectrum_stream_matches_single(pd_test_ctx *ctx)
         if (variants[k].level > have)
             continue;
         setenv("POUND_ISA", variants[k].isa, 1);
-        CHECK(ctx, pd_cpu_level() == variants[k].level, "POUND_ISA=%s: level %d",
-              variants[k].isa, pd_cpu_level());
+        CHECK(ctx, pd_cpu_level() == variants[k].level, "POUND_ISA=%s: level %d", variants[k].isa,
+              pd_cpu_level());
         stream_matches_single(ctx);
         osc_stream_matches_run(ctx);
         ran++;
@@ -829,8 +902,9 @@ static void stream_matches_single(pd_test_ctx *ctx)
     if (!CHECK(ctx, rec.acc != NULL, "out of memory"))
         return;
     for (long k = 0; k < rec.npts; k++) /* two sine cycles of 1 s and 0.5 s, then rest */
-        rec.acc[k] = k < 200 ? -2.0 * sin(PD_TWO_PI * k / 200.0)
-                   : k < 300 ? 1.5 * sin(PD_TWO_PI * (k - 200) / 100.0) : 0.0;
+        rec.acc[k] = k < 200   ? -2.0 * sin(PD_TWO_PI * k / 200.0)
+                     : k < 300 ? 1.5 * sin(PD_TWO_PI * (k - 200) / 100.0)
+                               : 0.0;
     pd_record_pulse rp = {.ap = 2.0, .Tp = 1.0};
     long compared = 0, batched_impacts = 0;
     for (int v = 0; v < 6; v++) {
@@ -891,14 +965,15 @@ static void stream_matches_single(pd_test_ctx *ctx)
                 batched_impacts += a.impacts;
             compared++;
         }
-        CHECK(ctx, differ == 0, "sweep %d: %ld of %ld tasks differ from single runs", v, differ,
-              n);
+        CHECK(ctx, differ == 0, "sweep %d: %ld of %ld tasks differ from single runs", v, differ, n);
         if (v == 5)
-            CHECK(ctx, failed > 0 && failed < n, "sweep 5 must fail in part (%ld of %ld)",
-                  failed, n);
+            CHECK(ctx, failed > 0 && failed < n, "sweep 5 must fail in part (%ld of %ld)", failed,
+                  n);
         if (v < 4)
-            CHECK(ctx, w.order_breaks > 0, "sweep %d: runs of different lengths end out of "
-                  "order on the lanes (%ld)", v, w.order_breaks);
+            CHECK(ctx, w.order_breaks > 0,
+                  "sweep %d: runs of different lengths end out of "
+                  "order on the lanes (%ld)",
+                  v, w.order_breaks);
         free(w.r);
         free(w.msg);
     }

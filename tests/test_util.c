@@ -10,7 +10,6 @@
 
 #include "pd_test.h"
 
-
 /* Read a whole file into a malloc'd NUL-terminated buffer. */
 char *pd_test_slurp(const char *path)
 {
@@ -182,7 +181,6 @@ double pd_test_h5_num(hid_t obj, const char *name)
     return x;
 }
 
-
 pd_run_opts pd_test_pen(const pd_run_opts *base, const pd_penalty_setup *po)
 {
     pd_run_opts o = base ? *base : pd_run_default_opts();
@@ -226,8 +224,8 @@ int pd_test_rinaldi_case(pd_test_ctx *ctx, pd_record *rec, pd_osc *c)
         pd_test_skip(ctx, "the Rinaldi record is absent");
         return 0;
     }
-    if (!CHECK(ctx, pd_record_read(path, PD_RECORD_AUTO, PD_UNITS_G, rec, &err) == PD_OK,
-               "%s", err.msg))
+    if (!CHECK(ctx, pd_record_read(path, PD_RECORD_AUTO, PD_UNITS_G, rec, &err) == PD_OK, "%s",
+               err.msg))
         return 0;
     if (!CHECK(ctx, pd_record_fit_pulse(rec, &p, &err) == PD_OK, "%s", err.msg)) {
         pd_record_free(rec);

@@ -28,9 +28,9 @@ int main(void)
     pd_osc_result mj, ref;
     pd_err err;
     c.pulse = PD_PULSE_SINE;
-    c.dir = 1;     /* normal: the wall is driven toward the oscillator */
-    c.ap = 4.0;    /* m/s^2 */
-    c.Tp = 0.3;    /* s */
+    c.dir = 1;  /* normal: the wall is driven toward the oscillator */
+    c.ap = 4.0; /* m/s^2 */
+    c.Tp = 0.3; /* s */
     c.eps = 0.6;
     pd_osc_set_T0(&c, 3.0);    /* Pi2 = Tp / T0 (ap and Tp first) */
     pd_osc_set_gap(&c, 0.004); /* Pi3 = gap / Le */
@@ -44,8 +44,7 @@ int main(void)
     printf("libpound %s: Pi2 = %g, Pi3 = %g, eps = %g\n", pd_version(), c.Pi2, c.Pi3, c.eps);
     printf("moreau  umax = %.6f m  (%ld steps of %g s, %ld impacts)\n", mj.umax, mj.steps, mj.dt,
            mj.impacts);
-    printf("event   umax = %.6f m  (%ld events, %ld impacts)\n", ref.umax, ref.steps,
-           ref.impacts);
+    printf("event   umax = %.6f m  (%ld events, %ld impacts)\n", ref.umax, ref.steps, ref.impacts);
     printf("relative difference %.3g\n", rel);
     return ref.umax > 0.0 && rel < 1e-2 ? 0 : 1;
 }

@@ -14,7 +14,7 @@
 static int build(pd_scene *sc, pd_err *err)
 {
     int rc;
-    if ((rc = pd_scene_add_sdof(sc, "stiff", 0.4, 0.05, 2.0e5, err)) ||   /* T0 [s], xi, kg */
+    if ((rc = pd_scene_add_sdof(sc, "stiff", 0.4, 0.05, 2.0e5, err)) || /* T0 [s], xi, kg */
         (rc = pd_scene_add_sdof(sc, "flexible", 1.2, 0.05, 1.0e5, err)))
         return rc;
     /* structure 0 storey 1 against structure 1 storey 1, gap 2 cm, eps 0.65 */
@@ -26,8 +26,8 @@ static int build(pd_scene *sc, pd_err *err)
 
 int main(void)
 {
-    pd_scene_excitation exc = {.pulse = PD_PULSE_COSINE, .dir = 1, .ap = 3.0, .Tp = 0.6,
-                               .scale = 1.0};
+    pd_scene_excitation exc = {
+        .pulse = PD_PULSE_COSINE, .dir = 1, .ap = 3.0, .Tp = 0.6, .scale = 1.0};
     pd_scene *sc = pd_scene_new(&exc);
     pd_scene_result res = {0};
     pd_run_opts opts = pd_run_default_opts(); /* Moreau-Jean, dt and tend derived */

@@ -21,11 +21,11 @@ static int point(const pd_spec_coords *co, const pd_spec_row *r, void *ctx)
 {
     seen *s = ctx;
     if (co->j == 0)
-        printf("%-7s %-7s %8s %8s %5s %10s %10s %9s %8s %7s\n", "pulse", "dir", "Pi2", "Pi3",
-               "eps", "umax [m]", "free [m]", "Pi1", "gamma", "impacts");
+        printf("%-7s %-7s %8s %8s %5s %10s %10s %9s %8s %7s\n", "pulse", "dir", "Pi2", "Pi3", "eps",
+               "umax [m]", "free [m]", "Pi1", "gamma", "impacts");
     printf("%-7s %-7s %8.4f %8.4f %5.2f %10.6f %10.6f %9.5f %8.4f %7ld\n",
-           pd_pulse_name(r->c.pulse), pd_dir_name(r->c.dir), r->c.Pi2, r->c.Pi3, r->c.eps,
-           r->umax, r->umax_free, r->Pi1, r->gamma, r->impacts);
+           pd_pulse_name(r->c.pulse), pd_dir_name(r->c.dir), r->c.Pi2, r->c.Pi3, r->c.eps, r->umax,
+           r->umax_free, r->Pi1, r->gamma, r->impacts);
     s->bad |= co->curve * s->npi2 + co->j != s->points || !isfinite(r->Pi1) ||
               !isfinite(r->gamma) || !(r->umax > 0.0);
     s->points++;

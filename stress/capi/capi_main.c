@@ -61,8 +61,7 @@ static void capi_result_shape(pd_test_ctx *ctx)
         pd_scene_add_sdof(fresh, "A", 0.5, 0.05, 1.0, NULL);
         CHECK(ctx, pd_scene_result_alloc(fresh, &early, NULL) == PD_EINVAL,
               "a result for an unfinished scene is refused");
-        CHECK(ctx, pd_scene_run(two, &o, NULL, NULL, &r2, NULL) == PD_OK,
-              "the right shape runs");
+        CHECK(ctx, pd_scene_run(two, &o, NULL, NULL, &r2, NULL) == PD_OK, "the right shape runs");
     }
     pd_scene_result_free(&r2);
     pd_scene_result_free(&early);
