@@ -53,6 +53,7 @@ DEFAULT_FILES = {
     "engine/event_row.c": ["rows", "edr", "row_"],
     "engine/event_row_cluster.c": ["rows", "edr", "row_"],
     "engine/event_row_scan.c": ["rows", "edr", "row_"],
+    "core/root.c": ["root", "edr_scan", "event", "rows"],
     "problems/demand.c": ["demand", "aabs"],
     "problems/scene_measure.c": ["measure", "general_history", "other_grid", "compare",
                                  "converge"],
