@@ -162,7 +162,10 @@ static void compare_steps(compare_ctx *c, const pd_scene_sample *s)
     int jump = 0;
     for (int a = 0; a < c->sc->ncontact; a++)
         jump |= s->impulse[a] > 0.0;
-    for (; c->row < c->ref->rows && (double)c->row * c->ref->dt <= s->t; c->row++) {
+    /* every row up to this sample's time, within the rows' rounding (a run to
+     * a tolerance ends at tend to a few ulps, below or above) */
+    for (; c->row < c->ref->rows && (double)c->row * c->ref->dt <= s->t + 1e-9 * c->ref->dt;
+         c->row++) {
         if (!c->have_prev) { /* t = 0 */
             compare_at(c, c->row, s->x);
             continue;
