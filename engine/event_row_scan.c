@@ -233,7 +233,9 @@ static int scan_simple(edr_scan *s, const edr_pt *a, const edr_pt *b, double *t_
             c = edr_scan_point(s, tc);
             double top = c.f + fabs(c.df) * w + fabs(c.ddf) * w * w;
             if (!(c.f > s->thr) && top > s->thr && w > s->width) {
-                tc = locate(s, 1, -1.0, fmax(a->t, tc - w), tc, s->width);
+                /* Newton from the coarse tc over the whole (a, b), where f'
+                 * changes sign: tc may lie on either side of the maximum */
+                tc = locate_from(s, 1, -1.0, a->t, b->t, s->width, tc);
                 c = edr_scan_point(s, tc);
             }
         } else {
