@@ -24,9 +24,13 @@
 #   make MPI=1    the MPI build (OpenMPI's mpicc, -DPD_MPI) in build-mpi/:
 #                 mpirun -np K build-mpi/pound spectrum ...
 #   make OPENMP=  without OpenMP (spectrum then runs one thread)
+#   make format / format-check   the layout of .clang-format (clang-format 14)
+#   make house    function lengths and comments inside them (scripts/house.py)
+#   make mutate   mutation testing of the numerical core (scripts/mutate.py)
 #
-# Layers: cli -> problems -> engine -> lcp; HDF5 is used by cli/ only; bench/
-# holds the drivers of `pound bench` (cli/cmd_bench.c calls them).
+# Layers: cli -> problems -> engine -> lcp -> core, each compiled with the
+# include paths of its layer and those below (INC_*); HDF5 is used by cli/
+# only; bench/ holds `pound bench` (cmd_bench.c and its drivers).
 
 CC      ?= cc
 OPT     ?= -O2
