@@ -21,6 +21,7 @@ runner's names), then the whole C suite, both stopping at the first failure
 and a per-mutant limit.  A mutant is
 
   stillborn  it does not compile (not counted),
+  (the build checks array indices against fixed sizes: -fsanitize=bounds, a trap)
   killed     a case failed, the run crashed, or it ran out of time,
   survived   every case passed.
 
@@ -58,6 +59,11 @@ DEFAULT_FILES = {
     "problems/scene_measure.c": ["measure", "general_history", "other_grid", "compare",
                                  "converge"],
 }
+
+# Array indices checked against the arrays' sizes (a trap, no runtime
+# library): a mutant that writes one past a fixed array crashes, killed,
+# instead of surviving by luck of the stack's layout.
+BOUNDS = "-fsanitize=bounds -fsanitize-undefined-trap-on-error"
 
 SKIP_DIRS = {".git", "build", "build-asan", "build-mpi", "build-tsan"}
 
@@ -182,7 +188,7 @@ def copy_tree(dst):
 
 
 def build(work, log):
-    p = subprocess.run(["make", "-j2", "all"], cwd=work, stdout=subprocess.PIPE,
+    p = subprocess.run(["make", "-j2", "all", "XCFLAGS=" + BOUNDS], cwd=work, stdout=subprocess.PIPE,
                        stderr=subprocess.STDOUT, timeout=900)
     if p.returncode != 0:
         log.write(p.stdout.decode("utf-8", "replace")[-2000:])
