@@ -241,6 +241,24 @@ static void test_measure_other_grid_recomputed(pd_test_ctx *ctx)
             CHECK(ctx, se.err_hist[st] > 0.0 && se.err_hist[st] == g.err[st],
                   "%s: err_hist %.17g, recomputed %.17g", sc->st[st].name, se.err_hist[st],
                   g.err[st]);
+        /* without the walls no step has an impulse: every row from the cubic
+         * (the largest error no longer at a step across an impact, where the
+         * line would hide which interpolation ran) */
+        interp_hist f = {.sc = sc, .ref = &tr, .scale = scale};
+        o.no_wall = 1;
+        o.no_demands = o.no_law_band = 0;
+        rc = pd_scene_measure_run(sc, &o, &tr, &rr, &mr, &se, &e);
+        o.no_demands = o.no_law_band = 1;
+        if (!rc)
+            rc = pd_scene_run(sc, &o, interp_hist_sample, &f, &own, &e);
+        if (CHECK(ctx, !rc, "no walls: %s", e.msg)) {
+            CHECK(ctx, f.jumps == 0 && f.row == 3001, "no walls: %ld jumps, %ld rows", f.jumps,
+                  f.row);
+            for (int st = 0; st < 2; st++)
+                CHECK(ctx, se.err_hist[st] > 0.0 && se.err_hist[st] == f.err[st],
+                      "no walls, %s: err_hist %.17g, recomputed %.17g", sc->st[st].name,
+                      se.err_hist[st], f.err[st]);
+        }
     }
     pd_scene_errors_free(&se);
     pd_scene_result_free(&own);
