@@ -89,10 +89,44 @@ static void test_root_bisect_limits(pd_test_ctx *ctx)
           a.evals);
 }
 
+/* f = t - r with a slope that lies (1e20): Newton's first step barely moves
+ * and looks converged half a unit above the root; the probe below it finds
+ * f > 0 there, so the bracket is cut to it and bisection still returns the
+ * first double above r: the slope guides, the signs decide. */
+static double line_lying_slope(void *ctx, double t, double *slope)
+{
+    if (slope)
+        *slope = 1e20;
+    return t - *(const double *)ctx;
+}
+
+static void test_root_lying_slope(pd_test_ctx *ctx)
+{
+    double r0 = 0.25;
+    pd_root r = {.f = line_lying_slope, .ctx = &r0};
+    double t = pd_root_newton(&r, 0.0, 1.0, 0.0, 0.75);
+    CHECK(ctx, t - r0 > 0.0 && nextafter(t, 0.0) - r0 <= 0.0, "%.17g: the first double above 0.25",
+          t);
+}
+
+/* A bracket already as narrow as the width asked is returned as it is (hi,
+ * no evaluation); one wider by a factor 2 takes one halving. */
+static void test_root_bisect_width(pd_test_ctx *ctx)
+{
+    double r0 = 0.3;
+    pd_root a = {.f = line_minus, .ctx = &r0}, b = {.f = line_minus, .ctx = &r0};
+    double t = pd_root_bisect(&a, 0.0, 1.0, 1.0);
+    CHECK(ctx, t == 1.0 && a.evals == 0, "width 1 on (0, 1): %.17g after %ld", t, a.evals);
+    t = pd_root_bisect(&b, 0.0, 1.0, 0.5);
+    CHECK(ctx, t == 0.5 && b.evals == 1, "width 0.5 on (0, 1): %.17g after %ld", t, b.evals);
+}
+
 void suite_root(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_root_first_double);
     PD_RUN(ctx, test_root_width);
     PD_RUN(ctx, test_root_rounding_plateau);
     PD_RUN(ctx, test_root_bisect_limits);
+    PD_RUN(ctx, test_root_lying_slope);
+    PD_RUN(ctx, test_root_bisect_width);
 }
