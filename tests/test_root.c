@@ -110,7 +110,8 @@ static void test_root_lying_slope(pd_test_ctx *ctx)
 }
 
 /* A bracket already as narrow as the width asked is returned as it is (hi,
- * no evaluation); one wider by a factor 2 takes one halving. */
+ * no evaluation), by bisection and by Newton; one wider by a factor 2 takes
+ * one halving. */
 static void test_root_bisect_width(pd_test_ctx *ctx)
 {
     double r0 = 0.3;
@@ -119,6 +120,13 @@ static void test_root_bisect_width(pd_test_ctx *ctx)
     CHECK(ctx, t == 1.0 && a.evals == 0, "width 1 on (0, 1): %.17g after %ld", t, a.evals);
     t = pd_root_bisect(&b, 0.0, 1.0, 0.5);
     CHECK(ctx, t == 0.5 && b.evals == 1, "width 0.5 on (0, 1): %.17g after %ld", t, b.evals);
+    /* Newton the same: (0, 1) at width 1, (0.5, 1) at width 0.6 */
+    pd_root c = {.f = line_minus, .ctx = &r0}, d = {.f = line_minus, .ctx = &r0};
+    t = pd_root_newton(&c, 0.0, 1.0, 1.0, NAN);
+    CHECK(ctx, t == 1.0 && c.evals == 0, "Newton, width 1 on (0, 1): %.17g after %ld", t, c.evals);
+    t = pd_root_newton(&d, 0.5, 1.0, 0.6, NAN);
+    CHECK(ctx, t == 1.0 && d.evals == 0, "Newton, width 0.6 on (0.5, 1): %.17g after %ld", t,
+          d.evals);
 }
 
 void suite_root(pd_test_ctx *ctx)
