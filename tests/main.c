@@ -148,6 +148,7 @@ int main(int argc, char **argv)
     suite_law(&ctx);
     suite_lemke_paths(&ctx);
     suite_row_paths(&ctx);
+    suite_row_paths2(&ctx);
     suite_measure_paths(&ctx);
     suite_api_null(&ctx);
 

@@ -113,6 +113,7 @@ void suite_scan(pd_test_ctx *ctx);
 void suite_root(pd_test_ctx *ctx);
 void suite_measure_paths(pd_test_ctx *ctx);
 void suite_row_paths(pd_test_ctx *ctx);
+void suite_row_paths2(pd_test_ctx *ctx);
 void suite_lemke_paths(pd_test_ctx *ctx);
 void suite_api_null(pd_test_ctx *ctx);
 
