@@ -1,0 +1,60 @@
+/* test_row_rerun.c — the row reference's object run again after a run its
+ * event callback stopped: the second run is whole. */
+#include "pd_engine.h"
+#include "pd_test.h"
+
+typedef struct stop_ctx {
+    int stop; /* 1: stop at the first event */
+    long events;
+} stop_ctx;
+
+static int stop_at_first(const pd_edr_event *ev, void *vctx)
+{
+    stop_ctx *s = vctx;
+    (void)ev;
+    s->events++;
+    return s->stop;
+}
+
+/* An undamped unit oscillator bouncing elastically on a wall at x = 0.5
+ * (from x = 0 at v = 1: an impact every 4 pi / 3), 10 periods: the first
+ * run stopped by its callback at the first impact, the second, on the same
+ * object, sees all 15. */
+static void test_edr_rerun_after_stop(pd_test_ctx *ctx)
+{
+    double one[1] = {1.0}, b[1] = {0.0}, g0[1] = {0.5}, e[1] = {1.0}, wv[1] = {-1.0}, v0[1] = {1.0};
+    int cp[2] = {0, 1}, ri[1] = {0};
+    pd_model md = {.n = 1,
+                   .m = 1,
+                   .M = pd_matrix_dense(1, 1, one),
+                   .C = pd_matrix_zero(1, 1),
+                   .K = pd_matrix_dense(1, 1, one),
+                   .W = pd_matrix_csc(1, 1, cp, ri, wv),
+                   .g0 = g0,
+                   .e = e};
+    pd_sine_piece pc = {.t_start = 0.0};
+    pd_piecewise_force F = {.b = b, .pieces = &pc, .npieces = 1};
+    stop_ctx sc = {.stop = 1};
+    pd_edr_opts eo = pd_edr_default_opts();
+    eo.on_event = stop_at_first;
+    eo.on_event_ctx = &sc;
+    pd_err err;
+    pd_edr *r = pd_edr_alloc(&md, &F, &eo, &err);
+    if (!CHECK(ctx, r != NULL, "%s", err.msg))
+        return;
+    int rc = pd_edr_run(r, 0.0, NULL, v0, 10.0 * PD_TWO_PI, NULL, NULL, &err);
+    CHECK(ctx, rc == PD_OK && sc.events == 1 && pd_edr_result_of(r)->impacts == 1,
+          "first run: %s, %ld events, %ld impacts", err.msg, sc.events,
+          pd_edr_result_of(r)->impacts);
+    sc = (stop_ctx){.stop = 0};
+    rc = pd_edr_run(r, 0.0, NULL, v0, 10.0 * PD_TWO_PI, NULL, NULL, &err);
+    CHECK(ctx, rc == PD_OK && sc.events == 15 && pd_edr_result_of(r)->impacts == 15,
+          "second run: %s, %ld events, %ld impacts (15)", err.msg, sc.events,
+          pd_edr_result_of(r)->impacts);
+    pd_edr_free(r);
+}
+
+void suite_row_rerun(pd_test_ctx *ctx)
+{
+    PD_RUN(ctx, test_edr_rerun_after_stop);
+}
