@@ -13,7 +13,13 @@
  *   - impacts of one contact count one scalar LCP each; close_tol 0 is
  *     taken (a gap of 1e-13 then closes on its own), a negative one refused;
  *   - cutting the load into pieces (the same function) changes no result
- *     and costs a piece change few flight evaluations. */
+ *     and costs a piece change few flight evaluations;
+ *   - a critically damped oscillator is refused (nearly defective modes);
+ *     a modal configuration met again is taken from the cache;
+ *   - a modal flight starts on its constraints (a gap closed within the
+ *     tolerance projected away);
+ *   - a second wall on a held tree is locked, the other held contacts'
+ *     impulses still balance the loads. */
 #include <math.h>
 #include <string.h>
 
@@ -391,6 +397,185 @@ static void test_edr_piece_changes_cost_little(pd_test_ctx *ctx)
           evals[1], NP, (evals[1] - evals[0]) / (NP - 1));
 }
 
+/* ---- the modal cluster's paths ----------------------------------------------------- */
+
+/* A critically damped unit oscillator (C = 2 sqrt(K M), w0 = 1 and 1e3,
+ * no contact) has a defective S: its (rounded) eigenvectors are nearly
+ * parallel, the modal basis condition |V|_1 |V^-1|_1 far above 1e10, and
+ * the row reference refuses it (PD_ENUMERICAL, "nearly defective") rather
+ * than follow modes that would cancel. */
+static void test_edr_critical_damping_refused(pd_test_ctx *ctx)
+{
+    const double ws[2] = {1.0, 1e3};
+    for (int k = 0; k < 2; k++) {
+        double w = ws[k];
+        double one[1] = {1.0}, C[1] = {2.0 * w}, K[1] = {w * w}, b[1] = {0.0}, x0[1] = {1.0};
+        int cp[1] = {0};
+        pd_model md = {.n = 1,
+                       .m = 0,
+                       .M = pd_matrix_dense(1, 1, one),
+                       .C = pd_matrix_dense(1, 1, C),
+                       .K = pd_matrix_dense(1, 1, K),
+                       .W = pd_matrix_csc(1, 0, cp, NULL, NULL)};
+        pd_sine_piece pc = {.t_start = 0.0};
+        pd_piecewise_force F = {.b = b, .pieces = &pc, .npieces = 1};
+        pd_err err;
+        pd_edr *r = pd_edr_alloc(&md, &F, NULL, &err);
+        if (!CHECK(ctx, r != NULL, "%s", err.msg))
+            return;
+        int rc = pd_edr_run(r, 0.0, x0, NULL, 10.0 / w, NULL, NULL, &err);
+        CHECK(ctx, rc == PD_ENUMERICAL && strstr(err.msg, "defective") != NULL,
+              "w0 = %g: rc %d (%s)", w, rc, rc ? err.msg : "ran");
+        pd_edr_free(r);
+    }
+}
+
+/* An overdamped unit oscillator (xi = 1.25) driven by f = 3 sin t against
+ * a wall at x = -0.5 (e = 0.5): it hits the wall, rests on it and leaves it
+ * again and again, each flight the same configuration (the one block, no
+ * persistent contact): one modal basis, taken from the cache by every later
+ * flight (the key kept whole). */
+static void test_edr_modal_basis_cached(pd_test_ctx *ctx)
+{
+    double one[1] = {1.0}, C[1] = {2.5}, b[1] = {1.0}, g0[1] = {0.5}, e[1] = {0.5}, wv[1] = {1.0};
+    int cp[2] = {0, 1}, ri[1] = {0};
+    pd_model md = {.n = 1,
+                   .m = 1,
+                   .M = pd_matrix_dense(1, 1, one),
+                   .C = pd_matrix_dense(1, 1, C),
+                   .K = pd_matrix_dense(1, 1, one),
+                   .W = pd_matrix_csc(1, 1, cp, ri, wv),
+                   .g0 = g0,
+                   .e = e};
+    pd_sine_piece pc = {.t_start = 0.0, .A = 3.0, .w = 1.0};
+    pd_piecewise_force F = {.b = b, .pieces = &pc, .npieces = 1};
+    pd_err err;
+    pd_edr *r = pd_edr_alloc(&md, &F, NULL, &err);
+    if (!CHECK(ctx, r != NULL, "%s", err.msg))
+        return;
+    int rc = pd_edr_run(r, 0.0, NULL, NULL, 10.0 * PD_TWO_PI, NULL, NULL, &err);
+    const pd_edr_result *res = pd_edr_result_of(r);
+    if (CHECK(ctx, rc == PD_OK, "%s", err.msg))
+        CHECK(ctx, res->impacts >= 5 && res->modal_bases == 1,
+              "impacts %ld, detachments %ld, modal bases %ld (1)", res->impacts, res->detachments,
+              res->modal_bases);
+    pd_edr_free(r);
+}
+
+typedef struct gap_ctx {
+    double worst, x[2];
+    long samples;
+} gap_ctx;
+
+static int check_gap(const pd_state *s, void *vctx)
+{
+    gap_ctx *c = vctx;
+    c->worst = fmax(c->worst, fabs(s->g[0]));
+    c->x[0] = s->q[0];
+    c->x[1] = s->q[1];
+    c->samples++;
+    return 0;
+}
+
+/* Two damped free unit masses (c = 1, no spring: a modal cluster) at rest
+ * at x = (0, 5e-11), their contact g = x1 - x0 open by 5e-11 (under
+ * close_tol 1e-10), pressed together by b = (1, -1): the contact closes at
+ * the start within the tolerance, and the flight starts on it, the masses
+ * moved onto g = 0 by the M-orthogonal projection (each by 2.5e-11): at
+ * rest there, every sampled gap zero to 1e-15 and x = (2.5e-11, 2.5e-11)
+ * to 1e-20. */
+static void test_edr_modal_origin_projected(pd_test_ctx *ctx)
+{
+    double I2[4] = {1.0, 0.0, 0.0, 1.0}, b[2] = {1.0, -1.0}, g0[1] = {0.0}, e[1] = {0.0};
+    double q0[2] = {0.0, 5e-11};
+    double wv[2] = {-1.0, 1.0};
+    int cp[2] = {0, 2}, ri[2] = {0, 1};
+    pd_model md = {.n = 2,
+                   .m = 1,
+                   .M = pd_matrix_dense(2, 2, I2),
+                   .C = pd_matrix_dense(2, 2, I2),
+                   .K = pd_matrix_zero(2, 2),
+                   .W = pd_matrix_csc(2, 1, cp, ri, wv),
+                   .g0 = g0,
+                   .e = e};
+    pd_sine_piece pc = {.t_start = 0.0, .c0 = 1.0};
+    pd_piecewise_force F = {.b = b, .pieces = &pc, .npieces = 1};
+    pd_edr_opts eo = pd_edr_default_opts();
+    eo.h_out = 0.5;
+    pd_err err;
+    pd_edr *r = pd_edr_alloc(&md, &F, &eo, &err);
+    if (!CHECK(ctx, r != NULL, "%s", err.msg))
+        return;
+    gap_ctx gc = {0};
+    int rc = pd_edr_run(r, 0.0, q0, NULL, 5.0, check_gap, &gc, &err);
+    if (CHECK(ctx, rc == PD_OK, "%s", err.msg))
+        CHECK(ctx,
+              gc.samples == 11 && gc.worst <= 1e-15 && fabs(gc.x[0] - 2.5e-11) <= 1e-20 &&
+                  fabs(gc.x[1] - 2.5e-11) <= 1e-20,
+              "%ld samples, gaps up to %.3g, x = (%.17g, %.17g)", gc.samples, gc.worst, gc.x[0],
+              gc.x[1]);
+    pd_edr_free(r);
+}
+
+typedef struct squeeze_ctx {
+    double h, worst, x;
+    long samples;
+} squeeze_ctx;
+
+static int check_squeeze(const pd_state *s, void *vctx)
+{
+    squeeze_ctx *c = vctx;
+    c->x = fmax(c->x, fmax(fabs(s->q[0]), fabs(s->q[1])));
+    if (s->t > 0.0) { /* at rest: each body's impulses balance the load's, int f */
+        double load = c->h + 0.5 * (cos(s->t) - cos(s->t - c->h));
+        c->worst =
+            fmax(c->worst, fmax(fabs(s->P[0] - s->P[1] - load), fabs(s->P[2] - s->P[0] - load)));
+        c->samples++;
+    }
+    return 0;
+}
+
+/* Two unit oscillators in a row squeezed between two walls, all at x = 0
+ * and touching: contact 0 between them (g = x1 - x0), contact 1 the left
+ * wall at body 0 (g = x0), contact 2 the right wall at body 1 (g = -x1),
+ * both bodies pushed right by f = 1 - 0.5 sin t > 0.  The right wall and
+ * the bodies' contact press (forces 2 f and f); the left wall at zero force
+ * is held too (its free jerk f' < 0 at t = 0 closes it): a second wall on
+ * the tree, locked (between the list's other two).  Nothing moves, and over
+ * each sample h = 0.25 each body's impulses balance its load's:
+ * P0 - P1 = P2 - P0 = int f (to 1e-12). */
+static void test_edr_rows_squeezed_between_walls(pd_test_ctx *ctx)
+{
+    double I2[4] = {1.0, 0.0, 0.0, 1.0}, b[2] = {1.0, 1.0}, g0[3] = {0.0, 0.0, 0.0};
+    double e[3] = {0.5, 0.5, 0.5}, wv[4] = {-1.0, 1.0, 1.0, -1.0};
+    int cp[4] = {0, 2, 3, 4}, ri[4] = {0, 1, 0, 1};
+    pd_model md = {.n = 2,
+                   .m = 3,
+                   .M = pd_matrix_dense(2, 2, I2),
+                   .C = pd_matrix_zero(2, 2),
+                   .K = pd_matrix_dense(2, 2, I2),
+                   .W = pd_matrix_csc(2, 3, cp, ri, wv),
+                   .g0 = g0,
+                   .e = e};
+    pd_sine_piece pc = {.t_start = 0.0, .A = -0.5, .w = 1.0, .c0 = 1.0};
+    pd_piecewise_force F = {.b = b, .pieces = &pc, .npieces = 1};
+    pd_edr_opts eo = pd_edr_default_opts();
+    eo.h_out = 0.25;
+    pd_err err;
+    pd_edr *r = pd_edr_alloc(&md, &F, &eo, &err);
+    if (!CHECK(ctx, r != NULL, "%s", err.msg))
+        return;
+    squeeze_ctx sc = {.h = 0.25};
+    int rc = pd_edr_run(r, 0.0, NULL, NULL, 10.0, check_squeeze, &sc, &err);
+    const pd_edr_result *res = pd_edr_result_of(r);
+    if (CHECK(ctx, rc == PD_OK, "%s", err.msg))
+        CHECK(ctx, sc.x <= 1e-12 && sc.samples == 40 && sc.worst <= 1e-12,
+              "impacts %ld, events %ld, detachments %ld, |x| up to %.3g, %ld samples, impulses off "
+              "by %.3g",
+              res->impacts, res->events, res->detachments, sc.x, sc.samples, sc.worst);
+    pd_edr_free(r);
+}
+
 void suite_row_paths(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_edr_observer_steps_numbered);
@@ -400,4 +585,8 @@ void suite_row_paths(pd_test_ctx *ctx)
     PD_RUN(ctx, test_edr_single_contact_impacts_counted);
     PD_RUN(ctx, test_edr_close_tol_zero_taken);
     PD_RUN(ctx, test_edr_piece_changes_cost_little);
+    PD_RUN(ctx, test_edr_critical_damping_refused);
+    PD_RUN(ctx, test_edr_modal_basis_cached);
+    PD_RUN(ctx, test_edr_modal_origin_projected);
+    PD_RUN(ctx, test_edr_rows_squeezed_between_walls);
 }
