@@ -2744,6 +2744,12 @@ static int check_opts(const pd_edr_opts *o, pd_err *err)
                           (int)o->impact_law);
     if (!(o->h_out >= 0.0) || !isfinite(o->h_out) || !isfinite(o->t_measure))
         return pd_err_set(err, PD_EINVAL, "row reference: h_out and t_measure must be finite");
+    /* refused here whatever the contacts (the solvers are taken for m > 1 only) */
+    if (o->lcp_solver < PD_LCP_AUTO || o->lcp_solver > PD_LCP_PGS)
+        return pd_err_set(err, PD_EINVAL,
+                          "row reference: lcp_solver must be auto (0), lemke (1), structured (2) "
+                          "or pgs (3) (got %d)",
+                          (int)o->lcp_solver);
     return PD_OK;
 }
 

@@ -1,5 +1,8 @@
 /* test_row_rerun.c — the row reference's object run again after a run its
- * event callback stopped: the second run is whole. */
+ * event callback stopped (the second run is whole), and its options checked
+ * whatever the model. */
+#include <string.h>
+
 #include "pd_engine.h"
 #include "pd_test.h"
 
@@ -54,7 +57,33 @@ static void test_edr_rerun_after_stop(pd_test_ctx *ctx)
     pd_edr_free(r);
 }
 
+/* An unknown LCP solver is refused at the allocation, one contact or more
+ * (with one it used to pass: its LCPs are closed forms, no solver taken). */
+static void test_edr_unknown_solver_refused(pd_test_ctx *ctx)
+{
+    double one[1] = {1.0}, b[1] = {0.0}, g0[1] = {0.5}, e[1] = {1.0}, wv[1] = {-1.0};
+    int cp[2] = {0, 1}, ri[1] = {0};
+    pd_model md = {.n = 1,
+                   .m = 1,
+                   .M = pd_matrix_dense(1, 1, one),
+                   .C = pd_matrix_zero(1, 1),
+                   .K = pd_matrix_dense(1, 1, one),
+                   .W = pd_matrix_csc(1, 1, cp, ri, wv),
+                   .g0 = g0,
+                   .e = e};
+    pd_sine_piece pc = {.t_start = 0.0};
+    pd_piecewise_force F = {.b = b, .pieces = &pc, .npieces = 1};
+    pd_edr_opts eo = pd_edr_default_opts();
+    eo.lcp_solver = (pd_lcp_method)99;
+    pd_err err = {0};
+    pd_edr *r = pd_edr_alloc(&md, &F, &eo, &err);
+    CHECK(ctx, !r && err.status == PD_EINVAL && strstr(err.msg, "lcp_solver"),
+          "one contact, solver 99: %s", r ? "accepted" : err.msg);
+    pd_edr_free(r);
+}
+
 void suite_row_rerun(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_edr_rerun_after_stop);
+    PD_RUN(ctx, test_edr_unknown_solver_refused);
 }
