@@ -44,6 +44,7 @@ static void test_edr_rows_third_nonzero_refused(pd_test_ctx *ctx)
 
 /* the last observed state (the observer called at t0 and at t1) */
 typedef struct last_ctx {
+    int n; /* the model's dofs (at most 4) */
     int calls;
     double q[4], v[4];
 } last_ctx;
@@ -51,7 +52,7 @@ typedef struct last_ctx {
 static int keep_last(const pd_state *s, void *vctx)
 {
     last_ctx *c = vctx;
-    for (int i = 0; i < 4; i++) {
+    for (int i = 0; i < c->n; i++) {
         c->q[i] = s->q[i];
         c->v[i] = s->v[i];
     }
@@ -86,7 +87,7 @@ static void test_edr_rows_pushed_off_wall(pd_test_ctx *ctx)
     pd_edr *r = pd_edr_alloc(&md, &F, &eo, &err);
     if (!CHECK(ctx, r != NULL, "%s", err.msg))
         return;
-    last_ctx lc = {0};
+    last_ctx lc = {.n = md.n};
     int rc = pd_edr_run(r, 0.0, x0, v0, 1.0, keep_last, &lc, &err);
     if (CHECK(ctx, rc == PD_OK && lc.calls == 2, "%s (%d states)", err.msg, lc.calls))
         CHECK(ctx,
@@ -125,7 +126,7 @@ static void test_edr_rows_single_law_stops_separating(pd_test_ctx *ctx)
     pd_edr *r = pd_edr_alloc(&md, &F, &eo, &err);
     if (!CHECK(ctx, r != NULL, "%s", err.msg))
         return;
-    last_ctx lc = {0};
+    last_ctx lc = {.n = md.n};
     int rc = pd_edr_run(r, 0.0, x0, v0, 1.0, keep_last, &lc, &err);
     const pd_edr_result *res = pd_edr_result_of(r);
     if (CHECK(ctx, rc == PD_OK && lc.calls == 2, "%s (%d states)", err.msg, lc.calls))
@@ -197,7 +198,7 @@ static void test_edr_rows_lever_wall_closed_on_it(pd_test_ctx *ctx)
     pd_edr *r = pd_edr_alloc(&md, &F, &eo, &err);
     if (!CHECK(ctx, r != NULL, "%s", err.msg))
         return;
-    last_ctx lc = {0};
+    last_ctx lc = {.n = md.n};
     int rc = pd_edr_run(r, 0.0, x0, v0, 2.0, keep_last, &lc, &err);
     if (CHECK(ctx, rc == PD_OK && lc.calls == 2, "%s (%d states)", err.msg, lc.calls))
         CHECK(ctx,
