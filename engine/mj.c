@@ -308,55 +308,6 @@ static int check_state(const pd_model *md, const pd_state *st, pd_err *err)
     return PD_OK;
 }
 
-/* One step of the scalar kernel (n = 1, m <= 1): pd_mj1.h's, with the force
- * F1 = F(t_k+1 -). */
-static inline int step_scalar_f(pd_mj *mj, double F1, pd_err *err)
-{
-    const pd_model *md = mj->model;
-    pd_state *st = &mj->st;
-    double h = mj->opts.h;
-    double t1 = mj->t0 + (double)(st->step + 1) * h;
-    double g = st->g[0], P;
-    /* vfree, the prediction g + h gamma U <= 0, P = max(0, -b) / D and q_k+1: mj1_step */
-    int active = mj1_step(h, mj->opts.theta, h * mj->opts.gamma, &mj->s1, mj->F0[0], F1, &st->q[0],
-                          &st->v[0], &g, &P);
-    if (md->m) {
-        /* P, active and g exist only with the wall (m = 1) */
-        st->P[0] = P;
-        st->active[0] = (unsigned char)active;
-        st->g[0] = g;
-    }
-    st->nactive = active;
-    st->lcp_pivots = 0;
-    st->lcp_solver = active ? "closed-form" : NULL;
-    /* the next step starts from F(t_k+1 -), or from F(t_k+1 +) at a breakpoint (advance_force) */
-    mj->F0[0] = F1;
-    if (mj->next_break < md->nbreaks) {
-        mj->F1[0] = F1;
-        advance_force(mj, t1);
-    }
-    st->t = t1;
-    st->step++;
-    if (!isfinite(st->q[0]) || !isfinite(st->v[0]))
-        return check_state(md, st, err);
-    return PD_OK;
-}
-
-/* The force's left limit F(t_k+1 -) at the end of step k (0 without one). */
-static inline double scalar_force(const pd_mj *mj, long k)
-{
-    const pd_model *md = mj->model;
-    double F1 = 0.0;
-    if (md->force)
-        md->force(mj->t0 + (double)(k + 1) * mj->opts.h, -1, &F1, md->force_ctx);
-    return F1;
-}
-
-static int step_scalar(pd_mj *mj, pd_err *err)
-{
-    return step_scalar_f(mj, scalar_force(mj, mj->st.step), err);
-}
-
 /* run_scalar's hooks into pd_mj1.h's loop: the model's force, and the state
  * written back for the observer. */
 typedef struct scalar_run {
@@ -793,7 +744,7 @@ static int step_general(pd_mj *mj, pd_err *err)
 
 static int mj_step(pd_mj *mj, pd_err *err)
 {
-    return mj->scalar ? step_scalar(mj, err) : step_general(mj, err);
+    return mj->scalar ? run_scalar(mj, 1, NULL, NULL, err) : step_general(mj, err);
 }
 
 /* The adaptive driver chooses its own steps: the fixed-step calls refuse it. */
