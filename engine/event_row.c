@@ -760,6 +760,8 @@ static void group_add_cluster(pd_edr *r, int c)
 static void group_add_contact(pd_edr *r, int a)
 {
     r->ev.ct_mark[a] = r->ev.epoch;
+    /* no jumped tail yet: regroup reads one only where decide_persistence set it */
+    r->ev.held_tail[r->ev.ngc] = 0.0;
     r->ev.g_ct[r->ev.ngc++] = a;
 }
 
@@ -1154,7 +1156,8 @@ static int regroup(pd_edr *r, double t, pd_err *err)
     for (int j = 0; j < r->ev.ngc; j++) {
         int a = r->ev.g_ct[j];
         const edr_contact *ct = &r->tp.ct[a];
-        int was = r->rs.cstate[a] == EDR_PERSIST;
+        /* in contact before: persistent, or locked in a cycle of held contacts */
+        int was = r->rs.cstate[a] != EDR_OPEN;
         /* a persistent contact released: its time in contact since it was held */
         if (was && !r->ev.held[j])
             r->rs.ctime[a] += t - r->rs.since[a] > 0.0 ? t - r->rs.since[a] : 0.0;
@@ -2397,10 +2400,8 @@ static int on_piece(pd_edr *r, double t, pd_err *err)
                     r->rs.res.detachments++;
         } else
             /* every closed contact stays held: the clusters re-origin on the piece */
-            for (int j = 0; j < r->ev.ngc; j++) {
+            for (int j = 0; j < r->ev.ngc; j++)
                 r->ev.held[j] = r->rs.cstate[r->ev.g_ct[j]] != EDR_OPEN;
-                r->ev.held_tail[j] = 0.0;
-            }
         if ((rc = regroup(r, t, err)))
             return rc;
     }
@@ -3161,8 +3162,8 @@ static void finish(pd_edr *r, double t)
             measure_cluster(r, c, t);
     for (int a = 0; a < r->tp.m; a++) {
         measure_contact(r, a, t);
-        /* a contact held at the end: its time in contact up to t */
-        if (r->rs.cstate[a] == EDR_PERSIST && t > r->rs.since[a])
+        /* a contact held at the end (persistent or locked): its time in contact up to t */
+        if (r->rs.cstate[a] != EDR_OPEN && t > r->rs.since[a])
             r->rs.ctime[a] += t - r->rs.since[a];
         /* never measured (never open, or no time to measure): its gap at t */
         if (!(r->rs.gmin[a] < HUGE_VAL))

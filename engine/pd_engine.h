@@ -583,7 +583,7 @@ typedef struct pd_edr_result {
     const long *contact_impacts;
     const double *first;        /* NAN: none */
     const double *max_impulse;  /* largest impulse of one event */
-    const double *contact_time; /* time persistent */
+    const double *contact_time; /* time held (persistent, or locked in a cycle) */
     const double *min_gap;      /* smallest gap (0 once closed) */
     long law_decided;           /* impacts whose LCP could take several closed contacts, one
                               closing (separating ones included): where the staged and

@@ -543,7 +543,8 @@ static int check_squeeze(const pd_state *s, void *vctx)
  * is held too (its free jerk f' < 0 at t = 0 closes it): a second wall on
  * the tree, locked (between the list's other two).  Nothing moves, and over
  * each sample h = 0.25 each body's impulses balance its load's:
- * P0 - P1 = P2 - P0 = int f (to 1e-12). */
+ * P0 - P1 = P2 - P0 = int f (to 1e-12); each contact, the locked one too,
+ * is in contact for the whole run (contact time 10). */
 static void test_edr_rows_squeezed_between_walls(pd_test_ctx *ctx)
 {
     double I2[4] = {1.0, 0.0, 0.0, 1.0}, b[2] = {1.0, 1.0}, g0[3] = {0.0, 0.0, 0.0};
@@ -568,11 +569,16 @@ static void test_edr_rows_squeezed_between_walls(pd_test_ctx *ctx)
     squeeze_ctx sc = {.h = 0.25};
     int rc = pd_edr_run(r, 0.0, NULL, NULL, 10.0, check_squeeze, &sc, &err);
     const pd_edr_result *res = pd_edr_result_of(r);
-    if (CHECK(ctx, rc == PD_OK, "%s", err.msg))
+    if (CHECK(ctx, rc == PD_OK, "%s", err.msg)) {
         CHECK(ctx, sc.x <= 1e-12 && sc.samples == 40 && sc.worst <= 1e-12,
               "impacts %ld, events %ld, detachments %ld, |x| up to %.3g, %ld samples, impulses off "
               "by %.3g",
               res->impacts, res->events, res->detachments, sc.x, sc.samples, sc.worst);
+        /* every contact, the locked one too, is held over the whole run */
+        for (int a = 0; a < 3; a++)
+            CHECK(ctx, fabs(res->contact_time[a] - 10.0) <= 1e-12,
+                  "contact %d held %.17g of the run's 10", a, res->contact_time[a]);
+    }
     pd_edr_free(r);
 }
 
