@@ -15,6 +15,9 @@ const char pd_cli_case_help[] =
     "  --gap D  initial gap, m        or  --Pi3 X = gap wp^2/ap [0.05]\n"
     "  --eps E  restitution in [0,1] [0.5]    --xi Z   damping ratio in [0,1) [0.05]\n"
     "  --height H  the oscillator's storey height, m, for its drift ratio [3]\n"
+    "  --uy U  yield displacement, m  or  --Piy X = uy wp^2/ap [none: elastic]\n"
+    "  --alpha A  post-yield stiffness ratio in [0,1] [0] (a yielding oscillator runs by\n"
+    "           moreau; docs/methods.md, \"Yielding\")\n"
     "records (docs/records.md):\n"
     "  --record F    the ground acceleration of a record (PEER .AT2, COSMOS V2, or text\n"
     "                't a'): replaces the pulse; ap and Tp come from its fitted pulse\n"
@@ -155,6 +158,9 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
                        {"--scale", &a->scale, &a->have_scale, 0},
                        {"--close-tol", &a->opts.close_tol, NULL, 0},
                        {"--height", &a->height, &a->have_height, 1},
+                       {"--uy", &a->uy, &a->have_uy, 1},
+                       {"--Piy", &a->c.Piy, &a->have_Piy, 1},
+                       {"--alpha", &a->c.alpha, &a->have_alpha, 1},
                        {"--contact-duration", &a->opts.contact_duration, NULL, 0}};
     /* flags that only one method takes choose it, unless --method says another */
     static const struct {
@@ -384,6 +390,42 @@ int pd_cli_case_check_derived(const pd_cli_case *a)
     return 0;
 }
 
+/* The yielding spring's flags: ranges, and the runs that model it. */
+static int check_yield(const pd_cli_case *a)
+{
+    const char *yf = a->have_uy ? "--uy" : "--Piy";
+    if (a->have_uy && a->have_Piy)
+        return pd_cli_usage_error("--uy and --Piy are alternatives: give one");
+    if (a->have_uy && !(a->uy > 0.0 && isfinite(a->uy)))
+        return pd_cli_usage_error("--uy: the yield displacement must be > 0 m (got %.10g)", a->uy);
+    if (a->have_Piy && !(a->c.Piy > 0.0 && isfinite(a->c.Piy)))
+        return pd_cli_usage_error("--Piy: the dimensionless yield displacement must be > 0 "
+                                  "(got %.10g)",
+                                  a->c.Piy);
+    if (a->have_alpha && !(a->c.alpha >= 0.0 && a->c.alpha <= 1.0))
+        return pd_cli_usage_error("--alpha: the post-yield stiffness ratio must be in [0, 1] "
+                                  "(got %.10g)",
+                                  a->c.alpha);
+    if (!a->have_uy && !a->have_Piy)
+        return a->have_alpha ? pd_cli_usage_error("--alpha: needs the yield displacement "
+                                                  "(--uy or --Piy)")
+                             : 0;
+    if (a->chain)
+        return pd_cli_usage_error("%s: a --chain's SDOFs are elastic (a yielding row is not "
+                                  "built yet)",
+                                  yf);
+    if (a->opts.method != PD_METHOD_AUTO && a->opts.method != PD_METHOD_MOREAU)
+        return pd_cli_usage_error("%s: a yielding oscillator runs by --method moreau only (the "
+                                  "exact reference and the penalty methods do not model "
+                                  "yielding yet; got --method %s)",
+                                  yf, pd_method_name(a->opts.method));
+    if (a->opts.rtol > 0.0)
+        return pd_cli_usage_error("%s: a yielding oscillator runs at a fixed step (--dt), not "
+                                  "to a tolerance (--rtol)",
+                                  yf);
+    return 0;
+}
+
 /* The oscillator's ranges, each error naming the flag. */
 static int check_case(const pd_cli_case *a)
 {
@@ -410,6 +452,8 @@ static int check_case(const pd_cli_case *a)
         return pd_cli_usage_error("--eps: restitution must be in [0, 1] (got %.10g)", a->c.eps);
     if (!(a->c.xi >= 0.0 && a->c.xi < 1.0))
         return pd_cli_usage_error("--xi: damping ratio must be in [0, 1) (got %.10g)", a->c.xi);
+    if ((rc = check_yield(a)))
+        return rc;
     if (a->chain && !(a->chain_ratio > 0.0))
         return pd_cli_usage_error("--chain-ratio: must be > 0 (got %.10g)", a->chain_ratio);
     /* the shorter period sets the step, the longer the run: at most CASE_MAX_RATIO apart */
@@ -613,6 +657,8 @@ static int case_finish(pd_cli_case *a)
         pd_osc_set_T0(&a->c, a->T0);
     if (a->have_gap && a->c.ap > 0.0 && a->c.Tp > 0.0)
         pd_osc_set_gap(&a->c, a->gap);
+    if (a->have_uy && a->uy > 0.0 && a->c.ap > 0.0 && a->c.Tp > 0.0)
+        pd_osc_set_uy(&a->c, a->uy);
     if ((rc = check_case(a)))
         return rc;
     if (a->chain)

@@ -189,6 +189,8 @@ static void method_line(const pd_cli_case *k)
     const char *m = pd_method_name(k->opts.method);
     if (k->method_by)
         printf("  method    = %s (%s)\n", m, k->method_by);
+    else if (pd_osc_yields(&k->c))
+        printf("  method    = %s (the one method that models yielding so far)\n", m);
     else if (pd_cli_is_scene(k))
         printf("  method    = %s (the default for scenes; --method event|penalty|newmark for "
                "the others)\n",
@@ -259,6 +261,24 @@ static void print_json(const sim_args *a, const pd_osc_summary *s)
     pd_json_num(&js, "gamma_active", s->r.gamma);
     pd_json_num(&js, "tend", s->r.tend);
     pd_json_str(&js, "kernel", s->r.kernel);
+    if (pd_osc_yields(c)) { /* the yielding spring (SPEC §7) */
+        pd_json_num(&js, "uy", pd_osc_uy(c));
+        pd_json_num(&js, "Piy", c->Piy);
+        pd_json_num(&js, "alpha", c->alpha);
+        pd_json_num(&js, "ductility", s->r.ductility);
+        pd_json_num(&js, "residual", s->r.residual);
+        pd_json_int(&js, "n_yield", s->r.n_yield);
+        pd_json_num(&js, "plastic_excursion", s->r.plastic_excursion);
+        pd_json_num(&js, "hysteretic_energy", s->r.hysteretic_energy);
+        pd_json_num(&js, "ductility_free", s->free.ductility);
+        const pd_energy *en = &s->r.energy; /* the balance per unit mass [J/kg] */
+        pd_json_num(&js, "energy_input", en->input);
+        pd_json_num(&js, "energy_kinetic", en->kinetic);
+        pd_json_num(&js, "energy_strain", en->strain);
+        pd_json_num(&js, "energy_damping", en->damping);
+        pd_json_num(&js, "energy_impact", en->impact);
+        pd_json_num(&js, "energy_residual", en->residual);
+    }
     pd_json_end_object(&js);
     pd_json_finish(&js);
 }
@@ -315,6 +335,17 @@ static void print_text(const sim_args *a, const pd_osc_summary *s)
                s->r.impacts, s->r.first_impact, s->r.first_impact_velocity, s->r.contact_time);
     else
         printf("  impacts   = 0 (the oscillator never reaches the wall)\n");
+    if (pd_osc_yields(c))
+        printf("  yielding  = uy %.6g m (Piy = %.6g), alpha %g: ductility %.5g (no wall %.5g), "
+               "residual %.5g m, %ld yield onsets, plastic excursion %.5g m, hysteretic "
+               "energy %.5g J/kg\n",
+               pd_osc_uy(c), c->Piy, c->alpha, s->r.ductility, s->free.ductility, s->r.residual,
+               s->r.n_yield, s->r.plastic_excursion, s->r.hysteretic_energy);
+    if (pd_osc_yields(c))
+        printf("  energy    = input %.6g J/kg = kinetic %.4g + strain %.4g + damping %.4g + "
+               "hysteretic %.4g + impacts %.4g, residual %.2g of the input\n",
+               s->r.energy.input, s->r.energy.kinetic, s->r.energy.strain, s->r.energy.damping,
+               s->r.energy.hysteretic, s->r.energy.impact, s->r.energy.residual);
     printf("  demands   = drift ratio %.5g (height %g m), a_abs %.6g m/s^2, base shear per "
            "unit mass %.6g N/kg\n",
            s->r.umax / a->k.height, a->k.height, s->r.acc_max, s->r.shear_max);
@@ -343,50 +374,71 @@ static int finish_output(const sim_args *a, const pd_osc_summary *s, pd_table_wr
     {                                                                                              \
         .name = n, .is_text = 1, .text = (x)                                                       \
     }
-    pd_attr attrs[] = {TXT("method", pd_method_name(a->k.opts.method)),
-                       TXT("pulse", pd_osc_excitation_name(c)),
-                       TXT("dir", pd_dir_name(c->dir)),
-                       NUM("scale", "1", c->record ? c->scale : 1.0),
-                       NUM("ap", "m/s^2", c->ap),
-                       NUM("Tp", "s", c->Tp),
-                       NUM("T0", "s", pd_osc_T0(c)),
-                       NUM("gap", "m", pd_osc_gap(c)),
-                       NUM("eps", "1", c->eps),
-                       NUM("xi", "1", c->xi),
-                       NUM("Pi2", "1", c->Pi2),
-                       NUM("Pi3", "1", c->Pi3),
-                       NUM("dt", "s", s->r.dt),
-                       NUM("theta", "1", s->r.theta),
-                       NUM("tend", "s", s->r.tend),
-                       NUM("every", "1", (double)a->every),
-                       NUM("umax", "m", s->r.umax),
-                       NUM("Pi1", "1", s->Pi1),
-                       NUM("u_toward", "m", s->r.u_toward),
-                       NUM("u_away", "m", s->r.u_away),
-                       NUM("impacts", "1", (double)s->r.impacts),
-                       NUM("first_impact", "s", s->r.first_impact),
-                       NUM("max_impulse", "m/s", s->r.max_impulse),
-                       NUM("contact_time", "s", s->r.contact_time),
-                       NUM("height", "m", a->k.height),
-                       NUM("drift_ratio", "1", s->r.umax / a->k.height),
-                       NUM("acc_max", "m/s^2", s->r.acc_max),
-                       NUM("shear_max", "N/kg", s->r.shear_max),
-                       NUM("force_equiv", "N/kg", s->r.force_equiv),
-                       NUM("force_max", "N/kg", s->r.force_max),
-                       NUM("contact_duration", "s", s->r.contact_duration),
-                       NUM("umax_free", "m", s->free.umax),
-                       NUM("gamma", "1", s->gamma),
-                       NUM("steps", "1", (double)s->r.steps),
-                       NUM("cpu_s", "s", s->cpu_s),
-                       NUM("rtol", "1", s->r.rtol),
-                       NUM("err_est", "1", s->err_est),
-                       NUM("rtol_met", "1", s->rtol_met),
-                       NUM("steps_rejected", "1", (double)s->r.steps_rejected),
-                       NUM("dt_min", "s", s->r.dt_min),
-                       NUM("dt_max", "s", s->r.dt_max)};
+    pd_attr attrs[64] = {TXT("method", pd_method_name(a->k.opts.method)),
+                         TXT("pulse", pd_osc_excitation_name(c)),
+                         TXT("dir", pd_dir_name(c->dir)),
+                         NUM("scale", "1", c->record ? c->scale : 1.0),
+                         NUM("ap", "m/s^2", c->ap),
+                         NUM("Tp", "s", c->Tp),
+                         NUM("T0", "s", pd_osc_T0(c)),
+                         NUM("gap", "m", pd_osc_gap(c)),
+                         NUM("eps", "1", c->eps),
+                         NUM("xi", "1", c->xi),
+                         NUM("Pi2", "1", c->Pi2),
+                         NUM("Pi3", "1", c->Pi3),
+                         NUM("dt", "s", s->r.dt),
+                         NUM("theta", "1", s->r.theta),
+                         NUM("tend", "s", s->r.tend),
+                         NUM("every", "1", (double)a->every),
+                         NUM("umax", "m", s->r.umax),
+                         NUM("Pi1", "1", s->Pi1),
+                         NUM("u_toward", "m", s->r.u_toward),
+                         NUM("u_away", "m", s->r.u_away),
+                         NUM("impacts", "1", (double)s->r.impacts),
+                         NUM("first_impact", "s", s->r.first_impact),
+                         NUM("max_impulse", "m/s", s->r.max_impulse),
+                         NUM("contact_time", "s", s->r.contact_time),
+                         NUM("height", "m", a->k.height),
+                         NUM("drift_ratio", "1", s->r.umax / a->k.height),
+                         NUM("acc_max", "m/s^2", s->r.acc_max),
+                         NUM("shear_max", "N/kg", s->r.shear_max),
+                         NUM("force_equiv", "N/kg", s->r.force_equiv),
+                         NUM("force_max", "N/kg", s->r.force_max),
+                         NUM("contact_duration", "s", s->r.contact_duration),
+                         NUM("umax_free", "m", s->free.umax),
+                         NUM("gamma", "1", s->gamma),
+                         NUM("steps", "1", (double)s->r.steps),
+                         NUM("cpu_s", "s", s->cpu_s),
+                         NUM("rtol", "1", s->r.rtol),
+                         NUM("err_est", "1", s->err_est),
+                         NUM("rtol_met", "1", s->rtol_met),
+                         NUM("steps_rejected", "1", (double)s->r.steps_rejected),
+                         NUM("dt_min", "s", s->r.dt_min),
+                         NUM("dt_max", "s", s->r.dt_max)};
+    int n = 0;
+    while (attrs[n].name)
+        n++;
+    if (pd_osc_yields(c)) { /* the yielding spring's inputs and figures */
+        pd_attr ya[] = {NUM("uy", "m", pd_osc_uy(c)),
+                        NUM("Piy", "1", c->Piy),
+                        NUM("alpha", "1", c->alpha),
+                        NUM("ductility", "1", s->r.ductility),
+                        NUM("residual", "m", s->r.residual),
+                        NUM("n_yield", "1", (double)s->r.n_yield),
+                        NUM("plastic_excursion", "m", s->r.plastic_excursion),
+                        NUM("hysteretic_energy", "J/kg", s->r.hysteretic_energy),
+                        NUM("energy_input", "J/kg", s->r.energy.input),
+                        NUM("energy_kinetic", "J/kg", s->r.energy.kinetic),
+                        NUM("energy_strain", "J/kg", s->r.energy.strain),
+                        NUM("energy_damping", "J/kg", s->r.energy.damping),
+                        NUM("energy_impact", "J/kg", s->r.energy.impact),
+                        NUM("energy_residual", "1", s->r.energy.residual)};
+        for (size_t i = 0; i < sizeof ya / sizeof ya[0]; i++)
+            attrs[n++] = ya[i];
+    }
 #undef NUM
 #undef TXT
-    return pd_table_finish(w, (int)(sizeof attrs / sizeof attrs[0]), attrs, err);
+    return pd_table_finish(w, n, attrs, err);
 }
 
 /* The oscillator as a one-structure scene, for the chart. */

@@ -33,6 +33,8 @@ typedef struct pd_cli_case {
     double height;  /* --height: the oscillator's storey height [m] (drift ratio) */
     int have_height;
     int have_T0, have_Pi2, have_gap, have_Pi3, have_dt, have_tend, have_kc;
+    double uy;                         /* --uy: the yield displacement [m] when given */
+    int have_uy, have_Piy, have_alpha; /* --uy, --Piy, --alpha given */
     double rtol; /* --rtol: Moreau-Jean's tolerance, or the penalty integrator's */
     int have_rtol;
     const char *model_flag;  /* the first model flag given (refused with --scene) */

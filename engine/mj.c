@@ -368,10 +368,10 @@ static int run_scalar(pd_mj *mj, long nsteps, pd_observer observer, void *ctx, p
                    .active = st->nactive};
     double h = mj->opts.h, th = mj->opts.theta, gamma = mj->opts.gamma;
     /* two calls: without an observer the inlined loop drops its call */
-    int rc = observer ? mj1_run(&mj->s1, h, th, gamma, mj->t0, md->breaks, md->nbreaks, nsteps, &x,
-                                scalar_force_at, scalar_observe, &r, err)
-                      : mj1_run(&mj->s1, h, th, gamma, mj->t0, md->breaks, md->nbreaks, nsteps, &x,
-                                scalar_force_at, NULL, &r, err);
+    int rc = observer ? mj1_run(&mj->s1, NULL, h, th, gamma, mj->t0, md->breaks, md->nbreaks,
+                                nsteps, &x, scalar_force_at, scalar_observe, &r, err)
+                      : mj1_run(&mj->s1, NULL, h, th, gamma, mj->t0, md->breaks, md->nbreaks,
+                                nsteps, &x, scalar_force_at, NULL, &r, err);
     /* the state back into mj->st once, after the last step */
     scalar_store(mj, &x, mj->t0 + (double)x.step * h);
     mj->F0[0] = x.F0;

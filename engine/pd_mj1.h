@@ -81,6 +81,88 @@ static inline int mj1_step(double h, double th, double hgamma, const mj1_coef *s
     return active;
 }
 
+/* ---- a yielding spring: the slider beside the contact ----------------- *
+ * The spring K [alpha q + (1 - alpha) z], |z| <= uy (docs/methods.md,
+ * "Yielding"), with up = q - z the plastic offset and Gamma its increment
+ * over the step (0 <= Gamma _|_ uy - z+ >= 0, and the mirror at -uy): the
+ * step's spring force is K q_theta - kbar (up + theta Gamma), kbar =
+ * (1 - alpha) K, so that
+ *   v+ = vfree + (h kbar / What) up + a Gamma + W^ P,   a = h theta kbar / What
+ *   z+ = ztrial - s Gamma + h theta W^ P,               s = 1 - h theta a > 0
+ * with ztrial the step's z+ at Gamma = P = 0.  The LCP in (P, Gamma) has the
+ * matrix [D, W a; -h theta W^, s], a P-matrix (positive diagonal, positive
+ * determinant): one answer.  The elastic step's (Gamma = 0) is it when its
+ * |z+| <= uy; else Gamma has the sign sigma of the side passed, z+ = sigma
+ * uy, and the contact's scalar LCP with Gamma eliminated is
+ *   b' = b + W a (ztrial - sigma uy) / s,   D' = D + h theta a W W^ / s. */
+typedef struct mj1_yield {
+    double uy;     /* the yield displacement > 0 */
+    double hkw;    /* h kbar / What: v's response to the offset */
+    double a;      /* h theta kbar / What: v's response to Gamma */
+    double sinv;   /* 1 / s */
+    double hthw;   /* h theta W / What: z's response to P */
+    double delinv; /* 1 / D', 0 without a wall */
+} mj1_yield;
+
+/* The slider's constants for the system s (stiffness K) stepped by h, theta. */
+static inline mj1_yield mj1_yield_make(const mj1_coef *s, double K, double alpha, double uy,
+                                       double h, double th)
+{
+    double kbar = (1.0 - alpha) * K;
+    mj1_yield y = {.uy = uy,
+                   .hkw = h * kbar * s->whatinv,
+                   .a = h * th * kbar * s->whatinv,
+                   .hthw = h * th * s->winv};
+    y.sinv = 1.0 / (1.0 - h * th * y.a);
+    double del = s->w * s->winv + y.a * y.hthw * s->w * y.sinv; /* D' */
+    y.delinv = del != 0.0 ? 1.0 / del : 0.0;
+    return y;
+}
+
+/* mj1_step with the slider: also up (the plastic offset) moves, and *G
+ * gets the step's Gamma.  While nothing yields (up = 0, Gamma = 0) its
+ * numbers are mj1_step's, bit for bit. */
+static inline int mj1y_step(double h, double th, double hgamma, const mj1_coef *s,
+                            const mj1_yield *y, double F0, double F1, double *q, double *v,
+                            double *g, double *P, double *up, double *G)
+{
+    double q0 = *q, v0 = *v, imp = 0.0, gam = 0.0;
+    double Fth = mj1_fth(th, F0, F1);
+    double rhs = h * (Fth - s->c * v0 - s->k * (q0 + h * th * v0));
+    double vfree = v0 + rhs * s->whatinv;
+    if (*up != 0.0) /* the offset's force kbar up */
+        vfree += y->hkw * *up;
+    double U0 = s->w * v0, b = 0.0;
+    int active = s->wall && *g + hgamma * U0 <= 0.0;
+    double vnew = vfree;
+    if (active) { /* the elastic step's contact */
+        b = s->w * vfree + s->e * U0;
+        imp = b < 0.0 ? -b * s->delinv : 0.0;
+        vnew += s->winv * imp;
+    }
+    double qnew = q0 + h * (th * vnew + (1.0 - th) * v0);
+    double z = qnew - *up;
+    if (!(fabs(z) <= y->uy)) {
+        /* it yields toward sigma: Gamma from z+ = sigma uy, P from (b', D') */
+        double sig = z > 0.0 ? 1.0 : -1.0;
+        double ztr = q0 + h * (th * vfree + (1.0 - th) * v0) - *up;
+        if (active) {
+            double bb = b + s->w * y->a * (ztr - sig * y->uy) * y->sinv;
+            imp = bb < 0.0 ? -bb * y->delinv : 0.0;
+        }
+        gam = (ztr + y->hthw * imp - sig * y->uy) * y->sinv;
+        vnew = vfree + y->a * gam + s->winv * imp;
+        qnew = q0 + h * (th * vnew + (1.0 - th) * v0);
+    }
+    *q = qnew;
+    *v = vnew;
+    *g = s->g0 + s->w * qnew;
+    *P = imp;
+    *up += gam;
+    *G = gam;
+    return active;
+}
+
 /* ---- the constants of a vector of systems -------------------------- *
  * The batch (engine/mj_batch.c) keeps its systems' constants in groups of
  * MJ1_WIDTH lanes; its step (mj_batch_lanes.h) computes, lane by lane,
@@ -141,7 +223,8 @@ static inline int mj_break_at(const double *breaks, int nbreaks, int *next, doub
 }
 
 /* ---- the scalar kernel's loop ------------------------------------------ *
- * nsteps steps of mj1_step from the state x at step x->step (its time t0 +
+ * nsteps steps of mj1_step (mj1y_step with the slider yl, when not NULL)
+ * from the state x at step x->step (its time t0 +
  * step h): the force's left limits F(t_k+1 -) asked MJ1_FORCE_AHEAD steps
  * ahead (the same values at the same instants, so that the excitation's
  * evaluation runs beside the step's chain of latencies instead of in it),
@@ -160,6 +243,7 @@ typedef struct mj1_state {
     long step;      /* steps taken */
     int next_break; /* the first force breakpoint not passed */
     int active;     /* the last step's contact was active */
+    double up, G;   /* a yielding spring's plastic offset, and its last step's increment */
 } mj1_state;
 
 /* F(t) from the left (side -1) or the right (+1). */
@@ -168,9 +252,9 @@ typedef double (*mj1_force_fn)(void *ctx, double t, int side);
 typedef int (*mj1_observe_fn)(void *ctx, const mj1_state *x, double t);
 
 static inline __attribute__((always_inline)) int
-mj1_run(const mj1_coef *s, double h, double th, double gamma, double t0, const double *breaks,
-        int nbreaks, long nsteps, mj1_state *x, mj1_force_fn force, mj1_observe_fn observe,
-        void *ctx, pd_err *err)
+mj1_run(const mj1_coef *s, const mj1_yield *yl, double h, double th, double gamma, double t0,
+        const double *breaks, int nbreaks, long nsteps, mj1_state *x, mj1_force_fn force,
+        mj1_observe_fn observe, void *ctx, pd_err *err)
 {
     const double hgamma = h * gamma, tol = 1e-9 * h; /* tol: a breakpoint this near t1 is on it */
     const long k0 = x->step;
@@ -185,7 +269,11 @@ mj1_run(const mj1_coef *s, double h, double th, double gamma, double t0, const d
         if (k + MJ1_FORCE_AHEAD < nsteps)
             F[k & (MJ1_FORCE_AHEAD - 1)] =
                 force(ctx, t0 + (double)(k0 + k + MJ1_FORCE_AHEAD + 1) * h, -1);
-        y.active = mj1_step(h, th, hgamma, s, y.F0, y.F1, &y.q, &y.v, &y.g, &y.P);
+        if (yl) /* a constant where the loop is inlined: one of the two steps is compiled */
+            y.active =
+                mj1y_step(h, th, hgamma, s, yl, y.F0, y.F1, &y.q, &y.v, &y.g, &y.P, &y.up, &y.G);
+        else
+            y.active = mj1_step(h, th, hgamma, s, y.F0, y.F1, &y.q, &y.v, &y.g, &y.P);
         y.step++;
         /* the next step starts from F(t1 +): F1, or the right limit at a breakpoint */
         y.F0 = y.F1;

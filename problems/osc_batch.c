@@ -298,7 +298,8 @@ int pd_osc_batchable(const pd_osc *c, const pd_run_opts *o)
 {
     if (!c || !o)
         return 0;
-    return o->method == PD_METHOD_MOREAU && o->kernel == PD_KERNEL_AUTO && !o->on_lcp;
+    return o->method == PD_METHOD_MOREAU && o->kernel == PD_KERNEL_AUTO && !o->on_lcp &&
+           !pd_osc_yields(c);
 }
 
 /* The steps for this processor (osc_batch_lanes.h, as for the engine's

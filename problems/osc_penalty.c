@@ -301,6 +301,7 @@ static void fill_result(const pen_track *tr, const pd_run_opts *o, const pd_pena
     res->gamma = NAN;
     res->kernel = pr->stepper ? pr->stepper : "penalty";
     pd_osc_result_no_rtol(res, NAN);
+    pd_osc_result_no_yield(res);
     pd_demand_osc_finish(res, o, tr->no_demands ? NAN : tr->dem.peak * tr->c->ap,
                          tr->no_demands ? NAN : tr->dem.shear * tr->c->ap,
                          tr->m ? tr->fpeak * tr->c->ap : NAN);
@@ -315,7 +316,8 @@ int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler samp
     if (!c || !res)
         return PD_NULL_ARG(err, !c ? "c" : "res");
     pd_err_clear(err);
-    if ((rc = pd_osc_resolve_opts(c, opts, &o, err)))
+    if ((rc = pd_osc_resolve_opts(c, opts, &o, err)) ||
+        (rc = pd_osc_refuse_yield(c, "the penalty method", err)))
         return rc;
 
     /* the scene in Pi units; outputs on the grid tau_k = k 2 pi dt / Tp */

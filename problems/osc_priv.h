@@ -37,6 +37,32 @@ static inline void pd_osc_result_no_rtol(pd_osc_result *res, double step)
     res->dt_min = res->dt_max = step;
 }
 
+/* The yielding fields of an elastic run: NAN, no onsets. */
+static inline void pd_osc_result_no_yield(pd_osc_result *res)
+{
+    res->ductility = res->residual = res->plastic_excursion = res->hysteretic_energy = NAN;
+    res->n_yield = 0;
+    res->energy = (pd_energy){.input = NAN,
+                              .kinetic = NAN,
+                              .strain = NAN,
+                              .damping = NAN,
+                              .hysteretic = NAN,
+                              .impact = NAN,
+                              .residual = NAN};
+}
+
+/* PD_EINVAL for a yielding oscillator in a run that does not model
+ * yielding (what: its name), else PD_OK. */
+static inline int pd_osc_refuse_yield(const pd_osc *c, const char *what, pd_err *err)
+{
+    if (!pd_osc_yields(c))
+        return PD_OK;
+    return pd_err_set(err, PD_EINVAL,
+                      "%s does not model yielding yet (uy, alpha < 1): a yielding oscillator "
+                      "runs by Moreau-Jean (method moreau)",
+                      what);
+}
+
 /* F = s phi(tau) (or the record's): the oscillator model's force callback. */
 static inline void pd_osc_model_force(double tau, int side, double *F, void *ctx)
 {

@@ -24,7 +24,9 @@ pd_osc pd_osc_default(void)
                     .Pi2 = 1.0,
                     .Pi3 = 0.05,
                     .eps = 0.5,
-                    .xi = 0.05};
+                    .xi = 0.05,
+                    .Piy = 0.0,
+                    .alpha = 0.0};
 }
 
 double pd_osc_wp(const pd_osc *c)
@@ -54,6 +56,24 @@ void pd_osc_set_gap(pd_osc *c, double gap)
 {
     if (c)
         c->Pi3 = gap / pd_osc_Le(c);
+}
+
+void pd_osc_set_uy(pd_osc *c, double uy)
+{
+    if (c)
+        c->Piy = uy / pd_osc_Le(c);
+}
+
+double pd_osc_uy(const pd_osc *c)
+{
+    if (!c)
+        return NAN;
+    return c->Piy > 0.0 ? c->Piy * pd_osc_Le(c) : INFINITY;
+}
+
+int pd_osc_yields(const pd_osc *c)
+{
+    return c && c->Piy > 0.0 && isfinite(c->Piy) && c->alpha < 1.0;
 }
 
 double pd_osc_excitation(const pd_osc *c, double t)
@@ -163,6 +183,14 @@ int pd_osc_check(const pd_osc *c, pd_err *err)
         return pd_err_set(err, PD_EINVAL, "eps (restitution) must be in [0, 1] (got %g)", c->eps);
     if (!in_range(c->xi, 0.0, 1.0, 1))
         return pd_err_set(err, PD_EINVAL, "xi (damping ratio) must be in [0, 1) (got %g)", c->xi);
+    if (!(c->Piy >= 0.0))
+        return pd_err_set(err, PD_EINVAL,
+                          "uy (yield displacement) must be > 0 (Piy = %g; 0 or INFINITY: elastic)",
+                          c->Piy);
+    if (!in_range(c->alpha, 0.0, 1.0, 0))
+        return pd_err_set(err, PD_EINVAL,
+                          "alpha (post-yield stiffness ratio) must be in [0, 1] (got %g)",
+                          c->alpha);
     return PD_OK;
 }
 
@@ -178,6 +206,13 @@ int pd_osc_resolve_opts(const pd_osc *c, const pd_run_opts *in, pd_run_opts *out
         return pd_err_set(err, PD_EINVAL,
                           "method: event-general is the general reference for "
                           "scenes; the oscillator's exact reference is event");
+    if (pd_osc_yields(c) &&
+        (out->rtol > 0.0 || (out->method != PD_METHOD_AUTO && out->method != PD_METHOD_MOREAU)))
+        return pd_err_set(err, PD_EINVAL,
+                          "a yielding oscillator (uy, alpha < 1) runs by Moreau-Jean at a "
+                          "fixed step only (method %s%s): the exact reference, the penalty "
+                          "methods and the tolerance do not model yielding yet",
+                          pd_method_name(out->method), out->rtol > 0.0 ? " with rtol" : "");
     if (out->dt == 0.0 && out->rtol == 0.0)
         out->dt = pd_osc_default_dt(c);
     if (out->tend == 0.0)
@@ -206,7 +241,7 @@ pd_method pd_osc_method(const pd_osc *c, const pd_run_opts *o)
         return PD_METHOD_AUTO; /* nothing to resolve */
     if (o->method != PD_METHOD_AUTO)
         return o->method;
-    if (o->rtol > 0.0) /* a tolerance is Moreau-Jean's */
+    if (o->rtol > 0.0 || pd_osc_yields(c)) /* a tolerance, a yielding spring: Moreau-Jean's */
         return PD_METHOD_MOREAU;
     double tend = o->tend > 0.0 ? o->tend : pd_osc_default_tend(c);
     return pd_osc_scan_points(c, tend) <= PD_OSC_MAX_SCAN ? PD_METHOD_EVENT : PD_METHOD_MOREAU;
@@ -334,6 +369,7 @@ void pd_osc_track_result(const pd_osc_track *tr, const pd_osc *c, double dt, lon
     res->steps = steps;
     res->dt = dt;
     pd_osc_result_no_rtol(res, dt);
+    pd_osc_result_no_yield(res);
     /* demands: not measured here (the single runs measure and set them) */
     res->acc_max = res->shear_max = res->force_max = res->force_equiv = res->contact_duration = NAN;
 }
@@ -395,18 +431,77 @@ static inline int scalar_osc_observe(void *ctx, const mj1_state *x, double tau)
     return 0;
 }
 
+/* A yielding run's measures (Pi units), the slider's constants and the
+ * sampler its observer feeds. */
+typedef struct osc_yield {
+    scalar_osc so;    /* the elastic run's measurements */
+    double soft;      /* 1 - alpha: the spring's force is K (q - soft up) */
+    double th, C;     /* theta; the damping */
+    double kbar;      /* (1 - alpha) K */
+    double Gprev;     /* the previous step's plastic increment */
+    long n_yield;     /* onsets: a step that slides after one that did not */
+    double excursion; /* sum |Gamma| */
+    double q, v, up;  /* the state at the step's start */
+    double F0;        /* the step's force at its start */
+    /* the balance's sums over the steps, with v_th = th v+ + (1 - th) v and
+     * z_th = z + th (z+ - z): the input h v_th F_th, the damping h C v_th^2,
+     * the slider's work kbar z_th Gamma, the impacts' losses -v_th W P */
+    double input, damping, work, impact;
+    tracker *sm; /* the sampler's bridge (sampler NULL: none) */
+} osc_yield;
+
+/* After a yielding step: the tracks (u itself), the demands of the
+ * spring's force K (q - (1 - alpha) up), the slider's tallies, the step's
+ * energies, the sample. */
+static inline int scalar_osc_observe_yield(void *ctx, const mj1_state *x, double tau)
+{
+    osc_yield *oy = ctx;
+    scalar_osc *so = &oy->so;
+    double qs = x->q - oy->soft * x->up; /* an elastic spring's q for the same force */
+    pd_osc_track_step(so->tr, x->step, tau, x->q, x->v, x->P);
+    if (so->dem)
+        pd_demand_osc_note_state(
+            so->dem, tau, qs, x->v,
+            pd_demand_osc_held(so->dem, so->h, x->P, so->Pprev, x->v, so->vprev, qs, x->F1));
+    so->Pprev = x->P;
+    so->vprev = x->v;
+    if (x->G != 0.0) {
+        oy->n_yield += oy->Gprev == 0.0;
+        oy->excursion += fabs(x->G);
+    }
+    oy->Gprev = x->G;
+    /* the energies of the step as it was taken (W = -1: -v_th W P = v_th P) */
+    double vth = oy->th * x->v + (1.0 - oy->th) * oy->v, z0 = oy->q - oy->up, z1 = x->q - x->up;
+    oy->input += so->h * vth * mj1_fth(oy->th, oy->F0, x->F1);
+    oy->damping += so->h * oy->C * vth * vth;
+    oy->work += oy->kbar * (z0 + oy->th * (z1 - z0)) * x->G;
+    oy->impact += vth * x->P;
+    oy->q = x->q;
+    oy->v = x->v;
+    oy->up = x->up;
+    oy->F0 = x->F0;
+    tracker *sm = oy->sm;
+    if (sm && sm->sampler) {
+        pd_osc_sample smp = pd_osc_track_sample(so->tr, &sm->sampled, x->step, tau, x->q, x->v,
+                                                x->P, sm->wp, sm->Le, sm->vscale);
+        return sm->sampler(&smp, sm->sampler_ctx);
+    }
+    return 0;
+}
+
 /* pd_mj_run's scalar kernel on the oscillator with the measurements
  * inline: the engine's loop (pd_mj1.h's mj1_run, the same step, forces,
  * breakpoints and failure as pd_mj's) with the tracks as its observer,
  * called directly, so that the state stays in registers.  Its steps taken
- * go to *steps. */
+ * go to *steps, its last state to *end.  oy (NULL: elastic): the yielding
+ * spring's run, its tallies and samples. */
 static int simulate_scalar(const pd_osc *c, const pd_model *md, const pd_mj_opts *mo, long nsteps,
-                           pd_osc_track *tr, pd_demand_osc *dem, long *steps, pd_err *err)
+                           pd_osc_track *tr, pd_demand_osc *dem, osc_yield *oy, mj1_state *end,
+                           pd_err *err)
 {
-    const double h = mo->h, t0 = 0.0;
-    mj1_coef s1 = mj1_coef_make(1.0, pd_matrix_get(&md->C, 0, 0), pd_matrix_get(&md->K, 0, 0),
-                                md->m > 0, md->m ? -1.0 : 0.0, md->m ? md->g0[0] : 0.0,
-                                md->m ? md->e[0] : 0.0, h, mo->theta);
+    const double h = mo->h, t0 = 0.0, K = pd_matrix_get(&md->K, 0, 0);
+    mj1_coef s1 = mj1_coef_make(1.0, pd_matrix_get(&md->C, 0, 0), K, md->m > 0, md->m ? -1.0 : 0.0,
+                                md->m ? md->g0[0] : 0.0, md->m ? md->e[0] : 0.0, h, mo->theta);
     scalar_osc so = {.c = c, .tr = tr, .dem = dem, .h = h};
     mj1_state x = {.g = s1.g0, .F0 = osc_force(c, t0, +1)};
     while (x.next_break < md->nbreaks && md->breaks[x.next_break] < t0 - 1e-9 * h)
@@ -414,10 +509,54 @@ static int simulate_scalar(const pd_osc *c, const pd_model *md, const pd_mj_opts
     pd_osc_track_step(tr, 0, t0, x.q, x.v, x.P);
     if (dem)
         pd_demand_osc_note_state(dem, t0, x.q, x.v, 0.0);
-    int rc = mj1_run(&s1, h, mo->theta, mo->gamma, t0, md->breaks, md->nbreaks, nsteps, &x,
+    int rc = PD_OK;
+    if (!oy)
+        rc = mj1_run(&s1, NULL, h, mo->theta, mo->gamma, t0, md->breaks, md->nbreaks, nsteps, &x,
                      scalar_osc_force, scalar_osc_observe, &so, err);
-    *steps = x.step;
+    else {
+        mj1_yield yl = mj1_yield_make(&s1, K, c->alpha, c->Piy, h, mo->theta);
+        oy->so = so;
+        oy->soft = 1.0 - c->alpha;
+        oy->th = mo->theta;
+        oy->C = pd_matrix_get(&md->C, 0, 0);
+        oy->kbar = (1.0 - c->alpha) * K;
+        oy->F0 = x.F0;
+        tracker *sm = oy->sm;
+        if (sm && sm->sampler) { /* the sample at t0 */
+            pd_osc_sample smp = pd_osc_track_sample(tr, &sm->sampled, 0, t0, x.q, x.v, x.P, sm->wp,
+                                                    sm->Le, sm->vscale);
+            if (sm->sampler(&smp, sm->sampler_ctx) > 0)
+                nsteps = 0;
+        }
+        rc = mj1_run(&s1, &yl, h, mo->theta, mo->gamma, t0, md->breaks, md->nbreaks, nsteps, &x,
+                     scalar_osc_force, scalar_osc_observe_yield, oy, err);
+    }
+    *end = x;
     return rc;
+}
+
+/* A yielding run's results from its tallies and its end (q, v, up; Pi
+ * units to metres, energies per unit mass in (Le wp)^2). */
+static void yield_result(const pd_osc *c, const osc_yield *oy, const mj1_state *end,
+                         pd_osc_result *res)
+{
+    double Le = pd_osc_Le(c), wp = pd_osc_wp(c), E = (Le * wp) * (Le * wp);
+    double K = c->Pi2 * c->Pi2, z = end->q - end->up;
+    res->ductility = res->umax / pd_osc_uy(c);
+    res->residual = (1.0 - c->alpha) * end->up * Le;
+    res->plastic_excursion = oy->excursion * Le;
+    res->hysteretic_energy = oy->work * E;
+    res->n_yield = oy->n_yield;
+    pd_energy *en = &res->energy;
+    en->input = oy->input * E;
+    en->kinetic = 0.5 * end->v * end->v * E;
+    en->strain = 0.5 * (c->alpha * K * end->q * end->q + oy->kbar * z * z) * E;
+    en->damping = oy->damping * E;
+    en->hysteretic = res->hysteretic_energy;
+    en->impact = oy->impact * E;
+    en->residual =
+        (en->input - en->kinetic - en->strain - en->damping - en->hysteretic - en->impact) /
+        en->input;
 }
 
 int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
@@ -453,14 +592,22 @@ int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sam
                   .sampler_ctx = ctx};
     pd_osc_track_init(&tr.m, c, mo.h, wp * pd_osc_measure_start(c, o.tend));
     tr.dem = (pd_demand_osc){.C = k.C, .K = k.K, .tau_measure = tr.m.tau_measure - 0.5 * mo.h};
-    if (!sampler && mo.kernel == PD_KERNEL_AUTO && mo.factor == PD_FACTOR_AUTO) {
+    int yields = pd_osc_yields(c);
+    if (yields && (mo.kernel != PD_KERNEL_AUTO || mo.factor != PD_FACTOR_AUTO))
+        return pd_err_set(err, PD_EINVAL,
+                          "a yielding oscillator runs on Moreau-Jean's scalar kernel only: "
+                          "kernel and factor must be auto");
+    if ((!sampler || yields) && mo.kernel == PD_KERNEL_AUTO && mo.factor == PD_FACTOR_AUTO) {
         /* the scalar kernel, which pd_mj would choose (n = 1, m <= 1) */
-        long steps = 0;
+        mj1_state end = {0};
+        osc_yield oy = {.sm = &tr};
         if ((rc = pd_model_check(&model, err)) || (rc = pd_mj_check_opts(&mo, err)))
             return rc;
-        rc = simulate_scalar(c, &model, &mo, nsteps, &tr.m, tr.demands ? &tr.dem : NULL, &steps,
-                             err);
-        pd_osc_track_result(&tr.m, c, o.dt, steps, res);
+        rc = simulate_scalar(c, &model, &mo, nsteps, &tr.m, tr.demands ? &tr.dem : NULL,
+                             yields ? &oy : NULL, &end, err);
+        pd_osc_track_result(&tr.m, c, o.dt, end.step, res);
+        if (yields)
+            yield_result(c, &oy, &end, res);
         res->tend = o.tend;
         res->theta = mo.theta;
         res->gamma = mo.gamma;
@@ -610,7 +757,8 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     if (!c || !res)
         return PD_NULL_ARG(err, !c ? "c" : "res");
     pd_err_clear(err);
-    if ((rc = pd_osc_resolve_opts(c, opts, &o, err)))
+    if ((rc = pd_osc_resolve_opts(c, opts, &o, err)) ||
+        (rc = pd_osc_refuse_yield(c, "the event-driven reference", err)))
         return rc;
     double scan = pd_osc_scan_points(c, o.tend); /* its scan grid: the cost */
     if (!(scan <= PD_OSC_MAX_SCAN))
@@ -673,6 +821,7 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     res->gamma = NAN;
     res->kernel = "event";
     pd_osc_result_no_rtol(res, NAN);
+    pd_osc_result_no_yield(res);
     pd_demand_osc_finish(res, &o, o.no_demands ? NAN : bridge.dem.peak * c->ap,
                          o.no_demands ? NAN : bridge.dem.shear * c->ap, NAN);
     res->cpu_s = pd_cpu_seconds() - cpu0;

@@ -297,9 +297,15 @@ typedef struct pd_osc {
     const pd_record *record;
     double rec_ap; /* the fitted pulse's ap at scale 1 [m/s^2] */
     double scale;  /* the record's scale S > 0 */
+    /* a yielding spring (SPEC §7): restoring force per unit mass w0^2 [alpha u +
+     * (1 - alpha) z], |z| <= uy, z' = u' inside and while unloading */
+    double Piy;   /* uy wp^2 / ap > 0, the dimensionless yield displacement; 0 (a
+                     zeroed struct's) or INFINITY: elastic */
+    double alpha; /* the post-yield stiffness ratio in [0, 1] (1: elastic) */
 } pd_osc;
 
-/* sine, normal, ap = 1, Tp = 1, Pi2 = 1, Pi3 = 0.05, eps = 0.5, xi = 0.05. */
+/* sine, normal, ap = 1, Tp = 1, Pi2 = 1, Pi3 = 0.05, eps = 0.5, xi = 0.05,
+ * elastic (Piy = 0, alpha = 0). */
 PD_API pd_osc pd_osc_default(void);
 
 /* Derived quantities. */
@@ -308,9 +314,14 @@ PD_API double pd_osc_T0(const pd_osc *c);  /* Tp / Pi2 */
 PD_API double pd_osc_gap(const pd_osc *c); /* delta = Pi3 ap / wp^2 [m] */
 PD_API double pd_osc_Le(const pd_osc *c);  /* ap / wp^2 [m] */
 
-/* The dimensional forms: Pi2 = Tp / T0, Pi3 = gap / Le (ap, Tp set first). */
+/* The dimensional forms: Pi2 = Tp / T0, Pi3 = gap / Le, Piy = uy / Le (ap,
+ * Tp set first). */
 PD_API void pd_osc_set_T0(pd_osc *c, double T0);
 PD_API void pd_osc_set_gap(pd_osc *c, double gap);
+PD_API void pd_osc_set_uy(pd_osc *c, double uy);
+PD_API double pd_osc_uy(const pd_osc *c); /* Piy Le [m]; INFINITY when elastic */
+/* 1 when the spring can yield: Piy > 0 finite and alpha < 1. */
+PD_API int pd_osc_yields(const pd_osc *c);
 
 /* Effective acceleration f(t) [m/s^2] at time t [s]. */
 PD_API double pd_osc_excitation(const pd_osc *c, double t);
@@ -368,6 +379,21 @@ typedef struct pd_osc_sample {
 /* Called at t = 0 and after every step (or output); return > 0 to stop. */
 typedef int (*pd_osc_sampler)(const pd_osc_sample *s, void *ctx);
 
+/* A run's energy balance per unit mass [J/kg]: the input work equals the
+ * kinetic and strain energy at the end plus what damping, the slider and
+ * the impacts took; residual is what is left, a fraction of the input
+ * (Moreau-Jean with theta = 1/2 closes it to rounding; theta > 1/2 leaves
+ * its numerical damping there). */
+typedef struct pd_energy {
+    double input;      /* int f u' dt */
+    double kinetic;    /* u'^2 / 2 at the end */
+    double strain;     /* w0^2 (alpha u^2 + (1 - alpha) z^2) / 2 at the end */
+    double damping;    /* int c u'^2 dt */
+    double hysteretic; /* the slider's work */
+    double impact;     /* the impacts' losses */
+    double residual;   /* (input - the others) / input */
+} pd_energy;
+
 /* What a run measures. */
 typedef struct pd_osc_result {
     double umax;                  /* max |u| over the measuring window [m] */
@@ -405,6 +431,13 @@ typedef struct pd_osc_result {
                              refinement */
     long steps_rejected;   /* tries thrown away (a step halved) */
     double dt_min, dt_max; /* the smallest and largest step kept [s] */
+    /* a yielding oscillator (pd_osc_yields; else NAN and 0), over the whole run: */
+    double ductility;         /* umax / uy */
+    double residual;          /* (1 - alpha) up at the end [m]: where the oscillator rests */
+    double plastic_excursion; /* sum of |d up| [m] */
+    double hysteretic_energy; /* the slider's work, per unit mass [J/kg] */
+    long n_yield;             /* yield onsets */
+    pd_energy energy;         /* the balance (NAN throughout for an elastic run) */
 } pd_osc_result;
 
 /* The method a run of (c, o) takes: o's, or for PD_METHOD_AUTO the exact

@@ -50,7 +50,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 # the runner's case names, run first.
 DEFAULT_FILES = {
     "lcp/lemke.c": ["lcp", "lemke", "solver"],
-    "engine/pd_mj1.h": ["engine", "moreau", "mj", "osc"],
+    "engine/pd_mj1.h": ["engine", "moreau", "mj", "osc", "yield"],
     "engine/event_row.c": ["rows", "edr", "row_"],
     "engine/event_row_cluster.c": ["rows", "edr", "row_"],
     "engine/event_row_scan.c": ["rows", "edr", "row_"],

@@ -114,6 +114,7 @@ void suite_root(pd_test_ctx *ctx);
 void suite_measure_paths(pd_test_ctx *ctx);
 void suite_row_paths(pd_test_ctx *ctx);
 void suite_row_paths2(pd_test_ctx *ctx);
+void suite_yield(pd_test_ctx *ctx);
 void suite_row_rerun(pd_test_ctx *ctx);
 void suite_lemke_paths(pd_test_ctx *ctx);
 void suite_api_null(pd_test_ctx *ctx);

@@ -1,5 +1,6 @@
 /* test_cli.c — the pound command line: bad input, output files, JSON. */
 #include <hdf5.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -34,6 +35,11 @@ static void test_cli_bad_input(pd_test_ctx *ctx)
                  {"--tend", "-2", "tend"},
                  {"--gamma", "2", "gamma"},
                  {"-o", "run.txt", "run.txt"},
+                 {"--Piy", "-1", "Piy"},
+                 {"--Piy", "nan", "Piy"},
+                 {"--uy", "0", "uy"},
+                 {"--alpha", "1.5", "alpha"},
+                 {"--alpha", "0.2", "--uy or --Piy"}, /* alpha without a yield displacement */
                  {"--Pi2", "1", "Pi2"} /* with --T0: both given */};
     if (!pd_test_have_pound(ctx))
         return;
@@ -239,6 +245,50 @@ done:
     rmdir(dir);
 }
 
+/* A yielding oscillator from the command line: --uy in metres is Piy Le,
+ * the JSON adds the yielding figures (ductility = umax / uy, the energy
+ * residual at rounding), the CSV's summary carries them, the elastic
+ * run's JSON has none of them; a method that does not model yielding is
+ * refused naming the flag (exit 2, one line). */
+static void test_cli_yielding(pd_test_ctx *ctx)
+{
+    if (!pd_test_have_pound(ctx))
+        return;
+    char dir[] = "/tmp/pd_cli_yieldXXXXXX", path[512];
+    if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
+        return;
+    snprintf(path, sizeof path, "%s/run.csv", dir);
+    const char *args[] = {"simulate", "--ap", "2",  "--Tp", "0.5",    "--uy", "0.003",
+                          "--alpha",  "0.05", "-o", path,   "--json", NULL};
+    proc_out r;
+    CHECK(ctx, pd_test_pound(ctx, args, &r) == 0, "exit %d: %s", r.status, r.err);
+    double Le = 2.0 * 0.25 / (4.0 * 9.869604401089358), umax = pd_test_json_num(r.out, "umax", 0);
+    CHECK_NEAR(ctx, pd_test_json_num(r.out, "Piy", 0), 0.003 / Le, 1e-12 * 0.003 / Le);
+    CHECK_NEAR(ctx, pd_test_json_num(r.out, "ductility", 0), umax / 0.003, 1e-12 * umax / 0.003);
+    CHECK(ctx,
+          pd_test_json_num(r.out, "n_yield", 0) >= 1 &&
+              fabs(pd_test_json_num(r.out, "energy_residual", 0)) <= 1e-12,
+          "onsets %g, energy residual %g", pd_test_json_num(r.out, "n_yield", 0),
+          pd_test_json_num(r.out, "energy_residual", 0));
+    char *text = pd_test_slurp(path);
+    CHECK(ctx, text && strstr(text, "# ductility = ") && strstr(text, "# residual = "),
+          "the CSV's summary carries the yielding figures");
+    free(text);
+    pd_test_proc_free(&r);
+    const char *elastic[] = {"simulate", "--json", NULL};
+    CHECK(ctx, pd_test_pound(ctx, elastic, &r) == 0 && !strstr(r.out, "ductility"),
+          "an elastic run's JSON reports no yielding: %s", r.out);
+    pd_test_proc_free(&r);
+    const char *refused[] = {"simulate", "--Piy", "0.5", "--method", "event", NULL};
+    pd_test_pound(ctx, refused, &r);
+    char *nl = strchr(r.err, '\n');
+    CHECK(ctx, r.status == 2 && strstr(r.err, "--Piy") && nl && nl[1] == '\0',
+          "--Piy with --method event: exit %d, %s", r.status, r.err);
+    pd_test_proc_free(&r);
+    unlink(path);
+    rmdir(dir);
+}
+
 /* A run that fails mid-way (theta < 1/2 at a huge step) exits 1, names the
  * time, and leaves no file. */
 static void test_cli_failed_run_leaves_no_file(pd_test_ctx *ctx)
@@ -435,6 +485,7 @@ void suite_cli(pd_test_ctx *ctx)
     PD_RUN(ctx, test_cli_hardening);
     PD_RUN(ctx, test_cli_hdf5_output);
     PD_RUN(ctx, test_cli_csv_and_json);
+    PD_RUN(ctx, test_cli_yielding);
     PD_RUN(ctx, test_cli_failed_run_leaves_no_file);
     PD_RUN(ctx, test_cli_converge_empty_list_elements);
     PD_RUN(ctx, test_cli_version);

@@ -9,7 +9,9 @@
  *   - a lever wall (weight -3) closed within close_tol by an impact puts
  *     its body exactly on it;
  *   - a piece boundary where the force does not change leaves a run's
- *     results where they were (rows of SDOFs and of buildings). */
+ *     results where they were (rows of SDOFs and of buildings);
+ *   - a held pair pushed into a wall rests on it after one impact (the
+ *     held contact's force through the wall's push). */
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -215,6 +217,58 @@ static void test_edr_rows_lever_wall_closed_on_it(pd_test_ctx *ctx)
     pd_edr_free(r);
 }
 
+/* Two free unit masses B (x0) and A (x1) touching (gap x_B - x_A), A
+ * pushed toward B by b_A = 1, a wall at 1/2 beyond B (gap 1/2 - x_B,
+ * restitution 0; B numbered first, so that the wall's force acts inside
+ * the held pair's subtree below the A-B edge).  Held together they accelerate at 1/2 (x = t^2 / 4) and
+ * strike the wall at t = sqrt 2 as one block; the impact stops both (e =
+ * 0) and the block rests on the wall: one impact, no detachment, the A-B
+ * contact held for the whole run, the wall's from sqrt 2 (its force 1, the
+ * A-B contact's 1 too: held through the wall's push on B). */
+static void test_edr_rows_block_rests_on_wall(pd_test_ctx *ctx)
+{
+    double one[2] = {1.0, 1.0}, b[2] = {0.0, 1.0}, g0[2] = {0.0, 0.5}, e[2] = {0.5, 0.0};
+    double wv[3] = {1.0, -1.0, -1.0}, x0[2] = {0.0, 0.0}, v0[2] = {0.0, 0.0};
+    int cp[3] = {0, 2, 3}, ri[3] = {0, 1, 0}, dp[3] = {0, 1, 2}, di[2] = {0, 1};
+    pd_model md = {.n = 2,
+                   .m = 2,
+                   .M = pd_matrix_csc(2, 2, dp, di, one),
+                   .C = pd_matrix_zero(2, 2),
+                   .K = pd_matrix_zero(2, 2),
+                   .W = pd_matrix_csc(2, 2, cp, ri, wv),
+                   .g0 = g0,
+                   .e = e};
+    pd_sine_piece pc = {.t_start = 0.0, .c0 = 1.0};
+    pd_piecewise_force F = {.b = b, .pieces = &pc, .npieces = 1};
+    pd_edr_opts eo = pd_edr_default_opts();
+    eo.h_out = 1.0;
+    pd_err err = {0};
+    pd_edr *r = pd_edr_alloc(&md, &F, &eo, &err);
+    if (!CHECK(ctx, r != NULL, "%s", err.msg))
+        return;
+    last_ctx lc = {.n = md.n};
+    int rc = pd_edr_run(r, 0.0, x0, v0, 5.0, keep_last, &lc, &err);
+    const pd_edr_result *res = pd_edr_result_of(r);
+    if (CHECK(ctx, rc == PD_OK, "%s", err.msg)) {
+        CHECK(ctx,
+              res->impacts == 1 && res->detachments == 0 &&
+                  fabs(res->first_impact - sqrt(2.0)) <= 1e-12,
+              "impacts %ld (first at %.17g), detachments %ld; one at t = sqrt 2, none",
+              res->impacts, res->first_impact, res->detachments);
+        CHECK(ctx,
+              fabs(res->contact_time[0] - 5.0) <= 1e-12 &&
+                  fabs(res->contact_time[1] - (5.0 - sqrt(2.0))) <= 1e-12,
+              "contact times %.17g, %.17g; 5 and 5 - sqrt 2", res->contact_time[0],
+              res->contact_time[1]);
+        CHECK(ctx,
+              fabs(lc.q[0] - 0.5) <= 1e-12 && fabs(lc.q[1] - 0.5) <= 1e-12 &&
+                  fabs(lc.v[0]) <= 1e-12 && fabs(lc.v[1]) <= 1e-12,
+              "x = (%.17g, %.17g), v = (%.17g, %.17g); at rest on the wall at 1/2", lc.q[0],
+              lc.q[1], lc.v[0], lc.v[1]);
+    }
+    pd_edr_free(r);
+}
+
 /* The pieces pc[0..np) with each one cut at the fraction frac of its span
  * (the last one's up to t1) into two pieces of the same force: the linear
  * term's constant moved to the cut.  NULL when out of memory. */
@@ -354,4 +408,5 @@ void suite_row_paths2(pd_test_ctx *ctx)
     PD_RUN(ctx, test_edr_rows_modal_impact_no_accumulation);
     PD_RUN(ctx, test_edr_rows_lever_wall_closed_on_it);
     PD_RUN(ctx, test_edr_rows_cut_pieces_same);
+    PD_RUN(ctx, test_edr_rows_block_rests_on_wall);
 }

@@ -15,7 +15,8 @@ from ._types import ArrayLike, PathArg
 
 # Keyword arguments and the CLI flags they mirror (the names without "--",
 # "-" written "_").
-MODEL_KEYS = ("pulse", "dir", "ap", "Tp", "T0", "Pi2", "gap", "Pi3", "eps", "xi")
+MODEL_KEYS = ("pulse", "dir", "ap", "Tp", "T0", "Pi2", "gap", "Pi3", "eps", "xi", "uy", "Piy",
+              "alpha")
 RECORD_KEYS = ("record", "scale", "units", "record_format", "record_dt")
 SCHEME_KEYS = ("method", "dt", "tend", "theta", "gamma", "allow_unstable", "no_accumulation",
                "no_wall", "kernel", "factor", "lcp_solver", "contact", "kc", "kc_abs", "rtol",
@@ -334,11 +335,12 @@ class Case:
                                  "sine, cosine, harmonic")
         if "dir" in kw:
             c.dir = parse_dir(kw["dir"])
-        for key in ("ap", "Tp", "Pi2", "Pi3", "eps", "xi"):
+        for key in ("ap", "Tp", "Pi2", "Pi3", "eps", "xi", "Piy", "alpha"):
             if key in kw:
                 setattr(c, key, number(key, kw[key]))
         self.T0 = number("T0", kw["T0"]) if "T0" in kw else None
         self.gap = number("gap", kw["gap"]) if "gap" in kw else None
+        self.uy = number("uy", kw["uy"]) if "uy" in kw else None
         self.c = c
         self.pulse_key = next((k for k in ("pulse", "ap", "Tp") if k in kw), None)
 
@@ -380,9 +382,39 @@ class Case:
             lib.pd_osc_set_T0(c, self.T0)
         if self.gap is not None:
             lib.pd_osc_set_gap(c, self.gap)
+        self.check_yield()
+        if self.uy is not None:
+            lib.pd_osc_set_uy(c, self.uy)
         err = PdErr()
         _lib.check(lib.pd_osc_check(c, err), err)
         self.check_derived(self.opts, self.have)
+
+    def check_yield(self):
+        """cli/case.c check_yield: the yielding spring's keys, and the runs
+        that model it."""
+        kw, c, o = self.kw, self.c, self.opts
+        key = "uy" if self.uy is not None else "Piy"
+        if self.uy is not None and "Piy" in kw:
+            raise InputError("uy and Piy are alternatives: give one")
+        if self.uy is not None and not (self.uy > 0.0 and math.isfinite(self.uy)):
+            raise InputError("uy: the yield displacement must be > 0 m (got %s)" % fmt(self.uy))
+        if "Piy" in kw and not (c.Piy > 0.0 and math.isfinite(c.Piy)):
+            raise InputError("Piy: the dimensionless yield displacement must be > 0 (got %s)"
+                             % fmt(c.Piy))
+        if "alpha" in kw and not 0.0 <= c.alpha <= 1.0:
+            raise InputError("alpha: the post-yield stiffness ratio must be in [0, 1] (got %s)"
+                             % fmt(c.alpha))
+        if self.uy is None and "Piy" not in kw:
+            if "alpha" in kw:
+                raise InputError("alpha: needs the yield displacement (uy or Piy)")
+            return
+        if o.method not in (0, PD_METHOD_AUTO):
+            raise InputError("%s: a yielding oscillator runs by method 'moreau' only (the exact "
+                             "reference and the penalty methods do not model yielding yet; got "
+                             "method %s)" % (key, _lib.s(lib.pd_method_name(o.method))))
+        if o.rtol > 0.0:
+            raise InputError("%s: a yielding oscillator runs at a fixed step (dt), not to a "
+                             "tolerance (rtol)" % key)
 
     def check_derived(self, o, have, dt_key="dt"):
         """cli/case.c pd_cli_case_check_derived: the run's size bounded."""

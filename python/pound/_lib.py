@@ -15,7 +15,7 @@ from typing import List, Optional, Tuple
 
 # The mirrors of the public structs, generated from the headers by
 # scripts/gen_py_structs.py (the other modules take them from here).
-from ._structs import (PD_SPEC_MAX_LIST, PD_WALL, PdContact, PdErr, PdLcpInfo,  # noqa: F401
+from ._structs import (PD_SPEC_MAX_LIST, PD_WALL, PdContact, PdEnergy, PdErr, PdLcpInfo,  # noqa: F401
                        PdLcpOpts, PdMatrix, PdMeasured, PdOsc, PdOscResult, PdOscSample,
                        PdOscSummary, PdPenaltySetup, PdRecord, PdRecordMeasures, PdRecordPulse,
                        PdRunOpts, PdScene, PdSceneErrors, PdSceneExcitation, PdSceneResult,
@@ -185,6 +185,9 @@ _PROTOTYPES = {
     "pd_osc_Le": (c_double, [P(PdOsc)]),
     "pd_osc_set_T0": (None, [P(PdOsc), c_double]),
     "pd_osc_set_gap": (None, [P(PdOsc), c_double]),
+    "pd_osc_set_uy": (None, [P(PdOsc), c_double]),
+    "pd_osc_uy": (c_double, [P(PdOsc)]),
+    "pd_osc_yields": (c_int, [P(PdOsc)]),
     "pd_osc_set_record": (None, [P(PdOsc), P(PdRecord), P(PdRecordPulse), c_double]),
     "pd_osc_excitation_name": (c_char_p, [P(PdOsc)]),
     "pd_osc_check": (c_int, [P(PdOsc), P(PdErr)]),

@@ -250,7 +250,8 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
     gamma [0.5], allow_unstable, no_accumulation, no_wall, kernel
     'auto'|'general', factor, lcp_solver, contact 'kelvin'|'hertz', kc,
     kc_abs, rtol, atol, stepper; height [3] m and contact_duration [0.005] s
-    of the demands.
+    of the demands; a yielding spring: uy [m] or Piy = uy wp^2 / ap, and
+    alpha [0] (docs/methods.md, "Yielding oscillators"; method 'moreau').
 
     rtol, as the CLI's --rtol: Moreau-Jean to a tolerance, in [1e-12, 1):
     steps chosen so that every peak (umax, u_toward, u_away, the drift,
@@ -278,6 +279,10 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
     dt_min and dt_max [s] (the smallest and largest step kept: dt for fixed
     steps, NaN for the other methods); steps counts every step taken (with
     history the kept run is repeated for the sampler, as the CLI's -o).
+    A yielding run adds uy [m], Piy, alpha, ductility (umax / uy),
+    residual [m], n_yield, plastic_excursion [m], hysteretic_energy and the
+    energy balance energy_input, _kinetic, _strain, _damping, _impact
+    [J/kg] with energy_residual (a fraction of the input).
     With history,
     r.history: the arrays step, t, u, v, impulse, gap, impacts of every
     every-th step (the CLI's -o file: t [s], u [m], v [m/s], impulse per
@@ -312,6 +317,15 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
     _demand.osc_fields(out, r, height)
     _case_json(k, out)
     out.update(dt=r.dt, theta=r.theta, gamma_active=r.gamma, tend=r.tend, kernel=s(r.kernel))
+    if lib.pd_osc_yields(k.c):  # the yielding spring (SPEC section 7), as the CLI's JSON
+        en = r.energy
+        out.update(uy=lib.pd_osc_uy(k.c), Piy=k.c.Piy, alpha=k.c.alpha, ductility=r.ductility,
+                   residual=r.residual, n_yield=r.n_yield,
+                   plastic_excursion=r.plastic_excursion,
+                   hysteretic_energy=r.hysteretic_energy, ductility_free=sm.free.ductility,
+                   energy_input=en.input, energy_kinetic=en.kinetic, energy_strain=en.strain,
+                   energy_damping=en.damping, energy_impact=en.impact,
+                   energy_residual=en.residual)
     if h is not None:
         rows = h.rows()
         hist = Result((name, np.ascontiguousarray(rows[name])) for name, _ in OSC_SAMPLE)

@@ -184,6 +184,8 @@ class PdOsc(Structure):
         ("record", POINTER(PdRecord)),
         ("rec_ap", c_double),
         ("scale", c_double),
+        ("Piy", c_double),
+        ("alpha", c_double),
     ]
 
 
@@ -197,6 +199,19 @@ class PdOscSample(Structure):
         ("impulse", c_double),
         ("gap", c_double),
         ("impacts", c_long),
+    ]
+
+
+class PdEnergy(Structure):
+    """pd_energy (problems/pd_problems.h)."""
+    _fields_ = [
+        ("input", c_double),
+        ("kinetic", c_double),
+        ("strain", c_double),
+        ("damping", c_double),
+        ("hysteretic", c_double),
+        ("impact", c_double),
+        ("residual", c_double),
     ]
 
 
@@ -232,6 +247,12 @@ class PdOscResult(Structure):
         ("steps_rejected", c_long),
         ("dt_min", c_double),
         ("dt_max", c_double),
+        ("ductility", c_double),
+        ("residual", c_double),
+        ("plastic_excursion", c_double),
+        ("hysteretic_energy", c_double),
+        ("n_yield", c_long),
+        ("energy", PdEnergy),
     ]
 
 
@@ -533,6 +554,7 @@ MIRRORS = {
     "pd_run_opts": PdRunOpts,
     "pd_osc": PdOsc,
     "pd_osc_sample": PdOscSample,
+    "pd_energy": PdEnergy,
     "pd_osc_result": PdOscResult,
     "pd_osc_summary": PdOscSummary,
     "pd_trace": PdTrace,

@@ -184,3 +184,29 @@ def test_every_record(cli, same):
     js = cli("record", *files)["records"]
     for f, j in zip(files, js):
         same(pound.record(f), j)
+
+
+@pytest.mark.parametrize("extra,kw", [
+    (["--uy", "0.003", "--alpha", "0.05", "--ap", "2", "--Tp", "0.5"],
+     dict(uy=0.003, alpha=0.05, ap=2, Tp=0.5)),
+    (["--Piy", "0.3", "--Pi3", "10", "--xi", "0"], dict(Piy=0.3, Pi3=10, xi=0)),
+])
+def test_simulate_yielding(cli, same, tmp_path, extra, kw):
+    """A yielding oscillator: the CLI's figures (ductility, residual, the
+    energy balance) and its history file, to the bit."""
+    out = tmp_path / "run.csv"
+    js = cli("simulate", *extra, "-o", out)
+    r = pound.simulate(**kw)
+    assert "ductility" in js and "energy_residual" in js
+    same(r, js)
+    _, data = read_csv(out)
+    assert np.array_equal(r.u, data[:, 1])
+
+
+@pytest.mark.parametrize("kw,named", [
+    (dict(Piy=-1), "Piy"), (dict(uy=0.01, Piy=1), "alternatives"), (dict(alpha=0.2), "uy or Piy"),
+    (dict(Piy=1, method="event"), "moreau"), (dict(Piy=1, rtol=1e-3), "tolerance"),
+])
+def test_simulate_yielding_refused(kw, named):
+    with pytest.raises(pound.InputError, match=named):
+        pound.simulate(history=False, **kw)

@@ -1,0 +1,434 @@
+/* test_yield.c — the yielding oscillator (SPEC §7) by Moreau–Jean with the
+ * slider in the step's LCP (engine/pd_mj1.h, mj1y_step):
+ *   - a spring that never yields (uy 1e6 Le) gives the elastic run's
+ *     numbers bit for bit, and alpha = 1 is the elastic run;
+ *   - a step load on an undamped elastic-plastic (and hardening) spring:
+ *     ductility, residual, plastic excursion and hysteretic work against
+ *     the closed form, the error falling as dt (order 1);
+ *   - the energy balance closes (theta 1/2) to rounding;
+ *   - self-similarity in (Pi2, Pi3, Piy, alpha, eps, xi);
+ *   - the sampler sees the same run; the methods that do not model
+ *     yielding refuse it, and bad uy, alpha are refused;
+ *   - one step (mj1y_step) against its equations: balance, slider and
+ *     contact complementarity, the elastic answer whenever it is feasible. */
+#include <math.h>
+#include <string.h>
+
+#include "pd_core.h"
+#include "pd_mj1.h"
+#include "pd_problems.h"
+#include "pd_test.h"
+
+/* The figures two runs of one case must share, bit for bit. */
+static int same_figures(const pd_osc_result *a, const pd_osc_result *b)
+{
+    const double x[] = {a->umax,        a->u_toward, a->u_away,  a->first_impact, a->max_impulse,
+                        a->contact_time, a->min_gap,  a->acc_max, a->shear_max},
+                 y[] = {b->umax,        b->u_toward, b->u_away,  b->first_impact, b->max_impulse,
+                        b->contact_time, b->min_gap,  b->acc_max, b->shear_max};
+    return memcmp(x, y, sizeof x) == 0 && a->impacts == b->impacts && a->steps == b->steps;
+}
+
+/* A spring that never reaches uy runs the yielding step and gives the
+ * elastic numbers bit for bit (the slider's terms enter only once it
+ * slides); alpha = 1 is elastic whatever uy. */
+static void test_yield_unreached_is_elastic(pd_test_ctx *ctx)
+{
+    const double eps[] = {0.0, 0.5, 1.0};
+    for (int k = 0; k < 6; k++) {
+        pd_osc c = pd_osc_default();
+        c.eps = eps[k % 3];
+        c.pulse = k % 2 ? PD_PULSE_COSINE : PD_PULSE_SINE;
+        c.Pi2 = 0.5 + 0.5 * k;
+        pd_run_opts o = pd_run_default_opts();
+        o.method = PD_METHOD_MOREAU;
+        o.no_wall = k == 5;
+        pd_osc_result el, far, hard;
+        pd_err e;
+        int rc = pd_osc_simulate(&c, &o, NULL, NULL, &el, &e);
+        c.Piy = 1e6;
+        rc = rc ? rc : pd_osc_simulate(&c, &o, NULL, NULL, &far, &e);
+        c.Piy = 0.01;
+        c.alpha = 1.0;
+        rc = rc ? rc : pd_osc_simulate(&c, &o, NULL, NULL, &hard, &e);
+        if (!CHECK(ctx, rc == PD_OK, "case %d: %s", k, e.msg))
+            continue;
+        CHECK(ctx, same_figures(&el, &far) && same_figures(&el, &hard),
+              "case %d: umax %.17g, %.17g (uy 1e6 Le), %.17g (alpha 1)", k, el.umax, far.umax,
+              hard.umax);
+        CHECK(ctx,
+              far.n_yield == 0 && far.residual == 0.0 && far.plastic_excursion == 0.0 &&
+                  far.hysteretic_energy == 0.0 && far.ductility == far.umax / (1e6 * pd_osc_Le(&c)),
+              "case %d: uy never reached, yet %ld onsets, residual %g", k, far.n_yield,
+              far.residual);
+        CHECK(ctx, isnan(el.ductility) && isnan(hard.residual) && hard.n_yield == 0,
+              "case %d: an elastic run reports ductility %g", k, el.ductility);
+    }
+}
+
+/* A constant ground acceleration -a0 for 4 s (a record: f = a0 per unit
+ * mass, from rest), no wall, undamped, T0 = 1 s: the oscillator c for
+ * uy and alpha, with its record rec (the caller frees it). */
+static int step_load(pd_osc *c, pd_record *rec, double a0, double uy, double alpha)
+{
+    double acc[401];
+    for (int i = 0; i < 401; i++)
+        acc[i] = -a0;
+    pd_err e;
+    if (pd_record_from_array(rec, "step", acc, 401, 0.01, PD_UNITS_M_S2, &e))
+        return 0;
+    pd_record_pulse p = {.ap = 1.0, .Tp = 1.0};
+    *c = pd_osc_default();
+    pd_osc_set_record(c, rec, &p, 1.0);
+    c->Pi2 = 1.0; /* T0 = Tp = 1 s */
+    c->Pi3 = 1e6; /* no wall within reach */
+    c->xi = 0.0;
+    c->alpha = alpha;
+    pd_osc_set_uy(c, uy);
+    return 1;
+}
+
+/* The step load's peak by the closed form (w = 2 pi, f = a0 < k uy, f >
+ * k uy / 2): elastic to uy, reached at rate v1, v1^2 = w^2 (2 uy f / k -
+ * uy^2); then sliding, x'' = f - k (alpha x + (1 - alpha) uy): for alpha =
+ * 0 a constant deceleration, umax = uy + v1^2 / (2 (k uy - f)); else an
+ * oscillation at w sqrt(alpha) about xc = (f - (1 - alpha) k uy) / (alpha
+ * k), umax = xc + sqrt((uy - xc)^2 + v1^2 / (alpha w^2)). */
+static double step_load_umax(double f, double uy, double alpha)
+{
+    double w = 2.0 * PD_PI, k = w * w;
+    double v1sq = w * w * (2.0 * uy * f / k - uy * uy);
+    if (alpha == 0.0)
+        return uy + v1sq / (2.0 * (k * uy - f));
+    double xc = (f - (1.0 - alpha) * k * uy) / (alpha * k);
+    return xc + sqrt((uy - xc) * (uy - xc) + v1sq / (alpha * w * w));
+}
+
+/* Under the step load the spring yields once, to umax; it unloads
+ * elastically about f / k + (1 - alpha) up and never yields back (the
+ * swing's far end keeps z >= -uy for these loads; its next top touches uy
+ * at rest, a grazing the run ends before), so that up = umax - uy:
+ * residual (1 - alpha) up, excursion up, the slider's work (1 - alpha) k
+ * uy up.  Moreau–Jean's errors against the closed form fall with dt: their
+ * envelope over steps near T0 / 4000 at least 2.5 times below the one
+ * near T0 / 1000 (first order gives 4; measured 12 to 22), which is below
+ * 1e-4 (measured 4e-6 to 9e-6). */
+static void test_yield_step_load_closed_form(pd_test_ctx *ctx)
+{
+    const double uy = 0.01, ratio[] = {0.8, 0.6, 0.7}, alphas[] = {0.0, 0.1, 0.3};
+    for (int k = 0; k < 3; k++) {
+        double w2 = 4.0 * PD_PI * PD_PI, f = ratio[k] * w2 * uy, alpha = alphas[k];
+        double umax = step_load_umax(f, uy, alpha), up = umax - uy;
+        pd_osc c;
+        pd_record rec = {0};
+        if (!CHECK(ctx, step_load(&c, &rec, f, uy, alpha), "case %d: no record", k))
+            continue;
+        /* the largest error over five steps near T0 / 1000, then near T0 / 4000
+         * (where the onset falls inside its step varies the error: its envelope) */
+        double err[2] = {0.0, 0.0};
+        pd_osc_result r = {0};
+        for (int h = 0; h < 10; h++) {
+            pd_run_opts o = pd_run_default_opts();
+            o.method = PD_METHOD_MOREAU;
+            o.dt = 1.0 / ((h < 5 ? 1000.0 : 4000.0) * (1.0 + 0.023 * (h % 5)));
+            o.tend = 1.5; /* before the elastic swing's next top grazes uy (t ~ 1.6 s) */
+            pd_err e;
+            if (!CHECK(ctx, pd_osc_simulate(&c, &o, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg))
+                break;
+            double e1 = fabs(r.umax - umax) / umax, e2 = fabs(r.residual - (1.0 - alpha) * up) / up,
+                   e3 = fabs(r.plastic_excursion - up) / up,
+                   e4 = fabs(r.hysteretic_energy - (1.0 - alpha) * w2 * uy * up) /
+                        ((1.0 - alpha) * w2 * uy * up);
+            err[h / 5] = fmax(err[h / 5], fmax(fmax(e1, e2), fmax(e3, e4)));
+            CHECK(ctx, r.n_yield == 1, "case %d, dt %g: %ld yield onsets, one", k, o.dt,
+                  r.n_yield);
+        }
+        CHECK(ctx, err[1] <= err[0] / 2.5 && err[0] <= 1e-4,
+              "case %d (alpha %g, f / Fy %g): errors up to %.3g near dt = T0/1000, %.3g near "
+              "T0/4000 (closed-form umax %.9g, ductility %.6g)",
+              k, alpha, ratio[k], err[0], err[1], umax, umax / uy);
+        CHECK(ctx, fabs(r.ductility - umax / uy) <= 1e-3 * umax / uy,
+              "case %d: ductility %.9g, closed form %.9g", k, r.ductility, umax / uy);
+        pd_record_free(&rec);
+    }
+}
+
+/* Against a wall: a yielding oscillator that pounds (Pi3 0.05, Piy 0.1,
+ * alpha 0.05, eps 0.5), Moreau–Jean converging: its figures' distances to
+ * the run at dt = T0 / 64000, largest over five steps near T0 / 500 and
+ * near T0 / 4000, fall at least 4-fold (first order gives 8; measured
+ * 1.9e-3 to 4.4e-7), and the onsets are the fine run's (its bounces, 12,
+ * are not: a coarse step merges the last of a burst, 8 or 9 near T0/500). */
+static void test_yield_wall_converges(pd_test_ctx *ctx)
+{
+    pd_osc c = pd_osc_default();
+    c.Piy = 0.1;
+    c.alpha = 0.05;
+    pd_run_opts o = pd_run_default_opts();
+    o.method = PD_METHOD_MOREAU;
+    o.dt = pd_osc_T0(&c) / 64000.0;
+    pd_osc_result fine, r;
+    pd_err e;
+    if (!CHECK(ctx, pd_osc_simulate(&c, &o, NULL, NULL, &fine, &e) == PD_OK, "%s", e.msg))
+        return;
+    double dist[2] = {0.0, 0.0};
+    for (int h = 0; h < 10; h++) {
+        o.dt = pd_osc_T0(&c) / ((h < 5 ? 500.0 : 4000.0) * (1.0 + 0.023 * (h % 5)));
+        if (!CHECK(ctx, pd_osc_simulate(&c, &o, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg))
+            return;
+        double d = fmax(fabs(r.umax - fine.umax) / fine.umax,
+                        fabs(r.residual - fine.residual) / fabs(fine.residual));
+        d = fmax(d, fabs(r.hysteretic_energy - fine.hysteretic_energy) / fine.hysteretic_energy);
+        dist[h / 5] = fmax(dist[h / 5], d);
+        CHECK(ctx, r.n_yield == fine.n_yield, "dt %g: %ld onsets; the fine run %ld", o.dt,
+              r.n_yield, fine.n_yield);
+    }
+    CHECK(ctx, dist[1] <= dist[0] / 4.0 && fine.impacts >= 2 && fine.n_yield >= 2,
+          "distances to the fine run up to %.3g near T0/500, %.3g near T0/4000 (fine: %ld "
+          "impacts, %ld onsets, ductility %.6g, residual %.6g m)",
+          dist[0], dist[1], fine.impacts, fine.n_yield, fine.ductility, fine.residual);
+}
+
+/* The energy balance of yielding runs with theta = 1/2 (the step's
+ * energy identity is exact for the midpoint: input = kinetic + strain +
+ * damping + slider + impacts per step) closes to rounding, 1e-12 of the
+ * input over some 10^4 steps (measured below 4e-14), with every loss >= 0
+ * (impacts with e <= 1, the slider's work, damping); theta = 0.7 leaves
+ * its numerical damping in the residual, > 0. */
+static void test_yield_energy_balance(pd_test_ctx *ctx)
+{
+    uint64_t rng = 0xe4e6;
+    double worst = 0.0, worst_loss = 0.0;
+    for (int k = 0; k < 24; k++) {
+        pd_osc c = pd_osc_default();
+        c.pulse = k % 3 == 2 ? PD_PULSE_HARMONIC : k % 2 ? PD_PULSE_COSINE : PD_PULSE_SINE;
+        c.Pi2 = 0.5 + 2.5 * pd_test_uniform(&rng);
+        c.Pi3 = k % 4 == 3 ? 1e6 : 0.5 * pd_test_uniform(&rng);
+        c.Piy = 0.05 + 0.5 * pd_test_uniform(&rng);
+        c.alpha = k % 5 == 0 ? 0.0 : 0.3 * pd_test_uniform(&rng);
+        c.eps = pd_test_uniform(&rng);
+        c.xi = 0.1 * pd_test_uniform(&rng);
+        pd_run_opts o = pd_run_default_opts();
+        o.method = PD_METHOD_MOREAU;
+        pd_osc_result r;
+        pd_err e;
+        if (!CHECK(ctx, pd_osc_simulate(&c, &o, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg))
+            continue;
+        const pd_energy *en = &r.energy;
+        worst = fmax(worst, fabs(en->residual));
+        double loss = fmin(fmin(en->damping, en->hysteretic), fmin(en->impact, en->strain));
+        worst_loss = fmin(worst_loss, fmin(loss, en->kinetic) / en->input);
+        if (k == 0) { /* the same case with theta 0.7: numerical damping */
+            o.theta = 0.7;
+            pd_osc_result r7;
+            if (CHECK(ctx, pd_osc_simulate(&c, &o, NULL, NULL, &r7, &e) == PD_OK, "%s", e.msg))
+                CHECK(ctx, r7.energy.residual > 1e-6,
+                      "theta 0.7: residual %.3g of the input (numerical damping, > 0)",
+                      r7.energy.residual);
+        }
+    }
+    CHECK(ctx, worst <= 1e-12 && worst_loss >= -1e-12,
+          "theta 1/2: energy balance residual up to %.3g of the input, a loss down to %.3g", worst,
+          worst_loss);
+}
+
+/* The run depends on the Pi terms only: ap tripled with Pi2, Pi3, Piy,
+ * alpha, eps, xi kept (gap and uy scale with Le) leaves Pi1, ductility,
+ * residual / uy and the counts (1e-12). */
+static void test_yield_self_similar(pd_test_ctx *ctx)
+{
+    pd_osc c = pd_osc_default();
+    c.Pi2 = 1.5;
+    c.Pi3 = 0.3;
+    c.Piy = 0.2;
+    c.alpha = 0.05;
+    c.eps = 0.6;
+    pd_run_opts o = pd_run_default_opts();
+    o.method = PD_METHOD_MOREAU;
+    pd_osc_result a, b;
+    pd_err e;
+    int rc = pd_osc_simulate(&c, &o, NULL, NULL, &a, &e);
+    double Le = pd_osc_Le(&c);
+    c.ap *= 3.0;
+    rc = rc ? rc : pd_osc_simulate(&c, &o, NULL, NULL, &b, &e);
+    if (!CHECK(ctx, rc == PD_OK, "%s", e.msg))
+        return;
+    double Le3 = pd_osc_Le(&c);
+    CHECK(ctx,
+          fabs(a.umax / Le - b.umax / Le3) <= 1e-12 * a.umax / Le &&
+              fabs(a.ductility - b.ductility) <= 1e-12 * a.ductility &&
+              fabs(a.residual / Le - b.residual / Le3) <= 1e-12 * fabs(a.residual / Le) &&
+              a.n_yield == b.n_yield && a.impacts == b.impacts && a.n_yield >= 2 && a.impacts >= 1,
+          "Pi1 %.17g, %.17g; ductility %.17g, %.17g; residual / Le %.17g, %.17g; onsets %ld, %ld",
+          a.umax / Le, b.umax / Le3, a.ductility, b.ductility, a.residual / Le, b.residual / Le3,
+          a.n_yield, b.n_yield);
+}
+
+/* The samples of a yielding run: one at t = 0 and one per step, the last
+ * at the run's end with its umax among them; the figures those of the run
+ * without a sampler, bit for bit. */
+typedef struct sample_tally {
+    long n;
+    double umax, t_last;
+} sample_tally;
+
+static int tally(const pd_osc_sample *s, void *ctx)
+{
+    sample_tally *st = ctx;
+    st->n++;
+    st->umax = fmax(st->umax, fabs(s->u));
+    st->t_last = s->t;
+    return 0;
+}
+
+static void test_yield_sampled(pd_test_ctx *ctx)
+{
+    pd_osc c = pd_osc_default();
+    c.Piy = 0.1;
+    c.alpha = 0.02;
+    pd_run_opts o = pd_run_default_opts();
+    o.method = PD_METHOD_MOREAU;
+    pd_osc_result a, b;
+    sample_tally st = {0};
+    pd_err e;
+    int rc = pd_osc_simulate(&c, &o, NULL, NULL, &a, &e);
+    rc = rc ? rc : pd_osc_simulate(&c, &o, tally, &st, &b, &e);
+    if (CHECK(ctx, rc == PD_OK, "%s", e.msg))
+        CHECK(ctx,
+              same_figures(&a, &b) && a.residual == b.residual && a.n_yield == b.n_yield &&
+                  st.n == a.steps + 1 && st.umax == a.umax &&
+                  fabs(st.t_last - a.tend) <= 1e-9 * a.tend,
+              "%ld samples for %ld steps, their umax %.17g (run %.17g), last at %g of %g",
+              st.n, a.steps, st.umax, a.umax, st.t_last, a.tend);
+}
+
+/* One yielding step from random states (K, C, alpha, uy, h, theta, a wall
+ * or none, e) against the equations it solves, each to 1e-12 of its terms:
+ *   What-free balance  v+ - v = h [F_th - C v_th - K q_th + kbar (up + th G)]
+ *                      + W P  (M = 1),  q_th = q + h th v_th, v_th = th v+ +
+ *                      (1 - th) v, q+ = q + h v_th;
+ *   the slider         |z+| <= uy, z+ = q+ - up+, G = up+ - up, G != 0 only
+ *                      with z+ = sign(G) uy;
+ *   the contact        P >= 0, U+ + e U >= 0, P (U+ + e U) = 0 when active
+ *                      (g + h gamma U <= 0), P = 0 otherwise;
+ *   uniqueness         G = 0 exactly when the elastic step (mj1_step with
+ *                      the offset's force) keeps |z+| <= uy, and then the
+ *                      elastic step's numbers. */
+static void test_yield_step_equations(pd_test_ctx *ctx)
+{
+    uint64_t rng = 0x1e1d;
+    double worst_bal = 0.0, worst_z = 0.0, worst_c = 0.0;
+    int yielded = 0, contacts = 0, wrong = 0;
+    for (int k = 0; k < 4000; k++) {
+        double K = pow(10.0, 2.0 * pd_test_uniform(&rng) - 1.0), C = 0.3 * pd_test_uniform(&rng);
+        double h = 0.05 * pd_test_uniform(&rng) + 1e-3, th = 0.5 + 0.5 * pd_test_uniform(&rng);
+        double alpha = k % 5 == 0 ? 0.0 : 0.4 * pd_test_uniform(&rng);
+        double uy = 0.01 + 0.1 * pd_test_uniform(&rng), e = pd_test_uniform(&rng), hgamma = 0.5 * h;
+        int wall = k % 3 != 0;
+        double up0 = (pd_test_uniform(&rng) - 0.5) * uy * (k % 2);
+        double z0 = (2.0 * pd_test_uniform(&rng) - 1.0) * uy;
+        double q0 = up0 + z0, v0 = 4.0 * (pd_test_uniform(&rng) - 0.5);
+        double g0 = q0 + 0.05 * (pd_test_uniform(&rng) - 0.3); /* the gap g0 - q0 near 0 */
+        if (k % 7 == 0) { /* touching at rest: g + h gamma U = 0, active */
+            g0 = q0;
+            v0 = 0.0;
+        }
+        mj1_coef s = mj1_coef_make(1.0, C, K, wall, -1.0, g0, e, h, th);
+        mj1_yield y = mj1_yield_make(&s, K, alpha, uy, h, th);
+        double F0 = 2.0 * pd_test_uniform(&rng) - 1.0, F1 = 2.0 * pd_test_uniform(&rng) - 1.0;
+        double q = q0, v = v0, g = g0 - q0, P, up = up0, G;
+        int active = mj1y_step(h, th, hgamma, &s, &y, F0, F1, &q, &v, &g, &P, &up, &G);
+        double kbar = (1.0 - alpha) * K, vth = th * v + (1.0 - th) * v0, qth = q0 + h * th * vth;
+        double terms = fabs(v) + fabs(v0) + h * (fabs(F0) + fabs(F1) + fabs(C * vth) +
+                                                fabs(K * qth) + fabs(kbar * (up0 + th * G))) +
+                       fabs(P);
+        double bal = v - v0 - h * (th * F1 + (1.0 - th) * F0 - C * vth - K * qth +
+                                    kbar * (up0 + th * G)) -
+                     (-1.0) * P;
+        worst_bal = fmax(worst_bal, fabs(bal) / terms);
+        wrong += fabs(q - (q0 + h * vth)) > 1e-12 * (fabs(q) + h * fabs(vth) + fabs(q0));
+        wrong += up != up0 + G || g != (wall ? g0 - q : 0.0); /* g+ = g0 + W q+ */
+        double z = q - up;
+        worst_z = fmax(worst_z, (fabs(z) - uy) / uy);
+        if (G != 0.0) {
+            yielded++;
+            worst_z = fmax(worst_z, fabs(z - (G > 0.0 ? uy : -uy)) / uy);
+        }
+        double U0 = -v0, Up = -v, ok_active = g0 - q0 + hgamma * U0 <= 0.0;
+        wrong += active != (wall && ok_active);
+        if (active) {
+            contacts += P > 0.0;
+            double sc = fabs(Up) + e * fabs(U0) + fabs(P); /* U+ = W vfree + W^ P: its terms */
+            worst_c = fmax(worst_c, fmax(-(Up + e * U0), 0.0) / sc);
+            worst_c = fmax(worst_c, P > 0.0 ? fabs(Up + e * U0) / sc : 0.0);
+            wrong += P < 0.0;
+        } else
+            wrong += P != 0.0;
+        /* the elastic step with the offset's force: its z+ decides whether G = 0 */
+        double qe = q0, ve = v0, ge = g0 - q0, Pe, upe = up0, Ge;
+        mj1_yield never = y;
+        never.uy = HUGE_VAL;
+        mj1y_step(h, th, hgamma, &s, &never, F0, F1, &qe, &ve, &ge, &Pe, &upe, &Ge);
+        int feasible = fabs(qe - up0) <= uy;
+        wrong += feasible != (G == 0.0) || Ge != 0.0;
+        if (feasible)
+            wrong += q != qe || v != ve || P != Pe;
+        if (up0 == 0.0 && feasible) { /* no offset: mj1_step's numbers, bit for bit */
+            double q1 = q0, v1 = v0, g1 = g0 - q0, P1;
+            mj1_step(h, th, hgamma, &s, F0, F1, &q1, &v1, &g1, &P1);
+            wrong += q1 != q || v1 != v || P1 != P || g1 != g;
+        }
+    }
+    CHECK(ctx, worst_bal <= 1e-12 && worst_z <= 1e-12 && worst_c <= 1e-12 && wrong == 0,
+          "balance off by %.3g of its terms, z+ beyond or off uy by %.3g uy, contact law off "
+          "by %.3g; %d other failures",
+          worst_bal, worst_z, worst_c, wrong);
+    CHECK(ctx, yielded >= 600 && contacts >= 400, "%d steps yielded, %d pushed a wall", yielded,
+          contacts);
+}
+
+/* What does not model yielding says so; bad uy and alpha are refused. */
+static void test_yield_refused(pd_test_ctx *ctx)
+{
+    pd_osc c = pd_osc_default();
+    c.Piy = 0.5;
+    pd_osc_result r;
+    pd_err e;
+    pd_run_opts o = pd_run_default_opts();
+    CHECK(ctx, pd_osc_reference(&c, &o, NULL, NULL, &r, &e) == PD_EINVAL &&
+                   strstr(e.msg, "yielding") != NULL,
+          "the event-driven reference took a yielding oscillator: %s", e.msg);
+    o.method = PD_METHOD_PENALTY;
+    CHECK(ctx, pd_osc_penalty(&c, &o, NULL, NULL, &r, &e) == PD_EINVAL, "penalty: %s", e.msg);
+    o = pd_run_default_opts();
+    o.rtol = 1e-3;
+    CHECK(ctx, pd_osc_run(&c, &o, NULL, NULL, &r, &e) == PD_EINVAL && strstr(e.msg, "rtol"),
+          "to a tolerance: %s", e.msg);
+    o = pd_run_default_opts();
+    CHECK(ctx, pd_osc_method(&c, &o) == PD_METHOD_MOREAU, "auto chose %s for a yielding spring",
+          pd_method_name(pd_osc_method(&c, &o)));
+    const double bad_piy[] = {-1.0, NAN}, bad_alpha[] = {-0.1, 1.5, NAN};
+    for (int k = 0; k < 2; k++) {
+        c.Piy = bad_piy[k];
+        CHECK(ctx, pd_osc_check(&c, &e) == PD_EINVAL && strstr(e.msg, "uy"), "Piy %g: %s",
+              bad_piy[k], e.msg);
+    }
+    c.Piy = 0.5;
+    for (int k = 0; k < 3; k++) {
+        c.alpha = bad_alpha[k];
+        CHECK(ctx, pd_osc_check(&c, &e) == PD_EINVAL && strstr(e.msg, "alpha"), "alpha %g: %s",
+              bad_alpha[k], e.msg);
+    }
+}
+
+void suite_yield(pd_test_ctx *ctx)
+{
+    PD_RUN(ctx, test_yield_unreached_is_elastic);
+    PD_RUN(ctx, test_yield_step_load_closed_form);
+    PD_RUN(ctx, test_yield_wall_converges);
+    PD_RUN(ctx, test_yield_energy_balance);
+    PD_RUN(ctx, test_yield_self_similar);
+    PD_RUN(ctx, test_yield_sampled);
+    PD_RUN(ctx, test_yield_refused);
+    PD_RUN(ctx, test_yield_step_equations);
+}
