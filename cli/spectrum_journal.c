@@ -4,6 +4,7 @@
  *   pound-spectrum-journal 1
  *   key <the canonical key of the sweep (pd_spec_key)>
  *   T <task> <umax> <u_toward> <u_away> <contact_time> <first_impact> <impacts> <steps> <cpu_s> #<fnv1a>
+ *   T ... <cpu_s> Y <ductility> <residual> #<fnv1a>      (a yielding sweep's)
  *
  * Doubles are written in C99 hexadecimal, so a resumed sweep reads back
  * exactly the bits it computed.  Each record is one write(2) on an
@@ -17,6 +18,7 @@
  * journal in place, so the sweep resumes. */
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -44,6 +46,8 @@ static int format_record(char *buf, size_t cap, long task, const pd_spec_result 
 {
     int n = snprintf(buf, cap, "T %ld %a %a %a %a %a %ld %ld %a", task, r->umax, r->u_toward,
                      r->u_away, r->contact_time, r->first_impact, r->impacts, r->steps, r->cpu_s);
+    if (n >= 0 && (size_t)n < cap && !isnan(r->ductility)) /* a yielding run's figures */
+        n += snprintf(buf + n, cap - (size_t)n, " Y %a %a", r->ductility, r->residual);
     if (n < 0 || (size_t)n >= cap)
         return -1;
     int m = snprintf(buf + n, cap - (size_t)n, " #%08lx\n", (unsigned long)fnv1a(buf, (size_t)n));
@@ -74,8 +78,16 @@ static int parse_record(const char *line, size_t len, long ntasks, long *task, p
     r->impacts = strtol(p, &p, 10);
     r->steps = strtol(p, &p, 10);
     r->cpu_s = strtod(p, &end);
+    r->ductility = r->residual = NAN;
+    int bad = end == p;
+    if (!bad && !strncmp(end, " Y ", 3)) { /* a yielding run's figures */
+        p = end + 3;
+        r->ductility = strtod(p, &p);
+        r->residual = strtod(p, &end);
+        bad = end == p;
+    }
     r->done = 1;
-    return end == p || *task < 0 || *task >= ntasks ? -1 : 0;
+    return bad || *task < 0 || *task >= ntasks ? -1 : 0;
 }
 
 /* An exclusive lock on the whole file, released when the process ends. */

@@ -33,22 +33,22 @@ typedef struct col_def {
     {                                                                                              \
         name, "1", offsetof(pd_spec_row, field), 1                                                 \
     }
-static const col_def point_cols[] = {DCOL("Pi2", "1", c.Pi2),
-                                     DCOL("T0", "s", T0),
-                                     DCOL("Pi1", "1", Pi1),
-                                     DCOL("umax", "m", umax),
-                                     DCOL("umax_free", "m", umax_free),
-                                     DCOL("gamma", "1", gamma),
-                                     DCOL("chi", "1", chi),
-                                     DCOL("u_toward", "m", u_toward),
-                                     DCOL("u_away", "m", u_away),
-                                     LCOL("impacts", impacts),
-                                     DCOL("contact_time", "s", contact_time),
-                                     DCOL("first_impact", "s", first_impact),
-                                     LCOL("steps", steps),
-                                     DCOL("dt", "s", dt),
-                                     DCOL("tend", "s", tend)};
-enum { NCOLS = sizeof point_cols / sizeof point_cols[0] };
+static const col_def point_cols[] = {
+    DCOL("Pi2", "1", c.Pi2), DCOL("T0", "s", T0), DCOL("Pi1", "1", Pi1), DCOL("umax", "m", umax),
+    DCOL("umax_free", "m", umax_free), DCOL("gamma", "1", gamma), DCOL("chi", "1", chi),
+    DCOL("u_toward", "m", u_toward), DCOL("u_away", "m", u_away), LCOL("impacts", impacts),
+    DCOL("contact_time", "s", contact_time), DCOL("first_impact", "s", first_impact),
+    LCOL("steps", steps), DCOL("dt", "s", dt), DCOL("tend", "s", tend),
+    /* a yielding sweep's, last (ncols) */
+    DCOL("ductility", "1", ductility), DCOL("ductility_free", "1", ductility_free),
+    DCOL("residual_uy", "1", residual_uy)};
+enum { NCOLS = sizeof point_cols / sizeof point_cols[0], NYIELD_COLS = 3 };
+
+/* The columns of s's points: the yielding ones for a yielding sweep only. */
+static int ncols(const pd_spectrum *s)
+{
+    return pd_osc_yields(&s->base) ? NCOLS : NCOLS - NYIELD_COLS;
+}
 
 /* The value of column d in row r. */
 static double col_value(const pd_spec_row *r, const col_def *d)
@@ -113,7 +113,10 @@ static int h5_curve_attrs(hid_t g, const pd_spectrum *s, const pd_spec_row *r, l
            pd_h5_attr(g, "method", pd_method_name(s->opts.method), 0) ||
            pd_h5_num(g, "ap", r->c.ap, "m/s^2") || pd_h5_num(g, "Tp", r->c.Tp, "s") ||
            pd_h5_num(g, "Pi3", r->c.Pi3, "1") || pd_h5_num(g, "gap", r->gap, "m") ||
-           pd_h5_num(g, "eps", r->c.eps, "1") || pd_h5_num(g, "xi", r->c.xi, "1");
+           pd_h5_num(g, "eps", r->c.eps, "1") || pd_h5_num(g, "xi", r->c.xi, "1") ||
+           (pd_osc_yields(&r->c) &&
+            (pd_h5_num(g, "Piy", r->c.Piy, "1") || pd_h5_num(g, "alpha", r->c.alpha, "1") ||
+             pd_h5_num(g, "uy", pd_osc_uy(&r->c), "m")));
 }
 
 /* Group curve_NNNN: attributes and one dataset per column. */
@@ -125,7 +128,7 @@ static int h5_curve(hid_t file, hid_t gcpl, hid_t dcpl, const pd_spectrum *s,
     snprintf(name, sizeof name, "curve_%04ld", curve);
     hid_t g = H5Gcreate2(file, name, H5P_DEFAULT, gcpl, H5P_DEFAULT);
     int rc = g < 0 ? -1 : h5_curve_attrs(g, s, r, curve);
-    for (int k = 0; k < NCOLS && !rc; k++) {
+    for (int k = 0; k < ncols(s) && !rc; k++) {
         for (int j = 0; j < s->npi2; j++)
             buf[j] = col_value(&r[j], &point_cols[k]);
         rc = h5_dataset(g, dcpl, point_cols[k].name, point_cols[k].units, buf, s->npi2);
@@ -201,12 +204,12 @@ static int write_csv(const char *path, const pd_spectrum *s, const pd_spec_row *
     pd_csv_printf(&f, "# units = ");
     for (int k = 0; k < NCURVE_COLS; k++)
         pd_csv_printf(&f, "%s%s", k ? "," : "", csv_curve_cols[k][1]);
-    for (int k = 0; k < NCOLS; k++)
+    for (int k = 0; k < ncols(s); k++)
         pd_csv_printf(&f, ",%s", point_cols[k].units);
     pd_csv_printf(&f, "\n");
     for (int k = 0; k < NCURVE_COLS; k++)
         pd_csv_printf(&f, "%s%s", k ? "," : "", csv_curve_cols[k][0]);
-    for (int k = 0; k < NCOLS; k++)
+    for (int k = 0; k < ncols(s); k++)
         pd_csv_printf(&f, ",%s", point_cols[k].name);
     pd_csv_printf(&f, "\n");
     for (long p = 0; p < pd_spec_points(s) && !f.failure; p++) {
@@ -215,7 +218,7 @@ static int write_csv(const char *path, const pd_spectrum *s, const pd_spec_row *
                       pd_osc_excitation_name(&r->c), pd_dir_name(r->c.dir),
                       pd_method_name(s->opts.method), r->c.ap, r->c.Tp, r->c.Pi3, r->gap, r->c.eps,
                       r->c.xi);
-        for (int k = 0; k < NCOLS; k++)
+        for (int k = 0; k < ncols(s); k++)
             pd_csv_printf(&f, ",%.17g", col_value(r, &point_cols[k]));
         pd_csv_printf(&f, "\n");
     }
@@ -387,6 +390,14 @@ static void json_point(pd_json *js, const pd_spectrum *s, const pd_spec_row *r)
     pd_json_num(js, "tend", r->tend);
     pd_json_int(js, "steps", r->steps);
     pd_json_num(js, "cpu_s", r->cpu_s);
+    if (pd_osc_yields(&r->c)) { /* a yielding sweep */
+        pd_json_num(js, "Piy", r->c.Piy);
+        pd_json_num(js, "alpha", r->c.alpha);
+        pd_json_num(js, "uy", pd_osc_uy(&r->c));
+        pd_json_num(js, "ductility", r->ductility);
+        pd_json_num(js, "ductility_free", r->ductility_free);
+        pd_json_num(js, "residual_uy", r->residual_uy);
+    }
     pd_json_end_object(js);
 }
 
@@ -427,8 +438,15 @@ static void text_curve(const pd_spectrum *s, const pd_spec_row *r, long curve)
         hit += r[j].impacts > 0;
     }
     pd_spec_curve_label(s, curve, label, sizeof label);
-    printf("  %-36s %10.4g %10.4g %9.4g %9.4g %7d/%d\n", label, r[jmax].Pi1, r[jmax].c.Pi2, gmin,
+    printf("  %-36s %10.4g %10.4g %9.4g %9.4g %7d/%d", label, r[jmax].Pi1, r[jmax].c.Pi2, gmin,
            gmax, hit, s->npi2);
+    if (pd_osc_yields(&s->base)) { /* the peak ductility and where */
+        int jmu = 0;
+        for (int j = 0; j < s->npi2; j++)
+            jmu = r[j].ductility > r[jmu].ductility ? j : jmu;
+        printf(" %9.4g %9.4g", r[jmu].ductility, r[jmu].c.Pi2);
+    }
+    printf("\n");
 }
 
 void pd_spec_print_text(const pd_spectrum *s, const pd_spec_row *rows, const pd_spec_totals *t)
@@ -438,11 +456,17 @@ void pd_spec_print_text(const pd_spectrum *s, const pd_spec_row *rows, const pd_
     printf("pounding spectra: %ld curves x %d Pi2 in [%g, %g] (%s), %s, dt = %s\n",
            pd_spec_curves(s), s->npi2, s->pi2_min, s->pi2_max, s->linear ? "linear" : "log",
            pd_method_name(s->opts.method), rule);
-    printf("  %-36s %10s %10s %9s %9s %9s\n", "curve", "max Pi1", "at Pi2", "min gamma",
-           "max gamma", "impacting");
+    if (pd_osc_yields(&s->base))
+        printf("  yielding: Piy = %g (uy = %g m at ap = %g m/s^2), alpha = %g\n", s->base.Piy,
+               pd_osc_uy(&s->base), s->base.ap, s->base.alpha);
+    printf("  %-36s %10s %10s %9s %9s %9s%s\n", "curve", "max Pi1", "at Pi2", "min gamma",
+           "max gamma", "impacting", pd_osc_yields(&s->base) ? "    max mu    at Pi2" : "");
     for (long c = 0; c < pd_spec_curves(s); c++)
         text_curve(s, rows + c * s->npi2, c);
-    if (!strcmp(t->method_by, "default"))
+    if (!strcmp(t->method_by, "default") && pd_osc_yields(&s->base))
+        printf("  method %s: the one method that models yielding so far\n",
+               pd_method_name(s->opts.method));
+    else if (!strcmp(t->method_by, "default"))
         printf("  method %s: the default for one oscillator (%s); --method "
                "moreau|event|penalty|newmark "
                "chooses\n",

@@ -896,8 +896,9 @@ typedef struct pd_spec_coords {
 typedef struct pd_spec_result {
     double umax, u_toward, u_away, contact_time, first_impact, cpu_s;
     long impacts, steps;
-    int status; /* 0 ok, else the run's PD_E* status */
-    int done;   /* 1 once computed (or read back from the journal) */
+    double ductility, residual; /* a yielding sweep's (pd_osc_result's); NAN if elastic */
+    int status;                 /* 0 ok, else the run's PD_E* status */
+    int done;                   /* 1 once computed (or read back from the journal) */
 } pd_spec_result;
 
 /* One point of the spectrum, ready for output. */
@@ -908,6 +909,9 @@ typedef struct pd_spec_row {
     double umax, Pi1, umax_free, gamma, chi, u_toward, u_away, contact_time, first_impact;
     double cpu_s;
     long impacts, steps;
+    /* a yielding sweep (base.Piy, base.alpha; NAN if elastic): umax / uy, the
+     * no-wall twin's, and (1 - alpha) up at the end over uy */
+    double ductility, ductility_free, residual_uy;
 } pd_spec_row;
 
 /* ---- the sweep (spectrum_sweep.c) ---------------------------------------- */

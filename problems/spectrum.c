@@ -172,6 +172,10 @@ void pd_spec_resolve_method(pd_spectrum *s)
     long n = pd_spec_tasks(s);
     if (s->opts.method != PD_METHOD_AUTO)
         return;
+    if (pd_osc_yields(&s->base)) { /* Moreau-Jean's alone models yielding */
+        s->opts.method = PD_METHOD_MOREAU;
+        return;
+    }
     s->opts.method = PD_METHOD_EVENT;
     for (long t = 0; t < n; t++)
         if (!pd_spec_case(s, t, &c, &o, NULL) && o.method != PD_METHOD_EVENT) {
@@ -202,6 +206,8 @@ static void result_of(const pd_osc_result *res, pd_spec_result *r)
     r->cpu_s = res->cpu_s;
     r->impacts = res->impacts;
     r->steps = res->steps;
+    r->ductility = res->ductility;
+    r->residual = res->residual;
     r->done = 1;
 }
 
@@ -370,6 +376,8 @@ char *pd_spec_key(const pd_spectrum *s)
                s->base.record->npts, s->base.record->dt, s->base.rec_ap,
                record_checksum(s->base.record));
     tb_list(&b, "xi", s->xi, s->nxi);
+    if (pd_osc_yields(&s->base)) /* a yielding sweep's spring (elastic keys unchanged) */
+        tb_add(&b, " Piy=%a alpha=%a", s->base.Piy, s->base.alpha);
     tb_list(&b, s->size_is_gap ? "gap" : "Pi3", s->size, s->nsize);
     tb_list(&b, "eps", s->eps, s->neps);
     tb_add(&b, " Pi2=%a:%a:%d spacing=%s", s->pi2_min, s->pi2_max, s->npi2,
@@ -414,6 +422,9 @@ static void fill_row(const pd_osc *c, const pd_run_opts *o, long curve, const pd
     row->cpu_s = r->cpu_s;
     row->impacts = r->impacts;
     row->steps = r->steps;
+    row->ductility = r->ductility;
+    row->ductility_free = f->ductility;
+    row->residual_uy = r->residual / pd_osc_uy(c);
 }
 
 void pd_spec_rows(const pd_spectrum *s, const pd_spec_result *res, pd_spec_row *rows)

@@ -125,18 +125,24 @@ def parse_doc(path):
                         {"name": unquote(c["dataset"]), "shape": unquote(c["shape"]),
                          "dims": tuple(d.strip() for d in unquote(c.get("dims", "()")).strip("()").split(",") if d.strip()),
                          "dtype": c["dtype"], "units": c["units"],
-                         "valueless": "without values" in c.get("contents", "")})
+                         "valueless": "without values" in c.get("contents", ""),
+                         "yielding": YIELDING.match(c.get("contents", "")) is not None})
             elif head[0].startswith("root attribute") or head[0].startswith("attribute of"):
                 m = re.match(r"attribute of `([^`]+)`", head[0])
                 obj = m.group(1) if m else "/"
                 q = re.search(r"\((\w+)\)", head[0])
                 key = obj + (":" + q.group(1) if q else "")
-                table = doc[section]["attrs"].setdefault(key, {})
-                for r in rows:
-                    table[unquote(r[0])] = (r[1], None if r[2] == "—" else r[2])
+                for r in rows:  # a yielding run's only: their own table, key:yielding
+                    k = key + (":yielding" if YIELDING.match(r[3]) else "")
+                    doc[section]["attrs"].setdefault(k, {})[unquote(r[0])] = \
+                        (r[1], None if r[2] == "—" else r[2])
             continue
         i += 1
     return doc
+
+
+# a row the page marks "a yielding oscillator's only" or "a yielding sweep's only"
+YIELDING = re.compile(r"a yielding (oscillator|sweep)'s only")
 
 
 def pattern(name):
@@ -229,9 +235,11 @@ def check_attrs(where, obj, documented, extra=()):
         check(False, f"{where}: attribute {n} is not in docs/formats.md")
 
 
-def check_h5(ctx, path, fmt, command, env, reproducible=False, root_qualifier=None, units_all=None):
+def check_h5(ctx, path, fmt, command, env, reproducible=False, root_qualifier=None, units_all=None,
+             yielding=False):
     """An HDF5 file against the page: provenance, datasets (shape from env,
-    which may be a function of the path), attributes.  The open file."""
+    which may be a function of the path), attributes (a yielding run's
+    rows too when yielding, else none of them).  The open file."""
     ctx.files += 1
     where = os.path.basename(path)
     spec = ctx.doc[fmt]
@@ -244,14 +252,17 @@ def check_h5(ctx, path, fmt, command, env, reproducible=False, root_qualifier=No
     root = dict(spec["attrs"].get("/", {}))
     if root_qualifier:
         root.update(spec["attrs"]["/:" + root_qualifier])
+    if yielding:
+        root.update(spec["attrs"].get("/:yielding", {}))
     check_attrs(where + " /", f, {**root, **prov})
     found, shapes = [], {}
     f.visititems(lambda n, o: found.append(n) if isinstance(o, h5py.Dataset) else None)
-    for d in spec["datasets"]:
+    datasets = [d for d in spec["datasets"] if yielding or not d["yielding"]]
+    for d in datasets:
         check(any(pattern(d["name"]).match(n) for n in found), f"{where}: no dataset {d['name']}")
     for n in found:
         ds = f[n]
-        docd = [d for d in spec["datasets"] if pattern(d["name"]).match(n)]
+        docd = [d for d in datasets if pattern(d["name"]).match(n)]
         if not check(len(docd) == 1, f"{where}: dataset {n} matches {len(docd)} rows of docs/formats.md"):
             continue
         d = docd[0]
@@ -263,8 +274,10 @@ def check_h5(ctx, path, fmt, command, env, reproducible=False, root_qualifier=No
         check(len(d["dims"]) == ds.ndim, f"{where}: {n}: the page names dims {d['dims']} for {ds.ndim} axes")
         shapes[n] = (d["dims"], ds.shape)
     for key, documented in spec["attrs"].items():
-        if key.startswith("/"):
+        if key.startswith("/") or key.endswith(":yielding"):
             continue
+        if yielding:
+            documented = {**documented, **spec["attrs"].get(key + ":yielding", {})}
         rx = pattern(key)
         groups = []
         f.visititems(lambda n, o: groups.append(n) if isinstance(o, h5py.Group) and rx.match(n) else None)
@@ -369,10 +382,11 @@ def column(header, rows, name):
     return np.array([float(r[header.index(name)]) for r in rows])
 
 
-def columns(ctx, fmt):
+def columns(ctx, fmt, yielding=False):
     """The datasets of a format that are CSV columns too (not the HDF5
-    dimensions without values)."""
-    return [d for d in ctx.doc[fmt]["datasets"] if not d["valueless"]]
+    dimensions without values; a yielding run's only when yielding)."""
+    return [d for d in ctx.doc[fmt]["datasets"]
+            if not d["valueless"] and (yielding or not d["yielding"])]
 
 
 def doc_units(ctx, fmt, name):
@@ -618,6 +632,41 @@ def journal(ctx):
           "j.h5.partial: --resume did not finish the file and remove the journal")
 
 
+
+def yielding(ctx):
+    """A yielding oscillator's and a yielding sweep's files: the rows the
+    page marks as theirs present, with the figures of --json."""
+    fmt = "pound simulate oscillator 1"
+    args = ["simulate", "--Piy", "0.3", "--alpha", "0.05", "--tend", "2", "-o", "yield.h5", "--json"]
+    j = json.loads(run(ctx.pound, args, ctx.tmp))
+    f = check_h5(ctx, os.path.join(ctx.tmp, "yield.h5"), fmt, command_of(args),
+                 {"N": j["steps"] + 1}, yielding=True)
+    for k in ("ductility", "residual", "n_yield", "hysteretic_energy", "energy_residual"):
+        check(close(f.attrs[k], j[k]), f"yield.h5: attribute {k} = {f.attrs[k]!r}, --json {j[k]!r}")
+    f.close()
+    fmt = "pound spectrum 1"
+    base = ["spectrum", "--Pi2", "0.5:3:4", "--Pi3", "0.1,0.5", "--Piy", "0.4", "--alpha", "0.05"]
+    for out in ("yspec.h5", "yspec.csv"):
+        args = base + ["-o", out, "--json"]
+        j = json.loads(run(ctx.pound, args, ctx.tmp))
+        pts, path = j["points"], os.path.join(ctx.tmp, out)
+        if out.endswith(".h5"):
+            f = check_h5(ctx, path, fmt, command_of(args, spectrum=True), {"npi2": 4},
+                         reproducible=True, yielding=True)
+            mu = np.concatenate([f[c]["ductility"][:] for c in sorted(f.keys())])
+            check(all(close(a, p["ductility"]) for a, p in zip(mu, pts)), f"{out}: ductility differs from --json")
+            f.close()
+        else:
+            curve_attrs = ctx.doc[fmt]["attrs"]["curve_NNNN"]
+            cols = [(n, "1" if curve_attrs[n][0] == "text" else curve_attrs[n][1])
+                    for n in ("pulse", "dir", "method", "ap", "Tp", "Pi3", "gap", "eps", "xi")]
+            cols += [(d["name"].split("/", 1)[1], d["units"]) for d in columns(ctx, fmt, yielding=True)]
+            header, rows, _, _ = check_csv(ctx, path, fmt, command_of(args, spectrum=True), cols,
+                                           len(pts), reproducible=True)
+            check(all(close(a, p["residual_uy"]) for a, p in zip(column(header, rows, "residual_uy"), pts)),
+                  f"{out}: residual_uy differs from --json")
+
+
 def main():
     if len(sys.argv) != 2:
         sys.exit("usage: /usr/bin/python3 tests/formats_check.py PATH/TO/pound")
@@ -634,7 +683,8 @@ def main():
     version = version_of(pound)
     with tempfile.TemporaryDirectory(prefix="pound_formats_") as tmp:
         ctx = Ctx(pound, tmp, doc, version)
-        for kind in (oscillator, scene, oscillator_dump, converge, spectrum, spectrum_scene, journal):
+        for kind in (oscillator, scene, oscillator_dump, converge, spectrum, spectrum_scene, journal,
+                     yielding):
             try:
                 kind(ctx)
             except Exception as e:  # a missing dataset or attribute: one line, go on

@@ -10,8 +10,12 @@
  *   - the sampler sees the same run; the methods that do not model
  *     yielding refuse it, and bad uy, alpha are refused;
  *   - one step (mj1y_step) against its equations: balance, slider and
- *     contact complementarity, the elastic answer whenever it is feasible. */
+ *     contact complementarity, the elastic answer whenever it is feasible;
+ *   - yielding spectra: their points are the single runs, self-similar in
+ *     ap, and a stopped sweep resumes to the whole sweep's file. */
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "pd_core.h"
@@ -22,9 +26,9 @@
 /* The figures two runs of one case must share, bit for bit. */
 static int same_figures(const pd_osc_result *a, const pd_osc_result *b)
 {
-    const double x[] = {a->umax,        a->u_toward, a->u_away,  a->first_impact, a->max_impulse,
+    const double x[] = {a->umax,         a->u_toward, a->u_away,  a->first_impact, a->max_impulse,
                         a->contact_time, a->min_gap,  a->acc_max, a->shear_max},
-                 y[] = {b->umax,        b->u_toward, b->u_away,  b->first_impact, b->max_impulse,
+                 y[] = {b->umax,         b->u_toward, b->u_away,  b->first_impact, b->max_impulse,
                         b->contact_time, b->min_gap,  b->acc_max, b->shear_max};
     return memcmp(x, y, sizeof x) == 0 && a->impacts == b->impacts && a->steps == b->steps;
 }
@@ -140,8 +144,7 @@ static void test_yield_step_load_closed_form(pd_test_ctx *ctx)
                    e4 = fabs(r.hysteretic_energy - (1.0 - alpha) * w2 * uy * up) /
                         ((1.0 - alpha) * w2 * uy * up);
             err[h / 5] = fmax(err[h / 5], fmax(fmax(e1, e2), fmax(e3, e4)));
-            CHECK(ctx, r.n_yield == 1, "case %d, dt %g: %ld yield onsets, one", k, o.dt,
-                  r.n_yield);
+            CHECK(ctx, r.n_yield == 1, "case %d, dt %g: %ld yield onsets, one", k, o.dt, r.n_yield);
         }
         CHECK(ctx, err[1] <= err[0] / 2.5 && err[0] <= 1e-4,
               "case %d (alpha %g, f / Fy %g): errors up to %.3g near dt = T0/1000, %.3g near "
@@ -298,8 +301,8 @@ static void test_yield_sampled(pd_test_ctx *ctx)
               same_figures(&a, &b) && a.residual == b.residual && a.n_yield == b.n_yield &&
                   st.n == a.steps + 1 && st.umax == a.umax &&
                   fabs(st.t_last - a.tend) <= 1e-9 * a.tend,
-              "%ld samples for %ld steps, their umax %.17g (run %.17g), last at %g of %g",
-              st.n, a.steps, st.umax, a.umax, st.t_last, a.tend);
+              "%ld samples for %ld steps, their umax %.17g (run %.17g), last at %g of %g", st.n,
+              a.steps, st.umax, a.umax, st.t_last, a.tend);
 }
 
 /* One yielding step from random states (K, C, alpha, uy, h, theta, a wall
@@ -339,11 +342,12 @@ static void test_yield_step_equations(pd_test_ctx *ctx)
         double q = q0, v = v0, g = g0 - q0, P, up = up0, G;
         int active = mj1y_step(h, th, hgamma, &s, &y, F0, F1, &q, &v, &g, &P, &up, &G);
         double kbar = (1.0 - alpha) * K, vth = th * v + (1.0 - th) * v0, qth = q0 + h * th * vth;
-        double terms = fabs(v) + fabs(v0) + h * (fabs(F0) + fabs(F1) + fabs(C * vth) +
-                                                fabs(K * qth) + fabs(kbar * (up0 + th * G))) +
+        double terms = fabs(v) + fabs(v0) +
+                       h * (fabs(F0) + fabs(F1) + fabs(C * vth) + fabs(K * qth) +
+                            fabs(kbar * (up0 + th * G))) +
                        fabs(P);
-        double bal = v - v0 - h * (th * F1 + (1.0 - th) * F0 - C * vth - K * qth +
-                                    kbar * (up0 + th * G)) -
+        double bal = v - v0 -
+                     h * (th * F1 + (1.0 - th) * F0 - C * vth - K * qth + kbar * (up0 + th * G)) -
                      (-1.0) * P;
         worst_bal = fmax(worst_bal, fabs(bal) / terms);
         wrong += fabs(q - (q0 + h * vth)) > 1e-12 * (fabs(q) + h * fabs(vth) + fabs(q0));
@@ -387,6 +391,110 @@ static void test_yield_step_equations(pd_test_ctx *ctx)
           contacts);
 }
 
+/* A yielding spectrum (Piy 0.4, alpha 0.05; two gaps x 5 Pi2, ap 1 and 3):
+ * Moreau-Jean chosen, each point's ductility and residual / uy those of
+ * the single run of its case bit for bit, ductility_free its no-wall
+ * twin's; ap tripled leaves ductility and residual / uy (1e-12). */
+static void test_yield_spectrum_points(pd_test_ctx *ctx)
+{
+    pd_spectrum s;
+    pd_spec_init(&s);
+    s.base.Piy = 0.4;
+    s.base.alpha = 0.05;
+    s.pi2_min = 0.5;
+    s.pi2_max = 3.0;
+    s.npi2 = 5;
+    s.nsize = 2;
+    s.size[0] = 0.05;
+    s.size[1] = 0.3;
+    s.nap = 2;
+    s.ap[0] = 1.0;
+    s.ap[1] = 3.0;
+    s.dimensional = 1;
+    pd_spec_resolve_method(&s);
+    CHECK(ctx, s.opts.method == PD_METHOD_MOREAU, "a yielding sweep runs by %s",
+          pd_method_name(s.opts.method));
+    enum { NT = 30, NP = 20 };
+    pd_spec_result res[NT];
+    pd_spec_row rows[NP];
+    pd_err e;
+    if (!CHECK(ctx, pd_spec_tasks(&s) == NT && pd_spec_points(&s) == NP, "%ld tasks, %ld points",
+               pd_spec_tasks(&s), pd_spec_points(&s)))
+        return;
+    for (long t = 0; t < NT; t++) {
+        pd_spec_run_task(&s, t, &res[t], &e);
+        if (!CHECK(ctx, res[t].status == PD_OK, "task %ld: %s", t, e.msg))
+            return;
+    }
+    pd_spec_rows(&s, res, rows);
+    int wrong = 0, yielded = 0, paired = 0;
+    double worst = 0.0;
+    long ntw = pd_spec_twins(&s);
+    for (long p = 0; p < NP; p++) {
+        pd_osc c;
+        pd_run_opts o;
+        pd_osc_result one, twin;
+        long t = ntw + p;
+        if (pd_spec_case(&s, t, &c, &o, &e) || pd_osc_run(&c, &o, NULL, NULL, &one, &e) ||
+            pd_spec_case(&s, pd_spec_twin_of(&s, t), &c, &o, &e) ||
+            pd_osc_run(&c, &o, NULL, NULL, &twin, &e)) {
+            CHECK(ctx, 0, "point %ld: %s", p, e.msg);
+            return;
+        }
+        wrong += rows[p].ductility != one.ductility ||
+                 rows[p].residual_uy != one.residual / pd_osc_uy(&rows[p].c) ||
+                 rows[p].ductility_free != twin.ductility;
+        yielded += rows[p].ductility > 1.0;
+        /* the same point at ap 3 */
+        for (long q = 0; q < NP && rows[p].c.ap == 1.0; q++)
+            if (rows[q].c.ap == 3.0 && rows[q].c.Pi3 == rows[p].c.Pi3 &&
+                rows[q].c.Pi2 == rows[p].c.Pi2) {
+                worst =
+                    fmax(worst, fabs(rows[q].ductility - rows[p].ductility) / rows[p].ductility);
+                worst = fmax(worst, fabs(rows[q].residual_uy - rows[p].residual_uy) /
+                                        fmax(fabs(rows[p].residual_uy), 1e-300));
+                paired++;
+            }
+    }
+    CHECK(ctx, wrong == 0 && yielded >= 10 && paired == NP / 2 && worst <= 1e-12,
+          "%d points differ from their single runs; %d of %d yield; ap tripled moves ductility "
+          "and residual / uy by %.3g (%d pairs)",
+          wrong, yielded, NP, worst, paired);
+}
+
+/* A yielding sweep stopped after 5 runs and resumed from its journal
+ * writes the file of an uninterrupted one, its ductility columns too. */
+static void test_yield_spectrum_resume(pd_test_ctx *ctx)
+{
+    if (!pd_test_have_pound(ctx))
+        return;
+    char dir[] = "/tmp/pd_yield_resumeXXXXXX", out[256], fresh[256];
+    if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
+        return;
+    snprintf(out, sizeof out, "%s/s.csv", dir);
+    snprintf(fresh, sizeof fresh, "%s/f.csv", dir);
+#define YSWEEP "spectrum", "--Pi2", "0.5:3:6", "--Piy", "0.5", "--alpha", "0.05", "--threads", "1"
+    const char *stop[] = {YSWEEP, "-o", out, "--stop-after", "5", NULL};
+    const char *resume[] = {YSWEEP, "-o", out, "--resume", NULL};
+    const char *whole[] = {YSWEEP, "-o", fresh, NULL};
+#undef YSWEEP
+    proc_out r;
+    pd_test_pound(ctx, stop, &r);
+    pd_test_proc_free(&r);
+    pd_test_pound(ctx, resume, &r);
+    CHECK(ctx, r.status == 0, "--resume: exit %d: %s", r.status, r.err);
+    pd_test_proc_free(&r);
+    pd_test_pound(ctx, whole, &r);
+    CHECK(ctx, r.status == 0, "exit %d: %s", r.status, r.err);
+    pd_test_proc_free(&r);
+    char *text = pd_test_slurp(out);
+    CHECK(ctx, text && strstr(text, ",ductility,ductility_free,residual_uy\n"),
+          "the yielding columns in %s", out);
+    free(text);
+    CHECK(ctx, pd_test_same_file(out, fresh), "the resumed file differs from a whole sweep's");
+    pd_test_rm_dir(dir);
+}
+
 /* What does not model yielding says so; bad uy and alpha are refused. */
 static void test_yield_refused(pd_test_ctx *ctx)
 {
@@ -395,8 +503,9 @@ static void test_yield_refused(pd_test_ctx *ctx)
     pd_osc_result r;
     pd_err e;
     pd_run_opts o = pd_run_default_opts();
-    CHECK(ctx, pd_osc_reference(&c, &o, NULL, NULL, &r, &e) == PD_EINVAL &&
-                   strstr(e.msg, "yielding") != NULL,
+    CHECK(ctx,
+          pd_osc_reference(&c, &o, NULL, NULL, &r, &e) == PD_EINVAL &&
+              strstr(e.msg, "yielding") != NULL,
           "the event-driven reference took a yielding oscillator: %s", e.msg);
     o.method = PD_METHOD_PENALTY;
     CHECK(ctx, pd_osc_penalty(&c, &o, NULL, NULL, &r, &e) == PD_EINVAL, "penalty: %s", e.msg);
@@ -431,4 +540,6 @@ void suite_yield(pd_test_ctx *ctx)
     PD_RUN(ctx, test_yield_sampled);
     PD_RUN(ctx, test_yield_refused);
     PD_RUN(ctx, test_yield_step_equations);
+    PD_RUN(ctx, test_yield_spectrum_points);
+    PD_RUN(ctx, test_yield_spectrum_resume);
 }

@@ -28,6 +28,9 @@ POINT_KEYS = ("pulse", "dir", "Pi2", "Pi3", "eps", "xi", "Pi1", "umax_free", "ga
               "first_impact", "ap", "Tp", "T0", "gap", "dt", "tend", "steps", "cpu_s")
 ARRAY_KEYS = ("Pi1", "gamma", "chi", "umax", "umax_free", "u_toward", "u_away",
               "contact_time", "first_impact", "impacts", "steps", "T0", "gap", "dt", "tend")
+# a yielding sweep's too (uy or Piy, alpha): the ductility of each point and
+# of its no-wall twin, the residual over uy
+YIELD_KEYS = ("ductility", "ductility_free", "residual_uy")
 
 
 def _list(what, v, cap):
@@ -129,6 +132,7 @@ def build(Pi2, linear=False, pulse=None, dir=None, ap=None, xi=None, Pi3=None, g
                               number("scale", case.get("scale", 1.0)))
         if not sp.dimensional:
             sp.ap[0] = sp.base.ap
+    sp.base.Piy = checked.c.Piy  # uy in metres made Piy (the sweep keeps Piy)
     sp.opts = k.opts  # dt and tend stay 0 (per point) unless given
     # the method given or implied (dt_per_Tp too), else one for the sweep
     m, key = implied_method(dict(case, dt_per_Tp=dt_per_Tp))
@@ -230,6 +234,15 @@ def sweep_rows(sp, on_point=None):
 def _point(r, method):
     """A pd_spec_row as the CLI's JSON point."""
     c = r.c
+    p = _elastic_point(r, method)
+    if lib.pd_osc_yields(c):  # a yielding sweep's, as the CLI's JSON
+        p.update(Piy=c.Piy, alpha=c.alpha, uy=lib.pd_osc_uy(c), ductility=r.ductility,
+                 ductility_free=r.ductility_free, residual_uy=r.residual_uy)
+    return p
+
+
+def _elastic_point(r, method):
+    c = r.c
     return Result(
         pulse=s(lib.pd_osc_excitation_name(c)), dir=s(lib.pd_dir_name(c.dir)), Pi2=c.Pi2,
         Pi3=c.Pi3, eps=c.eps, xi=c.xi, Pi1=r.Pi1, umax_free=r.umax_free, gamma=r.gamma,
@@ -284,7 +297,8 @@ def spectrum(Pi2: Union[Range, Sequence[float]], linear: bool = False,
         lib.pd_spec_rows(sp, res, rows)
     points = [_point(r, method) for r in rows]
     out = Result(Pi2=np.array([lib.pd_spec_pi2(sp, j) for j in range(npi2)]))
-    for key in ARRAY_KEYS:
+    keys = ARRAY_KEYS + (YIELD_KEYS if lib.pd_osc_yields(sp.base) else ())
+    for key in keys:
         dtype = np.int64 if key in ("impacts", "steps") else np.float64
         out[key] = np.array([p[key] for p in points], dtype=dtype).reshape(ncurves, npi2)
     curves = []

@@ -512,6 +512,8 @@ class PdSpecResult(Structure):
         ("cpu_s", c_double),
         ("impacts", c_long),
         ("steps", c_long),
+        ("ductility", c_double),
+        ("residual", c_double),
         ("status", c_int),
         ("done", c_int),
     ]
@@ -538,6 +540,9 @@ class PdSpecRow(Structure):
         ("cpu_s", c_double),
         ("impacts", c_long),
         ("steps", c_long),
+        ("ductility", c_double),
+        ("ductility_free", c_double),
+        ("residual_uy", c_double),
     ]
 
 

@@ -210,3 +210,14 @@ def test_simulate_yielding(cli, same, tmp_path, extra, kw):
 def test_simulate_yielding_refused(kw, named):
     with pytest.raises(pound.InputError, match=named):
         pound.simulate(history=False, **kw)
+
+
+def test_spectrum_yielding(cli, same):
+    """A yielding sweep: the CLI's points (ductility, residual_uy, the
+    spring's Piy, alpha, uy) and arrays, uy in metres as the CLI's --uy."""
+    r = pound.spectrum(Pi2=(0.5, 3, 5), Pi3=[0.05, 0.3], uy=0.01, alpha=0.05)
+    js = cli("spectrum", "--Pi2", "0.5:3:5", "--Pi3", "0.05,0.3", "--uy", "0.01", "--alpha",
+             "0.05")
+    same(r.points, js["points"])
+    assert js["method"] == "moreau" and r.ductility.shape == (2, 5)
+    assert list(r.ductility.ravel()) == [p["ductility"] for p in js["points"]]
