@@ -148,6 +148,7 @@ static int dump_finish(pd_lcp_dump *d)
 /* Where the oscillator's samples go: the file (every every-th step, at most
  * rows_max rows) and the chart. */
 typedef struct osc_out {
+    const pd_osc *c; /* the oscillator (its spring's force in the rows) */
     long every, rows, rows_max;
     pd_table_writer *file;
     pd_scene_plot *plot; /* --plot: the same samples as a one-structure scene */
@@ -158,8 +159,17 @@ static const pd_column osc_cols[] = {{.name = "t", .units = "s"},
                                      {.name = "u", .units = "m"},
                                      {.name = "v", .units = "m/s"},
                                      {.name = "impulse", .units = "m/s"},
-                                     {.name = "gap", .units = "m"}};
-enum { OSC_COLS = sizeof osc_cols / sizeof osc_cols[0] };
+                                     {.name = "gap", .units = "m"},
+                                     /* a yielding oscillator's (osc_ncols) */
+                                     {.name = "up", .units = "m"},
+                                     {.name = "spring_force", .units = "N/kg"}};
+enum { OSC_COLS = sizeof osc_cols / sizeof osc_cols[0], OSC_YIELD_COLS = 2 };
+
+/* The oscillator's columns: the yielding ones for a yielding oscillator only. */
+static int osc_ncols(const pd_osc *c)
+{
+    return pd_osc_yields(c) ? OSC_COLS : OSC_COLS - OSC_YIELD_COLS;
+}
 
 /* A pd_osc_sampler: a row to the file, a point to the chart; a failed write
  * stops the run. */
@@ -178,7 +188,14 @@ static int record(const pd_osc_sample *s, void *ctx)
     }
     if (!o->file || s->step % o->every || o->rows >= o->rows_max)
         return 0;
-    double row[OSC_COLS] = {s->t, s->u, s->v, s->impulse, s->gap};
+    double w0 = PD_TWO_PI / pd_osc_T0(o->c); /* the spring's force w0^2 (u - (1 - alpha) up) */
+    double row[OSC_COLS] = {s->t,
+                            s->u,
+                            s->v,
+                            s->impulse,
+                            s->gap,
+                            s->up,
+                            w0 * w0 * (s->u - (1.0 - o->c->alpha) * s->up)};
     o->rows++;
     return pd_table_row(o->file, row) ? 1 : 0;
 }
@@ -467,14 +484,15 @@ static int simulate_oscillator(sim_args *a)
      * default dt stands for them in the size estimate, no cap on the rows */
     int tol = a->k.opts.rtol > 0.0;
     long nsteps = pd_steps_for(a->k.opts.tend, tol ? pd_osc_default_dt(&a->k.c) : a->k.opts.dt);
-    osc_out o = {.every = a->every, .rows_max = tol ? LONG_MAX : nsteps / a->every + 1};
-    if (a->out &&
-        (status = check_output_size(a->out, output_bytes(a->out, nsteps / a->every + 1, OSC_COLS))))
+    osc_out o = {
+        .c = &a->k.c, .every = a->every, .rows_max = tol ? LONG_MAX : nsteps / a->every + 1};
+    if (a->out && (status = check_output_size(
+                       a->out, output_bytes(a->out, nsteps / a->every + 1, osc_ncols(&a->k.c)))))
         goto done;
     if ((status = dump_open(a, &dump, &a->k.opts)))
         goto done;
-    if (a->out &&
-        (rc = pd_table_open(&o.file, a->out, OSC_COLS, osc_cols, "t", o.rows_max, &err))) {
+    if (a->out && (rc = pd_table_open(&o.file, a->out, osc_ncols(&a->k.c), osc_cols, "t",
+                                      o.rows_max, &err))) {
         fprintf(stderr, "pound: simulate: %s\n", err.msg);
         status = rc == PD_EINVAL ? 2 : 1;
         goto done;

@@ -350,7 +350,7 @@ static int check_args(spec_args *a)
     a->k.record = checked.record; /* a record and its pulse: the sweep's */
     s->base = a->k.c;
     s->base.Piy = checked.c.Piy; /* --uy in metres made Piy: the sweep keeps Piy */
-    if (a->k.record) { /* its pulse's amplitude (times --scale) unless --ap lists them */
+    if (a->k.record) {           /* its pulse's amplitude (times --scale) unless --ap lists them */
         pd_osc_set_record(&s->base, &a->k.record->rec, &a->k.record->pulse, a->k.scale);
         if (!s->dimensional)
             s->ap[0] = s->base.ap;

@@ -484,6 +484,7 @@ static inline int scalar_osc_observe_yield(void *ctx, const mj1_state *x, double
     if (sm && sm->sampler) {
         pd_osc_sample smp = pd_osc_track_sample(so->tr, &sm->sampled, x->step, tau, x->q, x->v,
                                                 x->P, sm->wp, sm->Le, sm->vscale);
+        smp.up = x->up * sm->Le;
         return sm->sampler(&smp, sm->sampler_ctx);
     }
     return 0;

@@ -374,6 +374,8 @@ typedef struct pd_osc_sample {
     double gap;     /* delta - u [m] */
     long impacts;   /* impacts begun since the last sample (over the run they sum to
                        pd_osc_result.impacts; each method's count) */
+    double up;      /* a yielding spring's plastic offset [m] (0: elastic); its force per
+                       unit mass is w0^2 (u - (1 - alpha) up) */
 } pd_osc_sample;
 
 /* Called at t = 0 and after every step (or output); return > 0 to stop. */

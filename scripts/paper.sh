@@ -82,6 +82,33 @@ unset multiplot
 GP
 done
 
+# ---- Beyond the paper: Fig. 5 for a yielding oscillator (issue 30) -------
+# Piy = uy wp^2 / ap = 0.5, alpha = 0.05: the Pi1 spectra and the ductility
+# umax / uy (Moreau-Jean: the one method that models yielding so far).
+"$pound" spectrum --pulse sine --dir normal,reverse --Pi3 0.01,0.1,0.5,1,2 --eps 0.5 --Piy 0.5 \
+    --alpha 0.05 --Pi2 0.05:5:120 -o "$tmp/fy.csv" > "$out/paper-fig5-yielding.txt"
+for d in normal reverse; do for P in 0.01 0.1 0.5 1 2; do
+    grep -v '^#' "$tmp/fy.csv" | awk -F, -v d=$d -v P=$P 'NR > 1 && $2 == d && $6 == P {print $10, $12, $25, $26, $27}' > "$tmp/fy-$d-$P"
+done; done
+gnuplot <<GP
+$term
+set output '$out/paper-fig5-yielding.png'
+set multiplot layout 2,2 title 'Fig. 5, yielding: one-sine pulse, {/Symbol P}_y = u_y {/Symbol w}_p^2 / a_p = 0.5, {/Symbol a} = 0.05, {/Symbol e} = 0.5, {/Symbol x} = 0.05 (Moreau-Jean)'
+set grid; set logscale xy; set key bottom left
+set xlabel '{/Symbol P}_2 = T_p / T_0'
+do for [d in 'normal reverse'] {
+  set title d; set ylabel '{/Symbol P}_1 = u_{max} {/Symbol w}_p^2 / a_p'
+  plot for [P in '0.01 0.1 0.5 1 2'] '$tmp/fy-'.d.'-'.P u 1:2 w l lw 2 t '{/Symbol P}_3 = '.P
+}
+set key top right
+do for [d in 'normal reverse'] {
+  set title d.': ductility'; set ylabel '{/Symbol m} = u_{max} / u_y'
+  plot for [P in '0.01 0.1 0.5 1 2'] '$tmp/fy-'.d.'-'.P u 1:3 w l lw 2 t '{/Symbol P}_3 = '.P, \
+       '$tmp/fy-'.d.'-2' u 1:4 w l lw 1 dt 2 lc rgb 'black' t 'no wall'
+}
+unset multiplot
+GP
+
 # ---- Fig. 8: time histories in the three spectral regions ---------------
 for P2 in 0.2 1 3; do
     hist "$tmp/f8-$P2" --pulse sine --dir normal --Tp 1 --Pi2 $P2 --Pi3 0.05 --eps 0.5 --method event --dt 0.001

@@ -164,7 +164,7 @@ class _History:
 
 
 OSC_SAMPLE = [("step", "i8"), ("t", "f8"), ("u", "f8"), ("v", "f8"), ("impulse", "f8"),
-              ("gap", "f8"), ("impacts", "i8")]
+              ("gap", "f8"), ("impacts", "i8"), ("up", "f8")]
 
 
 def _osc_sampler(h):
@@ -287,8 +287,9 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
     r.history: the arrays step, t, u, v, impulse, gap, impacts of every
     every-th step (the CLI's -o file: t [s], u [m], v [m/s], impulse per
     unit mass since the last sample [m/s], gap delta - u [m]; and the
-    impacts begun since the last sample), with t, u, v, impulse also as
-    r.t, r.u, r.v, r.impulse."""
+    impacts begun since the last sample; a yielding run's also up, the
+    plastic offset [m]), with t, u, v, impulse also as r.t, r.u, r.v,
+    r.impulse."""
     history, every = history_args(history, every)
     height = _demand.pop_height(case)
     k = Case(case).resolve()
@@ -328,7 +329,8 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
                    energy_residual=en.residual)
     if h is not None:
         rows = h.rows()
-        hist = Result((name, np.ascontiguousarray(rows[name])) for name, _ in OSC_SAMPLE)
+        hist = Result((name, np.ascontiguousarray(rows[name])) for name, _ in OSC_SAMPLE
+                      if name != "up" or "ductility" in out)  # up: a yielding run's
         out["history"] = hist
         for name in ("t", "u", "v", "impulse"):  # shortcuts (gap is the case's gap)
             out[name] = hist[name]

@@ -199,6 +199,7 @@ class PdOscSample(Structure):
         ("impulse", c_double),
         ("gap", c_double),
         ("impacts", c_long),
+        ("up", c_double),
     ]
 
 

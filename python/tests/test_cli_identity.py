@@ -199,8 +199,10 @@ def test_simulate_yielding(cli, same, tmp_path, extra, kw):
     r = pound.simulate(**kw)
     assert "ductility" in js and "energy_residual" in js
     same(r, js)
-    _, data = read_csv(out)
-    assert np.array_equal(r.u, data[:, 1])
+    header, data = read_csv(out)
+    assert header == ["t", "u", "v", "impulse", "gap", "up", "spring_force"]
+    assert np.array_equal(r.u, data[:, 1]) and np.array_equal(r.history["up"], data[:, 5])
+    assert "up" not in pound.simulate(every=50).history  # an elastic run's history has none
 
 
 @pytest.mark.parametrize("kw,named", [
