@@ -182,7 +182,7 @@ static int time_pressing(pd_kernel kernel, pd_lcp_method solver, long nsteps, be
 
 int pd_bench_engine(pd_json *js)
 {
-    bench_case cases[10];
+    bench_case cases[12];
     int n = 0, rc = 0;
     pd_run_opts o = pd_run_default_opts();
     /* free flight: harmonic excitation, the wall out of reach */
@@ -231,6 +231,18 @@ int pd_bench_engine(pd_json *js)
     cases[n] = (bench_case){.name = "persistent_lemke",
                             .what = "the same, general kernel, --lcp-solver lemke"};
     rc |= time_pressing(PD_KERNEL_GENERAL, PD_LCP_LEMKE, 2000000, &cases[n++]);
+    /* the yielding step (issue 30): the same runs with a spring that yields
+     * (Piy 0.3, alpha 0.05: it slides in about a tenth of the steps) */
+    pd_osc yfree_c = free_c, yimp_c = imp_c;
+    yfree_c.Piy = yimp_c.Piy = 0.3;
+    yfree_c.alpha = yimp_c.alpha = 0.05;
+    cases[n] = (bench_case){.name = "yielding_free",
+                            .what = "free_flight with a yielding spring (Piy 0.3, alpha 0.05)"};
+    rc |= time_oscillator(&yfree_c, &o, &cases[n++]);
+    cases[n] =
+        (bench_case){.name = "yielding_impacts",
+                     .what = "many_impacts with the yielding spring (it drifts off the wall)"};
+    rc |= time_oscillator(&yimp_c, &o, &cases[n++]);
     /* the batched kernel on the free flight and the impacts (shorter runs) */
     pd_run_opts ob = o;
     ob.tend = 100.0;
@@ -246,7 +258,7 @@ int pd_bench_engine(pd_json *js)
     for (int k = 0; k < n; k++) {
         const char *nm = cases[k].name;
         int batched = !strncmp(nm, "batched", 7),
-            general = strstr(nm, "general") || strstr(nm, "lemke");
+            general = strstr(nm, "general") || strstr(nm, "lemke") || strstr(nm, "yielding");
         double ops = !strcmp(nm, "persistent_scalar") ? CHAIN_CONTACT : CHAIN_FREE;
         cases[k].chain_ns = general ? NAN : ops * lat / (batched ? PD_MJB_LANES : 1);
     }
@@ -293,6 +305,10 @@ int pd_bench_engine(pd_json *js)
                "with an impulse, at %.2f ns each, measured (wall %.2f ns); batched: per "
                "oscillator, the %d lanes' chains overlapping)\n",
                CHAIN_FREE, CHAIN_CONTACT, lat, lat_wall, PD_MJB_LANES);
+        printf("  yielding: %.2fx the elastic step's time in free flight, %.2fx with impacts (the "
+               "measured run's energy sums included)\n",
+               cases[0].steps_per_s / cases[6].steps_per_s,
+               cases[1].steps_per_s / cases[7].steps_per_s);
         printf("  targets: 20e6 steps/s in free flight, 5e6 steps/s with an LCP every step\n");
     }
     return rc ? 1 : 0;

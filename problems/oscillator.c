@@ -444,8 +444,9 @@ typedef struct osc_yield {
     double q, v, up;  /* the state at the step's start */
     double F0;        /* the step's force at its start */
     /* the balance's sums over the steps, with v_th = th v+ + (1 - th) v and
-     * z_th = z + th (z+ - z): the input h v_th F_th, the damping h C v_th^2,
-     * the slider's work kbar z_th Gamma, the impacts' losses -v_th W P */
+     * z_th = z + th (z+ - z): the input h sum v_th F_th, the damping h C sum
+     * v_th^2, the slider's work kbar sum z_th Gamma, the impacts' losses
+     * -sum v_th W P (the sums kept without their constant factors) */
     double input, damping, work, impact;
     tracker *sm; /* the sampler's bridge (sampler NULL: none) */
 } osc_yield;
@@ -465,17 +466,20 @@ static inline int scalar_osc_observe_yield(void *ctx, const mj1_state *x, double
             pd_demand_osc_held(so->dem, so->h, x->P, so->Pprev, x->v, so->vprev, qs, x->F1));
     so->Pprev = x->P;
     so->vprev = x->v;
+    /* the energies of the step as it was taken (W = -1: -v_th W P = v_th P);
+     * the constant factors h, h C, kbar applied at the end (yield_result) */
+    double vth = oy->th * x->v + (1.0 - oy->th) * oy->v;
+    oy->input += vth * mj1_fth(oy->th, oy->F0, x->F1);
+    oy->damping += vth * vth;
+    if (x->P != 0.0)
+        oy->impact += vth * x->P;
     if (x->G != 0.0) {
+        double z0 = oy->q - oy->up, z1 = x->q - x->up;
         oy->n_yield += oy->Gprev == 0.0;
         oy->excursion += fabs(x->G);
+        oy->work += (z0 + oy->th * (z1 - z0)) * x->G;
     }
     oy->Gprev = x->G;
-    /* the energies of the step as it was taken (W = -1: -v_th W P = v_th P) */
-    double vth = oy->th * x->v + (1.0 - oy->th) * oy->v, z0 = oy->q - oy->up, z1 = x->q - x->up;
-    oy->input += so->h * vth * mj1_fth(oy->th, oy->F0, x->F1);
-    oy->damping += so->h * oy->C * vth * vth;
-    oy->work += oy->kbar * (z0 + oy->th * (z1 - z0)) * x->G;
-    oy->impact += vth * x->P;
     oy->q = x->q;
     oy->v = x->v;
     oy->up = x->up;
@@ -546,13 +550,13 @@ static void yield_result(const pd_osc *c, const osc_yield *oy, const mj1_state *
     res->ductility = res->umax / pd_osc_uy(c);
     res->residual = (1.0 - c->alpha) * end->up * Le;
     res->plastic_excursion = oy->excursion * Le;
-    res->hysteretic_energy = oy->work * E;
+    res->hysteretic_energy = oy->kbar * oy->work * E;
     res->n_yield = oy->n_yield;
     pd_energy *en = &res->energy;
-    en->input = oy->input * E;
+    en->input = oy->so.h * oy->input * E;
     en->kinetic = 0.5 * end->v * end->v * E;
     en->strain = 0.5 * (c->alpha * K * end->q * end->q + oy->kbar * z * z) * E;
-    en->damping = oy->damping * E;
+    en->damping = oy->so.h * oy->C * oy->damping * E;
     en->hysteretic = res->hysteretic_energy;
     en->impact = oy->impact * E;
     en->residual =
