@@ -17,7 +17,7 @@ const char pd_cli_case_help[] =
     "  --height H  the oscillator's storey height, m, for its drift ratio [3]\n"
     "  --uy U  yield displacement, m  or  --Piy X = uy wp^2/ap [none: elastic]\n"
     "  --alpha A  post-yield stiffness ratio in [0,1] [0] (a yielding oscillator runs by\n"
-    "           moreau; docs/methods.md, \"Yielding\")\n"
+    "           event or moreau; docs/methods.md, \"Yielding oscillators\")\n"
     "records (docs/records.md):\n"
     "  --record F    the ground acceleration of a record (PEER .AT2, COSMOS V2, or text\n"
     "                't a'): replaces the pulse; ap and Tp come from its fitted pulse\n"
@@ -414,10 +414,16 @@ static int check_yield(const pd_cli_case *a)
         return pd_cli_usage_error("%s: a --chain's SDOFs are elastic (a yielding row is not "
                                   "built yet)",
                                   yf);
-    if (a->opts.method != PD_METHOD_AUTO && a->opts.method != PD_METHOD_MOREAU)
-        return pd_cli_usage_error("%s: a yielding oscillator runs by --method moreau only (the "
-                                  "exact reference and the penalty methods do not model "
-                                  "yielding yet; got --method %s)",
+    if (a->opts.method == PD_METHOD_EVENT && !pd_osc_yield_exact(&a->c))
+        return pd_cli_usage_error("%s: the exact reference models a yielding spring whose "
+                                  "sliding phase is underdamped, --xi < sqrt(--alpha) (or --xi "
+                                  "0; got xi %g, alpha %g): --method moreau runs it",
+                                  yf, a->c.xi, a->c.alpha);
+    if (a->opts.method != PD_METHOD_AUTO && a->opts.method != PD_METHOD_MOREAU &&
+        a->opts.method != PD_METHOD_EVENT)
+        return pd_cli_usage_error("%s: a yielding oscillator runs by --method event or moreau "
+                                  "(the penalty methods do not model yielding yet; got --method "
+                                  "%s)",
                                   yf, pd_method_name(a->opts.method));
     if (a->opts.rtol > 0.0)
         return pd_cli_usage_error("%s: a yielding oscillator runs at a fixed step (--dt), not "

@@ -206,8 +206,10 @@ static void method_line(const pd_cli_case *k)
     const char *m = pd_method_name(k->opts.method);
     if (k->method_by)
         printf("  method    = %s (%s)\n", m, k->method_by);
-    else if (pd_osc_yields(&k->c))
-        printf("  method    = %s (the one method that models yielding so far)\n", m);
+    else if (pd_osc_yields(&k->c) && !pd_osc_yield_exact(&k->c))
+        printf("  method    = %s (the exact reference does not model this yielding spring: its "
+               "sliding phase is not underdamped, xi >= sqrt(alpha))\n",
+               m);
     else if (pd_cli_is_scene(k))
         printf("  method    = %s (the default for scenes; --method event|penalty|newmark for "
                "the others)\n",
@@ -358,7 +360,7 @@ static void print_text(const sim_args *a, const pd_osc_summary *s)
                "energy %.5g J/kg\n",
                pd_osc_uy(c), c->Piy, c->alpha, s->r.ductility, s->free.ductility, s->r.residual,
                s->r.n_yield, s->r.plastic_excursion, s->r.hysteretic_energy);
-    if (pd_osc_yields(c))
+    if (pd_osc_yields(c) && isfinite(s->r.energy.input))
         printf("  energy    = input %.6g J/kg = kinetic %.4g + strain %.4g + damping %.4g + "
                "hysteretic %.4g + impacts %.4g, residual %.2g of the input\n",
                s->r.energy.input, s->r.energy.kinetic, s->r.energy.strain, s->r.energy.damping,

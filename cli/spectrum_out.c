@@ -463,8 +463,10 @@ void pd_spec_print_text(const pd_spectrum *s, const pd_spec_row *rows, const pd_
            "max gamma", "impacting", pd_osc_yields(&s->base) ? "    max mu    at Pi2" : "");
     for (long c = 0; c < pd_spec_curves(s); c++)
         text_curve(s, rows + c * s->npi2, c);
-    if (!strcmp(t->method_by, "default") && pd_osc_yields(&s->base))
-        printf("  method %s: the one method that models yielding so far\n",
+    if (!strcmp(t->method_by, "default") && pd_osc_yields(&s->base) &&
+        !pd_osc_yield_exact(&s->base))
+        printf("  method %s: the exact reference does not model this yielding spring (xi >= "
+               "sqrt(alpha))\n",
                pd_method_name(s->opts.method));
     else if (!strcmp(t->method_by, "default"))
         printf("  method %s: the default for one oscillator (%s); --method "

@@ -14,7 +14,16 @@
  * (the ends agree, the acceleration changes sign between them and the ends
  * are within reach of zero: the acceleration's zero splits the interval).
  * The gap's interior minima are thus all located; a maximum beyond the wall
- * means the gap closed before it (grazing). */
+ * means the gap closed before it (grazing).
+ *
+ * A yielding spring (uy > 0, alpha < 1) adds two phases of the same linear
+ * form: elastic (stiffness w0^2, the offset's force (1 - alpha) w0^2 up a
+ * constant of the piece) and sliding toward sigma (stiffness alpha w0^2,
+ * the constant -sigma (1 - alpha) w0^2 uy).  Between the located turns x is
+ * monotone, so a level (the wall, or up + sigma uy: a yield onset) is
+ * crossed inside a segment exactly when its end is beyond it; a slide ends
+ * at its turn (unloading, the velocity's zero to adjacent doubles), where
+ * up = x - sigma uy; an impact while sliding unloads it too. */
 #include <math.h>
 #include <string.h>
 
@@ -52,6 +61,15 @@ typedef struct ed_run {
     long max_events, max_burst;
     double t_first;
     int stopped; /* the sampler asked to stop */
+    /* a yielding spring (yielding 0: elastic, every field below unused) */
+    int yielding;
+    int phase;         /* 0 elastic, +-1 sliding toward that side */
+    double uy;         /* the yield displacement */
+    double kbar;       /* (1 - alpha) w0^2 */
+    double up;         /* the plastic offset (while sliding: at the slide's start) */
+    double shift;      /* the phase's constant force: kbar up, or -phase kbar uy */
+    pd_sdof osc;       /* the phase's oscillator (the problem's when elastic) */
+    pd_sdof osc_slide; /* stiffness alpha w0^2, the same damping */
 } ed_run;
 
 /* A flight's origin: the piece j and the state there. */
@@ -69,6 +87,8 @@ typedef struct ed_point {
 
 /* What a bisection brackets the sign change of. */
 typedef enum {
+    ED_YIELD_HI,   /* x - up - uy: a slide toward +1 begins */
+    ED_YIELD_LO,   /* up - uy - x: a slide toward -1 begins */
     ED_GAP,        /* x - delta: gap closing */
     ED_NEG_V,      /* -v: a maximum */
     ED_NEG_LAMBDA, /* -lambda: detachment */
@@ -77,10 +97,11 @@ typedef enum {
     ED_NEG_ACC     /* -acceleration: v's maximum */
 } ed_kind;
 
-/* F(t) of piece j. */
+/* F(t) of piece j (and the phase's constant force of a yielding spring). */
 static double piece_force(const ed_run *ed, int j, double t)
 {
-    return pd_sine_piece_force(&ed->p->pieces[j], t);
+    double F = pd_sine_piece_force(&ed->p->pieces[j], t);
+    return ed->shift != 0.0 ? F + ed->shift : F;
 }
 
 /* lambda = F - w0^2 delta: the wall's force on the resting oscillator. */
@@ -90,10 +111,10 @@ static double lambda_at(const ed_run *ed, int j, double t)
     return piece_force(ed, j, t) - osc->w0 * osc->w0 * ed->p->delta;
 }
 
-/* x'' = F - 2 xi w0 v - w0^2 x (free flight). */
+/* x'' = F - 2 xi w0 v - w0^2 x (free flight, the phase's w0 and xi). */
 static double free_accel(const ed_run *ed, int j, double t, double x, double v)
 {
-    const pd_sdof *osc = &ed->p->osc;
+    const pd_sdof *osc = &ed->osc;
     return piece_force(ed, j, t) - 2.0 * osc->xi * osc->w0 * v - osc->w0 * osc->w0 * x;
 }
 
@@ -168,6 +189,8 @@ static void emit(ed_run *ed, const ed_origin *o, double tb, int in_contact)
             v = q.v;
         }
         ed->next_out++;
+        if (ed->yielding) /* the offset at t for the sampler (res->up) */
+            ed->r->up = ed->phase ? x - ed->phase * ed->uy : ed->up;
         if (ed->sampler(t, x, v, in_contact, ed->ctx) > 0) {
             ed->stopped = 1;
             return;
@@ -180,6 +203,10 @@ static double bracket_value(const ed_run *ed, const ed_origin *o, ed_kind kind, 
 {
     if (kind == ED_NEG_LAMBDA)
         return -lambda_at(ed, o->j, t);
+    if (kind == ED_YIELD_HI || kind == ED_YIELD_LO) {
+        double x = probe(ed, o, t).x;
+        return kind == ED_YIELD_HI ? x - ed->up - ed->uy : ed->up - ed->uy - x;
+    }
     if (kind == ED_ACC || kind == ED_NEG_ACC) {
         ed_point q = probe_acc(ed, o, t);
         return kind == ED_ACC ? q.acc : -q.acc;
@@ -203,6 +230,10 @@ static double value_slope(const ed_run *ed, const ed_origin *o, ed_kind kind, do
 {
     ed_point q = probe_acc(ed, o, t);
     double s = kind == ED_NEG_V ? -1.0 : 1.0;
+    if (kind == ED_YIELD_HI || kind == ED_YIELD_LO) { /* d(+-(x - up)) / dt = +-v */
+        *df = kind == ED_YIELD_HI ? q.v : -q.v;
+        return kind == ED_YIELD_HI ? q.x - ed->up - ed->uy : ed->up - ed->uy - q.x;
+    }
     if (kind == ED_GAP) {
         *df = q.v; /* d(x - delta) / dt = v */
         return q.past;
@@ -240,10 +271,10 @@ static double newton_to(const ed_run *ed, const ed_origin *o, ed_kind kind, doub
     return pd_root_newton(&r, lo, hi, w, NAN);
 }
 
-/* Event times (gap closing, detachment): to adjacent doubles. */
+/* Event times (gap closing, yield onsets, detachment): to adjacent doubles. */
 static double bisect(const ed_run *ed, const ed_origin *o, ed_kind kind, double lo, double hi)
 {
-    if (kind == ED_GAP)
+    if (kind != ED_NEG_LAMBDA)
         return newton_to(ed, o, kind, lo, hi, 0.0);
     /* the gap's slope v is at hand in closed form (Newton); lambda is bisected */
     return bisect_to(ed, o, kind, lo, hi, 0.0);
@@ -293,6 +324,58 @@ static double scan_simple(ed_run *ed, const ed_origin *o, const ed_point *a, con
     return hit;
 }
 
+/* What ended a flight's scan interval (a yielding spring's events too). */
+typedef enum { EV_NONE = 0, EV_HIT, EV_YIELD_HI, EV_YIELD_LO, EV_UNLOAD } ed_event;
+
+/* The earliest level of a yielding spring's flight crossed on the monotone
+ * segment (ta, e] moving toward s: the wall (EV_HIT), or elastic, the yield
+ * level up + s uy (EV_YIELD_HI or _LO, the one in front: the other lies
+ * behind; already beyond it at ta: at ta).  Its time, or -1. */
+static double segment_event(const ed_run *ed, const ed_origin *o, double ta, const ed_point *e,
+                            int s, ed_event *kind)
+{
+    double t = -1.0;
+    if (ed->p->wall && s > 0 && e->past > 0.0) { /* beyond the wall at e */
+        t = bisect(ed, o, ED_GAP, ta, e->t);
+        *kind = EV_HIT;
+    }
+    if (ed->phase != 0 || s == 0)
+        return t;
+    ed_kind yk = s > 0 ? ED_YIELD_HI : ED_YIELD_LO;
+    double tend = t >= 0.0 ? t : e->t; /* the yield level before the wall, if crossed */
+    if (bracket_value(ed, o, yk, tend) > 0.0) {
+        t = bracket_value(ed, o, yk, ta) > 0.0 ? ta : bisect(ed, o, yk, ta, tend);
+        *kind = s > 0 ? EV_YIELD_HI : EV_YIELD_LO;
+    }
+    return t;
+}
+
+/* scan_simple for a yielding spring: the turn in (a, b] (if any) splits it
+ * into two monotone segments, each searched for its first level; a turn
+ * ending a slide (toward the slide's side) unloads it, located to adjacent
+ * doubles.  The event's time (*kind), or -1. */
+static double scan_simple_yield(ed_run *ed, const ed_origin *o, const ed_point *a,
+                                const ed_point *b, ed_event *kind)
+{
+    int s = dir_after(a);
+    if (s != 0 && sgn(b->v) != s) {
+        ed_kind vk = s > 0 ? ED_NEG_V : ED_V;
+        double tc = ed->phase == s ? newton_to(ed, o, vk, a->t, b->t, 0.0)
+                                   : bisect_turn(ed, o, vk, a->t, b->t);
+        ed_point c = probe(ed, o, tc);
+        double t = segment_event(ed, o, a->t, &c, s, kind);
+        if (t >= 0.0)
+            return t;
+        note(ed, tc, c.x);
+        if (ed->phase == s) { /* the slide turns back: unloading */
+            *kind = EV_UNLOAD;
+            return tc;
+        }
+        return segment_event(ed, o, tc, b, -s, kind);
+    }
+    return segment_event(ed, o, a->t, b, s, kind);
+}
+
 /* v has the sign s at both ends and may dip through zero between: the
  * acceleration turns v back toward s inside and v is within reach of zero
  * at an end.  With a monotone acceleration, |v(a) - v(t)| <= |acc(a)| h. */
@@ -307,9 +390,21 @@ static int may_turn_twice(const ed_point *a, const ed_point *b, int s)
            fabs(b->v) <= TURN_MARGIN * fabs(b->acc) * h;
 }
 
+/* One interval without a double turn: scan_simple (an impact: EV_HIT), or
+ * a yielding spring's scan_simple_yield. */
+static double scan_once(ed_run *ed, const ed_origin *o, const ed_point *a, const ed_point *b,
+                        ed_event *kind)
+{
+    if (ed->yielding)
+        return scan_simple_yield(ed, o, a, b, kind);
+    *kind = EV_HIT;
+    return scan_simple(ed, o, a, b);
+}
+
 /* One scan interval (a, b]: a velocity dip through zero and back is split
  * at the acceleration's zero into two intervals of one turn each. */
-static double scan_interval(ed_run *ed, const ed_origin *o, const ed_point *a, const ed_point *b)
+static double scan_interval(ed_run *ed, const ed_origin *o, const ed_point *a, const ed_point *b,
+                            ed_event *kind)
 {
     int s = dir_after(a);
     if (s != 0 && sgn(b->v) == s && may_turn_twice(a, b, s)) {
@@ -317,14 +412,14 @@ static double scan_interval(ed_run *ed, const ed_origin *o, const ed_point *a, c
         double tm = bisect_turn(ed, o, s > 0 ? ED_ACC : ED_NEG_ACC, a->t, b->t);
         ed_point m = probe_acc(ed, o, tm);
         if (sgn(m.v) != s) { /* v crossed zero: a turn on each side of tm */
-            double hit = scan_simple(ed, o, a, &m);
+            double hit = scan_once(ed, o, a, &m, kind);
             if (hit >= 0.0)
                 return hit;
             note(ed, m.t, m.x);
-            return scan_simple(ed, o, &m, b);
+            return scan_once(ed, o, &m, b, kind);
         }
     }
-    return scan_simple(ed, o, a, b);
+    return scan_once(ed, o, a, b, kind);
 }
 
 /* Scan intervals for a flight span: equal ones of at most the scan step. */
@@ -333,11 +428,12 @@ static long scan_count(const ed_run *ed, double span)
     return span > 0.0 ? (long)fmin(fmax(1.0, ceil(span / ed->scan)), SCAN_MAX_INTERVALS) : 0;
 }
 
-/* Free flight from the origin up to tb.  Returns 1 with *t_hit when the gap
- * closes first (exactly x = delta), else 0 with the state at tb.  Every
- * velocity zero inside is an extremum (noted). */
-static int free_flight(ed_run *ed, const ed_origin *o, double tb, double *t_hit, double *x_end,
-                       double *v_end)
+/* Free flight from the origin up to tb.  Returns the event that ends it
+ * first with its time *t_hit and state (an impact exactly at x = delta, a
+ * yield onset exactly on its level, an unloading at v = 0), else EV_NONE
+ * with the state at tb.  Every velocity zero inside is an extremum (noted). */
+static ed_event free_flight(ed_run *ed, const ed_origin *o, double tb, double *t_hit, double *x_end,
+                            double *v_end)
 {
     ed_point a = {.t = o->t, .x = o->x, .v = o->v, .past = o->x - ed->p->delta};
     a.acc = free_accel(ed, o->j, o->t, o->x, o->v);
@@ -346,14 +442,20 @@ static int free_flight(ed_run *ed, const ed_origin *o, double tb, double *t_hit,
     for (long i = 1; i <= n; i++) {
         double tbi = i == n ? tb : o->t + (tb - o->t) * ((double)i / (double)n);
         ed_point b = probe_acc(ed, o, tbi);
-        double hit = scan_interval(ed, o, &a, &b);
+        ed_event kind = EV_NONE;
+        double hit = scan_interval(ed, o, &a, &b, &kind);
         if (hit >= 0.0) {
             emit(ed, o, hit, 0);
+            ed_point h = probe(ed, o, hit);
             *t_hit = hit;
-            *v_end = probe(ed, o, hit).v;
-            *x_end = ed->p->delta; /* the impact exactly at the wall */
-            note(ed, hit, ed->p->delta);
-            return 1;
+            *v_end = kind == EV_UNLOAD ? 0.0 : h.v;
+            /* the impact exactly at the wall, the onset on its level */
+            *x_end = kind == EV_HIT        ? ed->p->delta
+                     : kind == EV_YIELD_HI ? ed->up + ed->uy
+                     : kind == EV_YIELD_LO ? ed->up - ed->uy
+                                           : h.x;
+            note(ed, hit, *x_end);
+            return kind;
         }
         note(ed, b.t, b.x);
         emit(ed, o, b.t, 0);
@@ -361,7 +463,7 @@ static int free_flight(ed_run *ed, const ed_origin *o, double tb, double *t_hit,
     }
     *x_end = a.x;
     *v_end = a.v;
-    return 0;
+    return EV_NONE;
 }
 
 /* lambda is linear on a linear piece: its zero ta + lambda(ta) / -c1,
@@ -556,6 +658,47 @@ static int impact(ed_run *ed, int j, double t_hit, double vn, double tb, double 
     return PD_OK;
 }
 
+/* A yielding spring's phase: elastic (0) or sliding toward ph, its
+ * oscillator and constant force. */
+static void set_phase(ed_run *ed, int ph)
+{
+    ed->phase = ph;
+    ed->osc = ph ? ed->osc_slide : ed->p->osc;
+    ed->shift = ph ? -ph * ed->kbar * ed->uy : ed->kbar * ed->up;
+}
+
+/* A slide ends at x (unloading, or an impact): the offset moves to
+ * x - sigma uy; elastic again. */
+static void end_slide(ed_run *ed, double x)
+{
+    double up = x - ed->phase * ed->uy;
+    ed->r->excursion += fabs(up - ed->up);
+    ed->up = up;
+    set_phase(ed, 0);
+}
+
+/* A yielding spring's problem: uy >= 0 finite, alpha in [0, 1], the
+ * sliding phase underdamped, the start inside the elastic range. */
+static int check_yield(const pd_ed_sdof *p, double x0, pd_err *err)
+{
+    if (!(p->uy >= 0.0) || !isfinite(p->uy) || !(p->alpha >= 0.0 && p->alpha <= 1.0))
+        return pd_err_set(err, PD_EINVAL,
+                          "event-driven: need uy >= 0 finite and alpha in [0, 1] (uy %g, alpha "
+                          "%g)",
+                          p->uy, p->alpha);
+    if (!(p->uy > 0.0) || p->alpha == 1.0)
+        return PD_OK;
+    if (!(p->osc.xi * p->osc.xi < p->alpha) && p->osc.xi > 0.0)
+        return pd_err_set(err, PD_EINVAL,
+                          "event-driven: a yielding spring's sliding phase must be underdamped: "
+                          "xi < sqrt(alpha) (xi %g, alpha %g), or xi = 0",
+                          p->osc.xi, p->alpha);
+    if (!(fabs(x0) <= p->uy))
+        return pd_err_set(err, PD_EINVAL, "event-driven: the start x0 = %g lies beyond uy = %g", x0,
+                          p->uy);
+    return PD_OK;
+}
+
 int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opts *opts,
                    pd_ed_sampler sampler, void *ctx, pd_ed_result *res, pd_err *err)
 {
@@ -570,7 +713,7 @@ int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opt
     memset(res, 0, sizeof *res);
     res->first_impact = res->first_impact_velocity = NAN;
     res->max_impact_velocity = 0.0;
-    if ((rc = check_problem(prob, opts, err)))
+    if ((rc = check_problem(prob, opts, err)) || (rc = check_yield(prob, x0, err)))
         return rc;
     double t = prob->pieces[0].t_start, x = x0, v = v0;
     ed = (ed_run){.p = prob,
@@ -581,7 +724,14 @@ int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opt
                   .scan = scan_step(prob, 0, opts->t_end - t, opts->scan_divisions),
                   .max_events = opts->max_events,
                   .max_burst = opts->max_burst,
-                  .t_first = t};
+                  .t_first = t,
+                  .yielding = prob->uy > 0.0 && prob->alpha < 1.0,
+                  .uy = prob->uy,
+                  .kbar = (1.0 - prob->alpha) * prob->osc.w0 * prob->osc.w0,
+                  .osc = prob->osc};
+    /* the sliding phase: stiffness alpha w0^2, the damping 2 xi w0 kept */
+    double sa = sqrt(prob->alpha);
+    ed.osc_slide = (pd_sdof){.w0 = prob->osc.w0 * sa, .xi = sa > 0.0 ? prob->osc.xi / sa : 0.0};
     note(&ed, t, x);
     if (prob->wall && x >= prob->delta && v >= 0.0) { /* starting on the wall */
         x = prob->delta;
@@ -606,12 +756,31 @@ int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opt
         } else {
             ed_origin o = {.j = j, .t = t, .x = x, .v = v};
             /* the flight's constants once: each later time is two
-             * sincos of half angles and one expm1 */
-            pd_sdof_flow_init(&o.flow, &prob->osc, &prob->pieces[j], t, x, v);
-            if (free_flight(&ed, &o, tb, &t_hit, &xn, &vn)) {
+             * sincos of half angles and one expm1 (the piece with the
+             * phase's constant force, a yielding spring's) */
+            pd_sine_piece pc = prob->pieces[j];
+            if (ed.shift != 0.0)
+                pc.c0 += ed.shift;
+            pd_sdof_flow_init(&o.flow, &ed.osc, &pc, t, x, v);
+            ed_event ev = free_flight(&ed, &o, tb, &t_hit, &xn, &vn);
+            if (ev == EV_HIT) {
                 x = prob->delta;
+                if (ed.phase) /* an impact unloads a slide */
+                    end_slide(&ed, x);
                 if ((rc = impact(&ed, j, t_hit, vn, tb, &t, &v, &resting, err)))
                     break;
+                continue;
+            }
+            if (ev != EV_NONE) { /* a slide begins (on its level) or ends (v = 0) */
+                t = t_hit;
+                x = xn;
+                v = vn;
+                if (ev == EV_UNLOAD)
+                    end_slide(&ed, x);
+                else {
+                    res->n_yield++;
+                    set_phase(&ed, ev == EV_YIELD_HI ? 1 : -1);
+                }
                 continue;
             }
             t = tb;
@@ -629,6 +798,10 @@ int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opt
             }
         }
     }
+    if (ed.phase) /* sliding at the end: the offset it has reached */
+        end_slide(&ed, x);
+    res->up = ed.up;
+    res->hysteretic = ed.kbar * ed.uy * res->excursion;
     res->t_reached = t;
     return rc;
 }

@@ -634,6 +634,11 @@ typedef struct pd_ed_sdof {
     int npieces;  /* >= 1; pieces[0].t_start is the start time, starts
                        non-decreasing and finite (PD_EINVAL otherwise) */
     const pd_sine_piece *pieces;
+    /* a yielding spring (SPEC §7; uy 0, or alpha 1: elastic): w0^2 [alpha x +
+     * (1 - alpha) z], |z| <= uy, the motion in phases of closed-form flights
+     * (elastic, or sliding with stiffness alpha w0^2); the sliding phase must be
+     * underdamped (xi < sqrt(alpha), or xi = alpha = 0), the start inside |x| <= uy */
+    double uy, alpha;
 } pd_ed_sdof;
 
 typedef struct pd_ed_opts {
@@ -664,6 +669,12 @@ typedef struct pd_ed_result {
     double contact_time; /* time spent resting on the wall */
     double t_reached;    /* where the run stopped (t_end unless it failed) */
     double impulse;      /* sum of the impacts' impulses (1 + e) vn per unit mass */
+    /* a yielding spring's (0 when elastic): */
+    double up;         /* the plastic offset x - z at the end (during the run: at the
+                          sampler's t) */
+    long n_yield;      /* slides begun (yield onsets) */
+    double excursion;  /* sum of |d up| */
+    double hysteretic; /* the slider's work (1 - alpha) w0^2 uy excursion */
 } pd_ed_result;
 
 /* Called on the output grid with the exact state; return > 0 to stop. */

@@ -76,6 +76,11 @@ int pd_osc_yields(const pd_osc *c)
     return c && c->Piy > 0.0 && isfinite(c->Piy) && c->alpha < 1.0;
 }
 
+int pd_osc_yield_exact(const pd_osc *c)
+{
+    return pd_osc_yields(c) && (c->xi == 0.0 || c->xi * c->xi < c->alpha);
+}
+
 double pd_osc_excitation(const pd_osc *c, double t)
 {
     if (!c)
@@ -207,12 +212,15 @@ int pd_osc_resolve_opts(const pd_osc *c, const pd_run_opts *in, pd_run_opts *out
                           "method: event-general is the general reference for "
                           "scenes; the oscillator's exact reference is event");
     if (pd_osc_yields(c) &&
-        (out->rtol > 0.0 || (out->method != PD_METHOD_AUTO && out->method != PD_METHOD_MOREAU)))
+        (out->rtol > 0.0 || (out->method != PD_METHOD_AUTO && out->method != PD_METHOD_MOREAU &&
+                             (out->method != PD_METHOD_EVENT || !pd_osc_yield_exact(c)))))
         return pd_err_set(err, PD_EINVAL,
                           "a yielding oscillator (uy, alpha < 1) runs by Moreau-Jean at a "
-                          "fixed step only (method %s%s): the exact reference, the penalty "
-                          "methods and the tolerance do not model yielding yet",
-                          pd_method_name(out->method), out->rtol > 0.0 ? " with rtol" : "");
+                          "fixed step, or by the exact reference when its sliding phase is "
+                          "underdamped, xi < sqrt(alpha) (method %s%s, xi %g, alpha %g): the "
+                          "penalty methods and the tolerance do not model yielding yet",
+                          pd_method_name(out->method), out->rtol > 0.0 ? " with rtol" : "", c->xi,
+                          c->alpha);
     if (out->dt == 0.0 && out->rtol == 0.0)
         out->dt = pd_osc_default_dt(c);
     if (out->tend == 0.0)
@@ -241,7 +249,8 @@ pd_method pd_osc_method(const pd_osc *c, const pd_run_opts *o)
         return PD_METHOD_AUTO; /* nothing to resolve */
     if (o->method != PD_METHOD_AUTO)
         return o->method;
-    if (o->rtol > 0.0 || pd_osc_yields(c)) /* a tolerance, a yielding spring: Moreau-Jean's */
+    /* a tolerance, a yielding spring the exact reference does not model: Moreau-Jean's */
+    if (o->rtol > 0.0 || (pd_osc_yields(c) && !pd_osc_yield_exact(c)))
         return PD_METHOD_MOREAU;
     double tend = o->tend > 0.0 ? o->tend : pd_osc_default_tend(c);
     return pd_osc_scan_points(c, tend) <= PD_OSC_MAX_SCAN ? PD_METHOD_EVENT : PD_METHOD_MOREAU;
@@ -647,7 +656,8 @@ typedef struct ref_bridge {
     int rest_prev;               /* the previous sample was resting on the wall */
     double tprev, fprev, fdprev; /* its time, excitation and excitation's rate */
     long step;
-    const pd_ed_result *er; /* the run's impacts and impulse so far */
+    const pd_ed_result *er; /* the run's impacts and impulse so far (and the offset) */
+    double up_prev;         /* a yielding spring's offset at the previous sample */
     long reported;          /* impacts and impulse reported to the sampler */
     double impulse_reported;
     pd_osc_sampler sampler;
@@ -661,9 +671,15 @@ static int ref_sample(double tau, double x, double v, int in_contact, void *ctx)
      * held force is f - C x' - K x (a_abs = a_g); the interval since the
      * previous sample is smooth when it held no impact and no rest */
     double f = pd_osc_shape(b->c, tau, -1), fd = pd_osc_shape_rate(b->c, tau, -1);
-    double a = f - b->dem.C * v - b->dem.K * x;
-    int smooth = !in_contact && !b->rest_prev && b->impacts == b->impacts_prev;
-    pd_demand_osc_note(&b->dem, tau, x, v, in_contact ? NULL : &a, in_contact ? a : 0.0, smooth);
+    /* a yielding spring's force K (x - (1 - alpha) up): an elastic one's at xs;
+     * smooth since the previous sample only if the offset stayed */
+    double xs = x, up = b->er->up;
+    if (up != 0.0 || b->up_prev != 0.0)
+        xs = x - (1.0 - b->c->alpha) * up;
+    double a = f - b->dem.C * v - b->dem.K * xs;
+    int smooth = !in_contact && !b->rest_prev && b->impacts == b->impacts_prev && up == b->up_prev;
+    b->up_prev = up;
+    pd_demand_osc_note(&b->dem, tau, xs, v, in_contact ? NULL : &a, in_contact ? a : 0.0, smooth);
     /* at rest from the previous sample on, a_abs = |f|: its peak between
      * them on the cubic Hermite of (f, f') */
     if (in_contact && b->rest_prev && tau > b->tprev && b->tprev >= b->dem.tau_measure)
@@ -684,7 +700,8 @@ static int ref_sample(double tau, double x, double v, int in_contact, void *ctx)
                        .v = v * b->vscale,
                        .impulse = (b->er->impulse - b->impulse_reported) * b->vscale,
                        .gap = (b->Pi3 - x) * b->Le,
-                       .impacts = b->er->impacts - b->reported};
+                       .impacts = b->er->impacts - b->reported,
+                       .up = b->er->up * b->Le}; /* the offset at the sample (0: elastic) */
     b->reported = b->er->impacts;
     b->impulse_reported = b->er->impulse;
     return b->sampler(&s, b->ctx);
@@ -762,9 +779,13 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     if (!c || !res)
         return PD_NULL_ARG(err, !c ? "c" : "res");
     pd_err_clear(err);
-    if ((rc = pd_osc_resolve_opts(c, opts, &o, err)) ||
-        (rc = pd_osc_refuse_yield(c, "the event-driven reference", err)))
+    if ((rc = pd_osc_resolve_opts(c, opts, &o, err)))
         return rc;
+    if (pd_osc_yields(c) && !pd_osc_yield_exact(c))
+        return pd_osc_refuse_yield(c,
+                                   "the event-driven reference (a sliding phase not underdamped: "
+                                   "xi >= sqrt(alpha))",
+                                   err);
     double scan = pd_osc_scan_points(c, o.tend); /* its scan grid: the cost */
     if (!(scan <= PD_OSC_MAX_SCAN))
         return pd_err_set(err, PD_EINVAL,
@@ -780,7 +801,9 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
                        .delta = c->Pi3,
                        .e = c->eps,
                        .npieces = npieces,
-                       .pieces = pieces};
+                       .pieces = pieces,
+                       .uy = pd_osc_yields(c) ? c->Piy : 0.0,
+                       .alpha = c->alpha};
     double wp = pd_osc_wp(c), Le = pd_osc_Le(c);
     pd_ed_opts eo = pd_ed_default_opts();
     eo.t_end = wp * o.tend;
@@ -827,6 +850,15 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     res->kernel = "event";
     pd_osc_result_no_rtol(res, NAN);
     pd_osc_result_no_yield(res);
+    /* a yielding spring's figures */
+    if (pd_osc_yields(c)) {
+        double Ev = (Le * wp) * (Le * wp);
+        res->ductility = res->umax / pd_osc_uy(c);
+        res->residual = (1.0 - c->alpha) * er.up * Le;
+        res->plastic_excursion = er.excursion * Le;
+        res->hysteretic_energy = er.hysteretic * Ev;
+        res->n_yield = er.n_yield;
+    }
     pd_demand_osc_finish(res, &o, o.no_demands ? NAN : bridge.dem.peak * c->ap,
                          o.no_demands ? NAN : bridge.dem.shear * c->ap, NAN);
     res->cpu_s = pd_cpu_seconds() - cpu0;

@@ -172,7 +172,7 @@ void pd_spec_resolve_method(pd_spectrum *s)
     long n = pd_spec_tasks(s);
     if (s->opts.method != PD_METHOD_AUTO)
         return;
-    if (pd_osc_yields(&s->base)) { /* Moreau-Jean's alone models yielding */
+    if (pd_osc_yields(&s->base) && !pd_osc_yield_exact(&s->base)) { /* Moreau-Jean's alone */
         s->opts.method = PD_METHOD_MOREAU;
         return;
     }

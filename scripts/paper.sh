@@ -84,7 +84,7 @@ done
 
 # ---- Beyond the paper: Fig. 5 for a yielding oscillator (issue 30) -------
 # Piy = uy wp^2 / ap = 0.5, alpha = 0.05: the Pi1 spectra and the ductility
-# umax / uy (Moreau-Jean: the one method that models yielding so far).
+# umax / uy (the exact reference: xi^2 < alpha, its sliding phase underdamped).
 "$pound" spectrum --pulse sine --dir normal,reverse --Pi3 0.01,0.1,0.5,1,2 --eps 0.5 --Piy 0.5 \
     --alpha 0.05 --Pi2 0.05:5:120 -o "$tmp/fy.csv" > "$out/paper-fig5-yielding.txt"
 for d in normal reverse; do for P in 0.01 0.1 0.5 1 2; do
@@ -93,7 +93,7 @@ done; done
 gnuplot <<GP
 $term
 set output '$out/paper-fig5-yielding.png'
-set multiplot layout 2,2 title 'Fig. 5, yielding: one-sine pulse, {/Symbol P}_y = u_y {/Symbol w}_p^2 / a_p = 0.5, {/Symbol a} = 0.05, {/Symbol e} = 0.5, {/Symbol x} = 0.05 (Moreau-Jean)'
+set multiplot layout 2,2 title 'Fig. 5, yielding: one-sine pulse, {/Symbol P}_y = u_y {/Symbol w}_p^2 / a_p = 0.5, {/Symbol a} = 0.05, {/Symbol e} = 0.5, {/Symbol x} = 0.05 (event-driven reference)'
 set grid; set logscale xy; set key bottom left
 set xlabel '{/Symbol P}_2 = T_p / T_0'
 do for [d in 'normal reverse'] {

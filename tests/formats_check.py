@@ -637,7 +637,8 @@ def yielding(ctx):
     """A yielding oscillator's and a yielding sweep's files: the rows the
     page marks as theirs present, with the figures of --json."""
     fmt = "pound simulate oscillator 1"
-    args = ["simulate", "--Piy", "0.3", "--alpha", "0.05", "--tend", "2", "-o", "yield.h5", "--json"]
+    args = ["simulate", "--Piy", "0.3", "--alpha", "0.05", "--tend", "2", "--method", "moreau",
+            "-o", "yield.h5", "--json"]
     j = json.loads(run(ctx.pound, args, ctx.tmp))
     f = check_h5(ctx, os.path.join(ctx.tmp, "yield.h5"), fmt, command_of(args),
                  {"N": j["steps"] + 1}, yielding=True)

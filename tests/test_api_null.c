@@ -1706,16 +1706,16 @@ static long api_case_208(void)
 static long api_case_209(void)
 {
     pd_err err = {0};
-    double v = pd_osc_excitation(NULL, 1.0);
-    (void)v;
+    long v = pd_osc_yield_exact(NULL);
     (void)err;
-    return 0;
+    return v;
 }
 
 static long api_case_210(void)
 {
     pd_err err = {0};
-    pd_osc_set_record(NULL, (const pd_record *)fx_object("pd_record", "pd_osc_set_record", 1), (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_osc_set_record", 2), 1.0);
+    double v = pd_osc_excitation(NULL, 1.0);
+    (void)v;
     (void)err;
     return 0;
 }
@@ -1723,7 +1723,7 @@ static long api_case_210(void)
 static long api_case_211(void)
 {
     pd_err err = {0};
-    pd_osc_set_record((pd_osc *)fx_object("pd_osc", "pd_osc_set_record", 0), NULL, (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_osc_set_record", 2), 1.0);
+    pd_osc_set_record(NULL, (const pd_record *)fx_object("pd_record", "pd_osc_set_record", 1), (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_osc_set_record", 2), 1.0);
     (void)err;
     return 0;
 }
@@ -1731,12 +1731,20 @@ static long api_case_211(void)
 static long api_case_212(void)
 {
     pd_err err = {0};
-    pd_osc_set_record((pd_osc *)fx_object("pd_osc", "pd_osc_set_record", 0), (const pd_record *)fx_object("pd_record", "pd_osc_set_record", 1), NULL, 1.0);
+    pd_osc_set_record((pd_osc *)fx_object("pd_osc", "pd_osc_set_record", 0), NULL, (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_osc_set_record", 2), 1.0);
     (void)err;
     return 0;
 }
 
 static long api_case_213(void)
+{
+    pd_err err = {0};
+    pd_osc_set_record((pd_osc *)fx_object("pd_osc", "pd_osc_set_record", 0), (const pd_record *)fx_object("pd_record", "pd_osc_set_record", 1), NULL, 1.0);
+    (void)err;
+    return 0;
+}
+
+static long api_case_214(void)
 {
     pd_err err = {0};
     double v = pd_osc_shape(NULL, 1.0, 0);
@@ -1745,7 +1753,7 @@ static long api_case_213(void)
     return 0;
 }
 
-static long api_case_214(void)
+static long api_case_215(void)
 {
     pd_err err = {0};
     double v = pd_osc_shape_rate(NULL, 1.0, 0);
@@ -1754,7 +1762,7 @@ static long api_case_214(void)
     return 0;
 }
 
-static long api_case_215(void)
+static long api_case_216(void)
 {
     pd_err err = {0};
     double v = pd_osc_shape_end(NULL);
@@ -1763,7 +1771,7 @@ static long api_case_215(void)
     return 0;
 }
 
-static long api_case_216(void)
+static long api_case_217(void)
 {
     pd_err err = {0};
     long v = pd_osc_pieces(NULL, (pd_sine_piece **)fx_slot(), (int *)fx_object("int", "pd_osc_pieces", 2), &err);
@@ -1771,7 +1779,7 @@ static long api_case_216(void)
     return v;
 }
 
-static long api_case_217(void)
+static long api_case_218(void)
 {
     pd_err err = {0};
     long v = pd_osc_pieces((const pd_osc *)fx_object("pd_osc", "pd_osc_pieces", 0), NULL, (int *)fx_object("int", "pd_osc_pieces", 2), &err);
@@ -1779,7 +1787,7 @@ static long api_case_217(void)
     return v;
 }
 
-static long api_case_218(void)
+static long api_case_219(void)
 {
     pd_err err = {0};
     long v = pd_osc_pieces((const pd_osc *)fx_object("pd_osc", "pd_osc_pieces", 0), (pd_sine_piece **)fx_slot(), NULL, &err);
@@ -1787,7 +1795,7 @@ static long api_case_218(void)
     return v;
 }
 
-static long api_case_219(void)
+static long api_case_220(void)
 {
     pd_err err = {0};
     const char *s = pd_osc_excitation_name(NULL);
@@ -1795,7 +1803,7 @@ static long api_case_219(void)
     return s ? (long)strlen(s) + 1 : 0;
 }
 
-static long api_case_220(void)
+static long api_case_221(void)
 {
     pd_err err = {0};
     long v = pd_osc_check(NULL, &err);
@@ -1803,7 +1811,7 @@ static long api_case_220(void)
     return v;
 }
 
-static long api_case_221(void)
+static long api_case_222(void)
 {
     pd_err err = {0};
     long v = pd_osc_resolve_opts(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_resolve_opts", 1), (pd_run_opts *)fx_object("pd_run_opts", "pd_osc_resolve_opts", 2), &err);
@@ -1811,7 +1819,7 @@ static long api_case_221(void)
     return v;
 }
 
-static long api_case_222(void)
+static long api_case_223(void)
 {
     pd_err err = {0};
     long v = pd_osc_resolve_opts((const pd_osc *)fx_object("pd_osc", "pd_osc_resolve_opts", 0), NULL, (pd_run_opts *)fx_object("pd_run_opts", "pd_osc_resolve_opts", 2), &err);
@@ -1819,7 +1827,7 @@ static long api_case_222(void)
     return v;
 }
 
-static long api_case_223(void)
+static long api_case_224(void)
 {
     pd_err err = {0};
     long v = pd_osc_resolve_opts((const pd_osc *)fx_object("pd_osc", "pd_osc_resolve_opts", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_resolve_opts", 1), NULL, &err);
@@ -1827,7 +1835,7 @@ static long api_case_223(void)
     return v;
 }
 
-static long api_case_224(void)
+static long api_case_225(void)
 {
     pd_err err = {0};
     double v = pd_osc_default_dt(NULL);
@@ -1836,7 +1844,7 @@ static long api_case_224(void)
     return 0;
 }
 
-static long api_case_225(void)
+static long api_case_226(void)
 {
     pd_err err = {0};
     double v = pd_osc_default_tend(NULL);
@@ -1845,7 +1853,7 @@ static long api_case_225(void)
     return 0;
 }
 
-static long api_case_226(void)
+static long api_case_227(void)
 {
     pd_err err = {0};
     double v = pd_osc_measure_start(NULL, 1.0);
@@ -1854,7 +1862,7 @@ static long api_case_226(void)
     return 0;
 }
 
-static long api_case_227(void)
+static long api_case_228(void)
 {
     pd_err err = {0};
     pd_method v = pd_osc_method(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_method", 1));
@@ -1863,7 +1871,7 @@ static long api_case_227(void)
     return 0;
 }
 
-static long api_case_228(void)
+static long api_case_229(void)
 {
     pd_err err = {0};
     pd_method v = pd_osc_method((const pd_osc *)fx_object("pd_osc", "pd_osc_method", 0), NULL);
@@ -1872,7 +1880,7 @@ static long api_case_228(void)
     return 0;
 }
 
-static long api_case_229(void)
+static long api_case_230(void)
 {
     pd_err err = {0};
     long v = pd_osc_run(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_run", 1), NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_run", 4), &err);
@@ -1880,7 +1888,7 @@ static long api_case_229(void)
     return v;
 }
 
-static long api_case_230(void)
+static long api_case_231(void)
 {
     pd_err err = {0};
     long v = pd_osc_run((const pd_osc *)fx_object("pd_osc", "pd_osc_run", 0), NULL, NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_run", 4), &err);
@@ -1888,7 +1896,7 @@ static long api_case_230(void)
     return v;
 }
 
-static long api_case_231(void)
+static long api_case_232(void)
 {
     pd_err err = {0};
     long v = pd_osc_run((const pd_osc *)fx_object("pd_osc", "pd_osc_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_run", 1), NULL, NULL, NULL, &err);
@@ -1896,7 +1904,7 @@ static long api_case_231(void)
     return v;
 }
 
-static long api_case_232(void)
+static long api_case_233(void)
 {
     pd_err err = {0};
     long v = pd_osc_batchable(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_batchable", 1));
@@ -1904,7 +1912,7 @@ static long api_case_232(void)
     return v;
 }
 
-static long api_case_233(void)
+static long api_case_234(void)
 {
     pd_err err = {0};
     long v = pd_osc_batchable((const pd_osc *)fx_object("pd_osc", "pd_osc_batchable", 0), NULL);
@@ -1912,7 +1920,7 @@ static long api_case_233(void)
     return v;
 }
 
-static long api_case_234(void)
+static long api_case_235(void)
 {
     pd_err err = {0};
     double v = pd_osc_scan_points(NULL, 1.0);
@@ -1921,7 +1929,7 @@ static long api_case_234(void)
     return 0;
 }
 
-static long api_case_235(void)
+static long api_case_236(void)
 {
     pd_err err = {0};
     long v = pd_osc_simulate(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_simulate", 1), NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_simulate", 4), &err);
@@ -1929,7 +1937,7 @@ static long api_case_235(void)
     return v;
 }
 
-static long api_case_236(void)
+static long api_case_237(void)
 {
     pd_err err = {0};
     long v = pd_osc_simulate((const pd_osc *)fx_object("pd_osc", "pd_osc_simulate", 0), NULL, NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_simulate", 4), &err);
@@ -1937,7 +1945,7 @@ static long api_case_236(void)
     return v;
 }
 
-static long api_case_237(void)
+static long api_case_238(void)
 {
     pd_err err = {0};
     long v = pd_osc_simulate((const pd_osc *)fx_object("pd_osc", "pd_osc_simulate", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_simulate", 1), NULL, NULL, NULL, &err);
@@ -1945,7 +1953,7 @@ static long api_case_237(void)
     return v;
 }
 
-static long api_case_238(void)
+static long api_case_239(void)
 {
     pd_err err = {0};
     long v = pd_osc_reference(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_reference", 1), NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_reference", 4), &err);
@@ -1953,7 +1961,7 @@ static long api_case_238(void)
     return v;
 }
 
-static long api_case_239(void)
+static long api_case_240(void)
 {
     pd_err err = {0};
     long v = pd_osc_reference((const pd_osc *)fx_object("pd_osc", "pd_osc_reference", 0), NULL, NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_reference", 4), &err);
@@ -1961,7 +1969,7 @@ static long api_case_239(void)
     return v;
 }
 
-static long api_case_240(void)
+static long api_case_241(void)
 {
     pd_err err = {0};
     long v = pd_osc_reference((const pd_osc *)fx_object("pd_osc", "pd_osc_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_reference", 1), NULL, NULL, NULL, &err);
@@ -1969,7 +1977,7 @@ static long api_case_240(void)
     return v;
 }
 
-static long api_case_241(void)
+static long api_case_242(void)
 {
     pd_err err = {0};
     long v = pd_osc_penalty(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_penalty", 1), NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_penalty", 4), &err);
@@ -1977,7 +1985,7 @@ static long api_case_241(void)
     return v;
 }
 
-static long api_case_242(void)
+static long api_case_243(void)
 {
     pd_err err = {0};
     long v = pd_osc_penalty((const pd_osc *)fx_object("pd_osc", "pd_osc_penalty", 0), NULL, NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_penalty", 4), &err);
@@ -1985,7 +1993,7 @@ static long api_case_242(void)
     return v;
 }
 
-static long api_case_243(void)
+static long api_case_244(void)
 {
     pd_err err = {0};
     long v = pd_osc_penalty((const pd_osc *)fx_object("pd_osc", "pd_osc_penalty", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_penalty", 1), NULL, NULL, NULL, &err);
@@ -1993,7 +2001,7 @@ static long api_case_243(void)
     return v;
 }
 
-static long api_case_244(void)
+static long api_case_245(void)
 {
     pd_err err = {0};
     long v = pd_osc_summarize(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_summarize", 1), NULL, NULL, (pd_osc_summary *)fx_object("pd_osc_summary", "pd_osc_summarize", 4), &err);
@@ -2001,7 +2009,7 @@ static long api_case_244(void)
     return v;
 }
 
-static long api_case_245(void)
+static long api_case_246(void)
 {
     pd_err err = {0};
     long v = pd_osc_summarize((const pd_osc *)fx_object("pd_osc", "pd_osc_summarize", 0), NULL, NULL, NULL, (pd_osc_summary *)fx_object("pd_osc_summary", "pd_osc_summarize", 4), &err);
@@ -2009,7 +2017,7 @@ static long api_case_245(void)
     return v;
 }
 
-static long api_case_246(void)
+static long api_case_247(void)
 {
     pd_err err = {0};
     long v = pd_osc_summarize((const pd_osc *)fx_object("pd_osc", "pd_osc_summarize", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_summarize", 1), NULL, NULL, NULL, &err);
@@ -2017,7 +2025,7 @@ static long api_case_246(void)
     return v;
 }
 
-static long api_case_247(void)
+static long api_case_248(void)
 {
     pd_err err = {0};
     pd_osc_free_exact(NULL, 1.0, (double *)fx_object("double", "pd_osc_free_exact", 2), (double *)fx_object("double", "pd_osc_free_exact", 3));
@@ -2025,7 +2033,7 @@ static long api_case_247(void)
     return 0;
 }
 
-static long api_case_248(void)
+static long api_case_249(void)
 {
     pd_err err = {0};
     pd_osc_free_exact((const pd_osc *)fx_object("pd_osc", "pd_osc_free_exact", 0), 1.0, NULL, (double *)fx_object("double", "pd_osc_free_exact", 3));
@@ -2033,7 +2041,7 @@ static long api_case_248(void)
     return 0;
 }
 
-static long api_case_249(void)
+static long api_case_250(void)
 {
     pd_err err = {0};
     pd_osc_free_exact((const pd_osc *)fx_object("pd_osc", "pd_osc_free_exact", 0), 1.0, (double *)fx_object("double", "pd_osc_free_exact", 2), NULL);
@@ -2041,7 +2049,7 @@ static long api_case_249(void)
     return 0;
 }
 
-static long api_case_250(void)
+static long api_case_251(void)
 {
     pd_err err = {0};
     long v = pd_osc_free_first_contact(NULL, 1.0, (double *)fx_object("double", "pd_osc_free_first_contact", 2), (double *)fx_object("double", "pd_osc_free_first_contact", 3));
@@ -2049,7 +2057,7 @@ static long api_case_250(void)
     return v;
 }
 
-static long api_case_251(void)
+static long api_case_252(void)
 {
     pd_err err = {0};
     long v = pd_osc_free_first_contact((const pd_osc *)fx_object("pd_osc", "pd_osc_free_first_contact", 0), 1.0, NULL, (double *)fx_object("double", "pd_osc_free_first_contact", 3));
@@ -2057,7 +2065,7 @@ static long api_case_251(void)
     return v;
 }
 
-static long api_case_252(void)
+static long api_case_253(void)
 {
     pd_err err = {0};
     long v = pd_osc_free_first_contact((const pd_osc *)fx_object("pd_osc", "pd_osc_free_first_contact", 0), 1.0, (double *)fx_object("double", "pd_osc_free_first_contact", 2), NULL);
@@ -2065,7 +2073,7 @@ static long api_case_252(void)
     return v;
 }
 
-static long api_case_253(void)
+static long api_case_254(void)
 {
     pd_err err = {0};
     long v = pd_trace_alloc(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_trace_alloc", 1));
@@ -2073,7 +2081,7 @@ static long api_case_253(void)
     return v;
 }
 
-static long api_case_254(void)
+static long api_case_255(void)
 {
     pd_err err = {0};
     long v = pd_trace_alloc((pd_trace *)fx_object("pd_trace", "pd_trace_alloc", 0), NULL);
@@ -2081,7 +2089,7 @@ static long api_case_254(void)
     return v;
 }
 
-static long api_case_255(void)
+static long api_case_256(void)
 {
     pd_err err = {0};
     pd_trace_free(NULL);
@@ -2089,7 +2097,7 @@ static long api_case_255(void)
     return 0;
 }
 
-static long api_case_256(void)
+static long api_case_257(void)
 {
     pd_err err = {0};
     long v = pd_measure_reference(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_reference", 1), (pd_trace *)fx_object("pd_trace", "pd_measure_reference", 2), (pd_osc_result *)fx_object("pd_osc_result", "pd_measure_reference", 3), &err);
@@ -2097,7 +2105,7 @@ static long api_case_256(void)
     return v;
 }
 
-static long api_case_257(void)
+static long api_case_258(void)
 {
     pd_err err = {0};
     long v = pd_measure_reference((const pd_osc *)fx_object("pd_osc", "pd_measure_reference", 0), NULL, (pd_trace *)fx_object("pd_trace", "pd_measure_reference", 2), (pd_osc_result *)fx_object("pd_osc_result", "pd_measure_reference", 3), &err);
@@ -2105,7 +2113,7 @@ static long api_case_257(void)
     return v;
 }
 
-static long api_case_258(void)
+static long api_case_259(void)
 {
     pd_err err = {0};
     long v = pd_measure_reference((const pd_osc *)fx_object("pd_osc", "pd_measure_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_reference", 1), NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_measure_reference", 3), &err);
@@ -2113,7 +2121,7 @@ static long api_case_258(void)
     return v;
 }
 
-static long api_case_259(void)
+static long api_case_260(void)
 {
     pd_err err = {0};
     long v = pd_measure_reference((const pd_osc *)fx_object("pd_osc", "pd_measure_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_reference", 1), (pd_trace *)fx_object("pd_trace", "pd_measure_reference", 2), NULL, &err);
@@ -2121,7 +2129,7 @@ static long api_case_259(void)
     return v;
 }
 
-static long api_case_260(void)
+static long api_case_261(void)
 {
     pd_err err = {0};
     long v = pd_measure_run(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_run", 1), (const pd_trace *)fx_object("pd_trace", "pd_measure_run", 2), 1.0, (pd_trace *)fx_object("pd_trace", "pd_measure_run", 4), (pd_measured *)fx_object("pd_measured", "pd_measure_run", 5), &err);
@@ -2129,7 +2137,7 @@ static long api_case_260(void)
     return v;
 }
 
-static long api_case_261(void)
+static long api_case_262(void)
 {
     pd_err err = {0};
     long v = pd_measure_run((const pd_osc *)fx_object("pd_osc", "pd_measure_run", 0), NULL, (const pd_trace *)fx_object("pd_trace", "pd_measure_run", 2), 1.0, (pd_trace *)fx_object("pd_trace", "pd_measure_run", 4), (pd_measured *)fx_object("pd_measured", "pd_measure_run", 5), &err);
@@ -2137,7 +2145,7 @@ static long api_case_261(void)
     return v;
 }
 
-static long api_case_262(void)
+static long api_case_263(void)
 {
     pd_err err = {0};
     long v = pd_measure_run((const pd_osc *)fx_object("pd_osc", "pd_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_run", 1), NULL, 1.0, (pd_trace *)fx_object("pd_trace", "pd_measure_run", 4), (pd_measured *)fx_object("pd_measured", "pd_measure_run", 5), &err);
@@ -2145,7 +2153,7 @@ static long api_case_262(void)
     return v;
 }
 
-static long api_case_263(void)
+static long api_case_264(void)
 {
     pd_err err = {0};
     long v = pd_measure_run((const pd_osc *)fx_object("pd_osc", "pd_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_run", 1), (const pd_trace *)fx_object("pd_trace", "pd_measure_run", 2), 1.0, NULL, (pd_measured *)fx_object("pd_measured", "pd_measure_run", 5), &err);
@@ -2153,7 +2161,7 @@ static long api_case_263(void)
     return v;
 }
 
-static long api_case_264(void)
+static long api_case_265(void)
 {
     pd_err err = {0};
     long v = pd_measure_run((const pd_osc *)fx_object("pd_osc", "pd_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_run", 1), (const pd_trace *)fx_object("pd_trace", "pd_measure_run", 2), 1.0, (pd_trace *)fx_object("pd_trace", "pd_measure_run", 4), NULL, &err);
@@ -2161,7 +2169,7 @@ static long api_case_264(void)
     return v;
 }
 
-static long api_case_265(void)
+static long api_case_266(void)
 {
     pd_err err = {0};
     pd_scene * p = pd_scene_new(NULL);
@@ -2169,7 +2177,7 @@ static long api_case_265(void)
     return p != NULL;
 }
 
-static long api_case_266(void)
+static long api_case_267(void)
 {
     pd_err err = {0};
     pd_scene_free(NULL);
@@ -2177,7 +2185,7 @@ static long api_case_266(void)
     return 0;
 }
 
-static long api_case_267(void)
+static long api_case_268(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_sdof(NULL, (const char *)fx_string("pd_scene_add_sdof", "name"), 1.0, 1.0, 1.0, &err);
@@ -2185,7 +2193,7 @@ static long api_case_267(void)
     return v;
 }
 
-static long api_case_268(void)
+static long api_case_269(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_sdof((pd_scene *)fx_object("pd_scene", "pd_scene_add_sdof", 0), NULL, 1.0, 1.0, 1.0, &err);
@@ -2193,7 +2201,7 @@ static long api_case_268(void)
     return v;
 }
 
-static long api_case_269(void)
+static long api_case_270(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_building(NULL, (const char *)fx_string("pd_scene_add_building", "name"), 1, (const double *)fx_object("double", "pd_scene_add_building", 3), (const double *)fx_object("double", "pd_scene_add_building", 4), 1.0, &err);
@@ -2201,7 +2209,7 @@ static long api_case_269(void)
     return v;
 }
 
-static long api_case_270(void)
+static long api_case_271(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_building((pd_scene *)fx_object("pd_scene", "pd_scene_add_building", 0), NULL, 1, (const double *)fx_object("double", "pd_scene_add_building", 3), (const double *)fx_object("double", "pd_scene_add_building", 4), 1.0, &err);
@@ -2209,7 +2217,7 @@ static long api_case_270(void)
     return v;
 }
 
-static long api_case_271(void)
+static long api_case_272(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_building((pd_scene *)fx_object("pd_scene", "pd_scene_add_building", 0), (const char *)fx_string("pd_scene_add_building", "name"), 1, NULL, (const double *)fx_object("double", "pd_scene_add_building", 4), 1.0, &err);
@@ -2217,7 +2225,7 @@ static long api_case_271(void)
     return v;
 }
 
-static long api_case_272(void)
+static long api_case_273(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_building((pd_scene *)fx_object("pd_scene", "pd_scene_add_building", 0), (const char *)fx_string("pd_scene_add_building", "name"), 1, (const double *)fx_object("double", "pd_scene_add_building", 3), NULL, 1.0, &err);
@@ -2225,7 +2233,7 @@ static long api_case_272(void)
     return v;
 }
 
-static long api_case_273(void)
+static long api_case_274(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_uniform(NULL, (const char *)fx_string("pd_scene_add_uniform", "name"), 1, 1.0, 1.0, 1.0, &err);
@@ -2233,7 +2241,7 @@ static long api_case_273(void)
     return v;
 }
 
-static long api_case_274(void)
+static long api_case_275(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_uniform((pd_scene *)fx_object("pd_scene", "pd_scene_add_uniform", 0), NULL, 1, 1.0, 1.0, 1.0, &err);
@@ -2241,7 +2249,7 @@ static long api_case_274(void)
     return v;
 }
 
-static long api_case_275(void)
+static long api_case_276(void)
 {
     pd_err err = {0};
     long v = pd_scene_set_damping(NULL, (pd_damping)0, 1, 1, &err);
@@ -2249,7 +2257,7 @@ static long api_case_275(void)
     return v;
 }
 
-static long api_case_276(void)
+static long api_case_277(void)
 {
     pd_err err = {0};
     long v = pd_scene_set_heights(NULL, (const double *)fx_object("double", "pd_scene_set_heights", 1), &err);
@@ -2257,7 +2265,7 @@ static long api_case_276(void)
     return v;
 }
 
-static long api_case_277(void)
+static long api_case_278(void)
 {
     pd_err err = {0};
     long v = pd_scene_set_heights((pd_scene *)fx_object("pd_scene", "pd_scene_set_heights", 0), NULL, &err);
@@ -2265,7 +2273,7 @@ static long api_case_277(void)
     return v;
 }
 
-static long api_case_278(void)
+static long api_case_279(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_contact(NULL, 1, 1, 1, 1, 1.0, 1.0, 1, &err);
@@ -2273,7 +2281,7 @@ static long api_case_278(void)
     return v;
 }
 
-static long api_case_279(void)
+static long api_case_280(void)
 {
     pd_err err = {0};
     pd_scene * p = pd_scene_copy(NULL);
@@ -2281,7 +2289,7 @@ static long api_case_279(void)
     return p != NULL;
 }
 
-static long api_case_280(void)
+static long api_case_281(void)
 {
     pd_err err = {0};
     long v = pd_scene_find(NULL, (const char *)fx_string("pd_scene_find", "name"));
@@ -2289,7 +2297,7 @@ static long api_case_280(void)
     return v;
 }
 
-static long api_case_281(void)
+static long api_case_282(void)
 {
     pd_err err = {0};
     long v = pd_scene_find((const pd_scene *)fx_object("pd_scene", "pd_scene_find", 0), NULL);
@@ -2297,7 +2305,7 @@ static long api_case_281(void)
     return v;
 }
 
-static long api_case_282(void)
+static long api_case_283(void)
 {
     pd_err err = {0};
     long v = pd_scene_finish(NULL, &err);
@@ -2305,7 +2313,7 @@ static long api_case_282(void)
     return v;
 }
 
-static long api_case_283(void)
+static long api_case_284(void)
 {
     pd_err err = {0};
     long v = pd_scene_load(NULL, (pd_scene **)fx_slot(), &err);
@@ -2313,7 +2321,7 @@ static long api_case_283(void)
     return v;
 }
 
-static long api_case_284(void)
+static long api_case_285(void)
 {
     pd_err err = {0};
     long v = pd_scene_load((const char *)fx_string("pd_scene_load", "path"), NULL, &err);
@@ -2321,7 +2329,7 @@ static long api_case_284(void)
     return v;
 }
 
-static long api_case_285(void)
+static long api_case_286(void)
 {
     pd_err err = {0};
     long v = pd_scene_chain(1, NULL, 1.0, 1.0, 1.0, 1.0, 1.0, (pd_scene **)fx_slot(), &err);
@@ -2329,7 +2337,7 @@ static long api_case_285(void)
     return v;
 }
 
-static long api_case_286(void)
+static long api_case_287(void)
 {
     pd_err err = {0};
     long v = pd_scene_chain(1, (const pd_scene_excitation *)fx_object("pd_scene_excitation", "pd_scene_chain", 1), 1.0, 1.0, 1.0, 1.0, 1.0, NULL, &err);
@@ -2337,7 +2345,7 @@ static long api_case_286(void)
     return v;
 }
 
-static long api_case_287(void)
+static long api_case_288(void)
 {
     pd_err err = {0};
     double v = pd_scene_wp(NULL);
@@ -2346,7 +2354,7 @@ static long api_case_287(void)
     return 0;
 }
 
-static long api_case_288(void)
+static long api_case_289(void)
 {
     pd_err err = {0};
     double v = pd_scene_Le(NULL);
@@ -2355,7 +2363,7 @@ static long api_case_288(void)
     return 0;
 }
 
-static long api_case_289(void)
+static long api_case_290(void)
 {
     pd_err err = {0};
     double v = pd_scene_default_dt(NULL);
@@ -2364,7 +2372,7 @@ static long api_case_289(void)
     return 0;
 }
 
-static long api_case_290(void)
+static long api_case_291(void)
 {
     pd_err err = {0};
     double v = pd_scene_default_tend(NULL);
@@ -2373,7 +2381,7 @@ static long api_case_290(void)
     return 0;
 }
 
-static long api_case_291(void)
+static long api_case_292(void)
 {
     pd_err err = {0};
     double v = pd_scene_measure_start(NULL, 1.0);
@@ -2382,7 +2390,7 @@ static long api_case_291(void)
     return 0;
 }
 
-static long api_case_292(void)
+static long api_case_293(void)
 {
     pd_err err = {0};
     long v = pd_scene_resolve_opts(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_resolve_opts", 1), (pd_run_opts *)fx_object("pd_run_opts", "pd_scene_resolve_opts", 2), &err);
@@ -2390,7 +2398,7 @@ static long api_case_292(void)
     return v;
 }
 
-static long api_case_293(void)
+static long api_case_294(void)
 {
     pd_err err = {0};
     long v = pd_scene_resolve_opts((const pd_scene *)fx_object("pd_scene", "pd_scene_resolve_opts", 0), NULL, (pd_run_opts *)fx_object("pd_run_opts", "pd_scene_resolve_opts", 2), &err);
@@ -2398,7 +2406,7 @@ static long api_case_293(void)
     return v;
 }
 
-static long api_case_294(void)
+static long api_case_295(void)
 {
     pd_err err = {0};
     long v = pd_scene_resolve_opts((const pd_scene *)fx_object("pd_scene", "pd_scene_resolve_opts", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_resolve_opts", 1), NULL, &err);
@@ -2406,7 +2414,7 @@ static long api_case_294(void)
     return v;
 }
 
-static long api_case_295(void)
+static long api_case_296(void)
 {
     pd_err err = {0};
     long v = pd_scene_as_oscillator(NULL, (pd_osc *)fx_object("pd_osc", "pd_scene_as_oscillator", 1), (int *)fx_object("int", "pd_scene_as_oscillator", 2));
@@ -2414,7 +2422,7 @@ static long api_case_295(void)
     return v;
 }
 
-static long api_case_296(void)
+static long api_case_297(void)
 {
     pd_err err = {0};
     long v = pd_scene_as_oscillator((const pd_scene *)fx_object("pd_scene", "pd_scene_as_oscillator", 0), NULL, (int *)fx_object("int", "pd_scene_as_oscillator", 2));
@@ -2422,7 +2430,7 @@ static long api_case_296(void)
     return v;
 }
 
-static long api_case_297(void)
+static long api_case_298(void)
 {
     pd_err err = {0};
     long v = pd_scene_as_oscillator((const pd_scene *)fx_object("pd_scene", "pd_scene_as_oscillator", 0), (pd_osc *)fx_object("pd_osc", "pd_scene_as_oscillator", 1), NULL);
@@ -2430,7 +2438,7 @@ static long api_case_297(void)
     return v;
 }
 
-static long api_case_298(void)
+static long api_case_299(void)
 {
     pd_err err = {0};
     long v = pd_scene_model_build(NULL, 1, (pd_scene_model *)fx_object("pd_scene_model", "pd_scene_model_build", 2), &err);
@@ -2438,7 +2446,7 @@ static long api_case_298(void)
     return v;
 }
 
-static long api_case_299(void)
+static long api_case_300(void)
 {
     pd_err err = {0};
     long v = pd_scene_model_build((const pd_scene *)fx_object("pd_scene", "pd_scene_model_build", 0), 1, NULL, &err);
@@ -2446,7 +2454,7 @@ static long api_case_299(void)
     return v;
 }
 
-static long api_case_300(void)
+static long api_case_301(void)
 {
     pd_err err = {0};
     pd_scene_model_free(NULL);
@@ -2454,7 +2462,7 @@ static long api_case_300(void)
     return 0;
 }
 
-static long api_case_301(void)
+static long api_case_302(void)
 {
     pd_err err = {0};
     long v = pd_scene_result_alloc(NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_result_alloc", 1), &err);
@@ -2462,7 +2470,7 @@ static long api_case_301(void)
     return v;
 }
 
-static long api_case_302(void)
+static long api_case_303(void)
 {
     pd_err err = {0};
     long v = pd_scene_result_alloc((const pd_scene *)fx_object("pd_scene", "pd_scene_result_alloc", 0), NULL, &err);
@@ -2470,7 +2478,7 @@ static long api_case_302(void)
     return v;
 }
 
-static long api_case_303(void)
+static long api_case_304(void)
 {
     pd_err err = {0};
     long v = pd_scene_result_fits(NULL, (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_result_fits", 1));
@@ -2478,7 +2486,7 @@ static long api_case_303(void)
     return v;
 }
 
-static long api_case_304(void)
+static long api_case_305(void)
 {
     pd_err err = {0};
     long v = pd_scene_result_fits((const pd_scene *)fx_object("pd_scene", "pd_scene_result_fits", 0), NULL);
@@ -2486,7 +2494,7 @@ static long api_case_304(void)
     return v;
 }
 
-static long api_case_305(void)
+static long api_case_306(void)
 {
     pd_err err = {0};
     pd_scene_result_free(NULL);
@@ -2494,7 +2502,7 @@ static long api_case_305(void)
     return 0;
 }
 
-static long api_case_306(void)
+static long api_case_307(void)
 {
     pd_err err = {0};
     long v = pd_scene_run(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_run", 1), NULL, NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_run", 4), &err);
@@ -2502,7 +2510,7 @@ static long api_case_306(void)
     return v;
 }
 
-static long api_case_307(void)
+static long api_case_308(void)
 {
     pd_err err = {0};
     long v = pd_scene_run((const pd_scene *)fx_object("pd_scene", "pd_scene_run", 0), NULL, NULL, NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_run", 4), &err);
@@ -2510,7 +2518,7 @@ static long api_case_307(void)
     return v;
 }
 
-static long api_case_308(void)
+static long api_case_309(void)
 {
     pd_err err = {0};
     long v = pd_scene_run((const pd_scene *)fx_object("pd_scene", "pd_scene_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_run", 1), NULL, NULL, NULL, &err);
@@ -2518,7 +2526,7 @@ static long api_case_308(void)
     return v;
 }
 
-static long api_case_309(void)
+static long api_case_310(void)
 {
     pd_err err = {0};
     long v = pd_scene_summarize(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_summarize", 1), NULL, NULL, (pd_scene_summary *)fx_object("pd_scene_summary", "pd_scene_summarize", 4), &err);
@@ -2526,7 +2534,7 @@ static long api_case_309(void)
     return v;
 }
 
-static long api_case_310(void)
+static long api_case_311(void)
 {
     pd_err err = {0};
     long v = pd_scene_summarize((const pd_scene *)fx_object("pd_scene", "pd_scene_summarize", 0), NULL, NULL, NULL, (pd_scene_summary *)fx_object("pd_scene_summary", "pd_scene_summarize", 4), &err);
@@ -2534,7 +2542,7 @@ static long api_case_310(void)
     return v;
 }
 
-static long api_case_311(void)
+static long api_case_312(void)
 {
     pd_err err = {0};
     long v = pd_scene_summarize((const pd_scene *)fx_object("pd_scene", "pd_scene_summarize", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_summarize", 1), NULL, NULL, NULL, &err);
@@ -2542,7 +2550,7 @@ static long api_case_311(void)
     return v;
 }
 
-static long api_case_312(void)
+static long api_case_313(void)
 {
     pd_err err = {0};
     pd_scene_summary_free(NULL);
@@ -2550,7 +2558,7 @@ static long api_case_312(void)
     return 0;
 }
 
-static long api_case_313(void)
+static long api_case_314(void)
 {
     pd_err err = {0};
     long v = pd_scene_trace_alloc(NULL, (const pd_scene *)fx_object("pd_scene", "pd_scene_trace_alloc", 1), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_trace_alloc", 2), &err);
@@ -2558,7 +2566,7 @@ static long api_case_313(void)
     return v;
 }
 
-static long api_case_314(void)
+static long api_case_315(void)
 {
     pd_err err = {0};
     long v = pd_scene_trace_alloc((pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_trace_alloc", 0), NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_trace_alloc", 2), &err);
@@ -2566,7 +2574,7 @@ static long api_case_314(void)
     return v;
 }
 
-static long api_case_315(void)
+static long api_case_316(void)
 {
     pd_err err = {0};
     long v = pd_scene_trace_alloc((pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_trace_alloc", 0), (const pd_scene *)fx_object("pd_scene", "pd_scene_trace_alloc", 1), NULL, &err);
@@ -2574,7 +2582,7 @@ static long api_case_315(void)
     return v;
 }
 
-static long api_case_316(void)
+static long api_case_317(void)
 {
     pd_err err = {0};
     pd_scene_trace_free(NULL);
@@ -2582,7 +2590,7 @@ static long api_case_316(void)
     return 0;
 }
 
-static long api_case_317(void)
+static long api_case_318(void)
 {
     pd_err err = {0};
     long v = pd_scene_errors_alloc(NULL, (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_errors_alloc", 1), &err);
@@ -2590,7 +2598,7 @@ static long api_case_317(void)
     return v;
 }
 
-static long api_case_318(void)
+static long api_case_319(void)
 {
     pd_err err = {0};
     long v = pd_scene_errors_alloc((const pd_scene *)fx_object("pd_scene", "pd_scene_errors_alloc", 0), NULL, &err);
@@ -2598,7 +2606,7 @@ static long api_case_318(void)
     return v;
 }
 
-static long api_case_319(void)
+static long api_case_320(void)
 {
     pd_err err = {0};
     pd_scene_errors_free(NULL);
@@ -2606,7 +2614,7 @@ static long api_case_319(void)
     return 0;
 }
 
-static long api_case_320(void)
+static long api_case_321(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_reference(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_reference", 1), (pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_reference", 2), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_reference", 3), &err);
@@ -2614,7 +2622,7 @@ static long api_case_320(void)
     return v;
 }
 
-static long api_case_321(void)
+static long api_case_322(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_reference((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_reference", 0), NULL, (pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_reference", 2), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_reference", 3), &err);
@@ -2622,7 +2630,7 @@ static long api_case_321(void)
     return v;
 }
 
-static long api_case_322(void)
+static long api_case_323(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_reference((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_reference", 1), NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_reference", 3), &err);
@@ -2630,7 +2638,7 @@ static long api_case_322(void)
     return v;
 }
 
-static long api_case_323(void)
+static long api_case_324(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_reference((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_reference", 1), (pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_reference", 2), NULL, &err);
@@ -2638,7 +2646,7 @@ static long api_case_323(void)
     return v;
 }
 
-static long api_case_324(void)
+static long api_case_325(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2646,7 +2654,7 @@ static long api_case_324(void)
     return v;
 }
 
-static long api_case_325(void)
+static long api_case_326(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), NULL, (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2654,7 +2662,7 @@ static long api_case_325(void)
     return v;
 }
 
-static long api_case_326(void)
+static long api_case_327(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), NULL, (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2662,7 +2670,7 @@ static long api_case_326(void)
     return v;
 }
 
-static long api_case_327(void)
+static long api_case_328(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2670,7 +2678,7 @@ static long api_case_327(void)
     return v;
 }
 
-static long api_case_328(void)
+static long api_case_329(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), NULL, (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2678,7 +2686,7 @@ static long api_case_328(void)
     return v;
 }
 
-static long api_case_329(void)
+static long api_case_330(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), NULL, &err);
@@ -2686,7 +2694,7 @@ static long api_case_329(void)
     return v;
 }
 
-static long api_case_330(void)
+static long api_case_331(void)
 {
     pd_err err = {0};
     pd_spec_init(NULL);
@@ -2694,7 +2702,7 @@ static long api_case_330(void)
     return 0;
 }
 
-static long api_case_331(void)
+static long api_case_332(void)
 {
     pd_err err = {0};
     long v = pd_spec_curves(NULL);
@@ -2702,7 +2710,7 @@ static long api_case_331(void)
     return v;
 }
 
-static long api_case_332(void)
+static long api_case_333(void)
 {
     pd_err err = {0};
     long v = pd_spec_points(NULL);
@@ -2710,7 +2718,7 @@ static long api_case_332(void)
     return v;
 }
 
-static long api_case_333(void)
+static long api_case_334(void)
 {
     pd_err err = {0};
     long v = pd_spec_twins(NULL);
@@ -2718,7 +2726,7 @@ static long api_case_333(void)
     return v;
 }
 
-static long api_case_334(void)
+static long api_case_335(void)
 {
     pd_err err = {0};
     long v = pd_spec_tasks(NULL);
@@ -2726,7 +2734,7 @@ static long api_case_334(void)
     return v;
 }
 
-static long api_case_335(void)
+static long api_case_336(void)
 {
     pd_err err = {0};
     double v = pd_spec_pi2(NULL, 0);
@@ -2735,7 +2743,7 @@ static long api_case_335(void)
     return 0;
 }
 
-static long api_case_336(void)
+static long api_case_337(void)
 {
     pd_err err = {0};
     pd_spec_coords_of(NULL, 0, (pd_spec_coords *)fx_object("pd_spec_coords", "pd_spec_coords_of", 2));
@@ -2743,7 +2751,7 @@ static long api_case_336(void)
     return 0;
 }
 
-static long api_case_337(void)
+static long api_case_338(void)
 {
     pd_err err = {0};
     pd_spec_coords_of((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_coords_of", 0), 0, NULL);
@@ -2751,7 +2759,7 @@ static long api_case_337(void)
     return 0;
 }
 
-static long api_case_338(void)
+static long api_case_339(void)
 {
     pd_err err = {0};
     long v = pd_spec_twin_of(NULL, 0);
@@ -2759,7 +2767,7 @@ static long api_case_338(void)
     return v;
 }
 
-static long api_case_339(void)
+static long api_case_340(void)
 {
     pd_err err = {0};
     long v = pd_spec_case(NULL, 0, (pd_osc *)fx_object("pd_osc", "pd_spec_case", 2), (pd_run_opts *)fx_object("pd_run_opts", "pd_spec_case", 3), &err);
@@ -2767,7 +2775,7 @@ static long api_case_339(void)
     return v;
 }
 
-static long api_case_340(void)
+static long api_case_341(void)
 {
     pd_err err = {0};
     long v = pd_spec_case((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_case", 0), 0, NULL, (pd_run_opts *)fx_object("pd_run_opts", "pd_spec_case", 3), &err);
@@ -2775,7 +2783,7 @@ static long api_case_340(void)
     return v;
 }
 
-static long api_case_341(void)
+static long api_case_342(void)
 {
     pd_err err = {0};
     long v = pd_spec_case((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_case", 0), 0, (pd_osc *)fx_object("pd_osc", "pd_spec_case", 2), NULL, &err);
@@ -2783,7 +2791,7 @@ static long api_case_341(void)
     return v;
 }
 
-static long api_case_342(void)
+static long api_case_343(void)
 {
     pd_err err = {0};
     long v = pd_spec_validate(NULL, &err);
@@ -2791,7 +2799,7 @@ static long api_case_342(void)
     return v;
 }
 
-static long api_case_343(void)
+static long api_case_344(void)
 {
     pd_err err = {0};
     pd_spec_resolve_method(NULL);
@@ -2799,7 +2807,7 @@ static long api_case_343(void)
     return 0;
 }
 
-static long api_case_344(void)
+static long api_case_345(void)
 {
     pd_err err = {0};
     pd_spec_run_task(NULL, 0, (pd_spec_result *)fx_object("pd_spec_result", "pd_spec_run_task", 2), &err);
@@ -2807,7 +2815,7 @@ static long api_case_344(void)
     return 0;
 }
 
-static long api_case_345(void)
+static long api_case_346(void)
 {
     pd_err err = {0};
     pd_spec_run_task((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_run_task", 0), 0, NULL, &err);
@@ -2815,7 +2823,7 @@ static long api_case_345(void)
     return 0;
 }
 
-static long api_case_346(void)
+static long api_case_347(void)
 {
     pd_err err = {0};
     long v = pd_spec_stream(NULL, NULL, NULL, NULL, &err);
@@ -2823,7 +2831,7 @@ static long api_case_346(void)
     return v;
 }
 
-static long api_case_347(void)
+static long api_case_348(void)
 {
     pd_err err = {0};
     double v = pd_spec_cost(NULL, 0);
@@ -2832,7 +2840,7 @@ static long api_case_347(void)
     return 0;
 }
 
-static long api_case_348(void)
+static long api_case_349(void)
 {
     pd_err err = {0};
     char * p = pd_spec_key(NULL);
@@ -2840,7 +2848,7 @@ static long api_case_348(void)
     return p != NULL;
 }
 
-static long api_case_349(void)
+static long api_case_350(void)
 {
     pd_err err = {0};
     pd_spec_rows(NULL, (const pd_spec_result *)fx_object("pd_spec_result", "pd_spec_rows", 1), (pd_spec_row *)fx_object("pd_spec_row", "pd_spec_rows", 2));
@@ -2848,7 +2856,7 @@ static long api_case_349(void)
     return 0;
 }
 
-static long api_case_350(void)
+static long api_case_351(void)
 {
     pd_err err = {0};
     pd_spec_rows((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_rows", 0), NULL, (pd_spec_row *)fx_object("pd_spec_row", "pd_spec_rows", 2));
@@ -2856,7 +2864,7 @@ static long api_case_350(void)
     return 0;
 }
 
-static long api_case_351(void)
+static long api_case_352(void)
 {
     pd_err err = {0};
     pd_spec_rows((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_rows", 0), (const pd_spec_result *)fx_object("pd_spec_result", "pd_spec_rows", 1), NULL);
@@ -2864,7 +2872,7 @@ static long api_case_351(void)
     return 0;
 }
 
-static long api_case_352(void)
+static long api_case_353(void)
 {
     pd_err err = {0};
     pd_spec_curve_label(NULL, 1, (char *)fx_string("pd_spec_curve_label", "buf"), 64);
@@ -2872,7 +2880,7 @@ static long api_case_352(void)
     return 0;
 }
 
-static long api_case_353(void)
+static long api_case_354(void)
 {
     pd_err err = {0};
     pd_spec_curve_label((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_curve_label", 0), 1, NULL, 64);
@@ -2880,7 +2888,7 @@ static long api_case_353(void)
     return 0;
 }
 
-static long api_case_354(void)
+static long api_case_355(void)
 {
     pd_err err = {0};
     long v = pd_spec_sweep(NULL, NULL, NULL, &err);
@@ -2888,7 +2896,7 @@ static long api_case_354(void)
     return v;
 }
 
-static long api_case_355(void)
+static long api_case_356(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_twins(NULL);
@@ -2896,7 +2904,7 @@ static long api_case_355(void)
     return v;
 }
 
-static long api_case_356(void)
+static long api_case_357(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_points(NULL);
@@ -2904,7 +2912,7 @@ static long api_case_356(void)
     return v;
 }
 
-static long api_case_357(void)
+static long api_case_358(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_check(NULL, &err);
@@ -2912,7 +2920,7 @@ static long api_case_357(void)
     return v;
 }
 
-static long api_case_358(void)
+static long api_case_359(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_scene(NULL, 0, (pd_scene **)fx_slot(), (pd_scene_point *)fx_object("pd_scene_point", "pd_scene_sweep_scene", 3), &err);
@@ -2920,7 +2928,7 @@ static long api_case_358(void)
     return v;
 }
 
-static long api_case_359(void)
+static long api_case_360(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_scene((const pd_scene_sweep *)fx_object("pd_scene_sweep", "pd_scene_sweep_scene", 0), 0, NULL, (pd_scene_point *)fx_object("pd_scene_point", "pd_scene_sweep_scene", 3), &err);
@@ -2928,7 +2936,7 @@ static long api_case_359(void)
     return v;
 }
 
-static long api_case_360(void)
+static long api_case_361(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_scene((const pd_scene_sweep *)fx_object("pd_scene_sweep", "pd_scene_sweep_scene", 0), 0, (pd_scene **)fx_slot(), NULL, &err);
@@ -2936,7 +2944,7 @@ static long api_case_360(void)
     return v;
 }
 
-static long api_case_361(void)
+static long api_case_362(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_run(NULL, 1, (pd_scene_point *)fx_object("pd_scene_point", "pd_scene_sweep_run", 2), (double *)fx_object("double", "pd_scene_sweep_run", 3), &err);
@@ -2944,7 +2952,7 @@ static long api_case_361(void)
     return v;
 }
 
-static long api_case_362(void)
+static long api_case_363(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_run((const pd_scene_sweep *)fx_object("pd_scene_sweep", "pd_scene_sweep_run", 0), 1, NULL, (double *)fx_object("double", "pd_scene_sweep_run", 3), &err);
@@ -2952,7 +2960,7 @@ static long api_case_362(void)
     return v;
 }
 
-static long api_case_363(void)
+static long api_case_364(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_run((const pd_scene_sweep *)fx_object("pd_scene_sweep", "pd_scene_sweep_run", 0), 1, (pd_scene_point *)fx_object("pd_scene_point", "pd_scene_sweep_run", 2), NULL, &err);
@@ -3170,161 +3178,162 @@ const api_null_case api_null_cases[] = {
     {.function = "pd_osc_set_uy", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_206},
     {.function = "pd_osc_uy", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_207},
     {.function = "pd_osc_yields", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_208},
-    {.function = "pd_osc_excitation", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_209},
-    {.function = "pd_osc_set_record", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_210},
-    {.function = "pd_osc_set_record", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_211},
-    {.function = "pd_osc_set_record", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_212},
-    {.function = "pd_osc_shape", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_213},
-    {.function = "pd_osc_shape_rate", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_214},
-    {.function = "pd_osc_shape_end", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_215},
-    {.function = "pd_osc_pieces", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_216},
-    {.function = "pd_osc_pieces", .argument = "pieces", .expect = EXPECT_ERROR, .call = api_case_217},
-    {.function = "pd_osc_pieces", .argument = "npieces", .expect = EXPECT_ERROR, .call = api_case_218},
-    {.function = "pd_osc_excitation_name", .argument = "c", .expect = EXPECT_NAME, .call = api_case_219},
-    {.function = "pd_osc_check", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_220},
-    {.function = "pd_osc_resolve_opts", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_221},
-    {.function = "pd_osc_resolve_opts", .argument = "in", .expect = EXPECT_NOCRASH, .call = api_case_222},
-    {.function = "pd_osc_resolve_opts", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_223},
-    {.function = "pd_osc_default_dt", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_224},
-    {.function = "pd_osc_default_tend", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_225},
-    {.function = "pd_osc_measure_start", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_226},
-    {.function = "pd_osc_method", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_227},
-    {.function = "pd_osc_method", .argument = "o", .expect = EXPECT_NOCRASH, .call = api_case_228},
-    {.function = "pd_osc_run", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_229},
-    {.function = "pd_osc_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_230},
-    {.function = "pd_osc_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_231},
-    {.function = "pd_osc_batchable", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_232},
-    {.function = "pd_osc_batchable", .argument = "o", .expect = EXPECT_COUNT, .call = api_case_233},
-    {.function = "pd_osc_scan_points", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_234},
-    {.function = "pd_osc_simulate", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_235},
-    {.function = "pd_osc_simulate", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_236},
-    {.function = "pd_osc_simulate", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_237},
-    {.function = "pd_osc_reference", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_238},
-    {.function = "pd_osc_reference", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_239},
-    {.function = "pd_osc_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_240},
-    {.function = "pd_osc_penalty", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_241},
-    {.function = "pd_osc_penalty", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_242},
-    {.function = "pd_osc_penalty", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_243},
-    {.function = "pd_osc_summarize", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_244},
-    {.function = "pd_osc_summarize", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_245},
-    {.function = "pd_osc_summarize", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_246},
-    {.function = "pd_osc_free_exact", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_247},
-    {.function = "pd_osc_free_exact", .argument = "u", .expect = EXPECT_NOCRASH, .call = api_case_248},
-    {.function = "pd_osc_free_exact", .argument = "v", .expect = EXPECT_NOCRASH, .call = api_case_249},
-    {.function = "pd_osc_free_first_contact", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_250},
-    {.function = "pd_osc_free_first_contact", .argument = "t", .expect = EXPECT_ERROR, .call = api_case_251},
-    {.function = "pd_osc_free_first_contact", .argument = "v", .expect = EXPECT_ERROR, .call = api_case_252},
-    {.function = "pd_trace_alloc", .argument = "tr", .expect = EXPECT_ERROR, .call = api_case_253},
-    {.function = "pd_trace_alloc", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_254},
-    {.function = "pd_trace_free", .argument = "tr", .expect = EXPECT_NOCRASH, .call = api_case_255},
-    {.function = "pd_measure_reference", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_256},
-    {.function = "pd_measure_reference", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_257},
-    {.function = "pd_measure_reference", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_258},
-    {.function = "pd_measure_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_259},
-    {.function = "pd_measure_run", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_260},
-    {.function = "pd_measure_run", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_261},
-    {.function = "pd_measure_run", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_262},
-    {.function = "pd_measure_run", .argument = "work", .expect = EXPECT_ERROR, .call = api_case_263},
-    {.function = "pd_measure_run", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_264},
-    {.function = "pd_scene_new", .argument = "exc", .expect = EXPECT_NOCRASH, .call = api_case_265},
-    {.function = "pd_scene_free", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_266},
-    {.function = "pd_scene_add_sdof", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_267},
-    {.function = "pd_scene_add_sdof", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_268},
-    {.function = "pd_scene_add_building", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_269},
-    {.function = "pd_scene_add_building", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_270},
-    {.function = "pd_scene_add_building", .argument = "masses", .expect = EXPECT_ERROR, .call = api_case_271},
-    {.function = "pd_scene_add_building", .argument = "stiffnesses", .expect = EXPECT_ERROR, .call = api_case_272},
-    {.function = "pd_scene_add_uniform", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_273},
-    {.function = "pd_scene_add_uniform", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_274},
-    {.function = "pd_scene_set_damping", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_275},
-    {.function = "pd_scene_set_heights", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_276},
-    {.function = "pd_scene_set_heights", .argument = "heights", .expect = EXPECT_ERROR, .call = api_case_277},
-    {.function = "pd_scene_add_contact", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_278},
-    {.function = "pd_scene_copy", .argument = "sc", .expect = EXPECT_NULL, .call = api_case_279},
-    {.function = "pd_scene_find", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_280},
-    {.function = "pd_scene_find", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_281},
-    {.function = "pd_scene_finish", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_282},
-    {.function = "pd_scene_load", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_283},
-    {.function = "pd_scene_load", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_284},
-    {.function = "pd_scene_chain", .argument = "exc", .expect = EXPECT_ERROR, .call = api_case_285},
-    {.function = "pd_scene_chain", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_286},
-    {.function = "pd_scene_wp", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_287},
-    {.function = "pd_scene_Le", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_288},
-    {.function = "pd_scene_default_dt", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_289},
-    {.function = "pd_scene_default_tend", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_290},
-    {.function = "pd_scene_measure_start", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_291},
-    {.function = "pd_scene_resolve_opts", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_292},
-    {.function = "pd_scene_resolve_opts", .argument = "in", .expect = EXPECT_NOCRASH, .call = api_case_293},
-    {.function = "pd_scene_resolve_opts", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_294},
-    {.function = "pd_scene_as_oscillator", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_295},
-    {.function = "pd_scene_as_oscillator", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_296},
-    {.function = "pd_scene_as_oscillator", .argument = "mirrored", .expect = EXPECT_COUNT, .call = api_case_297},
-    {.function = "pd_scene_model_build", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_298},
-    {.function = "pd_scene_model_build", .argument = "sm", .expect = EXPECT_ERROR, .call = api_case_299},
-    {.function = "pd_scene_model_free", .argument = "sm", .expect = EXPECT_NOCRASH, .call = api_case_300},
-    {.function = "pd_scene_result_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_301},
-    {.function = "pd_scene_result_alloc", .argument = "r", .expect = EXPECT_ERROR, .call = api_case_302},
-    {.function = "pd_scene_result_fits", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_303},
-    {.function = "pd_scene_result_fits", .argument = "r", .expect = EXPECT_COUNT, .call = api_case_304},
-    {.function = "pd_scene_result_free", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_305},
-    {.function = "pd_scene_run", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_306},
-    {.function = "pd_scene_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_307},
-    {.function = "pd_scene_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_308},
-    {.function = "pd_scene_summarize", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_309},
-    {.function = "pd_scene_summarize", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_310},
-    {.function = "pd_scene_summarize", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_311},
-    {.function = "pd_scene_summary_free", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_312},
-    {.function = "pd_scene_trace_alloc", .argument = "tr", .expect = EXPECT_ERROR, .call = api_case_313},
-    {.function = "pd_scene_trace_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_314},
-    {.function = "pd_scene_trace_alloc", .argument = "o", .expect = EXPECT_NOCRASH, .call = api_case_315},
-    {.function = "pd_scene_trace_free", .argument = "tr", .expect = EXPECT_NOCRASH, .call = api_case_316},
-    {.function = "pd_scene_errors_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_317},
-    {.function = "pd_scene_errors_alloc", .argument = "e", .expect = EXPECT_ERROR, .call = api_case_318},
-    {.function = "pd_scene_errors_free", .argument = "e", .expect = EXPECT_NOCRASH, .call = api_case_319},
-    {.function = "pd_scene_measure_reference", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_320},
-    {.function = "pd_scene_measure_reference", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_321},
-    {.function = "pd_scene_measure_reference", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_322},
-    {.function = "pd_scene_measure_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_323},
-    {.function = "pd_scene_measure_run", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_324},
-    {.function = "pd_scene_measure_run", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_325},
-    {.function = "pd_scene_measure_run", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_326},
-    {.function = "pd_scene_measure_run", .argument = "ref_res", .expect = EXPECT_ERROR, .call = api_case_327},
-    {.function = "pd_scene_measure_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_328},
-    {.function = "pd_scene_measure_run", .argument = "e", .expect = EXPECT_ERROR, .call = api_case_329},
-    {.function = "pd_spec_init", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_330},
-    {.function = "pd_spec_curves", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_331},
-    {.function = "pd_spec_points", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_332},
-    {.function = "pd_spec_twins", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_333},
-    {.function = "pd_spec_tasks", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_334},
-    {.function = "pd_spec_pi2", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_335},
-    {.function = "pd_spec_coords_of", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_336},
-    {.function = "pd_spec_coords_of", .argument = "co", .expect = EXPECT_NOCRASH, .call = api_case_337},
-    {.function = "pd_spec_twin_of", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_338},
-    {.function = "pd_spec_case", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_339},
-    {.function = "pd_spec_case", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_340},
-    {.function = "pd_spec_case", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_341},
-    {.function = "pd_spec_validate", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_342},
-    {.function = "pd_spec_resolve_method", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_343},
-    {.function = "pd_spec_run_task", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_344},
-    {.function = "pd_spec_run_task", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_345},
-    {.function = "pd_spec_stream", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_346},
-    {.function = "pd_spec_cost", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_347},
-    {.function = "pd_spec_key", .argument = "s", .expect = EXPECT_NULL, .call = api_case_348},
-    {.function = "pd_spec_rows", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_349},
-    {.function = "pd_spec_rows", .argument = "res", .expect = EXPECT_NOCRASH, .call = api_case_350},
-    {.function = "pd_spec_rows", .argument = "rows", .expect = EXPECT_NOCRASH, .call = api_case_351},
-    {.function = "pd_spec_curve_label", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_352},
-    {.function = "pd_spec_curve_label", .argument = "buf", .expect = EXPECT_NOCRASH, .call = api_case_353},
-    {.function = "pd_spec_sweep", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_354},
-    {.function = "pd_scene_sweep_twins", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_355},
-    {.function = "pd_scene_sweep_points", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_356},
-    {.function = "pd_scene_sweep_check", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_357},
-    {.function = "pd_scene_sweep_scene", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_358},
-    {.function = "pd_scene_sweep_scene", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_359},
-    {.function = "pd_scene_sweep_scene", .argument = "pt", .expect = EXPECT_ERROR, .call = api_case_360},
-    {.function = "pd_scene_sweep_run", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_361},
-    {.function = "pd_scene_sweep_run", .argument = "pts", .expect = EXPECT_ERROR, .call = api_case_362},
-    {.function = "pd_scene_sweep_run", .argument = "umax", .expect = EXPECT_ERROR, .call = api_case_363},
+    {.function = "pd_osc_yield_exact", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_209},
+    {.function = "pd_osc_excitation", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_210},
+    {.function = "pd_osc_set_record", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_211},
+    {.function = "pd_osc_set_record", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_212},
+    {.function = "pd_osc_set_record", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_213},
+    {.function = "pd_osc_shape", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_214},
+    {.function = "pd_osc_shape_rate", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_215},
+    {.function = "pd_osc_shape_end", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_216},
+    {.function = "pd_osc_pieces", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_217},
+    {.function = "pd_osc_pieces", .argument = "pieces", .expect = EXPECT_ERROR, .call = api_case_218},
+    {.function = "pd_osc_pieces", .argument = "npieces", .expect = EXPECT_ERROR, .call = api_case_219},
+    {.function = "pd_osc_excitation_name", .argument = "c", .expect = EXPECT_NAME, .call = api_case_220},
+    {.function = "pd_osc_check", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_221},
+    {.function = "pd_osc_resolve_opts", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_222},
+    {.function = "pd_osc_resolve_opts", .argument = "in", .expect = EXPECT_NOCRASH, .call = api_case_223},
+    {.function = "pd_osc_resolve_opts", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_224},
+    {.function = "pd_osc_default_dt", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_225},
+    {.function = "pd_osc_default_tend", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_226},
+    {.function = "pd_osc_measure_start", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_227},
+    {.function = "pd_osc_method", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_228},
+    {.function = "pd_osc_method", .argument = "o", .expect = EXPECT_NOCRASH, .call = api_case_229},
+    {.function = "pd_osc_run", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_230},
+    {.function = "pd_osc_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_231},
+    {.function = "pd_osc_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_232},
+    {.function = "pd_osc_batchable", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_233},
+    {.function = "pd_osc_batchable", .argument = "o", .expect = EXPECT_COUNT, .call = api_case_234},
+    {.function = "pd_osc_scan_points", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_235},
+    {.function = "pd_osc_simulate", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_236},
+    {.function = "pd_osc_simulate", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_237},
+    {.function = "pd_osc_simulate", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_238},
+    {.function = "pd_osc_reference", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_239},
+    {.function = "pd_osc_reference", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_240},
+    {.function = "pd_osc_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_241},
+    {.function = "pd_osc_penalty", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_242},
+    {.function = "pd_osc_penalty", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_243},
+    {.function = "pd_osc_penalty", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_244},
+    {.function = "pd_osc_summarize", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_245},
+    {.function = "pd_osc_summarize", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_246},
+    {.function = "pd_osc_summarize", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_247},
+    {.function = "pd_osc_free_exact", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_248},
+    {.function = "pd_osc_free_exact", .argument = "u", .expect = EXPECT_NOCRASH, .call = api_case_249},
+    {.function = "pd_osc_free_exact", .argument = "v", .expect = EXPECT_NOCRASH, .call = api_case_250},
+    {.function = "pd_osc_free_first_contact", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_251},
+    {.function = "pd_osc_free_first_contact", .argument = "t", .expect = EXPECT_ERROR, .call = api_case_252},
+    {.function = "pd_osc_free_first_contact", .argument = "v", .expect = EXPECT_ERROR, .call = api_case_253},
+    {.function = "pd_trace_alloc", .argument = "tr", .expect = EXPECT_ERROR, .call = api_case_254},
+    {.function = "pd_trace_alloc", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_255},
+    {.function = "pd_trace_free", .argument = "tr", .expect = EXPECT_NOCRASH, .call = api_case_256},
+    {.function = "pd_measure_reference", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_257},
+    {.function = "pd_measure_reference", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_258},
+    {.function = "pd_measure_reference", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_259},
+    {.function = "pd_measure_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_260},
+    {.function = "pd_measure_run", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_261},
+    {.function = "pd_measure_run", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_262},
+    {.function = "pd_measure_run", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_263},
+    {.function = "pd_measure_run", .argument = "work", .expect = EXPECT_ERROR, .call = api_case_264},
+    {.function = "pd_measure_run", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_265},
+    {.function = "pd_scene_new", .argument = "exc", .expect = EXPECT_NOCRASH, .call = api_case_266},
+    {.function = "pd_scene_free", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_267},
+    {.function = "pd_scene_add_sdof", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_268},
+    {.function = "pd_scene_add_sdof", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_269},
+    {.function = "pd_scene_add_building", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_270},
+    {.function = "pd_scene_add_building", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_271},
+    {.function = "pd_scene_add_building", .argument = "masses", .expect = EXPECT_ERROR, .call = api_case_272},
+    {.function = "pd_scene_add_building", .argument = "stiffnesses", .expect = EXPECT_ERROR, .call = api_case_273},
+    {.function = "pd_scene_add_uniform", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_274},
+    {.function = "pd_scene_add_uniform", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_275},
+    {.function = "pd_scene_set_damping", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_276},
+    {.function = "pd_scene_set_heights", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_277},
+    {.function = "pd_scene_set_heights", .argument = "heights", .expect = EXPECT_ERROR, .call = api_case_278},
+    {.function = "pd_scene_add_contact", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_279},
+    {.function = "pd_scene_copy", .argument = "sc", .expect = EXPECT_NULL, .call = api_case_280},
+    {.function = "pd_scene_find", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_281},
+    {.function = "pd_scene_find", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_282},
+    {.function = "pd_scene_finish", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_283},
+    {.function = "pd_scene_load", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_284},
+    {.function = "pd_scene_load", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_285},
+    {.function = "pd_scene_chain", .argument = "exc", .expect = EXPECT_ERROR, .call = api_case_286},
+    {.function = "pd_scene_chain", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_287},
+    {.function = "pd_scene_wp", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_288},
+    {.function = "pd_scene_Le", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_289},
+    {.function = "pd_scene_default_dt", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_290},
+    {.function = "pd_scene_default_tend", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_291},
+    {.function = "pd_scene_measure_start", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_292},
+    {.function = "pd_scene_resolve_opts", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_293},
+    {.function = "pd_scene_resolve_opts", .argument = "in", .expect = EXPECT_NOCRASH, .call = api_case_294},
+    {.function = "pd_scene_resolve_opts", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_295},
+    {.function = "pd_scene_as_oscillator", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_296},
+    {.function = "pd_scene_as_oscillator", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_297},
+    {.function = "pd_scene_as_oscillator", .argument = "mirrored", .expect = EXPECT_COUNT, .call = api_case_298},
+    {.function = "pd_scene_model_build", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_299},
+    {.function = "pd_scene_model_build", .argument = "sm", .expect = EXPECT_ERROR, .call = api_case_300},
+    {.function = "pd_scene_model_free", .argument = "sm", .expect = EXPECT_NOCRASH, .call = api_case_301},
+    {.function = "pd_scene_result_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_302},
+    {.function = "pd_scene_result_alloc", .argument = "r", .expect = EXPECT_ERROR, .call = api_case_303},
+    {.function = "pd_scene_result_fits", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_304},
+    {.function = "pd_scene_result_fits", .argument = "r", .expect = EXPECT_COUNT, .call = api_case_305},
+    {.function = "pd_scene_result_free", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_306},
+    {.function = "pd_scene_run", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_307},
+    {.function = "pd_scene_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_308},
+    {.function = "pd_scene_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_309},
+    {.function = "pd_scene_summarize", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_310},
+    {.function = "pd_scene_summarize", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_311},
+    {.function = "pd_scene_summarize", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_312},
+    {.function = "pd_scene_summary_free", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_313},
+    {.function = "pd_scene_trace_alloc", .argument = "tr", .expect = EXPECT_ERROR, .call = api_case_314},
+    {.function = "pd_scene_trace_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_315},
+    {.function = "pd_scene_trace_alloc", .argument = "o", .expect = EXPECT_NOCRASH, .call = api_case_316},
+    {.function = "pd_scene_trace_free", .argument = "tr", .expect = EXPECT_NOCRASH, .call = api_case_317},
+    {.function = "pd_scene_errors_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_318},
+    {.function = "pd_scene_errors_alloc", .argument = "e", .expect = EXPECT_ERROR, .call = api_case_319},
+    {.function = "pd_scene_errors_free", .argument = "e", .expect = EXPECT_NOCRASH, .call = api_case_320},
+    {.function = "pd_scene_measure_reference", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_321},
+    {.function = "pd_scene_measure_reference", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_322},
+    {.function = "pd_scene_measure_reference", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_323},
+    {.function = "pd_scene_measure_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_324},
+    {.function = "pd_scene_measure_run", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_325},
+    {.function = "pd_scene_measure_run", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_326},
+    {.function = "pd_scene_measure_run", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_327},
+    {.function = "pd_scene_measure_run", .argument = "ref_res", .expect = EXPECT_ERROR, .call = api_case_328},
+    {.function = "pd_scene_measure_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_329},
+    {.function = "pd_scene_measure_run", .argument = "e", .expect = EXPECT_ERROR, .call = api_case_330},
+    {.function = "pd_spec_init", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_331},
+    {.function = "pd_spec_curves", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_332},
+    {.function = "pd_spec_points", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_333},
+    {.function = "pd_spec_twins", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_334},
+    {.function = "pd_spec_tasks", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_335},
+    {.function = "pd_spec_pi2", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_336},
+    {.function = "pd_spec_coords_of", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_337},
+    {.function = "pd_spec_coords_of", .argument = "co", .expect = EXPECT_NOCRASH, .call = api_case_338},
+    {.function = "pd_spec_twin_of", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_339},
+    {.function = "pd_spec_case", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_340},
+    {.function = "pd_spec_case", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_341},
+    {.function = "pd_spec_case", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_342},
+    {.function = "pd_spec_validate", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_343},
+    {.function = "pd_spec_resolve_method", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_344},
+    {.function = "pd_spec_run_task", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_345},
+    {.function = "pd_spec_run_task", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_346},
+    {.function = "pd_spec_stream", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_347},
+    {.function = "pd_spec_cost", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_348},
+    {.function = "pd_spec_key", .argument = "s", .expect = EXPECT_NULL, .call = api_case_349},
+    {.function = "pd_spec_rows", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_350},
+    {.function = "pd_spec_rows", .argument = "res", .expect = EXPECT_NOCRASH, .call = api_case_351},
+    {.function = "pd_spec_rows", .argument = "rows", .expect = EXPECT_NOCRASH, .call = api_case_352},
+    {.function = "pd_spec_curve_label", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_353},
+    {.function = "pd_spec_curve_label", .argument = "buf", .expect = EXPECT_NOCRASH, .call = api_case_354},
+    {.function = "pd_spec_sweep", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_355},
+    {.function = "pd_scene_sweep_twins", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_356},
+    {.function = "pd_scene_sweep_points", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_357},
+    {.function = "pd_scene_sweep_check", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_358},
+    {.function = "pd_scene_sweep_scene", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_359},
+    {.function = "pd_scene_sweep_scene", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_360},
+    {.function = "pd_scene_sweep_scene", .argument = "pt", .expect = EXPECT_ERROR, .call = api_case_361},
+    {.function = "pd_scene_sweep_run", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_362},
+    {.function = "pd_scene_sweep_run", .argument = "pts", .expect = EXPECT_ERROR, .call = api_case_363},
+    {.function = "pd_scene_sweep_run", .argument = "umax", .expect = EXPECT_ERROR, .call = api_case_364},
 };
-const int api_null_ncases = 364;
-const int api_null_nfunctions = 217;
+const int api_null_ncases = 365;
+const int api_null_nfunctions = 218;

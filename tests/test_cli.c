@@ -258,8 +258,9 @@ static void test_cli_yielding(pd_test_ctx *ctx)
     if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
         return;
     snprintf(path, sizeof path, "%s/run.csv", dir);
-    const char *args[] = {"simulate", "--ap", "2",  "--Tp", "0.5",    "--uy", "0.003",
-                          "--alpha",  "0.05", "-o", path,   "--json", NULL};
+    const char *args[] = {"simulate", "--ap",   "2",        "--Tp",   "0.5",
+                          "--uy",     "0.003",  "--alpha",  "0.05",   "-o",
+                          path,       "--json", "--method", "moreau", NULL};
     proc_out r;
     CHECK(ctx, pd_test_pound(ctx, args, &r) == 0, "exit %d: %s", r.status, r.err);
     double Le = 2.0 * 0.25 / (4.0 * 9.869604401089358), umax = pd_test_json_num(r.out, "umax", 0);

@@ -66,7 +66,12 @@ static void test_ref_bouncing_ball_accumulation(pd_test_ctx *ctx)
     for (int k = 0; k < 5; k++) {
         double a = 2.0, delta = 0.5, e = es[k];
         pd_sine_piece piece = {.t_start = 0.0, .A = a, .w = 0.0, .phi = TWO_PI / 4}; /* a */
-        pd_ed_sdof prob = {{0.0, 0.0}, 1, delta, e, 1, &piece};
+        pd_ed_sdof prob = {.osc = {.w0 = 0.0, .xi = 0.0},
+                           .wall = 1,
+                           .delta = delta,
+                           .e = e,
+                           .npieces = 1,
+                           .pieces = &piece};
         double t1 = sqrt(2 * delta / a), v1 = a * t1, t_inf = t1 + 2 * e * v1 / (a * (1 - e));
         pd_ed_opts o;
         o = pd_ed_default_opts();
@@ -96,7 +101,12 @@ static void test_ref_accumulation_off_stalls(pd_test_ctx *ctx)
 {
     double a = 2.0, delta = 0.5, e = 0.8;
     pd_sine_piece piece = {.t_start = 0.0, .A = a, .w = 0.0, .phi = TWO_PI / 4};
-    pd_ed_sdof prob = {{0.0, 0.0}, 1, delta, e, 1, &piece};
+    pd_ed_sdof prob = {.osc = {.w0 = 0.0, .xi = 0.0},
+                       .wall = 1,
+                       .delta = delta,
+                       .e = e,
+                       .npieces = 1,
+                       .pieces = &piece};
     double t1 = sqrt(2 * delta / a), t_inf = t1 + 2 * e * a * t1 / (a * (1 - e));
     pd_ed_opts o;
     o = pd_ed_default_opts();
@@ -134,7 +144,12 @@ static void test_ref_impact_closed_form(pd_test_ctx *ctx)
 {
     double w0 = 2.0, V = 1.0, delta = 0.3;
     pd_sine_piece piece = {.t_start = 0.0};
-    pd_ed_sdof prob = {{w0, 0.0}, 1, delta, 1.0, 1, &piece};
+    pd_ed_sdof prob = {.osc = {.w0 = w0, .xi = 0.0},
+                       .wall = 1,
+                       .delta = delta,
+                       .e = 1.0,
+                       .npieces = 1,
+                       .pieces = &piece};
     pd_ed_opts o;
     o = pd_ed_default_opts();
     o.t_end = 50.0;
@@ -246,7 +261,12 @@ static void test_ref_self_consistent_on_grid(pd_test_ctx *ctx)
                         double phi = p ? TWO_PI / 4 : 0.0;
                         pd_sine_piece pc[2] = {{.t_start = 0, .A = (double)dir, .w = 1, .phi = phi},
                                                {.t_start = TWO_PI}};
-                        pd_ed_sdof prob = {{Pi2s[i], 0.05}, 1, Pi3s[j], epss[k], 2, pc};
+                        pd_ed_sdof prob = {.osc = {.w0 = Pi2s[i], .xi = 0.05},
+                                           .wall = 1,
+                                           .delta = Pi3s[j],
+                                           .e = epss[k],
+                                           .npieces = 2,
+                                           .pieces = pc};
                         pd_ed_opts o;
                         o = pd_ed_default_opts();
                         o.t_end = TWO_PI * pd_osc_default_tend(&c) / c.Tp;
@@ -444,7 +464,12 @@ static void test_ref_scan_per_piece_matches_fixed(pd_test_ctx *ctx)
                             {.t_start = TWO_PI}};
                         pd_sine_piece fixed[2] = {adaptive[0],
                                                   {.t_start = TWO_PI, .A = 1e-300, .w = 1}};
-                        pd_ed_sdof pa = {{Pi2s[i], 0.05}, 1, Pi3s[j], epss[k], 2, adaptive};
+                        pd_ed_sdof pa = {.osc = {.w0 = Pi2s[i], .xi = 0.05},
+                                         .wall = 1,
+                                         .delta = Pi3s[j],
+                                         .e = epss[k],
+                                         .npieces = 2,
+                                         .pieces = adaptive};
                         pd_ed_sdof pf = pa;
                         pf.pieces = fixed;
                         pd_ed_opts o = pd_ed_default_opts();

@@ -408,10 +408,14 @@ class Case:
             if "alpha" in kw:
                 raise InputError("alpha: needs the yield displacement (uy or Piy)")
             return
-        if o.method not in (0, PD_METHOD_AUTO):
-            raise InputError("%s: a yielding oscillator runs by method 'moreau' only (the exact "
-                             "reference and the penalty methods do not model yielding yet; got "
-                             "method %s)" % (key, _lib.s(lib.pd_method_name(o.method))))
+        if o.method == 1 and not lib.pd_osc_yield_exact(c):
+            raise InputError("%s: the exact reference models a yielding spring whose sliding "
+                             "phase is underdamped, xi < sqrt(alpha) (or xi 0; got xi %s, alpha "
+                             "%s): method='moreau' runs it" % (key, fmt(c.xi), fmt(c.alpha)))
+        if o.method not in (0, 1, PD_METHOD_AUTO):
+            raise InputError("%s: a yielding oscillator runs by method 'event' or 'moreau' (the "
+                             "penalty methods do not model yielding yet; got method %s)"
+                             % (key, _lib.s(lib.pd_method_name(o.method))))
         if o.rtol > 0.0:
             raise InputError("%s: a yielding oscillator runs at a fixed step (dt), not to a "
                              "tolerance (rtol)" % key)

@@ -188,6 +188,7 @@ _PROTOTYPES = {
     "pd_osc_set_uy": (None, [P(PdOsc), c_double]),
     "pd_osc_uy": (c_double, [P(PdOsc)]),
     "pd_osc_yields": (c_int, [P(PdOsc)]),
+    "pd_osc_yield_exact": (c_int, [P(PdOsc)]),
     "pd_osc_set_record": (None, [P(PdOsc), P(PdRecord), P(PdRecordPulse), c_double]),
     "pd_osc_excitation_name": (c_char_p, [P(PdOsc)]),
     "pd_osc_check": (c_int, [P(PdOsc), P(PdErr)]),
