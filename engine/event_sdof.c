@@ -570,6 +570,9 @@ static int check_problem(const pd_ed_sdof *p, const pd_ed_opts *o, pd_err *err)
         return pd_err_set(err, PD_EINVAL, "event-driven: need w0 >= 0 and xi in [0, 1)");
     if (p->wall && (!(p->delta >= 0.0) || !(p->e >= 0.0 && p->e <= 1.0)))
         return pd_err_set(err, PD_EINVAL, "event-driven: need gap >= 0 and e in [0, 1]");
+    if (!(p->pieces[0].t_start >= 0.0)) /* event times >= 0: -1 says "none" */
+        return pd_err_set(err, PD_EINVAL, "event-driven: the start time must be >= 0 (got %g)",
+                          p->pieces[0].t_start);
     if (!(o->t_end > p->pieces[0].t_start) || !isfinite(o->t_end))
         return pd_err_set(err, PD_EINVAL, "event-driven: t_end must follow the start time");
     if (o->max_events < 1 || o->max_burst < 1 || o->scan_divisions < 1 ||

@@ -500,6 +500,148 @@ static void test_ref_scan_per_piece_matches_fixed(pd_test_ctx *ctx)
     CHECK(ctx, pounding > points / 2, "the grid must pound (%d of %d)", pounding, points);
 }
 
+/* Samples while resting on the wall: x at the wall, v exactly 0 (the
+ * oscillator is held), for the plain and the yielding spring (a sine
+ * pulse into a close wall, eps 0: it rests for a while). */
+typedef struct rest_tally {
+    long resting;
+    double vmax;
+} rest_tally;
+
+static int rest_sample(const pd_osc_sample *s, void *ctx)
+{
+    rest_tally *rt = ctx;
+    if (s->gap == 0.0) {
+        rt->resting++;
+        rt->vmax = fmax(rt->vmax, fabs(s->v));
+    }
+    return 0;
+}
+
+static void test_ref_rest_samples_still(pd_test_ctx *ctx)
+{
+    for (int k = 0; k < 2; k++) {
+        pd_osc c = pd_osc_default();
+        c.eps = 0.0;
+        c.Pi3 = 0.02;
+        c.alpha = 0.2;
+        c.Piy = k ? 0.5 : 0.0;
+        pd_run_opts o = pd_run_default_opts();
+        o.method = PD_METHOD_EVENT;
+        rest_tally rt = {0};
+        pd_osc_result r;
+        pd_err e;
+        if (CHECK(ctx, pd_osc_run(&c, &o, rest_sample, &rt, &r, &e) == PD_OK, "%s", e.msg))
+            CHECK(ctx, rt.resting >= 10 && rt.vmax == 0.0,
+                  "%s: %ld samples at the wall, |v| up to %g there", k ? "yielding" : "elastic",
+                  rt.resting, rt.vmax);
+    }
+}
+
+/* The reference refuses options it cannot run with, naming them: an end
+ * time not after the start or not finite, a length scale not > 0 (0
+ * included), a yielding spring's alpha out of [0, 1] or a start beyond
+ * uy. */
+static void test_ref_refuses_bad_options(pd_test_ctx *ctx)
+{
+    pd_sine_piece piece = {.t_start = 0.0, .A = 1.0, .w = 1.0};
+    pd_ed_sdof prob = {.osc = {.w0 = 1.0, .xi = 0.05},
+                       .wall = 1,
+                       .delta = 0.1,
+                       .e = 0.5,
+                       .npieces = 1,
+                       .pieces = &piece};
+    pd_ed_result r;
+    pd_err e;
+    const double t_ends[] = {INFINITY, 0.0, NAN}, scales[] = {0.0, -1.0, INFINITY};
+    for (int k = 0; k < 3; k++) {
+        pd_ed_opts o = pd_ed_default_opts();
+        o.t_end = t_ends[k];
+        CHECK(ctx, pd_ed_sdof_run(&prob, 0.0, 0.0, &o, NULL, NULL, &r, &e) == PD_EINVAL,
+              "t_end %g taken", t_ends[k]);
+        o.t_end = 10.0;
+        o.length_scale = scales[k];
+        CHECK(ctx,
+              pd_ed_sdof_run(&prob, 0.0, 0.0, &o, NULL, NULL, &r, &e) == PD_EINVAL &&
+                  strstr(e.msg, "length scale"),
+              "length scale %g taken: %s", scales[k], e.msg);
+    }
+    pd_ed_opts o = pd_ed_default_opts();
+    o.t_end = 10.0;
+    prob.uy = 0.5;
+    prob.alpha = 1.5;
+    CHECK(ctx, pd_ed_sdof_run(&prob, 0.0, 0.0, &o, NULL, NULL, &r, &e) == PD_EINVAL,
+          "alpha 1.5 taken");
+    prob.alpha = 0.1;
+    CHECK(ctx,
+          pd_ed_sdof_run(&prob, 0.6, 0.0, &o, NULL, NULL, &r, &e) == PD_EINVAL &&
+              strstr(e.msg, "beyond uy"),
+          "a start beyond uy taken: %s", e.msg);
+    CHECK(ctx, pd_ed_sdof_run(&prob, 0.4, 0.0, &o, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg);
+}
+
+/* Closed-form rests and tails of a free mass (w0 = 0) at a wall (delta 0):
+ *   - held by F = sin(t + pi - 0.01) from t = 0: it detaches exactly where
+ *     F turns negative, t = 0.01, within the scan's first interval;
+ *   - pushed by F = 1 from x = -1/2 at rest: it strikes at t = 1 (v = 1,
+ *     to the adjacent double), and with e = 1/2 its bounces accumulate at
+ *     t = 1 + 2 (v / 2) / (a (1 - e)) = 3: with t_end 6 the accumulation
+ *     is jumped (at rest from 3), with t_end 3 - 1e-5 it is not (every
+ *     bounce's tail ends at 3, after the run: the run ends bouncing); the
+ *     first impact's speed is the largest, none gives 0;
+ *   - a budget of 5 events names 5 in its message. */
+static void test_ref_free_mass_rests(pd_test_ctx *ctx)
+{
+    pd_sine_piece hold = {.t_start = 0.0, .A = 1.0, .w = 1.0, .phi = PD_PI - 0.01};
+    pd_ed_sdof prob = {.osc = {.w0 = 0.0, .xi = 0.0},
+                       .wall = 1,
+                       .delta = 0.0,
+                       .e = 0.5,
+                       .npieces = 1,
+                       .pieces = &hold};
+    pd_ed_opts o = pd_ed_default_opts();
+    o.t_end = 1.0;
+    pd_ed_result r;
+    pd_err e;
+    if (CHECK(ctx, pd_ed_sdof_run(&prob, 0.0, 0.0, &o, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg))
+        CHECK(ctx, fabs(r.contact_time - 0.01) <= 1e-15 && r.detachments == 1,
+              "held until %.17g (0.01), %ld detachments", r.contact_time, r.detachments);
+    pd_sine_piece push = {.t_start = 0.0, .c0 = 1.0};
+    prob.pieces = &push;
+    const double t_ends[] = {6.0, 3.0 - 1e-5};
+    for (int k = 0; k < 2; k++) {
+        o.t_end = t_ends[k];
+        if (!CHECK(ctx, pd_ed_sdof_run(&prob, -0.5, 0.0, &o, NULL, NULL, &r, &e) == PD_OK, "%s",
+                   e.msg))
+            continue;
+        CHECK(ctx,
+              fabs(r.first_impact - 1.0) <= 4e-16 && fabs(r.max_impact_velocity - 1.0) <= 4e-16 &&
+                  r.t_reached == t_ends[k],
+              "t_end %.17g: first impact at %.17g, largest speed %.17g, reached %.17g", t_ends[k],
+              r.first_impact, r.max_impact_velocity, r.t_reached);
+        if (k == 0)
+            CHECK(ctx, r.accumulations == 1 && fabs(r.contact_time - 3.0) <= 1e-12,
+                  "t_end 6: %ld accumulations, at rest %.17g (3, from t = 3)", r.accumulations,
+                  r.contact_time);
+        else
+            CHECK(ctx, r.accumulations == 0 && r.contact_time == 0.0,
+                  "t_end 3 - 1e-5: %ld accumulations, at rest %.17g (none: the tail ends at 3)",
+                  r.accumulations, r.contact_time);
+    }
+    prob.wall = 0;
+    o.t_end = 6.0;
+    if (CHECK(ctx, pd_ed_sdof_run(&prob, -0.5, 0.0, &o, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg))
+        CHECK(ctx, r.impacts == 0 && r.max_impact_velocity == 0.0,
+              "no wall: %ld impacts, largest speed %g", r.impacts, r.max_impact_velocity);
+    prob.wall = 1;
+    o.max_events = 5;
+    o.no_accumulation = 1;
+    CHECK(ctx,
+          pd_ed_sdof_run(&prob, -0.5, 0.0, &o, NULL, NULL, &r, &e) == PD_EBUDGET &&
+              strstr(e.msg, ": 5 events by") != NULL,
+          "the budget's message: %s", e.msg);
+}
+
 void suite_reference(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_ref_no_wall_is_closed_form);
@@ -510,6 +652,9 @@ void suite_reference(pd_test_ctx *ctx)
     PD_RUN(ctx, test_ref_self_consistent_on_grid);
     PD_RUN(ctx, test_ref_scan_per_piece_matches_fixed);
     PD_RUN(ctx, test_ref_chatter_contact_time_consistent);
+    PD_RUN(ctx, test_ref_rest_samples_still);
+    PD_RUN(ctx, test_ref_refuses_bad_options);
+    PD_RUN(ctx, test_ref_free_mass_rests);
     PD_RUN(ctx, test_ref_moreau_order_one);
     PD_RUN(ctx, test_ref_stiff_penalty_limit);
 }
