@@ -581,14 +581,17 @@ static void test_ref_refuses_bad_options(pd_test_ctx *ctx)
 }
 
 /* Closed-form rests and tails of a free mass (w0 = 0) at a wall (delta 0):
- *   - held by F = sin(t + pi - 0.01) from t = 0: it detaches exactly where
- *     F turns negative, t = 0.01, within the scan's first interval;
+ *   - held by F = sin(t + pi - 0.01) from t = 0 (starting on the wall at
+ *     rest: held, no impact): it detaches exactly where F turns negative,
+ *     t = 0.01, within the scan's first interval;
  *   - pushed by F = 1 from x = -1/2 at rest: it strikes at t = 1 (v = 1,
  *     to the adjacent double), and with e = 1/2 its bounces accumulate at
  *     t = 1 + 2 (v / 2) / (a (1 - e)) = 3: with t_end 6 the accumulation
  *     is jumped (at rest from 3), with t_end 3 - 1e-5 it is not (every
  *     bounce's tail ends at 3, after the run: the run ends bouncing); the
  *     first impact's speed is the largest, none gives 0;
+ *   - a damped oscillator starting at rest on the wall, pushed into it,
+ *     stays held without an impact;
  *   - a budget of 5 events names 5 in its message. */
 static void test_ref_free_mass_rests(pd_test_ctx *ctx)
 {
@@ -604,8 +607,9 @@ static void test_ref_free_mass_rests(pd_test_ctx *ctx)
     pd_ed_result r;
     pd_err e;
     if (CHECK(ctx, pd_ed_sdof_run(&prob, 0.0, 0.0, &o, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg))
-        CHECK(ctx, fabs(r.contact_time - 0.01) <= 1e-15 && r.detachments == 1,
-              "held until %.17g (0.01), %ld detachments", r.contact_time, r.detachments);
+        CHECK(ctx, fabs(r.contact_time - 0.01) <= 1e-15 && r.detachments == 1 && r.impacts == 0,
+              "held until %.17g (0.01), %ld detachments, %ld impacts (none: it starts held)",
+              r.contact_time, r.detachments, r.impacts);
     pd_sine_piece push = {.t_start = 0.0, .c0 = 1.0};
     prob.pieces = &push;
     const double t_ends[] = {6.0, 3.0 - 1e-5};
@@ -628,6 +632,21 @@ static void test_ref_free_mass_rests(pd_test_ctx *ctx)
                   "t_end 3 - 1e-5: %ld accumulations, at rest %.17g (none: the tail ends at 3)",
                   r.accumulations, r.contact_time);
     }
+    /* a damped oscillator at rest on the wall, pushed into it by F = 1/2 > 0
+     * (its acceleration at rest; 2 xi w0 = 1 would make it -1/2 at v = 1):
+     * held the whole run, no impact */
+    pd_sine_piece half = {.t_start = 0.0, .c0 = 0.5};
+    pd_ed_sdof pressed = {.osc = {.w0 = 1.0, .xi = 0.5},
+                          .wall = 1,
+                          .delta = 0.0,
+                          .e = 0.5,
+                          .npieces = 1,
+                          .pieces = &half};
+    o.t_end = 2.0;
+    if (CHECK(ctx, pd_ed_sdof_run(&pressed, 0.0, 0.0, &o, NULL, NULL, &r, &e) == PD_OK, "%s",
+              e.msg))
+        CHECK(ctx, r.impacts == 0 && r.contact_time == 2.0,
+              "pressed at rest: %ld impacts, held %.17g of 2", r.impacts, r.contact_time);
     prob.wall = 0;
     o.t_end = 6.0;
     if (CHECK(ctx, pd_ed_sdof_run(&prob, -0.5, 0.0, &o, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg))
