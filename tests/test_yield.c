@@ -111,6 +111,22 @@ static double step_load_umax(double f, double uy, double alpha)
     return xc + sqrt((uy - xc) * (uy - xc) + v1sq / (alpha * w * w));
 }
 
+/* The step load's cases (f / Fy, alpha) and the largest relative error of
+ * a run's umax, residual, plastic excursion and slider's work against the
+ * closed form (up = umax - uy: one slide, never back). */
+static const double STEP_UY = 0.01, STEP_RATIO[3] = {0.8, 0.6, 0.7},
+                    STEP_ALPHA[3] = {0.0, 0.1, 0.3};
+
+static double step_load_error(const pd_osc_result *r, int k)
+{
+    double w2 = 4.0 * PD_PI * PD_PI, alpha = STEP_ALPHA[k], uy = STEP_UY;
+    double umax = step_load_umax(STEP_RATIO[k] * w2 * uy, uy, alpha), up = umax - uy;
+    double work = (1.0 - alpha) * w2 * uy * up;
+    double e1 = fabs(r->umax - umax) / umax, e2 = fabs(r->residual - (1.0 - alpha) * up) / up,
+           e3 = fabs(r->plastic_excursion - up) / up, e4 = fabs(r->hysteretic_energy - work) / work;
+    return fmax(fmax(e1, e2), fmax(e3, e4));
+}
+
 /* Under the step load the spring yields once, to umax; it unloads
  * elastically about f / k + (1 - alpha) up and never yields back (the
  * swing's far end keeps z >= -uy for these loads; its next top touches uy
@@ -122,13 +138,11 @@ static double step_load_umax(double f, double uy, double alpha)
  * 1e-4 (measured 4e-6 to 9e-6). */
 static void test_yield_step_load_closed_form(pd_test_ctx *ctx)
 {
-    const double uy = 0.01, ratio[] = {0.8, 0.6, 0.7}, alphas[] = {0.0, 0.1, 0.3};
     for (int k = 0; k < 3; k++) {
-        double w2 = 4.0 * PD_PI * PD_PI, f = ratio[k] * w2 * uy, alpha = alphas[k];
-        double umax = step_load_umax(f, uy, alpha), up = umax - uy;
+        double w2 = 4.0 * PD_PI * PD_PI, f = STEP_RATIO[k] * w2 * STEP_UY;
         pd_osc c;
         pd_record rec = {0};
-        if (!CHECK(ctx, step_load(&c, &rec, f, uy, alpha), "case %d: no record", k))
+        if (!CHECK(ctx, step_load(&c, &rec, f, STEP_UY, STEP_ALPHA[k]), "case %d: no record", k))
             continue;
         /* the largest error over five steps near T0 / 1000, then near T0 / 4000
          * (where the onset falls inside its step varies the error: its envelope) */
@@ -142,19 +156,16 @@ static void test_yield_step_load_closed_form(pd_test_ctx *ctx)
             pd_err e;
             if (!CHECK(ctx, pd_osc_simulate(&c, &o, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg))
                 break;
-            double e1 = fabs(r.umax - umax) / umax, e2 = fabs(r.residual - (1.0 - alpha) * up) / up,
-                   e3 = fabs(r.plastic_excursion - up) / up,
-                   e4 = fabs(r.hysteretic_energy - (1.0 - alpha) * w2 * uy * up) /
-                        ((1.0 - alpha) * w2 * uy * up);
-            err[h / 5] = fmax(err[h / 5], fmax(fmax(e1, e2), fmax(e3, e4)));
+            err[h / 5] = fmax(err[h / 5], step_load_error(&r, k));
             CHECK(ctx, r.n_yield == 1, "case %d, dt %g: %ld yield onsets, one", k, o.dt, r.n_yield);
         }
+        double mu = step_load_umax(f, STEP_UY, STEP_ALPHA[k]) / STEP_UY;
         CHECK(ctx, err[1] <= err[0] / 2.5 && err[0] <= 1e-4,
               "case %d (alpha %g, f / Fy %g): errors up to %.3g near dt = T0/1000, %.3g near "
-              "T0/4000 (closed-form umax %.9g, ductility %.6g)",
-              k, alpha, ratio[k], err[0], err[1], umax, umax / uy);
-        CHECK(ctx, fabs(r.ductility - umax / uy) <= 1e-3 * umax / uy,
-              "case %d: ductility %.9g, closed form %.9g", k, r.ductility, umax / uy);
+              "T0/4000 (closed-form ductility %.9g)",
+              k, STEP_ALPHA[k], STEP_RATIO[k], err[0], err[1], mu);
+        CHECK(ctx, fabs(r.ductility - mu) <= 1e-3 * mu, "case %d: ductility %.9g, closed form %.9g",
+              k, r.ductility, mu);
         pd_record_free(&rec);
     }
 }
@@ -506,29 +517,21 @@ static void test_yield_spectrum_resume(pd_test_ctx *ctx)
  * the slide is a free mass (xi = 0). */
 static void test_yield_exact_step_load(pd_test_ctx *ctx)
 {
-    const double uy = 0.01, ratio[] = {0.8, 0.6, 0.7}, alphas[] = {0.0, 0.1, 0.3};
     for (int k = 0; k < 3; k++) {
-        double w2 = 4.0 * PD_PI * PD_PI, f = ratio[k] * w2 * uy, alpha = alphas[k];
-        double umax = step_load_umax(f, uy, alpha), up = umax - uy;
+        double w2 = 4.0 * PD_PI * PD_PI, f = STEP_RATIO[k] * w2 * STEP_UY;
         pd_osc c;
         pd_record rec = {0};
-        if (!CHECK(ctx, step_load(&c, &rec, f, uy, alpha), "case %d: no record", k))
+        if (!CHECK(ctx, step_load(&c, &rec, f, STEP_UY, STEP_ALPHA[k]), "case %d: no record", k))
             continue;
         pd_run_opts o = pd_run_default_opts();
         o.method = PD_METHOD_EVENT;
         o.tend = 1.5;
         pd_osc_result r;
         pd_err e;
-        if (CHECK(ctx, pd_osc_run(&c, &o, NULL, NULL, &r, &e) == PD_OK, "case %d: %s", k, e.msg)) {
-            double e1 = fabs(r.umax - umax) / umax, e2 = fabs(r.residual - (1.0 - alpha) * up) / up,
-                   e3 = fabs(r.plastic_excursion - up) / up,
-                   e4 = fabs(r.hysteretic_energy - (1.0 - alpha) * w2 * uy * up) /
-                        ((1.0 - alpha) * w2 * uy * up);
-            CHECK(ctx, fmax(fmax(e1, e2), fmax(e3, e4)) <= 1e-12 && r.n_yield == 1,
-                  "case %d: umax off by %.3g, residual %.3g, excursion %.3g, work %.3g; %ld "
-                  "onsets",
-                  k, e1, e2, e3, e4, r.n_yield);
-        }
+        if (CHECK(ctx, pd_osc_run(&c, &o, NULL, NULL, &r, &e) == PD_OK, "case %d: %s", k, e.msg))
+            CHECK(ctx, step_load_error(&r, k) <= 1e-12 && r.n_yield == 1,
+                  "case %d: umax, residual, excursion or work off by %.3g; %ld onsets", k,
+                  step_load_error(&r, k), r.n_yield);
         pd_record_free(&rec);
     }
 }
