@@ -46,7 +46,8 @@ typedef struct conv_args {
     double dt_max, dt_min;
     int ndt, ntheta, nkc, nrtol, want_moreau, want_rtol, want_penalty, want_general, want_newmark,
         json, have_dt_range;
-    int use_umax; /* --error umax: chart and order err_umax_rel */
+    int use_umax;      /* --error umax: chart and order err_umax_rel */
+    int methods_given; /* --methods given (else the default rows) */
     double thetas[MAX_LIST], kcs[MAX_LIST], rtols[MAX_LIST];
     const char *plot, *out;
 } conv_args;
@@ -101,6 +102,7 @@ static int parse_methods(conv_args *a, const char *text)
         return pd_cli_usage_error("--methods: give moreau, moreau-rtol, penalty, newmark, "
                                   "event-general (got '')");
     strcpy(buf, text);
+    a->methods_given = 1;
     a->want_moreau = a->want_rtol = a->want_penalty = a->want_general = a->want_newmark = 0;
     for (int k = 1; p; k++) {
         char *tok = next_element(&p);
@@ -259,6 +261,13 @@ static int parse_args(conv_args *a, int argc, char **argv)
         return pd_cli_usage_error("--rtol: in converge the penalty rows' integrator tolerance "
                                   "(--methods ...,penalty); Moreau-Jean to a tolerance: "
                                   "--methods moreau-rtol --rtols LIST");
+    if (pd_osc_yields(&a->k.c)) { /* a yielding spring: Moreau-Jean's fixed steps only */
+        if (a->methods_given && (a->want_rtol || a->want_penalty || a->want_newmark))
+            return pd_cli_usage_error("--methods: a yielding oscillator converges by moreau "
+                                      "(moreau-rtol and the penalty methods do not model "
+                                      "yielding yet)");
+        a->want_rtol = 0; /* the default rows: moreau */
+    }
     if (a->want_general && !pd_cli_is_scene(&a->k))
         return pd_cli_usage_error("--methods: event-general is a reference for scenes (--scene, "
                                   "--chain); the oscillator's reference is exact");
