@@ -417,7 +417,8 @@ static int check_yield(const pd_cli_case *a)
     if (a->opts.method == PD_METHOD_EVENT && !pd_osc_yield_exact(&a->c))
         return pd_cli_usage_error("%s: the exact reference models a yielding spring whose "
                                   "sliding phase is underdamped, --xi < sqrt(--alpha) (or --xi "
-                                  "0; got xi %g, alpha %g): --method moreau runs it",
+                                  "0, or --alpha 0; got xi %g, alpha %g): --method moreau runs "
+                                  "it",
                                   yf, a->c.xi, a->c.alpha);
     if (a->opts.method != PD_METHOD_AUTO && a->opts.method != PD_METHOD_MOREAU &&
         a->opts.method != PD_METHOD_EVENT)

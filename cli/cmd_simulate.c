@@ -208,7 +208,7 @@ static void method_line(const pd_cli_case *k)
         printf("  method    = %s (%s)\n", m, k->method_by);
     else if (pd_osc_yields(&k->c) && !pd_osc_yield_exact(&k->c))
         printf("  method    = %s (the exact reference does not model this yielding spring: its "
-               "sliding phase is not underdamped, xi >= sqrt(alpha))\n",
+               "sliding phase is overdamped, 0 < alpha <= xi^2)\n",
                m);
     else if (pd_cli_is_scene(k))
         printf("  method    = %s (the default for scenes; --method event|penalty|newmark for "

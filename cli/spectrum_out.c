@@ -466,7 +466,7 @@ void pd_spec_print_text(const pd_spectrum *s, const pd_spec_row *rows, const pd_
     if (!strcmp(t->method_by, "default") && pd_osc_yields(&s->base) &&
         !pd_osc_yield_exact(&s->base))
         printf("  method %s: the exact reference does not model this yielding spring (xi >= "
-               "sqrt(alpha))\n",
+               "sqrt(alpha) > 0)\n",
                pd_method_name(s->opts.method));
     else if (!strcmp(t->method_by, "default"))
         printf("  method %s: the default for one oscillator (%s); --method "

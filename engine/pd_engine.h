@@ -637,7 +637,8 @@ typedef struct pd_ed_sdof {
     /* a yielding spring (SPEC §7; uy 0, or alpha 1: elastic): w0^2 [alpha x +
      * (1 - alpha) z], |z| <= uy, the motion in phases of closed-form flights
      * (elastic, or sliding with stiffness alpha w0^2); the sliding phase must be
-     * underdamped (xi < sqrt(alpha), or xi = alpha = 0), the start inside |x| <= uy */
+     * underdamped (xi < sqrt(alpha)), or a free mass (alpha = 0), or undamped
+     * (xi = 0), the start inside |x| <= uy */
     double uy, alpha;
 } pd_ed_sdof;
 

@@ -78,7 +78,7 @@ int pd_osc_yields(const pd_osc *c)
 
 int pd_osc_yield_exact(const pd_osc *c)
 {
-    return pd_osc_yields(c) && (c->xi == 0.0 || c->xi * c->xi < c->alpha);
+    return pd_osc_yields(c) && (c->xi == 0.0 || c->alpha == 0.0 || c->xi * c->xi < c->alpha);
 }
 
 double pd_osc_excitation(const pd_osc *c, double t)
@@ -217,7 +217,8 @@ int pd_osc_resolve_opts(const pd_osc *c, const pd_run_opts *in, pd_run_opts *out
         return pd_err_set(err, PD_EINVAL,
                           "a yielding oscillator (uy, alpha < 1) runs by Moreau-Jean at a "
                           "fixed step, or by the exact reference when its sliding phase is "
-                          "underdamped, xi < sqrt(alpha) (method %s%s, xi %g, alpha %g): the "
+                          "underdamped or a free mass, xi < sqrt(alpha) or alpha = 0 (method %s%s, "
+                          "xi %g, alpha %g): the "
                           "penalty methods and the tolerance do not model yielding yet",
                           pd_method_name(out->method), out->rtol > 0.0 ? " with rtol" : "", c->xi,
                           c->alpha);
@@ -784,7 +785,7 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     if (pd_osc_yields(c) && !pd_osc_yield_exact(c))
         return pd_osc_refuse_yield(c,
                                    "the event-driven reference (a sliding phase not underdamped: "
-                                   "xi >= sqrt(alpha))",
+                                   "0 < alpha <= xi^2)",
                                    err);
     double scan = pd_osc_scan_points(c, o.tend); /* its scan grid: the cost */
     if (!(scan <= PD_OSC_MAX_SCAN))

@@ -323,9 +323,9 @@ PD_API double pd_osc_uy(const pd_osc *c); /* Piy Le [m]; INFINITY when elastic *
 /* 1 when the spring can yield: Piy > 0 finite and alpha < 1. */
 PD_API int pd_osc_yields(const pd_osc *c);
 /* 1 when the exact event-driven reference models c's yielding spring: its
- * sliding phase underdamped, xi < sqrt(alpha) (or xi = 0); 0 when it does
- * not yield or only Moreau-Jean can run it (an elastic-perfectly-plastic
- * spring with damping, say). */
+ * sliding phase underdamped, xi < sqrt(alpha), or a free mass (alpha = 0,
+ * damped or not), or undamped (xi = 0); 0 when it does not yield or only
+ * Moreau-Jean can run it (an overdamped slide: 0 < alpha <= xi^2). */
 PD_API int pd_osc_yield_exact(const pd_osc *c);
 
 /* Effective acceleration f(t) [m/s^2] at time t [s]. */

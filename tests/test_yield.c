@@ -602,6 +602,8 @@ static void test_yield_exact_moreau_converges(pd_test_ctx *ctx)
         c.Pi3 = 0.02 + 0.3 * pd_test_uniform(&rng);
         c.Piy = 0.1 + 0.4 * pd_test_uniform(&rng);
         c.alpha = 0.05 + 0.25 * pd_test_uniform(&rng);
+        if (k % 4 == 3) /* elastic-perfectly-plastic, damped: the slide a damped free mass */
+            c.alpha = 0.0;
         c.eps = k / 7.0;
         c.xi = 0.05;
         pd_run_opts o = pd_run_default_opts();
@@ -634,13 +636,14 @@ static void test_yield_exact_moreau_converges(pd_test_ctx *ctx)
 }
 
 /* The reference refuses a slide it cannot write in closed form (an
- * elastic-perfectly-plastic spring with damping), naming xi and alpha;
- * the method auto runs it by Moreau-Jean. */
+ * overdamped one: 0 < alpha <= xi^2), naming xi and alpha; the method auto
+ * runs it by Moreau-Jean.  A damped free mass (alpha = 0) and an
+ * underdamped slide are the reference's. */
 static void test_yield_exact_refuses_overdamped_slide(pd_test_ctx *ctx)
 {
-    pd_osc c = pd_osc_default(); /* xi 0.05 */
+    pd_osc c = pd_osc_default(); /* xi 0.05: xi^2 = 0.0025 */
     c.Piy = 0.3;
-    c.alpha = 0.0;
+    c.alpha = 0.002;
     pd_run_opts o = pd_run_default_opts();
     o.method = PD_METHOD_EVENT;
     pd_osc_result r;
@@ -650,9 +653,12 @@ static void test_yield_exact_refuses_overdamped_slide(pd_test_ctx *ctx)
     o = pd_run_default_opts();
     CHECK(ctx, pd_osc_method(&c, &o) == PD_METHOD_MOREAU && !pd_osc_yield_exact(&c),
           "auto chose %s", pd_method_name(pd_osc_method(&c, &o)));
-    c.alpha = 0.01; /* xi^2 = 0.0025 < alpha: the reference's */
-    CHECK(ctx, pd_osc_method(&c, &o) == PD_METHOD_EVENT && pd_osc_yield_exact(&c),
-          "auto chose %s for an underdamped slide", pd_method_name(pd_osc_method(&c, &o)));
+    const double exact[] = {0.01, 0.0}; /* xi^2 < alpha; a damped free mass */
+    for (int k = 0; k < 2; k++) {
+        c.alpha = exact[k];
+        CHECK(ctx, pd_osc_method(&c, &o) == PD_METHOD_EVENT && pd_osc_yield_exact(&c),
+              "auto chose %s for alpha %g", pd_method_name(pd_osc_method(&c, &o)), c.alpha);
+    }
 }
 
 /* `pound converge` on a yielding oscillator: Moreau-Jean's rows only (the
@@ -688,6 +694,7 @@ static void test_yield_refused(pd_test_ctx *ctx)
 {
     pd_osc c = pd_osc_default();
     c.Piy = 0.5;
+    c.alpha = 0.002; /* an overdamped slide (xi^2 = 0.0025): not the reference's */
     pd_osc_result r;
     pd_err e;
     pd_run_opts o = pd_run_default_opts();
@@ -711,7 +718,7 @@ static void test_yield_refused(pd_test_ctx *ctx)
               bad_piy[k], e.msg);
     }
     c.Piy = 0.5;
-    for (int k = 0; k < 3; k++) {
+    for (int k = 0; k < 3; k++) { /* with alpha out of range */
         c.alpha = bad_alpha[k];
         CHECK(ctx, pd_osc_check(&c, &e) == PD_EINVAL && strstr(e.msg, "alpha"), "alpha %g: %s",
               bad_alpha[k], e.msg);

@@ -410,8 +410,9 @@ class Case:
             return
         if o.method == 1 and not lib.pd_osc_yield_exact(c):
             raise InputError("%s: the exact reference models a yielding spring whose sliding "
-                             "phase is underdamped, xi < sqrt(alpha) (or xi 0; got xi %s, alpha "
-                             "%s): method='moreau' runs it" % (key, fmt(c.xi), fmt(c.alpha)))
+                             "phase is underdamped, xi < sqrt(alpha) (or xi 0, or alpha 0; got xi "
+                             "%s, alpha %s): method='moreau' runs it"
+                             % (key, fmt(c.xi), fmt(c.alpha)))
         if o.method not in (0, 1, PD_METHOD_AUTO):
             raise InputError("%s: a yielding oscillator runs by method 'event' or 'moreau' (the "
                              "penalty methods do not model yielding yet; got method %s)"

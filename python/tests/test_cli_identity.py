@@ -207,7 +207,7 @@ def test_simulate_yielding(cli, same, tmp_path, extra, kw):
 
 @pytest.mark.parametrize("kw,named", [
     (dict(Piy=-1), "Piy"), (dict(uy=0.01, Piy=1), "alternatives"), (dict(alpha=0.2), "uy or Piy"),
-    (dict(Piy=1, method="event"), "moreau"), (dict(Piy=1, rtol=1e-3), "tolerance"),
+    (dict(Piy=1, alpha=0.002, method="event"), "moreau"), (dict(Piy=1, rtol=1e-3), "tolerance"),
 ])
 def test_simulate_yielding_refused(kw, named):
     with pytest.raises(pound.InputError, match=named):
