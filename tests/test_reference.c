@@ -540,8 +540,8 @@ static void test_ref_rest_samples_still(pd_test_ctx *ctx)
 
 /* The reference refuses options it cannot run with, naming them: an end
  * time not after the start or not finite, a length scale not > 0 (0
- * included), a yielding spring's alpha out of [0, 1] or a start beyond
- * uy. */
+ * included), a start before 0 (its value named), a yielding spring's
+ * alpha out of [0, 1] or a start beyond uy. */
 static void test_ref_refuses_bad_options(pd_test_ctx *ctx)
 {
     pd_sine_piece piece = {.t_start = 0.0, .A = 1.0, .w = 1.0};
@@ -568,6 +568,12 @@ static void test_ref_refuses_bad_options(pd_test_ctx *ctx)
     }
     pd_ed_opts o = pd_ed_default_opts();
     o.t_end = 10.0;
+    piece.t_start = -1.5; /* event times are >= 0 */
+    CHECK(ctx,
+          pd_ed_sdof_run(&prob, 0.0, 0.0, &o, NULL, NULL, &r, &e) == PD_EINVAL &&
+              strstr(e.msg, "(got -1.5)"),
+          "a start before 0 taken: %s", e.msg);
+    piece.t_start = 0.0;
     prob.uy = 0.5;
     prob.alpha = 1.5;
     CHECK(ctx, pd_ed_sdof_run(&prob, 0.0, 0.0, &o, NULL, NULL, &r, &e) == PD_EINVAL,
