@@ -428,16 +428,22 @@ static inline double scalar_osc_force(void *ctx, double tau, int side)
     return osc_force(((const scalar_osc *)ctx)->c, tau, side);
 }
 
-static inline int scalar_osc_observe(void *ctx, const mj1_state *x, double tau)
+/* After a step: the tracks (u itself) and the demands of the spring's
+ * force K qs (qs = q for an elastic spring). */
+static inline void scalar_osc_note(scalar_osc *so, const mj1_state *x, double tau, double qs)
 {
-    scalar_osc *so = ctx;
     pd_osc_track_step(so->tr, x->step, tau, x->q, x->v, x->P);
     if (so->dem) /* with a held contact's force */
         pd_demand_osc_note_state(
-            so->dem, tau, x->q, x->v,
-            pd_demand_osc_held(so->dem, so->h, x->P, so->Pprev, x->v, so->vprev, x->q, x->F1));
+            so->dem, tau, qs, x->v,
+            pd_demand_osc_held(so->dem, so->h, x->P, so->Pprev, x->v, so->vprev, qs, x->F1));
     so->Pprev = x->P;
     so->vprev = x->v;
+}
+
+static inline int scalar_osc_observe(void *ctx, const mj1_state *x, double tau)
+{
+    scalar_osc_note(ctx, x, tau, x->q);
     return 0;
 }
 
@@ -451,7 +457,7 @@ typedef struct osc_yield {
     double Gprev;     /* the previous step's plastic increment */
     long n_yield;     /* onsets: a step that slides after one that did not */
     double excursion; /* sum |Gamma| */
-    double q, v, up;  /* the state at the step's start */
+    double q, up;     /* the state at the step's start (its v: so.vprev) */
     double F0;        /* the step's force at its start */
     /* the balance's sums over the steps, with v_th = th v+ + (1 - th) v and
      * z_th = z + th (z+ - z): the input h sum v_th F_th, the damping h C sum
@@ -468,17 +474,11 @@ static inline int scalar_osc_observe_yield(void *ctx, const mj1_state *x, double
 {
     osc_yield *oy = ctx;
     scalar_osc *so = &oy->so;
-    double qs = x->q - oy->soft * x->up; /* an elastic spring's q for the same force */
-    pd_osc_track_step(so->tr, x->step, tau, x->q, x->v, x->P);
-    if (so->dem)
-        pd_demand_osc_note_state(
-            so->dem, tau, qs, x->v,
-            pd_demand_osc_held(so->dem, so->h, x->P, so->Pprev, x->v, so->vprev, qs, x->F1));
-    so->Pprev = x->P;
-    so->vprev = x->v;
     /* the energies of the step as it was taken (W = -1: -v_th W P = v_th P);
      * the constant factors h, h C, kbar applied at the end (yield_result) */
-    double vth = oy->th * x->v + (1.0 - oy->th) * oy->v;
+    double vth = oy->th * x->v + (1.0 - oy->th) * so->vprev;
+    /* the spring's force K (q - (1 - alpha) up): an elastic spring's at qs */
+    scalar_osc_note(so, x, tau, x->q - oy->soft * x->up);
     oy->input += vth * mj1_fth(oy->th, oy->F0, x->F1);
     oy->damping += vth * vth;
     if (x->P != 0.0)
@@ -491,7 +491,6 @@ static inline int scalar_osc_observe_yield(void *ctx, const mj1_state *x, double
     }
     oy->Gprev = x->G;
     oy->q = x->q;
-    oy->v = x->v;
     oy->up = x->up;
     oy->F0 = x->F0;
     tracker *sm = oy->sm;
@@ -552,16 +551,26 @@ static int simulate_scalar(const pd_osc *c, const pd_model *md, const pd_mj_opts
 
 /* A yielding run's results from its tallies and its end (q, v, up; Pi
  * units to metres, energies per unit mass in (Le wp)^2). */
+/* A yielding run's figures from its offset at the end, its excursion and
+ * the slider's work (Pi units: lengths times Le, energies per unit mass
+ * times (Le wp)^2), either method's. */
+static void yield_figures(const pd_osc *c, double up, double excursion, double work, long n_yield,
+                          pd_osc_result *res)
+{
+    double Le = pd_osc_Le(c), wp = pd_osc_wp(c);
+    res->ductility = res->umax / pd_osc_uy(c);
+    res->residual = (1.0 - c->alpha) * up * Le;
+    res->plastic_excursion = excursion * Le;
+    res->hysteretic_energy = work * ((Le * wp) * (Le * wp));
+    res->n_yield = n_yield;
+}
+
 static void yield_result(const pd_osc *c, const osc_yield *oy, const mj1_state *end,
                          pd_osc_result *res)
 {
     double Le = pd_osc_Le(c), wp = pd_osc_wp(c), E = (Le * wp) * (Le * wp);
     double K = c->Pi2 * c->Pi2, z = end->q - end->up;
-    res->ductility = res->umax / pd_osc_uy(c);
-    res->residual = (1.0 - c->alpha) * end->up * Le;
-    res->plastic_excursion = oy->excursion * Le;
-    res->hysteretic_energy = oy->kbar * oy->work * E;
-    res->n_yield = oy->n_yield;
+    yield_figures(c, end->up, oy->excursion, oy->kbar * oy->work, oy->n_yield, res);
     pd_energy *en = &res->energy;
     en->input = oy->so.h * oy->input * E;
     en->kinetic = 0.5 * end->v * end->v * E;
@@ -852,14 +861,8 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     pd_osc_result_no_rtol(res, NAN);
     pd_osc_result_no_yield(res);
     /* a yielding spring's figures */
-    if (pd_osc_yields(c)) {
-        double Ev = (Le * wp) * (Le * wp);
-        res->ductility = res->umax / pd_osc_uy(c);
-        res->residual = (1.0 - c->alpha) * er.up * Le;
-        res->plastic_excursion = er.excursion * Le;
-        res->hysteretic_energy = er.hysteretic * Ev;
-        res->n_yield = er.n_yield;
-    }
+    if (pd_osc_yields(c))
+        yield_figures(c, er.up, er.excursion, er.hysteretic, er.n_yield, res);
     pd_demand_osc_finish(res, &o, o.no_demands ? NAN : bridge.dem.peak * c->ap,
                          o.no_demands ? NAN : bridge.dem.shear * c->ap, NAN);
     res->cpu_s = pd_cpu_seconds() - cpu0;
