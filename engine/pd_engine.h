@@ -657,10 +657,13 @@ typedef struct pd_ed_opts {
      * -e vn (before an accumulation jumped or a rest begins) */
     void (*on_impact)(double t, double vn, double v_plus, void *ctx);
     void *on_impact_ctx;
+    int energy; /* 1: the energy balance's terms (pd_ed_result; Gauss-Legendre on
+                   every scan interval of the flights: about 3x the cost) */
 } pd_ed_opts;
 
 /* t_end 0 (must be set), t_measure 0, h_out 0, accumulations jumped, 10^7
- * events, bursts of 10^5, length scale 1, 64 scan divisions, no on_impact. */
+ * events, bursts of 10^5, length scale 1, 64 scan divisions, no on_impact,
+ * no energy balance. */
 PD_API pd_ed_opts pd_ed_default_opts(void);
 
 typedef struct pd_ed_result {
@@ -676,6 +679,14 @@ typedef struct pd_ed_result {
     long n_yield;      /* slides begun (yield onsets) */
     double excursion;  /* sum of |d up| */
     double hysteretic; /* the slider's work (1 - alpha) w0^2 uy excursion */
+    /* opts->energy (0 otherwise), per unit mass from the start to where the run
+       stopped: input = (kinetic + strain) - (their values at the start) + damping
+       + hysteretic + impact_loss */
+    double input_work;   /* int F x' dt */
+    double damping_work; /* int 2 xi w0 x'^2 dt */
+    double impact_loss;  /* (1 - e^2) vn^2 / 2 per impact; an accumulation's tail v+^2 / 2 */
+    double kinetic;      /* x'^2 / 2 at the end */
+    double strain;       /* w0^2 (alpha x^2 + (1 - alpha) z^2) / 2 at the end (z = x elastic) */
 } pd_ed_result;
 
 /* Called on the output grid with the exact state; return > 0 to stop. */

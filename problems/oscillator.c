@@ -565,6 +565,14 @@ static void yield_figures(const pd_osc *c, double up, double excursion, double w
     res->n_yield = n_yield;
 }
 
+/* The balance's residual: (input - every other term) / input. */
+static void energy_close(pd_energy *en)
+{
+    en->residual =
+        (en->input - en->kinetic - en->strain - en->damping - en->hysteretic - en->impact) /
+        en->input;
+}
+
 static void yield_result(const pd_osc *c, const osc_yield *oy, const mj1_state *end,
                          pd_osc_result *res)
 {
@@ -578,9 +586,22 @@ static void yield_result(const pd_osc *c, const osc_yield *oy, const mj1_state *
     en->damping = oy->so.h * oy->C * oy->damping * E;
     en->hysteretic = res->hysteretic_energy;
     en->impact = oy->impact * E;
-    en->residual =
-        (en->input - en->kinetic - en->strain - en->damping - en->hysteretic - en->impact) /
-        en->input;
+    energy_close(en);
+}
+
+/* The exact reference's energy balance (per unit mass, Pi units times
+ * vscale^2), from rest. */
+static void ref_energy(const pd_ed_result *er, double vscale, pd_osc_result *res)
+{
+    double E = vscale * vscale;
+    pd_energy *en = &res->energy;
+    en->input = er->input_work * E;
+    en->kinetic = er->kinetic * E;
+    en->strain = er->strain * E;
+    en->damping = er->damping_work * E;
+    en->hysteretic = res->hysteretic_energy;
+    en->impact = er->impact_loss * E;
+    energy_close(en);
 }
 
 int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,
@@ -824,6 +845,7 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
                               : PD_TWO_PI * (ref_demand_grid(c, o.dt) / c->Tp);
     eo.on_impact = o.no_demands ? NULL : ref_impact;
     eo.no_accumulation = o.no_accumulation;
+    eo.energy = pd_osc_yields(c) && !o.no_demands; /* a yielding run's balance, as Moreau-Jean's */
     ref_bridge bridge = {
         .wp = wp,
         .Le = Le,
@@ -861,8 +883,11 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     pd_osc_result_no_rtol(res, NAN);
     pd_osc_result_no_yield(res);
     /* a yielding spring's figures */
-    if (pd_osc_yields(c))
+    if (pd_osc_yields(c)) {
         yield_figures(c, er.up, er.excursion, er.hysteretic, er.n_yield, res);
+        if (eo.energy)
+            ref_energy(&er, Le * wp, res);
+    }
     pd_demand_osc_finish(res, &o, o.no_demands ? NAN : bridge.dem.peak * c->ap,
                          o.no_demands ? NAN : bridge.dem.shear * c->ap, NAN);
     res->cpu_s = pd_cpu_seconds() - cpu0;

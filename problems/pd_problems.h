@@ -234,7 +234,8 @@ typedef struct pd_run_opts {
     int no_demands;           /* 1: do not measure the peak accelerations and shears (NAN): the
                            sweeps, the contact-free twins and the timed re-runs, whose
                            figures do not use them (the exact references sample a grid
-                           for them) */
+                           for them); nor the exact reference's energy balance of a
+                           yielding run (its quadrature: 2.5x the run) */
     double rtol;              /* > 0: Moreau-Jean to this relative tolerance of every reported
                            peak (docs/scheme.md, "Moreau–Jean to a tolerance"; then dt must
                            be 0, the method moreau or auto, which it makes moreau); 0:
