@@ -421,10 +421,10 @@ static int check_yield(const pd_cli_case *a)
                                   "it",
                                   yf, a->c.xi, a->c.alpha);
     if (a->opts.method != PD_METHOD_AUTO && a->opts.method != PD_METHOD_MOREAU &&
-        a->opts.method != PD_METHOD_EVENT)
-        return pd_cli_usage_error("%s: a yielding oscillator runs by --method event or moreau "
-                                  "(the penalty methods do not model yielding yet; got --method "
-                                  "%s)",
+        a->opts.method != PD_METHOD_EVENT && a->opts.method != PD_METHOD_NEWMARK)
+        return pd_cli_usage_error("%s: a yielding oscillator runs by --method event, moreau or "
+                                  "newmark (the adaptive penalty does not model yielding yet; "
+                                  "got --method %s)",
                                   yf, pd_method_name(a->opts.method));
     if (a->opts.rtol > 0.0)
         return pd_cli_usage_error("%s: a yielding oscillator runs at a fixed step (--dt), not "

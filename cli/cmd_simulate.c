@@ -297,6 +297,8 @@ static void print_json(const sim_args *a, const pd_osc_summary *s)
         pd_json_num(&js, "energy_damping", en->damping);
         pd_json_num(&js, "energy_impact", en->impact);
         pd_json_num(&js, "energy_residual", en->residual);
+        if (!strcmp(s->r.kernel, "newmark")) /* Newton's failures, honestly */
+            pd_json_int(&js, "newton_failures", s->r.newton_failures);
     }
     pd_json_end_object(&js);
     pd_json_finish(&js);
@@ -360,6 +362,10 @@ static void print_text(const sim_args *a, const pd_osc_summary *s)
                "energy %.5g J/kg\n",
                pd_osc_uy(c), c->Piy, c->alpha, s->r.ductility, s->free.ductility, s->r.residual,
                s->r.n_yield, s->r.plastic_excursion, s->r.hysteretic_energy);
+    if (pd_osc_yields(c) && !strcmp(s->r.kernel, "newmark"))
+        printf("  newton    = %ld of %ld steps failed Newton's iterations (each redone at the "
+               "spring's initial stiffness)\n",
+               s->r.newton_failures, s->r.steps);
     if (pd_osc_yields(c) && isfinite(s->r.energy.input))
         printf("  energy    = input %.6g J/kg = kinetic %.4g + strain %.4g + damping %.4g + "
                "hysteretic %.4g + impacts %.4g, residual %.2g of the input\n",
@@ -454,6 +460,9 @@ static int finish_output(const sim_args *a, const pd_osc_summary *s, pd_table_wr
                         NUM("energy_residual", "1", s->r.energy.residual)};
         for (size_t i = 0; i < sizeof ya / sizeof ya[0]; i++)
             attrs[n++] = ya[i];
+        if (!strcmp(s->r.kernel, "newmark"))
+            attrs[n++] = (pd_attr){
+                .name = "newton_failures", .units = "1", .num = (double)s->r.newton_failures};
     }
 #undef NUM
 #undef TXT

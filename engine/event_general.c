@@ -263,7 +263,7 @@ static int check_inputs(const pd_model *md, double t0, const double *q0, const d
                         double t1, pd_err *err)
 {
     int rc = pd_model_check(md, err);
-    if (rc)
+    if (rc || (rc = pd_model_refuse_yield(md, "event-general", err)))
         return rc;
     if (!isfinite(t0) || !isfinite(t1) || !(t1 > t0))
         return pd_err_set(err, PD_EINVAL, "event-driven: t1 = %g must be finite and after t0 = %g",

@@ -2763,7 +2763,8 @@ static int check_inputs(const pd_model *md, const pd_piecewise_force *F, const p
         return pd_err_set(err, PD_EINVAL,
                           "row reference: a model and a piecewise force are "
                           "needed");
-    if ((rc = pd_model_check(md, err)) || (rc = check_opts(o, err)))
+    if ((rc = pd_model_check(md, err)) || (rc = pd_model_refuse_yield(md, "row reference", err)) ||
+        (rc = check_opts(o, err)))
         return rc;
     if (!pd_matrix_is_diagonal(&md->M))
         return pd_err_set(err, PD_EINVAL,

@@ -207,7 +207,8 @@ pd_mj *pd_mj_alloc(const pd_model *model, const pd_mj_opts *opts, pd_err *err)
     pd_mj_opts o = opts ? *opts : pd_mj_default_opts();
     int st;
     pd_err_clear(err);
-    if ((st = pd_model_check(model, err)) || (st = pd_mj_check_opts(&o, err)))
+    if ((st = pd_model_check(model, err)) ||
+        (st = pd_model_refuse_yield(model, "Moreau-Jean", err)) || (st = pd_mj_check_opts(&o, err)))
         return NULL;
     mj = calloc(1, sizeof *mj);
     if (!mj || alloc_arrays(mj, model->n, model->m)) {

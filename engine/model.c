@@ -1,7 +1,41 @@
-/* model.c — checking a model, and the step count of a run. */
+/* model.c — checking a model (its yielding springs too), and the step count of a run. */
 #include <math.h>
 
 #include "pd_engine.h"
+#include "pd_null.h"
+
+/* The yielding springs: S sized n x ns, ks and uy > 0 finite. */
+static int check_springs(const pd_model *model, pd_err *err)
+{
+    int st;
+    if (model->ns < 0)
+        return pd_err_set(err, PD_EINVAL, "model: %d yielding springs", model->ns);
+    if (model->ns == 0)
+        return PD_OK;
+    if ((st = pd_matrix_check(&model->S, model->n, model->ns, "S", err)))
+        return st;
+    if (!model->ks || !model->uy)
+        return pd_err_set(err, PD_EINVAL, "model: yielding springs need ks and uy");
+    for (int j = 0; j < model->ns; j++)
+        if (!(model->ks[j] > 0.0) || !isfinite(model->ks[j]) || !(model->uy[j] > 0.0) ||
+            !isfinite(model->uy[j]))
+            return pd_err_set(err, PD_EINVAL,
+                              "model: yielding spring %d needs ks > 0 and uy > 0 finite (ks %g, "
+                              "uy %g)",
+                              j, model->ks[j], model->uy[j]);
+    return PD_OK;
+}
+
+int pd_model_refuse_yield(const pd_model *model, const char *method, pd_err *err)
+{
+    if (!model || !method)
+        return PD_NULL_ARG(err, !model ? "model" : "method");
+    if (model->ns > 0)
+        return pd_err_set(err, PD_EINVAL,
+                          "%s: models no yielding springs (%d given; the newmark method does)",
+                          method, model->ns);
+    return PD_OK;
+}
 
 int pd_model_check(const pd_model *model, pd_err *err)
 {
@@ -23,6 +57,8 @@ int pd_model_check(const pd_model *model, pd_err *err)
     for (int k = 0; k < model->nbreaks; k++)
         if (!isfinite(model->breaks[k]) || (k > 0 && !(model->breaks[k] > model->breaks[k - 1])))
             return pd_err_set(err, PD_EINVAL, "model: breakpoints must be finite and increasing");
+    if ((st = check_springs(model, err)))
+        return st;
     if (model->m == 0) /* no contact: W, g0 and e unused */
         return PD_OK;
     if ((st = pd_matrix_check(&model->W, model->n, model->m, "W", err)))

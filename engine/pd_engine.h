@@ -61,10 +61,24 @@ typedef struct pd_model {
     void *force_ctx;
     const double *breaks; /* increasing times where F may jump (NULL if none) */
     int nbreaks;
+    /* yielding springs (SPEC §7; ns = 0: none, every method; ns > 0: newmark only):
+     * spring j acts on the drift d_j = S_j^T q; the part ks_j = (1 - alpha_j) k_j of
+     * its stiffness (counted in K) acts through the hysteretic displacement z_j =
+     * d_j - up_j, |z_j| <= uy_j, so that the restoring force is K q - S diag(ks) up
+     * with the plastic offsets up (0 at the start) */
+    int ns;
+    pd_matrix S;      /* n x ns */
+    const double *ks; /* ns, > 0 */
+    const double *uy; /* ns, > 0 */
 } pd_model;
 
-/* Check sizes, finiteness, gaps and restitution; message names the field. */
+/* Check sizes, finiteness, gaps, restitution and the yielding springs;
+ * message names the field. */
 PD_API int pd_model_check(const pd_model *model, pd_err *err);
+
+/* PD_EINVAL naming the method when the model has yielding springs (a method
+ * that models none); PD_OK otherwise (PD_EINVAL for a NULL argument). */
+PD_API int pd_model_refuse_yield(const pd_model *model, const char *method, pd_err *err);
 
 /* The kind the automatic choice gives this model (never PD_FACTOR_AUTO):
  * requested itself unless it is PD_FACTOR_AUTO.  A NULL model gives
@@ -96,6 +110,8 @@ typedef struct pd_state {
                               impact (its velocities jump inside it: no interpolation
                               across it); 0 otherwise */
     double h;                /* Moreau-Jean: the size of the last step */
+    const double *up;        /* newmark with yielding springs: the ns plastic offsets at t
+                              (NULL otherwise) */
     const double *err;       /* Moreau-Jean to a tolerance: n, the error estimate of each
                               dof accumulated over the steps so far, in units of q
                               (velocity errors e_v counted as e_v / w_i, w_i^2 = K_ii /
@@ -382,10 +398,14 @@ typedef struct pd_penalty_opts {
                             instant after the switch (right limits) */
     void *on_step_ctx;
     pd_factor_kind factor; /* storage of M */
+    int max_newton;        /* newmark: Newton iterations of a step before it has failed (0:
+                              50); a failed step with yielding springs is redone at their
+                              initial stiffness and counted, without them an error */
 } pd_penalty_opts;
 
 /* Kelvin-Voigt, kc = 0 (must be set), rtol 1e-10, atol 1e-12, rk8pd,
- * h_out 0, 10^8 steps, time unit 1 s, no on_step, automatic factor.  A run
+ * h_out 0, 10^8 steps, time unit 1 s, no on_step, automatic factor, newmark's
+ * 50 Newton iterations a step.  A run
  * whose steps stop advancing (elements switching at one instant: 1000
  * steps in a row advancing t by less than 1e-12 of it) ends PD_ENUMERICAL. */
 PD_API pd_penalty_opts pd_penalty_default_opts(void);
@@ -397,7 +417,10 @@ typedef struct pd_penalty_result {
     double max_penetration_velocity; /* largest -W_a^T v while contact a is engaged */
     long switches;                   /* contact elements engaged or released (located crossings) */
     const char *stepper;             /* canonical GSL stepper name (static string) */
-    int diagonal_mass;               /* 1: M was diagonal and inverted entrywise (no factor) */
+    long newton_failures;   /* newmark: steps whose Newton iterations did not converge (each
+                             then converged with the yielding springs' initial stiffness) */
+    long newton_iterations; /* newmark: Newton iterations over the run */
+    int diagonal_mass;      /* 1: M was diagonal and inverted entrywise (no factor) */
 } pd_penalty_result;
 
 /* Integrate the model from (t0, q0, v0) to t1 (NULL = zeros; opts NULL: the

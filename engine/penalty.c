@@ -138,7 +138,8 @@ pd_penalty_opts pd_penalty_default_opts(void)
                              .time_unit = 1.0,
                              .on_step = NULL,
                              .on_step_ctx = NULL,
-                             .factor = PD_FACTOR_AUTO};
+                             .factor = PD_FACTOR_AUTO,
+                             .max_newton = 0};
 }
 
 /* Free what the run took (safe on a partly set up run). */
@@ -1064,7 +1065,9 @@ int pd_penalty_run(const pd_model *model, double t0, const double *q0, const dou
         return (rc = pd_model_check(model, err))
                    ? rc
                    : pd_penalty_newmark(model, t0, q0, v0, t1, &p.o, observer, ctx, res, err);
-    if (!(rc = pd_model_check(model, err)) && !(rc = check_opts(&p, t0, t1, err))) {
+    if (!(rc = pd_model_check(model, err)) &&
+        !(rc = pd_model_refuse_yield(model, "the adaptive penalty (GSL)", err)) &&
+        !(rc = check_opts(&p, t0, t1, err))) {
         p.n = model->n;
         p.m = model->m;
         p.dim = 2 * (size_t)model->n; /* y = (q, v) */

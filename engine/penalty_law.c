@@ -24,6 +24,9 @@ int pd_penalty_check_opts(const pd_penalty_opts *o, double t0, double t1, const 
         return pd_err_set(err, PD_EINVAL, "%s: h_out must be >= 0 (got %g)", who, o->h_out);
     if (o->max_steps < 1)
         return pd_err_set(err, PD_EINVAL, "%s: max_steps must be >= 1", who);
+    if (o->max_newton < 0)
+        return pd_err_set(err, PD_EINVAL, "%s: max_newton must be >= 0 (got %d)", who,
+                          o->max_newton);
     if (!(o->time_unit > 0.0) || !isfinite(o->time_unit))
         return pd_err_set(err, PD_EINVAL, "%s: time_unit must be > 0 (got %g)", who, o->time_unit);
     /* a run of no length (t1 = t0) is allowed */

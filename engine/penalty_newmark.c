@@ -18,7 +18,17 @@
  * D_AA = W_A^T What^-1 W_A, Delta = y - What^-1 W_A mu.  A Kelvin-Voigt
  * element is linear in (d, d'): a step ends when the engaged set stops
  * changing; Hertz-damp iterates until Delta is below tol.  At a force
- * breakpoint landing on a step's end, a1 takes the right limit of F. */
+ * breakpoint landing on a step's end, a1 takes the right limit of F.
+ *
+ * Yielding springs (pd_model.S, ks, uy) add S diag(ks) up to the force,
+ * up by return mapping at each iterate: z = S_j^T q - up_j(t0) beyond
+ * +-uy_j slides (up_j = S_j^T q -+ uy_j, tangent ks_j removed), else
+ * elastic.  Newton's matrix takes -h^2/4 ks_j S_j S_j^T of each sliding
+ * spring (Woodbury over U = [W_A S_Y]); the system is piecewise linear, so
+ * a step ends when neither set moves.  Where they cycle (a switch inside the
+ * step), Newton has failed: the failure is counted and the step redone with
+ * the springs' initial stiffness (the practitioners' fallback, converging
+ * linearly), an error only if that fails too. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -31,10 +41,11 @@
 #include "penalty_law.h"
 #include "pd_null.h"
 
-#define NM_MAX_ACTIVE 1024 /* elements engaged at once (a dense LU of that size) */
-#define NM_MAX_NEWTON 50   /* Newton iterations of one step */
-#define NM_TOL 1e-12       /* Newton: |Delta| <= NM_TOL max(|q|, the gaps' scale) */
-#define NM_FREEZE 6        /* Newton iterations after which the engaged set is kept */
+#define NM_MAX_ACTIVE 1024  /* elements engaged at once (a dense LU of that size) */
+#define NM_MAX_NEWTON 50    /* Newton iterations of one step */
+#define NM_TOL 1e-12        /* Newton: |Delta| <= NM_TOL max(|q|, the gaps' scale) */
+#define NM_FREEZE 6         /* Newton iterations after which the engaged set is kept */
+#define NM_MAX_INITIAL 2000 /* iterations of a failed step redone at initial stiffness */
 
 /* One run: the model, the factors, the state and its workspaces. */
 typedef struct nm_run {
@@ -45,9 +56,17 @@ typedef struct nm_run {
     pd_factor *fac;  /* What at theta = 1/2 */
     pd_factor *mass; /* M (the accelerations at t0 and at breakpoints) */
     double *q0, *v0, *a0, *q, *v, *b, *r, *y, *F, *F2, *tmp; /* n */
-    double *lam, *kt, *cd, *mu, *s;                          /* m */
+    double *lam, *kt, *cd;                                   /* m */
+    double *mu, *s;   /* m + ns (at most NM_MAX_ACTIVE): Woodbury's unknowns and weights */
+    double *col;      /* n: What^-1 S_j */
+    int ns, cap;      /* yielding springs; Woodbury's columns at most */
+    double *up0, *up; /* ns: plastic offsets at the step's start, at the iterate */
+    unsigned char *slides, *slides_prev; /* ns: sliding at the iterate, at the last one */
+    int *yidx;                           /* ns: the sliding springs in Newton's matrix */
+    int initial; /* this step's iterations keep the springs' initial stiffness */
     unsigned char *eng, *eng_prev, *eng_step; /* m: engaged now, last iterate, at t0 */
     int frozen; /* this step's engaged set no longer follows d (see step) */
+    double t1;  /* the step's end (messages) */
     int *idx;   /* m */
     double *D;  /* NM_MAX_ACTIVE^2 */
     int *perm;  /* NM_MAX_ACTIVE */
@@ -61,14 +80,18 @@ static void nm_free(nm_run *w)
 {
     pd_factor_free(w->fac);
     pd_factor_free(w->mass);
-    double *dbl[] = {w->q0,  w->v0,  w->a0, w->q,  w->v,  w->b, w->r, w->y,    w->F,     w->F2,
-                     w->tmp, w->lam, w->kt, w->cd, w->mu, w->s, w->D, w->st.g, w->st.acc};
+    double *dbl[] = {w->q0, w->v0,   w->a0,     w->q,   w->v,   w->b,  w->r,  w->y,
+                     w->F,  w->F2,   w->tmp,    w->lam, w->kt,  w->cd, w->mu, w->s,
+                     w->D,  w->st.g, w->st.acc, w->col, w->up0, w->up};
     for (size_t k = 0; k < sizeof dbl / sizeof dbl[0]; k++)
         free(dbl[k]);
     free(w->eng);
     free(w->eng_prev);
     free(w->eng_step);
     free(w->idx);
+    free(w->yidx);
+    free(w->slides);
+    free(w->slides_prev);
     free(w->perm);
     free(w->st.active);
 }
@@ -77,15 +100,25 @@ static void nm_free(nm_run *w)
 static int nm_alloc(nm_run *w)
 {
     size_t n = (size_t)w->n;
-    int m = w->m, na = m < NM_MAX_ACTIVE ? m : NM_MAX_ACTIVE;
-    double **dn[] = {&w->q0, &w->v0, &w->a0, &w->q,  &w->v,   &w->b,
-                     &w->r,  &w->y,  &w->F,  &w->F2, &w->tmp, &w->st.acc};
-    double **dm[] = {&w->lam, &w->kt, &w->cd, &w->mu, &w->s, &w->st.g};
+    int m = w->m, ns = w->ns, na = m + ns < NM_MAX_ACTIVE ? m + ns : NM_MAX_ACTIVE;
+    double **dn[] = {&w->q0, &w->v0, &w->a0, &w->q,   &w->v,      &w->b,  &w->r,
+                     &w->y,  &w->F,  &w->F2, &w->tmp, &w->st.acc, &w->col};
+    double **dm[] = {&w->lam, &w->kt, &w->cd, &w->st.g};
+    double **dc[] = {&w->mu, &w->s};
+    double **ds[] = {&w->up0, &w->up};
     int ok = 1;
     for (size_t k = 0; k < sizeof dn / sizeof dn[0]; k++)
         ok &= (*dn[k] = calloc(n, sizeof(double))) != NULL;
     for (size_t k = 0; k < sizeof dm / sizeof dm[0]; k++)
         ok &= (*dm[k] = pd_calloc(m, sizeof(double))) != NULL;
+    for (size_t k = 0; k < sizeof dc / sizeof dc[0]; k++)
+        ok &= (*dc[k] = pd_calloc(na, sizeof(double))) != NULL;
+    for (size_t k = 0; k < sizeof ds / sizeof ds[0]; k++)
+        ok &= (*ds[k] = pd_calloc(ns, sizeof(double))) != NULL;
+    ok &= (w->yidx = pd_calloc(ns, sizeof(int))) != NULL;
+    ok &= (w->slides = pd_calloc(ns, 1)) != NULL;
+    ok &= (w->slides_prev = pd_calloc(ns, 1)) != NULL;
+    w->cap = na;
     ok &= (w->D = pd_calloc((long)na * na, sizeof(double))) != NULL;
     ok &= (w->perm = pd_calloc(na, sizeof(int))) != NULL;
     ok &= (w->idx = pd_calloc(m, sizeof(int))) != NULL;
@@ -144,40 +177,99 @@ static void what_times(const nm_run *w, const double *x, double *out)
     pd_matrix_gemv(&md->K, 0.25 * w->h * w->h, x, 1.0, out);
 }
 
-/* Solve (What + h^2/4 W_A diag(kt) W_A^T) Delta = r into w->y (Woodbury). */
+/* The springs at q by return mapping from the step's start: the offsets
+ * up and which slide. */
+static void springs(nm_run *w, const double *q)
+{
+    const pd_model *md = w->md;
+    for (int j = 0; j < w->ns; j++) {
+        double d = pd_matrix_col_dot(&md->S, j, q), z = d - w->up0[j], uy = md->uy[j];
+        w->slides[j] = fabs(z) > uy;
+        w->up[j] = z > uy ? d - uy : z < -uy ? d + uy : w->up0[j];
+    }
+}
+
+/* D from ld nI to ld N >= nI in place (back to front: no entry is
+ * overwritten before it moves). */
+static void widen(double *D, int nI, int N)
+{
+    for (int c = nI - 1; c >= 0; c--)
+        for (int r = nI - 1; r >= 0; r--)
+            D[(size_t)c * N + r] = D[(size_t)c * nI + r];
+}
+
+/* The columns of D = U^T What^-1 U of the sliding springs (U = [W_A S_Y],
+ * na contacts first), one solve each. */
+static void delassus_springs(nm_run *w, int na, int ny)
+{
+    const pd_model *md = w->md;
+    int N = na + ny;
+    for (int k = 0; k < ny; k++) {
+        memset(w->col, 0, (size_t)w->n * sizeof(double));
+        pd_matrix_col_axpy(&md->S, w->yidx[k], 1.0, w->col);
+        pd_factor_solve(w->fac, w->col); /* What^-1 S_j */
+        for (int i = 0; i < na; i++) {
+            double v = pd_matrix_col_dot(&md->W, w->idx[i], w->col);
+            w->D[(size_t)(na + k) * N + i] = w->D[(size_t)i * N + na + k] = v;
+        }
+        for (int k2 = 0; k2 < ny; k2++)
+            w->D[(size_t)(na + k) * N + na + k2] = pd_matrix_col_dot(&md->S, w->yidx[k2], w->col);
+    }
+}
+
+/* Solve (What + h^2/4 (W_A diag(kt) W_A^T - S_Y diag(ks) S_Y^T)) Delta = r
+ * into w->y by Woodbury on What's factor: U = [W_A S_Y], G = h^2/4 [kt;
+ * -ks], y = What^-1 r, (I + G D) mu = G U^T y, D = U^T What^-1 U, Delta =
+ * y - What^-1 U mu.  The springs' part is left out at initial stiffness. */
 static int newton_solve(nm_run *w, pd_err *err)
 {
     const pd_model *md = w->md;
     double g4 = 0.25 * w->h * w->h;
-    int na = 0;
+    int na = 0, ny = 0;
     memcpy(w->y, w->r, (size_t)w->n * sizeof(double));
     pd_factor_solve(w->fac, w->y); /* y = What^-1 r */
-    /* A: the engaged elements with kt > 0 */
+    /* A: the engaged elements with kt > 0; Y: the sliding springs */
     for (int a = 0; a < w->m; a++)
-        if (w->eng[a] && w->kt[a] > 0.0) {
-            if (na == NM_MAX_ACTIVE)
-                return pd_err_set(err, PD_EBUDGET,
-                                  "newmark: more than %d contact elements engaged at once",
-                                  NM_MAX_ACTIVE);
+        if (w->eng[a] && w->kt[a] > 0.0)
             w->idx[na++] = a;
-        }
-    if (na == 0) /* What alone */
+    for (int j = 0; j < w->ns && !w->initial; j++)
+        if (w->slides[j])
+            w->yidx[ny++] = j;
+    int N = na + ny;
+    if (N > w->cap)
+        return pd_err_set(err, PD_EBUDGET,
+                          "newmark: more than %d contact elements and sliding springs at once",
+                          w->cap);
+    if (N == 0) /* What alone */
         return PD_OK;
-    /* D_AA = W_A^T What^-1 W_A, made I + G D_AA in place; mu = G W_A^T y */
-    pd_factor_delassus_dense(w->fac, w->idx, na, w->D);
-    for (int j = 0; j < na; j++) {
-        double G = g4 * w->kt[w->idx[j]];
-        w->mu[j] = G * pd_matrix_col_dot(&md->W, w->idx[j], w->y);
-        for (int i = 0; i < na; i++) /* row j of I + G D: D is symmetric */
-            w->D[(size_t)i * na + j] = (i == j) + G * w->D[(size_t)i * na + j];
+    /* D, made I + G D in place; mu = G U^T y */
+    if (na > 0) {
+        pd_factor_delassus_dense(w->fac, w->idx, na, w->D);
+        widen(w->D, na, N);
     }
-    if (pd_dense_lu(na, w->D, na, w->perm, 1e-14))
+    delassus_springs(w, na, ny);
+    for (int j = 0; j < N; j++) {
+        double G = j < na ? g4 * w->kt[w->idx[j]] : -g4 * md->ks[w->yidx[j - na]];
+        w->mu[j] = G * (j < na ? pd_matrix_col_dot(&md->W, w->idx[j], w->y)
+                               : pd_matrix_col_dot(&md->S, w->yidx[j - na], w->y));
+        for (int i = 0; i < N; i++) /* row j of I + G D: D is symmetric */
+            w->D[(size_t)i * N + j] = (i == j) + G * w->D[(size_t)i * N + j];
+    }
+    if (pd_dense_lu(N, w->D, N, w->perm, 1e-14))
         return pd_err_set(err, PD_ENUMERICAL, "newmark: the contact update is singular");
-    pd_dense_lu_solve(na, w->D, na, w->perm, w->mu);
-    for (int j = 0; j < na; j++)
+    pd_dense_lu_solve(N, w->D, N, w->perm, w->mu);
+    for (int j = 0; j < N; j++)
         w->mu[j] = -w->mu[j];
-    /* Delta = y - What^-1 W_A mu */
+    /* Delta = y - What^-1 U mu: the contacts' part, then the springs' by one solve */
     pd_factor_add_impulse(w->fac, w->idx, na, w->mu, w->y);
+    if (ny > 0) {
+        memset(w->col, 0, (size_t)w->n * sizeof(double));
+        for (int k = 0; k < ny; k++)
+            pd_matrix_col_axpy(&md->S, w->yidx[k], w->mu[na + k], w->col);
+        pd_factor_solve(w->fac, w->col);
+        for (int i = 0; i < w->n; i++)
+            w->y[i] += w->col[i];
+    }
     return PD_OK;
 }
 
@@ -199,39 +291,40 @@ static void report(nm_run *w, long k, double t, pd_observer fn, void *ctx)
     }
     memcpy(w->st.acc, w->a0, (size_t)w->n * sizeof(double));
     w->st.has_acc = 1;
+    w->st.up = w->ns > 0 ? w->up0 : NULL;
     w->st.lcp_pivots = 0;
     w->st.lcp_solver = NULL;
     if (fn(&w->st, ctx) > 0)
         w->stopped = 1;
 }
 
-/* a = M^-1 (F - C v - K q + W lambda) at (q0, v0) with F in w->F. */
+/* out += s S diag(ks) up: the yielding springs' offsets' force. */
+static void spring_force(const nm_run *w, const double *up, double s, double *out)
+{
+    for (int j = 0; j < w->ns; j++)
+        pd_matrix_col_axpy(&w->md->S, j, s * w->md->ks[j] * up[j], out);
+}
+
+/* a = M^-1 (F - C v - K q + S ks up + W lambda) at (q0, v0) with F in w->F. */
 static void accelerations(nm_run *w)
 {
     const pd_model *md = w->md;
     memcpy(w->a0, w->F, (size_t)w->n * sizeof(double));
     pd_matrix_gemv(&md->C, -1.0, w->v0, 1.0, w->a0);
     pd_matrix_gemv(&md->K, -1.0, w->q0, 1.0, w->a0);
+    spring_force(w, w->up0, 1.0, w->a0);
     if (w->m > 0)
         pd_matrix_gemv(&md->W, 1.0, w->lam, 1.0, w->a0);
     pd_factor_solve(w->mass, w->a0);
 }
 
-/* One step from (q0, v0, a0) to t1 = t0 + h: Newton on q1, then the state
- * moves to the step's end. */
-static int step(nm_run *w, double t1, int at_break, pd_err *err)
+/* Newton's iterations from the predictor q0 + h v0 + h^2/2 a0, at most
+ * maxit: 1 when they converged (*rc an error otherwise). */
+static int newton(nm_run *w, int maxit, int *rc, pd_err *err)
 {
     const pd_model *md = w->md;
-    int n = w->n, rc;
+    int n = w->n;
     double h = w->h, g4 = 0.25 * h * h;
-    /* b = M (q0 + h v0 + h^2/4 a0) + C (h/2 q0 + h^2/4 v0) */
-    for (int i = 0; i < n; i++)
-        w->tmp[i] = w->q0[i] + h * w->v0[i] + g4 * w->a0[i];
-    pd_matrix_gemv(&md->M, 1.0, w->tmp, 0.0, w->b);
-    for (int i = 0; i < n; i++)
-        w->tmp[i] = 0.5 * h * w->q0[i] + g4 * w->v0[i];
-    pd_matrix_gemv(&md->C, 1.0, w->tmp, 1.0, w->b);
-    force_at(w, t1, -1, w->F);  /* F1 = F(t1-) */
     for (int i = 0; i < n; i++) /* predictor: a1 = a0 */
         w->q[i] = w->q0[i] + h * w->v0[i] + 2.0 * g4 * w->a0[i];
     int it, done = 0;
@@ -240,22 +333,25 @@ static int step(nm_run *w, double t1, int at_break, pd_err *err)
     for (int i = 0; i < n; i++)
         w->v[i] = (2.0 / h) * (w->q[i] - w->q0[i]) - w->v0[i];
     elements(w, w->q, w->v, w->v0); /* then after each update, below */
-    for (it = 0; it < NM_MAX_NEWTON && !done; it++) {
+    springs(w, w->q);
+    for (it = 0; it < maxit && !done; it++) {
         /* a Kelvin-Voigt element whose force jumps at d = 0 (c d' != 0) can
          * make the engaged set cycle: no set is consistent within the step.
          * Then the set of the last iterate is kept for the step, its
          * elements acting on both sides of d = 0 (as penalty.c's, frozen to
          * their mode within a step); the next step's set follows d again. */
         w->frozen = it >= NM_FREEZE;
-        /* r = b + h^2/4 (F1 + W lambda) - What q */
+        /* r = b + h^2/4 (F1 + S ks up + W lambda) - What q */
         what_times(w, w->q, w->r);
         for (int i = 0; i < n; i++)
             w->r[i] = w->b[i] + g4 * w->F[i] - w->r[i];
+        spring_force(w, w->up, g4, w->r);
         if (w->m > 0)
             pd_matrix_gemv(&md->W, g4, w->lam, 1.0, w->r);
         w->res.rhs++;
-        if ((rc = newton_solve(w, err)))
-            return rc;
+        w->res.newton_iterations++;
+        if ((*rc = newton_solve(w, err)))
+            return 0;
         /* q += Delta, |Delta| against the state's scale */
         double dmax = 0.0, qmax = w->qscale;
         for (int i = 0; i < n; i++) {
@@ -263,23 +359,64 @@ static int step(nm_run *w, double t1, int at_break, pd_err *err)
             dmax = fmax(dmax, fabs(w->y[i]));
             qmax = fmax(qmax, fabs(w->q[i]));
         }
-        if (!isfinite(dmax))
-            return pd_err_set(err, PD_ENONFINITE, "newmark: the state is not finite at t = %.9g s",
-                              t1 * w->o.time_unit);
+        if (!isfinite(dmax)) {
+            *rc = pd_err_set(err, PD_ENONFINITE, "newmark: the state is not finite at t = %.9g s",
+                             w->t1 * w->o.time_unit);
+            return 0;
+        }
         memcpy(w->eng_prev, w->eng, (size_t)w->m);
+        memcpy(w->slides_prev, w->slides, (size_t)w->ns);
         for (int i = 0; i < n; i++)
             w->v[i] = (2.0 / h) * (w->q[i] - w->q0[i]) - w->v0[i];
         elements(w, w->q, w->v, w->v0);
+        springs(w, w->q);
         int same = w->m == 0 || !memcmp(w->eng_prev, w->eng, (size_t)w->m);
-        /* Kelvin-Voigt (and free flight) is linear on a fixed engaged set;
-         * Hertz-damp's force is continuous at d = 0: its set may still move */
-        done = w->o.law == PD_PENALTY_KELVIN ? same : dmax <= NM_TOL * qmax;
+        int same_springs = w->ns == 0 || !memcmp(w->slides_prev, w->slides, (size_t)w->ns);
+        /* Kelvin-Voigt (and free flight) is linear on a fixed engaged set,
+         * and so are the springs on a fixed sliding set (unless at initial
+         * stiffness); Hertz-damp's force is continuous at d = 0: its set
+         * may still move */
+        done = same_springs &&
+               (w->o.law == PD_PENALTY_KELVIN && !w->initial ? same : dmax <= NM_TOL * qmax);
     }
+    return done;
+}
+
+/* One step from (q0, v0, a0) to t1 = t0 + h: Newton on q1 (a failure
+ * counted and the step redone at the springs' initial stiffness), then the
+ * state moves to the step's end. */
+static int step(nm_run *w, double t1, int at_break, pd_err *err)
+{
+    const pd_model *md = w->md;
+    int n = w->n, rc = PD_OK;
+    double h = w->h, g4 = 0.25 * h * h;
+    w->t1 = t1;
+    /* b = M (q0 + h v0 + h^2/4 a0) + C (h/2 q0 + h^2/4 v0) */
+    for (int i = 0; i < n; i++)
+        w->tmp[i] = w->q0[i] + h * w->v0[i] + g4 * w->a0[i];
+    pd_matrix_gemv(&md->M, 1.0, w->tmp, 0.0, w->b);
+    for (int i = 0; i < n; i++)
+        w->tmp[i] = 0.5 * h * w->q0[i] + g4 * w->v0[i];
+    pd_matrix_gemv(&md->C, 1.0, w->tmp, 1.0, w->b);
+    force_at(w, t1, -1, w->F); /* F1 = F(t1-) */
+    w->initial = 0;
+    int done = newton(w, w->o.max_newton > 0 ? w->o.max_newton : NM_MAX_NEWTON, &rc, err);
+    if (!done && !rc && w->ns > 0) { /* Newton failed: counted, redone at initial stiffness */
+        w->res.newton_failures++;
+        w->initial = 1;
+        done = newton(w, NM_MAX_INITIAL, &rc, err);
+    }
+    if (rc)
+        return rc;
     if (!done)
         return pd_err_set(err, PD_ENUMERICAL,
                           "newmark: Newton did not converge in %d iterations at t = %.9g s "
                           "(elements switching within the step: a smaller dt)",
-                          NM_MAX_NEWTON, t1 * w->o.time_unit);
+                          w->initial            ? NM_MAX_INITIAL
+                          : w->o.max_newton > 0 ? w->o.max_newton
+                                                : NM_MAX_NEWTON,
+                          t1 * w->o.time_unit);
+    memcpy(w->up0, w->up, (size_t)w->ns * sizeof(double)); /* the offsets committed */
     /* the step's end: a1 = 4/h^2 (q1 - q0) - 4/h v0 - a0, v1 */
     for (int i = 0; i < n; i++) {
         double a1 = (4.0 / (h * h)) * (w->q[i] - w->q0[i]) - (4.0 / h) * w->v0[i] - w->a0[i];
@@ -359,6 +496,8 @@ static int nm_start(nm_run *w, double t0, const double *q0, const double *v0, pd
             return pd_err_set(err, PD_EINVAL, "newmark: initial state: dof %d is not finite", i);
         w->qscale = fmax(w->qscale, fabs(w->q0[i]));
     }
+    for (int j = 0; j < w->ns; j++) /* the springs' offsets start at 0 */
+        w->qscale = fmax(w->qscale, md->uy[j]);
     if (!(w->qscale > 0.0))
         w->qscale = 1e-300; /* all zero */
     w->vfloor = 1e3 * w->o.atol;
@@ -386,9 +525,11 @@ int pd_penalty_newmark(const pd_model *model, double t0, const double *q0, const
     if (!(rc = nm_check(&w, t0, t1, err))) {
         w.n = model->n;
         w.m = model->m;
+        w.ns = model->ns;
         w.h = w.o.h;
         if (nm_alloc(&w))
-            rc = pd_err_set(err, PD_ENOMEM, "newmark: out of memory for n = %d, m = %d", w.n, w.m);
+            rc = pd_err_set(err, PD_ENOMEM, "newmark: out of memory for n = %d, m = %d, ns = %d",
+                            w.n, w.m, w.ns);
     }
     if (!rc && !(rc = nm_start(&w, t0, q0, v0, err))) {
         long nsteps = pd_steps_for(t1 - t0, w.h), every = 1, k;

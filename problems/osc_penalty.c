@@ -43,6 +43,11 @@ typedef struct pen_track {
     double Le, vscale, wp;
     pd_osc_sampler sampler;
     void *sampler_ctx;
+    /* a yielding spring (newmark): its yielding part kbar = (1 - alpha) K, the
+     * offset up (at the previous step), the tallies */
+    double kbar, up, excursion;
+    long n_yield;
+    int slid; /* the previous step slid */
 } pen_track;
 
 /* A step of the interpolant: x(s) = sum_k c_k (s/h)^k on [0, h]. */
@@ -151,12 +156,15 @@ static void add_impulse(pen_track *tr, double tau, double lam)
     tr->imp_t = tau;
 }
 
-/* x, x', x'' and (free flight) x''' = f' - C x'' - K x' at tau, side of f. */
-static pen_jet jet_at(const pen_track *tr, double tau, double x, double v, double lam, int side)
+/* x, x', x'' and (free flight) x''' = f' - C x'' - Kt x' at tau, side of f;
+ * a yielding spring's force K x - kbar up, its tangent Kt = K - kbar while
+ * the step slid. */
+static pen_jet jet_at(const pen_track *tr, double tau, double x, double v, double lam, double up,
+                      int side)
 {
     pen_jet q = {x, v, 0.0, 0.0};
-    q.a = pd_osc_shape(tr->c, tau, side) - tr->C * v - tr->K * x - lam;
-    q.j = pd_osc_shape_rate(tr->c, tau, side) - tr->C * q.a - tr->K * v;
+    q.a = pd_osc_shape(tr->c, tau, side) - tr->C * v - tr->K * x + tr->kbar * up - lam;
+    q.j = pd_osc_shape_rate(tr->c, tau, side) - tr->C * q.a - (tr->K - tr->slid * tr->kbar) * v;
     return q;
 }
 
@@ -166,7 +174,8 @@ static pen_jet jet_at(const pen_track *tr, double tau, double x, double v, doubl
  * from the law it ran with: lambda when still engaged, 0 when released by
  * Hertz-damp (d = 0); a Kelvin-Voigt release leaves it unknown here, so
  * that step gets the cubic. */
-static void close_step(pen_track *tr, double tau, double x, double v, double lam, int active)
+static void close_step(pen_track *tr, double tau, double x, double v, double lam, int active,
+                       double up)
 {
     double h = tau - tr->pt, lam_end = 0.0;
     int degree = tr->pactive ? 5 : 7;
@@ -174,8 +183,8 @@ static void close_step(pen_track *tr, double tau, double x, double v, double lam
         lam_end = lam;
     else if (tr->pactive && tr->law == PD_PENALTY_KELVIN)
         degree = 3;
-    pen_jet s = jet_at(tr, tr->pt, tr->px, tr->pv, tr->pactive ? tr->pP : 0.0, +1);
-    pen_jet e = jet_at(tr, tau, x, v, lam_end, -1);
+    pen_jet s = jet_at(tr, tr->pt, tr->px, tr->pv, tr->pactive ? tr->pP : 0.0, tr->up, +1);
+    pen_jet e = jet_at(tr, tau, x, v, lam_end, up, -1);
     pen_poly p = hermite_step(h, &s, &e, degree);
     interior_extremes(tr, &p, tr->pt);
     if (tr->pactive)
@@ -188,18 +197,26 @@ static int track_step(const pd_state *st, void *ctx)
 {
     pen_track *tr = ctx;
     double tau = st->t, x = st->q[0], v = st->v[0];
-    double lam = tr->m ? st->P[0] : 0.0;
+    double lam = tr->m ? st->P[0] : 0.0, up = st->up ? st->up[0] : 0.0;
     int active = tr->m ? st->active[0] : 0;
+    /* a yielding spring: a step that slid after one that did not is an onset */
+    int slides = up != tr->up;
+    tr->n_yield += slides && !tr->slid;
+    tr->excursion += fabs(up - tr->up);
+    tr->slid = slides;
     if (tr->have_prev && tau > tr->pt)
-        close_step(tr, tau, x, v, lam, active);
+        close_step(tr, tau, x, v, lam, active, up);
+    tr->up = up;
     record_x(tr, tau, x);
-    double f = pd_osc_shape(tr->c, tau, -1), a = f - tr->C * v - tr->K * x - lam;
+    /* the spring's force K (x - (1 - alpha) up): an elastic spring's at xs */
+    double xs = tr->kbar > 0.0 ? x - (tr->kbar / tr->K) * up : x;
+    double f = pd_osc_shape(tr->c, tau, -1), a = f - tr->C * v - tr->K * xs - lam;
     /* a_abs: the element's force is an impact's and a hold's at once; a
      * hold (engaged, at rest after this step and the one before) takes the
      * rigid wall's held force, never the element's ringing */
     if (!tr->no_demands)
         pd_demand_osc_note(
-            &tr->dem, tau, x, v, &a,
+            &tr->dem, tau, xs, v, &a,
             pd_demand_osc_held(&tr->dem, tr->h_out, active, tr->pactive, v, tr->pv, x, f),
             !active && !tr->pactive); /* free steps */
     if (active)
@@ -302,6 +319,10 @@ static void fill_result(const pen_track *tr, const pd_run_opts *o, const pd_pena
     res->kernel = pr->stepper ? pr->stepper : "penalty";
     pd_osc_result_no_rtol(res, NAN);
     pd_osc_result_no_yield(res);
+    res->newton_failures = pr->newton_failures;
+    if (tr->kbar > 0.0) /* the slider's work: its force kbar uy over the excursion */
+        pd_osc_yield_figures(tr->c, tr->up, tr->excursion, tr->kbar * tr->c->Piy * tr->excursion,
+                             tr->n_yield, res);
     pd_demand_osc_finish(res, o, tr->no_demands ? NAN : tr->dem.peak * tr->c->ap,
                          tr->no_demands ? NAN : tr->dem.shear * tr->c->ap,
                          tr->m ? tr->fpeak * tr->c->ap : NAN);
@@ -317,7 +338,8 @@ int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler samp
         return PD_NULL_ARG(err, !c ? "c" : "res");
     pd_err_clear(err);
     if ((rc = pd_osc_resolve_opts(c, opts, &o, err)) ||
-        (rc = pd_osc_refuse_yield(c, "the penalty method", err)))
+        (o.method != PD_METHOD_NEWMARK &&
+         (rc = pd_osc_refuse_yield(c, "the adaptive penalty method", err))))
         return rc;
 
     /* the scene in Pi units; outputs on the grid tau_k = k 2 pi dt / Tp */
@@ -351,6 +373,14 @@ int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler samp
                       .nbreaks = brks        ? (int)(c->record->npts - 1)
                                  : brk > 0.0 ? 1
                                              : 0};
+    /* a yielding spring (newmark): S = 1, ks = (1 - alpha) K, uy = Piy */
+    double S = 1.0, ks = (1.0 - c->alpha) * K, uy = c->Piy;
+    if (pd_osc_yields(c)) {
+        model.ns = 1;
+        model.S = pd_matrix_dense(1, 1, &S);
+        model.ks = &ks;
+        model.uy = &uy;
+    }
     pen_track tr;
     memset(&tr, 0, sizeof tr);
     tr.c = c;
@@ -369,6 +399,7 @@ int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler samp
     tr.vscale = tr.Le * wp;
     tr.sampler = sampler;
     tr.sampler_ctx = ctx;
+    tr.kbar = model.ns ? ks : 0.0;
     pd_penalty_opts eo = pd_penalty_default_opts();
     eo.law = o.pen.law;
     eo.kc = pd_osc_penalty_kc(c, &o.pen);

@@ -51,6 +51,12 @@ static inline void pd_osc_result_no_yield(pd_osc_result *res)
                               .residual = NAN};
 }
 
+/* A yielding run's figures from its offset at the end, its excursion and
+ * the slider's work (Pi units: lengths times Le, energies per unit mass
+ * times (Le wp)^2), every method's (oscillator.c). */
+void pd_osc_yield_figures(const pd_osc *c, double up, double excursion, double work, long n_yield,
+                          pd_osc_result *res);
+
 /* PD_EINVAL for a yielding oscillator in a run that does not model
  * yielding (what: its name), else PD_OK. */
 static inline int pd_osc_refuse_yield(const pd_osc *c, const char *what, pd_err *err)
@@ -59,7 +65,7 @@ static inline int pd_osc_refuse_yield(const pd_osc *c, const char *what, pd_err 
         return PD_OK;
     return pd_err_set(err, PD_EINVAL,
                       "%s does not model yielding yet (uy, alpha < 1): a yielding oscillator "
-                      "runs by Moreau-Jean (method moreau)",
+                      "runs by Moreau-Jean (method moreau), newmark or the exact reference",
                       what);
 }
 

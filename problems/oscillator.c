@@ -213,13 +213,14 @@ int pd_osc_resolve_opts(const pd_osc *c, const pd_run_opts *in, pd_run_opts *out
                           "scenes; the oscillator's exact reference is event");
     if (pd_osc_yields(c) &&
         (out->rtol > 0.0 || (out->method != PD_METHOD_AUTO && out->method != PD_METHOD_MOREAU &&
+                             out->method != PD_METHOD_NEWMARK &&
                              (out->method != PD_METHOD_EVENT || !pd_osc_yield_exact(c)))))
         return pd_err_set(err, PD_EINVAL,
                           "a yielding oscillator (uy, alpha < 1) runs by Moreau-Jean at a "
-                          "fixed step, or by the exact reference when its sliding phase is "
-                          "underdamped or a free mass, xi < sqrt(alpha) or alpha = 0 (method %s%s, "
-                          "xi %g, alpha %g): the "
-                          "penalty methods and the tolerance do not model yielding yet",
+                          "fixed step, by newmark, or by the exact reference when its sliding "
+                          "phase is underdamped or a free mass, xi < sqrt(alpha) or alpha = 0 "
+                          "(method %s%s, xi %g, alpha %g): the adaptive penalty and the "
+                          "tolerance do not model yielding yet",
                           pd_method_name(out->method), out->rtol > 0.0 ? " with rtol" : "", c->xi,
                           c->alpha);
     if (out->dt == 0.0 && out->rtol == 0.0)
@@ -549,12 +550,10 @@ static int simulate_scalar(const pd_osc *c, const pd_model *md, const pd_mj_opts
     return rc;
 }
 
-/* A yielding run's results from its tallies and its end (q, v, up; Pi
- * units to metres, energies per unit mass in (Le wp)^2). */
 /* A yielding run's figures from its offset at the end, its excursion and
  * the slider's work (Pi units: lengths times Le, energies per unit mass
- * times (Le wp)^2), either method's. */
-static void yield_figures(const pd_osc *c, double up, double excursion, double work, long n_yield,
+ * times (Le wp)^2), every method's. */
+void pd_osc_yield_figures(const pd_osc *c, double up, double excursion, double work, long n_yield,
                           pd_osc_result *res)
 {
     double Le = pd_osc_Le(c), wp = pd_osc_wp(c);
@@ -573,12 +572,14 @@ static void energy_close(pd_energy *en)
         en->input;
 }
 
+/* A yielding run's results from its tallies and its end (q, v, up; Pi
+ * units to metres, energies per unit mass in (Le wp)^2). */
 static void yield_result(const pd_osc *c, const osc_yield *oy, const mj1_state *end,
                          pd_osc_result *res)
 {
     double Le = pd_osc_Le(c), wp = pd_osc_wp(c), E = (Le * wp) * (Le * wp);
     double K = c->Pi2 * c->Pi2, z = end->q - end->up;
-    yield_figures(c, end->up, oy->excursion, oy->kbar * oy->work, oy->n_yield, res);
+    pd_osc_yield_figures(c, end->up, oy->excursion, oy->kbar * oy->work, oy->n_yield, res);
     pd_energy *en = &res->energy;
     en->input = oy->so.h * oy->input * E;
     en->kinetic = 0.5 * end->v * end->v * E;
@@ -884,7 +885,7 @@ int pd_osc_reference(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sa
     pd_osc_result_no_yield(res);
     /* a yielding spring's figures */
     if (pd_osc_yields(c)) {
-        yield_figures(c, er.up, er.excursion, er.hysteretic, er.n_yield, res);
+        pd_osc_yield_figures(c, er.up, er.excursion, er.hysteretic, er.n_yield, res);
         if (eo.energy)
             ref_energy(&er, Le * wp, res);
     }

@@ -445,6 +445,8 @@ typedef struct pd_osc_result {
     double plastic_excursion; /* sum of |d up| [m] */
     double hysteretic_energy; /* the slider's work, per unit mass [J/kg] */
     long n_yield;             /* yield onsets */
+    long newton_failures;     /* newmark: steps whose Newton iterations failed (each redone at
+                                 the spring's initial stiffness); 0 for the other methods */
     pd_energy energy;         /* the balance (NAN throughout for an elastic run) */
 } pd_osc_result;
 

@@ -43,7 +43,7 @@ STRUCTS = (
 STATUSES = ("PD_OK", "PD_ENOMEM", "PD_EINVAL", "PD_ENOSOLUTION", "PD_EMAXPIVOTS", "PD_ENUMERICAL",
             "PD_ENONFINITE", "PD_EIO", "PD_EPARSE", "PD_ESINGULAR", "PD_EBUDGET", "PD_ESTOPPED",
             "PD_EMAXITER")
-CONSTANTS = STATUSES + ("PD_WALL", "PD_METHOD_AUTO")
+CONSTANTS = STATUSES + ("PD_WALL", "PD_METHOD_AUTO", "PD_METHOD_NEWMARK")
 
 SCALARS = {"double": "c_double", "int": "c_int", "long": "c_long", "size_t": "c_size_t",
            "unsigned char": "c_ubyte", "char": "c_char"}

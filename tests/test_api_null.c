@@ -832,13 +832,29 @@ static long api_case_100(void)
 static long api_case_101(void)
 {
     pd_err err = {0};
+    long v = pd_model_refuse_yield(NULL, (const char *)fx_string("pd_model_refuse_yield", "method"), &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_102(void)
+{
+    pd_err err = {0};
+    long v = pd_model_refuse_yield((const pd_model *)fx_object("pd_model", "pd_model_refuse_yield", 0), NULL, &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_103(void)
+{
+    pd_err err = {0};
     pd_factor_kind v = pd_factor_choose(NULL, (pd_factor_kind)0);
     (void)v;
     (void)err;
     return 0;
 }
 
-static long api_case_102(void)
+static long api_case_104(void)
 {
     pd_err err = {0};
     pd_mj * p = pd_mj_alloc(NULL, (const pd_mj_opts *)fx_object("pd_mj_opts", "pd_mj_alloc", 1), &err);
@@ -846,7 +862,7 @@ static long api_case_102(void)
     return p != NULL;
 }
 
-static long api_case_103(void)
+static long api_case_105(void)
 {
     pd_err err = {0};
     pd_mj * p = pd_mj_alloc((const pd_model *)fx_object("pd_model", "pd_mj_alloc", 0), NULL, &err);
@@ -854,7 +870,7 @@ static long api_case_103(void)
     return p != NULL;
 }
 
-static long api_case_104(void)
+static long api_case_106(void)
 {
     pd_err err = {0};
     pd_mj_free(NULL);
@@ -862,7 +878,7 @@ static long api_case_104(void)
     return 0;
 }
 
-static long api_case_105(void)
+static long api_case_107(void)
 {
     pd_err err = {0};
     long v = pd_mj_reset(NULL, 1.0, (const double *)fx_object("double", "pd_mj_reset", 2), (const double *)fx_object("double", "pd_mj_reset", 3), &err);
@@ -870,7 +886,7 @@ static long api_case_105(void)
     return v;
 }
 
-static long api_case_106(void)
+static long api_case_108(void)
 {
     pd_err err = {0};
     long v = pd_mj_reset((pd_mj *)fx_object("pd_mj", "pd_mj_reset", 0), 1.0, NULL, (const double *)fx_object("double", "pd_mj_reset", 3), &err);
@@ -878,7 +894,7 @@ static long api_case_106(void)
     return v;
 }
 
-static long api_case_107(void)
+static long api_case_109(void)
 {
     pd_err err = {0};
     long v = pd_mj_reset((pd_mj *)fx_object("pd_mj", "pd_mj_reset", 0), 1.0, (const double *)fx_object("double", "pd_mj_reset", 2), NULL, &err);
@@ -886,7 +902,7 @@ static long api_case_107(void)
     return v;
 }
 
-static long api_case_108(void)
+static long api_case_110(void)
 {
     pd_err err = {0};
     long v = pd_mj_step(NULL, &err);
@@ -894,7 +910,7 @@ static long api_case_108(void)
     return v;
 }
 
-static long api_case_109(void)
+static long api_case_111(void)
 {
     pd_err err = {0};
     long v = pd_mj_run(NULL, 1, NULL, NULL, &err);
@@ -902,7 +918,7 @@ static long api_case_109(void)
     return v;
 }
 
-static long api_case_110(void)
+static long api_case_112(void)
 {
     pd_err err = {0};
     long v = pd_mj_run_until(NULL, 1.0, NULL, NULL, &err);
@@ -910,7 +926,7 @@ static long api_case_110(void)
     return v;
 }
 
-static long api_case_111(void)
+static long api_case_113(void)
 {
     pd_err err = {0};
     long v = pd_mj_get_stats(NULL, (pd_mj_stats *)fx_object("pd_mj_stats", "pd_mj_get_stats", 1));
@@ -918,7 +934,7 @@ static long api_case_111(void)
     return v;
 }
 
-static long api_case_112(void)
+static long api_case_114(void)
 {
     pd_err err = {0};
     long v = pd_mj_get_stats((const pd_mj *)fx_object("pd_mj", "pd_mj_get_stats", 0), NULL);
@@ -926,7 +942,7 @@ static long api_case_112(void)
     return v;
 }
 
-static long api_case_113(void)
+static long api_case_115(void)
 {
     pd_err err = {0};
     const pd_state * p = pd_mj_state(NULL);
@@ -934,7 +950,7 @@ static long api_case_113(void)
     return p != NULL;
 }
 
-static long api_case_114(void)
+static long api_case_116(void)
 {
     pd_err err = {0};
     const char *s = pd_mj_kernel_name(NULL);
@@ -942,7 +958,7 @@ static long api_case_114(void)
     return s ? (long)strlen(s) + 1 : 0;
 }
 
-static long api_case_115(void)
+static long api_case_117(void)
 {
     pd_err err = {0};
     const char *s = pd_mj_factor_name(NULL);
@@ -950,7 +966,7 @@ static long api_case_115(void)
     return s ? (long)strlen(s) + 1 : 0;
 }
 
-static long api_case_116(void)
+static long api_case_118(void)
 {
     pd_err err = {0};
     long v = pd_mjb_init(NULL, (const pd_mj_opts *)fx_object("pd_mj_opts", "pd_mjb_init", 1), NULL, NULL, &err);
@@ -958,7 +974,7 @@ static long api_case_116(void)
     return v;
 }
 
-static long api_case_117(void)
+static long api_case_119(void)
 {
     pd_err err = {0};
     long v = pd_mjb_init((pd_mjb *)fx_object("pd_mjb", "pd_mjb_init", 0), NULL, NULL, NULL, &err);
@@ -966,7 +982,7 @@ static long api_case_117(void)
     return v;
 }
 
-static long api_case_118(void)
+static long api_case_120(void)
 {
     pd_err err = {0};
     long v = pd_mjb_set_lane(NULL, 0, (const pd_mjb_lane *)fx_object("pd_mjb_lane", "pd_mjb_set_lane", 2), &err);
@@ -974,7 +990,7 @@ static long api_case_118(void)
     return v;
 }
 
-static long api_case_119(void)
+static long api_case_121(void)
 {
     pd_err err = {0};
     long v = pd_mjb_set_lane((pd_mjb *)fx_object("pd_mjb", "pd_mjb_set_lane", 0), 0, NULL, &err);
@@ -982,7 +998,7 @@ static long api_case_119(void)
     return v;
 }
 
-static long api_case_120(void)
+static long api_case_122(void)
 {
     pd_err err = {0};
     pd_mjb_run(NULL, 1, NULL, NULL);
@@ -990,7 +1006,7 @@ static long api_case_120(void)
     return 0;
 }
 
-static long api_case_121(void)
+static long api_case_123(void)
 {
     pd_err err = {0};
     long v = pd_mjb_finite(NULL, 0);
@@ -998,7 +1014,7 @@ static long api_case_121(void)
     return v;
 }
 
-static long api_case_122(void)
+static long api_case_124(void)
 {
     pd_err err = {0};
     long v = pd_edg_run(NULL, 1.0, (const double *)fx_object("double", "pd_edg_run", 2), (const double *)fx_object("double", "pd_edg_run", 3), 1.0, (const pd_edg_opts *)fx_object("pd_edg_opts", "pd_edg_run", 5), NULL, NULL, (pd_edg_result *)fx_object("pd_edg_result", "pd_edg_run", 8), &err);
@@ -1006,7 +1022,7 @@ static long api_case_122(void)
     return v;
 }
 
-static long api_case_123(void)
+static long api_case_125(void)
 {
     pd_err err = {0};
     long v = pd_edg_run((const pd_model *)fx_object("pd_model", "pd_edg_run", 0), 1.0, NULL, (const double *)fx_object("double", "pd_edg_run", 3), 1.0, (const pd_edg_opts *)fx_object("pd_edg_opts", "pd_edg_run", 5), NULL, NULL, (pd_edg_result *)fx_object("pd_edg_result", "pd_edg_run", 8), &err);
@@ -1014,7 +1030,7 @@ static long api_case_123(void)
     return v;
 }
 
-static long api_case_124(void)
+static long api_case_126(void)
 {
     pd_err err = {0};
     long v = pd_edg_run((const pd_model *)fx_object("pd_model", "pd_edg_run", 0), 1.0, (const double *)fx_object("double", "pd_edg_run", 2), NULL, 1.0, (const pd_edg_opts *)fx_object("pd_edg_opts", "pd_edg_run", 5), NULL, NULL, (pd_edg_result *)fx_object("pd_edg_result", "pd_edg_run", 8), &err);
@@ -1022,7 +1038,7 @@ static long api_case_124(void)
     return v;
 }
 
-static long api_case_125(void)
+static long api_case_127(void)
 {
     pd_err err = {0};
     long v = pd_edg_run((const pd_model *)fx_object("pd_model", "pd_edg_run", 0), 1.0, (const double *)fx_object("double", "pd_edg_run", 2), (const double *)fx_object("double", "pd_edg_run", 3), 1.0, NULL, NULL, NULL, (pd_edg_result *)fx_object("pd_edg_result", "pd_edg_run", 8), &err);
@@ -1030,7 +1046,7 @@ static long api_case_125(void)
     return v;
 }
 
-static long api_case_126(void)
+static long api_case_128(void)
 {
     pd_err err = {0};
     long v = pd_edg_run((const pd_model *)fx_object("pd_model", "pd_edg_run", 0), 1.0, (const double *)fx_object("double", "pd_edg_run", 2), (const double *)fx_object("double", "pd_edg_run", 3), 1.0, (const pd_edg_opts *)fx_object("pd_edg_opts", "pd_edg_run", 5), NULL, NULL, NULL, &err);
@@ -1038,7 +1054,7 @@ static long api_case_126(void)
     return v;
 }
 
-static long api_case_127(void)
+static long api_case_129(void)
 {
     pd_err err = {0};
     long v = pd_penalty_run(NULL, 1.0, (const double *)fx_object("double", "pd_penalty_run", 2), (const double *)fx_object("double", "pd_penalty_run", 3), 1.0, (const pd_penalty_opts *)fx_object("pd_penalty_opts", "pd_penalty_run", 5), NULL, NULL, (pd_penalty_result *)fx_object("pd_penalty_result", "pd_penalty_run", 8), &err);
@@ -1046,7 +1062,7 @@ static long api_case_127(void)
     return v;
 }
 
-static long api_case_128(void)
+static long api_case_130(void)
 {
     pd_err err = {0};
     long v = pd_penalty_run((const pd_model *)fx_object("pd_model", "pd_penalty_run", 0), 1.0, NULL, (const double *)fx_object("double", "pd_penalty_run", 3), 1.0, (const pd_penalty_opts *)fx_object("pd_penalty_opts", "pd_penalty_run", 5), NULL, NULL, (pd_penalty_result *)fx_object("pd_penalty_result", "pd_penalty_run", 8), &err);
@@ -1054,7 +1070,7 @@ static long api_case_128(void)
     return v;
 }
 
-static long api_case_129(void)
+static long api_case_131(void)
 {
     pd_err err = {0};
     long v = pd_penalty_run((const pd_model *)fx_object("pd_model", "pd_penalty_run", 0), 1.0, (const double *)fx_object("double", "pd_penalty_run", 2), NULL, 1.0, (const pd_penalty_opts *)fx_object("pd_penalty_opts", "pd_penalty_run", 5), NULL, NULL, (pd_penalty_result *)fx_object("pd_penalty_result", "pd_penalty_run", 8), &err);
@@ -1062,7 +1078,7 @@ static long api_case_129(void)
     return v;
 }
 
-static long api_case_130(void)
+static long api_case_132(void)
 {
     pd_err err = {0};
     long v = pd_penalty_run((const pd_model *)fx_object("pd_model", "pd_penalty_run", 0), 1.0, (const double *)fx_object("double", "pd_penalty_run", 2), (const double *)fx_object("double", "pd_penalty_run", 3), 1.0, NULL, NULL, NULL, (pd_penalty_result *)fx_object("pd_penalty_result", "pd_penalty_run", 8), &err);
@@ -1070,7 +1086,7 @@ static long api_case_130(void)
     return v;
 }
 
-static long api_case_131(void)
+static long api_case_133(void)
 {
     pd_err err = {0};
     long v = pd_penalty_run((const pd_model *)fx_object("pd_model", "pd_penalty_run", 0), 1.0, (const double *)fx_object("double", "pd_penalty_run", 2), (const double *)fx_object("double", "pd_penalty_run", 3), 1.0, (const pd_penalty_opts *)fx_object("pd_penalty_opts", "pd_penalty_run", 5), NULL, NULL, NULL, &err);
@@ -1078,7 +1094,7 @@ static long api_case_131(void)
     return v;
 }
 
-static long api_case_132(void)
+static long api_case_134(void)
 {
     pd_err err = {0};
     double v = pd_sine_piece_force(NULL, 1.0);
@@ -1087,7 +1103,7 @@ static long api_case_132(void)
     return 0;
 }
 
-static long api_case_133(void)
+static long api_case_135(void)
 {
     pd_err err = {0};
     pd_sdof_increment_piece(NULL, (const pd_sine_piece *)fx_object("pd_sine_piece", "pd_sdof_increment_piece", 1), 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_increment_piece", 6), (double *)fx_object("double", "pd_sdof_increment_piece", 7));
@@ -1095,7 +1111,7 @@ static long api_case_133(void)
     return 0;
 }
 
-static long api_case_134(void)
+static long api_case_136(void)
 {
     pd_err err = {0};
     pd_sdof_increment_piece((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_increment_piece", 0), NULL, 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_increment_piece", 6), (double *)fx_object("double", "pd_sdof_increment_piece", 7));
@@ -1103,7 +1119,7 @@ static long api_case_134(void)
     return 0;
 }
 
-static long api_case_135(void)
+static long api_case_137(void)
 {
     pd_err err = {0};
     pd_sdof_increment_piece((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_increment_piece", 0), (const pd_sine_piece *)fx_object("pd_sine_piece", "pd_sdof_increment_piece", 1), 1.0, 1.0, 1.0, 1.0, NULL, (double *)fx_object("double", "pd_sdof_increment_piece", 7));
@@ -1111,7 +1127,7 @@ static long api_case_135(void)
     return 0;
 }
 
-static long api_case_136(void)
+static long api_case_138(void)
 {
     pd_err err = {0};
     pd_sdof_increment_piece((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_increment_piece", 0), (const pd_sine_piece *)fx_object("pd_sine_piece", "pd_sdof_increment_piece", 1), 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_increment_piece", 6), NULL);
@@ -1119,7 +1135,7 @@ static long api_case_136(void)
     return 0;
 }
 
-static long api_case_137(void)
+static long api_case_139(void)
 {
     pd_err err = {0};
     pd_sdof_advance_piece(NULL, (const pd_sine_piece *)fx_object("pd_sine_piece", "pd_sdof_advance_piece", 1), 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_advance_piece", 6), (double *)fx_object("double", "pd_sdof_advance_piece", 7));
@@ -1127,7 +1143,7 @@ static long api_case_137(void)
     return 0;
 }
 
-static long api_case_138(void)
+static long api_case_140(void)
 {
     pd_err err = {0};
     pd_sdof_advance_piece((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_advance_piece", 0), NULL, 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_advance_piece", 6), (double *)fx_object("double", "pd_sdof_advance_piece", 7));
@@ -1135,7 +1151,7 @@ static long api_case_138(void)
     return 0;
 }
 
-static long api_case_139(void)
+static long api_case_141(void)
 {
     pd_err err = {0};
     pd_sdof_advance_piece((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_advance_piece", 0), (const pd_sine_piece *)fx_object("pd_sine_piece", "pd_sdof_advance_piece", 1), 1.0, 1.0, 1.0, 1.0, NULL, (double *)fx_object("double", "pd_sdof_advance_piece", 7));
@@ -1143,7 +1159,7 @@ static long api_case_139(void)
     return 0;
 }
 
-static long api_case_140(void)
+static long api_case_142(void)
 {
     pd_err err = {0};
     pd_sdof_advance_piece((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_advance_piece", 0), (const pd_sine_piece *)fx_object("pd_sine_piece", "pd_sdof_advance_piece", 1), 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_advance_piece", 6), NULL);
@@ -1151,7 +1167,7 @@ static long api_case_140(void)
     return 0;
 }
 
-static long api_case_141(void)
+static long api_case_143(void)
 {
     pd_err err = {0};
     pd_sdof_flow_init(NULL, (const pd_sdof *)fx_object("pd_sdof", "pd_sdof_flow_init", 1), (const pd_sine_piece *)fx_object("pd_sine_piece", "pd_sdof_flow_init", 2), 1.0, 1.0, 1.0);
@@ -1159,7 +1175,7 @@ static long api_case_141(void)
     return 0;
 }
 
-static long api_case_142(void)
+static long api_case_144(void)
 {
     pd_err err = {0};
     pd_sdof_flow_init((pd_sdof_flow *)fx_object("pd_sdof_flow", "pd_sdof_flow_init", 0), NULL, (const pd_sine_piece *)fx_object("pd_sine_piece", "pd_sdof_flow_init", 2), 1.0, 1.0, 1.0);
@@ -1167,7 +1183,7 @@ static long api_case_142(void)
     return 0;
 }
 
-static long api_case_143(void)
+static long api_case_145(void)
 {
     pd_err err = {0};
     pd_sdof_flow_init((pd_sdof_flow *)fx_object("pd_sdof_flow", "pd_sdof_flow_init", 0), (const pd_sdof *)fx_object("pd_sdof", "pd_sdof_flow_init", 1), NULL, 1.0, 1.0, 1.0);
@@ -1175,7 +1191,7 @@ static long api_case_143(void)
     return 0;
 }
 
-static long api_case_144(void)
+static long api_case_146(void)
 {
     pd_err err = {0};
     pd_sdof_flow_at(NULL, 1.0, (double *)fx_object("double", "pd_sdof_flow_at", 2), (double *)fx_object("double", "pd_sdof_flow_at", 3));
@@ -1183,7 +1199,7 @@ static long api_case_144(void)
     return 0;
 }
 
-static long api_case_145(void)
+static long api_case_147(void)
 {
     pd_err err = {0};
     pd_sdof_flow_at((const pd_sdof_flow *)fx_object("pd_sdof_flow", "pd_sdof_flow_at", 0), 1.0, NULL, (double *)fx_object("double", "pd_sdof_flow_at", 3));
@@ -1191,7 +1207,7 @@ static long api_case_145(void)
     return 0;
 }
 
-static long api_case_146(void)
+static long api_case_148(void)
 {
     pd_err err = {0};
     pd_sdof_flow_at((const pd_sdof_flow *)fx_object("pd_sdof_flow", "pd_sdof_flow_at", 0), 1.0, (double *)fx_object("double", "pd_sdof_flow_at", 2), NULL);
@@ -1199,7 +1215,7 @@ static long api_case_146(void)
     return 0;
 }
 
-static long api_case_147(void)
+static long api_case_149(void)
 {
     pd_err err = {0};
     pd_sdof_advance(NULL, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_advance", 8), (double *)fx_object("double", "pd_sdof_advance", 9));
@@ -1207,7 +1223,7 @@ static long api_case_147(void)
     return 0;
 }
 
-static long api_case_148(void)
+static long api_case_150(void)
 {
     pd_err err = {0};
     pd_sdof_advance((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_advance", 0), 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, NULL, (double *)fx_object("double", "pd_sdof_advance", 9));
@@ -1215,7 +1231,7 @@ static long api_case_148(void)
     return 0;
 }
 
-static long api_case_149(void)
+static long api_case_151(void)
 {
     pd_err err = {0};
     pd_sdof_advance((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_advance", 0), 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_advance", 8), NULL);
@@ -1223,7 +1239,7 @@ static long api_case_149(void)
     return 0;
 }
 
-static long api_case_150(void)
+static long api_case_152(void)
 {
     pd_err err = {0};
     pd_sdof_increment(NULL, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_increment", 8), (double *)fx_object("double", "pd_sdof_increment", 9));
@@ -1231,7 +1247,7 @@ static long api_case_150(void)
     return 0;
 }
 
-static long api_case_151(void)
+static long api_case_153(void)
 {
     pd_err err = {0};
     pd_sdof_increment((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_increment", 0), 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, NULL, (double *)fx_object("double", "pd_sdof_increment", 9));
@@ -1239,7 +1255,7 @@ static long api_case_151(void)
     return 0;
 }
 
-static long api_case_152(void)
+static long api_case_154(void)
 {
     pd_err err = {0};
     pd_sdof_increment((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_increment", 0), 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_increment", 8), NULL);
@@ -1247,7 +1263,7 @@ static long api_case_152(void)
     return 0;
 }
 
-static long api_case_153(void)
+static long api_case_155(void)
 {
     pd_err err = {0};
     pd_edr * p = pd_edr_alloc(NULL, (const pd_piecewise_force *)fx_object("pd_piecewise_force", "pd_edr_alloc", 1), (const pd_edr_opts *)fx_object("pd_edr_opts", "pd_edr_alloc", 2), &err);
@@ -1255,7 +1271,7 @@ static long api_case_153(void)
     return p != NULL;
 }
 
-static long api_case_154(void)
+static long api_case_156(void)
 {
     pd_err err = {0};
     pd_edr * p = pd_edr_alloc((const pd_model *)fx_object("pd_model", "pd_edr_alloc", 0), NULL, (const pd_edr_opts *)fx_object("pd_edr_opts", "pd_edr_alloc", 2), &err);
@@ -1263,7 +1279,7 @@ static long api_case_154(void)
     return p != NULL;
 }
 
-static long api_case_155(void)
+static long api_case_157(void)
 {
     pd_err err = {0};
     pd_edr * p = pd_edr_alloc((const pd_model *)fx_object("pd_model", "pd_edr_alloc", 0), (const pd_piecewise_force *)fx_object("pd_piecewise_force", "pd_edr_alloc", 1), NULL, &err);
@@ -1271,7 +1287,7 @@ static long api_case_155(void)
     return p != NULL;
 }
 
-static long api_case_156(void)
+static long api_case_158(void)
 {
     pd_err err = {0};
     pd_edr_free(NULL);
@@ -1279,7 +1295,7 @@ static long api_case_156(void)
     return 0;
 }
 
-static long api_case_157(void)
+static long api_case_159(void)
 {
     pd_err err = {0};
     long v = pd_edr_run(NULL, 1.0, (const double *)fx_object("double", "pd_edr_run", 2), (const double *)fx_object("double", "pd_edr_run", 3), 1.0, NULL, NULL, &err);
@@ -1287,7 +1303,7 @@ static long api_case_157(void)
     return v;
 }
 
-static long api_case_158(void)
+static long api_case_160(void)
 {
     pd_err err = {0};
     long v = pd_edr_run((pd_edr *)fx_object("pd_edr", "pd_edr_run", 0), 1.0, NULL, (const double *)fx_object("double", "pd_edr_run", 3), 1.0, NULL, NULL, &err);
@@ -1295,7 +1311,7 @@ static long api_case_158(void)
     return v;
 }
 
-static long api_case_159(void)
+static long api_case_161(void)
 {
     pd_err err = {0};
     long v = pd_edr_run((pd_edr *)fx_object("pd_edr", "pd_edr_run", 0), 1.0, (const double *)fx_object("double", "pd_edr_run", 2), NULL, 1.0, NULL, NULL, &err);
@@ -1303,7 +1319,7 @@ static long api_case_159(void)
     return v;
 }
 
-static long api_case_160(void)
+static long api_case_162(void)
 {
     pd_err err = {0};
     const pd_edr_result * p = pd_edr_result_of(NULL);
@@ -1311,7 +1327,7 @@ static long api_case_160(void)
     return p != NULL;
 }
 
-static long api_case_161(void)
+static long api_case_163(void)
 {
     pd_err err = {0};
     long v = pd_ed_sdof_run(NULL, 1.0, 1.0, (const pd_ed_opts *)fx_object("pd_ed_opts", "pd_ed_sdof_run", 3), NULL, NULL, (pd_ed_result *)fx_object("pd_ed_result", "pd_ed_sdof_run", 6), &err);
@@ -1319,7 +1335,7 @@ static long api_case_161(void)
     return v;
 }
 
-static long api_case_162(void)
+static long api_case_164(void)
 {
     pd_err err = {0};
     long v = pd_ed_sdof_run((const pd_ed_sdof *)fx_object("pd_ed_sdof", "pd_ed_sdof_run", 0), 1.0, 1.0, NULL, NULL, NULL, (pd_ed_result *)fx_object("pd_ed_result", "pd_ed_sdof_run", 6), &err);
@@ -1327,7 +1343,7 @@ static long api_case_162(void)
     return v;
 }
 
-static long api_case_163(void)
+static long api_case_165(void)
 {
     pd_err err = {0};
     long v = pd_ed_sdof_run((const pd_ed_sdof *)fx_object("pd_ed_sdof", "pd_ed_sdof_run", 0), 1.0, 1.0, (const pd_ed_opts *)fx_object("pd_ed_opts", "pd_ed_sdof_run", 3), NULL, NULL, NULL, &err);
@@ -1335,7 +1351,7 @@ static long api_case_163(void)
     return v;
 }
 
-static long api_case_164(void)
+static long api_case_166(void)
 {
     pd_err err = {0};
     long v = pd_pulse_parse(NULL, (pd_pulse *)fx_object("pd_pulse", "pd_pulse_parse", 1));
@@ -1343,7 +1359,7 @@ static long api_case_164(void)
     return v;
 }
 
-static long api_case_165(void)
+static long api_case_167(void)
 {
     pd_err err = {0};
     long v = pd_pulse_parse((const char *)fx_string("pd_pulse_parse", "name"), NULL);
@@ -1351,7 +1367,7 @@ static long api_case_165(void)
     return v;
 }
 
-static long api_case_166(void)
+static long api_case_168(void)
 {
     pd_err err = {0};
     long v = pd_dir_parse(NULL, (int *)fx_object("int", "pd_dir_parse", 1));
@@ -1359,7 +1375,7 @@ static long api_case_166(void)
     return v;
 }
 
-static long api_case_167(void)
+static long api_case_169(void)
 {
     pd_err err = {0};
     long v = pd_dir_parse((const char *)fx_string("pd_dir_parse", "name"), NULL);
@@ -1367,7 +1383,7 @@ static long api_case_167(void)
     return v;
 }
 
-static long api_case_168(void)
+static long api_case_170(void)
 {
     pd_err err = {0};
     long v = pd_record_format_parse(NULL, (pd_record_format *)fx_object("pd_record_format", "pd_record_format_parse", 1));
@@ -1375,7 +1391,7 @@ static long api_case_168(void)
     return v;
 }
 
-static long api_case_169(void)
+static long api_case_171(void)
 {
     pd_err err = {0};
     long v = pd_record_format_parse((const char *)fx_string("pd_record_format_parse", "name"), NULL);
@@ -1383,7 +1399,7 @@ static long api_case_169(void)
     return v;
 }
 
-static long api_case_170(void)
+static long api_case_172(void)
 {
     pd_err err = {0};
     long v = pd_record_units_parse(NULL, (pd_record_units *)fx_object("pd_record_units", "pd_record_units_parse", 1));
@@ -1391,7 +1407,7 @@ static long api_case_170(void)
     return v;
 }
 
-static long api_case_171(void)
+static long api_case_173(void)
 {
     pd_err err = {0};
     long v = pd_record_units_parse((const char *)fx_string("pd_record_units_parse", "name"), NULL);
@@ -1399,7 +1415,7 @@ static long api_case_171(void)
     return v;
 }
 
-static long api_case_172(void)
+static long api_case_174(void)
 {
     pd_err err = {0};
     long v = pd_record_read(NULL, (pd_record_format)0, (pd_record_units)0, (pd_record *)fx_object("pd_record", "pd_record_read", 3), &err);
@@ -1407,7 +1423,7 @@ static long api_case_172(void)
     return v;
 }
 
-static long api_case_173(void)
+static long api_case_175(void)
 {
     pd_err err = {0};
     long v = pd_record_read((const char *)fx_string("pd_record_read", "path"), (pd_record_format)0, (pd_record_units)0, NULL, &err);
@@ -1415,7 +1431,7 @@ static long api_case_173(void)
     return v;
 }
 
-static long api_case_174(void)
+static long api_case_176(void)
 {
     pd_err err = {0};
     pd_record_free(NULL);
@@ -1423,7 +1439,7 @@ static long api_case_174(void)
     return 0;
 }
 
-static long api_case_175(void)
+static long api_case_177(void)
 {
     pd_err err = {0};
     long v = pd_record_detect(NULL, (pd_record_format *)fx_object("pd_record_format", "pd_record_detect", 1), &err);
@@ -1431,7 +1447,7 @@ static long api_case_175(void)
     return v;
 }
 
-static long api_case_176(void)
+static long api_case_178(void)
 {
     pd_err err = {0};
     long v = pd_record_detect((const char *)fx_string("pd_record_detect", "path"), NULL, &err);
@@ -1439,7 +1455,7 @@ static long api_case_176(void)
     return v;
 }
 
-static long api_case_177(void)
+static long api_case_179(void)
 {
     pd_err err = {0};
     long v = pd_record_plausible(NULL, (pd_record_units)0, (char *)fx_string("pd_record_plausible", "msg"), 64);
@@ -1447,7 +1463,7 @@ static long api_case_177(void)
     return v;
 }
 
-static long api_case_178(void)
+static long api_case_180(void)
 {
     pd_err err = {0};
     long v = pd_record_plausible((const pd_record *)fx_object("pd_record", "pd_record_plausible", 0), (pd_record_units)0, NULL, 64);
@@ -1455,7 +1471,7 @@ static long api_case_178(void)
     return v;
 }
 
-static long api_case_179(void)
+static long api_case_181(void)
 {
     pd_err err = {0};
     long v = pd_record_from_array(NULL, (const char *)fx_string("pd_record_from_array", "name"), (const double *)fx_object("double", "pd_record_from_array", 2), 1, 1.0, (pd_record_units)0, &err);
@@ -1463,7 +1479,7 @@ static long api_case_179(void)
     return v;
 }
 
-static long api_case_180(void)
+static long api_case_182(void)
 {
     pd_err err = {0};
     long v = pd_record_from_array((pd_record *)fx_object("pd_record", "pd_record_from_array", 0), NULL, (const double *)fx_object("double", "pd_record_from_array", 2), 1, 1.0, (pd_record_units)0, &err);
@@ -1471,7 +1487,7 @@ static long api_case_180(void)
     return v;
 }
 
-static long api_case_181(void)
+static long api_case_183(void)
 {
     pd_err err = {0};
     long v = pd_record_from_array((pd_record *)fx_object("pd_record", "pd_record_from_array", 0), (const char *)fx_string("pd_record_from_array", "name"), NULL, 1, 1.0, (pd_record_units)0, &err);
@@ -1479,7 +1495,7 @@ static long api_case_181(void)
     return v;
 }
 
-static long api_case_182(void)
+static long api_case_184(void)
 {
     pd_err err = {0};
     double v = pd_record_duration(NULL);
@@ -1488,7 +1504,7 @@ static long api_case_182(void)
     return 0;
 }
 
-static long api_case_183(void)
+static long api_case_185(void)
 {
     pd_err err = {0};
     double v = pd_record_acc(NULL, 1.0);
@@ -1497,7 +1513,7 @@ static long api_case_183(void)
     return 0;
 }
 
-static long api_case_184(void)
+static long api_case_186(void)
 {
     pd_err err = {0};
     long v = pd_record_measure(NULL, (pd_record_measures *)fx_object("pd_record_measures", "pd_record_measure", 1), &err);
@@ -1505,7 +1521,7 @@ static long api_case_184(void)
     return v;
 }
 
-static long api_case_185(void)
+static long api_case_187(void)
 {
     pd_err err = {0};
     long v = pd_record_measure((const pd_record *)fx_object("pd_record", "pd_record_measure", 0), NULL, &err);
@@ -1513,7 +1529,7 @@ static long api_case_185(void)
     return v;
 }
 
-static long api_case_186(void)
+static long api_case_188(void)
 {
     pd_err err = {0};
     long v = pd_record_integrate(NULL, (double *)fx_object("double", "pd_record_integrate", 1), (double *)fx_object("double", "pd_record_integrate", 2), &err);
@@ -1521,7 +1537,7 @@ static long api_case_186(void)
     return v;
 }
 
-static long api_case_187(void)
+static long api_case_189(void)
 {
     pd_err err = {0};
     long v = pd_record_integrate((const pd_record *)fx_object("pd_record", "pd_record_integrate", 0), NULL, (double *)fx_object("double", "pd_record_integrate", 2), &err);
@@ -1529,7 +1545,7 @@ static long api_case_187(void)
     return v;
 }
 
-static long api_case_188(void)
+static long api_case_190(void)
 {
     pd_err err = {0};
     long v = pd_record_integrate((const pd_record *)fx_object("pd_record", "pd_record_integrate", 0), (double *)fx_object("double", "pd_record_integrate", 1), NULL, &err);
@@ -1537,7 +1553,7 @@ static long api_case_188(void)
     return v;
 }
 
-static long api_case_189(void)
+static long api_case_191(void)
 {
     pd_err err = {0};
     long v = pd_record_fit_pulse(NULL, (pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_fit_pulse", 1), &err);
@@ -1545,7 +1561,7 @@ static long api_case_189(void)
     return v;
 }
 
-static long api_case_190(void)
+static long api_case_192(void)
 {
     pd_err err = {0};
     long v = pd_record_fit_pulse((const pd_record *)fx_object("pd_record", "pd_record_fit_pulse", 0), NULL, &err);
@@ -1553,7 +1569,7 @@ static long api_case_190(void)
     return v;
 }
 
-static long api_case_191(void)
+static long api_case_193(void)
 {
     pd_err err = {0};
     pd_record_pulse_eval(NULL, 1.0, (double *)fx_object("double", "pd_record_pulse_eval", 2), (double *)fx_object("double", "pd_record_pulse_eval", 3));
@@ -1561,7 +1577,7 @@ static long api_case_191(void)
     return 0;
 }
 
-static long api_case_192(void)
+static long api_case_194(void)
 {
     pd_err err = {0};
     pd_record_pulse_eval((const pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_pulse_eval", 0), 1.0, NULL, (double *)fx_object("double", "pd_record_pulse_eval", 3));
@@ -1569,7 +1585,7 @@ static long api_case_192(void)
     return 0;
 }
 
-static long api_case_193(void)
+static long api_case_195(void)
 {
     pd_err err = {0};
     pd_record_pulse_eval((const pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_pulse_eval", 0), 1.0, (double *)fx_object("double", "pd_record_pulse_eval", 2), NULL);
@@ -1577,7 +1593,7 @@ static long api_case_193(void)
     return 0;
 }
 
-static long api_case_194(void)
+static long api_case_196(void)
 {
     pd_err err = {0};
     double v = pd_record_one_cycle(NULL, 1.0);
@@ -1586,7 +1602,7 @@ static long api_case_194(void)
     return 0;
 }
 
-static long api_case_195(void)
+static long api_case_197(void)
 {
     pd_err err = {0};
     long v = pd_method_parse(NULL, (pd_method *)fx_object("pd_method", "pd_method_parse", 1));
@@ -1594,7 +1610,7 @@ static long api_case_195(void)
     return v;
 }
 
-static long api_case_196(void)
+static long api_case_198(void)
 {
     pd_err err = {0};
     long v = pd_method_parse((const char *)fx_string("pd_method_parse", "name"), NULL);
@@ -1602,7 +1618,7 @@ static long api_case_196(void)
     return v;
 }
 
-static long api_case_197(void)
+static long api_case_199(void)
 {
     pd_err err = {0};
     long v = pd_impact_law_parse(NULL, (pd_impact_law *)fx_object("pd_impact_law", "pd_impact_law_parse", 1));
@@ -1610,7 +1626,7 @@ static long api_case_197(void)
     return v;
 }
 
-static long api_case_198(void)
+static long api_case_200(void)
 {
     pd_err err = {0};
     long v = pd_impact_law_parse((const char *)fx_string("pd_impact_law_parse", "name"), NULL);
@@ -1618,7 +1634,7 @@ static long api_case_198(void)
     return v;
 }
 
-static long api_case_199(void)
+static long api_case_201(void)
 {
     pd_err err = {0};
     long v = pd_run_opts_check(NULL, &err);
@@ -1626,7 +1642,7 @@ static long api_case_199(void)
     return v;
 }
 
-static long api_case_200(void)
+static long api_case_202(void)
 {
     pd_err err = {0};
     double v = pd_osc_wp(NULL);
@@ -1635,7 +1651,7 @@ static long api_case_200(void)
     return 0;
 }
 
-static long api_case_201(void)
+static long api_case_203(void)
 {
     pd_err err = {0};
     double v = pd_osc_T0(NULL);
@@ -1644,7 +1660,7 @@ static long api_case_201(void)
     return 0;
 }
 
-static long api_case_202(void)
+static long api_case_204(void)
 {
     pd_err err = {0};
     double v = pd_osc_gap(NULL);
@@ -1653,7 +1669,7 @@ static long api_case_202(void)
     return 0;
 }
 
-static long api_case_203(void)
+static long api_case_205(void)
 {
     pd_err err = {0};
     double v = pd_osc_Le(NULL);
@@ -1662,7 +1678,7 @@ static long api_case_203(void)
     return 0;
 }
 
-static long api_case_204(void)
+static long api_case_206(void)
 {
     pd_err err = {0};
     pd_osc_set_T0(NULL, 1.0);
@@ -1670,7 +1686,7 @@ static long api_case_204(void)
     return 0;
 }
 
-static long api_case_205(void)
+static long api_case_207(void)
 {
     pd_err err = {0};
     pd_osc_set_gap(NULL, 1.0);
@@ -1678,7 +1694,7 @@ static long api_case_205(void)
     return 0;
 }
 
-static long api_case_206(void)
+static long api_case_208(void)
 {
     pd_err err = {0};
     pd_osc_set_uy(NULL, 1.0);
@@ -1686,7 +1702,7 @@ static long api_case_206(void)
     return 0;
 }
 
-static long api_case_207(void)
+static long api_case_209(void)
 {
     pd_err err = {0};
     double v = pd_osc_uy(NULL);
@@ -1695,7 +1711,7 @@ static long api_case_207(void)
     return 0;
 }
 
-static long api_case_208(void)
+static long api_case_210(void)
 {
     pd_err err = {0};
     long v = pd_osc_yields(NULL);
@@ -1703,7 +1719,7 @@ static long api_case_208(void)
     return v;
 }
 
-static long api_case_209(void)
+static long api_case_211(void)
 {
     pd_err err = {0};
     long v = pd_osc_yield_exact(NULL);
@@ -1711,7 +1727,7 @@ static long api_case_209(void)
     return v;
 }
 
-static long api_case_210(void)
+static long api_case_212(void)
 {
     pd_err err = {0};
     double v = pd_osc_excitation(NULL, 1.0);
@@ -1720,7 +1736,7 @@ static long api_case_210(void)
     return 0;
 }
 
-static long api_case_211(void)
+static long api_case_213(void)
 {
     pd_err err = {0};
     pd_osc_set_record(NULL, (const pd_record *)fx_object("pd_record", "pd_osc_set_record", 1), (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_osc_set_record", 2), 1.0);
@@ -1728,7 +1744,7 @@ static long api_case_211(void)
     return 0;
 }
 
-static long api_case_212(void)
+static long api_case_214(void)
 {
     pd_err err = {0};
     pd_osc_set_record((pd_osc *)fx_object("pd_osc", "pd_osc_set_record", 0), NULL, (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_osc_set_record", 2), 1.0);
@@ -1736,7 +1752,7 @@ static long api_case_212(void)
     return 0;
 }
 
-static long api_case_213(void)
+static long api_case_215(void)
 {
     pd_err err = {0};
     pd_osc_set_record((pd_osc *)fx_object("pd_osc", "pd_osc_set_record", 0), (const pd_record *)fx_object("pd_record", "pd_osc_set_record", 1), NULL, 1.0);
@@ -1744,7 +1760,7 @@ static long api_case_213(void)
     return 0;
 }
 
-static long api_case_214(void)
+static long api_case_216(void)
 {
     pd_err err = {0};
     double v = pd_osc_shape(NULL, 1.0, 0);
@@ -1753,7 +1769,7 @@ static long api_case_214(void)
     return 0;
 }
 
-static long api_case_215(void)
+static long api_case_217(void)
 {
     pd_err err = {0};
     double v = pd_osc_shape_rate(NULL, 1.0, 0);
@@ -1762,7 +1778,7 @@ static long api_case_215(void)
     return 0;
 }
 
-static long api_case_216(void)
+static long api_case_218(void)
 {
     pd_err err = {0};
     double v = pd_osc_shape_end(NULL);
@@ -1771,7 +1787,7 @@ static long api_case_216(void)
     return 0;
 }
 
-static long api_case_217(void)
+static long api_case_219(void)
 {
     pd_err err = {0};
     long v = pd_osc_pieces(NULL, (pd_sine_piece **)fx_slot(), (int *)fx_object("int", "pd_osc_pieces", 2), &err);
@@ -1779,7 +1795,7 @@ static long api_case_217(void)
     return v;
 }
 
-static long api_case_218(void)
+static long api_case_220(void)
 {
     pd_err err = {0};
     long v = pd_osc_pieces((const pd_osc *)fx_object("pd_osc", "pd_osc_pieces", 0), NULL, (int *)fx_object("int", "pd_osc_pieces", 2), &err);
@@ -1787,7 +1803,7 @@ static long api_case_218(void)
     return v;
 }
 
-static long api_case_219(void)
+static long api_case_221(void)
 {
     pd_err err = {0};
     long v = pd_osc_pieces((const pd_osc *)fx_object("pd_osc", "pd_osc_pieces", 0), (pd_sine_piece **)fx_slot(), NULL, &err);
@@ -1795,7 +1811,7 @@ static long api_case_219(void)
     return v;
 }
 
-static long api_case_220(void)
+static long api_case_222(void)
 {
     pd_err err = {0};
     const char *s = pd_osc_excitation_name(NULL);
@@ -1803,7 +1819,7 @@ static long api_case_220(void)
     return s ? (long)strlen(s) + 1 : 0;
 }
 
-static long api_case_221(void)
+static long api_case_223(void)
 {
     pd_err err = {0};
     long v = pd_osc_check(NULL, &err);
@@ -1811,7 +1827,7 @@ static long api_case_221(void)
     return v;
 }
 
-static long api_case_222(void)
+static long api_case_224(void)
 {
     pd_err err = {0};
     long v = pd_osc_resolve_opts(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_resolve_opts", 1), (pd_run_opts *)fx_object("pd_run_opts", "pd_osc_resolve_opts", 2), &err);
@@ -1819,7 +1835,7 @@ static long api_case_222(void)
     return v;
 }
 
-static long api_case_223(void)
+static long api_case_225(void)
 {
     pd_err err = {0};
     long v = pd_osc_resolve_opts((const pd_osc *)fx_object("pd_osc", "pd_osc_resolve_opts", 0), NULL, (pd_run_opts *)fx_object("pd_run_opts", "pd_osc_resolve_opts", 2), &err);
@@ -1827,7 +1843,7 @@ static long api_case_223(void)
     return v;
 }
 
-static long api_case_224(void)
+static long api_case_226(void)
 {
     pd_err err = {0};
     long v = pd_osc_resolve_opts((const pd_osc *)fx_object("pd_osc", "pd_osc_resolve_opts", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_resolve_opts", 1), NULL, &err);
@@ -1835,7 +1851,7 @@ static long api_case_224(void)
     return v;
 }
 
-static long api_case_225(void)
+static long api_case_227(void)
 {
     pd_err err = {0};
     double v = pd_osc_default_dt(NULL);
@@ -1844,7 +1860,7 @@ static long api_case_225(void)
     return 0;
 }
 
-static long api_case_226(void)
+static long api_case_228(void)
 {
     pd_err err = {0};
     double v = pd_osc_default_tend(NULL);
@@ -1853,7 +1869,7 @@ static long api_case_226(void)
     return 0;
 }
 
-static long api_case_227(void)
+static long api_case_229(void)
 {
     pd_err err = {0};
     double v = pd_osc_measure_start(NULL, 1.0);
@@ -1862,7 +1878,7 @@ static long api_case_227(void)
     return 0;
 }
 
-static long api_case_228(void)
+static long api_case_230(void)
 {
     pd_err err = {0};
     pd_method v = pd_osc_method(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_method", 1));
@@ -1871,7 +1887,7 @@ static long api_case_228(void)
     return 0;
 }
 
-static long api_case_229(void)
+static long api_case_231(void)
 {
     pd_err err = {0};
     pd_method v = pd_osc_method((const pd_osc *)fx_object("pd_osc", "pd_osc_method", 0), NULL);
@@ -1880,7 +1896,7 @@ static long api_case_229(void)
     return 0;
 }
 
-static long api_case_230(void)
+static long api_case_232(void)
 {
     pd_err err = {0};
     long v = pd_osc_run(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_run", 1), NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_run", 4), &err);
@@ -1888,7 +1904,7 @@ static long api_case_230(void)
     return v;
 }
 
-static long api_case_231(void)
+static long api_case_233(void)
 {
     pd_err err = {0};
     long v = pd_osc_run((const pd_osc *)fx_object("pd_osc", "pd_osc_run", 0), NULL, NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_run", 4), &err);
@@ -1896,7 +1912,7 @@ static long api_case_231(void)
     return v;
 }
 
-static long api_case_232(void)
+static long api_case_234(void)
 {
     pd_err err = {0};
     long v = pd_osc_run((const pd_osc *)fx_object("pd_osc", "pd_osc_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_run", 1), NULL, NULL, NULL, &err);
@@ -1904,7 +1920,7 @@ static long api_case_232(void)
     return v;
 }
 
-static long api_case_233(void)
+static long api_case_235(void)
 {
     pd_err err = {0};
     long v = pd_osc_batchable(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_batchable", 1));
@@ -1912,7 +1928,7 @@ static long api_case_233(void)
     return v;
 }
 
-static long api_case_234(void)
+static long api_case_236(void)
 {
     pd_err err = {0};
     long v = pd_osc_batchable((const pd_osc *)fx_object("pd_osc", "pd_osc_batchable", 0), NULL);
@@ -1920,7 +1936,7 @@ static long api_case_234(void)
     return v;
 }
 
-static long api_case_235(void)
+static long api_case_237(void)
 {
     pd_err err = {0};
     double v = pd_osc_scan_points(NULL, 1.0);
@@ -1929,7 +1945,7 @@ static long api_case_235(void)
     return 0;
 }
 
-static long api_case_236(void)
+static long api_case_238(void)
 {
     pd_err err = {0};
     long v = pd_osc_simulate(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_simulate", 1), NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_simulate", 4), &err);
@@ -1937,7 +1953,7 @@ static long api_case_236(void)
     return v;
 }
 
-static long api_case_237(void)
+static long api_case_239(void)
 {
     pd_err err = {0};
     long v = pd_osc_simulate((const pd_osc *)fx_object("pd_osc", "pd_osc_simulate", 0), NULL, NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_simulate", 4), &err);
@@ -1945,7 +1961,7 @@ static long api_case_237(void)
     return v;
 }
 
-static long api_case_238(void)
+static long api_case_240(void)
 {
     pd_err err = {0};
     long v = pd_osc_simulate((const pd_osc *)fx_object("pd_osc", "pd_osc_simulate", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_simulate", 1), NULL, NULL, NULL, &err);
@@ -1953,7 +1969,7 @@ static long api_case_238(void)
     return v;
 }
 
-static long api_case_239(void)
+static long api_case_241(void)
 {
     pd_err err = {0};
     long v = pd_osc_reference(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_reference", 1), NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_reference", 4), &err);
@@ -1961,7 +1977,7 @@ static long api_case_239(void)
     return v;
 }
 
-static long api_case_240(void)
+static long api_case_242(void)
 {
     pd_err err = {0};
     long v = pd_osc_reference((const pd_osc *)fx_object("pd_osc", "pd_osc_reference", 0), NULL, NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_reference", 4), &err);
@@ -1969,7 +1985,7 @@ static long api_case_240(void)
     return v;
 }
 
-static long api_case_241(void)
+static long api_case_243(void)
 {
     pd_err err = {0};
     long v = pd_osc_reference((const pd_osc *)fx_object("pd_osc", "pd_osc_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_reference", 1), NULL, NULL, NULL, &err);
@@ -1977,7 +1993,7 @@ static long api_case_241(void)
     return v;
 }
 
-static long api_case_242(void)
+static long api_case_244(void)
 {
     pd_err err = {0};
     long v = pd_osc_penalty(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_penalty", 1), NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_penalty", 4), &err);
@@ -1985,7 +2001,7 @@ static long api_case_242(void)
     return v;
 }
 
-static long api_case_243(void)
+static long api_case_245(void)
 {
     pd_err err = {0};
     long v = pd_osc_penalty((const pd_osc *)fx_object("pd_osc", "pd_osc_penalty", 0), NULL, NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_penalty", 4), &err);
@@ -1993,7 +2009,7 @@ static long api_case_243(void)
     return v;
 }
 
-static long api_case_244(void)
+static long api_case_246(void)
 {
     pd_err err = {0};
     long v = pd_osc_penalty((const pd_osc *)fx_object("pd_osc", "pd_osc_penalty", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_penalty", 1), NULL, NULL, NULL, &err);
@@ -2001,7 +2017,7 @@ static long api_case_244(void)
     return v;
 }
 
-static long api_case_245(void)
+static long api_case_247(void)
 {
     pd_err err = {0};
     long v = pd_osc_summarize(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_summarize", 1), NULL, NULL, (pd_osc_summary *)fx_object("pd_osc_summary", "pd_osc_summarize", 4), &err);
@@ -2009,7 +2025,7 @@ static long api_case_245(void)
     return v;
 }
 
-static long api_case_246(void)
+static long api_case_248(void)
 {
     pd_err err = {0};
     long v = pd_osc_summarize((const pd_osc *)fx_object("pd_osc", "pd_osc_summarize", 0), NULL, NULL, NULL, (pd_osc_summary *)fx_object("pd_osc_summary", "pd_osc_summarize", 4), &err);
@@ -2017,7 +2033,7 @@ static long api_case_246(void)
     return v;
 }
 
-static long api_case_247(void)
+static long api_case_249(void)
 {
     pd_err err = {0};
     long v = pd_osc_summarize((const pd_osc *)fx_object("pd_osc", "pd_osc_summarize", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_summarize", 1), NULL, NULL, NULL, &err);
@@ -2025,7 +2041,7 @@ static long api_case_247(void)
     return v;
 }
 
-static long api_case_248(void)
+static long api_case_250(void)
 {
     pd_err err = {0};
     pd_osc_free_exact(NULL, 1.0, (double *)fx_object("double", "pd_osc_free_exact", 2), (double *)fx_object("double", "pd_osc_free_exact", 3));
@@ -2033,7 +2049,7 @@ static long api_case_248(void)
     return 0;
 }
 
-static long api_case_249(void)
+static long api_case_251(void)
 {
     pd_err err = {0};
     pd_osc_free_exact((const pd_osc *)fx_object("pd_osc", "pd_osc_free_exact", 0), 1.0, NULL, (double *)fx_object("double", "pd_osc_free_exact", 3));
@@ -2041,7 +2057,7 @@ static long api_case_249(void)
     return 0;
 }
 
-static long api_case_250(void)
+static long api_case_252(void)
 {
     pd_err err = {0};
     pd_osc_free_exact((const pd_osc *)fx_object("pd_osc", "pd_osc_free_exact", 0), 1.0, (double *)fx_object("double", "pd_osc_free_exact", 2), NULL);
@@ -2049,7 +2065,7 @@ static long api_case_250(void)
     return 0;
 }
 
-static long api_case_251(void)
+static long api_case_253(void)
 {
     pd_err err = {0};
     long v = pd_osc_free_first_contact(NULL, 1.0, (double *)fx_object("double", "pd_osc_free_first_contact", 2), (double *)fx_object("double", "pd_osc_free_first_contact", 3));
@@ -2057,7 +2073,7 @@ static long api_case_251(void)
     return v;
 }
 
-static long api_case_252(void)
+static long api_case_254(void)
 {
     pd_err err = {0};
     long v = pd_osc_free_first_contact((const pd_osc *)fx_object("pd_osc", "pd_osc_free_first_contact", 0), 1.0, NULL, (double *)fx_object("double", "pd_osc_free_first_contact", 3));
@@ -2065,7 +2081,7 @@ static long api_case_252(void)
     return v;
 }
 
-static long api_case_253(void)
+static long api_case_255(void)
 {
     pd_err err = {0};
     long v = pd_osc_free_first_contact((const pd_osc *)fx_object("pd_osc", "pd_osc_free_first_contact", 0), 1.0, (double *)fx_object("double", "pd_osc_free_first_contact", 2), NULL);
@@ -2073,7 +2089,7 @@ static long api_case_253(void)
     return v;
 }
 
-static long api_case_254(void)
+static long api_case_256(void)
 {
     pd_err err = {0};
     long v = pd_trace_alloc(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_trace_alloc", 1));
@@ -2081,7 +2097,7 @@ static long api_case_254(void)
     return v;
 }
 
-static long api_case_255(void)
+static long api_case_257(void)
 {
     pd_err err = {0};
     long v = pd_trace_alloc((pd_trace *)fx_object("pd_trace", "pd_trace_alloc", 0), NULL);
@@ -2089,7 +2105,7 @@ static long api_case_255(void)
     return v;
 }
 
-static long api_case_256(void)
+static long api_case_258(void)
 {
     pd_err err = {0};
     pd_trace_free(NULL);
@@ -2097,7 +2113,7 @@ static long api_case_256(void)
     return 0;
 }
 
-static long api_case_257(void)
+static long api_case_259(void)
 {
     pd_err err = {0};
     long v = pd_measure_reference(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_reference", 1), (pd_trace *)fx_object("pd_trace", "pd_measure_reference", 2), (pd_osc_result *)fx_object("pd_osc_result", "pd_measure_reference", 3), &err);
@@ -2105,7 +2121,7 @@ static long api_case_257(void)
     return v;
 }
 
-static long api_case_258(void)
+static long api_case_260(void)
 {
     pd_err err = {0};
     long v = pd_measure_reference((const pd_osc *)fx_object("pd_osc", "pd_measure_reference", 0), NULL, (pd_trace *)fx_object("pd_trace", "pd_measure_reference", 2), (pd_osc_result *)fx_object("pd_osc_result", "pd_measure_reference", 3), &err);
@@ -2113,7 +2129,7 @@ static long api_case_258(void)
     return v;
 }
 
-static long api_case_259(void)
+static long api_case_261(void)
 {
     pd_err err = {0};
     long v = pd_measure_reference((const pd_osc *)fx_object("pd_osc", "pd_measure_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_reference", 1), NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_measure_reference", 3), &err);
@@ -2121,7 +2137,7 @@ static long api_case_259(void)
     return v;
 }
 
-static long api_case_260(void)
+static long api_case_262(void)
 {
     pd_err err = {0};
     long v = pd_measure_reference((const pd_osc *)fx_object("pd_osc", "pd_measure_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_reference", 1), (pd_trace *)fx_object("pd_trace", "pd_measure_reference", 2), NULL, &err);
@@ -2129,7 +2145,7 @@ static long api_case_260(void)
     return v;
 }
 
-static long api_case_261(void)
+static long api_case_263(void)
 {
     pd_err err = {0};
     long v = pd_measure_run(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_run", 1), (const pd_trace *)fx_object("pd_trace", "pd_measure_run", 2), 1.0, (pd_trace *)fx_object("pd_trace", "pd_measure_run", 4), (pd_measured *)fx_object("pd_measured", "pd_measure_run", 5), &err);
@@ -2137,7 +2153,7 @@ static long api_case_261(void)
     return v;
 }
 
-static long api_case_262(void)
+static long api_case_264(void)
 {
     pd_err err = {0};
     long v = pd_measure_run((const pd_osc *)fx_object("pd_osc", "pd_measure_run", 0), NULL, (const pd_trace *)fx_object("pd_trace", "pd_measure_run", 2), 1.0, (pd_trace *)fx_object("pd_trace", "pd_measure_run", 4), (pd_measured *)fx_object("pd_measured", "pd_measure_run", 5), &err);
@@ -2145,7 +2161,7 @@ static long api_case_262(void)
     return v;
 }
 
-static long api_case_263(void)
+static long api_case_265(void)
 {
     pd_err err = {0};
     long v = pd_measure_run((const pd_osc *)fx_object("pd_osc", "pd_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_run", 1), NULL, 1.0, (pd_trace *)fx_object("pd_trace", "pd_measure_run", 4), (pd_measured *)fx_object("pd_measured", "pd_measure_run", 5), &err);
@@ -2153,7 +2169,7 @@ static long api_case_263(void)
     return v;
 }
 
-static long api_case_264(void)
+static long api_case_266(void)
 {
     pd_err err = {0};
     long v = pd_measure_run((const pd_osc *)fx_object("pd_osc", "pd_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_run", 1), (const pd_trace *)fx_object("pd_trace", "pd_measure_run", 2), 1.0, NULL, (pd_measured *)fx_object("pd_measured", "pd_measure_run", 5), &err);
@@ -2161,7 +2177,7 @@ static long api_case_264(void)
     return v;
 }
 
-static long api_case_265(void)
+static long api_case_267(void)
 {
     pd_err err = {0};
     long v = pd_measure_run((const pd_osc *)fx_object("pd_osc", "pd_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_run", 1), (const pd_trace *)fx_object("pd_trace", "pd_measure_run", 2), 1.0, (pd_trace *)fx_object("pd_trace", "pd_measure_run", 4), NULL, &err);
@@ -2169,7 +2185,7 @@ static long api_case_265(void)
     return v;
 }
 
-static long api_case_266(void)
+static long api_case_268(void)
 {
     pd_err err = {0};
     pd_scene * p = pd_scene_new(NULL);
@@ -2177,7 +2193,7 @@ static long api_case_266(void)
     return p != NULL;
 }
 
-static long api_case_267(void)
+static long api_case_269(void)
 {
     pd_err err = {0};
     pd_scene_free(NULL);
@@ -2185,7 +2201,7 @@ static long api_case_267(void)
     return 0;
 }
 
-static long api_case_268(void)
+static long api_case_270(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_sdof(NULL, (const char *)fx_string("pd_scene_add_sdof", "name"), 1.0, 1.0, 1.0, &err);
@@ -2193,7 +2209,7 @@ static long api_case_268(void)
     return v;
 }
 
-static long api_case_269(void)
+static long api_case_271(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_sdof((pd_scene *)fx_object("pd_scene", "pd_scene_add_sdof", 0), NULL, 1.0, 1.0, 1.0, &err);
@@ -2201,7 +2217,7 @@ static long api_case_269(void)
     return v;
 }
 
-static long api_case_270(void)
+static long api_case_272(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_building(NULL, (const char *)fx_string("pd_scene_add_building", "name"), 1, (const double *)fx_object("double", "pd_scene_add_building", 3), (const double *)fx_object("double", "pd_scene_add_building", 4), 1.0, &err);
@@ -2209,7 +2225,7 @@ static long api_case_270(void)
     return v;
 }
 
-static long api_case_271(void)
+static long api_case_273(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_building((pd_scene *)fx_object("pd_scene", "pd_scene_add_building", 0), NULL, 1, (const double *)fx_object("double", "pd_scene_add_building", 3), (const double *)fx_object("double", "pd_scene_add_building", 4), 1.0, &err);
@@ -2217,7 +2233,7 @@ static long api_case_271(void)
     return v;
 }
 
-static long api_case_272(void)
+static long api_case_274(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_building((pd_scene *)fx_object("pd_scene", "pd_scene_add_building", 0), (const char *)fx_string("pd_scene_add_building", "name"), 1, NULL, (const double *)fx_object("double", "pd_scene_add_building", 4), 1.0, &err);
@@ -2225,7 +2241,7 @@ static long api_case_272(void)
     return v;
 }
 
-static long api_case_273(void)
+static long api_case_275(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_building((pd_scene *)fx_object("pd_scene", "pd_scene_add_building", 0), (const char *)fx_string("pd_scene_add_building", "name"), 1, (const double *)fx_object("double", "pd_scene_add_building", 3), NULL, 1.0, &err);
@@ -2233,7 +2249,7 @@ static long api_case_273(void)
     return v;
 }
 
-static long api_case_274(void)
+static long api_case_276(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_uniform(NULL, (const char *)fx_string("pd_scene_add_uniform", "name"), 1, 1.0, 1.0, 1.0, &err);
@@ -2241,7 +2257,7 @@ static long api_case_274(void)
     return v;
 }
 
-static long api_case_275(void)
+static long api_case_277(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_uniform((pd_scene *)fx_object("pd_scene", "pd_scene_add_uniform", 0), NULL, 1, 1.0, 1.0, 1.0, &err);
@@ -2249,7 +2265,7 @@ static long api_case_275(void)
     return v;
 }
 
-static long api_case_276(void)
+static long api_case_278(void)
 {
     pd_err err = {0};
     long v = pd_scene_set_damping(NULL, (pd_damping)0, 1, 1, &err);
@@ -2257,7 +2273,7 @@ static long api_case_276(void)
     return v;
 }
 
-static long api_case_277(void)
+static long api_case_279(void)
 {
     pd_err err = {0};
     long v = pd_scene_set_heights(NULL, (const double *)fx_object("double", "pd_scene_set_heights", 1), &err);
@@ -2265,7 +2281,7 @@ static long api_case_277(void)
     return v;
 }
 
-static long api_case_278(void)
+static long api_case_280(void)
 {
     pd_err err = {0};
     long v = pd_scene_set_heights((pd_scene *)fx_object("pd_scene", "pd_scene_set_heights", 0), NULL, &err);
@@ -2273,7 +2289,7 @@ static long api_case_278(void)
     return v;
 }
 
-static long api_case_279(void)
+static long api_case_281(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_contact(NULL, 1, 1, 1, 1, 1.0, 1.0, 1, &err);
@@ -2281,7 +2297,7 @@ static long api_case_279(void)
     return v;
 }
 
-static long api_case_280(void)
+static long api_case_282(void)
 {
     pd_err err = {0};
     pd_scene * p = pd_scene_copy(NULL);
@@ -2289,7 +2305,7 @@ static long api_case_280(void)
     return p != NULL;
 }
 
-static long api_case_281(void)
+static long api_case_283(void)
 {
     pd_err err = {0};
     long v = pd_scene_find(NULL, (const char *)fx_string("pd_scene_find", "name"));
@@ -2297,7 +2313,7 @@ static long api_case_281(void)
     return v;
 }
 
-static long api_case_282(void)
+static long api_case_284(void)
 {
     pd_err err = {0};
     long v = pd_scene_find((const pd_scene *)fx_object("pd_scene", "pd_scene_find", 0), NULL);
@@ -2305,7 +2321,7 @@ static long api_case_282(void)
     return v;
 }
 
-static long api_case_283(void)
+static long api_case_285(void)
 {
     pd_err err = {0};
     long v = pd_scene_finish(NULL, &err);
@@ -2313,7 +2329,7 @@ static long api_case_283(void)
     return v;
 }
 
-static long api_case_284(void)
+static long api_case_286(void)
 {
     pd_err err = {0};
     long v = pd_scene_load(NULL, (pd_scene **)fx_slot(), &err);
@@ -2321,7 +2337,7 @@ static long api_case_284(void)
     return v;
 }
 
-static long api_case_285(void)
+static long api_case_287(void)
 {
     pd_err err = {0};
     long v = pd_scene_load((const char *)fx_string("pd_scene_load", "path"), NULL, &err);
@@ -2329,7 +2345,7 @@ static long api_case_285(void)
     return v;
 }
 
-static long api_case_286(void)
+static long api_case_288(void)
 {
     pd_err err = {0};
     long v = pd_scene_chain(1, NULL, 1.0, 1.0, 1.0, 1.0, 1.0, (pd_scene **)fx_slot(), &err);
@@ -2337,7 +2353,7 @@ static long api_case_286(void)
     return v;
 }
 
-static long api_case_287(void)
+static long api_case_289(void)
 {
     pd_err err = {0};
     long v = pd_scene_chain(1, (const pd_scene_excitation *)fx_object("pd_scene_excitation", "pd_scene_chain", 1), 1.0, 1.0, 1.0, 1.0, 1.0, NULL, &err);
@@ -2345,7 +2361,7 @@ static long api_case_287(void)
     return v;
 }
 
-static long api_case_288(void)
+static long api_case_290(void)
 {
     pd_err err = {0};
     double v = pd_scene_wp(NULL);
@@ -2354,7 +2370,7 @@ static long api_case_288(void)
     return 0;
 }
 
-static long api_case_289(void)
+static long api_case_291(void)
 {
     pd_err err = {0};
     double v = pd_scene_Le(NULL);
@@ -2363,7 +2379,7 @@ static long api_case_289(void)
     return 0;
 }
 
-static long api_case_290(void)
+static long api_case_292(void)
 {
     pd_err err = {0};
     double v = pd_scene_default_dt(NULL);
@@ -2372,7 +2388,7 @@ static long api_case_290(void)
     return 0;
 }
 
-static long api_case_291(void)
+static long api_case_293(void)
 {
     pd_err err = {0};
     double v = pd_scene_default_tend(NULL);
@@ -2381,7 +2397,7 @@ static long api_case_291(void)
     return 0;
 }
 
-static long api_case_292(void)
+static long api_case_294(void)
 {
     pd_err err = {0};
     double v = pd_scene_measure_start(NULL, 1.0);
@@ -2390,7 +2406,7 @@ static long api_case_292(void)
     return 0;
 }
 
-static long api_case_293(void)
+static long api_case_295(void)
 {
     pd_err err = {0};
     long v = pd_scene_resolve_opts(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_resolve_opts", 1), (pd_run_opts *)fx_object("pd_run_opts", "pd_scene_resolve_opts", 2), &err);
@@ -2398,7 +2414,7 @@ static long api_case_293(void)
     return v;
 }
 
-static long api_case_294(void)
+static long api_case_296(void)
 {
     pd_err err = {0};
     long v = pd_scene_resolve_opts((const pd_scene *)fx_object("pd_scene", "pd_scene_resolve_opts", 0), NULL, (pd_run_opts *)fx_object("pd_run_opts", "pd_scene_resolve_opts", 2), &err);
@@ -2406,7 +2422,7 @@ static long api_case_294(void)
     return v;
 }
 
-static long api_case_295(void)
+static long api_case_297(void)
 {
     pd_err err = {0};
     long v = pd_scene_resolve_opts((const pd_scene *)fx_object("pd_scene", "pd_scene_resolve_opts", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_resolve_opts", 1), NULL, &err);
@@ -2414,7 +2430,7 @@ static long api_case_295(void)
     return v;
 }
 
-static long api_case_296(void)
+static long api_case_298(void)
 {
     pd_err err = {0};
     long v = pd_scene_as_oscillator(NULL, (pd_osc *)fx_object("pd_osc", "pd_scene_as_oscillator", 1), (int *)fx_object("int", "pd_scene_as_oscillator", 2));
@@ -2422,7 +2438,7 @@ static long api_case_296(void)
     return v;
 }
 
-static long api_case_297(void)
+static long api_case_299(void)
 {
     pd_err err = {0};
     long v = pd_scene_as_oscillator((const pd_scene *)fx_object("pd_scene", "pd_scene_as_oscillator", 0), NULL, (int *)fx_object("int", "pd_scene_as_oscillator", 2));
@@ -2430,7 +2446,7 @@ static long api_case_297(void)
     return v;
 }
 
-static long api_case_298(void)
+static long api_case_300(void)
 {
     pd_err err = {0};
     long v = pd_scene_as_oscillator((const pd_scene *)fx_object("pd_scene", "pd_scene_as_oscillator", 0), (pd_osc *)fx_object("pd_osc", "pd_scene_as_oscillator", 1), NULL);
@@ -2438,7 +2454,7 @@ static long api_case_298(void)
     return v;
 }
 
-static long api_case_299(void)
+static long api_case_301(void)
 {
     pd_err err = {0};
     long v = pd_scene_model_build(NULL, 1, (pd_scene_model *)fx_object("pd_scene_model", "pd_scene_model_build", 2), &err);
@@ -2446,7 +2462,7 @@ static long api_case_299(void)
     return v;
 }
 
-static long api_case_300(void)
+static long api_case_302(void)
 {
     pd_err err = {0};
     long v = pd_scene_model_build((const pd_scene *)fx_object("pd_scene", "pd_scene_model_build", 0), 1, NULL, &err);
@@ -2454,7 +2470,7 @@ static long api_case_300(void)
     return v;
 }
 
-static long api_case_301(void)
+static long api_case_303(void)
 {
     pd_err err = {0};
     pd_scene_model_free(NULL);
@@ -2462,7 +2478,7 @@ static long api_case_301(void)
     return 0;
 }
 
-static long api_case_302(void)
+static long api_case_304(void)
 {
     pd_err err = {0};
     long v = pd_scene_result_alloc(NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_result_alloc", 1), &err);
@@ -2470,7 +2486,7 @@ static long api_case_302(void)
     return v;
 }
 
-static long api_case_303(void)
+static long api_case_305(void)
 {
     pd_err err = {0};
     long v = pd_scene_result_alloc((const pd_scene *)fx_object("pd_scene", "pd_scene_result_alloc", 0), NULL, &err);
@@ -2478,7 +2494,7 @@ static long api_case_303(void)
     return v;
 }
 
-static long api_case_304(void)
+static long api_case_306(void)
 {
     pd_err err = {0};
     long v = pd_scene_result_fits(NULL, (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_result_fits", 1));
@@ -2486,7 +2502,7 @@ static long api_case_304(void)
     return v;
 }
 
-static long api_case_305(void)
+static long api_case_307(void)
 {
     pd_err err = {0};
     long v = pd_scene_result_fits((const pd_scene *)fx_object("pd_scene", "pd_scene_result_fits", 0), NULL);
@@ -2494,7 +2510,7 @@ static long api_case_305(void)
     return v;
 }
 
-static long api_case_306(void)
+static long api_case_308(void)
 {
     pd_err err = {0};
     pd_scene_result_free(NULL);
@@ -2502,7 +2518,7 @@ static long api_case_306(void)
     return 0;
 }
 
-static long api_case_307(void)
+static long api_case_309(void)
 {
     pd_err err = {0};
     long v = pd_scene_run(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_run", 1), NULL, NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_run", 4), &err);
@@ -2510,7 +2526,7 @@ static long api_case_307(void)
     return v;
 }
 
-static long api_case_308(void)
+static long api_case_310(void)
 {
     pd_err err = {0};
     long v = pd_scene_run((const pd_scene *)fx_object("pd_scene", "pd_scene_run", 0), NULL, NULL, NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_run", 4), &err);
@@ -2518,7 +2534,7 @@ static long api_case_308(void)
     return v;
 }
 
-static long api_case_309(void)
+static long api_case_311(void)
 {
     pd_err err = {0};
     long v = pd_scene_run((const pd_scene *)fx_object("pd_scene", "pd_scene_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_run", 1), NULL, NULL, NULL, &err);
@@ -2526,7 +2542,7 @@ static long api_case_309(void)
     return v;
 }
 
-static long api_case_310(void)
+static long api_case_312(void)
 {
     pd_err err = {0};
     long v = pd_scene_summarize(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_summarize", 1), NULL, NULL, (pd_scene_summary *)fx_object("pd_scene_summary", "pd_scene_summarize", 4), &err);
@@ -2534,7 +2550,7 @@ static long api_case_310(void)
     return v;
 }
 
-static long api_case_311(void)
+static long api_case_313(void)
 {
     pd_err err = {0};
     long v = pd_scene_summarize((const pd_scene *)fx_object("pd_scene", "pd_scene_summarize", 0), NULL, NULL, NULL, (pd_scene_summary *)fx_object("pd_scene_summary", "pd_scene_summarize", 4), &err);
@@ -2542,7 +2558,7 @@ static long api_case_311(void)
     return v;
 }
 
-static long api_case_312(void)
+static long api_case_314(void)
 {
     pd_err err = {0};
     long v = pd_scene_summarize((const pd_scene *)fx_object("pd_scene", "pd_scene_summarize", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_summarize", 1), NULL, NULL, NULL, &err);
@@ -2550,7 +2566,7 @@ static long api_case_312(void)
     return v;
 }
 
-static long api_case_313(void)
+static long api_case_315(void)
 {
     pd_err err = {0};
     pd_scene_summary_free(NULL);
@@ -2558,7 +2574,7 @@ static long api_case_313(void)
     return 0;
 }
 
-static long api_case_314(void)
+static long api_case_316(void)
 {
     pd_err err = {0};
     long v = pd_scene_trace_alloc(NULL, (const pd_scene *)fx_object("pd_scene", "pd_scene_trace_alloc", 1), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_trace_alloc", 2), &err);
@@ -2566,7 +2582,7 @@ static long api_case_314(void)
     return v;
 }
 
-static long api_case_315(void)
+static long api_case_317(void)
 {
     pd_err err = {0};
     long v = pd_scene_trace_alloc((pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_trace_alloc", 0), NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_trace_alloc", 2), &err);
@@ -2574,7 +2590,7 @@ static long api_case_315(void)
     return v;
 }
 
-static long api_case_316(void)
+static long api_case_318(void)
 {
     pd_err err = {0};
     long v = pd_scene_trace_alloc((pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_trace_alloc", 0), (const pd_scene *)fx_object("pd_scene", "pd_scene_trace_alloc", 1), NULL, &err);
@@ -2582,7 +2598,7 @@ static long api_case_316(void)
     return v;
 }
 
-static long api_case_317(void)
+static long api_case_319(void)
 {
     pd_err err = {0};
     pd_scene_trace_free(NULL);
@@ -2590,7 +2606,7 @@ static long api_case_317(void)
     return 0;
 }
 
-static long api_case_318(void)
+static long api_case_320(void)
 {
     pd_err err = {0};
     long v = pd_scene_errors_alloc(NULL, (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_errors_alloc", 1), &err);
@@ -2598,7 +2614,7 @@ static long api_case_318(void)
     return v;
 }
 
-static long api_case_319(void)
+static long api_case_321(void)
 {
     pd_err err = {0};
     long v = pd_scene_errors_alloc((const pd_scene *)fx_object("pd_scene", "pd_scene_errors_alloc", 0), NULL, &err);
@@ -2606,7 +2622,7 @@ static long api_case_319(void)
     return v;
 }
 
-static long api_case_320(void)
+static long api_case_322(void)
 {
     pd_err err = {0};
     pd_scene_errors_free(NULL);
@@ -2614,7 +2630,7 @@ static long api_case_320(void)
     return 0;
 }
 
-static long api_case_321(void)
+static long api_case_323(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_reference(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_reference", 1), (pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_reference", 2), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_reference", 3), &err);
@@ -2622,7 +2638,7 @@ static long api_case_321(void)
     return v;
 }
 
-static long api_case_322(void)
+static long api_case_324(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_reference((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_reference", 0), NULL, (pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_reference", 2), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_reference", 3), &err);
@@ -2630,7 +2646,7 @@ static long api_case_322(void)
     return v;
 }
 
-static long api_case_323(void)
+static long api_case_325(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_reference((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_reference", 1), NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_reference", 3), &err);
@@ -2638,7 +2654,7 @@ static long api_case_323(void)
     return v;
 }
 
-static long api_case_324(void)
+static long api_case_326(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_reference((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_reference", 1), (pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_reference", 2), NULL, &err);
@@ -2646,7 +2662,7 @@ static long api_case_324(void)
     return v;
 }
 
-static long api_case_325(void)
+static long api_case_327(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2654,7 +2670,7 @@ static long api_case_325(void)
     return v;
 }
 
-static long api_case_326(void)
+static long api_case_328(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), NULL, (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2662,7 +2678,7 @@ static long api_case_326(void)
     return v;
 }
 
-static long api_case_327(void)
+static long api_case_329(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), NULL, (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2670,7 +2686,7 @@ static long api_case_327(void)
     return v;
 }
 
-static long api_case_328(void)
+static long api_case_330(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2678,7 +2694,7 @@ static long api_case_328(void)
     return v;
 }
 
-static long api_case_329(void)
+static long api_case_331(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), NULL, (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2686,7 +2702,7 @@ static long api_case_329(void)
     return v;
 }
 
-static long api_case_330(void)
+static long api_case_332(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), NULL, &err);
@@ -2694,7 +2710,7 @@ static long api_case_330(void)
     return v;
 }
 
-static long api_case_331(void)
+static long api_case_333(void)
 {
     pd_err err = {0};
     pd_spec_init(NULL);
@@ -2702,7 +2718,7 @@ static long api_case_331(void)
     return 0;
 }
 
-static long api_case_332(void)
+static long api_case_334(void)
 {
     pd_err err = {0};
     long v = pd_spec_curves(NULL);
@@ -2710,7 +2726,7 @@ static long api_case_332(void)
     return v;
 }
 
-static long api_case_333(void)
+static long api_case_335(void)
 {
     pd_err err = {0};
     long v = pd_spec_points(NULL);
@@ -2718,7 +2734,7 @@ static long api_case_333(void)
     return v;
 }
 
-static long api_case_334(void)
+static long api_case_336(void)
 {
     pd_err err = {0};
     long v = pd_spec_twins(NULL);
@@ -2726,7 +2742,7 @@ static long api_case_334(void)
     return v;
 }
 
-static long api_case_335(void)
+static long api_case_337(void)
 {
     pd_err err = {0};
     long v = pd_spec_tasks(NULL);
@@ -2734,7 +2750,7 @@ static long api_case_335(void)
     return v;
 }
 
-static long api_case_336(void)
+static long api_case_338(void)
 {
     pd_err err = {0};
     double v = pd_spec_pi2(NULL, 0);
@@ -2743,7 +2759,7 @@ static long api_case_336(void)
     return 0;
 }
 
-static long api_case_337(void)
+static long api_case_339(void)
 {
     pd_err err = {0};
     pd_spec_coords_of(NULL, 0, (pd_spec_coords *)fx_object("pd_spec_coords", "pd_spec_coords_of", 2));
@@ -2751,7 +2767,7 @@ static long api_case_337(void)
     return 0;
 }
 
-static long api_case_338(void)
+static long api_case_340(void)
 {
     pd_err err = {0};
     pd_spec_coords_of((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_coords_of", 0), 0, NULL);
@@ -2759,7 +2775,7 @@ static long api_case_338(void)
     return 0;
 }
 
-static long api_case_339(void)
+static long api_case_341(void)
 {
     pd_err err = {0};
     long v = pd_spec_twin_of(NULL, 0);
@@ -2767,7 +2783,7 @@ static long api_case_339(void)
     return v;
 }
 
-static long api_case_340(void)
+static long api_case_342(void)
 {
     pd_err err = {0};
     long v = pd_spec_case(NULL, 0, (pd_osc *)fx_object("pd_osc", "pd_spec_case", 2), (pd_run_opts *)fx_object("pd_run_opts", "pd_spec_case", 3), &err);
@@ -2775,7 +2791,7 @@ static long api_case_340(void)
     return v;
 }
 
-static long api_case_341(void)
+static long api_case_343(void)
 {
     pd_err err = {0};
     long v = pd_spec_case((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_case", 0), 0, NULL, (pd_run_opts *)fx_object("pd_run_opts", "pd_spec_case", 3), &err);
@@ -2783,7 +2799,7 @@ static long api_case_341(void)
     return v;
 }
 
-static long api_case_342(void)
+static long api_case_344(void)
 {
     pd_err err = {0};
     long v = pd_spec_case((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_case", 0), 0, (pd_osc *)fx_object("pd_osc", "pd_spec_case", 2), NULL, &err);
@@ -2791,7 +2807,7 @@ static long api_case_342(void)
     return v;
 }
 
-static long api_case_343(void)
+static long api_case_345(void)
 {
     pd_err err = {0};
     long v = pd_spec_validate(NULL, &err);
@@ -2799,7 +2815,7 @@ static long api_case_343(void)
     return v;
 }
 
-static long api_case_344(void)
+static long api_case_346(void)
 {
     pd_err err = {0};
     pd_spec_resolve_method(NULL);
@@ -2807,7 +2823,7 @@ static long api_case_344(void)
     return 0;
 }
 
-static long api_case_345(void)
+static long api_case_347(void)
 {
     pd_err err = {0};
     pd_spec_run_task(NULL, 0, (pd_spec_result *)fx_object("pd_spec_result", "pd_spec_run_task", 2), &err);
@@ -2815,7 +2831,7 @@ static long api_case_345(void)
     return 0;
 }
 
-static long api_case_346(void)
+static long api_case_348(void)
 {
     pd_err err = {0};
     pd_spec_run_task((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_run_task", 0), 0, NULL, &err);
@@ -2823,7 +2839,7 @@ static long api_case_346(void)
     return 0;
 }
 
-static long api_case_347(void)
+static long api_case_349(void)
 {
     pd_err err = {0};
     long v = pd_spec_stream(NULL, NULL, NULL, NULL, &err);
@@ -2831,7 +2847,7 @@ static long api_case_347(void)
     return v;
 }
 
-static long api_case_348(void)
+static long api_case_350(void)
 {
     pd_err err = {0};
     double v = pd_spec_cost(NULL, 0);
@@ -2840,7 +2856,7 @@ static long api_case_348(void)
     return 0;
 }
 
-static long api_case_349(void)
+static long api_case_351(void)
 {
     pd_err err = {0};
     char * p = pd_spec_key(NULL);
@@ -2848,7 +2864,7 @@ static long api_case_349(void)
     return p != NULL;
 }
 
-static long api_case_350(void)
+static long api_case_352(void)
 {
     pd_err err = {0};
     pd_spec_rows(NULL, (const pd_spec_result *)fx_object("pd_spec_result", "pd_spec_rows", 1), (pd_spec_row *)fx_object("pd_spec_row", "pd_spec_rows", 2));
@@ -2856,7 +2872,7 @@ static long api_case_350(void)
     return 0;
 }
 
-static long api_case_351(void)
+static long api_case_353(void)
 {
     pd_err err = {0};
     pd_spec_rows((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_rows", 0), NULL, (pd_spec_row *)fx_object("pd_spec_row", "pd_spec_rows", 2));
@@ -2864,7 +2880,7 @@ static long api_case_351(void)
     return 0;
 }
 
-static long api_case_352(void)
+static long api_case_354(void)
 {
     pd_err err = {0};
     pd_spec_rows((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_rows", 0), (const pd_spec_result *)fx_object("pd_spec_result", "pd_spec_rows", 1), NULL);
@@ -2872,7 +2888,7 @@ static long api_case_352(void)
     return 0;
 }
 
-static long api_case_353(void)
+static long api_case_355(void)
 {
     pd_err err = {0};
     pd_spec_curve_label(NULL, 1, (char *)fx_string("pd_spec_curve_label", "buf"), 64);
@@ -2880,7 +2896,7 @@ static long api_case_353(void)
     return 0;
 }
 
-static long api_case_354(void)
+static long api_case_356(void)
 {
     pd_err err = {0};
     pd_spec_curve_label((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_curve_label", 0), 1, NULL, 64);
@@ -2888,7 +2904,7 @@ static long api_case_354(void)
     return 0;
 }
 
-static long api_case_355(void)
+static long api_case_357(void)
 {
     pd_err err = {0};
     long v = pd_spec_sweep(NULL, NULL, NULL, &err);
@@ -2896,7 +2912,7 @@ static long api_case_355(void)
     return v;
 }
 
-static long api_case_356(void)
+static long api_case_358(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_twins(NULL);
@@ -2904,7 +2920,7 @@ static long api_case_356(void)
     return v;
 }
 
-static long api_case_357(void)
+static long api_case_359(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_points(NULL);
@@ -2912,7 +2928,7 @@ static long api_case_357(void)
     return v;
 }
 
-static long api_case_358(void)
+static long api_case_360(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_check(NULL, &err);
@@ -2920,7 +2936,7 @@ static long api_case_358(void)
     return v;
 }
 
-static long api_case_359(void)
+static long api_case_361(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_scene(NULL, 0, (pd_scene **)fx_slot(), (pd_scene_point *)fx_object("pd_scene_point", "pd_scene_sweep_scene", 3), &err);
@@ -2928,7 +2944,7 @@ static long api_case_359(void)
     return v;
 }
 
-static long api_case_360(void)
+static long api_case_362(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_scene((const pd_scene_sweep *)fx_object("pd_scene_sweep", "pd_scene_sweep_scene", 0), 0, NULL, (pd_scene_point *)fx_object("pd_scene_point", "pd_scene_sweep_scene", 3), &err);
@@ -2936,7 +2952,7 @@ static long api_case_360(void)
     return v;
 }
 
-static long api_case_361(void)
+static long api_case_363(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_scene((const pd_scene_sweep *)fx_object("pd_scene_sweep", "pd_scene_sweep_scene", 0), 0, (pd_scene **)fx_slot(), NULL, &err);
@@ -2944,7 +2960,7 @@ static long api_case_361(void)
     return v;
 }
 
-static long api_case_362(void)
+static long api_case_364(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_run(NULL, 1, (pd_scene_point *)fx_object("pd_scene_point", "pd_scene_sweep_run", 2), (double *)fx_object("double", "pd_scene_sweep_run", 3), &err);
@@ -2952,7 +2968,7 @@ static long api_case_362(void)
     return v;
 }
 
-static long api_case_363(void)
+static long api_case_365(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_run((const pd_scene_sweep *)fx_object("pd_scene_sweep", "pd_scene_sweep_run", 0), 1, NULL, (double *)fx_object("double", "pd_scene_sweep_run", 3), &err);
@@ -2960,7 +2976,7 @@ static long api_case_363(void)
     return v;
 }
 
-static long api_case_364(void)
+static long api_case_366(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_run((const pd_scene_sweep *)fx_object("pd_scene_sweep", "pd_scene_sweep_run", 0), 1, (pd_scene_point *)fx_object("pd_scene_point", "pd_scene_sweep_run", 2), NULL, &err);
@@ -3070,270 +3086,272 @@ const api_null_case api_null_cases[] = {
     {.function = "pd_factor_kind_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_98},
     {.function = "pd_factor_kind_parse", .argument = "kind", .expect = EXPECT_ERROR, .call = api_case_99},
     {.function = "pd_model_check", .argument = "model", .expect = EXPECT_ERROR, .call = api_case_100},
-    {.function = "pd_factor_choose", .argument = "model", .expect = EXPECT_NOCRASH, .call = api_case_101},
-    {.function = "pd_mj_alloc", .argument = "model", .expect = EXPECT_NULL, .call = api_case_102},
-    {.function = "pd_mj_alloc", .argument = "opts", .expect = EXPECT_NULL, .call = api_case_103},
-    {.function = "pd_mj_free", .argument = "mj", .expect = EXPECT_NOCRASH, .call = api_case_104},
-    {.function = "pd_mj_reset", .argument = "mj", .expect = EXPECT_ERROR, .call = api_case_105},
-    {.function = "pd_mj_reset", .argument = "q0", .expect = EXPECT_NOCRASH, .call = api_case_106},
-    {.function = "pd_mj_reset", .argument = "v0", .expect = EXPECT_NOCRASH, .call = api_case_107},
-    {.function = "pd_mj_step", .argument = "mj", .expect = EXPECT_ERROR, .call = api_case_108},
-    {.function = "pd_mj_run", .argument = "mj", .expect = EXPECT_ERROR, .call = api_case_109},
-    {.function = "pd_mj_run_until", .argument = "mj", .expect = EXPECT_ERROR, .call = api_case_110},
-    {.function = "pd_mj_get_stats", .argument = "mj", .expect = EXPECT_ERROR, .call = api_case_111},
-    {.function = "pd_mj_get_stats", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_112},
-    {.function = "pd_mj_state", .argument = "mj", .expect = EXPECT_NULL, .call = api_case_113},
-    {.function = "pd_mj_kernel_name", .argument = "mj", .expect = EXPECT_NAME, .call = api_case_114},
-    {.function = "pd_mj_factor_name", .argument = "mj", .expect = EXPECT_NAME, .call = api_case_115},
-    {.function = "pd_mjb_init", .argument = "b", .expect = EXPECT_ERROR, .call = api_case_116},
-    {.function = "pd_mjb_init", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_117},
-    {.function = "pd_mjb_set_lane", .argument = "b", .expect = EXPECT_ERROR, .call = api_case_118},
-    {.function = "pd_mjb_set_lane", .argument = "ln", .expect = EXPECT_ERROR, .call = api_case_119},
-    {.function = "pd_mjb_run", .argument = "b", .expect = EXPECT_NOCRASH, .call = api_case_120},
-    {.function = "pd_mjb_finite", .argument = "b", .expect = EXPECT_COUNT, .call = api_case_121},
-    {.function = "pd_edg_run", .argument = "model", .expect = EXPECT_ERROR, .call = api_case_122},
-    {.function = "pd_edg_run", .argument = "q0", .expect = EXPECT_NOCRASH, .call = api_case_123},
-    {.function = "pd_edg_run", .argument = "v0", .expect = EXPECT_NOCRASH, .call = api_case_124},
-    {.function = "pd_edg_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_125},
-    {.function = "pd_edg_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_126},
-    {.function = "pd_penalty_run", .argument = "model", .expect = EXPECT_ERROR, .call = api_case_127},
-    {.function = "pd_penalty_run", .argument = "q0", .expect = EXPECT_NOCRASH, .call = api_case_128},
-    {.function = "pd_penalty_run", .argument = "v0", .expect = EXPECT_NOCRASH, .call = api_case_129},
-    {.function = "pd_penalty_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_130},
-    {.function = "pd_penalty_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_131},
-    {.function = "pd_sine_piece_force", .argument = "pc", .expect = EXPECT_NOCRASH, .call = api_case_132},
-    {.function = "pd_sdof_increment_piece", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_133},
-    {.function = "pd_sdof_increment_piece", .argument = "pc", .expect = EXPECT_NOCRASH, .call = api_case_134},
-    {.function = "pd_sdof_increment_piece", .argument = "du", .expect = EXPECT_NOCRASH, .call = api_case_135},
-    {.function = "pd_sdof_increment_piece", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_136},
-    {.function = "pd_sdof_advance_piece", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_137},
-    {.function = "pd_sdof_advance_piece", .argument = "pc", .expect = EXPECT_NOCRASH, .call = api_case_138},
-    {.function = "pd_sdof_advance_piece", .argument = "u1", .expect = EXPECT_NOCRASH, .call = api_case_139},
-    {.function = "pd_sdof_advance_piece", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_140},
-    {.function = "pd_sdof_flow_init", .argument = "f", .expect = EXPECT_NOCRASH, .call = api_case_141},
-    {.function = "pd_sdof_flow_init", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_142},
-    {.function = "pd_sdof_flow_init", .argument = "pc", .expect = EXPECT_NOCRASH, .call = api_case_143},
-    {.function = "pd_sdof_flow_at", .argument = "f", .expect = EXPECT_NOCRASH, .call = api_case_144},
-    {.function = "pd_sdof_flow_at", .argument = "du", .expect = EXPECT_NOCRASH, .call = api_case_145},
-    {.function = "pd_sdof_flow_at", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_146},
-    {.function = "pd_sdof_advance", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_147},
-    {.function = "pd_sdof_advance", .argument = "u1", .expect = EXPECT_NOCRASH, .call = api_case_148},
-    {.function = "pd_sdof_advance", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_149},
-    {.function = "pd_sdof_increment", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_150},
-    {.function = "pd_sdof_increment", .argument = "du", .expect = EXPECT_NOCRASH, .call = api_case_151},
-    {.function = "pd_sdof_increment", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_152},
-    {.function = "pd_edr_alloc", .argument = "model", .expect = EXPECT_NULL, .call = api_case_153},
-    {.function = "pd_edr_alloc", .argument = "force", .expect = EXPECT_NULL, .call = api_case_154},
-    {.function = "pd_edr_alloc", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_155},
-    {.function = "pd_edr_free", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_156},
-    {.function = "pd_edr_run", .argument = "r", .expect = EXPECT_ERROR, .call = api_case_157},
-    {.function = "pd_edr_run", .argument = "q0", .expect = EXPECT_NOCRASH, .call = api_case_158},
-    {.function = "pd_edr_run", .argument = "v0", .expect = EXPECT_NOCRASH, .call = api_case_159},
-    {.function = "pd_edr_result_of", .argument = "r", .expect = EXPECT_NULL, .call = api_case_160},
-    {.function = "pd_ed_sdof_run", .argument = "prob", .expect = EXPECT_ERROR, .call = api_case_161},
-    {.function = "pd_ed_sdof_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_162},
-    {.function = "pd_ed_sdof_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_163},
-    {.function = "pd_pulse_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_164},
-    {.function = "pd_pulse_parse", .argument = "pulse", .expect = EXPECT_ERROR, .call = api_case_165},
-    {.function = "pd_dir_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_166},
-    {.function = "pd_dir_parse", .argument = "dir", .expect = EXPECT_ERROR, .call = api_case_167},
-    {.function = "pd_record_format_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_168},
-    {.function = "pd_record_format_parse", .argument = "f", .expect = EXPECT_ERROR, .call = api_case_169},
-    {.function = "pd_record_units_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_170},
-    {.function = "pd_record_units_parse", .argument = "u", .expect = EXPECT_ERROR, .call = api_case_171},
-    {.function = "pd_record_read", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_172},
-    {.function = "pd_record_read", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_173},
-    {.function = "pd_record_free", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_174},
-    {.function = "pd_record_detect", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_175},
-    {.function = "pd_record_detect", .argument = "format", .expect = EXPECT_ERROR, .call = api_case_176},
-    {.function = "pd_record_plausible", .argument = "rec", .expect = EXPECT_COUNT, .call = api_case_177},
-    {.function = "pd_record_plausible", .argument = "msg", .expect = EXPECT_NOCRASH, .call = api_case_178},
-    {.function = "pd_record_from_array", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_179},
-    {.function = "pd_record_from_array", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_180},
-    {.function = "pd_record_from_array", .argument = "acc", .expect = EXPECT_ERROR, .call = api_case_181},
-    {.function = "pd_record_duration", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_182},
-    {.function = "pd_record_acc", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_183},
-    {.function = "pd_record_measure", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_184},
-    {.function = "pd_record_measure", .argument = "m", .expect = EXPECT_ERROR, .call = api_case_185},
-    {.function = "pd_record_integrate", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_186},
-    {.function = "pd_record_integrate", .argument = "vel", .expect = EXPECT_ERROR, .call = api_case_187},
-    {.function = "pd_record_integrate", .argument = "disp", .expect = EXPECT_ERROR, .call = api_case_188},
-    {.function = "pd_record_fit_pulse", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_189},
-    {.function = "pd_record_fit_pulse", .argument = "p", .expect = EXPECT_ERROR, .call = api_case_190},
-    {.function = "pd_record_pulse_eval", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_191},
-    {.function = "pd_record_pulse_eval", .argument = "acc", .expect = EXPECT_NOCRASH, .call = api_case_192},
-    {.function = "pd_record_pulse_eval", .argument = "vel", .expect = EXPECT_NOCRASH, .call = api_case_193},
-    {.function = "pd_record_one_cycle", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_194},
-    {.function = "pd_method_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_195},
-    {.function = "pd_method_parse", .argument = "method", .expect = EXPECT_ERROR, .call = api_case_196},
-    {.function = "pd_impact_law_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_197},
-    {.function = "pd_impact_law_parse", .argument = "law", .expect = EXPECT_ERROR, .call = api_case_198},
-    {.function = "pd_run_opts_check", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_199},
-    {.function = "pd_osc_wp", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_200},
-    {.function = "pd_osc_T0", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_201},
-    {.function = "pd_osc_gap", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_202},
-    {.function = "pd_osc_Le", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_203},
-    {.function = "pd_osc_set_T0", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_204},
-    {.function = "pd_osc_set_gap", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_205},
-    {.function = "pd_osc_set_uy", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_206},
-    {.function = "pd_osc_uy", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_207},
-    {.function = "pd_osc_yields", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_208},
-    {.function = "pd_osc_yield_exact", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_209},
-    {.function = "pd_osc_excitation", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_210},
-    {.function = "pd_osc_set_record", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_211},
-    {.function = "pd_osc_set_record", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_212},
-    {.function = "pd_osc_set_record", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_213},
-    {.function = "pd_osc_shape", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_214},
-    {.function = "pd_osc_shape_rate", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_215},
-    {.function = "pd_osc_shape_end", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_216},
-    {.function = "pd_osc_pieces", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_217},
-    {.function = "pd_osc_pieces", .argument = "pieces", .expect = EXPECT_ERROR, .call = api_case_218},
-    {.function = "pd_osc_pieces", .argument = "npieces", .expect = EXPECT_ERROR, .call = api_case_219},
-    {.function = "pd_osc_excitation_name", .argument = "c", .expect = EXPECT_NAME, .call = api_case_220},
-    {.function = "pd_osc_check", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_221},
-    {.function = "pd_osc_resolve_opts", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_222},
-    {.function = "pd_osc_resolve_opts", .argument = "in", .expect = EXPECT_NOCRASH, .call = api_case_223},
-    {.function = "pd_osc_resolve_opts", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_224},
-    {.function = "pd_osc_default_dt", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_225},
-    {.function = "pd_osc_default_tend", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_226},
-    {.function = "pd_osc_measure_start", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_227},
-    {.function = "pd_osc_method", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_228},
-    {.function = "pd_osc_method", .argument = "o", .expect = EXPECT_NOCRASH, .call = api_case_229},
-    {.function = "pd_osc_run", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_230},
-    {.function = "pd_osc_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_231},
-    {.function = "pd_osc_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_232},
-    {.function = "pd_osc_batchable", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_233},
-    {.function = "pd_osc_batchable", .argument = "o", .expect = EXPECT_COUNT, .call = api_case_234},
-    {.function = "pd_osc_scan_points", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_235},
-    {.function = "pd_osc_simulate", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_236},
-    {.function = "pd_osc_simulate", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_237},
-    {.function = "pd_osc_simulate", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_238},
-    {.function = "pd_osc_reference", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_239},
-    {.function = "pd_osc_reference", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_240},
-    {.function = "pd_osc_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_241},
-    {.function = "pd_osc_penalty", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_242},
-    {.function = "pd_osc_penalty", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_243},
-    {.function = "pd_osc_penalty", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_244},
-    {.function = "pd_osc_summarize", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_245},
-    {.function = "pd_osc_summarize", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_246},
-    {.function = "pd_osc_summarize", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_247},
-    {.function = "pd_osc_free_exact", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_248},
-    {.function = "pd_osc_free_exact", .argument = "u", .expect = EXPECT_NOCRASH, .call = api_case_249},
-    {.function = "pd_osc_free_exact", .argument = "v", .expect = EXPECT_NOCRASH, .call = api_case_250},
-    {.function = "pd_osc_free_first_contact", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_251},
-    {.function = "pd_osc_free_first_contact", .argument = "t", .expect = EXPECT_ERROR, .call = api_case_252},
-    {.function = "pd_osc_free_first_contact", .argument = "v", .expect = EXPECT_ERROR, .call = api_case_253},
-    {.function = "pd_trace_alloc", .argument = "tr", .expect = EXPECT_ERROR, .call = api_case_254},
-    {.function = "pd_trace_alloc", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_255},
-    {.function = "pd_trace_free", .argument = "tr", .expect = EXPECT_NOCRASH, .call = api_case_256},
-    {.function = "pd_measure_reference", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_257},
-    {.function = "pd_measure_reference", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_258},
-    {.function = "pd_measure_reference", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_259},
-    {.function = "pd_measure_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_260},
-    {.function = "pd_measure_run", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_261},
-    {.function = "pd_measure_run", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_262},
-    {.function = "pd_measure_run", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_263},
-    {.function = "pd_measure_run", .argument = "work", .expect = EXPECT_ERROR, .call = api_case_264},
-    {.function = "pd_measure_run", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_265},
-    {.function = "pd_scene_new", .argument = "exc", .expect = EXPECT_NOCRASH, .call = api_case_266},
-    {.function = "pd_scene_free", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_267},
-    {.function = "pd_scene_add_sdof", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_268},
-    {.function = "pd_scene_add_sdof", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_269},
-    {.function = "pd_scene_add_building", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_270},
-    {.function = "pd_scene_add_building", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_271},
-    {.function = "pd_scene_add_building", .argument = "masses", .expect = EXPECT_ERROR, .call = api_case_272},
-    {.function = "pd_scene_add_building", .argument = "stiffnesses", .expect = EXPECT_ERROR, .call = api_case_273},
-    {.function = "pd_scene_add_uniform", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_274},
-    {.function = "pd_scene_add_uniform", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_275},
-    {.function = "pd_scene_set_damping", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_276},
-    {.function = "pd_scene_set_heights", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_277},
-    {.function = "pd_scene_set_heights", .argument = "heights", .expect = EXPECT_ERROR, .call = api_case_278},
-    {.function = "pd_scene_add_contact", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_279},
-    {.function = "pd_scene_copy", .argument = "sc", .expect = EXPECT_NULL, .call = api_case_280},
-    {.function = "pd_scene_find", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_281},
-    {.function = "pd_scene_find", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_282},
-    {.function = "pd_scene_finish", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_283},
-    {.function = "pd_scene_load", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_284},
-    {.function = "pd_scene_load", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_285},
-    {.function = "pd_scene_chain", .argument = "exc", .expect = EXPECT_ERROR, .call = api_case_286},
-    {.function = "pd_scene_chain", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_287},
-    {.function = "pd_scene_wp", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_288},
-    {.function = "pd_scene_Le", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_289},
-    {.function = "pd_scene_default_dt", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_290},
-    {.function = "pd_scene_default_tend", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_291},
-    {.function = "pd_scene_measure_start", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_292},
-    {.function = "pd_scene_resolve_opts", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_293},
-    {.function = "pd_scene_resolve_opts", .argument = "in", .expect = EXPECT_NOCRASH, .call = api_case_294},
-    {.function = "pd_scene_resolve_opts", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_295},
-    {.function = "pd_scene_as_oscillator", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_296},
-    {.function = "pd_scene_as_oscillator", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_297},
-    {.function = "pd_scene_as_oscillator", .argument = "mirrored", .expect = EXPECT_COUNT, .call = api_case_298},
-    {.function = "pd_scene_model_build", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_299},
-    {.function = "pd_scene_model_build", .argument = "sm", .expect = EXPECT_ERROR, .call = api_case_300},
-    {.function = "pd_scene_model_free", .argument = "sm", .expect = EXPECT_NOCRASH, .call = api_case_301},
-    {.function = "pd_scene_result_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_302},
-    {.function = "pd_scene_result_alloc", .argument = "r", .expect = EXPECT_ERROR, .call = api_case_303},
-    {.function = "pd_scene_result_fits", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_304},
-    {.function = "pd_scene_result_fits", .argument = "r", .expect = EXPECT_COUNT, .call = api_case_305},
-    {.function = "pd_scene_result_free", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_306},
-    {.function = "pd_scene_run", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_307},
-    {.function = "pd_scene_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_308},
-    {.function = "pd_scene_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_309},
-    {.function = "pd_scene_summarize", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_310},
-    {.function = "pd_scene_summarize", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_311},
-    {.function = "pd_scene_summarize", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_312},
-    {.function = "pd_scene_summary_free", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_313},
-    {.function = "pd_scene_trace_alloc", .argument = "tr", .expect = EXPECT_ERROR, .call = api_case_314},
-    {.function = "pd_scene_trace_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_315},
-    {.function = "pd_scene_trace_alloc", .argument = "o", .expect = EXPECT_NOCRASH, .call = api_case_316},
-    {.function = "pd_scene_trace_free", .argument = "tr", .expect = EXPECT_NOCRASH, .call = api_case_317},
-    {.function = "pd_scene_errors_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_318},
-    {.function = "pd_scene_errors_alloc", .argument = "e", .expect = EXPECT_ERROR, .call = api_case_319},
-    {.function = "pd_scene_errors_free", .argument = "e", .expect = EXPECT_NOCRASH, .call = api_case_320},
-    {.function = "pd_scene_measure_reference", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_321},
-    {.function = "pd_scene_measure_reference", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_322},
-    {.function = "pd_scene_measure_reference", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_323},
-    {.function = "pd_scene_measure_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_324},
-    {.function = "pd_scene_measure_run", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_325},
-    {.function = "pd_scene_measure_run", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_326},
-    {.function = "pd_scene_measure_run", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_327},
-    {.function = "pd_scene_measure_run", .argument = "ref_res", .expect = EXPECT_ERROR, .call = api_case_328},
-    {.function = "pd_scene_measure_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_329},
-    {.function = "pd_scene_measure_run", .argument = "e", .expect = EXPECT_ERROR, .call = api_case_330},
-    {.function = "pd_spec_init", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_331},
-    {.function = "pd_spec_curves", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_332},
-    {.function = "pd_spec_points", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_333},
-    {.function = "pd_spec_twins", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_334},
-    {.function = "pd_spec_tasks", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_335},
-    {.function = "pd_spec_pi2", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_336},
-    {.function = "pd_spec_coords_of", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_337},
-    {.function = "pd_spec_coords_of", .argument = "co", .expect = EXPECT_NOCRASH, .call = api_case_338},
-    {.function = "pd_spec_twin_of", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_339},
-    {.function = "pd_spec_case", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_340},
-    {.function = "pd_spec_case", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_341},
-    {.function = "pd_spec_case", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_342},
-    {.function = "pd_spec_validate", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_343},
-    {.function = "pd_spec_resolve_method", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_344},
-    {.function = "pd_spec_run_task", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_345},
-    {.function = "pd_spec_run_task", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_346},
-    {.function = "pd_spec_stream", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_347},
-    {.function = "pd_spec_cost", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_348},
-    {.function = "pd_spec_key", .argument = "s", .expect = EXPECT_NULL, .call = api_case_349},
-    {.function = "pd_spec_rows", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_350},
-    {.function = "pd_spec_rows", .argument = "res", .expect = EXPECT_NOCRASH, .call = api_case_351},
-    {.function = "pd_spec_rows", .argument = "rows", .expect = EXPECT_NOCRASH, .call = api_case_352},
-    {.function = "pd_spec_curve_label", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_353},
-    {.function = "pd_spec_curve_label", .argument = "buf", .expect = EXPECT_NOCRASH, .call = api_case_354},
-    {.function = "pd_spec_sweep", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_355},
-    {.function = "pd_scene_sweep_twins", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_356},
-    {.function = "pd_scene_sweep_points", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_357},
-    {.function = "pd_scene_sweep_check", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_358},
-    {.function = "pd_scene_sweep_scene", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_359},
-    {.function = "pd_scene_sweep_scene", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_360},
-    {.function = "pd_scene_sweep_scene", .argument = "pt", .expect = EXPECT_ERROR, .call = api_case_361},
-    {.function = "pd_scene_sweep_run", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_362},
-    {.function = "pd_scene_sweep_run", .argument = "pts", .expect = EXPECT_ERROR, .call = api_case_363},
-    {.function = "pd_scene_sweep_run", .argument = "umax", .expect = EXPECT_ERROR, .call = api_case_364},
+    {.function = "pd_model_refuse_yield", .argument = "model", .expect = EXPECT_ERROR, .call = api_case_101},
+    {.function = "pd_model_refuse_yield", .argument = "method", .expect = EXPECT_ERROR, .call = api_case_102},
+    {.function = "pd_factor_choose", .argument = "model", .expect = EXPECT_NOCRASH, .call = api_case_103},
+    {.function = "pd_mj_alloc", .argument = "model", .expect = EXPECT_NULL, .call = api_case_104},
+    {.function = "pd_mj_alloc", .argument = "opts", .expect = EXPECT_NULL, .call = api_case_105},
+    {.function = "pd_mj_free", .argument = "mj", .expect = EXPECT_NOCRASH, .call = api_case_106},
+    {.function = "pd_mj_reset", .argument = "mj", .expect = EXPECT_ERROR, .call = api_case_107},
+    {.function = "pd_mj_reset", .argument = "q0", .expect = EXPECT_NOCRASH, .call = api_case_108},
+    {.function = "pd_mj_reset", .argument = "v0", .expect = EXPECT_NOCRASH, .call = api_case_109},
+    {.function = "pd_mj_step", .argument = "mj", .expect = EXPECT_ERROR, .call = api_case_110},
+    {.function = "pd_mj_run", .argument = "mj", .expect = EXPECT_ERROR, .call = api_case_111},
+    {.function = "pd_mj_run_until", .argument = "mj", .expect = EXPECT_ERROR, .call = api_case_112},
+    {.function = "pd_mj_get_stats", .argument = "mj", .expect = EXPECT_ERROR, .call = api_case_113},
+    {.function = "pd_mj_get_stats", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_114},
+    {.function = "pd_mj_state", .argument = "mj", .expect = EXPECT_NULL, .call = api_case_115},
+    {.function = "pd_mj_kernel_name", .argument = "mj", .expect = EXPECT_NAME, .call = api_case_116},
+    {.function = "pd_mj_factor_name", .argument = "mj", .expect = EXPECT_NAME, .call = api_case_117},
+    {.function = "pd_mjb_init", .argument = "b", .expect = EXPECT_ERROR, .call = api_case_118},
+    {.function = "pd_mjb_init", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_119},
+    {.function = "pd_mjb_set_lane", .argument = "b", .expect = EXPECT_ERROR, .call = api_case_120},
+    {.function = "pd_mjb_set_lane", .argument = "ln", .expect = EXPECT_ERROR, .call = api_case_121},
+    {.function = "pd_mjb_run", .argument = "b", .expect = EXPECT_NOCRASH, .call = api_case_122},
+    {.function = "pd_mjb_finite", .argument = "b", .expect = EXPECT_COUNT, .call = api_case_123},
+    {.function = "pd_edg_run", .argument = "model", .expect = EXPECT_ERROR, .call = api_case_124},
+    {.function = "pd_edg_run", .argument = "q0", .expect = EXPECT_NOCRASH, .call = api_case_125},
+    {.function = "pd_edg_run", .argument = "v0", .expect = EXPECT_NOCRASH, .call = api_case_126},
+    {.function = "pd_edg_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_127},
+    {.function = "pd_edg_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_128},
+    {.function = "pd_penalty_run", .argument = "model", .expect = EXPECT_ERROR, .call = api_case_129},
+    {.function = "pd_penalty_run", .argument = "q0", .expect = EXPECT_NOCRASH, .call = api_case_130},
+    {.function = "pd_penalty_run", .argument = "v0", .expect = EXPECT_NOCRASH, .call = api_case_131},
+    {.function = "pd_penalty_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_132},
+    {.function = "pd_penalty_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_133},
+    {.function = "pd_sine_piece_force", .argument = "pc", .expect = EXPECT_NOCRASH, .call = api_case_134},
+    {.function = "pd_sdof_increment_piece", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_135},
+    {.function = "pd_sdof_increment_piece", .argument = "pc", .expect = EXPECT_NOCRASH, .call = api_case_136},
+    {.function = "pd_sdof_increment_piece", .argument = "du", .expect = EXPECT_NOCRASH, .call = api_case_137},
+    {.function = "pd_sdof_increment_piece", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_138},
+    {.function = "pd_sdof_advance_piece", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_139},
+    {.function = "pd_sdof_advance_piece", .argument = "pc", .expect = EXPECT_NOCRASH, .call = api_case_140},
+    {.function = "pd_sdof_advance_piece", .argument = "u1", .expect = EXPECT_NOCRASH, .call = api_case_141},
+    {.function = "pd_sdof_advance_piece", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_142},
+    {.function = "pd_sdof_flow_init", .argument = "f", .expect = EXPECT_NOCRASH, .call = api_case_143},
+    {.function = "pd_sdof_flow_init", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_144},
+    {.function = "pd_sdof_flow_init", .argument = "pc", .expect = EXPECT_NOCRASH, .call = api_case_145},
+    {.function = "pd_sdof_flow_at", .argument = "f", .expect = EXPECT_NOCRASH, .call = api_case_146},
+    {.function = "pd_sdof_flow_at", .argument = "du", .expect = EXPECT_NOCRASH, .call = api_case_147},
+    {.function = "pd_sdof_flow_at", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_148},
+    {.function = "pd_sdof_advance", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_149},
+    {.function = "pd_sdof_advance", .argument = "u1", .expect = EXPECT_NOCRASH, .call = api_case_150},
+    {.function = "pd_sdof_advance", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_151},
+    {.function = "pd_sdof_increment", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_152},
+    {.function = "pd_sdof_increment", .argument = "du", .expect = EXPECT_NOCRASH, .call = api_case_153},
+    {.function = "pd_sdof_increment", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_154},
+    {.function = "pd_edr_alloc", .argument = "model", .expect = EXPECT_NULL, .call = api_case_155},
+    {.function = "pd_edr_alloc", .argument = "force", .expect = EXPECT_NULL, .call = api_case_156},
+    {.function = "pd_edr_alloc", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_157},
+    {.function = "pd_edr_free", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_158},
+    {.function = "pd_edr_run", .argument = "r", .expect = EXPECT_ERROR, .call = api_case_159},
+    {.function = "pd_edr_run", .argument = "q0", .expect = EXPECT_NOCRASH, .call = api_case_160},
+    {.function = "pd_edr_run", .argument = "v0", .expect = EXPECT_NOCRASH, .call = api_case_161},
+    {.function = "pd_edr_result_of", .argument = "r", .expect = EXPECT_NULL, .call = api_case_162},
+    {.function = "pd_ed_sdof_run", .argument = "prob", .expect = EXPECT_ERROR, .call = api_case_163},
+    {.function = "pd_ed_sdof_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_164},
+    {.function = "pd_ed_sdof_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_165},
+    {.function = "pd_pulse_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_166},
+    {.function = "pd_pulse_parse", .argument = "pulse", .expect = EXPECT_ERROR, .call = api_case_167},
+    {.function = "pd_dir_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_168},
+    {.function = "pd_dir_parse", .argument = "dir", .expect = EXPECT_ERROR, .call = api_case_169},
+    {.function = "pd_record_format_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_170},
+    {.function = "pd_record_format_parse", .argument = "f", .expect = EXPECT_ERROR, .call = api_case_171},
+    {.function = "pd_record_units_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_172},
+    {.function = "pd_record_units_parse", .argument = "u", .expect = EXPECT_ERROR, .call = api_case_173},
+    {.function = "pd_record_read", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_174},
+    {.function = "pd_record_read", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_175},
+    {.function = "pd_record_free", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_176},
+    {.function = "pd_record_detect", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_177},
+    {.function = "pd_record_detect", .argument = "format", .expect = EXPECT_ERROR, .call = api_case_178},
+    {.function = "pd_record_plausible", .argument = "rec", .expect = EXPECT_COUNT, .call = api_case_179},
+    {.function = "pd_record_plausible", .argument = "msg", .expect = EXPECT_NOCRASH, .call = api_case_180},
+    {.function = "pd_record_from_array", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_181},
+    {.function = "pd_record_from_array", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_182},
+    {.function = "pd_record_from_array", .argument = "acc", .expect = EXPECT_ERROR, .call = api_case_183},
+    {.function = "pd_record_duration", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_184},
+    {.function = "pd_record_acc", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_185},
+    {.function = "pd_record_measure", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_186},
+    {.function = "pd_record_measure", .argument = "m", .expect = EXPECT_ERROR, .call = api_case_187},
+    {.function = "pd_record_integrate", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_188},
+    {.function = "pd_record_integrate", .argument = "vel", .expect = EXPECT_ERROR, .call = api_case_189},
+    {.function = "pd_record_integrate", .argument = "disp", .expect = EXPECT_ERROR, .call = api_case_190},
+    {.function = "pd_record_fit_pulse", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_191},
+    {.function = "pd_record_fit_pulse", .argument = "p", .expect = EXPECT_ERROR, .call = api_case_192},
+    {.function = "pd_record_pulse_eval", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_193},
+    {.function = "pd_record_pulse_eval", .argument = "acc", .expect = EXPECT_NOCRASH, .call = api_case_194},
+    {.function = "pd_record_pulse_eval", .argument = "vel", .expect = EXPECT_NOCRASH, .call = api_case_195},
+    {.function = "pd_record_one_cycle", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_196},
+    {.function = "pd_method_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_197},
+    {.function = "pd_method_parse", .argument = "method", .expect = EXPECT_ERROR, .call = api_case_198},
+    {.function = "pd_impact_law_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_199},
+    {.function = "pd_impact_law_parse", .argument = "law", .expect = EXPECT_ERROR, .call = api_case_200},
+    {.function = "pd_run_opts_check", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_201},
+    {.function = "pd_osc_wp", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_202},
+    {.function = "pd_osc_T0", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_203},
+    {.function = "pd_osc_gap", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_204},
+    {.function = "pd_osc_Le", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_205},
+    {.function = "pd_osc_set_T0", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_206},
+    {.function = "pd_osc_set_gap", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_207},
+    {.function = "pd_osc_set_uy", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_208},
+    {.function = "pd_osc_uy", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_209},
+    {.function = "pd_osc_yields", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_210},
+    {.function = "pd_osc_yield_exact", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_211},
+    {.function = "pd_osc_excitation", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_212},
+    {.function = "pd_osc_set_record", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_213},
+    {.function = "pd_osc_set_record", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_214},
+    {.function = "pd_osc_set_record", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_215},
+    {.function = "pd_osc_shape", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_216},
+    {.function = "pd_osc_shape_rate", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_217},
+    {.function = "pd_osc_shape_end", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_218},
+    {.function = "pd_osc_pieces", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_219},
+    {.function = "pd_osc_pieces", .argument = "pieces", .expect = EXPECT_ERROR, .call = api_case_220},
+    {.function = "pd_osc_pieces", .argument = "npieces", .expect = EXPECT_ERROR, .call = api_case_221},
+    {.function = "pd_osc_excitation_name", .argument = "c", .expect = EXPECT_NAME, .call = api_case_222},
+    {.function = "pd_osc_check", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_223},
+    {.function = "pd_osc_resolve_opts", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_224},
+    {.function = "pd_osc_resolve_opts", .argument = "in", .expect = EXPECT_NOCRASH, .call = api_case_225},
+    {.function = "pd_osc_resolve_opts", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_226},
+    {.function = "pd_osc_default_dt", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_227},
+    {.function = "pd_osc_default_tend", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_228},
+    {.function = "pd_osc_measure_start", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_229},
+    {.function = "pd_osc_method", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_230},
+    {.function = "pd_osc_method", .argument = "o", .expect = EXPECT_NOCRASH, .call = api_case_231},
+    {.function = "pd_osc_run", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_232},
+    {.function = "pd_osc_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_233},
+    {.function = "pd_osc_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_234},
+    {.function = "pd_osc_batchable", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_235},
+    {.function = "pd_osc_batchable", .argument = "o", .expect = EXPECT_COUNT, .call = api_case_236},
+    {.function = "pd_osc_scan_points", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_237},
+    {.function = "pd_osc_simulate", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_238},
+    {.function = "pd_osc_simulate", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_239},
+    {.function = "pd_osc_simulate", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_240},
+    {.function = "pd_osc_reference", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_241},
+    {.function = "pd_osc_reference", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_242},
+    {.function = "pd_osc_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_243},
+    {.function = "pd_osc_penalty", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_244},
+    {.function = "pd_osc_penalty", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_245},
+    {.function = "pd_osc_penalty", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_246},
+    {.function = "pd_osc_summarize", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_247},
+    {.function = "pd_osc_summarize", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_248},
+    {.function = "pd_osc_summarize", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_249},
+    {.function = "pd_osc_free_exact", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_250},
+    {.function = "pd_osc_free_exact", .argument = "u", .expect = EXPECT_NOCRASH, .call = api_case_251},
+    {.function = "pd_osc_free_exact", .argument = "v", .expect = EXPECT_NOCRASH, .call = api_case_252},
+    {.function = "pd_osc_free_first_contact", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_253},
+    {.function = "pd_osc_free_first_contact", .argument = "t", .expect = EXPECT_ERROR, .call = api_case_254},
+    {.function = "pd_osc_free_first_contact", .argument = "v", .expect = EXPECT_ERROR, .call = api_case_255},
+    {.function = "pd_trace_alloc", .argument = "tr", .expect = EXPECT_ERROR, .call = api_case_256},
+    {.function = "pd_trace_alloc", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_257},
+    {.function = "pd_trace_free", .argument = "tr", .expect = EXPECT_NOCRASH, .call = api_case_258},
+    {.function = "pd_measure_reference", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_259},
+    {.function = "pd_measure_reference", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_260},
+    {.function = "pd_measure_reference", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_261},
+    {.function = "pd_measure_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_262},
+    {.function = "pd_measure_run", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_263},
+    {.function = "pd_measure_run", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_264},
+    {.function = "pd_measure_run", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_265},
+    {.function = "pd_measure_run", .argument = "work", .expect = EXPECT_ERROR, .call = api_case_266},
+    {.function = "pd_measure_run", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_267},
+    {.function = "pd_scene_new", .argument = "exc", .expect = EXPECT_NOCRASH, .call = api_case_268},
+    {.function = "pd_scene_free", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_269},
+    {.function = "pd_scene_add_sdof", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_270},
+    {.function = "pd_scene_add_sdof", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_271},
+    {.function = "pd_scene_add_building", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_272},
+    {.function = "pd_scene_add_building", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_273},
+    {.function = "pd_scene_add_building", .argument = "masses", .expect = EXPECT_ERROR, .call = api_case_274},
+    {.function = "pd_scene_add_building", .argument = "stiffnesses", .expect = EXPECT_ERROR, .call = api_case_275},
+    {.function = "pd_scene_add_uniform", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_276},
+    {.function = "pd_scene_add_uniform", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_277},
+    {.function = "pd_scene_set_damping", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_278},
+    {.function = "pd_scene_set_heights", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_279},
+    {.function = "pd_scene_set_heights", .argument = "heights", .expect = EXPECT_ERROR, .call = api_case_280},
+    {.function = "pd_scene_add_contact", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_281},
+    {.function = "pd_scene_copy", .argument = "sc", .expect = EXPECT_NULL, .call = api_case_282},
+    {.function = "pd_scene_find", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_283},
+    {.function = "pd_scene_find", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_284},
+    {.function = "pd_scene_finish", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_285},
+    {.function = "pd_scene_load", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_286},
+    {.function = "pd_scene_load", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_287},
+    {.function = "pd_scene_chain", .argument = "exc", .expect = EXPECT_ERROR, .call = api_case_288},
+    {.function = "pd_scene_chain", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_289},
+    {.function = "pd_scene_wp", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_290},
+    {.function = "pd_scene_Le", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_291},
+    {.function = "pd_scene_default_dt", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_292},
+    {.function = "pd_scene_default_tend", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_293},
+    {.function = "pd_scene_measure_start", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_294},
+    {.function = "pd_scene_resolve_opts", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_295},
+    {.function = "pd_scene_resolve_opts", .argument = "in", .expect = EXPECT_NOCRASH, .call = api_case_296},
+    {.function = "pd_scene_resolve_opts", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_297},
+    {.function = "pd_scene_as_oscillator", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_298},
+    {.function = "pd_scene_as_oscillator", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_299},
+    {.function = "pd_scene_as_oscillator", .argument = "mirrored", .expect = EXPECT_COUNT, .call = api_case_300},
+    {.function = "pd_scene_model_build", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_301},
+    {.function = "pd_scene_model_build", .argument = "sm", .expect = EXPECT_ERROR, .call = api_case_302},
+    {.function = "pd_scene_model_free", .argument = "sm", .expect = EXPECT_NOCRASH, .call = api_case_303},
+    {.function = "pd_scene_result_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_304},
+    {.function = "pd_scene_result_alloc", .argument = "r", .expect = EXPECT_ERROR, .call = api_case_305},
+    {.function = "pd_scene_result_fits", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_306},
+    {.function = "pd_scene_result_fits", .argument = "r", .expect = EXPECT_COUNT, .call = api_case_307},
+    {.function = "pd_scene_result_free", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_308},
+    {.function = "pd_scene_run", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_309},
+    {.function = "pd_scene_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_310},
+    {.function = "pd_scene_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_311},
+    {.function = "pd_scene_summarize", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_312},
+    {.function = "pd_scene_summarize", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_313},
+    {.function = "pd_scene_summarize", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_314},
+    {.function = "pd_scene_summary_free", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_315},
+    {.function = "pd_scene_trace_alloc", .argument = "tr", .expect = EXPECT_ERROR, .call = api_case_316},
+    {.function = "pd_scene_trace_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_317},
+    {.function = "pd_scene_trace_alloc", .argument = "o", .expect = EXPECT_NOCRASH, .call = api_case_318},
+    {.function = "pd_scene_trace_free", .argument = "tr", .expect = EXPECT_NOCRASH, .call = api_case_319},
+    {.function = "pd_scene_errors_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_320},
+    {.function = "pd_scene_errors_alloc", .argument = "e", .expect = EXPECT_ERROR, .call = api_case_321},
+    {.function = "pd_scene_errors_free", .argument = "e", .expect = EXPECT_NOCRASH, .call = api_case_322},
+    {.function = "pd_scene_measure_reference", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_323},
+    {.function = "pd_scene_measure_reference", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_324},
+    {.function = "pd_scene_measure_reference", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_325},
+    {.function = "pd_scene_measure_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_326},
+    {.function = "pd_scene_measure_run", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_327},
+    {.function = "pd_scene_measure_run", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_328},
+    {.function = "pd_scene_measure_run", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_329},
+    {.function = "pd_scene_measure_run", .argument = "ref_res", .expect = EXPECT_ERROR, .call = api_case_330},
+    {.function = "pd_scene_measure_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_331},
+    {.function = "pd_scene_measure_run", .argument = "e", .expect = EXPECT_ERROR, .call = api_case_332},
+    {.function = "pd_spec_init", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_333},
+    {.function = "pd_spec_curves", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_334},
+    {.function = "pd_spec_points", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_335},
+    {.function = "pd_spec_twins", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_336},
+    {.function = "pd_spec_tasks", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_337},
+    {.function = "pd_spec_pi2", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_338},
+    {.function = "pd_spec_coords_of", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_339},
+    {.function = "pd_spec_coords_of", .argument = "co", .expect = EXPECT_NOCRASH, .call = api_case_340},
+    {.function = "pd_spec_twin_of", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_341},
+    {.function = "pd_spec_case", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_342},
+    {.function = "pd_spec_case", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_343},
+    {.function = "pd_spec_case", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_344},
+    {.function = "pd_spec_validate", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_345},
+    {.function = "pd_spec_resolve_method", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_346},
+    {.function = "pd_spec_run_task", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_347},
+    {.function = "pd_spec_run_task", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_348},
+    {.function = "pd_spec_stream", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_349},
+    {.function = "pd_spec_cost", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_350},
+    {.function = "pd_spec_key", .argument = "s", .expect = EXPECT_NULL, .call = api_case_351},
+    {.function = "pd_spec_rows", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_352},
+    {.function = "pd_spec_rows", .argument = "res", .expect = EXPECT_NOCRASH, .call = api_case_353},
+    {.function = "pd_spec_rows", .argument = "rows", .expect = EXPECT_NOCRASH, .call = api_case_354},
+    {.function = "pd_spec_curve_label", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_355},
+    {.function = "pd_spec_curve_label", .argument = "buf", .expect = EXPECT_NOCRASH, .call = api_case_356},
+    {.function = "pd_spec_sweep", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_357},
+    {.function = "pd_scene_sweep_twins", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_358},
+    {.function = "pd_scene_sweep_points", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_359},
+    {.function = "pd_scene_sweep_check", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_360},
+    {.function = "pd_scene_sweep_scene", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_361},
+    {.function = "pd_scene_sweep_scene", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_362},
+    {.function = "pd_scene_sweep_scene", .argument = "pt", .expect = EXPECT_ERROR, .call = api_case_363},
+    {.function = "pd_scene_sweep_run", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_364},
+    {.function = "pd_scene_sweep_run", .argument = "pts", .expect = EXPECT_ERROR, .call = api_case_365},
+    {.function = "pd_scene_sweep_run", .argument = "umax", .expect = EXPECT_ERROR, .call = api_case_366},
 };
-const int api_null_ncases = 365;
-const int api_null_nfunctions = 218;
+const int api_null_ncases = 367;
+const int api_null_nfunctions = 219;

@@ -31,7 +31,7 @@ IMPLIES = {"dt": 0, "theta": 0, "gamma": 0, "allow_unstable": 0, "kernel": 0, "f
            "lcp_solver": 0, "dt_per_Tp": 0, "no_accumulation": 1, "close_tol": 1,
            "impact_law": 1, "kc": 2,
            "kc_abs": 2, "atol": 2, "contact": 2, "stepper": 2}
-from ._structs import PD_METHOD_AUTO  # noqa: E402  (generated from pd_problems.h)
+from ._structs import PD_METHOD_AUTO, PD_METHOD_NEWMARK  # noqa: E402  (generated from pd_problems.h)
 PD_RTOL_MIN = 1e-12  # the tightest tolerance of Moreau-Jean's steps
 
 STEPPERS = {"rk8pd": b"rk8pd", "rkf45": b"rkf45", "rk4imp": b"rk4imp", "msbdf": b"msbdf"}
@@ -413,10 +413,10 @@ class Case:
                              "phase is underdamped, xi < sqrt(alpha) (or xi 0, or alpha 0; got xi "
                              "%s, alpha %s): method='moreau' runs it"
                              % (key, fmt(c.xi), fmt(c.alpha)))
-        if o.method not in (0, 1, PD_METHOD_AUTO):
-            raise InputError("%s: a yielding oscillator runs by method 'event' or 'moreau' (the "
-                             "penalty methods do not model yielding yet; got method %s)"
-                             % (key, _lib.s(lib.pd_method_name(o.method))))
+        if o.method not in (0, 1, PD_METHOD_NEWMARK, PD_METHOD_AUTO):
+            raise InputError("%s: a yielding oscillator runs by method 'event', 'moreau' or "
+                             "'newmark' (the adaptive penalty does not model yielding yet; got "
+                             "method %s)" % (key, _lib.s(lib.pd_method_name(o.method))))
         if o.rtol > 0.0:
             raise InputError("%s: a yielding oscillator runs at a fixed step (dt), not to a "
                              "tolerance (rtol)" % key)

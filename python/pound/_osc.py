@@ -282,7 +282,9 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
     A yielding run adds uy [m], Piy, alpha, ductility (umax / uy),
     residual [m], n_yield, plastic_excursion [m], hysteretic_energy and the
     energy balance energy_input, _kinetic, _strain, _damping, _impact
-    [J/kg] with energy_residual (a fraction of the input).
+    [J/kg] with energy_residual (a fraction of the input; NaN for newmark),
+    and with method 'newmark' newton_failures (steps whose Newton
+    iterations failed, each redone at the spring's initial stiffness).
     With history,
     r.history: the arrays step, t, u, v, impulse, gap, impacts of every
     every-th step (the CLI's -o file: t [s], u [m], v [m/s], impulse per
@@ -327,6 +329,8 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
                    energy_input=en.input, energy_kinetic=en.kinetic, energy_strain=en.strain,
                    energy_damping=en.damping, energy_impact=en.impact,
                    energy_residual=en.residual)
+        if out["kernel"] == "newmark":  # Newton's failures, as the CLI's
+            out.update(newton_failures=r.newton_failures)
     if h is not None:
         rows = h.rows()
         hist = Result((name, np.ascontiguousarray(rows[name])) for name, _ in OSC_SAMPLE

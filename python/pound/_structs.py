@@ -19,6 +19,7 @@ PD_EPARSE = -8
 PD_ESINGULAR = -9
 PD_ESTOPPED = -11
 PD_METHOD_AUTO = 3
+PD_METHOD_NEWMARK = 5
 PD_NAME_MAX = 64
 PD_OK = 0
 PD_SPEC_MAX_LIST = 64
@@ -253,6 +254,7 @@ class PdOscResult(Structure):
         ("plastic_excursion", c_double),
         ("hysteretic_energy", c_double),
         ("n_yield", c_long),
+        ("newton_failures", c_long),
         ("energy", PdEnergy),
     ]
 
