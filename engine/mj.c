@@ -61,6 +61,7 @@ void pd_mj_free(pd_mj *mj)
     if (!mj)
         return;
     mj_adapt_free(mj);
+    mj_yield_free(mj);
     pd_factor_free(mj->factor);
     pd_lcp_solver_free(mj->lcp);
     free(mj->F0);
@@ -208,7 +209,8 @@ pd_mj *pd_mj_alloc(const pd_model *model, const pd_mj_opts *opts, pd_err *err)
     int st;
     pd_err_clear(err);
     if ((st = pd_model_check(model, err)) ||
-        (st = pd_model_refuse_yield(model, "Moreau-Jean", err)) || (st = pd_mj_check_opts(&o, err)))
+        (o.rtol > 0.0 && (st = pd_model_refuse_yield(model, "Moreau-Jean to a tolerance", err))) ||
+        (st = pd_mj_check_opts(&o, err)))
         return NULL;
     mj = calloc(1, sizeof *mj);
     if (!mj || alloc_arrays(mj, model->n, model->m)) {
@@ -219,7 +221,7 @@ pd_mj *pd_mj_alloc(const pd_model *model, const pd_mj_opts *opts, pd_err *err)
     mj->model = model;
     mj->opts = o;
     /* one dof, at most one wall */
-    mj->scalar = o.kernel == PD_KERNEL_AUTO && model->n == 1 && model->m <= 1;
+    mj->scalar = o.kernel == PD_KERNEL_AUTO && model->n == 1 && model->m <= 1 && model->ns == 0;
     /* What = M + h theta C + h^2 theta^2 K, factored once for the run */
     mj->factor = pd_factor_alloc(model, o.h, o.theta, o.factor, err);
     if (!mj->factor)
@@ -230,6 +232,8 @@ pd_mj *pd_mj_alloc(const pd_model *model, const pd_mj_opts *opts, pd_err *err)
     if ((!mj->scalar || (o.rtol > 0.0 && o.pieces)) && model->m > 0 && contact_workspace(mj, err))
         goto fail;
     if (o.rtol > 0.0 && mj_adapt_alloc(mj, err))
+        goto fail;
+    if (model->ns > 0 && mj_yield_alloc(mj, err))
         goto fail;
     if (pd_mj_reset(mj, 0.0, NULL, NULL, err))
         goto fail;
@@ -276,6 +280,7 @@ int pd_mj_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_err
         mj->st.active[a] = 0;
     }
     gaps(md, mj->st.q, mj->st.g);
+    mj_yield_reset(mj); /* the offsets start at 0 */
     /* breakpoints before t0 are passed; F0 = F(t0 +) already takes the right limit of one at t0 */
     mj->next_break = 0;
     while (mj->next_break < md->nbreaks && md->breaks[mj->next_break] < t0 - 1e-9 * mj->opts.h)
@@ -677,6 +682,19 @@ static int impact_contacts(pd_mj *mj, const pd_factor *f, int nI, const double *
     return PD_OK;
 }
 
+int mj_contacts_apply(pd_mj *mj, const pd_factor *f, int nI, double t1, pd_state *out, pd_err *err)
+{
+    int rc = impact_contacts(mj, f, nI, out->v, t1, out, err);
+    if (rc)
+        return rc;
+    if (mj->refined) /* the impulses' velocity corrected on the pushing contacts */
+        for (int i = 0; i < mj->model->n; i++)
+            out->v[i] += mj->ref_y[i];
+    else
+        pd_factor_add_impulse(f, mj->idx_active, nI, mj->P_active, out->v);
+    return PD_OK;
+}
+
 int mj_general_step(pd_mj *mj, const pd_factor *f, double h, double t1, const double *F0,
                     const double *F1, const pd_state *in, pd_state *out, pd_err *err)
 {
@@ -693,6 +711,8 @@ int mj_general_step(pd_mj *mj, const pd_factor *f, double h, double t1, const do
     pd_matrix_gemv(&md->K, -1.0, mj->qtheta, 1.0, x);
     for (int i = 0; i < n; i++)
         x[i] *= h;
+    if (mj->yl) /* the yielding springs' offsets: h S ks up */
+        mj_yield_force(mj, h, x);
     /* vfree - v_k = What^-1 rhs */
     pd_factor_solve(f, x);
     /* I = {a : g_a + h gamma U_a <= 0} at the step's start */
@@ -707,16 +727,13 @@ int mj_general_step(pd_mj *mj, const pd_factor *f, double h, double t1, const do
     }
     out->t = t1;
     out->step = in->step + 1;
-    /* out->v = vfree; v_k+1 = vfree + What^-1 W_I P */
-    if (nI > 0) {
-        if ((rc = impact_contacts(mj, f, nI, out->v, t1, out, err)))
-            return rc;
-        if (mj->refined) /* the impulses' velocity corrected on the pushing contacts */
-            for (int i = 0; i < n; i++)
-                out->v[i] += mj->ref_y[i];
-        else
-            pd_factor_add_impulse(f, mj->idx_active, nI, mj->P_active, out->v);
-    }
+    /* out->v = vfree; v_k+1 = vfree + What^-1 (W_I P [+ the springs' slides]) */
+    if (mj->yl)
+        rc = mj_yield_step(mj, f, h, nI, t1, out, err);
+    else
+        rc = nI > 0 ? mj_contacts_apply(mj, f, nI, t1, out, err) : PD_OK;
+    if (rc)
+        return rc;
     /* q_k+1 = q_k + h [(1 - theta) v_k + theta v_k+1] */
     for (int i = 0; i < n; i++)
         out->q[i] += h * th * out->v[i];

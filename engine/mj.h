@@ -22,6 +22,7 @@ typedef struct mj_level {
 } mj_level;
 
 typedef struct mj_adapt mj_adapt;   /* the adaptive driver's own (mj_adapt.c) */
+typedef struct mj_yield mj_yield;   /* the yielding springs' (mj_yield.c) */
 typedef struct mj_flight mj_flight; /* its exact flights (mj_flight.c) */
 
 /* W by columns and by rows (the adaptive driver's): the dofs each contact
@@ -101,6 +102,7 @@ struct pd_mj {
     pd_state st_own;      /* the arrays mj->st was allocated with (the adaptive driver
                              points mj->st at its snapshots) */
     mj_adapt *ad;         /* NULL: fixed steps */
+    mj_yield *yl;         /* NULL: no yielding spring */
     mj_flight *fl;        /* adaptive with exact flights (linear blocks under piecewise
                              forcing); NULL: theta flights */
     mj_incidence inc;     /* the adaptive driver's view of W */
@@ -127,6 +129,18 @@ int mj_general_step(pd_mj *mj, const pd_factor *f, double h, double t1, const do
  * block in mj->D_active (dense, or compressed columns when mj->sparse) into
  * mj->P_active and out->P (t1 names the step's end in messages). */
 void mj_active_rhs(pd_mj *mj, int nI, const double *vfree);
+/* The contacts' LCP of the active set from out->v = vfree, and v+ into out->v. */
+int mj_contacts_apply(pd_mj *mj, const pd_factor *f, int nI, double t1, pd_state *out, pd_err *err);
+
+/* Yielding springs (mj_yield.c): the object, the offsets back to 0, their
+ * force x += s S ks up, and the step's LCP with them from out->v = vfree
+ * (out->q = q + h (1 - theta) v): v+ into out->v, the offsets moved. */
+int mj_yield_alloc(pd_mj *mj, pd_err *err);
+void mj_yield_free(pd_mj *mj);
+void mj_yield_reset(pd_mj *mj);
+void mj_yield_force(const pd_mj *mj, double s, double *x);
+int mj_yield_step(pd_mj *mj, const pd_factor *f, double h, int nI, double t1, pd_state *out,
+                  pd_err *err);
 int mj_impact_active(pd_mj *mj, int nI, double t1, pd_state *out, pd_err *err);
 
 /* The adaptive driver: its workspaces for mj (opts.rtol > 0), their

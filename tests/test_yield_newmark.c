@@ -47,12 +47,12 @@ static void test_yield_newmark_unreached_is_elastic(pd_test_ctx *ctx)
         c.alpha = 0.1;
         if (!run(ctx, &c, PD_METHOD_NEWMARK, 0.0, 0.0, 0, &far))
             continue;
-        const double a[] = {el.umax,         el.u_toward,   el.u_away,     el.first_impact,
-                            el.contact_time, el.max_impulse, el.acc_max,    el.shear_max,
-                            el.force_max},
-                     b[] = {far.umax,         far.u_toward,   far.u_away,  far.first_impact,
-                            far.contact_time, far.max_impulse, far.acc_max, far.shear_max,
-                            far.force_max};
+        const double a[] = {el.umax,         el.u_toward,     el.u_away,
+                            el.first_impact, el.contact_time, el.max_impulse,
+                            el.acc_max,      el.shear_max,    el.force_max},
+                     b[] = {far.umax,         far.u_toward,     far.u_away,
+                            far.first_impact, far.contact_time, far.max_impulse,
+                            far.acc_max,      far.shear_max,    far.force_max};
         CHECK(ctx,
               !memcmp(a, b, sizeof a) && el.impacts == far.impacts && el.steps == far.steps &&
                   far.n_yield == 0 && far.plastic_excursion == 0.0 && far.newton_failures == 0,
@@ -158,8 +158,15 @@ static int final_state(const pd_state *st, void *ctx)
  * 414 iterations: the predictor foresees nearly every switch). */
 static void test_yield_newmark_failures_redone(pd_test_ctx *ctx)
 {
-    nm_case k = {.M = 1.0, .C = 0.2, .K = 1.0, .W = -1.0, .S = 1.0, .ks = 0.8, .uy = 0.5,
-                 .g0 = 0.3, .e = 0.5};
+    nm_case k = {.M = 1.0,
+                 .C = 0.2,
+                 .K = 1.0,
+                 .W = -1.0,
+                 .S = 1.0,
+                 .ks = 0.8,
+                 .uy = 0.5,
+                 .g0 = 0.3,
+                 .e = 0.5};
     pd_model md = {.n = 1,
                    .m = 1,
                    .M = pd_matrix_dense(1, 1, &k.M),
@@ -180,17 +187,18 @@ static void test_yield_newmark_failures_redone(pd_test_ctx *ctx)
     double full[3], capped[3];
     pd_penalty_result r1, r2;
     pd_err e;
-    if (!CHECK(ctx, pd_penalty_run(&md, 0.0, NULL, NULL, 20.0, &o, final_state, full, &r1, &e) ==
-                        PD_OK,
+    if (!CHECK(ctx,
+               pd_penalty_run(&md, 0.0, NULL, NULL, 20.0, &o, final_state, full, &r1, &e) == PD_OK,
                "%s", e.msg))
         return;
     o.max_newton = 1;
-    if (!CHECK(ctx, pd_penalty_run(&md, 0.0, NULL, NULL, 20.0, &o, final_state, capped, &r2, &e) ==
-                        PD_OK,
+    if (!CHECK(ctx,
+               pd_penalty_run(&md, 0.0, NULL, NULL, 20.0, &o, final_state, capped, &r2, &e) ==
+                   PD_OK,
                "%s", e.msg))
         return;
-    double d = fmax(fabs(full[0] - capped[0]), fmax(fabs(full[1] - capped[1]),
-                                                    fabs(full[2] - capped[2])));
+    double d =
+        fmax(fabs(full[0] - capped[0]), fmax(fabs(full[1] - capped[1]), fabs(full[2] - capped[2])));
     printf("    capped at one iteration: %ld of %ld steps failed, the state %.3g apart "
            "(full Newton: %ld failures, %ld iterations)\n",
            r2.newton_failures, r2.steps, d, r1.newton_failures, r1.newton_iterations);
@@ -199,13 +207,15 @@ static void test_yield_newmark_failures_redone(pd_test_ctx *ctx)
           r2.newton_failures, d, full[2]);
     /* the adaptive penalty refuses the springs, the model's check their sizes */
     o.stepper = "rk8pd";
-    CHECK(ctx, pd_penalty_run(&md, 0.0, NULL, NULL, 1.0, &o, NULL, NULL, NULL, &e) == PD_EINVAL &&
-                   strstr(e.msg, "adaptive penalty") && strstr(e.msg, "newmark"),
+    CHECK(ctx,
+          pd_penalty_run(&md, 0.0, NULL, NULL, 1.0, &o, NULL, NULL, NULL, &e) == PD_EINVAL &&
+              strstr(e.msg, "adaptive penalty") && strstr(e.msg, "newmark"),
           "rk8pd with yielding springs: %s", e.msg);
     k.uy = -1.0;
     o.stepper = "newmark";
-    CHECK(ctx, pd_penalty_run(&md, 0.0, NULL, NULL, 1.0, &o, NULL, NULL, NULL, &e) == PD_EINVAL &&
-                   strstr(e.msg, "uy"),
+    CHECK(ctx,
+          pd_penalty_run(&md, 0.0, NULL, NULL, 1.0, &o, NULL, NULL, NULL, &e) == PD_EINVAL &&
+              strstr(e.msg, "uy"),
           "a negative uy: %s", e.msg);
 }
 
