@@ -297,8 +297,8 @@ static void print_json(const sim_args *a, const pd_osc_summary *s)
         pd_json_num(&js, "energy_damping", en->damping);
         pd_json_num(&js, "energy_impact", en->impact);
         pd_json_num(&js, "energy_residual", en->residual);
-        if (!strcmp(s->r.kernel, "newmark")) /* Newton's failures, honestly */
-            pd_json_int(&js, "newton_failures", s->r.newton_failures);
+        /* Newton's failures, honestly (newmark; 0: no Newton iterations) */
+        pd_json_int(&js, "newton_failures", s->r.newton_failures);
     }
     pd_json_end_object(&js);
     pd_json_finish(&js);
@@ -460,9 +460,10 @@ static int finish_output(const sim_args *a, const pd_osc_summary *s, pd_table_wr
                         NUM("energy_residual", "1", s->r.energy.residual)};
         for (size_t i = 0; i < sizeof ya / sizeof ya[0]; i++)
             attrs[n++] = ya[i];
-        if (!strcmp(s->r.kernel, "newmark"))
-            attrs[n++] = (pd_attr){
-                .name = "newton_failures", .units = "1", .num = (double)s->r.newton_failures};
+        attrs[n++] = (pd_attr){/* newmark's; 0: no Newton iterations */
+                               .name = "newton_failures",
+                               .units = "1",
+                               .num = (double)s->r.newton_failures};
     }
 #undef NUM
 #undef TXT
@@ -652,6 +653,17 @@ static void scene_json(const sim_args *a, const pd_scene *sc, const pd_scene_sum
         pd_json_nums(&js, "gamma", n, s->gamma + o);
         pd_json_num(&js, "err_est", s->err_est_structure[k]); /* NaN -> null: fixed steps */
         pd_json_num(&js, "law_band", r->law_band[k]);
+        if (st->uy) { /* yielding storeys (SPEC §7): NaN -> null for an elastic one */
+            pd_json_nums(&js, "uy", n, st->uy);
+            pd_json_nums(&js, "yield_alpha", n, st->yield_alpha);
+            pd_json_nums(&js, "ductility", n, r->ductility + o);
+            pd_json_nums(&js, "residual", n, r->residual + o);
+            pd_json_nums(&js, "plastic_excursion", n, r->plastic_excursion + o);
+            pd_json_begin_array(&js, "n_yield");
+            for (int i = 0; i < n; i++)
+                pd_json_int(&js, NULL, r->n_yield[o + i]);
+            pd_json_end_array(&js);
+        }
         pd_json_end_object(&js);
     }
     pd_json_end_array(&js);
@@ -763,6 +775,20 @@ static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_sum
             int d = st->dof + i;
             printf("  %-12s %7d %12.4g %12.5g %14.6g %14.6g\n", i ? "" : st->name, i + 1,
                    st->height[i], r->drift_ratio[d], r->acc_max[d], r->shear_max[d]);
+        }
+    }
+    if (pd_scene_springs(sc) > 0) { /* the yielding storeys */
+        printf("  yielding (storeys with a finite uy):\n");
+        printf("  %-12s %7s %10s %7s %10s %12s %8s %12s\n", "structure", "storey", "uy [m]",
+               "alpha", "ductility", "residual [m]", "onsets", "excursion [m]");
+        for (int k = 0; k < sc->nstruct && k < TEXT_MAX_STRUCTURES; k++) {
+            const pd_structure *st = &sc->st[k];
+            for (int i = 0; st->uy && i < st->storeys; i++) {
+                int d = st->dof + i;
+                printf("  %-12s %7d %10.4g %7.3g %10.5g %12.5g %8ld %12.5g\n", i ? "" : st->name,
+                       i + 1, st->uy[i], st->yield_alpha[i], r->ductility[d], r->residual[d],
+                       r->n_yield[d], r->plastic_excursion[d]);
+            }
         }
     }
     if (sc->ncontact)

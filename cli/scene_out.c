@@ -407,6 +407,18 @@ static int put_structure(pd_scene_writer *w, const pd_scene_summary *sum, int s)
          put_nums(w, g, prefix, "gamma", k, sum->gamma + o, "1") ||
          put_num(w, g, prefix, "err_est", sum->err_est_structure[s], "1") ||
          put_num(w, g, prefix, "law_band", sum->r.law_band[s], "1");
+    if (!rc && st->uy) { /* yielding storeys (SPEC §7); the onsets as numbers */
+        double *ny = malloc((size_t)k * sizeof(double));
+        for (int i = 0; ny && i < k; i++)
+            ny[i] = (double)sum->r.n_yield[o + i];
+        rc = !ny || put_nums(w, g, prefix, "uy", k, st->uy, "m") ||
+             put_nums(w, g, prefix, "yield_alpha", k, st->yield_alpha, "1") ||
+             put_nums(w, g, prefix, "ductility", k, sum->r.ductility + o, "1") ||
+             put_nums(w, g, prefix, "residual", k, sum->r.residual + o, "m") ||
+             put_nums(w, g, prefix, "plastic_excursion", k, sum->r.plastic_excursion + o, "m") ||
+             put_nums(w, g, prefix, "n_yield", k, ny, "1");
+        free(ny);
+    }
     if (g >= 0 && H5Gclose(g) < 0)
         rc = -1;
     return rc;

@@ -24,19 +24,19 @@
 #include "mj.h"
 #include "pd_alloc.h"
 
-#define MJY_CAP 512      /* contacts and sliding springs in one LCP at most */
-#define MJY_SLACK 1e-10  /* a spring past uy by more than this share of it joins Y */
+#define MJY_CAP 512     /* contacts and sliding springs in one LCP at most */
+#define MJY_SLACK 1e-10 /* a spring past uy by more than this share of it joins Y */
 
 struct mj_yield {
     int ns;
-    double *up;          /* ns: the offsets (the state's st.up) */
-    double *vfree;       /* n: the step's free velocity */
-    double *col;         /* n: What^-1 S_j, or a sum of columns */
-    int *ys;             /* ns: Y, in order of joining */
-    signed char *sigma;  /* ns: the side of each spring in Y (0: not in Y) */
+    double *up;            /* ns: the offsets (the state's st.up) */
+    double *vfree;         /* n: the step's free velocity */
+    double *col;           /* n: What^-1 S_j, or a sum of columns */
+    int *ys;               /* ns: Y, in order of joining */
+    signed char *sigma;    /* ns: the side of each spring in Y (0: not in Y) */
     double *L, *b, *z, *w; /* the LCP: MJY_CAP^2, MJY_CAP each */
     pd_lcp_work *lemke;
-    long rounds;         /* the LCPs solved with springs (statistics) */
+    long rounds; /* the LCPs solved with springs (statistics) */
 };
 
 void mj_yield_free(pd_mj *mj)
@@ -77,8 +77,8 @@ int mj_yield_alloc(pd_mj *mj, pd_err *err)
     y->z = pd_malloc(MJY_CAP, sizeof(double));
     y->w = pd_malloc(MJY_CAP, sizeof(double));
     y->lemke = pd_lcp_alloc(MJY_CAP);
-    if (!y->up || !y->vfree || !y->col || !y->ys || !y->sigma || !y->L || !y->b || !y->z ||
-        !y->w || !y->lemke)
+    if (!y->up || !y->vfree || !y->col || !y->ys || !y->sigma || !y->L || !y->b || !y->z || !y->w ||
+        !y->lemke)
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for %d yielding springs", ns);
     mj->st.up = y->up;
     return PD_OK;
@@ -165,9 +165,9 @@ static void build(pd_mj *mj, const pd_factor *f, int nI, int ny, double hth)
         }
         /* ks (uy - sigma z_free), z_free the end state with the free velocity
          * (mj->qtheta holds q + h (1 - theta) v in this step) */
-        y->b[nI + k] = ks * (md->uy[j] - sk * (pd_matrix_col_dot(&md->S, j, mj->qtheta) +
-                                                hth * pd_matrix_col_dot(&md->S, j, y->vfree) -
-                                                y->up[j]));
+        y->b[nI + k] =
+            ks * (md->uy[j] - sk * (pd_matrix_col_dot(&md->S, j, mj->qtheta) +
+                                    hth * pd_matrix_col_dot(&md->S, j, y->vfree) - y->up[j]));
     }
 }
 

@@ -596,6 +596,10 @@ typedef struct pd_structure {
     double alpha, beta; /* C = alpha M + beta K */
     int dof;            /* first dof of the structure in the scene's model */
     double *height;     /* storeys entries: storey heights [m] (PD_STOREY_HEIGHT unless set) */
+    /* yielding storeys (SPEC §7; pd_scene_set_yield; NULL: elastic): storey i's
+     * restoring force k_i [a d + (1 - a) z], |z| <= uy[i], a = yield_alpha[i] */
+    double *uy;          /* storeys entries: yield drifts [m] (INFINITY: that storey elastic) */
+    double *yield_alpha; /* storeys entries: post-yield stiffness ratios in [0, 1] */
 } pd_structure;
 
 typedef struct pd_contact {
@@ -652,6 +656,13 @@ PD_API int pd_scene_set_damping(pd_scene *sc, pd_damping damping, int mode1, int
 /* Storey heights of the last structure added (storeys entries, each finite
  * and > 0 [m]; the message names "storey_heights"). */
 PD_API int pd_scene_set_heights(pd_scene *sc, const double *heights, pd_err *err);
+/* The last structure's yielding storeys: uy one per storey, each > 0 [m]
+ * (INFINITY: that storey stays elastic); alpha one per storey in [0, 1]
+ * (NULL: 0, elastic-perfectly plastic).  Runs by Moreau-Jean at fixed steps
+ * and by newmark (the others refuse a yielding scene). */
+PD_API int pd_scene_set_yield(pd_scene *sc, const double *uy, const double *alpha, pd_err *err);
+/* The yielding springs of a scene: storeys with finite uy and alpha < 1. */
+PD_API int pd_scene_springs(const pd_scene *sc);
 /* A contact; a or b PD_WALL for a wall (level 0 there). */
 PD_API int pd_scene_add_contact(pd_scene *sc, int a, int level_a, int b, int level_b, double gap,
                                 double eps, int entry, pd_err *err);
@@ -700,6 +711,11 @@ typedef struct pd_scene_model {
     pd_model model;
     pd_sparse M, C, K, W;
     double *g0, *e, *mass;
+    /* the yielding springs (model.ns of them; pd_scene_springs): */
+    pd_sparse S;          /* n x ns: +1 at the storey's dof, -1 at the one below */
+    double *ks, *uy;      /* ns: (1 - alpha) k [reference units], uy [in Le] */
+    int *spring_dof;      /* ns: the storey's dof */
+    double *spring_alpha; /* ns: its post-yield stiffness ratio */
     double breaks[1];
     pd_osc shape; /* the excitation's shape in Pi units (pd_osc_shape) */
 } pd_scene_model;
@@ -774,6 +790,11 @@ typedef struct pd_scene_result {
     double *law_band;       /* nstruct */
     double law_band_max;    /* the largest over the structures (NAN: none measured) */
     long law_decided;
+    /* yielding storeys (pd_scene_set_yield; NAN, 0 for an elastic storey): */
+    double *ductility;         /* n: drift / uy */
+    double *residual;          /* n: (1 - alpha) up at the end [m] */
+    double *plastic_excursion; /* n: sum |d up| [m] */
+    long *n_yield;             /* n: yield onsets */
 } pd_scene_result;
 
 /* Arrays for the finished scene sc (PD_EINVAL before pd_scene_finish). */

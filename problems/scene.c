@@ -35,6 +35,8 @@ void pd_scene_free(pd_scene *sc)
         free(sc->st[s].mass);
         free(sc->st[s].stiffness);
         free(sc->st[s].height);
+        free(sc->st[s].uy);
+        free(sc->st[s].yield_alpha);
     }
     free(sc->st);
     free(sc->ct);
@@ -68,6 +70,8 @@ pd_scene *pd_scene_copy(const pd_scene *sc)
             memcpy(c->st[s].name, st->name, sizeof st->name);
             if (st->height)
                 memcpy(c->st[s].height, st->height, (size_t)st->storeys * sizeof(double));
+            if (st->uy) /* the yielding storeys */
+                ok = pd_scene_set_yield(c, st->uy, st->yield_alpha, NULL) == PD_OK;
         }
     }
     for (int a = 0; ok && a < sc->ncontact; a++) {
@@ -347,6 +351,45 @@ int pd_scene_set_heights(pd_scene *sc, const double *heights, pd_err *err)
                               i + 1, heights[i]);
     memcpy(st->height, heights, (size_t)st->storeys * sizeof(double));
     return PD_OK;
+}
+
+int pd_scene_set_yield(pd_scene *sc, const double *uy, const double *alpha, pd_err *err)
+{
+    if (!sc || !uy)
+        return PD_NULL_ARG(err, !sc ? "sc" : "uy");
+    if (sc->nstruct == 0)
+        return pd_err_set(err, PD_EINVAL, "uy: no structure to apply it to");
+    pd_structure *st = &sc->st[sc->nstruct - 1];
+    for (int i = 0; i < st->storeys; i++) {
+        if (!(uy[i] > 0.0)) /* INFINITY passes: an elastic storey */
+            return pd_err_set(err, PD_EINVAL,
+                              "uy: storey %d has yield drift %g, must be > 0 [m] (inf: elastic)",
+                              i + 1, uy[i]);
+        if (alpha && !(alpha[i] >= 0.0 && alpha[i] <= 1.0))
+            return pd_err_set(err, PD_EINVAL,
+                              "alpha: storey %d has post-yield stiffness ratio %g, must be in "
+                              "[0, 1]",
+                              i + 1, alpha[i]);
+    }
+    size_t bytes = (size_t)st->storeys * sizeof(double);
+    if (!st->uy && (!(st->uy = malloc(bytes)) || !(st->yield_alpha = malloc(bytes)))) {
+        free(st->uy);
+        st->uy = NULL;
+        return pd_err_set(err, PD_ENOMEM, "out of memory for the yield drifts of '%s'", st->name);
+    }
+    memcpy(st->uy, uy, bytes);
+    for (int i = 0; i < st->storeys; i++)
+        st->yield_alpha[i] = alpha ? alpha[i] : 0.0;
+    return PD_OK;
+}
+
+int pd_scene_springs(const pd_scene *sc)
+{
+    int ns = 0;
+    for (int s = 0; sc && s < sc->nstruct; s++)
+        for (int i = 0; sc->st[s].uy && i < sc->st[s].storeys; i++)
+            ns += isfinite(sc->st[s].uy[i]) && sc->st[s].yield_alpha[i] < 1.0;
+    return ns;
 }
 
 int pd_scene_add_contact(pd_scene *sc, int a, int level_a, int b, int level_b, double gap,
@@ -841,9 +884,14 @@ void pd_scene_model_free(pd_scene_model *sm)
     pd_sparse_free(&sm->C);
     pd_sparse_free(&sm->K);
     pd_sparse_free(&sm->W);
+    pd_sparse_free(&sm->S);
     free(sm->g0);
     free(sm->e);
     free(sm->mass);
+    free(sm->ks);
+    free(sm->uy);
+    free(sm->spring_dof);
+    free(sm->spring_alpha);
     memset(sm, 0, sizeof *sm);
 }
 
@@ -904,9 +952,38 @@ static int side_dof(const pd_scene *sc, int s, int level)
     return s == PD_WALL ? -1 : sc->st[s].dof + level - 1;
 }
 
+/* The yielding springs' triplets of S and their constants (reference
+ * units): one per storey with finite uy and alpha < 1, on its drift. */
+static int spring_triplets(const pd_scene *sc, double wp, double Le, pd_scene_model *sm,
+                           triplets *S)
+{
+    int ns = pd_scene_springs(sc), j = 0;
+    sm->ks = pd_malloc(ns, sizeof(double));
+    sm->uy = pd_malloc(ns, sizeof(double));
+    sm->spring_dof = pd_malloc(ns, sizeof(int));
+    sm->spring_alpha = pd_malloc(ns, sizeof(double));
+    if (!sm->ks || !sm->uy || !sm->spring_dof || !sm->spring_alpha || tri_alloc(S, 2L * ns))
+        return PD_ENOMEM;
+    for (int s = 0; s < sc->nstruct; s++) {
+        const pd_structure *st = &sc->st[s];
+        for (int i = 0; st->uy && i < st->storeys; i++) {
+            if (!isfinite(st->uy[i]) || !(st->yield_alpha[i] < 1.0))
+                continue; /* an elastic storey */
+            tri_add(S, st->dof + i, j, 1.0);
+            if (i > 0)
+                tri_add(S, st->dof + i - 1, j, -1.0);
+            sm->ks[j] = (1.0 - st->yield_alpha[i]) * st->stiffness[i] / (wp * wp);
+            sm->uy[j] = st->uy[i] / Le;
+            sm->spring_dof[j] = st->dof + i;
+            sm->spring_alpha[j++] = st->yield_alpha[i];
+        }
+    }
+    return PD_OK;
+}
+
 int pd_scene_model_build(const pd_scene *sc, int with_contacts, pd_scene_model *sm, pd_err *err)
 {
-    triplets M = {0}, K = {0}, C = {0}, W = {0};
+    triplets M = {0}, K = {0}, C = {0}, W = {0}, S = {0};
     if (!sc || !sm)
         return PD_NULL_ARG(err, !sc ? "sc" : "sm");
     int n = sc->n, m = with_contacts ? sc->ncontact : 0, rc = PD_OK;
@@ -937,10 +1014,16 @@ int pd_scene_model_build(const pd_scene *sc, int with_contacts, pd_scene_model *
         sm->g0[a] = ct->gap / Le;
         sm->e[a] = ct->eps;
     }
+    int ns = pd_scene_springs(sc);
+    if (spring_triplets(sc, wp, Le, sm, &S)) {
+        rc = pd_err_set(err, PD_ENOMEM, "out of memory for %d yielding springs", ns);
+        goto done;
+    }
     if ((rc = pd_sparse_from_triplets(&sm->M, n, n, M.n, M.i, M.j, M.x, err)) ||
         (rc = pd_sparse_from_triplets(&sm->K, n, n, K.n, K.i, K.j, K.x, err)) ||
         (rc = pd_sparse_from_triplets(&sm->C, n, n, C.n, C.i, C.j, C.x, err)) ||
-        (rc = pd_sparse_from_triplets(&sm->W, n, m, W.n, W.i, W.j, W.x, err)))
+        (rc = pd_sparse_from_triplets(&sm->W, n, m, W.n, W.i, W.j, W.x, err)) ||
+        (rc = pd_sparse_from_triplets(&sm->S, n, ns, S.n, S.i, S.j, S.x, err)))
         goto done;
     sm->shape = (pd_osc){.pulse = sc->exc.pulse,
                          .dir = sc->exc.dir,
@@ -961,8 +1044,13 @@ int pd_scene_model_build(const pd_scene *sc, int with_contacts, pd_scene_model *
                            .force = scene_force,
                            .force_ctx = sm,
                            .breaks = sm->breaks,
-                           .nbreaks = isfinite(sm->breaks[0]) ? 1 : 0};
+                           .nbreaks = isfinite(sm->breaks[0]) ? 1 : 0,
+                           .ns = ns,
+                           .S = ns > 0 ? pd_sparse_view(&sm->S) : pd_matrix_zero(n, 0),
+                           .ks = sm->ks,
+                           .uy = sm->uy};
 done:
+    tri_free(&S);
     tri_free(&M);
     tri_free(&K);
     tri_free(&C);

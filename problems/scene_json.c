@@ -514,11 +514,64 @@ static int read_heights(loader *L, pd_scene *sc, json_t *st, const char *path)
     return rc;
 }
 
-/* The damping fields, then the storey heights, of the last structure at path. */
+/* A per-storey field of the last structure at path: a number (every
+ * storey) or one per storey, into v (storeys entries, malloc'd). */
+static int per_storey(loader *L, json_t *x, const char *at, int storeys, double **v)
+{
+    int n = 0, rc;
+    if (json_is_number(x)) {
+        if (!(*v = malloc((size_t)storeys * sizeof(double))))
+            return fail(L, at, "out of memory");
+        for (int i = 0; i < storeys; i++)
+            (*v)[i] = json_number_value(x);
+        return PD_OK;
+    }
+    if ((rc = get_numbers(L, x, at, 0, v, &n)))
+        return rc;
+    if (n != storeys)
+        return fail(L, at, "%d values for %d storeys: give one per storey (or one number for all)",
+                    n, storeys);
+    return PD_OK;
+}
+
+/* "uy" (the yield drift [m]) and "alpha" (the post-yield stiffness ratio)
+ * of the last structure at path: each a number or one per storey (SPEC §7). */
+static int read_yield(loader *L, pd_scene *sc, json_t *st, const char *path)
+{
+    json_t *u = json_object_get(st, "uy"), *a = json_object_get(st, "alpha");
+    int storeys = sc->st[sc->nstruct - 1].storeys, rc;
+    char at[160], el[200];
+    double *uy = NULL, *alpha = NULL;
+    pd_err e;
+    if (!u)
+        return a ? fail(L, field(at, sizeof at, path, "alpha"),
+                        "needs the yield drift 'uy' of the same structure")
+                 : PD_OK;
+    if (!(rc = per_storey(L, u, field(at, sizeof at, path, "uy"), storeys, &uy)) && a)
+        rc = per_storey(L, a, field(at, sizeof at, path, "alpha"), storeys, &alpha);
+    for (int i = 0; i < storeys && !rc; i++) {
+        snprintf(el, sizeof el, "%s.uy[%d]", path, i);
+        if (!(uy[i] > 0.0) || !isfinite(uy[i]))
+            rc = fail(L, el, "the yield drift must be a finite number > 0 [m] (got %g)", uy[i]);
+        snprintf(el, sizeof el, "%s.alpha[%d]", path, i);
+        if (!rc && alpha && !(alpha[i] >= 0.0 && alpha[i] <= 1.0))
+            rc = fail(L, el, "the post-yield stiffness ratio must be in [0, 1] (got %g)", alpha[i]);
+    }
+    if (!rc && pd_scene_set_yield(sc, uy, alpha, &e))
+        rc = fail_builder(L, path, &e);
+    free(uy);
+    free(alpha);
+    return rc;
+}
+
+/* The damping fields, the storey heights and the yielding storeys of the
+ * last structure at path. */
 static int read_extras(loader *L, pd_scene *sc, json_t *st, const char *path)
 {
     int rc = read_damping(L, sc, st, path);
-    return rc ? rc : read_heights(L, sc, st, path);
+    if (!rc)
+        rc = read_heights(L, sc, st, path);
+    return rc ? rc : read_yield(L, sc, st, path);
 }
 
 /* Every storey's mass and stiffness of a building at path in the usable ranges. */
@@ -540,10 +593,10 @@ static int storeys_in_range(loader *L, const char *path, int n, const double *m,
  * (storeys, mass, T0). */
 static int read_structure(loader *L, pd_scene *sc, json_t *st, int k)
 {
-    static const char *const keys[] = {"name",           "T0",      "xi",
-                                       "mass",           "masses",  "stiffnesses",
-                                       "storeys",        "damping", "rayleigh_modes",
-                                       "storey_heights", NULL};
+    static const char *const keys[] = {
+        "name",        "T0",      "xi",      "mass",           "masses",
+        "stiffnesses", "storeys", "damping", "rayleigh_modes", "storey_heights",
+        "uy",          "alpha",   NULL};
     char path[64], at[160];
     const char *name;
     double xi, T0 = 0.0, mass = 1.0;

@@ -103,6 +103,16 @@ typedef struct track {
     double *serr;          /* nstruct: the structure's largest estimate now */
     double *wdof;          /* n: each dof's sqrt(K_ii / M_ii) (Pi units) */
     int dem_skipped;       /* a state was left out of the demands since the last */
+    /* yielding springs (the model's ns; their dofs, ratios and uy [Le] the model's) */
+    int ns;
+    const int *spring_dof;
+    const double *spring_alpha, *spring_uy;
+    double *up, *excursion; /* ns: the offsets at the last report, sum |d up| */
+    double *xeff;           /* n: displacements whose storey drifts d - (1 - alpha) up give
+                               the springs' forces (the demands' state) */
+    const double *xdem;     /* the demands' displacements of the report (q, or xeff) */
+    long *onsets;           /* ns: a report that slid after one that did not */
+    unsigned char *slid;    /* ns: the last report slid */
 } track;
 
 /* ---- results ---------------------------------------------------------------- */
@@ -135,9 +145,14 @@ int pd_scene_result_alloc(const pd_scene *sc, pd_scene_result *r, pd_err *err)
     r->nstruct = sc->nstruct;
     r->err_est = pd_calloc(sc->nstruct, sizeof(double));
     r->law_band = pd_calloc(sc->nstruct, sizeof(double));
-    if (!r->umax || !r->u_pos || !r->u_neg || !r->drift || !r->impacts || !r->first_impact ||
-        !r->max_impulse || !r->contact_time || !r->approach || !r->acc_max || !r->shear_max ||
-        !r->drift_ratio || !r->force_max || !r->force_equiv || !r->err_est || !r->law_band) {
+    r->ductility = pd_calloc(n, sizeof(double));
+    r->residual = pd_calloc(n, sizeof(double));
+    r->plastic_excursion = pd_calloc(n, sizeof(double));
+    r->n_yield = pd_calloc(n, sizeof(long));
+    if (!r->ductility || !r->residual || !r->plastic_excursion || !r->n_yield || !r->umax ||
+        !r->u_pos || !r->u_neg || !r->drift || !r->impacts || !r->first_impact || !r->max_impulse ||
+        !r->contact_time || !r->approach || !r->acc_max || !r->shear_max || !r->drift_ratio ||
+        !r->force_max || !r->force_equiv || !r->err_est || !r->law_band) {
         pd_scene_result_free(r);
         return pd_err_set(err, PD_ENOMEM, "out of memory for the results of %d dofs", sc->n);
     }
@@ -149,7 +164,8 @@ int pd_scene_result_fits(const pd_scene *sc, const pd_scene_result *r)
     return sc && r && r->n == sc->n && r->m == sc->ncontact && r->umax && r->u_pos && r->u_neg &&
            r->drift && r->impacts && r->first_impact && r->max_impulse && r->contact_time &&
            r->approach && r->acc_max && r->shear_max && r->drift_ratio && r->force_max &&
-           r->force_equiv && r->err_est && r->law_band && r->nstruct == sc->nstruct;
+           r->force_equiv && r->err_est && r->law_band && r->ductility && r->residual &&
+           r->plastic_excursion && r->n_yield && r->nstruct == sc->nstruct;
 }
 
 void pd_scene_result_free(pd_scene_result *r)
@@ -172,6 +188,10 @@ void pd_scene_result_free(pd_scene_result *r)
     free(r->force_equiv);
     free(r->err_est);
     free(r->law_band);
+    free(r->ductility);
+    free(r->residual);
+    free(r->plastic_excursion);
+    free(r->n_yield);
     memset(r, 0, sizeof *r);
 }
 
@@ -191,15 +211,16 @@ void pd_scene_result_free(pd_scene_result *r)
 static void track_free(track *tr)
 {
     void *arrays[] = {
-        tr->below,   tr->dof_a,   tr->dof_b,    tr->xmax,  tr->xpos,     tr->xneg,    tr->drift,
-        tr->impacts, tr->first,   tr->maxP,     tr->ctime, tr->approach, tr->episode, tr->g_prev,
-        tr->U_prev,  tr->U_prev2, tr->touching, tr->px,    tr->pv,       tr->pa,      tr->plam,
-        tr->pactive, tr->sx,      tr->sv,       tr->sg,    tr->sP,       tr->imp,     tr->imp_lam,
-        tr->acc,     tr->shear,   tr->da,       tr->dV,    tr->fpeak,    tr->dad,     tr->dVd,
-        tr->qa,      tr->qV,      tr->qad,      tr->qVd,   tr->st_of,    tr->ex,      tr->ev,
-        tr->sI,      tr->sampled, tr->errx,     tr->errd,  tr->erra,     tr->errv,    tr->acc0,
-        tr->shear0,  tr->serr,    tr->wdof,     tr->hacc,  tr->qh,       tr->hlam,    tr->hsm,
-        tr->hJ,      tr->hG,      tr->hz,       tr->hw,    tr->hD,       tr->sheld};
+        tr->below,     tr->dof_a,   tr->dof_b,    tr->xmax,  tr->xpos,     tr->xneg,    tr->drift,
+        tr->impacts,   tr->first,   tr->maxP,     tr->ctime, tr->approach, tr->episode, tr->g_prev,
+        tr->U_prev,    tr->U_prev2, tr->touching, tr->px,    tr->pv,       tr->pa,      tr->plam,
+        tr->pactive,   tr->sx,      tr->sv,       tr->sg,    tr->sP,       tr->imp,     tr->imp_lam,
+        tr->acc,       tr->shear,   tr->da,       tr->dV,    tr->fpeak,    tr->dad,     tr->dVd,
+        tr->qa,        tr->qV,      tr->qad,      tr->qVd,   tr->st_of,    tr->ex,      tr->ev,
+        tr->sI,        tr->sampled, tr->errx,     tr->errd,  tr->erra,     tr->errv,    tr->acc0,
+        tr->shear0,    tr->serr,    tr->wdof,     tr->hacc,  tr->qh,       tr->hlam,    tr->hsm,
+        tr->hJ,        tr->hG,      tr->hz,       tr->hw,    tr->hD,       tr->sheld,   tr->up,
+        tr->excursion, tr->onsets,  tr->slid,     tr->xeff};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(arrays[k]);
     pd_lcp_solver_free(tr->hlcp);
@@ -247,6 +268,48 @@ static int track_alloc(track *tr, const pd_scene *sc, pd_err *err)
         tr->approach[a] = -HUGE_VAL;
     }
     return PD_OK;
+}
+
+/* The yielding springs of the model built for sc (sm): their arrays. */
+static int track_springs(track *tr, const pd_scene_model *sm, pd_err *err)
+{
+    int ns = sm->model.ns;
+    tr->ns = ns;
+    tr->spring_dof = sm->spring_dof;
+    tr->spring_alpha = sm->spring_alpha;
+    tr->spring_uy = sm->uy;
+    tr->up = pd_calloc(ns, sizeof(double));
+    tr->excursion = pd_calloc(ns, sizeof(double));
+    tr->onsets = pd_calloc(ns, sizeof(long));
+    tr->slid = pd_calloc(ns, 1);
+    tr->xeff = pd_calloc(tr->n, sizeof(double));
+    if (!tr->up || !tr->excursion || !tr->onsets || !tr->slid || !tr->xeff)
+        return pd_err_set(err, PD_ENOMEM, "out of memory for tracking %d yielding springs", ns);
+    return PD_OK;
+}
+
+/* A report's offsets: a spring that moved slid since the last (an onset
+ * when it had not), its excursion summed; the demands' displacements: q,
+ * or with springs q less each yielding storey's (1 - alpha) up from its
+ * floor up (the storey forces k (d - (1 - alpha) up) as elastic ones). */
+static void note_springs(track *tr, const pd_state *st)
+{
+    tr->xdem = st->q;
+    if (!st->up)
+        return;
+    memcpy(tr->xeff, st->q, (size_t)tr->n * sizeof(double));
+    for (int j = 0; j < tr->ns; j++) {
+        double d = st->up[j] - tr->up[j];
+        tr->onsets[j] += d != 0.0 && !tr->slid[j];
+        tr->slid[j] = d != 0.0;
+        tr->excursion[j] += fabs(d);
+        tr->up[j] = st->up[j];
+        int i = tr->spring_dof[j], s = tr->st_of[i];
+        int top = tr->sc->st[s].dof + tr->sc->st[s].storeys;
+        for (int k = i; k < top; k++)
+            tr->xeff[k] -= (1.0 - tr->spring_alpha[j]) * st->up[j];
+    }
+    tr->xdem = tr->xeff;
 }
 
 /* Nothing measured yet (a run to a tolerance repeated): the run's arrays
@@ -596,8 +659,8 @@ static void held_lcp(track *tr, const pd_state *st, int k)
         for (int side = 0; side < 2; side++) {
             int i = side ? tr->dof_b[J[r]] : tr->dof_a[J[r]];
             if (i >= 0)
-                pd_demand_eval_structure(&tr->sc->st[tr->st_of[i]], st->q, st->v, tr->Le,
-                                         tr->Le * tr->wp, tr->hsm, tr->dV);
+                pd_demand_eval_structure(&tr->sc->st[tr->st_of[i]], tr->xdem ? tr->xdem : st->q,
+                                         st->v, tr->Le, tr->Le * tr->wp, tr->hsm, tr->dV);
         }
     for (int r = 0; r < k; r++) {
         int a = J[r], ia = tr->dof_a[a], ib = tr->dof_b[a];
@@ -659,11 +722,12 @@ static void penalty_held(track *tr, const pd_state *st)
 static int observe_moreau(const pd_state *st, void *ctx)
 {
     track *tr = ctx;
+    note_springs(tr, st);
     note_point(tr, st->t, st->q);
     note_approach(tr, st->q);
     if (tr->demands)
         moreau_held(tr, st);
-    note_demand(tr, st->t, st->q, st->v, NULL, tr->hacc, 0); /* the steps' own: as umax */
+    note_demand(tr, st->t, tr->xdem, st->v, NULL, tr->hacc, 0); /* the steps' own: as umax */
     tr->lcp_solves += st->nactive > 0;
     for (int a = 0; a < tr->model_m; a++) {
         double P = st->P[a], U = gap_rate(tr, a, st->v);
@@ -805,6 +869,7 @@ static int step_penalty(const pd_state *st, void *ctx)
 {
     track *tr = ctx;
     integrate_forces(tr, st);
+    note_springs(tr, st);
     if (tr->have_prev && st->has_acc)
         note_between(tr, st->t, st->q, st->v, st->acc);
     note_point(tr, st->t, st->q);
@@ -813,7 +878,7 @@ static int step_penalty(const pd_state *st, void *ctx)
      * impact's and its hold's at once); holds take the rigid held force */
     if (tr->demands)
         penalty_held(tr, st);
-    note_demand(tr, st->t, st->q, st->v, st->has_acc ? st->acc : NULL,
+    note_demand(tr, st->t, tr->xdem, st->v, st->has_acc ? st->acc : NULL,
                 tr->demands ? tr->hacc : NULL, no_element(tr, st));
     for (int a = 0; a < tr->model_m; a++) {
         double dt = tr->have_prev ? st->t - tr->pt : 0.0;
@@ -873,6 +938,13 @@ static void fill_result(const track *tr, pd_scene_result *r)
                               : NAN;
     }
     r->lcp_solves = tr->lcp_solves;
+    for (int j = 0; j < tr->ns; j++) { /* the yielding storeys */
+        int i = tr->spring_dof[j];
+        r->ductility[i] = tr->drift[i] / tr->spring_uy[j];
+        r->residual[i] = (1.0 - tr->spring_alpha[j]) * tr->up[j] * tr->Le;
+        r->plastic_excursion[i] = tr->excursion[j] * tr->Le;
+        r->n_yield[i] = tr->onsets[j];
+    }
 }
 
 /* ---- the one-wall oscillator: its fast paths ------------------------------- */
@@ -1369,7 +1441,12 @@ static int run_general(const pd_scene *sc, const pd_run_opts *o, pd_scene_sample
     /* the row reference measures the gaps of a free twin's contacts itself */
     if ((rc = pd_scene_model_build(sc, !o->no_wall || o->method == PD_METHOD_EVENT, &sm, err)))
         return rc;
-    if ((rc = track_alloc(&tr, sc, err))) {
+    if ((rc = track_alloc(&tr, sc, err))) { /* it freed what it took */
+        pd_scene_model_free(&sm);
+        return rc;
+    }
+    if ((rc = track_springs(&tr, &sm, err))) {
+        track_free(&tr);
         pd_scene_model_free(&sm);
         return rc;
     }
@@ -1499,9 +1576,20 @@ int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler s
                           "(pd_scene_result_alloc)");
     if ((rc = pd_scene_resolve_opts(sc, opts, &o, err)) || (rc = event_mass_ratio(sc, &o, err)))
         return rc;
-    for (int i = 0; i < res->n; i++)
+    int springs = pd_scene_springs(sc);
+    if (springs > 0 && !(o.method == PD_METHOD_MOREAU && o.rtol == 0.0) &&
+        o.method != PD_METHOD_NEWMARK)
+        return pd_err_set(err, PD_EINVAL,
+                          "uy: a yielding scene (%d yielding storeys) runs by Moreau-Jean at "
+                          "fixed steps (method moreau, dt) or by newmark; %s%s models no "
+                          "yielding storey yet",
+                          springs, pd_method_name(o.method), o.rtol > 0.0 ? " to a tolerance" : "");
+    for (int i = 0; i < res->n; i++) {
         res->umax[i] = res->u_pos[i] = res->u_neg[i] = res->drift[i] = res->acc_max[i] =
             res->shear_max[i] = res->drift_ratio[i] = 0.0;
+        res->ductility[i] = res->residual[i] = res->plastic_excursion[i] = NAN;
+        res->n_yield[i] = 0;
+    }
     for (int a = 0; a < res->m; a++) {
         res->impacts[a] = 0;
         res->first_impact[a] = res->force_max[a] = NAN;
@@ -1526,7 +1614,7 @@ int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler s
     for (int s = 0; s < res->nstruct; s++)
         res->law_band[s] = NAN;
     double cpu0 = pd_cpu_seconds(), wall0 = pd_wall_seconds(), sample_s = 0.0;
-    if (o.kernel == PD_KERNEL_AUTO && o.method != PD_METHOD_EVENT_GENERAL &&
+    if (o.kernel == PD_KERNEL_AUTO && o.method != PD_METHOD_EVENT_GENERAL && springs == 0 &&
         pd_scene_as_oscillator(sc, &c, &mirrored))
         rc = run_oscillator(sc, &c, mirrored, &o, sampler, ctx, res, err);
     else

@@ -47,7 +47,7 @@ OPTIONAL = {
 # int functions whose value is a count, a flag or an index: NULL gives <= 0.
 COUNTS = {"pd_scene_as_oscillator", "pd_scene_result_fits", "pd_osc_batchable", "pd_osc_yield_exact",
           "pd_matrix_is_diagonal", "pd_lcp_nmax", "pd_lcp_solver_nmax", "pd_mjb_finite",
-          "pd_record_plausible", "pd_osc_yields"}
+          "pd_record_plausible", "pd_osc_yields", "pd_scene_springs"}
 
 # Scalars given to the other arguments, by name (default: 1 / 1.0).
 ZERO_NAMES = {"i", "j", "k", "l", "lane", "task", "side", "seed", "index"}

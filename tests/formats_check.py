@@ -141,8 +141,9 @@ def parse_doc(path):
     return doc
 
 
-# a row the page marks "a yielding oscillator's only" or "a yielding sweep's only"
-YIELDING = re.compile(r"a yielding (oscillator|sweep)'s only")
+# a row the page marks "a yielding oscillator's only", "a yielding sweep's only" or
+# "a yielding structure's only"
+YIELDING = re.compile(r"a yielding (oscillator|sweep|structure)'s only")
 
 
 def pattern(name):

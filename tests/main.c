@@ -153,6 +153,7 @@ int main(int argc, char **argv)
     suite_yield_rk(&ctx);
     suite_yield_newmark(&ctx);
     suite_yield_mj(&ctx);
+    suite_yield_scene(&ctx);
     suite_row_rerun(&ctx);
     suite_measure_paths(&ctx);
     suite_api_null(&ctx);

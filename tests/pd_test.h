@@ -118,6 +118,7 @@ void suite_yield(pd_test_ctx *ctx);
 void suite_yield_rk(pd_test_ctx *ctx);
 void suite_yield_newmark(pd_test_ctx *ctx);
 void suite_yield_mj(pd_test_ctx *ctx);
+void suite_yield_scene(pd_test_ctx *ctx);
 void suite_row_rerun(pd_test_ctx *ctx);
 void suite_lemke_paths(pd_test_ctx *ctx);
 void suite_api_null(pd_test_ctx *ctx);

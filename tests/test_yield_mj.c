@@ -103,8 +103,8 @@ static void test_yield_mj_general_equals_scalar(pd_test_ctx *ctx)
             d = fmax(d, fmax(fabs(a.q[i] - b.q[i]), fabs(a.up[i] - b.up[i])));
         d /= r.umax;
         worst = fmax(worst, d);
-        CHECK(ctx, d <= 1e-9 && r.n_yield > 0, "case %d: the kernels %.3g of umax apart (%ld onsets)",
-              k, d, r.n_yield);
+        CHECK(ctx, d <= 1e-9 && r.n_yield > 0,
+              "case %d: the kernels %.3g of umax apart (%ld onsets)", k, d, r.n_yield);
     }
     printf("    the general kernel against the scalar one: %.2g of umax at most\n", worst);
     free(a.q);
@@ -262,6 +262,75 @@ static void test_yield_mj_soft_storey(pd_test_ctx *ctx)
     CHECK(ctx, prev <= 1e-2, "Newmark at kc 1e9: %.3g uy1 from Moreau-Jean", prev);
 }
 
+/* The equations of every Newmark step of the building: M a + C v + K q -
+ * S ks up - W lambda = F(t) at each step's end (away from the pulse's end,
+ * where a takes F's right limit), |S^T q - up| <= uy, an offset that moved
+ * sits on its yield level, and the reported gaps are g0 + W^T q. */
+typedef struct nm_check {
+    bldg *b;
+    double up_prev[2], res, comp, gap;
+    long steps, slid;
+} nm_check;
+
+static int nm_step_check(const pd_state *st, void *ctx)
+{
+    nm_check *c = ctx;
+    bldg *b = c->b;
+    double F[2], q[2] = {st->q[0], st->q[1]}, d[2] = {q[0], q[1] - q[0]};
+    bldg_force(st->t, -1, F, NULL);
+    double kup[2] = {b->ks[0] * st->up[0], b->ks[1] * st->up[1]}; /* S ks up */
+    double sku[2] = {kup[0] - kup[1], kup[1]}, lam = st->P[0];
+    double scale = 0.0;
+    for (int i = 0; i < 2 && fabs(st->t - PD_PI) > 1e-3; i++) {
+        double r = b->M[i + 2 * i] * st->acc[i] - F[i] - sku[i] - b->W[i] * lam;
+        double t = fabs(F[i]) + fabs(sku[i]) + fabs(b->W[i] * lam);
+        for (int j = 0; j < 2; j++) {
+            r += b->C[i + 2 * j] * st->v[j] + b->K[i + 2 * j] * q[j];
+            t += fabs(b->C[i + 2 * j] * st->v[j]) + fabs(b->K[i + 2 * j] * q[j]);
+        }
+        scale = fmax(scale, t);
+        c->res = fmax(c->res, fabs(r) / fmax(t, 1e-300));
+    }
+    for (int j = 0; j < 2; j++) {
+        double z = d[j] - st->up[j];
+        c->comp = fmax(c->comp, fabs(z) / b->uy[j] - 1.0);
+        if (st->up[j] != c->up_prev[j]) { /* it slid: on its level */
+            c->comp = fmax(c->comp, fabs(fabs(z) / b->uy[j] - 1.0));
+            c->slid++;
+        }
+        c->up_prev[j] = st->up[j];
+    }
+    c->gap = fmax(c->gap, fabs(st->g[0] - (b->g0 - q[1])));
+    c->steps++;
+    return 0;
+}
+
+static void test_yield_newmark_step_equations(pd_test_ctx *ctx)
+{
+    double brk = PD_PI;
+    bldg b;
+    pd_model md = bldg_model(&b, &brk);
+    pd_penalty_opts po = pd_penalty_default_opts();
+    po.stepper = "newmark";
+    po.kc = 1e5;
+    po.h = 0.05; /* coarse: the springs' tangent h^2/4 ks is 6 % of What, Newton's matrix
+                    matters */
+    nm_check c = {.b = &b};
+    po.on_step = nm_step_check;
+    po.on_step_ctx = &c;
+    pd_penalty_result pr;
+    pd_err e;
+    if (!CHECK(ctx, pd_penalty_run(&md, 0.0, NULL, NULL, 6.0, &po, NULL, NULL, &pr, &e) == PD_OK,
+               "%s", e.msg))
+        return;
+    printf(
+        "    %ld steps, %ld slides: balance %.2g of its terms, |z| / uy - 1 <= %.2g, gaps %.2g\n",
+        c.steps, c.slid, c.res, c.comp, c.gap);
+    CHECK(ctx, c.res <= 1e-10 && c.comp <= 1e-12 && c.gap <= 1e-15 && c.slid > 20,
+          "balance %.3g, complementarity %.3g, gaps %.3g, %ld slides", c.res, c.comp, c.gap,
+          c.slid);
+}
+
 /* Springs that never yield (uy 1e6 times): the run of the model without
  * them, bit for bit; Moreau-Jean to a tolerance refuses them. */
 static void test_yield_mj_unreached_is_elastic(pd_test_ctx *ctx)
@@ -280,8 +349,9 @@ static void test_yield_mj_unreached_is_elastic(pd_test_ctx *ctx)
         return;
     int rc = pd_mj_run(mj, pd_steps_for(6.0, 1e-3), bldg_note, &el, &e);
     pd_mj_free(mj);
-    CHECK(ctx, rc == PD_OK && !memcmp(far.peak, el.peak, sizeof far.peak) && far.up[0] == 0.0 &&
-                   far.up[1] == 0.0,
+    CHECK(ctx,
+          rc == PD_OK && !memcmp(far.peak, el.peak, sizeof far.peak) && far.up[0] == 0.0 &&
+              far.up[1] == 0.0,
           "peaks %.17g, %.17g against %.17g, %.17g", far.peak[0], far.peak[1], el.peak[0],
           el.peak[1]);
     md = bldg_model(&el, &brk);
@@ -296,5 +366,6 @@ void suite_yield_mj(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_yield_mj_general_equals_scalar);
     PD_RUN(ctx, test_yield_mj_soft_storey);
+    PD_RUN(ctx, test_yield_newmark_step_equations);
     PD_RUN(ctx, test_yield_mj_unreached_is_elastic);
 }

@@ -137,8 +137,7 @@ typedef struct nm_case {
 static void sine_force(double t, int side, double *F, void *ctx)
 {
     (void)side;
-    (void)ctx;
-    F[0] = 3.0 * sin(t);
+    F[0] = 3.0 * *(const double *)ctx * sin(t); /* ctx: the length scale */
 }
 
 static int final_state(const pd_state *st, void *ctx)
@@ -158,6 +157,7 @@ static int final_state(const pd_state *st, void *ctx)
  * 414 iterations: the predictor foresees nearly every switch). */
 static void test_yield_newmark_failures_redone(pd_test_ctx *ctx)
 {
+    double L = 1.0;
     nm_case k = {.M = 1.0,
                  .C = 0.2,
                  .K = 1.0,
@@ -176,6 +176,7 @@ static void test_yield_newmark_failures_redone(pd_test_ctx *ctx)
                    .g0 = &k.g0,
                    .e = &k.e,
                    .force = sine_force,
+                   .force_ctx = &L,
                    .ns = 1,
                    .S = pd_matrix_dense(1, 1, &k.S),
                    .ks = &k.ks,
@@ -205,7 +206,34 @@ static void test_yield_newmark_failures_redone(pd_test_ctx *ctx)
     CHECK(ctx, r1.newton_failures == 0 && r2.newton_failures >= 3 && d <= 1e-9 && full[2] != 0.0,
           "failures %ld and %ld, the states %.3g apart, the offset %g", r1.newton_failures,
           r2.newton_failures, d, full[2]);
-    /* the adaptive penalty refuses the springs, the model's check their sizes */
+    /* lengths scaled by 2^-20 (the force, uy, the gap: exactly, in binary;
+     * kc as before: a linear element): the capped run scales with them, its
+     * iterations converging to the state's own scale (1e-9 of it; measured
+     * equal) */
+    double small[3];
+    L = ldexp(1.0, -20);
+    k.uy *= L;
+    k.g0 *= L;
+    if (CHECK(ctx,
+              pd_penalty_run(&md, 0.0, NULL, NULL, 20.0, &o, final_state, small, &r2, &e) == PD_OK,
+              "%s", e.msg)) {
+        double ds = 0.0;
+        for (int i = 0; i < 3; i++)
+            ds = fmax(ds, fabs(small[i] / L - capped[i]));
+        CHECK(ctx, ds <= 1e-9 * fabs(capped[2]) && r2.newton_failures >= 3,
+              "lengths scaled by 2^-20: %.3g apart (scaled back), %ld failures", ds,
+              r2.newton_failures);
+    }
+    k.uy /= L;
+    k.g0 /= L;
+    L = 1.0;
+    /* a state that is not finite, the adaptive penalty with springs, a bad
+     * spring: refused, each named */
+    double q0 = NAN, v0 = 0.0;
+    CHECK(ctx,
+          pd_penalty_run(&md, 0.0, &q0, &v0, 1.0, &o, NULL, NULL, NULL, &e) == PD_EINVAL &&
+              strstr(e.msg, "not finite"),
+          "a NaN start: %s", e.msg);
     o.stepper = "rk8pd";
     CHECK(ctx,
           pd_penalty_run(&md, 0.0, NULL, NULL, 1.0, &o, NULL, NULL, NULL, &e) == PD_EINVAL &&

@@ -283,8 +283,9 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
     residual [m], n_yield, plastic_excursion [m], hysteretic_energy and the
     energy balance energy_input, _kinetic, _strain, _damping, _impact
     [J/kg] with energy_residual (a fraction of the input; NaN for newmark),
-    and with method 'newmark' newton_failures (steps whose Newton
-    iterations failed, each redone at the spring's initial stiffness).
+    and newton_failures (method 'newmark': steps whose Newton iterations
+    failed, each redone at the spring's initial stiffness; 0 for the
+    methods without Newton iterations).
     With history,
     r.history: the arrays step, t, u, v, impulse, gap, impacts of every
     every-th step (the CLI's -o file: t [s], u [m], v [m/s], impulse per
@@ -329,8 +330,7 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
                    energy_input=en.input, energy_kinetic=en.kinetic, energy_strain=en.strain,
                    energy_damping=en.damping, energy_impact=en.impact,
                    energy_residual=en.residual)
-        if out["kernel"] == "newmark":  # Newton's failures, as the CLI's
-            out.update(newton_failures=r.newton_failures)
+        out.update(newton_failures=r.newton_failures)  # as the CLI's (0: no Newton)
     if h is not None:
         rows = h.rows()
         hist = Result((name, np.ascontiguousarray(rows[name])) for name, _ in OSC_SAMPLE

@@ -183,7 +183,10 @@ class Scene:
         (docs/scenes.md, "Demands"): per structure storey_heights [m],
         drift_ratio, acc_max [m/s^2], shear_max, base_shear_max [N], per
         contact force_equiv, force_max [N] (NaN: not a penalty method), and
-        contact_duration [s].  opts: the scheme keywords of simulate()
+        contact_duration [s]; a structure with yielding storeys ("uy" in the
+        scene) also uy [m], yield_alpha, ductility, residual [m],
+        plastic_excursion [m] and n_yield per storey (NaN, 0 for an elastic
+        storey).  opts: the scheme keywords of simulate()
         (method, dt, tend, theta, ..., contact_duration; rtol as there:
         Moreau-Jean to a tolerance, or with method='penalty' the integrator's).
         Moreau-Jean to a tolerance: rtol (0: fixed steps), err_est (the
@@ -253,12 +256,19 @@ class Scene:
 
             def part(p, o=o, ns=ns):
                 return np.ctypeslib.as_array(p, (o + ns,))[o:].copy()
-            structs.append(Result(name=s(st.name), storeys=ns, T0=st.T0, Pi2=sm.Pi2[k],
-                                  umax=part(r.umax), u_pos=part(r.u_pos), u_neg=part(r.u_neg),
-                                  drift=part(r.drift), Pi1=part(sm.Pi1),
-                                  umax_free=part(sm.free.umax), gamma=part(sm.gamma),
-                                  err_est=sm.err_est_structure[k],
-                                  law_band=r.law_band[k]))
+            one = Result(name=s(st.name), storeys=ns, T0=st.T0, Pi2=sm.Pi2[k],
+                         umax=part(r.umax), u_pos=part(r.u_pos), u_neg=part(r.u_neg),
+                         drift=part(r.drift), Pi1=part(sm.Pi1),
+                         umax_free=part(sm.free.umax), gamma=part(sm.gamma),
+                         err_est=sm.err_est_structure[k],
+                         law_band=r.law_band[k])
+            if st.uy:  # yielding storeys (SPEC section 7), as the CLI's JSON
+                one.update(uy=np.ctypeslib.as_array(st.uy, (ns,)).copy(),
+                           yield_alpha=np.ctypeslib.as_array(st.yield_alpha, (ns,)).copy(),
+                           ductility=part(r.ductility), residual=part(r.residual),
+                           plastic_excursion=part(r.plastic_excursion),
+                           n_yield=np.ctypeslib.as_array(r.n_yield, (o + ns,))[o:].copy())
+            structs.append(one)
         out["structures"] = structs
         contacts = []
         for a in range(sc.ncontact):

@@ -310,6 +310,8 @@ class PdStructure(Structure):
         ("beta", c_double),
         ("dof", c_int),
         ("height", POINTER(c_double)),
+        ("uy", POINTER(c_double)),
+        ("yield_alpha", POINTER(c_double)),
     ]
 
 
@@ -417,6 +419,10 @@ class PdSceneResult(Structure):
         ("law_band", POINTER(c_double)),
         ("law_band_max", c_double),
         ("law_decided", c_long),
+        ("ductility", POINTER(c_double)),
+        ("residual", POINTER(c_double)),
+        ("plastic_excursion", POINTER(c_double)),
+        ("n_yield", POINTER(c_long)),
     ]
 
 

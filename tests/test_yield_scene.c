@@ -1,0 +1,255 @@
+/* test_yield_scene.c — yielding storeys in scenes ("uy", "alpha"; SPEC §7):
+ *   - examples/scenes/yielding-buildings.json: the soft storey yields,
+ *     Moreau-Jean and Newmark agree on its ductility and residual;
+ *   - storeys that never yield give the elastic scene's figures bit for bit;
+ *   - a row of 10 yielding SDOFs between walls: Moreau-Jean's ductilities
+ *     settle as dt is quartered, Newmark's come to them;
+ *   - the methods that model no yielding storey refuse, bad fields are
+ *     named with their place in the file. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pd_problems.h"
+#include "pd_test.h"
+
+#define YSCENE "examples/scenes/yielding-buildings.json"
+
+/* Run sc by method (dt 0: the default) into r (allocated here). */
+static int yrun(pd_test_ctx *ctx, const pd_scene *sc, pd_method method, double dt,
+                pd_scene_result *r)
+{
+    pd_run_opts o = pd_run_default_opts();
+    o.method = method;
+    o.dt = dt;
+    pd_err e;
+    int rc = pd_scene_result_alloc(sc, r, &e);
+    if (!rc)
+        rc = pd_scene_run(sc, &o, NULL, NULL, r, &e);
+    return CHECK(ctx, rc == PD_OK, "%s: %s", pd_method_name(method), e.msg);
+}
+
+/* The example: the soft storey (soft, storey 1: uy 3 cm) yields (measured
+ * ductility 2.19, three onsets), every other storey stays elastic (below
+ * 1); Newmark's ductility within 1 % of Moreau-Jean's and its residual
+ * within 1 % of uy (measured 0.3 % and 0.2 %); the demands take the
+ * springs' forces: the soft storey's shear stays below its bilinear
+ * envelope k (uy + alpha (drift - uy)) plus damping's share (20 %). */
+static void test_yield_scene_example(pd_test_ctx *ctx)
+{
+    pd_scene *sc = NULL;
+    pd_err e;
+    if (!CHECK(ctx, pd_scene_load(YSCENE, &sc, &e) == PD_OK, "%s", e.msg))
+        return;
+    pd_scene_result mj, nm;
+    if (yrun(ctx, sc, PD_METHOD_MOREAU, 0.0, &mj) && yrun(ctx, sc, PD_METHOD_NEWMARK, 0.0, &nm)) {
+        const pd_structure *soft = &sc->st[0];
+        int d0 = soft->dof;
+        double uy = soft->uy[0], k = soft->stiffness[0], a = soft->yield_alpha[0];
+        printf("    soft storey: ductility %.5g (newmark %.5g), residual %.4g m (%.4g m), shear "
+               "%.4g N\n",
+               mj.ductility[d0], nm.ductility[d0], mj.residual[d0], nm.residual[d0],
+               mj.shear_max[d0]);
+        CHECK(ctx, mj.ductility[d0] > 1.5 && mj.n_yield[d0] > 0 && mj.plastic_excursion[d0] > 0.0,
+              "the soft storey: ductility %g, %ld onsets", mj.ductility[d0], mj.n_yield[d0]);
+        for (int i = 1; i < sc->n; i++)
+            CHECK(ctx, mj.ductility[i] < 1.0 && mj.n_yield[i] == 0 && mj.residual[i] == 0.0,
+                  "dof %d: ductility %g, %ld onsets, residual %g", i, mj.ductility[i],
+                  mj.n_yield[i], mj.residual[i]);
+        CHECK(ctx,
+              fabs(nm.ductility[d0] - mj.ductility[d0]) <= 0.01 * mj.ductility[d0] &&
+                  fabs(nm.residual[d0] - mj.residual[d0]) <= 0.01 * uy,
+              "newmark: ductility %g against %g, residual %g against %g", nm.ductility[d0],
+              mj.ductility[d0], nm.residual[d0], mj.residual[d0]);
+        double envelope = k * (uy + a * (mj.drift[d0] - uy));
+        CHECK(ctx, mj.shear_max[d0] <= 1.2 * envelope && mj.shear_max[d0] >= 0.8 * k * uy,
+              "the soft storey's shear %g against its envelope %g", mj.shear_max[d0], envelope);
+        pd_scene_result_free(&nm);
+    }
+    pd_scene_result_free(&mj);
+    /* the methods without yielding storeys refuse, naming uy */
+    const pd_method refused[] = {PD_METHOD_EVENT, PD_METHOD_EVENT_GENERAL, PD_METHOD_PENALTY};
+    for (int m = 0; m < 3; m++) {
+        pd_run_opts o = pd_run_default_opts();
+        o.method = refused[m];
+        pd_scene_result r;
+        if (pd_scene_result_alloc(sc, &r, &e) == PD_OK) {
+            CHECK(ctx, pd_scene_run(sc, &o, NULL, NULL, &r, &e) == PD_EINVAL && strstr(e.msg, "uy"),
+                  "%s: %s", pd_method_name(refused[m]), e.msg);
+            pd_scene_result_free(&r);
+        }
+    }
+    pd_run_opts o = pd_run_default_opts();
+    o.rtol = 1e-3;
+    pd_scene_result r;
+    if (pd_scene_result_alloc(sc, &r, &e) == PD_OK) {
+        CHECK(ctx,
+              pd_scene_run(sc, &o, NULL, NULL, &r, &e) == PD_EINVAL && strstr(e.msg, "tolerance"),
+              "rtol: %s", e.msg);
+        pd_scene_result_free(&r);
+    }
+    pd_scene_free(sc);
+}
+
+/* uy 1e6 m on every storey: the elastic scene's run bit for bit (both
+ * methods), no onsets, residual 0. */
+static void test_yield_scene_unreached_is_elastic(pd_test_ctx *ctx)
+{
+    pd_scene *sc = NULL, *el = NULL;
+    pd_err e;
+    if (!CHECK(ctx, pd_scene_load(YSCENE, &sc, &e) == PD_OK, "%s", e.msg))
+        return;
+    for (int s = 0; s < sc->nstruct; s++)
+        for (int i = 0; i < sc->st[s].storeys; i++)
+            sc->st[s].uy[i] = 1e6;
+    el = pd_scene_copy(sc);
+    for (int s = 0; el && s < el->nstruct; s++) { /* the copy without springs */
+        free(el->st[s].uy);
+        free(el->st[s].yield_alpha);
+        el->st[s].uy = el->st[s].yield_alpha = NULL;
+    }
+    if (!CHECK(ctx, el && pd_scene_finish(el, &e) == PD_OK, "copy: %s", el ? e.msg : "NULL")) {
+        pd_scene_free(sc);
+        pd_scene_free(el);
+        return;
+    }
+    const pd_method methods[] = {PD_METHOD_MOREAU, PD_METHOD_NEWMARK};
+    for (int m = 0; m < 2; m++) {
+        pd_scene_result a, b;
+        if (yrun(ctx, sc, methods[m], 0.0, &a) && yrun(ctx, el, methods[m], 0.0, &b)) {
+            size_t n = (size_t)sc->n * sizeof(double);
+            CHECK(ctx,
+                  !memcmp(a.umax, b.umax, n) && !memcmp(a.drift, b.drift, n) &&
+                      !memcmp(a.acc_max, b.acc_max, n) && !memcmp(a.shear_max, b.shear_max, n) &&
+                      a.n_yield[0] == 0 && a.residual[0] == 0.0 && isnan(b.residual[0]),
+                  "%s: the far yield level changed the run (umax %.17g against %.17g)",
+                  pd_method_name(methods[m]), a.umax[0], b.umax[0]);
+            pd_scene_result_free(&b);
+        }
+        pd_scene_result_free(&a);
+    }
+    pd_scene_free(sc);
+    pd_scene_free(el);
+}
+
+/* A row of 10 SDOFs (T0 0.4 to 1.3 s, uy 1 to 2 cm, alpha 0 to 0.2) between
+ * two walls, gaps 3 cm, e 0.6, under a sine pulse of 4 m/s^2 and 0.8 s. */
+static pd_scene *row10(pd_test_ctx *ctx)
+{
+    pd_scene_excitation x = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 4.0, .Tp = 0.8};
+    pd_scene *sc = pd_scene_new(&x);
+    pd_err e;
+    int rc = sc ? PD_OK : PD_ENOMEM;
+    for (int i = 0; i < 10 && !rc; i++) {
+        char name[16];
+        double uy = 0.01 + 0.001 * i, alpha = 0.02 * i;
+        snprintf(name, sizeof name, "S%d", i + 1);
+        rc = pd_scene_add_sdof(sc, name, 0.4 + 0.1 * i, 0.05, 1e5, &e) ||
+             pd_scene_set_yield(sc, &uy, &alpha, &e);
+    }
+    for (int i = 0; i <= 10 && !rc; i++)
+        rc = pd_scene_add_contact(sc, i == 0 ? PD_WALL : i - 1, i == 0 ? 0 : 1,
+                                  i == 10 ? PD_WALL : i, i == 10 ? 0 : 1, 0.03, 0.6, i, &e);
+    if (!rc)
+        rc = pd_scene_finish(sc, &e);
+    if (!CHECK(ctx, rc == PD_OK, "the row: %s", sc ? e.msg : "out of memory")) {
+        pd_scene_free(sc);
+        return NULL;
+    }
+    sc->tend = 3.0;
+    return sc;
+}
+
+/* The largest relative distance of the ductilities, and of the residuals
+ * over uy. */
+static void row_dist(const pd_scene *sc, const pd_scene_result *a, const pd_scene_result *b,
+                     double *dmu, double *dres)
+{
+    *dmu = *dres = 0.0;
+    for (int i = 0; i < sc->n; i++) {
+        *dmu = fmax(*dmu, fabs(a->ductility[i] - b->ductility[i]) / a->ductility[i]);
+        *dres = fmax(*dres, fabs(a->residual[i] - b->residual[i]) / sc->st[i].uy[0]);
+    }
+}
+
+/* Moreau-Jean on the yielding row (ductilities 8 to 16, every SDOF yields,
+ * 150 to 200 impacts): at dt 1e-3, 2.5e-4, 6.25e-5 the ductilities within
+ * 1 % of the run at 1.5625e-5 (measured 2.7e-3, 2.9e-3, 1.1e-3), Newmark's
+ * within 2 % (measured 1.1e-2: its penetration).  The residuals carry the
+ * chattering of the impacts against the walls, whose count grows as dt
+ * shrinks (151 to 201): within 0.3 uy (measured 0.17 at worst). */
+static void test_yield_scene_row_converges(pd_test_ctx *ctx)
+{
+    pd_scene *sc = row10(ctx);
+    if (!sc)
+        return;
+    pd_scene_result fine, r;
+    if (!yrun(ctx, sc, PD_METHOD_MOREAU, 1.5625e-5, &fine)) {
+        pd_scene_free(sc);
+        return;
+    }
+    long onsets = 0;
+    for (int i = 0; i < sc->n; i++)
+        onsets += fine.n_yield[i];
+    for (int k = 0; k < 4; k++) {
+        double dt = 1e-3 / pow(4.0, k), dmu, dres;
+        pd_method method = k < 3 ? PD_METHOD_MOREAU : PD_METHOD_NEWMARK;
+        if (k == 3)
+            dt = 1.5625e-5;
+        if (!yrun(ctx, sc, method, dt, &r))
+            break;
+        row_dist(sc, &fine, &r, &dmu, &dres);
+        printf("    %s dt %.3g: ductilities %.2g, residuals %.2g uy from Moreau-Jean at 1.6e-5\n",
+               pd_method_name(method), dt, dmu, dres);
+        CHECK(ctx, dmu <= (k < 3 ? 1e-2 : 2e-2) && dres <= 0.3, "%s dt %g: %.3g, %.3g",
+              pd_method_name(method), dt, dmu, dres);
+        pd_scene_result_free(&r);
+    }
+    CHECK(ctx, onsets >= 10, "%ld onsets in the row", onsets);
+    pd_scene_result_free(&fine);
+    pd_scene_free(sc);
+}
+
+/* A scene's yielding fields refused with their place: alpha without uy,
+ * uy <= 0, a wrong count, alpha beyond 1. */
+static void test_yield_scene_bad_fields(pd_test_ctx *ctx)
+{
+    static const struct {
+        const char *fields, *says;
+    } cases[] = {
+        {"\"alpha\": 0.1", "needs the yield drift 'uy'"},
+        {"\"uy\": -0.01", "structures[0].uy[0]: the yield drift must be a finite number > 0"},
+        {"\"uy\": [0.01, 0.02]", "2 values for 1 storeys"},
+        {"\"uy\": 0.01, \"alpha\": 1.5", "structures[0].alpha[0]: the post-yield stiffness ratio"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char path[64], text[512];
+        snprintf(path, sizeof path, "/tmp/pd_yield_scene_%zu.json", k);
+        snprintf(text, sizeof text,
+                 "{\"excitation\": {\"pulse\": \"sine\", \"ap\": 3, \"Tp\": 0.8},\n"
+                 " \"structures\": [{\"name\": \"A\", \"T0\": 0.5, %s}],\n"
+                 " \"contacts\": [{\"a\": \"wall\", \"b\": \"A\", \"gap\": 0.01, \"eps\": 0.5}]}\n",
+                 cases[k].fields);
+        FILE *f = fopen(path, "w");
+        if (!CHECK(ctx, f != NULL, "cannot write %s", path))
+            continue;
+        fputs(text, f);
+        fclose(f);
+        pd_scene *sc = NULL;
+        pd_err e = {0};
+        int st = pd_scene_load(path, &sc, &e);
+        CHECK(ctx, st == PD_EPARSE && !sc && strstr(e.msg, cases[k].says), "case %zu: %s", k,
+              e.msg);
+        pd_scene_free(sc);
+        remove(path);
+    }
+}
+
+void suite_yield_scene(pd_test_ctx *ctx)
+{
+    PD_RUN(ctx, test_yield_scene_example);
+    PD_RUN(ctx, test_yield_scene_unreached_is_elastic);
+    PD_RUN(ctx, test_yield_scene_row_converges);
+    PD_RUN(ctx, test_yield_scene_bad_fields);
+}
