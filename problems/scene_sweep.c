@@ -39,6 +39,11 @@ int pd_scene_sweep_check(const pd_scene_sweep *w, pd_err *err)
         return pd_err_set(err, PD_EINVAL, "ref: no structure %d", w->ref);
     if (!(w->pi2_min > 0.0) || w->npi2 < 1 || !(w->pi2_max >= w->pi2_min))
         return pd_err_set(err, PD_EINVAL, "Pi2: need 0 < MIN <= MAX and N >= 1");
+    if (w->npi3 > 0 && pd_scene_springs(sc) > 0)
+        return pd_err_set(err, PD_EINVAL,
+                          "Pi3: a yielding scene's sweep keeps its gaps and yield drifts in "
+                          "metres (the contact-free twin would change with each Pi3): sweep "
+                          "Pi2 alone");
     if (w->npi3 > 0) {
         if (w->ref_contact < 0 || w->ref_contact >= sc->ncontact)
             return pd_err_set(err, PD_EINVAL, "ref-contact: no contact %d (the scene has %d)",

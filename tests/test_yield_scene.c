@@ -246,8 +246,36 @@ static void test_yield_scene_bad_fields(pd_test_ctx *ctx)
     }
 }
 
+/* The command line: the example runs (its yielding table, JSON's per
+ * storey arrays); the methods and sweeps that do not model it exit 2 with
+ * one line naming the flag. */
+static void test_yield_scene_cli(pd_test_ctx *ctx)
+{
+    const char *json[] = {"simulate", "--scene", YSCENE, "--json", NULL};
+    const char *event[] = {"simulate", "--scene", YSCENE, "--method", "event", NULL};
+    const char *pi3[] = {"spectrum", "--scene", YSCENE, "--Pi2", "0.5:2:2", "--Pi3", "0.5", NULL};
+    proc_out r;
+    pd_test_pound(ctx, json, &r);
+    CHECK(ctx,
+          r.status == 0 && r.out && strstr(r.out, "\"ductility\":[") &&
+              strstr(r.out, "\"n_yield\":[") && strstr(r.out, "\"yield_alpha\":["),
+          "--json: exit %d, %s", r.status, r.err);
+    pd_test_proc_free(&r);
+    pd_test_pound(ctx, event, &r);
+    CHECK(ctx,
+          r.status == 2 && r.err && strstr(r.err, "uy") &&
+              strchr(r.err, '\n') == strrchr(r.err, '\n'),
+          "--method event: exit %d, %s", r.status, r.err);
+    pd_test_proc_free(&r);
+    pd_test_pound(ctx, pi3, &r);
+    CHECK(ctx, r.status == 2 && r.err && strstr(r.err, "Pi3"), "--Pi3: exit %d, %s", r.status,
+          r.err);
+    pd_test_proc_free(&r);
+}
+
 void suite_yield_scene(pd_test_ctx *ctx)
 {
+    PD_RUN(ctx, test_yield_scene_cli);
     PD_RUN(ctx, test_yield_scene_example);
     PD_RUN(ctx, test_yield_scene_unreached_is_elastic);
     PD_RUN(ctx, test_yield_scene_row_converges);
