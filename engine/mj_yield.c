@@ -129,8 +129,8 @@ static int grow(pd_mj *mj, const pd_state *out, double hth, int *ny)
 }
 
 /* The LCP of the contacts idx_active (nI) and the springs Y (ny), dense
- * into y->L (column-major), y->b. */
-static void build(pd_mj *mj, const pd_factor *f, int nI, int ny, double hth)
+ * into y->L (column-major), y->b; q1 = q + h (1 - theta) v. */
+static void build(pd_mj *mj, const pd_factor *f, int nI, int ny, double hth, const double *q1)
 {
     const pd_model *md = mj->model;
     mj_yield *y = mj->yl;
@@ -163,10 +163,9 @@ static void build(pd_mj *mj, const pd_factor *f, int nI, int ny, double hth)
             y->L[(size_t)(nI + k) * N + nI + l] =
                 (l == k ? md->ks[jl] : 0.0) - hth * hth * y->sigma[jl] * sk * md->ks[jl] * ks * d;
         }
-        /* ks (uy - sigma z_free), z_free the end state with the free velocity
-         * (mj->qtheta holds q + h (1 - theta) v in this step) */
+        /* ks (uy - sigma z_free), z_free the end state with the free velocity */
         y->b[nI + k] =
-            ks * (md->uy[j] - sk * (pd_matrix_col_dot(&md->S, j, mj->qtheta) +
+            ks * (md->uy[j] - sk * (pd_matrix_col_dot(&md->S, j, q1) +
                                     hth * pd_matrix_col_dot(&md->S, j, y->vfree) - y->up[j]));
     }
 }
@@ -199,8 +198,6 @@ int mj_yield_step(pd_mj *mj, const pd_factor *f, double h, int nI, double t1, pd
     double hth = h * mj->opts.theta;
     int rc, ny = 0;
     memcpy(y->vfree, out->v, (size_t)md->n * sizeof(double));
-    /* q + h (1 - theta) v for the trial's z (out->q holds it) */
-    memcpy(mj->qtheta, out->q, (size_t)md->n * sizeof(double));
     memset(y->sigma, 0, (size_t)md->ns);
     /* the elastic step first: the contacts alone */
     if (nI > 0 && (rc = mj_contacts_apply(mj, f, nI, t1, out, err)))
@@ -212,7 +209,7 @@ int mj_yield_step(pd_mj *mj, const pd_factor *f, double h, int nI, double t1, pd
                               "Moreau-Jean: %d contacts and %d sliding springs at t = %.9g (at "
                               "most %d in one LCP, %d rounds)",
                               nI, ny, t1, MJY_CAP, md->ns + 1);
-        build(mj, f, nI, ny, hth);
+        build(mj, f, nI, ny, hth, out->q); /* out->q: q + h (1 - theta) v until the step ends */
         pd_lcp_opts lo = pd_lcp_default_opts();
         pd_lcp_info info;
         if ((rc = pd_lcp_lemke(y->lemke, N, y->L, y->b, &lo, y->z, y->w, &info)))

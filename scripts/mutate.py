@@ -58,6 +58,9 @@ DEFAULT_FILES = {
     "problems/demand.c": ["demand", "aabs"],
     "problems/scene_measure.c": ["measure", "general_history", "other_grid", "compare",
                                  "converge"],
+    "engine/event_sdof.c": ["yield_rk", "yield_exact", "event", "reference"],
+    "engine/penalty_newmark.c": ["yield_newmark", "newmark", "yield_mj", "penalty"],
+    "engine/mj_yield.c": ["yield_mj", "yield_scene", "yield"],
 }
 
 # Array indices checked against the arrays' sizes (a trap, no runtime

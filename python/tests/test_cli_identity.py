@@ -205,6 +205,31 @@ def test_simulate_yielding(cli, same, tmp_path, extra, kw):
     assert "up" not in pound.simulate(every=50).history  # an elastic run's history has none
 
 
+@pytest.mark.parametrize("method", ["newmark", "event"])
+def test_simulate_yielding_methods(cli, same, method):
+    """A yielding oscillator by newmark (Newton's failures reported, 0 here)
+    and by the exact reference (its energy balance), as the CLI's."""
+    js = cli("simulate", "--Piy", "0.2", "--alpha", "0.1", "--Pi3", "0.1", "--method", method)
+    r = pound.simulate(Piy=0.2, alpha=0.1, Pi3=0.1, method=method, history=False)
+    same(r, js)
+    assert js["newton_failures"] == 0 and r.newton_failures == 0
+    if method == "event":  # the exact reference's balance closes to rounding
+        assert abs(r.energy_residual) < 1e-12
+
+
+@pytest.mark.parametrize("method", ["moreau", "newmark"])
+def test_scene_yielding(cli, same, method):
+    """A scene with yielding storeys: per storey ductility, residual,
+    plastic excursion and onsets, as the CLI's; an elastic storey's NaN."""
+    f = EXAMPLES / "scenes" / "yielding-buildings.json"
+    r = pound.simulate_scene(f, method=method, history=False)
+    same(r, cli("simulate", "--scene", f, "--method", method))
+    soft = r.structures[0]
+    assert soft.ductility[0] > 1.5 and soft.n_yield[0] > 0 and soft.residual[1] == 0.0
+    with pytest.raises(pound.InputError, match="uy"):
+        pound.simulate_scene(f, method="event", history=False)
+
+
 @pytest.mark.parametrize("kw,named", [
     (dict(Piy=-1), "Piy"), (dict(uy=0.01, Piy=1), "alternatives"), (dict(alpha=0.2), "uy or Piy"),
     (dict(Piy=1, alpha=0.002, method="event"), "moreau"), (dict(Piy=1, rtol=1e-3), "tolerance"),
