@@ -24,6 +24,8 @@
 #define SCENE_MIN_STEPS 100
 #define SCENE_PI3 0.01
 #define SCENE_TARGET 5e6 /* DOF-steps per second at N = 10^4 */
+/* the yielding rows' uy / Le: most springs sliding in a step, few */
+static const double SCENE_PIY[2] = {0.5, 2.0};
 
 /* One row's figures. */
 typedef struct chain_case {
@@ -31,11 +33,36 @@ typedef struct chain_case {
     long steps;
     double ns_per_dof_step, wall_ns_per_dof_step; /* CPU, wall */
     double active_fraction, lcp_iterations;
+    double sliding_fraction; /* yielding: the share of springs that slide in a step */
     const char *factor, *lcp_solver;
 } chain_case;
 
-/* Time a chain of N; 1 on failure (message on stderr). */
-static int time_chain(int N, chain_case *cc)
+/* The share of the springs whose offset moves in each of SCENE_SLIDE_STEPS
+ * more steps (untimed). */
+#define SCENE_SLIDE_STEPS 200
+static int slide_share(pd_mj *mj, int ns, double *share, pd_err *err)
+{
+    double *prev = malloc((size_t)ns * sizeof(double));
+    long moved = 0;
+    int rc = prev ? PD_OK : PD_ENOMEM;
+    if (prev)
+        memcpy(prev, pd_mj_state(mj)->up, (size_t)ns * sizeof(double));
+    for (int s = 0; s < SCENE_SLIDE_STEPS && !rc; s++) {
+        rc = pd_mj_step(mj, err);
+        const double *up = pd_mj_state(mj)->up;
+        for (int j = 0; j < ns && !rc; j++) {
+            moved += up[j] != prev[j];
+            prev[j] = up[j];
+        }
+    }
+    *share = (double)moved / ((double)SCENE_SLIDE_STEPS * (double)ns);
+    free(prev);
+    return rc;
+}
+
+/* Time a chain of N (every SDOF yielding with uy = Piy Le when Piy > 0,
+ * alpha 0.05); 1 on failure (message on stderr). */
+static int time_chain(int N, double Piy, chain_case *cc)
 {
     pd_scene_excitation exc = {.pulse = PD_PULSE_HARMONIC, .dir = 1, .ap = 1.0, .Tp = 1.0};
     double wp = 2.0 * PD_PI / exc.Tp, gap = SCENE_PI3 * exc.ap / (wp * wp);
@@ -47,6 +74,7 @@ static int time_chain(int N, chain_case *cc)
     memset(cc, 0, sizeof *cc);
     cc->N = N;
     if (pd_scene_chain(N, &exc, 1.0, 1.5, 0.05, gap, 0.0, &sc, &err) ||
+        (Piy > 0.0 && pd_scene_yield_every(sc, Piy * exc.ap / (wp * wp), 0.05, &err)) ||
         pd_scene_model_build(sc, 1, &sm, &err))
         goto done;
     built = 1;
@@ -76,6 +104,8 @@ static int time_chain(int N, chain_case *cc)
     cc->active_fraction = (double)active / ((double)steps * (double)sm.model.m);
     cc->lcp_iterations = (double)iterations / (double)steps;
     cc->factor = pd_mj_factor_name(mj);
+    if (Piy > 0.0 && slide_share(mj, sm.model.ns, &cc->sliding_fraction, &err))
+        goto done;
     rc = 0;
 done:
     if (rc)
@@ -258,7 +288,15 @@ int pd_bench_scene(pd_json *js)
     chain_case cc[NSIZES];
     int rc = 0;
     for (int k = 0; k < NSIZES; k++)
-        rc |= time_chain(sizes[k], &cc[k]);
+        rc |= time_chain(sizes[k], 0.0, &cc[k]);
+    /* yielding (every SDOF, Piy SCENE_PIY): the cost per DOF-step against the
+     * elastic row's of 10^4 (goal: at most 1.5x) */
+    chain_case yc[2];
+    double yratio[2];
+    for (int k = 0; k < 2; k++) {
+        rc |= time_chain(10000, SCENE_PIY[k], &yc[k]);
+        yratio[k] = yc[k].ns_per_dof_step / cc[3].ns_per_dof_step;
+    }
     double ow[4] = {0.0, 0.0, 0.0, 0.0}; /* one wall: scene, oscillator; CPU, wall */
     rc |= one_wall(ow);
     double expo = growth(cc, NSIZES, 1000, 100000);
@@ -286,6 +324,19 @@ int pd_bench_scene(pd_json *js)
             pd_json_num(js, "active_fraction", cc[k].active_fraction);
             pd_json_num(js, "lcp_iterations_per_step", cc[k].lcp_iterations);
             pd_json_str(js, "factor", cc[k].factor ? cc[k].factor : "?");
+            pd_json_end_object(js);
+        }
+        pd_json_end_array(js);
+        pd_json_begin_array(js, "yielding_chains");
+        for (int k = 0; k < 2; k++) {
+            pd_json_begin_object(js, NULL);
+            pd_json_int(js, "N", yc[k].N);
+            pd_json_num(js, "Piy", SCENE_PIY[k]);
+            pd_json_num(js, "ns_per_dof_step", yc[k].ns_per_dof_step);
+            pd_json_num(js, "wall_ns_per_dof_step", yc[k].wall_ns_per_dof_step);
+            pd_json_num(js, "sliding_fraction", yc[k].sliding_fraction);
+            pd_json_num(js, "active_fraction", yc[k].active_fraction);
+            pd_json_num(js, "ratio_to_elastic", yratio[k]);
             pd_json_end_object(js);
         }
         pd_json_end_array(js);
@@ -331,6 +382,12 @@ int pd_bench_scene(pd_json *js)
         printf("  growth exponent of the time per step, N = 1e3 ... 1e5: %.3f (goal <= 1.2); "
                "goal %.0e DOF-steps/s at N = 1e4\n",
                expo, SCENE_TARGET);
+        for (int k = 0; k < 2; k++)
+            printf("  yielding (every SDOF, Piy %g, alpha 0.05), N = %d: %.1f ns/DOF-step, %.2fx "
+                   "the elastic row's (goal <= 1.5x); %.1f%% of the springs slide in a step, "
+                   "%.1f%% of the contacts in the LCP\n",
+                   SCENE_PIY[k], yc[k].N, yc[k].ns_per_dof_step, yratio[k],
+                   100.0 * yc[k].sliding_fraction, 100.0 * yc[k].active_fraction);
         printf("  one-wall scene %.4g steps/s, the oscillator %.4g steps/s: ratio %.3f (CPU; wall "
                "%.4g and %.4g)\n",
                ow[0], ow[1], ow[0] / ow[1], ow[2], ow[3]);

@@ -17,7 +17,8 @@ const char pd_cli_case_help[] =
     "  --height H  the oscillator's storey height, m, for its drift ratio [3]\n"
     "  --uy U  yield displacement, m  or  --Piy X = uy wp^2/ap [none: elastic]\n"
     "  --alpha A  post-yield stiffness ratio in [0,1] [0] (a yielding oscillator runs by\n"
-    "           event or moreau; docs/methods.md, \"Yielding oscillators\")\n"
+    "           event, moreau or newmark; with --chain every SDOF yields: moreau or\n"
+    "           newmark; docs/methods.md, \"Yielding oscillators\")\n"
     "records (docs/records.md):\n"
     "  --record F    the ground acceleration of a record (PEER .AT2, COSMOS V2, or text\n"
     "                't a'): replaces the pulse; ap and Tp come from its fitted pulse\n"
@@ -410,10 +411,6 @@ static int check_yield(const pd_cli_case *a)
         return a->have_alpha ? pd_cli_usage_error("--alpha: needs the yield displacement "
                                                   "(--uy or --Piy)")
                              : 0;
-    if (a->chain)
-        return pd_cli_usage_error("%s: a --chain's SDOFs are elastic (a yielding row is not "
-                                  "built yet)",
-                                  yf);
     if (a->opts.method == PD_METHOD_EVENT && !pd_osc_yield_exact(&a->c))
         return pd_cli_usage_error("%s: the exact reference models a yielding spring whose "
                                   "sliding phase is underdamped, --xi < sqrt(--alpha) (or --xi "
@@ -720,6 +717,8 @@ int pd_cli_scene(const pd_cli_case *a, pd_scene **sc)
             .pulse = a->c.pulse, .dir = a->c.dir, .ap = a->c.ap, .Tp = a->c.Tp};
         rc = pd_scene_chain(a->chain, &x, pd_osc_T0(&a->c), a->chain_ratio, a->c.xi,
                             pd_osc_gap(&a->c), a->c.eps, sc, &err);
+        if (!rc && pd_osc_yields(&a->c)) /* --uy or --Piy: every SDOF yields */
+            rc = pd_scene_yield_every(*sc, pd_osc_uy(&a->c), a->c.alpha, &err);
     }
     if (rc == PD_ENOMEM) {
         fprintf(stderr, "pound: %s\n", err.msg);

@@ -47,6 +47,7 @@ pd_mj_opts pd_mj_default_opts(void)
                         .max_level = PD_MJ_MAX_LEVEL, /* finest step h 2^-48 */
                         .max_evals = 1e9,
                         .sim_gap = 1e-10,
+                        .yield_lcp_max = 0,
                         .pieces = NULL};
 }
 
@@ -106,6 +107,9 @@ int pd_mj_check_opts(const pd_mj_opts *o, pd_err *err)
     if (!(o->rtol >= 0.0 && o->rtol < 1.0))
         return pd_err_set(err, PD_EINVAL, "rtol must be in [0, 1) (0: fixed steps; got %g)",
                           o->rtol);
+    if (o->yield_lcp_max < 0)
+        return pd_err_set(err, PD_EINVAL, "yield_lcp_max must be >= 0 (0: 512; got %d)",
+                          o->yield_lcp_max);
     /* the adaptive driver's options, read only when it runs */
     if (o->rtol > 0.0) {
         if (!(o->atol > 0.0) || !isfinite(o->atol))

@@ -13,10 +13,21 @@
  *   Y       the springs the step pushes past +-uy: first the contacts alone
  *           (the elastic step), then Y and the contacts together, Y grown
  *           (or a side turned) while a solve leaves a spring past uy
+ *   pieces  blocks of dofs that M, C, K couple, joined by the active
+ *           contacts: a spring alone in a piece of one dof and no contact
+ *           slides in closed form (G = max(0, -b / L), its 1 x 1 LCP); the
+ *           others' pieces, with their contacts, make one dense LCP (the
+ *           contacts outside keep the elastic pass's impulses: What is
+ *           block diagonal, the pieces do not interact); a piece beyond
+ *           MJY_CAP unknowns whose springs are each alone on a dof (a jammed
+ *           row of SDOFs) is solved by block Gauss-Seidel: the contacts' LCP
+ *           (the kernel's own solver) given the slides, each slide in closed
+ *           form given the contacts, until no slide moves (MJY_GS_TOL)
  *   up     += sigma G
  * When no spring passes uy the step is the elastic one, bit for bit (and
  * with every offset 0 nothing is added to the force).  Memory: the LCP of
- * at most MJY_CAP unknowns, dense, and a few vectors, taken with the object. */
+ * at most MJY_CAP unknowns, dense, and vectors of n, m, ns, taken with the
+ * object. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -24,19 +35,35 @@
 #include "mj.h"
 #include "pd_alloc.h"
 
-#define MJY_CAP 512     /* contacts and sliding springs in one LCP at most */
-#define MJY_SLACK 1e-10 /* a spring past uy by more than this share of it joins Y */
+#define MJY_CAP 512      /* contacts and sliding springs in one LCP at most */
+#define MJY_GS_MAX 200   /* block Gauss-Seidel sweeps of a larger piece at most */
+#define MJY_GS_TOL 1e-13 /* ... until no slide moves by more than this share of its uy */
+#define MJY_SLACK 1e-10  /* a spring past uy by more than this share of it joins Y */
 
 struct mj_yield {
     int ns;
     double *up;            /* ns: the offsets (the state's st.up) */
-    double *vfree;         /* n: the step's free velocity */
+    double *vfree, *vel;   /* n: the step's free velocity, the elastic pass's */
     double *col;           /* n: What^-1 S_j, or a sum of columns */
     int *ys;               /* ns: Y, in order of joining */
     signed char *sigma;    /* ns: the side of each spring in Y (0: not in Y) */
-    double *L, *b, *z, *w; /* the LCP: MJY_CAP^2, MJY_CAP each */
+    double *G;             /* ns: each spring's slide in the last solve */
+    double *L, *b, *z, *w; /* the dense LCP: MJY_CAP^2, MJY_CAP each */
     pd_lcp_work *lemke;
-    long rounds; /* the LCPs solved with springs (statistics) */
+    /* the pieces: dofs coupled by M, C, K (block, fixed), joined by contacts */
+    int *block;           /* n: the block's first dof */
+    double *dM, *dC, *dK; /* n: the diagonals (What of a one-dof block) */
+    unsigned char *alone; /* n: the dof is a block of its own */
+    int *uf;              /* n: union-find of the step's pieces */
+    unsigned char *mark;  /* n, by piece: 1 has a contact, 2 a coupled spring */
+    int *cidx;            /* m: the contacts of the coupled pieces */
+    double *P0, *dP;      /* m: the elastic pass's impulses, the change */
+    int *yc;              /* ns: the coupled springs of Y */
+    int all_alone;        /* every spring alone on its dof (rows of SDOFs) */
+    int ny_prev;          /* Y's springs that slid in the last step (Gauss-Seidel's start) */
+    int *sdof;            /* ns: a spring's only dof (-1: its drift takes several) */
+    double *sfac;         /* ns: its drift's multiple of that dof */
+    long rounds;          /* the LCPs solved with springs (statistics) */
 };
 
 void mj_yield_free(pd_mj *mj)
@@ -44,11 +71,11 @@ void mj_yield_free(pd_mj *mj)
     mj_yield *y = mj->yl;
     if (!y)
         return;
-    free(y->up);
-    free(y->vfree);
-    free(y->col);
-    free(y->ys);
-    free(y->sigma);
+    void *arrays[] = {y->sdof,  y->sfac, y->up,    y->vfree, y->vel, y->col, y->ys,
+                      y->sigma, y->G,    y->block, y->dM,    y->dC,  y->dK,  y->alone,
+                      y->uf,    y->mark, y->cidx,  y->P0,    y->dP,  y->yc};
+    for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
+        free(arrays[k]);
     free(y->L);
     free(y->b);
     free(y->z);
@@ -56,6 +83,52 @@ void mj_yield_free(pd_mj *mj)
     pd_lcp_free(y->lemke);
     free(y);
     mj->yl = NULL;
+}
+
+/* The root of dof i's piece (path halving). */
+static int find(int *uf, int i)
+{
+    while (uf[i] != i)
+        i = uf[i] = uf[uf[i]];
+    return i;
+}
+
+/* The blocks of dofs M, C, K couple (union-find over their off-diagonal
+ * entries), and each dof's diagonal entries. */
+static void blocks(mj_yield *y, const pd_model *md)
+{
+    const pd_matrix *A[3] = {&md->M, &md->C, &md->K};
+    double *diag[3] = {y->dM, y->dC, y->dK};
+    for (int i = 0; i < md->n; i++) {
+        y->uf[i] = i;
+        y->alone[i] = 1;
+    }
+    for (int k = 0; k < 3; k++)
+        for (int j = 0; j < md->n; j++) {
+            int p = -1, i;
+            double v;
+            while (mj_col_next(A[k], j, &p, &i, &v)) {
+                if (i == j)
+                    diag[k][j] += v;
+                else if (v != 0.0) {
+                    y->alone[i] = y->alone[j] = 0;
+                    y->uf[find(y->uf, i)] = find(y->uf, j);
+                }
+            }
+        }
+    for (int i = 0; i < md->n; i++)
+        y->block[i] = find(y->uf, i);
+}
+
+/* Spring j's only dof (its drift a multiple s of one dof), or -1. */
+static int spring_dof(const pd_model *md, int j, double *s)
+{
+    int p = -1, i, i2;
+    double v, v2;
+    if (!mj_col_next(&md->S, j, &p, &i, &v) || mj_col_next(&md->S, j, &p, &i2, &v2))
+        return -1;
+    *s = v;
+    return i;
 }
 
 int mj_yield_alloc(pd_mj *mj, pd_err *err)
@@ -67,27 +140,53 @@ int mj_yield_alloc(pd_mj *mj, pd_err *err)
     if (!y)
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for %d yielding springs", ns);
     y->ns = ns;
+    int m = md->m;
     y->up = pd_calloc(ns, sizeof(double));
     y->vfree = pd_calloc(n, sizeof(double));
+    y->vel = pd_calloc(n, sizeof(double));
     y->col = pd_calloc(n, sizeof(double));
     y->ys = pd_calloc(ns, sizeof(int));
     y->sigma = pd_calloc(ns, 1);
+    y->G = pd_calloc(ns, sizeof(double));
+    y->block = pd_calloc(n, sizeof(int));
+    y->dM = pd_calloc(n, sizeof(double));
+    y->dC = pd_calloc(n, sizeof(double));
+    y->dK = pd_calloc(n, sizeof(double));
+    y->alone = pd_calloc(n, 1);
+    y->uf = pd_calloc(n, sizeof(int));
+    y->mark = pd_calloc(n, 1);
+    y->cidx = pd_calloc(m, sizeof(int));
+    y->P0 = pd_calloc(m, sizeof(double));
+    y->dP = pd_calloc(m, sizeof(double));
+    y->yc = pd_calloc(ns, sizeof(int));
+    y->sdof = pd_calloc(ns, sizeof(int));
+    y->sfac = pd_calloc(ns, sizeof(double));
     y->L = pd_malloc((long)MJY_CAP * MJY_CAP, sizeof(double));
     y->b = pd_malloc(MJY_CAP, sizeof(double));
     y->z = pd_malloc(MJY_CAP, sizeof(double));
     y->w = pd_malloc(MJY_CAP, sizeof(double));
     y->lemke = pd_lcp_alloc(MJY_CAP);
-    if (!y->up || !y->vfree || !y->col || !y->ys || !y->sigma || !y->L || !y->b || !y->z || !y->w ||
-        !y->lemke)
+    if (!y->up || !y->vfree || !y->vel || !y->col || !y->ys || !y->sigma || !y->G || !y->block ||
+        !y->dM || !y->dC || !y->dK || !y->alone || !y->uf || !y->mark || !y->cidx || !y->P0 ||
+        !y->sdof || !y->sfac || !y->dP || !y->yc || !y->L || !y->b || !y->z || !y->w || !y->lemke)
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for %d yielding springs", ns);
+    blocks(y, md);
+    y->all_alone = 1;
+    for (int j = 0; j < ns; j++) {
+        y->sdof[j] = spring_dof(md, j, &y->sfac[j]);
+        y->all_alone &= y->sdof[j] >= 0 && y->alone[y->sdof[j]];
+    }
     mj->st.up = y->up;
     return PD_OK;
 }
 
 void mj_yield_reset(pd_mj *mj)
 {
-    if (mj->yl)
-        memset(mj->yl->up, 0, (size_t)mj->yl->ns * sizeof(double));
+    if (!mj->yl)
+        return;
+    memset(mj->yl->up, 0, (size_t)mj->yl->ns * sizeof(double));
+    memset(mj->yl->sigma, 0, (size_t)mj->yl->ns);
+    mj->yl->ny_prev = 0;
 }
 
 /* x += s S diag(ks) up (skipped for a zero offset: an elastic step's bits). */
@@ -115,7 +214,10 @@ static int grow(pd_mj *mj, const pd_state *out, double hth, int *ny)
     mj_yield *y = mj->yl;
     int changed = 0;
     for (int j = 0; j < md->ns; j++) {
-        double zj = z_end(mj, out, hth, j), lim = md->uy[j] * (1.0 + MJY_SLACK);
+        int i = y->sdof[j]; /* one dof: z+ without a walk of S */
+        double zj = i >= 0 ? y->sfac[j] * (out->q[i] + hth * out->v[i]) - y->up[j]
+                           : z_end(mj, out, hth, j),
+               lim = md->uy[j] * (1.0 + MJY_SLACK);
         /* a member's z+ is sigma uy at most; beyond -sigma uy it turns */
         int side = zj > lim ? 1 : zj < -lim ? -1 : 0;
         if (side == 0 || side == y->sigma[j])
@@ -123,71 +225,226 @@ static int grow(pd_mj *mj, const pd_state *out, double hth, int *ny)
         if (y->sigma[j] == 0)
             y->ys[(*ny)++] = j;
         y->sigma[j] = (signed char)side;
+        y->G[j] = 0.0;
         changed = 1;
     }
     return changed;
 }
 
-/* The LCP of the contacts idx_active (nI) and the springs Y (ny), dense
- * into y->L (column-major), y->b; q1 = q + h (1 - theta) v. */
-static void build(pd_mj *mj, const pd_factor *f, int nI, int ny, double hth, const double *q1)
+/* The pieces of the step: the blocks joined by the active contacts; mark
+ * bit 1: a contact in the piece, 4: a spring of Y on it, 8: two or more. */
+static void pieces(const pd_mj *mj, int nI)
 {
     const pd_model *md = mj->model;
     mj_yield *y = mj->yl;
-    int N = nI + ny;
-    /* contacts: D_II (written at ld nI, then widened to ld N in place, back
-     * to front: no entry is overwritten before it moves) and W_I^T vfree + e U */
-    if (nI > 0) {
-        pd_factor_delassus_dense(f, mj->idx_active, nI, y->L);
-        for (int c = nI - 1; c >= 0; c--)
-            for (int r = nI - 1; r >= 0; r--)
-                y->L[(size_t)c * N + r] = y->L[(size_t)c * nI + r];
-        mj_active_rhs(mj, nI, y->vfree);
-        memcpy(y->b, mj->b_active, (size_t)nI * sizeof(double));
+    for (int i = 0; i < md->n; i++) {
+        y->uf[i] = y->block[i];
+        y->mark[i] = 0;
+    }
+    for (int c = 0; c < nI; c++) {
+        int a = mj->idx_active[c], p = -1, i, first = -1;
+        double v;
+        while (mj_col_next(&md->W, a, &p, &i, &v))
+            if (first < 0)
+                first = find(y->uf, i);
+            else
+                y->uf[find(y->uf, i)] = first;
+    }
+    for (int c = 0; c < nI; c++) {
+        int p = -1, i;
+        double v;
+        if (mj_col_next(&md->W, mj->idx_active[c], &p, &i, &v))
+            y->mark[find(y->uf, i)] |= 1;
+    }
+}
+
+/* Y split: the springs alone on a one-dof piece without a contact (closed
+ * form) and the coupled ones (y->yc, *nyc), and the contacts of the coupled
+ * springs' pieces (y->cidx, *nc, increasing as idx_active). */
+static void classify(pd_mj *mj, int nI, int ny, int *nyc, int *nc)
+{
+    const pd_model *md = mj->model;
+    mj_yield *y = mj->yl;
+    double s;
+    for (int k = 0; k < ny; k++) { /* how many springs of Y on each piece */
+        int j = y->ys[k], i = spring_dof(md, j, &s), p = -1, r;
+        if (i < 0 && !mj_col_next(&md->S, j, &p, &i, &s))
+            continue; /* no entry: it cannot slide */
+        r = find(y->uf, i);
+        y->mark[r] |= y->mark[r] & 4 ? 8 : 4;
+    }
+    *nyc = *nc = 0;
+    for (int k = 0; k < ny; k++) {
+        int j = y->ys[k], i = spring_dof(md, j, &s);
+        if (i >= 0 && y->alone[i] && y->mark[find(y->uf, i)] == 4)
+            continue; /* alone: the closed form */
+        y->yc[(*nyc)++] = j;
+        int p = -1;
+        double v;
+        while (mj_col_next(&md->S, j, &p, &i, &v))
+            y->mark[find(y->uf, i)] |= 2;
+    }
+    for (int c = 0; c < nI; c++) {
+        int p = -1, i;
+        double v;
+        if (mj_col_next(&md->W, mj->idx_active[c], &p, &i, &v) && y->mark[find(y->uf, i)] & 2)
+            y->cidx[(*nc)++] = mj->idx_active[c];
+    }
+}
+
+/* The dense LCP of the coupled contacts (nc) and springs (nyc) into y->L
+ * (column-major), y->b; q1 = q + h (1 - theta) v. */
+static void build(pd_mj *mj, const pd_factor *f, int nc, int nyc, double hth, const double *q1)
+{
+    const pd_model *md = mj->model;
+    mj_yield *y = mj->yl;
+    int N = nc + nyc;
+    /* contacts: D_CC (written at ld nc, then widened to ld N in place, back
+     * to front: no entry is overwritten before it moves) and W_C^T vfree + e U */
+    if (nc > 0) {
+        pd_factor_delassus_dense(f, y->cidx, nc, y->L);
+        for (int c = nc - 1; c >= 0; c--)
+            for (int r = nc - 1; r >= 0; r--)
+                y->L[(size_t)c * N + r] = y->L[(size_t)c * nc + r];
+        for (int c = 0; c < nc; c++) {
+            int a = y->cidx[c];
+            y->b[c] = pd_matrix_col_dot(&md->W, a, y->vfree) + md->e[a] * mj->U0[a];
+        }
     }
     /* each spring k: the column What^-1 S_j gives its couplings */
-    for (int k = 0; k < ny; k++) {
-        int j = y->ys[k];
+    for (int k = 0; k < nyc; k++) {
+        int j = y->yc[k];
         double sk = y->sigma[j], ks = md->ks[j];
         memset(y->col, 0, (size_t)md->n * sizeof(double));
         pd_matrix_col_axpy(&md->S, j, 1.0, y->col);
         pd_factor_solve(f, y->col);
-        for (int c = 0; c < nI; c++) { /* P's velocity on z, G's on the contacts */
-            double d = hth * sk * ks * pd_matrix_col_dot(&md->W, mj->idx_active[c], y->col);
-            y->L[(size_t)(nI + k) * N + c] = d;
-            y->L[(size_t)c * N + nI + k] = -d;
+        for (int c = 0; c < nc; c++) { /* P's velocity on z, G's on the contacts */
+            double d = hth * sk * ks * pd_matrix_col_dot(&md->W, y->cidx[c], y->col);
+            y->L[(size_t)(nc + k) * N + c] = d;
+            y->L[(size_t)c * N + nc + k] = -d;
         }
-        for (int l = 0; l < ny; l++) { /* row l (spring jl) of column k, scaled by ks_jl */
-            int jl = y->ys[l];
+        for (int l = 0; l < nyc; l++) { /* row l (spring jl) of column k, scaled by ks_jl */
+            int jl = y->yc[l];
             double d = pd_matrix_col_dot(&md->S, jl, y->col);
-            y->L[(size_t)(nI + k) * N + nI + l] =
+            y->L[(size_t)(nc + k) * N + nc + l] =
                 (l == k ? md->ks[jl] : 0.0) - hth * hth * y->sigma[jl] * sk * md->ks[jl] * ks * d;
         }
         /* ks (uy - sigma z_free), z_free the end state with the free velocity */
-        y->b[nI + k] =
+        y->b[nc + k] =
             ks * (md->uy[j] - sk * (pd_matrix_col_dot(&md->S, j, q1) +
                                     hth * pd_matrix_col_dot(&md->S, j, y->vfree) - y->up[j]));
     }
 }
 
-/* v+ = vfree + What^-1 (W_I P + h theta S_Y ks sigma G); out->P the
- * contacts' impulses. */
-static void apply(pd_mj *mj, const pd_factor *f, int nI, int ny, double hth, pd_state *out)
+/* The dense LCP's answer on out: the coupled contacts' impulses (their
+ * change from the elastic pass's through What^-1 W), the coupled springs'
+ * slides through What^-1 S ks sigma G. */
+static void apply(pd_mj *mj, const pd_factor *f, int nc, int nyc, double hth, pd_state *out)
 {
     const pd_model *md = mj->model;
     mj_yield *y = mj->yl;
-    memcpy(out->v, y->vfree, (size_t)md->n * sizeof(double));
-    for (int c = 0; c < nI; c++)
-        out->P[mj->idx_active[c]] = mj->P_active[c] = y->z[c];
-    pd_factor_add_impulse(f, mj->idx_active, nI, mj->P_active, out->v);
+    for (int c = 0; c < nc; c++) {
+        int a = y->cidx[c];
+        y->dP[c] = y->z[c] - out->P[a];
+        out->P[a] = y->z[c];
+    }
+    pd_factor_add_impulse(f, y->cidx, nc, y->dP, out->v);
     memset(y->col, 0, (size_t)md->n * sizeof(double));
-    for (int k = 0; k < ny; k++) {
-        int j = y->ys[k];
-        pd_matrix_col_axpy(&md->S, j, hth * y->sigma[j] * md->ks[j] * y->z[nI + k], y->col);
+    for (int k = 0; k < nyc; k++) {
+        int j = y->yc[k];
+        y->G[j] = y->z[nc + k];
+        pd_matrix_col_axpy(&md->S, j, hth * y->sigma[j] * md->ks[j] * y->G[j], y->col);
     }
     pd_factor_solve(f, y->col);
     for (int i = 0; i < md->n; i++)
         out->v[i] += y->col[i];
+}
+
+/* The springs alone on their dof (classify's others): the 1 x 1 LCP
+ * G = max(0, -b / L), L = ks (1 - (h theta)^2 ks s^2 / What_ii), in closed
+ * form, on out->v[i] (= vfree: no contact in its piece). */
+static void slide_alone(pd_mj *mj, int ny, double hth, pd_state *out)
+{
+    const pd_model *md = mj->model;
+    mj_yield *y = mj->yl;
+    for (int k = 0; k < ny; k++) {
+        int j = y->ys[k];
+        double s, ks = md->ks[j];
+        int i = spring_dof(md, j, &s);
+        if (i < 0 || !y->alone[i] || y->mark[find(y->uf, i)] != 4)
+            continue;
+        double what = y->dM[i] + hth * (y->dC[i] + hth * y->dK[i]);
+        double z = s * (out->q[i] + hth * y->vfree[i]) - y->up[j];
+        double L = ks - hth * hth * ks * ks * s * s / what, b = ks * (md->uy[j] - y->sigma[j] * z);
+        y->G[j] = b < 0.0 ? -b / L : 0.0;
+        out->v[i] = y->vfree[i] + hth * y->sigma[j] * ks * s * y->G[j] / what;
+    }
+}
+
+/* Spring j alone on its dof: i, s and What_ii, or -1. */
+static int alone_dof(const mj_yield *y, int j, double hth, double *s, double *what)
+{
+    int i = y->sdof[j];
+    *s = y->sfac[j];
+    if (i < 0 || !y->alone[i])
+        return -1;
+    *what = y->dM[i] + hth * (y->dC[i] + hth * y->dK[i]);
+    return i;
+}
+
+/* 1 when every spring of Y is alone on its dof (block Gauss-Seidel's case). */
+static int all_alone(const pd_mj *mj, int ny, double hth)
+{
+    double s, what;
+    for (int k = 0; k < ny; k++)
+        if (alone_dof(mj->yl, mj->yl->ys[k], hth, &s, &what) < 0)
+            return 0;
+    return 1;
+}
+
+/* Block Gauss-Seidel over the springs (each alone on its dof) and the
+ * active contacts, from out->v = vfree with the slides G of Y: the
+ * contacts' LCP given the slides' velocity, then each slide in closed form
+ * given the contacts' and the others' velocity; a spring left past uy joins
+ * Y (G = 0); until no slide moves by MJY_GS_TOL of its uy and none joins.
+ * With Y empty the first sweep is the elastic step, bit for bit. */
+static int slide_gs(pd_mj *mj, const pd_factor *f, int nI, int *ny, double hth, double t1,
+                    pd_state *out, pd_err *err)
+{
+    const pd_model *md = mj->model;
+    mj_yield *y = mj->yl;
+    double s, what;
+    int rc;
+    for (int it = 0; it < MJY_GS_MAX; it++) {
+        if (it > 0 || *ny > 0) { /* the slides' velocity on vfree */
+            memcpy(out->v, y->vfree, (size_t)md->n * sizeof(double));
+            for (int k = 0; k < *ny; k++) {
+                int j = y->ys[k], i = alone_dof(y, j, hth, &s, &what);
+                out->v[i] += hth * y->sigma[j] * md->ks[j] * s * y->G[j] / what;
+            }
+        }
+        if (nI > 0 && (rc = mj_contacts_apply(mj, f, nI, t1, out, err)))
+            return rc;
+        double moved = 0.0;
+        for (int k = 0; k < *ny; k++) { /* each slide given the rest */
+            int j = y->ys[k], i = alone_dof(y, j, hth, &s, &what);
+            double ks = md->ks[j], inc = hth * y->sigma[j] * ks * s / what;
+            double vi = out->v[i] - inc * y->G[j]; /* without its own slide */
+            double z = s * (out->q[i] + hth * vi) - y->up[j];
+            double L = ks - hth * hth * ks * ks * s * s / what,
+                   b = ks * (md->uy[j] - y->sigma[j] * z);
+            double G = b < 0.0 ? -b / L : 0.0;
+            moved = fmax(moved, fabs(G - y->G[j]) / md->uy[j]);
+            y->G[j] = G;
+            out->v[i] = vi + inc * G;
+        }
+        if (!grow(mj, out, hth, ny) && moved <= MJY_GS_TOL)
+            return PD_OK;
+    }
+    return pd_err_set(err, PD_ENUMERICAL,
+                      "Moreau-Jean: the slides of %d springs and %d contacts did not settle in "
+                      "%d sweeps at t = %.9g",
+                      *ny, nI, MJY_GS_MAX, t1);
 }
 
 int mj_yield_step(pd_mj *mj, const pd_factor *f, double h, int nI, double t1, pd_state *out,
@@ -198,32 +455,80 @@ int mj_yield_step(pd_mj *mj, const pd_factor *f, double h, int nI, double t1, pd
     double hth = h * mj->opts.theta;
     int rc, ny = 0;
     memcpy(y->vfree, out->v, (size_t)md->n * sizeof(double));
+    if (y->all_alone && mj->opts.yield_lcp_max == 0) { /* rows of SDOFs: Gauss-Seidel */
+        /* its start: the springs that slid in the last step, with their slides */
+        for (int k = 0; k < y->ny_prev; k++) {
+            int j = y->ys[k];
+            if (y->G[j] > 0.0)
+                y->ys[ny++] = j;
+            else
+                y->sigma[j] = 0;
+        }
+        if ((rc = slide_gs(mj, f, nI, &ny, hth, t1, out, err)))
+            return rc;
+        int slid = 0;
+        for (int k = 0; k < ny; k++) {
+            int j = y->ys[k];
+            y->up[j] += y->sigma[j] * y->G[j];
+            if (y->G[j] > 0.0) /* kept for the next step's start, in order */
+                y->ys[slid++] = j;
+            else
+                y->sigma[j] = 0;
+        }
+        y->ny_prev = slid;
+        return PD_OK;
+    }
     memset(y->sigma, 0, (size_t)md->ns);
     /* the elastic step first: the contacts alone */
     if (nI > 0 && (rc = mj_contacts_apply(mj, f, nI, t1, out, err)))
         return rc;
     for (int round = 0; grow(mj, out, hth, &ny); round++) {
-        int N = nI + ny;
-        if (N > MJY_CAP || round > md->ns)
+        int nyc, nc;
+        if (round == 0) { /* the elastic pass, each round's start */
+            memcpy(y->vel, out->v, (size_t)md->n * sizeof(double));
+            for (int c = 0; c < nI; c++)
+                y->P0[c] = out->P[mj->idx_active[c]];
+        } else {
+            memcpy(out->v, y->vel, (size_t)md->n * sizeof(double));
+            for (int c = 0; c < nI; c++)
+                out->P[mj->idx_active[c]] = y->P0[c];
+        }
+        pieces(mj, nI);
+        classify(mj, nI, ny, &nyc, &nc);
+        int N = nc + nyc, cap = mj->opts.yield_lcp_max > 0 && mj->opts.yield_lcp_max < MJY_CAP
+                                    ? mj->opts.yield_lcp_max
+                                    : MJY_CAP;
+        if (N > cap && round <= md->ns && all_alone(mj, ny, hth)) {
+            memcpy(out->v, y->vfree, (size_t)md->n * sizeof(double));
+            for (int k = 0; k < ny; k++)
+                y->G[y->ys[k]] = 0.0;
+            if ((rc = slide_gs(mj, f, nI, &ny, hth, t1, out, err)))
+                return rc;
+            break; /* settled: no spring past uy */
+        }
+        if (N > cap || round > md->ns)
             return pd_err_set(err, PD_EBUDGET,
-                              "Moreau-Jean: %d contacts and %d sliding springs at t = %.9g (at "
-                              "most %d in one LCP, %d rounds)",
-                              nI, ny, t1, MJY_CAP, md->ns + 1);
-        build(mj, f, nI, ny, hth, out->q); /* out->q: q + h (1 - theta) v until the step ends */
-        pd_lcp_opts lo = pd_lcp_default_opts();
-        pd_lcp_info info;
-        if ((rc = pd_lcp_lemke(y->lemke, N, y->L, y->b, &lo, y->z, y->w, &info)))
-            return pd_err_set(err, rc,
-                              "Moreau-Jean: the LCP of %d contacts and %d sliding springs not "
-                              "solved at t = %.9g: %s",
-                              nI, ny, t1, pd_lcp_outcome_name(info.outcome));
-        y->rounds++;
-        out->lcp_pivots += info.pivots;
-        out->lcp_solver = "lemke";
-        apply(mj, f, nI, ny, hth, out);
+                              "Moreau-Jean: %d contacts and %d sliding springs coupled at t = "
+                              "%.9g (at most %d in one LCP, %d rounds; newmark runs it)",
+                              nc, nyc, t1, cap, md->ns + 1);
+        if (N > 0 && nyc > 0) {
+            build(mj, f, nc, nyc, hth, out->q); /* out->q: q + h (1 - theta) v */
+            pd_lcp_opts lo = pd_lcp_default_opts();
+            pd_lcp_info info;
+            if ((rc = pd_lcp_lemke(y->lemke, N, y->L, y->b, &lo, y->z, y->w, &info)))
+                return pd_err_set(err, rc,
+                                  "Moreau-Jean: the LCP of %d contacts and %d sliding springs "
+                                  "not solved at t = %.9g: %s",
+                                  nc, nyc, t1, pd_lcp_outcome_name(info.outcome));
+            y->rounds++;
+            out->lcp_pivots += info.pivots;
+            out->lcp_solver = "lemke";
+            apply(mj, f, nc, nyc, hth, out);
+        }
+        slide_alone(mj, ny, hth, out);
     }
     /* the offsets move by sigma G */
     for (int k = 0; k < ny; k++)
-        y->up[y->ys[k]] += y->sigma[y->ys[k]] * y->z[nI + k];
+        y->up[y->ys[k]] += y->sigma[y->ys[k]] * y->G[y->ys[k]];
     return PD_OK;
 }

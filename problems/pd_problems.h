@@ -661,6 +661,9 @@ PD_API int pd_scene_set_heights(pd_scene *sc, const double *heights, pd_err *err
  * (NULL: 0, elastic-perfectly plastic).  Runs by Moreau-Jean at fixed steps
  * and by newmark (the others refuse a yielding scene). */
 PD_API int pd_scene_set_yield(pd_scene *sc, const double *uy, const double *alpha, pd_err *err);
+/* Every storey of every structure yielding with uy [m] > 0 and alpha in
+ * [0, 1] (a generated row's, `--chain N --uy`). */
+PD_API int pd_scene_yield_every(pd_scene *sc, double uy, double alpha, pd_err *err);
 /* The yielding springs of a scene: storeys with finite uy and alpha < 1. */
 PD_API int pd_scene_springs(const pd_scene *sc);
 /* A contact; a or b PD_WALL for a wall (level 0 there). */

@@ -353,23 +353,23 @@ int pd_scene_set_heights(pd_scene *sc, const double *heights, pd_err *err)
     return PD_OK;
 }
 
-int pd_scene_set_yield(pd_scene *sc, const double *uy, const double *alpha, pd_err *err)
+/* Structure st's yielding storeys: uy[i] > 0 (INFINITY: elastic), alpha[i]
+ * in [0, 1] (alpha NULL: 0), or alpha_all for every storey when alpha_all
+ * >= 0 and uy_all for every storey when uy is NULL. */
+static int structure_yield(pd_structure *st, const double *uy, double uy_all, const double *alpha,
+                           double alpha_all, pd_err *err)
 {
-    if (!sc || !uy)
-        return PD_NULL_ARG(err, !sc ? "sc" : "uy");
-    if (sc->nstruct == 0)
-        return pd_err_set(err, PD_EINVAL, "uy: no structure to apply it to");
-    pd_structure *st = &sc->st[sc->nstruct - 1];
     for (int i = 0; i < st->storeys; i++) {
-        if (!(uy[i] > 0.0)) /* INFINITY passes: an elastic storey */
+        double u = uy ? uy[i] : uy_all, a = alpha ? alpha[i] : alpha_all;
+        if (!(u > 0.0)) /* INFINITY passes: an elastic storey */
             return pd_err_set(err, PD_EINVAL,
                               "uy: storey %d has yield drift %g, must be > 0 [m] (inf: elastic)",
-                              i + 1, uy[i]);
-        if (alpha && !(alpha[i] >= 0.0 && alpha[i] <= 1.0))
+                              i + 1, u);
+        if (!(a >= 0.0 && a <= 1.0))
             return pd_err_set(err, PD_EINVAL,
                               "alpha: storey %d has post-yield stiffness ratio %g, must be in "
                               "[0, 1]",
-                              i + 1, alpha[i]);
+                              i + 1, a);
     }
     size_t bytes = (size_t)st->storeys * sizeof(double);
     if (!st->uy && (!(st->uy = malloc(bytes)) || !(st->yield_alpha = malloc(bytes)))) {
@@ -377,10 +377,30 @@ int pd_scene_set_yield(pd_scene *sc, const double *uy, const double *alpha, pd_e
         st->uy = NULL;
         return pd_err_set(err, PD_ENOMEM, "out of memory for the yield drifts of '%s'", st->name);
     }
-    memcpy(st->uy, uy, bytes);
-    for (int i = 0; i < st->storeys; i++)
-        st->yield_alpha[i] = alpha ? alpha[i] : 0.0;
+    for (int i = 0; i < st->storeys; i++) {
+        st->uy[i] = uy ? uy[i] : uy_all;
+        st->yield_alpha[i] = alpha ? alpha[i] : alpha_all;
+    }
     return PD_OK;
+}
+
+int pd_scene_set_yield(pd_scene *sc, const double *uy, const double *alpha, pd_err *err)
+{
+    if (!sc || !uy)
+        return PD_NULL_ARG(err, !sc ? "sc" : "uy");
+    if (sc->nstruct == 0)
+        return pd_err_set(err, PD_EINVAL, "uy: no structure to apply it to");
+    return structure_yield(&sc->st[sc->nstruct - 1], uy, 0.0, alpha, 0.0, err);
+}
+
+int pd_scene_yield_every(pd_scene *sc, double uy, double alpha, pd_err *err)
+{
+    if (!sc)
+        return PD_NULL_ARG(err, "sc");
+    int rc = PD_OK;
+    for (int s = 0; s < sc->nstruct && !rc; s++)
+        rc = structure_yield(&sc->st[s], NULL, uy, NULL, alpha, err);
+    return rc;
 }
 
 int pd_scene_springs(const pd_scene *sc)

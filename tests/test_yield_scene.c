@@ -211,6 +211,63 @@ static void test_yield_scene_row_converges(pd_test_ctx *ctx)
     pd_scene_free(sc);
 }
 
+/* Per step: the largest |q| and |up|, their final values. */
+typedef struct gs_track {
+    double qmax, upmax, q[10], up[10];
+    long steps;
+} gs_track;
+
+static int gs_note(const pd_state *st, void *ctx)
+{
+    gs_track *g = ctx;
+    for (int i = 0; i < 10; i++) {
+        g->qmax = fmax(g->qmax, fabs(st->q[i]));
+        g->upmax = fmax(g->upmax, fabs(st->up[i]));
+        g->q[i] = st->q[i];
+        g->up[i] = st->up[i];
+    }
+    g->steps++;
+    return 0;
+}
+
+/* The row of 10 by Moreau-Jean's dense LCP of each piece's contacts and
+ * springs (yield_lcp_max 512: pivoting) and by block Gauss-Seidel (the
+ * default for springs each alone on a dof): the same solution of each
+ * step's LCP to MJY_GS_TOL, so the same run (the peaks and the final state
+ * within 1e-9 of the peaks; measured 3e-16). */
+static void test_yield_scene_gauss_seidel(pd_test_ctx *ctx)
+{
+    pd_scene *sc = row10(ctx);
+    pd_scene_model sm;
+    pd_err e;
+    if (!sc || !CHECK(ctx, pd_scene_model_build(sc, 1, &sm, &e) == PD_OK, "%s", e.msg)) {
+        pd_scene_free(sc);
+        return;
+    }
+    gs_track g[2];
+    memset(g, 0, sizeof g);
+    for (int k = 0; k < 2; k++) {
+        pd_mj_opts mo = pd_mj_default_opts();
+        mo.h = 2.5e-4 * PD_TWO_PI / sc->exc.Tp; /* dt 2.5e-4 s in the model's time */
+        mo.yield_lcp_max = k ? 0 : 512;
+        pd_mj *mj = pd_mj_alloc(&sm.model, &mo, &e);
+        if (!CHECK(ctx, mj != NULL, "%s", e.msg))
+            break;
+        int rc = pd_mj_run(mj, 6000, gs_note, &g[k], &e);
+        pd_mj_free(mj);
+        CHECK(ctx, rc == PD_OK, "yield_lcp_max %d: %s", mo.yield_lcp_max, e.msg);
+    }
+    double d = fmax(fabs(g[0].qmax - g[1].qmax), fabs(g[0].upmax - g[1].upmax));
+    for (int i = 0; i < 10; i++)
+        d = fmax(d, fmax(fabs(g[0].q[i] - g[1].q[i]), fabs(g[0].up[i] - g[1].up[i])));
+    d /= g[0].qmax;
+    printf("    dense against Gauss-Seidel: %.2g of the peak over %ld steps (offsets up to %.3g)\n",
+           d, g[0].steps, g[0].upmax);
+    CHECK(ctx, d <= 1e-9 && g[0].upmax > 0.0 && g[1].steps == g[0].steps, "%.3g apart", d);
+    pd_scene_model_free(&sm);
+    pd_scene_free(sc);
+}
+
 /* A scene's yielding fields refused with their place: alpha without uy,
  * uy <= 0, a wrong count, alpha beyond 1. */
 static void test_yield_scene_bad_fields(pd_test_ctx *ctx)
@@ -254,6 +311,8 @@ static void test_yield_scene_cli(pd_test_ctx *ctx)
     const char *json[] = {"simulate", "--scene", YSCENE, "--json", NULL};
     const char *event[] = {"simulate", "--scene", YSCENE, "--method", "event", NULL};
     const char *pi3[] = {"spectrum", "--scene", YSCENE, "--Pi2", "0.5:2:2", "--Pi3", "0.5", NULL};
+    const char *chain[] = {"simulate", "--chain", "8",    "--Piy",  "0.3", "--alpha",
+                           "0.05",     "--Pi3",   "0.05", "--json", NULL};
     proc_out r;
     pd_test_pound(ctx, json, &r);
     CHECK(ctx,
@@ -271,6 +330,13 @@ static void test_yield_scene_cli(pd_test_ctx *ctx)
     CHECK(ctx, r.status == 2 && r.err && strstr(r.err, "Pi3"), "--Pi3: exit %d, %s", r.status,
           r.err);
     pd_test_proc_free(&r);
+    pd_test_pound(ctx, chain, &r); /* a generated row, every SDOF yielding */
+    int rows = 0;
+    for (const char *p = r.out; p && (p = strstr(p, "\"ductility\":[")); p++)
+        rows++;
+    CHECK(ctx, r.status == 0 && rows == 8, "--chain 8 --Piy: exit %d, %d yielding structures, %s",
+          r.status, rows, r.err);
+    pd_test_proc_free(&r);
 }
 
 void suite_yield_scene(pd_test_ctx *ctx)
@@ -279,5 +345,6 @@ void suite_yield_scene(pd_test_ctx *ctx)
     PD_RUN(ctx, test_yield_scene_example);
     PD_RUN(ctx, test_yield_scene_unreached_is_elastic);
     PD_RUN(ctx, test_yield_scene_row_converges);
+    PD_RUN(ctx, test_yield_scene_gauss_seidel);
     PD_RUN(ctx, test_yield_scene_bad_fields);
 }

@@ -45,7 +45,8 @@ class Scene:
         """`pound simulate --chain N`: N SDOFs of unit mass between two walls,
         periods alternating T0 and ratio T0, every gap `gap` (or Pi3), every
         restitution eps; the model keywords of simulate() (pulse, dir, ap
-        [m/s^2], Tp [s], T0 [s] or Pi2, gap [m] or Pi3, eps, xi)."""
+        [m/s^2], Tp [s], T0 [s] or Pi2, gap [m] or Pi3, eps, xi; uy [m] or
+        Piy with alpha: every SDOF yields, as `--chain N --uy`)."""
         N = _args.integer("chain", N)
         if not 1 <= N <= 10000000:
             raise InputError("chain: N must be in [1, 1e7] (got %d)" % N)
@@ -55,7 +56,7 @@ class Scene:
         if N > 1 and not 1e-4 <= ratio <= 1e4:
             raise InputError("chain_ratio: must be in [1e-4, 1e4] (got %.10g)" % ratio)
         k = Case(model, allowed=("pulse", "dir", "ap", "Tp", "T0", "Pi2", "gap", "Pi3", "eps",
-                                 "xi"))
+                                 "xi", "uy", "Piy", "alpha"))
         k.finish_model()
         c = k.c
         x = _lib.PdSceneExcitation(pulse=c.pulse, dir=c.dir, ap=c.ap, Tp=c.Tp)
@@ -63,6 +64,11 @@ class Scene:
         err = PdErr()
         _lib.check(lib.pd_scene_chain(N, x, lib.pd_osc_T0(c), ratio, c.xi, lib.pd_osc_gap(c),
                                       c.eps, ctypes.byref(p), err), err)
+        if lib.pd_osc_yields(c):  # uy or Piy: every SDOF yields, as --chain N --uy
+            st = lib.pd_scene_yield_every(p, lib.pd_osc_uy(c), c.alpha, err)
+            if st:
+                lib.pd_scene_free(p)
+            _lib.check(st, err)
         return cls(_ptr=p, _name="chain of %d" % N)
 
     def close(self) -> None:

@@ -230,6 +230,13 @@ def test_scene_yielding(cli, same, method):
         pound.simulate_scene(f, method="event", history=False)
 
 
+def test_chain_yielding(cli, same):
+    """A generated row whose every SDOF yields, as `--chain N --Piy X --alpha A`."""
+    r = pound.Scene.chain(6, Pi3=0.05, Piy=0.3, alpha=0.05).simulate(history=False)
+    same(r, cli("simulate", "--chain", "6", "--Pi3", "0.05", "--Piy", "0.3", "--alpha", "0.05"))
+    assert all(st.ductility[0] > 1.0 for st in r.structures)
+
+
 @pytest.mark.parametrize("kw,named", [
     (dict(Piy=-1), "Piy"), (dict(uy=0.01, Piy=1), "alternatives"), (dict(alpha=0.2), "uy or Piy"),
     (dict(Piy=1, alpha=0.002, method="event"), "moreau"), (dict(Piy=1, rtol=1e-3), "tolerance"),
