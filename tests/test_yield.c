@@ -206,6 +206,22 @@ static void test_yield_wall_converges(pd_test_ctx *ctx)
           dist[0], dist[1], fine.impacts, fine.n_yield, fine.ductility, fine.residual);
 }
 
+/* Case k of the energy balances' 24: a pulse (harmonic one in three), Pi2
+ * 0.5 to 3, a wall or none (Pi3 1e6), Piy 0.05 to 0.55, alpha 0 to 0.3,
+ * eps 0 to 1, xi 0 to 0.1, drawn from rng. */
+static pd_osc energy_case(int k, uint64_t *rng)
+{
+    pd_osc c = pd_osc_default();
+    c.pulse = k % 3 == 2 ? PD_PULSE_HARMONIC : k % 2 ? PD_PULSE_COSINE : PD_PULSE_SINE;
+    c.Pi2 = 0.5 + 2.5 * pd_test_uniform(rng);
+    c.Pi3 = k % 4 == 3 ? 1e6 : 0.5 * pd_test_uniform(rng);
+    c.Piy = 0.05 + 0.5 * pd_test_uniform(rng);
+    c.alpha = k % 5 == 0 ? 0.0 : 0.3 * pd_test_uniform(rng);
+    c.eps = pd_test_uniform(rng);
+    c.xi = 0.1 * pd_test_uniform(rng);
+    return c;
+}
+
 /* The energy balance of yielding runs with theta = 1/2 (the step's
  * energy identity is exact for the midpoint: input = kinetic + strain +
  * damping + slider + impacts per step) closes to rounding, 1e-12 of the
@@ -217,14 +233,7 @@ static void test_yield_energy_balance(pd_test_ctx *ctx)
     uint64_t rng = 0xe4e6;
     double worst = 0.0, worst_loss = 0.0;
     for (int k = 0; k < 24; k++) {
-        pd_osc c = pd_osc_default();
-        c.pulse = k % 3 == 2 ? PD_PULSE_HARMONIC : k % 2 ? PD_PULSE_COSINE : PD_PULSE_SINE;
-        c.Pi2 = 0.5 + 2.5 * pd_test_uniform(&rng);
-        c.Pi3 = k % 4 == 3 ? 1e6 : 0.5 * pd_test_uniform(&rng);
-        c.Piy = 0.05 + 0.5 * pd_test_uniform(&rng);
-        c.alpha = k % 5 == 0 ? 0.0 : 0.3 * pd_test_uniform(&rng);
-        c.eps = pd_test_uniform(&rng);
-        c.xi = 0.1 * pd_test_uniform(&rng);
+        pd_osc c = energy_case(k, &rng);
         pd_run_opts o = pd_run_default_opts();
         o.method = PD_METHOD_MOREAU;
         pd_osc_result r;
@@ -261,14 +270,7 @@ static void test_yield_exact_energy_balance(pd_test_ctx *ctx)
     double worst = 0.0, worst_term = 0.0;
     int runs = 0;
     for (int k = 0; k < 24; k++) {
-        pd_osc c = pd_osc_default();
-        c.pulse = k % 3 == 2 ? PD_PULSE_HARMONIC : k % 2 ? PD_PULSE_COSINE : PD_PULSE_SINE;
-        c.Pi2 = 0.5 + 2.5 * pd_test_uniform(&rng);
-        c.Pi3 = k % 4 == 3 ? 1e6 : 0.5 * pd_test_uniform(&rng);
-        c.Piy = 0.05 + 0.5 * pd_test_uniform(&rng);
-        c.alpha = k % 5 == 0 ? 0.0 : 0.3 * pd_test_uniform(&rng);
-        c.eps = pd_test_uniform(&rng);
-        c.xi = 0.1 * pd_test_uniform(&rng);
+        pd_osc c = energy_case(k, &rng);
         if (!pd_osc_yield_exact(&c))
             continue;
         pd_run_opts o = pd_run_default_opts();
