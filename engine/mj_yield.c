@@ -120,15 +120,21 @@ static void blocks(mj_yield *y, const pd_model *md)
         y->block[i] = find(y->uf, i);
 }
 
-/* Spring j's only dof (its drift a multiple s of one dof), or -1. */
+/* Spring j's only dof (its drift a multiple s of one dof: one nonzero in
+ * S's column, dense or compressed), or -1. */
 static int spring_dof(const pd_model *md, int j, double *s)
 {
-    int p = -1, i, i2;
-    double v, v2;
-    if (!mj_col_next(&md->S, j, &p, &i, &v) || mj_col_next(&md->S, j, &p, &i2, &v2))
-        return -1;
-    *s = v;
-    return i;
+    int p = -1, i, dof = -1;
+    double v;
+    while (mj_col_next(&md->S, j, &p, &i, &v)) {
+        if (v == 0.0)
+            continue;
+        if (dof >= 0)
+            return -1;
+        dof = i;
+        *s = v;
+    }
+    return dof;
 }
 
 int mj_yield_alloc(pd_mj *mj, pd_err *err)

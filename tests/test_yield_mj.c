@@ -121,6 +121,8 @@ static void test_yield_mj_general_equals_scalar(pd_test_ctx *ctx)
 typedef struct bldg {
     double M[4], C[4], K[4], W[2], S[4], ks[2], uy[2], g0, e;
     double peak[2], up[2], zmax; /* measured: |drift| peaks, offsets at the end, max |z| / uy */
+    double zslide;               /* max ||z| / uy - 1| over the steps a spring slid in */
+    long slides;
 } bldg;
 
 static void bldg_force(double t, int side, double *F, void *ctx)
@@ -166,9 +168,14 @@ static int bldg_note(const pd_state *st, void *ctx)
     bldg *b = ctx;
     double d[2] = {st->q[0], st->q[1] - st->q[0]};
     for (int j = 0; j < 2; j++) {
+        double up = st->up ? st->up[j] : 0.0, z = fabs(d[j] - up) / b->uy[j];
+        if (up != b->up[j]) { /* it slid: its z on the yield level */
+            b->zslide = fmax(b->zslide, fabs(z - 1.0));
+            b->slides++;
+        }
         b->peak[j] = fmax(b->peak[j], fabs(d[j]));
-        b->up[j] = st->up ? st->up[j] : 0.0;
-        b->zmax = fmax(b->zmax, fabs(d[j] - b->up[j]) / b->uy[j]);
+        b->up[j] = up;
+        b->zmax = fmax(b->zmax, z);
     }
     return 0;
 }
@@ -236,10 +243,13 @@ static void test_yield_mj_soft_storey(pd_test_ctx *ctx)
         if (!bldg_mj(ctx, h, 1.0, &run))
             return;
         double d = bldg_dist(&fine, &run);
-        printf("    Moreau-Jean h %.3g: %.3g uy1 from h 3.1e-5 (|z| / uy <= 1 + %.2g)\n", h, d,
-               run.zmax - 1.0);
-        CHECK(ctx, d <= 0.5 * prev && run.zmax <= 1.0 + 1e-9,
-              "h %g: %.3g (was %.3g), |z| / uy %.17g", h, d, prev, run.zmax);
+        printf("    Moreau-Jean h %.3g: %.3g uy1 from h 3.1e-5 (|z| / uy <= 1 + %.2g; %ld slides "
+               "on the level to %.2g)\n",
+               h, d, run.zmax - 1.0, run.slides, run.zslide);
+        CHECK(ctx,
+              d <= 0.5 * prev && run.zmax <= 1.0 + 1e-9 && run.zslide <= 1e-12 && run.slides > 0,
+              "h %g: %.3g (was %.3g), |z| / uy %.17g, a slide off its level by %.3g", h, d, prev,
+              run.zmax, run.zslide);
         prev = d;
     }
     CHECK(ctx, fine.up[0] > 0.1 * fine.uy[0] && fine.peak[0] > 5.0 * fine.uy[0],
@@ -331,6 +341,86 @@ static void test_yield_newmark_step_equations(pd_test_ctx *ctx)
           c.slid);
 }
 
+/* Moreau-Jean's equations of every step of the building at a coarse h
+ * (0.05: the springs' tangent (h theta)^2 ks is 6 % of What, the storeys'
+ * coupling matters):
+ *   What (v+ - v) = h (F_theta - C v - K (q + h theta v)) + h S ks up
+ *                   + h theta S ks (up+ - up) + W P,
+ * What = M + h theta C + (h theta)^2 K, theta 1/2 (away from the pulse's
+ * end), to 1e-12 of its terms; every slide on its level. */
+typedef struct mj_check {
+    bldg *b;
+    double h, q[2], v[2], up[2], t, res, zslide;
+    long steps, slides;
+} mj_check;
+
+static int mj_step_check(const pd_state *st, void *ctx)
+{
+    mj_check *c = ctx;
+    bldg *b = c->b;
+    double h = c->h, th = 0.5, F0[2], F1[2];
+    if (st->step > 0 && fabs(st->t - PD_PI) > 2.0 * h && fabs(c->t - PD_PI) > 2.0 * h) {
+        bldg_force(c->t, +1, F0, NULL);
+        bldg_force(st->t, -1, F1, NULL);
+        double dup[2] = {st->up[0] - c->up[0], st->up[1] - c->up[1]};
+        for (int i = 0; i < 2; i++) {
+            double lhs = 0.0, rhs = h * (th * F1[i] + (1.0 - th) * F0[i]), scale = fabs(rhs);
+            for (int j = 0; j < 2; j++) {
+                double What =
+                    b->M[i + 2 * j] + h * th * b->C[i + 2 * j] + h * th * h * th * b->K[i + 2 * j];
+                lhs += What * (st->v[j] - c->v[j]);
+                double f = -h * (b->C[i + 2 * j] * c->v[j] +
+                                 b->K[i + 2 * j] * (c->q[j] + h * th * c->v[j])) +
+                           b->S[i + 2 * j] * b->ks[j] * (h * c->up[j] + h * th * dup[j]);
+                rhs += f;
+                scale += fabs(What * st->v[j]) + fabs(f);
+            }
+            rhs += b->W[i] * st->P[0];
+            c->res = fmax(c->res, fabs(lhs - rhs) / scale);
+        }
+        for (int j = 0; j < 2; j++) {
+            double d = j ? st->q[1] - st->q[0] : st->q[0];
+            if (dup[j] != 0.0) {
+                c->zslide = fmax(c->zslide, fabs(fabs(d - st->up[j]) / b->uy[j] - 1.0));
+                c->slides++;
+            }
+        }
+        c->steps++;
+    }
+    c->t = st->t;
+    for (int j = 0; j < 2; j++) {
+        c->q[j] = st->q[j];
+        c->v[j] = st->v[j];
+        c->up[j] = st->up[j];
+    }
+    return 0;
+}
+
+static void test_yield_mj_step_equations(pd_test_ctx *ctx)
+{
+    for (int wall = 1; wall >= 0; wall--) { /* without it a storey slides with no contact */
+        double brk = PD_PI;
+        bldg b;
+        pd_model md = bldg_model(&b, &brk);
+        md.m = wall;
+        pd_mj_opts mo = pd_mj_default_opts();
+        mo.h = 0.05;
+        mj_check c = {.b = &b, .h = mo.h};
+        pd_err e;
+        pd_mj *mj = pd_mj_alloc(&md, &mo, &e);
+        if (!CHECK(ctx, mj != NULL, "%s", e.msg))
+            return;
+        int rc = pd_mj_run(mj, 120, mj_step_check, &c, &e);
+        pd_mj_free(mj);
+        printf("    %s: %ld steps, %ld slides: the step's balance to %.2g of its terms, slides "
+               "on their level to %.2g\n",
+               wall ? "the wall" : "no wall", c.steps, c.slides, c.res, c.zslide);
+        CHECK(ctx, rc == PD_OK && c.res <= 1e-12 && c.zslide <= 1e-12 && c.slides > 10,
+              "%s: balance %.3g, slides off their level %.3g, %ld slides: %s",
+              wall ? "wall" : "no wall", c.res, c.zslide, c.slides, rc ? e.msg : "");
+    }
+}
+
 /* Springs that never yield (uy 1e6 times): the run of the model without
  * them, bit for bit; Moreau-Jean to a tolerance refuses them. */
 static void test_yield_mj_unreached_is_elastic(pd_test_ctx *ctx)
@@ -362,10 +452,63 @@ static void test_yield_mj_unreached_is_elastic(pd_test_ctx *ctx)
     pd_mj_free(mj);
 }
 
+/* A spring on the drift 2 q with uy 2 uy0 and ks ks0 / 4 is the spring on q
+ * with uy0 and ks0 (its offset twice): the general kernel's steps of both
+ * on the one-dof oscillator against a wall, in and out of contact, within
+ * 1e-12 of umax (measured 1e-15), the offsets in ratio 2. */
+static void test_yield_mj_spring_scale(pd_test_ctx *ctx)
+{
+    pd_osc c = pd_osc_default();
+    c.Pi2 = 1.3;
+    c.Pi3 = 0.1;
+    c.Piy = 0.2;
+    c.alpha = 0.1;
+    double brk = PD_TWO_PI;
+    traj t[2] = {{0}, {0}};
+    for (int k = 0; k < 2; k++) {
+        t[k].q = malloc(MAXSTEP * sizeof(double));
+        t[k].up = malloc(MAXSTEP * sizeof(double));
+        t[k].scale = 1.0;
+    }
+    for (int k = 0; k < 2 && t[k].q && t[k].up; k++) {
+        pd_osc_coefs cf;
+        pd_model md = pd_osc_model(&c, 0, &cf, &brk, 1);
+        double S = k ? 2.0 : 1.0, ks = (1.0 - c.alpha) * cf.K / (S * S), uy = c.Piy * S;
+        md.ns = 1;
+        md.S = pd_matrix_dense(1, 1, &S);
+        md.ks = &ks;
+        md.uy = &uy;
+        pd_mj_opts mo = pd_mj_default_opts();
+        mo.h = 2e-3;
+        pd_err e;
+        pd_mj *mj = pd_mj_alloc(&md, &mo, &e);
+        if (!CHECK(ctx, mj != NULL, "%s", e.msg))
+            break;
+        CHECK(ctx, pd_mj_run(mj, 8000, mj_sample, &t[k], &e) == PD_OK, "%s", e.msg);
+        pd_mj_free(mj);
+    }
+    double d = 0.0, umax = 0.0, upmax = 0.0;
+    for (long i = 0; i < t[0].n && i < t[1].n; i++) {
+        umax = fmax(umax, fabs(t[0].q[i]));
+        upmax = fmax(upmax, fabs(t[0].up[i]));
+        d = fmax(d, fmax(fabs(t[0].q[i] - t[1].q[i]), fabs(2.0 * t[0].up[i] - t[1].up[i])));
+    }
+    printf("    the spring on 2 q against the one on q: %.2g of umax (offsets up to %.3g)\n",
+           d / umax, upmax);
+    CHECK(ctx, t[0].n == t[1].n && t[0].n > 1000 && d <= 1e-12 * umax && upmax > 0.0,
+          "%.3g of umax apart over %ld and %ld steps", d / umax, t[0].n, t[1].n);
+    for (int k = 0; k < 2; k++) {
+        free(t[k].q);
+        free(t[k].up);
+    }
+}
+
 void suite_yield_mj(pd_test_ctx *ctx)
 {
+    PD_RUN(ctx, test_yield_mj_spring_scale);
     PD_RUN(ctx, test_yield_mj_general_equals_scalar);
     PD_RUN(ctx, test_yield_mj_soft_storey);
     PD_RUN(ctx, test_yield_newmark_step_equations);
+    PD_RUN(ctx, test_yield_mj_step_equations);
     PD_RUN(ctx, test_yield_mj_unreached_is_elastic);
 }
