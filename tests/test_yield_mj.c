@@ -444,7 +444,21 @@ static void test_yield_mj_unreached_is_elastic(pd_test_ctx *ctx)
               far.up[1] == 0.0,
           "peaks %.17g, %.17g against %.17g, %.17g", far.peak[0], far.peak[1], el.peak[0],
           el.peak[1]);
+    /* the dense LCP capped at 1 unknown: the building's springs share a dof,
+     * no Gauss-Seidel for them: refused, naming the cap, the rounds (ns + 1)
+     * and newmark */
     md = bldg_model(&el, &brk);
+    mo.yield_lcp_max = 1;
+    mj = pd_mj_alloc(&md, &mo, &e);
+    if (CHECK(ctx, mj != NULL, "%s", e.msg)) {
+        rc = pd_mj_run(mj, pd_steps_for(6.0, 1e-3), NULL, NULL, &e);
+        CHECK(ctx,
+              rc == PD_EBUDGET && strstr(e.msg, "at most 1 in one LCP, 3 rounds") &&
+                  strstr(e.msg, "newmark"),
+              "a capped LCP: %d, %s", rc, e.msg);
+        pd_mj_free(mj);
+    }
+    mo.yield_lcp_max = 0;
     mo.rtol = 1e-3;
     mj = pd_mj_alloc(&md, &mo, &e);
     CHECK(ctx, mj == NULL && e.status == PD_EINVAL && strstr(e.msg, "tolerance"),
