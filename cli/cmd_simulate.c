@@ -610,6 +610,15 @@ static void scene_json(const sim_args *a, const pd_scene *sc, const pd_scene_sum
     /* the row reference: its impact law ("none": another method), the peaks under the other */
     pd_json_str(&js, "impact_law", r->impact_law ? r->impact_law : "none");
     pd_json_num(&js, "law_band", r->law_band_max); /* NaN -> null: no simultaneous impact */
+    if (pd_scene_springs(sc) > 0) { /* a yielding scene's energy balance [J] (NaN -> null) */
+        pd_json_num(&js, "energy_input", r->energy.input);
+        pd_json_num(&js, "energy_kinetic", r->energy.kinetic);
+        pd_json_num(&js, "energy_strain", r->energy.strain);
+        pd_json_num(&js, "energy_damping", r->energy.damping);
+        pd_json_num(&js, "energy_hysteretic", r->energy.hysteretic);
+        pd_json_num(&js, "energy_impact", r->energy.impact);
+        pd_json_num(&js, "energy_residual", r->energy.residual);
+    }
     pd_json_num(&js, "contact_duration", r->contact_duration);
     pd_json_num(&js, "dt", r->dt);
     pd_json_num(&js, "theta", r->theta);
@@ -790,6 +799,11 @@ static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_sum
                        r->n_yield[d], r->plastic_excursion[d]);
             }
         }
+        if (isfinite(r->energy.input))
+            printf("  energy    = input %.6g J = kinetic %.4g + strain %.4g + damping %.4g + "
+                   "hysteretic %.4g + impacts %.4g, residual %.2g of the input\n",
+                   r->energy.input, r->energy.kinetic, r->energy.strain, r->energy.damping,
+                   r->energy.hysteretic, r->energy.impact, r->energy.residual);
     }
     if (sc->ncontact)
         printf("  %-22s %6s %10s %8s %12s %14s %10s\n", "contact", "level", "gap [m]", "impacts",

@@ -333,6 +333,21 @@ static int put_nums(pd_scene_writer *w, hid_t obj, const char *prefix, const cha
                          units ? "]" : "");
 }
 
+/* A yielding scene's energy balance (NaN: not by Moreau-Jean). */
+static int put_energy(pd_scene_writer *w, hid_t f, const pd_scene *sc, const pd_scene_result *r)
+{
+    if (pd_scene_springs(sc) == 0)
+        return 0;
+    const pd_energy *en = &r->energy;
+    return put_num(w, f, "", "energy_input", en->input, "J") ||
+           put_num(w, f, "", "energy_kinetic", en->kinetic, "J") ||
+           put_num(w, f, "", "energy_strain", en->strain, "J") ||
+           put_num(w, f, "", "energy_damping", en->damping, "J") ||
+           put_num(w, f, "", "energy_hysteretic", en->hysteretic, "J") ||
+           put_num(w, f, "", "energy_impact", en->impact, "J") ||
+           put_num(w, f, "", "energy_residual", en->residual, "1");
+}
+
 /* The run's inputs and figures on the root. */
 static int put_run(pd_scene_writer *w, const pd_scene_run_info *ri)
 {
@@ -365,7 +380,7 @@ static int put_run(pd_scene_writer *w, const pd_scene_run_info *ri)
            put_num(w, f, "", "rtol_met", ri->sum->rtol_met, "1") ||
            put_num(w, f, "", "steps_rejected", (double)r->steps_rejected, "1") ||
            put_num(w, f, "", "dt_min", r->dt_min, "s") ||
-           put_num(w, f, "", "dt_max", r->dt_max, "s");
+           put_num(w, f, "", "dt_max", r->dt_max, "s") || put_energy(w, f, sc, r);
 }
 
 /* Structure s: its description and results (group /structures/NAME). */

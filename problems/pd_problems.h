@@ -798,6 +798,8 @@ typedef struct pd_scene_result {
     double *residual;          /* n: (1 - alpha) up at the end [m] */
     double *plastic_excursion; /* n: sum |d up| [m] */
     long *n_yield;             /* n: yield onsets */
+    pd_energy energy;          /* a yielding scene by Moreau-Jean: the balance over the scene [J]
+                         (from rest; NAN throughout otherwise) */
 } pd_scene_result;
 
 /* Arrays for the finished scene sc (PD_EINVAL before pd_scene_finish). */

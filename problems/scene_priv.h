@@ -20,4 +20,14 @@ double pd_scene_penalty_kc(const pd_scene *sc, const pd_run_opts *o);
  * 1.5 kc sqrt(d) at a penetration of 1 % of Le): HUGE_VAL without contacts. */
 double pd_scene_contact_period_min(const pd_scene *sc, const pd_run_opts *o);
 
+/* The energy balance of a yielding scene's Moreau-Jean run (scene_energy.c):
+ * the step's identity summed, from rest, in the model's units. */
+typedef struct pd_scene_energy pd_scene_energy;
+pd_scene_energy *pd_scene_energy_alloc(const pd_model *md, double h, double theta);
+void pd_scene_energy_free(pd_scene_energy *e);
+/* After each step (and at the start: st->step 0). */
+void pd_scene_energy_note(pd_scene_energy *e, const pd_state *st);
+/* The balance in joules (energy unit E = Le^2 wp^2 kg). */
+void pd_scene_energy_finish(const pd_scene_energy *e, double E, pd_energy *out);
+
 #endif

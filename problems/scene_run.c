@@ -111,6 +111,7 @@ typedef struct track {
     double *xeff;           /* n: displacements whose storey drifts d - (1 - alpha) up give
                                the springs' forces (the demands' state) */
     const double *xdem;     /* the demands' displacements of the report (q, or xeff) */
+    pd_scene_energy *en;    /* a yielding scene by Moreau-Jean: its energy balance */
     long *onsets;           /* ns: a report that slid after one that did not */
     unsigned char *slid;    /* ns: the last report slid */
 } track;
@@ -723,6 +724,8 @@ static int observe_moreau(const pd_state *st, void *ctx)
 {
     track *tr = ctx;
     note_springs(tr, st);
+    if (tr->en)
+        pd_scene_energy_note(tr->en, st);
     note_point(tr, st->t, st->q);
     note_approach(tr, st->q);
     if (tr->demands)
@@ -1045,11 +1048,20 @@ static int run_moreau(const pd_model *md, const pd_run_opts *o, long nsteps, tra
     pd_mj *mj = pd_mj_alloc(md, &mo, err);
     if (!mj)
         return err->status;
+    /* a yielding scene's energy balance, summed step by step */
+    if (md->ns > 0 && !(tr->en = pd_scene_energy_alloc(md, tr->h, o->theta))) {
+        pd_mj_free(mj);
+        return pd_err_set(err, PD_ENOMEM, "out of memory for the energy balance");
+    }
     int rc = pd_mj_run(mj, nsteps, observe_moreau, tr, err);
     res->steps = pd_mj_state(mj)->step;
     res->kernel = pd_mj_kernel_name(mj);
     res->factor = pd_mj_factor_name(mj);
     res->lcp_solver = pd_lcp_method_name(o->lcp_solver);
+    if (tr->en) /* in joules: kg (Le wp)^2 */
+        pd_scene_energy_finish(tr->en, (tr->Le * tr->wp) * (tr->Le * tr->wp), &res->energy);
+    pd_scene_energy_free(tr->en);
+    tr->en = NULL;
     pd_mj_free(mj);
     return rc;
 }
@@ -1613,6 +1625,13 @@ int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler s
     res->law_band_max = NAN;
     for (int s = 0; s < res->nstruct; s++)
         res->law_band[s] = NAN;
+    res->energy = (pd_energy){.input = NAN,
+                              .kinetic = NAN,
+                              .strain = NAN,
+                              .damping = NAN,
+                              .hysteretic = NAN,
+                              .impact = NAN,
+                              .residual = NAN};
     double cpu0 = pd_cpu_seconds(), wall0 = pd_wall_seconds(), sample_s = 0.0;
     if (o.kernel == PD_KERNEL_AUTO && o.method != PD_METHOD_EVENT_GENERAL && springs == 0 &&
         pd_scene_as_oscillator(sc, &c, &mirrored))

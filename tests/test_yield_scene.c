@@ -63,6 +63,17 @@ static void test_yield_scene_example(pd_test_ctx *ctx)
                   fabs(nm.residual[d0] - mj.residual[d0]) <= 0.01 * uy,
               "newmark: ductility %g against %g, residual %g against %g", nm.ductility[d0],
               mj.ductility[d0], nm.residual[d0], mj.residual[d0]);
+        /* the scene's energy balance (theta 1/2: the midpoint's identity) */
+        const pd_energy *en = &mj.energy;
+        printf("    energy: input %.6g J = kinetic %.4g + strain %.4g + damping %.4g + "
+               "hysteretic %.4g + impacts %.4g, residual %.2g\n",
+               en->input, en->kinetic, en->strain, en->damping, en->hysteretic, en->impact,
+               en->residual);
+        CHECK(ctx,
+              fabs(en->residual) <= 1e-12 && en->hysteretic > 0.0 && en->impact > 0.0 &&
+                  en->damping > 0.0 && isnan(nm.energy.residual),
+              "the energy balance: residual %.3g, hysteretic %g, impacts %g (newmark's %g)",
+              en->residual, en->hysteretic, en->impact, nm.energy.residual);
         double envelope = k * (uy + a * (mj.drift[d0] - uy));
         CHECK(ctx, mj.shear_max[d0] <= 1.2 * envelope && mj.shear_max[d0] >= 0.8 * k * uy,
               "the soft storey's shear %g against its envelope %g", mj.shear_max[d0], envelope);
@@ -207,7 +218,11 @@ static void test_yield_scene_row_converges(pd_test_ctx *ctx)
               pd_method_name(method), dt, dmu, dres);
         pd_scene_result_free(&r);
     }
-    CHECK(ctx, onsets >= 10, "%ld onsets in the row", onsets);
+    CHECK(ctx, onsets >= 10 && fabs(fine.energy.residual) <= 1e-12,
+          "%ld onsets in the row, energy balance residual %.3g (Gauss-Seidel's steps)", onsets,
+          fine.energy.residual);
+    printf("    the row's energy balance: residual %.2g of the input (hysteretic %.3g of it)\n",
+           fine.energy.residual, fine.energy.hysteretic / fine.energy.input);
     pd_scene_result_free(&fine);
     pd_scene_free(sc);
 }

@@ -217,6 +217,7 @@ _PROTOTYPES = {
     "pd_scene_find": (c_int, [P(PdScene), c_char_p]),
     "pd_scene_finish": (c_int, [P(PdScene), P(PdErr)]),
     "pd_scene_load": (c_int, [c_char_p, P(P(PdScene)), P(PdErr)]),
+    "pd_scene_springs": (c_int, [P(PdScene)]),
     "pd_scene_yield_every": (c_int, [P(PdScene), c_double, c_double, P(PdErr)]),
     "pd_scene_chain": (c_int, [c_int, P(PdSceneExcitation), c_double, c_double, c_double,
                                c_double, c_double, P(P(PdScene)), P(PdErr)]),

@@ -192,7 +192,10 @@ class Scene:
         contact_duration [s]; a structure with yielding storeys ("uy" in the
         scene) also uy [m], yield_alpha, ductility, residual [m],
         plastic_excursion [m] and n_yield per storey (NaN, 0 for an elastic
-        storey).  opts: the scheme keywords of simulate()
+        storey), and over the scene the energy balance energy_input,
+        _kinetic, _strain, _damping, _hysteretic, _impact [J] with
+        energy_residual (Moreau-Jean; NaN for newmark).  opts: the scheme
+        keywords of simulate()
         (method, dt, tend, theta, ..., contact_duration; rtol as there:
         Moreau-Jean to a tolerance, or with method='penalty' the integrator's).
         Moreau-Jean to a tolerance: rtol (0: fixed steps), err_est (the
@@ -249,6 +252,12 @@ class Scene:
                      accumulations=r.accumulations, close_tol=r.close_tol,
                      impact_law=s(r.impact_law) if r.impact_law else "none",
                      law_band=r.law_band_max)
+        if lib.pd_scene_springs(self._p):  # a yielding scene's energy balance [J], as the CLI's
+            en = r.energy
+            out.update(energy_input=en.input, energy_kinetic=en.kinetic,
+                       energy_strain=en.strain, energy_damping=en.damping,
+                       energy_hysteretic=en.hysteretic, energy_impact=en.impact,
+                       energy_residual=en.residual)
         out.update(tolerance_fields(r, sm))
         x = self.excitation
         out["pulse"], out["dir"] = x["pulse"], x["dir"]

@@ -423,6 +423,7 @@ class PdSceneResult(Structure):
         ("residual", POINTER(c_double)),
         ("plastic_excursion", POINTER(c_double)),
         ("n_yield", POINTER(c_long)),
+        ("energy", PdEnergy),
     ]
 
 
