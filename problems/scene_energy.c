@@ -95,8 +95,8 @@ void pd_scene_energy_note(pd_scene_energy *e, const pd_state *st)
         for (int j = 0; j < md->ns; j++) {
             double D = st->up[j] - e->up[j];
             if (D != 0.0)
-                e->hysteretic += md->ks[j] * D *
-                                 (pd_matrix_col_dot(&md->S, j, e->tmp) - e->up[j] - th * D);
+                e->hysteretic +=
+                    md->ks[j] * D * (pd_matrix_col_dot(&md->S, j, e->tmp) - e->up[j] - th * D);
         }
     }
     e->t = st->t;
@@ -120,7 +120,7 @@ void pd_scene_energy_finish(const pd_scene_energy *e, double E, pd_energy *out)
     out->damping = e->damping * E;
     out->hysteretic = e->hysteretic * E;
     out->impact = e->impact * E;
-    out->residual = (out->input - out->kinetic - out->strain - out->damping - out->hysteretic -
-                     out->impact) /
-                    out->input;
+    out->residual =
+        (out->input - out->kinetic - out->strain - out->damping - out->hysteretic - out->impact) /
+        out->input;
 }
