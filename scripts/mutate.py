@@ -61,6 +61,7 @@ DEFAULT_FILES = {
     "engine/event_sdof.c": ["yield_rk", "yield_exact", "event", "reference"],
     "engine/penalty_newmark.c": ["yield_newmark", "newmark", "yield_mj", "penalty"],
     "engine/mj_yield.c": ["yield_mj", "yield_scene", "yield"],
+    "problems/scene_energy.c": ["yield_scene"],
 }
 
 # Array indices checked against the arrays' sizes (a trap, no runtime

@@ -80,6 +80,14 @@ static void test_yield_scene_example(pd_test_ctx *ctx)
         pd_scene_result_free(&nm);
     }
     pd_scene_result_free(&mj);
+    /* under a cosine pulse (full force from the first step: every step's
+     * share counts) the balance closes as well */
+    sc->exc.pulse = PD_PULSE_COSINE;
+    if (yrun(ctx, sc, PD_METHOD_MOREAU, 0.0, &mj))
+        CHECK(ctx, fabs(mj.energy.residual) <= 1e-12 && mj.energy.input > 0.0,
+              "cosine pulse: the energy balance's residual %.3g", mj.energy.residual);
+    pd_scene_result_free(&mj);
+    sc->exc.pulse = PD_PULSE_SINE;
     /* the methods without yielding storeys refuse, naming uy */
     const pd_method refused[] = {PD_METHOD_EVENT, PD_METHOD_EVENT_GENERAL, PD_METHOD_PENALTY};
     for (int m = 0; m < 3; m++) {
