@@ -316,6 +316,17 @@ static void warn_rtol(double rtol, double err_est, int met)
                 rtol, err_est);
 }
 
+/* A yielding run's energy balance on one line, when it has one (a finite
+ * input), in unit (J/kg for the oscillator, J for a scene). */
+static void energy_line(const pd_energy *en, const char *unit)
+{
+    if (isfinite(en->input))
+        printf("  energy    = input %.6g %s = kinetic %.4g + strain %.4g + damping %.4g + "
+               "hysteretic %.4g + impacts %.4g, residual %.2g of the input\n",
+               en->input, unit, en->kinetic, en->strain, en->damping, en->hysteretic, en->impact,
+               en->residual);
+}
+
 static void print_text(const sim_args *a, const pd_osc_summary *s)
 {
     const pd_osc *c = &a->k.c;
@@ -366,11 +377,8 @@ static void print_text(const sim_args *a, const pd_osc_summary *s)
         printf("  newton    = %ld of %ld steps failed Newton's iterations (each redone at the "
                "spring's initial stiffness)\n",
                s->r.newton_failures, s->r.steps);
-    if (pd_osc_yields(c) && isfinite(s->r.energy.input))
-        printf("  energy    = input %.6g J/kg = kinetic %.4g + strain %.4g + damping %.4g + "
-               "hysteretic %.4g + impacts %.4g, residual %.2g of the input\n",
-               s->r.energy.input, s->r.energy.kinetic, s->r.energy.strain, s->r.energy.damping,
-               s->r.energy.hysteretic, s->r.energy.impact, s->r.energy.residual);
+    if (pd_osc_yields(c))
+        energy_line(&s->r.energy, "J/kg");
     printf("  demands   = drift ratio %.5g (height %g m), a_abs %.6g m/s^2, base shear per "
            "unit mass %.6g N/kg\n",
            s->r.umax / a->k.height, a->k.height, s->r.acc_max, s->r.shear_max);
@@ -799,11 +807,7 @@ static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_sum
                        r->n_yield[d], r->plastic_excursion[d]);
             }
         }
-        if (isfinite(r->energy.input))
-            printf("  energy    = input %.6g J = kinetic %.4g + strain %.4g + damping %.4g + "
-                   "hysteretic %.4g + impacts %.4g, residual %.2g of the input\n",
-                   r->energy.input, r->energy.kinetic, r->energy.strain, r->energy.damping,
-                   r->energy.hysteretic, r->energy.impact, r->energy.residual);
+        energy_line(&r->energy, "J");
     }
     if (sc->ncontact)
         printf("  %-22s %6s %10s %8s %12s %14s %10s\n", "contact", "level", "gap [m]", "impacts",

@@ -37,18 +37,24 @@ static inline void pd_osc_result_no_rtol(pd_osc_result *res, double step)
     res->dt_min = res->dt_max = step;
 }
 
+/* An energy balance not measured: NAN throughout. */
+static inline pd_energy pd_energy_none(void)
+{
+    return (pd_energy){.input = NAN,
+                       .kinetic = NAN,
+                       .strain = NAN,
+                       .damping = NAN,
+                       .hysteretic = NAN,
+                       .impact = NAN,
+                       .residual = NAN};
+}
+
 /* The yielding fields of an elastic run: NAN, no onsets. */
 static inline void pd_osc_result_no_yield(pd_osc_result *res)
 {
     res->ductility = res->residual = res->plastic_excursion = res->hysteretic_energy = NAN;
     res->n_yield = 0;
-    res->energy = (pd_energy){.input = NAN,
-                              .kinetic = NAN,
-                              .strain = NAN,
-                              .damping = NAN,
-                              .hysteretic = NAN,
-                              .impact = NAN,
-                              .residual = NAN};
+    res->energy = pd_energy_none();
 }
 
 /* A yielding run's figures from its offset at the end, its excursion and

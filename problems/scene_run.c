@@ -1625,13 +1625,7 @@ int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler s
     res->law_band_max = NAN;
     for (int s = 0; s < res->nstruct; s++)
         res->law_band[s] = NAN;
-    res->energy = (pd_energy){.input = NAN,
-                              .kinetic = NAN,
-                              .strain = NAN,
-                              .damping = NAN,
-                              .hysteretic = NAN,
-                              .impact = NAN,
-                              .residual = NAN};
+    res->energy = pd_energy_none();
     double cpu0 = pd_cpu_seconds(), wall0 = pd_wall_seconds(), sample_s = 0.0;
     if (o.kernel == PD_KERNEL_AUTO && o.method != PD_METHOD_EVENT_GENERAL && springs == 0 &&
         pd_scene_as_oscillator(sc, &c, &mirrored))
