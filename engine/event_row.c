@@ -565,6 +565,95 @@ static void predict_detach(pd_edr *r, int c, double ts, int cont)
     q_set(&r->rs.q, slot, tw < tend ? tw : HUGE_VAL);
 }
 
+/* A yielding spring's event function (spring j, its dof's cluster c):
+ * elastic, z^2 - uy^2 with z = sig x - up (positive past either level: an
+ * onset); sliding toward ph, -ph sig v (positive once the drift turns
+ * back: the unloading). */
+typedef struct spring_ctx {
+    pd_edr *r;
+    int c, dof;
+    double sig, up, uy, ph;
+    double shift; /* rounding at the start taken off (f = 0 there) */
+} spring_ctx;
+
+static void spring_fn(void *vctx, double t, double out[3])
+{
+    spring_ctx *g = vctx;
+    double dx, v, a;
+    edr_dof_at(g->r, g->c, g->dof, t, &dx, &v, &a);
+    if (g->ph == 0.0) {
+        double z = g->sig * (g->r->rs.xo[g->dof] + dx) - g->up, dz = g->sig * v;
+        out[0] = (z - g->uy) * (z + g->uy) - g->shift;
+        out[1] = 2.0 * z * dz;
+        out[2] = 2.0 * (dz * dz + z * g->sig * a);
+        return;
+    }
+    double k = -g->ph * g->sig;
+    out[0] = k * v - g->shift;
+    out[1] = k * a;
+    out[2] = k * edr_dof_jerk(g->r, g->c, g->dof, t);
+}
+
+/* Spring j's next onset or unloading after ts, or the end of its scan
+ * window (as predict_contact's windows). */
+static void predict_spring(pd_edr *r, int j, double ts, int cont)
+{
+    int slot = r->rs.slot_spring0 + j, dof = r->tp.sp_dof[j], c = cl_of_dof(r, dof);
+    const edr_cluster *cl = &r->rs.cl[c];
+    if (cl->kind == EDR_REST) { /* held still: no drift changes (its release re-predicts) */
+        q_set(&r->rs.q, slot, HUGE_VAL);
+        return;
+    }
+    spring_ctx g = {.r = r,
+                    .c = c,
+                    .dof = dof,
+                    .sig = r->tp.sp_sig[j],
+                    .up = r->rs.sp_up[j],
+                    .uy = r->tp.md->uy[j],
+                    .ph = r->rs.sp_phase[j]};
+    /* rounding levels: of z^2 - uy^2, or of the drift's rate */
+    double dx, v, a;
+    edr_dof_at(r, c, dof, ts, &dx, &v, &a);
+    double thr = g.ph == 0.0 ? EDR_GAP_ROUND * g.uy * g.uy
+                             : EDR_RATE_TOL * fmax(r->rs.vscale, fabs(g.sig * v));
+    edr_scan s = {
+        .fn = spring_fn, .ctx = &g, .hit_mode = 1, .thr = thr, .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
+    int win = cont && r->rs.win[slot] > 0 ? r->rs.win[slot] : EDR_WINDOW0;
+    r->rs.win[slot] = win < EDR_WINDOW ? 2 * win : EDR_WINDOW;
+    double h = cl->h, tend = horizon(r), tw = fmin(tend, ts + win * h);
+    s.width = 4e-8 * h;
+    edr_pt p = edr_scan_point(&s, ts);
+    if (p.f > 0.0) { /* past the level at the start: rounding (the origin decided the phase) */
+        g.shift = p.f;
+        p.f = 0.0;
+    }
+    long n = (long)ceil((tw - ts) / h);
+    if (n < 1)
+        n = 1;
+    for (long i = 1; i <= n; i++) {
+        double tb = i == n ? tw : ts + (double)i * h, hit;
+        if (!(tb > p.t))
+            break;
+        edr_pt b = edr_scan_point(&s, tb);
+        if (edr_scan_interval(&s, &p, &b, &hit)) {
+            r->rs.qkind[slot] = EDR_Q_HIT;
+            q_set(&r->rs.q, slot, hit);
+            return;
+        }
+        p = b;
+    }
+    r->rs.qkind[slot] = EDR_Q_SCAN;
+    q_set(&r->rs.q, slot, tw < tend ? tw : HUGE_VAL);
+}
+
+/* The springs of cluster c predicted again from ts. */
+static void predict_cluster_springs(pd_edr *r, int c, double ts)
+{
+    for (int b = r->rs.cl[c].head; b >= 0 && r->tp.ns > 0; b = r->rs.blk_next[b])
+        if (r->tp.blk[b].spring >= 0)
+            predict_spring(r, r->tp.blk[b].spring, ts, 0);
+}
+
 /* ---- measurements ----------------------------------------------------------------- */
 
 typedef struct meas_ctx {
@@ -1046,14 +1135,20 @@ static int solve_lcp(pd_edr *r, const int *idx, int k, const double *q, double *
 /* out = M^-1 (b f - C v - K x) over the group's dofs (global index): the
  * free accelerations from (x, v) = (gx, gv) and f(t), the free jerks from
  * (v, a) and f'(t). */
-static void group_rhs(pd_edr *r, double f, const double *x, const double *v, double *out)
+static void group_rhs(pd_edr *r, double f, const double *x, const double *v, int konst, double *out)
 {
     for (int k = 0; k < r->ev.ngd; k++) {
         int i = r->ev.g_dof[k], b = r->tp.dof_blk[i];
         const edr_block *bk = &r->tp.blk[b];
         /* an SDOF block: (b f - c v - k x) / m */
-        if (bk->sdof) {
+        if (bk->sdof && bk->spring < 0) {
             out[i] = (bk->b * f - bk->c * v[i] - bk->k * x[i]) * r->tp.minv[i];
+            continue;
+        }
+        if (bk->sdof) { /* a yielding spring: k_eff x + r0 (r0 dropped from the jerks) */
+            double keff, r0;
+            edr_block_stiffness(r, b, &keff, &r0);
+            out[i] = (bk->b * f - bk->c * v[i] - keff * x[i] - (konst ? r0 : 0.0)) * r->tp.minv[i];
             continue;
         }
         /* a block: row li of b f - C v - K x over its dofs (C, K column-major at
@@ -1073,7 +1168,7 @@ static void group_rhs(pd_edr *r, double f, const double *x, const double *v, dou
 /* Free accelerations M^-1 (b f - C v - K x) of the group's dofs at t. */
 static void free_accelerations(pd_edr *r, double t)
 {
-    group_rhs(r, edr_force(r, edr_piece_at(r, t), t), r->ev.gx, r->ev.gv, r->ev.gacc);
+    group_rhs(r, edr_force(r, edr_piece_at(r, t), t), r->ev.gx, r->ev.gv, 1, r->ev.gacc);
 }
 
 /* The free jerks of the group's dofs into r->ev.gtmp, from the free
@@ -1083,7 +1178,7 @@ static void free_jerks(pd_edr *r, double t)
     const pd_sine_piece *pc = &r->tp.pieces[edr_piece_at(r, t)];
     /* f'(t) = c1 + A w cos(w t + phi) on the piece at t */
     double df = pc->c1 + (pc->A == 0.0 ? 0.0 : pc->A * pc->w * cos(pc->w * t + pc->phi));
-    group_rhs(r, df, r->ev.gv, r->ev.gacc, r->ev.gtmp);
+    group_rhs(r, df, r->ev.gv, r->ev.gacc, 0, r->ev.gtmp);
 }
 
 /* W_a^T y over the group's state array y (walls at rest). */
@@ -1261,6 +1356,7 @@ static void repredict(pd_edr *r, double t)
             }
         }
         predict_detach(r, c, t, 0);
+        predict_cluster_springs(r, c, t);
     }
 }
 
@@ -2342,6 +2438,60 @@ static int on_detach(pd_edr *r, int c, double t, pd_err *err)
     return PD_OK;
 }
 
+/* The time of the impact queued for an open contact of dof's structure
+ * whose gap is within the closing tolerance at t, closing (HUGE_VAL:
+ * none): a yield level there is the contact's (the offset a slide into it
+ * left), and its impact comes first. */
+static double impact_due(pd_edr *r, int dof, double t)
+{
+    const edr_block *bk = &r->tp.blk[r->tp.dof_blk[dof]];
+    double due = HUGE_VAL;
+    for (int k = 0; k < bk->ncont; k++) {
+        int a = r->tp.blk_cont[bk->cont0 + k];
+        double U;
+        if (r->rs.cstate[a] == EDR_OPEN && r->rs.qkind[a] == EDR_Q_HIT &&
+            gap_now(r, a, t, &U) <= r->tp.o.close_tol * r->rs.L && U < 0.0)
+            due = fmin(due, r->rs.q.key[a]);
+    }
+    return due;
+}
+
+/* Spring j yields or unloads at t: its cluster re-origins in the new phase
+ * (the force is continuous, the held contacts stay held).  An onset at a
+ * closing contact waits for its impact (which predicts it again). */
+static int on_spring(pd_edr *r, int j, double t, pd_err *err)
+{
+    int rc, dof = r->tp.sp_dof[j], c = cl_of_dof(r, dof), slot = r->rs.slot_spring0 + j;
+    if ((rc = count_event(r, slot, t, err)))
+        return rc;
+    double due = r->rs.sp_phase[j] == 0 ? impact_due(r, dof, t) : HUGE_VAL;
+    if (due < HUGE_VAL) {
+        r->rs.qkind[slot] = EDR_Q_SCAN;
+        q_set(&r->rs.q, slot, fmax(due, t));
+        return PD_OK;
+    }
+    group_begin(r);
+    group_add_cluster(r, c);
+    for (int b = r->rs.cl[c].head; b >= 0; b = r->rs.blk_next[b]) {
+        const edr_block *bk = &r->tp.blk[b];
+        for (int k = 0; k < bk->ncont; k++) {
+            int x = r->tp.blk_cont[bk->cont0 + k];
+            if (r->rs.cstate[x] != EDR_OPEN && r->ev.ct_mark[x] != r->ev.epoch)
+                group_add_contact(r, x);
+        }
+    }
+    group_state(r, t);
+    for (int k = 0; k < r->ev.ngc; k++)
+        r->ev.held[k] = r->rs.cstate[r->ev.g_ct[k]] != EDR_OPEN;
+    /* elastic: a slide toward the level passed; sliding: the drift turned back */
+    double x = r->ev.gx[dof], z = r->tp.sp_sig[j] * x - r->rs.sp_up[j];
+    edr_spring_set(r, j, x, r->rs.sp_phase[j] != 0 ? 0 : z > 0.0 ? 1 : -1);
+    if ((rc = regroup(r, t, err)))
+        return rc;
+    repredict(r, t);
+    return PD_OK;
+}
+
 /* The forcing's next piece starts at t: every cluster re-origins on it;
  * held contacts whose force would be negative decide again. */
 static int on_piece(pd_edr *r, double t, pd_err *err)
@@ -2409,12 +2559,28 @@ static int on_piece(pd_edr *r, double t, pd_err *err)
     for (int i = 0; i < r->tp.m; i++)
         predict_contact(r, i, t, 0);
     for (int c = 0; c < r->tp.nb; c++)
-        if (r->rs.cl[c].live)
+        if (r->rs.cl[c].live) {
             predict_detach(r, c, t, 0);
+            predict_cluster_springs(r, c, t);
+        }
     /* the next piece change, if before t1 */
     double next = edr_piece_end(r, r->rs.piece);
     q_set(&r->rs.q, r->rs.slot_piece, next < r->rs.t1 ? next : HUGE_VAL);
     return PD_OK;
+}
+
+/* The springs' offsets at t into sp_now (a slide's from its dof's x). */
+static void spring_offsets(pd_edr *r, double t)
+{
+    for (int j = 0; j < r->tp.ns; j++) {
+        double x, v, a;
+        if (r->rs.sp_phase[j] == 0) {
+            r->rs.sp_now[j] = r->rs.sp_up[j];
+            continue;
+        }
+        dof_state(r, r->tp.sp_dof[j], t, &x, &v, &a);
+        r->rs.sp_now[j] = r->tp.sp_sig[j] * x - r->rs.sp_phase[j] * r->tp.md->uy[j];
+    }
 }
 
 /* The observer's state at t. */
@@ -2435,6 +2601,10 @@ static int emit(pd_edr *r, double t, pd_observer obs, void *ctx)
         r->rs.st.P[a] = r->rs.imp_out[a];
         r->rs.imp_out[a] = 0.0;
         r->rs.st.active[a] = r->rs.cstate[a] == EDR_PERSIST;
+    }
+    if (r->tp.ns > 0) { /* the springs' offsets at t */
+        spring_offsets(r, t);
+        r->rs.st.up = r->rs.sp_now;
     }
     r->rs.st.t = t;
     r->rs.st.has_acc = 1;
@@ -2468,6 +2638,17 @@ static int emit(pd_edr *r, double t, pd_observer obs, void *ctx)
 #define EDR_BLOCK_ARRAYS(X)                                                                        \
     X(tp.blk, edr_block, nb)                                                                       \
     X(tp.blk_off, long, nb + 1)
+
+/* The yielding springs. */
+#define EDR_SPRING_ARRAYS(X)                                                                       \
+    X(tp.sp_dof, int, ns)                                                                          \
+    X(tp.sp_sig, double, ns)                                                                       \
+    X(rs.sp_phase, signed char, ns)                                                                \
+    X(rs.sp_up, double, ns)                                                                        \
+    X(rs.sp_upx, double, ns)                                                                       \
+    X(rs.sp_exc, double, ns)                                                                       \
+    X(rs.sp_now, double, ns)                                                                       \
+    X(rs.sp_onsets, long, ns)
 
 /* The blocks' dense damping and stiffness, sum over the blocks of n_b^2 entries. */
 #define EDR_MATRIX_ARRAYS(X)                                                                       \
@@ -2591,7 +2772,9 @@ static int emit(pd_edr *r, double t, pd_observer obs, void *ctx)
     X(rs.st.active, unsigned char, m)                                                              \
     X(rs.st.acc, double, n)
 
-#define EDR_ARRAYS(X) EDR_MODEL_ARRAYS(X) EDR_BLOCK_ARRAYS(X) EDR_MATRIX_ARRAYS(X) EDR_RUN_ARRAYS(X)
+#define EDR_ARRAYS(X)                                                                              \
+    EDR_MODEL_ARRAYS(X)                                                                            \
+    EDR_BLOCK_ARRAYS(X) EDR_SPRING_ARRAYS(X) EDR_MATRIX_ARRAYS(X) EDR_RUN_ARRAYS(X)
 
 /* Each entry's element type is its field's (checked, not evaluated). */
 #define EDR_ARRAY_TYPE(field, type, count)                                                         \
@@ -2604,8 +2787,10 @@ EDR_ARRAYS(EDR_ARRAY_TYPE)
 typedef struct edr_sizes {
     long n, m, npieces; /* dofs, contacts, forcing pieces */
     long nb;            /* blocks (and cluster slots: a cluster holds at least one) */
+    long ns;            /* yielding springs */
     long nentries;      /* the blocks' dense matrices: sum of n_b^2 */
-    long nslot;         /* queue slots: the contacts, the clusters, the piece, the output */
+    long nslot;         /* queue slots: the contacts, the clusters, the piece, the output,
+                           the springs */
     long dm;            /* the clusters' dense LCPs: min(m, EDR_REDUCED_MAX) contacts */
     long dcap;          /* entries of a compressed Delassus matrix */
     long nmeas;         /* functions measured on one cluster: each dof's x and drift */
@@ -2627,6 +2812,13 @@ static int alloc_block_arrays(pd_edr *r, const edr_sizes *sizes)
 {
     long nb = sizes->nb;
     EDR_BLOCK_ARRAYS(EDR_ALLOC_ARRAY)
+    return PD_OK;
+}
+
+static int alloc_spring_arrays(pd_edr *r, const edr_sizes *sizes)
+{
+    long ns = sizes->ns;
+    EDR_SPRING_ARRAYS(EDR_ALLOC_ARRAY)
     return PD_OK;
 }
 
@@ -2763,8 +2955,7 @@ static int check_inputs(const pd_model *md, const pd_piecewise_force *F, const p
         return pd_err_set(err, PD_EINVAL,
                           "row reference: a model and a piecewise force are "
                           "needed");
-    if ((rc = pd_model_check(md, err)) || (rc = pd_model_refuse_yield(md, "row reference", err)) ||
-        (rc = check_opts(o, err)))
+    if ((rc = pd_model_check(md, err)) || (rc = check_opts(o, err)))
         return rc;
     if (!pd_matrix_is_diagonal(&md->M))
         return pd_err_set(err, PD_EINVAL,
@@ -2878,6 +3069,65 @@ static int fill_blocks(pd_edr *r, pd_err *err)
     return PD_OK;
 }
 
+/* Spring j's entries of S: their count and the last one's dof and value. */
+typedef struct spring_col_ctx {
+    int *count, *dof;
+    double *val;
+} spring_col_ctx;
+
+static void spring_entry(void *ctx, int i, int j, double x)
+{
+    spring_col_ctx *c = ctx;
+    if (x == 0.0)
+        return;
+    c->count[j]++;
+    c->dof[j] = i;
+    c->val[j] = x;
+}
+
+/* The yielding springs: each on the one dof of an SDOF structure (its S
+ * column one entry), one a structure, its post-yield stiffness k - sig^2
+ * ks >= 0. */
+static int set_springs(pd_edr *r, pd_err *err)
+{
+    const pd_model *md = r->tp.md;
+    for (int b = 0; b < r->tp.nb; b++)
+        r->tp.blk[b].spring = -1;
+    if (r->tp.ns == 0)
+        return PD_OK;
+    int *cnt = pd_calloc(r->tp.ns, sizeof(int));
+    if (!cnt)
+        return out_of_memory(r, err);
+    spring_col_ctx c = {.count = cnt, .dof = r->tp.sp_dof, .val = r->tp.sp_sig};
+    for_each_entry(&md->S, spring_entry, &c);
+    int rc = PD_OK;
+    for (int j = 0; j < r->tp.ns && !rc; j++) {
+        int i = r->tp.sp_dof[j], b = cnt[j] == 1 ? r->tp.dof_blk[i] : -1;
+        edr_block *bk = b >= 0 ? &r->tp.blk[b] : NULL;
+        double sg = r->tp.sp_sig[j];
+        if (!bk || !bk->sdof)
+            rc = pd_err_set(err, PD_EINVAL,
+                            "uy: the row reference yields SDOF structures only; yielding spring "
+                            "%d is on %s (%d dofs): a yielding building runs by Moreau-Jean or "
+                            "newmark",
+                            j, bk ? "a storey of a building" : "a drift of several dofs",
+                            bk ? bk->n : cnt[j]);
+        else if (bk->spring >= 0)
+            rc = pd_err_set(err, PD_EINVAL,
+                            "uy: row reference: dof %d has two yielding springs (%d and %d)", i,
+                            bk->spring, j);
+        else if (bk->k - sg * sg * md->ks[j] < -1e-12 * bk->k)
+            rc = pd_err_set(err, PD_EINVAL,
+                            "uy: row reference: yielding spring %d leaves dof %d a negative "
+                            "post-yield stiffness (k %g < sig^2 ks %g)",
+                            j, i, bk->k, sg * sg * md->ks[j]);
+        else
+            bk->spring = j;
+    }
+    free(cnt);
+    return rc;
+}
+
 /* The contacts from W's columns: one or two dofs each, in different
  * structures (g = g0 + w0 x_dof0 + w1 x_dof1). */
 static int set_contacts(pd_edr *r, pd_err *err)
@@ -2987,10 +3237,15 @@ static int build(pd_edr *r, const pd_piecewise_force *F, int *uf, pd_err *err)
         return out_of_memory(r, err);
     if ((rc = fill_blocks(r, err)) || (rc = set_contacts(r, err)))
         return rc;
+    sizes.ns = r->tp.ns = r->tp.md->ns;
+    if (alloc_spring_arrays(r, &sizes))
+        return out_of_memory(r, err);
+    if ((rc = set_springs(r, err)))
+        return rc;
     /* D's entries: at most sum over the dofs of dg^2; m more to spare */
     r->ev.Dcap = link_contacts(r, uf) + r->tp.m;
     int dm = r->tp.m < EDR_REDUCED_MAX ? r->tp.m : EDR_REDUCED_MAX;
-    sizes.nslot = r->tp.m + r->tp.nb + 2;
+    sizes.nslot = r->tp.m + r->tp.nb + 2 + r->tp.ns;
     sizes.dm = dm;
     sizes.dcap = r->ev.Dcap;
     sizes.nmeas = 2L * r->tp.n;
@@ -3030,6 +3285,7 @@ pd_edr *pd_edr_alloc(const pd_model *md, const pd_piecewise_force *F, const pd_e
     /* the queue's last two slots: the piece change and the output */
     r->rs.slot_piece = r->tp.m + r->tp.nb;
     r->rs.slot_out = r->tp.m + r->tp.nb + 1;
+    r->rs.slot_spring0 = r->tp.m + r->tp.nb + 2;
     return r;
 }
 
@@ -3046,7 +3302,7 @@ static void reset(pd_edr *r, double t0, const double *q0, const double *v0, doub
     r->rs.piece = edr_piece_at(r, t0);
     /* the queue empty: every slot out of it (pos -1, key +inf) */
     r->rs.q.n = 0;
-    for (int k = 0; k < m + r->tp.nb + 2; k++) {
+    for (int k = 0; k < m + r->tp.nb + 2 + r->tp.ns; k++) {
         r->rs.q.pos[k] = -1;
         r->rs.q.key[k] = HUGE_VAL;
     }
@@ -3091,12 +3347,17 @@ static void reset(pd_edr *r, double t0, const double *q0, const double *v0, doub
     memset(r->ev.ct_markD, 0, (size_t)m * sizeof *r->ev.ct_markD);
     memset(r->ev.ct_markP, 0, (size_t)m * sizeof *r->ev.ct_markP);
     r->ev.epochP = 0;
-    for (int k = 0; k < m + r->tp.nb + 2; k++) {
+    for (int k = 0; k < m + r->tp.nb + 2 + r->tp.ns; k++) {
         /* NaN: no event yet (it equals no t) */
         r->rs.slot_t[k] = NAN;
         r->rs.slot_same[k] = 0;
         r->rs.slot_run[k] = 0;
         r->rs.slot_t0[k] = t0;
+    }
+    for (int j = 0; j < r->tp.ns; j++) { /* every spring elastic, unmoved */
+        r->rs.sp_phase[j] = 0;
+        r->rs.sp_up[j] = r->rs.sp_upx[j] = r->rs.sp_exc[j] = r->rs.sp_now[j] = 0.0;
+        r->rs.sp_onsets[j] = 0;
     }
     r->rs.stopped = 0;
     r->rs.vscale = 0.0;
@@ -3148,8 +3409,10 @@ static int start(pd_edr *r, double t0, pd_err *err)
     for (int a = 0; a < r->tp.m; a++)
         predict_contact(r, a, t0, 0);
     for (int c = 0; c < r->tp.nb; c++)
-        if (r->rs.cl[c].live)
+        if (r->rs.cl[c].live) {
             predict_detach(r, c, t0, 0);
+            predict_cluster_springs(r, c, t0);
+        }
     double next = edr_piece_end(r, r->rs.piece);
     q_set(&r->rs.q, r->rs.slot_piece, next < r->rs.t1 ? next : HUGE_VAL);
     return PD_OK;
@@ -3176,6 +3439,12 @@ static void finish(pd_edr *r, double t)
         if (!(r->rs.xpos[i] > -HUGE_VAL))
             r->rs.xpos[i] = r->rs.xneg[i] = r->rs.drift[i] = 0.0;
     }
+    spring_offsets(r, t);
+    for (int j = 0; j < r->tp.ns; j++) /* a slide under way: its excursion up to t */
+        if (r->rs.sp_phase[j] != 0) {
+            r->rs.sp_exc[j] += fabs(r->rs.sp_now[j] - r->rs.sp_upx[j]);
+            r->rs.sp_upx[j] = r->rs.sp_now[j];
+        }
     r->rs.res.t_reached = t;
     r->rs.res.evals = (double)r->rs.evals;
 }
@@ -3245,6 +3514,12 @@ int pd_edr_run(pd_edr *r, double t0, const double *q0, const double *v0, double 
                 predict_contact(r, slot, t, 1);
             else
                 rc = on_impact(r, slot, t, err);
+        } else if (slot >= r->rs.slot_spring0) { /* a spring's onset or unloading */
+            int j = slot - r->rs.slot_spring0;
+            if (r->rs.qkind[slot] == EDR_Q_SCAN)
+                predict_spring(r, j, t, 1);
+            else
+                rc = on_spring(r, j, t, err);
         } else {
             int c = slot - r->tp.m;
             if (r->rs.qkind[slot] == EDR_Q_SCAN)
@@ -3283,5 +3558,9 @@ const pd_edr_result *pd_edr_result_of(const pd_edr *r)
     res->contact_time = r->rs.ctime;
     res->min_gap = r->rs.gmin;
     res->modal_bases = r->rs.nbasis;
+    res->ns = r->tp.ns;
+    res->up = r->rs.sp_now;
+    res->plastic_excursion = r->rs.sp_exc;
+    res->yield_onsets = r->rs.sp_onsets;
     return res;
 }

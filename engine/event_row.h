@@ -70,6 +70,7 @@ typedef struct edr_block {
     double m, c, k;   /* SDOF: its scalars */
     double b;         /* SDOF: its load coefficient */
     int cont0, ncont; /* its contacts: r->tp.blk_cont[cont0 .. cont0 + ncont) */
+    int spring;       /* SDOF: its yielding spring (-1: none) */
 } edr_block;
 
 typedef struct edr_contact {
@@ -116,6 +117,10 @@ typedef struct edr_cluster {
     pd_sdof osc;
     double rho, kappa; /* y'' + 2 xi w0 y' + w0^2 y = rho f + kappa */
     double mass;       /* sum s^2 m */
+    double a2;         /* damping per unit mass of the flight: 2 xi w0, or the
+                          damped free mass's C / M (mass_flight) */
+    int mass_flight;   /* every spring of a free tree sliding with no stiffness
+                          left: y'' + a2 y' = F, pd_sdof_flow_init_mass */
     pd_sine_piece pc;  /* the piece as the flow sees it */
     pd_sdof_flow flow;
     double y0, vy0;
@@ -173,6 +178,11 @@ typedef struct edr_topo {
     int *dofc_ptr, *dofc; /* contacts of each dof */
     edr_contact *ct;
     double *minv; /* n: 1 / M_ii */
+    /* yielding springs (SDOF blocks only): spring j on dof sp_dof[j], its
+     * drift sp_sig[j] x (the model's S column), ks and uy the model's */
+    int ns;
+    int *sp_dof;
+    double *sp_sig;
 } edr_topo;
 
 /* The run: clusters, the contacts' states, results, the event queue, the
@@ -202,7 +212,8 @@ typedef struct edr_run {
     long *impacts;
     double *first, *maxP, *ctime, *imp_out; /* imp_out: impulses since the last sample */
     int sample_forces; /* the held forces' integrals go into imp_out (a sampler) */
-    /* queue: contacts 0..m-1, clusters m..m+nb-1, piece m+nb, output m+nb+1 */
+    /* queue: contacts 0..m-1, clusters m..m+nb-1, piece m+nb, output m+nb+1,
+     * springs m+nb+2.. */
     edr_queue q;
     int slot_piece, slot_out;
     long next_out;
@@ -217,6 +228,13 @@ typedef struct edr_run {
     int stopped;
     double vscale; /* largest velocity met at an event */
     long evals;
+    /* yielding springs: phase (0 elastic, +-1 sliding toward that side), the
+     * offset up (sliding: up = sig x - phase uy, sp_up its value at the
+     * slide's last origin), the excursion summed up to sp_upx, onsets */
+    signed char *sp_phase;
+    double *sp_up, *sp_upx, *sp_exc, *sp_now;
+    long *sp_onsets;
+    int slot_spring0; /* the springs' queue slots: slot_spring0 + j */
     /* modal cache */
     edr_basis **bhash;
     int nbhash;
@@ -298,8 +316,16 @@ int edr_cluster_start(pd_edr *r, int c, double t, pd_err *err);
 void edr_cluster_eval(pd_edr *r, int c, double t);
 /* x(t) - xo, v, a of one dof of cluster c (evaluated at t). */
 void edr_dof_at(pd_edr *r, int c, int dof, double t, double *dx, double *v, double *a);
+/* The jerk x^(3) of one dof of an SDOF tree (0 for the other kinds). */
+double edr_dof_jerk(pd_edr *r, int c, int dof, double t);
+/* Spring j into phase (0 elastic, +-1 sliding) with its dof at x: the
+ * offset, the excursion and the onsets kept. */
+void edr_spring_set(pd_edr *r, int j, double x, int phase);
 /* lambda of persistent contact a of cluster c at t. */
 double edr_force_at(pd_edr *r, int c, int a, double t);
+/* A block's restoring force k x - sig ks up(x) as k_eff x + r0 (its spring's
+ * phase; k, 0 without a spring). */
+void edr_block_stiffness(const pd_edr *r, int b, double *keff, double *r0);
 /* Release a cluster's modal storage and the cache. */
 void edr_basis_cache_free(pd_edr *r);
 void edr_cluster_free(edr_cluster *c);

@@ -177,7 +177,7 @@ static void taylor_init(pd_edr *r, edr_cluster *c, double t)
     const pd_sine_piece *p = &r->tp.pieces[c->piece], *q = &c->pc;
     double th = p->w * t + p->phi, sn = sin(th), cs = cos(th), w0 = c->osc.w0;
     /* d^k/dt^k sin(th) = sin(th + k pi / 2), one of cyc[k % 4]; wk = w^k */
-    double cyc[4] = {sn, cs, -sn, -cs}, wk = 1.0, a2 = 2.0 * c->osc.xi * w0, k0 = w0 * w0;
+    double cyc[4] = {sn, cs, -sn, -cs}, wk = 1.0, a2 = c->a2, k0 = w0 * w0;
     double *y = c->tay, *f = c->ftay;
     y[0] = c->y0;
     y[1] = c->vy0;
@@ -201,6 +201,8 @@ static void taylor_init(pd_edr *r, edr_cluster *c, double t)
     }
     /* Omega, the flight's fastest rate: the series serves for |s| <= REACH / Omega */
     double Om = fmax(w0, p->A != 0.0 ? p->w : 0.0);
+    if (c->mass_flight) /* the damped mass's rate */
+        Om = fmax(Om, a2);
     c->s_taylor = Om > 0.0 ? EDR_TAYLOR_REACH / Om : 0.0;
 }
 
@@ -236,6 +238,29 @@ static void flight_bounds(pd_edr *r, edr_cluster *c)
     c->bnd = 1;
 }
 
+/* A post-yield stiffness below this share of the initial one is none (an
+ * elastic-perfectly-plastic spring's k - sig^2 ks, zero up to rounding). */
+#define EDR_KEFF_ZERO 1e-12
+
+void edr_block_stiffness(const pd_edr *r, int b, double *keff, double *r0)
+{
+    const edr_block *bk = &r->tp.blk[b];
+    int j = bk->spring;
+    *keff = bk->k;
+    *r0 = 0.0;
+    if (j < 0)
+        return;
+    double sg = r->tp.sp_sig[j], ks = r->tp.md->ks[j], ph = r->rs.sp_phase[j];
+    if (ph == 0.0) { /* elastic: up fixed */
+        *r0 = -sg * ks * r->rs.sp_up[j];
+        return;
+    }
+    /* sliding: up = sg x - ph uy, so k x - sg ks up = (k - sg^2 ks) x + sg ks ph uy */
+    double k = bk->k - sg * sg * ks;
+    *keff = k > EDR_KEFF_ZERO * bk->k ? k : 0.0;
+    *r0 = sg * ks * ph * r->tp.md->uy[j];
+}
+
 /* The tree's per-node terms summed over each node's subtree (in r->ev.wk). */
 typedef struct tree_sums {
     double *Ms, *Cs, *Ks; /* sum s^2 m, sum s^2 c, sum s^2 k */
@@ -258,8 +283,15 @@ static tree_sums subtree_sums(pd_edr *r, const int *ord, const int *pd, int nn)
         double s = r->rs.s[i];
         S.Ms[i] = s * s * bk->m;
         S.Cs[i] = s * s * bk->c;
-        S.Ks[i] = s * s * bk->k;
-        S.KDs[i] = s * bk->k * r->rs.d[i];
+        if (bk->spring < 0) {
+            S.Ks[i] = s * s * bk->k;
+            S.KDs[i] = s * bk->k * r->rs.d[i];
+        } else { /* a yielding spring: its phase's k_eff x + r0 */
+            double keff, r0;
+            edr_block_stiffness(r, r->tp.dof_blk[i], &keff, &r0);
+            S.Ks[i] = s * s * keff;
+            S.KDs[i] = s * (keff * r->rs.d[i] + r0);
+        }
         S.Bs[i] = s * bk->b;
     }
     /* toward the root: in reverse breadth-first order every child is
@@ -290,8 +322,10 @@ static void tree_origin(pd_edr *r, edr_cluster *c, const int *ord, int nn, int w
         c->y0 = -ct->g0 / ww;
         c->vy0 = 0.0;
         c->osc = (pd_sdof){.w0 = 0.0, .xi = 0.0};
+        c->a2 = 0.0;
     } else {
         c->osc = (pd_sdof){.w0 = sqrt(K / M), .xi = K > 0.0 ? C / (2.0 * sqrt(K * M)) : 0.0};
+        c->a2 = c->mass_flight ? C / M : 2.0 * c->osc.xi * c->osc.w0;
         if (nn == 1) { /* one dof, no constraint: y = x */
             c->y0 = r->rs.xo[root];
             c->vy0 = r->rs.vo[root];
@@ -326,7 +360,7 @@ static void tree_origin(pd_edr *r, edr_cluster *c, const int *ord, int nn, int w
 static void tree_edge_forces(pd_edr *r, const edr_cluster *c, const int *ord, const int *pe, int nn,
                              const tree_sums *S)
 {
-    double w2 = c->osc.w0 * c->osc.w0, xw = 2.0 * c->osc.xi * c->osc.w0;
+    double w2 = c->osc.w0 * c->osc.w0, xw = c->a2;
     for (int k = 0; k < nn; k++) {
         int i = ord[k], e = pe[i];
         if (e < 0) /* a free tree's root; held, the root's edge is the wall's (the whole tree) */
@@ -345,6 +379,17 @@ static void tree_edge_forces(pd_edr *r, const edr_cluster *c, const int *ord, co
     }
 }
 
+/* Whether a spring of the tree's nodes ord[0..nn) slides. */
+static int tree_sliding(const pd_edr *r, const int *ord, int nn)
+{
+    for (int k = 0; k < nn; k++) {
+        int j = r->tp.blk[r->tp.dof_blk[ord[k]]].spring;
+        if (j >= 0 && r->rs.sp_phase[j] != 0)
+            return 1;
+    }
+    return 0;
+}
+
 /* An SDOF tree: aggregates, edge forces, flight.  Returns 0, or 1 when the
  * tree is no underdamped oscillator (it then runs as a modal cluster). */
 static int tree_start(pd_edr *r, edr_cluster *c, double t)
@@ -360,7 +405,9 @@ static int tree_start(pd_edr *r, edr_cluster *c, double t)
     tree_sums S = subtree_sums(r, ord, pd, nn);
     /* the aggregates M = sum s^2 m, C = sum s^2 c, K = sum s^2 k; critical C = 2 sqrt(K M) */
     double M = S.Ms[root], C = S.Cs[root], K = S.Ks[root];
-    if (wedge < 0 && (K > 0.0 ? C >= 2.0 * sqrt(K * M) : C > 0.0))
+    /* a damped free mass whose stiffness its sliding springs took: its own flight */
+    c->mass_flight = wedge < 0 && !(K > 0.0) && C > 0.0 && tree_sliding(r, ord, nn);
+    if (wedge < 0 && !c->mass_flight && (K > 0.0 ? C >= 2.0 * sqrt(K * M) : C > 0.0))
         return 1; /* overdamped, or a damped free mass */
     c->mass = M;
     c->root = root;
@@ -380,12 +427,18 @@ static int tree_start(pd_edr *r, edr_cluster *c, double t)
         c->pc.c1 = p->c1 * c->rho;
     }
     if (c->kind == EDR_SDOF) {
-        pd_sdof_flow_init(&c->flow, &c->osc, &c->pc, t, c->y0, c->vy0);
+        if (c->mass_flight)
+            pd_sdof_flow_init_mass(&c->flow, c->a2, &c->pc, t, c->y0, c->vy0);
+        else
+            pd_sdof_flow_init(&c->flow, &c->osc, &c->pc, t, c->y0, c->vy0);
         taylor_init(r, c, t);
     }
     flight_bounds(r, c);
-    /* the flight's shortest period 2 pi / w0 (none at rest or for a free mass) */
-    c->T_min = c->kind == EDR_SDOF && c->osc.w0 > 0.0 ? PD_TWO_PI / c->osc.w0 : HUGE_VAL;
+    /* the flight's shortest period 2 pi / w0 (none at rest or for a free
+     * mass; a damped one's 2 pi / a2, its decay's time scale) */
+    c->T_min = c->kind == EDR_SDOF && c->osc.w0 > 0.0 ? PD_TWO_PI / c->osc.w0
+               : c->mass_flight                       ? PD_TWO_PI / c->a2
+                                                      : HUGE_VAL;
     return 0;
 }
 
@@ -1162,6 +1215,76 @@ static int modal_start(pd_edr *r, edr_cluster *c, double t, pd_err *err)
     return PD_OK;
 }
 
+/* Whether a yielding spring of cluster c has left its initial state (a
+ * slide, or an offset): a modal flight has no place for its force. */
+static int cluster_yielded(const pd_edr *r, const edr_cluster *c)
+{
+    for (int b = c->head; b >= 0; b = r->rs.blk_next[b]) {
+        int j = r->tp.blk[b].spring;
+        if (j >= 0 && (r->rs.sp_phase[j] != 0 || r->rs.sp_up[j] != 0.0))
+            return 1;
+    }
+    return 0;
+}
+
+/* The phase spring j takes at a flight's origin (x, v, a its dof's): a
+ * slide goes on while its drift moves toward its side (or, at rest,
+ * accelerates there), else unloads; an elastic spring at its level starts
+ * sliding when its drift moves (or accelerates) past it. */
+static int spring_phase_at(const pd_edr *r, int j, double x, double v, double a)
+{
+    double sg = r->tp.sp_sig[j], ph = r->rs.sp_phase[j];
+    double dz = sg * v, ddz = sg * a;
+    if (ph != 0.0)
+        return ph * dz > 0.0 || (dz == 0.0 && ph * ddz > 0.0) ? (int)ph : 0;
+    double z = sg * x - r->rs.sp_up[j], side = z > 0.0 ? 1.0 : -1.0;
+    if (!(fabs(z) >= r->tp.md->uy[j]))
+        return 0;
+    return side * dz > 0.0 || (dz == 0.0 && side * ddz > 0.0) ? (int)side : 0;
+}
+
+void edr_spring_set(pd_edr *r, int j, double x, int phase)
+{
+    double sg = r->tp.sp_sig[j], uy = r->tp.md->uy[j];
+    int old = r->rs.sp_phase[j];
+    if (phase == old)
+        return;
+    /* up at x: the slide's (sg x - old uy), or the elastic offset */
+    double up = old != 0 ? sg * x - old * uy : r->rs.sp_up[j];
+    if (old != 0) { /* a slide ends: its excursion (monotone within a slide) */
+        r->rs.sp_exc[j] += fabs(up - r->rs.sp_upx[j]);
+        r->rs.sp_upx[j] = up;
+    } else
+        r->rs.sp_onsets[j]++;
+    /* sliding: up = sg x - phase uy (z exactly on the level at x) */
+    r->rs.sp_up[j] = phase != 0 ? sg * x - phase * uy : up;
+    r->rs.sp_phase[j] = (signed char)phase;
+}
+
+/* Each spring of a tree cluster at its flight's origin: the phase its
+ * motion there asks for; 1 when one changed (the flight is built again:
+ * the force is continuous across a change, so the state is unchanged). */
+static int spring_phases(pd_edr *r, int ci, double t)
+{
+    edr_cluster *c = &r->rs.cl[ci];
+    int changed = 0;
+    for (int b = c->head; b >= 0; b = r->rs.blk_next[b]) {
+        int j = r->tp.blk[b].spring;
+        if (j < 0)
+            continue;
+        int i = r->tp.sp_dof[j];
+        double dx, v, a;
+        edr_dof_at(r, ci, i, t, &dx, &v, &a);
+        double x = r->rs.xo[i] + dx;
+        int ph = spring_phase_at(r, j, x, v, a);
+        if (ph != r->rs.sp_phase[j]) {
+            edr_spring_set(r, j, x, ph);
+            changed = 1;
+        }
+    }
+    return changed;
+}
+
 int edr_cluster_start(pd_edr *r, int ci, double t, pd_err *err)
 {
     edr_cluster *c = &r->rs.cl[ci];
@@ -1175,7 +1298,20 @@ int edr_cluster_start(pd_edr *r, int ci, double t, pd_err *err)
         all_sdof &= r->tp.blk[b].sdof;
         c->ndof += r->tp.blk[b].n;
     }
-    if (!all_sdof || tree_start(r, c, t)) {
+    int tree = all_sdof && !tree_start(r, c, t);
+    /* a yielding spring's phase decided at the origin; a change builds the
+     * flight again (at most twice: the decision reads the state, which a
+     * change leaves as it was) */
+    for (int pass = 0; tree && r->tp.ns > 0 && pass < 2 && spring_phases(r, ci, t); pass++)
+        tree = !tree_start(r, c, t);
+    if (!tree) {
+        if (r->tp.ns > 0 && cluster_yielded(r, c))
+            return pd_err_set(err, PD_EINVAL,
+                              "row reference: at t = %.9g s a yielding structure moves in a "
+                              "cluster without an underdamped flight (overdamped, or a damped "
+                              "free mass); its exact flight is not built (Moreau-Jean, --method "
+                              "moreau, runs it)",
+                              t * r->tp.o.time_unit);
         /* a tree may have locked contacts already: the modal start re-reads the list */
         if ((rc = modal_start(r, c, t, err)))
             return rc;
@@ -1314,7 +1450,7 @@ void edr_cluster_eval(pd_edr *r, int ci, double t)
         double f = c->rho == 1.0 && c->kappa == 0.0 ? c->f_tc : pd_sine_piece_force(&c->pc, t);
         c->dy = dy;
         c->vy = vy;
-        c->ay = f - 2.0 * c->osc.xi * w0 * vy - w0 * w0 * (c->y0 + dy);
+        c->ay = f - c->a2 * vy - w0 * w0 * (c->y0 + dy);
         break;
     }
     case EDR_REST: /* held by the wall: y stays y0 */
@@ -1353,6 +1489,18 @@ void edr_dof_at(pd_edr *r, int ci, int dof, double t, double *dx, double *v, dou
     *dx = sx;
     *v = sv;
     *a = sa;
+}
+
+double edr_dof_jerk(pd_edr *r, int ci, int dof, double t)
+{
+    edr_cluster *c = &r->rs.cl[ci];
+    if (c->kind != EDR_SDOF)
+        return 0.0;
+    edr_cluster_eval(r, ci, t);
+    /* y^(3) = F' - a2 y'' - w0^2 y', F' = A w cos(w t + phi) + c1 of the scaled piece */
+    const pd_sine_piece *p = &c->pc;
+    double dF = p->c1 + (p->A == 0.0 ? 0.0 : p->A * p->w * cos(p->w * t + p->phi));
+    return r->rs.s[dof] * (dF - c->a2 * c->ay - c->osc.w0 * c->osc.w0 * c->vy);
 }
 
 double edr_force_at(pd_edr *r, int ci, int a, double t)

@@ -78,12 +78,8 @@ typedef struct ed_run {
 typedef struct ed_origin {
     int j;
     double t, x, v;
-    pd_sdof_flow flow; /* of a flight (pd_sdof_flow_init); unused at rest */
-    /* a damped free mass's flight instead (an elastic-perfectly-plastic
-     * spring's slide, alpha = 0: x'' + c x' = F), c > 0 and its piece */
-    int damped_mass;
-    double c;
-    pd_sine_piece pc;
+    pd_sdof_flow flow; /* of a flight (pd_sdof_flow_init, or _init_mass for an
+                          elastic-perfectly-plastic spring's damped slide); unused at rest */
 } ed_origin;
 
 /* A point of a flight: x, v, the distance past the wall x - delta (without
@@ -138,58 +134,6 @@ static double piece_end(const pd_ed_sdof *p, int j)
 }
 
 /* Exact increment dx = x(t) - x_o and velocity at t from the origin. */
-/* phi_k(s) = s^k sum_j (-c s)^j / (j + k)!, k = 1, 2, 3: the damped free
- * mass's kernels (phi1 = (1 - e^{-cs}) / c, phi2 = (s - phi1) / c, phi3 =
- * (s^2 / 2 - phi2) / c), by their series where c s < 1/2 (the closed forms
- * cancel there), else closed. */
-static void mass_kernels(double c, double s, double phi[3])
-{
-    double z = c * s;
-    if (z < 0.5) {
-        for (int k = 1; k <= 3; k++) {
-            double term = 1.0, sum = 0.0, fact = 1.0;
-            for (int i = 2; i <= k; i++)
-                fact *= i;
-            term = 1.0 / fact; /* j = 0: 1 / k! */
-            for (int j = 0; j < 24; j++) {
-                sum += term;
-                term *= -z / (double)(j + k + 1);
-            }
-            phi[k - 1] = sum * pow(s, k);
-        }
-        return;
-    }
-    phi[0] = -expm1(-z) / c;
-    phi[1] = (s - phi[0]) / c;
-    phi[2] = (0.5 * s * s - phi[1]) / c;
-}
-
-/* A damped free mass from (t0, v0) under F = A sin(w t + phi) + c0 + c1 (t
- * - ts): the sine's particular part x_p = B sin + C cos (B = -A / (w^2 +
- * c^2), C = c B / w) plus, for the rest v' + c v = f0 + c1 s with the
- * start's velocity less v_p's, v = v0' e^{-cs} + f0 phi1 + c1 phi2 and dx =
- * v0' phi1 + f0 phi2 + c1 phi3. */
-static void mass_increment(const ed_origin *o, double t, double *dx, double *v)
-{
-    const pd_sine_piece *pc = &o->pc;
-    double c = o->c, s = t - o->t, phi[3], f0 = pc->c0 + pc->c1 * (o->t - pc->t_start);
-    double dxp = 0.0, vp0 = 0.0, vp1 = 0.0;
-    if (pc->A != 0.0 && pc->w == 0.0) /* the constant A sin(phi) */
-        f0 += pc->A * sin(pc->phi);
-    else if (pc->A != 0.0) {
-        double w = pc->w, B = -pc->A / (w * w + c * c), C = c * B / w;
-        double th0 = w * o->t + pc->phi, d = w * s, h = sin(0.5 * d), m = th0 + 0.5 * d;
-        /* x_p(t) - x_p(t0) by half angles: no cancellation for short s */
-        dxp = B * 2.0 * cos(m) * h - C * 2.0 * sin(m) * h;
-        vp0 = w * (B * cos(th0) - C * sin(th0));
-        vp1 = w * (B * cos(th0 + d) - C * sin(th0 + d));
-    }
-    mass_kernels(c, s, phi);
-    double v0 = o->v - vp0;
-    *dx = dxp + v0 * phi[0] + f0 * phi[1] + pc->c1 * phi[2];
-    *v = vp1 + v0 * (1.0 - c * phi[0]) + f0 * phi[0] + pc->c1 * phi[1];
-}
-
 static void flow_inc(const ed_origin *o, double t, double *dx, double *v)
 {
     if (t == o->t) {
@@ -197,10 +141,7 @@ static void flow_inc(const ed_origin *o, double t, double *dx, double *v)
         *v = o->v;
         return;
     }
-    if (o->damped_mass)
-        mass_increment(o, t, dx, v);
-    else
-        pd_sdof_flow_at(&o->flow, t, dx, v);
+    pd_sdof_flow_at(&o->flow, t, dx, v);
 }
 
 /* The flight's point at t: past = (x_o - delta) + dx, and x clipped to the
@@ -861,11 +802,9 @@ int pd_ed_sdof_run(const pd_ed_sdof *prob, double x0, double v0, const pd_ed_opt
             pd_sine_piece pc = prob->pieces[j];
             if (ed.shift != 0.0)
                 pc.c0 += ed.shift;
-            if (ed.phase && ed.slide_mass) { /* a damped free mass slides */
-                o.damped_mass = 1;
-                o.c = ed.cdamp;
-                o.pc = pc;
-            } else
+            if (ed.phase && ed.slide_mass) /* a damped free mass slides */
+                pd_sdof_flow_init_mass(&o.flow, ed.cdamp, &pc, t, x, v);
+            else
                 pd_sdof_flow_init(&o.flow, &ed.osc, &pc, t, x, v);
             ed_event ev = free_flight(&ed, &o, tb, &t_hit, &xn, &vn);
             if (opts->energy)

@@ -496,9 +496,15 @@ typedef struct pd_sdof_flow {
     double pre, pim;    /* A re / den, A im / den: the particular's amplitudes */
     double vp0, c1, c2; /* v_p(t0) and the homogeneous constants */
     double f0, ur, vr;  /* the linear force at t0, its response's start state */
+    double mass_c;      /* > 0: a damped free mass u'' + mass_c u' = F instead
+                           (pd_sdof_flow_init_mass); 0: the oscillator */
 } pd_sdof_flow;
 PD_API void pd_sdof_flow_init(pd_sdof_flow *f, const pd_sdof *osc, const pd_sine_piece *pc,
                               double t0, double u0, double v0);
+/* A damped free mass's flight, u'' + c u' = F (c > 0: an elastic-perfectly-
+ * plastic spring's slide), from (t0, u0, v0) under one piece. */
+PD_API void pd_sdof_flow_init_mass(pd_sdof_flow *f, double c, const pd_sine_piece *pc, double t0,
+                                   double u0, double v0);
 /* du = u(t1) - u0 and v(t1) of the flight. */
 PD_API void pd_sdof_flow_at(const pd_sdof_flow *f, double t1, double *du, double *v1);
 
@@ -617,6 +623,11 @@ typedef struct pd_edr_result {
     long law_decided;           /* impacts whose LCP could take several closed contacts, one
                               closing (separating ones included): where the staged and
                               single impact laws may differ */
+    /* per yielding spring (ns; SDOF structures' springs only): */
+    int ns;
+    const double *up;                /* the plastic offset at t_reached */
+    const double *plastic_excursion; /* sum of |d up| */
+    const long *yield_onsets;        /* slides begun */
 } pd_edr_result;
 
 typedef struct pd_edr pd_edr;

@@ -211,6 +211,58 @@ void pd_sdof_advance_piece(const pd_sdof *osc, const pd_sine_piece *pc, double t
     *u1 = u0 + du;
 }
 
+/* phi_k(s) = s^k sum_j (-c s)^j / (j + k)!, k = 1, 2, 3: the damped free
+ * mass's kernels (phi1 = (1 - e^{-cs}) / c, phi2 = (s - phi1) / c, phi3 =
+ * (s^2 / 2 - phi2) / c), by their series where c s < 1/2 (the closed forms
+ * cancel there), else closed. */
+static void mass_kernels(double c, double s, double phi[3])
+{
+    double z = c * s;
+    if (z < 0.5) {
+        for (int k = 1; k <= 3; k++) {
+            double term = 1.0, sum = 0.0, fact = 1.0;
+            for (int i = 2; i <= k; i++)
+                fact *= i;
+            term = 1.0 / fact; /* j = 0: 1 / k! */
+            for (int j = 0; j < 24; j++) {
+                sum += term;
+                term *= -z / (double)(j + k + 1);
+            }
+            phi[k - 1] = sum * pow(s, k);
+        }
+        return;
+    }
+    phi[0] = -expm1(-z) / c;
+    phi[1] = (s - phi[0]) / c;
+    phi[2] = (0.5 * s * s - phi[1]) / c;
+}
+
+/* A damped free mass from (t0, v0) under F = A sin(w t + phi) + c0 + c1 (t
+ * - ts): the sine's particular part x_p = B sin + C cos (B = -A / (w^2 +
+ * c^2), C = c B / w) plus, for the rest v' + c v = f0 + c1 s with the
+ * start's velocity less v_p's, v = v0' e^{-cs} + f0 phi1 + c1 phi2 and dx =
+ * v0' phi1 + f0 phi2 + c1 phi3. */
+static void mass_increment(const pd_sdof_flow *f, double t, double *dx, double *v)
+{
+    const pd_sine_piece *pc = &f->pc;
+    double c = f->mass_c, s = t - f->t0, phi[3], f0 = pc->c0 + pc->c1 * (f->t0 - pc->t_start);
+    double dxp = 0.0, vp0 = 0.0, vp1 = 0.0;
+    if (pc->A != 0.0 && pc->w == 0.0) /* the constant A sin(phi) */
+        f0 += pc->A * sin(pc->phi);
+    else if (pc->A != 0.0) {
+        double w = pc->w, B = -pc->A / (w * w + c * c), C = c * B / w;
+        double th0 = w * f->t0 + pc->phi, d = w * s, h = sin(0.5 * d), m = th0 + 0.5 * d;
+        /* x_p(t) - x_p(t0) by half angles: no cancellation for short s */
+        dxp = B * 2.0 * cos(m) * h - C * 2.0 * sin(m) * h;
+        vp0 = w * (B * cos(th0) - C * sin(th0));
+        vp1 = w * (B * cos(th0 + d) - C * sin(th0 + d));
+    }
+    mass_kernels(c, s, phi);
+    double v0 = f->v0 - vp0;
+    *dx = dxp + v0 * phi[0] + f0 * phi[1] + pc->c1 * phi[2];
+    *v = vp1 + v0 * (1.0 - c * phi[0]) + f0 * phi[0] + pc->c1 * phi[1];
+}
+
 void pd_sdof_flow_init(pd_sdof_flow *f, const pd_sdof *osc, const pd_sine_piece *pc, double t0,
                        double u0, double v0)
 {
@@ -250,10 +302,22 @@ void pd_sdof_flow_init(pd_sdof_flow *f, const pd_sdof *osc, const pd_sine_piece 
     f->vr = p->A != 0.0 ? 0.0 : v0;
 }
 
+void pd_sdof_flow_init_mass(pd_sdof_flow *f, double c, const pd_sine_piece *pc, double t0,
+                            double u0, double v0)
+{
+    if (!f || !pc)
+        return;
+    *f = (pd_sdof_flow){.pc = *pc, .t0 = t0, .u0 = u0, .v0 = v0, .mass_c = c};
+}
+
 void pd_sdof_flow_at(const pd_sdof_flow *f, double t1, double *du, double *v1)
 {
     if (!f || !du || !v1)
         return;
+    if (f->mass_c > 0.0) {
+        mass_increment(f, t1, du, v1);
+        return;
+    }
     if (!f->fast) {
         pd_sdof_increment_piece(&f->osc, &f->pc, f->t0, f->u0, f->v0, t1, du, v1);
         return;

@@ -1360,6 +1360,11 @@ static int run_event(const pd_scene_model *sm, const pd_run_opts *o, double tau_
         tr->ctime[a] = er->contact_time[a];
         tr->approach[a] = sm->g0[a] - er->min_gap[a];
     }
+    for (int j = 0; j < tr->ns && j < er->ns; j++) { /* the springs' exact offsets and slides */
+        tr->up[j] = er->up[j];
+        tr->excursion[j] = er->plastic_excursion[j];
+        tr->onsets[j] = er->yield_onsets[j];
+    }
     tr->lcp_solves = er->lcp_solves;
     res->steps = er->events;
     res->simultaneous = er->simultaneous;
@@ -1590,11 +1595,11 @@ int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler s
         return rc;
     int springs = pd_scene_springs(sc);
     if (springs > 0 && !(o.method == PD_METHOD_MOREAU && o.rtol == 0.0) &&
-        o.method != PD_METHOD_NEWMARK)
+        o.method != PD_METHOD_NEWMARK && o.method != PD_METHOD_EVENT)
         return pd_err_set(err, PD_EINVAL,
                           "uy: a yielding scene (%d yielding storeys) runs by Moreau-Jean at "
-                          "fixed steps (method moreau, dt) or by newmark; %s%s models no "
-                          "yielding storey yet",
+                          "fixed steps (method moreau, dt), by newmark, or (SDOF structures) "
+                          "by event; %s%s models no yielding storey yet",
                           springs, pd_method_name(o.method), o.rtol > 0.0 ? " to a tolerance" : "");
     for (int i = 0; i < res->n; i++) {
         res->umax[i] = res->u_pos[i] = res->u_neg[i] = res->drift[i] = res->acc_max[i] =

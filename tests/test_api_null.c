@@ -1194,7 +1194,7 @@ static long api_case_145(void)
 static long api_case_146(void)
 {
     pd_err err = {0};
-    pd_sdof_flow_at(NULL, 1.0, (double *)fx_object("double", "pd_sdof_flow_at", 2), (double *)fx_object("double", "pd_sdof_flow_at", 3));
+    pd_sdof_flow_init_mass(NULL, 1.0, (const pd_sine_piece *)fx_object("pd_sine_piece", "pd_sdof_flow_init_mass", 2), 1.0, 1.0, 1.0);
     (void)err;
     return 0;
 }
@@ -1202,7 +1202,7 @@ static long api_case_146(void)
 static long api_case_147(void)
 {
     pd_err err = {0};
-    pd_sdof_flow_at((const pd_sdof_flow *)fx_object("pd_sdof_flow", "pd_sdof_flow_at", 0), 1.0, NULL, (double *)fx_object("double", "pd_sdof_flow_at", 3));
+    pd_sdof_flow_init_mass((pd_sdof_flow *)fx_object("pd_sdof_flow", "pd_sdof_flow_init_mass", 0), 1.0, NULL, 1.0, 1.0, 1.0);
     (void)err;
     return 0;
 }
@@ -1210,7 +1210,7 @@ static long api_case_147(void)
 static long api_case_148(void)
 {
     pd_err err = {0};
-    pd_sdof_flow_at((const pd_sdof_flow *)fx_object("pd_sdof_flow", "pd_sdof_flow_at", 0), 1.0, (double *)fx_object("double", "pd_sdof_flow_at", 2), NULL);
+    pd_sdof_flow_at(NULL, 1.0, (double *)fx_object("double", "pd_sdof_flow_at", 2), (double *)fx_object("double", "pd_sdof_flow_at", 3));
     (void)err;
     return 0;
 }
@@ -1218,7 +1218,7 @@ static long api_case_148(void)
 static long api_case_149(void)
 {
     pd_err err = {0};
-    pd_sdof_advance(NULL, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_advance", 8), (double *)fx_object("double", "pd_sdof_advance", 9));
+    pd_sdof_flow_at((const pd_sdof_flow *)fx_object("pd_sdof_flow", "pd_sdof_flow_at", 0), 1.0, NULL, (double *)fx_object("double", "pd_sdof_flow_at", 3));
     (void)err;
     return 0;
 }
@@ -1226,7 +1226,7 @@ static long api_case_149(void)
 static long api_case_150(void)
 {
     pd_err err = {0};
-    pd_sdof_advance((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_advance", 0), 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, NULL, (double *)fx_object("double", "pd_sdof_advance", 9));
+    pd_sdof_flow_at((const pd_sdof_flow *)fx_object("pd_sdof_flow", "pd_sdof_flow_at", 0), 1.0, (double *)fx_object("double", "pd_sdof_flow_at", 2), NULL);
     (void)err;
     return 0;
 }
@@ -1234,7 +1234,7 @@ static long api_case_150(void)
 static long api_case_151(void)
 {
     pd_err err = {0};
-    pd_sdof_advance((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_advance", 0), 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_advance", 8), NULL);
+    pd_sdof_advance(NULL, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_advance", 8), (double *)fx_object("double", "pd_sdof_advance", 9));
     (void)err;
     return 0;
 }
@@ -1242,7 +1242,7 @@ static long api_case_151(void)
 static long api_case_152(void)
 {
     pd_err err = {0};
-    pd_sdof_increment(NULL, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_increment", 8), (double *)fx_object("double", "pd_sdof_increment", 9));
+    pd_sdof_advance((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_advance", 0), 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, NULL, (double *)fx_object("double", "pd_sdof_advance", 9));
     (void)err;
     return 0;
 }
@@ -1250,7 +1250,7 @@ static long api_case_152(void)
 static long api_case_153(void)
 {
     pd_err err = {0};
-    pd_sdof_increment((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_increment", 0), 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, NULL, (double *)fx_object("double", "pd_sdof_increment", 9));
+    pd_sdof_advance((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_advance", 0), 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_advance", 8), NULL);
     (void)err;
     return 0;
 }
@@ -1258,7 +1258,7 @@ static long api_case_153(void)
 static long api_case_154(void)
 {
     pd_err err = {0};
-    pd_sdof_increment((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_increment", 0), 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_increment", 8), NULL);
+    pd_sdof_increment(NULL, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_increment", 8), (double *)fx_object("double", "pd_sdof_increment", 9));
     (void)err;
     return 0;
 }
@@ -1266,23 +1266,23 @@ static long api_case_154(void)
 static long api_case_155(void)
 {
     pd_err err = {0};
-    pd_edr * p = pd_edr_alloc(NULL, (const pd_piecewise_force *)fx_object("pd_piecewise_force", "pd_edr_alloc", 1), (const pd_edr_opts *)fx_object("pd_edr_opts", "pd_edr_alloc", 2), &err);
+    pd_sdof_increment((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_increment", 0), 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, NULL, (double *)fx_object("double", "pd_sdof_increment", 9));
     (void)err;
-    return p != NULL;
+    return 0;
 }
 
 static long api_case_156(void)
 {
     pd_err err = {0};
-    pd_edr * p = pd_edr_alloc((const pd_model *)fx_object("pd_model", "pd_edr_alloc", 0), NULL, (const pd_edr_opts *)fx_object("pd_edr_opts", "pd_edr_alloc", 2), &err);
+    pd_sdof_increment((const pd_sdof *)fx_object("pd_sdof", "pd_sdof_increment", 0), 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_sdof_increment", 8), NULL);
     (void)err;
-    return p != NULL;
+    return 0;
 }
 
 static long api_case_157(void)
 {
     pd_err err = {0};
-    pd_edr * p = pd_edr_alloc((const pd_model *)fx_object("pd_model", "pd_edr_alloc", 0), (const pd_piecewise_force *)fx_object("pd_piecewise_force", "pd_edr_alloc", 1), NULL, &err);
+    pd_edr * p = pd_edr_alloc(NULL, (const pd_piecewise_force *)fx_object("pd_piecewise_force", "pd_edr_alloc", 1), (const pd_edr_opts *)fx_object("pd_edr_opts", "pd_edr_alloc", 2), &err);
     (void)err;
     return p != NULL;
 }
@@ -1290,12 +1290,28 @@ static long api_case_157(void)
 static long api_case_158(void)
 {
     pd_err err = {0};
+    pd_edr * p = pd_edr_alloc((const pd_model *)fx_object("pd_model", "pd_edr_alloc", 0), NULL, (const pd_edr_opts *)fx_object("pd_edr_opts", "pd_edr_alloc", 2), &err);
+    (void)err;
+    return p != NULL;
+}
+
+static long api_case_159(void)
+{
+    pd_err err = {0};
+    pd_edr * p = pd_edr_alloc((const pd_model *)fx_object("pd_model", "pd_edr_alloc", 0), (const pd_piecewise_force *)fx_object("pd_piecewise_force", "pd_edr_alloc", 1), NULL, &err);
+    (void)err;
+    return p != NULL;
+}
+
+static long api_case_160(void)
+{
+    pd_err err = {0};
     pd_edr_free(NULL);
     (void)err;
     return 0;
 }
 
-static long api_case_159(void)
+static long api_case_161(void)
 {
     pd_err err = {0};
     long v = pd_edr_run(NULL, 1.0, (const double *)fx_object("double", "pd_edr_run", 2), (const double *)fx_object("double", "pd_edr_run", 3), 1.0, NULL, NULL, &err);
@@ -1303,7 +1319,7 @@ static long api_case_159(void)
     return v;
 }
 
-static long api_case_160(void)
+static long api_case_162(void)
 {
     pd_err err = {0};
     long v = pd_edr_run((pd_edr *)fx_object("pd_edr", "pd_edr_run", 0), 1.0, NULL, (const double *)fx_object("double", "pd_edr_run", 3), 1.0, NULL, NULL, &err);
@@ -1311,7 +1327,7 @@ static long api_case_160(void)
     return v;
 }
 
-static long api_case_161(void)
+static long api_case_163(void)
 {
     pd_err err = {0};
     long v = pd_edr_run((pd_edr *)fx_object("pd_edr", "pd_edr_run", 0), 1.0, (const double *)fx_object("double", "pd_edr_run", 2), NULL, 1.0, NULL, NULL, &err);
@@ -1319,7 +1335,7 @@ static long api_case_161(void)
     return v;
 }
 
-static long api_case_162(void)
+static long api_case_164(void)
 {
     pd_err err = {0};
     const pd_edr_result * p = pd_edr_result_of(NULL);
@@ -1327,7 +1343,7 @@ static long api_case_162(void)
     return p != NULL;
 }
 
-static long api_case_163(void)
+static long api_case_165(void)
 {
     pd_err err = {0};
     long v = pd_ed_sdof_run(NULL, 1.0, 1.0, (const pd_ed_opts *)fx_object("pd_ed_opts", "pd_ed_sdof_run", 3), NULL, NULL, (pd_ed_result *)fx_object("pd_ed_result", "pd_ed_sdof_run", 6), &err);
@@ -1335,7 +1351,7 @@ static long api_case_163(void)
     return v;
 }
 
-static long api_case_164(void)
+static long api_case_166(void)
 {
     pd_err err = {0};
     long v = pd_ed_sdof_run((const pd_ed_sdof *)fx_object("pd_ed_sdof", "pd_ed_sdof_run", 0), 1.0, 1.0, NULL, NULL, NULL, (pd_ed_result *)fx_object("pd_ed_result", "pd_ed_sdof_run", 6), &err);
@@ -1343,7 +1359,7 @@ static long api_case_164(void)
     return v;
 }
 
-static long api_case_165(void)
+static long api_case_167(void)
 {
     pd_err err = {0};
     long v = pd_ed_sdof_run((const pd_ed_sdof *)fx_object("pd_ed_sdof", "pd_ed_sdof_run", 0), 1.0, 1.0, (const pd_ed_opts *)fx_object("pd_ed_opts", "pd_ed_sdof_run", 3), NULL, NULL, NULL, &err);
@@ -1351,7 +1367,7 @@ static long api_case_165(void)
     return v;
 }
 
-static long api_case_166(void)
+static long api_case_168(void)
 {
     pd_err err = {0};
     long v = pd_pulse_parse(NULL, (pd_pulse *)fx_object("pd_pulse", "pd_pulse_parse", 1));
@@ -1359,7 +1375,7 @@ static long api_case_166(void)
     return v;
 }
 
-static long api_case_167(void)
+static long api_case_169(void)
 {
     pd_err err = {0};
     long v = pd_pulse_parse((const char *)fx_string("pd_pulse_parse", "name"), NULL);
@@ -1367,7 +1383,7 @@ static long api_case_167(void)
     return v;
 }
 
-static long api_case_168(void)
+static long api_case_170(void)
 {
     pd_err err = {0};
     long v = pd_dir_parse(NULL, (int *)fx_object("int", "pd_dir_parse", 1));
@@ -1375,7 +1391,7 @@ static long api_case_168(void)
     return v;
 }
 
-static long api_case_169(void)
+static long api_case_171(void)
 {
     pd_err err = {0};
     long v = pd_dir_parse((const char *)fx_string("pd_dir_parse", "name"), NULL);
@@ -1383,7 +1399,7 @@ static long api_case_169(void)
     return v;
 }
 
-static long api_case_170(void)
+static long api_case_172(void)
 {
     pd_err err = {0};
     long v = pd_record_format_parse(NULL, (pd_record_format *)fx_object("pd_record_format", "pd_record_format_parse", 1));
@@ -1391,7 +1407,7 @@ static long api_case_170(void)
     return v;
 }
 
-static long api_case_171(void)
+static long api_case_173(void)
 {
     pd_err err = {0};
     long v = pd_record_format_parse((const char *)fx_string("pd_record_format_parse", "name"), NULL);
@@ -1399,7 +1415,7 @@ static long api_case_171(void)
     return v;
 }
 
-static long api_case_172(void)
+static long api_case_174(void)
 {
     pd_err err = {0};
     long v = pd_record_units_parse(NULL, (pd_record_units *)fx_object("pd_record_units", "pd_record_units_parse", 1));
@@ -1407,7 +1423,7 @@ static long api_case_172(void)
     return v;
 }
 
-static long api_case_173(void)
+static long api_case_175(void)
 {
     pd_err err = {0};
     long v = pd_record_units_parse((const char *)fx_string("pd_record_units_parse", "name"), NULL);
@@ -1415,7 +1431,7 @@ static long api_case_173(void)
     return v;
 }
 
-static long api_case_174(void)
+static long api_case_176(void)
 {
     pd_err err = {0};
     long v = pd_record_read(NULL, (pd_record_format)0, (pd_record_units)0, (pd_record *)fx_object("pd_record", "pd_record_read", 3), &err);
@@ -1423,7 +1439,7 @@ static long api_case_174(void)
     return v;
 }
 
-static long api_case_175(void)
+static long api_case_177(void)
 {
     pd_err err = {0};
     long v = pd_record_read((const char *)fx_string("pd_record_read", "path"), (pd_record_format)0, (pd_record_units)0, NULL, &err);
@@ -1431,7 +1447,7 @@ static long api_case_175(void)
     return v;
 }
 
-static long api_case_176(void)
+static long api_case_178(void)
 {
     pd_err err = {0};
     pd_record_free(NULL);
@@ -1439,7 +1455,7 @@ static long api_case_176(void)
     return 0;
 }
 
-static long api_case_177(void)
+static long api_case_179(void)
 {
     pd_err err = {0};
     long v = pd_record_detect(NULL, (pd_record_format *)fx_object("pd_record_format", "pd_record_detect", 1), &err);
@@ -1447,7 +1463,7 @@ static long api_case_177(void)
     return v;
 }
 
-static long api_case_178(void)
+static long api_case_180(void)
 {
     pd_err err = {0};
     long v = pd_record_detect((const char *)fx_string("pd_record_detect", "path"), NULL, &err);
@@ -1455,7 +1471,7 @@ static long api_case_178(void)
     return v;
 }
 
-static long api_case_179(void)
+static long api_case_181(void)
 {
     pd_err err = {0};
     long v = pd_record_plausible(NULL, (pd_record_units)0, (char *)fx_string("pd_record_plausible", "msg"), 64);
@@ -1463,7 +1479,7 @@ static long api_case_179(void)
     return v;
 }
 
-static long api_case_180(void)
+static long api_case_182(void)
 {
     pd_err err = {0};
     long v = pd_record_plausible((const pd_record *)fx_object("pd_record", "pd_record_plausible", 0), (pd_record_units)0, NULL, 64);
@@ -1471,7 +1487,7 @@ static long api_case_180(void)
     return v;
 }
 
-static long api_case_181(void)
+static long api_case_183(void)
 {
     pd_err err = {0};
     long v = pd_record_from_array(NULL, (const char *)fx_string("pd_record_from_array", "name"), (const double *)fx_object("double", "pd_record_from_array", 2), 1, 1.0, (pd_record_units)0, &err);
@@ -1479,7 +1495,7 @@ static long api_case_181(void)
     return v;
 }
 
-static long api_case_182(void)
+static long api_case_184(void)
 {
     pd_err err = {0};
     long v = pd_record_from_array((pd_record *)fx_object("pd_record", "pd_record_from_array", 0), NULL, (const double *)fx_object("double", "pd_record_from_array", 2), 1, 1.0, (pd_record_units)0, &err);
@@ -1487,7 +1503,7 @@ static long api_case_182(void)
     return v;
 }
 
-static long api_case_183(void)
+static long api_case_185(void)
 {
     pd_err err = {0};
     long v = pd_record_from_array((pd_record *)fx_object("pd_record", "pd_record_from_array", 0), (const char *)fx_string("pd_record_from_array", "name"), NULL, 1, 1.0, (pd_record_units)0, &err);
@@ -1495,7 +1511,7 @@ static long api_case_183(void)
     return v;
 }
 
-static long api_case_184(void)
+static long api_case_186(void)
 {
     pd_err err = {0};
     double v = pd_record_duration(NULL);
@@ -1504,7 +1520,7 @@ static long api_case_184(void)
     return 0;
 }
 
-static long api_case_185(void)
+static long api_case_187(void)
 {
     pd_err err = {0};
     double v = pd_record_acc(NULL, 1.0);
@@ -1513,7 +1529,7 @@ static long api_case_185(void)
     return 0;
 }
 
-static long api_case_186(void)
+static long api_case_188(void)
 {
     pd_err err = {0};
     long v = pd_record_measure(NULL, (pd_record_measures *)fx_object("pd_record_measures", "pd_record_measure", 1), &err);
@@ -1521,7 +1537,7 @@ static long api_case_186(void)
     return v;
 }
 
-static long api_case_187(void)
+static long api_case_189(void)
 {
     pd_err err = {0};
     long v = pd_record_measure((const pd_record *)fx_object("pd_record", "pd_record_measure", 0), NULL, &err);
@@ -1529,7 +1545,7 @@ static long api_case_187(void)
     return v;
 }
 
-static long api_case_188(void)
+static long api_case_190(void)
 {
     pd_err err = {0};
     long v = pd_record_integrate(NULL, (double *)fx_object("double", "pd_record_integrate", 1), (double *)fx_object("double", "pd_record_integrate", 2), &err);
@@ -1537,7 +1553,7 @@ static long api_case_188(void)
     return v;
 }
 
-static long api_case_189(void)
+static long api_case_191(void)
 {
     pd_err err = {0};
     long v = pd_record_integrate((const pd_record *)fx_object("pd_record", "pd_record_integrate", 0), NULL, (double *)fx_object("double", "pd_record_integrate", 2), &err);
@@ -1545,7 +1561,7 @@ static long api_case_189(void)
     return v;
 }
 
-static long api_case_190(void)
+static long api_case_192(void)
 {
     pd_err err = {0};
     long v = pd_record_integrate((const pd_record *)fx_object("pd_record", "pd_record_integrate", 0), (double *)fx_object("double", "pd_record_integrate", 1), NULL, &err);
@@ -1553,7 +1569,7 @@ static long api_case_190(void)
     return v;
 }
 
-static long api_case_191(void)
+static long api_case_193(void)
 {
     pd_err err = {0};
     long v = pd_record_fit_pulse(NULL, (pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_fit_pulse", 1), &err);
@@ -1561,7 +1577,7 @@ static long api_case_191(void)
     return v;
 }
 
-static long api_case_192(void)
+static long api_case_194(void)
 {
     pd_err err = {0};
     long v = pd_record_fit_pulse((const pd_record *)fx_object("pd_record", "pd_record_fit_pulse", 0), NULL, &err);
@@ -1569,7 +1585,7 @@ static long api_case_192(void)
     return v;
 }
 
-static long api_case_193(void)
+static long api_case_195(void)
 {
     pd_err err = {0};
     pd_record_pulse_eval(NULL, 1.0, (double *)fx_object("double", "pd_record_pulse_eval", 2), (double *)fx_object("double", "pd_record_pulse_eval", 3));
@@ -1577,7 +1593,7 @@ static long api_case_193(void)
     return 0;
 }
 
-static long api_case_194(void)
+static long api_case_196(void)
 {
     pd_err err = {0};
     pd_record_pulse_eval((const pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_pulse_eval", 0), 1.0, NULL, (double *)fx_object("double", "pd_record_pulse_eval", 3));
@@ -1585,7 +1601,7 @@ static long api_case_194(void)
     return 0;
 }
 
-static long api_case_195(void)
+static long api_case_197(void)
 {
     pd_err err = {0};
     pd_record_pulse_eval((const pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_pulse_eval", 0), 1.0, (double *)fx_object("double", "pd_record_pulse_eval", 2), NULL);
@@ -1593,7 +1609,7 @@ static long api_case_195(void)
     return 0;
 }
 
-static long api_case_196(void)
+static long api_case_198(void)
 {
     pd_err err = {0};
     double v = pd_record_one_cycle(NULL, 1.0);
@@ -1602,7 +1618,7 @@ static long api_case_196(void)
     return 0;
 }
 
-static long api_case_197(void)
+static long api_case_199(void)
 {
     pd_err err = {0};
     long v = pd_method_parse(NULL, (pd_method *)fx_object("pd_method", "pd_method_parse", 1));
@@ -1610,7 +1626,7 @@ static long api_case_197(void)
     return v;
 }
 
-static long api_case_198(void)
+static long api_case_200(void)
 {
     pd_err err = {0};
     long v = pd_method_parse((const char *)fx_string("pd_method_parse", "name"), NULL);
@@ -1618,7 +1634,7 @@ static long api_case_198(void)
     return v;
 }
 
-static long api_case_199(void)
+static long api_case_201(void)
 {
     pd_err err = {0};
     long v = pd_impact_law_parse(NULL, (pd_impact_law *)fx_object("pd_impact_law", "pd_impact_law_parse", 1));
@@ -1626,7 +1642,7 @@ static long api_case_199(void)
     return v;
 }
 
-static long api_case_200(void)
+static long api_case_202(void)
 {
     pd_err err = {0};
     long v = pd_impact_law_parse((const char *)fx_string("pd_impact_law_parse", "name"), NULL);
@@ -1634,7 +1650,7 @@ static long api_case_200(void)
     return v;
 }
 
-static long api_case_201(void)
+static long api_case_203(void)
 {
     pd_err err = {0};
     long v = pd_run_opts_check(NULL, &err);
@@ -1642,7 +1658,7 @@ static long api_case_201(void)
     return v;
 }
 
-static long api_case_202(void)
+static long api_case_204(void)
 {
     pd_err err = {0};
     double v = pd_osc_wp(NULL);
@@ -1651,7 +1667,7 @@ static long api_case_202(void)
     return 0;
 }
 
-static long api_case_203(void)
+static long api_case_205(void)
 {
     pd_err err = {0};
     double v = pd_osc_T0(NULL);
@@ -1660,7 +1676,7 @@ static long api_case_203(void)
     return 0;
 }
 
-static long api_case_204(void)
+static long api_case_206(void)
 {
     pd_err err = {0};
     double v = pd_osc_gap(NULL);
@@ -1669,7 +1685,7 @@ static long api_case_204(void)
     return 0;
 }
 
-static long api_case_205(void)
+static long api_case_207(void)
 {
     pd_err err = {0};
     double v = pd_osc_Le(NULL);
@@ -1678,7 +1694,7 @@ static long api_case_205(void)
     return 0;
 }
 
-static long api_case_206(void)
+static long api_case_208(void)
 {
     pd_err err = {0};
     pd_osc_set_T0(NULL, 1.0);
@@ -1686,7 +1702,7 @@ static long api_case_206(void)
     return 0;
 }
 
-static long api_case_207(void)
+static long api_case_209(void)
 {
     pd_err err = {0};
     pd_osc_set_gap(NULL, 1.0);
@@ -1694,7 +1710,7 @@ static long api_case_207(void)
     return 0;
 }
 
-static long api_case_208(void)
+static long api_case_210(void)
 {
     pd_err err = {0};
     pd_osc_set_uy(NULL, 1.0);
@@ -1702,7 +1718,7 @@ static long api_case_208(void)
     return 0;
 }
 
-static long api_case_209(void)
+static long api_case_211(void)
 {
     pd_err err = {0};
     double v = pd_osc_uy(NULL);
@@ -1711,7 +1727,7 @@ static long api_case_209(void)
     return 0;
 }
 
-static long api_case_210(void)
+static long api_case_212(void)
 {
     pd_err err = {0};
     long v = pd_osc_yields(NULL);
@@ -1719,7 +1735,7 @@ static long api_case_210(void)
     return v;
 }
 
-static long api_case_211(void)
+static long api_case_213(void)
 {
     pd_err err = {0};
     long v = pd_osc_yield_exact(NULL);
@@ -1727,7 +1743,7 @@ static long api_case_211(void)
     return v;
 }
 
-static long api_case_212(void)
+static long api_case_214(void)
 {
     pd_err err = {0};
     double v = pd_osc_excitation(NULL, 1.0);
@@ -1736,7 +1752,7 @@ static long api_case_212(void)
     return 0;
 }
 
-static long api_case_213(void)
+static long api_case_215(void)
 {
     pd_err err = {0};
     pd_osc_set_record(NULL, (const pd_record *)fx_object("pd_record", "pd_osc_set_record", 1), (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_osc_set_record", 2), 1.0);
@@ -1744,7 +1760,7 @@ static long api_case_213(void)
     return 0;
 }
 
-static long api_case_214(void)
+static long api_case_216(void)
 {
     pd_err err = {0};
     pd_osc_set_record((pd_osc *)fx_object("pd_osc", "pd_osc_set_record", 0), NULL, (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_osc_set_record", 2), 1.0);
@@ -1752,7 +1768,7 @@ static long api_case_214(void)
     return 0;
 }
 
-static long api_case_215(void)
+static long api_case_217(void)
 {
     pd_err err = {0};
     pd_osc_set_record((pd_osc *)fx_object("pd_osc", "pd_osc_set_record", 0), (const pd_record *)fx_object("pd_record", "pd_osc_set_record", 1), NULL, 1.0);
@@ -1760,7 +1776,7 @@ static long api_case_215(void)
     return 0;
 }
 
-static long api_case_216(void)
+static long api_case_218(void)
 {
     pd_err err = {0};
     double v = pd_osc_shape(NULL, 1.0, 0);
@@ -1769,7 +1785,7 @@ static long api_case_216(void)
     return 0;
 }
 
-static long api_case_217(void)
+static long api_case_219(void)
 {
     pd_err err = {0};
     double v = pd_osc_shape_rate(NULL, 1.0, 0);
@@ -1778,7 +1794,7 @@ static long api_case_217(void)
     return 0;
 }
 
-static long api_case_218(void)
+static long api_case_220(void)
 {
     pd_err err = {0};
     double v = pd_osc_shape_end(NULL);
@@ -1787,7 +1803,7 @@ static long api_case_218(void)
     return 0;
 }
 
-static long api_case_219(void)
+static long api_case_221(void)
 {
     pd_err err = {0};
     long v = pd_osc_pieces(NULL, (pd_sine_piece **)fx_slot(), (int *)fx_object("int", "pd_osc_pieces", 2), &err);
@@ -1795,7 +1811,7 @@ static long api_case_219(void)
     return v;
 }
 
-static long api_case_220(void)
+static long api_case_222(void)
 {
     pd_err err = {0};
     long v = pd_osc_pieces((const pd_osc *)fx_object("pd_osc", "pd_osc_pieces", 0), NULL, (int *)fx_object("int", "pd_osc_pieces", 2), &err);
@@ -1803,7 +1819,7 @@ static long api_case_220(void)
     return v;
 }
 
-static long api_case_221(void)
+static long api_case_223(void)
 {
     pd_err err = {0};
     long v = pd_osc_pieces((const pd_osc *)fx_object("pd_osc", "pd_osc_pieces", 0), (pd_sine_piece **)fx_slot(), NULL, &err);
@@ -1811,7 +1827,7 @@ static long api_case_221(void)
     return v;
 }
 
-static long api_case_222(void)
+static long api_case_224(void)
 {
     pd_err err = {0};
     const char *s = pd_osc_excitation_name(NULL);
@@ -1819,7 +1835,7 @@ static long api_case_222(void)
     return s ? (long)strlen(s) + 1 : 0;
 }
 
-static long api_case_223(void)
+static long api_case_225(void)
 {
     pd_err err = {0};
     long v = pd_osc_check(NULL, &err);
@@ -1827,7 +1843,7 @@ static long api_case_223(void)
     return v;
 }
 
-static long api_case_224(void)
+static long api_case_226(void)
 {
     pd_err err = {0};
     long v = pd_osc_resolve_opts(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_resolve_opts", 1), (pd_run_opts *)fx_object("pd_run_opts", "pd_osc_resolve_opts", 2), &err);
@@ -1835,7 +1851,7 @@ static long api_case_224(void)
     return v;
 }
 
-static long api_case_225(void)
+static long api_case_227(void)
 {
     pd_err err = {0};
     long v = pd_osc_resolve_opts((const pd_osc *)fx_object("pd_osc", "pd_osc_resolve_opts", 0), NULL, (pd_run_opts *)fx_object("pd_run_opts", "pd_osc_resolve_opts", 2), &err);
@@ -1843,7 +1859,7 @@ static long api_case_225(void)
     return v;
 }
 
-static long api_case_226(void)
+static long api_case_228(void)
 {
     pd_err err = {0};
     long v = pd_osc_resolve_opts((const pd_osc *)fx_object("pd_osc", "pd_osc_resolve_opts", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_resolve_opts", 1), NULL, &err);
@@ -1851,7 +1867,7 @@ static long api_case_226(void)
     return v;
 }
 
-static long api_case_227(void)
+static long api_case_229(void)
 {
     pd_err err = {0};
     double v = pd_osc_default_dt(NULL);
@@ -1860,7 +1876,7 @@ static long api_case_227(void)
     return 0;
 }
 
-static long api_case_228(void)
+static long api_case_230(void)
 {
     pd_err err = {0};
     double v = pd_osc_default_tend(NULL);
@@ -1869,7 +1885,7 @@ static long api_case_228(void)
     return 0;
 }
 
-static long api_case_229(void)
+static long api_case_231(void)
 {
     pd_err err = {0};
     double v = pd_osc_measure_start(NULL, 1.0);
@@ -1878,7 +1894,7 @@ static long api_case_229(void)
     return 0;
 }
 
-static long api_case_230(void)
+static long api_case_232(void)
 {
     pd_err err = {0};
     pd_method v = pd_osc_method(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_method", 1));
@@ -1887,7 +1903,7 @@ static long api_case_230(void)
     return 0;
 }
 
-static long api_case_231(void)
+static long api_case_233(void)
 {
     pd_err err = {0};
     pd_method v = pd_osc_method((const pd_osc *)fx_object("pd_osc", "pd_osc_method", 0), NULL);
@@ -1896,7 +1912,7 @@ static long api_case_231(void)
     return 0;
 }
 
-static long api_case_232(void)
+static long api_case_234(void)
 {
     pd_err err = {0};
     long v = pd_osc_run(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_run", 1), NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_run", 4), &err);
@@ -1904,7 +1920,7 @@ static long api_case_232(void)
     return v;
 }
 
-static long api_case_233(void)
+static long api_case_235(void)
 {
     pd_err err = {0};
     long v = pd_osc_run((const pd_osc *)fx_object("pd_osc", "pd_osc_run", 0), NULL, NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_run", 4), &err);
@@ -1912,7 +1928,7 @@ static long api_case_233(void)
     return v;
 }
 
-static long api_case_234(void)
+static long api_case_236(void)
 {
     pd_err err = {0};
     long v = pd_osc_run((const pd_osc *)fx_object("pd_osc", "pd_osc_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_run", 1), NULL, NULL, NULL, &err);
@@ -1920,7 +1936,7 @@ static long api_case_234(void)
     return v;
 }
 
-static long api_case_235(void)
+static long api_case_237(void)
 {
     pd_err err = {0};
     long v = pd_osc_batchable(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_batchable", 1));
@@ -1928,7 +1944,7 @@ static long api_case_235(void)
     return v;
 }
 
-static long api_case_236(void)
+static long api_case_238(void)
 {
     pd_err err = {0};
     long v = pd_osc_batchable((const pd_osc *)fx_object("pd_osc", "pd_osc_batchable", 0), NULL);
@@ -1936,7 +1952,7 @@ static long api_case_236(void)
     return v;
 }
 
-static long api_case_237(void)
+static long api_case_239(void)
 {
     pd_err err = {0};
     double v = pd_osc_scan_points(NULL, 1.0);
@@ -1945,7 +1961,7 @@ static long api_case_237(void)
     return 0;
 }
 
-static long api_case_238(void)
+static long api_case_240(void)
 {
     pd_err err = {0};
     long v = pd_osc_simulate(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_simulate", 1), NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_simulate", 4), &err);
@@ -1953,7 +1969,7 @@ static long api_case_238(void)
     return v;
 }
 
-static long api_case_239(void)
+static long api_case_241(void)
 {
     pd_err err = {0};
     long v = pd_osc_simulate((const pd_osc *)fx_object("pd_osc", "pd_osc_simulate", 0), NULL, NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_simulate", 4), &err);
@@ -1961,7 +1977,7 @@ static long api_case_239(void)
     return v;
 }
 
-static long api_case_240(void)
+static long api_case_242(void)
 {
     pd_err err = {0};
     long v = pd_osc_simulate((const pd_osc *)fx_object("pd_osc", "pd_osc_simulate", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_simulate", 1), NULL, NULL, NULL, &err);
@@ -1969,7 +1985,7 @@ static long api_case_240(void)
     return v;
 }
 
-static long api_case_241(void)
+static long api_case_243(void)
 {
     pd_err err = {0};
     long v = pd_osc_reference(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_reference", 1), NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_reference", 4), &err);
@@ -1977,7 +1993,7 @@ static long api_case_241(void)
     return v;
 }
 
-static long api_case_242(void)
+static long api_case_244(void)
 {
     pd_err err = {0};
     long v = pd_osc_reference((const pd_osc *)fx_object("pd_osc", "pd_osc_reference", 0), NULL, NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_reference", 4), &err);
@@ -1985,7 +2001,7 @@ static long api_case_242(void)
     return v;
 }
 
-static long api_case_243(void)
+static long api_case_245(void)
 {
     pd_err err = {0};
     long v = pd_osc_reference((const pd_osc *)fx_object("pd_osc", "pd_osc_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_reference", 1), NULL, NULL, NULL, &err);
@@ -1993,7 +2009,7 @@ static long api_case_243(void)
     return v;
 }
 
-static long api_case_244(void)
+static long api_case_246(void)
 {
     pd_err err = {0};
     long v = pd_osc_penalty(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_penalty", 1), NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_penalty", 4), &err);
@@ -2001,7 +2017,7 @@ static long api_case_244(void)
     return v;
 }
 
-static long api_case_245(void)
+static long api_case_247(void)
 {
     pd_err err = {0};
     long v = pd_osc_penalty((const pd_osc *)fx_object("pd_osc", "pd_osc_penalty", 0), NULL, NULL, NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_osc_penalty", 4), &err);
@@ -2009,7 +2025,7 @@ static long api_case_245(void)
     return v;
 }
 
-static long api_case_246(void)
+static long api_case_248(void)
 {
     pd_err err = {0};
     long v = pd_osc_penalty((const pd_osc *)fx_object("pd_osc", "pd_osc_penalty", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_penalty", 1), NULL, NULL, NULL, &err);
@@ -2017,7 +2033,7 @@ static long api_case_246(void)
     return v;
 }
 
-static long api_case_247(void)
+static long api_case_249(void)
 {
     pd_err err = {0};
     long v = pd_osc_summarize(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_summarize", 1), NULL, NULL, (pd_osc_summary *)fx_object("pd_osc_summary", "pd_osc_summarize", 4), &err);
@@ -2025,7 +2041,7 @@ static long api_case_247(void)
     return v;
 }
 
-static long api_case_248(void)
+static long api_case_250(void)
 {
     pd_err err = {0};
     long v = pd_osc_summarize((const pd_osc *)fx_object("pd_osc", "pd_osc_summarize", 0), NULL, NULL, NULL, (pd_osc_summary *)fx_object("pd_osc_summary", "pd_osc_summarize", 4), &err);
@@ -2033,7 +2049,7 @@ static long api_case_248(void)
     return v;
 }
 
-static long api_case_249(void)
+static long api_case_251(void)
 {
     pd_err err = {0};
     long v = pd_osc_summarize((const pd_osc *)fx_object("pd_osc", "pd_osc_summarize", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_osc_summarize", 1), NULL, NULL, NULL, &err);
@@ -2041,7 +2057,7 @@ static long api_case_249(void)
     return v;
 }
 
-static long api_case_250(void)
+static long api_case_252(void)
 {
     pd_err err = {0};
     pd_osc_free_exact(NULL, 1.0, (double *)fx_object("double", "pd_osc_free_exact", 2), (double *)fx_object("double", "pd_osc_free_exact", 3));
@@ -2049,7 +2065,7 @@ static long api_case_250(void)
     return 0;
 }
 
-static long api_case_251(void)
+static long api_case_253(void)
 {
     pd_err err = {0};
     pd_osc_free_exact((const pd_osc *)fx_object("pd_osc", "pd_osc_free_exact", 0), 1.0, NULL, (double *)fx_object("double", "pd_osc_free_exact", 3));
@@ -2057,7 +2073,7 @@ static long api_case_251(void)
     return 0;
 }
 
-static long api_case_252(void)
+static long api_case_254(void)
 {
     pd_err err = {0};
     pd_osc_free_exact((const pd_osc *)fx_object("pd_osc", "pd_osc_free_exact", 0), 1.0, (double *)fx_object("double", "pd_osc_free_exact", 2), NULL);
@@ -2065,7 +2081,7 @@ static long api_case_252(void)
     return 0;
 }
 
-static long api_case_253(void)
+static long api_case_255(void)
 {
     pd_err err = {0};
     long v = pd_osc_free_first_contact(NULL, 1.0, (double *)fx_object("double", "pd_osc_free_first_contact", 2), (double *)fx_object("double", "pd_osc_free_first_contact", 3));
@@ -2073,7 +2089,7 @@ static long api_case_253(void)
     return v;
 }
 
-static long api_case_254(void)
+static long api_case_256(void)
 {
     pd_err err = {0};
     long v = pd_osc_free_first_contact((const pd_osc *)fx_object("pd_osc", "pd_osc_free_first_contact", 0), 1.0, NULL, (double *)fx_object("double", "pd_osc_free_first_contact", 3));
@@ -2081,7 +2097,7 @@ static long api_case_254(void)
     return v;
 }
 
-static long api_case_255(void)
+static long api_case_257(void)
 {
     pd_err err = {0};
     long v = pd_osc_free_first_contact((const pd_osc *)fx_object("pd_osc", "pd_osc_free_first_contact", 0), 1.0, (double *)fx_object("double", "pd_osc_free_first_contact", 2), NULL);
@@ -2089,7 +2105,7 @@ static long api_case_255(void)
     return v;
 }
 
-static long api_case_256(void)
+static long api_case_258(void)
 {
     pd_err err = {0};
     long v = pd_trace_alloc(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_trace_alloc", 1));
@@ -2097,7 +2113,7 @@ static long api_case_256(void)
     return v;
 }
 
-static long api_case_257(void)
+static long api_case_259(void)
 {
     pd_err err = {0};
     long v = pd_trace_alloc((pd_trace *)fx_object("pd_trace", "pd_trace_alloc", 0), NULL);
@@ -2105,7 +2121,7 @@ static long api_case_257(void)
     return v;
 }
 
-static long api_case_258(void)
+static long api_case_260(void)
 {
     pd_err err = {0};
     pd_trace_free(NULL);
@@ -2113,7 +2129,7 @@ static long api_case_258(void)
     return 0;
 }
 
-static long api_case_259(void)
+static long api_case_261(void)
 {
     pd_err err = {0};
     long v = pd_measure_reference(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_reference", 1), (pd_trace *)fx_object("pd_trace", "pd_measure_reference", 2), (pd_osc_result *)fx_object("pd_osc_result", "pd_measure_reference", 3), &err);
@@ -2121,7 +2137,7 @@ static long api_case_259(void)
     return v;
 }
 
-static long api_case_260(void)
+static long api_case_262(void)
 {
     pd_err err = {0};
     long v = pd_measure_reference((const pd_osc *)fx_object("pd_osc", "pd_measure_reference", 0), NULL, (pd_trace *)fx_object("pd_trace", "pd_measure_reference", 2), (pd_osc_result *)fx_object("pd_osc_result", "pd_measure_reference", 3), &err);
@@ -2129,7 +2145,7 @@ static long api_case_260(void)
     return v;
 }
 
-static long api_case_261(void)
+static long api_case_263(void)
 {
     pd_err err = {0};
     long v = pd_measure_reference((const pd_osc *)fx_object("pd_osc", "pd_measure_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_reference", 1), NULL, (pd_osc_result *)fx_object("pd_osc_result", "pd_measure_reference", 3), &err);
@@ -2137,7 +2153,7 @@ static long api_case_261(void)
     return v;
 }
 
-static long api_case_262(void)
+static long api_case_264(void)
 {
     pd_err err = {0};
     long v = pd_measure_reference((const pd_osc *)fx_object("pd_osc", "pd_measure_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_reference", 1), (pd_trace *)fx_object("pd_trace", "pd_measure_reference", 2), NULL, &err);
@@ -2145,7 +2161,7 @@ static long api_case_262(void)
     return v;
 }
 
-static long api_case_263(void)
+static long api_case_265(void)
 {
     pd_err err = {0};
     long v = pd_measure_run(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_run", 1), (const pd_trace *)fx_object("pd_trace", "pd_measure_run", 2), 1.0, (pd_trace *)fx_object("pd_trace", "pd_measure_run", 4), (pd_measured *)fx_object("pd_measured", "pd_measure_run", 5), &err);
@@ -2153,7 +2169,7 @@ static long api_case_263(void)
     return v;
 }
 
-static long api_case_264(void)
+static long api_case_266(void)
 {
     pd_err err = {0};
     long v = pd_measure_run((const pd_osc *)fx_object("pd_osc", "pd_measure_run", 0), NULL, (const pd_trace *)fx_object("pd_trace", "pd_measure_run", 2), 1.0, (pd_trace *)fx_object("pd_trace", "pd_measure_run", 4), (pd_measured *)fx_object("pd_measured", "pd_measure_run", 5), &err);
@@ -2161,7 +2177,7 @@ static long api_case_264(void)
     return v;
 }
 
-static long api_case_265(void)
+static long api_case_267(void)
 {
     pd_err err = {0};
     long v = pd_measure_run((const pd_osc *)fx_object("pd_osc", "pd_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_run", 1), NULL, 1.0, (pd_trace *)fx_object("pd_trace", "pd_measure_run", 4), (pd_measured *)fx_object("pd_measured", "pd_measure_run", 5), &err);
@@ -2169,7 +2185,7 @@ static long api_case_265(void)
     return v;
 }
 
-static long api_case_266(void)
+static long api_case_268(void)
 {
     pd_err err = {0};
     long v = pd_measure_run((const pd_osc *)fx_object("pd_osc", "pd_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_run", 1), (const pd_trace *)fx_object("pd_trace", "pd_measure_run", 2), 1.0, NULL, (pd_measured *)fx_object("pd_measured", "pd_measure_run", 5), &err);
@@ -2177,7 +2193,7 @@ static long api_case_266(void)
     return v;
 }
 
-static long api_case_267(void)
+static long api_case_269(void)
 {
     pd_err err = {0};
     long v = pd_measure_run((const pd_osc *)fx_object("pd_osc", "pd_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_measure_run", 1), (const pd_trace *)fx_object("pd_trace", "pd_measure_run", 2), 1.0, (pd_trace *)fx_object("pd_trace", "pd_measure_run", 4), NULL, &err);
@@ -2185,7 +2201,7 @@ static long api_case_267(void)
     return v;
 }
 
-static long api_case_268(void)
+static long api_case_270(void)
 {
     pd_err err = {0};
     pd_scene * p = pd_scene_new(NULL);
@@ -2193,7 +2209,7 @@ static long api_case_268(void)
     return p != NULL;
 }
 
-static long api_case_269(void)
+static long api_case_271(void)
 {
     pd_err err = {0};
     pd_scene_free(NULL);
@@ -2201,7 +2217,7 @@ static long api_case_269(void)
     return 0;
 }
 
-static long api_case_270(void)
+static long api_case_272(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_sdof(NULL, (const char *)fx_string("pd_scene_add_sdof", "name"), 1.0, 1.0, 1.0, &err);
@@ -2209,7 +2225,7 @@ static long api_case_270(void)
     return v;
 }
 
-static long api_case_271(void)
+static long api_case_273(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_sdof((pd_scene *)fx_object("pd_scene", "pd_scene_add_sdof", 0), NULL, 1.0, 1.0, 1.0, &err);
@@ -2217,7 +2233,7 @@ static long api_case_271(void)
     return v;
 }
 
-static long api_case_272(void)
+static long api_case_274(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_building(NULL, (const char *)fx_string("pd_scene_add_building", "name"), 1, (const double *)fx_object("double", "pd_scene_add_building", 3), (const double *)fx_object("double", "pd_scene_add_building", 4), 1.0, &err);
@@ -2225,7 +2241,7 @@ static long api_case_272(void)
     return v;
 }
 
-static long api_case_273(void)
+static long api_case_275(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_building((pd_scene *)fx_object("pd_scene", "pd_scene_add_building", 0), NULL, 1, (const double *)fx_object("double", "pd_scene_add_building", 3), (const double *)fx_object("double", "pd_scene_add_building", 4), 1.0, &err);
@@ -2233,7 +2249,7 @@ static long api_case_273(void)
     return v;
 }
 
-static long api_case_274(void)
+static long api_case_276(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_building((pd_scene *)fx_object("pd_scene", "pd_scene_add_building", 0), (const char *)fx_string("pd_scene_add_building", "name"), 1, NULL, (const double *)fx_object("double", "pd_scene_add_building", 4), 1.0, &err);
@@ -2241,7 +2257,7 @@ static long api_case_274(void)
     return v;
 }
 
-static long api_case_275(void)
+static long api_case_277(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_building((pd_scene *)fx_object("pd_scene", "pd_scene_add_building", 0), (const char *)fx_string("pd_scene_add_building", "name"), 1, (const double *)fx_object("double", "pd_scene_add_building", 3), NULL, 1.0, &err);
@@ -2249,7 +2265,7 @@ static long api_case_275(void)
     return v;
 }
 
-static long api_case_276(void)
+static long api_case_278(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_uniform(NULL, (const char *)fx_string("pd_scene_add_uniform", "name"), 1, 1.0, 1.0, 1.0, &err);
@@ -2257,7 +2273,7 @@ static long api_case_276(void)
     return v;
 }
 
-static long api_case_277(void)
+static long api_case_279(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_uniform((pd_scene *)fx_object("pd_scene", "pd_scene_add_uniform", 0), NULL, 1, 1.0, 1.0, 1.0, &err);
@@ -2265,7 +2281,7 @@ static long api_case_277(void)
     return v;
 }
 
-static long api_case_278(void)
+static long api_case_280(void)
 {
     pd_err err = {0};
     long v = pd_scene_set_damping(NULL, (pd_damping)0, 1, 1, &err);
@@ -2273,7 +2289,7 @@ static long api_case_278(void)
     return v;
 }
 
-static long api_case_279(void)
+static long api_case_281(void)
 {
     pd_err err = {0};
     long v = pd_scene_set_heights(NULL, (const double *)fx_object("double", "pd_scene_set_heights", 1), &err);
@@ -2281,7 +2297,7 @@ static long api_case_279(void)
     return v;
 }
 
-static long api_case_280(void)
+static long api_case_282(void)
 {
     pd_err err = {0};
     long v = pd_scene_set_heights((pd_scene *)fx_object("pd_scene", "pd_scene_set_heights", 0), NULL, &err);
@@ -2289,7 +2305,7 @@ static long api_case_280(void)
     return v;
 }
 
-static long api_case_281(void)
+static long api_case_283(void)
 {
     pd_err err = {0};
     long v = pd_scene_set_yield(NULL, (const double *)fx_object("double", "pd_scene_set_yield", 1), (const double *)fx_object("double", "pd_scene_set_yield", 2), &err);
@@ -2297,7 +2313,7 @@ static long api_case_281(void)
     return v;
 }
 
-static long api_case_282(void)
+static long api_case_284(void)
 {
     pd_err err = {0};
     long v = pd_scene_set_yield((pd_scene *)fx_object("pd_scene", "pd_scene_set_yield", 0), NULL, (const double *)fx_object("double", "pd_scene_set_yield", 2), &err);
@@ -2305,7 +2321,7 @@ static long api_case_282(void)
     return v;
 }
 
-static long api_case_283(void)
+static long api_case_285(void)
 {
     pd_err err = {0};
     long v = pd_scene_set_yield((pd_scene *)fx_object("pd_scene", "pd_scene_set_yield", 0), (const double *)fx_object("double", "pd_scene_set_yield", 1), NULL, &err);
@@ -2313,7 +2329,7 @@ static long api_case_283(void)
     return v;
 }
 
-static long api_case_284(void)
+static long api_case_286(void)
 {
     pd_err err = {0};
     long v = pd_scene_yield_every(NULL, 1.0, 1.0, &err);
@@ -2321,7 +2337,7 @@ static long api_case_284(void)
     return v;
 }
 
-static long api_case_285(void)
+static long api_case_287(void)
 {
     pd_err err = {0};
     long v = pd_scene_springs(NULL);
@@ -2329,7 +2345,7 @@ static long api_case_285(void)
     return v;
 }
 
-static long api_case_286(void)
+static long api_case_288(void)
 {
     pd_err err = {0};
     long v = pd_scene_add_contact(NULL, 1, 1, 1, 1, 1.0, 1.0, 1, &err);
@@ -2337,7 +2353,7 @@ static long api_case_286(void)
     return v;
 }
 
-static long api_case_287(void)
+static long api_case_289(void)
 {
     pd_err err = {0};
     pd_scene * p = pd_scene_copy(NULL);
@@ -2345,7 +2361,7 @@ static long api_case_287(void)
     return p != NULL;
 }
 
-static long api_case_288(void)
+static long api_case_290(void)
 {
     pd_err err = {0};
     long v = pd_scene_find(NULL, (const char *)fx_string("pd_scene_find", "name"));
@@ -2353,7 +2369,7 @@ static long api_case_288(void)
     return v;
 }
 
-static long api_case_289(void)
+static long api_case_291(void)
 {
     pd_err err = {0};
     long v = pd_scene_find((const pd_scene *)fx_object("pd_scene", "pd_scene_find", 0), NULL);
@@ -2361,7 +2377,7 @@ static long api_case_289(void)
     return v;
 }
 
-static long api_case_290(void)
+static long api_case_292(void)
 {
     pd_err err = {0};
     long v = pd_scene_finish(NULL, &err);
@@ -2369,7 +2385,7 @@ static long api_case_290(void)
     return v;
 }
 
-static long api_case_291(void)
+static long api_case_293(void)
 {
     pd_err err = {0};
     long v = pd_scene_load(NULL, (pd_scene **)fx_slot(), &err);
@@ -2377,7 +2393,7 @@ static long api_case_291(void)
     return v;
 }
 
-static long api_case_292(void)
+static long api_case_294(void)
 {
     pd_err err = {0};
     long v = pd_scene_load((const char *)fx_string("pd_scene_load", "path"), NULL, &err);
@@ -2385,7 +2401,7 @@ static long api_case_292(void)
     return v;
 }
 
-static long api_case_293(void)
+static long api_case_295(void)
 {
     pd_err err = {0};
     long v = pd_scene_chain(1, NULL, 1.0, 1.0, 1.0, 1.0, 1.0, (pd_scene **)fx_slot(), &err);
@@ -2393,7 +2409,7 @@ static long api_case_293(void)
     return v;
 }
 
-static long api_case_294(void)
+static long api_case_296(void)
 {
     pd_err err = {0};
     long v = pd_scene_chain(1, (const pd_scene_excitation *)fx_object("pd_scene_excitation", "pd_scene_chain", 1), 1.0, 1.0, 1.0, 1.0, 1.0, NULL, &err);
@@ -2401,7 +2417,7 @@ static long api_case_294(void)
     return v;
 }
 
-static long api_case_295(void)
+static long api_case_297(void)
 {
     pd_err err = {0};
     double v = pd_scene_wp(NULL);
@@ -2410,7 +2426,7 @@ static long api_case_295(void)
     return 0;
 }
 
-static long api_case_296(void)
+static long api_case_298(void)
 {
     pd_err err = {0};
     double v = pd_scene_Le(NULL);
@@ -2419,7 +2435,7 @@ static long api_case_296(void)
     return 0;
 }
 
-static long api_case_297(void)
+static long api_case_299(void)
 {
     pd_err err = {0};
     double v = pd_scene_default_dt(NULL);
@@ -2428,7 +2444,7 @@ static long api_case_297(void)
     return 0;
 }
 
-static long api_case_298(void)
+static long api_case_300(void)
 {
     pd_err err = {0};
     double v = pd_scene_default_tend(NULL);
@@ -2437,7 +2453,7 @@ static long api_case_298(void)
     return 0;
 }
 
-static long api_case_299(void)
+static long api_case_301(void)
 {
     pd_err err = {0};
     double v = pd_scene_measure_start(NULL, 1.0);
@@ -2446,7 +2462,7 @@ static long api_case_299(void)
     return 0;
 }
 
-static long api_case_300(void)
+static long api_case_302(void)
 {
     pd_err err = {0};
     long v = pd_scene_resolve_opts(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_resolve_opts", 1), (pd_run_opts *)fx_object("pd_run_opts", "pd_scene_resolve_opts", 2), &err);
@@ -2454,7 +2470,7 @@ static long api_case_300(void)
     return v;
 }
 
-static long api_case_301(void)
+static long api_case_303(void)
 {
     pd_err err = {0};
     long v = pd_scene_resolve_opts((const pd_scene *)fx_object("pd_scene", "pd_scene_resolve_opts", 0), NULL, (pd_run_opts *)fx_object("pd_run_opts", "pd_scene_resolve_opts", 2), &err);
@@ -2462,7 +2478,7 @@ static long api_case_301(void)
     return v;
 }
 
-static long api_case_302(void)
+static long api_case_304(void)
 {
     pd_err err = {0};
     long v = pd_scene_resolve_opts((const pd_scene *)fx_object("pd_scene", "pd_scene_resolve_opts", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_resolve_opts", 1), NULL, &err);
@@ -2470,7 +2486,7 @@ static long api_case_302(void)
     return v;
 }
 
-static long api_case_303(void)
+static long api_case_305(void)
 {
     pd_err err = {0};
     long v = pd_scene_as_oscillator(NULL, (pd_osc *)fx_object("pd_osc", "pd_scene_as_oscillator", 1), (int *)fx_object("int", "pd_scene_as_oscillator", 2));
@@ -2478,7 +2494,7 @@ static long api_case_303(void)
     return v;
 }
 
-static long api_case_304(void)
+static long api_case_306(void)
 {
     pd_err err = {0};
     long v = pd_scene_as_oscillator((const pd_scene *)fx_object("pd_scene", "pd_scene_as_oscillator", 0), NULL, (int *)fx_object("int", "pd_scene_as_oscillator", 2));
@@ -2486,7 +2502,7 @@ static long api_case_304(void)
     return v;
 }
 
-static long api_case_305(void)
+static long api_case_307(void)
 {
     pd_err err = {0};
     long v = pd_scene_as_oscillator((const pd_scene *)fx_object("pd_scene", "pd_scene_as_oscillator", 0), (pd_osc *)fx_object("pd_osc", "pd_scene_as_oscillator", 1), NULL);
@@ -2494,7 +2510,7 @@ static long api_case_305(void)
     return v;
 }
 
-static long api_case_306(void)
+static long api_case_308(void)
 {
     pd_err err = {0};
     long v = pd_scene_model_build(NULL, 1, (pd_scene_model *)fx_object("pd_scene_model", "pd_scene_model_build", 2), &err);
@@ -2502,7 +2518,7 @@ static long api_case_306(void)
     return v;
 }
 
-static long api_case_307(void)
+static long api_case_309(void)
 {
     pd_err err = {0};
     long v = pd_scene_model_build((const pd_scene *)fx_object("pd_scene", "pd_scene_model_build", 0), 1, NULL, &err);
@@ -2510,7 +2526,7 @@ static long api_case_307(void)
     return v;
 }
 
-static long api_case_308(void)
+static long api_case_310(void)
 {
     pd_err err = {0};
     pd_scene_model_free(NULL);
@@ -2518,7 +2534,7 @@ static long api_case_308(void)
     return 0;
 }
 
-static long api_case_309(void)
+static long api_case_311(void)
 {
     pd_err err = {0};
     long v = pd_scene_result_alloc(NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_result_alloc", 1), &err);
@@ -2526,7 +2542,7 @@ static long api_case_309(void)
     return v;
 }
 
-static long api_case_310(void)
+static long api_case_312(void)
 {
     pd_err err = {0};
     long v = pd_scene_result_alloc((const pd_scene *)fx_object("pd_scene", "pd_scene_result_alloc", 0), NULL, &err);
@@ -2534,7 +2550,7 @@ static long api_case_310(void)
     return v;
 }
 
-static long api_case_311(void)
+static long api_case_313(void)
 {
     pd_err err = {0};
     long v = pd_scene_result_fits(NULL, (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_result_fits", 1));
@@ -2542,7 +2558,7 @@ static long api_case_311(void)
     return v;
 }
 
-static long api_case_312(void)
+static long api_case_314(void)
 {
     pd_err err = {0};
     long v = pd_scene_result_fits((const pd_scene *)fx_object("pd_scene", "pd_scene_result_fits", 0), NULL);
@@ -2550,7 +2566,7 @@ static long api_case_312(void)
     return v;
 }
 
-static long api_case_313(void)
+static long api_case_315(void)
 {
     pd_err err = {0};
     pd_scene_result_free(NULL);
@@ -2558,7 +2574,7 @@ static long api_case_313(void)
     return 0;
 }
 
-static long api_case_314(void)
+static long api_case_316(void)
 {
     pd_err err = {0};
     long v = pd_scene_run(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_run", 1), NULL, NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_run", 4), &err);
@@ -2566,7 +2582,7 @@ static long api_case_314(void)
     return v;
 }
 
-static long api_case_315(void)
+static long api_case_317(void)
 {
     pd_err err = {0};
     long v = pd_scene_run((const pd_scene *)fx_object("pd_scene", "pd_scene_run", 0), NULL, NULL, NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_run", 4), &err);
@@ -2574,7 +2590,7 @@ static long api_case_315(void)
     return v;
 }
 
-static long api_case_316(void)
+static long api_case_318(void)
 {
     pd_err err = {0};
     long v = pd_scene_run((const pd_scene *)fx_object("pd_scene", "pd_scene_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_run", 1), NULL, NULL, NULL, &err);
@@ -2582,7 +2598,7 @@ static long api_case_316(void)
     return v;
 }
 
-static long api_case_317(void)
+static long api_case_319(void)
 {
     pd_err err = {0};
     long v = pd_scene_summarize(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_summarize", 1), NULL, NULL, (pd_scene_summary *)fx_object("pd_scene_summary", "pd_scene_summarize", 4), &err);
@@ -2590,7 +2606,7 @@ static long api_case_317(void)
     return v;
 }
 
-static long api_case_318(void)
+static long api_case_320(void)
 {
     pd_err err = {0};
     long v = pd_scene_summarize((const pd_scene *)fx_object("pd_scene", "pd_scene_summarize", 0), NULL, NULL, NULL, (pd_scene_summary *)fx_object("pd_scene_summary", "pd_scene_summarize", 4), &err);
@@ -2598,7 +2614,7 @@ static long api_case_318(void)
     return v;
 }
 
-static long api_case_319(void)
+static long api_case_321(void)
 {
     pd_err err = {0};
     long v = pd_scene_summarize((const pd_scene *)fx_object("pd_scene", "pd_scene_summarize", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_summarize", 1), NULL, NULL, NULL, &err);
@@ -2606,7 +2622,7 @@ static long api_case_319(void)
     return v;
 }
 
-static long api_case_320(void)
+static long api_case_322(void)
 {
     pd_err err = {0};
     pd_scene_summary_free(NULL);
@@ -2614,7 +2630,7 @@ static long api_case_320(void)
     return 0;
 }
 
-static long api_case_321(void)
+static long api_case_323(void)
 {
     pd_err err = {0};
     long v = pd_scene_trace_alloc(NULL, (const pd_scene *)fx_object("pd_scene", "pd_scene_trace_alloc", 1), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_trace_alloc", 2), &err);
@@ -2622,7 +2638,7 @@ static long api_case_321(void)
     return v;
 }
 
-static long api_case_322(void)
+static long api_case_324(void)
 {
     pd_err err = {0};
     long v = pd_scene_trace_alloc((pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_trace_alloc", 0), NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_trace_alloc", 2), &err);
@@ -2630,7 +2646,7 @@ static long api_case_322(void)
     return v;
 }
 
-static long api_case_323(void)
+static long api_case_325(void)
 {
     pd_err err = {0};
     long v = pd_scene_trace_alloc((pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_trace_alloc", 0), (const pd_scene *)fx_object("pd_scene", "pd_scene_trace_alloc", 1), NULL, &err);
@@ -2638,7 +2654,7 @@ static long api_case_323(void)
     return v;
 }
 
-static long api_case_324(void)
+static long api_case_326(void)
 {
     pd_err err = {0};
     pd_scene_trace_free(NULL);
@@ -2646,7 +2662,7 @@ static long api_case_324(void)
     return 0;
 }
 
-static long api_case_325(void)
+static long api_case_327(void)
 {
     pd_err err = {0};
     long v = pd_scene_errors_alloc(NULL, (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_errors_alloc", 1), &err);
@@ -2654,7 +2670,7 @@ static long api_case_325(void)
     return v;
 }
 
-static long api_case_326(void)
+static long api_case_328(void)
 {
     pd_err err = {0};
     long v = pd_scene_errors_alloc((const pd_scene *)fx_object("pd_scene", "pd_scene_errors_alloc", 0), NULL, &err);
@@ -2662,7 +2678,7 @@ static long api_case_326(void)
     return v;
 }
 
-static long api_case_327(void)
+static long api_case_329(void)
 {
     pd_err err = {0};
     pd_scene_errors_free(NULL);
@@ -2670,7 +2686,7 @@ static long api_case_327(void)
     return 0;
 }
 
-static long api_case_328(void)
+static long api_case_330(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_reference(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_reference", 1), (pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_reference", 2), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_reference", 3), &err);
@@ -2678,7 +2694,7 @@ static long api_case_328(void)
     return v;
 }
 
-static long api_case_329(void)
+static long api_case_331(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_reference((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_reference", 0), NULL, (pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_reference", 2), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_reference", 3), &err);
@@ -2686,7 +2702,7 @@ static long api_case_329(void)
     return v;
 }
 
-static long api_case_330(void)
+static long api_case_332(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_reference((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_reference", 1), NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_reference", 3), &err);
@@ -2694,7 +2710,7 @@ static long api_case_330(void)
     return v;
 }
 
-static long api_case_331(void)
+static long api_case_333(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_reference((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_reference", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_reference", 1), (pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_reference", 2), NULL, &err);
@@ -2702,7 +2718,7 @@ static long api_case_331(void)
     return v;
 }
 
-static long api_case_332(void)
+static long api_case_334(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run(NULL, (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2710,7 +2726,7 @@ static long api_case_332(void)
     return v;
 }
 
-static long api_case_333(void)
+static long api_case_335(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), NULL, (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2718,7 +2734,7 @@ static long api_case_333(void)
     return v;
 }
 
-static long api_case_334(void)
+static long api_case_336(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), NULL, (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2726,7 +2742,7 @@ static long api_case_334(void)
     return v;
 }
 
-static long api_case_335(void)
+static long api_case_337(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), NULL, (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2734,7 +2750,7 @@ static long api_case_335(void)
     return v;
 }
 
-static long api_case_336(void)
+static long api_case_338(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), NULL, (pd_scene_errors *)fx_object("pd_scene_errors", "pd_scene_measure_run", 5), &err);
@@ -2742,7 +2758,7 @@ static long api_case_336(void)
     return v;
 }
 
-static long api_case_337(void)
+static long api_case_339(void)
 {
     pd_err err = {0};
     long v = pd_scene_measure_run((const pd_scene *)fx_object("pd_scene", "pd_scene_measure_run", 0), (const pd_run_opts *)fx_object("pd_run_opts", "pd_scene_measure_run", 1), (const pd_scene_trace *)fx_object("pd_scene_trace", "pd_scene_measure_run", 2), (const pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 3), (pd_scene_result *)fx_object("pd_scene_result", "pd_scene_measure_run", 4), NULL, &err);
@@ -2750,7 +2766,7 @@ static long api_case_337(void)
     return v;
 }
 
-static long api_case_338(void)
+static long api_case_340(void)
 {
     pd_err err = {0};
     pd_spec_init(NULL);
@@ -2758,7 +2774,7 @@ static long api_case_338(void)
     return 0;
 }
 
-static long api_case_339(void)
+static long api_case_341(void)
 {
     pd_err err = {0};
     long v = pd_spec_curves(NULL);
@@ -2766,7 +2782,7 @@ static long api_case_339(void)
     return v;
 }
 
-static long api_case_340(void)
+static long api_case_342(void)
 {
     pd_err err = {0};
     long v = pd_spec_points(NULL);
@@ -2774,7 +2790,7 @@ static long api_case_340(void)
     return v;
 }
 
-static long api_case_341(void)
+static long api_case_343(void)
 {
     pd_err err = {0};
     long v = pd_spec_twins(NULL);
@@ -2782,7 +2798,7 @@ static long api_case_341(void)
     return v;
 }
 
-static long api_case_342(void)
+static long api_case_344(void)
 {
     pd_err err = {0};
     long v = pd_spec_tasks(NULL);
@@ -2790,7 +2806,7 @@ static long api_case_342(void)
     return v;
 }
 
-static long api_case_343(void)
+static long api_case_345(void)
 {
     pd_err err = {0};
     double v = pd_spec_pi2(NULL, 0);
@@ -2799,7 +2815,7 @@ static long api_case_343(void)
     return 0;
 }
 
-static long api_case_344(void)
+static long api_case_346(void)
 {
     pd_err err = {0};
     pd_spec_coords_of(NULL, 0, (pd_spec_coords *)fx_object("pd_spec_coords", "pd_spec_coords_of", 2));
@@ -2807,7 +2823,7 @@ static long api_case_344(void)
     return 0;
 }
 
-static long api_case_345(void)
+static long api_case_347(void)
 {
     pd_err err = {0};
     pd_spec_coords_of((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_coords_of", 0), 0, NULL);
@@ -2815,7 +2831,7 @@ static long api_case_345(void)
     return 0;
 }
 
-static long api_case_346(void)
+static long api_case_348(void)
 {
     pd_err err = {0};
     long v = pd_spec_twin_of(NULL, 0);
@@ -2823,7 +2839,7 @@ static long api_case_346(void)
     return v;
 }
 
-static long api_case_347(void)
+static long api_case_349(void)
 {
     pd_err err = {0};
     long v = pd_spec_case(NULL, 0, (pd_osc *)fx_object("pd_osc", "pd_spec_case", 2), (pd_run_opts *)fx_object("pd_run_opts", "pd_spec_case", 3), &err);
@@ -2831,7 +2847,7 @@ static long api_case_347(void)
     return v;
 }
 
-static long api_case_348(void)
+static long api_case_350(void)
 {
     pd_err err = {0};
     long v = pd_spec_case((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_case", 0), 0, NULL, (pd_run_opts *)fx_object("pd_run_opts", "pd_spec_case", 3), &err);
@@ -2839,7 +2855,7 @@ static long api_case_348(void)
     return v;
 }
 
-static long api_case_349(void)
+static long api_case_351(void)
 {
     pd_err err = {0};
     long v = pd_spec_case((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_case", 0), 0, (pd_osc *)fx_object("pd_osc", "pd_spec_case", 2), NULL, &err);
@@ -2847,7 +2863,7 @@ static long api_case_349(void)
     return v;
 }
 
-static long api_case_350(void)
+static long api_case_352(void)
 {
     pd_err err = {0};
     long v = pd_spec_validate(NULL, &err);
@@ -2855,7 +2871,7 @@ static long api_case_350(void)
     return v;
 }
 
-static long api_case_351(void)
+static long api_case_353(void)
 {
     pd_err err = {0};
     pd_spec_resolve_method(NULL);
@@ -2863,7 +2879,7 @@ static long api_case_351(void)
     return 0;
 }
 
-static long api_case_352(void)
+static long api_case_354(void)
 {
     pd_err err = {0};
     pd_spec_run_task(NULL, 0, (pd_spec_result *)fx_object("pd_spec_result", "pd_spec_run_task", 2), &err);
@@ -2871,7 +2887,7 @@ static long api_case_352(void)
     return 0;
 }
 
-static long api_case_353(void)
+static long api_case_355(void)
 {
     pd_err err = {0};
     pd_spec_run_task((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_run_task", 0), 0, NULL, &err);
@@ -2879,7 +2895,7 @@ static long api_case_353(void)
     return 0;
 }
 
-static long api_case_354(void)
+static long api_case_356(void)
 {
     pd_err err = {0};
     long v = pd_spec_stream(NULL, NULL, NULL, NULL, &err);
@@ -2887,7 +2903,7 @@ static long api_case_354(void)
     return v;
 }
 
-static long api_case_355(void)
+static long api_case_357(void)
 {
     pd_err err = {0};
     double v = pd_spec_cost(NULL, 0);
@@ -2896,7 +2912,7 @@ static long api_case_355(void)
     return 0;
 }
 
-static long api_case_356(void)
+static long api_case_358(void)
 {
     pd_err err = {0};
     char * p = pd_spec_key(NULL);
@@ -2904,7 +2920,7 @@ static long api_case_356(void)
     return p != NULL;
 }
 
-static long api_case_357(void)
+static long api_case_359(void)
 {
     pd_err err = {0};
     pd_spec_rows(NULL, (const pd_spec_result *)fx_object("pd_spec_result", "pd_spec_rows", 1), (pd_spec_row *)fx_object("pd_spec_row", "pd_spec_rows", 2));
@@ -2912,7 +2928,7 @@ static long api_case_357(void)
     return 0;
 }
 
-static long api_case_358(void)
+static long api_case_360(void)
 {
     pd_err err = {0};
     pd_spec_rows((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_rows", 0), NULL, (pd_spec_row *)fx_object("pd_spec_row", "pd_spec_rows", 2));
@@ -2920,7 +2936,7 @@ static long api_case_358(void)
     return 0;
 }
 
-static long api_case_359(void)
+static long api_case_361(void)
 {
     pd_err err = {0};
     pd_spec_rows((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_rows", 0), (const pd_spec_result *)fx_object("pd_spec_result", "pd_spec_rows", 1), NULL);
@@ -2928,7 +2944,7 @@ static long api_case_359(void)
     return 0;
 }
 
-static long api_case_360(void)
+static long api_case_362(void)
 {
     pd_err err = {0};
     pd_spec_curve_label(NULL, 1, (char *)fx_string("pd_spec_curve_label", "buf"), 64);
@@ -2936,7 +2952,7 @@ static long api_case_360(void)
     return 0;
 }
 
-static long api_case_361(void)
+static long api_case_363(void)
 {
     pd_err err = {0};
     pd_spec_curve_label((const pd_spectrum *)fx_object("pd_spectrum", "pd_spec_curve_label", 0), 1, NULL, 64);
@@ -2944,7 +2960,7 @@ static long api_case_361(void)
     return 0;
 }
 
-static long api_case_362(void)
+static long api_case_364(void)
 {
     pd_err err = {0};
     long v = pd_spec_sweep(NULL, NULL, NULL, &err);
@@ -2952,7 +2968,7 @@ static long api_case_362(void)
     return v;
 }
 
-static long api_case_363(void)
+static long api_case_365(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_twins(NULL);
@@ -2960,7 +2976,7 @@ static long api_case_363(void)
     return v;
 }
 
-static long api_case_364(void)
+static long api_case_366(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_points(NULL);
@@ -2968,7 +2984,7 @@ static long api_case_364(void)
     return v;
 }
 
-static long api_case_365(void)
+static long api_case_367(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_check(NULL, &err);
@@ -2976,7 +2992,7 @@ static long api_case_365(void)
     return v;
 }
 
-static long api_case_366(void)
+static long api_case_368(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_scene(NULL, 0, (pd_scene **)fx_slot(), (pd_scene_point *)fx_object("pd_scene_point", "pd_scene_sweep_scene", 3), &err);
@@ -2984,7 +3000,7 @@ static long api_case_366(void)
     return v;
 }
 
-static long api_case_367(void)
+static long api_case_369(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_scene((const pd_scene_sweep *)fx_object("pd_scene_sweep", "pd_scene_sweep_scene", 0), 0, NULL, (pd_scene_point *)fx_object("pd_scene_point", "pd_scene_sweep_scene", 3), &err);
@@ -2992,7 +3008,7 @@ static long api_case_367(void)
     return v;
 }
 
-static long api_case_368(void)
+static long api_case_370(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_scene((const pd_scene_sweep *)fx_object("pd_scene_sweep", "pd_scene_sweep_scene", 0), 0, (pd_scene **)fx_slot(), NULL, &err);
@@ -3000,7 +3016,7 @@ static long api_case_368(void)
     return v;
 }
 
-static long api_case_369(void)
+static long api_case_371(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_run(NULL, 1, (pd_scene_point *)fx_object("pd_scene_point", "pd_scene_sweep_run", 2), (double *)fx_object("double", "pd_scene_sweep_run", 3), &err);
@@ -3008,7 +3024,7 @@ static long api_case_369(void)
     return v;
 }
 
-static long api_case_370(void)
+static long api_case_372(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_run((const pd_scene_sweep *)fx_object("pd_scene_sweep", "pd_scene_sweep_run", 0), 1, NULL, (double *)fx_object("double", "pd_scene_sweep_run", 3), &err);
@@ -3016,7 +3032,7 @@ static long api_case_370(void)
     return v;
 }
 
-static long api_case_371(void)
+static long api_case_373(void)
 {
     pd_err err = {0};
     long v = pd_scene_sweep_run((const pd_scene_sweep *)fx_object("pd_scene_sweep", "pd_scene_sweep_run", 0), 1, (pd_scene_point *)fx_object("pd_scene_point", "pd_scene_sweep_run", 2), NULL, &err);
@@ -3171,232 +3187,234 @@ const api_null_case api_null_cases[] = {
     {.function = "pd_sdof_flow_init", .argument = "f", .expect = EXPECT_NOCRASH, .call = api_case_143},
     {.function = "pd_sdof_flow_init", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_144},
     {.function = "pd_sdof_flow_init", .argument = "pc", .expect = EXPECT_NOCRASH, .call = api_case_145},
-    {.function = "pd_sdof_flow_at", .argument = "f", .expect = EXPECT_NOCRASH, .call = api_case_146},
-    {.function = "pd_sdof_flow_at", .argument = "du", .expect = EXPECT_NOCRASH, .call = api_case_147},
-    {.function = "pd_sdof_flow_at", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_148},
-    {.function = "pd_sdof_advance", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_149},
-    {.function = "pd_sdof_advance", .argument = "u1", .expect = EXPECT_NOCRASH, .call = api_case_150},
-    {.function = "pd_sdof_advance", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_151},
-    {.function = "pd_sdof_increment", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_152},
-    {.function = "pd_sdof_increment", .argument = "du", .expect = EXPECT_NOCRASH, .call = api_case_153},
-    {.function = "pd_sdof_increment", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_154},
-    {.function = "pd_edr_alloc", .argument = "model", .expect = EXPECT_NULL, .call = api_case_155},
-    {.function = "pd_edr_alloc", .argument = "force", .expect = EXPECT_NULL, .call = api_case_156},
-    {.function = "pd_edr_alloc", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_157},
-    {.function = "pd_edr_free", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_158},
-    {.function = "pd_edr_run", .argument = "r", .expect = EXPECT_ERROR, .call = api_case_159},
-    {.function = "pd_edr_run", .argument = "q0", .expect = EXPECT_NOCRASH, .call = api_case_160},
-    {.function = "pd_edr_run", .argument = "v0", .expect = EXPECT_NOCRASH, .call = api_case_161},
-    {.function = "pd_edr_result_of", .argument = "r", .expect = EXPECT_NULL, .call = api_case_162},
-    {.function = "pd_ed_sdof_run", .argument = "prob", .expect = EXPECT_ERROR, .call = api_case_163},
-    {.function = "pd_ed_sdof_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_164},
-    {.function = "pd_ed_sdof_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_165},
-    {.function = "pd_pulse_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_166},
-    {.function = "pd_pulse_parse", .argument = "pulse", .expect = EXPECT_ERROR, .call = api_case_167},
-    {.function = "pd_dir_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_168},
-    {.function = "pd_dir_parse", .argument = "dir", .expect = EXPECT_ERROR, .call = api_case_169},
-    {.function = "pd_record_format_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_170},
-    {.function = "pd_record_format_parse", .argument = "f", .expect = EXPECT_ERROR, .call = api_case_171},
-    {.function = "pd_record_units_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_172},
-    {.function = "pd_record_units_parse", .argument = "u", .expect = EXPECT_ERROR, .call = api_case_173},
-    {.function = "pd_record_read", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_174},
-    {.function = "pd_record_read", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_175},
-    {.function = "pd_record_free", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_176},
-    {.function = "pd_record_detect", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_177},
-    {.function = "pd_record_detect", .argument = "format", .expect = EXPECT_ERROR, .call = api_case_178},
-    {.function = "pd_record_plausible", .argument = "rec", .expect = EXPECT_COUNT, .call = api_case_179},
-    {.function = "pd_record_plausible", .argument = "msg", .expect = EXPECT_NOCRASH, .call = api_case_180},
-    {.function = "pd_record_from_array", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_181},
-    {.function = "pd_record_from_array", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_182},
-    {.function = "pd_record_from_array", .argument = "acc", .expect = EXPECT_ERROR, .call = api_case_183},
-    {.function = "pd_record_duration", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_184},
-    {.function = "pd_record_acc", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_185},
-    {.function = "pd_record_measure", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_186},
-    {.function = "pd_record_measure", .argument = "m", .expect = EXPECT_ERROR, .call = api_case_187},
-    {.function = "pd_record_integrate", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_188},
-    {.function = "pd_record_integrate", .argument = "vel", .expect = EXPECT_ERROR, .call = api_case_189},
-    {.function = "pd_record_integrate", .argument = "disp", .expect = EXPECT_ERROR, .call = api_case_190},
-    {.function = "pd_record_fit_pulse", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_191},
-    {.function = "pd_record_fit_pulse", .argument = "p", .expect = EXPECT_ERROR, .call = api_case_192},
-    {.function = "pd_record_pulse_eval", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_193},
-    {.function = "pd_record_pulse_eval", .argument = "acc", .expect = EXPECT_NOCRASH, .call = api_case_194},
-    {.function = "pd_record_pulse_eval", .argument = "vel", .expect = EXPECT_NOCRASH, .call = api_case_195},
-    {.function = "pd_record_one_cycle", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_196},
-    {.function = "pd_method_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_197},
-    {.function = "pd_method_parse", .argument = "method", .expect = EXPECT_ERROR, .call = api_case_198},
-    {.function = "pd_impact_law_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_199},
-    {.function = "pd_impact_law_parse", .argument = "law", .expect = EXPECT_ERROR, .call = api_case_200},
-    {.function = "pd_run_opts_check", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_201},
-    {.function = "pd_osc_wp", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_202},
-    {.function = "pd_osc_T0", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_203},
-    {.function = "pd_osc_gap", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_204},
-    {.function = "pd_osc_Le", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_205},
-    {.function = "pd_osc_set_T0", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_206},
-    {.function = "pd_osc_set_gap", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_207},
-    {.function = "pd_osc_set_uy", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_208},
-    {.function = "pd_osc_uy", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_209},
-    {.function = "pd_osc_yields", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_210},
-    {.function = "pd_osc_yield_exact", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_211},
-    {.function = "pd_osc_excitation", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_212},
-    {.function = "pd_osc_set_record", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_213},
-    {.function = "pd_osc_set_record", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_214},
-    {.function = "pd_osc_set_record", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_215},
-    {.function = "pd_osc_shape", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_216},
-    {.function = "pd_osc_shape_rate", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_217},
-    {.function = "pd_osc_shape_end", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_218},
-    {.function = "pd_osc_pieces", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_219},
-    {.function = "pd_osc_pieces", .argument = "pieces", .expect = EXPECT_ERROR, .call = api_case_220},
-    {.function = "pd_osc_pieces", .argument = "npieces", .expect = EXPECT_ERROR, .call = api_case_221},
-    {.function = "pd_osc_excitation_name", .argument = "c", .expect = EXPECT_NAME, .call = api_case_222},
-    {.function = "pd_osc_check", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_223},
-    {.function = "pd_osc_resolve_opts", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_224},
-    {.function = "pd_osc_resolve_opts", .argument = "in", .expect = EXPECT_NOCRASH, .call = api_case_225},
-    {.function = "pd_osc_resolve_opts", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_226},
-    {.function = "pd_osc_default_dt", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_227},
-    {.function = "pd_osc_default_tend", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_228},
-    {.function = "pd_osc_measure_start", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_229},
-    {.function = "pd_osc_method", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_230},
-    {.function = "pd_osc_method", .argument = "o", .expect = EXPECT_NOCRASH, .call = api_case_231},
-    {.function = "pd_osc_run", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_232},
-    {.function = "pd_osc_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_233},
-    {.function = "pd_osc_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_234},
-    {.function = "pd_osc_batchable", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_235},
-    {.function = "pd_osc_batchable", .argument = "o", .expect = EXPECT_COUNT, .call = api_case_236},
-    {.function = "pd_osc_scan_points", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_237},
-    {.function = "pd_osc_simulate", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_238},
-    {.function = "pd_osc_simulate", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_239},
-    {.function = "pd_osc_simulate", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_240},
-    {.function = "pd_osc_reference", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_241},
-    {.function = "pd_osc_reference", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_242},
-    {.function = "pd_osc_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_243},
-    {.function = "pd_osc_penalty", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_244},
-    {.function = "pd_osc_penalty", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_245},
-    {.function = "pd_osc_penalty", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_246},
-    {.function = "pd_osc_summarize", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_247},
-    {.function = "pd_osc_summarize", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_248},
-    {.function = "pd_osc_summarize", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_249},
-    {.function = "pd_osc_free_exact", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_250},
-    {.function = "pd_osc_free_exact", .argument = "u", .expect = EXPECT_NOCRASH, .call = api_case_251},
-    {.function = "pd_osc_free_exact", .argument = "v", .expect = EXPECT_NOCRASH, .call = api_case_252},
-    {.function = "pd_osc_free_first_contact", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_253},
-    {.function = "pd_osc_free_first_contact", .argument = "t", .expect = EXPECT_ERROR, .call = api_case_254},
-    {.function = "pd_osc_free_first_contact", .argument = "v", .expect = EXPECT_ERROR, .call = api_case_255},
-    {.function = "pd_trace_alloc", .argument = "tr", .expect = EXPECT_ERROR, .call = api_case_256},
-    {.function = "pd_trace_alloc", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_257},
-    {.function = "pd_trace_free", .argument = "tr", .expect = EXPECT_NOCRASH, .call = api_case_258},
-    {.function = "pd_measure_reference", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_259},
-    {.function = "pd_measure_reference", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_260},
-    {.function = "pd_measure_reference", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_261},
-    {.function = "pd_measure_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_262},
-    {.function = "pd_measure_run", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_263},
-    {.function = "pd_measure_run", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_264},
-    {.function = "pd_measure_run", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_265},
-    {.function = "pd_measure_run", .argument = "work", .expect = EXPECT_ERROR, .call = api_case_266},
-    {.function = "pd_measure_run", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_267},
-    {.function = "pd_scene_new", .argument = "exc", .expect = EXPECT_NOCRASH, .call = api_case_268},
-    {.function = "pd_scene_free", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_269},
-    {.function = "pd_scene_add_sdof", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_270},
-    {.function = "pd_scene_add_sdof", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_271},
-    {.function = "pd_scene_add_building", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_272},
-    {.function = "pd_scene_add_building", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_273},
-    {.function = "pd_scene_add_building", .argument = "masses", .expect = EXPECT_ERROR, .call = api_case_274},
-    {.function = "pd_scene_add_building", .argument = "stiffnesses", .expect = EXPECT_ERROR, .call = api_case_275},
-    {.function = "pd_scene_add_uniform", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_276},
-    {.function = "pd_scene_add_uniform", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_277},
-    {.function = "pd_scene_set_damping", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_278},
-    {.function = "pd_scene_set_heights", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_279},
-    {.function = "pd_scene_set_heights", .argument = "heights", .expect = EXPECT_ERROR, .call = api_case_280},
-    {.function = "pd_scene_set_yield", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_281},
-    {.function = "pd_scene_set_yield", .argument = "uy", .expect = EXPECT_ERROR, .call = api_case_282},
-    {.function = "pd_scene_set_yield", .argument = "alpha", .expect = EXPECT_ERROR, .call = api_case_283},
-    {.function = "pd_scene_yield_every", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_284},
-    {.function = "pd_scene_springs", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_285},
-    {.function = "pd_scene_add_contact", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_286},
-    {.function = "pd_scene_copy", .argument = "sc", .expect = EXPECT_NULL, .call = api_case_287},
-    {.function = "pd_scene_find", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_288},
-    {.function = "pd_scene_find", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_289},
-    {.function = "pd_scene_finish", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_290},
-    {.function = "pd_scene_load", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_291},
-    {.function = "pd_scene_load", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_292},
-    {.function = "pd_scene_chain", .argument = "exc", .expect = EXPECT_ERROR, .call = api_case_293},
-    {.function = "pd_scene_chain", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_294},
-    {.function = "pd_scene_wp", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_295},
-    {.function = "pd_scene_Le", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_296},
-    {.function = "pd_scene_default_dt", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_297},
-    {.function = "pd_scene_default_tend", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_298},
-    {.function = "pd_scene_measure_start", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_299},
-    {.function = "pd_scene_resolve_opts", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_300},
-    {.function = "pd_scene_resolve_opts", .argument = "in", .expect = EXPECT_NOCRASH, .call = api_case_301},
-    {.function = "pd_scene_resolve_opts", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_302},
-    {.function = "pd_scene_as_oscillator", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_303},
-    {.function = "pd_scene_as_oscillator", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_304},
-    {.function = "pd_scene_as_oscillator", .argument = "mirrored", .expect = EXPECT_COUNT, .call = api_case_305},
-    {.function = "pd_scene_model_build", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_306},
-    {.function = "pd_scene_model_build", .argument = "sm", .expect = EXPECT_ERROR, .call = api_case_307},
-    {.function = "pd_scene_model_free", .argument = "sm", .expect = EXPECT_NOCRASH, .call = api_case_308},
-    {.function = "pd_scene_result_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_309},
-    {.function = "pd_scene_result_alloc", .argument = "r", .expect = EXPECT_ERROR, .call = api_case_310},
-    {.function = "pd_scene_result_fits", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_311},
-    {.function = "pd_scene_result_fits", .argument = "r", .expect = EXPECT_COUNT, .call = api_case_312},
-    {.function = "pd_scene_result_free", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_313},
-    {.function = "pd_scene_run", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_314},
-    {.function = "pd_scene_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_315},
-    {.function = "pd_scene_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_316},
-    {.function = "pd_scene_summarize", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_317},
-    {.function = "pd_scene_summarize", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_318},
-    {.function = "pd_scene_summarize", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_319},
-    {.function = "pd_scene_summary_free", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_320},
-    {.function = "pd_scene_trace_alloc", .argument = "tr", .expect = EXPECT_ERROR, .call = api_case_321},
-    {.function = "pd_scene_trace_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_322},
-    {.function = "pd_scene_trace_alloc", .argument = "o", .expect = EXPECT_NOCRASH, .call = api_case_323},
-    {.function = "pd_scene_trace_free", .argument = "tr", .expect = EXPECT_NOCRASH, .call = api_case_324},
-    {.function = "pd_scene_errors_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_325},
-    {.function = "pd_scene_errors_alloc", .argument = "e", .expect = EXPECT_ERROR, .call = api_case_326},
-    {.function = "pd_scene_errors_free", .argument = "e", .expect = EXPECT_NOCRASH, .call = api_case_327},
-    {.function = "pd_scene_measure_reference", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_328},
-    {.function = "pd_scene_measure_reference", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_329},
-    {.function = "pd_scene_measure_reference", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_330},
-    {.function = "pd_scene_measure_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_331},
-    {.function = "pd_scene_measure_run", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_332},
-    {.function = "pd_scene_measure_run", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_333},
-    {.function = "pd_scene_measure_run", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_334},
-    {.function = "pd_scene_measure_run", .argument = "ref_res", .expect = EXPECT_ERROR, .call = api_case_335},
-    {.function = "pd_scene_measure_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_336},
-    {.function = "pd_scene_measure_run", .argument = "e", .expect = EXPECT_ERROR, .call = api_case_337},
-    {.function = "pd_spec_init", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_338},
-    {.function = "pd_spec_curves", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_339},
-    {.function = "pd_spec_points", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_340},
-    {.function = "pd_spec_twins", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_341},
-    {.function = "pd_spec_tasks", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_342},
-    {.function = "pd_spec_pi2", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_343},
-    {.function = "pd_spec_coords_of", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_344},
-    {.function = "pd_spec_coords_of", .argument = "co", .expect = EXPECT_NOCRASH, .call = api_case_345},
-    {.function = "pd_spec_twin_of", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_346},
-    {.function = "pd_spec_case", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_347},
-    {.function = "pd_spec_case", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_348},
-    {.function = "pd_spec_case", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_349},
-    {.function = "pd_spec_validate", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_350},
-    {.function = "pd_spec_resolve_method", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_351},
-    {.function = "pd_spec_run_task", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_352},
-    {.function = "pd_spec_run_task", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_353},
-    {.function = "pd_spec_stream", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_354},
-    {.function = "pd_spec_cost", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_355},
-    {.function = "pd_spec_key", .argument = "s", .expect = EXPECT_NULL, .call = api_case_356},
-    {.function = "pd_spec_rows", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_357},
-    {.function = "pd_spec_rows", .argument = "res", .expect = EXPECT_NOCRASH, .call = api_case_358},
-    {.function = "pd_spec_rows", .argument = "rows", .expect = EXPECT_NOCRASH, .call = api_case_359},
-    {.function = "pd_spec_curve_label", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_360},
-    {.function = "pd_spec_curve_label", .argument = "buf", .expect = EXPECT_NOCRASH, .call = api_case_361},
-    {.function = "pd_spec_sweep", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_362},
-    {.function = "pd_scene_sweep_twins", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_363},
-    {.function = "pd_scene_sweep_points", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_364},
-    {.function = "pd_scene_sweep_check", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_365},
-    {.function = "pd_scene_sweep_scene", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_366},
-    {.function = "pd_scene_sweep_scene", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_367},
-    {.function = "pd_scene_sweep_scene", .argument = "pt", .expect = EXPECT_ERROR, .call = api_case_368},
-    {.function = "pd_scene_sweep_run", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_369},
-    {.function = "pd_scene_sweep_run", .argument = "pts", .expect = EXPECT_ERROR, .call = api_case_370},
-    {.function = "pd_scene_sweep_run", .argument = "umax", .expect = EXPECT_ERROR, .call = api_case_371},
+    {.function = "pd_sdof_flow_init_mass", .argument = "f", .expect = EXPECT_NOCRASH, .call = api_case_146},
+    {.function = "pd_sdof_flow_init_mass", .argument = "pc", .expect = EXPECT_NOCRASH, .call = api_case_147},
+    {.function = "pd_sdof_flow_at", .argument = "f", .expect = EXPECT_NOCRASH, .call = api_case_148},
+    {.function = "pd_sdof_flow_at", .argument = "du", .expect = EXPECT_NOCRASH, .call = api_case_149},
+    {.function = "pd_sdof_flow_at", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_150},
+    {.function = "pd_sdof_advance", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_151},
+    {.function = "pd_sdof_advance", .argument = "u1", .expect = EXPECT_NOCRASH, .call = api_case_152},
+    {.function = "pd_sdof_advance", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_153},
+    {.function = "pd_sdof_increment", .argument = "osc", .expect = EXPECT_NOCRASH, .call = api_case_154},
+    {.function = "pd_sdof_increment", .argument = "du", .expect = EXPECT_NOCRASH, .call = api_case_155},
+    {.function = "pd_sdof_increment", .argument = "v1", .expect = EXPECT_NOCRASH, .call = api_case_156},
+    {.function = "pd_edr_alloc", .argument = "model", .expect = EXPECT_NULL, .call = api_case_157},
+    {.function = "pd_edr_alloc", .argument = "force", .expect = EXPECT_NULL, .call = api_case_158},
+    {.function = "pd_edr_alloc", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_159},
+    {.function = "pd_edr_free", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_160},
+    {.function = "pd_edr_run", .argument = "r", .expect = EXPECT_ERROR, .call = api_case_161},
+    {.function = "pd_edr_run", .argument = "q0", .expect = EXPECT_NOCRASH, .call = api_case_162},
+    {.function = "pd_edr_run", .argument = "v0", .expect = EXPECT_NOCRASH, .call = api_case_163},
+    {.function = "pd_edr_result_of", .argument = "r", .expect = EXPECT_NULL, .call = api_case_164},
+    {.function = "pd_ed_sdof_run", .argument = "prob", .expect = EXPECT_ERROR, .call = api_case_165},
+    {.function = "pd_ed_sdof_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_166},
+    {.function = "pd_ed_sdof_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_167},
+    {.function = "pd_pulse_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_168},
+    {.function = "pd_pulse_parse", .argument = "pulse", .expect = EXPECT_ERROR, .call = api_case_169},
+    {.function = "pd_dir_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_170},
+    {.function = "pd_dir_parse", .argument = "dir", .expect = EXPECT_ERROR, .call = api_case_171},
+    {.function = "pd_record_format_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_172},
+    {.function = "pd_record_format_parse", .argument = "f", .expect = EXPECT_ERROR, .call = api_case_173},
+    {.function = "pd_record_units_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_174},
+    {.function = "pd_record_units_parse", .argument = "u", .expect = EXPECT_ERROR, .call = api_case_175},
+    {.function = "pd_record_read", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_176},
+    {.function = "pd_record_read", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_177},
+    {.function = "pd_record_free", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_178},
+    {.function = "pd_record_detect", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_179},
+    {.function = "pd_record_detect", .argument = "format", .expect = EXPECT_ERROR, .call = api_case_180},
+    {.function = "pd_record_plausible", .argument = "rec", .expect = EXPECT_COUNT, .call = api_case_181},
+    {.function = "pd_record_plausible", .argument = "msg", .expect = EXPECT_NOCRASH, .call = api_case_182},
+    {.function = "pd_record_from_array", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_183},
+    {.function = "pd_record_from_array", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_184},
+    {.function = "pd_record_from_array", .argument = "acc", .expect = EXPECT_ERROR, .call = api_case_185},
+    {.function = "pd_record_duration", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_186},
+    {.function = "pd_record_acc", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_187},
+    {.function = "pd_record_measure", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_188},
+    {.function = "pd_record_measure", .argument = "m", .expect = EXPECT_ERROR, .call = api_case_189},
+    {.function = "pd_record_integrate", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_190},
+    {.function = "pd_record_integrate", .argument = "vel", .expect = EXPECT_ERROR, .call = api_case_191},
+    {.function = "pd_record_integrate", .argument = "disp", .expect = EXPECT_ERROR, .call = api_case_192},
+    {.function = "pd_record_fit_pulse", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_193},
+    {.function = "pd_record_fit_pulse", .argument = "p", .expect = EXPECT_ERROR, .call = api_case_194},
+    {.function = "pd_record_pulse_eval", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_195},
+    {.function = "pd_record_pulse_eval", .argument = "acc", .expect = EXPECT_NOCRASH, .call = api_case_196},
+    {.function = "pd_record_pulse_eval", .argument = "vel", .expect = EXPECT_NOCRASH, .call = api_case_197},
+    {.function = "pd_record_one_cycle", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_198},
+    {.function = "pd_method_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_199},
+    {.function = "pd_method_parse", .argument = "method", .expect = EXPECT_ERROR, .call = api_case_200},
+    {.function = "pd_impact_law_parse", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_201},
+    {.function = "pd_impact_law_parse", .argument = "law", .expect = EXPECT_ERROR, .call = api_case_202},
+    {.function = "pd_run_opts_check", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_203},
+    {.function = "pd_osc_wp", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_204},
+    {.function = "pd_osc_T0", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_205},
+    {.function = "pd_osc_gap", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_206},
+    {.function = "pd_osc_Le", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_207},
+    {.function = "pd_osc_set_T0", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_208},
+    {.function = "pd_osc_set_gap", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_209},
+    {.function = "pd_osc_set_uy", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_210},
+    {.function = "pd_osc_uy", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_211},
+    {.function = "pd_osc_yields", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_212},
+    {.function = "pd_osc_yield_exact", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_213},
+    {.function = "pd_osc_excitation", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_214},
+    {.function = "pd_osc_set_record", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_215},
+    {.function = "pd_osc_set_record", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_216},
+    {.function = "pd_osc_set_record", .argument = "p", .expect = EXPECT_NOCRASH, .call = api_case_217},
+    {.function = "pd_osc_shape", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_218},
+    {.function = "pd_osc_shape_rate", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_219},
+    {.function = "pd_osc_shape_end", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_220},
+    {.function = "pd_osc_pieces", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_221},
+    {.function = "pd_osc_pieces", .argument = "pieces", .expect = EXPECT_ERROR, .call = api_case_222},
+    {.function = "pd_osc_pieces", .argument = "npieces", .expect = EXPECT_ERROR, .call = api_case_223},
+    {.function = "pd_osc_excitation_name", .argument = "c", .expect = EXPECT_NAME, .call = api_case_224},
+    {.function = "pd_osc_check", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_225},
+    {.function = "pd_osc_resolve_opts", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_226},
+    {.function = "pd_osc_resolve_opts", .argument = "in", .expect = EXPECT_NOCRASH, .call = api_case_227},
+    {.function = "pd_osc_resolve_opts", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_228},
+    {.function = "pd_osc_default_dt", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_229},
+    {.function = "pd_osc_default_tend", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_230},
+    {.function = "pd_osc_measure_start", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_231},
+    {.function = "pd_osc_method", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_232},
+    {.function = "pd_osc_method", .argument = "o", .expect = EXPECT_NOCRASH, .call = api_case_233},
+    {.function = "pd_osc_run", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_234},
+    {.function = "pd_osc_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_235},
+    {.function = "pd_osc_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_236},
+    {.function = "pd_osc_batchable", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_237},
+    {.function = "pd_osc_batchable", .argument = "o", .expect = EXPECT_COUNT, .call = api_case_238},
+    {.function = "pd_osc_scan_points", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_239},
+    {.function = "pd_osc_simulate", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_240},
+    {.function = "pd_osc_simulate", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_241},
+    {.function = "pd_osc_simulate", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_242},
+    {.function = "pd_osc_reference", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_243},
+    {.function = "pd_osc_reference", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_244},
+    {.function = "pd_osc_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_245},
+    {.function = "pd_osc_penalty", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_246},
+    {.function = "pd_osc_penalty", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_247},
+    {.function = "pd_osc_penalty", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_248},
+    {.function = "pd_osc_summarize", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_249},
+    {.function = "pd_osc_summarize", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_250},
+    {.function = "pd_osc_summarize", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_251},
+    {.function = "pd_osc_free_exact", .argument = "c", .expect = EXPECT_NOCRASH, .call = api_case_252},
+    {.function = "pd_osc_free_exact", .argument = "u", .expect = EXPECT_NOCRASH, .call = api_case_253},
+    {.function = "pd_osc_free_exact", .argument = "v", .expect = EXPECT_NOCRASH, .call = api_case_254},
+    {.function = "pd_osc_free_first_contact", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_255},
+    {.function = "pd_osc_free_first_contact", .argument = "t", .expect = EXPECT_ERROR, .call = api_case_256},
+    {.function = "pd_osc_free_first_contact", .argument = "v", .expect = EXPECT_ERROR, .call = api_case_257},
+    {.function = "pd_trace_alloc", .argument = "tr", .expect = EXPECT_ERROR, .call = api_case_258},
+    {.function = "pd_trace_alloc", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_259},
+    {.function = "pd_trace_free", .argument = "tr", .expect = EXPECT_NOCRASH, .call = api_case_260},
+    {.function = "pd_measure_reference", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_261},
+    {.function = "pd_measure_reference", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_262},
+    {.function = "pd_measure_reference", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_263},
+    {.function = "pd_measure_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_264},
+    {.function = "pd_measure_run", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_265},
+    {.function = "pd_measure_run", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_266},
+    {.function = "pd_measure_run", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_267},
+    {.function = "pd_measure_run", .argument = "work", .expect = EXPECT_ERROR, .call = api_case_268},
+    {.function = "pd_measure_run", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_269},
+    {.function = "pd_scene_new", .argument = "exc", .expect = EXPECT_NOCRASH, .call = api_case_270},
+    {.function = "pd_scene_free", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_271},
+    {.function = "pd_scene_add_sdof", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_272},
+    {.function = "pd_scene_add_sdof", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_273},
+    {.function = "pd_scene_add_building", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_274},
+    {.function = "pd_scene_add_building", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_275},
+    {.function = "pd_scene_add_building", .argument = "masses", .expect = EXPECT_ERROR, .call = api_case_276},
+    {.function = "pd_scene_add_building", .argument = "stiffnesses", .expect = EXPECT_ERROR, .call = api_case_277},
+    {.function = "pd_scene_add_uniform", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_278},
+    {.function = "pd_scene_add_uniform", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_279},
+    {.function = "pd_scene_set_damping", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_280},
+    {.function = "pd_scene_set_heights", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_281},
+    {.function = "pd_scene_set_heights", .argument = "heights", .expect = EXPECT_ERROR, .call = api_case_282},
+    {.function = "pd_scene_set_yield", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_283},
+    {.function = "pd_scene_set_yield", .argument = "uy", .expect = EXPECT_ERROR, .call = api_case_284},
+    {.function = "pd_scene_set_yield", .argument = "alpha", .expect = EXPECT_ERROR, .call = api_case_285},
+    {.function = "pd_scene_yield_every", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_286},
+    {.function = "pd_scene_springs", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_287},
+    {.function = "pd_scene_add_contact", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_288},
+    {.function = "pd_scene_copy", .argument = "sc", .expect = EXPECT_NULL, .call = api_case_289},
+    {.function = "pd_scene_find", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_290},
+    {.function = "pd_scene_find", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_291},
+    {.function = "pd_scene_finish", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_292},
+    {.function = "pd_scene_load", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_293},
+    {.function = "pd_scene_load", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_294},
+    {.function = "pd_scene_chain", .argument = "exc", .expect = EXPECT_ERROR, .call = api_case_295},
+    {.function = "pd_scene_chain", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_296},
+    {.function = "pd_scene_wp", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_297},
+    {.function = "pd_scene_Le", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_298},
+    {.function = "pd_scene_default_dt", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_299},
+    {.function = "pd_scene_default_tend", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_300},
+    {.function = "pd_scene_measure_start", .argument = "sc", .expect = EXPECT_NOCRASH, .call = api_case_301},
+    {.function = "pd_scene_resolve_opts", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_302},
+    {.function = "pd_scene_resolve_opts", .argument = "in", .expect = EXPECT_NOCRASH, .call = api_case_303},
+    {.function = "pd_scene_resolve_opts", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_304},
+    {.function = "pd_scene_as_oscillator", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_305},
+    {.function = "pd_scene_as_oscillator", .argument = "c", .expect = EXPECT_COUNT, .call = api_case_306},
+    {.function = "pd_scene_as_oscillator", .argument = "mirrored", .expect = EXPECT_COUNT, .call = api_case_307},
+    {.function = "pd_scene_model_build", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_308},
+    {.function = "pd_scene_model_build", .argument = "sm", .expect = EXPECT_ERROR, .call = api_case_309},
+    {.function = "pd_scene_model_free", .argument = "sm", .expect = EXPECT_NOCRASH, .call = api_case_310},
+    {.function = "pd_scene_result_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_311},
+    {.function = "pd_scene_result_alloc", .argument = "r", .expect = EXPECT_ERROR, .call = api_case_312},
+    {.function = "pd_scene_result_fits", .argument = "sc", .expect = EXPECT_COUNT, .call = api_case_313},
+    {.function = "pd_scene_result_fits", .argument = "r", .expect = EXPECT_COUNT, .call = api_case_314},
+    {.function = "pd_scene_result_free", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_315},
+    {.function = "pd_scene_run", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_316},
+    {.function = "pd_scene_run", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_317},
+    {.function = "pd_scene_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_318},
+    {.function = "pd_scene_summarize", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_319},
+    {.function = "pd_scene_summarize", .argument = "opts", .expect = EXPECT_NOCRASH, .call = api_case_320},
+    {.function = "pd_scene_summarize", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_321},
+    {.function = "pd_scene_summary_free", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_322},
+    {.function = "pd_scene_trace_alloc", .argument = "tr", .expect = EXPECT_ERROR, .call = api_case_323},
+    {.function = "pd_scene_trace_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_324},
+    {.function = "pd_scene_trace_alloc", .argument = "o", .expect = EXPECT_NOCRASH, .call = api_case_325},
+    {.function = "pd_scene_trace_free", .argument = "tr", .expect = EXPECT_NOCRASH, .call = api_case_326},
+    {.function = "pd_scene_errors_alloc", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_327},
+    {.function = "pd_scene_errors_alloc", .argument = "e", .expect = EXPECT_ERROR, .call = api_case_328},
+    {.function = "pd_scene_errors_free", .argument = "e", .expect = EXPECT_NOCRASH, .call = api_case_329},
+    {.function = "pd_scene_measure_reference", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_330},
+    {.function = "pd_scene_measure_reference", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_331},
+    {.function = "pd_scene_measure_reference", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_332},
+    {.function = "pd_scene_measure_reference", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_333},
+    {.function = "pd_scene_measure_run", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_334},
+    {.function = "pd_scene_measure_run", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_335},
+    {.function = "pd_scene_measure_run", .argument = "ref", .expect = EXPECT_ERROR, .call = api_case_336},
+    {.function = "pd_scene_measure_run", .argument = "ref_res", .expect = EXPECT_ERROR, .call = api_case_337},
+    {.function = "pd_scene_measure_run", .argument = "res", .expect = EXPECT_ERROR, .call = api_case_338},
+    {.function = "pd_scene_measure_run", .argument = "e", .expect = EXPECT_ERROR, .call = api_case_339},
+    {.function = "pd_spec_init", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_340},
+    {.function = "pd_spec_curves", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_341},
+    {.function = "pd_spec_points", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_342},
+    {.function = "pd_spec_twins", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_343},
+    {.function = "pd_spec_tasks", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_344},
+    {.function = "pd_spec_pi2", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_345},
+    {.function = "pd_spec_coords_of", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_346},
+    {.function = "pd_spec_coords_of", .argument = "co", .expect = EXPECT_NOCRASH, .call = api_case_347},
+    {.function = "pd_spec_twin_of", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_348},
+    {.function = "pd_spec_case", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_349},
+    {.function = "pd_spec_case", .argument = "c", .expect = EXPECT_ERROR, .call = api_case_350},
+    {.function = "pd_spec_case", .argument = "o", .expect = EXPECT_ERROR, .call = api_case_351},
+    {.function = "pd_spec_validate", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_352},
+    {.function = "pd_spec_resolve_method", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_353},
+    {.function = "pd_spec_run_task", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_354},
+    {.function = "pd_spec_run_task", .argument = "r", .expect = EXPECT_NOCRASH, .call = api_case_355},
+    {.function = "pd_spec_stream", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_356},
+    {.function = "pd_spec_cost", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_357},
+    {.function = "pd_spec_key", .argument = "s", .expect = EXPECT_NULL, .call = api_case_358},
+    {.function = "pd_spec_rows", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_359},
+    {.function = "pd_spec_rows", .argument = "res", .expect = EXPECT_NOCRASH, .call = api_case_360},
+    {.function = "pd_spec_rows", .argument = "rows", .expect = EXPECT_NOCRASH, .call = api_case_361},
+    {.function = "pd_spec_curve_label", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_362},
+    {.function = "pd_spec_curve_label", .argument = "buf", .expect = EXPECT_NOCRASH, .call = api_case_363},
+    {.function = "pd_spec_sweep", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_364},
+    {.function = "pd_scene_sweep_twins", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_365},
+    {.function = "pd_scene_sweep_points", .argument = "w", .expect = EXPECT_NOCRASH, .call = api_case_366},
+    {.function = "pd_scene_sweep_check", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_367},
+    {.function = "pd_scene_sweep_scene", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_368},
+    {.function = "pd_scene_sweep_scene", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_369},
+    {.function = "pd_scene_sweep_scene", .argument = "pt", .expect = EXPECT_ERROR, .call = api_case_370},
+    {.function = "pd_scene_sweep_run", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_371},
+    {.function = "pd_scene_sweep_run", .argument = "pts", .expect = EXPECT_ERROR, .call = api_case_372},
+    {.function = "pd_scene_sweep_run", .argument = "umax", .expect = EXPECT_ERROR, .call = api_case_373},
 };
-const int api_null_ncases = 372;
-const int api_null_nfunctions = 222;
+const int api_null_ncases = 374;
+const int api_null_nfunctions = 223;

@@ -88,7 +88,8 @@ static void test_yield_scene_example(pd_test_ctx *ctx)
               "cosine pulse: the energy balance's residual %.3g", mj.energy.residual);
     pd_scene_result_free(&mj);
     sc->exc.pulse = PD_PULSE_SINE;
-    /* the methods without yielding storeys refuse, naming uy */
+    /* the methods without yielding storeys refuse, naming uy (the row
+     * reference yields SDOFs only: it refuses the buildings) */
     const pd_method refused[] = {PD_METHOD_EVENT, PD_METHOD_EVENT_GENERAL, PD_METHOD_PENALTY};
     for (int m = 0; m < 3; m++) {
         pd_run_opts o = pd_run_default_opts();
