@@ -261,11 +261,11 @@ static int parse_args(conv_args *a, int argc, char **argv)
         return pd_cli_usage_error("--rtol: in converge the penalty rows' integrator tolerance "
                                   "(--methods ...,penalty); Moreau-Jean to a tolerance: "
                                   "--methods moreau-rtol --rtols LIST");
-    if (pd_osc_yields(&a->k.c)) { /* a yielding spring: Moreau-Jean's fixed steps only */
-        if (a->methods_given && (a->want_rtol || a->want_penalty || a->want_newmark))
-            return pd_cli_usage_error("--methods: a yielding oscillator converges by moreau "
-                                      "(moreau-rtol and the penalty methods do not model "
-                                      "yielding yet)");
+    if (pd_osc_yields(&a->k.c)) { /* a yielding spring: fixed steps, Moreau-Jean's or Newmark's */
+        if (a->methods_given && (a->want_rtol || a->want_penalty || a->want_general))
+            return pd_cli_usage_error("--methods: a yielding oscillator converges by moreau and "
+                                      "newmark (moreau-rtol, the adaptive penalty and "
+                                      "event-general do not model yielding yet)");
         a->want_rtol = 0; /* the default rows: moreau */
     }
     if (a->want_general && !pd_cli_is_scene(&a->k))
@@ -509,6 +509,11 @@ static void case_title(const conv_args *a, const measurer *M, int chart, char *b
     if (M->sc && (!chart || a->k.scene_path))
         snprintf(buf, cap, "scene %s (%d structures)", a->k.scene_path ? a->k.scene_path : "chain",
                  M->sc->nstruct);
+    else if (M->sc && pd_osc_yields(c))
+        snprintf(buf, cap,
+                 "a row of %d yielding SDOFs between two walls (--chain, Piy = %.3g, "
+                 "\u03b1 = %g)",
+                 M->sc->nstruct, c->Piy, c->alpha);
     else if (M->sc)
         snprintf(buf, cap, "a row of %d SDOFs between two walls (--chain)", M->sc->nstruct);
     else if (!chart)

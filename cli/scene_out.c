@@ -6,11 +6,13 @@
  * HDF5:  the provenance (format "pound simulate scene 1") and the run as
  *        attributes of the root; /t [s]; /structures/NAME/{x, v} (rows x
  *        storeys, m and m/s) with the structure and its results as
- *        attributes; /contacts/K/{gap, impulse} (m, N s) with the contact and
+ *        attributes (a yielding structure also up, m: its storeys' plastic
+ *        offsets); /contacts/K/{gap, impulse} (m, N s) with the contact and
  *        its results as attributes.
  * CSV:   '#' lines with the provenance, "# units = ..." (one per column), a
  *        header row, one row per sample (t, NAME.x1.., NAME.v1.., cK.gap..,
- *        cK.impulse..), '#' lines with the run and its results at the end.
+ *        cK.impulse.., then NAME.up1.. of the yielding structures), '#' lines
+ *        with the run and its results at the end.
  * docs/formats.md describes both.
  * Every write is checked; the first failure stops the run and is reported
  * with the system's reason, and the temporary file is removed. */
@@ -33,15 +35,22 @@ struct pd_scene_writer {
     int hdf5, failure; /* failure: errno of the first failed write, 0 if none */
     long every, seen, rows;
     double *imp; /* m: impulses since the last recorded row */
-    /* rows waiting to be written: t, x (n), v (n), gap (m), impulse (m) per row */
+    /* rows waiting to be written: t, x (n), v (n), gap (m), impulse (m), then
+     * up (nup: the storeys of the yielding structures) per row */
     long cap, nbuf;
     double *buf, *col; /* cap rows x width; col: one block of a structure */
-    int width;
+    int width, nup;
     hid_t file, ds_t;
-    hid_t *ds_x, *ds_v, *ds_g, *ds_p;
+    hid_t *ds_x, *ds_v, *ds_g, *ds_p, *ds_up;
     pd_csv csv;
     pd_provenance prov;
 };
+
+/* Whether structure s has a yielding storey (its offsets are written). */
+static int yields(const pd_scene *sc, int s)
+{
+    return sc->st[s].uy != NULL;
+}
 
 /* Does path end with suffix? */
 static int ends_with(const char *path, const char *suffix)
@@ -79,8 +88,10 @@ static int h5_open(pd_scene_writer *w)
             g < 0 || pd_h5_index(g, "storey", sc->st[s].storeys, 1, "1") ||
             (w->ds_x[s] =
                  pd_h5_extendible(g, "x", H5T_NATIVE_DOUBLE, sc->st[s].storeys, w->cap, "m")) < 0 ||
-            (w->ds_v[s] =
-                 pd_h5_extendible(g, "v", H5T_NATIVE_DOUBLE, sc->st[s].storeys, w->cap, "m/s")) < 0;
+            (w->ds_v[s] = pd_h5_extendible(g, "v", H5T_NATIVE_DOUBLE, sc->st[s].storeys, w->cap,
+                                           "m/s")) < 0 ||
+            (yields(sc, s) && (w->ds_up[s] = pd_h5_extendible(g, "up", H5T_NATIVE_DOUBLE,
+                                                              sc->st[s].storeys, w->cap, "m")) < 0);
         if (g >= 0 && H5Gclose(g) < 0)
             rc = 1;
     }
@@ -99,7 +110,8 @@ static int h5_open(pd_scene_writer *w)
      * attachments interleaved with the creations left 245 MB of dead lists).
      * A new dataset is attached here too. */
     for (int s = 0; s < sc->nstruct && !rc && !short_of_memory(w); s++)
-        rc = pd_h5_dims(w->ds_x[s], "t,storey") || pd_h5_dims(w->ds_v[s], "t,storey");
+        rc = pd_h5_dims(w->ds_x[s], "t,storey") || pd_h5_dims(w->ds_v[s], "t,storey") ||
+             (yields(sc, s) && pd_h5_dims(w->ds_up[s], "t,storey"));
     for (int a = 0; a < sc->ncontact && !rc && !short_of_memory(w); a++)
         rc = pd_h5_dims(w->ds_g[a], "t") || pd_h5_dims(w->ds_p[a], "t");
     if (gs >= 0 && H5Gclose(gs) < 0)
@@ -123,6 +135,8 @@ static int csv_open(pd_scene_writer *w)
     for (int part = 0; part < 2; part++)
         for (int a = 0; a < sc->ncontact; a++)
             pd_csv_printf(&w->csv, ",%s", part ? "N s" : "m");
+    for (int k = 0; k < w->nup; k++)
+        pd_csv_printf(&w->csv, ",m");
     pd_csv_printf(&w->csv, "\nt");
     for (int s = 0; s < sc->nstruct; s++)
         for (int k = 1; k <= sc->st[s].storeys; k++)
@@ -134,6 +148,9 @@ static int csv_open(pd_scene_writer *w)
         pd_csv_printf(&w->csv, ",c%d.gap", a);
     for (int a = 0; a < sc->ncontact; a++)
         pd_csv_printf(&w->csv, ",c%d.impulse", a);
+    for (int s = 0; s < sc->nstruct; s++) /* the yielding structures' offsets */
+        for (int k = 1; yields(sc, s) && k <= sc->st[s].storeys; k++)
+            pd_csv_printf(&w->csv, ",%s.up%d", sc->st[s].name, k);
     pd_csv_printf(&w->csv, "\n");
     return w->csv.failure;
 }
@@ -141,9 +158,11 @@ static int csv_open(pd_scene_writer *w)
 /* Close every dataset id (those not open are -1): 0, or -1 when one failed. */
 static int close_datasets(pd_scene_writer *w)
 {
-    hid_t *sets[] = {w->ds_x, w->ds_v, w->ds_g, w->ds_p};
-    int counts[] = {w->sc->nstruct, w->sc->nstruct, w->sc->ncontact, w->sc->ncontact}, rc = 0;
-    for (int k = 0; k < 4; k++)
+    hid_t *sets[] = {w->ds_x, w->ds_v, w->ds_up, w->ds_g, w->ds_p};
+    int counts[] = {w->sc->nstruct, w->sc->nstruct, w->sc->nstruct, w->sc->ncontact,
+                    w->sc->ncontact},
+        rc = 0;
+    for (int k = 0; k < 5; k++)
         for (int i = 0; sets[k] && i < counts[k]; i++)
             rc |= pd_h5_close_id(&sets[k][i]);
     rc |= pd_h5_close_id(&w->ds_t);
@@ -164,6 +183,7 @@ void pd_scene_writer_free(pd_scene_writer *w)
     free(w->col);
     free(w->ds_x);
     free(w->ds_v);
+    free(w->ds_up);
     free(w->ds_g);
     free(w->ds_p);
     free(w);
@@ -175,13 +195,14 @@ static int ids_init(pd_scene_writer *w, int m)
     const pd_scene *sc = w->sc;
     w->ds_x = malloc((size_t)sc->nstruct * sizeof(hid_t));
     w->ds_v = malloc((size_t)sc->nstruct * sizeof(hid_t));
+    w->ds_up = malloc((size_t)sc->nstruct * sizeof(hid_t));
     w->ds_g = malloc((size_t)m * sizeof(hid_t));
     w->ds_p = malloc((size_t)m * sizeof(hid_t));
-    for (int s = 0; w->ds_x && w->ds_v && s < sc->nstruct; s++)
-        w->ds_x[s] = w->ds_v[s] = -1;
+    for (int s = 0; w->ds_x && w->ds_v && w->ds_up && s < sc->nstruct; s++)
+        w->ds_x[s] = w->ds_v[s] = w->ds_up[s] = -1;
     for (int a = 0; w->ds_g && w->ds_p && a < m; a++)
         w->ds_g[a] = w->ds_p[a] = -1;
-    return w->ds_x && w->ds_v && w->ds_g && w->ds_p ? 0 : -1;
+    return w->ds_x && w->ds_v && w->ds_up && w->ds_g && w->ds_p ? 0 : -1;
 }
 
 /* The HDF5 layout keeps two datasets open per structure and per contact,
@@ -209,7 +230,9 @@ int pd_scene_writer_open(pd_scene_writer **out, const char *path, const pd_scene
     w->out.slot = -1;
     w->hdf5 = hdf5;
     pd_provenance_now(&w->prov, PD_FORMAT_SCENE);
-    w->width = 1 + 2 * sc->n + 2 * sc->ncontact;
+    for (int s = 0; s < sc->nstruct; s++)
+        w->nup += yields(sc, s) ? sc->st[s].storeys : 0;
+    w->width = 1 + 2 * sc->n + 2 * sc->ncontact + w->nup;
     w->cap = OUT_BUFFER_DOUBLES / w->width;
     w->cap = w->cap < 16 ? 16 : w->cap > 4096 ? 4096 : w->cap;
     for (int s = 0; s < sc->nstruct; s++)
@@ -267,6 +290,16 @@ static int flush_rows(pd_scene_writer *w)
                 rc = pd_h5_append(part ? w->ds_p[a] : w->ds_g[a], H5T_NATIVE_DOUBLE, w->rows - nb,
                                   nb, 0, w->col);
             }
+        for (int s = 0, off = 1 + 2 * n + 2 * m; s < sc->nstruct && !rc; s++) {
+            if (!yields(sc, s))
+                continue;
+            int st = sc->st[s].storeys; /* the yielding structures' offsets, in file order */
+            for (long r = 0; r < nb; r++)
+                memcpy(w->col + (size_t)r * st, w->buf + (size_t)r * w->width + off,
+                       (size_t)st * sizeof(double));
+            rc = pd_h5_append(w->ds_up[s], H5T_NATIVE_DOUBLE, w->rows - nb, nb, st, w->col);
+            off += st;
+        }
     }
     w->nbuf = 0;
     if (rc && !w->failure)
@@ -292,6 +325,10 @@ int pd_scene_writer_sample(const pd_scene_sample *s, void *ctx)
         row[1 + 2 * n + m + a] = w->imp[a];
         w->imp[a] = 0.0;
     }
+    double *up = row + 1 + 2 * n + 2 * m;
+    for (int st = 0; st < sc->nstruct; st++) /* the yielding structures' storeys */
+        for (int k = 0; yields(sc, st) && k < sc->st[st].storeys; k++)
+            *up++ = s->up ? s->up[sc->st[st].dof + k] : 0.0;
     w->nbuf++;
     w->rows++;
     if (w->nbuf == w->cap && flush_rows(w))

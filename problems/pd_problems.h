@@ -737,6 +737,8 @@ typedef struct pd_scene_sample {
     const double *impulse; /* m contact impulses since the last sample [N s] */
     const long *impacts;   /* m impacts begun since the last sample (over the run they sum
                               to pd_scene_result.impacts) */
+    const double *up;      /* n: each storey's plastic offset up at t [m] (0 for an
+                              elastic storey); NULL when no storey of the scene yields */
 } pd_scene_sample;
 
 typedef int (*pd_scene_sampler)(const pd_scene_sample *s, void *ctx);

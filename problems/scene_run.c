@@ -111,6 +111,7 @@ typedef struct track {
     double *xeff;           /* n: displacements whose storey drifts d - (1 - alpha) up give
                                the springs' forces (the demands' state) */
     const double *xdem;     /* the demands' displacements of the report (q, or xeff) */
+    double *sup;            /* n: the storeys' offsets at a sample [m] (0: elastic) */
     pd_scene_energy *en;    /* a yielding scene by Moreau-Jean: its energy balance */
     long *onsets;           /* ns: a report that slid after one that did not */
     unsigned char *slid;    /* ns: the last report slid */
@@ -221,7 +222,7 @@ static void track_free(track *tr)
         tr->sI,        tr->sampled, tr->errx,     tr->errd,  tr->erra,     tr->errv,    tr->acc0,
         tr->shear0,    tr->serr,    tr->wdof,     tr->hacc,  tr->qh,       tr->hlam,    tr->hsm,
         tr->hJ,        tr->hG,      tr->hz,       tr->hw,    tr->hD,       tr->sheld,   tr->up,
-        tr->excursion, tr->onsets,  tr->slid,     tr->xeff};
+        tr->excursion, tr->onsets,  tr->slid,     tr->xeff,  tr->sup};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(arrays[k]);
     pd_lcp_solver_free(tr->hlcp);
@@ -284,7 +285,8 @@ static int track_springs(track *tr, const pd_scene_model *sm, pd_err *err)
     tr->onsets = pd_calloc(ns, sizeof(long));
     tr->slid = pd_calloc(ns, 1);
     tr->xeff = pd_calloc(tr->n, sizeof(double));
-    if (!tr->up || !tr->excursion || !tr->onsets || !tr->slid || !tr->xeff)
+    tr->sup = pd_calloc(tr->n, sizeof(double));
+    if (!tr->up || !tr->excursion || !tr->onsets || !tr->slid || !tr->xeff || !tr->sup)
         return pd_err_set(err, PD_ENOMEM, "out of memory for tracking %d yielding springs", ns);
     return PD_OK;
 }
@@ -615,13 +617,16 @@ static int sample(track *tr, const pd_state *st)
         tr->sI[a] = tr->impacts[a] - tr->sampled[a];
         tr->sampled[a] = tr->impacts[a];
     }
+    for (int j = 0; j < tr->ns; j++) /* the storeys' offsets, in metres */
+        tr->sup[tr->spring_dof[j]] = st->up ? st->up[j] * tr->Le : 0.0;
     pd_scene_sample s = {.step = st->step,
                          .t = st->t / tr->wp,
                          .x = tr->sx,
                          .v = tr->sv,
                          .gap = tr->sg,
                          .impulse = tr->sP,
-                         .impacts = tr->sI};
+                         .impacts = tr->sI,
+                         .up = tr->ns > 0 ? tr->sup : NULL};
     int stop = tr->fn(&s, tr->ctx);
     tr->sample_s += pd_wall_seconds() - t0;
     return stop;

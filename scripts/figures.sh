@@ -37,6 +37,14 @@ for N in 2 10 100; do
         > "$out/rows-$N.txt"
 done
 
+# 1b'. Work-precision on a yielding row of 10 SDOFs (every SDOF elastic-
+#     plastic with 5 % hardening, Piy 0.3, gaps 0.5 Le) against the exact row
+#     reference with yield onsets and unloadings as events: Moreau-Jean and
+#     Newmark with Newton (elements at --kc 1e6); docs/methods.md.
+"$pound" converge --chain 10 --pulse sine --Tp 1 --T0 1 --Pi3 0.5 --Piy 0.3 --alpha 0.05 \
+    --eps 0.6 --dt 0.004:0.0000625:4 --methods moreau,newmark --kc 1e6 --error umax \
+    --plot "$out/rows-yield-10.png" > "$out/rows-yield-10.txt"
+
 # 1c. Work-precision under a real record (Rinaldi RRS228, when the shared
 #     records are there): Moreau-Jean and penalty against the exact reference
 #     on the record's linear pieces (docs/records.md).

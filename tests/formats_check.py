@@ -57,6 +57,7 @@ NCDUMP = shutil.which("ncdump")  # netCDF-C's (Debian's netcdf-bin), when instal
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DOC = os.path.join(ROOT, "docs", "formats.md")
 SCENE = os.path.join(ROOT, "examples", "scenes", "two-sdof.json")
+YSCENE = os.path.join(ROOT, "examples", "scenes", "yielding-buildings.json")
 PROVENANCE = ["format", "command", "pound_version", "created"]
 SPECTRUM_DROPPED = {"-o": 1, "--plot": 1, "--threads": 1, "--stop-after": 1, "--json": 0, "--resume": 0}
 
@@ -646,6 +647,38 @@ def yielding(ctx):
     for k in ("ductility", "residual", "n_yield", "hysteretic_energy", "energy_residual"):
         check(close(f.attrs[k], j[k]), f"yield.h5: attribute {k} = {f.attrs[k]!r}, --json {j[k]!r}")
     f.close()
+    fmt = "pound simulate scene 1"  # a yielding scene: the storeys' offsets up, their residuals
+    for every, out in ((1, "yscene.h5"), (3, "yscene.csv")):
+        args = ["simulate", "--scene", YSCENE, "--tend", "2", "--every", str(every), "-o", out,
+                "--json"]
+        j = json.loads(run(ctx.pound, args, ctx.tmp))
+        n = j["steps"] // every + 1
+        st = {s["name"]: s for s in j["structures"]}
+        path = os.path.join(ctx.tmp, out)
+        if out.endswith(".h5"):
+            env = lambda p: {"N": n, "storeys": st[p.split("/")[1]]["storeys"] if p.startswith("structures/") else -1}
+            f = check_h5(ctx, path, fmt, command_of(args), env, yielding=True)
+            for name, s in st.items():
+                up = f["structures"][name]["up"][:]
+                res = [(1 - a) * u for a, u in zip(s["yield_alpha"], up[-1])]
+                check(all(close(a, b) for a, b in zip(res, s["residual"])),
+                      f"{out}: {name}: (1 - alpha) up at the end {res} != residual {s['residual']}")
+            f.close()
+        else:
+            unit = {p: doc_units(ctx, fmt, p) for p in ("t", "structures/A/x", "structures/A/v",
+                                                        "structures/A/up", "contacts/0/gap",
+                                                        "contacts/0/impulse")}
+            cols = [("t", unit["t"])]
+            for part in ("x", "v"):
+                cols += [(f"{s}.{part}{i}", unit["structures/A/" + part]) for s in st
+                         for i in range(1, st[s]["storeys"] + 1)]
+            for part in ("gap", "impulse"):
+                cols += [(f"c{k}.{part}", unit["contacts/0/" + part]) for k in range(len(j["contacts"]))]
+            cols += [(f"{s}.up{i}", unit["structures/A/up"]) for s in st for i in range(1, st[s]["storeys"] + 1)]
+            header, rows, _, _ = check_csv(ctx, path, fmt, command_of(args), cols, n)
+            for name, s in st.items():  # the last row's offsets give the residuals
+                res = [(1 - a) * column(header, rows, f"{name}.up{i + 1}")[-1] for i, a in enumerate(s["yield_alpha"])]
+                check(all(close(a, b) for a, b in zip(res, s["residual"])), f"{out}: {name}: residuals {res}")
     fmt = "pound spectrum 1"
     base = ["spectrum", "--Pi2", "0.5:3:4", "--Pi3", "0.1,0.5", "--Piy", "0.4", "--alpha", "0.05"]
     for out in ("yspec.h5", "yspec.csv"):

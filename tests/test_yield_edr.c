@@ -313,6 +313,82 @@ static void test_yield_edr_rows_converge(pd_test_ctx *ctx)
     }
 }
 
+/* The samples' offsets: the last sample's (1 - alpha) up is the residual;
+ * |z| = |drift - up| never passes uy (1e-12 of it: the sampled state's
+ * rounding), and for Moreau-Jean (a sample per step) a step that slid
+ * ends with |z| on uy; a scene without yielding storeys samples none
+ * (NULL). */
+typedef struct up_track {
+    const pd_scene *sc;
+    double last[3], prev[3];
+    double off_level, past; /* the worst | |z| - uy | after a slide, the worst |z| - uy */
+    long samples, null_up;
+} up_track;
+
+static int up_note(const pd_scene_sample *s, void *ctx)
+{
+    up_track *u = ctx;
+    u->samples++;
+    if (!s->up) {
+        u->null_up++;
+        return 0;
+    }
+    for (int i = 0; i < u->sc->n && i < 3; i++) {
+        double uy = u->sc->st[i].uy[0], z = fabs(s->x[i] - s->up[i]);
+        u->past = fmax(u->past, (z - uy) / uy);
+        if (s->up[i] != u->prev[i]) /* it slid since the last sample */
+            u->off_level = fmax(u->off_level, fabs(z - uy) / uy);
+        u->prev[i] = u->last[i] = s->up[i];
+    }
+    return 0;
+}
+
+static void test_yield_edr_sampled_offsets(pd_test_ctx *ctx)
+{
+    pd_scene *sc = yrow(ctx, 3);
+    if (!sc)
+        return;
+    const pd_method methods[] = {PD_METHOD_EVENT, PD_METHOD_MOREAU};
+    for (int k = 0; k < 2; k++) {
+        up_track u = {.sc = sc};
+        pd_run_opts o = pd_run_default_opts();
+        o.method = methods[k];
+        o.dt = 1e-4;
+        pd_scene_result r;
+        pd_err e;
+        if (!CHECK(ctx, pd_scene_result_alloc(sc, &r, &e) == PD_OK, "%s", e.msg))
+            break;
+        int rc = pd_scene_run(sc, &o, up_note, &u, &r, &e);
+        double dres = 0.0;
+        for (int i = 0; i < 3; i++)
+            dres = fmax(dres, fabs((1.0 - sc->st[i].yield_alpha[0]) * u.last[i] - r.residual[i]) /
+                                  sc->st[i].uy[0]);
+        printf("    %s: %ld samples, residuals from the last sample within %.2g uy, |z| past uy "
+               "by %.2g uy at most, a step's slide off uy by %.2g uy\n",
+               pd_method_name(methods[k]), u.samples, dres, u.past, u.off_level);
+        CHECK(ctx,
+              rc == PD_OK && u.null_up == 0 && dres <= 1e-12 && u.past <= 1e-12 &&
+                  (k == 0 || u.off_level <= 1e-12) && r.n_yield[0] > 0,
+              "%s: %s; %ld NULL offsets, residuals %.3g, past uy %.3g, off the level %.3g",
+              pd_method_name(methods[k]), rc ? e.msg : "ok", u.null_up, dres, u.past, u.off_level);
+        pd_scene_result_free(&r);
+    }
+    pd_scene_free(sc);
+    /* an elastic scene: no offsets */
+    if (pd_scene_load("examples/scenes/two-sdof.json", &sc, NULL) == PD_OK) {
+        up_track u = {.sc = sc};
+        pd_run_opts o = pd_run_default_opts();
+        pd_scene_result r;
+        if (pd_scene_result_alloc(sc, &r, NULL) == PD_OK) {
+            pd_scene_run(sc, &o, up_note, &u, &r, NULL);
+            CHECK(ctx, u.samples > 0 && u.null_up == u.samples, "elastic: %ld of %ld with offsets",
+                  u.samples - u.null_up, u.samples);
+            pd_scene_result_free(&r);
+        }
+        pd_scene_free(sc);
+    }
+}
+
 /* Refused and named: a yielding building (a spring on a storey drift), two
  * springs on one dof. */
 static void test_yield_edr_refuses(pd_test_ctx *ctx)
@@ -364,5 +440,6 @@ void suite_yield_edr(pd_test_ctx *ctx)
     PD_RUN(ctx, test_yield_edr_record);
     PD_RUN(ctx, test_yield_edr_unreached);
     PD_RUN(ctx, test_yield_edr_rows_converge);
+    PD_RUN(ctx, test_yield_edr_sampled_offsets);
     PD_RUN(ctx, test_yield_edr_refuses);
 }

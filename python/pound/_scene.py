@@ -210,15 +210,20 @@ class Scene:
         r.history: step, t (N), x and v (N x dofs) [m, m/s], gap [m] and
         impulse [N s] (N x contacts), every every-th sample, the impulses
         summed since the last one kept (the CLI's -o file; t, x, v also as
-        r.t, r.x, r.v)."""
+        r.t, r.x, r.v); a scene with yielding storeys also up (N x dofs) [m],
+        each storey's plastic offset (0 for an elastic storey)."""
         history, every = history_args(history, every)
         _, o = self.opts(opts)
         sc = self._sc
         n, m = sc.n, sc.ncontact
         h = sampler = None
+        yields = bool(lib.pd_scene_springs(self._p))
+        names = ("step", "t", "x", "v", "gap", "impulse") + (("up",) if yields else ())
         if history:
             dtype = [("step", "i8"), ("t", "f8"), ("x", "f8", (n,)), ("v", "f8", (n,)),
                      ("gap", "f8", (m,)), ("impulse", "f8", (m,))]
+            if yields:  # the storeys' plastic offsets, as the CLI's NAME.upK columns
+                dtype.append(("up", "f8", (n,)))
             h = _History(dtype, history_cap(o, every), every)
             sampler = _scene_sampler(h, n, m)
         sm = _lib.PdSceneSummary()
@@ -235,8 +240,7 @@ class Scene:
             lib.pd_scene_summary_free(sm)
         if h is not None:
             rows = h.rows()
-            hist = Result((name, np.ascontiguousarray(rows[name]))
-                          for name in ("step", "t", "x", "v", "gap", "impulse"))
+            hist = Result((name, np.ascontiguousarray(rows[name])) for name in names)
             out["history"] = hist
             for name in ("t", "x", "v"):  # shortcuts
                 out[name] = hist[name]
@@ -314,7 +318,8 @@ def _scene_sampler(h, n, m):
     memmove = ctypes.memmove
     PdSceneSample = _lib.PdSceneSample
     item = h.dtype.itemsize
-    off = {k: h.dtype.fields[k][1] for k in ("step", "t", "x", "v", "gap", "impulse")}
+    off = {k: f[1] for k, f in h.dtype.fields.items()}
+    with_up = "up" in off
     nb, mb = 8 * n, 8 * m
     acc = np.zeros(m)
     state = {"seen": 0}
@@ -344,6 +349,8 @@ def _scene_sampler(h, n, m):
                 acc[:] = 0.0
             elif mb and x.impulse:
                 memmove(base + off["impulse"], x.impulse, mb)
+            if with_up and nb and x.up:
+                memmove(base + off["up"], x.up, nb)
             h.n += 1
             return 0
         except BaseException as e:

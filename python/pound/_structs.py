@@ -370,6 +370,7 @@ class PdSceneSample(Structure):
         ("gap", POINTER(c_double)),
         ("impulse", POINTER(c_double)),
         ("impacts", POINTER(c_long)),
+        ("up", POINTER(c_double)),
     ]
 
 

@@ -127,6 +127,24 @@ def test_scene_history_is_the_cli_file(cli, same, tmp_path):
     assert np.array_equal(cols, data)
 
 
+@pytest.mark.parametrize("method", ["moreau", "event"])
+def test_scene_yielding_history_is_the_cli_file(cli, same, tmp_path, method):
+    """A yielding row's history (the storeys' offsets up after the impulses, as
+    the CLI's NAME.upK columns); its last row's (1 - alpha) up is the residual."""
+    out = tmp_path / "yrow.csv"
+    args = ("--chain", "3", "--Pi3", "0.3", "--Piy", "0.1", "--alpha", "0.1", "--method", method)
+    js = cli("simulate", *args, "-o", out, "--every", "4")
+    r = pound.Scene.chain(3, Pi3=0.3, Piy=0.1, alpha=0.1).simulate(method=method, every=4)
+    same(r, js)
+    header, data = read_csv(out)
+    assert header[-3:] == ["S1.up1", "S2.up1", "S3.up1"]
+    cols = np.column_stack([r.t, r.x, r.v, r.history.gap, r.history.impulse, r.history.up])
+    assert np.array_equal(cols, data)
+    for k, st in enumerate(r.structures):  # the offsets at the end give the residuals
+        assert st.n_yield[0] > 0 and np.isclose(0.9 * r.history.up[-1, k], st.residual[0],
+                                                rtol=1e-12, atol=0)
+
+
 def test_scene_others(cli, same):
     for name in ("three-buildings.json", "oscillator.json"):
         f = EXAMPLES / "scenes" / name
