@@ -339,6 +339,42 @@ static double horizon(const pd_edr *r)
     return fmin(edr_piece_end(r, r->rs.piece), r->rs.t1);
 }
 
+/* The end of a prediction's window from ts: win scan steps of h (windows
+ * double from EDR_WINDOW0 to EDR_WINDOW as a prediction continues), cut at
+ * the horizon. */
+static double window_end(pd_edr *r, int slot, int cont, double ts, double h)
+{
+    int win = cont && r->rs.win[slot] > 0 ? r->rs.win[slot] : EDR_WINDOW0;
+    r->rs.win[slot] = win < EDR_WINDOW ? 2 * win : EDR_WINDOW;
+    return fmin(horizon(r), ts + win * h);
+}
+
+/* Scan (p.t, tw] interval by interval on the grid p.t + k h (the last
+ * interval ends at tw exactly): the first crossing found is slot's
+ * prediction (EDR_Q_HIT); none, the window's continuation is queued at tw
+ * (none at the horizon: a piece change predicts again, t1 ends the run). */
+static void scan_window(pd_edr *r, int slot, edr_scan *s, edr_pt p, double h, double tw)
+{
+    double t0 = p.t, tend = horizon(r);
+    long n = (long)ceil((tw - t0) / h);
+    if (n < 1)
+        n = 1;
+    for (long i = 1; i <= n; i++) {
+        double tb = i == n ? tw : t0 + (double)i * h, hit;
+        if (!(tb > p.t))
+            break;
+        edr_pt b = edr_scan_point(s, tb);
+        if (edr_scan_interval(s, &p, &b, &hit)) {
+            r->rs.qkind[slot] = EDR_Q_HIT;
+            q_set(&r->rs.q, slot, hit);
+            return;
+        }
+        p = b;
+    }
+    r->rs.qkind[slot] = EDR_Q_SCAN;
+    q_set(&r->rs.q, slot, tw < tend ? tw : HUGE_VAL);
+}
+
 /* Contact a's next closing after ts, or the end of its scan window. */
 static void predict_contact(pd_edr *r, int a, double ts, int cont)
 {
@@ -358,11 +394,7 @@ static void predict_contact(pd_edr *r, int a, double ts, int cont)
     gap_base(r, a, &g);
     edr_scan s = {
         .fn = gap_fn, .ctx = &g, .hit_mode = 1, .thr = g.thr, .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
-    /* windows double from EDR_WINDOW0 intervals as the prediction continues */
-    int win = cont && r->rs.win[slot] > 0 ? r->rs.win[slot] : EDR_WINDOW0;
-    r->rs.win[slot] = win < EDR_WINDOW ? 2 * win : EDR_WINDOW;
-    /* the window: win scan steps from ts, cut at the horizon */
-    double h = contact_step(r, a), tend = horizon(r), tw = fmin(tend, ts + win * h);
+    double h = contact_step(r, a), tend = horizon(r), tw = window_end(r, slot, cont, ts, h);
     s.width = 4e-8 * h;
     edr_pt p = edr_scan_point(&s, ts);
     /* a gap at zero (within the closing tolerance) closing at a rate an
@@ -416,27 +448,8 @@ static void predict_contact(pd_edr *r, int a, double ts, int cont)
         q_set(&r->rs.q, slot, ts + sf < tend ? ts + sf : HUGE_VAL);
         return;
     }
-    /* the window interval by interval on the contact's grid (the last
-     * interval ends at tw exactly): the first closing found is the prediction */
-    long n = (long)ceil((tw - t0) / h);
-    if (n < 1)
-        n = 1;
-    for (long i = 1; i <= n; i++) {
-        double tb = i == n ? tw : t0 + (double)i * h, hit;
-        if (!(tb > p.t))
-            break;
-        edr_pt b = edr_scan_point(&s, tb);
-        if (edr_scan_interval(&s, &p, &b, &hit)) {
-            r->rs.qkind[slot] = EDR_Q_HIT;
-            q_set(&r->rs.q, slot, hit);
-            return;
-        }
-        p = b;
-    }
-    /* nothing in the window: its continuation is queued at tw (none at the
-     * horizon: a piece change predicts every contact again, t1 ends the run) */
-    r->rs.qkind[slot] = EDR_Q_SCAN;
-    q_set(&r->rs.q, slot, tw < tend ? tw : HUGE_VAL);
+    /* the window on the contact's grid: the first closing is the prediction */
+    scan_window(r, slot, &s, p, h, tw);
 }
 
 typedef struct force_ctx {
@@ -504,9 +517,7 @@ static void predict_detach(pd_edr *r, int c, double ts, int cont)
         q_set(&r->rs.q, slot, best);
         return;
     }
-    int win = cont && r->rs.win[slot] > 0 ? r->rs.win[slot] : EDR_WINDOW0;
-    r->rs.win[slot] = win < EDR_WINDOW ? 2 * win : EDR_WINDOW;
-    double h = cl->h, tw = fmin(tend, ts + win * h), ta = ts;
+    double h = cl->h, tw = window_end(r, slot, cont, ts, h), ta = ts;
     if (cl->bnd && (cl->kind == EDR_SDOF || cl->kind == EDR_REST)) {
         /* lambda = la y + lb y' + lg f + ld: |lambda''| <= |la| Y2 + |lb| Y3 + |lg| F2 */
         const pd_sine_piece *pc2 = &r->tp.pieces[cl->piece];
@@ -618,32 +629,14 @@ static void predict_spring(pd_edr *r, int j, double ts, int cont)
                              : EDR_RATE_TOL * fmax(r->rs.vscale, fabs(g.sig * v));
     edr_scan s = {
         .fn = spring_fn, .ctx = &g, .hit_mode = 1, .thr = thr, .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
-    int win = cont && r->rs.win[slot] > 0 ? r->rs.win[slot] : EDR_WINDOW0;
-    r->rs.win[slot] = win < EDR_WINDOW ? 2 * win : EDR_WINDOW;
-    double h = cl->h, tend = horizon(r), tw = fmin(tend, ts + win * h);
+    double h = cl->h, tw = window_end(r, slot, cont, ts, h);
     s.width = 4e-8 * h;
     edr_pt p = edr_scan_point(&s, ts);
     if (p.f > 0.0) { /* past the level at the start: rounding (the origin decided the phase) */
         g.shift = p.f;
         p.f = 0.0;
     }
-    long n = (long)ceil((tw - ts) / h);
-    if (n < 1)
-        n = 1;
-    for (long i = 1; i <= n; i++) {
-        double tb = i == n ? tw : ts + (double)i * h, hit;
-        if (!(tb > p.t))
-            break;
-        edr_pt b = edr_scan_point(&s, tb);
-        if (edr_scan_interval(&s, &p, &b, &hit)) {
-            r->rs.qkind[slot] = EDR_Q_HIT;
-            q_set(&r->rs.q, slot, hit);
-            return;
-        }
-        p = b;
-    }
-    r->rs.qkind[slot] = EDR_Q_SCAN;
-    q_set(&r->rs.q, slot, tw < tend ? tw : HUGE_VAL);
+    scan_window(r, slot, &s, p, h, tw);
 }
 
 /* The springs of cluster c predicted again from ts. */
@@ -2369,6 +2362,21 @@ static void group_begin(pd_edr *r)
     r->ev.ngc = 0;
 }
 
+/* A new group: cluster c and its closed contacts (persistent or locked). */
+static void group_of_cluster(pd_edr *r, int c)
+{
+    group_begin(r);
+    group_add_cluster(r, c);
+    for (int b = r->rs.cl[c].head; b >= 0; b = r->rs.blk_next[b]) {
+        const edr_block *bk = &r->tp.blk[b];
+        for (int k = 0; k < bk->ncont; k++) {
+            int x = r->tp.blk_cont[bk->cont0 + k];
+            if (r->rs.cstate[x] != EDR_OPEN && r->ev.ct_mark[x] != r->ev.epoch)
+                group_add_contact(r, x);
+        }
+    }
+}
+
 /* Contact a closes at t: the group grows from it. */
 static int on_impact(pd_edr *r, int a, double t, pd_err *err)
 {
@@ -2392,17 +2400,7 @@ static int on_detach(pd_edr *r, int c, double t, pd_err *err)
     int rc, acc, a = r->rs.cl[c].det_contact;
     if ((rc = count_event(r, r->tp.m + c, t, err)))
         return rc;
-    /* the group: cluster c and its closed contacts (persistent or locked) */
-    group_begin(r);
-    group_add_cluster(r, c);
-    for (int b = r->rs.cl[c].head; b >= 0; b = r->rs.blk_next[b]) {
-        const edr_block *bk = &r->tp.blk[b];
-        for (int k = 0; k < bk->ncont; k++) {
-            int x = r->tp.blk_cont[bk->cont0 + k];
-            if (r->rs.cstate[x] != EDR_OPEN && r->ev.ct_mark[x] != r->ev.epoch)
-                group_add_contact(r, x);
-        }
-    }
+    group_of_cluster(r, c);
     group_state(r, t);
     /* no impact: v- is the state's v; U- = U+ = 0, P = 0 */
     for (int k = 0; k < r->ev.ngd; k++)
@@ -2470,16 +2468,7 @@ static int on_spring(pd_edr *r, int j, double t, pd_err *err)
         q_set(&r->rs.q, slot, fmax(due, t));
         return PD_OK;
     }
-    group_begin(r);
-    group_add_cluster(r, c);
-    for (int b = r->rs.cl[c].head; b >= 0; b = r->rs.blk_next[b]) {
-        const edr_block *bk = &r->tp.blk[b];
-        for (int k = 0; k < bk->ncont; k++) {
-            int x = r->tp.blk_cont[bk->cont0 + k];
-            if (r->rs.cstate[x] != EDR_OPEN && r->ev.ct_mark[x] != r->ev.epoch)
-                group_add_contact(r, x);
-        }
-    }
+    group_of_cluster(r, c);
     group_state(r, t);
     for (int k = 0; k < r->ev.ngc; k++)
         r->ev.held[k] = r->rs.cstate[r->ev.g_ct[k]] != EDR_OPEN;
@@ -2509,18 +2498,7 @@ static int on_piece(pd_edr *r, double t, pd_err *err)
         int c = r->ev.plist[i];
         if (!r->rs.cl[c].live || r->rs.cl[c].t0 == t) /* gone, or started at t on the new piece */
             continue;
-        edr_cluster *cl = &r->rs.cl[c];
-        /* the group: the cluster and its closed contacts (persistent or locked) */
-        group_begin(r);
-        group_add_cluster(r, c);
-        for (int b = cl->head; b >= 0; b = r->rs.blk_next[b]) {
-            const edr_block *bk = &r->tp.blk[b];
-            for (int k = 0; k < bk->ncont; k++) {
-                int x = r->tp.blk_cont[bk->cont0 + k];
-                if (r->rs.cstate[x] != EDR_OPEN && r->ev.ct_mark[x] != r->ev.epoch)
-                    group_add_contact(r, x);
-            }
-        }
+        group_of_cluster(r, c);
         group_state(r, t);
         for (int k = 0; k < r->ev.ngd; k++)
             r->ev.ev_vminus[k] = r->ev.gv[r->ev.g_dof[k]];

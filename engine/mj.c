@@ -107,8 +107,9 @@ int pd_mj_check_opts(const pd_mj_opts *o, pd_err *err)
     if (!(o->rtol >= 0.0 && o->rtol < 1.0))
         return pd_err_set(err, PD_EINVAL, "rtol must be in [0, 1) (0: fixed steps; got %g)",
                           o->rtol);
-    if (o->yield_lcp_max < 0)
-        return pd_err_set(err, PD_EINVAL, "yield_lcp_max must be >= 0 (0: 512; got %d)",
+    if (o->yield_lcp_max < -1)
+        return pd_err_set(err, PD_EINVAL,
+                          "yield_lcp_max must be >= -1 (0: 512, -1: Gauss-Seidel; got %d)",
                           o->yield_lcp_max);
     /* the adaptive driver's options, read only when it runs */
     if (o->rtol > 0.0) {
@@ -664,13 +665,16 @@ static int impact_refine(pd_mj *mj, const pd_factor *f, int nI, const double *vf
 /* Impulses of the active contacts into out->P: the LCP (D_II, W_I^T vfree
  * + e U) with D_II from the factor f, refined when it lost precision; t1
  * is the step's end (messages). */
-static int impact_contacts(pd_mj *mj, const pd_factor *f, int nI, const double *vfree, double t1,
-                           pd_state *out, pd_err *err)
+static int impact_contacts(pd_mj *mj, const pd_factor *f, int nI, int reuse_D, const double *vfree,
+                           double t1, pd_state *out, pd_err *err)
 {
     int rc;
     mj->refined = 0;
-    /* D_II = W_I^T What^-1 W_I from the factor, as it keeps D */
-    if (mj->sparse)
+    /* D_II = W_I^T What^-1 W_I from the factor, as it keeps D (kept from the
+     * last call on the same active set when reuse_D) */
+    if (reuse_D)
+        ;
+    else if (mj->sparse)
         pd_factor_delassus_csc(f, mj->idx_active, nI, mj->D_colptr, mj->D_rowind, mj->D_active);
     else
         pd_factor_delassus_dense(f, mj->idx_active, nI, mj->D_active);
@@ -686,9 +690,10 @@ static int impact_contacts(pd_mj *mj, const pd_factor *f, int nI, const double *
     return PD_OK;
 }
 
-int mj_contacts_apply(pd_mj *mj, const pd_factor *f, int nI, double t1, pd_state *out, pd_err *err)
+int mj_contacts_apply(pd_mj *mj, const pd_factor *f, int nI, int reuse_D, double t1, pd_state *out,
+                      pd_err *err)
 {
-    int rc = impact_contacts(mj, f, nI, out->v, t1, out, err);
+    int rc = impact_contacts(mj, f, nI, reuse_D, out->v, t1, out, err);
     if (rc)
         return rc;
     if (mj->refined) /* the impulses' velocity corrected on the pushing contacts */
@@ -735,7 +740,7 @@ int mj_general_step(pd_mj *mj, const pd_factor *f, double h, double t1, const do
     if (mj->yl)
         rc = mj_yield_step(mj, f, h, nI, t1, out, err);
     else
-        rc = nI > 0 ? mj_contacts_apply(mj, f, nI, t1, out, err) : PD_OK;
+        rc = nI > 0 ? mj_contacts_apply(mj, f, nI, 0, t1, out, err) : PD_OK;
     if (rc)
         return rc;
     /* q_k+1 = q_k + h [(1 - theta) v_k + theta v_k+1] */

@@ -129,8 +129,11 @@ int mj_general_step(pd_mj *mj, const pd_factor *f, double h, double t1, const do
  * block in mj->D_active (dense, or compressed columns when mj->sparse) into
  * mj->P_active and out->P (t1 names the step's end in messages). */
 void mj_active_rhs(pd_mj *mj, int nI, const double *vfree);
-/* The contacts' LCP of the active set from out->v = vfree, and v+ into out->v. */
-int mj_contacts_apply(pd_mj *mj, const pd_factor *f, int nI, double t1, pd_state *out, pd_err *err);
+/* The contacts' LCP of the active set from out->v = vfree, and v+ into
+ * out->v; reuse_D: the Delassus block of the last call (the same active
+ * set and factor) is kept. */
+int mj_contacts_apply(pd_mj *mj, const pd_factor *f, int nI, int reuse_D, double t1, pd_state *out,
+                      pd_err *err);
 
 /* Yielding springs (mj_yield.c): the object, the offsets back to 0, their
  * force x += s S ks up, and the step's LCP with them from out->v = vfree

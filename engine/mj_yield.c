@@ -23,6 +23,10 @@
  *           row of SDOFs) is solved by block Gauss-Seidel: the contacts' LCP
  *           (the kernel's own solver) given the slides, each slide in closed
  *           form given the contacts, until no slide moves (MJY_GS_TOL)
+ *   rows    every spring alone on its dof (rows of SDOFs): the slides of a
+ *           set A taken as sliding are put into the contacts' LCP (slide_set:
+ *           one LCP of the kernel's solver per try, the set corrected until
+ *           it holds; Gauss-Seidel when it does not settle)
  *   up     += sigma G
  * When no spring passes uy the step is the elastic one, bit for bit (and
  * with every offset 0 nothing is added to the force).  Memory: the LCP of
@@ -39,6 +43,7 @@
 #define MJY_GS_MAX 200   /* block Gauss-Seidel sweeps of a larger piece at most */
 #define MJY_GS_TOL 1e-13 /* ... until no slide moves by more than this share of its uy */
 #define MJY_SLACK 1e-10  /* a spring past uy by more than this share of it joins Y */
+#define MJY_SET_MAX 32   /* tries of the sliding set before Gauss-Seidel takes the step */
 
 struct mj_yield {
     int ns;
@@ -60,10 +65,26 @@ struct mj_yield {
     double *P0, *dP;      /* m: the elastic pass's impulses, the change */
     int *yc;              /* ns: the coupled springs of Y */
     int all_alone;        /* every spring alone on its dof (rows of SDOFs) */
+    int one_per_dof;      /* and no two on one dof (the sliding set's iteration) */
     int ny_prev;          /* Y's springs that slid in the last step (Gauss-Seidel's start) */
     int *sdof;            /* ns: a spring's only dof (-1: its drift takes several) */
     double *sfac;         /* ns: its drift's multiple of that dof */
     long rounds;          /* the LCPs solved with springs (statistics) */
+    /* slide_set: the constants of h theta (hth_set), per spring alone on its
+     * dof: What_ii and its slide's L; per step: the contacts' D_II as the
+     * factor gives it, W_I P on the dofs, each dof's first entry in the
+     * list of (active contact, W entry) on sliding dofs */
+    double hth_set;
+    double *what, *Ls; /* ns */
+    double *inc, *dcs; /* ns: h theta ks s / What_ii, the compliance a slide adds */
+    double *Dsave;     /* the Delassus block's capacity */
+    long Dcap;
+    double *wp;         /* n: (W_I P)_i */
+    int *head, *enext;  /* n, 2 m: the entries on each sliding dof */
+    int *er;            /* 2 m: an entry's active row */
+    double *ew;         /* 2 m: its W value */
+    int *snext;         /* n: the spring on a dof (-1: none), sliding-set iteration */
+    int *cmark, cstamp; /* n: a dof an active contact touches in this step (== cstamp) */
 };
 
 void mj_yield_free(pd_mj *mj)
@@ -71,9 +92,10 @@ void mj_yield_free(pd_mj *mj)
     mj_yield *y = mj->yl;
     if (!y)
         return;
-    void *arrays[] = {y->sdof,  y->sfac, y->up,    y->vfree, y->vel, y->col, y->ys,
-                      y->sigma, y->G,    y->block, y->dM,    y->dC,  y->dK,  y->alone,
-                      y->uf,    y->mark, y->cidx,  y->P0,    y->dP,  y->yc};
+    void *arrays[] = {y->sdof, y->sfac,  y->up, y->vfree, y->vel,   y->col,   y->ys,    y->sigma,
+                      y->G,    y->block, y->dM, y->dC,    y->dK,    y->alone, y->uf,    y->mark,
+                      y->cidx, y->P0,    y->dP, y->yc,    y->what,  y->Ls,    y->Dsave, y->wp,
+                      y->head, y->enext, y->er, y->ew,    y->snext, y->cmark, y->inc,   y->dcs};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(arrays[k]);
     free(y->L);
@@ -172,15 +194,37 @@ int mj_yield_alloc(pd_mj *mj, pd_err *err)
     y->z = pd_malloc(MJY_CAP, sizeof(double));
     y->w = pd_malloc(MJY_CAP, sizeof(double));
     y->lemke = pd_lcp_alloc(MJY_CAP);
+    y->what = pd_calloc(ns, sizeof(double));
+    y->Ls = pd_calloc(ns, sizeof(double));
+    y->inc = pd_calloc(ns, sizeof(double));
+    y->dcs = pd_calloc(ns, sizeof(double));
+    y->Dcap = mj->factor && m > 0 ? (mj->sparse ? mj->factor->delassus_nnz : (long)m * m) : 0;
+    y->Dsave = pd_calloc(y->Dcap, sizeof(double));
+    y->wp = pd_calloc(n, sizeof(double));
+    y->head = pd_calloc(n, sizeof(int));
+    y->snext = pd_calloc(n, sizeof(int));
+    y->cmark = pd_calloc(n, sizeof(int));
+    y->enext = pd_calloc(2L * m, sizeof(int));
+    y->er = pd_calloc(2L * m, sizeof(int));
+    y->ew = pd_calloc(2L * m, sizeof(double));
+    y->hth_set = NAN;
     if (!y->up || !y->vfree || !y->vel || !y->col || !y->ys || !y->sigma || !y->G || !y->block ||
         !y->dM || !y->dC || !y->dK || !y->alone || !y->uf || !y->mark || !y->cidx || !y->P0 ||
-        !y->sdof || !y->sfac || !y->dP || !y->yc || !y->L || !y->b || !y->z || !y->w || !y->lemke)
+        !y->sdof || !y->sfac || !y->dP || !y->yc || !y->L || !y->b || !y->z || !y->w || !y->lemke ||
+        !y->what || !y->Ls || !y->Dsave || !y->wp || !y->head || !y->snext || !y->enext || !y->er ||
+        !y->ew || !y->cmark || !y->inc || !y->dcs)
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for %d yielding springs", ns);
     blocks(y, md);
-    y->all_alone = 1;
+    y->all_alone = y->one_per_dof = 1;
+    for (int i = 0; i < n; i++)
+        y->snext[i] = -1;
     for (int j = 0; j < ns; j++) {
         y->sdof[j] = spring_dof(md, j, &y->sfac[j]);
         y->all_alone &= y->sdof[j] >= 0 && y->alone[y->sdof[j]];
+        if (y->sdof[j] >= 0) { /* two springs on one dof: Gauss-Seidel's rows only */
+            y->one_per_dof &= y->snext[y->sdof[j]] < 0;
+            y->snext[y->sdof[j]] = j;
+        }
     }
     mj->st.up = y->up;
     return PD_OK;
@@ -199,9 +243,16 @@ void mj_yield_reset(pd_mj *mj)
 void mj_yield_force(const pd_mj *mj, double s, double *x)
 {
     const pd_model *md = mj->model;
-    for (int j = 0; j < md->ns; j++)
-        if (mj->yl->up[j] != 0.0)
-            pd_matrix_col_axpy(&md->S, j, s * md->ks[j] * mj->yl->up[j], x);
+    const mj_yield *y = mj->yl;
+    for (int j = 0; j < md->ns; j++) {
+        if (y->up[j] == 0.0)
+            continue;
+        double a = s * md->ks[j] * y->up[j];
+        if (y->sdof[j] >= 0) /* one dof: the column's one entry, as col_axpy adds it */
+            x[y->sdof[j]] += a * y->sfac[j];
+        else
+            pd_matrix_col_axpy(&md->S, j, a, x);
+    }
 }
 
 /* z+_j of the step's end state (out->q holds q + h (1 - theta) v). */
@@ -429,7 +480,7 @@ static int slide_gs(pd_mj *mj, const pd_factor *f, int nI, int *ny, double hth, 
                 out->v[i] += hth * y->sigma[j] * md->ks[j] * s * y->G[j] / what;
             }
         }
-        if (nI > 0 && (rc = mj_contacts_apply(mj, f, nI, t1, out, err)))
+        if (nI > 0 && (rc = mj_contacts_apply(mj, f, nI, it > 0, t1, out, err)))
             return rc;
         double moved = 0.0;
         for (int k = 0; k < *ny; k++) { /* each slide given the rest */
@@ -453,6 +504,261 @@ static int slide_gs(pd_mj *mj, const pd_factor *f, int nI, int *ny, double hth, 
                       *ny, nI, MJY_GS_MAX, t1);
 }
 
+/* ---- rows of SDOFs: the sliding set in the contacts' LCP ---------------- */
+
+/* What_ii and the slide's L = ks - (h theta)^2 ks^2 s^2 / What_ii of each
+ * spring alone on its dof, at h theta (kept while it holds). */
+static void set_constants(mj_yield *y, const pd_model *md, double hth)
+{
+    if (y->hth_set == hth)
+        return;
+    for (int j = 0; j < md->ns; j++) {
+        int i = y->sdof[j];
+        if (i < 0)
+            continue;
+        double s = y->sfac[j], ks = md->ks[j];
+        double what = y->dM[i] + hth * (y->dC[i] + hth * y->dK[i]), r = hth * hth * ks * s * s;
+        y->what[j] = what;
+        y->Ls[j] = ks - hth * hth * ks * ks * s * s / what;
+        y->inc[j] = hth * ks * s / what;
+        /* 1 / (What_ii - (h theta)^2 ks s^2) - 1 / What_ii: the post-yield What is
+         * positive (k - ks s^2 >= 0) */
+        y->dcs[j] = r / (what * (what - r));
+    }
+    y->hth_set = hth;
+}
+
+/* b = ks (uy - sigma z) of spring j, z of the end state with its dof's
+ * velocity vi (its own slide left out); q1 = q + h (1 - theta) v. */
+static double slide_b(const pd_model *md, const mj_yield *y, int j, double hth, const double *q1,
+                      double vi)
+{
+    int i = y->sdof[j];
+    double z = y->sfac[j] * (q1[i] + hth * vi) - y->up[j];
+    return md->ks[j] * (md->uy[j] - y->sigma[j] * z);
+}
+
+/* The step's lists: the entries (active row, W value) of the active
+ * contacts on each dof they touch, from head[i] (valid where cmark[i] ==
+ * cstamp).  0, or 1 when they overflow (Gauss-Seidel then). */
+static int set_entries(pd_mj *mj, int nI)
+{
+    const pd_model *md = mj->model;
+    mj_yield *y = mj->yl;
+    int ne = 0;
+    y->cstamp++;
+    for (int r = 0; r < nI; r++) {
+        int p = -1, i;
+        double w;
+        while (mj_col_next(&md->W, mj->idx_active[r], &p, &i, &w)) {
+            if (y->cmark[i] != y->cstamp) {
+                y->cmark[i] = y->cstamp;
+                y->head[i] = -1;
+            }
+            if (ne == 2 * md->m)
+                return 1;
+            y->er[ne] = r;
+            y->ew[ne] = w;
+            y->enext[ne] = y->head[i];
+            y->head[i] = ne++;
+        }
+    }
+    return 0;
+}
+
+/* Whether an active contact touches dof i, and whether one pushes there. */
+static int touched(const mj_yield *y, int i)
+{
+    return y->cmark[i] == y->cstamp;
+}
+
+static int pushed(const pd_mj *mj, int i)
+{
+    const mj_yield *y = mj->yl;
+    for (int e = touched(y, i) ? y->head[i] : -1; e >= 0; e = y->enext[e])
+        if (mj->P_active[y->er[e]] > 0.0)
+            return 1;
+    return 0;
+}
+
+/* Whether every active contact on dof i keeps w = W^T v+ + e U >= 0. */
+static int contacts_hold(const pd_mj *mj, int i, const double *v)
+{
+    const pd_model *md = mj->model;
+    const mj_yield *y = mj->yl;
+    for (int e = touched(y, i) ? y->head[i] : -1; e >= 0; e = y->enext[e]) {
+        int a = mj->idx_active[y->er[e]];
+        if (pd_matrix_col_dot(&md->W, a, v) + md->e[a] * mj->U0[a] < 0.0)
+            return 0;
+    }
+    return 1;
+}
+
+/* D_II (restored from Dsave when restore) corrected on the sliding dofs, D_ab += W_ia
+ * W_ib dc_i over the pairs of active contacts on dof i.  0, or 1 when an
+ * entry falls outside D's pattern (Gauss-Seidel then). */
+static int set_delassus(pd_mj *mj, int nI, int ny, int restore)
+{
+    mj_yield *y = mj->yl;
+    long nnz = mj->sparse ? mj->D_colptr[nI] : (long)nI * nI;
+    if (restore) /* a try after the first: D_II as the factor gave it */
+        memcpy(mj->D_active, y->Dsave, (size_t)nnz * sizeof(double));
+    for (int k = 0; k < ny; k++) {
+        int j = y->ys[k], i = y->sdof[j];
+        if (!touched(y, i))
+            continue;
+        double dc = y->dcs[j];
+        for (int e1 = y->head[i]; e1 >= 0; e1 = y->enext[e1])
+            for (int e2 = y->head[i]; e2 >= 0; e2 = y->enext[e2]) {
+                int col = y->er[e1], row = y->er[e2], at = -1;
+                if (!mj->sparse)
+                    at = row + col * nI;
+                else
+                    for (int q = mj->D_colptr[col]; q < mj->D_colptr[col + 1] && at < 0; q++)
+                        at = mj->D_rowind[q] == row ? q : -1;
+                if (at < 0)
+                    return 1;
+                mj->D_active[at] += y->ew[e1] * y->ew[e2] * dc;
+            }
+    }
+    return 0;
+}
+
+/* The contacts' LCP with the slides of Y taken as sliding (each G solved
+ * for and put in): a sliding dof starts from vfree_i - sigma inc b / L and
+ * answers an impulse with the post-yield compliance; then v+ on out->v and
+ * (W_I P)_i of each sliding dof in y->wp.  The Delassus block is built at
+ * the first call of a step (*built) and kept in Dsave; with Y empty the
+ * step's contacts are the elastic step's, bit for bit.  0, 1 (Gauss-Seidel
+ * takes the step), or an error. */
+static int set_contacts(pd_mj *mj, const pd_factor *f, int nI, int ny, double hth, double t1,
+                        int *built, pd_state *out, pd_err *err)
+{
+    const pd_model *md = mj->model;
+    mj_yield *y = mj->yl;
+    int rc, fresh = !*built; /* the step's first try: out->v is vfree, D_II not built */
+    if (!fresh)
+        memcpy(out->v, y->vfree, (size_t)md->n * sizeof(double));
+    for (int k = 0; k < ny; k++) { /* the slides' constant parts */
+        int j = y->ys[k], i = y->sdof[j];
+        out->v[i] -=
+            y->sigma[j] * y->inc[j] * slide_b(md, y, j, hth, out->q, y->vfree[i]) / y->Ls[j];
+        y->wp[i] = 0.0;
+    }
+    if (nI == 0)
+        return PD_OK;
+    long nnz;
+    if (ny == 0) { /* no slide: the elastic step's contacts */
+        if (*built)
+            memcpy(mj->D_active, y->Dsave,
+                   (size_t)(mj->sparse ? mj->D_colptr[nI] : (long)nI * nI) * sizeof(double));
+        if ((rc = mj_contacts_apply(mj, f, nI, *built, t1, out, err)))
+            return rc;
+    } else if (!*built && mj->sparse)
+        pd_factor_delassus_csc(f, mj->idx_active, nI, mj->D_colptr, mj->D_rowind, mj->D_active);
+    else if (!*built)
+        pd_factor_delassus_dense(f, mj->idx_active, nI, mj->D_active);
+    if (!*built) { /* D_II as the factor gives it, kept for the tries */
+        if ((nnz = mj->sparse ? mj->D_colptr[nI] : (long)nI * nI) > y->Dcap)
+            return 1;
+        memcpy(y->Dsave, mj->D_active, (size_t)nnz * sizeof(double));
+        *built = 1;
+    }
+    if (ny == 0)
+        return PD_OK;
+    if (set_delassus(mj, nI, ny, !fresh))
+        return 1;
+    mj_active_rhs(mj, nI, out->v);
+    if ((rc = mj_impact_active(mj, nI, t1, out, err)))
+        return rc;
+    pd_factor_add_impulse(f, mj->idx_active, nI, mj->P_active, out->v);
+    for (int k = 0; k < ny; k++) { /* the sliding dofs' extra compliance */
+        int j = y->ys[k], i = y->sdof[j];
+        double s = 0.0;
+        for (int e = touched(y, i) ? y->head[i] : -1; e >= 0; e = y->enext[e])
+            s += y->ew[e] * mj->P_active[y->er[e]];
+        y->wp[i] = s;
+        out->v[i] += y->dcs[j] * s;
+    }
+    return PD_OK;
+}
+
+/* Spring j's slide where no contact pushes on its dof: G in closed form
+ * from vfree (the contacts give nothing there), its dof's v+ with it (G =
+ * 0 and out of Y when it would be negative).  1 when the active contacts
+ * on the dof still hold (else the contacts' LCP must take the change). */
+static int slide_unpushed(pd_mj *mj, int j, double hth, pd_state *out)
+{
+    const pd_model *md = mj->model;
+    mj_yield *y = mj->yl;
+    int i = y->sdof[j];
+    double G = y->sigma[j] ? -slide_b(md, y, j, hth, out->q, y->vfree[i]) / y->Ls[j] : 0.0;
+    y->G[j] = G > 0.0 ? G : 0.0;
+    if (!(G > 0.0))
+        y->sigma[j] = 0;
+    out->v[i] = y->vfree[i] + y->sigma[j] * y->inc[j] * y->G[j];
+    return contacts_hold(mj, i, out->v);
+}
+
+/* The sliding set's iteration (every spring alone on its dof, one a dof):
+ * from Y (the last step's slides), the contacts' LCP with Y sliding
+ * (set_contacts), then each G = -(b - beta (W_I P)_i) / L: a negative one
+ * leaves Y, a spring past uy joins it (grow).  A change on a dof where no
+ * contact pushes is made there (slide_unpushed: the others' impulses stay
+ * a solution while that dof's contacts hold); any other takes the LCP
+ * again, until nothing changes.  0, 1 when MJY_SET_MAX tries do not settle
+ * it (Gauss-Seidel then), or an error. */
+static int slide_set(pd_mj *mj, const pd_factor *f, int nI, int *ny, double hth, double t1,
+                     pd_state *out, pd_err *err)
+{
+    const pd_model *md = mj->model;
+    mj_yield *y = mj->yl;
+    int built = 0, rc;
+    set_constants(y, md, hth);
+    if (set_entries(mj, nI))
+        return 1;
+    for (int it = 0; it < MJY_SET_MAX; it++) {
+        if ((rc = set_contacts(mj, f, nI, *ny, hth, t1, &built, out, err)))
+            return rc;
+        int kept = 0, again = 0;
+        for (int k = 0; k < *ny; k++) {
+            int j = y->ys[k], i = y->sdof[j];
+            double b =
+                slide_b(md, y, j, hth, out->q, y->vfree[i]) - y->sigma[j] * y->inc[j] * y->wp[i];
+            y->G[j] = -b / y->Ls[j];
+            if (y->G[j] >= 0.0) {
+                y->ys[kept++] = j;
+                continue;
+            }
+            y->G[j] = 0.0; /* it does not slide: out of Y */
+            y->sigma[j] = 0;
+            if (pushed(mj, i))
+                again = 1;
+            else
+                again |= !slide_unpushed(mj, j, hth, out);
+        }
+        int ny0 = *ny = kept;
+        if (!again && grow(mj, out, hth, ny)) {
+            kept = 0; /* the joined (G = 0 from grow) and the turned */
+            for (int k = 0; k < *ny; k++) {
+                int j = y->ys[k], i = y->sdof[j];
+                if ((k >= ny0 || y->G[j] == 0.0) && !again) {
+                    if (pushed(mj, i))
+                        again = 1;
+                    else
+                        again |= !slide_unpushed(mj, j, hth, out);
+                }
+                if (y->sigma[j])
+                    y->ys[kept++] = j;
+            }
+            *ny = kept;
+        }
+        if (!again)
+            return PD_OK;
+    }
+    return 1;
+}
+
 int mj_yield_step(pd_mj *mj, const pd_factor *f, double h, int nI, double t1, pd_state *out,
                   pd_err *err)
 {
@@ -461,7 +767,7 @@ int mj_yield_step(pd_mj *mj, const pd_factor *f, double h, int nI, double t1, pd
     double hth = h * mj->opts.theta;
     int rc, ny = 0;
     memcpy(y->vfree, out->v, (size_t)md->n * sizeof(double));
-    if (y->all_alone && mj->opts.yield_lcp_max == 0) { /* rows of SDOFs: Gauss-Seidel */
+    if (y->all_alone && mj->opts.yield_lcp_max <= 0) { /* rows of SDOFs */
         /* its start: the springs that slid in the last step, with their slides */
         for (int k = 0; k < y->ny_prev; k++) {
             int j = y->ys[k];
@@ -470,7 +776,14 @@ int mj_yield_step(pd_mj *mj, const pd_factor *f, double h, int nI, double t1, pd
             else
                 y->sigma[j] = 0;
         }
-        if ((rc = slide_gs(mj, f, nI, &ny, hth, t1, out, err)))
+        rc = mj->opts.yield_lcp_max == 0 && y->one_per_dof && (y->Dcap > 0 || md->m == 0)
+                 ? slide_set(mj, f, nI, &ny, hth, t1, out, err)
+                 : 1;
+        if (rc > 0) { /* not settled: Gauss-Seidel from vfree and the slides found */
+            memcpy(out->v, y->vfree, (size_t)md->n * sizeof(double));
+            rc = slide_gs(mj, f, nI, &ny, hth, t1, out, err);
+        }
+        if (rc)
             return rc;
         int slid = 0;
         for (int k = 0; k < ny; k++) {
@@ -486,7 +799,7 @@ int mj_yield_step(pd_mj *mj, const pd_factor *f, double h, int nI, double t1, pd
     }
     memset(y->sigma, 0, (size_t)md->ns);
     /* the elastic step first: the contacts alone */
-    if (nI > 0 && (rc = mj_contacts_apply(mj, f, nI, t1, out, err)))
+    if (nI > 0 && (rc = mj_contacts_apply(mj, f, nI, 0, t1, out, err)))
         return rc;
     for (int round = 0; grow(mj, out, hth, &ny); round++) {
         int nyc, nc;

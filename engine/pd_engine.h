@@ -165,11 +165,12 @@ typedef struct pd_mj_opts {
                            units of q) are simultaneous: one LCP, as the exact reference's
                            close_tol; >= 0 */
     int yield_lcp_max;      /* yielding springs (pd_model.ns): 0: springs each alone on a dof
-                          (rows of SDOFs) by block Gauss-Seidel with the contacts' solver,
+                          (rows of SDOFs) with the sliding set in the contacts' LCP (the
+                          contacts' solver; block Gauss-Seidel when it does not settle),
                           the others by the dense LCP (pivoting) of their pieces of at most
-                          512 unknowns; > 0: every piece by the dense LCP of at most this
-                          many (Gauss-Seidel beyond when its springs are alone on a dof,
-                          else PD_EBUDGET) */
+                          512 unknowns; -1: such rows by block Gauss-Seidel; > 0: every
+                          piece by the dense LCP of at most this many (Gauss-Seidel beyond
+                          when its springs are alone on a dof, else PD_EBUDGET) */
     const struct pd_piecewise_force *pieces; /* with rtol > 0: the model's force as
                            pieces (F = b f(t), pd_piecewise_force below; the model's force
                            callback must agree): flights between the contacts' impulses

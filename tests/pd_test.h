@@ -65,6 +65,14 @@ int pd_test_spawn(const char *const *argv, const char *env, proc_out *r);
  * absent (the case skipped) or unreadable (the case failed). */
 #include "pd_problems.h"
 int pd_test_rinaldi_case(pd_test_ctx *ctx, pd_record *rec, pd_osc *c);
+/* The Rinaldi record's forcing pieces F = -a_g, linear between samples
+ * (its npts pieces, to free); NULL when the record is absent (skipped) or
+ * unreadable (failed). */
+pd_sine_piece *pd_test_rinaldi_pieces(pd_test_ctx *ctx, long *npieces);
+/* Run sc by method (dt 0: the default) into r (allocated here); 1 when it
+ * ran, else 0 with the failure named. */
+int pd_test_scene_run(pd_test_ctx *ctx, const pd_scene *sc, pd_method method, double dt,
+                      pd_scene_result *r);
 /* Run ctx->pound with args (NULL-terminated). */
 int pd_test_pound(const pd_test_ctx *ctx, const char *const *args, proc_out *r);
 int pd_test_have_pound(pd_test_ctx *ctx);                          /* else skips the case */

@@ -215,6 +215,39 @@ int pd_test_zero_file(char *path, size_t cap, long long bytes)
     return rc;
 }
 
+int pd_test_scene_run(pd_test_ctx *ctx, const pd_scene *sc, pd_method method, double dt,
+                      pd_scene_result *r)
+{
+    pd_run_opts o = pd_run_default_opts();
+    o.method = method;
+    o.dt = dt;
+    pd_err e;
+    int rc = pd_scene_result_alloc(sc, r, &e);
+    if (!rc)
+        rc = pd_scene_run(sc, &o, NULL, NULL, r, &e);
+    return CHECK(ctx, rc == PD_OK, "%s dt %g: %s", pd_method_name(method), dt, e.msg);
+}
+
+pd_sine_piece *pd_test_rinaldi_pieces(pd_test_ctx *ctx, long *npieces)
+{
+    pd_record rec;
+    pd_osc c;
+    if (!pd_test_rinaldi_case(ctx, &rec, &c))
+        return NULL;
+    long np = rec.npts;
+    pd_sine_piece *pc = calloc((size_t)np, sizeof *pc);
+    if (CHECK(ctx, pc != NULL, "out of memory")) {
+        for (long k = 0; k + 1 < np; k++) /* F = -a_g, linear between samples */
+            pc[k] = (pd_sine_piece){.t_start = (double)k * rec.dt,
+                                    .c0 = -rec.acc[k],
+                                    .c1 = -(rec.acc[k + 1] - rec.acc[k]) / rec.dt};
+        pc[np - 1] = (pd_sine_piece){.t_start = (double)(np - 1) * rec.dt};
+        *npieces = np;
+    }
+    pd_record_free(&rec);
+    return pc;
+}
+
 int pd_test_rinaldi_case(pd_test_ctx *ctx, pd_record *rec, pd_osc *c)
 {
     const char *path = "examples/records/NGA_no_1063_RRS228.AT2";

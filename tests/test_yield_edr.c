@@ -158,21 +158,10 @@ static void test_yield_edr_one_wall(pd_test_ctx *ctx)
  * away (eps 0.6) and none; alpha 0 and 0.1. */
 static void test_yield_edr_record(pd_test_ctx *ctx)
 {
-    pd_record rec;
-    pd_osc c;
-    if (!pd_test_rinaldi_case(ctx, &rec, &c))
+    long np;
+    pd_sine_piece *pc = pd_test_rinaldi_pieces(ctx, &np);
+    if (!pc)
         return;
-    long np = rec.npts;
-    pd_sine_piece *pc = calloc((size_t)np, sizeof *pc);
-    if (!CHECK(ctx, pc != NULL, "out of memory")) {
-        pd_record_free(&rec);
-        return;
-    }
-    for (long k = 0; k + 1 < np; k++) /* F = -a_g, linear between samples */
-        pc[k] = (pd_sine_piece){.t_start = (double)k * rec.dt,
-                                .c0 = -rec.acc[k],
-                                .c1 = -(rec.acc[k + 1] - rec.acc[k]) / rec.dt};
-    pc[np - 1] = (pd_sine_piece){.t_start = (double)(np - 1) * rec.dt};
     double worst = 0.0;
     long onsets = 0;
     for (int k = 0; k < 4; k++) {
@@ -186,11 +175,10 @@ static void test_yield_edr_record(pd_test_ctx *ctx)
                         .alpha = k % 2 ? 0.1 : 0.0};
         char name[64];
         snprintf(name, sizeof name, "record alpha %g wall %d", p.alpha, p.wall);
-        one_case(ctx, &p, (double)np * rec.dt + 2.0, 1.0, &worst, &onsets, name);
+        one_case(ctx, &p, pc[np - 1].t_start + 2.0, 1.0, &worst, &onsets, name);
     }
     printf("    record: %ld onsets, largest distance %.2g\n", onsets, worst);
     free(pc);
-    pd_record_free(&rec);
 }
 
 /* A spring whose uy is never reached (1e6 Le): the elastic run's figures
@@ -248,19 +236,6 @@ static pd_scene *yrow(pd_test_ctx *ctx, int n)
     return sc;
 }
 
-static int yrun(pd_test_ctx *ctx, const pd_scene *sc, pd_method method, double dt,
-                pd_scene_result *r)
-{
-    pd_run_opts o = pd_run_default_opts();
-    o.method = method;
-    o.dt = dt;
-    pd_err e;
-    int rc = pd_scene_result_alloc(sc, r, &e);
-    if (!rc)
-        rc = pd_scene_run(sc, &o, NULL, NULL, r, &e);
-    return CHECK(ctx, rc == PD_OK, "%s dt %g: %s", pd_method_name(method), dt, e.msg);
-}
-
 /* Moreau-Jean against the row reference on rows of 2, 10 and 100: the
  * largest relative distance of the ductilities, and of the residuals over
  * uy, at dt 1e-3, 1.25e-4 and 1.5625e-5 (the row of 100: the first and
@@ -277,7 +252,7 @@ static void test_yield_edr_rows_converge(pd_test_ctx *ctx)
         if (!sc)
             return;
         pd_scene_result ex, r;
-        if (!yrun(ctx, sc, PD_METHOD_EVENT, 0.0, &ex)) {
+        if (!pd_test_scene_run(ctx, sc, PD_METHOD_EVENT, 0.0, &ex)) {
             pd_scene_free(sc);
             return;
         }
@@ -290,7 +265,7 @@ static void test_yield_edr_rows_converge(pd_test_ctx *ctx)
         int step = ns[c] < 100 ? 1 : 2;
         for (int k = 0; k < 3; k += step) {
             double dt = 1e-3 / pow(8.0, k), dmu = 0.0, dres = 0.0;
-            if (!yrun(ctx, sc, PD_METHOD_MOREAU, dt, &r))
+            if (!pd_test_scene_run(ctx, sc, PD_METHOD_MOREAU, dt, &r))
                 break;
             for (int i = 0; i < sc->n; i++) {
                 dmu = fmax(dmu, fabs(r.ductility[i] - ex.ductility[i]) / ex.ductility[i]);

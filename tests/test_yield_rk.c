@@ -374,21 +374,10 @@ static void test_yield_rk_long_pulse(pd_test_ctx *ctx)
  * 4180 linear pieces. */
 static void test_yield_rk_record(pd_test_ctx *ctx)
 {
-    pd_record rec;
-    pd_osc c;
-    if (!pd_test_rinaldi_case(ctx, &rec, &c))
+    long np;
+    pd_sine_piece *pc = pd_test_rinaldi_pieces(ctx, &np);
+    if (!pc)
         return;
-    long np = rec.npts;
-    pd_sine_piece *pc = calloc((size_t)np, sizeof *pc);
-    if (!CHECK(ctx, pc != NULL, "out of memory")) {
-        pd_record_free(&rec);
-        return;
-    }
-    for (long k = 0; k + 1 < np; k++) /* F = -a_g, linear between samples */
-        pc[k] = (pd_sine_piece){.t_start = (double)k * rec.dt,
-                                .c0 = -rec.acc[k],
-                                .c1 = -(rec.acc[k + 1] - rec.acc[k]) / rec.dt};
-    pc[np - 1] = (pd_sine_piece){.t_start = (double)(np - 1) * rec.dt};
     const double eps[] = {0.0, 0.6, 1.0}, alphas[] = {0.0, 0.1, 0.3};
     double worst[3] = {0.0, 0.0, 0.0}, T0 = 0.8;
     for (int a = 0; a < 3; a++)
@@ -404,13 +393,12 @@ static void test_yield_rk_record(pd_test_ctx *ctx)
             char name[64];
             snprintf(name, sizeof name, "record alpha %g %s %g", alphas[a],
                      k < 3 ? "eps" : "no wall", k < 3 ? eps[k] : 0.0);
-            rk_case(ctx, &p, (double)np * rec.dt + 2.0, T0, 0.01, worst, name);
+            rk_case(ctx, &p, pc[np - 1].t_start + 2.0, T0, 0.01, worst, name);
         }
     printf("    record, the largest share of a bound: %.2g against the integration, %.2g the "
            "integration against itself; energy balance %.2g\n",
            worst[0], worst[1], worst[2]);
     free(pc);
-    pd_record_free(&rec);
 }
 
 /* The energy balance of elastic runs (uy 0: the strain w0^2 x^2 / 2) over

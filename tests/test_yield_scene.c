@@ -17,20 +17,6 @@
 
 #define YSCENE "examples/scenes/yielding-buildings.json"
 
-/* Run sc by method (dt 0: the default) into r (allocated here). */
-static int yrun(pd_test_ctx *ctx, const pd_scene *sc, pd_method method, double dt,
-                pd_scene_result *r)
-{
-    pd_run_opts o = pd_run_default_opts();
-    o.method = method;
-    o.dt = dt;
-    pd_err e;
-    int rc = pd_scene_result_alloc(sc, r, &e);
-    if (!rc)
-        rc = pd_scene_run(sc, &o, NULL, NULL, r, &e);
-    return CHECK(ctx, rc == PD_OK, "%s: %s", pd_method_name(method), e.msg);
-}
-
 /* The example: the soft storey (soft, storey 1: uy 3 cm) yields (measured
  * ductility 2.19, three onsets), every other storey stays elastic (below
  * 1); Newmark's ductility within 1 % of Moreau-Jean's and its residual
@@ -44,7 +30,8 @@ static void test_yield_scene_example(pd_test_ctx *ctx)
     if (!CHECK(ctx, pd_scene_load(YSCENE, &sc, &e) == PD_OK, "%s", e.msg))
         return;
     pd_scene_result mj, nm;
-    if (yrun(ctx, sc, PD_METHOD_MOREAU, 0.0, &mj) && yrun(ctx, sc, PD_METHOD_NEWMARK, 0.0, &nm)) {
+    if (pd_test_scene_run(ctx, sc, PD_METHOD_MOREAU, 0.0, &mj) &&
+        pd_test_scene_run(ctx, sc, PD_METHOD_NEWMARK, 0.0, &nm)) {
         const pd_structure *soft = &sc->st[0];
         int d0 = soft->dof;
         double uy = soft->uy[0], k = soft->stiffness[0], a = soft->yield_alpha[0];
@@ -83,7 +70,7 @@ static void test_yield_scene_example(pd_test_ctx *ctx)
     /* under a cosine pulse (full force from the first step: every step's
      * share counts) the balance closes as well */
     sc->exc.pulse = PD_PULSE_COSINE;
-    if (yrun(ctx, sc, PD_METHOD_MOREAU, 0.0, &mj))
+    if (pd_test_scene_run(ctx, sc, PD_METHOD_MOREAU, 0.0, &mj))
         CHECK(ctx, fabs(mj.energy.residual) <= 1e-12 && mj.energy.input > 0.0,
               "cosine pulse: the energy balance's residual %.3g", mj.energy.residual);
     pd_scene_result_free(&mj);
@@ -138,7 +125,8 @@ static void test_yield_scene_unreached_is_elastic(pd_test_ctx *ctx)
     const pd_method methods[] = {PD_METHOD_MOREAU, PD_METHOD_NEWMARK};
     for (int m = 0; m < 2; m++) {
         pd_scene_result a, b;
-        if (yrun(ctx, sc, methods[m], 0.0, &a) && yrun(ctx, el, methods[m], 0.0, &b)) {
+        if (pd_test_scene_run(ctx, sc, methods[m], 0.0, &a) &&
+            pd_test_scene_run(ctx, el, methods[m], 0.0, &b)) {
             size_t n = (size_t)sc->n * sizeof(double);
             CHECK(ctx,
                   !memcmp(a.umax, b.umax, n) && !memcmp(a.drift, b.drift, n) &&
@@ -206,7 +194,7 @@ static void test_yield_scene_row_converges(pd_test_ctx *ctx)
     if (!sc)
         return;
     pd_scene_result fine, r;
-    if (!yrun(ctx, sc, PD_METHOD_MOREAU, 1.5625e-5, &fine)) {
+    if (!pd_test_scene_run(ctx, sc, PD_METHOD_MOREAU, 1.5625e-5, &fine)) {
         pd_scene_free(sc);
         return;
     }
@@ -218,7 +206,7 @@ static void test_yield_scene_row_converges(pd_test_ctx *ctx)
         pd_method method = k < 3 ? PD_METHOD_MOREAU : PD_METHOD_NEWMARK;
         if (k == 3)
             dt = 1.5625e-5;
-        if (!yrun(ctx, sc, method, dt, &r))
+        if (!pd_test_scene_run(ctx, sc, method, dt, &r))
             break;
         row_dist(sc, &fine, &r, &dmu, &dres);
         printf("    %s dt %.3g: ductilities %.2g, residuals %.2g uy from Moreau-Jean at 1.6e-5\n",
@@ -256,10 +244,11 @@ static int gs_note(const pd_state *st, void *ctx)
 }
 
 /* The row of 10 by Moreau-Jean's dense LCP of each piece's contacts and
- * springs (yield_lcp_max 512: pivoting) and by block Gauss-Seidel (the
- * default for springs each alone on a dof): the same solution of each
- * step's LCP to MJY_GS_TOL, so the same run (the peaks and the final state
- * within 1e-9 of the peaks; measured 3e-16). */
+ * springs (yield_lcp_max 512: pivoting), by the sliding set in the
+ * contacts' LCP (0, the default for springs each alone on a dof) and by
+ * block Gauss-Seidel (-1): the same solution of each step's LCP (to
+ * MJY_GS_TOL for Gauss-Seidel), so the same run (the peaks and the final
+ * state within 1e-9 of the peaks; measured 3e-16). */
 static void test_yield_scene_gauss_seidel(pd_test_ctx *ctx)
 {
     pd_scene *sc = row10(ctx);
@@ -269,12 +258,13 @@ static void test_yield_scene_gauss_seidel(pd_test_ctx *ctx)
         pd_scene_free(sc);
         return;
     }
-    gs_track g[2];
+    gs_track g[3];
     memset(g, 0, sizeof g);
-    for (int k = 0; k < 2; k++) {
+    const int lcp_max[3] = {512, 0, -1};
+    for (int k = 0; k < 3; k++) {
         pd_mj_opts mo = pd_mj_default_opts();
         mo.h = 2.5e-4 * PD_TWO_PI / sc->exc.Tp; /* dt 2.5e-4 s in the model's time */
-        mo.yield_lcp_max = k ? 0 : 512;
+        mo.yield_lcp_max = lcp_max[k];
         pd_mj *mj = pd_mj_alloc(&sm.model, &mo, &e);
         if (!CHECK(ctx, mj != NULL, "%s", e.msg))
             break;
@@ -282,13 +272,23 @@ static void test_yield_scene_gauss_seidel(pd_test_ctx *ctx)
         pd_mj_free(mj);
         CHECK(ctx, rc == PD_OK, "yield_lcp_max %d: %s", mo.yield_lcp_max, e.msg);
     }
-    double d = fmax(fabs(g[0].qmax - g[1].qmax), fabs(g[0].upmax - g[1].upmax));
-    for (int i = 0; i < 10; i++)
-        d = fmax(d, fmax(fabs(g[0].q[i] - g[1].q[i]), fabs(g[0].up[i] - g[1].up[i])));
-    d /= g[0].qmax;
-    printf("    dense against Gauss-Seidel: %.2g of the peak over %ld steps (offsets up to %.3g)\n",
-           d, g[0].steps, g[0].upmax);
-    CHECK(ctx, d <= 1e-9 && g[0].upmax > 0.0 && g[1].steps == g[0].steps, "%.3g apart", d);
+    for (int k = 1; k < 3; k++) {
+        double d = fmax(fabs(g[0].qmax - g[k].qmax), fabs(g[0].upmax - g[k].upmax));
+        for (int i = 0; i < 10; i++)
+            d = fmax(d, fmax(fabs(g[0].q[i] - g[k].q[i]), fabs(g[0].up[i] - g[k].up[i])));
+        d /= g[0].qmax;
+        printf("    dense against %s: %.2g of the peak over %ld steps (offsets up to %.3g)\n",
+               k == 1 ? "the sliding set" : "Gauss-Seidel", d, g[0].steps, g[0].upmax);
+        CHECK(ctx, d <= 1e-9 && g[0].upmax > 0.0 && g[k].steps == g[0].steps, "%d: %.3g apart",
+              lcp_max[k], d);
+    }
+    pd_mj_opts mo = pd_mj_default_opts();
+    mo.h = 1e-3;
+    mo.yield_lcp_max = -2;
+    pd_mj *bad = pd_mj_alloc(&sm.model, &mo, &e);
+    CHECK(ctx, !bad && e.status == PD_EINVAL && strstr(e.msg, "yield_lcp_max"),
+          "yield_lcp_max -2: %s", bad ? "accepted" : e.msg);
+    pd_mj_free(bad);
     pd_scene_model_free(&sm);
     pd_scene_free(sc);
 }
@@ -334,8 +334,9 @@ static void test_yield_scene_soft_storey_record(pd_test_ctx *ctx)
         return;
     }
     pd_scene_result a = {0}, b = {0}, c = {0};
-    if (yrun(ctx, sc, PD_METHOD_MOREAU, 1e-3, &a) && yrun(ctx, sc, PD_METHOD_MOREAU, 2.5e-4, &b) &&
-        yrun(ctx, sc, PD_METHOD_NEWMARK, 2.5e-4, &c)) {
+    if (pd_test_scene_run(ctx, sc, PD_METHOD_MOREAU, 1e-3, &a) &&
+        pd_test_scene_run(ctx, sc, PD_METHOD_MOREAU, 2.5e-4, &b) &&
+        pd_test_scene_run(ctx, sc, PD_METHOD_NEWMARK, 2.5e-4, &c)) {
         double uy = sc->st[0].uy[0];
         printf("    soft storey under Rinaldi: ductility %.5g (dt 1e-3: %.5g, newmark %.5g), "
                "residual %.4g m (%.4g, %.4g), %ld onsets\n",
