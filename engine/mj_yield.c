@@ -72,19 +72,20 @@ struct mj_yield {
     long rounds;          /* the LCPs solved with springs (statistics) */
     /* slide_set: the constants of h theta (hth_set), per spring alone on its
      * dof: What_ii and its slide's L; per step: the contacts' D_II as the
-     * factor gives it, W_I P on the dofs, each dof's first entry in the
-     * list of (active contact, W entry) on sliding dofs */
+     * factor gives it, W_I P on the sliding dofs, the active rows */
     double hth_set;
     double *what, *Ls; /* ns */
     double *inc, *dcs; /* ns: h theta ks s / What_ii, the compliance a slide adds */
+    double *bfree;     /* ns: a sliding spring's b from vfree (this try's) */
     double *Dsave;     /* the Delassus block's capacity */
     long Dcap;
-    double *wp;         /* n: (W_I P)_i */
-    int *head, *enext;  /* n, 2 m: the entries on each sliding dof */
-    int *er;            /* 2 m: an entry's active row */
-    double *ew;         /* 2 m: its W value */
-    int *snext;         /* n: the spring on a dof (-1: none), sliding-set iteration */
-    int *cmark, cstamp; /* n: a dof an active contact touches in this step (== cstamp) */
+    double *wp;       /* n: (W_I P)_i */
+    int *dptr, *dcon; /* n + 1, nnz(W): the contacts on each dof (W^T by rows) */
+    double *dw;       /* nnz(W): their W entries */
+    int *pos;         /* m: a contact's row in this step's active set (valid where
+                             idx_active[pos[a]] == a, pos[a] < nI) */
+    int nI;           /* this step's active contacts */
+    int *snext;       /* n: the spring on a dof (-1: none) */
 };
 
 void mj_yield_free(pd_mj *mj)
@@ -95,7 +96,7 @@ void mj_yield_free(pd_mj *mj)
     void *arrays[] = {y->sdof, y->sfac,  y->up, y->vfree, y->vel,   y->col,   y->ys,    y->sigma,
                       y->G,    y->block, y->dM, y->dC,    y->dK,    y->alone, y->uf,    y->mark,
                       y->cidx, y->P0,    y->dP, y->yc,    y->what,  y->Ls,    y->Dsave, y->wp,
-                      y->head, y->enext, y->er, y->ew,    y->snext, y->cmark, y->inc,   y->dcs};
+                      y->dptr, y->dcon,  y->dw, y->pos,   y->snext, y->inc,   y->dcs,   y->bfree};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(arrays[k]);
     free(y->L);
@@ -159,6 +160,32 @@ static int spring_dof(const pd_model *md, int j, double *s)
     return dof;
 }
 
+/* W^T by rows: the contacts on each dof and their W entries (dptr, dcon,
+ * dw), in contact order; 0, or -1 out of memory. */
+static int dof_contacts(mj_yield *y, const pd_model *md)
+{
+    int p, i;
+    double w;
+    for (int a = 0; a < md->m; a++) /* counts, then their starts */
+        for (p = -1; mj_col_next(&md->W, a, &p, &i, &w);)
+            y->dptr[i + 1]++;
+    for (i = 0; i < md->n; i++)
+        y->dptr[i + 1] += y->dptr[i];
+    int *fill = pd_calloc(md->n, sizeof(int));
+    y->dcon = pd_calloc(y->dptr[md->n], sizeof(int));
+    y->dw = pd_calloc(y->dptr[md->n], sizeof(double));
+    if (fill && y->dcon && y->dw)
+        for (int a = 0; a < md->m; a++)
+            for (p = -1; mj_col_next(&md->W, a, &p, &i, &w);) {
+                int q = y->dptr[i] + fill[i]++;
+                y->dcon[q] = a;
+                y->dw[q] = w;
+            }
+    int rc = fill && y->dcon && y->dw ? 0 : -1;
+    free(fill);
+    return rc;
+}
+
 int mj_yield_alloc(pd_mj *mj, pd_err *err)
 {
     const pd_model *md = mj->model;
@@ -198,23 +225,23 @@ int mj_yield_alloc(pd_mj *mj, pd_err *err)
     y->Ls = pd_calloc(ns, sizeof(double));
     y->inc = pd_calloc(ns, sizeof(double));
     y->dcs = pd_calloc(ns, sizeof(double));
+    y->bfree = pd_calloc(ns, sizeof(double));
     y->Dcap = mj->factor && m > 0 ? (mj->sparse ? mj->factor->delassus_nnz : (long)m * m) : 0;
     y->Dsave = pd_calloc(y->Dcap, sizeof(double));
     y->wp = pd_calloc(n, sizeof(double));
-    y->head = pd_calloc(n, sizeof(int));
     y->snext = pd_calloc(n, sizeof(int));
-    y->cmark = pd_calloc(n, sizeof(int));
-    y->enext = pd_calloc(2L * m, sizeof(int));
-    y->er = pd_calloc(2L * m, sizeof(int));
-    y->ew = pd_calloc(2L * m, sizeof(double));
+    y->pos = pd_calloc(m, sizeof(int));
+    y->dptr = pd_calloc(n + 1L, sizeof(int));
     y->hth_set = NAN;
     if (!y->up || !y->vfree || !y->vel || !y->col || !y->ys || !y->sigma || !y->G || !y->block ||
         !y->dM || !y->dC || !y->dK || !y->alone || !y->uf || !y->mark || !y->cidx || !y->P0 ||
         !y->sdof || !y->sfac || !y->dP || !y->yc || !y->L || !y->b || !y->z || !y->w || !y->lemke ||
-        !y->what || !y->Ls || !y->Dsave || !y->wp || !y->head || !y->snext || !y->enext || !y->er ||
-        !y->ew || !y->cmark || !y->inc || !y->dcs)
+        !y->what || !y->Ls || !y->Dsave || !y->wp || !y->snext || !y->pos || !y->dptr || !y->inc ||
+        !y->dcs || !y->bfree)
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for %d yielding springs", ns);
     blocks(y, md);
+    if (dof_contacts(y, md))
+        return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for %d yielding springs", ns);
     y->all_alone = y->one_per_dof = 1;
     for (int i = 0; i < n; i++)
         y->snext[i] = -1;
@@ -538,46 +565,31 @@ static double slide_b(const pd_model *md, const mj_yield *y, int j, double hth, 
     return md->ks[j] * (md->uy[j] - y->sigma[j] * z);
 }
 
-/* The step's lists: the entries (active row, W value) of the active
- * contacts on each dof they touch, from head[i] (valid where cmark[i] ==
- * cstamp).  0, or 1 when they overflow (Gauss-Seidel then). */
-static int set_entries(pd_mj *mj, int nI)
+/* This step's active rows of the contacts (pos). */
+static void set_positions(pd_mj *mj, int nI)
 {
-    const pd_model *md = mj->model;
     mj_yield *y = mj->yl;
-    int ne = 0;
-    y->cstamp++;
-    for (int r = 0; r < nI; r++) {
-        int p = -1, i;
-        double w;
-        while (mj_col_next(&md->W, mj->idx_active[r], &p, &i, &w)) {
-            if (y->cmark[i] != y->cstamp) {
-                y->cmark[i] = y->cstamp;
-                y->head[i] = -1;
-            }
-            if (ne == 2 * md->m)
-                return 1;
-            y->er[ne] = r;
-            y->ew[ne] = w;
-            y->enext[ne] = y->head[i];
-            y->head[i] = ne++;
-        }
-    }
-    return 0;
+    y->nI = nI;
+    for (int r = 0; r < nI; r++)
+        y->pos[mj->idx_active[r]] = r;
 }
 
-/* Whether an active contact touches dof i, and whether one pushes there. */
-static int touched(const mj_yield *y, int i)
+/* Contact a's active row this step, or -1. */
+static int active_row(const pd_mj *mj, int a)
 {
-    return y->cmark[i] == y->cstamp;
+    int r = mj->yl->pos[a];
+    return r >= 0 && r < mj->yl->nI && mj->idx_active[r] == a ? r : -1;
 }
 
+/* Whether an active contact pushes on dof i. */
 static int pushed(const pd_mj *mj, int i)
 {
     const mj_yield *y = mj->yl;
-    for (int e = touched(y, i) ? y->head[i] : -1; e >= 0; e = y->enext[e])
-        if (mj->P_active[y->er[e]] > 0.0)
+    for (int q = y->dptr[i]; q < y->dptr[i + 1]; q++) {
+        int r = active_row(mj, y->dcon[q]);
+        if (r >= 0 && mj->P_active[r] > 0.0)
             return 1;
+    }
     return 0;
 }
 
@@ -586,9 +598,9 @@ static int contacts_hold(const pd_mj *mj, int i, const double *v)
 {
     const pd_model *md = mj->model;
     const mj_yield *y = mj->yl;
-    for (int e = touched(y, i) ? y->head[i] : -1; e >= 0; e = y->enext[e]) {
-        int a = mj->idx_active[y->er[e]];
-        if (pd_matrix_col_dot(&md->W, a, v) + md->e[a] * mj->U0[a] < 0.0)
+    for (int q = y->dptr[i]; q < y->dptr[i + 1]; q++) {
+        int a = y->dcon[q];
+        if (active_row(mj, a) >= 0 && pd_matrix_col_dot(&md->W, a, v) + md->e[a] * mj->U0[a] < 0.0)
             return 0;
     }
     return 1;
@@ -605,12 +617,12 @@ static int set_delassus(pd_mj *mj, int nI, int ny, int restore)
         memcpy(mj->D_active, y->Dsave, (size_t)nnz * sizeof(double));
     for (int k = 0; k < ny; k++) {
         int j = y->ys[k], i = y->sdof[j];
-        if (!touched(y, i))
-            continue;
-        double dc = y->dcs[j];
-        for (int e1 = y->head[i]; e1 >= 0; e1 = y->enext[e1])
-            for (int e2 = y->head[i]; e2 >= 0; e2 = y->enext[e2]) {
-                int col = y->er[e1], row = y->er[e2], at = -1;
+        for (int q1 = y->dptr[i]; q1 < y->dptr[i + 1]; q1++) {
+            int col = active_row(mj, y->dcon[q1]);
+            for (int q2 = y->dptr[i]; col >= 0 && q2 < y->dptr[i + 1]; q2++) {
+                int row = active_row(mj, y->dcon[q2]), at = -1;
+                if (row < 0)
+                    continue;
                 if (!mj->sparse)
                     at = row + col * nI;
                 else
@@ -618,8 +630,9 @@ static int set_delassus(pd_mj *mj, int nI, int ny, int restore)
                         at = mj->D_rowind[q] == row ? q : -1;
                 if (at < 0)
                     return 1;
-                mj->D_active[at] += y->ew[e1] * y->ew[e2] * dc;
+                mj->D_active[at] += y->dw[q1] * y->dw[q2] * y->dcs[j];
             }
+        }
     }
     return 0;
 }
@@ -641,8 +654,8 @@ static int set_contacts(pd_mj *mj, const pd_factor *f, int nI, int ny, double ht
         memcpy(out->v, y->vfree, (size_t)md->n * sizeof(double));
     for (int k = 0; k < ny; k++) { /* the slides' constant parts */
         int j = y->ys[k], i = y->sdof[j];
-        out->v[i] -=
-            y->sigma[j] * y->inc[j] * slide_b(md, y, j, hth, out->q, y->vfree[i]) / y->Ls[j];
+        y->bfree[j] = slide_b(md, y, j, hth, out->q, y->vfree[i]);
+        out->v[i] -= y->sigma[j] * y->inc[j] * y->bfree[j] / y->Ls[j];
         y->wp[i] = 0.0;
     }
     if (nI == 0)
@@ -675,8 +688,10 @@ static int set_contacts(pd_mj *mj, const pd_factor *f, int nI, int ny, double ht
     for (int k = 0; k < ny; k++) { /* the sliding dofs' extra compliance */
         int j = y->ys[k], i = y->sdof[j];
         double s = 0.0;
-        for (int e = touched(y, i) ? y->head[i] : -1; e >= 0; e = y->enext[e])
-            s += y->ew[e] * mj->P_active[y->er[e]];
+        for (int q = y->dptr[i]; q < y->dptr[i + 1]; q++) {
+            int r = active_row(mj, y->dcon[q]);
+            s += r >= 0 ? y->dw[q] * mj->P_active[r] : 0.0;
+        }
         y->wp[i] = s;
         out->v[i] += y->dcs[j] * s;
     }
@@ -715,16 +730,14 @@ static int slide_set(pd_mj *mj, const pd_factor *f, int nI, int *ny, double hth,
     mj_yield *y = mj->yl;
     int built = 0, rc;
     set_constants(y, md, hth);
-    if (set_entries(mj, nI))
-        return 1;
+    set_positions(mj, nI);
     for (int it = 0; it < MJY_SET_MAX; it++) {
         if ((rc = set_contacts(mj, f, nI, *ny, hth, t1, &built, out, err)))
             return rc;
         int kept = 0, again = 0;
         for (int k = 0; k < *ny; k++) {
             int j = y->ys[k], i = y->sdof[j];
-            double b =
-                slide_b(md, y, j, hth, out->q, y->vfree[i]) - y->sigma[j] * y->inc[j] * y->wp[i];
+            double b = y->bfree[j] - y->sigma[j] * y->inc[j] * y->wp[i];
             y->G[j] = -b / y->Ls[j];
             if (y->G[j] >= 0.0) {
                 y->ys[kept++] = j;

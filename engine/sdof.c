@@ -220,10 +220,10 @@ static void mass_kernels(double c, double s, double phi[3])
     double z = c * s;
     if (z < 0.5) {
         for (int k = 1; k <= 3; k++) {
-            double term = 1.0, sum = 0.0, fact = 1.0;
+            double sum = 0.0, fact = 1.0;
             for (int i = 2; i <= k; i++)
                 fact *= i;
-            term = 1.0 / fact; /* j = 0: 1 / k! */
+            double term = 1.0 / fact; /* j = 0: 1 / k! */
             for (int j = 0; j < 24; j++) {
                 sum += term;
                 term *= -z / (double)(j + k + 1);

@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "event_row.h"
 #include "pd_core.h"
 #include "pd_engine.h"
 #include "pd_problems.h"
@@ -364,6 +365,176 @@ static void test_yield_edr_sampled_offsets(pd_test_ctx *ctx)
     }
 }
 
+/* The flights' jerk (the unloading scan's f''): at every sample of a
+ * yielding run, elastic and sliding (alpha 0.1, and 0: the damped free
+ * mass), the jerk of the dof's flight against the central difference of
+ * its acceleration (step 1e-5: the difference's error ~ 1e-10 of the
+ * jerk's scale; bound 1e-7). */
+typedef struct jerk_track {
+    pd_edr *r;
+    double worst, scale;
+    long checked;
+} jerk_track;
+
+static int jerk_note(const pd_state *st, void *ctx)
+{
+    jerk_track *j = ctx;
+    pd_edr *r = j->r;
+    int c = r->rs.blk_cl[r->tp.dof_blk[0]];
+    if (r->rs.cl[c].kind != EDR_SDOF)
+        return 0;
+    double d = 1e-5, dx, v, ap, am;
+    edr_dof_at(r, c, 0, st->t + d, &dx, &v, &ap);
+    edr_dof_at(r, c, 0, st->t - d, &dx, &v, &am);
+    double jk = edr_dof_jerk(r, c, 0, st->t), fd = (ap - am) / (2.0 * d);
+    j->scale = fmax(j->scale, fabs(fd));
+    j->worst = fmax(j->worst, fabs(jk - fd));
+    j->checked++;
+    return 0;
+}
+
+static void test_yield_edr_jerk(pd_test_ctx *ctx)
+{
+    for (int k = 0; k < 2; k++) {
+        pd_sine_piece pc[2] = {{.t_start = 0.0, .A = -1.0, .w = 1.0}, {.t_start = 2.0 * PD_PI}};
+        pd_ed_sdof p = {.osc = {.w0 = 1.0 / 0.7, .xi = 0.05},
+                        .npieces = 2,
+                        .pieces = pc,
+                        .uy = 0.05,
+                        .alpha = k ? 0.0 : 0.1};
+        one_dof o;
+        pd_model md = one_dof_model(&o, &p, 1.0);
+        pd_piecewise_force F = {.b = &o.b, .pieces = pc, .npieces = 2};
+        pd_edr_opts eo = pd_edr_default_opts();
+        eo.h_out = 0.01;
+        pd_err err;
+        jerk_track j = {.r = pd_edr_alloc(&md, &F, &eo, &err)};
+        if (!CHECK(ctx, j.r != NULL, "%s", err.msg))
+            return;
+        int rc = pd_edr_run(j.r, 0.0, NULL, NULL, 20.0, jerk_note, &j, &err);
+        printf("    alpha %g: the jerk against its difference within %.2g of its scale over %ld "
+               "samples\n",
+               p.alpha, j.worst / j.scale, j.checked);
+        CHECK(ctx, rc == PD_OK && j.checked > 1000 && j.worst <= 1e-7 * j.scale,
+              "alpha %g: %s; jerk off by %.3g of %.3g", p.alpha, rc ? err.msg : "ok", j.worst,
+              j.scale);
+        pd_edr_free(j.r);
+    }
+}
+
+/* The damped free mass's flight (pd_sdof_flow_init_mass: an elastic-
+ * perfectly-plastic slide, x'' + c x' = F) against RK4 (step 1e-3, its
+ * error ~1e-13 here) over 12 s, both branches of its kernels (c s below and
+ * above 1/2), under a sine with a ramp, a ramp alone and a constant: x and
+ * v within 1e-10 of their scale. */
+static void mass_rhs(const pd_sine_piece *pc, double c, double t, const double y[2], double d[2])
+{
+    d[0] = y[1];
+    d[1] = pd_sine_piece_force(pc, t) - c * y[1];
+}
+
+static void test_yield_edr_mass_flow(pd_test_ctx *ctx)
+{
+    const pd_sine_piece pcs[3] = {
+        {.t_start = 0.5, .A = -1.0, .w = 1.3, .phi = 0.3, .c0 = 0.2, .c1 = 0.05},
+        {.t_start = 0.5, .c0 = 1.0, .c1 = -0.3},
+        {.t_start = 0.5, .A = 2.0, .w = 0.0, .phi = 0.4}};
+    const double cs[3] = {0.1, 1.0, 5.0};
+    double worst = 0.0;
+    for (int k = 0; k < 3; k++)
+        for (int m = 0; m < 3; m++) {
+            pd_sdof_flow f;
+            double t0 = 0.7, x0 = 0.3, v0 = -0.4, y[2] = {x0, v0}, h = 1e-3, scale = 1.0;
+            pd_sdof_flow_init_mass(&f, cs[m], &pcs[k], t0, x0, v0);
+            for (int step = 1; step <= 12000; step++) { /* RK4, checked every 0.25 s */
+                double t = t0 + (step - 1) * h, k1[2], k2[2], k3[2], k4[2], yt[2];
+                mass_rhs(&pcs[k], cs[m], t, y, k1);
+                for (int q = 0; q < 2; q++)
+                    yt[q] = y[q] + 0.5 * h * k1[q];
+                mass_rhs(&pcs[k], cs[m], t + 0.5 * h, yt, k2);
+                for (int q = 0; q < 2; q++)
+                    yt[q] = y[q] + 0.5 * h * k2[q];
+                mass_rhs(&pcs[k], cs[m], t + 0.5 * h, yt, k3);
+                for (int q = 0; q < 2; q++)
+                    yt[q] = y[q] + h * k3[q];
+                mass_rhs(&pcs[k], cs[m], t + h, yt, k4);
+                for (int q = 0; q < 2; q++)
+                    y[q] += h / 6.0 * (k1[q] + 2.0 * k2[q] + 2.0 * k3[q] + k4[q]);
+                if (step % 250)
+                    continue;
+                double dx, v;
+                pd_sdof_flow_at(&f, t0 + step * h, &dx, &v);
+                scale = fmax(scale, fmax(fabs(y[0]), fabs(y[1])));
+                worst = fmax(worst, fmax(fabs(x0 + dx - y[0]), fabs(v - y[1])) / scale);
+            }
+        }
+    printf("    the damped free mass's flight against RK4: %.2g of the motion's scale\n", worst);
+    CHECK(ctx, worst <= 1e-10, "%.3g off", worst);
+}
+
+/* A yielded oscillator held on the wall by a sustained push: F = 0.08 w0^2
+ * for 30 s, then none (w0 1, xi 0.05, the wall at 0.1, uy 0.05, alpha
+ * 0.1, eps 0.5).  It yields on its way, comes to rest on the wall, where
+ * the push (0.08) beats the spring (alpha x + (1 - alpha) z = 0.055) but
+ * not k x (0.1): the held force must take the offset's.  Both exact
+ * references agree (umax, offset, onsets, the time on the wall to 1e-9). */
+static void test_yield_edr_held_at_wall(pd_test_ctx *ctx)
+{
+    pd_sine_piece pc[2] = {{.t_start = 0.0, .c0 = 0.08}, {.t_start = 30.0}};
+    pd_ed_sdof p = {.osc = {.w0 = 1.0, .xi = 0.05},
+                    .wall = 1,
+                    .delta = 0.1,
+                    .e = 0.5,
+                    .npieces = 2,
+                    .pieces = pc,
+                    .uy = 0.05,
+                    .alpha = 0.1};
+    double worst = 0.0;
+    long onsets = 0;
+    one_case(ctx, &p, 40.0, 1.0, &worst, &onsets, "held at the wall");
+    pd_ed_opts eo = pd_ed_default_opts();
+    eo.t_end = 40.0;
+    pd_ed_result er;
+    one_dof o;
+    pd_model md = one_dof_model(&o, &p, 1.0);
+    pd_piecewise_force F = {.b = &o.b, .pieces = pc, .npieces = 2};
+    pd_err err;
+    pd_edr *r = pd_edr_alloc(&md, &F, NULL, &err);
+    if (!CHECK(ctx,
+               r && pd_ed_sdof_run(&p, 0.0, 0.0, &eo, NULL, NULL, &er, &err) == PD_OK &&
+                   pd_edr_run(r, 0.0, NULL, NULL, 40.0, NULL, NULL, &err) == PD_OK,
+               "%s", err.msg)) {
+        pd_edr_free(r);
+        return;
+    }
+    double held = pd_edr_result_of(r)->contact_time[0];
+    printf("    held at the wall: %.6g s (one-wall reference %.6g s), %ld onsets, distance %.2g\n",
+           held, er.contact_time, onsets, worst);
+    CHECK(ctx, fabs(held - er.contact_time) <= 1e-9 * 40.0 && er.contact_time > 10.0,
+          "time on the wall %.17g vs %.17g", held, er.contact_time);
+    pd_edr_free(r);
+}
+
+/* An overdamped yielding oscillator (xi 1.5): its flights are modal, which
+ * carry no offset's force: refused at its first onset (t > 0), named. */
+static void test_yield_edr_overdamped(pd_test_ctx *ctx)
+{
+    pd_sine_piece pc[2] = {{.t_start = 0.0, .A = -1.0, .w = 1.0}, {.t_start = 2.0 * PD_PI}};
+    pd_ed_sdof p = {
+        .osc = {.w0 = 1.0, .xi = 1.5}, .npieces = 2, .pieces = pc, .uy = 0.05, .alpha = 0.1};
+    one_dof o;
+    pd_model md = one_dof_model(&o, &p, 1.0);
+    pd_piecewise_force F = {.b = &o.b, .pieces = pc, .npieces = 2};
+    pd_err err;
+    pd_edr *r = pd_edr_alloc(&md, &F, NULL, &err);
+    if (!CHECK(ctx, r != NULL, "%s", err.msg))
+        return;
+    int rc = pd_edr_run(r, 0.0, NULL, NULL, 20.0, NULL, NULL, &err);
+    CHECK(ctx, rc == PD_EINVAL && strstr(err.msg, "overdamped") && !strstr(err.msg, "t = 0 s"),
+          "%s", rc ? err.msg : "ran");
+    pd_edr_free(r);
+}
+
 /* Refused and named: a yielding building (a spring on a storey drift), two
  * springs on one dof. */
 static void test_yield_edr_refuses(pd_test_ctx *ctx)
@@ -398,13 +569,15 @@ static void test_yield_edr_refuses(pd_test_ctx *ctx)
     CHECK(ctx, !r && err.status == PD_EINVAL && strstr(err.msg, "two yielding springs"),
           "two springs: %s", r ? "accepted" : err.msg);
     pd_edr_free(r);
-    /* a spring stiffer than its dof */
-    double S3[2] = {1, 0}, ks3 = 150;
+    /* a spring stiffer than its dof (its drift 2 x: sig^2 ks = 160 > k = 100) */
+    double S3[2] = {2, 0}, ks3 = 40;
     md.ns = 1;
     md.S = pd_matrix_dense(2, 1, S3);
     md.ks = &ks3;
     r = pd_edr_alloc(&md, &F, NULL, &err);
-    CHECK(ctx, !r && err.status == PD_EINVAL && strstr(err.msg, "negative post-yield"),
+    CHECK(ctx,
+          !r && err.status == PD_EINVAL && strstr(err.msg, "negative post-yield") &&
+              strstr(err.msg, "160"),
           "ks > k: %s", r ? "accepted" : err.msg);
     pd_edr_free(r);
 }
@@ -416,5 +589,9 @@ void suite_yield_edr(pd_test_ctx *ctx)
     PD_RUN(ctx, test_yield_edr_unreached);
     PD_RUN(ctx, test_yield_edr_rows_converge);
     PD_RUN(ctx, test_yield_edr_sampled_offsets);
+    PD_RUN(ctx, test_yield_edr_jerk);
+    PD_RUN(ctx, test_yield_edr_held_at_wall);
+    PD_RUN(ctx, test_yield_edr_mass_flow);
+    PD_RUN(ctx, test_yield_edr_overdamped);
     PD_RUN(ctx, test_yield_edr_refuses);
 }
