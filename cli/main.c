@@ -31,7 +31,8 @@ static const char usage[] =
     "\n"
     "  --version  pound's version and the libraries it was built with\n"
     "\n"
-    "`pound <command> --help` lists a command's options; man pound and docs/ have the details.\n";
+    "`pound <command> --help` lists a command's options (a value after the flag, or\n"
+    "--flag=value); man pound and docs/ have the details.\n";
 
 /* The commands and their entry points. */
 static const struct {
@@ -133,6 +134,32 @@ static int finish_stdout(int status)
     return status ? status : 1;
 }
 
+/* Every "--flag=value" token as "--flag" "value" (getopt_long's form, which
+ * the commands read as two tokens): the '=' ends the flag in place and the
+ * value follows it in a new argument vector (*out, to free; NULL when none
+ * needed splitting or out of memory: argv as given). */
+static char **split_equals(int argc, char **argv, int *out_argc)
+{
+    int extra = 0;
+    for (int i = 1; i < argc; i++) /* a flag's name before the '=' */
+        extra += !strncmp(argv[i], "--", 2) && strchr(argv[i] + 2, '=') > argv[i] + 2;
+    char **av = extra ? malloc(((size_t)argc + (size_t)extra + 1) * sizeof *av) : NULL;
+    if (!av)
+        return NULL;
+    int n = 0;
+    for (int i = 0; i < argc; i++) {
+        char *eq = i > 0 && !strncmp(argv[i], "--", 2) ? strchr(argv[i] + 2, '=') : NULL;
+        av[n++] = argv[i];
+        if (eq && eq > argv[i] + 2) {
+            *eq = '\0';
+            av[n++] = eq + 1;
+        }
+    }
+    av[n] = NULL;
+    *out_argc = n;
+    return av;
+}
+
 int main(int argc, char **argv)
 {
     /* CHOLMOD's BLAS on the calling thread (unless the user says): its
@@ -141,5 +168,9 @@ int main(int argc, char **argv)
      * forever while exit waits for them */
     setenv("OPENBLAS_NUM_THREADS", "1", 0);
     pd_output_signals();
-    return finish_stdout(dispatch(argc, argv));
+    int n = argc;
+    char **av = split_equals(argc, argv, &n);
+    int status = finish_stdout(dispatch(av ? n : argc, av ? av : argv));
+    free(av);
+    return status;
 }

@@ -849,6 +849,7 @@ int pd_mj_get_stats(const pd_mj *mj, pd_mj_stats *s)
                        .budget_hit = 0,
                        .err_max = NAN,
                        .h0 = mj->opts.h};
+    mj_yield_stats(mj, &s->yield_set_tries, &s->yield_gs_steps);
     return PD_OK;
 }
 

@@ -141,6 +141,9 @@ int mj_contacts_apply(pd_mj *mj, const pd_factor *f, int nI, int reuse_D, double
 int mj_yield_alloc(pd_mj *mj, pd_err *err);
 void mj_yield_free(pd_mj *mj);
 void mj_yield_reset(pd_mj *mj);
+/* Since the reset: the sliding set's LCP tries, the steps Gauss-Seidel took
+ * (both 0 without yielding springs). */
+void mj_yield_stats(const pd_mj *mj, long *set_tries, long *gs_steps);
 void mj_yield_force(const pd_mj *mj, double s, double *x);
 int mj_yield_step(pd_mj *mj, const pd_factor *f, double h, int nI, double t1, pd_state *out,
                   pd_err *err);

@@ -70,6 +70,8 @@ struct mj_yield {
     int *sdof;            /* ns: a spring's only dof (-1: its drift takes several) */
     double *sfac;         /* ns: its drift's multiple of that dof */
     long rounds;          /* the LCPs solved with springs (statistics) */
+    long set_tries;       /* the sliding set's LCP tries (statistics) */
+    long gs_steps;        /* steps block Gauss-Seidel took (statistics) */
     /* slide_set: the constants of h theta (hth_set), per spring alone on its
      * dof: What_ii and its slide's L; per step: the contacts' D_II as the
      * factor gives it, W_I P on the sliding dofs, the active rows */
@@ -264,6 +266,13 @@ void mj_yield_reset(pd_mj *mj)
     memset(mj->yl->up, 0, (size_t)mj->yl->ns * sizeof(double));
     memset(mj->yl->sigma, 0, (size_t)mj->yl->ns);
     mj->yl->ny_prev = 0;
+    mj->yl->set_tries = mj->yl->gs_steps = 0;
+}
+
+void mj_yield_stats(const pd_mj *mj, long *set_tries, long *gs_steps)
+{
+    *set_tries = mj->yl ? mj->yl->set_tries : 0;
+    *gs_steps = mj->yl ? mj->yl->gs_steps : 0;
 }
 
 /* x += s S diag(ks) up (skipped for a zero offset: an elastic step's bits). */
@@ -732,6 +741,7 @@ static int slide_set(pd_mj *mj, const pd_factor *f, int nI, int *ny, double hth,
     set_constants(y, md, hth);
     set_positions(mj, nI);
     for (int it = 0; it < MJY_SET_MAX; it++) {
+        y->set_tries++;
         if ((rc = set_contacts(mj, f, nI, *ny, hth, t1, &built, out, err)))
             return rc;
         int kept = 0, again = 0;
@@ -743,8 +753,7 @@ static int slide_set(pd_mj *mj, const pd_factor *f, int nI, int *ny, double hth,
                 y->ys[kept++] = j;
                 continue;
             }
-            y->G[j] = 0.0; /* it does not slide: out of Y */
-            y->sigma[j] = 0;
+            y->sigma[j] = 0; /* it does not slide: out of Y (G read for Y only) */
             if (pushed(mj, i))
                 again = 1;
             else
@@ -793,6 +802,7 @@ int mj_yield_step(pd_mj *mj, const pd_factor *f, double h, int nI, double t1, pd
                  ? slide_set(mj, f, nI, &ny, hth, t1, out, err)
                  : 1;
         if (rc > 0) { /* not settled: Gauss-Seidel from vfree and the slides found */
+            y->gs_steps++;
             memcpy(out->v, y->vfree, (size_t)md->n * sizeof(double));
             rc = slide_gs(mj, f, nI, &ny, hth, t1, out, err);
         }

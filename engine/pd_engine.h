@@ -231,6 +231,10 @@ typedef struct pd_mj_stats {
     double err_max;      /* the largest estimate over the dofs, relative to their
                             amplitude, at the end */
     double h0;           /* the coarsest step (h, lowered to the breakpoint) */
+    /* yielding springs on rows of SDOFs (0 otherwise): the contacts' LCPs the
+     * sliding set tried (about 1.3 a step), and the steps block Gauss-Seidel
+     * took (yield_lcp_max -1, or a sliding set that did not settle) */
+    long yield_set_tries, yield_gs_steps;
 } pd_mj_stats;
 PD_API int pd_mj_get_stats(const pd_mj *mj, pd_mj_stats *s);
 

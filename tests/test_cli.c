@@ -245,6 +245,39 @@ done:
     rmdir(dir);
 }
 
+/* --flag=value is --flag value (getopt_long's form): the same JSON, for a
+ * model flag, a list and a scene's path; an empty value is named; a token
+ * that is a value (after a flag) is left whole. */
+static void test_cli_flag_equals_value(pd_test_ctx *ctx)
+{
+    if (!pd_test_have_pound(ctx))
+        return;
+    const char *eq[] = {"simulate", "--gap=0.004", "--Tp=0.3", "--method=event", "--json", NULL};
+    const char *sp[] = {"simulate", "--gap", "0.004",  "--Tp", "0.3",
+                        "--method", "event", "--json", NULL};
+    const char *scene_eq[] = {"simulate", "--scene=examples/scenes/two-sdof.json", "--json", NULL};
+    const char *scene_sp[] = {"simulate", "--scene", "examples/scenes/two-sdof.json", "--json",
+                              NULL};
+    const char *empty[] = {"simulate", "--gap=", NULL};
+    proc_out a, b;
+    for (int k = 0; k < 2; k++) {
+        pd_test_pound(ctx, k ? scene_eq : eq, &a);
+        pd_test_pound(ctx, k ? scene_sp : sp, &b);
+        /* the runs' figures equal (the CPU times aside): umax and the impacts */
+        CHECK(ctx,
+              a.status == 0 && b.status == 0 &&
+                  pd_test_json_num(a.out, "umax", 0) == pd_test_json_num(b.out, "umax", 0) &&
+                  pd_test_json_num(a.out, "impacts", 0) == pd_test_json_num(b.out, "impacts", 0),
+              "%s: exit %d / %d: %s", k ? "--scene=" : "--gap=", a.status, b.status, a.err);
+        pd_test_proc_free(&a);
+        pd_test_proc_free(&b);
+    }
+    pd_test_pound(ctx, empty, &a);
+    CHECK(ctx, a.status == 2 && a.err && strstr(a.err, "--gap"), "--gap=: exit %d, %s", a.status,
+          a.err);
+    pd_test_proc_free(&a);
+}
+
 /* A yielding oscillator from the command line: --uy in metres is Piy Le,
  * the JSON adds the yielding figures (ductility = umax / uy, the energy
  * residual at rounding), the CSV's summary carries them, the elastic
@@ -488,6 +521,7 @@ void suite_cli(pd_test_ctx *ctx)
     PD_RUN(ctx, test_cli_hardening);
     PD_RUN(ctx, test_cli_hdf5_output);
     PD_RUN(ctx, test_cli_csv_and_json);
+    PD_RUN(ctx, test_cli_flag_equals_value);
     PD_RUN(ctx, test_cli_yielding);
     PD_RUN(ctx, test_cli_failed_run_leaves_no_file);
     PD_RUN(ctx, test_cli_converge_empty_list_elements);

@@ -122,13 +122,16 @@ class Record:
         buf = ctypes.create_string_buffer(512)
         if not lib.pd_record_plausible(self.rec, self.units_code, buf, len(buf)):
             import warnings
-            warnings.warn(buf.value.decode("utf-8", "replace"), stacklevel=4)
+            # the library's words name the CLI's flag; Python's keyword is units=
+            msg = buf.value.decode("utf-8", "replace").replace("(--units)", "(units=)")
+            warnings.warn(msg, stacklevel=4)
 
     @classmethod
-    def from_array(cls, acc: ArrayLike, dt: float, units: str = "g",
+    def from_array(cls, acc: ArrayLike, dt: float, units: str = "m/s2",
                    name: str = "array") -> "Record":
         """A record from the accelerations acc[k] (in units: 'g', 'm/s2',
-        'cm/s2') at t_k = k dt [s] (pd_record_from_array):
+        'cm/s2'; by default the library's own m/s^2, as Record.acc gives
+        them back) at t_k = k dt [s] (pd_record_from_array):
         the same values as a file's give the same record, bit for bit.
         acc: a 1-D array or list of real numbers (ints or floats); bools,
         strings, complex numbers and masked arrays with an entry masked raise
@@ -364,7 +367,8 @@ class Case:
                                      "array [s]")
                 if "record_format" in kw:
                     raise InputError("record_format: goes with a record file, not an array")
-                rec = Record.from_array(rec, kw["record_dt"], kw.get("units") or "g")
+                # in units=, or the library's own m/s^2 (what pound.record(p).acc holds)
+                rec = Record.from_array(rec, kw["record_dt"], kw.get("units") or "m/s2")
             else:
                 if "record_dt" in kw:
                     raise InputError("record_dt: goes with a record array (a file gives its "

@@ -242,7 +242,7 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
     'sine'|'cosine'|'harmonic' ['sine'], dir 'normal'|'reverse' (or +1/-1)
     ['normal'], ap [1] m/s^2, Tp [1] s, T0 s or Pi2 [1], gap m or Pi3 [0.05],
     eps [0.5], xi [0.05]; record (a file or a pound.Record), scale [1],
-    units ['g'], record_format ['auto']; method 'auto'|'moreau'|'event'|
+    units ['g' for a text file, 'm/s2' for an array], record_format ['auto']; method 'auto'|'moreau'|'event'|
     'penalty' ['auto': the exact event-driven reference, or Moreau-Jean
     where its scan would be over budget; a keyword only one method takes,
     dt, theta, kc, ..., chooses that method, as on the command line: r.method

@@ -38,7 +38,12 @@ def _list(what, v, cap):
 
 
 def _grid(Pi2):
-    """(MIN, MAX, N) or 'MIN:MAX:N'."""
+    """(MIN, MAX, N) or 'MIN:MAX:N'; a list (or array) would read as values,
+    which a spectrum does not take: refused, naming the range's forms."""
+    if not isinstance(Pi2, (str, tuple)):
+        raise InputError("Pi2: a spectrum sweeps a range, given as the tuple (MIN, MAX, N) or "
+                         "'MIN:MAX:N' (got %s %r: a list is not read as a range; explicit Pi2 "
+                         "values are not supported)" % (type(Pi2).__name__, Pi2))
     if isinstance(Pi2, str):
         parts = Pi2.split(":")
         if len(parts) != 3:
@@ -252,7 +257,7 @@ def _elastic_point(r, method):
         tend=r.tend, steps=r.steps, cpu_s=r.cpu_s)
 
 
-def spectrum(Pi2: Union[Range, Sequence[float]], linear: bool = False,
+def spectrum(Pi2: Range, linear: bool = False,
              pulse: Optional[Names] = None,
              dir: Optional[Union[Names, int, Sequence[int]]] = None, ap: Optional[Floats] = None,
              xi: Optional[Floats] = None, Pi3: Optional[Floats] = None,
@@ -261,7 +266,8 @@ def spectrum(Pi2: Union[Range, Sequence[float]], linear: bool = False,
              on_point: Optional[Callable[[Result], Any]] = None, **case: Any) -> Result:
     """Pounding spectra, as `pound spectrum --Pi2 MIN:MAX:N ... --json`.
 
-    Pi2: (MIN, MAX, N) or 'MIN:MAX:N', log-spaced (linear=True: equal steps).
+    Pi2: the tuple (MIN, MAX, N) or 'MIN:MAX:N', log-spaced (linear=True: equal
+    steps); a list is refused (it would read as values).
     Lists (a value or a sequence; one curve per combination): pulse, dir,
     ap [m/s^2] (the dimensional view), xi, Pi3 or gap [m], eps.  dt_per_Tp:
     steps per pulse period (dt = Tp / dt_per_Tp [s]).  Other keywords as

@@ -31,6 +31,15 @@ def test_array_in_m_s2_is_the_file():
     assert a["umax"] == b["umax"]
 
 
+def test_array_defaults_to_the_library_units():
+    """record.acc (m/s^2) given back without units= is read in m/s^2, the
+    library's own units: the file's run, bit for bit (not a 9.8x motion)."""
+    acc = pound.record(str(RINALDI))["acc"]
+    a = pound.simulate(record=str(RINALDI), method="event", **CASE)
+    b = pound.simulate(record=acc, record_dt=0.01, method="event", **CASE)
+    assert a["umax"] == b["umax"] and a["impacts"] == b["impacts"]
+
+
 def test_array_misuse():
     acc = rinaldi_in_g()
     with pytest.raises(pound.InputError, match="record_dt"):
@@ -56,5 +65,6 @@ def test_units_on_a_file_that_states_them():
 
 def test_implausible_units_warn():
     acc = pound.record(str(RINALDI))["acc"]  # m/s^2 values (8.1 at most) ...
-    with pytest.warns(UserWarning, match="m/s2"):  # ... called g: 8.3 g
+    with pytest.warns(UserWarning, match="m/s2") as w:  # ... called g: 8.3 g
         pound.simulate(record=acc, record_dt=0.01, units="g", **CASE)
+    assert "units=" in str(w[0].message) and "--units" not in str(w[0].message)

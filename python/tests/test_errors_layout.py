@@ -3,6 +3,7 @@ mirrors that do not match the library."""
 import ctypes
 import os
 
+import numpy as np
 import pytest
 
 import pound
@@ -91,6 +92,10 @@ def test_spectrum_errors():
     with pytest.raises(pound.InputError) as e:
         pound.spectrum(Pi2=(2, 1, 5))
     assert str(e.value).startswith("Pi2: need 0 < MIN < MAX")
+    for values in ([0.1, 1, 10], np.array([0.1, 1, 10])):  # values, not a range: named
+        with pytest.raises(pound.InputError) as e:
+            pound.spectrum(Pi2=values)
+        assert str(e.value).startswith("Pi2: a spectrum sweeps a range") and "(MIN, MAX, N)" in str(e.value)
     with pytest.raises(pound.InputError):
         pound.spectrum(Pi2=(0.1, 1, 5), eps=[0.5, 1.5])
     with pytest.raises(pound.InputError):
