@@ -868,19 +868,21 @@ def out_name(argv):
 
 
 def scene_layout(path):
-    """(names, storeys per structure, number of contacts) of a scene file,
-    or None when Python's JSON reader does not take it (a BOM, ...)."""
+    """(names, storeys per structure, number of contacts, storeys of the
+    yielding structures: their up columns) of a scene file, or None when
+    Python's JSON reader does not take it (a BOM, ...)."""
     try:
         with open(path, "rb") as f:
             doc = json.loads(f.read().decode("utf-8"))
-        names, storeys = [], []
+        names, storeys, yielding = [], [], 0
         for st in doc["structures"]:
             names.append(st["name"])
             storeys.append(len(st["masses"]) if "masses" in st else int(st.get("storeys", 1)))
+            yielding += storeys[-1] if "uy" in st else 0
         nc = 0
         for c in doc.get("contacts") or []:
             nc += len(c["pairs"]) if "pairs" in c else len(c.get("levels", [1]))
-        return names, storeys, nc
+        return names, storeys, nc, yielding
     except (ValueError, KeyError, TypeError, UnicodeDecodeError, OSError):
         return None
 
@@ -930,12 +932,12 @@ def verify_output(path, layout):
                         os.path.basename(path), i, len(r), len(head)))
                     break
         if layout:
-            names, storeys, nc = layout
-            want = 1 + 2 * sum(storeys) + 2 * nc
+            names, storeys, nc, yielding = layout
+            want = 1 + 2 * sum(storeys) + 2 * nc + yielding
             if len(head) != want:
                 f.append("%s: the header has %d columns, the scene needs %d (t, x and v of %d "
-                         "storeys, gap and impulse of %d contacts)" % (
-                             os.path.basename(path), len(head), want, sum(storeys), nc))
+                         "storeys, gap and impulse of %d contacts, up of %d yielding storeys)" % (
+                             os.path.basename(path), len(head), want, sum(storeys), nc, yielding))
             cols = set(head)
             missing = [n for n in names if n + ".x1" not in cols]
             if missing:
