@@ -564,10 +564,13 @@ def cases_flags(env):
                 continue
             add(cmd, base + [flag], "2", flag_re(flag), flag)
         # unknown flags and stray words
-        for tok in ["--bogus", "--Pi22", "--ap=1", "-", "--", "-x", "---ap", "--AP", "stray",
+        for tok in ["--bogus", "--Pi22", "-", "--", "-x", "---ap", "--AP", "stray",
                     "--" + "z" * 5000]:
             add(cmd, base + [tok], "2", flag_re(tok) if len(tok) < 100 else re.escape(tok[:40]),
                 "the unknown flag %s" % short_arg(tok))
+        # --flag=value is --flag value: an unknown flag, a bad value, an empty one, named
+        for tok, flag in [("--bogus=1", "--bogus"), ("--ap=0", "--ap"), ("--ap=", "--ap")]:
+            add(cmd, base + [tok], "2", flag_re(flag), "%s as --flag=value" % tok)
         # output names
         for flag in file_flags:
             for v, exp in [("x.txt", "2"), ("", "2"), ("x.jpg" if flag == "--plot" else "x.png", "2"),
