@@ -1227,20 +1227,17 @@ static int cluster_yielded(const pd_edr *r, const edr_cluster *c)
     return 0;
 }
 
-/* The phase spring j takes at a flight's origin (x, v, a its dof's): a
- * slide goes on while its drift moves toward its side (or, at rest,
- * accelerates there), else unloads; an elastic spring at its level starts
- * sliding when its drift moves (or accelerates) past it. */
-static int spring_phase_at(const pd_edr *r, int j, double x, double v, double a)
+/* The phase a sliding spring j takes at a flight's origin (x, v, a its
+ * dof's): the slide goes on while its drift moves toward its side (or, at
+ * rest, accelerates there), else unloads.  An elastic spring stays so: one
+ * on its level moving past it is an onset its prediction finds at once
+ * (past the level by its rounding threshold), an event of its own. */
+static int spring_phase_at(const pd_edr *r, int j, double v, double a)
 {
-    double sg = r->tp.sp_sig[j], ph = r->rs.sp_phase[j];
-    double dz = sg * v, ddz = sg * a;
-    if (ph != 0.0)
-        return ph * dz > 0.0 || (dz == 0.0 && ph * ddz > 0.0) ? (int)ph : 0;
-    double z = sg * x - r->rs.sp_up[j], side = z > 0.0 ? 1.0 : -1.0;
-    if (!(fabs(z) >= r->tp.md->uy[j]))
+    double ph = r->rs.sp_phase[j], dz = r->tp.sp_sig[j] * v, ddz = r->tp.sp_sig[j] * a;
+    if (ph == 0.0)
         return 0;
-    return side * dz > 0.0 || (dz == 0.0 && side * ddz > 0.0) ? (int)side : 0;
+    return ph * dz > 0.0 || (dz == 0.0 && ph * ddz > 0.0) ? (int)ph : 0;
 }
 
 void edr_spring_set(pd_edr *r, int j, double x, int phase)
@@ -1276,7 +1273,7 @@ static int spring_phases(pd_edr *r, int ci, double t)
         double dx, v, a;
         edr_dof_at(r, ci, i, t, &dx, &v, &a);
         double x = r->rs.xo[i] + dx;
-        int ph = spring_phase_at(r, j, x, v, a);
+        int ph = spring_phase_at(r, j, v, a);
         if (ph != r->rs.sp_phase[j]) {
             edr_spring_set(r, j, x, ph);
             changed = 1;
