@@ -2377,6 +2377,13 @@ static void group_of_cluster(pd_edr *r, int c)
     }
 }
 
+/* Every closed contact of the group stays held (no decision at t). */
+static void hold_closed(pd_edr *r)
+{
+    for (int j = 0; j < r->ev.ngc; j++)
+        r->ev.held[j] = r->rs.cstate[r->ev.g_ct[j]] != EDR_OPEN;
+}
+
 /* Contact a closes at t: the group grows from it. */
 static int on_impact(pd_edr *r, int a, double t, pd_err *err)
 {
@@ -2470,8 +2477,7 @@ static int on_spring(pd_edr *r, int j, double t, pd_err *err)
     }
     group_of_cluster(r, c);
     group_state(r, t);
-    for (int k = 0; k < r->ev.ngc; k++)
-        r->ev.held[k] = r->rs.cstate[r->ev.g_ct[k]] != EDR_OPEN;
+    hold_closed(r);
     /* elastic: a slide toward the level passed; sliding: the drift turned back */
     double x = r->ev.gx[dof], z = r->tp.sp_sig[j] * x - r->rs.sp_up[j];
     edr_spring_set(r, j, x, r->rs.sp_phase[j] != 0 ? 0 : z > 0.0 ? 1 : -1);
@@ -2526,10 +2532,8 @@ static int on_piece(pd_edr *r, double t, pd_err *err)
             for (int j = 0; j < r->ev.ngc; j++)
                 if (r->rs.cstate[r->ev.g_ct[j]] == EDR_PERSIST && !r->ev.held[j])
                     r->rs.res.detachments++;
-        } else
-            /* every closed contact stays held: the clusters re-origin on the piece */
-            for (int j = 0; j < r->ev.ngc; j++)
-                r->ev.held[j] = r->rs.cstate[r->ev.g_ct[j]] != EDR_OPEN;
+        } else /* every closed contact stays held: the clusters re-origin on the piece */
+            hold_closed(r);
         if ((rc = regroup(r, t, err)))
             return rc;
     }
