@@ -584,7 +584,6 @@ typedef struct spring_ctx {
     pd_edr *r;
     int c, dof;
     double sig, up, uy, ph;
-    double shift; /* rounding at the start taken off (f = 0 there) */
 } spring_ctx;
 
 static void spring_fn(void *vctx, double t, double out[3])
@@ -594,13 +593,13 @@ static void spring_fn(void *vctx, double t, double out[3])
     edr_dof_at(g->r, g->c, g->dof, t, &dx, &v, &a);
     if (g->ph == 0.0) {
         double z = g->sig * (g->r->rs.xo[g->dof] + dx) - g->up, dz = g->sig * v;
-        out[0] = (z - g->uy) * (z + g->uy) - g->shift;
+        out[0] = (z - g->uy) * (z + g->uy);
         out[1] = 2.0 * z * dz;
         out[2] = 2.0 * (dz * dz + z * g->sig * a);
         return;
     }
     double k = -g->ph * g->sig;
-    out[0] = k * v - g->shift;
+    out[0] = k * v;
     out[1] = k * a;
     out[2] = k * edr_dof_jerk(g->r, g->c, g->dof, t);
 }
@@ -631,12 +630,10 @@ static void predict_spring(pd_edr *r, int j, double ts, int cont)
         .fn = spring_fn, .ctx = &g, .hit_mode = 1, .thr = thr, .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
     double h = cl->h, tw = window_end(r, slot, cont, ts, h);
     s.width = 4e-8 * h;
-    edr_pt p = edr_scan_point(&s, ts);
-    if (p.f > 0.0) { /* past the level at the start: rounding (the origin decided the phase) */
-        g.shift = p.f;
-        p.f = 0.0;
-    }
-    scan_window(r, slot, &s, p, h, tw);
+    /* at the start f <= 0 but for rounding below thr: a slide moves toward its
+     * side there (the origin's decision), an elastic spring is inside its
+     * level or on it (an onset or an unloading put it there) */
+    scan_window(r, slot, &s, edr_scan_point(&s, ts), h, tw);
 }
 
 /* The springs of cluster c predicted again from ts. */

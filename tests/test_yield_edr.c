@@ -484,7 +484,9 @@ static int jerk_note(const pd_state *st, void *ctx)
 static void test_yield_edr_jerk(pd_test_ctx *ctx)
 {
     for (int k = 0; k < 2; k++) {
-        pd_sine_piece pc[2] = {{.t_start = 0.0, .A = -1.0, .w = 1.0}, {.t_start = 2.0 * PD_PI}};
+        /* a sine of frequency 1.3 and phase 0.4: its derivative's terms all count */
+        pd_sine_piece pc[2] = {{.t_start = 0.0, .A = -1.0, .w = 1.3, .phi = 0.4},
+                               {.t_start = 2.0 * PD_PI / 1.3}};
         pd_ed_sdof p = {.osc = {.w0 = 1.0 / 0.7, .xi = 0.05},
                         .npieces = 2,
                         .pieces = pc,
