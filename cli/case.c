@@ -247,6 +247,10 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
     else if (!strcmp(f, "--record")) {
         if (!val)
             return pd_cli_usage_error("--record needs a file name");
+        if (a->record_path) /* a second one would silently replace the first */
+            return pd_cli_usage_error("--record given twice ('%s', then '%s'): a run takes one "
+                                      "record (suites of records are not supported yet)",
+                                      a->record_path, val);
         a->record_path = val;
         rc = 1;
     } else if (!strcmp(f, "--scene")) {

@@ -247,7 +247,8 @@ done:
 
 /* --flag=value is --flag value (getopt_long's form): the same JSON, for a
  * model flag, a list and a scene's path; an empty value is named; a token
- * that is a value (after a flag) is left whole. */
+ * that is a value (after a flag) is left whole.  A repeated --record is
+ * refused (it would silently keep the last). */
 static void test_cli_flag_equals_value(pd_test_ctx *ctx)
 {
     if (!pd_test_have_pound(ctx))
@@ -275,6 +276,15 @@ static void test_cli_flag_equals_value(pd_test_ctx *ctx)
     pd_test_pound(ctx, empty, &a);
     CHECK(ctx, a.status == 2 && a.err && strstr(a.err, "--gap"), "--gap=: exit %d, %s", a.status,
           a.err);
+    pd_test_proc_free(&a);
+    /* a second --record would replace the first: refused, both named, one line */
+    const char *twice[] = {"simulate", "--record", "examples/records/NGA_no_1063_RRS228.AT2",
+                           "--record=other.AT2", NULL};
+    pd_test_pound(ctx, twice, &a);
+    CHECK(ctx,
+          a.status == 2 && a.err && strstr(a.err, "--record given twice") &&
+              strstr(a.err, "other.AT2") && strchr(a.err, '\n') == strrchr(a.err, '\n'),
+          "--record twice: exit %d, %s", a.status, a.err);
     pd_test_proc_free(&a);
 }
 

@@ -18,6 +18,20 @@ from ._types import ArrayLike, PathArg
 MODEL_KEYS = ("pulse", "dir", "ap", "Tp", "T0", "Pi2", "gap", "Pi3", "eps", "xi", "uy", "Piy",
               "alpha")
 RECORD_KEYS = ("record", "scale", "units", "record_format", "record_dt")
+
+
+def _a_path(x: Any) -> bool:
+    """A file's name (a path, or text that is no number): a list of them is
+    a suite of records, not an array of samples written as text."""
+    if isinstance(x, os.PathLike):
+        return True
+    if not isinstance(x, (str, bytes)):
+        return False
+    try:
+        float(x)
+        return False
+    except ValueError:
+        return True
 SCHEME_KEYS = ("method", "dt", "tend", "theta", "gamma", "allow_unstable", "no_accumulation",
                "no_wall", "kernel", "factor", "lcp_solver", "contact", "kc", "kc_abs", "rtol",
                "atol", "stepper", "close_tol", "impact_law", "contact_duration")
@@ -360,6 +374,10 @@ class Case:
             rec = kw["record"]
             if isinstance(rec, Record):
                 pass
+            elif isinstance(rec, (list, tuple)) and rec and all(map(_a_path, rec)):
+                raise InputError("record: %d files given: a run takes one record (a path, a "
+                                 "pound.Record or an array of accelerations); suites of records "
+                                 "are not supported yet" % len(rec))
             elif not isinstance(rec, (str, bytes, os.PathLike)):
                 # a ground motion as an array: its samples every record_dt, in units
                 if "record_dt" not in kw:

@@ -40,6 +40,14 @@ def test_array_defaults_to_the_library_units():
     assert a["umax"] == b["umax"] and a["impacts"] == b["impacts"]
 
 
+def test_a_list_of_files_is_named():
+    """A list of paths is not read as samples (a record_dt error): named."""
+    with pytest.raises(pound.InputError, match="record: 2 files given"):
+        pound.simulate(record=[str(RINALDI), str(RINALDI)], record_dt=0.01, **CASE)
+    with pytest.raises(pound.InputError, match="record: 2 files given"):
+        pound.simulate(record=[RINALDI, RINALDI], **CASE)
+
+
 def test_array_misuse():
     acc = rinaldi_in_g()
     with pytest.raises(pound.InputError, match="record_dt"):
