@@ -222,6 +222,21 @@ static void method_line(const pd_cli_case *k)
                                                  : "the exact reference's scan is over budget");
 }
 
+/* A yielding run's energy balance as JSON keys energy_* (NaN -> null), the
+ * hysteretic term among them when asked (the oscillator reports it as
+ * hysteretic_energy). */
+static void energy_json(pd_json *js, const pd_energy *en, int hysteretic)
+{
+    pd_json_num(js, "energy_input", en->input);
+    pd_json_num(js, "energy_kinetic", en->kinetic);
+    pd_json_num(js, "energy_strain", en->strain);
+    pd_json_num(js, "energy_damping", en->damping);
+    if (hysteretic)
+        pd_json_num(js, "energy_hysteretic", en->hysteretic);
+    pd_json_num(js, "energy_impact", en->impact);
+    pd_json_num(js, "energy_residual", en->residual);
+}
+
 static void print_json(const sim_args *a, const pd_osc_summary *s)
 {
     pd_json js;
@@ -290,13 +305,8 @@ static void print_json(const sim_args *a, const pd_osc_summary *s)
         pd_json_num(&js, "plastic_excursion", s->r.plastic_excursion);
         pd_json_num(&js, "hysteretic_energy", s->r.hysteretic_energy);
         pd_json_num(&js, "ductility_free", s->free.ductility);
-        const pd_energy *en = &s->r.energy; /* the balance per unit mass [J/kg] */
-        pd_json_num(&js, "energy_input", en->input);
-        pd_json_num(&js, "energy_kinetic", en->kinetic);
-        pd_json_num(&js, "energy_strain", en->strain);
-        pd_json_num(&js, "energy_damping", en->damping);
-        pd_json_num(&js, "energy_impact", en->impact);
-        pd_json_num(&js, "energy_residual", en->residual);
+        /* the balance per unit mass [J/kg]; its hysteretic term is hysteretic_energy */
+        energy_json(&js, &s->r.energy, 0);
         /* Newton's failures, honestly (newmark; 0: no Newton iterations) */
         pd_json_int(&js, "newton_failures", s->r.newton_failures);
     }
@@ -618,15 +628,8 @@ static void scene_json(const sim_args *a, const pd_scene *sc, const pd_scene_sum
     /* the row reference: its impact law ("none": another method), the peaks under the other */
     pd_json_str(&js, "impact_law", r->impact_law ? r->impact_law : "none");
     pd_json_num(&js, "law_band", r->law_band_max); /* NaN -> null: no simultaneous impact */
-    if (pd_scene_springs(sc) > 0) { /* a yielding scene's energy balance [J] (NaN -> null) */
-        pd_json_num(&js, "energy_input", r->energy.input);
-        pd_json_num(&js, "energy_kinetic", r->energy.kinetic);
-        pd_json_num(&js, "energy_strain", r->energy.strain);
-        pd_json_num(&js, "energy_damping", r->energy.damping);
-        pd_json_num(&js, "energy_hysteretic", r->energy.hysteretic);
-        pd_json_num(&js, "energy_impact", r->energy.impact);
-        pd_json_num(&js, "energy_residual", r->energy.residual);
-    }
+    if (pd_scene_springs(sc) > 0) /* a yielding scene's energy balance [J] (NaN -> null) */
+        energy_json(&js, &r->energy, 1);
     pd_json_num(&js, "contact_duration", r->contact_duration);
     pd_json_num(&js, "dt", r->dt);
     pd_json_num(&js, "theta", r->theta);

@@ -1130,12 +1130,10 @@ static void group_rhs(pd_edr *r, double f, const double *x, const double *v, int
     for (int k = 0; k < r->ev.ngd; k++) {
         int i = r->ev.g_dof[k], b = r->tp.dof_blk[i];
         const edr_block *bk = &r->tp.blk[b];
-        /* an SDOF block: (b f - c v - k x) / m */
-        if (bk->sdof && bk->spring < 0) {
-            out[i] = (bk->b * f - bk->c * v[i] - bk->k * x[i]) * r->tp.minv[i];
-            continue;
-        }
-        if (bk->sdof) { /* a yielding spring: k_eff x + r0 (r0 dropped from the jerks) */
+        /* an SDOF block: (b f - c v - k_eff x - r0) / m, its spring's phase in
+         * k_eff and r0 (k and 0 without one: the same bits), r0 dropped from
+         * the jerks */
+        if (bk->sdof) {
             double keff, r0;
             edr_block_stiffness(r, b, &keff, &r0);
             out[i] = (bk->b * f - bk->c * v[i] - keff * x[i] - (konst ? r0 : 0.0)) * r->tp.minv[i];
@@ -2552,13 +2550,10 @@ static int on_piece(pd_edr *r, double t, pd_err *err)
 static void spring_offsets(pd_edr *r, double t)
 {
     for (int j = 0; j < r->tp.ns; j++) {
-        double x, v, a;
-        if (r->rs.sp_phase[j] == 0) {
-            r->rs.sp_now[j] = r->rs.sp_up[j];
-            continue;
-        }
-        dof_state(r, r->tp.sp_dof[j], t, &x, &v, &a);
-        r->rs.sp_now[j] = r->tp.sp_sig[j] * x - r->rs.sp_phase[j] * r->tp.md->uy[j];
+        double x = 0.0, v, a;
+        if (r->rs.sp_phase[j] != 0) /* a slide's offset moves with its dof */
+            dof_state(r, r->tp.sp_dof[j], t, &x, &v, &a);
+        r->rs.sp_now[j] = edr_spring_up(r, j, x);
     }
 }
 

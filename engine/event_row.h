@@ -318,6 +318,8 @@ void edr_cluster_eval(pd_edr *r, int c, double t);
 void edr_dof_at(pd_edr *r, int c, int dof, double t, double *dx, double *v, double *a);
 /* The jerk x^(3) of one dof of an SDOF tree (0 for the other kinds). */
 double edr_dof_jerk(pd_edr *r, int c, int dof, double t);
+/* Spring j's plastic offset with its dof at x, in its phase. */
+double edr_spring_up(const pd_edr *r, int j, double x);
 /* Spring j into phase (0 elastic, +-1 sliding) with its dof at x: the
  * offset, the excursion and the onsets kept. */
 void edr_spring_set(pd_edr *r, int j, double x, int phase);

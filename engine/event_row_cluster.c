@@ -1240,22 +1240,28 @@ static int spring_phase_at(const pd_edr *r, int j, double v, double a)
     return ph * dz > 0.0 || (dz == 0.0 && ph * ddz > 0.0) ? (int)ph : 0;
 }
 
+double edr_spring_up(const pd_edr *r, int j, double x)
+{
+    int ph = r->rs.sp_phase[j];
+    /* sliding toward ph: z = ph uy, so up = sg x - ph uy; elastic: up fixed */
+    return ph != 0 ? r->tp.sp_sig[j] * x - ph * r->tp.md->uy[j] : r->rs.sp_up[j];
+}
+
 void edr_spring_set(pd_edr *r, int j, double x, int phase)
 {
-    double sg = r->tp.sp_sig[j], uy = r->tp.md->uy[j];
     int old = r->rs.sp_phase[j];
     if (phase == old)
         return;
-    /* up at x: the slide's (sg x - old uy), or the elastic offset */
-    double up = old != 0 ? sg * x - old * uy : r->rs.sp_up[j];
-    if (old != 0) { /* a slide ends: its excursion (monotone within a slide) */
+    double up = edr_spring_up(r, j, x); /* at x, in the old phase */
+    if (old != 0) {                     /* a slide ends: its excursion (monotone within a slide) */
         r->rs.sp_exc[j] += fabs(up - r->rs.sp_upx[j]);
         r->rs.sp_upx[j] = up;
     } else
         r->rs.sp_onsets[j]++;
-    /* sliding: up = sg x - phase uy (z exactly on the level at x) */
-    r->rs.sp_up[j] = phase != 0 ? sg * x - phase * uy : up;
     r->rs.sp_phase[j] = (signed char)phase;
+    r->rs.sp_up[j] = up;
+    if (phase != 0) /* sliding: z exactly on the level at x */
+        r->rs.sp_up[j] = edr_spring_up(r, j, x);
 }
 
 /* Each spring of a tree cluster at its flight's origin: the phase its

@@ -299,6 +299,13 @@ static double z_end(const pd_mj *mj, const pd_state *out, double hth, int j)
            mj->yl->up[j];
 }
 
+/* z+ of spring j alone on one dof with that dof's end velocity vi: s (q1 +
+ * h theta vi) - up, q1 = q + h (1 - theta) v. */
+static double z_one(const mj_yield *y, int j, double hth, const double *q1, double vi)
+{
+    return y->sfac[j] * (q1[y->sdof[j]] + hth * vi) - y->up[j];
+}
+
 /* The springs past uy after a solve: join Y on their side (a member past
  * the other side turns).  1 when Y changed. */
 static int grow(pd_mj *mj, const pd_state *out, double hth, int *ny)
@@ -308,8 +315,7 @@ static int grow(pd_mj *mj, const pd_state *out, double hth, int *ny)
     int changed = 0;
     for (int j = 0; j < md->ns; j++) {
         int i = y->sdof[j]; /* one dof: z+ without a walk of S */
-        double zj = i >= 0 ? y->sfac[j] * (out->q[i] + hth * out->v[i]) - y->up[j]
-                           : z_end(mj, out, hth, j),
+        double zj = i >= 0 ? z_one(y, j, hth, out->q, out->v[i]) : z_end(mj, out, hth, j),
                lim = md->uy[j] * (1.0 + MJY_SLACK);
         /* a member's z+ is sigma uy at most; beyond -sigma uy it turns */
         int side = zj > lim ? 1 : zj < -lim ? -1 : 0;
@@ -360,7 +366,7 @@ static void classify(pd_mj *mj, int nI, int ny, int *nyc, int *nc)
     mj_yield *y = mj->yl;
     double s;
     for (int k = 0; k < ny; k++) { /* how many springs of Y on each piece */
-        int j = y->ys[k], i = spring_dof(md, j, &s), p = -1, r;
+        int j = y->ys[k], i = y->sdof[j], p = -1, r;
         if (i < 0 && !mj_col_next(&md->S, j, &p, &i, &s))
             continue; /* no entry: it cannot slide */
         r = find(y->uf, i);
@@ -368,7 +374,7 @@ static void classify(pd_mj *mj, int nI, int ny, int *nyc, int *nc)
     }
     *nyc = *nc = 0;
     for (int k = 0; k < ny; k++) {
-        int j = y->ys[k], i = spring_dof(md, j, &s);
+        int j = y->ys[k], i = y->sdof[j];
         if (i >= 0 && y->alone[i] && y->mark[find(y->uf, i)] == 4)
             continue; /* alone: the closed form */
         y->yc[(*nyc)++] = j;
@@ -453,97 +459,9 @@ static void apply(pd_mj *mj, const pd_factor *f, int nc, int nyc, double hth, pd
         out->v[i] += y->col[i];
 }
 
-/* The springs alone on their dof (classify's others): the 1 x 1 LCP
- * G = max(0, -b / L), L = ks (1 - (h theta)^2 ks s^2 / What_ii), in closed
- * form, on out->v[i] (= vfree: no contact in its piece). */
-static void slide_alone(pd_mj *mj, int ny, double hth, pd_state *out)
-{
-    const pd_model *md = mj->model;
-    mj_yield *y = mj->yl;
-    for (int k = 0; k < ny; k++) {
-        int j = y->ys[k];
-        double s, ks = md->ks[j];
-        int i = spring_dof(md, j, &s);
-        if (i < 0 || !y->alone[i] || y->mark[find(y->uf, i)] != 4)
-            continue;
-        double what = y->dM[i] + hth * (y->dC[i] + hth * y->dK[i]);
-        double z = s * (out->q[i] + hth * y->vfree[i]) - y->up[j];
-        double L = ks - hth * hth * ks * ks * s * s / what, b = ks * (md->uy[j] - y->sigma[j] * z);
-        y->G[j] = b < 0.0 ? -b / L : 0.0;
-        out->v[i] = y->vfree[i] + hth * y->sigma[j] * ks * s * y->G[j] / what;
-    }
-}
-
-/* Spring j alone on its dof: i, s and What_ii, or -1. */
-static int alone_dof(const mj_yield *y, int j, double hth, double *s, double *what)
-{
-    int i = y->sdof[j];
-    *s = y->sfac[j];
-    if (i < 0 || !y->alone[i])
-        return -1;
-    *what = y->dM[i] + hth * (y->dC[i] + hth * y->dK[i]);
-    return i;
-}
-
-/* 1 when every spring of Y is alone on its dof (block Gauss-Seidel's case). */
-static int all_alone(const pd_mj *mj, int ny, double hth)
-{
-    double s, what;
-    for (int k = 0; k < ny; k++)
-        if (alone_dof(mj->yl, mj->yl->ys[k], hth, &s, &what) < 0)
-            return 0;
-    return 1;
-}
-
-/* Block Gauss-Seidel over the springs (each alone on its dof) and the
- * active contacts, from out->v = vfree with the slides G of Y: the
- * contacts' LCP given the slides' velocity, then each slide in closed form
- * given the contacts' and the others' velocity; a spring left past uy joins
- * Y (G = 0); until no slide moves by MJY_GS_TOL of its uy and none joins.
- * With Y empty the first sweep is the elastic step, bit for bit. */
-static int slide_gs(pd_mj *mj, const pd_factor *f, int nI, int *ny, double hth, double t1,
-                    pd_state *out, pd_err *err)
-{
-    const pd_model *md = mj->model;
-    mj_yield *y = mj->yl;
-    double s, what;
-    int rc;
-    for (int it = 0; it < MJY_GS_MAX; it++) {
-        if (it > 0 || *ny > 0) { /* the slides' velocity on vfree */
-            memcpy(out->v, y->vfree, (size_t)md->n * sizeof(double));
-            for (int k = 0; k < *ny; k++) {
-                int j = y->ys[k], i = alone_dof(y, j, hth, &s, &what);
-                out->v[i] += hth * y->sigma[j] * md->ks[j] * s * y->G[j] / what;
-            }
-        }
-        if (nI > 0 && (rc = mj_contacts_apply(mj, f, nI, it > 0, t1, out, err)))
-            return rc;
-        double moved = 0.0;
-        for (int k = 0; k < *ny; k++) { /* each slide given the rest */
-            int j = y->ys[k], i = alone_dof(y, j, hth, &s, &what);
-            double ks = md->ks[j], inc = hth * y->sigma[j] * ks * s / what;
-            double vi = out->v[i] - inc * y->G[j]; /* without its own slide */
-            double z = s * (out->q[i] + hth * vi) - y->up[j];
-            double L = ks - hth * hth * ks * ks * s * s / what,
-                   b = ks * (md->uy[j] - y->sigma[j] * z);
-            double G = b < 0.0 ? -b / L : 0.0;
-            moved = fmax(moved, fabs(G - y->G[j]) / md->uy[j]);
-            y->G[j] = G;
-            out->v[i] = vi + inc * G;
-        }
-        if (!grow(mj, out, hth, ny) && moved <= MJY_GS_TOL)
-            return PD_OK;
-    }
-    return pd_err_set(err, PD_ENUMERICAL,
-                      "Moreau-Jean: the slides of %d springs and %d contacts did not settle in "
-                      "%d sweeps at t = %.9g",
-                      *ny, nI, MJY_GS_MAX, t1);
-}
-
-/* ---- rows of SDOFs: the sliding set in the contacts' LCP ---------------- */
-
-/* What_ii and the slide's L = ks - (h theta)^2 ks^2 s^2 / What_ii of each
- * spring alone on its dof, at h theta (kept while it holds). */
+/* What_ii, the slide's L = ks - (h theta)^2 ks^2 s^2 / What_ii, its
+ * velocity per unit slide and added compliance, of each spring on one dof
+ * (read for the springs alone on theirs), at h theta (kept while it holds). */
 static void set_constants(mj_yield *y, const pd_model *md, double hth)
 {
     if (y->hth_set == hth)
@@ -569,10 +487,80 @@ static void set_constants(mj_yield *y, const pd_model *md, double hth)
 static double slide_b(const pd_model *md, const mj_yield *y, int j, double hth, const double *q1,
                       double vi)
 {
-    int i = y->sdof[j];
-    double z = y->sfac[j] * (q1[i] + hth * vi) - y->up[j];
-    return md->ks[j] * (md->uy[j] - y->sigma[j] * z);
+    return md->ks[j] * (md->uy[j] - y->sigma[j] * z_one(y, j, hth, q1, vi));
 }
+
+/* The springs alone on their dof (classify's others): the 1 x 1 LCP
+ * G = max(0, -b / L), L = ks (1 - (h theta)^2 ks s^2 / What_ii), in closed
+ * form, on out->v[i] (= vfree: no contact in its piece). */
+static void slide_alone(pd_mj *mj, int ny, double hth, pd_state *out)
+{
+    const pd_model *md = mj->model;
+    mj_yield *y = mj->yl;
+    for (int k = 0; k < ny; k++) {
+        int j = y->ys[k], i = y->sdof[j];
+        if (i < 0 || !y->alone[i] || y->mark[find(y->uf, i)] != 4)
+            continue;
+        double b = slide_b(md, y, j, hth, out->q, y->vfree[i]);
+        y->G[j] = b < 0.0 ? -b / y->Ls[j] : 0.0;
+        out->v[i] = y->vfree[i] + y->sigma[j] * y->inc[j] * y->G[j];
+    }
+}
+
+/* 1 when every spring of Y is alone on its dof (block Gauss-Seidel's case). */
+static int all_alone(const mj_yield *y, int ny)
+{
+    for (int k = 0; k < ny; k++) {
+        int i = y->sdof[y->ys[k]];
+        if (i < 0 || !y->alone[i])
+            return 0;
+    }
+    return 1;
+}
+
+/* Block Gauss-Seidel over the springs (each alone on its dof) and the
+ * active contacts, from out->v = vfree with the slides G of Y: the
+ * contacts' LCP given the slides' velocity, then each slide in closed form
+ * given the contacts' and the others' velocity; a spring left past uy joins
+ * Y (G = 0); until no slide moves by MJY_GS_TOL of its uy and none joins.
+ * With Y empty the first sweep is the elastic step, bit for bit. */
+static int slide_gs(pd_mj *mj, const pd_factor *f, int nI, int *ny, double hth, double t1,
+                    pd_state *out, pd_err *err)
+{
+    const pd_model *md = mj->model;
+    mj_yield *y = mj->yl;
+    int rc;
+    for (int it = 0; it < MJY_GS_MAX; it++) {
+        if (it > 0 || *ny > 0) { /* the slides' velocity on vfree */
+            memcpy(out->v, y->vfree, (size_t)md->n * sizeof(double));
+            for (int k = 0; k < *ny; k++) {
+                int j = y->ys[k];
+                out->v[y->sdof[j]] += y->sigma[j] * y->inc[j] * y->G[j];
+            }
+        }
+        if (nI > 0 && (rc = mj_contacts_apply(mj, f, nI, it > 0, t1, out, err)))
+            return rc;
+        double moved = 0.0;
+        for (int k = 0; k < *ny; k++) { /* each slide given the rest */
+            int j = y->ys[k], i = y->sdof[j];
+            double inc = y->sigma[j] * y->inc[j];
+            double vi = out->v[i] - inc * y->G[j]; /* without its own slide */
+            double b = slide_b(md, y, j, hth, out->q, vi);
+            double G = b < 0.0 ? -b / y->Ls[j] : 0.0;
+            moved = fmax(moved, fabs(G - y->G[j]) / md->uy[j]);
+            y->G[j] = G;
+            out->v[i] = vi + inc * G;
+        }
+        if (!grow(mj, out, hth, ny) && moved <= MJY_GS_TOL)
+            return PD_OK;
+    }
+    return pd_err_set(err, PD_ENUMERICAL,
+                      "Moreau-Jean: the slides of %d springs and %d contacts did not settle in "
+                      "%d sweeps at t = %.9g",
+                      *ny, nI, MJY_GS_MAX, t1);
+}
+
+/* ---- rows of SDOFs: the sliding set in the contacts' LCP ---------------- */
 
 /* This step's active rows of the contacts (pos). */
 static void set_positions(pd_mj *mj, int nI)
@@ -735,10 +723,8 @@ static int slide_unpushed(pd_mj *mj, int j, double hth, pd_state *out)
 static int slide_set(pd_mj *mj, const pd_factor *f, int nI, int *ny, double hth, double t1,
                      pd_state *out, pd_err *err)
 {
-    const pd_model *md = mj->model;
     mj_yield *y = mj->yl;
     int built = 0, rc;
-    set_constants(y, md, hth);
     set_positions(mj, nI);
     for (int it = 0; it < MJY_SET_MAX; it++) {
         y->set_tries++;
@@ -789,6 +775,7 @@ int mj_yield_step(pd_mj *mj, const pd_factor *f, double h, int nI, double t1, pd
     double hth = h * mj->opts.theta;
     int rc, ny = 0;
     memcpy(y->vfree, out->v, (size_t)md->n * sizeof(double));
+    set_constants(y, md, hth);
     if (y->all_alone && mj->opts.yield_lcp_max <= 0) { /* rows of SDOFs */
         /* its start: the springs that slid in the last step, with their slides */
         for (int k = 0; k < y->ny_prev; k++) {
@@ -840,7 +827,7 @@ int mj_yield_step(pd_mj *mj, const pd_factor *f, double h, int nI, double t1, pd
         int N = nc + nyc, cap = mj->opts.yield_lcp_max > 0 && mj->opts.yield_lcp_max < MJY_CAP
                                     ? mj->opts.yield_lcp_max
                                     : MJY_CAP;
-        if (N > cap && round <= md->ns && all_alone(mj, ny, hth)) {
+        if (N > cap && round <= md->ns && all_alone(y, ny)) {
             memcpy(out->v, y->vfree, (size_t)md->n * sizeof(double));
             for (int k = 0; k < ny; k++)
                 y->G[y->ys[k]] = 0.0;

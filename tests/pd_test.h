@@ -69,6 +69,17 @@ int pd_test_rinaldi_case(pd_test_ctx *ctx, pd_record *rec, pd_osc *c);
  * (its npts pieces, to free); NULL when the record is absent (skipped) or
  * unreadable (failed). */
 pd_sine_piece *pd_test_rinaldi_pieces(pd_test_ctx *ctx, long *npieces);
+/* The one-wall yielding pulse cases (test_yield_rk.c, test_yield_edr.c),
+ * Pi units: one sine or cosine cycle of unit amplitude and frequency (pc,
+ * two pieces), w0 = 1/Pi2 (0.7, 1.5), xi 0.05, a wall 0.1 away with eps 0,
+ * 0.5, 1 or none, alpha 0, 0.1, 0.3, uy 0.05, 0.3: case c of 96 into *p
+ * (pointing at pc) and name; 0 past the last. */
+int pd_test_yield_pulse_case(int c, pd_sine_piece pc[2], pd_ed_sdof *p, char *name, size_t cap);
+/* A row of n yielding SDOFs between two walls (T0 0.4 to 1.3 s, uy 1 to 2
+ * cm, alpha 0 to 0.2, cycling by ten; gaps 3 cm + dgap (k % 7) for contact
+ * k, e 0.6) under a sine pulse of 4 m/s^2 and 0.8 s, 3 s; NULL (named) on
+ * failure. */
+pd_scene *pd_test_yield_row(pd_test_ctx *ctx, int n, double dgap);
 /* Run sc by method (dt 0: the default) into r (allocated here); 1 when it
  * ran, else 0 with the failure named. */
 int pd_test_scene_run(pd_test_ctx *ctx, const pd_scene *sc, pd_method method, double dt,

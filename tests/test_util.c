@@ -215,6 +215,67 @@ int pd_test_zero_file(char *path, size_t cap, long long bytes)
     return rc;
 }
 
+int pd_test_yield_pulse_case(int c, pd_sine_piece pc[2], pd_ed_sdof *p, char *name, size_t cap)
+{
+    const double pi2s[] = {0.7, 1.5}, eps[] = {0.0, 0.5, 1.0}, alphas[] = {0.0, 0.1, 0.3},
+                 uys[] = {0.05, 0.3};
+    int n = 0;
+    for (int pulse = 0; pulse < 2; pulse++)
+        for (int i = 0; i < 2; i++)
+            for (int k = 0; k < 3; k++)
+                for (int a = 0; a < 3; a++)
+                    for (int u = 0; u < 2; u++)
+                        for (int wall = 0; wall < 2; wall++) {
+                            if ((!wall && k > 0) || n++ != c) /* eps: nothing without the wall */
+                                continue;
+                            pc[0] = (pd_sine_piece){.t_start = 0.0,
+                                                    .A = -1.0,
+                                                    .w = 1.0,
+                                                    .phi = pulse ? PD_PI / 2 : 0.0};
+                            pc[1] = (pd_sine_piece){.t_start = 2.0 * PD_PI};
+                            *p = (pd_ed_sdof){.osc = {.w0 = 1.0 / pi2s[i], .xi = 0.05},
+                                              .wall = wall,
+                                              .delta = 0.1,
+                                              .e = eps[k],
+                                              .npieces = 2,
+                                              .pieces = pc,
+                                              .uy = uys[u],
+                                              .alpha = alphas[a]};
+                            snprintf(name, cap, "%s Pi2 %g eps %g alpha %g uy %g wall %d",
+                                     pulse ? "cosine" : "sine", pi2s[i], eps[k], alphas[a], uys[u],
+                                     wall);
+                            return 1;
+                        }
+    return 0;
+}
+
+pd_scene *pd_test_yield_row(pd_test_ctx *ctx, int n, double dgap)
+{
+    pd_scene_excitation x = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 4.0, .Tp = 0.8};
+    pd_scene *sc = pd_scene_new(&x);
+    pd_err e;
+    int rc = sc ? PD_OK : PD_ENOMEM;
+    for (int i = 0; i < n && !rc; i++) {
+        char name[16];
+        double uy = 0.01 + 0.001 * (i % 10), alpha = 0.02 * (i % 10);
+        snprintf(name, sizeof name, "S%d", i + 1);
+        rc = pd_scene_add_sdof(sc, name, 0.4 + 0.1 * (i % 10), 0.05, 1e5, &e) ||
+             pd_scene_set_yield(sc, &uy, &alpha, &e);
+    }
+    for (int i = 0; i <= n && !rc; i++)
+        rc =
+            pd_scene_add_contact(sc, i == 0 ? PD_WALL : i - 1, i == 0 ? 0 : 1, i == n ? PD_WALL : i,
+                                 i == n ? 0 : 1, 0.03 + dgap * (i % 7), 0.6, i, &e);
+    if (!rc)
+        rc = pd_scene_finish(sc, &e);
+    if (!CHECK(ctx, rc == PD_OK, "the row: %s", sc ? e.msg : "out of memory")) {
+        pd_scene_free(sc);
+        return NULL;
+    }
+    sc->tend = 3.0;
+    return sc;
+}
+
 int pd_test_scene_run(pd_test_ctx *ctx, const pd_scene *sc, pd_method method, double dt,
                       pd_scene_result *r)
 {

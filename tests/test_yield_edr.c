@@ -141,43 +141,18 @@ static int one_case(pd_test_ctx *ctx, const pd_ed_sdof *p, double t_end, double 
  * uy 0.05 and 0.3; the spring on x, and on 2 x for a third of them. */
 static void test_yield_edr_one_wall(pd_test_ctx *ctx)
 {
-    const double pi2s[] = {0.7, 1.5}, eps[] = {0.0, 0.5, 1.0}, alphas[] = {0.0, 0.1, 0.3},
-                 uys[] = {0.05, 0.3};
     double worst = 0.0;
     long onsets = 0;
+    pd_sine_piece pc[2];
+    pd_ed_sdof p;
+    char name[112];
     int cases = 0, failed = 0;
-    for (int pulse = 0; pulse < 2; pulse++)
-        for (int i = 0; i < 2; i++)
-            for (int k = 0; k < 3; k++)
-                for (int a = 0; a < 3; a++)
-                    for (int u = 0; u < 2; u++)
-                        for (int wall = 0; wall < 2; wall++) {
-                            if (!wall && k > 0)
-                                continue;
-                            pd_sine_piece pc[2] = {{.t_start = 0.0,
-                                                    .A = -1.0,
-                                                    .w = 1.0,
-                                                    .phi = pulse ? PD_PI / 2 : 0.0},
-                                                   {.t_start = 2.0 * PD_PI}};
-                            pd_ed_sdof p = {.osc = {.w0 = 1.0 / pi2s[i], .xi = 0.05},
-                                            .wall = wall,
-                                            .delta = 0.1,
-                                            .e = eps[k],
-                                            .npieces = 2,
-                                            .pieces = pc,
-                                            .uy = uys[u],
-                                            .alpha = alphas[a]};
-                            double sig = cases % 3 == 2 ? 2.0 : 1.0;
-                            char name[112];
-                            snprintf(name, sizeof name,
-                                     "%s Pi2 %g eps %g alpha %g uy %g wall %d sig %g",
-                                     pulse ? "cosine" : "sine", pi2s[i], eps[k], alphas[a], uys[u],
-                                     wall, sig);
-                            /* a third with a partner whose contact comes first */
-                            failed += !one_case(ctx, &p, 8.0 * PD_PI, sig, cases % 3 == 1, &worst,
-                                                &onsets, name);
-                            cases++;
-                        }
+    for (; pd_test_yield_pulse_case(cases, pc, &p, name, 80); cases++) {
+        /* the spring on 2 x for a third, a partner whose contact comes first for another */
+        double sig = cases % 3 == 2 ? 2.0 : 1.0;
+        snprintf(name + strlen(name), sizeof name - strlen(name), " sig %g", sig);
+        failed += !one_case(ctx, &p, 8.0 * PD_PI, sig, cases % 3 == 1, &worst, &onsets, name);
+    }
     printf("    %d one-wall cases (%ld onsets): the row reference against the one-wall one, "
            "largest distance %.2g\n",
            cases, onsets, worst);
@@ -235,38 +210,6 @@ static void test_yield_edr_unreached(pd_test_ctx *ctx)
     CHECK(ctx, fabs(u1 - u2) <= 1e-14 * u2 && on == 0, "umax %.17g vs elastic %.17g", u1, u2);
 }
 
-/* A row of n SDOFs between two walls by scene (T0 0.4 to 1.3 s, uy 1 to 2
- * cm, alpha 0 to 0.2, cycling by ten; gaps 3 to 4.2 cm, cycling by seven;
- * e 0.6) under a sine pulse of 4 m/s^2 and 0.8 s, 3 s.  No two impacts
- * coincide (no law decides them: Moreau-Jean's merged impacts would tend
- * to neither). */
-static pd_scene *yrow(pd_test_ctx *ctx, int n)
-{
-    pd_scene_excitation x = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 4.0, .Tp = 0.8};
-    pd_scene *sc = pd_scene_new(&x);
-    pd_err e;
-    int rc = sc ? PD_OK : PD_ENOMEM;
-    for (int i = 0; i < n && !rc; i++) {
-        char name[16];
-        double uy = 0.01 + 0.001 * (i % 10), alpha = 0.02 * (i % 10);
-        snprintf(name, sizeof name, "S%d", i + 1);
-        rc = pd_scene_add_sdof(sc, name, 0.4 + 0.1 * (i % 10), 0.05, 1e5, &e) ||
-             pd_scene_set_yield(sc, &uy, &alpha, &e);
-    }
-    for (int i = 0; i <= n && !rc; i++)
-        rc =
-            pd_scene_add_contact(sc, i == 0 ? PD_WALL : i - 1, i == 0 ? 0 : 1, i == n ? PD_WALL : i,
-                                 i == n ? 0 : 1, 0.03 + 0.002 * (i % 7), 0.6, i, &e);
-    if (!rc)
-        rc = pd_scene_finish(sc, &e);
-    if (!CHECK(ctx, rc == PD_OK, "the row: %s", sc ? e.msg : "out of memory")) {
-        pd_scene_free(sc);
-        return NULL;
-    }
-    sc->tend = 3.0;
-    return sc;
-}
-
 /* Moreau-Jean against the row reference on rows of 2, 10 and 100: the
  * largest relative distance of the ductilities, and of the residuals over
  * uy, at dt 1e-3, 1.25e-4 and 1.5625e-5 (the row of 100: the first and
@@ -279,7 +222,7 @@ static void test_yield_edr_rows_converge(pd_test_ctx *ctx)
 {
     const int ns[] = {2, 10, 100};
     for (int c = 0; c < 3; c++) {
-        pd_scene *sc = yrow(ctx, ns[c]);
+        pd_scene *sc = pd_test_yield_row(ctx, ns[c], 0.002);
         if (!sc)
             return;
         pd_scene_result ex, r;
@@ -409,7 +352,7 @@ static int up_note(const pd_scene_sample *s, void *ctx)
 
 static void test_yield_edr_sampled_offsets(pd_test_ctx *ctx)
 {
-    pd_scene *sc = yrow(ctx, 3);
+    pd_scene *sc = pd_test_yield_row(ctx, 3, 0.002);
     if (!sc)
         return;
     const pd_method methods[] = {PD_METHOD_EVENT, PD_METHOD_MOREAU};

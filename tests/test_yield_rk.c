@@ -312,39 +312,15 @@ static int rk_case(pd_test_ctx *ctx, const pd_ed_sdof *p, double t_end, double t
  * slides underdamped or free masses), yields of 0.05 and 0.3 Le. */
 static void test_yield_rk_pulses(pd_test_ctx *ctx)
 {
-    const double pi2s[] = {0.7, 1.5}, eps[] = {0.0, 0.5, 1.0}, alphas[] = {0.0, 0.1, 0.3},
-                 uys[] = {0.05, 0.3};
     double worst[3] = {0.0, 0.0, 0.0};
+    pd_sine_piece pc[2];
+    pd_ed_sdof p;
+    char name[96];
     int cases = 0, failed = 0;
-    for (int pulse = 0; pulse < 2; pulse++)
-        for (int i = 0; i < 2; i++)
-            for (int k = 0; k < 3; k++)
-                for (int a = 0; a < 3; a++)
-                    for (int u = 0; u < 2; u++)
-                        for (int wall = 0; wall < 2; wall++) {
-                            if (!wall && k > 0)
-                                continue; /* eps means nothing without the wall */
-                            pd_sine_piece pc[2] = {{.t_start = 0.0,
-                                                    .A = -1.0,
-                                                    .w = 1.0,
-                                                    .phi = pulse ? PD_PI / 2 : 0.0},
-                                                   {.t_start = 2.0 * PD_PI}};
-                            pd_ed_sdof p = {.osc = {.w0 = 1.0 / pi2s[i], .xi = 0.05},
-                                            .wall = wall,
-                                            .delta = 0.1,
-                                            .e = eps[k],
-                                            .npieces = 2,
-                                            .pieces = pc,
-                                            .uy = uys[u],
-                                            .alpha = alphas[a]};
-                            char name[96];
-                            snprintf(name, sizeof name, "%s Pi2 %g eps %g alpha %g uy %g wall %d",
-                                     pulse ? "cosine" : "sine", pi2s[i], eps[k], alphas[a], uys[u],
-                                     wall);
-                            double tshort = fmin(2.0 * PD_PI, 2.0 * PD_PI / p.osc.w0);
-                            failed += !rk_case(ctx, &p, 8.0 * PD_PI, tshort, 1.0, worst, name);
-                            cases++;
-                        }
+    for (; pd_test_yield_pulse_case(cases, pc, &p, name, sizeof name); cases++) {
+        double tshort = fmin(2.0 * PD_PI, 2.0 * PD_PI / p.osc.w0);
+        failed += !rk_case(ctx, &p, 8.0 * PD_PI, tshort, 1.0, worst, name);
+    }
     printf("    %d pulse cases, the largest share of a bound: the reference against the "
            "integration %.2g, the integration against itself %.2g; energy balance %.2g\n",
            cases, worst[0], worst[1], worst[2]);

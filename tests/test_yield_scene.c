@@ -142,32 +142,12 @@ static void test_yield_scene_unreached_is_elastic(pd_test_ctx *ctx)
     pd_scene_free(el);
 }
 
-/* A row of 10 SDOFs (T0 0.4 to 1.3 s, uy 1 to 2 cm, alpha 0 to 0.2) between
- * two walls, gaps 3 cm, e 0.6, under a sine pulse of 4 m/s^2 and 0.8 s. */
+/* The row of 10 (tests/test_util.c): T0 0.4 to 1.3 s, uy 1 to 2 cm, alpha 0
+ * to 0.2, between two walls, gaps 3 cm, e 0.6, a sine pulse of 4 m/s^2 and
+ * 0.8 s, 3 s. */
 static pd_scene *row10(pd_test_ctx *ctx)
 {
-    pd_scene_excitation x = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 4.0, .Tp = 0.8};
-    pd_scene *sc = pd_scene_new(&x);
-    pd_err e;
-    int rc = sc ? PD_OK : PD_ENOMEM;
-    for (int i = 0; i < 10 && !rc; i++) {
-        char name[16];
-        double uy = 0.01 + 0.001 * i, alpha = 0.02 * i;
-        snprintf(name, sizeof name, "S%d", i + 1);
-        rc = pd_scene_add_sdof(sc, name, 0.4 + 0.1 * i, 0.05, 1e5, &e) ||
-             pd_scene_set_yield(sc, &uy, &alpha, &e);
-    }
-    for (int i = 0; i <= 10 && !rc; i++)
-        rc = pd_scene_add_contact(sc, i == 0 ? PD_WALL : i - 1, i == 0 ? 0 : 1,
-                                  i == 10 ? PD_WALL : i, i == 10 ? 0 : 1, 0.03, 0.6, i, &e);
-    if (!rc)
-        rc = pd_scene_finish(sc, &e);
-    if (!CHECK(ctx, rc == PD_OK, "the row: %s", sc ? e.msg : "out of memory")) {
-        pd_scene_free(sc);
-        return NULL;
-    }
-    sc->tend = 3.0;
-    return sc;
+    return pd_test_yield_row(ctx, 10, 0.0);
 }
 
 /* The largest relative distance of the ductilities, and of the residuals
