@@ -92,6 +92,14 @@ void pd_factor_free(pd_factor *f)
     free(f);
 }
 
+/* The place of D_ab (column a, row b) in a dense m x m D, or -1 for an exact
+ * zero (left out of the compressed D_II). */
+long pd_factor_dense_at(const double *D, int m, int a, int b)
+{
+    long k = b + (long)a * m;
+    return D[k] != 0.0 ? k : -1;
+}
+
 void pd_factor_gather_dense(const double *D, int m, const int *idx, int nI, double *out)
 {
     for (int s = 0; s < nI; s++) {
@@ -102,7 +110,7 @@ void pd_factor_gather_dense(const double *D, int m, const int *idx, int nI, doub
 }
 
 int pd_factor_gather_dense_csc(const double *D, int m, const int *idx, int nI, int *colptr,
-                               int *rowind, double *values)
+                               int *rowind, double *values, int *map)
 {
     int nz = 0;
     for (int s = 0; s < nI; s++) {
@@ -111,6 +119,8 @@ int pd_factor_gather_dense_csc(const double *D, int m, const int *idx, int nI, i
         /* exact zeros of D left out */
         for (int r = 0; r < nI; r++)
             if (col[idx[r]] != 0.0) {
+                if (map) /* D_(idx_s, idx_r) is D's entry idx_r + idx_s m */
+                    map[idx[r] + (size_t)idx[s] * m] = nz;
                 rowind[nz] = r;
                 values[nz++] = col[idx[r]];
             }

@@ -504,7 +504,7 @@ static void chol_delassus_dense(const pd_factor *f, const int *idx, int nI, doub
 }
 
 static int chol_delassus_csc(const pd_factor *f, const int *idx, int nI, int *colptr, int *rowind,
-                             double *values)
+                             double *values, int *map)
 {
     const chol_data *d = f->data;
     int nz = 0;
@@ -515,6 +515,8 @@ static int chol_delassus_csc(const pd_factor *f, const int *idx, int nI, int *co
         colptr[s] = nz;
         for (int k = d->Dp[idx[s]]; k < d->Dp[idx[s] + 1]; k++)
             if (d->pos[d->Di[k]] >= 0) {
+                if (map)
+                    map[k] = nz;
                 rowind[nz] = d->pos[d->Di[k]];
                 values[nz++] = d->Dx[k];
             }
@@ -525,6 +527,16 @@ static int chol_delassus_csc(const pd_factor *f, const int *idx, int nI, int *co
     return nz;
 }
 
+/* D's entry (column a, row b): a search of column a's rows. */
+static long chol_delassus_at(const pd_factor *f, int a, int b)
+{
+    const chol_data *d = f->data;
+    for (int k = d->Dp[a]; k < d->Dp[a + 1]; k++)
+        if (d->Di[k] == b)
+            return k;
+    return -1;
+}
+
 const pd_factor_type pd_factor_cholmod_type = {
     .name = "cholmod",
     .kind = PD_FACTOR_CHOLMOD,
@@ -533,5 +545,6 @@ const pd_factor_type pd_factor_cholmod_type = {
     .add_impulse = chol_add_impulse,
     .delassus_dense = chol_delassus_dense,
     .delassus_csc = chol_delassus_csc,
+    .delassus_at = chol_delassus_at,
     .release = chol_release,
 };

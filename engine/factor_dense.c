@@ -150,10 +150,16 @@ static void dense_delassus(const pd_factor *f, const int *idx, int nI, double *D
 }
 
 static int dense_delassus_csc(const pd_factor *f, const int *idx, int nI, int *colptr, int *rowind,
-                              double *values)
+                              double *values, int *map)
 {
     const dense_data *d = f->data;
-    return pd_factor_gather_dense_csc(d->del, f->model->m, idx, nI, colptr, rowind, values);
+    return pd_factor_gather_dense_csc(d->del, f->model->m, idx, nI, colptr, rowind, values, map);
+}
+
+static long dense_delassus_at(const pd_factor *f, int a, int b)
+{
+    const dense_data *d = f->data;
+    return pd_factor_dense_at(d->del, f->model->m, a, b);
 }
 
 const pd_factor_type pd_factor_scalar_type = {
@@ -164,6 +170,7 @@ const pd_factor_type pd_factor_scalar_type = {
     .add_impulse = dense_add_impulse,
     .delassus_dense = dense_delassus,
     .delassus_csc = dense_delassus_csc,
+    .delassus_at = dense_delassus_at,
     .release = dense_release,
 };
 
@@ -175,5 +182,6 @@ const pd_factor_type pd_factor_dense_type = {
     .add_impulse = dense_add_impulse,
     .delassus_dense = dense_delassus,
     .delassus_csc = dense_delassus_csc,
+    .delassus_at = dense_delassus_at,
     .release = dense_release,
 };

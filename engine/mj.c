@@ -57,12 +57,72 @@ double pd_contact_impulse_1(double D, double b)
     return b < 0.0 ? -b / D : 0.0; /* b >= 0: P = 0, w = b; else w = 0 */
 }
 
+/* W by columns (its nonzeros) and by rows (mj->inc), once for the drivers
+ * that read it (the adaptive one, the yielding springs'): PD_OK, or
+ * PD_ENOMEM (what was taken is freed with the object). */
+int mj_incidence_build(pd_mj *mj)
+{
+    const pd_model *md = mj->model;
+    mj_incidence *in = &mj->inc;
+    int n = md->n, m = md->m, nnz = 0;
+    double wia;
+    if (in->ptr)
+        return PD_OK; /* built */
+    if (!(in->ptr = calloc((size_t)m + 1, sizeof(int))) ||
+        !(in->dptr = calloc((size_t)n + 1, sizeof(int))))
+        return PD_ENOMEM;
+    for (int a = 0; a < m; a++)
+        for (int p = -1, i; mj_col_next(&md->W, a, &p, &i, &wia);)
+            if (wia != 0.0) {
+                nnz++;
+                in->dptr[i + 1]++;
+            }
+    /* W's nonzeros counted, per dof in dptr[i + 1]: by columns, then by rows */
+    if (!(in->dof = pd_malloc(nnz, sizeof(int))) || !(in->w = pd_malloc(nnz, sizeof(double))) ||
+        !(in->con = pd_malloc(nnz, sizeof(int))) || !(in->wr = pd_malloc(nnz, sizeof(double))))
+        return PD_ENOMEM;
+    /* the running sum: dptr[i] is dof i's first contact */
+    for (int i = 0; i < n; i++)
+        in->dptr[i + 1] += in->dptr[i];
+    /* fill[i]: the contacts dof i has so far */
+    int *fill = calloc((size_t)n, sizeof(int));
+    if (!fill)
+        return PD_ENOMEM;
+    nnz = 0;
+    for (int a = 0; a < m; a++) {
+        in->ptr[a] = nnz;
+        for (int p = -1, i; mj_col_next(&md->W, a, &p, &i, &wia);) {
+            if (wia == 0.0)
+                continue;
+            in->dof[nnz] = i;
+            in->w[nnz++] = wia;
+            in->con[in->dptr[i] + fill[i]] = a;
+            in->wr[in->dptr[i] + fill[i]++] = wia;
+        }
+    }
+    in->ptr[m] = nnz;
+    free(fill);
+    return PD_OK;
+}
+
+static void incidence_free(mj_incidence *in)
+{
+    free(in->ptr);
+    free(in->dof);
+    free(in->w);
+    free(in->dptr);
+    free(in->con);
+    free(in->wr);
+    memset(in, 0, sizeof *in);
+}
+
 void pd_mj_free(pd_mj *mj)
 {
     if (!mj)
         return;
     mj_adapt_free(mj);
     mj_yield_free(mj);
+    incidence_free(&mj->inc);
     pd_factor_free(mj->factor);
     pd_lcp_solver_free(mj->lcp);
     free(mj->F0);
@@ -675,7 +735,8 @@ static int impact_contacts(pd_mj *mj, const pd_factor *f, int nI, int reuse_D, c
     if (reuse_D)
         ;
     else if (mj->sparse)
-        pd_factor_delassus_csc(f, mj->idx_active, nI, mj->D_colptr, mj->D_rowind, mj->D_active);
+        pd_factor_delassus_csc(f, mj->idx_active, nI, mj->D_colptr, mj->D_rowind, mj->D_active,
+                               NULL);
     else
         pd_factor_delassus_dense(f, mj->idx_active, nI, mj->D_active);
     mj_active_rhs(mj, nI, vfree);

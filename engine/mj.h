@@ -31,6 +31,7 @@ typedef struct mj_incidence {
     int *ptr, *dof;  /* contact a: dof[ptr[a] .. ptr[a+1]) */
     double *w;       /* W_ia of each (dof, contact) pair, as dof */
     int *dptr, *con; /* dof i: con[dptr[i] .. dptr[i+1]) */
+    double *wr;      /* W_ia of each pair, as con */
 } mj_incidence;
 
 /* The stored entries of column j of A, one per call into (*i, *v), *p from
@@ -129,6 +130,7 @@ int mj_general_step(pd_mj *mj, const pd_factor *f, double h, double t1, const do
  * block in mj->D_active (dense, or compressed columns when mj->sparse) into
  * mj->P_active and out->P (t1 names the step's end in messages). */
 void mj_active_rhs(pd_mj *mj, int nI, const double *vfree);
+int mj_incidence_build(pd_mj *mj);
 /* The contacts' LCP of the active set from out->v = vfree, and v+ into
  * out->v; reuse_D: the Delassus block of the last call (the same active
  * set and factor) is kept. */

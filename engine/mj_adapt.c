@@ -137,23 +137,12 @@ static int snap_alloc(snap *s, int n, int m)
     return PD_OK;
 }
 
-static void incidence_free(mj_incidence *in)
-{
-    free(in->ptr);
-    free(in->dof);
-    free(in->w);
-    free(in->dptr);
-    free(in->con);
-    memset(in, 0, sizeof *in);
-}
-
 void mj_adapt_free(pd_mj *mj)
 {
     mj_adapt *ad = mj ? mj->ad : NULL;
     if (!ad)
         return;
     mj_flight_free(mj);
-    incidence_free(&mj->inc);
     if (ad->lev)
         for (int k = 0; k <= ad->L; k++)
             pd_factor_free(ad->lev[k].factor);
@@ -219,47 +208,6 @@ static void dof_frequencies(const pd_model *md, double *w)
         w[i] = fmax(w[i], wmax > 0.0 ? 1e-3 * wmax : 1.0);
 }
 
-/* W by columns (with its entries) and by rows. */
-static int incidence(const pd_model *md, mj_incidence *in)
-{
-    int n = md->n, m = md->m, nnz = 0;
-    double wia;
-    if (!(in->ptr = calloc((size_t)m + 1, sizeof(int))) ||
-        !(in->dptr = calloc((size_t)n + 1, sizeof(int))))
-        return PD_ENOMEM;
-    for (int a = 0; a < m; a++)
-        for (int p = -1, i; mj_col_next(&md->W, a, &p, &i, &wia);)
-            if (wia != 0.0) {
-                nnz++;
-                in->dptr[i + 1]++;
-            }
-    /* W's nonzeros counted, per dof in dptr[i + 1]: by columns, then by rows */
-    if (!(in->dof = pd_malloc(nnz, sizeof(int))) || !(in->w = pd_malloc(nnz, sizeof(double))) ||
-        !(in->con = pd_malloc(nnz, sizeof(int))))
-        return PD_ENOMEM;
-    /* the running sum: dptr[i] is dof i's first contact */
-    for (int i = 0; i < n; i++)
-        in->dptr[i + 1] += in->dptr[i];
-    /* fill[i]: the contacts dof i has so far */
-    int *fill = calloc((size_t)n, sizeof(int));
-    if (!fill)
-        return PD_ENOMEM;
-    nnz = 0;
-    for (int a = 0; a < m; a++) {
-        in->ptr[a] = nnz;
-        for (int p = -1, i; mj_col_next(&md->W, a, &p, &i, &wia);) {
-            if (wia == 0.0)
-                continue;
-            in->dof[nnz] = i;
-            in->w[nnz++] = wia;
-            in->con[in->dptr[i] + fill[i]++] = a;
-        }
-    }
-    in->ptr[m] = nnz;
-    free(fill);
-    return PD_OK;
-}
-
 /* Each piece's start on the grid of the last reset. */
 static void piece_ticks(mj_adapt *ad)
 {
@@ -301,7 +249,7 @@ int mj_adapt_alloc(pd_mj *mj, pd_err *err)
     ad->u_tol = pd_calloc(md->m, sizeof(double));
     ad->G = pd_calloc(md->m, sizeof(double));
     bad |= !ad->u_tol || !ad->G || !ad->mark || !ad->evmark || !ad->timed || !ad->u_rest ||
-           !ad->D0 || incidence(md, &mj->inc);
+           !ad->D0 || mj_incidence_build(mj);
     for (int s = 0; s < 4 && !bad; s++)
         bad = snap_alloc(&ad->sn[s], n, md->m) != PD_OK;
     if (bad)

@@ -26,7 +26,11 @@
  *   rows    every spring alone on its dof (rows of SDOFs): the slides of a
  *           set A taken as sliding are put into the contacts' LCP (slide_set:
  *           one LCP of the kernel's solver per try, the set corrected until
- *           it holds; Gauss-Seidel when it does not settle)
+ *           it holds; Gauss-Seidel when it does not settle).  A starts from
+ *           the last step's slides that its push would leave sliding; D_II's
+ *           corrections go to places found at the allocation (each pair of
+ *           contacts on a spring's dof, its entry of D) through the gather's
+ *           map, and are put back from a log for the next try
  *   up     += sigma G
  * When no spring passes uy the step is the elastic one, bit for bit (and
  * with every offset 0 nothing is added to the force).  Memory: the LCP of
@@ -72,22 +76,28 @@ struct mj_yield {
     long rounds;          /* the LCPs solved with springs (statistics) */
     long set_tries;       /* the sliding set's LCP tries (statistics) */
     long gs_steps;        /* steps block Gauss-Seidel took (statistics) */
+    int moved;            /* an offset has moved since the reset */
     /* slide_set: the constants of h theta (hth_set), per spring alone on its
-     * dof: What_ii and its slide's L; per step: the contacts' D_II as the
-     * factor gives it, W_I P on the sliding dofs, the active rows */
+     * dof: What_ii and its slide's L; the pairs of contacts on its dof and
+     * their entries of D; per step: where D's entries went in D_II, the
+     * entries a try changed, W_I P on the sliding dofs, the active rows */
     double hth_set;
-    double *what, *Ls; /* ns */
-    double *inc, *dcs; /* ns: h theta ks s / What_ii, the compliance a slide adds */
-    double *bfree;     /* ns: a sliding spring's b from vfree (this try's) */
-    double *Dsave;     /* the Delassus block's capacity */
-    long Dcap;
-    double *wp;       /* n: (W_I P)_i */
-    int *dptr, *dcon; /* n + 1, nnz(W): the contacts on each dof (W^T by rows) */
-    double *dw;       /* nnz(W): their W entries */
-    int *pos;         /* m: a contact's row in this step's active set (valid where
-                             idx_active[pos[a]] == a, pos[a] < nI) */
-    int nI;           /* this step's active contacts */
-    int *snext;       /* n: the spring on a dof (-1: none) */
+    double *what, *Linv; /* ns: What_ii, 1 / L */
+    double *inc, *dcs;   /* ns: h theta ks s / What_ii, the compliance a slide adds */
+    double *bfree;       /* ns: a sliding spring's b from vfree (this try's) */
+    int has_D;           /* a factor keeps D (m > 0) */
+    int *pptr;           /* ns + 1: spring j's pairs pptr[j] .. pptr[j+1] */
+    int *pcol, *prow;    /* the pair's contacts (D's column, row) */
+    long *pk;            /* their entry of D (pd_factor_delassus_at; -1: none) */
+    double *pw;          /* W_ia W_ib */
+    int *map;            /* delassus_nnz: D's entry k at map[k] of D_II (compressed) */
+    long *log_at;        /* the entries of D_II a try changed (as many as the pairs), */
+    double *log_v;       /* ... their values before */
+    int nlog;
+    double *wp; /* n: (W_I P)_i */
+    int *row;   /* m: a contact's row in the step's active set, -1 when
+                             inactive (set and cleared by slide_set) */
+    int *snext; /* n: the spring on a dof (-1: none) */
 };
 
 void mj_yield_free(pd_mj *mj)
@@ -95,10 +105,11 @@ void mj_yield_free(pd_mj *mj)
     mj_yield *y = mj->yl;
     if (!y)
         return;
-    void *arrays[] = {y->sdof, y->sfac,  y->up, y->vfree, y->vel,   y->col,   y->ys,    y->sigma,
-                      y->G,    y->block, y->dM, y->dC,    y->dK,    y->alone, y->uf,    y->mark,
-                      y->cidx, y->P0,    y->dP, y->yc,    y->what,  y->Ls,    y->Dsave, y->wp,
-                      y->dptr, y->dcon,  y->dw, y->pos,   y->snext, y->inc,   y->dcs,   y->bfree};
+    void *arrays[] = {y->sdof,  y->sfac,  y->up,  y->vfree, y->vel,  y->col,    y->ys,    y->sigma,
+                      y->G,     y->block, y->dM,  y->dC,    y->dK,   y->alone,  y->uf,    y->mark,
+                      y->cidx,  y->P0,    y->dP,  y->yc,    y->what, y->Linv,   y->wp,    y->pptr,
+                      y->pcol,  y->prow,  y->pk,  y->pw,    y->map,  y->log_at, y->log_v, y->row,
+                      y->snext, y->inc,   y->dcs, y->bfree};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(arrays[k]);
     free(y->L);
@@ -162,30 +173,38 @@ static int spring_dof(const pd_model *md, int j, double *s)
     return dof;
 }
 
-/* W^T by rows: the contacts on each dof and their W entries (dptr, dcon,
- * dw), in contact order; 0, or -1 out of memory. */
-static int dof_contacts(mj_yield *y, const pd_model *md)
+/* The pairs (a, b) of contacts on each spring's dof i (a one-dof spring's),
+ * W_ia W_ib and D_ab's entry in the factor's D: the sliding set's
+ * corrections of D_II.  0, or -1 out of memory. */
+static int dof_pairs(pd_mj *mj)
 {
-    int p, i;
-    double w;
-    for (int a = 0; a < md->m; a++) /* counts, then their starts */
-        for (p = -1; mj_col_next(&md->W, a, &p, &i, &w);)
-            y->dptr[i + 1]++;
-    for (i = 0; i < md->n; i++)
-        y->dptr[i + 1] += y->dptr[i];
-    int *fill = pd_calloc(md->n, sizeof(int));
-    y->dcon = pd_calloc(y->dptr[md->n], sizeof(int));
-    y->dw = pd_calloc(y->dptr[md->n], sizeof(double));
-    if (fill && y->dcon && y->dw)
-        for (int a = 0; a < md->m; a++)
-            for (p = -1; mj_col_next(&md->W, a, &p, &i, &w);) {
-                int q = y->dptr[i] + fill[i]++;
-                y->dcon[q] = a;
-                y->dw[q] = w;
+    const mj_incidence *in = &mj->inc;
+    mj_yield *y = mj->yl;
+    long np = 0;
+    for (int j = 0; j < y->ns; j++) {
+        int i = y->sdof[j], deg = i >= 0 ? in->dptr[i + 1] - in->dptr[i] : 0;
+        np += (long)deg * deg;
+        y->pptr[j + 1] = (int)np;
+    }
+    y->pcol = pd_calloc(np, sizeof(int));
+    y->prow = pd_calloc(np, sizeof(int));
+    y->pk = pd_calloc(np, sizeof(long));
+    y->pw = pd_calloc(np, sizeof(double));
+    y->log_at = pd_calloc(np, sizeof(long));
+    y->log_v = pd_calloc(np, sizeof(double));
+    if (!y->pcol || !y->prow || !y->pk || !y->pw || !y->log_at || !y->log_v)
+        return -1;
+    for (int j = 0; j < y->ns; j++) {
+        int i = y->sdof[j], p = y->pptr[j];
+        for (int q1 = i >= 0 ? in->dptr[i] : 0; i >= 0 && q1 < in->dptr[i + 1]; q1++)
+            for (int q2 = in->dptr[i]; q2 < in->dptr[i + 1]; q2++, p++) {
+                y->pcol[p] = in->con[q1];
+                y->prow[p] = in->con[q2];
+                y->pk[p] = pd_factor_delassus_at(mj->factor, in->con[q1], in->con[q2]);
+                y->pw[p] = in->wr[q1] * in->wr[q2];
             }
-    int rc = fill && y->dcon && y->dw ? 0 : -1;
-    free(fill);
-    return rc;
+    }
+    return 0;
 }
 
 int mj_yield_alloc(pd_mj *mj, pd_err *err)
@@ -224,29 +243,31 @@ int mj_yield_alloc(pd_mj *mj, pd_err *err)
     y->w = pd_malloc(MJY_CAP, sizeof(double));
     y->lemke = pd_lcp_alloc(MJY_CAP);
     y->what = pd_calloc(ns, sizeof(double));
-    y->Ls = pd_calloc(ns, sizeof(double));
+    y->Linv = pd_calloc(ns, sizeof(double));
     y->inc = pd_calloc(ns, sizeof(double));
     y->dcs = pd_calloc(ns, sizeof(double));
     y->bfree = pd_calloc(ns, sizeof(double));
-    y->Dcap = mj->factor && m > 0 ? (mj->sparse ? mj->factor->delassus_nnz : (long)m * m) : 0;
-    y->Dsave = pd_calloc(y->Dcap, sizeof(double));
+    y->has_D = mj->factor && m > 0;
+    y->map = pd_calloc(y->has_D && mj->sparse ? mj->factor->delassus_nnz : 0, sizeof(int));
+    y->pptr = pd_calloc(ns + 1L, sizeof(int));
     y->wp = pd_calloc(n, sizeof(double));
     y->snext = pd_calloc(n, sizeof(int));
-    y->pos = pd_calloc(m, sizeof(int));
-    y->dptr = pd_calloc(n + 1L, sizeof(int));
+    y->row = pd_malloc(m, sizeof(int));
     y->hth_set = NAN;
     if (!y->up || !y->vfree || !y->vel || !y->col || !y->ys || !y->sigma || !y->G || !y->block ||
         !y->dM || !y->dC || !y->dK || !y->alone || !y->uf || !y->mark || !y->cidx || !y->P0 ||
         !y->sdof || !y->sfac || !y->dP || !y->yc || !y->L || !y->b || !y->z || !y->w || !y->lemke ||
-        !y->what || !y->Ls || !y->Dsave || !y->wp || !y->snext || !y->pos || !y->dptr || !y->inc ||
+        !y->what || !y->Linv || !y->map || !y->pptr || !y->wp || !y->snext || !y->row || !y->inc ||
         !y->dcs || !y->bfree)
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for %d yielding springs", ns);
     blocks(y, md);
-    if (dof_contacts(y, md))
+    if (mj_incidence_build(mj))
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for %d yielding springs", ns);
     y->all_alone = y->one_per_dof = 1;
     for (int i = 0; i < n; i++)
         y->snext[i] = -1;
+    for (int a = 0; a < m; a++)
+        y->row[a] = -1;
     for (int j = 0; j < ns; j++) {
         y->sdof[j] = spring_dof(md, j, &y->sfac[j]);
         y->all_alone &= y->sdof[j] >= 0 && y->alone[y->sdof[j]];
@@ -255,6 +276,8 @@ int mj_yield_alloc(pd_mj *mj, pd_err *err)
             y->snext[y->sdof[j]] = j;
         }
     }
+    if (y->one_per_dof && y->has_D && dof_pairs(mj))
+        return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for %d yielding springs", ns);
     mj->st.up = y->up;
     return PD_OK;
 }
@@ -265,7 +288,7 @@ void mj_yield_reset(pd_mj *mj)
         return;
     memset(mj->yl->up, 0, (size_t)mj->yl->ns * sizeof(double));
     memset(mj->yl->sigma, 0, (size_t)mj->yl->ns);
-    mj->yl->ny_prev = 0;
+    mj->yl->ny_prev = mj->yl->moved = 0;
     mj->yl->set_tries = mj->yl->gs_steps = 0;
 }
 
@@ -275,11 +298,19 @@ void mj_yield_stats(const pd_mj *mj, long *set_tries, long *gs_steps)
     *gs_steps = mj->yl ? mj->yl->gs_steps : 0;
 }
 
-/* x += s S diag(ks) up (skipped for a zero offset: an elastic step's bits). */
+/* x += s S diag(ks) up (skipped while every offset is 0: an elastic step's
+ * bits; then branch-free where every spring is on one dof). */
 void mj_yield_force(const pd_mj *mj, double s, double *x)
 {
     const pd_model *md = mj->model;
     const mj_yield *y = mj->yl;
+    if (!y->moved)
+        return;
+    if (y->all_alone) { /* one dof each: the column's one entry, as col_axpy adds it */
+        for (int j = 0; j < md->ns; j++)
+            x[y->sdof[j]] += s * md->ks[j] * y->up[j] * y->sfac[j];
+        return;
+    }
     for (int j = 0; j < md->ns; j++) {
         if (y->up[j] == 0.0)
             continue;
@@ -312,14 +343,17 @@ static int grow(pd_mj *mj, const pd_state *out, double hth, int *ny)
 {
     const pd_model *md = mj->model;
     mj_yield *y = mj->yl;
+    const int *sdof = y->sdof;
+    const double *uy = md->uy, *q1 = out->q, *v = out->v;
     int changed = 0;
     for (int j = 0; j < md->ns; j++) {
-        int i = y->sdof[j]; /* one dof: z+ without a walk of S */
-        double zj = i >= 0 ? z_one(y, j, hth, out->q, out->v[i]) : z_end(mj, out, hth, j),
-               lim = md->uy[j] * (1.0 + MJY_SLACK);
-        /* a member's z+ is sigma uy at most; beyond -sigma uy it turns */
-        int side = zj > lim ? 1 : zj < -lim ? -1 : 0;
-        if (side == 0 || side == y->sigma[j])
+        int i = sdof[j]; /* one dof: z+ without a walk of S */
+        double zj = i >= 0 ? z_one(y, j, hth, q1, v[i]) : z_end(mj, out, hth, j),
+               lim = uy[j] * (1.0 + MJY_SLACK);
+        /* a member's z+ is sigma uy at most; beyond -sigma uy it turns
+         * (branch-free: the springs in Y sit on their level) */
+        int side = (zj > lim) - (zj < -lim);
+        if (!(side != 0 && side != y->sigma[j]))
             continue;
         if (y->sigma[j] == 0)
             y->ys[(*ny)++] = j;
@@ -473,7 +507,7 @@ static void set_constants(mj_yield *y, const pd_model *md, double hth)
         double s = y->sfac[j], ks = md->ks[j];
         double what = y->dM[i] + hth * (y->dC[i] + hth * y->dK[i]), r = hth * hth * ks * s * s;
         y->what[j] = what;
-        y->Ls[j] = ks - hth * hth * ks * ks * s * s / what;
+        y->Linv[j] = 1.0 / (ks - hth * hth * ks * ks * s * s / what);
         y->inc[j] = hth * ks * s / what;
         /* 1 / (What_ii - (h theta)^2 ks s^2) - 1 / What_ii: the post-yield What is
          * positive (k - ks s^2 >= 0) */
@@ -484,8 +518,8 @@ static void set_constants(mj_yield *y, const pd_model *md, double hth)
 
 /* b = ks (uy - sigma z) of spring j, z of the end state with its dof's
  * velocity vi (its own slide left out); q1 = q + h (1 - theta) v. */
-static double slide_b(const pd_model *md, const mj_yield *y, int j, double hth, const double *q1,
-                      double vi)
+static inline double slide_b(const pd_model *md, const mj_yield *y, int j, double hth,
+                             const double *q1, double vi)
 {
     return md->ks[j] * (md->uy[j] - y->sigma[j] * z_one(y, j, hth, q1, vi));
 }
@@ -502,7 +536,7 @@ static void slide_alone(pd_mj *mj, int ny, double hth, pd_state *out)
         if (i < 0 || !y->alone[i] || y->mark[find(y->uf, i)] != 4)
             continue;
         double b = slide_b(md, y, j, hth, out->q, y->vfree[i]);
-        y->G[j] = b < 0.0 ? -b / y->Ls[j] : 0.0;
+        y->G[j] = b < 0.0 ? -b * y->Linv[j] : 0.0;
         out->v[i] = y->vfree[i] + y->sigma[j] * y->inc[j] * y->G[j];
     }
 }
@@ -546,7 +580,7 @@ static int slide_gs(pd_mj *mj, const pd_factor *f, int nI, int *ny, double hth, 
             double inc = y->sigma[j] * y->inc[j];
             double vi = out->v[i] - inc * y->G[j]; /* without its own slide */
             double b = slide_b(md, y, j, hth, out->q, vi);
-            double G = b < 0.0 ? -b / y->Ls[j] : 0.0;
+            double G = b < 0.0 ? -b * y->Linv[j] : 0.0;
             moved = fmax(moved, fabs(G - y->G[j]) / md->uy[j]);
             y->G[j] = G;
             out->v[i] = vi + inc * G;
@@ -562,28 +596,25 @@ static int slide_gs(pd_mj *mj, const pd_factor *f, int nI, int *ny, double hth, 
 
 /* ---- rows of SDOFs: the sliding set in the contacts' LCP ---------------- */
 
-/* This step's active rows of the contacts (pos). */
-static void set_positions(pd_mj *mj, int nI)
+/* This step's active rows of the contacts (row), or -1 for all again (clear). */
+static void set_rows(pd_mj *mj, int nI, int clear)
 {
     mj_yield *y = mj->yl;
-    y->nI = nI;
     for (int r = 0; r < nI; r++)
-        y->pos[mj->idx_active[r]] = r;
+        y->row[mj->idx_active[r]] = clear ? -1 : r;
 }
 
 /* Contact a's active row this step, or -1. */
 static int active_row(const pd_mj *mj, int a)
 {
-    int r = mj->yl->pos[a];
-    return r >= 0 && r < mj->yl->nI && mj->idx_active[r] == a ? r : -1;
+    return mj->yl->row[a];
 }
 
 /* Whether an active contact pushes on dof i. */
 static int pushed(const pd_mj *mj, int i)
 {
-    const mj_yield *y = mj->yl;
-    for (int q = y->dptr[i]; q < y->dptr[i + 1]; q++) {
-        int r = active_row(mj, y->dcon[q]);
+    for (int q = mj->inc.dptr[i]; q < mj->inc.dptr[i + 1]; q++) {
+        int r = active_row(mj, mj->inc.con[q]);
         if (r >= 0 && mj->P_active[r] > 0.0)
             return 1;
     }
@@ -594,89 +625,108 @@ static int pushed(const pd_mj *mj, int i)
 static int contacts_hold(const pd_mj *mj, int i, const double *v)
 {
     const pd_model *md = mj->model;
-    const mj_yield *y = mj->yl;
-    for (int q = y->dptr[i]; q < y->dptr[i + 1]; q++) {
-        int a = y->dcon[q];
-        if (active_row(mj, a) >= 0 && pd_matrix_col_dot(&md->W, a, v) + md->e[a] * mj->U0[a] < 0.0)
+    for (int q = mj->inc.dptr[i]; q < mj->inc.dptr[i + 1]; q++) {
+        int a = mj->inc.con[q];
+        if (active_row(mj, a) >= 0 && mj_inc_dot(&mj->inc, a, v) + md->e[a] * mj->U0[a] < 0.0)
             return 0;
     }
     return 1;
 }
 
-/* D_II (restored from Dsave when restore) corrected on the sliding dofs, D_ab += W_ia
- * W_ib dc_i over the pairs of active contacts on dof i.  0, or 1 when an
- * entry falls outside D's pattern (Gauss-Seidel then). */
-static int set_delassus(pd_mj *mj, int nI, int ny, int restore)
+/* D_II corrected on the sliding dofs: D_ab += W_ia W_ib dc_j over the
+ * pairs of active contacts on spring j's dof i, each at its place (dense;
+ * compressed: D's entry's, through map).  0, or 1 when an entry falls
+ * outside D's pattern (Gauss-Seidel then). */
+static int set_delassus(pd_mj *mj, int nI, int ny)
 {
     mj_yield *y = mj->yl;
-    long nnz = mj->sparse ? mj->D_colptr[nI] : (long)nI * nI;
-    if (restore) /* a try after the first: D_II as the factor gave it */
-        memcpy(mj->D_active, y->Dsave, (size_t)nnz * sizeof(double));
     for (int k = 0; k < ny; k++) {
-        int j = y->ys[k], i = y->sdof[j];
-        for (int q1 = y->dptr[i]; q1 < y->dptr[i + 1]; q1++) {
-            int col = active_row(mj, y->dcon[q1]);
-            for (int q2 = y->dptr[i]; col >= 0 && q2 < y->dptr[i + 1]; q2++) {
-                int row = active_row(mj, y->dcon[q2]), at = -1;
-                if (row < 0)
-                    continue;
-                if (!mj->sparse)
-                    at = row + col * nI;
-                else
-                    for (int q = mj->D_colptr[col]; q < mj->D_colptr[col + 1] && at < 0; q++)
-                        at = mj->D_rowind[q] == row ? q : -1;
-                if (at < 0)
-                    return 1;
-                mj->D_active[at] += y->dw[q1] * y->dw[q2] * y->dcs[j];
-            }
+        int j = y->ys[k];
+        double dc = y->dcs[j];
+        for (int p = y->pptr[j]; p < y->pptr[j + 1]; p++) {
+            int col = y->row[y->pcol[p]], row = y->row[y->prow[p]];
+            if (col < 0 || row < 0)
+                continue;
+            long at = !mj->sparse ? row + (long)col * nI : y->pk[p] < 0 ? -1 : y->map[y->pk[p]];
+            if (at < 0)
+                return 1;
+            y->log_at[y->nlog] = at; /* the entry as it was, for the next try */
+            y->log_v[y->nlog++] = mj->D_active[at];
+            mj->D_active[at] += y->pw[p] * dc;
         }
     }
     return 0;
+}
+
+/* A sliding spring j's constant part on its dof i's v (from vfree):
+ * -sigma inc b / L; no push yet. */
+static inline void slide_free(mj_yield *y, int j, int i, double *v)
+{
+    v[i] -= y->sigma[j] * y->inc[j] * y->bfree[j] * y->Linv[j];
+    y->wp[i] = 0.0;
+}
+
+/* The sliding set's start, from the springs that slid in the last step
+ * (ys, *ny; out->v = vfree): each stays in Y where the last step's push on
+ * its dof would leave it sliding (b = bfree - sigma inc (W_I P)_i <= 0),
+ * its constant part on out->v; the others leave. */
+static void slide_start(pd_mj *mj, int *ny, double hth, pd_state *out)
+{
+    const pd_model *md = mj->model;
+    mj_yield *y = mj->yl;
+    int kept = 0;
+    for (int k = 0; k < *ny; k++) {
+        int j = y->ys[k], i = y->sdof[j];
+        y->bfree[j] = slide_b(md, y, j, hth, out->q, y->vfree[i]);
+        if (y->bfree[j] - y->sigma[j] * y->inc[j] * y->wp[i] <= 0.0) {
+            y->ys[kept++] = j;
+            slide_free(y, j, i, out->v);
+        } else
+            y->sigma[j] = 0;
+    }
+    *ny = kept;
 }
 
 /* The contacts' LCP with the slides of Y taken as sliding (each G solved
  * for and put in): a sliding dof starts from vfree_i - sigma inc b / L and
  * answers an impulse with the post-yield compliance; then v+ on out->v and
  * (W_I P)_i of each sliding dof in y->wp.  The Delassus block is built at
- * the first call of a step (*built) and kept in Dsave; with Y empty the
+ * the first call of a step (*built), its entries that a try changes put
+ * back at the next (the log); with Y empty the
  * step's contacts are the elastic step's, bit for bit.  0, 1 (Gauss-Seidel
  * takes the step), or an error. */
 static int set_contacts(pd_mj *mj, const pd_factor *f, int nI, int ny, double hth, double t1,
-                        int *built, pd_state *out, pd_err *err)
+                        int first, int *built, pd_state *out, pd_err *err)
 {
     const pd_model *md = mj->model;
     mj_yield *y = mj->yl;
-    int rc, fresh = !*built; /* the step's first try: out->v is vfree, D_II not built */
-    if (!fresh)
+    /* the step's first try: out->v and bfree as slide_start left them */
+    int rc;
+    if (!first)
         memcpy(out->v, y->vfree, (size_t)md->n * sizeof(double));
-    for (int k = 0; k < ny; k++) { /* the slides' constant parts */
+    for (int k = 0; k < ny && !first; k++) { /* the slides' constant parts (slide_start's) */
         int j = y->ys[k], i = y->sdof[j];
         y->bfree[j] = slide_b(md, y, j, hth, out->q, y->vfree[i]);
-        out->v[i] -= y->sigma[j] * y->inc[j] * y->bfree[j] / y->Ls[j];
-        y->wp[i] = 0.0;
+        slide_free(y, j, i, out->v);
     }
     if (nI == 0)
         return PD_OK;
-    long nnz;
-    if (ny == 0) { /* no slide: the elastic step's contacts */
-        if (*built)
-            memcpy(mj->D_active, y->Dsave,
-                   (size_t)(mj->sparse ? mj->D_colptr[nI] : (long)nI * nI) * sizeof(double));
-        if ((rc = mj_contacts_apply(mj, f, nI, *built, t1, out, err)))
-            return rc;
-    } else if (!*built && mj->sparse)
-        pd_factor_delassus_csc(f, mj->idx_active, nI, mj->D_colptr, mj->D_rowind, mj->D_active);
-    else if (!*built)
-        pd_factor_delassus_dense(f, mj->idx_active, nI, mj->D_active);
-    if (!*built) { /* D_II as the factor gives it, kept for the tries */
-        if ((nnz = mj->sparse ? mj->D_colptr[nI] : (long)nI * nI) > y->Dcap)
-            return 1;
-        memcpy(y->Dsave, mj->D_active, (size_t)nnz * sizeof(double));
+    if (!*built) { /* D_II as the factor gives it (and where D's entries went) */
+        if (mj->sparse)
+            pd_factor_delassus_csc(f, mj->idx_active, nI, mj->D_colptr, mj->D_rowind, mj->D_active,
+                                   y->map);
+        else
+            pd_factor_delassus_dense(f, mj->idx_active, nI, mj->D_active);
+        y->nlog = 0;
         *built = 1;
     }
-    if (ny == 0)
-        return PD_OK;
-    if (set_delassus(mj, nI, ny, !fresh))
+    while (y->nlog > 0) { /* a later try: the entries the last one changed, back */
+        y->nlog--;
+        mj->D_active[y->log_at[y->nlog]] = y->log_v[y->nlog];
+    }
+    if (ny == 0) /* no slide: the elastic step's contacts */
+        return mj_contacts_apply(mj, f, nI, 1, t1, out, err);
+    if (set_delassus(mj, nI, ny))
         return 1;
     mj_active_rhs(mj, nI, out->v);
     if ((rc = mj_impact_active(mj, nI, t1, out, err)))
@@ -685,9 +735,9 @@ static int set_contacts(pd_mj *mj, const pd_factor *f, int nI, int ny, double ht
     for (int k = 0; k < ny; k++) { /* the sliding dofs' extra compliance */
         int j = y->ys[k], i = y->sdof[j];
         double s = 0.0;
-        for (int q = y->dptr[i]; q < y->dptr[i + 1]; q++) {
-            int r = active_row(mj, y->dcon[q]);
-            s += r >= 0 ? y->dw[q] * mj->P_active[r] : 0.0;
+        for (int q = mj->inc.dptr[i]; q < mj->inc.dptr[i + 1]; q++) {
+            int r = active_row(mj, mj->inc.con[q]);
+            s += r >= 0 ? mj->inc.wr[q] * mj->P_active[r] : 0.0;
         }
         y->wp[i] = s;
         out->v[i] += y->dcs[j] * s;
@@ -704,11 +754,12 @@ static int slide_unpushed(pd_mj *mj, int j, double hth, pd_state *out)
     const pd_model *md = mj->model;
     mj_yield *y = mj->yl;
     int i = y->sdof[j];
-    double G = y->sigma[j] ? -slide_b(md, y, j, hth, out->q, y->vfree[i]) / y->Ls[j] : 0.0;
+    double G = y->sigma[j] ? -slide_b(md, y, j, hth, out->q, y->vfree[i]) * y->Linv[j] : 0.0;
     y->G[j] = G > 0.0 ? G : 0.0;
     if (!(G > 0.0))
         y->sigma[j] = 0;
     out->v[i] = y->vfree[i] + y->sigma[j] * y->inc[j] * y->G[j];
+    y->wp[i] = 0.0; /* no contact pushes on the dof */
     return contacts_hold(mj, i, out->v);
 }
 
@@ -719,22 +770,21 @@ static int slide_unpushed(pd_mj *mj, int j, double hth, pd_state *out)
  * contact pushes is made there (slide_unpushed: the others' impulses stay
  * a solution while that dof's contacts hold); any other takes the LCP
  * again, until nothing changes.  0, 1 when MJY_SET_MAX tries do not settle
- * it (Gauss-Seidel then), or an error. */
-static int slide_set(pd_mj *mj, const pd_factor *f, int nI, int *ny, double hth, double t1,
-                     pd_state *out, pd_err *err)
+ * it (Gauss-Seidel then), or an error.  The active rows are set (set_rows). */
+static int slide_tries(pd_mj *mj, const pd_factor *f, int nI, int *ny, double hth, double t1,
+                       pd_state *out, pd_err *err)
 {
     mj_yield *y = mj->yl;
     int built = 0, rc;
-    set_positions(mj, nI);
     for (int it = 0; it < MJY_SET_MAX; it++) {
         y->set_tries++;
-        if ((rc = set_contacts(mj, f, nI, *ny, hth, t1, &built, out, err)))
+        if ((rc = set_contacts(mj, f, nI, *ny, hth, t1, it == 0, &built, out, err)))
             return rc;
         int kept = 0, again = 0;
         for (int k = 0; k < *ny; k++) {
             int j = y->ys[k], i = y->sdof[j];
             double b = y->bfree[j] - y->sigma[j] * y->inc[j] * y->wp[i];
-            y->G[j] = -b / y->Ls[j];
+            y->G[j] = -b * y->Linv[j];
             if (y->G[j] >= 0.0) {
                 y->ys[kept++] = j;
                 continue;
@@ -767,6 +817,18 @@ static int slide_set(pd_mj *mj, const pd_factor *f, int nI, int *ny, double hth,
     return 1;
 }
 
+/* slide_start and slide_tries with this step's active rows (cleared
+ * after). */
+static int slide_set(pd_mj *mj, const pd_factor *f, int nI, int *ny, double hth, double t1,
+                     pd_state *out, pd_err *err)
+{
+    set_rows(mj, nI, 0);
+    slide_start(mj, ny, hth, out);
+    int rc = slide_tries(mj, f, nI, ny, hth, t1, out, err);
+    set_rows(mj, nI, 1);
+    return rc;
+}
+
 int mj_yield_step(pd_mj *mj, const pd_factor *f, double h, int nI, double t1, pd_state *out,
                   pd_err *err)
 {
@@ -778,14 +840,8 @@ int mj_yield_step(pd_mj *mj, const pd_factor *f, double h, int nI, double t1, pd
     set_constants(y, md, hth);
     if (y->all_alone && mj->opts.yield_lcp_max <= 0) { /* rows of SDOFs */
         /* its start: the springs that slid in the last step, with their slides */
-        for (int k = 0; k < y->ny_prev; k++) {
-            int j = y->ys[k];
-            if (y->G[j] > 0.0)
-                y->ys[ny++] = j;
-            else
-                y->sigma[j] = 0;
-        }
-        rc = mj->opts.yield_lcp_max == 0 && y->one_per_dof && (y->Dcap > 0 || md->m == 0)
+        ny = y->ny_prev;
+        rc = mj->opts.yield_lcp_max == 0 && y->one_per_dof && (y->has_D || md->m == 0)
                  ? slide_set(mj, f, nI, &ny, hth, t1, out, err)
                  : 1;
         if (rc > 0) { /* not settled: Gauss-Seidel from vfree and the slides found */
@@ -799,6 +855,7 @@ int mj_yield_step(pd_mj *mj, const pd_factor *f, double h, int nI, double t1, pd
         for (int k = 0; k < ny; k++) {
             int j = y->ys[k];
             y->up[j] += y->sigma[j] * y->G[j];
+            y->moved |= y->G[j] > 0.0;
             if (y->G[j] > 0.0) /* kept for the next step's start, in order */
                 y->ys[slid++] = j;
             else
@@ -857,7 +914,9 @@ int mj_yield_step(pd_mj *mj, const pd_factor *f, double h, int nI, double t1, pd
         slide_alone(mj, ny, hth, out);
     }
     /* the offsets move by sigma G */
-    for (int k = 0; k < ny; k++)
+    for (int k = 0; k < ny; k++) {
         y->up[y->ys[k]] += y->sigma[y->ys[k]] * y->G[y->ys[k]];
+        y->moved |= y->G[y->ys[k]] > 0.0;
+    }
     return PD_OK;
 }

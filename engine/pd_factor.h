@@ -26,9 +26,13 @@ typedef struct pd_factor_type {
     /* D_II into a dense nI x nI column-major array */
     void (*delassus_dense)(const pd_factor *f, const int *idx, int nI, double *D);
     /* D_II in compressed columns (row indices increasing, idx increasing);
-     * returns the entries (at most delassus_nnz) */
+     * returns the entries (at most delassus_nnz).  map (or NULL): for each
+     * entry of D gathered, map[k] = its place in values, k as delassus_at */
     int (*delassus_csc)(const pd_factor *f, const int *idx, int nI, int *colptr, int *rowind,
-                        double *values);
+                        double *values, int *map);
+    /* the index k < delassus_nnz of D's stored entry (a, b) (the contacts'),
+     * or -1 where D keeps none */
+    long (*delassus_at)(const pd_factor *f, int a, int b);
     void (*release)(pd_factor *f);
 } pd_factor_type;
 
@@ -64,17 +68,23 @@ static inline void pd_factor_delassus_dense(const pd_factor *f, const int *idx, 
     f->type->delassus_dense(f, idx, nI, D); /* D_II = W_I^T What^-1 W_I */
 }
 static inline int pd_factor_delassus_csc(const pd_factor *f, const int *idx, int nI, int *colptr,
-                                         int *rowind, double *values)
+                                         int *rowind, double *values, int *map)
 {
-    return f->type->delassus_csc(f, idx, nI, colptr, rowind, values); /* its entries */
+    return f->type->delassus_csc(f, idx, nI, colptr, rowind, values, map); /* its entries */
+}
+static inline long pd_factor_delassus_at(const pd_factor *f, int a, int b)
+{
+    return f->type->delassus_at(f, a, b); /* D_ab's place, or -1 */
 }
 
 /* ---- helpers the dense kinds share (factor.c) ------------------------------ */
 
+/* The place of D_ab (column a, row b) in a dense m x m D, or -1 for an exact zero. */
+long pd_factor_dense_at(const double *D, int m, int a, int b);
 /* D_II from a dense m x m D. */
 void pd_factor_gather_dense(const double *D, int m, const int *idx, int nI, double *out);
 /* D_II from a dense m x m D into compressed columns (entries that are 0 dropped). */
 int pd_factor_gather_dense_csc(const double *D, int m, const int *idx, int nI, int *colptr,
-                               int *rowind, double *values);
+                               int *rowind, double *values, int *map);
 
 #endif

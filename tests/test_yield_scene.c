@@ -288,7 +288,7 @@ static void test_yield_scene_gauss_seidel(pd_test_ctx *ctx)
         pd_mj_stats ms;
         pd_mj_get_stats(mj, &ms);
         pd_mj_free(mj);
-        /* the sliding set takes every step (about 1.3 tries each), Gauss-Seidel none;
+        /* the sliding set takes every step (about 1.0 tries each), Gauss-Seidel none;
          * asked for, Gauss-Seidel every one */
         printf("    yield_lcp_max %d: complementarity within %.2g; %ld sliding-set tries, %ld "
                "Gauss-Seidel steps over %ld\n",
@@ -324,7 +324,8 @@ static void test_yield_scene_gauss_seidel(pd_test_ctx *ctx)
 /* A compressed row (the bench's: 40 SDOFs, periods 1 and 1.5 s, gaps 0.01
  * Le, e 0, a harmonic excitation; every SDOF yielding, Piy 0.5, alpha 0.05):
  * many slides start and stop where contacts push, so the sliding set tries
- * the LCP again (measured 1.1 tries a step) and its changes where no
+ * the LCP again (measured 1.03 tries a step: the start keeps the springs
+ * the last step's push leaves sliding) and its changes where no
  * contact pushes are made locally; every step's complementarity holds (to
  * 1e-12 of its terms), Gauss-Seidel never takes a step, and the run equals
  * Gauss-Seidel's to 1e-9 of the peaks; so with What factored by CHOLMOD
@@ -373,7 +374,7 @@ static void test_yield_scene_sliding_set_compressed(pd_test_ctx *ctx)
            "%.2g of the peak from Gauss-Seidel and CHOLMOD's (offsets up to %.3g)\n",
            tries, g[0].bad, g[2].bad, d, g[0].upmax);
     CHECK(ctx,
-          ms[0].yield_gs_steps == 0 && ms[2].yield_gs_steps == 0 && tries > 1.05 && d <= 1e-9 &&
+          ms[0].yield_gs_steps == 0 && ms[2].yield_gs_steps == 0 && tries > 1.01 && d <= 1e-9 &&
               g[0].upmax > 0.0,
           "%ld and %ld Gauss-Seidel steps, %.3g tries a step, %.3g apart", ms[0].yield_gs_steps,
           ms[2].yield_gs_steps, tries, d);
