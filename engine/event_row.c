@@ -110,7 +110,8 @@ pd_edr_opts pd_edr_default_opts(void)
                          .lcp_solver = PD_LCP_AUTO,
                          .impact_law = PD_IMPACT_STAGED,
                          .on_event = NULL,
-                         .on_event_ctx = NULL};
+                         .on_event_ctx = NULL,
+                         .energy = 0};
 }
 
 /* ---- the queue ----------------------------------------------------------------- */
@@ -576,39 +577,43 @@ static void predict_detach(pd_edr *r, int c, double ts, int cont)
     q_set(&r->rs.q, slot, tw < tend ? tw : HUGE_VAL);
 }
 
-/* A yielding spring's event function (spring j, its dof's cluster c):
- * elastic, z^2 - uy^2 with z = sig x - up (positive past either level: an
- * onset); sliding toward ph, -ph sig v (positive once the drift turns
- * back: the unloading). */
+/* A yielding spring's event function (spring j, its structure's cluster
+ * c): elastic, z^2 - uy^2 with z = d - up, d its drift (positive past
+ * either level: an onset); sliding toward ph, -ph d' (positive once the
+ * drift turns back: the unloading). */
 typedef struct spring_ctx {
     pd_edr *r;
-    int c, dof;
-    double sig, up, uy, ph;
+    int c, j;
+    double up, uy, ph;
 } spring_ctx;
 
 static void spring_fn(void *vctx, double t, double out[3])
 {
     spring_ctx *g = vctx;
-    double dx, v, a;
-    edr_dof_at(g->r, g->c, g->dof, t, &dx, &v, &a);
+    double d, dd, ddd;
+    edr_spring_at(g->r, g->c, g->j, t, &d, &dd, &ddd);
     if (g->ph == 0.0) {
-        double z = g->sig * (g->r->rs.xo[g->dof] + dx) - g->up, dz = g->sig * v;
+        double z = d - g->up;
         out[0] = (z - g->uy) * (z + g->uy);
-        out[1] = 2.0 * z * dz;
-        out[2] = 2.0 * (dz * dz + z * g->sig * a);
+        out[1] = 2.0 * z * dd;
+        out[2] = 2.0 * (dd * dd + z * ddd);
         return;
     }
-    double k = -g->ph * g->sig;
-    out[0] = k * v;
-    out[1] = k * a;
-    out[2] = k * edr_dof_jerk(g->r, g->c, g->dof, t);
+    /* the drift's jerk: its dofs' */
+    const pd_edr *r = g->r;
+    double jerk = r->tp.sp_sig[g->j] * edr_dof_jerk(g->r, g->c, r->tp.sp_dof[g->j], t);
+    if (r->tp.sp_dof2[g->j] >= 0)
+        jerk += r->tp.sp_sig2[g->j] * edr_dof_jerk(g->r, g->c, r->tp.sp_dof2[g->j], t);
+    out[0] = -g->ph * dd;
+    out[1] = -g->ph * ddd;
+    out[2] = -g->ph * jerk;
 }
 
 /* Spring j's next onset or unloading after ts, or the end of its scan
  * window (as predict_contact's windows). */
 static void predict_spring(pd_edr *r, int j, double ts, int cont)
 {
-    int slot = r->rs.slot_spring0 + j, dof = r->tp.sp_dof[j], c = cl_of_dof(r, dof);
+    int slot = r->rs.slot_spring0 + j, c = cl_of_dof(r, r->tp.sp_dof[j]);
     const edr_cluster *cl = &r->rs.cl[c];
     if (cl->kind == EDR_REST) { /* held still: no drift changes (its release re-predicts) */
         q_set(&r->rs.q, slot, HUGE_VAL);
@@ -616,16 +621,15 @@ static void predict_spring(pd_edr *r, int j, double ts, int cont)
     }
     spring_ctx g = {.r = r,
                     .c = c,
-                    .dof = dof,
-                    .sig = r->tp.sp_sig[j],
+                    .j = j,
                     .up = r->rs.sp_up[j],
                     .uy = r->tp.md->uy[j],
                     .ph = r->rs.sp_phase[j]};
     /* rounding levels: of z^2 - uy^2, or of the drift's rate */
-    double dx, v, a;
-    edr_dof_at(r, c, dof, ts, &dx, &v, &a);
-    double thr = g.ph == 0.0 ? EDR_GAP_ROUND * g.uy * g.uy
-                             : EDR_RATE_TOL * fmax(r->rs.vscale, fabs(g.sig * v));
+    double d, dd, ddd;
+    edr_spring_at(r, c, j, ts, &d, &dd, &ddd);
+    double thr =
+        g.ph == 0.0 ? EDR_GAP_ROUND * g.uy * g.uy : EDR_RATE_TOL * fmax(r->rs.vscale, fabs(dd));
     edr_scan s = {
         .fn = spring_fn, .ctx = &g, .hit_mode = 1, .thr = thr, .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
     double h = cl->h, tw = window_end(r, slot, cont, ts, h);
@@ -640,8 +644,8 @@ static void predict_spring(pd_edr *r, int j, double ts, int cont)
 static void predict_cluster_springs(pd_edr *r, int c, double ts)
 {
     for (int b = r->rs.cl[c].head; b >= 0 && r->tp.ns > 0; b = r->rs.blk_next[b])
-        if (r->tp.blk[b].spring >= 0)
-            predict_spring(r, r->tp.blk[b].spring, ts, 0);
+        for (int k = 0; k < r->tp.blk[b].nsp; k++)
+            predict_spring(r, r->tp.blk_sp[r->tp.blk[b].sp0 + k], ts, 0);
 }
 
 /* ---- measurements ----------------------------------------------------------------- */
@@ -932,6 +936,69 @@ static void integrate_held(pd_edr *r, int c, double tb)
     r->rs.evals = evals;
 }
 
+/* The energy balance's integrals over cluster c's flight from its en_t to
+ * tb: input int (b f) . v dt and damping int v^T C v dt, 5-point
+ * Gauss-Legendre on sub-intervals no wider than the scan step (as
+ * integrate_held); the cache and the evaluation count left as they were. */
+static void integrate_energy(pd_edr *r, int c, double tb)
+{
+    static const double xg[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831,
+                                 0.9061798459386640};
+    static const double wg[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889,
+                                 0.4786286704993665, 0.2369268850561891};
+    edr_cluster *cl = &r->rs.cl[c];
+    double ta = cl->en_t;
+    if (!r->tp.o.energy || !(tb > ta)) {
+        cl->en_t = fmax(ta, tb);
+        return;
+    }
+    cl->en_t = tb;
+    long evals = r->rs.evals;
+    int cached = cl->cached;
+    double tc = cl->tc, *v = r->ev.wk; /* v by global dof (the cluster's entries) */
+    double h = cl->h > 0.0 ? cl->h : tb - ta;
+    long n = (long)ceil((tb - ta) / h);
+    if (n < 1)
+        n = 1;
+    double w = (tb - ta) / (double)n, input = 0.0, damping = 0.0;
+    for (long i = 0; i < n; i++) {
+        double mid = ta + ((double)i + 0.5) * w;
+        for (int k = 0; k < 5; k++) {
+            double t = mid + 0.5 * w * xg[k], f = edr_force(r, cl->piece, t), pin = 0.0, pd = 0.0;
+            for (int b = cl->head; b >= 0; b = r->rs.blk_next[b]) {
+                const edr_block *bk = &r->tp.blk[b];
+                const double *Cb = r->tp.Cb + r->tp.blk_off[b];
+                for (int l = 0; l < bk->n; l++) {
+                    int gi = r->tp.blk_dofs[bk->first + l];
+                    double dx, a;
+                    edr_dof_at(r, c, gi, t, &dx, &v[gi], &a);
+                    pin += r->tp.b[gi] * v[gi];
+                }
+                for (int l = 0; l < bk->n; l++) /* v^T C_b v, C_b column-major */
+                    for (int m = 0; m < bk->n; m++)
+                        pd += v[r->tp.blk_dofs[bk->first + l]] * Cb[l + (long)m * bk->n] *
+                              v[r->tp.blk_dofs[bk->first + m]];
+            }
+            input += 0.5 * w * wg[k] * f * pin;
+            damping += 0.5 * w * wg[k] * pd;
+        }
+    }
+    r->rs.e_input += input;
+    r->rs.e_damping += damping;
+    if (cached)
+        edr_cluster_eval(r, c, tc);
+    r->rs.evals = evals;
+}
+
+/* v^T M v / 2 over the listed dofs of the velocities v (global index). */
+static double kinetic_of(const pd_edr *r, const int *dofs, int nd, const double *v)
+{
+    double ke = 0.0;
+    for (int k = 0; k < nd; k++)
+        ke += 0.5 * v[dofs[k]] * v[dofs[k]] / r->tp.minv[dofs[k]];
+    return ke;
+}
+
 /* The state at t of every dof of the group (gx, gv), measured flights. */
 static void group_state(pd_edr *r, double t)
 {
@@ -941,6 +1008,7 @@ static void group_state(pd_edr *r, double t)
         /* held forces integrated and extremes measured up to t, before the
          * flights change at t */
         integrate_held(r, c, t);
+        integrate_energy(r, c, t);
         measure_cluster(r, c, t);
         for (int b = r->rs.cl[c].head; b >= 0; b = r->rs.blk_next[b]) {
             const edr_block *bk = &r->tp.blk[b];
@@ -954,6 +1022,8 @@ static void group_state(pd_edr *r, double t)
                 measure_contact(r, r->tp.blk_cont[bk->cont0 + k], t);
         }
     }
+    if (r->tp.o.energy) /* before the event: its losses are what the new flights lack */
+        r->rs.ke_group = kinetic_of(r, r->ev.g_dof, r->ev.ngd, r->ev.gv);
 }
 
 /* ---- the contact LCPs ----------------------------------------------------------------- */
@@ -1122,6 +1192,22 @@ static int solve_lcp(pd_edr *r, const int *idx, int k, const double *q, double *
     return PD_OK;
 }
 
+/* Spring j's offset force on dof i, ks s_ji up with up from the dofs'
+ * positions x (konst; sliding: up = d(x) - ph uy), or its rate from their
+ * velocities x (!konst: a slide's d(x), an elastic spring's 0). */
+static double spring_offset_force(const pd_edr *r, int j, int i, const double *x, int konst)
+{
+    double sij = r->tp.sp_dof[j] == i    ? r->tp.sp_sig[j]
+                 : r->tp.sp_dof2[j] == i ? r->tp.sp_sig2[j]
+                                         : 0.0;
+    int ph = r->rs.sp_phase[j];
+    if (sij == 0.0 || (!konst && ph == 0))
+        return 0.0;
+    double up =
+        ph == 0 ? r->rs.sp_up[j] : edr_spring_drift(r, j, x) - (konst ? ph * r->tp.md->uy[j] : 0.0);
+    return r->tp.md->ks[j] * sij * up;
+}
+
 /* out = M^-1 (b f - C v - K x) over the group's dofs (global index): the
  * free accelerations from (x, v) = (gx, gv) and f(t), the free jerks from
  * (v, a) and f'(t). */
@@ -1149,6 +1235,8 @@ static void group_rhs(pd_edr *r, double f, const double *x, const double *v, int
             s -= r->tp.Cb[off + li + (long)jj * bk->n] * v[gj] +
                  r->tp.Kb[off + li + (long)jj * bk->n] * x[gj];
         }
+        for (int l = 0; l < bk->nsp; l++) /* its yielding springs' offsets: + S ks up */
+            s += spring_offset_force(r, r->tp.blk_sp[bk->sp0 + l], i, x, konst);
         out[i] = s * r->tp.minv[i];
     }
 }
@@ -1322,6 +1410,10 @@ static int regroup(pd_edr *r, double t, pd_err *err)
         /* each new cluster's flight: an SDOF tree, a REST tree or modal */
         if ((rc = edr_cluster_start(r, r->ev.g_cl[i], t, err)))
             return rc;
+    /* the kinetic energy the event took: the impacts', and what the held
+     * contacts' starts projected away (forces are continuous) */
+    if (r->tp.o.energy)
+        r->rs.e_impact += r->rs.ke_group - kinetic_of(r, r->ev.g_dof, r->ev.ngd, r->rs.vo);
     return PD_OK;
 }
 
@@ -2474,8 +2566,8 @@ static int on_spring(pd_edr *r, int j, double t, pd_err *err)
     group_state(r, t);
     hold_closed(r);
     /* elastic: a slide toward the level passed; sliding: the drift turned back */
-    double x = r->ev.gx[dof], z = r->tp.sp_sig[j] * x - r->rs.sp_up[j];
-    edr_spring_set(r, j, x, r->rs.sp_phase[j] != 0 ? 0 : z > 0.0 ? 1 : -1);
+    double d = edr_spring_drift(r, j, r->ev.gx), z = d - r->rs.sp_up[j];
+    edr_spring_set(r, j, d, r->rs.sp_phase[j] != 0 ? 0 : z > 0.0 ? 1 : -1);
     if ((rc = regroup(r, t, err)))
         return rc;
     repredict(r, t);
@@ -2546,14 +2638,20 @@ static int on_piece(pd_edr *r, double t, pd_err *err)
     return PD_OK;
 }
 
-/* The springs' offsets at t into sp_now (a slide's from its dof's x). */
+/* The springs' offsets at t into sp_now (a slide's from its drift). */
 static void spring_offsets(pd_edr *r, double t)
 {
     for (int j = 0; j < r->tp.ns; j++) {
-        double x = 0.0, v, a;
-        if (r->rs.sp_phase[j] != 0) /* a slide's offset moves with its dof */
+        double d = 0.0, x, v, a;
+        if (r->rs.sp_phase[j] != 0) { /* a slide's offset moves with its drift */
             dof_state(r, r->tp.sp_dof[j], t, &x, &v, &a);
-        r->rs.sp_now[j] = edr_spring_up(r, j, x);
+            d = r->tp.sp_sig[j] * x;
+            if (r->tp.sp_dof2[j] >= 0) {
+                dof_state(r, r->tp.sp_dof2[j], t, &x, &v, &a);
+                d += r->tp.sp_sig2[j] * x;
+            }
+        }
+        r->rs.sp_now[j] = edr_spring_up(r, j, d);
     }
 }
 
@@ -2616,7 +2714,10 @@ static int emit(pd_edr *r, double t, pd_observer obs, void *ctx)
 /* The yielding springs. */
 #define EDR_SPRING_ARRAYS(X)                                                                       \
     X(tp.sp_dof, int, ns)                                                                          \
+    X(tp.sp_dof2, int, ns)                                                                         \
     X(tp.sp_sig, double, ns)                                                                       \
+    X(tp.sp_sig2, double, ns)                                                                      \
+    X(tp.blk_sp, int, ns)                                                                          \
     X(rs.sp_phase, signed char, ns)                                                                \
     X(rs.sp_up, double, ns)                                                                        \
     X(rs.sp_upx, double, ns)                                                                       \
@@ -2728,7 +2829,7 @@ static int emit(pd_edr *r, double t, pd_observer obs, void *ctx)
     X(ev.cvy, double, nb)                                                                          \
     X(ev.ext, double, n)                                                                           \
     X(ev.nimp, long, m)                                                                            \
-    X(ev.keybuf, int, 2 * (nb + m + 1))                                                            \
+    X(ev.keybuf, int, 2 * (nb + m + ns + 2))                                                       \
     X(ev.uf, int, nb)                                                                              \
     X(ev.gblk, int, nb)                                                                            \
     X(ev.newcl, int, nb)                                                                           \
@@ -2805,7 +2906,7 @@ static int alloc_matrix_arrays(pd_edr *r, const edr_sizes *sizes)
 
 static int alloc_run_arrays(pd_edr *r, const edr_sizes *sizes)
 {
-    long n = sizes->n, m = sizes->m, nb = sizes->nb, nslot = sizes->nslot;
+    long n = sizes->n, m = sizes->m, nb = sizes->nb, nslot = sizes->nslot, ns = sizes->ns;
     long dm = sizes->dm, dcap = sizes->dcap, nmeas = sizes->nmeas;
     EDR_RUN_ARRAYS(EDR_ALLOC_ARRAY)
     return PD_OK;
@@ -3045,58 +3146,83 @@ static int fill_blocks(pd_edr *r, pd_err *err)
 
 /* Spring j's entries of S: their count and the last one's dof and value. */
 typedef struct spring_col_ctx {
-    int *count, *dof;
-    double *val;
+    int *count, *dof, *dof2;
+    double *val, *val2;
 } spring_col_ctx;
 
+/* S's entries: a column's first into (dof, val), its second into (dof2, val2). */
 static void spring_entry(void *ctx, int i, int j, double x)
 {
     spring_col_ctx *c = ctx;
     if (x == 0.0)
         return;
-    c->count[j]++;
-    c->dof[j] = i;
-    c->val[j] = x;
+    if (c->count[j]++ == 0) {
+        c->dof[j] = i;
+        c->val[j] = x;
+    } else {
+        c->dof2[j] = i;
+        c->val2[j] = x;
+    }
 }
 
-/* The yielding springs: each on the one dof of an SDOF structure (its S
- * column one entry), one a structure, its post-yield stiffness k - sig^2
- * ks >= 0. */
+/* The yielding springs: each a drift of one structure (its S column one
+ * entry, an SDOF's or a first storey's, or two, a storey's above the
+ * first); on an SDOF one a structure, its post-yield stiffness k - sig^2
+ * ks >= 0; each block's springs listed (blk_sp). */
 static int set_springs(pd_edr *r, pd_err *err)
 {
     const pd_model *md = r->tp.md;
-    for (int b = 0; b < r->tp.nb; b++)
+    for (int b = 0; b < r->tp.nb; b++) {
         r->tp.blk[b].spring = -1;
+        r->tp.blk[b].nsp = 0;
+    }
     if (r->tp.ns == 0)
         return PD_OK;
     int *cnt = pd_calloc(r->tp.ns, sizeof(int));
     if (!cnt)
         return out_of_memory(r, err);
-    spring_col_ctx c = {.count = cnt, .dof = r->tp.sp_dof, .val = r->tp.sp_sig};
+    for (int j = 0; j < r->tp.ns; j++)
+        r->tp.sp_dof2[j] = -1;
+    spring_col_ctx c = {.count = cnt,
+                        .dof = r->tp.sp_dof,
+                        .dof2 = r->tp.sp_dof2,
+                        .val = r->tp.sp_sig,
+                        .val2 = r->tp.sp_sig2};
     for_each_entry(&md->S, spring_entry, &c);
     int rc = PD_OK;
     for (int j = 0; j < r->tp.ns && !rc; j++) {
-        int i = r->tp.sp_dof[j], b = cnt[j] == 1 ? r->tp.dof_blk[i] : -1;
+        int i = r->tp.sp_dof[j], i2 = r->tp.sp_dof2[j];
+        int b = cnt[j] >= 1 && cnt[j] <= 2 ? r->tp.dof_blk[i] : -1;
         edr_block *bk = b >= 0 ? &r->tp.blk[b] : NULL;
         double sg = r->tp.sp_sig[j];
-        if (!bk || !bk->sdof)
+        if (!bk || (i2 >= 0 && r->tp.dof_blk[i2] != b))
             rc = pd_err_set(err, PD_EINVAL,
-                            "uy: the row reference yields SDOF structures only; yielding spring "
-                            "%d is on %s (%d dofs): a yielding building runs by Moreau-Jean or "
-                            "newmark",
-                            j, bk ? "a storey of a building" : "a drift of several dofs",
-                            bk ? bk->n : cnt[j]);
-        else if (bk->spring >= 0)
+                            "uy: row reference: yielding spring %d's drift takes %d dofs%s (a "
+                            "storey's drift: one structure's, one or two dofs)",
+                            j, cnt[j], bk ? " of two structures" : "");
+        else if (bk->sdof && bk->spring >= 0)
             rc = pd_err_set(err, PD_EINVAL,
                             "uy: row reference: dof %d has two yielding springs (%d and %d)", i,
                             bk->spring, j);
-        else if (bk->k - sg * sg * md->ks[j] < -1e-12 * bk->k)
+        else if (bk->sdof && bk->k - sg * sg * md->ks[j] < -1e-12 * bk->k)
             rc = pd_err_set(err, PD_EINVAL,
                             "uy: row reference: yielding spring %d leaves dof %d a negative "
                             "post-yield stiffness (k %g < sig^2 ks %g)",
                             j, i, bk->k, sg * sg * md->ks[j]);
-        else
-            bk->spring = j;
+        else {
+            bk->spring = bk->sdof ? j : -1;
+            bk->nsp++;
+        }
+    }
+    /* each block's springs, in order: sp0 the running sum of the counts */
+    for (int b = 0, at = 0; b < r->tp.nb && !rc; b++) {
+        r->tp.blk[b].sp0 = at;
+        at += r->tp.blk[b].nsp;
+        r->tp.blk[b].nsp = 0;
+    }
+    for (int j = 0; j < r->tp.ns && !rc; j++) {
+        edr_block *bk = &r->tp.blk[r->tp.dof_blk[r->tp.sp_dof[j]]];
+        r->tp.blk_sp[bk->sp0 + bk->nsp++] = j;
     }
     free(cnt);
     return rc;
@@ -3270,6 +3396,7 @@ static void reset(pd_edr *r, double t0, const double *q0, const double *v0, doub
     int n = r->tp.n, m = r->tp.m;
     memset(&r->rs.res, 0, sizeof r->rs.res);
     r->rs.res.first_impact = NAN;
+    r->rs.e_input = r->rs.e_damping = r->rs.e_impact = r->rs.ke_group = 0.0;
     r->rs.t = t0;
     r->rs.t1 = t1;
     r->rs.L = r->tp.o.length_scale;
@@ -3392,6 +3519,51 @@ static int start(pd_edr *r, double t0, pd_err *err)
     return PD_OK;
 }
 
+/* The kinetic and strain energies of the state (q, v) (global index) with
+ * the springs' offsets up: v^T M v / 2, q^T K q / 2 - sum ks up d + sum
+ * ks up^2 / 2 (the storeys' alpha k d^2 / 2 and the springs' ks z^2 / 2). */
+static void state_energy(const pd_edr *r, const double *q, const double *v, const double *up,
+                         double *kinetic, double *strain)
+{
+    double ke = 0.0, se = 0.0;
+    for (int b = 0; b < r->tp.nb; b++) {
+        const edr_block *bk = &r->tp.blk[b];
+        const double *Kb = r->tp.Kb + r->tp.blk_off[b];
+        for (int l = 0; l < bk->n; l++) {
+            int gi = r->tp.blk_dofs[bk->first + l];
+            ke += 0.5 * v[gi] * v[gi] / r->tp.minv[gi];
+            for (int k = 0; k < bk->n; k++) /* K_b column-major */
+                se += 0.5 * q[gi] * Kb[l + (long)k * bk->n] * q[r->tp.blk_dofs[bk->first + k]];
+        }
+    }
+    for (int j = 0; j < r->tp.ns; j++)
+        se += r->tp.md->ks[j] * up[j] * (0.5 * up[j] - edr_spring_drift(r, j, q));
+    *kinetic = ke;
+    *strain = se;
+}
+
+/* The energy balance's terms at t (opts.energy): the flights' integrals to
+ * t, the end state's energies, the sliders' work. */
+static void finish_energy(pd_edr *r, double t)
+{
+    pd_edr_result *res = &r->rs.res;
+    double *q = r->ev.wk + r->tp.n, *v = r->ev.wk + 2 * r->tp.n;
+    for (int c = 0; c < r->tp.nb; c++)
+        if (r->rs.cl[c].live)
+            integrate_energy(r, c, t);
+    for (int i = 0; i < r->tp.n; i++) {
+        double a;
+        dof_state(r, i, t, &q[i], &v[i], &a);
+    }
+    state_energy(r, q, v, r->rs.sp_now, &res->kinetic, &res->strain);
+    res->hysteretic = 0.0;
+    for (int j = 0; j < r->tp.ns; j++) /* a slide's work: ks z dup = ks uy |dup| */
+        res->hysteretic += r->tp.md->ks[j] * r->tp.md->uy[j] * r->rs.sp_exc[j];
+    res->input_work = r->rs.e_input;
+    res->damping_work = r->rs.e_damping;
+    res->impact_loss = r->rs.e_impact;
+}
+
 /* Close the run at t: extremes and gaps to t, contact times. */
 static void finish(pd_edr *r, double t)
 {
@@ -3419,6 +3591,8 @@ static void finish(pd_edr *r, double t)
             r->rs.sp_exc[j] += fabs(r->rs.sp_now[j] - r->rs.sp_upx[j]);
             r->rs.sp_upx[j] = r->rs.sp_now[j];
         }
+    if (r->tp.o.energy)
+        finish_energy(r, t);
     r->rs.res.t_reached = t;
     r->rs.res.evals = (double)r->rs.evals;
 }
@@ -3438,6 +3612,9 @@ int pd_edr_run(pd_edr *r, double t0, const double *q0, const double *v0, double 
     /* a sampler reports impulses over each output interval: held forces integrated */
     r->rs.sample_forces = obs && r->tp.o.h_out > 0.0 && !r->tp.o.impacts_only;
     reset(r, t0, q0, v0, t1);
+    if (r->tp.o.energy) /* the energies at the start (offsets 0) */
+        state_energy(r, r->rs.xo, r->rs.vo, r->rs.sp_up, &r->rs.res.kinetic, &r->rs.res.strain);
+    r->rs.res.energy0 = r->rs.res.kinetic + r->rs.res.strain;
     if ((rc = start(r, t0, err)))
         goto out;
     r->rs.t_out0 = t0;

@@ -71,6 +71,7 @@ typedef struct edr_block {
     double b;         /* SDOF: its load coefficient */
     int cont0, ncont; /* its contacts: r->tp.blk_cont[cont0 .. cont0 + ncont) */
     int spring;       /* SDOF: its yielding spring (-1: none) */
+    int sp0, nsp;     /* its yielding springs: r->tp.blk_sp[sp0 .. sp0 + nsp) */
 } edr_block;
 
 typedef struct edr_contact {
@@ -95,8 +96,12 @@ typedef struct edr_basis {
     double *qstar;              /* nc */
     edr_cplx *F;                /* r x nmodes: lambda = sum wt Re(F eta) + gam f + del */
     double *gam, *del;          /* r */
-    double T_min;               /* shortest period 2 pi / max |lam| */
-    unsigned long key;          /* hash of (blocks, constraints) */
+    /* a constant force fc on the dofs (the yielding springs' offsets): the
+     * modes' kap + KF fc, the contacts' del + DF fc (NULL: no spring) */
+    edr_cplx *KF;      /* nmodes x nc */
+    double *DF;        /* r x nc */
+    double T_min;      /* shortest period 2 pi / max |lam| */
+    unsigned long key; /* hash of (blocks, constraints) */
     int nkey;
     int *keyv;              /* the configuration itself */
     struct edr_basis *next; /* hash chain */
@@ -112,6 +117,7 @@ typedef struct edr_cluster {
     double T_min;         /* shortest period of the flight (incl. the piece) */
     double meas_t;        /* extremes measured up to here */
     double imp_t;         /* held forces integrated up to here (sampled impulses) */
+    double en_t;          /* the energy balance's integrals up to here */
     /* SDOF / REST */
     int root; /* root dof */
     pd_sdof osc;
@@ -136,7 +142,9 @@ typedef struct edr_cluster {
     edr_cplx *gq, *bc1;           /* the flight's beta f_lin(t0) + kap, beta c1 */
     edr_cplx *ilp, *ilm;          /* 1 / (lam - i w), 1 / (lam + i w) */
     edr_cplx ath0;                /* A / (2i) e^{i th(t0)} */
-    int cap;
+    edr_cplx *kapc;               /* the flight's kap (the basis's, its springs' force added) */
+    double *delc;                 /* r: the flight's del */
+    int cap, capr;
     /* the state at tc (cache) */
     double tc;
     int cached;
@@ -178,11 +186,14 @@ typedef struct edr_topo {
     int *dofc_ptr, *dofc; /* contacts of each dof */
     edr_contact *ct;
     double *minv; /* n: 1 / M_ii */
-    /* yielding springs (SDOF blocks only): spring j on dof sp_dof[j], its
-     * drift sp_sig[j] x (the model's S column), ks and uy the model's */
+    /* yielding springs: spring j's drift d = sp_sig[j] x[sp_dof[j]] (+
+     * sp_sig2[j] x[sp_dof2[j]] for a storey above the first; sp_dof2 -1
+     * otherwise), the model's S column; ks and uy the model's; each block's
+     * springs in blk_sp */
     int ns;
-    int *sp_dof;
-    double *sp_sig;
+    int *sp_dof, *sp_dof2;
+    double *sp_sig, *sp_sig2;
+    int *blk_sp;
 } edr_topo;
 
 /* The run: clusters, the contacts' states, results, the event queue, the
@@ -227,6 +238,9 @@ typedef struct edr_run {
     double *slot_t0;
     int stopped;
     double vscale; /* largest velocity met at an event */
+    /* the energy balance (opts.energy): the flights' integrals, the impacts'
+     * losses; the group's kinetic energy before an event */
+    double e_input, e_damping, e_impact, ke_group;
     long evals;
     /* yielding springs: phase (0 elastic, +-1 sliding toward that side), the
      * offset up (sliding: up = sig x - phase uy, sp_up its value at the
@@ -316,13 +330,18 @@ int edr_cluster_start(pd_edr *r, int c, double t, pd_err *err);
 void edr_cluster_eval(pd_edr *r, int c, double t);
 /* x(t) - xo, v, a of one dof of cluster c (evaluated at t). */
 void edr_dof_at(pd_edr *r, int c, int dof, double t, double *dx, double *v, double *a);
-/* The jerk x^(3) of one dof of an SDOF tree (0 for the other kinds). */
+/* The jerk x^(3) of one dof (0 for a REST tree, held still). */
 double edr_dof_jerk(pd_edr *r, int c, int dof, double t);
-/* Spring j's plastic offset with its dof at x, in its phase. */
-double edr_spring_up(const pd_edr *r, int j, double x);
-/* Spring j into phase (0 elastic, +-1 sliding) with its dof at x: the
- * offset, the excursion and the onsets kept. */
-void edr_spring_set(pd_edr *r, int j, double x, int phase);
+/* Spring j's drift from the dofs' values y (positions, rates or
+ * accelerations: d, d', d''), y indexed by global dof. */
+double edr_spring_drift(const pd_edr *r, int j, const double *y);
+/* Spring j's drift, its rate and acceleration on cluster c's flight at t. */
+void edr_spring_at(pd_edr *r, int c, int j, double t, double *d, double *dd, double *ddd);
+/* Spring j's plastic offset at drift d, in its phase. */
+double edr_spring_up(const pd_edr *r, int j, double d);
+/* Spring j into phase (0 elastic, +-1 sliding) at drift d: the offset, the
+ * excursion and the onsets kept. */
+void edr_spring_set(pd_edr *r, int j, double d, int phase);
 /* lambda of persistent contact a of cluster c at t. */
 double edr_force_at(pd_edr *r, int c, int a, double t);
 /* A block's restoring force k x - sig ks up(x) as k_eff x + r0 (its spring's

@@ -463,6 +463,8 @@ static void basis_free(edr_basis *b)
     free(b->F);
     free(b->gam);
     free(b->del);
+    free(b->KF);
+    free(b->DF);
     free(b->keyv);
     free(b);
 }
@@ -492,8 +494,11 @@ void edr_cluster_free(edr_cluster *c)
     free(c->bc1);
     free(c->ilp);
     free(c->ilm);
-    c->eta0 = c->deta = c->etad = c->gq = c->bc1 = c->ilp = c->ilm = NULL;
-    c->cap = 0;
+    free(c->kapc);
+    free(c->delc);
+    c->eta0 = c->deta = c->etad = c->gq = c->bc1 = c->ilp = c->ilm = c->kapc = NULL;
+    c->delc = NULL;
+    c->cap = c->capr = 0;
 }
 
 static int cmp_int(const void *a, const void *b)
@@ -502,7 +507,9 @@ static int cmp_int(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* The configuration's key: sorted blocks, -1, sorted persistent contacts. */
+/* The configuration's key: sorted blocks, -1, sorted persistent contacts,
+ * and when a yielding spring of the blocks slides, -2 and the sorted
+ * sliding springs (their stiffness is the cluster's). */
 static int config_key(pd_edr *r, const edr_cluster *c, int *key, unsigned long *hash)
 {
     int nk = 0, nb0;
@@ -515,6 +522,20 @@ static int config_key(pd_edr *r, const edr_cluster *c, int *key, unsigned long *
     for (int a = c->pers_head; a >= 0; a = r->rs.pers_next[a])
         key[nk++] = a;
     qsort(key + a0, (size_t)(nk - a0), sizeof(int), cmp_int);
+    int nsl = 0; /* the sliding springs, listed after the -2 at key[nk] */
+    for (int k = 0; k < nb0; k++) {
+        const edr_block *bk = &r->tp.blk[key[k]];
+        for (int l = 0; l < bk->nsp; l++) {
+            int j = r->tp.blk_sp[bk->sp0 + l];
+            if (r->rs.sp_phase[j] != 0)
+                key[nk + 1 + nsl++] = j;
+        }
+    }
+    if (nsl > 0) {
+        key[nk] = -2;
+        qsort(key + nk + 1, (size_t)nsl, sizeof(int), cmp_int);
+        nk += 1 + nsl;
+    }
     /* sorted, the key names the configuration whatever the lists' order;
      * its 64-bit FNV-1a hash: h = (h ^ key_k) * FNV prime */
     unsigned long h = 1469598103934665603UL;
@@ -534,8 +555,11 @@ static int config_key(pd_edr *r, const edr_cluster *c, int *key, unsigned long *
  * column-major; every pointer is NULL until its phase allocates it and
  * scratch_free releases them all (the basis itself, B, is the caller's). */
 typedef struct basis_scratch {
-    int nb0, ncon;            /* blocks key[0..nb0), persistent contacts cons[0..ncon) */
-    const int *cons;          /* the key after its -1 */
+    int nb0, ncon;    /* blocks key[0..nb0), persistent contacts cons[0..ncon) */
+    const int *cons;  /* the key after its -1 */
+    const int *slide; /* the sliding springs (the key after its -2), nslide */
+    int nslide;
+    int springs;              /* a block has yielding springs: the basis takes KF, DF */
     int nc, nr, k;            /* dofs, independent constraints, coordinates left k = nc - nr */
     double *Cc, *Kc;          /* nc x nc: the cluster's C, K (block diagonal) */
     double *bc;               /* nc: the load coefficients b */
@@ -629,6 +653,19 @@ static int gather_blocks(pd_edr *r, const int *key, int nk, edr_basis *B, basis_
             }
         }
         at += bk->n;
+        w->springs |= bk->nsp > 0;
+    }
+    /* a sliding spring j's stiffness leaves K: K - ks_j s_j s_j^T, s_j its drift's
+     * column (sig at its dof, sig2 at the dof below) */
+    for (int l = 0; l < w->nslide; l++) {
+        int j = w->slide[l], li[2] = {r->ev.loc[r->tp.sp_dof[j]], -1};
+        double sg[2] = {r->tp.sp_sig[j], r->tp.sp_sig2[j]}, ks = r->tp.md->ks[j];
+        if (r->tp.sp_dof2[j] >= 0)
+            li[1] = r->ev.loc[r->tp.sp_dof2[j]];
+        for (int a = 0; a < 2; a++)
+            for (int b = 0; b < 2; b++)
+                if (li[a] >= 0 && li[b] >= 0)
+                    w->Kc[li[a] + (size_t)li[b] * nc] -= ks * sg[a] * sg[b];
     }
     return PD_OK;
 }
@@ -1040,6 +1077,43 @@ static void contact_force_modes(const pd_edr *r, edr_basis *B, const basis_scrat
     }
 }
 
+/* A constant force fc on the dofs in the modes and the contacts' forces
+ * (the yielding springs' offsets, set per flight): Mr y'' + ... = ... +
+ * N^T fc gives kap += KF fc, KF = Z_(., k..2k) Mr^-1 N^T, and lambda =
+ * L (M a + C v + K q - b f - fc) gives del += DF fc, DF = L (M N Mr^-1 N^T
+ * - I) (no coordinate left: -L). */
+static int constant_force_modes(const pd_edr *r, edr_basis *B, const basis_scratch *w, pd_err *err)
+{
+    int nc = w->nc, k = w->k, nr = w->nr, nm = B->nmodes;
+    B->KF = pd_calloc((long)nm * nc, sizeof(edr_cplx));
+    B->DF = pd_calloc((long)nr * nc, sizeof(double));
+    if (!B->KF || !B->DF)
+        return pd_err_set(err, PD_ENOMEM, "out of memory for a cluster's modes");
+    double *ak = w->tmp; /* N Mr^-1 N^T e_i: the accelerations of a unit force on dof i */
+    for (int i = 0; i < nc; i++) {
+        double mi = r->tp.minv[B->dofs[i]]; /* (Mr^-1 N^T)_ai = Y_ai / M_ii */
+        for (int q = 0; q < nm; q++) {
+            edr_cplx s = 0.0;
+            for (int a = 0; a < k; a++)
+                s += B->Z[(size_t)q * 2 * k + k + a] * (B->Y[a + (size_t)i * k] * mi);
+            B->KF[(size_t)q * nc + i] = s;
+        }
+        for (int l = 0; l < nc; l++) {
+            double s = 0.0;
+            for (int a = 0; a < k; a++)
+                s += MG(w->N, l, a) * (B->Y[a + (size_t)i * k] * mi);
+            ak[l] = s;
+        }
+        for (int c2 = 0; c2 < nr; c2++) {
+            double s = -w->L[c2 + (size_t)i * nr];
+            for (int l = 0; l < nc; l++)
+                s += w->L[c2 + (size_t)l * nr] * ak[l] / r->tp.minv[B->dofs[l]];
+            B->DF[(size_t)c2 * nc + i] = s;
+        }
+    }
+    return PD_OK;
+}
+
 /* Build the basis of a configuration (blocks key[0..nb0), contacts after
  * the -1): its dofs, independent constraints, modes and contact forces.
  * Dependent constraint contacts are listed in *dep (count ndep). */
@@ -1047,11 +1121,17 @@ static int basis_build(pd_edr *r, const int *key, int nk, edr_basis **out, int *
                        pd_err *err)
 {
     basis_scratch w = {.nb0 = 0};
-    /* key: the sorted blocks, -1, the sorted persistent contacts (config_key) */
+    /* key: the sorted blocks, -1, the sorted persistent contacts, and -2 and
+     * the sliding springs when there are (config_key) */
     while (key[w.nb0] >= 0)
         w.nb0++;
     w.cons = key + w.nb0 + 1;
-    w.ncon = nk - w.nb0 - 1;
+    while (w.nb0 + 1 + w.ncon < nk && w.cons[w.ncon] >= 0)
+        w.ncon++;
+    if (w.nb0 + 1 + w.ncon < nk) { /* after the -2 */
+        w.slide = w.cons + w.ncon + 1;
+        w.nslide = nk - (w.nb0 + 1 + w.ncon + 1);
+    }
     for (int k = 0; k < w.nb0; k++)
         w.nc += r->tp.blk[key[k]].n;
     edr_basis *B = pd_calloc(1, sizeof *B);
@@ -1074,6 +1154,8 @@ static int basis_build(pd_edr *r, const int *key, int nk, edr_basis **out, int *
     if (!rc) {
         modes_store(B, &w);
         contact_force_modes(r, B, &w);
+        if (w.springs)
+            rc = constant_force_modes(r, B, &w, err);
     }
     scratch_free(&w);
     if (rc) {
@@ -1087,7 +1169,7 @@ static int basis_build(pd_edr *r, const int *key, int nk, edr_basis **out, int *
 /* The cached basis of the cluster's configuration (built when first met). */
 static int basis_of(pd_edr *r, edr_cluster *c, edr_basis **out, pd_err *err)
 {
-    int *key = r->ev.keybuf, *dep = r->ev.keybuf + r->tp.nb + r->tp.m + 1, ndep = 0, rc;
+    int *key = r->ev.keybuf, *dep = r->ev.keybuf + r->tp.nb + r->tp.m + r->tp.ns + 2, ndep = 0, rc;
     unsigned long h;
     int nk = config_key(r, c, key, &h);
     if (!r->rs.bhash) { /* the buckets, taken when the first modal cluster starts */
@@ -1153,6 +1235,40 @@ static void modal_origin(pd_edr *r, edr_cluster *c, const edr_basis *B)
     }
 }
 
+/* The flight's kap and del: the basis's, with its yielding springs'
+ * constant force fc added (KF, DF): an elastic spring's ks up s, a sliding
+ * one's -ks ph uy s (its stiffness left K: K x - ks s up = (K - ks s s^T) x
+ * + ks ph uy s), s its drift's column.  Rows of Px, Pv: modal_origin's. */
+static void spring_constants(pd_edr *r, edr_cluster *c, const edr_basis *B)
+{
+    int nc = B->nc;
+    memcpy(c->kapc, B->kap, (size_t)B->nmodes * sizeof(edr_cplx));
+    memcpy(c->delc, B->del, (size_t)B->r * sizeof(double));
+    if (!B->KF)
+        return;
+    double *fc = r->ev.wk; /* nc (modal_origin is done with it) */
+    memset(fc, 0, (size_t)nc * sizeof(double));
+    for (int b = c->head; b >= 0; b = r->rs.blk_next[b]) {
+        const edr_block *bk = &r->tp.blk[b];
+        for (int l = 0; l < bk->nsp; l++) {
+            int j = r->tp.blk_sp[bk->sp0 + l], ph = r->rs.sp_phase[j];
+            double f = ph != 0 ? -r->tp.md->ks[j] * ph * r->tp.md->uy[j]
+                               : r->tp.md->ks[j] * r->rs.sp_up[j];
+            fc[r->rs.crow[r->tp.sp_dof[j]]] += f * r->tp.sp_sig[j];
+            if (r->tp.sp_dof2[j] >= 0)
+                fc[r->rs.crow[r->tp.sp_dof2[j]]] += f * r->tp.sp_sig2[j];
+        }
+    }
+    for (int i = 0; i < nc; i++) {
+        if (fc[i] == 0.0) /* (no offset yet: the basis's constants, bit for bit) */
+            continue;
+        for (int q = 0; q < B->nmodes; q++)
+            c->kapc[q] += B->KF[(size_t)q * nc + i] * fc[i];
+        for (int c2 = 0; c2 < B->r; c2++)
+            c->delc[c2] += B->DF[(size_t)c2 * nc + i] * fc[i];
+    }
+}
+
 /* The flight's constants at its origin t0 (modal_eval): beta f_lin(t0) + kap,
  * beta c1, A / (2i) e^{i th(t0)} and 1 / (lam -+ i w). */
 static void modal_flight_constants(const pd_edr *r, edr_cluster *c, const edr_basis *B, double t)
@@ -1162,7 +1278,7 @@ static void modal_flight_constants(const pd_edr *r, edr_cluster *c, const edr_ba
     double fl0 = pc->c0 + pc->c1 * (t - pc->t_start), th = pc->w * t + pc->phi;
     c->ath0 = pc->A != 0.0 ? pc->A / (2.0 * I) * (cos(th) + I * sin(th)) : 0.0;
     for (int q = 0; q < B->nmodes; q++) {
-        c->gq[q] = B->beta[q] * fl0 + B->kap[q];
+        c->gq[q] = B->beta[q] * fl0 + c->kapc[q];
         c->bc1[q] = B->beta[q] * pc->c1;
         if (pc->A != 0.0) { /* (without a sinusoid modal_eval reads neither) */
             edr_cplx lp = B->lam[q] - I * pc->w, lm = B->lam[q] + I * pc->w;
@@ -1200,59 +1316,82 @@ static int modal_start(pd_edr *r, edr_cluster *c, double t, pd_err *err)
         c->bc1 = pd_malloc(cap, sizeof(edr_cplx));
         c->ilp = pd_malloc(cap, sizeof(edr_cplx));
         c->ilm = pd_malloc(cap, sizeof(edr_cplx));
-        if (!c->eta0 || !c->deta || !c->etad || !c->gq || !c->bc1 || !c->ilp || !c->ilm) {
+        c->kapc = pd_malloc(cap, sizeof(edr_cplx));
+        if (!c->eta0 || !c->deta || !c->etad || !c->gq || !c->bc1 || !c->ilp || !c->ilm ||
+            !c->kapc) {
             edr_cluster_free(c);
             return pd_err_set(err, PD_ENOMEM, "out of memory for a cluster's modes");
         }
         c->cap = cap;
     }
+    if (!c->delc || c->capr < B->r) { /* the contacts' constants, as large as the most met */
+        free(c->delc);
+        if (!(c->delc = pd_malloc(B->r, sizeof(double)))) {
+            edr_cluster_free(c);
+            return pd_err_set(err, PD_ENOMEM, "out of memory for a cluster's modes");
+        }
+        c->capr = B->r;
+    }
     c->kind = EDR_MODAL;
     c->basis = B;
     c->bnd = 0; /* no closed bounds on a modal flight: its predictions scan */
     modal_origin(r, c, B);
+    spring_constants(r, c, B);
     modal_flight_constants(r, c, B, t);
     c->T_min = B->T_min;
     return PD_OK;
 }
 
-/* Whether a yielding spring of cluster c has left its initial state (a
- * slide, or an offset): a modal flight has no place for its force. */
-static int cluster_yielded(const pd_edr *r, const edr_cluster *c)
+/* The phase a sliding spring j takes at a flight's origin (dd, ddd its
+ * drift's rate and acceleration): the slide goes on while its drift moves
+ * toward its side (or, at rest, accelerates there), else unloads.  An
+ * elastic spring stays so: one on its level moving past it is an onset
+ * its prediction finds at once (past the level by its rounding threshold),
+ * an event of its own. */
+static int spring_phase_at(const pd_edr *r, int j, double dd, double ddd)
 {
-    for (int b = c->head; b >= 0; b = r->rs.blk_next[b]) {
-        int j = r->tp.blk[b].spring;
-        if (j >= 0 && (r->rs.sp_phase[j] != 0 || r->rs.sp_up[j] != 0.0))
-            return 1;
-    }
-    return 0;
-}
-
-/* The phase a sliding spring j takes at a flight's origin (x, v, a its
- * dof's): the slide goes on while its drift moves toward its side (or, at
- * rest, accelerates there), else unloads.  An elastic spring stays so: one
- * on its level moving past it is an onset its prediction finds at once
- * (past the level by its rounding threshold), an event of its own. */
-static int spring_phase_at(const pd_edr *r, int j, double v, double a)
-{
-    double ph = r->rs.sp_phase[j], dz = r->tp.sp_sig[j] * v, ddz = r->tp.sp_sig[j] * a;
+    double ph = r->rs.sp_phase[j];
     if (ph == 0.0)
         return 0;
-    return ph * dz > 0.0 || (dz == 0.0 && ph * ddz > 0.0) ? (int)ph : 0;
+    return ph * dd > 0.0 || (dd == 0.0 && ph * ddd > 0.0) ? (int)ph : 0;
 }
 
-double edr_spring_up(const pd_edr *r, int j, double x)
+double edr_spring_drift(const pd_edr *r, int j, const double *y)
+{
+    double d = r->tp.sp_sig[j] * y[r->tp.sp_dof[j]];
+    return r->tp.sp_dof2[j] >= 0 ? d + r->tp.sp_sig2[j] * y[r->tp.sp_dof2[j]] : d;
+}
+
+void edr_spring_at(pd_edr *r, int c, int j, double t, double *d, double *dd, double *ddd)
+{
+    int i = r->tp.sp_dof[j], i2 = r->tp.sp_dof2[j];
+    double sg = r->tp.sp_sig[j], dx, v, a;
+    edr_dof_at(r, c, i, t, &dx, &v, &a);
+    *d = sg * (r->rs.xo[i] + dx);
+    *dd = sg * v;
+    *ddd = sg * a;
+    if (i2 < 0)
+        return;
+    sg = r->tp.sp_sig2[j]; /* a storey above the first: its drift takes the dof below */
+    edr_dof_at(r, c, i2, t, &dx, &v, &a);
+    *d += sg * (r->rs.xo[i2] + dx);
+    *dd += sg * v;
+    *ddd += sg * a;
+}
+
+double edr_spring_up(const pd_edr *r, int j, double d)
 {
     int ph = r->rs.sp_phase[j];
-    /* sliding toward ph: z = ph uy, so up = sg x - ph uy; elastic: up fixed */
-    return ph != 0 ? r->tp.sp_sig[j] * x - ph * r->tp.md->uy[j] : r->rs.sp_up[j];
+    /* sliding toward ph: z = ph uy, so up = d - ph uy; elastic: up fixed */
+    return ph != 0 ? d - ph * r->tp.md->uy[j] : r->rs.sp_up[j];
 }
 
-void edr_spring_set(pd_edr *r, int j, double x, int phase)
+void edr_spring_set(pd_edr *r, int j, double d, int phase)
 {
     int old = r->rs.sp_phase[j];
     if (phase == old)
         return;
-    double up = edr_spring_up(r, j, x); /* at x, in the old phase */
+    double up = edr_spring_up(r, j, d); /* at d, in the old phase */
     if (old != 0) {                     /* a slide ends: its excursion (monotone within a slide) */
         r->rs.sp_exc[j] += fabs(up - r->rs.sp_upx[j]);
         r->rs.sp_upx[j] = up;
@@ -1260,29 +1399,28 @@ void edr_spring_set(pd_edr *r, int j, double x, int phase)
         r->rs.sp_onsets[j]++;
     r->rs.sp_phase[j] = (signed char)phase;
     r->rs.sp_up[j] = up;
-    if (phase != 0) /* sliding: z exactly on the level at x */
-        r->rs.sp_up[j] = edr_spring_up(r, j, x);
+    if (phase != 0) /* sliding: z exactly on the level at d */
+        r->rs.sp_up[j] = edr_spring_up(r, j, d);
 }
 
-/* Each spring of a tree cluster at its flight's origin: the phase its
- * motion there asks for; 1 when one changed (the flight is built again:
- * the force is continuous across a change, so the state is unchanged). */
+/* Each spring of cluster ci at its flight's origin: the phase its motion
+ * there asks for; 1 when one changed (the flight is built again: the force
+ * is continuous across a change, so the state is unchanged). */
 static int spring_phases(pd_edr *r, int ci, double t)
 {
     edr_cluster *c = &r->rs.cl[ci];
     int changed = 0;
     for (int b = c->head; b >= 0; b = r->rs.blk_next[b]) {
-        int j = r->tp.blk[b].spring;
-        if (j < 0)
-            continue;
-        int i = r->tp.sp_dof[j];
-        double dx, v, a;
-        edr_dof_at(r, ci, i, t, &dx, &v, &a);
-        double x = r->rs.xo[i] + dx;
-        int ph = spring_phase_at(r, j, v, a);
-        if (ph != r->rs.sp_phase[j]) {
-            edr_spring_set(r, j, x, ph);
-            changed = 1;
+        const edr_block *bk = &r->tp.blk[b];
+        for (int k = 0; k < bk->nsp; k++) {
+            int j = r->tp.blk_sp[bk->sp0 + k];
+            double d, dd, ddd;
+            edr_spring_at(r, ci, j, t, &d, &dd, &ddd);
+            int ph = spring_phase_at(r, j, dd, ddd);
+            if (ph != r->rs.sp_phase[j]) {
+                edr_spring_set(r, j, d, ph);
+                changed = 1;
+            }
         }
     }
     return changed;
@@ -1294,6 +1432,7 @@ int edr_cluster_start(pd_edr *r, int ci, double t, pd_err *err)
     int all_sdof = 1, rc;
     c->t0 = t;
     c->imp_t = t;
+    c->en_t = t;
     c->piece = edr_piece_at(r, t);
     c->cached = 0; /* a new flight: the state cached at tc belongs to the old one */
     c->ndof = 0;
@@ -1302,21 +1441,17 @@ int edr_cluster_start(pd_edr *r, int ci, double t, pd_err *err)
         c->ndof += r->tp.blk[b].n;
     }
     int tree = all_sdof && !tree_start(r, c, t);
+    /* a tree may have locked contacts already: the modal start re-reads the list */
+    if (!tree && (rc = modal_start(r, c, t, err)))
+        return rc;
     /* a yielding spring's phase decided at the origin; a change builds the
      * flight again (at most twice: the decision reads the state, which a
-     * change leaves as it was) */
-    for (int pass = 0; tree && r->tp.ns > 0 && pass < 2 && spring_phases(r, ci, t); pass++)
-        tree = !tree_start(r, c, t);
-    if (!tree) {
-        if (r->tp.ns > 0 && cluster_yielded(r, c))
-            return pd_err_set(err, PD_EINVAL,
-                              "row reference: at t = %.9g s a yielding structure moves in a "
-                              "cluster without an underdamped flight (overdamped, or a damped "
-                              "free mass); its exact flight is not built (Moreau-Jean, --method "
-                              "moreau, runs it)",
-                              t * r->tp.o.time_unit);
-        /* a tree may have locked contacts already: the modal start re-reads the list */
-        if ((rc = modal_start(r, c, t, err)))
+     * change leaves as it was); a tree whose new phase has no underdamped
+     * flight goes modal */
+    for (int pass = 0; r->tp.ns > 0 && pass < 2 && spring_phases(r, ci, t); pass++) {
+        if (tree)
+            tree = !tree_start(r, c, t);
+        if (!tree && (rc = modal_start(r, c, t, err)))
             return rc;
     }
     /* the scan step h = T / divisions, T the shortest of the flight's and the
@@ -1409,7 +1544,7 @@ static void modal_eval(const pd_edr *r, edr_cluster *c, double t)
         }
         c->deta[q] = de;
         /* the mode's equation: eta' = lam eta + beta f + kap */
-        c->etad[q] = lam * (c->eta0[q] + de) + B->beta[q] * ft + B->kap[q];
+        c->etad[q] = lam * (c->eta0[q] + de) + B->beta[q] * ft + c->kapc[q];
     }
     c->f_tc = ft;
 }
@@ -1494,9 +1629,26 @@ void edr_dof_at(pd_edr *r, int ci, int dof, double t, double *dx, double *v, dou
     *a = sa;
 }
 
+/* A modal cluster's dof's jerk: sum wt Re(Pv eta''), eta'' = lam eta' +
+ * beta f'(t). */
+static double modal_jerk(pd_edr *r, int ci, int dof, double t)
+{
+    edr_cluster *c = &r->rs.cl[ci];
+    edr_cluster_eval(r, ci, t);
+    const edr_basis *B = c->basis;
+    const pd_sine_piece *p = &r->tp.pieces[c->piece];
+    double df = p->c1 + (p->A == 0.0 ? 0.0 : p->A * p->w * cos(p->w * t + p->phi)), s = 0.0;
+    const edr_cplx *pv = B->Pv + (size_t)r->rs.crow[dof] * B->nmodes;
+    for (int q = 0; q < B->nmodes; q++)
+        s += B->wt[q] * creal(pv[q] * (B->lam[q] * c->etad[q] + B->beta[q] * df));
+    return s;
+}
+
 double edr_dof_jerk(pd_edr *r, int ci, int dof, double t)
 {
     edr_cluster *c = &r->rs.cl[ci];
+    if (c->kind == EDR_MODAL)
+        return modal_jerk(r, ci, dof, t);
     if (c->kind != EDR_SDOF)
         return 0.0;
     edr_cluster_eval(r, ci, t);
@@ -1519,7 +1671,7 @@ double edr_force_at(pd_edr *r, int ci, int a, double t)
     const edr_basis *B = c->basis;
     int row = r->rs.crow_c[a];
     const edr_cplx *F = B->F + (size_t)row * B->nmodes;
-    double s = B->gam[row] * c->f_tc + B->del[row];
+    double s = B->gam[row] * c->f_tc + c->delc[row];
     for (int q = 0; q < B->nmodes; q++)
         s += B->wt[q] * creal(F[q] * (c->eta0[q] + c->deta[q]));
     return s;

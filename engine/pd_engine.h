@@ -598,6 +598,8 @@ typedef struct pd_edr_opts {
     pd_impact_law impact_law; /* PD_IMPACT_STAGED (the default) or PD_IMPACT_SINGLE */
     pd_edr_event_fn on_event; /* optional: every impact, detachment, piece change */
     void *on_event_ctx;
+    int energy; /* 1: the energy balance's terms (pd_edr_result; Gauss-Legendre on
+                   every scan interval of the flights) */
 } pd_edr_opts;
 
 /* close_tol 1e-10 (the accumulation's bounce height: one "in contact"
@@ -605,7 +607,7 @@ typedef struct pd_edr_opts {
  * with the held forces when there is one), drift of
  * each dof against the ground, accumulations jumped, active contacts, 10^7
  * events, bursts of 10^5, 4e9 evaluations, 64 scan divisions, automatic
- * LCP solver, the staged impact law. */
+ * LCP solver, the staged impact law, no energy balance. */
 PD_API pd_edr_opts pd_edr_default_opts(void);
 
 typedef struct pd_edr_result {
@@ -628,11 +630,20 @@ typedef struct pd_edr_result {
     long law_decided;           /* impacts whose LCP could take several closed contacts, one
                               closing (separating ones included): where the staged and
                               single impact laws may differ */
-    /* per yielding spring (ns; SDOF structures' springs only): */
+    /* per yielding spring (ns): */
     int ns;
     const double *up;                /* the plastic offset at t_reached */
     const double *plastic_excursion; /* sum of |d up| */
     const long *yield_onsets;        /* slides begun */
+    /* opts.energy (0 otherwise), from t0 to t_reached:
+       input_work = (kinetic + strain) - energy0 + damping_work + hysteretic + impact_loss */
+    double input_work;   /* int (b f) . v dt */
+    double damping_work; /* int v^T C v dt */
+    double impact_loss;  /* the kinetic energy the impacts (and held contacts' starts) took */
+    double hysteretic;   /* the sliders' work, sum ks uy excursion */
+    double kinetic;      /* v^T M v / 2 at t_reached */
+    double strain;       /* q^T K q / 2 - sum ks up d + sum ks up^2 / 2 at t_reached */
+    double energy0;      /* kinetic + strain at t0 */
 } pd_edr_result;
 
 typedef struct pd_edr pd_edr;

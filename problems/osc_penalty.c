@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "osc_priv.h"
+#include "scene_priv.h"
 #include "pd_null.h"
 #include "demand.h"
 #include "pd_problems.h"
@@ -47,7 +48,8 @@ typedef struct pen_track {
      * offset up (at the previous step), the tallies */
     double kbar, up, excursion;
     long n_yield;
-    int slid; /* the previous step slid */
+    int slid;            /* the previous step slid */
+    pd_scene_energy *en; /* newmark on a yielding spring: the energy balance */
 } pen_track;
 
 /* A step of the interpolant: x(s) = sum_k c_k (s/h)^k on [0, h]. */
@@ -199,6 +201,10 @@ static int track_step(const pd_state *st, void *ctx)
     double tau = st->t, x = st->q[0], v = st->v[0];
     double lam = tr->m ? st->P[0] : 0.0, up = st->up ? st->up[0] : 0.0;
     int active = tr->m ? st->active[0] : 0;
+    if (tr->en) { /* the step's energy identity, the element's force at its start */
+        double lam0 = tr->have_prev && tr->pactive ? tr->pP : 0.0;
+        pd_scene_energy_note_forces(tr->en, st, &lam0);
+    }
     /* a yielding spring: a step that slid after one that did not is an onset */
     int slides = up != tr->up;
     tr->n_yield += slides && !tr->slid;
@@ -420,10 +426,20 @@ int pd_osc_penalty(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler samp
         free(brks);
         return rc;
     }
+    /* newmark on a yielding spring: its energy balance (the scene's identity;
+     * a sweep's runs go without, as the exact reference's) */
+    if (model.ns > 0 && o.method == PD_METHOD_NEWMARK && !o.no_demands &&
+        !(tr.en = pd_scene_energy_alloc(&model, eo.h, 0.5))) {
+        free(brks);
+        return pd_err_set(err, PD_ENOMEM, "out of memory for the energy balance");
+    }
     rc = pd_penalty_run(&model, 0.0, NULL, NULL, tau_end, &eo, sampler ? emit_sample : NULL, &tr,
                         &pr, err);
     free(brks);
     fill_result(&tr, &o, &pr, res);
+    if (tr.en) /* per unit mass: (Le wp)^2 */
+        pd_scene_energy_finish(tr.en, tr.vscale * tr.vscale, &res->energy);
+    pd_scene_energy_free(tr.en);
     res->cpu_s = pd_cpu_seconds() - cpu0;
     return rc;
 }

@@ -1,6 +1,9 @@
 /* scene_energy.c — the energy balance of a yielding scene run by
- * Moreau–Jean (fixed steps), from rest.  Each step's identity, exact at
- * theta = 1/2 (the midpoint), with v_th = theta v+ + (1 - theta) v,
+ * Moreau–Jean (fixed steps) or by Newmark (average acceleration: the same
+ * identity at theta = 1/2, its elements' forces by the trapezoid as the
+ * impulses), from rest.  Each step's identity, exact at theta = 1/2 (the
+ * midpoint; Newmark's q+ - q = h (v + v+) / 2), with v_th = theta v+ + (1 -
+ * theta) v,
  * q_mid = q + h theta v_th, D = up+ - up:
  *   input      h F_theta . v_th,  F_theta = theta F(t1-) + (1 - theta) F(t0+)
  *   damping    h v_th^T C v_th
@@ -19,6 +22,7 @@ struct pd_scene_energy {
     const pd_model *md;
     double h, theta;
     double *q, *v, *up, *F0, *F1, *vth, *tmp; /* the last state, scratch */
+    double *imp;                              /* m: a Newmark step's impulses */
     double t;
     double input, damping, impact, hysteretic, kinetic, strain;
 };
@@ -27,7 +31,7 @@ void pd_scene_energy_free(pd_scene_energy *e)
 {
     if (!e)
         return;
-    double *arrays[] = {e->q, e->v, e->up, e->F0, e->F1, e->vth, e->tmp};
+    double *arrays[] = {e->q, e->v, e->up, e->F0, e->F1, e->vth, e->tmp, e->imp};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(arrays[k]);
     free(e);
@@ -46,6 +50,7 @@ pd_scene_energy *pd_scene_energy_alloc(const pd_model *md, double h, double thet
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         ok &= (*arrays[k] = pd_calloc(md->n, sizeof(double))) != NULL;
     ok &= (e->up = pd_calloc(md->ns, sizeof(double))) != NULL;
+    ok &= (e->imp = pd_calloc(md->m, sizeof(double))) != NULL;
     if (!ok) {
         pd_scene_energy_free(e);
         return NULL;
@@ -72,12 +77,13 @@ static double quad(const pd_matrix *A, const double *x, const double *y, double 
     return s;
 }
 
-/* The step from the kept state to st: its terms summed; st kept. */
-void pd_scene_energy_note(pd_scene_energy *e, const pd_state *st)
+/* The step from the kept state to st (of length h, the contacts' impulses
+ * P over it): its terms summed; st kept. */
+static void note_step(pd_scene_energy *e, const pd_state *st, double h, const double *P)
 {
     const pd_model *md = e->md;
     int n = md->n;
-    double h = e->h, th = e->theta;
+    double th = e->theta;
     if (st->step > 0) {
         force_at(md, e->t, +1, e->F0);
         force_at(md, st->t, -1, e->F1);
@@ -89,7 +95,7 @@ void pd_scene_energy_note(pd_scene_energy *e, const pd_state *st)
         e->input += h * input;
         e->damping += h * quad(&md->C, e->vth, e->vth, e->tmp, n);
         for (int a = 0; a < md->m; a++) /* an impulse's work on the contact's mid-step rate */
-            e->impact -= st->P[a] * pd_matrix_col_dot(&md->W, a, e->vth);
+            e->impact -= P[a] * pd_matrix_col_dot(&md->W, a, e->vth);
         for (int i = 0; i < n; i++) /* q_mid */
             e->tmp[i] = e->q[i] + h * th * e->vth[i];
         for (int j = 0; j < md->ns; j++) {
@@ -103,6 +109,20 @@ void pd_scene_energy_note(pd_scene_energy *e, const pd_state *st)
     memcpy(e->q, st->q, (size_t)n * sizeof(double));
     memcpy(e->v, st->v, (size_t)n * sizeof(double));
     memcpy(e->up, st->up, (size_t)md->ns * sizeof(double));
+}
+
+void pd_scene_energy_note(pd_scene_energy *e, const pd_state *st)
+{
+    note_step(e, st, e->h, st->P);
+}
+
+void pd_scene_energy_note_forces(pd_scene_energy *e, const pd_state *st, const double *lam0)
+{
+    const pd_model *md = e->md;
+    double h = st->step > 0 ? st->t - e->t : 0.0;
+    for (int a = 0; a < md->m; a++) /* the trapezoid's impulse of the elements' forces */
+        e->imp[a] = 0.5 * h * (lam0[a] + (st->active[a] ? st->P[a] : 0.0));
+    note_step(e, st, h, e->imp);
 }
 
 void pd_scene_energy_finish(const pd_scene_energy *e, double E, pd_energy *out)
@@ -123,4 +143,18 @@ void pd_scene_energy_finish(const pd_scene_energy *e, double E, pd_energy *out)
     out->residual =
         (out->input - out->kinetic - out->strain - out->damping - out->hysteretic - out->impact) /
         out->input;
+}
+
+void pd_scene_energy_of_edr(const pd_edr_result *er, double E, pd_energy *out)
+{
+    out->input = er->input_work * E;
+    out->kinetic = er->kinetic * E;
+    out->strain = er->strain * E;
+    out->damping = er->damping_work * E;
+    out->hysteretic = er->hysteretic * E;
+    out->impact = er->impact_loss * E;
+    /* from rest: the energies at the start are 0 */
+    out->residual = (out->input + er->energy0 * E - out->kinetic - out->strain - out->damping -
+                     out->hysteretic - out->impact) /
+                    out->input;
 }

@@ -27,7 +27,12 @@ pd_scene_energy *pd_scene_energy_alloc(const pd_model *md, double h, double thet
 void pd_scene_energy_free(pd_scene_energy *e);
 /* After each step (and at the start: st->step 0). */
 void pd_scene_energy_note(pd_scene_energy *e, const pd_state *st);
+/* The same after each Newmark step (theta 1/2, the step's length from the
+ * times): st->P the elements' forces at its end, lam0 at its start. */
+void pd_scene_energy_note_forces(pd_scene_energy *e, const pd_state *st, const double *lam0);
 /* The balance in joules (energy unit E = Le^2 wp^2 kg). */
 void pd_scene_energy_finish(const pd_scene_energy *e, double E, pd_energy *out);
+/* The exact row reference's balance (its opts.energy terms) in joules. */
+void pd_scene_energy_of_edr(const pd_edr_result *er, double E, pd_energy *out);
 
 #endif

@@ -876,6 +876,8 @@ static void integrate_forces(track *tr, const pd_state *st)
 static int step_penalty(const pd_state *st, void *ctx)
 {
     track *tr = ctx;
+    if (tr->en) /* newmark's energy balance: the step from the last report */
+        pd_scene_energy_note_forces(tr->en, st, tr->plam);
     integrate_forces(tr, st);
     note_springs(tr, st);
     if (tr->have_prev && st->has_acc)
@@ -1339,6 +1341,7 @@ static int run_event(const pd_scene_model *sm, const pd_run_opts *o, double tau_
     eo.inactive = o->no_wall;
     eo.lcp_solver = o->lcp_solver;
     eo.impact_law = o->impact_law;
+    eo.energy = sm->model.ns > 0; /* a yielding scene's energy balance, as Moreau-Jean's */
     pd_edr *edr = pd_edr_alloc(&sm->model, &F, &eo, err);
     if (!edr) {
         free(pieces);
@@ -1370,6 +1373,8 @@ static int run_event(const pd_scene_model *sm, const pd_run_opts *o, double tau_
         tr->excursion[j] = er->plastic_excursion[j];
         tr->onsets[j] = er->yield_onsets[j];
     }
+    if (eo.energy) /* in joules: kg (Le wp)^2 */
+        pd_scene_energy_of_edr(er, (tr->Le * tr->wp) * (tr->Le * tr->wp), &res->energy);
     tr->lcp_solves = er->lcp_solves;
     res->steps = er->events;
     res->simultaneous = er->simultaneous;
@@ -1440,8 +1445,17 @@ static int run_penalty(const pd_model *md, const pd_run_opts *o, double tau_end,
         rc = held_solver(tr, md, err);
     if (rc)
         return rc;
+    /* a yielding scene by newmark: its energy balance, step by step (the
+     * adaptive penalty's steppers have no such identity) */
+    if (md->ns > 0 && o->method == PD_METHOD_NEWMARK &&
+        !(tr->en = pd_scene_energy_alloc(md, po.h, 0.5)))
+        return pd_err_set(err, PD_ENOMEM, "out of memory for the energy balance");
     rc = pd_penalty_run(md, 0.0, NULL, NULL, tau_end, &po, tr->fn ? observe_grid : NULL, tr, &pr,
                         err);
+    if (tr->en) /* in joules: kg (Le wp)^2 */
+        pd_scene_energy_finish(tr->en, (tr->Le * tr->wp) * (tr->Le * tr->wp), &res->energy);
+    pd_scene_energy_free(tr->en);
+    tr->en = NULL;
     res->steps = pr.steps;
     res->kernel = pr.stepper ? pr.stepper : "penalty";
     res->factor =

@@ -1091,15 +1091,16 @@ def cases_scene(env):
             path = os.path.join(ROOT, "examples", "scenes", name)
             if "rinaldi" in name and not rec:
                 continue
-            # a yielding scene: newmark for the reference, and compare (whose judge is
-            # the exact reference) refused naming uy
-            yielding = "yielding" in name
-            for cmd, expect, rx in (
-                    (["simulate", "--scene", path, "--json", "-o", "out.h5"], "0", None),
-                    (["simulate", "--scene", path, "--method", "newmark" if yielding else "event",
-                      "--json", "-o", "out.csv"], "0", None),
-                    (["compare", "--scene", path, "--dt", "1e-3", "--json"],
-                     "2" if yielding else "0", r"uy" if yielding else None)):
+            # a yielding scene: newmark as well (the exact reference and compare, whose
+            # judge it is, run yielding structures too)
+            runs = [(["simulate", "--scene", path, "--json", "-o", "out.h5"], "0", None),
+                    (["simulate", "--scene", path, "--method", "event", "--json", "-o",
+                      "out.csv"], "0", None),
+                    (["compare", "--scene", path, "--dt", "1e-3", "--json"], "0", None)]
+            if "yielding" in name:
+                runs.append((["simulate", "--scene", path, "--method", "newmark", "--json"], "0",
+                             None))
+            for cmd, expect, rx in runs:
                 cases.append(Case("scene", cmd, expect, rx, check=check_output,
                                   display="pound " + " ".join(
                                       os.path.relpath(a, ROOT) if a.startswith("/") else a
