@@ -625,11 +625,13 @@ static void predict_spring(pd_edr *r, int j, double ts, int cont)
                     .up = r->rs.sp_up[j],
                     .uy = r->tp.md->uy[j],
                     .ph = r->rs.sp_phase[j]};
-    /* rounding levels: of z^2 - uy^2, or of the drift's rate */
+    /* rounding levels: of z^2 - uy^2 (z = d - up rounds with the size of d
+     * and up: an offset far beyond uy, a drift of a flight's modal sums), or
+     * of the drift's rate */
     double d, dd, ddd;
     edr_spring_at(r, c, j, ts, &d, &dd, &ddd);
-    double thr =
-        g.ph == 0.0 ? EDR_GAP_ROUND * g.uy * g.uy : EDR_RATE_TOL * fmax(r->rs.vscale, fabs(dd));
+    double thr = g.ph == 0.0 ? EDR_GAP_ROUND * g.uy * (g.uy + fabs(d) + fabs(g.up))
+                             : EDR_RATE_TOL * fmax(r->rs.vscale, fabs(dd));
     edr_scan s = {
         .fn = spring_fn, .ctx = &g, .hit_mode = 1, .thr = thr, .fmax = -HUGE_VAL, .fmin = HUGE_VAL};
     double h = cl->h, tw = window_end(r, slot, cont, ts, h);
