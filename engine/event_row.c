@@ -892,28 +892,22 @@ static void group_grow(pd_edr *r, double t)
     }
 }
 
-/* The held contacts' forces of cluster c integrated from its imp_t to tb
- * into the sampled impulses (imp_out): 5-point Gauss–Legendre on
- * sub-intervals no wider than the scan step (a fraction of the flight's
- * shortest period and of the piece's), exact to rounding for the smooth
- * closed-form force.  Locked contacts (a cycle's redundant edge) have no
- * force of their own and are left out.  Only for a sampler; the cache and
- * the evaluation count are left as they were, so the run is unchanged. */
-static void integrate_held(pd_edr *r, int c, double tb)
+/* A node of flight_quadrature: t and its weight. */
+typedef void (*quad_node_fn)(pd_edr *r, int c, double t, double weight, void *ctx);
+
+/* int over [ta, tb] of cluster c's flight: 5-point Gauss-Legendre on n
+ * pieces of width w no wider than the scan step (a fraction of the flight's
+ * shortest period and of the piece's), on each int f = (w / 2) sum_k wg_k
+ * f(mid + (w / 2) xg_k), exact for polynomials of degree up to 9: node(t,
+ * weight) at each node.  The cache and the evaluation count are left as
+ * they were, so the run is unchanged. */
+static void flight_quadrature(pd_edr *r, int c, double ta, double tb, quad_node_fn node, void *ctx)
 {
     static const double xg[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831,
                                  0.9061798459386640};
     static const double wg[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889,
                                  0.4786286704993665, 0.2369268850561891};
     edr_cluster *cl = &r->rs.cl[c];
-    double ta = cl->imp_t;
-    /* no sampler, no held contact or nothing to integrate: only the mark moves */
-    if (!r->rs.sample_forces || cl->pers_head < 0 || !(tb > ta)) {
-        cl->imp_t = fmax(ta, tb);
-        return;
-    }
-    cl->imp_t = tb;
-    /* the cache and the evaluation count saved: sampling leaves the run as it was */
     long evals = r->rs.evals;
     int cached = cl->cached;
     double tc = cl->tc;
@@ -922,15 +916,10 @@ static void integrate_held(pd_edr *r, int c, double tb)
     if (n < 1)
         n = 1;
     double w = (tb - ta) / (double)n;
-    /* n pieces of width w <= h; on each, int f = (w / 2) sum_k wg_k
-     * f(mid + (w / 2) xg_k), exact for polynomials of degree up to 9 */
     for (long i = 0; i < n; i++) {
         double mid = ta + ((double)i + 0.5) * w;
-        for (int k = 0; k < 5; k++) {
-            double t = mid + 0.5 * w * xg[k], f = 0.5 * w * wg[k];
-            for (int a = cl->pers_head; a >= 0; a = r->rs.pers_next[a])
-                r->rs.imp_out[a] += f * edr_force_at(r, c, a, t);
-        }
+        for (int k = 0; k < 5; k++)
+            node(r, c, mid + 0.5 * w * xg[k], 0.5 * w * wg[k], ctx);
     }
     /* the cache back at tc, where the run left it */
     if (cached)
@@ -938,58 +927,61 @@ static void integrate_held(pd_edr *r, int c, double tb)
     r->rs.evals = evals;
 }
 
+/* The held contacts' forces at t into the sampled impulses. */
+static void held_node(pd_edr *r, int c, double t, double weight, void *ctx)
+{
+    (void)ctx;
+    for (int a = r->rs.cl[c].pers_head; a >= 0; a = r->rs.pers_next[a])
+        r->rs.imp_out[a] += weight * edr_force_at(r, c, a, t);
+}
+
+/* The held contacts' forces of cluster c integrated from its imp_t to tb
+ * into the sampled impulses (imp_out), exact to rounding for the smooth
+ * closed-form force.  Locked contacts (a cycle's redundant edge) have no
+ * force of their own and are left out.  Only for a sampler. */
+static void integrate_held(pd_edr *r, int c, double tb)
+{
+    edr_cluster *cl = &r->rs.cl[c];
+    double ta = cl->imp_t;
+    /* no sampler, no held contact or nothing to integrate: only the mark moves */
+    cl->imp_t = fmax(ta, tb);
+    if (r->rs.sample_forces && cl->pers_head >= 0 && tb > ta)
+        flight_quadrature(r, c, ta, tb, held_node, NULL);
+}
+
+/* The input and damping powers at t, (b f) . v and v^T C v, into the
+ * balance's integrals. */
+static void energy_node(pd_edr *r, int c, double t, double weight, void *ctx)
+{
+    edr_cluster *cl = &r->rs.cl[c];
+    double *v = ctx, pin = 0.0, pd = 0.0; /* v by global dof (the cluster's entries) */
+    for (int b = cl->head; b >= 0; b = r->rs.blk_next[b]) {
+        const edr_block *bk = &r->tp.blk[b];
+        const double *Cb = r->tp.Cb + r->tp.blk_off[b];
+        for (int l = 0; l < bk->n; l++) {
+            int gi = r->tp.blk_dofs[bk->first + l];
+            double dx, a;
+            edr_dof_at(r, c, gi, t, &dx, &v[gi], &a);
+            pin += r->tp.b[gi] * v[gi];
+        }
+        for (int l = 0; l < bk->n; l++) /* v^T C_b v, C_b column-major */
+            for (int m = 0; m < bk->n; m++)
+                pd += v[r->tp.blk_dofs[bk->first + l]] * Cb[l + (long)m * bk->n] *
+                      v[r->tp.blk_dofs[bk->first + m]];
+    }
+    r->rs.e_input += weight * edr_force(r, cl->piece, t) * pin;
+    r->rs.e_damping += weight * pd;
+}
+
 /* The energy balance's integrals over cluster c's flight from its en_t to
- * tb: input int (b f) . v dt and damping int v^T C v dt, 5-point
- * Gauss-Legendre on sub-intervals no wider than the scan step (as
- * integrate_held); the cache and the evaluation count left as they were. */
+ * tb: input int (b f) . v dt and damping int v^T C v dt (opts.energy). */
 static void integrate_energy(pd_edr *r, int c, double tb)
 {
-    static const double xg[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831,
-                                 0.9061798459386640};
-    static const double wg[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889,
-                                 0.4786286704993665, 0.2369268850561891};
     edr_cluster *cl = &r->rs.cl[c];
     double ta = cl->en_t;
-    if (!r->tp.o.energy || !(tb > ta)) {
-        cl->en_t = fmax(ta, tb);
-        return;
-    }
-    cl->en_t = tb;
-    long evals = r->rs.evals;
-    int cached = cl->cached;
-    double tc = cl->tc, *v = r->ev.wk; /* v by global dof (the cluster's entries) */
-    double h = cl->h > 0.0 ? cl->h : tb - ta;
-    long n = (long)ceil((tb - ta) / h);
-    if (n < 1)
-        n = 1;
-    double w = (tb - ta) / (double)n, input = 0.0, damping = 0.0;
-    for (long i = 0; i < n; i++) {
-        double mid = ta + ((double)i + 0.5) * w;
-        for (int k = 0; k < 5; k++) {
-            double t = mid + 0.5 * w * xg[k], f = edr_force(r, cl->piece, t), pin = 0.0, pd = 0.0;
-            for (int b = cl->head; b >= 0; b = r->rs.blk_next[b]) {
-                const edr_block *bk = &r->tp.blk[b];
-                const double *Cb = r->tp.Cb + r->tp.blk_off[b];
-                for (int l = 0; l < bk->n; l++) {
-                    int gi = r->tp.blk_dofs[bk->first + l];
-                    double dx, a;
-                    edr_dof_at(r, c, gi, t, &dx, &v[gi], &a);
-                    pin += r->tp.b[gi] * v[gi];
-                }
-                for (int l = 0; l < bk->n; l++) /* v^T C_b v, C_b column-major */
-                    for (int m = 0; m < bk->n; m++)
-                        pd += v[r->tp.blk_dofs[bk->first + l]] * Cb[l + (long)m * bk->n] *
-                              v[r->tp.blk_dofs[bk->first + m]];
-            }
-            input += 0.5 * w * wg[k] * f * pin;
-            damping += 0.5 * w * wg[k] * pd;
-        }
-    }
-    r->rs.e_input += input;
-    r->rs.e_damping += damping;
-    if (cached)
-        edr_cluster_eval(r, c, tc);
-    r->rs.evals = evals;
+    cl->en_t = fmax(ta, tb);
+    if (r->tp.o.energy && tb > ta)
+        flight_quadrature(r, c, ta, tb, energy_node, r->ev.wk);
 }
 
 /* v^T M v / 2 over the listed dofs of the velocities v (global index). */

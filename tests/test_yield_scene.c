@@ -445,6 +445,24 @@ static void test_yield_scene_sliding_set_compressed(pd_test_ctx *ctx)
     pd_scene_free(sc);
 }
 
+/* The scene of a JSON text written to path and loaded (NULL: named; the
+ * file is removed then). */
+static pd_scene *scene_of_text(pd_test_ctx *ctx, const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    if (!CHECK(ctx, f != NULL, "cannot write %s", path))
+        return NULL;
+    fputs(text, f);
+    fclose(f);
+    pd_scene *sc = NULL;
+    pd_err e;
+    if (!CHECK(ctx, pd_scene_load(path, &sc, &e) == PD_OK, "%s", e.msg)) {
+        remove(path);
+        return NULL;
+    }
+    return sc;
+}
+
 /* The soft-storey building of the example and its neighbour under the
  * Rinaldi record (examples/records, 20 s): the soft storey yields, with
  * onsets through the record (measured ductility 3.29, 8 onsets);
@@ -469,26 +487,20 @@ static void test_yield_scene_soft_storey_record(pd_test_ctx *ctx)
     }
     fclose(probe);
     snprintf(full, sizeof full, "%s/%s", cwd, rec);
-    FILE *f = fopen(path, "w");
-    if (!CHECK(ctx, f != NULL, "cannot write %s", path))
+    char text[6144];
+    snprintf(text, sizeof text,
+             "{\"excitation\": {\"record\": \"%s\"},\n"
+             " \"structures\": [\n"
+             "  {\"name\": \"soft\", \"masses\": [3e5, 3e5, 3e5, 2.5e5], \"stiffnesses\": [1.5e8, "
+             "4e8, 4e8, 3e8], \"uy\": [0.03, 0.04, 0.04, 0.04], \"alpha\": 0.05},\n"
+             "  {\"name\": \"stiff\", \"masses\": [3e5, 3e5, 2.5e5], \"stiffnesses\": [6e8, 5e8, "
+             "4e8], \"uy\": 0.02, \"alpha\": 0.1}],\n"
+             " \"contacts\": [{\"a\": \"soft\", \"b\": \"stiff\", \"levels\": [1, 2, 3], \"gap\": "
+             "0.03, \"eps\": 0.5}]}\n",
+             full);
+    pd_scene *sc = scene_of_text(ctx, path, text);
+    if (!sc)
         return;
-    fprintf(f,
-            "{\"excitation\": {\"record\": \"%s\"},\n"
-            " \"structures\": [\n"
-            "  {\"name\": \"soft\", \"masses\": [3e5, 3e5, 3e5, 2.5e5], \"stiffnesses\": [1.5e8, "
-            "4e8, 4e8, 3e8], \"uy\": [0.03, 0.04, 0.04, 0.04], \"alpha\": 0.05},\n"
-            "  {\"name\": \"stiff\", \"masses\": [3e5, 3e5, 2.5e5], \"stiffnesses\": [6e8, 5e8, "
-            "4e8], \"uy\": 0.02, \"alpha\": 0.1}],\n"
-            " \"contacts\": [{\"a\": \"soft\", \"b\": \"stiff\", \"levels\": [1, 2, 3], \"gap\": "
-            "0.03, \"eps\": 0.5}]}\n",
-            full);
-    fclose(f);
-    pd_scene *sc = NULL;
-    pd_err e;
-    if (!CHECK(ctx, pd_scene_load(path, &sc, &e) == PD_OK, "%s", e.msg)) {
-        remove(path);
-        return;
-    }
     pd_scene_result a = {0}, b = {0}, c = {0};
     if (pd_test_scene_run(ctx, sc, PD_METHOD_MOREAU, 1e-3, &a) &&
         pd_test_scene_run(ctx, sc, PD_METHOD_MOREAU, 2.5e-4, &b) &&
@@ -547,22 +559,15 @@ static void test_yield_scene_soft_storey_record(pd_test_ctx *ctx)
 static void test_yield_scene_held_and_sliding(pd_test_ctx *ctx)
 {
     const char *path = "/tmp/pd_yield_held.json";
-    FILE *f = fopen(path, "w");
-    if (!CHECK(ctx, f != NULL, "cannot write %s", path))
+    pd_scene *sc = scene_of_text(
+        ctx, path,
+        "{\"excitation\": {\"pulse\": \"sine\", \"dir\": \"+x\", \"ap\": 16.0, \"Tp\": 4.0},\n"
+        " \"structures\": [{\"name\": \"b\", \"masses\": [3e5, 3e5], \"stiffnesses\": "
+        "[1.5e8, 3e8], \"xi\": 0.05, \"uy\": [0.02, 0.004], \"alpha\": 0.05}],\n"
+        " \"contacts\": [{\"a\": \"b\", \"b\": \"wall\", \"levels\": [2], \"gap\": 0.01, "
+        "\"eps\": 0.0}],\n \"tend\": 6.0}\n");
+    if (!sc)
         return;
-    fputs("{\"excitation\": {\"pulse\": \"sine\", \"dir\": \"+x\", \"ap\": 16.0, \"Tp\": 4.0},\n"
-          " \"structures\": [{\"name\": \"b\", \"masses\": [3e5, 3e5], \"stiffnesses\": "
-          "[1.5e8, 3e8], \"xi\": 0.05, \"uy\": [0.02, 0.004], \"alpha\": 0.05}],\n"
-          " \"contacts\": [{\"a\": \"b\", \"b\": \"wall\", \"levels\": [2], \"gap\": 0.01, "
-          "\"eps\": 0.0}],\n \"tend\": 6.0}\n",
-          f);
-    fclose(f);
-    pd_scene *sc = NULL;
-    pd_err e;
-    if (!CHECK(ctx, pd_scene_load(path, &sc, &e) == PD_OK, "%s", e.msg)) {
-        remove(path);
-        return;
-    }
     pd_scene_result ex, mj;
     const double dts[2] = {1e-4, 1e-5}, tol[2] = {1e-4, 1e-5};
     if (pd_test_scene_run(ctx, sc, PD_METHOD_EVENT, 0.0, &ex)) {
