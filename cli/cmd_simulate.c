@@ -706,6 +706,12 @@ static void scene_json(const sim_args *a, const pd_scene *sc, const pd_scene_sum
         pd_json_num(&js, "force_equiv", r->force_equiv[c]);
         pd_json_num(&js, "force_max", r->force_max[c]); /* NaN -> null: not compliant */
         pd_json_num(&js, "chi", s->chi[c]);
+        pd_json_num(&js, "required_gap", s->required_gap[c]);
+        pd_json_begin_object(&js, "rules");
+        pd_json_num(&js, "abs", s->rule_abs[c]);
+        pd_json_num(&js, "srss", s->rule_srss[c]);
+        pd_json_num(&js, "ddc", s->rule_ddc[c]);
+        pd_json_end_object(&js);
         pd_json_end_object(&js);
     }
     pd_json_end_array(&js);
@@ -714,6 +720,14 @@ static void scene_json(const sim_args *a, const pd_scene *sc, const pd_scene_sum
 }
 
 enum { TEXT_MAX_STRUCTURES = 40, TEXT_MAX_CONTACTS = 60 };
+
+/* Contact c's sides as "a-b" into pair, and its level (a wall's side's). */
+static int contact_label(const pd_scene *sc, int c, char *pair, size_t cap)
+{
+    const pd_contact *ct = &sc->ct[c];
+    snprintf(pair, cap, "%s-%s", side_name(sc, ct->a), side_name(sc, ct->b));
+    return ct->a == PD_WALL ? ct->level_b : ct->level_a;
+}
 
 static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_summary *s)
 {
@@ -816,21 +830,30 @@ static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_sum
         printf("  %-22s %6s %10s %8s %12s %14s %10s\n", "contact", "level", "gap [m]", "impacts",
                "first [s]", "max imp. [N s]", "chi");
     for (int c = 0; c < sc->ncontact && c < TEXT_MAX_CONTACTS; c++) {
-        const pd_contact *ct = &sc->ct[c];
         char pair[2 * PD_NAME_MAX + 8];
-        snprintf(pair, sizeof pair, "%s-%s", side_name(sc, ct->a), side_name(sc, ct->b));
-        printf("  %-22s %6d %10.4g %8ld %12.6g %14.6g %10.4g\n", pair,
-               ct->a == PD_WALL ? ct->level_b : ct->level_a, ct->gap, r->impacts[c],
-               r->first_impact[c], r->max_impulse[c], s->chi[c]);
+        int level = contact_label(sc, c, pair, sizeof pair);
+        printf("  %-22s %6d %10.4g %8ld %12.6g %14.6g %10.4g\n", pair, level, sc->ct[c].gap,
+               r->impacts[c], r->first_impact[c], r->max_impulse[c], s->chi[c]);
     }
     if (sc->ncontact > TEXT_MAX_CONTACTS)
         printf("  ... %d more contacts (--json or -o for all)\n", sc->ncontact - TEXT_MAX_CONTACTS);
+    if (sc->ncontact) /* the gap each contact needs: exact, and the codes' rules */
+        printf("  %-22s %6s %10s %12s %10s %10s %10s\n", "separation [m]", "level", "gap",
+               "required", "ABS", "SRSS", "DDC");
+    for (int c = 0; c < sc->ncontact && c < TEXT_MAX_CONTACTS; c++) {
+        char pair[2 * PD_NAME_MAX + 8];
+        int level = contact_label(sc, c, pair, sizeof pair);
+        printf("  %-22s %6d %10.4g %12.6g %10.4g %10.4g %10.4g\n", pair, level, sc->ct[c].gap,
+               s->required_gap[c], s->rule_abs[c], s->rule_srss[c], s->rule_ddc[c]);
+    }
+    if (sc->ncontact)
+        printf("  (required: the largest closing of the free motions, the contact-free twin's%s)\n",
+               r->method && !strcmp(r->method, "event") ? ", exact" : "; exact by --method event");
     if (sc->ncontact)
         printf("  %-22s %18s %18s\n", "contact forces", "equivalent [N]", "peak (penalty) [N]");
     for (int c = 0; c < sc->ncontact && c < TEXT_MAX_CONTACTS; c++) {
-        const pd_contact *ct = &sc->ct[c];
         char pair[2 * PD_NAME_MAX + 8];
-        snprintf(pair, sizeof pair, "%s-%s", side_name(sc, ct->a), side_name(sc, ct->b));
+        contact_label(sc, c, pair, sizeof pair);
         char peak[32] = "-"; /* an impulsive method: no force history */
         if (!isnan(r->force_max[c]))
             snprintf(peak, sizeof peak, "%.6g", r->force_max[c]);

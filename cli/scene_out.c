@@ -499,6 +499,10 @@ static int put_contact(pd_scene_writer *w, const pd_scene_summary *sum, int a)
          put_num(w, g, prefix, "eps", ct->eps, "1") ||
          put_num(w, g, prefix, "Pi3", sum->Pi3[a], "1") ||
          put_num(w, g, prefix, "chi", sum->chi[a], "1") ||
+         put_num(w, g, prefix, "required_gap", sum->required_gap[a], "m") ||
+         put_num(w, g, prefix, "gap_abs", sum->rule_abs[a], "m") ||
+         put_num(w, g, prefix, "gap_srss", sum->rule_srss[a], "m") ||
+         put_num(w, g, prefix, "gap_ddc", sum->rule_ddc[a], "m") ||
          put_num(w, g, prefix, "impacts", (double)sum->r.impacts[a], "1") ||
          put_num(w, g, prefix, "first_impact", sum->r.first_impact[a], "s") ||
          put_num(w, g, prefix, "max_impulse", sum->r.max_impulse[a], "N s") ||

@@ -822,7 +822,14 @@ PD_API int pd_scene_run(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sa
 /* A run and its contact-free twin with the Pi terms:
  *   Pi1 = umax wp^2 / ap per dof,  Pi2 = Tp / T0 per structure,
  *   Pi3 = gap wp^2 / ap per contact,
- *   gamma = umax / umax_free per dof,  chi = gap / approach_free per contact. */
+ *   gamma = umax / umax_free per dof,  chi = gap / approach_free per contact;
+ * and the separation of each contact (docs/scenes.md, "Separation"): the
+ * gap it needs, the largest closing of its sides' free motions (the twin's
+ * approach: exact by the event method), beside the codes' rules from each
+ * side's own peak u (the twin's umax at its level; a wall's 0):
+ *   ABS u_a + u_b,  SRSS sqrt(u_a^2 + u_b^2),
+ *   DDC sqrt(u_a^2 + u_b^2 - 2 rho u_a u_b), rho pd_ddc_correlation of the
+ *   structures' fundamental periods and damping ratios. */
 typedef struct pd_scene_summary {
     pd_scene_result r, free;
     double *Pi1, *gamma; /* n */
@@ -833,7 +840,17 @@ typedef struct pd_scene_summary {
     int rtol_met;              /* both runs met their tolerance (1 without one) */
     double *err_est_structure; /* nstruct: each structure's, the larger of both runs' (NAN:
                                   fixed steps) */
+    double *required_gap;      /* m: [m] */
+    double *rule_abs, *rule_srss, *rule_ddc; /* m: [m] */
 } pd_scene_summary;
+
+/* The correlation coefficient of two oscillators' responses to one white
+ * noise (Der Kiureghian's, the DDC rule's rho): r = Ta / Tb,
+ *   rho = 8 sqrt(xa xb) (xa + r xb) r^(3/2) / ((1 - r^2)^2
+ *         + 4 xa xb r (1 + r^2) + 4 (xa^2 + xb^2) r^2),
+ * symmetric in the two, 1 for equal periods and damping; NAN for a period
+ * <= 0 or a damping ratio < 0 (0 when either damping is 0 and r != 1). */
+PD_API double pd_ddc_correlation(double Ta, double Tb, double xia, double xib);
 
 /* opts NULL: pd_run_default_opts(). */
 PD_API int pd_scene_summarize(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sampler sampler,

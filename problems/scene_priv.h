@@ -35,4 +35,8 @@ void pd_scene_energy_finish(const pd_scene_energy *e, double E, pd_energy *out);
 /* The exact row reference's balance (its opts.energy terms) in joules. */
 void pd_scene_energy_of_edr(const pd_edr_result *er, double E, pd_energy *out);
 
+/* Each contact's separation from the summary's twin (separation.c):
+ * required_gap and the rules, into the summary's arrays. */
+void pd_scene_separation(const pd_scene *sc, pd_scene_summary *s);
+
 #endif

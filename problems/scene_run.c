@@ -1694,6 +1694,10 @@ void pd_scene_summary_free(pd_scene_summary *s)
     free(s->Pi3);
     free(s->chi);
     free(s->err_est_structure);
+    free(s->required_gap);
+    free(s->rule_abs);
+    free(s->rule_srss);
+    free(s->rule_ddc);
     memset(s, 0, sizeof *s);
 }
 
@@ -1715,7 +1719,12 @@ int pd_scene_summarize(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sam
     s->Pi3 = pd_malloc(sc->ncontact, sizeof(double));
     s->chi = pd_malloc(sc->ncontact, sizeof(double));
     s->err_est_structure = pd_malloc(sc->nstruct, sizeof(double));
-    if (!s->Pi1 || !s->gamma || !s->Pi2 || !s->Pi3 || !s->chi || !s->err_est_structure) {
+    s->required_gap = pd_malloc(sc->ncontact, sizeof(double));
+    s->rule_abs = pd_malloc(sc->ncontact, sizeof(double));
+    s->rule_srss = pd_malloc(sc->ncontact, sizeof(double));
+    s->rule_ddc = pd_malloc(sc->ncontact, sizeof(double));
+    if (!s->Pi1 || !s->gamma || !s->Pi2 || !s->Pi3 || !s->chi || !s->err_est_structure ||
+        !s->required_gap || !s->rule_abs || !s->rule_srss || !s->rule_ddc) {
         pd_scene_summary_free(s);
         return pd_err_set(err, PD_ENOMEM, "out of memory for the summary of %d dofs", sc->n);
     }
@@ -1743,5 +1752,6 @@ int pd_scene_summarize(const pd_scene *sc, const pd_run_opts *opts, pd_scene_sam
         s->Pi3[a] = sc->ct[a].gap / Le;
         s->chi[a] = s->free.approach[a] > 0.0 ? sc->ct[a].gap / s->free.approach[a] : NAN;
     }
+    pd_scene_separation(sc, s);
     return PD_OK;
 }

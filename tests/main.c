@@ -153,6 +153,7 @@ int main(int argc, char **argv)
     suite_yield_rk(&ctx);
     suite_yield_edr(&ctx);
     suite_yield_edr_rk(&ctx);
+    suite_separation(&ctx);
     suite_yield_newmark(&ctx);
     suite_yield_mj(&ctx);
     suite_yield_scene(&ctx);

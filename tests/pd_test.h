@@ -82,6 +82,8 @@ int pd_test_yield_pulse_case(int c, pd_sine_piece pc[2], pd_ed_sdof *p, char *na
 pd_scene *pd_test_yield_row(pd_test_ctx *ctx, int n, double dgap);
 /* Run sc by method (dt 0: the default) into r (allocated here); 1 when it
  * ran, else 0 with the failure named. */
+/* The scene of a JSON text written to path and loaded (NULL: named). */
+pd_scene *pd_test_scene_of_text(pd_test_ctx *ctx, const char *path, const char *text);
 int pd_test_scene_run(pd_test_ctx *ctx, const pd_scene *sc, pd_method method, double dt,
                       pd_scene_result *r);
 /* Run ctx->pound with args (NULL-terminated). */
@@ -137,6 +139,7 @@ void suite_yield(pd_test_ctx *ctx);
 void suite_yield_rk(pd_test_ctx *ctx);
 void suite_yield_edr(pd_test_ctx *ctx);
 void suite_yield_edr_rk(pd_test_ctx *ctx);
+void suite_separation(pd_test_ctx *ctx);
 void suite_yield_newmark(pd_test_ctx *ctx);
 void suite_yield_mj(pd_test_ctx *ctx);
 void suite_yield_scene(pd_test_ctx *ctx);

@@ -3417,4 +3417,4 @@ const api_null_case api_null_cases[] = {
     {.function = "pd_scene_sweep_run", .argument = "umax", .expect = EXPECT_ERROR, .call = api_case_373},
 };
 const int api_null_ncases = 374;
-const int api_null_nfunctions = 223;
+const int api_null_nfunctions = 224;

@@ -332,3 +332,21 @@ int pd_test_rinaldi_case(pd_test_ctx *ctx, pd_record *rec, pd_osc *c)
     c->eps = 0.6;
     return 1;
 }
+
+/* The scene of a JSON text written to path and loaded (NULL: named; the
+ * file is removed then). */
+pd_scene *pd_test_scene_of_text(pd_test_ctx *ctx, const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    if (!CHECK(ctx, f != NULL, "cannot write %s", path))
+        return NULL;
+    fputs(text, f);
+    fclose(f);
+    pd_scene *sc = NULL;
+    pd_err e;
+    if (!CHECK(ctx, pd_scene_load(path, &sc, &e) == PD_OK, "%s", e.msg)) {
+        remove(path);
+        return NULL;
+    }
+    return sc;
+}

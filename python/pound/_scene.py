@@ -184,7 +184,9 @@ class Scene:
         --json`: per structure (r.structures) umax, u_pos, u_neg, drift,
         umax_free [m] and Pi1, gamma (one value per storey), T0 [s], Pi2; per
         contact (r.contacts) impacts, first_impact [s], max_impulse [N s],
-        contact_time [s], approach [m], Pi3, chi; dt, tend [s], Le [m], ap
+        contact_time [s], approach [m], Pi3, chi, required_gap [m] (the
+        separation it needs, exact by method="event") and rules {abs, srss,
+        ddc} [m] (the codes' estimates); dt, tend [s], Le [m], ap
         [m/s^2], Tp [s], impacts (all contacts), cpu_s [s of CPU]; the demands
         (docs/scenes.md, "Demands"): per structure storey_heights [m],
         drift_ratio, acc_max [m/s^2], shear_max, base_shear_max [N], per
@@ -298,7 +300,9 @@ class Scene:
                                    impacts=r.impacts[a], first_impact=r.first_impact[a],
                                    max_impulse=r.max_impulse[a],
                                    contact_time=r.contact_time[a], approach=r.approach[a],
-                                   chi=sm.chi[a]))
+                                   chi=sm.chi[a], required_gap=sm.required_gap[a],
+                                   rules={"abs": sm.rule_abs[a], "srss": sm.rule_srss[a],
+                                          "ddc": sm.rule_ddc[a]}))
         out["contacts"] = contacts
         _demand.scene_fields(out, sc, r)
         return out

@@ -442,6 +442,10 @@ class PdSceneSummary(Structure):
         ("err_est", c_double),
         ("rtol_met", c_int),
         ("err_est_structure", POINTER(c_double)),
+        ("required_gap", POINTER(c_double)),
+        ("rule_abs", POINTER(c_double)),
+        ("rule_srss", POINTER(c_double)),
+        ("rule_ddc", POINTER(c_double)),
     ]
 
 
