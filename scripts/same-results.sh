@@ -3,7 +3,8 @@
 # not move them (issue 32's refactors): a fixed set of runs (spectra, scenes
 # by every method, rows, the references) by the pound of BASE_REV, built in
 # a worktree of its own, and by build/pound, their outputs compared byte for
-# byte (the lines giving the version, the command, the date or the CPU time left out).
+# byte (the lines giving the version, the command, the date or the CPU time left out,
+# and the attributes added since the base: each contact's separation).
 #
 #   sh scripts/same-results.sh [BASE_REV]    (default: the refactors' base)
 set -u
@@ -30,7 +31,10 @@ run() { # name, then pound's arguments; the output file is OUT
         # shellcheck disable=SC2086
         (IFS='
 '; $bin $args) >/dev/null 2>"$work/$who-$name.err" || { echo "same-results: $name fails ($who)"; fail=1; }
-        grep -v -e '^# command' -e '^# pound_version' -e '^# created' -e '^# cpu_s' -e '^# wall_s' "$out" > "$out.cmp" 2>/dev/null
+        # (and the attributes added since: each contact's separation)
+        grep -v -e '^# command' -e '^# pound_version' -e '^# created' -e '^# cpu_s' -e '^# wall_s' \
+            -e '^# c[0-9]*\.required_gap' -e '^# c[0-9]*\.gap_abs' -e '^# c[0-9]*\.gap_srss' \
+            -e '^# c[0-9]*\.gap_ddc' "$out" > "$out.cmp" 2>/dev/null
     done
     n=$((n + 1))
     if ! cmp -s "$work/old-$name.csv.cmp" "$work/new-$name.csv.cmp"; then

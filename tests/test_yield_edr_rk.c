@@ -23,6 +23,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "event_row.h"
 #include "pd_core.h"
 #include "pd_engine.h"
 #include "pd_test.h"
@@ -268,8 +269,8 @@ static void building(yrk_model *y, int n, const double *mass, const double *k, d
 /* The row reference on y's model to t_end: peaks of the drifts, offsets,
  * excursions, onsets into the arrays, its energy balance's residual (of the
  * input work); 0 on failure (named). */
-static int edr_run(pd_test_ctx *ctx, const yrk_model *y, double t_end, double *peak, double *up,
-                   double *exc, long *onsets, double *balance, const char *name)
+static int reference_run(pd_test_ctx *ctx, const yrk_model *y, double t_end, double *peak,
+                         double *up, double *exc, long *onsets, double *balance, const char *name)
 {
     double W = 0.0, g0 = 0.0, e = 0.0;
     pd_model md = {.n = y->n,
@@ -300,8 +301,9 @@ static int edr_run(pd_test_ctx *ctx, const yrk_model *y, double t_end, double *p
         *balance = (res->input_work + res->energy0 - res->kinetic - res->strain -
                     res->damping_work - res->hysteretic - res->impact_loss) /
                    res->input_work;
-        for (int j = 0; j < y->ns; j++) { /* storey j's drift is measured on dof j */
-            peak[j] = res->drift[j];
+        for (int j = 0; j < y->ns; j++) { /* storey j's drift is measured on dof j (its
+                                              * spring's drift a multiple S_jj of it) */
+            peak[j] = res->drift[j] * fabs(y->S[j + j * y->n]);
             up[j] = res->up[j];
             exc[j] = res->plastic_excursion[j];
             onsets[j] = res->yield_onsets[j];
@@ -318,7 +320,7 @@ static int one_case(pd_test_ctx *ctx, const yrk_model *y, double h, double t_end
 {
     double peak[YRK_N], up[YRK_N], exc[YRK_N], balance = NAN;
     long on[YRK_N];
-    if (!edr_run(ctx, y, t_end, peak, up, exc, on, &balance, name))
+    if (!reference_run(ctx, y, t_end, peak, up, exc, on, &balance, name))
         return 0;
     yrk a, b;
     integrate(&a, y, h, t_end);
@@ -348,25 +350,30 @@ static int one_case(pd_test_ctx *ctx, const yrk_model *y, double h, double t_end
 }
 
 /* Overdamped yielding oscillators (xi 1.5 and 3, alpha 0.1 and 0: a slide
- * whose mode has rate 0): no underdamped flight, so modal ones. */
+ * whose mode has rate 0; the spring on x and on 2 x): no underdamped
+ * flight, so modal ones. */
 static void test_yield_edr_rk_overdamped(pd_test_ctx *ctx)
 {
     pd_sine_piece pc[2] = {{.t_start = 0.0, .A = -1.0, .w = 1.0}, {.t_start = 2.0 * PD_PI}};
     double worst = 0.0;
     long onsets = 0;
-    for (int k = 0; k < 4; k++) {
-        double xi = k % 2 ? 3.0 : 1.5, alpha = k / 2 ? 0.0 : 0.1;
+    for (int k = 0; k < 6; k++) {
+        /* the spring on x, and for the last two on the drift 2 x (ks / 4, 2 uy: the
+         * same oscillator) */
+        double xi = k % 2 ? 3.0 : 1.5, alpha = k / 2 == 1 ? 0.0 : 0.1, sig = k < 4 ? 1.0 : 2.0;
         yrk_model y = {.n = 1, .ns = 1, .pc = pc, .npc = 2};
-        y.M[0] = y.b[0] = y.S[0] = 1.0;
+        y.M[0] = y.b[0] = 1.0;
+        y.S[0] = sig;
         y.K[0] = 1.0;
         y.C[0] = 2.0 * xi;
-        y.ks[0] = 1.0 - alpha;
-        y.uy[0] = 0.05;
-        char name[64];
-        snprintf(name, sizeof name, "overdamped xi %g alpha %g", xi, alpha);
+        y.ks[0] = (1.0 - alpha) / (sig * sig);
+        y.uy[0] = 0.05 * sig;
+        char name[96];
+        snprintf(name, sizeof name, "overdamped xi %g alpha %g, the spring on %g x", xi, alpha,
+                 sig);
         one_case(ctx, &y, 2.0 * PD_PI / STEPS_PER_PERIOD, 20.0, &worst, &onsets, name);
     }
-    CHECK(ctx, onsets >= 4, "%ld onsets", onsets);
+    CHECK(ctx, onsets >= 6, "%ld onsets", onsets);
 }
 
 /* Shear buildings of 2 and 3 storeys (a soft first storey), every storey
@@ -408,8 +415,88 @@ static void test_yield_edr_rk_buildings(pd_test_ctx *ctx)
     CHECK(ctx, onsets >= 2 * cases, "%ld onsets over %d cases", onsets, cases);
 }
 
+/* A modal flight's derivatives against their differences (central, 1e-5):
+ * each dof's jerk (edr_dof_jerk: the unloading scan's curvature) and each
+ * spring's drift, its rate and acceleration (edr_spring_at), sampled
+ * through a run, the free vibration after the pulse included. */
+typedef struct modal_track {
+    pd_edr *r;
+    double worst, scale;
+    long checked;
+} modal_track;
+
+static int modal_note(const pd_state *st, void *ctx)
+{
+    modal_track *m = ctx;
+    pd_edr *r = m->r;
+    int c = r->rs.blk_cl[r->tp.dof_blk[0]];
+    if (r->rs.cl[c].kind != EDR_MODAL || st->t < 1e-3)
+        return 0;
+    double h = 1e-5, t = st->t;
+    for (int i = 0; i < r->tp.n; i++) { /* the jerk against a's difference */
+        double dx, v, ap, am;
+        edr_dof_at(r, c, i, t + h, &dx, &v, &ap);
+        edr_dof_at(r, c, i, t - h, &dx, &v, &am);
+        double fd = (ap - am) / (2.0 * h);
+        m->scale = fmax(m->scale, fabs(fd));
+        m->worst = fmax(m->worst, fabs(edr_dof_jerk(r, c, i, t) - fd));
+    }
+    for (int j = 0; j < r->tp.ns; j++) { /* d' and d'' against d's and d''s differences */
+        double dp, dm, vp, vm, ap, am, d, dd, ddd;
+        edr_spring_at(r, c, j, t + h, &dp, &vp, &ap);
+        edr_spring_at(r, c, j, t - h, &dm, &vm, &am);
+        edr_spring_at(r, c, j, t, &d, &dd, &ddd);
+        m->worst = fmax(m->worst, fmax(fabs(dd - (dp - dm) / (2.0 * h)) / fmax(fabs(dd), 1.0),
+                                       fabs(ddd - (vp - vm) / (2.0 * h)) / fmax(fabs(ddd), 1.0)) *
+                                      m->scale);
+    }
+    m->checked++;
+    return 0;
+}
+
+static void test_yield_edr_rk_modal_derivatives(pd_test_ctx *ctx)
+{
+    const double mass[2] = {3.0e5, 2.5e5}, k[2] = {1.5e8, 3.0e8}, uy[2] = {0.03, 0.01};
+    double w1 = PD_TWO_PI / 0.6, w2 = PD_TWO_PI / 0.2, xi = 0.05;
+    pd_sine_piece pc[2] = {{.t_start = 0.0, .A = -6.0, .w = PD_TWO_PI / 0.8, .phi = 0.3},
+                           {.t_start = 0.8}};
+    yrk_model y;
+    building(&y, 2, mass, k, 2.0 * xi * w1 * w2 / (w1 + w2), 2.0 * xi / (w1 + w2), uy, 0.05);
+    double W = 0.0, g0 = 0.0, e = 0.0;
+    pd_model md = {.n = 2,
+                   .m = 0,
+                   .M = pd_matrix_dense(2, 2, y.M),
+                   .C = pd_matrix_dense(2, 2, y.C),
+                   .K = pd_matrix_dense(2, 2, y.K),
+                   .W = pd_matrix_dense(2, 0, &W),
+                   .g0 = &g0,
+                   .e = &e,
+                   .ns = 2,
+                   .S = pd_matrix_dense(2, 2, y.S),
+                   .ks = y.ks,
+                   .uy = y.uy};
+    pd_piecewise_force F = {.b = y.b, .pieces = pc, .npieces = 2};
+    pd_edr_opts o = pd_edr_default_opts();
+    o.h_out = 0.005;
+    pd_err err;
+    modal_track m = {.r = pd_edr_alloc(&md, &F, &o, &err)};
+    if (!CHECK(ctx, m.r != NULL, "%s", err.msg))
+        return;
+    int rc = pd_edr_run(m.r, 0.0, NULL, NULL, 3.0, modal_note, &m, &err);
+    long onsets = 0;
+    for (int j = 0; j < 2 && !rc; j++)
+        onsets += pd_edr_result_of(m.r)->yield_onsets[j];
+    printf("    modal flights: jerks and drifts' derivatives against their differences within "
+           "%.2g of the jerks' scale over %ld samples (%ld onsets)\n",
+           m.worst / m.scale, m.checked, onsets);
+    CHECK(ctx, rc == PD_OK && m.checked > 500 && onsets >= 2 && m.worst <= 1e-6 * m.scale,
+          "%s; off by %.3g of %.3g", rc ? err.msg : "ok", m.worst, m.scale);
+    pd_edr_free(m.r);
+}
+
 void suite_yield_edr_rk(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_yield_edr_rk_overdamped);
     PD_RUN(ctx, test_yield_edr_rk_buildings);
+    PD_RUN(ctx, test_yield_edr_rk_modal_derivatives);
 }
