@@ -62,6 +62,7 @@ DEFAULT_FILES = {
     "engine/penalty_newmark.c": ["yield_newmark", "newmark", "yield_mj", "penalty"],
     "engine/mj_yield.c": ["yield_mj", "yield_scene", "yield"],
     "problems/scene_energy.c": ["yield_scene"],
+    "problems/separation.c": ["separation"],
 }
 
 # Array indices checked against the arrays' sizes (a trap, no runtime

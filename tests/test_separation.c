@@ -64,7 +64,7 @@ static void random_pair(int kind, uint64_t *rng, char *text, size_t cap)
 {
     double Tp = 0.3 + 1.2 * pd_test_uniform(rng), ap = 2.0 + 6.0 * pd_test_uniform(rng);
     const char *pulse = pd_test_uniform(rng) < 0.5 ? "sine" : "cosine";
-    char st[2][256];
+    char st[2][512];
     int storeys[2] = {1, 1};
     for (int s = 0; s < 2; s++) {
         double xi = 0.02 + 0.08 * pd_test_uniform(rng);
@@ -116,7 +116,7 @@ static void test_separation_required_gap(pd_test_ctx *ctx)
     pd_run_opts o = pd_run_default_opts();
     o.method = PD_METHOD_EVENT;
     for (int c = 0; c < 18; c++) {
-        char text[2048];
+        char text[4096];
         random_pair(c % 3, &rng, text, sizeof text);
         pd_scene *sc = pd_test_scene_of_text(ctx, "/tmp/pd_separation.json", text);
         if (!sc)
