@@ -703,6 +703,66 @@ static void test_engine_dense_lu_scaled(pd_test_ctx *ctx)
     CHECK(ctx, pd_dense_lu(2, Z, 2, perm, 1e-14) == PD_ESINGULAR, "the zero matrix factored");
 }
 
+/* Where D's entries land in a gathered D_II (pd_factor_delassus_at and the
+ * map of pd_factor_delassus_csc), by the dense and the CHOLMOD factors, on
+ * a row of 5 dofs and 6 contacts (a wall each end): for every pair of the
+ * chosen contacts (1, 2, 3, 5), D_ab's place through the map holds the dense
+ * gather's D_ab; the pairs that share no dof have no place in CHOLMOD's D
+ * (-1), and the dense D's exact zeros none either. */
+static void test_engine_delassus_map(pd_test_ctx *ctx)
+{
+    enum { N = 5, MC = 6, NI = 4 };
+    double M[N * N] = {0}, K[N * N] = {0}, W[N * MC] = {0}, g0[MC], e[MC];
+    for (int i = 0; i < N; i++) {
+        M[i * (N + 1)] = 1.0 + 0.3 * i;
+        K[i * (N + 1)] = 4.0 + i;
+    }
+    for (int a = 0; a < MC; a++) { /* contact a between dof a - 1 and dof a (walls at the ends) */
+        if (a > 0)
+            W[(a - 1) + a * N] = 1.0;
+        if (a < N)
+            W[a + a * N] = -1.0;
+        g0[a] = 0.01;
+        e[a] = 0.5;
+    }
+    pd_model md = {.n = N,
+                   .m = MC,
+                   .M = pd_matrix_dense(N, N, M),
+                   .C = pd_matrix_zero(N, N),
+                   .K = pd_matrix_dense(N, N, K),
+                   .W = pd_matrix_dense(N, MC, W),
+                   .g0 = g0,
+                   .e = e};
+    const int idx[NI] = {1, 2, 3, 5};
+    const pd_factor_kind kinds[2] = {PD_FACTOR_DENSE, PD_FACTOR_CHOLMOD};
+    for (int k = 0; k < 2; k++) {
+        pd_err err;
+        pd_factor *f = pd_factor_alloc(&md, 0.01, 0.5, kinds[k], &err);
+        if (!CHECK(ctx, f != NULL, "%s", err.msg))
+            continue;
+        double Dd[NI * NI], val[MC * MC];
+        int colptr[NI + 1], rowind[MC * MC], map[MC * MC];
+        pd_factor_delassus_dense(f, idx, NI, Dd);
+        pd_factor_delassus_csc(f, idx, NI, colptr, rowind, val, map);
+        int ok = 1, absent = 0;
+        for (int c = 0; c < NI; c++)
+            for (int r = 0; r < NI; r++) {
+                long at = pd_factor_delassus_at(f, idx[c], idx[r]);
+                int share = abs(idx[c] - idx[r]) <= 1; /* neighbours share a dof */
+                if (!share) {
+                    absent += at < 0;
+                    ok &= at < 0 || Dd[r + c * NI] == 0.0;
+                    continue;
+                }
+                ok &= at >= 0 && val[map[at]] == Dd[r + c * NI] && rowind[map[at]] == r &&
+                      map[at] >= colptr[c] && map[at] < colptr[c + 1];
+            }
+        CHECK(ctx, ok && absent == 8, "%s factor: places %s, %d absent pairs (8)",
+              k ? "cholmod" : "dense", ok ? "right" : "wrong", absent);
+        pd_factor_free(f);
+    }
+}
+
 /* The scene of issue 19 -- two oscillators of 1e12 kg (T0 = 0.4 s) and
  * 1e-6 kg (T0 = 1.2 s), one contact between them -- factors densely
  * (What = diag(1e12, 1e-6) (1 + ...), refused as singular before): What^-1
@@ -922,5 +982,6 @@ void suite_engine(pd_test_ctx *ctx)
     PD_RUN(ctx, test_engine_batch_flags_nonfinite);
     PD_RUN(ctx, test_engine_dense_lu_scaled);
     PD_RUN(ctx, test_engine_dense_factor_scaled);
+    PD_RUN(ctx, test_engine_delassus_map);
     PD_RUN(ctx, test_engine_breaks_inside_steps);
 }

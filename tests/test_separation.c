@@ -52,6 +52,9 @@ static void test_separation_ddc_correlation(pd_test_ctx *ctx)
               pd_ddc_correlation(0.7, 0.7, 0.0, 0.0) == 1.0 &&
               pd_ddc_correlation(0.7, 1.4, 0.0, 0.05) == 0.0 &&
               isnan(pd_ddc_correlation(0.0, 1.0, 0.05, 0.05)) &&
+              isnan(pd_ddc_correlation(1.0, 0.0, 0.05, 0.05)) &&
+              isnan(pd_ddc_correlation(1.0, 1.0, 0.05, -0.1)) &&
+              isnan(pd_ddc_correlation(1.0, INFINITY, 0.05, 0.05)) &&
               isnan(pd_ddc_correlation(1.0, 1.0, -0.1, 0.05)) &&
               isnan(pd_ddc_correlation(NAN, 1.0, 0.05, 0.05)),
           "special values");
