@@ -611,13 +611,11 @@ static int active_row(const pd_mj *mj, int a)
 }
 
 /* Whether an active contact pushes on dof i. */
-static int pushed(const pd_mj *mj, int i)
+static int pushed(const pd_mj *mj, const pd_state *out, int i)
 {
-    for (int q = mj->inc.dptr[i]; q < mj->inc.dptr[i + 1]; q++) {
-        int r = active_row(mj, mj->inc.con[q]);
-        if (r >= 0 && mj->P_active[r] > 0.0)
+    for (int q = mj->inc.dptr[i]; q < mj->inc.dptr[i + 1]; q++)
+        if (out->P[mj->inc.con[q]] > 0.0) /* (an inactive contact's is 0) */
             return 1;
-    }
     return 0;
 }
 
@@ -633,27 +631,51 @@ static int contacts_hold(const pd_mj *mj, int i, const double *v)
     return 1;
 }
 
+/* Pair p of a spring's dof (contacts in D_II's column col and row row, both
+ * active) corrected by dc: D_ab += W_ia W_ib dc at its place (dense, or
+ * through the map), the entry as it was logged for the next try.  0, or 1
+ * when the entry falls outside D's pattern. */
+static inline int correct_pair(pd_mj *mj, mj_yield *y, int p, int col, int row, int nI, double dc)
+{
+    long at = !mj->sparse ? row + (long)col * nI : y->pk[p] < 0 ? -1 : y->map[y->pk[p]];
+    if (at < 0)
+        return 1;
+    y->log_at[y->nlog] = at;
+    y->log_v[y->nlog++] = mj->D_active[at];
+    mj->D_active[at] += y->pw[p] * dc;
+    return 0;
+}
+
 /* D_II corrected on the sliding dofs: D_ab += W_ia W_ib dc_j over the
- * pairs of active contacts on spring j's dof i, each at its place (dense;
- * compressed: D's entry's, through map).  0, or 1 when an entry falls
- * outside D's pattern (Gauss-Seidel then). */
+ * pairs of active contacts on spring j's dof i (pairs in the order of the
+ * dof's contacts, pptr[j] + u deg + v): a dof of two contacts (a row's)
+ * reads their two rows once.  0, or 1 when an entry falls outside D's
+ * pattern (Gauss-Seidel then). */
 static int set_delassus(pd_mj *mj, int nI, int ny)
 {
     mj_yield *y = mj->yl;
+    const mj_incidence *in = &mj->inc;
     for (int k = 0; k < ny; k++) {
-        int j = y->ys[k];
+        int j = y->ys[k], i = y->sdof[j], p0 = y->pptr[j], q0 = in->dptr[i];
+        int deg = in->dptr[i + 1] - q0, bad = 0;
         double dc = y->dcs[j];
-        for (int p = y->pptr[j]; p < y->pptr[j + 1]; p++) {
-            int col = y->row[y->pcol[p]], row = y->row[y->prow[p]];
-            if (col < 0 || row < 0)
-                continue;
-            long at = !mj->sparse ? row + (long)col * nI : y->pk[p] < 0 ? -1 : y->map[y->pk[p]];
-            if (at < 0)
-                return 1;
-            y->log_at[y->nlog] = at; /* the entry as it was, for the next try */
-            y->log_v[y->nlog++] = mj->D_active[at];
-            mj->D_active[at] += y->pw[p] * dc;
-        }
+        if (deg == 2) { /* (a, a), (a, b), (b, a), (b, b) of the rows ra, rb */
+            int ra = y->row[in->con[q0]], rb = y->row[in->con[q0 + 1]];
+            if (ra >= 0)
+                bad |= correct_pair(mj, y, p0, ra, ra, nI, dc);
+            if (ra >= 0 && rb >= 0)
+                bad |= correct_pair(mj, y, p0 + 1, ra, rb, nI, dc) |
+                       correct_pair(mj, y, p0 + 2, rb, ra, nI, dc);
+            if (rb >= 0)
+                bad |= correct_pair(mj, y, p0 + 3, rb, rb, nI, dc);
+        } else
+            for (int p = p0; p < y->pptr[j + 1]; p++) {
+                int col = y->row[y->pcol[p]], row = y->row[y->prow[p]];
+                if (col >= 0 && row >= 0)
+                    bad |= correct_pair(mj, y, p, col, row, nI, dc);
+            }
+        if (bad)
+            return 1;
     }
     return 0;
 }
@@ -734,11 +756,9 @@ static int set_contacts(pd_mj *mj, const pd_factor *f, int nI, int ny, double ht
     pd_factor_add_impulse(f, mj->idx_active, nI, mj->P_active, out->v);
     for (int k = 0; k < ny; k++) { /* the sliding dofs' extra compliance */
         int j = y->ys[k], i = y->sdof[j];
-        double s = 0.0;
-        for (int q = mj->inc.dptr[i]; q < mj->inc.dptr[i + 1]; q++) {
-            int r = active_row(mj, mj->inc.con[q]);
-            s += r >= 0 ? mj->inc.wr[q] * mj->P_active[r] : 0.0;
-        }
+        double s = 0.0; /* out->P: the active contacts' impulses, the others' 0 */
+        for (int q = mj->inc.dptr[i]; q < mj->inc.dptr[i + 1]; q++)
+            s += mj->inc.wr[q] * out->P[mj->inc.con[q]];
         y->wp[i] = s;
         out->v[i] += y->dcs[j] * s;
     }
@@ -790,7 +810,7 @@ static int slide_tries(pd_mj *mj, const pd_factor *f, int nI, int *ny, double ht
                 continue;
             }
             y->sigma[j] = 0; /* it does not slide: out of Y (G read for Y only) */
-            if (pushed(mj, i))
+            if (pushed(mj, out, i))
                 again = 1;
             else
                 again |= !slide_unpushed(mj, j, hth, out);
@@ -801,7 +821,7 @@ static int slide_tries(pd_mj *mj, const pd_factor *f, int nI, int *ny, double ht
             for (int k = 0; k < *ny; k++) {
                 int j = y->ys[k], i = y->sdof[j];
                 if ((k >= ny0 || y->G[j] == 0.0) && !again) {
-                    if (pushed(mj, i))
+                    if (pushed(mj, out, i))
                         again = 1;
                     else
                         again |= !slide_unpushed(mj, j, hth, out);

@@ -384,6 +384,82 @@ static void test_yield_scene_gauss_seidel(pd_test_ctx *ctx)
     pd_scene_free(sc);
 }
 
+/* The peaks of the dofs and the spring's offset through a run of 3 dofs
+ * and one spring. */
+typedef struct star_track {
+    double qmax[3], q[3], up, upmax;
+} star_track;
+
+static int star_note(const pd_state *st, void *ctx)
+{
+    star_track *t = ctx;
+    for (int i = 0; i < 3; i++) {
+        t->qmax[i] = fmax(t->qmax[i], fabs(st->q[i]));
+        t->q[i] = st->q[i];
+    }
+    t->up = st->up[0];
+    t->upmax = fmax(t->upmax, fabs(st->up[0]));
+    return 0;
+}
+
+/* A yielding SDOF with three contacts on its dof (a neighbour each side
+ * and a wall beside the right one): the sliding set's corrections of D_II
+ * on a dof of three contacts, some active and some not, give the dense
+ * pivoting's run (the peaks, the offset and the end state within 1e-9 of
+ * the peaks), Gauss-Seidel never taking a step. */
+static void test_yield_scene_three_contacts_on_a_dof(pd_test_ctx *ctx)
+{
+    pd_scene *sc = pd_test_scene_of_text(
+        ctx, "/tmp/pd_yield_star.json",
+        "{\"excitation\": {\"pulse\": \"harmonic\", \"ap\": 4.0, \"Tp\": 0.6},\n"
+        " \"structures\": [{\"name\": \"a\", \"T0\": 0.9, \"xi\": 0.05},\n"
+        "  {\"name\": \"c\", \"T0\": 0.5, \"xi\": 0.05, \"uy\": 0.01, \"alpha\": 0.05},\n"
+        "  {\"name\": \"b\", \"T0\": 1.2, \"xi\": 0.05}],\n"
+        " \"contacts\": [{\"a\": \"a\", \"b\": \"c\", \"gap\": 0.002, \"eps\": 0.0},\n"
+        "  {\"a\": \"c\", \"b\": \"b\", \"gap\": 0.03, \"eps\": 0.3},\n"
+        "  {\"a\": \"c\", \"b\": \"wall\", \"gap\": 0.04, \"eps\": 0.0}],\n"
+        " \"tend\": 4.0}\n");
+    pd_scene_model sm;
+    pd_err e;
+    if (!sc || !CHECK(ctx, pd_scene_model_build(sc, 1, &sm, &e) == PD_OK, "%s", e.msg)) {
+        pd_scene_free(sc);
+        return;
+    }
+    star_track g[2];
+    memset(g, 0, sizeof g);
+    pd_mj_stats ms[2];
+    const int lcp_max[2] = {512, 0}; /* dense pivoting, the sliding set */
+    for (int k = 0; k < 2; k++) {
+        pd_mj_opts mo = pd_mj_default_opts();
+        mo.h = 2.5e-4 * PD_TWO_PI / sc->exc.Tp;
+        mo.yield_lcp_max = lcp_max[k];
+        pd_mj *mj = pd_mj_alloc(&sm.model, &mo, &e);
+        if (!CHECK(ctx, mj != NULL, "%s", e.msg))
+            break;
+        int rc = pd_mj_run(mj, 16000, star_note, &g[k], &e);
+        pd_mj_get_stats(mj, &ms[k]);
+        pd_mj_free(mj);
+        CHECK(ctx, rc == PD_OK, "%d: %s", k, rc ? e.msg : "ok");
+    }
+    double d = fabs(g[0].up - g[1].up), peak = 0.0;
+    for (int i = 0; i < 3; i++) {
+        d = fmax(d, fmax(fabs(g[0].qmax[i] - g[1].qmax[i]), fabs(g[0].q[i] - g[1].q[i])));
+        peak = fmax(peak, g[0].qmax[i]);
+    }
+    d /= peak;
+    printf("    three contacts on a yielding dof: the sliding set against dense pivoting %.2g "
+           "of the peak (offset up to %.3g, %ld tries over %ld steps)\n",
+           d, g[0].upmax, ms[1].yield_set_tries, ms[1].steps);
+    CHECK(ctx,
+          d <= 1e-9 && g[0].upmax > 0.0 && ms[1].yield_set_tries >= ms[1].steps &&
+              ms[1].yield_gs_steps == 0,
+          "%.3g apart, offsets %g, %ld tries, %ld Gauss-Seidel steps", d, g[0].upmax,
+          ms[1].yield_set_tries, ms[1].yield_gs_steps);
+    pd_scene_model_free(&sm);
+    pd_scene_free(sc);
+    remove("/tmp/pd_yield_star.json");
+}
+
 /* A compressed row (the bench's: 40 SDOFs, periods 1 and 1.5 s, gaps 0.01
  * Le, e 0, a harmonic excitation; every SDOF yielding, Piy 0.5, alpha 0.05):
  * many slides start and stop where contacts push, so the sliding set tries
@@ -715,5 +791,6 @@ void suite_yield_scene(pd_test_ctx *ctx)
     PD_RUN(ctx, test_yield_scene_soft_storey_record);
     PD_RUN(ctx, test_yield_scene_held_and_sliding);
     PD_RUN(ctx, test_yield_scene_held_together);
+    PD_RUN(ctx, test_yield_scene_three_contacts_on_a_dof);
     PD_RUN(ctx, test_yield_scene_bad_fields);
 }
