@@ -1341,7 +1341,8 @@ static int run_event(const pd_scene_model *sm, const pd_run_opts *o, double tau_
     eo.inactive = o->no_wall;
     eo.lcp_solver = o->lcp_solver;
     eo.impact_law = o->impact_law;
-    eo.energy = sm->model.ns > 0; /* a yielding scene's energy balance, as Moreau-Jean's */
+    /* a yielding scene's energy balance, as Moreau-Jean's (not a twin's or a sweep's) */
+    eo.energy = sm->model.ns > 0 && !o->no_demands;
     pd_edr *edr = pd_edr_alloc(&sm->model, &F, &eo, err);
     if (!edr) {
         free(pieces);
