@@ -3,7 +3,9 @@
 #   make demo     install missing packages (as root), build, run the main job
 #   make test     install missing packages (as root), build, run the tests
 #   make asan     the tests under AddressSanitizer + UndefinedBehaviorSanitizer
-#   make bench    performance figures (pound bench; pound against Siconos numerics)
+#   make bench    performance figures (pound bench; pound against Siconos numerics);
+#                 SHARED=DIR names the shared data's folder (default ../shared: the
+#                 Siconos LCP set and the record study, each said skipped when absent)
 #   make figures  the figures (convergence, work-precision, stability, energy)
 #                 and the paper's (make paper alone) into build/figures/;
 #                 DOCS=1 (or make figures-docs, paper-docs) refreshes the
@@ -242,7 +244,7 @@ asan: deps
 bench: deps
 	@sh scripts/deps.sh --bench || echo "bench: Siconos numerics not installed (the paired table is skipped)"
 	@$(MAKE) --no-print-directory all
-	$(BUILD)/pound bench
+	$(BUILD)/pound bench $(if $(SHARED),--shared $(SHARED))
 	@st=0; sh bench/build.sh $(BUILD) || st=$$?; \
 	if [ $$st = 0 ]; then $(BUILD)/siconos_lcp --chains; elif [ $$st != 3 ]; then exit $$st; fi
 
