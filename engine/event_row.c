@@ -2632,21 +2632,12 @@ static int on_piece(pd_edr *r, double t, pd_err *err)
     return PD_OK;
 }
 
-/* The springs' offsets at t into sp_now (a slide's from its drift). */
-static void spring_offsets(pd_edr *r, double t)
+/* The springs' offsets into sp_now, with the dofs at q (a slide's from its
+ * drift). */
+static void spring_offsets(pd_edr *r, const double *q)
 {
-    for (int j = 0; j < r->tp.ns; j++) {
-        double d = 0.0, x, v, a;
-        if (r->rs.sp_phase[j] != 0) { /* a slide's offset moves with its drift */
-            dof_state(r, r->tp.sp_dof[j], t, &x, &v, &a);
-            d = r->tp.sp_sig[j] * x;
-            if (r->tp.sp_dof2[j] >= 0) {
-                dof_state(r, r->tp.sp_dof2[j], t, &x, &v, &a);
-                d += r->tp.sp_sig2[j] * x;
-            }
-        }
-        r->rs.sp_now[j] = edr_spring_up(r, j, d);
-    }
+    for (int j = 0; j < r->tp.ns; j++) /* a slide's offset moves with its drift */
+        r->rs.sp_now[j] = edr_spring_up(r, j, r->rs.sp_phase[j] ? edr_spring_drift(r, j, q) : 0.0);
 }
 
 /* The observer's state at t. */
@@ -2669,7 +2660,7 @@ static int emit(pd_edr *r, double t, pd_observer obs, void *ctx)
         r->rs.st.active[a] = r->rs.cstate[a] == EDR_PERSIST;
     }
     if (r->tp.ns > 0) { /* the springs' offsets at t */
-        spring_offsets(r, t);
+        spring_offsets(r, r->rs.st.q);
         r->rs.st.up = r->rs.sp_now;
     }
     r->rs.st.t = t;
@@ -3523,9 +3514,9 @@ static void state_energy(const pd_edr *r, const double *q, const double *v, cons
     for (int b = 0; b < r->tp.nb; b++) {
         const edr_block *bk = &r->tp.blk[b];
         const double *Kb = r->tp.Kb + r->tp.blk_off[b];
+        ke += kinetic_of(r, r->tp.blk_dofs + bk->first, bk->n, v);
         for (int l = 0; l < bk->n; l++) {
             int gi = r->tp.blk_dofs[bk->first + l];
-            ke += 0.5 * v[gi] * v[gi] / r->tp.minv[gi];
             for (int k = 0; k < bk->n; k++) /* K_b column-major */
                 se += 0.5 * q[gi] * Kb[l + (long)k * bk->n] * q[r->tp.blk_dofs[bk->first + k]];
         }
@@ -3537,18 +3528,13 @@ static void state_energy(const pd_edr *r, const double *q, const double *v, cons
 }
 
 /* The energy balance's terms at t (opts.energy): the flights' integrals to
- * t, the end state's energies, the sliders' work. */
-static void finish_energy(pd_edr *r, double t)
+ * t, the end state's (q, v) energies, the sliders' work. */
+static void finish_energy(pd_edr *r, double t, const double *q, const double *v)
 {
     pd_edr_result *res = &r->rs.res;
-    double *q = r->ev.wk + r->tp.n, *v = r->ev.wk + 2 * r->tp.n;
     for (int c = 0; c < r->tp.nb; c++)
         if (r->rs.cl[c].live)
             integrate_energy(r, c, t);
-    for (int i = 0; i < r->tp.n; i++) {
-        double a;
-        dof_state(r, i, t, &q[i], &v[i], &a);
-    }
     state_energy(r, q, v, r->rs.sp_now, &res->kinetic, &res->strain);
     res->hysteretic = 0.0;
     for (int j = 0; j < r->tp.ns; j++) /* a slide's work: ks z dup = ks uy |dup| */
@@ -3579,14 +3565,19 @@ static void finish(pd_edr *r, double t)
         if (!(r->rs.xpos[i] > -HUGE_VAL))
             r->rs.xpos[i] = r->rs.xneg[i] = r->rs.drift[i] = 0.0;
     }
-    spring_offsets(r, t);
+    double *q = r->ev.wk + r->tp.n, *v = r->ev.wk + 2 * r->tp.n; /* the state at t */
+    for (int i = 0; i < r->tp.n; i++) {
+        double a;
+        dof_state(r, i, t, &q[i], &v[i], &a);
+    }
+    spring_offsets(r, q);
     for (int j = 0; j < r->tp.ns; j++) /* a slide under way: its excursion up to t */
         if (r->rs.sp_phase[j] != 0) {
             r->rs.sp_exc[j] += fabs(r->rs.sp_now[j] - r->rs.sp_upx[j]);
             r->rs.sp_upx[j] = r->rs.sp_now[j];
         }
     if (r->tp.o.energy)
-        finish_energy(r, t);
+        finish_energy(r, t, q, v);
     r->rs.res.t_reached = t;
     r->rs.res.evals = (double)r->rs.evals;
 }

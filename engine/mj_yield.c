@@ -78,21 +78,21 @@ struct mj_yield {
     long gs_steps;        /* steps block Gauss-Seidel took (statistics) */
     int moved;            /* an offset has moved since the reset */
     /* slide_set: the constants of h theta (hth_set), per spring alone on its
-     * dof: What_ii and its slide's L; the pairs of contacts on its dof and
+     * dof: its slide's 1 / L; the pairs of contacts on its dof and
      * their entries of D; per step: where D's entries went in D_II, the
      * entries a try changed, W_I P on the sliding dofs, the active rows */
     double hth_set;
-    double *what, *Linv; /* ns: What_ii, 1 / L */
-    double *inc, *dcs;   /* ns: h theta ks s / What_ii, the compliance a slide adds */
-    double *bfree;       /* ns: a sliding spring's b from vfree (this try's) */
-    int has_D;           /* a factor keeps D (m > 0) */
-    int *pptr;           /* ns + 1: spring j's pairs pptr[j] .. pptr[j+1] */
-    int *pcol, *prow;    /* the pair's contacts (D's column, row) */
-    long *pk;            /* their entry of D (pd_factor_delassus_at; -1: none) */
-    double *pw;          /* W_ia W_ib */
-    int *map;            /* delassus_nnz: D's entry k at map[k] of D_II (compressed) */
-    long *log_at;        /* the entries of D_II a try changed (as many as the pairs), */
-    double *log_v;       /* ... their values before */
+    double *Linv;      /* ns: 1 / L of a slide */
+    double *inc, *dcs; /* ns: h theta ks s / What_ii, the compliance a slide adds */
+    double *bfree;     /* ns: a sliding spring's b from vfree (this try's) */
+    int has_D;         /* a factor keeps D (m > 0) */
+    int *pptr;         /* ns + 1: spring j's pairs pptr[j] .. pptr[j+1] */
+    int *pcol, *prow;  /* the pair's contacts (D's column, row) */
+    long *pk;          /* their entry of D (pd_factor_delassus_at; -1: none) */
+    double *pw;        /* W_ia W_ib */
+    int *map;          /* delassus_nnz: D's entry k at map[k] of D_II (compressed) */
+    long *log_at;      /* the entries of D_II a try changed (as many as the pairs), */
+    double *log_v;     /* ... their values before */
     int nlog;
     double *wp; /* n: (W_I P)_i */
     int *row;   /* m: a contact's row in the step's active set, -1 when
@@ -105,11 +105,11 @@ void mj_yield_free(pd_mj *mj)
     mj_yield *y = mj->yl;
     if (!y)
         return;
-    void *arrays[] = {y->sdof,  y->sfac,  y->up,  y->vfree, y->vel,  y->col,    y->ys,    y->sigma,
-                      y->G,     y->block, y->dM,  y->dC,    y->dK,   y->alone,  y->uf,    y->mark,
-                      y->cidx,  y->P0,    y->dP,  y->yc,    y->what, y->Linv,   y->wp,    y->pptr,
-                      y->pcol,  y->prow,  y->pk,  y->pw,    y->map,  y->log_at, y->log_v, y->row,
-                      y->snext, y->inc,   y->dcs, y->bfree};
+    void *arrays[] = {y->sdof,   y->sfac,  y->up,    y->vfree, y->vel, y->col, y->ys,
+                      y->sigma,  y->G,     y->block, y->dM,    y->dC,  y->dK,  y->alone,
+                      y->uf,     y->mark,  y->cidx,  y->P0,    y->dP,  y->yc,  y->Linv,
+                      y->wp,     y->pptr,  y->pcol,  y->prow,  y->pk,  y->pw,  y->map,
+                      y->log_at, y->log_v, y->row,   y->snext, y->inc, y->dcs, y->bfree};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(arrays[k]);
     free(y->L);
@@ -242,7 +242,6 @@ int mj_yield_alloc(pd_mj *mj, pd_err *err)
     y->z = pd_malloc(MJY_CAP, sizeof(double));
     y->w = pd_malloc(MJY_CAP, sizeof(double));
     y->lemke = pd_lcp_alloc(MJY_CAP);
-    y->what = pd_calloc(ns, sizeof(double));
     y->Linv = pd_calloc(ns, sizeof(double));
     y->inc = pd_calloc(ns, sizeof(double));
     y->dcs = pd_calloc(ns, sizeof(double));
@@ -257,8 +256,8 @@ int mj_yield_alloc(pd_mj *mj, pd_err *err)
     if (!y->up || !y->vfree || !y->vel || !y->col || !y->ys || !y->sigma || !y->G || !y->block ||
         !y->dM || !y->dC || !y->dK || !y->alone || !y->uf || !y->mark || !y->cidx || !y->P0 ||
         !y->sdof || !y->sfac || !y->dP || !y->yc || !y->L || !y->b || !y->z || !y->w || !y->lemke ||
-        !y->what || !y->Linv || !y->map || !y->pptr || !y->wp || !y->snext || !y->row || !y->inc ||
-        !y->dcs || !y->bfree)
+        !y->Linv || !y->map || !y->pptr || !y->wp || !y->snext || !y->row || !y->inc || !y->dcs ||
+        !y->bfree)
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for %d yielding springs", ns);
     blocks(y, md);
     if (mj_incidence_build(mj))
@@ -493,7 +492,7 @@ static void apply(pd_mj *mj, const pd_factor *f, int nc, int nyc, double hth, pd
         out->v[i] += y->col[i];
 }
 
-/* What_ii, the slide's L = ks - (h theta)^2 ks^2 s^2 / What_ii, its
+/* The slide's L = ks - (h theta)^2 ks^2 s^2 / What_ii (its 1 / L), its
  * velocity per unit slide and added compliance, of each spring on one dof
  * (read for the springs alone on theirs), at h theta (kept while it holds). */
 static void set_constants(mj_yield *y, const pd_model *md, double hth)
@@ -506,7 +505,6 @@ static void set_constants(mj_yield *y, const pd_model *md, double hth)
             continue;
         double s = y->sfac[j], ks = md->ks[j];
         double what = y->dM[i] + hth * (y->dC[i] + hth * y->dK[i]), r = hth * hth * ks * s * s;
-        y->what[j] = what;
         y->Linv[j] = 1.0 / (ks - hth * hth * ks * ks * s * s / what);
         y->inc[j] = hth * ks * s / what;
         /* 1 / (What_ii - (h theta)^2 ks s^2) - 1 / What_ii: the post-yield What is

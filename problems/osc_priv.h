@@ -37,6 +37,15 @@ static inline void pd_osc_result_no_rtol(pd_osc_result *res, double step)
     res->dt_min = res->dt_max = step;
 }
 
+/* The balance's residual: (input + the energies at the start - every
+ * other term) / input. */
+static inline void pd_energy_close(pd_energy *en, double start)
+{
+    en->residual =
+        (en->input + start - en->kinetic - en->strain - en->damping - en->hysteretic - en->impact) /
+        en->input;
+}
+
 /* An energy balance not measured: NAN throughout. */
 static inline pd_energy pd_energy_none(void)
 {

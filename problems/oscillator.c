@@ -564,14 +564,6 @@ void pd_osc_yield_figures(const pd_osc *c, double up, double excursion, double w
     res->n_yield = n_yield;
 }
 
-/* The balance's residual: (input - every other term) / input. */
-static void energy_close(pd_energy *en)
-{
-    en->residual =
-        (en->input - en->kinetic - en->strain - en->damping - en->hysteretic - en->impact) /
-        en->input;
-}
-
 /* A yielding run's results from its tallies and its end (q, v, up; Pi
  * units to metres, energies per unit mass in (Le wp)^2). */
 static void yield_result(const pd_osc *c, const osc_yield *oy, const mj1_state *end,
@@ -587,7 +579,7 @@ static void yield_result(const pd_osc *c, const osc_yield *oy, const mj1_state *
     en->damping = oy->so.h * oy->C * oy->damping * E;
     en->hysteretic = res->hysteretic_energy;
     en->impact = oy->impact * E;
-    energy_close(en);
+    pd_energy_close(en, 0.0); /* from rest */
 }
 
 /* The exact reference's energy balance (per unit mass, Pi units times
@@ -602,7 +594,7 @@ static void ref_energy(const pd_ed_result *er, double vscale, pd_osc_result *res
     en->damping = er->damping_work * E;
     en->hysteretic = res->hysteretic_energy;
     en->impact = er->impact_loss * E;
-    energy_close(en);
+    pd_energy_close(en, 0.0); /* from rest */
 }
 
 int pd_osc_simulate(const pd_osc *c, const pd_run_opts *opts, pd_osc_sampler sampler, void *ctx,

@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "pd_alloc.h"
+#include "osc_priv.h"
 #include "scene_priv.h"
 
 struct pd_scene_energy {
@@ -140,9 +141,7 @@ void pd_scene_energy_finish(const pd_scene_energy *e, double E, pd_energy *out)
     out->damping = e->damping * E;
     out->hysteretic = e->hysteretic * E;
     out->impact = e->impact * E;
-    out->residual =
-        (out->input - out->kinetic - out->strain - out->damping - out->hysteretic - out->impact) /
-        out->input;
+    pd_energy_close(out, 0.0); /* from rest */
 }
 
 void pd_scene_energy_of_edr(const pd_edr_result *er, double E, pd_energy *out)
@@ -153,8 +152,5 @@ void pd_scene_energy_of_edr(const pd_edr_result *er, double E, pd_energy *out)
     out->damping = er->damping_work * E;
     out->hysteretic = er->hysteretic * E;
     out->impact = er->impact_loss * E;
-    /* from rest: the energies at the start are 0 */
-    out->residual = (out->input + er->energy0 * E - out->kinetic - out->strain - out->damping -
-                     out->hysteretic - out->impact) /
-                    out->input;
+    pd_energy_close(out, er->energy0 * E);
 }
