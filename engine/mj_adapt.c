@@ -90,6 +90,7 @@ struct mj_adapt {
     double *u_rest;    /* m: closing speeds without restitution (mj->u_rest) */
     double *u_tol, *G; /* m: the tolerance's rest speeds; |free gap acceleration| */
     double *D0;        /* m: sum_i W_ia^2 / M_ii, a unit impulse's change of gap rate */
+    double *lam;       /* m: each held contact's force, P / h of its last step with no onset */
     int p;             /* order of the flight's global error */
     double div;        /* 2^p - 1 */
     int k_flight;      /* exact flights: the coarsest level whose steps the observers'
@@ -151,7 +152,7 @@ void mj_adapt_free(pd_mj *mj)
     void *arrays[] = {ad->lev,    ad->piece_tick, ad->E,      ad->S2,    ad->Er,
                       ad->eps,    ad->rate,       ad->amp,    ad->w,     ad->atol,
                       ad->minv,   ad->mark,       ad->evmark, ad->timed, ad->bound,
-                      ad->u_rest, ad->D0,         ad->u_tol,  ad->G};
+                      ad->u_rest, ad->D0,         ad->u_tol,  ad->G,     ad->lam};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(arrays[k]);
     free(ad);
@@ -248,7 +249,8 @@ int mj_adapt_alloc(pd_mj *mj, pd_err *err)
     ad->D0 = pd_calloc(md->m, sizeof(double));
     ad->u_tol = pd_calloc(md->m, sizeof(double));
     ad->G = pd_calloc(md->m, sizeof(double));
-    bad |= !ad->u_tol || !ad->G || !ad->mark || !ad->evmark || !ad->timed || !ad->u_rest ||
+    ad->lam = pd_calloc(md->m, sizeof(double));
+    bad |= !ad->u_tol || !ad->G || !ad->lam || !ad->mark || !ad->evmark || !ad->timed || !ad->u_rest ||
            !ad->D0 || mj_incidence_build(mj);
     for (int s = 0; s < 4 && !bad; s++)
         bad = snap_alloc(&ad->sn[s], n, md->m) != PD_OK;
@@ -356,6 +358,7 @@ int mj_adapt_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_
         s->st.P[a] = 0.0;
         s->st.active[a] = 0;
         s->st.g[a] = md->g0[a] + mj_inc_dot(&mj->inc, a, s->st.q); /* g0 + W^T q */
+        ad->lam[a] = 0.0;
     }
     /* the four snapshots: now, one whole step, the first half, both halves */
     ad->cur = &ad->sn[0];
@@ -906,38 +909,53 @@ static void report_err(pd_mj *mj, double h)
     }
 }
 
-/* The held contacts' forces, their impulses over the step to x, into acc. */
-static void add_held(const pd_mj *mj, const snap *x, double *acc)
+/* The held contacts' forces after the step w -> x into ad->lam: a contact
+ * that pushed in that step and the one before is held, its force the
+ * step's mean P / h; a step where some contact starts pushing or strikes
+ * (an onset) carries impulses through every closed contact, impacts rather
+ * than forces (P / h of a step localising an impact can be any size), and
+ * there the held contacts keep the force of their step before. */
+static void held_forces(const pd_mj *mj, const snap *w, const snap *x)
 {
-    const mj_incidence *in = &mj->inc;
-    /* a_i += W_ia P_a / (h M_ii): the held force's mean */
-    for (int a = 0; a < mj->model->m && x->st.h > 0.0; a++)
-        if (x->st.P[a] > 0.0)
-            for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
-                acc[in->dof[j]] += mj->ad->minv[in->dof[j]] * in->w[j] * x->st.P[a] / x->st.h;
+    mj_adapt *ad = mj->ad;
+    int m = mj->model->m, onset = ad->impact_made;
+    for (int a = 0; a < m && !onset; a++)
+        onset = x->st.P[a] > 0.0 && !(w->st.P[a] > 0.0);
+    for (int a = 0; a < m; a++)
+        ad->lam[a] = !(x->st.P[a] > 0.0 && w->st.P[a] > 0.0 && x->st.h > 0.0) ? 0.0
+                     : onset                                                 ? ad->lam[a]
+                                                                             : x->st.P[a] / x->st.h;
 }
 
-/* The accelerations at x for the observers' quintic interpolation of the
- * step to it and of the next: the free motion's plus the held contacts'
- * forces (after a step with an impact the free motion's alone: the
- * impulses are no force); where a piece's start ended the step, the left
- * limit (the old piece's forcing) in acc, the right one in acc_right. */
-static void step_accelerations(pd_mj *mj, snap *x)
+/* The held contacts' forces ad->lam into acc: a_i += W_ia lam_a / M_ii. */
+static void add_held(const pd_mj *mj, double *acc)
+{
+    const mj_incidence *in = &mj->inc;
+    for (int a = 0; a < mj->model->m; a++)
+        if (mj->ad->lam[a] > 0.0)
+            for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
+                acc[in->dof[j]] += mj->ad->minv[in->dof[j]] * in->w[j] * mj->ad->lam[a];
+}
+
+/* The accelerations at x, made by a step from w, for the observers'
+ * quintic interpolation of the step to it and of the next: the free
+ * motion's plus the held contacts' forces (held_forces); where a piece's
+ * start ended the step, the left limit (the old piece's forcing) in acc,
+ * the right one in acc_right. */
+static void step_accelerations(pd_mj *mj, const snap *w, snap *x)
 {
     size_t bytes = (size_t)mj->model->n * sizeof(double);
-    int held = !mj->ad->impact_made; /* an impact's impulses are no force */
+    held_forces(mj, w, x);
     x->st.has_acc = 1;
     mj_flight_acc(mj, &x->st, x->z, x->af);
     x->st.acc_right = x->switched ? x->accr : x->st.acc;
     memcpy((double *)x->st.acc_right, x->af, bytes);
-    if (held)
-        add_held(mj, x, (double *)x->st.acc_right);
+    add_held(mj, (double *)x->st.acc_right);
     if (!x->switched)
         return;
     /* the left limit, under the old piece's forcing zl */
     mj_flight_acc(mj, &x->st, x->zl, x->st.acc);
-    if (held)
-        add_held(mj, x, x->st.acc);
+    add_held(mj, x->st.acc);
 }
 
 /* Errors cross contacts: a contact that pushed in the step to x moves
@@ -1027,7 +1045,7 @@ static int keep(pd_mj *mj, const snap *w, snap *x, double f, int events, pd_obse
     }
     share_errors(mj, x);
     if (ad->F) /* the accelerations, for the observers' interpolation */
-        step_accelerations(mj, x);
+        step_accelerations(mj, w, x);
     rest_speeds(mj, w, x);
     /* the statistics, the reported err, the observer */
     ad->stats.steps++;
