@@ -24,6 +24,8 @@ const char pd_cli_case_help[] =
     "                't a'): replaces the pulse; ap and Tp come from its fitted pulse\n"
     "  --scale S [1]  multiplies the record   --dir normal|reverse as for pulses\n"
     "  --units g|m/s2|cm/s2 [g]  of a text record   --record-format auto|at2|v2|text [auto]\n"
+    "  --target-pga A | --target-sa A  scale the record to a PGA or to a 5 %-damped Sa(T1)\n"
+    "                of A m/s^2 (--T1 T [the oscillator's --T0, a scene's first structure's])\n"
     "scenes (rows of structures, docs/scenes.md):\n"
     "  --scene F.json   run the scene of file F (its excitation replaces the model flags)\n"
     "  --chain N        a row of N SDOFs between two walls built from the model flags: unit\n"
@@ -72,13 +74,29 @@ void pd_cli_case_init(pd_cli_case *a)
     a->opts.contact_duration = PD_CONTACT_DURATION;
 }
 
+static void cli_record_free(pd_cli_record *r)
+{
+    if (r) {
+        pd_record_free(&r->rec);
+        free(r);
+    }
+}
+
 void pd_cli_case_free(pd_cli_case *a)
 {
-    if (a->record) {
-        pd_record_free(&a->record->rec);
-        free(a->record);
+    if (a->recs) { /* record is recs[0] */
+        for (int k = 0; k < a->suite->n; k++)
+            cli_record_free(a->recs[k]);
         a->record = NULL;
     }
+    cli_record_free(a->record);
+    a->record = NULL;
+    free(a->recs);
+    free(a->rec_scale);
+    pd_suite_free(a->suite);
+    a->recs = NULL;
+    a->rec_scale = NULL;
+    a->suite = NULL;
 }
 
 int pd_cli_record_load(const char *path, pd_record_format format, pd_record_units units,
@@ -247,11 +265,44 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i)
     else if (!strcmp(f, "--record")) {
         if (!val)
             return pd_cli_usage_error("--record needs a file name");
-        if (a->record_path) /* a second one would silently replace the first */
-            return pd_cli_usage_error("--record given twice ('%s', then '%s'): a run takes one "
-                                      "record (suites of records are not supported yet)",
-                                      a->record_path, val);
-        a->record_path = val;
+        pd_err err;
+        /* a second one makes a suite of both (and of any later) */
+        if (a->record_path && !a->suite && !(a->suite = pd_suite_new()))
+            return fprintf(stderr, "pound: out of memory for a suite\n"), 2;
+        if (a->record_path && a->suite->n == 0 && pd_suite_add(a->suite, a->record_path, 1.0, &err))
+            return pd_cli_usage_error("%s", err.msg);
+        if (a->suite && pd_suite_add(a->suite, val, 1.0, &err))
+            return pd_cli_usage_error("%s", err.msg);
+        if (!a->record_path)
+            a->record_path = val;
+        rc = 1;
+    } else if (!strcmp(f, "--records")) {
+        if (!val)
+            return pd_cli_usage_error("--records needs a suite file (PATH [SCALE] a line)");
+        if (a->records_path)
+            return pd_cli_usage_error("--records given twice ('%s', then '%s'): give one suite",
+                                      a->records_path, val);
+        a->records_path = val;
+        rc = 1;
+    } else if (!strcmp(f, "--target-pga") || !strcmp(f, "--target-sa")) {
+        if (a->target_flag)
+            return pd_cli_usage_error("%s and %s: a suite is scaled to one target", a->target_flag,
+                                      f);
+        if ((rc = pd_cli_double(f, val, &a->target_value)))
+            return rc;
+        if (!(a->target_value > 0.0) || a->target_value > 1e3)
+            return pd_cli_usage_error("%s: the target must be in (0, 1000] m/s^2 (got %.10g)", f,
+                                      a->target_value);
+        a->target = !strcmp(f, "--target-pga") ? PD_SCALE_PGA : PD_SCALE_SA;
+        a->target_flag = f;
+        rc = 1;
+    } else if (!strcmp(f, "--T1")) {
+        if ((rc = pd_cli_double(f, val, &a->T1)))
+            return rc;
+        if (!(a->T1 >= 1e-3 && a->T1 <= 1e3))
+            return pd_cli_usage_error("--T1: the period must be in [0.001, 1000] s (got %.10g)",
+                                      a->T1);
+        a->have_T1 = 1;
         rc = 1;
     } else if (!strcmp(f, "--scene")) {
         if (!val)
@@ -476,27 +527,127 @@ static int check_case(const pd_cli_case *a)
     return 0;
 }
 
-/* --record: its flags checked, the record read and its pulse fitted, the
- * oscillator excited by it: 0 or 2. */
-static int case_record(pd_cli_case *a)
+/* Sa(T1)'s period: --T1, else the oscillator's --T0, else the scene's
+ * first structure's fundamental period; 0 or 2. */
+static int case_T1(const pd_cli_case *a, double *T1)
 {
-    if (!a->record_path)
+    pd_scene *sc = NULL;
+    pd_err err;
+    *T1 = a->have_T1 ? a->T1 : a->have_T0 ? a->T0 : 0.0;
+    if (*T1 > 0.0 || a->target != PD_SCALE_SA)
+        return 0;
+    if (!a->scene_path)
+        return pd_cli_usage_error("--target-sa: give the period of Sa(T1) with --T1 (or the "
+                                  "oscillator's --T0)");
+    if (pd_scene_load(a->scene_path, &sc, &err))
+        return pd_cli_usage_error("%s", err.msg);
+    *T1 = sc->st[0].T0;
+    pd_scene_free(sc);
+    return 0;
+}
+
+/* --record (once or more) or --records: the flags checked, every record
+ * read and its pulse fitted, each one's scale (--scale times the suite
+ * file's, or the target's: PGA, or the 5 %-damped Sa(T1)); record is the
+ * first: 0 or 2. */
+static int case_records(pd_cli_case *a)
+{
+    pd_err err;
+    double T1;
+    int rc;
+    if (a->records_path && a->record_path)
+        return pd_cli_usage_error("--records and --record: give the suite one way (%s, %s)",
+                                  a->records_path, a->record_path);
+    if (a->target_flag && !a->record_path && !a->records_path)
+        return pd_cli_usage_error("%s: scales records (--record or --records)", a->target_flag);
+    if (a->have_T1 && a->target != PD_SCALE_SA)
+        return pd_cli_usage_error("--T1: the period of --target-sa");
+    if (!a->record_path && !a->records_path)
         return a->have_scale ? pd_cli_usage_error("--scale: goes with --record") : 0;
+    if (pd_cli_case_is_suite(a) && !a->suites_by)
+        return pd_cli_usage_error("%s: a suite of records runs through `pound simulate`; this "
+                                  "command takes one record",
+                                  a->records_path ? "--records" : "--record given twice");
     if (a->chain)
         return pd_cli_usage_error("--record: rows of structures take a record through a scene "
-                                  "file (docs/scenes.md)");
+                                  "(--scene F.json --record R, or the scene file's excitation)");
     if (a->pulse_flag)
         return pd_cli_usage_error("%s: the record replaces the pulse (its fitted pulse gives ap "
                                   "and Tp; --scale scales it)",
                                   a->pulse_flag);
     if (!(a->scale > 0.0) || !isfinite(a->scale))
         return pd_cli_usage_error("--scale: must be > 0 (got %.10g)", a->scale);
-    int rc = a->record ? 0
-                       : pd_cli_record_load(a->record_path, a->rec_format, a->rec_units,
-                                            a->have_units, &a->record);
-    if (!rc)
-        pd_osc_set_record(&a->c, &a->record->rec, &a->record->pulse, a->scale);
-    return rc;
+    if (a->target_flag && a->have_scale)
+        return pd_cli_usage_error("--scale and %s: the target sets each record's scale",
+                                  a->target_flag);
+    if (a->records_path && pd_suite_read(a->records_path, &a->suite, &err))
+        return pd_cli_usage_error("--records: %s", err.msg);
+    if (!a->suite &&
+        (!(a->suite = pd_suite_new()) || pd_suite_add(a->suite, a->record_path, 1.0, &err))) {
+        fprintf(stderr, "pound: out of memory for the record %s\n", a->record_path);
+        return 1;
+    }
+    int n = a->suite->n;
+    for (int k = 0; k < n && a->target_flag; k++)
+        if (a->suite->scale[k] != 1.0)
+            return pd_cli_usage_error("%s: %s gives %s a scale (%g); with a target the target "
+                                      "scales every record",
+                                      a->target_flag, a->records_path, a->suite->path[k],
+                                      a->suite->scale[k]);
+    if ((rc = case_T1(a, &T1)))
+        return rc;
+    a->recs = calloc((size_t)n, sizeof *a->recs);
+    a->rec_scale = calloc((size_t)n, sizeof *a->rec_scale);
+    if (!a->recs || !a->rec_scale) {
+        fprintf(stderr, "pound: out of memory for a suite of %d records\n", n);
+        return 1;
+    }
+    for (int k = 0; k < n; k++) {
+        if ((rc = pd_cli_record_load(a->suite->path[k], a->rec_format, a->rec_units, a->have_units,
+                                     &a->recs[k])))
+            return rc;
+        a->rec_scale[k] = a->scale * a->suite->scale[k];
+        if (a->target_flag && pd_record_scale_to(&a->recs[k]->rec, &a->recs[k]->pulse, a->target,
+                                                 a->target_value, T1, 0.05, &a->rec_scale[k], &err))
+            return pd_cli_usage_error("%s: %s", a->target_flag, err.msg);
+    }
+    a->record = a->recs[0];
+    a->record_path = a->suite->path[0];
+    return 0;
+}
+
+int pd_cli_case_is_suite(const pd_cli_case *a)
+{
+    return a->records_path != NULL || (a->suite && a->suite->n > 1);
+}
+
+int pd_cli_case_record(const pd_cli_case *a, int k, pd_osc *c, pd_run_opts *o)
+{
+    pd_cli_case t = *a; /* the flags, on the record's oscillator */
+    pd_err err;
+    int rc;
+    t.c = a->c_base;
+    pd_osc_set_record(&t.c, &a->recs[k]->rec, &a->recs[k]->pulse, a->rec_scale[k]);
+    /* the dimensional forms given keep their metres and seconds */
+    if (t.have_T0 && t.T0 > 0.0)
+        pd_osc_set_T0(&t.c, t.T0);
+    if (t.have_gap && t.c.ap > 0.0 && t.c.Tp > 0.0)
+        pd_osc_set_gap(&t.c, t.gap);
+    if (t.have_uy && t.uy > 0.0 && t.c.ap > 0.0 && t.c.Tp > 0.0)
+        pd_osc_set_uy(&t.c, t.uy);
+    if ((rc = check_case(&t)))
+        return rc;
+    if (pd_osc_resolve_opts(&t.c, &a->opts_in, o, &err))
+        return pd_cli_usage_error("%s", err.msg);
+    *c = t.c;
+    return 0;
+}
+
+int pd_cli_scene_record(const pd_cli_case *a, int k, pd_scene *sc, pd_err *err)
+{
+    pd_scene_excite_record(&sc->exc, &a->recs[k]->rec, &a->recs[k]->pulse, a->rec_scale[k]);
+    sc->tend = 0.0; /* derived from the record (--tend: the options') */
+    return pd_scene_finish(sc, err);
 }
 
 void pd_cli_case_implies(pd_cli_case *a, const char *flag, pd_method method)
@@ -655,12 +806,12 @@ static int case_finish(pd_cli_case *a)
         return pd_cli_usage_error("--height: the oscillator's; a --chain's SDOFs have the "
                                   "default storey height (%g m)",
                                   PD_STOREY_HEIGHT);
-    if (a->scene_path)
-        return a->record_path ? pd_cli_usage_error("--record: a scene names its record in its "
-                                                   "excitation (docs/scenes.md)")
-                              : 0;
-    if ((rc = case_record(a)))
+    if ((rc = case_records(a)))
         return rc;
+    a->c_base = a->c;
+    a->opts_in = a->opts;
+    if (a->scene_path || a->recs) /* a scene resolves its own; a record's: below */
+        return a->recs && !a->scene_path ? pd_cli_case_record(a, 0, &a->c, &a->opts) : 0;
     if (a->have_T0 && a->T0 > 0.0)
         pd_osc_set_T0(&a->c, a->T0);
     if (a->have_gap && a->c.ap > 0.0 && a->c.Tp > 0.0)
@@ -724,6 +875,8 @@ int pd_cli_scene(const pd_cli_case *a, pd_scene **sc)
         if (!rc && pd_osc_yields(&a->c)) /* --uy or --Piy: every SDOF yields */
             rc = pd_scene_yield_every(*sc, pd_osc_uy(&a->c), a->c.alpha, &err);
     }
+    if (!rc && a->recs && (rc = pd_cli_scene_record(a, 0, *sc, &err))) /* --record replaces */
+        pd_scene_free(*sc), *sc = NULL;                                /* the excitation */
     if (rc == PD_ENOMEM) {
         fprintf(stderr, "pound: %s\n", err.msg);
         return 1;

@@ -10,6 +10,7 @@
 #include "pd_lcp_dump.h"
 #include "pd_output.h"
 #include "pd_scene_out.h"
+#include "pd_spectrum.h"
 
 static const char simulate_usage[] =
     "usage: pound simulate [model flags | --scene F.json | --chain N] [--method M]\n"
@@ -29,7 +30,17 @@ static const char simulate_usage[] =
     "              impact marked once at the storey of its contact\n"
     "  --dump-lcp F.h5  every contact LCP Moreau-Jean solves (D, b, z, solver, pivots or\n"
     "              iterations), for `pound lcp F.h5 --all` (docs/lcp.md)\n"
-    "  --json      one JSON object on stdout\n";
+    "  --json      one JSON object on stdout\n"
+    "suites of records (docs/records.md, \"Suites\"):\n"
+    "  --records F  every record a suite file lists (PATH [SCALE] a line, '#' comments;\n"
+    "              paths from F's folder), or --record given twice or more: each record\n"
+    "              replaces the oscillator's or the scene's excitation; per record what a\n"
+    "              single run prints (JSON \"records\"), then the suite's mean, median,\n"
+    "              16th/84th percentiles and max of every peak (\"stats\"); for scenes per\n"
+    "              contact how often it closed and how often each code rule's gap would\n"
+    "              have (the exact required gap beyond ABS, SRSS, DDC)\n"
+    "  --threads K  records at once (OpenMP) [OMP_NUM_THREADS or all cores]; the numbers\n"
+    "              do not depend on K\n";
 
 /* Everything the command line sets. */
 typedef struct sim_args {
@@ -37,6 +48,7 @@ typedef struct sim_args {
     const char *out, *plot, *dump;
     long every;
     int json;
+    int threads; /* --threads: a suite's records at once (0: OpenMP's default) */
 } sim_args;
 
 /* Case flags, then the command's own; 0 or 2. */
@@ -46,6 +58,7 @@ static int parse_args(sim_args *a, int argc, char **argv)
     pd_err err;
     memset(a, 0, sizeof *a);
     pd_cli_case_init(&a->k);
+    a->k.suites_by = "simulate";
     a->every = 1;
     for (int i = 1; i < argc; i++) {
         const char *f = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
@@ -61,6 +74,13 @@ static int parse_args(sim_args *a, int argc, char **argv)
             *(!strcmp(f, "-o") ? &a->out : !strcmp(f, "--plot") ? &a->plot : &a->dump) = val;
             if (!strcmp(f, "--dump-lcp"))
                 pd_cli_case_implies(&a->k, f, PD_METHOD_MOREAU);
+            i++;
+        } else if (!strcmp(f, "--threads")) {
+            if ((rc = pd_cli_int(f, val, &n)))
+                return rc;
+            if (n < 1 || n > 4096)
+                return pd_cli_usage_error("--threads: must be in [1, 4096] (got %d)", n);
+            a->threads = n;
             i++;
         } else if (!strcmp(f, "--every")) {
             if ((rc = pd_cli_int(f, val, &n)))
@@ -237,80 +257,86 @@ static void energy_json(pd_json *js, const pd_energy *en, int hysteretic)
     pd_json_num(js, "energy_residual", en->residual);
 }
 
+/* The run of oscillator c by method into js as one object. */
+static void osc_json(pd_json *js, const sim_args *a, const pd_osc *c, pd_method method,
+                     const pd_osc_summary *s)
+{
+    pd_json_begin_object(js, NULL);
+    pd_json_str(js, "method", pd_method_name(method));
+    pd_json_str(js, "method_by", pd_cli_method_by(&a->k));
+    pd_json_num(js, "umax", s->r.umax);
+    pd_json_num(js, "Pi1", s->Pi1);
+    pd_json_num(js, "u_toward", s->r.u_toward);
+    pd_json_num(js, "u_away", s->r.u_away);
+    pd_json_int(js, "impacts", s->r.impacts);
+    pd_json_int(js, "accumulations", s->r.accumulations);
+    pd_json_num(js, "first_impact", s->r.first_impact); /* NaN -> null */
+    pd_json_num(js, "first_impact_velocity", s->r.first_impact_velocity);
+    pd_json_num(js, "max_impact_velocity", s->r.max_impact_velocity);
+    pd_json_num(js, "max_impulse", s->r.max_impulse);
+    pd_json_num(js, "contact_time", s->r.contact_time);
+    pd_json_num(js, "min_gap", s->r.min_gap);
+    /* demands, per unit mass (docs/scenes.md, "Demands") */
+    pd_json_num(js, "height", a->k.height);
+    pd_json_num(js, "drift_ratio", s->r.umax / a->k.height);
+    pd_json_num(js, "acc_max", s->r.acc_max);
+    pd_json_num(js, "shear_max", s->r.shear_max); /* per unit mass: |k u + c u'| / m */
+    pd_json_num(js, "force_equiv", s->r.force_equiv);
+    pd_json_num(js, "force_max", s->r.force_max); /* NaN -> null: not compliant */
+    pd_json_num(js, "contact_duration", s->r.contact_duration);
+    pd_json_num(js, "umax_free", s->free.umax);
+    pd_json_num(js, "gamma", s->gamma);
+    pd_json_num(js, "chi", s->chi);
+    pd_json_int(js, "steps", s->r.steps);
+    pd_json_num(js, "cpu_s", s->cpu_s);
+    pd_json_num(js, "rtol", s->r.rtol);
+    pd_json_num(js, "err_est", s->err_est); /* NaN -> null: fixed steps */
+    pd_json_bool(js, "rtol_met", s->rtol_met);
+    pd_json_int(js, "steps_rejected", s->r.steps_rejected);
+    pd_json_num(js, "dt_min", s->r.dt_min);
+    pd_json_num(js, "dt_max", s->r.dt_max);
+    pd_json_num(js, "Pi2", c->Pi2);
+    pd_json_num(js, "Pi3", c->Pi3);
+    pd_json_num(js, "eps", c->eps);
+    pd_json_num(js, "xi", c->xi);
+    pd_json_num(js, "ap", c->ap);
+    pd_json_num(js, "Tp", c->Tp);
+    pd_json_num(js, "T0", pd_osc_T0(c));
+    pd_json_num(js, "gap", pd_osc_gap(c));
+    pd_json_str(js, "pulse", pd_osc_excitation_name(c));
+    pd_json_str(js, "dir", pd_dir_name(c->dir));
+    if (c->record) {
+        pd_json_str(js, "record", c->record->name);
+        pd_json_num(js, "scale", c->scale);
+    }
+    pd_json_num(js, "dt", s->r.dt);
+    pd_json_num(js, "theta", s->r.theta);
+    pd_json_num(js, "gamma_active", s->r.gamma);
+    pd_json_num(js, "tend", s->r.tend);
+    pd_json_str(js, "kernel", s->r.kernel);
+    if (pd_osc_yields(c)) { /* the yielding spring (SPEC §7) */
+        pd_json_num(js, "uy", pd_osc_uy(c));
+        pd_json_num(js, "Piy", c->Piy);
+        pd_json_num(js, "alpha", c->alpha);
+        pd_json_num(js, "ductility", s->r.ductility);
+        pd_json_num(js, "residual", s->r.residual);
+        pd_json_int(js, "n_yield", s->r.n_yield);
+        pd_json_num(js, "plastic_excursion", s->r.plastic_excursion);
+        pd_json_num(js, "hysteretic_energy", s->r.hysteretic_energy);
+        pd_json_num(js, "ductility_free", s->free.ductility);
+        /* the balance per unit mass [J/kg]; its hysteretic term is hysteretic_energy */
+        energy_json(js, &s->r.energy, 0);
+        /* Newton's failures, honestly (newmark; 0: no Newton iterations) */
+        pd_json_int(js, "newton_failures", s->r.newton_failures);
+    }
+    pd_json_end_object(js);
+}
+
 static void print_json(const sim_args *a, const pd_osc_summary *s)
 {
     pd_json js;
-    const pd_osc *c = &a->k.c;
     pd_json_init(&js, stdout);
-    pd_json_begin_object(&js, NULL);
-    pd_json_str(&js, "method", pd_method_name(a->k.opts.method));
-    pd_json_str(&js, "method_by", pd_cli_method_by(&a->k));
-    pd_json_num(&js, "umax", s->r.umax);
-    pd_json_num(&js, "Pi1", s->Pi1);
-    pd_json_num(&js, "u_toward", s->r.u_toward);
-    pd_json_num(&js, "u_away", s->r.u_away);
-    pd_json_int(&js, "impacts", s->r.impacts);
-    pd_json_int(&js, "accumulations", s->r.accumulations);
-    pd_json_num(&js, "first_impact", s->r.first_impact); /* NaN -> null */
-    pd_json_num(&js, "first_impact_velocity", s->r.first_impact_velocity);
-    pd_json_num(&js, "max_impact_velocity", s->r.max_impact_velocity);
-    pd_json_num(&js, "max_impulse", s->r.max_impulse);
-    pd_json_num(&js, "contact_time", s->r.contact_time);
-    pd_json_num(&js, "min_gap", s->r.min_gap);
-    /* demands, per unit mass (docs/scenes.md, "Demands") */
-    pd_json_num(&js, "height", a->k.height);
-    pd_json_num(&js, "drift_ratio", s->r.umax / a->k.height);
-    pd_json_num(&js, "acc_max", s->r.acc_max);
-    pd_json_num(&js, "shear_max", s->r.shear_max); /* per unit mass: |k u + c u'| / m */
-    pd_json_num(&js, "force_equiv", s->r.force_equiv);
-    pd_json_num(&js, "force_max", s->r.force_max); /* NaN -> null: not compliant */
-    pd_json_num(&js, "contact_duration", s->r.contact_duration);
-    pd_json_num(&js, "umax_free", s->free.umax);
-    pd_json_num(&js, "gamma", s->gamma);
-    pd_json_num(&js, "chi", s->chi);
-    pd_json_int(&js, "steps", s->r.steps);
-    pd_json_num(&js, "cpu_s", s->cpu_s);
-    pd_json_num(&js, "rtol", s->r.rtol);
-    pd_json_num(&js, "err_est", s->err_est); /* NaN -> null: fixed steps */
-    pd_json_bool(&js, "rtol_met", s->rtol_met);
-    pd_json_int(&js, "steps_rejected", s->r.steps_rejected);
-    pd_json_num(&js, "dt_min", s->r.dt_min);
-    pd_json_num(&js, "dt_max", s->r.dt_max);
-    pd_json_num(&js, "Pi2", c->Pi2);
-    pd_json_num(&js, "Pi3", c->Pi3);
-    pd_json_num(&js, "eps", c->eps);
-    pd_json_num(&js, "xi", c->xi);
-    pd_json_num(&js, "ap", c->ap);
-    pd_json_num(&js, "Tp", c->Tp);
-    pd_json_num(&js, "T0", pd_osc_T0(c));
-    pd_json_num(&js, "gap", pd_osc_gap(c));
-    pd_json_str(&js, "pulse", pd_osc_excitation_name(c));
-    pd_json_str(&js, "dir", pd_dir_name(c->dir));
-    if (c->record) {
-        pd_json_str(&js, "record", c->record->name);
-        pd_json_num(&js, "scale", c->scale);
-    }
-    pd_json_num(&js, "dt", s->r.dt);
-    pd_json_num(&js, "theta", s->r.theta);
-    pd_json_num(&js, "gamma_active", s->r.gamma);
-    pd_json_num(&js, "tend", s->r.tend);
-    pd_json_str(&js, "kernel", s->r.kernel);
-    if (pd_osc_yields(c)) { /* the yielding spring (SPEC §7) */
-        pd_json_num(&js, "uy", pd_osc_uy(c));
-        pd_json_num(&js, "Piy", c->Piy);
-        pd_json_num(&js, "alpha", c->alpha);
-        pd_json_num(&js, "ductility", s->r.ductility);
-        pd_json_num(&js, "residual", s->r.residual);
-        pd_json_int(&js, "n_yield", s->r.n_yield);
-        pd_json_num(&js, "plastic_excursion", s->r.plastic_excursion);
-        pd_json_num(&js, "hysteretic_energy", s->r.hysteretic_energy);
-        pd_json_num(&js, "ductility_free", s->free.ductility);
-        /* the balance per unit mass [J/kg]; its hysteretic term is hysteretic_energy */
-        energy_json(&js, &s->r.energy, 0);
-        /* Newton's failures, honestly (newmark; 0: no Newton iterations) */
-        pd_json_int(&js, "newton_failures", s->r.newton_failures);
-    }
-    pd_json_end_object(&js);
+    osc_json(&js, a, &a->k.c, a->k.opts.method, s);
     pd_json_finish(&js);
 }
 
@@ -579,6 +605,195 @@ done:
     return status;
 }
 
+/* ==== suites of records ====================================================== */
+
+/* One figure of every record's run: its statistics into js under key. */
+static void stats_json(pd_json *js, const char *key, const double *x, int n)
+{
+    pd_stats st;
+    pd_err err;
+    if (pd_stats_of(x, n, &st, &err))
+        st = (pd_stats){
+            .n = 0, .mean = NAN, .median = NAN, .p16 = NAN, .p84 = NAN, .min = NAN, .max = NAN};
+    pd_json_begin_object(js, key);
+    pd_json_int(js, "n", st.n);
+    pd_json_num(js, "mean", st.mean);
+    pd_json_num(js, "median", st.median);
+    pd_json_num(js, "p16", st.p16);
+    pd_json_num(js, "p84", st.p84);
+    pd_json_num(js, "min", st.min);
+    pd_json_num(js, "max", st.max);
+    pd_json_end_object(js);
+}
+
+/* The share of the n flags set. */
+static double share(const unsigned char *flag, int n)
+{
+    int k = 0;
+    for (int i = 0; i < n; i++)
+        k += flag[i] != 0;
+    return n ? (double)k / n : NAN;
+}
+
+/* The suite's header: its file or records, the scaling. */
+static void suite_header(const sim_args *a, FILE *f)
+{
+    fprintf(f, "suite: %d records (%s)", a->k.suite->n,
+            a->k.records_path ? a->k.records_path : "--record");
+    if (a->k.target == PD_SCALE_PGA)
+        fprintf(f, ", each scaled to PGA = %g m/s^2", a->k.target_value);
+    else if (a->k.target == PD_SCALE_SA)
+        fprintf(f, ", each scaled to Sa(T1) = %g m/s^2 (5 %% damped)", a->k.target_value);
+    fprintf(f, "\n");
+}
+
+/* The statistics rows of a suite's text table: each statistic's name,
+ * lead blank columns, then the statistic of each of the ncol columns. */
+static void stats_rows(int lead, int ncol, const double *const *cols, int n)
+{
+    static const char *const names[] = {"mean", "median", "p16", "p84", "max"};
+    pd_stats st[16];
+    pd_err err;
+    ncol = ncol < 16 ? ncol : 16;
+    for (int j = 0; j < ncol; j++)
+        if (pd_stats_of(cols[j], n, &st[j], &err))
+            st[j] = (pd_stats){
+                .n = 0, .mean = NAN, .median = NAN, .p16 = NAN, .p84 = NAN, .min = NAN, .max = NAN};
+    for (int r = 0; r < 5; r++) {
+        printf("  %-24s", names[r]);
+        for (int j = 0; j < lead; j++)
+            printf(" %12s", "");
+        for (int j = 0; j < ncol; j++) {
+            const double v[5] = {st[j].mean, st[j].median, st[j].p16, st[j].p84, st[j].max};
+            printf(" %12.5g", v[r]);
+        }
+        printf("\n");
+    }
+}
+
+enum { OSC_FIGS = 9, SUITE_TEXT_STRUCTS = 6 };
+#define SUITE_RULE_TOL 1e-9 /* a rule's gap is closed when the required gap exceeds it by this */
+static const char *const osc_fig_names[OSC_FIGS] = {"umax",      "Pi1",         "gamma",
+                                                    "impacts",   "max_impulse", "acc_max",
+                                                    "shear_max", "drift_ratio", "ductility"};
+
+/* The oscillator's figures of a run, in osc_fig_names' order. */
+static void osc_figs(const sim_args *a, const pd_osc_summary *s, double *f)
+{
+    double v[OSC_FIGS] = {s->r.umax,        s->Pi1,       s->gamma,       (double)s->r.impacts,
+                          s->r.max_impulse, s->r.acc_max, s->r.shear_max, s->r.umax / a->k.height,
+                          s->r.ductility};
+    memcpy(f, v, sizeof v);
+}
+
+/* Every record of the suite through the oscillator: per-record results as
+ * single runs give them (the same function makes each), then the suite's
+ * statistics. */
+static int suite_oscillator(sim_args *a)
+{
+    int n = a->k.suite->n, status = 0, failed = -1;
+    pd_osc *cs = calloc((size_t)n, sizeof *cs);
+    pd_run_opts *os = calloc((size_t)n, sizeof *os);
+    pd_osc_summary *ss = calloc((size_t)n, sizeof *ss);
+    double *figs = calloc((size_t)n * OSC_FIGS, sizeof *figs),
+           *col = calloc((size_t)n, sizeof *col);
+    pd_err *errs = calloc((size_t)n, sizeof *errs);
+    if (!cs || !os || !ss || !figs || !col || !errs) {
+        fprintf(stderr, "pound: simulate: out of memory for a suite of %d records\n", n);
+        status = 1;
+        goto done;
+    }
+    for (int k = 0; k < n && !status; k++) /* each record's case, checked before any run */
+        status = pd_cli_case_record(&a->k, k, &cs[k], &os[k]);
+    if (status)
+        goto done;
+    int rc_first = 0, nt = pd_spec_threads(a->threads);
+#pragma omp parallel for schedule(dynamic) num_threads(nt)
+    for (int k = 0; k < n; k++) {
+        int rc = pd_osc_summarize(&cs[k], &os[k], NULL, NULL, &ss[k], &errs[k]);
+        if (rc) {
+#pragma omp critical
+            if (failed < 0 || k < failed) {
+                failed = k;
+                rc_first = rc;
+            }
+        }
+    }
+    if (failed >= 0) {
+        fprintf(stderr, "pound: simulate: %s: %s\n", a->k.suite->path[failed], errs[failed].msg);
+        status = rc_first == PD_EINVAL ? 2 : 1;
+        goto done;
+    }
+    for (int k = 0; k < n; k++) {
+        osc_figs(a, &ss[k], figs + (size_t)k * OSC_FIGS);
+        warn_rtol(ss[k].r.rtol, ss[k].err_est, ss[k].rtol_met);
+    }
+    int yields = pd_osc_yields(&cs[0]), nf = yields ? OSC_FIGS : OSC_FIGS - 1;
+    if (a->json) {
+        pd_json js;
+        pd_json_init(&js, stdout);
+        pd_json_begin_object(&js, NULL);
+        if (a->k.records_path) /* else the --record files */
+            pd_json_str(&js, "suite", a->k.records_path);
+        else
+            pd_json_null(&js, "suite");
+        pd_json_int(&js, "n", n);
+        if (a->k.target != PD_SCALE_NONE) {
+            pd_json_str(&js, "target", a->k.target == PD_SCALE_PGA ? "pga" : "sa");
+            pd_json_num(&js, "target_value", a->k.target_value);
+        }
+        pd_json_begin_array(&js, "records");
+        for (int k = 0; k < n; k++)
+            osc_json(&js, a, &cs[k], os[k].method, &ss[k]);
+        pd_json_end_array(&js);
+        pd_json_begin_object(&js, "stats");
+        for (int j = 0; j < nf; j++) {
+            for (int k = 0; k < n; k++)
+                col[k] = figs[(size_t)k * OSC_FIGS + j];
+            stats_json(&js, osc_fig_names[j], col, n);
+        }
+        pd_json_end_object(&js);
+        pd_json_end_object(&js);
+        pd_json_finish(&js);
+        goto done;
+    }
+    suite_header(a, stdout);
+    printf("  oscillator: T0 %s, gap %s, eps = %g, xi = %g; method %s\n",
+           a->k.have_T0 ? "given" : "from Pi2 and each record's Tp",
+           a->k.have_gap ? "given" : "from Pi3 and each record's Le", cs[0].eps, cs[0].xi,
+           pd_method_name(os[0].method));
+    printf("  %-24s %12s %12s %12s %12s %12s %12s %12s\n", "record", "scale", "T0 [s]", "umax [m]",
+           "Pi1", "impacts", "gamma", "a_abs [m/s2]");
+    for (int k = 0; k < n; k++)
+        printf("  %-24.24s %12.5g %12.5g %12.5g %12.5g %12ld %12.5g %12.5g\n", cs[k].record->name,
+               cs[k].scale, pd_osc_T0(&cs[k]), ss[k].r.umax, ss[k].Pi1, ss[k].r.impacts,
+               ss[k].gamma, ss[k].r.acc_max);
+    /* the columns umax, Pi1, impacts, gamma, a_abs over the records */
+    static const int pick[5] = {0, 1, 3, 2, 5};
+    double *buf = calloc((size_t)5 * n, sizeof *buf);
+    const double *cols[5];
+    if (!buf) {
+        fprintf(stderr, "pound: simulate: out of memory for the suite's statistics\n");
+        status = 1;
+        goto done;
+    }
+    for (int j = 0; j < 5; j++) {
+        for (int k = 0; k < n; k++)
+            buf[(size_t)j * n + k] = figs[(size_t)k * OSC_FIGS + pick[j]];
+        cols[j] = buf + (size_t)j * n;
+    }
+    stats_rows(2, 5, cols, n);
+    free(buf);
+done:
+    free(cs);
+    free(os);
+    free(ss);
+    free(figs);
+    free(col);
+    free(errs);
+    return status;
+}
+
 /* ==== scenes ================================================================ */
 
 /* The writer and the chart both take the samples. */
@@ -601,121 +816,128 @@ static const char *side_name(const pd_scene *sc, int s)
     return s == PD_WALL ? "wall" : sc->st[s].name;
 }
 
-static void scene_json(const sim_args *a, const pd_scene *sc, const pd_scene_summary *s)
+/* The run of scene sc into js as one object. */
+static void scene_json_obj(pd_json *js, const sim_args *a, const pd_scene *sc,
+                           const pd_scene_summary *s)
 {
-    pd_json js;
     const pd_scene_result *r = &s->r;
-    pd_json_init(&js, stdout);
-    pd_json_begin_object(&js, NULL);
-    pd_json_str(&js, "method", r->method);
-    pd_json_str(&js, "method_by", pd_cli_method_by(&a->k));
-    pd_json_int(&js, "steps", r->steps);
-    pd_json_num(&js, "cpu_s", s->cpu_s);
-    pd_json_num(&js, "cpu_s_run", r->cpu_s);
-    pd_json_str(&js, "kernel", r->kernel);
-    pd_json_str(&js, "factor", r->factor);
-    pd_json_str(&js, "lcp_solver", r->lcp_solver);
-    pd_json_int(&js, "lcp_solves", r->lcp_solves);
+    pd_json_begin_object(js, NULL);
+    pd_json_str(js, "method", r->method);
+    pd_json_str(js, "method_by", pd_cli_method_by(&a->k));
+    pd_json_int(js, "steps", r->steps);
+    pd_json_num(js, "cpu_s", s->cpu_s);
+    pd_json_num(js, "cpu_s_run", r->cpu_s);
+    pd_json_str(js, "kernel", r->kernel);
+    pd_json_str(js, "factor", r->factor);
+    pd_json_str(js, "lcp_solver", r->lcp_solver);
+    pd_json_int(js, "lcp_solves", r->lcp_solves);
     /* the event-driven reference's model decisions (0 for the other methods) */
     long impacts = 0;
     for (int c = 0; c < sc->ncontact; c++)
         impacts += r->impacts[c];
-    pd_json_int(&js, "impacts", impacts);
-    pd_json_int(&js, "simultaneous", r->simultaneous);
-    pd_json_int(&js, "tol_closed", r->tol_closed);
-    pd_json_int(&js, "accumulations", r->accumulations);
-    pd_json_num(&js, "close_tol", r->close_tol);
+    pd_json_int(js, "impacts", impacts);
+    pd_json_int(js, "simultaneous", r->simultaneous);
+    pd_json_int(js, "tol_closed", r->tol_closed);
+    pd_json_int(js, "accumulations", r->accumulations);
+    pd_json_num(js, "close_tol", r->close_tol);
     /* the row reference: its impact law ("none": another method), the peaks under the other */
-    pd_json_str(&js, "impact_law", r->impact_law ? r->impact_law : "none");
-    pd_json_num(&js, "law_band", r->law_band_max); /* NaN -> null: no simultaneous impact */
+    pd_json_str(js, "impact_law", r->impact_law ? r->impact_law : "none");
+    pd_json_num(js, "law_band", r->law_band_max); /* NaN -> null: no simultaneous impact */
     if (pd_scene_springs(sc) > 0) /* a yielding scene's energy balance [J] (NaN -> null) */
-        energy_json(&js, &r->energy, 1);
-    pd_json_num(&js, "contact_duration", r->contact_duration);
-    pd_json_num(&js, "dt", r->dt);
-    pd_json_num(&js, "theta", r->theta);
-    pd_json_num(&js, "tend", r->tend);
-    pd_json_num(&js, "rtol", r->rtol);
-    pd_json_num(&js, "err_est", s->err_est); /* NaN -> null: fixed steps */
-    pd_json_bool(&js, "rtol_met", s->rtol_met);
-    pd_json_int(&js, "steps_rejected", r->steps_rejected);
-    pd_json_num(&js, "dt_min", r->dt_min);
-    pd_json_num(&js, "dt_max", r->dt_max);
-    pd_json_int(&js, "dofs", sc->n);
-    pd_json_str(&js, "pulse", sc->exc.record ? sc->exc.record->name : pd_pulse_name(sc->exc.pulse));
-    pd_json_str(&js, "dir", sc->exc.dir > 0 ? "+x" : "-x");
+        energy_json(js, &r->energy, 1);
+    pd_json_num(js, "contact_duration", r->contact_duration);
+    pd_json_num(js, "dt", r->dt);
+    pd_json_num(js, "theta", r->theta);
+    pd_json_num(js, "tend", r->tend);
+    pd_json_num(js, "rtol", r->rtol);
+    pd_json_num(js, "err_est", s->err_est); /* NaN -> null: fixed steps */
+    pd_json_bool(js, "rtol_met", s->rtol_met);
+    pd_json_int(js, "steps_rejected", r->steps_rejected);
+    pd_json_num(js, "dt_min", r->dt_min);
+    pd_json_num(js, "dt_max", r->dt_max);
+    pd_json_int(js, "dofs", sc->n);
+    pd_json_str(js, "pulse", sc->exc.record ? sc->exc.record->name : pd_pulse_name(sc->exc.pulse));
+    pd_json_str(js, "dir", sc->exc.dir > 0 ? "+x" : "-x");
     if (sc->exc.record) {
-        pd_json_str(&js, "record", sc->exc.record->name);
-        pd_json_num(&js, "scale", sc->exc.scale);
+        pd_json_str(js, "record", sc->exc.record->name);
+        pd_json_num(js, "scale", sc->exc.scale);
     }
-    pd_json_num(&js, "ap", sc->exc.ap);
-    pd_json_num(&js, "Tp", sc->exc.Tp);
-    pd_json_num(&js, "Le", pd_scene_Le(sc));
-    pd_json_begin_array(&js, "structures");
+    pd_json_num(js, "ap", sc->exc.ap);
+    pd_json_num(js, "Tp", sc->exc.Tp);
+    pd_json_num(js, "Le", pd_scene_Le(sc));
+    pd_json_begin_array(js, "structures");
     for (int k = 0; k < sc->nstruct; k++) {
         const pd_structure *st = &sc->st[k];
         int o = st->dof, n = st->storeys;
-        pd_json_begin_object(&js, NULL);
-        pd_json_str(&js, "name", st->name);
-        pd_json_int(&js, "storeys", n);
-        pd_json_num(&js, "T0", st->T0);
-        pd_json_num(&js, "Pi2", s->Pi2[k]);
-        pd_json_nums(&js, "umax", n, r->umax + o);
-        pd_json_nums(&js, "u_pos", n, r->u_pos + o);
-        pd_json_nums(&js, "u_neg", n, r->u_neg + o);
-        pd_json_nums(&js, "drift", n, r->drift + o);
-        pd_json_nums(&js, "storey_heights", n, st->height);
-        pd_json_nums(&js, "drift_ratio", n, r->drift_ratio + o);
-        pd_json_nums(&js, "acc_max", n, r->acc_max + o);
-        pd_json_nums(&js, "shear_max", n, r->shear_max + o);
-        pd_json_num(&js, "base_shear_max", r->shear_max[o]);
-        pd_json_nums(&js, "Pi1", n, s->Pi1 + o);
-        pd_json_nums(&js, "umax_free", n, s->free.umax + o);
-        pd_json_nums(&js, "gamma", n, s->gamma + o);
-        pd_json_num(&js, "err_est", s->err_est_structure[k]); /* NaN -> null: fixed steps */
-        pd_json_num(&js, "law_band", r->law_band[k]);
+        pd_json_begin_object(js, NULL);
+        pd_json_str(js, "name", st->name);
+        pd_json_int(js, "storeys", n);
+        pd_json_num(js, "T0", st->T0);
+        pd_json_num(js, "Pi2", s->Pi2[k]);
+        pd_json_nums(js, "umax", n, r->umax + o);
+        pd_json_nums(js, "u_pos", n, r->u_pos + o);
+        pd_json_nums(js, "u_neg", n, r->u_neg + o);
+        pd_json_nums(js, "drift", n, r->drift + o);
+        pd_json_nums(js, "storey_heights", n, st->height);
+        pd_json_nums(js, "drift_ratio", n, r->drift_ratio + o);
+        pd_json_nums(js, "acc_max", n, r->acc_max + o);
+        pd_json_nums(js, "shear_max", n, r->shear_max + o);
+        pd_json_num(js, "base_shear_max", r->shear_max[o]);
+        pd_json_nums(js, "Pi1", n, s->Pi1 + o);
+        pd_json_nums(js, "umax_free", n, s->free.umax + o);
+        pd_json_nums(js, "gamma", n, s->gamma + o);
+        pd_json_num(js, "err_est", s->err_est_structure[k]); /* NaN -> null: fixed steps */
+        pd_json_num(js, "law_band", r->law_band[k]);
         if (st->uy) { /* yielding storeys (SPEC §7): NaN -> null for an elastic one */
-            pd_json_nums(&js, "uy", n, st->uy);
-            pd_json_nums(&js, "yield_alpha", n, st->yield_alpha);
-            pd_json_nums(&js, "ductility", n, r->ductility + o);
-            pd_json_nums(&js, "residual", n, r->residual + o);
-            pd_json_nums(&js, "plastic_excursion", n, r->plastic_excursion + o);
-            pd_json_begin_array(&js, "n_yield");
+            pd_json_nums(js, "uy", n, st->uy);
+            pd_json_nums(js, "yield_alpha", n, st->yield_alpha);
+            pd_json_nums(js, "ductility", n, r->ductility + o);
+            pd_json_nums(js, "residual", n, r->residual + o);
+            pd_json_nums(js, "plastic_excursion", n, r->plastic_excursion + o);
+            pd_json_begin_array(js, "n_yield");
             for (int i = 0; i < n; i++)
-                pd_json_int(&js, NULL, r->n_yield[o + i]);
-            pd_json_end_array(&js);
+                pd_json_int(js, NULL, r->n_yield[o + i]);
+            pd_json_end_array(js);
         }
-        pd_json_end_object(&js);
+        pd_json_end_object(js);
     }
-    pd_json_end_array(&js);
-    pd_json_begin_array(&js, "contacts");
+    pd_json_end_array(js);
+    pd_json_begin_array(js, "contacts");
     for (int c = 0; c < sc->ncontact; c++) {
         const pd_contact *ct = &sc->ct[c];
-        pd_json_begin_object(&js, NULL);
-        pd_json_str(&js, "a", side_name(sc, ct->a));
-        pd_json_str(&js, "b", side_name(sc, ct->b));
-        pd_json_int(&js, "level", ct->a == PD_WALL ? ct->level_b : ct->level_a);
-        pd_json_int(&js, "level_b", ct->level_b);
-        pd_json_num(&js, "gap", ct->gap);
-        pd_json_num(&js, "eps", ct->eps);
-        pd_json_num(&js, "Pi3", s->Pi3[c]);
-        pd_json_int(&js, "impacts", r->impacts[c]);
-        pd_json_num(&js, "first_impact", r->first_impact[c]);
-        pd_json_num(&js, "max_impulse", r->max_impulse[c]);
-        pd_json_num(&js, "contact_time", r->contact_time[c]);
-        pd_json_num(&js, "approach", r->approach[c]);
-        pd_json_num(&js, "force_equiv", r->force_equiv[c]);
-        pd_json_num(&js, "force_max", r->force_max[c]); /* NaN -> null: not compliant */
-        pd_json_num(&js, "chi", s->chi[c]);
-        pd_json_num(&js, "required_gap", s->required_gap[c]);
-        pd_json_begin_object(&js, "rules");
-        pd_json_num(&js, "abs", s->rule_abs[c]);
-        pd_json_num(&js, "srss", s->rule_srss[c]);
-        pd_json_num(&js, "ddc", s->rule_ddc[c]);
-        pd_json_end_object(&js);
-        pd_json_end_object(&js);
+        pd_json_begin_object(js, NULL);
+        pd_json_str(js, "a", side_name(sc, ct->a));
+        pd_json_str(js, "b", side_name(sc, ct->b));
+        pd_json_int(js, "level", ct->a == PD_WALL ? ct->level_b : ct->level_a);
+        pd_json_int(js, "level_b", ct->level_b);
+        pd_json_num(js, "gap", ct->gap);
+        pd_json_num(js, "eps", ct->eps);
+        pd_json_num(js, "Pi3", s->Pi3[c]);
+        pd_json_int(js, "impacts", r->impacts[c]);
+        pd_json_num(js, "first_impact", r->first_impact[c]);
+        pd_json_num(js, "max_impulse", r->max_impulse[c]);
+        pd_json_num(js, "contact_time", r->contact_time[c]);
+        pd_json_num(js, "approach", r->approach[c]);
+        pd_json_num(js, "force_equiv", r->force_equiv[c]);
+        pd_json_num(js, "force_max", r->force_max[c]); /* NaN -> null: not compliant */
+        pd_json_num(js, "chi", s->chi[c]);
+        pd_json_num(js, "required_gap", s->required_gap[c]);
+        pd_json_begin_object(js, "rules");
+        pd_json_num(js, "abs", s->rule_abs[c]);
+        pd_json_num(js, "srss", s->rule_srss[c]);
+        pd_json_num(js, "ddc", s->rule_ddc[c]);
+        pd_json_end_object(js);
+        pd_json_end_object(js);
     }
-    pd_json_end_array(&js);
-    pd_json_end_object(&js);
+    pd_json_end_array(js);
+    pd_json_end_object(js);
+}
+
+static void scene_json(const sim_args *a, const pd_scene *sc, const pd_scene_summary *s)
+{
+    pd_json js;
+    pd_json_init(&js, stdout);
+    scene_json_obj(&js, a, sc, s);
     pd_json_finish(&js);
 }
 
@@ -926,6 +1148,229 @@ done:
     return status;
 }
 
+/* Every record of the suite on the scene (each replacing its excitation):
+ * per-record results as single runs give them, then per structure and
+ * contact the suite's statistics, how often each contact closed and how
+ * often each code rule's gap would have been closed (the required gap
+ * above the rule's). */
+static int suite_scene(sim_args *a)
+{
+    pd_scene *base = NULL, **scs = NULL;
+    pd_scene_summary *ss = NULL;
+    pd_err *errs = NULL;
+    double *col = NULL;
+    unsigned char *flag = NULL;
+    int n = a->k.suite->n, status, failed = -1, rc_first = 0, nt = pd_spec_threads(a->threads);
+    if ((status = pd_cli_scene(&a->k, &base)))
+        return status;
+    scs = calloc((size_t)n, sizeof *scs);
+    ss = calloc((size_t)n, sizeof *ss);
+    errs = calloc((size_t)n, sizeof *errs);
+    col = calloc((size_t)n, sizeof *col);
+    flag = calloc((size_t)n, 1);
+    for (int k = 0; scs && k < n; k++)
+        scs[k] = pd_scene_copy(base);
+    for (int k = 0; scs && k < n && !status; k++)
+        status = !scs[k];
+    if (!scs || !ss || !errs || !col || !flag || status) {
+        fprintf(stderr, "pound: simulate: out of memory for a suite of %d records\n", n);
+        status = 1;
+        goto done;
+    }
+    for (int k = 0; k < n; k++) { /* each record on its copy, checked before any run */
+        pd_err err;
+        if (pd_cli_scene_record(&a->k, k, scs[k], &err)) {
+            status = pd_cli_usage_error("%s: %s", a->k.suite->path[k], err.msg);
+            goto done;
+        }
+    }
+#pragma omp parallel for schedule(dynamic) num_threads(nt)
+    for (int k = 0; k < n; k++) {
+        pd_run_opts o;
+        int rc = pd_scene_resolve_opts(scs[k], &a->k.opts, &o, &errs[k]);
+        if (!rc)
+            rc = pd_scene_summarize(scs[k], &o, NULL, NULL, &ss[k], &errs[k]);
+        if (rc) {
+#pragma omp critical
+            if (failed < 0 || k < failed) {
+                failed = k;
+                rc_first = rc;
+            }
+        }
+    }
+    if (failed >= 0) {
+        fprintf(stderr, "pound: simulate: %s: %s\n", a->k.suite->path[failed], errs[failed].msg);
+        status = rc_first == PD_EINVAL ? 2 : 1;
+        goto done;
+    }
+    for (int k = 0; k < n; k++)
+        warn_rtol(ss[k].r.rtol, ss[k].err_est, ss[k].rtol_met);
+    const pd_scene *sc = base;
+    pd_json js;
+    if (a->json) {
+        pd_json_init(&js, stdout);
+        pd_json_begin_object(&js, NULL);
+        if (a->k.records_path) /* else the --record files */
+            pd_json_str(&js, "suite", a->k.records_path);
+        else
+            pd_json_null(&js, "suite");
+        pd_json_int(&js, "n", n);
+        if (a->k.target != PD_SCALE_NONE) {
+            pd_json_str(&js, "target", a->k.target == PD_SCALE_PGA ? "pga" : "sa");
+            pd_json_num(&js, "target_value", a->k.target_value);
+        }
+        pd_json_begin_array(&js, "records");
+        for (int k = 0; k < n; k++)
+            scene_json_obj(&js, a, scs[k], &ss[k]);
+        pd_json_end_array(&js);
+        pd_json_begin_object(&js, "stats");
+        pd_json_begin_array(&js, "structures");
+    } else {
+        /* a row per record: each structure's umax (its largest storey) */
+        int ncol = sc->nstruct < SUITE_TEXT_STRUCTS ? sc->nstruct : SUITE_TEXT_STRUCTS;
+        suite_header(a, stdout);
+        printf("  scene %s: %d structures, %d contacts; method %s; umax [m] of each structure's "
+               "largest storey%s\n",
+               a->k.scene_path ? a->k.scene_path : "(chain)", sc->nstruct, sc->ncontact,
+               ss[0].r.method, ncol < sc->nstruct ? " (the first ones; --json: all)" : "");
+        printf("  %-24s %12s", "record", "scale");
+        for (int st = 0; st < ncol; st++)
+            printf(" %12.12s", sc->st[st].name);
+        printf("\n");
+        double *buf = calloc((size_t)(ncol > 0 ? ncol : 1) * n, sizeof *buf);
+        const double *cols[SUITE_TEXT_STRUCTS];
+        if (!buf) {
+            fprintf(stderr, "pound: simulate: out of memory for the suite's table\n");
+            status = 1;
+            goto done;
+        }
+        for (int st = 0; st < ncol; st++) {
+            const pd_structure *S = &sc->st[st];
+            for (int k = 0; k < n; k++) {
+                double v = 0.0;
+                for (int i = S->dof; i < S->dof + S->storeys; i++)
+                    v = pd_max(v, ss[k].r.umax[i]);
+                buf[(size_t)st * n + k] = v;
+            }
+            cols[st] = buf + (size_t)st * n;
+        }
+        for (int k = 0; k < n; k++) {
+            printf("  %-24.24s %12.5g", scs[k]->exc.record->name, scs[k]->exc.scale);
+            for (int st = 0; st < ncol; st++)
+                printf(" %12.5g", cols[st][k]);
+            printf("\n");
+        }
+        stats_rows(1, ncol, cols, n);
+        free(buf);
+    }
+    /* per structure: its largest storey's figures */
+    static const char *const sfig[] = {"umax", "drift_ratio", "acc_max", "shear_max", "gamma"};
+    for (int st = 0; st < sc->nstruct && a->json; st++) {
+        const pd_structure *S = &sc->st[st];
+        pd_json_begin_object(&js, NULL);
+        pd_json_str(&js, "name", S->name);
+        for (int f = 0; f < 5; f++) {
+            for (int k = 0; k < n; k++) {
+                const pd_scene_result *r = &ss[k].r;
+                double v = 0.0;
+                for (int i = S->dof; i < S->dof + S->storeys; i++)
+                    v = pd_max(v, f == 0   ? r->umax[i]
+                                  : f == 1 ? r->drift_ratio[i]
+                                  : f == 2 ? r->acc_max[i]
+                                  : f == 3 ? (i == S->dof ? r->shear_max[i] : 0.0)
+                                           : ss[k].gamma[i]);
+                col[k] = v;
+            }
+            stats_json(&js, sfig[f], col, n);
+        }
+        pd_json_end_object(&js);
+    }
+    if (a->json) {
+        pd_json_end_array(&js);
+        pd_json_begin_array(&js, "contacts");
+    } else if (sc->ncontact) {
+        printf("  %-24s %12s %12s %12s %12s %12s\n", "contact (level)", "closed", "required",
+               "ABS closed", "SRSS closed", "DDC closed");
+    }
+    for (int c = 0; c < sc->ncontact; c++) {
+        char pair[2 * PD_NAME_MAX + 4];
+        int level = contact_label(sc, c, pair, sizeof pair);
+        double closed, rules[3];
+        for (int k = 0; k < n; k++)
+            flag[k] = ss[k].r.impacts[c] > 0;
+        closed = share(flag, n);
+        for (int q = 0; q < 3; q++) {
+            for (int k = 0; k < n; k++) {
+                const double *rule = q == 0   ? ss[k].rule_abs
+                                     : q == 1 ? ss[k].rule_srss
+                                              : ss[k].rule_ddc;
+                /* beyond rounding: at a wall ABS is the required gap itself */
+                flag[k] = ss[k].required_gap[c] > rule[c] * (1.0 + SUITE_RULE_TOL);
+            }
+            rules[q] = share(flag, n);
+        }
+        for (int k = 0; k < n; k++)
+            col[k] = ss[k].required_gap[c];
+        if (!a->json) {
+            pd_stats st;
+            pd_err err;
+            if (pd_stats_of(col, n, &st, &err))
+                st.mean = NAN;
+            printf("  %-18.18s (%3d) %12.3g %12.5g %12.3g %12.3g %12.3g\n", pair, level, closed,
+                   st.mean, rules[0], rules[1], rules[2]);
+            continue;
+        }
+        pd_json_begin_object(&js, NULL);
+        pd_json_str(&js, "sides", pair);
+        pd_json_int(&js, "level", level);
+        pd_json_num(&js, "closed", closed); /* the share of records with an impact */
+        stats_json(&js, "required_gap", col, n);
+        for (int k = 0; k < n; k++)
+            col[k] = (double)ss[k].r.impacts[c];
+        stats_json(&js, "impacts", col, n);
+        for (int k = 0; k < n; k++)
+            col[k] = ss[k].r.max_impulse[c];
+        stats_json(&js, "max_impulse", col, n);
+        pd_json_begin_object(&js, "rules");
+        static const char *const rname[3] = {"abs", "srss", "ddc"};
+        for (int q = 0; q < 3; q++) {
+            for (int k = 0; k < n; k++)
+                col[k] = q == 0   ? ss[k].rule_abs[c]
+                         : q == 1 ? ss[k].rule_srss[c]
+                                  : ss[k].rule_ddc[c];
+            stats_json(&js, rname[q], col, n);
+        }
+        pd_json_end_object(&js);
+        /* the share of records whose required gap exceeds the rule's */
+        pd_json_begin_object(&js, "rule_closed");
+        for (int q = 0; q < 3; q++)
+            pd_json_num(&js, rname[q], rules[q]);
+        pd_json_end_object(&js);
+        pd_json_end_object(&js);
+    }
+    if (a->json) {
+        pd_json_end_array(&js);
+        pd_json_end_object(&js);
+        pd_json_end_object(&js);
+        pd_json_finish(&js);
+    } else if (sc->ncontact) {
+        printf("  (closed: the share of records with an impact; required: the mean required gap "
+               "[m]; RULE closed: the share whose required gap exceeds the rule's)\n");
+    }
+done:
+    for (int k = 0; ss && k < n; k++)
+        pd_scene_summary_free(&ss[k]);
+    for (int k = 0; scs && k < n; k++)
+        pd_scene_free(scs[k]);
+    free(scs);
+    free(ss);
+    free(errs);
+    free(col);
+    free(flag);
+    pd_scene_free(base);
+    return status;
+}
+
 int pd_cmd_simulate(int argc, char **argv)
 {
     sim_args a;
@@ -936,7 +1381,10 @@ int pd_cmd_simulate(int argc, char **argv)
         return rc;
     pd_provenance_set(argc, argv, pd_cli_is_scene(&a.k) ? PD_FORMAT_SCENE : PD_FORMAT_OSCILLATOR,
                       0);
-    rc = pd_cli_is_scene(&a.k) ? simulate_scene(&a) : simulate_oscillator(&a);
+    if (pd_cli_case_is_suite(&a.k))
+        rc = pd_cli_is_scene(&a.k) ? suite_scene(&a) : suite_oscillator(&a);
+    else
+        rc = pd_cli_is_scene(&a.k) ? simulate_scene(&a) : simulate_oscillator(&a);
     pd_cli_case_free(&a.k);
     return rc;
 }

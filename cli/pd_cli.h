@@ -50,6 +50,21 @@ typedef struct pd_cli_case {
     pd_record_units rec_units;   /* --units (text records) */
     int have_units;              /* --units given */
     pd_cli_record *record;       /* read by pd_cli_case_finish; released by pd_cli_case_free */
+    /* a suite (--record repeated, or --records FILE): its records, read by
+     * pd_cli_case_finish (record above is recs[0]), each one's scale (the
+     * suite file's times --scale, or the target's) */
+    pd_suite *suite;
+    const char *records_path; /* --records FILE */
+    pd_cli_record **recs;
+    double *rec_scale;
+    pd_scale_target target; /* --target-pga or --target-sa */
+    double target_value;    /* [m/s^2] */
+    const char *target_flag;
+    double T1;             /* --T1: Sa's period [s] */
+    const char *suites_by; /* the command that runs suites (NULL: it takes one record) */
+    int have_T1;
+    pd_osc c_base;       /* the oscillator as the flags set it, before a record */
+    pd_run_opts opts_in; /* the options as the flags set them, before resolution */
     /* the method: --method's, else the one the flags given belong to (a
      * flag of one method's only: --theta, --kc, ...), else the default;
      * method_by names the flag that chose it (NULL: the default) */
@@ -85,6 +100,17 @@ int pd_cli_case_flag(pd_cli_case *a, int argc, char **argv, int *i);
 int pd_cli_case_finish(pd_cli_case *a);
 /* What pd_cli_case_finish took (the record). */
 void pd_cli_case_free(pd_cli_case *a);
+/* A suite of records was given (--record twice or more, or --records). */
+int pd_cli_case_is_suite(const pd_cli_case *a);
+/* The oscillator of the suite's record k (the checked case's flags on it:
+ * T0, gap and uy in metres kept, Pi forms kept) into *c, its options
+ * resolved into *o: 0 or 2 (one line printed).  The single run of that
+ * record is made by the same function. */
+int pd_cli_case_record(const pd_cli_case *a, int k, pd_osc *c, pd_run_opts *o);
+/* The suite's record k on scene sc's excitation (its pulse's ap and Tp,
+ * its scale), the scene's duration derived for it unless --tend; the
+ * scene finished again (PD_OK, or the excitation's error). */
+int pd_cli_scene_record(const pd_cli_case *a, int k, pd_scene *sc, pd_err *err);
 /* Read a record and fit its pulse: 0, or 2 after printing the file's error.
  * --units given (units_given) on a format that fixes its units (AT2, V2) is
  * refused; a peak acceleration implausible in its units (pd_record_plausible)

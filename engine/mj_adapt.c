@@ -250,8 +250,8 @@ int mj_adapt_alloc(pd_mj *mj, pd_err *err)
     ad->u_tol = pd_calloc(md->m, sizeof(double));
     ad->G = pd_calloc(md->m, sizeof(double));
     ad->lam = pd_calloc(md->m, sizeof(double));
-    bad |= !ad->u_tol || !ad->G || !ad->lam || !ad->mark || !ad->evmark || !ad->timed || !ad->u_rest ||
-           !ad->D0 || mj_incidence_build(mj);
+    bad |= !ad->u_tol || !ad->G || !ad->lam || !ad->mark || !ad->evmark || !ad->timed ||
+           !ad->u_rest || !ad->D0 || mj_incidence_build(mj);
     for (int s = 0; s < 4 && !bad; s++)
         bad = snap_alloc(&ad->sn[s], n, md->m) != PD_OK;
     if (bad)
@@ -923,8 +923,8 @@ static void held_forces(const pd_mj *mj, const snap *w, const snap *x)
         onset = x->st.P[a] > 0.0 && !(w->st.P[a] > 0.0);
     for (int a = 0; a < m; a++)
         ad->lam[a] = !(x->st.P[a] > 0.0 && w->st.P[a] > 0.0 && x->st.h > 0.0) ? 0.0
-                     : onset                                                 ? ad->lam[a]
-                                                                             : x->st.P[a] / x->st.h;
+                     : onset                                                  ? ad->lam[a]
+                             : x->st.P[a] / x->st.h;
 }
 
 /* The held contacts' forces ad->lam into acc: a_i += W_ia lam_a / M_ii. */

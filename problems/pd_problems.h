@@ -1076,4 +1076,76 @@ PD_API int pd_scene_sweep_scene(const pd_scene_sweep *w, long task, pd_scene **o
 PD_API int pd_scene_sweep_run(const pd_scene_sweep *w, int threads, pd_scene_point *pts,
                               double *umax, pd_err *err);
 
+/* ==== suites of ground motions (suite.c) ====================================== */
+
+/* The records of a suite, each with its scale factor. */
+typedef struct pd_suite {
+    int n, cap;
+    char **path;   /* n record files */
+    double *scale; /* n factors > 0 */
+} pd_suite;
+
+/* An empty suite (NULL: out of memory); pd_suite_free frees it and its paths. */
+PD_API pd_suite *pd_suite_new(void);
+PD_API void pd_suite_free(pd_suite *s);
+/* Append a record path (copied) with its scale (> 0). */
+PD_API int pd_suite_add(pd_suite *s, const char *path, double scale, pd_err *err);
+/* A suite file: one record a line, PATH [SCALE], '#' comments, blank lines
+ * skipped; a relative PATH is read from the suite file's folder.
+ * PD_EINVAL naming the file and line; *out NULL on error. */
+PD_API int pd_suite_read(const char *file, pd_suite **out, pd_err *err);
+
+/* The statistics of a suite's values: of the n finite ones (NaN left out),
+ * mean, median, 16th and 84th percentiles (linear between order
+ * statistics, NumPy's default), min and max; all NaN when none is finite. */
+typedef struct pd_stats {
+    int n;
+    double mean, median, p16, p84, min, max;
+} pd_stats;
+
+PD_API int pd_stats_of(const double *x, int n, pd_stats *st, pd_err *err);
+
+/* The 5 %- (xi-) damped pseudo-spectral acceleration Sa(T) = w^2 max |u| of
+ * the record at scale 1 [m/s^2]: the elastic oscillator's exact response
+ * (the event reference with no wall: exact flights of the piecewise-linear
+ * record, its peaks inside a sample step included). */
+PD_API int pd_record_sa(const pd_record *rec, const pd_record_pulse *pulse, double T, double xi,
+                        double *Sa, pd_err *err);
+
+/* Scaling a record to a target: its PGA, or Sa(T1) at damping xi. */
+typedef enum { PD_SCALE_NONE = 0, PD_SCALE_PGA = 1, PD_SCALE_SA = 2 } pd_scale_target;
+
+/* The factor that takes the record to the target value [m/s^2] (1 for
+ * PD_SCALE_NONE): value / PGA or value / Sa(T1). */
+PD_API int pd_record_scale_to(const pd_record *rec, const pd_record_pulse *pulse,
+                              pd_scale_target kind, double value, double T1, double xi,
+                              double *scale, pd_err *err);
+
+/* A stochastic near-fault ground motion: the Mavroeidis-Papageorgiou
+ * (2003) velocity pulse's acceleration (vp, Tp = 1 / fp, gamma, nu, t0)
+ * plus white noise of spectral density S0 [m^2/s^3] through the
+ * Clough-Penzien filters (ground wg, zg; high-pass wf, zf) under the
+ * Jennings-Housner-Tsai envelope ((t / t1)^2, 1 to t2, then exp(-c (t -
+ * t2))), sampled at dt for duration seconds; the noise from splitmix64
+ * seeded by seed, held over each sample step (four RK4 steps a sample):
+ * the same record bit for bit on every platform. */
+typedef struct pd_synth {
+    double duration, dt;          /* [s] */
+    double vp, Tp, gamma, nu, t0; /* the pulse [m/s, s, 1, rad, s] */
+    double S0, wg, zg, wf, zf;    /* the noise [m^2/s^3, rad/s, 1, rad/s, 1] */
+    double t1, t2, c;             /* the envelope [s, s, 1/s] */
+    unsigned long long seed;      /* the noise's stream */
+} pd_synth;
+
+PD_API int pd_record_synth(const pd_synth *p, const char *name, pd_record *rec, pd_err *err);
+/* The parameters of the suite pound ships (examples/records/suite/): k in
+ * [0, pd_synth_shipped_count()), NULL outside. */
+PD_API int pd_synth_shipped_count(void);
+PD_API const pd_synth *pd_synth_shipped(int k);
+
+/* A scene's excitation by a record at scale (its fitted pulse gives ap and
+ * Tp, as a scene file's "record"): pulse and direction kept. */
+PD_API void pd_scene_excite_record(pd_scene_excitation *x, const pd_record *rec,
+                                   const pd_record_pulse *pulse, double scale);
+
 #endif

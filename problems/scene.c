@@ -1128,3 +1128,16 @@ double pd_scene_penalty_kc(const pd_scene *sc, const pd_run_opts *o)
         return o->pen.kc_abs;
     return (o->pen.kc_mult > 0.0 ? o->pen.kc_mult : SCENE_PEN_KC) * pd_scene_stiffest(sc);
 }
+
+/* x excited by rec at scale: ap = scale times the fitted pulse's, Tp its. */
+void pd_scene_excite_record(pd_scene_excitation *x, const pd_record *rec,
+                            const pd_record_pulse *pulse, double scale)
+{
+    if (!x || !rec || !pulse)
+        return;
+    x->record = rec;
+    x->scale = scale;
+    x->rec_ap = pulse->ap;
+    x->ap = scale * pulse->ap;
+    x->Tp = pulse->Tp;
+}

@@ -378,10 +378,7 @@ static int read_record(loader *L, json_t *ex, pd_scene_excitation *x, pd_record 
         return rc == PD_ENOMEM ? pd_err_set(L->err, rc, "%s", e.msg)
                                : fail(L, "excitation.record", "%s", e.msg);
     }
-    x->record = *rec;
-    x->rec_ap = pulse.ap;
-    x->ap = x->scale * pulse.ap;
-    x->Tp = pulse.Tp;
+    pd_scene_excite_record(x, *rec, &pulse, x->scale);
     if ((rc = in_range(L, "excitation.record", "the fitted pulse's period Tp =", x->Tp,
                        SCENE_PERIOD_MIN, SCENE_PERIOD_MAX, "s")) ||
         (rc = in_range(L, "excitation.scale", "the fitted pulse's amplitude scale * ap =", x->ap,

@@ -154,6 +154,7 @@ int main(int argc, char **argv)
     suite_yield_edr(&ctx);
     suite_yield_edr_rk(&ctx);
     suite_separation(&ctx);
+    suite_suite(&ctx);
     suite_yield_newmark(&ctx);
     suite_yield_mj(&ctx);
     suite_yield_scene(&ctx);

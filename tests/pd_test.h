@@ -140,6 +140,7 @@ void suite_yield_rk(pd_test_ctx *ctx);
 void suite_yield_edr(pd_test_ctx *ctx);
 void suite_yield_edr_rk(pd_test_ctx *ctx);
 void suite_separation(pd_test_ctx *ctx);
+void suite_suite(pd_test_ctx *ctx);
 void suite_yield_newmark(pd_test_ctx *ctx);
 void suite_yield_mj(pd_test_ctx *ctx);
 void suite_yield_scene(pd_test_ctx *ctx);

@@ -3040,6 +3040,158 @@ static long api_case_373(void)
     return v;
 }
 
+static long api_case_374(void)
+{
+    pd_err err = {0};
+    pd_suite_free(NULL);
+    (void)err;
+    return 0;
+}
+
+static long api_case_375(void)
+{
+    pd_err err = {0};
+    long v = pd_suite_add(NULL, (const char *)fx_string("pd_suite_add", "path"), 1.0, &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_376(void)
+{
+    pd_err err = {0};
+    long v = pd_suite_add((pd_suite *)fx_object("pd_suite", "pd_suite_add", 0), NULL, 1.0, &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_377(void)
+{
+    pd_err err = {0};
+    long v = pd_suite_read(NULL, (pd_suite **)fx_slot(), &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_378(void)
+{
+    pd_err err = {0};
+    long v = pd_suite_read((const char *)fx_string("pd_suite_read", "file"), NULL, &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_379(void)
+{
+    pd_err err = {0};
+    long v = pd_stats_of(NULL, 1, (pd_stats *)fx_object("pd_stats", "pd_stats_of", 2), &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_380(void)
+{
+    pd_err err = {0};
+    long v = pd_stats_of((const double *)fx_object("double", "pd_stats_of", 0), 1, NULL, &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_381(void)
+{
+    pd_err err = {0};
+    long v = pd_record_sa(NULL, (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_sa", 1), 1.0, 1.0, (double *)fx_object("double", "pd_record_sa", 4), &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_382(void)
+{
+    pd_err err = {0};
+    long v = pd_record_sa((const pd_record *)fx_object("pd_record", "pd_record_sa", 0), NULL, 1.0, 1.0, (double *)fx_object("double", "pd_record_sa", 4), &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_383(void)
+{
+    pd_err err = {0};
+    long v = pd_record_sa((const pd_record *)fx_object("pd_record", "pd_record_sa", 0), (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_sa", 1), 1.0, 1.0, NULL, &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_384(void)
+{
+    pd_err err = {0};
+    long v = pd_record_scale_to(NULL, (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_scale_to", 1), (pd_scale_target)0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_record_scale_to", 6), &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_385(void)
+{
+    pd_err err = {0};
+    long v = pd_record_scale_to((const pd_record *)fx_object("pd_record", "pd_record_scale_to", 0), NULL, (pd_scale_target)0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_record_scale_to", 6), &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_386(void)
+{
+    pd_err err = {0};
+    long v = pd_record_scale_to((const pd_record *)fx_object("pd_record", "pd_record_scale_to", 0), (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_scale_to", 1), (pd_scale_target)0, 1.0, 1.0, 1.0, NULL, &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_387(void)
+{
+    pd_err err = {0};
+    long v = pd_record_synth(NULL, (const char *)fx_string("pd_record_synth", "name"), (pd_record *)fx_object("pd_record", "pd_record_synth", 2), &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_388(void)
+{
+    pd_err err = {0};
+    long v = pd_record_synth((const pd_synth *)fx_object("pd_synth", "pd_record_synth", 0), NULL, (pd_record *)fx_object("pd_record", "pd_record_synth", 2), &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_389(void)
+{
+    pd_err err = {0};
+    long v = pd_record_synth((const pd_synth *)fx_object("pd_synth", "pd_record_synth", 0), (const char *)fx_string("pd_record_synth", "name"), NULL, &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_390(void)
+{
+    pd_err err = {0};
+    pd_scene_excite_record(NULL, (const pd_record *)fx_object("pd_record", "pd_scene_excite_record", 1), (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_scene_excite_record", 2), 1.0);
+    (void)err;
+    return 0;
+}
+
+static long api_case_391(void)
+{
+    pd_err err = {0};
+    pd_scene_excite_record((pd_scene_excitation *)fx_object("pd_scene_excitation", "pd_scene_excite_record", 0), NULL, (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_scene_excite_record", 2), 1.0);
+    (void)err;
+    return 0;
+}
+
+static long api_case_392(void)
+{
+    pd_err err = {0};
+    pd_scene_excite_record((pd_scene_excitation *)fx_object("pd_scene_excitation", "pd_scene_excite_record", 0), (const pd_record *)fx_object("pd_record", "pd_scene_excite_record", 1), NULL, 1.0);
+    (void)err;
+    return 0;
+}
+
 const api_null_case api_null_cases[] = {
     {.function = "pd_err_set", .argument = "fmt", .expect = EXPECT_ERROR, .call = api_case_0},
     {.function = "pd_err_sanitize", .argument = "msg", .expect = EXPECT_NOCRASH, .call = api_case_1},
@@ -3415,6 +3567,25 @@ const api_null_case api_null_cases[] = {
     {.function = "pd_scene_sweep_run", .argument = "w", .expect = EXPECT_ERROR, .call = api_case_371},
     {.function = "pd_scene_sweep_run", .argument = "pts", .expect = EXPECT_ERROR, .call = api_case_372},
     {.function = "pd_scene_sweep_run", .argument = "umax", .expect = EXPECT_ERROR, .call = api_case_373},
+    {.function = "pd_suite_free", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_374},
+    {.function = "pd_suite_add", .argument = "s", .expect = EXPECT_ERROR, .call = api_case_375},
+    {.function = "pd_suite_add", .argument = "path", .expect = EXPECT_ERROR, .call = api_case_376},
+    {.function = "pd_suite_read", .argument = "file", .expect = EXPECT_ERROR, .call = api_case_377},
+    {.function = "pd_suite_read", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_378},
+    {.function = "pd_stats_of", .argument = "x", .expect = EXPECT_ERROR, .call = api_case_379},
+    {.function = "pd_stats_of", .argument = "st", .expect = EXPECT_ERROR, .call = api_case_380},
+    {.function = "pd_record_sa", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_381},
+    {.function = "pd_record_sa", .argument = "pulse", .expect = EXPECT_ERROR, .call = api_case_382},
+    {.function = "pd_record_sa", .argument = "Sa", .expect = EXPECT_ERROR, .call = api_case_383},
+    {.function = "pd_record_scale_to", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_384},
+    {.function = "pd_record_scale_to", .argument = "pulse", .expect = EXPECT_ERROR, .call = api_case_385},
+    {.function = "pd_record_scale_to", .argument = "scale", .expect = EXPECT_ERROR, .call = api_case_386},
+    {.function = "pd_record_synth", .argument = "p", .expect = EXPECT_ERROR, .call = api_case_387},
+    {.function = "pd_record_synth", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_388},
+    {.function = "pd_record_synth", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_389},
+    {.function = "pd_scene_excite_record", .argument = "x", .expect = EXPECT_NOCRASH, .call = api_case_390},
+    {.function = "pd_scene_excite_record", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_391},
+    {.function = "pd_scene_excite_record", .argument = "pulse", .expect = EXPECT_NOCRASH, .call = api_case_392},
 };
-const int api_null_ncases = 374;
-const int api_null_nfunctions = 224;
+const int api_null_ncases = 393;
+const int api_null_nfunctions = 235;

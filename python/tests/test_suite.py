@@ -1,0 +1,141 @@
+"""Suites of records from the command line (`--records FILE`, `--record`
+repeated): each record's entry is the single run of that record to the last
+bit, the statistics are NumPy's, one thread gives what two give, and the
+targets scale each record to them."""
+import json
+import subprocess
+
+import numpy as np
+import pytest
+
+from conftest import EXAMPLES, TIMING_KEYS, pound_bin
+
+SUITE = EXAMPLES / "records" / "suite" / "suite.txt"
+RECS = [SUITE.parent / line.split()[0] for line in SUITE.read_text().splitlines()
+        if line.strip() and not line.startswith("#")]
+OSC = ["--T0", "0.8", "--gap", "0.01", "--eps", "0.6"]
+SCENE = EXAMPLES / "scenes" / "two-sdof.json"
+
+
+def untimed(x):
+    """x without its timings (they differ from run to run)."""
+    if isinstance(x, dict):
+        return {k: untimed(v) for k, v in x.items() if k not in TIMING_KEYS}
+    if isinstance(x, list):
+        return [untimed(v) for v in x]
+    return x
+
+
+def run(*args, status=0):
+    out = subprocess.run([str(pound_bin())] + [str(a) for a in args], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, check=False)
+    assert out.returncode == status, out.stderr.decode()
+    return out
+
+
+def test_shipped_suite_has_seven_records():
+    assert len(RECS) == 7 and all(p.exists() for p in RECS)
+
+
+@pytest.mark.parametrize("where", ["oscillator", "scene"])
+def test_records_are_single_runs(cli, where):
+    """records[k] is what the single run of record k prints, bit for bit."""
+    flags = OSC if where == "oscillator" else ["--scene", SCENE]
+    js = cli("simulate", "--records", SUITE, *flags)
+    assert js["n"] == 7 and len(js["records"]) == 7
+    for rec, path in zip(js["records"], RECS):
+        single = cli("simulate", "--record", path, *flags)
+        assert untimed(rec) == untimed(single), path.name
+
+
+def test_scene_record_is_the_scene_files_record(cli, tmp_path):
+    """A suite's record on a scene equals the scene file that names it."""
+    scene = json.loads(SCENE.read_text())
+    scene["excitation"] = {"record": str(RECS[2]), "units": "g"}
+    scene.pop("tend", None)
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(scene))
+    js = cli("simulate", "--scene", SCENE, "--records", SUITE)
+    single = cli("simulate", "--scene", path)
+    assert untimed(js["records"][2]) == untimed(single)
+
+
+def stats_ok(stats, values):
+    x = np.asarray(values, dtype=float)
+    want = dict(n=len(x), mean=np.mean(x), median=np.median(x), p16=np.percentile(x, 16),
+                p84=np.percentile(x, 84), min=np.min(x), max=np.max(x))
+    for key, w in want.items():
+        assert stats[key] == pytest.approx(w, rel=1e-14, abs=1e-300), key
+
+
+def test_oscillator_stats_are_numpys(cli):
+    js = cli("simulate", "--records", SUITE, *OSC)
+    for key in ["umax", "Pi1", "gamma", "impacts", "max_impulse", "acc_max", "shear_max"]:
+        stats_ok(js["stats"][key], [r[key] for r in js["records"]])
+    stats_ok(js["stats"]["drift_ratio"], [r["drift_ratio"] for r in js["records"]])
+
+
+def test_scene_stats_are_numpys(cli):
+    js = cli("simulate", "--records", SUITE, "--scene", EXAMPLES / "scenes" /
+             "three-buildings.json", "--method", "event")
+    for s, st in enumerate(js["stats"]["structures"]):
+        stats_ok(st["umax"], [max(r["structures"][s]["umax"]) for r in js["records"]])
+        stats_ok(st["acc_max"], [max(r["structures"][s]["acc_max"]) for r in js["records"]])
+    for c, ct in enumerate(js["stats"]["contacts"]):
+        req = [r["contacts"][c]["required_gap"] for r in js["records"]]
+        stats_ok(ct["required_gap"], req)
+        hits = [r["contacts"][c]["impacts"] > 0 for r in js["records"]]
+        assert ct["closed"] == pytest.approx(np.mean(hits), abs=1e-15)
+        for rule in ["abs", "srss", "ddc"]:
+            ruled = [r["contacts"][c]["rules"][rule] for r in js["records"]]
+            stats_ok(ct["rules"][rule], ruled)
+            over = np.mean([q > g * (1 + 1e-9) for q, g in zip(req, ruled)])
+            assert ct["rule_closed"][rule] == pytest.approx(over, abs=1e-15)
+
+
+def test_one_thread_is_two(cli):
+    one = cli("simulate", "--records", SUITE, "--scene", SCENE, "--threads", "1")
+    two = cli("simulate", "--records", SUITE, "--scene", SCENE, "--threads", "2")
+    assert untimed(one) == untimed(two)
+
+
+def test_targets_reach_their_values(cli):
+    meas = cli("record", "--records", SUITE, "--sa", "0.8")["records"]
+    pga = cli("simulate", "--records", SUITE, *OSC, "--target-pga", "3")
+    sa = cli("simulate", "--records", SUITE, *OSC, "--target-sa", "5")  # T1 = T0
+    for m, a, b in zip(meas, pga["records"], sa["records"]):
+        assert a["scale"] * m["pga"] == pytest.approx(3.0, rel=1e-13)
+        assert b["scale"] * m["sa"] == pytest.approx(5.0, rel=1e-13)
+
+
+def test_record_repeated_is_a_suite(cli):
+    js = cli("simulate", "--record", RECS[0], "--record", RECS[1], *OSC)
+    assert [r["record"] for r in js["records"]] == ["nf1.txt", "nf2.txt"]
+
+
+@pytest.mark.parametrize("args,says", [
+    (["--records", "/nonexistent/suite.txt"], "cannot open the suite file"),
+    (["--records", SUITE, "--record", RECS[0]], "give the suite one way"),
+    (["--records", SUITE, "--target-sa", "3", "--Pi2", "1"], "--T1"),
+    (["--records", SUITE, "--target-pga", "3", "--scale", "2"], "--scale and --target-pga"),
+    (["--target-pga", "3"], "scales records"),
+    (["--records", SUITE, "--T1", "1"], "--T1: the period of --target-sa"),
+])
+def test_bad_suites_are_refused(args, says):
+    out = run("simulate", *args, status=2)
+    err = out.stderr.decode()
+    assert says in err and err.count("\n") == 1 and not out.stdout, err
+
+
+def test_suite_file_errors_name_the_line(tmp_path):
+    bad = tmp_path / "bad.txt"
+    bad.write_text("%s\n%s 0\n" % (RECS[0], RECS[1]))
+    err = run("simulate", "--records", bad, *OSC, status=2).stderr.decode()
+    assert "bad.txt:2" in err and "scale" in err
+
+
+def test_synth_suite_is_the_shipped_one(tmp_path):
+    """`pound record --synth-suite DIR` writes the shipped files byte for byte."""
+    run("record", "--synth-suite", tmp_path)
+    for p in RECS + [SUITE]:
+        assert (tmp_path / p.name).read_bytes() == p.read_bytes(), p.name

@@ -1,0 +1,222 @@
+/* test_suite.c — suites of ground motions (problems/suite.c):
+ *   - the statistics against values worked by hand (NumPy's percentile
+ *     convention), NaN left out;
+ *   - suite files: comments, scales, paths from the file's folder, each
+ *     error naming its file and line;
+ *   - Sa(T) against an independent integration of the elastic oscillator
+ *     (RK4 at a 400th of a sample, peaks refined on its steps), and the
+ *     scale to a target PGA or Sa(T1) reaching it;
+ *   - the shipped suite: the generator gives the files of
+ *     examples/records/suite/ to their 9 printed digits, the same record
+ *     twice, another record for another seed. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "pd_core.h"
+#include "pd_problems.h"
+#include "pd_test.h"
+
+/* x = 7, 1, 5, 3, NaN, 6, 2, 4: mean 4, median 4; p16 at 0.96 between the
+ * 1st and 2nd order statistics (1.96), p84 at 5.04 (6.04); min 1, max 7. */
+static void test_suite_stats(pd_test_ctx *ctx)
+{
+    const double x[8] = {7, 1, 5, 3, NAN, 6, 2, 4};
+    pd_stats st;
+    pd_err err;
+    int rc = pd_stats_of(x, 8, &st, &err);
+    CHECK(ctx,
+          rc == PD_OK && st.n == 7 && st.mean == 4.0 && st.median == 4.0 &&
+              fabs(st.p16 - 1.96) < 1e-15 && fabs(st.p84 - 6.04) < 1e-15 && st.min == 1.0 &&
+              st.max == 7.0,
+          "n %d mean %g median %g p16 %.17g p84 %.17g min %g max %g", st.n, st.mean, st.median,
+          st.p16, st.p84, st.min, st.max);
+    /* an even count: the median between the middle two; one value: itself */
+    const double y[4] = {4, 1, 3, 2}, one = 0.25;
+    rc = pd_stats_of(y, 4, &st, &err);
+    CHECK(ctx, rc == PD_OK && st.median == 2.5 && fabs(st.p16 - 1.48) < 1e-15,
+          "even: median %g p16 %.17g", st.median, st.p16);
+    rc = pd_stats_of(&one, 1, &st, &err);
+    CHECK(ctx, rc == PD_OK && st.mean == one && st.p16 == one && st.p84 == one && st.max == one,
+          "one value");
+    const double none[2] = {NAN, INFINITY};
+    rc = pd_stats_of(none, 2, &st, &err);
+    CHECK(ctx, rc == PD_OK && st.n == 0 && isnan(st.mean) && isnan(st.max), "no finite value");
+}
+
+/* A suite file: its lines, scales, folder; the errors name file:line. */
+static void test_suite_file(pd_test_ctx *ctx)
+{
+    char dir[] = "/tmp/pd_suiteXXXXXX", path[600];
+    if (!CHECK(ctx, mkdtemp(dir) != NULL, "mkdtemp"))
+        return;
+    snprintf(path, sizeof path, "%s/s.txt", dir);
+    FILE *f = fopen(path, "w");
+    fprintf(f, "# a suite\n\na.AT2   # first\n  sub/b.txt 2.5\n/abs/c.V2 0.5\n");
+    fclose(f);
+    pd_suite *s = NULL;
+    pd_err err;
+    int rc = pd_suite_read(path, &s, &err);
+    char want_a[600], want_b[600];
+    snprintf(want_a, sizeof want_a, "%s/a.AT2", dir);
+    snprintf(want_b, sizeof want_b, "%s/sub/b.txt", dir);
+    CHECK(ctx,
+          rc == PD_OK && s && s->n == 3 && !strcmp(s->path[0], want_a) &&
+              !strcmp(s->path[1], want_b) && !strcmp(s->path[2], "/abs/c.V2") &&
+              s->scale[0] == 1.0 && s->scale[1] == 2.5 && s->scale[2] == 0.5,
+          "read: %s", rc ? err.msg : "ok");
+    pd_suite_free(s);
+    /* errors: a bad scale, a third column, an empty suite, no file */
+    const char *bad[3] = {"a.AT2\nb.AT2 -1\n", "a.AT2 1 2\n", "# nothing\n"};
+    const char *says[3] = {"s.txt:2: the scale '-1'", "s.txt:1: expected PATH [SCALE]",
+                           "lists no record"};
+    for (int k = 0; k < 3; k++) {
+        f = fopen(path, "w");
+        fputs(bad[k], f);
+        fclose(f);
+        s = (pd_suite *)1;
+        rc = pd_suite_read(path, &s, &err);
+        CHECK(ctx, rc == PD_EINVAL && s == NULL && strstr(err.msg, says[k]), "bad %d: %s", k,
+              err.msg);
+    }
+    unlink(path);
+    rc = pd_suite_read(path, &s, &err);
+    CHECK(ctx, rc == PD_EINVAL && strstr(err.msg, "cannot open"), "missing: %s", err.msg);
+    rmdir(dir);
+}
+
+/* u'' + 2 xi w u' + w^2 u = -a(t), a linear between samples: RK4 at dt /
+ * 400 from rest to the record's end plus 2 T; max |u| over its steps, each
+ * step's peak refined on the cubic Hermite of (u, u') at its ends. */
+static double sa_rk4(const pd_record *rec, double T, double xi)
+{
+    const int sub = 400;
+    double w = PD_TWO_PI / T, u = 0.0, v = 0.0, peak = 0.0, h = rec->dt / sub;
+    long steps = (long)ceil((pd_record_duration(rec) + 2.0 * T) / h);
+    for (long j = 0; j < steps; j++) {
+        double t = j * h, u0 = u, v0 = v, k[4][2], y[2];
+        double tt[4] = {t, t + 0.5 * h, t + 0.5 * h, t + h};
+        for (int s = 0; s < 4; s++) {
+            double c = s == 0 ? 0.0 : s == 3 ? 1.0 : 0.5;
+            y[0] = u + (s ? c * h * k[s - 1][0] : 0.0);
+            y[1] = v + (s ? c * h * k[s - 1][1] : 0.0);
+            k[s][0] = y[1];
+            k[s][1] = -pd_record_acc(rec, tt[s]) - 2.0 * xi * w * y[1] - w * w * y[0];
+        }
+        u += h / 6.0 * (k[0][0] + 2.0 * k[1][0] + 2.0 * k[2][0] + k[3][0]);
+        v += h / 6.0 * (k[0][1] + 2.0 * k[1][1] + 2.0 * k[2][1] + k[3][1]);
+        peak = fmax(peak, fabs(u));
+        /* a turn inside the step (v changes sign): the Hermite's extremum */
+        if (v0 * v < 0.0) {
+            double r = v0 / (v0 - v); /* the turn's fraction, linear in v */
+            double h00 = 2 * r * r * r - 3 * r * r + 1, h10 = r * r * r - 2 * r * r + r;
+            double h01 = -2 * r * r * r + 3 * r * r, h11 = r * r * r - r * r;
+            peak = fmax(peak, fabs(h00 * u0 + h10 * h * v0 + h01 * u + h11 * h * v));
+        }
+    }
+    return w * w * peak;
+}
+
+/* Sa(T) of the exact reference against the integration (1e-6 relative),
+ * at three periods on two records; scaled to a target, the record's PGA
+ * or Sa(T1) is the target. */
+static void test_suite_sa(pd_test_ctx *ctx)
+{
+    const double Ts[3] = {0.3, 1.0, 2.5};
+    double worst = 0.0;
+    for (int r = 0; r < 2; r++) {
+        pd_record rec;
+        pd_record_pulse pulse;
+        pd_err err;
+        if (!CHECK(ctx,
+                   pd_record_synth(pd_synth_shipped(2 * r + 1), "s", &rec, &err) == PD_OK &&
+                       pd_record_fit_pulse(&rec, &pulse, &err) == PD_OK,
+                   "record %d: %s", r, err.msg))
+            return;
+        for (int j = 0; j < 3; j++) {
+            double Sa = NAN;
+            int rc = pd_record_sa(&rec, &pulse, Ts[j], 0.05, &Sa, &err);
+            double ref = sa_rk4(&rec, Ts[j], 0.05);
+            CHECK(ctx, rc == PD_OK, "Sa: %s", err.msg);
+            worst = fmax(worst, fabs(Sa - ref) / ref);
+        }
+        /* to a target: the scaled record's Sa(1 s) is the target (linear) */
+        double scale, Sa1, target = 7.0;
+        int rc = pd_record_scale_to(&rec, &pulse, PD_SCALE_SA, target, 1.0, 0.05, &scale, &err);
+        if (!rc) {
+            for (long i = 0; i < rec.npts; i++)
+                rec.acc[i] *= scale;
+            rc = pd_record_sa(&rec, &pulse, 1.0, 0.05, &Sa1, &err);
+        }
+        CHECK(ctx, rc == PD_OK && fabs(Sa1 - target) <= 1e-12 * target, "Sa target: %.17g (%s)",
+              Sa1, rc ? err.msg : "ok");
+        pd_record_measures m;
+        rc = pd_record_scale_to(&rec, &pulse, PD_SCALE_PGA, 3.0, 0.0, 0.05, &scale, &err);
+        if (!rc)
+            rc = pd_record_measure(&rec, &m, &err);
+        CHECK(ctx, rc == PD_OK && fabs(scale * m.pga - 3.0) <= 1e-12, "PGA target: %.17g",
+              scale * m.pga);
+        pd_record_free(&rec);
+    }
+    CHECK(ctx, worst <= 1e-6, "Sa against RK4: %.3g", worst);
+    printf("      Sa(T) against RK4 at dt/400: %.2g relative (6 cases)\n", worst);
+}
+
+/* The shipped suite: the files are the generator's output (9 digits), the
+ * generator is deterministic and the seed matters. */
+static void test_suite_shipped(pd_test_ctx *ctx)
+{
+    int n = pd_synth_shipped_count(), same = 1;
+    double worst = 0.0;
+    for (int k = 0; k < n; k++) {
+        char path[128];
+        pd_record gen, again, file;
+        pd_err err;
+        snprintf(path, sizeof path, "examples/records/suite/nf%d.txt", k + 1);
+        if (!CHECK(ctx,
+                   pd_record_synth(pd_synth_shipped(k), "g", &gen, &err) == PD_OK &&
+                       pd_record_synth(pd_synth_shipped(k), "g", &again, &err) == PD_OK &&
+                       pd_record_read(path, PD_RECORD_TEXT, PD_UNITS_G, &file, &err) == PD_OK,
+                   "%s: %s", path, err.msg))
+            return;
+        same &= gen.npts == again.npts &&
+                !memcmp(gen.acc, again.acc, (size_t)gen.npts * sizeof(double));
+        CHECK(ctx, file.npts == gen.npts && file.dt == gen.dt, "%s: %ld samples at %g", path,
+              file.npts, file.dt);
+        double amax = 0.0;
+        for (long i = 0; i < gen.npts; i++)
+            amax = fmax(amax, fabs(gen.acc[i]));
+        for (long i = 0; i < gen.npts && i < file.npts; i++)
+            worst = fmax(worst, fabs(file.acc[i] - gen.acc[i]) / amax);
+        pd_record_free(&gen);
+        pd_record_free(&again);
+        pd_record_free(&file);
+    }
+    /* 9 significant digits in g of each sample: within 1e-9 of the peak */
+    CHECK(ctx, same && worst <= 1e-9, "deterministic %d, files within %.3g of the peak", same,
+          worst);
+    pd_synth p = *pd_synth_shipped(0);
+    pd_record a, b;
+    pd_err err;
+    p.seed++;
+    int rc =
+        pd_record_synth(pd_synth_shipped(0), "a", &a, &err) || pd_record_synth(&p, "b", &b, &err);
+    CHECK(ctx, !rc && memcmp(a.acc, b.acc, (size_t)a.npts * sizeof(double)),
+          "another seed, another record");
+    if (!rc) {
+        pd_record_free(&a);
+        pd_record_free(&b);
+    }
+    p.dt = -1.0;
+    CHECK(ctx, pd_record_synth(&p, "c", &a, &err) == PD_EINVAL, "a bad parameter refused");
+}
+
+void suite_suite(pd_test_ctx *ctx)
+{
+    PD_RUN(ctx, test_suite_stats);
+    PD_RUN(ctx, test_suite_file);
+    PD_RUN(ctx, test_suite_sa);
+    PD_RUN(ctx, test_suite_shipped);
+}
