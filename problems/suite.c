@@ -241,6 +241,8 @@ int pd_record_scale_to(const pd_record *rec, const pd_record_pulse *pulse, pd_sc
 {
     if (!rec)
         return PD_NULL_ARG(err, "rec");
+    if (!pulse)
+        return PD_NULL_ARG(err, "pulse");
     if (!scale)
         return PD_NULL_ARG(err, "scale");
     *scale = 1.0;
