@@ -146,7 +146,7 @@ INSTALLED   = $(bindir)/pound $(libdir)/libpound.a $(libdir)/$(SOREAL) $(libdir)
 # make check ends with scripts/api-check.sh (not under the sanitizers)
 API_CHECK  ?= 1
 
-.PHONY: all deps demo test check asan bench mutate format format-check house clean acceptance figures paper figures-docs \
+.PHONY: docs-check all deps demo test check asan bench mutate format format-check house clean acceptance figures paper figures-docs \
         paper-docs stress print-libs \
         shared install uninstall install-check formats-check flags-check python-check
 
@@ -214,6 +214,14 @@ check: all
 	@$(if $(API_CHECK),$(MAKE) --no-print-directory install-check)
 	@$(if $(API_CHECK),$(MAKE) --no-print-directory formats-check)
 	@$(if $(API_CHECK),$(MAKE) --no-print-directory flags-check)
+	@$(if $(API_CHECK),$(MAKE) --no-print-directory docs-check)
+
+# Every pound command of the README's and the docs' code blocks, run as
+# written from a folder that sees only the repository (no ../shared).
+docs-check: all
+	@python3 scripts/docs-commands.py $(BUILD)/pound > $(BUILD)/docs-commands.log || \
+	  { cat $(BUILD)/docs-commands.log; exit 1; }
+	@tail -1 $(BUILD)/docs-commands.log
 
 # Every command's flags (its --help) against the man page, the bash
 # completion and the parser (scripts/flags-check.py; Python's standard library).

@@ -5,6 +5,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "pd_cli.h"
 #include "pd_lcp_dump.h"
@@ -605,6 +606,54 @@ done:
     return status;
 }
 
+/* ==== a progress line ======================================================== */
+
+/* A run longer than PROGRESS_AFTER seconds says how far it has come on
+ * stderr, on one line rewritten in place, when stderr is a terminal. */
+#define PROGRESS_AFTER 2.0
+
+typedef struct progress {
+    double t0;  /* wall clock at the start */
+    int shown;  /* a line is on the terminal */
+    int active; /* stderr is a terminal */
+} progress;
+
+static void progress_start(progress *p)
+{
+    *p = (progress){.t0 = pd_wall_seconds(), .shown = 0, .active = isatty(STDERR_FILENO)};
+}
+
+static void on_progress(double fraction, void *ctx)
+{
+    progress *p = ctx;
+    double elapsed = pd_wall_seconds() - p->t0;
+    if (!p->active || elapsed < PROGRESS_AFTER)
+        return;
+    fprintf(stderr,
+            "\rpound: simulate: %3.0f %% of a run (the scene's, then its contact-free "
+            "twin's), %.0f s ",
+            100.0 * fraction, elapsed);
+    p->shown = 1;
+}
+
+/* A suite's records done so far. */
+static void suite_progress(progress *p, int done, int n)
+{
+    double elapsed = pd_wall_seconds() - p->t0;
+    if (!p->active || elapsed < PROGRESS_AFTER)
+        return;
+    fprintf(stderr, "\rpound: simulate: %d of %d records, %.0f s ", done, n, elapsed);
+    p->shown = 1;
+}
+
+/* The line cleared before the results. */
+static void progress_end(progress *p)
+{
+    if (p->shown)
+        fprintf(stderr, "\r%78s\r", "");
+    p->shown = 0;
+}
+
 /* ==== suites of records ====================================================== */
 
 /* One figure of every record's run: its statistics into js under key. */
@@ -708,17 +757,22 @@ static int suite_oscillator(sim_args *a)
     if (status)
         goto done;
     int rc_first = 0, nt = pd_spec_threads(a->threads);
+    progress pr;
+    int done = 0;
+    progress_start(&pr);
 #pragma omp parallel for schedule(dynamic) num_threads(nt)
     for (int k = 0; k < n; k++) {
         int rc = pd_osc_summarize(&cs[k], &os[k], NULL, NULL, &ss[k], &errs[k]);
-        if (rc) {
 #pragma omp critical
-            if (failed < 0 || k < failed) {
+        {
+            if (rc && (failed < 0 || k < failed)) {
                 failed = k;
                 rc_first = rc;
             }
+            suite_progress(&pr, ++done, n);
         }
     }
+    progress_end(&pr);
     if (failed >= 0) {
         fprintf(stderr, "pound: simulate: %s: %s\n", a->k.suite->path[failed], errs[failed].msg);
         status = rc_first == PD_EINVAL ? 2 : 1;
@@ -1119,7 +1173,13 @@ static int simulate_scene(sim_args *a)
         status = err.status == PD_EINVAL ? 2 : 1;
         goto done;
     }
-    if ((rc = pd_scene_summarize(sc, &o, fo.w || fo.p ? fan_sample : NULL, &fo, &s, &err))) {
+    progress pr;
+    progress_start(&pr);
+    o.progress = on_progress;
+    o.progress_ctx = &pr;
+    rc = pd_scene_summarize(sc, &o, fo.w || fo.p ? fan_sample : NULL, &fo, &s, &err);
+    progress_end(&pr);
+    if (rc) {
         fprintf(stderr, "pound: simulate: %s\n", err.msg);
         status = rc == PD_EINVAL ? 2 : 1;
         goto done;
@@ -1184,20 +1244,25 @@ static int suite_scene(sim_args *a)
             goto done;
         }
     }
+    progress pr;
+    int done = 0;
+    progress_start(&pr);
 #pragma omp parallel for schedule(dynamic) num_threads(nt)
     for (int k = 0; k < n; k++) {
         pd_run_opts o;
         int rc = pd_scene_resolve_opts(scs[k], &a->k.opts, &o, &errs[k]);
         if (!rc)
             rc = pd_scene_summarize(scs[k], &o, NULL, NULL, &ss[k], &errs[k]);
-        if (rc) {
 #pragma omp critical
-            if (failed < 0 || k < failed) {
+        {
+            if (rc && (failed < 0 || k < failed)) {
                 failed = k;
                 rc_first = rc;
             }
+            suite_progress(&pr, ++done, n);
         }
     }
+    progress_end(&pr);
     if (failed >= 0) {
         fprintf(stderr, "pound: simulate: %s: %s\n", a->k.suite->path[failed], errs[failed].msg);
         status = rc_first == PD_EINVAL ? 2 : 1;

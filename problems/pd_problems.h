@@ -207,6 +207,9 @@ typedef struct pd_penalty_setup {
  * refused as bad input rather than left to run for hours. */
 #define PD_MAX_STEPS 2e9
 
+/* How far a run has come: fraction in [0, 1]. */
+typedef void (*pd_progress_fn)(double fraction, void *ctx);
+
 /* The run request of every command and sweep. */
 typedef struct pd_run_opts {
     pd_method method;
@@ -240,6 +243,13 @@ typedef struct pd_run_opts {
                            peak (docs/scheme.md, "Moreau–Jean to a tolerance"; then dt must
                            be 0, the method moreau or auto, which it makes moreau); 0:
                            fixed steps dt */
+    /* Told how far a scene's run has come (fraction of tend in [0, 1]) at
+     * every hundredth of it, by the methods that visit its steps or events
+     * (Moreau-Jean, to a tolerance, the exact row reference); NULL: not
+     * told.  The caller's (a command line's progress line); its return is
+     * ignored. */
+    pd_progress_fn progress;
+    void *progress_ctx;
 } pd_run_opts;
 
 /* The tightest tolerance a run to a tolerance takes (below, rounding rules). */

@@ -65,17 +65,20 @@ typedef struct track {
     int *hJ;                            /* m: Moreau-Jean: the candidate holds */
     double *hG, *hz, *hw, *hD;          /* their LCP: q (MJ_HELD_LCP), z, w, D (^2) */
     pd_lcp_solver *hlcp;
-    unsigned char *sheld; /* nstruct: row reference: a closed contact at an
+    unsigned char *sheld;    /* nstruct: row reference: a closed contact at an
                                            impact */
-    const pd_osc *shape;  /* the excitation's shape: f = F_i / m_i */
-    const double *mass;   /* n: the floors' masses [kg] */
-    double dem_t;         /* its time */
-    int dem_prev;         /* 1: it has rates (an interval can be refined) */
-    int demands;          /* 0: not measured (pd_run_opts.no_demands) */
-    int *st_of;           /* n: the structure of each dof */
-    double *ex, *ev;      /* n: an impact's positions and velocities */
-    double *fpeak;        /* m: largest element force (reference units) */
-    long *impacts;        /* m */
+    const pd_osc *shape;     /* the excitation's shape: f = F_i / m_i */
+    const double *mass;      /* n: the floors' masses [kg] */
+    pd_progress_fn progress; /* told every hundredth of tau_end (NULL: not) */
+    void *progress_ctx;
+    double prog_next, prog_step; /* the next mark and the marks' spacing [tau] */
+    double dem_t;                /* its time */
+    int dem_prev;                /* 1: it has rates (an interval can be refined) */
+    int demands;                 /* 0: not measured (pd_run_opts.no_demands) */
+    int *st_of;                  /* n: the structure of each dof */
+    double *ex, *ev;             /* n: an impact's positions and velocities */
+    double *fpeak;               /* m: largest element force (reference units) */
+    long *impacts;               /* m */
     double *first, *maxP, *ctime, *approach, *episode; /* m */
     double *g_prev, *U_prev, *U_prev2;                 /* m: Moreau–Jean first-impact estimate */
     unsigned char *touching;                           /* m: in an impact episode */
@@ -459,11 +462,21 @@ static void note_demand(track *tr, double t, const double *x, const double *v, c
     tr->dem_prev = 1;
 }
 
+/* The caller told how far the run has come, at each hundredth of it. */
+static void note_progress(track *tr, double t)
+{
+    if (!tr->progress || t < tr->prog_next)
+        return;
+    tr->progress(fmin(1.0, t / (100.0 * tr->prog_step)), tr->progress_ctx);
+    tr->prog_next = (floor(t / tr->prog_step) + 1.0) * tr->prog_step;
+}
+
 /* The row reference's impacts: the demands of the structures involved with
  * the velocities before and after (positions are continuous). */
 static int on_edr_event(const pd_edr_event *e, void *ctx)
 {
     track *tr = ctx;
+    note_progress(tr, e->t);
     double us = tr->Le, vs = tr->Le * tr->wp;
     if (e->kind != PD_EDR_IMPACT)
         return 0;
@@ -728,6 +741,7 @@ static void penalty_held(track *tr, const pd_state *st)
 static int observe_moreau(const pd_state *st, void *ctx)
 {
     track *tr = ctx;
+    note_progress(tr, st->t);
     note_springs(tr, st);
     if (tr->en)
         pd_scene_energy_note(tr->en, st);
@@ -766,6 +780,7 @@ static int observe_moreau(const pd_state *st, void *ctx)
 static int observe_adapt(const pd_state *st, void *ctx)
 {
     track *tr = ctx;
+    note_progress(tr, st->t);
     /* a smooth step: no impact in it, the accelerations at both ends (the
      * start's right limit, kept below, and the end's left one; held
      * contacts' forces included) */
@@ -1500,6 +1515,10 @@ static int run_general(const pd_scene *sc, const pd_run_opts *o, pd_scene_sample
     tr.mass = sm.mass;
     long nsteps = o->rtol > 0.0 ? 0 : pd_steps_for(o->tend, o->dt);
     double tau_end = o->rtol > 0.0 ? tr.wp * o->tend : (double)nsteps * tr.h;
+    tr.progress = o->progress;
+    tr.progress_ctx = o->progress_ctx;
+    tr.prog_step = tau_end / 100.0;
+    tr.prog_next = tr.prog_step;
     switch (o->method) {
     case PD_METHOD_EVENT:
         rc = run_event(&sm, o, tau_end, &tr, res, err);

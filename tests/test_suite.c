@@ -213,10 +213,53 @@ static void test_suite_shipped(pd_test_ctx *ctx)
     CHECK(ctx, pd_record_synth(&p, "c", &a, &err) == PD_EINVAL, "a bad parameter refused");
 }
 
+/* The progress hook: a scene's run by each method that visits its steps
+ * (Moreau-Jean fixed and to a tolerance, the exact row reference) tells
+ * its caller at most 100 times, fractions rising in (0, 1], the last at
+ * least 0.99 (the reference: at its last impact, before the end). */
+typedef struct prog_log {
+    int calls, rising;
+    double last;
+} prog_log;
+
+static void log_progress(double f, void *ctx)
+{
+    prog_log *l = ctx;
+    l->rising &= f > l->last && f <= 1.0;
+    l->last = f;
+    l->calls++;
+}
+
+static void test_suite_progress(pd_test_ctx *ctx)
+{
+    pd_scene_excitation x = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 3.0, .Tp = 0.5};
+    pd_scene *sc = NULL;
+    pd_scene_result r = {0};
+    pd_err err;
+    int rc = pd_scene_chain(6, &x, 1.0, 1.5, 0.05, 0.002, 0.5, &sc, &err) ||
+             pd_scene_result_alloc(sc, &r, &err);
+    for (int m = 0; m < 3 && !rc; m++) {
+        pd_run_opts o = pd_run_default_opts();
+        prog_log l = {.calls = 0, .rising = 1, .last = 0.0};
+        o.method = m == 2 ? PD_METHOD_EVENT : PD_METHOD_MOREAU;
+        o.rtol = m == 1 ? 1e-3 : 0.0;
+        o.progress = log_progress;
+        o.progress_ctx = &l;
+        rc = pd_scene_resolve_opts(sc, &o, &o, &err) || pd_scene_run(sc, &o, NULL, NULL, &r, &err);
+        CHECK(ctx,
+              !rc && l.calls >= 1 && l.calls <= 100 && l.rising && l.last >= (m == 2 ? 0.3 : 0.99),
+              "method %d: %d calls, rising %d, last %g (%s)", m, l.calls, l.rising, l.last,
+              rc ? err.msg : "ok");
+    }
+    pd_scene_result_free(&r);
+    pd_scene_free(sc);
+}
+
 void suite_suite(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_suite_stats);
     PD_RUN(ctx, test_suite_file);
     PD_RUN(ctx, test_suite_sa);
     PD_RUN(ctx, test_suite_shipped);
+    PD_RUN(ctx, test_suite_progress);
 }

@@ -168,6 +168,8 @@ class PdRunOpts(Structure):
         ("contact_duration", c_double),
         ("no_demands", c_int),
         ("rtol", c_double),
+        ("progress", c_void_p),
+        ("progress_ctx", c_void_p),
     ]
 
 
