@@ -1167,7 +1167,9 @@ static int simulate_scene(sim_args *a)
         goto done;
     if ((status = dump_open(a, &dump, &o)))
         goto done;
-    if ((a->out && pd_scene_writer_open(&fo.w, a->out, sc, a->every, &err)) ||
+    if ((a->out && pd_scene_writer_open(
+                       &fo.w, a->out, sc, a->every,
+                       o.method == PD_METHOD_PENALTY || o.method == PD_METHOD_NEWMARK, &err)) ||
         (a->plot && pd_scene_plot_open(&fo.p, sc, expected, &err))) {
         fprintf(stderr, "pound: simulate: %s\n", err.msg);
         status = err.status == PD_EINVAL ? 2 : 1;

@@ -185,6 +185,10 @@ H5_FN(herr_t, H5Aclose, (hid_t attr_id), (attr_id), -1)
 H5_FN(herr_t, H5Tset_cset, (hid_t type_id, H5T_cset_t cset), (type_id, cset), -1)
 H5_FN(htri_t, H5Lexists, (hid_t loc_id, const char *name, hid_t lapl_id), (loc_id, name, lapl_id),
       -1)
+H5_FN(herr_t, H5Lcreate_hard,
+      (hid_t cur_loc, const char *cur_name, hid_t dst_loc, const char *dst_name, hid_t lcpl_id,
+       hid_t lapl_id),
+      (cur_loc, cur_name, dst_loc, dst_name, lcpl_id, lapl_id), -1)
 H5_FN(ssize_t, H5Iget_name, (hid_t id, char *name, size_t size), (id, name, size), -1)
 H5_FN(hid_t, H5Iget_file_id, (hid_t id), (id), -1)
 H5_FN(herr_t, H5Pset_attr_creation_order, (hid_t plist_id, unsigned crt_order_flags),

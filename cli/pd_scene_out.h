@@ -14,9 +14,10 @@ typedef struct pd_scene_run_info {
 
 typedef struct pd_scene_writer pd_scene_writer;
 
-/* Open PATH.tmpPID (HDF5 for .h5/.hdf5, else CSV) for every every-th sample. */
+/* Open PATH.tmpPID (HDF5 for .h5/.hdf5, else CSV) for every every-th sample;
+ * forces: the contacts' element forces too (the penalty methods). */
 int pd_scene_writer_open(pd_scene_writer **w, const char *path, const pd_scene *sc, long every,
-                         pd_err *err);
+                         int forces, pd_err *err);
 /* A pd_scene_sampler (ctx: the writer); asks the run to stop if a write fails. */
 int pd_scene_writer_sample(const pd_scene_sample *s, void *ctx);
 /* Write what is buffered and the results, close, rename into place. */

@@ -7,11 +7,14 @@
  *        attributes of the root; /t [s]; /structures/NAME/{x, v} (rows x
  *        storeys, m and m/s) with the structure and its results as
  *        attributes (a yielding structure also up, m: its storeys' plastic
- *        offsets); /contacts/K/{gap, impulse} (m, N s) with the contact and
- *        its results as attributes.
+ *        offsets), a (rows x storeys, m/s^2: the floors' absolute
+ *        accelerations); /contacts/K/{gap, impulse} (m, N s), force (N: the
+ *        penalty methods' element force) with the contact and its results as
+ *        attributes.
  * CSV:   '#' lines with the provenance, "# units = ..." (one per column), a
  *        header row, one row per sample (t, NAME.x1.., NAME.v1.., cK.gap..,
- *        cK.impulse.., then NAME.up1.. of the yielding structures), '#' lines
+ *        cK.impulse.., then NAME.up1.. of the yielding structures, NAME.a1..,
+ *        then cK.force.. of the penalty methods), '#' lines
  *        with the run and its results at the end.
  * docs/formats.md describes both.
  * Every write is checked; the first failure stops the run and is reported
@@ -36,12 +39,13 @@ struct pd_scene_writer {
     long every, seen, rows;
     double *imp; /* m: impulses since the last recorded row */
     /* rows waiting to be written: t, x (n), v (n), gap (m), impulse (m), then
-     * up (nup: the storeys of the yielding structures) per row */
+     * up (nup: the storeys of the yielding structures), a (n), force (m when
+     * forces) per row */
     long cap, nbuf;
-    double *buf, *col; /* cap rows x width; col: one block of a structure */
-    int width, nup;
+    double *buf, *col;      /* cap rows x width; col: one block of a structure */
+    int width, nup, forces; /* forces: the contacts' element forces are written */
     hid_t file, ds_t;
-    hid_t *ds_x, *ds_v, *ds_g, *ds_p, *ds_up;
+    hid_t *ds_x, *ds_v, *ds_g, *ds_p, *ds_up, *ds_a, *ds_f;
     pd_csv csv;
     pd_provenance prov;
 };
@@ -84,23 +88,31 @@ static int h5_open(pd_scene_writer *w)
     int rc = gs < 0 || gc < 0 || (w->ds_t = pd_h5_extendible_coord(w->file, "t", w->cap, "s")) < 0;
     for (int s = 0; s < sc->nstruct && !rc && !short_of_memory(w); s++) {
         hid_t g = H5Gcreate2(gs, sc->st[s].name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-        rc =
-            g < 0 || pd_h5_index(g, "storey", sc->st[s].storeys, 1, "1") ||
-            (w->ds_x[s] =
-                 pd_h5_extendible(g, "x", H5T_NATIVE_DOUBLE, sc->st[s].storeys, w->cap, "m")) < 0 ||
-            (w->ds_v[s] = pd_h5_extendible(g, "v", H5T_NATIVE_DOUBLE, sc->st[s].storeys, w->cap,
-                                           "m/s")) < 0 ||
-            (yields(sc, s) && (w->ds_up[s] = pd_h5_extendible(g, "up", H5T_NATIVE_DOUBLE,
-                                                              sc->st[s].storeys, w->cap, "m")) < 0);
+        /* t in the group too (a hard link to /t: no copy), so that a reader
+         * of the group alone (xarray's group=) finds its coordinate */
+        rc = g < 0 || H5Lcreate_hard(w->file, "/t", g, "t", H5P_DEFAULT, H5P_DEFAULT) < 0 ||
+             pd_h5_index(g, "storey", sc->st[s].storeys, 1, "1") ||
+             (w->ds_x[s] = pd_h5_extendible(g, "x", H5T_NATIVE_DOUBLE, sc->st[s].storeys, w->cap,
+                                            "m")) < 0 ||
+             (w->ds_v[s] = pd_h5_extendible(g, "v", H5T_NATIVE_DOUBLE, sc->st[s].storeys, w->cap,
+                                            "m/s")) < 0 ||
+             (yields(sc, s) &&
+              (w->ds_up[s] = pd_h5_extendible(g, "up", H5T_NATIVE_DOUBLE, sc->st[s].storeys, w->cap,
+                                              "m")) < 0) ||
+             (w->ds_a[s] = pd_h5_extendible(g, "a", H5T_NATIVE_DOUBLE, sc->st[s].storeys, w->cap,
+                                            "m/s^2")) < 0;
         if (g >= 0 && H5Gclose(g) < 0)
             rc = 1;
     }
     for (int a = 0; a < sc->ncontact && !rc && !short_of_memory(w); a++) {
         snprintf(name, sizeof name, "%d", a);
         hid_t g = H5Gcreate2(gc, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-        rc = g < 0 ||
+        rc = g < 0 || H5Lcreate_hard(w->file, "/t", g, "t", H5P_DEFAULT, H5P_DEFAULT) < 0 ||
              (w->ds_g[a] = pd_h5_extendible(g, "gap", H5T_NATIVE_DOUBLE, 0, w->cap, "m")) < 0 ||
-             (w->ds_p[a] = pd_h5_extendible(g, "impulse", H5T_NATIVE_DOUBLE, 0, w->cap, "N s")) < 0;
+             (w->ds_p[a] = pd_h5_extendible(g, "impulse", H5T_NATIVE_DOUBLE, 0, w->cap, "N s")) <
+                 0 ||
+             (w->forces &&
+              (w->ds_f[a] = pd_h5_extendible(g, "force", H5T_NATIVE_DOUBLE, 0, w->cap, "N")) < 0);
         if (g >= 0 && H5Gclose(g) < 0)
             rc = 1;
     }
@@ -111,9 +123,11 @@ static int h5_open(pd_scene_writer *w)
      * A new dataset is attached here too. */
     for (int s = 0; s < sc->nstruct && !rc && !short_of_memory(w); s++)
         rc = pd_h5_dims(w->ds_x[s], "t,storey") || pd_h5_dims(w->ds_v[s], "t,storey") ||
-             (yields(sc, s) && pd_h5_dims(w->ds_up[s], "t,storey"));
+             (yields(sc, s) && pd_h5_dims(w->ds_up[s], "t,storey")) ||
+             pd_h5_dims(w->ds_a[s], "t,storey");
     for (int a = 0; a < sc->ncontact && !rc && !short_of_memory(w); a++)
-        rc = pd_h5_dims(w->ds_g[a], "t") || pd_h5_dims(w->ds_p[a], "t");
+        rc = pd_h5_dims(w->ds_g[a], "t") || pd_h5_dims(w->ds_p[a], "t") ||
+             (w->forces && pd_h5_dims(w->ds_f[a], "t"));
     if (gs >= 0 && H5Gclose(gs) < 0)
         rc = 1;
     if (gc >= 0 && H5Gclose(gc) < 0)
@@ -137,6 +151,10 @@ static int csv_open(pd_scene_writer *w)
             pd_csv_printf(&w->csv, ",%s", part ? "N s" : "m");
     for (int k = 0; k < w->nup; k++)
         pd_csv_printf(&w->csv, ",m");
+    for (int k = 0; k < sc->n; k++)
+        pd_csv_printf(&w->csv, ",m/s^2");
+    for (int a = 0; w->forces && a < sc->ncontact; a++)
+        pd_csv_printf(&w->csv, ",N");
     pd_csv_printf(&w->csv, "\nt");
     for (int s = 0; s < sc->nstruct; s++)
         for (int k = 1; k <= sc->st[s].storeys; k++)
@@ -151,6 +169,11 @@ static int csv_open(pd_scene_writer *w)
     for (int s = 0; s < sc->nstruct; s++) /* the yielding structures' offsets */
         for (int k = 1; yields(sc, s) && k <= sc->st[s].storeys; k++)
             pd_csv_printf(&w->csv, ",%s.up%d", sc->st[s].name, k);
+    for (int s = 0; s < sc->nstruct; s++) /* the floors' absolute accelerations */
+        for (int k = 1; k <= sc->st[s].storeys; k++)
+            pd_csv_printf(&w->csv, ",%s.a%d", sc->st[s].name, k);
+    for (int a = 0; w->forces && a < sc->ncontact; a++)
+        pd_csv_printf(&w->csv, ",c%d.force", a);
     pd_csv_printf(&w->csv, "\n");
     return w->csv.failure;
 }
@@ -158,11 +181,11 @@ static int csv_open(pd_scene_writer *w)
 /* Close every dataset id (those not open are -1): 0, or -1 when one failed. */
 static int close_datasets(pd_scene_writer *w)
 {
-    hid_t *sets[] = {w->ds_x, w->ds_v, w->ds_up, w->ds_g, w->ds_p};
-    int counts[] = {w->sc->nstruct, w->sc->nstruct, w->sc->nstruct, w->sc->ncontact,
-                    w->sc->ncontact},
+    hid_t *sets[] = {w->ds_x, w->ds_v, w->ds_up, w->ds_a, w->ds_g, w->ds_p, w->ds_f};
+    int counts[] = {w->sc->nstruct,  w->sc->nstruct,  w->sc->nstruct, w->sc->nstruct,
+                    w->sc->ncontact, w->sc->ncontact, w->sc->ncontact},
         rc = 0;
-    for (int k = 0; k < 5; k++)
+    for (int k = 0; k < 7; k++)
         for (int i = 0; sets[k] && i < counts[k]; i++)
             rc |= pd_h5_close_id(&sets[k][i]);
     rc |= pd_h5_close_id(&w->ds_t);
@@ -184,8 +207,10 @@ void pd_scene_writer_free(pd_scene_writer *w)
     free(w->ds_x);
     free(w->ds_v);
     free(w->ds_up);
+    free(w->ds_a);
     free(w->ds_g);
     free(w->ds_p);
+    free(w->ds_f);
     free(w);
 }
 
@@ -196,13 +221,16 @@ static int ids_init(pd_scene_writer *w, int m)
     w->ds_x = malloc((size_t)sc->nstruct * sizeof(hid_t));
     w->ds_v = malloc((size_t)sc->nstruct * sizeof(hid_t));
     w->ds_up = malloc((size_t)sc->nstruct * sizeof(hid_t));
+    w->ds_a = malloc((size_t)sc->nstruct * sizeof(hid_t));
     w->ds_g = malloc((size_t)m * sizeof(hid_t));
     w->ds_p = malloc((size_t)m * sizeof(hid_t));
-    for (int s = 0; w->ds_x && w->ds_v && w->ds_up && s < sc->nstruct; s++)
-        w->ds_x[s] = w->ds_v[s] = w->ds_up[s] = -1;
-    for (int a = 0; w->ds_g && w->ds_p && a < m; a++)
-        w->ds_g[a] = w->ds_p[a] = -1;
-    return w->ds_x && w->ds_v && w->ds_up && w->ds_g && w->ds_p ? 0 : -1;
+    w->ds_f = malloc((size_t)m * sizeof(hid_t));
+    int ok = w->ds_x && w->ds_v && w->ds_up && w->ds_a && w->ds_g && w->ds_p && w->ds_f;
+    for (int s = 0; ok && s < sc->nstruct; s++)
+        w->ds_x[s] = w->ds_v[s] = w->ds_up[s] = w->ds_a[s] = -1;
+    for (int a = 0; ok && a < m; a++)
+        w->ds_g[a] = w->ds_p[a] = w->ds_f[a] = -1;
+    return ok ? 0 : -1;
 }
 
 /* The HDF5 layout keeps two datasets open per structure and per contact,
@@ -211,7 +239,7 @@ static int ids_init(pd_scene_writer *w, int m)
 #define SCENE_H5_GROUPS_MAX 5000
 
 int pd_scene_writer_open(pd_scene_writer **out, const char *path, const pd_scene *sc, long every,
-                         pd_err *err)
+                         int forces, pd_err *err)
 {
     pd_scene_writer *w;
     int smax = 1, m = sc->ncontact > 0 ? sc->ncontact : 1, rc, e;
@@ -229,10 +257,11 @@ int pd_scene_writer_open(pd_scene_writer **out, const char *path, const pd_scene
     w->file = w->ds_t = -1;
     w->out.slot = -1;
     w->hdf5 = hdf5;
+    w->forces = forces && sc->ncontact > 0;
     pd_provenance_now(&w->prov, PD_FORMAT_SCENE);
     for (int s = 0; s < sc->nstruct; s++)
         w->nup += yields(sc, s) ? sc->st[s].storeys : 0;
-    w->width = 1 + 2 * sc->n + 2 * sc->ncontact + w->nup;
+    w->width = 1 + 3 * sc->n + 2 * sc->ncontact + w->nup + (w->forces ? sc->ncontact : 0);
     w->cap = OUT_BUFFER_DOUBLES / w->width;
     w->cap = w->cap < 16 ? 16 : w->cap > 4096 ? 4096 : w->cap;
     for (int s = 0; s < sc->nstruct; s++)
@@ -300,6 +329,18 @@ static int flush_rows(pd_scene_writer *w)
             rc = pd_h5_append(w->ds_up[s], H5T_NATIVE_DOUBLE, w->rows - nb, nb, st, w->col);
             off += st;
         }
+        for (int s = 0; s < sc->nstruct && !rc; s++) { /* the floors' accelerations */
+            int st = sc->st[s].storeys, off = 1 + 2 * n + 2 * m + w->nup + sc->st[s].dof;
+            for (long r = 0; r < nb; r++)
+                memcpy(w->col + (size_t)r * st, w->buf + (size_t)r * w->width + off,
+                       (size_t)st * sizeof(double));
+            rc = pd_h5_append(w->ds_a[s], H5T_NATIVE_DOUBLE, w->rows - nb, nb, st, w->col);
+        }
+        for (int a = 0; w->forces && a < m && !rc; a++) {
+            for (long r = 0; r < nb; r++)
+                w->col[r] = w->buf[(size_t)r * w->width + 1 + 3 * n + 2 * m + w->nup + a];
+            rc = pd_h5_append(w->ds_f[a], H5T_NATIVE_DOUBLE, w->rows - nb, nb, 0, w->col);
+        }
     }
     w->nbuf = 0;
     if (rc && !w->failure)
@@ -329,6 +370,10 @@ int pd_scene_writer_sample(const pd_scene_sample *s, void *ctx)
     for (int st = 0; st < sc->nstruct; st++) /* the yielding structures' storeys */
         for (int k = 0; yields(sc, st) && k < sc->st[st].storeys; k++)
             *up++ = s->up ? s->up[sc->st[st].dof + k] : 0.0;
+    for (int i = 0; i < n; i++) /* the floors' absolute accelerations (NAN: not measured) */
+        *up++ = s->a_abs ? s->a_abs[i] : NAN;
+    for (int a = 0; w->forces && a < m; a++) /* the elements' forces */
+        *up++ = s->force ? s->force[a] : 0.0;
     w->nbuf++;
     w->rows++;
     if (w->nbuf == w->cap && flush_rows(w))
@@ -491,7 +536,13 @@ static int put_contact(pd_scene_writer *w, const pd_scene_summary *sum, int a)
         if ((g = H5Gopen2(w->file, path, H5P_DEFAULT)) < 0)
             return -1;
     }
-    rc = put_text(w, g, prefix, "a", ct->a == PD_WALL ? "wall" : sc->st[ct->a].name) ||
+    /* its name, as Python's coordinates give it: the sides and the level */
+    char name[2 * PD_NAME_MAX + 32];
+    snprintf(name, sizeof name, "%s-%s@%d", ct->a == PD_WALL ? "wall" : sc->st[ct->a].name,
+             ct->b == PD_WALL ? "wall" : sc->st[ct->b].name,
+             ct->a == PD_WALL ? ct->level_b : ct->level_a);
+    rc = put_text(w, g, prefix, "name", name) ||
+         put_text(w, g, prefix, "a", ct->a == PD_WALL ? "wall" : sc->st[ct->a].name) ||
          put_text(w, g, prefix, "b", ct->b == PD_WALL ? "wall" : sc->st[ct->b].name) ||
          put_num(w, g, prefix, "level_a", ct->level_a, "1") ||
          put_num(w, g, prefix, "level_b", ct->level_b, "1") ||

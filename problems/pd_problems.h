@@ -749,6 +749,12 @@ typedef struct pd_scene_sample {
                               to pd_scene_result.impacts) */
     const double *up;      /* n: each storey's plastic offset up at t [m] (0 for an
                               elastic storey); NULL when no storey of the scene yields */
+    const double *a_abs;   /* n: each floor's absolute acceleration [m/s^2] as the demands
+                              measure it (the held contacts' forces in it, an impact's
+                              impulse not: at a sample that ends an impact step, the finite
+                              part); NULL when the demands are not measured */
+    const double *force;   /* m: each contact element's force at t [N] (penalty, newmark);
+                              NULL for the rigid methods, whose history is the impulse */
 } pd_scene_sample;
 
 typedef int (*pd_scene_sampler)(const pd_scene_sample *s, void *ctx);

@@ -115,6 +115,7 @@ typedef struct track {
                                the springs' forces (the demands' state) */
     const double *xdem;     /* the demands' displacements of the report (q, or xeff) */
     double *sup;            /* n: the storeys' offsets at a sample [m] (0: elastic) */
+    double *sF;             /* m: the contact elements' forces at a sample [N] */
     pd_scene_energy *en;    /* a yielding scene by Moreau-Jean: its energy balance */
     long *onsets;           /* ns: a report that slid after one that did not */
     unsigned char *slid;    /* ns: the last report slid */
@@ -225,7 +226,7 @@ static void track_free(track *tr)
         tr->sI,        tr->sampled, tr->errx,     tr->errd,  tr->erra,     tr->errv,    tr->acc0,
         tr->shear0,    tr->serr,    tr->wdof,     tr->hacc,  tr->qh,       tr->hlam,    tr->hsm,
         tr->hJ,        tr->hG,      tr->hz,       tr->hw,    tr->hD,       tr->sheld,   tr->up,
-        tr->excursion, tr->onsets,  tr->slid,     tr->xeff,  tr->sup};
+        tr->excursion, tr->onsets,  tr->slid,     tr->xeff,  tr->sup,      tr->sF};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(arrays[k]);
     pd_lcp_solver_free(tr->hlcp);
@@ -255,7 +256,7 @@ static int track_alloc(track *tr, const pd_scene *sc, pd_err *err)
         !TA(tr->hacc, n) || !TA(tr->qh, n) || !TA(tr->hlam, m) || !TA(tr->hsm, n) ||
         !TA(tr->hJ, m) || !TA(tr->hG, MJ_HELD_LCP) || !TA(tr->hz, MJ_HELD_LCP) ||
         !TA(tr->hw, MJ_HELD_LCP) || !TA(tr->hD, MJ_HELD_LCP * MJ_HELD_LCP) ||
-        !TA(tr->sheld, sc->nstruct)) {
+        !TA(tr->sheld, sc->nstruct) || !TA(tr->sF, m)) {
 #undef TA
         track_free(tr);
         return pd_err_set(err, PD_ENOMEM, "out of memory for tracking %d dofs", sc->n);
@@ -632,6 +633,9 @@ static int sample(track *tr, const pd_state *st)
     }
     for (int j = 0; j < tr->ns; j++) /* the storeys' offsets, in metres */
         tr->sup[tr->spring_dof[j]] = st->up ? st->up[j] * tr->Le : 0.0;
+    int penalty = tr->method == PD_METHOD_PENALTY || tr->method == PD_METHOD_NEWMARK;
+    for (int a = 0; penalty && a < tr->m; a++) /* the elements' forces [N]: ap kg a unit */
+        tr->sF[a] = tr->imp_lam[a] * tr->sc->exc.ap;
     pd_scene_sample s = {.step = st->step,
                          .t = st->t / tr->wp,
                          .x = tr->sx,
@@ -639,7 +643,9 @@ static int sample(track *tr, const pd_state *st)
                          .gap = tr->sg,
                          .impulse = tr->sP,
                          .impacts = tr->sI,
-                         .up = tr->ns > 0 ? tr->sup : NULL};
+                         .up = tr->ns > 0 ? tr->sup : NULL,
+                         .a_abs = tr->demands ? tr->da : NULL,
+                         .force = penalty ? tr->sF : NULL};
     int stop = tr->fn(&s, tr->ctx);
     tr->sample_s += pd_wall_seconds() - t0;
     return stop;

@@ -4,7 +4,8 @@
 # by every method, rows, the references) by the pound of BASE_REV, built in
 # a worktree of its own, and by build/pound, their outputs compared byte for
 # byte (the lines giving the version, the command, the date or the CPU time left out,
-# and the attributes added since the base: each contact's separation).
+# and the attributes added since the base: each contact's separation; and the
+# columns added since: the floors' accelerations, the elements' forces).
 #
 #   sh scripts/same-results.sh [BASE_REV]    (default: the refactors' base)
 set -u
@@ -34,9 +35,29 @@ run() { # name, then pound's arguments; the output file is OUT
         # (and the attributes added since: each contact's separation)
         grep -v -e '^# command' -e '^# pound_version' -e '^# created' -e '^# cpu_s' -e '^# wall_s' \
             -e '^# c[0-9]*\.required_gap' -e '^# c[0-9]*\.gap_abs' -e '^# c[0-9]*\.gap_srss' \
-            -e '^# c[0-9]*\.gap_ddc' "$out" > "$out.cmp" 2>/dev/null
+            -e '^# c[0-9]*\.gap_ddc' -e '^# c[0-9]*\.name' "$out" > "$out.cmp" 2>/dev/null
     done
     n=$((n + 1))
+    # the columns added since the base (the floors' accelerations, the elements'
+    # forces) left out: the new file projected on the base's header
+    python3 - "$work/old-$name.csv.cmp" "$work/new-$name.csv.cmp" <<'PY'
+import sys
+old, new = (open(p).read().split("\n") for p in sys.argv[1:3])
+hdr = lambda ls: next((k for k, l in enumerate(ls) if l and not l.startswith("#")), None)
+ho, hn = hdr(old), hdr(new)
+if ho is not None and hn is not None and old[ho] != new[hn]:
+    cols = new[hn].split(",")
+    keep = [cols.index(c) for c in old[ho].split(",") if c in cols]
+    units = lambda l: ",".join(l[len("# units = "):].split(",")[k] for k in keep)
+    out = []
+    for k, l in enumerate(new):
+        if l.startswith("# units = "):
+            l = "# units = " + units(l)
+        elif k >= hn and l and not l.startswith("#"):
+            l = ",".join(l.split(",")[j] for j in keep)
+        out.append(l)
+    open(sys.argv[2], "w").write("\n".join(out))
+PY
     if ! cmp -s "$work/old-$name.csv.cmp" "$work/new-$name.csv.cmp"; then
         echo "same-results: $name differs"
         fail=1

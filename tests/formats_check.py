@@ -127,7 +127,8 @@ def parse_doc(path):
                          "dims": tuple(d.strip() for d in unquote(c.get("dims", "()")).strip("()").split(",") if d.strip()),
                          "dtype": c["dtype"], "units": c["units"],
                          "valueless": "without values" in c.get("contents", ""),
-                         "yielding": YIELDING.match(c.get("contents", "")) is not None})
+                         "yielding": YIELDING.match(c.get("contents", "")) is not None,
+                         "penalty": PENALTY.match(c.get("contents", "")) is not None})
             elif head[0].startswith("root attribute") or head[0].startswith("attribute of"):
                 m = re.match(r"attribute of `([^`]+)`", head[0])
                 obj = m.group(1) if m else "/"
@@ -145,6 +146,7 @@ def parse_doc(path):
 # a row the page marks "a yielding oscillator's only", "a yielding sweep's only" or
 # "a yielding structure's only"
 YIELDING = re.compile(r"a yielding (oscillator|sweep|structure)'s only")
+PENALTY = re.compile(r"penalty and newmark only")
 
 
 def pattern(name):
@@ -238,7 +240,7 @@ def check_attrs(where, obj, documented, extra=()):
 
 
 def check_h5(ctx, path, fmt, command, env, reproducible=False, root_qualifier=None, units_all=None,
-             yielding=False):
+             yielding=False, penalty=False):
     """An HDF5 file against the page: provenance, datasets (shape from env,
     which may be a function of the path), attributes (a yielding run's
     rows too when yielding, else none of them).  The open file."""
@@ -258,8 +260,17 @@ def check_h5(ctx, path, fmt, command, env, reproducible=False, root_qualifier=No
         root.update(spec["attrs"].get("/:yielding", {}))
     check_attrs(where + " /", f, {**root, **prov})
     found, shapes = [], {}
-    f.visititems(lambda n, o: found.append(n) if isinstance(o, h5py.Dataset) else None)
-    datasets = [d for d in spec["datasets"] if yielding or not d["yielding"]]
+
+    def walk(g, prefix):  # every link's name (visititems names a hard-linked dataset once)
+        for k in g:
+            o = g[k]
+            if isinstance(o, h5py.Dataset):
+                found.append(prefix + k)
+            elif isinstance(o, h5py.Group):
+                walk(o, prefix + k + "/")
+    walk(f, "")
+    datasets = [d for d in spec["datasets"] if (yielding or not d["yielding"]) and
+                (penalty or not d.get("penalty"))]
     for d in datasets:
         check(any(pattern(d["name"]).match(n) for n in found), f"{where}: no dataset {d['name']}")
     for n in found:
@@ -472,12 +483,13 @@ def scene(ctx):
             f.close()
             lcp_dump(ctx, os.path.join(ctx.tmp, "dump.h5"), command_of(args), j["lcp_solves"], "scene")
         else:
-            unit = {p: doc_units(ctx, fmt, p) for p in ("t", "structures/A/x", "structures/A/v", "contacts/0/gap", "contacts/0/impulse")}
+            unit = {p: doc_units(ctx, fmt, p) for p in ("t", "structures/A/x", "structures/A/v", "structures/A/a", "contacts/0/gap", "contacts/0/impulse")}
             cols = [("t", unit["t"])]
             for part, key in (("x", "structures/A/x"), ("v", "structures/A/v")):
                 cols += [(f"{s['name']}.{part}{i}", unit[key]) for s in j["structures"] for i in range(1, s["storeys"] + 1)]
             for part, key in (("gap", "contacts/0/gap"), ("impulse", "contacts/0/impulse")):
                 cols += [(f"c{k}.{part}", unit[key]) for k in range(len(j["contacts"]))]
+            cols += [(f"{s['name']}.a{i}", unit["structures/A/a"]) for s in j["structures"] for i in range(1, s["storeys"] + 1)]
             header, rows, _, tail = check_csv(ctx, path, fmt, command_of(args), cols, n)
             check(close(float(tail.get("steps", "nan").split(" [")[0]), j["steps"]), f"{out}: # steps after the rows")
             s0 = j["structures"][1]
@@ -486,6 +498,22 @@ def scene(ctx):
             check(close(float(got.split("]")[0].strip("[")), s0["umax"][0]) and got.endswith("] [m]"),
                   f"{out}: # {s0['name']}.umax = {got!r}, want {want}")
             check(tail.get("c0.a") == j["contacts"][0]["a"], f"{out}: # c0.a")
+    # the penalty methods: each contact's element force too, its peak force_max
+    args = ["simulate", "--scene", "two sdof's.json", "--tend", "2", "--method", "newmark", "-o",
+            "pscene.h5", "--json"]
+    j = json.loads(run(ctx.pound, args, ctx.tmp))
+    storeys = {s["name"]: s["storeys"] for s in j["structures"]}
+    with h5py.File(os.path.join(ctx.tmp, "pscene.h5"), "r") as g:
+        n = len(g["t"])
+    env = lambda p: {"N": n, "storeys": storeys.get(p.split("/")[1], -1) if p.startswith("structures/") else -1}
+    f = check_h5(ctx, os.path.join(ctx.tmp, "pscene.h5"), fmt, command_of(args), env, penalty=True)
+    for k, c in enumerate(j["contacts"]):
+        check(close(f["contacts"][str(k)]["force"][:].max(), c["force_max"]), f"pscene.h5: contact {k}: max force != force_max")
+    for s in j["structures"]:
+        a = np.abs(f["structures"][s["name"]]["a"][:]).max(axis=0)
+        check(all(b <= m * (1 + 1e-12) and b >= 0.99 * m for b, m in zip(a, s["acc_max"])),
+              f"pscene.h5: {s['name']}: max |a| {a} against acc_max {s['acc_max']}")
+    f.close()
 
 
 def lcp_dump(ctx, path, command, solves, model):
@@ -666,8 +694,8 @@ def yielding(ctx):
             f.close()
         else:
             unit = {p: doc_units(ctx, fmt, p) for p in ("t", "structures/A/x", "structures/A/v",
-                                                        "structures/A/up", "contacts/0/gap",
-                                                        "contacts/0/impulse")}
+                                                        "structures/A/up", "structures/A/a",
+                                                        "contacts/0/gap", "contacts/0/impulse")}
             cols = [("t", unit["t"])]
             for part in ("x", "v"):
                 cols += [(f"{s}.{part}{i}", unit["structures/A/" + part]) for s in st
@@ -675,6 +703,7 @@ def yielding(ctx):
             for part in ("gap", "impulse"):
                 cols += [(f"c{k}.{part}", unit["contacts/0/" + part]) for k in range(len(j["contacts"]))]
             cols += [(f"{s}.up{i}", unit["structures/A/up"]) for s in st for i in range(1, st[s]["storeys"] + 1)]
+            cols += [(f"{s}.a{i}", unit["structures/A/a"]) for s in st for i in range(1, st[s]["storeys"] + 1)]
             header, rows, _, _ = check_csv(ctx, path, fmt, command_of(args), cols, n)
             for name, s in st.items():  # the last row's offsets give the residuals
                 res = [(1 - a) * column(header, rows, f"{name}.up{i + 1}")[-1] for i, a in enumerate(s["yield_alpha"])]

@@ -1042,8 +1042,9 @@ static void test_scene_cli_outputs(pd_test_ctx *ctx)
           "CSV header");
     CHECK(ctx, rows == 402, "CSV has %ld lines after the attributes (the header, 401 rows)", rows);
     free(text);
-    /* several contacts: every gap, then every impulse, as the header says
-     * (the first row: gaps 0.01 m, impulses 0) */
+    /* several contacts: every gap, then every impulse, then each floor's
+     * absolute acceleration, as the header says (the first row: gaps 0.01 m,
+     * impulses 0, a_abs 0 from rest) */
     const char *a3[] = {"simulate", "--chain", "3",    "--gap", "0.01", "--dt",
                         "1e-3",     "--tend",  "0.01", "-o",    csv,    NULL};
     pd_test_pound(ctx, a3, &r);
@@ -1052,19 +1053,20 @@ static void test_scene_cli_outputs(pd_test_ctx *ctx)
     text = pd_test_slurp(csv);
     const char *hdr = text ? strstr(text, "\nt,") : NULL,
                *row0 = hdr ? strchr(hdr + 1, '\n') : NULL;
-    double vals[16];
+    double vals[20];
     int nv = 0;
     char line[1024] = "";
     if (row0)
         sscanf(row0 + 1, "%1023[^\n]", line);
-    for (char *tok = strtok(line, ","); tok && nv < 16; tok = strtok(NULL, ","))
+    for (char *tok = strtok(line, ","); tok && nv < 20; tok = strtok(NULL, ","))
         vals[nv++] = strtod(tok, NULL);
     CHECK(ctx,
           hdr && strstr(hdr, "c0.gap,c1.gap,c2.gap,c3.gap,c0.impulse,c1.impulse,c2.impulse,"
-                             "c3.impulse\n"),
+                             "c3.impulse,S1.a1,S2.a1,S3.a1\n"),
           "CSV header of four contacts");
     CHECK(ctx,
-          nv == 15 && vals[7] == 0.01 && vals[10] == 0.01 && vals[11] == 0.0 && vals[14] == 0.0,
+          nv == 18 && vals[7] == 0.01 && vals[10] == 0.01 && vals[11] == 0.0 && vals[14] == 0.0 &&
+              vals[15] == 0.0 && vals[17] == 0.0,
           "first row: %d values, gaps %g %g, impulses %g %g", nv, nv > 10 ? vals[7] : NAN,
           nv > 10 ? vals[10] : NAN, nv > 14 ? vals[11] : NAN, nv > 14 ? vals[14] : NAN);
     free(text);

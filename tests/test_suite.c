@@ -255,6 +255,54 @@ static void test_suite_progress(pd_test_ctx *ctx)
     pd_scene_free(sc);
 }
 
+/* The histories' absolute accelerations and contact forces: their peaks
+ * are the run's acc_max (Moreau-Jean: both read at every step, held
+ * contacts' forces in them: equal) and force_max (newmark: the elements'
+ * forces at every step: equal); a rigid method writes no force. */
+typedef struct hist_peaks {
+    double a[8], f[8];
+    int forces, accs;
+} hist_peaks;
+
+static int peak_sampler(const pd_scene_sample *smp, void *ctx)
+{
+    hist_peaks *h = ctx;
+    h->accs |= smp->a_abs != NULL;
+    h->forces |= smp->force != NULL;
+    for (int i = 0; smp->a_abs && i < 3; i++)
+        h->a[i] = fmax(h->a[i], fabs(smp->a_abs[i]));
+    for (int c = 0; smp->force && c < 4; c++)
+        h->f[c] = fmax(h->f[c], smp->force[c]);
+    return 0;
+}
+
+static void test_suite_histories(pd_test_ctx *ctx)
+{
+    pd_scene_excitation x = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 3.0, .Tp = 0.5};
+    pd_scene *sc = NULL;
+    pd_scene_result r = {0};
+    pd_err err;
+    int rc = pd_scene_chain(3, &x, 1.0, 1.5, 0.05, 0.002, 0.5, &sc, &err) ||
+             pd_scene_result_alloc(sc, &r, &err);
+    for (int m = 0; m < 2 && !rc; m++) {
+        pd_run_opts o = pd_run_default_opts();
+        hist_peaks h = {{0}, {0}, 0, 0};
+        o.method = m ? PD_METHOD_NEWMARK : PD_METHOD_MOREAU;
+        rc = pd_scene_resolve_opts(sc, &o, &o, &err) ||
+             pd_scene_run(sc, &o, peak_sampler, &h, &r, &err);
+        double ea = 0.0, ef = 0.0;
+        for (int i = 0; !rc && i < 3; i++)
+            ea = fmax(ea, fabs(h.a[i] - r.acc_max[i]) / r.acc_max[i]);
+        for (int c = 0; !rc && m && c < 4; c++)
+            ef = fmax(ef, fabs(h.f[c] - r.force_max[c]) / fmax(r.force_max[c], 1e-300));
+        CHECK(ctx, !rc && h.accs && h.forces == m && ea <= (m ? 1e-6 : 0.0) && ef == 0.0,
+              "%s: a_abs %d (peaks %.3g from acc_max), forces %d (%.3g from force_max): %s",
+              m ? "newmark" : "moreau", h.accs, ea, h.forces, ef, rc ? err.msg : "ok");
+    }
+    pd_scene_result_free(&r);
+    pd_scene_free(sc);
+}
+
 void suite_suite(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_suite_stats);
@@ -262,4 +310,5 @@ void suite_suite(pd_test_ctx *ctx)
     PD_RUN(ctx, test_suite_sa);
     PD_RUN(ctx, test_suite_shipped);
     PD_RUN(ctx, test_suite_progress);
+    PD_RUN(ctx, test_suite_histories);
 }

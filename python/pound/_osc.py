@@ -17,6 +17,23 @@ if TYPE_CHECKING:
 NAN = float("nan")
 
 
+# CF units of the histories' variables (the CLI's files give the same)
+UNITS = {"u": "m", "v": "m/s", "x": "m", "gap": "m", "impulse": "N s", "a": "m/s^2",
+         "force": "N", "up": "m"}
+
+
+def _column_name(k, j, dofs, contacts):
+    """Column j of a scene history's array k as the CLI's CSV names it
+    (NAME.xK, cJ.gap, ...: dofs NAME.K, contacts by index); k[j] without
+    the scene's names."""
+    if dofs is not None and k in ("x", "v", "a", "up") and j < len(dofs):
+        name, storey = dofs[j].rsplit(".", 1)
+        return "%s.%s%s" % (name, k, storey)
+    if contacts is not None and k in ("gap", "impulse", "force") and j < len(contacts):
+        return "c%d.%s" % (j, k)
+    return "%s[%d]" % (k, j)
+
+
 class Result(dict):
     """A dict whose keys are also attributes (r.umax is r['umax']), with a
     short repr and, when pandas or xarray is installed, to_pandas() and
@@ -66,12 +83,13 @@ class Result(dict):
         naming them (not pandas' 'All arrays must be of the same length')."""
         h = self["history"] if "history" in self else self
         cols = {}
+        dofs, contacts = h.get("dof"), h.get("contact")
         for k, v in h.items():
             if isinstance(v, np.ndarray) and v.ndim == 1:
                 cols[k] = v
             elif isinstance(v, np.ndarray) and v.ndim == 2:
                 for j in range(v.shape[1]):
-                    cols["%s[%d]" % (k, j)] = v[:, j]
+                    cols[_column_name(k, j, dofs, contacts)] = v[:, j]
         lengths = {}
         for k, v in cols.items():
             lengths.setdefault(len(v), k)
@@ -119,14 +137,18 @@ class Result(dict):
         h = self["history"] if "history" in self else self
         if "t" not in h:
             raise ValueError("to_xarray: no history (run with history=True)")
-        data = {}
+        data, coords = {}, {"t": ("t", h["t"], {"units": "s", "long_name": "time"})}
         for k, v in h.items():
             if k == "t" or not isinstance(v, np.ndarray):
                 continue
-            second = {"x": "dof", "v": "dof", "gap": "contact", "impulse": "contact"}.get(
-                k, k + "_index")
-            data[k] = (("t",) if v.ndim == 1 else ("t", second)), v
-        return xr.Dataset(data, coords={"t": h["t"]}, attrs=self._scalars())
+            second = {"x": "dof", "v": "dof", "a": "dof", "up": "dof", "gap": "contact",
+                      "impulse": "contact", "force": "contact"}.get(k, k + "_index")
+            attrs = {"units": UNITS[k]} if k in UNITS else {}
+            data[k] = (("t",) if v.ndim == 1 else ("t", second)), v, attrs
+        for dim in ("dof", "contact"):  # a scene's names of its dofs and contacts
+            if dim in h and len(h[dim]):
+                coords[dim] = (dim, list(h[dim]))
+        return xr.Dataset(data, coords=coords, attrs=self._scalars())
 
     def _spectrum_xarray(self, xr):
         curves = self["curves"]

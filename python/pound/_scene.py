@@ -212,20 +212,32 @@ class Scene:
         r.history: step, t (N), x and v (N x dofs) [m, m/s], gap [m] and
         impulse [N s] (N x contacts), every every-th sample, the impulses
         summed since the last one kept (the CLI's -o file; t, x, v also as
-        r.t, r.x, r.v); a scene with yielding storeys also up (N x dofs) [m],
-        each storey's plastic offset (0 for an elastic storey)."""
+        r.t, r.x, r.v); a (N x dofs) [m/s^2], each floor's absolute
+        acceleration as the demands measure it (the held contacts' forces in
+        it, an impact's impulse not); with method 'penalty' or 'newmark' force
+        (N x contacts) [N], each contact element's force; a scene with
+        yielding storeys also up (N x dofs) [m], each storey's plastic offset
+        (0 for an elastic storey).  r.history.dof and .contact name the
+        columns (NAME.k, the storey k of structure NAME; A-B@k, the contact
+        between sides A and B at level k); to_xarray() makes them the
+        coordinates and gives each variable its CF units."""
         history, every = history_args(history, every)
         _, o = self.opts(opts)
         sc = self._sc
         n, m = sc.n, sc.ncontact
         h = sampler = None
         yields = bool(lib.pd_scene_springs(self._p))
-        names = ("step", "t", "x", "v", "gap", "impulse") + (("up",) if yields else ())
+        forces = s(lib.pd_method_name(o.method)) in ("penalty", "newmark") and m > 0
+        names = (("step", "t", "x", "v", "gap", "impulse") + (("up",) if yields else ()) +
+                 ("a",) + (("force",) if forces else ()))
         if history:
             dtype = [("step", "i8"), ("t", "f8"), ("x", "f8", (n,)), ("v", "f8", (n,)),
                      ("gap", "f8", (m,)), ("impulse", "f8", (m,))]
             if yields:  # the storeys' plastic offsets, as the CLI's NAME.upK columns
                 dtype.append(("up", "f8", (n,)))
+            dtype.append(("a", "f8", (n,)))  # the floors' absolute accelerations, NAME.aK
+            if forces:  # the elements' forces, cK.force
+                dtype.append(("force", "f8", (m,)))
             h = _History(dtype, history_cap(o, every), every)
             sampler = _scene_sampler(h, n, m)
         sm = _lib.PdSceneSummary()
@@ -243,10 +255,24 @@ class Scene:
         if h is not None:
             rows = h.rows()
             hist = Result((name, np.ascontiguousarray(rows[name])) for name in names)
+            hist["dof"], hist["contact"] = self._labels()
             out["history"] = hist
             for name in ("t", "x", "v"):  # shortcuts
                 out[name] = hist[name]
         return out
+
+    def _labels(self):
+        """The dofs' names (NAME.k) and the contacts' (A-B@k: sides and level)."""
+        sc = self._sc
+        dofs = ["%s.%d" % (s(sc.st[i].name), k + 1) for i in range(sc.nstruct)
+                for k in range(sc.st[i].storeys)]
+        side = lambda j: "wall" if j < 0 else s(sc.st[j].name)  # noqa: E731
+        contacts = []
+        for a in range(sc.ncontact):
+            c = sc.ct[a]
+            level = c.level_b if c.a < 0 else c.level_a
+            contacts.append("%s-%s@%d" % (side(c.a), side(c.b), level))
+        return dofs, contacts
 
     def _summary(self, sm):
         sc, r = self._sc, sm.r
@@ -324,6 +350,7 @@ def _scene_sampler(h, n, m):
     item = h.dtype.itemsize
     off = {k: f[1] for k, f in h.dtype.fields.items()}
     with_up = "up" in off
+    with_force = "force" in off
     nb, mb = 8 * n, 8 * m
     acc = np.zeros(m)
     state = {"seen": 0}
@@ -355,6 +382,12 @@ def _scene_sampler(h, n, m):
                 memmove(base + off["impulse"], x.impulse, mb)
             if with_up and nb and x.up:
                 memmove(base + off["up"], x.up, nb)
+            if nb and x.a_abs:
+                memmove(base + off["a"], x.a_abs, nb)
+            elif nb:
+                h.buf["a"][h.n] = np.nan
+            if with_force and mb and x.force:
+                memmove(base + off["force"], x.force, mb)
             h.n += 1
             return 0
         except BaseException as e:

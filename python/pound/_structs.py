@@ -373,6 +373,8 @@ class PdSceneSample(Structure):
         ("impulse", POINTER(c_double)),
         ("impacts", POINTER(c_long)),
         ("up", POINTER(c_double)),
+        ("a_abs", POINTER(c_double)),
+        ("force", POINTER(c_double)),
     ]
 
 
