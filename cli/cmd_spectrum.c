@@ -3,6 +3,7 @@
  * parallel (OpenMP threads; MPI ranks in the MPI build), journaled so that
  * an interrupted sweep resumes (--resume). */
 #include <fcntl.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -30,6 +31,12 @@ static const char spectrum_usage[] =
     "                   umax [cm] vs T0 in F-dim.png)\n"
     "  --threads K      OpenMP threads [OMP_NUM_THREADS or all cores]\n"
     "  --json           {\"points\": [...], \"cpu_s\": ..., \"wall_s\": ...} on stdout\n"
+    "suites: --records F (a suite file; or --record given twice or more): each record's\n"
+    "                   spectrum (JSON records) and the suite's statistics at every point\n"
+    "                   (JSON stats: mean, median, p16, p84, min, max of Pi1, gamma, umax);\n"
+    "                   -o writes the mean spectrum, FILE.recK.partial journals record K\n"
+    "  --T0 MIN:MAX:N   a suite against the period instead of Pi2 (each record at Pi2 = its\n"
+    "                   Tp / T0, log-spaced; with --gap the gap in metres)\n"
     "MPI: make MPI=1, then mpirun -np K build-mpi/pound spectrum ... (rank 0 writes)\n"
     "scenes: pound spectrum --scene F.json --Pi2 MIN:MAX:N [--ref NAME] [--Pi3 LIST]\n"
     "                       [--ref-contact K] [--eps LIST] [-o F] [--plot F.png] [--json]\n"
@@ -49,6 +56,9 @@ typedef struct spec_args {
     const char *ref_name;              /* --ref NAME (scene sweeps) */
     int ref_contact, have_ref_contact; /* --ref-contact K */
     long stop_after;
+    double t0_min, t0_max; /* --T0 MIN:MAX:N: a suite's axis of periods [s] */
+    int t0_axis;
+    pd_method method_in; /* the method before its resolution (a suite resolves per record) */
 } spec_args;
 
 /* The next comma-separated token of *p into tok: 0, or -1 when empty or
@@ -175,8 +185,24 @@ static int own_flag(spec_args *a, int argc, char **argv, int *i)
         a->s.linear |= !strcmp(f, "--linear");
         return 1;
     }
+    if (!strcmp(f, "--T0") && val && strchr(val, ':')) { /* a suite's axis of periods */
+        char buf[256], *p1, *p2;
+        if (strlen(val) >= sizeof buf || !(p1 = strchr(strcpy(buf, val), ':')) ||
+            !(p2 = strchr(p1 + 1, ':')))
+            return pd_cli_usage_error("--T0: give MIN:MAX:N (got '%s')", val);
+        *p1 = *p2 = '\0';
+        if (pd_cli_double(f, buf, &a->t0_min) || pd_cli_double(f, p1 + 1, &a->t0_max) ||
+            pd_cli_int(f, p2 + 1, &a->s.npi2))
+            return 2;
+        if (!(a->t0_min > 0.0 && a->t0_max > a->t0_min) || a->s.npi2 < 2 || a->s.npi2 > 1000000)
+            return pd_cli_usage_error("--T0: need 0 < MIN < MAX and 2 <= N <= 1e6 (got %s)", val);
+        a->t0_axis = a->have_pi2 = 1;
+        (*i)++;
+        return 1;
+    }
     if (!strcmp(f, "--T0"))
-        return pd_cli_usage_error("--T0: spectrum sweeps Pi2 = Tp/T0: give --Pi2 MIN:MAX:N");
+        return pd_cli_usage_error("--T0: spectrum sweeps Pi2 = Tp/T0: give --Pi2 MIN:MAX:N (a "
+                                  "suite of records also takes --T0 MIN:MAX:N)");
     if (!strcmp(f, "--no-wall"))
         return pd_cli_usage_error("--no-wall: spectrum runs the no-wall twin of every point "
                                   "itself (umax_free)");
@@ -300,6 +326,19 @@ static int check_args(spec_args *a)
     pd_err err;
     if (!a->have_pi2)
         return pd_cli_usage_error("spectrum: --Pi2 MIN:MAX:N is required");
+    if (pd_cli_case_is_suite(&a->k) && (a->k.scene_path || a->k.chain))
+        return pd_cli_usage_error("--records: a suite's spectrum is the oscillator's (a scene's "
+                                  "suite: pound simulate --scene F --records R)");
+    if (a->t0_axis && !pd_cli_case_is_suite(&a->k))
+        return pd_cli_usage_error("--T0 MIN:MAX:N: the axis of a suite's spectrum (--records); "
+                                  "one record or a pulse: --Pi2 MIN:MAX:N");
+    if (a->t0_axis && a->s.linear)
+        return pd_cli_usage_error("--linear: a suite's --T0 axis is log-spaced");
+    if (a->t0_axis && a->plot)
+        return pd_cli_usage_error("--plot: the charts are against Pi2; a suite's --T0 axis is "
+                                  "in -o's file and --json (umax against T0)");
+    if (pd_cli_case_is_suite(&a->k) && (a->resume || a->stop_after) && !a->out)
+        return pd_cli_usage_error("%s needs -o FILE", a->resume ? "--resume" : "--stop-after");
     if (a->k.scene_path || a->k.chain)
         return check_scene_args(a);
     if (a->ref_name || a->have_ref_contact)
@@ -348,6 +387,13 @@ static int check_args(spec_args *a)
                                   "tolerance here (--method penalty); exact points: --method "
                                   "event");
     a->k.record = checked.record; /* a record and its pulse: the sweep's */
+    a->k.recs = checked.recs;     /* a suite's records (owned by a->k from here) */
+    a->k.rec_scale = checked.rec_scale;
+    a->k.suite = checked.suite;
+    if (a->t0_axis) { /* the first record's Pi2 range, for the checks below */
+        a->s.pi2_min = checked.c.Tp / a->t0_max;
+        a->s.pi2_max = checked.c.Tp / a->t0_min;
+    }
     s->base = a->k.c;
     s->base.Piy = checked.c.Piy; /* --uy in metres made Piy: the sweep keeps Piy */
     if (a->k.record) {           /* its pulse's amplitude (times --scale) unless --ap lists them */
@@ -361,6 +407,7 @@ static int check_args(spec_args *a)
      * it), else one for the whole sweep */
     a->k.method_by = checked.method_by;
     s->opts.method = checked.method_by ? checked.opts.method : PD_METHOD_AUTO;
+    a->method_in = s->opts.method;
     pd_spec_resolve_method(s);
     if ((rc = check_corners(a)))
         return rc;
@@ -376,6 +423,7 @@ static int parse_args(spec_args *a, int argc, char **argv)
     memset(a, 0, sizeof *a);
     pd_spec_init(&a->s);
     pd_cli_case_init(&a->k);
+    a->k.suites_by = "spectrum";
     for (int i = 1; i < argc; i++) {
         if ((rc = own_flag(a, argc, argv, &i)) == 1)
             continue;
@@ -412,12 +460,12 @@ static int parse_on_rank(spec_args *a, int argc, char **argv, int rank)
 }
 
 /* Rank 0: the journal (read back with --resume): 0, 1 or 2. */
-static int open_journal(const spec_args *a, pd_spec_journal *j, pd_spec_result *res, long *loaded)
+static int open_journal(const spec_args *a, const pd_spectrum *s, const char *out,
+                        pd_spec_journal *j, pd_spec_result *res, long *loaded)
 {
     pd_err err;
-    char *key = pd_spec_key(&a->s);
-    int rc = key ? pd_spec_journal_open(j, a->out, key, pd_spec_tasks(&a->s), a->resume, res,
-                                        loaded, &err)
+    char *key = pd_spec_key(s);
+    int rc = key ? pd_spec_journal_open(j, out, key, pd_spec_tasks(s), a->resume, res, loaded, &err)
                  : pd_err_set(&err, PD_ENOMEM, "out of memory");
     free(key);
     if (rc)
@@ -469,7 +517,7 @@ static int sweep(spec_args *a, int rank, int size, double wall0)
     pd_err err;
     int status = res ? 0 : 1;
     if (rank == 0 && !status && a->out)
-        status = open_journal(a, &j, res, &t.resumed);
+        status = open_journal(a, &a->s, a->out, &j, res, &t.resumed);
     pd_spec_mpi_agree(&status);
     if (!status && pd_spec_mpi_bcast_done(res, t.runs))
         status = 1;
@@ -490,6 +538,230 @@ static int sweep(spec_args *a, int rank, int size, double wall0)
         status = write_results(a, res, &j, &t);
     pd_spec_journal_close(&j, 0);
     pd_spec_mpi_agree(&status);
+    free(res);
+    return status;
+}
+
+/* ==== a suite of records ===================================================== */
+
+/* Record k's sweep: the suite's sweep on its record (its scale, its
+ * method resolved; with --T0 its Pi2 range Tp / T0). */
+static int suite_spectrum(const spec_args *a, int k, pd_spectrum *s, pd_err *err)
+{
+    *s = a->s;
+    pd_osc_set_record(&s->base, &a->k.recs[k]->rec, &a->k.recs[k]->pulse, a->k.rec_scale[k]);
+    if (!s->dimensional)
+        s->ap[0] = s->base.ap;
+    if (a->t0_axis) { /* log-spaced in T0 = log-spaced in Pi2, the same N */
+        s->pi2_min = s->base.Tp / a->t0_max;
+        s->pi2_max = s->base.Tp / a->t0_min;
+    }
+    s->opts.method = a->method_in;
+    pd_spec_resolve_method(s);
+    return pd_spec_validate(s, err);
+}
+
+/* The statistics of figure f (0 Pi1, 1 gamma, 2 umax) at point p over the
+ * records' rows (nrec x points). */
+static void point_stats(const pd_spec_row *rows, int nrec, long points, long p, int f, double *x,
+                        pd_stats *st)
+{
+    pd_err err;
+    for (int k = 0; k < nrec; k++) {
+        const pd_spec_row *r = &rows[(size_t)k * points + p];
+        x[k] = f == 0 ? r->Pi1 : f == 1 ? r->gamma : r->umax;
+    }
+    if (pd_stats_of(x, nrec, st, &err))
+        st->n = 0;
+}
+
+static void stats_obj(pd_json *js, const char *key, const pd_stats *st)
+{
+    pd_json_begin_object(js, key);
+    pd_json_int(js, "n", st->n);
+    pd_json_num(js, "mean", st->mean);
+    pd_json_num(js, "median", st->median);
+    pd_json_num(js, "p16", st->p16);
+    pd_json_num(js, "p84", st->p84);
+    pd_json_num(js, "min", st->min);
+    pd_json_num(js, "max", st->max);
+    pd_json_end_object(js);
+}
+
+/* The suite's output: JSON (every record's points, the statistics at each
+ * point), or text (per curve, the mean spectrum at up to SUITE_TEXT_ROWS
+ * points); -o and --plot: the mean spectrum. */
+#define SUITE_TEXT_ROWS 12
+static int suite_output(const spec_args *a, const pd_spectrum *specs, pd_spec_row *rows,
+                        const pd_spec_totals *t)
+{
+    int nrec = a->k.suite->n, rc = 0;
+    long points = pd_spec_points(&specs[0]);
+    static const char *const fig[3] = {"Pi1", "gamma", "umax"};
+    double *x = malloc((size_t)nrec * sizeof *x);
+    pd_spec_row *mean = malloc((size_t)points * sizeof *mean);
+    pd_err err;
+    if (!x || !mean) {
+        free(x);
+        free(mean);
+        fprintf(stderr, "pound: spectrum: out of memory for the suite's statistics\n");
+        return 1;
+    }
+    /* the mean spectrum: the first record's rows with the means of the figures */
+    for (long p = 0; p < points; p++) {
+        pd_stats st[3];
+        for (int f = 0; f < 3; f++)
+            point_stats(rows, nrec, points, p, f, x, &st[f]);
+        mean[p] = rows[p];
+        mean[p].Pi1 = st[0].mean;
+        mean[p].gamma = st[1].mean;
+        mean[p].umax = st[2].mean;
+        if (a->t0_axis)
+            mean[p].c.Pi2 = NAN; /* each record's Tp / T0 */
+    }
+    if (a->out && (rc = pd_spec_write(a->out, &specs[0], mean, &err)) == 0)
+        for (int k = 0; k < nrec; k++) { /* the file is in place: the journals have served */
+            char path[4096];
+            snprintf(path, sizeof path, "%s.rec%d.partial", a->out, k + 1);
+            remove(path);
+        }
+    if (!rc && a->plot)
+        rc = pd_spec_plot(a->plot, &specs[0], mean, &err);
+    if (rc) {
+        fprintf(stderr, "pound: spectrum: %s\n", err.msg);
+        free(x);
+        free(mean);
+        return 1;
+    }
+    if (a->json) {
+        pd_json js;
+        pd_json_init(&js, stdout);
+        pd_json_begin_object(&js, NULL);
+        pd_json_str(&js, "suite", a->k.records_path ? a->k.records_path : "--record");
+        pd_json_int(&js, "n", nrec);
+        pd_json_str(&js, "axis", a->t0_axis ? "T0" : "Pi2");
+        pd_json_begin_array(&js, "records");
+        for (int k = 0; k < nrec; k++) {
+            pd_json_begin_object(&js, NULL);
+            pd_json_str(&js, "record", a->k.recs[k]->rec.name);
+            pd_json_num(&js, "scale", a->k.rec_scale[k]);
+            pd_json_num(&js, "Tp", specs[k].base.Tp);
+            pd_json_num(&js, "ap", specs[k].base.ap);
+            pd_json_str(&js, "method", pd_method_name(specs[k].opts.method));
+            pd_json_begin_array(&js, "points");
+            for (long p = 0; p < points; p++)
+                pd_spec_json_point(&js, &specs[k], &rows[(size_t)k * points + p]);
+            pd_json_end_array(&js);
+            pd_json_end_object(&js);
+        }
+        pd_json_end_array(&js);
+        pd_json_begin_array(&js, "stats");
+        for (long p = 0; p < points; p++) {
+            pd_json_begin_object(&js, NULL);
+            pd_json_int(&js, "curve", rows[p].curve);
+            if (a->t0_axis)
+                pd_json_num(&js, "T0", rows[p].T0);
+            else
+                pd_json_num(&js, "Pi2", rows[p].c.Pi2);
+            pd_json_num(&js, a->k.c.Pi3 >= 0.0 && !specs[0].size_is_gap ? "Pi3" : "gap",
+                        specs[0].size_is_gap ? rows[p].gap : rows[p].c.Pi3);
+            pd_json_num(&js, "eps", rows[p].c.eps);
+            for (int f = 0; f < 3; f++) {
+                pd_stats st;
+                point_stats(rows, nrec, points, p, f, x, &st);
+                stats_obj(&js, fig[f], &st);
+            }
+            pd_json_end_object(&js);
+        }
+        pd_json_end_array(&js);
+        pd_json_num(&js, "cpu_s", t->cpu_s);
+        pd_json_num(&js, "wall_s", t->wall_s);
+        pd_json_end_object(&js);
+        pd_json_finish(&js);
+    } else {
+        printf("pounding spectra over a suite of %d records (%s): %ld curves x %d %s, %s\n", nrec,
+               a->k.records_path ? a->k.records_path : "--record", pd_spec_curves(&specs[0]),
+               specs[0].npi2, a->t0_axis ? "T0" : "Pi2", pd_method_name(specs[0].opts.method));
+        for (long c = 0; c < pd_spec_curves(&specs[0]); c++) {
+            char label[128];
+            pd_spec_curve_label(&specs[0], c, label, sizeof label);
+            printf("  curve %s\n  %12s %12s %12s %12s %12s %12s\n", label,
+                   a->t0_axis ? "T0 [s]" : "Pi2", "mean Pi1", "p16 Pi1", "p84 Pi1", "mean gamma",
+                   "mean umax");
+            int stride = specs[0].npi2 > SUITE_TEXT_ROWS
+                             ? (specs[0].npi2 + SUITE_TEXT_ROWS - 1) / SUITE_TEXT_ROWS
+                             : 1;
+            for (int j = 0; j < specs[0].npi2; j += stride) {
+                long p = c * specs[0].npi2 + j;
+                pd_stats st[3];
+                for (int f = 0; f < 3; f++)
+                    point_stats(rows, nrec, points, p, f, x, &st[f]);
+                printf("  %12.5g %12.5g %12.5g %12.5g %12.5g %12.5g\n",
+                       a->t0_axis ? rows[p].T0 : rows[p].c.Pi2, st[0].mean, st[0].p16, st[0].p84,
+                       st[1].mean, st[2].mean);
+            }
+        }
+        printf("  (every %s point and each record's spectrum: --json; -o writes the mean "
+               "spectrum)\n  cpu %.3g s, wall %.3g s\n",
+               a->t0_axis ? "T0" : "Pi2", t->cpu_s, t->wall_s);
+    }
+    free(x);
+    free(mean);
+    return 0;
+}
+
+/* Every record's sweep in turn (each on every thread, each journaled to
+ * FILE.recK.partial with -o), then the suite's statistics at every point. */
+static int suite_sweep(spec_args *a, double wall0)
+{
+    int nrec = a->k.suite->n, status = 0;
+    pd_spectrum *specs = calloc((size_t)nrec, sizeof *specs);
+    long points = pd_spec_points(&a->s), runs = pd_spec_tasks(&a->s);
+    pd_spec_row *rows = malloc((size_t)nrec * (size_t)points * sizeof *rows);
+    pd_spec_result *res = malloc((size_t)runs * sizeof *res);
+    pd_spec_totals t = {
+        .method_by = pd_cli_method_by(&a->k), .threads = pd_spec_threads(a->threads), .ranks = 1};
+    pd_err err;
+    if (!specs || !rows || !res) {
+        fprintf(stderr, "pound: spectrum: out of memory for a suite of %d records\n", nrec);
+        status = 1;
+    }
+    for (int k = 0; k < nrec && !status; k++) {
+        pd_spec_journal j = {.fd = -1};
+        pd_spec_exec ex = {.threads = a->threads,
+                           .progress = isatty(2),
+                           .stop_after = a->stop_after,
+                           .rank = 0,
+                           .size = 1};
+        char out[4096];
+        if (suite_spectrum(a, k, &specs[k], &err)) {
+            status = pd_cli_usage_error("%s: %s", a->k.suite->path[k], err.msg);
+            break;
+        }
+        memset(res, 0, (size_t)runs * sizeof *res);
+        snprintf(out, sizeof out, "%s.rec%d", a->out ? a->out : "", k + 1);
+        if (a->out)
+            status = open_journal(a, &specs[k], out, &j, res, &t.resumed);
+        ex.journal = a->out ? &j : NULL;
+        int rc = status ? 0 : pd_spec_compute(&specs[k], &ex, res, &err);
+        if (rc) {
+            fprintf(stderr, "pound: spectrum: %s: %s\n", a->k.suite->path[k], err.msg);
+            status = rc == PD_EINVAL ? 2 : 1;
+        }
+        for (long r = 0; r < runs && !status; r++) {
+            t.cpu_s += res[r].cpu_s;
+            t.steps += (double)res[r].steps;
+        }
+        t.runs += runs;
+        if (!status)
+            pd_spec_rows(&specs[k], res, rows + (size_t)k * points);
+        pd_spec_journal_close(&j, 0);
+    }
+    t.wall_s = pd_wall_seconds() - wall0;
+    if (!status)
+        status = suite_output(a, specs, rows, &t);
+    free(specs);
+    free(rows);
     free(res);
     return status;
 }
@@ -560,7 +832,11 @@ int pd_cmd_spectrum(int argc, char **argv)
             rc = size > 1 ? pd_cli_usage_error("spectrum --scene runs in one process (OpenMP "
                                                "threads), not under mpirun")
                           : pd_cmd_spectrum_scene(&sa, wall0);
-        } else
+        } else if (pd_cli_case_is_suite(&a->k))
+            rc = size > 1 ? pd_cli_usage_error("spectrum --records runs in one process (OpenMP "
+                                               "threads), not under mpirun")
+                          : suite_sweep(a, wall0);
+        else
             rc = sweep(a, rank, size, wall0);
     }
     pd_cli_case_free(&a->k);

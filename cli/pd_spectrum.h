@@ -122,6 +122,8 @@ typedef struct pd_spec_totals {
     const char *method_by; /* how the method was chosen: "default", or the flag */
 } pd_spec_totals;
 void pd_spec_print_json(const pd_spectrum *s, const pd_spec_row *rows, const pd_spec_totals *t);
+/* One point as a JSON object (the "points" entries of --json). */
+void pd_spec_json_point(pd_json *js, const pd_spectrum *s, const pd_spec_row *r);
 void pd_spec_print_text(const pd_spectrum *s, const pd_spec_row *rows, const pd_spec_totals *t);
 
 #endif

@@ -361,7 +361,7 @@ int pd_spec_plot(const char *png, const pd_spectrum *s, const pd_spec_row *rows,
 /* ---- JSON and text ------------------------------------------------------ */
 
 /* One point as a JSON object (the SPEC keys first). */
-static void json_point(pd_json *js, const pd_spectrum *s, const pd_spec_row *r)
+void pd_spec_json_point(pd_json *js, const pd_spectrum *s, const pd_spec_row *r)
 {
     pd_json_begin_object(js, NULL);
     pd_json_str(js, "pulse", pd_osc_excitation_name(&r->c));
@@ -408,7 +408,7 @@ void pd_spec_print_json(const pd_spectrum *s, const pd_spec_row *rows, const pd_
     pd_json_begin_object(&js, NULL);
     pd_json_begin_array(&js, "points");
     for (long p = 0; p < pd_spec_points(s); p++)
-        json_point(&js, s, &rows[p]);
+        pd_spec_json_point(&js, s, &rows[p]);
     pd_json_end_array(&js);
     pd_json_str(&js, "method", pd_method_name(s->opts.method));
     pd_json_str(&js, "method_by", t->method_by);

@@ -22,18 +22,6 @@ UNITS = {"u": "m", "v": "m/s", "x": "m", "gap": "m", "impulse": "N s", "a": "m/s
          "force": "N", "up": "m"}
 
 
-def _column_name(k, j, dofs, contacts):
-    """Column j of a scene history's array k as the CLI's CSV names it
-    (NAME.xK, cJ.gap, ...: dofs NAME.K, contacts by index); k[j] without
-    the scene's names."""
-    if dofs is not None and k in ("x", "v", "a", "up") and j < len(dofs):
-        name, storey = dofs[j].rsplit(".", 1)
-        return "%s.%s%s" % (name, k, storey)
-    if contacts is not None and k in ("gap", "impulse", "force") and j < len(contacts):
-        return "c%d.%s" % (j, k)
-    return "%s[%d]" % (k, j)
-
-
 class Result(dict):
     """A dict whose keys are also attributes (r.umax is r['umax']), with a
     short repr and, when pandas or xarray is installed, to_pandas() and
@@ -83,13 +71,12 @@ class Result(dict):
         naming them (not pandas' 'All arrays must be of the same length')."""
         h = self["history"] if "history" in self else self
         cols = {}
-        dofs, contacts = h.get("dof"), h.get("contact")
         for k, v in h.items():
             if isinstance(v, np.ndarray) and v.ndim == 1:
                 cols[k] = v
             elif isinstance(v, np.ndarray) and v.ndim == 2:
                 for j in range(v.shape[1]):
-                    cols[_column_name(k, j, dofs, contacts)] = v[:, j]
+                    cols["%s[%d]" % (k, j)] = v[:, j]
         lengths = {}
         for k, v in cols.items():
             lengths.setdefault(len(v), k)

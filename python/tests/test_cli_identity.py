@@ -122,9 +122,27 @@ def test_scene_history_is_the_cli_file(cli, same, tmp_path):
     same(r, js)
     header, data = read_csv(out)
     assert header == ["t", "stiff.x1", "flexible.x1", "stiff.v1", "flexible.v1", "c0.gap",
-                      "c0.impulse"]
-    cols = np.column_stack([r.t, r.x, r.v, r.history.gap, r.history.impulse])
+                      "c0.impulse", "stiff.a1", "flexible.a1"]
+    cols = np.column_stack([r.t, r.x, r.v, r.history.gap, r.history.impulse, r.history.a])
     assert np.array_equal(cols, data)
+    assert list(r.history.dof) == ["stiff.1", "flexible.1"]
+    assert list(r.history.contact) == ["stiff-flexible@1"]
+
+
+@pytest.mark.parametrize("method", ["penalty", "newmark"])
+def test_scene_forces_are_the_cli_file(cli, same, tmp_path, method):
+    """The penalty methods' element forces (cK.force) and the floors'
+    accelerations, column for column; their peaks force_max and acc_max."""
+    out = tmp_path / "scene.csv"
+    js = cli("simulate", "--scene", SCENE, "--method", method, "-o", out, "--every", "2")
+    r = pound.simulate_scene(SCENE, method=method, every=2)
+    same(r, js)
+    header, data = read_csv(out)
+    assert header[-3:] == ["stiff.a1", "flexible.a1", "c0.force"]
+    cols = np.column_stack([r.t, r.x, r.v, r.history.gap, r.history.impulse, r.history.a,
+                            r.history.force])
+    assert np.array_equal(cols, data)
+    assert np.max(r.history.force[:, 0]) <= r.contacts[0].force_max * (1 + 1e-15)
 
 
 @pytest.mark.parametrize("method", ["moreau", "event"])
@@ -137,8 +155,9 @@ def test_scene_yielding_history_is_the_cli_file(cli, same, tmp_path, method):
     r = pound.Scene.chain(3, Pi3=0.3, Piy=0.1, alpha=0.1).simulate(method=method, every=4)
     same(r, js)
     header, data = read_csv(out)
-    assert header[-3:] == ["S1.up1", "S2.up1", "S3.up1"]
-    cols = np.column_stack([r.t, r.x, r.v, r.history.gap, r.history.impulse, r.history.up])
+    assert header[-6:] == ["S1.up1", "S2.up1", "S3.up1", "S1.a1", "S2.a1", "S3.a1"]
+    cols = np.column_stack([r.t, r.x, r.v, r.history.gap, r.history.impulse, r.history.up,
+                            r.history.a])
     assert np.array_equal(cols, data)
     for k, st in enumerate(r.structures):  # the offsets at the end give the residuals
         assert st.n_yield[0] > 0 and np.isclose(0.9 * r.history.up[-1, k], st.residual[0],

@@ -36,3 +36,20 @@ def test_to_xarray_scene():
     assert isinstance(ds, xr.Dataset) and "t" in ds.coords
     assert ds["x"].dims == ("t", "dof") and np.array_equal(ds["x"].values, r.x)
     assert float(ds["x"].sel(t=r.t[10]).values[0]) == r.x[10, 0]
+
+
+def test_to_xarray_scene_names_and_units():
+    """The dofs and contacts named (NAME.k; sides and level), CF units."""
+    pytest.importorskip("xarray")
+    r = pound.simulate_scene(EXAMPLES / "scenes" / "three-buildings.json", every=50)
+    ds = r.to_xarray()
+    assert ds["x"].dims == ("t", "dof") and ds["gap"].dims == ("t", "contact")
+    assert list(ds["dof"].values)[:2] == ["low.1", "low.2"]
+    assert list(ds["contact"].values)[:2] == ["wall-low@1", "low-tower@1"]
+    units = {k: ds[k].attrs.get("units") for k in ("x", "v", "a", "gap", "impulse")}
+    assert units == {"x": "m", "v": "m/s", "a": "m/s^2", "gap": "m", "impulse": "N s"}
+    assert ds["t"].attrs["units"] == "s"
+    # every 50th step's a_abs is among the states the demands measured
+    acc = np.concatenate([st.acc_max for st in r.structures])
+    assert np.all(np.abs(ds["a"].values).max(axis=0) <= acc)
+    assert float(np.abs(ds["a"].sel(dof="tower.1")).max()) == np.abs(r.history.a[:, 3]).max()

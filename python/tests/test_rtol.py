@@ -81,7 +81,7 @@ def test_scene_history_to_a_tolerance_is_the_cli_file(cli, same, tmp_path):
     r = pound.simulate_scene(THREE, rtol=1e-4)
     same(r, js)
     _, data = read_csv(out)
-    cols = np.column_stack([r.t, r.x, r.v, r.history.gap, r.history.impulse])
+    cols = np.column_stack([r.t, r.x, r.v, r.history.gap, r.history.impulse, r.history.a])
     assert np.array_equal(cols, data)
 
 

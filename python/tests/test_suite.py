@@ -139,3 +139,52 @@ def test_synth_suite_is_the_shipped_one(tmp_path):
     run("record", "--synth-suite", tmp_path)
     for p in RECS + [SUITE]:
         assert (tmp_path / p.name).read_bytes() == p.read_bytes(), p.name
+
+
+SPEC = ["--Pi2", "0.2:5:12", "--Pi3", "0.05,0.3", "--eps", "0.6"]
+
+
+def test_spectrum_records_are_single_spectra(cli):
+    """Each record's spectrum in a suite's is the single sweep of that record."""
+    js = cli("spectrum", "--records", SUITE, *SPEC)
+    assert js["n"] == 7 and js["axis"] == "Pi2"
+    for rec, path in zip(js["records"], RECS):
+        single = cli("spectrum", "--record", path, *SPEC)
+        assert untimed(rec["points"]) == untimed(single["points"]), path.name
+
+
+def test_spectrum_stats_are_numpys(cli):
+    js = cli("spectrum", "--records", SUITE, *SPEC, "--threads", "1")
+    for p, st in enumerate(js["stats"]):
+        for key in ("Pi1", "gamma", "umax"):
+            stats_ok(st[key], [r["points"][p][key] for r in js["records"]])
+    two = cli("spectrum", "--records", SUITE, *SPEC, "--threads", "2")
+    assert untimed(two["stats"]) == untimed(js["stats"])
+    assert untimed(two["records"]) == untimed(js["records"])
+
+
+def test_spectrum_against_periods(cli):
+    """--T0 MIN:MAX:N: every record on the same periods (Pi2 = its Tp / T0),
+    the gap in metres; the statistics of umax at each period."""
+    js = cli("spectrum", "--records", SUITE, "--T0", "0.2:2:8", "--gap", "0.01", "--eps", "0.6")
+    assert js["axis"] == "T0"
+    T0 = np.array([[p["T0"] for p in r["points"]] for r in js["records"]])
+    assert np.all(np.abs(T0 - T0[0]) <= 1e-13 * T0[0])
+    assert np.allclose(T0[0], np.geomspace(2, 0.2, 8), rtol=1e-13) or \
+        np.allclose(T0[0], np.geomspace(0.2, 2, 8), rtol=1e-13)
+    for r in js["records"]:
+        assert all(p["gap"] == pytest.approx(0.01, rel=1e-12) for p in r["points"])
+    for p, st in enumerate(js["stats"]):
+        stats_ok(st["umax"], [r["points"][p]["umax"] for r in js["records"]])
+
+
+@pytest.mark.parametrize("args,says", [
+    (["--T0", "0.2:2:8", "--Pi3", "0.05"], "the axis of a suite's spectrum"),
+    (["--records", SUITE, "--T0", "0.2:2:8", "--gap", "0.01", "--plot", "x.png"], "--plot"),
+    (["--records", SUITE, "--scene", SCENE, "--Pi2", "0.5:2:4"], "a scene's suite"),
+])
+def test_bad_spectrum_suites(args, says):
+    args = list(args) + ([] if "--Pi2" in args or "--T0" in args else ["--Pi2", "0.5:2:4"])
+    out = run("spectrum", *args, status=2)
+    err = out.stderr.decode()
+    assert says in err and err.count("\n") == 1, err
