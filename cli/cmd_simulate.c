@@ -787,10 +787,8 @@ static int suite_oscillator(sim_args *a)
         pd_json js;
         pd_json_init(&js, stdout);
         pd_json_begin_object(&js, NULL);
-        if (a->k.records_path) /* else the --record files */
+        if (a->k.records_path) /* the suite file (none: the --record files) */
             pd_json_str(&js, "suite", a->k.records_path);
-        else
-            pd_json_null(&js, "suite");
         pd_json_int(&js, "n", n);
         if (a->k.target != PD_SCALE_NONE) {
             pd_json_str(&js, "target", a->k.target == PD_SCALE_PGA ? "pga" : "sa");
@@ -1277,10 +1275,8 @@ static int suite_scene(sim_args *a)
     if (a->json) {
         pd_json_init(&js, stdout);
         pd_json_begin_object(&js, NULL);
-        if (a->k.records_path) /* else the --record files */
+        if (a->k.records_path) /* the suite file (none: the --record files) */
             pd_json_str(&js, "suite", a->k.records_path);
-        else
-            pd_json_null(&js, "suite");
         pd_json_int(&js, "n", n);
         if (a->k.target != PD_SCALE_NONE) {
             pd_json_str(&js, "target", a->k.target == PD_SCALE_PGA ? "pga" : "sa");

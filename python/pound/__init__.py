@@ -20,7 +20,7 @@ docstring.
 from ._lib import (BudgetError, FileError, InputError, LayoutError, NumericalError, ParseError,
                    PoundError, PoundMemoryError, SolverError, library_path, version)
 from ._case import Record
-from ._osc import Result, compare, converge, dt_range, simulate
+from ._osc import Result, compare, converge, dt_range, simulate, stats_of
 from ._scene import Scene, scene, simulate_scene
 from ._spectrum import spectrum
 from ._lcp import lcp, read_lcp, record
@@ -28,7 +28,7 @@ from . import plot
 
 __version__ = "0.13.0"
 
-__all__ = ["simulate", "compare", "converge", "dt_range", "spectrum", "lcp", "read_lcp",
+__all__ = ["simulate", "stats_of", "compare", "converge", "dt_range", "spectrum", "lcp", "read_lcp",
            "scene", "simulate_scene", "Scene", "record", "Record", "Result", "PoundError",
            "InputError", "ParseError", "FileError", "NumericalError", "SolverError",
            "BudgetError", "PoundMemoryError", "LayoutError", "library_path", "version", "plot"]

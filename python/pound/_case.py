@@ -376,8 +376,8 @@ class Case:
                 pass
             elif isinstance(rec, (list, tuple)) and rec and all(map(_a_path, rec)):
                 raise InputError("record: %d files given: a run takes one record (a path, a "
-                                 "pound.Record or an array of accelerations); suites of records "
-                                 "are not supported yet" % len(rec))
+                                 "pound.Record or an array of accelerations); a suite: "
+                                 "records=[...]" % len(rec))
             elif not isinstance(rec, (str, bytes, os.PathLike)):
                 # a ground motion as an array: its samples every record_dt, in units
                 if "record_dt" not in kw:

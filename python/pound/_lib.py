@@ -20,7 +20,7 @@ from ._structs import (PD_SPEC_MAX_LIST, PD_WALL, PdContact, PdEnergy, PdErr, Pd
                        PdOscSummary, PdPenaltySetup, PdRecord, PdRecordMeasures, PdRecordPulse,
                        PdRunOpts, PdScene, PdSceneErrors, PdSceneExcitation, PdSceneResult,
                        PdSceneSample, PdSceneSummary, PdSceneTrace, PdSpecCoords, PdSpecResult,
-                       PdSpecRow, PdSpectrum, PdStructure, PdTrace)
+                       PdSpecRow, PdSpectrum, PdStats, PdStructure, PdTrace)
 
 # ---- errors --------------------------------------------------------------------------
 
@@ -173,6 +173,12 @@ _PROTOTYPES = {
     "pd_record_integrate": (c_int, [P(PdRecord), P(c_double), P(c_double), P(PdErr)]),
     "pd_record_fit_pulse": (c_int, [P(PdRecord), P(PdRecordPulse), P(PdErr)]),
     "pd_record_pulse_eval": (None, [P(PdRecordPulse), c_double, P(c_double), P(c_double)]),
+    # suites
+    "pd_stats_of": (c_int, [P(c_double), c_int, P(PdStats), P(PdErr)]),
+    "pd_record_sa": (c_int, [P(PdRecord), P(PdRecordPulse), c_double, c_double, P(c_double),
+                             P(PdErr)]),
+    "pd_record_scale_to": (c_int, [P(PdRecord), P(PdRecordPulse), c_int, c_double, c_double,
+                                   c_double, P(c_double), P(PdErr)]),
     "pd_record_one_cycle": (c_double, [P(PdRecordPulse), c_double]),
     # the run request
     "pd_run_default_opts": (_padded(PdRunOpts), []),

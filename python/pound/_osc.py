@@ -2,6 +2,7 @@
 cli/cmd_compare.c, cli/cmd_converge.c reproduced from library calls)."""
 import ctypes
 import math
+import os
 from typing import TYPE_CHECKING, Any, List, Optional, Sequence, Union
 
 import numpy as np
@@ -296,12 +297,21 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
     failed, each redone at the spring's initial stiffness; 0 for the
     methods without Newton iterations).
     With history,
+    records=[...] (files, pound.Records or arrays with record_dt): a
+    suite, as `pound simulate --record F1 --record F2 ...`: r.records, one
+    Result per record (each what simulate(record=...) gives), r.stats, per
+    figure (umax, Pi1, gamma, impacts, max_impulse, acc_max, shear_max,
+    drift_ratio; a yielding run's ductility) the suite's n, mean, median,
+    p16, p84, min and max; target_pga=A or target_sa=A [m/s^2] (with T1 [s],
+    default T0) scale each record to that PGA or 5 %-damped Sa(T1).
     r.history: the arrays step, t, u, v, impulse, gap, impacts of every
     every-th step (the CLI's -o file: t [s], u [m], v [m/s], impulse per
     unit mass since the last sample [m/s], gap delta - u [m]; and the
     impacts begun since the last sample; a yielding run's also up, the
     plastic offset [m]), with t, u, v, impulse also as r.t, r.u, r.v,
     r.impulse."""
+    if "records" in case:
+        return _simulate_suite(history, every, case)
     history, every = history_args(history, every)
     height = _demand.pop_height(case)
     k = Case(case).resolve()
@@ -359,6 +369,81 @@ MOREAU_RTOL = _NMETHOD
 _CONVERGE_CODE = {"moreau": 0, "moreau-rtol": MOREAU_RTOL, "penalty": 2, "newmark": 5,
                   "event-general": 4}
 DEFAULT_RTOLS = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)  # converge --rtols
+
+
+
+SUITE_FIGS = ("umax", "Pi1", "gamma", "impacts", "max_impulse", "acc_max", "shear_max",
+              "drift_ratio", "ductility")  # the CLI's stats (ductility: yielding runs)
+
+
+def stats_of(values: Sequence[float]) -> "Result":
+    """The suite's statistics of values (pd_stats_of: NaN left out): n,
+    mean, median, p16, p84 (linear between order statistics), min, max."""
+    a = np.ascontiguousarray(np.asarray(values, dtype=float))
+    st, err = _lib.PdStats(), PdErr()
+    _lib.check(lib.pd_stats_of(a.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), len(a), st,
+                               err), err)
+    return Result(n=st.n, mean=st.mean, median=st.median, p16=st.p16, p84=st.p84, min=st.min,
+                  max=st.max)
+
+
+def _suite_record(item, case):
+    """One entry of records=: a pound.Record, a file, or an array (record_dt,
+    units)."""
+    from ._case import Record
+    if isinstance(item, Record):
+        return item
+    if isinstance(item, (str, bytes, os.PathLike)):
+        return Record(item, case.get("units"), case.get("record_format", "auto"))
+    if "record_dt" not in case:
+        raise InputError("record_dt: give the sampling interval of the record arrays [s]")
+    return Record.from_array(item, case["record_dt"], case.get("units") or "m/s2")
+
+
+def _simulate_suite(history, every, case):
+    """simulate(records=[...]): every record's run and the suite's statistics."""
+    items = case.pop("records")
+    if isinstance(items, (str, bytes, os.PathLike)) or not isinstance(items, (list, tuple)) \
+            or not items:
+        raise InputError("records: a list of record files, pound.Records or arrays (a suite)")
+    if "record" in case:
+        raise InputError("records and record: give the suite one way")
+    target = [k for k in ("target_pga", "target_sa") if k in case]
+    if len(target) > 1:
+        raise InputError("target_pga and target_sa: a suite is scaled to one target")
+    kind, value = (0, 0.0) if not target else (1 if target[0] == "target_pga" else 2,
+                                               number(target[0], case.pop(target[0])))
+    if target and not 0.0 < value <= 1e3:
+        raise InputError("%s: the target must be in (0, 1000] m/s^2" % target[0])
+    T1 = number("T1", case.pop("T1")) if "T1" in case else None
+    if T1 is not None and kind != 2:
+        raise InputError("T1: the period of target_sa")
+    if kind == 2 and T1 is None:
+        if "T0" not in case:
+            raise InputError("target_sa: give the period of Sa(T1) with T1 (or the "
+                             "oscillator's T0)")
+        T1 = number("T0", case["T0"])
+    if target and "scale" in case:
+        raise InputError("scale and %s: the target sets each record's scale" % target[0])
+    base = number("scale", case.pop("scale", 1.0))
+    runs = []
+    for item in items:
+        rec = _suite_record(item, case)
+        scale = ctypes.c_double(base)
+        if kind:
+            err = PdErr()
+            _lib.check(lib.pd_record_scale_to(rec.rec, rec.pulse, kind, value, T1 or 0.0, 0.05,
+                                              scale, err), err)
+        kw = {k: v for k, v in case.items() if k not in ("units", "record_format",
+                                                          "record_dt")}
+        runs.append(simulate(history, every, record=rec, scale=scale.value, **kw))
+    out = Result(n=len(runs))
+    if kind:
+        out.update(target="pga" if kind == 1 else "sa", target_value=value)
+    out["records"] = runs
+    out["stats"] = Result((f, stats_of([r[f] for r in runs])) for f in SUITE_FIGS
+                          if all(f in r for r in runs))
+    return out
 
 
 def parse_methods(methods, codes=None):

@@ -565,6 +565,19 @@ class PdSpecRow(Structure):
     ]
 
 
+class PdStats(Structure):
+    """pd_stats (problems/pd_problems.h)."""
+    _fields_ = [
+        ("n", c_int),
+        ("mean", c_double),
+        ("median", c_double),
+        ("p16", c_double),
+        ("p84", c_double),
+        ("min", c_double),
+        ("max", c_double),
+    ]
+
+
 # C name -> mirror, for the layout tests
 MIRRORS = {
     "pd_err": PdErr,
@@ -596,4 +609,5 @@ MIRRORS = {
     "pd_spec_coords": PdSpecCoords,
     "pd_spec_result": PdSpecResult,
     "pd_spec_row": PdSpecRow,
+    "pd_stats": PdStats,
 }

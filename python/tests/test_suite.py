@@ -188,3 +188,35 @@ def test_bad_spectrum_suites(args, says):
     out = run("spectrum", *args, status=2)
     err = out.stderr.decode()
     assert says in err and err.count("\n") == 1, err
+
+
+def test_python_suite_is_the_clis(cli, same):
+    """pound.simulate(records=[...]) gives the CLI's suite JSON to the bit:
+    every record's run and the statistics (pd_stats_of, the CLI's)."""
+    import pound
+    args = []
+    for p in RECS:
+        args += ["--record", p]
+    js = cli("simulate", *args, *OSC, "--target-sa", "6")
+    r = pound.simulate(records=RECS, T0=0.8, gap=0.01, eps=0.6, target_sa=6, history=False)
+    same(r, js)
+    assert "suite" not in r and "suite" not in js and r.target == "sa"
+    # arrays as records: the library's m/s^2 unless units say otherwise
+    arrays = [pound.record(p).acc for p in RECS[:2]]
+    dt = pound.record(RECS[0]).dt
+    ra = pound.simulate(records=arrays, record_dt=dt, T0=0.8, gap=0.01, eps=0.6, history=False)
+    rp = pound.simulate(records=RECS[:2], T0=0.8, gap=0.01, eps=0.6, history=False)
+    assert [x.umax for x in ra.records] == [x.umax for x in rp.records]
+
+
+@pytest.mark.parametrize("kw,says", [
+    (dict(records=str(RECS[0])), "a list of record files"),
+    (dict(records=RECS, record=RECS[0]), "give the suite one way"),
+    (dict(records=RECS, target_pga=3, target_sa=3), "one target"),
+    (dict(records=RECS, target_sa=3, Pi2=1), "T1"),
+    (dict(records=RECS, target_pga=3, scale=2), "scale and target_pga"),
+])
+def test_python_suite_refusals(kw, says):
+    import pound
+    with pytest.raises(pound.InputError, match=says):
+        pound.simulate(history=False, **kw)
