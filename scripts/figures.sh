@@ -45,10 +45,10 @@ done
     --eps 0.6 --dt 0.004:0.0000625:4 --methods moreau,newmark --kc 1e6 --error umax \
     --plot "$out/rows-yield-10.png" > "$out/rows-yield-10.txt"
 
-# 1c. Work-precision under a real record (Rinaldi RRS228, when the shared
-#     records are there): Moreau-Jean and penalty against the exact reference
+# 1c. Work-precision under a real record (Rinaldi RRS228, shipped in
+#     examples/records): Moreau-Jean and penalty against the exact reference
 #     on the record's linear pieces (docs/records.md).
-rec=../shared/data/records/NGA_no_1063_RRS228.AT2
+rec=examples/records/NGA_no_1063_RRS228.AT2 # shipped with the repository
 if [ -f "$rec" ]; then
     "$pound" converge --record "$rec" --T0 0.8 --gap 0.01 --eps 0.6 \
         --dt 0.004:0.0000625:7 --theta 0.5,1 --methods moreau,penalty \
