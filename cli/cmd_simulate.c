@@ -1144,6 +1144,12 @@ static void scene_text(const sim_args *a, const pd_scene *sc, const pd_scene_sum
     printf("  cpu       = %.3g s (the run and its contact-free twin)\n", s->cpu_s);
 }
 
+/* The method a scene's run took. */
+static const char *r_method(const pd_scene_summary *s)
+{
+    return s->r.method ? s->r.method : "?";
+}
+
 static int simulate_scene(sim_args *a)
 {
     pd_scene *sc = NULL;
@@ -1186,8 +1192,14 @@ static int simulate_scene(sim_args *a)
     }
     snprintf(name, sizeof name, "chain of %d", a->k.chain);
     pd_scene_run_info ri = {.sum = &s, .scene_name = a->k.scene_path ? a->k.scene_path : name};
+    /* the chart's title: the scene file's name (not its folders), method, excitation */
+    char title[512];
+    const char *base = strrchr(ri.scene_name, '/');
+    snprintf(title, sizeof title, "%s: %s, %s%s", base ? base + 1 : ri.scene_name, r_method(&s),
+             sc->exc.record ? "record " : "",
+             sc->exc.record ? sc->exc.record->name : pd_pulse_name(sc->exc.pulse));
     if ((fo.w && pd_scene_writer_finish(fo.w, &ri, &err)) ||
-        (fo.p && pd_scene_plot_draw(fo.p, a->plot, ri.scene_name, &err))) {
+        (fo.p && pd_scene_plot_draw(fo.p, a->plot, title, &err))) {
         fprintf(stderr, "pound: simulate: %s\n", err.msg);
         status = 1;
         goto done;

@@ -127,20 +127,70 @@ static void slope_guide(FILE *g, const pd_chart *c)
             cv->x[0], c->slope_ref, c->slope_ref);
 }
 
+/* The range of axis y (0: x) fitted to the data with a margin of 4 % of
+ * it each side (log: of its decades), and on a log axis spanning less than
+ * three decades ticks at 1, 2 and 5 of each decade (gnuplot's default,
+ * whole decades, leaves such an axis one or two labels).  include: a value
+ * the range must hold (NAN: none). */
+static void axis_range(FILE *g, const pd_chart *c, int y, int logscale, double include)
+{
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    const char *ax = y ? "y" : "x";
+    for (int k = 0; k < c->ncurves; k++)
+        for (int i = 0; i < c->curves[k].n; i++) {
+            double v = y ? c->curves[k].y[i] : c->curves[k].x[i];
+            if (isfinite(v) && (!logscale || v > 0.0)) {
+                lo = fmin(lo, v);
+                hi = fmax(hi, v);
+            }
+        }
+    if (isfinite(include) && (!logscale || include > 0.0)) {
+        lo = fmin(lo, include);
+        hi = fmax(hi, include);
+    }
+    if (!(lo <= hi)) /* no data: gnuplot's own */
+        return;
+    if (logscale) {
+        double span = log10(hi / lo), m = pow(10.0, 0.04 * (span > 0.0 ? span : 1.0));
+        fprintf(g, "set %srange [%.17g:%.17g]\n", ax, lo / m, hi * m);
+        if (span < 3.0) {
+            fprintf(g, "set format %s '%%g'\nset %stics (", ax, ax);
+            int first = 1;
+            for (int e = (int)floor(log10(lo / m)); e <= (int)ceil(log10(hi * m)); e++)
+                for (int j = 0; j < 3; j++) {
+                    double t = (j == 0 ? 1.0 : j == 1 ? 2.0 : 5.0) * pow(10.0, e);
+                    if (t >= lo / m && t <= hi * m) {
+                        fprintf(g, "%s%.3g", first ? "" : ", ", t);
+                        first = 0;
+                    }
+                }
+            fputs(")\n", g);
+        }
+    } else {
+        double pad = 0.04 * (hi > lo ? hi - lo : fabs(hi) > 0.0 ? fabs(hi) : 1.0);
+        fprintf(g, "set %srange [%.17g:%.17g]\n", ax, lo - pad, hi + pad);
+    }
+}
+
 /* The chart's gnuplot script, reading data, writing png_tmp. */
 static void chart_script(FILE *g, const char *data, const char *png_tmp, const void *ctx)
 {
     const pd_chart *c = ctx;
-    fprintf(g, "set terminal pngcairo size 900,650 enhanced font 'sans,11'\n");
+    fprintf(g, "set terminal pngcairo size 1100,650 enhanced font 'sans,11'\n");
     pd_plot_style(g);
     fputs("set output ", g);
     pd_plot_text(g, png_tmp);
-    /* the key under the chart, in a smaller font as the curves grow */
-    fprintf(g, "\nset grid\nset key below font ',%d' spacing 0.9\n", c->ncurves > 6 ? 9 : 10);
+    /* the key right of the chart, clear of the axis labels, in a smaller font
+     * as the curves grow; the axes fit to the data (no padding to whole
+     * decades), a margin inside them so that no curve touches the frame */
+    fprintf(g, "\nset grid\nset key outside right top vertical font ',%d' spacing 0.9\n",
+            c->ncurves > 6 ? 9 : 10);
     if (c->logx)
         fputs("set logscale x\nset format x '10^{%L}'\n", g);
     if (c->logy)
         fputs("set logscale y\nset format y '10^{%L}'\n", g);
+    axis_range(g, c, 0, c->logx, isfinite(c->vline) ? c->vline : NAN);
+    axis_range(g, c, 1, c->logy, NAN);
     fputs("set title ", g);
     pd_plot_literal(g, c->title);
     fputs("\nset xlabel ", g);
@@ -149,17 +199,6 @@ static void chart_script(FILE *g, const char *data, const char *png_tmp, const v
     pd_plot_text(g, c->ylabel);
     fputc('\n', g);
     if (isfinite(c->vline)) {
-        double lo = c->vline, hi = c->vline; /* the marker inside the x range */
-        for (int k = 0; k < c->ncurves; k++)
-            for (int i = 0; i < c->curves[k].n; i++)
-                if (!c->logx || c->curves[k].x[i] > 0.0) {
-                    lo = fmin(lo, c->curves[k].x[i]);
-                    hi = fmax(hi, c->curves[k].x[i]);
-                }
-        if (c->logx)
-            fprintf(g, "set xrange [%.17g:%.17g]\n", lo / 2.0, hi * 2.0);
-        else
-            fprintf(g, "set xrange [%.17g:%.17g]\n", lo - 0.05 * (hi - lo), hi + 0.05 * (hi - lo));
         fprintf(g, "set arrow from %.17g, graph 0 to %.17g, graph 1 nohead dt 3 lc rgb 'black'\n",
                 c->vline, c->vline);
         fprintf(g, "set label ");

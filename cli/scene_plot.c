@@ -249,8 +249,14 @@ static void plot_walls(FILE *g, const pd_scene_plot *p, int q)
             snprintf(key, sizeof key, "wall%s (gap %.3g m)", at, c->gap);
         else
             snprintf(key, sizeof key, "wall of %s%s (gap %.3g m)", sc->st[s].name, at, c->gap);
-        fprintf(g, ", %.17g with lines lw 1.5 dt 2 lc rgb 'black' title ",
-                c->a == PD_WALL ? -c->gap : c->gap);
+        /* black in a structure's own panel; in one panel for several
+         * structures, in its structure's colour: the wall binds that one */
+        if (p->panel_mode || sc->nstruct == 1)
+            fprintf(g, ", %.17g with lines lw 1.5 dt 2 lc rgb 'black' title ",
+                    c->a == PD_WALL ? -c->gap : c->gap);
+        else
+            fprintf(g, ", %.17g with lines lw 1.5 dt 2 lt %d title ",
+                    c->a == PD_WALL ? -c->gap : c->gap, s + 1);
         pd_plot_literal(g, key);
     }
 }
@@ -276,7 +282,9 @@ static void plot_panel(FILE *g, const char *data, const pd_scene_plot *p, int q)
         fputs(first ? "" : ", ", g);
         first = 0;
         pd_plot_text(g, data);
-        fprintf(g, " index %d with lines lw 1.5 title ", k);
+        /* one colour per storey in every panel, per structure in one panel */
+        fprintf(g, " index %d with lines lw 1.5 lt %d title ", k,
+                p->panel_mode ? cv->storey : cv->st + 1);
         pd_plot_literal(g, key);
     }
     plot_walls(g, p, q);
