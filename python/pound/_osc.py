@@ -3,7 +3,7 @@ cli/cmd_compare.c, cli/cmd_converge.c reproduced from library calls)."""
 import ctypes
 import math
 import os
-from typing import TYPE_CHECKING, Any, List, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Any, Dict, List, Optional, Sequence, Union
 
 import numpy as np
 
@@ -125,7 +125,8 @@ class Result(dict):
         h = self["history"] if "history" in self else self
         if "t" not in h:
             raise ValueError("to_xarray: no history (run with history=True)")
-        data, coords = {}, {"t": ("t", h["t"], {"units": "s", "long_name": "time"})}
+        data: Dict[str, Any] = {}
+        coords: Dict[str, Any] = {"t": ("t", h["t"], {"units": "s", "long_name": "time"})}
         for k, v in h.items():
             if k == "t" or not isinstance(v, np.ndarray):
                 continue
