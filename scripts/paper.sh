@@ -13,11 +13,12 @@ mkdir -p "$out"
 term="set terminal pngcairo size 1100,800 enhanced font 'sans,10'
 load 'scripts/plot_style.gp'"
 
-# A history as "t u v" rows (CSV of pound simulate, comments dropped).
+# A history as "t u v impulse" rows (CSV of pound simulate, comments dropped):
+# the impulse is nonzero at the samples that end an impact (the charts mark them).
 hist() { # file args...
     f=$1; shift
     "$pound" simulate "$@" -o "$tmp/h.csv" > /dev/null
-    grep -v '^#' "$tmp/h.csv" | awk -F, 'NR > 1 {print $1, $2, $3}' > "$f"
+    grep -v '^#' "$tmp/h.csv" | awk -F, 'NR > 1 {print $1, $2, $3, $4}' > "$f"
 }
 
 # Rows of a spectrum CSV matching pulse, dir and a numeric column test.
@@ -36,7 +37,9 @@ set output '$out/paper-fig3.png'
 set multiplot layout 2,2 title 'Fig. 3: T_0 = 0.5 s (a_p = 3 m/s^2, T_p = 0.3 s) and T_0 = 1.5 s (a_p = 5 m/s^2, T_p = 0.9 s), {/Symbol P}_2 = 0.6, {/Symbol P}_3 = 0.2, {/Symbol e} = 0.7'
 set grid
 set xlabel 't [s]'; set ylabel 'u [cm]'
-plot '$tmp/f3a' u 1:(100*\$2) w l lw 2 t 'T_0 = 0.5 s', '$tmp/f3b' u 1:(100*\$2) w l lw 2 t 'T_0 = 1.5 s'
+plot '$tmp/f3a' u 1:(100*\$2) w l lw 2 t 'T_0 = 0.5 s', '$tmp/f3b' u 1:(100*\$2) w l lw 2 t 'T_0 = 1.5 s', \
+     '$tmp/f3a' u 1:(\$4 != 0 ? 100*\$2 : 1/0) w p pt 7 ps 0.6 lc rgb 'black' t 'impacts', \
+     '$tmp/f3b' u 1:(\$4 != 0 ? 100*\$2 : 1/0) w p pt 7 ps 0.6 lc rgb 'black' t ''
 set ylabel 'du/dt [m/s]'
 plot '$tmp/f3a' u 1:3 w l lw 2 t 'T_0 = 0.5 s', '$tmp/f3b' u 1:3 w l lw 2 t 'T_0 = 1.5 s'
 set xlabel 't / T_p'; set ylabel 'u {/Symbol w}_p^2 / a_p'
@@ -73,6 +76,8 @@ do for [d in 'normal reverse'] {
   plot for [P in '0.01 0.1 0.5 1 2'] '$tmp/f$n-'.d.'-'.P u 1:2 w l lw 2 t '{/Symbol P}_3 = '.P
 }
 unset logscale y; set key top right
+# gamma from 0, a margin above its largest (the reverse pulse's is 1: on the frame before)
+set yrange [0:*]; set offsets 0, 0, graph 0.08, 0
 set xlabel '{/Symbol c} = gap / u_{max,free}'; set ylabel '{/Symbol g} = u_{max} / u_{max,free}'
 do for [d in 'normal reverse'] {
   set title d.' (traditional view)'
@@ -122,7 +127,8 @@ set grid; set ylabel 'u / L_e'; set xlabel 't / T_p'
 L = 1/(2*pi)**2
 do for [P in '0.2 1 3'] {
   set title '{/Symbol P}_2 = '.P
-  plot '$tmp/f8-'.P u 1:(\$2/L) w l lw 2 t 'with the wall', '$tmp/f8f-'.P u 1:(\$2/L) w l lw 1 dt 2 t 'without', 0.05 w l dt 2 lc rgb 'black' t 'wall'
+  plot '$tmp/f8-'.P u 1:(\$2/L) w l lw 2 t 'with the wall', '$tmp/f8f-'.P u 1:(\$2/L) w l lw 1 dt 2 t 'without', 0.05 w l dt 2 lc rgb 'black' t 'wall', \
+       '$tmp/f8-'.P u 1:(\$4 != 0 ? \$2/L : 1/0) w p pt 7 ps 0.6 lc rgb 'black' t 'impacts'
 }
 unset multiplot
 GP
@@ -138,8 +144,10 @@ $term
 set output '$out/paper-fig9.png'
 set multiplot layout 2,1 title 'Fig. 9: T_0 = 3 s, one-sine pulse T_p = 0.3 s, a_p = 4 m/s^2, gap 4 mm, {/Symbol e} = 0.6'
 set grid; set xlabel 't [s]'; set ylabel 'u [cm]'
-set title 'normal'; plot '$tmp/f9-normal' u 1:(100*\$2) w l lw 2 t '', 0.4 w l dt 2 lc rgb 'black' t 'wall'
-set title 'reverse'; plot '$tmp/f9-reverse' u 1:(100*\$2) w l lw 2 t '', 0.4 w l dt 2 lc rgb 'black' t 'wall'
+set title 'normal'; plot '$tmp/f9-normal' u 1:(100*\$2) w l lw 2 t '', 0.4 w l dt 2 lc rgb 'black' t 'wall', \
+    '$tmp/f9-normal' u 1:(\$4 != 0 ? 100*\$2 : 1/0) w p pt 7 ps 0.6 lc rgb 'black' t 'impacts'
+set title 'reverse'; plot '$tmp/f9-reverse' u 1:(100*\$2) w l lw 2 t '', 0.4 w l dt 2 lc rgb 'black' t 'wall', \
+    '$tmp/f9-reverse' u 1:(\$4 != 0 ? 100*\$2 : 1/0) w p pt 7 ps 0.6 lc rgb 'black' t 'impacts'
 unset multiplot
 GP
 
@@ -174,7 +182,9 @@ set grid; set xlabel 't / T_p'; set key below
 L = 1/(2*pi)**2; V = 1/(2*pi)
 do for [P in '0.3 0.05'] {
   set title '{/Symbol P}_3 = '.P; set ylabel 'u / L_e'
-  plot '$tmp/f11-'.P.'-0.2' u 1:(\$2/L) w l lw 2 t '{/Symbol e} = 0.2', '$tmp/f11-'.P.'-1' u 1:(\$2/L) w l lw 2 t '{/Symbol e} = 1', P+0 w l dt 2 lc rgb 'black' t 'wall'
+  plot '$tmp/f11-'.P.'-0.2' u 1:(\$2/L) w l lw 2 t '{/Symbol e} = 0.2', '$tmp/f11-'.P.'-1' u 1:(\$2/L) w l lw 2 t '{/Symbol e} = 1', P+0 w l dt 2 lc rgb 'black' t 'wall', \
+       '$tmp/f11-'.P.'-0.2' u 1:(\$4 != 0 ? \$2/L : 1/0) w p pt 7 ps 0.6 lc rgb 'black' t 'impacts', \
+       '$tmp/f11-'.P.'-1' u 1:(\$4 != 0 ? \$2/L : 1/0) w p pt 7 ps 0.6 lc rgb 'black' t ''
 }
 do for [P in '0.3 0.05'] {
   set title '{/Symbol P}_3 = '.P; set ylabel '(du/dt) / (a_p / {/Symbol w}_p)'
