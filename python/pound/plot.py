@@ -332,12 +332,14 @@ def record(rec: Mapping[str, Any], ax: Optional[Axes] = None, in_g: bool = True
     t = np.asarray(rec["t"])
     ax.plot(t, np.asarray(rec["acc"]) / unit, lw=0.7, color="0.45", label=str(rec["name"]))
     p = rec["pulse"]
+    # every figure in the axis' unit (the labels too)
+    uname = "g" if in_g else "m/s$^2$"
     ax.plot(t, np.asarray(rec["pulse_acc"]) / unit, lw=1.6, color="C3",
-            label="fitted %s pulse: Tp = %.3g s, ap = %.3g m/s$^2$" % (p["shape"], p["Tp"],
-                                                                    p["ap"]))
+            label="fitted %s pulse: Tp = %.3g s, ap = %.3g %s" % (p["shape"], p["Tp"],
+                                                               p["ap"] / unit, uname))
     k = int(np.argmin(np.abs(t - float(rec["t_pga"]))))
     ax.plot([t[k]], [np.asarray(rec["acc"])[k] / unit], ls="none", marker="v", color="k",
-            label="pga = %.3g m/s$^2$" % float(rec["pga"]))
+            label="pga = %.3g %s" % (float(rec["pga"]) / unit, uname))
     ax.set_xlabel("t [s]")
     ax.set_ylabel("ground acceleration [%s]" % ("g" if in_g else "m/s$^2$"))
     ax.grid(True, alpha=0.3)

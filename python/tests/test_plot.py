@@ -162,6 +162,14 @@ def test_record_plot():
     assert np.array_equal(pulse.get_ydata(), rec.pulse_acc)
     assert peak.get_xdata()[0] == pytest.approx(rec.t_pga, abs=rec.dt / 2)
     assert abs(peak.get_ydata()[0]) == pytest.approx(rec.pga, rel=1e-12)
+    # in g: the curves and every label's figure in g (they mixed in m/s^2)
+    fig, ax = pp.record(rec)
+    acc, pulse, peak = ax.lines
+    g = 9.80665
+    assert np.allclose(acc.get_ydata(), rec.acc / g, rtol=1e-15)
+    assert "pga = %.3g g" % (rec.pga / g) in peak.get_label()
+    assert "ap = %.3g g" % (rec.pulse["ap"] / g) in pulse.get_label()
+    assert "m/s" not in peak.get_label() + pulse.get_label()
 
 
 def test_without_matplotlib_the_message_says_what_to_install(monkeypatch):
