@@ -63,6 +63,7 @@ DEFAULT_FILES = {
     "engine/mj_yield.c": ["yield_mj", "yield_scene", "yield"],
     "problems/scene_energy.c": ["yield_scene"],
     "problems/separation.c": ["separation"],
+    "problems/suite.c": ["suite"],
 }
 
 # Array indices checked against the arrays' sizes (a trap, no runtime
