@@ -921,10 +921,12 @@ static void held_forces(const pd_mj *mj, const snap *w, const snap *x)
     int m = mj->model->m, onset = ad->impact_made;
     for (int a = 0; a < m && !onset; a++)
         onset = x->st.P[a] > 0.0 && !(w->st.P[a] > 0.0);
+    /* a contact not pushing holds nothing; one that starts is an onset, and
+     * keeps its force of the step before: 0 */
     for (int a = 0; a < m; a++)
-        ad->lam[a] = !(x->st.P[a] > 0.0 && w->st.P[a] > 0.0 && x->st.h > 0.0) ? 0.0
-                     : onset                                                  ? ad->lam[a]
-                             : x->st.P[a] / x->st.h;
+        ad->lam[a] = !(x->st.P[a] > 0.0 && x->st.h > 0.0) ? 0.0
+                     : onset                              ? ad->lam[a]
+                                                          : x->st.P[a] / x->st.h;
 }
 
 /* The held contacts' forces ad->lam into acc: a_i += W_ia lam_a / M_ii. */
