@@ -108,6 +108,13 @@ static int parse_args(sim_args *a, int argc, char **argv)
         return pd_cli_usage_error("%s", err.msg);
     if ((rc = pd_cli_case_finish(&a->k)))
         return rc;
+    if (pd_cli_case_is_suite(&a->k) && (a->out || a->plot || a->dump)) {
+        const char *f = a->out ? "-o" : a->plot ? "--plot" : "--dump-lcp";
+        pd_cli_case_free(&a->k);
+        return pd_cli_usage_error("%s: a suite of records prints its records' figures and their "
+                                  "statistics; histories and charts are one run's (--record F)",
+                                  f);
+    }
     if (a->dump && a->k.opts.method != PD_METHOD_MOREAU) {
         pd_cli_case_free(&a->k);
         return pd_cli_usage_error(

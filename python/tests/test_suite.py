@@ -120,6 +120,7 @@ def test_record_repeated_is_a_suite(cli):
     (["--records", SUITE, "--target-pga", "3", "--scale", "2"], "--scale and --target-pga"),
     (["--target-pga", "3"], "scales records"),
     (["--records", SUITE, "--T1", "1"], "--T1: the period of --target-sa"),
+    (["--records", SUITE, "-o", "x.csv"], "-o: a suite of records"),
 ])
 def test_bad_suites_are_refused(args, says):
     out = run("simulate", *args, status=2)
