@@ -84,6 +84,27 @@ static void test_suite_file(pd_test_ctx *ctx)
     unlink(path);
     rc = pd_suite_read(path, &s, &err);
     CHECK(ctx, rc == PD_EINVAL && strstr(err.msg, "cannot open"), "missing: %s", err.msg);
+    /* pd_suite_add: a scale of 0, NaN or infinity and an empty path refused;
+     * past its first capacity (8) the suite grows, every entry kept */
+    pd_suite *t = pd_suite_new();
+    int refused = pd_suite_add(t, "r", 0.0, &err) == PD_EINVAL &&
+                  pd_suite_add(t, "r", NAN, &err) == PD_EINVAL &&
+                  pd_suite_add(t, "r", INFINITY, &err) == PD_EINVAL &&
+                  pd_suite_add(t, "", 1.0, &err) == PD_EINVAL && t->n == 0;
+    int grew = 1;
+    for (int k = 0; k < 20; k++) {
+        char name[16];
+        snprintf(name, sizeof name, "r%d", k);
+        grew &= pd_suite_add(t, name, 1.0 + k, &err) == PD_OK;
+    }
+    for (int k = 0; k < 20 && grew; k++) {
+        char name[16];
+        snprintf(name, sizeof name, "r%d", k);
+        grew &= !strcmp(t->path[k], name) && t->scale[k] == 1.0 + k;
+    }
+    CHECK(ctx, refused && grew && t->n == 20, "pd_suite_add: refusals %d, 20 entries %d", refused,
+          grew);
+    pd_suite_free(t);
     rmdir(dir);
 }
 
