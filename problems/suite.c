@@ -81,20 +81,18 @@ int pd_suite_add(pd_suite *s, const char *path, double scale, pd_err *err)
 static int suite_line(pd_suite *s, char *line, const char *file, int lineno, const char *dir,
                       size_t ndir, pd_err *err)
 {
-    char *hash = strchr(line, '#'), *tok[3] = {0};
+    char *hash = strchr(line, '#'), *tok[2] = {0};
     int ntok = 0;
     if (hash)
         *hash = '\0';
-    for (char *p = strtok(line, " \t\r\n"); p; p = strtok(NULL, " \t\r\n"))
-        if (ntok < 3)
-            tok[ntok++] = p;
-        else
+    for (char *p = strtok(line, " \t\r\n"); p; p = strtok(NULL, " \t\r\n")) {
+        if (ntok == 2)
             return pd_err_set(err, PD_EINVAL, "%s:%d: expected PATH [SCALE], got more", file,
                               lineno);
+        tok[ntok++] = p;
+    }
     if (ntok == 0)
         return PD_OK;
-    if (ntok > 2)
-        return pd_err_set(err, PD_EINVAL, "%s:%d: expected PATH [SCALE], got more", file, lineno);
     double scale = 1.0;
     if (ntok == 2) {
         char *end;

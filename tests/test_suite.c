@@ -69,10 +69,16 @@ static void test_suite_file(pd_test_ctx *ctx)
           "read: %s", rc ? err.msg : "ok");
     pd_suite_free(s);
     /* errors: a bad scale, a third column, an empty suite, no file */
-    const char *bad[3] = {"a.AT2\nb.AT2 -1\n", "a.AT2 1 2\n", "# nothing\n"};
-    const char *says[3] = {"s.txt:2: the scale '-1'", "s.txt:1: expected PATH [SCALE]",
-                           "lists no record"};
-    for (int k = 0; k < 3; k++) {
+    char longline[5000];
+    memset(longline, 'x', sizeof longline - 2);
+    longline[sizeof longline - 2] = '\n';
+    longline[sizeof longline - 1] = '\0';
+    const char *bad[6] = {"a.AT2\nb.AT2 -1\n", "a.AT2 1 2\n", "# nothing\n",
+                          "a.AT2 1 2 3\n",     "a.AT2 0\n",   longline};
+    const char *says[6] = {"s.txt:2: the scale '-1'", "s.txt:1: expected PATH [SCALE]",
+                           "lists no record",         "s.txt:1: expected PATH [SCALE]",
+                           "s.txt:1: the scale '0'",  "s.txt:1: a line longer than"};
+    for (int k = 0; k < 6; k++) {
         f = fopen(path, "w");
         fputs(bad[k], f);
         fclose(f);
@@ -80,6 +86,19 @@ static void test_suite_file(pd_test_ctx *ctx)
         rc = pd_suite_read(path, &s, &err);
         CHECK(ctx, rc == PD_EINVAL && s == NULL && strstr(err.msg, says[k]), "bad %d: %s", k,
               err.msg);
+    }
+    /* a suite file named without a folder: its paths as they are */
+    char cwd[4096];
+    f = fopen(path, "w");
+    fputs("a.AT2\n", f);
+    fclose(f);
+    if (getcwd(cwd, sizeof cwd) && chdir(dir) == 0) {
+        s = NULL;
+        rc = pd_suite_read("s.txt", &s, &err);
+        CHECK(ctx, rc == PD_OK && s && s->n == 1 && !strcmp(s->path[0], "a.AT2"),
+              "a file in the working folder: %s", rc ? err.msg : s->path[0]);
+        pd_suite_free(s);
+        CHECK(ctx, chdir(cwd) == 0, "back to %s", cwd);
     }
     unlink(path);
     rc = pd_suite_read(path, &s, &err);
