@@ -7,7 +7,9 @@
  * a panel each with the storeys of their contacts and the top; otherwise
  * one panel holds the top storeys of up to PLOT_STRUCTS structures, evenly
  * spread over the row (an impact at a storey not drawn is then counted in
- * the key but not marked). */
+ * the key but not marked).  A last panel draws the gaps of the contacts
+ * (PLOT_GAPS at most, evenly over the scene's), zero where a contact is
+ * closed. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -21,6 +23,7 @@
 #define PLOT_STOREYS 8   /* most storeys of one structure drawn */
 #define PLOT_POINTS 2000 /* points per curve (the samples are decimated) */
 #define PLOT_MARKS 4000  /* most impacts marked */
+#define PLOT_GAPS 8      /* most contacts whose gaps are drawn */
 
 /* A curve: storey `storey` (1-based) of structure st, in panel `panel`. */
 typedef struct plot_curve {
@@ -39,6 +42,9 @@ struct pd_scene_plot {
     int *mp;         /* the panel of each mark */
     long impacts[PLOT_PANELS > 1 ? PLOT_PANELS : 1]; /* impacts of each panel's contacts */
     long impacts_all;                                /* of the run */
+    int ngaps;                                       /* contacts whose gaps are drawn */
+    int gap_of[PLOT_GAPS];                           /* their indices */
+    double *g;                                       /* ngaps x (PLOT_POINTS + 2) gaps */
 };
 
 void pd_scene_plot_free(pd_scene_plot *p)
@@ -51,6 +57,7 @@ void pd_scene_plot_free(pd_scene_plot *p)
     free(p->mt);
     free(p->my);
     free(p->mp);
+    free(p->g);
     free(p);
 }
 
@@ -110,7 +117,11 @@ int pd_scene_plot_open(pd_scene_plot **out, const pd_scene *sc, long expected, p
     p->mt = malloc(PLOT_MARKS * sizeof(double));
     p->my = malloc(PLOT_MARKS * sizeof(double));
     p->mp = malloc(PLOT_MARKS * sizeof(int));
-    int bad = !p->cv || !p->t || !p->y || !p->mt || !p->my || !p->mp;
+    p->ngaps = sc->ncontact < PLOT_GAPS ? sc->ncontact : PLOT_GAPS;
+    for (int j = 0; j < p->ngaps; j++) /* evenly over the contacts, both ends */
+        p->gap_of[j] = p->ngaps > 1 ? (int)((long)j * (sc->ncontact - 1) / (p->ngaps - 1)) : 0;
+    p->g = malloc((size_t)(p->ngaps > 0 ? p->ngaps : 1) * (PLOT_POINTS + 2) * sizeof(double));
+    int bad = !p->cv || !p->t || !p->y || !p->mt || !p->my || !p->mp || !p->g;
     if (!bad && p->panel_mode)
         for (int s = 0; s < sc->nstruct && !bad; s++)
             bad = panel_curves(p, s, s) != 0;
@@ -174,6 +185,11 @@ static void halve(pd_scene_plot *p)
         for (long i = 0; i < n; i++)
             y[i] = y[2 * i];
     }
+    for (int j = 0; j < p->ngaps; j++) {
+        double *gj = p->g + (size_t)j * (PLOT_POINTS + 2);
+        for (long i = 0; i < n; i++)
+            gj[i] = gj[2 * i];
+    }
     p->np = n;
     p->stride *= 2;
 }
@@ -192,6 +208,8 @@ int pd_scene_plot_sample(const pd_scene_sample *s, void *ctx)
     p->t[p->np] = s->t;
     for (int k = 0; k < p->ncurves; k++)
         p->y[(size_t)k * (PLOT_POINTS + 2) + p->np] = storey_x(sc, s, p->cv[k].st, p->cv[k].storey);
+    for (int j = 0; j < p->ngaps; j++)
+        p->g[(size_t)j * (PLOT_POINTS + 2) + p->np] = s->gap ? s->gap[p->gap_of[j]] : NAN;
     p->np++;
     return 0;
 }
@@ -215,6 +233,11 @@ static int plot_data(FILE *f, const void *ctx)
         for (long i = 0; i < p->nmarks; i++)
             if (p->mp[i] == q)
                 fprintf(f, "%.17g %.17g\n", p->mt[i], p->my[i]);
+        fputs("\n\n", f);
+    }
+    for (int j = 0; j < p->ngaps; j++) { /* the gaps' blocks, after the marks' */
+        for (long i = 0; i < p->np; i++)
+            fprintf(f, "%.17g %.17g\n", p->t[i], p->g[(size_t)j * (PLOT_POINTS + 2) + i]);
         fputs("\n\n", f);
     }
     return ferror(f) ? -1 : 0;
@@ -299,25 +322,62 @@ static void plot_panel(FILE *g, const char *data, const pd_scene_plot *p, int q)
     fputc('\n', g);
 }
 
+/* The gaps' panel: each drawn contact's gap against t, closed at 0. */
+static void plot_gaps(FILE *g, const char *data, const pd_scene_plot *p)
+{
+    const pd_scene *sc = p->sc;
+    fputs("set title 'gaps (0: in contact)'\nset xlabel 't [s]'\nset ylabel 'gap [m]'\n"
+          "plot 0 with lines lw 1 lc rgb 'black' title ''",
+          g);
+    for (int j = 0; j < p->ngaps; j++) {
+        const pd_contact *c = &sc->ct[p->gap_of[j]];
+        char key[2 * PD_NAME_MAX + 32];
+        snprintf(key, sizeof key, "%s-%s@%d", c->a == PD_WALL ? "wall" : sc->st[c->a].name,
+                 c->b == PD_WALL ? "wall" : sc->st[c->b].name,
+                 c->a == PD_WALL ? c->level_b : c->level_a);
+        fputs(", ", g);
+        pd_plot_text(g, data);
+        fprintf(g, " index %d with lines lw 1.2 lt %d title ", p->ncurves + p->npanels + j, j + 1);
+        pd_plot_literal(g, key);
+    }
+    fputc('\n', g);
+}
+
 static void plot_script(FILE *g, const char *data, const char *png_tmp, const void *ctx)
 {
     const plot_fig *fig = ctx;
     const pd_scene_plot *p = fig->p;
+    int gaps = p->ngaps > 0; /* a last panel of the gaps */
     fprintf(g, "set terminal pngcairo size 900,%d enhanced font 'sans,10'\n",
-            p->panel_mode ? 60 + 260 * p->npanels : 650);
+            (p->panel_mode ? 60 + 260 * p->npanels : 650) + (gaps ? 260 : 0));
     pd_plot_style(g);
     fputs("set output ", g);
     pd_plot_text(g, png_tmp);
     fputs("\nset grid\nset autoscale xfix\n", g); /* the time axis: the run, no more */
     if (!p->panel_mode) {
-        fputs("set key below font ',9'\nset title ", g);
-        pd_plot_literal(g, fig->title);
-        fputs("\nset xlabel 't [s]'\nset ylabel 'displacement relative to the ground [m]'\n", g);
+        if (gaps) { /* the displacements over 70 % of the height, the gaps below */
+            fputs("set multiplot\nset size 1,0.7\nset origin 0,0.3\nset key outside right top "
+                  "vertical font ',9'\nset rmargin 24\nset lmargin 10\nset xlabel ''\n"
+                  "set title ",
+                  g);
+            pd_plot_literal(g, fig->title);
+            fputc('\n', g);
+        } else {
+            fputs("set key below font ',9'\nset title ", g);
+            pd_plot_literal(g, fig->title);
+            fputs("\nset xlabel 't [s]'\n", g);
+        }
+        fputs("set ylabel 'displacement relative to the ground [m]'\n", g);
         plot_panel(g, data, p, 0);
+        if (gaps) {
+            fputs("set size 1,0.3\nset origin 0,0\n", g);
+            plot_gaps(g, data, p);
+            fputs("unset multiplot\n", g);
+        }
         return;
     }
     fputs("set multiplot layout ", g);
-    fprintf(g, "%d,1 title ", p->npanels);
+    fprintf(g, "%d,1 title ", p->npanels + gaps);
     pd_plot_literal(g, fig->title);
     fputs("\nset key outside right top vertical font ',9'\nset lmargin 10\nset rmargin 24\n"
           "set ylabel 'x [m]'\n",
@@ -325,9 +385,11 @@ static void plot_script(FILE *g, const char *data, const char *png_tmp, const vo
     for (int q = 0; q < p->npanels; q++) {
         fputs("set title ", g);
         pd_plot_literal(g, p->sc->st[q].name);
-        fprintf(g, "\nset xlabel '%s'\n", q + 1 == p->npanels ? "t [s]" : "");
+        fprintf(g, "\nset xlabel '%s'\n", q + 1 == p->npanels && !gaps ? "t [s]" : "");
         plot_panel(g, data, p, q);
     }
+    if (gaps)
+        plot_gaps(g, data, p);
     fputs("unset multiplot\n", g);
 }
 
