@@ -175,6 +175,8 @@ _PROTOTYPES = {
     "pd_record_pulse_eval": (None, [P(PdRecordPulse), c_double, P(c_double), P(c_double)]),
     # suites
     "pd_stats_of": (c_int, [P(c_double), c_int, P(PdStats), P(PdErr)]),
+    "pd_scene_excite_record": (None, [P(PdSceneExcitation), P(PdRecord), P(PdRecordPulse),
+                                      c_double]),
     "pd_record_sa": (c_int, [P(PdRecord), P(PdRecordPulse), c_double, c_double, P(c_double),
                              P(PdErr)]),
     "pd_record_scale_to": (c_int, [P(PdRecord), P(PdRecordPulse), c_int, c_double, c_double,

@@ -1,7 +1,8 @@
 """Scenes: rows of structures read from JSON files (docs/scenes.md) or
 generated (chain), run as `pound simulate --scene F --json` runs them."""
 import ctypes
-from typing import Any, Dict, List, Optional, Tuple, Union
+import os
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -178,6 +179,66 @@ class Scene:
         _lib.check(lib.pd_scene_resolve_opts(self._p, o, out, err), err)
         self._method_by = have["method_by"] or "default"
         return o, out
+
+    def simulate_records(self, records: Sequence[Any], history: bool = False, every: Int = 1,
+                         **opts: Any) -> Result:
+        """A suite of records on this scene, as `pound simulate --scene F
+        --record R1 --record R2 ... --json`: each record (a file, a
+        pound.Record, or an array with record_dt and units) replaces the
+        excitation in turn (the scene's duration derived for it unless
+        tend), r.records holds each run (as simulate() gives it) and r.stats
+        per structure the suite's statistics of its largest storey's umax,
+        drift_ratio, acc_max, base shear_max and gamma, and per contact how
+        often it closed, the statistics of its required gap, impacts, largest
+        impulse and the code rules' gaps, and how often each rule's gap would
+        have been closed.  target_pga=A or target_sa=A [m/s^2] (T1 [s],
+        default the first structure's period) scale each record; the scene's
+        own excitation is back afterwards."""
+        from ._osc import _suite_record, stats_of
+        case = {k: opts.pop(k) for k in ("units", "record_format", "record_dt", "target_pga",
+                                         "target_sa", "T1", "scale") if k in opts}
+        if isinstance(records, (str, bytes, os.PathLike)) or not isinstance(
+                records, (list, tuple)) or not records:
+            raise InputError("records: a list of record files, pound.Records or arrays (a suite)")
+        target = [k for k in ("target_pga", "target_sa") if k in case]
+        if len(target) > 1:
+            raise InputError("target_pga and target_sa: a suite is scaled to one target")
+        kind = 0 if not target else 1 if target[0] == "target_pga" else 2
+        value = number(target[0], case[target[0]]) if target else 0.0
+        if target and not 0.0 < value <= 1e3:
+            raise InputError("%s: the target must be in (0, 1000] m/s^2" % target[0])
+        if "T1" in case and kind != 2:
+            raise InputError("T1: the period of target_sa")
+        if target and "scale" in case:
+            raise InputError("scale and %s: the target sets each record's scale" % target[0])
+        T1 = number("T1", case["T1"]) if "T1" in case else self._sc.st[0].T0
+        base = number("scale", case.get("scale", 1.0))
+        sc = self._sc
+        saved, saved_tend, kept, runs = sc.exc, sc.tend, [], []
+        saved = _lib.PdSceneExcitation.from_buffer_copy(saved)
+        err = PdErr()
+        try:
+            for item in records:
+                rec = _suite_record(item, case)
+                kept.append(rec)  # the scene points at it while it runs
+                scale = ctypes.c_double(base)
+                if kind:
+                    _lib.check(lib.pd_record_scale_to(rec.rec, rec.pulse, kind, value, T1, 0.05,
+                                                      scale, err), err)
+                lib.pd_scene_excite_record(ctypes.byref(sc.exc), rec.rec, rec.pulse, scale.value)
+                sc.tend = 0.0
+                _lib.check(lib.pd_scene_finish(self._p, err), err)
+                runs.append(self.simulate(history, every, **opts))
+        finally:
+            ctypes.memmove(ctypes.byref(sc.exc), ctypes.byref(saved), ctypes.sizeof(saved))
+            sc.tend = saved_tend
+            lib.pd_scene_finish(self._p, err)
+        out = Result(n=len(runs))
+        if kind:
+            out.update(target="pga" if kind == 1 else "sa", target_value=value)
+        out["records"] = runs
+        out["stats"] = _suite_stats(runs, stats_of)
+        return out
 
     def simulate(self, history: bool = True, every: Int = 1, **opts: Any) -> Result:
         """The run and its contact-free twin, as `pound simulate --scene F
@@ -399,6 +460,37 @@ def _scene_sampler(h, n, m):
 def scene(path: PathArg) -> Scene:
     """Read a scene file (JSON, docs/scenes.md): a pound.Scene."""
     return Scene(path)
+
+
+def _suite_stats(runs, stats_of):
+    """The CLI's suite statistics of a scene (cli/cmd_simulate.c suite_scene)."""
+    structs, contacts = [], []
+    for k, st in enumerate(runs[0]["structures"]):
+        one = Result(name=st["name"])
+        for f in ("umax", "drift_ratio", "acc_max", "shear_max", "gamma"):
+            vals = []
+            for r in runs:  # the largest storey's (base shear: storey 1), NaN passed over
+                v = 0.0
+                for x in np.asarray(r["structures"][k][f], dtype=float)[:1 if f == "shear_max"
+                                                                         else None]:
+                    v = float(x) if x > v else v
+                vals.append(v)
+            one[f] = stats_of(vals)
+        structs.append(one)
+    for c, ct in enumerate(runs[0]["contacts"]):
+        req = [r["contacts"][c]["required_gap"] for r in runs]
+        one = Result(sides="%s-%s" % (ct["a"], ct["b"]), level=ct["level"],
+                     closed=float(np.mean([r["contacts"][c]["impacts"] > 0 for r in runs])),
+                     required_gap=stats_of(req),
+                     impacts=stats_of([float(r["contacts"][c]["impacts"]) for r in runs]),
+                     max_impulse=stats_of([r["contacts"][c]["max_impulse"] for r in runs]))
+        one["rules"] = Result((q, stats_of([r["contacts"][c]["rules"][q] for r in runs]))
+                              for q in ("abs", "srss", "ddc"))
+        one["rule_closed"] = Result(
+            (q, float(np.mean([g > r["contacts"][c]["rules"][q] * (1 + 1e-9)
+                               for g, r in zip(req, runs)]))) for q in ("abs", "srss", "ddc"))
+        contacts.append(one)
+    return Result(structures=structs, contacts=contacts)
 
 
 def simulate_scene(path: Union[PathArg, Scene], history: bool = True, every: Int = 1,

@@ -221,3 +221,21 @@ def test_python_suite_refusals(kw, says):
     import pound
     with pytest.raises(pound.InputError, match=says):
         pound.simulate(history=False, **kw)
+
+
+def test_python_scene_suite_is_the_clis(cli, same):
+    """Scene.simulate_records gives the CLI's scene suite JSON to the bit; the
+    scene's own excitation is back afterwards."""
+    import pound
+    scene = EXAMPLES / "scenes" / "three-buildings.json"
+    args = []
+    for p in RECS[:3]:
+        args += ["--record", p]
+    js = cli("simulate", "--scene", scene, *args, "--method", "event", "--target-pga", "4")
+    with pound.Scene(scene) as sc:
+        before = sc.simulate(method="event", history=False)
+        r = sc.simulate_records(RECS[:3], method="event", target_pga=4)
+        after = sc.simulate(method="event", history=False)
+    same(r, js)
+    assert after.pulse == before.pulse and after.structures[1].umax.tolist() == \
+        before.structures[1].umax.tolist()
