@@ -87,6 +87,19 @@ static void test_suite_file(pd_test_ctx *ctx)
         CHECK(ctx, rc == PD_EINVAL && s == NULL && strstr(err.msg, says[k]), "bad %d: %s", k,
               err.msg);
     }
+    /* a path of 3500 bytes (the line's limit is 4 kB) kept whole, its folder
+     * before it */
+    static char lp[3600];
+    memset(lp, 'p', 3500);
+    lp[3500] = '\n';
+    f = fopen(path, "w");
+    fputs(lp, f);
+    fclose(f);
+    s = NULL;
+    rc = pd_suite_read(path, &s, &err);
+    CHECK(ctx, rc == PD_OK && s && strlen(s->path[0]) == strlen(dir) + 1 + 3500,
+          "a long path: %s", rc ? err.msg : "kept");
+    pd_suite_free(s);
     /* a suite file named without a folder: its paths as they are */
     char cwd[4096];
     f = fopen(path, "w");
