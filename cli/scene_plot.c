@@ -5,9 +5,9 @@
  *
  * A few structures with contacts below their top (at most PLOT_PANELS) get
  * a panel each with the storeys of their contacts and the top; otherwise
- * one panel holds the top storeys of up to PLOT_STRUCTS structures, evenly
- * spread over the row (an impact at a storey not drawn is then counted in
- * the key but not marked).  A last panel draws the gaps of the contacts
+ * the top storeys of up to PLOT_STRUCTS structures, evenly spread over the
+ * row, PLOT_GROUP to a panel (an impact at a storey not drawn is then
+ * counted in the key but not marked).  A last panel draws the gaps of the contacts
  * (PLOT_GAPS at most, evenly over the scene's), zero where a contact is
  * closed. */
 #include <math.h>
@@ -24,6 +24,7 @@
 #define PLOT_POINTS 2000 /* points per curve (the samples are decimated) */
 #define PLOT_MARKS 4000  /* most impacts marked */
 #define PLOT_GAPS 8      /* most contacts whose gaps are drawn */
+#define PLOT_GROUP 4     /* most structures' tops in one panel */
 
 /* A curve: storey `storey` (1-based) of structure st, in panel `panel`. */
 typedef struct plot_curve {
@@ -127,9 +128,12 @@ int pd_scene_plot_open(pd_scene_plot **out, const pd_scene *sc, long expected, p
             bad = panel_curves(p, s, s) != 0;
     else if (!bad) { /* top storeys, evenly over the row, both ends included */
         p->ncurves = sc->nstruct < PLOT_STRUCTS ? sc->nstruct : PLOT_STRUCTS;
+        /* panels of PLOT_GROUP tops at most, as even as they go */
+        p->npanels = (p->ncurves + PLOT_GROUP - 1) / PLOT_GROUP;
         for (int k = 0; k < p->ncurves; k++) {
             int s = p->ncurves > 1 ? (int)((long)k * (sc->nstruct - 1) / (p->ncurves - 1)) : 0;
-            p->cv[k] = (plot_curve){.st = s, .storey = sc->st[s].storeys, .panel = 0};
+            p->cv[k] = (plot_curve){
+                .st = s, .storey = sc->st[s].storeys, .panel = k * p->npanels / p->ncurves};
         }
     }
     if (bad) {
@@ -313,7 +317,11 @@ static void plot_panel(FILE *g, const char *data, const pd_scene_plot *p, int q)
     plot_walls(g, p, q);
     if (panel_marks(p, q) > 0) {
         char key[64];
-        snprintf(key, sizeof key, "impacts (%ld)", p->panel_mode ? p->impacts[q] : p->impacts_all);
+        if (!p->panel_mode && p->npanels > 1) /* a group's: the marks on its curves */
+            snprintf(key, sizeof key, "impacts marked (%ld)", panel_marks(p, q));
+        else
+            snprintf(key, sizeof key, "impacts (%ld)",
+                     p->panel_mode ? p->impacts[q] : p->impacts_all);
         fputs(", ", g);
         pd_plot_text(g, data);
         fprintf(g, " index %d with points pt 7 ps 0.8 lc rgb 'black' title ", p->ncurves + q);
@@ -354,7 +362,7 @@ static void plot_script(FILE *g, const char *data, const char *png_tmp, const vo
     fputs("set output ", g);
     pd_plot_text(g, png_tmp);
     fputs("\nset grid\nset autoscale xfix\n", g); /* the time axis: the run, no more */
-    if (!p->panel_mode) {
+    if (!p->panel_mode && p->npanels == 1) {
         if (gaps) { /* the displacements over 70 % of the height, the gaps below */
             fputs("set multiplot\nset size 1,0.7\nset origin 0,0.3\nset key outside right top "
                   "vertical font ',9'\nset rmargin 24\nset lmargin 10\nset xlabel ''\n"
@@ -383,8 +391,21 @@ static void plot_script(FILE *g, const char *data, const char *png_tmp, const vo
           "set ylabel 'x [m]'\n",
           g);
     for (int q = 0; q < p->npanels; q++) {
+        char name[2 * PD_NAME_MAX + 8];
+        if (p->panel_mode)
+            snprintf(name, sizeof name, "%s", p->sc->st[q].name);
+        else { /* the first and last structures of the group */
+            int a = -1, b = -1;
+            for (int k = 0; k < p->ncurves; k++)
+                if (p->cv[k].panel == q) {
+                    a = a < 0 ? p->cv[k].st : a;
+                    b = p->cv[k].st;
+                }
+            snprintf(name, sizeof name, "%s ... %s", a >= 0 ? p->sc->st[a].name : "",
+                     b >= 0 ? p->sc->st[b].name : "");
+        }
         fputs("set title ", g);
-        pd_plot_literal(g, p->sc->st[q].name);
+        pd_plot_literal(g, name);
         fprintf(g, "\nset xlabel '%s'\n", q + 1 == p->npanels && !gaps ? "t [s]" : "");
         plot_panel(g, data, p, q);
     }

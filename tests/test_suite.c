@@ -97,8 +97,8 @@ static void test_suite_file(pd_test_ctx *ctx)
     fclose(f);
     s = NULL;
     rc = pd_suite_read(path, &s, &err);
-    CHECK(ctx, rc == PD_OK && s && strlen(s->path[0]) == strlen(dir) + 1 + 3500,
-          "a long path: %s", rc ? err.msg : "kept");
+    CHECK(ctx, rc == PD_OK && s && strlen(s->path[0]) == strlen(dir) + 1 + 3500, "a long path: %s",
+          rc ? err.msg : "kept");
     pd_suite_free(s);
     /* a suite file named without a folder: its paths as they are */
     char cwd[4096];
