@@ -1227,44 +1227,17 @@ done:
     return status;
 }
 
-/* Every record of the suite on the scene (each replacing its excitation):
- * per-record results as single runs give them, then per structure and
- * contact the suite's statistics, how often each contact closed and how
- * often each code rule's gap would have been closed (the required gap
- * above the rule's). */
-static int suite_scene(sim_args *a)
+/* The suite's runs on the scene: ss[k] of record k on its copy scs[k] (OpenMP
+ * over the records; the numbers do not depend on the threads): 0, 1 or 2. */
+static int suite_scene_run(sim_args *a, pd_scene **scs, pd_scene_summary *ss, pd_err *errs)
 {
-    pd_scene *base = NULL, **scs = NULL;
-    pd_scene_summary *ss = NULL;
-    pd_err *errs = NULL;
-    double *col = NULL;
-    unsigned char *flag = NULL;
-    int n = a->k.suite->n, status, failed = -1, rc_first = 0, nt = pd_spec_threads(a->threads);
-    if ((status = pd_cli_scene(&a->k, &base)))
-        return status;
-    scs = calloc((size_t)n, sizeof *scs);
-    ss = calloc((size_t)n, sizeof *ss);
-    errs = calloc((size_t)n, sizeof *errs);
-    col = calloc((size_t)n, sizeof *col);
-    flag = calloc((size_t)n, 1);
-    for (int k = 0; scs && k < n; k++)
-        scs[k] = pd_scene_copy(base);
-    for (int k = 0; scs && k < n && !status; k++)
-        status = !scs[k];
-    if (!scs || !ss || !errs || !col || !flag || status) {
-        fprintf(stderr, "pound: simulate: out of memory for a suite of %d records\n", n);
-        status = 1;
-        goto done;
-    }
+    int n = a->k.suite->n, failed = -1, rc_first = 0, nt = pd_spec_threads(a->threads), done = 0;
     for (int k = 0; k < n; k++) { /* each record on its copy, checked before any run */
         pd_err err;
-        if (pd_cli_scene_record(&a->k, k, scs[k], &err)) {
-            status = pd_cli_usage_error("%s: %s", a->k.suite->path[k], err.msg);
-            goto done;
-        }
+        if (pd_cli_scene_record(&a->k, k, scs[k], &err))
+            return pd_cli_usage_error("%s: %s", a->k.suite->path[k], err.msg);
     }
     progress pr;
-    int done = 0;
     progress_start(&pr);
 #pragma omp parallel for schedule(dynamic) num_threads(nt)
     for (int k = 0; k < n; k++) {
@@ -1284,128 +1257,94 @@ static int suite_scene(sim_args *a)
     progress_end(&pr);
     if (failed >= 0) {
         fprintf(stderr, "pound: simulate: %s: %s\n", a->k.suite->path[failed], errs[failed].msg);
-        status = rc_first == PD_EINVAL ? 2 : 1;
-        goto done;
+        return rc_first == PD_EINVAL ? 2 : 1;
     }
     for (int k = 0; k < n; k++)
         warn_rtol(ss[k].r.rtol, ss[k].err_est, ss[k].rtol_met);
-    const pd_scene *sc = base;
-    pd_json js;
-    if (a->json) {
-        pd_json_init(&js, stdout);
-        pd_json_begin_object(&js, NULL);
-        if (a->k.records_path) /* the suite file (none: the --record files) */
-            pd_json_str(&js, "suite", a->k.records_path);
-        pd_json_int(&js, "n", n);
-        if (a->k.target != PD_SCALE_NONE) {
-            pd_json_str(&js, "target", a->k.target == PD_SCALE_PGA ? "pga" : "sa");
-            pd_json_num(&js, "target_value", a->k.target_value);
-        }
-        pd_json_begin_array(&js, "records");
-        for (int k = 0; k < n; k++)
-            scene_json_obj(&js, a, scs[k], &ss[k]);
-        pd_json_end_array(&js);
-        pd_json_begin_object(&js, "stats");
-        pd_json_begin_array(&js, "structures");
-    } else {
-        /* a row per record: each structure's umax (its largest storey) */
-        int ncol = sc->nstruct < SUITE_TEXT_STRUCTS ? sc->nstruct : SUITE_TEXT_STRUCTS;
-        suite_header(a, stdout);
-        printf("  scene %s: %d structures, %d contacts; method %s; umax [m] of each structure's "
-               "largest storey%s\n",
-               a->k.scene_path ? a->k.scene_path : "(chain)", sc->nstruct, sc->ncontact,
-               ss[0].r.method, ncol < sc->nstruct ? " (the first ones; --json: all)" : "");
-        printf("  %-24s %12s", "record", "scale");
-        for (int st = 0; st < ncol; st++)
-            printf(" %12.12s", sc->st[st].name);
-        printf("\n");
-        double *buf = calloc((size_t)(ncol > 0 ? ncol : 1) * n, sizeof *buf);
-        const double *cols[SUITE_TEXT_STRUCTS];
-        if (!buf) {
-            fprintf(stderr, "pound: simulate: out of memory for the suite's table\n");
-            status = 1;
-            goto done;
-        }
-        for (int st = 0; st < ncol; st++) {
-            const pd_structure *S = &sc->st[st];
-            for (int k = 0; k < n; k++) {
-                double v = 0.0;
-                for (int i = S->dof; i < S->dof + S->storeys; i++)
-                    v = pd_max(v, ss[k].r.umax[i]);
-                buf[(size_t)st * n + k] = v;
-            }
-            cols[st] = buf + (size_t)st * n;
-        }
+    return 0;
+}
+
+/* Figure f of structure S in run r: its largest storey's umax, drift
+ * ratio, a_abs, gamma (f 0, 1, 2, 4), its base shear (3). */
+static double structure_fig(const pd_structure *S, const pd_scene_summary *r, int f)
+{
+    double v = 0.0;
+    for (int i = S->dof; i < S->dof + S->storeys; i++)
+        v = pd_max(v, f == 0   ? r->r.umax[i]
+                      : f == 1 ? r->r.drift_ratio[i]
+                      : f == 2 ? r->r.acc_max[i]
+                      : f == 3 ? (i == S->dof ? r->r.shear_max[i] : 0.0)
+                               : r->gamma[i]);
+    return v;
+}
+
+/* Contact c over the suite: the share of records with an impact, and the
+ * share whose required gap exceeds each rule's (past rounding: at a wall
+ * ABS is the required gap itself) into rules. */
+static double contact_shares(const pd_scene_summary *ss, int n, int c, unsigned char *flag,
+                             double rules[3])
+{
+    for (int q = 0; q < 3; q++) {
         for (int k = 0; k < n; k++) {
-            printf("  %-24.24s %12.5g", scs[k]->exc.record->name, scs[k]->exc.scale);
-            for (int st = 0; st < ncol; st++)
-                printf(" %12.5g", cols[st][k]);
-            printf("\n");
+            const double *rule = q == 0   ? ss[k].rule_abs
+                                 : q == 1 ? ss[k].rule_srss
+                                          : ss[k].rule_ddc;
+            flag[k] = ss[k].required_gap[c] > rule[c] * (1.0 + SUITE_RULE_TOL);
         }
-        stats_rows(1, ncol, cols, n);
-        free(buf);
+        rules[q] = share(flag, n);
     }
-    /* per structure: its largest storey's figures */
+    for (int k = 0; k < n; k++)
+        flag[k] = ss[k].r.impacts[c] > 0;
+    return share(flag, n);
+}
+
+/* The scene suite's JSON: each record's run, then per structure and contact
+ * the statistics (docs/records.md, "Suites"). */
+static void suite_scene_json(const sim_args *a, const pd_scene *sc, pd_scene **scs,
+                             const pd_scene_summary *ss, double *col, unsigned char *flag)
+{
     static const char *const sfig[] = {"umax", "drift_ratio", "acc_max", "shear_max", "gamma"};
-    for (int st = 0; st < sc->nstruct && a->json; st++) {
-        const pd_structure *S = &sc->st[st];
+    static const char *const rname[3] = {"abs", "srss", "ddc"};
+    int n = a->k.suite->n;
+    pd_json js;
+    pd_json_init(&js, stdout);
+    pd_json_begin_object(&js, NULL);
+    if (a->k.records_path) /* the suite file (none: the --record files) */
+        pd_json_str(&js, "suite", a->k.records_path);
+    pd_json_int(&js, "n", n);
+    if (a->k.target != PD_SCALE_NONE) {
+        pd_json_str(&js, "target", a->k.target == PD_SCALE_PGA ? "pga" : "sa");
+        pd_json_num(&js, "target_value", a->k.target_value);
+    }
+    pd_json_begin_array(&js, "records");
+    for (int k = 0; k < n; k++)
+        scene_json_obj(&js, a, scs[k], &ss[k]);
+    pd_json_end_array(&js);
+    pd_json_begin_object(&js, "stats");
+    pd_json_begin_array(&js, "structures");
+    for (int st = 0; st < sc->nstruct; st++) {
         pd_json_begin_object(&js, NULL);
-        pd_json_str(&js, "name", S->name);
+        pd_json_str(&js, "name", sc->st[st].name);
         for (int f = 0; f < 5; f++) {
-            for (int k = 0; k < n; k++) {
-                const pd_scene_result *r = &ss[k].r;
-                double v = 0.0;
-                for (int i = S->dof; i < S->dof + S->storeys; i++)
-                    v = pd_max(v, f == 0   ? r->umax[i]
-                                  : f == 1 ? r->drift_ratio[i]
-                                  : f == 2 ? r->acc_max[i]
-                                  : f == 3 ? (i == S->dof ? r->shear_max[i] : 0.0)
-                                           : ss[k].gamma[i]);
-                col[k] = v;
-            }
+            for (int k = 0; k < n; k++)
+                col[k] = structure_fig(&sc->st[st], &ss[k], f);
             stats_json(&js, sfig[f], col, n);
         }
         pd_json_end_object(&js);
     }
-    if (a->json) {
-        pd_json_end_array(&js);
-        pd_json_begin_array(&js, "contacts");
-    } else if (sc->ncontact) {
-        printf("  %-24s %12s %12s %12s %12s %12s\n", "contact (level)", "closed", "required",
-               "ABS closed", "SRSS closed", "DDC closed");
-    }
+    pd_json_end_array(&js);
+    pd_json_begin_array(&js, "contacts");
     for (int c = 0; c < sc->ncontact; c++) {
         char pair[2 * PD_NAME_MAX + 4];
+        double rules[3];
         int level = contact_label(sc, c, pair, sizeof pair);
-        double closed, rules[3];
-        for (int k = 0; k < n; k++)
-            flag[k] = ss[k].r.impacts[c] > 0;
-        closed = share(flag, n);
-        for (int q = 0; q < 3; q++) {
-            for (int k = 0; k < n; k++) {
-                const double *rule = q == 0   ? ss[k].rule_abs
-                                     : q == 1 ? ss[k].rule_srss
-                                              : ss[k].rule_ddc;
-                /* beyond rounding: at a wall ABS is the required gap itself */
-                flag[k] = ss[k].required_gap[c] > rule[c] * (1.0 + SUITE_RULE_TOL);
-            }
-            rules[q] = share(flag, n);
-        }
-        for (int k = 0; k < n; k++)
-            col[k] = ss[k].required_gap[c];
-        if (!a->json) {
-            pd_stats st;
-            pd_err err;
-            if (pd_stats_of(col, n, &st, &err))
-                st.mean = NAN;
-            printf("  %-18.18s (%3d) %12.3g %12.5g %12.3g %12.3g %12.3g\n", pair, level, closed,
-                   st.mean, rules[0], rules[1], rules[2]);
-            continue;
-        }
+        double closed = contact_shares(ss, n, c, flag, rules);
         pd_json_begin_object(&js, NULL);
         pd_json_str(&js, "sides", pair);
         pd_json_int(&js, "level", level);
         pd_json_num(&js, "closed", closed); /* the share of records with an impact */
+        for (int k = 0; k < n; k++)
+            col[k] = ss[k].required_gap[c];
         stats_json(&js, "required_gap", col, n);
         for (int k = 0; k < n; k++)
             col[k] = (double)ss[k].r.impacts[c];
@@ -1414,7 +1353,6 @@ static int suite_scene(sim_args *a)
             col[k] = ss[k].r.max_impulse[c];
         stats_json(&js, "max_impulse", col, n);
         pd_json_begin_object(&js, "rules");
-        static const char *const rname[3] = {"abs", "srss", "ddc"};
         for (int q = 0; q < 3; q++) {
             for (int k = 0; k < n; k++)
                 col[k] = q == 0   ? ss[k].rule_abs[c]
@@ -1430,16 +1368,104 @@ static int suite_scene(sim_args *a)
         pd_json_end_object(&js);
         pd_json_end_object(&js);
     }
-    if (a->json) {
-        pd_json_end_array(&js);
-        pd_json_end_object(&js);
-        pd_json_end_object(&js);
-        pd_json_finish(&js);
-    } else if (sc->ncontact) {
-        printf("  (closed: the share of records with an impact; required: the mean required gap "
-               "[m]; RULE closed: the share whose required gap exceeds the rule's)\n");
+    pd_json_end_array(&js);
+    pd_json_end_object(&js);
+    pd_json_end_object(&js);
+    pd_json_finish(&js);
+}
+
+/* The scene suite's text: a row per record (each structure's umax), the
+ * statistics rows, then per contact how often it and each rule closed. */
+static int suite_scene_text(const sim_args *a, const pd_scene *sc, pd_scene **scs,
+                            const pd_scene_summary *ss, double *col, unsigned char *flag)
+{
+    int n = a->k.suite->n;
+    int ncol = sc->nstruct < SUITE_TEXT_STRUCTS ? sc->nstruct : SUITE_TEXT_STRUCTS;
+    const double *cols[SUITE_TEXT_STRUCTS];
+    double *buf = calloc((size_t)(ncol > 0 ? ncol : 1) * n, sizeof *buf);
+    if (!buf) {
+        fprintf(stderr, "pound: simulate: out of memory for the suite's table\n");
+        return 1;
     }
-done:
+    suite_header(a, stdout);
+    printf("  scene %s: %d structures, %d contacts; method %s; umax [m] of each structure's "
+           "largest storey%s\n",
+           a->k.scene_path ? a->k.scene_path : "(chain)", sc->nstruct, sc->ncontact, ss[0].r.method,
+           ncol < sc->nstruct ? " (the first ones; --json: all)" : "");
+    printf("  %-24s %12s", "record", "scale");
+    for (int st = 0; st < ncol; st++)
+        printf(" %12.12s", sc->st[st].name);
+    printf("\n");
+    for (int st = 0; st < ncol; st++) {
+        for (int k = 0; k < n; k++)
+            buf[(size_t)st * n + k] = structure_fig(&sc->st[st], &ss[k], 0);
+        cols[st] = buf + (size_t)st * n;
+    }
+    for (int k = 0; k < n; k++) {
+        printf("  %-24.24s %12.5g", scs[k]->exc.record->name, scs[k]->exc.scale);
+        for (int st = 0; st < ncol; st++)
+            printf(" %12.5g", cols[st][k]);
+        printf("\n");
+    }
+    stats_rows(1, ncol, cols, n);
+    free(buf);
+    if (!sc->ncontact)
+        return 0;
+    printf("  %-24s %12s %12s %12s %12s %12s\n", "contact (level)", "closed", "required",
+           "ABS closed", "SRSS closed", "DDC closed");
+    for (int c = 0; c < sc->ncontact; c++) {
+        char pair[2 * PD_NAME_MAX + 4];
+        double rules[3];
+        pd_stats st;
+        pd_err err;
+        int level = contact_label(sc, c, pair, sizeof pair);
+        double closed = contact_shares(ss, n, c, flag, rules);
+        for (int k = 0; k < n; k++)
+            col[k] = ss[k].required_gap[c];
+        if (pd_stats_of(col, n, &st, &err))
+            st.mean = NAN;
+        printf("  %-18.18s (%3d) %12.3g %12.5g %12.3g %12.3g %12.3g\n", pair, level, closed,
+               st.mean, rules[0], rules[1], rules[2]);
+    }
+    printf("  (closed: the share of records with an impact; required: the mean required gap "
+           "[m]; RULE closed: the share whose required gap exceeds the rule's)\n");
+    return 0;
+}
+
+/* Every record of the suite on the scene (each replacing its excitation):
+ * per-record results as single runs give them, then per structure and
+ * contact the suite's statistics, how often each contact closed and how
+ * often each code rule's gap would have been closed (the required gap
+ * above the rule's). */
+static int suite_scene(sim_args *a)
+{
+    pd_scene *base = NULL, **scs = NULL;
+    pd_scene_summary *ss = NULL;
+    pd_err *errs = NULL;
+    double *col = NULL;
+    unsigned char *flag = NULL;
+    int n = a->k.suite->n, status;
+    if ((status = pd_cli_scene(&a->k, &base)))
+        return status;
+    scs = calloc((size_t)n, sizeof *scs);
+    ss = calloc((size_t)n, sizeof *ss);
+    errs = calloc((size_t)n, sizeof *errs);
+    col = calloc((size_t)n, sizeof *col);
+    flag = calloc((size_t)n, 1);
+    for (int k = 0; scs && k < n; k++)
+        scs[k] = pd_scene_copy(base);
+    for (int k = 0; scs && k < n && !status; k++)
+        status = !scs[k];
+    if (!scs || !ss || !errs || !col || !flag || status) {
+        fprintf(stderr, "pound: simulate: out of memory for a suite of %d records\n", n);
+        status = 1;
+    }
+    if (!status)
+        status = suite_scene_run(a, scs, ss, errs);
+    if (!status && a->json)
+        suite_scene_json(a, base, scs, ss, col, flag);
+    else if (!status)
+        status = suite_scene_text(a, base, scs, ss, col, flag);
     for (int k = 0; ss && k < n; k++)
         pd_scene_summary_free(&ss[k]);
     for (int k = 0; scs && k < n; k++)
