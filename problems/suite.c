@@ -178,13 +178,13 @@ int pd_stats_of(const double *x, int n, pd_stats *st, pd_err *err)
     if (!y)
         return pd_err_set(err, PD_ENOMEM, "out of memory for the statistics of %d values", n);
     int m = 0;
-    for (int k = 0; k < n; k++)
-        if (isfinite(x[k]))
+    for (int k = 0; k < n; k++) /* the finite values, summed in their order */
+        if (isfinite(x[k])) {
             y[m++] = x[k];
+            sum += x[k];
+        }
     if (m > 0) {
         qsort(y, (size_t)m, sizeof *y, cmp_double);
-        for (int k = 0; k < m; k++)
-            sum += y[k];
         *st = (pd_stats){.n = m,
                          .mean = sum / m,
                          .median = quantile(y, m, 0.5),

@@ -19,20 +19,24 @@
 #include "pd_problems.h"
 #include "pd_test.h"
 
-/* x = 7, 1, 5, 3, NaN, 6, 2, 4: mean 4, median 4; p16 at 0.96 between the
- * 1st and 2nd order statistics (1.96), p84 at 5.04 (6.04); min 1, max 7. */
+/* x = the squares of 0.7, 0.1, 0.5, 0.3, NaN, 0.6, 0.2, 0.4 (uneven
+ * spacing): mean 0.2, median 0.16; p16 at 0.96 between the 1st and 2nd
+ * order statistics (0.01 + 0.96 0.03 = 0.0388), p84 at 5.04 (0.36 + 0.04
+ * 0.13 = 0.3652); min 0.01, max 0.49; no values, even a NULL array: n 0. */
 static void test_suite_stats(pd_test_ctx *ctx)
 {
-    const double x[8] = {7, 1, 5, 3, NAN, 6, 2, 4};
+    const double x[8] = {0.49, 0.01, 0.25, 0.09, NAN, 0.36, 0.04, 0.16};
     pd_stats st;
     pd_err err;
     int rc = pd_stats_of(x, 8, &st, &err);
     CHECK(ctx,
-          rc == PD_OK && st.n == 7 && st.mean == 4.0 && st.median == 4.0 &&
-              fabs(st.p16 - 1.96) < 1e-15 && fabs(st.p84 - 6.04) < 1e-15 && st.min == 1.0 &&
-              st.max == 7.0,
+          rc == PD_OK && st.n == 7 && fabs(st.mean - 0.2) < 1e-16 && st.median == 0.16 &&
+              fabs(st.p16 - 0.0388) < 1e-16 && fabs(st.p84 - 0.3652) < 1e-15 &&
+              st.min == 0.01 && st.max == 0.49,
           "n %d mean %g median %g p16 %.17g p84 %.17g min %g max %g", st.n, st.mean, st.median,
           st.p16, st.p84, st.min, st.max);
+    rc = pd_stats_of(NULL, 0, &st, &err);
+    CHECK(ctx, rc == PD_OK && st.n == 0 && isnan(st.median), "no values: %d", rc);
     /* an even count: the median between the middle two; one value: itself */
     const double y[4] = {4, 1, 3, 2}, one = 0.25;
     rc = pd_stats_of(y, 4, &st, &err);
@@ -195,6 +199,11 @@ static void test_suite_sa(pd_test_ctx *ctx)
             CHECK(ctx, rc == PD_OK, "Sa: %s", err.msg);
             worst = fmax(worst, fabs(Sa - ref) / ref);
         }
+        double Sa0;
+        CHECK(ctx,
+              pd_record_sa(&rec, &pulse, 0.0, 0.05, &Sa0, &err) == PD_EINVAL &&
+                  strstr(err.msg, "the period must be > 0") && isnan(Sa0),
+              "T = 0: %s", err.msg);
         /* to a target: the scaled record's Sa(1 s) is the target (linear) */
         double scale, Sa1, target = 7.0;
         int rc = pd_record_scale_to(&rec, &pulse, PD_SCALE_SA, target, 1.0, 0.05, &scale, &err);
