@@ -220,9 +220,8 @@ int pd_record_sa(const pd_record *rec, const pd_record_pulse *pulse, double T, d
     c.Pi2 = c.Tp / T;
     c.xi = xi;
     pd_run_opts o = pd_run_default_opts();
-    o.method = PD_METHOD_EVENT;
     o.no_wall = 1;
-    o.no_demands = 1;
+    o.no_demands = 1; /* umax alone (faster; the same umax) */
     pd_osc_result r;
     int rc = pd_osc_resolve_opts(&c, &o, &o, err);
     if (!rc)

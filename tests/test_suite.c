@@ -222,7 +222,9 @@ static void test_suite_sa(pd_test_ctx *ctx)
               scale * m.pga);
         pd_record_free(&rec);
     }
-    CHECK(ctx, worst <= 1e-6, "Sa against RK4: %.3g", worst);
+    /* the issue asks 1e-6; both are exact to rounding here (RK4 at dt/400:
+     * (w h)^4 ~ 1e-14): a looser method (the penalty integrator, 1e-10) fails */
+    CHECK(ctx, worst <= 1e-11, "Sa against RK4: %.3g", worst);
     printf("      Sa(T) against RK4 at dt/400: %.2g relative (6 cases)\n", worst);
 }
 
