@@ -225,6 +225,16 @@ static void test_suite_sa(pd_test_ctx *ctx)
     /* the issue asks 1e-6; both are exact to rounding here (RK4 at dt/400:
      * (w h)^4 ~ 1e-14): a looser method (the penalty integrator, 1e-10) fails */
     CHECK(ctx, worst <= 1e-11, "Sa against RK4: %.3g", worst);
+    /* a record of zeros cannot be scaled to a target: refused, not infinite */
+    pd_record z;
+    pd_err err;
+    double zeros[16] = {0}, scale = 0.0;
+    pd_record_pulse zp = {.Tp = 1.0, .ap = 1.0};
+    int rc = pd_record_from_array(&z, "zeros", zeros, 16, 0.01, PD_UNITS_M_S2, &err);
+    if (!rc)
+        rc = pd_record_scale_to(&z, &zp, PD_SCALE_PGA, 3.0, 0.0, 0.05, &scale, &err);
+    CHECK(ctx, rc == PD_EINVAL && strstr(err.msg, "its PGA is 0"), "zeros: %s", err.msg);
+    pd_record_free(&z);
     printf("      Sa(T) against RK4 at dt/400: %.2g relative (6 cases)\n", worst);
 }
 
