@@ -247,7 +247,7 @@ int pd_record_scale_to(const pd_record *rec, const pd_record_pulse *pulse, pd_sc
         return PD_OK;
     if (!(value > 0.0) || !isfinite(value))
         return pd_err_set(err, PD_EINVAL, "the scaling target must be > 0 m/s^2 (got %g)", value);
-    double now;
+    double now = NAN; /* the record's PGA or Sa(T1) at scale 1 */
     int rc;
     if (kind == PD_SCALE_PGA) {
         pd_record_measures m;

@@ -235,6 +235,14 @@ static void test_suite_sa(pd_test_ctx *ctx)
         rc = pd_record_scale_to(&z, &zp, PD_SCALE_PGA, 3.0, 0.0, 0.05, &scale, &err);
     CHECK(ctx, rc == PD_EINVAL && strstr(err.msg, "its PGA is 0"), "zeros: %s", err.msg);
     pd_record_free(&z);
+    /* a weak record (PGA 0.02 m/s^2) scaled up: 150 times to 3 m/s^2 */
+    zeros[5] = -0.02;
+    rc = pd_record_from_array(&z, "weak", zeros, 16, 0.01, PD_UNITS_M_S2, &err);
+    if (!rc)
+        rc = pd_record_scale_to(&z, &zp, PD_SCALE_PGA, 3.0, 0.0, 0.05, &scale, &err);
+    CHECK(ctx, rc == PD_OK && fabs(scale - 150.0) <= 1e-12 * 150.0, "weak: %.17g (%s)", scale,
+          rc ? err.msg : "ok");
+    pd_record_free(&z);
     printf("      Sa(T) against RK4 at dt/400: %.2g relative (6 cases)\n", worst);
 }
 
