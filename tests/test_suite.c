@@ -31,8 +31,8 @@ static void test_suite_stats(pd_test_ctx *ctx)
     int rc = pd_stats_of(x, 8, &st, &err);
     CHECK(ctx,
           rc == PD_OK && st.n == 7 && fabs(st.mean - 0.2) < 1e-16 && st.median == 0.16 &&
-              fabs(st.p16 - 0.0388) < 1e-16 && fabs(st.p84 - 0.3652) < 1e-15 &&
-              st.min == 0.01 && st.max == 0.49,
+              fabs(st.p16 - 0.0388) < 1e-16 && fabs(st.p84 - 0.3652) < 1e-15 && st.min == 0.01 &&
+              st.max == 0.49,
           "n %d mean %g median %g p16 %.17g p84 %.17g min %g max %g", st.n, st.mean, st.median,
           st.p16, st.p84, st.min, st.max);
     rc = pd_stats_of(NULL, 0, &st, &err);
