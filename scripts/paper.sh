@@ -247,7 +247,7 @@ $term
 set output '$out/paper-fig7.png'
 set title 'Fig. 7: {/Symbol P}_3 = gap / L_e on the (1/L_e, gap) plane; records at their fitted 1/L_e'
 set xlabel '1/L_e = {/Symbol w}_p^2 / a_p [m^{-1}]'; set ylabel 'gap [m]'
-set xrange [0:12]; set yrange [0:0.1]; set grid; set key top right
+set xrange [0:13]; set yrange [0:0.1]; set grid; set key top right  # 13: a record at 12 is not cut
 set samples 400
 set arrow from 1.2, graph 0 to 1.2, graph 1 nohead dt 2 lc rgb 'black'
 set label 'Tabas (paper)' at 1.25, 0.095 font ',9'

@@ -225,6 +225,41 @@ static void test_suite_sa(pd_test_ctx *ctx)
     /* the issue asks 1e-6; both are exact to rounding here (RK4 at dt/400:
      * (w h)^4 ~ 1e-14): a looser method (the penalty integrator, 1e-10) fails */
     CHECK(ctx, worst <= 1e-11, "Sa against RK4: %.3g", worst);
+    /* the damping given is the damping used (xi 0 and 0.02 against RK4); out
+     * of [0, 1) refused; a target must be a finite value > 0; no target: 1 */
+    {
+        pd_record rec;
+        pd_record_pulse pulse;
+        pd_err e2;
+        double Sa = NAN, scale = NAN, worst_xi = 0.0;
+        int rc2 = pd_record_synth(pd_synth_shipped(0), "s", &rec, &e2) ||
+                  pd_record_fit_pulse(&rec, &pulse, &e2);
+        for (int j = 0; j < 2 && !rc2; j++) {
+            double xi = j ? 0.02 : 0.0;
+            rc2 = pd_record_sa(&rec, &pulse, 0.7, xi, &Sa, &e2);
+            worst_xi = fmax(worst_xi, fabs(Sa - sa_rk4(&rec, 0.7, xi)) / Sa);
+        }
+        CHECK(ctx, !rc2 && worst_xi <= 1e-11, "Sa at xi 0, 0.02: %.3g (%s)", worst_xi,
+              rc2 ? e2.msg : "ok");
+        int refused = !rc2 && pd_record_sa(&rec, &pulse, 0.7, 1.0, &Sa, &e2) == PD_EINVAL &&
+                      pd_record_sa(&rec, &pulse, 0.7, -0.01, &Sa, &e2) == PD_EINVAL &&
+                      pd_record_scale_to(&rec, &pulse, PD_SCALE_PGA, 0.0, 0, 0.05, &scale, &e2) ==
+                          PD_EINVAL &&
+                      pd_record_scale_to(&rec, &pulse, PD_SCALE_PGA, INFINITY, 0, 0.05, &scale,
+                                         &e2) == PD_EINVAL;
+        int none =
+            !rc2 &&
+            pd_record_scale_to(&rec, &pulse, PD_SCALE_NONE, 5.0, 0, 0.05, &scale, &e2) == PD_OK &&
+            scale == 1.0;
+        int small =
+            !rc2 &&
+            pd_record_scale_to(&rec, &pulse, PD_SCALE_PGA, 0.5, 0, 0.05, &scale, &e2) == PD_OK &&
+            scale > 0.0 && scale < 1.0;
+        CHECK(ctx, refused && none && small, "refusals %d, no target %d, a target of 0.5 %d",
+              refused, none, small);
+        if (!rc2)
+            pd_record_free(&rec);
+    }
     /* a record of zeros cannot be scaled to a target: refused, not infinite */
     pd_record z;
     pd_err err;
@@ -291,8 +326,25 @@ static void test_suite_shipped(pd_test_ctx *ctx)
         pd_record_free(&a);
         pd_record_free(&b);
     }
-    p.dt = -1.0;
-    CHECK(ctx, pd_record_synth(&p, "c", &a, &err) == PD_EINVAL, "a bad parameter refused");
+    /* each parameter out of its range refused alone; at their edges (no
+     * noise, t2 = t1) accepted */
+    int refused = 1;
+    for (int k = 0; k < 13; k++) {
+        pd_synth q = *pd_synth_shipped(0);
+        double *field[13] = {&q.dt, &q.duration, &q.duration, &q.Tp, &q.gamma, &q.wg, &q.wf,
+                             &q.zg, &q.zf,       &q.S0,       &q.t1, &q.t2,    &q.c};
+        double bad[13] = {0.0, 0.01, 2e6, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, -1e-3, 0.0, 1.9, 0.0};
+        *field[k] = bad[k]; /* duration: dt itself, then 2e8 samples */
+        refused &= pd_record_synth(&q, "c", &a, &err) == PD_EINVAL;
+    }
+    pd_synth edge = *pd_synth_shipped(0);
+    edge.S0 = 0.0;
+    edge.t2 = edge.t1;
+    rc = pd_record_synth(&edge, "e", &a, &err);
+    CHECK(ctx, refused && rc == PD_OK, "bad parameters refused %d, the edges accepted %d", refused,
+          rc == PD_OK);
+    if (!rc)
+        pd_record_free(&a);
 }
 
 /* The progress hook: a scene's run by each method that visits its steps
