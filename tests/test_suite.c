@@ -334,8 +334,9 @@ static void test_suite_shipped(pd_test_ctx *ctx)
         double *field[13] = {&q.dt, &q.duration, &q.duration, &q.Tp, &q.gamma, &q.wg, &q.wf,
                              &q.zg, &q.zf,       &q.S0,       &q.t1, &q.t2,    &q.c};
         double bad[13] = {0.0, 0.01, 2e6, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, -1e-3, 0.0, 1.9, 0.0};
-        *field[k] = bad[k]; /* duration: dt itself, then 2e8 samples */
-        refused &= pd_record_synth(&q, "c", &a, &err) == PD_EINVAL;
+        *field[k] = bad[k];   /* duration: dt itself, then 2e8 samples */
+        a.acc = (double *)&a; /* not NULL: the refusal must leave the record empty */
+        refused &= pd_record_synth(&q, "c", &a, &err) == PD_EINVAL && !a.acc && a.npts == 0;
     }
     pd_synth edge = *pd_synth_shipped(0);
     edge.S0 = 0.0;
