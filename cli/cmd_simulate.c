@@ -742,12 +742,68 @@ static void osc_figs(const sim_args *a, const pd_osc_summary *s, double *f)
     memcpy(f, v, sizeof v);
 }
 
+/* A suite's JSON opening keys: its file (none for --record files), the
+ * number of records, the target. */
+static void suite_json_head(pd_json *js, const sim_args *a)
+{
+    if (a->k.records_path)
+        pd_json_str(js, "suite", a->k.records_path);
+    pd_json_int(js, "n", a->k.suite->n);
+    if (a->k.target != PD_SCALE_NONE) {
+        pd_json_str(js, "target", a->k.target == PD_SCALE_PGA ? "pga" : "sa");
+        pd_json_num(js, "target_value", a->k.target_value);
+    }
+}
+
+/* One record's run of a suite: PD_OK or its status, its message in err. */
+typedef int (*record_run)(void *ctx, int k, pd_err *err);
+
+/* Every record's run (OpenMP over the records, the numbers the same
+ * whatever the threads), a progress line counting them; the first failing
+ * record's message: 0, 1 or 2. */
+static int run_records(const sim_args *a, record_run fn, void *ctx, pd_err *errs)
+{
+    int n = a->k.suite->n, failed = -1, rc_first = 0, nt = pd_spec_threads(a->threads), done = 0;
+    progress pr;
+    progress_start(&pr);
+#pragma omp parallel for schedule(dynamic) num_threads(nt)
+    for (int k = 0; k < n; k++) {
+        int rc = fn(ctx, k, &errs[k]);
+#pragma omp critical
+        {
+            if (rc && (failed < 0 || k < failed)) {
+                failed = k;
+                rc_first = rc;
+            }
+            suite_progress(&pr, ++done, n);
+        }
+    }
+    progress_end(&pr);
+    if (failed < 0)
+        return 0;
+    fprintf(stderr, "pound: simulate: %s: %s\n", a->k.suite->path[failed], errs[failed].msg);
+    return rc_first == PD_EINVAL ? 2 : 1;
+}
+
+/* The oscillator's runs of a suite: record k's case, options, summary. */
+typedef struct osc_runs {
+    const pd_osc *cs;
+    const pd_run_opts *os;
+    pd_osc_summary *ss;
+} osc_runs;
+
+static int osc_record_run(void *ctx, int k, pd_err *err)
+{
+    osc_runs *r = ctx;
+    return pd_osc_summarize(&r->cs[k], &r->os[k], NULL, NULL, &r->ss[k], err);
+}
+
 /* Every record of the suite through the oscillator: per-record results as
  * single runs give them (the same function makes each), then the suite's
  * statistics. */
 static int suite_oscillator(sim_args *a)
 {
-    int n = a->k.suite->n, status = 0, failed = -1;
+    int n = a->k.suite->n, status = 0;
     pd_osc *cs = calloc((size_t)n, sizeof *cs);
     pd_run_opts *os = calloc((size_t)n, sizeof *os);
     pd_osc_summary *ss = calloc((size_t)n, sizeof *ss);
@@ -763,28 +819,9 @@ static int suite_oscillator(sim_args *a)
         status = pd_cli_case_record(&a->k, k, &cs[k], &os[k]);
     if (status)
         goto done;
-    int rc_first = 0, nt = pd_spec_threads(a->threads);
-    progress pr;
-    int done = 0;
-    progress_start(&pr);
-#pragma omp parallel for schedule(dynamic) num_threads(nt)
-    for (int k = 0; k < n; k++) {
-        int rc = pd_osc_summarize(&cs[k], &os[k], NULL, NULL, &ss[k], &errs[k]);
-#pragma omp critical
-        {
-            if (rc && (failed < 0 || k < failed)) {
-                failed = k;
-                rc_first = rc;
-            }
-            suite_progress(&pr, ++done, n);
-        }
-    }
-    progress_end(&pr);
-    if (failed >= 0) {
-        fprintf(stderr, "pound: simulate: %s: %s\n", a->k.suite->path[failed], errs[failed].msg);
-        status = rc_first == PD_EINVAL ? 2 : 1;
+    osc_runs runs = {.cs = cs, .os = os, .ss = ss};
+    if ((status = run_records(a, osc_record_run, &runs, errs)))
         goto done;
-    }
     for (int k = 0; k < n; k++) {
         osc_figs(a, &ss[k], figs + (size_t)k * OSC_FIGS);
         warn_rtol(ss[k].r.rtol, ss[k].err_est, ss[k].rtol_met);
@@ -794,13 +831,7 @@ static int suite_oscillator(sim_args *a)
         pd_json js;
         pd_json_init(&js, stdout);
         pd_json_begin_object(&js, NULL);
-        if (a->k.records_path) /* the suite file (none: the --record files) */
-            pd_json_str(&js, "suite", a->k.records_path);
-        pd_json_int(&js, "n", n);
-        if (a->k.target != PD_SCALE_NONE) {
-            pd_json_str(&js, "target", a->k.target == PD_SCALE_PGA ? "pga" : "sa");
-            pd_json_num(&js, "target_value", a->k.target_value);
-        }
+        suite_json_head(&js, a);
         pd_json_begin_array(&js, "records");
         for (int k = 0; k < n; k++)
             osc_json(&js, a, &cs[k], os[k].method, &ss[k]);
@@ -1227,38 +1258,34 @@ done:
     return status;
 }
 
-/* The suite's runs on the scene: ss[k] of record k on its copy scs[k] (OpenMP
- * over the records; the numbers do not depend on the threads): 0, 1 or 2. */
+/* The suite's runs on the scene: ss[k] of record k on its copy scs[k]: 0,
+ * 1 or 2. */
+/* The scene's runs of a suite: record k's scene copy, the options, summary. */
+typedef struct scene_runs {
+    pd_scene **scs;
+    const pd_run_opts *opts;
+    pd_scene_summary *ss;
+} scene_runs;
+
+static int scene_record_run(void *ctx, int k, pd_err *err)
+{
+    scene_runs *r = ctx;
+    pd_run_opts o;
+    int rc = pd_scene_resolve_opts(r->scs[k], r->opts, &o, err);
+    return rc ? rc : pd_scene_summarize(r->scs[k], &o, NULL, NULL, &r->ss[k], err);
+}
+
 static int suite_scene_run(sim_args *a, pd_scene **scs, pd_scene_summary *ss, pd_err *errs)
 {
-    int n = a->k.suite->n, failed = -1, rc_first = 0, nt = pd_spec_threads(a->threads), done = 0;
+    int n = a->k.suite->n, status;
     for (int k = 0; k < n; k++) { /* each record on its copy, checked before any run */
         pd_err err;
         if (pd_cli_scene_record(&a->k, k, scs[k], &err))
             return pd_cli_usage_error("%s: %s", a->k.suite->path[k], err.msg);
     }
-    progress pr;
-    progress_start(&pr);
-#pragma omp parallel for schedule(dynamic) num_threads(nt)
-    for (int k = 0; k < n; k++) {
-        pd_run_opts o;
-        int rc = pd_scene_resolve_opts(scs[k], &a->k.opts, &o, &errs[k]);
-        if (!rc)
-            rc = pd_scene_summarize(scs[k], &o, NULL, NULL, &ss[k], &errs[k]);
-#pragma omp critical
-        {
-            if (rc && (failed < 0 || k < failed)) {
-                failed = k;
-                rc_first = rc;
-            }
-            suite_progress(&pr, ++done, n);
-        }
-    }
-    progress_end(&pr);
-    if (failed >= 0) {
-        fprintf(stderr, "pound: simulate: %s: %s\n", a->k.suite->path[failed], errs[failed].msg);
-        return rc_first == PD_EINVAL ? 2 : 1;
-    }
+    scene_runs runs = {.scs = scs, .opts = &a->k.opts, .ss = ss};
+    if ((status = run_records(a, scene_record_run, &runs, errs)))
+        return status;
     for (int k = 0; k < n; k++)
         warn_rtol(ss[k].r.rtol, ss[k].err_est, ss[k].rtol_met);
     return 0;
@@ -1309,13 +1336,7 @@ static void suite_scene_json(const sim_args *a, const pd_scene *sc, pd_scene **s
     pd_json js;
     pd_json_init(&js, stdout);
     pd_json_begin_object(&js, NULL);
-    if (a->k.records_path) /* the suite file (none: the --record files) */
-        pd_json_str(&js, "suite", a->k.records_path);
-    pd_json_int(&js, "n", n);
-    if (a->k.target != PD_SCALE_NONE) {
-        pd_json_str(&js, "target", a->k.target == PD_SCALE_PGA ? "pga" : "sa");
-        pd_json_num(&js, "target_value", a->k.target_value);
-    }
+    suite_json_head(&js, a);
     pd_json_begin_array(&js, "records");
     for (int k = 0; k < n; k++)
         scene_json_obj(&js, a, scs[k], &ss[k]);
