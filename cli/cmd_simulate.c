@@ -668,18 +668,8 @@ static void stats_json(pd_json *js, const char *key, const double *x, int n)
 {
     pd_stats st;
     pd_err err;
-    if (pd_stats_of(x, n, &st, &err))
-        st = (pd_stats){
-            .n = 0, .mean = NAN, .median = NAN, .p16 = NAN, .p84 = NAN, .min = NAN, .max = NAN};
-    pd_json_begin_object(js, key);
-    pd_json_int(js, "n", st.n);
-    pd_json_num(js, "mean", st.mean);
-    pd_json_num(js, "median", st.median);
-    pd_json_num(js, "p16", st.p16);
-    pd_json_num(js, "p84", st.p84);
-    pd_json_num(js, "min", st.min);
-    pd_json_num(js, "max", st.max);
-    pd_json_end_object(js);
+    pd_stats_of(x, n, &st, &err); /* out of memory: st stays NaN, n 0 */
+    pd_json_stats(js, key, &st);
 }
 
 /* The share of the n flags set. */
@@ -712,9 +702,7 @@ static void stats_rows(int lead, int ncol, const double *const *cols, int n)
     pd_err err;
     ncol = ncol < 16 ? ncol : 16;
     for (int j = 0; j < ncol; j++)
-        if (pd_stats_of(cols[j], n, &st[j], &err))
-            st[j] = (pd_stats){
-                .n = 0, .mean = NAN, .median = NAN, .p16 = NAN, .p84 = NAN, .min = NAN, .max = NAN};
+        pd_stats_of(cols[j], n, &st[j], &err); /* out of memory: NaN */
     for (int r = 0; r < 5; r++) {
         printf("  %-24s", names[r]);
         for (int j = 0; j < lead; j++)
@@ -1443,8 +1431,7 @@ static int suite_scene_text(const sim_args *a, const pd_scene *sc, pd_scene **sc
         double closed = contact_shares(ss, n, c, flag, rules);
         for (int k = 0; k < n; k++)
             col[k] = ss[k].required_gap[c];
-        if (pd_stats_of(col, n, &st, &err))
-            st.mean = NAN;
+        pd_stats_of(col, n, &st, &err); /* out of memory: NaN */
         printf("  %-18.18s (%3d) %12.3g %12.5g %12.3g %12.3g %12.3g\n", pair, level, closed,
                st.mean, rules[0], rules[1], rules[2]);
     }

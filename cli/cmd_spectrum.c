@@ -571,21 +571,7 @@ static void point_stats(const pd_spec_row *rows, int nrec, long points, long p, 
         const pd_spec_row *r = &rows[(size_t)k * points + p];
         x[k] = f == 0 ? r->Pi1 : f == 1 ? r->gamma : r->umax;
     }
-    if (pd_stats_of(x, nrec, st, &err))
-        st->n = 0;
-}
-
-static void stats_obj(pd_json *js, const char *key, const pd_stats *st)
-{
-    pd_json_begin_object(js, key);
-    pd_json_int(js, "n", st->n);
-    pd_json_num(js, "mean", st->mean);
-    pd_json_num(js, "median", st->median);
-    pd_json_num(js, "p16", st->p16);
-    pd_json_num(js, "p84", st->p84);
-    pd_json_num(js, "min", st->min);
-    pd_json_num(js, "max", st->max);
-    pd_json_end_object(js);
+    pd_stats_of(x, nrec, st, &err); /* out of memory: st stays NaN, n 0 */
 }
 
 /* The suite's output: JSON (every record's points, the statistics at each
@@ -669,7 +655,7 @@ static int suite_output(const spec_args *a, const pd_spectrum *specs, pd_spec_ro
             for (int f = 0; f < 3; f++) {
                 pd_stats st;
                 point_stats(rows, nrec, points, p, f, x, &st);
-                stats_obj(&js, fig[f], &st);
+                pd_json_stats(&js, fig[f], &st);
             }
             pd_json_end_object(&js);
         }

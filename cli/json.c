@@ -102,6 +102,19 @@ void pd_json_null(pd_json *js, const char *key)
     fputs("null", js->out);
 }
 
+void pd_json_stats(pd_json *js, const char *key, const pd_stats *st)
+{
+    pd_json_begin_object(js, key);
+    pd_json_int(js, "n", st->n);
+    pd_json_num(js, "mean", st->mean);
+    pd_json_num(js, "median", st->median);
+    pd_json_num(js, "p16", st->p16);
+    pd_json_num(js, "p84", st->p84);
+    pd_json_num(js, "min", st->min);
+    pd_json_num(js, "max", st->max);
+    pd_json_end_object(js);
+}
+
 void pd_json_nums(pd_json *js, const char *key, int n, const double *x)
 {
     pd_json_begin_array(js, key);

@@ -155,6 +155,8 @@ void pd_json_str(pd_json *js, const char *key, const char *s);
 void pd_json_bool(pd_json *js, const char *key, int b);
 void pd_json_null(pd_json *js, const char *key);
 void pd_json_nums(pd_json *js, const char *key, int n, const double *x);
+/* A suite's statistics as one object {n, mean, median, p16, p84, min, max}. */
+void pd_json_stats(pd_json *js, const char *key, const pd_stats *st);
 void pd_json_finish(pd_json *js); /* newline after the top-level value */
 
 /* The decisions a scene's reference run rests on (docs/methods.md, "The

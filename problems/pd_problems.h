@@ -1113,7 +1113,8 @@ PD_API int pd_suite_read(const char *file, pd_suite **out, pd_err *err);
 
 /* The statistics of a suite's values: of the n finite ones (NaN left out),
  * mean, median, 16th and 84th percentiles (linear between order
- * statistics, NumPy's default), min and max; all NaN when none is finite. */
+ * statistics, NumPy's default), min and max; all NaN (n 0) when none is
+ * finite, and when the call fails (out of memory, NULL x). */
 typedef struct pd_stats {
     int n;
     double mean, median, p16, p84, min, max;
