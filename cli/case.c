@@ -94,6 +94,8 @@ void pd_cli_case_free(pd_cli_case *a)
     free(a->recs);
     free(a->rec_scale);
     pd_suite_free(a->suite);
+    pd_scene_free(a->scene);
+    a->scene = NULL;
     a->recs = NULL;
     a->rec_scale = NULL;
     a->suite = NULL;
@@ -528,10 +530,10 @@ static int check_case(const pd_cli_case *a)
 }
 
 /* Sa(T1)'s period: --T1, else the oscillator's --T0, else the scene's
- * first structure's fundamental period; 0 or 2. */
-static int case_T1(const pd_cli_case *a, double *T1)
+ * first structure's fundamental period (the scene kept for pd_cli_scene);
+ * 0 or 2. */
+static int case_T1(pd_cli_case *a, double *T1)
 {
-    pd_scene *sc = NULL;
     pd_err err;
     *T1 = a->have_T1 ? a->T1 : a->have_T0 ? a->T0 : 0.0;
     if (*T1 > 0.0 || a->target != PD_SCALE_SA)
@@ -539,10 +541,9 @@ static int case_T1(const pd_cli_case *a, double *T1)
     if (!a->scene_path)
         return pd_cli_usage_error("--target-sa: give the period of Sa(T1) with --T1 (or the "
                                   "oscillator's --T0)");
-    if (pd_scene_load(a->scene_path, &sc, &err))
+    if (pd_scene_load(a->scene_path, &a->scene, &err))
         return pd_cli_usage_error("%s", err.msg);
-    *T1 = sc->st[0].T0;
-    pd_scene_free(sc);
+    *T1 = a->scene->st[0].T0;
     return 0;
 }
 
@@ -865,7 +866,9 @@ int pd_cli_scene(const pd_cli_case *a, pd_scene **sc)
     pd_err err;
     int rc;
     *sc = NULL;
-    if (a->scene_path)
+    if (a->scene) /* read already */
+        rc = (*sc = pd_scene_copy(a->scene)) ? PD_OK : pd_err_set(&err, PD_ENOMEM, "out of memory");
+    else if (a->scene_path)
         rc = pd_scene_load(a->scene_path, sc, &err);
     else {
         pd_scene_excitation x = {

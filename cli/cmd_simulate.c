@@ -39,9 +39,10 @@ static const char simulate_usage[] =
     "              single run prints (JSON \"records\"), then the suite's mean, median,\n"
     "              16th/84th percentiles and max of every peak (\"stats\"); for scenes per\n"
     "              contact how often it closed and how often each code rule's gap would\n"
-    "              have (the exact required gap beyond ABS, SRSS, DDC)\n"
-    "  --threads K  records at once (OpenMP) [OMP_NUM_THREADS or all cores]; the numbers\n"
-    "              do not depend on K\n";
+    "              have (the exact required gap beyond ABS, SRSS, DDC); -o FILE.EXT and\n"
+    "              --plot F.png write each record's as FILE.recK.EXT (K from 1)\n"
+    "  --threads K  records at once (OpenMP; one at a time with -o or --plot)\n"
+    "              [OMP_NUM_THREADS or all cores]; the numbers do not depend on K\n";
 
 /* Everything the command line sets. */
 typedef struct sim_args {
@@ -53,6 +54,18 @@ typedef struct sim_args {
 } sim_args;
 
 /* Case flags, then the command's own; 0 or 2. */
+/* Record k's file of a suite: PATH with ".recK" (K from 1) before its
+ * extension ("out.h5" -> "out.rec1.h5"), or at its end: 0, or -1 when it
+ * does not fit in cap. */
+static int suite_path(const char *path, int k, char *buf, size_t cap)
+{
+    const char *slash = strrchr(path, '/'), *dot = strrchr(path, '.');
+    if (!dot || (slash && dot < slash) || dot == (slash ? slash + 1 : path))
+        dot = path + strlen(path); /* no extension (or a hidden file's dot) */
+    int n = snprintf(buf, cap, "%.*s.rec%d%s", (int)(dot - path), path, k + 1, dot);
+    return n < 0 || (size_t)n >= cap ? -1 : 0;
+}
+
 static int parse_args(sim_args *a, int argc, char **argv)
 {
     int rc, n;
@@ -108,12 +121,26 @@ static int parse_args(sim_args *a, int argc, char **argv)
         return pd_cli_usage_error("%s", err.msg);
     if ((rc = pd_cli_case_finish(&a->k)))
         return rc;
-    if (pd_cli_case_is_suite(&a->k) && (a->out || a->plot || a->dump)) {
-        const char *f = a->out ? "-o" : a->plot ? "--plot" : "--dump-lcp";
+    if (pd_cli_case_is_suite(&a->k) && a->dump) {
         pd_cli_case_free(&a->k);
-        return pd_cli_usage_error("%s: a suite of records prints its records' figures and their "
-                                  "statistics; histories and charts are one run's (--record F)",
-                                  f);
+        return pd_cli_usage_error("--dump-lcp: the LCPs of one run (--record F), not of a suite");
+    }
+    for (int k = 0; pd_cli_case_is_suite(&a->k) && k < a->k.suite->n; k++) {
+        char out[PD_PATH_MAX], plot[PD_PATH_MAX];
+        const char *flag = NULL;
+        if (a->out && suite_path(a->out, k, out, sizeof out))
+            flag = "-o";
+        else if (a->plot && suite_path(a->plot, k, plot, sizeof plot))
+            flag = "--plot";
+        else if ((a->out && pd_output_check_writable("-o", out, &err)) ||
+                 (a->plot && pd_output_check_writable("--plot", plot, &err))) {
+            pd_cli_case_free(&a->k);
+            return pd_cli_usage_error("%s", err.msg);
+        }
+        if (flag) {
+            pd_cli_case_free(&a->k);
+            return pd_cli_usage_error("%s: the path is too long for a suite's record files", flag);
+        }
     }
     if (a->dump && a->k.opts.method != PD_METHOD_MOREAU) {
         pd_cli_case_free(&a->k);
@@ -442,16 +469,15 @@ static void print_text(const sim_args *a, const pd_osc_summary *s)
 }
 
 /* Every input and summary figure after the histories; the file into place. */
-static int finish_output(const sim_args *a, const pd_osc_summary *s, pd_table_writer *w,
-                         pd_err *err)
+static int finish_output(const sim_args *a, const pd_osc *c, const pd_run_opts *opts,
+                         const pd_osc_summary *s, pd_table_writer *w, pd_err *err)
 {
-    const pd_osc *c = &a->k.c;
 #define NUM(n, u, x) {.name = n, .units = u, .num = (x)}
 #define TXT(n, x)                                                                                  \
     {                                                                                              \
         .name = n, .is_text = 1, .text = (x)                                                       \
     }
-    pd_attr attrs[64] = {TXT("method", pd_method_name(a->k.opts.method)),
+    pd_attr attrs[64] = {TXT("method", pd_method_name(opts->method)),
                          TXT("pulse", pd_osc_excitation_name(c)),
                          TXT("dir", pd_dir_name(c->dir)),
                          NUM("scale", "1", c->record ? c->scale : 1.0),
@@ -536,66 +562,76 @@ static pd_scene *oscillator_scene(const pd_osc *c)
     return sc;
 }
 
-/* The oscillator's run, its file, chart, dump and summary: the exit status. */
-static int simulate_oscillator(sim_args *a)
+/* The oscillator's run of case c under opts, its file (out) and chart
+ * (plot) written, nothing printed: PD_OK or a status, its message in err. */
+static int osc_run_files(const sim_args *a, const pd_osc *c, const pd_run_opts *opts,
+                         const char *out, const char *plot, pd_osc_summary *s, pd_err *err)
 {
-    pd_osc_summary s;
     pd_scene *psc = NULL;
-    pd_lcp_dump *dump = NULL;
-    pd_err err;
-    int rc, status = 0;
+    int rc = PD_OK;
     /* to a tolerance the steps are the run's: the fixed scheme's count at the
-     * default dt stands for them in the size estimate, no cap on the rows */
-    int tol = a->k.opts.rtol > 0.0;
-    long nsteps = pd_steps_for(a->k.opts.tend, tol ? pd_osc_default_dt(&a->k.c) : a->k.opts.dt);
-    osc_out o = {
-        .c = &a->k.c, .every = a->every, .rows_max = tol ? LONG_MAX : nsteps / a->every + 1};
-    if (a->out && (status = check_output_size(
-                       a->out, output_bytes(a->out, nsteps / a->every + 1, osc_ncols(&a->k.c)))))
+     * default dt stands for them in the chart's size, no cap on the rows */
+    int tol = opts->rtol > 0.0;
+    long nsteps = pd_steps_for(opts->tend, tol ? pd_osc_default_dt(c) : opts->dt);
+    osc_out o = {.c = c, .every = a->every, .rows_max = tol ? LONG_MAX : nsteps / a->every + 1};
+    if (out && (rc = pd_table_open(&o.file, out, osc_ncols(c), osc_cols, "t", o.rows_max, err)))
         goto done;
-    if ((status = dump_open(a, &dump, &a->k.opts)))
-        goto done;
-    if (a->out && (rc = pd_table_open(&o.file, a->out, osc_ncols(&a->k.c), osc_cols, "t",
-                                      o.rows_max, &err))) {
-        fprintf(stderr, "pound: simulate: %s\n", err.msg);
-        status = rc == PD_EINVAL ? 2 : 1;
+    if (plot && (!(psc = oscillator_scene(c)) || pd_scene_plot_open(&o.plot, psc, nsteps, err))) {
+        rc = pd_err_set(err, PD_ENOMEM, "out of memory for the chart");
         goto done;
     }
-    if (a->plot &&
-        (!(psc = oscillator_scene(&a->k.c)) || pd_scene_plot_open(&o.plot, psc, nsteps, &err))) {
-        fprintf(stderr, "pound: simulate: out of memory for the chart\n");
-        status = 1;
+    if ((rc = pd_osc_summarize(c, opts, out || plot ? record : NULL, &o, s, err)))
+        goto done;
+    if (isfinite(s->r.umax) && !isfinite(s->r.umax / a->k.height)) {
+        rc = pd_err_set(err, PD_EINVAL,
+                        "--height: the drift ratio umax / H overflows (umax %g m, H %g m): give "
+                        "a larger height",
+                        s->r.umax, a->k.height);
         goto done;
     }
-    if ((rc = pd_osc_summarize(&a->k.c, &a->k.opts, a->out || a->plot ? record : NULL, &o, &s,
-                               &err)) ||
-        (isfinite(s.r.umax) && !isfinite(s.r.umax / a->k.height) &&
-         (rc = pd_err_set(&err, PD_EINVAL,
-                          "--height: the drift ratio umax / H overflows "
-                          "(umax %g m, H %g m): give a larger height",
-                          s.r.umax, a->k.height))) ||
-        /* an impulse whose equivalent force overflows at any duration: the
-         * excitation's scale (the duration's own case is the library's) */
-        (isfinite(s.r.max_impulse) && !isfinite(s.r.force_equiv) &&
-         (rc = pd_err_set(&err, PD_EINVAL,
-                          "%s: the impacts' equivalent force pi I / (2 td) "
-                          "overflows (impulse I = %g): a weaker excitation",
-                          a->k.record_path ? "--scale" : "--ap", s.r.max_impulse)))) {
-        fprintf(stderr, "pound: simulate: %s\n", err.msg);
-        status = rc == PD_EINVAL ? 2 : 1;
+    /* an impulse whose equivalent force overflows at any duration: the
+     * excitation's scale (the duration's own case is the library's) */
+    if (isfinite(s->r.max_impulse) && !isfinite(s->r.force_equiv)) {
+        rc = pd_err_set(err, PD_EINVAL,
+                        "%s: the impacts' equivalent force pi I / (2 td) overflows (impulse I = "
+                        "%g): a weaker excitation",
+                        c->record ? "--scale" : "--ap", s->r.max_impulse);
         goto done;
     }
     char title[PD_NAME_MAX + 160];
     snprintf(title, sizeof title,
              "pounding oscillator: %s %s%s, T0 = %.3g s, gap = %.3g m, "
              "eps = %.3g (%s)",
-             pd_osc_excitation_name(&a->k.c), pd_dir_name(a->k.c.dir),
-             a->k.c.record ? "" : " pulse", pd_osc_T0(&a->k.c), pd_osc_gap(&a->k.c), a->k.c.eps,
-             pd_method_name(a->k.opts.method));
-    if ((o.file && finish_output(a, &s, o.file, &err)) ||
-        (a->plot && pd_scene_plot_draw(o.plot, a->plot, title, &err))) {
+             pd_osc_excitation_name(c), pd_dir_name(c->dir), c->record ? "" : " pulse",
+             pd_osc_T0(c), pd_osc_gap(c), c->eps, pd_method_name(opts->method));
+    if (o.file && (rc = finish_output(a, c, opts, s, o.file, err)))
+        goto done;
+    if (plot)
+        rc = pd_scene_plot_draw(o.plot, plot, title, err);
+done:
+    pd_table_free(o.file);
+    pd_scene_plot_free(o.plot);
+    pd_scene_free(psc);
+    return rc;
+}
+
+/* The oscillator's run, its file, chart, dump and summary: the exit status. */
+static int simulate_oscillator(sim_args *a)
+{
+    pd_osc_summary s;
+    pd_lcp_dump *dump = NULL;
+    pd_err err;
+    int rc, status = 0;
+    int tol = a->k.opts.rtol > 0.0;
+    long nsteps = pd_steps_for(a->k.opts.tend, tol ? pd_osc_default_dt(&a->k.c) : a->k.opts.dt);
+    if (a->out && (status = check_output_size(
+                       a->out, output_bytes(a->out, nsteps / a->every + 1, osc_ncols(&a->k.c)))))
+        goto done;
+    if ((status = dump_open(a, &dump, &a->k.opts)))
+        goto done;
+    if ((rc = osc_run_files(a, &a->k.c, &a->k.opts, a->out, a->plot, &s, &err))) {
         fprintf(stderr, "pound: simulate: %s\n", err.msg);
-        status = 1;
+        status = rc == PD_EINVAL ? 2 : 1;
         goto done;
     }
     if ((status = dump_finish(dump)))
@@ -607,9 +643,6 @@ static int simulate_oscillator(sim_args *a)
         print_text(a, &s);
 done:
     pd_lcp_dump_free(dump);
-    pd_table_free(o.file);
-    pd_scene_plot_free(o.plot);
-    pd_scene_free(psc);
     return status;
 }
 
@@ -672,15 +705,6 @@ static void stats_json(pd_json *js, const char *key, const double *x, int n)
     pd_json_stats(js, key, &st);
 }
 
-/* The share of the n flags set. */
-static double share(const unsigned char *flag, int n)
-{
-    int k = 0;
-    for (int i = 0; i < n; i++)
-        k += flag[i] != 0;
-    return n ? (double)k / n : NAN;
-}
-
 /* The suite's header: its file or records, the scaling. */
 static void suite_header(const sim_args *a, FILE *f)
 {
@@ -716,7 +740,6 @@ static void stats_rows(int lead, int ncol, const double *const *cols, int n)
 }
 
 enum { OSC_FIGS = 9, SUITE_TEXT_STRUCTS = 6 };
-#define SUITE_RULE_TOL 1e-9 /* a rule's gap is closed when the required gap exceeds it by this */
 static const char *const osc_fig_names[OSC_FIGS] = {"umax",      "Pi1",         "gamma",
                                                     "impacts",   "max_impulse", "acc_max",
                                                     "shear_max", "drift_ratio", "ductility"};
@@ -751,7 +774,9 @@ typedef int (*record_run)(void *ctx, int k, pd_err *err);
  * record's message: 0, 1 or 2. */
 static int run_records(const sim_args *a, record_run fn, void *ctx, pd_err *errs)
 {
-    int n = a->k.suite->n, failed = -1, rc_first = 0, nt = pd_spec_threads(a->threads), done = 0;
+    int n = a->k.suite->n, failed = -1, rc_first = 0, done = 0;
+    /* records in turn when each writes files (HDF5 is not thread-safe) */
+    int nt = a->out || a->plot ? 1 : pd_spec_threads(a->threads);
     progress pr;
     progress_start(&pr);
 #pragma omp parallel for schedule(dynamic) num_threads(nt)
@@ -769,21 +794,38 @@ static int run_records(const sim_args *a, record_run fn, void *ctx, pd_err *errs
     progress_end(&pr);
     if (failed < 0)
         return 0;
+    for (int k = 0; k < n && (a->out || a->plot); k++) { /* no partial output */
+        char path[PD_PATH_MAX];
+        if (a->out && !suite_path(a->out, k, path, sizeof path))
+            unlink(path);
+        if (a->plot && !suite_path(a->plot, k, path, sizeof path))
+            unlink(path);
+    }
     fprintf(stderr, "pound: simulate: %s: %s\n", a->k.suite->path[failed], errs[failed].msg);
     return rc_first == PD_EINVAL ? 2 : 1;
 }
 
 /* The oscillator's runs of a suite: record k's case, options, summary. */
 typedef struct osc_runs {
+    const sim_args *a;
     const pd_osc *cs;
     const pd_run_opts *os;
     pd_osc_summary *ss;
 } osc_runs;
 
+/* Record k's run, its files (-o, --plot: PATH.recK.EXT) written. */
 static int osc_record_run(void *ctx, int k, pd_err *err)
 {
     osc_runs *r = ctx;
-    return pd_osc_summarize(&r->cs[k], &r->os[k], NULL, NULL, &r->ss[k], err);
+    char out[PD_PATH_MAX], plot[PD_PATH_MAX];
+    if (!r->a->out && !r->a->plot)
+        return pd_osc_summarize(&r->cs[k], &r->os[k], NULL, NULL, &r->ss[k], err);
+    if (r->a->out)
+        suite_path(r->a->out, k, out, sizeof out); /* fits: parse_args checked */
+    if (r->a->plot)
+        suite_path(r->a->plot, k, plot, sizeof plot);
+    return osc_run_files(r->a, &r->cs[k], &r->os[k], r->a->out ? out : NULL,
+                         r->a->plot ? plot : NULL, &r->ss[k], err);
 }
 
 /* Every record of the suite through the oscillator: per-record results as
@@ -807,7 +849,7 @@ static int suite_oscillator(sim_args *a)
         status = pd_cli_case_record(&a->k, k, &cs[k], &os[k]);
     if (status)
         goto done;
-    osc_runs runs = {.cs = cs, .os = os, .ss = ss};
+    osc_runs runs = {.a = a, .cs = cs, .os = os, .ss = ss};
     if ((status = run_records(a, osc_record_run, &runs, errs)))
         goto done;
     for (int k = 0; k < n; k++) {
@@ -1176,58 +1218,74 @@ static const char *r_method(const pd_scene_summary *s)
     return s->r.method ? s->r.method : "?";
 }
 
+/* The run of scene sc under the resolved options o, its file (out) and
+ * chart (plot) written, nothing printed: PD_OK or a status, its message in
+ * err. */
+static int scene_run_files(const sim_args *a, const pd_scene *sc, const pd_run_opts *o,
+                           const char *out, const char *plot, pd_scene_summary *s, pd_err *err)
+{
+    fanout fo = {0};
+    char name[64], title[512];
+    long expected = pd_steps_for(o->tend, o->dt); /* samples: every step or every dt */
+    int rc = PD_OK;
+    if ((out && (rc = pd_scene_writer_open(
+                     &fo.w, out, sc, a->every,
+                     o->method == PD_METHOD_PENALTY || o->method == PD_METHOD_NEWMARK, err))) ||
+        (plot && (rc = pd_scene_plot_open(&fo.p, sc, expected, err))))
+        goto done;
+    if ((rc = pd_scene_summarize(sc, o, fo.w || fo.p ? fan_sample : NULL, &fo, s, err)))
+        goto done;
+    snprintf(name, sizeof name, "chain of %d", a->k.chain);
+    pd_scene_run_info ri = {.sum = s, .scene_name = a->k.scene_path ? a->k.scene_path : name};
+    /* the chart's title: the scene file's name (not its folders), method, excitation */
+    const char *base = strrchr(ri.scene_name, '/');
+    snprintf(title, sizeof title, "%s: %s, %s%s", base ? base + 1 : ri.scene_name, r_method(s),
+             sc->exc.record ? "record " : "",
+             sc->exc.record ? sc->exc.record->name : pd_pulse_name(sc->exc.pulse));
+    if (fo.w && (rc = pd_scene_writer_finish(fo.w, &ri, err)))
+        goto done;
+    if (fo.p)
+        rc = pd_scene_plot_draw(fo.p, plot, title, err);
+done:
+    pd_scene_writer_free(fo.w);
+    pd_scene_plot_free(fo.p);
+    return rc;
+}
+
+/* The width of a scene's file: t, x and v of every dof, gap and impulse of
+ * every contact. */
+static int scene_width(const pd_scene *sc)
+{
+    return 1 + 2 * sc->n + 2 * sc->ncontact;
+}
+
 static int simulate_scene(sim_args *a)
 {
     pd_scene *sc = NULL;
     pd_scene_summary s;
     pd_run_opts o;
     pd_lcp_dump *dump = NULL;
-    fanout fo = {0};
     pd_err err;
-    char name[64];
     int rc, status;
     memset(&s, 0, sizeof s);
     if ((status = pd_cli_scene(&a->k, &sc)))
         return status;
     pd_scene_resolve_opts(sc, &a->k.opts, &o, &err);
-    long expected = pd_steps_for(o.tend, o.dt); /* samples: every step or every dt */
-    int width = 1 + 2 * sc->n + 2 * sc->ncontact;
-    if (a->out &&
-        (status = check_output_size(a->out, output_bytes(a->out, expected / a->every + 1, width))))
+    long expected = pd_steps_for(o.tend, o.dt);
+    if (a->out && (status = check_output_size(
+                       a->out, output_bytes(a->out, expected / a->every + 1, scene_width(sc)))))
         goto done;
     if ((status = dump_open(a, &dump, &o)))
         goto done;
-    if ((a->out && pd_scene_writer_open(
-                       &fo.w, a->out, sc, a->every,
-                       o.method == PD_METHOD_PENALTY || o.method == PD_METHOD_NEWMARK, &err)) ||
-        (a->plot && pd_scene_plot_open(&fo.p, sc, expected, &err))) {
-        fprintf(stderr, "pound: simulate: %s\n", err.msg);
-        status = err.status == PD_EINVAL ? 2 : 1;
-        goto done;
-    }
     progress pr;
     progress_start(&pr);
     o.progress = on_progress;
     o.progress_ctx = &pr;
-    rc = pd_scene_summarize(sc, &o, fo.w || fo.p ? fan_sample : NULL, &fo, &s, &err);
+    rc = scene_run_files(a, sc, &o, a->out, a->plot, &s, &err);
     progress_end(&pr);
     if (rc) {
         fprintf(stderr, "pound: simulate: %s\n", err.msg);
         status = rc == PD_EINVAL ? 2 : 1;
-        goto done;
-    }
-    snprintf(name, sizeof name, "chain of %d", a->k.chain);
-    pd_scene_run_info ri = {.sum = &s, .scene_name = a->k.scene_path ? a->k.scene_path : name};
-    /* the chart's title: the scene file's name (not its folders), method, excitation */
-    char title[512];
-    const char *base = strrchr(ri.scene_name, '/');
-    snprintf(title, sizeof title, "%s: %s, %s%s", base ? base + 1 : ri.scene_name, r_method(&s),
-             sc->exc.record ? "record " : "",
-             sc->exc.record ? sc->exc.record->name : pd_pulse_name(sc->exc.pulse));
-    if ((fo.w && pd_scene_writer_finish(fo.w, &ri, &err)) ||
-        (fo.p && pd_scene_plot_draw(fo.p, a->plot, title, &err))) {
-        fprintf(stderr, "pound: simulate: %s\n", err.msg);
-        status = 1;
         goto done;
     }
     if ((status = dump_finish(dump)))
@@ -1239,8 +1297,6 @@ static int simulate_scene(sim_args *a)
         scene_text(a, sc, &s);
 done:
     pd_lcp_dump_free(dump);
-    pd_scene_writer_free(fo.w);
-    pd_scene_plot_free(fo.p);
     pd_scene_summary_free(&s);
     pd_scene_free(sc);
     return status;
@@ -1250,17 +1306,27 @@ done:
  * 1 or 2. */
 /* The scene's runs of a suite: record k's scene copy, the options, summary. */
 typedef struct scene_runs {
+    const sim_args *a;
     pd_scene **scs;
     const pd_run_opts *opts;
     pd_scene_summary *ss;
 } scene_runs;
 
+/* Record k's run, its files (-o, --plot: PATH.recK.EXT) written. */
 static int scene_record_run(void *ctx, int k, pd_err *err)
 {
     scene_runs *r = ctx;
+    char out[PD_PATH_MAX], plot[PD_PATH_MAX];
     pd_run_opts o;
     int rc = pd_scene_resolve_opts(r->scs[k], r->opts, &o, err);
-    return rc ? rc : pd_scene_summarize(r->scs[k], &o, NULL, NULL, &r->ss[k], err);
+    if (rc || (!r->a->out && !r->a->plot))
+        return rc ? rc : pd_scene_summarize(r->scs[k], &o, NULL, NULL, &r->ss[k], err);
+    if (r->a->out)
+        suite_path(r->a->out, k, out, sizeof out); /* fits: parse_args checked */
+    if (r->a->plot)
+        suite_path(r->a->plot, k, plot, sizeof plot);
+    return scene_run_files(r->a, r->scs[k], &o, r->a->out ? out : NULL, r->a->plot ? plot : NULL,
+                           &r->ss[k], err);
 }
 
 static int suite_scene_run(sim_args *a, pd_scene **scs, pd_scene_summary *ss, pd_err *errs)
@@ -1271,7 +1337,7 @@ static int suite_scene_run(sim_args *a, pd_scene **scs, pd_scene_summary *ss, pd
         if (pd_cli_scene_record(&a->k, k, scs[k], &err))
             return pd_cli_usage_error("%s: %s", a->k.suite->path[k], err.msg);
     }
-    scene_runs runs = {.scs = scs, .opts = &a->k.opts, .ss = ss};
+    scene_runs runs = {.a = a, .scs = scs, .opts = &a->k.opts, .ss = ss};
     if ((status = run_records(a, scene_record_run, &runs, errs)))
         return status;
     for (int k = 0; k < n; k++)
@@ -1279,48 +1345,24 @@ static int suite_scene_run(sim_args *a, pd_scene **scs, pd_scene_summary *ss, pd
     return 0;
 }
 
-/* Figure f of structure S in run r: its largest storey's umax, drift
- * ratio, a_abs, gamma (f 0, 1, 2, 4), its base shear (3). */
-static double structure_fig(const pd_structure *S, const pd_scene_summary *r, int f)
+/* One set of peaks' statistics into js (ductility only when yielding). */
+static void peaks_json(pd_json *js, const pd_suite_peaks *p, int yields)
 {
-    double v = 0.0;
-    for (int i = S->dof; i < S->dof + S->storeys; i++)
-        v = pd_max(v, f == 0   ? r->r.umax[i]
-                      : f == 1 ? r->r.drift_ratio[i]
-                      : f == 2 ? r->r.acc_max[i]
-                      : f == 3 ? (i == S->dof ? r->r.shear_max[i] : 0.0)
-                               : r->gamma[i]);
-    return v;
+    pd_json_stats(js, "umax", &p->umax);
+    pd_json_stats(js, "drift_ratio", &p->drift_ratio);
+    pd_json_stats(js, "acc_max", &p->acc_max);
+    pd_json_stats(js, "shear_max", &p->shear_max);
+    pd_json_stats(js, "gamma", &p->gamma);
+    if (yields)
+        pd_json_stats(js, "ductility", &p->ductility);
 }
 
-/* Contact c over the suite: the share of records with an impact, and the
- * share whose required gap exceeds each rule's (past rounding: at a wall
- * ABS is the required gap itself) into rules. */
-static double contact_shares(const pd_scene_summary *ss, int n, int c, unsigned char *flag,
-                             double rules[3])
-{
-    for (int q = 0; q < 3; q++) {
-        for (int k = 0; k < n; k++) {
-            const double *rule = q == 0   ? ss[k].rule_abs
-                                 : q == 1 ? ss[k].rule_srss
-                                          : ss[k].rule_ddc;
-            flag[k] = ss[k].required_gap[c] > rule[c] * (1.0 + SUITE_RULE_TOL);
-        }
-        rules[q] = share(flag, n);
-    }
-    for (int k = 0; k < n; k++)
-        flag[k] = ss[k].r.impacts[c] > 0;
-    return share(flag, n);
-}
-
-/* The scene suite's JSON: each record's run, then per structure and contact
- * the statistics (docs/records.md, "Suites"). */
+/* The scene suite's JSON: each record's run, then per structure (and its
+ * storeys) and contact the statistics (docs/records.md, "Suites"). */
 static void suite_scene_json(const sim_args *a, const pd_scene *sc, pd_scene **scs,
-                             const pd_scene_summary *ss, double *col, unsigned char *flag)
+                             const pd_scene_summary *ss, const pd_scene_suite *st)
 {
-    static const char *const sfig[] = {"umax", "drift_ratio", "acc_max", "shear_max", "gamma"};
-    static const char *const rname[3] = {"abs", "srss", "ddc"};
-    int n = a->k.suite->n;
+    int n = a->k.suite->n, yields = pd_scene_springs(sc) > 0;
     pd_json js;
     pd_json_init(&js, stdout);
     pd_json_begin_object(&js, NULL);
@@ -1331,49 +1373,44 @@ static void suite_scene_json(const sim_args *a, const pd_scene *sc, pd_scene **s
     pd_json_end_array(&js);
     pd_json_begin_object(&js, "stats");
     pd_json_begin_array(&js, "structures");
-    for (int st = 0; st < sc->nstruct; st++) {
+    for (int s = 0; s < sc->nstruct; s++) {
+        const pd_structure *S = &sc->st[s];
         pd_json_begin_object(&js, NULL);
-        pd_json_str(&js, "name", sc->st[st].name);
-        for (int f = 0; f < 5; f++) {
-            for (int k = 0; k < n; k++)
-                col[k] = structure_fig(&sc->st[st], &ss[k], f);
-            stats_json(&js, sfig[f], col, n);
+        pd_json_str(&js, "name", S->name);
+        peaks_json(&js, &st->structure[s], yields);
+        pd_json_begin_array(&js, "storeys"); /* each storey's own */
+        for (int i = S->dof; i < S->dof + S->storeys; i++) {
+            pd_json_begin_object(&js, NULL);
+            pd_json_int(&js, "storey", i - S->dof + 1);
+            peaks_json(&js, &st->storey[i], yields);
+            pd_json_end_object(&js);
         }
+        pd_json_end_array(&js);
         pd_json_end_object(&js);
     }
     pd_json_end_array(&js);
     pd_json_begin_array(&js, "contacts");
     for (int c = 0; c < sc->ncontact; c++) {
+        const pd_suite_contact *ct = &st->contact[c];
         char pair[2 * PD_NAME_MAX + 4];
-        double rules[3];
         int level = contact_label(sc, c, pair, sizeof pair);
-        double closed = contact_shares(ss, n, c, flag, rules);
         pd_json_begin_object(&js, NULL);
         pd_json_str(&js, "sides", pair);
         pd_json_int(&js, "level", level);
-        pd_json_num(&js, "closed", closed); /* the share of records with an impact */
-        for (int k = 0; k < n; k++)
-            col[k] = ss[k].required_gap[c];
-        stats_json(&js, "required_gap", col, n);
-        for (int k = 0; k < n; k++)
-            col[k] = (double)ss[k].r.impacts[c];
-        stats_json(&js, "impacts", col, n);
-        for (int k = 0; k < n; k++)
-            col[k] = ss[k].r.max_impulse[c];
-        stats_json(&js, "max_impulse", col, n);
+        pd_json_num(&js, "closed", ct->closed); /* the share of records with an impact */
+        pd_json_stats(&js, "required_gap", &ct->required_gap);
+        pd_json_stats(&js, "impacts", &ct->impacts);
+        pd_json_stats(&js, "max_impulse", &ct->max_impulse);
         pd_json_begin_object(&js, "rules");
-        for (int q = 0; q < 3; q++) {
-            for (int k = 0; k < n; k++)
-                col[k] = q == 0   ? ss[k].rule_abs[c]
-                         : q == 1 ? ss[k].rule_srss[c]
-                                  : ss[k].rule_ddc[c];
-            stats_json(&js, rname[q], col, n);
-        }
+        pd_json_stats(&js, "abs", &ct->rule_abs);
+        pd_json_stats(&js, "srss", &ct->rule_srss);
+        pd_json_stats(&js, "ddc", &ct->rule_ddc);
         pd_json_end_object(&js);
         /* the share of records whose required gap exceeds the rule's */
         pd_json_begin_object(&js, "rule_closed");
-        for (int q = 0; q < 3; q++)
-            pd_json_num(&js, rname[q], rules[q]);
+        pd_json_num(&js, "abs", ct->abs_closed);
+        pd_json_num(&js, "srss", ct->srss_closed);
+        pd_json_num(&js, "ddc", ct->ddc_closed);
         pd_json_end_object(&js);
         pd_json_end_object(&js);
     }
@@ -1383,57 +1420,54 @@ static void suite_scene_json(const sim_args *a, const pd_scene *sc, pd_scene **s
     pd_json_finish(&js);
 }
 
-/* The scene suite's text: a row per record (each structure's umax), the
- * statistics rows, then per contact how often it and each rule closed. */
+/* The scene suite's text: a row per record (each structure's largest
+ * storey's umax), the statistics rows, then per contact how often it and
+ * each rule closed. */
 static int suite_scene_text(const sim_args *a, const pd_scene *sc, pd_scene **scs,
-                            const pd_scene_summary *ss, double *col, unsigned char *flag)
+                            const pd_scene_summary *ss, const pd_scene_suite *st)
 {
+    static const char *const names[] = {"mean", "median", "p16", "p84", "max"};
     int n = a->k.suite->n;
     int ncol = sc->nstruct < SUITE_TEXT_STRUCTS ? sc->nstruct : SUITE_TEXT_STRUCTS;
-    const double *cols[SUITE_TEXT_STRUCTS];
-    double *buf = calloc((size_t)(ncol > 0 ? ncol : 1) * n, sizeof *buf);
-    if (!buf) {
-        fprintf(stderr, "pound: simulate: out of memory for the suite's table\n");
-        return 1;
-    }
     suite_header(a, stdout);
     printf("  scene %s: %d structures, %d contacts; method %s; umax [m] of each structure's "
            "largest storey%s\n",
            a->k.scene_path ? a->k.scene_path : "(chain)", sc->nstruct, sc->ncontact, ss[0].r.method,
            ncol < sc->nstruct ? " (the first ones; --json: all)" : "");
     printf("  %-24s %12s", "record", "scale");
-    for (int st = 0; st < ncol; st++)
-        printf(" %12.12s", sc->st[st].name);
+    for (int s = 0; s < ncol; s++)
+        printf(" %12.12s", sc->st[s].name);
     printf("\n");
-    for (int st = 0; st < ncol; st++) {
-        for (int k = 0; k < n; k++)
-            buf[(size_t)st * n + k] = structure_fig(&sc->st[st], &ss[k], 0);
-        cols[st] = buf + (size_t)st * n;
-    }
     for (int k = 0; k < n; k++) {
         printf("  %-24.24s %12.5g", scs[k]->exc.record->name, scs[k]->exc.scale);
-        for (int st = 0; st < ncol; st++)
-            printf(" %12.5g", cols[st][k]);
+        for (int s = 0; s < ncol; s++) {
+            const pd_structure *S = &sc->st[s];
+            double v = 0.0;
+            for (int i = S->dof; i < S->dof + S->storeys; i++)
+                v = ss[k].r.umax[i] > v ? ss[k].r.umax[i] : v;
+            printf(" %12.5g", v);
+        }
         printf("\n");
     }
-    stats_rows(1, ncol, cols, n);
-    free(buf);
+    for (int r = 0; r < 5; r++) {
+        printf("  %-24s %12s", names[r], "");
+        for (int s = 0; s < ncol; s++) {
+            const pd_stats *u = &st->structure[s].umax;
+            const double v[5] = {u->mean, u->median, u->p16, u->p84, u->max};
+            printf(" %12.5g", v[r]);
+        }
+        printf("\n");
+    }
     if (!sc->ncontact)
         return 0;
     printf("  %-24s %12s %12s %12s %12s %12s\n", "contact (level)", "closed", "required",
            "ABS closed", "SRSS closed", "DDC closed");
     for (int c = 0; c < sc->ncontact; c++) {
+        const pd_suite_contact *ct = &st->contact[c];
         char pair[2 * PD_NAME_MAX + 4];
-        double rules[3];
-        pd_stats st;
-        pd_err err;
         int level = contact_label(sc, c, pair, sizeof pair);
-        double closed = contact_shares(ss, n, c, flag, rules);
-        for (int k = 0; k < n; k++)
-            col[k] = ss[k].required_gap[c];
-        pd_stats_of(col, n, &st, &err); /* out of memory: NaN */
-        printf("  %-18.18s (%3d) %12.3g %12.5g %12.3g %12.3g %12.3g\n", pair, level, closed,
-               st.mean, rules[0], rules[1], rules[2]);
+        printf("  %-18.18s (%3d) %12.3g %12.5g %12.3g %12.3g %12.3g\n", pair, level, ct->closed,
+               ct->required_gap.mean, ct->abs_closed, ct->srss_closed, ct->ddc_closed);
     }
     printf("  (closed: the share of records with an impact; required: the mean required gap "
            "[m]; RULE closed: the share whose required gap exceeds the rule's)\n");
@@ -1449,31 +1483,33 @@ static int suite_scene(sim_args *a)
 {
     pd_scene *base = NULL, **scs = NULL;
     pd_scene_summary *ss = NULL;
-    pd_err *errs = NULL;
-    double *col = NULL;
-    unsigned char *flag = NULL;
+    pd_scene_suite st = {.n = 0};
+    pd_err *errs = NULL, err;
     int n = a->k.suite->n, status;
     if ((status = pd_cli_scene(&a->k, &base)))
         return status;
     scs = calloc((size_t)n, sizeof *scs);
     ss = calloc((size_t)n, sizeof *ss);
     errs = calloc((size_t)n, sizeof *errs);
-    col = calloc((size_t)n, sizeof *col);
-    flag = calloc((size_t)n, 1);
     for (int k = 0; scs && k < n; k++)
         scs[k] = pd_scene_copy(base);
     for (int k = 0; scs && k < n && !status; k++)
         status = !scs[k];
-    if (!scs || !ss || !errs || !col || !flag || status) {
+    if (!scs || !ss || !errs || status) {
         fprintf(stderr, "pound: simulate: out of memory for a suite of %d records\n", n);
         status = 1;
     }
     if (!status)
         status = suite_scene_run(a, scs, ss, errs);
+    if (!status && pd_scene_suite_stats(base, ss, n, &st, &err)) {
+        fprintf(stderr, "pound: simulate: %s\n", err.msg);
+        status = 1;
+    }
     if (!status && a->json)
-        suite_scene_json(a, base, scs, ss, col, flag);
+        suite_scene_json(a, base, scs, ss, &st);
     else if (!status)
-        status = suite_scene_text(a, base, scs, ss, col, flag);
+        status = suite_scene_text(a, base, scs, ss, &st);
+    pd_scene_suite_free(&st);
     for (int k = 0; ss && k < n; k++)
         pd_scene_summary_free(&ss[k]);
     for (int k = 0; scs && k < n; k++)
@@ -1481,8 +1517,6 @@ static int suite_scene(sim_args *a)
     free(scs);
     free(ss);
     free(errs);
-    free(col);
-    free(flag);
     pd_scene_free(base);
     return status;
 }

@@ -39,6 +39,7 @@ typedef struct pd_cli_case {
     int have_rtol;
     const char *model_flag;  /* the first model flag given (refused with --scene) */
     const char *scene_path;  /* --scene F */
+    pd_scene *scene;         /* F read once when the case needed it (--target-sa's T1) */
     int chain;               /* --chain N (0: none) */
     double chain_ratio;      /* --chain-ratio R */
     const char *record_path; /* --record F */

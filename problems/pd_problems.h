@@ -1122,6 +1122,43 @@ typedef struct pd_stats {
 
 PD_API int pd_stats_of(const double *x, int n, pd_stats *st, pd_err *err);
 
+/* A scene's statistics over a suite: n runs of one scene (its structures
+ * and contacts), each under one record (docs/records.md, "Suites").
+ * Peaks of a storey (dof), or of a structure: its largest storey's (NaN
+ * passed over; the base shear: storey 1's); ductility NaN when elastic. */
+typedef struct pd_suite_peaks {
+    pd_stats umax, drift_ratio, acc_max, shear_max, gamma, ductility;
+} pd_suite_peaks;
+
+/* A rule's gap is taken as closed when the required gap exceeds it by more
+ * than this fraction of it (rounding: at a wall ABS is the gap itself). */
+#define PD_SUITE_RULE_TOL 1e-9
+
+/* A contact over the suite: how often it closed, its required gap, the
+ * codes' rules (ABS, SRSS, DDC) and how often each rule's gap would have
+ * been closed (the required gap above it). */
+typedef struct pd_suite_contact {
+    double closed; /* the share of runs with an impact */
+    pd_stats required_gap, impacts, max_impulse;
+    pd_stats rule_abs, rule_srss, rule_ddc;
+    double abs_closed, srss_closed, ddc_closed; /* the shares of runs */
+} pd_suite_contact;
+
+typedef struct pd_scene_suite {
+    int n;                       /* runs */
+    int nstruct, ndof, ncontact; /* the scene's */
+    pd_suite_peaks *structure;   /* nstruct */
+    pd_suite_peaks *storey;      /* ndof, in the scene's dof order */
+    pd_suite_contact *contact;   /* ncontact */
+} pd_scene_suite;
+
+/* The statistics of the n summaries runs[0..n) of the finished scene sc
+ * (each a pd_scene_summarize of sc under one record) into *out, which
+ * pd_scene_suite_free releases (also after a failure). */
+PD_API int pd_scene_suite_stats(const pd_scene *sc, const pd_scene_summary *runs, int n,
+                                pd_scene_suite *out, pd_err *err);
+PD_API void pd_scene_suite_free(pd_scene_suite *s);
+
 /* The 5 %- (xi-) damped pseudo-spectral acceleration Sa(T) = w^2 max |u| of
  * the record at scale 1 [m/s^2]: the elastic oscillator's exact response
  * (the event reference with no wall: exact flights of the piecewise-linear

@@ -197,6 +197,139 @@ int pd_stats_of(const double *x, int n, pd_stats *st, pd_err *err)
     return PD_OK;
 }
 
+/* ---- a scene over a suite ------------------------------------------------------ */
+
+enum { PEAK_UMAX, PEAK_DRIFT, PEAK_ACC, PEAK_SHEAR, PEAK_GAMMA, PEAK_DUCT, PEAK_FIGS };
+
+/* Figure f of dof i in run r. */
+static double dof_peak(const pd_scene_summary *r, int i, int f)
+{
+    const double v[PEAK_FIGS] = {r->r.umax[i],      r->r.drift_ratio[i], r->r.acc_max[i],
+                                 r->r.shear_max[i], r->gamma[i],         r->r.ductility[i]};
+    return v[f];
+}
+
+/* Figure f of structure S in run r: its largest storey's (NaN passed
+ * over; none finite: 0, ductility NaN), the base shear storey 1's. */
+static double structure_peak(const pd_structure *S, const pd_scene_summary *r, int f)
+{
+    double v = f == PEAK_DUCT ? NAN : 0.0;
+    int top = f == PEAK_SHEAR ? S->dof + 1 : S->dof + S->storeys;
+    for (int i = S->dof; i < top; i++) {
+        double x = dof_peak(r, i, f);
+        v = x > v || (isnan(v) && isfinite(x)) ? x : v;
+    }
+    return v;
+}
+
+/* The six statistics of one set of peaks; col holds run k's figure f as
+ * peak(k, f). */
+static int peaks_of(pd_suite_peaks *p, double *col, int n, const pd_structure *S, int dof,
+                    const pd_scene_summary *runs, pd_err *err)
+{
+    pd_stats *st[PEAK_FIGS] = {&p->umax,      &p->drift_ratio, &p->acc_max,
+                               &p->shear_max, &p->gamma,       &p->ductility};
+    for (int f = 0; f < PEAK_FIGS; f++) {
+        for (int k = 0; k < n; k++)
+            col[k] = S ? structure_peak(S, &runs[k], f) : dof_peak(&runs[k], dof, f);
+        int rc = pd_stats_of(col, n, st[f], err);
+        if (rc)
+            return rc;
+    }
+    return PD_OK;
+}
+
+/* The share of runs whose required gap at contact c exceeds rule's. */
+static double rule_share(const pd_scene_summary *runs, int n, int c, int q)
+{
+    int k, closed = 0;
+    for (k = 0; k < n; k++) {
+        const double *rule = q == 0   ? runs[k].rule_abs
+                             : q == 1 ? runs[k].rule_srss
+                                      : runs[k].rule_ddc;
+        closed += runs[k].required_gap[c] > rule[c] * (1.0 + PD_SUITE_RULE_TOL);
+    }
+    return (double)closed / n;
+}
+
+/* Contact c's statistics over the runs. */
+static int contact_of(pd_suite_contact *p, double *col, int n, int c, const pd_scene_summary *runs,
+                      pd_err *err)
+{
+    pd_stats *st[6] = {&p->required_gap, &p->impacts,   &p->max_impulse,
+                       &p->rule_abs,     &p->rule_srss, &p->rule_ddc};
+    int hit = 0;
+    for (int k = 0; k < n; k++)
+        hit += runs[k].r.impacts[c] > 0;
+    p->closed = (double)hit / n;
+    for (int f = 0; f < 6; f++) {
+        for (int k = 0; k < n; k++) {
+            const pd_scene_summary *r = &runs[k];
+            const double v[6] = {r->required_gap[c], (double)r->r.impacts[c], r->r.max_impulse[c],
+                                 r->rule_abs[c],     r->rule_srss[c],         r->rule_ddc[c]};
+            col[k] = v[f];
+        }
+        int rc = pd_stats_of(col, n, st[f], err);
+        if (rc)
+            return rc;
+    }
+    p->abs_closed = rule_share(runs, n, c, 0);
+    p->srss_closed = rule_share(runs, n, c, 1);
+    p->ddc_closed = rule_share(runs, n, c, 2);
+    return PD_OK;
+}
+
+void pd_scene_suite_free(pd_scene_suite *s)
+{
+    if (!s)
+        return;
+    free(s->structure);
+    free(s->storey);
+    free(s->contact);
+    *s = (pd_scene_suite){.n = 0};
+}
+
+int pd_scene_suite_stats(const pd_scene *sc, const pd_scene_summary *runs, int n,
+                         pd_scene_suite *out, pd_err *err)
+{
+    if (!out)
+        return PD_NULL_ARG(err, "out");
+    *out = (pd_scene_suite){.n = 0};
+    if (!sc)
+        return PD_NULL_ARG(err, "sc");
+    if (!runs)
+        return PD_NULL_ARG(err, "runs");
+    if (n < 1)
+        return pd_err_set(err, PD_EINVAL, "a suite needs at least one run (got %d)", n);
+    for (int k = 0; k < n; k++)
+        if (runs[k].r.n != sc->n || runs[k].r.m != sc->ncontact || !runs[k].required_gap)
+            return pd_err_set(err, PD_EINVAL, "run %d is not a summary of this scene", k);
+    int rc = PD_OK;
+    double *col = pd_malloc(n, sizeof *col);
+    *out = (pd_scene_suite){.n = n,
+                            .nstruct = sc->nstruct,
+                            .ndof = sc->n,
+                            .ncontact = sc->ncontact,
+                            .structure = pd_calloc(sc->nstruct, sizeof *out->structure),
+                            .storey = pd_calloc(sc->n, sizeof *out->storey),
+                            .contact = pd_calloc(sc->ncontact, sizeof *out->contact)};
+    if (!col || !out->structure || !out->storey || (sc->ncontact && !out->contact)) {
+        rc = pd_err_set(err, PD_ENOMEM, "out of memory for a suite of %d runs", n);
+        goto done;
+    }
+    for (int s = 0; s < sc->nstruct && !rc; s++) /* each structure: its largest storey's */
+        rc = peaks_of(&out->structure[s], col, n, &sc->st[s], 0, runs, err);
+    for (int i = 0; i < sc->n && !rc; i++) /* each storey */
+        rc = peaks_of(&out->storey[i], col, n, NULL, i, runs, err);
+    for (int c = 0; c < sc->ncontact && !rc; c++)
+        rc = contact_of(&out->contact[c], col, n, c, runs, err);
+done:
+    free(col);
+    if (rc)
+        pd_scene_suite_free(out);
+    return rc;
+}
+
 /* ---- scaling ------------------------------------------------------------------ */
 
 int pd_record_sa(const pd_record *rec, const pd_record_pulse *pulse, double T, double xi,

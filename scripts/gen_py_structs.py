@@ -36,7 +36,7 @@ STRUCTS = (
     "pd_osc_result", "pd_osc_summary", "pd_trace", "pd_measured", "pd_structure", "pd_contact",
     "pd_scene_excitation", "pd_scene", "pd_scene_sample", "pd_scene_result", "pd_scene_summary",
     "pd_scene_trace", "pd_scene_errors", "pd_spectrum", "pd_spec_coords", "pd_spec_result",
-    "pd_spec_row", "pd_stats",
+    "pd_spec_row", "pd_stats", "pd_suite_peaks", "pd_suite_contact", "pd_scene_suite",
 )
 # Integer constants the package uses besides the array sizes: the statuses,
 # the wall's index, the automatic method.

@@ -240,14 +240,26 @@ if [ -n "$all" ]; then
     "$pound" record $all > "$out/paper-records.txt"
     "$pound" record $all --json | tr '{' '\n' | awk -F'"name":"' 'NF > 1 {split($2, a, "\""); n = a[1]}
         /"Le":/ {sub(/.*"Le":/, ""); sub(/,.*/, ""); printf "%s %.6g\n", n, 1 / $0}' |
-        sort -g -k2,2 | awk '{print $0, 0.002 + 0.024 * ((NR - 1) % 3)}' > "$tmp/le"
+        sort -g -k2,2 > "$tmp/le0"
+    # a log axis from 1 (or below the first record) to past the last, every
+    # record inside; each label at the lowest of four heights whose last
+    # label is at least 2.2 % of the axis' width to its left (a 7-point
+    # rotated label's height), else at the height whose last label is farthest
+    xmin=$(awk 'NR == 1 {printf "%.3g", $2 < 1.2 ? 0.8 * $2 : 1}' "$tmp/le0")
+    xmax=$(awk '{x = $2 > x ? $2 : x} END {printf "%.3g", 1.25 * (x > 12 ? x : 12)}' "$tmp/le0")
+    awk -v xmin="$xmin" -v xmax="$xmax" 'BEGIN {for (l = 0; l < 4; l++) last[l] = -1e9}
+        {x = log($2); best = -1
+         for (l = 0; l < 4 && best < 0; l++) if (x - last[l] >= 0.022 * log(xmax / xmin)) best = l
+         if (best < 0) {best = 0; for (l = 1; l < 4; l++) if (last[l] < last[best]) best = l}
+         last[best] = x; name = $1; sub(/\.[^.]*$/, "", name)
+         print name, $2, 0.002 + 0.022 * best}' "$tmp/le0" > "$tmp/le"
     # Fig. 7: contours of Pi3 = gap / Le on the (1/Le, gap) plane, the records placed
     gnuplot <<GP
 $term
 set output '$out/paper-fig7.png'
 set title 'Fig. 7: {/Symbol P}_3 = gap / L_e on the (1/L_e, gap) plane; records at their fitted 1/L_e'
 set xlabel '1/L_e = {/Symbol w}_p^2 / a_p [m^{-1}]'; set ylabel 'gap [m]'
-set xrange [0:13]; set yrange [0:0.1]; set grid; set key top right  # 13: a record at 12 is not cut
+set logscale x; set xrange [$xmin:$xmax]; set xtics add (2, 5, 20, 50); set yrange [0:0.1]; set grid; set key top right
 set samples 400
 set arrow from 1.2, graph 0 to 1.2, graph 1 nohead dt 2 lc rgb 'black'
 set label 'Tabas (paper)' at 1.25, 0.095 font ',9'

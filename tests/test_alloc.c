@@ -237,9 +237,59 @@ static int case_rows(void)
     return st;
 }
 
+/* A scene suite's statistics of two runs prepared beforehand (test state:
+ * only pd_scene_suite_stats' own allocations fail in turn). */
+static const pd_scene *stats_scene;
+static const pd_scene_summary *stats_runs;
+
+static int case_suite_stats(void)
+{
+    pd_scene_suite st;
+    pd_err err;
+    int rc = pd_scene_suite_stats(stats_scene, stats_runs, 2, &st, &err);
+    pd_scene_suite_free(&st);
+    return rc;
+}
+
+/* Two runs of a two-building scene for case_suite_stats: 0 or a status. */
+static int suite_prepare(pd_scene **sc, pd_scene_summary runs[2])
+{
+    pd_scene_excitation exc = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 4.0, .Tp = 0.5};
+    double m[2] = {2e5, 2e5}, k[2] = {3e8, 2e8};
+    pd_err err;
+    pd_run_opts o = pd_run_default_opts();
+    o.method = PD_METHOD_EVENT;
+    int st = (*sc = pd_scene_new(&exc)) ? PD_OK : PD_ENOMEM;
+    if (!st)
+        st = pd_scene_add_building(*sc, "A", 2, m, k, 0.05, &err);
+    if (!st)
+        st = pd_scene_add_sdof(*sc, "B", 0.5, 0.05, 1e5, &err);
+    if (!st)
+        st = pd_scene_add_contact(*sc, 0, 1, 1, 1, 0.002, 0.3, 0, &err);
+    if (!st)
+        st = pd_scene_finish(*sc, &err);
+    for (int r = 0; r < 2 && !st; r++) {
+        (*sc)->exc.ap = 2.0 + 4.0 * r;
+        st = pd_scene_summarize(*sc, &o, NULL, NULL, &runs[r], &err);
+    }
+    return st;
+}
+
 static void test_alloc_every_failure_reported(pd_test_ctx *ctx)
 {
-    long n[6];
+    long n[7];
+    pd_scene *sc = NULL;
+    pd_scene_summary runs[2] = {{.cpu_s = 0}};
+    alloc_countdown = -1;
+    int st = suite_prepare(&sc, runs);
+    CHECK(ctx, st == PD_OK, "a suite's two runs: %d", st);
+    stats_scene = sc;
+    stats_runs = runs;
+    n[6] = st ? 0 : fail_each(ctx, "pd_scene_suite_stats", case_suite_stats);
+    CHECK(ctx, n[6] >= 4, "the suite's statistics take several allocations (%ld)", n[6]);
+    for (int r = 0; r < 2; r++)
+        pd_scene_summary_free(&runs[r]);
+    pd_scene_free(sc);
     n[0] = fail_each(ctx, "pd_lcp_alloc", case_lcp);
     n[1] = fail_each(ctx, "pd_mj_alloc (general)", case_moreau_general);
     n[2] = fail_each(ctx, "pd_osc_simulate", case_oscillator);
@@ -251,7 +301,7 @@ static void test_alloc_every_failure_reported(pd_test_ctx *ctx)
     /* the single Moreau-Jean run without a sampler: no allocation at all */
     alloc_countdown = -1;
     alloc_seen = 0;
-    int st = case_oscillator_plain();
+    st = case_oscillator_plain();
     CHECK(ctx, st == PD_OK && alloc_seen == 0,
           "pd_osc_simulate without a sampler: status %d, "
           "%ld allocations",

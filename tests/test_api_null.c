@@ -3099,7 +3099,7 @@ static long api_case_380(void)
 static long api_case_381(void)
 {
     pd_err err = {0};
-    long v = pd_record_sa(NULL, (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_sa", 1), 1.0, 1.0, (double *)fx_object("double", "pd_record_sa", 4), &err);
+    long v = pd_scene_suite_stats(NULL, (const pd_scene_summary *)fx_object("pd_scene_summary", "pd_scene_suite_stats", 1), 1, (pd_scene_suite *)fx_object("pd_scene_suite", "pd_scene_suite_stats", 3), &err);
     (void)err;
     return v;
 }
@@ -3107,7 +3107,7 @@ static long api_case_381(void)
 static long api_case_382(void)
 {
     pd_err err = {0};
-    long v = pd_record_sa((const pd_record *)fx_object("pd_record", "pd_record_sa", 0), NULL, 1.0, 1.0, (double *)fx_object("double", "pd_record_sa", 4), &err);
+    long v = pd_scene_suite_stats((const pd_scene *)fx_object("pd_scene", "pd_scene_suite_stats", 0), NULL, 1, (pd_scene_suite *)fx_object("pd_scene_suite", "pd_scene_suite_stats", 3), &err);
     (void)err;
     return v;
 }
@@ -3115,7 +3115,7 @@ static long api_case_382(void)
 static long api_case_383(void)
 {
     pd_err err = {0};
-    long v = pd_record_sa((const pd_record *)fx_object("pd_record", "pd_record_sa", 0), (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_sa", 1), 1.0, 1.0, NULL, &err);
+    long v = pd_scene_suite_stats((const pd_scene *)fx_object("pd_scene", "pd_scene_suite_stats", 0), (const pd_scene_summary *)fx_object("pd_scene_summary", "pd_scene_suite_stats", 1), 1, NULL, &err);
     (void)err;
     return v;
 }
@@ -3123,15 +3123,15 @@ static long api_case_383(void)
 static long api_case_384(void)
 {
     pd_err err = {0};
-    long v = pd_record_scale_to(NULL, (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_scale_to", 1), (pd_scale_target)0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_record_scale_to", 6), &err);
+    pd_scene_suite_free(NULL);
     (void)err;
-    return v;
+    return 0;
 }
 
 static long api_case_385(void)
 {
     pd_err err = {0};
-    long v = pd_record_scale_to((const pd_record *)fx_object("pd_record", "pd_record_scale_to", 0), NULL, (pd_scale_target)0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_record_scale_to", 6), &err);
+    long v = pd_record_sa(NULL, (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_sa", 1), 1.0, 1.0, (double *)fx_object("double", "pd_record_sa", 4), &err);
     (void)err;
     return v;
 }
@@ -3139,7 +3139,7 @@ static long api_case_385(void)
 static long api_case_386(void)
 {
     pd_err err = {0};
-    long v = pd_record_scale_to((const pd_record *)fx_object("pd_record", "pd_record_scale_to", 0), (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_scale_to", 1), (pd_scale_target)0, 1.0, 1.0, 1.0, NULL, &err);
+    long v = pd_record_sa((const pd_record *)fx_object("pd_record", "pd_record_sa", 0), NULL, 1.0, 1.0, (double *)fx_object("double", "pd_record_sa", 4), &err);
     (void)err;
     return v;
 }
@@ -3147,7 +3147,7 @@ static long api_case_386(void)
 static long api_case_387(void)
 {
     pd_err err = {0};
-    long v = pd_record_synth(NULL, (const char *)fx_string("pd_record_synth", "name"), (pd_record *)fx_object("pd_record", "pd_record_synth", 2), &err);
+    long v = pd_record_sa((const pd_record *)fx_object("pd_record", "pd_record_sa", 0), (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_sa", 1), 1.0, 1.0, NULL, &err);
     (void)err;
     return v;
 }
@@ -3155,7 +3155,7 @@ static long api_case_387(void)
 static long api_case_388(void)
 {
     pd_err err = {0};
-    long v = pd_record_synth((const pd_synth *)fx_object("pd_synth", "pd_record_synth", 0), NULL, (pd_record *)fx_object("pd_record", "pd_record_synth", 2), &err);
+    long v = pd_record_scale_to(NULL, (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_scale_to", 1), (pd_scale_target)0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_record_scale_to", 6), &err);
     (void)err;
     return v;
 }
@@ -3163,7 +3163,7 @@ static long api_case_388(void)
 static long api_case_389(void)
 {
     pd_err err = {0};
-    long v = pd_record_synth((const pd_synth *)fx_object("pd_synth", "pd_record_synth", 0), (const char *)fx_string("pd_record_synth", "name"), NULL, &err);
+    long v = pd_record_scale_to((const pd_record *)fx_object("pd_record", "pd_record_scale_to", 0), NULL, (pd_scale_target)0, 1.0, 1.0, 1.0, (double *)fx_object("double", "pd_record_scale_to", 6), &err);
     (void)err;
     return v;
 }
@@ -3171,12 +3171,44 @@ static long api_case_389(void)
 static long api_case_390(void)
 {
     pd_err err = {0};
+    long v = pd_record_scale_to((const pd_record *)fx_object("pd_record", "pd_record_scale_to", 0), (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_record_scale_to", 1), (pd_scale_target)0, 1.0, 1.0, 1.0, NULL, &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_391(void)
+{
+    pd_err err = {0};
+    long v = pd_record_synth(NULL, (const char *)fx_string("pd_record_synth", "name"), (pd_record *)fx_object("pd_record", "pd_record_synth", 2), &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_392(void)
+{
+    pd_err err = {0};
+    long v = pd_record_synth((const pd_synth *)fx_object("pd_synth", "pd_record_synth", 0), NULL, (pd_record *)fx_object("pd_record", "pd_record_synth", 2), &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_393(void)
+{
+    pd_err err = {0};
+    long v = pd_record_synth((const pd_synth *)fx_object("pd_synth", "pd_record_synth", 0), (const char *)fx_string("pd_record_synth", "name"), NULL, &err);
+    (void)err;
+    return v;
+}
+
+static long api_case_394(void)
+{
+    pd_err err = {0};
     pd_scene_excite_record(NULL, (const pd_record *)fx_object("pd_record", "pd_scene_excite_record", 1), (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_scene_excite_record", 2), 1.0);
     (void)err;
     return 0;
 }
 
-static long api_case_391(void)
+static long api_case_395(void)
 {
     pd_err err = {0};
     pd_scene_excite_record((pd_scene_excitation *)fx_object("pd_scene_excitation", "pd_scene_excite_record", 0), NULL, (const pd_record_pulse *)fx_object("pd_record_pulse", "pd_scene_excite_record", 2), 1.0);
@@ -3184,7 +3216,7 @@ static long api_case_391(void)
     return 0;
 }
 
-static long api_case_392(void)
+static long api_case_396(void)
 {
     pd_err err = {0};
     pd_scene_excite_record((pd_scene_excitation *)fx_object("pd_scene_excitation", "pd_scene_excite_record", 0), (const pd_record *)fx_object("pd_record", "pd_scene_excite_record", 1), NULL, 1.0);
@@ -3574,18 +3606,22 @@ const api_null_case api_null_cases[] = {
     {.function = "pd_suite_read", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_378},
     {.function = "pd_stats_of", .argument = "x", .expect = EXPECT_ERROR, .call = api_case_379},
     {.function = "pd_stats_of", .argument = "st", .expect = EXPECT_ERROR, .call = api_case_380},
-    {.function = "pd_record_sa", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_381},
-    {.function = "pd_record_sa", .argument = "pulse", .expect = EXPECT_ERROR, .call = api_case_382},
-    {.function = "pd_record_sa", .argument = "Sa", .expect = EXPECT_ERROR, .call = api_case_383},
-    {.function = "pd_record_scale_to", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_384},
-    {.function = "pd_record_scale_to", .argument = "pulse", .expect = EXPECT_ERROR, .call = api_case_385},
-    {.function = "pd_record_scale_to", .argument = "scale", .expect = EXPECT_ERROR, .call = api_case_386},
-    {.function = "pd_record_synth", .argument = "p", .expect = EXPECT_ERROR, .call = api_case_387},
-    {.function = "pd_record_synth", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_388},
-    {.function = "pd_record_synth", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_389},
-    {.function = "pd_scene_excite_record", .argument = "x", .expect = EXPECT_NOCRASH, .call = api_case_390},
-    {.function = "pd_scene_excite_record", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_391},
-    {.function = "pd_scene_excite_record", .argument = "pulse", .expect = EXPECT_NOCRASH, .call = api_case_392},
+    {.function = "pd_scene_suite_stats", .argument = "sc", .expect = EXPECT_ERROR, .call = api_case_381},
+    {.function = "pd_scene_suite_stats", .argument = "runs", .expect = EXPECT_ERROR, .call = api_case_382},
+    {.function = "pd_scene_suite_stats", .argument = "out", .expect = EXPECT_ERROR, .call = api_case_383},
+    {.function = "pd_scene_suite_free", .argument = "s", .expect = EXPECT_NOCRASH, .call = api_case_384},
+    {.function = "pd_record_sa", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_385},
+    {.function = "pd_record_sa", .argument = "pulse", .expect = EXPECT_ERROR, .call = api_case_386},
+    {.function = "pd_record_sa", .argument = "Sa", .expect = EXPECT_ERROR, .call = api_case_387},
+    {.function = "pd_record_scale_to", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_388},
+    {.function = "pd_record_scale_to", .argument = "pulse", .expect = EXPECT_ERROR, .call = api_case_389},
+    {.function = "pd_record_scale_to", .argument = "scale", .expect = EXPECT_ERROR, .call = api_case_390},
+    {.function = "pd_record_synth", .argument = "p", .expect = EXPECT_ERROR, .call = api_case_391},
+    {.function = "pd_record_synth", .argument = "name", .expect = EXPECT_ERROR, .call = api_case_392},
+    {.function = "pd_record_synth", .argument = "rec", .expect = EXPECT_ERROR, .call = api_case_393},
+    {.function = "pd_scene_excite_record", .argument = "x", .expect = EXPECT_NOCRASH, .call = api_case_394},
+    {.function = "pd_scene_excite_record", .argument = "rec", .expect = EXPECT_NOCRASH, .call = api_case_395},
+    {.function = "pd_scene_excite_record", .argument = "pulse", .expect = EXPECT_NOCRASH, .call = api_case_396},
 };
-const int api_null_ncases = 393;
-const int api_null_nfunctions = 235;
+const int api_null_ncases = 397;
+const int api_null_nfunctions = 237;

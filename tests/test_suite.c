@@ -438,8 +438,86 @@ static void test_suite_histories(pd_test_ctx *ctx)
     pd_scene_free(sc);
 }
 
+/* Equal statistics, field by field (NaN equal to NaN). */
+static int stats_equal(const pd_stats *a, const pd_stats *b)
+{
+    const double x[6] = {a->mean, a->median, a->p16, a->p84, a->min, a->max};
+    const double y[6] = {b->mean, b->median, b->p16, b->p84, b->min, b->max};
+    for (int i = 0; i < 6; i++)
+        if (!(x[i] == y[i] || (isnan(x[i]) && isnan(y[i]))))
+            return 0;
+    return a->n == b->n;
+}
+
+/* A scene over a suite: a two-storey building and an SDOF touching at
+ * level 1, three runs (ap 0.02, 3, 6 m/s^2, so that the weakest leaves the
+ * gap open): a structure's peaks are its largest storey's (an SDOF's its
+ * storey's, the base shear storey 1's), the shares count the runs, the
+ * means are the runs' means; bad calls are refused. */
+static void test_suite_scene_stats(pd_test_ctx *ctx)
+{
+    pd_scene_excitation exc = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 1.0, .Tp = 0.5};
+    double m[2] = {2e5, 2e5}, k[2] = {3e8, 2e8}, ap[3] = {0.02, 3.0, 6.0};
+    pd_scene *sc = pd_scene_new(&exc);
+    pd_scene_summary runs[3] = {{.cpu_s = 0}};
+    pd_scene_suite st = {.n = 0};
+    pd_run_opts o = pd_run_default_opts();
+    pd_err err;
+    o.method = PD_METHOD_EVENT;
+    int rc = !sc || pd_scene_add_building(sc, "A", 2, m, k, 0.05, &err) ||
+             pd_scene_add_sdof(sc, "B", 0.6, 0.05, 1e5, &err) ||
+             pd_scene_add_contact(sc, 0, 1, 1, 1, 0.004, 0.5, 0, &err) || pd_scene_finish(sc, &err);
+    for (int r = 0; r < 3 && !rc; r++) {
+        sc->exc.ap = ap[r];
+        rc = pd_scene_summarize(sc, &o, NULL, NULL, &runs[r], &err);
+    }
+    rc = rc || pd_scene_suite_stats(sc, runs, 3, &st, &err);
+    CHECK(ctx, !rc && st.n == 3 && st.nstruct == 2 && st.ndof == 3 && st.ncontact == 1, "%s",
+          rc ? err.msg : "shape");
+    if (rc)
+        goto done;
+    double top = 0.0, mean1 = 0.0, hits = 0.0, srss = 0.0;
+    for (int r = 0; r < 3; r++) {
+        top = fmax(top, fmax(runs[r].r.umax[0], runs[r].r.umax[1]));
+        mean1 += runs[r].r.umax[1] / 3.0;
+        hits += runs[r].r.impacts[0] > 0;
+        srss += runs[r].required_gap[0] > runs[r].rule_srss[0] * (1.0 + PD_SUITE_RULE_TOL);
+    }
+    const pd_suite_peaks *A = &st.structure[0], *B = &st.structure[1];
+    CHECK(ctx, A->umax.max == top && fabs(st.storey[1].umax.mean - mean1) <= 1e-16 * mean1,
+          "A: umax max %.17g (storeys' %.17g), roof mean %.17g (%.17g)", A->umax.max, top,
+          st.storey[1].umax.mean, mean1);
+    CHECK(ctx,
+          stats_equal(&B->umax, &st.storey[2].umax) &&
+              stats_equal(&B->gamma, &st.storey[2].gamma) &&
+              stats_equal(&B->acc_max, &st.storey[2].acc_max) &&
+              stats_equal(&A->shear_max, &st.storey[0].shear_max),
+          "an SDOF's peaks are its storey's, the base shear storey 1's");
+    CHECK(ctx, A->ductility.n == 0 && isnan(A->ductility.mean), "elastic: no ductility");
+    const pd_suite_contact *c = &st.contact[0];
+    CHECK(ctx,
+          hits == 2.0 && c->closed == hits / 3.0 && c->srss_closed == srss / 3.0 &&
+              c->impacts.min == 0.0 && c->required_gap.n == 3,
+          "closed %g (%g of 3), SRSS closed %g (%g)", c->closed, hits, c->srss_closed, srss);
+    pd_scene_suite_free(&st);
+    /* refused: no runs, another scene's run, NULLs */
+    int bad0 = pd_scene_suite_stats(sc, runs, 0, &st, &err);
+    runs[1].r.n = 2;
+    int bad1 = pd_scene_suite_stats(sc, runs, 3, &st, &err);
+    runs[1].r.n = 3;
+    int bad2 = pd_scene_suite_stats(sc, NULL, 3, &st, &err);
+    CHECK(ctx, bad0 == PD_EINVAL && bad1 == PD_EINVAL && bad2 == PD_EINVAL && st.n == 0,
+          "bad calls: %d %d %d", bad0, bad1, bad2);
+done:
+    pd_scene_suite_free(&st);
+    for (int r = 0; r < 3; r++)
+        pd_scene_summary_free(&runs[r]);
+    pd_scene_free(sc);
+}
+
 void suite_suite(pd_test_ctx *ctx)
 {
+    PD_RUN(ctx, test_suite_scene_stats);
     PD_RUN(ctx, test_suite_stats);
     PD_RUN(ctx, test_suite_file);
     PD_RUN(ctx, test_suite_sa);

@@ -19,8 +19,9 @@ from ._structs import (PD_SPEC_MAX_LIST, PD_WALL, PdContact, PdEnergy, PdErr, Pd
                        PdLcpOpts, PdMatrix, PdMeasured, PdOsc, PdOscResult, PdOscSample,
                        PdOscSummary, PdPenaltySetup, PdRecord, PdRecordMeasures, PdRecordPulse,
                        PdRunOpts, PdScene, PdSceneErrors, PdSceneExcitation, PdSceneResult,
-                       PdSceneSample, PdSceneSummary, PdSceneTrace, PdSpecCoords, PdSpecResult,
-                       PdSpecRow, PdSpectrum, PdStats, PdStructure, PdTrace)
+                       PdSceneSample, PdSceneSuite, PdSceneSummary, PdSceneTrace, PdSpecCoords,
+                       PdSpecResult, PdSpecRow, PdSpectrum, PdStats, PdStructure, PdSuiteContact,
+                       PdSuitePeaks, PdTrace)
 
 # ---- errors --------------------------------------------------------------------------
 
@@ -175,6 +176,9 @@ _PROTOTYPES = {
     "pd_record_pulse_eval": (None, [P(PdRecordPulse), c_double, P(c_double), P(c_double)]),
     # suites
     "pd_stats_of": (c_int, [P(c_double), c_int, P(PdStats), P(PdErr)]),
+    "pd_scene_suite_stats": (c_int, [P(PdScene), P(PdSceneSummary), c_int, P(PdSceneSuite),
+                                     P(PdErr)]),
+    "pd_scene_suite_free": (None, [P(PdSceneSuite)]),
     "pd_scene_excite_record": (None, [P(PdSceneExcitation), P(PdRecord), P(PdRecordPulse),
                                       c_double]),
     "pd_record_sa": (c_int, [P(PdRecord), P(PdRecordPulse), c_double, c_double, P(c_double),

@@ -194,7 +194,7 @@ class Scene:
         have been closed.  target_pga=A or target_sa=A [m/s^2] (T1 [s],
         default the first structure's period) scale each record; the scene's
         own excitation is back afterwards."""
-        from ._osc import _suite_record, stats_of
+        from ._osc import _suite_record
         case = {k: opts.pop(k) for k in ("units", "record_format", "record_dt", "target_pga",
                                          "target_sa", "T1", "scale") if k in opts}
         if isinstance(records, (str, bytes, os.PathLike)) or not isinstance(
@@ -215,6 +215,7 @@ class Scene:
         base = number("scale", case.get("scale", 1.0))
         sc = self._sc
         saved, saved_tend, kept, runs = sc.exc, sc.tend, [], []
+        kept_sums: List[Any] = []
         saved = _lib.PdSceneExcitation.from_buffer_copy(saved)
         err = PdErr()
         try:
@@ -228,8 +229,11 @@ class Scene:
                 lib.pd_scene_excite_record(ctypes.byref(sc.exc), rec.rec, rec.pulse, scale.value)
                 sc.tend = 0.0
                 _lib.check(lib.pd_scene_finish(self._p, err), err)
-                runs.append(self.simulate(history, every, **opts))
+                runs.append(self._run(history, every, opts, keep=kept_sums))
+            stats = _suite_stats(self, kept_sums)
         finally:
+            for sm in kept_sums:
+                lib.pd_scene_summary_free(sm)
             ctypes.memmove(ctypes.byref(sc.exc), ctypes.byref(saved), ctypes.sizeof(saved))
             sc.tend = saved_tend
             lib.pd_scene_finish(self._p, err)
@@ -237,7 +241,7 @@ class Scene:
         if kind:
             out.update(target="pga" if kind == 1 else "sa", target_value=value)
         out["records"] = runs
-        out["stats"] = _suite_stats(runs, stats_of)
+        out["stats"] = stats
         return out
 
     def simulate(self, history: bool = True, every: Int = 1, **opts: Any) -> Result:
@@ -282,6 +286,11 @@ class Scene:
         columns (NAME.k, the storey k of structure NAME; A-B@k, the contact
         between sides A and B at level k); to_xarray() makes them the
         coordinates and gives each variable its CF units."""
+        return self._run(history, every, opts)
+
+    def _run(self, history, every, opts, keep=None):
+        """simulate(); with keep, the run's pd_scene_summary is appended to it
+        (the caller frees it) instead of freed here."""
         history, every = history_args(history, every)
         _, o = self.opts(opts)
         sc = self._sc
@@ -304,15 +313,18 @@ class Scene:
         sm = _lib.PdSceneSummary()
         err = PdErr()
         try:
-            st = lib.pd_scene_summarize(self._p, o, sampler or _lib.SceneSampler(),  # type: ignore
+            st = lib.pd_scene_summarize(self._p, o, sampler or _lib.SceneSampler(),
                                         None, sm, err)
             if h is not None and h.error is not None:
                 raise h.error
             _lib.check(st, err)
             out = self._summary(sm)
             out["method_by"] = self._method_by
+            if keep is not None:
+                keep.append(sm)
         finally:
-            lib.pd_scene_summary_free(sm)
+            if keep is None or not keep or keep[-1] is not sm:
+                lib.pd_scene_summary_free(sm)
         if h is not None:
             rows = h.rows()
             hist = Result((name, np.ascontiguousarray(rows[name])) for name in names)
@@ -462,35 +474,52 @@ def scene(path: PathArg) -> Scene:
     return Scene(path)
 
 
-def _suite_stats(runs, stats_of):
-    """The CLI's suite statistics of a scene (cli/cmd_simulate.c suite_scene)."""
-    structs, contacts = [], []
-    for k, st in enumerate(runs[0]["structures"]):
-        one = Result(name=st["name"])
-        for f in ("umax", "drift_ratio", "acc_max", "shear_max", "gamma"):
-            vals = []
-            for r in runs:  # the largest storey's (base shear: storey 1), NaN passed over
-                v = 0.0
-                for x in np.asarray(r["structures"][k][f], dtype=float)[:1 if f == "shear_max"
-                                                                         else None]:
-                    v = float(x) if x > v else v
-                vals.append(v)
-            one[f] = stats_of(vals)
-        structs.append(one)
-    for c, ct in enumerate(runs[0]["contacts"]):
-        req = [r["contacts"][c]["required_gap"] for r in runs]
-        one = Result(sides="%s-%s" % (ct["a"], ct["b"]), level=ct["level"],
-                     closed=float(np.mean([r["contacts"][c]["impacts"] > 0 for r in runs])),
-                     required_gap=stats_of(req),
-                     impacts=stats_of([float(r["contacts"][c]["impacts"]) for r in runs]),
-                     max_impulse=stats_of([r["contacts"][c]["max_impulse"] for r in runs]))
-        one["rules"] = Result((q, stats_of([r["contacts"][c]["rules"][q] for r in runs]))
-                              for q in ("abs", "srss", "ddc"))
-        one["rule_closed"] = Result(
-            (q, float(np.mean([g > r["contacts"][c]["rules"][q] * (1 + 1e-9)
-                               for g, r in zip(req, runs)]))) for q in ("abs", "srss", "ddc"))
-        contacts.append(one)
-    return Result(structures=structs, contacts=contacts)
+def _stats(st):
+    return Result(n=st.n, mean=st.mean, median=st.median, p16=st.p16, p84=st.p84, min=st.min,
+                  max=st.max)
+
+
+def _peaks(p, yields):
+    out = Result((f, _stats(getattr(p, f))) for f in
+                 ("umax", "drift_ratio", "acc_max", "shear_max", "gamma"))
+    if yields:
+        out["ductility"] = _stats(p.ductility)
+    return out
+
+
+def _suite_stats(scene, sums):
+    """A scene suite's statistics (pd_scene_suite_stats, the CLI's) of the
+    runs' summaries sums."""
+    arr = (_lib.PdSceneSummary * len(sums))()
+    for k, sm in enumerate(sums):
+        ctypes.memmove(ctypes.byref(arr[k]), ctypes.byref(sm), ctypes.sizeof(sm))
+    st, err = _lib.PdSceneSuite(), PdErr()
+    _lib.check(lib.pd_scene_suite_stats(scene._p, arr, len(sums), st, err), err)
+    try:
+        sc, yields = scene._sc, bool(lib.pd_scene_springs(scene._p))
+        structs, contacts = [], []
+        for k in range(sc.nstruct):
+            S = sc.st[k]
+            one = Result(name=s(S.name))
+            one.update(_peaks(st.structure[k], yields))
+            one["storeys"] = [Result(storey=i + 1, **_peaks(st.storey[S.dof + i], yields))
+                              for i in range(S.storeys)]
+            structs.append(one)
+        for c in range(sc.ncontact):
+            ct, side = st.contact[c], (lambda j: "wall" if j < 0 else s(sc.st[j].name))
+            k = sc.ct[c]
+            one = Result(sides="%s-%s" % (side(k.a), side(k.b)),
+                         level=k.level_b if k.a < 0 else k.level_a, closed=ct.closed,
+                         required_gap=_stats(ct.required_gap), impacts=_stats(ct.impacts),
+                         max_impulse=_stats(ct.max_impulse))
+            one["rules"] = Result(abs=_stats(ct.rule_abs), srss=_stats(ct.rule_srss),
+                                  ddc=_stats(ct.rule_ddc))
+            one["rule_closed"] = Result(abs=ct.abs_closed, srss=ct.srss_closed,
+                                        ddc=ct.ddc_closed)
+            contacts.append(one)
+        return Result(structures=structs, contacts=contacts)
+    finally:
+        lib.pd_scene_suite_free(st)
 
 
 def simulate_scene(path: Union[PathArg, Scene], history: bool = True, every: Int = 1,

@@ -578,6 +578,47 @@ class PdStats(Structure):
     ]
 
 
+class PdSuitePeaks(Structure):
+    """pd_suite_peaks (problems/pd_problems.h)."""
+    _fields_ = [
+        ("umax", PdStats),
+        ("drift_ratio", PdStats),
+        ("acc_max", PdStats),
+        ("shear_max", PdStats),
+        ("gamma", PdStats),
+        ("ductility", PdStats),
+    ]
+
+
+class PdSuiteContact(Structure):
+    """pd_suite_contact (problems/pd_problems.h)."""
+    _fields_ = [
+        ("closed", c_double),
+        ("required_gap", PdStats),
+        ("impacts", PdStats),
+        ("max_impulse", PdStats),
+        ("rule_abs", PdStats),
+        ("rule_srss", PdStats),
+        ("rule_ddc", PdStats),
+        ("abs_closed", c_double),
+        ("srss_closed", c_double),
+        ("ddc_closed", c_double),
+    ]
+
+
+class PdSceneSuite(Structure):
+    """pd_scene_suite (problems/pd_problems.h)."""
+    _fields_ = [
+        ("n", c_int),
+        ("nstruct", c_int),
+        ("ndof", c_int),
+        ("ncontact", c_int),
+        ("structure", POINTER(PdSuitePeaks)),
+        ("storey", POINTER(PdSuitePeaks)),
+        ("contact", POINTER(PdSuiteContact)),
+    ]
+
+
 # C name -> mirror, for the layout tests
 MIRRORS = {
     "pd_err": PdErr,
@@ -610,4 +651,7 @@ MIRRORS = {
     "pd_spec_result": PdSpecResult,
     "pd_spec_row": PdSpecRow,
     "pd_stats": PdStats,
+    "pd_suite_peaks": PdSuitePeaks,
+    "pd_suite_contact": PdSuiteContact,
+    "pd_scene_suite": PdSceneSuite,
 }

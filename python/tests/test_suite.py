@@ -81,6 +81,13 @@ def test_scene_stats_are_numpys(cli):
     for s, st in enumerate(js["stats"]["structures"]):
         stats_ok(st["umax"], [max(r["structures"][s]["umax"]) for r in js["records"]])
         stats_ok(st["acc_max"], [max(r["structures"][s]["acc_max"]) for r in js["records"]])
+        stats_ok(st["shear_max"], [r["structures"][s]["shear_max"][0] for r in js["records"]])
+        # each storey's own (pd_scene_suite_stats' per-dof statistics)
+        assert [x["storey"] for x in st["storeys"]] == \
+            list(range(1, len(js["records"][0]["structures"][s]["umax"]) + 1))
+        for i, one in enumerate(st["storeys"]):
+            for key in ["umax", "drift_ratio", "acc_max", "shear_max", "gamma"]:
+                stats_ok(one[key], [r["structures"][s][key][i] for r in js["records"]])
     for c, ct in enumerate(js["stats"]["contacts"]):
         req = [r["contacts"][c]["required_gap"] for r in js["records"]]
         stats_ok(ct["required_gap"], req)
@@ -91,6 +98,19 @@ def test_scene_stats_are_numpys(cli):
             stats_ok(ct["rules"][rule], ruled)
             over = np.mean([q > g * (1 + 1e-9) for q, g in zip(req, ruled)])
             assert ct["rule_closed"][rule] == pytest.approx(over, abs=1e-15)
+
+
+def test_yielding_scene_stats_have_ductility(cli):
+    """A yielding scene's suite: each structure's and storey's ductility
+    (the largest storey's, NaN storeys passed over) as NumPy's."""
+    js = cli("simulate", "--records", SUITE, "--scene", EXAMPLES / "scenes" /
+             "yielding-buildings.json", "--target-pga", "3", "--tend", "6")
+    for s, st in enumerate(js["stats"]["structures"]):
+        duct = [[np.nan if d is None else d for d in r["structures"][s]["ductility"]]
+                for r in js["records"]]
+        stats_ok(st["ductility"], [np.nanmax(d) for d in duct])
+        for i, one in enumerate(st["storeys"]):
+            stats_ok(one["ductility"], [d[i] for d in duct])
 
 
 def test_one_thread_is_two(cli):
@@ -108,6 +128,42 @@ def test_targets_reach_their_values(cli):
         assert b["scale"] * m["sa"] == pytest.approx(5.0, rel=1e-13)
 
 
+@pytest.mark.parametrize("where,ext", [("oscillator", "csv"), ("scene", "h5")])
+def test_suite_files_are_single_runs(tmp_path, where, ext):
+    """-o FILE.EXT with a suite: FILE.recK.EXT holds record K's histories,
+    the single run's to the bit (the provenance line and timings aside)."""
+    h5py = pytest.importorskip("h5py") if ext == "h5" else None
+    flags = OSC if where == "oscillator" else ["--scene", SCENE]
+    run("simulate", "--record", RECS[0], "--record", RECS[1], *flags, "-o",
+        tmp_path / ("s." + ext), "--json")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.rec1." + ext, "s.rec2." + ext]
+    run("simulate", "--record", RECS[1], *flags, "-o", tmp_path / ("one." + ext), "--json")
+    a, b = tmp_path / ("s.rec2." + ext), tmp_path / ("one." + ext)
+    if ext == "csv":
+        keep = lambda p: [ln for ln in p.read_text().splitlines()  # noqa: E731
+                          if not ln.startswith(("# command", "# cpu_s"))]
+        assert keep(a) == keep(b)
+    else:
+        with h5py.File(a, "r") as fa, h5py.File(b, "r") as fb:
+            names = []
+            fa.visit(names.append)
+            for name in names:
+                if isinstance(fa[name], h5py.Dataset):
+                    assert np.array_equal(fa[name][()], fb[name][()]), name
+
+
+def test_failed_suite_leaves_no_files(tmp_path):
+    """A record whose run fails after an earlier record's files were
+    written (its impacts' equivalent force overflows at td 1e-306; the
+    first record, scaled down, has none) leaves none of the suite's files."""
+    suite = tmp_path / "two.txt"
+    suite.write_text("%s 0.001\n%s 200\n" % (RECS[0], RECS[1]))
+    out = run("simulate", "--records", suite, *OSC, "--contact-duration", "1e-306", "-o",
+              tmp_path / "s.csv", "--plot", tmp_path / "s.png", status=2)
+    assert "nf2.txt" in out.stderr.decode() and "overflows" in out.stderr.decode()
+    assert not list(tmp_path.glob("s.*"))
+
+
 def test_record_repeated_is_a_suite(cli):
     js = cli("simulate", "--record", RECS[0], "--record", RECS[1], *OSC)
     assert [r["record"] for r in js["records"]] == ["nf1.txt", "nf2.txt"]
@@ -120,7 +176,7 @@ def test_record_repeated_is_a_suite(cli):
     (["--records", SUITE, "--target-pga", "3", "--scale", "2"], "--scale and --target-pga"),
     (["--target-pga", "3"], "scales records"),
     (["--records", SUITE, "--T1", "1"], "--T1: the period of --target-sa"),
-    (["--records", SUITE, "-o", "x.csv"], "-o: a suite of records"),
+    (["--records", SUITE, "--dump-lcp", "x.h5", "--method", "moreau"], "not of a suite"),
 ])
 def test_bad_suites_are_refused(args, says):
     out = run("simulate", *args, status=2)
