@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "pd_cli.h"
+#include "pd_journal.h"
 #include "pd_lcp_dump.h"
 #include "pd_output.h"
 #include "pd_scene_out.h"
@@ -42,7 +43,12 @@ static const char simulate_usage[] =
     "              have (the exact required gap beyond ABS, SRSS, DDC); -o FILE.EXT and\n"
     "              --plot F.png write each record's as FILE.recK.EXT (K from 1)\n"
     "  --threads K  records at once (OpenMP; one at a time with -o or --plot)\n"
-    "              [OMP_NUM_THREADS or all cores]; the numbers do not depend on K\n";
+    "              [OMP_NUM_THREADS or all cores]; the numbers do not depend on K; the MPI\n"
+    "              build shares the records out over mpirun's ranks\n"
+    "  --journal F  each finished record's results appended to F (removed when the suite\n"
+    "              is printed, or when a record fails)\n"
+    "  --resume    continue an interrupted suite from its --journal F (the same flags):\n"
+    "              the records F holds are read back to the bit, the others run\n";
 
 /* Everything the command line sets. */
 typedef struct sim_args {
@@ -51,9 +57,14 @@ typedef struct sim_args {
     long every;
     int json;
     int threads; /* --threads: a suite's records at once (0: OpenMP's default) */
+    /* a suite's journal and ranks */
+    const char *journal; /* --journal F: the finished records */
+    int resume;          /* --resume: continue from F */
+    long stop_after;     /* --stop-after K: the test hook (exit 130 after K records) */
+    int rank, size;      /* MPI (1 rank in the plain build) */
+    char *key;           /* the suite's journal key (suite_key) */
 } sim_args;
 
-/* Case flags, then the command's own; 0 or 2. */
 /* Record k's file of a suite: PATH with ".recK" (K from 1) before its
  * extension ("out.h5" -> "out.rec1.h5"), or at its end: 0, or -1 when it
  * does not fit in cap. */
@@ -66,6 +77,7 @@ static int suite_path(const char *path, int k, char *buf, size_t cap)
     return n < 0 || (size_t)n >= cap ? -1 : 0;
 }
 
+/* Case flags, then the command's own; 0 or 2. */
 static int parse_args(sim_args *a, int argc, char **argv)
 {
     int rc, n;
@@ -96,6 +108,20 @@ static int parse_args(sim_args *a, int argc, char **argv)
                 return pd_cli_usage_error("--threads: must be in [1, 4096] (got %d)", n);
             a->threads = n;
             i++;
+        } else if (!strcmp(f, "--journal")) {
+            if (!val)
+                return pd_cli_usage_error("--journal needs a file name");
+            a->journal = val;
+            i++;
+        } else if (!strcmp(f, "--resume"))
+            a->resume = 1;
+        else if (!strcmp(f, "--stop-after")) { /* test hook: die after K finished records */
+            if ((rc = pd_cli_int(f, val, &n)))
+                return rc;
+            if (n < 1)
+                return pd_cli_usage_error("--stop-after: must be >= 1 (got %d)", n);
+            a->stop_after = n;
+            i++;
         } else if (!strcmp(f, "--every")) {
             if ((rc = pd_cli_int(f, val, &n)))
                 return rc;
@@ -116,11 +142,22 @@ static int parse_args(sim_args *a, int argc, char **argv)
         return pd_cli_usage_error("--dump-lcp: '%s' must end in .h5", a->dump);
     if (a->dump && pd_output_check_writable("--dump-lcp", a->dump, &err))
         return pd_cli_usage_error("%s", err.msg);
-    const char *flags[] = {"-o", "--plot", "--dump-lcp"}, *paths[] = {a->out, a->plot, a->dump};
-    if (pd_output_check_distinct(3, flags, paths, &err))
+    const char *flags[] = {"-o", "--plot", "--dump-lcp", "--journal"},
+               *paths[] = {a->out, a->plot, a->dump, a->journal};
+    if (pd_output_check_distinct(4, flags, paths, &err))
+        return pd_cli_usage_error("%s", err.msg);
+    if ((a->resume || a->stop_after) && !a->journal)
+        return pd_cli_usage_error("%s needs --journal F (the suite's finished records)",
+                                  a->resume ? "--resume" : "--stop-after");
+    if (a->journal && pd_output_check_writable("--journal", a->journal, &err))
         return pd_cli_usage_error("%s", err.msg);
     if ((rc = pd_cli_case_finish(&a->k)))
         return rc;
+    if (a->journal && !pd_cli_case_is_suite(&a->k)) {
+        pd_cli_case_free(&a->k);
+        return pd_cli_usage_error("--journal: the journal of a suite (--records F, or --record "
+                                  "given twice or more)");
+    }
     if (pd_cli_case_is_suite(&a->k) && a->dump) {
         pd_cli_case_free(&a->k);
         return pd_cli_usage_error("--dump-lcp: the LCPs of one run (--record F), not of a suite");
@@ -766,43 +803,200 @@ static void suite_json_head(pd_json *js, const sim_args *a)
     }
 }
 
-/* One record's run of a suite: PD_OK or its status, its message in err. */
-typedef int (*record_run)(void *ctx, int k, pd_err *err);
+/* A suite's runs: record k's run, its summary as a journal line's body and
+ * back (suite_journal.c), over the records this rank has not read back. */
+typedef struct suite_runner {
+    const sim_args *a;
+    int (*run)(void *ctx, int k, pd_err *err);                     /* PD_OK or a status */
+    char *(*body)(const void *ctx, int k, size_t *len);            /* NULL: out of memory */
+    int (*parse)(void *ctx, const char *body, size_t len, int *k); /* 0 or -1 */
+    void *ctx;
+    unsigned char *done; /* n: finished (run here, read back, or sent by a rank) */
+    pd_suite_names names;
+    pd_journal journal; /* --journal (rank 0) */
+    int rank, size;
+    int failed, rc_failed; /* the lowest failed record (-1: none) and its status */
+    char msg[sizeof(((pd_err *)0)->msg)];
+    long finished_here; /* for --stop-after */
+} suite_runner;
 
-/* Every record's run (OpenMP over the records, the numbers the same
- * whatever the threads), a progress line counting them; the first failing
- * record's message: 0, 1 or 2. */
-static int run_records(const sim_args *a, record_run fn, void *ctx, pd_err *errs)
+/* A journal line read back, or a rank's: record k finished (a body read
+ * twice replaces the first). */
+static int runner_read(const char *body, size_t len, void *ctx)
 {
-    int n = a->k.suite->n, failed = -1, rc_first = 0, done = 0;
+    suite_runner *s = ctx;
+    int k;
+    if (s->parse(s->ctx, body, len, &k))
+        return -1;
+    s->done[k] = 1;
+    return 0;
+}
+
+/* Record k failed with rc: the lowest failure's message kept. */
+static void runner_fail(suite_runner *s, int k, int rc, const char *msg)
+{
+    if (s->failed >= 0 && s->failed < k)
+        return;
+    s->failed = k;
+    s->rc_failed = rc;
+    snprintf(s->msg, sizeof s->msg, "%s", msg);
+}
+
+/* Rank 0: a finished record into the journal (a failed append said once). */
+static void runner_journal(suite_runner *s, const char *body, size_t len)
+{
+    if (!s->a->journal || !pd_journal_append(&s->journal, body, len) || s->journal.failed != 1)
+        return;
+    fprintf(stderr, "pound: simulate: cannot append to %s; the suite goes on\n", s->journal.path);
+    s->journal.failed = 2; /* said once */
+}
+
+/* Rank 0: a rank's message ("R ..." a finished record, "E k rc msg" a
+ * failed one), journaled like rank 0's own. */
+static void runner_message(suite_runner *s, const char *text, size_t len)
+{
+    int k, rc, at = 0;
+    if (len > 2 && text[0] == 'E' && sscanf(text, "E %d %d %n", &k, &rc, &at) == 2 && at > 0)
+        runner_fail(s, k, rc, text + at);
+    else if (runner_read(text, len, s))
+        runner_fail(s, s->a->k.suite->n, PD_EIO, "a rank's record could not be read back");
+    else
+        runner_journal(s, text, len);
+}
+
+/* Record k finished here with rc: journaled (rank 0) or sent to rank 0. */
+static void runner_finished(suite_runner *s, int k, int rc, const pd_err *err)
+{
+    size_t len = 0;
+    char *body = rc ? NULL : s->body(s->ctx, k, &len);
+    if (!rc && !body) {
+        rc = PD_ENOMEM;
+        err = &(pd_err){.status = PD_ENOMEM, .msg = "out of memory for the record's summary"};
+    }
+    if (s->rank == 0) {
+        if (rc)
+            runner_fail(s, k, rc, err->msg);
+        else {
+            s->done[k] = 1;
+            runner_journal(s, body, len);
+        }
+    } else {
+        char line[sizeof err->msg + 32];
+        int n = rc ? snprintf(line, sizeof line, "E %d %d %s", k, rc, err->msg) : 0;
+        if (rc ? pd_mpi_send_text(line, (size_t)n) : pd_mpi_send_text(body, len))
+            pd_spec_mpi_abort(1); /* rank 0 would wait for it */
+    }
+    free(body);
+    if (s->a->stop_after > 0 && ++s->finished_here >= s->a->stop_after)
+        _exit(130); /* the test hook: die like an interrupted suite */
+}
+
+/* The messages rank 0 awaits: one for each record the other ranks run. */
+static int awaited(const suite_runner *s)
+{
+    int m = 0;
+    for (int k = 0; s->rank == 0 && k < s->a->k.suite->n; k++)
+        m += k % s->size != 0 && !s->done[k];
+    return m;
+}
+
+/* Rank 0: a rank's message, waiting for one when block; 1 when one came. */
+static int runner_receive(suite_runner *s, int block)
+{
+    size_t len;
+    char *text = s->rank == 0 ? pd_mpi_recv_text(block, &len) : NULL;
+    if (!text)
+        return 0;
+    runner_message(s, text, len);
+    free(text);
+    return 1;
+}
+
+/* Open --journal (rank 0; with --resume its records read back) and tell
+ * every rank which records are done: 0, 1 or 2. */
+static int runner_open(suite_runner *s, const char *key)
+{
+    pd_err err;
+    int rc = 0, n = s->a->k.suite->n;
+    if (s->rank == 0 && s->a->journal)
+        rc = pd_suite_journal_open(&s->journal, s->a->journal, key, s->a->resume, runner_read, s,
+                                   &err);
+    int status = rc == PD_EINVAL ? 2 : rc ? 1 : 0;
+    pd_spec_mpi_agree(&status);
+    if (status) {
+        if (rc)
+            fprintf(stderr, "pound: simulate: %s\n", err.msg);
+        return status;
+    }
+    pd_mpi_bcast_bytes(s->done, n);
+    return 0;
+}
+
+/* Every record's run (OpenMP over this rank's records: k = rank mod size;
+ * the numbers the same whatever the threads and ranks), a progress line
+ * counting them, the journal; the first failing record's message: 0, 1 or
+ * 2 on every rank. */
+static int run_records(suite_runner *s, const char *key, pd_err *errs)
+{
+    const sim_args *a = s->a;
+    int n = a->k.suite->n, count = 0, status;
     /* records in turn when each writes files (HDF5 is not thread-safe) */
     int nt = a->out || a->plot ? 1 : pd_spec_threads(a->threads);
+    s->failed = -1;
+    if ((status = runner_open(s, key)))
+        return status;
+    int expect = awaited(s);
     progress pr;
     progress_start(&pr);
 #pragma omp parallel for schedule(dynamic) num_threads(nt)
     for (int k = 0; k < n; k++) {
-        int rc = fn(ctx, k, &errs[k]);
+        if (k % s->size != s->rank || s->done[k])
+            continue;
+        int rc = s->run(s->ctx, k, &errs[k]);
 #pragma omp critical
         {
-            if (rc && (failed < 0 || k < failed)) {
-                failed = k;
-                rc_first = rc;
-            }
-            suite_progress(&pr, ++done, n);
+            runner_finished(s, k, rc, &errs[k]);
+            while (expect > 0 && runner_receive(s, 0)) /* the ranks' so far */
+                expect--;
+            for (int j = count = 0; j < n; j++)
+                count += s->done[j];
+            suite_progress(&pr, count, n);
         }
     }
+    for (; expect > 0; expect--) { /* every rank's, a failure or not: they wait to send */
+        runner_receive(s, 1);
+        for (int j = count = 0; j < n; j++)
+            count += s->done[j];
+        suite_progress(&pr, count, n);
+    }
     progress_end(&pr);
-    if (failed < 0)
+    status = s->failed < 0 ? 0 : s->rc_failed == PD_EINVAL ? 2 : 1;
+    pd_spec_mpi_agree(&status);
+    if (!status)
         return 0;
-    for (int k = 0; k < n && (a->out || a->plot); k++) { /* no partial output */
+    /* the suite cannot finish with these flags (the runs are deterministic):
+     * no partial output, and no journal to resume */
+    for (int k = 0; k < n && (a->out || a->plot); k++) {
         char path[PD_PATH_MAX];
         if (a->out && !suite_path(a->out, k, path, sizeof path))
             unlink(path);
         if (a->plot && !suite_path(a->plot, k, path, sizeof path))
             unlink(path);
     }
-    fprintf(stderr, "pound: simulate: %s: %s\n", a->k.suite->path[failed], errs[failed].msg);
-    return rc_first == PD_EINVAL ? 2 : 1;
+    if (s->rank == 0)
+        pd_journal_close(&s->journal, 1);
+    if (s->rank == 0 && s->failed >= 0)
+        fprintf(stderr, "pound: simulate: %s: %s\n",
+                a->k.suite->path[s->failed < n ? s->failed : 0], s->msg);
+    return status;
+}
+
+/* After the suite's output: the journal has served; the names go. */
+static void runner_end(suite_runner *s)
+{
+    if (s->a && s->rank == 0 && s->a->journal && s->journal.fd >= 0)
+        pd_journal_close(&s->journal, 1);
+    pd_suite_names_free(&s->names);
 }
 
 /* The oscillator's runs of a suite: record k's case, options, summary. */
@@ -811,7 +1005,24 @@ typedef struct osc_runs {
     const pd_osc *cs;
     const pd_run_opts *os;
     pd_osc_summary *ss;
+    pd_suite_names *names; /* the kernels' names read back */
 } osc_runs;
+
+static char *osc_record_body(const void *ctx, int k, size_t *len)
+{
+    const osc_runs *r = ctx;
+    return pd_suite_osc_body(k, &r->ss[k], len);
+}
+
+static int osc_record_parse(void *ctx, const char *body, size_t len, int *k)
+{
+    osc_runs *r = ctx;
+    pd_osc_summary v;
+    if (pd_suite_osc_parse(body, len, r->a->k.suite->n, k, &v, r->names))
+        return -1;
+    r->ss[*k] = v;
+    return 0;
+}
 
 /* Record k's run, its files (-o, --plot: PATH.recK.EXT) written. */
 static int osc_record_run(void *ctx, int k, pd_err *err)
@@ -840,7 +1051,9 @@ static int suite_oscillator(sim_args *a)
     double *figs = calloc((size_t)n * OSC_FIGS, sizeof *figs),
            *col = calloc((size_t)n, sizeof *col);
     pd_err *errs = calloc((size_t)n, sizeof *errs);
-    if (!cs || !os || !ss || !figs || !col || !errs) {
+    unsigned char *done = calloc((size_t)n, 1);
+    suite_runner sr = {.journal = {.fd = -1}};
+    if (!cs || !os || !ss || !figs || !col || !errs || !done) {
         fprintf(stderr, "pound: simulate: out of memory for a suite of %d records\n", n);
         status = 1;
         goto done;
@@ -849,8 +1062,17 @@ static int suite_oscillator(sim_args *a)
         status = pd_cli_case_record(&a->k, k, &cs[k], &os[k]);
     if (status)
         goto done;
-    osc_runs runs = {.a = a, .cs = cs, .os = os, .ss = ss};
-    if ((status = run_records(a, osc_record_run, &runs, errs)))
+    osc_runs runs = {.a = a, .cs = cs, .os = os, .ss = ss, .names = &sr.names};
+    sr = (suite_runner){.a = a,
+                        .run = osc_record_run,
+                        .body = osc_record_body,
+                        .parse = osc_record_parse,
+                        .ctx = &runs,
+                        .done = done,
+                        .journal = {.fd = -1},
+                        .rank = a->rank,
+                        .size = a->size};
+    if ((status = run_records(&sr, a->key, errs)) || a->rank)
         goto done;
     for (int k = 0; k < n; k++) {
         osc_figs(a, &ss[k], figs + (size_t)k * OSC_FIGS);
@@ -905,12 +1127,14 @@ static int suite_oscillator(sim_args *a)
     stats_rows(2, 5, cols, n);
     free(buf);
 done:
+    runner_end(&sr);
     free(cs);
     free(os);
     free(ss);
     free(figs);
     free(col);
     free(errs);
+    free(done);
     return status;
 }
 
@@ -1310,7 +1534,25 @@ typedef struct scene_runs {
     pd_scene **scs;
     const pd_run_opts *opts;
     pd_scene_summary *ss;
+    pd_suite_names *names; /* the runs' names read back */
 } scene_runs;
+
+static char *scene_record_body(const void *ctx, int k, size_t *len)
+{
+    const scene_runs *r = ctx;
+    return pd_suite_scene_body(k, &r->ss[k], len);
+}
+
+static int scene_record_parse(void *ctx, const char *body, size_t len, int *k)
+{
+    scene_runs *r = ctx;
+    pd_scene_summary v;
+    if (pd_suite_scene_parse(body, len, r->scs[0], r->a->k.suite->n, k, &v, r->names))
+        return -1;
+    pd_scene_summary_free(&r->ss[*k]); /* a record read twice: the later line */
+    r->ss[*k] = v;
+    return 0;
+}
 
 /* Record k's run, its files (-o, --plot: PATH.recK.EXT) written. */
 static int scene_record_run(void *ctx, int k, pd_err *err)
@@ -1329,7 +1571,8 @@ static int scene_record_run(void *ctx, int k, pd_err *err)
                            &r->ss[k], err);
 }
 
-static int suite_scene_run(sim_args *a, pd_scene **scs, pd_scene_summary *ss, pd_err *errs)
+static int suite_scene_run(sim_args *a, pd_scene **scs, pd_scene_summary *ss, pd_err *errs,
+                           suite_runner *sr, unsigned char *done)
 {
     int n = a->k.suite->n, status;
     for (int k = 0; k < n; k++) { /* each record on its copy, checked before any run */
@@ -1337,8 +1580,17 @@ static int suite_scene_run(sim_args *a, pd_scene **scs, pd_scene_summary *ss, pd
         if (pd_cli_scene_record(&a->k, k, scs[k], &err))
             return pd_cli_usage_error("%s: %s", a->k.suite->path[k], err.msg);
     }
-    scene_runs runs = {.a = a, .scs = scs, .opts = &a->k.opts, .ss = ss};
-    if ((status = run_records(a, scene_record_run, &runs, errs)))
+    scene_runs runs = {.a = a, .scs = scs, .opts = &a->k.opts, .ss = ss, .names = &sr->names};
+    *sr = (suite_runner){.a = a,
+                         .run = scene_record_run,
+                         .body = scene_record_body,
+                         .parse = scene_record_parse,
+                         .ctx = &runs,
+                         .done = done,
+                         .journal = {.fd = -1},
+                         .rank = a->rank,
+                         .size = a->size};
+    if ((status = run_records(sr, a->key, errs)) || a->rank)
         return status;
     for (int k = 0; k < n; k++)
         warn_rtol(ss[k].r.rtol, ss[k].err_est, ss[k].rtol_met);
@@ -1485,22 +1737,27 @@ static int suite_scene(sim_args *a)
     pd_scene_summary *ss = NULL;
     pd_scene_suite st = {.n = 0};
     pd_err *errs = NULL, err;
+    suite_runner sr = {.journal = {.fd = -1}};
+    unsigned char *done = NULL;
     int n = a->k.suite->n, status;
     if ((status = pd_cli_scene(&a->k, &base)))
         return status;
     scs = calloc((size_t)n, sizeof *scs);
     ss = calloc((size_t)n, sizeof *ss);
     errs = calloc((size_t)n, sizeof *errs);
+    done = calloc((size_t)n, 1);
     for (int k = 0; scs && k < n; k++)
         scs[k] = pd_scene_copy(base);
     for (int k = 0; scs && k < n && !status; k++)
         status = !scs[k];
-    if (!scs || !ss || !errs || status) {
+    if (!scs || !ss || !errs || !done || status) {
         fprintf(stderr, "pound: simulate: out of memory for a suite of %d records\n", n);
         status = 1;
     }
     if (!status)
-        status = suite_scene_run(a, scs, ss, errs);
+        status = suite_scene_run(a, scs, ss, errs, &sr, done);
+    if (!status && a->rank) /* rank 0 prints */
+        goto done;
     if (!status && pd_scene_suite_stats(base, ss, n, &st, &err)) {
         fprintf(stderr, "pound: simulate: %s\n", err.msg);
         status = 1;
@@ -1509,6 +1766,9 @@ static int suite_scene(sim_args *a)
         suite_scene_json(a, base, scs, ss, &st);
     else if (!status)
         status = suite_scene_text(a, base, scs, ss, &st);
+done:
+    runner_end(&sr);
+    free(done);
     pd_scene_suite_free(&st);
     for (int k = 0; ss && k < n; k++)
         pd_scene_summary_free(&ss[k]);
@@ -1521,6 +1781,44 @@ static int suite_scene(sim_args *a)
     return status;
 }
 
+/* A suite's journal key: pound's version and the summaries' layouts, the
+ * flags that decide its numbers and files (all but --json, --threads,
+ * --journal, --resume, --stop-after) as flag=value, and every record with
+ * its scale; NULL when out of memory. */
+static char *suite_key(const sim_args *a, int argc, char **argv)
+{
+    static const char *const skipped[] = {"--json", "--threads", "--journal", "--resume",
+                                          "--stop-after"};
+    char *key = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&key, &len);
+    if (!f)
+        return NULL;
+    fprintf(f, "version=%s layout=%zu,%zu,%zu", PD_VERSION, sizeof(pd_osc_summary),
+            sizeof(pd_scene_summary), sizeof(pd_scene_result));
+    for (int i = 1; i < argc; i++) {
+        const char *t = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL, *eq = strchr(t, '=');
+        size_t nl = eq ? (size_t)(eq - t) : strlen(t);
+        int skip = 0, value = t[0] == '-' && !eq && v &&
+                              (v[0] != '-' || (v[1] >= '0' && v[1] <= '9') || v[1] == '.');
+        for (size_t q = 0; q < sizeof skipped / sizeof *skipped; q++)
+            skip |= strlen(skipped[q]) == nl && !strncmp(t, skipped[q], nl);
+        if (!skip && t[0] == '-')
+            fprintf(f, " %.*s=%s", (int)nl, t, eq ? eq + 1 : value ? v : "1");
+        else if (!skip)
+            fprintf(f, " arg=%s", t);
+        i += value && strcmp(t, "--json") && strcmp(t, "--resume"); /* its value */
+    }
+    for (int k = 0; k < a->k.suite->n; k++)
+        fprintf(f, " rec%d=%s@%a", k + 1, a->k.suite->path[k], a->k.rec_scale[k]);
+    int bad = ferror(f);
+    if (fclose(f) || bad) {
+        free(key);
+        return NULL;
+    }
+    return key;
+}
+
 int pd_cmd_simulate(int argc, char **argv)
 {
     sim_args a;
@@ -1531,10 +1829,27 @@ int pd_cmd_simulate(int argc, char **argv)
         return rc;
     pd_provenance_set(argc, argv, pd_cli_is_scene(&a.k) ? PD_FORMAT_SCENE : PD_FORMAT_OSCILLATOR,
                       0);
-    if (pd_cli_case_is_suite(&a.k))
-        rc = pd_cli_is_scene(&a.k) ? suite_scene(&a) : suite_oscillator(&a);
-    else
+    /* a suite's records over the ranks (MPI) and threads, journaled; one run
+     * is one process's */
+    int threaded = 1, suite = pd_cli_case_is_suite(&a.k);
+    a.size = 1;
+    if ((rc = pd_spec_mpi_init("simulate", &a.rank, &a.size, &threaded)))
+        ;
+    else if (!suite && a.size > 1)
+        rc = pd_cli_usage_error("simulate: one run is one process's; mpirun shares out the "
+                                "records of a suite (--records F)");
+    else if (!suite)
         rc = pd_cli_is_scene(&a.k) ? simulate_scene(&a) : simulate_oscillator(&a);
+    else if (!(a.key = suite_key(&a, argc, argv))) {
+        fprintf(stderr, "pound: simulate: out of memory\n");
+        rc = 1;
+    } else {
+        if (!threaded)
+            a.threads = 1; /* MPI without thread support: one thread per rank */
+        rc = pd_cli_is_scene(&a.k) ? suite_scene(&a) : suite_oscillator(&a);
+    }
+    free(a.key);
     pd_cli_case_free(&a.k);
+    pd_spec_mpi_finalize();
     return rc;
 }

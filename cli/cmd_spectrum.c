@@ -791,7 +791,7 @@ int pd_cmd_spectrum(int argc, char **argv)
             fputs(pd_cli_case_help, stdout);
             return 0;
         }
-    if ((rc = pd_spec_mpi_init(&rank, &size, &threaded)))
+    if ((rc = pd_spec_mpi_init("spectrum", &rank, &size, &threaded)))
         return rc;
     double wall0 = pd_wall_seconds();
     if (!(a = malloc(sizeof *a)))

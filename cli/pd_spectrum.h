@@ -5,6 +5,7 @@
 #define PD_SPECTRUM_H
 
 #include "pd_cli.h"
+#include "pd_journal.h"
 
 /* `pound spectrum` (cmd_spectrum.c): the exit status. */
 int pd_cmd_spectrum(int argc, char **argv);
@@ -26,12 +27,7 @@ int pd_cmd_spectrum_scene(const pd_scene_sweep_args *a, double wall0);
 
 /* ---- the journal of finished tasks (spectrum_journal.c) ------------------ */
 
-typedef struct pd_spec_journal {
-    int fd;
-    char path[4096];
-    double last_sync;
-    int failed; /* an append failed: warned once, the sweep goes on */
-} pd_spec_journal;
+typedef pd_journal pd_spec_journal;
 
 /* Open OUT.partial: with resume, read back the finished tasks (res[t].done)
  * whose header matches key, dropping a torn last line; without resume,
@@ -49,13 +45,22 @@ void pd_spec_journal_close(pd_spec_journal *j, int remove);
 
 /* Start MPI (the MPI build) or refuse to run as one of several copies
  * under mpirun (the plain build): 0, or 2 after printing why. */
-int pd_spec_mpi_init(int *rank, int *size, int *threaded);
+int pd_spec_mpi_init(const char *cmd, int *rank, int *size, int *threaded);
 void pd_spec_mpi_finalize(void);
 /* End every rank at once (a rank that cannot go on would leave the others
  * waiting); no-op in the plain build. */
 void pd_spec_mpi_abort(int status);
 /* The largest status of any rank, on every rank. */
 void pd_spec_mpi_agree(int *status);
+/* Rank 0's n bytes at p on every rank (no-op in the plain build). */
+void pd_mpi_bcast_bytes(void *p, long n);
+/* A text of len bytes to rank 0 (a suite's finished record): 0, or -1
+ * when it is too long (and always in the plain build). */
+int pd_mpi_send_text(const char *text, size_t len);
+/* Rank 0: the next text a rank sent (block: wait for one), malloc'd and
+ * NUL-terminated, its length in *len; NULL when none is there (out of
+ * memory ends every rank: the others would wait for this one). */
+char *pd_mpi_recv_text(int block, size_t *len);
 /* Rank 0's done flags on every rank. */
 int pd_spec_mpi_bcast_done(pd_spec_result *res, long ntasks);
 /* Dynamic distribution: rank 0 holds the queue of tasks (in decreasing

@@ -6,6 +6,7 @@
  * chunks on request, and computes from the same queue; workers report
  * finished tasks in batches; rank 0 stores, journals and counts them, and
  * alone writes the output. */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -14,10 +15,11 @@
 #ifdef PD_MPI
 #include <mpi.h>
 
-enum { TAG_REPORT = 7, TAG_GRANT = 8 };
+enum { TAG_REPORT = 7, TAG_GRANT = 8, TAG_TEXT = 9 };
 
-int pd_spec_mpi_init(int *rank, int *size, int *threaded)
+int pd_spec_mpi_init(const char *cmd, int *rank, int *size, int *threaded)
 {
+    (void)cmd;
     int provided = MPI_THREAD_SINGLE, inited = 0;
     MPI_Initialized(&inited);
     if (!inited)
@@ -104,6 +106,43 @@ int pd_spec_mpi_poll_grant(int block, pd_spec_grant *g)
     return 1;
 }
 
+void pd_mpi_bcast_bytes(void *p, long n)
+{
+    for (long off = 0; off < n; off += 1L << 30) /* counts are ints */
+        MPI_Bcast((char *)p + off, (int)(n - off < (1L << 30) ? n - off : 1L << 30), MPI_BYTE, 0,
+                  MPI_COMM_WORLD);
+}
+
+int pd_mpi_send_text(const char *text, size_t len)
+{
+    if (len > (size_t)1 << 30)
+        return -1;
+    MPI_Send(text, (int)len, MPI_CHAR, 0, TAG_TEXT, MPI_COMM_WORLD);
+    return 0;
+}
+
+char *pd_mpi_recv_text(int block, size_t *len)
+{
+    int flag = 1, count = 0;
+    MPI_Status st;
+    if (block)
+        MPI_Probe(MPI_ANY_SOURCE, TAG_TEXT, MPI_COMM_WORLD, &st);
+    else
+        MPI_Iprobe(MPI_ANY_SOURCE, TAG_TEXT, MPI_COMM_WORLD, &flag, &st);
+    if (!flag)
+        return NULL;
+    MPI_Get_count(&st, MPI_CHAR, &count);
+    char *buf = malloc((size_t)count + 1);
+    if (!buf) { /* the ranks would wait for each other: end them all */
+        fprintf(stderr, "pound: out of memory for a rank's message of %d bytes\n", count);
+        MPI_Abort(MPI_COMM_WORLD, 1);
+    }
+    MPI_Recv(buf, count, MPI_CHAR, st.MPI_SOURCE, TAG_TEXT, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    buf[count] = '\0';
+    *len = (size_t)count;
+    return buf;
+}
+
 #else /* the plain build: one process */
 
 /* The number of copies mpirun (OpenMPI or a PMI launcher) started, or 1. */
@@ -118,17 +157,17 @@ static long launched_copies(void)
     return 1;
 }
 
-int pd_spec_mpi_init(int *rank, int *size, int *threaded)
+int pd_spec_mpi_init(const char *cmd, int *rank, int *size, int *threaded)
 {
     long copies = launched_copies();
     *rank = 0;
     *size = 1;
     *threaded = 1;
     if (copies > 1)
-        return pd_cli_usage_error("spectrum: started by mpirun as one of %ld copies, but this "
+        return pd_cli_usage_error("%s: started by mpirun as one of %ld copies, but this "
                                   "pound has no MPI (each copy would compute and write the whole "
-                                  "sweep): build it with `make MPI=1` and run build-mpi/pound",
-                                  copies);
+                                  "%s): build it with `make MPI=1` and run build-mpi/pound",
+                                  cmd, copies, strcmp(cmd, "spectrum") ? "suite" : "sweep");
     return 0;
 }
 
@@ -175,6 +214,26 @@ int pd_spec_mpi_poll_grant(int block, pd_spec_grant *g)
     (void)block;
     (void)g;
     return 0;
+}
+
+void pd_mpi_bcast_bytes(void *p, long n)
+{
+    (void)p;
+    (void)n;
+}
+
+int pd_mpi_send_text(const char *text, size_t len)
+{
+    (void)text;
+    (void)len;
+    return -1;
+}
+
+char *pd_mpi_recv_text(int block, size_t *len)
+{
+    (void)block;
+    *len = 0;
+    return NULL;
 }
 
 #endif

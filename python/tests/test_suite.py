@@ -164,6 +164,80 @@ def test_failed_suite_leaves_no_files(tmp_path):
     assert not list(tmp_path.glob("s.*"))
 
 
+def journal_lines(path):
+    return [ln for ln in path.read_text().splitlines() if ln.startswith("R ")]
+
+
+RESUMED = {"scene": ["--scene", EXAMPLES / "scenes" / "three-buildings.json"],
+           "yielding": ["--scene", EXAMPLES / "scenes" / "yielding-buildings.json"],
+           "rtol": ["--scene", SCENE, "--method", "moreau", "--rtol", "1e-3"]}
+
+
+@pytest.mark.parametrize("where,json_out", [("oscillator", False), ("oscillator", True),
+                                           ("scene", True), ("yielding", True), ("rtol", True)])
+def test_resumed_suite_is_uninterrupted(tmp_path, where, json_out):
+    """--journal F --stop-after 3 dies (130) with three records in F; the
+    same command with --resume prints what the uninterrupted suite prints
+    (the records read back to the bit) and removes F; a torn last line and
+    a line whose checksum fails are run again."""
+    flags = OSC if where == "oscillator" else RESUMED[where]
+    flags = ["--records", SUITE, *flags] + (["--json"] if json_out else [])
+    full = run("simulate", *flags).stdout.decode()
+    journal = tmp_path / "j.txt"
+    out = run("simulate", *flags, "--journal", journal, "--stop-after", "3", status=130)
+    assert not out.stdout and len(journal_lines(journal)) == 3
+    lines = journal.read_text().splitlines(keepends=True)
+    # a record whose checksum fails (a changed figure): run again
+    lines[-1] = lines[-1][:12] + ("1" if lines[-1][12] != "1" else "2") + lines[-1][13:]
+    journal.write_text("".join(lines) + "R 6 " + ("O 00" if where == "oscillator" else "S 1"))
+    resumed = run("simulate", *flags, "--journal", journal, "--resume").stdout.decode()
+    if json_out:
+        assert untimed(json.loads(full)) == untimed(json.loads(resumed))
+    else:
+        assert full == resumed
+    assert not journal.exists()
+
+
+def test_journal_refusals(tmp_path):
+    journal = tmp_path / "j.txt"
+    run("simulate", "--records", SUITE, *OSC, "--journal", journal, "--stop-after", "1",
+        status=130)
+    cases = [
+        (["--records", SUITE, *OSC, "--journal", journal], "exists: an interrupted suite"),
+        (["--records", SUITE, "--T0", "0.9", "--gap", "0.01", "--eps", "0.6", "--journal",
+          journal, "--resume"], "different suite (--T0 differs)"),
+        ([*OSC, "--resume"], "--resume needs --journal"),
+        ([*OSC, "--journal", tmp_path / "k.txt"], "the journal of a suite"),
+    ]
+    for args, says in cases:
+        err = run("simulate", *args, status=2).stderr.decode()
+        assert says in err and err.count("\n") == 1, err
+    assert len(journal_lines(journal)) == 1  # the refusals left it as it was
+
+
+def test_mpi_suite_is_serial(tmp_path):
+    """mpirun -np 2 of the MPI build (POUND_MPI, default build-mpi/pound)
+    prints the serial suite; with a journal, the ranks' records are in it."""
+    import os
+    import shutil
+    mpi = os.environ.get("POUND_MPI", str(pound_bin().parent.parent / "build-mpi" / "pound"))
+    if not os.path.exists(mpi) or not shutil.which("mpirun"):
+        pytest.skip("no MPI build (make MPI=1) or no mpirun")
+    flags = ["simulate", "--records", str(SUITE), "--scene", str(SCENE), "--json"]
+    serial = json.loads(run(*flags).stdout.decode())
+    journal = tmp_path / "j.txt"
+    out = subprocess.run(["mpirun", "-np", "2", "--allow-run-as-root", "--oversubscribe", mpi,
+                          *flags, "--journal", str(journal), "--stop-after", "2"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, check=False)
+    assert out.returncode != 0 and len(journal_lines(journal)) >= 2
+    out = subprocess.run(["mpirun", "-np", "2", "--allow-run-as-root", "--oversubscribe", mpi,
+                          *flags, "--journal", str(journal), "--resume"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, check=False)
+    assert out.returncode == 0, out.stderr.decode()
+    assert untimed(json.loads(out.stdout.decode())) == untimed(serial)
+    assert not journal.exists()
+
+
 def test_record_repeated_is_a_suite(cli):
     js = cli("simulate", "--record", RECS[0], "--record", RECS[1], *OSC)
     assert [r["record"] for r in js["records"]] == ["nf1.txt", "nf2.txt"]
