@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "pd_cli.h"
 
@@ -107,6 +108,10 @@ int pd_cli_record_load(const char *path, pd_record_format format, pd_record_unit
     pd_err err;
     pd_record_format fmt = format;
     *out = NULL;
+    if (strchr(path, ',') && access(path, F_OK) != 0) /* a comma list, as spectra take */
+        return pd_cli_usage_error("%s: no such file; a suite is --record given once per record, "
+                                  "or --records FILE (one record a line)",
+                                  path);
     if (units_given && fmt == PD_RECORD_AUTO && pd_record_detect(path, &fmt, &err))
         return pd_cli_usage_error("%s", err.msg);
     if (units_given && fmt != PD_RECORD_TEXT)

@@ -776,17 +776,21 @@ static void stats_rows(int lead, int ncol, const double *const *cols, int n)
     }
 }
 
-enum { OSC_FIGS = 9, SUITE_TEXT_STRUCTS = 6 };
-static const char *const osc_fig_names[OSC_FIGS] = {"umax",      "Pi1",         "gamma",
-                                                    "impacts",   "max_impulse", "acc_max",
-                                                    "shear_max", "drift_ratio", "ductility"};
+/* The oscillator's peaks over a suite (ductility last: yielding runs). */
+enum { OSC_FIGS = 16, SUITE_TEXT_STRUCTS = 6 };
+static const char *const osc_fig_names[OSC_FIGS] = {
+    "umax",         "Pi1",         "gamma",     "impacts",  "max_impulse", "acc_max",
+    "shear_max",    "drift_ratio", "u_toward",  "u_away",   "umax_free",   "max_impact_velocity",
+    "contact_time", "force_equiv", "force_max", "ductility"};
 
 /* The oscillator's figures of a run, in osc_fig_names' order. */
 static void osc_figs(const sim_args *a, const pd_osc_summary *s, double *f)
 {
-    double v[OSC_FIGS] = {s->r.umax,        s->Pi1,       s->gamma,       (double)s->r.impacts,
-                          s->r.max_impulse, s->r.acc_max, s->r.shear_max, s->r.umax / a->k.height,
-                          s->r.ductility};
+    double v[OSC_FIGS] = {
+        s->r.umax,         s->Pi1,           s->gamma,       (double)s->r.impacts,
+        s->r.max_impulse,  s->r.acc_max,     s->r.shear_max, s->r.umax / a->k.height,
+        s->r.u_toward,     s->r.u_away,      s->free.umax,   s->r.max_impact_velocity,
+        s->r.contact_time, s->r.force_equiv, s->r.force_max, s->r.ductility};
     memcpy(f, v, sizeof v);
 }
 
@@ -1605,6 +1609,7 @@ static void peaks_json(pd_json *js, const pd_suite_peaks *p, int yields)
     pd_json_stats(js, "acc_max", &p->acc_max);
     pd_json_stats(js, "shear_max", &p->shear_max);
     pd_json_stats(js, "gamma", &p->gamma);
+    pd_json_stats(js, "umax_free", &p->umax_free);
     if (yields)
         pd_json_stats(js, "ductility", &p->ductility);
 }
@@ -1653,6 +1658,9 @@ static void suite_scene_json(const sim_args *a, const pd_scene *sc, pd_scene **s
         pd_json_stats(&js, "required_gap", &ct->required_gap);
         pd_json_stats(&js, "impacts", &ct->impacts);
         pd_json_stats(&js, "max_impulse", &ct->max_impulse);
+        pd_json_stats(&js, "contact_time", &ct->contact_time);
+        pd_json_stats(&js, "force_equiv", &ct->force_equiv);
+        pd_json_stats(&js, "force_max", &ct->force_max);
         pd_json_begin_object(&js, "rules");
         pd_json_stats(&js, "abs", &ct->rule_abs);
         pd_json_stats(&js, "srss", &ct->rule_srss);

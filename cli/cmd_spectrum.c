@@ -34,7 +34,8 @@ static const char spectrum_usage[] =
     "suites: --records F (a suite file; or --record given twice or more): each record's\n"
     "                   spectrum (JSON records) and the suite's statistics at every point\n"
     "                   (JSON stats: mean, median, p16, p84, min, max of Pi1, gamma, umax);\n"
-    "                   -o writes the mean spectrum, FILE.recK.partial journals record K\n"
+    "                   -o writes the mean spectrum, FILE.recK.partial journals record K;\n"
+    "                   --plot draws each record's curves and their mean (against Pi2 or T0)\n"
     "  --T0 MIN:MAX:N   a suite against the period instead of Pi2 (each record at Pi2 = its\n"
     "                   Tp / T0, log-spaced; with --gap the gap in metres)\n"
     "MPI: make MPI=1, then mpirun -np K build-mpi/pound spectrum ... (rank 0 writes)\n"
@@ -334,9 +335,6 @@ static int check_args(spec_args *a)
                                   "one record or a pulse: --Pi2 MIN:MAX:N");
     if (a->t0_axis && a->s.linear)
         return pd_cli_usage_error("--linear: a suite's --T0 axis is log-spaced");
-    if (a->t0_axis && a->plot)
-        return pd_cli_usage_error("--plot: the charts are against Pi2; a suite's --T0 axis is "
-                                  "in -o's file and --json (umax against T0)");
     if (pd_cli_case_is_suite(&a->k) && (a->resume || a->stop_after) && !a->out)
         return pd_cli_usage_error("%s needs -o FILE", a->resume ? "--resume" : "--stop-after");
     if (a->k.scene_path || a->k.chain)
@@ -612,7 +610,7 @@ static int suite_output(const spec_args *a, const pd_spectrum *specs, pd_spec_ro
             remove(path);
         }
     if (!rc && a->plot)
-        rc = pd_spec_plot(a->plot, &specs[0], mean, &err);
+        rc = pd_spec_plot_suite(a->plot, &specs[0], nrec, rows, mean, a->t0_axis, &err);
     if (rc) {
         fprintf(stderr, "pound: spectrum: %s\n", err.msg);
         free(x);
@@ -698,54 +696,62 @@ static int suite_output(const spec_args *a, const pd_spectrum *specs, pd_spec_ro
 
 /* Every record's sweep in turn (each on every thread, each journaled to
  * FILE.recK.partial with -o), then the suite's statistics at every point. */
-static int suite_sweep(spec_args *a, double wall0)
+static int suite_sweep(spec_args *a, int rank, int size, double wall0)
 {
     int nrec = a->k.suite->n, status = 0;
     pd_spectrum *specs = calloc((size_t)nrec, sizeof *specs);
     long points = pd_spec_points(&a->s), runs = pd_spec_tasks(&a->s);
     pd_spec_row *rows = malloc((size_t)nrec * (size_t)points * sizeof *rows);
     pd_spec_result *res = malloc((size_t)runs * sizeof *res);
-    pd_spec_totals t = {
-        .method_by = pd_cli_method_by(&a->k), .threads = pd_spec_threads(a->threads), .ranks = 1};
+    pd_spec_totals t = {.method_by = pd_cli_method_by(&a->k),
+                        .threads = pd_spec_threads(a->threads),
+                        .ranks = size};
     pd_err err;
     if (!specs || !rows || !res) {
         fprintf(stderr, "pound: spectrum: out of memory for a suite of %d records\n", nrec);
         status = 1;
     }
+    pd_spec_mpi_agree(&status);
+    /* each record's sweep in turn, over every rank and thread (as sweep) */
     for (int k = 0; k < nrec && !status; k++) {
         pd_spec_journal j = {.fd = -1};
         pd_spec_exec ex = {.threads = a->threads,
-                           .progress = isatty(2),
+                           .progress = rank == 0 && isatty(2),
                            .stop_after = a->stop_after,
-                           .rank = 0,
-                           .size = 1};
+                           .rank = rank,
+                           .size = size};
         char out[4096];
-        if (suite_spectrum(a, k, &specs[k], &err)) {
-            status = pd_cli_usage_error("%s: %s", a->k.suite->path[k], err.msg);
+        if (suite_spectrum(a, k, &specs[k], &err)) { /* the same on every rank */
+            status = rank == 0 ? pd_cli_usage_error("%s: %s", a->k.suite->path[k], err.msg) : 2;
             break;
         }
         memset(res, 0, (size_t)runs * sizeof *res);
         snprintf(out, sizeof out, "%s.rec%d", a->out ? a->out : "", k + 1);
-        if (a->out)
+        if (rank == 0 && a->out)
             status = open_journal(a, &specs[k], out, &j, res, &t.resumed);
+        pd_spec_mpi_agree(&status);
+        if (!status && pd_spec_mpi_bcast_done(res, runs))
+            status = 1;
         ex.journal = a->out ? &j : NULL;
         int rc = status ? 0 : pd_spec_compute(&specs[k], &ex, res, &err);
-        if (rc) {
+        if (rc && rank == 0)
             fprintf(stderr, "pound: spectrum: %s: %s\n", a->k.suite->path[k], err.msg);
+        if (rc)
             status = rc == PD_EINVAL ? 2 : 1;
-        }
+        pd_spec_mpi_agree(&status);
         for (long r = 0; r < runs && !status; r++) {
             t.cpu_s += res[r].cpu_s;
             t.steps += (double)res[r].steps;
         }
         t.runs += runs;
-        if (!status)
+        if (!status && rank == 0)
             pd_spec_rows(&specs[k], res, rows + (size_t)k * points);
         pd_spec_journal_close(&j, 0);
     }
     t.wall_s = pd_wall_seconds() - wall0;
-    if (!status)
+    if (!status && rank == 0)
         status = suite_output(a, specs, rows, &t);
+    pd_spec_mpi_agree(&status);
     free(specs);
     free(rows);
     free(res);
@@ -819,9 +825,7 @@ int pd_cmd_spectrum(int argc, char **argv)
                                                "threads), not under mpirun")
                           : pd_cmd_spectrum_scene(&sa, wall0);
         } else if (pd_cli_case_is_suite(&a->k))
-            rc = size > 1 ? pd_cli_usage_error("spectrum --records runs in one process (OpenMP "
-                                               "threads), not under mpirun")
-                          : suite_sweep(a, wall0);
+            rc = suite_sweep(a, rank, size, wall0);
         else
             rc = sweep(a, rank, size, wall0);
     }

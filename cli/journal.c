@@ -208,8 +208,8 @@ static int resume_journal(pd_journal *j, const pd_journal_kind *kd, const char *
     return rc;
 }
 
-int pd_journal_open(pd_journal *j, const pd_journal_kind *kind, const char *path,
-                    const char *key, int resume, pd_journal_reader read, void *ctx, pd_err *err)
+int pd_journal_open(pd_journal *j, const pd_journal_kind *kind, const char *path, const char *key,
+                    int resume, pd_journal_reader read, void *ctx, pd_err *err)
 {
     int rc;
     memset(j, 0, sizeof *j);
@@ -228,9 +228,9 @@ int pd_journal_open(pd_journal *j, const pd_journal_kind *kind, const char *path
 int pd_journal_append(pd_journal *j, const char *body, size_t len)
 {
     char small[1024], *line = len + 16 <= sizeof small ? small : malloc(len + 16);
-    int n = line ? pd_journal_line(body, len, line, len + 16 <= sizeof small ? sizeof small
-                                                                              : len + 16)
-                 : -1;
+    int n =
+        line ? pd_journal_line(body, len, line, len + 16 <= sizeof small ? sizeof small : len + 16)
+             : -1;
     if (j->fd < 0 || j->failed || n < 0 || write_all(j->fd, line, (size_t)n))
         j->failed = 1;
     if (line != small)

@@ -41,9 +41,8 @@ typedef int (*pd_journal_reader)(const char *body, size_t len, void *ctx);
  * new one); without resume, create it (an existing one is an error:
  * PD_EINVAL, as is a header that does not match or a journal locked by a
  * running process). */
-int pd_journal_open(pd_journal *j, const pd_journal_kind *kind, const char *path,
-                    const char *key, int resume, pd_journal_reader read, void *ctx,
-                    pd_err *err);
+int pd_journal_open(pd_journal *j, const pd_journal_kind *kind, const char *path, const char *key,
+                    int resume, pd_journal_reader read, void *ctx, pd_err *err);
 /* Append body (no newline) as one checksummed line, written at once,
  * fdatasync'd at most once a second: 0 or -1. */
 int pd_journal_append(pd_journal *j, const char *body, size_t len);

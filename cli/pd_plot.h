@@ -11,7 +11,8 @@ typedef enum {
     PD_CURVE_LINESPOINTS = 0,
     PD_CURVE_LINES = 1,
     PD_CURVE_POINTS = 2, /* small dots: a scatter of many */
-    PD_CURVE_MARKER = 3  /* large diamonds: one or a few points to find at a glance */
+    PD_CURVE_MARKER = 3, /* large diamonds: one or a few points to find at a glance */
+    PD_CURVE_FAINT = 4   /* thin grey lines: the members behind a statistic */
 } pd_curve_style;
 
 typedef struct pd_curve {

@@ -119,6 +119,11 @@ int pd_spec_write(const char *path, const pd_spectrum *s, const pd_spec_row *row
 /* PNG.png: Pi1 vs Pi2 (log-log); PNG-gamma.png: gamma vs Pi2; with the
  * dimensional view PNG-dim.png: umax [cm] vs T0 [s]. */
 int pd_spec_plot(const char *png, const pd_spectrum *s, const pd_spec_row *rows, pd_err *err);
+/* A suite's charts (png, png-gamma.png, png-dim.png: Pi1, gamma, umax [cm]
+ * against T0 or Pi2): each of the nrec records' curves (rows: nrec x the
+ * points of s) faint, and their mean (mean: the points of s). */
+int pd_spec_plot_suite(const char *png, const pd_spectrum *s, int nrec, const pd_spec_row *rows,
+                       const pd_spec_row *mean, int use_T0, pd_err *err);
 /* Totals printed beside the points. */
 typedef struct pd_spec_totals {
     double cpu_s, wall_s, steps; /* steps: of every run, twins included */

@@ -208,7 +208,8 @@ static void chart_script(FILE *g, const char *data, const char *png_tmp, const v
     fputs("plot ", g);
     for (int k = 0; k < c->ncurves; k++) {
         static const char *const styles[] = {"linespoints lw 2", "lines lw 1.5",
-                                             "points pt 7 ps 0.8", "points pt 13 ps 2.2"};
+                                             "points pt 7 ps 0.8", "points pt 13 ps 2.2",
+                                             "lines lw 1 dt 1 lc rgb 'gray65'"};
         fputs(k ? ", " : "", g);
         pd_plot_text(g, data);
         fprintf(g, " index %d with %s title ", k, styles[c->curves[k].style]);

@@ -244,15 +244,17 @@ int pd_spec_write(const char *path, const pd_spectrum *s, const pd_spec_row *row
 /* ---- charts ------------------------------------------------------------- */
 
 /* The parameters every curve shares, for a chart title (UTF-8: the charts
- * show names as they are, pd_plot_literal). */
-static void common_title(const pd_spectrum *s, char *buf, size_t cap)
+ * show names as they are, pd_plot_literal); nrec > 0: a suite's records. */
+static void common_title(const pd_spectrum *s, int nrec, char *buf, size_t cap)
 {
     size_t n = (size_t)snprintf(buf, cap, "spectra (%s", pd_method_name(s->opts.method));
 #define ADD(...) (n += (size_t)snprintf(buf + n, n < cap ? cap - n : 0, __VA_ARGS__))
-    if (s->npulse == 1)
+    if (nrec > 0)
+        ADD(", a suite of %d records", nrec);
+    else if (s->npulse == 1)
         ADD(", %s", s->base.record ? s->base.record->name : pd_pulse_name(s->pulse[0]));
     if (s->ndir == 1)
-        ADD(" %s", pd_dir_name(s->dir[0]));
+        ADD(nrec > 0 ? ", %s" : " %s", pd_dir_name(s->dir[0]));
     if (s->nsize == 1)
         ADD(", %s = %g%s", s->size_is_gap ? "gap" : "\u03a0\u2083", s->size[0],
             s->size_is_gap ? " m" : "");
@@ -299,6 +301,24 @@ static void curve_key(const char *label, char *buf, size_t cap)
     }
 }
 
+/* The chart of the curves cv on log axes against T0 or Pi2, titled with
+ * what the curves share (nrec > 0: a suite's). */
+static int draw(const char *png, const pd_spectrum *s, int nrec, const pd_curve *cv, long ncurves,
+                int use_T0, const char *ylabel, int logy, pd_err *err)
+{
+    char title[256];
+    common_title(s, nrec, title, sizeof title);
+    pd_chart ch = {.title = title,
+                   .xlabel = use_T0 ? "T_0 [s]" : "{/Symbol P}_2 = T_p / T_0",
+                   .ylabel = ylabel,
+                   .logx = 1,
+                   .logy = logy,
+                   .ncurves = (int)ncurves,
+                   .curves = cv,
+                   .vline = NAN};
+    return pd_plot(png, &ch, err);
+}
+
 /* One chart, one curve per spectrum curve; y = f(row) scaled; x = T0 or Pi2. */
 static int chart(const char *png, const pd_spectrum *s, const pd_spec_row *rows, int use_T0,
                  size_t yoff, double yscale, const char *ylabel, int logy, pd_err *err)
@@ -306,7 +326,7 @@ static int chart(const char *png, const pd_spectrum *s, const pd_spec_row *rows,
     long nc = pd_spec_curves(s), np = pd_spec_points(s);
     double *x = malloc((size_t)np * sizeof *x), *y = malloc((size_t)np * sizeof *y);
     pd_curve *cv = malloc((size_t)nc * sizeof *cv);
-    char *labels = malloc((size_t)nc * 128), title[256];
+    char *labels = malloc((size_t)nc * 128);
     int rc;
     if (!x || !y || !cv || !labels) {
         rc = pd_err_set(err, PD_ENOMEM, "--plot: out of memory");
@@ -324,21 +344,80 @@ static int chart(const char *png, const pd_spectrum *s, const pd_spec_row *rows,
         cv[c] = (pd_curve){
             .label = labels + 128 * c, .n = s->npi2, .x = x + c * s->npi2, .y = y + c * s->npi2};
     }
-    common_title(s, title, sizeof title);
-    pd_chart ch = {.title = title,
-                   .xlabel = use_T0 ? "T_0 [s]" : "{/Symbol P}_2 = T_p / T_0",
-                   .ylabel = ylabel,
-                   .logx = 1,
-                   .logy = logy,
-                   .ncurves = (int)nc,
-                   .curves = cv,
-                   .vline = NAN};
-    rc = pd_plot(png, &ch, err);
+    rc = draw(png, s, 0, cv, nc, use_T0, ylabel, logy, err);
 done:
     free(x);
     free(y);
     free(cv);
     free(labels);
+    return rc;
+}
+
+/* A suite's chart: each record's curves faint, then the mean of every
+ * curve over the records; y = f(row) scaled, x = T0 or Pi2. */
+static int chart_suite(const char *png, const pd_spectrum *s, int nrec, const pd_spec_row *rows,
+                       const pd_spec_row *mean, int use_T0, size_t yoff, double yscale,
+                       const char *ylabel, int logy, pd_err *err)
+{
+    long nc = pd_spec_curves(s), np = pd_spec_points(s), nall = (long)(nrec + 1) * np;
+    long ncurves = (long)(nrec + 1) * nc;
+    double *x = malloc((size_t)nall * sizeof *x), *y = malloc((size_t)nall * sizeof *y);
+    pd_curve *cv = malloc((size_t)ncurves * sizeof *cv);
+    char *labels = malloc((size_t)nc * 160), faint[64];
+    int rc;
+    if (!x || !y || !cv || !labels) {
+        rc = pd_err_set(err, PD_ENOMEM, "--plot: out of memory");
+        goto done;
+    }
+    for (long p = 0; p < nall; p++) { /* the records' rows, then the mean's */
+        const pd_spec_row *r = p < (long)nrec * np ? &rows[p] : &mean[p - (long)nrec * np];
+        x[p] = use_T0 ? r->T0 : r->c.Pi2;
+        memcpy(&y[p], (const char *)r + yoff, sizeof y[p]);
+        y[p] *= yscale;
+    }
+    snprintf(faint, sizeof faint, "each of the %d records", nrec);
+    for (int k = 0; k < nrec; k++)
+        for (long c = 0; c < nc; c++) {
+            long off = (long)k * np + c * s->npi2;
+            cv[k * nc + c] = (pd_curve){.label = k == 0 && c == 0 ? faint : "",
+                                        .n = s->npi2,
+                                        .x = x + off,
+                                        .y = y + off,
+                                        .style = PD_CURVE_FAINT};
+        }
+    for (long c = 0; c < nc; c++) {
+        char label[128], key[128];
+        long off = (long)nrec * np + c * s->npi2;
+        pd_spec_curve_label(s, c, label, sizeof label);
+        curve_key(label, key, sizeof key);
+        snprintf(labels + 160 * c, 160, "mean%s%s", nc > 1 ? ": " : "", nc > 1 ? key : "");
+        cv[(long)nrec * nc + c] =
+            (pd_curve){.label = labels + 160 * c, .n = s->npi2, .x = x + off, .y = y + off};
+    }
+    rc = draw(png, s, nrec, cv, ncurves, use_T0, ylabel, logy, err);
+done:
+    free(x);
+    free(y);
+    free(cv);
+    free(labels);
+    return rc;
+}
+
+int pd_spec_plot_suite(const char *png, const pd_spectrum *s, int nrec, const pd_spec_row *rows,
+                       const pd_spec_row *mean, int use_T0, pd_err *err)
+{
+    char other[4200];
+    size_t len = strlen(png);
+    int rc = chart_suite(png, s, nrec, rows, mean, use_T0, offsetof(pd_spec_row, Pi1), 1.0,
+                         "{/Symbol P}_1 = u_{max} {/Symbol w}_p^2 / a_p", 1, err);
+    snprintf(other, sizeof other, "%.*s-gamma.png", (int)(len - 4), png);
+    if (!rc)
+        rc = chart_suite(other, s, nrec, rows, mean, use_T0, offsetof(pd_spec_row, gamma), 1.0,
+                         "{/Symbol g} = u_{max} / u_{max,free}", 0, err);
+    snprintf(other, sizeof other, "%.*s-dim.png", (int)(len - 4), png);
+    if (!rc)
+        rc = chart_suite(other, s, nrec, rows, mean, use_T0, offsetof(pd_spec_row, umax), 100.0,
+                         "u_{max} [cm]", 1, err);
     return rc;
 }
 

@@ -48,53 +48,90 @@ typedef struct field {
     size_t offset;
 } field;
 
-#define R_(k, c, f) {.kind = k, .count = c, .offset = offsetof(pd_scene_result, f)}
-#define S_(k, c, f) {.kind = k, .count = c, .offset = offsetof(pd_scene_summary, f)}
+#define R_(k, c, f)                                                                                \
+    {                                                                                              \
+        .kind = k, .count = c, .offset = offsetof(pd_scene_result, f)                              \
+    }
+#define S_(k, c, f)                                                                                \
+    {                                                                                              \
+        .kind = k, .count = c, .offset = offsetof(pd_scene_summary, f)                             \
+    }
 
 /* pd_scene_result but n, m and nstruct (pd_scene_result_alloc's). */
-static const field result_fields[] = {
-    R_(F_LONG, C_ONE, steps),          R_(F_LONG, C_ONE, lcp_solves),
-    R_(F_LONG, C_ONE, simultaneous),   R_(F_LONG, C_ONE, tol_closed),
-    R_(F_LONG, C_ONE, accumulations),  R_(F_LONG, C_ONE, steps_rejected),
-    R_(F_LONG, C_ONE, law_decided),    R_(F_DOUBLE, C_ONE, close_tol),
-    R_(F_DOUBLE, C_ONE, dt),           R_(F_DOUBLE, C_ONE, tend),
-    R_(F_DOUBLE, C_ONE, theta),        R_(F_DOUBLE, C_ONE, cpu_s),
-    R_(F_DOUBLE, C_ONE, contact_duration), R_(F_DOUBLE, C_ONE, rtol),
-    R_(F_DOUBLE, C_ONE, err_est_max),  R_(F_DOUBLE, C_ONE, dt_min),
-    R_(F_DOUBLE, C_ONE, dt_max),       R_(F_DOUBLE, C_ONE, law_band_max),
-    R_(F_DOUBLE, C_ONE, energy.input), R_(F_DOUBLE, C_ONE, energy.kinetic),
-    R_(F_DOUBLE, C_ONE, energy.strain), R_(F_DOUBLE, C_ONE, energy.damping),
-    R_(F_DOUBLE, C_ONE, energy.hysteretic), R_(F_DOUBLE, C_ONE, energy.impact),
-    R_(F_DOUBLE, C_ONE, energy.residual), R_(F_INT, C_ONE, rtol_met),
-    R_(F_NAME, C_ONE, method),         R_(F_NAME, C_ONE, kernel),
-    R_(F_NAME, C_ONE, factor),         R_(F_NAME, C_ONE, lcp_solver),
-    R_(F_NAME, C_ONE, impact_law),     R_(F_DOUBLES, C_DOF, umax),
-    R_(F_DOUBLES, C_DOF, u_pos),       R_(F_DOUBLES, C_DOF, u_neg),
-    R_(F_DOUBLES, C_DOF, drift),       R_(F_DOUBLES, C_DOF, acc_max),
-    R_(F_DOUBLES, C_DOF, shear_max),   R_(F_DOUBLES, C_DOF, drift_ratio),
-    R_(F_DOUBLES, C_DOF, ductility),   R_(F_DOUBLES, C_DOF, residual),
-    R_(F_DOUBLES, C_DOF, plastic_excursion), R_(F_LONGS, C_DOF, n_yield),
-    R_(F_LONGS, C_CONTACT, impacts),   R_(F_DOUBLES, C_CONTACT, first_impact),
-    R_(F_DOUBLES, C_CONTACT, max_impulse), R_(F_DOUBLES, C_CONTACT, contact_time),
-    R_(F_DOUBLES, C_CONTACT, approach), R_(F_DOUBLES, C_CONTACT, force_max),
-    R_(F_DOUBLES, C_CONTACT, force_equiv), R_(F_DOUBLES, C_STRUCT, err_est),
-    R_(F_DOUBLES, C_STRUCT, law_band)};
+static const field result_fields[] = {R_(F_LONG, C_ONE, steps),
+                                      R_(F_LONG, C_ONE, lcp_solves),
+                                      R_(F_LONG, C_ONE, simultaneous),
+                                      R_(F_LONG, C_ONE, tol_closed),
+                                      R_(F_LONG, C_ONE, accumulations),
+                                      R_(F_LONG, C_ONE, steps_rejected),
+                                      R_(F_LONG, C_ONE, law_decided),
+                                      R_(F_DOUBLE, C_ONE, close_tol),
+                                      R_(F_DOUBLE, C_ONE, dt),
+                                      R_(F_DOUBLE, C_ONE, tend),
+                                      R_(F_DOUBLE, C_ONE, theta),
+                                      R_(F_DOUBLE, C_ONE, cpu_s),
+                                      R_(F_DOUBLE, C_ONE, contact_duration),
+                                      R_(F_DOUBLE, C_ONE, rtol),
+                                      R_(F_DOUBLE, C_ONE, err_est_max),
+                                      R_(F_DOUBLE, C_ONE, dt_min),
+                                      R_(F_DOUBLE, C_ONE, dt_max),
+                                      R_(F_DOUBLE, C_ONE, law_band_max),
+                                      R_(F_DOUBLE, C_ONE, energy.input),
+                                      R_(F_DOUBLE, C_ONE, energy.kinetic),
+                                      R_(F_DOUBLE, C_ONE, energy.strain),
+                                      R_(F_DOUBLE, C_ONE, energy.damping),
+                                      R_(F_DOUBLE, C_ONE, energy.hysteretic),
+                                      R_(F_DOUBLE, C_ONE, energy.impact),
+                                      R_(F_DOUBLE, C_ONE, energy.residual),
+                                      R_(F_INT, C_ONE, rtol_met),
+                                      R_(F_NAME, C_ONE, method),
+                                      R_(F_NAME, C_ONE, kernel),
+                                      R_(F_NAME, C_ONE, factor),
+                                      R_(F_NAME, C_ONE, lcp_solver),
+                                      R_(F_NAME, C_ONE, impact_law),
+                                      R_(F_DOUBLES, C_DOF, umax),
+                                      R_(F_DOUBLES, C_DOF, u_pos),
+                                      R_(F_DOUBLES, C_DOF, u_neg),
+                                      R_(F_DOUBLES, C_DOF, drift),
+                                      R_(F_DOUBLES, C_DOF, acc_max),
+                                      R_(F_DOUBLES, C_DOF, shear_max),
+                                      R_(F_DOUBLES, C_DOF, drift_ratio),
+                                      R_(F_DOUBLES, C_DOF, ductility),
+                                      R_(F_DOUBLES, C_DOF, residual),
+                                      R_(F_DOUBLES, C_DOF, plastic_excursion),
+                                      R_(F_LONGS, C_DOF, n_yield),
+                                      R_(F_LONGS, C_CONTACT, impacts),
+                                      R_(F_DOUBLES, C_CONTACT, first_impact),
+                                      R_(F_DOUBLES, C_CONTACT, max_impulse),
+                                      R_(F_DOUBLES, C_CONTACT, contact_time),
+                                      R_(F_DOUBLES, C_CONTACT, approach),
+                                      R_(F_DOUBLES, C_CONTACT, force_max),
+                                      R_(F_DOUBLES, C_CONTACT, force_equiv),
+                                      R_(F_DOUBLES, C_STRUCT, err_est),
+                                      R_(F_DOUBLES, C_STRUCT, law_band)};
 
 /* pd_scene_summary but its two results. */
-static const field summary_fields[] = {
-    S_(F_DOUBLE, C_ONE, cpu_s),        S_(F_DOUBLE, C_ONE, err_est),
-    S_(F_INT, C_ONE, rtol_met),        S_(F_DOUBLES, C_DOF, Pi1),
-    S_(F_DOUBLES, C_DOF, gamma),       S_(F_DOUBLES, C_STRUCT, Pi2),
-    S_(F_DOUBLES, C_STRUCT, err_est_structure), S_(F_DOUBLES, C_CONTACT, Pi3),
-    S_(F_DOUBLES, C_CONTACT, chi),     S_(F_DOUBLES, C_CONTACT, required_gap),
-    S_(F_DOUBLES, C_CONTACT, rule_abs), S_(F_DOUBLES, C_CONTACT, rule_srss),
-    S_(F_DOUBLES, C_CONTACT, rule_ddc)};
+static const field summary_fields[] = {S_(F_DOUBLE, C_ONE, cpu_s),
+                                       S_(F_DOUBLE, C_ONE, err_est),
+                                       S_(F_INT, C_ONE, rtol_met),
+                                       S_(F_DOUBLES, C_DOF, Pi1),
+                                       S_(F_DOUBLES, C_DOF, gamma),
+                                       S_(F_DOUBLES, C_STRUCT, Pi2),
+                                       S_(F_DOUBLES, C_STRUCT, err_est_structure),
+                                       S_(F_DOUBLES, C_CONTACT, Pi3),
+                                       S_(F_DOUBLES, C_CONTACT, chi),
+                                       S_(F_DOUBLES, C_CONTACT, required_gap),
+                                       S_(F_DOUBLES, C_CONTACT, rule_abs),
+                                       S_(F_DOUBLES, C_CONTACT, rule_srss),
+                                       S_(F_DOUBLES, C_CONTACT, rule_ddc)};
 
 #undef R_
 #undef S_
 
-enum { NRESULT = sizeof result_fields / sizeof *result_fields,
-       NSUMMARY = sizeof summary_fields / sizeof *summary_fields };
+enum {
+    NRESULT = sizeof result_fields / sizeof *result_fields,
+    NSUMMARY = sizeof summary_fields / sizeof *summary_fields
+};
 
 /* The count of a field's values in a scene of n dofs, m contacts, ns
  * structures. */
@@ -383,8 +420,8 @@ int pd_suite_scene_parse(const char *body, size_t len, const pd_scene *sc, int n
         rc = summary_alloc(sc, s);
     if (!rc)
         rc = get_fields(&t, result_fields, NRESULT, &s->r, ndof, m, ns, names) ||
-             get_fields(&t, result_fields, NRESULT, &s->free, ndof, m, ns, names) ||
-             get_fields(&t, summary_fields, NSUMMARY, s, ndof, m, ns, names) || tok(&t)
+                     get_fields(&t, result_fields, NRESULT, &s->free, ndof, m, ns, names) ||
+                     get_fields(&t, summary_fields, NSUMMARY, s, ndof, m, ns, names) || tok(&t)
                  ? -1
                  : 0;
     free(t.copy);

@@ -1128,6 +1128,7 @@ PD_API int pd_stats_of(const double *x, int n, pd_stats *st, pd_err *err);
  * passed over; the base shear: storey 1's); ductility NaN when elastic. */
 typedef struct pd_suite_peaks {
     pd_stats umax, drift_ratio, acc_max, shear_max, gamma, ductility;
+    pd_stats umax_free; /* the contact-free twin's umax */
 } pd_suite_peaks;
 
 /* A rule's gap is taken as closed when the required gap exceeds it by more
@@ -1140,6 +1141,7 @@ typedef struct pd_suite_peaks {
 typedef struct pd_suite_contact {
     double closed; /* the share of runs with an impact */
     pd_stats required_gap, impacts, max_impulse;
+    pd_stats contact_time, force_equiv, force_max; /* force_max: penalty, newmark (n 0 else) */
     pd_stats rule_abs, rule_srss, rule_ddc;
     double abs_closed, srss_closed, ddc_closed; /* the shares of runs */
 } pd_suite_contact;

@@ -199,13 +199,14 @@ int pd_stats_of(const double *x, int n, pd_stats *st, pd_err *err)
 
 /* ---- a scene over a suite ------------------------------------------------------ */
 
-enum { PEAK_UMAX, PEAK_DRIFT, PEAK_ACC, PEAK_SHEAR, PEAK_GAMMA, PEAK_DUCT, PEAK_FIGS };
+enum { PEAK_UMAX, PEAK_DRIFT, PEAK_ACC, PEAK_SHEAR, PEAK_GAMMA, PEAK_DUCT, PEAK_FREE, PEAK_FIGS };
 
 /* Figure f of dof i in run r. */
 static double dof_peak(const pd_scene_summary *r, int i, int f)
 {
     const double v[PEAK_FIGS] = {r->r.umax[i],      r->r.drift_ratio[i], r->r.acc_max[i],
-                                 r->r.shear_max[i], r->gamma[i],         r->r.ductility[i]};
+                                 r->r.shear_max[i], r->gamma[i],         r->r.ductility[i],
+                                 r->free.umax[i]};
     return v[f];
 }
 
@@ -227,8 +228,8 @@ static double structure_peak(const pd_structure *S, const pd_scene_summary *r, i
 static int peaks_of(pd_suite_peaks *p, double *col, int n, const pd_structure *S, int dof,
                     const pd_scene_summary *runs, pd_err *err)
 {
-    pd_stats *st[PEAK_FIGS] = {&p->umax,      &p->drift_ratio, &p->acc_max,
-                               &p->shear_max, &p->gamma,       &p->ductility};
+    pd_stats *st[PEAK_FIGS] = {&p->umax,  &p->drift_ratio, &p->acc_max,  &p->shear_max,
+                               &p->gamma, &p->ductility,   &p->umax_free};
     for (int f = 0; f < PEAK_FIGS; f++) {
         for (int k = 0; k < n; k++)
             col[k] = S ? structure_peak(S, &runs[k], f) : dof_peak(&runs[k], dof, f);
@@ -256,17 +257,20 @@ static double rule_share(const pd_scene_summary *runs, int n, int c, int q)
 static int contact_of(pd_suite_contact *p, double *col, int n, int c, const pd_scene_summary *runs,
                       pd_err *err)
 {
-    pd_stats *st[6] = {&p->required_gap, &p->impacts,   &p->max_impulse,
-                       &p->rule_abs,     &p->rule_srss, &p->rule_ddc};
+    pd_stats *st[9] = {&p->required_gap, &p->impacts,     &p->max_impulse,
+                       &p->contact_time, &p->force_equiv, &p->force_max,
+                       &p->rule_abs,     &p->rule_srss,   &p->rule_ddc};
     int hit = 0;
     for (int k = 0; k < n; k++)
         hit += runs[k].r.impacts[c] > 0;
     p->closed = (double)hit / n;
-    for (int f = 0; f < 6; f++) {
+    for (int f = 0; f < 9; f++) {
         for (int k = 0; k < n; k++) {
-            const pd_scene_summary *r = &runs[k];
-            const double v[6] = {r->required_gap[c], (double)r->r.impacts[c], r->r.max_impulse[c],
-                                 r->rule_abs[c],     r->rule_srss[c],         r->rule_ddc[c]};
+            const pd_scene_result *r = &runs[k].r;
+            const double v[9] = {
+                runs[k].required_gap[c], (double)r->impacts[c], r->max_impulse[c],
+                r->contact_time[c],      r->force_equiv[c],     r->force_max[c],
+                runs[k].rule_abs[c],     runs[k].rule_srss[c],  runs[k].rule_ddc[c]};
             col[k] = v[f];
         }
         int rc = pd_stats_of(col, n, st[f], err);

@@ -21,8 +21,8 @@ Pi3 = [0.01, 0.1, 0.5, 1, 2]
 
 # = pound spectrum --pulse sine --dir normal,reverse --Pi3 0.01,0.1,0.5,1,2 --eps 0.5
 #                  --Pi2 0.05:5:120 --method event
-s = pound.spectrum(Pi2=(0.05, 5, npi2), pulse="sine", dir=["normal", "reverse"], Pi3=Pi3,
-                   eps=0.5, method="event")
+s = pound.spectrum(Pi2_range=(0.05, 5, npi2), pulse="sine", dir=["normal", "reverse"],
+                   Pi3=Pi3, eps=0.5, method="event")
 
 fig, axes = plt.subplots(1, 2, figsize=(11, 4.5), sharey=True)
 for k, curve in enumerate(s.curves):  # curves: dir slowest, Pi3 fastest

@@ -4,6 +4,7 @@ that the numbers are the CLI's to the last bit."""
 import ctypes
 import math
 import os
+from collections.abc import Mapping
 from typing import Any, Optional
 
 import numpy as np
@@ -87,6 +88,29 @@ def record_samples(acc):
         raise InputError("record: expected a 1-D array of accelerations (got shape %s)"
                          % (a.shape,))
     return np.ascontiguousarray(a)
+
+
+def record_of_result(rec, kw=None, what="record"):
+    """pound.record(path)'s Result given as a record: its samples acc [m/s^2]
+    every dt [s], named as the file (Record.from_array: the file's record to
+    the bit).  A dict without the samples (the CLI's `pound record --json`,
+    the measures only) raises InputError naming what to give instead.  kw:
+    a single run's keywords, whose units, record_dt and record_format would
+    contradict the Result's own (a suite's apply to its files and arrays)."""
+    missing = [k for k in ("acc", "dt") if k not in rec]
+    if missing:
+        raise InputError("%s: a dict without the samples (%s): pound.record(path)'s Result "
+                         "has them (acc [m/s^2], dt [s]); or give the record's file, a "
+                         "pound.Record(path), or the accelerations with record_dt"
+                         % (what, ", ".join(missing)))
+    for key in ("units", "record_dt", "record_format"):
+        if kw and kw.get(key) is not None and (key != "units" or kw[key] != "m/s2"):
+            raise InputError("%s: pound.record()'s Result gives its samples in m/s^2 every "
+                             "dt = %s s (it takes no %s)" % (key, rec["dt"],
+                                                             key))
+    name = rec.get("name", "array")
+    return Record.from_array(rec["acc"], rec["dt"], "m/s2",
+                             name if isinstance(name, str) else "array")
 
 
 class Record:
@@ -374,6 +398,8 @@ class Case:
             rec = kw["record"]
             if isinstance(rec, Record):
                 pass
+            elif isinstance(rec, Mapping):  # pound.record(path)'s Result: its acc and dt
+                rec = record_of_result(rec, kw)
             elif isinstance(rec, (list, tuple)) and rec and all(map(_a_path, rec)):
                 raise InputError("record: %d files given: a run takes one record (a path, a "
                                  "pound.Record or an array of accelerations); a suite: "

@@ -3,6 +3,7 @@ cli/cmd_compare.c, cli/cmd_converge.c reproduced from library calls)."""
 import ctypes
 import math
 import os
+from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any, Dict, List, Optional, Sequence, Union
 
 import numpy as np
@@ -18,9 +19,11 @@ if TYPE_CHECKING:
 NAN = float("nan")
 
 
-# CF units of the histories' variables (the CLI's files give the same)
+# CF units of the histories' variables (the CLI's files give the same): a scene's
+# (its impulses in N s), and the oscillator's (per unit mass: its impulse in m/s)
 UNITS = {"u": "m", "v": "m/s", "x": "m", "gap": "m", "impulse": "N s", "a": "m/s^2",
          "force": "N", "up": "m"}
+OSC_UNITS = {"t": "s", "u": "m", "v": "m/s", "impulse": "m/s", "gap": "m", "up": "m"}
 
 
 class Result(dict):
@@ -127,12 +130,13 @@ class Result(dict):
             raise ValueError("to_xarray: no history (run with history=True)")
         data: Dict[str, Any] = {}
         coords: Dict[str, Any] = {"t": ("t", h["t"], {"units": "s", "long_name": "time"})}
+        units = OSC_UNITS if "u" in h else UNITS  # the oscillator's history has u, a scene's x
         for k, v in h.items():
             if k == "t" or not isinstance(v, np.ndarray):
                 continue
             second = {"x": "dof", "v": "dof", "a": "dof", "up": "dof", "gap": "contact",
                       "impulse": "contact", "force": "contact"}.get(k, k + "_index")
-            attrs = {"units": UNITS[k]} if k in UNITS else {}
+            attrs = {"units": units[k]} if k in units else {}
             data[k] = (("t",) if v.ndim == 1 else ("t", second)), v, attrs
         for dim in ("dof", "contact"):  # a scene's names of its dofs and contacts
             if dim in h and len(h[dim]):
@@ -252,9 +256,10 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
     Keywords mirror the CLI's flags (defaults in brackets): pulse
     'sine'|'cosine'|'harmonic' ['sine'], dir 'normal'|'reverse' (or +1/-1)
     ['normal'], ap [1] m/s^2, Tp [1] s, T0 s or Pi2 [1], gap m or Pi3 [0.05],
-    eps [0.5], xi [0.05]; record (a file or a pound.Record), scale [1],
-    units ['g' for a text file, 'm/s2' for an array], record_format ['auto']; method 'auto'|'moreau'|'event'|
-    'penalty' ['auto': the exact event-driven reference, or Moreau-Jean
+    eps [0.5], xi [0.05]; record (a file, a pound.Record, or pound.record()'s
+    Result: its acc [m/s^2] every dt), scale [1], units ['g' for a text
+    file, 'm/s2' for an array], record_format ['auto']; method
+    'auto'|'moreau'|'event'|'penalty' ['auto': the exact event-driven reference, or Moreau-Jean
     where its scan would be over budget; a keyword only one method takes,
     dt, theta, kc, ..., chooses that method, as on the command line: r.method
     and r.method_by say which and why], dt [min(Tp, T0)/2000], tend [Tp + 2 T0], theta [0.5],
@@ -298,7 +303,8 @@ def simulate(history: bool = True, every: Int = 1, **case: Any) -> Result:
     failed, each redone at the spring's initial stiffness; 0 for the
     methods without Newton iterations).
     With history,
-    records=[...] (files, pound.Records or arrays with record_dt): a
+    records=[...] (files, pound.Records, pound.record() Results or arrays
+    with record_dt): a
     suite, as `pound simulate --record F1 --record F2 ...`: r.records, one
     Result per record (each what simulate(record=...) gives), r.stats, per
     figure (umax, Pi1, gamma, impacts, max_impulse, acc_max, shear_max,
@@ -374,7 +380,9 @@ DEFAULT_RTOLS = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)  # converge --rtols
 
 
 SUITE_FIGS = ("umax", "Pi1", "gamma", "impacts", "max_impulse", "acc_max", "shear_max",
-              "drift_ratio", "ductility")  # the CLI's stats (ductility: yielding runs)
+              "drift_ratio", "u_toward", "u_away", "umax_free", "max_impact_velocity",
+              "contact_time", "force_equiv", "force_max",
+              "ductility")  # the CLI's stats (ductility: yielding runs)
 
 
 def stats_of(values: Sequence[float]) -> "Result":
@@ -389,11 +397,13 @@ def stats_of(values: Sequence[float]) -> "Result":
 
 
 def _suite_record(item, case):
-    """One entry of records=: a pound.Record, a file, or an array (record_dt,
-    units)."""
-    from ._case import Record
+    """One entry of records=: a pound.Record, a file, pound.record(path)'s
+    Result (its acc [m/s^2] every dt), or an array (record_dt, units)."""
+    from ._case import Record, record_of_result
     if isinstance(item, Record):
         return item
+    if isinstance(item, Mapping):
+        return record_of_result(item, what="records")
     if isinstance(item, (str, bytes, os.PathLike)):
         return Record(item, case.get("units"), case.get("record_format", "auto"))
     if "record_dt" not in case:
@@ -401,14 +411,11 @@ def _suite_record(item, case):
     return Record.from_array(item, case["record_dt"], case.get("units") or "m/s2")
 
 
-def _simulate_suite(history, every, case):
-    """simulate(records=[...]): every record's run and the suite's statistics."""
-    items = case.pop("records")
-    if isinstance(items, (str, bytes, os.PathLike)) or not isinstance(items, (list, tuple)) \
-            or not items:
-        raise InputError("records: a list of record files, pound.Records or arrays (a suite)")
-    if "record" in case:
-        raise InputError("records and record: give the suite one way")
+def suite_target(case, T1_default=None, T1_says=""):
+    """A suite's scaling keywords (taken out of case): (kind, value, T1,
+    name) with kind 0 (none), 1 (target_pga) or 2 (target_sa, at T1 or
+    T1_default; T1_says names the default in the message when neither is
+    there), the checks of cli/case.c."""
     target = [k for k in ("target_pga", "target_sa") if k in case]
     if len(target) > 1:
         raise InputError("target_pga and target_sa: a suite is scaled to one target")
@@ -420,12 +427,24 @@ def _simulate_suite(history, every, case):
     if T1 is not None and kind != 2:
         raise InputError("T1: the period of target_sa")
     if kind == 2 and T1 is None:
-        if "T0" not in case:
-            raise InputError("target_sa: give the period of Sa(T1) with T1 (or the "
-                             "oscillator's T0)")
-        T1 = number("T0", case["T0"])
+        if T1_default is None:
+            raise InputError("target_sa: give the period of Sa(T1) with T1%s" % T1_says)
+        T1 = T1_default
     if target and "scale" in case:
         raise InputError("scale and %s: the target sets each record's scale" % target[0])
+    return kind, value, T1, target[0] if target else None
+
+
+def _simulate_suite(history, every, case):
+    """simulate(records=[...]): every record's run and the suite's statistics."""
+    items = case.pop("records")
+    if isinstance(items, (str, bytes, os.PathLike)) or not isinstance(items, (list, tuple)) \
+            or not items:
+        raise InputError("records: a list of record files, pound.Records or arrays (a suite)")
+    if "record" in case:
+        raise InputError("records and record: give the suite one way")
+    kind, value, T1, _ = suite_target(case, number("T0", case["T0"]) if "T0" in case else None,
+                                      " (or the oscillator's T0)")
     base = number("scale", case.pop("scale", 1.0))
     runs = []
     for item in items:

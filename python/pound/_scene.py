@@ -194,24 +194,13 @@ class Scene:
         have been closed.  target_pga=A or target_sa=A [m/s^2] (T1 [s],
         default the first structure's period) scale each record; the scene's
         own excitation is back afterwards."""
-        from ._osc import _suite_record
+        from ._osc import _suite_record, suite_target
         case = {k: opts.pop(k) for k in ("units", "record_format", "record_dt", "target_pga",
                                          "target_sa", "T1", "scale") if k in opts}
         if isinstance(records, (str, bytes, os.PathLike)) or not isinstance(
                 records, (list, tuple)) or not records:
             raise InputError("records: a list of record files, pound.Records or arrays (a suite)")
-        target = [k for k in ("target_pga", "target_sa") if k in case]
-        if len(target) > 1:
-            raise InputError("target_pga and target_sa: a suite is scaled to one target")
-        kind = 0 if not target else 1 if target[0] == "target_pga" else 2
-        value = number(target[0], case[target[0]]) if target else 0.0
-        if target and not 0.0 < value <= 1e3:
-            raise InputError("%s: the target must be in (0, 1000] m/s^2" % target[0])
-        if "T1" in case and kind != 2:
-            raise InputError("T1: the period of target_sa")
-        if target and "scale" in case:
-            raise InputError("scale and %s: the target sets each record's scale" % target[0])
-        T1 = number("T1", case["T1"]) if "T1" in case else self._sc.st[0].T0
+        kind, value, T1, _ = suite_target(case, self._sc.st[0].T0)
         base = number("scale", case.get("scale", 1.0))
         sc = self._sc
         saved, saved_tend, kept, runs = sc.exc, sc.tend, [], []
@@ -224,8 +213,8 @@ class Scene:
                 kept.append(rec)  # the scene points at it while it runs
                 scale = ctypes.c_double(base)
                 if kind:
-                    _lib.check(lib.pd_record_scale_to(rec.rec, rec.pulse, kind, value, T1, 0.05,
-                                                      scale, err), err)
+                    _lib.check(lib.pd_record_scale_to(rec.rec, rec.pulse, kind, value,
+                                                      T1 or 0.0, 0.05, scale, err), err)
                 lib.pd_scene_excite_record(ctypes.byref(sc.exc), rec.rec, rec.pulse, scale.value)
                 sc.tend = 0.0
                 _lib.check(lib.pd_scene_finish(self._p, err), err)
@@ -481,7 +470,7 @@ def _stats(st):
 
 def _peaks(p, yields):
     out = Result((f, _stats(getattr(p, f))) for f in
-                 ("umax", "drift_ratio", "acc_max", "shear_max", "gamma"))
+                 ("umax", "drift_ratio", "acc_max", "shear_max", "gamma", "umax_free"))
     if yields:
         out["ductility"] = _stats(p.ductility)
     return out
@@ -511,7 +500,9 @@ def _suite_stats(scene, sums):
             one = Result(sides="%s-%s" % (side(k.a), side(k.b)),
                          level=k.level_b if k.a < 0 else k.level_a, closed=ct.closed,
                          required_gap=_stats(ct.required_gap), impacts=_stats(ct.impacts),
-                         max_impulse=_stats(ct.max_impulse))
+                         max_impulse=_stats(ct.max_impulse),
+                         contact_time=_stats(ct.contact_time),
+                         force_equiv=_stats(ct.force_equiv), force_max=_stats(ct.force_max))
             one["rules"] = Result(abs=_stats(ct.rule_abs), srss=_stats(ct.rule_srss),
                                   ddc=_stats(ct.rule_ddc))
             one["rule_closed"] = Result(abs=ct.abs_closed, srss=ct.srss_closed,

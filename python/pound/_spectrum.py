@@ -6,6 +6,7 @@ the threads), the points from pd_spec_rows."""
 import ctypes
 import os
 import threading
+import warnings
 from typing import Any, Callable, Optional, Sequence, Union
 
 import numpy as np
@@ -13,7 +14,7 @@ import numpy as np
 from . import _args, _lib
 from ._case import (CASE_KEYS, PD_METHOD_AUTO, Case, InputError, implied_method, number,
                     parse_dir, parse_name)
-from ._lib import PD_SPEC_MAX_LIST, PdErr, err_text, lib, s
+from ._lib import PD_SPEC_MAX_LIST, PdErr, PoundError, err_text, lib, s
 from ._osc import Result
 from ._types import Floats, Int, Names, Range
 
@@ -22,6 +23,7 @@ from ._types import Floats, Int, Names, Range
 _CASE = tuple(k for k in CASE_KEYS if k not in ("T0", "Pi2", "no_wall", "pulse", "dir", "ap",
                                                 "gap", "Pi3", "eps", "xi"))
 PD_SPEC_MAX_TASKS = 2000000
+PD_METHOD_MOREAU = 0  # pd_method
 
 POINT_KEYS = ("pulse", "dir", "Pi2", "Pi3", "eps", "xi", "Pi1", "umax_free", "gamma", "chi",
               "impacts", "method", "curve", "umax", "u_toward", "u_away", "contact_time",
@@ -37,42 +39,89 @@ def _list(what, v, cap):
     return _args.values(what, v, cap)
 
 
-def _grid(Pi2):
-    """(MIN, MAX, N) or 'MIN:MAX:N'; a list (or array) would read as values,
-    which a spectrum does not take: refused, naming the range's forms."""
-    if not isinstance(Pi2, (str, tuple)):
-        raise InputError("Pi2: a spectrum sweeps a range, given as the tuple (MIN, MAX, N) or "
-                         "'MIN:MAX:N' (got %s %r: a list is not read as a range; explicit Pi2 "
-                         "values are not supported)" % (type(Pi2).__name__, Pi2))
-    if isinstance(Pi2, str):
-        parts = Pi2.split(":")
+def _range(what, r, T0=False):
+    """A range (MIN, MAX, N) or the CLI's text 'MIN:MAX:N', checked as
+    cmd_spectrum.c checks --Pi2 (T0: a suite's --T0 axis, 2 <= N): (MIN, MAX, N)."""
+    if isinstance(r, str):
+        parts = r.split(":")
         if len(parts) != 3:
-            raise InputError("Pi2: give MIN:MAX:N (got '%s')" % Pi2)
-        Pi2 = parts
-    try:
-        parts = list(Pi2)
-    except TypeError:
-        parts = None
-    if parts is None or len(parts) != 3:
-        raise InputError("Pi2: give (MIN, MAX, N) (got %r)" % (Pi2,))
-    lo, hi = _args.number("Pi2", parts[0], "MIN ="), _args.number("Pi2", parts[1], "MAX =")
-    n = _args.integer("Pi2", parts[2], "N =")
-    if not lo > 0.0 or n < 1 or n > 1000000 or (hi != lo if n == 1 else not hi > lo):
-        raise InputError("Pi2: need 0 < MIN < MAX and 2 <= N <= 1e6, or MIN = MAX with N = 1 "
-                         "(got %g:%g:%d)" % (lo, hi, n))
+            raise InputError("%s: give MIN:MAX:N (got '%s')" % (what, r))
+    elif isinstance(r, (tuple, list, np.ndarray)) and len(r) == 3:
+        parts = list(r)
+    else:
+        raise InputError("%s: give the range (MIN, MAX, N) or 'MIN:MAX:N' (got %r)" % (what, r))
+    lo, hi = _args.number(what, parts[0], "MIN ="), _args.number(what, parts[1], "MAX =")
+    n = _args.integer(what, parts[2], "N =")
+    if T0:
+        if not (0.0 < lo < hi) or n < 2 or n > 1000000:
+            raise InputError("%s: need 0 < MIN < MAX and 2 <= N <= 1e6 (got %g:%g:%d)"
+                             % (what, lo, hi, n))
+    elif not lo > 0.0 or n < 1 or n > 1000000 or (hi != lo if n == 1 else not hi > lo):
+        raise InputError("%s: need 0 < MIN < MAX and 2 <= N <= 1e6, or MIN = MAX with N = 1 "
+                         "(got %g:%g:%d)" % (what, lo, hi, n))
     return lo, hi, n
 
 
-def build(Pi2, linear=False, pulse=None, dir=None, ap=None, xi=None, Pi3=None, gap=None,
+def _values(Pi2, stacklevel):
+    """Explicit Pi2 values (a value, a list, tuple or array): each > 0.  A
+    3-tuple ending in an integer, the range form of older versions, is read as
+    values too, with a warning naming Pi2_range."""
+    if isinstance(Pi2, tuple) and len(Pi2) == 3 and isinstance(Pi2[2], (int, np.integer)) \
+            and not _args.is_bool(Pi2[2]):
+        warnings.warn("Pi2=%r is read as the three Pi2 values %s (a range of N values is "
+                      "Pi2_range=(MIN, MAX, N) or Pi2='MIN:MAX:N'; a list of values does not "
+                      "warn)" % (Pi2, ", ".join("%g" % _args.number("Pi2", v) for v in Pi2)),
+                      UserWarning, stacklevel=stacklevel)
+    vals = [_args.number("Pi2", v) for v in _args.values("Pi2", Pi2, 1000000)]
+    for v in vals:
+        if not v > 0.0:
+            raise InputError("Pi2: the values must be > 0 (got %g)" % v)
+    return vals
+
+
+def axis_of(Pi2, Pi2_range, T0_range, linear, suite, stacklevel=4):
+    """The sweep's axis: ('Pi2', (MIN, MAX, N)) for a range, ('values', [Pi2
+    ...]) for explicit values, ('T0', (MIN, MAX, N)) for a suite against the
+    period; the CLI's refusals (stacklevel: the user's frame, for a warning)."""
+    given = [k for k, v in (("Pi2", Pi2), ("Pi2_range", Pi2_range), ("T0_range", T0_range))
+             if v is not None]
+    if len(given) > 1:
+        raise InputError("%s and %s are alternatives: give one" % (given[0], given[1]))
+    if not given:
+        raise TypeError("spectrum: give Pi2 (values), Pi2_range=(MIN, MAX, N)%s"
+                        % (" or T0_range=(MIN, MAX, N)" if suite else ""))
+    if T0_range is not None:
+        if not suite:
+            raise InputError("T0_range: the axis of a suite's spectrum (records=); one record "
+                             "or a pulse: Pi2 or Pi2_range")
+        if _args.flag("linear", linear):
+            raise InputError("linear: a suite's T0_range axis is log-spaced")
+        return "T0", _range("T0_range", T0_range, T0=True)
+    if Pi2_range is not None:
+        return "Pi2", _range("Pi2_range", Pi2_range)
+    if isinstance(Pi2, str):  # the CLI's text MIN:MAX:N
+        return "Pi2", _range("Pi2", Pi2)
+    if isinstance(Pi2, bytes):
+        raise InputError("Pi2: give values, Pi2_range=(MIN, MAX, N) or 'MIN:MAX:N' (got %r)"
+                         % (Pi2,))
+    if _args.flag("linear", linear):
+        raise InputError("linear: the spacing of Pi2_range (explicit Pi2 values are taken as "
+                         "given)")
+    return "values", _values(Pi2, stacklevel)
+
+
+def build(grid, linear=False, pulse=None, dir=None, ap=None, xi=None, Pi3=None, gap=None,
           eps=None, dt_per_Tp=None, **case):
-    """The pd_spectrum of the keywords, checked as cmd_spectrum.c checks its
-    flags; (spectrum, case) (the case owns a record)."""
+    """The pd_spectrum of the keywords on the grid (MIN, MAX, N), checked as
+    cmd_spectrum.c checks its flags; (spectrum, case) (the case owns a
+    record).  Its method is not resolved yet (k.method_in: the method given or
+    implied, else auto): finish() resolves it and checks every point."""
     unknown = sorted(set(case) - set(_CASE))
     if unknown:
         raise TypeError("unexpected keyword argument(s) %s" % ", ".join(unknown))
     sp = _lib.PdSpectrum()
     lib.pd_spec_init(sp)
-    sp.pi2_min, sp.pi2_max, sp.npi2 = _grid(Pi2)
+    sp.pi2_min, sp.pi2_max, sp.npi2 = grid
     sp.linear = 1 if _args.flag("linear", linear) else 0
     if Pi3 is not None and gap is not None:
         raise InputError("gap and Pi3 are alternatives: give one")
@@ -106,9 +155,6 @@ def build(Pi2, linear=False, pulse=None, dir=None, ap=None, xi=None, Pi3=None, g
             raise InputError("dt_per_Tp: must be > 0 (got %g)" % sp.dt_per_Tp)
         if case.get("dt") is not None:
             raise InputError("dt and dt_per_Tp are alternatives: give one")
-    if lib.pd_spec_tasks(sp) > PD_SPEC_MAX_TASKS:
-        raise InputError("Pi2: %d runs in this sweep, at most %d"
-                         % (lib.pd_spec_tasks(sp), PD_SPEC_MAX_TASKS))
     for i in range(sp.neps):
         if not 0.0 <= sp.eps[i] <= 1.0:
             raise InputError("eps: restitution must be in [0, 1] (got %g)" % sp.eps[i])
@@ -139,18 +185,49 @@ def build(Pi2, linear=False, pulse=None, dir=None, ap=None, xi=None, Pi3=None, g
             sp.ap[0] = sp.base.ap
     sp.base.Piy = checked.c.Piy  # uy in metres made Piy (the sweep keeps Piy)
     sp.opts = k.opts  # dt and tend stay 0 (per point) unless given
-    # the method given or implied (dt_per_Tp too), else one for the sweep
+    # the method given or implied (dt_per_Tp too), else one for the sweep (finish)
     m, key = implied_method(dict(case, dt_per_Tp=dt_per_Tp))
     by = k.have["method_by"]
     if by is None and m is not None:
         sp.opts.method, by = m, "--" + key.replace("_", "-")
     if by is None:
         sp.opts.method = PD_METHOD_AUTO
-        lib.pd_spec_resolve_method(sp)
     k.method_by = by or "default"
-    err = PdErr()
-    _lib.check(lib.pd_spec_validate(sp, err), err)
+    k.method_in = sp.opts.method
     return sp, k
+
+
+def on_values(sp, values):
+    """One sweep per explicit Pi2 value (its grid v:v:1, the CLI's route for
+    one value): copies of sp."""
+    out = []
+    for v in values:
+        one = _lib.PdSpectrum.from_buffer_copy(sp)
+        one.pi2_min = one.pi2_max = v
+        one.npi2 = 1
+        out.append(one)
+    return out
+
+
+def finish(sps, method_in, where=None):
+    """The method of sweeps that make one spectrum (the sweeps of its explicit
+    values), resolved as pd_spec_resolve_method resolves one sweep over all
+    their points: the exact event-driven reference when every point's scan
+    fits, else Moreau-Jean for all; then every point checked (where: the
+    record's name, prefixed to a refusal)."""
+    for sp in sps:
+        sp.opts.method = method_in
+        lib.pd_spec_resolve_method(sp)
+    methods = set(sp.opts.method for sp in sps)
+    if len(methods) > 1:  # some points over the reference's budget: Moreau-Jean for all
+        for sp in sps:
+            sp.opts.method = PD_METHOD_MOREAU
+    err = PdErr()
+    for sp in sps:
+        st = lib.pd_spec_validate(sp, err)
+        if st != 0:
+            msg = err_text(err)
+            raise _lib.make_error(st, "%s: %s" % (where, msg) if where else msg)
 
 
 def _threads(threads):
@@ -162,36 +239,38 @@ def _threads(threads):
     return threads
 
 
-def run_tasks(sp, threads=None):
-    """Every task of the sweep into its slot; the lowest failed task raises."""
-    ntasks = lib.pd_spec_tasks(sp)
-    res = (_lib.PdSpecResult * ntasks)()
+def run_tasks(sps, threads=None, names=None):
+    """Every task of the sweeps into its slot, on one pool of threads (one
+    result array per sweep); the lowest failed task (sweep, task) raises,
+    prefixed with names[sweep] when given."""
+    res = [(_lib.PdSpecResult * lib.pd_spec_tasks(sp))() for sp in sps]
+    jobs = [(i, t) for i, sp in enumerate(sps) for t in range(lib.pd_spec_tasks(sp))]
     # costliest first, so that the last tasks are short (as the CLI orders them)
-    order = sorted(range(ntasks), key=lambda t: (-lib.pd_spec_cost(sp, t), t))
-    threads = min(_threads(threads), max(1, ntasks))
+    order = sorted(jobs, key=lambda j: (-lib.pd_spec_cost(sps[j[0]], j[1]), j))
+    threads = min(_threads(threads), max(1, len(jobs)))
     msgs = {}
     lock = threading.Lock()
     it = iter(order)
+
+    def one(job, err):
+        i, t = job
+        lib.pd_spec_run_task(sps[i], t, res[i][t], err)
+        if res[i][t].status:
+            with lock:
+                msgs[job] = err_text(err)
 
     def work():
         err = PdErr()
         while True:
             with lock:
-                t = next(it, None)
-            if t is None:
+                job = next(it, None)
+            if job is None:
                 return
-            lib.pd_spec_run_task(sp, t, res[t], err)
-            if res[t].status:
-                with lock:
-                    msgs[t] = err_text(err)
+            one(job, err)
 
-    if sp.opts.method == 2 and ntasks:
+    if jobs and sps[0].opts.method == 2:
         # the penalty runs turn GSL's process-wide error handler off: once, before the threads
-        first = next(it)
-        err = PdErr()
-        lib.pd_spec_run_task(sp, first, res[first], err)
-        if res[first].status:
-            msgs[first] = err_text(err)
+        one(next(it), PdErr())
     if threads == 1:
         work()
     else:
@@ -202,7 +281,8 @@ def run_tasks(sp, threads=None):
             th.join()
     if msgs:
         bad = min(msgs)
-        raise _lib.make_error(res[bad].status, msgs[bad])
+        msg = msgs[bad] if names is None else "%s: %s" % (names[bad[0]], msgs[bad])
+        raise _lib.make_error(res[bad[0]][bad[1]].status, msg)
     return res
 
 
@@ -257,52 +337,49 @@ def _elastic_point(r, method):
         tend=r.tend, steps=r.steps, cpu_s=r.cpu_s)
 
 
-def spectrum(Pi2: Range, linear: bool = False,
-             pulse: Optional[Names] = None,
-             dir: Optional[Union[Names, int, Sequence[int]]] = None, ap: Optional[Floats] = None,
-             xi: Optional[Floats] = None, Pi3: Optional[Floats] = None,
-             gap: Optional[Floats] = None, eps: Optional[Floats] = None,
-             dt_per_Tp: Optional[float] = None, threads: Optional[Int] = None,
-             on_point: Optional[Callable[[Result], Any]] = None, **case: Any) -> Result:
-    """Pounding spectra, as `pound spectrum --Pi2 MIN:MAX:N ... --json`.
-
-    Pi2: the tuple (MIN, MAX, N) or 'MIN:MAX:N', log-spaced (linear=True: equal
-    steps); a list is refused (it would read as values).
-    Lists (a value or a sequence; one curve per combination): pulse, dir,
-    ap [m/s^2] (the dimensional view), xi, Pi3 or gap [m], eps.  dt_per_Tp:
-    steps per pulse period (dt = Tp / dt_per_Tp [s]).  Other keywords as
-    for simulate(): Tp, record, scale, units, method, dt (or dt_per_Tp),
-    tend, theta, ...; rtol only with method='penalty' (its integrator's
-    tolerance): a spectrum runs Moreau-Jean on fixed steps, and rtol for
-    Moreau-Jean raises InputError.
-
-    threads: runs at once [OMP_NUM_THREADS or all cores]; the tasks go to a
-    pool of threads (pd_spec_run_task), or with threads=1 or on_point to
-    the library's serial sweep pd_spec_sweep when the library has it;
-    on_point(point) is then called as each point completes (a truthy return
-    stops the sweep: PoundError PD_ESTOPPED).  The numbers are the same
-    either way, and the CLI's.
-
-    Returns a Result: Pi2 (N,), the arrays of shape (curves, N) Pi1 =
-    umax / Le, gamma, chi (dimensionless), umax, umax_free, u_toward, u_away,
-    gap [m], contact_time, first_impact, T0, dt, tend [s], impacts, steps
-    (counts), curves (a dict per curve: pulse, dir,
-    ap, xi, Pi3 or gap, eps, label), points (the CLI's JSON points), runs,
-    twins."""
-    sp, k = build(Pi2, linear, pulse, dir, ap, xi, Pi3, gap, eps, dt_per_Tp, **case)
-    npoints, npi2, ncurves = lib.pd_spec_points(sp), sp.npi2, lib.pd_spec_curves(sp)
-    method = s(lib.pd_method_name(sp.opts.method))
+def _rows(sps, threads, on_point, names=None):
+    """The rows of each sweep: the library's serial sweep (on_point called as
+    each point completes) with threads=1 or on_point, else the tasks on a
+    pool of threads and pd_spec_rows."""
     serial = threads is not None and _threads(threads) == 1
     if hasattr(lib, "pd_spec_sweep") and (serial or on_point is not None):
-        rows = sweep_rows(sp, on_point)
-    elif on_point is not None:
+        out = []
+        for i, sp in enumerate(sps):
+            try:
+                out.append(sweep_rows(sp, on_point))
+            except PoundError as e:
+                if names is None:
+                    raise
+                raise _lib.make_error(e.status, "%s: %s" % (names[i], e.message)) from None
+        return out
+    if on_point is not None:
         raise InputError("on_point: this libpound has no pd_spec_sweep")
-    else:
-        res = run_tasks(sp, threads)
-        rows = (_lib.PdSpecRow * npoints)()
-        lib.pd_spec_rows(sp, res, rows)
+    res = run_tasks(sps, threads, names)
+    out = []
+    for sp, r in zip(sps, res):
+        rows = (_lib.PdSpecRow * lib.pd_spec_points(sp))()
+        lib.pd_spec_rows(sp, r, rows)
+        out.append(rows)
+    return out
+
+
+def _merged(sps, rows):
+    """The rows of one spectrum from its sweeps' (one sweep, or one per
+    explicit value): point p = curve * N + j, as a sweep orders them."""
+    if len(sps) == 1:
+        return list(rows[0])
+    ncurves = lib.pd_spec_curves(sps[0])
+    return [rows[j][cv] for cv in range(ncurves) for j in range(len(sps))]
+
+
+def _result(sps, k, rows, pi2):
+    """A spectrum's Result from its sweeps (one, or one per explicit Pi2
+    value) and their merged rows."""
+    sp = sps[0]
+    method = s(lib.pd_method_name(sp.opts.method))
+    npi2, ncurves = len(pi2), lib.pd_spec_curves(sp)
     points = [_point(r, method) for r in rows]
-    out = Result(Pi2=np.array([lib.pd_spec_pi2(sp, j) for j in range(npi2)]))
+    out = Result(Pi2=np.array(pi2, dtype=np.float64))
     keys = ARRAY_KEYS + (YIELD_KEYS if lib.pd_osc_yields(sp.base) else ())
     for key in keys:
         dtype = np.int64 if key in ("impacts", "steps") else np.float64
@@ -320,6 +397,221 @@ def spectrum(Pi2: Range, linear: bool = False,
         d["label"] = label.value.decode()
         curves.append(d)
     out.update(curves=curves, points=points, method=method, method_by=k.method_by,
-               runs=lib.pd_spec_tasks(sp),
-               twins=lib.pd_spec_twins(sp))
+               runs=sum(lib.pd_spec_tasks(x) for x in sps),
+               twins=sum(lib.pd_spec_twins(x) for x in sps))
+    return out
+
+
+def _check_tasks(sps):
+    n = sum(lib.pd_spec_tasks(sp) for sp in sps)
+    if n > PD_SPEC_MAX_TASKS:
+        raise InputError("Pi2: %d runs in this sweep, at most %d" % (n, PD_SPEC_MAX_TASKS))
+
+
+def spectrum(Pi2: Optional[Union[Floats, str]] = None, linear: bool = False,
+             pulse: Optional[Names] = None,
+             dir: Optional[Union[Names, int, Sequence[int]]] = None, ap: Optional[Floats] = None,
+             xi: Optional[Floats] = None, Pi3: Optional[Floats] = None,
+             gap: Optional[Floats] = None, eps: Optional[Floats] = None,
+             dt_per_Tp: Optional[float] = None, threads: Optional[Int] = None,
+             on_point: Optional[Callable[[Result], Any]] = None,
+             Pi2_range: Optional[Range] = None, records: Optional[Any] = None,
+             T0_range: Optional[Range] = None, **case: Any) -> Result:
+    """Pounding spectra, as `pound spectrum --Pi2 MIN:MAX:N ... --json`.
+
+    The Pi2 axis, one of: Pi2, explicit values (a value, or a list, tuple or
+    array of them: each point at that Pi2 exactly, as `--Pi2 X:X:1` runs
+    it; a tuple of three is three values, never a range); Pi2_range, the
+    range (MIN, MAX, N) or 'MIN:MAX:N' (the CLI's --Pi2 MIN:MAX:N: N values,
+    log-spaced, linear=True: equal steps; the text 'MIN:MAX:N' given as Pi2
+    is that range too); with records, T0_range=(MIN, MAX, N) or 'MIN:MAX:N'
+    [s] (the CLI's --T0 MIN:MAX:N: every record at the same periods, Pi2 =
+    its Tp / T0, log-spaced).
+    Lists (a value or a sequence; one curve per combination): pulse, dir,
+    ap [m/s^2] (the dimensional view), xi, Pi3 or gap [m], eps.  dt_per_Tp:
+    steps per pulse period (dt = Tp / dt_per_Tp [s]).  Other keywords as
+    for simulate(): Tp, record, scale, units, method, dt (or dt_per_Tp),
+    tend, theta, ...; rtol only with method='penalty' (its integrator's
+    tolerance): a spectrum runs Moreau-Jean on fixed steps, and rtol for
+    Moreau-Jean raises InputError.
+
+    threads: runs at once [OMP_NUM_THREADS or all cores]; the tasks go to a
+    pool of threads (pd_spec_run_task), or with threads=1 or on_point to
+    the library's serial sweep pd_spec_sweep when the library has it;
+    on_point(point) is then called as each point completes (a truthy return
+    stops the sweep: PoundError PD_ESTOPPED; explicit values run one after
+    the other, each point's curves in turn).  The numbers are the same
+    either way, and the CLI's.
+
+    Returns a Result: Pi2 (N,), the arrays of shape (curves, N) Pi1 =
+    umax / Le, gamma, chi (dimensionless), umax, umax_free, u_toward, u_away,
+    gap [m], contact_time, first_impact, T0, dt, tend [s], impacts, steps
+    (counts), curves (a dict per curve: pulse, dir,
+    ap, xi, Pi3 or gap, eps, label), points (the CLI's JSON points), runs,
+    twins.
+
+    records: a suite, as `pound spectrum --records FILE --json`: a suite
+    file (one record a line, PATH [SCALE]) or a list of records (files,
+    pound.Records, pound.record()'s Results or arrays with record_dt, as
+    `--record` given for each); scale multiplies every record's, or
+    target_pga=A or target_sa=A [m/s^2] (with T1 [s]) scales each to that
+    PGA or 5 %-damped Sa(T1).  Returns a Result with the CLI's keys: suite
+    (the file, or '--record'), n, axis ('Pi2' or 'T0'), records (per
+    record: record, scale, Tp [s], ap [m/s^2], method, points, and the
+    arrays and curves of its spectrum as above), stats (per point: curve,
+    Pi2 or T0 [s], Pi3 or gap [m], eps, and the suite's n, mean, median,
+    p16, p84, min, max of Pi1, gamma and umax [m]); curves; and Pi2 (N,)
+    or T0 (N,) [s], the axis."""
+    lists = (linear, pulse, dir, ap, xi, Pi3, gap, eps, dt_per_Tp)
+    if "T0" in case:
+        raise InputError("T0: a spectrum sweeps Pi2 = Tp / T0 (Pi2 or Pi2_range); a suite "
+                         "against the period: records=..., T0_range=(MIN, MAX, N)")
+    if records is not None:
+        return _suite(records, Pi2, Pi2_range, T0_range, lists, threads, on_point, case)
+    if any(key in case for key in _SUITE_KEYS):
+        raise InputError("%s: scales a suite's records (records=)"
+                         % next(key for key in _SUITE_KEYS if key in case))
+    kind, axis = axis_of(Pi2, Pi2_range, T0_range, linear, False)
+    if kind == "values":
+        sp, k = build((axis[0], axis[0], 1), *lists, **case)
+        sps = on_values(sp, axis)
+    else:
+        sp, k = build(axis, *lists, **case)
+        sps = [sp]
+    _check_tasks(sps)
+    finish(sps, k.method_in)
+    rows = _merged(sps, _rows(sps, threads, on_point))
+    pi2 = axis if kind == "values" else [lib.pd_spec_pi2(sp, j) for j in range(sp.npi2)]
+    return _result(sps, k, rows, pi2)
+
+
+# ---- suites of records (cli/cmd_spectrum.c suite_sweep) ---------------------------------------
+
+_SUITE_KEYS = ("target_pga", "target_sa", "T1")
+
+
+class _PdSuite(ctypes.Structure):
+    """pd_suite (problems/pd_problems.h): the records of a suite file."""
+    _fields_ = [("n", ctypes.c_int), ("cap", ctypes.c_int),
+                ("path", ctypes.POINTER(ctypes.c_char_p)),
+                ("scale", ctypes.POINTER(ctypes.c_double))]
+
+
+def _suite_file(path):
+    """The records of a suite file (pd_suite_read: PATH [SCALE] a line, a
+    relative PATH from the file's folder): [(path, scale)]."""
+    read, free = lib["pd_suite_read"], lib["pd_suite_free"]
+    read.restype, free.restype = ctypes.c_int, None
+    read.argtypes = [ctypes.c_char_p, ctypes.POINTER(ctypes.POINTER(_PdSuite)),
+                     ctypes.POINTER(PdErr)]
+    free.argtypes = [ctypes.POINTER(_PdSuite)]
+    cpath, _ = _args.path("records", path)
+    out, err = ctypes.POINTER(_PdSuite)(), PdErr()
+    st = read(cpath, ctypes.byref(out), err)
+    if st != 0:
+        raise _lib.make_error(st, "records: %s" % err_text(err))
+    try:
+        su = out.contents
+        return [(su.path[k].decode("utf-8", "surrogateescape"), su.scale[k])
+                for k in range(su.n)]
+    finally:
+        free(out)
+
+
+def _suite_scales(items, case):
+    """The suite's records and each one's scale (cli/case.c case_records:
+    scale times the suite file's, or the target's factor)."""
+    from ._osc import _suite_record, suite_target
+    kind, value, T1, name = suite_target(case)
+    base = number("scale", case.get("scale", 1.0))
+    if not base > 0.0:
+        raise InputError("scale: must be > 0 (got %g)" % base)
+    recs, scales = [], []
+    for item, factor in items:
+        if kind and factor != 1.0:
+            raise InputError("%s: the suite gives %s a scale (%g); with a target the target "
+                             "scales every record" % (name, item, factor))
+        rec = _suite_record(item, case)
+        scale = ctypes.c_double(base * factor)
+        if kind:
+            err = PdErr()
+            st = lib.pd_record_scale_to(rec.rec, rec.pulse, kind, value, T1 or 0.0, 0.05, scale,
+                                        err)
+            if st != 0:
+                raise _lib.make_error(st, "%s: %s" % (name, err_text(err)))
+        recs.append(rec)
+        scales.append(scale.value)
+    return recs, scales
+
+
+def _suite(records, Pi2, Pi2_range, T0_range, lists, threads, on_point, case):
+    """spectrum(records=...): each record's sweep (cmd_spectrum.c
+    suite_spectrum) and the suite's statistics at every point (pd_stats_of)."""
+    from ._osc import stats_of
+    if case.get("record") is not None:
+        raise InputError("records and record: give the suite one way")
+    kind, axis = axis_of(Pi2, Pi2_range, T0_range, lists[0], True, stacklevel=5)
+    if isinstance(records, (str, bytes, os.PathLike)):
+        items, name = _suite_file(records), os.fsdecode(records)
+    elif isinstance(records, (list, tuple)) and records:
+        items, name = [(item, 1.0) for item in records], "--record"
+    else:
+        raise InputError("records: a suite file, or a list of record files, pound.Records, "
+                         "pound.record() Results or arrays (with record_dt)")
+    case = dict(case)
+    recs, scales = _suite_scales(items, case)
+    run = {key: v for key, v in case.items() if key not in ("units", "record_format",
+                                                             "record_dt", "scale")}
+    # the sweep on the first record (its flags checked), then each record's copy of it
+    first = recs[0].pulse.Tp
+    grid = ((axis[0], axis[0], 1) if kind == "values" else
+            (first / axis[1], first / axis[0], axis[2]) if kind == "T0" else axis)
+    sp0, k = build(grid, *lists, record=recs[0], scale=scales[0], **run)
+    blocks, names = [], []
+    for rec, scale in zip(recs, scales):
+        sp = _lib.PdSpectrum.from_buffer_copy(sp0)
+        lib.pd_osc_set_record(sp.base, rec.rec, rec.pulse, scale)
+        if not sp.dimensional:
+            sp.ap[0] = sp.base.ap
+        if kind == "T0":  # log-spaced in T0 = log-spaced in Pi2, the same N
+            sp.pi2_min, sp.pi2_max = sp.base.Tp / axis[1], sp.base.Tp / axis[0]
+        sps = on_values(sp, axis) if kind == "values" else [sp]
+        finish(sps, k.method_in, rec.name)
+        blocks.append(sps)
+        names += [rec.name] * len(sps)
+    _check_tasks([sp for sps in blocks for sp in sps])
+    flat = _rows([sp for sps in blocks for sp in sps], threads, on_point, names)
+    entries, first_rows, at = [], None, 0
+    for sps, rec, scale in zip(blocks, recs, scales):
+        rows = _merged(sps, flat[at:at + len(sps)])
+        at += len(sps)
+        first_rows = rows if first_rows is None else first_rows
+        pi2 = axis if kind == "values" else [lib.pd_spec_pi2(sps[0], j)
+                                             for j in range(sps[0].npi2)]
+        one = _result(sps, k, rows, pi2)
+        entry = Result(record=rec.name, scale=scale, Tp=sps[0].base.Tp, ap=sps[0].base.ap,
+                       method=one.method, points=one.points)
+        entry.update((key, v) for key, v in one.items() if key not in entry)
+        entries.append(entry)
+    # the CLI's statistics at each point, named by the first record's row
+    gap_key = "Pi3" if k.c.Pi3 >= 0.0 and not sp0.size_is_gap else "gap"
+    stats = []
+    for p, r in enumerate(first_rows):
+        st = Result(curve=r.curve)
+        if kind == "T0":
+            st["T0"] = r.T0
+        else:
+            st["Pi2"] = r.c.Pi2
+        st[gap_key] = r.gap if sp0.size_is_gap else r.c.Pi3
+        st["eps"] = r.c.eps
+        for fig in ("Pi1", "gamma", "umax"):
+            st[fig] = stats_of([e.points[p][fig] for e in entries])
+        stats.append(st)
+    out = Result(suite=name, n=len(entries), axis="T0" if kind == "T0" else "Pi2",
+                 records=entries, stats=stats, curves=entries[0].curves,
+                 method_by=k.method_by, runs=sum(e.runs for e in entries))
+    if kind == "T0":
+        out["T0"] = entries[0].T0[0].copy()
+    else:
+        out["Pi2"] = entries[0].Pi2.copy()
     return out

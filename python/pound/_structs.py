@@ -587,6 +587,7 @@ class PdSuitePeaks(Structure):
         ("shear_max", PdStats),
         ("gamma", PdStats),
         ("ductility", PdStats),
+        ("umax_free", PdStats),
     ]
 
 
@@ -597,6 +598,9 @@ class PdSuiteContact(Structure):
         ("required_gap", PdStats),
         ("impacts", PdStats),
         ("max_impulse", PdStats),
+        ("contact_time", PdStats),
+        ("force_equiv", PdStats),
+        ("force_max", PdStats),
         ("rule_abs", PdStats),
         ("rule_srss", PdStats),
         ("rule_ddc", PdStats),

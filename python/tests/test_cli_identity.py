@@ -78,7 +78,7 @@ def test_converge(cli, same):
 
 
 def test_spectrum(cli, same):
-    r = pound.spectrum(Pi2=(0.1, 3, 9), Pi3=[0.05, 0.5], eps=[0.3, 0.8],
+    r = pound.spectrum(Pi2_range=(0.1, 3, 9), Pi3=[0.05, 0.5], eps=[0.3, 0.8],
                        pulse=["sine", "cosine"], dir=["normal", "reverse"], method="event")
     js = cli("spectrum", "--Pi2", "0.1:3:9", "--Pi3", "0.05,0.5", "--eps", "0.3,0.8", "--pulse",
              "sine,cosine", "--dir", "normal,reverse", "--method", "event")
@@ -87,7 +87,7 @@ def test_spectrum(cli, same):
     assert r.Pi1.shape == (js["curves"], 9)
     if hasattr(pound._lib.lib, "pd_spec_sweep"):  # the library's serial sweep, the same
         seen = []
-        s = pound.spectrum(Pi2=(0.1, 3, 9), Pi3=[0.05, 0.5], eps=[0.3, 0.8],
+        s = pound.spectrum(Pi2_range=(0.1, 3, 9), Pi3=[0.05, 0.5], eps=[0.3, 0.8],
                            pulse=["sine", "cosine"], dir=["normal", "reverse"], method="event",
                            threads=1, on_point=seen.append)
         same(s.points, js["points"])
@@ -206,7 +206,7 @@ def test_record(cli, same):
          cli("simulate", *args, "--method", "event"))
     same(pound.simulate(history=False, scale=0.5, dir="reverse", **kw),
          cli("simulate", *args, "--scale", "0.5", "--dir", "reverse"))
-    r = pound.spectrum(Pi2=(0.2, 2, 4), record=RECORD, Pi3=[0.05], method="event")
+    r = pound.spectrum(Pi2_range=(0.2, 2, 4), record=RECORD, Pi3=[0.05], method="event")
     js = cli("spectrum", "--Pi2", "0.2:2:4", "--record", RECORD, "--Pi3", "0.05", "--method",
              "event")
     same(r.points, js["points"])
@@ -299,7 +299,7 @@ def test_simulate_yielding_refused(kw, named):
 def test_spectrum_yielding(cli, same):
     """A yielding sweep: the CLI's points (ductility, residual_uy, the
     spring's Piy, alpha, uy) and arrays, uy in metres as the CLI's --uy."""
-    r = pound.spectrum(Pi2=(0.5, 3, 5), Pi3=[0.05, 0.3], uy=0.01, alpha=0.05)
+    r = pound.spectrum(Pi2_range=(0.5, 3, 5), Pi3=[0.05, 0.3], uy=0.01, alpha=0.05)
     js = cli("spectrum", "--Pi2", "0.5:3:5", "--Pi3", "0.05,0.3", "--uy", "0.01", "--alpha",
              "0.05")
     same(r.points, js["points"])

@@ -90,16 +90,16 @@ def test_lcp_input_errors():
 
 def test_spectrum_errors():
     with pytest.raises(pound.InputError) as e:
-        pound.spectrum(Pi2=(2, 1, 5))
-    assert str(e.value).startswith("Pi2: need 0 < MIN < MAX")
-    for values in ([0.1, 1, 10], np.array([0.1, 1, 10])):  # values, not a range: named
+        pound.spectrum(Pi2_range=(2, 1, 5))
+    assert str(e.value).startswith("Pi2_range: need 0 < MIN < MAX")
+    for values in ([0.1, 1, -10], np.array([0.1, 0, 10])):  # values, each > 0
         with pytest.raises(pound.InputError) as e:
             pound.spectrum(Pi2=values)
-        assert str(e.value).startswith("Pi2: a spectrum sweeps a range") and "(MIN, MAX, N)" in str(e.value)
+        assert str(e.value).startswith("Pi2: the values must be > 0")
     with pytest.raises(pound.InputError):
-        pound.spectrum(Pi2=(0.1, 1, 5), eps=[0.5, 1.5])
+        pound.spectrum(Pi2_range=(0.1, 1, 5), eps=[0.5, 1.5])
     with pytest.raises(pound.InputError):
-        pound.spectrum(Pi2=(0.1, 1, 5), Pi3=[0.1], gap=[0.01])
+        pound.spectrum(Pi2_range=(0.1, 1, 5), Pi3=[0.1], gap=[0.01])
 
 
 def test_library_not_found(tmp_path):

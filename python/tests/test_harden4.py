@@ -38,7 +38,7 @@ def _rows_are_the_points(r, df):
 
 def test_spectrum_to_pandas_one_curve():
     pytest.importorskip("pandas")
-    r = pound.spectrum(Pi2=(0.5, 2, 3), Pi3=0.01, eps=0.5)
+    r = pound.spectrum(Pi2_range=(0.5, 2, 3), Pi3=0.01, eps=0.5)
     df = r.to_pandas()  # raised "All arrays must be of the same length"
     _rows_are_the_points(r, df)
     assert list(df["Pi3"]) == [0.01] * 3 and list(df["eps"]) == [0.5] * 3
@@ -49,7 +49,7 @@ def test_spectrum_to_pandas_as_many_curves_as_points():
     pytest.importorskip("pandas")
     # 3 curves of 3 points: the (curves, N) arrays were cut into columns Pi1[j], a row per
     # curve labelled as a Pi2
-    r = pound.spectrum(Pi2=(0.5, 2, 3), Pi3=(0.01, 0.02, 0.03), eps=0.5)
+    r = pound.spectrum(Pi2_range=(0.5, 2, 3), Pi3=(0.01, 0.02, 0.03), eps=0.5)
     df = r.to_pandas()
     _rows_are_the_points(r, df)
     assert list(df["Pi3"]) == [0.01] * 3 + [0.02] * 3 + [0.03] * 3
@@ -57,7 +57,7 @@ def test_spectrum_to_pandas_as_many_curves_as_points():
 
 def test_spectrum_to_pandas_every_list_swept():
     pytest.importorskip("pandas")
-    r = pound.spectrum(Pi2=(0.5, 2, 4), dir=["normal", "reverse"], gap=(0.001, 0.002),
+    r = pound.spectrum(Pi2_range=(0.5, 2, 4), dir=["normal", "reverse"], gap=(0.001, 0.002),
                        eps=(0.5, 0.8))
     df = r.to_pandas()
     _rows_are_the_points(r, df)
@@ -73,7 +73,7 @@ def test_spectrum_to_pandas_every_list_swept():
 
 def test_spectrum_to_xarray_along_curve_and_pi2():
     pytest.importorskip("xarray")
-    r = pound.spectrum(Pi2=(0.5, 2, 3), Pi3=(0.01, 0.02), eps=0.5)
+    r = pound.spectrum(Pi2_range=(0.5, 2, 3), Pi3=(0.01, 0.02), eps=0.5)
     ds = r.to_xarray()  # raised "no history (run with history=True)": a spectrum has none
     assert ds["Pi1"].dims == ("curve", "Pi2") and np.array_equal(ds["Pi1"].values, r.Pi1)
     assert np.array_equal(ds["Pi2"].values, r.Pi2)
@@ -177,7 +177,7 @@ BAD = [
 
 ENTRY_POINTS = [
     ("simulate", lambda a: pound.simulate(record=a, record_dt=0.01, history=False, **CASE)),
-    ("spectrum", lambda a: pound.spectrum(Pi2=(0.5, 1, 2), record=a, record_dt=0.01,
+    ("spectrum", lambda a: pound.spectrum(Pi2_range=(0.5, 1, 2), record=a, record_dt=0.01,
                                           Pi3=0.05)),
     ("compare", lambda a: pound.compare(record=a, record_dt=0.01, **CASE)),
     ("converge", lambda a: pound.converge((1e-3, 5e-4, 2), record=a, record_dt=0.01,

@@ -94,7 +94,7 @@ def _nul_calls(path):
             ("scene", lambda: pound.converge("1e-3:5e-4:2", scene=s)),
             ("record", lambda: pound.record(s)),
             ("record", lambda: pound.simulate(record=s, history=False)),
-            ("record", lambda: pound.spectrum(Pi2=(0.5, 1, 2), record=s)),
+            ("record", lambda: pound.spectrum(Pi2_range=(0.5, 1, 2), record=s)),
             ("read_lcp", lambda: pound.read_lcp(s))]
 
 
@@ -167,12 +167,15 @@ def test_every_and_threads_take_integers():
     refused(lambda: pound.simulate(every=2.5, method="moreau"), "every: '2.5' is not an integer")
     refused(lambda: pound.simulate(every=True, method="moreau"), "every: 'True' is a bool")
     refused(lambda: pound.simulate_scene(TWO_SDOF, every=1.5), "every: '1.5' is not an integer")
-    refused(lambda: pound.spectrum(Pi2=(0.5, 1, 2), threads=1.5),
+    refused(lambda: pound.spectrum(Pi2_range=(0.5, 1, 2), threads=1.5),
             "threads: '1.5' is not an integer")
-    refused(lambda: pound.spectrum(Pi2=(0.5, 1, 2), threads=True), "threads: 'True' is a bool")
-    refused(lambda: pound.spectrum(Pi2=(0.5, 1, 2.5)), "Pi2: N = '2.5' is not an integer")
-    refused(lambda: pound.spectrum(Pi2=(0.5, 1, True)), "Pi2: N = 'True' is a bool")
-    refused(lambda: pound.spectrum(Pi2=(0.5, INF, 2)), "Pi2: MAX = 'inf' is not a finite")
+    refused(lambda: pound.spectrum(Pi2_range=(0.5, 1, 2), threads=True),
+            "threads: 'True' is a bool")
+    refused(lambda: pound.spectrum(Pi2_range=(0.5, 1, 2.5)),
+            "Pi2_range: N = '2.5' is not an integer")
+    refused(lambda: pound.spectrum(Pi2_range=(0.5, 1, True)), "Pi2_range: N = 'True' is a bool")
+    refused(lambda: pound.spectrum(Pi2_range=(0.5, INF, 2)),
+            "Pi2_range: MAX = 'inf' is not a finite")
     refused(lambda: pound.spectrum(Pi2="0.5:1:2.5"), "Pi2: N = '2.5' is not an integer")
     refused(lambda: pound.dt_range(1e-2, 1e-3, 2.5), "dt: N = '2.5' is not an integer")
     refused(lambda: pound.dt_range(INF, 1e-3, 3), "dt: MAX = 'inf' is not a finite number")
@@ -194,9 +197,9 @@ def test_bool_is_not_a_number(key, value):
 
 
 def test_bool_in_lists_is_not_a_number():
-    refused(lambda: pound.spectrum(Pi2=(0.5, 1, 2), eps=True), "eps: 'True' is a bool")
-    refused(lambda: pound.spectrum(Pi2=(0.5, 1, 2), Pi3=[0.1, True]), "Pi3: 'True' is a bool")
-    refused(lambda: pound.spectrum(Pi2=(0.5, 1, 2), dt_per_Tp=True), "dt_per_Tp: 'True'")
+    refused(lambda: pound.spectrum(Pi2_range=(0.5, 1, 2), eps=True), "eps: 'True' is a bool")
+    refused(lambda: pound.spectrum(Pi2_range=(0.5, 1, 2), Pi3=[0.1, True]), "Pi3: 'True' is a bool")
+    refused(lambda: pound.spectrum(Pi2_range=(0.5, 1, 2), dt_per_Tp=True), "dt_per_Tp: 'True'")
     refused(lambda: pound.converge("1e-3:5e-4:2", theta=True), "theta: 'True' is a bool")
     refused(lambda: pound.converge("1e-3:5e-4:2", theta=[0.5, True]), "theta: 'True'")
     refused(lambda: pound.converge([1e-3, True]), "dt: 'True' is a bool")
@@ -210,7 +213,7 @@ def test_flags_are_booleans():
             "no_wall: expected True or False (got 'false')")
     refused(lambda: pound.simulate(allow_unstable=2, theta=0.3, history=False),
             "allow_unstable: expected True or False (got '2')")
-    refused(lambda: pound.spectrum(Pi2=(0.5, 1, 2), linear="yes"), "linear: expected True")
+    refused(lambda: pound.spectrum(Pi2_range=(0.5, 1, 2), linear="yes"), "linear: expected True")
     refused(lambda: pound.simulate(history="no"), "history: expected True or False")
     a = pound.simulate(no_wall=1, history=False, method="moreau")
     b = pound.simulate(no_wall=np.bool_(True), history=False, method="moreau")

@@ -119,9 +119,9 @@ def test_compare_and_converge():
 # ---- spectrum -------------------------------------------------------------------------------
 
 def test_spectrum_invariants():
-    s1 = pound.spectrum(Pi2=(0.1, 4, 12), Pi3=[0.05, 1], eps=[0.5], pulse=["sine", "cosine"],
+    s1 = pound.spectrum(Pi2_range=(0.1, 4, 12), Pi3=[0.05, 1], eps=[0.5], pulse=["sine", "cosine"],
                         method="event", threads=1)
-    s3 = pound.spectrum(Pi2=(0.1, 4, 12), Pi3=[0.05, 1], eps=[0.5], pulse=["sine", "cosine"],
+    s3 = pound.spectrum(Pi2_range=(0.1, 4, 12), Pi3=[0.05, 1], eps=[0.5], pulse=["sine", "cosine"],
                         method="event", threads=3)
     for k in ("Pi1", "gamma", "chi", "umax", "impacts"):
         assert np.array_equal(s1[k], s3[k], equal_nan=True), k  # any split of the tasks
@@ -143,20 +143,20 @@ def test_spectrum_invariants():
 def test_spectrum_on_point_stops():
     seen = []
     with pytest.raises(pound.PoundError) as e:
-        pound.spectrum(Pi2=(0.5, 2, 5), eps=[0.2, 0.9], method="event",
+        pound.spectrum(Pi2_range=(0.5, 2, 5), eps=[0.2, 0.9], method="event",
                        on_point=lambda p: seen.append(p) or len(seen) == 3)
     assert e.value.status == -11 and len(seen) == 3
-    assert [p.Pi2 for p in seen] == [0.5, pound.spectrum(Pi2=(0.5, 2, 5)).Pi2[1], seen[2].Pi2]
+    assert [p.Pi2 for p in seen] == [0.5, pound.spectrum(Pi2_range=(0.5, 2, 5)).Pi2[1], seen[2].Pi2]
 
     def boom(p):
         raise KeyError("from the callback")
     with pytest.raises(KeyError):
-        pound.spectrum(Pi2=(0.5, 2, 5), on_point=boom)
+        pound.spectrum(Pi2_range=(0.5, 2, 5), on_point=boom)
 
 
 def test_spectra_collapse_in_pi_terms():
     """The paper's Fig. 4: amplitudes 1, 3, 9 m/s^2 at one Pi3 give one curve."""
-    s = pound.spectrum(Pi2=(0.05, 5, 20), ap=[1, 3, 9], Pi3=0.05, pulse="cosine", Tp=0.5,
+    s = pound.spectrum(Pi2_range=(0.05, 5, 20), ap=[1, 3, 9], Pi3=0.05, pulse="cosine", Tp=0.5,
                        method="event")
     assert not np.allclose(s.umax[0], s.umax[2])
     assert np.allclose(s.Pi1[0], s.Pi1[1], rtol=1e-12) and np.allclose(s.Pi1[0], s.Pi1[2],

@@ -130,7 +130,7 @@ def test_history_needs_a_history():
 
 
 def test_spectrum_in_pi_terms_and_the_traditional_view():
-    s = pound.spectrum(Pi2=(0.1, 5, 12), pulse="sine", dir=["normal", "reverse"],
+    s = pound.spectrum(Pi2_range=(0.1, 5, 12), pulse="sine", dir=["normal", "reverse"],
                        Pi3=[0.01, 0.1, 1], eps=0.5, threads=1)
     fig, axes = pp.spectrum(s)
     assert axes.shape == (1, 2)

@@ -182,10 +182,10 @@ def test_rtol_out_of_range(value):
 
 def test_spectrum_refuses_moreaus_tolerance():
     with pytest.raises(pound.InputError) as e:
-        pound.spectrum(Pi2=(0.5, 2, 2), rtol=1e-4)
+        pound.spectrum(Pi2_range=(0.5, 2, 2), rtol=1e-4)
     assert str(e.value).startswith("rtol: a spectrum runs Moreau-Jean on fixed steps")
-    s = pound.spectrum(Pi2=(0.5, 2, 2), method="penalty", rtol=1e-6, threads=1)
-    d = pound.spectrum(Pi2=(0.5, 2, 2), method="penalty", threads=1)
+    s = pound.spectrum(Pi2_range=(0.5, 2, 2), method="penalty", rtol=1e-6, threads=1)
+    d = pound.spectrum(Pi2_range=(0.5, 2, 2), method="penalty", threads=1)
     assert s.method == "penalty" and not np.array_equal(s.steps, d.steps)
 
 

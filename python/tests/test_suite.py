@@ -70,8 +70,12 @@ def stats_ok(stats, values):
 
 def test_oscillator_stats_are_numpys(cli):
     js = cli("simulate", "--records", SUITE, *OSC)
-    for key in ["umax", "Pi1", "gamma", "impacts", "max_impulse", "acc_max", "shear_max"]:
+    for key in ["umax", "Pi1", "gamma", "impacts", "max_impulse", "acc_max", "shear_max",
+                "u_toward", "u_away", "umax_free", "max_impact_velocity", "contact_time",
+                "force_equiv"]:
         stats_ok(js["stats"][key], [r[key] for r in js["records"]])
+    # an impulsive method has no contact force: no finite value, n 0
+    assert js["stats"]["force_max"]["n"] == 0 and js["stats"]["force_max"]["mean"] is None
     stats_ok(js["stats"]["drift_ratio"], [r["drift_ratio"] for r in js["records"]])
 
 
@@ -86,11 +90,13 @@ def test_scene_stats_are_numpys(cli):
         assert [x["storey"] for x in st["storeys"]] == \
             list(range(1, len(js["records"][0]["structures"][s]["umax"]) + 1))
         for i, one in enumerate(st["storeys"]):
-            for key in ["umax", "drift_ratio", "acc_max", "shear_max", "gamma"]:
+            for key in ["umax", "drift_ratio", "acc_max", "shear_max", "gamma", "umax_free"]:
                 stats_ok(one[key], [r["structures"][s][key][i] for r in js["records"]])
     for c, ct in enumerate(js["stats"]["contacts"]):
         req = [r["contacts"][c]["required_gap"] for r in js["records"]]
         stats_ok(ct["required_gap"], req)
+        for key in ["max_impulse", "contact_time", "force_equiv"]:
+            stats_ok(ct[key], [r["contacts"][c][key] for r in js["records"]])
         hits = [r["contacts"][c]["impacts"] > 0 for r in js["records"]]
         assert ct["closed"] == pytest.approx(np.mean(hits), abs=1e-15)
         for rule in ["abs", "srss", "ddc"]:
@@ -98,6 +104,14 @@ def test_scene_stats_are_numpys(cli):
             stats_ok(ct["rules"][rule], ruled)
             over = np.mean([q > g * (1 + 1e-9) for q, g in zip(req, ruled)])
             assert ct["rule_closed"][rule] == pytest.approx(over, abs=1e-15)
+
+
+def test_penalty_scene_stats_have_forces(cli):
+    """A penalty suite: each contact's peak force as NumPy's."""
+    js = cli("simulate", "--records", SUITE, "--scene", SCENE, "--method", "penalty")
+    for c, ct in enumerate(js["stats"]["contacts"]):
+        stats_ok(ct["force_max"], [r["contacts"][c]["force_max"] for r in js["records"]])
+        assert ct["force_max"]["n"] == 7
 
 
 def test_yielding_scene_stats_have_ductility(cli):
@@ -141,7 +155,7 @@ def test_suite_files_are_single_runs(tmp_path, where, ext):
     a, b = tmp_path / ("s.rec2." + ext), tmp_path / ("one." + ext)
     if ext == "csv":
         keep = lambda p: [ln for ln in p.read_text().splitlines()  # noqa: E731
-                          if not ln.startswith(("# command", "# cpu_s"))]
+                          if not ln.startswith(("# command", "# created", "# cpu_s"))]
         assert keep(a) == keep(b)
     else:
         with h5py.File(a, "r") as fa, h5py.File(b, "r") as fb:
@@ -251,6 +265,7 @@ def test_record_repeated_is_a_suite(cli):
     (["--target-pga", "3"], "scales records"),
     (["--records", SUITE, "--T1", "1"], "--T1: the period of --target-sa"),
     (["--records", SUITE, "--dump-lcp", "x.h5", "--method", "moreau"], "not of a suite"),
+    (["--record", "%s,%s" % (RECS[0], RECS[1]), *OSC], "given once per record"),
 ])
 def test_bad_suites_are_refused(args, says):
     out = run("simulate", *args, status=2)
@@ -309,9 +324,35 @@ def test_spectrum_against_periods(cli):
         stats_ok(st["umax"], [r["points"][p]["umax"] for r in js["records"]])
 
 
+def test_spectrum_suite_resumes(tmp_path):
+    """A suite's spectra killed inside its first record (--stop-after, 130)
+    leave FILE.rec1.partial; --resume writes the uninterrupted file byte for
+    byte and removes the journals."""
+    grid = ["--records", SUITE, "--Pi2", "0.1:5:12", "--Pi3", "0.05", "--eps", "0.5"]
+    run("spectrum", *grid, "-o", tmp_path / "full.h5")
+    run("spectrum", *grid, "-o", tmp_path / "r.h5", "--stop-after", "20", status=130)
+    assert (tmp_path / "r.h5.rec1.partial").exists() and not (tmp_path / "r.h5").exists()
+    run("spectrum", *grid, "-o", tmp_path / "r.h5", "--resume")
+    assert (tmp_path / "r.h5").read_bytes() == (tmp_path / "full.h5").read_bytes()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["full.h5", "r.h5"]
+
+
+@pytest.mark.parametrize("axis", [["--T0", "0.2:2:6"], ["--Pi2", "0.2:5:6"]])
+def test_spectrum_suite_charts(tmp_path, axis):
+    """--plot with a suite: Pi1, gamma and umax charts (each record faint,
+    the mean) against T0 or Pi2."""
+    import shutil
+    if not shutil.which("gnuplot"):
+        pytest.skip("no gnuplot")
+    png = tmp_path / "s.png"
+    run("spectrum", "--records", SUITE, *axis, "--gap", "0.01", "--eps", "0.6", "--plot", png)
+    for name in ["s.png", "s-gamma.png", "s-dim.png"]:
+        data = (tmp_path / name).read_bytes()
+        assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 10000, name
+
+
 @pytest.mark.parametrize("args,says", [
     (["--T0", "0.2:2:8", "--Pi3", "0.05"], "the axis of a suite's spectrum"),
-    (["--records", SUITE, "--T0", "0.2:2:8", "--gap", "0.01", "--plot", "x.png"], "--plot"),
     (["--records", SUITE, "--scene", SCENE, "--Pi2", "0.5:2:4"], "a scene's suite"),
 ])
 def test_bad_spectrum_suites(args, says):

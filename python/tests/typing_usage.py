@@ -18,7 +18,7 @@ EXAMPLES = HERE.parent.parent / "examples"
 def run() -> List[float]:
     r: pound.Result = pound.simulate(pulse="sine", Tp=0.3, T0=3, ap=4, gap=0.004, eps=0.6)
     umax: float = r.umax
-    s = pound.spectrum(Pi2=(0.05, 5, 4), pulse="sine", dir=["normal", "reverse"],
+    s = pound.spectrum(Pi2_range=(0.05, 5, 4), pulse="sine", dir=["normal", "reverse"],
                        Pi3=[0.01, 0.1], eps=0.5, threads=1)
     c = pound.compare(methods="moreau,penalty", Pi2=1.0, Pi3=0.05)
     steps: List[float] = pound.dt_range(1e-3, 1e-4, np.int64(3))
