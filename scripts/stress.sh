@@ -27,11 +27,13 @@ else
     # The library under ASan + UBSan with libFuzzer's coverage hooks, no OpenMP.
     fz="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
     make --no-print-directory BUILD="$s/fuzzlib" CC=clang OPT=-O1 OPENMP= XCFLAGS="$fz" \
-        "$s/fuzzlib/libpound.a" "$s/fuzzlib/cli/spectrum_journal.o"
+        "$s/fuzzlib/libpound.a" "$s/fuzzlib/cli/spectrum_journal.o" "$s/fuzzlib/cli/journal.o" \
+        "$s/fuzzlib/cli/suite_journal.o"
     libs=$(make --no-print-directory -s print-libs)
-    for t in lcp scene record journal; do
+    for t in lcp scene record journal suite; do
         extra=""
-        [ $t = journal ] && extra="$s/fuzzlib/cli/spectrum_journal.o"
+        [ $t = journal ] && extra="$s/fuzzlib/cli/spectrum_journal.o $s/fuzzlib/cli/journal.o"
+        [ $t = suite ] && extra="$s/fuzzlib/cli/suite_journal.o $s/fuzzlib/cli/journal.o"
         echo "  LD    $s/fuzz/fuzz_$t"
         clang -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
             -Icore -Ilcp -Iengine -Iproblems -Icli stress/fuzz/fuzz_$t.c $extra \

@@ -123,7 +123,8 @@ CAT_TEXT = {
               "scenes, paths with NUL bytes or as bytes, fractional counts, booleans as "
               "numbers (python/tests/test_misuse.py); to_pandas of sweeps, plot indices, "
               "record= arrays of every dtype (test_harden4.py)",
-    "fuzz": "libFuzzer + ASan + UBSan on the readers: LCP, scene, record, spectrum journal",
+    "fuzz": "libFuzzer + ASan + UBSan on the readers: LCP, scene, record, spectrum and suite "
+            "journals",
     "tsan": "ThreadSanitizer on parallel spectrum sweeps (2 OpenMP threads); "
             "2 threads = 1 thread byte for byte",
 }
@@ -1902,7 +1903,7 @@ def cases_hostile(env):
 def run_fuzz(runner, env, fuzz_time):
     fdir = os.path.join(env["stress"], "fuzz")
     skip = os.path.join(env["stress"], "fuzz.skip")
-    targets = ["fuzz_lcp", "fuzz_scene", "fuzz_record", "fuzz_journal"]
+    targets = ["fuzz_lcp", "fuzz_scene", "fuzz_record", "fuzz_journal", "fuzz_suite"]
     if os.path.exists(skip) or not all(os.path.exists(os.path.join(fdir, t)) for t in targets):
         msg = open(skip).read().strip() if os.path.exists(skip) else "fuzz: skip (harnesses not built)"
         return None, msg
@@ -1911,6 +1912,7 @@ def run_fuzz(runner, env, fuzz_time):
         "fuzz_scene": [os.path.join(ROOT, "examples", "scenes"), os.path.join(HERE, "corpus", "scene")],
         "fuzz_record": [os.path.join(HERE, "corpus", "record"), os.path.join(SHARED, "data", "records")],
         "fuzz_journal": [],
+        "fuzz_suite": [],
     }
 
     def one(t):
@@ -1927,6 +1929,15 @@ def run_fuzz(runner, env, fuzz_time):
                     if os.path.getsize(p) <= 16384 and not name.startswith(("COPYING", "README")):
                         shutil.copyfile(p, os.path.join(seed_dir, "s%04d" % k))
                         k += 1
+        if t == "fuzz_suite":  # two real interrupted suites' journals: a scene's, an oscillator's
+            for flags in (["--scene", os.path.join(ROOT, "examples", "scenes", "two-sdof.json")],
+                          ["--T0", "0.8", "--gap", "0.01", "--eps", "0.6"]):
+                jpath = os.path.join(seed_dir, "s%04d" % k)
+                subprocess.run([runner.pound, "simulate", "--records",
+                                os.path.join(ROOT, "examples", "records", "suite", "suite.txt"),
+                                *flags, "--journal", jpath, "--stop-after", "3"],
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=False)
+                k += os.path.exists(jpath)
         if t == "fuzz_journal" and "journal" in env:
             for m in mutate.journal_mutants(env["journal"], env["other_key"]):
                 if len(m.data) <= 16384:
@@ -1938,7 +1949,8 @@ def run_fuzz(runner, env, fuzz_time):
                "-rss_limit_mb=2048", "-max_len=16384", "-print_final_stats=1",
                "-artifact_prefix=" + art + "/", work, seed_dir]
         envv = dict(os.environ, ASAN_OPTIONS="detect_leaks=1:allocator_may_return_null=0",
-                    UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1", TMPDIR=runner.scratch)
+                    UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1", TMPDIR=runner.scratch,
+                    POUND_FUZZ_SCENE=os.path.join(ROOT, "examples", "scenes", "two-sdof.json"))
         t0 = time.monotonic()
         p = subprocess.run(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                            stderr=subprocess.STDOUT, env=envv, timeout=fuzz_time + 120)
