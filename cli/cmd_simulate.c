@@ -46,7 +46,7 @@ static const char simulate_usage[] =
     "              [OMP_NUM_THREADS or all cores]; the numbers do not depend on K; the MPI\n"
     "              build shares the records out over mpirun's ranks\n"
     "  --journal F  each finished record's results appended to F (removed when the suite\n"
-    "              is printed, or when a record fails)\n"
+    "              is printed, or when a record fails on its input or computation)\n"
     "  --resume    continue an interrupted suite from its --journal F (the same flags):\n"
     "              the records F holds are read back to the bit, the others run\n";
 
@@ -171,6 +171,12 @@ static int parse_args(sim_args *a, int argc, char **argv)
             flag = "--plot";
         else if ((a->out && pd_output_check_writable("-o", out, &err)) ||
                  (a->plot && pd_output_check_writable("--plot", plot, &err))) {
+            pd_cli_case_free(&a->k);
+            return pd_cli_usage_error("%s", err.msg);
+        }
+        const char *rflags[] = {"-o (a record's file)", "--plot (a record's chart)", "--journal"},
+                   *rpaths[] = {a->out ? out : NULL, a->plot ? plot : NULL, a->journal};
+        if (!flag && pd_output_check_distinct(3, rflags, rpaths, &err)) {
             pd_cli_case_free(&a->k);
             return pd_cli_usage_error("%s", err.msg);
         }
@@ -891,7 +897,7 @@ static void runner_finished(suite_runner *s, int k, int rc, const pd_err *err)
             pd_spec_mpi_abort(1); /* rank 0 would wait for it */
     }
     free(body);
-    if (s->a->stop_after > 0 && ++s->finished_here >= s->a->stop_after)
+    if (!rc && s->a->stop_after > 0 && ++s->finished_here >= s->a->stop_after)
         _exit(130); /* the test hook: die like an interrupted suite */
 }
 
@@ -975,11 +981,23 @@ static int run_records(suite_runner *s, const char *key, pd_err *errs)
     }
     progress_end(&pr);
     status = s->failed < 0 ? 0 : s->rc_failed == PD_EINVAL ? 2 : 1;
+    /* a failure of the machine (a write, memory) may not come again: the
+     * journal and the finished records' files stay for --resume */
+    int keep =
+        s->failed >= 0 && a->journal && (s->rc_failed == PD_EIO || s->rc_failed == PD_ENOMEM);
     pd_spec_mpi_agree(&status);
+    pd_spec_mpi_agree(&keep);
     if (!status)
         return 0;
-    /* the suite cannot finish with these flags (the runs are deterministic):
-     * no partial output, and no journal to resume */
+    if (s->rank == 0 && s->failed >= 0)
+        fprintf(stderr, "pound: simulate: %s: %s%s%s%s\n",
+                a->k.suite->path[s->failed < n ? s->failed : 0], s->msg,
+                keep ? " (the finished records stay in " : "", keep ? a->journal : "",
+                keep ? ": --resume continues the suite)" : "");
+    if (keep)
+        return status;
+    /* else the suite cannot finish with these flags (the runs are
+     * deterministic): no partial output, and no journal to resume */
     for (int k = 0; k < n && (a->out || a->plot); k++) {
         char path[PD_PATH_MAX];
         if (a->out && !suite_path(a->out, k, path, sizeof path))
@@ -989,17 +1007,17 @@ static int run_records(suite_runner *s, const char *key, pd_err *errs)
     }
     if (s->rank == 0)
         pd_journal_close(&s->journal, 1);
-    if (s->rank == 0 && s->failed >= 0)
-        fprintf(stderr, "pound: simulate: %s: %s\n",
-                a->k.suite->path[s->failed < n ? s->failed : 0], s->msg);
     return status;
 }
 
-/* After the suite's output: the journal has served; the names go. */
-static void runner_end(suite_runner *s)
+/* After the suite's output (status 0: printed): the journal has served;
+ * the names go. */
+static void runner_end(suite_runner *s, int status)
 {
+    /* removed once the results are out (stdout written: not a full disk) */
+    int out = !status && fflush(stdout) == 0 && !ferror(stdout);
     if (s->a && s->rank == 0 && s->a->journal && s->journal.fd >= 0)
-        pd_journal_close(&s->journal, 1);
+        pd_journal_close(&s->journal, out);
     pd_suite_names_free(&s->names);
 }
 
@@ -1060,10 +1078,17 @@ static int suite_oscillator(sim_args *a)
     if (!cs || !os || !ss || !figs || !col || !errs || !done) {
         fprintf(stderr, "pound: simulate: out of memory for a suite of %d records\n", n);
         status = 1;
-        goto done;
     }
-    for (int k = 0; k < n && !status; k++) /* each record's case, checked before any run */
+    double bytes = 0.0;                      /* the records' files together */
+    for (int k = 0; k < n && !status; k++) { /* each record's case, checked before any run */
         status = pd_cli_case_record(&a->k, k, &cs[k], &os[k]);
+        long steps =
+            pd_steps_for(os[k].tend, os[k].rtol > 0.0 ? pd_osc_default_dt(&cs[k]) : os[k].dt);
+        bytes += a->out ? output_bytes(a->out, steps / a->every + 1, osc_ncols(&cs[k])) : 0.0;
+    }
+    if (!status && a->out)
+        status = check_output_size(a->out, bytes);
+    pd_spec_mpi_agree(&status); /* every rank goes on, or none */
     if (status)
         goto done;
     osc_runs runs = {.a = a, .cs = cs, .os = os, .ss = ss, .names = &sr.names};
@@ -1131,7 +1156,7 @@ static int suite_oscillator(sim_args *a)
     stats_rows(2, 5, cols, n);
     free(buf);
 done:
-    runner_end(&sr);
+    runner_end(&sr, status);
     free(cs);
     free(os);
     free(ss);
@@ -1579,11 +1604,18 @@ static int suite_scene_run(sim_args *a, pd_scene **scs, pd_scene_summary *ss, pd
                            suite_runner *sr, unsigned char *done)
 {
     int n = a->k.suite->n, status;
+    double bytes = 0.0;           /* the records' files together */
     for (int k = 0; k < n; k++) { /* each record on its copy, checked before any run */
         pd_err err;
-        if (pd_cli_scene_record(&a->k, k, scs[k], &err))
+        pd_run_opts o;
+        if (pd_cli_scene_record(&a->k, k, scs[k], &err) ||
+            pd_scene_resolve_opts(scs[k], &a->k.opts, &o, &err))
             return pd_cli_usage_error("%s: %s", a->k.suite->path[k], err.msg);
+        long rows = pd_steps_for(o.tend, o.dt) / a->every + 1;
+        bytes += a->out ? output_bytes(a->out, rows, scene_width(scs[k])) : 0.0;
     }
+    if (a->out && (status = check_output_size(a->out, bytes)))
+        return status;
     scene_runs runs = {.a = a, .scs = scs, .opts = &a->k.opts, .ss = ss, .names = &sr->names};
     *sr = (suite_runner){.a = a,
                          .run = scene_record_run,
@@ -1762,6 +1794,7 @@ static int suite_scene(sim_args *a)
         fprintf(stderr, "pound: simulate: out of memory for a suite of %d records\n", n);
         status = 1;
     }
+    pd_spec_mpi_agree(&status); /* every rank goes on, or none */
     if (!status)
         status = suite_scene_run(a, scs, ss, errs, &sr, done);
     if (!status && a->rank) /* rank 0 prints */
@@ -1775,7 +1808,7 @@ static int suite_scene(sim_args *a)
     else if (!status)
         status = suite_scene_text(a, base, scs, ss, &st);
 done:
-    runner_end(&sr);
+    runner_end(&sr, status);
     free(done);
     pd_scene_suite_free(&st);
     for (int k = 0; ss && k < n; k++)
@@ -1789,10 +1822,29 @@ done:
     return status;
 }
 
+/* FNV-1a (64 bits) of a file's bytes (0 when it cannot be read): a
+ * journal's key holds it, so that a changed scene or record file is not
+ * mixed with the runs made before the change. */
+static unsigned long long file_hash(const char *path)
+{
+    unsigned long long h = 14695981039346656037ull;
+    unsigned char buf[8192];
+    size_t n;
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return 0;
+    while ((n = fread(buf, 1, sizeof buf, f)) > 0)
+        for (size_t i = 0; i < n; i++)
+            h = (h ^ buf[i]) * 1099511628211ull;
+    fclose(f);
+    return h;
+}
+
 /* A suite's journal key: pound's version and the summaries' layouts, the
  * flags that decide its numbers and files (all but --json, --threads,
- * --journal, --resume, --stop-after) as flag=value, and every record with
- * its scale; NULL when out of memory. */
+ * --journal, --resume, --stop-after) as flag=value, the scene file's hash,
+ * and every record with its scale and its file's hash; NULL when out of
+ * memory. */
 static char *suite_key(const sim_args *a, int argc, char **argv)
 {
     static const char *const skipped[] = {"--json", "--threads", "--journal", "--resume",
@@ -1817,8 +1869,11 @@ static char *suite_key(const sim_args *a, int argc, char **argv)
             fprintf(f, " arg=%s", t);
         i += value && strcmp(t, "--json") && strcmp(t, "--resume"); /* its value */
     }
+    if (a->k.scene_path)
+        fprintf(f, " <the-scene-file>=%016llx", file_hash(a->k.scene_path));
     for (int k = 0; k < a->k.suite->n; k++)
-        fprintf(f, " rec%d=%s@%a", k + 1, a->k.suite->path[k], a->k.rec_scale[k]);
+        fprintf(f, " <record-%d>=%s@%a#%016llx", k + 1, a->k.suite->path[k], a->k.rec_scale[k],
+                file_hash(a->k.suite->path[k]));
     int bad = ferror(f);
     if (fclose(f) || bad) {
         free(key);

@@ -94,9 +94,18 @@ static int create_journal(pd_journal *j, const pd_journal_kind *kd, const char *
     if (j->fd < 0)
         return pd_err_set(err, PD_EIO, "%s: cannot create %s: %s", kd->flag, j->path,
                           strerror(errno));
-    if (lock_fd(j->fd) || write_all(j->fd, kd->magic, strlen(kd->magic)) ||
-        write_all(j->fd, "key ", 4) || write_all(j->fd, key, strlen(key)) ||
-        write_all(j->fd, "\n", 1) || fdatasync(j->fd)) {
+    /* the header in one write: a killed process leaves all of it or none */
+    size_t lm = strlen(kd->magic), lk = strlen(key);
+    char *head = malloc(lm + lk + 6);
+    if (head) {
+        memcpy(head, kd->magic, lm);
+        memcpy(head + lm, "key ", 4);
+        memcpy(head + lm + 4, key, lk);
+        head[lm + 4 + lk] = '\n';
+    }
+    int bad = !head || lock_fd(j->fd) || write_all(j->fd, head, lm + lk + 5) || fdatasync(j->fd);
+    free(head);
+    if (bad) {
         int e = errno ? errno : EIO;
         close(j->fd);
         j->fd = -1;
@@ -135,8 +144,9 @@ static void first_difference(const char *a, const char *b, char *name, size_t ca
     while (*a && *b) {
         size_t la = strcspn(a, " "), lb = strcspn(b, " ");
         if (la != lb || memcmp(a, b, la)) {
-            size_t k = strcspn(b, "= "); /* a flag as it is, a name as its flag */
-            snprintf(name, cap, "%s%.*s", b[0] == '-' ? "" : "--", (int)(k < 60 ? k : 60), b);
+            size_t k = strcspn(b, "= "); /* a name as its flag, a flag or <what> as it is */
+            int bare = (b[0] >= 'a' && b[0] <= 'z') || (b[0] >= 'A' && b[0] <= 'Z');
+            snprintf(name, cap, "%s%.*s", bare ? "--" : "", (int)(k < 60 ? k : 60), b);
             return;
         }
         a += la + (a[la] == ' ');

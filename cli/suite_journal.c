@@ -207,9 +207,11 @@ char *pd_suite_osc_body(int k, const pd_osc_summary *s, size_t *len)
     FILE *f = open_memstream(&buf, len);
     if (!f)
         return NULL;
-    const unsigned char *b = (const unsigned char *)s;
+    pd_osc_summary v = *s; /* its names go as names, not as addresses */
+    v.r.kernel = v.free.kernel = NULL;
+    const unsigned char *b = (const unsigned char *)&v;
     fprintf(f, "R %d O ", k);
-    for (size_t i = 0; i < sizeof *s; i++)
+    for (size_t i = 0; i < sizeof v; i++)
         fprintf(f, "%02x", b[i]);
     put_name(f, s->r.kernel);
     put_name(f, s->free.kernel);
@@ -265,6 +267,15 @@ static int tok_double(tokens *t, double *v)
     return *end ? -1 : 0;
 }
 
+/* A hexadecimal digit's value, or -1. */
+static int hex_digit(char c)
+{
+    return c >= '0' && c <= '9'   ? c - '0'
+           : c >= 'A' && c <= 'F' ? c - 'A' + 10
+           : c >= 'a' && c <= 'f' ? c - 'a' + 10
+                                  : -1;
+}
+
 /* A name token back: NULL for "-", else the name kept in names (one copy
  * of each). */
 static int tok_name(tokens *t, pd_suite_names *names, const char **out)
@@ -279,13 +290,18 @@ static int tok_name(tokens *t, pd_suite_names *names, const char **out)
     char *name = malloc(strlen(s)), *o = name;
     if (!name)
         return -1;
-    for (s++; *s; s++) {
-        unsigned int c;
-        if (*s == '%' && sscanf(s + 1, "%2X", &c) == 1 && c > 0) {
-            *o++ = (char)c;
-            s += 2;
-        } else
+    for (s++; *s; s++) { /* %XX: exactly two hex digits, not NUL */
+        if (*s != '%') {
             *o++ = *s;
+            continue;
+        }
+        int hi = hex_digit(s[1]), lo = hi < 0 ? -1 : hex_digit(s[2]);
+        if (lo < 0 || (hi | lo) == 0) {
+            free(name);
+            return -1;
+        }
+        *o++ = (char)(16 * hi + lo);
+        s += 2;
     }
     *o = '\0';
     for (int i = 0; i < names->n; i++)
@@ -313,7 +329,7 @@ static int tok_head(tokens *t, const char *body, size_t len, int n, const char *
 {
     long kk;
     *t = (tokens){.copy = malloc(len + 1)};
-    if (!t->copy)
+    if (!t->copy || memchr(body, '\0', len)) /* a NUL would end the tokens early */
         return -1;
     memcpy(t->copy, body, len);
     t->copy[len] = '\0';

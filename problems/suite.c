@@ -305,9 +305,12 @@ int pd_scene_suite_stats(const pd_scene *sc, const pd_scene_summary *runs, int n
         return PD_NULL_ARG(err, "runs");
     if (n < 1)
         return pd_err_set(err, PD_EINVAL, "a suite needs at least one run (got %d)", n);
-    for (int k = 0; k < n; k++)
-        if (runs[k].r.n != sc->n || runs[k].r.m != sc->ncontact || !runs[k].required_gap)
+    for (int k = 0; k < n; k++) {
+        const pd_scene_summary *r = &runs[k];
+        if (!pd_scene_result_fits(sc, &r->r) || !pd_scene_result_fits(sc, &r->free) || !r->gamma ||
+            !r->required_gap || !r->rule_abs || !r->rule_srss || !r->rule_ddc)
             return pd_err_set(err, PD_EINVAL, "run %d is not a summary of this scene", k);
+    }
     int rc = PD_OK;
     double *col = pd_malloc(n, sizeof *col);
     *out = (pd_scene_suite){.n = n,

@@ -500,14 +500,57 @@ static void test_suite_scene_stats(pd_test_ctx *ctx)
               c->impacts.min == 0.0 && c->required_gap.n == 3,
           "closed %g (%g of 3), SRSS closed %g (%g)", c->closed, hits, c->srss_closed, srss);
     pd_scene_suite_free(&st);
-    /* refused: no runs, another scene's run, NULLs */
+    /* chosen figures: a lower storey above the roof, storey 2's shear above
+     * the base's, ductilities with NaN storeys, impacts {1, 0, 3}, and each
+     * rule closed on a different share (1/3, 2/3, 1) with run 0 at the
+     * tolerance's edge: the required gap equal to ABS (1 + tol) and SRSS's
+     * tolerance scaled by 1 + 0.5e-9 */
+    const double tol = PD_SUITE_RULE_TOL, req = 1.0 + tol;
+    const double abs_gap[3] = {1.0, 0.5, 2.0}, srss_gap[3] = {req / (1.0 + 0.5e-9), 0.5, 0.5};
+    const double duct[3][2] = {{NAN, 2.0}, {3.0, NAN}, {NAN, NAN}};
+    const long hits3[3] = {1, 0, 3};
+    for (int r = 0; r < 3; r++) {
+        runs[r].r.umax[0] = 0.5 + r, runs[r].r.umax[1] = 0.25;
+        runs[r].r.shear_max[0] = 1.0, runs[r].r.shear_max[1] = 7.0;
+        runs[r].r.ductility[0] = duct[r][0], runs[r].r.ductility[1] = duct[r][1];
+        runs[r].r.impacts[0] = hits3[r];
+        runs[r].required_gap[0] = req;
+        runs[r].rule_abs[0] = abs_gap[r], runs[r].rule_srss[0] = srss_gap[r];
+        runs[r].rule_ddc[0] = 0.5;
+    }
+    rc = pd_scene_suite_stats(sc, runs, 3, &st, &err);
+    A = &st.structure[0];
+    c = &st.contact[0];
+    CHECK(ctx, !rc && A->umax.max == 2.5 && A->umax.min == 0.5 && A->shear_max.max == 1.0,
+          "the largest storey's umax (max %g min %g), storey 1's shear (%g)", A->umax.max,
+          A->umax.min, A->shear_max.max);
+    CHECK(ctx, !rc && A->ductility.n == 2 && A->ductility.min == 2.0 && A->ductility.max == 3.0,
+          "ductility over the finite storeys: n %d, %g to %g", A->ductility.n, A->ductility.min,
+          A->ductility.max);
+    CHECK(ctx,
+          !rc && c->closed == 2.0 / 3.0 && c->abs_closed == 1.0 / 3.0 &&
+              c->srss_closed == 2.0 / 3.0 && c->ddc_closed == 1.0,
+          "closed %g; ABS %g, SRSS %g, DDC %g closed", c->closed, c->abs_closed, c->srss_closed,
+          c->ddc_closed);
+    pd_scene_suite_free(&st);
+    /* one run: its own figures */
+    rc = pd_scene_suite_stats(sc, runs, 1, &st, &err);
+    CHECK(ctx, !rc && st.n == 1 && st.structure[0].umax.median == 0.5, "one run: %d, median %g", rc,
+          rc ? NAN : st.structure[0].umax.median);
+    pd_scene_suite_free(&st);
+    /* refused: no runs, another scene's run (the first or a later), NULLs */
     int bad0 = pd_scene_suite_stats(sc, runs, 0, &st, &err);
+    runs[0].r.m = 2;
+    int bad3 = pd_scene_suite_stats(sc, runs, 3, &st, &err);
+    runs[0].r.m = 1;
     runs[1].r.n = 2;
     int bad1 = pd_scene_suite_stats(sc, runs, 3, &st, &err);
     runs[1].r.n = 3;
     int bad2 = pd_scene_suite_stats(sc, NULL, 3, &st, &err);
-    CHECK(ctx, bad0 == PD_EINVAL && bad1 == PD_EINVAL && bad2 == PD_EINVAL && st.n == 0,
-          "bad calls: %d %d %d", bad0, bad1, bad2);
+    CHECK(ctx,
+          bad0 == PD_EINVAL && bad1 == PD_EINVAL && bad2 == PD_EINVAL && bad3 == PD_EINVAL &&
+              st.n == 0,
+          "bad calls: %d %d %d %d", bad0, bad1, bad2, bad3);
 done:
     pd_scene_suite_free(&st);
     for (int r = 0; r < 3; r++)

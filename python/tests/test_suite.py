@@ -212,6 +212,41 @@ def test_resumed_suite_is_uninterrupted(tmp_path, where, json_out):
     assert not journal.exists()
 
 
+def fnv1a(data):
+    h = 2166136261
+    for b in data:
+        h = ((h ^ b) * 16777619) & 0xFFFFFFFF
+    return h
+
+
+@pytest.mark.parametrize("name", ["=%1", "=%", "=%e!", "=%00", "=%4", "-x"])
+def test_forged_journal_lines_are_refused(tmp_path, name):
+    """A line whose checksum is right (forged) but whose names are not
+    escaped as the writer escapes them (a lone %, one hex digit, NUL) is
+    dropped and its record run again (ASan: the reader stays in bounds);
+    a well-escaped name is read back (the forged kernel shows)."""
+    journal = tmp_path / "j.txt"
+    flags = ["--records", SUITE, *OSC, "--json"]
+    full = json.loads(run("simulate", *flags).stdout.decode())
+    run("simulate", *flags, "--journal", journal, "--stop-after", "2", status=130)
+    first = journal.read_bytes().split(b"\n")[2]  # after the magic and the key
+    fields = first.rsplit(b" #", 1)[0].split(b" ")  # R k O hex kernel kernel
+    assert fields[0] == b"R" and fields[2] == b"O" and len(fields) == 6
+    fields[1], fields[4] = b"2", name.encode()
+    forged = b" ".join(fields)
+    journal.write_bytes(journal.read_bytes() + forged + b" #%08x\n" % fnv1a(forged))
+    out = json.loads(run("simulate", *flags, "--journal", journal, "--resume").stdout.decode())
+    assert untimed(out) == untimed(full)
+    if name == "=%4":  # the same line well escaped: read back, its name shown
+        fields[4] = b"=%41%41"
+        forged = b" ".join(fields)
+        run("simulate", *flags, "--journal", journal, "--stop-after", "2", status=130)
+        journal.write_bytes(journal.read_bytes() + forged + b" #%08x\n" % fnv1a(forged))
+        out = json.loads(run("simulate", *flags, "--journal", journal,
+                             "--resume").stdout.decode())
+        assert out["records"][2]["kernel"] == "AA"
+
+
 def test_journal_refusals(tmp_path):
     journal = tmp_path / "j.txt"
     run("simulate", "--records", SUITE, *OSC, "--journal", journal, "--stop-after", "1",
