@@ -372,6 +372,18 @@ def test_spectrum_suite_resumes(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["full.h5", "r.h5"]
 
 
+def test_spectrum_suite_bad_record_leaves_no_journals(tmp_path):
+    """A suite whose second record fails as bad input (its impacts'
+    equivalent force overflows at td 1e-306; the first, scaled down, has
+    none) exits 2 and leaves neither the file nor any record's journal."""
+    suite = tmp_path / "two.txt"
+    suite.write_text("%s 0.001\n%s 200\n" % (RECS[0], RECS[1]))
+    out = run("spectrum", "--records", suite, "--Pi2", "0.5:2:3", "--Pi3", "0.05", "--eps",
+              "0.5", "--contact-duration", "1e-306", "-o", tmp_path / "s.h5", status=2)
+    assert "nf2.txt" in out.stderr.decode()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["two.txt"]
+
+
 @pytest.mark.parametrize("axis", [["--T0", "0.2:2:6"], ["--Pi2", "0.2:5:6"]])
 def test_spectrum_suite_charts(tmp_path, axis):
     """--plot with a suite: Pi1, gamma and umax charts (each record faint,
