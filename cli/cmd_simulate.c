@@ -901,6 +901,32 @@ static void runner_finished(suite_runner *s, int k, int rc, const pd_err *err)
         _exit(130); /* the test hook: die like an interrupted suite */
 }
 
+/* The records finished so far (run here, read back, or sent by a rank). */
+static int done_count(const suite_runner *s)
+{
+    int m = 0;
+    for (int k = 0; k < s->a->k.suite->n; k++)
+        m += s->done[k];
+    return m;
+}
+
+/* A suite's runner over ctx's records (done: n flags, zero), this rank's. */
+static suite_runner runner_make(const sim_args *a, int (*run)(void *, int, pd_err *),
+                                char *(*body)(const void *, int, size_t *),
+                                int (*parse)(void *, const char *, size_t, int *), void *ctx,
+                                unsigned char *done)
+{
+    return (suite_runner){.a = a,
+                          .run = run,
+                          .body = body,
+                          .parse = parse,
+                          .ctx = ctx,
+                          .done = done,
+                          .journal = {.fd = -1},
+                          .rank = a->rank,
+                          .size = a->size};
+}
+
 /* The messages rank 0 awaits: one for each record the other ranks run. */
 static int awaited(const suite_runner *s)
 {
@@ -949,7 +975,7 @@ static int runner_open(suite_runner *s, const char *key)
 static int run_records(suite_runner *s, const char *key, pd_err *errs)
 {
     const sim_args *a = s->a;
-    int n = a->k.suite->n, count = 0, status;
+    int n = a->k.suite->n, status;
     /* records in turn when each writes files (HDF5 is not thread-safe) */
     int nt = a->out || a->plot ? 1 : pd_spec_threads(a->threads);
     s->failed = -1;
@@ -968,16 +994,12 @@ static int run_records(suite_runner *s, const char *key, pd_err *errs)
             runner_finished(s, k, rc, &errs[k]);
             while (expect > 0 && runner_receive(s, 0)) /* the ranks' so far */
                 expect--;
-            for (int j = count = 0; j < n; j++)
-                count += s->done[j];
-            suite_progress(&pr, count, n);
+            suite_progress(&pr, done_count(s), n);
         }
     }
     for (; expect > 0; expect--) { /* every rank's, a failure or not: they wait to send */
         runner_receive(s, 1);
-        for (int j = count = 0; j < n; j++)
-            count += s->done[j];
-        suite_progress(&pr, count, n);
+        suite_progress(&pr, done_count(s), n);
     }
     progress_end(&pr);
     status = s->failed < 0 ? 0 : s->rc_failed == PD_EINVAL ? 2 : 1;
@@ -1092,15 +1114,7 @@ static int suite_oscillator(sim_args *a)
     if (status)
         goto done;
     osc_runs runs = {.a = a, .cs = cs, .os = os, .ss = ss, .names = &sr.names};
-    sr = (suite_runner){.a = a,
-                        .run = osc_record_run,
-                        .body = osc_record_body,
-                        .parse = osc_record_parse,
-                        .ctx = &runs,
-                        .done = done,
-                        .journal = {.fd = -1},
-                        .rank = a->rank,
-                        .size = a->size};
+    sr = runner_make(a, osc_record_run, osc_record_body, osc_record_parse, &runs, done);
     if ((status = run_records(&sr, a->key, errs)) || a->rank)
         goto done;
     for (int k = 0; k < n; k++) {
@@ -1555,8 +1569,6 @@ done:
     return status;
 }
 
-/* The suite's runs on the scene: ss[k] of record k on its copy scs[k]: 0,
- * 1 or 2. */
 /* The scene's runs of a suite: record k's scene copy, the options, summary. */
 typedef struct scene_runs {
     const sim_args *a;
@@ -1600,6 +1612,8 @@ static int scene_record_run(void *ctx, int k, pd_err *err)
                            &r->ss[k], err);
 }
 
+/* The suite's runs on the scene: ss[k] of record k on its copy scs[k]: 0,
+ * 1 or 2. */
 static int suite_scene_run(sim_args *a, pd_scene **scs, pd_scene_summary *ss, pd_err *errs,
                            suite_runner *sr, unsigned char *done)
 {
@@ -1617,15 +1631,7 @@ static int suite_scene_run(sim_args *a, pd_scene **scs, pd_scene_summary *ss, pd
     if (a->out && (status = check_output_size(a->out, bytes)))
         return status;
     scene_runs runs = {.a = a, .scs = scs, .opts = &a->k.opts, .ss = ss, .names = &sr->names};
-    *sr = (suite_runner){.a = a,
-                         .run = scene_record_run,
-                         .body = scene_record_body,
-                         .parse = scene_record_parse,
-                         .ctx = &runs,
-                         .done = done,
-                         .journal = {.fd = -1},
-                         .rank = a->rank,
-                         .size = a->size};
+    *sr = runner_make(a, scene_record_run, scene_record_body, scene_record_parse, &runs, done);
     if ((status = run_records(sr, a->key, errs)) || a->rank)
         return status;
     for (int k = 0; k < n; k++)
@@ -1732,13 +1738,8 @@ static int suite_scene_text(const sim_args *a, const pd_scene *sc, pd_scene **sc
     printf("\n");
     for (int k = 0; k < n; k++) {
         printf("  %-24.24s %12.5g", scs[k]->exc.record->name, scs[k]->exc.scale);
-        for (int s = 0; s < ncol; s++) {
-            const pd_structure *S = &sc->st[s];
-            double v = 0.0;
-            for (int i = S->dof; i < S->dof + S->storeys; i++)
-                v = ss[k].r.umax[i] > v ? ss[k].r.umax[i] : v;
-            printf(" %12.5g", v);
-        }
+        for (int s = 0; s < ncol; s++)
+            printf(" %12.5g", st->structure_umax[(size_t)s * n + k]);
         printf("\n");
     }
     for (int r = 0; r < 5; r++) {

@@ -28,7 +28,9 @@ static uint32_t fnv1a(const char *p, size_t n)
     return h;
 }
 
-int pd_journal_line(const char *body, size_t len, char *line, size_t cap)
+/* The checksummed line of body into line (cap bytes): its length, or -1
+ * when it does not fit. */
+static int journal_line(const char *body, size_t len, char *line, size_t cap)
 {
     if (len + 12 > cap)
         return -1;
@@ -37,7 +39,9 @@ int pd_journal_line(const char *body, size_t len, char *line, size_t cap)
     return m < 0 || len + (size_t)m >= cap ? -1 : (int)(len + (size_t)m);
 }
 
-long pd_journal_check(const char *line, size_t len)
+/* A line (without its newline) checked: its body's length, or -1 when the
+ * checksum does not match. */
+static long journal_check(const char *line, size_t len)
 {
     const char *hash = NULL;
     char buf[16], *end;
@@ -186,7 +190,7 @@ static int load_lines(pd_journal *j, const char *buf, size_t len, size_t pos,
         const char *nl = memchr(buf + pos, '\n', len - pos);
         if (!nl)
             return ftruncate(j->fd, (off_t)pos);
-        long body = pd_journal_check(buf + pos, (size_t)(nl - buf - pos));
+        long body = journal_check(buf + pos, (size_t)(nl - buf - pos));
         if (body >= 0)
             read(buf + pos, (size_t)body, ctx); /* a malformed line is skipped */
         pos = (size_t)(nl + 1 - buf);
@@ -237,10 +241,9 @@ int pd_journal_open(pd_journal *j, const pd_journal_kind *kind, const char *path
 
 int pd_journal_append(pd_journal *j, const char *body, size_t len)
 {
-    char small[1024], *line = len + 16 <= sizeof small ? small : malloc(len + 16);
-    int n =
-        line ? pd_journal_line(body, len, line, len + 16 <= sizeof small ? sizeof small : len + 16)
-             : -1;
+    size_t cap = len + 16; /* the body, " #xxxxxxxx\n" and its NUL */
+    char small[1024], *line = cap <= sizeof small ? small : malloc(cap);
+    int n = line ? journal_line(body, len, line, cap) : -1;
     if (j->fd < 0 || j->failed || n < 0 || write_all(j->fd, line, (size_t)n))
         j->failed = 1;
     if (line != small)

@@ -46,12 +46,6 @@ int pd_journal_open(pd_journal *j, const pd_journal_kind *kind, const char *path
 /* Append body (no newline) as one checksummed line, written at once,
  * fdatasync'd at most once a second: 0 or -1. */
 int pd_journal_append(pd_journal *j, const char *body, size_t len);
-/* The checksummed line of body into line (cap bytes): its length, or -1
- * when it does not fit (what pd_journal_append writes; MPI ranks send it). */
-int pd_journal_line(const char *body, size_t len, char *line, size_t cap);
-/* Check a line (without its newline) and find its body: the body's length,
- * or -1 when the checksum does not match. */
-long pd_journal_check(const char *line, size_t len);
 /* Close; remove the file when remove is set. */
 void pd_journal_close(pd_journal *j, int remove);
 

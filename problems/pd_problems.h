@@ -1152,6 +1152,8 @@ typedef struct pd_scene_suite {
     pd_suite_peaks *structure;   /* nstruct */
     pd_suite_peaks *storey;      /* ndof, in the scene's dof order */
     pd_suite_contact *contact;   /* ncontact */
+    double *structure_umax;      /* nstruct x n: run k's umax of structure s (its largest
+                                    storey's) at [s n + k] */
 } pd_scene_suite;
 
 /* The statistics of the n summaries runs[0..n) of the finished scene sc

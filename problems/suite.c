@@ -223,16 +223,18 @@ static double structure_peak(const pd_structure *S, const pd_scene_summary *r, i
     return v;
 }
 
-/* The six statistics of one set of peaks; col holds run k's figure f as
- * peak(k, f). */
+/* The statistics of one set of peaks (a structure's, S, or dof's); col
+ * holds run k's figure f in turn; umax (NULL: not kept): each run's umax. */
 static int peaks_of(pd_suite_peaks *p, double *col, int n, const pd_structure *S, int dof,
-                    const pd_scene_summary *runs, pd_err *err)
+                    const pd_scene_summary *runs, double *umax, pd_err *err)
 {
     pd_stats *st[PEAK_FIGS] = {&p->umax,  &p->drift_ratio, &p->acc_max,  &p->shear_max,
                                &p->gamma, &p->ductility,   &p->umax_free};
     for (int f = 0; f < PEAK_FIGS; f++) {
         for (int k = 0; k < n; k++)
             col[k] = S ? structure_peak(S, &runs[k], f) : dof_peak(&runs[k], dof, f);
+        if (f == PEAK_UMAX && umax)
+            memcpy(umax, col, (size_t)n * sizeof *col);
         int rc = pd_stats_of(col, n, st[f], err);
         if (rc)
             return rc;
@@ -290,6 +292,7 @@ void pd_scene_suite_free(pd_scene_suite *s)
     free(s->structure);
     free(s->storey);
     free(s->contact);
+    free(s->structure_umax);
     *s = (pd_scene_suite){.n = 0};
 }
 
@@ -319,15 +322,18 @@ int pd_scene_suite_stats(const pd_scene *sc, const pd_scene_summary *runs, int n
                             .ncontact = sc->ncontact,
                             .structure = pd_calloc(sc->nstruct, sizeof *out->structure),
                             .storey = pd_calloc(sc->n, sizeof *out->storey),
-                            .contact = pd_calloc(sc->ncontact, sizeof *out->contact)};
-    if (!col || !out->structure || !out->storey || (sc->ncontact && !out->contact)) {
+                            .contact = pd_calloc(sc->ncontact, sizeof *out->contact),
+                            .structure_umax = pd_calloc((long)sc->nstruct * n, sizeof(double))};
+    if (!col || !out->structure || !out->storey || (sc->ncontact && !out->contact) ||
+        !out->structure_umax) {
         rc = pd_err_set(err, PD_ENOMEM, "out of memory for a suite of %d runs", n);
         goto done;
     }
     for (int s = 0; s < sc->nstruct && !rc; s++) /* each structure: its largest storey's */
-        rc = peaks_of(&out->structure[s], col, n, &sc->st[s], 0, runs, err);
+        rc = peaks_of(&out->structure[s], col, n, &sc->st[s], 0, runs,
+                      out->structure_umax + (size_t)s * n, err);
     for (int i = 0; i < sc->n && !rc; i++) /* each storey */
-        rc = peaks_of(&out->storey[i], col, n, NULL, i, runs, err);
+        rc = peaks_of(&out->storey[i], col, n, NULL, i, runs, NULL, err);
     for (int c = 0; c < sc->ncontact && !rc; c++)
         rc = contact_of(&out->contact[c], col, n, c, runs, err);
 done:

@@ -524,6 +524,11 @@ static void test_suite_scene_stats(pd_test_ctx *ctx)
     CHECK(ctx, !rc && A->umax.max == 2.5 && A->umax.min == 0.5 && A->shear_max.max == 1.0,
           "the largest storey's umax (max %g min %g), storey 1's shear (%g)", A->umax.max,
           A->umax.min, A->shear_max.max);
+    CHECK(ctx,
+          !rc && st.structure_umax[0] == 0.5 && st.structure_umax[1] == 1.5 &&
+              st.structure_umax[2] == 2.5 && st.structure_umax[3] == runs[0].r.umax[2],
+          "each run's umax of a structure: A %g %g %g, B's first %g", st.structure_umax[0],
+          st.structure_umax[1], st.structure_umax[2], st.structure_umax[3]);
     CHECK(ctx, !rc && A->ductility.n == 2 && A->ductility.min == 2.0 && A->ductility.max == 3.0,
           "ductility over the finite storeys: n %d, %g to %g", A->ductility.n, A->ductility.min,
           A->ductility.max);

@@ -620,6 +620,7 @@ class PdSceneSuite(Structure):
         ("structure", POINTER(PdSuitePeaks)),
         ("storey", POINTER(PdSuitePeaks)),
         ("contact", POINTER(PdSuiteContact)),
+        ("structure_umax", POINTER(c_double)),
     ]
 
 

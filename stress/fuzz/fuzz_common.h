@@ -41,4 +41,21 @@ static void fuzz_write(const char *name, const uint8_t *data, size_t size, char 
     fclose(f);
 }
 
+/* The key line of a journal input that starts with magic ("...\nkey ")
+ * into key (cap bytes), so that the reader gets past its header check;
+ * key is left as it is when the input has none.  Its length, or 0. */
+static size_t fuzz_key(const uint8_t *data, size_t size, const char *magic, char *key, size_t cap)
+{
+    size_t lm = strlen(magic);
+    if (size <= lm || memcmp(data, magic, lm))
+        return 0;
+    const uint8_t *k = data + lm, *nl = memchr(k, '\n', size - lm);
+    size_t len = nl ? (size_t)(nl - k) : 0;
+    if (!nl || len == 0 || len >= cap || memchr(k, '\0', len))
+        return 0;
+    memcpy(key, k, len);
+    key[len] = '\0';
+    return len;
+}
+
 #endif

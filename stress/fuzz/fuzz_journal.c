@@ -15,25 +15,18 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    static const char magic[] = "pound-spectrum-journal 1\nkey ";
     char out[1024], path[1100], key[4096] = "v=1 tasks=16";
     long ntasks = 16;
-    size_t lm = sizeof magic - 1;
-    if (size > lm && !memcmp(data, magic, lm)) {
-        const uint8_t *k = data + lm, *nl = memchr(k, '\n', size - lm);
-        size_t len = nl ? (size_t)(nl - k) : 0;
-        if (nl && len > 0 && len < sizeof key && !memchr(k, '\0', len)) {
-            memcpy(key, k, len);
-            key[len] = '\0';
-            const char *t = strstr(key, "tasks=");
-            if (t) {
-                long v = strtol(t + 6, NULL, 10);
-                if (v >= 1 && v <= MAXTASKS)
-                    ntasks = v;
-            }
-            if (size % 2)
-                key[len - 1] ^= 1;
+    size_t len = fuzz_key(data, size, "pound-spectrum-journal 1\nkey ", key, sizeof key);
+    if (len > 0) {
+        const char *t = strstr(key, "tasks=");
+        if (t) {
+            long v = strtol(t + 6, NULL, 10);
+            if (v >= 1 && v <= MAXTASKS)
+                ntasks = v;
         }
+        if (size % 2)
+            key[len - 1] ^= 1;
     }
     snprintf(out, sizeof out, "%s/out.h5", fuzz_dir());
     fuzz_write("out.h5.partial", data, size, path, sizeof path);

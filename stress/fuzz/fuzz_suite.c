@@ -43,11 +43,9 @@ static int read_line(const char *body, size_t len, void *ctx)
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    static const char magic[] = "pound-suite-journal 1\nkey ";
     static pd_scene *sc;
     static int tried;
     char path[1100], key[4096] = "v=1";
-    size_t lm = sizeof magic - 1;
     pd_err err;
     if (!tried) { /* the scene, once */
         const char *f = getenv("POUND_FUZZ_SCENE");
@@ -55,14 +53,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (pd_scene_load(f ? f : "examples/scenes/two-sdof.json", &sc, &err))
             sc = NULL;
     }
-    if (size > lm && !memcmp(data, magic, lm)) {
-        const uint8_t *k = data + lm, *nl = memchr(k, '\n', size - lm);
-        size_t len = nl ? (size_t)(nl - k) : 0;
-        if (nl && len > 0 && len < sizeof key && !memchr(k, '\0', len)) {
-            memcpy(key, k, len);
-            key[len] = '\0';
-        }
-    }
+    fuzz_key(data, size, "pound-suite-journal 1\nkey ", key, sizeof key);
     fuzz_write("suite.journal", data, size, path, sizeof path);
     reader r = {.sc = sc};
     pd_journal j;
