@@ -172,6 +172,10 @@ int mj_flight_step(pd_mj *mj, int k, double t1, const pd_state *in, const double
                    pd_state *out, double *zout, pd_err *err);
 double mj_flight_wmax(const pd_mj *mj, int dof);
 double mj_flight_forcing_w(const pd_mj *mj);
+/* The Delassus block of the active set mj->idx_active (nI contacts) into
+ * mj->D_active: W^T Phi_vv(h_k / 2) M^-1 W (minv NULL) or W^T M^-1 W with
+ * M^-1 = diag(minv). */
+void mj_flight_delassus(pd_mj *mj, int k, const double *minv, int nI);
 /* The accelerations of the free motion at st (the forcing's state z). */
 void mj_flight_acc(const pd_mj *mj, const pd_state *st, const double *z, double *acc);
 

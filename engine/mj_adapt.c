@@ -90,7 +90,7 @@ struct mj_adapt {
     double *u_rest;    /* m: closing speeds without restitution (mj->u_rest) */
     double *u_tol, *G; /* m: the tolerance's rest speeds; |free gap acceleration| */
     double *D0;        /* m: sum_i W_ia^2 / M_ii, a unit impulse's change of gap rate */
-    double *lam;       /* m: each held contact's force, P / h of its last step with no onset */
+    double *lam;       /* m: each held contact's force at the kept state (held_forces) */
     int p;             /* order of the flight's global error */
     double div;        /* 2^p - 1 */
     int k_flight;      /* exact flights: the coarsest level whose steps the observers'
@@ -909,24 +909,46 @@ static void report_err(pd_mj *mj, double h)
     }
 }
 
-/* The held contacts' forces after the step w -> x into ad->lam: a contact
- * that pushed in that step and the one before is held, its force the
- * step's mean P / h; a step where some contact starts pushing or strikes
- * (an onset) carries impulses through every closed contact, impacts rather
- * than forces (P / h of a step localising an impact can be any size), and
- * there the held contacts keep the force of their step before. */
-static void held_forces(const pd_mj *mj, const snap *w, const snap *x)
+/* The held contacts' forces at x under the free motion's accelerations af
+ * into ad->lam: H the contacts that pushed in the step to x and rest there
+ * (|U| <= u_rest: the impulses held the gap rate at zero), their forces
+ * the acceleration LCP  lam_H >= 0, W_H^T (af + M^-1 W_H lam_H) >= 0,
+ * complementary (M diagonal), every other contact's 0.  The forces at the
+ * state's instant, as the exact reference has them: a step's mean P / h
+ * moves with the step's length and with the impulses of its neighbours'
+ * impacts.  Where the LCP is not solved the held contacts take P / h. */
+static void held_forces(pd_mj *mj, const snap *x, const double *af)
 {
+    const pd_model *md = mj->model;
+    const mj_incidence *in = &mj->inc;
     mj_adapt *ad = mj->ad;
-    int m = mj->model->m, onset = ad->impact_made;
-    for (int a = 0; a < m && !onset; a++)
-        onset = x->st.P[a] > 0.0 && !(w->st.P[a] > 0.0);
-    /* a contact not pushing holds nothing; one that starts is an onset, and
-     * keeps its force of the step before: 0 */
-    for (int a = 0; a < m; a++)
-        ad->lam[a] = !(x->st.P[a] > 0.0 && x->st.h > 0.0) ? 0.0
-                     : onset                              ? ad->lam[a]
-                                                          : x->st.P[a] / x->st.h;
+    int nH = 0;
+    for (int a = 0; a < md->m; a++) {
+        ad->lam[a] = 0.0;
+        if (x->st.P[a] > 0.0 && fabs(mj_inc_dot(in, a, x->st.v)) <= mj->u_rest[a])
+            mj->idx_active[nH++] = a;
+    }
+    if (nH == 0)
+        return;
+    /* D = W_H^T M^-1 W_H, b = W_H^T af: the free gap accelerations */
+    mj_flight_delassus(mj, 0, ad->minv, nH);
+    for (int r = 0; r < nH; r++)
+        mj->b_active[r] = mj_inc_dot(in, mj->idx_active[r], af);
+    if (nH == 1 && mj->D_active[0] > 0.0) { /* one contact: the closed form */
+        ad->lam[mj->idx_active[0]] = pd_contact_impulse_1(mj->D_active[0], mj->b_active[0]);
+        return;
+    }
+    pd_lcp_opts lo = pd_lcp_default_opts();
+    pd_lcp_info info;
+    pd_matrix D = mj->sparse ? pd_matrix_csc(nH, nH, mj->D_colptr, mj->D_rowind, mj->D_active)
+                             : pd_matrix_dense(nH, nH, mj->D_active);
+    /* beyond Lemke's workspace (PD_LCP_LEMKE_NMAX) the solver refuses: not solved */
+    int solved =
+        pd_lcp_solve(mj->lcp, &D, mj->b_active, &lo, mj->P_active, mj->w_active, &info) == PD_OK;
+    for (int r = 0; r < nH; r++) {
+        int a = mj->idx_active[r];
+        ad->lam[a] = solved ? mj->P_active[r] : x->st.h > 0.0 ? x->st.P[a] / x->st.h : 0.0;
+    }
 }
 
 /* The held contacts' forces ad->lam into acc: a_i += W_ia lam_a / M_ii. */
@@ -939,24 +961,24 @@ static void add_held(const pd_mj *mj, double *acc)
                 acc[in->dof[j]] += mj->ad->minv[in->dof[j]] * in->w[j] * mj->ad->lam[a];
 }
 
-/* The accelerations at x, made by a step from w, for the observers'
- * quintic interpolation of the step to it and of the next: the free
- * motion's plus the held contacts' forces (held_forces); where a piece's
- * start ended the step, the left limit (the old piece's forcing) in acc,
- * the right one in acc_right. */
-static void step_accelerations(pd_mj *mj, const snap *w, snap *x)
+/* The accelerations at x for the observers' quintic interpolation of the
+ * step to it and of the next: the free motion's plus the held contacts'
+ * forces (held_forces); where a piece's start ended the step, the left
+ * limit (the old piece's forcing) in acc, the right one in acc_right. */
+static void step_accelerations(pd_mj *mj, snap *x)
 {
     size_t bytes = (size_t)mj->model->n * sizeof(double);
-    held_forces(mj, w, x);
     x->st.has_acc = 1;
     mj_flight_acc(mj, &x->st, x->z, x->af);
     x->st.acc_right = x->switched ? x->accr : x->st.acc;
     memcpy((double *)x->st.acc_right, x->af, bytes);
+    held_forces(mj, x, x->af);
     add_held(mj, (double *)x->st.acc_right);
     if (!x->switched)
         return;
     /* the left limit, under the old piece's forcing zl */
     mj_flight_acc(mj, &x->st, x->zl, x->st.acc);
+    held_forces(mj, x, x->st.acc);
     add_held(mj, x->st.acc);
 }
 
@@ -1047,7 +1069,7 @@ static int keep(pd_mj *mj, const snap *w, snap *x, double f, int events, pd_obse
     }
     share_errors(mj, x);
     if (ad->F) /* the accelerations, for the observers' interpolation */
-        step_accelerations(mj, w, x);
+        step_accelerations(mj, x);
     rest_speeds(mj, w, x);
     /* the statistics, the reported err, the observer */
     ad->stats.steps++;

@@ -66,16 +66,27 @@ struct mj_flight {
 
 /* ---- dense helpers ---------------------------------------------------------- */
 
-/* C = A B for na x na column-major A, B (C distinct). */
-static void matmul(int na, const double *A, const double *B, double *C)
+/* C = A B for na x na column-major A, B (C distinct) that are block upper
+ * triangular over [rows | na - rows] (A~, its powers and exponentials: the
+ * forcing's states move by themselves).  By columns, C_:j = sum_l A_:l B_lj
+ * with l in order (each C_ij the same sum as a row times a column, bit for
+ * bit), skipping the terms of zero B_lj and, for l < rows, A's zero rows
+ * below: the sums of a column run side by side, not in one chain. */
+static void matmul(int na, int rows, const double *A, const double *B, double *C)
 {
-    for (int j = 0; j < na; j++)
-        for (int i = 0; i < na; i++) {
-            double sum = 0.0;
-            for (int l = 0; l < na; l++)
-                sum += A[i + (size_t)l * na] * B[l + (size_t)j * na]; /* C_ij = sum_l A_il B_lj */
-            C[i + (size_t)j * na] = sum;
+    for (int j = 0; j < na; j++) {
+        double *c = C + (size_t)j * na;
+        for (int i = 0; i < na; i++)
+            c[i] = 0.0;
+        for (int l = 0; l < na; l++) {
+            double b = B[l + (size_t)j * na];
+            if (b == 0.0)
+                continue;
+            const double *a = A + (size_t)l * na;
+            for (int i = 0, end = l < rows ? rows : na; i < end; i++)
+                c[i] += a[i] * b;
         }
+    }
 }
 
 /* ||A||_1 (the largest column sum). */
@@ -294,7 +305,7 @@ static int ladder(const mj_flight *fl, fl_kind *kd, const double *A, pd_err *err
         E[i] = T[i] = A[i] * hf;
     /* T = (A h)^j / j! added while it counts beyond 1e-18 of E, FL_TAYLOR_MAX terms at most */
     for (int j = 2; j <= FL_TAYLOR_MAX && norm1(na, T) > 1e-18 * fmax(norm1(na, E), 1e-300); j++) {
-        matmul(na, T, A, U);
+        matmul(na, rows, T, A, U);
         for (size_t i = 0; i < nn; i++) {
             T[i] = U[i] * hf / j;
             E[i] += T[i];
@@ -307,7 +318,7 @@ static int ladder(const mj_flight *fl, fl_kind *kd, const double *A, pd_err *err
         if (k == 0)
             break;
         /* E_k-1 = exp(2 A~ h_k) - I = (I + E_k)^2 - I = 2 E_k + E_k^2 */
-        matmul(na, E, E, U);
+        matmul(na, rows, E, E, U);
         for (size_t i = 0; i < nn; i++)
             E[i] = 2.0 * E[i] + U[i];
     }
@@ -576,8 +587,9 @@ static void free_flight(const mj_flight *fl, const fl_block *bl, int k, const pd
     }
 }
 
-/* D_ab = W_a^T Phi_vv(h/2) M^-1 W_b over the blocks they share (PV_k). */
-static double delassus(const pd_mj *mj, int k, int a, int b)
+/* D_ab = W_a^T Phi_vv(h/2) M^-1 W_b over the blocks they share (PV_k), or,
+ * given minv (M diagonal), W_a^T M^-1 W_b = sum_i W_ia W_ib / M_ii. */
+static double delassus(const pd_mj *mj, int k, const double *minv, int a, int b)
 {
     const mj_flight *fl = mj->fl;
     const mj_incidence *in = &mj->inc;
@@ -591,7 +603,9 @@ static double delassus(const pd_mj *mj, int k, int a, int b)
         for (int q = in->ptr[b]; q < in->ptr[b + 1]; q++) {
             int j = in->dof[q];
             /* PV is block diagonal: W_ia PV_ij W_jb for i, j in one block */
-            if (fl->block_of[j] == bi)
+            if (minv)
+                sum += i == j ? in->w[p] * minv[i] * in->w[q] : 0.0;
+            else if (fl->block_of[j] == bi)
                 sum += in->w[p] * PV[fl->at[i] + (size_t)fl->at[j] * s] * in->w[q];
         }
     }
@@ -615,10 +629,10 @@ static int cmp_int(const void *x, const void *y)
     return a < b ? -1 : a > b;
 }
 
-/* D_II of the active set into mj->D_active: dense, or compressed columns
- * with the contacts that share a block (found through the dofs of each
- * block a contact acts on). */
-static void assemble_delassus(pd_mj *mj, int k, int nI)
+/* D_II of the active set into mj->D_active (delassus: at level k, or with
+ * M^-1 = diag(minv)): dense, or compressed columns with the contacts that
+ * share a block (found through the dofs of each block a contact acts on). */
+void mj_flight_delassus(pd_mj *mj, int k, const double *minv, int nI)
 {
     mj_flight *fl = mj->fl;
     const mj_incidence *in = &mj->inc;
@@ -630,7 +644,7 @@ static void assemble_delassus(pd_mj *mj, int k, int nI)
             for (int r = 0; r < nI; r++)
                 mj->D_active[r + (size_t)c * nI] =
                     r == c || shares_block(mj, mj->idx_active[r], mj->idx_active[c])
-                        ? delassus(mj, k, mj->idx_active[r], mj->idx_active[c])
+                        ? delassus(mj, k, minv, mj->idx_active[r], mj->idx_active[c])
                         : 0.0;
     } else {
         int nnz = 0;
@@ -660,7 +674,7 @@ static void assemble_delassus(pd_mj *mj, int k, int nI)
             /* rows increasing, as compressed columns have them */
             qsort(mj->D_rowind + start, (size_t)(nnz - start), sizeof(int), cmp_int);
             for (int e = start; e < nnz; e++)
-                mj->D_active[e] = delassus(mj, k, mj->idx_active[mj->D_rowind[e]], a);
+                mj->D_active[e] = delassus(mj, k, minv, mj->idx_active[mj->D_rowind[e]], a);
         }
         mj->D_colptr[nI] = nnz;
     }
@@ -802,7 +816,7 @@ int mj_flight_step(pd_mj *mj, int k, double t1, const pd_state *in, const double
     out->nactive = nI;
     if (nI > 0) {
         /* D = W_I^T Phi_vv(h/2) M^-1 W_I and b = W_I^T v_free + e U_k; the impulses at mid-step */
-        assemble_delassus(mj, k, nI);
+        mj_flight_delassus(mj, k, NULL, nI);
         mj_active_rhs(mj, nI, out->v);
         if ((rc = mj_impact_active(mj, nI, t1, out, err)))
             return rc;

@@ -64,6 +64,8 @@ DEFAULT_FILES = {
     "problems/scene_energy.c": ["yield_scene"],
     "problems/separation.c": ["separation"],
     "problems/suite.c": ["suite"],
+    "engine/mj_adapt.c": ["adapt"],
+    "engine/mj_flight.c": ["adapt"],
 }
 
 # Array indices checked against the arrays' sizes (a trap, no runtime
