@@ -909,29 +909,41 @@ static void report_err(pd_mj *mj, double h)
     }
 }
 
-/* The held contacts' forces at x under the free motion's accelerations af
- * into ad->lam: H the contacts that pushed in the step to x and rest there
- * (|U| <= u_rest: the impulses held the gap rate at zero), their forces
- * the acceleration LCP  lam_H >= 0, W_H^T (af + M^-1 W_H lam_H) >= 0,
- * complementary (M diagonal), every other contact's 0.  The forces at the
- * state's instant, as the exact reference has them: a step's mean P / h
- * moves with the step's length and with the impulses of its neighbours'
- * impacts.  Where the LCP is not solved the held contacts take P / h. */
-static void held_forces(pd_mj *mj, const snap *x, const double *af)
+/* Contact a held at x: it pushed in the step to x and rests there (|U| <=
+ * u_rest: the impulses held its gap rate at zero). */
+static int is_held(const pd_mj *mj, const snap *x, int a)
 {
-    const pd_model *md = mj->model;
+    return x->st.P[a] > 0.0 && fabs(mj_inc_dot(&mj->inc, a, x->st.v)) <= mj->u_rest[a];
+}
+
+/* The contacts held at x into mj->idx_active and their block D_HH = W_H^T
+ * M^-1 W_H (M diagonal) into mj->D_active: their number. */
+static int held_set(pd_mj *mj, const snap *x)
+{
+    int nH = 0;
+    for (int a = 0; a < mj->model->m; a++)
+        if (is_held(mj, x, a))
+            mj->idx_active[nH++] = a;
+    mj_flight_delassus(mj, 0, mj->ad->minv, nH);
+    return nH;
+}
+
+/* The held contacts' forces at x under the free motion's accelerations af
+ * into ad->lam: the acceleration LCP over the held set of held_set (nH),
+ * lam_H >= 0, W_H^T (af + M^-1 W_H lam_H) >= 0, complementary, every other
+ * contact's 0.  The forces at the state's instant, as the exact reference
+ * has them: a step's mean P / h moves with the step's length and with the
+ * impulses of its neighbours' impacts.  Where the LCP is not solved the
+ * held contacts take P / h. */
+static void held_forces(pd_mj *mj, const snap *x, int nH, const double *af)
+{
     const mj_incidence *in = &mj->inc;
     mj_adapt *ad = mj->ad;
-    int nH = 0;
-    for (int a = 0; a < md->m; a++) {
+    for (int a = 0; a < mj->model->m; a++)
         ad->lam[a] = 0.0;
-        if (x->st.P[a] > 0.0 && fabs(mj_inc_dot(in, a, x->st.v)) <= mj->u_rest[a])
-            mj->idx_active[nH++] = a;
-    }
     if (nH == 0)
         return;
-    /* D = W_H^T M^-1 W_H, b = W_H^T af: the free gap accelerations */
-    mj_flight_delassus(mj, 0, ad->minv, nH);
+    /* b = W_H^T af: the free gap accelerations */
     for (int r = 0; r < nH; r++)
         mj->b_active[r] = mj_inc_dot(in, mj->idx_active[r], af);
     if (nH == 1 && mj->D_active[0] > 0.0) { /* one contact: the closed form */
@@ -972,13 +984,14 @@ static void step_accelerations(pd_mj *mj, snap *x)
     mj_flight_acc(mj, &x->st, x->z, x->af);
     x->st.acc_right = x->switched ? x->accr : x->st.acc;
     memcpy((double *)x->st.acc_right, x->af, bytes);
-    held_forces(mj, x, x->af);
+    int nH = held_set(mj, x); /* one held set and block for both limits */
+    held_forces(mj, x, nH, x->af);
     add_held(mj, (double *)x->st.acc_right);
     if (!x->switched)
         return;
     /* the left limit, under the old piece's forcing zl */
     mj_flight_acc(mj, &x->st, x->zl, x->st.acc);
-    held_forces(mj, x, x->st.acc);
+    held_forces(mj, x, nH, x->st.acc);
     add_held(mj, x->st.acc);
 }
 
@@ -1029,8 +1042,7 @@ static void hold_gaps(pd_mj *mj, const snap *w, snap *x)
     int moved = 0;
     for (int sweep = 0; sweep < ADAPT_HOLD_SWEEPS; sweep++)
         for (int a = 0; a < md->m; a++) {
-            /* held: pushing, at rest (|U| <= u_rest) */
-            if (!(x->st.P[a] > 0.0) || fabs(mj_inc_dot(in, a, x->st.v)) > mj->u_rest[a])
+            if (!is_held(mj, x, a))
                 continue;
             /* d: the gap's move to min(g(w), 0) */
             double d = fmin(w->st.g[a], 0.0) - (md->g0[a] + mj_inc_dot(in, a, x->st.q));

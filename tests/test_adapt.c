@@ -370,18 +370,22 @@ static void test_adapt_engine_contract(pd_test_ctx *ctx)
     }
 }
 
-/* A constant force toward a wall, F = 1 (exact flights). */
+#define HELD_FLIP 2.5 /* test_adapt_held_set: the push turns into a pull */
+
+/* A force toward a wall, F = 1, then away from it, F = -1 from HELD_FLIP
+ * (side -1 at the flip: the push). */
 static void push_force(double t, int side, double *F, void *ctx)
 {
-    (void)t, (void)side, (void)ctx;
-    F[0] = 1.0;
+    (void)ctx;
+    F[0] = t < HELD_FLIP || (t == HELD_FLIP && side < 0) ? 1.0 : -1.0;
 }
 
 /* What the held set observer saw: the largest |acc - a_free| over the
- * states with the contact open (no force may act) and over those held. */
+ * states with the contact open (no force may act), the largest |acc| over
+ * those held (the force cancels a_free). */
 typedef struct held_watch {
     double open_dev, held_dev;
-    long open_states, held_states;
+    long open_states, held_states, released; /* released: open states after a hold */
 } held_watch;
 
 static int watch_held(const pd_state *st, void *ctx)
@@ -389,11 +393,14 @@ static int watch_held(const pd_state *st, void *ctx)
     held_watch *hw = ctx;
     if (!st->has_acc)
         return 0;
-    /* a_free = (F - C v - K q) / M with M = 1, C = 0.1, K = 4, F = 1 */
-    double a_free = 1.0 - 0.1 * st->v[0] - 4.0 * st->q[0];
+    /* a_free = (F - C v - K q) / M with M = 1, C = 0.1, K = 4, F(t-) of push_force */
+    double F;
+    push_force(st->t, -1, &F, NULL);
+    double a_free = F - 0.1 * st->v[0] - 4.0 * st->q[0];
     if (st->g[0] > 1e-9 && !(st->P[0] > 0.0)) {
         hw->open_dev = fmax(hw->open_dev, fabs(st->acc[0] - a_free));
         hw->open_states++;
+        hw->released += hw->held_states > 0;
     } else if (st->P[0] > 0.0 && fabs(st->v[0]) <= 1e-9) {
         /* held on the wall (q = 0.05): the force takes the whole free acceleration */
         hw->held_dev = fmax(hw->held_dev, fabs(st->acc[0]));
@@ -405,7 +412,8 @@ static int watch_held(const pd_state *st, void *ctx)
 /* The held set of the accelerations (exact flights): an SDOF (M 1, C 0.1,
  * K 4) pushed by F = 1 toward a wall at q = 0.05 (its static deflection
  * 0.25 lies beyond) through a lever, gap 0.1 - 2 q (W = -2: the Delassus
- * entries W^2 / M, not W / M), e = 0: while the gap is open its acceleration is the free
+ * entries W^2 / M, not W / M), e = 0, pulled away by F = -1 from t = 2.5
+ * (a force left from the hold would show): while the gap is open its acceleration is the free
  * motion's to rounding, whatever the rest speeds (atol 10: a rest speed of
  * 2, above every speed of the run, so that a contact open and slow would
  * count as held if pushing were not asked); once it rests on the wall, the
@@ -413,10 +421,12 @@ static int watch_held(const pd_state *st, void *ctx)
 static void test_adapt_held_set(pd_test_ctx *ctx)
 {
     wall_dof d = {.M = 1.0, .C = 0.1, .K = 4.0, .W = -2.0, .g0 = 0.1, .e = 0.0};
-    double b = 1.0, atol = 10.0;
-    pd_sine_piece piece = {.t_start = 0.0, .c0 = 1.0};
-    pd_piecewise_force F = {.b = &b, .pieces = &piece, .npieces = 1};
+    double b = 1.0, atol = 10.0, brk = HELD_FLIP;
+    pd_sine_piece pieces[2] = {{.t_start = 0.0, .c0 = 1.0}, {.t_start = HELD_FLIP, .c0 = -1.0}};
+    pd_piecewise_force F = {.b = &b, .pieces = pieces, .npieces = 2};
     pd_model md = wall_dof_model(&d, push_force, NULL);
+    md.breaks = &brk;
+    md.nbreaks = 1;
     pd_mj_opts o = pd_mj_default_opts();
     o.h = 0.1;
     o.rtol = 0.1;
@@ -427,10 +437,12 @@ static void test_adapt_held_set(pd_test_ctx *ctx)
     pd_mj *mj = pd_mj_alloc(&md, &o, &err);
     int rc = mj ? pd_mj_run_until(mj, 5.0, watch_held, &hw, &err) : err.status;
     CHECK(ctx,
-          rc == PD_OK && hw.open_states > 3 && hw.held_states > 3 && hw.open_dev <= 1e-12 &&
-              hw.held_dev <= 1e-12,
-          "run %s: open %ld states, |acc - a_free| <= %.3g; held %ld states, |acc| <= %.3g",
-          rc ? err.msg : "ok", hw.open_states, hw.open_dev, hw.held_states, hw.held_dev);
+          rc == PD_OK && hw.open_states > 3 && hw.held_states > 3 && hw.released > 3 &&
+              hw.open_dev <= 1e-12 && hw.held_dev <= 1e-12,
+          "run %s: open %ld states (%ld after the hold), |acc - a_free| <= %.3g; held %ld "
+          "states, |acc| <= %.3g",
+          rc ? err.msg : "ok", hw.open_states, hw.released, hw.open_dev, hw.held_states,
+          hw.held_dev);
     pd_mj_free(mj);
 }
 
