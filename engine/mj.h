@@ -163,13 +163,17 @@ void mj_adapt_stats(const pd_mj *mj, pd_mj_stats *s);
 /* Exact flights (mj_flight.c): the tables of every block for the ladder
  * h_k = h0 2^-k, k = 0..L + 1, under the forcing F; their release; the
  * forcing state z (4) of piece p at t; the step of level k from (in, zin)
- * to (out, zout) ending at t1; the highest frequency of the dof's block
- * (for the grazing test) and of the forcing. */
+ * to (out, zout) ending at t1; a span: the free flights of levels lev[0..
+ * nlev) in turn, 1 when no contact shut at its end (else 0, out no step;
+ * < 0 on failure); the highest frequency of the dof's block (for the
+ * grazing test) and of the forcing. */
 int mj_flight_alloc(pd_mj *mj, const pd_piecewise_force *F, double h0, int L, pd_err *err);
 void mj_flight_free(pd_mj *mj);
 void mj_flight_z(const pd_mj *mj, int p, double t, double *z);
 int mj_flight_step(pd_mj *mj, int k, double t1, const pd_state *in, const double *zin,
                    pd_state *out, double *zout, pd_err *err);
+int mj_flight_span(pd_mj *mj, const int *lev, int nlev, double t1, const pd_state *in,
+                   const double *zin, pd_state *out, double *zout, pd_err *err);
 double mj_flight_wmax(const pd_mj *mj, int dof);
 double mj_flight_forcing_w(const pd_mj *mj);
 /* The Delassus block of the active set mj->idx_active (nI contacts) into

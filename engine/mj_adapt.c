@@ -39,6 +39,7 @@
 #define ADAPT_KF 0.5          /* share of rtol for the flight's errors over the run */
 #define ADAPT_KE 0.1          /* share of rtol for one event */
 #define ADAPT_GROW 0.9        /* double the step below ADAPT_GROW 2^-p of the tolerance */
+#define ADAPT_CLIMB 4         /* levels a kept try may climb at most (exact flights) */
 #define ADAPT_START 3         /* the first try's level */
 #define ADAPT_BREAK_TOL 1e-12 /* a time within this relative distance of a breakpoint is it */
 #define ADAPT_CHATTER 4.0     /* rest speeds: this many steps' worth of the gap's force */
@@ -49,7 +50,8 @@
 typedef struct snap {
     pd_state st;     /* q, v, P, g, active, t, step, ... */
     double *Fl, *Fr; /* n: F(t-) and F(t+) (theta flights) */
-    double *af;      /* n: the free motion's accelerations (valid with st.has_acc) */
+    double *af;      /* n: the free motion's accelerations (exact flights: when af_ok) */
+    int af_ok;       /* af is the state's (exact flights; free_acc forms it once) */
     double *accr;    /* n: the accelerations' right limit where the forcing jumps */
     double zl[4];    /* the forcing's state before a piece's start took over */
     int switched;    /* the step to this state ended at a piece's start */
@@ -91,21 +93,26 @@ struct mj_adapt {
     double *u_tol, *G; /* m: the tolerance's rest speeds; |free gap acceleration| */
     double *D0;        /* m: sum_i W_ia^2 / M_ii, a unit impulse's change of gap rate */
     double *lam;       /* m: each held contact's force at the kept state (held_forces) */
+    double *dmem;      /* the block of the n- and m-arrays of doubles above */
+    unsigned *umem;    /* the block of mark, evmark and timed */
     int p;             /* order of the flight's global error */
     double div;        /* 2^p - 1 */
-    int k_flight;      /* exact flights: the coarsest level whose steps the observers'
-                              quintic interpolation keeps within a tenth of the event
-                              tolerance, (w h)^6 / 46080 <= ke rtol / 10 */
+    int k_flight[2];   /* exact flights: the coarsest level whose steps the observers'
+                              quintic interpolation keeps within the event tolerance,
+                              (w h)^6 / 46080 <= ke rtol: w the highest
+                              dof or forcing frequency [0], the highest dof frequency
+                              for pieces without a sinusoid [1] */
     int k;             /* the level of the next try */
     int started;       /* the reset state was reported */
     int impact_made;   /* the step that made the state had an impact */
     long deep;         /* tries in a row at the ladder's foot */
+    uint64_t target;   /* exact flights: the tick an impact's approach flies to (0: none) */
     pd_mj_stats stats;
 };
 
-static void rest_speeds(pd_mj *mj, const snap *w, const snap *x);
+static void rest_speeds(pd_mj *mj, const snap *w, snap *x);
 static void rest_for_step(pd_mj *mj, const snap *x, double h);
-static void report_err(pd_mj *mj, double h);
+static void report_err(pd_mj *mj, double h, double wf);
 
 /* ---- the object ---------------------------------------------------------------- */
 
@@ -149,12 +156,10 @@ void mj_adapt_free(pd_mj *mj)
             pd_factor_free(ad->lev[k].factor);
     for (int s = 0; s < 4; s++)
         snap_free(&ad->sn[s]);
-    void *arrays[] = {ad->lev,    ad->piece_tick, ad->E,      ad->S2,    ad->Er,
-                      ad->eps,    ad->rate,       ad->amp,    ad->w,     ad->atol,
-                      ad->minv,   ad->mark,       ad->evmark, ad->timed, ad->bound,
-                      ad->u_rest, ad->D0,         ad->u_tol,  ad->G,     ad->lam};
-    for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
-        free(arrays[k]);
+    free(ad->lev);
+    free(ad->piece_tick);
+    free(ad->dmem);
+    free(ad->umem);
     free(ad);
     mj->ad = NULL;
     mj->u_rest = NULL;   /* the fixed-step kernel: every restitution again */
@@ -193,6 +198,14 @@ static double coarsest_step(const pd_model *md, const pd_piecewise_force *F, dou
     return h;
 }
 
+/* The largest w h of an exact flight that the observers' quintic
+ * interpolation keeps within the event tolerance: (w h)^6 / 46080 <= ke
+ * rtol (w the fastest frequency in the step). */
+static double flight_room(double rtol)
+{
+    return pow(46080.0 * ADAPT_KE * rtol, 1.0 / 6.0);
+}
+
 /* Each dof's frequency w_i = sqrt(K_ii / M_ii) (floored at 1e-3 of the
  * largest, so that a free dof's velocity error still counts). */
 static void dof_frequencies(const pd_model *md, double *w)
@@ -229,44 +242,50 @@ int mj_adapt_alloc(pd_mj *mj, pd_err *err)
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for its levels");
     ad->F = o->pieces;
     ad->L = L;
-    ad->h0 = coarsest_step(md, ad->F, o->h);
-    ad->htick = ldexp(ad->h0, -L); /* h_L: the tick */
     /* the flight's global order p: 2 at theta = 1/2 and for exact flights, else 1 */
     ad->p = o->theta == 0.5 || ad->F ? 2 : 1;
     ad->div = ad->p == 2 ? 3.0 : 1.0; /* 2^p - 1: Richardson's divisor */
     ad->lev = calloc((size_t)L + 1, sizeof *ad->lev);
     /* one element without pieces, so that NULL means out of memory */
     ad->piece_tick = calloc(ad->F ? (size_t)ad->F->npieces : 1, sizeof(uint64_t));
+    /* the dofs' and contacts' arrays in two blocks: 10 n + 5 max(m, 1) doubles, 3 n stamps */
     double **nv[] = {&ad->E,   &ad->S2, &ad->Er,   &ad->eps,  &ad->rate,
                      &ad->amp, &ad->w,  &ad->atol, &ad->minv, &ad->bound};
-    int bad = !ad->lev || !ad->piece_tick;
-    for (size_t k = 0; k < sizeof nv / sizeof nv[0]; k++)
-        bad |= !(*nv[k] = calloc((size_t)n, sizeof(double)));
-    ad->mark = calloc((size_t)n, sizeof(unsigned));
-    ad->evmark = calloc((size_t)n, sizeof(unsigned));
-    ad->timed = calloc((size_t)n, sizeof(unsigned));
-    ad->u_rest = pd_calloc(md->m, sizeof(double));
-    ad->D0 = pd_calloc(md->m, sizeof(double));
-    ad->u_tol = pd_calloc(md->m, sizeof(double));
-    ad->G = pd_calloc(md->m, sizeof(double));
-    ad->lam = pd_calloc(md->m, sizeof(double));
-    bad |= !ad->u_tol || !ad->G || !ad->lam || !ad->mark || !ad->evmark || !ad->timed ||
-           !ad->u_rest || !ad->D0 || mj_incidence_build(mj);
+    double **mv[] = {&ad->u_rest, &ad->D0, &ad->u_tol, &ad->G, &ad->lam};
+    unsigned **uv[] = {&ad->mark, &ad->evmark, &ad->timed};
+    size_t nn = (size_t)n, mm = md->m > 0 ? (size_t)md->m : 1;
+    ad->dmem = calloc(10 * nn + 5 * mm, sizeof(double));
+    ad->umem = calloc(3 * nn, sizeof(unsigned));
+    int bad = !ad->lev || !ad->piece_tick || !ad->dmem || !ad->umem;
+    for (size_t k = 0; !bad && k < 10; k++)
+        *nv[k] = ad->dmem + k * nn;
+    for (size_t k = 0; !bad && k < 5; k++)
+        *mv[k] = ad->dmem + 10 * nn + k * mm;
+    for (size_t k = 0; !bad && k < 3; k++)
+        *uv[k] = ad->umem + k * nn;
+    bad = bad || mj_incidence_build(mj);
     for (int s = 0; s < 4 && !bad; s++)
         bad = snap_alloc(&ad->sn[s], n, md->m) != PD_OK;
     if (bad)
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for its levels (n = %d)", n);
+    dof_frequencies(md, ad->w);
+    double wdof = 0.0, room = flight_room(o->rtol);
+    for (int i = 0; i < n; i++)
+        wdof = fmax(wdof, ad->w[i]);
+    /* exact flights: h0 no coarser than the observers' interpolation allows
+     * where the forcing has no sinusoid, room / w (w the highest dof frequency) */
+    ad->h0 = coarsest_step(md, ad->F, ad->F ? fmin(o->h, room / wdof) : o->h);
+    ad->htick = ldexp(ad->h0, -L); /* h_L: the tick */
     for (int k = 0; k <= L; k++) {
         /* h_k = h0 2^-k: the scalar kernel's constants now, the
          * general kernel's factors at their first use */
         ad->lev[k].h = ldexp(ad->h0, -k);
-        if (mj->scalar)
+        if (mj->scalar && !ad->F) /* theta flights only */
             ad->lev[k].s1 = mj1_coef_make(
                 pd_matrix_get(&md->M, 0, 0), pd_matrix_get(&md->C, 0, 0),
                 pd_matrix_get(&md->K, 0, 0), md->m > 0, md->m ? pd_matrix_get(&md->W, 0, 0) : 0.0,
                 md->m ? md->g0[0] : 0.0, md->m ? md->e[0] : 0.0, ad->lev[k].h, o->theta);
     }
-    dof_frequencies(md, ad->w);
     for (int i = 0; i < n; i++) {
         ad->minv[i] = 1.0 / pd_matrix_get(&md->M, i, i);
         ad->atol[i] = o->atol_dof ? o->atol_dof[i] : o->atol;
@@ -288,14 +307,13 @@ int mj_adapt_alloc(pd_mj *mj, pd_err *err)
     if (ad->F && (rc = mj_flight_alloc(mj, ad->F, ad->h0, L, err)))
         return rc;
     if (ad->F) {
-        /* k_flight: the coarsest level with (w h)^6 / 46080 <= ke rtol / 10,
-         * w the highest dof or forcing frequency */
-        double w = 0.0, room = pow(46080.0 * 0.1 * ADAPT_KE * o->rtol, 1.0 / 6.0);
-        for (int i = 0; i < n; i++)
-            w = fmax(w, ad->w[i]);
-        w = fmax(w, mj_flight_forcing_w(mj));
-        while (ad->k_flight < L - 1 && w * ad->lev[ad->k_flight].h > room)
-            ad->k_flight++;
+        /* k_flight: the coarsest level with w h <= room, w the highest dof
+         * or (pieces with a sinusoid) forcing frequency */
+        for (int j = 0; j < 2; j++) {
+            double wj = j == 0 ? fmax(wdof, mj_flight_forcing_w(mj)) : wdof;
+            while (ad->k_flight[j] < L - 1 && wj * ad->lev[ad->k_flight[j]].h > room)
+                ad->k_flight[j]++;
+        }
     }
     return PD_OK;
 }
@@ -307,9 +325,34 @@ static double tick_time(const mj_adapt *ad, uint64_t tick)
     return ad->t_origin + (double)tick * ad->htick;
 }
 
+/* The trailing zero bits of d > 0. */
+static int trailing_zeros(uint64_t d)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    return __builtin_ctzll(d);
+#else
+    int z = 0;
+    for (; !(d & 1); d >>= 1)
+        z++;
+    return z;
+#endif
+}
+
 static uint64_t level_ticks(const mj_adapt *ad, int k)
 {
     return (uint64_t)1 << (ad->L - k); /* 2^(L - k) ticks */
+}
+
+/* The forcing's frequency in piece p (exact flights; 0 without a sinusoid). */
+static double piece_w(const pd_mj *mj, int p)
+{
+    return mj->ad->F->pieces[p].A != 0.0 ? mj_flight_forcing_w(mj) : 0.0;
+}
+
+/* The coarsest level of an exact flight from x (k_flight of x's piece). */
+static int flight_level(const mj_adapt *ad, const snap *x)
+{
+    return ad->k_flight[ad->F->pieces[x->piece].A != 0.0 ? 0 : 1];
 }
 
 /* 1 when t is one of the model's breakpoints (to a relative ADAPT_BREAK_TOL). */
@@ -369,10 +412,13 @@ int mj_adapt_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_
     ad->span = 0.0; /* T: set by the first run */
     /* the first try at level ADAPT_START (above the foot), or at k_flight when that is finer */
     ad->k = ADAPT_START < ad->L ? ADAPT_START : ad->L - 1;
-    ad->k = ad->k > ad->k_flight ? ad->k : ad->k_flight;
+    ad->k = ad->k > ad->k_flight[0] ? ad->k : ad->k_flight[0];
+    if (ad->F) /* exact flights: the coarsest the observers allow (no error to size) */
+        ad->k = ad->k_flight[0];
     ad->started = 0;
     ad->impact_made = 0;
     ad->deep = 0;
+    ad->target = 0;
     ad->stats = (pd_mj_stats){.h_min = HUGE_VAL, .h_max = 0.0, .h0 = ad->h0};
     s->tick = 0;
     s->st.t = t0;
@@ -394,6 +440,7 @@ int mj_adapt_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_
     if (ad->F) {
         /* the free motion's accelerations, for the observers' interpolation */
         mj_flight_acc(mj, &s->st, s->z, s->af);
+        s->af_ok = 1;
         memcpy(s->st.acc, s->af, (size_t)mj->model->n * sizeof(double));
         s->st.has_acc = 1;
         s->st.acc_right = s->st.acc;
@@ -402,7 +449,7 @@ int mj_adapt_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_
     /* no step made this state (h = 0): no held force in its rest speeds */
     rest_speeds(mj, s, s);
     mj->t0 = t0;
-    report_err(mj, 0.0);
+    report_err(mj, 0.0, 0.0);
     mj->st = s->st;
     mj->st.err = ad->Er; /* the estimate: 0 here */
     return PD_OK;
@@ -452,6 +499,20 @@ static int scalar_step(pd_mj *mj, int k, double t1, const snap *x, snap *y, pd_e
     return PD_OK;
 }
 
+/* y reached by an exact flight from x: at a piece's start its forcing takes over. */
+static void flight_end(const pd_mj *mj, const snap *x, snap *y)
+{
+    const mj_adapt *ad = mj->ad;
+    y->piece = x->piece;
+    /* steps never cross a piece's start: one may end on it */
+    y->switched = y->piece + 1 < ad->F->npieces && y->tick >= ad->piece_tick[y->piece + 1];
+    if (y->switched) {
+        memcpy(y->zl, y->z, sizeof y->zl);
+        y->piece++;
+        mj_flight_z(mj, y->piece, ad->F->pieces[y->piece].t_start, y->z);
+    }
+}
+
 /* One step of level k from x into y (its forces at the end included). */
 static int take_step(pd_mj *mj, int k, const snap *x, snap *y, pd_err *err)
 {
@@ -462,17 +523,11 @@ static int take_step(pd_mj *mj, int k, const snap *x, snap *y, pd_err *err)
     ad->stats.evals++;
     rest_for_step(mj, x, ad->lev[k].h); /* mj->u_rest for this step size */
     y->st.h = ad->lev[k].h;
-    if (ad->F) { /* exact flight; at a piece's start its forcing takes over */
+    if (ad->F) { /* exact flight */
         if ((rc = mj_flight_step(mj, k, t1, &x->st, x->z, &y->st, y->z, err)))
             return rc;
-        y->piece = x->piece;
-        /* steps never cross a piece's start: one may end on it */
-        y->switched = y->piece + 1 < ad->F->npieces && y->tick >= ad->piece_tick[y->piece + 1];
-        if (y->switched) {
-            memcpy(y->zl, y->z, sizeof y->zl);
-            y->piece++;
-            mj_flight_z(mj, y->piece, ad->F->pieces[y->piece].t_start, y->z);
-        }
+        y->af_ok = 0;
+        flight_end(mj, x, y);
         return PD_OK;
     }
     /* theta flights: F(t1-) and F(t1+), then the scheme on What(h_k) */
@@ -483,6 +538,33 @@ static int take_step(pd_mj *mj, int k, const snap *x, snap *y, pd_err *err)
         return rc;
     return mj_general_step(mj, ad->lev[k].factor, ad->lev[k].h, t1, x->Fr, y->Fl, &x->st, &y->st,
                            err);
+}
+
+/* An exact flight of D ticks from x into y (D below h_0's, not a power of
+ * two): the free flights of the levels of D's binary digits, the coarsest
+ * first, as one step (exp(A~ D h_L) is their product); a contact shut at
+ * its end or at x fails it (a contact shut inside and open again at the
+ * end is the grazing test's, scan_dips over the whole span).  Returns 1
+ * when no contact shut, 0 when one did (y is no step then), < 0 on
+ * failure. */
+static int span_step(pd_mj *mj, uint64_t D, const snap *x, snap *y, pd_err *err)
+{
+    mj_adapt *ad = mj->ad;
+    int lev[64], nlev = 0, rc;
+    for (int k = 0; k <= ad->L; k++)
+        if (D & level_ticks(ad, k))
+            lev[nlev++] = k;
+    y->tick = x->tick + D;
+    y->af_ok = 0;
+    ad->stats.evals += nlev;
+    rest_for_step(mj, x, (double)D * ad->htick);
+    rc = mj_flight_span(mj, lev, nlev, tick_time(ad, y->tick), &x->st, x->z, &y->st, y->z, err);
+    if (rc <= 0)
+        return rc;
+    y->st.h = (double)D * ad->htick;
+    y->af_ok = 0;
+    flight_end(mj, x, y);
+    return 1;
 }
 
 /* ---- the tests of a try ------------------------------------------------------------ */
@@ -611,13 +693,40 @@ static double hermite_min(double g0, double U0, double g1, double U1, double h)
     return best;
 }
 
+static double gap_acc(const pd_mj *mj, snap *x, int a);
+static double first_root(double g, double U, double G);
+
+/* Exact flights: a contact opening at x (U0 >= 0, a rebound) that the free
+ * motion presses back (its gap acceleration G < 0) closes again at the
+ * first root s of g + U0 s + G s^2 / 2; inside the step h the flight
+ * may have passed through the wall and out again (two turns of the gap,
+ * which neither its ends nor their cubic show).  Its dofs are marked with
+ * the bound of an impact there, (1 + e) |U0 + G s| h on the gap rate.
+ * Returns 1 when marked. */
+static int scan_return(pd_mj *mj, snap *x, int a, double U0, double h)
+{
+    const mj_incidence *in = &mj->inc;
+    mj_adapt *ad = mj->ad;
+    double G = gap_acc(mj, x, a), s = first_root(x->st.g[a], U0, G);
+    if (!(G < 0.0 && s < h) || !(ad->D0[a] > 0.0))
+        return 0;
+    double jump = (1.0 + mj->model->e[a]) * fabs(U0 + G * s);
+    for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
+        int i = in->dof[j];
+        mark_event(ad, i, jump * h * fabs(in->w[j]) * ad->minv[i] / ad->D0[a]);
+    }
+    return 1;
+}
+
 /* A contact open at both ends of a free step x -> y whose gap may have
  * dipped to zero inside it (a grazing impact the step would miss): the
  * cubic Hermite of the gap, within its error (w h)^4 / 384 of the gap's
  * scale (w: the highest frequency of the blocks it joins, exact flights;
  * of its dofs, theta flights), comes below that margin.  Its dofs are
- * marked with the margin as bound. */
-static void scan_dips(pd_mj *mj, const snap *x, const snap *y, double h)
+ * marked with the margin as bound, or, when the cubic goes below zero by
+ * more, with a missed impact's (1 + e) |U0| h.  Exact flights: a rebound
+ * pressed back inside the step (scan_return). */
+static void scan_dips(pd_mj *mj, snap *x, const snap *y, double h)
 {
     const pd_model *md = mj->model;
     const mj_incidence *in = &mj->inc;
@@ -627,6 +736,8 @@ static void scan_dips(pd_mj *mj, const snap *x, const snap *y, double h)
         if (!(x->st.g[a] > 0.0 && y->st.g[a] > 0.0) || y->st.P[a] > 0.0)
             continue;
         double U0 = mj_inc_dot(in, a, x->st.v), U1 = mj_inc_dot(in, a, y->st.v);
+        if (mj->fl && U0 >= 0.0 && scan_return(mj, x, a, U0, h))
+            continue;
         /* closing at the start and opening at the end: it turned inside */
         if (!(U0 < 0.0 && U1 > 0.0))
             continue;
@@ -638,9 +749,16 @@ static void scan_dips(pd_mj *mj, const snap *x, const snap *y, double h)
             scale += fabs(in->w[j]) * dof_scale(ad, i);
         }
         double wh = w * h, margin = wh * wh * wh * wh / 384.0 * scale;
-        if (hermite_min(x->st.g[a], U0, y->st.g[a], U1, h) < margin)
-            for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
-                mark_event(ad, in->dof[j], margin);
+        double gmin = hermite_min(x->st.g[a], U0, y->st.g[a], U1, h);
+        if (!(gmin < margin))
+            continue;
+        /* below zero by more than the cubic's error: the flight went through the
+         * wall, an impact missed, whose bound is (1 + e) |U0| h on the gap rate */
+        double jump = gmin < -margin && ad->D0[a] > 0.0 ? (1.0 + md->e[a]) * -U0 : 0.0;
+        for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
+            int i = in->dof[j];
+            mark_event(ad, i, fmax(margin, jump * h * fabs(in->w[j]) * ad->minv[i] / ad->D0[a]));
+        }
     }
 }
 
@@ -655,13 +773,19 @@ static void mark_impulse(pd_mj *mj, int a, double dP)
     }
 }
 
-/* The free motion's acceleration of dof i at x: the state's own (exact
- * flights), else M_ii^-1 (F - C v - K q)_i (C, K symmetric: rows are columns). */
-static double free_acc(const pd_mj *mj, const snap *x, int i)
+/* The free motion's acceleration of dof i at x: exact flights, the state's
+ * own (formed at its first use), else M_ii^-1 (F - C v - K q)_i (C, K
+ * symmetric: rows are columns). */
+static double free_acc(const pd_mj *mj, snap *x, int i)
 {
     const pd_model *md = mj->model;
-    if (x->st.has_acc)
+    if (mj->fl) {
+        if (!x->af_ok) {
+            mj_flight_acc(mj, &x->st, x->z, x->af);
+            x->af_ok = 1;
+        }
         return x->af[i];
+    }
     return mj->ad->minv[i] * (x->Fr[i] - pd_matrix_col_dot(&md->C, i, x->st.v) -
                               pd_matrix_col_dot(&md->K, i, x->st.q));
 }
@@ -672,7 +796,7 @@ static double free_acc(const pd_mj *mj, const snap *x, int i)
  * it (its gap's acceleration G >= 0); else the contact would have held,
  * and the step lost up to |G| h of gap rate: its dofs get the bound
  * |G| h / w_i.  Returns 1 when marked. */
-static int released(pd_mj *mj, int a, const snap *y, double h)
+static int released(pd_mj *mj, int a, snap *y, double h)
 {
     const mj_incidence *in = &mj->inc;
     mj_adapt *ad = mj->ad;
@@ -710,6 +834,35 @@ static double overrun(pd_mj *mj, int a, double lambda0, double t0, double lambda
     return zero;
 }
 
+/* The free gap acceleration of contact a at x, W_a^T a_free. */
+static double gap_acc(const pd_mj *mj, snap *x, int a)
+{
+    const mj_incidence *in = &mj->inc;
+    double G = 0.0;
+    for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
+        G += in->w[j] * free_acc(mj, x, in->dof[j]);
+    return G;
+}
+
+/* Contact a held through a step x -> y of size h (exact flights): its
+ * force at an instant is about -G / D0_a (G the free gap acceleration),
+ * pressing (G < 0) at x and, when G > 0 at y (the free motion there opens
+ * it), negative at y: the force crossed zero at z (G's line) and was held
+ * d = h - z too long, an impulse error |lambda'| d^2 / 2 on the contact's
+ * dofs.  The means' line of overrun() is a curved force's secant, which
+ * puts the zero too late.  Returns 1 when marked. */
+static int force_zero(pd_mj *mj, int a, snap *x, snap *y, double h)
+{
+    mj_adapt *ad = mj->ad;
+    double G0 = gap_acc(mj, x, a), G1 = gap_acc(mj, y, a);
+    if (!(G0 < 0.0 && G1 > 0.0) || !(ad->D0[a] > 0.0))
+        return 0;
+    double d = h * G1 / (G1 - G0);           /* h - z, z = h (-G0) / (G1 - G0) */
+    double rate = (G1 - G0) / h / ad->D0[a]; /* |lambda'| */
+    mark_impulse(mj, a, rate * d * d / 2.0);
+    return 1;
+}
+
 /* Contacts that stop pushing in the try (its halves of size h, times from
  * its start): the scheme lets go at the end of the step where the contact
  * force's mean turns negative, so a held step may overrun the force's
@@ -732,6 +885,9 @@ static int scan_releases(pd_mj *mj, double h)
             first |= released(mj, a, ad->cur, h);
         if (!(Pa > 0.0))
             continue;
+        /* exact flights: the force's zero in the first half from its instants' */
+        if (ad->F && !flight_event(mj, a, impact_jump(mj, a, ad->cur, ad->half)))
+            first |= force_zero(mj, a, ad->cur, ad->half, h);
         /* held before and in the first half: their means' line, times from the try's start */
         if (P0 > 0.0 && hc > 0.0 && !ad->impact_made &&
             overrun(mj, a, P0 / hc, -0.5 * hc, Pa / h, 0.5 * h, h) < h)
@@ -746,6 +902,9 @@ static int scan_releases(pd_mj *mj, double h)
             continue;
         /* held in both halves: a zero before h lies in the first */
         first |= overrun(mj, a, Pa / h, 0.5 * h, P2 / h, 1.5 * h, 2.0 * h) < h;
+        /* exact flights: the force's zero in the second half from its instants' */
+        if (ad->F)
+            force_zero(mj, a, ad->half, ad->two, h);
     }
     return first;
 }
@@ -854,11 +1013,15 @@ static void try_begin(mj_adapt *ad, int n)
  * at the state x (made by a step from w): its free motion's, G, and the
  * held forces of the contacts it shares a dof with (their impulses in both
  * steps, over the step), for the steps' own part (rest_for_step). */
-static void rest_speeds(pd_mj *mj, const snap *w, const snap *x)
+static void rest_speeds(pd_mj *mj, const snap *w, snap *x)
 {
     const pd_model *md = mj->model;
     const mj_incidence *in = &mj->inc;
     mj_adapt *ad = mj->ad;
+    /* any contact pushing through both steps (else no held force to add) */
+    int both = 0;
+    for (int b = 0; b < md->m && x->st.h > 0.0 && !both; b++)
+        both = w->st.P[b] > 0.0 && x->st.P[b] > 0.0;
     for (int a = 0; a < md->m; a++) {
         double u = HUGE_VAL, G = 0.0, held = 0.0;
         for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
@@ -867,7 +1030,7 @@ static void rest_speeds(pd_mj *mj, const snap *w, const snap *x)
             u = fmin(u, ADAPT_KE * mj->opts.rtol * dof_scale(ad, i) * ad->w[i]);
             G += in->w[j] * free_acc(mj, x, i); /* W_a^T a_free */
             /* the other contacts on dof i held through both steps: their mean forces P_b / h */
-            for (int q = in->dptr[i]; x->st.h > 0.0 && q < in->dptr[i + 1]; q++) {
+            for (int q = in->dptr[i]; both && q < in->dptr[i + 1]; q++) {
                 int b = in->con[q];
                 if (b != a && w->st.P[b] > 0.0 && x->st.P[b] > 0.0)
                     held += fabs(in->w[j]) * ad->minv[i] * x->st.P[b] / x->st.h;
@@ -896,11 +1059,11 @@ static void rest_for_step(pd_mj *mj, const snap *x, double h)
 
 /* The state's err: the estimate so far and, for exact flights, the bound
  * of the observers' quintic interpolation inside the last step h, (w h)^6
- * / 46080 s_i (w: the dof's frequency or the forcing's, the larger). */
-static void report_err(pd_mj *mj, double h)
+ * / 46080 s_i (w: the dof's frequency or the forcing's in the step, wf, the
+ * larger). */
+static void report_err(pd_mj *mj, double h, double wf)
 {
     mj_adapt *ad = mj->ad;
-    double wf = ad->F ? mj_flight_forcing_w(mj) : 0.0;
     for (int i = 0; i < mj->model->n; i++) {
         double wh = fmax(ad->w[i], wf) * h, wh3 = wh * wh * wh;
         /* flights' errors add up (E), events' in quadrature (S2) */
@@ -973,6 +1136,15 @@ static void add_held(const pd_mj *mj, double *acc)
                 acc[in->dof[j]] += mj->ad->minv[in->dof[j]] * in->w[j] * mj->ad->lam[a];
 }
 
+/* 1 when no contact pushed in the step that made x. */
+static int none_pushing(const pd_model *md, const snap *x)
+{
+    for (int a = 0; a < md->m; a++)
+        if (x->st.P[a] > 0.0)
+            return 0;
+    return 1;
+}
+
 /* The accelerations at x for the observers' quintic interpolation of the
  * step to it and of the next: the free motion's plus the held contacts'
  * forces (held_forces); where a piece's start ended the step, the left
@@ -982,17 +1154,21 @@ static void step_accelerations(pd_mj *mj, snap *x)
     size_t bytes = (size_t)mj->model->n * sizeof(double);
     x->st.has_acc = 1;
     mj_flight_acc(mj, &x->st, x->z, x->af);
+    x->af_ok = 1;
     x->st.acc_right = x->switched ? x->accr : x->st.acc;
     memcpy((double *)x->st.acc_right, x->af, bytes);
-    int nH = held_set(mj, x); /* one held set and block for both limits */
+    /* one held set and block for both limits (none when no contact pushed) */
+    int nH = none_pushing(mj->model, x) ? 0 : held_set(mj, x);
     held_forces(mj, x, nH, x->af);
-    add_held(mj, (double *)x->st.acc_right);
+    if (nH > 0)
+        add_held(mj, (double *)x->st.acc_right);
     if (!x->switched)
         return;
     /* the left limit, under the old piece's forcing zl */
     mj_flight_acc(mj, &x->st, x->zl, x->st.acc);
     held_forces(mj, x, nH, x->st.acc);
-    add_held(mj, x->st.acc);
+    if (nH > 0)
+        add_held(mj, x->st.acc);
 }
 
 /* Errors cross contacts: a contact that pushed in the step to x moves
@@ -1087,7 +1263,8 @@ static int keep(pd_mj *mj, const snap *w, snap *x, double f, int events, pd_obse
     ad->stats.steps++;
     ad->stats.h_min = fmin(ad->stats.h_min, x->st.h);
     ad->stats.h_max = fmax(ad->stats.h_max, x->st.h);
-    report_err(mj, x->st.h);
+    /* the step's piece: the one before x's when x is that piece's end */
+    report_err(mj, x->st.h, ad->F ? piece_w(mj, x->switched ? x->piece - 1 : x->piece) : 0.0);
     mj->st = x->st;
     mj->st.err = ad->Er;
     return observer ? observer(&mj->st, ctx) : 0;
@@ -1153,15 +1330,6 @@ static uint64_t step_limit(const mj_adapt *ad, const snap *x, uint64_t tick_end)
     return tick_end;
 }
 
-/* 1 when no contact pushed in the step that made x. */
-static int none_pushing(const pd_model *md, const snap *x)
-{
-    for (int a = 0; a < md->m; a++)
-        if (x->st.P[a] > 0.0)
-            return 0;
-    return 1;
-}
-
 /* The finest level: one step, no try (the estimate from the last smooth
  * pair, the events' bound); rtol is not met when an event needed more. */
 static int finest_step(pd_mj *mj, pd_observer observer, void *ctx, pd_err *err)
@@ -1187,22 +1355,123 @@ static int finest_step(pd_mj *mj, pd_observer observer, void *ctx, pd_err *err)
     return stop;
 }
 
-/* An exact flight from a state where no contact pushes: kept whole when no
+/* The first positive root of g + U s + G s^2 / 2 (+inf when none). */
+static double first_root(double g, double U, double G)
+{
+    double r = HUGE_VAL, d = U * U - 2.0 * G * g;
+    if (G == 0.0)
+        return U < 0.0 ? -g / U : HUGE_VAL;
+    if (d < 0.0)
+        return HUGE_VAL;
+    /* roots q / (G / 2) and g / q, q = -(U + sign(U) sqrt(d)) / 2 * 2: no cancellation */
+    double q = -(U + copysign(sqrt(d), U));
+    double s1 = q / G, s2 = q != 0.0 ? 2.0 * g / q : HUGE_VAL;
+    if (s1 > 0.0)
+        r = s1;
+    if (s2 > 0.0 && s2 < r)
+        r = s2;
+    return r;
+}
+
+/* An impact's approach (exact flights): the flight of level k from x = cur
+ * into ad->one shut a contact that was open at x.  Its instant s* from x
+ * by the gap's Taylor polynomial g + U s + G s^2 / 2 (G the free motion's
+ * gap acceleration; relative error about (w s)^2 / 6, w the fastest
+ * frequency it sees), the earliest of the shut contacts'; the level of the
+ * try that takes it, k_try: the coarsest whose halves h keep the impact's
+ * bound, the dof's velocity jump times h, within half the event tolerance
+ * ke rtol s_i.  The approach flies to the tick ad->target, at least (w s*)^2
+ * / 2 s* and half a try's step before s*, on the grid of quarter steps of
+ * k_try, and predicts again there.  Returns 1 with a target; 2 when the
+ * impact lies within that lead: the try from x at level *k_try; 0 when
+ * the halving is as good (k_try the next level, a contact shut at x, no
+ * root).  by_flight: the contacts the flight shut (else every open one
+ * whose polynomial closes within 2 h_k: at a target, no flight to find
+ * them). */
+static int approach(pd_mj *mj, int k, int *k_try, int by_flight)
+{
+    const pd_model *md = mj->model;
+    const mj_incidence *in = &mj->inc;
+    mj_adapt *ad = mj->ad;
+    snap *x = ad->cur;
+    double smin = HUGE_VAL, h_need = HUGE_VAL, w = 0.0;
+    for (int a = 0; a < md->m; a++) {
+        if (by_flight && !ad->one->st.active[a])
+            continue;
+        if (x->st.g[a] <= mj->opts.sim_gap) {
+            if (by_flight)
+                return 0; /* shut at x: a held contact's step, not an arrival */
+            continue;
+        }
+        double U = mj_inc_dot(in, a, x->st.v), G = 0.0;
+        for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
+            G += in->w[j] * free_acc(mj, x, in->dof[j]);
+        double s = first_root(x->st.g[a], U, G);
+        if (!(s < 2.0 * ad->lev[k].h)) {
+            if (by_flight)
+                return 0; /* no root near the step: the try's halving */
+            continue;
+        }
+        /* the closing speed there, (1 + e) |U(s)| of gap rate; on dof i
+         * |W_ia| M_ii^-1 / D0_a of it */
+        double jump = (1.0 + md->e[a]) * fabs(U + G * s);
+        for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
+            int i = in->dof[j];
+            double dv = jump * fabs(in->w[j]) * ad->minv[i] / ad->D0[a];
+            if (dv > 0.0)
+                h_need =
+                    fmin(h_need, 0.5 * ADAPT_KE * mj->opts.rtol *
+                                     fmin(dof_scale(ad, i),
+                                          md->g0[a] > 0.0 ? md->g0[a] / fabs(in->w[j]) : HUGE_VAL) /
+                                     dv);
+            w = fmax(w, fmax(mj_flight_wmax(mj, i), piece_w(mj, x->piece)));
+        }
+        smin = fmin(smin, s);
+    }
+    if (!isfinite(smin))
+        return 0;
+    /* the try's level: its halves h_k_try+1 <= h_need */
+    int kt = k + 1;
+    while (kt + 1 < ad->L && ad->lev[kt + 1].h > h_need)
+        kt++;
+    if (kt <= k + 1 || kt + 2 > ad->L)
+        return 0;
+    *k_try = kt;
+    double H = ad->lev[kt].h, margin = fmin(0.5, 0.5 * (w * smin) * (w * smin));
+    double lead = fmax(margin * smin, 0.5 * H); /* how far before s* to stop */
+    /* the target on the grid of quarter steps of k_try */
+    uint64_t D = smin - lead <= H ? 0 : (uint64_t)((smin - lead) / ad->lev[kt + 2].h);
+    if (D == 0)
+        return 2;
+    ad->target = x->tick + D * level_ticks(ad, kt + 2);
+    return 1;
+}
+
+/* An exact flight of D ticks from a state where no contact pushes (one
+ * level's step, or a span of several: span_step): kept whole when no
  * contact shuts, grazes or closes in it (then it has no error).  Returns 1
- * when kept, 0 when the step (in ad->one) needs a try, < 0 on failure. */
-static int exact_flight(pd_mj *mj, int k, pd_observer observer, void *ctx, int *stop, pd_err *err)
+ * when kept, 0 when the step needs a try (a level's: in ad->one), < 0 on
+ * failure. */
+static int exact_flight(pd_mj *mj, uint64_t D, pd_observer observer, void *ctx, int *stop,
+                        pd_err *err)
 {
     mj_adapt *ad = mj->ad;
-    int rc;
-    if ((rc = take_step(mj, k, ad->cur, ad->one, err)))
+    int k = ad->L, rc;
+    /* D = 2^(L - k): one level (D nonzero, at most h_0's 2^L ticks) */
+    k -= trailing_zeros(D);
+    if (level_ticks(ad, k) == D) { /* one level */
+        if ((rc = take_step(mj, k, ad->cur, ad->one, err)))
+            return rc;
+    } else if ((rc = span_step(mj, D, ad->cur, ad->one, err)) <= 0) {
         return rc;
+    }
     /* a contact predicted active: a try */
     if (ad->one->st.nactive > 0)
         return 0;
     try_begin(ad, mj->model->n);
     long before = ad->nmarked;
     /* a grazing dip inside: a try */
-    scan_dips(mj, ad->cur, ad->one, ad->lev[k].h);
+    scan_dips(mj, ad->cur, ad->one, ad->one->st.h);
     if (ad->nmarked > before)
         return 0;
     *stop = keep(mj, ad->cur, ad->one, 0.0, 0, observer, ctx); /* no error: f = 0 */
@@ -1229,11 +1498,39 @@ int mj_adapt_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx,
     }
     mj->stop = 0;
     int k = ad->k;
+    uint64_t no_span = UINT64_MAX; /* a tick whose span to the limit found a contact */
     while (ad->cur->tick < tick_end && !stop && !mj->stop) {
-        /* the coarsest level from k on that starts here and ends in time */
-        uint64_t limit = step_limit(ad, ad->cur, tick_end);
-        while (k < ad->L && ((ad->cur->tick & (level_ticks(ad, k) - 1)) != 0 ||
-                             ad->cur->tick + level_ticks(ad, k) > limit)) {
+        uint64_t limit = step_limit(ad, ad->cur, tick_end), tick = ad->cur->tick;
+        /* an impact's approach: its target a limit; there, predicted again */
+        if (ad->target && tick >= ad->target) {
+            int k_try, how;
+            ad->target = 0;
+            k = flight_level(ad, ad->cur);
+            have_one = 0;
+            if ((how = approach(mj, k, &k_try, 0)) == 2)
+                k = k_try;
+            if (how)
+                continue;
+        }
+        if (ad->target && ad->target < limit)
+            limit = ad->target;
+        /* exact flights: the rest of the way to t_end or a piece's start in one span
+         * when a step of level k would cross it (the ladder's digits, not a walk) */
+        if (ad->F && !have_one && k < ad->L && tick + level_ticks(ad, k) > limit &&
+            tick != no_span && none_pushing(md, ad->cur)) {
+            if ((rc = exact_flight(mj, limit - tick, observer, ctx, &stop, err)) < 0)
+                return rc;
+            if (rc == 1) {
+                k = flight_level(ad, ad->cur);
+                continue;
+            }
+            no_span = tick;
+            ad->target = 0; /* the approach came too close: the tries from here */
+        }
+        /* the coarsest level from k on that ends in time and (theta flights)
+         * starts on a multiple of its step; exact flights start anywhere */
+        while (k < ad->L && ((!ad->F && (tick & (level_ticks(ad, k) - 1)) != 0) ||
+                             tick + level_ticks(ad, k) > limit)) {
             k++;
             have_one = 0;
         }
@@ -1258,10 +1555,18 @@ int mj_adapt_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx,
         double H = ad->lev[k].h, h = ad->lev[k + 1].h;
         if (ad->F && !have_one && none_pushing(md, ad->cur)) {
             /* an exact flight: no error to control, so back to the coarsest step */
-            if ((rc = exact_flight(mj, k, observer, ctx, &stop, err)) < 0)
+            if ((rc = exact_flight(mj, level_ticks(ad, k), observer, ctx, &stop, err)) < 0)
                 return rc;
             if (rc == 1) {
-                k = ad->k_flight;
+                k = flight_level(ad, ad->cur);
+                continue;
+            }
+            /* an impact ahead: fly to it, or try at its level, when the halving
+             * would take longer */
+            int k_try, how = ad->target ? 0 : approach(mj, k, &k_try, 1);
+            if (how) {
+                k = how == 2 ? k_try : k;
+                have_one = 0;
                 continue;
             }
             have_one = 1;
@@ -1282,9 +1587,17 @@ int mj_adapt_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx,
             if (!event)
                 note_rate(ad, n, H); /* a smooth pair: its error constant */
             stop = keep_pair(mj, observer, ctx);
-            /* well within 2^-p of the tolerance: the step doubles */
-            if (!event && r <= ADAPT_GROW / (ad->div + 1.0) && k > 0)
+            /* well within 2^-p of the tolerance: the step doubles; exact flights
+             * climb as many levels as r h^p keeps within ADAPT_GROW (at most
+             * ADAPT_CLIMB a try while a contact pushes, 4 ADAPT_CLIMB else), never
+             * above the observers' level k_flight */
+            int top = ad->F ? flight_level(ad, ad->cur) : 0;
+            int climb = !ad->F ? 1 : none_pushing(md, ad->cur) ? 4 * ADAPT_CLIMB : ADAPT_CLIMB;
+            for (int up = 0; !event && k > top && up < climb && r * (ad->div + 1.0) <= ADAPT_GROW;
+                 up++) {
                 k--;
+                r *= ad->div + 1.0;
+            }
             if (stuck) {
                 ad->deep = 0;
                 k = ad->L - ADAPT_DEEP - 1;

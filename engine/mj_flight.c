@@ -285,8 +285,57 @@ static double block_wmax(const fl_kind *kd, const double *A)
     return sqrt(best);
 }
 
-/* E at every level: the finest one's series, then E_k-1 = 2 E_k + E_k^2;
- * the first 2 s rows kept. */
+/* One level up the ladder on the first 2 s rows of E_k = [[X, Y], [0, Z_k]]
+ * (Z_k = exp(A_z h_k) - I, the forcing's own, in closed form: rows
+ * [cm1, sw, 0, 0], [-sw, cm1, 0, 0], [0, 0, 0, h], 0): E_k-1 = 2 E_k + E_k^2,
+ * whose rows are X' = 2 X + X X and Y' = 2 Y + X Y + Y Z_k.  T and T1 are
+ * rows x na by columns (leading dimension rows), T1 distinct. */
+static void level_up(const mj_flight *fl, int k, int rows, const double *T, double *T1)
+{
+    double cm1 = fl->cm1[k], sw = fl->sw[k], h = fl->h[k];
+    if (rows == 2) { /* an SDOF: X = [[a, c], [b, d]] by columns, the same sums unrolled */
+        double a = T[0], b = T[1], c = T[2], d = T[3];
+        for (int j = 0; j < 6; j++) {
+            double t0 = T[2 * j], t1 = T[2 * j + 1];
+            T1[2 * j] = 2.0 * t0 + a * t0 + c * t1;
+            T1[2 * j + 1] = 2.0 * t1 + b * t0 + d * t1;
+        }
+        for (int i = 0; i < 2; i++) {
+            double y0 = T[4 + i], y1 = T[6 + i], y2 = T[8 + i];
+            T1[4 + i] += y0 * cm1 - y1 * sw;
+            T1[6 + i] += y0 * sw + y1 * cm1;
+            T1[10 + i] += y2 * h;
+        }
+        return;
+    }
+    /* T1 = 2 T + X T over every column (X T = [X X, X Y]) */
+    for (int j = 0; j < rows + 4; j++) {
+        const double *t = T + (size_t)j * rows;
+        double *c = T1 + (size_t)j * rows;
+        for (int i = 0; i < rows; i++)
+            c[i] = 2.0 * t[i];
+        for (int l = 0; l < rows; l++) {
+            double b = t[l];
+            if (b == 0.0)
+                continue;
+            const double *x = T + (size_t)l * rows; /* column l of X */
+            for (int i = 0; i < rows; i++)
+                c[i] += x[i] * b;
+        }
+    }
+    /* + Y Z_k: column 0 Y_0 cm1 - Y_1 sw, column 1 Y_0 sw + Y_1 cm1, column 3 Y_2 h */
+    const double *Y = T + (size_t)rows * rows;
+    double *Y1 = T1 + (size_t)rows * rows;
+    for (int i = 0; i < rows; i++) {
+        double y0 = Y[i], y1 = Y[rows + i], y2 = Y[2 * rows + i];
+        Y1[i] += y0 * cm1 - y1 * sw;
+        Y1[rows + i] += y0 * sw + y1 * cm1;
+        Y1[3 * rows + i] += y2 * h;
+    }
+}
+
+/* E at every level: the finest one's series, then E_k-1 = 2 E_k + E_k^2
+ * on the first 2 s rows (level_up), which are kept. */
 static int ladder(const mj_flight *fl, fl_kind *kd, const double *A, pd_err *err)
 {
     int na = kd->na, rows = 2 * kd->s, L = fl->L;
@@ -311,20 +360,17 @@ static int ladder(const mj_flight *fl, fl_kind *kd, const double *A, pd_err *err
             E[i] += T[i];
         }
     }
-    for (int k = L + 1; k >= 0; k--) {
-        for (int c = 0; c < na; c++) /* keep the first 2 s rows */
-            for (int r = 0; r < rows; r++)
-                kd->E[(size_t)k * lev + r + (size_t)c * rows] = E[r + (size_t)c * na];
-        if (k == 0)
-            break;
-        /* E_k-1 = exp(2 A~ h_k) - I = (I + E_k)^2 - I = 2 E_k + E_k^2 */
-        matmul(na, rows, E, E, U);
-        for (size_t i = 0; i < nn; i++)
-            E[i] = 2.0 * E[i] + U[i];
-    }
-    /* an overflow at the coarse levels (large w h) refuses the run: a smaller h */
+    /* its first 2 s rows, then each coarser level's from the finer one's */
+    double *top = kd->E + (size_t)(L + 1) * lev;
+    for (int c = 0; c < na; c++)
+        for (int r = 0; r < rows; r++)
+            top[r + (size_t)c * rows] = E[r + (size_t)c * na];
+    for (int k = L + 1; k > 0; k--)
+        level_up(fl, k, rows, kd->E + (size_t)k * lev, kd->E + (size_t)(k - 1) * lev);
+    /* an overflow at the coarse levels (large w h) refuses the run: a smaller h
+     * (level 0 is formed from every finer one: a NaN or inf anywhere shows there) */
     int finite = 1;
-    for (size_t i = 0; i < lev * (size_t)(L + 2); i++)
+    for (size_t i = 0; i < lev; i++)
         finite &= isfinite(kd->E[i]);
     free(E);
     free(T);
@@ -770,31 +816,58 @@ void mj_flight_acc(const pd_mj *mj, const pd_state *st, const double *z, double 
     }
 }
 
-int mj_flight_step(pd_mj *mj, int k, double t1, const pd_state *in, const double *zin,
-                   pd_state *out, double *zout, pd_err *err)
+/* The free flights of levels lev[0..nlev) in turn from in into out (no
+ * contact): every block's, z turned by w h and its line advanced. */
+static void free_flights(const mj_flight *fl, const int *lev, int nlev, const pd_state *in,
+                         const double *zin, pd_state *out, double *zout)
+{
+    if (fl->nblocks == 1 && fl->blocks[0].s == 1) { /* one SDOF: free_flight's sums, inline */
+        int d = fl->blocks[0].dofs[0];
+        const double *E0 = fl->kinds[fl->blocks[0].kind].E;
+        double q = in->q[d], v = in->v[d], z0 = zin[0], z1 = zin[1], z2 = zin[2], z3 = zin[3];
+        for (int j = 0; j < nlev; j++) {
+            int k = lev[j];
+            const double *E = E0 + (size_t)k * 12; /* 2 rows x 6 columns a level */
+            double dq = E[0] * q + E[2] * v + E[4] * z0 + E[6] * z1 + E[8] * z2 + E[10] * z3;
+            double dv = E[1] * q + E[3] * v + E[5] * z0 + E[7] * z1 + E[9] * z2 + E[11] * z3;
+            q += dq;
+            v += dv;
+            double y0 = z0 + fl->cm1[k] * z0 + fl->sw[k] * z1;
+            double y1 = z1 + fl->cm1[k] * z1 - fl->sw[k] * z0;
+            z0 = y0;
+            z1 = y1;
+            z2 = z2 + fl->h[k] * z3;
+        }
+        out->q[d] = q;
+        out->v[d] = v;
+        zout[0] = z0;
+        zout[1] = z1;
+        zout[2] = z2;
+        zout[3] = z3;
+        return;
+    }
+    for (int j = 0; j < nlev; j++) {
+        int k = lev[j];
+        for (int b = 0; b < fl->nblocks; b++)
+            free_flight(fl, &fl->blocks[b], k, j ? out : in, j ? zout : zin, out);
+        /* z: the sinusoid turned by w h, (z0, z1) += (cos - 1)
+         * (z0, z1) + sin (z1, -z0); the line advanced */
+        double z0 = zin[0], z1 = zin[1], z2 = zin[2], z3 = zin[3];
+        zout[0] = z0 + fl->cm1[k] * z0 + fl->sw[k] * z1;
+        zout[1] = z1 + fl->cm1[k] * z1 - fl->sw[k] * z0;
+        zout[2] = z2 + fl->h[k] * z3;
+        zout[3] = z3;
+        zin = zout;
+    }
+}
+
+/* The contacts shut at the start (within sim_gap) or at the free flight's
+ * end, but for those the free flight opens, into mj->idx_active (their
+ * guesses too); every gap at the end into out.  Returns their number. */
+static int shut_contacts(pd_mj *mj, const pd_state *in, pd_state *out)
 {
     const pd_model *md = mj->model;
-    mj_flight *fl = mj->fl;
-    int nI = 0, rc;
-    double h = fl->h[k];
-    /* U_k before the free flight overwrites v (out may be in) */
-    for (int a = 0; a < md->m; a++)
-        mj->U0[a] = mj_inc_dot(&mj->inc, a, in->v);
-    for (int b = 0; b < fl->nblocks; b++)
-        free_flight(fl, &fl->blocks[b], k, in, zin, out);
-    /* z: the sinusoid turned by w h, (z0, z1) += (cos - 1)
-     * (z0, z1) + sin (z1, -z0); the line advanced */
-    double z0 = zin[0], z1 = zin[1];
-    zout[0] = z0 + fl->cm1[k] * z0 + fl->sw[k] * z1;
-    zout[1] = z1 + fl->cm1[k] * z1 - fl->sw[k] * z0;
-    zout[2] = zin[2] + h * zin[3];
-    zout[3] = zin[3];
-    out->t = t1;
-    out->step = in->step + 1;
-    out->lcp_pivots = 0;
-    out->lcp_solver = NULL;
-    /* the contacts shut at the start (within sim_gap) or at the free flight's end,
-     * but for those the free flight opens */
+    int nI = 0;
     for (int a = 0; a < md->m; a++) {
         unsigned char was = in->active[a] ? in->P[a] > 0.0 : 2;
         double g_start = in->g[a], g_end = md->g0[a] + mj_inc_dot(&mj->inc, a, out->q);
@@ -814,6 +887,49 @@ int mj_flight_step(pd_mj *mj, int k, double t1, const pd_state *in, const double
         }
     }
     out->nactive = nI;
+    return nI;
+}
+
+/* The state's dofs finite, or PD_ENONFINITE. */
+static int check_finite(const pd_mj *mj, double t1, const pd_state *out, pd_err *err)
+{
+    for (int i = 0; i < mj->model->n; i++)
+        if (!isfinite(out->q[i]) || !isfinite(out->v[i]))
+            return pd_err_set(err, PD_ENONFINITE,
+                              "Moreau-Jean: non-finite state at t = %.9g (dof %d)", t1, i);
+    return PD_OK;
+}
+
+int mj_flight_span(pd_mj *mj, const int *lev, int nlev, double t1, const pd_state *in,
+                   const double *zin, pd_state *out, double *zout, pd_err *err)
+{
+    for (int a = 0; a < mj->model->m; a++)
+        mj->U0[a] = mj_inc_dot(&mj->inc, a, in->v);
+    free_flights(mj->fl, lev, nlev, in, zin, out, zout);
+    out->t = t1;
+    out->step = in->step + 1;
+    out->lcp_pivots = 0;
+    out->lcp_solver = NULL;
+    if (shut_contacts(mj, in, out) > 0)
+        return 0;
+    int rc = check_finite(mj, t1, out, err);
+    return rc ? rc : 1;
+}
+
+int mj_flight_step(pd_mj *mj, int k, double t1, const pd_state *in, const double *zin,
+                   pd_state *out, double *zout, pd_err *err)
+{
+    const pd_model *md = mj->model;
+    int rc;
+    /* U_k before the free flight overwrites v (out may be in) */
+    for (int a = 0; a < md->m; a++)
+        mj->U0[a] = mj_inc_dot(&mj->inc, a, in->v);
+    free_flights(mj->fl, &k, 1, in, zin, out, zout);
+    out->t = t1;
+    out->step = in->step + 1;
+    out->lcp_pivots = 0;
+    out->lcp_solver = NULL;
+    int nI = shut_contacts(mj, in, out);
     if (nI > 0) {
         /* D = W_I^T Phi_vv(h/2) M^-1 W_I and b = W_I^T v_free + e U_k; the impulses at mid-step */
         mj_flight_delassus(mj, k, NULL, nI);
@@ -827,9 +943,5 @@ int mj_flight_step(pd_mj *mj, int k, double t1, const pd_state *in, const double
         for (int a = 0; a < md->m; a++)
             out->g[a] = md->g0[a] + mj_inc_dot(&mj->inc, a, out->q);
     }
-    for (int i = 0; i < md->n; i++)
-        if (!isfinite(out->q[i]) || !isfinite(out->v[i]))
-            return pd_err_set(err, PD_ENONFINITE,
-                              "Moreau-Jean: non-finite state at t = %.9g (dof %d)", t1, i);
-    return PD_OK;
+    return check_finite(mj, t1, out, err);
 }

@@ -23,7 +23,9 @@
 #include "pd_problems.h"
 
 #define OSC_ADAPT_TRIES 3
-#define OSC_ADAPT_H0 16.0    /* the coarsest step: min(Tp, T0) / this */
+#define OSC_ADAPT_H0                                                                               \
+    2.0                      /* the coarsest step at most max(Tp, T0) / this (the engine
+                               lowers it to what the observers allow) */
 #define OSC_ADAPT_FLOOR 1e-3 /* errors below this share of the static scale count as none */
 
 /* The observer's measurements in Pi units. */
@@ -143,7 +145,7 @@ static int run_once(const pd_osc *c, const pd_run_opts *o, double rtol, pd_osc_s
         return rc;
     pd_piecewise_force F = {.b = &b, .pieces = pieces, .npieces = npieces};
     double wp = pd_osc_wp(c), Le = pd_osc_Le(c);
-    pd_mj_opts mo = pd_run_mj_opts(o, PD_TWO_PI * fmin(1.0, 1.0 / c->Pi2) / OSC_ADAPT_H0);
+    pd_mj_opts mo = pd_run_mj_opts(o, PD_TWO_PI * fmax(1.0, 1.0 / c->Pi2) / OSC_ADAPT_H0);
     mo.rtol = rtol;
     /* below a thousandth of the static deflection under ap (1 / Pi2^2 in Pi
      * units) or of Le, an error is measured absolutely */
