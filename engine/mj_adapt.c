@@ -1,19 +1,23 @@
 /* mj_adapt.c — Moreau–Jean to a tolerance: steps chosen from a dyadic ladder,
- * impacts located by halving, an error estimate carried along.
+ * impacts approached or located by halving, an error estimate carried along.
  *
  *   ladder    h_k = h0 2^-k, k = 0..L; times on the grid t_origin + j h_L (integer
- *             ticks), a step of level k starting on a multiple of its own length and
- *             never crossing t_end or a forcing piece's start
+ *             ticks), a step never crossing t_end or a forcing piece's start; theta
+ *             flights: a step of level k starts on a multiple of its own length
  *   flights   theta: the theta scheme (What(h_k) factored at level k's first use);
  *             exact: the linear structures' exact flow (mj_flight.c), impulses at
- *             mid-step.  An exact flight with no contact pushing, closing or grazing
- *             is kept whole: it has no error to control
+ *             mid-step, from any tick.  An exact flight with no contact pushing,
+ *             closing or grazing is kept whole: it has no error to control; the rest
+ *             of the way to t_end or a piece's start is one span of the ladder's
+ *             digits; a flight that shuts a contact predicts the impact's instant
+ *             from the gap's Taylor polynomial, flies near it and tries there
  *   a try     from S at t: S1 = one step h_k; Sa, S2 = two steps h_k+1 (kept when
  *             the try passes)
  *   flight    no event: e_i = (|q2 - q1|_i + |v2 - v1|_i / w_i) / (2^p - 1)  (p = 2 at
  *             theta 1/2) against the error per unit step kf rtol s_i h_k / T over the
  *             run's span T; s_i = max(atol_i, the amplitude sqrt(q_i^2 + (v_i/w_i)^2)
  *             seen so far), w_i^2 = K_ii / M_ii; the step doubles below 2^-p of that
+ *             (exact flights: as many levels as r h^p allows, not above k_flight)
  *   events    on the dofs an event moves: an impact (a contact pushes while closing,
  *             (1 + e) |U-| above the flight's reach), a gap closed past zero or
  *             grazing inside a free step, a contact let go (its force's zero
@@ -410,10 +414,10 @@ int mj_adapt_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_
     ad->two = &ad->sn[3];
     ad->t_origin = t0;
     ad->span = 0.0; /* T: set by the first run */
-    /* the first try at level ADAPT_START (above the foot), or at k_flight when that is finer */
+    /* the first try at level ADAPT_START (above the foot); exact flights: the
+     * coarsest the observers allow (no error to size) */
     ad->k = ADAPT_START < ad->L ? ADAPT_START : ad->L - 1;
-    ad->k = ad->k > ad->k_flight[0] ? ad->k : ad->k_flight[0];
-    if (ad->F) /* exact flights: the coarsest the observers allow (no error to size) */
+    if (ad->F)
         ad->k = ad->k_flight[0];
     ad->started = 0;
     ad->impact_made = 0;

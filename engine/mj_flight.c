@@ -9,7 +9,10 @@
  *                z' = [w z1, -w z0, z3, 0]            (A~, na = 2 s + 4)
  *   ladder     E_k = exp(A~ h_k) - I: the finest level's by its Taylor series, then
  *              E_k-1 = 2 E_k + E_k^2 (the increment form keeps tiny steps exact:
- *              x+ = x + E_k [x; z])
+ *              x+ = x + E_k [x; z]) on the first 2 s rows, the forcing's own
+ *              block Z_k = exp(A_z h_k) - I in closed form
+ *   a span     the free flights of several levels in turn (the binary digits of
+ *              a stretch of the grid), one step when no contact shut at its end
  *   a step     the free flight of every block, z in closed form; contacts active
  *              when their gap is shut at the step's start (within sim_gap, the scale
  *              below which the reference takes contacts as closed) or at the free
