@@ -711,8 +711,9 @@ static int scan_return(pd_mj *mj, snap *x, int a, double U0, double h)
 {
     const mj_incidence *in = &mj->inc;
     mj_adapt *ad = mj->ad;
+    /* a root after an opening start needs G < 0 (g > 0, U0 >= 0) */
     double G = gap_acc(mj, x, a), s = first_root(x->st.g[a], U0, G);
-    if (!(G < 0.0 && s < h) || !(ad->D0[a] > 0.0))
+    if (!(s < h) || !(ad->D0[a] > 0.0))
         return 0;
     double jump = (1.0 + mj->model->e[a]) * fabs(U0 + G * s);
     for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
