@@ -68,7 +68,8 @@ run spectrum-event spectrum --Pi2 0.1:10:8 --method event --Pi3 0.02,0.3 -o OUT
 run spectrum-scene spectrum --scene $sc/two-sdof.json --Pi2 0.3:3:4 -o OUT
 run osc-moreau simulate --Pi2 2 --eps 0.7 --tend 6 -o OUT
 run osc-event simulate --Pi2 2 --eps 0.7 --method event --tend 6 -o OUT
-run osc-rtol simulate --Pi2 2 --eps 0.7 --method moreau --rtol 1e-4 --tend 6 -o OUT
+# (a run to a tolerance, --rtol, is left out: its steps are the controller's,
+# which issue 28 changes; fixed steps are the promise kept bit for bit)
 run osc-penalty simulate --Pi2 2 --eps 0.7 --method penalty --tend 6 -o OUT
 run three-moreau simulate --scene $sc/three-sdof.json -o OUT
 run three-event simulate --scene $sc/three-sdof.json --method event -o OUT
