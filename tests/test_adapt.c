@@ -642,6 +642,66 @@ static void ball_force(double t, int side, double *F, void *ctx)
     F[0] = ((const ball *)ctx)->F;
 }
 
+/* Two unit masses coupled by springs, K = [[2, -1], [-1, 2]] (one block of
+ * two dofs: the ladder's general products), forced on the first by sin 2t,
+ * against the modes' closed form: mode 1 (1, 1) / sqrt 2 at w 1, mode 2
+ * (1, -1) / sqrt 2 at sqrt 3, each an undamped SDOF under sin 2t /
+ * sqrt 2. */
+typedef struct pair_watch {
+    double dev, amp;
+    long states;
+} pair_watch;
+
+static int watch_pair(const pd_state *st, void *ctx)
+{
+    pair_watch *pw = ctx;
+    const double r2 = sqrt(0.5);
+    pd_sine_piece pc = {.t_start = 0.0, .A = r2, .w = 2.0};
+    pd_sdof m1 = {.w0 = 1.0}, m2 = {.w0 = sqrt(3.0)};
+    double u1, v1, u2, v2;
+    pd_sdof_advance_piece(&m1, &pc, 0.0, 0.0, 0.0, st->t, &u1, &v1);
+    pd_sdof_advance_piece(&m2, &pc, 0.0, 0.0, 0.0, st->t, &u2, &v2);
+    double q[2] = {r2 * (u1 + u2), r2 * (u1 - u2)}, v[2] = {r2 * (v1 + v2), r2 * (v1 - v2)};
+    for (int i = 0; i < 2; i++) {
+        pw->dev = fmax(pw->dev, fmax(fabs(st->q[i] - q[i]), fabs(st->v[i] - v[i])));
+        pw->amp = fmax(pw->amp, fabs(q[i]));
+    }
+    pw->states++;
+    return 0;
+}
+
+/* Exact flights of a block of two dofs (the general level_up and
+ * free_flight, not an SDOF's unrolled sums): every kept state within
+ * 1e-12 of the amplitude of the modes' closed form, to t = 7.3 (its last
+ * stretch a span). */
+static void test_adapt_exact_flights_block(pd_test_ctx *ctx)
+{
+    double M[4] = {1.0, 0.0, 0.0, 1.0}, C[4] = {0.0}, K[4] = {2.0, -1.0, -1.0, 2.0};
+    double W[2] = {-1.0, 0.0}, g0 = 1e3, e = 0.5, b[2] = {1.0, 0.0};
+    pd_sine_piece piece = {.t_start = 0.0, .A = 1.0, .w = 2.0};
+    pd_piecewise_force F = {.b = b, .pieces = &piece, .npieces = 1};
+    pd_model md = {.n = 2,
+                   .m = 1,
+                   .M = pd_matrix_dense(2, 2, M),
+                   .C = pd_matrix_dense(2, 2, C),
+                   .K = pd_matrix_dense(2, 2, K),
+                   .W = pd_matrix_dense(2, 1, W),
+                   .g0 = &g0,
+                   .e = &e};
+    pd_mj_opts o = pd_mj_default_opts();
+    o.h = 0.25;
+    o.rtol = 1e-6;
+    o.pieces = &F;
+    pair_watch pw = {0};
+    pd_err err;
+    pd_mj *mj = pd_mj_alloc(&md, &o, &err);
+    int rc = mj ? pd_mj_run_until(mj, 7.3, watch_pair, &pw, &err) : err.status;
+    CHECK(ctx, rc == PD_OK && pw.states > 20 && pw.dev <= 1e-12 * pw.amp,
+          "run %s: %ld states, the modes' closed form within %.3g (amplitude %.3g)",
+          rc ? err.msg : "ok", pw.states, pw.dev, pw.amp);
+    pd_mj_free(mj);
+}
+
 /* The ball b (F, v0, g0, e set) through t_end: its impacts, the closed form
  * at every kept state within 1e-6 g0, at most 40 flights an impact and 20
  * for the rest of the run. */
@@ -831,6 +891,7 @@ void suite_adapt(pd_test_ctx *ctx)
     PD_RUN(ctx, test_adapt_engine_contract);
     PD_RUN(ctx, test_adapt_held_set);
     PD_RUN(ctx, test_adapt_exact_flights);
+    PD_RUN(ctx, test_adapt_exact_flights_block);
     PD_RUN(ctx, test_adapt_impact_approach);
     PD_RUN(ctx, test_adapt_held_release);
     PD_RUN(ctx, test_adapt_rebound_inside_flight);
