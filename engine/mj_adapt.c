@@ -1422,13 +1422,13 @@ static int approach(pd_mj *mj, int k, int *k_try, int by_flight)
         double jump = (1.0 + md->e[a]) * fabs(U + G * s);
         for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
             int i = in->dof[j];
+            /* measured against the dof's scale and the contact's gap in its
+             * units (the peak toward the wall is the gap) */
             double dv = jump * fabs(in->w[j]) * ad->minv[i] / ad->D0[a];
+            double gap = md->g0[a] > 0.0 ? md->g0[a] / fabs(in->w[j]) : HUGE_VAL;
             if (dv > 0.0)
                 h_need =
-                    fmin(h_need, 0.5 * ADAPT_KE * mj->opts.rtol *
-                                     fmin(dof_scale(ad, i),
-                                          md->g0[a] > 0.0 ? md->g0[a] / fabs(in->w[j]) : HUGE_VAL) /
-                                     dv);
+                    fmin(h_need, 0.5 * ADAPT_KE * mj->opts.rtol * fmin(dof_scale(ad, i), gap) / dv);
             w = fmax(w, fmax(mj_flight_wmax(mj, i), piece_w(mj, x->piece)));
         }
         smin = fmin(smin, s);
