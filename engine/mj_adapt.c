@@ -566,7 +566,6 @@ static int span_step(pd_mj *mj, uint64_t D, const snap *x, snap *y, pd_err *err)
     if (rc <= 0)
         return rc;
     y->st.h = (double)D * ad->htick;
-    y->af_ok = 0;
     flight_end(mj, x, y);
     return 1;
 }
@@ -795,6 +794,16 @@ static double free_acc(const pd_mj *mj, snap *x, int i)
                               pd_matrix_col_dot(&md->K, i, x->st.q));
 }
 
+/* The free gap acceleration of contact a at x, W_a^T a_free. */
+static double gap_acc(const pd_mj *mj, snap *x, int a)
+{
+    const mj_incidence *in = &mj->inc;
+    double G = 0.0;
+    for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
+        G += in->w[j] * free_acc(mj, x, in->dof[j]);
+    return G;
+}
+
 /* A contact that pushed in the step that made y and not in the next, of
  * size h: let go at y.  Right when it was not resting on its contact (|U|
  * above the rest speed: an impact's rebound) or when the free motion opens
@@ -807,11 +816,8 @@ static int released(pd_mj *mj, int a, snap *y, double h)
     mj_adapt *ad = mj->ad;
     if (fabs(mj_inc_dot(in, a, y->st.v)) > ad->u_rest[a]) /* moving: an impact's rebound */
         return 0;
-    double G = 0.0;
-    /* G = W_a^T a_free: the gap's free acceleration */
-    for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
-        G += in->w[j] * free_acc(mj, y, in->dof[j]);
-    if (!(G < 0.0)) /* the free motion opens it */
+    double G = gap_acc(mj, y, a); /* the gap's free acceleration */
+    if (!(G < 0.0))               /* the free motion opens it */
         return 0;
     /* it would have held: |G| h of gap rate lost, |G| h / w_i on each dof */
     for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
@@ -837,16 +843,6 @@ static double overrun(pd_mj *mj, int a, double lambda0, double t0, double lambda
     /* the force held d = until - z too long: |lambda'| d^2 / 2 of impulse */
     mark_impulse(mj, a, -rate * (until - zero) * (until - zero) / 2.0);
     return zero;
-}
-
-/* The free gap acceleration of contact a at x, W_a^T a_free. */
-static double gap_acc(const pd_mj *mj, snap *x, int a)
-{
-    const mj_incidence *in = &mj->inc;
-    double G = 0.0;
-    for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
-        G += in->w[j] * free_acc(mj, x, in->dof[j]);
-    return G;
 }
 
 /* Contact a held through a step x -> y of size h (exact flights): its
@@ -1408,9 +1404,7 @@ static int approach(pd_mj *mj, int k, int *k_try, int by_flight)
                 return 0; /* shut at x: a held contact's step, not an arrival */
             continue;
         }
-        double U = mj_inc_dot(in, a, x->st.v), G = 0.0;
-        for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
-            G += in->w[j] * free_acc(mj, x, in->dof[j]);
+        double U = mj_inc_dot(in, a, x->st.v), G = gap_acc(mj, x, a);
         double s = first_root(x->st.g[a], U, G);
         if (!(s < 2.0 * ad->lev[k].h)) {
             if (by_flight)
@@ -1429,7 +1423,7 @@ static int approach(pd_mj *mj, int k, int *k_try, int by_flight)
             if (dv > 0.0)
                 h_need =
                     fmin(h_need, 0.5 * ADAPT_KE * mj->opts.rtol * fmin(dof_scale(ad, i), gap) / dv);
-            w = fmax(w, fmax(mj_flight_wmax(mj, i), piece_w(mj, x->piece)));
+            w = fmax(w, mj_flight_wmax(mj, i)); /* its block's or the forcing's */
         }
         smin = fmin(smin, s);
     }

@@ -903,9 +903,12 @@ static int check_finite(const pd_mj *mj, double t1, const pd_state *out, pd_err 
     return PD_OK;
 }
 
-int mj_flight_span(pd_mj *mj, const int *lev, int nlev, double t1, const pd_state *in,
-                   const double *zin, pd_state *out, double *zout, pd_err *err)
+/* The free flights of levels lev[0..nlev) from in into out ending at t1,
+ * the contacts they shut (shut_contacts): their number. */
+static int fly(pd_mj *mj, const int *lev, int nlev, double t1, const pd_state *in,
+               const double *zin, pd_state *out, double *zout)
 {
+    /* U_k before the free flight overwrites v (out may be in) */
     for (int a = 0; a < mj->model->m; a++)
         mj->U0[a] = mj_inc_dot(&mj->inc, a, in->v);
     free_flights(mj->fl, lev, nlev, in, zin, out, zout);
@@ -913,7 +916,13 @@ int mj_flight_span(pd_mj *mj, const int *lev, int nlev, double t1, const pd_stat
     out->step = in->step + 1;
     out->lcp_pivots = 0;
     out->lcp_solver = NULL;
-    if (shut_contacts(mj, in, out) > 0)
+    return shut_contacts(mj, in, out);
+}
+
+int mj_flight_span(pd_mj *mj, const int *lev, int nlev, double t1, const pd_state *in,
+                   const double *zin, pd_state *out, double *zout, pd_err *err)
+{
+    if (fly(mj, lev, nlev, t1, in, zin, out, zout) > 0)
         return 0;
     int rc = check_finite(mj, t1, out, err);
     return rc ? rc : 1;
@@ -923,16 +932,7 @@ int mj_flight_step(pd_mj *mj, int k, double t1, const pd_state *in, const double
                    pd_state *out, double *zout, pd_err *err)
 {
     const pd_model *md = mj->model;
-    int rc;
-    /* U_k before the free flight overwrites v (out may be in) */
-    for (int a = 0; a < md->m; a++)
-        mj->U0[a] = mj_inc_dot(&mj->inc, a, in->v);
-    free_flights(mj->fl, &k, 1, in, zin, out, zout);
-    out->t = t1;
-    out->step = in->step + 1;
-    out->lcp_pivots = 0;
-    out->lcp_solver = NULL;
-    int nI = shut_contacts(mj, in, out);
+    int rc, nI = fly(mj, &k, 1, t1, in, zin, out, zout);
     if (nI > 0) {
         /* D = W_I^T Phi_vv(h/2) M^-1 W_I and b = W_I^T v_free + e U_k; the impulses at mid-step */
         mj_flight_delassus(mj, k, NULL, nI);
