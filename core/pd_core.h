@@ -93,6 +93,12 @@ static inline double pd_max(double a, double b)
     return a > b ? a : b;
 }
 
+/* The smaller, likewise. */
+static inline double pd_min(double a, double b)
+{
+    return a < b ? a : b;
+}
+
 /* ---- reproducible random numbers ------------------------------------------ */
 
 /* splitmix64: the next 64 random bits of the stream *state (the same on

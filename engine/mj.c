@@ -60,6 +60,24 @@ double pd_contact_impulse_1(double D, double b)
 /* W by columns (its nonzeros) and by rows (mj->inc), once for the drivers
  * that read it (the adaptive one, the yielding springs'): PD_OK, or
  * PD_ENOMEM (what was taken is freed with the object). */
+/* The pairs' form of the incidence when no contact acts on more than two
+ * dofs (mj_inc_dot's two terms). */
+static int incidence_pairs(mj_incidence *in, int m)
+{
+    for (int a = 0; a < m; a++)
+        if (in->ptr[a + 1] - in->ptr[a] > 2)
+            return PD_OK;
+    if (!(in->pair = pd_calloc(2 * (long)m, sizeof(int))) ||
+        !(in->pw = pd_calloc(2 * (long)m, sizeof(double))))
+        return PD_ENOMEM;
+    for (int a = 0; a < m; a++)
+        for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
+            in->pair[2 * a + j - in->ptr[a]] = in->dof[j];
+            in->pw[2 * a + j - in->ptr[a]] = in->w[j];
+        }
+    return PD_OK;
+}
+
 int mj_incidence_build(pd_mj *mj)
 {
     const pd_model *md = mj->model;
@@ -102,7 +120,7 @@ int mj_incidence_build(pd_mj *mj)
     }
     in->ptr[m] = nnz;
     free(fill);
-    return PD_OK;
+    return incidence_pairs(in, m);
 }
 
 static void incidence_free(mj_incidence *in)
@@ -113,6 +131,8 @@ static void incidence_free(mj_incidence *in)
     free(in->dptr);
     free(in->con);
     free(in->wr);
+    free(in->pair);
+    free(in->pw);
     memset(in, 0, sizeof *in);
 }
 

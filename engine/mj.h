@@ -32,6 +32,9 @@ typedef struct mj_incidence {
     double *w;       /* W_ia of each (dof, contact) pair, as dof */
     int *dptr, *con; /* dof i: con[dptr[i] .. dptr[i+1]) */
     double *wr;      /* W_ia of each pair, as con */
+    int *pair;       /* 2 m, when no contact acts on more than 2 dofs (rows): each
+                        contact's dofs, a missing one dof 0 of weight 0 (else NULL) */
+    double *pw;      /* 2 m: their weights */
 } mj_incidence;
 
 /* The stored entries of column j of A, one per call into (*i, *v), *p from
@@ -58,6 +61,11 @@ static inline int mj_col_next(const pd_matrix *A, int j, int *p, int *i, double 
 /* W_a^T x. */
 static inline double mj_inc_dot(const mj_incidence *in, int a, const double *x)
 {
+    if (in->pair) { /* rows: two terms, no loop */
+        const int *d = in->pair + 2 * a;
+        const double *w = in->pw + 2 * a;
+        return w[0] * x[d[0]] + w[1] * x[d[1]];
+    }
     double sum = 0.0;
     for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
         sum += in->w[j] * x[in->dof[j]]; /* over the dofs contact a acts on */

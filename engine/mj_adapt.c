@@ -92,11 +92,15 @@ struct mj_adapt {
     unsigned *timed;  /* n: try_stamp when impulses at other instants moved the dof */
     unsigned try_stamp;
     double *bound;     /* n: the try's events' bound */
+    double *hsum;      /* n: the forces P_b / h of the contacts held through a kept step
+                          (rest_speeds) */
     long nmarked;      /* dofs marked for events so far */
     double *u_rest;    /* m: closing speeds without restitution (mj->u_rest) */
     double *u_tol, *G; /* m: the tolerance's rest speeds; |free gap acceleration| */
     double *D0;        /* m: sum_i W_ia^2 / M_ii, a unit impulse's change of gap rate */
     double *lam;       /* m: each held contact's force at the kept state (held_forces) */
+    int *push;         /* m: the contacts pushing at the kept state, increasing (keep) */
+    int npush;         /* their number */
     double *dmem;      /* the block of the n- and m-arrays of doubles above */
     unsigned *umem;    /* the block of mark, evmark and timed */
     int p;             /* order of the flight's global error */
@@ -164,6 +168,7 @@ void mj_adapt_free(pd_mj *mj)
     free(ad->piece_tick);
     free(ad->dmem);
     free(ad->umem);
+    free(ad->push);
     free(ad);
     mj->ad = NULL;
     mj->u_rest = NULL;   /* the fixed-step kernel: every restitution again */
@@ -252,19 +257,20 @@ int mj_adapt_alloc(pd_mj *mj, pd_err *err)
     ad->lev = calloc((size_t)L + 1, sizeof *ad->lev);
     /* one element without pieces, so that NULL means out of memory */
     ad->piece_tick = calloc(ad->F ? (size_t)ad->F->npieces : 1, sizeof(uint64_t));
-    /* the dofs' and contacts' arrays in two blocks: 10 n + 5 max(m, 1) doubles, 3 n stamps */
-    double **nv[] = {&ad->E,   &ad->S2, &ad->Er,   &ad->eps,  &ad->rate,
-                     &ad->amp, &ad->w,  &ad->atol, &ad->minv, &ad->bound};
+    /* the dofs' and contacts' arrays in two blocks: 11 n + 5 max(m, 1) doubles, 3 n stamps */
+    double **nv[] = {&ad->E, &ad->S2,   &ad->Er,   &ad->eps,   &ad->rate, &ad->amp,
+                     &ad->w, &ad->atol, &ad->minv, &ad->bound, &ad->hsum};
     double **mv[] = {&ad->u_rest, &ad->D0, &ad->u_tol, &ad->G, &ad->lam};
     unsigned **uv[] = {&ad->mark, &ad->evmark, &ad->timed};
     size_t nn = (size_t)n, mm = md->m > 0 ? (size_t)md->m : 1;
-    ad->dmem = calloc(10 * nn + 5 * mm, sizeof(double));
+    ad->dmem = calloc(11 * nn + 5 * mm, sizeof(double));
     ad->umem = calloc(3 * nn, sizeof(unsigned));
-    int bad = !ad->lev || !ad->piece_tick || !ad->dmem || !ad->umem;
-    for (size_t k = 0; !bad && k < 10; k++)
+    ad->push = pd_malloc(md->m, sizeof(int));
+    int bad = !ad->lev || !ad->piece_tick || !ad->dmem || !ad->umem || !ad->push;
+    for (size_t k = 0; !bad && k < 11; k++)
         *nv[k] = ad->dmem + k * nn;
     for (size_t k = 0; !bad && k < 5; k++)
-        *mv[k] = ad->dmem + 10 * nn + k * mm;
+        *mv[k] = ad->dmem + 11 * nn + k * mm;
     for (size_t k = 0; !bad && k < 3; k++)
         *uv[k] = ad->umem + k * nn;
     bad = bad || mj_incidence_build(mj);
@@ -450,7 +456,9 @@ int mj_adapt_reset(pd_mj *mj, double t0, const double *q0, const double *v0, pd_
         s->st.acc_right = s->st.acc;
         s->switched = 0;
     }
-    /* no step made this state (h = 0): no held force in its rest speeds */
+    /* no step made this state (h = 0): no contact pushing, no held force in
+     * its rest speeds */
+    ad->npush = 0;
     rest_speeds(mj, s, s);
     mj->t0 = t0;
     report_err(mj, 0.0, 0.0);
@@ -696,7 +704,7 @@ static double hermite_min(double g0, double U0, double g1, double U1, double h)
     return best;
 }
 
-static double gap_acc(const pd_mj *mj, snap *x, int a);
+static inline double gap_acc(const pd_mj *mj, snap *x, int a);
 static double first_root(double g, double U, double G);
 
 /* Exact flights: a contact opening at x (U0 >= 0, a rebound) that the free
@@ -710,8 +718,12 @@ static int scan_return(pd_mj *mj, snap *x, int a, double U0, double h)
 {
     const mj_incidence *in = &mj->inc;
     mj_adapt *ad = mj->ad;
-    /* a root after an opening start needs G < 0 (g > 0, U0 >= 0) */
-    double G = gap_acc(mj, x, a), s = first_root(x->st.g[a], U0, G);
+    /* a root after an opening start needs G < 0 (g > 0, U0 >= 0), and one
+     * before h needs g + G h^2 / 2 < 0 (U0 s >= 0) */
+    double G = gap_acc(mj, x, a), g = x->st.g[a];
+    if (!(G < 0.0 && g + 0.5 * G * h * h < 0.0))
+        return 0;
+    double s = first_root(g, U0, G);
     if (!(s < h) || !(ad->D0[a] > 0.0))
         return 0;
     double jump = (1.0 + mj->model->e[a]) * fabs(U0 + G * s);
@@ -777,30 +789,38 @@ static void mark_impulse(pd_mj *mj, int a, double dP)
     }
 }
 
-/* The free motion's acceleration of dof i at x: exact flights, the state's
- * own (formed at its first use), else M_ii^-1 (F - C v - K q)_i (C, K
- * symmetric: rows are columns). */
+/* Exact flights: the free motion's accelerations at x, the state's own
+ * (formed at their first use); theta flights: NULL. */
+static const double *free_accs(const pd_mj *mj, snap *x)
+{
+    if (!mj->fl)
+        return NULL;
+    if (!x->af_ok) {
+        mj_flight_acc(mj, &x->st, x->z, x->af);
+        x->af_ok = 1;
+    }
+    return x->af;
+}
+
+/* The free motion's acceleration of dof i at x: exact flights, free_accs',
+ * else M_ii^-1 (F - C v - K q)_i (C, K symmetric: rows are columns). */
 static double free_acc(const pd_mj *mj, snap *x, int i)
 {
     const pd_model *md = mj->model;
-    if (mj->fl) {
-        if (!x->af_ok) {
-            mj_flight_acc(mj, &x->st, x->z, x->af);
-            x->af_ok = 1;
-        }
-        return x->af[i];
-    }
+    if (mj->fl)
+        return free_accs(mj, x)[i];
     return mj->ad->minv[i] * (x->Fr[i] - pd_matrix_col_dot(&md->C, i, x->st.v) -
                               pd_matrix_col_dot(&md->K, i, x->st.q));
 }
 
 /* The free gap acceleration of contact a at x, W_a^T a_free. */
-static double gap_acc(const pd_mj *mj, snap *x, int a)
+static inline double gap_acc(const pd_mj *mj, snap *x, int a)
 {
     const mj_incidence *in = &mj->inc;
+    const double *af = free_accs(mj, x);
     double G = 0.0;
     for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
-        G += in->w[j] * free_acc(mj, x, in->dof[j]);
+        G += in->w[j] * (af ? af[in->dof[j]] : free_acc(mj, x, in->dof[j]));
     return G;
 }
 
@@ -985,7 +1005,7 @@ static double try_error(pd_mj *mj, double H)
          * the whole step's in its next step): that moves the dof by dv over
          * the step, not dv / w */
         int timed = event || ad->timed[i] == ad->try_stamp;
-        double d = fmax(dq + dv * (timed ? H : 1.0 / ad->w[i]) - noise, 0.0);
+        double d = pd_max(dq + dv * (timed ? H : 1.0 / ad->w[i]) - noise, 0.0);
         /* an event's error: first order plus its bounds; a flight's: Richardson's d / (2^p - 1) */
         double e = event ? d + ad->bound[i] : d / div;
         ad->eps[i] = e;
@@ -1019,23 +1039,33 @@ static void rest_speeds(pd_mj *mj, const snap *w, snap *x)
     const pd_model *md = mj->model;
     const mj_incidence *in = &mj->inc;
     mj_adapt *ad = mj->ad;
-    /* any contact pushing through both steps (else no held force to add) */
+    /* the contacts pushing through both steps (else no held force to add):
+     * their mean forces P_b / h summed on each of their dofs */
     int both = 0;
-    for (int b = 0; b < md->m && x->st.h > 0.0 && !both; b++)
-        both = w->st.P[b] > 0.0 && x->st.P[b] > 0.0;
+    for (int r = 0; r < ad->npush && x->st.h > 0.0; r++) {
+        int b = ad->push[r]; /* pushing at x (keep) */
+        if (!(w->st.P[b] > 0.0))
+            continue;
+        if (!both)
+            memset(ad->hsum, 0, (size_t)md->n * sizeof *ad->hsum);
+        both = 1;
+        for (int j = in->ptr[b]; j < in->ptr[b + 1]; j++)
+            ad->hsum[in->dof[j]] += x->st.P[b] / x->st.h;
+    }
+    const double *af = free_accs(mj, x);
+    double ku = ADAPT_KE * mj->opts.rtol;
     for (int a = 0; a < md->m; a++) {
         double u = HUGE_VAL, G = 0.0, held = 0.0;
+        int self = both && w->st.P[a] > 0.0 && x->st.P[a] > 0.0;
         for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
             int i = in->dof[j];
             /* u: the smallest ke rtol s_i w_i of its dofs */
-            u = fmin(u, ADAPT_KE * mj->opts.rtol * dof_scale(ad, i) * ad->w[i]);
-            G += in->w[j] * free_acc(mj, x, i); /* W_a^T a_free */
-            /* the other contacts on dof i held through both steps: their mean forces P_b / h */
-            for (int q = in->dptr[i]; both && q < in->dptr[i + 1]; q++) {
-                int b = in->con[q];
-                if (b != a && w->st.P[b] > 0.0 && x->st.P[b] > 0.0)
-                    held += fabs(in->w[j]) * ad->minv[i] * x->st.P[b] / x->st.h;
-            }
+            u = pd_min(u, ku * dof_scale(ad, i) * ad->w[i]);
+            G += in->w[j] * (af ? af[i] : free_acc(mj, x, i)); /* W_a^T a_free */
+            /* the other contacts on dof i held through both steps */
+            if (both)
+                held += fabs(in->w[j]) * ad->minv[i] *
+                        (self ? ad->hsum[i] - x->st.P[a] / x->st.h : ad->hsum[i]);
         }
         ad->u_tol[a] = isfinite(u) ? u : 0.0; /* no dof: none */
         ad->G[a] = fabs(G) + held;
@@ -1066,10 +1096,10 @@ static void report_err(pd_mj *mj, double h, double wf)
 {
     mj_adapt *ad = mj->ad;
     for (int i = 0; i < mj->model->n; i++) {
-        double wh = fmax(ad->w[i], wf) * h, wh3 = wh * wh * wh;
+        double wh = pd_max(ad->w[i], wf) * h, wh3 = wh * wh * wh;
         /* flights' errors add up (E), events' in quadrature (S2) */
-        ad->Er[i] =
-            ad->E[i] + sqrt(ad->S2[i]) + (ad->F ? wh3 * wh3 / 46080.0 * dof_scale(ad, i) : 0.0);
+        ad->Er[i] = ad->E[i] + (ad->S2[i] > 0.0 ? sqrt(ad->S2[i]) : 0.0) +
+                    (ad->F ? wh3 * wh3 / 46080.0 * dof_scale(ad, i) : 0.0);
     }
 }
 
@@ -1080,14 +1110,15 @@ static int is_held(const pd_mj *mj, const snap *x, int a)
     return x->st.P[a] > 0.0 && fabs(mj_inc_dot(&mj->inc, a, x->st.v)) <= mj->u_rest[a];
 }
 
-/* The contacts held at x into mj->idx_active and their block D_HH = W_H^T
- * M^-1 W_H (M diagonal) into mj->D_active: their number. */
+/* The contacts held at x (the kept state: among ad->push) into
+ * mj->idx_active and their block D_HH = W_H^T M^-1 W_H (M diagonal) into
+ * mj->D_active: their number. */
 static int held_set(pd_mj *mj, const snap *x)
 {
     int nH = 0;
-    for (int a = 0; a < mj->model->m; a++)
-        if (is_held(mj, x, a))
-            mj->idx_active[nH++] = a;
+    for (int r = 0; r < mj->ad->npush; r++)
+        if (is_held(mj, x, mj->ad->push[r]))
+            mj->idx_active[nH++] = mj->ad->push[r];
     mj_flight_delassus(mj, 0, mj->ad->minv, nH);
     return nH;
 }
@@ -1127,14 +1158,17 @@ static void held_forces(pd_mj *mj, const snap *x, int nH, const double *af)
     }
 }
 
-/* The held contacts' forces ad->lam into acc: a_i += W_ia lam_a / M_ii. */
+/* The held contacts' forces ad->lam (pushing ones only) into acc: a_i +=
+ * W_ia lam_a / M_ii. */
 static void add_held(const pd_mj *mj, double *acc)
 {
     const mj_incidence *in = &mj->inc;
-    for (int a = 0; a < mj->model->m; a++)
+    for (int r = 0; r < mj->ad->npush; r++) {
+        int a = mj->ad->push[r];
         if (mj->ad->lam[a] > 0.0)
             for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++)
                 acc[in->dof[j]] += mj->ad->minv[in->dof[j]] * in->w[j] * mj->ad->lam[a];
+    }
 }
 
 /* 1 when no contact pushed in the step that made x. */
@@ -1154,12 +1188,10 @@ static void step_accelerations(pd_mj *mj, snap *x)
 {
     size_t bytes = (size_t)mj->model->n * sizeof(double);
     x->st.has_acc = 1;
-    mj_flight_acc(mj, &x->st, x->z, x->af);
-    x->af_ok = 1;
     x->st.acc_right = x->switched ? x->accr : x->st.acc;
-    memcpy((double *)x->st.acc_right, x->af, bytes);
+    memcpy((double *)x->st.acc_right, free_accs(mj, x), bytes);
     /* one held set and block for both limits (none when no contact pushed) */
-    int nH = none_pushing(mj->model, x) ? 0 : held_set(mj, x);
+    int nH = mj->ad->npush == 0 ? 0 : held_set(mj, x);
     held_forces(mj, x, nH, x->af);
     if (nH > 0)
         add_held(mj, (double *)x->st.acc_right);
@@ -1180,9 +1212,9 @@ static void share_errors(pd_mj *mj, const snap *x)
 {
     const mj_incidence *in = &mj->inc;
     mj_adapt *ad = mj->ad;
-    for (int a = 0; a < mj->model->m; a++) {
-        if (!(x->st.P[a] > 0.0))
-            continue;
+    (void)x; /* its pushing contacts: ad->push */
+    for (int r = 0; r < ad->npush; r++) {
+        int a = ad->push[r];
         /* the largest E and S2 of the contact's dofs, to each */
         double E = 0.0, S2 = 0.0;
         for (int j = in->ptr[a]; j < in->ptr[a + 1]; j++) {
@@ -1218,7 +1250,8 @@ static void hold_gaps(pd_mj *mj, const snap *w, snap *x)
     const mj_adapt *ad = mj->ad;
     int moved = 0;
     for (int sweep = 0; sweep < ADAPT_HOLD_SWEEPS; sweep++)
-        for (int a = 0; a < md->m; a++) {
+        for (int r = 0; r < ad->npush; r++) {
+            int a = ad->push[r];
             if (!is_held(mj, x, a))
                 continue;
             /* d: the gap's move to min(g(w), 0) */
@@ -1231,9 +1264,10 @@ static void hold_gaps(pd_mj *mj, const snap *w, snap *x)
                 x->st.q[in->dof[j]] += ad->minv[in->dof[j]] * in->w[j] * d / D0;
             moved = 1;
         }
-    /* the moved state's gaps */
+    /* the moved state's gaps; its accelerations anew */
     for (int a = 0; moved && a < md->m; a++)
         x->st.g[a] = md->g0[a] + mj_inc_dot(in, a, x->st.q);
+    x->af_ok &= !moved;
 }
 
 static int keep(pd_mj *mj, const snap *w, snap *x, double f, int events, pd_observer observer,
@@ -1241,10 +1275,14 @@ static int keep(pd_mj *mj, const snap *w, snap *x, double f, int events, pd_obse
 {
     const pd_model *md = mj->model;
     mj_adapt *ad = mj->ad;
+    ad->npush = 0; /* the contacts pushing at x */
+    for (int a = 0; a < md->m; a++)
+        if (x->st.P[a] > 0.0)
+            ad->push[ad->npush++] = a;
     hold_gaps(mj, w, x);
     ad->impact_made = 0; /* an impact in the step w -> x (its impulses are no held force) */
-    for (int a = 0; a < md->m && !ad->impact_made; a++)
-        ad->impact_made = flight_event(mj, a, impact_jump(mj, a, w, x));
+    for (int r = 0; r < ad->npush && !ad->impact_made; r++)
+        ad->impact_made = flight_event(mj, ad->push[r], impact_jump(mj, ad->push[r], w, x));
     x->st.impact = ad->impact_made;
     for (int i = 0; i < md->n; i++) {
         /* the estimate: an event's dofs in quadrature (S2), the others added (E) */
@@ -1259,7 +1297,6 @@ static int keep(pd_mj *mj, const snap *w, snap *x, double f, int events, pd_obse
     share_errors(mj, x);
     if (ad->F) /* the accelerations, for the observers' interpolation */
         step_accelerations(mj, x);
-    rest_speeds(mj, w, x);
     /* the statistics, the reported err, the observer */
     ad->stats.steps++;
     ad->stats.h_min = fmin(ad->stats.h_min, x->st.h);
@@ -1271,6 +1308,15 @@ static int keep(pd_mj *mj, const snap *w, snap *x, double f, int events, pd_obse
     return observer ? observer(&mj->st, ctx) : 0;
 }
 
+/* keep, then the rest speeds at x for the steps from it (rest_speeds). */
+static int keep_from(pd_mj *mj, const snap *w, snap *x, double f, int events, pd_observer observer,
+                     void *ctx)
+{
+    int stop = keep(mj, w, x, f, events, observer, ctx);
+    rest_speeds(mj, w, x);
+    return stop;
+}
+
 static void swap(snap **a, snap **b)
 {
     snap *t = *a;
@@ -1279,13 +1325,18 @@ static void swap(snap **a, snap **b)
 }
 
 /* Keep the pair of halves: half then two become the state, each with half
- * of the try's estimate. */
+ * of the try's estimate (the rest speeds of the last kept only).  An
+ * observer that stops the run at the half leaves the state there. */
 static int keep_pair(pd_mj *mj, pd_observer observer, void *ctx)
 {
     mj_adapt *ad = mj->ad;
     int stop = keep(mj, ad->cur, ad->half, 0.5, 1, observer, ctx);
-    if (!stop)
-        stop = keep(mj, ad->half, ad->two, 0.5, 1, observer, ctx);
+    if (stop) {
+        rest_speeds(mj, ad->cur, ad->half);
+        swap(&ad->cur, &ad->half);
+        return stop;
+    }
+    stop = keep_from(mj, ad->half, ad->two, 0.5, 1, observer, ctx);
     swap(&ad->cur, &ad->two);
     return stop;
 }
@@ -1351,7 +1402,7 @@ static int finest_step(pd_mj *mj, pd_observer observer, void *ctx, pd_err *err)
             if (ad->eps[i] > ADAPT_KE * mj->opts.rtol * dof_scale(ad, i))
                 ad->stats.floor_hit = 1;
         }
-    int stop = keep(mj, ad->cur, ad->two, 1.0, 1, observer, ctx);
+    int stop = keep_from(mj, ad->cur, ad->two, 1.0, 1, observer, ctx);
     swap(&ad->cur, &ad->two);
     return stop;
 }
@@ -1473,7 +1524,7 @@ static int exact_flight(pd_mj *mj, uint64_t D, pd_observer observer, void *ctx, 
     scan_dips(mj, ad->cur, ad->one, ad->one->st.h);
     if (ad->nmarked > before)
         return 0;
-    *stop = keep(mj, ad->cur, ad->one, 0.0, 0, observer, ctx); /* no error: f = 0 */
+    *stop = keep_from(mj, ad->cur, ad->one, 0.0, 0, observer, ctx); /* no error: f = 0 */
     swap(&ad->cur, &ad->one);
     return 1;
 }
@@ -1608,7 +1659,7 @@ int mj_adapt_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx,
         if (event && !ev_half) {
             /* the event lies in the second half: keep the first, try the second */
             rate_estimate(ad, n, h);
-            stop = keep(mj, ad->cur, ad->half, 1.0, 0, observer, ctx);
+            stop = keep_from(mj, ad->cur, ad->half, 1.0, 0, observer, ctx);
             swap(&ad->cur, &ad->half);
             swap(&ad->one, &ad->two); /* the second half's whole step */
         } else {

@@ -63,8 +63,14 @@ struct mj_flight {
     unsigned *cmark;    /* m: the stamp of the last visit */
     unsigned stamp;
     int *pos;           /* m: place of a contact in the active set, or -1 */
+    int *rows;          /* m: a column's rows (column_rows, sdof_column) */
+    double *vals;       /* m: its values (sdof_column) */
     double *r;          /* n: W P */
     double *x, *dx, *y; /* 2 smax + 4 */
+    int sdofs;          /* every block one dof (rows of SDOFs): the flights by dofs */
+    int *kind_d;        /* n (sdofs): each dof's kind */
+    double *Ac;         /* 6 nkinds (sdofs): each kind's flight over a span (sdof_compose) */
+    double *zs;         /* 4 (L + 2): the forcing's state before each level of a span */
 };
 
 /* ---- dense helpers ---------------------------------------------------------- */
@@ -499,9 +505,14 @@ void mj_flight_free(pd_mj *mj)
     free(fl->touched);
     free(fl->cmark);
     free(fl->pos);
+    free(fl->rows);
+    free(fl->vals);
     free(fl->r);
     free(fl->x);
     free(fl->h);
+    free(fl->kind_d);
+    free(fl->Ac);
+    free(fl->zs);
     free(fl);
     mj->fl = NULL;
 }
@@ -526,6 +537,23 @@ static int forcing_frequency(const pd_piecewise_force *F, double *w, pd_err *err
     return PD_OK;
 }
 
+/* Rows of SDOFs (every block one dof): each dof's tables by pointer, the
+ * forcing's states of a span's levels. */
+static int sdof_tables(const pd_model *md, mj_flight *fl, pd_err *err)
+{
+    fl->sdofs = fl->nblocks == md->n;
+    if (!fl->sdofs)
+        return PD_OK;
+    fl->kind_d = malloc((size_t)md->n * sizeof(int));
+    fl->Ac = malloc((size_t)6 * fl->nkinds * sizeof(double));
+    fl->zs = malloc((size_t)4 * (fl->L + 2) * sizeof(double));
+    if (!fl->kind_d || !fl->Ac || !fl->zs)
+        return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for its flights");
+    for (int d = 0; d < md->n; d++)
+        fl->kind_d[d] = fl->blocks[fl->block_of[d]].kind;
+    return PD_OK;
+}
+
 int mj_flight_alloc(pd_mj *mj, const pd_piecewise_force *F, double h0, int L, pd_err *err)
 {
     const pd_model *md = mj->model;
@@ -543,8 +571,11 @@ int mj_flight_alloc(pd_mj *mj, const pd_piecewise_force *F, double h0, int L, pd
     fl->dofs = malloc((size_t)n * sizeof(int));
     fl->r = calloc((size_t)n, sizeof(double));
     fl->pos = pd_malloc(md->m, sizeof(int));
-    if (!fl->h || !fl->block_of || !fl->at || !fl->dofs || !fl->r || !fl->pos ||
-        find_blocks(md, fl) || !(fl->touched = calloc((size_t)fl->nblocks, sizeof(unsigned))) ||
+    fl->rows = pd_malloc(md->m, sizeof(int));
+    fl->vals = pd_malloc(md->m, sizeof(double));
+    if (!fl->h || !fl->block_of || !fl->at || !fl->dofs || !fl->r || !fl->pos || !fl->rows ||
+        !fl->vals || find_blocks(md, fl) ||
+        !(fl->touched = calloc((size_t)fl->nblocks, sizeof(unsigned))) ||
         !(fl->cmark = pd_calloc(md->m, sizeof(unsigned))))
         return pd_err_set(err, PD_ENOMEM, "Moreau-Jean: out of memory for its flights");
     fl->cm1 = fl->h + L + 2;
@@ -568,7 +599,7 @@ int mj_flight_alloc(pd_mj *mj, const pd_piecewise_force *F, double h0, int L, pd
     fl->y = fl->dx + 2 * smax + 4;
     if ((rc = form_kinds(md, fl, err)))
         return rc;
-    return PD_OK;
+    return sdof_tables(md, fl, err);
 }
 
 void mj_flight_z(const pd_mj *mj, int p, double t, double *z)
@@ -643,6 +674,16 @@ static double delassus(const pd_mj *mj, int k, const double *minv, int a, int b)
     const mj_flight *fl = mj->fl;
     const mj_incidence *in = &mj->inc;
     double sum = 0.0;
+    if (fl->sdofs) { /* rows of SDOFs: the sums below over shared dofs, PV_k a scalar */
+        for (int p = in->ptr[a]; p < in->ptr[a + 1]; p++) {
+            int i = in->dof[p];
+            double Pi = minv ? minv[i] : fl->kinds[fl->kind_d[i]].PV[k];
+            for (int q = in->ptr[b]; q < in->ptr[b + 1]; q++)
+                if (in->dof[q] == i)
+                    sum += in->w[p] * Pi * in->w[q];
+        }
+        return sum;
+    }
     for (int p = in->ptr[a]; p < in->ptr[a + 1]; p++) {
         int i = in->dof[p], bi = fl->block_of[i];
         const fl_block *bl = &fl->blocks[bi];
@@ -661,67 +702,118 @@ static double delassus(const pd_mj *mj, int k, const double *minv, int a, int b)
     return sum;
 }
 
-/* The contacts that act on a block of contact a's: b's with a shared block. */
-static int shares_block(const pd_mj *mj, int a, int b)
+/* Sort v[0..n) increasing, x (NULL: none) along (a column's few rows:
+ * insertion). */
+static void sort_rows(int *v, double *x, int n)
 {
-    const mj_incidence *in = &mj->inc;
-    for (int p = in->ptr[a]; p < in->ptr[a + 1]; p++)
-        for (int q = in->ptr[b]; q < in->ptr[b + 1]; q++)
-            if (mj->fl->block_of[in->dof[p]] == mj->fl->block_of[in->dof[q]])
-                return 1;
-    return 0;
+    for (int i = 1; i < n; i++) {
+        int vi = v[i], j = i;
+        double xi = x ? x[i] : 0.0;
+        for (; j > 0 && v[j - 1] > vi; j--) {
+            v[j] = v[j - 1];
+            if (x)
+                x[j] = x[j - 1];
+        }
+        v[j] = vi;
+        if (x)
+            x[j] = xi;
+    }
 }
 
-static int cmp_int(const void *x, const void *y)
+/* Rows of SDOFs: column a of D in one pass over its dofs, D_ba = sum over
+ * their shared dofs i of W_ib P_i W_ia (P_i = PV_k of its kind, or minv_i),
+ * delassus's terms in its order; rows and values, unsorted, into rows and
+ * vals: their number. */
+static int sdof_column(const pd_mj *mj, int k, const double *minv, int a, int *rows, double *vals)
 {
-    int a = *(const int *)x, b = *(const int *)y;
-    return a < b ? -1 : a > b;
+    const mj_flight *fl = mj->fl;
+    const mj_incidence *in = &mj->inc;
+    int nr = 0;
+    for (int p = in->ptr[a]; p < in->ptr[a + 1]; p++) {
+        int i = in->dof[p];
+        double Pi = minv ? minv[i] : fl->kinds[fl->kind_d[i]].PV[k];
+        for (int q = in->dptr[i]; q < in->dptr[i + 1]; q++) {
+            int r = fl->pos[in->con[q]], e = 0;
+            if (r < 0) /* not active */
+                continue;
+            double t = in->wr[q] * Pi * in->w[p];
+            while (e < nr && rows[e] != r)
+                e++;
+            if (e == nr) {
+                rows[nr] = r;
+                vals[nr++] = t;
+            } else {
+                vals[e] += t;
+            }
+        }
+    }
+    return nr;
 }
 
 /* D_II of the active set into mj->D_active (delassus: at level k, or with
  * M^-1 = diag(minv)): dense, or compressed columns with the contacts that
  * share a block (found through the dofs of each block a contact acts on). */
-void mj_flight_delassus(pd_mj *mj, int k, const double *minv, int nI)
+/* The rows of the active contacts on the blocks contact a touches (the
+ * nonzeros of its column of D), each once (stamps), into rows: their number. */
+static int column_rows(pd_mj *mj, int a, int *rows)
 {
     mj_flight *fl = mj->fl;
     const mj_incidence *in = &mj->inc;
+    unsigned stamp = ++fl->stamp;
+    int nr = 0;
+    for (int p = in->ptr[a]; p < in->ptr[a + 1]; p++) {
+        int bi = fl->block_of[in->dof[p]];
+        if (fl->touched[bi] == stamp)
+            continue;
+        fl->touched[bi] = stamp;
+        const fl_block *bl = &fl->blocks[bi];
+        for (int d = 0; d < bl->s; d++) {
+            int i = bl->dofs[d];
+            for (int q = in->dptr[i]; q < in->dptr[i + 1]; q++) {
+                int b = in->con[q];
+                if (fl->pos[b] < 0 || fl->cmark[b] == stamp)
+                    continue;
+                fl->cmark[b] = stamp;
+                rows[nr++] = fl->pos[b];
+            }
+        }
+    }
+    return nr;
+}
+
+void mj_flight_delassus(pd_mj *mj, int k, const double *minv, int nI)
+{
+    mj_flight *fl = mj->fl;
     for (int r = 0; r < nI; r++)
         fl->pos[mj->idx_active[r]] = r; /* each active contact's row */
     if (!mj->sparse) {
         /* D_rc = 0 unless r and c share a block */
-        for (int c = 0; c < nI; c++)
+        for (int c = 0; c < nI; c++) {
+            int a = mj->idx_active[c];
+            double *col = mj->D_active + (size_t)c * nI;
             for (int r = 0; r < nI; r++)
-                mj->D_active[r + (size_t)c * nI] =
-                    r == c || shares_block(mj, mj->idx_active[r], mj->idx_active[c])
-                        ? delassus(mj, k, minv, mj->idx_active[r], mj->idx_active[c])
-                        : 0.0;
+                col[r] = 0.0;
+            if (fl->sdofs) {
+                for (int e = 0, nr = sdof_column(mj, k, minv, a, fl->rows, fl->vals); e < nr; e++)
+                    col[fl->rows[e]] = fl->vals[e];
+                continue;
+            }
+            for (int e = 0, nr = column_rows(mj, a, fl->rows); e < nr; e++)
+                col[fl->rows[e]] = delassus(mj, k, minv, mj->idx_active[fl->rows[e]], a);
+        }
     } else {
         int nnz = 0;
         for (int c = 0; c < nI; c++) {
             int a = mj->idx_active[c], start = nnz;
-            /* column c: the active contacts on the blocks contact a
-             * touches, each block and each contact once (stamps) */
-            unsigned stamp = ++fl->stamp;
             mj->D_colptr[c] = nnz;
-            for (int p = in->ptr[a]; p < in->ptr[a + 1]; p++) {
-                int bi = fl->block_of[in->dof[p]];
-                if (fl->touched[bi] == stamp)
-                    continue;
-                fl->touched[bi] = stamp;
-                const fl_block *bl = &fl->blocks[bi];
-                for (int d = 0; d < bl->s; d++) {
-                    int i = bl->dofs[d];
-                    for (int q = in->dptr[i]; q < in->dptr[i + 1]; q++) {
-                        int b = in->con[q];
-                        if (fl->pos[b] < 0 || fl->cmark[b] == stamp)
-                            continue;
-                        fl->cmark[b] = stamp;
-                        mj->D_rowind[nnz++] = fl->pos[b];
-                    }
-                }
+            if (fl->sdofs) {
+                nnz += sdof_column(mj, k, minv, a, mj->D_rowind + start, mj->D_active + start);
+                /* rows increasing, as compressed columns have them */
+                sort_rows(mj->D_rowind + start, mj->D_active + start, nnz - start);
+                continue;
             }
-            /* rows increasing, as compressed columns have them */
-            qsort(mj->D_rowind + start, (size_t)(nnz - start), sizeof(int), cmp_int);
+            nnz += column_rows(mj, a, mj->D_rowind + start);
+            sort_rows(mj->D_rowind + start, NULL, nnz - start);
             for (int e = start; e < nnz; e++)
                 mj->D_active[e] = delassus(mj, k, minv, mj->idx_active[mj->D_rowind[e]], a);
         }
@@ -802,6 +894,19 @@ static void hold_gaps(pd_mj *mj, int nI, const pd_state *in, pd_state *out)
 void mj_flight_acc(const pd_mj *mj, const pd_state *st, const double *z, double *acc)
 {
     const mj_flight *fl = mj->fl;
+    if (fl->sdofs) { /* rows of SDOFs: the sums below with s = 1 */
+        for (int d = 0; d < mj->model->n; d++) {
+            const double *Av = fl->kinds[fl->kind_d[d]].Av;
+            double sum = 0.0;
+            sum += Av[0] * st->q[d] + Av[1] * st->v[d];
+            sum += Av[2] * z[0];
+            sum += Av[3] * z[1];
+            sum += Av[4] * z[2];
+            sum += Av[5] * z[3];
+            acc[d] = sum;
+        }
+        return;
+    }
     for (int b = 0; b < fl->nblocks; b++) {
         const fl_block *bl = &fl->blocks[b];
         const fl_kind *kd = &fl->kinds[bl->kind];
@@ -819,70 +924,104 @@ void mj_flight_acc(const pd_mj *mj, const pd_state *st, const double *z, double 
     }
 }
 
+/* z over level k (zout may be zin): the sinusoid turned by w h, (z0, z1)
+ * += (cos - 1) (z0, z1) + sin (z1, -z0); the line advanced. */
+static void z_turn(const mj_flight *fl, int k, const double *zin, double *zout)
+{
+    double z0 = zin[0], z1 = zin[1], z2 = zin[2], z3 = zin[3];
+    zout[0] = z0 + fl->cm1[k] * z0 + fl->sw[k] * z1;
+    zout[1] = z1 + fl->cm1[k] * z1 - fl->sw[k] * z0;
+    zout[2] = z2 + fl->h[k] * z3;
+    zout[3] = z3;
+}
+
+/* An SDOF kind's flight over levels lev[0..nlev) from the forcing's states
+ * zs (before each level) as one map x -> x + A x + c (A 2 x 2 by columns,
+ * then c, into Ac): level j's E = [Ex | Ez] takes x_j = (I + A_j) x_0 + c_j
+ * to x_j + Ex x_j + Ez z_j, so A_j+1 = A_j + Ex (I + A_j) and c_j+1 = c_j +
+ * Ex c_j + Ez z_j (increments: tiny steps stay exact). */
+static void sdof_compose(const double *E0, const int *lev, int nlev, const double *zs, double *Ac)
+{
+    double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0, c0 = 0.0, c1 = 0.0;
+    for (int j = 0; j < nlev; j++) {
+        const double *E = E0 + (size_t)lev[j] * 12, *z = zs + 4 * j;
+        double fz0 = E[4] * z[0] + E[6] * z[1] + E[8] * z[2] + E[10] * z[3];
+        double fz1 = E[5] * z[0] + E[7] * z[1] + E[9] * z[2] + E[11] * z[3];
+        /* Ex (I + A): columns (1 + a0, a1) and (a2, 1 + a3) */
+        double b0 = E[0] * (1.0 + a0) + E[2] * a1, b1 = E[1] * (1.0 + a0) + E[3] * a1;
+        double b2 = E[0] * a2 + E[2] * (1.0 + a3), b3 = E[1] * a2 + E[3] * (1.0 + a3);
+        double d0 = E[0] * c0 + E[2] * c1 + fz0, d1 = E[1] * c0 + E[3] * c1 + fz1;
+        a0 += b0;
+        a1 += b1;
+        a2 += b2;
+        a3 += b3;
+        c0 += d0;
+        c1 += d1;
+    }
+    Ac[0] = a0;
+    Ac[1] = a1;
+    Ac[2] = a2;
+    Ac[3] = a3;
+    Ac[4] = c0;
+    Ac[5] = c1;
+}
+
 /* The free flights of levels lev[0..nlev) in turn from in into out (no
  * contact): every block's, z turned by w h and its line advanced. */
 static void free_flights(const mj_flight *fl, const int *lev, int nlev, const pd_state *in,
                          const double *zin, pd_state *out, double *zout)
 {
-    if (fl->nblocks == 1 && fl->blocks[0].s == 1) { /* one SDOF: free_flight's sums, inline */
-        int d = fl->blocks[0].dofs[0];
-        const double *E0 = fl->kinds[fl->blocks[0].kind].E;
-        double q = in->q[d], v = in->v[d], z0 = zin[0], z1 = zin[1], z2 = zin[2], z3 = zin[3];
-        for (int j = 0; j < nlev; j++) {
-            int k = lev[j];
-            const double *E = E0 + (size_t)k * 12; /* 2 rows x 6 columns a level */
-            double dq = E[0] * q + E[2] * v + E[4] * z0 + E[6] * z1 + E[8] * z2 + E[10] * z3;
-            double dv = E[1] * q + E[3] * v + E[5] * z0 + E[7] * z1 + E[9] * z2 + E[11] * z3;
-            q += dq;
-            v += dv;
-            double y0 = z0 + fl->cm1[k] * z0 + fl->sw[k] * z1;
-            double y1 = z1 + fl->cm1[k] * z1 - fl->sw[k] * z0;
-            z0 = y0;
-            z1 = y1;
-            z2 = z2 + fl->h[k] * z3;
+    if (fl->sdofs) { /* rows of SDOFs: each kind's flight over the levels, then each dof */
+        double *zs = fl->zs;
+        for (int i = 0; i < 4; i++)
+            zs[i] = zin[i];
+        for (int j = 0; j < nlev; j++)
+            z_turn(fl, lev[j], zs + 4 * j, zs + 4 * (j + 1));
+        for (int c = 0; c < fl->nkinds; c++)
+            sdof_compose(fl->kinds[c].E, lev, nlev, zs, fl->Ac + 6 * c);
+        for (int d = 0; d < fl->nblocks; d++) {
+            const double *A = fl->Ac + 6 * fl->kind_d[d];
+            double q = in->q[d], v = in->v[d];
+            out->q[d] = q + (A[0] * q + A[2] * v + A[4]);
+            out->v[d] = v + (A[1] * q + A[3] * v + A[5]);
         }
-        out->q[d] = q;
-        out->v[d] = v;
-        zout[0] = z0;
-        zout[1] = z1;
-        zout[2] = z2;
-        zout[3] = z3;
+        for (int i = 0; i < 4; i++)
+            zout[i] = zs[4 * nlev + i];
         return;
     }
     for (int j = 0; j < nlev; j++) {
         int k = lev[j];
         for (int b = 0; b < fl->nblocks; b++)
             free_flight(fl, &fl->blocks[b], k, j ? out : in, j ? zout : zin, out);
-        /* z: the sinusoid turned by w h, (z0, z1) += (cos - 1)
-         * (z0, z1) + sin (z1, -z0); the line advanced */
-        double z0 = zin[0], z1 = zin[1], z2 = zin[2], z3 = zin[3];
-        zout[0] = z0 + fl->cm1[k] * z0 + fl->sw[k] * z1;
-        zout[1] = z1 + fl->cm1[k] * z1 - fl->sw[k] * z0;
-        zout[2] = z2 + fl->h[k] * z3;
-        zout[3] = z3;
+        z_turn(fl, k, zin, zout);
         zin = zout;
     }
 }
 
 /* The contacts shut at the start (within sim_gap) or at the free flight's
  * end, but for those the free flight opens, into mj->idx_active (their
- * guesses too); every gap at the end into out.  Returns their number. */
+ * guesses too), their U_k into mj->U0 (from in: out is another state);
+ * every gap at the end into out.  Returns their number. */
 static int shut_contacts(pd_mj *mj, const pd_state *in, pd_state *out)
 {
     const pd_model *md = mj->model;
     int nI = 0;
     for (int a = 0; a < md->m; a++) {
-        unsigned char was = in->active[a] ? in->P[a] > 0.0 : 2;
         double g_start = in->g[a], g_end = md->g0[a] + mj_inc_dot(&mj->inc, a, out->q);
         out->active[a] = 0;
         out->P[a] = 0.0;
         out->g[a] = g_end;
+        if (!(g_start <= mj->opts.sim_gap || g_end <= 0.0))
+            continue;
+        /* U_k of a shut contact (the impacts' restitution) */
+        mj->U0[a] = mj_inc_dot(&mj->inc, a, in->v);
         /* an opening contact (faster than u_rest) left open by the free flight
          * takes no impulse: if an impulse of this step makes it close, the
          * next step's is its own impact (the references' next stage) */
         /* opening: U_k above its rest speed, and the free flight did not close it */
         int opening = mj->U0[a] > mj->u_rest[a] && g_end >= g_start;
-        if ((g_start <= mj->opts.sim_gap || g_end <= 0.0) && !opening) {
+        if (!opening) {
+            unsigned char was = in->active[a] ? in->P[a] > 0.0 : 2;
             out->active[a] = 1;
             if (mj->guess)
                 mj->guess[nI] = was;
@@ -903,14 +1042,12 @@ static int check_finite(const pd_mj *mj, double t1, const pd_state *out, pd_err 
     return PD_OK;
 }
 
-/* The free flights of levels lev[0..nlev) from in into out ending at t1,
- * the contacts they shut (shut_contacts): their number. */
+/* The free flights of levels lev[0..nlev) from in into out (another
+ * state) ending at t1, the contacts they shut (shut_contacts): their
+ * number. */
 static int fly(pd_mj *mj, const int *lev, int nlev, double t1, const pd_state *in,
                const double *zin, pd_state *out, double *zout)
 {
-    /* U_k before the free flight overwrites v (out may be in) */
-    for (int a = 0; a < mj->model->m; a++)
-        mj->U0[a] = mj_inc_dot(&mj->inc, a, in->v);
     free_flights(mj->fl, lev, nlev, in, zin, out, zout);
     out->t = t1;
     out->step = in->step + 1;

@@ -53,15 +53,9 @@ double pd_demand_td(const pd_run_opts *o)
     return o && o->contact_duration > 0.0 ? o->contact_duration : PD_CONTACT_DURATION;
 }
 
-void pd_demand_eval(const pd_scene *sc, const double *x, const double *v, double us, double vs,
-                    double *a, double *V)
-{
-    for (int s = 0; s < sc->nstruct; s++)
-        pd_demand_eval_structure(&sc->st[s], x, v, us, vs, a, V);
-}
-
-void pd_demand_eval_structure(const pd_structure *st, const double *x, const double *v, double us,
-                              double vs, double *a, double *V)
+/* pd_demand_eval_structure's sums, inlined into pd_demand_eval's loop. */
+static inline void eval_structure(const pd_structure *st, const double *x, const double *v,
+                                  double us, double vs, double *a, double *V)
 {
     {
         const double *xs = x + st->dof, *vs_ = v + st->dof;
@@ -78,6 +72,19 @@ void pd_demand_eval_structure(const pd_structure *st, const double *x, const dou
             S_up = S;
         }
     }
+}
+
+void pd_demand_eval_structure(const pd_structure *st, const double *x, const double *v, double us,
+                              double vs, double *a, double *V)
+{
+    eval_structure(st, x, v, us, vs, a, V);
+}
+
+void pd_demand_eval(const pd_scene *sc, const double *x, const double *v, double us, double vs,
+                    double *a, double *V)
+{
+    for (int s = 0; s < sc->nstruct; s++)
+        eval_structure(&sc->st[s], x, v, us, vs, a, V);
 }
 
 void pd_demand_note(const pd_scene *sc, const double *x, const double *v, double us, double vs,

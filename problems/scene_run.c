@@ -391,19 +391,31 @@ static void held_from_forces(track *tr, const double *lam)
 /* The same from the accelerations acc (reference units, held forces in
  * them) of the state (x, v) at t: a_abs = ap (x'' - f(t)) with f = F_i / m_i
  * the excitation's (side: its limit at a jump), less the smooth part
- * -M^-1 (C u' + K u); zero when held is 0 (no contact held: rounding). */
-static void held_from_acc(track *tr, double t, int side, const double *x, const double *v,
-                          const double *acc, int held)
+ * -M^-1 (C u' + K u), evaluated into a (n) and tr->dV: returns 1 then;
+ * zero when held is 0 (no contact held: rounding), returns 0. */
+static int held_from_acc(track *tr, double t, int side, const double *x, const double *v,
+                         const double *acc, int held, double *a)
 {
     double us = tr->Le, vs = tr->Le * tr->wp, ap = tr->sc->exc.ap;
     if (!held || !acc || !tr->demands) {
         held_from_forces(tr, NULL);
-        return;
+        return 0;
     }
     double f = pd_osc_shape(tr->shape, t, side);
-    pd_demand_eval(tr->sc, x, v, us, vs, tr->hacc, tr->dV);
+    pd_demand_eval(tr->sc, x, v, us, vs, a, tr->dV);
     for (int i = 0; i < tr->n; i++)
-        tr->hacc[i] = ap * (acc[i] - f) - tr->hacc[i];
+        tr->hacc[i] = ap * (acc[i] - f) - a[i];
+    return 1;
+}
+
+/* 1 when the cubic Hermite through (f0, d0) and (f1, d1) over a step h > 0
+ * is monotone, so that no value inside it passes its ends: the rates on
+ * the secant's side, (d0^2 + d1^2) <= 9 m^2 with m = (f1 - f0) / h (Fritsch
+ * and Carlson's circle, inside the monotone region), times h^2. */
+static int cubic_monotone(double f0, double d0, double f1, double d1, double h)
+{
+    double df = f1 - f0;
+    return d0 * df >= 0.0 && d1 * df >= 0.0 && (d0 * d0 + d1 * d1) * (h * h) <= 9.0 * df * df;
 }
 
 /* The demands of the state (x, v) at t, inside the window, a_abs with the
@@ -411,18 +423,22 @@ static void held_from_acc(track *tr, double t, int side, const double *x, const 
  * accelerations acc (NULL: none), their peaks between it and the previous
  * state on the cubic Hermite of the values and rates, when the interval
  * was smooth (no impulse in it): the held part linear over the interval
- * (its rate the secant's), the rest with its exact rates. */
+ * (its rate the secant's), the rest with its exact rates.  evaluated: the
+ * smooth part of (x, v) is in tr->da and tr->dV already (held_from_acc). */
 static void note_demand(track *tr, double t, const double *x, const double *v, const double *acc,
-                        const double *held, int smooth)
+                        const double *held, int smooth, int evaluated)
 {
     double us = tr->Le, vs = tr->Le * tr->wp, as = vs * tr->wp;
     if (!tr->demands)
         return;
     if (t < tr->tau_measure - 0.5 * tr->h) {
         tr->dem_prev = 0;
+        if (evaluated) /* no demands before the window (the samples' a_abs 0) */
+            memset(tr->da, 0, (size_t)tr->n * sizeof(double));
         return;
     }
-    pd_demand_eval(tr->sc, x, v, us, vs, tr->da, tr->dV);
+    if (!evaluated)
+        pd_demand_eval(tr->sc, x, v, us, vs, tr->da, tr->dV);
     for (int i = 0; i < tr->n; i++) {
         tr->da[i] += held ? held[i] : 0.0;
         tr->acc[i] = pd_max(tr->acc[i], fabs(tr->da[i]));
@@ -435,18 +451,21 @@ static void note_demand(track *tr, double t, const double *x, const double *v, c
     pd_demand_eval(tr->sc, v, acc, vs, as, tr->dad, tr->dVd); /* the rates [1/s] */
     double h = (t - tr->dem_t) / tr->wp;
     /* the cubic's turns only where they could raise the peak: inside the step
-     * it strays from its ends by at most h (|d0| + |d1|) / 4 */
+     * it strays from its ends by at most h (|d0| + |d1|) / 4, and not at all
+     * where it is monotone (cubic_monotone) */
     if (tr->dem_prev && smooth && h > 0.0)
         for (int i = 0; i < tr->n; i++) {
             double hs = held ? (held[i] - tr->qh[i]) / h : -tr->qh[i] / h; /* the secant */
             double d0 = tr->qad[i] + hs, d1 = tr->dad[i] + hs;
             if (pd_max(fabs(tr->qa[i]), fabs(tr->da[i])) + 0.25 * h * (fabs(d0) + fabs(d1)) >
-                tr->acc[i])
+                    tr->acc[i] &&
+                !cubic_monotone(tr->qa[i], d0, tr->da[i], d1, h))
                 tr->acc[i] =
                     pd_max(tr->acc[i], pd_demand_cubic_peak(tr->qa[i], d0, tr->da[i], d1, h));
             if (pd_max(fabs(tr->qV[i]), fabs(tr->dV[i])) +
-                    0.25 * h * (fabs(tr->qVd[i]) + fabs(tr->dVd[i])) >
-                tr->shear[i])
+                        0.25 * h * (fabs(tr->qVd[i]) + fabs(tr->dVd[i])) >
+                    tr->shear[i] &&
+                !cubic_monotone(tr->qV[i], tr->qVd[i], tr->dV[i], tr->dVd[i], h))
                 tr->shear[i] = pd_max(tr->shear[i], pd_demand_cubic_peak(tr->qV[i], tr->qVd[i],
                                                                          tr->dV[i], tr->dVd[i], h));
         }
@@ -559,8 +578,11 @@ static void note_between(track *tr, double t, const double *x, const double *v, 
     if (!(h > 0.0) || t < tr->tau_measure)
         return;
     for (int i = 0; i < tr->n; i++) {
-        double p0[3] = {tr->px[i], tr->pv[i], tr->pa[i]}, p1[3] = {x[i], v[i], acc[i]};
         int b = tr->below[i];
+        /* a turn needs the rate's sign to change (pd_demand_quintic_turn's test) */
+        if (b < 0 && !(tr->pv[i] * v[i] < 0.0))
+            continue;
+        double p0[3] = {tr->px[i], tr->pv[i], tr->pa[i]}, p1[3] = {x[i], v[i], acc[i]};
         if (pd_demand_quintic_turn(p0, p1, h, &f)) {
             note_err(tr, i, 0, fabs(f), tr->xmax[i]);
             tr->xmax[i] = pd_max(tr->xmax[i], fabs(f));
@@ -755,7 +777,7 @@ static int observe_moreau(const pd_state *st, void *ctx)
     note_approach(tr, st->q);
     if (tr->demands)
         moreau_held(tr, st);
-    note_demand(tr, st->t, tr->xdem, st->v, NULL, tr->hacc, 0); /* the steps' own: as umax */
+    note_demand(tr, st->t, tr->xdem, st->v, NULL, tr->hacc, 0, 0); /* the steps' own: as umax */
     tr->lcp_solves += st->nactive > 0;
     for (int a = 0; a < tr->model_m; a++) {
         double P = st->P[a], U = gap_rate(tr, a, st->v);
@@ -794,9 +816,10 @@ static int observe_adapt(const pd_state *st, void *ctx)
     tr->err = st->err;
     for (int s = 0; s < tr->sc->nstruct; s++) {
         const pd_structure *ps = &tr->sc->st[s];
-        tr->serr[s] = 0.0;
+        double e = 0.0;
         for (int k = 0; k < ps->storeys; k++)
-            tr->serr[s] = pd_max(tr->serr[s], st->err[ps->dof + k]);
+            e = pd_max(e, st->err[ps->dof + k]);
+        tr->serr[s] = e;
     }
     if (tr->have_prev && st->has_acc && smooth)
         note_between(tr, st->t, st->q, st->v, st->acc);
@@ -809,8 +832,8 @@ static int observe_adapt(const pd_state *st, void *ctx)
     if (tr->demands && st->has_acc && !st->impact) {
         memcpy(tr->acc0, tr->acc, (size_t)tr->n * sizeof(double));
         memcpy(tr->shear0, tr->shear, (size_t)tr->n * sizeof(double));
-        held_from_acc(tr, st->t, -1, st->q, st->v, st->acc, !no_impulse(tr, st));
-        note_demand(tr, st->t, st->q, st->v, st->acc, tr->hacc, smooth && !tr->dem_skipped);
+        int ev = held_from_acc(tr, st->t, -1, st->q, st->v, st->acc, !no_impulse(tr, st), tr->da);
+        note_demand(tr, st->t, st->q, st->v, st->acc, tr->hacc, smooth && !tr->dem_skipped, ev);
         tr->dem_skipped = 0;
         for (int i = 0; i < tr->n; i++) {
             if (tr->acc[i] > tr->acc0[i])
@@ -841,7 +864,8 @@ static int observe_adapt(const pd_state *st, void *ctx)
         if (tr->demands && tr->dem_prev) {
             pd_demand_eval(tr->sc, st->v, st->acc_right, vs, as, tr->qad, tr->qVd);
             /* a_abs's right limit: the next interval's start, and a value it takes */
-            held_from_acc(tr, st->t, +1, st->q, st->v, st->acc_right, !no_impulse(tr, st));
+            held_from_acc(tr, st->t, +1, st->q, st->v, st->acc_right, !no_impulse(tr, st),
+                          tr->hacc);
             for (int i = 0; i < tr->n; i++) {
                 tr->qa[i] += tr->hacc[i] - tr->qh[i];
                 tr->qh[i] = tr->hacc[i];
@@ -861,9 +885,10 @@ static int step_event(const pd_state *st, void *ctx)
         note_between(tr, st->t, st->q, st->v, st->acc);
     note_point(tr, st->t, st->q);
     note_approach(tr, st->q);
-    held_from_acc(tr, st->t, -1, st->q, st->v, st->has_acc ? st->acc : NULL, st->nactive > 0);
-    note_demand(tr, st->t, st->q, st->v, st->has_acc ? st->acc : NULL, tr->hacc,
-                no_impulse(tr, st));
+    int ev = held_from_acc(tr, st->t, -1, st->q, st->v, st->has_acc ? st->acc : NULL,
+                           st->nactive > 0, tr->da);
+    note_demand(tr, st->t, st->q, st->v, st->has_acc ? st->acc : NULL, tr->hacc, no_impulse(tr, st),
+                ev);
     for (int a = 0; a < tr->model_m; a++) {
         double P = st->P[a];
         if (tr->pactive[a] && tr->have_prev)
@@ -910,7 +935,7 @@ static int step_penalty(const pd_state *st, void *ctx)
     if (tr->demands)
         penalty_held(tr, st);
     note_demand(tr, st->t, tr->xdem, st->v, st->has_acc ? st->acc : NULL,
-                tr->demands ? tr->hacc : NULL, no_element(tr, st));
+                tr->demands ? tr->hacc : NULL, no_element(tr, st), 0);
     for (int a = 0; a < tr->model_m; a++) {
         double dt = tr->have_prev ? st->t - tr->pt : 0.0;
         if (st->active[a])
@@ -1113,13 +1138,13 @@ static double demand_bound(const pd_structure *st, int k, double E, double w, do
     return (Sk + Sup + st->mass[k] * mv) / st->mass[k];
 }
 
-/* Each structure's estimate: its peaks' (umax, drift, a_abs and V per
- * storey) largest relative error; the largest over the structures. */
-static void structure_errors(const track *tr, pd_scene_result *res)
+/* Each structure's estimate into err_est (nstruct): its peaks' (umax,
+ * drift and, with demands, a_abs and V per storey) largest relative error;
+ * returns the largest over the structures. */
+static double structure_errors(const track *tr, int demands, double *err_est)
 {
     const pd_scene *sc = tr->sc;
-    double us = tr->Le, vs = tr->Le * tr->wp;
-    res->err_est_max = 0.0;
+    double us = tr->Le, vs = tr->Le * tr->wp, most = 0.0;
     for (int s = 0; s < sc->nstruct; s++) {
         const pd_structure *st = &sc->st[s];
         double e = 0.0, w = 0.0;
@@ -1131,14 +1156,15 @@ static void structure_errors(const track *tr, pd_scene_result *res)
                 e = pd_max(e, tr->errx[i] / tr->xmax[i]);
             if (tr->drift[i] > 0.0)
                 e = pd_max(e, tr->errd[i] / tr->drift[i]);
-            if (tr->demands && tr->acc[i] > 0.0)
+            if (demands && tr->acc[i] > 0.0)
                 e = pd_max(e, demand_bound(st, k, tr->erra[i], w, us, vs, 0) / tr->acc[i]);
-            if (tr->demands && tr->shear[i] > 0.0)
+            if (demands && tr->shear[i] > 0.0)
                 e = pd_max(e, demand_bound(st, k, tr->errv[i], w, us, vs, 1) / tr->shear[i]);
         }
-        res->err_est[s] = e;
-        res->err_est_max = pd_max(res->err_est_max, e);
+        err_est[s] = e;
+        most = pd_max(most, e);
     }
+    return most;
 }
 
 /* The coarsest step of a run to a tolerance [tau]: the shortest of the
@@ -1147,6 +1173,9 @@ static void structure_errors(const track *tr, pd_scene_result *res)
 #define SCENE_ADAPT_TRIES 3
 #define SCENE_ADAPT_LOOSE 4.0  /* the second pass: a tolerance this many times looser */
 #define SCENE_ADAPT_FLOOR 1e-3 /* errors below this share of a dof's static scale count as none */
+/* a tighter run whose displacements are within rtol must bring the
+ * estimate below this share of the last one's, or no other is tried */
+#define SCENE_ADAPT_STALL 0.5
 
 /* One run to the tolerance rtol, measured into tr; stats of the engine. */
 static int adapt_once(const pd_scene_model *sm, const pd_run_opts *o, double rtol,
@@ -1179,7 +1208,7 @@ static int adapt_once(const pd_scene_model *sm, const pd_run_opts *o, double rto
     res->factor = mo.pieces ? "blocks" : pd_mj_factor_name(mj);
     res->lcp_solver = pd_lcp_method_name(o->lcp_solver);
     pd_mj_free(mj);
-    structure_errors(tr, res);
+    res->err_est_max = structure_errors(tr, tr->demands, res->err_est);
     return rc;
 }
 
@@ -1197,16 +1226,17 @@ static void keep_peaks(const track *tr, double *buf)
  * SCENE_ADAPT_LOOSE = c times looser, p_c: the errors scale with the
  * tolerance (p_c - p* ~ c (p - p*)), so p - p* ~ |p - p_c| / (c - 1); it
  * sees what the local estimates cannot, errors carried and amplified from
- * structure to structure (docs/scheme.md).  Each structure's estimate is
- * the larger of the two. */
-static void second_pass(const track *tr, const double *loose, pd_scene_result *res)
+ * structure to structure (docs/scheme.md).  Each structure's estimate in
+ * err_est (its local one there) becomes the larger of the two (peaks
+ * umax, drift and, with demands, a_abs and V); returns the largest. */
+static double second_pass(const track *tr, const double *loose, int demands, double *err_est)
 {
     const pd_scene *sc = tr->sc;
     const double *cur[4] = {tr->xmax, tr->drift, tr->acc, tr->shear};
-    int kinds = tr->demands ? 4 : 2;
-    res->err_est_max = 0.0;
+    int kinds = demands ? 4 : 2;
+    double most = 0.0;
     for (int s = 0; s < sc->nstruct; s++) {
-        double e = res->err_est[s];
+        double e = err_est[s];
         for (int k = 0; k < sc->st[s].storeys; k++) {
             int i = sc->st[s].dof + k;
             for (int q = 0; q < kinds; q++)
@@ -1214,17 +1244,22 @@ static void second_pass(const track *tr, const double *loose, pd_scene_result *r
                     e = pd_max(e, fabs(cur[q][i] - loose[q * tr->n + i]) /
                                       ((SCENE_ADAPT_LOOSE - 1.0) * cur[q][i]));
         }
-        res->err_est[s] = e;
-        res->err_est_max = pd_max(res->err_est_max, e);
+        err_est[s] = e;
+        most = pd_max(most, e);
     }
+    return most;
 }
 
 /* Moreau–Jean to a tolerance on the scene's model: with two contacts or
  * more a second pass first, SCENE_ADAPT_LOOSE times looser; then runs at
  * rtol, repeated SCENE_ADAPT_LOOSE times tighter while the estimate exceeds
  * rtol (the run before is the next one's second pass; at most
- * SCENE_ADAPT_TRIES); the figures the last run's, the steps all runs'; a
- * sampler sees the last run, repeated for it (the same numbers). */
+ * SCENE_ADAPT_TRIES) and falls with the tolerance (a tighter run that
+ * leaves the displacements' part within rtol and the estimate above
+ * SCENE_ADAPT_STALL of the last: the demands' peaks do not converge with
+ * the tolerance, and no other run is tried); the figures
+ * the last run's, the steps all runs'; a sampler sees the last run,
+ * repeated for it (the same numbers). */
 static int run_moreau_adapt(const pd_scene_model *sm, const pd_run_opts *o, double tau_end,
                             track *tr, pd_scene_result *res, pd_err *err)
 {
@@ -1233,7 +1268,9 @@ static int run_moreau_adapt(const pd_scene_model *sm, const pd_run_opts *o, doub
     int npieces, rc, runs = 0, n = tr->n;
     if ((rc = pd_osc_pieces(&sm->shape, &pieces, &npieces, err)))
         return rc;
-    double *atol = malloc((size_t)n * 5 * sizeof(double)), *loose = atol + n;
+    /* atol (n), the last run's peaks (4 n), the displacements' estimates (nstruct) */
+    double *atol = malloc(((size_t)n * 5 + (size_t)sc->nstruct) * sizeof(double)),
+           *loose = atol + n, *sest = loose + 4 * (size_t)n;
     if (!atol) {
         free(pieces);
         return pd_err_set(err, PD_ENOMEM, "out of memory for the tolerances of %d dofs", n);
@@ -1252,7 +1289,7 @@ static int run_moreau_adapt(const pd_scene_model *sm, const pd_run_opts *o, doub
     pd_piecewise_force F = {.b = sm->mass, .pieces = pieces, .npieces = npieces};
     pd_scene_sampler fn = tr->fn;
     pd_mj_stats st;
-    double rtol = o->rtol;
+    double rtol = o->rtol, est_last = HUGE_VAL;
     long steps = 0, rejected = 0;
     /* contacts that share structures carry errors into each other and can
      * amplify them: the second pass, a run SCENE_ADAPT_LOOSE times looser */
@@ -1270,11 +1307,20 @@ static int run_moreau_adapt(const pd_scene_model *sm, const pd_run_opts *o, doub
         runs++;
         steps += res->steps;
         rejected += res->steps_rejected;
-        if (second && !rc)
-            second_pass(tr, loose, res);
+        /* the displacements' part of the estimate (umax, drift) */
+        double disp = structure_errors(tr, 0, sest);
+        if (second && !rc) {
+            res->err_est_max = second_pass(tr, loose, tr->demands, res->err_est);
+            disp = second_pass(tr, loose, 0, sest);
+        }
+        /* a tighter run that leaves the displacements within rtol and the
+         * estimate above SCENE_ADAPT_STALL of the last: the demands' peaks
+         * do not follow the tolerance, and no other run is tried */
+        int stall = disp <= o->rtol && res->err_est_max > SCENE_ADAPT_STALL * est_last;
         if (rc || st.budget_hit || res->err_est_max <= o->rtol || runs >= SCENE_ADAPT_TRIES ||
-            rtol / SCENE_ADAPT_LOOSE < PD_RTOL_MIN)
+            rtol / SCENE_ADAPT_LOOSE < PD_RTOL_MIN || stall)
             break;
+        est_last = res->err_est_max;
         /* again at a tighter tolerance: this run is the next one's looser pass */
         keep_peaks(tr, loose);
         rtol /= SCENE_ADAPT_LOOSE;
@@ -1313,8 +1359,8 @@ static int observe_edr(const pd_state *st, void *ctx)
     int held = 0;
     for (int a = 0; a < tr->model_m; a++)
         held |= st->active[a];
-    held_from_acc(tr, st->t, -1, st->q, st->v, st->has_acc ? st->acc : NULL, held);
-    note_demand(tr, st->t, st->q, st->v, st->has_acc ? st->acc : NULL, tr->hacc, smooth);
+    int ev = held_from_acc(tr, st->t, -1, st->q, st->v, st->has_acc ? st->acc : NULL, held, tr->da);
+    note_demand(tr, st->t, st->q, st->v, st->has_acc ? st->acc : NULL, tr->hacc, smooth, ev);
     if (!tr->fn)
         return 0;
     for (int a = 0; a < tr->model_m; a++) {
