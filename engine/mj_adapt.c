@@ -97,6 +97,7 @@ struct mj_adapt {
     long nmarked;      /* dofs marked for events so far */
     double *u_rest;    /* m: closing speeds without restitution (mj->u_rest) */
     double *u_tol, *G; /* m: the tolerance's rest speeds; |free gap acceleration| */
+    double *Gs;        /* m: the free gap accelerations at the kept state, W^T a_free */
     double *D0;        /* m: sum_i W_ia^2 / M_ii, a unit impulse's change of gap rate */
     double *lam;       /* m: each held contact's force at the kept state (held_forces) */
     int *push;         /* m: the contacts pushing at the kept state, increasing (keep) */
@@ -257,19 +258,19 @@ int mj_adapt_alloc(pd_mj *mj, pd_err *err)
     ad->lev = calloc((size_t)L + 1, sizeof *ad->lev);
     /* one element without pieces, so that NULL means out of memory */
     ad->piece_tick = calloc(ad->F ? (size_t)ad->F->npieces : 1, sizeof(uint64_t));
-    /* the dofs' and contacts' arrays in two blocks: 11 n + 5 max(m, 1) doubles, 3 n stamps */
+    /* the dofs' and contacts' arrays in two blocks: 11 n + 6 max(m, 1) doubles, 3 n stamps */
     double **nv[] = {&ad->E, &ad->S2,   &ad->Er,   &ad->eps,   &ad->rate, &ad->amp,
                      &ad->w, &ad->atol, &ad->minv, &ad->bound, &ad->hsum};
-    double **mv[] = {&ad->u_rest, &ad->D0, &ad->u_tol, &ad->G, &ad->lam};
+    double **mv[] = {&ad->u_rest, &ad->D0, &ad->u_tol, &ad->G, &ad->lam, &ad->Gs};
     unsigned **uv[] = {&ad->mark, &ad->evmark, &ad->timed};
     size_t nn = (size_t)n, mm = md->m > 0 ? (size_t)md->m : 1;
-    ad->dmem = calloc(11 * nn + 5 * mm, sizeof(double));
+    ad->dmem = calloc(11 * nn + 6 * mm, sizeof(double));
     ad->umem = calloc(3 * nn, sizeof(unsigned));
     ad->push = pd_malloc(md->m, sizeof(int));
     int bad = !ad->lev || !ad->piece_tick || !ad->dmem || !ad->umem || !ad->push;
     for (size_t k = 0; !bad && k < 11; k++)
         *nv[k] = ad->dmem + k * nn;
-    for (size_t k = 0; !bad && k < 5; k++)
+    for (size_t k = 0; !bad && k < 6; k++)
         *mv[k] = ad->dmem + 11 * nn + k * mm;
     for (size_t k = 0; !bad && k < 3; k++)
         *uv[k] = ad->umem + k * nn;
@@ -647,6 +648,9 @@ static int scan_impacts(pd_mj *mj, const snap *x, const snap *y, double h, doubl
     int cascade = 0;
     unsigned stamp = ++ad->stamp; /* this scan's significant impacts, per dof */
     for (int a = 0; a < md->m; a++) {
+        /* neither an impulse nor a gap closed past zero: nothing */
+        if (!(y->st.P[a] > 0.0) && !(x->st.g[a] > 0.0 && y->st.g[a] < 0.0))
+            continue;
         double jump = impact_jump(mj, a, x, y);
         /* open to past zero without an impulse: the penetration is the error */
         double missed =
@@ -720,7 +724,8 @@ static int scan_return(pd_mj *mj, snap *x, int a, double U0, double h)
     mj_adapt *ad = mj->ad;
     /* a root after an opening start needs G < 0 (g > 0, U0 >= 0), and one
      * before h needs g + G h^2 / 2 < 0 (U0 s >= 0) */
-    double G = gap_acc(mj, x, a), g = x->st.g[a];
+    /* G: at the kept state rest_speeds formed it */
+    double G = x == ad->cur ? ad->Gs[a] : gap_acc(mj, x, a), g = x->st.g[a];
     if (!(G < 0.0 && g + 0.5 * G * h * h < 0.0))
         return 0;
     double s = first_root(g, U0, G);
@@ -1068,6 +1073,7 @@ static void rest_speeds(pd_mj *mj, const snap *w, snap *x)
                         (self ? ad->hsum[i] - x->st.P[a] / x->st.h : ad->hsum[i]);
         }
         ad->u_tol[a] = isfinite(u) ? u : 0.0; /* no dof: none */
+        ad->Gs[a] = G;
         ad->G[a] = fabs(G) + held;
     }
 }

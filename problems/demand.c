@@ -57,6 +57,14 @@ double pd_demand_td(const pd_run_opts *o)
 static inline void eval_structure(const pd_structure *st, const double *x, const double *v,
                                   double us, double vs, double *a, double *V)
 {
+    if (st->storeys == 1) { /* an SDOF: the sums below with one floor */
+        int i = st->dof;
+        double S = st->stiffness[0] * (us * x[i] + st->beta * (vs * v[i]));
+        double mv = st->alpha * st->mass[0] * vs * v[i];
+        a[i] = -(S + mv) / st->mass[0];
+        V[i] = S + mv;
+        return;
+    }
     {
         const double *xs = x + st->dof, *vs_ = v + st->dof;
         double S_up = 0.0, mv_up = 0.0; /* S_k+1, alpha sum over floors above of m u' */

@@ -99,13 +99,12 @@ typedef struct track {
                                          last sample (its samples' P also hold the
                                          held contacts' force integrals) */
     /* Moreau-Jean to a tolerance: the engine's estimate at each peak's instant */
-    const double *err;     /* the state's estimate (NULL: none) */
-    double *errx, *errd;   /* n: at the umax, drift peaks */
-    double *erra, *errv;   /* n: the structure's largest at the a_abs, V peaks */
-    double *acc0, *shear0; /* n: the demand peaks before the state */
-    double *serr;          /* nstruct: the structure's largest estimate now */
-    double *wdof;          /* n: each dof's sqrt(K_ii / M_ii) (Pi units) */
-    int dem_skipped;       /* a state was left out of the demands since the last */
+    const double *err;   /* the state's estimate (NULL: none) */
+    double *errx, *errd; /* n: at the umax, drift peaks */
+    double *erra, *errv; /* n: the structure's largest at the a_abs, V peaks */
+    double *serr;        /* nstruct: the structure's largest estimate now */
+    double *wdof;        /* n: each dof's sqrt(K_ii / M_ii) (Pi units) */
+    int dem_skipped;     /* a state was left out of the demands since the last */
     /* yielding springs (the model's ns; their dofs, ratios and uy [Le] the model's) */
     int ns;
     const int *spring_dof;
@@ -217,16 +216,16 @@ void pd_scene_result_free(pd_scene_result *r)
 static void track_free(track *tr)
 {
     void *arrays[] = {
-        tr->below,     tr->dof_a,   tr->dof_b,    tr->xmax,  tr->xpos,     tr->xneg,    tr->drift,
-        tr->impacts,   tr->first,   tr->maxP,     tr->ctime, tr->approach, tr->episode, tr->g_prev,
-        tr->U_prev,    tr->U_prev2, tr->touching, tr->px,    tr->pv,       tr->pa,      tr->plam,
-        tr->pactive,   tr->sx,      tr->sv,       tr->sg,    tr->sP,       tr->imp,     tr->imp_lam,
-        tr->acc,       tr->shear,   tr->da,       tr->dV,    tr->fpeak,    tr->dad,     tr->dVd,
-        tr->qa,        tr->qV,      tr->qad,      tr->qVd,   tr->st_of,    tr->ex,      tr->ev,
-        tr->sI,        tr->sampled, tr->errx,     tr->errd,  tr->erra,     tr->errv,    tr->acc0,
-        tr->shear0,    tr->serr,    tr->wdof,     tr->hacc,  tr->qh,       tr->hlam,    tr->hsm,
-        tr->hJ,        tr->hG,      tr->hz,       tr->hw,    tr->hD,       tr->sheld,   tr->up,
-        tr->excursion, tr->onsets,  tr->slid,     tr->xeff,  tr->sup,      tr->sF};
+        tr->below,   tr->dof_a,   tr->dof_b,    tr->xmax,  tr->xpos,     tr->xneg,      tr->drift,
+        tr->impacts, tr->first,   tr->maxP,     tr->ctime, tr->approach, tr->episode,   tr->g_prev,
+        tr->U_prev,  tr->U_prev2, tr->touching, tr->px,    tr->pv,       tr->pa,        tr->plam,
+        tr->pactive, tr->sx,      tr->sv,       tr->sg,    tr->sP,       tr->imp,       tr->imp_lam,
+        tr->acc,     tr->shear,   tr->da,       tr->dV,    tr->fpeak,    tr->dad,       tr->dVd,
+        tr->qa,      tr->qV,      tr->qad,      tr->qVd,   tr->st_of,    tr->ex,        tr->ev,
+        tr->sI,      tr->sampled, tr->errx,     tr->errd,  tr->erra,     tr->errv,      tr->serr,
+        tr->wdof,    tr->hacc,    tr->qh,       tr->hlam,  tr->hsm,      tr->hJ,        tr->hG,
+        tr->hz,      tr->hw,      tr->hD,       tr->sheld, tr->up,       tr->excursion, tr->onsets,
+        tr->slid,    tr->xeff,    tr->sup,      tr->sF};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(arrays[k]);
     pd_lcp_solver_free(tr->hlcp);
@@ -252,11 +251,10 @@ static int track_alloc(track *tr, const pd_scene *sc, pd_err *err)
         !TA(tr->qV, n) || !TA(tr->qad, n) || !TA(tr->qVd, n) || !TA(tr->st_of, n) ||
         !TA(tr->ex, n) || !TA(tr->ev, n) || !TA(tr->sI, m) || !TA(tr->sampled, m) ||
         !TA(tr->errx, n) || !TA(tr->errd, n) || !TA(tr->erra, n) || !TA(tr->errv, n) ||
-        !TA(tr->acc0, n) || !TA(tr->shear0, n) || !TA(tr->serr, sc->nstruct) || !TA(tr->wdof, n) ||
-        !TA(tr->hacc, n) || !TA(tr->qh, n) || !TA(tr->hlam, m) || !TA(tr->hsm, n) ||
-        !TA(tr->hJ, m) || !TA(tr->hG, MJ_HELD_LCP) || !TA(tr->hz, MJ_HELD_LCP) ||
-        !TA(tr->hw, MJ_HELD_LCP) || !TA(tr->hD, MJ_HELD_LCP * MJ_HELD_LCP) ||
-        !TA(tr->sheld, sc->nstruct) || !TA(tr->sF, m)) {
+        !TA(tr->serr, sc->nstruct) || !TA(tr->wdof, n) || !TA(tr->hacc, n) || !TA(tr->qh, n) ||
+        !TA(tr->hlam, m) || !TA(tr->hsm, n) || !TA(tr->hJ, m) || !TA(tr->hG, MJ_HELD_LCP) ||
+        !TA(tr->hz, MJ_HELD_LCP) || !TA(tr->hw, MJ_HELD_LCP) ||
+        !TA(tr->hD, MJ_HELD_LCP * MJ_HELD_LCP) || !TA(tr->sheld, sc->nstruct) || !TA(tr->sF, m)) {
 #undef TA
         track_free(tr);
         return pd_err_set(err, PD_ENOMEM, "out of memory for tracking %d dofs", sc->n);
@@ -361,13 +359,17 @@ static void note_point(track *tr, double t, const double *x)
     if (t < tr->tau_measure - 0.5 * tr->h)
         return;
     for (int i = 0; i < tr->n; i++) {
-        double d = x[i] - (tr->below[i] >= 0 ? x[tr->below[i]] : 0.0);
-        note_err(tr, i, 0, fabs(x[i]), tr->xmax[i]);
-        note_err(tr, i, 1, fabs(d), tr->drift[i]);
-        tr->xmax[i] = pd_max(tr->xmax[i], fabs(x[i]));
+        double d = x[i] - (tr->below[i] >= 0 ? x[tr->below[i]] : 0.0), ax = fabs(x[i]);
+        if (ax > tr->xmax[i]) { /* raised: its estimate now (note_err) */
+            note_err(tr, i, 0, ax, tr->xmax[i]);
+            tr->xmax[i] = ax;
+        }
+        if (fabs(d) > tr->drift[i]) {
+            note_err(tr, i, 1, fabs(d), tr->drift[i]);
+            tr->drift[i] = fabs(d);
+        }
         tr->xpos[i] = pd_max(tr->xpos[i], x[i]);
         tr->xneg[i] = pd_max(tr->xneg[i], -x[i]);
-        tr->drift[i] = pd_max(tr->drift[i], fabs(d));
     }
 }
 
@@ -408,6 +410,16 @@ static int held_from_acc(track *tr, double t, int side, const double *x, const d
     return 1;
 }
 
+/* peak[i] = max(peak[i], p); a peak raised takes, in runs to a tolerance
+ * (tr->err), its structure's estimate now into err_at[i]. */
+static inline void raise_peak(track *tr, double *peak, double *err_at, int i, double p)
+{
+    double old = peak[i];
+    peak[i] = pd_max(old, p);
+    if (tr->err && peak[i] > old)
+        err_at[i] = tr->serr[tr->st_of[i]];
+}
+
 /* 1 when the cubic Hermite through (f0, d0) and (f1, d1) over a step h > 0
  * is monotone, so that no value inside it passes its ends: the rates on
  * the secant's side, (d0^2 + d1^2) <= 9 m^2 with m = (f1 - f0) / h (Fritsch
@@ -441,8 +453,8 @@ static void note_demand(track *tr, double t, const double *x, const double *v, c
         pd_demand_eval(tr->sc, x, v, us, vs, tr->da, tr->dV);
     for (int i = 0; i < tr->n; i++) {
         tr->da[i] += held ? held[i] : 0.0;
-        tr->acc[i] = pd_max(tr->acc[i], fabs(tr->da[i]));
-        tr->shear[i] = pd_max(tr->shear[i], fabs(tr->dV[i]));
+        raise_peak(tr, tr->acc, tr->erra, i, fabs(tr->da[i]));
+        raise_peak(tr, tr->shear, tr->errv, i, fabs(tr->dV[i]));
     }
     if (!acc) {
         tr->dem_prev = 0;
@@ -457,17 +469,17 @@ static void note_demand(track *tr, double t, const double *x, const double *v, c
         for (int i = 0; i < tr->n; i++) {
             double hs = held ? (held[i] - tr->qh[i]) / h : -tr->qh[i] / h; /* the secant */
             double d0 = tr->qad[i] + hs, d1 = tr->dad[i] + hs;
-            if (pd_max(fabs(tr->qa[i]), fabs(tr->da[i])) + 0.25 * h * (fabs(d0) + fabs(d1)) >
-                    tr->acc[i] &&
-                !cubic_monotone(tr->qa[i], d0, tr->da[i], d1, h))
-                tr->acc[i] =
-                    pd_max(tr->acc[i], pd_demand_cubic_peak(tr->qa[i], d0, tr->da[i], d1, h));
-            if (pd_max(fabs(tr->qV[i]), fabs(tr->dV[i])) +
+            if (!cubic_monotone(tr->qa[i], d0, tr->da[i], d1, h) &&
+                pd_max(fabs(tr->qa[i]), fabs(tr->da[i])) + 0.25 * h * (fabs(d0) + fabs(d1)) >
+                    tr->acc[i])
+                raise_peak(tr, tr->acc, tr->erra, i,
+                           pd_demand_cubic_peak(tr->qa[i], d0, tr->da[i], d1, h));
+            if (!cubic_monotone(tr->qV[i], tr->qVd[i], tr->dV[i], tr->dVd[i], h) &&
+                pd_max(fabs(tr->qV[i]), fabs(tr->dV[i])) +
                         0.25 * h * (fabs(tr->qVd[i]) + fabs(tr->dVd[i])) >
-                    tr->shear[i] &&
-                !cubic_monotone(tr->qV[i], tr->qVd[i], tr->dV[i], tr->dVd[i], h))
-                tr->shear[i] = pd_max(tr->shear[i], pd_demand_cubic_peak(tr->qV[i], tr->qVd[i],
-                                                                         tr->dV[i], tr->dVd[i], h));
+                    tr->shear[i])
+                raise_peak(tr, tr->shear, tr->errv, i,
+                           pd_demand_cubic_peak(tr->qV[i], tr->qVd[i], tr->dV[i], tr->dVd[i], h));
         }
     size_t bytes = (size_t)tr->n * sizeof(double);
     memcpy(tr->qa, tr->da, bytes);
@@ -830,17 +842,9 @@ static int observe_adapt(const pd_state *st, void *ctx)
      * completes (the impact's outcome is the next state's, a step the
      * controller made short) */
     if (tr->demands && st->has_acc && !st->impact) {
-        memcpy(tr->acc0, tr->acc, (size_t)tr->n * sizeof(double));
-        memcpy(tr->shear0, tr->shear, (size_t)tr->n * sizeof(double));
         int ev = held_from_acc(tr, st->t, -1, st->q, st->v, st->acc, !no_impulse(tr, st), tr->da);
         note_demand(tr, st->t, st->q, st->v, st->acc, tr->hacc, smooth && !tr->dem_skipped, ev);
         tr->dem_skipped = 0;
-        for (int i = 0; i < tr->n; i++) {
-            if (tr->acc[i] > tr->acc0[i])
-                tr->erra[i] = tr->serr[tr->st_of[i]];
-            if (tr->shear[i] > tr->shear0[i])
-                tr->errv[i] = tr->serr[tr->st_of[i]];
-        }
     } else if (tr->demands) {
         tr->dem_skipped = 1;
     }
