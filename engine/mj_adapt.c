@@ -1194,8 +1194,10 @@ static void step_accelerations(pd_mj *mj, snap *x)
 {
     size_t bytes = (size_t)mj->model->n * sizeof(double);
     x->st.has_acc = 1;
+    mj_flight_acc(mj, &x->st, x->z, x->af); /* anew: the held gaps may have moved q */
+    x->af_ok = 1;
     x->st.acc_right = x->switched ? x->accr : x->st.acc;
-    memcpy((double *)x->st.acc_right, free_accs(mj, x), bytes);
+    memcpy((double *)x->st.acc_right, x->af, bytes);
     /* one held set and block for both limits (none when no contact pushed) */
     int nH = mj->ad->npush == 0 ? 0 : held_set(mj, x);
     held_forces(mj, x, nH, x->af);
@@ -1270,10 +1272,9 @@ static void hold_gaps(pd_mj *mj, const snap *w, snap *x)
                 x->st.q[in->dof[j]] += ad->minv[in->dof[j]] * in->w[j] * d / D0;
             moved = 1;
         }
-    /* the moved state's gaps; its accelerations anew */
+    /* the moved state's gaps */
     for (int a = 0; moved && a < md->m; a++)
         x->st.g[a] = md->g0[a] + mj_inc_dot(in, a, x->st.q);
-    x->af_ok &= !moved;
 }
 
 static int keep(pd_mj *mj, const snap *w, snap *x, double f, int events, pd_observer observer,

@@ -674,16 +674,6 @@ static double delassus(const pd_mj *mj, int k, const double *minv, int a, int b)
     const mj_flight *fl = mj->fl;
     const mj_incidence *in = &mj->inc;
     double sum = 0.0;
-    if (fl->sdofs) { /* rows of SDOFs: the sums below over shared dofs, PV_k a scalar */
-        for (int p = in->ptr[a]; p < in->ptr[a + 1]; p++) {
-            int i = in->dof[p];
-            double Pi = minv ? minv[i] : fl->kinds[fl->kind_d[i]].PV[k];
-            for (int q = in->ptr[b]; q < in->ptr[b + 1]; q++)
-                if (in->dof[q] == i)
-                    sum += in->w[p] * Pi * in->w[q];
-        }
-        return sum;
-    }
     for (int p = in->ptr[a]; p < in->ptr[a + 1]; p++) {
         int i = in->dof[p], bi = fl->block_of[i];
         const fl_block *bl = &fl->blocks[bi];
@@ -899,10 +889,9 @@ void mj_flight_acc(const pd_mj *mj, const pd_state *st, const double *z, double 
             const double *Av = fl->kinds[fl->kind_d[d]].Av;
             double sum = 0.0;
             sum += Av[0] * st->q[d] + Av[1] * st->v[d];
+            /* f = z0 + z2: z1 and z3 (Av[3], Av[5] = 0) add nothing */
             sum += Av[2] * z[0];
-            sum += Av[3] * z[1];
             sum += Av[4] * z[2];
-            sum += Av[5] * z[3];
             acc[d] = sum;
         }
         return;

@@ -146,6 +146,13 @@ double pd_demand_cubic_peak(double f0, double d0, double f1, double d1, double h
     return peak;
 }
 
+/* alpha = d0 / m, beta = d1 / m >= 0 and alpha^2 + beta^2 <= 9, times m^2 h^2. */
+int pd_demand_cubic_monotone(double f0, double d0, double f1, double d1, double h)
+{
+    double df = f1 - f0;
+    return d0 * df >= 0.0 && d1 * df >= 0.0 && (d0 * d0 + d1 * d1) * (h * h) <= 9.0 * df * df;
+}
+
 void pd_demand_osc_note(pd_demand_osc *d, double tau, double x, double v, const double *a,
                         double lam, int smooth)
 {

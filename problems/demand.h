@@ -31,6 +31,14 @@ void pd_demand_note(const pd_scene *sc, const double *x, const double *v, double
  * has none there): a peak of a demand between two states. */
 double pd_demand_cubic_peak(double f0, double d0, double f1, double d1, double h);
 
+/* 1 when the cubic Hermite with values f0, f1 and slopes d0, d1 at the
+ * ends of a step h > 0 is monotone, so that no value inside passes its
+ * ends: the slopes on the secant m = (f1 - f0) / h's side with d0^2 + d1^2
+ * <= 9 m^2 (Fritsch and Carlson's circle, inside the region where it is
+ * monotone); 0 otherwise (it may still be).  A demand's peak between two
+ * states needs pd_demand_cubic_peak only where this says 0. */
+int pd_demand_cubic_monotone(double f0, double d0, double f1, double d1, double h);
+
 /* A turning point of f inside a step of length h: when f' changes sign
  * between its ends, the root of f' on the quintic Hermite of (f, f', f'')
  * = p0 at the start and p1 at the end (Illinois steps to 1e-12 of the step); *f gets the

@@ -420,16 +420,6 @@ static inline void raise_peak(track *tr, double *peak, double *err_at, int i, do
         err_at[i] = tr->serr[tr->st_of[i]];
 }
 
-/* 1 when the cubic Hermite through (f0, d0) and (f1, d1) over a step h > 0
- * is monotone, so that no value inside it passes its ends: the rates on
- * the secant's side, (d0^2 + d1^2) <= 9 m^2 with m = (f1 - f0) / h (Fritsch
- * and Carlson's circle, inside the monotone region), times h^2. */
-static int cubic_monotone(double f0, double d0, double f1, double d1, double h)
-{
-    double df = f1 - f0;
-    return d0 * df >= 0.0 && d1 * df >= 0.0 && (d0 * d0 + d1 * d1) * (h * h) <= 9.0 * df * df;
-}
-
 /* The demands of the state (x, v) at t, inside the window, a_abs with the
  * held contact forces' part held (n, SI; NULL: none); with its
  * accelerations acc (NULL: none), their peaks between it and the previous
@@ -464,17 +454,17 @@ static void note_demand(track *tr, double t, const double *x, const double *v, c
     double h = (t - tr->dem_t) / tr->wp;
     /* the cubic's turns only where they could raise the peak: inside the step
      * it strays from its ends by at most h (|d0| + |d1|) / 4, and not at all
-     * where it is monotone (cubic_monotone) */
+     * where it is monotone (pd_demand_cubic_monotone) */
     if (tr->dem_prev && smooth && h > 0.0)
         for (int i = 0; i < tr->n; i++) {
             double hs = held ? (held[i] - tr->qh[i]) / h : -tr->qh[i] / h; /* the secant */
             double d0 = tr->qad[i] + hs, d1 = tr->dad[i] + hs;
-            if (!cubic_monotone(tr->qa[i], d0, tr->da[i], d1, h) &&
+            if (!pd_demand_cubic_monotone(tr->qa[i], d0, tr->da[i], d1, h) &&
                 pd_max(fabs(tr->qa[i]), fabs(tr->da[i])) + 0.25 * h * (fabs(d0) + fabs(d1)) >
                     tr->acc[i])
                 raise_peak(tr, tr->acc, tr->erra, i,
                            pd_demand_cubic_peak(tr->qa[i], d0, tr->da[i], d1, h));
-            if (!cubic_monotone(tr->qV[i], tr->qVd[i], tr->dV[i], tr->dVd[i], h) &&
+            if (!pd_demand_cubic_monotone(tr->qV[i], tr->qVd[i], tr->dV[i], tr->dVd[i], h) &&
                 pd_max(fabs(tr->qV[i]), fabs(tr->dV[i])) +
                         0.25 * h * (fabs(tr->qVd[i]) + fabs(tr->dVd[i])) >
                     tr->shear[i])

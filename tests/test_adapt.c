@@ -213,6 +213,64 @@ static void test_adapt_compressed_cluster(pd_test_ctx *ctx)
     pd_scene_free(sc);
 }
 
+/* A row of four SDOFs between walls whose contacts are listed out of their
+ * order along the row (S3-S4, S1-S2, wall-S1, S2-S3, S4-wall): a Delassus
+ * column's rows are found out of order and sorted for compressed columns
+ * (mj_flight.c, sort_rows).  To R = 1e-4 on CHOLMOD's compressed blocks and
+ * on dense ones the peaks agree to 1e-9 of the largest umax (the two LCP
+ * paths round apart, the decisions alike), both within R of the exact row
+ * reference. */
+static void test_adapt_contacts_out_of_order(pd_test_ctx *ctx)
+{
+    pd_scene_excitation x = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 4.0, .Tp = 0.6};
+    pd_scene *sc = pd_scene_new(&x);
+    pd_scene_result ref = {0}, r[2] = {{0}, {0}};
+    pd_err err;
+    int rc = !sc || pd_scene_add_sdof(sc, "S1", 0.3, 0.05, 1e5, &err) ||
+             pd_scene_add_sdof(sc, "S2", 0.5, 0.05, 2e5, &err) ||
+             pd_scene_add_sdof(sc, "S3", 0.4, 0.02, 1.5e5, &err) ||
+             pd_scene_add_sdof(sc, "S4", 0.6, 0.05, 1e5, &err) ||
+             pd_scene_add_contact(sc, 2, 1, 3, 1, 0.006, 0.5, 0, &err) ||
+             pd_scene_add_contact(sc, 0, 1, 1, 1, 0.004, 0.6, 1, &err) ||
+             pd_scene_add_contact(sc, PD_WALL, 0, 0, 1, 0.01, 0.4, 2, &err) ||
+             pd_scene_add_contact(sc, 1, 1, 2, 1, 0.005, 0.5, 3, &err) ||
+             pd_scene_add_contact(sc, 3, 1, PD_WALL, 0, 0.012, 0.7, 4, &err) ||
+             pd_scene_finish(sc, &err) || pd_scene_result_alloc(sc, &ref, &err) ||
+             pd_scene_result_alloc(sc, &r[0], &err) || pd_scene_result_alloc(sc, &r[1], &err);
+    if (CHECK(ctx, !rc, "scene: %s", err.msg)) {
+        sc->tend = 3.0;
+        pd_run_opts o = pd_run_default_opts();
+        o.method = PD_METHOD_EVENT;
+        rc = pd_scene_run(sc, &o, NULL, NULL, &ref, &err);
+        long impacts = 0;
+        for (int a = 0; a < sc->ncontact; a++)
+            impacts += ref.impacts[a];
+        CHECK(ctx, rc == PD_OK && impacts > 10, "reference: %s (%ld impacts)", rc ? err.msg : "ok",
+              impacts);
+        const pd_factor_kind kinds[2] = {PD_FACTOR_DENSE, PD_FACTOR_CHOLMOD};
+        for (int k = 0; k < 2 && !rc; k++) {
+            o.method = PD_METHOD_MOREAU;
+            o.rtol = 1e-4;
+            o.factor = kinds[k];
+            rc = pd_scene_run(sc, &o, NULL, NULL, &r[k], &err);
+            double e = rc ? NAN : umax_error(sc, &r[k], &ref);
+            CHECK(ctx, rc == PD_OK && e <= o.rtol, "%s: umax error %.3g (%s)",
+                  pd_factor_kind_name(kinds[k]), e, rc ? err.msg : "ok");
+        }
+        double um = 0.0, d = 0.0;
+        for (int i = 0; i < sc->n && !rc; i++) {
+            um = fmax(um, r[0].umax[i]);
+            d = fmax(d, fabs(r[0].umax[i] - r[1].umax[i]));
+        }
+        CHECK(ctx, !rc && d <= 1e-9 * um, "dense and compressed Delassus blocks: umax %.3g apart",
+              d);
+    }
+    pd_scene_result_free(&ref);
+    pd_scene_result_free(&r[0]);
+    pd_scene_result_free(&r[1]);
+    pd_scene_free(sc);
+}
+
 /* a_abs of --chain N (the docs' row with restitution eps) to rtol 1e-2,
  * 1e-3, 1e-4 against the exact reference: each structure's within tol_a,
  * the worst umax within R. */
@@ -887,6 +945,7 @@ void suite_adapt(pd_test_ctx *ctx)
     PD_RUN(ctx, test_adapt_one_wall_reliability);
     PD_RUN(ctx, test_adapt_rows_reliability);
     PD_RUN(ctx, test_adapt_compressed_cluster);
+    PD_RUN(ctx, test_adapt_contacts_out_of_order);
     PD_RUN(ctx, test_adapt_record);
     PD_RUN(ctx, test_adapt_held_forces);
     PD_RUN(ctx, test_adapt_engine_contract);

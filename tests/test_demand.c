@@ -636,6 +636,82 @@ static void test_demand_cubic_peak(pd_test_ctx *ctx)
     CHECK(ctx, got == 0.0, "monotone cubic: peak %.17g, expected 0", got);
 }
 
+/* The cubic Hermite with values f0, f1 and slopes d0, d1 on [0, h] at s. */
+static double hermite3(double f0, double d0, double f1, double d1, double h, double s)
+{
+    double t = s / h, t2 = t * t, t3 = t2 * t;
+    return (2.0 * t3 - 3.0 * t2 + 1.0) * f0 + (t3 - 2.0 * t2 + t) * h * d0 +
+           (-2.0 * t3 + 3.0 * t2) * f1 + (t3 - t2) * h * d1;
+}
+
+/* pd_demand_cubic_monotone (Fritsch and Carlson's circle) against the
+ * cubic sampled densely and against pd_demand_cubic_peak:
+ *   - 2000 seeded cubics with alpha = d0 / m, beta = d1 / m drawn in the
+ *     circle's quarter (m the secant, of either sign): it says monotone,
+ *     and no sample of 400 inside passes the ends by more than rounding
+ *     (1e-12 of |f0| + |f1| + |h m|), nor does pd_demand_cubic_peak find a
+ *     turn above them — what lets the observers skip the peak there;
+ *   - 2000 cubics with slopes anywhere in [-6 m, 6 m]: whenever a sample
+ *     passes the ends by more than rounding it said not monotone (no peak
+ *     skipped);
+ *   - exact edges: alpha = 3, beta = 0 and alpha = 0, beta = 3 (on the
+ *     circle, monotone: yes), alpha = beta = 2.2 (outside: no, though
+ *     monotone), a slope against the secant (no), a constant (yes). */
+static void test_demand_cubic_monotone(pd_test_ctx *ctx)
+{
+    uint64_t seed = 20261130;
+    int said_no = 0, passed = 0, peak_above = 0, skipped = 0, overshoots = 0;
+    for (int k = 0; k < 4000; k++) {
+        int inside = k < 2000;
+        double h = 0.01 + pd_test_uniform(&seed), f0 = 4.0 * pd_test_uniform(&seed) - 2.0;
+        double m = (pd_test_uniform(&seed) < 0.5 ? -1.0 : 1.0) * (0.1 + pd_test_uniform(&seed));
+        double al, be;
+        if (inside) { /* in the quarter circle of radius 3 */
+            double r = 3.0 * sqrt(pd_test_uniform(&seed)), th = 1.5707963 * pd_test_uniform(&seed);
+            al = r * cos(th);
+            be = r * sin(th);
+        } else {
+            al = 12.0 * pd_test_uniform(&seed) - 6.0;
+            be = 12.0 * pd_test_uniform(&seed) - 6.0;
+        }
+        double f1 = f0 + m * h, d0 = al * m, d1 = be * m;
+        int mono = pd_demand_cubic_monotone(f0, d0, f1, d1, h);
+        double hi = fmax(f0, f1), lo = fmin(f0, f1),
+               room = 1e-12 * (fabs(f0) + fabs(f1) + fabs(h * m));
+        int passes = 0;
+        for (int j = 1; j < 400; j++) {
+            double p = hermite3(f0, d0, f1, d1, h, h * j / 400.0);
+            passes |= p > hi + room || p < lo - room;
+        }
+        if (inside) {
+            said_no += !mono;
+            passed += passes;
+            peak_above += pd_demand_cubic_peak(f0, d0, f1, d1, h) > fmax(fabs(f0), fabs(f1)) + room;
+        } else {
+            overshoots += passes;
+            skipped += passes && mono;
+        }
+    }
+    CHECK(ctx, said_no == 0 && passed == 0 && peak_above == 0,
+          "inside the circle: %d said not monotone, %d passed their ends, %d with a peak "
+          "above them (of 2000)",
+          said_no, passed, peak_above);
+    CHECK(ctx, overshoots > 100 && skipped == 0,
+          "slopes anywhere: %d of 2000 pass their ends, %d of them said monotone", overshoots,
+          skipped);
+    /* the edges, exact in doubles: f 0 -> 1 on h = 1, m = 1 */
+    CHECK(ctx,
+          pd_demand_cubic_monotone(0.0, 3.0, 1.0, 0.0, 1.0) == 1 &&
+              pd_demand_cubic_monotone(0.0, 0.0, 1.0, 3.0, 1.0) == 1 &&
+              pd_demand_cubic_monotone(2.0, 0.0, 2.0, 0.0, 0.5) == 1,
+          "on the circle and constant: monotone");
+    CHECK(ctx,
+          pd_demand_cubic_monotone(0.0, 2.2, 1.0, 2.2, 1.0) == 0 &&
+              pd_demand_cubic_monotone(0.0, -0.5, 1.0, 1.0, 1.0) == 0 &&
+              pd_demand_cubic_monotone(1.0, 0.5, 0.0, -1.0, 1.0) == 0,
+          "outside the circle, or a slope against the secant: not said monotone");
+}
+
 void suite_demand(pd_test_ctx *ctx)
 {
     PD_RUN(ctx, test_demand_sdof_closed_form);
@@ -648,4 +724,5 @@ void suite_demand(pd_test_ctx *ctx)
     PD_RUN(ctx, test_demand_storey_heights);
     PD_RUN(ctx, test_demand_cli_refusals);
     PD_RUN(ctx, test_demand_cubic_peak);
+    PD_RUN(ctx, test_demand_cubic_monotone);
 }
