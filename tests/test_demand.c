@@ -636,6 +636,46 @@ static void test_demand_cubic_peak(pd_test_ctx *ctx)
     CHECK(ctx, got == 0.0, "monotone cubic: peak %.17g, expected 0", got);
 }
 
+/* An SDOF's base shear is its inertia: V = k u + c u' = -m a_abs at every
+ * instant (Rayleigh damping, its mass part included), so its peaks are
+ * shear_max = m acc_max to rounding whatever the method, the steps or the
+ * cubic interpolation between them (the rates obey the same identity).  Two
+ * SDOFs (different masses, periods, damping) in a scene whose contacts
+ * never close (gaps of a metre): Moreau–Jean at fixed steps, to rtol 1e-4,
+ * and the exact reference, 1e-12 relative. */
+static void test_demand_sdof_scene_shear(pd_test_ctx *ctx)
+{
+    pd_scene_excitation x = {.pulse = PD_PULSE_SINE, .dir = 1, .ap = 3.0, .Tp = 0.7};
+    pd_scene *sc = pd_scene_new(&x);
+    const double mass[2] = {1.2e5, 3e5};
+    pd_scene_result r = {0};
+    pd_err e;
+    int rc = !sc || pd_scene_add_sdof(sc, "S1", 0.45, 0.05, mass[0], &e) ||
+             pd_scene_add_sdof(sc, "S2", 0.8, 0.02, mass[1], &e) ||
+             pd_scene_add_contact(sc, PD_WALL, 0, 0, 1, 1.0, 0.5, 0, &e) ||
+             pd_scene_add_contact(sc, 0, 1, 1, 1, 1.0, 0.5, 1, &e) || pd_scene_finish(sc, &e) ||
+             pd_scene_result_alloc(sc, &r, &e);
+    if (CHECK(ctx, !rc, "scene: %s", sc ? e.msg : "out of memory")) {
+        const pd_method methods[3] = {PD_METHOD_MOREAU, PD_METHOD_MOREAU, PD_METHOD_EVENT};
+        for (int k = 0; k < 3; k++) {
+            pd_run_opts o = pd_run_default_opts();
+            o.method = methods[k];
+            o.rtol = k == 1 ? 1e-4 : 0.0;
+            o.tend = 2.0;
+            if (!CHECK(ctx, pd_scene_run(sc, &o, NULL, NULL, &r, &e) == PD_OK, "%s", e.msg))
+                continue;
+            for (int s = 0; s < 2; s++) {
+                double want = mass[s] * r.acc_max[s];
+                CHECK(ctx, want > 0.0 && fabs(r.shear_max[s] - want) <= 1e-12 * want,
+                      "run %d, S%d: shear_max %.17g, m acc_max %.17g", k, s + 1, r.shear_max[s],
+                      want);
+            }
+        }
+    }
+    pd_scene_result_free(&r);
+    pd_scene_free(sc);
+}
+
 /* The cubic Hermite with values f0, f1 and slopes d0, d1 on [0, h] at s. */
 static double hermite3(double f0, double d0, double f1, double d1, double h, double s)
 {
@@ -725,4 +765,5 @@ void suite_demand(pd_test_ctx *ctx)
     PD_RUN(ctx, test_demand_cli_refusals);
     PD_RUN(ctx, test_demand_cubic_peak);
     PD_RUN(ctx, test_demand_cubic_monotone);
+    PD_RUN(ctx, test_demand_sdof_scene_shear);
 }
