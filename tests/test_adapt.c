@@ -167,6 +167,23 @@ static void test_adapt_rows_reliability(pd_test_ctx *ctx)
         check_tally(ctx, "rows", &t[k], adapt_rtols[k]);
 }
 
+/* The exact row reference of sc into ref, checked to take more than
+ * min_impacts impacts: its status. */
+static int scene_reference(pd_test_ctx *ctx, const pd_scene *sc, long min_impacts,
+                           pd_scene_result *ref)
+{
+    pd_run_opts o = pd_run_default_opts();
+    pd_err err;
+    o.method = PD_METHOD_EVENT;
+    int rc = pd_scene_run(sc, &o, NULL, NULL, ref, &err);
+    long impacts = 0;
+    for (int a = 0; !rc && a < sc->ncontact; a++)
+        impacts += ref->impacts[a];
+    CHECK(ctx, rc == PD_OK && impacts > min_impacts, "reference: %s (%ld impacts)",
+          rc ? err.msg : "ok", impacts);
+    return rc;
+}
+
 /* A compressed cluster: stiff S1 (0.234 s) on a wall, S2 (1.36 s) and S3
  * (0.81 s) behind it, eps 0.08, 0.08, 0.71, a cosine pulse (4.18 m/s^2,
  * 0.89 s): the wall, S1 and S2 close near t = 0.42-0.50 s in cascades of
@@ -191,13 +208,7 @@ static void test_adapt_compressed_cluster(pd_test_ctx *ctx)
     if (CHECK(ctx, !rc, "scene: %s", err.msg)) {
         sc->tend = 4.5;
         pd_run_opts o = pd_run_default_opts();
-        o.method = PD_METHOD_EVENT;
-        rc = pd_scene_run(sc, &o, NULL, NULL, &ref, &err);
-        long impacts = 0;
-        for (int a = 0; a < sc->ncontact; a++)
-            impacts += ref.impacts[a];
-        CHECK(ctx, rc == PD_OK && impacts > 15, "reference: %s (%ld impacts)", rc ? err.msg : "ok",
-              impacts);
+        rc = scene_reference(ctx, sc, 15, &ref);
         for (int k = 0; k < ADAPT_NR && !rc; k++) {
             o.method = PD_METHOD_MOREAU;
             o.rtol = adapt_rtols[k];
@@ -240,13 +251,7 @@ static void test_adapt_contacts_out_of_order(pd_test_ctx *ctx)
     if (CHECK(ctx, !rc, "scene: %s", err.msg)) {
         sc->tend = 3.0;
         pd_run_opts o = pd_run_default_opts();
-        o.method = PD_METHOD_EVENT;
-        rc = pd_scene_run(sc, &o, NULL, NULL, &ref, &err);
-        long impacts = 0;
-        for (int a = 0; a < sc->ncontact; a++)
-            impacts += ref.impacts[a];
-        CHECK(ctx, rc == PD_OK && impacts > 10, "reference: %s (%ld impacts)", rc ? err.msg : "ok",
-              impacts);
+        rc = scene_reference(ctx, sc, 10, &ref);
         const pd_factor_kind kinds[2] = {PD_FACTOR_DENSE, PD_FACTOR_CHOLMOD};
         for (int k = 0; k < 2 && !rc; k++) {
             o.method = PD_METHOD_MOREAU;
