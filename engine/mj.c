@@ -57,9 +57,6 @@ double pd_contact_impulse_1(double D, double b)
     return b < 0.0 ? -b / D : 0.0; /* b >= 0: P = 0, w = b; else w = 0 */
 }
 
-/* W by columns (its nonzeros) and by rows (mj->inc), once for the drivers
- * that read it (the adaptive one, the yielding springs'): PD_OK, or
- * PD_ENOMEM (what was taken is freed with the object). */
 /* The pairs' form of the incidence when no contact acts on more than two
  * dofs (mj_inc_dot's two terms). */
 static int incidence_pairs(mj_incidence *in, int m)
@@ -78,6 +75,9 @@ static int incidence_pairs(mj_incidence *in, int m)
     return PD_OK;
 }
 
+/* W by columns (its nonzeros) and by rows (mj->inc), once for the drivers
+ * that read it (the adaptive one, the yielding springs'): PD_OK, or
+ * PD_ENOMEM (what was taken is freed with the object). */
 int mj_incidence_build(pd_mj *mj)
 {
     const pd_model *md = mj->model;

@@ -100,7 +100,8 @@ struct mj_adapt {
     double *Gs;        /* m: the free gap accelerations at the kept state, W^T a_free */
     double *D0;        /* m: sum_i W_ia^2 / M_ii, a unit impulse's change of gap rate */
     double *lam;       /* m: each held contact's force at the kept state (held_forces) */
-    int *push;         /* m: the contacts pushing at the kept state, increasing (keep) */
+    int *push;         /* m: the contacts pushing at the kept state, ad->cur once kept,
+                          increasing (keep; none after a reset) */
     int npush;         /* their number */
     double *dmem;      /* the block of the n- and m-arrays of doubles above */
     unsigned *umem;    /* the block of mark, evmark and timed */
@@ -1177,15 +1178,6 @@ static void add_held(const pd_mj *mj, double *acc)
     }
 }
 
-/* 1 when no contact pushed in the step that made x. */
-static int none_pushing(const pd_model *md, const snap *x)
-{
-    for (int a = 0; a < md->m; a++)
-        if (x->st.P[a] > 0.0)
-            return 0;
-    return 1;
-}
-
 /* The accelerations at x for the observers' quintic interpolation of the
  * step to it and of the next: the free motion's plus the held contacts'
  * forces (held_forces); where a piece's start ended the step, the left
@@ -1212,15 +1204,14 @@ static void step_accelerations(pd_mj *mj, snap *x)
         add_held(mj, x->st.acc);
 }
 
-/* Errors cross contacts: a contact that pushed in the step to x moves
- * each of its dofs by the others' motion (an impact exchanges their
- * momentum, a held contact makes them one body), so each takes the
- * largest estimate among them. */
-static void share_errors(pd_mj *mj, const snap *x)
+/* Errors cross contacts: a contact that pushed in the step to the kept
+ * state (ad->push) moves each of its dofs by the others' motion (an
+ * impact exchanges their momentum, a held contact makes them one body),
+ * so each takes the largest estimate among them. */
+static void share_errors(pd_mj *mj)
 {
     const mj_incidence *in = &mj->inc;
     mj_adapt *ad = mj->ad;
-    (void)x; /* its pushing contacts: ad->push */
     for (int r = 0; r < ad->npush; r++) {
         int a = ad->push[r];
         /* the largest E and S2 of the contact's dofs, to each */
@@ -1301,7 +1292,7 @@ static int keep(pd_mj *mj, const snap *w, snap *x, double f, int events, pd_obse
         /* sqrt(q^2 + (v/w)^2) */
         ad->amp[i] = pd_max(ad->amp[i], sqrt(x->st.q[i] * x->st.q[i] + vw * vw));
     }
-    share_errors(mj, x);
+    share_errors(mj);
     if (ad->F) /* the accelerations, for the observers' interpolation */
         step_accelerations(mj, x);
     /* the statistics, the reported err, the observer */
@@ -1574,7 +1565,7 @@ int mj_adapt_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx,
         /* exact flights: the rest of the way to t_end or a piece's start in one span
          * when a step of level k would cross it (the ladder's digits, not a walk) */
         if (ad->F && !have_one && k < ad->L && tick + level_ticks(ad, k) > limit &&
-            tick != no_span && none_pushing(md, ad->cur)) {
+            tick != no_span && ad->npush == 0) {
             if ((rc = exact_flight(mj, limit - tick, observer, ctx, &stop, err)) < 0)
                 return rc;
             if (rc == 1) {
@@ -1610,7 +1601,7 @@ int mj_adapt_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx,
         int budget = (double)ad->stats.evals >= mj->opts.max_evals;
         ad->stats.budget_hit |= budget;
         double H = ad->lev[k].h, h = ad->lev[k + 1].h;
-        if (ad->F && !have_one && none_pushing(md, ad->cur)) {
+        if (ad->F && !have_one && ad->npush == 0) {
             /* an exact flight: no error to control, so back to the coarsest step */
             if ((rc = exact_flight(mj, level_ticks(ad, k), observer, ctx, &stop, err)) < 0)
                 return rc;
@@ -1649,7 +1640,7 @@ int mj_adapt_run_until(pd_mj *mj, double t_end, pd_observer observer, void *ctx,
              * ADAPT_CLIMB a try while a contact pushes, 4 ADAPT_CLIMB else), never
              * above the observers' level k_flight */
             int top = ad->F ? flight_level(ad, ad->cur) : 0;
-            int climb = !ad->F ? 1 : none_pushing(md, ad->cur) ? 4 * ADAPT_CLIMB : ADAPT_CLIMB;
+            int climb = !ad->F ? 1 : ad->npush == 0 ? 4 * ADAPT_CLIMB : ADAPT_CLIMB;
             for (int up = 0; !event && k > top && up < climb && r * (ad->div + 1.0) <= ADAPT_GROW;
                  up++) {
                 k--;

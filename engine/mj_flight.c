@@ -537,8 +537,8 @@ static int forcing_frequency(const pd_piecewise_force *F, double *w, pd_err *err
     return PD_OK;
 }
 
-/* Rows of SDOFs (every block one dof): each dof's tables by pointer, the
- * forcing's states of a span's levels. */
+/* Rows of SDOFs (every block one dof): each dof's kind, the kinds' maps of
+ * a span and the forcing's states before its levels. */
 static int sdof_tables(const pd_model *md, mj_flight *fl, pd_err *err)
 {
     fl->sdofs = fl->nblocks == md->n;
@@ -740,9 +740,6 @@ static int sdof_column(const pd_mj *mj, int k, const double *minv, int a, int *r
     return nr;
 }
 
-/* D_II of the active set into mj->D_active (delassus: at level k, or with
- * M^-1 = diag(minv)): dense, or compressed columns with the contacts that
- * share a block (found through the dofs of each block a contact acts on). */
 /* The rows of the active contacts on the blocks contact a touches (the
  * nonzeros of its column of D), each once (stamps), into rows: their number. */
 static int column_rows(pd_mj *mj, int a, int *rows)
@@ -771,6 +768,10 @@ static int column_rows(pd_mj *mj, int a, int *rows)
     return nr;
 }
 
+/* D_II of the active set into mj->D_active (delassus: at level k, or with
+ * M^-1 = diag(minv)): dense, or compressed columns with the contacts that
+ * share a block (found through the dofs of each block a contact acts on;
+ * rows of SDOFs: sdof_column). */
 void mj_flight_delassus(pd_mj *mj, int k, const double *minv, int nI)
 {
     mj_flight *fl = mj->fl;
